@@ -1,0 +1,1 @@
+"""ccproof.algebra (see DESIGN.md section 1)."""

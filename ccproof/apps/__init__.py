@@ -1,0 +1,1 @@
+"""ccproof.apps (see DESIGN.md section 1)."""

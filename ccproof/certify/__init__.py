@@ -1,0 +1,1 @@
+"""ccproof.certify (see DESIGN.md section 1)."""

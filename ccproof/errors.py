@@ -1,0 +1,51 @@
+"""Exception types shared by every layer (imports nothing from ccproof)."""
+
+
+class CCProofError(ValueError):
+    """Base class of the errors ccproof raises for bad input."""
+
+
+class ValenceError(CCProofError):
+    """A valence that is not an integer >= 3."""
+
+
+class TableNotFoundError(CCProofError):
+    """A certified table that does not exist; the message lists the ones that do."""
+
+
+class MeshError(CCProofError):
+    """A mesh that is not a valid manifold quad mesh; the message names the element."""
+
+
+class CertificateError(CCProofError):
+    """A certificate file that is malformed or of an unknown schema."""
+
+
+def check_valence(k, *, minimum=3):
+    """Return ``k`` as a Python ``int`` after checking it is an integer valence >= ``minimum``.
+
+    >>> check_valence(5)
+    5
+    >>> check_valence(2)
+    Traceback (most recent call last):
+    ...
+    ccproof.errors.ValenceError: valence must be an integer >= 3, got 2
+    """
+    if isinstance(k, bool):
+        raise ValenceError(f"valence must be an integer >= {minimum}, got {k!r}")
+    try:
+        import numbers
+
+        if isinstance(k, numbers.Integral):
+            kk = int(k)
+        elif isinstance(k, numbers.Real) and k == k and float(k).is_integer():
+            kk = int(k)
+        elif isinstance(k, str) and k.strip().lstrip("+").isdigit():
+            kk = int(k)
+        else:
+            raise TypeError
+    except (TypeError, ValueError, OverflowError):
+        raise ValenceError(f"valence must be an integer >= {minimum}, got {k!r}") from None
+    if kk < minimum:
+        raise ValenceError(f"valence must be an integer >= {minimum}, got {k!r}")
+    return kk

@@ -1,0 +1,1 @@
+"""ccproof.evaluate (see DESIGN.md section 1)."""

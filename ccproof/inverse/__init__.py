@@ -1,0 +1,1 @@
+"""ccproof.inverse (see DESIGN.md section 1)."""

@@ -1,0 +1,1 @@
+"""ccproof.mesh (see DESIGN.md section 1)."""

@@ -1,0 +1,1 @@
+"""ccproof.reparam (see DESIGN.md section 1)."""

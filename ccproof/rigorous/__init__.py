@@ -1,0 +1,1 @@
+"""ccproof.rigorous (see DESIGN.md section 1)."""

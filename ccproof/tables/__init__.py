@@ -1,0 +1,1 @@
+"""ccproof.tables (see DESIGN.md section 1)."""
