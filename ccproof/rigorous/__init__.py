@@ -1,1 +1,48 @@
-"""ccproof.rigorous (see DESIGN.md section 1)."""
+"""Rigorous kernels: polynomials and Bernstein forms over ``fmpq`` (exact) and ``arb`` (balls).
+
+No Python float is used or accepted anywhere in this package; every number is an ``fmpq``,
+``fmpz`` or ``arb``.  Ball arithmetic runs at a precision carried by the objects (``prec``, bits)
+inside ``flint.ctx.workprec``; the global flint precision is never changed.
+
+Guarantees
+----------
+* Exact inputs (``prec is None``) give exact outputs: polynomial arithmetic, composition, affine
+  change of variables, Bernstein conversion, degree elevation, de Casteljau subdivision and
+  Bernstein products are computed in ``fmpq`` without rounding.
+* Ball inputs give ball outputs that *enclose* the exact result for every choice of real numbers
+  in the input balls (and for the exact rational basis-change matrices, which are enclosed in
+  ``arb`` at the working precision when they are not dyadic).
+* The Bernstein basis on a box is non-negative and a partition of unity, so
+  ``range_enclosure(bernstein_coefficients(p, box))`` brackets ``p`` on the whole box and
+  ``certainly_positive`` (every coefficient certainly > 0, finite) proves ``p > 0`` on it.
+
+Main entry points: :class:`Poly`, :func:`jacobian_determinant`, :func:`bernstein_coefficients`,
+:class:`BernsteinForm` (``split``, ``restrict``, ``elevate``, ``diff``, ``+ - *``),
+:func:`range_enclosure`, :func:`lower_bound`, :func:`certainly_positive`,
+:func:`bernstein_jacobian_determinant`.  See ``docs/rigorous.md``.
+"""
+
+from .bernstein import (
+    BernsteinForm,
+    bernstein_coefficients,
+    bernstein_jacobian_determinant,
+    certainly_positive,
+    exact_fmpq,
+    lower_bound,
+    range_enclosure,
+    unit_box,
+)
+from .poly import Poly, jacobian_determinant
+
+__all__ = [
+    "BernsteinForm",
+    "Poly",
+    "bernstein_coefficients",
+    "bernstein_jacobian_determinant",
+    "certainly_positive",
+    "exact_fmpq",
+    "jacobian_determinant",
+    "lower_bound",
+    "range_enclosure",
+    "unit_box",
+]

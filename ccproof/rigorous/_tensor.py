@@ -1,0 +1,218 @@
+"""Dense coefficient tensors shared by :mod:`.poly` and :mod:`.bernstein` (internal).
+
+A tensor is a flat Python list in row-major order together with its ``shape`` (a tuple of
+positive ints, one per variable).  Every entry is an ``fmpq`` (exact kind, ``prec is None``) or an
+``arb`` (ball kind, ``prec`` an int).  Arithmetic on balls always runs inside
+``flint.ctx.workprec(prec)``; the global precision is never changed.
+
+Exact rational matrices (basis changes) are built once as ``fmpq_mat`` and cached; for the ball
+kind they are converted to ``arb_mat`` at the working precision (which encloses each rational
+entry) and the product is flint's rigorous ``arb_mat`` product.
+"""
+
+from functools import lru_cache
+from math import prod
+
+import flint
+from flint import arb, arb_mat, arb_poly, fmpq, fmpq_mat, fmpq_poly, fmpz
+
+MAX_VARS = 4
+
+_ZERO = fmpq(0)
+
+
+def check_prec(prec):
+    """Return ``prec`` (``None`` or an int >= 2), else raise ``ValueError``."""
+    if prec is None:
+        return None
+    if isinstance(prec, bool) or not isinstance(prec, int) or prec < 2:
+        raise ValueError(f"precision must be an int >= 2 (bits) or None, got {prec!r}")
+    return prec
+
+
+def join_prec(p, q):
+    """Precision of a result combining kinds ``p`` and ``q`` (``None`` = exact)."""
+    if p is None:
+        return q
+    if q is None:
+        return p
+    return max(p, q)
+
+
+def exact_scalar(x):
+    """Coerce int/fmpz/fmpq/str (e.g. ``"1/3"``) to ``fmpq``; reject floats and the rest."""
+    if isinstance(x, fmpq):
+        return x
+    if isinstance(x, (int, fmpz)) and not isinstance(x, bool):
+        return fmpq(x)
+    if isinstance(x, str):
+        try:
+            return fmpq(x)
+        except (ValueError, TypeError):
+            pass
+        raise ValueError(f"not a rational number: {x!r}")
+    raise TypeError(
+        f"expected an exact number (int, fmpz, fmpq or 'p/q' string), got {type(x).__name__}"
+    )
+
+
+def scalar(x):
+    """Coerce a scalar to ``fmpq`` (exact) or keep an ``arb``; reject floats."""
+    if isinstance(x, arb):
+        return x
+    return exact_scalar(x)
+
+
+def to_kind(x, prec):
+    """``x`` (fmpq or arb) as an element of the kind ``prec`` (caller holds the workprec)."""
+    if prec is None:
+        if isinstance(x, arb):
+            raise TypeError("cannot convert an arb ball to an exact fmpq coefficient")
+        return x
+    return x if isinstance(x, arb) else arb(x)
+
+
+def convert(coeffs, prec):
+    """Coefficients converted to kind ``prec`` (exact fmpq -> arb balls at ``prec`` bits)."""
+    if prec is None:
+        return [to_kind(c, None) for c in coeffs]
+    with flint.ctx.workprec(prec):
+        return [c if isinstance(c, arb) else arb(c) for c in coeffs]
+
+
+def zero(prec):
+    return _ZERO if prec is None else arb(0)
+
+
+def size(shape):
+    return prod(shape)
+
+
+# ---------------------------------------------------------------------------- matrices
+
+
+def to_matrix(mat, prec):
+    """The exact ``fmpq_mat`` ``mat`` for kind ``prec``: itself, or an enclosing ``arb_mat``."""
+    if prec is None:
+        return mat
+    return _arb_matrix(mat, prec)
+
+
+_ARB_MATS = {}
+
+
+def _arb_matrix(mat, prec):
+    # fmpq_mat is unhashable: key on identity, keeping ``mat`` alive in the entry so that its id
+    # cannot be reused while the entry exists.  The exact matrices come from lru_caches, so the
+    # same object recurs for the same basis change.
+    key = (id(mat), prec)
+    hit = _ARB_MATS.get(key)
+    if hit is not None and hit[0] is mat:
+        return hit[1]
+    with flint.ctx.workprec(prec):
+        out = arb_mat(mat)
+    if len(_ARB_MATS) > 4096:
+        _ARB_MATS.clear()
+    _ARB_MATS[key] = (mat, out)
+    return out
+
+
+def apply_along_axis(coeffs, shape, axis, mat, prec):
+    """Multiply the tensor by the exact matrix ``mat`` (m x shape[axis]) along ``axis``.
+
+    Returns ``(coeffs, shape)`` with ``shape[axis]`` replaced by ``m``.
+    """
+    n = shape[axis]
+    m = mat.nrows()
+    if mat.ncols() != n:
+        raise ValueError(f"matrix with {mat.ncols()} columns applied to an axis of length {n}")
+    pre = prod(shape[:axis])
+    post = prod(shape[axis + 1 :])
+    rest = pre * post
+    # X[i, p*post + q] = c[(p*n + i)*post + q]
+    x = [coeffs[(p * n + i) * post + q] for i in range(n) for p in range(pre) for q in range(post)]
+    if prec is None:
+        y = (mat * fmpq_mat(n, rest, x)).entries()
+    else:
+        with flint.ctx.workprec(prec):
+            y = (_arb_matrix(mat, prec) * arb_mat(n, rest, x)).entries()
+    out = [y[j * rest + p * post + q] for p in range(pre) for j in range(m) for q in range(post)]
+    new_shape = shape[:axis] + (m,) + shape[axis + 1 :]
+    return out, new_shape
+
+
+def multiply(a, a_shape, b, b_shape, prec):
+    """Product of two dense polynomial tensors (Kronecker substitution, one flint product).
+
+    The exponent tuple ``e`` of either factor is sent to ``sum e_i * S_i`` with ``S`` the
+    row-major strides of the product's shape; exponents of the product never exceed that shape,
+    so the univariate product's coefficients are exactly the product tensor's coefficients.
+    """
+    shape = tuple(p + q - 1 for p, q in zip(a_shape, b_shape))
+    strides = _strides(shape)
+    total = size(shape)
+    pa = _embed(a, a_shape, strides, prec)
+    pb = _embed(b, b_shape, strides, prec)
+    if prec is None:
+        c = (fmpq_poly(pa) * fmpq_poly(pb)).coeffs()
+    else:
+        with flint.ctx.workprec(prec):
+            c = (arb_poly(pa) * arb_poly(pb)).coeffs()
+    z = zero(prec)
+    if len(c) < total:
+        c = list(c) + [z] * (total - len(c))
+    elif len(c) > total:  # cannot happen; guard the invariant
+        raise AssertionError("Kronecker product longer than its shape")
+    return list(c), shape
+
+
+def _strides(shape):
+    s = [1] * len(shape)
+    for i in range(len(shape) - 2, -1, -1):
+        s[i] = s[i + 1] * shape[i + 1]
+    return tuple(s)
+
+
+def _embed(coeffs, shape, strides, prec):
+    idx = embed_indices(shape, strides)
+    out = [zero(prec)] * (idx[-1] + 1)
+    for c, i in zip(coeffs, idx):
+        out[i] = c
+    return out
+
+
+@lru_cache(maxsize=1024)
+def embed_indices(shape, strides):
+    """Positions of the row-major entries of ``shape`` under ``strides``."""
+    idx = [0]
+    for n, s in zip(shape, strides):
+        idx = [i + k * s for i in idx for k in range(n)]
+    return tuple(idx)
+
+
+def multi_indices(shape):
+    """All exponent tuples of ``shape`` in row-major order."""
+    out = [()]
+    for n in shape:
+        out = [e + (k,) for e in out for k in range(n)]
+    return out
+
+
+def weights(shape, per_axis):
+    """Row-major tensor of ``prod_i per_axis[i][e_i]`` (exact)."""
+    out = [fmpz(1)]
+    for n, w in zip(shape, per_axis):
+        out = [x * w[k] for x in out for k in range(n)]
+    return out
+
+
+def pad(coeffs, shape, new_shape, prec):
+    """Zero-pad a tensor to a larger shape (same number of axes)."""
+    if shape == new_shape:
+        return list(coeffs)
+    z = zero(prec)
+    out = [z] * size(new_shape)
+    idx = embed_indices(shape, _strides(new_shape))
+    for c, i in zip(coeffs, idx):
+        out[i] = c
+    return out

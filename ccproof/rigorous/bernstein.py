@@ -1,0 +1,467 @@
+"""Tensor-product Bernstein forms on boxes, de Casteljau subdivision and range enclosure.
+
+A :class:`BernsteinForm` of degrees ``(n_0, ..., n_{d-1})`` on the box ``B = prod [lo_i, hi_i]``
+(exact rational endpoints) stands for
+
+    f(x) = sum_k b[k] prod_i C(n_i, k_i) t_i^k_i (1 - t_i)^(n_i - k_i),   t_i = (x_i - lo_i) / (hi_i - lo_i).
+
+Since the basis functions are non-negative and sum to one on ``B``, ``min b <= f <= max b`` there
+(:func:`range_enclosure`, :func:`certainly_positive`).  Coefficients are all ``fmpq`` (exact) or
+all ``arb``; in the ball case every returned coefficient encloses the exact coefficient for every
+choice of real inputs in the input balls.
+
+>>> from ccproof.rigorous.poly import Poly
+>>> x, y = Poly.variable(0, 2), Poly.variable(1, 2)
+>>> f = bernstein_coefficients(x * y - x / 4 + 1, box=[(0, 1), (0, 1)])
+>>> f.coeffs
+[1, 1, 3/4, 7/4]
+>>> left, right = f.split(0)
+>>> left.box[0], left.coeffs
+((0, 1/2), [1, 1, 7/8, 11/8])
+>>> range_enclosure(f), certainly_positive(f)
+((3/4, 7/4), True)
+"""
+
+from math import comb
+
+import flint
+from flint import arb, fmpq, fmpq_mat, fmpz
+
+from . import _tensor as T
+from .poly import Poly, _det, check_box, taylor_shift_matrix
+
+_HALF = fmpq(1, 2)
+
+
+class BernsteinForm:
+    """Bernstein coefficients ``coeffs`` (row-major, shape ``degrees + 1``) of a polynomial on ``box``.
+
+    Build one with :func:`bernstein_coefficients`; the constructor does no conversion.
+    """
+
+    __slots__ = ("shape", "coeffs", "box", "prec")
+
+    def __init__(self, shape, coeffs, box=None, prec=None):
+        shape = tuple(shape)
+        if not 1 <= len(shape) <= T.MAX_VARS or any(
+            isinstance(n, bool) or not isinstance(n, int) or n < 1 for n in shape
+        ):
+            raise ValueError(f"bad shape {shape!r}")
+        coeffs = list(coeffs)
+        if len(coeffs) != T.size(shape):
+            raise ValueError(f"{len(coeffs)} coefficients for shape {shape}")
+        prec = T.check_prec(prec)
+        coeffs = [T.scalar(c) for c in coeffs]
+        if prec is None and any(isinstance(c, arb) for c in coeffs):
+            raise TypeError("arb coefficient in an exact Bernstein form: pass prec=...")
+        self.shape = shape
+        self.coeffs = T.convert(coeffs, prec)
+        self.box = unit_box(len(shape)) if box is None else check_box(box, len(shape))
+        self.prec = prec
+
+    @classmethod
+    def _raw(cls, shape, coeffs, box, prec):
+        f = object.__new__(cls)
+        f.shape, f.coeffs, f.box, f.prec = tuple(shape), coeffs, box, prec
+        return f
+
+    @property
+    def nvars(self):
+        return len(self.shape)
+
+    @property
+    def degrees(self):
+        return tuple(n - 1 for n in self.shape)
+
+    @property
+    def is_exact(self):
+        return self.prec is None
+
+    def __repr__(self):
+        kind = "exact" if self.prec is None else f"arb {self.prec} bits"
+        box = " x ".join(f"[{lo}, {hi}]" for lo, hi in self.box)
+        return f"BernsteinForm({kind}, degrees={self.degrees}, box={box})"
+
+    def to_arb(self, prec):
+        """Ball version at ``prec`` bits."""
+        if T.check_prec(prec) is None:
+            raise ValueError("to_arb needs a precision in bits")
+        return BernsteinForm._raw(self.shape, T.convert(self.coeffs, prec), self.box, prec)
+
+    # ------------------------------------------------------------------ subdivision
+
+    def split(self, axis, t=_HALF):
+        """De Casteljau split of ``box`` along ``axis`` at fraction ``t`` (default 1/2): ``(low, high)``.
+
+        With the default ``t = 1/2`` the sub-boxes of a dyadic box are dyadic and the matrices are
+        dyadic (exact in ``arb``); the result is exact for exact input.
+        """
+        axis = self._axis(axis)
+        t = T.exact_scalar(t)
+        if not 0 < t < 1:
+            raise ValueError(f"split fraction must lie in (0, 1), got {t}")
+        n = self.shape[axis] - 1
+        lo, hi = self.box[axis]
+        mid = lo + (hi - lo) * t
+        low = self._along(axis, split_matrix(n, t, 0), (lo, mid))
+        high = self._along(axis, split_matrix(n, t, 1), (mid, hi))
+        return low, high
+
+    def restrict(self, box):
+        """Bernstein form of the same polynomial on a sub-box ``box`` of ``self.box``."""
+        box = check_box(box, self.nvars)
+        f = self
+        for axis, ((lo, hi), (a, b)) in enumerate(zip(self.box, box)):
+            if (a, b) == (lo, hi):
+                continue
+            if a < lo or b > hi:
+                raise ValueError(f"[{a}, {b}] is not inside [{lo}, {hi}] (axis {axis})")
+            h = hi - lo
+            f = f._along(axis, restrict_matrix(f.shape[axis] - 1, (a - lo) / h, (b - lo) / h), (a, b))
+        return f
+
+    def elevate(self, degrees):
+        """Same polynomial in the Bernstein basis of higher ``degrees`` (per variable)."""
+        degrees = tuple(degrees)
+        if len(degrees) != self.nvars or any(d < n - 1 for d, n in zip(degrees, self.shape)):
+            raise ValueError(f"cannot elevate degrees {self.degrees} to {degrees}")
+        f = self
+        for axis, d in enumerate(degrees):
+            if d != f.shape[axis] - 1:
+                f = f._along(axis, elevation_matrix(f.shape[axis] - 1, d), self.box[axis])
+        return f
+
+    def diff(self, axis):
+        """Bernstein form (degree one less along ``axis``) of the partial derivative on the box."""
+        axis = self._axis(axis)
+        n = self.shape[axis] - 1
+        lo, hi = self.box[axis]
+        return self._along(axis, derivative_matrix(n, hi - lo), self.box[axis])
+
+    def to_poly(self):
+        """The polynomial in the original (box) variables, in the power basis."""
+        c, shape = self.coeffs, self.shape
+        for axis in range(self.nvars):
+            c, shape = T.apply_along_axis(
+                c, shape, axis, bernstein_to_power_matrix(shape[axis] - 1), self.prec
+            )
+        p = Poly._raw(shape, c, self.prec)
+        for axis, (lo, hi) in enumerate(self.box):
+            if (lo, hi) != (0, 1):
+                h = hi - lo
+                p = p.affine(axis, -lo / h, (1 - lo) / h)  # t = (x - lo) / h
+        return p
+
+    def _along(self, axis, mat, interval):
+        c, shape = T.apply_along_axis(self.coeffs, self.shape, axis, mat, self.prec)
+        box = self.box[:axis] + (interval,) + self.box[axis + 1 :]
+        return BernsteinForm._raw(shape, c, box, self.prec)
+
+    def _axis(self, axis):
+        if isinstance(axis, bool) or not isinstance(axis, int) or not 0 <= axis < self.nvars:
+            raise ValueError(f"axis {axis!r} out of range for {self.nvars} variables")
+        return axis
+
+    # ------------------------------------------------------------------ arithmetic (same box)
+
+    def _common(self, other):
+        if not isinstance(other, BernsteinForm):
+            raise TypeError(f"expected a BernsteinForm, got {type(other).__name__}")
+        if other.box != self.box:
+            raise ValueError(f"Bernstein forms on different boxes: {self.box} and {other.box}")
+        prec = T.join_prec(self.prec, other.prec)
+        degrees = tuple(max(p, q) - 1 for p, q in zip(self.shape, other.shape))
+        a, b = self.elevate(degrees), other.elevate(degrees)
+        return T.convert(a.coeffs, prec), T.convert(b.coeffs, prec), a.shape, prec
+
+    def __add__(self, other):
+        if not isinstance(other, BernsteinForm):
+            return self._shift(T.scalar(other), 1)
+        a, b, shape, prec = self._common(other)
+        with flint.ctx.workprec(prec or flint.ctx.prec):
+            return BernsteinForm._raw(shape, [x + y for x, y in zip(a, b)], self.box, prec)
+
+    __radd__ = __add__
+
+    def __sub__(self, other):
+        if not isinstance(other, BernsteinForm):
+            return self._shift(T.scalar(other), -1)
+        a, b, shape, prec = self._common(other)
+        with flint.ctx.workprec(prec or flint.ctx.prec):
+            return BernsteinForm._raw(shape, [x - y for x, y in zip(a, b)], self.box, prec)
+
+    def __rsub__(self, other):
+        return (-self)._shift(T.scalar(other), 1)
+
+    def __neg__(self):
+        return BernsteinForm._raw(self.shape, [-c for c in self.coeffs], self.box, self.prec)
+
+    def _shift(self, c, sign):
+        # adding a constant adds it to every coefficient (partition of unity)
+        self._check_scalar_kind(c)
+        with flint.ctx.workprec(self.prec or flint.ctx.prec):
+            out = [x + c for x in self.coeffs] if sign > 0 else [x - c for x in self.coeffs]
+        return BernsteinForm._raw(self.shape, out, self.box, self.prec)
+
+    def _check_scalar_kind(self, c):
+        if isinstance(c, arb) and self.prec is None:
+            raise TypeError("arb scalar with an exact Bernstein form: convert it with .to_arb(prec)")
+
+    def __mul__(self, other):
+        """Product on the same box, of degree ``m + n``, computed in Bernstein form.
+
+        With ``a~_i = C(m, i) a_i`` (coefficients in the basis t^i (1-t)^(m-i)), the product's
+        scaled coefficients are the plain convolution of ``a~`` and ``b~``; divide by C(m+n, k).
+        """
+        if not isinstance(other, BernsteinForm):
+            c = T.scalar(other)
+            self._check_scalar_kind(c)
+            with flint.ctx.workprec(self.prec or flint.ctx.prec):
+                return BernsteinForm._raw(self.shape, [x * c for x in self.coeffs], self.box, self.prec)
+        if other.box != self.box:
+            raise ValueError(f"Bernstein forms on different boxes: {self.box} and {other.box}")
+        prec = T.join_prec(self.prec, other.prec)
+        wa = T.weights(self.shape, [_binomials(n - 1) for n in self.shape])
+        wb = T.weights(other.shape, [_binomials(n - 1) for n in other.shape])
+        with flint.ctx.workprec(prec or flint.ctx.prec):
+            a = [c * w for c, w in zip(T.convert(self.coeffs, prec), wa)]
+            b = [c * w for c, w in zip(T.convert(other.coeffs, prec), wb)]
+        c, shape = T.multiply(a, self.shape, b, other.shape, prec)
+        wc = T.weights(shape, [_binomials(n - 1) for n in shape])
+        with flint.ctx.workprec(prec or flint.ctx.prec):
+            c = [x / w for x, w in zip(c, wc)]
+        return BernsteinForm._raw(shape, c, self.box, prec)
+
+    __rmul__ = __mul__
+
+    def __truediv__(self, c):
+        """Division by a non-zero scalar."""
+        c = T.scalar(c)
+        self._check_scalar_kind(c)
+        if isinstance(c, fmpq):
+            if c == 0:
+                raise ZeroDivisionError("Bernstein form divided by zero")
+            return self * (1 / c)
+        with flint.ctx.workprec(self.prec):
+            return BernsteinForm._raw(self.shape, [x / c for x in self.coeffs], self.box, self.prec)
+
+
+# ---------------------------------------------------------------------------- conversion
+
+
+def unit_box(nvars):
+    return ((fmpq(0), fmpq(1)),) * nvars
+
+
+def bernstein_coefficients(poly, box=None, degrees=None):
+    """Bernstein form of ``poly`` on ``box`` (default [0,1]^n) of ``degrees`` (default ``poly.degrees``).
+
+    Per variable, one exact matrix (Taylor shift to the box, then power -> Bernstein basis with
+    degree elevation) is applied along the axis; exact input gives exact ``fmpq`` coefficients,
+    ball input gives balls at ``poly.prec``.  For tight balls on small sub-boxes prefer converting
+    once on a large box and then using :meth:`BernsteinForm.split` / :meth:`BernsteinForm.restrict`
+    (both numerically stable) over re-expanding the power form on each sub-box.
+    """
+    if not isinstance(poly, Poly):
+        raise TypeError(f"expected a Poly, got {type(poly).__name__}")
+    box = unit_box(poly.nvars) if box is None else check_box(box, poly.nvars)
+    degrees = poly.degrees if degrees is None else tuple(degrees)
+    if len(degrees) != poly.nvars or any(
+        isinstance(d, bool) or not isinstance(d, int) or d < n for d, n in zip(degrees, poly.degrees)
+    ):
+        raise ValueError(f"Bernstein degrees {degrees} below the polynomial's degrees {poly.degrees}")
+    c, shape = poly.coeffs, poly.shape
+    for axis, ((lo, hi), d) in enumerate(zip(box, degrees)):
+        c, shape = T.apply_along_axis(
+            c, shape, axis, _conversion_matrix(shape[axis] - 1, d, lo, hi), poly.prec
+        )
+    return BernsteinForm._raw(shape, c, box, poly.prec)
+
+
+def range_enclosure(form):
+    """``(lo, hi)`` with ``lo <= f <= hi`` on the box: min and max of the coefficients.
+
+    Exact forms give ``fmpq``; ball forms give zero-radius ``arb`` endpoints rounded outward
+    (``lo`` = min of the balls' lower endpoints, ``hi`` = max of upper endpoints); a NaN
+    coefficient gives ``(-inf, +inf)``.  Also accepts a plain list of coefficients.
+    """
+    coeffs = _coefficients(form)
+    if not coeffs:
+        raise ValueError("no coefficients")
+    if all(isinstance(c, fmpq) for c in coeffs):
+        return min(coeffs), max(coeffs)
+    balls = [c if isinstance(c, arb) else None for c in coeffs]
+    if any(b is None for b in balls):
+        raise TypeError("mixed exact and ball coefficients")
+    if any(b.is_nan() for b in balls):
+        return arb.neg_inf(), arb.pos_inf()
+    lows = [b.lower() for b in balls]
+    highs = [b.upper() for b in balls]
+    # endpoints are exact (radius 0), so ``<`` is a total order on them (including +-inf)
+    lo = lows[0]
+    for x in lows[1:]:
+        if x < lo:
+            lo = x
+    hi = highs[0]
+    for x in highs[1:]:
+        if x > hi:
+            hi = x
+    return lo, hi
+
+
+def lower_bound(form):
+    """Lower end of :func:`range_enclosure` as an exact ``fmpq`` (``None`` if it is -inf/NaN).
+
+    >>> lower_bound([arb(1) / 3, arb(2)]) < fmpq(1, 3)
+    True
+    """
+    lo = range_enclosure(form)[0]
+    if isinstance(lo, fmpq):
+        return lo
+    return exact_fmpq(lo)
+
+
+def exact_fmpq(x):
+    """The exact rational value of a zero-radius finite ``arb`` (e.g. an endpoint); else ``None``."""
+    if not x.is_finite() or not x.is_exact():
+        return None
+    man, exp = x.man_exp()
+    return fmpq(man) * fmpq(2) ** int(exp)
+
+
+def certainly_positive(form):
+    """True only when every coefficient is certainly > 0 (so the polynomial is > 0 on the box).
+
+    Exact ``fmpq`` coefficients are compared exactly; ``arb`` balls with arb's ``>`` (True only when
+    the whole ball is > 0) and must be finite.  Accepts a form, a list of coefficients or one number.
+
+    >>> certainly_positive([arb(1), arb("0 +/- 0.1")]), certainly_positive(arb("nan"))
+    (False, False)
+    """
+    coeffs = _coefficients(form)
+    for c in coeffs:
+        if isinstance(c, arb):
+            if not (c.is_finite() and c > 0):
+                return False
+        elif not T.exact_scalar(c) > 0:
+            return False
+    return bool(coeffs)
+
+
+def bernstein_jacobian_determinant(forms, axes=None):
+    """Bernstein form of det(d forms[i] / d x_axes[j]) on the forms' common box, in Bernstein arithmetic."""
+    forms = list(forms)
+    n = len(forms)
+    axes = tuple(range(n)) if axes is None else tuple(axes)
+    if not 1 <= n <= T.MAX_VARS or len(axes) != n or len(set(axes)) != n:
+        raise ValueError(f"{n} components with axes {axes!r}")
+    jac = [[f.diff(a) for a in axes] for f in forms]
+    return _det(jac)
+
+
+def _coefficients(form):
+    if isinstance(form, BernsteinForm):
+        return form.coeffs
+    if isinstance(form, (arb, fmpq, fmpz, int)) and not isinstance(form, bool):
+        return [form]
+    return list(form)
+
+
+# ---------------------------------------------------------------------------- exact matrices
+
+_CACHE = {}
+
+
+def _cached(key, build):
+    mat = _CACHE.get(key)
+    if mat is None:
+        mat = build()
+        if len(_CACHE) > 8192:
+            _CACHE.clear()
+        _CACHE[key] = mat
+    return mat
+
+
+def _matrix(rows, cols, entry):
+    return fmpq_mat(rows, cols, [entry(i, j) for i in range(rows) for j in range(cols)])
+
+
+def _binomials(n):
+    return [fmpz(comb(n, i)) for i in range(n + 1)]
+
+
+def power_to_bernstein_matrix(n, d):
+    """(d+1) x (n+1): power coefficients of degree n -> Bernstein coefficients of degree d >= n on [0,1]."""
+    return _cached(
+        ("p2b", n, d),
+        lambda: _matrix(d + 1, n + 1, lambda k, i: fmpq(comb(k, i), comb(d, i))),
+    )
+
+
+def bernstein_to_power_matrix(n):
+    """(n+1) x (n+1): Bernstein coefficients of degree n on [0,1] -> power coefficients."""
+    return _cached(
+        ("b2p", n),
+        lambda: _matrix(n + 1, n + 1, lambda i, k: fmpq((-1) ** (i - k) * comb(n, i) * comb(i, k))),
+    )
+
+
+def elevation_matrix(n, d):
+    """(d+1) x (n+1): Bernstein degree elevation n -> d."""
+    return _cached(
+        ("elev", n, d),
+        lambda: _matrix(d + 1, n + 1, lambda k, i: fmpq(comb(n, i) * comb(d - n, k - i), comb(d, k))),
+    )
+
+
+def split_matrix(n, t, side):
+    """De Casteljau at ``t``: side 0 gives the coefficients on [0, t], side 1 on [t, 1]."""
+    s = 1 - t
+    if side == 0:  # b'_i = sum_j C(i, j) t^j s^(i-j) b_j
+        return _cached(
+            ("split", n, t, 0),
+            lambda: _matrix(
+                n + 1, n + 1, lambda i, j: comb(i, j) * t**j * s ** (i - j) if j <= i else fmpq(0)
+            ),
+        )
+    # b'_i = sum_j C(n-i, j-i) t^(n-j) s^(j-i) b_j
+    return _cached(
+        ("split", n, t, 1),
+        lambda: _matrix(
+            n + 1,
+            n + 1,
+            lambda i, j: comb(n - i, j - i) * t ** (n - j) * s ** (j - i) if j >= i else fmpq(0),
+        ),
+    )
+
+
+def restrict_matrix(n, a, b):
+    """Bernstein coefficients on [0,1] -> on [a, b] (0 <= a < b <= 1, exact)."""
+
+    def build():
+        mat = split_matrix(n, b, 0) if b < 1 else None
+        if a > 0:
+            right = split_matrix(n, a / b, 1)
+            mat = right if mat is None else right * mat
+        return mat if mat is not None else _matrix(n + 1, n + 1, lambda i, j: fmpq(int(i == j)))
+
+    return _cached(("restrict", n, a, b), build)
+
+
+def derivative_matrix(n, h):
+    """n x (n+1) (1 x 1 zero when n = 0): Bernstein coefficients of f' for an interval of width h."""
+    if n == 0:
+        return _cached(("diff", 0), lambda: fmpq_mat(1, 1, [0]))
+    return _cached(
+        ("diff", n, h),
+        lambda: _matrix(n, n + 1, lambda i, j: n / h if j == i + 1 else -n / h if j == i else fmpq(0)),
+    )
+
+
+def _conversion_matrix(n, d, lo, hi):
+    if (lo, hi) == (0, 1):
+        return power_to_bernstein_matrix(n, d)
+    return _cached(
+        ("conv", n, d, lo, hi),
+        lambda: power_to_bernstein_matrix(n, d) * taylor_shift_matrix(n, lo, hi - lo),
+    )
