@@ -1,0 +1,185 @@
+"""Specialize the symbolic characteristic map to a valence: exact, arb ball, arb interval, float.
+
+The nets of :mod:`ccproof.algebra.characteristic_map` are derived once with c = cos(2 pi/k)
+symbolic; here c (and lam, R2) get values:
+
+* ``"exact"``: sympy numbers, c = cos(2 pi/k) and lam = (5 + c + sqrt((1+c)(9+c)))/16 exactly;
+* ``"arb"``: python-flint balls at ``prec`` bits (outward rounded: each ball contains the exact value);
+* ``"float"``: Python floats (from the arb ball's midpoint; for numerics only, never for proofs);
+* an *interval* of valences k >= k0 (:func:`valence_interval`): c in [cos(2 pi/k0), 1] and lam in
+  [lam(k0), lam(infinity)] as arb balls. The nets evaluated there are enclosures valid for every
+  k >= k0 (the union over k of the exact nets lies inside them).
+"""
+
+from __future__ import annotations
+
+from ccproof.algebra.field import eval_integer_form, subdominant_lam_sympy
+from ccproof.errors import CCProofError, check_valence
+
+ARITHMETICS = ("exact", "arb", "float")
+
+
+def _check_arithmetic(arithmetic):
+    if arithmetic not in ARITHMETICS:
+        raise CCProofError(f"unknown arithmetic {arithmetic!r}; choose one of {', '.join(ARITHMETICS)}")
+
+
+def _check_prec(prec):
+    if not isinstance(prec, int) or prec < 16:
+        raise CCProofError(f"precision must be an integer number of bits >= 16, got {prec!r}")
+
+
+def cos_2pi_over_k(k, arithmetic="arb", prec=128):
+    """c = cos(2 pi / k) (R2, R3).
+
+    >>> cos_2pi_over_k(6, "exact")
+    1/2
+    >>> cos_2pi_over_k(4, "arb", 64)
+    0
+    """
+    k = check_valence(k)
+    _check_arithmetic(arithmetic)
+    if arithmetic == "exact":
+        from sympy import cos, pi
+
+        return cos(2 * pi / k)
+    _check_prec(prec)
+    from flint import arb, ctx, fmpq
+
+    with ctx.workprec(prec):
+        c = arb(fmpq(2, k)).cos_pi()
+    return c if arithmetic == "arb" else float(c.mid())
+
+
+def _lam_from_c_arb(c):
+    return (5 + c + ((1 + c) * (9 + c)).sqrt()) / 16
+
+
+def subdominant_eigenvalue(k, arithmetic="arb", prec=128):
+    """Subdominant eigenvalue lam(k) = (5 + c + sqrt((1+c)(9+c)))/16, c = cos(2 pi/k) (R2).
+
+    The larger root of 16 L^2 - 2(5 + c) L + 1 = 0; the double eigenvalue lam_1 = lam_2 of the
+    Catmull-Clark subdivision matrix of valence k (bmz04 section 3, Definition 4).
+
+    >>> subdominant_eigenvalue(4, "exact")
+    1/2
+    >>> subdominant_eigenvalue(3, "exact")
+    sqrt(17)/32 + 9/32
+    """
+    k = check_valence(k)
+    _check_arithmetic(arithmetic)
+    if arithmetic == "exact":
+        from sympy import expand, radsimp
+
+        return expand(radsimp(subdominant_lam_sympy(cos_2pi_over_k(k, "exact"))))
+    _check_prec(prec)
+    from flint import ctx
+
+    with ctx.workprec(prec + 10):
+        lam = _lam_from_c_arb(cos_2pi_over_k(k, "arb", prec + 10))
+    with ctx.workprec(prec):
+        lam = +lam
+    return lam if arithmetic == "arb" else float(lam.mid())
+
+
+def valence_interval(k0, prec=128):
+    """Balls ``(c, lam)`` enclosing c = cos(2 pi/k) and lam(k) for every integer k >= k0 (R10).
+
+    c ranges over [cos(2 pi/k0), 1] and lam, increasing in c, over [lam(k0), (3 + sqrt 5)/8].
+    """
+    k0 = check_valence(k0)
+    _check_prec(prec)
+    from flint import arb, ctx
+
+    with ctx.workprec(prec):
+        c_lo = cos_2pi_over_k(k0, "arb", prec)
+        c = c_lo.union(arb(1))
+        lam = _lam_from_c_arb(c_lo).union((3 + arb(5).sqrt()) / 8)
+    return c, lam
+
+
+def specialize(element_form, k, arithmetic="arb", prec=128):
+    """Value of an integer form ``(A, B, D)`` (see :meth:`QcLam.integer_form`) at valence k.
+
+    ``k`` may be an int or the string ``">=K0"`` for the interval of valences k >= K0.
+    """
+    values = _field_values(k, arithmetic, prec)
+    return _eval(element_form, values, arithmetic, prec)
+
+
+def _field_values(k, arithmetic, prec):
+    _check_arithmetic(arithmetic)
+    if isinstance(k, str) and k.startswith(">="):
+        if arithmetic != "arb":
+            raise CCProofError("an interval of valences can only be specialized in 'arb' arithmetic")
+        return valence_interval(int(k[2:]), prec)
+    if arithmetic == "exact":
+        c = cos_2pi_over_k(k, "exact")
+        return c, subdominant_lam_sympy(c)
+    return cos_2pi_over_k(k, "arb", prec + 20), subdominant_eigenvalue(k, "arb", prec + 20)
+
+
+def _eval(form, values, arithmetic, prec):
+    c, lam = values
+    if arithmetic == "exact":
+        from sympy import Integer
+
+        return eval_integer_form([[Integer(x) for x in p] for p in form], c, lam)
+    from flint import ctx
+
+    with ctx.workprec(prec + 20):
+        val = eval_integer_form(form, c, lam)
+    with ctx.workprec(prec):
+        val = +val
+    return val if arithmetic == "arb" else float(val.mid())
+
+
+def characteristic_map_patches(k, form="bezier", arithmetic="arb", prec=128):
+    """Control nets of the three bicubic layer-0 pieces P1, P2, P3 of the characteristic map of
+    valence k in the normalized frame (bmz04 section 4.3, Fig. 3; DESIGN.md R3, R4).
+
+    Parameters
+    ----------
+    k : int or str
+        Valence k >= 3, or ``">=K0"`` for enclosures valid for every valence k >= K0 (arb only).
+    form : {"bezier", "bspline"}
+        Bezier net of each piece on its domain, or its uniform cubic B-spline net.
+    arithmetic : {"exact", "arb", "float"}
+    prec : int
+        Bits of precision of the arb result.
+
+    Returns
+    -------
+    dict
+        ``{"P1": net, "P2": net, "P3": net}`` where ``net[i][j] = (x, y)``, i, j = 0..3, index i
+        along the local parameter s (the face's u), j along t (v). Domains: P1 on [1/2,1]x[0,1/2],
+        P2 on [1/2,1]^2, P3 on [0,1/2]x[1/2,1], with s = 2u - 1 or 2u, t = 2v or 2v - 1.
+
+    >>> nets = characteristic_map_patches(4, "bezier", "exact")
+    >>> nets["P2"][3][3]        # k = 4 is the identity map: P2(1, 1) = (1, 1)
+    (1, 1)
+    """
+    from ccproof.algebra.characteristic_map import symbolic_bezier_nets, symbolic_bspline_nets
+
+    if not (isinstance(k, str) and k.startswith(">=")):
+        k = check_valence(k)
+    if form not in ("bezier", "bspline"):
+        raise CCProofError(f"unknown net form {form!r}; use 'bezier' or 'bspline'")
+    sym = symbolic_bezier_nets() if form == "bezier" else symbolic_bspline_nets()
+    values = _field_values(k, arithmetic, prec)
+    out = {}
+    for name, net in sym.items():
+        out[name] = [
+            [tuple(_simplify(_eval(x.integer_form(), values, arithmetic, prec), arithmetic) for x in p)
+             for p in row]
+            for row in net
+        ]
+    return out
+
+
+def _simplify(val, arithmetic):
+    if arithmetic == "exact":
+        from sympy import expand, radsimp
+
+        return expand(radsimp(val))
+    return val
