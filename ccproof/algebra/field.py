@@ -161,7 +161,8 @@ class QcLam:
 
         lam = sympify("lam")
         cval = 8 * lam + Rational(1, 2) / lam - 5
-        return cancel(self.a.as_expr().subs(sympify("c"), cval) + self.b.as_expr().subs(sympify("c"), cval) * lam)
+        csym = sympify("c")
+        return cancel(self.a.as_expr().subs(csym, cval) + self.b.as_expr().subs(csym, cval) * lam)
 
 
 def integer_form_string(form):

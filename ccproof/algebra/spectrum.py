@@ -7,12 +7,12 @@ whose characteristic polynomial, computed symbolically once (see docs/readings.m
     mode m != 0:  (8x-1)(16x-1)(32x-1)(64x-1) (16x^2 - 2(5 + c_m) x + 1),   c_m = cos(2 pi m/k)
     mode m == 0:  (x-1)(8x-1)(16x-1)(32x-1)(64x-1) (16k x^2 - (12k - 28) x + k - 3)   (7x7, with centre)
 
-Hence (:func:`charpoly_product_formula`), with y = (16x^2 - 10x + 1)/(2x) and the Chebyshev identity
-prod_{m=1}^{k-1} (y - c_m) = 2^(1-k) (T_k(y) - 1)/(y - 1),
+Hence det(x I - S) is the mode-0 factor times [(8x-1)(16x-1)(32x-1)(64x-1)]^(k-1) times
+prod_{m=1}^{k-1} (16x^2 - 2(5 + c_m)x + 1), and with y = (16x^2 - 10x + 1)/(2x) the Chebyshev identity
+prod_{m=1}^{k-1} (y - c_m) = 2^(1-k) (T_k(y) - 1)/(y - 1) makes the last product a rational polynomial,
 
-    det(x I - S) = [mode-0 factor] * [(8x-1)(16x-1)(32x-1)(64x-1)/2^19]^(k-1) * 2^(1-k) U_k(x)/(16x^2-12x+1) * ...
-
-which :func:`check_charpoly_factorization` verifies exactly (fmpq) for a given k.
+which :func:`charpoly_product_formula` writes out and :func:`check_charpoly_factorization` compares
+exactly (fmpq) with the characteristic polynomial of the exact matrix for a given k.
 
 Ordering for every k >= 3 (:func:`spectral_conditions`): lam(c) = (5 + c + sqrt((1+c)(9+c)))/16 is
 increasing in c, and c_1 = c_{k-1} = cos(2 pi/k) > c_m for 2 <= m <= k-2, so lam = lam(c_1) is the

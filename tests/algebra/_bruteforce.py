@@ -56,7 +56,7 @@ def cc_step(faces, values, zero):
     for i, f in enumerate(faces):
         for v in f:
             vfaces.setdefault(v, []).append(i)
-    for e, fl in edge_faces.items():
+    for e in edge_faces:
         for v in e:
             vedges.setdefault(v, []).append(e)
     for v, fl in vfaces.items():
