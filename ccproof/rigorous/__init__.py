@@ -18,16 +18,16 @@ Guarantees
 
 Main entry points: :class:`Poly`, :func:`jacobian_determinant`, :func:`bernstein_coefficients`,
 :class:`BernsteinForm` (``split``, ``restrict``, ``elevate``, ``diff``, ``+ - *``),
-:func:`range_enclosure`, :func:`lower_bound`, :func:`certainly_positive`,
+:func:`range_enclosure`, :func:`lower_bound`, :func:`certainly_positive`, :func:`ball_contains`,
 :func:`bernstein_jacobian_determinant`.  See ``docs/rigorous.md``.
 """
 
+from ._tensor import ball_contains, exact_fmpq
 from .bernstein import (
     BernsteinForm,
     bernstein_coefficients,
     bernstein_jacobian_determinant,
     certainly_positive,
-    exact_fmpq,
     lower_bound,
     range_enclosure,
     unit_box,
@@ -37,6 +37,7 @@ from .poly import Poly, jacobian_determinant
 __all__ = [
     "BernsteinForm",
     "Poly",
+    "ball_contains",
     "bernstein_coefficients",
     "bernstein_jacobian_determinant",
     "certainly_positive",

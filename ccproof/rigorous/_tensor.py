@@ -80,6 +80,29 @@ def convert(coeffs, prec):
         return [c if isinstance(c, arb) else arb(c) for c in coeffs]
 
 
+def exact_fmpq(x):
+    """The exact rational value of a zero-radius finite ``arb`` (e.g. an endpoint); else ``None``."""
+    if not x.is_finite() or not x.is_exact():
+        return None
+    man, exp = x.man_exp()
+    return fmpq(man) * fmpq(2) ** int(exp)
+
+
+def ball_contains(ball, value):
+    """True when the ball certainly contains ``value`` (an exact number or another ball).
+
+    Exact values are compared with the ball's endpoints in exact rational arithmetic (converting
+    them to a ball first would round them and could wrongly report a miss).
+    """
+    if isinstance(value, arb):
+        return bool(ball.contains(value))
+    value = exact_scalar(value)
+    if not ball.is_finite():
+        return bool(ball.contains(arb(value)))  # nan: False; infinite radius: True
+    mid, rad = exact_fmpq(ball.mid()), exact_fmpq(ball.rad())
+    return mid - rad <= value <= mid + rad
+
+
 def zero(prec):
     return _ZERO if prec is None else arb(0)
 

@@ -295,8 +295,10 @@ def range_enclosure(form):
         raise TypeError("mixed exact and ball coefficients")
     if any(b.is_nan() for b in balls):
         return arb.neg_inf(), arb.pos_inf()
-    lows = [b.lower() for b in balls]
-    highs = [b.upper() for b in balls]
+    prec = max(form.prec if isinstance(form, BernsteinForm) and form.prec else 0, flint.ctx.prec)
+    with flint.ctx.workprec(prec):  # endpoints rounded outward at (at least) the form's precision
+        lows = [b.lower() for b in balls]
+        highs = [b.upper() for b in balls]
     # endpoints are exact (radius 0), so ``<`` is a total order on them (including +-inf)
     lo = lows[0]
     for x in lows[1:]:
@@ -318,15 +320,7 @@ def lower_bound(form):
     lo = range_enclosure(form)[0]
     if isinstance(lo, fmpq):
         return lo
-    return exact_fmpq(lo)
-
-
-def exact_fmpq(x):
-    """The exact rational value of a zero-radius finite ``arb`` (e.g. an endpoint); else ``None``."""
-    if not x.is_finite() or not x.is_exact():
-        return None
-    man, exp = x.man_exp()
-    return fmpq(man) * fmpq(2) ** int(exp)
+    return T.exact_fmpq(lo)
 
 
 def certainly_positive(form):
@@ -383,7 +377,12 @@ def _cached(key, build):
 
 
 def _matrix(rows, cols, entry):
-    return fmpq_mat(rows, cols, [entry(i, j) for i in range(rows) for j in range(cols)])
+    return fmpq_mat(rows, cols, [fmpq(entry(i, j)) for i in range(rows) for j in range(cols)])
+
+
+def _C(n, k):
+    """Binomial coefficient, zero outside 0 <= k <= n."""
+    return comb(n, k) if 0 <= k <= n else 0
 
 
 def _binomials(n):
@@ -391,48 +390,49 @@ def _binomials(n):
 
 
 def power_to_bernstein_matrix(n, d):
-    """(d+1) x (n+1): power coefficients of degree n -> Bernstein coefficients of degree d >= n on [0,1]."""
-    return _cached(
-        ("p2b", n, d),
-        lambda: _matrix(d + 1, n + 1, lambda k, i: fmpq(comb(k, i), comb(d, i))),
-    )
+    """(d+1) x (n+1): power coefficients of degree n -> Bernstein coefficients of degree d >= n on [0,1].
+
+    b_k = sum_i C(k, i) / C(d, i) a_i.
+    """
+    return _cached(("p2b", n, d), lambda: _matrix(d + 1, n + 1, lambda k, i: fmpq(_C(k, i), comb(d, i))))
 
 
 def bernstein_to_power_matrix(n):
-    """(n+1) x (n+1): Bernstein coefficients of degree n on [0,1] -> power coefficients."""
-    return _cached(
-        ("b2p", n),
-        lambda: _matrix(n + 1, n + 1, lambda i, k: fmpq((-1) ** (i - k) * comb(n, i) * comb(i, k))),
-    )
+    """(n+1) x (n+1): Bernstein coefficients of degree n on [0,1] -> power coefficients.
+
+    a_i = sum_k (-1)^(i-k) C(n, i) C(i, k) b_k.
+    """
+
+    def entry(i, k):
+        return (-1) ** ((i - k) % 2) * _C(n, i) * _C(i, k)
+
+    return _cached(("b2p", n), lambda: _matrix(n + 1, n + 1, entry))
 
 
 def elevation_matrix(n, d):
-    """(d+1) x (n+1): Bernstein degree elevation n -> d."""
-    return _cached(
-        ("elev", n, d),
-        lambda: _matrix(d + 1, n + 1, lambda k, i: fmpq(comb(n, i) * comb(d - n, k - i), comb(d, k))),
-    )
+    """(d+1) x (n+1): Bernstein degree elevation n -> d: b'_k = sum_i C(n,i) C(d-n,k-i) / C(d,k) b_i."""
+
+    def entry(k, i):
+        return fmpq(_C(n, i) * _C(d - n, k - i), comb(d, k))
+
+    return _cached(("elev", n, d), lambda: _matrix(d + 1, n + 1, entry))
 
 
 def split_matrix(n, t, side):
-    """De Casteljau at ``t``: side 0 gives the coefficients on [0, t], side 1 on [t, 1]."""
+    """De Casteljau at ``t``: side 0 gives the coefficients on [0, t], side 1 on [t, 1].
+
+    side 0: b'_i = sum_{j <= i} C(i, j) t^j (1-t)^(i-j) b_j;
+    side 1: b'_i = sum_{j >= i} C(n-i, j-i) t^(j-i) (1-t)^(n-j) b_j.
+    """
     s = 1 - t
-    if side == 0:  # b'_i = sum_j C(i, j) t^j s^(i-j) b_j
-        return _cached(
-            ("split", n, t, 0),
-            lambda: _matrix(
-                n + 1, n + 1, lambda i, j: comb(i, j) * t**j * s ** (i - j) if j <= i else fmpq(0)
-            ),
-        )
-    # b'_i = sum_j C(n-i, j-i) t^(n-j) s^(j-i) b_j
-    return _cached(
-        ("split", n, t, 1),
-        lambda: _matrix(
-            n + 1,
-            n + 1,
-            lambda i, j: comb(n - i, j - i) * t ** (n - j) * s ** (j - i) if j >= i else fmpq(0),
-        ),
-    )
+
+    def left(i, j):
+        return _C(i, j) * t**j * s ** (i - j) if j <= i else 0
+
+    def right(i, j):
+        return _C(n - i, j - i) * t ** (j - i) * s ** (n - j) if j >= i else 0
+
+    return _cached(("split", n, t, side), lambda: _matrix(n + 1, n + 1, right if side else left))
 
 
 def restrict_matrix(n, a, b):
@@ -443,7 +443,7 @@ def restrict_matrix(n, a, b):
         if a > 0:
             right = split_matrix(n, a / b, 1)
             mat = right if mat is None else right * mat
-        return mat if mat is not None else _matrix(n + 1, n + 1, lambda i, j: fmpq(int(i == j)))
+        return mat if mat is not None else _matrix(n + 1, n + 1, lambda i, j: int(i == j))
 
     return _cached(("restrict", n, a, b), build)
 
@@ -454,7 +454,7 @@ def derivative_matrix(n, h):
         return _cached(("diff", 0), lambda: fmpq_mat(1, 1, [0]))
     return _cached(
         ("diff", n, h),
-        lambda: _matrix(n, n + 1, lambda i, j: n / h if j == i + 1 else -n / h if j == i else fmpq(0)),
+        lambda: _matrix(n, n + 1, lambda i, j: n / h if j == i + 1 else -n / h if j == i else 0),
     )
 
 

@@ -166,8 +166,7 @@ class Poly:
         shape = tuple(max(p, q) for p, q in zip(self.shape, other.shape))
         a = T.pad(self.coeffs, self.shape, shape, self.prec)
         b = T.pad(other.coeffs, other.shape, shape, other.prec)
-        with flint.ctx.workprec(self.prec):
-            return all(x.contains(y) for x, y in zip(a, b))
+        return all(T.ball_contains(x, y) for x, y in zip(a, b))
 
     def __eq__(self, other):
         """Exact equality of exact polynomials (ball polynomials refuse ``==``)."""
