@@ -1,0 +1,142 @@
+"""Limit-position and limit-tangent masks of Catmull-Clark at the vertices of a mesh.
+
+Interior vertex of valence k with edge neighbours e_j and face-diagonal neighbours d_j (counter-
+clockwise, :meth:`QuadMesh.one_ring`):
+
+* position (left eigenvector of eigenvalue 1; Halstead, Kass, DeRose 1993; Stam 1998):
+  ``(k^2 V + 4 sum e_j + sum d_j) / (k (k + 5))``;
+* tangents (left eigenvectors of the subdominant eigenvalue lam of DESIGN.md R2):
+  ``t1 = sum_j A cos(2 pi j/k) e_j + (cos(2 pi j/k) + cos(2 pi (j+1)/k)) d_j`` and ``t2`` the same
+  with sines, where ``A = 1 + c + sqrt((1 + c)(9 + c)) = 16 lam - 4`` and ``c = cos(2 pi/k)``;
+  the normal is ``t1 x t2`` (it points to the side from which the faces are counter-clockwise).
+
+Boundary vertex (the boundary is the cubic B-spline through the boundary vertices):
+
+* position ``(e0 + 4 V + e1) / 6`` on the two boundary neighbours (any number of faces);
+* for a *regular* boundary vertex (two faces, boundary neighbours e0, e2, interior neighbour e1,
+  diagonals d0, d1) the tangent along the boundary is ``e0 - e2`` and the cross-boundary tangent
+  is ``(d0 + 4 e1 + d1 - e0 - 4 V - e2) / 6`` (bicubic B-spline with the ghost row ``2 B - I``).
+  Other boundary vertices have no closed-form mask here (their normal is NaN; the evaluation
+  layer computes them from the exact surface).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ccproof.mesh.quadmesh import QuadMesh
+from ccproof.mesh.subdivision import _boundary_neighbours
+
+__all__ = ["limit_positions", "limit_tangents", "limit_normals"]
+
+
+def limit_positions(mesh: QuadMesh, vertices=None):
+    """Exact limit positions of the vertices (masks in the module docstring).
+
+    Parameters
+    ----------
+    mesh : QuadMesh
+    vertices : ndarray, shape (n, 3), optional
+        Control points to use instead of ``mesh.vertices`` (same connectivity).
+
+    Returns
+    -------
+    ndarray, shape (n, 3)
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> V = np.array([[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1],
+    ...               [-1, -1, 1], [1, -1, 1], [1, 1, 1], [-1, 1, 1]], float)
+    >>> F = [[0, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6], [3, 0, 4, 7]]
+    >>> limit_positions(QuadMesh(V, F))[6].tolist()      # cube corner: (9 V + 4*3 e + 3 d)/24
+    [0.5, 0.5, 0.5]
+    """
+    V = mesh.vertices if vertices is None else np.asarray(vertices, dtype=np.float64)
+    F = mesh.faces
+    n = mesh.n_vertices
+    org = F.reshape(-1)
+    e = np.roll(F, -1, axis=1).reshape(-1)
+    d = np.roll(F, -2, axis=1).reshape(-1)
+    esum = np.zeros((n, 3))
+    dsum = np.zeros((n, 3))
+    np.add.at(esum, org, V[e])
+    np.add.at(dsum, org, V[d])
+    k = mesh.valence.astype(np.float64)[:, None]
+    L = (k * k * V + 4 * esum + dsum) / (k * (k + 5))
+    bv = mesh.is_boundary_vertex
+    if bv.any():
+        e0, e1 = _boundary_neighbours(mesh)
+        L[bv] = (V[e0[bv]] + 4 * V[bv] + V[e1[bv]]) / 6
+    return L
+
+
+def limit_tangents(mesh: QuadMesh, vertices=None):
+    """Limit tangent masks t1, t2 (module docstring), NaN at irregular boundary vertices.
+
+    Returns
+    -------
+    t1, t2 : ndarray, shape (n, 3)
+        Scaled as in the masks (only the plane they span and its orientation are meaningful).
+    """
+    V = mesh.vertices if vertices is None else np.asarray(vertices, dtype=np.float64)
+    F = mesh.faces
+    n = mesh.n_vertices
+    t1 = np.full((n, 3), np.nan)
+    t2 = np.full((n, 3), np.nan)
+    ptr, fan = mesh.fan_ptr, mesh.fan_corners
+    cnt = mesh.face_count
+    # position j of every corner in its vertex's fan
+    j = np.arange(fan.size) - np.repeat(ptr[:-1], cnt)
+    v = F.reshape(-1)[fan]
+    f, i = fan // 4, fan % 4
+    e = F[f, (i + 1) % 4]
+    d = F[f, (i + 2) % 4]
+    inner = ~mesh.is_boundary_vertex[v]
+    k = mesh.valence[v].astype(np.float64)
+    c = np.cos(2 * np.pi / k)
+    A = 1 + c + np.sqrt((1 + c) * (9 + c))
+    th = 2 * np.pi * j / k
+    th1 = 2 * np.pi * (j + 1) / k
+    for t, trig in ((t1, np.cos), (t2, np.sin)):
+        w_e = A * trig(th)
+        w_d = trig(th) + trig(th1)
+        contrib = w_e[:, None] * V[e] + w_d[:, None] * V[d]
+        acc = np.zeros((n, 3))
+        np.add.at(acc, v[inner], contrib[inner])
+        iv = ~mesh.is_boundary_vertex
+        t[iv] = acc[iv]
+    rb = np.flatnonzero(mesh.is_boundary_vertex & (mesh.face_count == 2))
+    if rb.size:
+        c0 = fan[ptr[rb]]
+        c1 = fan[ptr[rb] + 1]
+        f0, i0, f1, i1 = c0 // 4, c0 % 4, c1 // 4, c1 % 4
+        e0 = F[f0, (i0 + 1) % 4]
+        e1 = F[f1, (i1 + 1) % 4]
+        e2 = F[f1, (i1 + 3) % 4]
+        d0 = F[f0, (i0 + 2) % 4]
+        d1 = F[f1, (i1 + 2) % 4]
+        t1[rb] = V[e0] - V[e2]
+        t2[rb] = (V[d0] + 4 * V[e1] + V[d1] - V[e0] - 4 * V[rb] - V[e2]) / 6
+    return t1, t2
+
+
+def limit_normals(mesh: QuadMesh, vertices=None):
+    """Unit limit normals ``t1 x t2 / |t1 x t2|`` (NaN at irregular boundary vertices).
+
+    Returns
+    -------
+    ndarray, shape (n, 3)
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> V = np.array([[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1],
+    ...               [-1, -1, 1], [1, -1, 1], [1, 1, 1], [-1, 1, 1]], float)
+    >>> F = [[0, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6], [3, 0, 4, 7]]
+    >>> np.round(limit_normals(QuadMesh(V, F))[6] * np.sqrt(3), 12).tolist()
+    [1.0, 1.0, 1.0]
+    """
+    t1, t2 = limit_tangents(mesh, vertices)
+    nrm = np.cross(t1, t2)
+    return nrm / np.linalg.norm(nrm, axis=1, keepdims=True)

@@ -1,0 +1,314 @@
+"""Validated all-quad meshes and their topology (bmz04 section 2, "Control meshes").
+
+A :class:`QuadMesh` is a two-dimensional polygonal complex K = (V, E, F) whose faces are
+quadruples of vertices (bmz04 section 2) together with the control points p (one 3-vector per
+vertex). The constructor checks everything the subdivision and evaluation layers rely on and raises
+:class:`ccproof.errors.MeshError` naming the offending face, edge or vertex otherwise:
+
+* every face is a quadrilateral with four distinct vertex indices in range;
+* coordinates are finite;
+* every edge has one (boundary) or two (interior) faces (edge-manifold);
+* the two faces of an interior edge traverse it in opposite directions (consistent orientation);
+* the faces around every vertex form a single fan, closed (interior vertex) or open (boundary
+  vertex): the *link* of every vertex is a simple polygonal line (bmz04: manifold meshes);
+* every interior vertex has valence >= 3, every vertex is used by a face.
+
+Half-edge conventions (used throughout ccproof): half-edge ``h = 4 f + i`` runs from
+``faces[f, i]`` to ``faces[f, (i + 1) % 4]``; it is also the *corner* of face ``f`` at vertex
+``faces[f, i]``. ``twin[h]`` is the opposite half-edge, ``-1`` on the boundary.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
+
+from ccproof.errors import MeshError
+
+__all__ = ["QuadMesh"]
+
+
+def _edge_str(a, b):
+    return f"edge ({int(a)}, {int(b)})"
+
+
+class QuadMesh:
+    """An all-quad, manifold, consistently oriented control mesh (bmz04 section 2).
+
+    Parameters
+    ----------
+    vertices : array_like, shape (n, 3)
+        Control points p, float64.
+    faces : array_like, shape (m, 4)
+        0-based vertex indices of each quad, in order around the face (OBJ order). The face
+        parameter (u, v) of face ``f`` puts corner ``i`` at (0,0), (1,0), (1,1), (0,1) for
+        ``i = 0, 1, 2, 3`` (the ptex convention of OpenSubdiv).
+
+    Raises
+    ------
+    MeshError
+        If any of the checks in the module docstring fails; the message names the element.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> V = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]
+    >>> m = QuadMesh(V, [[0, 1, 2, 3]])
+    >>> m.n_vertices, m.n_faces, int(m.is_boundary_vertex.sum())
+    (4, 1, 4)
+    >>> QuadMesh(V, [[0, 1, 2, 2]])
+    Traceback (most recent call last):
+    ...
+    ccproof.errors.MeshError: face 0 repeats vertex 2: [0, 1, 2, 2]
+    """
+
+    def __init__(self, vertices, faces):
+        V = np.array(vertices, dtype=np.float64)
+        if V.ndim != 2 or V.shape[1] != 3:
+            raise MeshError(f"vertices must have shape (n, 3), got {V.shape}")
+        F = np.asarray(faces)
+        if F.size == 0:
+            raise MeshError("the mesh has no faces")
+        if F.ndim != 2 or F.shape[1] != 4:
+            raise MeshError(f"faces must have shape (m, 4) (all quads), got {F.shape}")
+        if not np.issubdtype(F.dtype, np.integer):
+            Fi = F.astype(np.int64)
+            if not np.array_equal(Fi, F):
+                raise MeshError("face indices must be integers")
+            F = Fi
+        F = np.array(F, dtype=np.int64)
+        bad = np.flatnonzero(~np.isfinite(V).all(axis=1))
+        if bad.size:
+            raise MeshError(f"vertex {int(bad[0])} has a non-finite coordinate: {V[bad[0]].tolist()}")
+        n = V.shape[0]
+        out = np.flatnonzero(((F < 0) | (F >= n)).any(axis=1))
+        if out.size:
+            f = int(out[0])
+            raise MeshError(f"face {f} has a vertex index out of range [0, {n}): {F[f].tolist()}")
+        s = np.sort(F, axis=1)
+        rep = np.flatnonzero((s[:, 1:] == s[:, :-1]).any(axis=1))
+        if rep.size:
+            f = int(rep[0])
+            r = s[f][np.flatnonzero(s[f][1:] == s[f][:-1])[0]]
+            raise MeshError(f"face {f} repeats vertex {int(r)}: {F[f].tolist()}")
+        self.vertices = V
+        self.faces = F
+        self.vertices.setflags(write=False)
+        self.faces.setflags(write=False)
+        self._build_topology()
+
+    # ------------------------------------------------------------------ construction
+    @classmethod
+    def from_polygons(cls, vertices, polygons, *, lines=None):
+        """Build a QuadMesh from a list of polygons, rejecting any face that is not a quad.
+
+        Parameters
+        ----------
+        vertices : array_like, shape (n, 3)
+        polygons : sequence of sequences of int
+            0-based vertex indices per face.
+        lines : sequence of int, optional
+            Source line number of each polygon (for error messages).
+
+        >>> QuadMesh.from_polygons([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 2]])
+        Traceback (most recent call last):
+        ...
+        ccproof.errors.MeshError: face 0 has 3 vertices, not 4: ccproof needs an all-quad mesh
+        """
+        for f, poly in enumerate(polygons):
+            if len(poly) != 4:
+                where = f" (line {lines[f]})" if lines is not None else ""
+                raise MeshError(
+                    f"face {f}{where} has {len(poly)} vertices, not 4: ccproof needs an all-quad mesh"
+                )
+        faces = np.array(polygons, dtype=np.int64).reshape(-1, 4)
+        return cls(vertices, faces)
+
+    def with_vertices(self, vertices):
+        """Same connectivity, new control points (shape (n, 3)); the topology is re-used."""
+        new = object.__new__(QuadMesh)
+        new.__dict__.update(self.__dict__)
+        V = np.array(vertices, dtype=np.float64)
+        if V.shape != self.vertices.shape:
+            raise MeshError(f"vertices must have shape {self.vertices.shape}, got {V.shape}")
+        bad = np.flatnonzero(~np.isfinite(V).all(axis=1))
+        if bad.size:
+            raise MeshError(f"vertex {int(bad[0])} has a non-finite coordinate: {V[bad[0]].tolist()}")
+        V.setflags(write=False)
+        new.vertices = V
+        return new
+
+    # ------------------------------------------------------------------ topology
+    def _build_topology(self):
+        F = self.faces
+        n, m = self.vertices.shape[0], F.shape[0]
+        H = 4 * m
+        org = F.reshape(-1)
+        dst = np.roll(F, -1, axis=1).reshape(-1)
+        # undirected edges
+        lo, hi = np.minimum(org, dst), np.maximum(org, dst)
+        ukey = lo * n + hi
+        order = np.argsort(ukey, kind="stable")
+        sk = ukey[order]
+        starts = np.flatnonzero(np.r_[True, sk[1:] != sk[:-1]])
+        counts = np.diff(np.r_[starts, H])
+        if (counts > 2).any():
+            g = int(np.flatnonzero(counts > 2)[0])
+            hs = order[starts[g] : starts[g] + counts[g]]
+            raise MeshError(
+                f"non-manifold {_edge_str(lo[hs[0]], hi[hs[0]])}: shared by {int(counts[g])} faces "
+                f"{sorted(int(h) // 4 for h in hs)}"
+            )
+        edge_of = np.empty(H, dtype=np.int64)
+        edge_of[order] = np.repeat(np.arange(starts.size), counts)
+        twin = np.full(H, -1, dtype=np.int64)
+        two = starts[counts == 2]
+        h1, h2 = order[two], order[two + 1]
+        same = org[h1] == org[h2]
+        if same.any():
+            i = int(np.flatnonzero(same)[0])
+            a, b = org[h1[i]], dst[h1[i]]
+            raise MeshError(
+                f"inconsistent orientation: faces {int(h1[i]) // 4} and {int(h2[i]) // 4} both traverse "
+                f"{_edge_str(a, b)} from {int(a)} to {int(b)}"
+            )
+        twin[h1], twin[h2] = h2, h1
+        self.twin = twin
+        self.edge_of_halfedge = edge_of
+        first = order[starts]
+        self.edges = np.stack([lo[first], hi[first]], axis=1)
+        self.edge_faces = np.full((starts.size, 2), -1, dtype=np.int64)
+        self.edge_faces[:, 0] = first // 4
+        self.edge_faces[counts == 2, 1] = order[starts[counts == 2] + 1] // 4
+        self.is_boundary_edge = counts == 1
+
+        # vertices: corners, fans
+        face_count = np.bincount(org, minlength=n)
+        unused = np.flatnonzero(face_count == 0)
+        if unused.size:
+            raise MeshError(f"vertex {int(unused[0])} is not used by any face")
+        # rot(c): next corner counter-clockwise around the same vertex = twin(prev(c))
+        prev = (np.arange(H) // 4) * 4 + (np.arange(H) + 3) % 4
+        rot = twin[prev]
+        ok = rot >= 0
+        g = sp.coo_matrix((np.ones(int(ok.sum())), (np.arange(H)[ok], rot[ok])), shape=(H, H))
+        ncomp, label = connected_components(g, directed=False)
+        pairs = np.unique(org * ncomp + label)
+        nfans = np.bincount(pairs // ncomp, minlength=n)
+        if (nfans > 1).any():
+            v = int(np.flatnonzero(nfans > 1)[0])
+            raise MeshError(
+                f"non-manifold vertex {v}: its faces form {int(nfans[v])} separate fans "
+                f"(faces {sorted(set((np.flatnonzero(org == v) // 4).tolist()))})"
+            )
+        bnd_out = np.bincount(org[twin < 0], minlength=n)
+        is_bv = bnd_out > 0
+        valence = face_count + is_bv
+        bad = np.flatnonzero(~is_bv & (valence < 3))
+        if bad.size:
+            v = int(bad[0])
+            raise MeshError(f"interior vertex {v} has valence {int(valence[v])} (needs >= 3)")
+        # fan order: start at the clockwise-most corner (boundary) or the smallest corner (interior)
+        start = np.full(n, H, dtype=np.int64)
+        np.minimum.at(start, org, np.arange(H))
+        bstart = np.flatnonzero(twin < 0)  # outgoing boundary half-edge: clockwise-most corner
+        start[org[bstart]] = bstart
+        ptr = np.r_[0, np.cumsum(face_count)]
+        fan = np.empty(H, dtype=np.int64)
+        cur = start.copy()
+        for j in range(int(face_count.max())):
+            idx = np.flatnonzero(face_count > j)
+            fan[ptr[idx] + j] = cur[idx]
+            cur[idx] = rot[cur[idx]]
+        self.rot = rot
+        self.fan_ptr = ptr
+        self.fan_corners = fan
+        self.face_count = face_count
+        self.valence = valence
+        self.is_boundary_vertex = is_bv
+        for a in (self.twin, self.edge_of_halfedge, self.edges, self.edge_faces, self.is_boundary_edge,
+                  self.rot, self.fan_ptr, self.fan_corners, self.face_count, self.valence,
+                  self.is_boundary_vertex):
+            a.setflags(write=False)
+
+    # ------------------------------------------------------------------ accessors
+    @property
+    def n_vertices(self):
+        """Number of vertices n."""
+        return self.vertices.shape[0]
+
+    @property
+    def n_faces(self):
+        """Number of faces m."""
+        return self.faces.shape[0]
+
+    @property
+    def n_edges(self):
+        """Number of (undirected) edges."""
+        return self.edges.shape[0]
+
+    @property
+    def is_regular_vertex(self):
+        """bool (n,): interior of valence 4, or boundary with exactly two faces."""
+        return np.where(self.is_boundary_vertex, self.face_count == 2, self.valence == 4)
+
+    @property
+    def extraordinary_vertices(self):
+        """int (e,): interior vertices of valence != 4 (bmz04: extraordinary vertices)."""
+        return np.flatnonzero(~self.is_boundary_vertex & (self.valence != 4))
+
+    @property
+    def boundary_edges(self):
+        """int (b, 2): the boundary edges, as directed along the boundary (face on the left)."""
+        h = np.flatnonzero(self.twin < 0)
+        return np.stack([self.faces.reshape(-1)[h], np.roll(self.faces, -1, axis=1).reshape(-1)[h]], 1)
+
+    @property
+    def bounding_box_diagonal(self):
+        """Length of the diagonal of the axis-aligned bounding box of the control points."""
+        return float(np.linalg.norm(self.vertices.max(axis=0) - self.vertices.min(axis=0)))
+
+    def corner_vertex(self, c):
+        """Vertex of corner / origin of half-edge ``c`` (array_like of int)."""
+        return self.faces.reshape(-1)[c]
+
+    def one_ring(self, v):
+        """The 1-ring of vertex ``v`` in counter-clockwise cyclic order.
+
+        Returns
+        -------
+        edge_nbrs : ndarray of int, shape (valence,)
+            e_0, e_1, ...: the edge neighbours. For a boundary vertex the first and the last are
+            the two boundary neighbours.
+        face_nbrs : ndarray of int, shape (face_count,)
+            d_0, d_1, ...: the vertex of face j opposite to ``v`` (face j lies between e_j and
+            e_{j+1}).
+        faces : ndarray of int, shape (face_count,)
+            The faces, in the same order.
+
+        >>> import numpy as np
+        >>> V = np.array([[x, y, 0.0] for y in range(3) for x in range(3)])
+        >>> F = [[0, 1, 4, 3], [1, 2, 5, 4], [3, 4, 7, 6], [4, 5, 8, 7]]
+        >>> e, d, f = QuadMesh(V, F).one_ring(4)
+        >>> e.tolist(), d.tolist(), f.tolist()
+        ([3, 1, 5, 7], [0, 2, 8, 6], [0, 1, 3, 2])
+        """
+        v = int(v)
+        if not 0 <= v < self.n_vertices:
+            raise MeshError(f"vertex {v} out of range [0, {self.n_vertices})")
+        c = self.fan_corners[self.fan_ptr[v] : self.fan_ptr[v + 1]]
+        f, i = c // 4, c % 4
+        F = self.faces
+        e = F[f, (i + 1) % 4]
+        d = F[f, (i + 2) % 4]
+        if self.is_boundary_vertex[v]:
+            e = np.r_[e, F[f[-1], (i[-1] + 3) % 4]]
+        return e, d, f
+
+    def __repr__(self):
+        return (
+            f"QuadMesh({self.n_vertices} vertices, {self.n_faces} faces, "
+            f"{int(self.is_boundary_edge.sum())} boundary edges, "
+            f"{self.extraordinary_vertices.size} extraordinary vertices)"
+        )

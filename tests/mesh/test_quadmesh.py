@@ -1,0 +1,92 @@
+"""Topology checks of QuadMesh: each kind of bad input gives a MeshError naming the element."""
+
+import numpy as np
+import pytest
+
+from ccproof.errors import MeshError
+from ccproof.mesh import QuadMesh
+from ccproof.mesh.examples import cube, grid, k_regular_disk, torus
+
+
+def test_grid_topology():
+    m = grid(3, 2)
+    assert m.n_vertices == 12 and m.n_faces == 6 and m.n_edges == 17
+    assert m.is_boundary_vertex.sum() == 10
+    assert m.is_boundary_edge.sum() == 10
+    assert m.valence.tolist() == [2, 3, 3, 2, 3, 4, 4, 3, 2, 3, 3, 2]
+    assert m.extraordinary_vertices.size == 0
+    # boundary edges directed with the face on the left: a closed loop
+    be = m.boundary_edges
+    assert sorted(be[:, 0].tolist()) == sorted(be[:, 1].tolist())
+
+
+def test_one_ring_cyclic_ccw():
+    m = k_regular_disk(5, rings=2)
+    e, d, f = m.one_ring(0)
+    assert len(e) == len(d) == len(f) == 5
+    ang = np.arctan2(m.vertices[e, 1], m.vertices[e, 0])
+    steps = np.mod(np.diff(np.r_[ang, ang[0]]), 2 * np.pi)
+    assert np.allclose(steps, 2 * np.pi / 5)  # counter-clockwise
+    for j in range(5):  # d_j lies in the face between e_j and e_{j+1}
+        assert {e[j], e[(j + 1) % 5], d[j], 0} == set(m.faces[f[j]].tolist())
+
+
+def test_boundary_one_ring_starts_and_ends_on_boundary():
+    m = grid(2, 2)
+    e, d, f = m.one_ring(1)  # bottom middle vertex
+    assert e.tolist() == [2, 4, 0] and d.tolist() == [5, 3] and f.tolist() == [1, 0]
+
+
+def test_closed_meshes():
+    assert cube().valence.tolist() == [3] * 8
+    t = torus()
+    assert not t.is_boundary_vertex.any() and (t.valence == 4).all()
+
+
+def test_non_finite_coordinate():
+    V = np.array(cube().vertices)
+    V[5, 1] = np.nan
+    with pytest.raises(MeshError, match="vertex 5 has a non-finite coordinate"):
+        QuadMesh(V, cube().faces)
+    V[5, 1] = np.inf
+    with pytest.raises(MeshError, match="vertex 5"):
+        cube().with_vertices(V)
+
+
+def test_non_manifold_edge():
+    V = np.zeros((8, 3))
+    F = [[0, 1, 2, 3], [1, 0, 4, 5], [0, 1, 6, 7]]
+    with pytest.raises(MeshError, match=r"non-manifold edge \(0, 1\): shared by 3 faces \[0, 1, 2\]"):
+        QuadMesh(V, F)
+
+
+def test_inconsistent_orientation():
+    V = np.zeros((6, 3))
+    F = [[0, 1, 2, 3], [1, 2, 5, 4]]  # the second face traverses edge (1, 2) from 1 to 2 as well
+    msg = r"inconsistent orientation: faces 0 and 1 both traverse edge \(1, 2\)"
+    with pytest.raises(MeshError, match=msg):
+        QuadMesh(V, F)
+
+
+def test_non_manifold_vertex():
+    V = np.zeros((7, 3))
+    F = [[0, 1, 2, 3], [0, 4, 5, 6]]  # bow tie: two faces meet at vertex 0 only
+    with pytest.raises(MeshError, match="non-manifold vertex 0: its faces form 2 separate fans"):
+        QuadMesh(V, F)
+
+
+def test_valence_two_interior_vertex():
+    V = np.random.default_rng(0).normal(size=(4, 3))
+    with pytest.raises(MeshError, match=r"interior vertex \d has valence 2"):
+        QuadMesh(V, [[0, 1, 2, 3], [3, 2, 1, 0]])  # a pillow: every vertex interior of valence 2
+
+
+def test_other_bad_faces():
+    with pytest.raises(MeshError, match=r"face 0 has a vertex index out of range \[0, 4\)"):
+        QuadMesh(np.zeros((4, 3)), [[0, 1, 2, 4]])
+    with pytest.raises(MeshError, match="face 1 repeats vertex 1"):
+        QuadMesh(np.zeros((6, 3)), [[0, 1, 2, 3], [1, 4, 1, 5]])
+    with pytest.raises(MeshError, match="all quads"):
+        QuadMesh(np.zeros((4, 3)), [[0, 1, 2]])
+    with pytest.raises(MeshError, match="vertex 4 is not used"):
+        QuadMesh(np.zeros((5, 3)), [[0, 1, 2, 3]])

@@ -1,0 +1,101 @@
+"""The reference Catmull-Clark step and the vertex masks.
+
+Expected values come from the rules written out by hand here (R1), from invariance under the step
+(the masks are left eigenvectors) and from OpenSubdiv 3.6 (``vertex_limit``, ``vertex_limit_normal``).
+"""
+
+import json
+
+import numpy as np
+import pytest
+
+from ccproof.mesh import (
+    limit_normals,
+    limit_positions,
+    read_obj,
+    subdivide,
+    subdivision_matrix,
+)
+from ccproof.mesh.examples import cube, grid, k_regular_disk
+
+MESHES = ["cube", "sector_k3", "sector_k5", "sector_k6", "torus_8x6"]
+
+
+def _wavy(m, seed=0):
+    rng = np.random.default_rng(seed)
+    return m.with_vertices(m.vertices + 0.1 * rng.normal(size=m.vertices.shape))
+
+
+@pytest.mark.parametrize("make", [cube, lambda: grid(3, 2), lambda: k_regular_disk(7, 2)])
+def test_matrix_equals_function(make):
+    m = _wavy(make())
+    S = subdivision_matrix(m)
+    m1 = subdivide(m)
+    assert np.allclose(S.sum(axis=1), 1, atol=1e-15, rtol=0)
+    assert np.abs(S @ m.vertices - m1.vertices).max() <= 1e-15 * np.abs(m.vertices).max() * 4
+    # twice
+    S2 = subdivision_matrix(m1) @ S
+    assert np.abs(S2 @ m.vertices - subdivide(m1).vertices).max() <= 1e-14
+
+
+def test_bunny_matrix_equals_function(refdir):
+    m = read_obj(refdir / "meshes" / "bunny_quads.obj")
+    assert m.n_faces == 2036 and m.extraordinary_vertices.size == 103 and not m.is_boundary_vertex.any()
+    assert np.abs(subdivision_matrix(m) @ m.vertices - subdivide(m).vertices).max() < 1e-15
+
+
+@pytest.mark.parametrize("k", [3, 5, 6, 9])
+def test_rules_by_hand(k):
+    m = _wavy(k_regular_disk(k, rings=2), seed=k)
+    V = m.vertices
+    m1 = subdivide(m)
+    n, E = m.n_vertices, m.n_edges
+    # centre: weights 1 - 7/(4k), 3/(2k^2) on edge neighbours, 1/(4k^2) on diagonals
+    e, d, f = m.one_ring(0)
+    want = (1 - 7 / (4 * k)) * V[0] + 3 / (2 * k * k) * V[e].sum(0) + 1 / (4 * k * k) * V[d].sum(0)
+    assert np.allclose(m1.vertices[0], want, atol=1e-15, rtol=0)
+    # face point of face 0 and edge point of the interior edge (0, e_0)
+    assert np.allclose(m1.vertices[n + E + f[0]], V[m.faces[f[0]]].mean(0), atol=1e-15, rtol=0)
+    eid = int(np.flatnonzero((m.edges == sorted([0, e[0]])).all(1))[0])
+    fa, fb = m.edge_faces[eid]
+    want = (V[0] + V[e[0]] + V[m.faces[fa]].mean(0) + V[m.faces[fb]].mean(0)) / 4
+    assert np.allclose(m1.vertices[n + eid], want, atol=1e-15, rtol=0)
+    # boundary: cubic B-spline curve rule and midpoints
+    for v in np.flatnonzero(m.is_boundary_vertex)[:5]:
+        e, _, _ = m.one_ring(v)
+        assert np.allclose(m1.vertices[v], (V[e[0]] + 6 * V[v] + V[e[-1]]) / 8, atol=1e-15, rtol=0)
+    for eid in np.flatnonzero(m.is_boundary_edge)[:5]:
+        a, b = m.edges[eid]
+        assert np.allclose(m1.vertices[n + eid], (V[a] + V[b]) / 2, atol=1e-15, rtol=0)
+
+
+def test_children_orientation_and_parameter():
+    m = grid(1, 1)
+    m1 = subdivide(m)
+    # child 4f+i covers the quarter at corner i of face f, its corner 0 being the vertex point of corner i
+    assert m1.faces[:4, 0].tolist() == m.faces[0].tolist()
+    assert not m1.is_boundary_vertex[8] and m1.valence[8] == 4
+
+
+@pytest.mark.parametrize("make", [cube, lambda: grid(3, 3), lambda: k_regular_disk(5, 3)])
+def test_masks_are_invariant_under_the_step(make):
+    m = _wavy(make(), seed=3)
+    m1 = subdivide(m)
+    n = m.n_vertices
+    assert np.abs(limit_positions(m1)[:n] - limit_positions(m)).max() < 1e-14
+    N0, N1 = limit_normals(m), limit_normals(m1)[:n]
+    ok = ~np.isnan(N0).any(1)
+    assert ok.sum() >= n - 5
+    assert np.abs(N1[ok] - N0[ok]).max() < 1e-13
+
+
+@pytest.mark.parametrize("name", MESHES)
+def test_vertex_limits_against_opensubdiv(refdir, name):
+    d = json.loads((refdir / f"osd_limit_{name}.json").read_text())
+    m = read_obj(refdir / "meshes" / f"{name}.obj")
+    assert np.abs(limit_positions(m) - np.array(d["vertex_limit"])).max() <= 1e-13
+    N = limit_normals(m)
+    ok = ~np.isnan(N).any(1)
+    # NaN only at boundary vertices with one face (no closed-form mask in the mesh layer)
+    assert (m.is_boundary_vertex & (m.face_count != 2))[~ok].all()
+    assert np.abs(N[ok] - np.array(d["vertex_limit_normal"])[ok]).max() <= 1e-13
