@@ -140,11 +140,8 @@ class BernsteinForm:
 
     def to_poly(self):
         """The polynomial in the original (box) variables, in the power basis."""
-        c, shape = self.coeffs, self.shape
-        for axis in range(self.nvars):
-            c, shape = T.apply_along_axis(
-                c, shape, axis, bernstein_to_power_matrix(shape[axis] - 1), self.prec
-            )
+        mats = [bernstein_to_power_matrix(n - 1) for n in self.shape]
+        c, shape = T.apply_all_axes(self.coeffs, self.shape, mats, self.prec)
         p = Poly._raw(shape, c, self.prec)
         for axis, (lo, hi) in enumerate(self.box):
             if (lo, hi) != (0, 1):
@@ -270,11 +267,8 @@ def bernstein_coefficients(poly, box=None, degrees=None):
         isinstance(d, bool) or not isinstance(d, int) or d < n for d, n in zip(degrees, poly.degrees)
     ):
         raise ValueError(f"Bernstein degrees {degrees} below the polynomial's degrees {poly.degrees}")
-    c, shape = poly.coeffs, poly.shape
-    for axis, ((lo, hi), d) in enumerate(zip(box, degrees)):
-        c, shape = T.apply_along_axis(
-            c, shape, axis, _conversion_matrix(shape[axis] - 1, d, lo, hi), poly.prec
-        )
+    mats = [_conversion_matrix(n - 1, d, lo, hi) for n, d, (lo, hi) in zip(poly.shape, degrees, box)]
+    c, shape = T.apply_all_axes(poly.coeffs, poly.shape, mats, poly.prec)
     return BernsteinForm._raw(shape, c, box, poly.prec)
 
 

@@ -91,6 +91,19 @@ def test_arb_conversion_encloses_exact_and_is_tight(prec):
 # ---------------------------------------------------------------------------- subdivision
 
 
+def test_repeated_arb_splits_stay_tight():
+    p = H.random_poly(H.rng(3), (12, 12), lo=-99, hi=99, denom=99)
+    f, fe = bernstein_coefficients(p.to_arb(128)), bernstein_coefficients(p)
+    scale = max(abs(c) for c in fe.coeffs)
+    for level in range(12):
+        side = level % 3 % 2
+        f, fe = f.split(level % 2)[side], fe.split(level % 2)[side]
+    assert f.box == fe.box and f.box[0][1] - f.box[0][0] == fmpq(1, 64)
+    assert all(ball_contains(b, e) for b, e in zip(f.coeffs, fe.coeffs))
+    assert max(exact_fmpq(b.rad()) for b in f.coeffs) <= scale / 2 ** (128 - 20)
+
+
+
 @pytest.mark.parametrize("degrees", [(4,), (3, 5), (2, 3, 2), (2, 1, 2, 1)])
 def test_split_equals_direct_conversion_on_halves(degrees):
     p = H.random_poly(H.rng(sum(degrees) + 100), degrees)
