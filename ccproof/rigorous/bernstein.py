@@ -36,7 +36,9 @@ _HALF = fmpq(1, 2)
 class BernsteinForm:
     """Bernstein coefficients ``coeffs`` (row-major, shape ``degrees + 1``) of a polynomial on ``box``.
 
-    Build one with :func:`bernstein_coefficients`; the constructor does no conversion.
+    Build one with :func:`bernstein_coefficients`, or directly from Bezier control values (for
+    example the 4 x 4 net of a bicubic patch, row-major, ``shape=(4, 4)``) with this constructor,
+    which does no basis conversion; :meth:`to_poly` gives the power form in the box variables.
     """
 
     __slots__ = ("shape", "coeffs", "box", "prec")

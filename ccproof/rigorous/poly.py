@@ -159,6 +159,12 @@ class Poly:
             raise ValueError("to_arb needs a precision in bits")
         return Poly._raw(self.shape, T.convert(self.coeffs, prec), prec)
 
+    def midpoint(self):
+        """Exact polynomial of the balls' midpoints (a representative, *not* an enclosure)."""
+        if self.prec is None:
+            return self
+        return Poly._raw(self.shape, [T.exact_fmpq(c.mid()) for c in self.coeffs], None)
+
     def contains(self, other):
         """True when every coefficient ball contains the matching coefficient of ``other``."""
         if self.prec is None:

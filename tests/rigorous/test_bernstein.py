@@ -380,3 +380,27 @@ def test_bernstein_form_validation():
     with pytest.raises(TypeError):
         f * 0.5
     assert comb(4, 2) == 6  # keep the import honest
+
+
+def test_bezier_net_to_poly_and_det_j_of_a_bicubic_patch():
+    # a bicubic Bezier patch given by its control net on the box [1/2, 1] x [0, 1/2]
+    r = H.rng(53)
+    box = [(fmpq(1, 2), 1), (0, fmpq(1, 2))]
+    nets = [
+        [fmpq(i, 3) + fmpq(r.randint(-2, 2), 40) for i in range(4) for _ in range(4)],
+        [fmpq(j, 3) + fmpq(r.randint(-2, 2), 40) for _ in range(4) for j in range(4)],
+    ]
+    patch = [BernsteinForm((4, 4), net, box) for net in nets]
+    polys = [f.to_poly() for f in patch]
+    for f, p in zip(patch, polys):
+        assert _sympy_equal(f, p)
+        assert bernstein_coefficients(p, box).coeffs == f.coeffs
+    det_b = bernstein_jacobian_determinant(patch)
+    det_p = jacobian_determinant(polys)
+    assert det_b.coeffs == bernstein_coefficients(det_p, box, det_b.degrees).coeffs
+    # ball nets (as read from a table) enclose the exact determinant's coefficients
+    balls = bernstein_jacobian_determinant([f.to_arb(100) for f in patch])
+    assert all(ball_contains(b, e) for b, e in zip(balls.coeffs, det_b.coeffs))
+    mid = Poly.from_dense(polys[0].shape, polys[0].coeffs).to_arb(64).midpoint()
+    assert mid.is_exact
+    assert all(abs(a - b) <= (1 + abs(b)) / 2**62 for a, b in zip(mid.coeffs, polys[0].coeffs))
