@@ -1,0 +1,89 @@
+"""Print or regenerate the certified characteristic-map tables.
+
+  ccproof table K          summary of the table of valence K (lam, N, det J_Phi bounds, hash)
+  ccproof table '>=40'     summary of the table for every valence k >= 40
+  ccproof table --all      regenerate certificates/tables/ for k = 3..100 and k >= 40 (progress bar)
+
+Tables hold the exact nets of the characteristic-map pieces P1, P2, P3 (bmz04 section 4.3) in
+c = cos(2 pi/k) and lam, their arb enclosures, float64 copies and derived quantities certified with
+Bernstein bounds; see docs/tables.md.
+"""
+
+from __future__ import annotations
+
+
+def add_arguments(p):
+    p.add_argument("valence", nargs="?", help="valence K >= 3, or '>=K0' for the interval table")
+    p.add_argument("--all", action="store_true", help="regenerate every table (k = 3..100 and k >= 40)")
+    p.add_argument("--kmax", type=int, default=100, help="largest valence with --all (default 100)")
+    p.add_argument("--jobs", type=int, default=2, help="worker processes with --all (default 2)")
+    p.add_argument("--dir", default=None, help="tables folder (default: certificates/tables)")
+    p.add_argument("--json", action="store_true", help="print the raw JSON instead of a summary")
+
+
+def _summary(obj):
+    from ccproof.tables.format import arb_from_json
+
+    d = obj["derived"]
+    prec = obj["prec"]
+
+    def ball(x):
+        return arb_from_json(x, prec).str(12, radius=False)
+
+    v = obj["valence"]
+    name = f"k >= {v['min']}" if isinstance(v, dict) else f"k = {v}"
+    lines = [
+        f"characteristic map table, {name}  ({obj['schema']}, {prec} bits)",
+        f"  c = cos(2 pi/k)        {ball(obj['c'])}",
+        f"  lam (subdominant)      {ball(obj['lam'])}",
+        f"  spectral ordering      {'certified' if obj['spectral']['ok'] else 'NOT certified'}",
+        f"  N (R8)                 {d['N']}{'  (minimal)' if d['N_is_minimal'] else ''}",
+        f"  min det J_Phi layer 0  in [{ball(d['det_jacobian_phi']['min_lower'])}, "
+        f"{ball(d['det_jacobian_phi']['min_upper'])}]",
+        f"  max Phi_x on the face  in [{ball(d['max_coordinate']['lower'])}, {ball(d['max_coordinate']['upper'])}]",
+        f"  [0,1/2]^2 in image     {d['square_inside_image']}",
+        f"  max |Phi| outer bdry   <= {ball(d['max_norm_outer_boundary']['upper'])}",
+        f"  hash                   {obj['hash']}",
+    ]
+    return "\n".join(lines)
+
+
+def _build_one(args):
+    k, directory = args
+    from ccproof.tables.build import write_table
+
+    return str(write_table(k, directory))
+
+
+def run(args):
+    import json
+
+    from ccproof.errors import CCProofError, TableNotFoundError, check_valence
+    from ccproof.tables.format import describe_available, read_table_json, table_path
+
+    if args.all:
+        from concurrent.futures import ProcessPoolExecutor
+
+        from tqdm import tqdm
+
+        ks = list(range(3, args.kmax + 1)) + [">=40"]
+        work = [(k, args.dir) for k in ks]
+        with ProcessPoolExecutor(max_workers=max(1, args.jobs)) as ex:
+            for _ in tqdm(ex.map(_build_one, work), total=len(work), desc="tables", unit="table"):
+                pass
+        print(f"wrote {len(work)} tables; {describe_available(args.dir)}")
+        return 0
+    if args.valence is None:
+        raise CCProofError("give a valence K (or '>=K0'), or --all")
+    v = args.valence.strip()
+    if v.startswith(">="):
+        key = {"min": check_valence(v[2:])}
+    else:
+        key = check_valence(v)
+    path = table_path(key, args.dir)
+    try:
+        obj = read_table_json(path)
+    except FileNotFoundError:
+        raise TableNotFoundError(f"no table for {v}; {describe_available(args.dir)}") from None
+    print(json.dumps(obj, indent=1) if args.json else _summary(obj))
+    return 0

@@ -1,0 +1,247 @@
+"""File format of the certified characteristic-map tables (schema ``ccproof.table/1``).
+
+This module is part of the trusted base: the verifier imports it. It uses only the standard
+library and python-flint (no numpy, no sympy, no float arithmetic in decisions).
+
+A table is a JSON object; ``docs/tables.md`` has the full grammar and a worked example. The fields
+read by the verifier are:
+
+* ``schema`` = ``"ccproof.table/1"``; ``valence``: an int k >= 3, or ``{"min": k0}`` for the interval
+  of valences k >= k0;
+* ``prec``: bits of the arb enclosures;
+* ``c``, ``lam``: arb balls (``{"mid": str, "rad": str}``, decimal strings) enclosing c = cos(2 pi/k)
+  and lam(k) (for an interval: every value for k >= k0);
+* ``exact.bspline.P1..P3``: 4x4 nets of points, each coordinate an integer form ``[A, B, D]`` (integer
+  coefficient lists in c, constant term first) meaning (A(c) + B(c) lam)/D(c);
+* ``arb.bezier.P1..P3`` and ``arb.bspline.P1..P3``: the same nets as balls;
+* ``hash``: ``"sha256:<hex>"`` of the canonical JSON of every other field.
+
+An arb ball is written as decimal strings ``mid`` and ``rad`` such that the closed decimal interval
+[mid - rad, mid + rad] contains the ball; :func:`arb_from_json` reads it back into a ball containing
+that interval, so a round trip never loses an enclosure.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+from pathlib import Path
+
+SCHEMA = "ccproof.table/1"
+PATCHES = ("P1", "P2", "P3")
+
+
+class TableFormatError(ValueError):
+    """A table file that is malformed, of an unknown schema, or whose hash does not match."""
+
+
+# ----------------------------------------------------------------------------- JSON + hash
+def canonical_json(obj):
+    """Canonical serialization used for hashing: sorted keys, no whitespace, ASCII."""
+    return json.dumps(obj, sort_keys=True, separators=(",", ":"), ensure_ascii=True)
+
+
+def content_hash(obj, *, exclude=("hash",)):
+    """``"sha256:<hex>"`` of the canonical JSON of ``obj`` without the ``exclude`` keys."""
+    body = {k: v for k, v in obj.items() if k not in exclude}
+    return "sha256:" + hashlib.sha256(canonical_json(body).encode("ascii")).hexdigest()
+
+
+# ----------------------------------------------------------------------------- arb <-> JSON
+def arb_to_json(x, digits=40):
+    """Decimal ``{"mid", "rad"}`` whose interval contains the ball ``x`` (outward)."""
+    from flint import arb, ctx
+
+    if not isinstance(x, arb) or not x.is_finite():
+        raise TableFormatError(f"cannot write a non-finite ball {x!r}")
+    with ctx.workprec(max(ctx.prec, 4 * digits)):
+        m, r, e = x.mid_rad_10exp(digits)
+    return {"mid": f"{m}e{e}", "rad": f"{r}e{e}"}
+
+
+def arb_from_json(obj, prec):
+    """Ball at ``prec`` bits containing the decimal interval of ``obj`` (see :func:`arb_to_json`)."""
+    from flint import arb, ctx
+
+    if not isinstance(obj, dict) or set(obj) != {"mid", "rad"}:
+        raise TableFormatError(f"a ball must be {{'mid': str, 'rad': str}}, got {obj!r}")
+    mid, rad = obj["mid"], obj["rad"]
+    for s in (mid, rad):
+        if not isinstance(s, str) or not _is_decimal(s):
+            raise TableFormatError(f"ball component {s!r} is not a decimal string")
+    if rad.startswith("-"):
+        raise TableFormatError(f"negative radius {rad!r}")
+    with ctx.workprec(prec):
+        x = arb(f"[{mid} +/- {rad}]")
+    if not x.is_finite():
+        raise TableFormatError(f"ball {obj!r} is not finite")
+    return x
+
+
+def _is_decimal(s):
+    import re
+
+    return re.fullmatch(r"-?[0-9]+(\.[0-9]+)?(e-?[0-9]+)?", s) is not None
+
+
+# ----------------------------------------------------------------------------- integer forms
+def check_integer_form(form, where):
+    """Validate ``[A, B, D]`` with integer lists and D not the zero polynomial."""
+    if not (isinstance(form, list) and len(form) == 3):
+        raise TableFormatError(f"{where}: an exact entry must be [A, B, D]")
+    for lst in form:
+        if not (isinstance(lst, list) and lst and all(isinstance(a, int) and not isinstance(a, bool) for a in lst)):
+            raise TableFormatError(f"{where}: coefficient lists must be non-empty lists of integers")
+    if all(a == 0 for a in form[2]):
+        raise TableFormatError(f"{where}: zero denominator")
+    return form
+
+
+def eval_form_arb(form, c, lam):
+    """(A(c) + B(c) lam)/D(c) in ball arithmetic (Horner); encloses the value for all c, lam in
+    the balls (the caller sets the working precision)."""
+
+    def horner(coeffs):
+        acc = 0
+        for a in reversed(coeffs):
+            acc = acc * c + a
+        return acc
+
+    return (horner(form[0]) + horner(form[1]) * lam) / horner(form[2])
+
+
+# ----------------------------------------------------------------------------- locations
+def certificates_dir():
+    """The ``certificates/`` folder: ``$CCPROOF_CERTIFICATES`` if set, else the one beside the
+    package source (repository checkout or editable install), else ``./certificates``."""
+    env = os.environ.get("CCPROOF_CERTIFICATES")
+    if env:
+        return Path(env)
+    here = Path(__file__).resolve()
+    for parent in here.parents:
+        cand = parent / "certificates"
+        if (cand / "tables").is_dir():
+            return cand
+    return Path.cwd() / "certificates"
+
+
+def table_filename(valence):
+    """``k007.json`` for k = 7, ``k_ge_40.json`` for the interval k >= 40."""
+    if isinstance(valence, dict):
+        return f"k_ge_{int(valence['min'])}.json"
+    return f"k{int(valence):03d}.json"
+
+
+def table_path(valence, directory=None):
+    return Path(directory or certificates_dir() / "tables") / table_filename(valence)
+
+
+def available_tables(directory=None):
+    """Sorted list of the valences (ints) and intervals (``">=K0"``) with a table file."""
+    d = Path(directory or certificates_dir() / "tables")
+    ks, intervals = [], []
+    if d.is_dir():
+        for p in d.glob("k*.json"):
+            stem = p.stem
+            if stem.startswith("k_ge_") and stem[5:].isdigit():
+                intervals.append(f">={int(stem[5:])}")
+            elif stem[1:].isdigit():
+                ks.append(int(stem[1:]))
+    return sorted(ks) + sorted(intervals)
+
+
+def describe_available(directory=None):
+    av = available_tables(directory)
+    ints = [a for a in av if isinstance(a, int)]
+    rest = [a for a in av if not isinstance(a, int)]
+    if not av:
+        return "no tables exist yet (run `ccproof table --all`)"
+    parts = []
+    if ints:
+        parts.append(f"k = {ints[0]}..{ints[-1]}" if ints == list(range(ints[0], ints[-1] + 1)) else
+                     "k in " + ", ".join(map(str, ints)))
+    parts += [f"k {r}" for r in rest]
+    return "tables exist for " + "; ".join(parts)
+
+
+# ----------------------------------------------------------------------------- loading
+def read_table_json(path, *, check_hash=True):
+    """Read and validate a table file; returns the dict. Raises :class:`TableFormatError` naming
+    the problem (unknown schema, missing field, hash mismatch)."""
+    path = Path(path)
+    try:
+        with open(path, encoding="ascii") as fh:
+            obj = json.load(fh)
+    except FileNotFoundError:
+        raise
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise TableFormatError(f"{path}: not a readable JSON table ({exc})") from None
+    if not isinstance(obj, dict):
+        raise TableFormatError(f"{path}: a table must be a JSON object")
+    if obj.get("schema") != SCHEMA:
+        raise TableFormatError(f"{path}: unknown schema {obj.get('schema')!r}, expected {SCHEMA!r}")
+    for key in ("valence", "prec", "c", "lam", "exact", "arb", "hash"):
+        if key not in obj:
+            raise TableFormatError(f"{path}: missing field {key!r}")
+    v = obj["valence"]
+    if isinstance(v, bool) or not (
+        (isinstance(v, int) and v >= 3)
+        or (isinstance(v, dict) and set(v) == {"min"} and isinstance(v["min"], int) and v["min"] >= 3)
+    ):
+        raise TableFormatError(f"{path}: bad valence field {v!r}")
+    if not isinstance(obj["prec"], int) or isinstance(obj["prec"], bool) or not 32 <= obj["prec"] <= 4096:
+        raise TableFormatError(f"{path}: bad precision {obj['prec']!r}")
+    if check_hash:
+        h = content_hash(obj)
+        if obj["hash"] != h:
+            raise TableFormatError(f"{path}: table hash mismatch (file says {obj['hash']}, content is {h})")
+    return obj
+
+
+def table_nets_arb(obj, form="bezier", prec=None):
+    """The ``arb`` nets of a validated table: ``{"P1": net, ...}``, ``net[i][j] = (x, y)`` balls."""
+    prec = prec or obj["prec"]
+    try:
+        nets = obj["arb"][form]
+    except (KeyError, TypeError):
+        raise TableFormatError(f"table has no arb {form} nets") from None
+    out = {}
+    for name in PATCHES:
+        net = nets.get(name) if isinstance(nets, dict) else None
+        if not (isinstance(net, list) and len(net) == 4 and all(isinstance(r, list) and len(r) == 4 for r in net)):
+            raise TableFormatError(f"arb {form} net {name} must be 4x4")
+        out[name] = [[_point(p, prec, f"{form} {name}[{i}][{j}]") for j, p in enumerate(row)]
+                     for i, row in enumerate(net)]
+    return out
+
+
+def _point(p, prec, where):
+    if not (isinstance(p, list) and len(p) == 2):
+        raise TableFormatError(f"{where}: a point must be [x, y]")
+    return tuple(arb_from_json(q, prec) for q in p)
+
+
+def table_nets_exact(obj):
+    """The exact B-spline nets of a validated table: ``net[i][j] = ([A,B,D], [A,B,D])``."""
+    try:
+        nets = obj["exact"]["bspline"]
+    except (KeyError, TypeError):
+        raise TableFormatError("table has no exact bspline nets") from None
+    out = {}
+    for name in PATCHES:
+        net = nets.get(name) if isinstance(nets, dict) else None
+        if not (isinstance(net, list) and len(net) == 4 and all(isinstance(r, list) and len(r) == 4 for r in net)):
+            raise TableFormatError(f"exact net {name} must be 4x4")
+        out[name] = [
+            [tuple(check_integer_form(q, f"exact {name}[{i}][{j}]") for q in _pair(p, f"{name}[{i}][{j}]"))
+             for j, p in enumerate(row)]
+            for i, row in enumerate(net)
+        ]
+    return out
+
+
+def _pair(p, where):
+    if not (isinstance(p, list) and len(p) == 2 and all(isinstance(q, dict) and "form" in q for q in p)):
+        raise TableFormatError(f"exact {where}: a point must be [{{'form': ...}}, {{'form': ...}}]")
+    return [q["form"] for q in p]
