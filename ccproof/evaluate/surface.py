@@ -1,0 +1,422 @@
+"""The natural parameterization of a Catmull-Clark surface, evaluated exactly (bmz04 section 2, R12).
+
+:func:`limit_surface` turns a :class:`~ccproof.mesh.QuadMesh` into a :class:`LimitSurface` whose
+:meth:`~LimitSurface.evaluate` returns positions and first and second derivatives at batches of
+points ``(face, u, v)``, with respect to the face's own parameter (corner i of the face's vertex
+list at (0,0), (1,0), (1,1), (0,1) for i = 0..3: the ptex convention of OpenSubdiv).
+
+Method (everything below is exact up to floating-point round-off):
+
+* A face whose four vertices are regular (interior valence 4, or boundary with two faces) is a
+  bicubic uniform B-spline patch on its 4 x 4 net (boundary rows completed by ghost points
+  ``2 B - I``, which reproduce the boundary curve rule; OpenSubdiv ``VTX_BOUNDARY_EDGE_ONLY``).
+* A face with one irregular vertex (interior valence != 4, or boundary with a number of faces
+  other than two) whose one-ring is self-similar is evaluated by self-similarity (Stam 1998, bmz04
+  section 3 and Fig. 3): a point in layer n = floor(-log2 max(u, v)) (corner at the origin) lies in
+  one of three regular sub-patches of level n + 1 whose nets are ``M_j A^n C`` (exact matrices of
+  :func:`ccproof.evaluate.local.corner_scheme`, precomputed for every layer), derivatives scaled
+  by 2^(n+1). Points closer to the corner than the last stored layer (where every net equals the
+  limit point to 2^-60 of the one-ring's size) get the limit point and the derivatives of that layer.
+* Any other face (several irregular vertices, or a one-ring that is not yet self-similar, e.g. an
+  extraordinary vertex next to the boundary) is subdivided once, exactly and locally; its four
+  children are classified again (at most ``MAX_DEPTH`` times; beyond that a MeshError).
+
+At evaluation time a point is a gather of one precomputed 4 x 4 net plus one bicubic evaluation: no
+Python loop over points, memory bounded by evaluating in chunks.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ccproof.errors import CCProofError, MeshError
+from ccproof.evaluate.bspline import bspline_basis
+from ccproof.evaluate.local import CORNERS, LocalTopology, canonical_ring, corner_scheme, refine_exact, regular_net
+from ccproof.mesh import QuadMesh, limit_normals, limit_positions
+
+__all__ = ["limit_surface", "LimitSurface"]
+
+#: how many times a face may be subdivided before it must be regular or self-similar
+MAX_DEPTH = 4
+#: points evaluated per chunk (bounds the temporary memory: about 1 kB per point)
+CHUNK = 1 << 15
+
+_REGULAR, _CORNER, _SPLIT = 0, 1, 2
+
+_KEYS = {0: ("P",), 1: ("P", "Pu", "Pv"), 2: ("P", "Pu", "Pv", "Puu", "Puv", "Pvv")}
+
+
+# ---------------------------------------------------------------------------------- frames
+# A frame maps a face's own parameter (s, t) to the base face's (u, v): (u, v) = o + s a + t b,
+# with a, b axis-aligned of the same length (a power of 2).
+def _compose(frame, sub):
+    o, a, b = frame
+    so, sa, sb = sub
+    return (o + a * so[0] + b * so[1], a * sa[0] + b * sa[1], a * sb[0] + b * sb[1])
+
+
+def _corner_frame(i, scale=1.0):
+    """Frame of the square at corner i of [0,1]^2, rotated so that corner i is its origin."""
+    c = np.array(CORNERS, dtype=np.float64)
+    return (c[i] * 1.0, (c[(i + 1) % 4] - c[i]) * scale, (c[(i + 3) % 4] - c[i]) * scale)
+
+
+def _child_frame(i):
+    c = np.array(CORNERS, dtype=np.float64)
+    return (c[i], (c[(i + 1) % 4] - c[i]) / 2, (c[(i + 3) % 4] - c[i]) / 2)
+
+
+def _layer_frame(n, j):
+    """Frame of patch P_j of layer n in the corner frame (corner at the origin), bmz04 Fig. 3."""
+    c = np.array(CORNERS, dtype=np.float64)
+    h = 2.0 ** -(n + 1)
+    return (c[j] * 2.0 * h, (c[(j + 1) % 4] - c[j]) * h, (c[(j + 3) % 4] - c[j]) * h)
+
+
+def _domain(frame):
+    o, a, b = frame
+    lo = o + np.minimum(a, 0) + np.minimum(b, 0)
+    return float(lo[0]), float(lo[1]), float(np.abs(a).max())
+
+
+def _net_permutation(frame):
+    """Index map sending a net in the frame's own orientation to the base orientation."""
+    _, a, b = frame
+    ah, bh = np.sign(a).astype(int), np.sign(b).astype(int)
+    perm = np.empty(16, dtype=np.int64)
+    for q in range(4):
+        for p in range(4):
+            off = (p - 1.5) * ah + (q - 1.5) * bh
+            i, j = int(round(1.5 + off[0])), int(round(1.5 + off[1]))
+            perm[i + 4 * j] = p + 4 * q
+    return perm
+
+
+def _stencil_matrix(stencils, ncols):
+    M = np.zeros((len(stencils), ncols))
+    for r, s in enumerate(stencils):
+        for c, w in s.items():
+            M[r, c] += float(w)
+    return M
+
+
+class _Builder:
+    """Collects patches and virtual faces while classifying the faces of a mesh."""
+
+    def __init__(self):
+        self.nets, self.origins, self.pdom = [], [], []
+        self.vkind, self.vdom, self.vpatch, self.vchild, self.vcorner, self.vnmax = [], [], [], [], [], []
+        self.max_depth = 0
+
+    def new_vface(self, kind, frame):
+        self.vkind.append(kind)
+        self.vdom.append(_domain(frame))
+        self.vpatch.append(-1)
+        self.vchild.append([-1, -1, -1, -1])
+        self.vcorner.append((0, 0))
+        self.vnmax.append(0)
+        return len(self.vkind) - 1
+
+    def add_patch(self, net, origin, frame):
+        """net: (16, 3) in the frame's own orientation, relative to origin."""
+        self.nets.append(net[_net_permutation(frame)])
+        self.origins.append(origin)
+        self.pdom.append(_domain(frame))
+        return len(self.nets) - 1
+
+    # ------------------------------------------------------------------ classification
+    def face(self, topo, X, f, frame, depth, base_face, vid=None):
+        F = topo.flat
+        irregular = [i for i in range(4) if not topo.is_regular(F[4 * f + i])]
+        if not irregular:
+            net = regular_net(topo, f)
+            if net is None:  # pragma: no cover - regular vertices always give a net
+                raise MeshError(f"face {base_face}: no regular B-spline net")
+            ids = sorted({v for s in net for v in s})
+            M = _stencil_matrix([{ids.index(v): w for v, w in s.items()} for s in net], len(ids))
+            Xl = X[ids]
+            origin = Xl.mean(axis=0)
+            vid = self.new_vface(_REGULAR, frame) if vid is None else vid
+            self.vkind[vid] = _REGULAR
+            self.vpatch[vid] = self.add_patch(M @ (Xl - origin), origin, frame)
+            return vid
+        if len(irregular) == 1:
+            r = irregular[0]
+            ring, key, _ = canonical_ring(topo, f, r)
+            scheme = corner_scheme(key)
+            if scheme is not None:
+                return self.corner_face(scheme, X[ring], r, frame, vid)
+        if depth >= MAX_DEPTH:
+            raise MeshError(
+                f"face {base_face}: the configuration around it is not supported "
+                f"(still irregular after {MAX_DEPTH} local subdivisions)"
+            )
+        return self.split_face(topo, X, f, frame, depth, base_face, vid)
+
+    def corner_face(self, scheme, C, r, frame, vid):
+        rot = _compose(frame, _corner_frame(r))
+        vid = self.new_vface(_CORNER, frame) if vid is None else vid
+        self.vkind[vid] = _CORNER
+        U0, V0, H = self.vdom[vid]
+        corner = rot[0]
+        self.vcorner[vid] = (int(corner[0] > U0), int(corner[1] > V0))
+        rel = C - C[0]
+        origin = C[0] + scheme.limit_mask @ rel
+        dev = np.einsum("njqN,Nc->njqc", scheme.layers, rel)  # (n_layers, 3, 16, 3)
+        nl = dev.shape[0]
+        base = len(self.nets)
+        slots = [None] * (3 * nl)
+        # P_1 lies along the frame's a-axis: code 0 (u-distance >= 1/2, v-distance < 1/2) if a is
+        # along u, else code 2; P_2 (diagonal) is code 1; P_3 the other one
+        a_along_u = abs(rot[1][0]) > 0
+        codes = {1: 0 if a_along_u else 2, 2: 1, 3: 2 if a_along_u else 0}
+        for n in range(nl):
+            for j in (1, 2, 3):
+                slots[3 * n + codes[j]] = (dev[n, j - 1], _compose(rot, _layer_frame(n, j)))
+        for net, pf in slots:
+            self.add_patch(net, origin, pf)
+        self.vpatch[vid] = base
+        self.vnmax[vid] = nl - 1
+        return vid
+
+    def split_face(self, topo, X, f, frame, depth, base_face, vid):
+        ring, key, _ = canonical_ring(topo, f, 0)
+        stencils, children = refine_exact(key)
+        need = sorted({v for c in children[:4] for v in c})
+        topo1 = LocalTopology(children)
+        # only the rows that the children's one-rings can use are needed; others may be None
+        rows = [s if s is not None else {} for s in stencils]
+        X1 = _stencil_matrix(rows, len(ring)) @ X[ring]
+        del need
+        vid = self.new_vface(_SPLIT, frame) if vid is None else vid
+        self.vkind[vid] = _SPLIT
+        self.max_depth = max(self.max_depth, depth + 1)
+        U0, V0, H = self.vdom[vid]
+        for i in range(4):
+            cf = _compose(frame, _child_frame(i))
+            cu, cv, _ = _domain(cf)
+            q = int(cu > U0) + 2 * int(cv > V0)
+            child = self.new_vface(_REGULAR, cf)
+            self.vchild[vid][q] = child
+            self.face(topo1, X1, i, cf, depth + 1, base_face, vid=child)
+        return vid
+
+
+class LimitSurface:
+    """Exact evaluator of the limit surface of a quad mesh (natural parameterization, bmz04 section 2).
+
+    Build it with :func:`limit_surface`. Attributes: ``mesh``, ``n_patches`` (bicubic patches
+    stored), ``max_layers`` (deepest layer stored at an irregular corner), ``split_depth`` (how many
+    local subdivisions the most irregular face needed).
+    """
+
+    def __init__(self, mesh: QuadMesh):
+        self.mesh = mesh
+        b = _Builder()
+        topo = LocalTopology(mesh.faces)
+        X = mesh.vertices
+        base = (np.zeros(2), np.array([1.0, 0.0]), np.array([0.0, 1.0]))
+        m = mesh.n_faces
+        for _ in range(m):  # virtual faces 0..m-1 are the base faces
+            b.new_vface(_REGULAR, base)
+        for f in range(m):
+            b.face(topo, X, f, base, 0, f, vid=f)
+        self._nets = np.ascontiguousarray(np.array(b.nets).reshape(-1, 16, 3))
+        self._origin = np.array(b.origins).reshape(-1, 3)
+        pd = np.array(b.pdom).reshape(-1, 3)
+        self._pu0, self._pv0, self._ph = pd[:, 0].copy(), pd[:, 1].copy(), pd[:, 2].copy()
+        self._vkind = np.array(b.vkind, dtype=np.int8)
+        vd = np.array(b.vdom).reshape(-1, 3)
+        self._vu0, self._vv0, self._vh = vd[:, 0].copy(), vd[:, 1].copy(), vd[:, 2].copy()
+        self._vpatch = np.array(b.vpatch, dtype=np.int64)
+        self._vchild = np.array(b.vchild, dtype=np.int64).reshape(-1, 4)
+        vc = np.array(b.vcorner, dtype=bool).reshape(-1, 2)
+        self._vcu, self._vcv = vc[:, 0].copy(), vc[:, 1].copy()
+        self._vnmax = np.array(b.vnmax, dtype=np.int64)
+        self.split_depth = b.max_depth
+        self.n_patches = self._nets.shape[0]
+        self.max_layers = int(self._vnmax.max()) + 1 if (self._vkind == _CORNER).any() else 0
+
+    # ------------------------------------------------------------------ input checks
+    def _check(self, face_ids, u, v):
+        f = np.asarray(face_ids)
+        u = np.asarray(u, dtype=np.float64)
+        v = np.asarray(v, dtype=np.float64)
+        try:
+            f, u, v = np.broadcast_arrays(f, u, v)
+        except ValueError:
+            raise CCProofError(
+                f"face_ids, u, v must have the same length, got {np.shape(face_ids)}, {u.shape}, {v.shape}"
+            ) from None
+        f, u, v = f.reshape(-1), u.reshape(-1), v.reshape(-1)
+        if f.size and not np.issubdtype(f.dtype, np.integer):
+            fi = f.astype(np.int64) if np.isfinite(f.astype(float)).all() else None
+            if fi is None or not np.array_equal(fi, f):
+                bad = int(np.flatnonzero(fi != f)[0]) if fi is not None else 0
+                raise CCProofError(f"point {bad}: face id {f[bad]!r} is not an integer")
+            f = fi
+        f = f.astype(np.int64, copy=False)
+        m = self.mesh.n_faces
+        bad = np.flatnonzero((f < 0) | (f >= m))
+        if bad.size:
+            i = int(bad[0])
+            raise CCProofError(f"point {i}: face id {int(f[i])} out of range [0, {m})")
+        for name, x in (("u", u), ("v", v)):
+            bad = np.flatnonzero(~((x >= 0.0) & (x <= 1.0)))
+            if bad.size:
+                i = int(bad[0])
+                raise CCProofError(f"point {i}: {name} = {x[i]!r} is outside [0, 1]")
+        return f, u, v
+
+    # ------------------------------------------------------------------ evaluation
+    def locate(self, face_ids, u, v):
+        """The stored patch of every point and the point's parameter in it.
+
+        Returns
+        -------
+        patch : ndarray of int, shape (n,)
+        s, t : ndarray, shape (n,)
+            Parameter in the patch, in [0, 1]; exact (dyadic rescaling).
+        scale : ndarray, shape (n,)
+            ``1 / h``: d/du = scale * d/ds for a patch of side h (a power of 2).
+        """
+        f, u, v = self._check(face_ids, u, v)
+        return self._locate(f, u, v)
+
+    def _locate(self, f, u, v):
+        vf = f.copy()
+        kind = self._vkind[vf]
+        for _ in range(self.split_depth):
+            idx = np.flatnonzero(kind == _SPLIT)
+            if idx.size == 0:
+                break
+            w = vf[idx]
+            half = self._vh[w] * 0.5
+            q = (u[idx] >= self._vu0[w] + half).astype(np.int64) + 2 * (v[idx] >= self._vv0[w] + half)
+            vf[idx] = self._vchild[w, q]
+            kind[idx] = self._vkind[vf[idx]]
+        patch = self._vpatch[vf].copy()
+        idx = np.flatnonzero(kind == _CORNER)
+        if idx.size:
+            w = vf[idx]
+            U0, V0, H = self._vu0[w], self._vv0[w], self._vh[w]
+            uu, vv = u[idx], v[idx]
+            du = np.where(self._vcu[w], (U0 + H) - uu, uu - U0) / H  # exact: dyadic, Sterbenz
+            dv = np.where(self._vcv[w], (V0 + H) - vv, vv - V0) / H
+            mx = np.maximum(du, dv)
+            _, e = np.frexp(mx)  # mx in [2^(e-1), 2^e): layer n = -e
+            nmax = self._vnmax[w]
+            n = np.where(mx > 0, np.clip(-e, 0, nmax), nmax)
+            du, dv = np.ldexp(du, n), np.ldexp(dv, n)
+            a, b = du >= 0.5, dv >= 0.5
+            code = np.where(a & ~b, 0, np.where(a & b, 1, np.where(b, 2, 1)))
+            patch[idx] = patch[idx] + 3 * n + code
+        h = self._ph[patch]
+        s = np.clip((u - self._pu0[patch]) / h, 0.0, 1.0)
+        t = np.clip((v - self._pv0[patch]) / h, 0.0, 1.0)
+        return patch, s, t, 1.0 / h
+
+    def evaluate(self, face_ids, u, v, derivatives=1, *, chunk=CHUNK, out=None):
+        """Positions and derivatives of the limit surface at points (face, u, v).
+
+        Parameters
+        ----------
+        face_ids : array_like of int, shape (n,)
+        u, v : array_like of float, shape (n,)
+            Face parameters in [0, 1] (corner i of the face at (0,0), (1,0), (1,1), (0,1)).
+        derivatives : int, 0, 1 or 2
+        chunk : int
+            Points per chunk (memory beyond the outputs is about 1 kB per chunk point).
+        out : dict of ndarray, optional
+            Preallocated outputs (shape (n, 3) each) to fill.
+
+        Returns
+        -------
+        dict of ndarray, shape (n, 3)
+            ``P``; with ``derivatives >= 1`` also ``Pu``, ``Pv``; with 2 also ``Puu``, ``Puv``,
+            ``Pvv``: derivatives with respect to the face's own (u, v).
+
+        Raises
+        ------
+        CCProofError
+            Face id out of range or not an integer, (u, v) outside [0, 1]^2 or NaN (names the point).
+
+        Examples
+        --------
+        >>> from ccproof.mesh.examples import cube
+        >>> S = limit_surface(cube())
+        >>> r = S.evaluate([0, 1], [0.0, 0.5], [0.0, 0.5])
+        >>> r["P"].round(12).tolist()      # a cube corner's limit point; centre of the top face
+        [[-0.5, -0.5, -0.5], [0.0, 0.0, 0.75]]
+        """
+        if derivatives not in (0, 1, 2):
+            raise CCProofError(f"derivatives must be 0, 1 or 2, got {derivatives!r}")
+        f, u, v = self._check(face_ids, u, v)
+        n = f.size
+        keys = _KEYS[derivatives]
+        if out is None:
+            out = {k: np.empty((n, 3)) for k in keys}
+        for lo in range(0, n, chunk):
+            hi = min(n, lo + chunk)
+            self._eval_chunk(f[lo:hi], u[lo:hi], v[lo:hi], derivatives, {k: out[k][lo:hi] for k in keys})
+        return out
+
+    def _eval_chunk(self, f, u, v, d, out):
+        patch, s, t, g = self._locate(f, u, v)
+        bs = bspline_basis(s, d)
+        bt = bspline_basis(t, d)
+        N = self._nets[patch].reshape(-1, 4, 4, 3)  # [n, j, i, c]
+        T0 = np.einsum("nj,njic->nic", bt[0], N)
+        np.add(self._origin[patch], np.einsum("ni,nic->nc", bs[0], T0), out=out["P"])
+        if d >= 1:
+            T1 = np.einsum("nj,njic->nic", bt[1], N)
+            gg = g[:, None]
+            np.multiply(np.einsum("ni,nic->nc", bs[1], T0), gg, out=out["Pu"])
+            np.multiply(np.einsum("ni,nic->nc", bs[0], T1), gg, out=out["Pv"])
+        if d >= 2:
+            T2 = np.einsum("nj,njic->nic", bt[2], N)
+            g2 = (g * g)[:, None]
+            np.multiply(np.einsum("ni,nic->nc", bs[2], T0), g2, out=out["Puu"])
+            np.multiply(np.einsum("ni,nic->nc", bs[1], T1), g2, out=out["Puv"])
+            np.multiply(np.einsum("ni,nic->nc", bs[0], T2), g2, out=out["Pvv"])
+
+    # ------------------------------------------------------------------ vertices
+    def vertex_limits(self):
+        """Exact limit positions of the control vertices (masks), shape (n_vertices, 3)."""
+        return limit_positions(self.mesh)
+
+    def vertex_normals(self):
+        """Unit limit normals at the control vertices, shape (n_vertices, 3).
+
+        Eigen masks (:func:`ccproof.mesh.limit_normals`) at interior and regular boundary vertices;
+        at other boundary vertices the normal of the innermost stored layer at the corner of an
+        incident face, ``Pu x Pv`` (converged to the tangent plane to round-off).
+        """
+        Nn = limit_normals(self.mesh)
+        bad = np.flatnonzero(np.isnan(Nn).any(axis=1))
+        if bad.size:
+            c = self.mesh.fan_corners[self.mesh.fan_ptr[bad]]
+            f, i = c // 4, c % 4
+            uv = np.array(CORNERS, dtype=np.float64)[i]
+            r = self.evaluate(f, uv[:, 0], uv[:, 1], 1)
+            nrm = np.cross(r["Pu"], r["Pv"])
+            Nn[bad] = nrm / np.linalg.norm(nrm, axis=1, keepdims=True)
+        return Nn
+
+
+def limit_surface(mesh):
+    """Prepare the exact evaluation of the limit surface of ``mesh`` (a QuadMesh or an OBJ path).
+
+    Parameters
+    ----------
+    mesh : QuadMesh or str or os.PathLike
+
+    Returns
+    -------
+    LimitSurface
+    """
+    if not isinstance(mesh, QuadMesh):
+        from ccproof.mesh import read_obj
+
+        mesh = read_obj(mesh)
+    return LimitSurface(mesh)
