@@ -1,0 +1,497 @@
+"""The dynamic Catmull-Clark surface: generalized coordinates, global matrices, limit evaluation (qmv98 2.4-3.1).
+
+The generalized coordinates are the control points ``p`` of the initial mesh (qmv98 eq. 15,
+``s = J p``). ccproof stores them as an ``(n, 3)`` array ``P``; the paper's interleaved vector is
+``P.reshape(-1)`` and every paper matrix is ``X_scalar (x) I_3`` of the scalar ``n x n`` matrices
+built here (the three coordinates never couple).
+
+Global matrices (qmv98 eqs. 18-20) are sums of element matrices: normal elements (16 x 16,
+analytic, :mod:`ccproof.apps.dynamics.basis`) and special elements (``(6n+1) x (6n+1)``,
+:mod:`ccproof.apps.dynamics.elements`). With constant densities the mass and damping matrices
+are ``mu M1`` and ``gamma M1`` with the unit-density mass ``M1``; the special-element part of ``M1`` is
+the exact infinite sum, the stiffness is truncated at the level ``levels`` (``L``).
+
+Two products with any combination ``c_m M1 + c_k K``: the assembled :mod:`scipy.sparse` matrix
+(:meth:`DynamicSurface.assemble`) and the element-by-element product without a global matrix
+(:meth:`DynamicSurface.matvec`, the paper's choice "in the interest of time").
+
+>>> from ccproof.apps.dynamics.meshes import paper_initial_model
+>>> model = DynamicSurface(paper_initial_model())
+>>> model.n_vertices, model.layout.n_normal, model.layout.n_special
+(98, 72, 8)
+>>> import numpy as np
+>>> M1 = model.assemble(c_mass=1.0, c_stiff=0.0)
+>>> round(float(M1.sum()), 12)       # 1^T M1 1 = total parametric area = number of faces
+96.0
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, replace
+
+import numpy as np
+import scipy.sparse as sp
+
+from ccproof.apps.dynamics.basis import patch_rows, term_matrix
+from ccproof.apps.dynamics.elements import (
+    STIFFNESS_TERMS,
+    element_layout,
+    face_to_sector,
+    sector_derivative_maps,
+    special_scheme,
+)
+from ccproof.errors import CCProofError
+
+__all__ = ["Material", "DynamicSurface", "MAX_EVAL_LEVEL"]
+
+#: deepest local level used by the evaluation; below 2^-MAX_EVAL_LEVEL the EV limit point is returned
+MAX_EVAL_LEVEL = 60
+
+
+@dataclass(frozen=True)
+class Material:
+    """Constant material densities of qmv98 eqs. (18)-(20).
+
+    Parameters
+    ----------
+    mu : float
+        Mass density (eq. 18).
+    gamma : float
+        Damping density (eq. 19).
+    a11, a22 : float
+        Tension along u and v (eq. 20).
+    b11, b12, b22 : float
+        Rigidity; ``b12`` multiplies ``J_uv^T J_uv`` once (the isotropic thin plate is
+        ``b11 = b22 = b, b12 = 2 b``).
+
+    All must be finite and >= 0.
+
+    >>> Material(mu=-1)
+    Traceback (most recent call last):
+    ...
+    ccproof.errors.CCProofError: material parameter mu must be finite and >= 0, got -1
+    """
+
+    mu: float = 1.0
+    gamma: float = 1.0
+    a11: float = 1.0
+    a22: float = 1.0
+    b11: float = 1.0
+    b12: float = 2.0
+    b22: float = 1.0
+
+    def __post_init__(self):
+        for name, val in asdict(self).items():
+            try:
+                ok = math.isfinite(float(val)) and float(val) >= 0
+            except (TypeError, ValueError):
+                ok = False
+            if not ok:
+                raise CCProofError(f"material parameter {name} must be finite and >= 0, got {val!r}")
+
+    def term_coefficients(self, swap=False):
+        """Coefficients of the stiffness integrands of :data:`~ccproof.apps.dynamics.basis.TERMS`.
+
+        ``swap=True`` exchanges the u and v roles (a special-element sector whose s axis is the
+        face's v axis, i.e. the EV at an odd corner).
+        """
+        if swap:
+            return {"uu1": self.a22, "vv1": self.a11, "uu2": self.b22, "uv2": self.b12, "vv2": self.b11}
+        return {"uu1": self.a11, "vv1": self.a22, "uu2": self.b11, "uv2": self.b12, "vv2": self.b22}
+
+    def refined(self):
+        """Densities for the model rebuilt on the CC-subdivided mesh with the *same* energies.
+
+        Every child face gets its own unit domain, so the same densities would make the mass
+        4 times, the rigidity energy 1/4 of the coarse one (spec B4): mu, gamma / 4, b * 4.
+        """
+        return replace(self, mu=self.mu / 4, gamma=self.gamma / 4, b11=4 * self.b11, b12=4 * self.b12,
+                       b22=4 * self.b22)
+
+
+def _check_points(faces, u, v):
+    faces = np.atleast_1d(np.asarray(faces))
+    u = np.atleast_1d(np.asarray(u, dtype=np.float64))
+    v = np.atleast_1d(np.asarray(v, dtype=np.float64))
+    if not np.issubdtype(faces.dtype, np.integer):
+        raise CCProofError("face ids must be integers")
+    faces, u, v = np.broadcast_arrays(faces.astype(np.int64), u, v)
+    if not (np.isfinite(u).all() and np.isfinite(v).all()):
+        raise CCProofError("parameters (u, v) must be finite")
+    if ((u < 0) | (u > 1) | (v < 0) | (v > 1)).any():
+        raise CCProofError("parameters (u, v) must lie in [0, 1]^2")
+    return faces.reshape(-1), u.reshape(-1), v.reshape(-1)
+
+
+class DynamicSurface:
+    """Finite-element model of a dynamic Catmull-Clark surface on a control mesh (qmv98 sections 2-3).
+
+    Parameters
+    ----------
+    mesh : ccproof.mesh.QuadMesh
+        The initial mesh; extraordinary vertices must be isolated (no face with two of them).
+        ``mesh.vertices`` is only the default state; the dynamics work on separate arrays ``P``.
+    material : Material, optional
+    levels : int
+        Truncation level L of the special-element stiffness sums (the mass is exact).
+    face_swap : bool array (m,), optional
+        Faces whose tension/rigidity directions are exchanged (``a11 <-> a22``, ``b11 <-> b22``).
+        :meth:`refine` sets it so that the child faces, whose parameters
+        :func:`ccproof.mesh.subdivide` rotates by a quarter turn at odd corners, keep the directions
+        of their parent; irrelevant for isotropic material (``a11 = a22``, ``b11 = b22``).
+
+    Attributes
+    ----------
+    layout : ccproof.apps.dynamics.elements.ElementLayout
+    """
+
+    def __init__(self, mesh, material=None, levels=8, face_swap=None):
+        if material is None:
+            material = Material()
+        if not isinstance(material, Material):
+            raise CCProofError(f"material must be a Material, got {type(material).__name__}")
+        if int(levels) != levels or levels < 1:
+            raise CCProofError(f"truncation level must be an integer >= 1, got {levels!r}")
+        self.mesh = mesh
+        self.material = material
+        self.levels = int(levels)
+        self.layout = element_layout(mesh)
+        if face_swap is None:
+            face_swap = np.zeros(mesh.n_faces, dtype=bool)
+        face_swap = np.asarray(face_swap, dtype=bool)
+        if face_swap.shape != (mesh.n_faces,):
+            raise CCProofError(f"face_swap must have shape ({mesh.n_faces},), got {face_swap.shape}")
+        self.face_swap = face_swap
+        if self.layout.n_patch_faces == 0:
+            raise CCProofError("the mesh has no face with a limit patch (every face touches the boundary)")
+        self._pattern = None
+        self._special_cache = None
+
+    # ------------------------------------------------------------------ basics
+    @property
+    def n_vertices(self):
+        return self.mesh.n_vertices
+
+    @property
+    def vertices(self):
+        """The mesh's control points (the default state), (n, 3)."""
+        return np.array(self.mesh.vertices)
+
+    def normal_element_matrices(self, swap=False):
+        """Unit mass and material stiffness of a normal element (16 x 16 each)."""
+        coef = self.material.term_coefficients(swap=swap)
+        K = sum(c * term_matrix(t) for t, c in coef.items())
+        return term_matrix("mass"), K
+
+    def _normal_swap(self):
+        return self.face_swap[self.layout.normal_faces]
+
+    def special_element_matrices(self):
+        """Per special element: ``(ring, unit mass (exact), material stiffness (levels 1..L))``."""
+        if self._special_cache is None:
+            out = []
+            lay = self.layout
+            for e in range(lay.n_special):
+                n = int(lay.special_valence[e])
+                S = special_scheme(n)
+                sums, _, _ = S.stiffness_truncated(self.levels)
+                K = np.zeros((S.d, S.d))
+                for j, (f, c) in enumerate(zip(lay.special_faces[e], lay.special_corners[e])):
+                    coef = self.material.term_coefficients(swap=bool(c % 2) ^ bool(self.face_swap[f]))
+                    for t in STIFFNESS_TERMS:
+                        if coef[t]:
+                            K += coef[t] * sums[t][j]
+                out.append((lay.special_rings[e], S.mass_exact(), K))
+            self._special_cache = out
+        return self._special_cache
+
+    # ------------------------------------------------------------------ assembly
+    def _build_pattern(self):
+        lay = self.layout
+        n = self.n_vertices
+        nets = lay.normal_nets
+        r = [np.repeat(nets, 16, axis=1).reshape(-1)]
+        c = [np.tile(nets, (1, 16)).reshape(-1)]
+        for ring in lay.special_rings:
+            r.append(np.repeat(ring, ring.size))
+            c.append(np.tile(ring, ring.size))
+        rows = np.concatenate(r)
+        cols = np.concatenate(c)
+        keys = rows * n + cols
+        uniq = np.unique(keys)
+        pos = np.searchsorted(uniq, keys)
+        indptr = np.searchsorted(uniq // n, np.arange(n + 1))
+        self._pattern = (uniq % n, indptr, pos, nets.shape[0] * 256)
+
+    def assemble(self, c_mass=0.0, c_stiff=1.0):
+        """Sparse ``c_mass M1 + c_stiff K`` (n x n CSR), element by element into a fixed pattern.
+
+        ``M1`` is the unit-density mass (``M = mu M1``, ``D = gamma M1``), ``K`` the stiffness of
+        the material.
+        """
+        if self._pattern is None:
+            self._build_pattern()
+        indices, indptr, pos, nn = self._pattern
+        Ke = self._normal_combined(c_mass, c_stiff)
+        vals = [Ke.reshape(-1)]
+        for _, Ms, Ks in self.special_element_matrices():
+            vals.append((c_mass * Ms + c_stiff * Ks).reshape(-1))
+        data = np.bincount(pos, weights=np.concatenate(vals), minlength=indices.size)
+        n = self.n_vertices
+        return sp.csr_matrix((data, indices, indptr), shape=(n, n))
+
+    def _normal_combined(self, c_mass, c_stiff):
+        """Element matrices ``c_mass M1_e + c_stiff K_e`` of every normal element, (Nn, 16, 16)."""
+        sw = self._normal_swap()
+        out = np.empty((sw.size, 16, 16))
+        for flag in (False, True):
+            sel = np.flatnonzero(sw == flag)
+            if sel.size:
+                Mn, Kn = self.normal_element_matrices(swap=flag)
+                out[sel] = c_mass * Mn + c_stiff * Kn
+        return out
+
+    def diagonal(self, c_mass=0.0, c_stiff=1.0):
+        """Diagonal of ``c_mass M1 + c_stiff K`` from the element matrices (no global matrix)."""
+        n = self.n_vertices
+        d = np.zeros(n)
+        if self.layout.n_normal:
+            Ke = self._normal_combined(c_mass, c_stiff)
+            d += np.bincount(self.layout.normal_nets.reshape(-1),
+                             weights=np.diagonal(Ke, axis1=1, axis2=2).reshape(-1), minlength=n)
+        for ring, Ms, Ks in self.special_element_matrices():
+            np.add.at(d, ring, np.diag(c_mass * Ms + c_stiff * Ks))
+        return d
+
+    def mass_matrix(self):
+        """``M = mu M1`` (sparse)."""
+        return self.assemble(self.material.mu, 0.0)
+
+    def damping_matrix(self):
+        """``D = gamma M1`` (sparse)."""
+        return self.assemble(self.material.gamma, 0.0)
+
+    def stiffness_matrix(self):
+        """``K`` (sparse), special elements truncated at level L."""
+        return self.assemble(0.0, 1.0)
+
+    def matvec(self, X, c_mass=0.0, c_stiff=1.0):
+        """Matrix-free ``(c_mass M1 + c_stiff K) X`` element by element (X: (n,) or (n, k))."""
+        X = np.asarray(X, dtype=np.float64)
+        vec = X.ndim == 1
+        X2 = X[:, None] if vec else X
+        n = self.n_vertices
+        Y = np.zeros_like(X2)
+        lay = self.layout
+        if lay.n_normal:
+            nets = lay.normal_nets
+            sw = self._normal_swap()
+            Ye = np.empty(nets.shape + (X2.shape[1],))
+            for flag in (False, True):
+                sel = np.flatnonzero(sw == flag)
+                if sel.size:
+                    Mn, Kn = self.normal_element_matrices(swap=flag)
+                    Ye[sel] = np.einsum("ab,ebk->eak", c_mass * Mn + c_stiff * Kn, X2[nets[sel]])
+            flat = nets.reshape(-1)
+            for k in range(X2.shape[1]):
+                Y[:, k] += np.bincount(flat, weights=Ye[:, :, k].reshape(-1), minlength=n)
+        for ring, Ms, Ks in self.special_element_matrices():
+            np.add.at(Y, ring, (c_mass * Ms + c_stiff * Ks) @ X2[ring])
+        return Y[:, 0] if vec else Y
+
+    def energy(self, P):
+        """Elastic energy ``1/2 tr(P^T K P)`` of the state P (n, 3)."""
+        P = np.asarray(P, dtype=np.float64)
+        return 0.5 * float(np.sum(P * self.matvec(P)))
+
+    # ------------------------------------------------------------------ truncation report
+    def truncation_report(self, P=None):
+        """How much of each special element's stiffness series the truncation at level L keeps.
+
+        For every special element: the valence n, the per-level ratios of the tension (lam^2) and
+        rigidity (4 lam^2) series, the Frobenius norms of the truncated stiffness and of its level-L
+        increment, and the geometric estimate of the neglected tail (``inf`` when the rigidity
+        series diverges, n >= 5). With ``P`` the same numbers are given as energies
+        ``1/2 tr(P_e^T X P_e)`` of the element's ring.
+        """
+        from ccproof.algebra.specialize import subdominant_eigenvalue
+
+        out = []
+        lay = self.layout
+        for e in range(lay.n_special):
+            n = int(lay.special_valence[e])
+            S = special_scheme(n)
+            sums, last, _ = S.stiffness_truncated(self.levels)
+            lam = subdominant_eigenvalue(n, "float")
+            rec = {"ev": int(lay.special_ev[e]), "valence": n, "levels": self.levels}
+            for group, terms, ratio in (("tension", ("uu1", "vv1"), lam**2), ("rigidity", ("uu2", "uv2", "vv2"),
+                                                                                4 * lam**2)):
+                tot = np.zeros((S.d, S.d))
+                inc = np.zeros((S.d, S.d))
+                for j, (f, c) in enumerate(zip(lay.special_faces[e], lay.special_corners[e])):
+                    coef = self.material.term_coefficients(swap=bool(c % 2) ^ bool(self.face_swap[f]))
+                    for t in terms:
+                        tot += coef[t] * sums[t][j]
+                        inc += coef[t] * last[t][j]
+                if P is not None:
+                    Pe = np.asarray(P, dtype=np.float64)[lay.special_rings[e]]
+                    a = 0.5 * float(np.sum(Pe * (tot @ Pe)))
+                    b = 0.5 * float(np.sum(Pe * (inc @ Pe)))
+                else:
+                    a, b = float(np.linalg.norm(tot)), float(np.linalg.norm(inc))
+                tail = b * ratio / (1 - ratio) if ratio < 1 else math.inf
+                rec[group] = {"ratio": ratio, "truncated": a, "last_level": b, "tail_estimate": tail}
+            out.append(rec)
+        return out
+
+    # ------------------------------------------------------------------ evaluation
+    def _rows(self, faces, u, v, derivatives):
+        """Shape-function rows grouped by element type: list of (points, vertex ids, rows dict)."""
+        lay = self.layout
+        kind = lay.face_kind[faces]
+        if (kind == 0).any():
+            f = int(faces[np.flatnonzero(kind == 0)[0]])
+            raise CCProofError(f"face {f} carries no limit patch (it touches the boundary)")
+        groups = []
+        nrm = np.flatnonzero(kind == 1)
+        if nrm.size:
+            rows = patch_rows(u[nrm], v[nrm], derivatives)
+            groups.append((nrm, lay.normal_nets[lay.face_element[faces[nrm]]], rows))
+        spc = np.flatnonzero(kind == 2)
+        if spc.size:
+            groups += self._special_rows(spc, faces[spc], u[spc], v[spc], derivatives)
+        return groups
+
+    def _special_rows(self, pts, faces, u, v, derivatives):
+        lay = self.layout
+        elem = lay.face_element[faces]
+        corner = lay.face_corner[faces]
+        sector = lay.face_sector[faces]
+        s, t = face_to_sector(corner, u, v)
+        m = np.maximum(s, t)
+        with np.errstate(divide="ignore"):
+            lev = np.where(m > 0, np.floor(-np.log2(np.where(m > 0, m, 1.0))) + 1, MAX_EVAL_LEVEL + 1)
+        lev = lev.astype(np.int64)
+        # guard the floor against rounding: the level-l patches cover 2^-l <= m <= 2^-(l-1)
+        lev = np.where((lev <= MAX_EVAL_LEVEL) & (m * 2.0**lev < 1.0), lev + 1, lev)
+        lev = np.where((lev > 1) & (lev <= MAX_EVAL_LEVEL) & (m * 2.0 ** (lev - 1) > 1.0), lev - 1, lev)
+        valence = lay.special_valence[elem]
+        R = sector_derivative_maps()[corner]
+        names = ["P"] + (["Pu", "Pv"] if derivatives >= 1 else []) + (["Puu", "Puv", "Pvv"] if derivatives >= 2 else [])
+        groups = []
+        for n in np.unique(valence):
+            S = special_scheme(int(n))
+            sel_n = np.flatnonzero(valence == n)
+            ring_ids = np.stack([lay.special_rings[e] for e in elem[sel_n]]) if sel_n.size else None
+            out = {k: np.zeros((sel_n.size, S.d)) for k in names}
+            lv = lev[sel_n]
+            deep = lv > MAX_EVAL_LEVEL
+            if deep.any():
+                out["P"][deep] = S.limit_row
+            for level in np.unique(lv[~deep]):
+                idx = np.flatnonzero(lv == level)
+                g = sel_n[idx]
+                scale = 2.0**level
+                xs, ys = s[g] * scale, t[g] * scale
+                a = np.minimum(np.floor(xs), 1.0)
+                b = np.minimum(np.floor(ys), 1.0)
+                q = np.where(a == 1, np.where(b == 1, 1, 0), 2)  # (1,0) -> 0, (1,1) -> 1, (0,1) -> 2
+                x, y = xs - a, ys - b
+                pr = patch_rows(x, y, derivatives)
+                Pl = S.level_map(int(level))
+                T = Pl[S.select[sector[g], q]]  # (g, 16, d)
+                loc = {k: np.einsum("gk,gkd->gd", pr[k], T) for k in pr}
+                out["P"][idx] = loc["P"]
+                if derivatives >= 1:
+                    Rg = R[g]
+                    Ps, Pt = loc["Pu"] * scale, loc["Pv"] * scale
+                    out["Pu"][idx] = Rg[:, 0, 0, None] * Ps + Rg[:, 0, 1, None] * Pt
+                    out["Pv"][idx] = Rg[:, 1, 0, None] * Ps + Rg[:, 1, 1, None] * Pt
+                if derivatives >= 2:
+                    s2 = scale * scale
+                    H = {(0, 0): loc["Puu"] * s2, (0, 1): loc["Puv"] * s2, (1, 1): loc["Pvv"] * s2}
+                    H[(1, 0)] = H[(0, 1)]
+                    for name, (r1, r2) in (("Puu", (0, 0)), ("Puv", (0, 1)), ("Pvv", (1, 1))):
+                        acc = 0.0
+                        for a1 in range(2):
+                            for a2 in range(2):
+                                acc = acc + (Rg[:, r1, a1] * Rg[:, r2, a2])[:, None] * H[(a1, a2)]
+                        out[name][idx] = acc
+            groups.append((pts[sel_n], ring_ids, out))
+        return groups
+
+    def basis(self, faces, u, v, derivatives=0):
+        """Rows of ``J`` (and of its derivatives) at points: dict name -> CSR (m, n).
+
+        ``basis(...)["P"] @ P`` is the limit surface at the points (qmv98 eq. 15, scalar form).
+        """
+        faces, u, v = _check_points(faces, u, v)
+        m, n = faces.size, self.n_vertices
+        mats = {}
+        for pts, ids, rows in self._rows(faces, u, v, derivatives):
+            w = ids.shape[1]
+            for k, W in rows.items():
+                mats.setdefault(k, []).append((np.repeat(pts, w), ids.reshape(-1), W.reshape(-1)))
+        out = {}
+        for k, parts in mats.items():
+            r = np.concatenate([p[0] for p in parts])
+            c = np.concatenate([p[1] for p in parts])
+            d = np.concatenate([p[2] for p in parts])
+            out[k] = sp.csr_matrix((d, (r, c)), shape=(m, n))
+        return out
+
+    def evaluate(self, faces, u, v, derivatives=0, P=None):
+        """Limit surface (and derivatives in the face parameter) at points: dict name -> (m, 3)."""
+        faces, u, v = _check_points(faces, u, v)
+        P = self.vertices if P is None else np.asarray(P, dtype=np.float64)
+        if P.shape != (self.n_vertices, 3):
+            raise CCProofError(f"control points must have shape ({self.n_vertices}, 3), got {P.shape}")
+        out = {}
+        for pts, ids, rows in self._rows(faces, u, v, derivatives):
+            Pg = P[ids]  # (g, w, 3)
+            for k, W in rows.items():
+                out.setdefault(k, np.zeros((faces.size, 3)))[pts] = np.einsum("gw,gwc->gc", W, Pg)
+        return out
+
+    def sample_parameters(self, per_edge=8):
+        """A grid of ``per_edge x per_edge`` cell-centred parameters on every face with a patch.
+
+        Returns ``faces, u, v`` (flat arrays).
+        """
+        per_edge = int(per_edge)
+        if per_edge < 1:
+            raise CCProofError("per_edge must be >= 1")
+        f = np.flatnonzero(self.layout.face_kind > 0)
+        g = (np.arange(per_edge) + 0.5) / per_edge
+        uu, vv = np.meshgrid(g, g, indexing="ij")
+        return np.repeat(f, uu.size), np.tile(uu.reshape(-1), f.size), np.tile(vv.reshape(-1), f.size)
+
+    # ------------------------------------------------------------------ multilevel
+    def refine(self, P=None, rescale=True):
+        """Rebuild the model on the CC-subdivided mesh (qmv98 section 3.4; spec B4).
+
+        Parameters
+        ----------
+        P : ndarray (n, 3), optional
+            Current state (default: the mesh's vertices).
+        rescale : bool
+            Use :meth:`Material.refined` so that the energies of a given limit surface are
+            unchanged (default); ``False`` keeps the densities per unit face domain.
+
+        Returns
+        -------
+        model : DynamicSurface
+            On ``subdivide(mesh)`` with control points ``A P``.
+        A : scipy.sparse.csr_matrix
+            The global subdivision matrix (``q = A p``, qmv98 section 2.5.1).
+        """
+        from ccproof.mesh import subdivide, subdivision_matrix
+
+        mesh = self.mesh if P is None else self.mesh.with_vertices(P)
+        A = subdivision_matrix(mesh)
+        mat = self.material.refined() if rescale else self.material
+        # child 4 f + i of face f is rotated by i quarter turns (ccproof.mesh.subdivision)
+        swap = np.repeat(self.face_swap, 4) ^ np.tile(np.array([False, True, False, True]), mesh.n_faces)
+        return DynamicSurface(subdivide(mesh), mat, self.levels, face_swap=swap), A
+
