@@ -27,6 +27,8 @@ Python loop over points, memory bounded by evaluating in chunks.
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from ccproof.errors import CCProofError, MeshError
@@ -79,17 +81,22 @@ def _domain(frame):
     return float(lo[0]), float(lo[1]), float(np.abs(a).max())
 
 
-def _net_permutation(frame):
-    """Index map sending a net in the frame's own orientation to the base orientation."""
-    _, a, b = frame
-    ah, bh = np.sign(a).astype(int), np.sign(b).astype(int)
+@functools.lru_cache(maxsize=64)
+def _permutation(ah, bh):
     perm = np.empty(16, dtype=np.int64)
     for q in range(4):
         for p in range(4):
-            off = (p - 1.5) * ah + (q - 1.5) * bh
-            i, j = int(round(1.5 + off[0])), int(round(1.5 + off[1]))
+            i = int(round(1.5 + (p - 1.5) * ah[0] + (q - 1.5) * bh[0]))
+            j = int(round(1.5 + (p - 1.5) * ah[1] + (q - 1.5) * bh[1]))
             perm[i + 4 * j] = p + 4 * q
+    perm.setflags(write=False)
     return perm
+
+
+def _net_permutation(frame):
+    """Index map sending a net in the frame's own orientation to the base orientation."""
+    _, a, b = frame
+    return _permutation(tuple(int(x) for x in np.sign(a)), tuple(int(x) for x in np.sign(b)))
 
 
 def _stencil_matrix(stencils, ncols):
@@ -107,6 +114,7 @@ class _Builder:
         self.nets, self.origins, self.pdom = [], [], []
         self.vkind, self.vdom, self.vpatch, self.vchild, self.vcorner, self.vnmax = [], [], [], [], [], []
         self.max_depth = 0
+        self.n_patches = 0
 
     def new_vface(self, kind, frame):
         self.vkind.append(kind)
@@ -119,10 +127,11 @@ class _Builder:
 
     def add_patch(self, net, origin, frame):
         """net: (16, 3) in the frame's own orientation, relative to origin."""
-        self.nets.append(net[_net_permutation(frame)])
-        self.origins.append(origin)
-        self.pdom.append(_domain(frame))
-        return len(self.nets) - 1
+        self.nets.append(net[_net_permutation(frame)][None])
+        self.origins.append(origin[None])
+        self.pdom.append(np.array([_domain(frame)]))
+        self.n_patches += 1
+        return self.n_patches - 1
 
     # ------------------------------------------------------------------ classification
     def face(self, topo, X, f, frame, depth, base_face, vid=None):
@@ -164,17 +173,27 @@ class _Builder:
         origin = C[0] + scheme.limit_mask @ rel
         dev = np.einsum("njqN,Nc->njqc", scheme.layers, rel)  # (n_layers, 3, 16, 3)
         nl = dev.shape[0]
-        base = len(self.nets)
-        slots = [None] * (3 * nl)
+        base = self.n_patches
         # P_1 lies along the frame's a-axis: code 0 (u-distance >= 1/2, v-distance < 1/2) if a is
         # along u, else code 2; P_2 (diagonal) is code 1; P_3 the other one
         a_along_u = abs(rot[1][0]) > 0
         codes = {1: 0 if a_along_u else 2, 2: 1, 3: 2 if a_along_u else 0}
-        for n in range(nl):
-            for j in (1, 2, 3):
-                slots[3 * n + codes[j]] = (dev[n, j - 1], _compose(rot, _layer_frame(n, j)))
-        for net, pf in slots:
-            self.add_patch(net, origin, pf)
+        nets = np.empty((nl, 3, 16, 3))
+        doms = np.empty((nl, 3, 3))
+        for j in (1, 2, 3):
+            f0 = _compose(rot, _layer_frame(0, j))
+            perm = _net_permutation(f0)
+            nets[:, codes[j]] = dev[:, j - 1][:, perm]
+            u0, v0, h0 = _domain(f0)
+            # layer n is layer 0 scaled by 2^-n towards the corner (exact: powers of two)
+            sc = 0.5 ** np.arange(nl)
+            doms[:, codes[j], 0] = corner[0] + (u0 - corner[0]) * sc
+            doms[:, codes[j], 1] = corner[1] + (v0 - corner[1]) * sc
+            doms[:, codes[j], 2] = h0 * sc
+        self.nets.append(nets.reshape(-1, 16, 3))
+        self.origins.append(np.repeat(origin[None], 3 * nl, axis=0))
+        self.pdom.append(doms.reshape(-1, 3))
+        self.n_patches += 3 * nl
         self.vpatch[vid] = base
         self.vnmax[vid] = nl - 1
         return vid
@@ -221,9 +240,9 @@ class LimitSurface:
             b.new_vface(_REGULAR, base)
         for f in range(m):
             b.face(topo, X, f, base, 0, f, vid=f)
-        self._nets = np.ascontiguousarray(np.array(b.nets).reshape(-1, 16, 3))
-        self._origin = np.array(b.origins).reshape(-1, 3)
-        pd = np.array(b.pdom).reshape(-1, 3)
+        self._nets = np.ascontiguousarray(np.concatenate(b.nets))
+        self._origin = np.concatenate(b.origins)
+        pd = np.concatenate(b.pdom)
         self._pu0, self._pv0, self._ph = pd[:, 0].copy(), pd[:, 1].copy(), pd[:, 2].copy()
         self._vkind = np.array(b.vkind, dtype=np.int8)
         vd = np.array(b.vdom).reshape(-1, 3)
