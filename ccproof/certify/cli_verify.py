@@ -1,0 +1,37 @@
+"""Re-check injectivity certificates with the small trusted verifier.
+
+  ccproof verify certificates/injectivity/k005.json
+  ccproof verify --all            every certificate under certificates/injectivity/
+
+The verifier (ccproof/certify/verify.py) imports nothing from the prover: it checks the table hash,
+recomputes every Bernstein coefficient in arb from the table, replays each box's split path,
+checks each claimed bound and that the boxes partition each domain exactly. It prints PASS/FAIL
+per part and VERIFIED only when every part passed; the exit status is 0 only then.
+"""
+
+from __future__ import annotations
+
+
+def add_arguments(p):
+    p.add_argument("files", nargs="*", help="certificate files")
+    p.add_argument("--all", action="store_true", help="verify every certificate in certificates/injectivity")
+    p.add_argument("--quiet", action="store_true", help="print only the VERIFIED/FAILED line per file")
+
+
+def run(args):
+    from pathlib import Path
+
+    from ccproof.certify.verify import verify_file
+    from ccproof.errors import CCProofError
+    from ccproof.tables.format import certificates_dir
+
+    files = [Path(f) for f in args.files]
+    if args.all:
+        files += sorted((certificates_dir() / "injectivity").glob("k*.json"))
+    if not files:
+        raise CCProofError("give certificate files or --all")
+    log = (lambda s: print(s) if s.startswith(("VERIFIED", "FAILED")) else None) if args.quiet else print
+    bad = [f for f in files if not verify_file(f, log=log)]
+    print(f"{len(files) - len(bad)} of {len(files)} certificates verified" + (
+        "" if not bad else "; failed: " + ", ".join(str(b) for b in bad)))
+    return 0 if not bad else 1
