@@ -101,10 +101,25 @@ def valence_interval(k0, prec=128):
 def specialize(element_form, k, arithmetic="arb", prec=128):
     """Value of an integer form ``(A, B, D)`` (see :meth:`QcLam.integer_form`) at valence k.
 
-    ``k`` may be an int or the string ``">=K0"`` for the interval of valences k >= K0.
+    ``k`` may be an int or the string ``">=K0"`` for the interval of valences k >= K0 (then the
+    value is the union over :func:`interval_pieces`).
     """
+    if isinstance(k, str) and k.startswith(">="):
+        return _eval_interval(element_form, interval_pieces(int(k[2:]), 256, prec + 20), prec)
     values = _field_values(k, arithmetic, prec)
     return _eval(element_form, values, arithmetic, prec)
+
+
+def _eval_interval(form, boxes, prec):
+    from flint import ctx
+
+    acc = None
+    with ctx.workprec(prec + 20):
+        for c, lam in boxes:
+            v = eval_integer_form(form, c, lam)
+            acc = v if acc is None else acc.union(v)
+    with ctx.workprec(prec):
+        return +acc
 
 
 def _field_values(k, arithmetic, prec):
@@ -134,14 +149,37 @@ def _eval(form, values, arithmetic, prec):
     return val if arithmetic == "arb" else float(val.mid())
 
 
-def characteristic_map_patches(k, form="bezier", arithmetic="arb", prec=128):
+def interval_pieces(k0, pieces, prec=128):
+    """Cover the valences k >= k0 by ``pieces`` boxes ``(c, lam)`` (uniform in t = 1/k in [0, 1/k0]).
+
+    Each box pairs a c-interval [cos(2 pi t_{i+1}), cos(2 pi t_i)] with the lam-interval it maps to
+    (lam is increasing in c), so evaluating an element on every box and taking the union encloses
+    its values for all k >= k0 much more tightly than one evaluation on the whole interval.
+    """
+    k0 = check_valence(k0)
+    from flint import arb, ctx, fmpq
+
+    out = []
+    with ctx.workprec(prec):
+        for i in range(pieces):
+            # t in [i/(k0 pieces), (i+1)/(k0 pieces)]; c = cos(2 pi t) decreasing in t
+            c_hi = arb(fmpq(2 * i, k0 * pieces)).cos_pi() if i else arb(1)
+            c_lo = arb(fmpq(2 * (i + 1), k0 * pieces)).cos_pi()
+            c = c_lo.union(c_hi)
+            lam = _lam_from_c_arb(c_lo).union(_lam_from_c_arb(c_hi))
+            out.append((c, lam))
+    return out
+
+
+def characteristic_map_patches(k, form="bezier", arithmetic="arb", prec=128, pieces=256):
     """Control nets of the three bicubic layer-0 pieces P1, P2, P3 of the characteristic map of
     valence k in the normalized frame (bmz04 section 4.3, Fig. 3; DESIGN.md R3, R4).
 
     Parameters
     ----------
     k : int or str
-        Valence k >= 3, or ``">=K0"`` for enclosures valid for every valence k >= K0 (arb only).
+        Valence k >= 3, or ``">=K0"`` for enclosures valid for every valence k >= K0 (arb only;
+        the union of the values on ``pieces`` sub-intervals, see :func:`interval_pieces`).
     form : {"bezier", "bspline"}
         Bezier net of each piece on its domain, or its uniform cubic B-spline net.
     arithmetic : {"exact", "arb", "float"}
@@ -166,15 +204,16 @@ def characteristic_map_patches(k, form="bezier", arithmetic="arb", prec=128):
     if form not in ("bezier", "bspline"):
         raise CCProofError(f"unknown net form {form!r}; use 'bezier' or 'bspline'")
     sym = symbolic_bezier_nets() if form == "bezier" else symbolic_bspline_nets()
-    values = _field_values(k, arithmetic, prec)
-    out = {}
-    for name, net in sym.items():
-        out[name] = [
-            [tuple(_simplify(_eval(x.integer_form(), values, arithmetic, prec), arithmetic) for x in p)
-             for p in row]
-            for row in net
-        ]
-    return out
+    if isinstance(k, str):
+        if arithmetic != "arb":
+            raise CCProofError("an interval of valences can only be specialized in 'arb' arithmetic")
+        boxes = interval_pieces(check_valence(k[2:]), pieces, prec + 20)
+        ev = lambda f: _eval_interval(f, boxes, prec)
+    else:
+        values = _field_values(k, arithmetic, prec)
+        ev = lambda f: _simplify(_eval(f, values, arithmetic, prec), arithmetic)
+    return {name: [[tuple(ev(x.integer_form()) for x in p) for p in row] for row in net]
+            for name, net in sym.items()}
 
 
 def _simplify(val, arithmetic):
