@@ -417,6 +417,56 @@ class CornerScheme:
     def n_layers(self):
         return self.layers.shape[0]
 
+    @functools.cached_property
+    def tangent_masks(self):
+        """Masks of two limit tangents at the corner, shape (2, N), or ``None`` if undetermined.
+
+        The tangent plane at the corner vertex is spanned by the coefficients of the dominant
+        eigenfunctions after the constant one: the left eigenvectors of ``A`` of the largest
+        eigenvalue below 1, and, if that one is simple, of the next eigenvalue (its true left
+        eigenvector when it is defective: the Jordan chain's ``n mu^n`` term dominates there, as at a
+        boundary vertex with one face). Computed from the exact ``A`` in 80-digit arithmetic.
+        ``None`` when the second eigenspace has several directions (the tangent plane would depend
+        on the direction of approach).
+        """
+        return _tangent_masks(self.A)
+
+
+def _tangent_masks(A):
+    import mpmath
+
+    with mpmath.workdps(80):
+        N = A.nrows()
+        M = mpmath.matrix([[mpmath.mpf(int(x.p)) / int(x.q) for x in row] for row in A.tolist()])
+        E = mpmath.eig(M.T, left=False, right=False)
+        vals = sorted(E, key=lambda z: -abs(z))
+        # group numerically equal eigenvalues (a defective pair splits by ~sqrt(eps))
+        groups = []
+        for z in vals:
+            if groups and abs(groups[-1][0] - z) < 1e-15:
+                groups[-1].append(z)
+            else:
+                groups.append([z])
+        masks = []
+        for g in groups:
+            mu = sum(g) / len(g)
+            if abs(mu - 1) < 1e-12:
+                continue
+            if abs(mpmath.im(mu)) > 1e-12:
+                return None
+            B = M.T - mpmath.re(mu) * mpmath.eye(N)
+            U, S, V = mpmath.svd_r(B)
+            null = [i for i in range(N) if abs(S[i]) < mpmath.mpf(10) ** -25]
+            if not null:
+                return None
+            if masks and len(null) > 1:
+                return None
+            for i in null[: 2 - len(masks)]:
+                masks.append([float(V[i, j]) for j in range(N)])
+            if len(masks) == 2:
+                return np.array(masks)
+    return None
+
 
 @functools.lru_cache(maxsize=1024)
 def corner_scheme(key):

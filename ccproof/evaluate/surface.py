@@ -113,10 +113,13 @@ class _Builder:
     def __init__(self):
         self.nets, self.origins, self.pdom = [], [], []
         self.vkind, self.vdom, self.vpatch, self.vchild, self.vcorner, self.vnmax = [], [], [], [], [], []
+        self.vbase = []
         self.max_depth = 0
         self.n_patches = 0
+        self.corner_of_vertex = {}
 
-    def new_vface(self, kind, frame):
+    def new_vface(self, kind, frame, base_face):
+        self.vbase.append(base_face)
         self.vkind.append(kind)
         self.vdom.append(_domain(frame))
         self.vpatch.append(-1)
@@ -134,7 +137,7 @@ class _Builder:
         return self.n_patches - 1
 
     # ------------------------------------------------------------------ classification
-    def face(self, topo, X, f, frame, depth, base_face, vid=None):
+    def face(self, topo, X, f, frame, depth, base_face, vid, vmap=None):
         F = topo.flat
         irregular = [i for i in range(4) if not topo.is_regular(F[4 * f + i])]
         if not irregular:
@@ -145,7 +148,6 @@ class _Builder:
             M = _stencil_matrix([{ids.index(v): w for v, w in s.items()} for s in net], len(ids))
             Xl = X[ids]
             origin = Xl.mean(axis=0)
-            vid = self.new_vface(_REGULAR, frame) if vid is None else vid
             self.vkind[vid] = _REGULAR
             self.vpatch[vid] = self.add_patch(M @ (Xl - origin), origin, frame)
             return vid
@@ -154,17 +156,20 @@ class _Builder:
             ring, key, _ = canonical_ring(topo, f, r)
             scheme = corner_scheme(key)
             if scheme is not None:
-                return self.corner_face(scheme, X[ring], r, frame, vid)
+                vid = self.corner_face(scheme, X[ring], r, frame, vid)
+                vertex = int(vmap[F[4 * f + r]]) if vmap is not None else -1
+                if vertex >= 0 and vertex not in self.corner_of_vertex:
+                    self.corner_of_vertex[vertex] = (scheme, X[ring], vid)
+                return vid
         if depth >= MAX_DEPTH:
             raise MeshError(
                 f"face {base_face}: the configuration around it is not supported "
                 f"(still irregular after {MAX_DEPTH} local subdivisions)"
             )
-        return self.split_face(topo, X, f, frame, depth, base_face, vid)
+        return self.split_face(topo, X, f, frame, depth, base_face, vid, vmap)
 
     def corner_face(self, scheme, C, r, frame, vid):
         rot = _compose(frame, _corner_frame(r))
-        vid = self.new_vface(_CORNER, frame) if vid is None else vid
         self.vkind[vid] = _CORNER
         U0, V0, H = self.vdom[vid]
         corner = rot[0]
@@ -198,16 +203,17 @@ class _Builder:
         self.vnmax[vid] = nl - 1
         return vid
 
-    def split_face(self, topo, X, f, frame, depth, base_face, vid):
+    def split_face(self, topo, X, f, frame, depth, base_face, vid, vmap):
         ring, key, _ = canonical_ring(topo, f, 0)
         stencils, children = refine_exact(key)
-        need = sorted({v for c in children[:4] for v in c})
         topo1 = LocalTopology(children)
         # only the rows that the children's one-rings can use are needed; others may be None
         rows = [s if s is not None else {} for s in stencils]
         X1 = _stencil_matrix(rows, len(ring)) @ X[ring]
-        del need
-        vid = self.new_vface(_SPLIT, frame) if vid is None else vid
+        # base-mesh vertex of every local vertex (vertex points keep their vertex), -1 for new points
+        vmap1 = np.full(len(stencils), -1, dtype=np.int64)
+        if vmap is not None:
+            vmap1[: len(ring)] = vmap[ring]
         self.vkind[vid] = _SPLIT
         self.max_depth = max(self.max_depth, depth + 1)
         U0, V0, H = self.vdom[vid]
@@ -215,9 +221,9 @@ class _Builder:
             cf = _compose(frame, _child_frame(i))
             cu, cv, _ = _domain(cf)
             q = int(cu > U0) + 2 * int(cv > V0)
-            child = self.new_vface(_REGULAR, cf)
+            child = self.new_vface(_REGULAR, cf, base_face)
             self.vchild[vid][q] = child
-            self.face(topo1, X1, i, cf, depth + 1, base_face, vid=child)
+            self.face(topo1, X1, i, cf, depth + 1, base_face, vid=child, vmap=vmap1)
         return vid
 
 
@@ -236,10 +242,11 @@ class LimitSurface:
         X = mesh.vertices
         base = (np.zeros(2), np.array([1.0, 0.0]), np.array([0.0, 1.0]))
         m = mesh.n_faces
-        for _ in range(m):  # virtual faces 0..m-1 are the base faces
-            b.new_vface(_REGULAR, base)
+        vmap = np.arange(mesh.n_vertices)
+        for f in range(m):  # virtual faces 0..m-1 are the base faces
+            b.new_vface(_REGULAR, base, f)
         for f in range(m):
-            b.face(topo, X, f, base, 0, f, vid=f)
+            b.face(topo, X, f, base, 0, f, vid=f, vmap=vmap)
         self._nets = np.ascontiguousarray(np.concatenate(b.nets))
         self._origin = np.concatenate(b.origins)
         pd = np.concatenate(b.pdom)
@@ -253,6 +260,8 @@ class LimitSurface:
         self._vcu, self._vcv = vc[:, 0].copy(), vc[:, 1].copy()
         self._vnmax = np.array(b.vnmax, dtype=np.int64)
         self.split_depth = b.max_depth
+        self._corner_of_vertex = b.corner_of_vertex
+        self._vbase = np.array(b.vbase, dtype=np.int64)
         self.n_patches = self._nets.shape[0]
         self.max_layers = int(self._vnmax.max()) + 1 if (self._vkind == _CORNER).any() else 0
 
@@ -272,7 +281,7 @@ class LimitSurface:
             fi = f.astype(np.int64) if np.isfinite(f.astype(float)).all() else None
             if fi is None or not np.array_equal(fi, f):
                 bad = int(np.flatnonzero(fi != f)[0]) if fi is not None else 0
-                raise CCProofError(f"point {bad}: face id {f[bad]!r} is not an integer")
+                raise CCProofError(f"point {bad}: face id {f[bad].item()!r} is not an integer")
             f = fi
         f = f.astype(np.int64, copy=False)
         m = self.mesh.n_faces
@@ -284,7 +293,7 @@ class LimitSurface:
             bad = np.flatnonzero(~((x >= 0.0) & (x <= 1.0)))
             if bad.size:
                 i = int(bad[0])
-                raise CCProofError(f"point {i}: {name} = {x[i]!r} is outside [0, 1]")
+                raise CCProofError(f"point {i}: {name} = {float(x[i])!r} is outside [0, 1]")
         return f, u, v
 
     # ------------------------------------------------------------------ evaluation
@@ -408,19 +417,35 @@ class LimitSurface:
         """Unit limit normals at the control vertices, shape (n_vertices, 3).
 
         Eigen masks (:func:`ccproof.mesh.limit_normals`) at interior and regular boundary vertices;
-        at other boundary vertices the normal of the innermost stored layer at the corner of an
-        incident face, ``Pu x Pv`` (converged to the tangent plane to round-off).
+        at other boundary vertices the tangent masks of the exact corner matrix
+        (:attr:`ccproof.evaluate.local.CornerScheme.tangent_masks`), oriented like ``Pu x Pv``.
+        NaN where the tangent plane is not determined by the dominant eigenvectors.
         """
         Nn = limit_normals(self.mesh)
-        bad = np.flatnonzero(np.isnan(Nn).any(axis=1))
-        if bad.size:
-            c = self.mesh.fan_corners[self.mesh.fan_ptr[bad]]
-            f, i = c // 4, c % 4
-            uv = np.array(CORNERS, dtype=np.float64)[i]
-            r = self.evaluate(f, uv[:, 0], uv[:, 1], 1)
-            nrm = np.cross(r["Pu"], r["Pv"])
-            Nn[bad] = nrm / np.linalg.norm(nrm, axis=1, keepdims=True)
+        for v in np.flatnonzero(np.isnan(Nn).any(axis=1)):
+            item = self._corner_of_vertex.get(int(v))
+            if item is None:
+                continue
+            scheme, C, vid = item
+            T = scheme.tangent_masks
+            if T is None:
+                continue
+            t1, t2 = T @ (C - C[0])
+            nrm = np.cross(t1, t2)
+            # orientation: Pu x Pv just inside the corner's virtual face
+            U0, V0, H = self._vu0[vid], self._vv0[vid], self._vh[vid]
+            d = 2.0**-12 * H
+            u = U0 + H - d if self._vcu[vid] else U0 + d
+            w = V0 + H - d if self._vcv[vid] else V0 + d
+            f = self._base_face_of(vid)
+            r = self.evaluate([f], [u], [w], 1)
+            if np.dot(nrm, np.cross(r["Pu"][0], r["Pv"][0])) < 0:
+                nrm = -nrm
+            Nn[v] = nrm / np.linalg.norm(nrm)
         return Nn
+
+    def _base_face_of(self, vid):
+        return int(self._vbase[vid])
 
 
 def limit_surface(mesh):

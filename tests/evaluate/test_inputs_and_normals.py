@@ -1,0 +1,109 @@
+"""Bad input is refused with a message naming the element; vertex normals at every kind of vertex."""
+
+import json
+
+import numpy as np
+import pytest
+
+from ccproof.errors import CCProofError, MeshError
+from ccproof.evaluate import limit_surface
+from ccproof.evaluate.local import LocalTopology, canonical_ring, corner_scheme
+from ccproof.mesh import QuadMesh, limit_normals, read_obj
+from ccproof.mesh.examples import cube, k_regular_disk
+from tests.evaluate.conftest import l_shape
+
+
+@pytest.fixture(scope="module")
+def S():
+    return limit_surface(cube())
+
+
+def test_face_id_out_of_range(S):
+    with pytest.raises(CCProofError, match=r"point 2: face id 6 out of range \[0, 6\)"):
+        S.evaluate([0, 1, 6], [0.5] * 3, [0.5] * 3)
+    with pytest.raises(CCProofError, match="point 0: face id -1"):
+        S.evaluate([-1], [0.5], [0.5])
+    with pytest.raises(CCProofError, match="point 1: face id 1.5 is not an integer"):
+        S.evaluate([0.0, 1.5], [0.5] * 2, [0.5] * 2)
+
+
+def test_parameter_outside_unit_square(S):
+    with pytest.raises(CCProofError, match=r"point 1: u = 1.0000001 is outside \[0, 1\]"):
+        S.evaluate([0, 0], [0.5, 1.0000001], [0.5, 0.5])
+    with pytest.raises(CCProofError, match=r"point 0: v = -1e-300 is outside"):
+        S.evaluate([0], [0.5], [-1e-300])
+    with pytest.raises(CCProofError, match="point 0: u = nan"):
+        S.evaluate([0], [np.nan], [0.5])
+
+
+def test_shapes_and_derivative_order(S):
+    with pytest.raises(CCProofError, match="same length"):
+        S.evaluate([0, 1], [0.5, 0.5, 0.5], [0.5])
+    with pytest.raises(CCProofError, match="derivatives must be 0, 1 or 2"):
+        S.evaluate([0], [0.5], [0.5], derivatives=3)
+    r = S.evaluate(np.array([], int), [], [], 2)
+    assert set(r) == {"P", "Pu", "Pv", "Puu", "Puv", "Pvv"} and r["P"].shape == (0, 3)
+
+
+def test_bad_meshes_are_refused():
+    V = np.array(cube().vertices)
+    V[3, 2] = np.nan
+    with pytest.raises(MeshError, match="vertex 3 has a non-finite coordinate"):
+        limit_surface(QuadMesh(V, cube().faces))
+    with pytest.raises(MeshError, match=r"interior vertex \d has valence 2"):
+        limit_surface(QuadMesh(np.eye(4, 3), [[0, 1, 2, 3], [3, 2, 1, 0]]))
+
+
+def test_obj_path_and_non_quad(tmp_path):
+    p = tmp_path / "t.obj"
+    p.write_text("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nf 1 2 3 4\nf 2 5 3\n")
+    with pytest.raises(MeshError, match=r"face 1 \(line 7\) has 3 vertices"):
+        limit_surface(p)
+
+
+def test_chunking_does_not_change_results():
+    m = k_regular_disk(5, 2)
+    S = limit_surface(m)
+    rng = np.random.default_rng(0)
+    f, u, v = rng.integers(0, m.n_faces, 1000), rng.random(1000), rng.random(1000)
+    a = S.evaluate(f, u, v, 2)
+    b = S.evaluate(f, u, v, 2, chunk=7)
+    assert all(np.array_equal(a[k], b[k]) for k in a)
+
+
+def test_normals_at_opensubdiv_vertices(refdir):
+    """All vertices, including boundary vertices with one face (tangent masks of the exact corner
+    matrix, whose second eigenvalue 1/4 is defective)."""
+    for name in ["sector_k3", "sector_k5", "cube"]:
+        d = json.loads((refdir / f"osd_limit_{name}.json").read_text())
+        S = limit_surface(read_obj(refdir / "meshes" / f"{name}.obj"))
+        assert np.abs(S.vertex_normals() - np.array(d["vertex_limit_normal"])).max() < 1e-13
+
+
+def test_corner_tangent_masks_equal_interior_masks():
+    m = k_regular_disk(7, 3)
+    m = m.with_vertices(m.vertices + 0.1 * np.random.default_rng(2).normal(size=m.vertices.shape))
+    ring, key, _ = canonical_ring(LocalTopology(m.faces), 0, 0)
+    t1, t2 = corner_scheme(key).tangent_masks @ m.vertices[ring]
+    n = np.cross(t1, t2)
+    n /= np.linalg.norm(n)
+    assert abs(abs(n @ limit_normals(m)[0]) - 1) < 1e-14
+
+
+def test_concave_boundary_vertex_normal_is_the_limit_of_surface_normals():
+    m = l_shape(0)
+    S = limit_surface(m)
+    v = int(np.flatnonzero(m.is_boundary_vertex & (m.face_count == 3))[0])
+    N = S.vertex_normals()[v]
+    _, _, faces = m.one_ring(v)
+    errs = []
+    for n in (10, 30, 50):
+        h = 2.0**-n
+        for f in faces:
+            i = list(m.faces[f]).index(v)
+            cu, cv = [(0, 0), (1, 0), (1, 1), (0, 1)][i]
+            r = S.evaluate([f], [abs(cu - h)], [abs(cv - 0.7 * h)], 1)
+            nn = np.cross(r["Pu"][0], r["Pv"][0])
+            errs.append(np.linalg.norm(nn / np.linalg.norm(nn) - N))
+    errs = np.array(errs).reshape(3, -1).max(axis=1)
+    assert errs[2] < errs[1] < errs[0] and errs[2] < 1e-3  # converges like (0.5/0.5797)^n
