@@ -171,3 +171,15 @@ def test_tables_folder_is_used(tmp_path, cert3):
     shutil.copy(certificates_dir() / "tables" / "k003.json", d / "k003.json")
     ok, log = run(copy.deepcopy(cert3), tables_dir=d)
     assert ok
+
+
+def test_every_valence_3_to_39_has_a_certificate():
+    ks = sorted(json.loads(p.read_text())["valence"] for p in CERTS.glob("k[0-9]*.json"))
+    assert ks == list(range(3, 40))
+
+
+@pytest.mark.slow
+def test_verify_all_published_certificates():
+    from ccproof.cli import main
+
+    assert main(["verify", "--all", "--quiet"]) == 0
