@@ -1,0 +1,93 @@
+"""Isoparameter lines of the natural parameterization around a vertex (bmz04 Fig. 2).
+
+Matplotlib is imported inside the functions, so that importing this module stays cheap.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ccproof.errors import CCProofError
+
+__all__ = ["isoparameter_lines", "plot_isoparameter_lines"]
+
+_CORNER_UV = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+
+
+def isoparameter_lines(surface, vertex, n_lines=16, n_samples=257):
+    """Polylines u = i/n_lines and v = j/n_lines of every face around ``vertex``, on the limit surface.
+
+    Parameters
+    ----------
+    surface : LimitSurface
+    vertex : int
+    n_lines : int
+        Lines per direction and face (the face edges included).
+    n_samples : int
+        Points per line; they are denser near the vertex (quadratic spacing) so that the
+        behaviour of bmz04 section 3 is visible.
+
+    Returns
+    -------
+    lines : list of ndarray, shape (n_samples, 3)
+    is_edge : list of bool
+        Whether the line is a face edge (u or v in {0, 1}).
+    """
+    mesh = surface.mesh
+    if not 0 <= int(vertex) < mesh.n_vertices:
+        raise CCProofError(f"vertex {vertex} out of range [0, {mesh.n_vertices})")
+    _, _, faces = mesh.one_ring(int(vertex))
+    t = np.linspace(0.0, 1.0, n_samples) ** 2  # dense at the vertex end
+    lines, is_edge = [], []
+    for f in faces:
+        i = int(np.flatnonzero(mesh.faces[f] == vertex)[0])
+        c = _CORNER_UV[i]
+        a = _CORNER_UV[(i + 1) % 4] - c
+        b = _CORNER_UV[(i + 3) % 4] - c
+        for k in range(n_lines + 1):
+            s = k / n_lines
+            for d0, d1 in ((a, b), (b, a)):
+                uv = c + np.outer(t, d0) + s * d1
+                uv = np.clip(uv, 0.0, 1.0)
+                P = surface.evaluate(np.full(n_samples, f), uv[:, 0], uv[:, 1], 0)["P"]
+                lines.append(P)
+                is_edge.append(k in (0, n_lines))
+    return lines, is_edge
+
+
+def plot_isoparameter_lines(surface, vertex, path, n_lines=16, title=None):
+    """Draw :func:`isoparameter_lines` projected on the tangent plane at the vertex; save to ``path``.
+
+    The view is the limit tangent plane at the vertex (axes: the direction of the first edge
+    neighbour and its normal complement), as in bmz04 Fig. 2 for planar k-regular meshes.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    lines, is_edge = isoparameter_lines(surface, vertex, n_lines=n_lines)
+    L = surface.vertex_limits()[vertex]
+    nrm = surface.vertex_normals()[vertex]
+    if not np.isfinite(nrm).all():
+        nrm = np.array([0.0, 0.0, 1.0])
+    e = surface.mesh.one_ring(int(vertex))[0][0]
+    x = surface.mesh.vertices[e] - L
+    x = x - (x @ nrm) * nrm
+    if np.linalg.norm(x) < 1e-300:
+        x = np.cross(nrm, [1.0, 0.0, 0.0])
+    x /= np.linalg.norm(x)
+    y = np.cross(nrm, x)
+    fig, ax = plt.subplots(figsize=(6, 6), dpi=150)
+    for P, edge in zip(lines, is_edge):
+        q = P - L
+        ax.plot(q @ x, q @ y, color="k" if edge else "tab:blue", lw=1.1 if edge else 0.45)
+    ax.plot([0], [0], "o", color="tab:red", ms=4)
+    ax.set_aspect("equal")
+    ax.set_axis_off()
+    k = int(surface.mesh.valence[vertex])
+    kind = "boundary" if surface.mesh.is_boundary_vertex[vertex] else "interior"
+    ax.set_title(title or f"natural parameterization near vertex {vertex} ({kind}, valence {k})", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
