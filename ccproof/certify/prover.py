@@ -96,7 +96,10 @@ def _corners(f):
 
 def prove_valence(k, prec=DEFAULT_PREC, tables_dir=None, progress=True):
     """Search a certificate for valence k; returns the certificate dict (see docs/certificates.md)."""
-    k = check_valence(k)
+    if isinstance(k, str) and k.strip().startswith(">="):
+        k = {"min": check_valence(k.strip()[2:])}
+    else:
+        k = check_valence(k)
     t0 = time.perf_counter()
     table = read_table_json(table_path(k, tables_dir))
     N = int(table["derived"]["N"])
@@ -125,7 +128,7 @@ def prove_valence(k, prec=DEFAULT_PREC, tables_dir=None, progress=True):
         if progress:
             from tqdm import tqdm
 
-            it = tqdm(todo, desc=f"k={k} cells", unit="cell", leave=False)
+            it = tqdm(todo, desc=f"k={_kname(k)} cells", unit="cell", leave=False)
         for l, m, p, q in it:
             root = bernstein_coefficients(cell_det_poly(nets, lam, N, l, m, p, q, prec))
             cells[f"{l},{m},{p},{q}"] = prove_positive(root, (0, 1), f"cell ({l},{m}) piece ({p},{q})")
@@ -165,6 +168,10 @@ def prove_valence(k, prec=DEFAULT_PREC, tables_dir=None, progress=True):
     }
 
 
+def _kname(k):
+    return f">={k['min']}" if isinstance(k, dict) else str(k)
+
+
 def fmpq_of(s):
     from ccproof.certify.verify import _decimal
 
@@ -172,7 +179,11 @@ def fmpq_of(s):
 
 
 def certificate_path(k, directory=None):
-    return Path(directory or certificates_dir() / "injectivity") / f"k{int(k):03d}.json"
+    """``k005.json`` for a valence, ``k_ge_40.json`` for the interval ``{"min": 40}``/``">=40"``."""
+    if isinstance(k, str) and k.startswith(">="):
+        k = {"min": int(k[2:])}
+    name = f"k_ge_{int(k['min'])}.json" if isinstance(k, dict) else f"k{int(k):03d}.json"
+    return Path(directory or certificates_dir() / "injectivity") / name
 
 
 def write_certificate(cert, path=None):

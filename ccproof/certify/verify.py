@@ -252,9 +252,15 @@ def verify_certificate(cert, tables_dir=None, log=print):
     if not isinstance(cert, dict) or cert.get("schema") != SCHEMA:
         raise CertificateError(f"unknown certificate schema {cert.get('schema') if isinstance(cert, dict) else None!r}"
                                f" (expected {SCHEMA!r})")
-    k = _field(cert, "valence", int, "certificate")
-    if k < 3:
+    k = _field(cert, "valence", (int, dict), "certificate")
+    if isinstance(k, dict):  # the interval of valences k >= k0: {"min": k0}
+        if set(k) != {"min"} or not isinstance(k["min"], int) or isinstance(k["min"], bool):
+            raise CertificateError(f"valence interval must be {{'min': K0}}, got {k!r}")
+        if k["min"] < 3:
+            raise CertificateError(f"valence {k['min']} < 3")
+    elif k < 3:
         raise CertificateError(f"valence {k} < 3")
+    kname = f">={k['min']}" if isinstance(k, dict) else str(k)
     N = _field(cert, "N", int, "certificate")
     prec = _field(cert, "prec", int, "certificate")
     if not 64 <= prec <= 1024 or not 1 <= N <= 12:
@@ -262,11 +268,12 @@ def verify_certificate(cert, tables_dir=None, log=print):
     tinfo = _field(cert, "table", dict, "certificate")
     thash = _field(tinfo, "hash", str, "table")
     parts = _field(cert, "parts", dict, "certificate")
-    log(f"certificate for valence {k} (N = {N}, {prec} bits)")
+    _check_structure(parts)
+    log(f"certificate for valence {kname} (N = {N}, {prec} bits)")
     try:
         table = read_table_json(table_path(k, tables_dir))
     except FileNotFoundError:
-        part("table", False, f"no table for valence {k}")
+        part("table", False, f"no table for valence {kname}")
         return False
     except TableFormatError as exc:
         part("table", False, str(exc))
@@ -344,6 +351,24 @@ def verify_certificate(cert, tables_dir=None, log=print):
         if okE:
             part("E det J_G / h^2 > 0 on the corner cell (all layers >= N)", True, f"min bound {minE}")
     return all(results) and okB and okD and okE
+
+
+def _check_structure(parts):
+    """Validate every box list before any arithmetic, so a malformed file fails fast and by name."""
+    for section, nvars in (("regularity", 2), ("cells", 2), ("corner", 4)):
+        sec = _field(parts, section, dict, "parts")
+        if section != "cells" and set(sec) != set(PATCHES):
+            raise CertificateError(f"parts.{section} must have exactly the keys {', '.join(PATCHES)}")
+        for key, boxes in sec.items():
+            if section == "cells" and not re.fullmatch(r"[0-9]+,[0-9]+,[0-2],[0-2]", key):
+                raise CertificateError(f"parts.cells: malformed key {key!r} (expected 'l,m,p,q')")
+            if not isinstance(boxes, list) or not boxes:
+                raise CertificateError(f"parts.{section}.{key}: boxes must be a non-empty list")
+            for b in boxes:
+                if not isinstance(b, dict) or set(b) != {"path", "bound"}:
+                    raise CertificateError(f"parts.{section}.{key}: a box must be {{'path', 'bound'}}")
+                parse_path(b["path"], nvars)
+                _decimal(b["bound"])
 
 
 def arb_from_table(table, prec):
