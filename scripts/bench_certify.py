@@ -1,0 +1,67 @@
+"""Benchmark of the injectivity certificates (issue 7).
+
+Certifies each valence of a range with a process pool (certify runs are independent), then verifies
+every certificate written, and prints per valence: N, boxes, certify seconds, verify seconds, and the
+totals (wall clock) with the ratio certify/verify, against the targets (all of 3..39 certified in
+<= 10 min and verified in <= 2 min on 2 cores; verification >= 3x faster than certification).
+
+    python scripts/bench_certify.py [--kmin 3] [--kmax 39] [--jobs 2]
+
+Certificates go to a temporary folder; the published ones are not touched.
+"""
+
+import argparse
+import tempfile
+import time
+from concurrent.futures import ProcessPoolExecutor
+
+
+def _certify(args):
+    k, d = args
+    from ccproof.certify.prover import certificate_path, prove_valence, write_certificate
+
+    t = time.perf_counter()
+    cert = prove_valence(k, progress=False)
+    dt = time.perf_counter() - t
+    write_certificate(cert, certificate_path(k, d))
+    return k, cert["N"], cert["stats"]["boxes"], dt
+
+
+def _verify(args):
+    k, d = args
+    from ccproof.certify.prover import certificate_path
+    from ccproof.certify.verify import verify_file
+
+    t = time.perf_counter()
+    ok = verify_file(certificate_path(k, d), log=lambda s: None)
+    return k, ok, time.perf_counter() - t
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--kmin", type=int, default=3)
+    ap.add_argument("--kmax", type=int, default=39)
+    ap.add_argument("--jobs", type=int, default=2)
+    args = ap.parse_args()
+    ks = list(range(args.kmin, args.kmax + 1))
+    with tempfile.TemporaryDirectory() as d:
+        t0 = time.perf_counter()
+        with ProcessPoolExecutor(args.jobs) as ex:
+            cert = {k: (N, b, dt) for k, N, b, dt in ex.map(_certify, [(k, d) for k in ks])}
+        t_cert = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        with ProcessPoolExecutor(args.jobs) as ex:
+            ver = {k: (ok, dt) for k, ok, dt in ex.map(_verify, [(k, d) for k in ks])}
+        t_ver = time.perf_counter() - t0
+    print(f"{'k':>4} {'N':>2} {'boxes':>6} {'certify s':>10} {'verify s':>9} {'ratio':>6}  verified")
+    for k in ks:
+        N, b, tc = cert[k]
+        ok, tv = ver[k]
+        print(f"{k:>4} {N:>2} {b:>6} {tc:>10.2f} {tv:>9.2f} {tc / tv:>6.2f}  {ok}")
+    print(f"all {ks[0]}..{ks[-1]} with {args.jobs} processes: certify {t_cert:.1f} s (target 600 s), "
+          f"verify {t_ver:.1f} s (target 120 s), certify/verify = {t_cert / t_ver:.2f} (target >= 3)")
+    print(f"failures: {[k for k in ks if not ver[k][0]]}")
+
+
+if __name__ == "__main__":
+    main()
