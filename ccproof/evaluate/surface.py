@@ -42,6 +42,9 @@ __all__ = ["limit_surface", "LimitSurface"]
 MAX_DEPTH = 4
 #: points evaluated per chunk (bounds the temporary memory: about 1 kB per point)
 CHUNK = 1 << 15
+#: layers of every corner table stored with the regular patches ("hot" region, for cache locality:
+#: a uniformly random point lies in layer >= 3 of a corner face with probability 1/64)
+HOT_LAYERS = 3
 
 _REGULAR, _CORNER, _SPLIT = 0, 1, 2
 
@@ -111,11 +114,14 @@ class _Builder:
     """Collects patches and virtual faces while classifying the faces of a mesh."""
 
     def __init__(self):
-        self.nets, self.origins, self.pdom = [], [], []
+        self.hot = ([], [], [])  # nets (k, 17, 3) with the origin as row 16; domains (k, 3)
+        self.cold = ([], [], [])
+        self.n_hot = 0
+        self.n_cold = 0
+        self.vcold = []
         self.vkind, self.vdom, self.vpatch, self.vchild, self.vcorner, self.vnmax = [], [], [], [], [], []
         self.vbase = []
         self.max_depth = 0
-        self.n_patches = 0
         self.corner_of_vertex = {}
 
     def new_vface(self, kind, frame, base_face):
@@ -123,6 +129,7 @@ class _Builder:
         self.vkind.append(kind)
         self.vdom.append(_domain(frame))
         self.vpatch.append(-1)
+        self.vcold.append(0)
         self.vchild.append([-1, -1, -1, -1])
         self.vcorner.append((0, 0))
         self.vnmax.append(0)
@@ -130,11 +137,17 @@ class _Builder:
 
     def add_patch(self, net, origin, frame):
         """net: (16, 3) in the frame's own orientation, relative to origin."""
-        self.nets.append(net[_net_permutation(frame)][None])
-        self.origins.append(origin[None])
-        self.pdom.append(np.array([_domain(frame)]))
-        self.n_patches += 1
-        return self.n_patches - 1
+        self._store(self.hot, net[_net_permutation(frame)][None], origin, np.array([_domain(frame)]))
+        self.n_hot += 1
+        return self.n_hot - 1
+
+    @staticmethod
+    def _store(region, nets, origin, doms):
+        block = np.empty((nets.shape[0], 17, 3))
+        block[:, :16] = nets
+        block[:, 16] = origin
+        region[0].append(block)
+        region[1].append(doms)
 
     # ------------------------------------------------------------------ classification
     def face(self, topo, X, f, frame, depth, base_face, vid, vmap=None):
@@ -178,7 +191,6 @@ class _Builder:
         origin = C[0] + scheme.limit_mask @ rel
         dev = np.einsum("njqN,Nc->njqc", scheme.layers, rel)  # (n_layers, 3, 16, 3)
         nl = dev.shape[0]
-        base = self.n_patches
         # P_1 lies along the frame's a-axis: code 0 (u-distance >= 1/2, v-distance < 1/2) if a is
         # along u, else code 2; P_2 (diagonal) is code 1; P_3 the other one
         a_along_u = abs(rot[1][0]) > 0
@@ -195,11 +207,13 @@ class _Builder:
             doms[:, codes[j], 0] = corner[0] + (u0 - corner[0]) * sc
             doms[:, codes[j], 1] = corner[1] + (v0 - corner[1]) * sc
             doms[:, codes[j], 2] = h0 * sc
-        self.nets.append(nets.reshape(-1, 16, 3))
-        self.origins.append(np.repeat(origin[None], 3 * nl, axis=0))
-        self.pdom.append(doms.reshape(-1, 3))
-        self.n_patches += 3 * nl
-        self.vpatch[vid] = base
+        K = min(HOT_LAYERS, nl)
+        self._store(self.hot, nets[:K].reshape(-1, 16, 3), origin, doms[:K].reshape(-1, 3))
+        self._store(self.cold, nets[K:].reshape(-1, 16, 3), origin, doms[K:].reshape(-1, 3))
+        self.vpatch[vid] = self.n_hot
+        self.vcold[vid] = self.n_cold - 3 * K  # patch of layer n >= K: vcold + n_hot_total + 3 n + code
+        self.n_hot += 3 * K
+        self.n_cold += 3 * (nl - K)
         self.vnmax[vid] = nl - 1
         return vid
 
@@ -247,10 +261,11 @@ class LimitSurface:
             b.new_vface(_REGULAR, base, f)
         for f in range(m):
             b.face(topo, X, f, base, 0, f, vid=f, vmap=vmap)
-        self._nets = np.ascontiguousarray(np.concatenate(b.nets))
-        self._origin = np.concatenate(b.origins)
-        pd = np.concatenate(b.pdom)
+        self._nets = np.ascontiguousarray(np.concatenate(b.hot[0] + b.cold[0]))  # (n_patches, 17, 3)
+        pd = np.concatenate(b.hot[1] + b.cold[1])
         self._pu0, self._pv0, self._ph = pd[:, 0].copy(), pd[:, 1].copy(), pd[:, 2].copy()
+        self._vcold = np.array(b.vcold, dtype=np.int64) + b.n_hot
+        self.hot_layers = HOT_LAYERS
         self._vkind = np.array(b.vkind, dtype=np.int8)
         vd = np.array(b.vdom).reshape(-1, 3)
         self._vu0, self._vv0, self._vh = vd[:, 0].copy(), vd[:, 1].copy(), vd[:, 2].copy()
@@ -285,15 +300,18 @@ class LimitSurface:
             f = fi
         f = f.astype(np.int64, copy=False)
         m = self.mesh.n_faces
-        bad = np.flatnonzero((f < 0) | (f >= m))
-        if bad.size:
-            i = int(bad[0])
-            raise CCProofError(f"point {i}: face id {int(f[i])} out of range [0, {m})")
-        for name, x in (("u", u), ("v", v)):
-            bad = np.flatnonzero(~((x >= 0.0) & (x <= 1.0)))
+        step = 1 << 18  # bounded temporaries
+        for lo in range(0, f.size, step):
+            fb, ub, vb = f[lo : lo + step], u[lo : lo + step], v[lo : lo + step]
+            bad = np.flatnonzero((fb < 0) | (fb >= m))
             if bad.size:
-                i = int(bad[0])
-                raise CCProofError(f"point {i}: {name} = {float(x[i])!r} is outside [0, 1]")
+                i = lo + int(bad[0])
+                raise CCProofError(f"point {i}: face id {int(f[i])} out of range [0, {m})")
+            for name, x, xb in (("u", u, ub), ("v", v, vb)):
+                bad = np.flatnonzero(~((xb >= 0.0) & (xb <= 1.0)))
+                if bad.size:
+                    i = lo + int(bad[0])
+                    raise CCProofError(f"point {i}: {name} = {float(x[i])!r} is outside [0, 1]")
         return f, u, v
 
     # ------------------------------------------------------------------ evaluation
@@ -338,13 +356,14 @@ class LimitSurface:
             du, dv = np.ldexp(du, n), np.ldexp(dv, n)
             a, b = du >= 0.5, dv >= 0.5
             code = np.where(a & ~b, 0, np.where(a & b, 1, np.where(b, 2, 1)))
-            patch[idx] = patch[idx] + 3 * n + code
+            start = np.where(n < self.hot_layers, patch[idx], self._vcold[w])
+            patch[idx] = start + 3 * n + code
         h = self._ph[patch]
         s = np.clip((u - self._pu0[patch]) / h, 0.0, 1.0)
         t = np.clip((v - self._pv0[patch]) / h, 0.0, 1.0)
         return patch, s, t, 1.0 / h
 
-    def evaluate(self, face_ids, u, v, derivatives=1, *, chunk=CHUNK, out=None):
+    def evaluate(self, face_ids, u, v, derivatives=1, *, chunk=CHUNK, out=None, backend=None):
         """Positions and derivatives of the limit surface at points (face, u, v).
 
         Parameters
@@ -357,6 +376,9 @@ class LimitSurface:
             Points per chunk (memory beyond the outputs is about 1 kB per chunk point).
         out : dict of ndarray, optional
             Preallocated outputs (shape (n, 3) each) to fill.
+        backend : {None, "numpy", "numba"}
+            ``None``: the compiled kernel if numba is installed (and the environment variable
+            ``CCPROOF_BACKEND`` is not ``numpy``), else numpy. Both compute the same formulas.
 
         Returns
         -------
@@ -386,6 +408,14 @@ class LimitSurface:
         keys = _KEYS[derivatives]
         if out is None:
             out = {k: np.empty((n, 3)) for k in keys}
+        kernel = _numba_kernel(backend)
+        if kernel is not None:
+            dummy = np.empty((0, 3))
+            arrs = [out.get(k, dummy) for k in _KEYS[2]]
+            kernel(f, u, v, derivatives, self._vkind, self._vchild, self._vu0, self._vv0, self._vh,
+                   self._vpatch, self._vcold, self.hot_layers, self._vcu, self._vcv, self._vnmax,
+                   self.split_depth, self._nets, self._pu0, self._pv0, self._ph, *arrs)
+            return out
         for lo in range(0, n, chunk):
             hi = min(n, lo + chunk)
             self._eval_chunk(f[lo:hi], u[lo:hi], v[lo:hi], derivatives, {k: out[k][lo:hi] for k in keys})
@@ -395,9 +425,10 @@ class LimitSurface:
         patch, s, t, g = self._locate(f, u, v)
         bs = bspline_basis(s, d)
         bt = bspline_basis(t, d)
-        N = self._nets[patch].reshape(-1, 4, 4, 3)  # [n, j, i, c]
+        G = np.take(self._nets.reshape(-1, 51), patch, axis=0)
+        N = G[:, :48].reshape(-1, 4, 4, 3)  # [n, j, i, c]
         T0 = np.einsum("nj,njic->nic", bt[0], N)
-        np.add(self._origin[patch], np.einsum("ni,nic->nc", bs[0], T0), out=out["P"])
+        np.add(G[:, 48:], np.einsum("ni,nic->nc", bs[0], T0), out=out["P"])
         if d >= 1:
             T1 = np.einsum("nj,njic->nic", bt[1], N)
             gg = g[:, None]
@@ -448,6 +479,25 @@ class LimitSurface:
 
     def _base_face_of(self, vid):
         return int(self._vbase[vid])
+
+
+def _numba_kernel(backend):
+    """The compiled kernel for ``backend`` (None: automatic), or None for the numpy path."""
+    import os
+
+    if backend is None:
+        backend = os.environ.get("CCPROOF_BACKEND", "auto")
+    if backend == "numpy":
+        return None
+    if backend not in ("auto", "numba"):
+        raise CCProofError(f"unknown backend {backend!r} (use 'numpy' or 'numba')")
+    try:
+        from ccproof.evaluate._numba_kernel import evaluate_points
+    except ImportError:
+        if backend == "numba":
+            raise CCProofError("backend 'numba' requested but numba is not installed") from None
+        return None
+    return evaluate_points
 
 
 def limit_surface(mesh):

@@ -61,14 +61,27 @@ def test_obj_path_and_non_quad(tmp_path):
         limit_surface(p)
 
 
-def test_chunking_does_not_change_results():
-    m = k_regular_disk(5, 2)
+def test_chunking_and_backends_agree():
+    m = cube()
     S = limit_surface(m)
     rng = np.random.default_rng(0)
     f, u, v = rng.integers(0, m.n_faces, 1000), rng.random(1000), rng.random(1000)
-    a = S.evaluate(f, u, v, 2)
-    b = S.evaluate(f, u, v, 2, chunk=7)
+    u[:100] = 0.5 ** rng.integers(0, 200, 100)  # every layer, down to the innermost table and beyond
+    v[:100] = u[:100] * rng.random(100)
+    u[100:110], v[100:110] = 0.0, 0.0
+    u[110:120], v[110:120] = 1.0, 1.0 - 2.0**-53
+    a = S.evaluate(f, u, v, 2, backend="numpy")
+    b = S.evaluate(f, u, v, 2, chunk=7, backend="numpy")
     assert all(np.array_equal(a[k], b[k]) for k in a)
+    try:
+        import numba  # noqa: F401
+    except ImportError:
+        pytest.skip("numba not installed")
+    c = S.evaluate(f, u, v, 2, backend="numba")
+    for k in a:
+        assert np.abs(a[k] - c[k]).max() <= 1e-14 * np.abs(a[k]).max(), k
+    with pytest.raises(CCProofError, match="unknown backend"):
+        S.evaluate(f, u, v, 1, backend="cuda")
 
 
 def test_normals_at_opensubdiv_vertices(refdir):

@@ -5,6 +5,7 @@ derivatives 1e-10 on every sample outside an OpenSubdiv end cap (``endcap=false`
 ``deep`` values where the deeper evaluation is itself outside an end cap; vertex limits 1e-13.
 """
 
+import functools
 import json
 
 import numpy as np
@@ -33,14 +34,29 @@ def _exact_samples(d):
     return rows
 
 
+def _backends():
+    try:
+        import numba  # noqa: F401
+
+        return ["numpy", "numba"]
+    except ImportError:
+        return ["numpy"]
+
+
+@functools.cache
+def _surface(refdir, name):
+    return limit_surface(read_obj(refdir / "meshes" / f"{name}.obj"))
+
+
+@pytest.mark.parametrize("backend", _backends())
 @pytest.mark.parametrize("name", MESHES)
-def test_samples_match_opensubdiv(refdir, name):
+def test_samples_match_opensubdiv(refdir, name, backend):
     d, mesh = _load(refdir, name)
     rows = _exact_samples(d)
     assert len(rows) >= 99
-    S = limit_surface(mesh)
+    S = _surface(refdir, name)
     f, u, v = (np.array([r[i] for r in rows]) for i in range(3))
-    out = S.evaluate(f, u, v, derivatives=1)
+    out = S.evaluate(f, u, v, derivatives=1, backend=backend)
     diag = mesh.bounding_box_diagonal
     P, Ps, Pt = (np.array([r[i] for r in rows]) for i in (3, 4, 5))
     assert np.abs(out["P"] - P).max() <= 1e-12 * diag
@@ -57,7 +73,7 @@ def test_exact_corner_samples(refdir, name):
     rows = [s for s in d["samples"] if s["endcap"] and s["tag"].startswith("corner")]
     if not rows:
         pytest.skip("no end-cap corner samples")
-    S = limit_surface(mesh)
+    S = _surface(refdir, name)
     out = S.evaluate([s["face"] for s in rows], [s["s"] for s in rows], [s["t"] for s in rows], 0)
     P = np.array([s["P"] for s in rows])
     assert np.abs(out["P"] - P).max() <= 1e-15 * mesh.bounding_box_diagonal
@@ -66,7 +82,7 @@ def test_exact_corner_samples(refdir, name):
 @pytest.mark.parametrize("name", MESHES)
 def test_vertex_limits(refdir, name):
     d, mesh = _load(refdir, name)
-    S = limit_surface(mesh)
+    S = _surface(refdir, name)
     assert np.abs(S.vertex_limits() - np.array(d["vertex_limit"])).max() <= 1e-13
     # the surface passes through the vertex limits at the face corners
     F = mesh.faces
