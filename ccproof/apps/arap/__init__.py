@@ -1,0 +1,1 @@
+"""ARAP parameterization of Catmull-Clark subdivision surfaces (He, Schaefer, Hormann 2010)."""

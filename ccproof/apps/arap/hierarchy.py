@@ -1,0 +1,342 @@
+"""Subdivision hierarchy of one chart: the surface, the extended chart and the boundary-rule chart.
+
+For a chart (a disk of control faces) we keep, at every level k, one local quad complex ``E_k``:
+the level-k chart faces (first) plus the *ring* of level-k faces that share a vertex with them
+(spec A8: "all vertices of faces outside the chart that share a vertex with the chart boundary").
+Its control points are the level-k surface points ``P^k`` restricted to ``E_k``.
+
+Why one ring is enough (spec A11.5): a level-(k+1) vertex of ``E_{k+1}`` is a vertex point of a
+level-k *chart* vertex, an edge point of an edge with a chart end point, or a face point of an
+``E_k`` face; all three stencils (full fan of a chart vertex, the two faces of such an edge, the
+four face vertices) lie in ``E_k``, and the mesh layer's rules there are the global ones. This is
+asserted at every refinement (:class:`HierarchyError` otherwise). Vertices of ``E_k`` outside the
+chart whose faces form several fans are duplicated so that ``E_k`` is a valid
+:class:`~ccproof.mesh.QuadMesh`; the duplicates share one unknown.
+
+Three linear subdivision operators act on values attached to the vertices of ``E_k``:
+
+* ``S_E[k]`` (*extended chart*, hsh10 section 3.2 (c), and the surface itself): the surface rules
+  (mesh layer: interior Catmull-Clark, crease rules on the surface boundary). Exact on chart
+  vertices and the ring.
+* ``S_B[k]`` (*boundary rules*, hsh10 section 3.2 (b)): the chart as a surface with boundary. Chart
+  boundary edges get the midpoint rule, chart boundary vertices the cubic B-spline crease rule
+  ``(e0 + 6 V + e1) / 8`` on their two chart-boundary neighbours, except *corners* (one chart face,
+  i.e. "valence 2" in the chart) which are kept (``V' = V``), as Biermann et al. 2000 do. Where the
+  chart boundary runs along the surface boundary the rules coincide with the surface's; a vertex
+  that is a one-face corner of the surface itself keeps the surface's crease rule. Rows outside the
+  chart are zero (boundary-rule textures live on the chart only).
+
+Texture unknowns ``T^0``: for the extended chart, one per distinct control vertex of ``E_0``
+(chart vertices first); for the boundary-rule chart, one per chart control vertex (the same first
+ones). ``A_E[k]`` and ``A_B[k]`` map them to level k.
+
+>>> from ccproof.mesh.examples import grid
+>>> h = ChartHierarchy(grid(4, 4), [5, 6, 9, 10])
+>>> h.n_unknowns("extended"), h.n_unknowns("boundary")
+(25, 9)
+>>> L = h.level(2)                  # 64 chart faces and the 36 faces of their ring
+>>> L.n_chart_faces, L.mesh.n_faces
+(64, 100)
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
+
+from ccproof.errors import CCProofError, MeshError
+from ccproof.mesh import QuadMesh, child_faces, subdivision_matrix
+
+__all__ = ["ChartHierarchy", "Level", "HierarchyError", "split_nonmanifold", "RULES"]
+
+#: texture rule sets: "extended" = surface rules on chart + ring, "boundary" = chart boundary rules
+RULES = ("extended", "boundary")
+
+
+class HierarchyError(CCProofError):
+    """An internal consistency check of the chart hierarchy failed."""
+
+
+def split_nonmanifold(F, n):
+    """Duplicate every vertex whose faces form several fans (edge-manifold, oriented input).
+
+    Parameters
+    ----------
+    F : int array (m, 4), indices in ``[0, n)``, every vertex used
+    n : int
+
+    Returns
+    -------
+    F_new : int array (m, 4)
+    orig : int array (n_new,)
+        ``orig[v]`` is the input vertex of output vertex ``v``; the first fan of a vertex keeps its
+        index, extra fans get ``n, n + 1, ...``.
+
+    >>> F = [[0, 1, 2, 3], [0, 4, 5, 6]]          # two quads touching at vertex 0
+    >>> Fn, orig = split_nonmanifold(F, 7)
+    >>> Fn.tolist(), orig.tolist()
+    ([[0, 1, 2, 3], [7, 4, 5, 6]], [0, 1, 2, 3, 4, 5, 6, 0])
+    """
+    F = np.asarray(F, dtype=np.int64)
+    m = F.shape[0]
+    H = 4 * m
+    org = F.ravel()
+    dst = np.roll(F, -1, axis=1).ravel()
+    key = org * n + dst
+    order = np.argsort(key, kind="stable")
+    skey = key[order]
+    rkey = dst * n + org
+    pos = np.minimum(np.searchsorted(skey, rkey), H - 1)
+    twin = np.where(skey[pos] == rkey, order[pos], -1)
+    ar = np.arange(H)
+    prev = (ar // 4) * 4 + (ar + 3) % 4
+    rot = twin[prev]
+    ok = rot >= 0
+    g = sp.coo_matrix((np.ones(int(ok.sum())), (ar[ok], rot[ok])), shape=(H, H))
+    ncomp, lab = connected_components(g, directed=False)
+    pair = org * ncomp + lab
+    uniq, inv = np.unique(pair, return_inverse=True)
+    uorg = uniq // ncomp
+    if uniq.size == n:
+        return F.copy(), np.arange(n)
+    first = np.r_[True, uorg[1:] != uorg[:-1]]
+    newid = np.empty(uniq.size, dtype=np.int64)
+    newid[first] = uorg[first]
+    extra = np.flatnonzero(~first)
+    newid[extra] = n + np.arange(extra.size)
+    orig = np.r_[np.arange(n), uorg[extra]]
+    return newid[inv].reshape(m, 4), orig
+
+
+def _boundary_neighbours(mesh):
+    F = mesh.faces
+    org = F.ravel()
+    dst = np.roll(F, -1, axis=1).ravel()
+    bh = np.flatnonzero(mesh.twin < 0)
+    nb = np.full((mesh.n_vertices, 2), -1, dtype=np.int64)
+    nb[org[bh], 0] = dst[bh]
+    nb[dst[bh], 1] = org[bh]
+    return nb
+
+
+class Level:
+    """One level ``E_k`` of a chart hierarchy and its chart bookkeeping.
+
+    Attributes
+    ----------
+    mesh : QuadMesh
+        ``E_k``; its vertices are the level-k surface control points. Faces ``0 .. n_chart_faces-1``
+        are the chart's.
+    chart_vertex, chart_interior, chart_boundary : bool (n,)
+        Vertex of a chart face; chart vertex all of whose faces are chart faces and which is not on
+        the surface boundary; the other chart vertices.
+    chart_face_count : int (n,)
+    chart_boundary_edge : bool (n_edges,)
+        Edges with exactly one chart face.
+    chart_boundary_nbrs : int (n, 2)
+        The two chart-boundary neighbours of a chart boundary vertex (-1 elsewhere).
+    corner : bool (n,)
+        Chart corners of the boundary rules (one chart face; not a one-face surface corner).
+    surface_boundary_nbrs : int (n, 2)
+        The two surface-boundary neighbours (crease rule of the surface), -1 elsewhere.
+    """
+
+    def __init__(self, mesh: QuadMesh, n_chart_faces: int):
+        self.mesh = mesh
+        mc = int(n_chart_faces)
+        self.n_chart_faces = mc
+        F = mesh.faces
+        n = mesh.n_vertices
+        cfc = np.bincount(F[:mc].ravel(), minlength=n)
+        self.chart_face_count = cfc
+        self.chart_vertex = cfc > 0
+        self.chart_interior = (cfc == mesh.face_count) & ~mesh.is_boundary_vertex
+        self.chart_boundary = self.chart_vertex & ~self.chart_interior
+        ef = mesh.edge_faces
+        nchart = (ef[:, 0] < mc).astype(np.int64) + ((ef[:, 1] >= 0) & (ef[:, 1] < mc))
+        self.chart_boundary_edge = nchart == 1
+        e = mesh.edges[self.chart_boundary_edge]
+        src = np.r_[e[:, 0], e[:, 1]]
+        tgt = np.r_[e[:, 1], e[:, 0]]
+        order = np.argsort(src, kind="stable")
+        src, tgt = src[order], tgt[order]
+        cnt = np.bincount(src, minlength=n)
+        if (cnt[self.chart_boundary] != 2).any() or (cnt[~self.chart_boundary] != 0).any():
+            raise HierarchyError("chart boundary is not a simple closed curve (is the chart a disk?)")
+        start = np.cumsum(cnt) - cnt
+        nb = np.full((n, 2), -1, dtype=np.int64)
+        nb[src, np.arange(src.size) - start[src]] = tgt
+        self.chart_boundary_nbrs = nb
+        self.corner = (
+            self.chart_boundary & (cfc == 1) & ~(mesh.is_boundary_vertex & (mesh.face_count == 1))
+        )
+        self.surface_boundary_nbrs = _boundary_neighbours(mesh)
+
+    @property
+    def n_vertices(self):
+        return self.mesh.n_vertices
+
+    def chart_faces(self):
+        """Faces of the chart at this level, int (n_chart_faces, 4), local vertex indices."""
+        return self.mesh.faces[: self.n_chart_faces]
+
+
+class ChartHierarchy:
+    """Levels ``E_0, E_1, ...`` of one chart with the subdivision operators of both boundary treatments.
+
+    Parameters
+    ----------
+    mesh : QuadMesh
+        The whole control mesh (the surface).
+    chart_faces : array_like of int
+        Face indices of the chart in ``mesh`` (a topological disk; not re-checked here).
+    """
+
+    def __init__(self, mesh: QuadMesh, chart_faces):
+        chart = np.asarray(chart_faces, dtype=np.int64)
+        self.surface = mesh
+        self.chart_faces = chart
+        Fg = mesh.faces
+        in_chart = np.zeros(mesh.n_faces, dtype=bool)
+        in_chart[chart] = True
+        cv = np.unique(Fg[chart])
+        isc = np.zeros(mesh.n_vertices, dtype=bool)
+        isc[cv] = True
+        ring = np.flatnonzero(~in_chart & isc[Fg].any(axis=1))
+        self.ring_faces = ring
+        faces0 = np.r_[chart, ring]
+        allv = np.unique(Fg[faces0])
+        rv = allv[~isc[allv]]
+        gid = np.r_[cv, rv]
+        loc = np.full(mesh.n_vertices, -1, dtype=np.int64)
+        loc[gid] = np.arange(gid.size)
+        F0, orig = split_nonmanifold(loc[Fg[faces0]], gid.size)
+        #: global control-vertex index of every texture unknown (chart vertices first)
+        self.unknown_vertices = gid
+        self.n_chart_vertices = cv.size
+        #: unknown of every vertex of E_0 (duplicated outer vertices share one)
+        self.orig0 = orig
+        E0 = QuadMesh(mesh.vertices[gid[orig]], F0)
+        n0 = orig.size
+        self.A0 = {
+            "extended": sp.csr_matrix((np.ones(n0), (np.arange(n0), orig)), shape=(n0, gid.size)),
+        }
+        cm = orig < cv.size
+        self.A0["boundary"] = sp.csr_matrix(
+            (np.ones(int(cm.sum())), (np.flatnonzero(cm), orig[cm])), shape=(n0, cv.size)
+        )
+        self.levels = [Level(E0, chart.size)]
+        self.S = {"extended": [], "boundary": []}
+        self._A = {"extended": [self.A0["extended"]], "boundary": [self.A0["boundary"]]}
+
+    # ------------------------------------------------------------------ construction
+    def n_unknowns(self, rules):
+        """Number of texture unknowns for ``rules`` ("extended" or "boundary")."""
+        return self.unknown_vertices.size if _rules(rules) == "extended" else self.n_chart_vertices
+
+    def level(self, k) -> Level:
+        """Level ``k`` (built on demand)."""
+        while len(self.levels) <= k:
+            self._refine()
+        return self.levels[k]
+
+    def _refine(self):
+        L = self.levels[-1]
+        E = L.mesh
+        n, ne, m = E.n_vertices, E.n_edges, E.n_faces
+        S = subdivision_matrix(E).tocsr()
+        CF = child_faces(E)
+        mc = L.n_chart_faces
+        cc = CF[: 4 * mc]
+        isc = np.zeros(n + ne + m, dtype=bool)
+        isc[cc.ravel()] = True
+        other = CF[4 * mc :]
+        ring = other[isc[other].any(axis=1)]
+        kept = np.concatenate([cc, ring])
+        used, inv = np.unique(kept, return_inverse=True)
+        # validity of the local stencils (module docstring)
+        vp = used < n
+        if not L.chart_vertex[used[vp]].all():
+            raise HierarchyError("a kept vertex point is not that of a chart vertex")
+        ep = (used >= n) & (used < n + ne)
+        ee = E.edges[used[ep] - n]
+        if not (L.chart_vertex[ee[:, 0]] | L.chart_vertex[ee[:, 1]]).all():
+            raise HierarchyError("a kept edge point belongs to an edge without a chart vertex")
+        Fk = inv.reshape(-1, 4)
+        P = S[used] @ E.vertices
+        try:  # usually manifold: avoid the fan analysis
+            new = QuadMesh(P, Fk)
+            rows = used
+        except MeshError:
+            Fs, orig = split_nonmanifold(Fk, used.size)
+            rows = used[orig]
+            new = QuadMesh(P[orig], Fs)
+        SE = S[rows]
+        chart_rows = isc[rows]
+        SB = self._boundary_rows(L, SE, rows, chart_rows)
+        self.S["extended"].append(SE)
+        self.S["boundary"].append(SB)
+        self.levels.append(Level(new, cc.shape[0]))
+
+    @staticmethod
+    def _boundary_rows(L: Level, SE, rows, chart_rows):
+        E = L.mesh
+        n, ne = E.n_vertices, E.n_edges
+        isvp = rows < n
+        repl_v = np.zeros(rows.size, dtype=bool)
+        repl_v[isvp] = L.chart_boundary[rows[isvp]]
+        isep = (rows >= n) & (rows < n + ne)
+        repl_e = np.zeros(rows.size, dtype=bool)
+        repl_e[isep] = L.chart_boundary_edge[rows[isep] - n]
+        keep = chart_rows & ~repl_v & ~repl_e
+        base = sp.diags(keep.astype(np.float64)) @ SE
+        r_v = np.flatnonzero(repl_v)
+        v = rows[r_v]
+        cor = L.corner[v]
+        nb = L.chart_boundary_nbrs[v]
+        rr, cc, ww = [r_v[cor]], [v[cor]], [np.ones(int(cor.sum()))]
+        cr = ~cor
+        rr += [r_v[cr]] * 3
+        cc += [v[cr], nb[cr, 0], nb[cr, 1]]
+        ww += [np.full(int(cr.sum()), 0.75), np.full(int(cr.sum()), 0.125), np.full(int(cr.sum()), 0.125)]
+        r_e = np.flatnonzero(repl_e)
+        ed = E.edges[rows[r_e] - n]
+        rr += [r_e, r_e]
+        cc += [ed[:, 0], ed[:, 1]]
+        ww += [np.full(r_e.size, 0.5)] * 2
+        extra = sp.coo_matrix(
+            (np.concatenate(ww), (np.concatenate(rr), np.concatenate(cc))), shape=SE.shape
+        )
+        out = (base + extra).tocsr()
+        out.eliminate_zeros()
+        return out
+
+    # ------------------------------------------------------------------ operators
+    def operator(self, k, rules):
+        """Sparse ``A_k``: texture unknowns -> level-k values on ``E_k`` (shape (n_k, n_unknowns))."""
+        r = _rules(rules)
+        self.level(k)
+        A = self._A[r]
+        while len(A) <= k:
+            A.append((self.S[r][len(A) - 1] @ A[-1]).tocsr())
+        return A[k]
+
+    def subdivide_values(self, X, rules, from_level, to_level):
+        """Push values given on ``E_{from_level}`` to ``E_{to_level}`` with the rules ``rules``."""
+        r = _rules(rules)
+        self.level(to_level)
+        X = np.asarray(X, dtype=np.float64)
+        for k in range(from_level, to_level):
+            X = self.S[r][k] @ X
+        return X
+
+    def lift_unknowns(self, X, rules):
+        """Level-0 values on ``E_0`` of the unknowns ``X`` (n_unknowns, d)."""
+        return self.A0[_rules(rules)] @ np.asarray(X, dtype=np.float64)
+
+
+def _rules(rules):
+    if rules not in RULES:
+        raise CCProofError(f"unknown texture rules {rules!r}; expected one of {RULES}")
+    return rules

@@ -1,0 +1,137 @@
+"""Distortion metrics of hsh10 section 4 (spec A9) and flip counts.
+
+For every sample j with singular values s1 >= s2 of grad phi_j = (t1 t2)(p^1 p^2)^-1, surface area
+element A_j and texture area element A_T,j:
+
+    E_angle   = sum A_j (s1/s2 + s2/s1)     / sum A_j                     (>= 2)
+    E_area    = sum A_j (s1 s2 + 1/(s1 s2)) / sum A_j                     (>= 2)
+    E_stretch = sqrt(sum A_j (1/s1^2 + 1/s2^2)/2 / sum A_j) sqrt(sum A_T,j / sum A_j)   (>= 1)
+
+E_area is not scale invariant (it is meant for maps with their natural scale, as ARAP produces);
+:meth:`Metrics.rescaled` gives the value after scaling the texture to the surface area. A sample
+is *flipped* when det grad phi <= 0. Several charts are combined by summing the area-weighted
+sums (spec A11.4).
+
+>>> import numpy as np
+>>> J = np.array([[[2.0, 0.0], [0.0, 0.5]]])
+>>> [float(x) for x in np.concatenate(singular_values(J))]
+[2.0, 0.5, 1.0]
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ccproof.apps.arap.samples import SampleSet, isometric_frames
+
+__all__ = ["singular_values", "jacobians", "Metrics", "sample_metrics"]
+
+
+def singular_values(J):
+    """Singular values s1 >= s2 >= 0 and the determinant of 2x2 matrices J (s, 2, 2)."""
+    a, b, c, d = J[:, 0, 0], J[:, 0, 1], J[:, 1, 0], J[:, 1, 1]
+    Q = np.hypot(0.5 * (a + d), 0.5 * (c - b))
+    R = np.hypot(0.5 * (a - d), 0.5 * (c + b))
+    return Q + R, np.abs(Q - R), a * d - b * c
+
+
+def jacobians(p1, p2, t1, t2):
+    """grad phi = (t1 t2)(p^1 p^2)^-1 in the isometric frame of (p1, p2), shape (s, 2, 2)."""
+    a, b, c = isometric_frames(p1, p2)
+    J = np.empty((a.size, 2, 2))
+    J[:, :, 0] = t1 / a[:, None]
+    J[:, :, 1] = (t2 - t1 * (b / a)[:, None]) / c[:, None]
+    return J
+
+
+@dataclass
+class Metrics:
+    """Accumulated area-weighted sums; combine charts with ``+``."""
+
+    area: float = 0.0
+    angle_sum: float = 0.0
+    area_sum: float = 0.0
+    stretch_sum: float = 0.0
+    texture_area: float = 0.0
+    #: sum A_j s1 s2 and sum A_j / (s1 s2): for the rescaled E_area
+    det_sum: float = 0.0
+    invdet_sum: float = 0.0
+    samples: int = 0
+    flips: int = 0
+    extra: dict = field(default_factory=dict)
+
+    def __add__(self, other):
+        return Metrics(
+            self.area + other.area,
+            self.angle_sum + other.angle_sum,
+            self.area_sum + other.area_sum,
+            self.stretch_sum + other.stretch_sum,
+            self.texture_area + other.texture_area,
+            self.det_sum + other.det_sum,
+            self.invdet_sum + other.invdet_sum,
+            self.samples + other.samples,
+            self.flips + other.flips,
+        )
+
+    @property
+    def E_angle(self):
+        return self.angle_sum / self.area
+
+    @property
+    def E_area(self):
+        return self.area_sum / self.area
+
+    @property
+    def E_stretch(self):
+        return np.sqrt(self.stretch_sum / self.area) * np.sqrt(self.texture_area / self.area)
+
+    def rescaled(self):
+        """(E_angle, E_area, E_stretch) after scaling the texture so that sum A_T = sum A."""
+        s2 = self.area / self.texture_area  # texture scale^2 to apply
+        e_area = (s2 * self.det_sum + self.invdet_sum / s2) / self.area
+        return self.E_angle, e_area, self.E_stretch
+
+    def as_tuple(self):
+        return self.E_angle, self.E_area, self.E_stretch
+
+    def __repr__(self):
+        return (
+            f"Metrics(E_angle={self.E_angle:.6f}, E_area={self.E_area:.6f}, E_stretch={self.E_stretch:.6f}, "
+            f"flips={self.flips}, samples={self.samples})"
+        )
+
+
+def sample_metrics(samples: SampleSet, T, per_sample=False):
+    """Metrics of the level-k texture values ``T`` (n_k, 2) on the samples ``samples``.
+
+    Returns
+    -------
+    Metrics, and with ``per_sample=True`` also a dict of per-sample arrays (s1, s2, det, weight,
+    area distortion s1 s2 + 1/(s1 s2)).
+    """
+    t1, t2 = samples.texture_tangents(T)
+    J = jacobians(samples.p1, samples.p2, t1, t2)
+    s1, s2, det = singular_values(J)
+    w = samples.weight
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ang = s1 / s2 + s2 / s1
+        pr = s1 * s2
+        are = pr + 1.0 / pr
+        st = 0.5 * (1.0 / s1**2 + 1.0 / s2**2)
+    at = np.abs(t1[:, 0] * t2[:, 1] - t1[:, 1] * t2[:, 0]) * samples.area_factor
+    m = Metrics(
+        area=float(w.sum()),
+        angle_sum=float(w @ ang),
+        area_sum=float(w @ are),
+        stretch_sum=float(w @ st),
+        texture_area=float(at.sum()),
+        det_sum=float(w @ pr),
+        invdet_sum=float(w @ (1.0 / pr)),
+        samples=int(w.size),
+        flips=int((det <= 0).sum()),
+    )
+    if per_sample:
+        return m, {"s1": s1, "s2": s2, "det": det, "weight": w, "area_distortion": are, "vertex": samples.vertex}
+    return m

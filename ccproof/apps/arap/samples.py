@@ -1,0 +1,242 @@
+"""Limit tangent masks (hsh10 Eq. 2, spec A3) and the level-k samples of Eq. 3 and of the metrics.
+
+Tangent masks (A3). For an interior vertex of valence n with edge neighbours e_0 .. e_{n-1}
+(counter-clockwise) and face-diagonal neighbours f_i (face i between e_i and e_{i+1}):
+
+    alpha_i = (1/n + cos(pi/n) / (n sqrt(4 + cos^2(pi/n)))) cos(2 pi i/n)      on e_i
+    beta_i  = cos((2 pi i + pi)/n) / (n sqrt(4 + cos^2(pi/n)))                  on f_i
+
+``p_1 = sum alpha_i e_i + beta_i f_i`` and ``p_2`` uses the same weights rotated once around the
+vertex (``p_2 = sum alpha_i e_{i+1} + beta_i f_{i+1}``); the centre weight is 0. They are exact limit
+tangents (left eigenvectors of the subdominant eigenvalue), the derivatives along the limit curves
+of the edges e_0 and e_1 in the characteristic-map parameter, scaled so that for n = 4 they are the
+bicubic B-spline derivative with unit knot spacing (edge weights 1/3, face weights 1/12).
+
+Samples. A *sample* is one term of the quadrature of hsh10 Eq. 1 at level k: two surface tangents
+p_1, p_2 (3-vectors), two linear texture operators O_1, O_2 (rows acting on the level-k texture
+values of ``E_k``) for the *same* two parametric directions, and a weight. Two kinds:
+
+* *mask sample* at a vertex whose texture and surface both follow the interior rules there: A3
+  masks for both; weight ``||p_1 x p_2||`` times the fraction of its faces that belong to the chart.
+* *corner samples* at every other chart vertex (chart boundary for boundary-rule textures; the
+  surface boundary for all): one per chart face corner (v, f), with the secants of *limit points*
+  along the two edges of f at v, ``d_a = L(a) - L(v)`` and ``d_b = L(b) - L(v)``, for the surface
+  and for the texture (each with its own rules, so the secant pairs span the same parameter
+  triangle); weight ``||d_a x d_b|| / 4`` (a quarter face). hsh10 gives no masks at chart boundary
+  vertices (spec A11.2); secants are exact for affine maps and reproduce the texture's own boundary
+  behaviour, which is what (b) is about.
+
+Limit position masks: interior ``(n^2 V + 4 sum e + sum f) / (n (n + 5))``; crease (cubic B-spline
+boundary) ``(e0 + 4 V + e1) / 6``; corner ``V``.
+
+>>> import numpy as np
+>>> a, b = mask_weights(4)
+>>> (np.round(a * 12, 12) + 0.0).tolist(), (np.round(b * 12, 12) + 0.0).tolist()
+([4.0, 0.0, -4.0, 0.0], [1.0, -1.0, -1.0, 1.0])
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from ccproof.apps.arap.hierarchy import Level, _rules
+
+__all__ = [
+    "mask_weights",
+    "tangent_mask_operators",
+    "limit_operator",
+    "SampleSet",
+    "build_samples",
+    "isometric_frames",
+]
+
+
+def mask_weights(n):
+    """The A3 weights (alpha_i, beta_i), i = 0 .. n-1, of a valence-``n`` vertex."""
+    n = int(n)
+    i = np.arange(n)
+    c = np.cos(np.pi / n)
+    s = 1.0 / (n * np.sqrt(4.0 + c * c))
+    alpha = (1.0 / n + c * s) * np.cos(2 * np.pi * i / n)
+    beta = s * np.cos((2 * np.pi * i + np.pi) / n)
+    return alpha, beta
+
+
+def _fan_corners(mesh, verts):
+    """All corners (half-edges) of the fans of ``verts`` in fan order: (row, position j, corner)."""
+    ptr, fan = mesh.fan_ptr, mesh.fan_corners
+    cnt = mesh.face_count[verts]
+    row = np.repeat(np.arange(verts.size), cnt)
+    j = np.arange(row.size) - np.repeat(np.cumsum(cnt) - cnt, cnt)
+    c = fan[np.repeat(ptr[verts], cnt) + j]
+    return row, j, c
+
+
+def tangent_mask_operators(mesh, verts):
+    """Sparse (len(verts), n) operators of the A3 masks p_1, p_2 at interior vertices ``verts``."""
+    verts = np.asarray(verts, dtype=np.int64)
+    F = mesh.faces
+    row, j, c = _fan_corners(mesh, verts)
+    f, i = c // 4, c % 4
+    e = F[f, (i + 1) % 4]
+    d = F[f, (i + 2) % 4]
+    n = mesh.face_count[verts][row].astype(np.float64)
+    cn = np.cos(np.pi / n)
+    s = 1.0 / (n * np.sqrt(4.0 + cn * cn))
+    a0 = 1.0 / n + cn * s
+
+    def op(jj):
+        al = a0 * np.cos(2 * np.pi * jj / n)
+        be = s * np.cos((2 * np.pi * jj + np.pi) / n)
+        return sp.csr_matrix(
+            (np.concatenate([al, be]), (np.concatenate([row, row]), np.concatenate([e, d]))),
+            shape=(verts.size, mesh.n_vertices),
+        )
+
+    return op(j), op(j - 1)
+
+
+def limit_operator(level: Level, rules):
+    """Sparse (n, n) limit-position operator on ``E_k`` for ``rules``; rows of chart vertices only."""
+    r = _rules(rules)
+    mesh = level.mesh
+    F = mesh.faces
+    n = mesh.n_vertices
+    if r == "extended":
+        inner = level.chart_vertex & ~mesh.is_boundary_vertex
+        crease = level.chart_vertex & mesh.is_boundary_vertex
+        nbrs = level.surface_boundary_nbrs
+        corner = np.zeros(n, dtype=bool)
+    else:
+        inner = level.chart_interior
+        corner = level.corner
+        crease = level.chart_boundary & ~corner
+        nbrs = level.chart_boundary_nbrs
+    org = F.ravel()
+    h = np.flatnonzero(inner[org])
+    v = org[h]
+    k = mesh.valence[v].astype(np.float64)
+    f, i = h // 4, h % 4
+    e = F[f, (i + 1) % 4]
+    d = F[f, (i + 2) % 4]
+    iv = np.flatnonzero(inner)
+    ki = mesh.valence[iv].astype(np.float64)
+    cv = np.flatnonzero(crease)
+    kv = np.flatnonzero(corner)
+    rows = np.concatenate([v, v, iv, cv, cv, cv, kv])
+    cols = np.concatenate([e, d, iv, cv, nbrs[cv, 0], nbrs[cv, 1], kv])
+    vals = np.concatenate(
+        [
+            4.0 / (k * (k + 5)),
+            1.0 / (k * (k + 5)),
+            ki / (ki + 5),
+            np.full(cv.size, 4.0 / 6),
+            np.full(cv.size, 1.0 / 6),
+            np.full(cv.size, 1.0 / 6),
+            np.ones(kv.size),
+        ]
+    )
+    return sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
+
+
+def isometric_frames(p1, p2):
+    """The isometric images (a, b, c) of the frames: p^_1 = (a, 0), p^_2 = (b, c) (spec A2).
+
+    ``a = |p1|``, ``b = p1.p2 / |p1|``, ``c = |p1 x p2| / |p1|`` (c >= 0).
+    """
+    a = np.linalg.norm(p1, axis=1)
+    b = np.einsum("ij,ij->i", p1, p2) / a
+    c = np.linalg.norm(np.cross(p1, p2), axis=1) / a
+    return a, b, c
+
+
+@dataclass
+class SampleSet:
+    """Level-k samples of one chart (module docstring).
+
+    Attributes
+    ----------
+    p1, p2 : (s, 3) surface tangents
+    O1, O2 : sparse (s, n_k) texture operators on ``E_k`` values
+    weight : (s,) quadrature weights (surface area elements)
+    area_factor : (s,) factor turning ``|det(t1, t2)|`` into the texture area element
+    vertex : (s,) level-k vertex of each sample
+    corner : (s,) bool, corner sample
+    """
+
+    p1: np.ndarray
+    p2: np.ndarray
+    O1: sp.csr_matrix
+    O2: sp.csr_matrix
+    weight: np.ndarray
+    area_factor: np.ndarray
+    vertex: np.ndarray
+    corner: np.ndarray
+
+    @property
+    def size(self):
+        return self.weight.size
+
+    def texture_tangents(self, T):
+        """t1, t2 (s, d) of level-k texture values ``T`` (n_k, d)."""
+        return self.O1 @ T, self.O2 @ T
+
+
+def build_samples(level: Level, rules, purpose="optimize") -> SampleSet:
+    """The samples of one level.
+
+    Parameters
+    ----------
+    level : Level
+    rules : "extended" or "boundary"
+        The texture's subdivision rules.
+    purpose : "optimize" or "metric"
+        "optimize": the energy of hsh10 Eq. 3 for that variant (mask samples wherever the texture
+        follows the interior rules, i.e. at every chart vertex off the surface boundary for
+        extended charts). "metric": the same sampling for every method (mask samples at
+        chart-interior vertices, corner samples on the chart boundary), spec A9 / A11.4.
+    """
+    r = _rules(rules)
+    mesh = level.mesh
+    F = mesh.faces
+    P = mesh.vertices
+    if purpose == "optimize" and r == "extended":
+        mask_v = np.flatnonzero(level.chart_vertex & ~mesh.is_boundary_vertex)
+    elif purpose in ("optimize", "metric"):
+        mask_v = np.flatnonzero(level.chart_interior)
+    else:
+        raise ValueError(f"purpose must be 'optimize' or 'metric', got {purpose!r}")
+    corner_v = np.zeros(mesh.n_vertices, dtype=bool)
+    corner_v[level.chart_vertex] = True
+    corner_v[mask_v] = False
+    M1, M2 = tangent_mask_operators(mesh, mask_v)
+    p1m, p2m = M1 @ P, M2 @ P
+    frac = level.chart_face_count[mask_v] / mesh.face_count[mask_v]
+    wm = np.linalg.norm(np.cross(p1m, p2m), axis=1) * frac
+    # corner samples: chart faces' corners at corner_v vertices
+    hc = np.arange(4 * level.n_chart_faces)
+    hc = hc[corner_v[F.ravel()[hc]]]
+    f, i = hc // 4, hc % 4
+    v = F[f, i]
+    a = F[f, (i + 1) % 4]
+    b = F[f, (i + 3) % 4]
+    Ls = limit_operator(level, "extended")
+    Lt = Ls if r == "extended" else limit_operator(level, "boundary")
+    Da = Lt[a] - Lt[v]
+    Db = Lt[b] - Lt[v]
+    LP = Ls @ P
+    p1c, p2c = LP[a] - LP[v], LP[b] - LP[v]
+    wc = np.linalg.norm(np.cross(p1c, p2c), axis=1) / 4
+    return SampleSet(
+        p1=np.concatenate([p1m, p1c]),
+        p2=np.concatenate([p2m, p2c]),
+        O1=sp.vstack([M1, Da]).tocsr(),
+        O2=sp.vstack([M2, Db]).tocsr(),
+        weight=np.concatenate([wm, wc]),
+        area_factor=np.concatenate([frac, np.full(hc.size, 0.25)]),
+        vertex=np.concatenate([mask_v, v]),
+        corner=np.r_[np.zeros(mask_v.size, dtype=bool), np.ones(hc.size, dtype=bool)],
+    )

@@ -1,0 +1,229 @@
+"""Local/global ARAP iteration on samples (hsh10 section 3, Appendix; spec A5, A6, A7).
+
+Energy (Eq. 3 / A6): with X = T^0 (N x 2) the texture unknowns, every sample j has
+``t_{j,c} = G_c[j] X`` (rows of sparse operators), the isometric frame ``Q_j = (p^_1 p^_2)^-1`` and a
+weight ``w_j``; ``grad phi_j = (t_1 t_2) Q_j = X^T H_j`` and
+
+    E(X, R) = sum_j w_j || X^T H_j - R_j ||_F^2.
+
+Local step (A5, Theorem 1): for A = [[a, b], [c, d]] the closest rotation is
+``[[a + d, b - c], [c - b, a + d]] / sqrt((a + d)^2 + (c - b)^2)`` (identity in the degenerate
+case a = -d, b = c, where every rotation is equally good).
+
+Global step (A6): the normal equations ``L X = B`` with ``L = sum_j w_j H_j H_j^T`` (independent of
+R: factorized ONCE per level with SuperLU and reused) and ``B = sum_j w_j H_j R_j^T`` (rebuilt every
+iteration, two sparse products). One unknown is pinned (the energy is translation invariant).
+If ``L`` restricted to the free unknowns is (numerically) singular, e.g. at level 0 on regular
+grids (spec A6 caution), a proximal term ``mu ||X - X_prev||^2`` is added; it keeps the energy
+monotone and the run reports ``regularized=True``.
+
+The same class runs Liu et al.'s triangle ARAP (baselines (a), (d)): one sample per triangle with
+the edge vectors as tangents and the area as weight (:func:`triangle_samples`).
+
+>>> import numpy as np
+>>> R = closest_rotations(np.array([[[1.0, 2.0], [3.0, 4.0]]]))
+>>> np.round(R[0] * np.hypot(5, 1), 12).tolist()
+[[5.0, -1.0], [1.0, 5.0]]
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from ccproof.apps.arap.samples import SampleSet, isometric_frames
+
+__all__ = ["closest_rotations", "LocalGlobal", "IterationResult", "iterate", "triangle_samples"]
+
+
+def closest_rotations(J, previous=None):
+    """Theorem 1 of hsh10: the rotation closest to each 2x2 matrix of ``J`` (s, 2, 2)."""
+    a, b, c, d = J[:, 0, 0], J[:, 0, 1], J[:, 1, 0], J[:, 1, 1]
+    x = a + d
+    y = c - b
+    nrm = np.hypot(x, y)
+    deg = nrm <= 1e-300
+    safe = np.where(deg, 1.0, nrm)
+    co = np.where(deg, 1.0, x / safe)
+    si = np.where(deg, 0.0, y / safe)
+    R = np.empty_like(J)
+    R[:, 0, 0] = co
+    R[:, 0, 1] = -si
+    R[:, 1, 0] = si
+    R[:, 1, 1] = co
+    if previous is not None and deg.any():
+        R[deg] = previous[deg]
+    return R
+
+
+@dataclass
+class IterationResult:
+    """Outcome of :func:`iterate` at one level."""
+
+    X: np.ndarray
+    iterations: int
+    energies: list
+    seconds: float
+    converged: bool
+    #: energy after each half step (global, local, global, ...) when traced
+    trace: list = field(default_factory=list)
+    residuals: list = field(default_factory=list)
+
+    @property
+    def seconds_per_iteration(self):
+        return self.seconds / max(self.iterations, 1)
+
+
+class LocalGlobal:
+    """The fixed-level system: operators H, matrix L (factorized once), local and global steps.
+
+    Parameters
+    ----------
+    p1, p2 : (s, 3) surface tangents; G1, G2 : sparse (s, N) texture rows; weight : (s,)
+    pin : int, the pinned unknown
+    """
+
+    def __init__(self, p1, p2, G1, G2, weight, pin=0, factor=True):
+        t0 = time.perf_counter()
+        a, b, c = isometric_frames(p1, p2)
+        w = np.asarray(weight, dtype=np.float64)
+        good = (w > 1e-14 * w.max()) & (a > 0) & (c > 0)
+        self.dropped = int((~good).sum())
+        idx = np.flatnonzero(good)
+        a, b, c, w = a[idx], b[idx], c[idx], w[idx]
+        G1 = sp.csr_matrix(G1)[idx]
+        G2 = sp.csr_matrix(G2)[idx]
+        self.Hu = (sp.diags(1.0 / a) @ G1).tocsr()
+        self.Hv = (sp.diags(-b / (a * c)) @ G1 + sp.diags(1.0 / c) @ G2).tocsr()
+        self.HuT = self.Hu.T.tocsr()
+        self.HvT = self.Hv.T.tocsr()
+        self.w = w
+        self.weight_sum = float(w.sum())
+        self.pin = int(pin)
+        self.mu = 0.0
+        self.regularized = False
+        self.n_samples = idx.size
+        if not factor:  # energy evaluation only
+            self.build_seconds = time.perf_counter() - t0
+            return
+        W = sp.diags(w)
+        self.L = (self.HuT @ W @ self.Hu + self.HvT @ W @ self.Hv).tocsc()
+        N = self.L.shape[0]
+        self.N = N
+        self.free = np.setdiff1d(np.arange(N), [self.pin])
+        Lff = self.L[self.free][:, self.free].tocsc()
+        self.Lfp = self.L[self.free][:, [self.pin]]
+        self._factor(Lff)
+        self.build_seconds = time.perf_counter() - t0
+
+    def _factor(self, Lff):
+        try:
+            lu = spla.splu(Lff)
+            d = np.abs(lu.U.diagonal())
+            if d.size and d.min() <= 1e-12 * d.max():
+                raise RuntimeError("nearly singular")
+            self.lu = lu
+        except RuntimeError:
+            self.mu = 1e-8 * float(np.abs(Lff.diagonal()).mean() or 1.0)
+            self.regularized = True
+            self.lu = spla.splu((Lff + self.mu * sp.identity(Lff.shape[0], format="csc")).tocsc())
+        self.Lff = Lff
+
+    def jacobians(self, X):
+        """grad phi of every sample, (s, 2, 2): J[:, c, 0] = (Hu X)[:, c], J[:, c, 1] = (Hv X)[:, c]."""
+        J = np.empty((self.w.size, 2, 2))
+        J[:, :, 0] = self.Hu @ X
+        J[:, :, 1] = self.Hv @ X
+        return J
+
+    def energy(self, J, R):
+        """E(X, R) = sum_j w_j ||J_j - R_j||^2."""
+        D = J - R
+        return float(self.w @ np.einsum("sij,sij->s", D, D))
+
+    def rhs(self, R):
+        """B = sum_j w_j H_j R_j^T, shape (N, 2)."""
+        return self.HuT @ (self.w[:, None] * R[:, :, 0]) + self.HvT @ (self.w[:, None] * R[:, :, 1])
+
+    def global_step(self, R, X):
+        """Minimize E(., R) (plus the proximal term when regularized); the pinned unknown stays."""
+        B = self.rhs(R)
+        Xn = np.array(X, dtype=np.float64, copy=True)
+        rhs = B[self.free] - self.Lfp @ X[[self.pin]]
+        if self.mu:
+            rhs = rhs + self.mu * X[self.free]
+        Xn[self.free] = self.lu.solve(np.asarray(rhs))
+        return Xn
+
+    def residual(self, R, X):
+        """||L X - B|| / ||B|| on the free unknowns (without the proximal term)."""
+        B = self.rhs(R)
+        r = (self.L @ X - B)[self.free]
+        nb = np.linalg.norm(B[self.free])
+        return float(np.linalg.norm(r) / nb) if nb else float(np.linalg.norm(r))
+
+
+def iterate(system: LocalGlobal, X0, tol=1e-6, max_iter=200, trace=False, min_iter=1):
+    """Alternate local and global steps until the relative energy decrease is below ``tol``.
+
+    Returns
+    -------
+    IterationResult
+        ``energies[i]`` is E(X_i, R(X_i)) (after each local step); with ``trace`` also the energy
+        after every global step (``trace``) and the global solve residuals.
+    """
+    t0 = time.perf_counter()
+    X = np.array(X0, dtype=np.float64, copy=True)
+    J = system.jacobians(X)
+    R = closest_rotations(J)
+    E = system.energy(J, R)
+    energies = [E]
+    tr = [E] if trace else []
+    res = []
+    converged = False
+    it = 0
+    while it < max_iter:
+        Xn = system.global_step(R, X)
+        it += 1
+        J = system.jacobians(Xn)
+        if trace:
+            tr.append(system.energy(J, R))
+            res.append(system.residual(R, Xn) if not system.mu else np.nan)
+        R = closest_rotations(J, previous=R)
+        En = system.energy(J, R)
+        if trace:
+            tr.append(En)
+        energies.append(En)
+        X = Xn
+        done = En <= 1e-28 * system.weight_sum or (E - En) <= tol * E
+        E = En
+        if done and it >= min_iter:
+            converged = True
+            break
+    return IterationResult(X, it, energies, time.perf_counter() - t0, converged, tr, res)
+
+
+def triangle_samples(V, T):
+    """Liu et al. 2008 triangle ARAP as samples: tangents = edge vectors, weight = triangle area.
+
+    Returns p1, p2 (t, 3) and sparse G1, G2 (t, n) with G1 X = X[v1] - X[v0], G2 X = X[v2] - X[v0].
+    """
+    V = np.asarray(V, dtype=np.float64)
+    T = np.asarray(T, dtype=np.int64)
+    t, n = T.shape[0], V.shape[0]
+    p1 = V[T[:, 1]] - V[T[:, 0]]
+    p2 = V[T[:, 2]] - V[T[:, 0]]
+    r = np.arange(t)
+    G1 = sp.csr_matrix((np.r_[np.ones(t), -np.ones(t)], (np.r_[r, r], np.r_[T[:, 1], T[:, 0]])), shape=(t, n))
+    G2 = sp.csr_matrix((np.r_[np.ones(t), -np.ones(t)], (np.r_[r, r], np.r_[T[:, 2], T[:, 0]])), shape=(t, n))
+    w = 0.5 * np.linalg.norm(np.cross(p1, p2), axis=1)
+    return p1, p2, G1, G2, w
+
+
+def system_from_samples(samples: SampleSet, A, pin=0):
+    """The :class:`LocalGlobal` system of level-k samples with unknown->level operator ``A``."""
+    return LocalGlobal(samples.p1, samples.p2, samples.O1 @ A, samples.O2 @ A, samples.weight, pin=pin)
