@@ -229,11 +229,11 @@ def as_points(u, v, what="point"):
         bad = ~np.isfinite(a)
         if bad.any():
             i = int(np.flatnonzero(bad)[0])
-            raise CCProofError(f"{what} {name} coordinate is not finite (NaN or inf) at index {i}: {a[i]!r}")
+            raise CCProofError(f"{what} {name} coordinate is not finite (NaN or inf) at index {i}: {float(a[i])!r}")
         neg = a < 0
         if neg.any():
             i = int(np.flatnonzero(neg)[0])
             raise CCProofError(
-                f"{what} {name} coordinate is negative at index {i}: {a[i]!r}; the characteristic map "
+                f"{what} {name} coordinate is negative at index {i}: {float(a[i])!r}; the characteristic map "
                 "and its inverse are defined on the quadrant [0, inf)^2")
     return u, v, shape

@@ -69,6 +69,8 @@ class InverseResult:
     outside the face). ``patch``: 0, 1, 2 for P1, P2, P3 (-1 at the origin). ``fallback``: True
     where the subdivision fallback produced the answer. ``verified``: False only where even the
     fallback's acceptance test failed (never observed; counted as a failure by the benchmark).
+    ``stats``: counts of points, fallbacks and failures. ``boxes``: with ``rigorous=True``, one
+    :class:`~ccproof.inverse.certified.CertifiedPreimage` per point (flattened order).
     """
 
     r: np.ndarray
@@ -78,6 +80,7 @@ class InverseResult:
     fallback: np.ndarray
     verified: np.ndarray
     stats: dict = field(default_factory=dict)
+    boxes: list | None = None
 
 
 def inverse_characteristic_map(k, u, v, *, domain="quadrant", full_output=False, rigorous=False, prec=128):
@@ -97,8 +100,9 @@ def inverse_characteristic_map(k, u, v, *, domain="quadrant", full_output=False,
         Return an :class:`InverseResult` (layer, patch, fallback flags, statistics).
     rigorous : bool
         Also certify every preimage with an interval Newton (Krawczyk) test in arb at ``prec``
-        bits (slow: Python per point); see :func:`ccproof.inverse.certified.certify_preimage`.
-        With ``full_output`` the boxes are in ``stats["boxes"]``.
+        bits (slow: about 10 ms per point); see :func:`ccproof.inverse.certified.certify_preimage`.
+        Implies ``full_output``; the boxes are in ``result.boxes`` and
+        ``result.stats["uncertified"]`` counts the points whose test failed (0 in all our runs).
 
     Returns
     -------
@@ -136,13 +140,15 @@ def inverse_characteristic_map(k, u, v, *, domain="quadrant", full_output=False,
     if domain == "face":
         _check_face(x, y, R, S)
     stats = {"points": npts, "fallback": int(fb.sum()), "failures": int((~ver).sum())}
+    boxes = None
     if rigorous:
         from ccproof.inverse.certified import certify_preimage
 
-        stats["boxes"] = [certify_preimage(k, x[i], y[i], R[i], S[i], prec) for i in range(npts)]
-    if full_output:
+        boxes = [certify_preimage(k, x[i], y[i], R[i], S[i], prec) for i in range(npts)]
+        stats["uncertified"] = sum(not b.certified for b in boxes)
+    if full_output or rigorous:
         return InverseResult(R.reshape(shape), S.reshape(shape), layer.reshape(shape),
-                             patch.reshape(shape), fb.reshape(shape), ver.reshape(shape), stats)
+                             patch.reshape(shape), fb.reshape(shape), ver.reshape(shape), stats, boxes)
     return R.reshape(shape), S.reshape(shape)
 
 
@@ -152,8 +158,9 @@ def _check_face(x, y, R, S):
     if out.any():
         i = int(np.flatnonzero(out)[0])
         raise CCProofError(
-            f"point ({x[i]!r}, {y[i]!r}) is outside the image Phi([0,1]^2) of the face (its preimage "
-            f"in the quadrant is ({R[i]!r}, {S[i]!r})); use domain='quadrant' for the extension")
+            f"point ({float(x[i])!r}, {float(y[i])!r}) is outside the image Phi([0,1]^2) of the face (its "
+            f"preimage in the quadrant is ({float(R[i])!r}, {float(S[i])!r})); use domain='quadrant' for "
+            "the extension")
     np.minimum(R, 1.0, out=R)
     np.minimum(S, 1.0, out=S)
 
@@ -201,6 +208,8 @@ def _inverse_chunk(D, x, y, R, S, layer, patch):
         s_loc[sel] = s
         t_loc[sel] = t
         ok[sel] = good
+    # on the axis the preimage is on the axis (Phi maps each axis onto itself, injectively)
+    t_loc[b == 0] = 0.0
     # local -> layer-0 face coordinates -> face coordinates (exact scaling by 2^-n)
     u0 = (s_loc + 1.0) * 0.5
     v0 = (t_loc + p) * 0.5
@@ -224,7 +233,7 @@ def newton(Wp, s, t, X, Y):
     """Newton for P(s, t) = (X, Y) on one piece; returns (s, t, accepted)."""
     s = s.copy()
     t = t.copy()
-    step = None
+    step = np.full(s.shape, np.inf)
     for _ in range(NEWTON_STEPS):
         s, t, step = _newton_step(Wp, s, t, X, Y)
     todo = np.flatnonzero(~(step <= STEP_TOL))
@@ -265,6 +274,7 @@ def _run_fallback(D, x, y, idx, R, S, layer, patch, ver):
         n0 = np.floor((np.log(a) - D.log_a) * D.inv_log_lam)
     n0 = np.clip(n0, -NMAX + 4, NMAX - 4).astype(np.int64)
     n, p, s_loc, t_loc, verified = subdivision_inverse(D, a, b, n0)
+    t_loc[(b == 0) & (p == 0)] = 0.0
     r = np.maximum(np.ldexp((s_loc + 1.0) * 0.5, -n), 0.0)
     s = np.maximum(np.ldexp((t_loc + p) * 0.5, -n), 0.0)
     R[idx] = np.where(sw, s, r)

@@ -466,18 +466,13 @@ def exact_value_rational_c(edge, c, u, v):
 
     c, u, v = Fraction(c), Fraction(u), Fraction(v)
     sym = symbolic_implicit(get_edge(edge))
-    num = sym.numerator
     f = lambda x: fmpq(x.numerator, x.denominator)
-    # numerator = N0 + N1 lam at (c, u, v); lam = (5 + c)/16 + sqrt(d)/16
+    # numerator = N0 + N1 lam at (c, u, v) (exact substitution in flint); lam = (5 + c + sqrt d)/16
+    rest = sym.numerator.subs({"c": f(c), "u": f(u), "v": f(v)})
     n0 = n1 = Fraction(0)
-    cu = {}
-    for exps, coef in num.to_dict().items():
-        i, j, a, b = (int(x) for x in exps)
-        key = (j, a, b)
-        if key not in cu:
-            cu[key] = c**j * u**a * v**b
-        val = Fraction(int(coef.p), int(coef.q)) * cu[key]
-        if i == 0:
+    for exps, coef in rest.to_dict().items():
+        val = Fraction(int(coef.p), int(coef.q))
+        if int(exps[0]) == 0:
             n0 += val
         else:
             n1 += val
