@@ -7,13 +7,16 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
+
+try:
+    import numba
+except ImportError:  # pragma: no cover - optional dependency
+    numba = None
 
 _REGULAR, _CORNER, _SPLIT = 0, 1, 2
 
 
-@numba.njit(cache=True, nogil=True)
 def _basis(x, B, D, D2):
     t = 1.0 - x
     x2 = x * x
@@ -140,4 +143,8 @@ def _evaluate_points(f, u, v, d, vkind, vchild, vu0, vv0, vh, vpatch, vcold, hot
                 Pvv[k, c] = a5 * g2
 
 
-evaluate_points = numba.njit(cache=True, nogil=True)(_evaluate_points)
+if numba is not None:
+    _basis = numba.njit(cache=True, nogil=True)(_basis)
+    evaluate_points = numba.njit(cache=True, nogil=True)(_evaluate_points)
+else:  # pragma: no cover
+    evaluate_points = None

@@ -491,12 +491,10 @@ def _numba_kernel(backend):
         return None
     if backend not in ("auto", "numba"):
         raise CCProofError(f"unknown backend {backend!r} (use 'numpy' or 'numba')")
-    try:
-        from ccproof.evaluate._numba_kernel import evaluate_points
-    except ImportError:
-        if backend == "numba":
-            raise CCProofError("backend 'numba' requested but numba is not installed") from None
-        return None
+    from ccproof.evaluate._numba_kernel import evaluate_points
+
+    if evaluate_points is None and backend == "numba":
+        raise CCProofError("backend 'numba' requested but numba is not installed")
     return evaluate_points
 
 

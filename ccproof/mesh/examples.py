@@ -11,7 +11,7 @@ import numpy as np
 from ccproof.errors import CCProofError
 from ccproof.mesh.quadmesh import QuadMesh
 
-__all__ = ["k_regular_disk", "grid", "cube", "torus"]
+__all__ = ["k_regular_disk", "grid", "cube", "torus", "l_shape"]
 
 
 def k_regular_disk(k, rings=3, height=None):
@@ -90,3 +90,24 @@ def torus(n_major=8, n_minor=6, R=2.0, r=0.75):
     idx = np.arange(n_major * n_minor).reshape(n_major, n_minor)
     F = np.stack([idx, np.roll(idx, -1, 0), np.roll(np.roll(idx, -1, 0), -1, 1), np.roll(idx, -1, 1)], -1)
     return QuadMesh(V.reshape(-1, 3), F.reshape(-1, 4))
+
+
+def l_shape(seed=0, noise=0.15):
+    """A 4 x 4 grid minus its top-right 2 x 2 block, randomly perturbed.
+
+    It has a concave boundary vertex with three faces, boundary vertices with one face (the
+    convex corners) and regular boundary vertices.
+
+    >>> m = l_shape()
+    >>> m.n_faces, int((m.is_boundary_vertex & (m.face_count == 3)).sum())
+    (12, 1)
+    """
+    rng = np.random.default_rng(seed)
+    g = grid(4, 4)
+    keep = [f for f in range(16) if not (f % 4 >= 2 and f // 4 >= 2)]
+    F = g.faces[keep]
+    used = np.unique(F)
+    remap = -np.ones(25, dtype=np.int64)
+    remap[used] = np.arange(used.size)
+    V = g.vertices[used] + noise * rng.normal(size=(used.size, 3))
+    return QuadMesh(V, remap[F])

@@ -5,12 +5,10 @@ from pathlib import Path
 
 import pytest
 
-from tests.evaluate.conftest import shared_reference
-
 
 @pytest.mark.slow
-def test_bench_quick(capsys):
-    if not (shared_reference() / "meshes" / "bunny_quads.obj").exists():
+def test_bench_quick(capsys, refdir):
+    if not (refdir / "meshes" / "bunny_quads.obj").exists():
         pytest.skip("bunny mesh not available")
     path = Path(__file__).resolve().parents[2] / "scripts" / "bench_evaluate.py"
     spec = importlib.util.spec_from_file_location("bench_evaluate", path)

@@ -12,8 +12,7 @@ import pytest
 from ccproof.evaluate import limit_surface
 from ccproof.evaluate.local import LocalTopology, canonical_ring, corner_scheme
 from ccproof.mesh import QuadMesh, limit_positions, subdivide, subdivision_matrix
-from ccproof.mesh.examples import cube, grid, k_regular_disk
-from tests.evaluate.conftest import l_shape
+from ccproof.mesh.examples import cube, grid, k_regular_disk, l_shape
 
 CORNERS = [(0, 0), (1, 0), (1, 1), (0, 1)]
 

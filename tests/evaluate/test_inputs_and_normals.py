@@ -9,8 +9,7 @@ from ccproof.errors import CCProofError, MeshError
 from ccproof.evaluate import limit_surface
 from ccproof.evaluate.local import LocalTopology, canonical_ring, corner_scheme
 from ccproof.mesh import QuadMesh, limit_normals, read_obj
-from ccproof.mesh.examples import cube, k_regular_disk
-from tests.evaluate.conftest import l_shape
+from ccproof.mesh.examples import cube, k_regular_disk, l_shape
 
 
 @pytest.fixture(scope="module")
