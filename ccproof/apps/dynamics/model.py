@@ -33,7 +33,7 @@ from dataclasses import asdict, dataclass, replace
 import numpy as np
 import scipy.sparse as sp
 
-from ccproof.apps.dynamics.basis import patch_rows, term_matrix
+from ccproof.apps.dynamics.basis import basis_1d, patch_rows, term_matrix
 from ccproof.apps.dynamics.elements import (
     STIFFNESS_TERMS,
     element_layout,
@@ -43,7 +43,7 @@ from ccproof.apps.dynamics.elements import (
 )
 from ccproof.errors import CCProofError
 
-__all__ = ["Material", "DynamicSurface", "MAX_EVAL_LEVEL"]
+__all__ = ["Material", "DynamicSurface", "LimitEvaluator", "MAX_EVAL_LEVEL"]
 
 #: deepest local level used by the evaluation; below 2^-MAX_EVAL_LEVEL the EV limit point is returned
 MAX_EVAL_LEVEL = 60
@@ -110,7 +110,7 @@ class Material:
                        b22=4 * self.b22)
 
 
-def _check_points(faces, u, v):
+def _check_points(faces, u, v, n_faces):
     faces = np.atleast_1d(np.asarray(faces))
     u = np.atleast_1d(np.asarray(u, dtype=np.float64))
     v = np.atleast_1d(np.asarray(v, dtype=np.float64))
@@ -121,6 +121,8 @@ def _check_points(faces, u, v):
         raise CCProofError("parameters (u, v) must be finite")
     if ((u < 0) | (u > 1) | (v < 0) | (v > 1)).any():
         raise CCProofError("parameters (u, v) must lie in [0, 1]^2")
+    if ((faces < 0) | (faces >= n_faces)).any():
+        raise CCProofError(f"face ids must lie in [0, {n_faces})")
     return faces.reshape(-1), u.reshape(-1), v.reshape(-1)
 
 
@@ -363,7 +365,8 @@ class DynamicSurface:
             groups += self._special_rows(spc, faces[spc], u[spc], v[spc], derivatives)
         return groups
 
-    def _special_rows(self, pts, faces, u, v, derivatives):
+    def _special_locate(self, faces, u, v):
+        """Element, sector, local level, patch and patch parameter of points on special faces."""
         lay = self.layout
         elem = lay.face_element[faces]
         corner = lay.face_corner[faces]
@@ -376,48 +379,68 @@ class DynamicSurface:
         # guard the floor against rounding: the level-l patches cover 2^-l <= m <= 2^-(l-1)
         lev = np.where((lev <= MAX_EVAL_LEVEL) & (m * 2.0**lev < 1.0), lev + 1, lev)
         lev = np.where((lev > 1) & (lev <= MAX_EVAL_LEVEL) & (m * 2.0 ** (lev - 1) > 1.0), lev - 1, lev)
-        valence = lay.special_valence[elem]
+        deep = lev > MAX_EVAL_LEVEL
+        scale = np.ldexp(1.0, np.minimum(lev, MAX_EVAL_LEVEL))
+        xs, ys = s * scale, t * scale
+        a = np.minimum(np.floor(xs), 1.0)
+        b = np.minimum(np.floor(ys), 1.0)
+        q = np.where(a == 1, np.where(b == 1, 1, 0), 2)  # (1,0) -> 0, (1,1) -> 1, (0,1) -> 2
+        x = np.clip(xs - a, 0.0, 1.0)
+        y = np.clip(ys - b, 0.0, 1.0)
+        return elem, sector, corner, lev, deep, q, x, y, scale
+
+    @staticmethod
+    def _to_face_derivatives(loc, corner, scale, derivatives, out, idx):
+        """Patch-parameter derivatives -> face-parameter derivatives (level scale and sector rotation)."""
+        out["P"][idx] = loc["P"]
+        if derivatives < 1:
+            return
         R = sector_derivative_maps()[corner]
+        sc = scale.reshape((-1,) + (1,) * (loc["P"].ndim - 1))
+        Ps, Pt = loc["Pu"] * sc, loc["Pv"] * sc
+
+        def r(i, j):
+            return R[:, i, j].reshape(sc.shape)
+
+        out["Pu"][idx] = r(0, 0) * Ps + r(0, 1) * Pt
+        out["Pv"][idx] = r(1, 0) * Ps + r(1, 1) * Pt
+        if derivatives < 2:
+            return
+        s2 = sc * sc
+        H = {(0, 0): loc["Puu"] * s2, (0, 1): loc["Puv"] * s2, (1, 1): loc["Pvv"] * s2}
+        H[(1, 0)] = H[(0, 1)]
+        for name, (r1, r2) in (("Puu", (0, 0)), ("Puv", (0, 1)), ("Pvv", (1, 1))):
+            acc = 0.0
+            for a1 in range(2):
+                for a2 in range(2):
+                    acc = acc + r(r1, a1) * r(r2, a2) * H[(a1, a2)]
+            out[name][idx] = acc
+
+    def _special_rows(self, pts, faces, u, v, derivatives):
+        lay = self.layout
+        elem, sector, corner, lev, deep, q, x, y, scale = self._special_locate(faces, u, v)
+        valence = lay.special_valence[elem]
         names = ["P"] + (["Pu", "Pv"] if derivatives >= 1 else []) + (["Puu", "Puv", "Pvv"] if derivatives >= 2 else [])
         groups = []
         for n in np.unique(valence):
             S = special_scheme(int(n))
             sel_n = np.flatnonzero(valence == n)
-            ring_ids = np.stack([lay.special_rings[e] for e in elem[sel_n]]) if sel_n.size else None
+            ring_ids = np.stack([lay.special_rings[e] for e in elem[sel_n]])
             out = {k: np.zeros((sel_n.size, S.d)) for k in names}
             lv = lev[sel_n]
-            deep = lv > MAX_EVAL_LEVEL
-            if deep.any():
-                out["P"][deep] = S.limit_row
-            for level in np.unique(lv[~deep]):
-                idx = np.flatnonzero(lv == level)
+            dp = deep[sel_n]
+            if dp.any():
+                out["P"][dp] = S.limit_row
+            for level in np.unique(lv[~dp]):
+                idx = np.flatnonzero((lv == level) & ~dp)
                 g = sel_n[idx]
-                scale = 2.0**level
-                xs, ys = s[g] * scale, t[g] * scale
-                a = np.minimum(np.floor(xs), 1.0)
-                b = np.minimum(np.floor(ys), 1.0)
-                q = np.where(a == 1, np.where(b == 1, 1, 0), 2)  # (1,0) -> 0, (1,1) -> 1, (0,1) -> 2
-                x, y = xs - a, ys - b
-                pr = patch_rows(x, y, derivatives)
-                Pl = S.level_map(int(level))
-                T = Pl[S.select[sector[g], q]]  # (g, 16, d)
+                pr = patch_rows(x[g], y[g], derivatives)
+                # deviation from the limit point (decays like lam^level, no cancellation); the patch
+                # rows of P sum to 1 and those of the derivatives to 0, so only P gets the limit row
+                T = S.level_deviation(int(level))[S.select[sector[g], q[g]]]  # (g, 16, d)
                 loc = {k: np.einsum("gk,gkd->gd", pr[k], T) for k in pr}
-                out["P"][idx] = loc["P"]
-                if derivatives >= 1:
-                    Rg = R[g]
-                    Ps, Pt = loc["Pu"] * scale, loc["Pv"] * scale
-                    out["Pu"][idx] = Rg[:, 0, 0, None] * Ps + Rg[:, 0, 1, None] * Pt
-                    out["Pv"][idx] = Rg[:, 1, 0, None] * Ps + Rg[:, 1, 1, None] * Pt
-                if derivatives >= 2:
-                    s2 = scale * scale
-                    H = {(0, 0): loc["Puu"] * s2, (0, 1): loc["Puv"] * s2, (1, 1): loc["Pvv"] * s2}
-                    H[(1, 0)] = H[(0, 1)]
-                    for name, (r1, r2) in (("Puu", (0, 0)), ("Puv", (0, 1)), ("Pvv", (1, 1))):
-                        acc = 0.0
-                        for a1 in range(2):
-                            for a2 in range(2):
-                                acc = acc + (Rg[:, r1, a1] * Rg[:, r2, a2])[:, None] * H[(a1, a2)]
-                        out[name][idx] = acc
+                loc["P"] += S.limit_row[None, :]
+                self._to_face_derivatives(loc, corner[g], scale[g], derivatives, out, idx)
             groups.append((pts[sel_n], ring_ids, out))
         return groups
 
@@ -426,7 +449,7 @@ class DynamicSurface:
 
         ``basis(...)["P"] @ P`` is the limit surface at the points (qmv98 eq. 15, scalar form).
         """
-        faces, u, v = _check_points(faces, u, v)
+        faces, u, v = _check_points(faces, u, v, self.mesh.n_faces)
         m, n = faces.size, self.n_vertices
         mats = {}
         for pts, ids, rows in self._rows(faces, u, v, derivatives):
@@ -442,17 +465,15 @@ class DynamicSurface:
         return out
 
     def evaluate(self, faces, u, v, derivatives=0, P=None):
-        """Limit surface (and derivatives in the face parameter) at points: dict name -> (m, 3)."""
-        faces, u, v = _check_points(faces, u, v)
-        P = self.vertices if P is None else np.asarray(P, dtype=np.float64)
-        if P.shape != (self.n_vertices, 3):
-            raise CCProofError(f"control points must have shape ({self.n_vertices}, 3), got {P.shape}")
-        out = {}
-        for pts, ids, rows in self._rows(faces, u, v, derivatives):
-            Pg = P[ids]  # (g, w, 3)
-            for k, W in rows.items():
-                out.setdefault(k, np.zeros((faces.size, 3)))[pts] = np.einsum("gw,gwc->gc", W, Pg)
-        return out
+        """Limit surface (and derivatives in the face parameter) at points: dict name -> (m, 3).
+
+        For many evaluations with the same state use :meth:`evaluator`.
+        """
+        return self.evaluator(P).evaluate(faces, u, v, derivatives)
+
+    def evaluator(self, P=None):
+        """A :class:`LimitEvaluator` of the limit surface of the state P (default: the mesh's vertices)."""
+        return LimitEvaluator(self, self.vertices if P is None else P)
 
     def sample_parameters(self, per_edge=8):
         """A grid of ``per_edge x per_edge`` cell-centred parameters on every face with a patch.
@@ -495,3 +516,102 @@ class DynamicSurface:
         swap = np.repeat(self.face_swap, 4) ^ np.tile(np.array([False, True, False, True]), mesh.n_faces)
         return DynamicSurface(subdivide(mesh), mat, self.levels, face_swap=swap), A
 
+
+
+def _contract(bu, bv, N, derivatives):
+    """Tensor-product evaluation of 4 x 4 nets N (g, 4, 4, 3) (first index along u)."""
+    T = [(b[:, None, None, :] @ N)[:, :, 0, :] for b in bv]  # contract along v: (g, 4, 3)
+
+    def c(b, t):
+        return (b[:, None, :] @ t)[:, 0, :]
+
+    out = {"P": c(bu[0], T[0])}
+    if derivatives >= 1:
+        out["Pu"] = c(bu[1], T[0])
+        out["Pv"] = c(bu[0], T[1])
+    if derivatives >= 2:
+        out["Puu"] = c(bu[2], T[0])
+        out["Puv"] = c(bu[1], T[1])
+        out["Pvv"] = c(bu[0], T[2])
+    return out
+
+
+class LimitEvaluator:
+    """Evaluation of the limit surface of one state P with the patch nets cached.
+
+    The nets of the normal faces are gathered once; for the special elements the level-l three-ring
+    positions ``(P_l - 1 l^T) P_ring`` are computed once per level that is asked for.
+    """
+
+    def __init__(self, model, P):
+        P = np.asarray(P, dtype=np.float64)
+        if P.shape != (model.n_vertices, 3):
+            raise CCProofError(f"control points must have shape ({model.n_vertices}, 3), got {P.shape}")
+        if not np.isfinite(P).all():
+            raise CCProofError("control points must be finite")
+        self.model = model
+        self.P = P
+        lay = model.layout
+        self._normal = P[lay.normal_nets].reshape(-1, 4, 4, 3)
+        self._groups = {}
+        for n in np.unique(lay.special_valence):
+            elems = np.flatnonzero(lay.special_valence == n)
+            PR = P[np.stack([lay.special_rings[e] for e in elems])]  # (E, d, 3)
+            S = special_scheme(int(n))
+            self._groups[int(n)] = (elems, PR, np.einsum("d,edk->ek", S.limit_row, PR), {})
+        self._slot = np.full(lay.n_special, -1, dtype=np.int64)
+        for elems, *_ in self._groups.values():
+            self._slot[elems] = np.arange(elems.size)
+
+    def _level_positions(self, n, level):
+        elems, PR, _, cache = self._groups[n]
+        if level not in cache:
+            cache[level] = np.einsum("cd,edk->eck", special_scheme(n).level_deviation(level), PR)
+        return cache[level]
+
+    def evaluate(self, faces, u, v, derivatives=0):
+        """Limit surface (and derivatives in the face parameter) at points: dict name -> (m, 3)."""
+        if derivatives not in (0, 1, 2):
+            raise CCProofError(f"derivatives must be 0, 1 or 2, got {derivatives!r}")
+        model = self.model
+        faces, u, v = _check_points(faces, u, v, model.mesh.n_faces)
+        lay = model.layout
+        kind = lay.face_kind[faces]
+        if (kind == 0).any():
+            f = int(faces[np.flatnonzero(kind == 0)[0]])
+            raise CCProofError(f"face {f} carries no limit patch (it touches the boundary)")
+        names = ["P"] + (["Pu", "Pv"] if derivatives >= 1 else []) + (["Puu", "Puv", "Pvv"] if derivatives >= 2 else [])
+        out = {k: np.zeros((faces.size, 3)) for k in names}
+        nrm = np.flatnonzero(kind == 1)
+        if nrm.size:
+            loc = _contract(basis_1d(u[nrm], derivatives), basis_1d(v[nrm], derivatives),
+                            self._normal[lay.face_element[faces[nrm]]], derivatives)
+            for k in names:
+                out[k][nrm] = loc[k]
+        spc = np.flatnonzero(kind == 2)
+        if spc.size:
+            self._special(faces[spc], u[spc], v[spc], derivatives, out, spc)
+        return out
+
+    def _special(self, faces, u, v, derivatives, out, pts):
+        model = self.model
+        lay = model.layout
+        elem, sector, corner, lev, deep, q, x, y, scale = model._special_locate(faces, u, v)
+        valence = lay.special_valence[elem]
+        for n in np.unique(valence):
+            n = int(n)
+            S = special_scheme(n)
+            limit = self._groups[n][2]
+            sel_n = np.flatnonzero(valence == n)
+            dp = deep[sel_n]
+            if dp.any():
+                g = sel_n[dp]
+                out["P"][pts[g]] = limit[self._slot[elem[g]]]
+            lv = lev[sel_n]
+            for level in np.unique(lv[~dp]):
+                g = sel_n[(lv == level) & ~dp]
+                Q = self._level_positions(n, int(level))
+                nets = Q[self._slot[elem[g]][:, None], S.select[sector[g], q[g]]].reshape(-1, 4, 4, 3)
+                loc = _contract(basis_1d(x[g], derivatives), basis_1d(y[g], derivatives), nets, derivatives)
+                loc["P"] += limit[self._slot[elem[g]]]
+                model._to_face_derivatives(loc, corner[g], scale[g], derivatives, out, pts[g])

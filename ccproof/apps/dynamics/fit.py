@@ -1,0 +1,417 @@
+"""Shape recovery from range data with a dynamic Catmull-Clark surface (qmv98 sections 3.4, 4.2; spec B6, Q9).
+
+Pipeline (:func:`fit_points`):
+
+1. normalize the data: centre and diameter of the minimal enclosing sphere (Welzl,
+   :func:`minimal_enclosing_sphere`), so that every parameter below is dimensionless;
+2. initial model: the paper's 98-vertex model (the cube subdivided twice) placed inside the data
+   (centred at the centroid, control cube half-extents ``init_scale`` times the data's half-extents),
+   or a user mesh;
+3. evolve with the massless scheme (32) (default) or (31) under data springs: every data point pulls
+   its nearest limit-surface point (re-projected every step), until equilibrium: the total energy
+   (elastic + springs) changes by less than ``tol`` (relative) between steps t - dt and t + dt (the
+   paper's criterion, section 3.4; two steps because (32) advances two interleaved sequences), or
+   ``max_steps``;
+4. subdivide globally and rebuild the model (densities rescaled, :meth:`Material.refined`), refit;
+   repeat ``levels`` times;
+5. report the paper's fit error: the largest distance of a data point to the limit surface, in % of the
+   diameter of the minimal enclosing sphere, and the mean distance.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ccproof.apps.dynamics.forces import ClosestPointFinder, Springs, check_points
+from ccproof.apps.dynamics.integrate import ImplicitIntegrator
+from ccproof.apps.dynamics.meshes import paper_initial_model
+from ccproof.apps.dynamics.model import DynamicSurface, Material
+from ccproof.errors import CCProofError
+
+__all__ = [
+    "minimal_enclosing_sphere",
+    "read_points",
+    "fit_error",
+    "FitLevel",
+    "FitResult",
+    "fit_points",
+    "DEFAULT_FIT_MATERIAL",
+]
+
+#: material of the shape-recovery runs, in units where the data's enclosing sphere has diameter 1
+#: and the data springs sum to 1 (``spring_total``): massless, weak tension, weak rigidity
+DEFAULT_FIT_MATERIAL = Material(mu=0.0, gamma=1.0, a11=1e-5, a22=1e-5, b11=1e-6, b12=2e-6, b22=1e-6)
+
+
+# ---------------------------------------------------------------------------- enclosing sphere
+
+
+def _ball(pts):
+    """Smallest ball with all of ``pts`` (1 to 4 points) on its boundary; (centre, radius)."""
+    pts = np.asarray(pts, dtype=np.float64)
+    k = pts.shape[0]
+    if k == 1:
+        return pts[0].copy(), 0.0
+    if k == 2:
+        c = 0.5 * (pts[0] + pts[1])
+        return c, float(np.linalg.norm(pts[0] - c))
+    if k == 3:
+        a, b = pts[1] - pts[0], pts[2] - pts[0]
+        axb = np.cross(a, b)
+        den = 2.0 * float(axb @ axb)
+        if den <= 1e-30 * max(float(a @ a), float(b @ b), 1e-300) ** 2:
+            return _best_sub_ball(pts)
+        c = pts[0] + (np.cross(axb, a) * float(b @ b) + np.cross(b, axb) * float(a @ a)) / den
+        return c, float(np.linalg.norm(pts[0] - c))
+    A = 2.0 * (pts[1:] - pts[0])
+    rhs = np.sum(pts[1:] ** 2, axis=1) - float(pts[0] @ pts[0])
+    if abs(np.linalg.det(A)) <= 1e-14 * np.abs(A).max() ** 3:
+        return _best_sub_ball(pts)
+    c = np.linalg.solve(A, rhs)
+    return c, float(np.linalg.norm(pts[0] - c))
+
+
+def _best_sub_ball(pts):
+    """Degenerate support set: the smallest ball through a subset that contains all of ``pts``."""
+    from itertools import combinations
+
+    best = None
+    for size in range(2, pts.shape[0]):
+        for sub in combinations(range(pts.shape[0]), size):
+            c, r = _ball(pts[list(sub)])
+            if np.all(np.linalg.norm(pts - c, axis=1) <= r * (1 + 1e-12) + 1e-15) and (best is None or r < best[1]):
+                best = (c, r)
+    return best
+
+
+def minimal_enclosing_sphere(X, seed=0):
+    """Smallest sphere containing the points (Welzl's algorithm, randomized, expected linear time).
+
+    Parameters
+    ----------
+    X : array_like (m, 3)
+    seed : int
+        Seed of the random permutation (the result does not depend on it up to round-off).
+
+    Returns
+    -------
+    centre : ndarray (3,)
+    radius : float
+
+    >>> c, r = minimal_enclosing_sphere([[1, 0, 0], [-1, 0, 0], [0, 0.5, 0], [0, 0, 0.2]])
+    >>> np.round(c, 12).tolist(), round(r, 12)
+    [[0.0, 0.0, 0.0], 1.0]
+    """
+    X = check_points(X)
+    P = X[np.random.default_rng(seed).permutation(X.shape[0])]
+    scale = float(np.abs(P).max()) or 1.0
+    eps = 1e-12
+
+    def first_out(c, r, lo, hi):
+        if hi <= lo:
+            return -1
+        d = np.linalg.norm(P[lo:hi] - c, axis=1)
+        out = np.flatnonzero(d > r * (1 + eps) + eps * scale)
+        return lo + int(out[0]) if out.size else -1
+
+    def with_support(n, support):
+        if not support:  # the ball of P[:n]: start from the first point
+            c, r = P[0].copy(), 0.0
+            i = first_out(c, r, 1, n)
+        else:
+            c, r = _ball(np.array(support))
+            if len(support) == 4:
+                return c, r
+            i = first_out(c, r, 0, n)
+        while i >= 0:
+            c, r = with_support(i, support + [P[i]])
+            i = first_out(c, r, i + 1, n)
+        return c, r
+
+    return with_support(P.shape[0], [])[0:2]
+
+
+# ---------------------------------------------------------------------------- point files
+
+
+def read_points(path):
+    """Read a point cloud: ``.xyz`` (whitespace columns x y z ...), ``.ply`` (ASCII or binary vertex
+    element), ``.obj`` (the ``v`` lines). Returns float64 (m, 3).
+    """
+    path = Path(path)
+    if not path.exists():
+        raise CCProofError(f"{path}: no such file")
+    ext = path.suffix.lower()
+    if ext in (".xyz", ".txt", ".pts"):
+        rows = []
+        for ln, line in enumerate(path.read_text().splitlines(), 1):
+            s = line.split("#", 1)[0].replace(",", " ").split()
+            if not s:
+                continue
+            if len(s) < 3:
+                raise CCProofError(f"{path}:{ln}: expected at least 3 numbers, got {line!r}")
+            try:
+                rows.append([float(x) for x in s[:3]])
+            except ValueError:
+                raise CCProofError(f"{path}:{ln}: not a number in {line!r}") from None
+        X = np.array(rows, dtype=np.float64).reshape(-1, 3)
+    elif ext == ".obj":
+        rows = []
+        for ln, line in enumerate(path.read_text().splitlines(), 1):
+            s = line.split()
+            if s and s[0] == "v":
+                try:
+                    rows.append([float(x) for x in s[1:4]])
+                except ValueError:
+                    raise CCProofError(f"{path}:{ln}: bad vertex line {line!r}") from None
+        X = np.array(rows, dtype=np.float64).reshape(-1, 3)
+    elif ext == ".ply":
+        X = _read_ply(path)
+    else:
+        raise CCProofError(f"{path}: unknown point-cloud format {ext!r} (use .xyz, .ply or .obj)")
+    return check_points(X, f"point cloud {path.name}")
+
+
+_PLY_TYPES = {"char": "i1", "uchar": "u1", "short": "i2", "ushort": "u2", "int": "i4", "uint": "u4",
+              "float": "f4", "double": "f8", "int8": "i1", "uint8": "u1", "int16": "i2", "uint16": "u2",
+              "int32": "i4", "uint32": "u4", "float32": "f4", "float64": "f8"}
+
+
+def _read_ply(path):
+    data = path.read_bytes()
+    end = data.find(b"end_header")
+    if not data.startswith(b"ply") or end < 0:
+        raise CCProofError(f"{path}: not a PLY file")
+    header = data[:end].decode("ascii", "replace").splitlines()
+    body = data[data.index(b"\n", end) + 1 :]
+    fmt = None
+    elements = []
+    for line in header:
+        s = line.split()
+        if not s:
+            continue
+        if s[0] == "format":
+            fmt = s[1]
+        elif s[0] == "element":
+            elements.append([s[1], int(s[2]), []])
+        elif s[0] == "property" and elements:
+            if s[1] == "list":
+                elements[-1][2].append((s[-1], "list", s[2], s[3]))
+            else:
+                elements[-1][2].append((s[2], _PLY_TYPES.get(s[1])))
+    if not elements or elements[0][0] != "vertex":
+        raise CCProofError(f"{path}: the first PLY element must be 'vertex'")
+    _, nv, props = elements[0]
+    names = [p[0] for p in props]
+    if any(len(p) != 2 or p[1] is None for p in props) or not {"x", "y", "z"} <= set(names):
+        raise CCProofError(f"{path}: the vertex element needs scalar properties x, y, z")
+    if fmt == "ascii":
+        lines = body.decode("ascii", "replace").split("\n")[:nv]
+        A = np.array([[float(x) for x in ln.split()[: len(props)]] for ln in lines], dtype=np.float64)
+        if A.shape != (nv, len(props)):
+            raise CCProofError(f"{path}: truncated vertex list")
+        return A[:, [names.index(k) for k in "xyz"]]
+    if fmt in ("binary_little_endian", "binary_big_endian"):
+        bo = "<" if fmt == "binary_little_endian" else ">"
+        dt = np.dtype([(p[0], bo + p[1]) for p in props])
+        if len(body) < nv * dt.itemsize:
+            raise CCProofError(f"{path}: truncated vertex list")
+        A = np.frombuffer(body[: nv * dt.itemsize], dtype=dt)
+        return np.stack([A["x"], A["y"], A["z"]], axis=1).astype(np.float64)
+    raise CCProofError(f"{path}: unknown PLY format {fmt!r}")
+
+
+# ---------------------------------------------------------------------------- fitting
+
+
+def fit_error(model, P, X, finder=None, per_edge=12, diameter=None):
+    """Distances of the data points to the limit surface (nearest points) and the paper's fit error.
+
+    Returns a dict: ``max``, ``mean`` (absolute), ``max_percent``, ``mean_percent`` (of the diameter
+    of the minimal enclosing sphere of X, or of ``diameter``), ``distances``.
+    """
+    X = check_points(X)
+    if finder is None:
+        finder = ClosestPointFinder(model, per_edge=per_edge, candidates=4, iterations=12)
+    *_, dist = finder.query(P, X)
+    if diameter is None:
+        diameter = 2.0 * minimal_enclosing_sphere(X)[1]
+    return {
+        "max": float(dist.max()),
+        "mean": float(dist.mean()),
+        "max_percent": 100.0 * float(dist.max()) / diameter,
+        "mean_percent": 100.0 * float(dist.mean()) / diameter,
+        "distances": dist,
+    }
+
+
+@dataclass
+class FitLevel:
+    """One level of the multilevel fit."""
+
+    n_vertices: int
+    n_faces: int
+    steps: int
+    converged: bool
+    max_error_percent: float
+    mean_error_percent: float
+    seconds: float
+    cg_iterations: int
+
+
+@dataclass
+class FitResult:
+    """Outcome of :func:`fit_points`; ``mesh`` is in the data's coordinates."""
+
+    mesh: object
+    model: object
+    levels: list = field(default_factory=list)
+    center: np.ndarray = None
+    diameter: float = 0.0
+    parameters: dict = field(default_factory=dict)
+
+    @property
+    def max_error_percent(self):
+        return self.levels[-1].max_error_percent
+
+    @property
+    def mean_error_percent(self):
+        return self.levels[-1].mean_error_percent
+
+
+def _initial_mesh(init, Xn, init_scale):
+    from ccproof.mesh import QuadMesh
+
+    if isinstance(init, str):
+        if init != "cube":
+            raise CCProofError(f"unknown initial model {init!r} (use 'cube' or a mesh)")
+        lo, hi = Xn.min(axis=0), Xn.max(axis=0)
+        centroid = Xn.mean(axis=0)
+        half = init_scale * 0.5 * (hi - lo)
+        return paper_initial_model(center=centroid, half_extent=half)
+    if not isinstance(init, QuadMesh):
+        raise CCProofError("init must be 'cube' or a QuadMesh (normalized with the data, see fit_points)")
+    return init
+
+
+def fit_points(X, init="cube", levels=1, material=None, spring_total=1.0, dt=None, scheme="massless",
+               max_steps=60, tol=1e-3, init_scale=0.5, truncation=6, progress=False, callback=None):
+    """Recover a closed surface from range data (module docstring).
+
+    Parameters
+    ----------
+    X : array_like (m, 3)
+        Data points (at least 4, finite).
+    init : "cube" or QuadMesh
+        Initial control mesh; a QuadMesh is given in the data's coordinates.
+    levels : int >= 0
+        Global subdivisions after the first equilibrium (paper: 1, 98 -> 386 vertices).
+    material : Material, optional
+        Densities in normalized units (default :data:`DEFAULT_FIT_MATERIAL`), for the initial level;
+        rescaled at each subdivision (:meth:`Material.refined`).
+    spring_total : float > 0
+        Sum of the data-spring constants (each point gets ``spring_total / m``).
+    dt : float > 0, optional
+        Time step (normalized units); default 1000 (massless: nearly quasi-static steps) or 10
+        (inertial).
+    scheme : "massless" (eq. 32) or "inertial" (eq. 31)
+    max_steps : int
+        Time steps per level at most.
+    tol : float
+        Equilibrium: relative change of the total energy between steps t - dt and t + dt.
+    init_scale : float in (0, 1]
+        Size of the initial control cube relative to the data's bounding box.
+    truncation : int
+        Truncation level L of the special-element stiffness.
+    progress : bool
+        Show a tqdm progress bar over the time steps.
+    callback : callable, optional
+        ``callback(level, step, model, P_normalized)`` after every step.
+
+    Returns
+    -------
+    FitResult
+    """
+    X = check_points(X)
+    if X.shape[0] < 4:
+        raise CCProofError(f"need at least 4 data points, got {X.shape[0]}")
+    if int(levels) != levels or levels < 0:
+        raise CCProofError(f"levels must be an integer >= 0, got {levels!r}")
+    if not (spring_total > 0 and math.isfinite(spring_total)):
+        raise CCProofError(f"spring_total must be finite and > 0, got {spring_total!r}")
+    if not (0 < init_scale <= 1):
+        raise CCProofError(f"init_scale must be in (0, 1], got {init_scale!r}")
+    if dt is None:
+        dt = 1000.0 if scheme == "massless" else 10.0
+    material = DEFAULT_FIT_MATERIAL if material is None else material
+    centre, radius = minimal_enclosing_sphere(X)
+    diameter = 2.0 * radius
+    if not diameter > 0:
+        raise CCProofError("the data points all coincide")
+    Xn = (X - centre) / diameter
+    if isinstance(init, str):
+        mesh0 = _initial_mesh(init, Xn, init_scale)
+    else:
+        mesh0 = _initial_mesh(init, Xn, init_scale)
+        mesh0 = mesh0.with_vertices((np.asarray(mesh0.vertices) - centre) / diameter)
+    from ccproof.apps.dynamics.elements import isolate_extraordinary
+
+    mesh0, _ = isolate_extraordinary(mesh0)
+    model = DynamicSurface(mesh0, material, levels=truncation)
+    P = np.array(mesh0.vertices)
+    k = np.full(X.shape[0], spring_total / X.shape[0])
+    result = FitResult(mesh=None, model=None, center=centre, diameter=diameter,
+                       parameters={"material": material, "spring_total": spring_total, "dt": dt, "scheme": scheme,
+                                   "max_steps": max_steps, "tol": tol, "init_scale": init_scale,
+                                   "truncation": truncation, "levels": levels})
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=(levels + 1) * max_steps, desc="fit", unit="step")
+    try:
+        for level in range(levels + 1):
+            t0 = time.perf_counter()
+            finder = ClosestPointFinder(model)
+            integ = ImplicitIntegrator(model, dt, P=P, scheme=scheme, tol=1e-9)
+            prev = None
+            converged = False
+            cg = 0
+            step = 0
+            energies = []
+            for step in range(1, max_steps + 1):
+                f, u, v, _, _ = finder.query(integ.P, Xn, previous=prev)
+                prev = (f, u, v)
+                springs = Springs(model, f, u, v, Xn, k)
+                info = integ.step(springs=springs)
+                cg += info.iterations
+                energies.append(model.energy(integ.P) + springs.energy(integ.P))
+                if bar is not None:
+                    bar.update(1)
+                    bar.set_postfix(level=level, move=f"{info.displacement:.1e}")
+                if callback is not None:
+                    callback(level, step, model, integ.P)
+                if len(energies) >= 3 and abs(energies[-1] - energies[-3]) <= tol * abs(energies[-1]):
+                    converged = True
+                    break
+            if bar is not None and step < max_steps:
+                bar.update(max_steps - step)
+            P = integ.P
+            err = fit_error(model, P, Xn, diameter=1.0)
+            result.levels.append(FitLevel(model.n_vertices, model.mesh.n_faces, step, converged,
+                                          err["max_percent"], err["mean_percent"], time.perf_counter() - t0, cg))
+            if level < levels:
+                model, A = model.refine(P)
+                P = np.asarray(A @ P)
+    finally:
+        if bar is not None:
+            bar.close()
+    result.model = model
+    result.mesh = model.mesh.with_vertices(P * diameter + centre)
+    result.normalized_state = P
+    return result
