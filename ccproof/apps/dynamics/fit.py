@@ -105,7 +105,7 @@ def minimal_enclosing_sphere(X, seed=0):
 
     >>> c, r = minimal_enclosing_sphere([[1, 0, 0], [-1, 0, 0], [0, 0.5, 0], [0, 0, 0.2]])
     >>> np.round(c, 12).tolist(), round(r, 12)
-    [[0.0, 0.0, 0.0], 1.0]
+    ([0.0, 0.0, 0.0], 1.0)
     """
     X = check_points(X)
     P = X[np.random.default_rng(seed).permutation(X.shape[0])]
@@ -133,7 +133,8 @@ def minimal_enclosing_sphere(X, seed=0):
             i = first_out(c, r, i + 1, n)
         return c, r
 
-    return with_support(P.shape[0], [])[0:2]
+    c, r = with_support(P.shape[0], [])
+    return c, r
 
 
 # ---------------------------------------------------------------------------- point files
