@@ -221,9 +221,11 @@ class _Builder:
         ring, key, _ = canonical_ring(topo, f, 0)
         stencils, children = refine_exact(key)
         topo1 = LocalTopology(children)
-        # only the rows that the children's one-rings can use are needed; others may be None
-        rows = [s if s is not None else {} for s in stencils]
-        X1 = _stencil_matrix(rows, len(ring)) @ X[ring]
+        # only the rows that the children's one-rings use are needed; the others (vertex points of
+        # outer vertices whose faces are not all in the one-ring) are None: NaN, so that any use
+        # would show up in the final check of the tables instead of passing silently
+        X1 = _stencil_matrix([s if s is not None else {} for s in stencils], len(ring)) @ X[ring]
+        X1[[i for i, s in enumerate(stencils) if s is None]] = np.nan
         # base-mesh vertex of every local vertex (vertex points keep their vertex), -1 for new points
         vmap1 = np.full(len(stencils), -1, dtype=np.int64)
         if vmap is not None:
@@ -262,6 +264,9 @@ class LimitSurface:
         for f in range(m):
             b.face(topo, X, f, base, 0, f, vid=f, vmap=vmap)
         self._nets = np.ascontiguousarray(np.concatenate(b.hot[0] + b.cold[0]))  # (n_patches, 17, 3)
+        if not np.isfinite(self._nets).all():  # pragma: no cover - would be a bug in the classification
+            bad = int(np.flatnonzero(~np.isfinite(self._nets).all(axis=(1, 2)))[0])
+            raise MeshError(f"internal error: patch {bad} uses a point outside the exact local refinement")
         pd = np.concatenate(b.hot[1] + b.cold[1])
         self._pu0, self._pv0, self._ph = pd[:, 0].copy(), pd[:, 1].copy(), pd[:, 2].copy()
         self._vcold = np.array(b.vcold, dtype=np.int64) + b.n_hot

@@ -12,7 +12,7 @@ import pytest
 from ccproof.evaluate import limit_surface
 from ccproof.evaluate.local import LocalTopology, canonical_ring, corner_scheme
 from ccproof.mesh import QuadMesh, limit_positions, subdivide, subdivision_matrix
-from ccproof.mesh.examples import cube, grid, k_regular_disk, l_shape
+from ccproof.mesh.examples import cube, grid, k_regular_disk, l_shape, torus
 
 CORNERS = [(0, 0), (1, 0), (1, 1), (0, 1)]
 
@@ -52,6 +52,7 @@ CASES = {
     "l_shape": (lambda: l_shape(4), 5),  # concave boundary vertex with three faces
     "single_quad": (single_quad, 7),  # four one-face corners
     "k6_grid_mix": (lambda: _perturbed(k_regular_disk(6, 3), 5, 0.05), 4),
+    "torus_3x3": (lambda: _perturbed(torus(3, 3), 6, 0.05), 4),  # 4 x 4 nets that wrap around
 }
 
 
