@@ -219,6 +219,28 @@ def _lin(*terms):
 
 
 @functools.lru_cache(maxsize=4096)
+def local_edges(key):
+    """Edges of the local complex ``key`` in the order of :func:`refine_exact` (first half-edge seen).
+
+    Returns
+    -------
+    edges : tuple of int
+        One half-edge ``4 f + i`` per edge (from ``key[f][i]`` to ``key[f][(i+1) % 4]``).
+    edge_of_halfedge : tuple of int
+    """
+    eid, edges, he_edge = {}, [], []
+    for f, face in enumerate(key):
+        for i in range(4):
+            a, b = face[i], face[(i + 1) % 4]
+            e = (min(a, b), max(a, b))
+            if e not in eid:
+                eid[e] = len(edges)
+                edges.append(4 * f + i)
+            he_edge.append(eid[e])
+    return tuple(edges), tuple(he_edge)
+
+
+@functools.lru_cache(maxsize=4096)
 def refine_exact(key):
     """One exact Catmull-Clark step of the local complex ``key`` (faces in labels 0..N-1).
 
@@ -240,15 +262,7 @@ def refine_exact(key):
     topo = LocalTopology(key)
     F = topo.faces
     n, m = topo.n_vertices, F.shape[0]
-    eid, edges = {}, []
-    he_edge = []
-    for h in range(4 * m):
-        a, b = topo.org(h), topo.dst(h)
-        e = (min(a, b), max(a, b))
-        if e not in eid:
-            eid[e] = len(edges)
-            edges.append(h)
-        he_edge.append(eid[e])
+    edges, he_edge = local_edges(key)
     E = len(edges)
     q4, q8, q16 = Fraction(1, 4), Fraction(1, 8), Fraction(1, 16)
     fpts = [{int(v): q4 for v in F[f]} for f in range(m)]

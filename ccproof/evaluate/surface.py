@@ -33,7 +33,15 @@ import numpy as np
 
 from ccproof.errors import CCProofError, MeshError
 from ccproof.evaluate.bspline import bspline_basis
-from ccproof.evaluate.local import CORNERS, LocalTopology, canonical_ring, corner_scheme, refine_exact, regular_net
+from ccproof.evaluate.local import (
+    CORNERS,
+    LocalTopology,
+    canonical_ring,
+    corner_scheme,
+    local_edges,
+    refine_exact,
+    regular_net,
+)
 from ccproof.mesh import QuadMesh, limit_normals, limit_positions
 
 __all__ = ["limit_surface", "LimitSurface"]
@@ -221,11 +229,15 @@ class _Builder:
         ring, key, _ = canonical_ring(topo, f, 0)
         stencils, children = refine_exact(key)
         topo1 = LocalTopology(children)
-        # only the rows that the children's one-rings use are needed; the others (vertex points of
-        # outer vertices whose faces are not all in the one-ring) are None: NaN, so that any use
-        # would show up in the final check of the tables instead of passing silently
+        # Only the points whose stencils lie inside the one-ring are exact: the vertex points of the
+        # face's own vertices (labels 0..3), the edge points of edges at them and all face points.
+        # The children's one-rings use no other point (the others are set to NaN, so that any use
+        # would show up in the final check of the tables instead of passing silently).
         X1 = _stencil_matrix([s if s is not None else {} for s in stencils], len(ring)) @ X[ring]
-        X1[[i for i, s in enumerate(stencils) if s is None]] = np.nan
+        n = len(ring)
+        edges, _ = local_edges(key)
+        outer_edges = [n + e for e, h in enumerate(edges) if min(key[h // 4][h % 4], key[h // 4][(h + 1) % 4]) > 3]
+        X1[list(range(4, n)) + outer_edges] = np.nan
         # base-mesh vertex of every local vertex (vertex points keep their vertex), -1 for new points
         vmap1 = np.full(len(stencils), -1, dtype=np.int64)
         if vmap is not None:
