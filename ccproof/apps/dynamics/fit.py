@@ -392,12 +392,13 @@ def fit_points(X, init="cube", levels=1, material=None, spring_total=1.0, dt=Non
                 info = integ.step(springs=springs)
                 cg += info.iterations
                 energies.append(model.energy(integ.P) + springs.energy(integ.P))
+                change = abs(energies[-1] - energies[-3]) / abs(energies[-1]) if len(energies) >= 3 else math.inf
                 if bar is not None:
                     bar.update(1)
-                    bar.set_postfix(level=level, move=f"{info.displacement:.1e}")
+                    bar.set_postfix(level=level, dE=f"{change:.1e}")
                 if callback is not None:
                     callback(level, step, model, integ.P)
-                if len(energies) >= 3 and abs(energies[-1] - energies[-3]) <= tol * abs(energies[-1]):
+                if change <= tol:
                     converged = True
                     break
             if bar is not None and step < max_steps:

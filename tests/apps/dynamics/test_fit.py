@@ -1,0 +1,192 @@
+"""Q8 (the paper's meshes), Q9 (shape recovery), the enclosing sphere, point files, the CLI, bad input."""
+
+import itertools
+
+import numpy as np
+import pytest
+
+from ccproof.apps.dynamics.fit import fit_points, minimal_enclosing_sphere, read_points
+from ccproof.apps.dynamics.meshes import (
+    flat_sheet,
+    genus2_surface,
+    open_surface_valence5,
+    paper_initial_model,
+    torus_32,
+)
+from ccproof.apps.dynamics.model import DynamicSurface
+from ccproof.apps.dynamics.shapes import synthetic_range_data
+from ccproof.errors import CCProofError
+from ccproof.mesh import subdivide
+
+
+def test_q8_paper_mesh_counts():
+    m98 = paper_initial_model()
+    assert (m98.n_vertices, m98.n_faces) == (98, 96)
+    assert m98.valence[m98.extraordinary_vertices].tolist() == [3] * 8
+    m386 = subdivide(m98)
+    assert (m386.n_vertices, m386.n_faces) == (386, 384)
+    t = torus_32()
+    assert (t.n_vertices, t.n_faces, t.extraordinary_vertices.size) == (32, 32, 0)
+    s = flat_sheet()
+    assert (s.n_vertices, s.n_faces) == (81, 64)
+    assert DynamicSurface(s).layout.n_patch_faces == 36
+    o = open_surface_valence5()
+    assert (o.n_vertices, o.n_faces) == (61, 45)
+    assert o.valence[o.extraordinary_vertices].tolist() == [5]
+    g = genus2_surface()
+    assert (g.n_vertices, g.n_faces) == (542, 544)
+    assert g.n_vertices - g.n_edges + g.n_faces == -2
+    assert g.valence[g.extraordinary_vertices].tolist() == [5] * 8
+    lay = DynamicSurface(g).layout
+    assert lay.n_special == 8 and lay.n_normal + 5 * 8 == 544
+
+
+def _brute_force_ball(X):
+    """Smallest ball over all balls spanned by 2, 3 or 4 of the points (independent oracle)."""
+    best = None
+    for k in (2, 3, 4):
+        for sub in itertools.combinations(range(len(X)), k):
+            P = X[list(sub)]
+            if k == 2:
+                c = P.mean(0)
+            elif k == 3:
+                a, b = P[1] - P[0], P[2] - P[0]
+                # centre in the plane: c = P0 + x a + y b with |c - Pi| equal
+                G = np.array([[a @ a, a @ b], [a @ b, b @ b]])
+                if abs(np.linalg.det(G)) < 1e-12:
+                    continue
+                x, y = np.linalg.solve(G, 0.5 * np.array([a @ a, b @ b]))
+                c = P[0] + x * a + y * b
+            else:
+                A = 2 * (P[1:] - P[0])
+                if abs(np.linalg.det(A)) < 1e-12:
+                    continue
+                c = np.linalg.solve(A, (P[1:] ** 2).sum(1) - P[0] @ P[0])
+            r = np.linalg.norm(P[0] - c)
+            if np.linalg.norm(X - c, axis=1).max() <= r * (1 + 1e-9) and (best is None or r < best[1]):
+                best = (c, r)
+    return best
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_welzl_against_brute_force(seed):
+    rng = np.random.default_rng(seed)
+    X = rng.standard_normal((9, 3)) * [1, 0.5, 2]
+    c, r = minimal_enclosing_sphere(X, seed=seed)
+    cb, rb = _brute_force_ball(X)
+    assert r == pytest.approx(rb, rel=1e-10)
+    assert np.abs(c - cb).max() < 1e-9
+    assert np.linalg.norm(X - c, axis=1).max() <= r * (1 + 1e-12)
+
+
+def test_welzl_large_and_degenerate():
+    from scipy.spatial.distance import pdist
+
+    X = synthetic_range_data("ellipsoid", 3000)
+    c, r = minimal_enclosing_sphere(X)
+    d = np.linalg.norm(X - c, axis=1)
+    assert d.max() <= r * (1 + 1e-12)
+    assert r <= 1.25  # the ball of radius 1.25 about 0 contains the ellipsoid
+    assert r >= 0.5 * pdist(X).max()  # and no ball is smaller than half the diameter of the set
+    assert (d >= r * (1 - 1e-9)).sum() >= 2  # supported by points on the sphere
+    grid = np.array([[i, j, 0.0] for i in range(5) for j in range(5)])  # coplanar, cocircular corners
+    c, r = minimal_enclosing_sphere(grid)
+    assert r == pytest.approx(np.sqrt(8)) and np.allclose(c, [2, 2, 0])
+
+
+def test_read_points_formats(tmp_path):
+    X = np.random.default_rng(0).standard_normal((20, 3))
+    (tmp_path / "a.xyz").write_text("\n".join(" ".join(f"{x:.17g}" for x in row) + " 1 2" for row in X))
+    assert np.array_equal(read_points(tmp_path / "a.xyz"), X)
+    lines = "\n".join("v " + " ".join(f"{x:.17g}" for x in r) for r in X)
+    (tmp_path / "a.obj").write_text("# c\n" + lines + "\nf 1 2 3\n")
+    assert np.array_equal(read_points(tmp_path / "a.obj"), X)
+    head = "ply\nformat {}\nelement vertex 20\nproperty float nx\nproperty double x\nproperty double y\n" \
+           "property double z\nelement face 0\nproperty list uchar int vertex_indices\nend_header\n"
+    (tmp_path / "a.ply").write_text(head.format("ascii 1.0") + "\n".join(
+        "0 " + " ".join(f"{x:.17g}" for x in r) for r in X) + "\n")
+    assert np.array_equal(read_points(tmp_path / "a.ply"), X)
+    rec = np.zeros(20, dtype=[("nx", "<f4"), ("x", "<f8"), ("y", "<f8"), ("z", "<f8")])
+    rec["x"], rec["y"], rec["z"] = X.T
+    (tmp_path / "b.ply").write_bytes(head.format("binary_little_endian 1.0").encode() + rec.tobytes())
+    assert np.array_equal(read_points(tmp_path / "b.ply"), X)
+
+
+def test_bad_point_clouds(tmp_path):
+    with pytest.raises(CCProofError, match="empty"):
+        fit_points(np.zeros((0, 3)))
+    X = synthetic_range_data("bulb", 50)
+    X[7, 1] = np.nan
+    with pytest.raises(CCProofError, match="non-finite"):
+        fit_points(X)
+    with pytest.raises(CCProofError, match="coincide"):
+        fit_points(np.ones((10, 3)))
+    (tmp_path / "e.xyz").write_text("")
+    with pytest.raises(CCProofError, match="empty"):
+        read_points(tmp_path / "e.xyz")
+    (tmp_path / "n.xyz").write_text("1 2 nan\n")
+    with pytest.raises(CCProofError, match="non-finite"):
+        read_points(tmp_path / "n.xyz")
+    (tmp_path / "x.stl").write_text("")
+    with pytest.raises(CCProofError, match="format"):
+        read_points(tmp_path / "x.stl")
+    with pytest.raises(CCProofError, match="no such file"):
+        read_points(tmp_path / "missing.xyz")
+    with pytest.raises(CCProofError, match="dt"):
+        fit_points(synthetic_range_data("bulb", 50), dt=-1.0)
+
+
+def test_q9_fit_ellipsoid_98_then_386():
+    X = synthetic_range_data("ellipsoid")  # 1,779 points (the head's size)
+    res = fit_points(X, levels=1)
+    l0, l1 = res.levels
+    assert (l0.n_vertices, l1.n_vertices) == (98, 386)
+    assert l1.max_error_percent <= 3.0
+    assert l1.max_error_percent < l0.max_error_percent
+    assert l1.mean_error_percent < l0.mean_error_percent
+    # the returned mesh is in the data's coordinates: its limit surface is close to the data
+    model = DynamicSurface(res.mesh)
+    from ccproof.apps.dynamics.fit import fit_error
+
+    err = fit_error(model, np.asarray(res.mesh.vertices), X)
+    assert err["max_percent"] == pytest.approx(l1.max_error_percent, rel=0.05)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["bulb", "superquadric"])
+def test_q9_fit_other_shapes(name):
+    res = fit_points(synthetic_range_data(name), levels=1)
+    assert res.levels[1].max_error_percent <= 3.0
+    assert res.levels[1].max_error_percent < res.levels[0].max_error_percent
+
+
+@pytest.mark.slow
+def test_q9_fit_scanned_bunny():
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[4] / "shared" / "reference" / "meshes" / "bunny_quads.obj"
+    if not path.exists():
+        pytest.skip("shared reference data not available")
+    res = fit_points(read_points(path), levels=1)
+    assert res.levels[1].max_error_percent <= 3.0
+    assert res.levels[1].max_error_percent < res.levels[0].max_error_percent
+
+
+def test_cli_fit(tmp_path, capsys):
+    from ccproof.cli import main
+    from ccproof.mesh import read_obj
+
+    pts = tmp_path / "bulb.xyz"
+    np.savetxt(pts, synthetic_range_data("bulb", 400, seed=1))
+    out = tmp_path / "fit.obj"
+    rc = main(["fit", str(pts), "--out", str(out), "--no-progress", "--max-steps", "25"])
+    text = capsys.readouterr().out
+    assert rc == 0
+    assert "fit error" in text and "% of the enclosing-sphere diameter" in text
+    mesh = read_obj(out)
+    assert (mesh.n_vertices, mesh.n_faces) == (386, 384)
+    rc = main(["fit", str(tmp_path / "missing.xyz"), "--out", str(out)])
+    assert rc == 2
+    rc = main(["fit", str(pts), "--out", str(out), "--dt", "-1", "--no-progress"])
+    assert rc == 2
+    assert "dt" in capsys.readouterr().err
