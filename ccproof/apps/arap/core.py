@@ -124,7 +124,7 @@ def initial_texture(h: ChartHierarchy, rules):
     V, Tc = _chart_triangles(h)
     nc = h.n_chart_vertices
     UV = fit_area(lscm(V[:nc], Tc), V[:nc], Tc)
-    if rules == "boundary":
+    if rules == "boundary" or h.unknown_vertices.size == nc:
         return UV
     L0 = h.level(0)
     orig = h.orig0

@@ -20,7 +20,7 @@ sums (spec A11.4).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -60,7 +60,8 @@ class Metrics:
     invdet_sum: float = 0.0
     samples: int = 0
     flips: int = 0
-    extra: dict = field(default_factory=dict)
+    #: sum A_j min_R ||grad phi_j - R||^2: the quadrature of hsh10 Eq. 1
+    arap_sum: float = 0.0
 
     def __add__(self, other):
         return Metrics(
@@ -73,6 +74,7 @@ class Metrics:
             self.invdet_sum + other.invdet_sum,
             self.samples + other.samples,
             self.flips + other.flips,
+            self.arap_sum + other.arap_sum,
         )
 
     @property
@@ -82,6 +84,11 @@ class Metrics:
     @property
     def E_area(self):
         return self.area_sum / self.area
+
+    @property
+    def E_arap(self):
+        """Area-weighted mean of min_R ||grad phi - R||_F^2 (hsh10 Eq. 1 divided by the area)."""
+        return self.arap_sum / self.area
 
     @property
     def E_stretch(self):
@@ -131,6 +138,7 @@ def sample_metrics(samples: SampleSet, T, per_sample=False):
         invdet_sum=float(w @ (1.0 / pr)),
         samples=int(w.size),
         flips=int((det <= 0).sum()),
+        arap_sum=float(w @ ((s1 - 1) ** 2 + (s2 - np.sign(det)) ** 2)),
     )
     if per_sample:
         return m, {"s1": s1, "s2": s2, "det": det, "weight": w, "area_distortion": are, "vertex": samples.vertex}

@@ -1,0 +1,82 @@
+"""Writing parameterizations: OBJ with per-corner texture coordinates, plus a JSON sidecar.
+
+The OBJ holds the control mesh (``v``), the texture control points of every chart (``vt``; the
+charts are laid side by side, each at its natural ARAP scale) and the chart faces as ``f v/vt``.
+Faces in no chart are written without texture. For extended charts the texture of a chart also
+has control points on the ring of faces around it (hsh10 section 3.2): they are written as extra
+``vt`` lines that no face uses, and the JSON sidecar (``<out>.json``) lists, for every chart, the
+global vertex of every texture control point, the subdivision rules and the metrics, so that the
+texture can be subdivided with the surface (DeRose et al. 1998) exactly as it was optimized.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+
+import numpy as np
+
+__all__ = ["write_uv_obj", "layout_offsets"]
+
+
+def layout_offsets(uvs, gap=0.05):
+    """Translations placing the charts' texture boxes left to right (gap relative to the width)."""
+    offs = []
+    x = 0.0
+    for uv in uvs:
+        lo, hi = uv.min(axis=0), uv.max(axis=0)
+        offs.append(np.array([x - lo[0], -lo[1]]))
+        x += (hi[0] - lo[0]) * (1 + gap) + 1e-12
+    return offs
+
+
+def write_uv_obj(path, mesh, result, comment=None, table=None):
+    """Write ``result`` (a :class:`~ccproof.apps.arap.core.MethodResult`) for ``mesh``.
+
+    Returns the path of the JSON sidecar.
+    """
+    path = os.fspath(path)
+    texs = result.textures
+    uvs = [np.asarray(t.unknowns, dtype=np.float64) for t in texs]
+    offs = layout_offsets(uvs)
+    V, F = mesh.vertices, mesh.faces
+    face_vt = np.full((mesh.n_faces, 4), -1, dtype=np.int64)
+    charts_json = []
+    base = 0
+    lines_vt = []
+    for tex, uv, off in zip(texs, uvs, offs):
+        h = tex.hierarchy
+        if tex.level != 0:
+            raise ValueError("only level-0 textures can be written (method d is evaluation only)")
+        uvo = uv + off
+        lines_vt.extend(uvo.tolist())
+        loc = np.full(mesh.n_vertices, -1, dtype=np.int64)
+        nc = h.n_chart_vertices
+        loc[h.unknown_vertices[:nc]] = np.arange(nc)
+        face_vt[h.chart_faces] = base + loc[F[h.chart_faces]]
+        charts_json.append(
+            {
+                "faces": h.chart_faces.tolist(),
+                "rules": tex.rules,
+                "vertices": h.unknown_vertices[: uv.shape[0]].tolist(),
+                "n_chart_vertices": int(nc),
+                "vt_first": int(base),
+                "uv": uvo.tolist(),
+            }
+        )
+        base += uv.shape[0]
+    with open(path, "w", encoding="utf-8") as fh:
+        for c in (comment or "").splitlines():
+            fh.write(f"# {c}\n")
+        fh.write(f"# {V.shape[0]} vertices, {F.shape[0]} faces, {len(texs)} charts, {base} texture points\n")
+        fh.writelines(f"v {x:.17g} {y:.17g} {z:.17g}\n" for x, y, z in V.tolist())
+        fh.writelines(f"vt {u:.17g} {v:.17g}\n" for u, v in lines_vt)
+        for f in range(F.shape[0]):
+            if face_vt[f, 0] >= 0:
+                fh.write("f " + " ".join(f"{a + 1}/{b + 1}" for a, b in zip(F[f], face_vt[f])) + "\n")
+            else:
+                fh.write("f " + " ".join(str(a + 1) for a in F[f]) + "\n")
+    side = path + ".json"
+    with open(side, "w", encoding="utf-8") as fh:
+        json.dump({"method": result.method, "charts": charts_json, "table": table or {}}, fh)
+    return side
