@@ -186,6 +186,11 @@ class DynamicSurface:
         K = sum(c * term_matrix(t) for t, c in coef.items())
         return term_matrix("mass"), K
 
+    def _nets_t(self):
+        if getattr(self, "_nets_transposed", None) is None:
+            self._nets_transposed = np.ascontiguousarray(self.layout.normal_nets.T)
+        return self._nets_transposed
+
     def _normal_swap(self):
         return self.face_swap[self.layout.normal_faces]
 
@@ -209,39 +214,30 @@ class DynamicSurface:
         return self._special_cache
 
     # ------------------------------------------------------------------ assembly
-    def _build_pattern(self):
-        lay = self.layout
-        n = self.n_vertices
-        nets = lay.normal_nets
-        r = [np.repeat(nets, 16, axis=1).reshape(-1)]
-        c = [np.tile(nets, (1, 16)).reshape(-1)]
-        for ring in lay.special_rings:
-            r.append(np.repeat(ring, ring.size))
-            c.append(np.tile(ring, ring.size))
-        rows = np.concatenate(r)
-        cols = np.concatenate(c)
-        keys = rows * n + cols
-        uniq = np.unique(keys)
-        pos = np.searchsorted(uniq, keys)
-        indptr = np.searchsorted(uniq // n, np.arange(n + 1))
-        self._pattern = (uniq % n, indptr, pos, nets.shape[0] * 256)
+    def _coo_indices(self):
+        if self._pattern is None:
+            lay = self.layout
+            nets = lay.normal_nets
+            r = [np.repeat(nets, 16, axis=1).reshape(-1)]
+            c = [np.tile(nets, (1, 16)).reshape(-1)]
+            for ring in lay.special_rings:
+                r.append(np.repeat(ring, ring.size))
+                c.append(np.tile(ring, ring.size))
+            self._pattern = (np.concatenate(r), np.concatenate(c))
+        return self._pattern
 
     def assemble(self, c_mass=0.0, c_stiff=1.0):
-        """Sparse ``c_mass M1 + c_stiff K`` (n x n CSR), element by element into a fixed pattern.
+        """Sparse ``c_mass M1 + c_stiff K`` (n x n CSR), summed element by element.
 
         ``M1`` is the unit-density mass (``M = mu M1``, ``D = gamma M1``), ``K`` the stiffness of
         the material.
         """
-        if self._pattern is None:
-            self._build_pattern()
-        indices, indptr, pos, nn = self._pattern
-        Ke = self._normal_combined(c_mass, c_stiff)
-        vals = [Ke.reshape(-1)]
+        rows, cols = self._coo_indices()
+        vals = [self._normal_combined(c_mass, c_stiff).reshape(-1)]
         for _, Ms, Ks in self.special_element_matrices():
             vals.append((c_mass * Ms + c_stiff * Ks).reshape(-1))
-        data = np.bincount(pos, weights=np.concatenate(vals), minlength=indices.size)
         n = self.n_vertices
-        return sp.csr_matrix((data, indices, indptr), shape=(n, n))
+        return sp.coo_matrix((np.concatenate(vals), (rows, cols)), shape=(n, n)).tocsr()
 
     def _normal_combined(self, c_mass, c_stiff):
         """Element matrices ``c_mass M1_e + c_stiff K_e`` of every normal element, (Nn, 16, 16)."""
@@ -287,17 +283,23 @@ class DynamicSurface:
         Y = np.zeros_like(X2)
         lay = self.layout
         if lay.n_normal:
-            nets = lay.normal_nets
             sw = self._normal_swap()
-            Ye = np.empty(nets.shape + (X2.shape[1],))
+            kk = X2.shape[1]
             for flag in (False, True):
-                sel = np.flatnonzero(sw == flag)
-                if sel.size:
-                    Mn, Kn = self.normal_element_matrices(swap=flag)
-                    Ye[sel] = np.einsum("ab,ebk->eak", c_mass * Mn + c_stiff * Kn, X2[nets[sel]])
-            flat = nets.reshape(-1)
-            for k in range(X2.shape[1]):
-                Y[:, k] += np.bincount(flat, weights=Ye[:, :, k].reshape(-1), minlength=n)
+                if sw.any() == sw.all():  # one element matrix for all normal elements
+                    if flag != bool(sw[0]):
+                        continue
+                    netsT = self._nets_t()
+                else:
+                    netsT = lay.normal_nets[sw == flag].T
+                if not netsT.size:
+                    continue
+                # (16, E): one GEMM for all elements and columns
+                Mn, Kn = self.normal_element_matrices(swap=flag)
+                Ye = ((c_mass * Mn + c_stiff * Kn) @ X2[netsT].reshape(16, -1)).reshape(16, -1, kk)
+                flat = netsT.reshape(-1)
+                for k in range(kk):
+                    Y[:, k] += np.bincount(flat, weights=Ye[:, :, k].reshape(-1), minlength=n)
         for ring, Ms, Ks in self.special_element_matrices():
             np.add.at(Y, ring, (c_mass * Ms + c_stiff * Ks) @ X2[ring])
         return Y[:, 0] if vec else Y
