@@ -9,8 +9,10 @@ On the same N points (default 10^6), per valence:
 * the fraction of points that needed the fallback, the failures (must be 0), the round-trip error
   max |Phi(Phi^-1(t)) - t|, and the ratios inverse / forward and location / forward.
 
-Times are the minimum over ``--repeat`` runs (the machine is shared; the minimum is the least
-disturbed run). Usage: ``python scripts/bench_inverse.py [--n 1000000] [--k 3 5 8 ...]``.
+The four computations are run interleaved, ``--repeat`` rounds; times are the minimum over the
+rounds (the least disturbed run on a shared machine) and the ratios are also given as the median
+over the rounds of the per-round ratios (robust to load changing between rounds).
+Usage: ``python scripts/bench_inverse.py [--n 1000000] [--k 3 5 8 ...] [--repeat 7]``.
 """
 
 from __future__ import annotations
@@ -22,14 +24,16 @@ import time
 import numpy as np
 
 
-def best_time(fn, repeat):
-    best = float("inf")
-    out = None
+def interleaved(fns, repeat):
+    """Run the callables in turn ``repeat`` times: (per-callable list of times, last outputs)."""
+    times = [[] for _ in fns]
+    outs = [None] * len(fns)
     for _ in range(repeat):
-        t0 = time.perf_counter()
-        out = fn()
-        best = min(best, time.perf_counter() - t0)
-    return best, out
+        for i, fn in enumerate(fns):
+            t0 = time.perf_counter()
+            outs[i] = fn()
+            times[i].append(time.perf_counter() - t0)
+    return times, outs
 
 
 def location_only(k, u, v):
@@ -62,24 +66,33 @@ def main(argv=None):
     rng = np.random.default_rng(args.seed)
     u = rng.random(args.n)
     v = rng.random(args.n)
-    print(f"N = {args.n} points uniform in [0,1]^2, times = min over {args.repeat} runs (seconds)")
-    head = (f"{'k':>5} {'forward':>8} {'fwd+J':>8} {'inverse':>8} {'locate':>8} {'inv/fwd':>8} "
-            f"{'inv/fwdJ':>8} {'loc/fwd':>8} {'fallback':>9} {'fail':>5} {'roundtrip':>10}")
+    print(f"N = {args.n} points uniform in [0,1]^2; {args.repeat} interleaved rounds; times: minimum (s);"
+          " ratios: min/min and [median of per-round ratios]")
+    head = (f"{'k':>5} {'forward':>8} {'fwd+J':>8} {'inverse':>8} {'locate':>8} {'inv/fwd':>14} "
+            f"{'inv/fwd+J':>14} {'loc/fwd':>14} {'fallback':>9} {'fail':>5} {'roundtrip':>10}")
     print(head)
     worst = 0
     for k in args.k:
         characteristic_map(k, u[:4], v[:4])
         inverse_characteristic_map(k, u[:4], v[:4])
-        tf, _ = best_time(lambda k=k: characteristic_map(k, u, v), args.repeat)
-        tj, _ = best_time(lambda k=k: characteristic_map(k, u, v, jacobian=True), args.repeat)
-        ti, res = best_time(lambda k=k: inverse_characteristic_map(k, u, v, full_output=True), args.repeat)
-        tl, _ = best_time(lambda k=k: location_only(k, u, v), args.repeat)
+        fns = [lambda k=k: characteristic_map(k, u, v),
+               lambda k=k: characteristic_map(k, u, v, jacobian=True),
+               lambda k=k: inverse_characteristic_map(k, u, v, full_output=True),
+               lambda k=k: location_only(k, u, v)]
+        times, outs = interleaved(fns, args.repeat)
+        tf, tj, ti, tl = (np.array(t) for t in times)
+        res = outs[2]
         x, y = characteristic_map(k, res.r, res.s)
         err = float(np.maximum(np.abs(x - u), np.abs(y - v)).max())
         fails = res.stats["failures"]
         worst = max(worst, fails)
-        print(f"{k:>5} {tf:8.4f} {tj:8.4f} {ti:8.4f} {tl:8.4f} {ti / tf:8.2f} {ti / tj:8.2f} {tl / tf:8.2f} "
-              f"{res.stats['fallback'] / args.n:9.2e} {fails:>5} {err:10.2e}")
+
+        def ratio(a, b):
+            return f"{a.min() / b.min():5.2f} [{np.median(a / b):5.2f}]"
+
+        print(f"{k:>5} {tf.min():8.4f} {tj.min():8.4f} {ti.min():8.4f} {tl.min():8.4f} {ratio(ti, tf):>14} "
+              f"{ratio(ti, tj):>14} {ratio(tl, tf):>14} {res.stats['fallback'] / args.n:9.2e} {fails:>5} "
+              f"{err:10.2e}")
         sys.stdout.flush()
     return 1 if worst else 0
 

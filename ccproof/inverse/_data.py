@@ -24,7 +24,7 @@ from ccproof.errors import check_valence
 #: powers lam^n are tabulated for |n| <= NMAX (as mantissa and binary exponent)
 NMAX = 2200
 #: total degree of the polynomial first guess of the inverse of P1 and P2
-FIT_DEGREE = 6
+FIT_DEGREE = 5
 
 # Bezier -> power basis: power[m] = sum_i BEZ2POW[i, m] * bezier[i]
 BEZ2POW = np.array([[comb(3, i) * comb(3 - i, m - i) * (-1) ** (m - i) if m >= i else 0
@@ -74,9 +74,13 @@ class ValenceData:
     lam: float
     bezier: np.ndarray          # (3, 4, 4, 2) Bezier nets of P1, P2, P3
     power: np.ndarray           # (2, 2, 4, 4): [patch P1/P2, comp x/y, s power, t power]
-    W: np.ndarray               # (2, 16, 4): q_i(t) rows (x: 0-3, y: 4-7, x': 8-11, y': 12-15)
-    pow_mant: np.ndarray        # lam^n = pow_mant[n + NMAX] * 2**pow_exp[n + NMAX]
+    W: np.ndarray               # (2, 22, 4): rows of t-coefficients of q_i(t) (x: 0-3, y: 4-7),
+                                # q_i'(t) (x: 8-11, y: 12-15), i q_i(t) (x: 16-18, y: 19-21)
+    pow_mant: np.ndarray        # lam^n = pow_mant[n + NMAX] * 2**pow_exp[n + NMAX] (any n, exact range)
     pow_exp: np.ndarray
+    pow_lam: np.ndarray         # lam^n as a double (0 / inf where out of range): the fast path
+    pow_2lam: np.ndarray        # (2 lam)^n as a double (Jacobians)
+    pow2: np.ndarray            # 2^n as a double
     inv_log_lam: float          # 1 / log(lam)
     log_a: float                # log(A): first guess puts max(t0) in (lam A, A]
     G: np.ndarray               # (5, 10) location rows on the cubic monomials of t0: g_Gamma(t0),
@@ -123,7 +127,7 @@ def valence_data(k):
     k = check_valence(k)
     lam, bez = float_nets(k)
     power = np.einsum("im,jn,pijc->pcmn", BEZ2POW, BEZ2POW, bez[:2])
-    W = np.zeros((2, 16, 4))
+    W = np.zeros((2, 22, 4))
     for p in range(2):
         for c in range(2):
             for i in range(4):
@@ -131,6 +135,8 @@ def valence_data(k):
                     W[p, 4 * c + i, j] = power[p, c, i, j]
                     if j >= 1:
                         W[p, 8 + 4 * c + i, j - 1] = j * power[p, c, i, j]
+                    if i >= 1:
+                        W[p, 16 + 3 * c + i - 1, j] = i * power[p, c, i, j]
     mant, expo = _arb_pow_table(subdominant_eigenvalue(k, "arb", 128))
 
     # location: Gamma = image of u = 1/2, 0 <= v <= 1/2 (edge s = 0 of P1), the inner boundary of
@@ -168,19 +174,58 @@ def valence_data(k):
     gx = B.T @ bez[0, 0, :, 0]
     xmin, xmax = gx.min(), gx.max()
     log_a = 0.5 * (np.log(xmax) + np.log(xmin) - 2 * np.log(lam))
-    return ValenceData(k, lam, bez, power, W, mant, expo, 1.0 / np.log(lam), float(log_a), G, fit,
-                       inside_sign(k, "P1:s=0"), inside_sign(k, "P1:t=1"))
+    lam_arb = subdominant_eigenvalue(k, "arb", 128)
+    m2, e2 = _arb_pow_table(2 * lam_arb)
+    with np.errstate(over="ignore", under="ignore"):
+        pow_lam = np.ldexp(mant, expo)
+        pow_2lam = np.ldexp(m2, e2)
+        pow2 = np.ldexp(1.0, np.arange(-NMAX, NMAX + 1))
+    return ValenceData(k, lam, bez, power, W, mant, expo, pow_lam, pow_2lam, pow2, 1.0 / np.log(lam),
+                       float(log_a), G, fit, inside_sign(k, "P1:s=0"), inside_sign(k, "P1:t=1"))
 
 
 #: points per block in the vectorized kernels (keeps the temporaries in cache)
-CHUNK = 4096
+CHUNK = 16384
+#: OpenBLAS runs a product m x k times k x n single-threaded when m n k <= 4 * 65536; above that it
+#: starts threads, which for these tiny products only costs time (and a lot on a loaded machine)
+_GEMM_SINGLE = 4 * 65536
+
+
+def matmul(A, B):
+    """A @ B for a small A (m x k) and a wide B (k x n), in column blocks small enough for OpenBLAS
+    to stay single-threaded."""
+    m, k = A.shape
+    n = B.shape[1]
+    step = max(256, _GEMM_SINGLE // max(1, m * k))
+    if n <= step:
+        return A @ B
+    out = np.empty((m, n))
+    for i in range(0, n, step):
+        np.matmul(A, B[:, i:i + step], out=out[:, i:i + step])
+    return out
+#: blocks whose points all have max(u, v) in [SAFE_LO, SAFE_HI] scale with the double tables
+#: (plain products); others with mantissa/exponent tables and ldexp (exact range, 30x slower)
+SAFE_LO = 2.0**-900
+SAFE_HI = 2.0**900
+
+_LN2 = float(np.log(2.0))
+#: quadratic approximation of log(m) on [1/2, 1) (error < 1e-2), used by :func:`approx_log`
+_LOG_Q = np.polyfit(np.linspace(0.5, 1.0, 200), np.log(np.linspace(0.5, 1.0, 200)), 2)
+
+
+def approx_log(a):
+    """log(a) to within 1e-2 (a > 0): frexp plus a quadratic; 3x cheaper than np.log."""
+    m, e = np.frexp(a)
+    c2, c1, c0 = _LOG_Q
+    return (c2 * m + c1) * m + (c0 + _LN2 * e)
 
 
 def patch_eval(Wp, s, t, jacobian=False):
     """P(s, t) of one piece (``Wp`` = ``ValenceData.W[p]``) at arrays s, t (local coordinates).
 
     Returns (x, y) or (x, y, x_s, x_t, y_s, y_t). The t-polynomials q_i(t) of both components
-    (and their derivatives) come out of one small matrix product, then Horner in s.
+    (and their t- and s-derivative coefficients) come out of one small matrix product, then
+    Horner in s.
     """
     n = s.shape[0]
     T = np.empty((4, n))
@@ -189,18 +234,29 @@ def patch_eval(Wp, s, t, jacobian=False):
     np.multiply(t, t, out=T[2])
     np.multiply(T[2], t, out=T[3])
     if not jacobian:
-        Q = Wp[:8] @ T
-        x = Q[0] + s * (Q[1] + s * (Q[2] + s * Q[3]))
-        y = Q[4] + s * (Q[5] + s * (Q[6] + s * Q[7]))
-        return x, y
-    Q = Wp @ T
-    x = Q[0] + s * (Q[1] + s * (Q[2] + s * Q[3]))
-    y = Q[4] + s * (Q[5] + s * (Q[6] + s * Q[7]))
-    xs = Q[1] + s * (2.0 * Q[2] + s * (3.0 * Q[3]))
-    ys = Q[5] + s * (2.0 * Q[6] + s * (3.0 * Q[7]))
-    xt = Q[8] + s * (Q[9] + s * (Q[10] + s * Q[11]))
-    yt = Q[12] + s * (Q[13] + s * (Q[14] + s * Q[15]))
-    return x, y, xs, xt, ys, yt
+        Q = matmul(Wp[:8], T)
+        return _horner3(Q, 0, s), _horner3(Q, 4, s)
+    Q = matmul(Wp, T)
+    return (_horner3(Q, 0, s), _horner3(Q, 4, s), _horner2(Q, 16, s), _horner3(Q, 8, s),
+            _horner2(Q, 19, s), _horner3(Q, 12, s))
+
+
+def _horner3(Q, i, s):
+    acc = Q[i + 3] * s
+    acc += Q[i + 2]
+    acc *= s
+    acc += Q[i + 1]
+    acc *= s
+    acc += Q[i]
+    return acc
+
+
+def _horner2(Q, i, s):
+    acc = Q[i + 2] * s
+    acc += Q[i + 1]
+    acc *= s
+    acc += Q[i]
+    return acc
 
 
 def chunks(n, size=CHUNK):

@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from ccproof.errors import check_valence
-from ccproof.inverse._data import NMAX, as_points, chunks, patch_eval, valence_data
+from ccproof.inverse._data import NMAX, SAFE_HI, SAFE_LO, as_points, chunks, patch_eval, valence_data
 
 
 def characteristic_map(k, r, s, jacobian=False):
@@ -63,13 +63,12 @@ def _forward_chunk(D, r, s, X, Y, J):
     a = np.where(sw, s, r)
     b = np.where(sw, r, s)
     m, e = np.frexp(a)
-    b0 = np.ldexp(b, -e)
+    idx = NMAX - e
+    fast = a.size == 0 or (a.min() >= SAFE_LO and a.max() <= SAFE_HI)
+    b0 = b * D.pow2[idx] if fast else np.ldexp(b, -e)   # exact either way
     p2 = b0 >= 0.5
     sl = 2.0 * m - 1.0
     tl = 2.0 * b0 - p2
-    idx = -e + NMAX
-    mant = D.pow_mant[idx]
-    expo = D.pow_exp[idx]
     px = np.empty_like(a)
     py = np.empty_like(a)
     if J is not None:
@@ -84,14 +83,24 @@ def _forward_chunk(D, r, s, X, Y, J):
             for i in range(4):
                 jac[i, sel] = out[2 + i]
     zero = a == 0
-    px = np.ldexp(px * mant, expo)
-    py = np.ldexp(py * mant, expo)
+    if fast:
+        f = D.pow_lam[idx]
+        px *= f
+        py *= f
+    else:
+        mant = D.pow_mant[idx]
+        expo = D.pow_exp[idx]
+        with np.errstate(over="ignore", under="ignore"):
+            px = np.ldexp(px * mant, expo)
+            py = np.ldexp(py * mant, expo)
     px[zero] = 0.0
     py[zero] = 0.0
     X[:] = np.where(sw, py, px)
     Y[:] = np.where(sw, px, py)
     if J is not None:
-        jac = np.ldexp(jac * mant, expo + 1 - e)
+        # d/dy = lam^-e * 2 * 2^-e * d/d(local) = 2 (2 lam)^-e d/d(local)
+        with np.errstate(over="ignore", under="ignore", invalid="ignore"):
+            jac *= 2.0 * D.pow_2lam[idx]
         jac[:, zero] = np.nan  # Phi is not differentiable at the extraordinary vertex
         xs, xt, ys, yt = jac
         # for swapped points Phi = swap o Phi_0 o swap: J = [[yt, ys], [xt, xs]]

@@ -124,8 +124,8 @@ def test_newton_failure_is_caught(monkeypatch):
     """A location that is wrong (piece flipped) makes Newton leave the piece: the fallback fixes it."""
     real = alg.locate
 
-    def wrong(D, a, b):
-        n, p, a1, b1, n0 = real(D, a, b)
+    def wrong(D, a, b, fast=True):
+        n, p, a1, b1, n0 = real(D, a, b, fast)
         return n, 1 - p, a1, b1, n0
 
     monkeypatch.setattr(alg, "locate", wrong)
