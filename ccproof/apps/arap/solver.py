@@ -99,9 +99,11 @@ class LocalGlobal:
         G2 = sp.csr_matrix(G2)[idx]
         self.Hu = (sp.diags(1.0 / a) @ G1).tocsr()
         self.Hv = (sp.diags(-b / (a * c)) @ G1 + sp.diags(1.0 / c) @ G2).tocsr()
-        self.HuT = self.Hu.T.tocsr()
-        self.HvT = self.Hv.T.tocsr()
+        # stacked [Hu; Hv]: one sparse product per direction and iteration
+        self.H = sp.vstack([self.Hu, self.Hv]).tocsr()
+        self.HT = self.H.T.tocsr()
         self.w = w
+        self.w2 = np.concatenate([w, w])[:, None]
         self.weight_sum = float(w.sum())
         self.pin = int(pin)
         self.mu = 0.0
@@ -110,8 +112,7 @@ class LocalGlobal:
         if not factor:  # energy evaluation only
             self.build_seconds = time.perf_counter() - t0
             return
-        W = sp.diags(w)
-        self.L = (self.HuT @ W @ self.Hu + self.HvT @ W @ self.Hv).tocsc()
+        self.L = (self.HT @ sp.diags(self.w2[:, 0]) @ self.H).tocsc()
         N = self.L.shape[0]
         self.N = N
         self.free = np.setdiff1d(np.arange(N), [self.pin])
@@ -135,9 +136,11 @@ class LocalGlobal:
 
     def jacobians(self, X):
         """grad phi of every sample, (s, 2, 2): J[:, c, 0] = (Hu X)[:, c], J[:, c, 1] = (Hv X)[:, c]."""
-        J = np.empty((self.w.size, 2, 2))
-        J[:, :, 0] = self.Hu @ X
-        J[:, :, 1] = self.Hv @ X
+        s = self.w.size
+        Y = self.H @ X
+        J = np.empty((s, 2, 2))
+        J[:, :, 0] = Y[:s]
+        J[:, :, 1] = Y[s:]
         return J
 
     def energy(self, J, R):
@@ -147,7 +150,7 @@ class LocalGlobal:
 
     def rhs(self, R):
         """B = sum_j w_j H_j R_j^T, shape (N, 2)."""
-        return self.HuT @ (self.w[:, None] * R[:, :, 0]) + self.HvT @ (self.w[:, None] * R[:, :, 1])
+        return self.HT @ (self.w2 * np.concatenate([R[:, :, 0], R[:, :, 1]]))
 
     def global_step(self, R, X):
         """Minimize E(., R) (plus the proximal term when regularized); the pinned unknown stays."""
