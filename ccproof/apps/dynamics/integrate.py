@@ -30,6 +30,7 @@ K) and ``k J^T d`` (added to ``f_p``), with the attachment points fixed during t
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -284,6 +285,9 @@ class ImplicitIntegrator:
         apply, diag = self.system_operator(springs)
         X0 = 2 * P - Pp  # linear extrapolation as the starting guess
         Pn, info = pcg(apply, rhs, diag, X0=X0, tol=self.tol)
+        if not info["residual"] <= 10 * self.tol:
+            warnings.warn(f"CG stopped at relative residual {info['residual']:.2e} > {self.tol:.1e} "
+                          f"after {info['iterations']} iterations", RuntimeWarning, stacklevel=2)
         disp = float(np.max(np.linalg.norm(Pn - P, axis=1))) if P.size else 0.0
         self.P_prev, self.P = P, Pn
         self.t += dt

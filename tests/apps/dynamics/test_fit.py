@@ -185,6 +185,17 @@ def test_cli_fit(tmp_path, capsys):
     assert "fit error" in text and "% of the enclosing-sphere diameter" in text
     mesh = read_obj(out)
     assert (mesh.n_vertices, mesh.n_faces) == (386, 384)
+    # a user mesh whose extraordinary vertices share faces is subdivided once first (26 vertices)
+    from ccproof.mesh import write_obj
+    from ccproof.mesh.examples import cube
+
+    X = np.loadtxt(pts)
+    c = X.mean(0)
+    init = cube().with_vertices(c + 0.3 * np.asarray(cube().vertices))
+    write_obj(tmp_path / "init.obj", init)
+    rc = main(["fit", str(pts), "--init", str(tmp_path / "init.obj"), "--levels", "0", "--max-steps", "5",
+               "--out", str(out), "--no-progress"])
+    assert rc == 0 and read_obj(out).n_vertices == 26
     rc = main(["fit", str(tmp_path / "missing.xyz"), "--out", str(out)])
     assert rc == 2
     rc = main(["fit", str(pts), "--out", str(out), "--dt", "-1", "--no-progress"])
