@@ -85,7 +85,7 @@ class ValenceData:
     log_a: float                # log(A): first guess puts max(t0) in (lam A, A]
     G: np.ndarray               # (5, 10) location rows on the cubic monomials of t0: g_Gamma(t0),
                                 # g_Gamma(lam t0), g_C(t0 / lam), g_C(t0), g_C(lam t0)
-    fit: np.ndarray             # (2, 2, M): first guess of (s, t) of P1 / P2, monomials of degree 6
+    fit: np.ndarray             # (2, 2, M): first guess of (s, t) of P1 / P2, monomials of degree FIT_DEGREE (5)
     gamma_sign: int
     sep_sign: int
 

@@ -221,6 +221,14 @@ def test_sign_test_agrees_with_exact_evaluation(k, name, w, e):
             assert side == (1 if inward else -1)
 
 
+def test_inside_signs_do_not_depend_on_the_valence():
+    """The documented sign table (docs/inverse.md) holds for every k != 4 sampled."""
+    want = {"P1:s=0": -1, "P2:s=0": -1, "P1:t=1": -1, "P2:t=1": -1, "P3:t=1": -1,
+            "P1:s=1": 1, "P2:s=1": 1, "P2:t=0": 1, "P3:s=1": 1, "P3:t=0": 1}
+    for k in (3, 5, 6, 9, 17, 33, 64, 100):
+        assert {n: inside_sign(k, n) for n in EDGES} == want
+
+
 def test_exact_sign_on_the_curve_and_k4():
     assert exact_sign(4, "P1:s=1", 1, Fraction(1, 3)) == 0
     assert exact_sign(4, "P1:s=1", Fraction(99, 100), 0) == inside_sign(4, "P1:s=1")
