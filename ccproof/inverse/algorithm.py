@@ -49,7 +49,7 @@ from ccproof.inverse._data import (
     as_points,
     matmul,
     monomials,
-    patch_eval,
+    patch_eval_jac,
     valence_data,
 )
 
@@ -220,7 +220,7 @@ def _inverse_chunk(D, x, y, R, S, layer, patch):
             continue
         X, Y = a1[sel], b1[sel]
         s0, t0 = matmul(D.fit[q], monomials(X, Y, FIT_DEGREE))
-        s, t, good = newton(D.W[q], s0, t0, X, Y)
+        s, t, good = newton(D.C6[q], s0, t0, X, Y)
         s_loc[sel] = s
         t_loc[sel] = t
         ok[sel] = good
@@ -249,18 +249,18 @@ def _inverse_chunk(D, x, y, R, S, layer, patch):
     return np.flatnonzero(~ok)
 
 
-def newton(Wp, s, t, X, Y):
+def newton(Cp, s, t, X, Y):
     """Newton for P(s, t) = (X, Y) on one piece; returns (s, t, accepted)."""
     step = np.full(s.shape, np.inf)
     for i in range(NEWTON_STEPS):
-        s, t, step = _newton_step(Wp, s, t, X, Y, i == NEWTON_STEPS - 1)
+        s, t, step = _newton_step(Cp, s, t, X, Y, i == NEWTON_STEPS - 1)
     todo = np.flatnonzero(~(step <= STEP_TOL))
     if todo.size:
         s, t = s.copy(), t.copy()
     for _ in range(EXTRA_STEPS):
         if todo.size == 0:
             break
-        s2, t2, st2 = _newton_step(Wp, s[todo], t[todo], X[todo], Y[todo])
+        s2, t2, st2 = _newton_step(Cp, s[todo], t[todo], X[todo], Y[todo])
         s[todo] = s2
         t[todo] = t2
         step[todo] = st2
@@ -270,8 +270,8 @@ def newton(Wp, s, t, X, Y):
     return s, t, good
 
 
-def _newton_step(Wp, s, t, X, Y, want_step=True):
-    x, y, xs, xt, ys, yt = patch_eval(Wp, s, t, True)
+def _newton_step(Cp, s, t, X, Y, want_step=True):
+    x, y, xs, xt, ys, yt = patch_eval_jac(Cp, s, t)
     x -= X
     y -= Y
     with np.errstate(all="ignore"):

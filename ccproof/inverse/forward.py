@@ -17,7 +17,16 @@ from __future__ import annotations
 import numpy as np
 
 from ccproof.errors import check_valence
-from ccproof.inverse._data import NMAX, SAFE_HI, SAFE_LO, as_points, chunks, patch_eval, valence_data
+from ccproof.inverse._data import (
+    NMAX,
+    SAFE_HI,
+    SAFE_LO,
+    as_points,
+    chunks,
+    patch_eval,
+    patch_eval_jac,
+    valence_data,
+)
 
 
 def characteristic_map(k, r, s, jacobian=False):
@@ -76,7 +85,10 @@ def _forward_chunk(D, r, s, X, Y, J):
     for p, sel in ((0, np.flatnonzero(~p2)), (1, np.flatnonzero(p2))):
         if sel.size == 0:
             continue
-        out = patch_eval(D.W[p], sl[sel], tl[sel], J is not None)
+        if J is None:
+            out = patch_eval(D.W[p], sl[sel], tl[sel])
+        else:
+            out = patch_eval_jac(D.C6[p], sl[sel], tl[sel])
         px[sel] = out[0]
         py[sel] = out[1]
         if J is not None:
