@@ -652,7 +652,6 @@ class FloatImplicit:
         self.k, self.edge, self.coeffs = k, e, c
         self.abs_coeffs = np.abs(c)
         self.sign = inside_sign(k, e.name)
-        self._terms = [(a, b, c[a, b]) for a in range(4) for b in range(4) if c[a, b] != 0]
 
     def __call__(self, u, v):
         import numpy as np
