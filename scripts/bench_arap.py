@@ -15,7 +15,7 @@ Measured in one run, on the closed bunny cut into charts by ``segment_by_normals
   with ``--engine numpy``), including its LSCM init and the level-3 positions;
 * distortion at level 5 of both, and (c)'s E_area excess relative to (d)'s.
 
-Writes a JSON summary (``--out``, default ``bench_arap.json``) and prints a table.
+Writes a JSON summary (``--out``, default ``out/bench_arap.json``) and prints a table.
 
 Usage:  python scripts/bench_arap.py [--mesh PATH] [--engine igl|numpy] [--patch] [--out FILE]
 """
@@ -174,7 +174,7 @@ def main(argv=None):
     ap.add_argument("--tol", type=float, default=1e-6)
     ap.add_argument("--repeat", type=int, default=15, help="iterations timed per chart and level")
     ap.add_argument("--patch", action="store_true", help="also the open patch (one chart)")
-    ap.add_argument("--out", default="bench_arap.json")
+    ap.add_argument("--out", default="out/bench_arap.json")
     args = ap.parse_args(argv)
     engine = args.engine
     if engine is None:
@@ -199,6 +199,7 @@ def main(argv=None):
     if args.patch:
         out["cases"]["patch"] = run_case("open patch (grow_patch(1000, 8)) as one chart", mesh,
                                          [grow_patch(mesh, 1000, 8)], engine, args.tol, args.repeat)
+    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     Path(args.out).write_text(json.dumps(out, indent=1))
     print(f"wrote {args.out}")
     return 0

@@ -13,7 +13,7 @@ charts, (d) ARAP on the control mesh subdivided 3 times. Cases:
   closed surface;
 * ``bunny_charts``: the closed bunny cut by ``segment_by_normals`` (hsh10 Fig. 6).
 
-Figures (PNG, in ``--out``): ``<case>_compare.png`` (checkerboard on the limit surface and the
+Figures (PNG, in ``--out``, default ``out/hsh10``): ``<case>_compare.png`` (checkerboard on the limit surface and the
 per-sample area distortion s1 s2 + 1/(s1 s2), colour from 2 (blue) to the 99th percentile of (a)
 (red), chart boundaries in black), ``<case>_texture.png`` (texture control meshes of (a), (b), (c),
 extension ring in red, and the subdivided chart boundary), ``levels_bunny_patch.png`` (extended
@@ -87,7 +87,7 @@ def case(name):
         chart = [(j * 4 + a) * 4 + b for j in range(5) for a in range(3) for b in range(3) if a + b < 4]
         lab = -np.ones(m.n_faces, dtype=int)
         lab[chart] = 0
-        return m, lab, (50, -60), 5, "saddle around a valence-5 vertex, zigzag chart (54 faces)"
+        return m, lab, (50, -60), 5, "saddle around a valence-5 vertex, zigzag chart (40 faces)"
     if name == "ev24":
         m = polar_disk(24, 3, height=lambda x, y: 0.08 * (x**2 + y**2))
         lab = -np.ones(m.n_faces, dtype=int)
@@ -103,8 +103,8 @@ def case(name):
         if name == "bunny_patch":
             lab = -np.ones(m.n_faces, dtype=int)
             lab[grow_patch(m, 1000, 8)] = 0
-            return m, lab, (10, 100), 4, "open patch of the bunny (283 faces) as one chart of the closed surface"
-        return m, segment_by_normals(m), (10, 120), 3, "closed bunny, segment_by_normals charts"
+            return m, lab, "auto", 4, "open patch of the bunny (283 faces) as one chart of the closed surface"
+        return m, segment_by_normals(m), (15, -25, "y"), 3, "closed bunny, segment_by_normals charts"
     raise SystemExit(f"unknown case {name!r}")
 
 
@@ -127,7 +127,13 @@ def vertex_values(samples, values, n):
     return acc / np.maximum(cnt, 1)
 
 
+#: coordinate permutation that makes the mesh's "up" axis the z axis of the renderer
+UP = {"z": [0, 1, 2], "y": [2, 0, 1]}
+
+
 def project(P, view):
+    """Orthographic projection; view = (elev, azim[, up]) with up "z" (default) or "y"."""
+    P = P[:, UP[view[2] if len(view) > 2 else "z"]]
     elev, azim = np.radians(view[0]), np.radians(view[1])
     d = np.array([np.cos(elev) * np.cos(azim), np.cos(elev) * np.sin(azim), np.sin(elev)])  # towards viewer
     right = np.cross([0, 0, 1.0], d)
@@ -142,8 +148,9 @@ def draw(ax, items, view, cull):
 
     polys, cols, depth = [], [], []
     segs = []
-    for P, F, rgb, bsegs in items:
+    for P, F, rgb, (bsegs, bface) in items:
         xy, z, d = project(P, view)
+        P = P[:, UP[view[2] if len(view) > 2 else "z"]]
         nrm = np.cross(P[F[:, 2]] - P[F[:, 0]], P[F[:, 3]] - P[F[:, 1]])
         nrm /= np.maximum(np.linalg.norm(nrm, axis=1, keepdims=True), 1e-300)
         facing = nrm @ d
@@ -154,7 +161,7 @@ def draw(ax, items, view, cull):
         depth.append(z[F[keep]].mean(axis=1))
         if bsegs is not None and len(bsegs):
             bxy, bz, _ = project(bsegs.reshape(-1, 3), view)
-            segs.append(bxy.reshape(-1, 2, 2))
+            segs.append(bxy.reshape(-1, 2, 2)[keep[bface]])
     polys = np.concatenate(polys)
     cols = np.concatenate(cols)
     order = np.argsort(np.concatenate(depth))
@@ -172,8 +179,12 @@ def draw(ax, items, view, cull):
 
 
 def boundary_segments(L, P):
-    e = L.mesh.edges[L.chart_boundary_edge]
-    return np.stack([P[e[:, 0]], P[e[:, 1]]], 1)
+    """Chart boundary edges at level L (as 3D segments) and the chart face of each."""
+    be = np.flatnonzero(L.chart_boundary_edge)
+    e = L.mesh.edges[be]
+    ef = L.mesh.edge_faces[be]
+    face = np.where(ef[:, 0] < L.n_chart_faces, ef[:, 0], ef[:, 1])
+    return np.stack([P[e[:, 0]], P[e[:, 1]]], 1), face
 
 
 def compare_figure(path, name, desc, results, view, level, cull):
@@ -314,7 +325,7 @@ def levels_figure(path, mesh, labels, view, out):
 # --------------------------------------------------------------------------- main
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--out", default="hsh10_figures")
+    ap.add_argument("--out", default="out/hsh10")
     ap.add_argument("--cases", default="ev5,ev24,cylinder,bunny_patch,bunny_charts")
     ap.add_argument("--engine", choices=["igl", "numpy"], default=None)
     args = ap.parse_args(argv)
@@ -346,6 +357,12 @@ def main(argv=None):
         entry["area_excess_ratio_a_over_c"] = ea["a"] / ea["c"]
         entry["area_excess_ratio_c_over_d"] = ea["c"] / ea["d"]
         cull = name == "bunny_charts"
+        if view == "auto":  # look along the mean normal of the chart
+            F = mesh.faces[labels >= 0]
+            V = mesh.vertices
+            nrm = np.cross(V[F[:, 2]] - V[F[:, 0]], V[F[:, 3]] - V[F[:, 1]]).sum(axis=0)
+            nrm /= np.linalg.norm(nrm)
+            view = (float(np.degrees(np.arcsin(nrm[2]))), float(np.degrees(np.arctan2(nrm[1], nrm[0]))))
         entry["colour_max"] = compare_figure(out / f"{name}_compare.png", name, desc, results, view, level, cull)
         if len(hs) == 1:
             texture_figure(out / f"{name}_texture.png", name, results)

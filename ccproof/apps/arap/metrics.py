@@ -92,7 +92,7 @@ class Metrics:
 
     @property
     def E_stretch(self):
-        return np.sqrt(self.stretch_sum / self.area) * np.sqrt(self.texture_area / self.area)
+        return float(np.sqrt(self.stretch_sum / self.area) * np.sqrt(self.texture_area / self.area))
 
     def rescaled(self):
         """(E_angle, E_area, E_stretch) after scaling the texture so that sum A_T = sum A."""
