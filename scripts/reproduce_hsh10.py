@@ -119,11 +119,12 @@ def chart_surface(tex: ChartTexture, level):
     return L, P, T
 
 
-def vertex_values(samples, values, n):
+def vertex_values(vertex, values, n):
+    """Mean of the per-sample ``values`` at every level-k vertex (corner samples share a vertex)."""
     acc = np.zeros(n)
     cnt = np.zeros(n)
-    np.add.at(acc, samples.vertex, values)
-    np.add.at(cnt, samples.vertex, 1)
+    np.add.at(acc, vertex, values)
+    np.add.at(cnt, vertex, 1)
     return acc / np.maximum(cnt, 1)
 
 
@@ -205,7 +206,7 @@ def compare_figure(path, name, desc, results, view, level, cull):
             S = build_samples(L, tex.rules, "metric")
             X = tex.hierarchy.subdivide_values(tex.values, tex.rules, tex.level, level)
             _, ps = sample_metrics(S, X, per_sample=True)
-            vv = vertex_values(S, ps["area_distortion"], L.n_vertices)
+            vv = vertex_values(ps["vertex"], ps["area_distortion"], L.n_vertices)
             chk.append((P, F, T[F].mean(axis=1), boundary_segments(L, P)))
             dist.append((P, F, vv[F].mean(axis=1), boundary_segments(L, P)))
             if diag is None:
@@ -309,7 +310,7 @@ def levels_figure(path, mesh, labels, view, out):
         S = build_samples(L, "extended", "metric")
         X = tex.hierarchy.subdivide_values(tex.values, "extended", 0, 4)
         _, ps = sample_metrics(S, X, per_sample=True)
-        v = vertex_values(S, ps["area_distortion"], L.n_vertices)[L.chart_faces()].mean(axis=1)
+        v = vertex_values(ps["vertex"], ps["area_distortion"], L.n_vertices)[L.chart_faces()].mean(axis=1)
         if vmax is None:
             vmax = 2 + max(np.percentile(v - 2, 99), 1e-6)
         rgb = cmap(np.clip((v - 2) / (vmax - 2), 0, 1))[:, :3]

@@ -94,8 +94,11 @@ def run(args) -> int:
     for k in range(len(lv[0]) if lv and lv[0] else 0):
         its = sum(c[k].iterations for c in lv)
         spi = sum(c[k].seconds for c in lv) / max(its, 1)
+        e0 = sum(c[k].energy_start for c in lv)
+        e1 = sum(c[k].energy_end for c in lv)
         print(f"  {results[ours].name}: level {lv[0][k].level}: {its} iterations, "
-              f"{1e3 * spi:.2f} ms/iteration (all charts), converged: {all(c[k].converged for c in lv)}")
+              f"{1e3 * spi:.2f} ms per chart iteration, energy {e0:.6g} -> {e1:.6g}, "
+              f"converged: {all(c[k].converged for c in lv)}")
     if args.out:
         table = {
             m: {"E_angle": r.metrics.E_angle, "E_area": r.metrics.E_area, "E_stretch": r.metrics.E_stretch,

@@ -119,15 +119,18 @@ def sample_metrics(samples: SampleSet, T, per_sample=False):
     area distortion s1 s2 + 1/(s1 s2)).
     """
     t1, t2 = samples.texture_tangents(T)
-    J = jacobians(samples.p1, samples.p2, t1, t2)
+    # samples with a degenerate surface frame (zero area element) carry no weight: leave them out
+    ok = samples.weight > 1e-14 * samples.weight.max()
+    p1, p2, t1, t2 = samples.p1[ok], samples.p2[ok], t1[ok], t2[ok]
+    J = jacobians(p1, p2, t1, t2)
     s1, s2, det = singular_values(J)
-    w = samples.weight
+    w = samples.weight[ok]
     with np.errstate(divide="ignore", invalid="ignore"):
         ang = s1 / s2 + s2 / s1
         pr = s1 * s2
         are = pr + 1.0 / pr
         st = 0.5 * (1.0 / s1**2 + 1.0 / s2**2)
-    at = np.abs(t1[:, 0] * t2[:, 1] - t1[:, 1] * t2[:, 0]) * samples.area_factor
+    at = np.abs(t1[:, 0] * t2[:, 1] - t1[:, 1] * t2[:, 0]) * samples.area_factor[ok]
     m = Metrics(
         area=float(w.sum()),
         angle_sum=float(w @ ang),
@@ -141,5 +144,6 @@ def sample_metrics(samples: SampleSet, T, per_sample=False):
         arap_sum=float(w @ ((s1 - 1) ** 2 + (s2 - np.sign(det)) ** 2)),
     )
     if per_sample:
-        return m, {"s1": s1, "s2": s2, "det": det, "weight": w, "area_distortion": are, "vertex": samples.vertex}
+        return m, {"s1": s1, "s2": s2, "det": det, "weight": w, "area_distortion": are,
+                   "vertex": samples.vertex[ok]}
     return m

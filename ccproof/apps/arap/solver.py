@@ -97,10 +97,10 @@ class LocalGlobal:
         a, b, c, w = a[idx], b[idx], c[idx], w[idx]
         G1 = sp.csr_matrix(G1)[idx]
         G2 = sp.csr_matrix(G2)[idx]
-        self.Hu = (sp.diags(1.0 / a) @ G1).tocsr()
-        self.Hv = (sp.diags(-b / (a * c)) @ G1 + sp.diags(1.0 / c) @ G2).tocsr()
+        Hu = sp.diags(1.0 / a) @ G1  # rows h_{j,1}^T: first column of H_j = [g1 g2] Q_j
+        Hv = sp.diags(-b / (a * c)) @ G1 + sp.diags(1.0 / c) @ G2  # rows h_{j,2}^T
         # stacked [Hu; Hv]: one sparse product per direction and iteration
-        self.H = sp.vstack([self.Hu, self.Hv]).tocsr()
+        self.H = sp.vstack([Hu, Hv]).tocsr()
         self.HT = self.H.T.tocsr()
         self.w = w
         self.w2 = np.concatenate([w, w])[:, None]
