@@ -1,7 +1,9 @@
 """Re-check injectivity certificates with the small trusted verifier.
 
   ccproof verify certificates/injectivity/k005.json
-  ccproof verify --all            every certificate under certificates/injectivity/
+  ccproof verify --all            every certificate under certificates/injectivity/ and certificates/c1/,
+                                  then the valence coverage of each statement (C1 must cover every
+                                  k >= 3 exactly once; injectivity reports the valences it covers)
 
 The verifier (ccproof/certify/verify.py) imports nothing from the prover: it checks the table hash,
 recomputes every Bernstein coefficient in arb from the table, replays each box's split path,
@@ -28,10 +30,27 @@ def run(args):
     files = [Path(f) for f in args.files]
     if args.all:
         files += sorted((certificates_dir() / "injectivity").glob("k*.json"))
+        files += sorted((certificates_dir() / "c1").glob("k*.json"))
     if not files:
         raise CCProofError("give certificate files or --all")
     log = (lambda s: print(s) if s.startswith(("VERIFIED", "FAILED")) else None) if args.quiet else print
     bad = [f for f in files if not verify_file(f, log=log)]
     print(f"{len(files) - len(bad)} of {len(files)} certificates verified" + (
         "" if not bad else "; failed: " + ", ".join(str(b) for b in bad)))
+    if args.all:
+        import json
+
+        from ccproof.certify.verify import check_coverage
+
+        good = [json.loads(f.read_text()) for f in files if f not in bad]
+        c1 = [c["valence"] for c in good if c.get("schema") == "ccproof.c1/1"]
+        ok, msg = check_coverage(c1)
+        print(f"C1 (Reif) coverage: {'OK' if ok else 'INCOMPLETE'}: {msg}")
+        inj = sorted(c["valence"] for c in good if c.get("schema") == "ccproof.injectivity/1"
+                     and isinstance(c["valence"], int))
+        if inj:
+            runs = "..".join(map(str, (inj[0], inj[-1]))) if inj == list(range(inj[0], inj[-1] + 1)) else str(inj)
+            print(f"injectivity (Appendix A) certified for k = {runs}; k >= {inj[-1] + 1}: not certified")
+        if not ok:
+            return 1
     return 0 if not bad else 1

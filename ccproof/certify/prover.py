@@ -16,8 +16,10 @@ from pathlib import Path
 from flint import ctx, fmpq
 
 from ccproof.certify.verify import (
+    C1_SCHEMA,
     PATCHES,
     SCHEMA,
+    STAR_CURVES,
     BernsteinForm,
     arb_from_table,
     cell_det_poly,
@@ -25,7 +27,8 @@ from ccproof.certify.verify import (
     cell_pieces,
     corner_det_poly,
     net_form,
-    regularity_det_poly,
+    regularity_form,
+    star_form,
 )
 from ccproof.errors import CCProofError, check_valence
 from ccproof.rigorous import bernstein_coefficients, certainly_positive, lower_bound
@@ -105,8 +108,8 @@ def prove_valence(k, prec=DEFAULT_PREC, tables_dir=None, progress=True):
     with ctx.workprec(prec):
         lam = arb_from_table(table, prec)
         nets = table_nets_arb(table, "bezier", prec)
-        regularity = {n: prove_positive(bernstein_coefficients(regularity_det_poly(nets, n, prec)), (0, 1),
-                                        f"det J_Phi on {n}") for n in PATCHES}
+        regularity = {n: prove_positive(regularity_form(nets, n, prec), (0, 1), f"det J_Phi on {n}")
+                      for n in PATCHES}
         cells = {}
         todo = []
         for l in range(2**N):
@@ -188,3 +191,41 @@ def write_certificate(cert, path=None):
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(json.dumps(cert, indent=1, sort_keys=True) + "\n", encoding="ascii")
     return path
+
+
+def _parse_k(k):
+    if isinstance(k, str) and k.strip().startswith(">="):
+        return {"min": check_valence(k.strip()[2:])}
+    if isinstance(k, dict):
+        return {"min": check_valence(k["min"])}
+    return check_valence(k)
+
+
+def prove_c1(k, prec=DEFAULT_PREC, tables_dir=None):
+    """C1 certificate (Reif's criterion) for valence k or the interval ``">=K0"``: det J_Phi > 0 on
+    layer 0 and a star-shaped outer boundary, boxes found by subdivision; the spectral ordering is
+    re-derived by the verifier from the table (see :func:`ccproof.certify.verify.verify_c1_certificate`)."""
+    k = _parse_k(k)
+    table = read_table_json(table_path(k, tables_dir))
+    if not table["spectral"]["ok"]:
+        raise ProofFailed(f"the spectral ordering is not certified in the table of {_kname(k)}")
+    with ctx.workprec(prec):
+        nets = table_nets_arb(table, "bezier", prec)
+        reg = {n: prove_positive(regularity_form(nets, n, prec), (0, 1), f"det J_Phi on {n}") for n in PATCHES}
+        star = {c: prove_positive(star_form(nets, c, prec), (0,), f"star {c}") for c in STAR_CURVES}
+    return {
+        "schema": C1_SCHEMA,
+        "valence": k,
+        "prec": prec,
+        "table": {"file": f"tables/{table_path(k).name}", "hash": table["hash"]},
+        "statement": ("Reif's C1 criterion for Catmull-Clark at valence k: 1 = lam_0 > lam_1 = lam_2 > |lam_3|, "
+                      "the characteristic map is regular (det J_Phi > 0) and injective (layer 0 locally "
+                      "homeomorphic with a star-shaped outer boundary image)."),
+        "parts": {"regularity": reg, "star": star},
+    }
+
+
+def c1_certificate_path(k, directory=None):
+    k = _parse_k(k)
+    name = f"k_ge_{k['min']}.json" if isinstance(k, dict) else f"k{k:03d}.json"
+    return Path(directory or certificates_dir() / "c1") / name

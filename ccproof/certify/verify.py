@@ -29,12 +29,19 @@ import re
 import time
 from pathlib import Path
 
-from flint import ctx, fmpq, fmpq_poly
+from flint import arb, ctx, fmpq, fmpq_poly
 
-from ccproof.rigorous import BernsteinForm, Poly, bernstein_coefficients, jacobian_determinant
+from ccproof.rigorous import (
+    BernsteinForm,
+    Poly,
+    bernstein_coefficients,
+    bernstein_jacobian_determinant,
+    jacobian_determinant,
+)
 from ccproof.tables.format import PATCHES, TableFormatError, read_table_json, table_nets_arb, table_path
 
 SCHEMA = "ccproof.injectivity/1"
+C1_SCHEMA = "ccproof.c1/1"
 BREAKS = (fmpq(0), fmpq(1, 6), fmpq(1, 3), fmpq(1, 2))  # w pieces (R5); piece 3 is w = 0
 _TOKEN = re.compile(r"([0-3])([LH])")
 
@@ -162,10 +169,28 @@ def corner_det_poly(nets, lam, N, name, prec):
         return J[0][0] * J[1][1] - J[0][1] * J[1][0]
 
 
-def regularity_det_poly(nets, name, prec):
-    """det J_Phi w.r.t. the local (s, t) of piece ``name`` on layer 0."""
+def regularity_form(nets, name, prec):
+    """Bernstein form (degree (5,5)) of det J_Phi w.r.t. the local (s, t) of piece ``name`` on layer 0,
+    computed in Bernstein arithmetic (stays tight for the interval nets of k >= k0)."""
     with ctx.workprec(prec):
-        return jacobian_determinant([net_form(nets[name], 0, prec).to_poly(), net_form(nets[name], 1, prec).to_poly()])
+        return bernstein_jacobian_determinant([net_form(nets[name], 0, prec), net_form(nets[name], 1, prec)])
+
+
+#: the outer boundary of the face, from Phi(1,0) = (1,0) to Phi(0,1) = (0,1): (piece, side, direction)
+STAR_CURVES = {"P1s1": ("P1", "s", 1), "P2s1": ("P2", "s", 1), "P2t1": ("P2", "t", -1), "P3t1": ("P3", "t", -1)}
+
+
+def star_form(nets, curve, prec):
+    """Bernstein form (degree 5) of x y' - y x' along one cubic of the outer boundary, oriented from
+    (1,0) towards (0,1). Positive on all four curves means the outer boundary is star-shaped."""
+    name, side, sign = STAR_CURVES[curve]
+    net = nets[name]
+    pts = [net[3][j] for j in range(4)] if side == "s" else [net[i][3] for i in range(4)]
+    with ctx.workprec(prec):
+        X = BernsteinForm((4,), [p[0] for p in pts], prec=prec)
+        Y = BernsteinForm((4,), [p[1] for p in pts], prec=prec)
+        cross = X * Y.diff(0) - Y * X.diff(0)
+        return cross if sign > 0 else -cross
 
 
 # ------------------------------------------------------------------------ replaying boxes
@@ -294,7 +319,7 @@ def verify_certificate(cert, tables_dir=None, log=print):
         regs = _field(parts, "regularity", dict, "parts")
         okB, minB = True, None
         for name in PATCHES:
-            root = bernstein_coefficients(regularity_det_poly(nets, name, prec))
+            root = regularity_form(nets, name, prec)
             ok, msg, mb = check_boxes(root, _field(regs, name, list, "regularity"), f"regularity {name}")
             okB &= ok
             if not ok:
@@ -403,7 +428,10 @@ def verify_file(path, tables_dir=None, log=print):
     t0 = time.perf_counter()
     try:
         cert = json.loads(Path(path).read_text(encoding="ascii"))
-        ok = verify_certificate(cert, tables_dir, log)
+        if isinstance(cert, dict) and cert.get("schema") == C1_SCHEMA:
+            ok = verify_c1_certificate(cert, tables_dir, log)
+        else:
+            ok = verify_certificate(cert, tables_dir, log)
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
         log(f"FAILED {path}: not a readable certificate ({exc})")
         return False
@@ -413,3 +441,123 @@ def verify_file(path, tables_dir=None, log=print):
     dt = time.perf_counter() - t0
     log(f"{'VERIFIED' if ok else 'FAILED'} {path} ({dt:.1f} s)")
     return ok
+
+
+# ------------------------------------------------------------------------ C1 (Reif) certificates
+def _valence(cert):
+    k = _field(cert, "valence", (int, dict), "certificate")
+    if isinstance(k, dict):
+        if set(k) != {"min"} or not isinstance(k["min"], int) or isinstance(k["min"], bool) or k["min"] < 3:
+            raise CertificateError(f"valence interval must be {{'min': K0 >= 3}}, got {k!r}")
+    elif k < 3:
+        raise CertificateError(f"valence {k} < 3")
+    return k
+
+
+def spectral_check(table, k, prec):
+    """1 = lam_0 > lam_1 = lam_2 = lam > |lam_3| from the Fourier-block spectrum (docs/readings.md R2):
+    every eigenvalue is 1, 1/8..1/64, a root of 16L^2 - 2(5 + c_m)L + 1 (m != 0, increasing in c_m, so
+    lam = lam(c_1) beats the modes 2 <= m <= k-2 since c_m < c_1) or of the mode-0 quadratic
+    16k x^2 - (12k-28)x + k - 3, whose larger root mu < lam iff (28 lam - 3)/k > 2(1 - c) lam."""
+    from ccproof.tables.format import arb_from_json
+
+    with ctx.workprec(prec):
+        c, lam = arb_from_json(table["c"], prec), arb_from_json(table["lam"], prec)
+        if not (16 * lam**2 - 2 * (5 + c) * lam + 1).contains(0) or not lam > (5 + c) / 16:
+            return False, "lam is not the larger root of 16 L^2 - 2(5 + c) L + 1"
+        if not (lam < 1 and lam > fmpq(1, 8)):
+            return False, "lam not in (1/8, 1)"
+        if isinstance(k, dict):
+            k0 = k["min"]
+            if not (c.contains(arb(fmpq(2, k0)).cos_pi()) and c.contains(1)):
+                return False, f"the table's c does not cover [cos(2 pi/{k0}), 1]"
+            if not 28 * lam - 3 > 4 * arb.pi() ** 2 * lam / k0:
+                return False, "28 lam - 3 > 4 pi^2 lam / k0 fails: mode 0 not separated"
+            return True, f"all k >= {k0}: lam > mu by (28 lam - 3) > 4 pi^2 lam / k0"
+        c1 = arb(fmpq(2, k)).cos_pi()
+        if not c.contains(c1):
+            return False, f"the table's c does not contain cos(2 pi/{k})"
+        b = arb(12 * k - 28)
+        mu = (b + (b * b - 64 * k * (k - 3)).sqrt()) / (32 * k)
+        others = [mu]
+        if k >= 4:
+            c2 = arb(fmpq(4, k)).cos_pi()
+            others.append((5 + c2 + ((1 + c2) * (9 + c2)).sqrt()) / 16)
+        if not all(lam > o for o in others):
+            return False, "an eigenvalue of another mode is not below lam"
+        gap = min((lam - o for o in others), key=lambda z: z.lower())
+        return True, f"gap lam - max|other| >= {gap.lower().str(6)}"
+
+
+def verify_c1_certificate(cert, tables_dir=None, log=print):
+    """Reif's C1 criterion for valence k (or every k >= k0): spectral ordering, det J_Phi > 0 on
+    layer 0 (hence on the face), and a star-shaped image of the outer boundary. With det J_Phi > 0 the
+    L-shaped layer 0 is mapped locally homeomorphically; its boundary goes to the Jordan curve made of
+    the axis segments [lam, 1], the outer curve C and lam C (disjoint because C is star-shaped), so
+    layer 0 maps injectively onto the annulus between lam C and C, and the layers, scaled by lam^i,
+    onto nested disjoint annuli: Phi is injective on the face, and on the k-star by symmetry."""
+    if not isinstance(cert, dict) or cert.get("schema") != C1_SCHEMA:
+        raise CertificateError(f"unknown certificate schema (expected {C1_SCHEMA!r})")
+    k = _valence(cert)
+    prec = _field(cert, "prec", int, "certificate")
+    if not 64 <= prec <= 1024:
+        raise CertificateError("prec must lie in 64..1024")
+    thash = _field(_field(cert, "table", dict, "certificate"), "hash", str, "table")
+    parts = _field(cert, "parts", dict, "certificate")
+    reg, star = _field(parts, "regularity", dict, "parts"), _field(parts, "star", dict, "parts")
+    if set(reg) != set(PATCHES) or set(star) != set(STAR_CURVES):
+        raise CertificateError("parts.regularity needs P1..P3 and parts.star needs " + ", ".join(STAR_CURVES))
+    for sec, nv in ((reg, 2), (star, 1)):
+        for boxes in sec.values():
+            for b in boxes if isinstance(boxes, list) else [None]:
+                if not isinstance(b, dict) or set(b) != {"path", "bound"}:
+                    raise CertificateError("a box must be {'path', 'bound'}")
+                parse_path(b["path"], nv)
+                _decimal(b["bound"])
+    kname = f">={k['min']}" if isinstance(k, dict) else str(k)
+    log(f"C1 certificate for valence {kname} ({prec} bits)")
+    results = []
+
+    def part(name, ok, msg=""):
+        results.append(ok)
+        log(f"  {'PASS' if ok else 'FAIL'}  {name}{(': ' + msg) if msg else ''}")
+
+    try:
+        table = read_table_json(table_path(k, tables_dir))
+    except FileNotFoundError:
+        part("table", False, f"no table for valence {kname}")
+        return False
+    except TableFormatError as exc:
+        part("table", False, str(exc))
+        return False
+    if table["valence"] != k or table["hash"] != thash:
+        part("table", False, f"the table's hash {table['hash']} is not the certificate's {thash}")
+        return False
+    part("table", True, thash)
+    ok, msg = spectral_check(table, k, prec)
+    part("spectral ordering 1 > lam = lam > |lam_3|", ok, msg)
+    with ctx.workprec(prec):
+        nets = table_nets_arb(table, "bezier", prec)
+        for name in PATCHES:
+            ok, msg, mb = check_boxes(regularity_form(nets, name, prec), reg[name], f"regularity {name}")
+            part(f"det J_Phi > 0 on {name}", ok, msg or f"min bound {mb} (local s,t)")
+        for curve in STAR_CURVES:
+            ok, msg, mb = check_boxes(star_form(nets, curve, prec), star[curve], f"star {curve}")
+            part(f"outer boundary star-shaped on {curve}", ok, msg or f"min bound {mb}")
+    return all(results)
+
+
+def check_coverage(valences):
+    """Do the valences (ints and {'min': k0}) cover every k >= 3 exactly once? Returns (ok, message)."""
+    ints = sorted(v for v in valences if isinstance(v, int))
+    tails = sorted(v["min"] for v in valences if isinstance(v, dict))
+    if len(set(ints)) != len(ints):
+        return False, "a valence is claimed twice"
+    if len(tails) != 1:
+        return False, "no interval k >= k0" if not tails else "more than one interval k >= k0"
+    k0 = tails[0]
+    if ints != list(range(3, k0)):
+        missing = sorted(set(range(3, k0)) - set(ints))
+        extra = [k for k in ints if k >= k0]
+        return False, f"missing valences {missing}" if missing else f"valences {extra} overlap k >= {k0}"
+    return True, f"every k >= 3 exactly once (3..{k0 - 1} and k >= {k0})"

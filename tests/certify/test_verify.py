@@ -183,3 +183,36 @@ def test_verify_all_published_certificates():
     from ccproof.cli import main
 
     assert main(["verify", "--all", "--quiet"]) == 0
+
+
+# ---------------------------------------------------------------- C1 (Reif) certificates
+C1 = certificates_dir() / "c1"
+
+
+def test_c1_certificates_cover_every_valence_once():
+    vals = [json.loads(p.read_text())["valence"] for p in C1.glob("k*.json")]
+    ok, msg = V.check_coverage(vals)
+    assert ok, msg
+    assert not V.check_coverage([v for v in vals if v != 17])[0]  # gap
+    assert not V.check_coverage(vals + [45])[0]  # overlap with k >= 40
+    assert not V.check_coverage([v for v in vals if isinstance(v, int)])[0]  # no tail
+
+
+@pytest.mark.parametrize("name", ["k003.json", "k005.json", "k_ge_40.json"])
+def test_c1_certificate_verifies(name):
+    lines = []
+    assert V.verify_c1_certificate(json.loads((C1 / name).read_text()), log=lines.append), lines
+
+
+def test_c1_tampering_rejected():
+    c = json.loads((C1 / "k_ge_40.json").read_text())
+    bad = copy.deepcopy(c)
+    bad["parts"]["star"]["P2s1"][0]["bound"] = "0.9"
+    lines = []
+    assert not V.verify_c1_certificate(bad, log=lines.append)
+    assert any("FAIL  outer boundary star-shaped on P2s1" in s for s in lines)
+    bad = copy.deepcopy(c)
+    bad["valence"] = {"min": 3}  # widen the interval: no such table, the claim is not established
+    lines = []
+    assert not V.verify_c1_certificate(bad, log=lines.append)
+    assert any("FAIL  table" in s for s in lines)
