@@ -2,8 +2,9 @@
 
 This module is the trusted base. It imports only python-flint, the standard library,
 :mod:`ccproof.rigorous` (Bernstein forms in arb) and :mod:`ccproof.tables.format` (hash-checked
-table reading); never the prover, numpy or sympy. It replays the hints of a certificate and never
-searches. The statement, the grammar and a worked example are in docs/certificates.md; in short,
+table reading); never the prover nor any floating-point array or CAS library. It replays
+the hints of a certificate and never searches. The statement, the grammar and a worked example
+are in docs/certificates.md; in short,
 for a valence k with table T (identified by its content hash) and N = N(k) it checks
 
   A. corner containment: lam^N * max(coefficients of X, Y of P1..P3) < 1/6, so the dyadic corner
@@ -295,18 +296,9 @@ def verify_certificate(cert, tables_dir=None, log=print):
     parts = _field(cert, "parts", dict, "certificate")
     _check_structure(parts)
     log(f"certificate for valence {kname} (N = {N}, {prec} bits)")
-    try:
-        table = read_table_json(table_path(k, tables_dir))
-    except FileNotFoundError:
-        part("table", False, f"no table for valence {kname}")
+    table = _load_table(k, kname, thash, tables_dir, part)
+    if table is None:
         return False
-    except TableFormatError as exc:
-        part("table", False, str(exc))
-        return False
-    if table["valence"] != k or table["hash"] != thash:
-        part("table", False, f"the table's hash {table['hash']} is not the certificate's {thash}")
-        return False
-    part("table", True, thash)
     with ctx.workprec(prec):
         lam = arb_from_table(table, prec)
         nets = table_nets_arb(table, "bezier", prec)
@@ -376,6 +368,23 @@ def verify_certificate(cert, tables_dir=None, log=print):
         if okE:
             part("E det J_G / h^2 > 0 on the corner cell (all layers >= N)", True, f"min bound {minE}")
     return all(results) and okB and okD and okE
+
+
+def _load_table(k, kname, thash, tables_dir, part):
+    """The hash-checked table of valence ``k`` whose hash is ``thash``, or None (after a FAIL line)."""
+    try:
+        table = read_table_json(table_path(k, tables_dir))
+    except FileNotFoundError:
+        part("table", False, f"no table for valence {kname}")
+        return None
+    except TableFormatError as exc:
+        part("table", False, str(exc))
+        return None
+    if table["valence"] != k or table["hash"] != thash:
+        part("table", False, f"the table's hash {table['hash']} is not the certificate's {thash}")
+        return None
+    part("table", True, thash)
+    return table
 
 
 def _check_structure(parts):
@@ -522,18 +531,9 @@ def verify_c1_certificate(cert, tables_dir=None, log=print):
         results.append(ok)
         log(f"  {'PASS' if ok else 'FAIL'}  {name}{(': ' + msg) if msg else ''}")
 
-    try:
-        table = read_table_json(table_path(k, tables_dir))
-    except FileNotFoundError:
-        part("table", False, f"no table for valence {kname}")
+    table = _load_table(k, kname, thash, tables_dir, part)
+    if table is None:
         return False
-    except TableFormatError as exc:
-        part("table", False, str(exc))
-        return False
-    if table["valence"] != k or table["hash"] != thash:
-        part("table", False, f"the table's hash {table['hash']} is not the certificate's {thash}")
-        return False
-    part("table", True, thash)
     ok, msg = spectral_check(table, k, prec)
     part("spectral ordering 1 > lam = lam > |lam_3|", ok, msg)
     with ctx.workprec(prec):
