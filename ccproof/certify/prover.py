@@ -20,14 +20,11 @@ from ccproof.certify.verify import (
     PATCHES,
     SCHEMA,
     STAR_CURVES,
-    BernsteinForm,
     arb_from_table,
     cell_det_poly,
-    cell_geometry,
-    cell_pieces,
     corner_det_poly,
-    net_form,
     regularity_form,
+    required_cells,
     star_form,
 )
 from ccproof.errors import CCProofError, check_valence
@@ -111,20 +108,7 @@ def prove_valence(k, prec=DEFAULT_PREC, tables_dir=None, progress=True):
         regularity = {n: prove_positive(regularity_form(nets, n, prec), (0, 1), f"det J_Phi on {n}")
                       for n in PATCHES}
         cells = {}
-        todo = []
-        for l in range(2**N):
-            for m in range(2**N):
-                if (l, m) == (0, 0):
-                    continue
-                i, name, box = cell_geometry(l, m, N)
-                li = lam**i
-                X = net_form(nets[name], 0, prec, box)
-                Y = net_form(nets[name], 1, prec, box)
-                X = BernsteinForm(X.shape, [c * li for c in X.coeffs], prec=prec)
-                Y = BernsteinForm(Y.shape, [c * li for c in Y.coeffs], prec=prec)
-                for p, q in cell_pieces(X, Y):
-                    if p < 3 and q < 3:
-                        todo.append((l, m, p, q))
+        todo = required_cells(nets, lam, N, prec)
         it = todo
         if progress:
             from tqdm import tqdm

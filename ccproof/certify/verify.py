@@ -128,6 +128,24 @@ def cell_pieces(X, Y):
     return out
 
 
+def required_cells(nets, lam, N, prec):
+    """Every (l, m, p, q) of part D: cell (l, m) != (0, 0) and w piece (p, q), p, q < 3, met by the
+    Bezier hull of Phi(cell). Pieces with p = 3 or q = 3 have w = 0 (G = Phi, covered by part B)."""
+    out = []
+    with ctx.workprec(prec):
+        for l in range(2**N):
+            for m in range(2**N):
+                if (l, m) == (0, 0):
+                    continue
+                i, name, box = cell_geometry(l, m, N)
+                li = lam**i
+                X, Y = (net_form(nets[name], d, prec, box) for d in (0, 1))
+                X = BernsteinForm(X.shape, [c * li for c in X.coeffs], prec=prec)
+                Y = BernsteinForm(Y.shape, [c * li for c in Y.coeffs], prec=prec)
+                out += [(l, m, p, q) for p, q in cell_pieces(X, Y) if p < 3 and q < 3]
+    return out
+
+
 def cell_det_poly(nets, lam, N, l, m, p, q, prec):
     """det dG/d(s,t) on cell (l, m) for the w piece (p, q) (p, q < 3), local coordinates in [0,1]^2."""
     i, name, box = cell_geometry(l, m, N)
@@ -325,33 +343,21 @@ def verify_certificate(cert, tables_dir=None, log=print):
         # D. the cells (l, m) != (0, 0)
         cells = _field(parts, "cells", dict, "parts")
         okD, minD, nboxes = True, None, 0
-        for l in range(2**N):
-            for m in range(2**N):
-                if (l, m) == (0, 0):
-                    continue
-                i, name, box = cell_geometry(l, m, N)
-                X = net_form(nets[name], 0, prec, box)
-                Y = net_form(nets[name], 1, prec, box)
-                li = lam**i
-                X = BernsteinForm(X.shape, [c * li for c in X.coeffs], prec=prec)
-                Y = BernsteinForm(Y.shape, [c * li for c in Y.coeffs], prec=prec)
-                for p, q in cell_pieces(X, Y):
-                    if p == 3 or q == 3:
-                        continue  # w = 0 there: G = Phi, covered by B
-                    key = f"{l},{m},{p},{q}"
-                    boxes = cells.get(key)
-                    if boxes is None:
-                        part(f"D cell {key}", False, "required (l, m, p, q) not in the certificate")
-                        okD = False
-                        continue
-                    root = bernstein_coefficients(cell_det_poly(nets, lam, N, l, m, p, q, prec))
-                    ok, msg, mb = check_boxes(root, boxes, f"cell {key}")
-                    nboxes += len(boxes)
-                    if not ok:
-                        part(f"D cell {key}", False, msg)
-                        okD = False
-                    elif minD is None or mb < minD:
-                        minD = mb
+        for l, m, p, q in required_cells(nets, lam, N, prec):
+            key = f"{l},{m},{p},{q}"
+            boxes = cells.get(key)
+            if boxes is None:
+                part(f"D cell {key}", False, "required (l, m, p, q) not in the certificate")
+                okD = False
+                continue
+            root = bernstein_coefficients(cell_det_poly(nets, lam, N, l, m, p, q, prec))
+            ok, msg, mb = check_boxes(root, boxes, f"cell {key}")
+            nboxes += len(boxes)
+            if not ok:
+                part(f"D cell {key}", False, msg)
+                okD = False
+            elif minD is None or mb < minD:
+                minD = mb
         if okD:
             part("D det J_G > 0 on every cell != (0,0)", True, f"{nboxes} boxes, min bound {minD}")
         # E. the corner cell, all layers i >= N at once
