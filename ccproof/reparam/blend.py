@@ -1,0 +1,198 @@
+"""The blended reparameterization F_b of a face, bmz04 eq. (4) (DESIGN.md R6):
+
+    F_b(t) = sum_i w_i(T_i^-1 t) T_i F_i T_i^-1 t + (1 - sum_i w_i(T_i^-1 t)) t,
+
+over the four corners i of the face [0,1]^2 (corner i at (0,0), (1,0), (1,1), (0,1)). T_i maps the
+quadrant frame of corner i to the face: ``T_i(s, t) = c_i + s a_i + t b_i`` with ``a_i`` along the
+edge to corner i+1 and ``b_i`` along the edge to corner i-1 (a rotation by i quarter turns; the
+evaluator's corner frames). The weights w_i vanish outside the open quarter [0, 1/2)^2 of their
+corner, so at most one term is active at a point and F_b is, on the quarter of corner i,
+``G_i(t) = w(t) F_i(t) + (1 - w(t)) t`` in local coordinates (R7), and the identity elsewhere.
+
+F_i: Phi^-1 of the corner's valence ("characteristic", w = b(s) b(t)) or F^alpha
+("vanishing", w = b(|t|)); the identity at valence-4 corners and at boundary vertices (code 0).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ccproof.errors import CCProofError
+from ccproof.reparam.quadrant import characteristic_inverse, default_alpha, vanishing_map
+from ccproof.reparam.weights import weight_radial, weight_tensor
+
+__all__ = ["PARAMETERIZATIONS", "CORNER_FRAMES", "to_local", "from_local", "face_map"]
+
+#: names accepted by ``parameterization=``
+PARAMETERIZATIONS = ("natural", "vanishing", "characteristic")
+
+#: linear parts A_i = [a_i b_i] of the corner transforms T_i (columns), shape (4, 2, 2)
+CORNER_FRAMES = np.array([
+    [[1.0, 0.0], [0.0, 1.0]],
+    [[0.0, -1.0], [1.0, 0.0]],
+    [[-1.0, 0.0], [0.0, -1.0]],
+    [[0.0, 1.0], [-1.0, 0.0]],
+])
+
+
+def quarter(u, v):
+    """Index of the corner whose closed quarter contains (u, v) (ties towards the larger index)."""
+    cu = u >= 0.5
+    cv = v >= 0.5
+    return np.where(cv, np.where(cu, 2, 3), np.where(cu, 1, 0)).astype(np.int64)
+
+
+def to_local(q, u, v):
+    """T_q^-1: face parameter (u, v) -> local (s, t) of corner q (exact in floating point).
+
+    >>> to_local(np.array([1]), np.array([0.75]), np.array([0.25]))
+    (array([0.25]), array([0.25]))
+    """
+    s = np.where(q == 0, u, np.where(q == 1, v, np.where(q == 2, 1.0 - u, 1.0 - v)))
+    t = np.where(q == 0, v, np.where(q == 1, 1.0 - u, np.where(q == 2, 1.0 - v, u)))
+    return s, t
+
+
+def from_local(q, s, t):
+    """T_q: local (s, t) of corner q -> face parameter (u, v).
+
+    >>> from_local(np.array([3]), np.array([0.25]), np.array([0.125]))
+    (array([0.125]), array([0.75]))
+    """
+    u = np.where(q == 0, s, np.where(q == 1, 1.0 - t, np.where(q == 2, 1.0 - s, t)))
+    v = np.where(q == 0, t, np.where(q == 1, s, np.where(q == 2, 1.0 - t, 1.0 - s)))
+    return u, v
+
+
+def _alpha_for(alpha, k):
+    if alpha is None:
+        return default_alpha(k)
+    if isinstance(alpha, dict):
+        return float(alpha[k]) if k in alpha else default_alpha(k)
+    return float(alpha)
+
+
+def quarter_map(k, s, t, parameterization, alpha=None, derivatives=1):
+    """G(t) = w(t) F(t) + (1 - w(t)) t on the quarter of a corner of valence k (local coordinates).
+
+    Parameters
+    ----------
+    k : int
+        Valence of the corner (!= 4, interior).
+    s, t : ndarray, shape (n,)
+        Local coordinates in [0, 1/2]^2.
+    parameterization : {"vanishing", "characteristic"}
+    alpha : float or dict or None
+        Exponent of F^alpha ("vanishing" only); None: :func:`~ccproof.reparam.quadrant.default_alpha`.
+    derivatives : int, 0, 1 or 2
+
+    Returns
+    -------
+    G : ndarray, shape (n, 2)
+    DG : ndarray, shape (n, 2, 2)
+        ``DG[:, a, i] = dG_a / dt_i`` (with ``derivatives >= 1``).
+    D2G : ndarray, shape (n, 2, 2, 2)
+        With 2.
+    """
+    if parameterization == "characteristic":
+        Fo = characteristic_inverse(k, s, t, derivatives)
+        W = weight_tensor(s, t, derivatives)
+    elif parameterization == "vanishing":
+        Fo = vanishing_map(s, t, _alpha_for(alpha, k), derivatives)
+        W = weight_radial(s, t, derivatives)
+    else:
+        raise CCProofError(f"unknown parameterization {parameterization!r}; use one of {', '.join(PARAMETERIZATIONS)}")
+    w = W[0][:, None]
+    T = np.stack([s, t], axis=1)
+    F = Fo[0]
+    d = F - T
+    out = [w * F + (1.0 - w) * T]
+    if derivatives >= 1:
+        JF = Fo[1]
+        eye = np.eye(2)
+        gw = np.stack(W[1:3], axis=1)  # (n, 2)
+        DG = w[:, :, None] * JF + (1.0 - w)[:, :, None] * eye + d[:, :, None] * gw[:, None, :]
+        out.append(DG)
+    if derivatives >= 2:
+        HF = Fo[2]
+        hw = np.empty((s.shape[0], 2, 2))
+        hw[:, 0, 0], hw[:, 0, 1], hw[:, 1, 1] = W[3], W[4], W[5]
+        hw[:, 1, 0] = W[4]
+        JmI = JF - eye
+        D2G = (w[:, :, None, None] * HF + gw[:, None, :, None] * JmI[:, :, None, :]
+               + gw[:, None, None, :] * JmI[:, :, :, None] + d[:, :, None, None] * hw[:, None, :, :])
+        out.append(D2G)
+    return tuple(out)
+
+
+def face_map(corner_valence, u, v, parameterization, alpha=None, derivatives=1):
+    """F_b of bmz04 eq. (4) at points (u, v) of faces with the given corner valences.
+
+    Parameters
+    ----------
+    corner_valence : array_like of int, shape (4,) or (n, 4)
+        Valence of corner i of the face of each point; 0 (or 4) for an identity corner (valence
+        4 or a boundary vertex).
+    u, v : ndarray, shape (n,)
+        Face parameters in [0, 1].
+    parameterization : {"natural", "vanishing", "characteristic"}
+    alpha : float or dict or None
+        See :func:`quarter_map`.
+    derivatives : int, 0, 1 or 2
+
+    Returns
+    -------
+    dict
+        ``u``, ``v``: F_b(u, v), shape (n,); ``J`` (n, 2, 2) with ``J[:, a, i] = dF_b,a / dt_i`` and
+        ``H`` (n, 2, 2, 2) with ``derivatives`` >= 1, 2; ``active`` (n,) bool: points where a
+        weight is positive (elsewhere F_b is the identity); ``quarter`` (n,), ``local`` (n, 2)
+        the local coordinates of F_b(u, v) in the quarter's corner frame, ``corner`` (n,) bool:
+        the points exactly at a non-identity corner (where J is not defined: see
+        :meth:`ccproof.reparam.surface.ReparamLimitSurface.evaluate`).
+
+    Examples
+    --------
+    >>> r = face_map([5, 4, 4, 4], np.array([0.0, 0.5, 0.2]), np.array([0.0, 0.0, 0.6]), "characteristic")
+    >>> r["u"].tolist(), r["v"].tolist()          # corner, side and the quarter of a regular corner: fixed
+    ([0.0, 0.5, 0.2], [0.0, 0.0, 0.6])
+    """
+    if parameterization not in PARAMETERIZATIONS:
+        raise CCProofError(f"unknown parameterization {parameterization!r}; use one of {', '.join(PARAMETERIZATIONS)}")
+    u = np.asarray(u, dtype=np.float64).reshape(-1)
+    v = np.asarray(v, dtype=np.float64).reshape(-1)
+    n = u.shape[0]
+    cv = np.asarray(corner_valence, dtype=np.int64)
+    if cv.ndim == 1:
+        cv = np.broadcast_to(cv, (n, 4))
+    q = quarter(u, v)
+    s, t = to_local(q, u, v)
+    kk = np.take_along_axis(cv, q[:, None], axis=1)[:, 0]
+    kk = np.where(kk == 4, 0, kk)
+    if parameterization == "natural":
+        active = np.zeros(n, dtype=bool)
+    elif parameterization == "characteristic":
+        active = (kk > 0) & (s < 0.5) & (t < 0.5)
+    else:
+        active = (kk > 0) & (s * s + t * t < 0.25)
+    out = {"u": u.copy(), "v": v.copy(), "active": active, "quarter": q,
+           "local": np.stack([s, t], axis=1), "corner": active & (s == 0) & (t == 0)}
+    if derivatives >= 1:
+        out["J"] = np.broadcast_to(np.eye(2), (n, 2, 2)).copy()
+    if derivatives >= 2:
+        out["H"] = np.zeros((n, 2, 2, 2))
+    idx = np.flatnonzero(active)
+    if idx.size == 0:
+        return out
+    for k in np.unique(kk[idx]):
+        sel = idx[kk[idx] == k]
+        res = quarter_map(int(k), s[sel], t[sel], parameterization, alpha, derivatives)
+        G = res[0]
+        out["local"][sel] = G
+        uu, vv = from_local(q[sel], np.clip(G[:, 0], 0.0, 1.0), np.clip(G[:, 1], 0.0, 1.0))
+        out["u"][sel], out["v"][sel] = uu, vv
+        A = CORNER_FRAMES[q[sel]]
+        if derivatives >= 1:
+            out["J"][sel] = np.einsum("nab,nbc,nic->nai", A, res[1], A)
+        if derivatives >= 2:
+            out["H"][sel] = np.einsum("nab,nbcd,nic,njd->naij", A, res[2], A, A)
+    return out

@@ -1,0 +1,199 @@
+"""The differentiable parameterizations of bmz04 section 4 on real meshes: f o F_b.
+
+:func:`limit_surface` returns a :class:`ReparamLimitSurface`, a
+:class:`~ccproof.evaluate.surface.LimitSurface` whose :meth:`~ReparamLimitSurface.evaluate` takes
+``parameterization="natural" | "vanishing" | "characteristic"``:
+
+* ``natural``: the evaluator's own parameterization (Stam; bmz04 section 2);
+* ``vanishing``: f o F_b with F_i = F^alpha and w = b(|t|) (section 4.2);
+* ``characteristic``: f o F_b with F_i = Phi^-1 and w = b(s) b(t) (section 4.3).
+
+F_b (:func:`ccproof.reparam.blend.face_map`) is applied at every corner that is an interior
+vertex of valence != 4; it is the identity at valence-4 vertices and at *boundary* vertices
+(bmz04's characteristic map and its bound on alpha are for interior vertices; the boundary rules
+have other eigenstructures, so the natural parameterization is kept there). The derivatives are
+the chain rule ``D(f o F_b) = Df(F_b(t)) DF_b(t)`` (second derivatives
+``D^2 f[DF_b, DF_b] + Df D^2 F_b``), with the analytic derivatives of F_b.
+
+At a point exactly at an extraordinary corner the natural derivatives are 0 (k = 3) or infinite
+(k >= 5) and DF_b is singular, so the limit is returned instead: 0 for ``vanishing``, and for
+``characteristic`` the exact limit D(f o Phi^-1)(0) of :mod:`ccproof.reparam.corner` (the
+lam-eigencomponent of the surface at the two edge neighbours). The same limit values are used at
+the (very few) points whose preimage F_b(t) is closer to the corner than the deepest layer the
+evaluator stores (about 2^-47 .. 2^-100 of the face, where it returns the limit point): there the
+limit is the best available value of the derivative. Second derivatives are NaN at these points
+(f o F_b is C1 but in general not C2 at an extraordinary vertex).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ccproof.errors import CCProofError
+from ccproof.evaluate.surface import CHUNK, LimitSurface
+from ccproof.mesh import QuadMesh
+from ccproof.reparam.blend import CORNER_FRAMES, PARAMETERIZATIONS, face_map
+from ccproof.reparam.quadrant import check_alpha, default_alpha
+
+__all__ = ["ReparamLimitSurface", "limit_surface"]
+
+_KEYS = {0: ("P",), 1: ("P", "Pu", "Pv"), 2: ("P", "Pu", "Pv", "Puu", "Puv", "Pvv")}
+#: points whose preimage is this close to the corner (local max-norm) are checked against the
+#: evaluator's deepest stored layer (every corner stores more than 40 layers)
+_DEEP = 2.0**-30
+
+
+class ReparamLimitSurface(LimitSurface):
+    """Limit surface with the three parameterizations of bmz04 (see the module docstring).
+
+    Attributes (besides those of LimitSurface): ``alpha`` (dict valence -> exponent of F^alpha for
+    every extraordinary interior valence of the mesh), ``corner_valence`` ((n_faces, 4) int: the
+    valence of each face corner, 0 where F_i is the identity).
+    """
+
+    def __init__(self, mesh: QuadMesh, alpha=None):
+        super().__init__(mesh)
+        val = np.asarray(mesh.valence, dtype=np.int64)
+        code = np.where(mesh.is_boundary_vertex | (val == 4), 0, val)
+        self.corner_valence = code[mesh.faces]
+        kinds = sorted({int(k) for k in np.unique(code) if k > 0})
+        self.alpha = {}
+        for k in kinds:
+            if alpha is None:
+                a = default_alpha(k)
+            elif isinstance(alpha, dict):
+                a = alpha[k] if k in alpha else default_alpha(k)
+            else:
+                a = alpha
+            self.alpha[k] = check_alpha(a, k)
+        self._tangent_cache = {}
+
+    def evaluate(self, face_ids, u, v, derivatives=1, *, parameterization="natural", chunk=CHUNK, out=None,
+                 backend=None):
+        """Positions and derivatives at points (face, u, v) in the chosen parameterization.
+
+        Parameters
+        ----------
+        face_ids : array_like of int, shape (n,)
+        u, v : array_like of float, shape (n,)
+            Face parameters in [0, 1] (corner i of the face at (0,0), (1,0), (1,1), (0,1)).
+        derivatives : int, 0, 1 or 2
+        parameterization : {"natural", "vanishing", "characteristic"}
+            bmz04 section 2, 4.2 or 4.3.
+        chunk, out, backend
+            As in :meth:`ccproof.evaluate.surface.LimitSurface.evaluate`.
+
+        Returns
+        -------
+        dict of ndarray, shape (n, 3)
+            ``P``; ``Pu``, ``Pv`` with ``derivatives >= 1``; ``Puu``, ``Puv``, ``Pvv`` with 2:
+            derivatives of f o F_b with respect to the face's own (u, v).
+
+        Raises
+        ------
+        CCProofError
+            Unknown parameterization; face id out of range; (u, v) outside [0, 1]^2 or NaN.
+
+        Examples
+        --------
+        >>> from ccproof.mesh.examples import k_regular_disk
+        >>> S = limit_surface(k_regular_disk(5, 2))
+        >>> r = S.evaluate([0], [0.0], [0.0], parameterization="characteristic")
+        >>> bool(np.linalg.norm(np.cross(r["Pu"][0], r["Pv"][0])) > 0.1)   # rank 2 at the vertex
+        True
+        """
+        if parameterization not in PARAMETERIZATIONS:
+            raise CCProofError(
+                f"unknown parameterization {parameterization!r}; use one of {', '.join(PARAMETERIZATIONS)}")
+        if derivatives not in (0, 1, 2):
+            raise CCProofError(f"derivatives must be 0, 1 or 2, got {derivatives!r}")
+        if parameterization == "natural":
+            return super().evaluate(face_ids, u, v, derivatives, chunk=chunk, out=out, backend=backend)
+        f, u, v = self._check(face_ids, u, v)
+        res = face_map(self.corner_valence[f], u, v, parameterization, self.alpha, derivatives)
+        R = super().evaluate(f, res["u"], res["v"], derivatives, chunk=chunk, backend=backend)
+        idx = np.flatnonzero(res["active"])
+        if idx.size and derivatives >= 1:
+            J = res["J"][idx]
+            Pu, Pv = R["Pu"][idx], R["Pv"][idx]
+            if derivatives >= 2:
+                H = res["H"][idx]
+                Puu, Puv, Pvv = R["Puu"][idx], R["Puv"][idx], R["Pvv"][idx]
+                for key, i, j in (("Puu", 0, 0), ("Puv", 0, 1), ("Pvv", 1, 1)):
+                    R[key][idx] = (Puu * (J[:, 0, i] * J[:, 0, j])[:, None]
+                                   + Puv * (J[:, 0, i] * J[:, 1, j] + J[:, 1, i] * J[:, 0, j])[:, None]
+                                   + Pvv * (J[:, 1, i] * J[:, 1, j])[:, None]
+                                   + Pu * H[:, 0, i, j, None] + Pv * H[:, 1, i, j, None])
+            R["Pu"][idx] = Pu * J[:, 0, 0, None] + Pv * J[:, 1, 0, None]
+            R["Pv"][idx] = Pu * J[:, 0, 1, None] + Pv * J[:, 1, 1, None]
+            self._fix_corner_limits(f, res, R, parameterization, derivatives)
+        if out is not None:
+            for key in _KEYS[derivatives]:
+                out[key][...] = R[key]
+            return out
+        return R
+
+    def _fix_corner_limits(self, f, res, R, parameterization, derivatives):
+        """Limit derivatives at the corner and beyond the evaluator's deepest layer (module doc)."""
+        loc = res["local"]
+        m = np.maximum(loc[:, 0], loc[:, 1])
+        cand = np.flatnonzero(res["active"] & (m < _DEEP))
+        if cand.size == 0:
+            return
+        _, _, _, scale = self._locate(f[cand], res["u"][cand], res["v"][cand])
+        fix = cand[(m[cand] * scale < 0.5) | res["corner"][cand]]
+        if fix.size == 0:
+            return
+        if parameterization == "vanishing":
+            R["Pu"][fix] = 0.0
+            R["Pv"][fix] = 0.0
+        else:
+            q = res["quarter"][fix]
+            for i, (ff, qq) in enumerate(zip(f[fix].tolist(), q.tolist())):
+                D = self.corner_derivatives(ff, qq)  # (2, 3): d/ds, d/dt in the corner frame
+                A = CORNER_FRAMES[qq]
+                # d/du_i = sum_beta d/dt_beta * dt_beta/du_i, dt_loc/du = A^T
+                R["Pu"][fix[i]] = A[0, 0] * D[0] + A[0, 1] * D[1]
+                R["Pv"][fix[i]] = A[1, 0] * D[0] + A[1, 1] * D[1]
+        if derivatives >= 2:
+            for key in ("Puu", "Puv", "Pvv"):
+                R[key][fix] = np.nan
+
+    def corner_derivatives(self, face, corner):
+        """D(f o Phi^-1)(0) at corner ``corner`` of ``face``: rows d/ds, d/dt in the corner frame, (2, 3).
+
+        See :mod:`ccproof.reparam.corner`. Only for interior vertices of valence != 4.
+        """
+        key = (int(face), int(corner))
+        if key not in self._tangent_cache:
+            from ccproof.reparam.corner import corner_tangents
+
+            self._tangent_cache[key] = corner_tangents(self.mesh, *key)
+        return self._tangent_cache[key]
+
+
+def limit_surface(mesh, alpha=None):
+    """Prepare the evaluation of ``mesh`` in the parameterizations of bmz04 (a QuadMesh or OBJ path).
+
+    Parameters
+    ----------
+    mesh : QuadMesh or str or os.PathLike
+    alpha : float or dict or None
+        Exponent of F^alpha for the "vanishing" parameterization: one value for every valence, a
+        dict valence -> value (missing valences get the default), or None for
+        :func:`~ccproof.reparam.quadrant.default_alpha` (twice the bound of bmz04 section 4.2).
+
+    Returns
+    -------
+    ReparamLimitSurface
+
+    Raises
+    ------
+    CCProofError
+        alpha not above -log 2 / log lam(k) for a valence k of an interior extraordinary vertex.
+    """
+    if not isinstance(mesh, QuadMesh):
+        from ccproof.mesh import read_obj
+
+        mesh = read_obj(mesh)
+    return ReparamLimitSurface(mesh, alpha)

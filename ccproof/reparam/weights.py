@@ -1,0 +1,119 @@
+"""The blending weights of bmz04 section 4.2-4.3 (DESIGN.md R5).
+
+``b(x) = B(6x + 1) + B(6x) + B(6x - 1)`` with ``B`` the centred uniform cubic B-spline (support
+[-2, 2]); the paper's "c = 1/6" must be 6 (R5). ``b`` is even, piecewise cubic with breakpoints
+1/6, 1/3, 1/2 (in |x|), C2, equal to ``1 - 36 x^3`` on [0, 1/6] and to 0 for |x| >= 1/2.
+With ``z = 6|x|``:
+
+=============  =====================================
+ z in [0, 1]    1 - z^3 / 6
+ z in [1, 2]    (5 - 3 d - 3 d^2 + 2 d^3) / 6,  d = z - 1
+ z in [2, 3]    (1 - d)^3 / 6,                  d = z - 2
+ z >= 3         0
+=============  =====================================
+
+Two weights on a corner quarter (local coordinates (s, t) >= 0, corner at the origin):
+:func:`weight_radial` ``w = b(|t|)`` (section 4.2, vanishing derivatives) and
+:func:`weight_tensor` ``w = b(s) b(t)`` (section 4.3, characteristic map). Both are 1 at the
+corner, C2, and vanish outside [0, 1/2)^2, so the supports of the four corners of a face are
+disjoint.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["bump", "weight_radial", "weight_tensor"]
+
+
+def bump(x, derivatives=0):
+    """The weight b(x) of bmz04 section 4.2 (R5) and its derivatives, vectorized.
+
+    Parameters
+    ----------
+    x : array_like, shape (n,)
+    derivatives : int, 0, 1 or 2
+
+    Returns
+    -------
+    tuple of ndarray, shape (n,)
+        ``(b,)``, ``(b, b')`` or ``(b, b', b'')``.
+
+    Examples
+    --------
+    >>> [float(v) for v in bump([0.0, 1 / 6, 1 / 3, 0.5, 0.7])[0]]
+    [1.0, 0.8333333333333334, 0.16666666666666666, 0.0, 0.0]
+    """
+    x = np.asarray(x, dtype=np.float64)
+    sg = np.where(x < 0, -1.0, 1.0)
+    z = 6.0 * np.abs(x)
+    p0 = z <= 1.0
+    p1 = (z > 1.0) & (z <= 2.0)
+    p2 = (z > 2.0) & (z < 3.0)
+    d1 = z - 1.0
+    d2 = np.clip(z - 2.0, 0.0, 1.0)
+    e2 = 1.0 - d2
+    b = np.where(p0, 1.0 - z**3 / 6.0,
+                 np.where(p1, (5.0 - 3.0 * d1 - 3.0 * d1**2 + 2.0 * d1**3) / 6.0,
+                          np.where(p2, e2**3 / 6.0, 0.0)))
+    out = [b]
+    if derivatives >= 1:
+        bz = np.where(p0, -0.5 * z**2,
+                      np.where(p1, (-3.0 - 6.0 * d1 + 6.0 * d1**2) / 6.0, np.where(p2, -0.5 * e2**2, 0.0)))
+        out.append(6.0 * sg * bz)
+    if derivatives >= 2:
+        bzz = np.where(p0, -z, np.where(p1, -1.0 + 2.0 * d1, np.where(p2, e2, 0.0)))
+        out.append(36.0 * bzz)
+    return tuple(out)
+
+
+def weight_tensor(s, t, derivatives=0):
+    """w(s, t) = b(s) b(t) (bmz04 section 4.3) and its derivatives.
+
+    Parameters
+    ----------
+    s, t : ndarray, shape (n,)
+        Corner-local coordinates (corner at the origin).
+    derivatives : int, 0, 1 or 2
+
+    Returns
+    -------
+    tuple of ndarray, shape (n,)
+        ``(w,)``; with 1 also ``w_s, w_t``; with 2 also ``w_ss, w_st, w_tt``.
+
+    >>> [float(v[0]) for v in weight_tensor(np.array([0.0]), np.array([1 / 6]))]
+    [0.8333333333333334]
+    """
+    bs = bump(s, derivatives)
+    bt = bump(t, derivatives)
+    out = [bs[0] * bt[0]]
+    if derivatives >= 1:
+        out += [bs[1] * bt[0], bs[0] * bt[1]]
+    if derivatives >= 2:
+        out += [bs[2] * bt[0], bs[1] * bt[1], bs[0] * bt[2]]
+    return tuple(out)
+
+
+def weight_radial(s, t, derivatives=0):
+    """w(s, t) = b(sqrt(s^2 + t^2)) (bmz04 section 4.2) and its derivatives.
+
+    Same conventions as :func:`weight_tensor`. At the origin the gradient and the Hessian are 0
+    (b = 1 - 36 rho^3 there, so b'(rho)/rho = -108 rho -> 0 and b''(0) = 0).
+
+    >>> [float(v[0]) for v in weight_radial(np.array([0.3]), np.array([0.4]))]
+    [0.0]
+    """
+    s = np.asarray(s, dtype=np.float64)
+    t = np.asarray(t, dtype=np.float64)
+    rho = np.hypot(s, t)
+    bb = bump(rho, derivatives)
+    out = [bb[0]]
+    if derivatives >= 1:
+        pos = rho > 0
+        safe = np.where(pos, rho, 1.0)
+        ns, nt = np.where(pos, s / safe, 0.0), np.where(pos, t / safe, 0.0)
+        out += [bb[1] * ns, bb[1] * nt]
+        if derivatives >= 2:
+            q = np.where(pos, bb[1] / safe, 0.0)  # b'(rho)/rho, -> 0 at the origin
+            out += [bb[2] * ns * ns + q * (1.0 - ns * ns), (bb[2] - q) * ns * nt, bb[2] * nt * nt + q * (1.0 - nt * nt)]
+    return tuple(out)
