@@ -134,21 +134,18 @@ def vanishing_map(s, t, alpha, derivatives=1):
     rho = np.hypot(s, t)
     pos = rho > 0
     safe = np.where(pos, rho, 1.0)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        p = np.where(pos, safe ** (alpha - 1.0), 0.0 if alpha > 1 else np.inf)
+    p = np.where(pos, safe ** (alpha - 1.0), 0.0)
     F = np.stack([p * s, p * t], axis=1)
-    F[~pos] = 0.0
     out = [F]
     if derivatives >= 1:
         n = np.stack([np.where(pos, s / safe, 0.0), np.where(pos, t / safe, 0.0)], axis=1)
         eye = np.eye(2)
         J = p[:, None, None] * (eye + (alpha - 1.0) * n[:, :, None] * n[:, None, :])
         if alpha <= 1:
-            J[~pos] = np.nan
+            J[~pos] = np.nan  # not differentiable at the origin
         out.append(J)
     if derivatives >= 2:
-        with np.errstate(divide="ignore", invalid="ignore"):
-            q = (alpha - 1.0) * np.where(pos, safe ** (alpha - 2.0), 0.0 if alpha > 2 else np.nan)
+        q = (alpha - 1.0) * np.where(pos, safe ** (alpha - 2.0), 0.0 if alpha > 2 else np.nan)
         # H[a, i, j] = (alpha - 1) rho^(alpha - 2) (d_ai n_j + d_ij n_a + d_ja n_i + (alpha - 3) n_a n_i n_j)
         H = (np.einsum("ai,nj->naij", eye, n) + np.einsum("ij,na->naij", eye, n)
              + np.einsum("ja,ni->naij", eye, n)
