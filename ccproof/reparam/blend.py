@@ -146,7 +146,9 @@ def face_map(corner_valence, u, v, parameterization, alpha=None, derivatives=1):
         ``u``, ``v``: F_b(u, v), shape (n,); ``J`` (n, 2, 2) with ``J[:, a, i] = dF_b,a / dt_i`` and
         ``H`` (n, 2, 2, 2) with ``derivatives`` >= 1, 2; ``active`` (n,) bool: points where a
         weight is positive (elsewhere F_b is the identity); ``quarter`` (n,), ``local`` (n, 2)
-        the local coordinates of F_b(u, v) in the quarter's corner frame, ``corner`` (n,) bool:
+        the local coordinates of F_b(u, v) in the quarter's corner frame (full relative precision
+        near the corner, unlike ``u``, ``v`` near a corner at 1), ``J_local``, ``H_local`` the
+        derivatives in that frame, ``corner`` (n,) bool:
         the points exactly at a non-identity corner (where J is not defined: see
         :meth:`ccproof.reparam.surface.ReparamLimitSurface.evaluate`).
 
@@ -178,8 +180,10 @@ def face_map(corner_valence, u, v, parameterization, alpha=None, derivatives=1):
            "local": np.stack([s, t], axis=1), "corner": active & (s == 0) & (t == 0)}
     if derivatives >= 1:
         out["J"] = np.broadcast_to(np.eye(2), (n, 2, 2)).copy()
+        out["J_local"] = out["J"].copy()
     if derivatives >= 2:
         out["H"] = np.zeros((n, 2, 2, 2))
+        out["H_local"] = out["H"].copy()
     idx = np.flatnonzero(active)
     if idx.size == 0:
         return out
@@ -193,6 +197,8 @@ def face_map(corner_valence, u, v, parameterization, alpha=None, derivatives=1):
         A = CORNER_FRAMES[q[sel]]
         if derivatives >= 1:
             out["J"][sel] = np.einsum("nab,nbc,nic->nai", A, res[1], A)
+            out["J_local"][sel] = res[1]
         if derivatives >= 2:
             out["H"][sel] = np.einsum("nab,nbcd,nic,njd->naij", A, res[2], A, A)
+            out["H_local"][sel] = res[2]
     return out

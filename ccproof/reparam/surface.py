@@ -23,6 +23,12 @@ the (very few) points whose preimage F_b(t) is closer to the corner than the dee
 evaluator stores (about 2^-47 .. 2^-100 of the face, where it returns the limit point): there the
 limit is the best available value of the derivative. Second derivatives are NaN at these points
 (f o F_b is C1 but in general not C2 at an extraordinary vertex).
+
+Precision near corners: F_b(t) is computed in the corner's local frame with full relative precision;
+written as a face parameter near a corner at 1 (u = 1 - s) it would lose it (s < 2^-53 even collapses
+onto the corner). Active points within 2^-8 of a corner other than (0, 0) are therefore evaluated on
+the same surface with every face's vertex list rotated so that the corner is (0, 0) (built once, on
+first use, per rotation), and their derivatives are rotated back.
 """
 
 from __future__ import annotations
@@ -41,6 +47,23 @@ _KEYS = {0: ("P",), 1: ("P", "Pu", "Pv"), 2: ("P", "Pu", "Pv", "Puu", "Puv", "Pv
 #: points whose preimage is this close to the corner (local max-norm) are checked against the
 #: evaluator's deepest stored layer (every corner stores more than 40 layers)
 _DEEP = 2.0**-30
+#: active points of a quarter whose corner is not at (0, 0) and whose preimage is this close to it
+#: are evaluated in the corner's own frame (relative precision of the local coordinates kept)
+_NEAR = 2.0**-8
+
+
+def _chain_rule(R, idx, J, H, derivatives):
+    """In place: derivatives of f o F at rows idx of R from those of f, J = DF, H = D^2 F."""
+    Pu, Pv = R["Pu"][idx], R["Pv"][idx]
+    if derivatives >= 2:
+        Puu, Puv, Pvv = R["Puu"][idx], R["Puv"][idx], R["Pvv"][idx]
+        for key, i, j in (("Puu", 0, 0), ("Puv", 0, 1), ("Pvv", 1, 1)):
+            R[key][idx] = (Puu * (J[:, 0, i] * J[:, 0, j])[:, None]
+                           + Puv * (J[:, 0, i] * J[:, 1, j] + J[:, 1, i] * J[:, 0, j])[:, None]
+                           + Pvv * (J[:, 1, i] * J[:, 1, j])[:, None]
+                           + Pu * H[:, 0, i, j, None] + Pv * H[:, 1, i, j, None])
+    R["Pu"][idx] = Pu * J[:, 0, 0, None] + Pv * J[:, 1, 0, None]
+    R["Pv"][idx] = Pu * J[:, 0, 1, None] + Pv * J[:, 1, 1, None]
 
 
 class ReparamLimitSurface(LimitSurface):
@@ -67,6 +90,7 @@ class ReparamLimitSurface(LimitSurface):
                 a = alpha
             self.alpha[k] = check_alpha(a, k)
         self._tangent_cache = {}
+        self._rotated_cache = {}
 
     def evaluate(self, face_ids, u, v, derivatives=1, *, parameterization="natural", chunk=CHUNK, out=None,
                  backend=None):
@@ -112,26 +136,46 @@ class ReparamLimitSurface(LimitSurface):
         f, u, v = self._check(face_ids, u, v)
         res = face_map(self.corner_valence[f], u, v, parameterization, self.alpha, derivatives)
         R = super().evaluate(f, res["u"], res["v"], derivatives, chunk=chunk, backend=backend)
-        idx = np.flatnonzero(res["active"])
-        if idx.size and derivatives >= 1:
-            J = res["J"][idx]
-            Pu, Pv = R["Pu"][idx], R["Pv"][idx]
-            if derivatives >= 2:
-                H = res["H"][idx]
-                Puu, Puv, Pvv = R["Puu"][idx], R["Puv"][idx], R["Pvv"][idx]
-                for key, i, j in (("Puu", 0, 0), ("Puv", 0, 1), ("Pvv", 1, 1)):
-                    R[key][idx] = (Puu * (J[:, 0, i] * J[:, 0, j])[:, None]
-                                   + Puv * (J[:, 0, i] * J[:, 1, j] + J[:, 1, i] * J[:, 0, j])[:, None]
-                                   + Pvv * (J[:, 1, i] * J[:, 1, j])[:, None]
-                                   + Pu * H[:, 0, i, j, None] + Pv * H[:, 1, i, j, None])
-            R["Pu"][idx] = Pu * J[:, 0, 0, None] + Pv * J[:, 1, 0, None]
-            R["Pv"][idx] = Pu * J[:, 0, 1, None] + Pv * J[:, 1, 1, None]
+        if derivatives >= 1:
+            idx = np.flatnonzero(res["active"])
+            if idx.size:
+                _chain_rule(R, idx, res["J"][idx], res["H"][idx] if derivatives >= 2 else None, derivatives)
+            loc = res["local"]
+            m = np.maximum(loc[:, 0], loc[:, 1])
+            q = res["quarter"]
+            # near a corner at 1, u = 1 - s loses the relative precision of s: evaluate those points
+            # in the corner's own frame (the mesh with its faces' vertex lists rotated)
+            for qq in (1, 2, 3):
+                sel = np.flatnonzero(res["active"] & (q == qq) & (m < _NEAR))
+                if sel.size:
+                    self._eval_in_corner_frame(qq, f[sel], sel, res, R, derivatives, backend)
             self._fix_corner_limits(f, res, R, parameterization, derivatives)
         if out is not None:
             for key in _KEYS[derivatives]:
                 out[key][...] = R[key]
             return out
         return R
+
+    def _rotated(self, q):
+        """The same surface with every face's vertex list rotated by q (corner q becomes corner 0)."""
+        if q not in self._rotated_cache:
+            F = np.roll(self.mesh.faces, -q, axis=1)
+            self._rotated_cache[q] = LimitSurface(QuadMesh(self.mesh.vertices, F))
+        return self._rotated_cache[q]
+
+    def _eval_in_corner_frame(self, q, f, sel, res, R, d, backend):
+        S = self._rotated(q)
+        G = res["local"][sel]
+        Rl = LimitSurface.evaluate(S, f, G[:, 0], G[:, 1], d, backend=backend)
+        _chain_rule(Rl, np.arange(sel.size), res["J_local"][sel], res["H_local"][sel] if d >= 2 else None, d)
+        A = CORNER_FRAMES[q]  # d/du_i = sum_b A[i, b] d/ds_b
+        R["P"][sel] = Rl["P"]
+        R["Pu"][sel] = A[0, 0] * Rl["Pu"] + A[0, 1] * Rl["Pv"]
+        R["Pv"][sel] = A[1, 0] * Rl["Pu"] + A[1, 1] * Rl["Pv"]
+        if d >= 2:
+            L = {(0, 0): Rl["Puu"], (0, 1): Rl["Puv"], (1, 0): Rl["Puv"], (1, 1): Rl["Pvv"]}
+            for key, i, j in (("Puu", 0, 0), ("Puv", 0, 1), ("Pvv", 1, 1)):
+                R[key][sel] = sum(A[i, b] * A[j, c] * L[(b, c)] for b in range(2) for c in range(2))
 
     def _fix_corner_limits(self, f, res, R, parameterization, derivatives):
         """Limit derivatives at the corner and beyond the evaluator's deepest layer (module doc)."""
@@ -140,8 +184,15 @@ class ReparamLimitSurface(LimitSurface):
         cand = np.flatnonzero(res["active"] & (m < _DEEP))
         if cand.size == 0:
             return
-        _, _, _, scale = self._locate(f[cand], res["u"][cand], res["v"][cand])
-        fix = cand[(m[cand] * scale < 0.5) | res["corner"][cand]]
+        q = res["quarter"][cand]
+        scale = np.empty(cand.size)
+        for qq in range(4):
+            sel = np.flatnonzero(q == qq)
+            if sel.size:
+                S = self if qq == 0 else self._rotated(qq)
+                scale[sel] = S._locate(f[cand[sel]], loc[cand[sel], 0], loc[cand[sel], 1])[3]
+        # a point inside a stored layer of side h has max(local) >= h, i.e. m * scale >= 1
+        fix = cand[(m[cand] * scale < 1.0) | res["corner"][cand]]
         if fix.size == 0:
             return
         if parameterization == "vanishing":
@@ -152,7 +203,6 @@ class ReparamLimitSurface(LimitSurface):
             for i, (ff, qq) in enumerate(zip(f[fix].tolist(), q.tolist())):
                 D = self.corner_derivatives(ff, qq)  # (2, 3): d/ds, d/dt in the corner frame
                 A = CORNER_FRAMES[qq]
-                # d/du_i = sum_beta d/dt_beta * dt_beta/du_i, dt_loc/du = A^T
                 R["Pu"][fix[i]] = A[0, 0] * D[0] + A[0, 1] * D[1]
                 R["Pv"][fix[i]] = A[1, 0] * D[0] + A[1, 1] * D[1]
         if derivatives >= 2:
