@@ -21,7 +21,8 @@ from ccproof.errors import CCProofError
 from ccproof.reparam.quadrant import characteristic_inverse, default_alpha, vanishing_map
 from ccproof.reparam.weights import weight_radial, weight_tensor
 
-__all__ = ["PARAMETERIZATIONS", "CORNER_FRAMES", "to_local", "from_local", "face_map"]
+__all__ = ["PARAMETERIZATIONS", "CORNER_FRAMES", "to_local", "from_local", "quarter_map", "active_points",
+           "blend_points", "face_map"]
 
 #: names accepted by ``parameterization=``
 PARAMETERIZATIONS = ("natural", "vanishing", "characteristic")
@@ -125,6 +126,81 @@ def quarter_map(k, s, t, parameterization, alpha=None, derivatives=1):
     return tuple(out)
 
 
+def active_points(corner_valence, f, u, v, parameterization):
+    """The points of a batch where a blending weight is positive, and their corner data.
+
+    Parameters
+    ----------
+    corner_valence : ndarray of int, shape (m, 4)
+        Per face: the valence of each corner, 0 (or 4) for an identity corner.
+    f : ndarray of int, shape (n,)
+        Face of each point (row of ``corner_valence``).
+    u, v : ndarray, shape (n,)
+    parameterization : {"natural", "vanishing", "characteristic"}
+
+    Returns
+    -------
+    idx : ndarray of int, shape (a,)
+        Indices of the active points.
+    q : ndarray of int, shape (a,)
+        Their quarter (corner index).
+    s, t : ndarray, shape (a,)
+        Their local coordinates in the corner frame.
+    k : ndarray of int, shape (a,)
+        The corner's valence.
+    """
+    if parameterization not in PARAMETERIZATIONS:
+        raise CCProofError(f"unknown parameterization {parameterization!r}; use one of {', '.join(PARAMETERIZATIONS)}")
+    empty = np.zeros(0, dtype=np.int64)
+    if parameterization == "natural":
+        return empty, empty, np.zeros(0), np.zeros(0), empty
+    cv = np.asarray(corner_valence, dtype=np.int64)
+    cv = np.where(cv == 4, 0, cv)[:, [0, 1, 3, 2]]  # column = (u >= 1/2) + 2 (v >= 1/2)
+    bits = (u >= 0.5).view(np.int8) + 2 * (v >= 0.5).view(np.int8)
+    kk = cv.ravel()[4 * f + bits]
+    idx = np.flatnonzero(kk)
+    q = np.array([0, 1, 3, 2], dtype=np.int64)[bits[idx]]
+    s, t = to_local(q, u[idx], v[idx])
+    ok = (s < 0.5) & (t < 0.5) if parameterization == "characteristic" else (s * s + t * t < 0.25)
+    return idx[ok], q[ok], s[ok], t[ok], kk[idx][ok]
+
+
+def blend_points(q, s, t, k, parameterization, alpha=None, derivatives=1):
+    """F_b at active points (output of :func:`active_points`), grouped by valence.
+
+    Returns
+    -------
+    dict
+        ``local`` (a, 2): F_b in the corner frame; ``u``, ``v`` (a,): F_b as a face parameter;
+        ``J_local``, ``H_local``: derivatives in the corner frame; ``J``, ``H``: in the face frame;
+        ``corner`` (a,) bool: the points at the corner itself.
+    """
+    a = q.shape[0]
+    out = {"local": np.empty((a, 2)), "corner": (s == 0) & (t == 0)}
+    if derivatives >= 1:
+        out["J_local"] = np.empty((a, 2, 2))
+    if derivatives >= 2:
+        out["H_local"] = np.empty((a, 2, 2, 2))
+    for kv in np.unique(k):
+        sel = np.flatnonzero(k == kv)
+        res = quarter_map(int(kv), s[sel], t[sel], parameterization, alpha, derivatives)
+        out["local"][sel] = res[0]
+        if derivatives >= 1:
+            out["J_local"][sel] = res[1]
+        if derivatives >= 2:
+            out["H_local"][sel] = res[2]
+    G = out["local"]
+    out["u"], out["v"] = from_local(q, np.clip(G[:, 0], 0.0, 1.0), np.clip(G[:, 1], 0.0, 1.0))
+    A = CORNER_FRAMES[q]
+    At = A.transpose(0, 2, 1)
+    if derivatives >= 1:
+        out["J"] = A @ out["J_local"] @ At  # J_face = A J A^T (t_local = A^T (t - c_i))
+    if derivatives >= 2:
+        H = np.einsum("nab,nbcd->nacd", A, out["H_local"], optimize=False)
+        out["H"] = A[:, None] @ H @ At[:, None]
+    return out
+
+
 def face_map(corner_valence, u, v, parameterization, alpha=None, derivatives=1):
     """F_b of bmz04 eq. (4) at points (u, v) of faces with the given corner valences.
 
@@ -148,8 +224,8 @@ def face_map(corner_valence, u, v, parameterization, alpha=None, derivatives=1):
         weight is positive (elsewhere F_b is the identity); ``quarter`` (n,), ``local`` (n, 2)
         the local coordinates of F_b(u, v) in the quarter's corner frame (full relative precision
         near the corner, unlike ``u``, ``v`` near a corner at 1), ``J_local``, ``H_local`` the
-        derivatives in that frame, ``corner`` (n,) bool:
-        the points exactly at a non-identity corner (where J is not defined: see
+        derivatives in that frame, ``corner`` (n,) bool: the points exactly at a non-identity
+        corner (where J is not defined: see
         :meth:`ccproof.reparam.surface.ReparamLimitSurface.evaluate`).
 
     Examples
@@ -158,47 +234,29 @@ def face_map(corner_valence, u, v, parameterization, alpha=None, derivatives=1):
     >>> r["u"].tolist(), r["v"].tolist()          # corner, side and the quarter of a regular corner: fixed
     ([0.0, 0.5, 0.2], [0.0, 0.0, 0.6])
     """
-    if parameterization not in PARAMETERIZATIONS:
-        raise CCProofError(f"unknown parameterization {parameterization!r}; use one of {', '.join(PARAMETERIZATIONS)}")
     u = np.asarray(u, dtype=np.float64).reshape(-1)
     v = np.asarray(v, dtype=np.float64).reshape(-1)
     n = u.shape[0]
     cv = np.asarray(corner_valence, dtype=np.int64)
     if cv.ndim == 1:
-        cv = np.broadcast_to(cv, (n, 4))
-    q = quarter(u, v)
-    s, t = to_local(q, u, v)
-    kk = np.take_along_axis(cv, q[:, None], axis=1)[:, 0]
-    kk = np.where(kk == 4, 0, kk)
-    if parameterization == "natural":
-        active = np.zeros(n, dtype=bool)
-    elif parameterization == "characteristic":
-        active = (kk > 0) & (s < 0.5) & (t < 0.5)
+        cv = cv[None, :]
+        f = np.zeros(n, dtype=np.int64)
     else:
-        active = (kk > 0) & (s * s + t * t < 0.25)
-    out = {"u": u.copy(), "v": v.copy(), "active": active, "quarter": q,
-           "local": np.stack([s, t], axis=1), "corner": active & (s == 0) & (t == 0)}
+        f = np.arange(n)
+    idx, qa, s, t, k = active_points(cv, f, u, v, parameterization)
+    q = quarter(u, v)
+    out = {"u": u.copy(), "v": v.copy(), "active": np.zeros(n, dtype=bool), "quarter": q,
+           "local": np.stack(to_local(q, u, v), axis=1), "corner": np.zeros(n, dtype=bool)}
+    out["active"][idx] = True
+    eye = np.broadcast_to(np.eye(2), (n, 2, 2))
     if derivatives >= 1:
-        out["J"] = np.broadcast_to(np.eye(2), (n, 2, 2)).copy()
-        out["J_local"] = out["J"].copy()
+        out["J"], out["J_local"] = eye.copy(), eye.copy()
     if derivatives >= 2:
-        out["H"] = np.zeros((n, 2, 2, 2))
-        out["H_local"] = out["H"].copy()
-    idx = np.flatnonzero(active)
+        out["H"], out["H_local"] = np.zeros((n, 2, 2, 2)), np.zeros((n, 2, 2, 2))
     if idx.size == 0:
         return out
-    for k in np.unique(kk[idx]):
-        sel = idx[kk[idx] == k]
-        res = quarter_map(int(k), s[sel], t[sel], parameterization, alpha, derivatives)
-        G = res[0]
-        out["local"][sel] = G
-        uu, vv = from_local(q[sel], np.clip(G[:, 0], 0.0, 1.0), np.clip(G[:, 1], 0.0, 1.0))
-        out["u"][sel], out["v"][sel] = uu, vv
-        A = CORNER_FRAMES[q[sel]]
-        if derivatives >= 1:
-            out["J"][sel] = np.einsum("nab,nbc,nic->nai", A, res[1], A)
-            out["J_local"][sel] = res[1]
-        if derivatives >= 2:
-            out["H"][sel] = np.einsum("nab,nbcd,nic,njd->naij", A, res[2], A, A)
-            out["H_local"][sel] = res[2]
+    res = blend_points(qa, s, t, k, parameterization, alpha, derivatives)
+    for key in ("u", "v", "local", "corner", "J", "H", "J_local", "H_local"):
+        if key in res:
+            out[key][idx] = res[key]
     return out

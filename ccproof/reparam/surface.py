@@ -38,7 +38,7 @@ import numpy as np
 from ccproof.errors import CCProofError
 from ccproof.evaluate.surface import CHUNK, LimitSurface
 from ccproof.mesh import QuadMesh
-from ccproof.reparam.blend import CORNER_FRAMES, PARAMETERIZATIONS, face_map
+from ccproof.reparam.blend import CORNER_FRAMES, PARAMETERIZATIONS, active_points, blend_points
 from ccproof.reparam.quadrant import check_alpha, default_alpha
 
 __all__ = ["ReparamLimitSurface", "limit_surface"]
@@ -52,18 +52,27 @@ _DEEP = 2.0**-30
 _NEAR = 2.0**-8
 
 
+def _put_rows(a, idx, x):
+    """a[idx] = x for an (n, 3) array (row scatter through a void view: ~10x faster than fancy indexing)."""
+    if a.flags.c_contiguous and x.flags.c_contiguous and a.dtype == x.dtype == np.float64:
+        row = np.dtype((np.void, 8 * a.shape[1]))
+        a.view(row).reshape(-1)[idx] = x.view(row).reshape(-1)
+    else:  # pragma: no cover - the evaluator's outputs are contiguous
+        a[idx] = x
+
+
 def _chain_rule(R, idx, J, H, derivatives):
     """In place: derivatives of f o F at rows idx of R from those of f, J = DF, H = D^2 F."""
-    Pu, Pv = R["Pu"][idx], R["Pv"][idx]
+    Pu, Pv = np.take(R["Pu"], idx, axis=0), np.take(R["Pv"], idx, axis=0)
     if derivatives >= 2:
-        Puu, Puv, Pvv = R["Puu"][idx], R["Puv"][idx], R["Pvv"][idx]
+        Puu, Puv, Pvv = (np.take(R[key], idx, axis=0) for key in ("Puu", "Puv", "Pvv"))
         for key, i, j in (("Puu", 0, 0), ("Puv", 0, 1), ("Pvv", 1, 1)):
-            R[key][idx] = (Puu * (J[:, 0, i] * J[:, 0, j])[:, None]
-                           + Puv * (J[:, 0, i] * J[:, 1, j] + J[:, 1, i] * J[:, 0, j])[:, None]
-                           + Pvv * (J[:, 1, i] * J[:, 1, j])[:, None]
-                           + Pu * H[:, 0, i, j, None] + Pv * H[:, 1, i, j, None])
-    R["Pu"][idx] = Pu * J[:, 0, 0, None] + Pv * J[:, 1, 0, None]
-    R["Pv"][idx] = Pu * J[:, 0, 1, None] + Pv * J[:, 1, 1, None]
+            _put_rows(R[key], idx, Puu * (J[:, 0, i] * J[:, 0, j])[:, None]
+                      + Puv * (J[:, 0, i] * J[:, 1, j] + J[:, 1, i] * J[:, 0, j])[:, None]
+                      + Pvv * (J[:, 1, i] * J[:, 1, j])[:, None]
+                      + Pu * H[:, 0, i, j, None] + Pv * H[:, 1, i, j, None])
+    _put_rows(R["Pu"], idx, Pu * J[:, 0, 0, None] + Pv * J[:, 1, 0, None])
+    _put_rows(R["Pv"], idx, Pu * J[:, 0, 1, None] + Pv * J[:, 1, 1, None])
 
 
 class ReparamLimitSurface(LimitSurface):
@@ -134,26 +143,23 @@ class ReparamLimitSurface(LimitSurface):
         if parameterization == "natural":
             return super().evaluate(face_ids, u, v, derivatives, chunk=chunk, out=out, backend=backend)
         f, u, v = self._check(face_ids, u, v)
-        res = face_map(self.corner_valence[f], u, v, parameterization, self.alpha, derivatives)
-        R = super().evaluate(f, res["u"], res["v"], derivatives, chunk=chunk, backend=backend)
+        idx, q, s, t, k = active_points(self.corner_valence, f, u, v, parameterization)
+        if idx.size == 0:
+            return super().evaluate(f, u, v, derivatives, chunk=chunk, out=out, backend=backend)
+        res = blend_points(q, s, t, k, parameterization, self.alpha, derivatives)
+        u2, v2 = u.copy(), v.copy()
+        u2[idx], v2[idx] = res["u"], res["v"]
+        R = super().evaluate(f, u2, v2, derivatives, chunk=chunk, out=out, backend=backend)
         if derivatives >= 1:
-            idx = np.flatnonzero(res["active"])
-            if idx.size:
-                _chain_rule(R, idx, res["J"][idx], res["H"][idx] if derivatives >= 2 else None, derivatives)
-            loc = res["local"]
-            m = np.maximum(loc[:, 0], loc[:, 1])
-            q = res["quarter"]
+            _chain_rule(R, idx, res["J"], res.get("H"), derivatives)
+            m = res["local"].max(axis=1)
             # near a corner at 1, u = 1 - s loses the relative precision of s: evaluate those points
             # in the corner's own frame (the mesh with its faces' vertex lists rotated)
             for qq in (1, 2, 3):
-                sel = np.flatnonzero(res["active"] & (q == qq) & (m < _NEAR))
+                sel = np.flatnonzero((q == qq) & (m < _NEAR))
                 if sel.size:
-                    self._eval_in_corner_frame(qq, f[sel], sel, res, R, derivatives, backend)
-            self._fix_corner_limits(f, res, R, parameterization, derivatives)
-        if out is not None:
-            for key in _KEYS[derivatives]:
-                out[key][...] = R[key]
-            return out
+                    self._eval_in_corner_frame(qq, f[idx[sel]], idx[sel], sel, res, R, derivatives, backend)
+            self._fix_corner_limits(f[idx], idx, q, m, res, R, parameterization, derivatives)
         return R
 
     def _rotated(self, q):
@@ -163,51 +169,52 @@ class ReparamLimitSurface(LimitSurface):
             self._rotated_cache[q] = LimitSurface(QuadMesh(self.mesh.vertices, F))
         return self._rotated_cache[q]
 
-    def _eval_in_corner_frame(self, q, f, sel, res, R, d, backend):
+    def _eval_in_corner_frame(self, q, f, rows, sel, res, R, d, backend):
+        """Rows ``rows`` of R (active points ``sel`` of ``res``) evaluated in the frame of corner q."""
         S = self._rotated(q)
         G = res["local"][sel]
         Rl = LimitSurface.evaluate(S, f, G[:, 0], G[:, 1], d, backend=backend)
         _chain_rule(Rl, np.arange(sel.size), res["J_local"][sel], res["H_local"][sel] if d >= 2 else None, d)
         A = CORNER_FRAMES[q]  # d/du_i = sum_b A[i, b] d/ds_b
-        R["P"][sel] = Rl["P"]
-        R["Pu"][sel] = A[0, 0] * Rl["Pu"] + A[0, 1] * Rl["Pv"]
-        R["Pv"][sel] = A[1, 0] * Rl["Pu"] + A[1, 1] * Rl["Pv"]
+        R["P"][rows] = Rl["P"]
+        R["Pu"][rows] = A[0, 0] * Rl["Pu"] + A[0, 1] * Rl["Pv"]
+        R["Pv"][rows] = A[1, 0] * Rl["Pu"] + A[1, 1] * Rl["Pv"]
         if d >= 2:
             L = {(0, 0): Rl["Puu"], (0, 1): Rl["Puv"], (1, 0): Rl["Puv"], (1, 1): Rl["Pvv"]}
             for key, i, j in (("Puu", 0, 0), ("Puv", 0, 1), ("Pvv", 1, 1)):
-                R[key][sel] = sum(A[i, b] * A[j, c] * L[(b, c)] for b in range(2) for c in range(2))
+                R[key][rows] = sum(A[i, b] * A[j, c] * L[(b, c)] for b in range(2) for c in range(2))
 
-    def _fix_corner_limits(self, f, res, R, parameterization, derivatives):
-        """Limit derivatives at the corner and beyond the evaluator's deepest layer (module doc)."""
-        loc = res["local"]
-        m = np.maximum(loc[:, 0], loc[:, 1])
-        cand = np.flatnonzero(res["active"] & (m < _DEEP))
+    def _fix_corner_limits(self, f, idx, q, m, res, R, parameterization, derivatives):
+        """Limit derivatives at the corner and beyond the evaluator's deepest layer (module doc).
+
+        ``f``, ``q``, ``m``: face, quarter and max local coordinate of the active points ``idx``."""
+        cand = np.flatnonzero(m < _DEEP)
         if cand.size == 0:
             return
-        q = res["quarter"][cand]
+        loc = res["local"]
         scale = np.empty(cand.size)
         for qq in range(4):
-            sel = np.flatnonzero(q == qq)
+            sel = cand[q[cand] == qq]
             if sel.size:
                 S = self if qq == 0 else self._rotated(qq)
-                scale[sel] = S._locate(f[cand[sel]], loc[cand[sel], 0], loc[cand[sel], 1])[3]
+                scale[q[cand] == qq] = S._locate(f[sel], loc[sel, 0], loc[sel, 1])[3]
         # a point inside a stored layer of side h has max(local) >= h, i.e. m * scale >= 1
         fix = cand[(m[cand] * scale < 1.0) | res["corner"][cand]]
         if fix.size == 0:
             return
+        rows = idx[fix]
         if parameterization == "vanishing":
-            R["Pu"][fix] = 0.0
-            R["Pv"][fix] = 0.0
+            R["Pu"][rows] = 0.0
+            R["Pv"][rows] = 0.0
         else:
-            q = res["quarter"][fix]
-            for i, (ff, qq) in enumerate(zip(f[fix].tolist(), q.tolist())):
+            for row, ff, qq in zip(rows.tolist(), f[fix].tolist(), q[fix].tolist()):
                 D = self.corner_derivatives(ff, qq)  # (2, 3): d/ds, d/dt in the corner frame
                 A = CORNER_FRAMES[qq]
-                R["Pu"][fix[i]] = A[0, 0] * D[0] + A[0, 1] * D[1]
-                R["Pv"][fix[i]] = A[1, 0] * D[0] + A[1, 1] * D[1]
+                R["Pu"][row] = A[0, 0] * D[0] + A[0, 1] * D[1]
+                R["Pv"][row] = A[1, 0] * D[0] + A[1, 1] * D[1]
         if derivatives >= 2:
             for key in ("Puu", "Puv", "Pvv"):
-                R[key][fix] = np.nan
+                R[key][rows] = np.nan
 
     def corner_derivatives(self, face, corner):
         """D(f o Phi^-1)(0) at corner ``corner`` of ``face``: rows d/ds, d/dt in the corner frame, (2, 3).
