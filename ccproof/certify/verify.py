@@ -37,9 +37,18 @@ from ccproof.rigorous import (
     Poly,
     bernstein_coefficients,
     bernstein_jacobian_determinant,
+    exact_fmpq,
     jacobian_determinant,
+    range_enclosure,
 )
-from ccproof.tables.format import PATCHES, TableFormatError, read_table_json, table_nets_arb, table_path
+from ccproof.tables.format import (
+    PATCHES,
+    TableFormatError,
+    read_table_json,
+    table_nets_arb,
+    table_nets_exact,
+    table_path,
+)
 
 SCHEMA = "ccproof.injectivity/1"
 C1_SCHEMA = "ccproof.c1/1"
@@ -162,29 +171,27 @@ def cell_det_poly(nets, lam, N, l, m, p, q, prec):
         return jacobian_determinant([G1, G2])
 
 
-def corner_det_poly(nets, lam, N, name, prec):
-    """det(J_G)/h^2 on layer i >= N of piece ``name`` as a Poly in (rho, kappa, s, t) (R9 form)."""
+def corner_det_form(nets, lam, N, name, prec):
+    """Bernstein form on [0,1]^4 of det(J_G)/h^2 on layer i >= N of piece ``name`` in (rho, kappa, s, t)
+    (R9 form), computed in Bernstein arithmetic (stays tight for the interval nets of k >= k0)."""
     with ctx.workprec(prec):
-        emb = [Poly.variable(2, 4, prec), Poly.variable(3, 4, prec)]
-        Px = net_form(nets[name], 0, prec).to_poly().compose(emb)
-        Py = net_form(nets[name], 1, prec).to_poly().compose(emb)
-        r = Poly.variable(0, 4, prec) * lam ** (3 * N)
-        qv = Poly.variable(1, 4, prec) * (2 * lam**4) ** N
-        s, t = emb
+        def var(axis, c):  # c * x_axis
+            return BernsteinForm(tuple(2 if i == axis else 1 for i in range(4)), [0, c], prec=prec)
+
+        P = [BernsteinForm((1, 1, 4, 4), net_form(nets[name], d, prec).coeffs, prec=prec) for d in range(2)]
+        r, qv, s, t = var(0, lam ** (3 * N)), var(1, (2 * lam**4) ** N), var(2, 1), var(3, 1)
         half = fmpq(1, 2)
         D = {"P1": (half + s * half, t * half), "P2": (half + s * half, half + t * half),
              "P3": (s * half, half + t * half)}[name]
-        Px3, Py3 = Px**3, Py**3
+        Px3, Py3 = P[0] * P[0] * P[0], P[1] * P[1] * P[1]
         U = (Px3 + Py3) * 36 - r * Px3 * Py3 * 1296
         W = 1 - r * U
-        P = (Px, Py)
         gradU = (U.diff(2), U.diff(3))
         J = [[None, None], [None, None]]
         for a in range(2):
             for b in range(2):
-                e = W * half if a == b else Poly.constant(0, 4, prec)
-                e = e - r * D[a] * gradU[b] + qv * (U * P[a].diff(2 + b) + P[a] * gradU[b])
-                J[a][b] = e
+                e = qv * (U * P[a].diff(2 + b) + P[a] * gradU[b]) - r * D[a] * gradU[b]
+                J[a][b] = e + W * half if a == b else e
         return J[0][0] * J[1][1] - J[0][1] * J[1][0]
 
 
@@ -296,23 +303,17 @@ def verify_certificate(cert, tables_dir=None, log=print):
     if not isinstance(cert, dict) or cert.get("schema") != SCHEMA:
         raise CertificateError(f"unknown certificate schema {cert.get('schema') if isinstance(cert, dict) else None!r}"
                                f" (expected {SCHEMA!r})")
-    k = _field(cert, "valence", (int, dict), "certificate")
-    if isinstance(k, dict):  # the interval of valences k >= k0: {"min": k0}
-        if set(k) != {"min"} or not isinstance(k["min"], int) or isinstance(k["min"], bool):
-            raise CertificateError(f"valence interval must be {{'min': K0}}, got {k!r}")
-        if k["min"] < 3:
-            raise CertificateError(f"valence {k['min']} < 3")
-    elif k < 3:
-        raise CertificateError(f"valence {k} < 3")
+    k = _valence(cert)
     kname = f">={k['min']}" if isinstance(k, dict) else str(k)
     N = _field(cert, "N", int, "certificate")
     prec = _field(cert, "prec", int, "certificate")
     if not 64 <= prec <= 1024 or not 1 <= N <= 12:
         raise CertificateError("prec must lie in 64..1024 and N in 1..12")
-    tinfo = _field(cert, "table", dict, "certificate")
-    thash = _field(tinfo, "hash", str, "table")
+    thash = _field(_field(cert, "table", dict, "certificate"), "hash", str, "table")
+    if isinstance(k, dict):
+        return _verify_interval(cert, k, N, prec, thash, tables_dir, log, part, results)
     parts = _field(cert, "parts", dict, "certificate")
-    _check_structure(parts)
+    _check_structure(parts, 2)
     log(f"certificate for valence {kname} (N = {N}, {prec} bits)")
     table = _load_table(k, kname, thash, tables_dir, part)
     if table is None:
@@ -320,60 +321,205 @@ def verify_certificate(cert, tables_dir=None, log=print):
     with ctx.workprec(prec):
         lam = arb_from_table(table, prec)
         nets = table_nets_arb(table, "bezier", prec)
-        # A. corner containment
-        hull = max((c[d].upper() for n in PATCHES for row in nets[n] for c in row for d in range(2)),
-                   key=lambda z: z.mid())
-        okA = bool(lam**N * hull < fmpq(1, 6))
-        part("A corner cell maps into [0,1/6)^2", okA, "" if okA else f"lam^N * max = {(lam**N * hull).str(6)}")
-        # B. regularity of Phi on layer 0
-        regs = _field(parts, "regularity", dict, "parts")
-        okB, minB = True, None
+        cells = [(f"{l},{m},{p},{q}",
+                  lambda c=(l, m, p, q): bernstein_coefficients(cell_det_poly(nets, lam, N, *c, prec)))
+                 for l, m, p, q in required_cells(nets, lam, N, prec)]
+        _check_parts(parts, nets, lam, N, prec, cells, part, "")
+    return all(results)
+
+
+def _check_parts(parts, nets, lam, N, prec, cells, part, tag):
+    """Parts A-E (module docstring) for the arb ``nets`` and ``lam``; ``cells`` lists (key, build root)."""
+    # A. corner containment
+    hull = max((c[d].upper() for n in PATCHES for row in nets[n] for c in row for d in range(2)),
+               key=lambda z: z.mid())
+    okA = bool(lam**N * hull < fmpq(1, 6))
+    part(f"{tag}A corner cell maps into [0,1/6)^2", okA, "" if okA else f"lam^N * max = {(lam**N * hull).str(6)}")
+    _check_sections(parts, "regularity", "B det J_Phi > 0 on layer 0", lambda n: regularity_form(nets, n, prec),
+                    part, tag)
+    # C. [0,1/2]^2 inside the image of the face
+    part(f"{tag}C [0,1/2]^2 inside Phi([0,1]^2)", all(_curve_avoids(cv, 40) for cv in _outer_curves(nets)))
+    # D. the cells (l, m) != (0, 0)
+    okD, minD, nboxes = True, None, 0
+    for key, build in cells:
+        boxes = parts["cells"].get(key)
+        if boxes is None:
+            part(f"{tag}D cell {key}", False, "required (l, m, p, q) not in the certificate")
+            okD = False
+            continue
+        ok, msg, mb = check_boxes(build(), boxes, f"cell {key}")
+        nboxes += len(boxes)
+        if not ok:
+            part(f"{tag}D cell {key}", False, msg)
+            okD = False
+        elif minD is None or mb < minD:
+            minD = mb
+    if okD:
+        part(f"{tag}D det J_G > 0 on every cell != (0,0)", True,
+             f"{len(cells)} cells, {nboxes} boxes, min bound {minD}")
+    # E. the corner cell, all layers i >= N at once (R9)
+    _check_sections(parts, "corner", "E det J_G / h^2 > 0 on the corner cell (all layers >= N)",
+                    lambda n: corner_det_form(nets, lam, N, n, prec), part, tag)
+
+
+def _check_sections(parts, sec, label, build, part, tag):
+    ok_all, mins = True, []
+    for name in PATCHES:
+        ok, msg, mb = check_boxes(build(name), parts[sec][name], f"{sec} {name}")
+        ok_all &= ok
+        mins.append(mb)
+        if not ok:
+            part(f"{tag}{label[0]} {sec} {name}", False, msg)
+    if ok_all:
+        part(f"{tag}{label}", True, f"min bound {min(mins)} (w.r.t. the local variables)")
+
+
+# ------------------------------------------------------------------------ every k >= k0 at once (R10)
+ZBOX = ((fmpq(-1), fmpq(1)), (fmpq(0), fmpq(1)), (fmpq(0), fmpq(1)))  # (zeta, s, t) of part D
+_B2Z = ((1, 4, 1, 0), (0, 4, 2, 0), (0, 2, 4, 0), (0, 1, 4, 1))  # uniform cubic B-spline -> Bezier, / 6
+
+
+def _bern1(p, prec=None):
+    """Bernstein coefficients on zeta in [-1, 1] of an fmpq_poly (or a list of arb coefficients)."""
+    c = [p[i] for i in range(max(1, p.degree() + 1))] if isinstance(p, fmpq_poly) else p
+    return bernstein_coefficients(Poly.from_dense((len(c),), c, prec), box=ZBOX[:1]).coeffs
+
+
+def entry_model(form, L, layer, degree, prec):
+    """lam^layer (A(c) + B(c) lam)/D(c) for lam = L(zeta), zeta in [-1, 1], c = (16 lam^2 - 10 lam + 1)/(2 lam)
+    (R2), as arb coefficients of T(zeta) + [-r, r]: T the exact Taylor polynomial of ``degree`` at 0 and
+    r = max|Bernstein coefficients of num - den T| / min|those of den| (den of one strict sign)."""
+    cn, cd = 16 * L * L - 10 * L + 1, 2 * L
+    M = max(len(f) for f in form) - 1
+
+    def clear(P):  # P(c) (2 lam)^M as a polynomial in zeta
+        return sum((cn**e * cd ** (M - e) * int(a) for e, a in enumerate(P)), fmpq_poly([]))
+
+    num, den = (clear(form[0]) + clear(form[1]) * L) * L**layer, clear(form[2])
+    db = _bern1(den)
+    if not (all(c > 0 for c in db) or all(c < 0 for c in db)):
+        raise CertificateError("a denominator of the exact nets may vanish on the lam interval")
+    T = []
+    for j in range(degree + 1):
+        T.append((num[j] - sum((den[i] * T[j - i] for i in range(1, j + 1)), fmpq(0))) / den[0])
+    r = max(abs(c) for c in _bern1(num - den * fmpq_poly(T))) / min(abs(c) for c in db)
+    out = [arb(t) for t in T]
+    out[0] += arb(0, arb(r).upper())
+    return out
+
+
+def parameter_nets(exact, La, Lb, layer, degree, prec):
+    """Bezier nets of lam^layer Phi for every lam in [La, Lb]: net[i][j] = (x, y), each a list of arb
+    coefficients of a polynomial in zeta in [-1, 1] (lam = (La + Lb)/2 + zeta (Lb - La)/2), from the
+    table's exact B-spline forms (see :func:`entry_model`)."""
+    L = fmpq_poly([(La + Lb) / 2, (Lb - La) / 2])
+    out = {}
+    with ctx.workprec(prec):
         for name in PATCHES:
-            root = regularity_form(nets, name, prec)
-            ok, msg, mb = check_boxes(root, _field(regs, name, list, "regularity"), f"regularity {name}")
-            okB &= ok
-            if not ok:
-                part(f"B det J_Phi > 0 on {name}", False, msg)
-            minB = mb if minB is None or (mb is not None and mb < minB) else minB
-        if okB:
-            part("B det J_Phi > 0 on layer 0", True, f"min bound {minB} (w.r.t. local s,t)")
-        # C. [0,1/2]^2 inside the image of the face
-        okC = all(_curve_avoids(cv, 40) for cv in _outer_curves(nets))
-        part("C [0,1/2]^2 inside Phi([0,1]^2)", okC)
-        # D. the cells (l, m) != (0, 0)
-        cells = _field(parts, "cells", dict, "parts")
-        okD, minD, nboxes = True, None, 0
-        for l, m, p, q in required_cells(nets, lam, N, prec):
-            key = f"{l},{m},{p},{q}"
-            boxes = cells.get(key)
-            if boxes is None:
-                part(f"D cell {key}", False, "required (l, m, p, q) not in the certificate")
-                okD = False
-                continue
-            root = bernstein_coefficients(cell_det_poly(nets, lam, N, l, m, p, q, prec))
-            ok, msg, mb = check_boxes(root, boxes, f"cell {key}")
-            nboxes += len(boxes)
-            if not ok:
-                part(f"D cell {key}", False, msg)
-                okD = False
-            elif minD is None or mb < minD:
-                minD = mb
-        if okD:
-            part("D det J_G > 0 on every cell != (0,0)", True, f"{nboxes} boxes, min bound {minD}")
-        # E. the corner cell, all layers i >= N at once
-        corner = _field(parts, "corner", dict, "parts")
-        okE, minE = True, None
-        for name in PATCHES:
-            root = bernstein_coefficients(corner_det_poly(nets, lam, N, name, prec))
-            ok, msg, mb = check_boxes(root, _field(corner, name, list, "corner"), f"corner {name}")
-            if not ok:
-                part(f"E corner {name}", False, msg)
-                okE = False
-            elif minE is None or mb < minE:
-                minE = mb
-        if okE:
-            part("E det J_G / h^2 > 0 on the corner cell (all layers >= N)", True, f"min bound {minE}")
-    return all(results) and okB and okD and okE
+            bs = [[[entry_model(f, L, layer, degree, prec) for f in pt] for pt in row] for row in exact[name]]
+            out[name] = [[tuple([sum((bs[i][j][d][e] * _B2Z[a][i] * _B2Z[b][j] for i in range(4) for j in range(4)),
+                                     arb(0)) / 36 for e in range(degree + 1)] for d in range(2))
+                          for b in range(4)] for a in range(4)]
+    return out
+
+
+def hull_nets(znets, prec):
+    """arb nets enclosing the zeta-polynomial nets for every zeta in [-1, 1] (Bernstein range)."""
+    def hull(co):
+        lo, hi = range_enclosure(_bern1(co, prec))
+        return lo.union(hi)
+    return {n: [[tuple(hull(co) for co in pt) for pt in row] for row in net] for n, net in znets.items()}
+
+
+def cell_maps_z(znets, N, l, m, D, prec):
+    """(X, Y) = lam^i Phi on cell (l, m) as ball Polys in (zeta, s, t), truncated to degree D in zeta."""
+    i, name, box = cell_geometry(l, m, N)
+    v = [Poly.variable(a, 3, prec) for a in range(3)]
+    out = []
+    for d in range(2):
+        acc = Poly.constant(0, 3, prec)
+        for e in range(len(znets[i][name][0][0][d])):
+            net = [[(pt[0][e], pt[1][e]) for pt in row] for row in znets[i][name]]
+            acc = acc + net_form(net, d, prec, box).to_poly().compose(v[1:]) * v[0] ** e
+        out.append(acc.truncate(D))
+    return out
+
+
+def _weight_z(p, X, D):
+    """b(X) on piece p, Horner around the exact midpoint x0 of X's constant term (tighter balls)."""
+    x0 = exact_fmpq(X.coeffs[0].mid())
+    b = weight_piece(p).affine(0, x0, x0 + 1)
+    acc = Poly.constant(b.coeffs[-1], 3, X.prec)
+    for c in b.coeffs[-2::-1]:
+        acc = (acc * (X - x0)).truncate(D) + c
+    return acc
+
+
+def interval_cells(znets, N, D, prec):
+    """Part D for an interval: every (key, build root) with a w piece met by the Bernstein hull of the
+    cell's image over all zeta; the root is det dG/d(s,t) in (zeta, s, t) on ZBOX (Taylor model in zeta)."""
+    out = []
+    v = [Poly.variable(a, 3, prec) for a in range(3)]
+    with ctx.workprec(prec):
+        for l in range(2**N):
+            for m in range(2**N):
+                if (l, m) == (0, 0):
+                    continue
+                X, Y = cell_maps_z(znets, N, l, m, D, prec)
+                XY = [bernstein_coefficients(F, box=ZBOX) for F in (X, Y)]
+                y1, y2 = (v[1] + l) * fmpq(1, 2**N), (v[2] + m) * fmpq(1, 2**N)
+                for p, q in cell_pieces(*XY):
+                    if p < 3 and q < 3:
+                        def build(X=X, Y=Y, p=p, q=q, y1=y1, y2=y2):
+                            with ctx.workprec(prec):
+                                w = (_weight_z(p, X, D) * _weight_z(q, Y, D)).truncate(D)
+                                G = [(w * y + (1 - w) * F).truncate(D) for y, F in ((y1, X), (y2, Y))]
+                                return bernstein_coefficients(jacobian_determinant(G, (1, 2)).truncate(D), box=ZBOX)
+                        out.append((f"{l},{m},{p},{q}", build))
+    return out
+
+
+def lam_interval_ok(k0, La, Lb, prec):
+    """[La, Lb] contains lam(k) for every k >= k0: La <= lam(k0) and Lb >= (3 + sqrt 5)/8 = lim lam
+    (lam increases with c = cos(2 pi/k), which increases with k)."""
+    with ctx.workprec(prec):
+        c = arb(fmpq(2, k0)).cos_pi()
+        lam0 = (5 + c + ((1 + c) * (9 + c)).sqrt()) / 16
+        return bool(lam0 >= La) and bool((3 + arb(5).sqrt()) / 8 <= Lb)
+
+
+def _verify_interval(cert, k, N, prec, thash, tables_dir, log, part, results):
+    param = _field(cert, "parameter", dict, "certificate")
+    deg, D = _field(param, "taylor_degree", int, "parameter"), _field(param, "truncation_degree", int, "parameter")
+    if param.get("variable") != "lam" or not 1 <= D <= deg <= 8:
+        raise CertificateError("parameter must be {'variable': 'lam', 1 <= truncation_degree <= taylor_degree <= 8}")
+    pieces = _field(cert, "pieces", list, "certificate")
+    if not pieces:
+        raise CertificateError("no pieces")
+    ends = []
+    for pc in pieces:
+        lo_hi = _field(pc, "lam", list, "piece")
+        if len(lo_hi) != 2:
+            raise CertificateError("piece lam must be [low, high]")
+        ends.append(tuple(_decimal(x) for x in lo_hi))
+        _check_structure(_field(pc, "parts", dict, "piece"), 3)
+    if any(a >= b for a, b in ends) or any(ends[i][1] != ends[i + 1][0] for i in range(len(ends) - 1)):
+        raise CertificateError("the lam pieces must be increasing and contiguous")
+    log(f"certificate for valences k >= {k['min']} (N = {N}, {prec} bits, {len(pieces)} lam piece(s), "
+        f"Taylor degree {deg}, truncation {D})")
+    table = _load_table(k, f">={k['min']}", thash, tables_dir, part)
+    if table is None:
+        return False
+    exact = table_nets_exact(table)
+    ok = lam_interval_ok(k["min"], ends[0][0], ends[-1][1], prec)
+    part(f"lam(k) in [{ends[0][0]}, {ends[-1][1]}] for every k >= {k['min']}", ok)
+    for idx, ((La, Lb), pc) in enumerate(zip(ends, pieces)):
+        with ctx.workprec(prec):
+            zn = [parameter_nets(exact, La, Lb, i, deg, prec) for i in range(N)]
+            nets = hull_nets(zn[0], prec)
+            lam = arb(La).union(arb(Lb))
+            _check_parts(pc["parts"], nets, lam, N, prec, interval_cells(zn, N, D, prec), part, f"[piece {idx}] ")
+    return all(results)
 
 
 def _load_table(k, kname, thash, tables_dir, part):
@@ -393,9 +539,9 @@ def _load_table(k, kname, thash, tables_dir, part):
     return table
 
 
-def _check_structure(parts):
+def _check_structure(parts, cell_vars):
     """Validate every box list before any arithmetic, so a malformed file fails fast and by name."""
-    for section, nvars in (("regularity", 2), ("cells", 2), ("corner", 4)):
+    for section, nvars in (("regularity", 2), ("cells", cell_vars), ("corner", 4)):
         sec = _field(parts, section, dict, "parts")
         if section != "cells" and set(sec) != set(PATCHES):
             raise CertificateError(f"parts.{section} must have exactly the keys {', '.join(PATCHES)}")

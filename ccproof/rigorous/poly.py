@@ -358,6 +358,46 @@ class Poly:
         c, shape = T.apply_along_axis(self.coeffs, self.shape, axis, mat, self.prec)
         return Poly._raw(shape, c, self.prec)
 
+    def truncate(self, degree, axis=0):
+        """Ball polynomial of degree <= ``degree`` in ``x_axis`` that encloses ``self`` for
+        ``x_axis`` in [-1, 1] *pointwise in that variable* (a Taylor model with a remainder).
+
+        Every term ``c x_axis^j x'^e`` with ``j > degree`` is absorbed into the ball of the
+        coefficient of ``x_axis^0 x'^e`` (radius += ``|c|``, as ``|x_axis^j| <= 1``).  So for each
+        fixed ``a`` in [-1, 1], the polynomial ``self(x_axis = a)`` in the other variables belongs
+        to the family ``result(x_axis = a)``; this survives products, sums and derivatives in the
+        *other* variables (not in ``x_axis``), and a Bernstein lower bound of the result on a box
+        with ``x_axis`` in [-1, 1] bounds ``self`` there.
+
+        >>> z, s = Poly.variable(0, 2, 64), Poly.variable(1, 2, 64)
+        >>> r = (1 + z * s + z**2 * s**2).truncate(1)
+        >>> r.degrees, r.coefficient((0, 2)).contains(0), r.coefficient((0, 2)).rad() >= 1
+        ((1, 2), True, True)
+        """
+        axis = self._axis(axis)
+        if isinstance(degree, bool) or not isinstance(degree, int) or degree < 0:
+            raise ValueError(f"degree must be a non-negative int, got {degree!r}")
+        n = self.shape[axis]
+        if n <= degree + 1:
+            return self
+        if self.prec is None:
+            raise TypeError("truncate() makes balls: convert with .to_arb(prec) first")
+        pre, post = T.size(self.shape[:axis]), T.size(self.shape[axis + 1 :])
+        c = self.coeffs
+        out = []
+        with flint.ctx.workprec(self.prec):
+            for p in range(pre):
+                base = p * n * post
+                head = [c[base + q] for q in range(post)]
+                for j in range(degree + 1, n):
+                    for q in range(post):
+                        x = c[base + j * post + q]
+                        if x != 0:
+                            head[q] = head[q] + arb(0, abs(x).upper())
+                out += head + c[base + post : base + (degree + 1) * post]
+        shape = self.shape[:axis] + (degree + 1,) + self.shape[axis + 1 :]
+        return Poly._raw(shape, out, self.prec)
+
     def restrict(self, box):
         """``p`` reparameterized so that [0,1]^n maps affinely onto ``box`` = [(lo, hi), ...]."""
         box = check_box(box, self.nvars)
