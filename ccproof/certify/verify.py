@@ -328,17 +328,22 @@ def verify_certificate(cert, tables_dir=None, log=print):
     return all(results)
 
 
-def _check_parts(parts, nets, lam, N, prec, cells, part, tag):
-    """Parts A-E (module docstring) for the arb ``nets`` and ``lam``; ``cells`` lists (key, build root)."""
+def _check_parts(parts, nets, lam, N, prec, cells, part, tag, failed=lambda: False):
+    """Parts A-E (module docstring) for the arb ``nets`` and ``lam``; ``cells`` lists (key, build root).
+    Stops after the first part for which ``failed()`` is true (the interval check uses it)."""
     # A. corner containment
     hull = max((c[d].upper() for n in PATCHES for row in nets[n] for c in row for d in range(2)),
                key=lambda z: z.mid())
     okA = bool(lam**N * hull < fmpq(1, 6))
     part(f"{tag}A corner cell maps into [0,1/6)^2", okA, "" if okA else f"lam^N * max = {(lam**N * hull).str(6)}")
+    if failed():
+        return
     _check_sections(parts, "regularity", "B det J_Phi > 0 on layer 0", lambda n: regularity_form(nets, n, prec),
                     part, tag)
     # C. [0,1/2]^2 inside the image of the face
     part(f"{tag}C [0,1/2]^2 inside Phi([0,1]^2)", all(_curve_avoids(cv, 40) for cv in _outer_curves(nets)))
+    if failed():
+        return
     # D. the cells (l, m) != (0, 0)
     okD, minD, nboxes = True, None, 0
     for key, build in cells:
@@ -357,6 +362,8 @@ def _check_parts(parts, nets, lam, N, prec, cells, part, tag):
     if okD:
         part(f"{tag}D det J_G > 0 on every cell != (0,0)", True,
              f"{len(cells)} cells, {nboxes} boxes, min bound {minD}")
+    if failed():
+        return
     # E. the corner cell, all layers i >= N at once (R9)
     _check_sections(parts, "corner", "E det J_G / h^2 > 0 on the corner cell (all layers >= N)",
                     lambda n: corner_det_form(nets, lam, N, n, prec), part, tag)
@@ -514,11 +521,14 @@ def _verify_interval(cert, k, N, prec, thash, tables_dir, log, part, results):
     ok = lam_interval_ok(k["min"], ends[0][0], ends[-1][1], prec)
     part(f"lam(k) in [{ends[0][0]}, {ends[-1][1]}] for every k >= {k['min']}", ok)
     for idx, ((La, Lb), pc) in enumerate(zip(ends, pieces)):
+        if not all(results):  # stop at the first failure: it is named, the rest is moot
+            break
         with ctx.workprec(prec):
             zn = [parameter_nets(exact, La, Lb, i, deg, prec) for i in range(N)]
             nets = hull_nets(zn[0], prec)
             lam = arb(La).union(arb(Lb))
-            _check_parts(pc["parts"], nets, lam, N, prec, interval_cells(zn, N, D, prec), part, f"[piece {idx}] ")
+            _check_parts(pc["parts"], nets, lam, N, prec, interval_cells(zn, N, D, prec), part, f"[piece {idx}] ",
+                         failed=lambda: not all(results))
     return all(results)
 
 
