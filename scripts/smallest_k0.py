@@ -19,6 +19,7 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--k0", type=int, nargs="+", default=[30, 20, 14, 10, 8, 6, 5, 4, 3])
     ap.add_argument("--max-pieces", type=int, default=1)
+    ap.add_argument("--truncation-degree", type=int, default=2, help="zeta degree kept in part D (default 2)")
     ap.add_argument("--out", default=None, help="folder to keep the certificates found (default: discard)")
     args = ap.parse_args(argv)
 
@@ -31,7 +32,8 @@ def main(argv=None):
             write_table(f">={k0}", tmp)
             t1 = time.perf_counter()
             try:
-                cert = prove_interval(k0, tables_dir=tmp, progress=False, max_pieces=args.max_pieces)
+                cert = prove_interval(k0, tables_dir=tmp, progress=False, max_pieces=args.max_pieces,
+                                      truncation_degree=args.truncation_degree)
             except ProofFailed as exc:
                 print(f"k0 = {k0:3d}: FAILED after {time.perf_counter() - t1:.0f} s (table {t1 - t0:.0f} s): {exc}",
                       flush=True)

@@ -26,13 +26,18 @@ def collect(verify=False):
     from ccproof.tables.format import certificates_dir, read_table_json, table_path
 
     rows = []
-    for path in sorted((certificates_dir() / "injectivity").glob("k[0-9]*.json")):
+    paths = sorted((certificates_dir() / "injectivity").glob("k[0-9]*.json"))
+    paths += sorted((certificates_dir() / "injectivity").glob("k_ge_*.json"))
+    for path in paths:
         c = json.loads(path.read_text())
         k = c["valence"]
-        tab = read_table_json(table_path(k))
         s = c["summary"]
+        if isinstance(k, dict):  # every k >= k0: lam over the certificate's pieces
+            lam = f"[{float(c['pieces'][0]['lam'][0]):.6f}, {float(c['pieces'][-1]['lam'][1]):.6f}]"
+        else:
+            lam = f"{read_table_json(table_path(k))['float64']['lam']:.6f}"
         row = {
-            "k": k, "N": c["N"], "lam": tab["float64"]["lam"],
+            "k": k, "N": c["N"], "lam": lam,
             "detPhi": float(Fraction(s["min_bound_det_J_phi_local"])) * 4,  # d(s,t)/d(u,v) = 4
             "detG_cells": float(Fraction(s["min_bound_det_J_G_cells_local"])) * 4 ** c["N"],
             "detG_corner": float(Fraction(s["min_bound_det_J_G_corner_over_h2"])),
@@ -50,10 +55,14 @@ def markdown(rows):
     head = ("| k | N | lam | min det J_Phi (layer 0, w.r.t. (u,v)) | min det J_G cells (w.r.t. y) | "
             "min det J_G / h^2 corner | boxes | verify s |\n|---|---|---|---|---|---|---|---|\n")
     body = "".join(
-        f"| {r['k']} | {r['N']} | {r['lam']:.6f} | {r['detPhi']:.4g} | {r['detG_cells']:.4g} | "
+        f"| {_kname(r['k'])} | {r['N']} | {r['lam']} | {r['detPhi']:.4g} | {r['detG_cells']:.4g} | "
         f"{r['detG_corner']:.4g} | {r['boxes']} | {'' if r['verify_s'] is None else r['verify_s']} |\n"
         for r in rows)
     return head + body
+
+
+def _kname(k):
+    return f">= {k['min']}" if isinstance(k, dict) else str(k)
 
 
 def run(args):
@@ -76,11 +85,21 @@ def run(args):
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
 
-        ks = [r["k"] for r in rows]
+        single = [r for r in rows if isinstance(r["k"], int)]
+        ks = [r["k"] for r in single]
         fig, ax = plt.subplots(figsize=(7, 4))
-        ax.plot(ks, [r["detPhi"] for r in rows], "o-", label="min det J_Phi (layer 0, w.r.t. (u,v))")
-        ax.plot(ks, [r["detG_corner"] for r in rows], "s-", label="min det J_G / h^2 (corner)")
-        ax.plot(ks, [r["detG_cells"] for r in rows], "^-", label="min det J_G (cells, w.r.t. y)")
+        keys = (("detPhi", "o-", "C0", "min det J_Phi (layer 0, w.r.t. (u,v))"),
+                ("detG_corner", "s-", "C1", "min det J_G / h^2 (corner)"),
+                ("detG_cells", "^-", "C2", "min det J_G (cells, w.r.t. y)"))
+        for key, style, color, label in keys:
+            ax.plot(ks, [r[key] for r in single], style, color=color, label=label)
+        for r in rows:
+            if isinstance(r["k"], dict):  # the band k >= k0: one bound for all of them
+                k0, k1 = r["k"]["min"], r["k"]["min"] + 25
+                ax.axvspan(k0, k1, color="0.9", zorder=0)
+                for key, _, color, _ in keys:
+                    ax.hlines(r[key], k0, k1, colors=color, linestyles="--")
+                ax.text(k0 + 1, 1.1, f"all k >= {k0}\n(one certificate)", fontsize=8)
         ax.set_xlabel("valence k")
         ax.set_ylabel("certified lower bound")
         ax.set_title("Certified injectivity margins (bmz04 Appendix A, corrected)")

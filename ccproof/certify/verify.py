@@ -441,14 +441,13 @@ def hull_nets(znets, prec):
 def cell_maps_z(znets, N, l, m, D, prec):
     """(X, Y) = lam^i Phi on cell (l, m) as ball Polys in (zeta, s, t), truncated to degree D in zeta."""
     i, name, box = cell_geometry(l, m, N)
-    v = [Poly.variable(a, 3, prec) for a in range(3)]
     out = []
     for d in range(2):
-        acc = Poly.constant(0, 3, prec)
+        co = []  # zeta^e blocks of the (s, t) power forms
         for e in range(len(znets[i][name][0][0][d])):
             net = [[(pt[0][e], pt[1][e]) for pt in row] for row in znets[i][name]]
-            acc = acc + net_form(net, d, prec, box).to_poly().compose(v[1:]) * v[0] ** e
-        out.append(acc.truncate(D))
+            co += net_form(net, d, prec, box).to_poly().coeffs
+        out.append(Poly.from_dense((len(co) // 16, 4, 4), co, prec).truncate(D))
     return out
 
 
@@ -480,7 +479,7 @@ def interval_cells(znets, N, D, prec):
                         def build(X=X, Y=Y, p=p, q=q, y1=y1, y2=y2):
                             with ctx.workprec(prec):
                                 w = (_weight_z(p, X, D) * _weight_z(q, Y, D)).truncate(D)
-                                G = [(w * y + (1 - w) * F).truncate(D) for y, F in ((y1, X), (y2, Y))]
+                                G = [(F + w * (y - F)).truncate(D) for y, F in ((y1, X), (y2, Y))]
                                 return bernstein_coefficients(jacobian_determinant(G, (1, 2)).truncate(D), box=ZBOX)
                         out.append((f"{l},{m},{p},{q}", build))
     return out
