@@ -351,12 +351,16 @@ def _check_parts(parts, nets, lam, N, prec, cells, part, tag, failed=lambda: Fal
         if boxes is None:
             part(f"{tag}D cell {key}", False, "required (l, m, p, q) not in the certificate")
             okD = False
+            if failed():
+                break
             continue
         ok, msg, mb = check_boxes(build(), boxes, f"cell {key}")
         nboxes += len(boxes)
         if not ok:
             part(f"{tag}D cell {key}", False, msg)
             okD = False
+            if failed():
+                break
         elif minD is None or mb < minD:
             minD = mb
     if okD:
