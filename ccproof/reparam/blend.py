@@ -19,7 +19,7 @@ import numpy as np
 
 from ccproof.errors import CCProofError
 from ccproof.reparam.quadrant import characteristic_inverse, default_alpha, vanishing_map
-from ccproof.reparam.weights import weight_radial, weight_tensor
+from ccproof.reparam.weights import weight_complement, weight_radial, weight_tensor
 
 __all__ = ["PARAMETERIZATIONS", "CORNER_FRAMES", "to_local", "from_local", "quarter_map", "active_points",
            "blend_points", "face_map"]
@@ -103,18 +103,27 @@ def quarter_map(k, s, t, parameterization, alpha=None, derivatives=1):
         W = weight_radial(s, t, derivatives)
     else:
         raise CCProofError(f"unknown parameterization {parameterization!r}; use one of {', '.join(PARAMETERIZATIONS)}")
-    w = W[0][:, None]
-    T = np.stack([s, t], axis=1)
+    w = W[0]
+    w1 = weight_complement(s, t, parameterization == "vanishing")  # 1 - w, relatively exact near 0
     F = Fo[0]
-    d = F - T
-    out = [w * F + (1.0 - w) * T]
+    d0, d1 = F[:, 0] - s, F[:, 1] - t
+    G = np.empty_like(F)
+    G[:, 0] = w * F[:, 0] + w1 * s  # (not s + w (F - s): F << s near the corner for k >= 5)
+    G[:, 1] = w * F[:, 1] + w1 * t
+    out = [G]
     if derivatives >= 1:
         JF = Fo[1]
         eye = np.eye(2)
-        gw = np.stack(W[1:3], axis=1)  # (n, 2)
-        DG = w[:, :, None] * JF + (1.0 - w)[:, :, None] * eye + d[:, :, None] * gw[:, None, :]
+        DG = np.empty_like(JF)  # w DF + (1 - w) I + (F - t) grad(w)^T
+        DG[:, 0, 0] = w * JF[:, 0, 0] + w1 + d0 * W[1]
+        DG[:, 0, 1] = w * JF[:, 0, 1] + d0 * W[2]
+        DG[:, 1, 0] = w * JF[:, 1, 0] + d1 * W[1]
+        DG[:, 1, 1] = w * JF[:, 1, 1] + w1 + d1 * W[2]
         out.append(DG)
     if derivatives >= 2:
+        w = w[:, None]
+        d = np.stack([d0, d1], axis=1)
+        gw = np.stack(W[1:3], axis=1)  # (n, 2)
         HF = Fo[2]
         hw = np.empty((s.shape[0], 2, 2))
         hw[:, 0, 0], hw[:, 0, 1], hw[:, 1, 1] = W[3], W[4], W[5]
@@ -191,11 +200,17 @@ def blend_points(q, s, t, k, parameterization, alpha=None, derivatives=1):
             out["H_local"][sel] = res[2]
     G = out["local"]
     out["u"], out["v"] = from_local(q, np.clip(G[:, 0], 0.0, 1.0), np.clip(G[:, 1], 0.0, 1.0))
-    A = CORNER_FRAMES[q]
-    At = A.transpose(0, 2, 1)
     if derivatives >= 1:
-        out["J"] = A @ out["J_local"] @ At  # J_face = A J A^T (t_local = A^T (t - c_i))
+        # J_face = A J A^T (t_local = A^T (t - c_i)); A = +-I for even q, +-[[0, -1], [1, 0]] for odd q
+        Jl = out["J_local"]
+        odd = (q & 1).astype(bool)
+        J = Jl.copy()
+        J[odd, 0, 0], J[odd, 1, 1] = Jl[odd, 1, 1], Jl[odd, 0, 0]
+        J[odd, 0, 1], J[odd, 1, 0] = -Jl[odd, 1, 0], -Jl[odd, 0, 1]
+        out["J"] = J
     if derivatives >= 2:
+        A = CORNER_FRAMES[q]
+        At = A.transpose(0, 2, 1)
         H = np.einsum("nab,nbcd->nacd", A, out["H_local"], optimize=False)
         out["H"] = A[:, None] @ H @ At[:, None]
     return out

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["bump", "weight_radial", "weight_tensor"]
+__all__ = ["bump", "bump_complement", "weight_radial", "weight_tensor", "weight_complement"]
 
 
 def bump(x, derivatives=0):
@@ -45,26 +45,52 @@ def bump(x, derivatives=0):
     [1.0, 0.8333333333333334, 0.16666666666666666, 0.0, 0.0]
     """
     x = np.asarray(x, dtype=np.float64)
-    sg = np.where(x < 0, -1.0, 1.0)
     z = 6.0 * np.abs(x)
-    p0 = z <= 1.0
-    p1 = (z > 1.0) & (z <= 2.0)
-    p2 = (z > 2.0) & (z < 3.0)
-    d1 = z - 1.0
-    d2 = np.clip(z - 2.0, 0.0, 1.0)
-    e2 = 1.0 - d2
-    b = np.where(p0, 1.0 - z**3 / 6.0,
-                 np.where(p1, (5.0 - 3.0 * d1 - 3.0 * d1**2 + 2.0 * d1**3) / 6.0,
-                          np.where(p2, e2**3 / 6.0, 0.0)))
-    out = [b]
+    zc = np.minimum(z, 3.0)
+    i = np.where(zc >= 0, zc, 3.0).astype(np.int64)  # piece: z in [i, i + 1); 3 for z >= 3 (b = 0) and NaN
+    d = z - i
+    c = _COEF[i]  # (n, 4): coefficients of the piece in d
+    out = [((c[:, 3] * d + c[:, 2]) * d + c[:, 1]) * d + c[:, 0]]
     if derivatives >= 1:
-        bz = np.where(p0, -0.5 * z**2,
-                      np.where(p1, (-3.0 - 6.0 * d1 + 6.0 * d1**2) / 6.0, np.where(p2, -0.5 * e2**2, 0.0)))
-        out.append(6.0 * sg * bz)
+        bz = (3.0 * c[:, 3] * d + 2.0 * c[:, 2]) * d + c[:, 1]
+        out.append(np.copysign(6.0, x) * bz)
     if derivatives >= 2:
-        bzz = np.where(p0, -z, np.where(p1, -1.0 + 2.0 * d1, np.where(p2, e2, 0.0)))
-        out.append(36.0 * bzz)
+        out.append(36.0 * (6.0 * c[:, 3] * d + 2.0 * c[:, 2]))
     return tuple(out)
+
+
+def bump_complement(x):
+    """1 - b(x) with full relative precision near 0 (36 |x|^3 on [0, 1/6]), shape of x.
+
+    >>> float(bump_complement(np.array([1e-10]))[0]) / 3.6e-29      # 1 - b(x) = 36 x^3, while 1 - b(x) in
+    1.0000000000000002
+    >>> float(1.0 - bump(np.array([1e-10]))[0][0])                 # floating point is 0
+    0.0
+    """
+    x = np.asarray(x, dtype=np.float64)
+    z = 6.0 * np.abs(x)
+    return np.where(z < 1.0, z * z * z / 6.0, 1.0 - bump(x)[0])
+
+
+def weight_complement(s, t, radial):
+    """1 - w(s, t) with full relative precision near the corner (w radial or tensor product).
+
+    >>> float(weight_complement(np.array([1e-10]), np.array([0.0]), radial=False)[0]) / 3.6e-29
+    1.0000000000000002
+    """
+    if radial:
+        return bump_complement(np.hypot(s, t))
+    cs, ct = bump_complement(s), bump_complement(t)
+    return cs + ct - cs * ct
+
+
+#: b on z = 6|x| in [i, i + 1): sum_j _COEF[i, j] (z - i)^j (module docstring)
+_COEF = np.array([
+    [1.0, 0.0, 0.0, -1.0 / 6.0],
+    [5.0 / 6.0, -0.5, -0.5, 1.0 / 3.0],
+    [1.0 / 6.0, -0.5, 0.5, -1.0 / 6.0],
+    [0.0, 0.0, 0.0, 0.0],
+])
 
 
 def weight_tensor(s, t, derivatives=0):

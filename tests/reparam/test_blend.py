@@ -126,3 +126,37 @@ def test_phi_keeps_the_sides_exact(k):
 def test_bad_parameterization():
     with pytest.raises(CCProofError, match="unknown parameterization"):
         face_map([5, 4, 4, 4], np.zeros(1), np.zeros(1), "smooth")
+
+
+@pytest.mark.parametrize("param", PARAMS)
+@pytest.mark.parametrize("k", [3, 5, 20])
+def test_relative_precision_near_the_corner(param, k):
+    """G = w F + (1 - w) t near the corner, against 150-digit mpmath with the same F (F << t there for
+    k >= 5, so 1 - w must be computed without cancellation)."""
+    import mpmath
+
+    from ccproof.reparam.quadrant import characteristic_inverse, default_alpha, vanishing_map
+
+    rho = 2.0 ** -np.arange(4, 60, 3)
+    s, t = 0.8 * rho, 0.6 * rho
+    r = face_map([k, 4, 4, 4], s, t, param)
+    if param == "vanishing":
+        F = vanishing_map(s, t, default_alpha(k), 0)[0]
+    else:
+        F = characteristic_inverse(k, s, t, 0)[0]
+    with mpmath.workdps(150):  # 1 - w ~ 1e-51 at the smallest rho: no cancellation at 150 digits
+        for i in range(s.size):
+            S, Tt = mpmath.mpf(s[i]), mpmath.mpf(t[i])
+
+            def b(x):
+                z = 6 * abs(x)
+                return 1 - z**3 / 6 if z <= 1 else None
+
+            if param == "vanishing":
+                w = b(mpmath.sqrt(S * S + Tt * Tt))
+            else:
+                w = b(S) * b(Tt)
+            want = [w * mpmath.mpf(F[i, 0]) + (1 - w) * S, w * mpmath.mpf(F[i, 1]) + (1 - w) * Tt]
+            got = [r["u"][i], r["v"][i]]
+            for g, x in zip(got, want):
+                assert abs(mpmath.mpf(g) - x) <= 4e-16 * abs(x), (i, g, x)
