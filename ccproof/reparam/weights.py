@@ -49,13 +49,13 @@ def bump(x, derivatives=0):
     zc = np.minimum(z, 3.0)
     i = np.where(zc >= 0, zc, 3.0).astype(np.int64)  # piece: z in [i, i + 1); 3 for z >= 3 (b = 0) and NaN
     d = z - i
-    c = _COEF[i]  # (n, 4): coefficients of the piece in d
-    out = [((c[:, 3] * d + c[:, 2]) * d + c[:, 1]) * d + c[:, 0]]
+    c0, c1, c2, c3 = (np.take(col, i) for col in _COEF_T)  # coefficients of the piece in d
+    out = [((c3 * d + c2) * d + c1) * d + c0]
     if derivatives >= 1:
-        bz = (3.0 * c[:, 3] * d + 2.0 * c[:, 2]) * d + c[:, 1]
+        bz = (3.0 * c3 * d + 2.0 * c2) * d + c1
         out.append(np.copysign(6.0, x) * bz)
     if derivatives >= 2:
-        out.append(36.0 * (6.0 * c[:, 3] * d + 2.0 * c[:, 2]))
+        out.append(36.0 * (6.0 * c3 * d + 2.0 * c2))
     return tuple(out)
 
 
@@ -69,7 +69,10 @@ def bump_complement(x):
     """
     x = np.asarray(x, dtype=np.float64)
     z = 6.0 * np.abs(x)
-    return np.where(z < 1.0, z * z * z / 6.0, 1.0 - bump(x)[0])
+    out = 1.0 - bump(x)[0]
+    near = z < 1.0
+    out[near] = z[near] ** 3 / 6.0
+    return out
 
 
 def weight_complement(s, t, radial):
@@ -91,6 +94,7 @@ _COEF = np.array([
     [1.0 / 6.0, -0.5, 0.5, -1.0 / 6.0],
     [0.0, 0.0, 0.0, 0.0],
 ])
+_COEF_T = np.ascontiguousarray(_COEF.T)
 
 
 def weight_tensor(s, t, derivatives=0):
