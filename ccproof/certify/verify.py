@@ -21,6 +21,11 @@ for a valence k with table T (identified by its content hash) and N = N(k) it ch
 Every Bernstein coefficient is recomputed in arb from the table's nets; each box of a part is
 given by a split path, the boxes of a part must partition its domain exactly, and each claimed
 bound must be positive and below every coefficient of its box.
+
+For every valence k >= k0 at once (``"valence": {"min": k0}``) lam is a variable: the certificate's
+pieces must cover [lam(k0), (3 + sqrt 5)/8]; on each piece the nets are Taylor models in zeta
+(lam = mid + zeta * half-width) built exactly from the table's exact forms with a Bernstein bound on
+the remainder; A, B, C, E use their hulls, D keeps zeta as a Bernstein variable (axis 0).
 """
 
 from __future__ import annotations
