@@ -152,13 +152,14 @@ class ReparamLimitSurface(LimitSurface):
         R = super().evaluate(f, u2, v2, derivatives, chunk=chunk, out=out, backend=backend)
         if derivatives >= 1:
             _chain_rule(R, idx, res["J"], res.get("H"), derivatives)
-            m = res["local"].max(axis=1)
-            # near a corner at 1, u = 1 - s loses the relative precision of s: evaluate those points
-            # in the corner's own frame (the mesh with its faces' vertex lists rotated)
-            for qq in (1, 2, 3):
-                sel = np.flatnonzero((q == qq) & (m < _NEAR))
-                if sel.size:
-                    self._eval_in_corner_frame(qq, f[idx[sel]], idx[sel], sel, res, R, derivatives, backend)
+        m = res["local"].max(axis=1)
+        # near a corner at 1, u = 1 - s loses the relative precision of s: evaluate those points
+        # in the corner's own frame (the mesh with its faces' vertex lists rotated)
+        for qq in (1, 2, 3):
+            sel = np.flatnonzero((q == qq) & (m < _NEAR))
+            if sel.size:
+                self._eval_in_corner_frame(qq, f[idx[sel]], idx[sel], sel, res, R, derivatives, backend)
+        if derivatives >= 1:
             self._fix_corner_limits(f[idx], idx, q, m, res, R, parameterization, derivatives)
         return R
 
@@ -174,9 +175,11 @@ class ReparamLimitSurface(LimitSurface):
         S = self._rotated(q)
         G = res["local"][sel]
         Rl = LimitSurface.evaluate(S, f, G[:, 0], G[:, 1], d, backend=backend)
+        R["P"][rows] = Rl["P"]
+        if d == 0:
+            return
         _chain_rule(Rl, np.arange(sel.size), res["J_local"][sel], res["H_local"][sel] if d >= 2 else None, d)
         A = CORNER_FRAMES[q]  # d/du_i = sum_b A[i, b] d/ds_b
-        R["P"][rows] = Rl["P"]
         R["Pu"][rows] = A[0, 0] * Rl["Pu"] + A[0, 1] * Rl["Pv"]
         R["Pv"][rows] = A[1, 0] * Rl["Pu"] + A[1, 1] * Rl["Pv"]
         if d >= 2:

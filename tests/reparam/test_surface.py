@@ -257,3 +257,15 @@ def test_cli(tmp_path):
         assert np.array_equal(z[key], ref[key])
     assert main(["eval", str(obj), "--samples", "10", "--parameterization", "vanishing", "--alpha", "0.5",
                  "--out", str(out)]) == 2
+
+
+def test_positions_do_not_depend_on_the_derivative_order():
+    S = limit_surface(disk(6, roll_seed=3))
+    rng = np.random.default_rng(4)
+    f = rng.integers(0, S.mesh.n_faces, 2000)
+    u = np.concatenate([rng.random(1000), 1 - 2.0 ** -rng.uniform(5, 40, 1000)])
+    v = np.concatenate([rng.random(1000), 1 - 2.0 ** -rng.uniform(5, 40, 1000)])
+    for param in ("vanishing", "characteristic"):
+        p0 = S.evaluate(f, u, v, 0, parameterization=param)["P"]
+        for d in (1, 2):
+            assert np.array_equal(S.evaluate(f, u, v, d, parameterization=param)["P"], p0)
