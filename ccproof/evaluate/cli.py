@@ -1,4 +1,7 @@
-"""Evaluate the Catmull-Clark limit surface of an all-quad OBJ mesh exactly (natural parameterization).
+"""Arguments and point reader of ``ccproof eval`` (the command itself is :mod:`ccproof.reparam.cli`,
+which adds the bmz04 parameterizations; it lives there because ``reparam`` is above ``evaluate``).
+
+Evaluate the Catmull-Clark limit surface of an all-quad OBJ mesh exactly (natural parameterization).
 
 Positions P and derivatives (Pu, Pv; Puu, Puv, Pvv) with respect to each face's own parameter
 (u, v): corner i of the face's OBJ vertex list at (0,0), (1,0), (1,1), (0,1) for i = 0..3 (the ptex
@@ -15,9 +18,6 @@ Example:
 """
 
 from __future__ import annotations
-
-import sys
-import time
 
 from ccproof.errors import CCProofError
 
@@ -66,45 +66,3 @@ def read_points(path):
             us.append(u)
             vs.append(v)
     return np.array(faces, dtype=np.int64), np.array(us), np.array(vs)
-
-
-def run(args) -> int:
-    import numpy as np
-
-    from ccproof.evaluate import limit_surface
-    from ccproof.mesh import read_obj
-
-    t0 = time.perf_counter()
-    mesh = read_obj(args.mesh)
-    surface = limit_surface(mesh)
-    t1 = time.perf_counter()
-    if args.points is not None:
-        f, u, v = read_points(args.points)
-    else:
-        if args.samples < 0:
-            raise CCProofError(f"--samples must be >= 0, got {args.samples}")
-        rng = np.random.default_rng(args.seed)
-        f = rng.integers(0, mesh.n_faces, args.samples)
-        u, v = rng.random(args.samples), rng.random(args.samples)
-    t2 = time.perf_counter()
-    out = surface.evaluate(f, u, v, derivatives=args.derivatives)
-    t3 = time.perf_counter()
-    np.savez(args.out, face=f, u=u, v=v, **out)
-    print(
-        f"{args.mesh}: {mesh.n_vertices} vertices, {mesh.n_faces} faces, "
-        f"{mesh.extraordinary_vertices.size} extraordinary vertices; prepared in {t1 - t0:.2f} s"
-    )
-    rate = f.size / (t3 - t2) if t3 > t2 and f.size else float("nan")
-    print(f"evaluated {f.size} points (derivatives {args.derivatives}) in {t3 - t2:.3f} s ({rate:,.0f} points/s)")
-    print(f"wrote {args.out}: {', '.join(['face', 'u', 'v', *out])}")
-    if args.plot:
-        from ccproof.evaluate.plot import plot_isoparameter_lines
-
-        vtx = args.plot_vertex
-        if vtx is None:
-            ev = mesh.extraordinary_vertices
-            vtx = int(ev[np.argmax(mesh.valence[ev])]) if ev.size else 0
-        plot_isoparameter_lines(surface, vtx, args.plot)
-        print(f"wrote {args.plot}: isoparameter lines around vertex {vtx} (valence {int(mesh.valence[vtx])})")
-    sys.stdout.flush()
-    return 0
