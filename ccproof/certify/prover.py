@@ -127,17 +127,8 @@ def prove_valence(k, prec=DEFAULT_PREC, tables_dir=None, progress=True):
         corner = {n: prove_positive(corner_det_form(nets, lam, N, n, prec), (2, 3, 0, 1),
                                     f"corner {n}") for n in PATCHES}
     stats["cells_with_weight"] = len(todo)
-    stats["boxes"] = (sum(len(v) for v in regularity.values()) + sum(len(v) for v in cells.values())
-                      + sum(len(v) for v in corner.values()))
-
-    def minb(groups):
-        return min((fmpq_of(b["bound"]) for g in groups for b in g), default=None)
-
-    summary = {
-        "min_bound_det_J_phi_local": str(minb(regularity.values())),
-        "min_bound_det_J_G_cells_local": str(minb(cells.values())),
-        "min_bound_det_J_G_corner_over_h2": str(minb(corner.values())),
-    }
+    parts = {"regularity": regularity, "cells": cells, "corner": corner}
+    summary, stats["boxes"] = _summary([parts])
     return {
         "schema": SCHEMA,
         "valence": k,
@@ -153,7 +144,7 @@ def prove_valence(k, prec=DEFAULT_PREC, tables_dir=None, progress=True):
         "readings": {"weight": "R5 (c = 6)", "N": "R8 (smallest N with Phi([0,2^-N]^2) in [0,1/6)^2)",
                      "corner": "R9 with rho = lam^(3(i-N)), kappa = (2 lam^4)^(i-N)",
                      "jacobians": "cells and regularity w.r.t. the local (s,t) of each box's root"},
-        "parts": {"regularity": regularity, "cells": cells, "corner": corner},
+        "parts": parts,
         "summary": summary,
         "stats": stats,
     }
@@ -232,11 +223,7 @@ def prove_interval(k0, prec=DEFAULT_PREC, tables_dir=None, progress=True, taylor
             todo[:0] = [(a, mid), (mid, b)]
             continue
         pieces.append({"lam": [a, b], "parts": parts})
-    boxes = sum(len(v) for pc in pieces for sec in pc["parts"].values() for v in sec.values())
-
-    def minb(sec):
-        return str(min(fmpq_of(b["bound"]) for pc in pieces for v in pc["parts"][sec].values() for b in v))
-
+    summary, boxes = _summary([pc["parts"] for pc in pieces])
     return {
         "schema": SCHEMA,
         "valence": k,
@@ -252,11 +239,19 @@ def prove_interval(k0, prec=DEFAULT_PREC, tables_dir=None, progress=True, taylor
             "/(2 lam). Part D uses Taylor models in zeta (lam = mid + zeta * half-width), axis 0 of its boxes."
         ),
         "readings": {"weight": "R5 (c = 6)", "N": "R8", "corner": "R9", "interval": "R10 with lam as the variable"},
-        "summary": {"min_bound_det_J_phi_local": minb("regularity"), "min_bound_det_J_G_cells_local": minb("cells"),
-                    "min_bound_det_J_G_corner_over_h2": minb("corner")},
+        "summary": summary,
         "stats": {"pieces": len(pieces), "boxes": boxes,
                   "cells_with_weight": sum(len(pc["parts"]["cells"]) for pc in pieces)},
     }
+
+
+def _summary(parts_list):
+    """(smallest claimed bound per section as strings, number of boxes) over a list of ``parts``."""
+    names = {"regularity": "min_bound_det_J_phi_local", "cells": "min_bound_det_J_G_cells_local",
+             "corner": "min_bound_det_J_G_corner_over_h2"}
+    summary = {name: str(min((fmpq_of(b["bound"]) for parts in parts_list for boxes in parts[sec].values()
+                              for b in boxes), default=None)) for sec, name in names.items()}
+    return summary, sum(len(v) for parts in parts_list for sec in parts.values() for v in sec.values())
 
 
 def _kname(k):
