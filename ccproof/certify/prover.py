@@ -20,11 +20,10 @@ from ccproof.certify.verify import (
     PATCHES,
     SCHEMA,
     STAR_CURVES,
-    _curve_avoids,
     _decimal,
-    _outer_curves,
     arb_from_table,
     cell_det_poly,
+    corner_containment,
     corner_det_form,
     hull_nets,
     interval_cells,
@@ -32,6 +31,7 @@ from ccproof.certify.verify import (
     parameter_nets,
     regularity_form,
     required_cells,
+    square_inside_image,
     star_form,
 )
 from ccproof.errors import CCProofError, check_valence
@@ -170,11 +170,9 @@ def _prove_piece(exact, La, Lb, N, degree, trunc, prec, progress, label):
         zn = [parameter_nets(exact, La, Lb, i, degree, prec) for i in range(N)]
         nets = hull_nets(zn[0], prec)
         lam = arb(La).union(arb(Lb))
-        hull = max((c[d].upper() for n in PATCHES for row in nets[n] for c in row for d in range(2)),
-                   key=lambda z: z.mid())
-        if not lam**N * hull < fmpq(1, 6):
+        if not corner_containment(nets, lam, N)[0]:
             raise ProofFailed(f"{label}: the corner cell [0, 2^-{N}]^2 is not certainly mapped into [0,1/6)^2")
-        if not all(_curve_avoids(cv, 40) for cv in _outer_curves(nets)):
+        if not square_inside_image(nets):
             raise ProofFailed(f"{label}: [0,1/2]^2 not certainly inside Phi([0,1]^2)")
         regularity = {n: prove_positive(regularity_form(nets, n, prec), (0, 1), f"{label} det J_Phi on {n}")
                       for n in PATCHES}

@@ -336,17 +336,13 @@ def verify_certificate(cert, tables_dir=None, log=print):
 def _check_parts(parts, nets, lam, N, prec, cells, part, tag, failed=lambda: False):
     """Parts A-E (module docstring) for the arb ``nets`` and ``lam``; ``cells`` lists (key, build root).
     Stops after the first part for which ``failed()`` is true (the interval check uses it)."""
-    # A. corner containment
-    hull = max((c[d].upper() for n in PATCHES for row in nets[n] for c in row for d in range(2)),
-               key=lambda z: z.mid())
-    okA = bool(lam**N * hull < fmpq(1, 6))
-    part(f"{tag}A corner cell maps into [0,1/6)^2", okA, "" if okA else f"lam^N * max = {(lam**N * hull).str(6)}")
+    okA, value = corner_containment(nets, lam, N)
+    part(f"{tag}A corner cell maps into [0,1/6)^2", okA, "" if okA else f"lam^N * max = {value.str(6)}")
     if failed():
         return
     _check_sections(parts, "regularity", "B det J_Phi > 0 on layer 0", lambda n: regularity_form(nets, n, prec),
                     part, tag)
-    # C. [0,1/2]^2 inside the image of the face
-    part(f"{tag}C [0,1/2]^2 inside Phi([0,1]^2)", all(_curve_avoids(cv, 40) for cv in _outer_curves(nets)))
+    part(f"{tag}C [0,1/2]^2 inside Phi([0,1]^2)", square_inside_image(nets))
     if failed():
         return
     # D. the cells (l, m) != (0, 0)
@@ -376,6 +372,18 @@ def _check_parts(parts, nets, lam, N, prec, cells, part, tag, failed=lambda: Fal
     # E. the corner cell, all layers i >= N at once (R9)
     _check_sections(parts, "corner", "E det J_G / h^2 > 0 on the corner cell (all layers >= N)",
                     lambda n: corner_det_form(nets, lam, N, n, prec), part, tag)
+
+
+def corner_containment(nets, lam, N):
+    """Part A: (lam^N * max(all Bezier coordinates) < 1/6 certainly, that ball)."""
+    hull = max((c[d].upper() for n in PATCHES for row in nets[n] for c in row for d in range(2)),
+               key=lambda z: z.mid())
+    return bool(lam**N * hull < fmpq(1, 6)), lam**N * hull
+
+
+def square_inside_image(nets):
+    """Part C: the images of the outer sides u = 1, v = 1 avoid [0,1/2]^2 (replayed bisection)."""
+    return all(_curve_avoids(cv, 40) for cv in _outer_curves(nets))
 
 
 def _check_sections(parts, sec, label, build, part, tag):
