@@ -28,6 +28,7 @@ from ccproof.certify.verify import (
     hull_nets,
     interval_cells,
     lam_interval_ok,
+    mirror_symmetric,
     parameter_nets,
     regularity_form,
     required_cells,
@@ -115,7 +116,7 @@ def prove_valence(k, prec=DEFAULT_PREC, tables_dir=None, progress=True):
         regularity = {n: prove_positive(regularity_form(nets, n, prec), (0, 1), f"det J_Phi on {n}")
                       for n in PATCHES}
         cells = {}
-        todo = required_cells(nets, lam, N, prec)
+        todo = required_cells(nets, lam, N, prec, mirror_symmetric(table_nets_exact(table)))
         it = todo
         if progress:
             from tqdm import tqdm
@@ -178,7 +179,7 @@ def _prove_piece(exact, La, Lb, N, degree, trunc, prec, progress, label):
                       for n in PATCHES}
         corner = {n: prove_positive(corner_det_form(nets, lam, N, n, prec), (2, 3, 0, 1),
                                     f"{label} corner {n}") for n in PATCHES}
-        todo = interval_cells(zn, N, trunc, prec)
+        todo = interval_cells(zn, N, trunc, prec, mirror_symmetric(exact))
         it = todo
         if progress:
             from tqdm import tqdm

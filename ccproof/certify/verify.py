@@ -142,21 +142,34 @@ def cell_pieces(X, Y):
     return out
 
 
-def required_cells(nets, lam, N, prec):
-    """Every (l, m, p, q) of part D: cell (l, m) != (0, 0) and w piece (p, q), p, q < 3, met by the
-    Bezier hull of Phi(cell). Pieces with p = 3 or q = 3 have w = 0 (G = Phi, covered by part B)."""
+def mirror_symmetric(exact):
+    """True when the exact B-spline nets satisfy P3[i][j] = S P1[j][i] and P2[i][j] = S P2[j][i],
+    S(x, y) = (y, x) (identical integer forms). Then Phi(S y) = S Phi(y) on the face, and as
+    w(u, v) = b(u) b(v) is symmetric, G(S y) = S G(y), det J_G(S y) = det J_G(y): the cell (m, l) with
+    piece (q, p) follows from (l, m) with (p, q) (part D; B and E still check P3, which is cheap)."""
+    def swap(pt):
+        return (pt[1], pt[0])
+    return all(exact["P3"][i][j] == swap(exact["P1"][j][i]) and exact["P2"][i][j] == swap(exact["P2"][j][i])
+               for i in range(4) for j in range(4))
+
+
+def dyadic_cells(N, symmetric):
+    """The cells (l, m) != (0, 0) of level N that part D checks (l <= m only when ``symmetric``)."""
+    return [(l, m) for l in range(2**N) for m in range(2**N) if (l, m) != (0, 0) and not (symmetric and l > m)]
+
+
+def required_cells(nets, lam, N, prec, symmetric=False):
+    """Every (l, m, p, q) of part D: cell (l, m) of :func:`dyadic_cells` and w piece (p, q), p, q < 3, met
+    by the Bezier hull of Phi(cell). Pieces with p = 3 or q = 3 have w = 0 (G = Phi, covered by part B)."""
     out = []
     with ctx.workprec(prec):
-        for l in range(2**N):
-            for m in range(2**N):
-                if (l, m) == (0, 0):
-                    continue
-                i, name, box = cell_geometry(l, m, N)
-                li = lam**i
-                X, Y = (net_form(nets[name], d, prec, box) for d in (0, 1))
-                X = BernsteinForm(X.shape, [c * li for c in X.coeffs], prec=prec)
-                Y = BernsteinForm(Y.shape, [c * li for c in Y.coeffs], prec=prec)
-                out += [(l, m, p, q) for p, q in cell_pieces(X, Y) if p < 3 and q < 3]
+        for l, m in dyadic_cells(N, symmetric):
+            i, name, box = cell_geometry(l, m, N)
+            li = lam**i
+            X, Y = (net_form(nets[name], d, prec, box) for d in (0, 1))
+            X = BernsteinForm(X.shape, [c * li for c in X.coeffs], prec=prec)
+            Y = BernsteinForm(Y.shape, [c * li for c in Y.coeffs], prec=prec)
+            out += [(l, m, p, q) for p, q in cell_pieces(X, Y) if p < 3 and q < 3]
     return out
 
 
@@ -323,14 +336,22 @@ def verify_certificate(cert, tables_dir=None, log=print):
     table = _load_table(k, kname, thash, tables_dir, part)
     if table is None:
         return False
+    sym = _symmetry(table, log)
     with ctx.workprec(prec):
         lam = arb_from_table(table, prec)
         nets = table_nets_arb(table, "bezier", prec)
         cells = [(f"{l},{m},{p},{q}",
                   lambda c=(l, m, p, q): bernstein_coefficients(cell_det_poly(nets, lam, N, *c, prec)))
-                 for l, m, p, q in required_cells(nets, lam, N, prec)]
+                 for l, m, p, q in required_cells(nets, lam, N, prec, sym)]
         _check_parts(parts, nets, lam, N, prec, cells, part, "")
     return all(results)
+
+
+def _symmetry(table, log):
+    sym = mirror_symmetric(table_nets_exact(table))
+    log("  mirror symmetry of the exact nets: " + ("holds; the cells (l, m) with l > m follow from their mirror "
+        "images (m, l)" if sym else "does not hold; every cell is checked"))
+    return sym
 
 
 def _check_parts(parts, nets, lam, N, prec, cells, part, tag, failed=lambda: False):
@@ -478,27 +499,24 @@ def _weight_z(p, X, D):
     return acc
 
 
-def interval_cells(znets, N, D, prec):
+def interval_cells(znets, N, D, prec, symmetric=False):
     """Part D for an interval: every (key, build root) with a w piece met by the Bernstein hull of the
     cell's image over all zeta; the root is det dG/d(s,t) in (zeta, s, t) on ZBOX (Taylor model in zeta)."""
     out = []
     v = [Poly.variable(a, 3, prec) for a in range(3)]
     with ctx.workprec(prec):
-        for l in range(2**N):
-            for m in range(2**N):
-                if (l, m) == (0, 0):
-                    continue
-                X, Y = cell_maps_z(znets, N, l, m, D, prec)
-                XY = [bernstein_coefficients(F, box=ZBOX) for F in (X, Y)]
-                y1, y2 = (v[1] + l) * fmpq(1, 2**N), (v[2] + m) * fmpq(1, 2**N)
-                for p, q in cell_pieces(*XY):
-                    if p < 3 and q < 3:
-                        def build(X=X, Y=Y, p=p, q=q, y1=y1, y2=y2):
-                            with ctx.workprec(prec):
-                                w = (_weight_z(p, X, D) * _weight_z(q, Y, D)).truncate(D)
-                                G = [(F + w * (y - F)).truncate(D) for y, F in ((y1, X), (y2, Y))]
-                                return bernstein_coefficients(jacobian_determinant(G, (1, 2)).truncate(D), box=ZBOX)
-                        out.append((f"{l},{m},{p},{q}", build))
+        for l, m in dyadic_cells(N, symmetric):
+            X, Y = cell_maps_z(znets, N, l, m, D, prec)
+            XY = [bernstein_coefficients(F, box=ZBOX) for F in (X, Y)]
+            y1, y2 = (v[1] + l) * fmpq(1, 2**N), (v[2] + m) * fmpq(1, 2**N)
+            for p, q in cell_pieces(*XY):
+                if p < 3 and q < 3:
+                    def build(X=X, Y=Y, p=p, q=q, y1=y1, y2=y2):
+                        with ctx.workprec(prec):
+                            w = (_weight_z(p, X, D) * _weight_z(q, Y, D)).truncate(D)
+                            G = [(F + w * (y - F)).truncate(D) for y, F in ((y1, X), (y2, Y))]
+                            return bernstein_coefficients(jacobian_determinant(G, (1, 2)).truncate(D), box=ZBOX)
+                    out.append((f"{l},{m},{p},{q}", build))
     return out
 
 
@@ -534,6 +552,7 @@ def _verify_interval(cert, k, N, prec, thash, tables_dir, log, part, results):
     if table is None:
         return False
     exact = table_nets_exact(table)
+    sym = _symmetry(table, log)
     ok = lam_interval_ok(k["min"], ends[0][0], ends[-1][1], prec)
     part(f"lam(k) in [{ends[0][0]}, {ends[-1][1]}] for every k >= {k['min']}", ok)
     for idx, ((La, Lb), pc) in enumerate(zip(ends, pieces)):
@@ -543,8 +562,8 @@ def _verify_interval(cert, k, N, prec, thash, tables_dir, log, part, results):
             zn = [parameter_nets(exact, La, Lb, i, deg, prec) for i in range(N)]
             nets = hull_nets(zn[0], prec)
             lam = arb(La).union(arb(Lb))
-            _check_parts(pc["parts"], nets, lam, N, prec, interval_cells(zn, N, D, prec), part, f"[piece {idx}] ",
-                         failed=lambda: not all(results))
+            _check_parts(pc["parts"], nets, lam, N, prec, interval_cells(zn, N, D, prec, sym), part,
+                         f"[piece {idx}] ", failed=lambda: not all(results))
     return all(results)
 
 

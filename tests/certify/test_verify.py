@@ -216,3 +216,51 @@ def test_c1_tampering_rejected():
     lines = []
     assert not V.verify_c1_certificate(bad, log=lines.append)
     assert any("FAIL  table" in s for s in lines)
+
+
+# ---------------------------------------------------------------- mirror symmetry (parts B, D, E)
+def test_mirror_symmetry_of_the_exact_nets_and_its_consequence():
+    from flint import ctx
+
+    from ccproof.rigorous import bernstein_coefficients
+    from ccproof.tables.format import read_table_json, table_nets_arb, table_nets_exact, table_path
+
+    table = read_table_json(table_path(5))
+    exact = table_nets_exact(table)
+    assert V.mirror_symmetric(exact)
+    broken = copy.deepcopy(exact)
+    broken["P3"][1][2] = (broken["P3"][1][2][0], [[1], [0], [1]])
+    assert not V.mirror_symmetric(broken)
+    # consequence, checked on the determinants themselves: the Bernstein form of det J_G on the mirrored
+    # cell (m, l) with piece (q, p) is the transpose of that on (l, m) with (p, q)
+    with ctx.workprec(128):
+        nets = table_nets_arb(table, "bezier", 128)
+        lam = V.arb_from_table(table, 128)
+        full = V.required_cells(nets, lam, 3, 128)
+        half = V.required_cells(nets, lam, 3, 128, symmetric=True)
+        assert set(half) == {c for c in full if c[0] <= c[1]}
+        assert {(m, l, q, p) for l, m, p, q in full} == set(full)  # the required set itself is symmetric
+        for l, m, p, q in [(0, 1, 0, 0), (1, 6, 1, 2), (2, 7, 2, 2)]:
+            a = bernstein_coefficients(V.cell_det_poly(nets, lam, 3, l, m, p, q, 128))
+            b = bernstein_coefficients(V.cell_det_poly(nets, lam, 3, m, l, q, p, 128))
+            n0, n1 = a.shape
+            assert b.shape == (n1, n0)
+            for i in range(n0):
+                for j in range(n1):
+                    x, y = a.coeffs[i * n1 + j], b.coeffs[j * n0 + i]
+                    assert x.overlaps(y) and abs(x.mid() - y.mid()) < 1e-30
+
+
+def test_removing_a_mirrored_cell_is_harmless_but_its_twin_is_not(cert3):
+    c = copy.deepcopy(cert3)
+    lower = [k for k in c["parts"]["cells"] if int(k.split(",")[0]) > int(k.split(",")[1])]
+    assert lower
+    for k in lower:
+        del c["parts"]["cells"][k]
+    ok, log = run(c)
+    assert ok, log
+    l, m, p, q = lower[0].split(",")
+    twin = f"{m},{l},{q},{p}"
+    del c["parts"]["cells"][twin]
+    ok, log = run(c)
+    assert not ok and f"D cell {twin}" in log
