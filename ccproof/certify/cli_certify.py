@@ -57,7 +57,6 @@ def _one(args):
 
 def _run_c1(ks, args):
     from ccproof.certify.prover import c1_certificate_path, prove_c1, write_certificate
-    from ccproof.certify.verify import verify_file
 
     ok_all = True
     for k in ks:
@@ -65,10 +64,7 @@ def _run_c1(ks, args):
         path = write_certificate(cert, c1_certificate_path(k, args.out))
         mins = {n: min(b["bound"] for b in v) for sec in cert["parts"].values() for n, v in sec.items()}
         print(f"valence {k}: C1 certificate written to {path}; root bounds {mins}")
-        if not args.no_verify:
-            ok = verify_file(path, log=lambda s: None)
-            print(f"  independent verifier: {'VERIFIED' if ok else 'FAILED'}")
-            ok_all &= ok
+        ok_all &= _recheck(path, args)
     return 0 if ok_all else 1
 
 
@@ -76,7 +72,6 @@ def _run_interval(k, args):
     import time
 
     from ccproof.certify.prover import certificate_path, prove_interval, write_certificate
-    from ccproof.certify.verify import verify_file
 
     t0 = time.perf_counter()
     cert = prove_interval(k, prec=args.prec)
@@ -87,12 +82,7 @@ def _run_interval(k, args):
           f"{[p['lam'] for p in cert['pieces']]}, {stats['boxes']} boxes, {seconds:.1f} s")
     _print_summary(summary)
     print(f"  certificate written to {path}")
-    if args.no_verify:
-        return 0
-    t0 = time.perf_counter()
-    ok = verify_file(path, log=lambda s: None)
-    print(f"  independent verifier: {'VERIFIED' if ok else 'FAILED'} ({time.perf_counter() - t0:.1f} s)")
-    return 0 if ok else 1
+    return 0 if _recheck(path, args) else 1
 
 
 def _print_summary(summary):
@@ -102,7 +92,6 @@ def _print_summary(summary):
 
 
 def run(args):
-    from ccproof.certify.verify import verify_file
 
     ks = parse_valences(args.valences)
     if args.c1:
@@ -124,11 +113,22 @@ def run(args):
         print(f"valence {k}: N = {N}, {stats['boxes']} boxes, {stats['seconds']} s")
         _print_summary(summary)
         print(f"  certificate written to {path}")
-        if not args.no_verify:
-            ok = verify_file(path, log=lambda s: None)
-            print(f"  independent verifier: {'VERIFIED' if ok else 'FAILED'}")
-            ok_all &= ok
+        ok_all &= _recheck(path, args)
     return 0 if ok_all else 1
+
+
+def _recheck(path, args):
+    """Re-check a written certificate with the independent verifier (unless --no-verify); True if it passed."""
+    if args.no_verify:
+        return True
+    import time
+
+    from ccproof.certify.verify import verify_file
+
+    t0 = time.perf_counter()
+    ok = verify_file(path, log=lambda s: None)
+    print(f"  independent verifier: {'VERIFIED' if ok else 'FAILED'} ({time.perf_counter() - t0:.1f} s)")
+    return ok
 
 
 def float_str(q):
