@@ -47,7 +47,7 @@ from ccproof.apps.arap.solver import closest_rotations, system_from_samples
 from ccproof.mesh import read_obj
 
 REPO = Path(__file__).resolve().parents[1]
-DEFAULT_MESH = Path(os.environ.get("CCPROOF_SHARED", REPO.parent / "shared")) / "reference/meshes/bunny_quads.obj"
+DEFAULT_MESH = REPO / "tests" / "data" / "meshes" / "bunny_quads.obj"
 
 
 def per_iteration_times(hs, rules, X, levels=(1, 2, 3), repeat=10):

@@ -15,8 +15,7 @@ Measures, in one run:
    reach the accuracy of exact evaluation;
 4. the peak memory beyond inputs and outputs for 10^7 points (tracemalloc).
 
-The reference data folder is ``../shared/reference`` relative to the repository root, or
-``$CCPROOF_SHARED`` (the folder that contains ``reference/``, or the reference folder itself).
+The bunny mesh is read from the repository's test data (``tests/data/meshes/bunny_quads.obj``).
 
 Usage: python scripts/bench_evaluate.py [--points 1000000] [--memory-points 10000000] [--quick]
 """
@@ -25,7 +24,6 @@ from __future__ import annotations
 
 import argparse
 import math
-import os
 import sys
 import time
 import tracemalloc
@@ -39,12 +37,6 @@ sys.path.insert(0, str(REPO))
 from ccproof.evaluate import limit_surface  # noqa: E402
 from ccproof.evaluate.surface import _CORNER, _SPLIT  # noqa: E402
 from ccproof.mesh import limit_normals, limit_positions, read_obj, subdivide  # noqa: E402
-
-
-def shared_reference():
-    base = os.environ.get("CCPROOF_SHARED")
-    root = Path(base) if base else REPO.parent / "shared"
-    return root / "reference" if (root / "reference").is_dir() else root
 
 
 def timed(fn, repeat=3):
@@ -114,10 +106,7 @@ def main(argv=None):
     if args.quick:
         args.points, args.memory_points, args.naive_points, args.pygel_levels = 20_000, 50_000, 200, 2
 
-    path = shared_reference() / "meshes" / "bunny_quads.obj"
-    if not path.exists():
-        print(f"bunny mesh not found at {path} (set CCPROOF_SHARED)")
-        return 1
+    path = REPO / "tests" / "data" / "meshes" / "bunny_quads.obj"
     mesh = read_obj(path)
     diag = mesh.bounding_box_diagonal
     print(f"mesh: {path.name}: {mesh.n_vertices} vertices, {mesh.n_faces} quads, "

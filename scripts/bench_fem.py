@@ -91,7 +91,7 @@ def bench_fit():
     from ccproof.apps.dynamics.fit import fit_points, read_points
     from ccproof.apps.dynamics.shapes import synthetic_range_data
 
-    bunny = Path(__file__).resolve().parents[2] / "shared" / "reference" / "meshes" / "bunny_quads.obj"
+    bunny = Path(__file__).resolve().parents[1] / "tests" / "data" / "meshes" / "bunny_quads.obj"
     if bunny.exists():
         name, X = "Stanford bunny, scanned vertices", read_points(bunny)
     else:

@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-DEFAULT_MESH = Path(__file__).resolve().parents[2] / "shared" / "reference" / "meshes" / "bunny_quads.obj"
+DEFAULT_MESH = Path(__file__).resolve().parents[1] / "tests" / "data" / "meshes" / "bunny_quads.obj"
 
 
 def load_mesh(spec):

@@ -159,7 +159,7 @@ def fitting(out):
     from ccproof.apps.dynamics.plot import draw_surface, set_equal_axes
     from ccproof.apps.dynamics.shapes import synthetic_range_data
 
-    bunny = Path(__file__).resolve().parents[2] / "shared" / "reference" / "meshes" / "bunny_quads.obj"
+    bunny = Path(__file__).resolve().parents[1] / "tests" / "data" / "meshes" / "bunny_quads.obj"
     cases = [("bulb (synthetic, 1,000 points)", synthetic_range_data("bulb"))]
     if bunny.exists():
         cases.append(("Stanford bunny (2,038 scanned vertices)", read_points(bunny)))

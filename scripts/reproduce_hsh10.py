@@ -26,7 +26,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import sys
 import time
 from pathlib import Path
@@ -49,7 +48,7 @@ from ccproof.mesh import QuadMesh, read_obj
 from ccproof.mesh.examples import k_regular_disk
 
 REPO = Path(__file__).resolve().parents[1]
-BUNNY = Path(os.environ.get("CCPROOF_SHARED", REPO.parent / "shared")) / "reference/meshes/bunny_quads.obj"
+BUNNY = REPO / "tests" / "data" / "meshes" / "bunny_quads.obj"
 
 
 # --------------------------------------------------------------------------- cases

@@ -8,8 +8,6 @@ import pytest
 
 @pytest.mark.slow
 def test_bench_quick(capsys, refdir):
-    if not (refdir / "meshes" / "bunny_quads.obj").exists():
-        pytest.skip("bunny mesh not available")
     path = Path(__file__).resolve().parents[2] / "scripts" / "bench_evaluate.py"
     spec = importlib.util.spec_from_file_location("bench_evaluate", path)
     mod = importlib.util.module_from_spec(spec)

@@ -1,6 +1,5 @@
 """Shared test meshes for the hsh10 (ARAP) tests (loaded by path: tests run with --import-mode=importlib)."""
 
-import os
 from pathlib import Path
 
 import numpy as np
@@ -9,7 +8,7 @@ from ccproof.mesh import QuadMesh
 from ccproof.mesh.examples import grid, k_regular_disk
 
 REPO = Path(__file__).resolve().parents[3]
-BUNNY = Path(os.environ.get("CCPROOF_SHARED", REPO.parent / "shared")) / "reference" / "meshes" / "bunny_quads.obj"
+BUNNY = REPO / "tests" / "data" / "meshes" / "bunny_quads.obj"
 
 
 def zigzag_chart(k=5, rings=4):

@@ -164,9 +164,7 @@ def test_q9_fit_other_shapes(name):
 def test_q9_fit_scanned_bunny():
     from pathlib import Path
 
-    path = Path(__file__).resolve().parents[4] / "shared" / "reference" / "meshes" / "bunny_quads.obj"
-    if not path.exists():
-        pytest.skip("shared reference data not available")
+    path = Path(__file__).resolve().parents[2] / "data" / "meshes" / "bunny_quads.obj"
     res = fit_points(read_points(path), levels=1)
     assert res.levels[1].max_error_percent <= 3.0
     assert res.levels[1].max_error_percent < res.levels[0].max_error_percent
