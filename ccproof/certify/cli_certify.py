@@ -46,13 +46,14 @@ def _one(args):
     k, prec, out, progress = args
     import time
 
-    from ccproof.certify.prover import certificate_path, prove_valence, write_certificate
+    from ccproof.certify.prover import certificate_path, claimed_margins, prove_valence, write_certificate
 
     t0 = time.perf_counter()
     cert = prove_valence(k, prec=prec, progress=progress)
     seconds = round(time.perf_counter() - t0, 2)
     path = write_certificate(cert, certificate_path(k, out))
-    return k, cert["N"], cert["summary"], dict(cert["stats"], seconds=seconds), str(path)
+    summary, boxes = claimed_margins(cert)
+    return k, cert["N"], summary, {"boxes": boxes, "seconds": seconds}, str(path)
 
 
 def _run_c1(ks, args):
@@ -62,7 +63,8 @@ def _run_c1(ks, args):
     for k in ks:
         cert = prove_c1(k, prec=args.prec)
         path = write_certificate(cert, c1_certificate_path(k, args.out))
-        mins = {n: min(b["bound"] for b in v) for sec in cert["parts"].values() for n, v in sec.items()}
+        parts = cert["pieces"][0]["parts"] if "pieces" in cert else cert["parts"]
+        mins = {n: min(b["bound"] for b in v) for sec in parts.values() for n, v in sec.items()}
         print(f"valence {k}: C1 certificate written to {path}; root bounds {mins}")
         ok_all &= _recheck(path, args)
     return 0 if ok_all else 1
@@ -71,21 +73,22 @@ def _run_c1(ks, args):
 def _run_interval(k, args):
     import time
 
-    from ccproof.certify.prover import certificate_path, prove_interval, write_certificate
+    from ccproof.certify.prover import certificate_path, claimed_margins, prove_interval, write_certificate
 
     t0 = time.perf_counter()
     cert = prove_interval(k, prec=args.prec)
     seconds = time.perf_counter() - t0
     path = write_certificate(cert, certificate_path(k, args.out))
-    summary, stats = cert["summary"], cert["stats"]
-    print(f"valences {k}: N = {cert['N']}, {stats['pieces']} lam piece(s) "
-          f"{[p['lam'] for p in cert['pieces']]}, {stats['boxes']} boxes, {seconds:.1f} s")
+    summary, boxes = claimed_margins(cert)
+    print(f"valences {k}: N = {cert['N']}, {len(cert['pieces'])} lam piece(s) "
+          f"{[p['lam'] for p in cert['pieces']]}, {boxes} boxes, {seconds:.1f} s")
     _print_summary(summary)
     print(f"  certificate written to {path}")
     return 0 if _recheck(path, args) else 1
 
 
 def _print_summary(summary):
+    print("  bounds claimed by the prover (re-checked below by the verifier):")
     print(f"  min det J_Phi bound (local)        {float_str(summary['min_bound_det_J_phi_local'])}")
     print(f"  min det J_G bound, cells (local)   {float_str(summary['min_bound_det_J_G_cells_local'])}")
     print(f"  min det J_G / h^2 bound, corner    {float_str(summary['min_bound_det_J_G_corner_over_h2'])}")
@@ -126,7 +129,7 @@ def _recheck(path, args):
     from ccproof.certify.verify import verify_file
 
     t0 = time.perf_counter()
-    ok = verify_file(path, log=lambda s: None)
+    ok = bool(verify_file(path, log=lambda s: None))
     print(f"  independent verifier: {'VERIFIED' if ok else 'FAILED'} ({time.perf_counter() - t0:.1f} s)")
     return ok
 

@@ -1,6 +1,7 @@
-"""Injectivity prover for bmz04 Appendix A (untrusted search; DESIGN.md section 3).
+"""Injectivity and C1 prover for bmz04 Appendix A and Reif's criterion (untrusted search).
 
-For a valence k the prover builds, from the certified table, every Bernstein form the verifier
+For a valence k the prover builds, from the characteristic map the verifier derives
+(:func:`ccproof.certify.verify.statement.nets_for_valence`), every Bernstein form the verifier
 will rebuild (det J_Phi on layer 0, det J_G on each dyadic cell and w piece, the R9 corner form),
 subdivides each adaptively until all of its coefficients are certainly positive, and writes the
 leaves as split paths with a lower bound each. Only the choice of where to split is heuristic;
@@ -15,29 +16,23 @@ from pathlib import Path
 
 from flint import arb, ctx, fmpq
 
-from ccproof.certify.verify import (
-    C1_SCHEMA,
-    PATCHES,
-    SCHEMA,
+from ccproof.certify.verify import C1_SCHEMA, SCHEMA
+from ccproof.certify.verify.interval import hull_nets, interval_cells, lam_interval_ok, parameter_nets
+from ccproof.certify.verify.maps import (
     STAR_CURVES,
-    _decimal,
-    arb_from_table,
     cell_det_poly,
     corner_containment,
     corner_det_form,
-    hull_nets,
-    interval_cells,
-    lam_interval_ok,
-    mirror_symmetric,
-    parameter_nets,
     regularity_form,
     required_cells,
     square_inside_image,
     star_form,
 )
+from ccproof.certify.verify.replay import parse_decimal
+from ccproof.certify.verify.statement import PATCHES, c_lam, derivation, nets_for_valence
 from ccproof.errors import CCProofError, check_valence
 from ccproof.rigorous import bernstein_coefficients, certainly_positive, lower_bound
-from ccproof.tables.format import certificates_dir, read_table_json, table_nets_arb, table_nets_exact, table_path
+from ccproof.tables.format import certificates_dir
 
 DEFAULT_PREC = 128
 MAX_DEPTH = 14
@@ -101,54 +96,37 @@ def _corners(f):
     return vals
 
 
-def prove_valence(k, prec=DEFAULT_PREC, tables_dir=None, progress=True):
-    """Search a certificate for valence k; returns the certificate dict (see docs/certificates.md)."""
-    if isinstance(k, str) and k.strip().startswith(">="):
-        k = {"min": check_valence(k.strip()[2:])}
-    else:
-        k = check_valence(k)
-    table = read_table_json(table_path(k, tables_dir))
-    N = int(table["derived"]["N"])
-    stats = {}
+def smallest_level(nets, lam, max_level=8):
+    """The smallest N with lam^N max(coordinates) < 1/6 (part A), found by trying N = 1, 2, ..."""
+    for N in range(1, max_level + 1):
+        if corner_containment(nets, lam, N)[0]:
+            return N
+    raise ProofFailed(f"no level N <= {max_level} maps the corner cell into [0,1/6)^2")
+
+
+def prove_valence(k, prec=DEFAULT_PREC, progress=True):
+    """Search an injectivity certificate for valence k; returns the certificate dict (docs/certificates.md)."""
+    k = check_valence(k)
     with ctx.workprec(prec):
-        lam = arb_from_table(table, prec)
-        nets = table_nets_arb(table, "bezier", prec)
+        lam = c_lam(k, prec)[1]
+        nets = nets_for_valence(k, prec)
+        N = smallest_level(nets, lam)
         regularity = {n: prove_positive(regularity_form(nets, n, prec), (0, 1), f"det J_Phi on {n}")
                       for n in PATCHES}
         cells = {}
-        todo = required_cells(nets, lam, N, prec, mirror_symmetric(table_nets_exact(table)))
+        todo = required_cells(nets, lam, N, prec, derivation().symmetric)
         it = todo
         if progress:
             from tqdm import tqdm
 
-            it = tqdm(todo, desc=f"k={_kname(k)} cells", unit="cell", leave=False)
+            it = tqdm(todo, desc=f"k={k} cells", unit="cell", leave=False)
         for l, m, p, q in it:
             root = bernstein_coefficients(cell_det_poly(nets, lam, N, l, m, p, q, prec))
             cells[f"{l},{m},{p},{q}"] = prove_positive(root, (0, 1), f"cell ({l},{m}) piece ({p},{q})")
         corner = {n: prove_positive(corner_det_form(nets, lam, N, n, prec), (2, 3, 0, 1),
                                     f"corner {n}") for n in PATCHES}
-    stats["cells_with_weight"] = len(todo)
-    parts = {"regularity": regularity, "cells": cells, "corner": corner}
-    summary, stats["boxes"] = _summary([parts])
-    return {
-        "schema": SCHEMA,
-        "valence": k,
-        "N": N,
-        "prec": prec,
-        "table": {"file": f"tables/{table_path(k).name}", "hash": table["hash"]},
-        "statement": (
-            "For the blend F_b of bmz04 eq. (4) with F = Phi^-1 of valence k and w(u,v) = b(u) b(v) (R5), "
-            "det J_G > 0 on [0,1]^2 minus the corner for G(y) = w(Phi(y)) y + (1 - w(Phi(y))) Phi(y) (R7), "
-            "det J_Phi > 0, and [0,1/2]^2 lies inside Phi([0,1]^2); with the injectivity of Phi (Reif) "
-            "this gives det J_F_b > 0 on the corner quarter (Proposition 1)."
-        ),
-        "readings": {"weight": "R5 (c = 6)", "N": "R8 (smallest N with Phi([0,2^-N]^2) in [0,1/6)^2)",
-                     "corner": "R9 with rho = lam^(3(i-N)), kappa = (2 lam^4)^(i-N)",
-                     "jacobians": "cells and regularity w.r.t. the local (s,t) of each box's root"},
-        "parts": parts,
-        "summary": summary,
-        "stats": stats,
-    }
+    return {"schema": SCHEMA, "valence": k, "N": N, "prec": prec,
+            "parts": {"regularity": regularity, "cells": cells, "corner": corner}}
 
 
 def _decimal_str(x, up, digits=14):
@@ -159,10 +137,19 @@ def _decimal_str(x, up, digits=14):
                                                                  rounding=ROUND_CEILING if up else ROUND_FLOOR)
     step = Decimal(10) ** -digits
     while True:  # move outward until the exact comparison holds
-        q = _decimal(str(d))
+        q = parse_decimal(str(d))
         if (q >= x) if up else (q <= x):
             return str(d)
         d = d + step if up else d - step
+
+
+def _lam_range(k0, prec):
+    """Decimal strings [La, Lb] with La <= lam(k0) and Lb >= (3 + sqrt 5)/8 (checked by the verifier)."""
+    with ctx.workprec(prec):
+        lam0 = c_lam(k0, prec)[1]
+        ends = [_decimal_str(lam0.lower(), up=False), _decimal_str(((3 + arb(5).sqrt()) / 8).upper(), up=True)]
+    assert lam_interval_ok(k0, parse_decimal(ends[0]), parse_decimal(ends[1]), prec)
+    return ends
 
 
 def _prove_piece(exact, La, Lb, N, degree, trunc, prec, progress, label):
@@ -179,7 +166,7 @@ def _prove_piece(exact, La, Lb, N, degree, trunc, prec, progress, label):
                       for n in PATCHES}
         corner = {n: prove_positive(corner_det_form(nets, lam, N, n, prec), (2, 3, 0, 1),
                                     f"{label} corner {n}") for n in PATCHES}
-        todo = interval_cells(zn, N, trunc, prec, mirror_symmetric(exact))
+        todo = interval_cells(zn, N, trunc, prec, derivation().symmetric)
         it = todo
         if progress:
             from tqdm import tqdm
@@ -189,78 +176,59 @@ def _prove_piece(exact, La, Lb, N, degree, trunc, prec, progress, label):
     return {"regularity": regularity, "cells": cells, "corner": corner}
 
 
-def prove_interval(k0, prec=DEFAULT_PREC, tables_dir=None, progress=True, taylor_degree=3, truncation_degree=2,
-                   max_pieces=16):
-    """Appendix-A certificate for every valence k >= k0 at once (R10, docs/appendix_a.md).
+def prove_interval(k0, prec=DEFAULT_PREC, progress=True, taylor_degree=3, truncation_degree=2, max_pieces=16):
+    """Appendix-A certificate for every valence k >= k0 at once (docs/appendix_a.md section 6).
 
     lam runs over [La, Lb] with La <= lam(k0) and Lb >= (3 + sqrt 5)/8; the nets are Taylor models in
-    zeta (lam = mid + zeta * half-width) built from the table's exact forms, so part D keeps the
+    zeta (lam = mid + zeta * half-width) built from the derived exact forms, so part D keeps the
     correlation between control points (an interval hull of the nets does not: its coefficients are
     ~0.02 wide against cell margins of ~4e-4). A piece that fails is bisected (up to ``max_pieces``).
     """
     k = _parse_k(f">={k0}" if isinstance(k0, int) else k0)
-    table = read_table_json(table_path(k, tables_dir))
-    exact = table_nets_exact(table)
-    N = int(table["derived"]["N"])
+    exact = derivation().integer_forms("bspline")
+    ends = _lam_range(k["min"], prec)
     with ctx.workprec(prec):
-        c = arb(fmpq(2, k["min"])).cos_pi()
-        lam0 = (5 + c + ((1 + c) * (9 + c)).sqrt()) / 16
-        ends = [_decimal_str(lam0.lower(), up=False), _decimal_str(((3 + arb(5).sqrt()) / 8).upper(), up=True)]
-    assert lam_interval_ok(k["min"], _decimal(ends[0]), _decimal(ends[1]), prec)
+        La, Lb = parse_decimal(ends[0]), parse_decimal(ends[1])
+        N = smallest_level(hull_nets(parameter_nets(exact, La, Lb, 0, taylor_degree, prec), prec),
+                           arb(La).union(arb(Lb)))
     todo = [(ends[0], ends[1])]
     pieces = []
     while todo:
         a, b = todo.pop(0)
         label = f"k>={k['min']} lam in [{a}, {b}]"
         try:
-            parts = _prove_piece(exact, _decimal(a), _decimal(b), N, taylor_degree, truncation_degree, prec,
-                                 progress, label)
+            parts = _prove_piece(exact, parse_decimal(a), parse_decimal(b), N, taylor_degree, truncation_degree,
+                                 prec, progress, label)
         except ProofFailed:
             if len(pieces) + len(todo) + 2 > max_pieces:
                 raise
-            mid = _decimal_str((_decimal(a) + _decimal(b)) / 2, up=False)
+            mid = _decimal_str((parse_decimal(a) + parse_decimal(b)) / 2, up=False)
             todo[:0] = [(a, mid), (mid, b)]
             continue
         pieces.append({"lam": [a, b], "parts": parts})
-    summary, boxes = _summary([pc["parts"] for pc in pieces])
-    return {
-        "schema": SCHEMA,
-        "valence": k,
-        "N": N,
-        "prec": prec,
-        "table": {"file": f"tables/{table_path(k).name}", "hash": table["hash"]},
-        "parameter": {"variable": "lam", "taylor_degree": taylor_degree, "truncation_degree": truncation_degree},
-        "pieces": pieces,
-        "statement": (
-            f"For every valence k >= {k['min']}: the Appendix-A statement of the per-valence certificates "
-            "(det J_Phi > 0, [0,1/2]^2 inside Phi([0,1]^2), det J_G > 0 on every cell and on the corner cell), "
-            "proved for every lam in the pieces, which cover [lam(k0), (3 + sqrt 5)/8]; c = (16 lam^2 - 10 lam + 1)"
-            "/(2 lam). Part D uses Taylor models in zeta (lam = mid + zeta * half-width), axis 0 of its boxes."
-        ),
-        "readings": {"weight": "R5 (c = 6)", "N": "R8", "corner": "R9", "interval": "R10 with lam as the variable"},
-        "summary": summary,
-        "stats": {"pieces": len(pieces), "boxes": boxes,
-                  "cells_with_weight": sum(len(pc["parts"]["cells"]) for pc in pieces)},
-    }
+    return {"schema": SCHEMA, "valence": k, "N": N, "prec": prec,
+            "parameter": {"variable": "lam", "taylor_degree": taylor_degree, "truncation_degree": truncation_degree},
+            "pieces": pieces}
+
+
+def claimed_margins(cert):
+    """The smallest bound claimed per section of a certificate this prover just wrote, and its number of
+    boxes (the prover's own claims, printed before the verifier re-checks them; never read back)."""
+    parts_list = [pc["parts"] for pc in cert["pieces"]] if "pieces" in cert else [cert["parts"]]
+    return _summary(parts_list)
 
 
 def _summary(parts_list):
     """(smallest claimed bound per section as strings, number of boxes) over a list of ``parts``."""
     names = {"regularity": "min_bound_det_J_phi_local", "cells": "min_bound_det_J_G_cells_local",
              "corner": "min_bound_det_J_G_corner_over_h2"}
-    summary = {name: str(min((fmpq_of(b["bound"]) for parts in parts_list for boxes in parts[sec].values()
+    summary = {name: str(min((parse_decimal(b["bound"]) for parts in parts_list for boxes in parts[sec].values()
                               for b in boxes), default=None)) for sec, name in names.items()}
     return summary, sum(len(v) for parts in parts_list for sec in parts.values() for v in sec.values())
 
 
 def _kname(k):
     return f">={k['min']}" if isinstance(k, dict) else str(k)
-
-
-def fmpq_of(s):
-    from ccproof.certify.verify import _decimal
-
-    return _decimal(s)
 
 
 def certificate_path(k, directory=None):
@@ -286,28 +254,24 @@ def _parse_k(k):
     return check_valence(k)
 
 
-def prove_c1(k, prec=DEFAULT_PREC, tables_dir=None):
+def prove_c1(k, prec=DEFAULT_PREC):
     """C1 certificate (Reif's criterion) for valence k or the interval ``">=K0"``: det J_Phi > 0 on
     layer 0 and a star-shaped outer boundary, boxes found by subdivision; the spectral ordering is
-    re-derived by the verifier from the table (see :func:`ccproof.certify.verify.verify_c1_certificate`)."""
+    re-derived by the verifier from the rules (:mod:`ccproof.certify.verify.spectrum`)."""
     k = _parse_k(k)
-    table = read_table_json(table_path(k, tables_dir))
-    if not table["spectral"]["ok"]:
-        raise ProofFailed(f"the spectral ordering is not certified in the table of {_kname(k)}")
     with ctx.workprec(prec):
-        nets = table_nets_arb(table, "bezier", prec)
+        if isinstance(k, dict):
+            ends = _lam_range(k["min"], prec)
+            La, Lb = parse_decimal(ends[0]), parse_decimal(ends[1])
+            nets = hull_nets(parameter_nets(derivation().integer_forms("bspline"), La, Lb, 0, 3, prec), prec)
+        else:
+            nets = nets_for_valence(k, prec)
         reg = {n: prove_positive(regularity_form(nets, n, prec), (0, 1), f"det J_Phi on {n}") for n in PATCHES}
         star = {c: prove_positive(star_form(nets, c, prec), (0,), f"star {c}") for c in STAR_CURVES}
-    return {
-        "schema": C1_SCHEMA,
-        "valence": k,
-        "prec": prec,
-        "table": {"file": f"tables/{table_path(k).name}", "hash": table["hash"]},
-        "statement": ("Reif's C1 criterion for Catmull-Clark at valence k: 1 = lam_0 > lam_1 = lam_2 > |lam_3|, "
-                      "the characteristic map is regular (det J_Phi > 0) and injective (layer 0 locally "
-                      "homeomorphic with a star-shaped outer boundary image)."),
-        "parts": {"regularity": reg, "star": star},
-    }
+    parts = {"regularity": reg, "star": star}
+    if isinstance(k, dict):
+        return {"schema": C1_SCHEMA, "valence": k, "prec": prec, "pieces": [{"lam": ends, "parts": parts}]}
+    return {"schema": C1_SCHEMA, "valence": k, "prec": prec, "parts": parts}
 
 
 def c1_certificate_path(k, directory=None):

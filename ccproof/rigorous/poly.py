@@ -373,6 +373,8 @@ class Poly:
         >>> r = (1 + z * s + z**2 * s**2).truncate(1)
         >>> r.degrees, r.coefficient((0, 2)).contains(0), r.coefficient((0, 2)).rad() >= 1
         ((1, 2), True, True)
+        >>> (1 + arb(0, fmpq(1, 10**6)) * z**2).truncate(1).coefficient((0, 0)).rad() >= fmpq(1, 10**6)
+        True
         """
         axis = self._axis(axis)
         if isinstance(degree, bool) or not isinstance(degree, int) or degree < 0:
@@ -392,7 +394,7 @@ class Poly:
                 for j in range(degree + 1, n):
                     for q in range(post):
                         x = c[base + j * post + q]
-                        if x != 0:
+                        if not x.is_zero():  # exact zero only: a ball that merely contains 0 still counts
                             head[q] = head[q] + arb(0, abs(x).upper())
                 out += head + c[base + post : base + (degree + 1) * post]
         shape = self.shape[:axis] + (degree + 1,) + self.shape[axis + 1 :]

@@ -1,0 +1,107 @@
+"""The trusted verifier of ccproof certificates (``ccproof verify``).
+
+A certificate is a statement plus hints. The statement is fixed by the schema and the valence alone:
+this package derives c = cos(2 pi/k), lam(k), the subdominant eigenvector, the characteristic map's
+nets, the spectrum and every hypothesis the proofs use from k and the Catmull-Clark rules
+(:mod:`.rules`, :mod:`.statement`, :mod:`.spectrum`), reads no table, and replays the hints (dyadic
+boxes with claimed bounds, :mod:`.replay`) without searching. It imports only python-flint, the
+standard library and :mod:`ccproof.rigorous`; docs/trusted_base.md lists the modules it consists of.
+
+>>> from ccproof.certify.verify import verify_file, certificate_files
+>>> res = verify_file(certificate_files()[0], log=lambda line: None)   # certificates/c1/k003.json
+>>> bool(res), res.valence, res.parts[0].name
+(True, 3, 'S statement derived from the rules')
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from pathlib import Path
+
+from .c1 import C1_SCHEMA, verify_c1
+from .errors import CertificateError
+from .injectivity import SCHEMA, verify_injectivity
+from .record import Part, Recorder, VerifyResult, read_valence
+
+__all__ = ["SCHEMA", "C1_SCHEMA", "CertificateError", "Part", "VerifyResult", "verify_certificate", "verify_file",
+           "check_coverage", "certificate_files"]
+
+MAX_FILE_BYTES = 64 * 2**20
+_KINDS = {SCHEMA: verify_injectivity, C1_SCHEMA: verify_c1}
+#: what a malformed file can raise while it is being read; each ends in FAIL with the reason
+_MALFORMED = (CertificateError, ValueError, TypeError, KeyError, IndexError, AttributeError, RecursionError,
+              OverflowError, ZeroDivisionError)
+
+
+def verify_certificate(cert, log=print, path=None):
+    """Check a parsed certificate (a dict). Returns a :class:`VerifyResult`; never raises for bad input."""
+    res = VerifyResult(path=None if path is None else str(path))
+    t0 = time.perf_counter()
+    part = Recorder(res, log)
+    try:
+        if not isinstance(cert, dict) or cert.get("schema") not in _KINDS:
+            got = cert.get("schema") if isinstance(cert, dict) else None
+            raise CertificateError(f"unknown certificate schema {str(got)[:60]!r} (expected one of "
+                                   f"{', '.join(map(repr, _KINDS))})")
+        res.schema = cert["schema"]
+        res.valence = read_valence(cert)
+        res.N = cert.get("N") if isinstance(cert.get("N"), int) else None
+        _KINDS[res.schema](cert, res.valence, part, log)
+    except _MALFORMED as exc:
+        res.error = f"{type(exc).__name__}: {exc}" if not isinstance(exc, CertificateError) else str(exc)
+    res.seconds = time.perf_counter() - t0
+    return res
+
+
+def verify_file(path, log=print, tables_dir=None):
+    """Verify one certificate file; logs PASS/FAIL per part, then VERIFIED or FAILED with the reason.
+
+    Returns a :class:`VerifyResult` (true as a bool exactly when every part passed). ``tables_dir`` is
+    accepted for compatibility and ignored: the verifier reads no table."""
+    del tables_dir
+    t0 = time.perf_counter()
+    path = Path(path)
+    try:
+        if path.stat().st_size > MAX_FILE_BYTES:
+            raise CertificateError(f"larger than {MAX_FILE_BYTES >> 20} MiB")
+        cert = json.loads(path.read_text(encoding="ascii"))
+    except (OSError, UnicodeDecodeError, ValueError, RecursionError, CertificateError) as exc:
+        res = VerifyResult(path=str(path), error=f"not a readable certificate ({exc})")
+    else:
+        res = verify_certificate(cert, log, path)
+    res.seconds = time.perf_counter() - t0
+    if res.error:
+        log(f"FAILED {path}: {res.error}")
+    else:
+        why = "" if res.ok else ": " + "; ".join(f"{p.name}: {p.message}" if p.message else p.name
+                                                 for p in res.failures())
+        log(f"{'VERIFIED' if res.ok else 'FAILED'} {path} ({res.seconds:.1f} s){why}")
+    return res
+
+
+def certificate_files(directory=None):
+    """The published certificate files: ``c1/k*.json`` then ``injectivity/k*.json`` of ``directory``
+    (default: the package's certificates folder)."""
+    if directory is None:
+        from ccproof.tables.format import certificates_dir
+
+        directory = certificates_dir()
+    d = Path(directory)
+    return sorted((d / "c1").glob("k*.json")) + sorted((d / "injectivity").glob("k*.json"))
+
+
+def check_coverage(valences):
+    """Do the valences (ints and {'min': k0}) cover every k >= 3 exactly once? Returns (ok, message)."""
+    ints = sorted(v for v in valences if isinstance(v, int))
+    tails = sorted(v["min"] for v in valences if isinstance(v, dict))
+    if len(set(ints)) != len(ints):
+        return False, "a valence is claimed twice"
+    if len(tails) != 1:
+        return False, "no interval k >= k0" if not tails else "more than one interval k >= k0"
+    k0 = tails[0]
+    if ints != list(range(3, k0)):
+        missing = sorted(set(range(3, k0)) - set(ints))
+        extra = [k for k in ints if k >= k0]
+        return False, f"missing valences {missing}" if missing else f"valences {extra} overlap k >= {k0}"
+    return True, f"every k >= 3 exactly once (3..{k0 - 1} and k >= {k0})"

@@ -1,0 +1,102 @@
+"""C1 certificates: Reif's criterion for Catmull-Clark at valence k or every k >= k0 (trusted).
+
+Statement: the spectral ordering 1 = lam_0 > lam_1 = lam_2 = lam(k) > |lam_3| with the lam block
+non-defective (:mod:`.spectrum`, from the rules), and the characteristic map (:mod:`.statement`, from
+the rules) regular and injective: det J_Phi > 0 on layer 0 and a star-shaped image of the outer
+boundary. With det J_Phi > 0 the L-shaped layer 0 is mapped locally homeomorphically; its boundary goes
+to the Jordan curve made of the axis segments [lam, 1] (part S: the axis edges map onto the axes), the
+outer curve C (in the first quadrant, part H) and lam C (the layer boundary identity of part S),
+disjoint because C is star-shaped, so layer 0 maps injectively onto the annulus between lam C and C,
+and the layers, scaled by lam^i, onto nested disjoint annuli: Phi is injective on the face, and on the
+k-star by symmetry. The hints are the boxes of ``parts.regularity`` and ``parts.star``.
+"""
+
+from __future__ import annotations
+
+from flint import arb, ctx
+
+from .errors import CertificateError
+from .injectivity import check_derivation, check_hypotheses
+from .interval import hull_nets, lam_interval_ok, parameter_nets
+from .maps import STAR_CURVES, regularity_form, star_form
+from .record import exact_keys, field_of, kname
+from .replay import check_boxes, parse_decimal, parse_path
+from .spectrum import check_block_polynomials, spectral_ordering
+from .statement import PATCHES, StatementError, c_lam, derivation, nets_for_valence
+
+C1_SCHEMA = "ccproof.c1/2"
+
+
+def verify_c1(cert, k, part, log):
+    exact_keys(cert, ("schema", "valence", "prec", "pieces" if isinstance(k, dict) else "parts"), "certificate")
+    prec = field_of(cert, "prec", int, "certificate")
+    if not 64 <= prec <= 1024:
+        raise CertificateError("prec must lie in 64..1024")
+    piece_list = field_of(cert, "pieces", list, "certificate") if isinstance(k, dict) else [
+        {"lam": None, "parts": field_of(cert, "parts", dict, "certificate")}]
+    if not 1 <= len(piece_list) <= 64:
+        raise CertificateError("there must be 1..64 lam pieces")
+    ends = []
+    for pc in piece_list:
+        if isinstance(k, dict):
+            exact_keys(pc, ("lam", "parts"), "piece")
+            lo_hi = field_of(pc, "lam", list, "piece")
+            if len(lo_hi) != 2:
+                raise CertificateError("piece lam must be [low, high]")
+            ends.append(tuple(parse_decimal(x) for x in lo_hi))
+        parts = pc["parts"]
+        exact_keys(parts, ("regularity", "star"), "parts")
+        reg, star = field_of(parts, "regularity", dict, "parts"), field_of(parts, "star", dict, "parts")
+        exact_keys(reg, PATCHES, "parts.regularity")
+        exact_keys(star, tuple(STAR_CURVES), "parts.star")
+        for sec, nv in ((reg, 2), (star, 1)):
+            for boxes in sec.values():
+                if not isinstance(boxes, list) or not boxes:
+                    raise CertificateError("boxes must be a non-empty list")
+                for b in boxes:
+                    if not isinstance(b, dict) or set(b) != {"path", "bound"}:
+                        raise CertificateError("a box must be {'path', 'bound'}")
+                    parse_path(b["path"], nv)
+                    parse_decimal(b["bound"])
+    if ends and (any(not a < b for a, b in ends) or any(ends[i][1] != ends[i + 1][0] for i in range(len(ends) - 1))):
+        raise CertificateError("the lam pieces must be increasing and contiguous")  # exact fmpq comparisons
+    log(f"C1 certificate for valence {kname(k)} ({prec} bits)")
+    if not check_derivation(part):
+        return
+    ok = check_block_polynomials()
+    part("spectrum: Fourier blocks of the rules have the stated characteristic polynomials", ok,
+         "exact identities in (x, w) and (x, 1/k)" if ok else "an identity fails")
+    if not ok:
+        return
+    ok, msg = spectral_ordering(k, prec)
+    part("spectral ordering 1 > lam = lam > |lam_3|, lam non-defective", ok, msg)
+    if not ok:
+        return
+    if ends:
+        ok = lam_interval_ok(k["min"], ends[0][0], ends[-1][1], prec)
+        part(f"lam(k) in [{ends[0][0]}, {ends[-1][1]}] for every k >= {k['min']}", ok)
+        if not ok:
+            return
+    exact = derivation().integer_forms("bspline") if ends else None
+    for idx, pc in enumerate(piece_list):
+        tag = f"[piece {idx}] " if ends else ""
+        with ctx.workprec(prec):
+            try:
+                if ends:
+                    La, Lb = ends[idx]
+                    nets, lam = hull_nets(parameter_nets(exact, La, Lb, 0, 3, prec), prec), arb(La).union(arb(Lb))
+                else:
+                    nets, lam = nets_for_valence(k, prec), c_lam(k, prec)[1]
+            except (StatementError, CertificateError) as exc:
+                part(f"{tag}S nets of the characteristic map", False, str(exc))
+                return
+            check_hypotheses(nets, lam, part, tag)
+            for name in PATCHES:
+                ok, msg, mb = check_boxes(regularity_form(nets, name, prec), pc["parts"]["regularity"][name],
+                                          f"regularity {name}")
+                part(f"{tag}det J_Phi > 0 on {name}", ok, msg or f"min bound {mb} (local s,t)", mb, "regularity")
+            for curve in STAR_CURVES:
+                ok, msg, mb = check_boxes(star_form(nets, curve, prec), pc["parts"]["star"][curve], f"star {curve}")
+                part(f"{tag}outer boundary star-shaped on {curve}", ok, msg or f"min bound {mb}", mb, "star")
+            if part.failed:
+                return

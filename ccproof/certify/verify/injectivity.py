@@ -1,0 +1,216 @@
+"""Appendix-A injectivity certificates: one valence, or every k >= k0 at once (trusted).
+
+Statement (valence k, everything derived by :mod:`.statement` from k and the rules): for the blend
+G(y) = w(Phi(y)) y + (1 - w(Phi(y))) Phi(y) on the face y in [0, 1]^2 (docs/readings.md R5-R7),
+det J_G > 0 on [0, 1]^2 minus the corner, det J_Phi > 0, and [0, 1/2]^2 lies inside Phi([0, 1]^2).
+The hints are the level N and the boxes of parts B, D, E. Parts (docs/certificates.md):
+
+  S  the derivation's identities in F (eigen-equation, normalization, axes, continuity, layers);
+  H  0 < lam < 1, 2 lam^4 < 1 and the outer curve in the closed first quadrant (arb);
+  A  lam^N max(coordinates) < 1/6;  B  det J_Phi > 0 on layer 0;  C  [0,1/2]^2 inside the image;
+  D  det J_G > 0 on every required (cell, w piece);  E  det J_G / h^2 > 0 on the corner cell.
+"""
+
+from __future__ import annotations
+
+import re
+
+from flint import arb, ctx, fmpq
+
+from ccproof.rigorous import bernstein_coefficients
+
+from .errors import CertificateError
+from .interval import hull_nets, interval_cells, lam_interval_ok, parameter_nets
+from .maps import (
+    cell_det_poly,
+    corner_containment,
+    corner_det_form,
+    outer_curves,
+    regularity_form,
+    required_cells,
+    square_inside_image,
+)
+from .record import exact_keys, field_of, kname
+from .replay import check_boxes, parse_decimal, parse_path
+from .statement import PATCHES, StatementError, c_lam, derivation, nets_for_valence
+
+SCHEMA = "ccproof.injectivity/2"
+_CELL_KEY = re.compile(r"[0-9]{1,4},[0-9]{1,4},[0-2],[0-2]")
+
+
+def check_derivation(part):
+    """Part S: the statement's identities (once per process; every valence at once)."""
+    d = derivation()
+    bad = [name for name, ok in d.hypotheses if not ok]
+    part("S statement derived from the rules", not bad,
+         "fails: " + "; ".join(bad) if bad else f"{len(d.hypotheses)} identities in Q(c)[lam] hold exactly "
+         f"(mirror symmetry {'holds' if d.symmetric else 'does not hold'})")
+    return not bad
+
+
+def check_hypotheses(nets, lam, part, tag=""):
+    """Part H: 0 < lam < 1, 2 lam^4 < 1 and the outer curve of the face in the closed first quadrant."""
+    exact = outer_curves(derivation().bezier)  # a coordinate that is exactly 0 in F is on the axis
+    quadrant = all(q.is_zero() or x >= 0 for cv, ecv in zip(outer_curves(nets), exact) for p, e in zip(cv, ecv)
+                   for x, q in zip(p, e))  # arb >= : certainly
+    ok = lam > 0 and lam < 1 and 2 * lam**4 < 1
+    part(f"{tag}H 0 < lam < 1, 2 lam^4 < 1, outer curve in the first quadrant", ok and quadrant,
+         "" if ok and quadrant else ("lam fails" if not ok else "an outer control point may leave the quadrant"))
+
+
+def _check_structure(parts, cell_vars):
+    """Validate every box list before any arithmetic, so a malformed file fails fast and by name."""
+    exact_keys(parts, ("regularity", "cells", "corner"), "parts")
+    for section, nvars in (("regularity", 2), ("cells", cell_vars), ("corner", 4)):
+        sec = field_of(parts, section, dict, "parts")
+        if section != "cells":
+            exact_keys(sec, PATCHES, f"parts.{section}")
+        for key, boxes in sec.items():
+            if section == "cells" and not (isinstance(key, str) and _CELL_KEY.fullmatch(key)):
+                raise CertificateError(f"parts.cells: malformed key {key!r} (expected 'l,m,p,q')")
+            if not isinstance(boxes, list) or not boxes:
+                raise CertificateError(f"parts.{section}.{key}: boxes must be a non-empty list")
+            for b in boxes:
+                if not isinstance(b, dict) or set(b) != {"path", "bound"}:
+                    raise CertificateError(f"parts.{section}.{key}: a box must be {{'path', 'bound'}}")
+                parse_path(b["path"], nvars)
+                parse_decimal(b["bound"])
+
+
+def read_n_prec(cert):
+    N = field_of(cert, "N", int, "certificate")
+    prec = field_of(cert, "prec", int, "certificate")
+    if not 64 <= prec <= 1024 or not 1 <= N <= 8:
+        raise CertificateError("prec must lie in 64..1024 and N in 1..8")
+    return N, prec
+
+
+def verify_valence(cert, k, part, log):
+    """One valence k (an int)."""
+    exact_keys(cert, ("schema", "valence", "N", "prec", "parts"), "certificate")
+    N, prec = read_n_prec(cert)
+    parts = field_of(cert, "parts", dict, "certificate")
+    _check_structure(parts, 2)
+    log(f"certificate for valence {k} (N = {N}, {prec} bits)")
+    if not check_derivation(part):
+        return
+    sym = derivation().symmetric
+    try:
+        nets = nets_for_valence(k, prec)
+    except StatementError as exc:
+        part("S nets of valence k in arb", False, str(exc))
+        return
+    with ctx.workprec(prec):
+        lam = c_lam(k, prec)[1]
+        check_hypotheses(nets, lam, part)
+        cells = [(f"{l},{m},{p},{q}",
+                  lambda c=(l, m, p, q): bernstein_coefficients(cell_det_poly(nets, lam, N, *c, prec)))
+                 for l, m, p, q in required_cells(nets, lam, N, prec, sym)]
+        check_parts(parts, nets, lam, N, prec, cells, part, "")
+
+
+def check_parts(parts, nets, lam, N, prec, cells, part, tag):
+    """Parts A-E for the arb ``nets`` and ``lam``; ``cells`` lists (key, build root) of every required cell.
+    Stops at the first failed part (it is named; the rest is moot)."""
+    okA, value = corner_containment(nets, lam, N)
+    part(f"{tag}A corner cell maps into [0,1/6)^2", okA, "" if okA else f"lam^N * max = {value.str(6)}")
+    if part.failed:
+        return
+    _check_sections(parts, "regularity", "B det J_Phi > 0 on layer 0", lambda n: regularity_form(nets, n, prec),
+                    part, tag)
+    if part.failed:
+        return
+    part(f"{tag}C [0,1/2]^2 inside Phi([0,1]^2)", square_inside_image(nets))
+    if part.failed:
+        return
+    required = {key for key, _ in cells}
+    extra = sorted(set(parts["cells"]) - required)
+    if extra:
+        part(f"{tag}D cells", False, f"cell(s) {', '.join(extra[:5])} are not required by the statement "
+             "(a certificate holds nothing unchecked)")
+        return
+    minD, nboxes = None, 0
+    for key, build in cells:
+        boxes = parts["cells"].get(key)
+        if boxes is None:
+            part(f"{tag}D cell {key}", False, "required (l, m, p, q) not in the certificate")
+            return
+        ok, msg, mb = check_boxes(build(), boxes, f"cell {key}")
+        nboxes += len(boxes)
+        if not ok:
+            part(f"{tag}D cell {key}", False, msg)
+            return
+        minD = mb if minD is None or mb < minD else minD
+    part(f"{tag}D det J_G > 0 on every cell != (0,0)", True, f"{len(cells)} cells, {nboxes} boxes, min bound {minD}",
+         minD, "cells")
+    _check_sections(parts, "corner", "E det J_G / h^2 > 0 on the corner cell (all layers >= N)",
+                    lambda n: corner_det_form(nets, lam, N, n, prec), part, tag)
+
+
+def _check_sections(parts, sec, label, build, part, tag):
+    mins = []
+    for name in PATCHES:
+        ok, msg, mb = check_boxes(build(name), parts[sec][name], f"{sec} {name}")
+        if not ok:
+            part(f"{tag}{label[0]} {sec} {name}", False, msg)
+            return
+        mins.append(mb)
+    part(f"{tag}{label}", True, f"min bound {min(mins)} (w.r.t. the local variables)", min(mins), sec)
+
+
+def verify_interval(cert, k, part, log):
+    """Every valence k >= k0 (``k = {"min": k0}``)."""
+    exact_keys(cert, ("schema", "valence", "N", "prec", "parameter", "pieces"), "certificate")
+    N, prec = read_n_prec(cert)
+    param = field_of(cert, "parameter", dict, "certificate")
+    exact_keys(param, ("variable", "taylor_degree", "truncation_degree"), "parameter")
+    deg, D = field_of(param, "taylor_degree", int, "parameter"), field_of(param, "truncation_degree", int, "parameter")
+    if param["variable"] != "lam" or not 1 <= D <= deg <= 8:
+        raise CertificateError("parameter must be {'variable': 'lam', 1 <= truncation_degree <= taylor_degree <= 8}")
+    pieces = field_of(cert, "pieces", list, "certificate")
+    if not 1 <= len(pieces) <= 64:
+        raise CertificateError("there must be 1..64 lam pieces")
+    ends = []
+    for pc in pieces:
+        exact_keys(pc, ("lam", "parts"), "piece")
+        lo_hi = field_of(pc, "lam", list, "piece")
+        if len(lo_hi) != 2:
+            raise CertificateError("piece lam must be [low, high]")
+        ends.append(tuple(parse_decimal(x) for x in lo_hi))
+        _check_structure(field_of(pc, "parts", dict, "piece"), 3)
+    if any(not a < b for a, b in ends) or any(ends[i][1] != ends[i + 1][0] for i in range(len(ends) - 1)):
+        raise CertificateError("the lam pieces must be increasing and contiguous")  # exact fmpq comparisons
+    if not (ends[0][0] > fmpq(1, 4) and ends[-1][1] < 1):
+        raise CertificateError("the lam pieces must lie inside (1/4, 1)")
+    log(f"certificate for valences k >= {k['min']} (N = {N}, {prec} bits, {len(pieces)} lam piece(s), "
+        f"Taylor degree {deg}, truncation {D})")
+    if not check_derivation(part):
+        return
+    exact = derivation().integer_forms("bspline")
+    sym = derivation().symmetric
+    ok = lam_interval_ok(k["min"], ends[0][0], ends[-1][1], prec)
+    part(f"lam(k) in [{ends[0][0]}, {ends[-1][1]}] for every k >= {k['min']}", ok)
+    for idx, ((La, Lb), pc) in enumerate(zip(ends, pieces)):
+        if part.failed:
+            return
+        with ctx.workprec(prec):
+            try:
+                zn = [parameter_nets(exact, La, Lb, i, deg, prec) for i in range(N)]
+            except CertificateError as exc:
+                part(f"[piece {idx}] S nets as Taylor models", False, str(exc))
+                return
+            nets = hull_nets(zn[0], prec)
+            lam = arb(La).union(arb(Lb))
+            check_hypotheses(nets, lam, part, f"[piece {idx}] ")
+            if part.failed:
+                return
+            check_parts(pc["parts"], nets, lam, N, prec, interval_cells(zn, N, D, prec, sym), part,
+                        f"[piece {idx}] ")
+
+
+def verify_injectivity(cert, k, part, log):
+    if isinstance(k, dict):
+        verify_interval(cert, k, part, log)
+    else:
+        verify_valence(cert, k, part, log)
+    return kname(k)

@@ -1,0 +1,126 @@
+"""Every valence k >= k0 in one certificate: lam as a variable, Taylor models in zeta (trusted).
+
+The valence enters the statement only through lam = lam(k), with c = (16 lam^2 - 10 lam + 1)/(2 lam)
+(docs/readings.md R2), so the exact forms of :mod:`.statement` are rational functions of lam. On a piece
+[La, Lb] of lam, lam = mid + zeta * half-width with zeta in [-1, 1]; every net entry becomes an exact
+Taylor polynomial in zeta plus a remainder bounded by exact Bernstein coefficients
+(:func:`entry_model`). Parts A, B, C, E use the hulls over zeta, part D keeps zeta as a Bernstein
+variable (axis 0). docs/appendix_a.md section 6 has the mathematics.
+"""
+
+from __future__ import annotations
+
+from flint import arb, ctx, fmpq, fmpq_poly
+
+from ccproof.rigorous import Poly, bernstein_coefficients, exact_fmpq, jacobian_determinant, range_enclosure
+
+from .errors import CertificateError
+from .maps import cell_geometry, cell_pieces, dyadic_cells, net_form, weight_piece
+from .statement import B2Z, PATCHES
+
+ZBOX = ((fmpq(-1), fmpq(1)), (fmpq(0), fmpq(1)), (fmpq(0), fmpq(1)))  # (zeta, s, t) of part D
+
+
+def _bern1(p, prec=None):
+    """Bernstein coefficients on zeta in [-1, 1] of an fmpq_poly (or a list of arb coefficients)."""
+    c = [p[i] for i in range(max(1, p.degree() + 1))] if isinstance(p, fmpq_poly) else p
+    return bernstein_coefficients(Poly.from_dense((len(c),), c, prec), box=ZBOX[:1]).coeffs
+
+
+def entry_model(form, L, layer, degree, prec):
+    """lam^layer (A(c) + B(c) lam)/D(c) for lam = L(zeta), zeta in [-1, 1], c = (16 lam^2 - 10 lam + 1)/(2 lam)
+    (R2), as arb coefficients of T(zeta) + [-r, r]: T the exact Taylor polynomial of ``degree`` at 0 and
+    r = max|Bernstein coefficients of num - den T| / min|those of den| (den of one strict sign)."""
+    cn, cd = 16 * L * L - 10 * L + 1, 2 * L
+    M = max(len(f) for f in form) - 1
+
+    def clear(P):  # P(c) (2 lam)^M as a polynomial in zeta
+        return sum((cn**e * cd ** (M - e) * int(a) for e, a in enumerate(P)), fmpq_poly([]))
+
+    num, den = (clear(form[0]) + clear(form[1]) * L) * L**layer, clear(form[2])
+    db = _bern1(den)
+    if not (all(c > 0 for c in db) or all(c < 0 for c in db)):
+        raise CertificateError("a denominator of the exact nets may vanish on the lam interval")
+    T = []
+    for j in range(degree + 1):
+        T.append((num[j] - sum((den[i] * T[j - i] for i in range(1, j + 1)), fmpq(0))) / den[0])
+    r = max(abs(c) for c in _bern1(num - den * fmpq_poly(T))) / min(abs(c) for c in db)
+    out = [arb(t) for t in T]
+    out[0] += arb(0, arb(r).upper())
+    return out
+
+
+def parameter_nets(exact, La, Lb, layer, degree, prec):
+    """Bezier nets of lam^layer Phi for every lam in [La, Lb]: net[i][j] = (x, y), each a list of arb
+    coefficients of a polynomial in zeta in [-1, 1] (lam = (La + Lb)/2 + zeta (Lb - La)/2), from the
+    table's exact B-spline forms (see :func:`entry_model`)."""
+    L = fmpq_poly([(La + Lb) / 2, (Lb - La) / 2])
+    out = {}
+    with ctx.workprec(prec):
+        for name in PATCHES:
+            bs = [[[entry_model(f, L, layer, degree, prec) for f in pt] for pt in row] for row in exact[name]]
+            out[name] = [[tuple([sum((bs[i][j][d][e] * B2Z[a][i] * B2Z[b][j] for i in range(4) for j in range(4)),
+                                     arb(0)) / 36 for e in range(degree + 1)] for d in range(2))
+                          for b in range(4)] for a in range(4)]
+    return out
+
+
+def hull_nets(znets, prec):
+    """arb nets enclosing the zeta-polynomial nets for every zeta in [-1, 1] (Bernstein range)."""
+    def hull(co):
+        lo, hi = range_enclosure(_bern1(co, prec))
+        return lo.union(hi)
+    return {n: [[tuple(hull(co) for co in pt) for pt in row] for row in net] for n, net in znets.items()}
+
+
+def cell_maps_z(znets, N, l, m, D, prec):
+    """(X, Y) = lam^i Phi on cell (l, m) as ball Polys in (zeta, s, t), truncated to degree D in zeta."""
+    i, name, box = cell_geometry(l, m, N)
+    out = []
+    for d in range(2):
+        co = []  # zeta^e blocks of the (s, t) power forms
+        for e in range(len(znets[i][name][0][0][d])):
+            net = [[(pt[0][e], pt[1][e]) for pt in row] for row in znets[i][name]]
+            co += net_form(net, d, prec, box).to_poly().coeffs
+        out.append(Poly.from_dense((len(co) // 16, 4, 4), co, prec).truncate(D))
+    return out
+
+
+def _weight_z(p, X, D):
+    """b(X) on piece p, Horner around the exact midpoint x0 of X's constant term (tighter balls)."""
+    x0 = exact_fmpq(X.coeffs[0].mid())
+    b = weight_piece(p).affine(0, x0, x0 + 1)
+    acc = Poly.constant(b.coeffs[-1], 3, X.prec)
+    for c in b.coeffs[-2::-1]:
+        acc = (acc * (X - x0)).truncate(D) + c
+    return acc
+
+
+def interval_cells(znets, N, D, prec, symmetric=False):
+    """Part D for an interval: every (key, build root) with a w piece met by the Bernstein hull of the
+    cell's image over all zeta; the root is det dG/d(s,t) in (zeta, s, t) on ZBOX (Taylor model in zeta)."""
+    out = []
+    v = [Poly.variable(a, 3, prec) for a in range(3)]
+    with ctx.workprec(prec):
+        for l, m in dyadic_cells(N, symmetric):
+            X, Y = cell_maps_z(znets, N, l, m, D, prec)
+            XY = [bernstein_coefficients(F, box=ZBOX) for F in (X, Y)]
+            y1, y2 = (v[1] + l) * fmpq(1, 2**N), (v[2] + m) * fmpq(1, 2**N)
+            for p, q in cell_pieces(*XY):
+                if p < 3 and q < 3:
+                    def build(X=X, Y=Y, p=p, q=q, y1=y1, y2=y2):
+                        with ctx.workprec(prec):
+                            w = (_weight_z(p, X, D) * _weight_z(q, Y, D)).truncate(D)
+                            G = [(F + w * (y - F)).truncate(D) for y, F in ((y1, X), (y2, Y))]
+                            return bernstein_coefficients(jacobian_determinant(G, (1, 2)).truncate(D), box=ZBOX)
+                    out.append((f"{l},{m},{p},{q}", build))
+    return out
+
+
+def lam_interval_ok(k0, La, Lb, prec):
+    """[La, Lb] contains lam(k) for every k >= k0: La <= lam(k0) and Lb >= (3 + sqrt 5)/8 = lim lam
+    (lam increases with c = cos(2 pi/k), which increases with k)."""
+    with ctx.workprec(prec):
+        c = arb(fmpq(2, k0)).cos_pi()
+        lam0 = (5 + c + ((1 + c) * (9 + c)).sqrt()) / 16
+        return bool(lam0 >= La) and bool((3 + arb(5).sqrt()) / 8 <= Lb)

@@ -1,0 +1,198 @@
+"""The maps of the statement as Bernstein forms: weight, cells, corner, regularity, outer curves (trusted).
+
+Given nets of the characteristic map (arb balls enclosing the exact nets of :mod:`.statement`) and
+lam, these functions build the polynomials whose positivity the certificates claim
+(docs/certificates.md, parts A-E; docs/appendix_a.md derives them).
+"""
+
+from __future__ import annotations
+
+from flint import ctx, fmpq, fmpq_poly
+
+from ccproof.rigorous import BernsteinForm, Poly, bernstein_jacobian_determinant, jacobian_determinant
+
+from .statement import PATCHES
+
+BREAKS = (fmpq(0), fmpq(1, 6), fmpq(1, 3), fmpq(1, 2))  # w pieces (docs/readings.md R5); piece 3 is w = 0
+
+
+def weight_piece(p):
+    """b(x) = B(6x+1) + B(6x) + B(6x-1) on [BREAKS[p], BREAKS[p+1]] (R5) as an exact 1-var Poly;
+    B is the centred uniform cubic B-spline: (4 - 6z^2 + 3|z|^3)/6 on |z| <= 1, (2 - |z|)^3/6 on 1..2."""
+    z = fmpq_poly([0, 6])  # z = 6x
+
+    def B(shift, region):  # B(z + shift) on a region where z + shift has one sign/one piece
+        a = z + shift
+        if region == "inner+":
+            return (4 - 6 * a**2 + 3 * a**3) / 6
+        if region == "inner-":
+            return (4 - 6 * a**2 - 3 * a**3) / 6
+        if region == "outer+":
+            return (2 - a) ** 3 / 6
+        return fmpq_poly([0])
+
+    pieces = {  # z in [0,1]: z+1 in [1,2], z in [0,1], z-1 in [-1,0]; and so on
+        0: B(1, "outer+") + B(0, "inner+") + B(-1, "inner-"),
+        1: B(1, "zero") + B(0, "outer+") + B(-1, "inner+"),
+        2: B(0, "zero") + B(-1, "outer+"),
+    }
+    poly = pieces[p]
+    return Poly({(i,): poly[i] for i in range(poly.degree() + 1)}, 1)
+
+
+def net_form(net, coord, prec, box=None):
+    """Bernstein form (unit box in the local variables) of one coordinate of a 4x4 Bezier net,
+    restricted to ``box`` (dyadic sub-box of [0,1]^2 in the piece's local parameters)."""
+    f = BernsteinForm((4, 4), [net[i][j][coord] for i in range(4) for j in range(4)], prec=prec)
+    if box is not None:
+        f = f.restrict(box)
+    return BernsteinForm((4, 4), f.coeffs, prec=prec)  # relabel the sub-box as the unit box
+
+
+def cell_geometry(l, m, N):
+    """Layer i, piece name and (s, t) sub-box of the dyadic cell (l, m) != (0, 0) of level N."""
+    M = max(l, m)
+    i = N - 1 - (M.bit_length() - 1)
+    scale = fmpq(2**i, 2**N)  # layer-0 coordinates of the cell: [l, l+1] * scale
+    u0, v0 = l * scale, m * scale
+    half = fmpq(1, 2)
+    if u0 >= half and v0 < half:
+        name, s0, t0 = "P1", 2 * u0 - 1, 2 * v0
+    elif u0 >= half:
+        name, s0, t0 = "P2", 2 * u0 - 1, 2 * v0 - 1
+    else:
+        name, s0, t0 = "P3", 2 * u0, 2 * v0 - 1
+    h = 2 * scale
+    return i, name, ((s0, s0 + h), (t0, t0 + h))
+
+
+def cell_pieces(X, Y):
+    """The w pieces (p, q), p, q in 0..3, whose regions the Bezier hull of (X, Y) may meet."""
+    out = []
+    rng = []
+    for F in (X, Y):
+        lo = min(c.lower() for c in F.coeffs)
+        hi = max(c.upper() for c in F.coeffs)
+        rng.append([p for p in range(4) if not (hi < BREAKS[p] or (p < 3 and lo > BREAKS[p + 1]))])
+    for p in rng[0]:
+        for q in rng[1]:
+            out.append((p, q))
+    return out
+
+
+def dyadic_cells(N, symmetric):
+    """The cells (l, m) != (0, 0) of level N that part D checks (l <= m only when ``symmetric``)."""
+    return [(l, m) for l in range(2**N) for m in range(2**N) if (l, m) != (0, 0) and not (symmetric and l > m)]
+
+
+def required_cells(nets, lam, N, prec, symmetric=False):
+    """Every (l, m, p, q) of part D: cell (l, m) of :func:`dyadic_cells` and w piece (p, q), p, q < 3, met
+    by the Bezier hull of Phi(cell). Pieces with p = 3 or q = 3 have w = 0 (G = Phi, covered by part B)."""
+    out = []
+    with ctx.workprec(prec):
+        for l, m in dyadic_cells(N, symmetric):
+            i, name, box = cell_geometry(l, m, N)
+            li = lam**i
+            X, Y = (net_form(nets[name], d, prec, box) for d in (0, 1))
+            X = BernsteinForm(X.shape, [c * li for c in X.coeffs], prec=prec)
+            Y = BernsteinForm(Y.shape, [c * li for c in Y.coeffs], prec=prec)
+            out += [(l, m, p, q) for p, q in cell_pieces(X, Y) if p < 3 and q < 3]
+    return out
+
+
+def cell_det_poly(nets, lam, N, l, m, p, q, prec):
+    """det dG/d(s,t) on cell (l, m) for the w piece (p, q) (p, q < 3), local coordinates in [0,1]^2."""
+    i, name, box = cell_geometry(l, m, N)
+    with ctx.workprec(prec):
+        li = lam**i
+        X = net_form(nets[name], 0, prec, box).to_poly() * li
+        Y = net_form(nets[name], 1, prec, box).to_poly() * li
+        s, t = Poly.variable(0, 2), Poly.variable(1, 2)
+        y1 = (s + l) * fmpq(1, 2**N)
+        y2 = (t + m) * fmpq(1, 2**N)
+        w = weight_piece(p).compose([X]) * weight_piece(q).compose([Y])
+        G1 = w * y1 + (1 - w) * X
+        G2 = w * y2 + (1 - w) * Y
+        return jacobian_determinant([G1, G2])
+
+
+def corner_det_form(nets, lam, N, name, prec):
+    """Bernstein form on [0,1]^4 of det(J_G)/h^2 on layer i >= N of piece ``name`` in (rho, kappa, s, t)
+    (R9 form), computed in Bernstein arithmetic (stays tight for the interval nets of k >= k0)."""
+    with ctx.workprec(prec):
+        def var(axis, c):  # c * x_axis
+            return BernsteinForm(tuple(2 if i == axis else 1 for i in range(4)), [0, c], prec=prec)
+
+        P = [BernsteinForm((1, 1, 4, 4), net_form(nets[name], d, prec).coeffs, prec=prec) for d in range(2)]
+        r, qv, s, t = var(0, lam ** (3 * N)), var(1, (2 * lam**4) ** N), var(2, 1), var(3, 1)
+        half = fmpq(1, 2)
+        D = {"P1": (half + s * half, t * half), "P2": (half + s * half, half + t * half),
+             "P3": (s * half, half + t * half)}[name]
+        Px3, Py3 = P[0] * P[0] * P[0], P[1] * P[1] * P[1]
+        U = (Px3 + Py3) * 36 - r * Px3 * Py3 * 1296
+        W = 1 - r * U
+        gradU = (U.diff(2), U.diff(3))
+        J = [[None, None], [None, None]]
+        for a in range(2):
+            for b in range(2):
+                e = qv * (U * P[a].diff(2 + b) + P[a] * gradU[b]) - r * D[a] * gradU[b]
+                J[a][b] = e + W * half if a == b else e
+        return J[0][0] * J[1][1] - J[0][1] * J[1][0]
+
+
+def regularity_form(nets, name, prec):
+    """Bernstein form (degree (5,5)) of det J_Phi w.r.t. the local (s, t) of piece ``name`` on layer 0,
+    computed in Bernstein arithmetic (stays tight for the interval nets of k >= k0)."""
+    with ctx.workprec(prec):
+        return bernstein_jacobian_determinant([net_form(nets[name], 0, prec), net_form(nets[name], 1, prec)])
+
+
+STAR_CURVES = {"P1s1": ("P1", "s", 1), "P2s1": ("P2", "s", 1), "P2t1": ("P2", "t", -1), "P3t1": ("P3", "t", -1)}
+
+
+def star_form(nets, curve, prec):
+    """Bernstein form (degree 5) of x y' - y x' along one cubic of the outer boundary, oriented from
+    (1,0) towards (0,1). Positive on all four curves means the outer boundary is star-shaped."""
+    name, side, sign = STAR_CURVES[curve]
+    net = nets[name]
+    pts = [net[3][j] for j in range(4)] if side == "s" else [net[i][3] for i in range(4)]
+    with ctx.workprec(prec):
+        X = BernsteinForm((4,), [p[0] for p in pts], prec=prec)
+        Y = BernsteinForm((4,), [p[1] for p in pts], prec=prec)
+        cross = X * Y.diff(0) - Y * X.diff(0)
+        return cross if sign > 0 else -cross
+
+
+def corner_containment(nets, lam, N):
+    """Part A: (lam^N * max(all Bezier coordinates) < 1/6 certainly, that ball)."""
+    hull = max((c[d].upper() for n in PATCHES for row in nets[n] for c in row for d in range(2)),
+               key=lambda z: z.mid())
+    return bool(lam**N * hull < fmpq(1, 6)), lam**N * hull
+
+
+def square_inside_image(nets):
+    """Part C: the images of the outer sides u = 1, v = 1 avoid [0,1/2]^2 (replayed bisection)."""
+    return all(_curve_avoids(cv, 40) for cv in outer_curves(nets))
+
+
+def outer_curves(nets):
+    return [[nets["P1"][3][j] for j in range(4)], [nets["P2"][3][j] for j in range(4)],
+            [nets["P2"][i][3] for i in range(4)], [nets["P3"][i][3] for i in range(4)]]
+
+
+def _curve_avoids(curve, depth):
+    """max(x, y) > 1/2 on the whole cubic Bezier curve (replayed bisection, bounded depth)."""
+    half = fmpq(1, 2)
+    if all(p[0] > half for p in curve) or all(p[1] > half for p in curve):
+        return True
+    if depth == 0:
+        return False
+    b = [list(p) for p in curve]
+    left, right, pts = [b[0]], [b[3]], b
+    for _ in range(3):
+        pts = [[(p[i] + q[i]) * half for i in range(2)] for p, q in zip(pts, pts[1:])]
+        left.append(pts[0])
+        right.append(pts[-1])
+    return _curve_avoids(left, depth - 1) and _curve_avoids(right[::-1], depth - 1)
+
+

@@ -1,0 +1,104 @@
+"""Verdicts: the parts of a check with their reasons, and strict reading of certificate fields (trusted)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from flint import fmpq
+
+from .errors import CertificateError
+
+
+@dataclass
+class Part:
+    """One checked claim: ``name``, ``ok``, a ``message`` (the reason when it failed) and, for box parts,
+    the smallest claimed bound that was re-checked (``bound``, an exact fmpq) in local coordinates."""
+
+    name: str
+    ok: bool
+    message: str = ""
+    bound: fmpq | None = None
+
+
+@dataclass
+class VerifyResult:
+    """The verdict on one certificate: ``ok`` only when every part passed; ``parts`` in order; ``error``
+    names why the file could not be checked at all (malformed, unknown field), else None. True as a bool
+    exactly when ``ok``. ``margins`` maps a section (``regularity``, ``cells``, ``corner``, ``star``) to the
+    smallest bound re-checked in this run."""
+
+    path: str | None = None
+    schema: str | None = None
+    valence: object = None
+    N: int | None = None
+    parts: list = field(default_factory=list)
+    error: str | None = None
+    seconds: float = 0.0
+    margins: dict = field(default_factory=dict)
+
+    @property
+    def ok(self):
+        return self.error is None and bool(self.parts) and all(p.ok for p in self.parts)
+
+    def __bool__(self):
+        return self.ok
+
+    def failures(self):
+        return [p for p in self.parts if not p.ok]
+
+
+class Recorder:
+    """Collects the parts of a :class:`VerifyResult` and prints each as PASS/FAIL through ``log``."""
+
+    def __init__(self, result, log):
+        self.result, self.log = result, log
+
+    def __call__(self, name, ok, msg="", bound=None, section=None):
+        self.result.parts.append(Part(name, bool(ok), msg, bound))
+        if ok and bound is not None and section is not None:
+            old = self.result.margins.get(section)
+            self.result.margins[section] = bound if old is None or bound < old else old
+        self.log(f"  {'PASS' if ok else 'FAIL'}  {name}{(': ' + msg) if msg else ''}")
+
+    @property
+    def failed(self):
+        return any(not p.ok for p in self.result.parts)
+
+
+def field_of(obj, key, kind, where):
+    """``obj[key]`` of type ``kind`` (bool is never an int here), else :class:`CertificateError`."""
+    if not isinstance(obj, dict) or key not in obj:
+        raise CertificateError(f"{where}: missing field {key!r}")
+    val = obj[key]
+    if not isinstance(val, kind) or isinstance(val, bool):
+        raise CertificateError(f"{where}: field {key!r} has the wrong type")
+    return val
+
+
+def exact_keys(obj, keys, where):
+    """Reject unknown and missing keys: nothing in a certificate goes unchecked."""
+    if not isinstance(obj, dict):
+        raise CertificateError(f"{where} must be an object")
+    extra, missing = sorted(set(obj) - set(keys)), sorted(set(keys) - set(obj))
+    if extra:
+        raise CertificateError(f"{where}: unknown field(s) {', '.join(map(repr, extra))} (nothing unchecked "
+                               "is allowed in a certificate)")
+    if missing:
+        raise CertificateError(f"{where}: missing field(s) {', '.join(map(repr, missing))}")
+
+
+def read_valence(cert):
+    """An int k >= 3 or ``{"min": k0}`` with k0 >= 3 (at most 10^6, so every derived check stays fast)."""
+    k = field_of(cert, "valence", (int, dict), "certificate")
+    if isinstance(k, dict):
+        exact_keys(k, ("min",), "valence")
+        k0 = k["min"]
+        if not isinstance(k0, int) or isinstance(k0, bool) or not 3 <= k0 <= 10**6:
+            raise CertificateError(f"valence interval must be {{'min': K0}} with 3 <= K0 <= 10^6, got {k!r}")
+    elif not 3 <= k <= 10**6:
+        raise CertificateError(f"valence {k} outside 3..10^6")
+    return k
+
+
+def kname(k):
+    return f">={k['min']}" if isinstance(k, dict) else str(k)

@@ -1,0 +1,112 @@
+"""The Catmull-Clark rules on the k-regular complex, written out for the verifier (trusted).
+
+The verifier re-derives everything from these three rules (bmz04 Fig. 1, docs/readings.md R1) and
+nothing else: face point = mean of the face's corners; edge point = mean of the edge's two ends and
+the two new face points beside it; vertex point V' = (F + 2R + (n - 3) V)/n with F the mean of the new
+face points and R the mean of the edge midpoints around V, n its valence.
+
+Positions. Sector j of the k-regular complex is the quadrant of grid positions (a, b), a, b >= 0,
+spanned by the edges e_j (along a) and e_(j+1) (along b); the centre (0, 0) is the extraordinary
+vertex; every other vertex has valence 4. A position given in sector j's coordinates that lies in a
+neighbouring sector is canonicalized to (delta, a', b'): position (a', b') of sector j + delta::
+
+        b
+        ^   sector j+1 | sector j
+        |   (a <= 0)   | (a >= 1, b >= 0)
+        +--------------C---------> a      (a, 0), a < 0: on e_(j+2)
+            sector j-1: b <= -1 (a >= 0)
+
+The two-ring of sector 0 is :data:`TWO_RING` (6 positions); a symmetric (Fourier-mode) vector is
+given by its sector-0 values and ``value(j, p) = rot^j value(0, p)``.
+"""
+
+from __future__ import annotations
+
+from flint import fmpq
+
+TWO_RING = ((1, 0), (2, 0), (1, 1), (2, 1), (1, 2), (2, 2))
+CENTRE = (0, 0)
+
+
+def canonical(a, b):
+    """``(delta, a', b')``: the position (a, b) of some sector is (a', b') of the sector delta steps on;
+    ``(0, 0, 0)`` is the centre."""
+    if a == 0 and b == 0:
+        return (0, 0, 0)
+    if a >= 1 and b >= 0:
+        return (0, a, b)
+    if a <= 0 and b >= 1:
+        return (1, b, -a)
+    if a >= 0 and b <= -1:
+        return (-1, -b, a)
+    if b == 0 and a < 0:
+        return (2, -a, 0)
+    raise ValueError(f"grid position ({a}, {b}) is more than one sector away")
+
+
+def _add(acc, comb, w):
+    for p, x in comb.items():
+        acc[p] = acc.get(p, 0) + w * x
+    return acc
+
+
+def face_point(a, b):
+    """New face point of the level-0 face with lower corner (a, b): {raw position: weight}."""
+    return {(a + i, b + j): fmpq(1, 4) for i in (0, 1) for j in (0, 1)}
+
+
+def level1_rule(A, B):
+    """The level-1 vertex at sector-local level-1 position (A, B) != (0, 0) as a combination of level-0
+    positions (raw, sector-local), derived from the three rules (the vertex is not the centre, so
+    a vertex point has n = 4)."""
+    if (A, B) == CENTRE:
+        raise ValueError("the centre has valence k: use centre_rule")
+    half = fmpq(1, 2)
+    if A % 2 and B % 2:
+        return face_point((A - 1) // 2, (B - 1) // 2)
+    if A % 2 or B % 2:
+        if A % 2:  # edge (a, b)-(a+1, b); faces (a, b) and (a, b-1)
+            a, b = (A - 1) // 2, B // 2
+            ends, faces = ((a, b), (a + 1, b)), ((a, b), (a, b - 1))
+        else:  # edge (a, b)-(a, b+1); faces (a, b) and (a-1, b)
+            a, b = A // 2, (B - 1) // 2
+            ends, faces = ((a, b), (a, b + 1)), ((a, b), (a - 1, b))
+        acc = {}
+        for e in ends:
+            _add(acc, {e: 1}, fmpq(1, 4))
+        for f in faces:
+            _add(acc, face_point(*f), fmpq(1, 4))
+        return acc
+    a, b = A // 2, B // 2  # vertex point, n = 4: V' = (F + 2R + V)/4
+    acc = {(a, b): fmpq(1, 4)}
+    for fa, fb in ((a, b), (a - 1, b), (a, b - 1), (a - 1, b - 1)):
+        _add(acc, face_point(fa, fb), fmpq(1, 16))  # F/4 = (mean of 4 face points)/4
+    for e in ((a + 1, b), (a - 1, b), (a, b + 1), (a, b - 1)):
+        _add(acc, {(a, b): half, e: half}, fmpq(2, 16))  # 2R/4 = 2 (mean of 4 midpoints)/4
+    return acc
+
+
+def centre_rule_mode0(t):
+    """The new centre in Fourier mode 0 (every sector equal) for t = 1/k: V' = t (F + 2R) + (1 - 3t) V,
+    with F = the face point of the sector-0 face (0, 0) and R = (V + value(1, 0))/2 (all sectors alike)."""
+    acc = {CENTRE: 1 - 3 * t}
+    _add(acc, face_point(0, 0), t)
+    _add(acc, {CENTRE: fmpq(1, 2), (1, 0): fmpq(1, 2)}, 2 * t)
+    return acc
+
+
+def apply(comb, lookup, zero):
+    """Sum of weight * lookup(delta, (a', b')) over a combination of raw positions; the centre is
+    ``lookup(0, (0, 0))``."""
+    acc = zero
+    for (a, b), w in comb.items():
+        delta, a2, b2 = canonical(a, b)
+        acc = acc + lookup(delta, (a2, b2)) * w
+    return acc
+
+
+def level1_value(A, B, lookup, zero):
+    """The level-1 value at any sector-local level-1 position (A, B) != centre, rotated into place:
+    canonicalize to (delta, A', B'), apply the rule in sector delta."""
+    delta, A2, B2 = canonical(A, B)
+    return delta, apply(level1_rule(A2, B2), lookup, zero)

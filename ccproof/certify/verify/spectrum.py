@@ -1,0 +1,136 @@
+"""The spectrum of the Catmull-Clark subdivision matrix, re-derived from the rules (trusted).
+
+The (6k + 1) x (6k + 1) matrix S on the two-ring of the k-regular complex commutes with the rotation
+of the sectors, so the discrete Fourier transform splits it into blocks: for a k-th root of unity
+w = exp(2 pi i m/k), m != 0, the 6 x 6 block B(w) acting on the sector-0 values of vectors with
+value(j, p) = w^j value(0, p) (the centre is then 0), and for m = 0 a 7 x 7 block B0(t), t = 1/k, that
+includes the centre. The spectrum of S is the union of the blocks' spectra. The blocks are built
+here from :mod:`.rules`, and their characteristic polynomials are checked exactly:
+
+  det(x - B(w))  = (x - 1/8)(x - 1/16)(x - 1/32)(x - 1/64) (x^2 - (5 + c) x/8 + 1/16),  c = (w + 1/w)/2,
+  det(x - B0(t)) = (x - 1)(x - 1/8)(x - 1/16)(x - 1/32)(x - 1/64) (x^2 - (12 - 28 t) x/16 + (1 - 3t)/16).
+
+Each is an identity of polynomials (after multiplying by w^6, entries of w B(w) have degree <= 3 in w;
+B0 is affine in t), so it holds as soon as both sides agree on a grid of (deg_x + 1) x (deg_w + 1)
+rational points, which :func:`check_block_polynomials` evaluates with exact determinants.
+
+Consequences (every k >= 3; :func:`spectral_ordering` checks the numbers in arb): mode m != 0 has the
+eigenvalues 1/8..1/64 and the roots of 16 x^2 - 2(5 + c_m) x + 1, c_m = cos(2 pi m/k); the larger root
+lam(c) = (5 + c + sqrt((1 + c)(9 + c)))/16 increases with c and c_1 = c_(k-1) > c_m for 2 <= m <= k - 2,
+so lam = lam(c_1) is the largest of the modes m != 0, a simple root in each of the modes 1 and k - 1
+(discriminant 4(1 + c_1)(9 + c_1) > 0), hence a double, non-defective eigenvalue of S; the smaller roots
+are 1/(16 lam(c_m)) <= 1/4. Mode 0 has 1 (simple), 1/8..1/64 and the roots of
+p0(x) = 16k x^2 - (12k - 28) x + k - 3, both real and >= 0; with 16 lam^2 = 2(5 + c) lam - 1,
+p0(lam) = 28 lam - 3 - 2k(1 - c) lam, so lam exceeds both roots iff p0(lam) > 0 and lam > 3/8 (> the
+vertex (12k - 28)/(32k)).
+"""
+
+from __future__ import annotations
+
+from flint import arb, ctx, fmpq, fmpq_mat
+
+from .rules import CENTRE, TWO_RING, apply, centre_rule_mode0, level1_rule
+
+
+def _block(w=None, t=None):
+    """B(w) (6 x 6, centre dropped) or, with ``t``, B0(t) (7 x 7, centre first) as fmpq rows."""
+    pos = list(TWO_RING) if t is None else [CENTRE] + list(TWO_RING)
+    idx = {p: i for i, p in enumerate(pos)}
+    n = len(pos)
+
+    def column_lookup(delta, p):  # the row vector of the value at (delta, p) in the unknowns
+        out = [fmpq(0)] * n
+        if p == CENTRE:
+            if t is not None:
+                out[idx[CENTRE]] = fmpq(1)
+            return _Vec(out)
+        out[idx[p]] = fmpq(1) if t is not None else fmpq(w) ** delta
+        return _Vec(out)
+
+    rows = []
+    for p in pos:
+        comb = centre_rule_mode0(t) if p == CENTRE else level1_rule(*p)
+        rows.append(list(apply(comb, column_lookup, _Vec([fmpq(0)] * n))))
+    return rows
+
+
+class _Vec(list):
+    def __add__(self, other):
+        return _Vec([a + b for a, b in zip(self, other)])
+
+    def __mul__(self, s):
+        return _Vec([a * s for a in self])
+
+
+def _charpoly_at(rows, x):
+    n = len(rows)
+    return fmpq_mat(n, n, [(x if i == j else 0) - rows[i][j] for i in range(n) for j in range(n)]).det()
+
+
+_SMALL = (fmpq(1, 8), fmpq(1, 16), fmpq(1, 32), fmpq(1, 64))
+
+
+def _claimed_mode(x, c):
+    out = x * x - (5 + c) * x / 8 + fmpq(1, 16)
+    for r in _SMALL:
+        out *= x - r
+    return out
+
+
+def _claimed_mode0(x, t):
+    out = (x - 1) * (x * x - (12 - 28 * t) * x / 16 + (1 - 3 * t) / 16)
+    for r in _SMALL:
+        out *= x - r
+    return out
+
+
+def check_block_polynomials():
+    """True iff both characteristic-polynomial identities of the module docstring hold (exact grid)."""
+    for w in range(1, 20):  # degree <= 18 in w after multiplying by w^6
+        rows = _block(w=fmpq(w))
+        c = (fmpq(w) + 1 / fmpq(w)) / 2
+        for x in range(7):  # degree 6 in x
+            if _charpoly_at(rows, fmpq(x)) != _claimed_mode(fmpq(x), c):
+                return False
+    for t in range(1, 9):  # degree <= 7 in t and in x
+        rows = _block(t=fmpq(t))
+        for x in range(8):
+            if _charpoly_at(rows, fmpq(x)) != _claimed_mode0(fmpq(x), fmpq(t)):
+                return False
+    return True
+
+
+def lam_of(c):
+    return (5 + c + ((1 + c) * (9 + c)).sqrt()) / 16
+
+
+def spectral_ordering(k, prec):
+    """(ok, message): 1 = lam_0 > lam_1 = lam_2 = lam(k) > |lam_3|, lam double and non-defective, for the
+    valence k (an int) or every k >= k0 (``{"min": k0}``); assumes :func:`check_block_polynomials`."""
+    with ctx.workprec(prec):
+        if isinstance(k, dict):
+            k0 = k["min"]
+            c_lo = arb(fmpq(2, k0)).cos_pi()
+            lam_lo, lam_hi = lam_of(c_lo), lam_of(arb(1))
+            lam = lam_lo.union(lam_hi)  # lam(k) for every k >= k0 (lam increases with c)
+            # p0(lam) > 0 for every k >= k0: 1 - c_1 <= 2 pi^2/k^2, so 28 lam - 3 > 4 pi^2 lam / k0 suffices
+            mode0 = 28 * lam - 3 > 4 * arb.pi() ** 2 * lam / k0
+            label = f"every k >= {k0}"
+            c1 = c_lo
+        else:
+            c1 = arb(fmpq(2, k)).cos_pi()
+            lam = lam_of(c1)
+            mode0 = 28 * lam - 3 - 2 * k * (1 - c1) * lam > 0
+            label = f"k = {k}"
+        checks = [
+            (lam < 1, "lam < 1 (1 is the dominant eigenvalue, simple in mode 0)"),
+            (lam > fmpq(1, 4), "lam > 1/4 >= the smaller roots and > 1/8"),
+            ((1 + c1) * (9 + c1) > 0, "lam simple in modes 1 and k-1 (discriminant > 0)"),
+            (mode0 and lam > fmpq(3, 8), "lam above both mode-0 roots (p0(lam) > 0, lam > 3/8)"),
+        ]
+        if not isinstance(k, dict) and k >= 4:
+            checks.append((lam > lam_of(arb(fmpq(4, k)).cos_pi()), "lam > lam(c_2) (modes 2..k-2)"))
+        for ok, what in checks:
+            if not ok:
+                return False, f"{label}: {what} fails"
+        return True, f"{label}: " + "; ".join(w for _, w in checks)

@@ -1,0 +1,260 @@
+"""The statement of a certificate, derived from the valence and the Catmull-Clark rules alone (trusted).
+
+Nothing here is read from a file. :func:`derivation` computes once, with c = cos(2 pi/k) an
+indeterminate (so for every valence at once), in the field F of :mod:`.field`:
+
+1. the mode-1 subdominant eigenvector on the two-ring of sector 0 in the normalized frame
+   (docs/readings.md R3): the rotation to the next sector is R = [[0, -1], [1, 2c]]; the vector solves
+   (M(c) - lam) v = 0 with v(1, 0) = (1, 0) by exact elimination, and the eigen-equation
+   M(c) v = lam v is then checked as an identity in F (all 12 coordinates);
+2. the layer-0 pieces P1, P2, P3: the B-spline nets after one Catmull-Clark step of v
+   (:mod:`.rules`), their Bezier nets, scaled so that Phi(1, 0) = (1, 0);
+3. the hypotheses the proofs use, each an exact identity in F: Phi(1, 0) = (1, 0); the axis edges
+   mapped onto the axes; Phi continuous across P1|P2 and P2|P3; the layer boundary
+   Phi(1/2, v) = lam Phi(1, 2v), Phi(u, 1/2) = lam Phi(2u, 1); the mirror symmetry
+   P3 = S P1^T, P2 = S P2^T, S(x, y) = (y, x).
+
+:func:`nets_for_valence` specializes to one valence in arb: c = cos(2 pi/k) (arb's rigorous cos) and
+lam = (5 + c + sqrt((1 + c)(9 + c)))/16, the larger root of the quadratic, whose ball therefore holds
+lam(k); each net entry is evaluated from its exact form, after checking that no denominator vanishes.
+That the eigenvector is *the* subdominant one (lam simple in its Fourier block, the ordering of the
+spectrum) is :mod:`.spectrum`.
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+
+from flint import arb, ctx, fmpq
+
+from .field import QL
+from .rules import TWO_RING, level1_value
+
+PATCHES = ("P1", "P2", "P3")
+#: level-1 grid position of B-spline control point [0][0] of each piece (net[i][j] at offset + (i, j))
+NET_OFFSETS = {"P1": (0, -1), "P2": (0, 0), "P3": (-1, 0)}
+#: uniform cubic B-spline segment -> Bezier (per direction), times 6
+B2Z = ((1, 4, 1, 0), (0, 4, 2, 0), (0, 2, 4, 0), (0, 1, 4, 1))
+
+
+class StatementError(ValueError):
+    """The derivation of the statement failed (cannot happen for the true rules; a tripwire)."""
+
+
+# ------------------------------------------------------------------------ points in F^2
+def rot(delta, p):
+    """R^delta p in the normalized frame, R = [[0, -1], [1, 2c]] (delta in -1..2)."""
+    c2 = 2 * QL.c()
+    x, y = p
+    for _ in range(delta % 4 if delta >= 0 else 0):
+        x, y = -y, x + c2 * y
+    if delta == -1:
+        x, y = c2 * x + y, -x
+    return (x, y)
+
+
+def _pt_add(p, q):
+    return (p[0] + q[0], p[1] + q[1])
+
+
+def _pt_scale(p, w):
+    return (p[0] * w, p[1] * w)
+
+
+class _Pt(tuple):
+    """A point of F^2 supporting ``+`` and ``* weight`` (what :func:`.rules.apply` needs)."""
+
+    def __add__(self, other):
+        return _Pt(_pt_add(self, other))
+
+    def __mul__(self, w):
+        return _Pt(_pt_scale(self, w))
+
+
+_ZERO = _Pt((QL(0), QL(0)))
+
+
+def _lookup(values):
+    def look(delta, p):
+        if p == (0, 0):
+            return _ZERO  # the centre is 0 in Fourier mode 1
+        return _Pt(rot(delta, values[p]))
+    return look
+
+
+def level1(values, A, B):
+    """Level-1 mode-1 value at sector-local position (A, B) from the level-0 sector-0 ``values``."""
+    if (A, B) == (0, 0):
+        return _ZERO
+    delta, v = level1_value(A, B, _lookup(values), _ZERO)
+    return _Pt(rot(delta, v))
+
+
+# ------------------------------------------------------------------------ the derivation
+def _solve(rows, rhs):
+    """Exact Gauss-Jordan over F; rows: n x m (n >= m). Returns the solution; raises if inconsistent
+    or not of full column rank."""
+    n, m = len(rows), len(rows[0])
+    M = [list(r) + [b] for r, b in zip(rows, rhs)]
+    r = 0
+    for col in range(m):
+        piv = next((i for i in range(r, n) if not M[i][col].is_zero()), None)
+        if piv is None:
+            raise StatementError("the eigenvector is not determined (rank deficient)")
+        M[r], M[piv] = M[piv], M[r]
+        inv = M[r][col].inverse()
+        M[r] = [x * inv for x in M[r]]
+        for i in range(n):
+            if i != r and not M[i][col].is_zero():
+                f = M[i][col]
+                M[i] = [x - f * y for x, y in zip(M[i], M[r])]
+        r += 1
+    if any(not M[i][m].is_zero() for i in range(r, n)):
+        raise StatementError("the eigen-equation has no solution with v(1, 0) = (1, 0)")
+    return [M[i][m] for i in range(m)]
+
+
+def _eigen_equations(values):
+    """M(c) v - lam v on the 6 two-ring positions (12 coordinates in F)."""
+    L = QL.lam()
+    return [level1(values, *p)[d] - L * values[p][d] for p in TWO_RING for d in range(2)]
+
+
+def _eigenvector():
+    """Solve for v with v(1, 0) = (1, 0): the 10 other coordinates are linear unknowns."""
+    unknowns = [(p, d) for p in TWO_RING[1:] for d in range(2)]
+
+    def values_with(assign):
+        vals = {TWO_RING[0]: (QL(1), QL(0))}
+        for p in TWO_RING[1:]:
+            vals[p] = (assign.get((p, 0), QL(0)), assign.get((p, 1), QL(0)))
+        return vals
+
+    base = _eigen_equations(values_with({}))  # affine part
+    cols = []
+    for u in unknowns:
+        eq = _eigen_equations(values_with({u: QL(1)}))
+        cols.append([e - b for e, b in zip(eq, base)])
+    rows = [[cols[j][i] for j in range(len(unknowns))] for i in range(len(base))]
+    sol = _solve(rows, [-b for b in base])
+    return values_with(dict(zip(unknowns, sol)))
+
+
+def bspline_to_bezier(net):
+    """Bezier net of the uniform bicubic B-spline segment of a 4x4 net of F-points (exact)."""
+    def lin(coeffs, pts):
+        acc = _ZERO
+        for a, p in zip(coeffs, pts):
+            if a:
+                acc = acc + _Pt(p) * fmpq(a, 6)
+        return acc
+    tmp = [[lin(B2Z[i], [net[r][j] for r in range(4)]) for j in range(4)] for i in range(4)]
+    return [[tuple(lin(B2Z[j], tmp[i])) for j in range(4)] for i in range(4)]
+
+
+def _swap(p):
+    return (p[1], p[0])
+
+
+def _eq(p, q):
+    return p[0] == q[0] and p[1] == q[1]
+
+
+def _split_half(curve):
+    """De Casteljau halves of a cubic Bezier curve of F-points (exact)."""
+    half = QL(fmpq(1, 2))
+    left, right, pts = [curve[0]], [curve[3]], list(curve)
+    for _ in range(3):
+        pts = [((p[0] + q[0]) * half, (p[1] + q[1]) * half) for p, q in zip(pts, pts[1:])]
+        left.append(pts[0])
+        right.append(pts[-1])
+    return left, right[::-1]
+
+
+class Derivation:
+    """What :func:`derivation` computes: ``eigenvector`` {position: (x, y)}, ``bspline`` and ``bezier``
+    nets {piece: 4x4 of (x, y)} with entries in F, ``symmetric`` and ``hypotheses`` [(name, ok)]."""
+
+    def __init__(self, eigenvector, bspline, bezier, symmetric, hypotheses):
+        self.eigenvector, self.bspline, self.bezier = eigenvector, bspline, bezier
+        self.symmetric, self.hypotheses = symmetric, hypotheses
+
+    def integer_forms(self, which="bspline"):
+        """{piece: 4x4 of ([A,B,D], [A,B,D])}: the exact forms (A(c) + B(c) lam)/D(c) of the nets."""
+        nets = self.bspline if which == "bspline" else self.bezier
+        return {n: [[tuple(q.integer_form() for q in p) for p in row] for row in net] for n, net in nets.items()}
+
+    def denominators(self):
+        """Every denominator in Q[c] that the specialization divides by (eigenvector and nets)."""
+        out = [q.d for p in self.eigenvector.values() for q in p]
+        out += [q.d for nets in (self.bspline, self.bezier) for net in nets.values() for row in net
+                for p in row for q in p]
+        return out
+
+
+@lru_cache(maxsize=1)
+def derivation():
+    """The statement's maps for every valence at once (module docstring); cached per process."""
+    vals = _eigenvector()
+    eig_ok = all(e.is_zero() for e in _eigen_equations(vals))
+    raw = {n: [[level1(vals, oa + i, ob + j) for j in range(4)] for i in range(4)]
+           for n, (oa, ob) in NET_OFFSETS.items()}
+    phi10 = bspline_to_bezier(raw["P1"])[3][0]
+    if phi10[0].is_zero():
+        raise StatementError("Phi(1, 0) = 0: the normalization is impossible")
+    scale = phi10[0].inverse()
+    bs = {n: [[tuple(q * scale for q in p) for p in row] for row in net] for n, net in raw.items()}
+    vec = {p: tuple(q * scale for q in v) for p, v in vals.items()}
+    bz = {n: bspline_to_bezier(net) for n, net in bs.items()}
+    P1, P2, P3 = bz["P1"], bz["P2"], bz["P3"]
+    L = QL.lam()
+    zero, one = QL(0), QL(1)
+
+    def scaled(curve):
+        return [(L * p[0], L * p[1]) for p in curve]
+
+    def same(c1, c2):
+        return all(_eq(p, q) for p, q in zip(c1, c2))
+
+    col = lambda net, i: [net[i][j] for j in range(4)]  # side s = i/3 (a curve in t)
+    row = lambda net, j: [net[i][j] for i in range(4)]  # side t = j/3 (a curve in s)
+    inner1, inner3 = _split_half(col(P1, 0)), _split_half(row(P3, 0))
+    symmetric = all(_eq(P3[i][j], _swap(P1[j][i])) and _eq(P2[i][j], _swap(P2[j][i]))
+                    for i in range(4) for j in range(4))
+    hyp = [
+        ("eigen-equation M(c) v = lam v on the two-ring (identity in F)", eig_ok),
+        ("Phi(1, 0) = (1, 0)", _eq(P1[3][0], (one, zero))),
+        ("the edge v = 0 is mapped onto the x-axis (P1, t = 0)", all(p[1].is_zero() for p in row(P1, 0))),
+        ("the edge u = 0 is mapped onto the y-axis (P3, s = 0)", all(p[0].is_zero() for p in col(P3, 0))),
+        ("Phi continuous across P1 | P2 (v = 1/2)", same(row(P1, 3), row(P2, 0))),
+        ("Phi continuous across P2 | P3 (u = 1/2)", same(col(P3, 3), col(P2, 0))),
+        ("layer boundary: Phi(1/2, v) = lam Phi(1, 2v)",
+         same(inner1[0], scaled(col(P1, 3))) and same(inner1[1], scaled(col(P2, 3)))),
+        ("layer boundary: Phi(u, 1/2) = lam Phi(2u, 1)",
+         same(inner3[0], scaled(row(P3, 3))) and same(inner3[1], scaled(row(P2, 3)))),
+    ]
+    return Derivation(vec, bs, bz, symmetric, hyp)
+
+
+# ------------------------------------------------------------------------ one valence in arb
+def c_lam(k, prec):
+    """Balls (c, lam) holding cos(2 pi/k) and lam(k) = (5 + c + sqrt((1 + c)(9 + c)))/16."""
+    with ctx.workprec(prec):
+        c = arb(fmpq(2, k)).cos_pi()
+        return c, (5 + c + ((1 + c) * (9 + c)).sqrt()) / 16
+
+
+def nets_for_valence(k, prec, which="bezier"):
+    """arb nets {piece: 4x4 of (x, y)} of valence k, evaluated from the derived exact forms; raises
+    :class:`StatementError` if a denominator may vanish at c = cos(2 pi/k)."""
+    d = derivation()
+    c, lam = c_lam(k, prec)
+    nets = d.bezier if which == "bezier" else d.bspline
+    with ctx.workprec(prec):
+        try:
+            for q in d.denominators():
+                QL(1, 0, q).evaluate(c, lam)
+            return {n: [[tuple(q.evaluate(c, lam) for q in p) for p in row] for row in net]
+                    for n, net in nets.items()}
+        except ZeroDivisionError:
+            raise StatementError(f"a denominator of the exact forms may vanish at c = cos(2 pi/{k})") from None
