@@ -6,6 +6,8 @@ from flint import fmpq
 
 from ccproof.certify import prover as P
 from ccproof.certify import verify as V
+from ccproof.certify.verify import maps as M
+from ccproof.certify.verify import replay as R
 from ccproof.rigorous import Poly
 from ccproof.tables.numeric import load_table
 
@@ -26,8 +28,7 @@ def _steep_weight(p):
 
 def test_folding_weight_gives_no_certificate_and_forged_one_fails(monkeypatch):
     genuine = P.prove_valence(5, progress=False)
-    monkeypatch.setattr(V, "weight_piece", _steep_weight)
-    monkeypatch.setattr(P, "cell_det_poly", V.cell_det_poly)
+    monkeypatch.setattr(M, "weight_piece", _steep_weight)
     with pytest.raises(P.ProofFailed):
         P.prove_valence(5, progress=False)
     lines = []
@@ -62,7 +63,7 @@ def test_certified_corner_minimum_against_float_sampling(k):
     from ccproof.tables.format import certificates_dir
 
     cert = json.loads((certificates_dir() / "injectivity" / f"k{k:03d}.json").read_text())
-    bound = min(float(V._decimal(b["bound"])) for n in ("P1", "P2", "P3") for b in cert["parts"]["corner"][n])
+    bound = min(float(R.parse_decimal(b["bound"])) for n in ("P1", "P2", "P3") for b in cert["parts"]["corner"][n])
     tab = load_table(k)
     lam, N = tab.lam, cert["N"]
     s, t = np.meshgrid(np.linspace(0, 1, 41), np.linspace(0, 1, 41), indexing="ij")

@@ -61,7 +61,8 @@ def test_eigenvector_of_the_exact_two_ring_matrix(k):
             worst = arb(0)
             for i in range(len(verts)):
                 for dd in range(2):
-                    r = sum((S[i][m] * vec[m][dd] for m in range(len(verts)) if S[i][m] != 0), arb(0)) - lam * vec[i][dd]
+                    r = sum((S[i][m] * vec[m][dd] for m in range(len(verts)) if S[i][m] != 0), arb(0))
+                    r -= lam * vec[i][dd]
                     if not perturb:
                         assert r.contains(0) and r.rad() < 1e-50
                     worst = max(worst, abs(r).upper())

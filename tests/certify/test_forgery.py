@@ -1,0 +1,170 @@
+"""Forgeries by someone who can run our own tools: each ends in FAIL with a reason naming what failed.
+
+The verifier derives the statement from the valence and the rules, so a forger's only levers are the
+certificate file itself and the prover (which they can run on any nets they like). Each test changes
+one of them as the audit of the verifier did and checks the verdict and its reason.
+"""
+
+import json
+import time
+
+import pytest
+from flint import arb, ctx
+
+from ccproof.certify import prover as P
+from ccproof.certify import verify as V
+from ccproof.certify.verify import statement as St
+from ccproof.tables.format import certificates_dir
+
+CERTS = certificates_dir() / "injectivity"
+
+
+def load(k, kind="injectivity"):
+    return json.loads((certificates_dir() / kind / f"k{k:03d}.json").read_text())
+
+
+def run(cert):
+    lines = []
+    res = V.verify_certificate(cert, log=lines.append)
+    return res, "\n".join(lines + [res.error or ""])
+
+
+def failed_with(cert, *reasons):
+    res, log = run(cert)
+    assert not res, log
+    for r in reasons:
+        assert r in log, log
+    return log
+
+
+def test_another_valence_relabelled():
+    """k = 5's certificate (its N and boxes) claimed for k = 8."""
+    c = load(5)
+    c["valence"] = 8
+    failed_with(c, "FAIL  ")
+
+
+def _prove_with_nets_of(monkeypatch, claimed, actual_nets, actual_lam):
+    """Run our own prover for valence ``claimed`` on other nets (what a forger with our code can do)."""
+    monkeypatch.setattr(P, "nets_for_valence", lambda k, prec: actual_nets)
+    monkeypatch.setattr(P, "c_lam", lambda k, prec: (None, actual_lam))
+    return P.prove_valence(claimed, progress=False)
+
+
+def test_another_valences_nets_with_a_regenerated_certificate(monkeypatch):
+    nets5, lam5 = St.nets_for_valence(5, 128), St.c_lam(5, 128)[1]
+    forged = _prove_with_nets_of(monkeypatch, 8, nets5, lam5)
+    assert forged["valence"] == 8
+    failed_with(forged, "FAIL  ")
+
+
+def test_identity_nets_as_valence_8(monkeypatch):
+    """The k = 4 map (the identity) with lam = 1/2, certified by our prover and labelled valence 8."""
+    nets4, lam4 = St.nets_for_valence(4, 128), St.c_lam(4, 128)[1]
+    forged = _prove_with_nets_of(monkeypatch, 8, nets4, lam4)
+    failed_with(forged, "FAIL  ")
+
+
+def test_scaled_nets_with_a_regenerated_certificate(monkeypatch):
+    """arb nets scaled by 1.01 (the exact forms untouched): the prover's boxes fit the scaled map only."""
+    with ctx.workprec(128):
+        nets = {n: [[tuple(x * arb("1.01") for x in p) for p in row] for row in net]
+                for n, net in St.nets_for_valence(8, 128).items()}
+    forged = _prove_with_nets_of(monkeypatch, 8, nets, St.c_lam(8, 128)[1])
+    failed_with(forged, "FAIL  ")
+
+
+def test_asymmetric_perturbation_under_the_symmetry_shortcut(monkeypatch):
+    """P1's nets shifted (P3 left alone) while the prover keeps the mirror shortcut: its cells l <= m are
+    computed on a map that is not the characteristic map, and the verifier's own nets disagree."""
+    with ctx.workprec(128):
+        nets = St.nets_for_valence(8, 128)
+        nets = dict(nets, P1=[[(p[0] + arb("0.003"), p[1]) for p in row] for row in nets["P1"]])
+    forged = _prove_with_nets_of(monkeypatch, 8, nets, St.c_lam(8, 128)[1])
+    failed_with(forged, "FAIL  ")
+
+
+def test_lam_excluding_the_root(monkeypatch):
+    """A prover run with lam(8) + 0.01 (a ball excluding lam(8)); a certificate cannot carry lam at all."""
+    with ctx.workprec(128):
+        lam = St.c_lam(8, 128)[1] + arb("0.01")
+    forged = _prove_with_nets_of(monkeypatch, 8, St.nets_for_valence(8, 128), lam)
+    failed_with(forged, "FAIL  ")
+    c = load(8)
+    c["lam"] = {"mid": "0.6", "rad": "0.1"}
+    failed_with(c, "unknown field(s) 'lam'")
+
+
+def test_extra_cells_with_false_bounds():
+    c = load(5)
+    c["parts"]["cells"]["7,7,2,2"] = [{"path": "", "bound": "1000"}]
+    failed_with(c, "7,7,2,2", "not required by the statement")
+
+
+def test_the_table_files_are_not_evidence(tmp_path, monkeypatch):
+    """Tables are caches: the verifier reads none, so a forged table (nets of k = 5 in k = 8's file, hash
+    recomputed) changes no verdict: the genuine k = 8 certificate still verifies and k = 5's boxes still
+    fail as valence 8."""
+    import shutil
+
+    from ccproof.tables.format import content_hash
+
+    root = tmp_path / "certificates"
+    shutil.copytree(certificates_dir() / "tables", root / "tables")
+    t8 = json.loads((root / "tables" / "k008.json").read_text())
+    t5 = json.loads((root / "tables" / "k005.json").read_text())
+    t8["exact"], t8["arb"] = t5["exact"], t5["arb"]
+    t8["hash"] = content_hash(t8)
+    (root / "tables" / "k008.json").write_text(json.dumps(t8))
+    monkeypatch.setenv("CCPROOF_CERTIFICATES", str(root))
+    res, log = run(load(8))  # load() read the genuine file before the env var mattered
+    assert res, log
+    c = load(5)
+    c["valence"] = 8
+    failed_with(c, "FAIL  ")
+
+
+def test_a_faked_summary_is_rejected_and_report_shows_only_verified_numbers(tmp_path):
+    from ccproof.certify.cli_report import _row
+
+    c = load(5)
+    c["summary"] = {"min_bound_det_J_phi_local": "0.9"}
+    failed_with(c, "unknown field(s) 'summary'")
+    p = tmp_path / "k005.json"
+    p.write_text(json.dumps(c))
+    assert _row(p)["ok"] is False and "detPhi" not in _row(p)
+    p.write_text(json.dumps(load(5)))
+    row = _row(p)
+    claimed = min(float(V.replay.parse_decimal(b["bound"])) for n in St.PATCHES
+                  for b in load(5)["parts"]["regularity"][n])
+    assert row["ok"] and abs(row["detPhi"] - 4 * claimed) < 1e-12
+
+
+@pytest.mark.parametrize("bound", ["1e-999999999", "1e999999999", "1" * 5001, "0." + "0" * 70 + "1", "1e-401"])
+def test_huge_tiny_and_overlong_decimals_fail_fast(bound, tmp_path):
+    c = load(5)
+    c["parts"]["corner"]["P1"][0]["bound"] = bound
+    p = tmp_path / "k.json"
+    p.write_text(json.dumps(c))
+    t = time.perf_counter()
+    res = V.verify_file(p, log=lambda s: None)
+    assert time.perf_counter() - t < 1.0
+    assert not res and ("exponent" in res.error or "at most 64 characters" in res.error)
+
+
+def test_verify_all_goes_on_past_a_bad_file(tmp_path, capsys):
+    from ccproof.certify.cli_verify import run as verify_run
+
+    good = tmp_path / "good.json"
+    good.write_text(json.dumps(load(3, "c1")))
+    bad = tmp_path / "bad.json"
+    bad.write_text('{"schema": "ccproof.c1/2", "valence": [1, 2]}')
+    deep = tmp_path / "deep.json"
+    deep.write_text("[" * 100000 + "]" * 100000)
+
+    class A:
+        files, all, jobs, quiet = [str(bad), str(deep), str(good)], False, 1, False
+
+    assert verify_run(A()) == 1
+    out = capsys.readouterr().out
+    assert "VERIFIED " + str(good) in out and out.count("FAILED") >= 2 and "1 of 3 certificates verified" in out
