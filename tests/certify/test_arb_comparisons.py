@@ -95,5 +95,6 @@ def test_every_risky_comparison_in_the_trusted_base_is_reviewed():
 
 
 def test_the_scanner_finds_the_truncate_bug_shape():
-    src = "def f(x):\n    if x != 0:\n        return 1\n    if not (x < 1):\n        return 2\n    return x.contains(0)\n"
+    src = ("def f(x):\n    if x != 0:\n        return 1\n    if not (x < 1):\n        return 2\n"
+           "    return x.contains(0)\n")
     assert len(list(_risky(ast.parse(src), src))) == 3
