@@ -1,4 +1,4 @@
-"""Benchmark of the injectivity certificates (issue 7).
+"""Benchmark of the certificates.
 
 Certifies each valence of a range with a process pool (certify runs are independent), then verifies
 every certificate written, and prints per valence: N, boxes, certify seconds, verify seconds, and the
@@ -6,8 +6,10 @@ totals (wall clock) with the ratio certify/verify, against the targets (all of 3
 <= 10 min and verified in <= 2 min on 2 cores; verification >= 3x faster than certification).
 
     python scripts/bench_certify.py [--kmin 3] [--kmax 39] [--jobs 2]
-    python scripts/bench_certify.py --interval 40     the one certificate for every k >= 40 (issue 8:
-                                                       targets certify <= 5 min, verify <= 1 min)
+    python scripts/bench_certify.py --interval 40     the one certificate for every k >= 40
+                                                       (targets certify <= 5 min, verify <= 1 min)
+    python scripts/bench_certify.py --verify-all      `ccproof verify --all` on 2 processes (target
+                                                       <= 90 s), and the share of the statement derivation
 
 Certificates go to a temporary folder; the published ones are not touched.
 """
@@ -26,7 +28,7 @@ def _certify(args):
     cert = prove_valence(k, progress=False)
     dt = time.perf_counter() - t
     write_certificate(cert, certificate_path(k, d))
-    return k, cert["N"], cert["stats"]["boxes"], dt
+    return k, cert["N"], sum(len(v) for sec in cert["parts"].values() for v in sec.values()), dt
 
 
 def _verify(args):
@@ -45,7 +47,10 @@ def main():
     ap.add_argument("--kmax", type=int, default=39)
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--interval", type=int, default=None, metavar="K0", help="bench the k >= K0 certificate")
+    ap.add_argument("--verify-all", action="store_true", help="time `ccproof verify --all --jobs JOBS`")
     args = ap.parse_args()
+    if args.verify_all:
+        return bench_verify_all(args.jobs)
     if args.interval is not None:
         return bench_interval(args.interval)
     ks = list(range(args.kmin, args.kmax + 1))
@@ -80,9 +85,39 @@ def bench_interval(k0):
         t = time.perf_counter()
         ok = verify_file(path, log=lambda s: None)
         tv = time.perf_counter() - t
-    print(f"k >= {k0}: {cert['stats']['pieces']} lam piece(s), {cert['stats']['boxes']} boxes; "
+    boxes = sum(len(v) for pc in cert["pieces"] for sec in pc["parts"].values() for v in sec.values())
+    print(f"k >= {k0}: {len(cert['pieces'])} lam piece(s), {boxes} boxes; "
           f"certify {tc:.1f} s (target 300 s), verify {tv:.1f} s (target 60 s), certify/verify = {tc / tv:.2f}; "
           f"verified: {ok}")
+
+
+def _derivation_seconds(_):
+    t = time.perf_counter()
+    from ccproof.certify.verify.spectrum import check_block_polynomials
+    from ccproof.certify.verify.statement import derivation
+
+    derivation()
+    check_block_polynomials()
+    return time.perf_counter() - t
+
+
+def bench_verify_all(jobs):
+    """Wall clock of `ccproof verify --all --jobs JOBS` (fresh processes, derivation included), and the
+    derivation's cost per worker process measured alone."""
+    import subprocess
+    import sys
+
+    t = time.perf_counter()
+    out = subprocess.run([sys.executable, "-m", "ccproof.cli", "verify", "--all", "--quiet", "--jobs", str(jobs)],
+                         capture_output=True, text=True)
+    total = time.perf_counter() - t
+    with ProcessPoolExecutor(1) as ex:
+        deriv = ex.submit(_derivation_seconds, None).result()
+    tail = out.stdout.strip().splitlines()[-3:]
+    print("\n".join(tail))
+    print(f"verify --all with {jobs} processes: {total:.1f} s (target 90 s); statement derivation {deriv:.2f} s "
+          f"per worker process ({jobs} x {deriv:.2f} s = {100 * jobs * deriv / (jobs * total):.1f} % of the "
+          f"{jobs} x {total:.1f} s of process time); exit status {out.returncode}")
 
 
 if __name__ == "__main__":

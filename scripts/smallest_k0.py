@@ -1,7 +1,7 @@
-"""Search the smallest k0 for which the one-certificate argument for every k >= k0 succeeds (issue 8).
+"""Search the smallest k0 for which the one-certificate argument for every k >= k0 succeeds.
 
-For each k0 (largest first) the script builds the interval table for k >= k0 in a temporary folder,
-runs the interval prover (lam as a Taylor-model variable, ccproof.certify.prover.prove_interval)
+For each k0 (largest first) the script runs the interval prover (lam as a Taylor-model variable,
+ccproof.certify.prover.prove_interval)
 with at most ``--max-pieces`` lam pieces, and prints success or the reason of failure with the time.
 
   python scripts/smallest_k0.py --k0 30 20 14 10 --max-pieces 1
@@ -10,7 +10,6 @@ with at most ``--max-pieces`` lam pieces, and prints success or the reason of fa
 from __future__ import annotations
 
 import argparse
-import tempfile
 import time
 from fractions import Fraction
 
@@ -23,28 +22,24 @@ def main(argv=None):
     ap.add_argument("--out", default=None, help="folder to keep the certificates found (default: discard)")
     args = ap.parse_args(argv)
 
-    from ccproof.certify.prover import ProofFailed, certificate_path, prove_interval, write_certificate
-    from ccproof.tables.build import write_table
+    from ccproof.certify.prover import ProofFailed, certificate_path, claimed_margins, prove_interval, write_certificate
 
-    with tempfile.TemporaryDirectory() as tmp:
-        for k0 in sorted(args.k0, reverse=True):
-            t0 = time.perf_counter()
-            write_table(f">={k0}", tmp)
-            t1 = time.perf_counter()
-            try:
-                cert = prove_interval(k0, tables_dir=tmp, progress=False, max_pieces=args.max_pieces,
-                                      truncation_degree=args.truncation_degree)
-            except ProofFailed as exc:
-                print(f"k0 = {k0:3d}: FAILED after {time.perf_counter() - t1:.0f} s (table {t1 - t0:.0f} s): {exc}",
-                      flush=True)
-                continue
-            s = {k: float(Fraction(v)) for k, v in cert["summary"].items()}
-            print(f"k0 = {k0:3d}: proved in {time.perf_counter() - t1:.0f} s (table {t1 - t0:.0f} s), "
-                  f"N = {cert['N']}, {cert['stats']['pieces']} piece(s), {cert['stats']['boxes']} boxes; min bounds: "
-                  f"det J_Phi {s['min_bound_det_J_phi_local']:.4g}, cells {s['min_bound_det_J_G_cells_local']:.4g}, "
-                  f"corner {s['min_bound_det_J_G_corner_over_h2']:.4g}", flush=True)
-            if args.out:
-                write_certificate(cert, certificate_path({"min": k0}, args.out))
+    for k0 in sorted(args.k0, reverse=True):
+        t1 = time.perf_counter()
+        try:
+            cert = prove_interval(k0, progress=False, max_pieces=args.max_pieces,
+                                  truncation_degree=args.truncation_degree)
+        except ProofFailed as exc:
+            print(f"k0 = {k0:3d}: FAILED after {time.perf_counter() - t1:.0f} s: {exc}", flush=True)
+            continue
+        summary, boxes = claimed_margins(cert)
+        s = {k: float(Fraction(v)) for k, v in summary.items()}
+        print(f"k0 = {k0:3d}: proved in {time.perf_counter() - t1:.0f} s, "
+              f"N = {cert['N']}, {len(cert['pieces'])} piece(s), {boxes} boxes; claimed min bounds: "
+              f"det J_Phi {s['min_bound_det_J_phi_local']:.4g}, cells {s['min_bound_det_J_G_cells_local']:.4g}, "
+              f"corner {s['min_bound_det_J_G_corner_over_h2']:.4g}", flush=True)
+        if args.out:
+            write_certificate(cert, certificate_path({"min": k0}, args.out))
 
 
 if __name__ == "__main__":

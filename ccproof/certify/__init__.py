@@ -1,1 +1,1 @@
-"""ccproof.certify (see DESIGN.md section 1)."""
+"""ccproof.certify: the prover (untrusted search) and the verifier (the trusted base, docs/trusted_base.md)."""

@@ -49,8 +49,9 @@ def _row(path):
 def collect(jobs=1):
     """One row per injectivity certificate, each from a fresh verifier run."""
     from ccproof.certify.verify import certificate_files
+    from ccproof.tables.format import certificates_dir
 
-    paths = [p for p in certificate_files() if p.parent.name == "injectivity"]
+    paths = [p for p in certificate_files(certificates_dir()) if p.parent.name == "injectivity"]
     if jobs > 1:
         from concurrent.futures import ProcessPoolExecutor
 

@@ -41,10 +41,11 @@ def run(args):
 
     from ccproof.certify.verify import certificate_files, check_coverage
     from ccproof.errors import CCProofError
+    from ccproof.tables.format import certificates_dir
 
     files = [Path(f) for f in args.files]
     if args.all:
-        files += certificate_files()
+        files += certificate_files(certificates_dir())
     if not files:
         raise CCProofError("give certificate files or --all")
     work = [(f, args.quiet) for f in files]

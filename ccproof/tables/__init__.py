@@ -1,1 +1,2 @@
-"""ccproof.tables (see DESIGN.md section 1)."""
+"""ccproof.tables: the characteristic-map tables (exact, arb, float64), written once and read as caches by
+the prover and the numerics (docs/tables.md)."""

@@ -1,4 +1,4 @@
-"""Build the certified characteristic-map tables (writer side; DESIGN.md section 1, R2-R8, R10).
+"""Build the characteristic-map tables (writer side; docs/readings.md R2-R8, R10).
 
 For a valence k (or the interval k >= k0) a table holds the exact nets of P1, P2, P3 (integer forms
 in c and lam, valence-independent), their arb enclosures and float64 copies, and quantities derived
@@ -238,7 +238,7 @@ def build_table(k, prec=DEFAULT_PREC):
         "valence": {"min": int(k[2:])} if interval else k,
         "c_definition": "cos(2*pi/k)" + (" for every integer k >= k0" if interval else ""),
         "lam_definition": "(5 + c + sqrt((1 + c)*(9 + c)))/16, the larger root of 16 lam^2 - 2(5 + c) lam + 1",
-        "frame": "normalized: e0 -> (1,0), e1 -> (0,1), Phi(1,0) = (1,0) (DESIGN.md R3)",
+        "frame": "normalized: e0 -> (1,0), e1 -> (0,1), Phi(1,0) = (1,0) (docs/readings.md R3)",
         "patches": {"P1": "[1/2,1]x[0,1/2]", "P2": "[1/2,1]x[1/2,1]", "P3": "[0,1/2]x[1/2,1]",
                     "local_parameters": "s along u, t along v, net[i][j] with i along s"},
         "prec": prec,

@@ -8,7 +8,8 @@ boxes with claimed bounds, :mod:`.replay`) without searching. It imports only py
 standard library and :mod:`ccproof.rigorous`; docs/trusted_base.md lists the modules it consists of.
 
 >>> from ccproof.certify.verify import verify_file, certificate_files
->>> res = verify_file(certificate_files()[0], log=lambda line: None)   # certificates/c1/k003.json
+>>> from ccproof.tables.format import certificates_dir
+>>> res = verify_file(certificate_files(certificates_dir())[0], log=lambda line: None)  # c1/k003.json
 >>> bool(res), res.valence, res.parts[0].name
 (True, 3, 'S statement derived from the rules')
 """
@@ -80,13 +81,8 @@ def verify_file(path, log=print, tables_dir=None):
     return res
 
 
-def certificate_files(directory=None):
-    """The published certificate files: ``c1/k*.json`` then ``injectivity/k*.json`` of ``directory``
-    (default: the package's certificates folder)."""
-    if directory is None:
-        from ccproof.tables.format import certificates_dir
-
-        directory = certificates_dir()
+def certificate_files(directory):
+    """The certificate files under ``directory``: ``c1/k*.json`` then ``injectivity/k*.json``."""
     d = Path(directory)
     return sorted((d / "c1").glob("k*.json")) + sorted((d / "injectivity").glob("k*.json"))
 
