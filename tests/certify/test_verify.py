@@ -180,10 +180,14 @@ def test_c1_tampering_rejected():
     assert not V.verify_certificate(bad, log=lines.append)
     assert any("FAIL  [piece 0] outer boundary star-shaped on P2s1" in s for s in lines)
     bad = copy.deepcopy(c)
-    bad["valence"] = {"min": 3}  # widen the interval: lam(3) is not in the pieces, the claim is not established
+    bad["valence"] = {"min": 30}  # widen the interval: lam(30) is not in the pieces, the claim is not established
     lines = []
     assert not V.verify_certificate(bad, log=lines.append)
     assert any("FAIL  lam(k) in" in s for s in lines)
+    bad["valence"] = {"min": 3}  # the mode-0 argument for all k >= k0 does not hold from k0 = 3
+    lines = []
+    assert not V.verify_certificate(bad, log=lines.append)
+    assert any("FAIL  spectral ordering" in s and "mode-0" in s for s in lines)
 
 
 # ---------------------------------------------------------------- mirror symmetry (parts B, D, E)
