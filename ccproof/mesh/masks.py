@@ -49,7 +49,7 @@ def limit_positions(mesh: QuadMesh, vertices=None):
     >>> V = np.array([[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1],
     ...               [-1, -1, 1], [1, -1, 1], [1, 1, 1], [-1, 1, 1]], float)
     >>> F = [[0, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6], [3, 0, 4, 7]]
-    >>> limit_positions(QuadMesh(V, F))[6].tolist()      # cube corner: (9 V + 4*3 e + 3 d)/24
+    >>> np.round(limit_positions(QuadMesh(V, F))[6], 12).tolist()      # cube corner: (9 V + 4*3 e + 3 d)/24
     [0.5, 0.5, 0.5]
     """
     V = mesh.vertices if vertices is None else np.asarray(vertices, dtype=np.float64)

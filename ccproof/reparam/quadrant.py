@@ -126,7 +126,7 @@ def vanishing_map(s, t, alpha, derivatives=1):
         ``H[:, a, i, j] = d^2 F_a / dt_i dt_j`` (with 2; NaN at the origin when alpha < 2).
 
     >>> F, J = vanishing_map(np.array([3.0]), np.array([4.0]), 2.0)
-    >>> F.tolist(), np.round(J[0], 12).tolist()
+    >>> np.round(F, 12).tolist(), np.round(J[0], 12).tolist()
     ([[15.0, 20.0]], [[6.8, 2.4], [2.4, 8.2]])
     """
     s = np.asarray(s, dtype=np.float64)

@@ -113,7 +113,7 @@ class MatrixSystem:
     """``M, D, K`` given as matrices (dense or sparse): the generic system of :class:`ImplicitIntegrator`.
 
     >>> s = MatrixSystem(M=[[1.0]], D=[[0.5]], K=[[4.0]])
-    >>> s.assemble(2.0, 0.1, 0.02).toarray().tolist()
+    >>> np.round(s.assemble(2.0, 0.1, 0.02).toarray(), 12).tolist()      # 2 * 1 + 0.1 * 0.5 + 0.02 * 4
     [[2.13]]
     """
 
