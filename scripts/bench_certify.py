@@ -1,4 +1,4 @@
-"""Benchmark of the injectivity certificates (issue 7).
+"""Benchmark of the injectivity certificates.
 
 Certifies each valence of a range with a process pool (certify runs are independent), then verifies
 every certificate written, and prints per valence: N, boxes, certify seconds, verify seconds, and the
@@ -6,8 +6,8 @@ totals (wall clock) with the ratio certify/verify, against the targets (all of 3
 <= 10 min and verified in <= 2 min on 2 cores; verification >= 3x faster than certification).
 
     python scripts/bench_certify.py [--kmin 3] [--kmax 39] [--jobs 2]
-    python scripts/bench_certify.py --interval 40     the one certificate for every k >= 40 (issue 8:
-                                                       targets certify <= 5 min, verify <= 1 min)
+    python scripts/bench_certify.py --interval 40     the one certificate for every k >= 40 (targets:
+                                                       certify <= 5 min, verify <= 1 min)
 
 Certificates go to a temporary folder; the published ones are not touched.
 """

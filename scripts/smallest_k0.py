@@ -1,4 +1,5 @@
-"""Search the smallest k0 for which the one-certificate argument for every k >= k0 succeeds (issue 8).
+"""Search the smallest k0 for which the one-certificate argument for every k >= k0 succeeds
+(docs/appendix_a.md section 6).
 
 For each k0 (largest first) the script builds the interval table for k >= k0 in a temporary folder,
 runs the interval prover (lam as a Taylor-model variable, ccproof.certify.prover.prove_interval)

@@ -1,6 +1,6 @@
 """The characteristic map Phi of valence k on the quadrant, vectorized (bmz04 section 4.3).
 
-Phi is evaluated through its layer structure (DESIGN.md R4): for y = (r, s) in [0, inf)^2 with
+Phi is evaluated through its layer structure (docs/readings.md R4): for y = (r, s) in [0, inf)^2 with
 max(r, s) = m 2^e (m in [1/2, 1)), y0 = 2^-e y lies in layer 0 = [0,1]^2 minus [0,1/2)^2, and
 
     Phi(y) = lam^-e Phi(y0),

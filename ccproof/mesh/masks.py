@@ -5,7 +5,7 @@ clockwise, :meth:`QuadMesh.one_ring`):
 
 * position (left eigenvector of eigenvalue 1; Halstead, Kass, DeRose 1993; Stam 1998):
   ``(k^2 V + 4 sum e_j + sum d_j) / (k (k + 5))``;
-* tangents (left eigenvectors of the subdominant eigenvalue lam of DESIGN.md R2):
+* tangents (left eigenvectors of the subdominant eigenvalue lam of docs/readings.md R2):
   ``t1 = sum_j A cos(2 pi j/k) e_j + (cos(2 pi j/k) + cos(2 pi (j+1)/k)) d_j`` and ``t2`` the same
   with sines, where ``A = 1 + c + sqrt((1 + c)(9 + c)) = 16 lam - 4`` and ``c = cos(2 pi/k)``;
   the normal is ``t1 x t2`` (it points to the side from which the faces are counter-clockwise).

@@ -1,5 +1,5 @@
 """Quadrant maps F_i of bmz04 eq. (4): the vanishing-derivative map F^alpha (section 4.2) and the
-inverse characteristic map Phi^-1 in the normalized frame (section 4.3, DESIGN.md R3, R6).
+inverse characteristic map Phi^-1 in the normalized frame (section 4.3, docs/readings.md R3, R6).
 
 Both map the quadrant [0, inf)^2 onto itself, fix the origin, map each axis onto itself and commute
 with the swap (s, t) -> (t, s). Each function returns the map, its Jacobian and (on request) its
@@ -35,7 +35,7 @@ __all__ = [
 
 
 def subdominant_lambda(k):
-    """lam(k) = (5 + c + sqrt((1 + c)(9 + c))) / 16, c = cos(2 pi / k) (DESIGN.md R2), as a float.
+    """lam(k) = (5 + c + sqrt((1 + c)(9 + c))) / 16, c = cos(2 pi / k) (docs/readings.md R2), as a float.
 
     >>> subdominant_lambda(4)
     0.5

@@ -1,4 +1,4 @@
-"""The blending weights of bmz04 section 4.2-4.3 (DESIGN.md R5).
+"""The blending weights of bmz04 section 4.2-4.3 (docs/readings.md R5).
 
 ``b(x) = B(6x + 1) + B(6x) + B(6x - 1)`` with ``B`` the centred uniform cubic B-spline (support
 [-2, 2]); the paper's "c = 1/6" must be 6 (R5). ``b`` is even, piecewise cubic with breakpoints

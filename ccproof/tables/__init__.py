@@ -1,1 +1,1 @@
-"""ccproof.tables (see DESIGN.md section 1)."""
+"""ccproof.tables (layer of docs/architecture.md)."""
