@@ -1,4 +1,5 @@
-"""Normal and special elements of a dynamic Catmull-Clark surface (qmv98 sections 2.2-2.4, 3.1; docs/qmv98.md B2, B3, B5).
+"""Normal and special elements of a dynamic Catmull-Clark surface (qmv98 sections 2.2-2.4,
+3.1; docs/qmv98.md B2, B3, B5).
 
 **Element layout.** Every face of the initial (control) mesh is one of
 

@@ -124,8 +124,8 @@ def test_q3_truncated_mass_total_and_stein(n):
 def test_q3_level_ratios(n):
     """Level increments of p^T dX_L p: mass -> 1/4, tension -> lam^2, rigidity -> 4 lam^2.
 
-    The spec's "within 5% by L = 8" holds for the mass and (n = 3) the tension; the rigidity terms at
-    n = 5, 6 approach 4 lam^2 like (mu2/lam)^L with a large prefactor (30% off at L = 8 for a random p),
+    The target of docs/qmv98.md Q3, "within 5% by L = 8", holds for the mass and (n = 3) the tension; the rigidity terms
+    at n = 5, 6 approach 4 lam^2 like (mu2/lam)^L with a large prefactor (30% off at L = 8 for a random p),
     so the ratios are measured at L = 14, where all are within 1%.
     """
     S = special_scheme(n)
