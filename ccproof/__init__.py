@@ -1,6 +1,6 @@
 """ccproof: Catmull-Clark subdivision surfaces as certified parametric surfaces.
 
-Layers (DESIGN.md section 1), each importing only from the ones before it:
+Layers (docs/architecture.md), each importing only from the ones before it:
 ``algebra`` (exact) -> ``rigorous`` (arb/fmpq Bernstein kernels) -> ``tables`` (certified
 per-valence tables) -> ``mesh`` -> ``evaluate`` -> ``inverse`` -> ``reparam`` -> ``certify`` -> ``apps``.
 """

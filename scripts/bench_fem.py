@@ -7,7 +7,7 @@ For every mesh: the element layout, the assembly of M1 (unit mass, exact special
 (thin plate under tension, special elements truncated at L = 8), and the time of one implicit step of
 eq. (31) (mu = gamma = 1, a = b = 1, dt = 0.01, random generalized force, Jacobi-preconditioned CG to a
 relative residual of 1e-8, warm start) with the assembled matrix and element by element. Then the fit
-of ~2,000 range points (the Stanford bunny's 2,038 scanned vertices from ../shared/reference, or a
+of ~2,000 range points (the Stanford bunny's 2,038 scanned vertices in tests/data/meshes, or a
 2,031-point synthetic block when that file is absent) from the 98-vertex model to 386 vertices.
 The log-log slope of time against vertices is printed (1 = linear growth).
 """

@@ -1,4 +1,4 @@
-"""Benchmark of the inverse characteristic map against the forward map (issue 5).
+"""Benchmark of the inverse characteristic map against the forward map (docs/inverse.md).
 
 On the same N points (default 10^6), per valence:
 

@@ -1,4 +1,4 @@
-"""Benchmark of the characteristic-map tables (issue 3).
+"""Benchmark of the characteristic-map tables (docs/tables.md).
 
 Prints, measured in one run: the time to derive the symbolic nets once, the time per valence to
 specialize them exactly (sympy), in arb at 53 and 256 bits and in float64, and the time to build the

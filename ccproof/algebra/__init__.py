@@ -1,1 +1,1 @@
-"""ccproof.algebra (see DESIGN.md section 1)."""
+"""ccproof.algebra (layer of docs/architecture.md)."""

@@ -1,6 +1,6 @@
 """The characteristic map of Catmull-Clark subdivision, symbolic in c = cos(2 pi/k) (bmz04 section 4.3).
 
-Derivation (DESIGN.md R2-R4, written up in docs/readings.md):
+Derivation (docs/readings.md R2-R4):
 
 1. Fourier mode 1. The characteristic map is the limit function of the subdominant eigenvector.
    For Fourier mode 1 the value at position p of sector j is ``R^j x_p`` where ``x_p`` is the value

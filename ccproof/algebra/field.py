@@ -1,4 +1,4 @@
-"""The field Q(c, lam) in which every characteristic-map control point lives (DESIGN.md R2, R3).
+"""The field Q(c, lam) in which every characteristic-map control point lives (docs/readings.md R2, R3).
 
 ``c`` stands for cos(2 pi / k) and ``lam`` for the subdominant eigenvalue of the Catmull-Clark
 subdivision matrix of valence k, the larger root of

@@ -173,7 +173,7 @@ def interval_pieces(k0, pieces, prec=128):
 
 def characteristic_map_patches(k, form="bezier", arithmetic="arb", prec=128, pieces=256):
     """Control nets of the three bicubic layer-0 pieces P1, P2, P3 of the characteristic map of
-    valence k in the normalized frame (bmz04 section 4.3, Fig. 3; DESIGN.md R3, R4).
+    valence k in the normalized frame (bmz04 section 4.3, Fig. 3; docs/readings.md R3, R4).
 
     Parameters
     ----------

@@ -1,4 +1,4 @@
-"""Spectrum of the Catmull-Clark subdivision matrix of valence k (bmz04 section 3; DESIGN.md R2).
+"""Spectrum of the Catmull-Clark subdivision matrix of valence k (bmz04 section 3; docs/readings.md R2).
 
 The two-ring matrix S of Definition 2 is block-circulant over the k sectors. In Fourier mode m
 (values z_p omega^(m j) on position p of sector j, omega = exp(2 pi i/k)) it becomes a 6x6 block

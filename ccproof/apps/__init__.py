@@ -1,1 +1,1 @@
-"""ccproof.apps (see DESIGN.md section 1)."""
+"""ccproof.apps (layer of docs/architecture.md)."""

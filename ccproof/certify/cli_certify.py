@@ -2,6 +2,7 @@
 
   ccproof certify 5             prove valence 5, print the certified margins, write
                                 certificates/injectivity/k005.json, then re-check it with the verifier
+  ccproof certify 7 --out DIR   write the certificate to DIR/k007.json instead
   ccproof certify 3-39 --jobs 2 all valences 3..39 in parallel
   ccproof certify 3-39 --c1      C1 certificates (Reif's criterion: spectrum, regular and injective
   ccproof certify '>=40' --c1    characteristic map) for valences 3..39 and for every k >= 40 at once
@@ -12,6 +13,12 @@
 The proof follows bmz04 Appendix A as corrected in docs/appendix_a.md: N(k) dyadic subdivisions (R8),
 every polynomial piece of the weight met by each subpatch, and the corner subpatch for all layers
 at once in the scale variables (rho, kappa) (R9). Floats never decide: every bound is an arb ball.
+
+Where new certificates go by default: the repository's certificates/injectivity/ (certificates/c1/
+with --c1) when ccproof runs from a checkout; for an installed package, which only reads its
+published certificates, $XDG_DATA_HOME/ccproof/certificates/injectivity/ (XDG_DATA_HOME defaults to
+~/.local/share), never inside site-packages. The verifier reads the referenced table from the
+published tables either way.
 """
 
 from __future__ import annotations
@@ -23,7 +30,8 @@ def add_arguments(p):
                    help="certify Reif's C1 criterion (regular, injective characteristic map) instead")
     p.add_argument("--prec", type=int, default=128, help="arb precision in bits (default 128)")
     p.add_argument("--jobs", type=int, default=1, help="worker processes for a range (default 1)")
-    p.add_argument("--out", default=None, help="folder for the certificates (default certificates/injectivity)")
+    p.add_argument("--out", default=None,
+                   help="folder for the new certificates (default: see above; certificates/injectivity in a checkout)")
     p.add_argument("--no-verify", action="store_true", help="do not re-check the written certificate")
 
 
@@ -95,7 +103,10 @@ def _print_summary(summary):
 
 
 def run(args):
+    if args.out is None:
+        from ccproof.tables.format import output_dir
 
+        args.out = str(output_dir() / ("c1" if args.c1 else "injectivity"))
     ks = parse_valences(args.valences)
     if args.c1:
         return _run_c1(ks, args)

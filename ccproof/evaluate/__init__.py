@@ -1,6 +1,6 @@
 """Exact evaluation of Catmull-Clark limit surfaces at (face, u, v) batches (natural parameterization).
 
-Layer ``evaluate`` of DESIGN.md section 1; imports only :mod:`ccproof.mesh` and :mod:`ccproof.errors`.
+Layer ``evaluate`` of docs/architecture.md; imports only :mod:`ccproof.mesh` and :mod:`ccproof.errors`.
 See :mod:`ccproof.evaluate.surface` for the method and docs/evaluate.md for accuracy and speed.
 The names are loaded lazily, so that ``ccproof --help`` does not import numpy.
 

@@ -32,7 +32,7 @@ def bspline_basis(s, derivatives=0):
     --------
     >>> import numpy as np
     >>> B, dB = bspline_basis(np.array([0.0, 1.0]), 1)
-    >>> (B * 6).tolist(), (dB * 2 + 0.0).tolist()
+    >>> (np.round(B * 6, 12) + 0.0).tolist(), (np.round(dB * 2, 12) + 0.0).tolist()
     ([[1.0, 4.0, 1.0, 0.0], [0.0, 1.0, 4.0, 1.0]], [[-1.0, 0.0, 1.0, 0.0], [0.0, -1.0, 0.0, 1.0]])
     """
     s = np.asarray(s, dtype=np.float64)

@@ -13,7 +13,7 @@ degree 3 in (u, v) and vanishes exactly on the (whole algebraic) curve.
 
 Exactness and the choice of field
 ---------------------------------
-The edge control points lie in Q(c, lam) with c = cos(2 pi/k) *symbolic* (DESIGN.md R3, the field
+The edge control points lie in Q(c, lam) with c = cos(2 pi/k) *symbolic* (docs/readings.md R3, the field
 of the certified tables). We therefore compute g ONCE, symbolically, for every valence at the same
 time: each coefficient ``(A(c) + B(c) lam)/D(c)`` is cleared of its denominator, the Sylvester
 determinant is expanded exactly in Z[lam, c, u, v] (python-flint ``fmpz_mpoly``, a Laplace

@@ -1,6 +1,6 @@
 """Quad-mesh input/output, validated topology, one reference Catmull-Clark step and vertex masks.
 
-Layer ``mesh`` of DESIGN.md section 1: imports nothing from ccproof but :mod:`ccproof.errors`.
+Layer ``mesh`` of docs/architecture.md: imports nothing from ccproof but :mod:`ccproof.errors`.
 
 >>> from ccproof.mesh import QuadMesh, subdivide, subdivision_matrix
 >>> m = QuadMesh([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], [[0, 1, 2, 3]])

@@ -5,7 +5,7 @@ clockwise, :meth:`QuadMesh.one_ring`):
 
 * position (left eigenvector of eigenvalue 1; Halstead, Kass, DeRose 1993; Stam 1998):
   ``(k^2 V + 4 sum e_j + sum d_j) / (k (k + 5))``;
-* tangents (left eigenvectors of the subdominant eigenvalue lam of DESIGN.md R2):
+* tangents (left eigenvectors of the subdominant eigenvalue lam of docs/readings.md R2):
   ``t1 = sum_j A cos(2 pi j/k) e_j + (cos(2 pi j/k) + cos(2 pi (j+1)/k)) d_j`` and ``t2`` the same
   with sines, where ``A = 1 + c + sqrt((1 + c)(9 + c)) = 16 lam - 4`` and ``c = cos(2 pi/k)``;
   the normal is ``t1 x t2`` (it points to the side from which the faces are counter-clockwise).
@@ -49,7 +49,7 @@ def limit_positions(mesh: QuadMesh, vertices=None):
     >>> V = np.array([[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1],
     ...               [-1, -1, 1], [1, -1, 1], [1, 1, 1], [-1, 1, 1]], float)
     >>> F = [[0, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6], [3, 0, 4, 7]]
-    >>> limit_positions(QuadMesh(V, F))[6].tolist()      # cube corner: (9 V + 4*3 e + 3 d)/24
+    >>> np.round(limit_positions(QuadMesh(V, F))[6], 12).tolist()      # cube corner: (9 V + 4*3 e + 3 d)/24
     [0.5, 0.5, 0.5]
     """
     V = mesh.vertices if vertices is None else np.asarray(vertices, dtype=np.float64)

@@ -1,4 +1,4 @@
-"""One reference Catmull-Clark step (bmz04 Fig. 1, DESIGN.md R1) with the standard boundary rules.
+"""One reference Catmull-Clark step (bmz04 Fig. 1, docs/readings.md R1) with the standard boundary rules.
 
 Rules (no creases; boundary as OpenSubdiv ``VTX_BOUNDARY_EDGE_ONLY``: every boundary edge is an
 infinitely sharp crease, no vertex is a corner):

@@ -1,4 +1,4 @@
-"""ccproof.reparam: the differentiable parameterizations of bmz04 section 4 (DESIGN.md R5-R7).
+"""ccproof.reparam: the differentiable parameterizations of bmz04 section 4 (docs/readings.md R5-R7).
 
 Weights b, w (:mod:`~ccproof.reparam.weights`), quadrant maps F^alpha and Phi^-1
 (:mod:`~ccproof.reparam.quadrant`), the blend F_b of eq. (4) (:mod:`~ccproof.reparam.blend`), the

@@ -1,4 +1,4 @@
-"""The blended reparameterization F_b of a face, bmz04 eq. (4) (DESIGN.md R6):
+"""The blended reparameterization F_b of a face, bmz04 eq. (4) (docs/readings.md R6):
 
     F_b(t) = sum_i w_i(T_i^-1 t) T_i F_i T_i^-1 t + (1 - sum_i w_i(T_i^-1 t)) t,
 

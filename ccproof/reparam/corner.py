@@ -7,7 +7,7 @@ face's next vertex, t along the edge to its previous vertex), is
 
     D (f o Phi^-1)(0) = [ f_lam(1, 0), f_lam(0, 1) ],
 
-where f_lam is the lam-eigencomponent of f (DESIGN.md R2). Derivation: write
+where f_lam is the lam-eigencomponent of f (docs/readings.md R2). Derivation: write
 ``f(y) = x0 + sum_a (l_a . C) g_a(y) + (eigencomponents of smaller eigenvalues)`` with
 ``l_1, l_2`` a basis of left eigenvectors of lam (they live on the vertex's 1-ring), ``g_a`` the
 limit functions of the dual right eigenvectors (``l_a . r_b = delta_ab``) and C the control points.

@@ -1,5 +1,5 @@
 """Quadrant maps F_i of bmz04 eq. (4): the vanishing-derivative map F^alpha (section 4.2) and the
-inverse characteristic map Phi^-1 in the normalized frame (section 4.3, DESIGN.md R3, R6).
+inverse characteristic map Phi^-1 in the normalized frame (section 4.3, docs/readings.md R3, R6).
 
 Both map the quadrant [0, inf)^2 onto itself, fix the origin, map each axis onto itself and commute
 with the swap (s, t) -> (t, s). Each function returns the map, its Jacobian and (on request) its
@@ -35,7 +35,7 @@ __all__ = [
 
 
 def subdominant_lambda(k):
-    """lam(k) = (5 + c + sqrt((1 + c)(9 + c))) / 16, c = cos(2 pi / k) (DESIGN.md R2), as a float.
+    """lam(k) = (5 + c + sqrt((1 + c)(9 + c))) / 16, c = cos(2 pi / k) (docs/readings.md R2), as a float.
 
     >>> subdominant_lambda(4)
     0.5
@@ -126,7 +126,7 @@ def vanishing_map(s, t, alpha, derivatives=1):
         ``H[:, a, i, j] = d^2 F_a / dt_i dt_j`` (with 2; NaN at the origin when alpha < 2).
 
     >>> F, J = vanishing_map(np.array([3.0]), np.array([4.0]), 2.0)
-    >>> F.tolist(), np.round(J[0], 12).tolist()
+    >>> np.round(F, 12).tolist(), np.round(J[0], 12).tolist()
     ([[15.0, 20.0]], [[6.8, 2.4], [2.4, 8.2]])
     """
     s = np.asarray(s, dtype=np.float64)

@@ -113,17 +113,36 @@ def eval_form_arb(form, c, lam):
 
 # ----------------------------------------------------------------------------- locations
 def certificates_dir():
-    """The ``certificates/`` folder: ``$CCPROOF_CERTIFICATES`` if set, else the one beside the
-    package source (repository checkout or editable install), else ``./certificates``."""
+    """The published certificates (``tables/``, ``injectivity/``, ``c1/``), read-only for the package.
+
+    ``$CCPROOF_CERTIFICATES`` if set; else the repository's top-level ``certificates/`` when this
+    module runs from a checkout (also an editable install): the folder beside ``pyproject.toml``
+    two levels above the package; else the copy the wheel ships as package data,
+    ``ccproof/_certificates`` (written by the build hook in ``setup.py``).
+    """
     env = os.environ.get("CCPROOF_CERTIFICATES")
     if env:
         return Path(env)
-    here = Path(__file__).resolve()
-    for parent in here.parents:
-        cand = parent / "certificates"
-        if (cand / "tables").is_dir():
-            return cand
-    return Path.cwd() / "certificates"
+    package = Path(__file__).resolve().parents[1]
+    checkout = package.parent
+    if (checkout / "pyproject.toml").is_file() and (checkout / "certificates" / "tables").is_dir():
+        return checkout / "certificates"
+    return package / "_certificates"
+
+
+def output_dir():
+    """Where ``ccproof certify`` writes new certificates by default (never inside site-packages).
+
+    In a checkout (or with ``$CCPROOF_CERTIFICATES``): :func:`certificates_dir`. For an installed
+    package: ``$XDG_DATA_HOME/ccproof/certificates`` (``~/.local/share/ccproof/certificates`` when
+    ``XDG_DATA_HOME`` is unset). The tables a new certificate references are read from
+    :func:`certificates_dir`, so ``ccproof verify`` finds them wherever the certificate is written.
+    """
+    published = certificates_dir()
+    if published != Path(__file__).resolve().parents[1] / "_certificates":
+        return published
+    data_home = os.environ.get("XDG_DATA_HOME") or str(Path.home() / ".local" / "share")
+    return Path(data_home) / "ccproof" / "certificates"
 
 
 def table_filename(valence):

@@ -60,7 +60,7 @@ def test_overlapping_boxes(cert3):
 
 def test_bound_raised_above_true_minimum(cert3):
     c = copy.deepcopy(cert3)
-    # the minimum of det J_G / h^2 on the corner is about 0.132 for k = 3 (DESIGN.md R9; the float
+    # the minimum of det J_G / h^2 on the corner is about 0.132 for k = 3 (docs/readings.md R9; the float
     # sampling in test_prover shows the certified bound is within 0.01 of it): claim 0.2 everywhere
     for name in ("P1", "P2", "P3"):
         for b in c["parts"]["corner"][name]:

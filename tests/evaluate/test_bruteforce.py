@@ -138,7 +138,7 @@ def test_corner_matrix_equals_global_step(k):
         ringn, keyn, _ = canonical_ring(LocalTopology(mn.faces), 0, 0)
         assert keyn == key0
         assert np.abs(mn.vertices[ringn] - An @ C).max() < 1e-14
-    # eigenvalues: 1, then lam (double), DESIGN.md R2
+    # eigenvalues: 1, then lam (double), docs/readings.md R2
     c = np.cos(2 * np.pi / k)
     lam = (5 + c + np.sqrt((1 + c) * (9 + c))) / 16
     ev = np.sort(np.abs(np.linalg.eigvals(A)))[::-1]

@@ -75,7 +75,7 @@ def test_chunking_and_backends_agree():
     try:
         import numba  # noqa: F401
     except ImportError:
-        pytest.skip("numba not installed")
+        pytest.skip("numba not installed (optional extra ccproof[fast])")
     c = S.evaluate(f, u, v, 2, backend="numba")
     for k in a:
         assert np.abs(a[k] - c[k]).max() <= 1e-14 * np.abs(a[k]).max(), k

@@ -72,7 +72,7 @@ def test_roundtrip_random_and_clustered(k):
 @pytest.mark.slow
 @pytest.mark.parametrize("k", ALL_K)
 def test_roundtrip_full(k):
-    """The issue's full set: 10^6 random t, 10^5 clustered t, and the reverse round trips."""
+    """The full benchmark set of docs/inverse.md: 10^6 random t, 10^5 clustered t, and the reverse round trips."""
     rng = np.random.default_rng(1000 + k)
     err, res = roundtrip_error(k, rng.random(10**6), rng.random(10**6))
     assert err <= TOL and res.stats["failures"] == 0

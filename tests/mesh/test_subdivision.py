@@ -103,7 +103,7 @@ def test_vertex_limits_against_opensubdiv(refdir, name):
 
 def test_reference_step_agrees_with_pygel3d(refdir):
     """An established implementation (pygel3d's cc_subdivide) gives the same points, as a set."""
-    hmesh = pytest.importorskip("pygel3d.hmesh")
+    hmesh = pytest.importorskip("pygel3d.hmesh", reason="pygel3d not installed (optional extra ccproof[bench])")
     from scipy.spatial import cKDTree
 
     path = refdir / "meshes" / "bunny_quads.obj"

@@ -1,4 +1,4 @@
-"""The weight b of bmz04 section 4.2 (DESIGN.md R5) against an exact sympy construction.
+"""The weight b of bmz04 section 4.2 (docs/readings.md R5) against an exact sympy construction.
 
 Expected values: B built from its truncated-power formula in sympy rationals (not the piecewise
 formulas of the implementation), one-sided derivatives computed exactly by sympy, and the

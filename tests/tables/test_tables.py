@@ -34,7 +34,7 @@ def test_committed_tables_are_what_the_code_builds(k):
 
 
 def test_N_matches_the_prototype_readings_R8():
-    """DESIGN.md R8 (independent double-precision prototype): N = 3 for k <= 5, 4 for 6..13,
+    """Reading R8 of docs/readings.md (independent double-precision prototype): N = 3 for k <= 5, 4 for 6..13,
     5 for k >= 14; the paper's N = 3 fails from k = 6 on."""
     for k in range(3, 101):
         N = load_table(k).N

@@ -1,6 +1,6 @@
 """hsh10 end to end: initialization, the multi-resolution optimization, the baselines, the metrics.
 
-Methods (the rows of hsh10's comparison figures, spec A10):
+Methods (the rows of hsh10's comparison figures, docs/hsh10.md A10):
 
 * ``"a"``: ARAP polygon parameterization (Liu et al. 2008) of the triangulated chart control mesh,
   texture then subdivided with the chart's boundary rules;
@@ -11,12 +11,12 @@ Methods (the rows of hsh10's comparison figures, spec A10):
 
 Every method is initialized by LSCM on its own triangulated control mesh (for (c): LSCM on the
 chart, then the conformal extension to the ring). Every method is measured the same way:
-:func:`texture_metrics` at evaluation level 5 (spec A9), plus flipped triangles of the texture
+:func:`texture_metrics` at evaluation level 5 (docs/hsh10.md A9), plus flipped triangles of the texture
 control mesh (:func:`control_flips`).
 
 Multi-resolution schedule (A7): optimize at ``start_level`` until the relative energy decrease
 per iteration is below ``tol``, then at the next level warm-started from the current ``T^0``, up
-to ``levels``. The default start is level 1 (spec A6 caution: at level 0 the masks miss the
+to ``levels``. The default start is level 1 (docs/hsh10.md A6 caution: at level 0 the masks miss the
 odd-even modes of regular grids; level 0 is allowed and then regularized if singular).
 """
 

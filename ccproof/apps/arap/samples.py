@@ -1,4 +1,4 @@
-"""Limit tangent masks (hsh10 Eq. 2, spec A3) and the level-k samples of Eq. 3 and of the metrics.
+"""Limit tangent masks (hsh10 Eq. 2, docs/hsh10.md A3) and the level-k samples of Eq. 3 and of the metrics.
 
 Tangent masks (A3). For an interior vertex of valence n with edge neighbours e_0 .. e_{n-1}
 (counter-clockwise) and face-diagonal neighbours f_i (face i between e_i and e_{i+1}):
@@ -23,7 +23,7 @@ values of ``E_k``) for the *same* two parametric directions, and a weight. Two k
   along the two edges of f at v, ``d_a = L(a) - L(v)`` and ``d_b = L(b) - L(v)``, for the surface
   and for the texture (each with its own rules, so the secant pairs span the same parameter
   triangle); weight ``||d_a x d_b|| / 4`` (a quarter face). hsh10 gives no masks at chart boundary
-  vertices (spec A11.2); secants are exact for affine maps and reproduce the texture's own boundary
+  vertices (docs/hsh10.md A11.2); secants are exact for affine maps and reproduce the texture's own boundary
   behaviour, which is what (b) is about.
 
 Limit position masks: interior ``(n^2 V + 4 sum e + sum f) / (n (n + 5))``; crease (cubic B-spline
@@ -143,7 +143,7 @@ def limit_operator(level: Level, rules):
 
 
 def isometric_frames(p1, p2):
-    """The isometric images (a, b, c) of the frames: p^_1 = (a, 0), p^_2 = (b, c) (spec A2).
+    """The isometric images (a, b, c) of the frames: p^_1 = (a, 0), p^_2 = (b, c) (docs/hsh10.md A2).
 
     ``a = |p1|``, ``b = p1.p2 / |p1|``, ``c = |p1 x p2| / |p1|`` (c >= 0).
     """
@@ -197,7 +197,7 @@ def build_samples(level: Level, rules, purpose="optimize") -> SampleSet:
         "optimize": the energy of hsh10 Eq. 3 for that variant (mask samples wherever the texture
         follows the interior rules, i.e. at every chart vertex off the surface boundary for
         extended charts). "metric": the same sampling for every method (mask samples at
-        chart-interior vertices, corner samples on the chart boundary), spec A9 / A11.4.
+        chart-interior vertices, corner samples on the chart boundary), docs/hsh10.md A9 / A11.4.
     """
     r = _rules(rules)
     mesh = level.mesh

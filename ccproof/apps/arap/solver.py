@@ -1,4 +1,4 @@
-"""Local/global ARAP iteration on samples (hsh10 section 3, Appendix; spec A5, A6, A7).
+"""Local/global ARAP iteration on samples (hsh10 section 3, Appendix; docs/hsh10.md A5, A6, A7).
 
 Energy (Eq. 3 / A6): with X = T^0 (N x 2) the texture unknowns, every sample j has
 ``t_{j,c} = G_c[j] X`` (rows of sparse operators), the isometric frame ``Q_j = (p^_1 p^_2)^-1`` and a
@@ -14,7 +14,7 @@ Global step (A6): the normal equations ``L X = B`` with ``L = sum_j w_j H_j H_j^
 R: factorized ONCE per level with SuperLU and reused) and ``B = sum_j w_j H_j R_j^T`` (rebuilt every
 iteration, two sparse products). One unknown is pinned (the energy is translation invariant).
 If ``L`` restricted to the free unknowns is (numerically) singular, e.g. at level 0 on regular
-grids (spec A6 caution), a proximal term ``mu ||X - X_prev||^2`` is added; it keeps the energy
+grids (docs/hsh10.md A6 caution), a proximal term ``mu ||X - X_prev||^2`` is added; it keeps the energy
 monotone and the run reports ``regularized=True``.
 
 The same class runs Liu et al.'s triangle ARAP (baselines (a), (d)): one sample per triangle with

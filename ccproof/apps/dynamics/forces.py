@@ -6,7 +6,7 @@ springs is stored as the sparse matrix ``J_S`` (one row ``J(u0, v0)`` per spring
 the anchor points; :class:`~ccproof.apps.dynamics.integrate.ImplicitIntegrator` moves ``k J^T J``
 into the step matrix (semi-implicit).
 
-Range data: every data point pulls the *nearest* point of the limit surface (spec B7.4, B7.5): the
+Range data: every data point pulls the *nearest* point of the limit surface (docs/qmv98.md B7.4, B7.5): the
 surface is sampled densely (a grid per face, evaluated through a precomputed sparse sampling matrix),
 the nearest samples are found with a k-d tree, and each candidate is refined by a projected
 Gauss-Newton iteration on (u, v) inside its face; the closest candidate wins.

@@ -1,7 +1,7 @@
 """The chart hierarchy reproduces the surface and both texture rule sets.
 
 Expected values: the mesh layer's global Catmull-Clark step applied to the whole mesh (surface and
-extended-chart texture: spec A8/A11.5), and the mesh layer's subdivision of the chart cut out as
+extended-chart texture: docs/hsh10.md A8/A11.5), and the mesh layer's subdivision of the chart cut out as
 its own mesh (crease boundary) with the corner rule V' = V written out here (boundary rules).
 Vertices are matched by position (generic perturbed meshes: positions are distinct).
 """

@@ -61,7 +61,7 @@ def test_lscm_triangulation_uses_shorter_diagonal():
 
 
 def test_lscm_matches_libigl():
-    igl = pytest.importorskip("igl")
+    igl = pytest.importorskip("igl", reason="libigl not installed (optional extra ccproof[bench])")
     m, _ = M.curved_ev_mesh()
     V = m.vertices
     T = triangulate_quads(V, m.faces)
@@ -72,7 +72,7 @@ def test_lscm_matches_libigl():
 
 
 def test_numpy_triangle_arap_matches_libigl():
-    pytest.importorskip("igl")
+    pytest.importorskip("igl", reason="libigl not installed (optional extra ccproof[bench])")
     m, _ = M.curved_ev_mesh()
     V = m.vertices
     T = triangulate_quads(V, m.faces)

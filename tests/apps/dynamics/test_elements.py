@@ -11,7 +11,7 @@ from ccproof.apps.dynamics.elements import special_scheme
 from ccproof.apps.dynamics.meshes import torus_32
 from ccproof.apps.dynamics.model import DynamicSurface, Material
 
-# spec B5, copied by hand (independent of the code under test)
+# docs/qmv98.md B5, copied by hand (independent of the code under test)
 SPEC_G0 = [[Fr(1, 252), Fr(43, 1680), Fr(1, 84), Fr(1, 5040)], [Fr(43, 1680), Fr(33, 140), Fr(311, 1680), Fr(1, 84)],
            [Fr(1, 84), Fr(311, 1680), Fr(33, 140), Fr(43, 1680)], [Fr(1, 5040), Fr(1, 84), Fr(43, 1680), Fr(1, 252)]]
 SPEC_G1 = [[Fr(1, 20), Fr(7, 120), Fr(-1, 10), Fr(-1, 120)], [Fr(7, 120), Fr(17, 60), Fr(-29, 120), Fr(-1, 10)],
@@ -21,7 +21,7 @@ SPEC_G2 = [[Fr(1, 3), Fr(-1, 2), Fr(0), Fr(1, 6)], [Fr(-1, 2), Fr(1), Fr(-1, 2),
 
 
 def _basis_spec(x, r):
-    """B0..B3 of spec B2 and their derivatives, written out independently."""
+    """B0..B3 of docs/qmv98.md B2 and their derivatives, written out independently."""
     x = np.asarray(x, dtype=float)
     if r == 0:
         return np.stack([(1 - x) ** 3 / 6, (3 * x**3 - 6 * x**2 + 4) / 6, (-3 * x**3 + 3 * x**2 + 3 * x + 1) / 6,
@@ -124,8 +124,8 @@ def test_q3_truncated_mass_total_and_stein(n):
 def test_q3_level_ratios(n):
     """Level increments of p^T dX_L p: mass -> 1/4, tension -> lam^2, rigidity -> 4 lam^2.
 
-    The spec's "within 5% by L = 8" holds for the mass and (n = 3) the tension; the rigidity terms at
-    n = 5, 6 approach 4 lam^2 like (mu2/lam)^L with a large prefactor (30% off at L = 8 for a random p),
+    The target of docs/qmv98.md Q3, "within 5% by L = 8", holds for the mass and (n = 3) the tension; the rigidity terms
+    at n = 5, 6 approach 4 lam^2 like (mu2/lam)^L with a large prefactor (30% off at L = 8 for a random p),
     so the ratios are measured at L = 14, where all are within 1%.
     """
     S = special_scheme(n)

@@ -15,7 +15,7 @@ MAT = Material(mu=1.0, gamma=0.5, a11=0.3, a22=0.6, b11=0.2, b12=0.5, b22=0.4)
 
 
 def test_q6_scheme31_first_order_on_oscillator():
-    """m = 1, d = 0.5, k = 4, p(0) = 1 at rest, T = 5: errors 0.159, 0.099, 0.056, 0.030 (spec B5)."""
+    """m = 1, d = 0.5, k = 4, p(0) = 1 at rest, T = 5: errors 0.159, 0.099, 0.056, 0.030 (docs/qmv98.md B5)."""
     m, d, k, T = 1.0, 0.5, 4.0, 5.0
     z = d / (2 * m)
     w = np.sqrt(k / m - z * z)

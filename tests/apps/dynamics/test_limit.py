@@ -102,7 +102,8 @@ def test_q4_converges_to_limit_point(make):
 
 
 def test_q4_matches_exact_evaluator():
-    evaluate = pytest.importorskip("ccproof.evaluate")
+    from ccproof import evaluate
+
     rng = np.random.default_rng(5)
     for make in (paper_initial_model, open_surface_valence5):
         mesh = perturbed(make(), seed=3, amp=0.05)
