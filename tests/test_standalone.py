@@ -10,7 +10,8 @@ import re
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
-ROOTS = ["ccproof", "tests", "scripts", "docs", ".ci", "README.md", "pyproject.toml", "setup.py", "MANIFEST.in"]
+ROOTS = ["ccproof", "tests", "scripts", "docs", ".ci", "README.md", "pyproject.toml", "setup.py", "MANIFEST.in",
+         "certificates"]
 BINARY = {".png", ".jpg", ".pdf", ".npz", ".npy", ".pyc", ".whl", ".gz", ".zip"}
 SKIP_DIRS = {"__pycache__", ".pytest_cache", ".ruff_cache", ".hypothesis", "_certificates"}
 

@@ -17,7 +17,8 @@ def add_arguments(p):
     p.add_argument("--all", action="store_true", help="regenerate every table (k = 3..100 and k >= 40)")
     p.add_argument("--kmax", type=int, default=100, help="largest valence with --all (default 100)")
     p.add_argument("--jobs", type=int, default=2, help="worker processes with --all (default 2)")
-    p.add_argument("--dir", default=None, help="tables folder (default: certificates/tables)")
+    p.add_argument("--dir", default=None, help="tables folder for --all (default: certificates/tables of the "
+                   "checkout, or the user folder of an installed package, never site-packages)")
     p.add_argument("--json", action="store_true", help="print the raw JSON instead of a summary")
 
 
@@ -66,7 +67,10 @@ def run(args):
 
         from tqdm import tqdm
 
+        from ccproof.tables.format import output_dir
+
         ks = list(range(3, args.kmax + 1)) + [">=40"]
+        args.dir = args.dir or str(output_dir() / "tables")
         work = [(k, args.dir) for k in ks]
         with ProcessPoolExecutor(max_workers=max(1, args.jobs)) as ex:
             for _ in tqdm(ex.map(_build_one, work), total=len(work), desc="tables", unit="table"):

@@ -135,8 +135,8 @@ def output_dir():
 
     In a checkout (or with ``$CCPROOF_CERTIFICATES``): :func:`certificates_dir`. For an installed
     package: ``$XDG_DATA_HOME/ccproof/certificates`` (``~/.local/share/ccproof/certificates`` when
-    ``XDG_DATA_HOME`` is unset). The tables a new certificate references are read from
-    :func:`certificates_dir`, so ``ccproof verify`` finds them wherever the certificate is written.
+    ``XDG_DATA_HOME`` is unset). A certificate needs no other file: ``ccproof verify`` checks it wherever
+    it is written.
     """
     published = certificates_dir()
     if published != Path(__file__).resolve().parents[1] / "_certificates":
