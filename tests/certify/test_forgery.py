@@ -170,3 +170,26 @@ def test_verify_all_goes_on_past_a_bad_file(tmp_path, capsys):
     assert verify_run(A()) == 1
     out = capsys.readouterr().out
     assert "VERIFIED " + str(good) in out and out.count("FAILED") >= 2 and "1 of 3 certificates verified" in out
+
+
+class _IdentityDerivation:
+    """What a forger would put in place of the derivation: the identity map's B-spline nets (the k = 4
+    nets), independent of lam, as exact forms."""
+
+    symmetric = True
+
+    def integer_forms(self, which="bspline"):
+        def f(num):
+            return [[num], [0], [2]]  # num / 2
+        nets = {"P1": lambda i, j: (f(i), f(j - 1)), "P2": lambda i, j: (f(i), f(j)),
+                "P3": lambda i, j: (f(i - 1), f(j))}
+        return {n: [[g(i, j) for j in range(4)] for i in range(4)] for n, g in nets.items()}
+
+
+@pytest.mark.slow
+def test_identity_nets_for_every_k_ge_40(monkeypatch):
+    """Our interval prover run on the identity nets (every exact form replaced by the identity) finds a
+    certificate for that map; the verifier, which derives the k >= 40 nets itself, rejects it at part B."""
+    monkeypatch.setattr(P, "derivation", lambda: _IdentityDerivation())
+    forged = P.prove_interval(40, progress=False, max_pieces=1)
+    failed_with(forged, "FAIL  [piece 0] B regularity P1", "is not above the claimed bound")

@@ -162,3 +162,36 @@ def test_input_validation():
         Poly.variable(0, 2).evaluate([arb(1), 1])  # exact poly at a ball needs prec
     with pytest.raises(ValueError):
         Poly.variable(0, 2).to_arb(1)
+
+
+def test_truncate_keeps_a_ball_that_contains_zero():
+    """(1 + [+-1e-6] z^2).truncate(1): the z^2 term's ball contains 0 but is not 0; it must go into the
+    remainder (arb's `!=` means "certainly different", so a test `x != 0` would drop it)."""
+    from flint import arb, fmpq
+
+    z = Poly.variable(0, 1, 64)
+    p = 1 + arb(0, fmpq(1, 10**6)) * z**2
+    r = p.truncate(1)
+    c0 = r.coefficient((0,))
+    assert c0.contains(1) and c0.rad() >= fmpq(1, 10**6)
+    for zv in (fmpq(-1), fmpq(1, 3), fmpq(1)):  # encloses p pointwise on [-1, 1]: p(z) in [1 - 1e-6 z^2, 1 + ...]
+        assert c0.contains(1 + fmpq(1, 10**6) * zv**2) and c0.contains(1 - fmpq(1, 10**6) * zv**2)
+
+
+def test_truncate_encloses_random_ball_polynomials():
+    import random
+
+    from flint import arb, ctx, fmpq
+
+    rng = random.Random(7)
+    with ctx.workprec(64):
+        for _ in range(50):
+            coeffs = {(i, j): arb(fmpq(rng.randint(-9, 9), 7), fmpq(rng.randint(0, 3), 10**rng.randint(1, 9)))
+                      for i in range(5) for j in range(3)}
+            p = Poly(coeffs, 2, 64)
+            r = p.truncate(2)
+            for _ in range(5):
+                zv, sv = fmpq(rng.randint(-8, 8), 8), fmpq(rng.randint(0, 8), 8)
+                # every polynomial in the family of p evaluated at (zv, sv): take the coefficients' mid-points
+                mid = sum((arb(c.mid()) * zv**i * sv**j for (i, j), c in coeffs.items()), arb(0))
+                assert r(zv, sv).contains(mid)
