@@ -297,6 +297,11 @@ class LimitSurface:
         self.n_patches = self._nets.shape[0]
         self.max_layers = int(self._vnmax.max()) + 1 if (self._vkind == _CORNER).any() else 0
 
+    @property
+    def n_faces(self):
+        """Number of (ptex) faces: the valid ``face`` ids of :meth:`evaluate`."""
+        return self.mesh.n_faces
+
     # ------------------------------------------------------------------ input checks
     def _check(self, face_ids, u, v):
         f = np.asarray(face_ids)
@@ -316,7 +321,7 @@ class LimitSurface:
                 raise CCProofError(f"point {bad}: face id {f[bad].item()!r} is not an integer")
             f = fi
         f = f.astype(np.int64, copy=False)
-        m = self.mesh.n_faces
+        m = self.n_faces
         step = 1 << 18  # bounded temporaries
         for lo in range(0, f.size, step):
             fb, ub, vb = f[lo : lo + step], u[lo : lo + step], v[lo : lo + step]
@@ -516,18 +521,31 @@ def _numba_kernel(backend):
 
 
 def limit_surface(mesh):
-    """Prepare the exact evaluation of the limit surface of ``mesh`` (a QuadMesh or an OBJ path).
+    """Prepare the exact evaluation of the limit surface of ``mesh``.
 
     Parameters
     ----------
-    mesh : QuadMesh or str or os.PathLike
+    mesh : QuadMesh, PolyMesh, or str or os.PathLike
+        A path is read by :func:`ccproof.mesh.io.read_mesh` (OBJ with OpenSubdiv tags, or any
+        meshio format). An untagged all-quad mesh uses the all-quad evaluator; anything else
+        (triangles, n-gons, creases, corners, holes, boundary modes) the tagged one
+        (:class:`ccproof.evaluate.tagged.TaggedLimitSurface`), with ``face`` the ptex face index.
 
     Returns
     -------
     LimitSurface
     """
-    if not isinstance(mesh, QuadMesh):
-        from ccproof.mesh import read_obj
+    if isinstance(mesh, QuadMesh):
+        return LimitSurface(mesh)
+    from ccproof.mesh.polymesh import PolyMesh
 
-        mesh = read_obj(mesh)
-    return LimitSurface(mesh)
+    if not isinstance(mesh, PolyMesh):
+        from ccproof.mesh.io import read_mesh
+
+        mesh = read_mesh(mesh)
+    if mesh.is_all_quads and not mesh.has_tags:
+        # the all-quad evaluator (same rules: EDGE_ONLY boundary, no tags), ptex face = face
+        return LimitSurface(QuadMesh(mesh.vertices, np.array(mesh.polygons, dtype=np.int64).reshape(-1, 4)))
+    from ccproof.evaluate.tagged import TaggedLimitSurface
+
+    return TaggedLimitSurface(mesh)
