@@ -397,11 +397,53 @@ def _to_fmpq_mat(rows, ncols):
 
 
 def _fmpq_mat_to_float(M):
-    out = np.empty((M.nrows(), M.ncols()))
-    for idx, x in enumerate(M.entries()):
-        p, q = int(x.p), int(x.q)
-        out.flat[idx] = p / q  # correctly rounded (Python int true division)
-    return out
+    """Correctly rounded float matrix of an exact one (common denominator, Python int true division)."""
+    num, den = M.numer_denom()
+    q = int(den)
+    out = np.array([int(p) / q for p in num.entries()], dtype=np.float64)
+    return out.reshape(M.nrows(), M.ncols())
+
+
+def power_layers(M, A, l_row):
+    """Rounded deviations ``M A^n - 1 l^T`` for n = 0, 1, ... until below ``LAYER_TOLERANCE``.
+
+    Parameters
+    ----------
+    M : flint.fmpq_mat, shape (48, N)
+    A : flint.fmpq_mat, shape (N, N)
+    l_row : flint.fmpq_mat, shape (1, N)
+
+    Returns
+    -------
+    ndarray, shape (n_layers, 3, 16, N)
+
+    Notes
+    -----
+    Exact throughout: with ``A = Ai / a``, ``M = Mi / m`` and ``l = li / c`` (integer matrices and
+    common denominators) the n-th deviation is ``(c Mi Ai^n - m a^n 1 li^T) / (c m a^n)``; the powers
+    are integer matrix products (flint ``fmpz_mat``), and only the final quotients are rounded.
+    """
+    N = A.nrows()
+    Ai, a = A.numer_denom()
+    Mi, m = M.numer_denom()
+    li, c = l_row.numer_denom()
+    a, m, c = int(a), int(m), int(c)
+    Lrow = [int(x) for x in li.entries()]
+    ones = flint.fmpz_mat(48, 1, [1] * 48)
+    L1 = ones * flint.fmpz_mat(1, N, Lrow)
+    R = Mi
+    den = m
+    layers = []
+    for _ in range(MAX_LAYERS):
+        num = R * c - L1 * den
+        q = c * den
+        D = np.array([int(p) / q for p in num.entries()], dtype=np.float64).reshape(48, N)
+        layers.append(D.reshape(3, 16, N))
+        if np.abs(D).max() < LAYER_TOLERANCE:
+            return np.array(layers)
+        R = R * Ai
+        den *= a
+    raise MeshError(f"corner configuration of {N} vertices does not converge to its limit point")
 
 
 class CornerScheme:
@@ -545,16 +587,5 @@ def corner_scheme(key):
     except ZeroDivisionError:
         raise MeshError("corner configuration whose subdivision matrix has a multiple eigenvalue 1") from None
     l_row = flint.fmpq_mat(1, N, [lvec[i, 0] for i in range(N)])
-    ones = flint.fmpq_mat(48, 1, [1] * 48)
-    L1 = ones * l_row
-    layers = []
-    R = M
-    for _ in range(MAX_LAYERS):
-        D = _fmpq_mat_to_float(R - L1)
-        layers.append(D.reshape(3, 16, N))
-        if np.abs(D).max() < LAYER_TOLERANCE:
-            break
-        R = R * A
-    else:  # pragma: no cover - every Catmull-Clark corner contracts
-        raise MeshError(f"corner configuration of {N} vertices does not converge to its limit point")
-    return CornerScheme(N, A, _fmpq_mat_to_float(l_row)[0], np.array(layers))
+    layers = power_layers(M, A, l_row)
+    return CornerScheme(N, A, _fmpq_mat_to_float(l_row)[0], layers)

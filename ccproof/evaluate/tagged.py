@@ -34,12 +34,11 @@ import numpy as np
 
 from ccproof.errors import CCProofError, MeshError
 from ccproof.evaluate.local import (
-    LAYER_TOLERANCE,
-    MAX_LAYERS,
     CornerScheme,
     _fmpq_mat_to_float,
     _lin,
     _to_fmpq_mat,
+    power_layers,
 )
 from ccproof.evaluate.surface import (
     _CORNER,
@@ -347,18 +346,8 @@ def tagged_corner_scheme(key):
     except ZeroDivisionError:
         raise MeshError("corner configuration whose subdivision matrix has a multiple eigenvalue 1") from None
     l_row = flint.fmpq_mat(1, N, [lvec[i, 0] for i in range(N)])
-    L1 = flint.fmpq_mat(48, 1, [1] * 48) * l_row
-    layers = []
-    R = M
-    for _ in range(MAX_LAYERS):
-        D = _fmpq_mat_to_float(R - L1)
-        layers.append(D.reshape(3, 16, N))
-        if np.abs(D).max() < LAYER_TOLERANCE:
-            break
-        R = R * A
-    else:  # pragma: no cover
-        raise MeshError(f"corner configuration of {N} vertices does not converge to its limit point")
-    return CornerScheme(N, A, _fmpq_mat_to_float(l_row)[0], np.array(layers))
+    layers = power_layers(M, A, l_row)
+    return CornerScheme(N, A, _fmpq_mat_to_float(l_row)[0], layers)
 
 
 # ------------------------------------------------------------------------------ builder
