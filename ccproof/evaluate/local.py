@@ -461,13 +461,18 @@ class CornerScheme:
         ``D[n, j-1] = M_j A^n - 1 l^T`` (exact, then rounded): deviation of the net of patch P_j of
         layer n from the limit point. Layers beyond ``n_layers - 1`` equal the limit point to
         within ``LAYER_TOLERANCE`` times the size of the one-ring.
+    support : tuple of int or None
+        The ring points the surface over the face depends on (closed under ``A``), when fewer
+        than all: across an infinitely sharp crease the other sector is decoupled, and its
+        eigenvalues must not enter the tangent plane of this one. ``None``: all points.
     """
 
-    def __init__(self, size, A, limit_mask, layers):
+    def __init__(self, size, A, limit_mask, layers, support=None):
         self.size = size
         self.A = A
         self.limit_mask = limit_mask
         self.layers = layers
+        self.support = None if support is None or len(support) == size else tuple(support)
 
     @property
     def n_layers(self):
@@ -485,7 +490,58 @@ class CornerScheme:
         ``None`` when the second eigenspace has several directions (the tangent plane would depend
         on the direction of approach).
         """
-        return _tangent_masks(self.A)
+        A = self.A
+        if self.support is not None:
+            idx = self.support
+            A = flint.fmpq_mat(len(idx), len(idx), [A[i, j] for i in idx for j in idx])
+        T = _tangent_masks_float(A)
+        if T is None:
+            T = _tangent_masks(A)
+        if T is None or self.support is None:
+            return T
+        out = np.zeros((2, self.size))
+        out[:, list(self.support)] = T
+        return out
+
+
+def _tangent_masks_float(A):
+    """:meth:`CornerScheme.tangent_masks` in double precision, or None (then the 80-digit path decides).
+
+    Eigenvalues of the rounded ``A`` (numpy), grouped within 1e-6 (a defective pair splits by about
+    sqrt(eps)); the left null vectors of ``A - mu`` for the group mean ``mu`` by SVD (singular
+    values below 1e-9). Accepted only when every step is unambiguous: real groups, the expected
+    null-space dimensions, and residuals ``|x (A - mu)| <= 1e-12 |x|``.
+    """
+    Af = _fmpq_mat_to_float(A)
+    N = Af.shape[0]
+    vals = np.linalg.eigvals(Af)
+    vals = vals[np.argsort(-np.abs(vals), kind="stable")]
+    groups = []
+    for z in vals:
+        if groups and abs(groups[-1][0] - z) < 1e-6:
+            groups[-1].append(z)
+        else:
+            groups.append([z])
+    masks = []
+    for g in groups:
+        mu = sum(g) / len(g)
+        if abs(mu - 1) < 1e-9:
+            continue
+        if abs(mu.imag) > 1e-9:
+            return None
+        B = Af.T - mu.real * np.eye(N)
+        _, S, Vt = np.linalg.svd(B)
+        null = [i for i in range(N) if S[i] < 1e-9]
+        if not null or (masks and len(null) > 1):
+            return None
+        for i in null[: 2 - len(masks)]:
+            x = Vt[i]
+            if np.linalg.norm(x @ Af - mu.real * x) > 1e-12 * np.linalg.norm(x):
+                return None
+            masks.append(x)
+        if len(masks) == 2:
+            return np.array(masks)
+    return None
 
 
 def _tangent_masks(A):

@@ -131,6 +131,7 @@ class _Builder:
         self.vbase = []
         self.max_depth = 0
         self.corner_of_vertex = {}
+        self.corner_data = {}  # corner virtual face -> (CornerScheme, ring control points)
 
     def new_vface(self, kind, frame, base_face):
         self.vbase.append(base_face)
@@ -190,6 +191,7 @@ class _Builder:
         return self.split_face(topo, X, f, frame, depth, base_face, vid, vmap)
 
     def corner_face(self, scheme, C, r, frame, vid):
+        self.corner_data[vid] = (scheme, C)
         rot = _compose(frame, _corner_frame(r))
         self.vkind[vid] = _CORNER
         U0, V0, H = self.vdom[vid]
@@ -293,6 +295,8 @@ class LimitSurface:
         self._vnmax = np.array(b.vnmax, dtype=np.int64)
         self.split_depth = b.max_depth
         self._corner_of_vertex = b.corner_of_vertex
+        self._corner_data = b.corner_data
+        self._corner_normal = {}
         self._vbase = np.array(b.vbase, dtype=np.int64)
         self.n_patches = self._nets.shape[0]
         self.max_layers = int(self._vnmax.max()) + 1 if (self._vkind == _CORNER).any() else 0
@@ -462,6 +466,67 @@ class LimitSurface:
             np.multiply(np.einsum("ni,nic->nc", bs[2], T0), g2, out=out["Puu"])
             np.multiply(np.einsum("ni,nic->nc", bs[1], T1), g2, out=out["Puv"])
             np.multiply(np.einsum("ni,nic->nc", bs[0], T2), g2, out=out["Pvv"])
+
+    # ------------------------------------------------------------------ normals
+    def _vface_of(self, f, u, v):
+        vf = f.copy()
+        kind = self._vkind[vf]
+        for _ in range(self.split_depth):
+            idx = np.flatnonzero(kind == _SPLIT)
+            if idx.size == 0:
+                break
+            w = vf[idx]
+            half = self._vh[w] * 0.5
+            q = (u[idx] >= self._vu0[w] + half).astype(np.int64) + 2 * (v[idx] >= self._vv0[w] + half)
+            vf[idx] = self._vchild[w, q]
+            kind[idx] = self._vkind[vf[idx]]
+        return vf, kind
+
+    def _eigen_normal(self, vid):
+        """Unit normal at the irregular corner of corner face ``vid`` from the exact tangent masks."""
+        if vid not in self._corner_normal:
+            scheme, C = self._corner_data[vid]
+            T = scheme.tangent_masks
+            nrm = None
+            if T is not None:
+                t1, t2 = T @ (C - C[0])
+                c = np.cross(t1, t2)
+                if np.linalg.norm(c) > 0:
+                    nrm = c / np.linalg.norm(c)
+            self._corner_normal[vid] = nrm
+        return self._corner_normal[vid]
+
+    def normals(self, face_ids, u, v):
+        """Unit limit normals, shape (n, 3), oriented like ``Pu x Pv``.
+
+        ``Pu x Pv`` normalized, except closer to an irregular corner than the innermost stored layer
+        (including the corner itself, where ``Pu x Pv`` degenerates): there the normal of the exact
+        tangent plane at the vertex (left eigenvectors of the corner's exact subdivision matrix,
+        :attr:`ccproof.evaluate.local.CornerScheme.tangent_masks`); it differs from ``Pu x Pv`` at
+        the innermost layer by the decay of the third eigenvalue over some 50 layers (round-off).
+        NaN where the tangent plane at such a corner is not determined by two eigenvectors.
+        """
+        f, u, v = self._check(face_ids, u, v)
+        r = self.evaluate(f, u, v, 1)
+        N = np.cross(r["Pu"], r["Pv"])
+        vf, kind = self._vface_of(f, u, v)
+        idx = np.flatnonzero(kind == _CORNER)
+        if idx.size:
+            w = vf[idx]
+            U0, V0, H = self._vu0[w], self._vv0[w], self._vh[w]
+            du = np.where(self._vcu[w], (U0 + H) - u[idx], u[idx] - U0) / H
+            dv = np.where(self._vcv[w], (V0 + H) - v[idx], v[idx] - V0) / H
+            mx = np.maximum(du, dv)
+            inner = mx < np.ldexp(1.0, -(self._vnmax[w] + 1))
+            for j in np.flatnonzero(inner):
+                e = self._eigen_normal(int(w[j]))
+                i = idx[j]
+                if e is None:
+                    N[i] = np.nan
+                else:
+                    N[i] = e if np.dot(e, N[i]) >= 0 else -e
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return N / np.linalg.norm(N, axis=1)[:, None]
 
     # ------------------------------------------------------------------ vertices
     def vertex_limits(self):

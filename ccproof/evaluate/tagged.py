@@ -337,6 +337,16 @@ def tagged_corner_scheme(key):
                     row[u] = row.get(u, 0) + w * x
             nets.append(row)
     M = _to_fmpq_mat(nets, N)
+    support = set()
+    for row in nets:
+        support.update(row)
+    todo = list(support)
+    while todo:  # close under A: the rows of A at the support use only the support
+        i = todo.pop()
+        for j in rows[i]:
+            if j not in support:
+                support.add(j)
+                todo.append(j)
     Bt = (A - flint.fmpq_mat(N, N, [int(i == j) for i in range(N) for j in range(N)])).transpose()
     for j in range(N):
         Bt[N - 1, j] = 1
@@ -347,7 +357,7 @@ def tagged_corner_scheme(key):
         raise MeshError("corner configuration whose subdivision matrix has a multiple eigenvalue 1") from None
     l_row = flint.fmpq_mat(1, N, [lvec[i, 0] for i in range(N)])
     layers = power_layers(M, A, l_row)
-    return CornerScheme(N, A, _fmpq_mat_to_float(l_row)[0], layers)
+    return CornerScheme(N, A, _fmpq_mat_to_float(l_row)[0], layers, sorted(support))
 
 
 # ------------------------------------------------------------------------------ builder
@@ -479,6 +489,8 @@ class TaggedLimitSurface(LimitSurface):
                     depth[c] = depth[vid] + 1
         self.split_depth = int(depth.max())
         self._corner_of_vertex = {}
+        self._corner_data = b.corner_data
+        self._corner_normal = {}
         self._vbase = np.array(b.vbase, dtype=np.int64)
         self.n_patches = self._nets.shape[0]
         self.max_layers = int(self._vnmax.max()) + 1 if (self._vkind == _CORNER).any() else 0
@@ -499,15 +511,11 @@ class TaggedLimitSurface(LimitSurface):
                 )
         return f, u, v
 
-    def vertex_limits(self):
-        """Limit positions of the base vertices (shape (n_vertices, 3)), NaN at unused vertices.
-
-        Evaluated at the ptex corner (0, 0) of a sub-face at the vertex, or at the quad corner.
-        """
-        mesh = self.mesh
-        out = np.full((mesh.n_vertices, 3), np.nan)
+    def _vertex_corners(self):
+        """One ptex corner (face, s, t) per corner of every base face, and its vertex."""
         from ccproof.evaluate.local import CORNERS
 
+        mesh = self.mesh
         faces, us, vs, verts = [], [], [], []
         for f, p in enumerate(mesh.polygons):
             for i, v in enumerate(p):
@@ -520,17 +528,30 @@ class TaggedLimitSurface(LimitSurface):
                     us.append(0.0)
                     vs.append(0.0)
                 verts.append(v)
-        f, u, v = np.array(faces), np.array(us), np.array(vs)
-        r = self._evaluate_unchecked(f, u, v)
-        out[np.array(verts)] = r
+        return np.array(faces, dtype=np.int64), np.array(us), np.array(vs), np.array(verts, dtype=np.int64)
+
+    def vertex_limits(self):
+        """Limit positions of the base vertices (shape (n_vertices, 3)), NaN at unused vertices.
+
+        Evaluated at the ptex corner (0, 0) of a sub-face at the vertex, or at the quad corner
+        (hole faces included: holes do not change the surface of the other faces).
+        """
+        out = np.full((self.mesh.n_vertices, 3), np.nan)
+        f, u, v, verts = self._vertex_corners()
+        r = {"P": np.empty((f.size, 3))}
+        self._eval_chunk(f, u, v, 0, r)
+        out[verts] = r["P"]
         return out
 
-    def _evaluate_unchecked(self, f, u, v):
-        outp = {"P": np.empty((f.size, 3))}
-        for lo in range(0, f.size, 1 << 15):
-            hi = min(f.size, lo + (1 << 15))
-            self._eval_chunk(f[lo:hi], u[lo:hi], v[lo:hi], 0, {"P": outp["P"][lo:hi]})
-        return outp["P"]
+    def vertex_normals(self):
+        """Unit limit normals of the base vertices (shape (n_vertices, 3)), see :meth:`normals`.
 
-    def vertex_normals(self):  # pragma: no cover - not yet available on tagged meshes
-        raise CCProofError("vertex_normals() is not implemented for tagged polygon meshes yet")
+        Each vertex takes the normal of its first face corner that is not on a hole; NaN where the
+        tangent plane is not determined (see :meth:`normals`) or the vertex has only hole faces.
+        """
+        out = np.full((self.mesh.n_vertices, 3), np.nan)
+        f, u, v, verts = self._vertex_corners()
+        keep = ~self._hole_ptex[f]
+        f, u, v, verts = f[keep][::-1], u[keep][::-1], v[keep][::-1], verts[keep][::-1]
+        out[verts] = self.normals(f, u, v)  # reversed: the first corner of a vertex is written last
+        return out
