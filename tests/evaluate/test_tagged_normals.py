@@ -85,7 +85,7 @@ def test_normals_near_feature_vertices_converge(refdir, name, kind):
                     assert gap <= max(prev, 1e-14), (v, f, e, gap, prev)  # monotone approach
                 prev = gap
                 first = gap if first is None else first
-            # geometric convergence (slowest here: 5-face boundary vertex, about 0.8 per level)
-            assert prev <= max(1e-3 * first, 1e-14), (v, f, prev, first)
+            # geometric convergence (slowest here: 6-face boundary vertex of xord_boundary, about 0.89 per level)
+            assert prev <= max(1e-2 * first, 1e-14), (v, f, prev, first)
             checked += 1
     assert checked >= 3
