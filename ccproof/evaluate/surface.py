@@ -389,7 +389,7 @@ class LimitSurface:
         t = np.clip((v - self._pv0[patch]) / h, 0.0, 1.0)
         return patch, s, t, 1.0 / h
 
-    def evaluate(self, face_ids, u, v, derivatives=1, *, chunk=CHUNK, out=None, backend=None):
+    def evaluate(self, face_ids, u, v, derivatives=1, *, chunk=CHUNK, out=None, backend=None, threads=None):
         """Positions and derivatives of the limit surface at points (face, u, v).
 
         Parameters
@@ -405,6 +405,11 @@ class LimitSurface:
         backend : {None, "numpy", "numba"}
             ``None``: the compiled kernel if numba is installed (and the environment variable
             ``CCPROOF_BACKEND`` is not ``numpy``), else numpy. Both compute the same formulas.
+        threads : int, optional
+            Threads for the compiled kernel (it releases the GIL; the points are split into
+            contiguous blocks, the results are identical). Default: all cores
+            (``os.cpu_count()``, or the environment variable ``CCPROOF_THREADS``) for batches of
+            at least 2^17 points, else 1. The numpy path always runs on one thread.
 
         Returns
         -------
@@ -438,9 +443,24 @@ class LimitSurface:
         if kernel is not None:
             dummy = np.empty((0, 3))
             arrs = [out.get(k, dummy) for k in _KEYS[2]]
-            kernel(f, u, v, derivatives, self._vkind, self._vchild, self._vu0, self._vv0, self._vh,
-                   self._vpatch, self._vcold, self.hot_layers, self._vcu, self._vcv, self._vnmax,
-                   self.split_depth, self._nets, self._pu0, self._pv0, self._ph, *arrs)
+            tables = (self._vkind, self._vchild, self._vu0, self._vv0, self._vh, self._vpatch, self._vcold,
+                      self.hot_layers, self._vcu, self._vcv, self._vnmax, self.split_depth, self._nets,
+                      self._pu0, self._pv0, self._ph)
+            nt = _threads(threads, n)
+            if nt <= 1:
+                kernel(f, u, v, derivatives, *tables, *arrs)
+                return out
+            from concurrent.futures import ThreadPoolExecutor
+
+            bounds = np.linspace(0, n, nt + 1).astype(np.int64)
+
+            def block(i):
+                lo, hi = bounds[i], bounds[i + 1]
+                kernel(f[lo:hi], u[lo:hi], v[lo:hi], derivatives, *tables,
+                       *[a[lo:hi] if a.shape[0] else a for a in arrs])
+
+            with ThreadPoolExecutor(nt) as ex:
+                list(ex.map(block, range(nt)))
             return out
         for lo in range(0, n, chunk):
             hi = min(n, lo + chunk)
@@ -566,6 +586,20 @@ class LimitSurface:
 
     def _base_face_of(self, vid):
         return int(self._vbase[vid])
+
+
+def _threads(threads, n):
+    """Number of threads for n points (see :meth:`LimitSurface.evaluate`)."""
+    import os
+
+    if threads is None:
+        if n < 1 << 17:
+            return 1
+        threads = int(os.environ.get("CCPROOF_THREADS", os.cpu_count() or 1))
+    threads = int(threads)
+    if threads < 1:
+        raise CCProofError(f"threads must be >= 1, got {threads}")
+    return max(1, min(threads, n // 1024 or 1))
 
 
 def _numba_kernel(backend):

@@ -83,3 +83,20 @@ def test_holes_are_refused_by_name(refdir):
     hole = int(np.flatnonzero(mesh.is_hole)[0])
     with pytest.raises(CCProofError, match=rf"point 1: ptex face {hole} \(face {hole}\) is a hole"):
         S.evaluate([0, hole], [0.5, 0.5], [0.5, 0.5])
+
+
+def test_backends_and_threads_agree_on_tagged_meshes(refdir):
+    pytest.importorskip("numba")
+    mesh, S = _surface(refdir, "pyramid_creases1")
+    rng = np.random.default_rng(3)
+    n = 5000
+    f = rng.integers(0, mesh.n_ptex, n)
+    s, t = rng.random(n), rng.random(n)
+    s[:500] = 0.5 ** rng.integers(0, 80, 500)  # deep layers at corners
+    t[:500] = s[:500] * rng.random(500)
+    a = S.evaluate(f, s, t, 2, backend="numpy")
+    b = S.evaluate(f, s, t, 2, backend="numba", threads=1)
+    c = S.evaluate(f, s, t, 2, backend="numba", threads=3)
+    for k in a:
+        assert np.array_equal(a[k], b[k]), k
+        assert np.array_equal(b[k], c[k]), k
