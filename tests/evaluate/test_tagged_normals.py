@@ -89,3 +89,59 @@ def test_normals_near_feature_vertices_converge(refdir, name, kind):
             assert prev <= max(1e-2 * first, 1e-14), (v, f, prev, first)
             checked += 1
     assert checked >= 3
+
+
+def _subdominant(S, p, c):
+    """Largest eigenvalue below 1 of the corner's subdivision matrix on the points the face uses."""
+    from ccproof.evaluate.local import _fmpq_mat_to_float
+    from ccproof.evaluate.surface import _CORNER
+
+    vf, kind = S._vface_of(np.array([p]), np.array([c[0]]), np.array([c[1]]))
+    assert kind[0] == _CORNER
+    scheme, _ = S._corner_data[int(vf[0])]
+    A = _fmpq_mat_to_float(scheme.A)
+    sup = list(scheme.support) if scheme.support else list(range(A.shape[0]))
+    ev = np.abs(np.linalg.eigvals(A[np.ix_(sup, sup)]))
+    return float(ev[ev < 1 - 1e-9].max())
+
+
+def _growth(S, p, c, a, b):
+    """Fitted slope of log2 |Pu| along the diagonal (2^-m) (a + b), m = 12..44."""
+    ms = np.arange(12, 45, 2)
+    st = c[None, :] + (2.0**-ms)[:, None] * (a + b)[None, :]
+    r = S.evaluate(np.full(ms.size, p), st[:, 0], st[:, 1], 1)
+    return float(np.polyfit(ms, np.log2(np.linalg.norm(r["Pu"], axis=1)), 1)[0])
+
+
+@pytest.mark.parametrize("name,kind", [("cube_creases0", "ev"), ("cubes_infsharp", "corner"),
+                                       ("cubes_infsharp", "crease_ev"), ("cubes_infsharp", "dart"),
+                                       ("dart_edgeonly", "boundary_ev")])
+def test_derivative_growth_follows_the_subdominant_eigenvalue(refdir, name, kind):
+    """|Pu| at distance 2^-m grows like (2 lam)^m (bmz04 eq. 3): fitted slope within 1 % of log2(2 lam)."""
+    d, m, S = _load(refdir, name)
+    v = next(fv["vertex"] for fv in d["feature_vertices"] if fv["kind"] == kind)
+    f = next(f for f, poly in enumerate(m.polygons) if v in poly and len(poly) == 4 and not m.is_hole[f])
+    i = m.polygons[f].index(v)
+    c = np.array(CORNERS[i], float)
+    a = np.array(CORNERS[(i + 1) % 4], float) - c
+    b = np.array(CORNERS[(i + 3) % 4], float) - c
+    lam = _subdominant(S, int(m.ptex_start[f]), c)
+    want, got = np.log2(2 * lam), _growth(S, int(m.ptex_start[f]), c, a, b)
+    if abs(want) < 1e-9:  # lam = 1/2 (crease curve, one-face corner): bounded derivatives
+        assert abs(got) < 1e-4, (lam, got)
+    else:
+        assert abs(got - want) <= 0.01 * abs(want), (lam, want, got)
+
+
+def test_derivative_growth_at_ngon_centres_matches_closed_form_eigenvalue(refdir):
+    """n-gon centres are smooth vertices of valence n after one step: lam of Catmull-Clark in closed form."""
+    d, m, S = _load(refdir, "nonquads")
+    for k in (3, 5, 6):
+        f = int(np.flatnonzero(m.sizes == k)[0])
+        ck = np.cos(2 * np.pi / k)
+        lam = (5 + ck + np.cos(np.pi / k) * np.sqrt(2 * (9 + ck))) / 16
+        p = int(m.ptex_start[f])
+        c = np.array([1.0, 1.0])
+        assert abs(_subdominant(S, p, c) - lam) < 1e-12
+        got = _growth(S, p, c, np.array([-1.0, 0.0]), np.array([0.0, -1.0]))
+        assert abs(got - np.log2(2 * lam)) <= 0.01 * abs(np.log2(2 * lam)), (k, got)
