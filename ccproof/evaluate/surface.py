@@ -118,6 +118,18 @@ def _stencil_matrix(stencils, ncols):
     return M
 
 
+@functools.lru_cache(maxsize=4096)
+def _regular_net_matrix(key):
+    """(16, k) float net matrix of face 0 of the one-ring ``key`` and the k ring positions it uses."""
+    net = regular_net(LocalTopology(key), 0)
+    if net is None:  # pragma: no cover
+        return None, None
+    cols = sorted({v for s in net for v in s})
+    M = _stencil_matrix([{cols.index(v): w for v, w in s.items()} for s in net], len(cols))
+    M.setflags(write=False)
+    return M, np.array(cols, dtype=np.int64)
+
+
 class _Builder:
     """Collects patches and virtual faces while classifying the faces of a mesh."""
 
@@ -163,12 +175,11 @@ class _Builder:
         F = topo.flat
         irregular = [i for i in range(4) if not topo.is_regular(F[4 * f + i])]
         if not irregular:
-            net = regular_net(topo, f)
-            if net is None:  # pragma: no cover - regular vertices always give a net
+            ring, key, _ = canonical_ring(topo, f, 0)
+            M, cols = _regular_net_matrix(key)
+            if M is None:  # pragma: no cover - regular vertices always give a net
                 raise MeshError(f"face {base_face}: no regular B-spline net")
-            ids = sorted({v for s in net for v in s})
-            M = _stencil_matrix([{ids.index(v): w for v, w in s.items()} for s in net], len(ids))
-            Xl = X[ids]
+            Xl = X[np.asarray(ring)[cols]]
             origin = Xl.mean(axis=0)
             self.vkind[vid] = _REGULAR
             self.vpatch[vid] = self.add_patch(M @ (Xl - origin), origin, frame)
@@ -199,8 +210,9 @@ class _Builder:
         self.vcorner[vid] = (int(corner[0] > U0), int(corner[1] > V0))
         rel = C - C[0]
         origin = C[0] + scheme.limit_mask @ rel
-        dev = np.einsum("njqN,Nc->njqc", scheme.layers, rel)  # (n_layers, 3, 16, 3)
-        nl = dev.shape[0]
+        L = scheme.layers
+        nl = L.shape[0]
+        dev = (L.reshape(-1, L.shape[-1]) @ rel).reshape(nl, 3, 16, 3)  # (n_layers, 3, 16, 3)
         # P_1 lies along the frame's a-axis: code 0 (u-distance >= 1/2, v-distance < 1/2) if a is
         # along u, else code 2; P_2 (diagonal) is code 1; P_3 the other one
         a_along_u = abs(rot[1][0]) > 0
