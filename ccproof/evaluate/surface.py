@@ -637,10 +637,12 @@ def limit_surface(mesh):
     Parameters
     ----------
     mesh : QuadMesh, PolyMesh, or str or os.PathLike
-        A path is read by :func:`ccproof.mesh.io.read_mesh` (OBJ with OpenSubdiv tags, or any
-        meshio format). An untagged all-quad mesh uses the all-quad evaluator; anything else
-        (triangles, n-gons, creases, corners, holes, boundary modes) the tagged one
-        (:class:`ccproof.evaluate.tagged.TaggedLimitSurface`), with ``face`` the ptex face index.
+        A QuadMesh gives a :class:`LimitSurface`; a PolyMesh the tagged evaluator
+        (:class:`ccproof.evaluate.tagged.TaggedLimitSurface`, ``face`` = ptex face index; on
+        untagged all-quad meshes the same numbers as LimitSurface to round-off). A path is read by
+        :func:`ccproof.mesh.io.read_mesh` (OBJ with OpenSubdiv tags, or any meshio format): an
+        untagged all-quad file gives a LimitSurface on a QuadMesh, anything else (triangles,
+        n-gons, creases, corners, holes, boundary modes) the tagged evaluator.
 
     Returns
     -------
@@ -648,15 +650,16 @@ def limit_surface(mesh):
     """
     if isinstance(mesh, QuadMesh):
         return LimitSurface(mesh)
+    from ccproof.evaluate.tagged import TaggedLimitSurface
     from ccproof.mesh.polymesh import PolyMesh
 
-    if not isinstance(mesh, PolyMesh):
-        from ccproof.mesh.io import read_mesh
+    if isinstance(mesh, PolyMesh):
+        return TaggedLimitSurface(mesh)
+    from ccproof.mesh.io import read_mesh
 
-        mesh = read_mesh(mesh)
+    mesh = read_mesh(mesh)
     if mesh.is_all_quads and not mesh.has_tags:
-        # the all-quad evaluator (same rules: EDGE_ONLY boundary, no tags), ptex face = face
+        # a file holding an untagged all-quad mesh: the QuadMesh evaluator, as before (same numbers
+        # as the tagged one to round-off; ``S.mesh`` is a QuadMesh)
         return LimitSurface(QuadMesh(mesh.vertices, np.array(mesh.polygons, dtype=np.int64).reshape(-1, 4)))
-    from ccproof.evaluate.tagged import TaggedLimitSurface
-
     return TaggedLimitSurface(mesh)

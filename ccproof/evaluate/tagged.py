@@ -437,15 +437,33 @@ class TaggedLimitSurface(LimitSurface):
 
     def __init__(self, mesh: PolyMesh):
         self.mesh = mesh
-        m1, _ = mesh.refine()
-        cx = m1.complex()
-        X = np.asarray(m1.vertices)
         b = _TaggedBuilder(2 if mesh.options.crease_method == "chaikin" else 1)
         ident = (np.zeros(2), np.array([1.0, 0.0]), np.array([0.0, 1.0]))
         P = mesh.n_ptex
         self._ptex_face = np.empty(P, dtype=np.int64)
         for p in range(P):
             b.new_vface(_REGULAR, ident, p)
+        if mesh.is_all_quads:
+            # no global step needed: start on the base mesh, with the one level-0-only rule that
+            # can act on quads (EDGE_AND_CORNER sharpens one-face boundary vertices) made explicit
+            cx = mesh.complex()
+            if mesh.options.boundary == "edge_and_corner":
+                vs = dict(cx.vertex_sharpness)
+                for v in range(mesh.n_vertices):
+                    fan, closed = cx.fan(v)
+                    if fan is not None and not closed and len(fan) == 1:
+                        vs[v] = math.inf
+                cx = Complex(cx.faces, cx.edge_sharpness, vs, cx.options, level=1, n_vertices=cx.n_vertices)
+            X = np.asarray(mesh.vertices)
+            for f in range(mesh.n_faces):
+                self._ptex_face[f] = f
+                b.tagged_face(cx, X, f, ident, 0, 0, f, f)
+            self._finish(b)
+            self._hole_ptex = mesh.is_hole[self._ptex_face]
+            return
+        m1, _ = mesh.refine()
+        cx = m1.complex()
+        X = np.asarray(m1.vertices)
         for f in range(mesh.n_faces):
             k = int(mesh.sizes[f])
             p0 = int(mesh.ptex_start[f])

@@ -100,3 +100,25 @@ def test_backends_and_threads_agree_on_tagged_meshes(refdir):
     for k in a:
         assert np.array_equal(a[k], b[k]), k
         assert np.array_equal(b[k], c[k]), k
+
+
+@pytest.mark.parametrize("name", ["cube", "sector_k3", "sector_k5", "torus_8x6"])
+def test_tagged_evaluator_on_the_quad_references(refdir, name):
+    """The tagged evaluator on untagged all-quad meshes (tests/data/osd_limit_*.json)."""
+    from ccproof.mesh.io import read_mesh
+
+    d = json.loads((refdir / f"osd_limit_{name}.json").read_text())
+    mesh = read_mesh(refdir / "meshes" / f"{name}.obj")
+    S = TaggedLimitSurface(mesh)
+    rows = []
+    for s in d["samples"]:
+        q = s if not s["endcap"] else (s["deep"] if not s["deep"]["endcap"] else None)
+        if q is not None:
+            rows.append((s["face"], s["s"], s["t"], q["P"], q["Ps"], q["Pt"]))
+    f, u, v = (np.array([r[i] for r in rows]) for i in range(3))
+    out = S.evaluate(f, u, v, 1)
+    diag = mesh.bounding_box_diagonal
+    for key, i, tol in (("P", 3, 1e-12), ("Pu", 4, 1e-10), ("Pv", 5, 1e-10)):
+        assert np.abs(out[key] - np.array([r[i] for r in rows])).max() / diag <= tol, key
+    VL = np.array(d["vertex_limit"], dtype=float)
+    assert np.abs(S.vertex_limits() - VL).max() / diag <= 1e-13
