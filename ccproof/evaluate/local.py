@@ -446,6 +446,77 @@ def power_layers(M, A, l_row):
     raise MeshError(f"corner configuration of {N} vertices does not converge to its limit point")
 
 
+_SOURCES = ("evaluate/local.py", "evaluate/tagged.py", "mesh/rules.py")
+
+
+@functools.lru_cache(maxsize=1)
+def _code_version():
+    """Hash of the sources that define the exact data (a change invalidates the disk cache)."""
+    import hashlib
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    h = hashlib.sha256()
+    for rel in _SOURCES:
+        h.update((root / rel).read_bytes())
+    return h.hexdigest()[:16]
+
+
+def _cache_dir():
+    import os
+    from pathlib import Path
+
+    d = os.environ.get("CCPROOF_CACHE")
+    if d is not None and d.strip().lower() in ("", "0", "off", "none", "no"):
+        return None
+    return Path(d) if d else Path.home() / ".cache" / "ccproof" / "corner_schemes"
+
+
+def cached_scheme(kind, key, compute):
+    """``compute()`` (a CornerScheme or None), kept between runs in a disk cache.
+
+    The cache (default ``~/.cache/ccproof/corner_schemes``; environment variable
+    ``CCPROOF_CACHE`` = another folder, or ``off``) holds one ``.npz`` per configuration, named by
+    the SHA-256 of the configuration key and of the sources that compute it; it stores the rounded
+    layers, the limit mask, the support and the exact matrix ``A`` (integer numerators as decimal
+    strings and one denominator), so a cached scheme is the computed one bit for bit. Unreadable
+    or unwritable cache files are ignored (the data are then computed).
+    """
+    import hashlib
+    import os
+
+    d = _cache_dir()
+    if d is None:
+        return compute()
+    name = hashlib.sha256(f"{kind}|{_code_version()}|{key!r}".encode()).hexdigest()
+    path = d / f"{name}.npz"
+    if path.exists():
+        try:
+            with np.load(path, allow_pickle=False) as z:
+                N = int(z["size"])
+                den = int(str(z["A_den"]))
+                A = flint.fmpq_mat(N, N, [flint.fmpq(int(x), den) for x in z["A_num"].tolist()])
+                sup = z["support"]
+                return CornerScheme(N, A, z["limit_mask"].copy(), z["layers"].copy(),
+                                    None if sup.size == 0 else [int(i) for i in sup])
+        except (OSError, ValueError, KeyError):
+            pass
+    sch = compute()
+    if sch is None:
+        return None
+    try:
+        d.mkdir(parents=True, exist_ok=True)
+        num, den = sch.A.numer_denom()
+        tmp = d / f".{name}.{os.getpid()}.npz"
+        np.savez(tmp, size=np.array(sch.size), A_den=np.array(str(den)),
+                 A_num=np.array([str(x) for x in num.entries()]), limit_mask=sch.limit_mask,
+                 layers=sch.layers, support=np.array(sch.support if sch.support else [], dtype=np.int64))
+        os.replace(tmp, path)
+    except OSError:
+        pass
+    return sch
+
+
 class CornerScheme:
     """Exact self-similar evaluation data of one corner configuration (see :func:`corner_scheme`).
 
@@ -582,6 +653,12 @@ def _tangent_masks(A):
 
 @functools.lru_cache(maxsize=1024)
 def corner_scheme(key):
+    """Exact layered-patch data of a face with one irregular corner (:func:`_corner_scheme`),
+    kept between runs in the disk cache of :func:`cached_scheme`."""
+    return cached_scheme("quad", key, lambda: _corner_scheme(key))
+
+
+def _corner_scheme(key):
     """Exact layered-patch data of a face with one irregular corner, or ``None`` if not self-similar.
 
     Parameters

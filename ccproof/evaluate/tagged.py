@@ -38,6 +38,7 @@ from ccproof.evaluate.local import (
     _fmpq_mat_to_float,
     _lin,
     _to_fmpq_mat,
+    cached_scheme,
     power_layers,
 )
 from ccproof.evaluate.surface import (
@@ -184,6 +185,15 @@ def refine_key(key, n_rule):
     return stencil_matrix(stencils, cx.n_vertices), tuple(stencils), child
 
 
+@functools.lru_cache(maxsize=1 << 16)
+def _child_ring(key, n_rule, g, r, depth):
+    """Ring (ring positions as an index array, tagged key, rule count) of face ``g`` of the child
+    complex of :func:`refine_key` ``(key, n_rule)``, from corner ``r``."""
+    _, _, child = refine_key(key, n_rule)
+    ring, faces, nr = canonical_ring(child, g, r, depth)
+    return np.array(ring, dtype=np.int64), ring_key(child, ring, faces, nr), nr
+
+
 # ------------------------------------------------------------------------------ regularity
 def _corner_info(cx, c):
     """(rule, sector size, closed, valence) of the corner ``c`` (a rule vertex of ``cx``)."""
@@ -305,6 +315,11 @@ def irregular_corners(key):
 # ------------------------------------------------------------------------------ corner schemes
 @functools.lru_cache(maxsize=2048)
 def tagged_corner_scheme(key):
+    """:func:`_tagged_corner_scheme`, kept between runs (:func:`ccproof.evaluate.local.cached_scheme`)."""
+    return cached_scheme("tagged", key, lambda: _tagged_corner_scheme(key))
+
+
+def _tagged_corner_scheme(key):
     """Exact layered-patch data of face 0 of the tagged one-ring ``key`` (irregular corner 0).
 
     ``None`` unless the configuration is stationary (the tagged one-ring of the child at corner 0
@@ -366,17 +381,25 @@ class _TaggedBuilder(_Builder):
         super().__init__()
         self.depth_semi = depth_semi
 
-    def tagged_face(self, cx, X, g, frame, depth, semi_depth, base, vid):
-        """Classify quad ``g`` of complex ``cx`` with positions ``X`` (NaN where not exact)."""
-        ring, faces, nr = canonical_ring(cx, g, 0, 1)
-        key = ring_key(cx, ring, faces, nr)
+    def tagged_face(self, cx, X, g, frame, depth, semi_depth, base, vid, src=None):
+        """Classify quad ``g`` of complex ``cx`` with positions ``X`` (NaN where not exact).
+
+        ``src = (key, n_rule)``: ``cx`` is the child complex of that ring (its rings are cached).
+        """
+
+        def ring_of(r, depth_):
+            if src is not None:
+                return _child_ring(src[0], src[1], g, r, depth_)
+            ring_, faces_, nr_ = canonical_ring(cx, g, r, depth_)
+            return ring_, ring_key(cx, ring_, faces_, nr_), nr_
+
+        ring, key, nr = ring_of(0, 1)
         if _has_semi_sharp(key):
             if semi_depth >= MAX_SEMI_DEPTH:
                 raise MeshError(f"ptex face {base}: semi-sharp creases did not decay in {MAX_SEMI_DEPTH} levels")
             D = self.depth_semi
             if D != 1:
-                ring, faces, nr = canonical_ring(cx, g, 0, D)
-                key = ring_key(cx, ring, faces, nr)
+                ring, key, nr = ring_of(0, D)
             return self.split(key, nr, X[ring], frame, depth, semi_depth + 1, base, vid)
         irr = irregular_corners(key)
         if not irr:
@@ -391,8 +414,7 @@ class _TaggedBuilder(_Builder):
             return vid
         if len(irr) == 1:
             r = irr[0]
-            ring_r, faces_r, nr_r = canonical_ring(cx, g, r, 1)
-            key_r = ring_key(cx, ring_r, faces_r, nr_r)
+            ring_r, key_r, _ = ring_of(r, 1)
             scheme = tagged_corner_scheme(key_r)
             if scheme is not None:
                 C = X[ring_r]
@@ -422,7 +444,7 @@ class _TaggedBuilder(_Builder):
             q = int(cu > U0) + 2 * int(cv > V0)
             c = self.new_vface(_REGULAR, cf, base)
             self.vchild[vid][q] = c
-            self.tagged_face(child, X1, i, cf, depth, semi_depth, base, c)
+            self.tagged_face(child, X1, i, cf, depth, semi_depth, base, c, src=(key, nr))
         return vid
 
 
