@@ -82,46 +82,51 @@ def canonical_ring(cx, g, r, depth):
         The number of leading ring vertices whose whole fan is in the ring (4 for depth 1).
     """
     pos, ring = {}, []
-    s0 = cx.start[g]
+    twin, prv, nxt, org, face_of, fstart, cfaces = cx.twin, cx.prv, cx.nxt, cx.org, cx.face_of, cx.start, cx.faces
+    s0 = fstart[g]
+    first_corner = {}
     for i in range(4):
-        v = cx.org[s0 + (r + i) % 4]
+        h = s0 + (r + i) % 4
+        v = org[h]
         pos[v] = len(ring)
         ring.append(v)
-    faces = [tuple(range(4))]
+        first_corner[v] = h
+    faces = [(0, 1, 2, 3)]
     seen = {g}
-    first_corner = {cx.org[s0 + (r + i) % 4]: s0 + (r + i) % 4 for i in range(4)}
     done = 0
     for _ in range(depth):
         upto = len(ring)
         for idx in range(done, upto):
-            v = ring[idx]
-            c0 = first_corner[v]
+            c0 = first_corner[ring[idx]]
             walk = [c0]
-            c = cx.ccw(c0)
+            c = twin[prv[c0]]
             while c >= 0 and c != c0:
                 walk.append(c)
-                c = cx.ccw(c)
+                c = twin[prv[c]]
             if c != c0:
-                c = cx.cw(c0)
+                t = twin[c0]
+                c = -1 if t < 0 else nxt[t]
                 while c >= 0:
                     walk.append(c)
-                    c = cx.cw(c)
+                    t = twin[c]
+                    c = -1 if t < 0 else nxt[t]
             for c in walk:
-                h = cx.face_of[c]
+                h = face_of[c]
                 if h in seen:
                     continue
                 seen.add(h)
-                sh, k = cx.start[h], len(cx.faces[h])
+                sh, k = fstart[h], len(cfaces[h])
                 j0 = c - sh
                 vs = []
                 for t in range(k):
                     hc = sh + (j0 + t) % k
-                    u = cx.org[hc]
-                    if u not in pos:
-                        pos[u] = len(ring)
+                    u = org[hc]
+                    q = pos.get(u)
+                    if q is None:
+                        q = pos[u] = len(ring)
                         ring.append(u)
                         first_corner[u] = hc
-                    vs.append(pos[u])
+                    vs.append(q)
                 faces.append(tuple(vs))
         done = upto
     return ring, tuple(faces), done
