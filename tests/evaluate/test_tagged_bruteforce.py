@@ -92,10 +92,16 @@ def test_dyadic_points_equal_subdivision_limits(refdir, name, levels):
     m, frames = refine_with_frames(mesh, levels)
     assert all(s == 0 or math.isinf(s) for s in m.edge_sharpness.values())
     rng = np.random.default_rng(1)
-    faces = rng.choice(m.n_faces, size=min(m.n_faces, 150), replace=False)
+    faces = set(rng.choice(m.n_faces, size=min(m.n_faces, 150), replace=False).tolist())
+    # and every level-N face at a base vertex (vertex points keep their index) or an n-gon centre
+    # (the level-1 face point n + E + f keeps its index too): the points next to creases, corners,
+    # darts, extraordinary vertices and n-gon centres, at distance 2^-N
+    E1 = len(mesh.complex().edges)
+    special = set(range(mesh.n_vertices)) | {mesh.n_vertices + E1 + f for f in np.flatnonzero(mesh.sizes != 4)}
+    faces |= {g for g, poly in enumerate(m.polygons) if special.intersection(poly)}
     pts, want = [], []
     cx = m.complex()
-    for g in faces:
+    for g in sorted(faces):
         p, (o, a, b) = frames[g]
         if mesh.is_hole[mesh.face_of_ptex(p)[0]]:
             continue
@@ -107,6 +113,7 @@ def test_dyadic_points_equal_subdivision_limits(refdir, name, levels):
             pts.append((p, st[0], st[1]))
             want.append(L)
     assert len(pts) >= 300
+    assert special.intersection(m.polygons[g][i] for g in faces for i in range(4))
     f, s, t = (np.array([q[i] for q in pts]) for i in range(3))
     got = S.evaluate(f.astype(int), s, t, 0)["P"]
     err = np.abs(got - np.array(want)).max() / mesh.bounding_box_diagonal
