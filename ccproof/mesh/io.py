@@ -226,9 +226,17 @@ def read_obj(path):
     ------
     MeshError
         If the file is malformed, a face is not a quad (the message gives its number and source
-        line), or the mesh fails any check of :class:`QuadMesh`.
+        line), it has OpenSubdiv tag lines (creases, corners, holes, boundary modes: never
+        ignored; use :func:`read_mesh`), or the mesh fails any check of :class:`QuadMesh`.
     """
     V, polys, lines = read_obj_polygons(path)
+    with open(os.fspath(path), encoding="utf-8", errors="replace") as fh:
+        for no, name, *_ in _parse_tags(path, fh.read()):
+            if name not in ("facevaryinginterpolateboundary", "facevaryingpropagatecorners"):
+                raise MeshError(
+                    f"{path}:{no}: OpenSubdiv tag {name!r}: a QuadMesh has no creases, corners, holes or "
+                    "boundary modes; read the file with read_mesh / read_obj_tagged (PolyMesh) instead"
+                )
     try:
         return QuadMesh.from_polygons(V, polys, lines=lines)
     except MeshError as exc:

@@ -169,3 +169,10 @@ def test_untagged_step_matches_reference(refdir):
         ref = int(np.flatnonzero((q.edges[:, 0] == min(a, b)) & (q.edges[:, 1] == max(a, b)))[0])
         assert close(p1.vertices[n + e], r.vertices[n + ref])
     assert isinstance(q, QuadMesh) and F_ == 6
+
+
+def test_quad_reader_refuses_tags(refdir):
+    from ccproof.mesh import read_obj
+
+    with pytest.raises(MeshError, match=r"catmark_cube_creases0.obj:\d+: OpenSubdiv tag 'crease'"):
+        read_obj(refdir / "osd_features" / "meshes" / "catmark_cube_creases0.obj")
