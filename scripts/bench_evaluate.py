@@ -13,11 +13,18 @@ Measures, in one run:
    size, and accuracy of the level-L control points as surface points (distance to their own
    limit positions, relative to the bounding-box diagonal), extrapolated to the level that would
    reach the accuracy of exact evaluation;
-4. the peak memory beyond inputs and outputs for 10^7 points (tracemalloc).
+4. the peak memory beyond inputs and outputs for 10^7 points (tracemalloc);
+5. side by side with OpenSubdiv Far (one thread, isolation level 10, Gregory end caps), on the bunny,
+   a crease shape and a triangle shape: setup times and points/s for 10^6 uniform points and 10^6
+   points near irregular vertices (distance 2^-(12 x) from the vertex, x uniform), ours with the
+   numpy kernel, the compiled kernel on one thread and on all threads; ratios ours / OpenSubdiv,
+   and the largest position difference. The C++ driver is compiled against the system's
+   OpenSubdiv (Debian: ``apt-get install -y libosd-dev g++``); without it this part is skipped
+   with that instruction.
 
 The bunny mesh is read from the repository's test data (``tests/data/meshes/bunny_quads.obj``).
 
-Usage: python scripts/bench_evaluate.py [--points 1000000] [--memory-points 10000000] [--quick]
+Usage: python scripts/bench_evaluate.py [--points 1000000] [--memory-points 10000000] [--quick] [--osd-only]
 """
 
 from __future__ import annotations
@@ -35,8 +42,272 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
 from ccproof.evaluate import limit_surface  # noqa: E402
+from ccproof.evaluate.local import CORNERS  # noqa: E402
 from ccproof.evaluate.surface import _CORNER, _SPLIT  # noqa: E402
 from ccproof.mesh import limit_normals, limit_positions, read_obj, subdivide  # noqa: E402
+from ccproof.mesh.io import read_mesh  # noqa: E402
+
+OSD_DRIVER = r"""
+// OpenSubdiv Far evaluation driver for scripts/bench_evaluate.py (written by the script).
+// Input (binary, little endian): see write_mesh() in the script. Output: timings on stdout and the
+// evaluated P, Ps, Pt of all points (double, n x 9) in the output file.
+#include <opensubdiv/far/topologyDescriptor.h>
+#include <opensubdiv/far/primvarRefiner.h>
+#include <opensubdiv/far/patchTableFactory.h>
+#include <opensubdiv/far/patchMap.h>
+#include <chrono>
+#include <cstdio>
+#include <cstdint>
+#include <vector>
+
+using namespace OpenSubdiv;
+
+struct V3 {
+    double p[3];
+    void Clear(void * = 0) { p[0] = p[1] = p[2] = 0; }
+    void AddWithWeight(V3 const &s, double w) { p[0] += w * s.p[0]; p[1] += w * s.p[1]; p[2] += w * s.p[2]; }
+};
+
+template <class T> static void rd(FILE *f, T *x, size_t n) {
+    if (n && fread(x, sizeof(T), n, f) != n) { fprintf(stderr, "short read\n"); exit(2); }
+}
+
+int main(int argc, char **argv) {
+    if (argc < 5) { fprintf(stderr, "usage: driver mesh.bin points.bin out.bin level\n"); return 2; }
+    FILE *fm = fopen(argv[1], "rb");
+    int32_t hdr[8];  // nv nf nidx ncrease ncorner nhole boundary flags (1 chaikin, 2 smooth triangles)
+    rd(fm, hdr, 8);
+    int nv = hdr[0], nf = hdr[1], nidx = hdr[2], nc = hdr[3], nk = hdr[4], nh = hdr[5];
+    std::vector<double> X(3 * nv); rd(fm, X.data(), X.size());
+    std::vector<int> sizes(nf), idx(nidx), cre(2 * nc), cor(nk), holes(nh);
+    std::vector<float> cw(nc), kw(nk);
+    rd(fm, sizes.data(), nf); rd(fm, idx.data(), nidx); rd(fm, cre.data(), 2 * nc); rd(fm, cw.data(), nc);
+    rd(fm, cor.data(), nk); rd(fm, kw.data(), nk); rd(fm, holes.data(), nh);
+    fclose(fm);
+    FILE *fp = fopen(argv[2], "rb");
+    int64_t n; rd(fp, &n, 1);
+    std::vector<int32_t> pf(n); std::vector<double> ps(n), pt(n);
+    rd(fp, pf.data(), n); rd(fp, ps.data(), n); rd(fp, pt.data(), n);
+    fclose(fp);
+    int level = atoi(argv[4]);
+
+    auto t0 = std::chrono::steady_clock::now();
+    Sdc::Options so;
+    so.SetVtxBoundaryInterpolation((Sdc::Options::VtxBoundaryInterpolation)hdr[6]);
+    so.SetCreasingMethod(hdr[7] & 1 ? Sdc::Options::CREASE_CHAIKIN : Sdc::Options::CREASE_UNIFORM);
+    so.SetTriangleSubdivision(hdr[7] & 2 ? Sdc::Options::TRI_SUB_SMOOTH : Sdc::Options::TRI_SUB_CATMARK);
+    Far::TopologyDescriptor d;
+    d.numVertices = nv; d.numFaces = nf; d.numVertsPerFace = sizes.data(); d.vertIndicesPerFace = idx.data();
+    d.numCreases = nc; d.creaseVertexIndexPairs = cre.data(); d.creaseWeights = cw.data();
+    d.numCorners = nk; d.cornerVertexIndices = cor.data(); d.cornerWeights = kw.data();
+    d.numHoles = nh; d.holeIndices = holes.data();
+    typedef Far::TopologyRefinerFactory<Far::TopologyDescriptor> Factory;
+    Far::TopologyRefiner *ref = Factory::Create(d, Factory::Options(Sdc::SCHEME_CATMARK, so));
+    Far::PatchTableFactory::Options po(level);
+    po.SetEndCapType(Far::PatchTableFactory::Options::ENDCAP_GREGORY_BASIS);
+    po.SetPatchPrecision<double>();
+    po.useInfSharpPatch = true;
+    po.generateLegacySharpCornerPatches = false;
+    ref->RefineAdaptive(po.GetRefineAdaptiveOptions());
+    Far::PatchTable *tab = Far::PatchTableFactory::Create(*ref, po);
+    int nref = ref->GetNumVerticesTotal(), nloc = tab->GetNumLocalPoints();
+    std::vector<V3> V(nref + nloc);
+    for (int i = 0; i < nv; ++i) for (int c = 0; c < 3; ++c) V[i].p[c] = X[3 * i + c];
+    Far::PrimvarRefinerReal<double> pr(*ref);
+    V3 *src = V.data();
+    for (int l = 1; l <= ref->GetMaxLevel(); ++l) {
+        V3 *dst = src + ref->GetLevel(l - 1).GetNumVertices();
+        pr.Interpolate(l, src, dst);
+        src = dst;
+    }
+    if (nloc) tab->GetLocalPointStencilTable<double>()->UpdateValues(V.data(), V.data() + nref);
+    Far::PatchMap pmap(*tab);
+    auto t1 = std::chrono::steady_clock::now();
+
+    std::vector<double> out(9 * n);
+    double w[20], ws[20], wt[20];
+    for (int64_t i = 0; i < n; ++i) {
+        Far::PatchTable::PatchHandle const *h = pmap.FindPatch(pf[i], ps[i], pt[i]);
+        double *o = &out[9 * i];
+        for (int k = 0; k < 9; ++k) o[k] = 0;
+        if (!h) { for (int k = 0; k < 9; ++k) o[k] = 0.0 / 0.0; continue; }
+        tab->EvaluateBasis(*h, ps[i], pt[i], w, ws, wt);
+        if (tab->GetPatchParam(*h).NonQuadRoot()) {  // EvaluateBasis scales by the depth of the
+            for (int j = 0; j < 20; ++j) { ws[j] *= 0.5; wt[j] *= 0.5; }  // n-gon's level-1 quad
+        }
+        Far::ConstIndexArray cv = tab->GetPatchVertices(*h);
+        for (int j = 0; j < cv.size(); ++j) {
+            double const *p = V[cv[j]].p;
+            for (int c = 0; c < 3; ++c) { o[c] += w[j] * p[c]; o[3 + c] += ws[j] * p[c]; o[6 + c] += wt[j] * p[c]; }
+        }
+    }
+    auto t2 = std::chrono::steady_clock::now();
+    FILE *fo = fopen(argv[3], "wb");
+    fwrite(out.data(), sizeof(double), out.size(), fo);
+    fclose(fo);
+    printf("setup %.6f eval %.6f patches %d\n", std::chrono::duration<double>(t1 - t0).count(),
+           std::chrono::duration<double>(t2 - t1).count(), tab->GetNumPatchesTotal());
+    return 0;
+}
+"""
+
+
+def build_osd_driver():
+    """Compile the OpenSubdiv driver (cached in the temp folder); None with a message if impossible."""
+    import shutil
+    import subprocess
+    import tempfile
+
+    header = Path("/usr/include/opensubdiv/far/patchTable.h")
+    if not header.exists() or shutil.which("g++") is None:
+        print("   OpenSubdiv headers or g++ not found: install them with\n"
+              "       apt-get update && apt-get install -y libosd-dev g++\n"
+              "   (Debian/Ubuntu; elsewhere build OpenSubdiv and put far/ under /usr/include/opensubdiv)."
+              " Skipped.")
+        return None
+    d = Path(tempfile.gettempdir()) / "ccproof_bench_osd"
+    d.mkdir(exist_ok=True)
+    src, exe = d / "driver.cpp", d / "driver"
+    if not exe.exists() or not src.exists() or src.read_text() != OSD_DRIVER:
+        src.write_text(OSD_DRIVER)
+        r = subprocess.run(["g++", "-O2", "-std=c++14", str(src), "-o", str(exe), "-losdCPU"],
+                           capture_output=True, text=True)
+        if r.returncode != 0:
+            print(f"   compiling the OpenSubdiv driver failed:\n{r.stderr[-2000:]}\n   Skipped.")
+            return None
+    return exe
+
+
+def _write_osd_input(d, mesh, f, s, t):
+    """Binary mesh and points files for the driver (layout read by its main())."""
+    flags = int(mesh.options.crease_method == "chaikin") | 2 * int(mesh.options.triangle_subdivision == "smooth")
+    bmode = {"none": 0, "edge_only": 1, "edge_and_corner": 2}[mesh.options.boundary]
+    cre = list(mesh.edge_sharpness.items())
+    cor = list(mesh.vertex_sharpness.items())
+    holes = np.flatnonzero(mesh.is_hole_tagged).astype(np.int32)
+    hdr = np.array([mesh.n_vertices, mesh.n_faces, mesh.indices.size, len(cre), len(cor), holes.size, bmode, flags],
+                   dtype=np.int32)
+    with open(d / "mesh.bin", "wb") as fh:
+        fh.write(hdr.tobytes())
+        fh.write(np.ascontiguousarray(mesh.vertices, dtype=np.float64).tobytes())
+        fh.write(mesh.sizes.astype(np.int32).tobytes())
+        fh.write(mesh.indices.astype(np.int32).tobytes())
+        fh.write(np.array([e for e, _ in cre], dtype=np.int32).reshape(-1).tobytes())
+        fh.write(np.array([min(x, 10.0) for _, x in cre], dtype=np.float32).tobytes())
+        fh.write(np.array([v for v, _ in cor], dtype=np.int32).tobytes())
+        fh.write(np.array([min(x, 10.0) for _, x in cor], dtype=np.float32).tobytes())
+        fh.write(holes.tobytes())
+    with open(d / "points.bin", "wb") as fh:
+        fh.write(np.array([f.size], dtype=np.int64).tobytes())
+        fh.write(f.astype(np.int32).tobytes())
+        fh.write(np.ascontiguousarray(s, dtype=np.float64).tobytes())
+        fh.write(np.ascontiguousarray(t, dtype=np.float64).tobytes())
+
+
+def run_osd(exe, mesh, f, s, t, level=10):
+    """(setup seconds, evaluation seconds, P, Ps, Pt) of OpenSubdiv Far on one thread."""
+    import subprocess
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as tmp:
+        d = Path(tmp)
+        _write_osd_input(d, mesh, f, s, t)
+        r = subprocess.run([str(exe), str(d / "mesh.bin"), str(d / "points.bin"), str(d / "out.bin"), str(level)],
+                           capture_output=True, text=True)
+        if r.returncode != 0:
+            raise RuntimeError(f"OpenSubdiv driver failed: {r.stderr}")
+        words = r.stdout.split()
+        out = np.fromfile(d / "out.bin", dtype=np.float64).reshape(-1, 9)
+    return float(words[1]), float(words[3]), out[:, :3], out[:, 3:6], out[:, 6:9]
+
+
+def irregular_corners(S):
+    """(ptex face, corner) pairs whose corner is an irregular (self-similar corner) vertex."""
+    P = S.n_faces
+    out = []
+    for i, (cu, cv) in enumerate(CORNERS):
+        f = np.arange(P)
+        vf, kind = S._vface_of(f, np.full(P, float(cu)), np.full(P, float(cv)))
+        out.extend((int(p), i) for p in f[kind == _CORNER])
+    return out
+
+
+def near_points(S, n, rng):
+    """n points at distance 2^-(12 x) (x uniform) from irregular corners, in the face."""
+    pairs = irregular_corners(S)
+    pick = rng.integers(0, len(pairs), n)
+    f = np.array([pairs[k][0] for k in pick], dtype=np.int64)
+    c = np.array([CORNERS[pairs[k][1]] for k in pick], dtype=np.float64)
+    r = 2.0 ** (-12 * rng.random(n))
+    a, b = rng.random(n) * r, rng.random(n) * r
+    s = np.where(c[:, 0] > 0, 1.0 - a, a)
+    t = np.where(c[:, 1] > 0, 1.0 - b, b)
+    return f, s, t, len(pairs)
+
+
+def osd_side_by_side(n, rng, quick=False):
+    print("\n5. side by side with OpenSubdiv Far (positions + first derivatives)")
+    exe = build_osd_driver()
+    if exe is None:
+        return None
+    import os
+
+    shapes = [("bunny_quads", REPO / "tests" / "data" / "meshes" / "bunny_quads.obj"),
+              ("crease: catmark_cubes_infsharp", REPO / "tests" / "data" / "osd_features" / "meshes"
+               / "catmark_cubes_infsharp.obj"),
+              ("triangles: catmark_smoothtris1", REPO / "tests" / "data" / "osd_features" / "meshes"
+               / "catmark_smoothtris1.obj")]
+    threads = os.cpu_count() or 1
+    rows = []
+    for label, path in shapes:
+        mesh = read_mesh(path)
+        w0 = time.perf_counter()
+        S = limit_surface(mesh)
+        setup = time.perf_counter() - w0
+        P = S.n_faces
+        uni = (rng.integers(0, P, n), rng.random(n), rng.random(n))
+        fn, sn, tn, npairs = near_points(S, n, rng)
+        for dist, (f, s, t) in (("uniform", uni), ("near irregular", (fn, sn, tn))):
+            runs = [run_osd(exe, mesh, f, s, t) for _ in range(1 if quick else 3)]  # best of 3, as ours
+            osd_setup = min(r[0] for r in runs)
+            osd_eval = min(r[1] for r in runs)
+            _, _, oP, oPs, oPt = runs[0]
+            rate_osd = n / osd_eval
+            res = {}
+            for be, th in (("numpy", 1), ("numba", 1), ("numba", threads)):
+                if be == "numba" and not _has_numba():
+                    continue
+                out = {k: np.empty((n, 3)) for k in ("P", "Pu", "Pv")}
+                S.evaluate(f[:10], s[:10], t[:10], 1, backend=be)
+                def run(S=S, f=f, s=s, t=t, be=be, th=th, out=out):
+                    S.evaluate(f, s, t, 1, out=out, backend=be, threads=th)
+
+                w, _ = timed(run, repeat=1 if quick else 3)
+                res[(be, th)] = (n / w, out)
+            out = res[("numpy", 1)][1]
+            ok = np.isfinite(oP).all(axis=1)
+            dP = np.abs(out["P"][ok] - oP[ok]).max() / mesh.bounding_box_diagonal
+            dD = np.abs(out["Pu"][ok] - oPs[ok]).max() / mesh.bounding_box_diagonal
+            rows.append((label, dist, setup, osd_setup, rate_osd, res, dP, dD))
+            extra = f", {npairs} irregular corners" if dist != "uniform" else ""
+            print(f"   {label}, {dist} ({n:,} points{extra}): setup ours {setup:.3f} s, "
+                  f"OpenSubdiv {osd_setup:.3f} s ({setup / osd_setup:.1f}x)")
+            print(f"      OpenSubdiv Far, 1 thread: {rate_osd / 1e6:6.2f} M points/s")
+            for (be, th), (rate, _) in res.items():
+                print(f"      ours {be:5s} {th} thread{'s' if th > 1 else ' '}: {rate / 1e6:6.2f} M points/s"
+                      f"  = {rate / rate_osd:5.2f} x OpenSubdiv")
+            print(f"      max |P ours - P OpenSubdiv| / diagonal {dP:.1e}, |Ps| {dD:.1e} (OpenSubdiv's end caps"
+                  f" near irregular vertices are approximations)")
+    return rows
+
+
+def _has_numba():
+    try:
+        import numba  # noqa: F401
+
+        return True
+    except ImportError:
+        return False
 
 
 def timed(fn, repeat=3):
@@ -102,7 +373,12 @@ def main(argv=None):
     ap.add_argument("--naive-points", type=int, default=2000)
     ap.add_argument("--pygel-levels", type=int, default=5)
     ap.add_argument("--quick", action="store_true", help="small sizes (smoke test)")
+    ap.add_argument("--osd-points", type=int, default=1_000_000)
+    ap.add_argument("--osd-only", action="store_true", help="only part 5 (OpenSubdiv side by side)")
     args = ap.parse_args(argv)
+    if args.osd_only:
+        osd_side_by_side(args.osd_points if not args.quick else 20_000, np.random.default_rng(2024), args.quick)
+        return 0
     if args.quick:
         args.points, args.memory_points, args.naive_points, args.pygel_levels = 20_000, 50_000, 200, 2
 
@@ -219,10 +495,15 @@ def main(argv=None):
         io = sum(a.nbytes for a in (fm, um, vm)) + sum(a.nbytes for a in outm.values())
         print(f"   {be:6s}: {peak / 2**20:8.1f} MiB extra (inputs + outputs: {io / 2**20:.0f} MiB; "
               f"patch tables {S._nets.nbytes / 2**20:.1f} MiB)")
+    osd = osd_side_by_side(args.osd_points if not args.quick else 20_000, rng, args.quick)
     print("\nsummary:")
     for be in backends:
         print(f"   {be}: {rates[be][1] / 1e6:.2f} M points/s (P + first derivatives, single thread, CPU time)")
-    print("   target (OpenSubdiv 3.6 C++ patch-table evaluation, single thread): ~10 M points/s")
+    if osd:
+        print("   ours / OpenSubdiv Far (1 thread), points/s:")
+        for label, dist, setup, osd_setup, rate_osd, res, _, _ in osd:
+            parts = ", ".join(f"{be} {th}t {rate / rate_osd:.2f}x" for (be, th), (rate, _) in res.items())
+            print(f"      {label:32s} {dist:15s} {parts}; setup {setup / osd_setup:.1f}x OpenSubdiv's")
     return 0
 
 

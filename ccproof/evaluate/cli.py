@@ -1,7 +1,9 @@
 """Arguments and point reader of ``ccproof eval`` (the command itself is :mod:`ccproof.reparam.cli`,
 which adds the bmz04 parameterizations; it lives there because ``reparam`` is above ``evaluate``).
 
-Evaluate the Catmull-Clark limit surface of an all-quad OBJ mesh exactly (natural parameterization).
+Evaluate the Catmull-Clark limit surface of a mesh exactly (natural parameterization): all-quad, or
+with triangles, n-gons, creases, corners, holes and boundary modes (OpenSubdiv tags in the OBJ),
+``face`` being OpenSubdiv's ptex face index (the face index on all-quad meshes).
 
 Positions P and derivatives (Pu, Pv; Puu, Puv, Pvv) with respect to each face's own parameter
 (u, v): corner i of the face's OBJ vertex list at (0,0), (1,0), (1,1), (0,1) for i = 0..3 (the ptex
@@ -23,9 +25,9 @@ from ccproof.errors import CCProofError
 
 
 def add_arguments(parser):
-    parser.add_argument("mesh", help="all-quad OBJ file")
+    parser.add_argument("mesh", help="mesh file: OBJ (OpenSubdiv tag lines allowed) or any meshio format")
     src = parser.add_mutually_exclusive_group(required=True)
-    src.add_argument("--points", metavar="CSV", help="CSV file with header face,u,v")
+    src.add_argument("--points", metavar="CSV", help="CSV file with header face,u,v (face: ptex face index)")
     src.add_argument("--samples", metavar="N", type=int, help="evaluate at N random points")
     parser.add_argument("--derivatives", type=int, choices=(0, 1, 2), default=1, help="derivative order (default 1)")
     parser.add_argument("--out", metavar="FILE.npz", required=True, help="output file (numpy .npz)")

@@ -397,11 +397,124 @@ def _to_fmpq_mat(rows, ncols):
 
 
 def _fmpq_mat_to_float(M):
-    out = np.empty((M.nrows(), M.ncols()))
-    for idx, x in enumerate(M.entries()):
-        p, q = int(x.p), int(x.q)
-        out.flat[idx] = p / q  # correctly rounded (Python int true division)
-    return out
+    """Correctly rounded float matrix of an exact one (common denominator, Python int true division)."""
+    num, den = M.numer_denom()
+    q = int(den)
+    out = np.array([int(p) / q for p in num.entries()], dtype=np.float64)
+    return out.reshape(M.nrows(), M.ncols())
+
+
+def power_layers(M, A, l_row):
+    """Rounded deviations ``M A^n - 1 l^T`` for n = 0, 1, ... until below ``LAYER_TOLERANCE``.
+
+    Parameters
+    ----------
+    M : flint.fmpq_mat, shape (48, N)
+    A : flint.fmpq_mat, shape (N, N)
+    l_row : flint.fmpq_mat, shape (1, N)
+
+    Returns
+    -------
+    ndarray, shape (n_layers, 3, 16, N)
+
+    Notes
+    -----
+    Exact throughout: with ``A = Ai / a``, ``M = Mi / m`` and ``l = li / c`` (integer matrices and
+    common denominators) the n-th deviation is ``(c Mi Ai^n - m a^n 1 li^T) / (c m a^n)``; the powers
+    are integer matrix products (flint ``fmpz_mat``), and only the final quotients are rounded.
+    """
+    N = A.nrows()
+    Ai, a = A.numer_denom()
+    Mi, m = M.numer_denom()
+    li, c = l_row.numer_denom()
+    a, m, c = int(a), int(m), int(c)
+    Lrow = [int(x) for x in li.entries()]
+    ones = flint.fmpz_mat(48, 1, [1] * 48)
+    L1 = ones * flint.fmpz_mat(1, N, Lrow)
+    R = Mi
+    den = m
+    layers = []
+    for _ in range(MAX_LAYERS):
+        num = R * c - L1 * den
+        q = c * den
+        D = np.array([int(p) / q for p in num.entries()], dtype=np.float64).reshape(48, N)
+        layers.append(D.reshape(3, 16, N))
+        if np.abs(D).max() < LAYER_TOLERANCE:
+            return np.array(layers)
+        R = R * Ai
+        den *= a
+    raise MeshError(f"corner configuration of {N} vertices does not converge to its limit point")
+
+
+_SOURCES = ("evaluate/local.py", "evaluate/tagged.py", "mesh/rules.py")
+
+
+@functools.lru_cache(maxsize=1)
+def _code_version():
+    """Hash of the sources that define the exact data (a change invalidates the disk cache)."""
+    import hashlib
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    h = hashlib.sha256()
+    for rel in _SOURCES:
+        h.update((root / rel).read_bytes())
+    return h.hexdigest()[:16]
+
+
+def _cache_dir():
+    import os
+    from pathlib import Path
+
+    d = os.environ.get("CCPROOF_CACHE")
+    if d is not None and d.strip().lower() in ("", "0", "off", "none", "no"):
+        return None
+    return Path(d) if d else Path.home() / ".cache" / "ccproof" / "corner_schemes"
+
+
+def cached_scheme(kind, key, compute):
+    """``compute()`` (a CornerScheme or None), kept between runs in a disk cache.
+
+    The cache (default ``~/.cache/ccproof/corner_schemes``; environment variable
+    ``CCPROOF_CACHE`` = another folder, or ``off``) holds one ``.npz`` per configuration, named by
+    the SHA-256 of the configuration key and of the sources that compute it; it stores the rounded
+    layers, the limit mask, the support and the exact matrix ``A`` (integer numerators as decimal
+    strings and one denominator), so a cached scheme is the computed one bit for bit. Unreadable
+    or unwritable cache files are ignored (the data are then computed).
+    """
+    import hashlib
+    import os
+
+    d = _cache_dir()
+    if d is None:
+        return compute()
+    name = hashlib.sha256(f"{kind}|{_code_version()}|{key!r}".encode()).hexdigest()
+    path = d / f"{name}.npz"
+    if path.exists():
+        try:
+            with np.load(path, allow_pickle=False) as z:
+                N = int(z["size"])
+                den = int(str(z["A_den"]))
+                A = flint.fmpq_mat(N, N, [flint.fmpq(int(x), den) for x in z["A_num"].tolist()])
+                sup = z["support"]
+                return CornerScheme(N, A, z["limit_mask"].copy(), z["layers"].copy(),
+                                    None if sup.size == 0 else [int(i) for i in sup])
+        except (OSError, ValueError, KeyError):
+            pass
+    sch = compute()
+    if sch is None:
+        return None
+    try:
+        d.mkdir(parents=True, exist_ok=True)
+        num, den = sch.A.numer_denom()
+        tmp = d / f".{name}.{os.getpid()}.npz"
+        np.savez(tmp, size=np.array(sch.size), A_den=np.array(str(den)),
+                 A_num=np.array([str(x) for x in num.entries()]), limit_mask=sch.limit_mask,
+                 layers=sch.layers, support=np.array(sch.support if sch.support else [], dtype=np.int64))
+        os.replace(tmp, path)
+    except OSError:
+        pass
+    return sch
 
 
 class CornerScheme:
@@ -419,13 +532,18 @@ class CornerScheme:
         ``D[n, j-1] = M_j A^n - 1 l^T`` (exact, then rounded): deviation of the net of patch P_j of
         layer n from the limit point. Layers beyond ``n_layers - 1`` equal the limit point to
         within ``LAYER_TOLERANCE`` times the size of the one-ring.
+    support : tuple of int or None
+        The ring points the surface over the face depends on (closed under ``A``), when fewer
+        than all: across an infinitely sharp crease the other sector is decoupled, and its
+        eigenvalues must not enter the tangent plane of this one. ``None``: all points.
     """
 
-    def __init__(self, size, A, limit_mask, layers):
+    def __init__(self, size, A, limit_mask, layers, support=None):
         self.size = size
         self.A = A
         self.limit_mask = limit_mask
         self.layers = layers
+        self.support = None if support is None or len(support) == size else tuple(support)
 
     @property
     def n_layers(self):
@@ -443,7 +561,58 @@ class CornerScheme:
         ``None`` when the second eigenspace has several directions (the tangent plane would depend
         on the direction of approach).
         """
-        return _tangent_masks(self.A)
+        A = self.A
+        if self.support is not None:
+            idx = self.support
+            A = flint.fmpq_mat(len(idx), len(idx), [A[i, j] for i in idx for j in idx])
+        T = _tangent_masks_float(A)
+        if T is None:
+            T = _tangent_masks(A)
+        if T is None or self.support is None:
+            return T
+        out = np.zeros((2, self.size))
+        out[:, list(self.support)] = T
+        return out
+
+
+def _tangent_masks_float(A):
+    """:meth:`CornerScheme.tangent_masks` in double precision, or None (then the 80-digit path decides).
+
+    Eigenvalues of the rounded ``A`` (numpy), grouped within 1e-6 (a defective pair splits by about
+    sqrt(eps)); the left null vectors of ``A - mu`` for the group mean ``mu`` by SVD (singular
+    values below 1e-9). Accepted only when every step is unambiguous: real groups, the expected
+    null-space dimensions, and residuals ``|x (A - mu)| <= 1e-12 |x|``.
+    """
+    Af = _fmpq_mat_to_float(A)
+    N = Af.shape[0]
+    vals = np.linalg.eigvals(Af)
+    vals = vals[np.argsort(-np.abs(vals), kind="stable")]
+    groups = []
+    for z in vals:
+        if groups and abs(groups[-1][0] - z) < 1e-6:
+            groups[-1].append(z)
+        else:
+            groups.append([z])
+    masks = []
+    for g in groups:
+        mu = sum(g) / len(g)
+        if abs(mu - 1) < 1e-9:
+            continue
+        if abs(mu.imag) > 1e-9:
+            return None
+        B = Af.T - mu.real * np.eye(N)
+        _, S, Vt = np.linalg.svd(B)
+        null = [i for i in range(N) if S[i] < 1e-9]
+        if not null or (masks and len(null) > 1):
+            return None
+        for i in null[: 2 - len(masks)]:
+            x = Vt[i]
+            if np.linalg.norm(x @ Af - mu.real * x) > 1e-12 * np.linalg.norm(x):
+                return None
+            masks.append(x)
+        if len(masks) == 2:
+            return np.array(masks)
+    return None
 
 
 def _tangent_masks(A):
@@ -484,6 +653,12 @@ def _tangent_masks(A):
 
 @functools.lru_cache(maxsize=1024)
 def corner_scheme(key):
+    """Exact layered-patch data of a face with one irregular corner (:func:`_corner_scheme`),
+    kept between runs in the disk cache of :func:`cached_scheme`."""
+    return cached_scheme("quad", key, lambda: _corner_scheme(key))
+
+
+def _corner_scheme(key):
     """Exact layered-patch data of a face with one irregular corner, or ``None`` if not self-similar.
 
     Parameters
@@ -545,16 +720,5 @@ def corner_scheme(key):
     except ZeroDivisionError:
         raise MeshError("corner configuration whose subdivision matrix has a multiple eigenvalue 1") from None
     l_row = flint.fmpq_mat(1, N, [lvec[i, 0] for i in range(N)])
-    ones = flint.fmpq_mat(48, 1, [1] * 48)
-    L1 = ones * l_row
-    layers = []
-    R = M
-    for _ in range(MAX_LAYERS):
-        D = _fmpq_mat_to_float(R - L1)
-        layers.append(D.reshape(3, 16, N))
-        if np.abs(D).max() < LAYER_TOLERANCE:
-            break
-        R = R * A
-    else:  # pragma: no cover - every Catmull-Clark corner contracts
-        raise MeshError(f"corner configuration of {N} vertices does not converge to its limit point")
-    return CornerScheme(N, A, _fmpq_mat_to_float(l_row)[0], np.array(layers))
+    layers = power_layers(M, A, l_row)
+    return CornerScheme(N, A, _fmpq_mat_to_float(l_row)[0], layers)

@@ -118,6 +118,18 @@ def _stencil_matrix(stencils, ncols):
     return M
 
 
+@functools.lru_cache(maxsize=4096)
+def _regular_net_matrix(key):
+    """(16, k) float net matrix of face 0 of the one-ring ``key`` and the k ring positions it uses."""
+    net = regular_net(LocalTopology(key), 0)
+    if net is None:  # pragma: no cover
+        return None, None
+    cols = sorted({v for s in net for v in s})
+    M = _stencil_matrix([{cols.index(v): w for v, w in s.items()} for s in net], len(cols))
+    M.setflags(write=False)
+    return M, np.array(cols, dtype=np.int64)
+
+
 class _Builder:
     """Collects patches and virtual faces while classifying the faces of a mesh."""
 
@@ -131,6 +143,7 @@ class _Builder:
         self.vbase = []
         self.max_depth = 0
         self.corner_of_vertex = {}
+        self.corner_data = {}  # corner virtual face -> (CornerScheme, ring control points)
 
     def new_vface(self, kind, frame, base_face):
         self.vbase.append(base_face)
@@ -162,12 +175,11 @@ class _Builder:
         F = topo.flat
         irregular = [i for i in range(4) if not topo.is_regular(F[4 * f + i])]
         if not irregular:
-            net = regular_net(topo, f)
-            if net is None:  # pragma: no cover - regular vertices always give a net
+            ring, key, _ = canonical_ring(topo, f, 0)
+            M, cols = _regular_net_matrix(key)
+            if M is None:  # pragma: no cover - regular vertices always give a net
                 raise MeshError(f"face {base_face}: no regular B-spline net")
-            ids = sorted({v for s in net for v in s})
-            M = _stencil_matrix([{ids.index(v): w for v, w in s.items()} for s in net], len(ids))
-            Xl = X[ids]
+            Xl = X[np.asarray(ring)[cols]]
             origin = Xl.mean(axis=0)
             self.vkind[vid] = _REGULAR
             self.vpatch[vid] = self.add_patch(M @ (Xl - origin), origin, frame)
@@ -190,6 +202,7 @@ class _Builder:
         return self.split_face(topo, X, f, frame, depth, base_face, vid, vmap)
 
     def corner_face(self, scheme, C, r, frame, vid):
+        self.corner_data[vid] = (scheme, C)
         rot = _compose(frame, _corner_frame(r))
         self.vkind[vid] = _CORNER
         U0, V0, H = self.vdom[vid]
@@ -197,8 +210,9 @@ class _Builder:
         self.vcorner[vid] = (int(corner[0] > U0), int(corner[1] > V0))
         rel = C - C[0]
         origin = C[0] + scheme.limit_mask @ rel
-        dev = np.einsum("njqN,Nc->njqc", scheme.layers, rel)  # (n_layers, 3, 16, 3)
-        nl = dev.shape[0]
+        L = scheme.layers
+        nl = L.shape[0]
+        dev = (L.reshape(-1, L.shape[-1]) @ rel).reshape(nl, 3, 16, 3)  # (n_layers, 3, 16, 3)
         # P_1 lies along the frame's a-axis: code 0 (u-distance >= 1/2, v-distance < 1/2) if a is
         # along u, else code 2; P_2 (diagonal) is code 1; P_3 the other one
         a_along_u = abs(rot[1][0]) > 0
@@ -293,9 +307,16 @@ class LimitSurface:
         self._vnmax = np.array(b.vnmax, dtype=np.int64)
         self.split_depth = b.max_depth
         self._corner_of_vertex = b.corner_of_vertex
+        self._corner_data = b.corner_data
+        self._corner_normal = {}
         self._vbase = np.array(b.vbase, dtype=np.int64)
         self.n_patches = self._nets.shape[0]
         self.max_layers = int(self._vnmax.max()) + 1 if (self._vkind == _CORNER).any() else 0
+
+    @property
+    def n_faces(self):
+        """Number of (ptex) faces: the valid ``face`` ids of :meth:`evaluate`."""
+        return self.mesh.n_faces
 
     # ------------------------------------------------------------------ input checks
     def _check(self, face_ids, u, v):
@@ -316,7 +337,7 @@ class LimitSurface:
                 raise CCProofError(f"point {bad}: face id {f[bad].item()!r} is not an integer")
             f = fi
         f = f.astype(np.int64, copy=False)
-        m = self.mesh.n_faces
+        m = self.n_faces
         step = 1 << 18  # bounded temporaries
         for lo in range(0, f.size, step):
             fb, ub, vb = f[lo : lo + step], u[lo : lo + step], v[lo : lo + step]
@@ -380,7 +401,7 @@ class LimitSurface:
         t = np.clip((v - self._pv0[patch]) / h, 0.0, 1.0)
         return patch, s, t, 1.0 / h
 
-    def evaluate(self, face_ids, u, v, derivatives=1, *, chunk=CHUNK, out=None, backend=None):
+    def evaluate(self, face_ids, u, v, derivatives=1, *, chunk=CHUNK, out=None, backend=None, threads=None):
         """Positions and derivatives of the limit surface at points (face, u, v).
 
         Parameters
@@ -396,6 +417,11 @@ class LimitSurface:
         backend : {None, "numpy", "numba"}
             ``None``: the compiled kernel if numba is installed (and the environment variable
             ``CCPROOF_BACKEND`` is not ``numpy``), else numpy. Both compute the same formulas.
+        threads : int, optional
+            Threads for the compiled kernel (it releases the GIL; the points are split into
+            contiguous blocks, the results are identical). Default: all cores
+            (``os.cpu_count()``, or the environment variable ``CCPROOF_THREADS``) for batches of
+            at least 2^17 points, else 1. The numpy path always runs on one thread.
 
         Returns
         -------
@@ -429,9 +455,24 @@ class LimitSurface:
         if kernel is not None:
             dummy = np.empty((0, 3))
             arrs = [out.get(k, dummy) for k in _KEYS[2]]
-            kernel(f, u, v, derivatives, self._vkind, self._vchild, self._vu0, self._vv0, self._vh,
-                   self._vpatch, self._vcold, self.hot_layers, self._vcu, self._vcv, self._vnmax,
-                   self.split_depth, self._nets, self._pu0, self._pv0, self._ph, *arrs)
+            tables = (self._vkind, self._vchild, self._vu0, self._vv0, self._vh, self._vpatch, self._vcold,
+                      self.hot_layers, self._vcu, self._vcv, self._vnmax, self.split_depth, self._nets,
+                      self._pu0, self._pv0, self._ph)
+            nt = _threads(threads, n)
+            if nt <= 1:
+                kernel(f, u, v, derivatives, *tables, *arrs)
+                return out
+            from concurrent.futures import ThreadPoolExecutor
+
+            bounds = np.linspace(0, n, nt + 1).astype(np.int64)
+
+            def block(i):
+                lo, hi = bounds[i], bounds[i + 1]
+                kernel(f[lo:hi], u[lo:hi], v[lo:hi], derivatives, *tables,
+                       *[a[lo:hi] if a.shape[0] else a for a in arrs])
+
+            with ThreadPoolExecutor(nt) as ex:
+                list(ex.map(block, range(nt)))
             return out
         for lo in range(0, n, chunk):
             hi = min(n, lo + chunk)
@@ -457,6 +498,67 @@ class LimitSurface:
             np.multiply(np.einsum("ni,nic->nc", bs[2], T0), g2, out=out["Puu"])
             np.multiply(np.einsum("ni,nic->nc", bs[1], T1), g2, out=out["Puv"])
             np.multiply(np.einsum("ni,nic->nc", bs[0], T2), g2, out=out["Pvv"])
+
+    # ------------------------------------------------------------------ normals
+    def _vface_of(self, f, u, v):
+        vf = f.copy()
+        kind = self._vkind[vf]
+        for _ in range(self.split_depth):
+            idx = np.flatnonzero(kind == _SPLIT)
+            if idx.size == 0:
+                break
+            w = vf[idx]
+            half = self._vh[w] * 0.5
+            q = (u[idx] >= self._vu0[w] + half).astype(np.int64) + 2 * (v[idx] >= self._vv0[w] + half)
+            vf[idx] = self._vchild[w, q]
+            kind[idx] = self._vkind[vf[idx]]
+        return vf, kind
+
+    def _eigen_normal(self, vid):
+        """Unit normal at the irregular corner of corner face ``vid`` from the exact tangent masks."""
+        if vid not in self._corner_normal:
+            scheme, C = self._corner_data[vid]
+            T = scheme.tangent_masks
+            nrm = None
+            if T is not None:
+                t1, t2 = T @ (C - C[0])
+                c = np.cross(t1, t2)
+                if np.linalg.norm(c) > 0:
+                    nrm = c / np.linalg.norm(c)
+            self._corner_normal[vid] = nrm
+        return self._corner_normal[vid]
+
+    def normals(self, face_ids, u, v):
+        """Unit limit normals, shape (n, 3), oriented like ``Pu x Pv``.
+
+        ``Pu x Pv`` normalized, except closer to an irregular corner than the innermost stored layer
+        (including the corner itself, where ``Pu x Pv`` degenerates): there the normal of the exact
+        tangent plane at the vertex (left eigenvectors of the corner's exact subdivision matrix,
+        :attr:`ccproof.evaluate.local.CornerScheme.tangent_masks`); it differs from ``Pu x Pv`` at
+        the innermost layer by the decay of the third eigenvalue over some 50 layers (round-off).
+        NaN where the tangent plane at such a corner is not determined by two eigenvectors.
+        """
+        f, u, v = self._check(face_ids, u, v)
+        r = self.evaluate(f, u, v, 1)
+        N = np.cross(r["Pu"], r["Pv"])
+        vf, kind = self._vface_of(f, u, v)
+        idx = np.flatnonzero(kind == _CORNER)
+        if idx.size:
+            w = vf[idx]
+            U0, V0, H = self._vu0[w], self._vv0[w], self._vh[w]
+            du = np.where(self._vcu[w], (U0 + H) - u[idx], u[idx] - U0) / H
+            dv = np.where(self._vcv[w], (V0 + H) - v[idx], v[idx] - V0) / H
+            mx = np.maximum(du, dv)
+            inner = mx < np.ldexp(1.0, -(self._vnmax[w] + 1))
+            for j in np.flatnonzero(inner):
+                e = self._eigen_normal(int(w[j]))
+                i = idx[j]
+                if e is None:
+                    N[i] = np.nan
+                else:
+                    N[i] = e if np.dot(e, N[i]) >= 0 else -e
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return N / np.linalg.norm(N, axis=1)[:, None]
 
     # ------------------------------------------------------------------ vertices
     def vertex_limits(self):
@@ -498,6 +600,20 @@ class LimitSurface:
         return int(self._vbase[vid])
 
 
+def _threads(threads, n):
+    """Number of threads for n points (see :meth:`LimitSurface.evaluate`)."""
+    import os
+
+    if threads is None:
+        if n < 1 << 17:
+            return 1
+        threads = int(os.environ.get("CCPROOF_THREADS", os.cpu_count() or 1))
+    threads = int(threads)
+    if threads < 1:
+        raise CCProofError(f"threads must be >= 1, got {threads}")
+    return max(1, min(threads, n // 1024 or 1))
+
+
 def _numba_kernel(backend):
     """The compiled kernel for ``backend`` (None: automatic), or None for the numpy path."""
     import os
@@ -516,18 +632,34 @@ def _numba_kernel(backend):
 
 
 def limit_surface(mesh):
-    """Prepare the exact evaluation of the limit surface of ``mesh`` (a QuadMesh or an OBJ path).
+    """Prepare the exact evaluation of the limit surface of ``mesh``.
 
     Parameters
     ----------
-    mesh : QuadMesh or str or os.PathLike
+    mesh : QuadMesh, PolyMesh, or str or os.PathLike
+        A QuadMesh gives a :class:`LimitSurface`; a PolyMesh the tagged evaluator
+        (:class:`ccproof.evaluate.tagged.TaggedLimitSurface`, ``face`` = ptex face index; on
+        untagged all-quad meshes the same numbers as LimitSurface to round-off). A path is read by
+        :func:`ccproof.mesh.io.read_mesh` (OBJ with OpenSubdiv tags, or any meshio format): an
+        untagged all-quad file gives a LimitSurface on a QuadMesh, anything else (triangles,
+        n-gons, creases, corners, holes, boundary modes) the tagged evaluator.
 
     Returns
     -------
     LimitSurface
     """
-    if not isinstance(mesh, QuadMesh):
-        from ccproof.mesh import read_obj
+    if isinstance(mesh, QuadMesh):
+        return LimitSurface(mesh)
+    from ccproof.evaluate.tagged import TaggedLimitSurface
+    from ccproof.mesh.polymesh import PolyMesh
 
-        mesh = read_obj(mesh)
-    return LimitSurface(mesh)
+    if isinstance(mesh, PolyMesh):
+        return TaggedLimitSurface(mesh)
+    from ccproof.mesh.io import read_mesh
+
+    mesh = read_mesh(mesh)
+    if mesh.is_all_quads and not mesh.has_tags:
+        # a file holding an untagged all-quad mesh: the QuadMesh evaluator, as before (same numbers
+        # as the tagged one to round-off; ``S.mesh`` is a QuadMesh)
+        return LimitSurface(QuadMesh(mesh.vertices, np.array(mesh.polygons, dtype=np.int64).reshape(-1, 4)))
+    return TaggedLimitSurface(mesh)

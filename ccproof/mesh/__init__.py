@@ -1,4 +1,5 @@
-"""Quad-mesh input/output, validated topology, one reference Catmull-Clark step and vertex masks.
+"""Mesh input/output, validated topology (quad meshes; tagged polygon meshes with OpenSubdiv's
+creases, corners, holes and boundary modes), the Catmull-Clark rules and vertex masks.
 
 Layer ``mesh`` of docs/architecture.md: imports nothing from ccproof but :mod:`ccproof.errors`.
 
@@ -8,13 +9,19 @@ Layer ``mesh`` of docs/architecture.md: imports nothing from ccproof but :mod:`c
 True
 """
 
-from ccproof.mesh.io import read_obj, read_obj_polygons, write_obj
+from ccproof.mesh.io import read_mesh, read_obj, read_obj_polygons, read_obj_tagged, write_obj
 from ccproof.mesh.masks import limit_normals, limit_positions, limit_tangents
+from ccproof.mesh.polymesh import PolyMesh
 from ccproof.mesh.quadmesh import QuadMesh
+from ccproof.mesh.rules import Options
 from ccproof.mesh.subdivision import child_faces, subdivide, subdivision_matrix
 
 __all__ = [
     "QuadMesh",
+    "PolyMesh",
+    "Options",
+    "read_mesh",
+    "read_obj_tagged",
     "read_obj",
     "read_obj_polygons",
     "write_obj",

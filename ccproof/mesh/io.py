@@ -17,7 +17,7 @@ import numpy as np
 from ccproof.errors import MeshError
 from ccproof.mesh.quadmesh import QuadMesh
 
-__all__ = ["read_obj", "read_obj_polygons", "write_obj"]
+__all__ = ["read_obj", "read_obj_polygons", "read_obj_tagged", "read_mesh", "write_obj"]
 
 
 def _logical_lines(text):
@@ -90,6 +90,132 @@ def read_obj_polygons(path):
     return V, polys, lines
 
 
+def _parse_tags(path, text):
+    """The OpenSubdiv ``t`` lines of an OBJ text: list of (line, name, ints, floats, strings)."""
+    out = []
+    for no, line in _logical_lines(text):
+        s = line.split("#", 1)[0].split()
+        if not s or s[0] != "t":
+            continue
+        if len(s) < 3:
+            raise MeshError(f"{path}:{no}: tag line needs a name and counts: {line.strip()!r}")
+        name = s[1]
+        try:
+            ni, nf, ns = (int(x) for x in s[2].split("/"))
+        except ValueError:
+            raise MeshError(f"{path}:{no}: bad tag counts {s[2]!r} (expected nints/nfloats/nstrings)") from None
+        rest = s[3:]
+        if len(rest) < ni + nf + ns:
+            raise MeshError(f"{path}:{no}: tag {name!r} announces {ni + nf + ns} values, has {len(rest)}")
+        try:
+            ints = [int(x) for x in rest[:ni]]
+            floats = [float(x) for x in rest[ni : ni + nf]]
+        except ValueError:
+            raise MeshError(f"{path}:{no}: bad value in tag {name!r}: {line.strip()!r}") from None
+        out.append((no, name, ints, floats, rest[ni + nf : ni + nf + ns]))
+    return out
+
+
+def read_obj_tagged(path):
+    """Read an OBJ file with OpenSubdiv's tag lines into a :class:`~ccproof.mesh.polymesh.PolyMesh`.
+
+    Tags (grammar of OpenSubdiv's ``regression/common/shape_utils.cpp``; indices 0-based):
+    ``t crease n/1/0 a b [c d ...] s`` (pairs of vertices, one sharpness for all, or one float per
+    pair), ``t corner n/1/0 v [...] s`` (or one float per vertex), ``t hole n/0/0 f ...``,
+    ``t interpolateboundary 1/0/0 m`` (0 none, 1 edge and corner, 2 edge only; default edge only),
+    ``t creasemethod 0/0/1 normal|chaikin``, ``t smoothtriangles 0/0/1 catmark|smooth``.
+    Face-varying tags are ignored; any other tag is an error (never silently ignored). Negative
+    sharpness is clamped to 0, as OpenSubdiv does, with the line in the error if it is NaN.
+    """
+    from ccproof.mesh.polymesh import PolyMesh
+    from ccproof.mesh.rules import Options
+
+    V, polys, lines = read_obj_polygons(path)
+    with open(os.fspath(path), encoding="utf-8", errors="replace") as fh:
+        tags = _parse_tags(path, fh.read())
+    creases, corners, holes = {}, {}, []
+    opts = {}
+    for no, name, ints, floats, strings in tags:
+        where = f"{path}:{no}: tag {name!r}"
+        if name == "crease":
+            if len(ints) % 2 or not floats:
+                raise MeshError(f"{where}: needs vertex pairs and a sharpness")
+            for j in range(0, len(ints), 2):
+                s = floats[j] if len(floats) > 1 and j < len(floats) else floats[0]
+                if s != s:
+                    raise MeshError(f"{where}: sharpness is NaN on edge ({ints[j]}, {ints[j + 1]})")
+                creases[(ints[j], ints[j + 1])] = max(s, 0.0)
+        elif name == "corner":
+            if not floats:
+                raise MeshError(f"{where}: needs a sharpness")
+            for j, v in enumerate(ints):
+                s = floats[j] if len(floats) > 1 and j < len(floats) else floats[0]
+                if s != s:
+                    raise MeshError(f"{where}: sharpness is NaN on vertex {v}")
+                corners[v] = max(s, 0.0)
+        elif name == "hole":
+            holes.extend(ints)
+        elif name == "interpolateboundary":
+            modes = {0: "none", 1: "edge_and_corner", 2: "edge_only"}
+            if len(ints) != 1 or ints[0] not in modes:
+                raise MeshError(f"{where}: expected one of 0, 1, 2, got {ints}")
+            opts["boundary"] = modes[ints[0]]
+        elif name == "creasemethod":
+            m = {"normal": "uniform", "chaikin": "chaikin"}
+            if len(strings) != 1 or strings[0] not in m:
+                raise MeshError(f"{where}: expected 'normal' or 'chaikin', got {strings}")
+            opts["crease_method"] = m[strings[0]]
+        elif name == "smoothtriangles":
+            m = {"catmark": "catmark", "smooth": "smooth"}
+            if len(strings) != 1 or strings[0] not in m:
+                raise MeshError(f"{where}: expected 'catmark' or 'smooth', got {strings}")
+            opts["triangle_subdivision"] = m[strings[0]]
+        elif name in ("facevaryinginterpolateboundary", "facevaryingpropagatecorners"):
+            continue  # face-varying data only
+        else:
+            raise MeshError(f"{where}: not supported (hierarchical edits and unknown tags are refused)")
+    try:
+        return PolyMesh(V, polys, creases=creases or None, corners=corners or None, holes=holes or None,
+                        options=Options(**opts))
+    except MeshError as exc:
+        raise MeshError(f"{path}: {exc}") from None
+
+
+def read_mesh(path):
+    """Read any polygon mesh: OBJ (with OpenSubdiv tags) directly, other formats through meshio.
+
+    Returns
+    -------
+    PolyMesh
+        meshio cells of type triangle, quad and polygon are kept in file order (by cell block);
+        other cell types (lines, vertices, volumes) raise a MeshError naming the block.
+    """
+    from ccproof.mesh.polymesh import PolyMesh
+
+    p = os.fspath(path)
+    if p.lower().endswith(".obj"):
+        return read_obj_tagged(p)
+    import meshio
+
+    try:
+        mesh = meshio.read(p)
+    except Exception as exc:  # meshio raises many types
+        raise MeshError(f"{p}: meshio cannot read it: {exc}") from None
+    polys = []
+    for b, block in enumerate(mesh.cells):
+        if block.type in ("triangle", "quad") or block.type.startswith("polygon"):
+            polys.extend(np.asarray(block.data).tolist())
+        else:
+            raise MeshError(f"{p}: cell block {b} has type {block.type!r}: only polygon faces are supported")
+    pts = np.asarray(mesh.points, dtype=np.float64)
+    if pts.shape[1] == 2:
+        pts = np.c_[pts, np.zeros(len(pts))]
+    try:
+        return PolyMesh(pts, polys)
+    except MeshError as exc:
+        raise MeshError(f"{p}: {exc}") from None
+
+
 def read_obj(path):
     """Read an all-quad OBJ file into a validated :class:`QuadMesh`.
 
@@ -100,9 +226,17 @@ def read_obj(path):
     ------
     MeshError
         If the file is malformed, a face is not a quad (the message gives its number and source
-        line), or the mesh fails any check of :class:`QuadMesh`.
+        line), it has OpenSubdiv tag lines (creases, corners, holes, boundary modes: never
+        ignored; use :func:`read_mesh`), or the mesh fails any check of :class:`QuadMesh`.
     """
     V, polys, lines = read_obj_polygons(path)
+    with open(os.fspath(path), encoding="utf-8", errors="replace") as fh:
+        for no, name, *_ in _parse_tags(path, fh.read()):
+            if name not in ("facevaryinginterpolateboundary", "facevaryingpropagatecorners"):
+                raise MeshError(
+                    f"{path}:{no}: OpenSubdiv tag {name!r}: a QuadMesh has no creases, corners, holes or "
+                    "boundary modes; read the file with read_mesh / read_obj_tagged (PolyMesh) instead"
+                )
     try:
         return QuadMesh.from_polygons(V, polys, lines=lines)
     except MeshError as exc:

@@ -1,7 +1,8 @@
-"""Evaluate the Catmull-Clark limit surface of an all-quad OBJ mesh in one of the parameterizations
-of bmz04: natural (Stam, section 2), vanishing (F^alpha blend, section 4.2: derivatives tend to 0
-at extraordinary vertices) or characteristic (Phi^-1 blend, section 4.3: C1 with a Jacobian of
-rank 2 at extraordinary vertices).
+"""Evaluate the Catmull-Clark limit surface of a mesh (OBJ with OpenSubdiv tags, or any meshio
+format) in one of the parameterizations of bmz04 (triangles, n-gons and tagged meshes: natural only,
+``face`` being the ptex face index): natural (Stam, section 2), vanishing (F^alpha blend,
+section 4.2: derivatives tend to 0 at extraordinary vertices) or characteristic (Phi^-1 blend,
+section 4.3: C1 with a Jacobian of rank 2 at extraordinary vertices).
 
 Positions P and derivatives (Pu, Pv; Puu, Puv, Pvv) with respect to each face's own parameter
 (u, v): corner i of the face's OBJ vertex list at (0,0), (1,0), (1,1), (0,1) for i = 0..3 (the ptex
@@ -48,12 +49,30 @@ def add_arguments(parser):
 def run(args) -> int:
     import numpy as np
 
-    from ccproof.mesh import read_obj
+    from ccproof.mesh import QuadMesh
+    from ccproof.mesh.io import read_mesh
     from ccproof.reparam.surface import limit_surface
 
     t0 = time.perf_counter()
-    mesh = read_obj(args.mesh)
-    surface = limit_surface(mesh, alpha=args.alpha)
+    poly = read_mesh(args.mesh)  # OBJ with OpenSubdiv tags, or any meshio format
+    tagged = not poly.is_all_quads or poly.has_tags
+    if tagged:
+        # triangles, n-gons, creases, corners, holes, boundary modes: the natural parameterization
+        # of the tagged evaluator, by ptex face (equal to the face index on all-quad meshes)
+        from ccproof.evaluate import limit_surface as natural_surface
+
+        if args.parameterization != "natural":
+            raise CCProofError(
+                f"{args.mesh}: the {args.parameterization} parameterization needs an untagged all-quad mesh "
+                "(this one has non-quad faces or OpenSubdiv tags); use --parameterization natural"
+            )
+        if args.plot:
+            raise CCProofError(f"{args.mesh}: --plot needs an untagged all-quad mesh")
+        mesh = poly
+        natural = natural_surface(poly)
+    else:
+        mesh = QuadMesh(poly.vertices, np.array(poly.polygons, dtype=np.int64).reshape(-1, 4))
+        surface = limit_surface(mesh, alpha=args.alpha)
     t1 = time.perf_counter()
     if args.points is not None:
         f, u, v = read_points(args.points)
@@ -61,16 +80,22 @@ def run(args) -> int:
         if args.samples < 0:
             raise CCProofError(f"--samples must be >= 0, got {args.samples}")
         rng = np.random.default_rng(args.seed)
-        f = rng.integers(0, mesh.n_faces, args.samples)
+        f = rng.integers(0, natural.n_faces if tagged else mesh.n_faces, args.samples)
         u, v = rng.random(args.samples), rng.random(args.samples)
     t2 = time.perf_counter()
-    out = surface.evaluate(f, u, v, derivatives=args.derivatives, parameterization=args.parameterization)
+    if tagged:
+        out = natural.evaluate(f, u, v, derivatives=args.derivatives)
+    else:
+        out = surface.evaluate(f, u, v, derivatives=args.derivatives, parameterization=args.parameterization)
     t3 = time.perf_counter()
     np.savez(args.out, face=f, u=u, v=v, **out)
-    print(
-        f"{args.mesh}: {mesh.n_vertices} vertices, {mesh.n_faces} faces, "
-        f"{mesh.extraordinary_vertices.size} extraordinary vertices; prepared in {t1 - t0:.2f} s"
-    )
+    if tagged:
+        print(f"{args.mesh}: {mesh}; prepared in {t1 - t0:.2f} s")
+    else:
+        print(
+            f"{args.mesh}: {mesh.n_vertices} vertices, {mesh.n_faces} faces, "
+            f"{mesh.extraordinary_vertices.size} extraordinary vertices; prepared in {t1 - t0:.2f} s"
+        )
     rate = f.size / (t3 - t2) if t3 > t2 and f.size else float("nan")
     print(
         f"evaluated {f.size} points ({args.parameterization} parameterization, derivatives {args.derivatives}) "

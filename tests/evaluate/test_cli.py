@@ -55,6 +55,23 @@ def test_errors_are_reported(tmp_path, disk, capsys):
     assert main(["eval", str(obj), "--points", str(csv), "--out", str(tmp_path / "x.npz")]) == 2
     assert "u = 1.5 is outside [0, 1]" in capsys.readouterr().err
     tri = tmp_path / "tri.obj"
-    tri.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    tri.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nt crease 2/1/0 0 1 -1\n")
+    argv = ["eval", str(tri), "--samples", "3", "--out", str(tmp_path / "x.npz"), "--parameterization", "vanishing"]
+    assert main(argv) == 2
+    assert "the vanishing parameterization needs an untagged all-quad mesh" in capsys.readouterr().err
+    tri.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nt crease 2/1/0 0 3 1\n")
     assert main(["eval", str(tri), "--samples", "3", "--out", str(tmp_path / "x.npz")]) == 2
-    assert "face 0 (line 4) has 3 vertices" in capsys.readouterr().err
+    assert "crease on edge (0, 3): no such edge in the mesh" in capsys.readouterr().err
+
+
+def test_tagged_mesh_by_ptex_face(tmp_path, refdir):
+    obj = refdir / "osd_features" / "meshes" / "catmark_pyramid_creases1.obj"
+    d = __import__("json").loads((refdir / "osd_features" / "osd_limit_catmark_pyramid_creases1.json").read_text())
+    rows = [s for s in d["samples"] if s["exact"]][:20]
+    csv = tmp_path / "p.csv"
+    csv.write_text("face,u,v\n" + "".join(f"{s['ptex']},{s['s']!r},{s['t']!r}\n" for s in rows))
+    out = tmp_path / "r.npz"
+    assert main(["eval", str(obj), "--points", str(csv), "--out", str(out)]) == 0
+    r = np.load(out)
+    assert np.abs(r["P"] - np.array([s["P"] for s in rows])).max() < 1e-14
+    assert np.abs(r["Pu"] - np.array([s["Ps"] for s in rows])).max() < 1e-12

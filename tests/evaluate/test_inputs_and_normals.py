@@ -56,8 +56,13 @@ def test_bad_meshes_are_refused():
 def test_obj_path_and_non_quad(tmp_path):
     p = tmp_path / "t.obj"
     p.write_text("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nf 1 2 3 4\nf 2 5 3\n")
-    with pytest.raises(MeshError, match=r"face 1 \(line 7\) has 3 vertices"):
-        limit_surface(p)
+    S = limit_surface(p)  # a quad and a triangle: 1 + 3 ptex faces
+    assert S.n_faces == 4
+    with pytest.raises(CCProofError, match=r"point 0: face id 4 out of range \[0, 4\)"):
+        S.evaluate([4], [0.5], [0.5])
+    # the triangle's sub-faces meet at its centre (1, 1) in every sub-face's (s, t)
+    P = S.evaluate([1, 2, 3], [1.0] * 3, [1.0] * 3)["P"]
+    assert np.abs(P - P[0]).max() < 1e-15
 
 
 def test_chunking_and_backends_agree():

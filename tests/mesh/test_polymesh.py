@@ -1,0 +1,178 @@
+"""PolyMesh input (OBJ with OpenSubdiv tags, meshio, numpy), validation errors, ptex indexing, the rules."""
+
+import json
+import math
+from fractions import Fraction
+
+import numpy as np
+import pytest
+
+from ccproof.errors import CCProofError, MeshError
+from ccproof.mesh import QuadMesh, subdivide
+from ccproof.mesh.io import read_mesh, read_obj_tagged
+from ccproof.mesh.polymesh import PolyMesh
+
+OSD_BOUNDARY = {"VTX_BOUNDARY_EDGE_ONLY": "edge_only", "VTX_BOUNDARY_EDGE_AND_CORNER": "edge_and_corner",
+                "VTX_BOUNDARY_NONE": "none"}
+SHAPES = ["chaikin1", "cube_corner2", "cubes_infsharp", "edgenone", "hole_test2", "nonquads",
+          "pyramid_creases1", "smoothtris1", "helmet"]
+
+
+@pytest.mark.parametrize("name", SHAPES)
+def test_obj_tags_match_opensubdiv_topology(refdir, name):
+    d = json.loads((refdir / "osd_features" / f"osd_limit_catmark_{name}.json").read_text())
+    m = read_obj_tagged(refdir / "osd_features" / d["mesh"])
+    assert (m.n_vertices, m.n_faces, m.n_ptex) == (d["num_vertices"], d["num_faces"], d["num_ptex_faces"])
+    assert m.options.boundary == OSD_BOUNDARY[d["boundary_interpolation"]]
+    assert m.options.crease_method == {"CREASE_UNIFORM": "uniform", "CREASE_CHAIKIN": "chaikin"}[d["creasing_method"]]
+    assert m.options.triangle_subdivision == d["triangle_subdivision"].split("_")[-1].lower()
+    for c in d["creases"]:
+        a, b = c["edge"]
+        s = m.edge_sharpness.get((min(a, b), max(a, b)), 0.0)
+        assert s == (math.inf if c["infinite"] else c["sharpness"]), c
+    for c in d["corners"]:
+        assert m.vertex_sharpness.get(c["vertex"], 0.0) == (math.inf if c["sharpness"] >= 10 else c["sharpness"])
+    assert [f["verts"] for f in d["faces"]] == [list(p) for p in m.polygons]
+    assert [f["ptex"] for f in d["faces"]] == m.ptex_start[:-1].tolist()
+    assert sorted(np.flatnonzero(m.is_hole_tagged).tolist()) == sorted(d["holes"])
+    assert sorted(np.flatnonzero(m.is_hole & ~m.is_hole_tagged).tolist()) == sorted(d["implicit_holes"])
+    for f, p in enumerate(m.polygons):
+        for k in range(len(p)):
+            q = m.ptex_of(f, k)
+            assert m.face_of_ptex(q) == (f, k if len(p) != 4 else 0)
+
+
+def _mixed():
+    V = [[0, 0, 0], [1, 0, 0], [2, 0, 0], [0, 1, 0], [1, 1, 0], [2, 1, 0.5], [1, 2, 0]]
+    F = [[0, 1, 4, 3], [1, 2, 5, 4], [3, 4, 6], [4, 5, 6]]
+    return V, F
+
+
+def test_numpy_inputs_agree():
+    V, F = _mixed()
+    a = PolyMesh(V, F, creases=([[1, 4], [4, 6]], [2.5, 12.0]), corners=([0], [1.0]), holes=[3])
+    idx = np.concatenate([np.array(f) for f in F])
+    off = np.r_[0, np.cumsum([len(f) for f in F])]
+    b = PolyMesh(V, (idx, off), creases={(4, 1): 2.5, (6, 4): 12}, corners={0: 1.0}, holes=[3])
+    c = PolyMesh(V, idx, sizes=[4, 4, 3, 3], creases=(np.array([[1, 4], [4, 6]]), np.array([2.5, 12.0])),
+                 corners={0: 1}, holes=[3])
+    for m in (b, c):
+        assert m.polygons == a.polygons and m.edge_sharpness == a.edge_sharpness
+        assert m.vertex_sharpness == a.vertex_sharpness and (m.is_hole == a.is_hole).all()
+    assert a.edge_sharpness[(4, 6)] == math.inf and a.n_ptex == 2 + 3 + 3
+    assert a.face_of_ptex(5) == (3, 0) and a.ptex_of(2, 2) == 4
+
+
+def test_meshio_input(tmp_path):
+    meshio = pytest.importorskip("meshio")
+    V, F = _mixed()
+    p = tmp_path / "mixed.vtk"
+    meshio.write_points_cells(str(p), np.array(V, float), [("quad", np.array(F[:2])), ("triangle", np.array(F[2:]))])
+    m = read_mesh(p)
+    assert [list(q) for q in m.polygons] == F and np.array_equal(m.vertices, np.array(V, float))
+    q = tmp_path / "lines.vtk"
+    meshio.write_points_cells(str(q), np.array(V, float), [("line", np.array([[0, 1]]))])
+    with pytest.raises(MeshError, match="cell block 0 has type 'line'"):
+        read_mesh(q)
+
+
+@pytest.mark.parametrize("kwargs,msg", [
+    ({"faces": [[0, 1, 4, 3], [1, 4, 2, 5], [4, 1, 6]]}, r"non-manifold edge \(1, 4\): shared by 3 faces"),
+    ({"faces": [[0, 1, 3], [1, 2, 4], [4, 5, 1]], "n": 6}, r"non-manifold vertex 1: its faces form 2 separate fans"),
+    ({"faces": [[0, 1, 4, 3], [1, 4, 5, 2]]}, r"inconsistent orientation: faces 0 and 1 both traverse edge \(1, 4\)"),
+    ({"creases": {(0, 5): 1.0}}, r"crease on edge \(0, 5\): no such edge in the mesh"),
+    ({"creases": {(0, 1): -0.5}}, r"crease on edge \(0, 1\): negative sharpness -0.5"),
+    ({"creases": {(0, 1): float("nan")}}, r"crease on edge \(0, 1\): sharpness is NaN"),
+    ({"corners": {2: -1}}, r"corner on vertex 2: negative sharpness"),
+    ({"corners": {9: 1}}, r"corner on vertex 9: out of range"),
+    ({"holes": [7]}, r"hole face 7 out of range"),
+    ({"faces": [[0, 1, 1]]}, r"face 0 repeats vertex 1"),
+    ({"faces": [[0, 1]]}, r"face 0 has 2 vertices"),
+    ({"faces": [[0, 1, 9]]}, r"face 0 has a vertex index out of range"),
+    ({"nan": True}, r"vertex 2 has a non-finite coordinate"),
+])
+def test_bad_input_names_the_element(kwargs, msg):
+    V, F = _mixed()
+    V = np.array(V, float)
+    n = kwargs.pop("n", None)
+    if n is not None:
+        V = np.random.default_rng(0).random((n, 3))
+    if kwargs.pop("nan", False):
+        V[2, 1] = np.nan
+    F = kwargs.pop("faces", F)
+    with pytest.raises(MeshError, match=msg):
+        PolyMesh(V, F, **kwargs)
+
+
+def test_obj_tag_errors(tmp_path):
+    base = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n"
+    for tag, msg in [("t vertexedit 1/0/0 0", "tag 'vertexedit': not supported"),
+                     ("t crease 2/1/0 0 2 1.0", r"crease on edge \(0, 2\): no such edge"),
+                     ("t crease 2/1/0 0 1 nan", r"sharpness is NaN on edge \(0, 1\)"),
+                     ("t interpolateboundary 1/0/0 5", "expected one of 0, 1, 2"),
+                     ("t crease 2/1/0 0 1", "announces 3 values, has 2")]:
+        p = tmp_path / "t.obj"
+        p.write_text(base + tag + "\n")
+        with pytest.raises(MeshError, match=msg):
+            read_obj_tagged(p)
+    p.write_text(base + "t crease 2/1/0 0 1 -3\nt corner 1/1/0 2 0.5\n")
+    m = read_obj_tagged(p)  # negative sharpness is clamped to 0, as OpenSubdiv's shape_utils does
+    assert m.edge_sharpness == {} and m.vertex_sharpness == {2: 0.5}
+
+
+def test_ptex_and_parameter_errors(refdir):
+    from ccproof.evaluate import limit_surface
+
+    m = read_obj_tagged(refdir / "osd_features" / "meshes" / "catmark_pyramid_creases1.obj")
+    S = limit_surface(m)
+    with pytest.raises(CCProofError, match=r"point 1: face id 13 out of range \[0, 13\)"):
+        S.evaluate([0, 13], [0.5, 0.5], [0.5, 0.5])
+    with pytest.raises(CCProofError, match=r"point 0: v = 1.5 is outside \[0, 1\]"):
+        S.evaluate([0], [0.5], [1.5])
+    with pytest.raises(CCProofError, match=r"point 0: u = nan is outside"):
+        S.evaluate([0], [np.nan], [0.5])
+    with pytest.raises(MeshError, match=r"ptex face 13 out of range"):
+        m.face_of_ptex(13)
+
+
+@pytest.mark.parametrize("name", ["pyramid_creases1", "chaikin1", "smoothtris1", "edgecorner"])
+def test_exact_and_float_operator_agree(refdir, name):
+    m = read_obj_tagged(refdir / "osd_features" / "meshes" / f"catmark_{name}.obj")
+    for _ in range(2):  # level 0 (n-gons, level-0 rules) and level 1 (decayed tags)
+        exact = m.subdivision_operator(exact=True)
+        S = m.subdivision_operator().toarray()
+        E = np.array([[float(r.get(j, Fraction(0))) for j in range(m.n_vertices)] for r in exact])
+        assert np.array_equal(S, E)
+        assert all(sum(r.values()) == 1 for r in exact)  # affine invariance, exactly
+        m1, S1 = m.refine()
+        assert np.array_equal(m1.vertices, S1 @ m.vertices)
+        m = m1
+
+
+def test_untagged_step_matches_reference(refdir):
+    # untagged all-quad meshes: the same step as the independent ccproof.mesh.subdivide
+    from ccproof.mesh.examples import cube
+
+    q = cube()
+    p = PolyMesh(q.vertices, q.faces)
+    p1, _ = p.refine()
+    r = subdivide(q)
+    n, E_, F_ = q.n_vertices, q.n_edges, q.n_faces
+    def close(x, y):  # the two implementations sum the same exact weights in different orders
+        return np.abs(x - y).max() <= 4e-16
+
+    assert close(p1.vertices[:n], r.vertices[:n])
+    assert close(p1.vertices[n + E_ :], r.vertices[n + E_ :])
+    cx = p.complex()
+    for e, h in enumerate(cx.edges):
+        a, b = cx.org[h], cx.dst(h)
+        ref = int(np.flatnonzero((q.edges[:, 0] == min(a, b)) & (q.edges[:, 1] == max(a, b)))[0])
+        assert close(p1.vertices[n + e], r.vertices[n + ref])
+    assert isinstance(q, QuadMesh) and F_ == 6
+
+
+def test_quad_reader_refuses_tags(refdir):
+    from ccproof.mesh import read_obj
+
+    with pytest.raises(MeshError, match=r"catmark_cube_creases0.obj:\d+: OpenSubdiv tag 'crease'"):
+        read_obj(refdir / "osd_features" / "meshes" / "catmark_cube_creases0.obj")
