@@ -43,6 +43,12 @@ def add_arguments(parser):
         help="exponent of F^alpha for --parameterization vanishing (must exceed -log 2 / log lam of every "
         "extraordinary valence; default: twice that bound, per valence)",
     )
+    from ccproof.scale.engine import add_scheduler_arguments
+
+    add_scheduler_arguments(parser)
+    parser.add_argument("--chunk", type=int, default=1_000_000, metavar="M",
+                        help="points per task (default 1000000); --out FOLDER writes one .npz shard per chunk and "
+                        "--points FOLDER reads one (docs/scale-out.md)")
 
 
 def run(args) -> int:
@@ -55,25 +61,31 @@ def run(args) -> int:
     mesh = read_obj(args.mesh)
     surface = limit_surface(mesh, alpha=args.alpha)
     t1 = time.perf_counter()
-    if args.points is not None:
-        f, u, v = read_points(args.points)
+    from pathlib import Path
+
+    from ccproof.scale import evaluate_points, point_chunks, scheduler_from_args, ship
+
+    if args.points is not None and Path(args.points).is_dir():
+        sources = point_chunks(args.chunk, shards=args.points)
+    elif args.points is not None:
+        sources = point_chunks(args.chunk, arrays=read_points(args.points))
     else:
         if args.samples < 0:
             raise CCProofError(f"--samples must be >= 0, got {args.samples}")
-        rng = np.random.default_rng(args.seed)
-        f = rng.integers(0, mesh.n_faces, args.samples)
-        u, v = rng.random(args.samples), rng.random(args.samples)
+        sources = point_chunks(args.chunk, samples=args.samples, seed=args.seed, n_faces=mesh.n_faces)
     t2 = time.perf_counter()
-    out = surface.evaluate(f, u, v, derivatives=args.derivatives, parameterization=args.parameterization)
+    n, names, _ = evaluate_points(ship(limit_surface, mesh, alpha=args.alpha), sources, args.derivatives,
+                                  {"parameterization": args.parameterization}, args.out, scheduler_from_args(args),
+                                  local=surface)
     t3 = time.perf_counter()
-    np.savez(args.out, face=f, u=u, v=v, **out)
+    out = dict.fromkeys(names)
     print(
         f"{args.mesh}: {mesh.n_vertices} vertices, {mesh.n_faces} faces, "
         f"{mesh.extraordinary_vertices.size} extraordinary vertices; prepared in {t1 - t0:.2f} s"
     )
-    rate = f.size / (t3 - t2) if t3 > t2 and f.size else float("nan")
+    rate = n / (t3 - t2) if t3 > t2 and n else float("nan")
     print(
-        f"evaluated {f.size} points ({args.parameterization} parameterization, derivatives {args.derivatives}) "
+        f"evaluated {n} points ({args.parameterization} parameterization, derivatives {args.derivatives}) "
         f"in {t3 - t2:.3f} s ({rate:,.0f} points/s)"
     )
     print(f"wrote {args.out}: {', '.join(['face', 'u', 'v', *out])}")
