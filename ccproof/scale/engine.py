@@ -260,25 +260,35 @@ def run_tasks(fn, tasks, scheduler=None, *, shared=(), retries=2, deterministic=
                 futs[key] = client.submit(call, tasks[i], *shared_f, key=key, retries=retries, pure=False,
                                           priority=0 if priority is None else int(priority[i]))
             done = as_completed(list(futs.values()))
+            bar = None
             if progress:
                 from tqdm import tqdm
 
-                done = tqdm(done, total=len(futs), desc=desc, unit=unit)
-            for fut in done:
-                i = index[fut.key]
-                try:
-                    outcomes[i] = fut.result()
-                except Exception as exc:  # retries exhausted, or KilledWorker: reported, not dropped
-                    outcomes[i] = (False, exc)
-            info = client.run_on_scheduler(_retry_info, list(futs), retries)
-            for key, (used, lost) in info.items():
-                what = []
-                if lost:
-                    what.append(f"its worker was lost {lost} time(s); re-run on another worker")
-                if used > 0:
-                    what.append(f"raised an exception {used} time(s); retried")
-                if what:
-                    sweep.retried[index[key]] = "; ".join(what)
+                bar = tqdm(total=len(futs), desc=desc, unit=unit)
+            for batch in done.batches():
+                for fut in batch:
+                    i = index[fut.key]
+                    try:
+                        outcomes[i] = fut.result()
+                    except Exception as exc:  # retries exhausted, or KilledWorker: reported, not dropped
+                        outcomes[i] = (False, exc)
+                # how each finished task got there, asked before it is released (a released result is not
+                # recomputed when a worker that held it dies later)
+                info = client.run_on_scheduler(_retry_info, [f.key for f in batch], retries)
+                for key, (used, lost) in info.items():
+                    what = []
+                    if lost:
+                        what.append(f"its worker was lost {lost} time(s); re-run on another worker")
+                    if used > 0:
+                        what.append(f"raised an exception {used} time(s); retried")
+                    if what:
+                        sweep.retried[index[key]] = "; ".join(what)
+                for fut in batch:
+                    futs.pop(fut.key).release()
+                if bar is not None:
+                    bar.update(len(batch))
+            if bar is not None:
+                bar.close()
             del futs, shared_f
     for i, (ok, value) in outcomes.items():
         if ok:
