@@ -199,8 +199,9 @@ def test_a_killed_worker_loses_no_task(cluster, tmp_path, capsys):
     sweep = run_tasks(_slow_square_kill_once, range(10), cluster[1], shared=[str(tmp_path)], progress=False)
     assert (tmp_path / "killed").exists()
     assert sweep.results == [i * i for i in range(10)]
-    # task 3 died with its worker; a task queued on that worker may be re-assigned too, finished ones are not
-    assert 3 in sweep.retried and len(sweep.retried) <= 2, sweep.retried
+    # task 3 died with its worker; the tasks the scheduler had already assigned to that worker are re-run
+    # elsewhere too and reported the same way (how many depends on dask's queueing)
+    assert 3 in sweep.retried, sweep.retried
     assert all("worker was lost 1 time(s)" in what for what in sweep.retried.values())
     assert "task(s) retried; every result is in" in sweep.report()[0]
     assert time.perf_counter() - t0 < 60
