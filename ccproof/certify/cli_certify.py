@@ -30,6 +30,11 @@ def add_arguments(p):
     add_scheduler_arguments(p)
     p.add_argument("--out", default=None, help="folder for the certificates (default certificates/injectivity)")
     p.add_argument("--no-verify", action="store_true", help="do not re-check the written certificate")
+    p.add_argument("--truncation-degree", type=int, default=2,
+                   help="for '>=K0': zeta degree kept in the cell Taylor models (default 2)")
+    p.add_argument("--max-pieces", type=int, default=16,
+                   help="for '>=K0': most lam pieces of the bisection (default 16); the pieces of each bisection "
+                        "wave run as tasks on --scheduler")
 
 
 def parse_valences(text):
@@ -80,7 +85,11 @@ def _run_interval(k, args):
     from ccproof.certify.prover import certificate_path, claimed_margins, prove_interval, write_certificate
 
     t0 = time.perf_counter()
-    cert = prove_interval(k, prec=args.prec)
+    from ccproof.scale.engine import scheduler_from_args
+
+    sched = scheduler_from_args(args)
+    cert = prove_interval(k, prec=args.prec, truncation_degree=args.truncation_degree, max_pieces=args.max_pieces,
+                          scheduler=None if sched.kind == "serial" else sched)
     seconds = time.perf_counter() - t0
     path = write_certificate(cert, certificate_path(k, args.out))
     summary, boxes = claimed_margins(cert)

@@ -4,7 +4,8 @@
   ccproof verify --all            every published certificate (certificates/c1/ and certificates/injectivity/),
                                   then the valence coverage of each statement: both the C1 and the
                                   injectivity (Appendix A) certificates must cover every k >= 3
-                                  exactly once (k = 3..k0-1 one by one, k >= k0 in one certificate)
+                                  (k = 3..k0-1 one by one, each once; interval certificates k >= k0
+                                  may overlap each other and single valences)
   ccproof verify --all            runs on a local Dask cluster (one worker per core) by default;
   ccproof verify --all --serial   in this process; --scheduler local:2 | tcp://host:8786 elsewhere
                                   (the workers read the files: a remote cluster needs them on a shared
