@@ -59,11 +59,14 @@ def run(args) -> int:
 
     t0 = time.perf_counter()
     mesh = read_obj(args.mesh)
-    surface = limit_surface(mesh, alpha=args.alpha)
-    t1 = time.perf_counter()
     from pathlib import Path
 
-    from ccproof.scale import evaluate_points, point_chunks, scheduler_from_args, ship
+    from ccproof.scale import evaluate_points, open_scheduler, point_chunks, scheduler_from_args, ship
+
+    sched = scheduler_from_args(args)
+    # on a cluster each worker builds the surface itself (once); here only for in-process work or --plot
+    surface = limit_surface(mesh, alpha=args.alpha) if sched.kind == "serial" or args.plot else None
+    t1 = time.perf_counter()
 
     if args.points is not None and Path(args.points).is_dir():
         sources = point_chunks(args.chunk, shards=args.points)
@@ -74,9 +77,11 @@ def run(args) -> int:
             raise CCProofError(f"--samples must be >= 0, got {args.samples}")
         sources = point_chunks(args.chunk, samples=args.samples, seed=args.seed, n_faces=mesh.n_faces)
     t2 = time.perf_counter()
-    n, names, _ = evaluate_points(ship(limit_surface, mesh, alpha=args.alpha), sources, args.derivatives,
-                                  {"parameterization": args.parameterization}, args.out, scheduler_from_args(args),
-                                  local=surface)
+    with open_scheduler(sched, len(sources)) as sched:
+        if surface is None and sched.__class__.__name__ == "Scheduler":  # a single chunk runs here after all
+            surface = limit_surface(mesh, alpha=args.alpha)
+        n, names, _ = evaluate_points(ship(limit_surface, mesh, alpha=args.alpha), sources, args.derivatives,
+                                      {"parameterization": args.parameterization}, args.out, sched, local=surface)
     t3 = time.perf_counter()
     out = dict.fromkeys(names)
     print(
