@@ -3,7 +3,9 @@
   ccproof certify 5             prove valence 5, print the certified margins, write
                                 certificates/injectivity/k005.json, then re-check it with the verifier
   ccproof certify 7 --out DIR   write the certificate to DIR/k007.json instead
-  ccproof certify 3-39 --jobs 2 all valences 3..39 in parallel
+  ccproof certify 3-39          all valences 3..39 on a local Dask cluster (one worker per core)
+  ccproof certify 3-39 --serial  the same in this process; --scheduler local:2 or tcp://host:8786
+                                 for 2 local workers or a running Dask scheduler (docs/scale-out.md)
   ccproof certify 3-39 --c1      C1 certificates (Reif's criterion: spectrum, regular and injective
   ccproof certify '>=40' --c1    characteristic map) for valences 3..39 and for every k >= 40 at once
   ccproof certify '>=40'         the Appendix-A statement for every k >= 40 in one certificate: lam is a
@@ -29,10 +31,18 @@ def add_arguments(p):
     p.add_argument("--c1", action="store_true",
                    help="certify Reif's C1 criterion (regular, injective characteristic map) instead")
     p.add_argument("--prec", type=int, default=128, help="arb precision in bits (default 128)")
-    p.add_argument("--jobs", type=int, default=1, help="worker processes for a range (default 1)")
+    p.add_argument("--jobs", type=int, default=None, help="same as --scheduler local:JOBS (kept for old scripts)")
+    from ccproof.scale.engine import add_scheduler_arguments
+
+    add_scheduler_arguments(p)
     p.add_argument("--out", default=None,
                    help="folder for the new certificates (default: see above; certificates/injectivity in a checkout)")
     p.add_argument("--no-verify", action="store_true", help="do not re-check the written certificate")
+    p.add_argument("--truncation-degree", type=int, default=2,
+                   help="for '>=K0': zeta degree kept in the cell Taylor models (default 2)")
+    p.add_argument("--max-pieces", type=int, default=16,
+                   help="for '>=K0': most lam pieces of the bisection (default 16); the pieces of each bisection "
+                        "wave run as tasks on --scheduler")
 
 
 def parse_valences(text):
@@ -51,17 +61,16 @@ def parse_valences(text):
 
 
 def _one(args):
+    """One task of a sweep: prove a valence; returns the certificate (the caller writes it, so that a
+    remote worker needs no shared file system) and its timing."""
     k, prec, out, progress = args
     import time
 
-    from ccproof.certify.prover import certificate_path, claimed_margins, prove_valence, write_certificate
+    from ccproof.certify.prover import prove_valence
 
     t0 = time.perf_counter()
     cert = prove_valence(k, prec=prec, progress=progress)
-    seconds = round(time.perf_counter() - t0, 2)
-    path = write_certificate(cert, certificate_path(k, out))
-    summary, boxes = claimed_margins(cert)
-    return k, cert["N"], summary, {"boxes": boxes, "seconds": seconds}, str(path)
+    return cert, round(time.perf_counter() - t0, 2)
 
 
 def _run_c1(ks, args):
@@ -84,7 +93,11 @@ def _run_interval(k, args):
     from ccproof.certify.prover import certificate_path, claimed_margins, prove_interval, write_certificate
 
     t0 = time.perf_counter()
-    cert = prove_interval(k, prec=args.prec)
+    from ccproof.scale.engine import scheduler_from_args
+
+    sched = scheduler_from_args(args)
+    cert = prove_interval(k, prec=args.prec, truncation_degree=args.truncation_degree, max_pieces=args.max_pieces,
+                          scheduler=None if sched.kind == "serial" else sched)
     seconds = time.perf_counter() - t0
     path = write_certificate(cert, certificate_path(k, args.out))
     summary, boxes = claimed_margins(cert)
@@ -112,22 +125,40 @@ def run(args):
         return _run_c1(ks, args)
     if any(isinstance(k, str) for k in ks):
         return _run_interval(ks[0], args)
+    from ccproof.certify.prover import certificate_path, claimed_margins, write_certificate
+    from ccproof.scale.engine import open_scheduler, run_tasks, scheduler_from_args
+
     work = [(k, args.prec, args.out, len(ks) == 1) for k in ks]
-    if len(ks) > 1 and args.jobs > 1:
-        from concurrent.futures import ProcessPoolExecutor
+    names = [f"valence {k}" for k in ks]
+    with open_scheduler(scheduler_from_args(args), len(ks)) as sched:
+        sweep = run_tasks(_one, work, sched, desc="certify", unit="valence", priority=ks, names=names,
+                          raise_errors=False)
+        for line in sweep.report(names):
+            print(line)
+        ok_all = not sweep.errors
+        written = []
+        for k, res in zip(ks, sweep.results):
+            if res is None:
+                continue
+            cert, seconds = res
+            path = write_certificate(cert, certificate_path(k, args.out))
+            summary, boxes = claimed_margins(cert)
+            print(f"valence {k}: N = {cert['N']}, {boxes} boxes, {seconds} s")
+            _print_summary(summary)
+            print(f"  certificate written to {path}")
+            written.append(path)
+        if not args.no_verify and written:
+            from ccproof.certify.cli_verify import _check
 
-        from tqdm import tqdm
-
-        with ProcessPoolExecutor(max_workers=args.jobs) as ex:
-            results = list(tqdm(ex.map(_one, work), total=len(work), desc="certify", unit="valence"))
-    else:
-        results = [_one(w) for w in work]
-    ok_all = True
-    for k, N, summary, stats, path in results:
-        print(f"valence {k}: N = {N}, {stats['boxes']} boxes, {stats['seconds']} s")
-        _print_summary(summary)
-        print(f"  certificate written to {path}")
-        ok_all &= _recheck(path, args)
+            check = run_tasks(_check, [(str(p), True) for p in written], sched, desc="verify", unit="file",
+                              names=[str(p) for p in written], raise_errors=False)
+            for line in check.report([str(p) for p in written]):
+                print(line)
+            for p, res in zip(written, check.results):
+                verdict = bool(res and res[0])
+                seconds = res[0].seconds if res else float("nan")
+                print(f"  independent verifier on {p}: {'VERIFIED' if verdict else 'FAILED'} ({seconds:.1f} s)")
+                ok_all &= verdict
     return 0 if ok_all else 1
 
 

@@ -4,8 +4,12 @@
   ccproof verify --all            every published certificate (certificates/c1/ and certificates/injectivity/),
                                   then the valence coverage of each statement: both the C1 and the
                                   injectivity (Appendix A) certificates must cover every k >= 3
-                                  exactly once (k = 3..k0-1 one by one, k >= k0 in one certificate)
-  ccproof verify --all --jobs 2   the same on 2 processes
+                                  (k = 3..k0-1 one by one, each once; interval certificates k >= k0
+                                  may overlap each other and single valences)
+  ccproof verify --all            runs on a local Dask cluster (one worker per core) by default;
+  ccproof verify --all --serial   in this process; --scheduler local:2 | tcp://host:8786 elsewhere
+                                  (the workers read the files: a remote cluster needs them on a shared
+                                  file system, docs/scale-out.md)
 
 The verifier (ccproof/certify/verify/, listed in docs/trusted_base.md) imports nothing from the prover
 and reads no table: it derives each statement (c, lam, the eigenvector, the nets, the spectrum and every
@@ -21,7 +25,10 @@ from __future__ import annotations
 def add_arguments(p):
     p.add_argument("files", nargs="*", help="certificate files")
     p.add_argument("--all", action="store_true", help="verify every published certificate and the coverage")
-    p.add_argument("--jobs", type=int, default=1, help="worker processes (default 1)")
+    p.add_argument("--jobs", type=int, default=None, help="same as --scheduler local:JOBS (kept for old scripts)")
+    from ccproof.scale.engine import add_scheduler_arguments
+
+    add_scheduler_arguments(p)
     p.add_argument("--quiet", action="store_true", help="print only the VERIFIED/FAILED line per file")
 
 
@@ -48,24 +55,25 @@ def run(args):
         files += certificate_files(certificates_dir())
     if not files:
         raise CCProofError("give certificate files or --all")
-    work = [(f, args.quiet) for f in files]
-    if args.jobs > 1 and len(files) > 1:
-        from concurrent.futures import ProcessPoolExecutor
+    from ccproof.certify.verify import VerifyResult
+    from ccproof.scale.engine import run_tasks, scheduler_from_args
 
-        # longest first (the k >= k0 certificates), so the two workers finish together
-        order = sorted(range(len(work)), key=lambda i: -work[i][0].stat().st_size if work[i][0].exists() else 0)
-        with ProcessPoolExecutor(max_workers=args.jobs) as ex:
-            done = dict(zip(order, ex.map(_check, [work[i] for i in order])))
-        outcome = [done[i] for i in range(len(work))]
-        for _, lines in outcome:
+    work = [(str(f), args.quiet) for f in files]
+    # longest first (the k >= k0 certificates), so that the workers finish together
+    size = [f.stat().st_size if f.is_file() else 0 for f in files]
+    sweep = run_tasks(_check, work, scheduler_from_args(args), desc="verify", unit="file", priority=size,
+                      names=[str(f) for f in files], raise_errors=False)
+    results = []
+    for f, out in zip(files, sweep.results):
+        if out is None:  # the task itself failed (after its retries): reported, counted as FAILED
+            res = VerifyResult(path=str(f), error=f"not checked: {sweep.errors[len(results)]!r}")
+            print(f"FAILED {f}: {res.error}")
+        else:
+            res, lines = out
             print("\n".join(lines))
-    else:
-        outcome = []
-        for w in work:
-            res, lines = _check(w)
-            print("\n".join(lines))
-            outcome.append((res, lines))
-    results = [r for r, _ in outcome]
+        results.append(res)
+    for line in sweep.report([str(f) for f in files]):
+        print(line)
     bad = [r for r in results if not r]
     print(f"{len(results) - len(bad)} of {len(results)} certificates verified" + (
         "" if not bad else "; failed: " + ", ".join(str(r.path) for r in bad)))

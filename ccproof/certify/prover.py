@@ -176,13 +176,60 @@ def _prove_piece(exact, La, Lb, N, degree, trunc, prec, progress, label):
     return {"regularity": regularity, "cells": cells, "corner": corner}
 
 
-def prove_interval(k0, prec=DEFAULT_PREC, progress=True, taylor_degree=3, truncation_degree=2, max_pieces=16):
+def _piece_task(task):
+    """One lam piece as an independent task (for :func:`prove_interval` on a scheduler)."""
+    a, b, N, taylor_degree, truncation_degree, prec, label = task
+    exact = derivation().integer_forms("bspline")
+    return _prove_piece(exact, parse_decimal(a), parse_decimal(b), N, taylor_degree, truncation_degree, prec,
+                        False, label)
+
+
+def _pieces_in_waves(k0, ends, N, taylor_degree, truncation_degree, prec, max_pieces, scheduler, piece=_piece_task):
+    """The pieces of the serial bisection below, found wave by wave: every pending piece is one task, the
+    failed ones are bisected into the next wave. The successful pieces (the leaves of the same bisection
+    tree) are returned in lam order, as the serial depth-first search appends them."""
+    from ccproof.scale.engine import open_scheduler
+
+    with open_scheduler(scheduler) as sched:
+        return _waves(k0, ends, N, taylor_degree, truncation_degree, prec, max_pieces, sched, piece)
+
+
+def _waves(k0, ends, N, taylor_degree, truncation_degree, prec, max_pieces, scheduler, piece):
+    from ccproof.scale.engine import run_tasks
+
+    todo, pieces = [(ends[0], ends[1])], []
+    while todo:
+        tasks = [(a, b, N, taylor_degree, truncation_degree, prec, f"k>={k0} lam in [{a}, {b}]") for a, b in todo]
+        sweep = run_tasks(piece, tasks, scheduler, desc=f"k>={k0} lam pieces", unit="piece", raise_errors=False,
+                          retries=2, deterministic=(ProofFailed,), names=[t[-1] for t in tasks])
+        failed = []
+        for (a, b), parts in zip(todo, sweep.results):
+            if parts is not None:
+                pieces.append({"lam": [a, b], "parts": parts})
+        for i, exc in sorted(sweep.errors.items()):
+            if not isinstance(exc, ProofFailed):
+                raise exc
+            failed.append((todo[i], exc))
+        if failed and len(pieces) + 2 * len(failed) > max_pieces:
+            raise failed[0][1]
+        todo = []
+        for (a, b), _ in failed:
+            mid = _decimal_str((parse_decimal(a) + parse_decimal(b)) / 2, up=False)
+            todo += [(a, mid), (mid, b)]
+    pieces.sort(key=lambda p: parse_decimal(p["lam"][0]))
+    return pieces
+
+
+def prove_interval(k0, prec=DEFAULT_PREC, progress=True, taylor_degree=3, truncation_degree=2, max_pieces=16,
+                   scheduler=None):
     """Appendix-A certificate for every valence k >= k0 at once (docs/appendix_a.md section 6).
 
     lam runs over [La, Lb] with La <= lam(k0) and Lb >= (3 + sqrt 5)/8; the nets are Taylor models in
     zeta (lam = mid + zeta * half-width) built from the derived exact forms, so part D keeps the
     correlation between control points (an interval hull of the nets does not: its coefficients are
     ~0.02 wide against cell margins of ~4e-4). A piece that fails is bisected (up to ``max_pieces``).
+    ``scheduler`` (a :func:`ccproof.scale.engine.parse_scheduler` spec or a Client): run the pieces of each
+    bisection wave as tasks there; None keeps the serial search. Both give the same certificate.
     """
     k = _parse_k(f">={k0}" if isinstance(k0, int) else k0)
     exact = derivation().integer_forms("bspline")
@@ -191,8 +238,9 @@ def prove_interval(k0, prec=DEFAULT_PREC, progress=True, taylor_degree=3, trunca
         La, Lb = parse_decimal(ends[0]), parse_decimal(ends[1])
         N = smallest_level(hull_nets(parameter_nets(exact, La, Lb, 0, taylor_degree, prec), prec),
                            arb(La).union(arb(Lb)))
-    todo = [(ends[0], ends[1])]
-    pieces = []
+    todo = [(ends[0], ends[1])] if scheduler is None else []
+    pieces = [] if scheduler is None else _pieces_in_waves(
+        k["min"], ends, N, taylor_degree, truncation_degree, prec, max_pieces, scheduler)
     while todo:
         a, b = todo.pop(0)
         label = f"k>={k['min']} lam in [{a}, {b}]"

@@ -44,14 +44,35 @@ def add_arguments(parser):
         help="exponent of F^alpha for --parameterization vanishing (must exceed -log 2 / log lam of every "
         "extraordinary valence; default: twice that bound, per valence)",
     )
+    from ccproof.scale.engine import add_scheduler_arguments
+
+    add_scheduler_arguments(parser)
+    parser.add_argument("--chunk", type=int, default=1_000_000, metavar="M",
+                        help="points per task (default 1000000); --out FOLDER writes one .npz shard per chunk and "
+                        "--points FOLDER reads one (docs/scale-out.md)")
+
+
+def build_surface(mesh, tagged, alpha=None):
+    """The surface ``ccproof eval`` evaluates (module level, so a Dask worker can rebuild it by name):
+    the tagged evaluator's natural parameterization for a tagged or non-quad :class:`PolyMesh`, else the
+    reparameterizable surface of an all-quad :class:`QuadMesh`."""
+    if tagged:
+        from ccproof.evaluate import limit_surface as natural_surface
+
+        return natural_surface(mesh)
+    from ccproof.reparam.surface import limit_surface
+
+    return limit_surface(mesh, alpha=alpha)
 
 
 def run(args) -> int:
+    from pathlib import Path
+
     import numpy as np
 
     from ccproof.mesh import QuadMesh
     from ccproof.mesh.io import read_mesh
-    from ccproof.reparam.surface import limit_surface
+    from ccproof.scale import evaluate_points, open_scheduler, point_chunks, scheduler_from_args, ship
 
     t0 = time.perf_counter()
     poly = read_mesh(args.mesh)  # OBJ with OpenSubdiv tags, or any meshio format
@@ -59,8 +80,6 @@ def run(args) -> int:
     if tagged:
         # triangles, n-gons, creases, corners, holes, boundary modes: the natural parameterization
         # of the tagged evaluator, by ptex face (equal to the face index on all-quad meshes)
-        from ccproof.evaluate import limit_surface as natural_surface
-
         if args.parameterization != "natural":
             raise CCProofError(
                 f"{args.mesh}: the {args.parameterization} parameterization needs an untagged all-quad mesh "
@@ -68,27 +87,31 @@ def run(args) -> int:
             )
         if args.plot:
             raise CCProofError(f"{args.mesh}: --plot needs an untagged all-quad mesh")
-        mesh = poly
-        natural = natural_surface(poly)
+        mesh, n_faces, kwargs = poly, poly.n_ptex, {}
     else:
         mesh = QuadMesh(poly.vertices, np.array(poly.polygons, dtype=np.int64).reshape(-1, 4))
-        surface = limit_surface(mesh, alpha=args.alpha)
+        n_faces, kwargs = mesh.n_faces, {"parameterization": args.parameterization}
+    sched = scheduler_from_args(args)
+    # on a cluster each worker builds the surface itself (once); here only for in-process work or --plot
+    surface = build_surface(mesh, tagged, args.alpha) if sched.kind == "serial" or args.plot else None
     t1 = time.perf_counter()
-    if args.points is not None:
-        f, u, v = read_points(args.points)
+
+    if args.points is not None and Path(args.points).is_dir():
+        sources = point_chunks(args.chunk, shards=args.points)
+    elif args.points is not None:
+        sources = point_chunks(args.chunk, arrays=read_points(args.points))
     else:
         if args.samples < 0:
             raise CCProofError(f"--samples must be >= 0, got {args.samples}")
-        rng = np.random.default_rng(args.seed)
-        f = rng.integers(0, natural.n_faces if tagged else mesh.n_faces, args.samples)
-        u, v = rng.random(args.samples), rng.random(args.samples)
+        sources = point_chunks(args.chunk, samples=args.samples, seed=args.seed, n_faces=n_faces)
     t2 = time.perf_counter()
-    if tagged:
-        out = natural.evaluate(f, u, v, derivatives=args.derivatives)
-    else:
-        out = surface.evaluate(f, u, v, derivatives=args.derivatives, parameterization=args.parameterization)
+    with open_scheduler(sched, len(sources)) as sched:
+        if surface is None and sched.__class__.__name__ == "Scheduler":  # a single chunk runs here after all
+            surface = build_surface(mesh, tagged, args.alpha)
+        n, names, _ = evaluate_points(ship(build_surface, mesh, tagged, args.alpha), sources, args.derivatives,
+                                      kwargs, args.out, sched, local=surface)
     t3 = time.perf_counter()
-    np.savez(args.out, face=f, u=u, v=v, **out)
+    out = dict.fromkeys(names)
     if tagged:
         print(f"{args.mesh}: {mesh}; prepared in {t1 - t0:.2f} s")
     else:
@@ -96,9 +119,9 @@ def run(args) -> int:
             f"{args.mesh}: {mesh.n_vertices} vertices, {mesh.n_faces} faces, "
             f"{mesh.extraordinary_vertices.size} extraordinary vertices; prepared in {t1 - t0:.2f} s"
         )
-    rate = f.size / (t3 - t2) if t3 > t2 and f.size else float("nan")
+    rate = n / (t3 - t2) if t3 > t2 and n else float("nan")
     print(
-        f"evaluated {f.size} points ({args.parameterization} parameterization, derivatives {args.derivatives}) "
+        f"evaluated {n} points ({args.parameterization} parameterization, derivatives {args.derivatives}) "
         f"in {t3 - t2:.3f} s ({rate:,.0f} points/s)"
     )
     print(f"wrote {args.out}: {', '.join(['face', 'u', 'v', *out])}")

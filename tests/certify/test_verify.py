@@ -162,7 +162,10 @@ def test_c1_certificates_cover_every_valence_once():
     ok, msg = V.check_coverage(vals)
     assert ok, msg
     assert not V.check_coverage([v for v in vals if v != 17])[0]  # gap
-    assert not V.check_coverage(vals + [45])[0]  # overlap with k >= 40
+    assert not V.check_coverage(vals + [17])[0]  # a single valence twice
+    assert V.check_coverage(vals + [45])[0]  # overlaps with an interval are accepted (proved twice)
+    assert V.check_coverage(vals + [{"min": 30}])[0]  # ... and so are overlapping intervals
+    assert not V.check_coverage([v for v in vals if v != 35] + [{"min": 36}])[0]  # 35 is now missing
     assert not V.check_coverage([v for v in vals if isinstance(v, int)])[0]  # no tail
 
 

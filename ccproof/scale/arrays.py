@@ -1,0 +1,257 @@
+"""Chunk-wise evaluation of a limit surface and point sets kept as a folder of ``.npz`` shards.
+
+The surface is never imported here: it comes as a :class:`~ccproof.scale.shipping.Shipped` builder
+call (e.g. ``ship(limit_surface, mesh)``) and only its ``evaluate(face, u, v, derivatives=..., **kw)``
+is called, on each chunk, with the same numpy arrays the serial evaluation would see; the chunk
+results are concatenated, so a chunked or distributed evaluation is bit-identical to one call on
+all points (each point is evaluated independently of the others).
+
+Shard folder (``ccproof eval --out FOLDER``): ``index.json`` ({"format": "ccproof.shards/1", "n": total
+points, "arrays": names, "shards": [{"file": "part-00000.npz", "n": points}, ...]}) and one
+``part-NNNNN.npz`` per chunk holding ``face`` (int64, (m,)), ``u``, ``v`` (float64, (m,)) and each
+result array (float64, (m, 3)), in point order.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from ccproof.errors import CCProofError
+
+from .shipping import rebuild
+
+SHARDS_FORMAT = "ccproof.shards/1"
+_KEYS = {0: ("P",), 1: ("P", "Pu", "Pv"), 2: ("P", "Pu", "Pv", "Puu", "Puv", "Pvv")}
+
+
+def output_names(derivatives):
+    """The result arrays for a derivative order: P; Pu, Pv; Puu, Puv, Pvv."""
+    if derivatives not in _KEYS:
+        raise CCProofError(f"derivatives must be 0, 1 or 2, got {derivatives!r}")
+    return _KEYS[derivatives]
+
+
+def _evaluate_block(face, u, v, shipped, derivatives, kwargs):
+    """(on a worker) evaluate one chunk; returns shape (m, n_outputs, 3)."""
+    import numpy as np
+
+    out = rebuild(shipped).evaluate(face, u, v, derivatives=derivatives, **dict(kwargs))
+    return np.stack([np.asarray(out[n], dtype=np.float64) for n in output_names(derivatives)], axis=1)
+
+
+def evaluate_dask(shipped, face, u, v, derivatives=1, **kwargs):
+    """Evaluate the shipped surface at dask arrays of points, one task per chunk (``map_blocks``).
+
+    Parameters
+    ----------
+    shipped : Shipped
+        ``ship(limit_surface, mesh, ...)``: sent once per worker, built once per worker process.
+    face : dask or numpy array of int, shape (n,)
+    u, v : dask or numpy arrays of float, shape (n,)
+        Rechunked to the chunks of ``face``.
+    derivatives : int
+    **kwargs
+        Passed to ``evaluate`` (e.g. ``parameterization="characteristic"``).
+
+    Returns
+    -------
+    dict of str -> dask array of shape (n, 3)
+        ``P`` (and ``Pu``, ``Pv``; ``Puu``, ``Puv``, ``Pvv``), lazy; equal to the bit to
+        ``surface.evaluate(face, u, v)`` on the same points.
+    """
+    import dask
+    import dask.array as da
+    import numpy as np
+
+    face = da.asarray(face)
+    u = da.asarray(u).rechunk(face.chunks)
+    v = da.asarray(v).rechunk(face.chunks)
+    if face.ndim != 1 or u.shape != face.shape or v.shape != face.shape:
+        raise CCProofError(f"face, u, v must be 1-D arrays of one length, got shapes {face.shape}, {u.shape}, "
+                           f"{v.shape}")
+    names = output_names(derivatives)
+    ref = dask.delayed(shipped, pure=True, traverse=False)
+    arr = da.map_blocks(_evaluate_block, face, u, v, ref, derivatives, tuple(sorted(kwargs.items())),
+                        new_axis=[1, 2], chunks=(face.chunks[0], (len(names),), (3,)), dtype=np.float64,
+                        meta=np.empty((0, len(names), 3)), name=f"evaluate-{shipped.digest[:12]}")
+    return {n: arr[:, j, :] for j, n in enumerate(names)}
+
+
+# ---------------------------------------------------------------- chunks of a point set
+
+
+def sample_chunk(seed, n_faces, count, index):
+    """Random points of chunk ``index``: uniform face and (u, v), from ``default_rng(seed)`` for chunk 0
+    (so one chunk equals the unchunked draw ``f = integers(0, n_faces, count); u = random(count);
+    v = random(count)``) and ``default_rng([seed, index])`` for the others."""
+    import numpy as np
+
+    rng = np.random.default_rng(seed if index == 0 else [seed, index])
+    return rng.integers(0, n_faces, count), rng.random(count), rng.random(count)
+
+
+def chunk_points(source):
+    """The (face, u, v) numpy arrays of one chunk description (see :func:`evaluate_chunk`)."""
+    import numpy as np
+
+    kind = source[0]
+    if kind == "samples":
+        return sample_chunk(*source[1:])
+    if kind == "arrays":
+        return tuple(np.asarray(a) for a in source[1:])
+    if kind == "shard":
+        with np.load(source[1]) as z:
+            return z["face"], z["u"], z["v"]
+    raise CCProofError(f"unknown chunk source {kind!r}")
+
+
+def evaluate_chunk(task, shipped):
+    """One task of ``ccproof eval``: evaluate a chunk of points and write its shard (or return it).
+
+    ``task`` is ``{"source": ("samples", seed, n_faces, count, index) | ("arrays", face, u, v) |
+    ("shard", path), "derivatives": d, "kwargs": {...}, "out": path or None}``; returns the number of
+    points written, or the dict face, u, v, P, ... when ``out`` is None.
+    """
+    import numpy as np
+
+    f, u, v = chunk_points(task["source"])
+    res = _evaluate_block(f, u, v, shipped, task["derivatives"], tuple(sorted(task["kwargs"].items())))
+    arrays = {"face": f, "u": u, "v": v}
+    arrays.update({n: res[:, j, :] for j, n in enumerate(output_names(task["derivatives"]))})
+    if task["out"] is None:
+        return arrays
+    np.savez(task["out"], **arrays)
+    return int(f.size)
+
+
+def shard_name(i):
+    return f"part-{i:05d}.npz"
+
+
+def write_index(folder, sizes, names):
+    """Write ``index.json`` of a shard folder (``sizes``: points per shard, in order)."""
+    folder = Path(folder)
+    idx = {"format": SHARDS_FORMAT, "n": int(sum(sizes)), "arrays": list(names),
+           "shards": [{"file": shard_name(i), "n": int(m)} for i, m in enumerate(sizes)]}
+    (folder / "index.json").write_text(json.dumps(idx, indent=1) + "\n", encoding="utf-8")
+
+
+def shard_index(folder):
+    """The parsed ``index.json`` of a shard folder, checked (names the folder and the field)."""
+    folder = Path(folder)
+    try:
+        idx = json.loads((folder / "index.json").read_text(encoding="utf-8"))
+    except (OSError, ValueError) as exc:
+        raise CCProofError(f"{folder}: not a shard folder (index.json: {exc})") from None
+    if not isinstance(idx, dict) or idx.get("format") != SHARDS_FORMAT:
+        raise CCProofError(f"{folder}/index.json: field 'format' must be {SHARDS_FORMAT!r}")
+    for j, s in enumerate(idx.get("shards", [])):
+        if not isinstance(s, dict) or not isinstance(s.get("n"), int) or not isinstance(s.get("file"), str):
+            raise CCProofError(f"{folder}/index.json: shards[{j}] needs 'file' (str) and 'n' (int)")
+        if not (folder / s["file"]).is_file():
+            raise CCProofError(f"{folder}: shard {s['file']} listed in index.json is missing")
+    return idx
+
+
+def write_shards(folder, arrays):
+    """Write a dict of equally chunked dask (or numpy) arrays of length n as a shard folder.
+
+    Each chunk of the first array's chunking becomes one ``part-NNNNN.npz``; returns the folder.
+    """
+    import dask
+    import dask.array as da
+    import numpy as np
+
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    names = list(arrays)
+    first = da.asarray(arrays[names[0]])
+    chunks = first.chunks[0]
+    arrs = {n: da.asarray(a).rechunk({0: chunks}) for n, a in arrays.items()}
+
+    def save(path, *blocks):
+        np.savez(path, **dict(zip(names, blocks)))
+        return blocks[0].shape[0]
+
+    writes = [dask.delayed(save)(str(folder / shard_name(i)), *[arrs[n].blocks[i] for n in names])
+              for i in range(len(chunks))]
+    sizes = dask.compute(*writes)
+    write_index(folder, sizes, names)
+    return folder
+
+
+def read_shards(folder):
+    """The arrays of a shard folder as dask arrays (one chunk per shard), name -> array."""
+    import dask
+    import dask.array as da
+    import numpy as np
+
+    folder = Path(folder)
+    idx = shard_index(folder)
+    names = idx["arrays"]
+    with np.load(folder / idx["shards"][0]["file"]) as z:
+        protos = {n: z[n] for n in names}
+
+    def load(path, name):
+        with np.load(path) as z:
+            return z[name]
+
+    out = {}
+    for n in names:
+        parts = [da.from_delayed(dask.delayed(load)(str(folder / s["file"]), n),
+                                 shape=(s["n"], *protos[n].shape[1:]), dtype=protos[n].dtype)
+                 for s in idx["shards"]]
+        out[n] = da.concatenate(parts) if parts else da.from_array(protos[n][:0])
+    return out
+
+
+def point_chunks(chunk, *, arrays=None, shards=None, samples=None, seed=0, n_faces=None):
+    """Chunk sources for :func:`evaluate_chunk` from in-memory arrays (face, u, v), a shard folder, or
+    ``samples`` random points (chunk i from :func:`sample_chunk`); ``chunk`` points per chunk."""
+    if chunk < 1:
+        raise CCProofError(f"--chunk must be >= 1, got {chunk}")
+    if shards is not None:
+        idx = shard_index(shards)
+        return [("shard", str(Path(shards) / s["file"])) for s in idx["shards"]]
+    if arrays is not None:
+        f, u, v = arrays
+        n = len(f)
+        return [("arrays", f[a:a + chunk], u[a:a + chunk], v[a:a + chunk]) for a in range(0, max(n, 1), chunk)]
+    if samples is None or samples < 0:
+        raise CCProofError(f"--samples must be >= 0, got {samples}")
+    return [("samples", seed, n_faces, min(chunk, samples - a), i)
+            for i, a in enumerate(range(0, max(samples, 1), chunk))]
+
+
+def evaluate_points(shipped, sources, derivatives, kwargs, out, scheduler=None, *, local=None, progress=True):
+    """Evaluate every chunk (one task each, see :func:`ccproof.scale.engine.run_tasks`) and write ``out``.
+
+    ``out`` ending in ``.npz`` gathers all points into one file (arrays face, u, v, P, ...); any other
+    path is a shard folder (one ``part-NNNNN.npz`` per chunk, written by the worker, and
+    ``index.json``), for point sets that do not fit in memory. ``local`` is the surface already built
+    in this process (used by in-process tasks instead of a rebuild). Returns (number of points,
+    result names, the :class:`~ccproof.scale.engine.Sweep`).
+    """
+    import numpy as np
+
+    from .engine import run_tasks
+
+    if local is not None:
+        rebuild(shipped, local=local)
+    names = output_names(derivatives)
+    folder = None if str(out).endswith(".npz") else Path(out)
+    if folder is not None:
+        folder.mkdir(parents=True, exist_ok=True)
+    tasks = [{"source": s, "derivatives": derivatives, "kwargs": dict(kwargs),
+              "out": None if folder is None else str(folder / shard_name(i))} for i, s in enumerate(sources)]
+    sweep = run_tasks(evaluate_chunk, tasks, scheduler, shared=[shipped], desc="evaluate", unit="chunk",
+                      progress=progress, names=[f"chunk {i}" for i in range(len(tasks))])
+    if folder is None:
+        arrays = {n: np.concatenate([r[n] for r in sweep.results]) for n in ("face", "u", "v", *names)}
+        np.savez(out, **arrays)
+        n = int(arrays["face"].size)
+    else:
+        write_index(folder, sweep.results, ("face", "u", "v", *names))
+        n = int(sum(sweep.results))
+    return n, names, sweep

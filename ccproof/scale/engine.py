@@ -1,0 +1,302 @@
+"""Run independent tasks in process or on a Dask cluster: one function, one scheduler spec.
+
+A *scheduler spec* is one of
+
+* ``"serial"`` (or ``"local:1"``): in this process, one task after the other, as without Dask;
+* ``"local"``: a :class:`distributed.LocalCluster` with one single-threaded worker process per core
+  (the default), or ``"local:N"`` with N worker processes;
+* an address such as ``"tcp://10.0.0.5:8786"``: a running ``dask scheduler`` (for example one started by
+  dask-jobqueue or ``dask ssh``, docs/scale-out.md);
+* a :class:`distributed.Client` already connected (it is used and left open).
+
+:func:`run_tasks` returns the results in the order of the tasks whatever the order in which they
+finish. An exception listed in ``deterministic`` (by default every :class:`ccproof.errors.CCProofError`,
+e.g. a proof that fails) is the task's outcome and is not retried; any other exception is retried up
+to ``retries`` times (Dask's ``retries=``), a task whose worker died is re-run on another worker by the
+scheduler, and both are reported in :attr:`Sweep.retried`. A task that still fails is reported in
+:attr:`Sweep.errors` and, by default, raises :class:`TaskFailed` once every other task has finished.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import time
+import uuid
+from dataclasses import dataclass, field
+from functools import partial
+
+from ccproof.errors import CCProofError
+
+MISSING_EXTRA = ("a Dask scheduler needs the optional extra 'scale': pip install 'ccproof[scale]' "
+                 "(or run with --serial / --scheduler local:1)")
+
+
+class TaskFailed(CCProofError):
+    """At least one task of a sweep failed after its retries; the message names each one."""
+
+
+def dask_available():
+    """True when ``dask.distributed`` can be imported (the optional extra ``scale``)."""
+    try:
+        import distributed  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+@dataclass(frozen=True)
+class Scheduler:
+    """A parsed scheduler spec: ``kind`` is "serial", "local" or "address"."""
+
+    kind: str
+    workers: int | None = None
+    address: str | None = None
+    implicit: bool = False  # the default, not asked for: falls back to serial without Dask
+
+    def __str__(self):
+        if self.kind == "local":
+            return f"local:{self.workers}"
+        return self.address if self.kind == "address" else "serial"
+
+
+def parse_scheduler(spec=None, *, serial=False):
+    """Parse ``"serial" | "local" | "local:N" | ADDRESS`` (None: "local", one worker per core).
+
+    >>> [str(parse_scheduler(s)) for s in ("local:3", "local:1", "serial", "tcp://h:8786")]
+    ['local:3', 'serial', 'serial', 'tcp://h:8786']
+    >>> parse_scheduler("local:0")
+    Traceback (most recent call last):
+    ...
+    ccproof.errors.CCProofError: --scheduler: local:N needs an integer N >= 1, got 'local:0'
+    """
+    if isinstance(spec, Scheduler):
+        return Scheduler("serial") if serial else spec
+    if serial:
+        return Scheduler("serial")
+    implicit = spec is None
+    text = "local" if spec is None else str(spec).strip()
+    if text in ("serial", ""):
+        return Scheduler("serial")
+    if text == "local":
+        return Scheduler("local", workers=max(1, os.cpu_count() or 1), implicit=implicit)
+    if text.startswith("local:"):
+        n = text[6:]
+        if not n.isdigit() or int(n) < 1:
+            raise CCProofError(f"--scheduler: local:N needs an integer N >= 1, got {text!r}")
+        return Scheduler("serial") if int(n) == 1 else Scheduler("local", workers=int(n))
+    if "://" in text or ":" in text:
+        return Scheduler("address", address=text)
+    raise CCProofError(f"--scheduler: expected serial, local, local:N or a scheduler address such as "
+                       f"tcp://host:8786, got {text!r}")
+
+
+def add_scheduler_arguments(p):
+    """Add ``--scheduler`` and ``--serial`` to an argparse parser."""
+    p.add_argument("--scheduler", default=None, metavar="local[:N]|ADDRESS",
+                   help="where the tasks run: local (default: a local Dask cluster with one worker process per "
+                        "core), local:N (N worker processes; local:1 runs in process) or the address of a "
+                        "running Dask scheduler (tcp://host:8786); needs the extra 'scale' (pip install "
+                        "'ccproof[scale]'), without it the default runs in process")
+    p.add_argument("--serial", action="store_true", help="run every task in this process (same as local:1)")
+
+
+def scheduler_from_args(args):
+    """The :class:`Scheduler` of parsed CLI arguments (``--serial``, ``--scheduler``, the older ``--jobs N``)."""
+    spec = getattr(args, "scheduler", None)
+    jobs = getattr(args, "jobs", None)
+    if spec is None and jobs is not None:
+        spec = f"local:{int(jobs)}" if int(jobs) >= 1 else None
+    return parse_scheduler(spec, serial=bool(getattr(args, "serial", False)))
+
+
+@contextlib.contextmanager
+def client_for(scheduler):
+    """A connected :class:`distributed.Client` for a local or address scheduler (closed on exit)."""
+    try:
+        from distributed import Client, LocalCluster
+    except ImportError:
+        raise CCProofError(MISSING_EXTRA) from None
+    if scheduler.__class__.__name__ == "Client":
+        yield scheduler
+        return
+    s = parse_scheduler(scheduler)
+    if s.kind == "local":
+        import logging
+
+        with LocalCluster(n_workers=s.workers, threads_per_worker=1, processes=True, dashboard_address=None,
+                          silence_logs=logging.ERROR) as cluster, Client(cluster) as client:
+            yield client
+    elif s.kind == "address":
+        with Client(s.address, timeout="30s") as client:
+            yield client
+    else:
+        raise CCProofError("client_for needs a local or address scheduler, not 'serial'")
+
+
+@contextlib.contextmanager
+def open_scheduler(scheduler=None, n_tasks=None):
+    """A scheduler kept open for several sweeps: yields a connected Client, or the serial
+    :class:`Scheduler` (for "serial", for a single local task, or for the default without Dask)."""
+    if scheduler.__class__.__name__ == "Client":
+        yield scheduler
+        return
+    s = parse_scheduler(scheduler)
+    if s.kind == "serial" or s.kind == "local" and n_tasks is not None and n_tasks <= 1 or (
+            s.implicit and not dask_available()):
+        yield Scheduler("serial")
+        return
+    with client_for(s) as client:
+        yield client
+
+
+@dataclass
+class Sweep:
+    """The outcome of :func:`run_tasks`: one entry of ``results`` per task, in task order.
+
+    ``errors`` maps a task index to the exception it ended with (its result is then None),
+    ``retried`` a task index to what happened to it (an exception retried, a worker lost under it).
+    """
+
+    results: list
+    errors: dict = field(default_factory=dict)
+    retried: dict = field(default_factory=dict)
+    scheduler: str = "serial"
+    seconds: float = 0.0
+
+    def report(self, names=None):
+        """Lines describing retries and failures (empty when every task succeeded at once)."""
+        name = (lambda i: names[i]) if names is not None else (lambda i: f"task {i}")
+        lines = [f"{name(i)}: {what}" for i, what in sorted(self.retried.items())]
+        if self.retried:
+            lines.insert(0, f"{len(self.retried)} task(s) retried; every result is in")
+        lines += [f"{name(i)}: FAILED: {type(e).__name__}: {e}" for i, e in sorted(self.errors.items())]
+        return lines
+
+
+def _call(fn, deterministic, task, *shared):
+    """Run one task; an expected (deterministic) exception becomes its outcome instead of a retry."""
+    try:
+        return True, fn(task, *shared)
+    except deterministic as exc:
+        return False, exc
+
+
+def _identity(x):
+    return x
+
+
+def _retry_info(keys, retries, dask_scheduler=None):
+    """(on the scheduler) key -> (exception retries used, times its worker was lost under it)."""
+    out = {}
+    for key in keys:
+        ts = dask_scheduler.tasks.get(key)
+        if ts is not None:
+            out[key] = (retries - (ts.retries or 0), int(ts.suspicious or 0))
+    return out
+
+
+def run_tasks(fn, tasks, scheduler=None, *, shared=(), retries=2, deterministic=(CCProofError,), desc="tasks",
+              unit="task", progress=True, priority=None, raise_errors=True, names=None):
+    """Map ``fn(task, *shared)`` over ``tasks`` on a scheduler; returns a :class:`Sweep`.
+
+    Parameters
+    ----------
+    fn : callable
+        A module-level function (it is pickled by reference for the workers).
+    tasks : sequence
+        Picklable task descriptions (a valence, a path, a chunk of points ...).
+    scheduler : str or Scheduler or distributed.Client or None
+        See :func:`parse_scheduler`; None is "local". A single task always runs in process.
+    shared : sequence
+        Objects every task needs (e.g. a :func:`~ccproof.scale.shipping.ship`-ped mesh): on a cluster each
+        is sent to the scheduler once and fetched once per worker, not with every task.
+    retries : int
+        How often a task that raised an exception not in ``deterministic`` is run again.
+    priority : sequence of int, optional
+        Higher runs first (e.g. the longest tasks first, so that the workers finish together).
+    raise_errors : bool
+        Raise :class:`TaskFailed` naming the failed tasks (after all others finished).
+    names : sequence of str, optional
+        A name per task for the report (default "task i").
+    """
+    tasks = list(tasks)
+    s = scheduler if scheduler.__class__.__name__ == "Client" else parse_scheduler(scheduler)
+    if isinstance(s, Scheduler) and (s.kind == "local" and len(tasks) <= 1
+                                     or s.implicit and not dask_available()):
+        s = Scheduler("serial")
+    call = partial(_call, fn, tuple(deterministic))
+    t0 = time.perf_counter()
+    sweep = Sweep(results=[None] * len(tasks), scheduler=str(s) if isinstance(s, Scheduler) else "client")
+    outcomes = {}
+    if isinstance(s, Scheduler) and s.kind == "serial":
+        it = range(len(tasks))
+        if progress and len(tasks) > 1:
+            from tqdm import tqdm
+
+            it = tqdm(it, desc=desc, unit=unit)
+        for i in it:
+            for attempt in range(retries + 1):
+                try:
+                    outcomes[i] = call(tasks[i], *shared)
+                    break
+                except Exception as exc:  # an unexpected error: retried like on a cluster
+                    if attempt == retries:
+                        outcomes[i] = (False, exc)
+                    else:
+                        sweep.retried[i] = f"raised {type(exc).__name__}: {exc}; retried"
+    else:
+        with client_for(s) as client:
+            from distributed import as_completed
+
+            run = uuid.uuid4().hex[:8]
+            shared_f = [client.submit(_identity, obj, key=f"shared-{getattr(obj, 'digest', uuid.uuid4().hex)[:16]}",
+                                      pure=False) for obj in shared]
+            order = range(len(tasks)) if priority is None else sorted(range(len(tasks)), key=lambda i: -priority[i])
+            futs, index = {}, {}
+            for i in order:
+                key = f"{desc.replace(' ', '_')}-{i}-{run}"
+                index[key] = i
+                futs[key] = client.submit(call, tasks[i], *shared_f, key=key, retries=retries, pure=False,
+                                          priority=0 if priority is None else int(priority[i]))
+            done = as_completed(list(futs.values()))
+            bar = None
+            if progress:
+                from tqdm import tqdm
+
+                bar = tqdm(total=len(futs), desc=desc, unit=unit)
+            for batch in done.batches():
+                for fut in batch:
+                    i = index[fut.key]
+                    try:
+                        outcomes[i] = fut.result()
+                    except Exception as exc:  # retries exhausted, or KilledWorker: reported, not dropped
+                        outcomes[i] = (False, exc)
+                # how each finished task got there, asked before it is released (a released result is not
+                # recomputed when a worker that held it dies later)
+                info = client.run_on_scheduler(_retry_info, [f.key for f in batch], retries)
+                for key, (used, lost) in info.items():
+                    what = []
+                    if lost:
+                        what.append(f"its worker was lost {lost} time(s); re-run on another worker")
+                    if used > 0:
+                        what.append(f"raised an exception {used} time(s); retried")
+                    if what:
+                        sweep.retried[index[key]] = "; ".join(what)
+                for fut in batch:
+                    futs.pop(fut.key).release()
+                if bar is not None:
+                    bar.update(len(batch))
+            if bar is not None:
+                bar.close()
+            del futs, shared_f
+    for i, (ok, value) in outcomes.items():
+        if ok:
+            sweep.results[i] = value
+        else:
+            sweep.errors[i] = value
+    sweep.seconds = time.perf_counter() - t0
+    if sweep.errors and raise_errors:
+        lines = [ln for ln in sweep.report(names) if "FAILED" in ln]
+        raise TaskFailed(f"{len(sweep.errors)} of {len(tasks)} task(s) failed: " + "; ".join(lines))
+    return sweep
