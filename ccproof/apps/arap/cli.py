@@ -11,11 +11,20 @@ triangles of the control mesh and flipped samples at the evaluation level, secon
 With --baselines also (a) ARAP on the triangulated control mesh, the other variant, and (d) ARAP on
 the control mesh subdivided 3 times, all measured the same way.
 
+Output for other tools (--out FILE): the limit surface sampled at --out-level (default 3) as a
+triangle (or --cells quad) mesh whose per-vertex UVs are the parameterization evaluated exactly at
+the limit points; charts packed into [0, 1]^2 without overlap (shelf packing, one common scale);
+seams as duplicated vertices (one UV per chart). FILE.obj is written directly (v, vt, f i/i), any
+other extension through meshio (point data "uv"; PLY: "s", "t"); FILE.json holds the metrics, the
+packing scale and the written triangles' own distortion. --control-out FILE.obj writes the control
+mesh with its texture control points and states the subdivision rule they need.
+
 Example:  ccproof arap bunny_quads.obj --segment normals --baselines --out bunny_uv.obj
 """
 
 from __future__ import annotations
 
+import json
 import sys
 
 __all__ = ["add_arguments", "run", "format_table"]
@@ -35,7 +44,13 @@ def add_arguments(parser):
     parser.add_argument("--baselines", action="store_true", help="also run (a), the other variant and (d)")
     parser.add_argument("--engine", choices=["auto", "numpy", "igl"], default="auto",
                         help="triangle ARAP engine of the baselines (auto: libigl if installed)")
-    parser.add_argument("--out", metavar="UV.obj", help="write the texture (OBJ with vt, plus UV.obj.json)")
+    parser.add_argument("--out", metavar="FILE",
+                        help="write the limit surface sampled at --out-level with exact UVs (.obj, or any "
+                             "meshio format such as .vtu .ply), plus FILE.json")
+    parser.add_argument("--out-level", type=int, default=3, help="sampling level of --out (default 3)")
+    parser.add_argument("--cells", choices=["triangle", "quad"], default="triangle", help="cells of --out")
+    parser.add_argument("--control-out", metavar="UV.obj",
+                        help="write the control mesh with texture control points (OBJ with vt, plus UV.obj.json)")
     parser.add_argument("--labels-out", metavar="FILE", help="write the chart labels used")
 
 
@@ -56,6 +71,7 @@ def format_table(results, eval_level=5):
 def run(args) -> int:
     from ccproof.apps.arap.charts import read_labels, segment_by_normals, write_labels
     from ccproof.apps.arap.core import VARIANTS, compare
+    from ccproof.apps.arap.export import sampled_surface, write_surface
     from ccproof.apps.arap.io import write_uv_obj
     from ccproof.mesh import read_obj
 
@@ -99,16 +115,32 @@ def run(args) -> int:
         print(f"  {results[ours].name}: level {lv[0][k].level}: {its} iterations, "
               f"{1e3 * spi:.2f} ms per chart iteration, energy {e0:.6g} -> {e1:.6g}, "
               f"converged: {all(c[k].converged for c in lv)}")
+    table = {
+        m: {"E_angle": r.metrics.E_angle, "E_area": r.metrics.E_area, "E_stretch": r.metrics.E_stretch,
+            "flips_control": r.flips_control, "flips_eval": r.metrics.flips, "seconds": r.seconds,
+            "iterations": r.iterations}
+        for m, r in results.items()
+    }
+    comment = f"ccproof arap {args.mesh}: {results[ours].name}, levels {args.start_level}..{args.levels}"
+    surf = None
+    if args.out or args.control_out:
+        surf = sampled_surface(results[ours], args.out_level, args.cells)
     if args.out:
-        table = {
-            m: {"E_angle": r.metrics.E_angle, "E_area": r.metrics.E_area, "E_stretch": r.metrics.E_stretch,
-                "flips_control": r.flips_control, "flips_eval": r.metrics.flips, "seconds": r.seconds,
-                "iterations": r.iterations}
-            for m, r in results.items()
-        }
-        side = write_uv_obj(args.out, mesh, results[ours],
-                            comment=f"ccproof arap: {results[ours].name}, levels {args.start_level}..{args.levels}",
-                            table=table)
-        print(f"wrote {args.out} and {side}")
+        write_surface(args.out, surf, comment)
+        wm = surf.metrics()
+        info = {"method": ours, "level": surf.level, "cells": surf.cell_type, "uv_scale": surf.scale,
+                "folds": surf.folds(), "seams": "vertices duplicated per chart",
+                "written_triangles": {"E_angle": wm.E_angle, "E_area": wm.E_area, "E_stretch": wm.E_stretch,
+                                      "note": "E_area at the natural UV scale: divide the file's UVs by uv_scale"},
+                "table": table}
+        with open(args.out + ".json", "w", encoding="utf-8") as fh:
+            json.dump(info, fh, indent=1)
+        print(f"wrote {args.out} (level {surf.level}: {surf.points.shape[0]} vertices, {surf.cells.shape[0]} "
+              f"{surf.cell_type}s, {surf.folds()} folded; written triangles E_angle {wm.E_angle:.6f} "
+              f"E_area {wm.E_area:.6f} E_stretch {wm.E_stretch:.6f}) and {args.out}.json")
+    if args.control_out:
+        side = write_uv_obj(args.control_out, mesh, results[ours], comment=comment, table=table,
+                            transforms=surf.transforms, scale=surf.scale)
+        print(f"wrote {args.control_out} and {side}")
     sys.stdout.flush()
     return 0
