@@ -38,7 +38,15 @@ def add_arguments(parser):
                         help="chart boundary treatment: extended charts (c) or boundary rules (b)")
     parser.add_argument("--levels", type=int, default=3, metavar="K", help="finest optimization level (default 3)")
     parser.add_argument("--start-level", type=int, default=1, help="coarsest optimization level (default 1)")
-    parser.add_argument("--eval-level", type=int, default=5, help="level of the metric samples (default 5)")
+    parser.add_argument("--eval-level", type=int, default=None,
+                        help="level of the metric samples (default: 5, lowered for large meshes so that all "
+                             "charts have at most 4M samples, at least 3 with --baselines)")
+    parser.add_argument("--refine", default="auto",
+                        help="subdivide the control mesh R times before optimizing (b)/(c): 0, 1, 2 or auto "
+                             "(default: the smallest R in 0..2 giving >= 1000 control faces per chart)")
+    parser.add_argument("--max-memory", type=float, default=2.0, metavar="GB",
+                        help="refuse runs whose estimated peak memory exceeds this (default 2 GB)")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.add_argument("--tol", type=float, default=1e-6, help="relative energy decrease to stop a level")
     parser.add_argument("--max-iter", type=int, default=1000, help="iterations per level at most")
     parser.add_argument("--baselines", action="store_true", help="also run (a), the other variant and (d)")
@@ -52,6 +60,9 @@ def add_arguments(parser):
     parser.add_argument("--control-out", metavar="UV.obj",
                         help="write the control mesh with texture control points (OBJ with vt, plus UV.obj.json)")
     parser.add_argument("--labels-out", metavar="FILE", help="write the chart labels used")
+    parser.add_argument("--preview", metavar="FILE.png",
+                        help="render a checkerboard through the UVs and the per-triangle distortion (matplotlib), "
+                             "one row per method")
 
 
 def format_table(results, eval_level=5):
@@ -68,11 +79,35 @@ def format_table(results, eval_level=5):
     return "\n".join(rows)
 
 
+#: at most this many metric samples (faces of E_k over all charts) for the default --eval-level
+MAX_DEFAULT_SAMPLES = 4_000_000
+
+
+def default_eval_level(mesh, labels, levels, with_d):
+    """5 (hsh10's level), lowered while the charts' E_k hold more than MAX_DEFAULT_SAMPLES faces, but not
+    below the optimization level, nor below 3 when (d) is measured (its texture lives at level 3)."""
+    import numpy as np
+
+    from ccproof.apps.arap.core import _charts
+
+    F = mesh.faces
+    n = 0
+    for fc in _charts(mesh, labels):  # faces of E_0: the chart and its ring
+        isc = np.zeros(mesh.n_vertices, dtype=bool)
+        isc[F[fc]] = True
+        n += int(isc[F].any(axis=1).sum())
+    k = 5
+    while k > 0 and n * 4**k > MAX_DEFAULT_SAMPLES:
+        k -= 1
+    return max(k, levels, 3 if with_d else 0)
+
+
 def run(args) -> int:
     from ccproof.apps.arap.charts import read_labels, segment_by_normals, write_labels
-    from ccproof.apps.arap.core import VARIANTS, compare
+    from ccproof.apps.arap.core import VARIANTS, MemoryBudgetError, auto_refine, compare
     from ccproof.apps.arap.export import sampled_surface, write_surface
     from ccproof.apps.arap.io import write_uv_obj
+    from ccproof.errors import CCProofError
     from ccproof.mesh import read_obj
 
     mesh = read_obj(args.mesh)
@@ -100,12 +135,33 @@ def run(args) -> int:
                 engine = "numpy"
     elif engine == "auto":
         engine = "numpy"
-    results, _ = compare(mesh, labels, methods, levels=args.levels, start_level=args.start_level,
-                         eval_level=args.eval_level, tol=args.tol, max_iter=args.max_iter, engine=engine)
+    if args.refine == "auto":
+        refine = auto_refine(mesh, labels)
+    else:
+        try:
+            refine = int(args.refine)
+        except ValueError:
+            raise CCProofError(f"--refine must be auto or an integer >= 0, got {args.refine!r}") from None
+    eval_level = args.eval_level
+    if eval_level is None:
+        eval_level = default_eval_level(mesh, labels, args.levels, "d" in methods)
+    sample_level = args.out_level if (args.out or args.control_out or args.preview) else None
+    try:
+        results, _ = compare(mesh, labels, methods, levels=args.levels, start_level=args.start_level,
+                             eval_level=eval_level, tol=args.tol, max_iter=args.max_iter, engine=engine,
+                             refine=refine, sample_level=sample_level, release=True,
+                             max_memory=args.max_memory * 1e9, progress=not args.no_progress)
+    except MemoryBudgetError:
+        raise
+    except MemoryError as exc:
+        raise CCProofError(f"out of memory ({exc}); lower --eval-level, --levels or --out-level (each level "
+                           f"less needs 4x less memory) or lower --max-memory so that the estimate refuses "
+                           f"earlier") from None
     nch = len(results[ours].textures)
     print(f"{args.mesh}: {mesh.n_vertices} vertices, {mesh.n_faces} faces, {nch} chart(s); "
-          f"levels {args.start_level}..{args.levels}, metrics at level {args.eval_level}, baseline engine {engine}")
-    print(format_table(results, args.eval_level))
+          f"levels {args.start_level}..{args.levels}, refine {refine}, metrics at level {eval_level}, "
+          f"baseline engine {engine}")
+    print(format_table(results, eval_level))
     lv = results[ours].levels
     for k in range(len(lv[0]) if lv and lv[0] else 0):
         its = sum(c[k].iterations for c in lv)
@@ -125,6 +181,12 @@ def run(args) -> int:
     surf = None
     if args.out or args.control_out:
         surf = sampled_surface(results[ours], args.out_level, args.cells)
+    if args.preview:
+        from ccproof.apps.arap.preview import render_preview
+
+        surfs = {m: sampled_surface(r, r.sample_level) for m, r in results.items()}
+        render_preview(args.preview, surfs, {m: r.name for m, r in results.items()}, title=args.mesh)
+        print(f"wrote {args.preview}")
     if args.out:
         write_surface(args.out, surf, comment)
         wm = surf.metrics()
@@ -139,7 +201,10 @@ def run(args) -> int:
               f"{surf.cell_type}s, {surf.folds()} folded; written triangles E_angle {wm.E_angle:.6f} "
               f"E_area {wm.E_area:.6f} E_stretch {wm.E_stretch:.6f}) and {args.out}.json")
     if args.control_out:
-        side = write_uv_obj(args.control_out, mesh, results[ours], comment=comment, table=table,
+        r = results[ours]
+        cmesh = r.textures[0].hierarchy.surface  # with --refine: the refined control mesh the texture lives on
+        note = f"\ncontrol mesh: the input subdivided {r.refine} times (Catmull-Clark)" if r.refine else ""
+        side = write_uv_obj(args.control_out, cmesh, r, comment=comment + note, table=table,
                             transforms=surf.transforms, scale=surf.scale)
         print(f"wrote {args.control_out} and {side}")
     sys.stdout.flush()

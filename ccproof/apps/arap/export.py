@@ -190,7 +190,11 @@ def sampled_surface(result, level=3, cells="triangle", gap=0.02):
     """
     if cells not in ("triangle", "quad"):
         raise CCProofError(f"cells must be 'triangle' or 'quad', got {cells!r}")
-    parts = [sample_chart(tex, level) for tex in result.textures]
+    if getattr(result, "samples", None) is not None and result.sample_level == level:
+        parts = result.samples  # computed by compare before the charts' fine levels were released
+    else:
+        off = getattr(result, "refine", 0)
+        parts = [sample_chart(tex, level - off) for tex in result.textures]
     transforms, scale = pack_charts([uv for _, uv, _ in parts], gap)
     pts, raw, packed, cl, chart, cchart = [], [], [], [], [], []
     base = 0

@@ -122,8 +122,8 @@ class LocalGlobal:
         self.build_seconds = time.perf_counter() - t0
 
     def _factor(self, Lff):
-        try:
-            lu = spla.splu(Lff)
+        try:  # L is symmetric positive (semi)definite: symmetric ordering, no pivoting (much less fill)
+            lu = spla.splu(Lff, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options={"SymmetricMode": True})
             d = np.abs(lu.U.diagonal())
             if d.size and d.min() <= 1e-12 * d.max():
                 raise RuntimeError("nearly singular")
@@ -131,7 +131,8 @@ class LocalGlobal:
         except RuntimeError:
             self.mu = 1e-8 * float(np.abs(Lff.diagonal()).mean() or 1.0)
             self.regularized = True
-            self.lu = spla.splu((Lff + self.mu * sp.identity(Lff.shape[0], format="csc")).tocsc())
+            self.lu = spla.splu((Lff + self.mu * sp.identity(Lff.shape[0], format="csc")).tocsc(),
+                                permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options={"SymmetricMode": True})
         self.Lff = Lff
 
     def jacobians(self, X):
@@ -145,8 +146,8 @@ class LocalGlobal:
 
     def energy(self, J, R):
         """E(X, R) = sum_j w_j ||J_j - R_j||^2."""
-        D = J - R
-        return float(self.w @ np.einsum("sij,sij->s", D, D))
+        D = (J - R).reshape(-1, 4)
+        return float(self.w @ (D * D).sum(axis=1))
 
     def rhs(self, R):
         """B = sum_j w_j H_j R_j^T, shape (N, 2)."""
