@@ -241,3 +241,21 @@ def test_refining_the_control_mesh_makes_c_beat_d_on_a_bunny_patch(bunny_path):
     assert c0.E_area > d.E_area  # without refinement (c) is behind (d) here
     assert c2.E_area <= d.E_area and c2.E_stretch <= d.E_stretch
     assert c2.samples == d.samples
+
+
+def test_preview_png_one_row_per_method(tmp_path, capsys):
+    import matplotlib.image as mpimg
+
+    m, chart = M.curved_ev_mesh()
+    write_obj(tmp_path / "m.obj", m)
+    lab = -np.ones(m.n_faces, dtype=int)
+    lab[chart] = 0
+    (tmp_path / "l.txt").write_text("\n".join(map(str, lab)))
+    png = tmp_path / "p.png"
+    rc = main(["arap", str(tmp_path / "m.obj"), "--charts", str(tmp_path / "l.txt"), "--baselines", "--engine",
+               "numpy", "--levels", "2", "--eval-level", "3", "--out-level", "2", "--preview", str(png),
+               "--refine", "0", "--no-progress"])
+    assert rc == 0 and f"wrote {png}" in capsys.readouterr().out
+    img = mpimg.imread(png)
+    assert img.shape[0] > 1.2 * img.shape[1]  # four rows of three panels (13 x 16.8 inches)
+    assert img[..., :3].std() > 0.1  # not blank
