@@ -54,6 +54,7 @@ __all__ = [
     "limit_surface_mesh",
     "surface_to_data",
     "data_spacing",
+    "samples_per_edge",
 ]
 
 #: material of the shape-recovery runs, in units where the data's enclosing sphere has diameter 1
@@ -243,14 +244,31 @@ def _read_ply(path):
 # ---------------------------------------------------------------------------- fitting
 
 
-def fit_error(model, P, X, finder=None, per_edge=12, diameter=None):
+def samples_per_edge(n_faces, n_points, most, budget=50_000):
+    """Samples per face edge of the closest-point initial guesses: ``most`` on small models, fewer on
+    large ones so that the sample count stays about ``max(budget, 16 n_points)`` (memory linear in the
+    data and the mesh, not in their product); at least 2. The Gauss-Newton refinement does the rest.
+
+    >>> samples_per_edge(96, 2000, 12), samples_per_edge(24576, 20000, 12)
+    (12, 4)
+    """
+    target = max(budget, 16 * int(n_points))
+    return int(min(most, max(2, math.ceil(math.sqrt(target / max(int(n_faces), 1))))))
+
+
+def fit_error(model, P, X, finder=None, per_edge=None, diameter=None):
     """Distances of the data points to the limit surface (nearest points) and the paper's fit error.
+
+    ``per_edge``: samples per face edge of the initial guesses (default :func:`samples_per_edge` with
+    at most 12).
 
     Returns a dict: ``max``, ``mean`` (absolute), ``max_percent``, ``mean_percent`` (of the diameter
     of the minimal enclosing sphere of X, or of ``diameter``), ``distances``.
     """
     X = check_points(X)
     if finder is None:
+        if per_edge is None:
+            per_edge = samples_per_edge(model.mesh.n_faces, X.shape[0], 12)
         finder = ClosestPointFinder(model, per_edge=per_edge, candidates=4, iterations=12)
     *_, dist = finder.query(P, X)
     if diameter is None:
@@ -481,7 +499,7 @@ def fit_points(X, init="cube", levels=1, material=None, spring_total=1.0, dt=Non
     try:
         for level in range(levels + 1):
             t0 = time.perf_counter()
-            finder = ClosestPointFinder(model)
+            finder = ClosestPointFinder(model, per_edge=samples_per_edge(model.mesh.n_faces, X.shape[0], 6))
             integ = ImplicitIntegrator(model, dt, P=P, scheme=scheme, tol=1e-9)
             prev = None
             converged = False
