@@ -191,7 +191,8 @@ def one_run(args):
     refine = auto_refine(mesh, labels) if args.refine == "auto" else int(args.refine)
     t0 = time.perf_counter()
     res, hs = compare(mesh, labels, (args.one,), eval_level=args.eval_level, engine=args.engine_one,
-                      refine=refine, release=True, baseline_max_iter=args.baseline_max_iter, progress=False)
+                      refine=refine, release=True, baseline_max_iter=args.baseline_max_iter, progress=False,
+                      accel=5)
     total = time.perf_counter() - t0
     r = res[args.one]
     conv = None

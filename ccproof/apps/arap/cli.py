@@ -47,6 +47,8 @@ def add_arguments(parser):
     parser.add_argument("--max-memory", type=float, default=2.0, metavar="GB",
                         help="refuse runs whose estimated peak memory exceeds this (default 2 GB)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    parser.add_argument("--accel", type=int, default=5, metavar="M",
+                        help="Anderson acceleration history of (b)/(c), energy-safeguarded (default 5; 0: plain)")
     parser.add_argument("--tol", type=float, default=1e-6, help="relative energy decrease to stop a level")
     parser.add_argument("--max-iter", type=int, default=1000, help="iterations per level at most")
     parser.add_argument("--baselines", action="store_true", help="also run (a), the other variant and (d)")
@@ -150,7 +152,7 @@ def run(args) -> int:
         results, _ = compare(mesh, labels, methods, levels=args.levels, start_level=args.start_level,
                              eval_level=eval_level, tol=args.tol, max_iter=args.max_iter, engine=engine,
                              refine=refine, sample_level=sample_level, release=True,
-                             max_memory=args.max_memory * 1e9, progress=not args.no_progress)
+                             max_memory=args.max_memory * 1e9, progress=not args.no_progress, accel=args.accel)
     except MemoryBudgetError:
         raise
     except MemoryError as exc:

@@ -142,8 +142,11 @@ def initial_texture(h: ChartHierarchy, rules):
 
 
 # --------------------------------------------------------------------------- optimization
-def optimize_chart(h: ChartHierarchy, rules, X0, levels=3, start_level=1, tol=1e-6, max_iter=1000, trace=False):
+def optimize_chart(h: ChartHierarchy, rules, X0, levels=3, start_level=1, tol=1e-6, max_iter=1000, trace=False,
+                   accel=0):
     """Multi-resolution local/global optimization of one chart (A4-A7).
+
+    ``accel``: Anderson acceleration history of :func:`~ccproof.apps.arap.solver.iterate` (0: plain).
 
     Returns
     -------
@@ -159,7 +162,7 @@ def optimize_chart(h: ChartHierarchy, rules, X0, levels=3, start_level=1, tol=1e
         S = build_samples(L, rules, "optimize")
         sysk = system_from_samples(S, h.operator(k, rules), pin=0)
         tb = time.perf_counter() - t0
-        res = iterate(sysk, X, tol=tol, max_iter=max_iter, trace=trace)
+        res = iterate(sysk, X, tol=tol, max_iter=max_iter, trace=trace, accel=accel)
         X = res.X
         stats.append(
             LevelStats(
@@ -241,15 +244,16 @@ def lift_to_refined(h: ChartHierarchy, X, rules, fine: ChartHierarchy, times):
 
 
 def run_method(h: ChartHierarchy, method, levels=3, start_level=1, tol=1e-6, max_iter=1000, engine="numpy",
-               baseline_level=3, baseline_max_iter=2000, trace=False, X0=None):
+               baseline_level=3, baseline_max_iter=2000, trace=False, X0=None, accel=0):
     """Run one method on one chart. Returns (ChartTexture, seconds, iterations, level stats).
 
-    ``X0``: initial texture unknowns of (b) / (c) (default: :func:`initial_texture`)."""
+    ``X0``: initial texture unknowns of (b) / (c) (default: :func:`initial_texture`); ``accel``:
+    Anderson acceleration of (b) / (c) (:func:`~ccproof.apps.arap.solver.iterate`)."""
     t0 = time.perf_counter()
     if method in ("b", "c"):
         rules = "boundary" if method == "b" else "extended"
         X0 = initial_texture(h, rules) if X0 is None else X0
-        X, stats, _ = optimize_chart(h, rules, X0, levels, start_level, tol, max_iter, trace)
+        X, stats, _ = optimize_chart(h, rules, X0, levels, start_level, tol, max_iter, trace, accel)
         tex = ChartTexture(h, rules, 0, h.lift_unknowns(X, rules), X)
         return tex, time.perf_counter() - t0, sum(s.iterations for s in stats), stats
     if method == "a":
@@ -356,7 +360,7 @@ class MemoryBudgetError(CCProofError):
 
 def compare(mesh, labels=None, methods=METHODS, levels=3, start_level=1, eval_level=5, tol=1e-6, max_iter=1000,
             engine="numpy", baseline_level=3, baseline_max_iter=2000, hierarchies=None, trace=False,
-            refine=0, sample_level=None, release=False, max_memory=None, progress=False):
+            refine=0, sample_level=None, release=False, max_memory=None, progress=False, accel=0):
     """Run ``methods`` on every chart and measure them the same way.
 
     Parameters
@@ -380,6 +384,9 @@ def compare(mesh, labels=None, methods=METHODS, levels=3, start_level=1, eval_le
         Bytes; raise :class:`MemoryBudgetError` before allocating when :func:`estimate_memory` exceeds it.
     progress : bool
         A tqdm progress bar over (chart, method).
+    accel : int
+        Anderson acceleration history for (b) and (c) (0: the plain local/global iteration; the CLI
+        uses 5). (a) and (d) are never accelerated (they are the baselines as published).
 
     Returns
     -------
@@ -423,7 +430,8 @@ def compare(mesh, labels=None, methods=METHODS, levels=3, start_level=1, eval_le
                     hm, st, lv, ev = fine["hierarchies"][i], fine["start"], fine["levels"], eval_level - refine
                     if start_level <= refine:  # multi-resolution: the input mesh's levels below the refined ones
                         t0 = time.perf_counter()
-                        texc, _, it0, st0 = run_method(h, m, refine, start_level, tol, max_iter, engine)
+                        texc, _, it0, st0 = run_method(h, m, refine, start_level, tol, max_iter, engine,
+                                                       accel=accel)
                         X0 = lift_to_refined(h, texc.unknowns, texc.rules, hm, refine)
                         sec0 = time.perf_counter() - t0
                 else:
@@ -431,7 +439,7 @@ def compare(mesh, labels=None, methods=METHODS, levels=3, start_level=1, eval_le
                 if ev < 0:
                     raise CCProofError(f"eval_level {eval_level} is below refine {refine}")
                 tex, sec, it, stt = run_method(hm, m, lv, st, tol, max_iter, engine, baseline_level,
-                                               baseline_max_iter, trace, X0=X0)
+                                               baseline_max_iter, trace, X0=X0, accel=accel)
                 if hm is not h:  # level numbers on the input mesh
                     stt = [replace(x, level=x.level + refine) for x in stt]
                 sec, it, stt = sec + sec0, it + it0, st0 + stt

@@ -171,8 +171,14 @@ class LocalGlobal:
         return float(np.linalg.norm(r) / nb) if nb else float(np.linalg.norm(r))
 
 
-def iterate(system: LocalGlobal, X0, tol=1e-6, max_iter=200, trace=False, min_iter=1):
+def iterate(system: LocalGlobal, X0, tol=1e-6, max_iter=200, trace=False, min_iter=1, accel=0):
     """Alternate local and global steps until the relative energy decrease is below ``tol``.
+
+    ``accel`` > 0: Anderson acceleration of the fixed-point map X -> global_step(R(X)) with a history of
+    ``accel`` steps, safeguarded by the energy (Peng et al. 2018, "Anderson acceleration for geometry
+    optimization and physics simulation"): the accelerated iterate is kept only if its energy
+    E(X, R(X)) is below the last accepted one, else the plain local/global step is taken, so the
+    energy still decreases monotonically (``trace`` is not recorded then).
 
     Returns
     -------
@@ -180,6 +186,8 @@ def iterate(system: LocalGlobal, X0, tol=1e-6, max_iter=200, trace=False, min_it
         ``energies[i]`` is E(X_i, R(X_i)) (after each local step); with ``trace`` also the energy
         after every global step (``trace``) and the global solve residuals.
     """
+    if accel and not trace:
+        return _iterate_anderson(system, X0, tol, max_iter, min_iter, int(accel))
     t0 = time.perf_counter()
     X = np.array(X0, dtype=np.float64, copy=True)
     J = system.jacobians(X)
@@ -209,6 +217,58 @@ def iterate(system: LocalGlobal, X0, tol=1e-6, max_iter=200, trace=False, min_it
             converged = True
             break
     return IterationResult(X, it, energies, time.perf_counter() - t0, converged, tr, res)
+
+
+def _iterate_anderson(system, X0, tol, max_iter, min_iter, m):
+    t0 = time.perf_counter()
+    X = np.array(X0, dtype=np.float64, copy=True)
+    J = system.jacobians(X)
+    R = closest_rotations(J)
+    E = system.energy(J, R)
+    energies = [E]
+    dG, dF = [], []
+    g_prev = f_prev = None
+    converged = False
+    it = 0
+    while it < max_iter:
+        G = system.global_step(R, X)  # plain step from the accepted iterate
+        it += 1
+        f = (G - X).ravel()
+        g = G.ravel()
+        if g_prev is not None:
+            dG.append(g - g_prev)
+            dF.append(f - f_prev)
+            if len(dG) > m:
+                dG.pop(0)
+                dF.pop(0)
+        g_prev, f_prev = g, f
+        Xn = G
+        if dF:
+            Fm = np.stack(dF, axis=1)
+            gamma, *_ = np.linalg.lstsq(Fm, f, rcond=None)
+            Xa = (g - np.stack(dG, axis=1) @ gamma).reshape(X.shape)
+            Ja = system.jacobians(Xa)
+            Ra = closest_rotations(Ja, previous=R)
+            Ea = system.energy(Ja, Ra)
+            if Ea < E:
+                Xn, J, R, En = Xa, Ja, Ra, Ea
+            else:  # safeguard: the plain step, and a fresh history
+                dG.clear()
+                dF.clear()
+                Xn = None
+        if Xn is None or not dF:
+            Xn = G
+            J = system.jacobians(Xn)
+            R = closest_rotations(J, previous=R)
+            En = system.energy(J, R)
+        energies.append(En)
+        X = Xn
+        done = En <= 1e-28 * system.weight_sum or (E - En) <= tol * E
+        E = En
+        if done and it >= min_iter:
+            converged = True
+            break
+    return IterationResult(X, it, energies, time.perf_counter() - t0, converged)
 
 
 def triangle_samples(V, T):
