@@ -256,7 +256,7 @@ def main(argv=None):
     ap.add_argument("--scale", action="store_true", help="the user-facing runs (module docstring)")
     ap.add_argument("--eval-level", type=int, default=5)
     ap.add_argument("--large-subdivisions", type=int, default=2)
-    ap.add_argument("--large-d-iterations", type=int, default=300)
+    ap.add_argument("--large-d-iterations", type=int, default=30)
     ap.add_argument("--one", choices=["c", "d"], help=argparse.SUPPRESS)
     ap.add_argument("--subdivide", type=int, default=0, help=argparse.SUPPRESS)
     ap.add_argument("--refine", default="auto", help=argparse.SUPPRESS)

@@ -57,7 +57,9 @@ def add_arguments(parser):
     parser.add_argument("--out", metavar="FILE",
                         help="write the limit surface sampled at --out-level with exact UVs (.obj, or any "
                              "meshio format such as .vtu .ply), plus FILE.json")
-    parser.add_argument("--out-level", type=int, default=3, help="sampling level of --out (default 3)")
+    parser.add_argument("--out-level", type=int, default=None,
+                        help="sampling level of --out and --preview (default 3, lowered for large meshes to "
+                             "at most 2M triangles)")
     parser.add_argument("--cells", choices=["triangle", "quad"], default="triangle", help="cells of --out")
     parser.add_argument("--control-out", metavar="UV.obj",
                         help="write the control mesh with texture control points (OBJ with vt, plus UV.obj.json)")
@@ -81,6 +83,8 @@ def format_table(results, eval_level=5):
     return "\n".join(rows)
 
 
+#: at most this many triangles in the default --out
+MAX_DEFAULT_OUT_TRIANGLES = 2_000_000
 #: at most this many metric samples (faces of E_k over all charts) for the default --eval-level
 MAX_DEFAULT_SAMPLES = 4_000_000
 
@@ -147,7 +151,13 @@ def run(args) -> int:
     eval_level = args.eval_level
     if eval_level is None:
         eval_level = default_eval_level(mesh, labels, args.levels, "d" in methods)
-    sample_level = args.out_level if (args.out or args.control_out or args.preview) else None
+    out_level = args.out_level
+    if out_level is None:
+        n = mesh.n_faces if labels is None else int((labels >= 0).sum())
+        out_level = 3
+        while out_level > 0 and 2 * n * 4**out_level > MAX_DEFAULT_OUT_TRIANGLES:
+            out_level -= 1
+    sample_level = out_level if (args.out or args.control_out or args.preview) else None
     try:
         results, _ = compare(mesh, labels, methods, levels=args.levels, start_level=args.start_level,
                              eval_level=eval_level, tol=args.tol, max_iter=args.max_iter, engine=engine,
@@ -182,7 +192,7 @@ def run(args) -> int:
     comment = f"ccproof arap {args.mesh}: {results[ours].name}, levels {args.start_level}..{args.levels}"
     surf = None
     if args.out or args.control_out:
-        surf = sampled_surface(results[ours], args.out_level, args.cells)
+        surf = sampled_surface(results[ours], out_level, args.cells)
     if args.preview:
         from ccproof.apps.arap.preview import render_preview
 

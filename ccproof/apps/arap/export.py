@@ -213,25 +213,38 @@ def sampled_surface(result, level=3, cells="triangle", gap=0.02):
     )
 
 
+_CHUNK = 50_000
+
+
+def _write_rows(fh, tag, A, fmt):
+    line = tag + (" " + fmt) * A.shape[1] + "\n"
+    for i in range(0, A.shape[0], _CHUNK):
+        fh.write("".join(line % tuple(r) for r in A[i : i + _CHUNK].tolist()))
+
+
 def write_surface(path, surf: SampledSurface, comment=None):
     """Write a :class:`SampledSurface`: ``.obj`` (``v``, ``vt``, ``f i/i ...``; full precision) by
     this function, any other extension through meshio (point data ``uv`` and ``chart``; for PLY,
     which has scalar vertex properties only, ``s`` and ``t``)."""
     path = os.fspath(path)
     if path.lower().endswith(".obj"):
+        ch = surf.cell_chart
         with open(path, "w", encoding="utf-8") as fh:
             for c in (comment or "").splitlines():
                 fh.write(f"# {c}\n")
             fh.write(f"# limit surface sampled at level {surf.level}: {surf.points.shape[0]} vertices "
                      f"(duplicated per chart at seams), {surf.cells.shape[0]} {surf.cell_type}s, "
                      f"{int(surf.chart.max(initial=-1)) + 1} charts; uv packing scale {surf.scale:.17g}\n")
-            fh.writelines(f"v {x:.17g} {y:.17g} {z:.17g}\n" for x, y, z in surf.points.tolist())
-            fh.writelines(f"vt {u:.17g} {v:.17g}\n" for u, v in surf.uv.tolist())
-            ch = surf.cell_chart
-            C = surf.cells + 1
+            _write_rows(fh, "v", surf.points, "%.17g")
+            _write_rows(fh, "vt", surf.uv, "%.17g")
+            k = surf.cells.shape[1]
+            fmt = "f " + " ".join(["%d/%d"] * k) + "\n"
             for c in range(int(ch.max(initial=-1)) + 1):
                 fh.write(f"g chart{c}\n")
-                fh.writelines("f " + " ".join(f"{a}/{a}" for a in row) + "\n" for row in C[ch == c].tolist())
+                C = surf.cells[ch == c] + 1
+                for i in range(0, C.shape[0], _CHUNK):  # chunks: memory of the output, not of Python objects
+                    B = np.repeat(C[i : i + _CHUNK], 2, axis=1)
+                    fh.write("".join(fmt % tuple(r) for r in B.tolist()))
         return path
     try:
         import meshio
