@@ -19,7 +19,14 @@ other extension through meshio (point data "uv"; PLY: "s", "t"); FILE.json holds
 packing scale and the written triangles' own distortion. --control-out FILE.obj writes the control
 mesh with its texture control points and states the subdivision rule they need.
 
-Example:  ccproof arap bunny_quads.obj --segment normals --baselines --out bunny_uv.obj
+Scale: charts are processed one at a time; the peak memory is estimated first and a run above
+--max-memory (default 2 GB) stops with an error naming the options that lower it. --refine R (default:
+the smallest R in 0..2 giving >= 1000 control faces per chart) subdivides the control mesh before
+optimizing (b)/(c), which lets (c) reach (d)'s E_area on small charts; --accel (default 5) is the
+Anderson acceleration of the local/global iteration. --preview FILE.png renders checkerboard and
+distortion maps.
+
+Example:  ccproof arap bunny_quads.obj --segment normals --baselines --out bunny_uv.obj --preview bunny.png
 """
 
 from __future__ import annotations
