@@ -200,7 +200,7 @@ def one_run(args):
         conv = r.iterations < args.baseline_max_iter * len(hs)
     m = r.metrics
     print(json.dumps({
-        "method": args.one, "faces": mesh.n_faces, "charts": len(hs), "refine": refine,
+        "method": args.one, "faces": mesh.n_faces, "charts": len(hs), "refine": refine if args.one == "c" else 0,
         "segmentation_seconds": t_seg, "method_seconds": r.seconds, "total_seconds": total,
         "iterations": r.iterations, "E_angle": m.E_angle, "E_area": m.E_area, "E_stretch": m.E_stretch,
         "flips": m.flips, "samples": m.samples, "eval_level": args.eval_level,
