@@ -1,5 +1,5 @@
 #!/usr/bin/env python
-"""Benchmark of the hsh10 ARAP parameterization on the quad bunny (issue 9, "Speed").
+"""Benchmark of the hsh10 ARAP parameterization on the quad bunny.
 
 Measured in one run, on the closed bunny cut into charts by ``segment_by_normals`` (and, with
 ``--patch``, on an open patch of it as one chart):

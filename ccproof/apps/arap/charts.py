@@ -1,4 +1,4 @@
-"""Charts of a quad mesh given as per-face labels (hsh10 section 3, spec A1 and A11.1).
+"""Charts of a quad mesh given as per-face labels (hsh10 section 3).
 
 Segmenting a surface into charts is not part of hsh10: the input is one integer label per control
 face, and every label defines one chart. Each chart must be a *topological disk*: connected,

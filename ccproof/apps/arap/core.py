@@ -1,6 +1,6 @@
 """hsh10 end to end: initialization, the multi-resolution optimization, the baselines, the metrics.
 
-Methods (the rows of hsh10's comparison figures, spec A10):
+Methods (the rows of hsh10's comparison figures):
 
 * ``"a"``: ARAP polygon parameterization (Liu et al. 2008) of the triangulated chart control mesh,
   texture then subdivided with the chart's boundary rules;
@@ -11,12 +11,12 @@ Methods (the rows of hsh10's comparison figures, spec A10):
 
 Every method is initialized by LSCM on its own triangulated control mesh (for (c): LSCM on the
 chart, then the conformal extension to the ring). Every method is measured the same way:
-:func:`texture_metrics` at evaluation level 5 (spec A9), plus flipped triangles of the texture
+:func:`texture_metrics` at evaluation level 5, plus flipped triangles of the texture
 control mesh (:func:`control_flips`).
 
-Multi-resolution schedule (A7): optimize at ``start_level`` until the relative energy decrease
+Multi-resolution schedule: optimize at ``start_level`` until the relative energy decrease
 per iteration is below ``tol``, then at the next level warm-started from the current ``T^0``, up
-to ``levels``. The default start is level 1 (spec A6 caution: at level 0 the masks miss the
+to ``levels``. The default start is level 1 (caution: at level 0 the masks miss the
 odd-even modes of regular grids; level 0 is allowed and then regularized if singular).
 """
 
@@ -128,8 +128,8 @@ def _chart_triangles(h: ChartHierarchy):
 
 
 def initial_texture(h: ChartHierarchy, rules):
-    """LSCM of the triangulated chart control mesh at its natural scale (A6); for extended charts the
-    ring unknowns are the conformal extension of it (A11.6). Shape (n_unknowns, 2)."""
+    """LSCM of the triangulated chart control mesh at its natural scale; for extended charts the
+    ring unknowns are the conformal extension of it. Shape (n_unknowns, 2)."""
     V, Tc = _chart_triangles(h)
     nc = h.n_chart_vertices
     UV = fit_area(lscm(V[:nc], Tc), V[:nc], Tc)
@@ -144,7 +144,7 @@ def initial_texture(h: ChartHierarchy, rules):
 # --------------------------------------------------------------------------- optimization
 def optimize_chart(h: ChartHierarchy, rules, X0, levels=3, start_level=1, tol=1e-6, max_iter=1000, trace=False,
                    accel=0):
-    """Multi-resolution local/global optimization of one chart (A4-A7).
+    """Multi-resolution local/global optimization of one chart (hsh10 sections 3.1-3.3).
 
     ``accel``: Anderson acceleration history of :func:`~ccproof.apps.arap.solver.iterate` (0: plain).
 

@@ -24,8 +24,10 @@ scale invariant, E_area of the file's UVs is that of the parameterization after 
 ``s``.
 
 >>> import numpy as np
->>> T, s = pack_charts([np.array([[0.0, 0], [2, 0], [2, 1], [0, 1]]), np.array([[0.0, 0], [1, 0], [0, 1]])])
->>> all(0 <= v <= 1 for R, t in T for v in np.ravel(s * (np.array([[0.0, 0], [2, 1]]) @ R.T + t)))
+>>> uvs = [np.array([[0.0, 0], [2, 0], [2, 1], [0, 1]]), np.array([[0.0, 0], [1, 0], [0, 1]])]
+>>> T, s = pack_charts(uvs)
+>>> packed = [s * (uv @ R.T + t) for uv, (R, t) in zip(uvs, T)]
+>>> all(p.min() >= 0 and p.max() <= 1 for p in packed)
 True
 """
 

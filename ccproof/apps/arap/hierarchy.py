@@ -2,10 +2,10 @@
 
 For a chart (a disk of control faces) we keep, at every level k, one local quad complex ``E_k``:
 the level-k chart faces (first) plus the *ring* of level-k faces that share a vertex with them
-(spec A8: "all vertices of faces outside the chart that share a vertex with the chart boundary").
+("all vertices of faces outside the chart that share a vertex with the chart boundary").
 Its control points are the level-k surface points ``P^k`` restricted to ``E_k``.
 
-Why one ring is enough (spec A11.5): a level-(k+1) vertex of ``E_{k+1}`` is a vertex point of a
+Why one ring is enough: a level-(k+1) vertex of ``E_{k+1}`` is a vertex point of a
 level-k *chart* vertex, an edge point of an edge with a chart end point, or a face point of an
 ``E_k`` face; all three stencils (full fan of a chart vertex, the two faces of such an edge, the
 four face vertices) lie in ``E_k``, and the mesh layer's rules there are the global ones. This is

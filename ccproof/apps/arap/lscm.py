@@ -1,11 +1,11 @@
 """Triangulation of quad charts and least-squares conformal maps (Levy et al. 2002), numpy/scipy only.
 
 hsh10 initializes by "triangulating the control mesh and applying a polygon parameterization method
-such as LSCM" (spec A6). :func:`lscm` minimizes the conformal energy
+such as LSCM". :func:`lscm` minimizes the conformal energy
 ``sum_t A_t |grad u - rot90(grad v)|^2`` (piecewise linear on triangles, local orthonormal frames;
 the Cauchy-Riemann form keeps the orientation) with two pinned vertices, by one sparse solve of the
 normal equations. :func:`lscm_extend` solves the same energy for free vertices around fixed ones
-(used for the extension ring of extended charts, spec A11.6).
+(used for the extension ring of extended charts).
 
 Quads are split along their shorter 3D diagonal (:func:`triangulate_quads`), the choice used for
 every polygon method here (init, baselines (a) and (d), control-level flip counts).

@@ -1,4 +1,4 @@
-"""Distortion metrics of hsh10 section 4 (spec A9) and flip counts.
+"""Distortion metrics of hsh10 section 4 and flip counts.
 
 For every sample j with singular values s1 >= s2 of grad phi_j = (t1 t2)(p^1 p^2)^-1, surface area
 element A_j and texture area element A_T,j:
@@ -10,7 +10,7 @@ element A_j and texture area element A_T,j:
 E_area is not scale invariant (it is meant for maps with their natural scale, as ARAP produces);
 :meth:`Metrics.rescaled` gives the value after scaling the texture to the surface area. A sample
 is *flipped* when det grad phi <= 0. Several charts are combined by summing the area-weighted
-sums (spec A11.4).
+sums.
 
 >>> import numpy as np
 >>> J = np.array([[[2.0, 0.0], [0.0, 0.5]]])

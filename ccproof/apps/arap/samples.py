@@ -1,6 +1,6 @@
-"""Limit tangent masks (hsh10 Eq. 2, spec A3) and the level-k samples of Eq. 3 and of the metrics.
+"""Limit tangent masks (hsh10 Eq. 2) and the level-k samples of Eq. 3 and of the metrics.
 
-Tangent masks (A3). For an interior vertex of valence n with edge neighbours e_0 .. e_{n-1}
+Tangent masks. For an interior vertex of valence n with edge neighbours e_0 .. e_{n-1}
 (counter-clockwise) and face-diagonal neighbours f_i (face i between e_i and e_{i+1}):
 
     alpha_i = (1/n + cos(pi/n) / (n sqrt(4 + cos^2(pi/n)))) cos(2 pi i/n)      on e_i
@@ -23,7 +23,7 @@ values of ``E_k``) for the *same* two parametric directions, and a weight. Two k
   along the two edges of f at v, ``d_a = L(a) - L(v)`` and ``d_b = L(b) - L(v)``, for the surface
   and for the texture (each with its own rules, so the secant pairs span the same parameter
   triangle); weight ``||d_a x d_b|| / 4`` (a quarter face). hsh10 gives no masks at chart boundary
-  vertices (spec A11.2); secants are exact for affine maps and reproduce the texture's own boundary
+  vertices; secants are exact for affine maps and reproduce the texture's own boundary
   behaviour, which is what (b) is about.
 
 Limit position masks: interior ``(n^2 V + 4 sum e + sum f) / (n (n + 5))``; crease (cubic B-spline
@@ -55,7 +55,7 @@ __all__ = [
 
 
 def mask_weights(n):
-    """The A3 weights (alpha_i, beta_i), i = 0 .. n-1, of a valence-``n`` vertex."""
+    """The tangent-mask weights (alpha_i, beta_i), i = 0 .. n-1, of a valence-``n`` vertex."""
     n = int(n)
     i = np.arange(n)
     c = np.cos(np.pi / n)
@@ -76,7 +76,7 @@ def _fan_corners(mesh, verts):
 
 
 def tangent_mask_operators(mesh, verts):
-    """Sparse (len(verts), n) operators of the A3 masks p_1, p_2 at interior vertices ``verts``."""
+    """Sparse (len(verts), n) operators of the tangent masks p_1, p_2 at interior vertices ``verts``."""
     verts = np.asarray(verts, dtype=np.int64)
     F = mesh.faces
     row, j, c = _fan_corners(mesh, verts)
@@ -143,7 +143,7 @@ def limit_operator(level: Level, rules):
 
 
 def isometric_frames(p1, p2):
-    """The isometric images (a, b, c) of the frames: p^_1 = (a, 0), p^_2 = (b, c) (spec A2).
+    """The isometric images (a, b, c) of the frames: p^_1 = (a, 0), p^_2 = (b, c).
 
     ``a = |p1|``, ``b = p1.p2 / |p1|``, ``c = |p1 x p2| / |p1|`` (c >= 0).
     """
@@ -197,7 +197,7 @@ def build_samples(level: Level, rules, purpose="optimize") -> SampleSet:
         "optimize": the energy of hsh10 Eq. 3 for that variant (mask samples wherever the texture
         follows the interior rules, i.e. at every chart vertex off the surface boundary for
         extended charts). "metric": the same sampling for every method (mask samples at
-        chart-interior vertices, corner samples on the chart boundary), spec A9 / A11.4.
+        chart-interior vertices, corner samples on the chart boundary).
     """
     r = _rules(rules)
     mesh = level.mesh

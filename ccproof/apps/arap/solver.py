@@ -1,20 +1,20 @@
-"""Local/global ARAP iteration on samples (hsh10 section 3, Appendix; spec A5, A6, A7).
+"""Local/global ARAP iteration on samples (hsh10 section 3, Appendix).
 
-Energy (Eq. 3 / A6): with X = T^0 (N x 2) the texture unknowns, every sample j has
+Energy (Eq. 3): with X = T^0 (N x 2) the texture unknowns, every sample j has
 ``t_{j,c} = G_c[j] X`` (rows of sparse operators), the isometric frame ``Q_j = (p^_1 p^_2)^-1`` and a
 weight ``w_j``; ``grad phi_j = (t_1 t_2) Q_j = X^T H_j`` and
 
     E(X, R) = sum_j w_j || X^T H_j - R_j ||_F^2.
 
-Local step (A5, Theorem 1): for A = [[a, b], [c, d]] the closest rotation is
+Local step (Theorem 1): for A = [[a, b], [c, d]] the closest rotation is
 ``[[a + d, b - c], [c - b, a + d]] / sqrt((a + d)^2 + (c - b)^2)`` (identity in the degenerate
 case a = -d, b = c, where every rotation is equally good).
 
-Global step (A6): the normal equations ``L X = B`` with ``L = sum_j w_j H_j H_j^T`` (independent of
+Global step: the normal equations ``L X = B`` with ``L = sum_j w_j H_j H_j^T`` (independent of
 R: factorized ONCE per level with SuperLU and reused) and ``B = sum_j w_j H_j R_j^T`` (rebuilt every
 iteration, two sparse products). One unknown is pinned (the energy is translation invariant).
 If ``L`` restricted to the free unknowns is (numerically) singular, e.g. at level 0 on regular
-grids (spec A6 caution), a proximal term ``mu ||X - X_prev||^2`` is added; it keeps the energy
+grids, a proximal term ``mu ||X - X_prev||^2`` is added; it keeps the energy
 monotone and the run reports ``regularized=True``.
 
 The same class runs Liu et al.'s triangle ARAP (baselines (a), (d)): one sample per triangle with

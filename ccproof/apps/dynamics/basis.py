@@ -1,6 +1,6 @@
-"""Uniform cubic B-spline basis, its exact 1D Gram matrices and the normal-element matrices (qmv98 B2, B5).
+"""Uniform cubic B-spline basis, its exact 1D Gram matrices and the normal-element matrices (qmv98).
 
-One knot span of the uniform cubic B-spline (qmv98 eq. 1, spec B2)::
+One knot span of the uniform cubic B-spline (qmv98 eq. 1)::
 
     B0 = (1-u)^3/6,  B1 = (3u^3 - 6u^2 + 4)/6,  B2 = (-3u^3 + 3u^2 + 3u + 1)/6,  B3 = u^3/6.
 
@@ -11,7 +11,7 @@ weights, ccproof works with the *scalar* 1 x 16 row ``N(u, v)`` (``J_p = N (x) I
 :func:`paper_patch_jacobian`) and with control points as ``(n, 3)`` arrays.
 
 With constant densities the normal-element matrices are Kronecker products of the span Grams
-``G_r[a, b] = int_0^1 B_a^(r) B_b^(r) du`` (spec B5; computed here exactly in rational arithmetic):
+``G_r[a, b] = int_0^1 B_a^(r) B_b^(r) du`` (computed here exactly in rational arithmetic):
 
 * mass ``M = mu G0 (x) G0``;
 * stiffness ``K = a11 G1(x)G0 + a22 G0(x)G1 + b11 G2(x)G0 + b12 G1(x)G1 + b22 G0(x)G2`` (qmv98 eq. 20,

@@ -1,4 +1,4 @@
-"""Normal and special elements of a dynamic Catmull-Clark surface (qmv98 sections 2.2-2.4, 3.1; spec B2, B3, B5).
+"""Normal and special elements of a dynamic Catmull-Clark surface (qmv98 sections 2.2-2.4, 3.1).
 
 **Element layout.** Every face of the initial (control) mesh is one of
 
@@ -12,12 +12,12 @@
   :func:`ccproof.algebra.subdivision.two_ring_vertices`: the EV, then sector by sector the grid
   positions (1,0), (2,0), (1,1), (2,1), (1,2), (2,2));
 * a face without patch: a face with a boundary vertex (qmv98 Figs. 1-3: boundary faces carry no patch;
-  the B-spline convention of spec B7.7), or a face around an EV whose fan contains such a face.
+  the B-spline convention), or a face around an EV whose fan contains such a face.
 
 A face with two or more EVs among its interior vertices is rejected: the paper subdivides the mesh
 globally first (qmv98 section 2.4.2); :func:`isolate_extraordinary` does that.
 
-**Special elements (spec B3, qmv98 eqs. 8-12, 26).** Sector j of an EV is the face whose corner c is the
+**Special elements (qmv98 eqs. 8-12, 26).** Sector j of an EV is the face whose corner c is the
 EV; in it the *sector parameter* (s, t) has the EV at (0, 0), s along the edge to e_j = grid (1, 0),
 t along the edge to e_{j+1} = grid (0, 1). One local CC step maps the two-ring to the level-1
 *three-ring* (``c = 12 n + 1`` vertices: the EV and the positions 1 <= a <= 3, 0 <= b <= 3 of every
@@ -113,7 +113,7 @@ def sector_derivative_maps():
 
 
 def term_scale(term, level):
-    """Per-level factor of a special-element patch at local level ``level`` (spec B3).
+    """Per-level factor of a special-element patch at local level ``level``.
 
     >>> term_scale("mass", 2), term_scale("uu1", 2), term_scale("uv2", 2)
     (0.0625, 1.0, 16.0)

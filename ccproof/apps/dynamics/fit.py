@@ -1,4 +1,4 @@
-"""Shape recovery from range data with a dynamic Catmull-Clark surface (qmv98 sections 3.4, 4.2; spec B6, Q9).
+"""Shape recovery from range data with a dynamic Catmull-Clark surface (qmv98 sections 3.4, 4.2).
 
 Pipeline (:func:`fit_points`):
 

@@ -1,4 +1,4 @@
-"""Applied forces: springs to points of the limit surface and data forces from point clouds (qmv98 3.2; B5).
+"""Applied forces: springs to points of the limit surface and data forces from point clouds (qmv98 section 3.2).
 
 A spring of stiffness k from a point d0 to the limit-surface point ``s(u0, v0)`` (eq. 27, delta
 kernel) has the generalized force ``f_p = k J(u0, v0)^T (d0 - J(u0, v0) p)`` (eq. 21). A set of
@@ -6,7 +6,7 @@ springs is stored as the sparse matrix ``J_S`` (one row ``J(u0, v0)`` per spring
 the anchor points; :class:`~ccproof.apps.dynamics.integrate.ImplicitIntegrator` moves ``k J^T J``
 into the step matrix (semi-implicit).
 
-Range data: every data point pulls the *nearest* point of the limit surface (spec B7.4, B7.5): the
+Range data: every data point pulls the *nearest* point of the limit surface: the
 surface is sampled densely (a grid per face, evaluated through a precomputed sparse sampling matrix),
 the nearest samples are found with a k-d tree, and each candidate is refined by a projected
 Gauss-Newton iteration on (u, v) inside its face; the closest candidate wins.

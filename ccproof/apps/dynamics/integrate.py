@@ -1,4 +1,4 @@
-"""Implicit time integration of ``M p'' + D p' + K p = f_p`` (qmv98 section 3.3, eqs. 29-32; spec B5).
+"""Implicit time integration of ``M p'' + D p' + K p = f_p`` (qmv98 section 3.3, eqs. 29-32).
 
 With the central differences (29), (30) at ``t + dt``, the paper's scheme (31) is::
 
@@ -23,7 +23,7 @@ K) and ``k J^T d`` (added to ``f_p``), with the attachment points fixed during t
 >>> integ = ImplicitIntegrator(sysm, dt=0.1, P=np.array([[1.0]]))
 >>> for _ in range(50):
 ...     _ = integ.step()
->>> round(float(integ.P[0, 0]), 3)        # scheme (31) at T = 5; exact -0.269 (error 0.159, spec B5)
+>>> round(float(integ.P[0, 0]), 3)        # scheme (31) at T = 5; exact -0.269 (error 0.159)
 -0.11
 """
 

@@ -1,4 +1,4 @@
-"""The control meshes of qmv98 (Fig. 6 and the shape-recovery model of section 4.2; spec B6, Q8).
+"""The control meshes of qmv98 (Fig. 6 and the shape-recovery model of section 4.2).
 
 The paper gives only their sizes; these generators reproduce the sizes (and the valences):
 

@@ -104,7 +104,7 @@ class Material:
         """Densities for the model rebuilt on the CC-subdivided mesh with the *same* energies.
 
         Every child face gets its own unit domain, so the same densities would make the mass
-        4 times, the rigidity energy 1/4 of the coarse one (spec B4): mu, gamma / 4, b * 4.
+        4 times, the rigidity energy 1/4 of the coarse one: mu, gamma / 4, b * 4.
         """
         return replace(self, mu=self.mu / 4, gamma=self.gamma / 4, b11=4 * self.b11, b12=4 * self.b12,
                        b22=4 * self.b22)
@@ -492,7 +492,7 @@ class DynamicSurface:
 
     # ------------------------------------------------------------------ multilevel
     def refine(self, P=None, rescale=True):
-        """Rebuild the model on the CC-subdivided mesh (qmv98 section 3.4; spec B4).
+        """Rebuild the model on the CC-subdivided mesh (qmv98 section 3.4).
 
         Parameters
         ----------

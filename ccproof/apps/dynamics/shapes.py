@@ -1,4 +1,4 @@
-"""Synthetic range data standing in for the paper's scans (spec Q9; the bulb, head and anvil scans of
+"""Synthetic range data standing in for the paper's scans (the bulb, head and anvil scans of
 qmv98 Figs. 7-9 are not available).
 
 * ``"bulb"``: a surface of revolution, a unit sphere above the equator that narrows and stretches below
