@@ -43,7 +43,9 @@ def add_arguments(parser):
     parser.add_argument("--segment", choices=["normals"], help="segment into charts (when no --charts)")
     parser.add_argument("--variant", choices=["extended", "boundary"], default="extended",
                         help="chart boundary treatment: extended charts (c) or boundary rules (b)")
-    parser.add_argument("--levels", type=int, default=3, metavar="K", help="finest optimization level (default 3)")
+    parser.add_argument("--levels", type=int, default=None, metavar="K",
+                        help="finest optimization level (default 3, lowered while the estimated memory of the "
+                             "largest chart exceeds --max-memory)")
     parser.add_argument("--start-level", type=int, default=1, help="coarsest optimization level (default 1)")
     parser.add_argument("--eval-level", type=int, default=None,
                         help="level of the metric samples (default: 5, lowered for large meshes so that all "
@@ -155,6 +157,16 @@ def run(args) -> int:
             refine = int(args.refine)
         except ValueError:
             raise CCProofError(f"--refine must be auto or an integer >= 0, got {args.refine!r}") from None
+    from ccproof.apps.arap.core import _charts, estimate_memory
+    from ccproof.apps.arap.hierarchy import ChartHierarchy
+
+    hierarchies = [ChartHierarchy(mesh, fc) for fc in _charts(mesh, labels)]
+    levels = args.levels
+    if levels is None:
+        levels = 3
+        while levels > 1 and estimate_memory(hierarchies, 0, True, levels) > args.max_memory * 1e9:
+            levels -= 1
+    args.levels = levels
     eval_level = args.eval_level
     if eval_level is None:
         eval_level = default_eval_level(mesh, labels, args.levels, "d" in methods)
@@ -168,7 +180,7 @@ def run(args) -> int:
     try:
         results, _ = compare(mesh, labels, methods, levels=args.levels, start_level=args.start_level,
                              eval_level=eval_level, tol=args.tol, max_iter=args.max_iter, engine=engine,
-                             refine=refine, sample_level=sample_level, release=True,
+                             refine=refine, sample_level=sample_level, release=True, hierarchies=hierarchies,
                              max_memory=args.max_memory * 1e9, progress=not args.no_progress, accel=args.accel)
     except MemoryBudgetError:
         raise

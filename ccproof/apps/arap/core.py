@@ -316,9 +316,13 @@ def _charts(mesh, labels):
     return charts_from_labels(mesh, labels)
 
 
-#: measured peak bytes per face of the deepest level ``E_k`` built for one chart (hierarchy, samples,
-#: operators; bunny charts, levels 3-5: 0.9-1.1 kB), with a margin
+#: measured peak bytes per face of the metric / output level ``E_k`` of one chart (hierarchy, samples,
+#: subdivision operators; bunny charts, levels 3-5: 0.9-1.1 kB), with a margin
 BYTES_PER_FACE = 1400
+#: measured peak bytes per face of the finest optimization level of one chart (samples composed with the
+#: unknowns-to-level operator, the normal matrix and its factor; bunny x2 with refine 1: 3.9 kB before
+#: the transposed operator stopped being stored), with a margin
+OPT_BYTES_PER_FACE = 4000
 #: memory of the interpreter and the libraries (numpy, scipy) before any chart
 BASE_BYTES = 150e6
 
@@ -347,11 +351,18 @@ def auto_refine(mesh, labels, faces_per_chart=1000):
     return r
 
 
-def estimate_memory(hierarchies, deepest_level, release=True):
-    """Estimated peak bytes: :data:`BYTES_PER_FACE` per face of ``E_deepest`` of the largest chart
-    (``release``: charts are processed one at a time) or of all charts, plus :data:`BASE_BYTES`."""
-    faces = [h.n_faces(deepest_level) for h in hierarchies]
-    return BASE_BYTES + BYTES_PER_FACE * (max(faces) if release else sum(faces))
+def estimate_memory(hierarchies, deepest_level, release=True, opt_level=None):
+    """Estimated peak bytes (linear in the faces): :data:`BYTES_PER_FACE` per face of ``E_deepest``
+    (metrics, output) and :data:`OPT_BYTES_PER_FACE` per face of ``E_opt_level`` (optimization), for the
+    largest chart (``release``: charts are processed one at a time) or all charts, plus
+    :data:`BASE_BYTES`."""
+    def need(k, per):
+        if k is None:
+            return 0.0
+        faces = [h.n_faces(k) for h in hierarchies]
+        return per * (max(faces) if release else sum(faces))
+
+    return BASE_BYTES + max(need(deepest_level, BYTES_PER_FACE), need(opt_level, OPT_BYTES_PER_FACE))
 
 
 class MemoryBudgetError(CCProofError):
@@ -404,15 +415,18 @@ def compare(mesh, labels=None, methods=METHODS, levels=3, start_level=1, eval_le
         fine = {"hierarchies": [ChartHierarchy(rmesh, fc) for fc in _charts(rmesh, rlab)],
                 "start": max(start_level, refine + 1) - refine, "levels": max(levels, refine + 1) - refine}
     deepest = max([eval_level] + ([sample_level] if sample_level is not None else [])
-                  + ([levels] if any(m in ("b", "c") for m in methods) else [])
-                  + ([baseline_level] if "d" in methods else []) + ([fine["levels"] + refine] if fine else []))
-    need = estimate_memory(hierarchies, deepest, release)
+                  + ([baseline_level] if "d" in methods else []))
+    opt = None
+    if any(m in ("b", "c") for m in methods):
+        opt = fine["levels"] + refine if fine else levels
+    need = estimate_memory(hierarchies, deepest, release, opt)
     if max_memory is not None and need > max_memory:
         big = int(np.argmax([h.n_faces(0) for h in hierarchies]))
         raise MemoryBudgetError(
             f"estimated peak memory {need / 1e9:.2f} GB exceeds the budget {max_memory / 1e9:.2f} GB "
-            f"(--max-memory): chart {big} has {hierarchies[big].n_faces(deepest):,} faces at level {deepest}; "
-            f"lower --eval-level / --levels / --out-level (each level less divides it by 4), or use smaller charts")
+            f"(--max-memory): chart {big} has {hierarchies[big].n_faces(max(deepest, opt or 0)):,} faces at level "
+            f"{max(deepest, opt or 0)}; lower --eval-level / --levels / --out-level (each level less divides it "
+            f"by 4), or use smaller charts")
     bar = None
     if progress:
         from tqdm import tqdm

@@ -101,7 +101,7 @@ class LocalGlobal:
         Hv = sp.diags(-b / (a * c)) @ G1 + sp.diags(1.0 / c) @ G2  # rows h_{j,2}^T
         # stacked [Hu; Hv]: one sparse product per direction and iteration
         self.H = sp.vstack([Hu, Hv]).tocsr()
-        self.HT = self.H.T.tocsr()
+        del Hu, Hv, G1, G2
         self.w = w
         self.w2 = np.concatenate([w, w])[:, None]
         self.weight_sum = float(w.sum())
@@ -112,7 +112,7 @@ class LocalGlobal:
         if not factor:  # energy evaluation only
             self.build_seconds = time.perf_counter() - t0
             return
-        self.L = (self.HT @ sp.diags(self.w2[:, 0]) @ self.H).tocsc()
+        self.L = (self.H.T @ sp.diags(self.w2[:, 0]) @ self.H).tocsc()
         N = self.L.shape[0]
         self.N = N
         self.free = np.setdiff1d(np.arange(N), [self.pin])
@@ -151,7 +151,7 @@ class LocalGlobal:
 
     def rhs(self, R):
         """B = sum_j w_j H_j R_j^T, shape (N, 2)."""
-        return self.HT @ (self.w2 * np.concatenate([R[:, :, 0], R[:, :, 1]]))
+        return self.H.T @ (self.w2 * np.concatenate([R[:, :, 0], R[:, :, 1]]))  # CSC view: no stored copy
 
     def global_step(self, R, X):
         """Minimize E(., R) (plus the proximal term when regularized); the pinned unknown stays."""
