@@ -17,7 +17,16 @@ Measured in one run, on the closed bunny cut into charts by ``segment_by_normals
 
 Writes a JSON summary (``--out``, default ``out/bench_arap.json``) and prints a table.
 
+``--scale``: the user-facing runs instead, each in its own process (peak memory = that process's
+maximum resident set size): (c) as ``ccproof arap`` runs it (charts one at a time, ``--refine``
+by its default rule, metrics at ``--eval-level``) and (d) (libigl) to convergence, on the bunny and
+on the bunny subdivided twice (32,576 faces; ``--large-faces`` picks the number of subdivisions),
+with the ratios time(c)/time(d) (target <= 1/4), E_area and E_stretch of (c) minus those of (d)
+(target <= 0) and the peak memory (target <= 2 GB at the large mesh). (d) on the large mesh is
+capped at ``--large-d-iterations`` iterations per chart (it is reported as capped).
+
 Usage:  python scripts/bench_arap.py [--mesh PATH] [--engine igl|numpy] [--patch] [--out FILE]
+        python scripts/bench_arap.py --scale [--eval-level 5] [--out out/bench_arap_scale.json]
 """
 
 from __future__ import annotations
@@ -167,8 +176,92 @@ def run_case(name, mesh, charts, engine, tol, repeat):
     return r
 
 
+def one_run(args):
+    """Child process of --scale: one method on one mesh, printed as one JSON line."""
+    import resource
+
+    from ccproof.apps.arap.core import auto_refine, compare, refine_mesh
+
+    mesh = read_obj(args.mesh)
+    if args.subdivide:
+        mesh, _ = refine_mesh(mesh, None, args.subdivide)
+    t0 = time.perf_counter()
+    labels = segment_by_normals(mesh)
+    t_seg = time.perf_counter() - t0
+    refine = auto_refine(mesh, labels) if args.refine == "auto" else int(args.refine)
+    t0 = time.perf_counter()
+    res, hs = compare(mesh, labels, (args.one,), eval_level=args.eval_level, engine=args.engine_one,
+                      refine=refine, release=True, baseline_max_iter=args.baseline_max_iter, progress=False,
+                      accel=5)
+    total = time.perf_counter() - t0
+    r = res[args.one]
+    conv = None
+    if args.one == "d":
+        conv = r.iterations < args.baseline_max_iter * len(hs)
+    m = r.metrics
+    print(json.dumps({
+        "method": args.one, "faces": mesh.n_faces, "charts": len(hs), "refine": refine if args.one == "c" else 0,
+        "segmentation_seconds": t_seg, "method_seconds": r.seconds, "total_seconds": total,
+        "iterations": r.iterations, "E_angle": m.E_angle, "E_area": m.E_area, "E_stretch": m.E_stretch,
+        "flips": m.flips, "samples": m.samples, "eval_level": args.eval_level,
+        "peak_rss_gb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1e6,
+        "d_capped": (None if conv is None else not conv),
+    }))
+    return 0
+
+
+def scale_runs(args, engine):
+    import subprocess
+
+    cases = [("bunny", 0), (f"bunny x{args.large_subdivisions}", args.large_subdivisions)]
+    out = {"eval_level": args.eval_level, "engine": engine, "load_average_at_start": os.getloadavg(),
+           "cases": {}}
+    for name, sub in cases:
+        rows = {}
+        for meth in ("c", "d"):
+            cmd = [sys.executable, __file__, "--one", meth, "--mesh", args.mesh, "--subdivide", str(sub),
+                   "--eval-level", str(args.eval_level if sub == 0 else min(args.eval_level, 3)),
+                   "--engine-one", engine]
+            if meth == "d" and sub:
+                cmd += ["--baseline-max-iter", str(args.large_d_iterations)]
+            print(f"== {name}: {meth} ...", flush=True)
+            p = subprocess.run(cmd, capture_output=True, text=True)
+            if p.returncode:
+                print(p.stderr[-3000:], flush=True)
+                rows[meth] = {"error": p.stderr[-500:]}
+                continue
+            rows[meth] = json.loads(p.stdout.strip().splitlines()[-1])
+            v = rows[meth]
+            print(f"   {v['faces']} faces, {v['charts']} charts, refine {v['refine']}: {v['method_seconds']:.1f} s "
+                  f"(total {v['total_seconds']:.1f} s), {v['iterations']} iterations, peak {v['peak_rss_gb']:.2f} GB, "
+                  f"E = {v['E_angle']:.6f} {v['E_area']:.6f} {v['E_stretch']:.6f} at level {v['eval_level']}, "
+                  f"flips {v['flips']}" + (", CAPPED" if v.get("d_capped") else ""), flush=True)
+        c, d = rows.get("c", {}), rows.get("d", {})
+        if "E_area" in c and "E_area" in d:
+            rows["ratio_time_c_over_d"] = c["method_seconds"] / d["method_seconds"]
+            rows["E_area_c_minus_d"] = c["E_area"] - d["E_area"]
+            rows["E_stretch_c_minus_d"] = c["E_stretch"] - d["E_stretch"]
+            rows["area_excess_ratio_c_over_d"] = (c["E_area"] - 2) / (d["E_area"] - 2)
+            print(f"   time (c) / time (d) = {rows['ratio_time_c_over_d']:.3f} (target <= 0.25)"
+                  f"{' [(d) capped: a lower bound on its time]' if d.get('d_capped') else ''}; "
+                  f"E_area (c) - (d) = {rows['E_area_c_minus_d']:+.2e}, E_stretch (c) - (d) = "
+                  f"{rows['E_stretch_c_minus_d']:+.2e} (target <= 0); excess ratio "
+                  f"{rows['area_excess_ratio_c_over_d']:.3f}; peak (c) {c['peak_rss_gb']:.2f} GB", flush=True)
+        out["cases"][name] = rows
+    return out
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--scale", action="store_true", help="the user-facing runs (module docstring)")
+    ap.add_argument("--eval-level", type=int, default=5)
+    ap.add_argument("--large-subdivisions", type=int, default=2)
+    ap.add_argument("--large-d-iterations", type=int, default=30)
+    ap.add_argument("--one", choices=["c", "d"], help=argparse.SUPPRESS)
+    ap.add_argument("--subdivide", type=int, default=0, help=argparse.SUPPRESS)
+    ap.add_argument("--refine", default="auto", help=argparse.SUPPRESS)
+    ap.add_argument("--engine-one", default="igl", help=argparse.SUPPRESS)
+    ap.add_argument("--baseline-max-iter", type=int, default=20000, help=argparse.SUPPRESS)
     ap.add_argument("--mesh", default=str(DEFAULT_MESH))
     ap.add_argument("--engine", choices=["igl", "numpy"], default=None, help="baseline (d) engine (default igl)")
     ap.add_argument("--tol", type=float, default=1e-6)
@@ -176,6 +269,8 @@ def main(argv=None):
     ap.add_argument("--patch", action="store_true", help="also the open patch (one chart)")
     ap.add_argument("--out", default="out/bench_arap.json")
     args = ap.parse_args(argv)
+    if args.one:
+        return one_run(args)
     engine = args.engine
     if engine is None:
         try:
@@ -184,6 +279,13 @@ def main(argv=None):
             engine = "igl"
         except ImportError:
             engine = "numpy"
+    if args.scale:
+        out = scale_runs(args, engine)
+        dest = Path(args.out if args.out != "out/bench_arap.json" else "out/bench_arap_scale.json")
+        dest.parent.mkdir(parents=True, exist_ok=True)
+        dest.write_text(json.dumps(out, indent=1))
+        print(f"wrote {dest}")
+        return 0
     mesh = read_obj(args.mesh)
     labels = segment_by_normals(mesh)
     load = os.getloadavg() if hasattr(os, "getloadavg") else None

@@ -10,6 +10,12 @@ relative residual of 1e-8, warm start) with the assembled matrix and element by 
 of ~2,000 range points (the Stanford bunny's 2,038 scanned vertices in tests/data/meshes, or a
 2,031-point synthetic block when that file is absent) from the 98-vertex model to 386 vertices.
 The log-log slope of time against vertices is printed (1 = linear growth).
+
+``--fit-large``: the fit of 20,000 points (synthetic ellipsoid, ``--fit-points``) from the 98-vertex model
+up to 24,578 control vertices (4 subdivisions, ``--fit-levels``), in its own process: time and peak
+memory (maximum resident set size; target <= 1 GB), with the data -> surface and two-sided errors.
+
+  python scripts/bench_fem.py --fit-large --max-level 1 --no-fit
 """
 
 from __future__ import annotations
@@ -108,14 +114,60 @@ def bench_fit():
             "levels": [lev.__dict__ for lev in res.levels]}
 
 
+def one_fit(points, levels, max_steps):
+    """Child process of --fit-large: one fit, printed as one JSON line."""
+    import resource
+
+    from ccproof.apps.dynamics.fit import fit_points
+    from ccproof.apps.dynamics.shapes import synthetic_range_data
+
+    X = synthetic_range_data("ellipsoid", points)
+    t0 = time.perf_counter()
+    res = fit_points(X, levels=levels, max_steps=max_steps)
+    total = time.perf_counter() - t0
+    print(json.dumps({
+        "points": points, "levels": [lev.__dict__ for lev in res.levels], "total_s": total,
+        "max_error_percent": res.max_error_percent, "two_sided_error_percent": res.two_sided_error_percent,
+        "stray_fraction": res.surface_report["stray_fraction"], "warnings": res.warnings,
+        "peak_rss_gb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1e6}, default=float))
+
+
+def bench_fit_large(points, levels, max_steps, target_gb=1.0):
+    import subprocess
+    import sys
+
+    p = subprocess.run([sys.executable, __file__, "--one-fit", str(points), str(levels), str(max_steps)],
+                       capture_output=True, text=True)
+    if p.returncode:
+        print(p.stderr[-3000:])
+        return {"error": p.stderr[-500:]}
+    r = json.loads(p.stdout.strip().splitlines()[-1])
+    print(f"fit of {points} points up to {r['levels'][-1]['n_vertices']} control vertices: {r['total_s']:.1f} s, "
+          f"peak memory {r['peak_rss_gb']:.2f} GB (target <= {target_gb} GB: "
+          f"ratio {r['peak_rss_gb'] / target_gb:.2f}); "
+          f"max error {r['max_error_percent']:.3f} %, two-sided {r['two_sided_error_percent']:.3f} %")
+    for lev in r["levels"]:
+        print(f"   {lev['n_vertices']:6d} vertices: {lev['steps']:3d} steps{'' if lev['converged'] else ' (cap)'}, "
+              f"{lev['seconds']:6.1f} s, max error {lev['max_error_percent']:.3f} %")
+    return r
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--fit-large", action="store_true", help="the 20k-point fit up to 24,578 vertices")
+    ap.add_argument("--fit-points", type=int, default=20000)
+    ap.add_argument("--fit-levels", type=int, default=4)
+    ap.add_argument("--fit-max-steps", type=int, default=60)
+    ap.add_argument("--one-fit", nargs=3, type=int, help=argparse.SUPPRESS)
     ap.add_argument("--max-level", type=int, default=6, help="largest number of cube subdivisions (default 6)")
     ap.add_argument("--matrix-free-max", type=int, default=30000,
                     help="skip the element-by-element step above this many vertices")
     ap.add_argument("--no-fit", action="store_true")
     ap.add_argument("--json", default=None, help="write the numbers here")
     args = ap.parse_args(argv)
+    if args.one_fit:
+        one_fit(*args.one_fit)
+        return 0
     print("subdivisions, vertices, nnz(K), layout s, assemble M1 s, assemble K s, implicit step (31) s "
           "(assembled), CG iterations, step s (element by element)")
     rows = bench_levels(range(2, args.max_level + 1), args.matrix_free_max)
@@ -124,6 +176,8 @@ def main(argv=None):
     out = {"levels": rows}
     if not args.no_fit:
         out["fit"] = bench_fit()
+    if args.fit_large:
+        out["fit_large"] = bench_fit_large(args.fit_points, args.fit_levels, args.fit_max_steps)
     if args.json:
         Path(args.json).write_text(json.dumps(out, indent=1, default=float))
     return 0

@@ -11,11 +11,27 @@ triangles of the control mesh and flipped samples at the evaluation level, secon
 With --baselines also (a) ARAP on the triangulated control mesh, the other variant, and (d) ARAP on
 the control mesh subdivided 3 times, all measured the same way.
 
-Example:  ccproof arap bunny_quads.obj --segment normals --baselines --out bunny_uv.obj
+Output for other tools (--out FILE): the limit surface sampled at --out-level (default 3) as a
+triangle (or --cells quad) mesh whose per-vertex UVs are the parameterization evaluated exactly at
+the limit points; charts packed into [0, 1]^2 without overlap (shelf packing, one common scale);
+seams as duplicated vertices (one UV per chart). FILE.obj is written directly (v, vt, f i/i), any
+other extension through meshio (point data "uv"; PLY: "s", "t"); FILE.json holds the metrics, the
+packing scale and the written triangles' own distortion. --control-out FILE.obj writes the control
+mesh with its texture control points and states the subdivision rule they need.
+
+Scale: charts are processed one at a time; the peak memory is estimated first and a run above
+--max-memory (default 2 GB) stops with an error naming the options that lower it. --refine R (default:
+the smallest R in 0..2 giving >= 1000 control faces per chart) subdivides the control mesh before
+optimizing (b)/(c), which lets (c) reach (d)'s E_area on small charts; --accel (default 5) is the
+Anderson acceleration of the local/global iteration. --preview FILE.png renders checkerboard and
+distortion maps.
+
+Example:  ccproof arap bunny_quads.obj --segment normals --baselines --out bunny_uv.obj --preview bunny.png
 """
 
 from __future__ import annotations
 
+import json
 import sys
 
 __all__ = ["add_arguments", "run", "format_table"]
@@ -27,16 +43,39 @@ def add_arguments(parser):
     parser.add_argument("--segment", choices=["normals"], help="segment into charts (when no --charts)")
     parser.add_argument("--variant", choices=["extended", "boundary"], default="extended",
                         help="chart boundary treatment: extended charts (c) or boundary rules (b)")
-    parser.add_argument("--levels", type=int, default=3, metavar="K", help="finest optimization level (default 3)")
+    parser.add_argument("--levels", type=int, default=None, metavar="K",
+                        help="finest optimization level (default 3, lowered while the estimated memory of the "
+                             "largest chart exceeds --max-memory)")
     parser.add_argument("--start-level", type=int, default=1, help="coarsest optimization level (default 1)")
-    parser.add_argument("--eval-level", type=int, default=5, help="level of the metric samples (default 5)")
+    parser.add_argument("--eval-level", type=int, default=None,
+                        help="level of the metric samples (default: 5, lowered for large meshes so that all "
+                             "charts have at most 4M samples, at least 3 with --baselines)")
+    parser.add_argument("--refine", default="auto",
+                        help="subdivide the control mesh R times before optimizing (b)/(c): 0, 1, 2 or auto "
+                             "(default: the smallest R in 0..2 giving >= 1000 control faces per chart)")
+    parser.add_argument("--max-memory", type=float, default=2.0, metavar="GB",
+                        help="refuse runs whose estimated peak memory exceeds this (default 2 GB)")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    parser.add_argument("--accel", type=int, default=5, metavar="M",
+                        help="Anderson acceleration history of (b)/(c), energy-safeguarded (default 5; 0: plain)")
     parser.add_argument("--tol", type=float, default=1e-6, help="relative energy decrease to stop a level")
     parser.add_argument("--max-iter", type=int, default=1000, help="iterations per level at most")
     parser.add_argument("--baselines", action="store_true", help="also run (a), the other variant and (d)")
     parser.add_argument("--engine", choices=["auto", "numpy", "igl"], default="auto",
                         help="triangle ARAP engine of the baselines (auto: libigl if installed)")
-    parser.add_argument("--out", metavar="UV.obj", help="write the texture (OBJ with vt, plus UV.obj.json)")
+    parser.add_argument("--out", metavar="FILE",
+                        help="write the limit surface sampled at --out-level with exact UVs (.obj, or any "
+                             "meshio format such as .vtu .ply), plus FILE.json")
+    parser.add_argument("--out-level", type=int, default=None,
+                        help="sampling level of --out and --preview (default 3, lowered for large meshes to "
+                             "at most 2M triangles)")
+    parser.add_argument("--cells", choices=["triangle", "quad"], default="triangle", help="cells of --out")
+    parser.add_argument("--control-out", metavar="UV.obj",
+                        help="write the control mesh with texture control points (OBJ with vt, plus UV.obj.json)")
     parser.add_argument("--labels-out", metavar="FILE", help="write the chart labels used")
+    parser.add_argument("--preview", metavar="FILE.png",
+                        help="render a checkerboard through the UVs and the per-triangle distortion (matplotlib), "
+                             "one row per method")
 
 
 def format_table(results, eval_level=5):
@@ -53,10 +92,37 @@ def format_table(results, eval_level=5):
     return "\n".join(rows)
 
 
+#: at most this many triangles in the default --out
+MAX_DEFAULT_OUT_TRIANGLES = 2_000_000
+#: at most this many metric samples (faces of E_k over all charts) for the default --eval-level
+MAX_DEFAULT_SAMPLES = 4_000_000
+
+
+def default_eval_level(mesh, labels, levels, with_d):
+    """5 (hsh10's level), lowered while the charts' E_k hold more than MAX_DEFAULT_SAMPLES faces, but not
+    below the optimization level, nor below 3 when (d) is measured (its texture lives at level 3)."""
+    import numpy as np
+
+    from ccproof.apps.arap.core import _charts
+
+    F = mesh.faces
+    n = 0
+    for fc in _charts(mesh, labels):  # faces of E_0: the chart and its ring
+        isc = np.zeros(mesh.n_vertices, dtype=bool)
+        isc[F[fc]] = True
+        n += int(isc[F].any(axis=1).sum())
+    k = 5
+    while k > 0 and n * 4**k > MAX_DEFAULT_SAMPLES:
+        k -= 1
+    return max(k, levels, 3 if with_d else 0)
+
+
 def run(args) -> int:
     from ccproof.apps.arap.charts import read_labels, segment_by_normals, write_labels
-    from ccproof.apps.arap.core import VARIANTS, compare
+    from ccproof.apps.arap.core import VARIANTS, MemoryBudgetError, auto_refine, compare
+    from ccproof.apps.arap.export import sampled_surface, write_surface
     from ccproof.apps.arap.io import write_uv_obj
+    from ccproof.errors import CCProofError
     from ccproof.mesh import read_obj
 
     mesh = read_obj(args.mesh)
@@ -84,12 +150,49 @@ def run(args) -> int:
                 engine = "numpy"
     elif engine == "auto":
         engine = "numpy"
-    results, _ = compare(mesh, labels, methods, levels=args.levels, start_level=args.start_level,
-                         eval_level=args.eval_level, tol=args.tol, max_iter=args.max_iter, engine=engine)
+    if args.refine == "auto":
+        refine = auto_refine(mesh, labels)
+    else:
+        try:
+            refine = int(args.refine)
+        except ValueError:
+            raise CCProofError(f"--refine must be auto or an integer >= 0, got {args.refine!r}") from None
+    from ccproof.apps.arap.core import _charts, estimate_memory
+    from ccproof.apps.arap.hierarchy import ChartHierarchy
+
+    hierarchies = [ChartHierarchy(mesh, fc) for fc in _charts(mesh, labels)]
+    levels = args.levels
+    if levels is None:
+        levels = 3
+        while levels > 1 and estimate_memory(hierarchies, 0, True, levels) > args.max_memory * 1e9:
+            levels -= 1
+    args.levels = levels
+    eval_level = args.eval_level
+    if eval_level is None:
+        eval_level = default_eval_level(mesh, labels, args.levels, "d" in methods)
+    out_level = args.out_level
+    if out_level is None:
+        n = mesh.n_faces if labels is None else int((labels >= 0).sum())
+        out_level = 3
+        while out_level > 0 and 2 * n * 4**out_level > MAX_DEFAULT_OUT_TRIANGLES:
+            out_level -= 1
+    sample_level = out_level if (args.out or args.control_out or args.preview) else None
+    try:
+        results, _ = compare(mesh, labels, methods, levels=args.levels, start_level=args.start_level,
+                             eval_level=eval_level, tol=args.tol, max_iter=args.max_iter, engine=engine,
+                             refine=refine, sample_level=sample_level, release=True, hierarchies=hierarchies,
+                             max_memory=args.max_memory * 1e9, progress=not args.no_progress, accel=args.accel)
+    except MemoryBudgetError:
+        raise
+    except MemoryError as exc:
+        raise CCProofError(f"out of memory ({exc}); lower --eval-level, --levels or --out-level (each level "
+                           f"less needs 4x less memory) or lower --max-memory so that the estimate refuses "
+                           f"earlier") from None
     nch = len(results[ours].textures)
     print(f"{args.mesh}: {mesh.n_vertices} vertices, {mesh.n_faces} faces, {nch} chart(s); "
-          f"levels {args.start_level}..{args.levels}, metrics at level {args.eval_level}, baseline engine {engine}")
-    print(format_table(results, args.eval_level))
+          f"levels {args.start_level}..{args.levels}, refine {refine}, metrics at level {eval_level}, "
+          f"baseline engine {engine}")
+    print(format_table(results, eval_level))
     lv = results[ours].levels
     for k in range(len(lv[0]) if lv and lv[0] else 0):
         its = sum(c[k].iterations for c in lv)
@@ -99,16 +202,41 @@ def run(args) -> int:
         print(f"  {results[ours].name}: level {lv[0][k].level}: {its} iterations, "
               f"{1e3 * spi:.2f} ms per chart iteration, energy {e0:.6g} -> {e1:.6g}, "
               f"converged: {all(c[k].converged for c in lv)}")
+    table = {
+        m: {"E_angle": r.metrics.E_angle, "E_area": r.metrics.E_area, "E_stretch": r.metrics.E_stretch,
+            "flips_control": r.flips_control, "flips_eval": r.metrics.flips, "seconds": r.seconds,
+            "iterations": r.iterations}
+        for m, r in results.items()
+    }
+    comment = f"ccproof arap {args.mesh}: {results[ours].name}, levels {args.start_level}..{args.levels}"
+    surf = None
+    if args.out or args.control_out:
+        surf = sampled_surface(results[ours], out_level, args.cells)
+    if args.preview:
+        from ccproof.apps.arap.preview import render_preview
+
+        surfs = {m: sampled_surface(r, r.sample_level) for m, r in results.items()}
+        render_preview(args.preview, surfs, {m: r.name for m, r in results.items()}, title=args.mesh)
+        print(f"wrote {args.preview}")
     if args.out:
-        table = {
-            m: {"E_angle": r.metrics.E_angle, "E_area": r.metrics.E_area, "E_stretch": r.metrics.E_stretch,
-                "flips_control": r.flips_control, "flips_eval": r.metrics.flips, "seconds": r.seconds,
-                "iterations": r.iterations}
-            for m, r in results.items()
-        }
-        side = write_uv_obj(args.out, mesh, results[ours],
-                            comment=f"ccproof arap: {results[ours].name}, levels {args.start_level}..{args.levels}",
-                            table=table)
-        print(f"wrote {args.out} and {side}")
+        write_surface(args.out, surf, comment)
+        wm = surf.metrics()
+        info = {"method": ours, "level": surf.level, "cells": surf.cell_type, "uv_scale": surf.scale,
+                "folds": surf.folds(), "seams": "vertices duplicated per chart",
+                "written_triangles": {"E_angle": wm.E_angle, "E_area": wm.E_area, "E_stretch": wm.E_stretch,
+                                      "note": "E_area at the natural UV scale: divide the file's UVs by uv_scale"},
+                "table": table}
+        with open(args.out + ".json", "w", encoding="utf-8") as fh:
+            json.dump(info, fh, indent=1)
+        print(f"wrote {args.out} (level {surf.level}: {surf.points.shape[0]} vertices, {surf.cells.shape[0]} "
+              f"{surf.cell_type}s, {surf.folds()} folded; written triangles E_angle {wm.E_angle:.6f} "
+              f"E_area {wm.E_area:.6f} E_stretch {wm.E_stretch:.6f}) and {args.out}.json")
+    if args.control_out:
+        r = results[ours]
+        cmesh = r.textures[0].hierarchy.surface  # with --refine: the refined control mesh the texture lives on
+        note = f"\ncontrol mesh: the input subdivided {r.refine} times (Catmull-Clark)" if r.refine else ""
+        side = write_uv_obj(args.control_out, cmesh, r, comment=comment + note, table=table,
+                            transforms=surf.transforms, scale=surf.scale)
+        print(f"wrote {args.control_out} and {side}")
     sys.stdout.flush()
     return 0

@@ -14,7 +14,7 @@ chart, then the conformal extension to the ring). Every method is measured the s
 :func:`texture_metrics` at evaluation level 5 (docs/hsh10.md A9), plus flipped triangles of the texture
 control mesh (:func:`control_flips`).
 
-Multi-resolution schedule (A7): optimize at ``start_level`` until the relative energy decrease
+Multi-resolution schedule: optimize at ``start_level`` until the relative energy decrease
 per iteration is below ``tol``, then at the next level warm-started from the current ``T^0``, up
 to ``levels``. The default start is level 1 (docs/hsh10.md A6 caution: at level 0 the masks miss the
 odd-even modes of regular grids; level 0 is allowed and then regularized if singular).
@@ -23,7 +23,7 @@ odd-even modes of regular grids; level 0 is allowed and then regularized if sing
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -47,6 +47,10 @@ __all__ = [
     "control_flips",
     "parameterize",
     "compare",
+    "refine_mesh",
+    "auto_refine",
+    "estimate_memory",
+    "MemoryBudgetError",
     "METHODS",
     "VARIANTS",
 ]
@@ -102,10 +106,15 @@ class MethodResult:
     flips_control: int = 0
     triangles_control: int = 0
     levels: list = field(default_factory=list)
+    #: times the control mesh was subdivided before optimizing (b, c)
+    refine: int = 0
+    #: per chart (P, UV, Q) limit samples at ``sample_level`` (see :func:`compare`), or None
+    samples: list = None
+    sample_level: int = None
 
     @property
     def name(self):
-        return METHOD_NAMES[self.method]
+        return METHOD_NAMES[self.method] + (f", refined x{self.refine}" if self.refine else "")
 
 
 # --------------------------------------------------------------------------- initialization
@@ -119,8 +128,8 @@ def _chart_triangles(h: ChartHierarchy):
 
 
 def initial_texture(h: ChartHierarchy, rules):
-    """LSCM of the triangulated chart control mesh at its natural scale (A6); for extended charts the
-    ring unknowns are the conformal extension of it (A11.6). Shape (n_unknowns, 2)."""
+    """LSCM of the triangulated chart control mesh at its natural scale; for extended charts the
+    ring unknowns are the conformal extension of it. Shape (n_unknowns, 2)."""
     V, Tc = _chart_triangles(h)
     nc = h.n_chart_vertices
     UV = fit_area(lscm(V[:nc], Tc), V[:nc], Tc)
@@ -133,8 +142,11 @@ def initial_texture(h: ChartHierarchy, rules):
 
 
 # --------------------------------------------------------------------------- optimization
-def optimize_chart(h: ChartHierarchy, rules, X0, levels=3, start_level=1, tol=1e-6, max_iter=1000, trace=False):
-    """Multi-resolution local/global optimization of one chart (A4-A7).
+def optimize_chart(h: ChartHierarchy, rules, X0, levels=3, start_level=1, tol=1e-6, max_iter=1000, trace=False,
+                   accel=0):
+    """Multi-resolution local/global optimization of one chart (hsh10 sections 3.1-3.3).
+
+    ``accel``: Anderson acceleration history of :func:`~ccproof.apps.arap.solver.iterate` (0: plain).
 
     Returns
     -------
@@ -150,7 +162,7 @@ def optimize_chart(h: ChartHierarchy, rules, X0, levels=3, start_level=1, tol=1e
         S = build_samples(L, rules, "optimize")
         sysk = system_from_samples(S, h.operator(k, rules), pin=0)
         tb = time.perf_counter() - t0
-        res = iterate(sysk, X, tol=tol, max_iter=max_iter, trace=trace)
+        res = iterate(sysk, X, tol=tol, max_iter=max_iter, trace=trace, accel=accel)
         X = res.X
         stats.append(
             LevelStats(
@@ -215,14 +227,33 @@ def polygon_arap(V, T, UV0, engine="numpy", tol=1e-6, max_iter=500):
     return _triangle_arap_numpy(V, T, UV0, tol, max_iter)
 
 
+def lift_to_refined(h: ChartHierarchy, X, rules, fine: ChartHierarchy, times):
+    """Texture unknowns of the chart of the ``times`` times refined mesh (``fine``) that give exactly
+    the texture ``X`` of ``h``: the level-``times`` values of ``h`` (its ``E_times`` is the refined
+    chart's ``E_0``), matched by position. Shape (fine.n_unknowns(rules), 2)."""
+    from scipy.spatial import cKDTree
+
+    L = h.level(times)
+    vals = h.subdivide_values(h.lift_unknowns(X, rules), rules, 0, times)
+    P = fine.surface.vertices[fine.unknown_vertices[: fine.n_unknowns(rules)]]
+    d, idx = cKDTree(L.mesh.vertices).query(P)
+    scale = float(np.ptp(P, axis=0).max()) or 1.0
+    if d.max() > 1e-9 * scale:
+        raise CCProofError("refined chart does not match the subdivided chart (internal error)")
+    return vals[idx]
+
+
 def run_method(h: ChartHierarchy, method, levels=3, start_level=1, tol=1e-6, max_iter=1000, engine="numpy",
-               baseline_level=3, baseline_max_iter=2000, trace=False):
-    """Run one method on one chart. Returns (ChartTexture, seconds, iterations, level stats)."""
+               baseline_level=3, baseline_max_iter=2000, trace=False, X0=None, accel=0):
+    """Run one method on one chart. Returns (ChartTexture, seconds, iterations, level stats).
+
+    ``X0``: initial texture unknowns of (b) / (c) (default: :func:`initial_texture`); ``accel``:
+    Anderson acceleration of (b) / (c) (:func:`~ccproof.apps.arap.solver.iterate`)."""
     t0 = time.perf_counter()
     if method in ("b", "c"):
         rules = "boundary" if method == "b" else "extended"
-        X0 = initial_texture(h, rules)
-        X, stats, _ = optimize_chart(h, rules, X0, levels, start_level, tol, max_iter, trace)
+        X0 = initial_texture(h, rules) if X0 is None else X0
+        X, stats, _ = optimize_chart(h, rules, X0, levels, start_level, tol, max_iter, trace, accel)
         tex = ChartTexture(h, rules, 0, h.lift_unknowns(X, rules), X)
         return tex, time.perf_counter() - t0, sum(s.iterations for s in stats), stats
     if method == "a":
@@ -285,37 +316,181 @@ def _charts(mesh, labels):
     return charts_from_labels(mesh, labels)
 
 
+#: measured peak bytes per face of the metric / output level ``E_k`` of one chart (hierarchy, samples,
+#: subdivision operators; bunny charts, levels 3-5: 0.9-1.1 kB), with a margin
+BYTES_PER_FACE = 1400
+#: measured peak bytes per face of the finest optimization level of one chart (samples composed with the
+#: unknowns-to-level operator, the normal matrix and its factor; bunny x2 with refine 1: 3.9 kB before
+#: the transposed operator stopped being stored), with a margin
+OPT_BYTES_PER_FACE = 4000
+#: memory of the interpreter and the libraries (numpy, scipy) before any chart
+BASE_BYTES = 150e6
+
+
+def refine_mesh(mesh, labels, times):
+    """The control mesh subdivided ``times`` times (the same limit surface) and the labels of the
+    children (child ``4 f + i`` of face ``f`` keeps its label)."""
+    from ccproof.mesh import subdivide
+
+    lab = None if labels is None else np.asarray(labels)
+    for _ in range(int(times)):
+        mesh = subdivide(mesh)
+        if lab is not None:
+            lab = np.repeat(lab, 4)
+    return mesh, lab
+
+
+def auto_refine(mesh, labels, faces_per_chart=1000):
+    """The measured default of ``refine``: the smallest r in 0..2 with at least ``faces_per_chart``
+    control faces per chart after r subdivisions (docs/hsh10.md, "(c) and (d)")."""
+    n_charts = len(_charts(mesh, labels))
+    per = mesh.n_faces / max(n_charts, 1) if labels is None else (np.asarray(labels) >= 0).sum() / max(n_charts, 1)
+    r = 0
+    while r < 2 and per * 4**r < faces_per_chart:
+        r += 1
+    return r
+
+
+def estimate_memory(hierarchies, deepest_level, release=True, opt_level=None):
+    """Estimated peak bytes (linear in the faces): :data:`BYTES_PER_FACE` per face of ``E_deepest``
+    (metrics, output) and :data:`OPT_BYTES_PER_FACE` per face of ``E_opt_level`` (optimization), for the
+    largest chart (``release``: charts are processed one at a time) or all charts, plus
+    :data:`BASE_BYTES`."""
+    def need(k, per):
+        if k is None:
+            return 0.0
+        faces = [h.n_faces(k) for h in hierarchies]
+        return per * (max(faces) if release else sum(faces))
+
+    return BASE_BYTES + max(need(deepest_level, BYTES_PER_FACE), need(opt_level, OPT_BYTES_PER_FACE))
+
+
+class MemoryBudgetError(CCProofError):
+    """The estimated memory of a run exceeds the budget (raised before allocating)."""
+
+
 def compare(mesh, labels=None, methods=METHODS, levels=3, start_level=1, eval_level=5, tol=1e-6, max_iter=1000,
-            engine="numpy", baseline_level=3, baseline_max_iter=2000, hierarchies=None, trace=False):
+            engine="numpy", baseline_level=3, baseline_max_iter=2000, hierarchies=None, trace=False,
+            refine=0, sample_level=None, release=False, max_memory=None, progress=False, accel=0):
     """Run ``methods`` on every chart and measure them the same way.
+
+    Parameters
+    ----------
+    levels, start_level, eval_level : int
+        Optimization and metric levels, counted on the input mesh.
+    refine : int >= 0
+        Subdivide the control mesh ``refine`` times before optimizing (b) and (c) (more texture unknowns,
+        the same surface and the same metric samples); their optimization levels are then
+        ``max(start_level, refine + 1) .. max(levels, refine + 1)`` on the input mesh, i.e. from level 1
+        of the refined mesh (level 0 misses odd-even modes), warm-started from the input mesh's
+        optimization at levels ``start_level .. refine`` (:func:`lift_to_refined`: the same texture
+        on the refined unknowns). (a) and (d) use the input mesh.
+    sample_level : int, optional
+        Also keep every chart's limit samples at this level (:func:`~ccproof.apps.arap.export.sample_chart`)
+        in ``MethodResult.samples`` (computed before ``release``).
+    release : bool
+        Process the charts one at a time and drop their fine levels afterwards (peak memory of the
+        largest chart instead of the sum).
+    max_memory : float, optional
+        Bytes; raise :class:`MemoryBudgetError` before allocating when :func:`estimate_memory` exceeds it.
+    progress : bool
+        A tqdm progress bar over (chart, method).
+    accel : int
+        Anderson acceleration history for (b) and (c) (0: the plain local/global iteration; the CLI
+        uses 5). (a) and (d) are never accelerated (they are the baselines as published).
 
     Returns
     -------
-    dict method -> MethodResult, and the list of ChartHierarchy (reusable)
+    dict method -> MethodResult, and the list of ChartHierarchy of the input mesh (reusable)
     """
     charts = _charts(mesh, labels)
     if hierarchies is None:
         hierarchies = [ChartHierarchy(mesh, fc) for fc in charts]
+    refine = int(refine)
+    if refine < 0:
+        raise CCProofError(f"refine must be >= 0, got {refine}")
+    fine = {}
+    if refine and any(m in ("b", "c") for m in methods):
+        rmesh, rlab = refine_mesh(mesh, labels, refine)
+        fine = {"hierarchies": [ChartHierarchy(rmesh, fc) for fc in _charts(rmesh, rlab)],
+                "start": max(start_level, refine + 1) - refine, "levels": max(levels, refine + 1) - refine}
+    deepest = max([eval_level] + ([sample_level] if sample_level is not None else [])
+                  + ([baseline_level] if "d" in methods else []))
+    opt = None
+    if any(m in ("b", "c") for m in methods):
+        opt = fine["levels"] + refine if fine else levels
+    need = estimate_memory(hierarchies, deepest, release, opt)
+    if max_memory is not None and need > max_memory:
+        big = int(np.argmax([h.n_faces(0) for h in hierarchies]))
+        raise MemoryBudgetError(
+            f"estimated peak memory {need / 1e9:.2f} GB exceeds the budget {max_memory / 1e9:.2f} GB "
+            f"(--max-memory): chart {big} has {hierarchies[big].n_faces(max(deepest, opt or 0)):,} faces at level "
+            f"{max(deepest, opt or 0)}; lower --eval-level / --levels / --out-level (each level less divides it "
+            f"by 4), or use smaller charts")
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=len(hierarchies) * len(methods), desc="arap", unit="chart")
+    acc = {m: {"texs": [], "secs": 0.0, "its": 0, "lv": [], "met": Metrics(), "fl": 0, "tot": 0, "samples": []}
+           for m in methods}
+    try:
+        for i, h in enumerate(hierarchies):
+            for m in methods:
+                if bar is not None:
+                    bar.set_postfix(method=m, chart=i)
+                X0, sec0, it0, st0 = None, 0.0, 0, []
+                if fine and m in ("b", "c"):
+                    hm, st, lv, ev = fine["hierarchies"][i], fine["start"], fine["levels"], eval_level - refine
+                    if start_level <= refine:  # multi-resolution: the input mesh's levels below the refined ones
+                        t0 = time.perf_counter()
+                        texc, _, it0, st0 = run_method(h, m, refine, start_level, tol, max_iter, engine,
+                                                       accel=accel)
+                        X0 = lift_to_refined(h, texc.unknowns, texc.rules, hm, refine)
+                        sec0 = time.perf_counter() - t0
+                else:
+                    hm, st, lv, ev = h, start_level, levels, eval_level
+                if ev < 0:
+                    raise CCProofError(f"eval_level {eval_level} is below refine {refine}")
+                tex, sec, it, stt = run_method(hm, m, lv, st, tol, max_iter, engine, baseline_level,
+                                               baseline_max_iter, trace, X0=X0, accel=accel)
+                if hm is not h:  # level numbers on the input mesh
+                    stt = [replace(x, level=x.level + refine) for x in stt]
+                sec, it, stt = sec + sec0, it + it0, st0 + stt
+                a = acc[m]
+                a["texs"].append(tex)
+                a["secs"] += sec
+                a["its"] += it
+                a["lv"].append(stt)
+                a["met"] = a["met"] + texture_metrics(tex, ev)
+                f, t = control_flips(tex)
+                a["fl"] += f
+                a["tot"] += t
+                if sample_level is not None:
+                    from ccproof.apps.arap.export import sample_chart
+
+                    off = refine if hm is not h else 0
+                    sl = max(sample_level - off, tex.level)  # (d) lives at level 3
+                    a["samples"].append(sample_chart(tex, sl))
+                    a["sample_level"] = sl + off
+                if release and hm is not h:
+                    hm.release()
+                if bar is not None:
+                    bar.update(1)
+            if release:
+                h.release()
+    finally:
+        if bar is not None:
+            bar.close()
     out = {}
     for m in methods:
-        texs, secs, its, lv = [], 0.0, 0, []
-        for h in hierarchies:
-            tex, s, it, st = run_method(h, m, levels, start_level, tol, max_iter, engine, baseline_level,
-                                        baseline_max_iter, trace)
-            texs.append(tex)
-            secs += s
-            its += it
-            lv.append(st)
-        out[m] = MethodResult(m, texs, secs, its, levels=lv)
-    for r in out.values():
-        met = Metrics()
-        fl = tot = 0
-        for tex in r.textures:
-            met = met + texture_metrics(tex, eval_level)
-            f, t = control_flips(tex)
-            fl += f
-            tot += t
-        r.metrics, r.flips_control, r.triangles_control = met, fl, tot
+        a = acc[m]
+        r = MethodResult(m, a["texs"], a["secs"], a["its"], levels=a["lv"])
+        r.metrics, r.flips_control, r.triangles_control = a["met"], a["fl"], a["tot"]
+        r.refine = refine if (fine and m in ("b", "c")) else 0
+        r.samples = a["samples"] if sample_level is not None else None
+        r.sample_level = a.get("sample_level", sample_level)
+        out[m] = r
     return out, hierarchies
 
 

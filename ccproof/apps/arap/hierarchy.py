@@ -312,6 +312,18 @@ class ChartHierarchy:
         out.eliminate_zeros()
         return out
 
+    def release(self):
+        """Drop every level above 0 and the cached operators and samples (rebuilt on demand): keeps
+        the memory of a multi-chart run at that of its largest chart."""
+        del self.levels[1:]
+        self.S = {"extended": [], "boundary": []}
+        self._A = {"extended": [self.A0["extended"]], "boundary": [self.A0["boundary"]]}
+        self.__dict__.pop("_metric_samples", None)
+
+    def n_faces(self, k):
+        """Faces of ``E_k`` (chart and ring) without building it: ``4^k`` times those of ``E_0``."""
+        return self.levels[0].mesh.n_faces * 4 ** int(k)
+
     # ------------------------------------------------------------------ operators
     def operator(self, k, rules):
         """Sparse ``A_k``: texture unknowns -> level-k values on ``E_k`` (shape (n_k, n_unknowns))."""

@@ -1,7 +1,12 @@
-"""Writing parameterizations: OBJ with per-corner texture coordinates, plus a JSON sidecar.
+"""Writing the control-mesh texture: OBJ with per-corner texture coordinates, plus a JSON sidecar.
 
-The OBJ holds the control mesh (``v``), the texture control points of every chart (``vt``; the
-charts are laid side by side, each at its natural ARAP scale) and the chart faces as ``f v/vt``.
+For other tools prefer :mod:`~ccproof.apps.arap.export` (the limit surface sampled at a level with
+exact UVs). This file is for users who subdivide the control mesh themselves; the rule they must
+use is written in the header (:data:`RULE_TEXT`).
+
+The OBJ holds the control mesh (``v``), the texture control points of every chart (``vt``; packed
+with the transforms of :func:`~ccproof.apps.arap.export.pack_charts` when given, else laid side by
+side at their natural ARAP scale) and the chart faces as ``f v/vt``.
 Faces in no chart are written without texture. For extended charts the texture of a chart also
 has control points on the ring of faces around it (hsh10 section 3.2): they are written as extra
 ``vt`` lines that no face uses, and the JSON sidecar (``<out>.json``) lists, for every chart, the
@@ -16,7 +21,24 @@ import os
 
 import numpy as np
 
-__all__ = ["write_uv_obj", "layout_offsets"]
+__all__ = ["write_uv_obj", "layout_offsets", "RULE_TEXT"]
+
+#: the subdivision rule the written texture control points need, per texture rule set
+RULE_TEXT = {
+    "boundary": (
+        "subdivision rule for these vt: Catmull-Clark with every chart boundary treated as a mesh boundary "
+        "(edge points of chart boundary edges = midpoints, chart boundary vertices (e0 + 6 V + e1) / 8, "
+        "vertices with one chart face kept), i.e. face-varying boundary interpolation 'corners only' "
+        "(OpenSubdiv FVAR_LINEAR_CORNERS_ONLY, Blender UV Smooth 'Keep Corners')"
+    ),
+    "extended": (
+        "subdivision rule for these vt: extended charts: subdivide every chart TOGETHER WITH its ring of "
+        "neighbouring faces with the surface's own Catmull-Clark rules (the ring's texture points are the vt "
+        "lines no face uses; the JSON sidecar lists the control vertex of every texture point). Standard "
+        "face-varying subdivision of the chart faces alone does NOT reproduce this texture (it folds); use "
+        "the sampled limit surface (ccproof arap --out) or --variant boundary for that"
+    ),
+}
 
 
 def layout_offsets(uvs, gap=0.05):
@@ -30,25 +52,30 @@ def layout_offsets(uvs, gap=0.05):
     return offs
 
 
-def write_uv_obj(path, mesh, result, comment=None, table=None):
+def write_uv_obj(path, mesh, result, comment=None, table=None, transforms=None, scale=1.0):
     """Write ``result`` (a :class:`~ccproof.apps.arap.core.MethodResult`) for ``mesh``.
 
+    ``transforms`` (list of (R, t) per chart) and ``scale``: the packing of
+    :func:`~ccproof.apps.arap.export.pack_charts` (texture point ``scale * (uv @ R.T + t)``).
     Returns the path of the JSON sidecar.
     """
     path = os.fspath(path)
     texs = result.textures
     uvs = [np.asarray(t.unknowns, dtype=np.float64) for t in texs]
-    offs = layout_offsets(uvs)
+    if transforms is None:
+        offs = layout_offsets(uvs)
+        transforms = [(np.eye(2), o) for o in offs]
+        scale = 1.0
     V, F = mesh.vertices, mesh.faces
     face_vt = np.full((mesh.n_faces, 4), -1, dtype=np.int64)
     charts_json = []
     base = 0
     lines_vt = []
-    for tex, uv, off in zip(texs, uvs, offs):
+    for tex, uv, (R, off) in zip(texs, uvs, transforms):
         h = tex.hierarchy
         if tex.level != 0:
             raise ValueError("only level-0 textures can be written (method d is evaluation only)")
-        uvo = uv + off
+        uvo = scale * (uv @ np.asarray(R).T + off)
         lines_vt.extend(uvo.tolist())
         loc = np.full(mesh.n_vertices, -1, dtype=np.int64)
         nc = h.n_chart_vertices
@@ -68,6 +95,8 @@ def write_uv_obj(path, mesh, result, comment=None, table=None):
     with open(path, "w", encoding="utf-8") as fh:
         for c in (comment or "").splitlines():
             fh.write(f"# {c}\n")
+        for r in sorted({t.rules for t in texs}):
+            fh.write(f"# {RULE_TEXT[r]}\n")
         fh.write(f"# {V.shape[0]} vertices, {F.shape[0]} faces, {len(texs)} charts, {base} texture points\n")
         fh.writelines(f"v {x:.17g} {y:.17g} {z:.17g}\n" for x, y, z in V.tolist())
         fh.writelines(f"vt {u:.17g} {v:.17g}\n" for u, v in lines_vt)
@@ -78,5 +107,6 @@ def write_uv_obj(path, mesh, result, comment=None, table=None):
                 fh.write("f " + " ".join(str(a + 1) for a in F[f]) + "\n")
     side = path + ".json"
     with open(side, "w", encoding="utf-8") as fh:
-        json.dump({"method": result.method, "charts": charts_json, "table": table or {}}, fh)
+        json.dump({"method": result.method, "rules": {r: RULE_TEXT[r] for r in {t.rules for t in texs}},
+                   "uv_scale": float(scale), "charts": charts_json, "table": table or {}}, fh)
     return side

@@ -26,7 +26,7 @@ import numpy as np
 
 from ccproof.apps.arap.samples import SampleSet, isometric_frames
 
-__all__ = ["singular_values", "jacobians", "Metrics", "sample_metrics"]
+__all__ = ["singular_values", "jacobians", "Metrics", "sample_metrics", "triangle_metrics"]
 
 
 def singular_values(J):
@@ -147,3 +147,53 @@ def sample_metrics(samples: SampleSet, T, per_sample=False):
         return m, {"s1": s1, "s2": s2, "det": det, "weight": w, "area_distortion": are,
                    "vertex": samples.vertex[ok]}
     return m
+
+
+def triangle_metrics(P, UV, T, per_triangle=False):
+    """The section-4 metrics of a piecewise-linear map: triangles ``T`` of positions ``P`` to ``UV``.
+
+    Every triangle is one sample with tangents = its edge vectors ``p1 = P[b] - P[a]``,
+    ``p2 = P[c] - P[a]`` (and the same for UV), weight = its 3D area, texture area = its UV area.
+    This is how other tools see a written mesh (:mod:`~ccproof.apps.arap.export`).
+
+    Parameters
+    ----------
+    P : (n, 3), UV : (n, 2), T : int (m, 3)
+
+    Returns
+    -------
+    Metrics, and with ``per_triangle`` a dict of (m,) arrays s1, s2, det, weight, area_distortion
+    (``s1 s2 + 1/(s1 s2)``) and stretch (``sqrt((1/s1^2 + 1/s2^2) / 2)``).
+    """
+    P = np.asarray(P, dtype=np.float64)
+    UV = np.asarray(UV, dtype=np.float64)
+    T = np.asarray(T, dtype=np.int64)
+    p1, p2 = P[T[:, 1]] - P[T[:, 0]], P[T[:, 2]] - P[T[:, 0]]
+    t1, t2 = UV[T[:, 1]] - UV[T[:, 0]], UV[T[:, 2]] - UV[T[:, 0]]
+    w = 0.5 * np.linalg.norm(np.cross(p1, p2), axis=1)
+    ok = w > 1e-14 * w.max()
+    J = jacobians(p1[ok], p2[ok], t1[ok], t2[ok])
+    s1, s2, det = singular_values(J)
+    wk = w[ok]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ang = s1 / s2 + s2 / s1
+        pr = s1 * s2
+        are = pr + 1.0 / pr
+        st = 0.5 * (1.0 / s1**2 + 1.0 / s2**2)
+    at = 0.5 * np.abs(t1[ok, 0] * t2[ok, 1] - t1[ok, 1] * t2[ok, 0])
+    m = Metrics(
+        area=float(wk.sum()), angle_sum=float(wk @ ang), area_sum=float(wk @ are), stretch_sum=float(wk @ st),
+        texture_area=float(at.sum()), det_sum=float(wk @ pr), invdet_sum=float(wk @ (1.0 / pr)),
+        samples=int(wk.size), flips=int((det <= 0).sum()),
+        arap_sum=float(wk @ ((s1 - 1) ** 2 + (s2 - np.sign(det)) ** 2)),
+    )
+    if not per_triangle:
+        return m
+
+    def full(x, fill=np.nan):
+        out = np.full(T.shape[0], fill)
+        out[ok] = x
+        return out
+
+    return m, {"s1": full(s1), "s2": full(s2), "det": full(det), "weight": w, "area_distortion": full(are),
+               "stretch": full(np.sqrt(st))}

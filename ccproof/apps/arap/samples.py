@@ -1,6 +1,6 @@
 """Limit tangent masks (hsh10 Eq. 2, docs/hsh10.md A3) and the level-k samples of Eq. 3 and of the metrics.
 
-Tangent masks (A3). For an interior vertex of valence n with edge neighbours e_0 .. e_{n-1}
+Tangent masks. For an interior vertex of valence n with edge neighbours e_0 .. e_{n-1}
 (counter-clockwise) and face-diagonal neighbours f_i (face i between e_i and e_{i+1}):
 
     alpha_i = (1/n + cos(pi/n) / (n sqrt(4 + cos^2(pi/n)))) cos(2 pi i/n)      on e_i
@@ -55,7 +55,7 @@ __all__ = [
 
 
 def mask_weights(n):
-    """The A3 weights (alpha_i, beta_i), i = 0 .. n-1, of a valence-``n`` vertex."""
+    """The tangent-mask weights (alpha_i, beta_i), i = 0 .. n-1, of a valence-``n`` vertex."""
     n = int(n)
     i = np.arange(n)
     c = np.cos(np.pi / n)
@@ -76,7 +76,7 @@ def _fan_corners(mesh, verts):
 
 
 def tangent_mask_operators(mesh, verts):
-    """Sparse (len(verts), n) operators of the A3 masks p_1, p_2 at interior vertices ``verts``."""
+    """Sparse (len(verts), n) operators of the tangent masks p_1, p_2 at interior vertices ``verts``."""
     verts = np.asarray(verts, dtype=np.int64)
     F = mesh.faces
     row, j, c = _fan_corners(mesh, verts)

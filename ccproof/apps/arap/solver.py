@@ -1,16 +1,16 @@
 """Local/global ARAP iteration on samples (hsh10 section 3, Appendix; docs/hsh10.md A5, A6, A7).
 
-Energy (Eq. 3 / A6): with X = T^0 (N x 2) the texture unknowns, every sample j has
+Energy (Eq. 3): with X = T^0 (N x 2) the texture unknowns, every sample j has
 ``t_{j,c} = G_c[j] X`` (rows of sparse operators), the isometric frame ``Q_j = (p^_1 p^_2)^-1`` and a
 weight ``w_j``; ``grad phi_j = (t_1 t_2) Q_j = X^T H_j`` and
 
     E(X, R) = sum_j w_j || X^T H_j - R_j ||_F^2.
 
-Local step (A5, Theorem 1): for A = [[a, b], [c, d]] the closest rotation is
+Local step (Theorem 1): for A = [[a, b], [c, d]] the closest rotation is
 ``[[a + d, b - c], [c - b, a + d]] / sqrt((a + d)^2 + (c - b)^2)`` (identity in the degenerate
 case a = -d, b = c, where every rotation is equally good).
 
-Global step (A6): the normal equations ``L X = B`` with ``L = sum_j w_j H_j H_j^T`` (independent of
+Global step: the normal equations ``L X = B`` with ``L = sum_j w_j H_j H_j^T`` (independent of
 R: factorized ONCE per level with SuperLU and reused) and ``B = sum_j w_j H_j R_j^T`` (rebuilt every
 iteration, two sparse products). One unknown is pinned (the energy is translation invariant).
 If ``L`` restricted to the free unknowns is (numerically) singular, e.g. at level 0 on regular
@@ -101,7 +101,7 @@ class LocalGlobal:
         Hv = sp.diags(-b / (a * c)) @ G1 + sp.diags(1.0 / c) @ G2  # rows h_{j,2}^T
         # stacked [Hu; Hv]: one sparse product per direction and iteration
         self.H = sp.vstack([Hu, Hv]).tocsr()
-        self.HT = self.H.T.tocsr()
+        del Hu, Hv, G1, G2
         self.w = w
         self.w2 = np.concatenate([w, w])[:, None]
         self.weight_sum = float(w.sum())
@@ -112,7 +112,7 @@ class LocalGlobal:
         if not factor:  # energy evaluation only
             self.build_seconds = time.perf_counter() - t0
             return
-        self.L = (self.HT @ sp.diags(self.w2[:, 0]) @ self.H).tocsc()
+        self.L = (self.H.T @ sp.diags(self.w2[:, 0]) @ self.H).tocsc()
         N = self.L.shape[0]
         self.N = N
         self.free = np.setdiff1d(np.arange(N), [self.pin])
@@ -122,8 +122,8 @@ class LocalGlobal:
         self.build_seconds = time.perf_counter() - t0
 
     def _factor(self, Lff):
-        try:
-            lu = spla.splu(Lff)
+        try:  # L is symmetric positive (semi)definite: symmetric ordering, no pivoting (much less fill)
+            lu = spla.splu(Lff, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options={"SymmetricMode": True})
             d = np.abs(lu.U.diagonal())
             if d.size and d.min() <= 1e-12 * d.max():
                 raise RuntimeError("nearly singular")
@@ -131,7 +131,8 @@ class LocalGlobal:
         except RuntimeError:
             self.mu = 1e-8 * float(np.abs(Lff.diagonal()).mean() or 1.0)
             self.regularized = True
-            self.lu = spla.splu((Lff + self.mu * sp.identity(Lff.shape[0], format="csc")).tocsc())
+            self.lu = spla.splu((Lff + self.mu * sp.identity(Lff.shape[0], format="csc")).tocsc(),
+                                permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options={"SymmetricMode": True})
         self.Lff = Lff
 
     def jacobians(self, X):
@@ -145,12 +146,12 @@ class LocalGlobal:
 
     def energy(self, J, R):
         """E(X, R) = sum_j w_j ||J_j - R_j||^2."""
-        D = J - R
-        return float(self.w @ np.einsum("sij,sij->s", D, D))
+        D = (J - R).reshape(-1, 4)
+        return float(self.w @ (D * D).sum(axis=1))
 
     def rhs(self, R):
         """B = sum_j w_j H_j R_j^T, shape (N, 2)."""
-        return self.HT @ (self.w2 * np.concatenate([R[:, :, 0], R[:, :, 1]]))
+        return self.H.T @ (self.w2 * np.concatenate([R[:, :, 0], R[:, :, 1]]))  # CSC view: no stored copy
 
     def global_step(self, R, X):
         """Minimize E(., R) (plus the proximal term when regularized); the pinned unknown stays."""
@@ -170,8 +171,14 @@ class LocalGlobal:
         return float(np.linalg.norm(r) / nb) if nb else float(np.linalg.norm(r))
 
 
-def iterate(system: LocalGlobal, X0, tol=1e-6, max_iter=200, trace=False, min_iter=1):
+def iterate(system: LocalGlobal, X0, tol=1e-6, max_iter=200, trace=False, min_iter=1, accel=0):
     """Alternate local and global steps until the relative energy decrease is below ``tol``.
+
+    ``accel`` > 0: Anderson acceleration of the fixed-point map X -> global_step(R(X)) with a history of
+    ``accel`` steps, safeguarded by the energy (Peng et al. 2018, "Anderson acceleration for geometry
+    optimization and physics simulation"): the accelerated iterate is kept only if its energy
+    E(X, R(X)) is below the last accepted one, else the plain local/global step is taken, so the
+    energy still decreases monotonically (``trace`` is not recorded then).
 
     Returns
     -------
@@ -179,6 +186,8 @@ def iterate(system: LocalGlobal, X0, tol=1e-6, max_iter=200, trace=False, min_it
         ``energies[i]`` is E(X_i, R(X_i)) (after each local step); with ``trace`` also the energy
         after every global step (``trace``) and the global solve residuals.
     """
+    if accel and not trace:
+        return _iterate_anderson(system, X0, tol, max_iter, min_iter, int(accel))
     t0 = time.perf_counter()
     X = np.array(X0, dtype=np.float64, copy=True)
     J = system.jacobians(X)
@@ -208,6 +217,58 @@ def iterate(system: LocalGlobal, X0, tol=1e-6, max_iter=200, trace=False, min_it
             converged = True
             break
     return IterationResult(X, it, energies, time.perf_counter() - t0, converged, tr, res)
+
+
+def _iterate_anderson(system, X0, tol, max_iter, min_iter, m):
+    t0 = time.perf_counter()
+    X = np.array(X0, dtype=np.float64, copy=True)
+    J = system.jacobians(X)
+    R = closest_rotations(J)
+    E = system.energy(J, R)
+    energies = [E]
+    dG, dF = [], []
+    g_prev = f_prev = None
+    converged = False
+    it = 0
+    while it < max_iter:
+        G = system.global_step(R, X)  # plain step from the accepted iterate
+        it += 1
+        f = (G - X).ravel()
+        g = G.ravel()
+        if g_prev is not None:
+            dG.append(g - g_prev)
+            dF.append(f - f_prev)
+            if len(dG) > m:
+                dG.pop(0)
+                dF.pop(0)
+        g_prev, f_prev = g, f
+        Xn = G
+        if dF:
+            Fm = np.stack(dF, axis=1)
+            gamma, *_ = np.linalg.lstsq(Fm, f, rcond=None)
+            Xa = (g - np.stack(dG, axis=1) @ gamma).reshape(X.shape)
+            Ja = system.jacobians(Xa)
+            Ra = closest_rotations(Ja, previous=R)
+            Ea = system.energy(Ja, Ra)
+            if Ea < E:
+                Xn, J, R, En = Xa, Ja, Ra, Ea
+            else:  # safeguard: the plain step, and a fresh history
+                dG.clear()
+                dF.clear()
+                Xn = None
+        if Xn is None or not dF:
+            Xn = G
+            J = system.jacobians(Xn)
+            R = closest_rotations(J, previous=R)
+            En = system.energy(J, R)
+        energies.append(En)
+        X = Xn
+        done = En <= 1e-28 * system.weight_sum or (E - En) <= tol * E
+        E = En
+        if done and it >= min_iter:
+            converged = True
+            break
+    return IterationResult(X, it, energies, time.perf_counter() - t0, converged)
 
 
 def triangle_samples(V, T):

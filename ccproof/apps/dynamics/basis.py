@@ -1,4 +1,4 @@
-"""Uniform cubic B-spline basis, its exact 1D Gram matrices and the normal-element matrices (qmv98 B2, B5).
+"""Uniform cubic B-spline basis, its exact 1D Gram matrices and the normal-element matrices (qmv98).
 
 One knot span of the uniform cubic B-spline (qmv98 eq. 1, docs/qmv98.md B2)::
 

@@ -11,9 +11,18 @@ equilibrium, is subdivided once (386 vertices) and refitted. Printed per level: 
 steps, the paper's fit error (the largest distance of a data point to the limit surface, in % of the
 diameter of the smallest enclosing sphere, Welzl) and the mean distance in the same unit. All material
 parameters are in units where that diameter is 1 and the data springs sum to --spring.
+
+The other direction is reported too: the limit surface sampled at --sample-level (written to
+--surface-out, default OUT with "_limit" before the extension) and the distance of every sample to its
+nearest data point; the area fraction farther than --stray-distance (default 3 data spacings) and the
+two-sided (Hausdorff) error. A warning (stderr) says when more than --stray-fraction of the surface
+strays (a torus' hole spanned, an unseen side filled in) or a level stopped at --max-steps.
+--errors FILE.csv writes x, y, z, distance and distance in % for every data point.
 """
 
 from __future__ import annotations
+
+import sys
 
 
 def add_arguments(p):
@@ -36,10 +45,23 @@ def add_arguments(p):
     p.add_argument("--truncation", type=int, default=6, help="special-element stiffness level L (default 6)")
     p.add_argument("--init-scale", type=float, default=0.5, help="initial cube size / data box (default 0.5)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.add_argument("--surface-out", default=None,
+                   help="write the fitted limit surface sampled at --sample-level (.obj or any meshio format; "
+                        "default OUT with _limit before the extension)")
+    p.add_argument("--sample-level", type=int, default=None,
+                   help="subdivision level of the sampled limit surface (default: 1..3, >= 4 samples per point)")
+    p.add_argument("--stray-distance", type=float, default=None,
+                   help="surface samples farther than this (%% of the diameter) from every data point stray "
+                        "(default 3 data spacings)")
+    p.add_argument("--stray-fraction", type=float, default=0.01,
+                   help="warn when more than this area fraction of the surface strays (default 0.01)")
+    p.add_argument("--errors", default=None, metavar="FILE.csv", help="write the per-point errors here")
 
 
 def run(args) -> int:
     from pathlib import Path
+
+    import numpy as np
 
     from ccproof.apps.dynamics.fit import fit_points, read_points
     from ccproof.apps.dynamics.model import Material
@@ -57,7 +79,8 @@ def run(args) -> int:
                         b12=2 * args.rigidity, b22=args.rigidity)
     res = fit_points(X, init=init, levels=args.levels, material=material, spring_total=args.spring, dt=args.dt,
                      scheme=args.scheme, max_steps=args.max_steps, tol=args.tol, init_scale=args.init_scale,
-                     truncation=args.truncation, progress=not args.no_progress)
+                     truncation=args.truncation, progress=not args.no_progress, sample_level=args.sample_level,
+                     stray_distance_percent=args.stray_distance, stray_fraction=args.stray_fraction)
     print(f"data: {X.shape[0]} points from {args.points}; minimal enclosing sphere diameter {res.diameter:.6g}")
     print("level  vertices  faces  steps  equilibrium  max error %  mean error %  seconds")
     for i, lev in enumerate(res.levels):
@@ -65,8 +88,45 @@ def run(args) -> int:
               f"  {lev.max_error_percent:11.3f}  {lev.mean_error_percent:12.4f}  {lev.seconds:7.1f}")
     print(f"fit error (max distance to the limit surface, % of the enclosing-sphere diameter): "
           f"{res.max_error_percent:.3f} %   mean: {res.mean_error_percent:.4f} %")
-    write_obj(args.out, res.mesh, comment=(
-        f"ccproof fit {Path(args.points).name}: {res.mesh.n_vertices} control vertices, max error "
-        f"{res.max_error_percent:.3f} % of the enclosing-sphere diameter"))
-    print(f"wrote {args.out}")
+    rep = res.surface_report
+    print(f"surface -> data (limit surface at level {res.sample_level}, {res.surface.n_vertices} samples): max "
+          f"{res.surface_max_percent:.3f} %, area-weighted mean {100 * rep['mean'] / res.diameter:.4f} %, "
+          f"{100 * rep['stray_fraction']:.2f} % of the area farther than {res.stray_distance_percent:.3f} % "
+          f"(data spacing {100 * res.spacing / res.diameter:.3f} %)")
+    print(f"two-sided (Hausdorff) error: {res.two_sided_error_percent:.3f} % of the enclosing-sphere diameter")
+    for w in res.warnings:
+        print(f"warning: {w}", file=sys.stderr)
+    comment = (f"ccproof fit {Path(args.points).name}: {res.mesh.n_vertices} control vertices, max error "
+               f"{res.max_error_percent:.3f} %, two-sided {res.two_sided_error_percent:.3f} % of the "
+               f"enclosing-sphere diameter")
+    write_obj(args.out, res.mesh, comment=comment)
+    surf_out = args.surface_out
+    if surf_out is None:
+        o = Path(args.out)
+        surf_out = str(o.with_name(o.stem + "_limit" + (o.suffix or ".obj")))
+    _write_surface(surf_out, res, comment)
+    print(f"wrote {args.out} (control mesh) and {surf_out} (limit surface at level {res.sample_level})")
+    if args.errors:
+        d = res.data_distances
+        np.savetxt(args.errors, np.column_stack([X, d, 100 * d / res.diameter]), delimiter=",",
+                   header="x,y,z,distance,distance_percent_of_diameter", comments="", fmt="%.9g")
+        print(f"wrote {args.errors} (per-point data -> surface distances)")
     return 0
+
+
+def _write_surface(path, res, comment):
+    import numpy as np
+
+    from ccproof.errors import CCProofError
+    from ccproof.mesh import write_obj
+
+    if path.lower().endswith(".obj"):
+        write_obj(path, res.surface, comment=comment + f"; limit surface sampled at level {res.sample_level}")
+        return
+    import meshio
+
+    try:
+        meshio.write(path, meshio.Mesh(np.asarray(res.surface.vertices), [("quad", res.surface.faces)],
+                                       point_data={"distance_to_data": res.surface_report["distances"]}))
+    except Exception as exc:
+        raise CCProofError(f"cannot write {path!r}: {exc}") from exc

@@ -15,7 +15,16 @@ Pipeline (:func:`fit_points`):
 4. subdivide globally and rebuild the model (densities rescaled, :meth:`Material.refined`), refit;
    repeat ``levels`` times;
 5. report the paper's fit error: the largest distance of a data point to the limit surface, in % of the
-   diameter of the minimal enclosing sphere, and the mean distance.
+   diameter of the minimal enclosing sphere, and the mean distance;
+6. and the other direction (:func:`surface_to_data`), which the paper's error cannot see: the limit
+   surface sampled at a level (exact limit points of the subdivided control mesh) and, per sample, the
+   distance to the nearest data point (scipy cKDTree). A sample *strays* when it is farther than
+   ``stray_distance`` (default 3 times the data's median nearest-neighbour spacing: a covered surface is
+   within about one spacing of the data everywhere) from every data point; the area fraction of stray
+   samples, their largest distance, and the two-sided (Hausdorff) error ``max(data -> surface,
+   surface -> data)`` are reported. :class:`FitResult` ``.warnings`` says when more than
+   ``stray_fraction`` of the surface strays (a surface spanning a torus' hole, an unseen side filled in)
+   or a level stopped at the step cap.
 """
 
 from __future__ import annotations
@@ -41,6 +50,11 @@ __all__ = [
     "FitResult",
     "fit_points",
     "DEFAULT_FIT_MATERIAL",
+    "check_cloud",
+    "limit_surface_mesh",
+    "surface_to_data",
+    "data_spacing",
+    "samples_per_edge",
 ]
 
 #: material of the shape-recovery runs, in units where the data's enclosing sphere has diameter 1
@@ -230,14 +244,31 @@ def _read_ply(path):
 # ---------------------------------------------------------------------------- fitting
 
 
-def fit_error(model, P, X, finder=None, per_edge=12, diameter=None):
+def samples_per_edge(n_faces, n_points, most, budget=50_000):
+    """Samples per face edge of the closest-point initial guesses: ``most`` on small models, fewer on
+    large ones so that the sample count stays about ``max(budget, 16 n_points)`` (memory linear in the
+    data and the mesh, not in their product); at least 2. The Gauss-Newton refinement does the rest.
+
+    >>> samples_per_edge(96, 2000, 12), samples_per_edge(24576, 20000, 12)
+    (12, 4)
+    """
+    target = max(budget, 16 * int(n_points))
+    return int(min(most, max(2, math.ceil(math.sqrt(target / max(int(n_faces), 1))))))
+
+
+def fit_error(model, P, X, finder=None, per_edge=None, diameter=None):
     """Distances of the data points to the limit surface (nearest points) and the paper's fit error.
+
+    ``per_edge``: samples per face edge of the initial guesses (default :func:`samples_per_edge` with
+    at most 12).
 
     Returns a dict: ``max``, ``mean`` (absolute), ``max_percent``, ``mean_percent`` (of the diameter
     of the minimal enclosing sphere of X, or of ``diameter``), ``distances``.
     """
     X = check_points(X)
     if finder is None:
+        if per_edge is None:
+            per_edge = samples_per_edge(model.mesh.n_faces, X.shape[0], 12)
         finder = ClosestPointFinder(model, per_edge=per_edge, candidates=4, iterations=12)
     *_, dist = finder.query(P, X)
     if diameter is None:
@@ -249,6 +280,66 @@ def fit_error(model, P, X, finder=None, per_edge=12, diameter=None):
         "mean_percent": 100.0 * float(dist.mean()) / diameter,
         "distances": dist,
     }
+
+
+def check_cloud(X, min_points=20, flatness=1e-3):
+    """Reject clouds no closed surface can be fitted to: too few points, non-finite, coincident, coplanar
+    or collinear (smallest principal extent below ``flatness`` times the largest). Returns X (m, 3)."""
+    X = check_points(X)
+    C = X - X.mean(axis=0)
+    s = np.linalg.svd(C, compute_uv=False)
+    if not s[0] > 0:
+        raise CCProofError("the data points all coincide")
+    if X.shape[0] < min_points:
+        raise CCProofError(f"need at least {min_points} data points to fit a closed surface, got {X.shape[0]}")
+    if s[2] <= flatness * s[0]:
+        kind = "collinear" if s[1] <= flatness * s[0] else "coplanar"
+        raise CCProofError(
+            f"the data points are (nearly) {kind}: principal extents {s[0]:.3g}, {s[1]:.3g}, {s[2]:.3g} "
+            f"(ratio {s[2] / s[0]:.2g} <= {flatness:g}); a closed surface cannot be fitted to them")
+    return X
+
+
+def limit_surface_mesh(mesh, level):
+    """The limit surface sampled at ``level``: the control mesh subdivided ``level`` times with its
+    vertices moved to their exact limit positions (Catmull-Clark limit masks). Returns a QuadMesh."""
+    from ccproof.mesh import limit_positions, subdivide
+
+    m = mesh
+    for _ in range(int(level)):
+        m = subdivide(m)
+    return m.with_vertices(limit_positions(m))
+
+
+def _vertex_areas(mesh):
+    V, F = np.asarray(mesh.vertices), mesh.faces
+    a = 0.5 * (np.linalg.norm(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]), axis=1)
+               + np.linalg.norm(np.cross(V[F[:, 2]] - V[F[:, 0]], V[F[:, 3]] - V[F[:, 0]]), axis=1))
+    return np.bincount(F.ravel(), weights=np.repeat(a / 4, 4), minlength=V.shape[0])
+
+
+def data_spacing(X):
+    """Median distance of a data point to its nearest other data point (cKDTree)."""
+    from scipy.spatial import cKDTree
+
+    d, _ = cKDTree(X).query(X, k=2)
+    return float(np.median(d[:, 1]))
+
+
+def surface_to_data(surface, X, stray_distance):
+    """Surface -> data distances of the vertices of ``surface`` (a sampled limit surface, QuadMesh).
+
+    Returns a dict: ``distances`` (n,), ``areas`` (n,) vertex area weights, ``max``, ``mean``
+    (area-weighted), ``stray_fraction`` (area fraction farther than ``stray_distance``).
+    """
+    from scipy.spatial import cKDTree
+
+    S = np.asarray(surface.vertices)
+    d, _ = cKDTree(X).query(S)
+    w = _vertex_areas(surface)
+    W = float(w.sum()) or 1.0
+    return {"distances": d, "areas": w, "max": float(d.max()), "mean": float(w @ d) / W,
+            "stray_fraction": float(w[d > stray_distance].sum()) / W}
 
 
 @dataclass
@@ -275,6 +366,29 @@ class FitResult:
     center: np.ndarray = None
     diameter: float = 0.0
     parameters: dict = field(default_factory=dict)
+    #: data -> surface distances of the data points (data units), at the final level
+    data_distances: np.ndarray = None
+    #: the limit surface sampled at ``sample_level`` (QuadMesh, data units) and surface -> data report
+    surface: object = None
+    sample_level: int = 0
+    surface_report: dict = field(default_factory=dict)
+    #: data spacing, stray distance (data units)
+    spacing: float = 0.0
+    stray_distance: float = 0.0
+    warnings: list = field(default_factory=list)
+
+    @property
+    def two_sided_error_percent(self):
+        """max(data -> surface, surface -> data) in % of the enclosing-sphere diameter (Hausdorff)."""
+        return 100.0 * max(float(self.data_distances.max()), self.surface_report["max"]) / self.diameter
+
+    @property
+    def surface_max_percent(self):
+        return 100.0 * self.surface_report["max"] / self.diameter
+
+    @property
+    def stray_distance_percent(self):
+        return 100.0 * self.stray_distance / self.diameter
 
     @property
     def max_error_percent(self):
@@ -301,7 +415,8 @@ def _initial_mesh(init, Xn, init_scale):
 
 
 def fit_points(X, init="cube", levels=1, material=None, spring_total=1.0, dt=None, scheme="massless",
-               max_steps=60, tol=1e-3, init_scale=0.5, truncation=6, progress=False, callback=None):
+               max_steps=60, tol=1e-3, init_scale=0.5, truncation=6, progress=False, callback=None,
+               sample_level=None, stray_distance_percent=None, stray_fraction=0.01):
     """Recover a closed surface from range data (module docstring).
 
     Parameters
@@ -333,14 +448,20 @@ def fit_points(X, init="cube", levels=1, material=None, spring_total=1.0, dt=Non
         Show a tqdm progress bar over the time steps.
     callback : callable, optional
         ``callback(level, step, model, P_normalized)`` after every step.
+    sample_level : int, optional
+        Level of the sampled limit surface (default: the smallest level in 1..3 with at least 4 samples
+        per data point).
+    stray_distance_percent : float, optional
+        Surface -> data distance above which a surface sample strays, in % of the enclosing-sphere
+        diameter (default 3 times :func:`data_spacing`).
+    stray_fraction : float
+        Warn when more than this area fraction of the surface strays.
 
     Returns
     -------
     FitResult
     """
-    X = check_points(X)
-    if X.shape[0] < 4:
-        raise CCProofError(f"need at least 4 data points, got {X.shape[0]}")
+    X = check_cloud(X)
     if int(levels) != levels or levels < 0:
         raise CCProofError(f"levels must be an integer >= 0, got {levels!r}")
     if not (spring_total > 0 and math.isfinite(spring_total)):
@@ -378,7 +499,7 @@ def fit_points(X, init="cube", levels=1, material=None, spring_total=1.0, dt=Non
     try:
         for level in range(levels + 1):
             t0 = time.perf_counter()
-            finder = ClosestPointFinder(model)
+            finder = ClosestPointFinder(model, per_edge=samples_per_edge(model.mesh.n_faces, X.shape[0], 6))
             integ = ImplicitIntegrator(model, dt, P=P, scheme=scheme, tol=1e-9)
             prev = None
             converged = False
@@ -416,4 +537,26 @@ def fit_points(X, init="cube", levels=1, material=None, spring_total=1.0, dt=Non
     result.model = model
     result.mesh = model.mesh.with_vertices(P * diameter + centre)
     result.normalized_state = P
+    result.data_distances = err["distances"] * diameter
+    for i, lev in enumerate(result.levels):
+        if not lev.converged:
+            result.warnings.append(
+                f"level {i} stopped at the step cap ({max_steps} steps, --max-steps) before equilibrium "
+                f"(relative energy change > {tol:g}); raise --max-steps or --dt")
+    if sample_level is None:
+        nf = result.mesh.n_faces
+        sample_level = next((k for k in (1, 2, 3) if nf * 4**k >= 4 * X.shape[0]), 3)
+    result.sample_level = int(sample_level)
+    result.surface = limit_surface_mesh(result.mesh, sample_level)
+    result.spacing = data_spacing(X)
+    result.stray_distance = (3.0 * result.spacing if stray_distance_percent is None
+                             else float(stray_distance_percent) * diameter / 100.0)
+    rep = surface_to_data(result.surface, X, result.stray_distance)
+    result.surface_report = rep
+    if rep["stray_fraction"] > stray_fraction:
+        result.warnings.append(
+            f"the fitted surface strays from the data: {100 * rep['stray_fraction']:.1f} % of its area is farther "
+            f"than {result.stray_distance_percent:.2f} % of the diameter from every data point, "
+            f"up to {result.surface_max_percent:.2f} %; the data may not cover the surface (an unseen side) or the "
+            f"start mesh's topology may not match the data's (e.g. a genus-0 start for a torus: give --init)")
     return result

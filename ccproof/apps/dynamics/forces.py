@@ -1,4 +1,4 @@
-"""Applied forces: springs to points of the limit surface and data forces from point clouds (qmv98 3.2; B5).
+"""Applied forces: springs to points of the limit surface and data forces from point clouds (qmv98 section 3.2).
 
 A spring of stiffness k from a point d0 to the limit-surface point ``s(u0, v0)`` (eq. 27, delta
 kernel) has the generalized force ``f_p = k J(u0, v0)^T (d0 - J(u0, v0) p)`` (eq. 21). A set of

@@ -5,7 +5,11 @@ qmv98 Figs. 7-9 are not available).
   it (a light-bulb profile), 1,000 points in the paper;
 * ``"ellipsoid"``: semi-axes 1, 0.8, 1.25 (a head-sized blob), 1,779 points;
 * ``"superquadric"``: exponent 0.5 (rounded box, an anvil-like block), semi-axes 1.4, 0.7, 0.8,
-  2,031 points.
+  2,031 points;
+* ``"torus"``: radii 1 and 0.4 around the z axis (genus 1: a closed genus-0 start mesh cannot match
+  it), 1,500 points;
+* ``"half_ellipsoid"``: the ``"ellipsoid"`` points with z >= 0 only (a scan seen from one side),
+  1,000 points.
 
 Points are drawn area-uniformly (surfaces of revolution and ellipsoids) or as the image of uniform
 points of the sphere (superquadric).
@@ -23,10 +27,10 @@ from ccproof.errors import CCProofError
 
 __all__ = ["SHAPES", "PAPER_SIZES", "synthetic_range_data"]
 
-SHAPES = ("bulb", "ellipsoid", "superquadric")
+SHAPES = ("bulb", "ellipsoid", "superquadric", "torus", "half_ellipsoid")
 
 #: the paper's data sizes (bulb, head, anvil)
-PAPER_SIZES = {"bulb": 1000, "ellipsoid": 1779, "superquadric": 2031}
+PAPER_SIZES = {"bulb": 1000, "ellipsoid": 1779, "superquadric": 2031, "torus": 1500, "half_ellipsoid": 1000}
 
 
 def _smoothstep(x):
@@ -79,6 +83,18 @@ def synthetic_range_data(name, m=None, seed=0, noise=0.0):
             keep = rng.random(n.shape[0]) < g / g.max() if g.max() > 0 else np.ones(n.shape[0], bool)
             out.append(n[keep] * ax)
         X = np.concatenate(out)[:m]
+    elif name == "torus":
+        R, r = 1.0, 0.4
+        out = []
+        while sum(len(o) for o in out) < m:  # area element (R + r cos v): rejection on v
+            u, v = rng.random((2, 4 * m)) * 2 * np.pi
+            keep = rng.random(4 * m) < (R + r * np.cos(v)) / (R + r)
+            u, v = u[keep], v[keep]
+            out.append(np.stack([(R + r * np.cos(v)) * np.cos(u), (R + r * np.cos(v)) * np.sin(u), r * np.sin(v)], 1))
+        X = np.concatenate(out)[:m]
+    elif name == "half_ellipsoid":
+        E = synthetic_range_data("ellipsoid", 2 * m + 50, seed=seed)
+        X = E[E[:, 2] >= 0][:m]
     else:
         ax = np.array([1.4, 0.7, 0.8])
         n = _sphere(m, rng)

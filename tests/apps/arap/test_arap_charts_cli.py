@@ -81,7 +81,7 @@ def test_cli_end_to_end(tmp_path, capsys):
     m, chart, mp, lp = _write_case(tmp_path)
     out = tmp_path / "uv.obj"
     rc = main(["arap", str(mp), "--charts", str(lp), "--baselines", "--engine", "numpy", "--levels", "2",
-               "--out", str(out)])
+               "--refine", "0", "--control-out", str(out)])
     text = capsys.readouterr().out
     assert rc == 0
     for name in ("(a) ARAP on control mesh", "(b) ours, boundary rules", "(c) ours, extended charts",

@@ -116,3 +116,20 @@ def test_matrix_is_factorized_once_per_level():
     X = initial_texture(h, "extended")
     iterate(sysk, X, tol=0.0, max_iter=5)
     assert sysk.lu is lu and not sysk.regularized
+
+
+def test_anderson_acceleration_is_monotone_and_reaches_the_same_minimum():
+    m, chart = M.curved_ev_mesh()
+    h = ChartHierarchy(m, chart)
+    sysk = system_from_samples(build_samples(h.level(2), "extended", "optimize"), h.operator(2, "extended"))
+    X0 = initial_texture(h, "extended")
+    plain = iterate(sysk, X0, tol=1e-12, max_iter=20000)
+    fast = iterate(sysk, X0, tol=1e-12, max_iter=20000, accel=5)
+    assert fast.converged and plain.converged
+    assert (np.diff(fast.energies) <= 1e-15 * fast.energies[0]).all()  # the safeguard keeps it monotone
+    E_ref = min(plain.energies[-1], fast.energies[-1])
+    assert abs(fast.energies[-1] - E_ref) <= 1e-9 * E_ref and abs(plain.energies[-1] - E_ref) <= 1e-6 * E_ref
+    assert fast.iterations < plain.iterations / 3
+    # the minimizer itself: the global step of the final rotations does not move it
+    R = closest_rotations(sysk.jacobians(fast.X))
+    assert np.abs(sysk.global_step(R, fast.X) - fast.X).max() < 1e-5 * np.abs(fast.X).max()

@@ -199,3 +199,81 @@ def test_cli_fit(tmp_path, capsys):
     rc = main(["fit", str(pts), "--out", str(out), "--dt", "-1", "--no-progress"])
     assert rc == 2
     assert "dt" in capsys.readouterr().err
+
+
+# ---------------------------------------------------------------------------- the two-sided report
+
+
+def _torus_distance(P, R=1.0, r=0.4):
+    """Exact distance of points to the torus of synthetic_range_data('torus') (closed form)."""
+    rho = np.hypot(P[:, 0], P[:, 1])
+    return np.abs(np.hypot(rho - R, P[:, 2]) - r)
+
+
+def test_fit_torus_from_the_cube_reports_the_spanned_hole_and_warns():
+    X = synthetic_range_data("torus", 600)
+    res = fit_points(X, levels=0, max_steps=25)
+    # data -> surface alone looks good (the paper's error) ...
+    assert res.max_error_percent < 5.0
+    # ... but the surface spans the hole: far from the true torus (closed-form distance, not the code's)
+    S = np.asarray(res.surface.vertices)
+    assert 100 * _torus_distance(S).max() / res.diameter > 15.0
+    assert res.two_sided_error_percent > res.stray_distance_percent
+    assert res.surface_report["stray_fraction"] > 0.03
+    assert any("strays from the data" in w for w in res.warnings)
+    # the surface -> data distances agree with a brute-force nearest data point
+    i = np.argsort(res.surface_report["distances"])[-5:]
+    brute = np.sqrt(((S[i, None, :] - X[None]) ** 2).sum(-1)).min(1)
+    assert np.allclose(res.surface_report["distances"][i], brute)
+
+
+def test_fit_ellipsoid_does_not_warn():
+    res = fit_points(synthetic_range_data("ellipsoid", 600), levels=0)
+    assert not [w for w in res.warnings if "strays" in w]
+    assert res.surface_report["stray_fraction"] < 0.01
+    assert res.two_sided_error_percent < 15.0
+
+
+def test_degenerate_clouds_are_rejected_clearly():
+    rng = np.random.default_rng(0)
+    flat = np.c_[rng.random((200, 2)), np.zeros(200)] @ np.array([[1, 0, 0], [0, 0.6, 0.8], [0, -0.8, 0.6]])
+    with pytest.raises(CCProofError, match="coplanar"):
+        fit_points(flat)
+    with pytest.raises(CCProofError, match="coplanar"):
+        fit_points(np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0.0]] * 10))
+    with pytest.raises(CCProofError, match="collinear"):
+        fit_points(np.c_[np.linspace(0, 1, 50), np.linspace(0, 2, 50), np.linspace(0, 3, 50)])
+    with pytest.raises(CCProofError, match="at least 20 data points"):
+        fit_points(rng.random((6, 3)))
+    X = synthetic_range_data("ellipsoid", 100)
+    X[3, 2] = np.nan
+    with pytest.raises(CCProofError, match="non-finite coordinate at point 3"):
+        fit_points(X)
+
+
+def test_cli_fit_writes_surface_errors_and_warnings(tmp_path, capsys):
+    from ccproof.cli import main
+    from ccproof.mesh import read_obj
+
+    pts = tmp_path / "torus.xyz"
+    X = synthetic_range_data("torus", 400, seed=2)
+    np.savetxt(pts, X)
+    out = tmp_path / "fit.obj"
+    rc = main(["fit", str(pts), "--out", str(out), "--levels", "0", "--max-steps", "8", "--no-progress",
+               "--errors", str(tmp_path / "err.csv")])
+    cap = capsys.readouterr()
+    assert rc == 0
+    assert "two-sided (Hausdorff) error" in cap.out and "surface -> data" in cap.out
+    assert "warning: level 0 stopped at the step cap (8 steps" in cap.err
+    assert "warning: the fitted surface strays from the data" in cap.err
+    lim = read_obj(tmp_path / "fit_limit.obj")
+    assert lim.n_faces == read_obj(out).n_faces * 4**3  # 96 * 16 < 4 * 400 samples: level 3
+    E = np.loadtxt(tmp_path / "err.csv", delimiter=",", skiprows=1)
+    assert E.shape == (400, 5) and np.allclose(E[:, :3], X, atol=1e-8) and (E[:, 3] >= 0).all()
+    rc = main(["fit", str(pts), "--out", str(out), "--levels", "0", "--max-steps", "2", "--no-progress",
+               "--surface-out", str(tmp_path / "lim.vtu")])
+    assert rc == 0
+    import meshio
+
+    m = meshio.read(tmp_path / "lim.vtu")
+    assert m.point_data["distance_to_data"].shape == (m.points.shape[0],)
