@@ -179,6 +179,7 @@ def newton(surface, X, face, u, v, max_iter=MAX_ITER):
             dv = np.where(both, -(Auu * gv - Auv * gu) / det, np.where(fv, -gv / Avv, 0.0))
         bad = ~(np.isfinite(du) & np.isfinite(dv))
         du[bad], dv[bad] = -gu[bad] / tr[bad], -gv[bad] / tr[bad]
+        pg = np.hypot(np.where(fu, gu, 0.0), np.where(fv, gv, 0.0))
         al = alpha[a]
         done = np.zeros(a.size, dtype=bool)
         # backtracking: accept the first step with an Armijo decrease; give up below 2^-50
@@ -194,7 +195,16 @@ def newton(surface, X, face, u, v, max_iter=MAX_ITER):
             Rt = rt["P"] - X[ai]
             Et = 0.5 * _dot(Rt, Rt)
             pred = gu[idx] * (nu - ua[idx]) + gv[idx] * (nv - va[idx])
-            ok = moved & (Et <= E[ai] + 1e-4 * np.minimum(pred, 0.0))
+            # Armijo decrease; or, where E is flat to round-off (next to the minimum), a smaller
+            # projected gradient at no larger E (beyond round-off)
+            gtu, gtv = _dot(rt["Pu"], Rt), _dot(rt["Pv"], Rt)
+            ftu = ~(((nu <= 0.0) & (gtu > 0)) | ((nu >= 1.0) & (gtu < 0)))
+            ftv = ~(((nv <= 0.0) & (gtv > 0)) | ((nv >= 1.0) & (gtv < 0)))
+            pg_t = np.hypot(np.where(ftu, gtu, 0.0), np.where(ftv, gtv, 0.0))
+            ok = moved & (
+                (Et <= E[ai] + 1e-4 * np.minimum(pred, 0.0))
+                | ((Et <= E[ai] * (1.0 + 1e-13)) & (pg_t < 0.5 * pg[idx]))
+            )
             acc = idx[ok]
             aa = a[acc]
             u[aa], v[aa] = nu[ok], nv[ok]
@@ -222,6 +232,9 @@ class ClosestPointFinder:
     surface : LimitSurface
     cells : int
         Cells per face side (``cells^2`` bounding cylinders per face, ``(2 cells + 1)^2`` samples).
+    cover : int, optional
+        A descent in a face covers the candidate cells of that face within ``cover`` cells of its
+        start or end cell (default: all of them, i.e. one descent per point and face).
     """
 
     def __init__(self, surface, cells=CELLS, cover=None):
@@ -373,15 +386,16 @@ def _check_points(X):
     return X
 
 
-def closest_points(surface, X, *, cells=CELLS, finder=None):
+def closest_points(surface, X, *, cells=CELLS, cover=None, finder=None):
     """Globally nearest limit points of ``X`` (shape (n, 3)) on ``surface``.
 
     Parameters
     ----------
     surface : LimitSurface (or an OBJ path / QuadMesh, passed to :func:`~ccproof.evaluate.limit_surface`)
     X : array_like, shape (n, 3)
-    cells : int
-        Cells per face side of the search structure (see :class:`ClosestPointFinder`).
+    cells, cover : int
+        Cells per face side of the search structure, covering radius of a descent in cells
+        (default: the whole face); see :class:`ClosestPointFinder`.
     finder : ClosestPointFinder, optional
         A prepared search structure to reuse (then ``surface`` and ``cells`` are ignored).
 
@@ -404,5 +418,5 @@ def closest_points(surface, X, *, cells=CELLS, finder=None):
             from ccproof.evaluate.surface import limit_surface
 
             surface = limit_surface(surface)
-        finder = ClosestPointFinder(surface, cells=cells)
+        finder = ClosestPointFinder(surface, cells=cells, cover=cover)
     return finder.query(X)
