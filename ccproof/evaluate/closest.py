@@ -23,10 +23,14 @@ Method (global search, then local refinement):
    the projected Newton iteration below from it gives an upper bound ``d*`` of the distance.
 3. **Pruning.** The cells whose lower bound is below ``d*`` are the candidates, listed by a
    bounding-volume hierarchy over the cells (:mod:`ccproof.evaluate._bvh`). A candidate is
-   *covered* once a descent ran in its face (``cover=c``: only if the descent started or ended
-   within ``c`` cells of it); uncovered candidates start new descents, best first (per round one
-   descent per point, from its open candidate of lowest bound), until every candidate is covered
-   or its bound exceeds the best distance found. The answer is the best of all descents.
+   *covered* once a descent in its face started in it or ended within ``cover`` cells of it
+   (default 3); uncovered candidates start new descents, best first (per round one descent per
+   point, from its open candidate of lowest bound), until every candidate is covered or its bound
+   exceeds the best distance found. A descent whose result is a new best on an edge of its face is
+   *handed off* to the face on the other side: a new descent starts from the sample of another face
+   nearest to the end point (a k-d tree over the samples, queried with surface points), so minima
+   next to face edges and corners are reached from both sides without any adjacency information.
+   The answer is the best of all descents.
 4. **Projected Newton** on ``E(u, v) = |P(u, v) - X|^2 / 2`` in ``[0, 1]^2``: gradient
    ``(<P_u, R>, <P_v, R>)``, Hessian ``J^T J + <P_ww, R>`` (``R = P - X``); variables at a bound with
    the gradient pushing outwards are frozen (minima on face edges and corners, boundaries); an
@@ -55,13 +59,17 @@ from ccproof.evaluate import _bvh
 __all__ = ["ClosestPoints", "ClosestPointFinder", "closest_points", "parameter_faces"]
 
 #: cells per face side
-CELLS = 4
+CELLS = 8
+#: a descent covers the candidate cells within this many cells of its end (and its start cell)
+COVER = 3
 #: enlargement of the sampled cell bounds, in units of the largest second difference of the samples
 SAFETY = 2.0
 #: Newton steps at most per descent
 MAX_ITER = 60
 #: rounds of descents at most (each runs one descent per point still open)
 MAX_ROUNDS = 64
+#: hand-offs across face edges at most per point
+MAX_HANDOFFS = 4
 #: points per chunk
 CHUNK = 1 << 16
 
@@ -149,6 +157,9 @@ def newton(surface, X, face, u, v, max_iter=MAX_ITER):
     E = 0.5 * _dot(R, R)
     alpha = np.ones(n)
     active = np.arange(n)
+    # round-off of E = |P - X|^2 / 2: P is accurate to about eps |P|, so E to about eps |P| |R|
+    xs = np.abs(X).max(axis=1) if n else np.zeros(0)
+    slack = 1e-13 * E + 4e-16 * np.sqrt(2.0 * E) * (xs + np.sqrt(2.0 * E))
     cur = {k: r[k] for k in ("Pu", "Pv", "Puu", "Puv", "Pvv")}
     for _ in range(max_iter):
         if active.size == 0:
@@ -196,14 +207,14 @@ def newton(surface, X, face, u, v, max_iter=MAX_ITER):
             Et = 0.5 * _dot(Rt, Rt)
             pred = gu[idx] * (nu - ua[idx]) + gv[idx] * (nv - va[idx])
             # Armijo decrease; or, where E is flat to round-off (next to the minimum), a smaller
-            # projected gradient at no larger E (beyond round-off)
+            # projected gradient at no larger E beyond its round-off (slack, fixed at the start)
             gtu, gtv = _dot(rt["Pu"], Rt), _dot(rt["Pv"], Rt)
             ftu = ~(((nu <= 0.0) & (gtu > 0)) | ((nu >= 1.0) & (gtu < 0)))
             ftv = ~(((nv <= 0.0) & (gtv > 0)) | ((nv >= 1.0) & (gtv < 0)))
             pg_t = np.hypot(np.where(ftu, gtu, 0.0), np.where(ftv, gtv, 0.0))
             ok = moved & (
                 (Et <= E[ai] + 1e-4 * np.minimum(pred, 0.0))
-                | ((Et <= E[ai] * (1.0 + 1e-13)) & (pg_t < 0.5 * pg[idx]))
+                | ((Et <= E[ai] + slack[ai]) & (pg_t < 0.5 * pg[idx]))
             )
             acc = idx[ok]
             aa = a[acc]
@@ -233,8 +244,9 @@ class ClosestPointFinder:
     cells : int
         Cells per face side (``cells^2`` bounding cylinders per face, ``(2 cells + 1)^2`` samples).
     cover : int, optional
-        A descent in a face covers the candidate cells of that face within ``cover`` cells of its
-        start or end cell (default: all of them, i.e. one descent per point and face).
+        A descent in a face covers its start cell and the candidate cells of that face within
+        ``cover`` cells of its end cell (default ``COVER``; ``cover >= cells``: the whole face, i.e.
+        one descent per point and face, faster but it misses a second local minimum in a face).
     """
 
     def __init__(self, surface, cells=CELLS, cover=None):
@@ -244,7 +256,7 @@ class ClosestPointFinder:
             raise CCProofError(f"cells must be a positive integer, got {cells!r}")
         self.surface = surface
         self.m = m = int(cells)
-        self.cover = m if cover is None else int(cover)
+        self.cover = min(COVER, m) if cover is None else int(cover)
         nf = parameter_faces(surface)
         self.n_faces = nf
         g = 2 * m + 1
@@ -255,6 +267,11 @@ class ClosestPointFinder:
         S = r["P"].reshape(nf, g, g, 3)
         Nrm = _unit_normal(r["Pu"], r["Pv"]).reshape(nf, g, g, 3)
         self._samples = r["P"]
+        self._sample_face = fu
+        self._sample_u = np.tile(U.ravel(), nf)
+        self._sample_v = np.tile(V.ravel(), nf)
+        # samples, for hand-offs across face edges (queried with surface points only: fast)
+        self._stree = cKDTree(self._samples)
         # cells: [face, ci, cj] with 3x3 samples S[f, 2ci:2ci+3, 2cj:2cj+3]
         blocks = np.stack(
             [S[:, i0 : i0 + 2 * m - 1 : 2, j0 : j0 + 2 * m - 1 : 2] for i0 in range(3) for j0 in range(3)],
@@ -331,36 +348,79 @@ class ClosestPointFinder:
         n = X.shape[0]
         m = self.m
         _, j = self._ctree.query(X, k=1)
-        bf = self._cface[j].copy()
+        # starts of the current round: point, face, (u, v)
+        sp, sf = np.arange(n), self._cface[j]
         su, sv = (self._ci[j] + 0.5) / m, (self._cj[j] + 0.5) / m
-        bu, bv, bE = newton(self.surface, X, bf, su, sv)
-        ndesc = np.ones(n, dtype=np.int32)
-        pid, cid, lb = self._candidates(X, np.sqrt(2.0 * bE))
-        covered = self._covered_by(pid, cid, bf[pid], self._cell_of(su)[pid], self._cell_of(sv)[pid],
-                                   self._cell_of(bu)[pid], self._cell_of(bv)[pid])
-        # best first: per round, one descent per point from its open candidate of lowest bound
-        for _round in range(MAX_ROUNDS):
-            keep = ~covered & (lb < np.sqrt(2.0 * bE[pid]))
-            pid, cid, lb = pid[keep], cid[keep], lb[keep]
-            if pid.size == 0:
-                break
-            order = np.lexsort((lb, pid))
-            first = order[np.r_[True, pid[order[1:]] != pid[order[:-1]]]]
-            sp, sc = pid[first], cid[first]
-            sf = self._cface[sc]
-            nu, nv, nE = newton(self.surface, X[sp], sf, (self._ci[sc] + 0.5) / m, (self._cj[sc] + 0.5) / m)
-            ndesc[sp] += 1
-            better = nE < bE[sp]
+        bf = np.zeros(n, dtype=np.int64)
+        bu, bv, bE = np.zeros(n), np.zeros(n), np.full(n, np.inf)
+        ndesc = np.zeros(n, dtype=np.int32)
+        handoffs = np.zeros(n, dtype=np.int32)
+        pid = None
+        for _round in range(MAX_ROUNDS + 1):
+            nu, nv, nE = newton(self.surface, X[sp], sf, su, sv)
+            np.add.at(ndesc, sp, 1)
+            # best per point among this round's descents, then against the best so far
+            order = np.lexsort((nE, sp))
+            first = order[np.r_[True, sp[order[1:]] != sp[order[:-1]]]] if sp.size else order
+            better = first[nE[first] < bE[sp[first]]]
             q = sp[better]
             bf[q], bu[q], bv[q], bE[q] = sf[better], nu[better], nv[better], nE[better]
-            # the run of each point, looked up by point
-            rf = np.full(n, -1, dtype=np.int64)
-            ri = np.zeros((4, n), dtype=np.int64)
-            rf[sp] = sf
-            ri[0, sp], ri[1, sp] = self._ci[sc], self._cj[sc]
-            ri[2, sp], ri[3, sp] = self._cell_of(nu), self._cell_of(nv)
-            covered = self._covered_by(pid, cid, rf[pid], *ri[:, pid])
+            if pid is None:
+                pid, cid, lb = self._candidates(X, np.sqrt(2.0 * bE))
+                covered = np.zeros(pid.size, dtype=bool)
+            # coverage: every descent covers its start cell and the cells near its end, in its face
+            for grp in self._one_per_point(sp):
+                rf = np.full(n, -1, dtype=np.int64)
+                ri = np.zeros((4, n), dtype=np.int64)
+                g = grp
+                rf[sp[g]] = sf[g]
+                ri[0, sp[g]], ri[1, sp[g]] = self._cell_of(su[g]), self._cell_of(sv[g])
+                ri[2, sp[g]], ri[3, sp[g]] = self._cell_of(nu[g]), self._cell_of(nv[g])
+                covered |= self._covered_by(pid, cid, rf[pid], *ri[:, pid])
+            # hand-off across face edges: a new best on an edge of its face continues in the face on
+            # the other side, from the sample there nearest to the end point (found geometrically)
+            edge = (bu[q] == 0.0) | (bu[q] == 1.0) | (bv[q] == 0.0) | (bv[q] == 1.0)
+            hq = q[edge & (handoffs[q] < MAX_HANDOFFS)]
+            hf, hu, hv, hp = self._across(hq, bf[hq], bu[hq], bv[hq])
+            handoffs[hp] += 1
+            keep = ~covered & (lb < np.sqrt(2.0 * bE[pid]))
+            pid, cid, lb, covered = pid[keep], cid[keep], lb[keep], covered[keep]
+            if (pid.size == 0 and hp.size == 0) or _round == MAX_ROUNDS:
+                break
+            # best first: one descent per point from its open candidate of lowest bound
+            order = np.lexsort((lb, pid))
+            first = order[np.r_[True, pid[order[1:]] != pid[order[:-1]]]] if pid.size else order
+            cp, cc = pid[first], cid[first]
+            sp = np.concatenate([cp, hp])
+            sf = np.concatenate([self._cface[cc], hf])
+            su = np.concatenate([(self._ci[cc] + 0.5) / m, hu])
+            sv = np.concatenate([(self._cj[cc] + 0.5) / m, hv])
         return bf, bu, bv, ndesc
+
+    @staticmethod
+    def _one_per_point(sp):
+        """Split indices of ``sp`` into groups with each point at most once."""
+        if sp.size == 0:
+            return []
+        order = np.argsort(sp, kind="stable")
+        s = sp[order]
+        start = np.r_[0, np.flatnonzero(s[1:] != s[:-1]) + 1]
+        rank = np.arange(s.size) - np.repeat(start, np.diff(np.r_[start, s.size]))
+        return [order[rank == r] for r in range(int(rank.max()) + 1)]
+
+    def _across(self, p, f, u, v):
+        """For end points (f, u, v) on a face edge: the nearest sample of another face (points p)."""
+        if p.size == 0:
+            e = np.empty(0, dtype=np.int64)
+            return e, np.empty(0), np.empty(0), e
+        P = self.surface.evaluate(f, u, v, 0)["P"]
+        k = 8
+        _, J = self._stree.query(P, k=k)
+        other = self._sample_face[J] != f[:, None]
+        has = other.any(axis=1)
+        col = np.argmax(other, axis=1)
+        jj = J[np.arange(p.size), col][has]
+        return self._sample_face[jj], self._sample_u[jj], self._sample_v[jj], p[has]
 
     def _cell_of(self, t):
         return np.minimum((np.asarray(t) * self.m).astype(np.int64), self.m - 1)
@@ -372,7 +432,7 @@ class ClosestPointFinder:
         if self.cover >= self.m:
             return same
         ci, cj, c = self._ci[cid], self._cj[cid], self.cover
-        near = ((np.abs(ci - si) <= c) & (np.abs(cj - sj) <= c)) | ((np.abs(ci - ei) <= c) & (np.abs(cj - ej) <= c))
+        near = ((ci == si) & (cj == sj)) | ((np.abs(ci - ei) <= c) & (np.abs(cj - ej) <= c))
         return same & near
 
 
@@ -395,7 +455,7 @@ def closest_points(surface, X, *, cells=CELLS, cover=None, finder=None):
     X : array_like, shape (n, 3)
     cells, cover : int
         Cells per face side of the search structure, covering radius of a descent in cells
-        (default: the whole face); see :class:`ClosestPointFinder`.
+        (default ``COVER``); see :class:`ClosestPointFinder`.
     finder : ClosestPointFinder, optional
         A prepared search structure to reuse (then ``surface`` and ``cells`` are ignored).
 
