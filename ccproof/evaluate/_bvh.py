@@ -80,8 +80,8 @@ def build(centres, radii):
     )
 
 
-def _traverse(X, dstar, order, lo, hi, child, start, count, c, nrm, r, h, out_p, out_c, out_lb, fill):
-    """Count (fill = False) or write the pairs (point, cell, lower bound) with lower bound < d*."""
+def _traverse(X, dstar, order, lo, hi, child, start, count, c, nrm, r, h, out_p, out_c, out_lb, cap):
+    """Write the pairs (point, cell, lower bound) with lower bound < d* (the first ``cap``); their number."""
     npts = X.shape[0]
     total = 0
     stack = np.empty(128, dtype=np.int64)
@@ -117,7 +117,7 @@ def _traverse(X, dstar, order, lo, hi, child, start, count, c, nrm, r, h, out_p,
                 a2 = max(z - h[j], 0.0)
                 lb = math.sqrt(a1 * a1 + a2 * a2)
                 if lb < ds:
-                    if fill:
+                    if total < cap:
                         out_p[total] = p
                         out_c[total] = j
                         out_lb[total] = lb
@@ -150,11 +150,12 @@ def candidates(X, dstar, tree, c, nrm, r, h):
     """
     X = np.ascontiguousarray(X, dtype=np.float64)
     dstar = np.ascontiguousarray(dstar, dtype=np.float64)
-    e_i = np.empty(0, dtype=np.int64)
-    e_f = np.empty(0)
-    k = _traverse(X, dstar, *tree, c, nrm, r, h, e_i, e_i, e_f, False)
-    pid = np.empty(k, dtype=np.int64)
-    cid = np.empty(k, dtype=np.int64)
-    lb = np.empty(k)
-    _traverse(X, dstar, *tree, c, nrm, r, h, pid, cid, lb, True)
-    return pid, cid, lb
+    cap = 32 * X.shape[0] + 1024
+    while True:  # one pass if the guessed capacity suffices, else count exactly and fill again
+        pid = np.empty(cap, dtype=np.int64)
+        cid = np.empty(cap, dtype=np.int64)
+        lb = np.empty(cap)
+        k = _traverse(X, dstar, *tree, c, nrm, r, h, pid, cid, lb, cap)
+        if k <= cap:
+            return pid[:k], cid[:k], lb[:k]
+        cap = k

@@ -66,6 +66,8 @@ COVER = 3
 SAFETY = 2.0
 #: Newton steps at most per descent
 MAX_ITER = 60
+#: step halvings at most per Newton step (then the descent stops: no decrease at that scale)
+MAX_HALVINGS = 20
 #: rounds of descents at most (each runs one descent per point still open)
 MAX_ROUNDS = 64
 #: hand-offs across face edges at most per point
@@ -193,8 +195,8 @@ def newton(surface, X, face, u, v, max_iter=MAX_ITER):
         pg = np.hypot(np.where(fu, gu, 0.0), np.where(fv, gv, 0.0))
         al = alpha[a]
         done = np.zeros(a.size, dtype=bool)
-        # backtracking: accept the first step with an Armijo decrease; give up below 2^-50
-        for _ls in range(52):
+        # backtracking: accept the first step with an Armijo decrease; give up below 2^-MAX_HALVINGS
+        for _ls in range(MAX_HALVINGS + 1):
             idx = np.flatnonzero(~done)
             if idx.size == 0:
                 break
@@ -224,12 +226,17 @@ def newton(surface, X, face, u, v, max_iter=MAX_ITER):
                 cur[k][aa] = rt[k][ok]
             done[acc] = True
             still = idx[~ok]
-            stop = ~moved[~ok] | (al[still] < 2.0**-50)
+            stop = ~moved[~ok] | (al[still] <= 2.0**-MAX_HALVINGS)
             done[still[stop]] = True
             al[still[~stop]] *= 0.5
         step = np.maximum(np.abs(u[a] - ua), np.abs(v[a] - va))
         # converged: no move, or a full step smaller than round-off of the parameter
-        keep = (step > 0) & ~((al >= 1.0) & (step <= 4e-16))
+        # or a step below 1e-12 of the distance to the nearest face corner (converged to round-off:
+        # E is quadratic there), or a projected gradient at the round-off level of <P_w, R>
+        ucorner = np.maximum(np.minimum(u[a], 1.0 - u[a]), np.minimum(v[a], 1.0 - v[a]))
+        nR = np.sqrt(2.0 * E[a])
+        keep = (step > 0) & ~((al >= 1.0) & (step <= 4e-16)) & ~(step <= 1e-12 * ucorner)
+        keep &= ~(pg <= 1e-15 * nR * np.sqrt(guu + gvv))
         alpha[a] = np.minimum(1.0, al * 2.0)
         active = a[keep]
     return u, v, E
