@@ -374,6 +374,8 @@ class ClosestPointFinder:
             bf[q], bu[q], bv[q], bE[q] = sf[better], nu[better], nv[better], nE[better]
             if pid is None:
                 pid, cid, lb = self._candidates(X, np.sqrt(2.0 * bE))
+                order = np.lexsort((lb, pid))  # sorted by point, then bound (kept by every compression)
+                pid, cid, lb = pid[order], cid[order], lb[order]
                 covered = np.zeros(pid.size, dtype=bool)
             # coverage: every descent covers its start cell and the cells near its end, in its face
             for grp in self._one_per_point(sp):
@@ -395,8 +397,7 @@ class ClosestPointFinder:
             if (pid.size == 0 and hp.size == 0) or _round == MAX_ROUNDS:
                 break
             # best first: one descent per point from its open candidate of lowest bound
-            order = np.lexsort((lb, pid))
-            first = order[np.r_[True, pid[order[1:]] != pid[order[:-1]]]] if pid.size else order
+            first = np.flatnonzero(np.r_[True, pid[1:] != pid[:-1]]) if pid.size else np.zeros(0, dtype=np.int64)
             cp, cc = pid[first], cid[first]
             sp = np.concatenate([cp, hp])
             sf = np.concatenate([self._cface[cc], hf])
