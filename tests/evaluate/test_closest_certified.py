@@ -56,3 +56,41 @@ def test_non_quad_input_refused():
 
     with pytest.raises(CCProofError, match="quad"):
         certify_closest(Fake(), [0, 0, 0], 0, 0.5, 0.5)
+
+
+@pytest.mark.parametrize("name", ["cube", "sector_k5", "sector_k3"])
+def test_local_refinement_matches_the_evaluator(refdir, name):
+    """The arb one-rings of deep pieces: their corner limit points are the evaluator's positions at the
+    piece corners, and the evaluator's point inside the piece lies in the box of its one-ring."""
+    import flint
+
+    from ccproof.evaluate import closest_certified as cc
+
+    S = limit_surface(refdir / "meshes" / f"{name}.obj")
+    F, Vx = S.mesh.faces, S.mesh.vertices
+    rng = np.random.default_rng(2)
+    old = flint.ctx.prec
+    flint.ctx.prec = cc.PREC
+    try:
+        arb = flint.arb
+        for _ in range(6):
+            f = int(rng.integers(F.shape[0]))
+            u, v = rng.random(2)
+            ring = sorted({g for g in range(F.shape[0]) if set(F[g]) & set(F[f])})
+            verts = sorted({w for g in ring for w in F[g]})
+            loc = {w: i for i, w in enumerate(verts)}
+            p = cc._Piece([tuple(loc[w] for w in F[g]) for g in ring], [[arb(float(t)) for t in Vx[w]] for w in verts],
+                          ring.index(f), f, 0.0, 0.0, 1.0, 0)
+            for _level in range(7):
+                p = cc._corner_piece(p, u, v, arb)
+            cu = np.array([p.u0, p.u0 + p.h, p.u0 + p.h, p.u0])
+            cv = np.array([p.v0, p.v0, p.v0 + p.h, p.v0 + p.h])
+            ref = S.evaluate(np.full(4, f), cu, cv, 0)["P"]
+            lim = np.array([[float(c.mid()) for c in L] for L in cc._corner_limits(p, arb)])
+            np.testing.assert_allclose(lim, ref, rtol=0, atol=1e-14)
+            P = S.evaluate([f], [u], [v], 0)["P"][0]
+            lo = np.array([min(float(q[k].lower()) for q in p.pts) for k in range(3)])
+            hi = np.array([max(float(q[k].upper()) for q in p.pts) for k in range(3)])
+            assert np.all(P >= lo - 1e-15) and np.all(P <= hi + 1e-15)
+    finally:
+        flint.ctx.prec = old
