@@ -11,8 +11,9 @@ Method (branch and bound on convex hulls of control nets):
   it, as in exact local refinement), here in ``arb`` ball arithmetic from the exact float
   coordinates of the mesh: every point is an enclosure of the true control point.
 * A *piece* is a dyadic sub-square (face, level L, box) with its one-ring. Lower bound of the
-  distance from X to the piece: the larger of the distance to the box around its points and of the
-  half-space bound ``min_j <a, X - c_j> / |a|`` along the direction ``a = X - P`` of the float answer.
+  distance from X to the piece: the largest of the distance to the box around its points and of the
+  half-space bounds ``min_j <a, X - c_j> / |a|`` along the direction ``a = X - P`` of the float
+  answer and ``min_j <w, c_j - X> / |w|`` along the direction ``w`` from X to the piece's centre.
   Upper bound: the distance to the nearest of the limit points of the 4 corners of the piece (exact
   limit masks, surface points), at most ``max_j |X - c_j|``.
 * ``d_up``: the upper bound of the piece of level ``up_level`` containing the float answer
@@ -208,6 +209,13 @@ def _bounds(piece, X, a, an, arb):
             d2 += _sq(X[k] - hi[k])
     lb_box = _sqrt_lo(d2)
     hs = min((sum((a[k] * (X[k] - p[k]) for k in range(3)), arb(0)) / an).lower() for p in piece.pts)
+    # half-space bound along the direction from X to the piece's centre (tight for far pieces)
+    w = [arb(float(sum((p[k] for p in piece.pts), arb(0)).mid()) / len(piece.pts) - float(X[k].mid()))
+         for k in range(3)]
+    wn2 = sum((t * t for t in w), arb(0))
+    if wn2 > 0:
+        wn = wn2.sqrt()
+        hs = max(hs, min((sum((w[k] * (p[k] - X[k]) for k in range(3)), arb(0)) / wn).lower() for p in piece.pts))
     ub = max(_sqrt_up(sum((_sq(X[k] - p[k]) for k in range(3)), arb(0))) for p in piece.pts)
     for L in _corner_limits(piece, arb):
         ub = min(ub, _sqrt_up(sum((_sq(X[k] - L[k]) for k in range(3)), arb(0))))
