@@ -204,3 +204,27 @@ def test_bad_input(surfaces):
         closest_points(S, [[0, 0, 0], [np.nan, 0, 0]])
     with pytest.raises(CCProofError, match="cells"):
         ClosestPointFinder(S, cells=0)
+
+
+def test_only_the_public_evaluator_is_used(surfaces):
+    """A stand-in surface with its own face numbering and orientation (like ptex faces of another
+    evaluator): only ``evaluate`` and ``n_ptex_faces`` are available, and the answers map back."""
+    S = surfaces["sector_k6"]
+    perm = np.random.default_rng(0).permutation(S.mesh.n_faces)
+
+    class Ptex:
+        n_ptex_faces = S.mesh.n_faces
+
+        def evaluate(self, faces, u, v, derivatives=1):
+            r = S.evaluate(perm[np.asarray(faces)], 1.0 - np.asarray(u), v, derivatives)
+            for k in ("Pu", "Puv"):
+                if k in r:
+                    r[k] = -r[k]
+            return r
+
+    X = _points(S, 30, seed=5)
+    a = closest_points(S, X)
+    b = closest_points(Ptex(), X)
+    np.testing.assert_allclose(b.distance, a.distance, rtol=1e-12)
+    P = S.evaluate(perm[b.face], 1.0 - b.u, b.v, 0)["P"]
+    np.testing.assert_allclose(P, b.P, rtol=0, atol=0)
