@@ -91,8 +91,9 @@ def test_against_brute_force(surfaces, name):
     ref, refP = brute_force(S, X)
     rel = (res.distance - ref) / ref
     assert rel.max() <= 1e-12, f"{name}: distance above brute force by {rel.max():.3g} (relative)"
-    # brute force is a sampling: it can never be below the true minimum (tolerance: round-off)
-    assert rel.min() >= -1e-12, f"{name}: distance below the sampled surface by {-rel.min():.3g}"
+    # both are distances to true surface points; ours below the reference would mean the reference
+    # missed the minimum (then this comparison is not a check): on these small meshes it never does
+    assert rel.min() >= -1e-12, f"{name}: the brute-force reference missed the minimum by {-rel.min():.3g}"
     # the same nearest point (a region, not necessarily the same face: points on shared edges)
     diag = S.mesh.bounding_box_diagonal
     assert np.linalg.norm(res.P - refP, axis=1).max() <= 1e-5 * diag
