@@ -19,6 +19,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "verify": ("ccproof.certify.cli_verify", "re-check certificates with the trusted verifier"),
     "report": ("ccproof.certify.cli_report", "table of every certified valence"),
     "eval": ("ccproof.reparam.cli", "evaluate the limit surface of a quad mesh (natural or bmz04 parameterizations)"),
+    "project": ("ccproof.evaluate.cli_project", "nearest points of the limit surface to 3-D points (closest points)"),
     "invert": ("ccproof.inverse.cli", "invert the characteristic map at a point"),
     "arap": ("ccproof.apps.arap.cli", "ARAP parameterization of a subdivision surface (hsh10)"),
     "fit": ("ccproof.apps.dynamics.cli", "fit a dynamic Catmull-Clark surface to points (qmv98)"),

@@ -1,0 +1,490 @@
+"""Globally nearest points of the limit surface (float path).
+
+:func:`closest_points` projects a batch of 3-D points ``X`` (shape (n, 3)) onto the limit surface of a
+:class:`~ccproof.evaluate.LimitSurface`: for every point the parameter ``(face, u, v)`` of the nearest
+limit point, the point ``P``, the distance ``|X - P|`` and the unit normal there. It uses only the
+evaluator's public :meth:`~ccproof.evaluate.LimitSurface.evaluate` (and the number of parameter
+faces), so it works on every mesh the evaluator accepts.
+
+Method (global search, then local refinement):
+
+1. **Cells.** Every face's parameter square is cut into ``m x m`` cells; the surface is sampled on
+   the ``(2m+1)^2`` grid of cell corners, edge midpoints and centres. Each cell gets a bounding
+   *cylinder* around its centre sample ``c`` with axis the normal ``n`` there: lateral radius ``r``
+   and half-height ``delta`` are the largest lateral and normal offsets of the cell's 9 samples
+   (the bilinear interpolant of the samples lies in their convex hull, hence in the cylinder),
+   enlarged by ``SAFETY`` times the largest second difference of the samples (the interpolation
+   error of a bilinear patch is at most 1/8 of the second differences). The lower bound of the
+   distance from ``X`` to the cell is the distance to the cylinder,
+   ``sqrt(max(rho - r, 0)^2 + max(z - delta, 0)^2)`` with ``z = |<X - c, n>|`` and ``rho`` the lateral
+   offset. These bounds are sampled estimates (the rigorous counterpart, from convex hulls of control
+   nets in interval arithmetic, is :mod:`ccproof.evaluate.closest_certified`).
+2. **First descent.** A k-d tree (scipy ``cKDTree``) over the cell centres gives the nearest one;
+   the projected Newton iteration below from it gives an upper bound ``d*`` of the distance.
+3. **Pruning.** The cells whose lower bound is below ``d*`` are the candidates, listed by a
+   bounding-volume hierarchy over the cells (:mod:`ccproof.evaluate._bvh`). A candidate is
+   *covered* once a descent in its face started in it or ended within ``cover`` cells of it
+   (default 3); uncovered candidates start new descents, best first (per round one descent per
+   point, from its open candidate of lowest bound), until every candidate is covered or its bound
+   exceeds the best distance found. A descent whose result is a new best on an edge of its face is
+   *handed off* to the face on the other side: a new descent starts from the sample of another face
+   nearest to the end point (a k-d tree over the samples, queried with surface points), so minima
+   next to face edges and corners are reached from both sides without any adjacency information.
+   The answer is the best of all descents.
+4. **Projected Newton** on ``E(u, v) = |P(u, v) - X|^2 / 2`` in ``[0, 1]^2``: gradient
+   ``(<P_u, R>, <P_v, R>)``, Hessian ``J^T J + <P_ww, R>`` (``R = P - X``); variables at a bound with
+   the gradient pushing outwards are frozen (minima on face edges and corners, boundaries); an
+   indefinite Hessian is replaced by ``J^T J`` plus a Levenberg term; every step is backtracked
+   (Armijo) so ``E`` never increases, and the iteration stops after ``MAX_ITER`` steps at the latest.
+   Near an extraordinary vertex the natural parameterization is singular at the corner (derivatives
+   tend to 0 for valence 3 and to infinity for valence >= 5); there the clipping at the face's
+   corner and the backtracking still give a monotone descent, and the evaluator's self-similar
+   layers keep the derivatives exact down to ``2^-60`` of the corner, so Newton converges (linearly
+   in the last layers at worst) to the corner or to the nearby minimum.
+
+The normal is ``P_u x P_v / |P_u x P_v|`` at the answer (at a face corner that is an
+extraordinary vertex this is the normal of the innermost stored layer, which converges to the
+limit normal).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ccproof.errors import CCProofError
+from ccproof.evaluate import _bvh
+
+__all__ = ["ClosestPoints", "ClosestPointFinder", "closest_points", "parameter_faces"]
+
+#: cells per face side
+CELLS = 8
+#: a descent covers the candidate cells within this many cells of its end (and its start cell)
+COVER = 3
+#: enlargement of the sampled cell bounds, in units of the largest second difference of the samples
+SAFETY = 2.0
+#: Newton steps at most per descent
+MAX_ITER = 60
+#: step halvings at most per Newton step (then the descent stops: no decrease at that scale)
+MAX_HALVINGS = 20
+#: rounds of descents at most (each runs one descent per point still open)
+MAX_ROUNDS = 64
+#: hand-offs across face edges at most per point
+MAX_HANDOFFS = 4
+#: points per chunk
+CHUNK = 1 << 16
+
+
+def parameter_faces(surface):
+    """Number of parameter faces (ptex faces) of ``surface``: face ids are ``0 .. parameter_faces - 1``."""
+    for name in ("n_ptex_faces", "n_param_faces"):
+        n = getattr(surface, name, None)
+        if n is not None:
+            return int(n)
+    mesh = getattr(surface, "mesh", None)
+    for name in ("n_ptex_faces", "n_faces"):
+        n = getattr(mesh, name, None)
+        if n is not None:
+            return int(n)
+    raise CCProofError("the surface does not say how many parameter faces it has")
+
+
+@dataclass
+class ClosestPoints:
+    """Result of :func:`closest_points` for n points.
+
+    Attributes
+    ----------
+    face : ndarray of int64, shape (n,)
+        Parameter (ptex) face of the nearest limit point.
+    u, v : ndarray, shape (n,)
+        Its parameter in the face, in [0, 1].
+    P : ndarray, shape (n, 3)
+        The nearest limit point.
+    distance : ndarray, shape (n,)
+        ``|X - P|``.
+    normal : ndarray, shape (n, 3)
+        Unit normal ``P_u x P_v / |P_u x P_v|`` at (face, u, v).
+    descents : ndarray of int32, shape (n,)
+        Number of Newton descents run for the point (1 when the first one was provably best
+        among the candidate cells).
+    """
+
+    face: np.ndarray
+    u: np.ndarray
+    v: np.ndarray
+    P: np.ndarray
+    distance: np.ndarray
+    normal: np.ndarray
+    descents: np.ndarray
+
+
+def _dot(a, b):
+    return np.einsum("ij,ij->i", a, b)
+
+
+def _unit_normal(Pu, Pv):
+    N = np.cross(Pu, Pv)
+    nn = np.linalg.norm(N, axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        N = N / nn[:, None]
+    return N
+
+
+def newton(surface, X, face, u, v, max_iter=MAX_ITER):
+    """Projected, backtracked Newton descent of ``|P(face, u, v) - X|^2 / 2`` in ``[0, 1]^2``.
+
+    Parameters
+    ----------
+    surface : LimitSurface
+    X : ndarray, shape (n, 3)
+    face : ndarray of int, shape (n,)
+    u, v : ndarray, shape (n,)
+        Starting parameters (clipped to [0, 1]).
+
+    Returns
+    -------
+    u, v : ndarray, shape (n,)
+    E : ndarray, shape (n,)
+        ``|P - X|^2 / 2`` at the result (never larger than at the start).
+    """
+    X = np.asarray(X, dtype=np.float64)
+    face = np.asarray(face, dtype=np.int64)
+    u = np.clip(np.asarray(u, dtype=np.float64), 0.0, 1.0).copy()
+    v = np.clip(np.asarray(v, dtype=np.float64), 0.0, 1.0).copy()
+    n = u.size
+    r = surface.evaluate(face, u, v, 2)
+    R = r["P"] - X
+    E = 0.5 * _dot(R, R)
+    alpha = np.ones(n)
+    active = np.arange(n)
+    # round-off of E = |P - X|^2 / 2: P is accurate to about eps |P|, so E to about eps |P| |R|
+    xs = np.abs(X).max(axis=1) if n else np.zeros(0)
+    slack = 1e-13 * E + 4e-16 * np.sqrt(2.0 * E) * (xs + np.sqrt(2.0 * E))
+    cur = {k: r[k] for k in ("Pu", "Pv", "Puu", "Puv", "Pvv")}
+    for _ in range(max_iter):
+        if active.size == 0:
+            break
+        a = active
+        Ra = R[a]
+        Pu, Pv = cur["Pu"][a], cur["Pv"][a]
+        gu, gv = _dot(Pu, Ra), _dot(Pv, Ra)
+        guu, guv, gvv = _dot(Pu, Pu), _dot(Pu, Pv), _dot(Pv, Pv)
+        huu = guu + _dot(cur["Puu"][a], Ra)
+        huv = guv + _dot(cur["Puv"][a], Ra)
+        hvv = gvv + _dot(cur["Pvv"][a], Ra)
+        ua, va = u[a], v[a]
+        fu = ~(((ua <= 0.0) & (gu > 0)) | ((ua >= 1.0) & (gu < 0)))
+        fv = ~(((va <= 0.0) & (gv > 0)) | ((va >= 1.0) & (gv < 0)))
+        # Newton where the (free part of the) Hessian is positive definite, else Gauss-Newton + LM
+        tr = np.abs(guu) + np.abs(gvv) + 1e-300
+        pd = (huu > 0) & (hvv > 0) & (huu * hvv - huv * huv > 1e-14 * tr * tr)
+        pd1u, pd1v = huu > 1e-14 * tr, hvv > 1e-14 * tr
+        lm = 1e-6 * tr
+        Auu = np.where(pd | (fu & ~fv & pd1u), huu, guu + lm)
+        Avv = np.where(pd | (fv & ~fu & pd1v), hvv, gvv + lm)
+        Auv = np.where(pd, huv, guv)
+        both = fu & fv
+        det = Auu * Avv - Auv * Auv
+        with np.errstate(invalid="ignore", divide="ignore"):
+            du = np.where(both, -(Avv * gu - Auv * gv) / det, np.where(fu, -gu / Auu, 0.0))
+            dv = np.where(both, -(Auu * gv - Auv * gu) / det, np.where(fv, -gv / Avv, 0.0))
+        bad = ~(np.isfinite(du) & np.isfinite(dv))
+        du[bad], dv[bad] = -gu[bad] / tr[bad], -gv[bad] / tr[bad]
+        pg = np.hypot(np.where(fu, gu, 0.0), np.where(fv, gv, 0.0))
+        al = alpha[a]
+        done = np.zeros(a.size, dtype=bool)
+        # backtracking: accept the first step with an Armijo decrease; give up below 2^-MAX_HALVINGS
+        for _ls in range(MAX_HALVINGS + 1):
+            idx = np.flatnonzero(~done)
+            if idx.size == 0:
+                break
+            ai = a[idx]
+            nu = np.clip(ua[idx] + al[idx] * du[idx], 0.0, 1.0)
+            nv = np.clip(va[idx] + al[idx] * dv[idx], 0.0, 1.0)
+            moved = (nu != ua[idx]) | (nv != va[idx])
+            rt = surface.evaluate(face[ai], nu, nv, 2)
+            Rt = rt["P"] - X[ai]
+            Et = 0.5 * _dot(Rt, Rt)
+            pred = gu[idx] * (nu - ua[idx]) + gv[idx] * (nv - va[idx])
+            # Armijo decrease; or, where E is flat to round-off (next to the minimum), a smaller
+            # projected gradient at no larger E beyond its round-off (slack, fixed at the start)
+            gtu, gtv = _dot(rt["Pu"], Rt), _dot(rt["Pv"], Rt)
+            ftu = ~(((nu <= 0.0) & (gtu > 0)) | ((nu >= 1.0) & (gtu < 0)))
+            ftv = ~(((nv <= 0.0) & (gtv > 0)) | ((nv >= 1.0) & (gtv < 0)))
+            pg_t = np.hypot(np.where(ftu, gtu, 0.0), np.where(ftv, gtv, 0.0))
+            ok = moved & (
+                (Et <= E[ai] + 1e-4 * np.minimum(pred, 0.0))
+                | ((Et <= E[ai] + slack[ai]) & (pg_t < 0.5 * pg[idx]))
+            )
+            acc = idx[ok]
+            aa = a[acc]
+            u[aa], v[aa] = nu[ok], nv[ok]
+            E[aa], R[aa] = Et[ok], Rt[ok]
+            for k in cur:
+                cur[k][aa] = rt[k][ok]
+            done[acc] = True
+            still = idx[~ok]
+            stop = ~moved[~ok] | (al[still] <= 2.0**-MAX_HALVINGS)
+            done[still[stop]] = True
+            al[still[~stop]] *= 0.5
+        step = np.maximum(np.abs(u[a] - ua), np.abs(v[a] - va))
+        # converged: no move, or a full step smaller than round-off of the parameter
+        # or a step below 1e-12 of the distance to the nearest face corner (converged to round-off:
+        # E is quadratic there), or a projected gradient at the round-off level of <P_w, R>
+        ucorner = np.maximum(np.minimum(u[a], 1.0 - u[a]), np.minimum(v[a], 1.0 - v[a]))
+        nR = np.sqrt(2.0 * E[a])
+        keep = (step > 0) & ~((al >= 1.0) & (step <= 4e-16)) & ~(step <= 1e-12 * ucorner)
+        keep &= ~(pg <= 1e-15 * nR * np.sqrt(guu + gvv))
+        alpha[a] = np.minimum(1.0, al * 2.0)
+        active = a[keep]
+    return u, v, E
+
+
+class ClosestPointFinder:
+    """Reusable search structure for :func:`closest_points` on one surface.
+
+    Parameters
+    ----------
+    surface : LimitSurface
+    cells : int
+        Cells per face side (``cells^2`` bounding cylinders per face, ``(2 cells + 1)^2`` samples).
+    cover : int, optional
+        A descent in a face covers its start cell and the candidate cells of that face within
+        ``cover`` cells of its end cell (default ``COVER``; ``cover >= cells``: the whole face, i.e.
+        one descent per point and face, faster but it misses a second local minimum in a face).
+    """
+
+    def __init__(self, surface, cells=CELLS, cover=None):
+        from scipy.spatial import cKDTree
+
+        if int(cells) != cells or cells < 1:
+            raise CCProofError(f"cells must be a positive integer, got {cells!r}")
+        self.surface = surface
+        self.m = m = int(cells)
+        self.cover = min(COVER, m) if cover is None else int(cover)
+        nf = parameter_faces(surface)
+        self.n_faces = nf
+        g = 2 * m + 1
+        t = np.arange(g) / (2 * m)
+        U, V = np.meshgrid(t, t, indexing="ij")  # [i along u, j along v]
+        fu = np.repeat(np.arange(nf), g * g)
+        r = surface.evaluate(fu, np.tile(U.ravel(), nf), np.tile(V.ravel(), nf), 1)
+        S = r["P"].reshape(nf, g, g, 3)
+        Nrm = _unit_normal(r["Pu"], r["Pv"]).reshape(nf, g, g, 3)
+        self._samples = r["P"]
+        self._sample_face = fu
+        self._sample_u = np.tile(U.ravel(), nf)
+        self._sample_v = np.tile(V.ravel(), nf)
+        # samples, for hand-offs across face edges (queried with surface points only: fast)
+        self._stree = cKDTree(self._samples)
+        # cells: [face, ci, cj] with 3x3 samples S[f, 2ci:2ci+3, 2cj:2cj+3]
+        blocks = np.stack(
+            [S[:, i0 : i0 + 2 * m - 1 : 2, j0 : j0 + 2 * m - 1 : 2] for i0 in range(3) for j0 in range(3)],
+            axis=3,
+        )  # (nf, m, m, 9, 3), sample (i0, j0) -> 3 i0 + j0
+        C = blocks[:, :, :, 4]
+        Nc = Nrm[:, 1::2, 1::2]
+        # a degenerate normal at the centre (e.g. exactly at a singular point): use the cell's diagonals
+        bad = ~np.isfinite(Nc).all(axis=-1)
+        if bad.any():
+            d1 = blocks[:, :, :, 8] - blocks[:, :, :, 0]
+            d2 = blocks[:, :, :, 6] - blocks[:, :, :, 2]
+            alt = np.cross(d1, d2)
+            alt /= np.maximum(np.linalg.norm(alt, axis=-1, keepdims=True), 1e-300)
+            Nc = np.where(bad[..., None], alt, Nc)
+        W = blocks - C[:, :, :, None]
+        z = np.einsum("fijsc,fijc->fijs", W, Nc)
+        rho = np.sqrt(np.maximum(np.einsum("fijsc,fijsc->fijs", W, W) - z * z, 0.0))
+        b = blocks.reshape(nf, m, m, 3, 3, 3)
+        d2u = np.linalg.norm(b[:, :, :, 0] - 2 * b[:, :, :, 1] + b[:, :, :, 2], axis=-1).max(axis=-1)
+        d2v = np.linalg.norm(b[:, :, :, :, 0] - 2 * b[:, :, :, :, 1] + b[:, :, :, :, 2], axis=-1).max(axis=-1)
+        d2x = np.linalg.norm(b[:, :, :, 0, 0] - b[:, :, :, 0, 2] - b[:, :, :, 2, 0] + b[:, :, :, 2, 2], axis=-1)
+        margin = SAFETY * np.maximum(np.maximum(d2u, d2v), d2x)
+        scale = np.abs(self._samples).max() if self._samples.size else 1.0
+        margin = margin + 1e-13 * scale
+        self._c = C.reshape(-1, 3)
+        self._n = Nc.reshape(-1, 3)
+        self._r = (rho.max(axis=-1) + margin).reshape(-1)
+        self._h = (np.abs(z).max(axis=-1) + margin).reshape(-1)
+        self._R = np.hypot(self._r, self._h)
+        self._Rmax = float(self._R.max()) if self._R.size else 0.0
+        self._bvh = _bvh.build(self._c, self._R)
+        # (unbalanced, non-compact nodes: several times faster queries for points far from the surface)
+        self._ctree = cKDTree(self._c, balanced_tree=False, compact_nodes=False)
+        cid = np.arange(nf * m * m)
+        self._cface = cid // (m * m)
+        self._ci = (cid // m) % m
+        self._cj = cid % m
+
+    # ------------------------------------------------------------------ bounds
+    def lower_bounds(self, X, cells):
+        """Lower bounds of the distance from points ``X`` (n, 3) to cells ``cells`` (n,) (sampled cylinders)."""
+        w = X - self._c[cells]
+        z = np.abs(_dot(w, self._n[cells]))
+        rho = np.sqrt(np.maximum(_dot(w, w) - z * z, 0.0))
+        return np.hypot(np.maximum(rho - self._r[cells], 0.0), np.maximum(z - self._h[cells], 0.0))
+
+    def _candidates(self, X, dstar):
+        """Pairs (point, cell) with lower bound < d*: arrays pid, cid, lb."""
+        return _bvh.candidates(X, dstar, self._bvh, self._c, self._n, self._r, self._h)
+
+    # ------------------------------------------------------------------ query
+    def query(self, X, *, chunk=CHUNK):
+        """Nearest limit points of ``X`` (n, 3); returns :class:`ClosestPoints`."""
+        X = _check_points(X)
+        n = X.shape[0]
+        out = ClosestPoints(
+            np.empty(n, dtype=np.int64), np.empty(n), np.empty(n), np.empty((n, 3)), np.empty(n),
+            np.empty((n, 3)), np.empty(n, dtype=np.int32),
+        )
+        for lo in range(0, n, chunk):
+            hi = min(n, lo + chunk)
+            f, u, v, nd = self._query_chunk(X[lo:hi])
+            out.face[lo:hi], out.u[lo:hi], out.v[lo:hi], out.descents[lo:hi] = f, u, v, nd
+        r = self.surface.evaluate(out.face, out.u, out.v, 1)
+        out.P[:] = r["P"]
+        out.distance[:] = np.linalg.norm(X - r["P"], axis=1)
+        out.normal[:] = _unit_normal(r["Pu"], r["Pv"])
+        return out
+
+    __call__ = query
+
+    def _query_chunk(self, X):
+        n = X.shape[0]
+        m = self.m
+        _, j = self._ctree.query(X, k=1)
+        # starts of the current round: point, face, (u, v)
+        sp, sf = np.arange(n), self._cface[j]
+        su, sv = (self._ci[j] + 0.5) / m, (self._cj[j] + 0.5) / m
+        bf = np.zeros(n, dtype=np.int64)
+        bu, bv, bE = np.zeros(n), np.zeros(n), np.full(n, np.inf)
+        ndesc = np.zeros(n, dtype=np.int32)
+        handoffs = np.zeros(n, dtype=np.int32)
+        pid = None
+        for _round in range(MAX_ROUNDS + 1):
+            nu, nv, nE = newton(self.surface, X[sp], sf, su, sv)
+            np.add.at(ndesc, sp, 1)
+            # best per point among this round's descents, then against the best so far
+            order = np.lexsort((nE, sp))
+            first = order[np.r_[True, sp[order[1:]] != sp[order[:-1]]]] if sp.size else order
+            better = first[nE[first] < bE[sp[first]]]
+            q = sp[better]
+            bf[q], bu[q], bv[q], bE[q] = sf[better], nu[better], nv[better], nE[better]
+            if pid is None:
+                pid, cid, lb = self._candidates(X, np.sqrt(2.0 * bE))
+                order = np.lexsort((lb, pid))  # sorted by point, then bound (kept by every compression)
+                pid, cid, lb = pid[order], cid[order], lb[order]
+                covered = np.zeros(pid.size, dtype=bool)
+            # coverage: every descent covers its start cell and the cells near its end, in its face
+            for grp in self._one_per_point(sp):
+                rf = np.full(n, -1, dtype=np.int64)
+                ri = np.zeros((4, n), dtype=np.int64)
+                g = grp
+                rf[sp[g]] = sf[g]
+                ri[0, sp[g]], ri[1, sp[g]] = self._cell_of(su[g]), self._cell_of(sv[g])
+                ri[2, sp[g]], ri[3, sp[g]] = self._cell_of(nu[g]), self._cell_of(nv[g])
+                covered |= self._covered_by(pid, cid, rf[pid], *ri[:, pid])
+            # hand-off across face edges: a new best on an edge of its face continues in the face on
+            # the other side, from the sample there nearest to the end point (found geometrically)
+            edge = (bu[q] == 0.0) | (bu[q] == 1.0) | (bv[q] == 0.0) | (bv[q] == 1.0)
+            hq = q[edge & (handoffs[q] < MAX_HANDOFFS)]
+            hf, hu, hv, hp = self._across(hq, bf[hq], bu[hq], bv[hq])
+            handoffs[hp] += 1
+            keep = ~covered & (lb < np.sqrt(2.0 * bE[pid]))
+            pid, cid, lb, covered = pid[keep], cid[keep], lb[keep], covered[keep]
+            if (pid.size == 0 and hp.size == 0) or _round == MAX_ROUNDS:
+                break
+            # best first: one descent per point from its open candidate of lowest bound
+            first = np.flatnonzero(np.r_[True, pid[1:] != pid[:-1]]) if pid.size else np.zeros(0, dtype=np.int64)
+            cp, cc = pid[first], cid[first]
+            sp = np.concatenate([cp, hp])
+            sf = np.concatenate([self._cface[cc], hf])
+            su = np.concatenate([(self._ci[cc] + 0.5) / m, hu])
+            sv = np.concatenate([(self._cj[cc] + 0.5) / m, hv])
+        return bf, bu, bv, ndesc
+
+    @staticmethod
+    def _one_per_point(sp):
+        """Split indices of ``sp`` into groups with each point at most once."""
+        if sp.size == 0:
+            return []
+        order = np.argsort(sp, kind="stable")
+        s = sp[order]
+        start = np.r_[0, np.flatnonzero(s[1:] != s[:-1]) + 1]
+        rank = np.arange(s.size) - np.repeat(start, np.diff(np.r_[start, s.size]))
+        return [order[rank == r] for r in range(int(rank.max()) + 1)]
+
+    def _across(self, p, f, u, v):
+        """For end points (f, u, v) on a face edge: the nearest sample of another face (points p)."""
+        if p.size == 0:
+            e = np.empty(0, dtype=np.int64)
+            return e, np.empty(0), np.empty(0), e
+        P = self.surface.evaluate(f, u, v, 0)["P"]
+        k = 8
+        _, J = self._stree.query(P, k=k)
+        other = self._sample_face[J] != f[:, None]
+        has = other.any(axis=1)
+        col = np.argmax(other, axis=1)
+        jj = J[np.arange(p.size), col][has]
+        return self._sample_face[jj], self._sample_u[jj], self._sample_v[jj], p[has]
+
+    def _cell_of(self, t):
+        return np.minimum((np.asarray(t) * self.m).astype(np.int64), self.m - 1)
+
+    def _covered_by(self, pid, cid, rf, si, sj, ei, ej):
+        """Candidates (pid, cid) in the face ``rf`` of a descent of the same point, within one cell of
+        its start cell (si, sj) or its end cell (ei, ej) (all arrays aligned with pid)."""
+        same = self._cface[cid] == rf
+        if self.cover >= self.m:
+            return same
+        ci, cj, c = self._ci[cid], self._cj[cid], self.cover
+        near = ((ci == si) & (cj == sj)) | ((np.abs(ci - ei) <= c) & (np.abs(cj - ej) <= c))
+        return same & near
+
+
+def _check_points(X):
+    X = np.asarray(X, dtype=np.float64)
+    if X.ndim != 2 or X.shape[1] != 3:
+        raise CCProofError(f"points must have shape (n, 3), got {X.shape}")
+    bad = np.flatnonzero(~np.isfinite(X).all(axis=1))
+    if bad.size:
+        raise CCProofError(f"point {int(bad[0])}: coordinates {X[bad[0]].tolist()} are not finite")
+    return X
+
+
+def closest_points(surface, X, *, cells=CELLS, cover=None, finder=None):
+    """Globally nearest limit points of ``X`` (shape (n, 3)) on ``surface``.
+
+    Parameters
+    ----------
+    surface : LimitSurface (or an OBJ path / QuadMesh, passed to :func:`~ccproof.evaluate.limit_surface`)
+    X : array_like, shape (n, 3)
+    cells, cover : int
+        Cells per face side of the search structure, covering radius of a descent in cells
+        (default ``COVER``); see :class:`ClosestPointFinder`.
+    finder : ClosestPointFinder, optional
+        A prepared search structure to reuse (then ``surface`` and ``cells`` are ignored).
+
+    Returns
+    -------
+    ClosestPoints
+        ``face``, ``u``, ``v``, ``P`` (n, 3), ``distance`` (n,), ``normal`` (n, 3), ``descents``.
+
+    Examples
+    --------
+    >>> from ccproof.evaluate import limit_surface
+    >>> from ccproof.mesh.examples import cube
+    >>> S = limit_surface(cube())
+    >>> res = closest_points(S, [[0.0, 0.0, 2.0]])
+    >>> round(float(res.distance[0] * 81), 9), round(float(res.P[0, 2] * 81), 9)  # top face centre, z = 68/81
+    (94.0, 68.0)
+    """
+    if finder is None:
+        if not hasattr(surface, "evaluate"):
+            from ccproof.evaluate.surface import limit_surface
+
+            surface = limit_surface(surface)
+        finder = ClosestPointFinder(surface, cells=cells, cover=cover)
+    return finder.query(X)

@@ -1,0 +1,414 @@
+"""Certified nearest point (interval arithmetic, python-flint ``arb``): a proof that no other part of
+the limit surface is closer, or an honest verdict that this could not be shown.
+
+Method (branch and bound on convex hulls of control nets):
+
+* Every Catmull-Clark rule (face, edge, vertex and the ``VTX_BOUNDARY_EDGE_ONLY`` boundary rules) is
+  a convex combination, and the limit surface over a face depends only on the face's one-ring (the
+  vertices of the faces sharing a vertex with it). Hence the limit surface over a face, or over a
+  dyadic sub-square of it, lies in the **convex hull of the one-ring** of that (sub)face. The one-ring
+  of a child face is computed from the parent's one-ring alone (the points whose stencils lie in
+  it, as in exact local refinement), here in ``arb`` ball arithmetic from the exact float
+  coordinates of the mesh: every point is an enclosure of the true control point.
+* A *piece* is a dyadic sub-square (face, level L, box) with its one-ring. Lower bound of the
+  distance from X to the piece: the largest of the distance to the box around its points and of the
+  half-space bounds ``min_j <a, X - c_j> / |a|`` along the direction ``a = X - P`` of the float
+  answer and ``min_j <w, c_j - X> / |w|`` along the direction ``w`` from X to the piece's centre.
+  Upper bound: the distance to the nearest of the limit points of the 4 corners of the piece (exact
+  limit masks, surface points), at most ``max_j |X - c_j|``.
+* ``d_up``: the upper bound of the piece of level ``up_level`` containing the float answer
+  (face, u, v). Starting from all base faces, pieces whose lower bound exceeds ``d_up`` are
+  excluded; the others are split into their 4 children, down to level ``max_level``.
+* Pieces are split until they lie within ``radius`` (3-D) of the float answer P or reach
+  ``max_level``. Verdict: **certified** if every remaining piece lies within ``separation`` of P:
+  then every surface point at distance <= d_up from X, in particular the nearest one, lies in the
+  remaining pieces; their parameter boxes enclose the nearest parameter and ``[min lb, d_up]``
+  encloses the distance. **ambiguous** if a remaining piece farther than ``separation`` from P has an
+  upper bound within ``ambiguity`` of ``d_up``: another part of the surface is as close to within
+  that tolerance (e.g. the centre of a sphere-like surface). **uncertified** otherwise (the budget of
+  pieces or levels ran out).
+
+Supported meshes: quad meshes of :class:`~ccproof.mesh.QuadMesh` (boundary rule
+``VTX_BOUNDARY_EDGE_ONLY``); other meshes raise a :class:`~ccproof.errors.CCProofError`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from ccproof.errors import CCProofError
+
+__all__ = ["CertifiedClosest", "certify_closest"]
+
+#: level of the piece giving the upper bound d_up
+UP_LEVEL = 24
+#: deepest level of the branch and bound
+MAX_LEVEL = 22
+#: pieces examined at most per point
+MAX_PIECES = 20000
+#: precision of the ball arithmetic (bits)
+PREC = 106
+
+
+@dataclass
+class CertifiedClosest:
+    """Verdict of :func:`certify_closest` for one point.
+
+    Attributes
+    ----------
+    verdict : str
+        ``"certified"``, ``"ambiguous"`` or ``"uncertified"``.
+    distance_lo, distance_hi : float
+        Rigorous enclosure of the distance from X to the surface (``distance_lo`` is the lower bound
+        over the remaining pieces; valid as an enclosure only when certified; ``distance_hi`` is
+        always a rigorous upper bound).
+    parameter_radius : float
+        The nearest parameter lies within this max-norm radius of the float (u, v) in ``face``
+        (certified only; NaN otherwise, inf if the remaining pieces extend into other faces, which
+        are listed in ``boxes``).
+    boxes : list of (face, (u_lo, u_hi), (v_lo, v_hi))
+        Parameter boxes of the remaining pieces (certified: they contain the nearest parameter).
+    pieces : int
+        Pieces examined.
+    message : str
+    """
+
+    verdict: str
+    distance_lo: float
+    distance_hi: float
+    parameter_radius: float
+    boxes: list = field(default_factory=list)
+    pieces: int = 0
+    message: str = ""
+
+
+# ------------------------------------------------------------------------------ local nets
+class _Piece:
+    __slots__ = ("faces", "pts", "c", "face", "u0", "v0", "h", "level", "lb", "ub", "far")
+
+    def __init__(self, faces, pts, c, face, u0, v0, h, level):
+        self.faces, self.pts, self.c = faces, pts, c
+        self.face, self.u0, self.v0, self.h, self.level = face, u0, v0, h, level
+
+
+def _one_ring_faces(faces, c):
+    vs = set(faces[c])
+    return [g for g, F in enumerate(faces) if vs.intersection(F)]
+
+
+def _refine(piece, q, arb):
+    """The child of ``piece`` at corner ``q`` of its centre face (its own one-ring, exact rules)."""
+    faces, pts, c = piece.faces, piece.pts, piece.c
+    C = faces[c]
+    # star of every local vertex: faces (as (g, position)) and edges
+    star = {}
+    for g, F in enumerate(faces):
+        for i, w in enumerate(F):
+            star.setdefault(w, []).append((g, i))
+    cache = {}
+
+    def avg(ps):
+        n = len(ps)
+        return [sum((p[k] for p in ps), arb(0)) / n for k in range(3)]
+
+    def face_pt(g):
+        key = ("f", g)
+        if key not in cache:
+            cache[key] = avg([pts[w] for w in faces[g]])
+        return cache[key]
+
+    def edge_faces(a, b):
+        out = []
+        for g, i in star[a]:
+            F = faces[g]
+            if F[(i + 1) % 4] == b or F[(i - 1) % 4] == b:
+                out.append(g)
+        return out
+
+    def edge_pt(a, b):
+        key = ("e", min(a, b), max(a, b))
+        if key not in cache:
+            gs = edge_faces(a, b)
+            if len(gs) == 1:
+                cache[key] = avg([pts[a], pts[b]])
+            else:
+                f0, f1 = face_pt(gs[0]), face_pt(gs[1])
+                cache[key] = [(pts[a][k] + pts[b][k] + f0[k] + f1[k]) / 4 for k in range(3)]
+        return cache[key]
+
+    def vertex_pt(w):
+        key = ("v", w)
+        if key not in cache:
+            gs = star[w]
+            nbrs = []
+            for g, i in gs:
+                F = faces[g]
+                for b in (F[(i + 1) % 4], F[(i - 1) % 4]):
+                    if b not in nbrs:
+                        nbrs.append(b)
+            bnd = [b for b in nbrs if len(edge_faces(w, b)) == 1]
+            V = pts[w]
+            if bnd:
+                if len(bnd) != 2:  # pragma: no cover - QuadMesh guarantees manifold boundaries
+                    raise CCProofError("non-manifold boundary vertex in a local net")
+                e0, e1 = pts[bnd[0]], pts[bnd[1]]
+                cache[key] = [(e0[k] + 6 * V[k] + e1[k]) / 8 for k in range(3)]
+            else:
+                k_ = len(nbrs)
+                Fa = avg([face_pt(g) for g, _ in gs])
+                R = avg([avg([V, pts[b]]) for b in nbrs])
+                cache[key] = [(Fa[k] + 2 * R[k] + (k_ - 3) * V[k]) / k_ for k in range(3)]
+        return cache[key]
+
+    def child_face(g, i):
+        """Child of face g at its corner i, as keys, starting at the vertex point."""
+        F = faces[g]
+        w, nx, pv = F[i], F[(i + 1) % 4], F[(i - 1) % 4]
+        return [("v", w), ("e", min(w, nx), max(w, nx)), ("f", g), ("e", min(w, pv), max(w, pv))]
+
+    # children at the corners of C of the faces at those corners; the child's one-ring among them
+    kids = []
+    for w in C:
+        for g, i in star[w]:
+            kids.append((g, i, child_face(g, i)))
+    own = child_face(c, q)
+    own_set = set(own)
+    ring = [k for k in kids if own_set.intersection(k[2])]
+    ids, new_pts, new_faces = {}, [], []
+    for g, i, keys in ring:
+        F = []
+        for key in keys:
+            if key not in ids:
+                ids[key] = len(new_pts)
+                if key[0] == "v":
+                    new_pts.append(vertex_pt(key[1]))
+                elif key[0] == "e":
+                    new_pts.append(edge_pt(key[1], key[2]))
+                else:
+                    new_pts.append(face_pt(key[1]))
+            F.append(ids[key])
+        if (g, i) == (c, q):
+            r = (0, 3, 2, 1)[q]  # corner 0 of the child at the sub-square's lowest (u, v) corner
+            F = F[r:] + F[:r]
+            new_c = len(new_faces)
+        new_faces.append(tuple(F))
+    h = piece.h / 2
+    du, dv = ((0, 0), (1, 0), (1, 1), (0, 1))[q]
+    return _Piece(new_faces, new_pts, new_c, piece.face, piece.u0 + du * h, piece.v0 + dv * h, h, piece.level + 1)
+
+
+def _bounds(piece, X, a, an, arb):
+    """Lower and upper bounds (floats, rigorous) of the distance from X to the piece's hull."""
+    lo = [min(p[k].lower() for p in piece.pts) for k in range(3)]
+    hi = [max(p[k].upper() for p in piece.pts) for k in range(3)]
+    d2 = arb(0)
+    for k in range(3):
+        if X[k] < lo[k]:
+            d2 += _sq(lo[k] - X[k])
+        elif X[k] > hi[k]:
+            d2 += _sq(X[k] - hi[k])
+    lb_box = _sqrt_lo(d2)
+    hs = min((sum((a[k] * (X[k] - p[k]) for k in range(3)), arb(0)) / an).lower() for p in piece.pts)
+    # half-space bound along the direction from X to the piece's centre (tight for far pieces)
+    w = [arb(float(sum((p[k] for p in piece.pts), arb(0)).mid()) / len(piece.pts) - float(X[k].mid()))
+         for k in range(3)]
+    wn2 = sum((t * t for t in w), arb(0))
+    if wn2 > 0:
+        wn = wn2.sqrt()
+        hs = max(hs, min((sum((w[k] * (p[k] - X[k]) for k in range(3)), arb(0)) / wn).lower() for p in piece.pts))
+    ub = max(_sqrt_up(sum((_sq(X[k] - p[k]) for k in range(3)), arb(0))) for p in piece.pts)
+    for L in _corner_limits(piece, arb):
+        ub = min(ub, _sqrt_up(sum((_sq(X[k] - L[k]) for k in range(3)), arb(0))))
+    return max(lb_box, hs, arb(0).lower()), ub
+
+
+def _sq(x):
+    # x * x, not x ** 2: python-flint's power of a ball containing 0 is NaN
+    return x * x
+
+
+def _sqrt_up(s):
+    """Upper bound of sqrt over a ball s (of a sum of squares, which may straddle 0 by round-off)."""
+    up = s.upper()
+    return up.sqrt().upper() if up > 0 else up * 0
+
+
+def _sqrt_lo(s):
+    lo = s.lower()
+    return lo.sqrt().lower() if lo > 0 else lo * 0
+
+
+def _corner_limits(piece, arb):
+    """Limit points (surface points, in arb) of the 4 corners of the piece's centre face: masks
+    ``(k^2 V + 4 sum e + sum d) / (k (k + 5))`` (interior) and ``(e0 + 4 V + e1) / 6`` (boundary)."""
+    faces, pts = piece.faces, piece.pts
+    out = []
+    for w in faces[piece.c]:
+        e, d, cnt = [], [], {}
+        for F in faces:
+            if w in F:
+                i = F.index(w)
+                e += [F[(i + 1) % 4], F[(i - 1) % 4]]
+                d.append(F[(i + 2) % 4])
+        for b in e:
+            cnt[b] = cnt.get(b, 0) + 1
+        V = pts[w]
+        bnd = [b for b, n in cnt.items() if n == 1]
+        if bnd:
+            e0, e1 = pts[bnd[0]], pts[bnd[1]]
+            out.append([(e0[k] + 4 * V[k] + e1[k]) / 6 for k in range(3)])
+        else:
+            k_ = len(cnt)
+            se = [sum((pts[b][k] for b in cnt), arb(0)) for k in range(3)]
+            sd = [sum((pts[b][k] for b in d), arb(0)) for k in range(3)]
+            out.append([(k_ * k_ * V[k] + 4 * se[k] + sd[k]) / (k_ * (k_ + 5)) for k in range(3)])
+    return out
+
+
+def _corner_piece(piece, u, v, arb):
+    h = piece.h / 2
+    q = (int(u >= piece.u0 + h), int(v >= piece.v0 + h))
+    return _refine(piece, {(0, 0): 0, (1, 0): 1, (1, 1): 2, (0, 1): 3}[q], arb)
+
+
+def _ring_boxes(F, Vx, vf):
+    import numpy as np
+
+    lo = np.empty((F.shape[0], 3))
+    hi = np.empty((F.shape[0], 3))
+    for g, row in enumerate(F.tolist()):
+        ring = set().union(*(vf[w] for w in row))
+        verts = np.unique(F[sorted(ring)])
+        lo[g], hi[g] = Vx[verts].min(0), Vx[verts].max(0)
+    return lo, hi
+
+
+def certify_closest(surface, x, face, u, v, *, radius=None, separation=None, ambiguity=None, up_level=UP_LEVEL,
+                    max_level=MAX_LEVEL, max_pieces=MAX_PIECES):
+    """Certify that the limit point at (face, u, v) is (within enclosures) the nearest one to ``x``.
+
+    Parameters
+    ----------
+    surface : LimitSurface
+        Of a quad mesh (its ``mesh`` must have ``faces`` (m, 4) and ``vertices`` (n, 3)).
+    x : array_like, shape (3,)
+    face, u, v : the float answer (e.g. from :func:`~ccproof.evaluate.closest.closest_points`).
+    radius : float, optional
+        Pieces are split until they lie within this 3-D radius of the float answer P (or reach
+        ``max_level``); default 1e-6 of the bounding box diagonal.
+    separation : float, optional
+        Certified if every remaining piece lies within this distance of P (default 1e-3 of the
+        diagonal; the enclosure actually reached is reported); remaining pieces farther away make
+        the point ambiguous or uncertified.
+    ambiguity : float, optional
+        Tolerance of the ambiguity verdict (default 1e-9 of the diagonal).
+
+    Returns
+    -------
+    CertifiedClosest
+    """
+    import flint
+    import numpy as np
+
+    mesh = getattr(surface, "mesh", surface)
+    F = np.asarray(getattr(mesh, "faces", None)) if getattr(mesh, "faces", None) is not None else None
+    if F is None or F.ndim != 2 or F.shape[1] != 4:
+        raise CCProofError("certified closest points support quad meshes only (faces of 4 vertices)")
+    Vx = np.asarray(mesh.vertices, dtype=np.float64)
+    x = np.asarray(x, dtype=np.float64).reshape(3)
+    face, u, v = int(face), float(u), float(v)
+    diag = float(np.linalg.norm(Vx.max(0) - Vx.min(0)))
+    radius = 1e-6 * diag if radius is None else float(radius)
+    ambiguity = 1e-9 * diag if ambiguity is None else float(ambiguity)
+    separation = 1e-3 * diag if separation is None else float(separation)
+    old = flint.ctx.prec
+    flint.ctx.prec = PREC
+    try:
+        arb = flint.arb
+        X = [arb(float(t)) for t in x]
+        P = surface.evaluate([face], [u], [v], 0)["P"][0]
+        a_f = x - P
+        if not np.any(a_f):
+            a_f = np.asarray(surface.evaluate([face], [u], [v], 1)["Pu"][0], dtype=np.float64)
+            a_f = np.cross(a_f, surface.evaluate([face], [u], [v], 1)["Pv"][0])
+        a = [arb(float(t)) for t in a_f]
+        an = sum((t * t for t in a), arb(0)).sqrt()
+        Pa = [arb(float(t)) for t in P]
+        # vertex -> faces
+        vf = {}
+        for g, row in enumerate(F.tolist()):
+            for w in row:
+                vf.setdefault(w, set()).add(g)
+
+        def base_piece(g):
+            ring = sorted(set().union(*(vf[w] for w in F[g].tolist())))
+            verts = sorted({w for h in ring for w in F[h].tolist()})
+            loc = {w: i for i, w in enumerate(verts)}
+            faces = [tuple(loc[w] for w in F[h].tolist()) for h in ring]
+            pts = [[arb(float(t)) for t in Vx[w]] for w in verts]
+            return _Piece(faces, pts, ring.index(g), g, 0.0, 0.0, 1.0, 0)
+
+        def far_from_P(piece):
+            # the hull is farther than `radius` from P somewhere: max_j |P - c_j| > radius
+            return spread(piece) > radius
+
+        def spread(piece):
+            return max(_sqrt_up(sum((_sq(Pa[k] - p[k]) for k in range(3)), arb(0))) for p in piece.pts)
+
+        # upper bound: the piece at level up_level containing (u, v)
+        pc = base_piece(face)
+        for _ in range(up_level):
+            pc = _corner_piece(pc, u, v, arb)
+        d_up = _bounds(pc, X, a, an, arb)[1]
+        # float prefilter of the base faces (box of the one-ring; the margin covers the rounding)
+        ring_lo, ring_hi = _ring_boxes(F, Vx, vf)
+        gap = np.maximum(np.maximum(ring_lo - x, x - ring_hi), 0.0)
+        lbf = np.sqrt((gap * gap).sum(axis=1)) * (1 - 1e-12)
+        active = []
+        for g in np.flatnonzero(lbf <= float(d_up) * (1 + 1e-12)).tolist():
+            p = base_piece(g)
+            p.lb, p.ub = _bounds(p, X, a, an, arb)
+            if p.lb <= d_up:
+                active.append(p)
+        n_pieces = F.shape[0] + up_level
+        while True:
+            split = [p for p in active if p.level < max_level and far_from_P(p)]
+            if not split:
+                break
+            if n_pieces + 4 * len(split) > max_pieces:
+                break
+            keep = [p for p in active if not (p.level < max_level and far_from_P(p))]
+            for p in split:
+                for q in range(4):
+                    ch = _refine(p, q, arb)
+                    ch.lb, ch.ub = _bounds(ch, X, a, an, arb)
+                    n_pieces += 1
+                    if ch.lb <= d_up:
+                        keep.append(ch)
+            active = keep
+        lo = min((p.lb for p in active), default=d_up)
+        boxes = [(p.face, (p.u0, p.u0 + p.h), (p.v0, p.v0 + p.h)) for p in active]
+        if not (np.isfinite(float(d_up)) and np.isfinite(float(lo))):
+            return CertifiedClosest("uncertified", float("nan"), float("nan"), float("nan"), [], n_pieces,
+                                    "the enclosures are not finite")
+        sp = [float(spread(p)) for p in active]
+        sep = [p for p, r_ in zip(active, sp) if r_ > separation]
+        if not sep:
+            same = [b for b in boxes if b[0] == face]
+            rad = max((max(abs(b[1][0] - u), abs(b[1][1] - u), abs(b[2][0] - v), abs(b[2][1] - v)) for b in same),
+                      default=0.0)
+            if len(same) < len(boxes):
+                rad = float("inf")
+            return CertifiedClosest("certified", float(lo), float(d_up), float(rad), boxes, n_pieces,
+                                    f"every surface point within {float(d_up):.17g} of x lies within "
+                                    f"{max(sp, default=0.0):.3g} of P")
+        near_min = [p for p in sep if p.ub <= d_up + ambiguity]
+        if near_min:
+            return CertifiedClosest("ambiguous", float(lo), float(d_up), float("nan"), boxes, n_pieces,
+                                    f"{len(near_min)} pieces farther than {separation:.3g} from P are within "
+                                    f"{ambiguity:.3g} of the distance")
+        return CertifiedClosest("uncertified", float(lo), float(d_up), float("nan"), boxes, n_pieces,
+                                f"{len(sep)} pieces farther than {separation:.3g} from P could not be excluded "
+                                f"(levels <= {max_level}, pieces <= {max_pieces})")
+    finally:
+        flint.ctx.prec = old
