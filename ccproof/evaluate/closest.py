@@ -83,7 +83,7 @@ def parameter_faces(surface):
         if n is not None:
             return int(n)
     mesh = getattr(surface, "mesh", None)
-    for name in ("n_ptex_faces", "n_faces"):
+    for name in ("n_ptex_faces", "n_ptex", "n_faces"):  # a PolyMesh's n_faces counts polygons, not ptex faces
         n = getattr(mesh, name, None)
         if n is not None:
             return int(n)

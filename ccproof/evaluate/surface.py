@@ -528,6 +528,13 @@ class LimitSurface:
             self._corner_normal[vid] = nrm
         return self._corner_normal[vid]
 
+    def closest_points(self, X, **options):
+        """Globally nearest limit points to the rows of ``X`` (n, 3): see :func:`ccproof.evaluate.closest.closest_points`
+        (returns face, u, v, P, distance, normal)."""
+        from .closest import closest_points
+
+        return closest_points(self, X, **options)
+
     def normals(self, face_ids, u, v):
         """Unit limit normals, shape (n, 3), oriented like ``Pu x Pv``.
 

@@ -248,3 +248,26 @@ def test_bunny_against_brute_force(bunny_path):
     same = np.abs(rel) <= 1e-9
     assert same.mean() > 0.99
     assert np.linalg.norm(res.P - refP, axis=1)[same].max() <= 1e-5 * diag
+
+
+@pytest.mark.parametrize("name", ["catmark_nonquads", "catmark_cube_creases0"])
+def test_tagged_meshes_never_farther_than_dense_sampling(refdir, name):
+    """Triangles, n-gons (ptex faces) and creases: on the tagged evaluator the search is never farther
+    than a 41 x 41 sampling of every ptex face, and within that sampling's resolution of it."""
+    from ccproof.evaluate import limit_surface
+    from ccproof.mesh.io import read_mesh
+
+    s = limit_surface(read_mesh(refdir / "osd_features" / "meshes" / f"{name}.obj"))
+    g = np.linspace(0, 1, 41)
+    U, V = np.meshgrid(g, g, indexing="ij")
+    nf = s.n_faces
+    P = s.evaluate(np.repeat(np.arange(nf), U.size), np.tile(U.ravel(), nf), np.tile(V.ravel(), nf),
+                   derivatives=0)["P"]
+    lo, hi = P.min(0), P.max(0)
+    X = lo - 0.05 * (hi - lo) + 1.1 * (hi - lo) * np.random.default_rng(1).random((200, 3))
+    r = s.closest_points(X)
+    brute = np.sqrt(((X[:, None, :] - P[None]) ** 2).sum(-1)).min(1)
+    diag = np.linalg.norm(hi - lo)
+    assert r.face.max() < nf
+    assert (r.distance - brute).max() <= 1e-12 * diag
+    assert (brute - r.distance).max() < 1e-2 * diag
