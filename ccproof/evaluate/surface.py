@@ -529,8 +529,8 @@ class LimitSurface:
         return self._corner_normal[vid]
 
     def closest_points(self, X, **options):
-        """Globally nearest limit points to the rows of ``X`` (n, 3): see :func:`ccproof.evaluate.closest.closest_points`
-        (returns face, u, v, P, distance, normal)."""
+        """Globally nearest limit points to the rows of ``X`` (n, 3): face, u, v, P, distance, normal
+        (see :func:`ccproof.evaluate.closest.closest_points`)."""
         from .closest import closest_points
 
         return closest_points(self, X, **options)
