@@ -111,9 +111,8 @@ def cell_det_poly(nets, lam, N, l, m, p, q, prec):
         y1 = (s + l) * fmpq(1, 2**N)
         y2 = (t + m) * fmpq(1, 2**N)
         w = weight_piece(p).compose([X]) * weight_piece(q).compose([Y])
-        G1 = w * y1 + (1 - w) * X
-        G2 = w * y2 + (1 - w) * Y
-        return jacobian_determinant([G1, G2])
+        # G = w y + (1 - w) Phi, written X + w (y - X): one product per coordinate
+        return jacobian_determinant([X + w * (y1 - X), Y + w * (y2 - Y)])
 
 
 def corner_det_form(nets, lam, N, name, prec):
