@@ -127,7 +127,7 @@ def test_the_table_files_are_not_evidence(tmp_path, monkeypatch):
 
 
 def test_a_faked_summary_is_rejected_and_report_shows_only_verified_numbers(tmp_path):
-    from ccproof.certify.cli_report import _row
+    from ccproof.cli.report import _row
 
     c = load(5)
     c["summary"] = {"min_bound_det_J_phi_local": "0.9"}
@@ -155,7 +155,7 @@ def test_huge_tiny_and_overlong_decimals_fail_fast(bound, tmp_path):
 
 
 def test_verify_all_goes_on_past_a_bad_file(tmp_path, capsys):
-    from ccproof.certify.cli_verify import run as verify_run
+    from ccproof.cli.verify import run as verify_run
 
     good = tmp_path / "good.json"
     good.write_text(json.dumps(load(3, "c1")))

@@ -70,7 +70,7 @@ def _forged(tmp_path):
 
 
 def test_verify_verdicts_equal_on_the_cluster(cluster, tmp_path, capsys):
-    from ccproof.certify.cli_verify import _check
+    from ccproof.cli.verify import _check
 
     files = [ROOT / "certificates" / "c1" / "k003.json", ROOT / "certificates" / "c1" / "k004.json",
              _forged(tmp_path), ROOT / "certificates" / "c1" / "k005.json"]

@@ -9,7 +9,7 @@
 * :mod:`~ccproof.apps.arap.lscm`: triangulation and LSCM initialization (numpy/scipy);
 * :mod:`~ccproof.apps.arap.metrics`: E_angle, E_area, E_stretch (section 4), flips;
 * :mod:`~ccproof.apps.arap.core`: the methods (a)-(d), multi-resolution schedule, ``compare``;
-* :mod:`~ccproof.apps.arap.cli`: ``ccproof arap``.
+* :mod:`~ccproof.cli.arap`: ``ccproof arap``.
 
 The names below are loaded lazily (``ccproof --help`` does not import numpy).
 

@@ -8,6 +8,6 @@ Modules: :mod:`~ccproof.apps.dynamics.basis` (B-spline basis, analytic element G
 :mod:`~ccproof.apps.dynamics.forces` (springs to the nearest limit point, data forces),
 :mod:`~ccproof.apps.dynamics.fit` (multilevel shape recovery, fit error, minimal enclosing sphere),
 :mod:`~ccproof.apps.dynamics.meshes` (the paper's meshes), :mod:`~ccproof.apps.dynamics.shapes` (synthetic range
-data), :mod:`~ccproof.apps.dynamics.plot` (figures), :mod:`~ccproof.apps.dynamics.cli` (``ccproof fit``).
+data), :mod:`~ccproof.apps.dynamics.plot` (figures), :mod:`~ccproof.cli.fit` (``ccproof fit``).
 See docs/qmv98.md.
 """

@@ -1,8 +1,8 @@
-"""The ``ccproof`` command line.
+"""The ``ccproof`` command line: one thin module per command in this package.
 
-Every subcommand lives in the layer it belongs to, in a module that defines
-``add_arguments(parser)`` and ``run(args) -> int``; they are imported lazily so that
-``ccproof --help`` stays fast.
+Each command module defines ``add_arguments(parser)`` and ``run(args) -> int``: it parses, calls the
+library (imported inside ``run``, so that ``ccproof --help`` stays fast) and prints. No library
+package imports argparse or this package (tests/test_cli_package.py).
 """
 
 from __future__ import annotations
@@ -14,15 +14,15 @@ import sys
 
 #: name -> (module, one-line help)
 COMMANDS: dict[str, tuple[str, str]] = {
-    "table": ("ccproof.tables.cli", "print or regenerate the certified characteristic-map tables"),
-    "certify": ("ccproof.certify.cli_certify", "prove injectivity for a valence and write a certificate"),
-    "verify": ("ccproof.certify.cli_verify", "re-check certificates with the trusted verifier"),
-    "report": ("ccproof.certify.cli_report", "table of every certified valence"),
-    "eval": ("ccproof.reparam.cli", "evaluate the limit surface of a quad mesh (natural or bmz04 parameterizations)"),
-    "project": ("ccproof.evaluate.cli_project", "nearest points of the limit surface to 3-D points (closest points)"),
-    "invert": ("ccproof.inverse.cli", "invert the characteristic map at a point"),
-    "arap": ("ccproof.apps.arap.cli", "ARAP parameterization of a subdivision surface (hsh10)"),
-    "fit": ("ccproof.apps.dynamics.cli", "fit a dynamic Catmull-Clark surface to points (qmv98)"),
+    "table": ("ccproof.cli.table", "print or regenerate the certified characteristic-map tables"),
+    "certify": ("ccproof.cli.certify", "prove injectivity for a valence and write a certificate"),
+    "verify": ("ccproof.cli.verify", "re-check certificates with the trusted verifier"),
+    "report": ("ccproof.cli.report", "table of every certified valence"),
+    "eval": ("ccproof.cli.eval", "evaluate the limit surface of a quad mesh (natural or bmz04 parameterizations)"),
+    "project": ("ccproof.cli.project", "nearest points of the limit surface to 3-D points (closest points)"),
+    "invert": ("ccproof.cli.invert", "invert the characteristic map at a point"),
+    "arap": ("ccproof.cli.arap", "ARAP parameterization of a subdivision surface (hsh10)"),
+    "fit": ("ccproof.cli.fit", "fit a dynamic Catmull-Clark surface to points (qmv98)"),
 }
 
 

@@ -24,9 +24,9 @@ from __future__ import annotations
 import sys
 import time
 
+from ccproof.cli._eval_args import add_arguments as _add_evaluate_arguments
+from ccproof.cli._eval_args import read_points
 from ccproof.errors import CCProofError
-from ccproof.evaluate.cli import add_arguments as _add_evaluate_arguments
-from ccproof.evaluate.cli import read_points
 
 
 def add_arguments(parser):

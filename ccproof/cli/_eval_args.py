@@ -1,5 +1,5 @@
-"""Arguments and point reader of ``ccproof eval`` (the command itself is :mod:`ccproof.reparam.cli`,
-which adds the bmz04 parameterizations; it lives there because ``reparam`` is above ``evaluate``).
+"""Arguments and point reader of ``ccproof eval`` (the command itself is :mod:`ccproof.cli.eval`, which
+adds the bmz04 parameterizations and the scheduler options).
 
 Evaluate the Catmull-Clark limit surface of a mesh exactly (natural parameterization): all-quad, or
 with triangles, n-gons, creases, corners, holes and boundary modes (OpenSubdiv tags in the OBJ),

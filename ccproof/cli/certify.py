@@ -148,7 +148,7 @@ def run(args):
             print(f"  certificate written to {path}")
             written.append(path)
         if not args.no_verify and written:
-            from ccproof.certify.cli_verify import _check
+            from ccproof.cli.verify import _check
 
             check = run_tasks(_check, [(str(p), True) for p in written], sched, desc="verify", unit="file",
                               names=[str(p) for p in written], raise_errors=False)
