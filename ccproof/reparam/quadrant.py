@@ -162,7 +162,7 @@ def _phi_hessian(k, r, s):
     basis of the layer-0 pieces P1, P2 and the scaling Phi(2^e y0) = lam^-e Phi(y0), as in
     :mod:`ccproof.inverse.forward` (swap symmetry for s > r).
     """
-    from ccproof.inverse._data import NMAX, valence_data
+    from ccproof.inverse.data import NMAX, valence_data
 
     D = valence_data(k)
     sw = s > r
