@@ -1,4 +1,10 @@
-"""Exception types shared by every layer (imports nothing from ccproof)."""
+"""Exception types shared by every layer (imports nothing from ccproof).
+
+A malformed certificate is reported by the trusted verifier's own
+:class:`ccproof.certify.verify.errors.CertificateError` (a ``ValueError``): the verifier imports
+nothing of the package outside the trusted base (docs/trusted_base.md), so that one exception type
+is deliberately not a :class:`CCProofError` and has no twin here.
+"""
 
 
 class CCProofError(ValueError):
@@ -15,10 +21,6 @@ class TableNotFoundError(CCProofError):
 
 class MeshError(CCProofError):
     """A mesh that is not a valid manifold quad mesh; the message names the element."""
-
-
-class CertificateError(CCProofError):
-    """A certificate file that is malformed or of an unknown schema."""
 
 
 def check_valence(k, *, minimum=3):
