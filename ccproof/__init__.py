@@ -1,17 +1,101 @@
 """ccproof: Catmull-Clark subdivision surfaces as certified parametric surfaces.
 
-Layers (docs/architecture.md), each importing only from the ones before it:
-``algebra`` (exact) -> ``rigorous`` (arb/fmpq Bernstein kernels) -> ``tables`` (certified
-per-valence tables) -> ``mesh`` -> ``evaluate`` -> ``inverse`` -> ``reparam`` -> ``certify`` -> ``apps``.
+One entry point per capability (``ccproof.__all__``; every name has a docstring with an example):
+
+==================================  ======================================================================
+capability                          names
+==================================  ======================================================================
+valences (one k, or every k >= k0)  :class:`Valence` (parsed and printed in one place), ``parse_valence``
+the table of a valence              :func:`load_table` (float64 view), :func:`build_table` (write side)
+certify                             :func:`prove_valence`, :func:`prove_interval`, :func:`prove_c1`
+verify (the trusted base)           :func:`verify_file` -> :class:`VerifyResult` (parts and reasons)
+meshes                              :class:`QuadMesh`, :class:`PolyMesh`, :func:`read_obj`, :func:`read_mesh`
+the limit surface of a mesh         :func:`limit_surface` (evaluate, normals, parameterizations)
+the characteristic map, Phi^-1      :func:`characteristic_map`, :func:`inverse_characteristic_map`
+ARAP texture parameterization       :func:`parameterize` (hsh10)
+fit a surface to points             :func:`fit_points` (qmv98)
+errors                              :class:`CCProofError` and subclasses; the verifier's own :class:`CertificateError`
+==================================  ======================================================================
+
+The error types and :class:`Valence` use only the standard library and are imported eagerly; the
+others load on first use (PEP 562), because importing numpy, scipy and numba costs ~0.5 s and
+``ccproof --help`` must start in < 0.3 s (``python -X importtime -c 'import ccproof'``: 2 ms with
+this lazy table, ~1 s if it were eager; see scripts/bench_reparam.py).
+
+Layers (docs/architecture.md): the proof branch ``algebra`` -> ``rigorous`` -> ``tables`` ->
+``certify`` and the numerics branch ``mesh`` -> ``evaluate`` -> ``inverse`` -> ``reparam``, fed by
+the certified tables; ``apps`` and the command line on top.
+
+>>> import ccproof
+>>> ccproof.Valence.parse(">=40"), ccproof.load_table(5).N
+(Valence('>=40'), 3)
 """
+
+from importlib import import_module
+
+from ccproof.errors import CCProofError, MeshError, TableNotFoundError, ValenceError
+from ccproof.valence import Valence, parse_valence
 
 __version__ = "0.1.0"
 
+#: lazily loaded public names -> defining module
+_LAZY = {
+    "load_table": "ccproof.tables.numeric",
+    "build_table": "ccproof.tables.build",
+    "prove_valence": "ccproof.certify.prover",
+    "prove_interval": "ccproof.certify.prover",
+    "prove_c1": "ccproof.certify.prover",
+    "verify_file": "ccproof.certify.verify",
+    "VerifyResult": "ccproof.certify.verify.record",
+    "CertificateError": "ccproof.certify.verify.errors",
+    "QuadMesh": "ccproof.mesh",
+    "PolyMesh": "ccproof.mesh",
+    "read_obj": "ccproof.mesh",
+    "read_mesh": "ccproof.mesh",
+    "limit_surface": "ccproof.reparam.surface",
+    "characteristic_map": "ccproof.inverse.forward",
+    "inverse_characteristic_map": "ccproof.inverse.algorithm",
+    "parameterize": "ccproof.apps.arap.core",
+    "fit_points": "ccproof.apps.dynamics.fit",
+}
+
+__all__ = [
+    "CCProofError",
+    "CertificateError",
+    "MeshError",
+    "PolyMesh",
+    "QuadMesh",
+    "TableNotFoundError",
+    "Valence",
+    "ValenceError",
+    "VerifyResult",
+    "build_table",
+    "characteristic_map",
+    "fit_points",
+    "inverse_characteristic_map",
+    "limit_surface",
+    "load_table",
+    "parameterize",
+    "parse_valence",
+    "prove_c1",
+    "prove_interval",
+    "prove_valence",
+    "read_mesh",
+    "read_obj",
+    "verify_file",
+]
+
+_EAGER = {"CCProofError", "MeshError", "TableNotFoundError", "ValenceError", "Valence", "parse_valence"}
+assert set(__all__) == _EAGER | set(_LAZY)
+
 
 def __getattr__(name):
-    """Lazy top-level shortcut: ``ccproof.limit_surface`` is :func:`ccproof.reparam.limit_surface`."""
-    if name == "limit_surface":
-        from ccproof.reparam.surface import limit_surface
-
-        return limit_surface
+    if name in _LAZY:
+        value = getattr(import_module(_LAZY[name]), name)
+        globals()[name] = value
+        return value
     raise AttributeError(f"module 'ccproof' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | set(__all__))

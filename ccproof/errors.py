@@ -1,24 +1,56 @@
-"""Exception types shared by every layer (imports nothing from ccproof)."""
+"""Exception types shared by every layer (imports nothing from ccproof).
+
+A malformed certificate is reported by the trusted verifier's own
+:class:`ccproof.certify.verify.errors.CertificateError` (a ``ValueError``): the verifier imports
+nothing of the package outside the trusted base (docs/trusted_base.md), so that one exception type
+is deliberately not a :class:`CCProofError` and has no twin here.
+"""
 
 
 class CCProofError(ValueError):
-    """Base class of the errors ccproof raises for bad input."""
+    """Base class of the errors ccproof raises for bad input (a ``ValueError``).
+
+    >>> issubclass(MeshError, CCProofError), issubclass(CCProofError, ValueError)
+    (True, True)
+    >>> import ccproof
+    >>> try:
+    ...     ccproof.inverse_characteristic_map(5, [-1.0], [0.0])
+    ... except ValueError as exc:
+    ...     print(type(exc).__name__, str(exc)[:45])
+    CCProofError image first coordinate is negative at index 0
+    """
 
 
 class ValenceError(CCProofError):
-    """A valence that is not an integer >= 3."""
+    """A valence that is not an integer >= 3.
+
+    >>> check_valence(2.5)
+    Traceback (most recent call last):
+    ...
+    ccproof.errors.ValenceError: valence must be an integer >= 3, got 2.5
+    """
 
 
 class TableNotFoundError(CCProofError):
-    """A certified table that does not exist; the message lists the ones that do."""
+    """A certified table that does not exist; the message lists the ones that do.
+
+    >>> from ccproof.tables.numeric import load_table
+    >>> load_table(200)
+    Traceback (most recent call last):
+    ...
+    ccproof.errors.TableNotFoundError: no certified table for valence 200; tables exist for k = 3..100; k >=40
+    """
 
 
 class MeshError(CCProofError):
-    """A mesh that is not a valid manifold quad mesh; the message names the element."""
+    """A mesh that is not a valid manifold quad mesh; the message names the element.
 
-
-class CertificateError(CCProofError):
-    """A certificate file that is malformed or of an unknown schema."""
+    >>> from ccproof.mesh import QuadMesh
+    >>> QuadMesh([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], [[0, 1, 2, 7]])
+    Traceback (most recent call last):
+    ...
+    ccproof.errors.MeshError: ...
+    """
 
 
 def check_valence(k, *, minimum=3):

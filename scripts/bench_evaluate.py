@@ -41,7 +41,7 @@ import numpy as np
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
-from ccproof.evaluate import limit_surface  # noqa: E402
+from ccproof.evaluate import natural_limit_surface as limit_surface  # noqa: E402
 from ccproof.evaluate.local import CORNERS  # noqa: E402
 from ccproof.evaluate.surface import _CORNER, _SPLIT  # noqa: E402
 from ccproof.mesh import limit_normals, limit_positions, read_obj, subdivide  # noqa: E402

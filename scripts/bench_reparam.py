@@ -10,9 +10,17 @@ the compiled kernel, "numpy" for the pure numpy path); the reparameterization it
 both cases. The one-time costs (surface preparation, the first call that builds the per-valence
 tables of Phi^-1 and, if needed, the rotated corner frames) are reported separately.
 
+First-call cost per valence (--first-calls): in a fresh interpreter, after the imports, the time of
+the first ``valence_data(k)`` (the per-valence data of Phi and Phi^-1, derived from the certified
+tables, ccproof/inverse/data.py) and, for k <= 64, of a first characteristic-parameterization
+evaluation of 4 points on a k-regular disk (after a natural one, so that the evaluator's own
+one-time costs are not counted); the target is <= 0.2 s per new valence. Also the start-up time of
+``ccproof --help`` (target < 0.3 s). Both are timings on a shared machine: a benchmark, not a test.
+
 Examples:
   python scripts/bench_reparam.py                                  # bunny, 10^6 points, numba
   python scripts/bench_reparam.py --mesh disk:7 --points 200000 --backend numpy
+  python scripts/bench_reparam.py --first-calls 3,5,7,13,100,1000 --points 0   # only the one-time costs
 """
 
 from __future__ import annotations
@@ -20,6 +28,8 @@ from __future__ import annotations
 import argparse
 import os
 import statistics
+import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -37,6 +47,64 @@ def load_mesh(spec):
     return read_obj(spec)
 
 
+_FIRST_CALL = r"""
+import json, sys, time
+t = time.perf_counter()
+from ccproof.inverse.data import valence_data
+from ccproof.mesh.examples import k_regular_disk
+from ccproof.reparam import limit_surface
+import numpy as np, flint  # noqa: E401
+imports = time.perf_counter() - t
+rows = []
+for k in map(int, sys.argv[1].split(",")):
+    a = time.perf_counter()
+    valence_data(k)
+    b = time.perf_counter()
+    first_eval = None
+    if k <= 64:  # a k-regular disk is a mesh of 8k faces: keep the evaluator's own set-up small
+        S = limit_surface(k_regular_disk(k, 2))
+        f, u, v = [0, 1, 2, 3], [0.1, 0.3, 0.5, 0.7], [0.2, 0.4, 0.6, 0.1]
+        S.evaluate(f, u, v, parameterization="natural")   # the evaluator's own first-call costs
+        c = time.perf_counter()
+        S.evaluate(f, u, v, parameterization="characteristic")
+        first_eval = time.perf_counter() - c
+    rows.append((k, b - a, first_eval))
+print(json.dumps({"imports": imports, "rows": rows, "sympy": "sympy" in sys.modules}))
+"""
+
+
+def first_call_costs(valences):
+    """Run :data:`_FIRST_CALL` in a fresh interpreter: (import time, [(k, valence_data s, first eval s)],
+    whether sympy got imported)."""
+    import json
+
+    out = subprocess.run([sys.executable, "-c", _FIRST_CALL, ",".join(map(str, valences))], check=True,
+                         capture_output=True, text=True).stdout
+    res = json.loads(out.strip().splitlines()[-1])
+    return res["imports"], res["rows"], res["sympy"]
+
+
+def help_startup(rounds=3):
+    """Best wall time of ``python -m ccproof.cli --help`` over ``rounds`` runs (seconds)."""
+    best = float("inf")
+    for _ in range(rounds):
+        a = time.perf_counter()
+        subprocess.run([sys.executable, "-m", "ccproof.cli", "--help"], check=True, capture_output=True)
+        best = min(best, time.perf_counter() - a)
+    return best
+
+
+def report_first_calls(valences):
+    imports, rows, sympy_loaded = first_call_costs(valences)
+    print(f"first call per new valence (fresh interpreter; imports {imports:.2f} s once; target <= 0.2 s):")
+    for k, data_s, eval_s in rows:
+        ev = "" if eval_s is None else (f", first characteristic evaluation of 4 points (after a natural one) "
+                                        f"{eval_s * 1e3:7.1f} ms")
+        print(f"  k = {k:5d}: valence_data {data_s * 1e3:7.1f} ms{ev}")
+    print(f"sympy imported by the numerics: {'YES (regression)' if sympy_loaded else 'no'}")
+    print(f"`ccproof --help` start-up: {help_startup() * 1e3:.0f} ms (best of 3; target < 300 ms)")
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--mesh", default=str(DEFAULT_MESH), help="OBJ file or disk:K (k-regular disk, 4 rings)")
@@ -45,11 +113,17 @@ def main(argv=None):
     ap.add_argument("--derivatives", type=int, default=1, choices=(0, 1, 2))
     ap.add_argument("--backend", choices=("numba", "numpy"), default="numba")
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--first-calls", default="3,5,7,13,100,1000",
+                    help="comma-separated valences whose first-call cost is measured ('' to skip)")
     ap.add_argument("--sampling", choices=("uniform", "ev-faces"), default="uniform",
                     help="uniform: random face and (u, v); ev-faces: only faces with an extraordinary corner "
                     "(the worst case for the reparameterizations)")
     args = ap.parse_args(argv)
     os.environ["CCPROOF_BACKEND"] = args.backend
+    if args.first_calls:
+        report_first_calls([int(k) for k in args.first_calls.split(",")])
+    if args.points <= 0:
+        return
 
     from ccproof.evaluate._numba_kernel import evaluate_points
     from ccproof.reparam import limit_surface

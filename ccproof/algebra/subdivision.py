@@ -122,7 +122,7 @@ def level1_stencil(k, vertex):
 
 def two_ring_vertices(k):
     """The 6k+1 vertices of the two-ring N_2 of Definition 2, in the order used by
-    :func:`subdivision_matrix`: the centre, then sector by sector the positions
+    :func:`ring_subdivision_matrix`: the centre, then sector by sector the positions
     :data:`TWO_RING_POSITIONS`."""
     k = check_valence(k)
     return [CENTER] + [(j, a, b) for j in range(k) for (a, b) in TWO_RING_POSITIONS]
@@ -142,7 +142,7 @@ def stam_vertices(k):
     return verts
 
 
-def subdivision_matrix(k, ring="two_ring"):
+def ring_subdivision_matrix(k, ring="two_ring"):
     """Exact Catmull-Clark subdivision matrix S of the k-regular complex (bmz04 Definition 2).
 
     Parameters
@@ -158,7 +158,7 @@ def subdivision_matrix(k, ring="two_ring"):
     S : list of list of Fraction, shape (n, n)
         ``p1 = S @ p0`` maps level-0 values on the ring to level-1 values on the ring.
 
-    >>> S = subdivision_matrix(4)
+    >>> S = ring_subdivision_matrix(4)
     >>> len(S), sum(S[0])
     (25, Fraction(1, 1))
     """
@@ -181,8 +181,13 @@ def subdivision_matrix(k, ring="two_ring"):
 
 
 def subdivision_matrix_fmpq(k, ring="two_ring"):
-    """:func:`subdivision_matrix` as a ``flint.fmpq_mat`` (exact)."""
+    """:func:`ring_subdivision_matrix` as a ``flint.fmpq_mat`` (exact)."""
     from flint import fmpq, fmpq_mat
 
-    S = subdivision_matrix(k, ring)
+    S = ring_subdivision_matrix(k, ring)
     return fmpq_mat([[fmpq(x.numerator, x.denominator) for x in row] for row in S])
+
+
+#: former name, kept importable for ccproof/apps/dynamics/elements.py; the package-wide
+#: ``subdivision_matrix`` is :func:`ccproof.mesh.subdivision_matrix` (of a mesh, sparse float)
+subdivision_matrix = ring_subdivision_matrix

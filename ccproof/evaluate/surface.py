@@ -1,6 +1,6 @@
 """The natural parameterization of a Catmull-Clark surface, evaluated exactly (bmz04 section 2, R12).
 
-:func:`limit_surface` turns a :class:`~ccproof.mesh.QuadMesh` into a :class:`LimitSurface` whose
+:func:`natural_limit_surface` turns a :class:`~ccproof.mesh.QuadMesh` into a :class:`LimitSurface` whose
 :meth:`~LimitSurface.evaluate` returns positions and first and second derivatives at batches of
 points ``(face, u, v)``, with respect to the face's own parameter (corner i of the face's vertex
 list at (0,0), (1,0), (1,1), (0,1) for i = 0..3: the ptex convention of OpenSubdiv).
@@ -44,7 +44,7 @@ from ccproof.evaluate.local import (
 )
 from ccproof.mesh import QuadMesh, limit_normals, limit_positions
 
-__all__ = ["limit_surface", "LimitSurface"]
+__all__ = ["natural_limit_surface", "LimitSurface"]
 
 #: how many times a face may be subdivided before it must be regular or self-similar
 MAX_DEPTH = 4
@@ -272,7 +272,7 @@ class _Builder:
 class LimitSurface:
     """Exact evaluator of the limit surface of a quad mesh (natural parameterization, bmz04 section 2).
 
-    Build it with :func:`limit_surface`. Attributes: ``mesh``, ``n_patches`` (bicubic patches
+    Build it with :func:`natural_limit_surface`. Attributes: ``mesh``, ``n_patches`` (bicubic patches
     stored), ``max_layers`` (deepest layer stored at an irregular corner), ``split_depth`` (how many
     local subdivisions the most irregular face needed).
     """
@@ -437,7 +437,7 @@ class LimitSurface:
         Examples
         --------
         >>> from ccproof.mesh.examples import cube
-        >>> S = limit_surface(cube())
+        >>> S = natural_limit_surface(cube())
         >>> r = S.evaluate([0, 1], [0.0, 0.5], [0.0, 0.5])
         >>> np.round(r["P"][0], 12).tolist()     # a cube corner: limit point (9 V + 4 sum e + sum d)/24
         [-0.5, -0.5, -0.5]
@@ -638,8 +638,11 @@ def _numba_kernel(backend):
     return evaluate_points
 
 
-def limit_surface(mesh):
-    """Prepare the exact evaluation of the limit surface of ``mesh``.
+def natural_limit_surface(mesh):
+    """Prepare the exact evaluation of the limit surface of ``mesh`` in its natural parameterization.
+
+    The package-wide entry point is :func:`ccproof.limit_surface` (the same surfaces, plus the
+    parameterizations of bmz04 on quad meshes); this one is the evaluator alone.
 
     Parameters
     ----------
@@ -654,6 +657,12 @@ def limit_surface(mesh):
     Returns
     -------
     LimitSurface
+
+    Examples
+    --------
+    >>> from ccproof.mesh.examples import torus
+    >>> natural_limit_surface(torus()).evaluate([0], [0.5], [0.5])["P"].shape
+    (1, 3)
     """
     if isinstance(mesh, QuadMesh):
         return LimitSurface(mesh)
@@ -670,3 +679,8 @@ def limit_surface(mesh):
         # as the tagged one to round-off; ``S.mesh`` is a QuadMesh)
         return LimitSurface(QuadMesh(mesh.vertices, np.array(mesh.polygons, dtype=np.int64).reshape(-1, 4)))
     return TaggedLimitSurface(mesh)
+
+
+#: former name, kept importable for ccproof/evaluate/cli.py, ccproof/reparam/cli.py and tests; the
+#: package-wide ``limit_surface`` is :func:`ccproof.reparam.limit_surface` (= ``ccproof.limit_surface``)
+limit_surface = natural_limit_surface

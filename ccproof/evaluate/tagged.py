@@ -456,7 +456,7 @@ class _TaggedBuilder(_Builder):
 class TaggedLimitSurface(LimitSurface):
     """Exact evaluator of the limit surface of a tagged polygon mesh, by ptex face.
 
-    Build it with :func:`ccproof.evaluate.limit_surface`. ``evaluate(ptex, s, t, derivatives)``
+    Build it with :func:`ccproof.limit_surface`. ``evaluate(ptex, s, t, derivatives)``
     as :meth:`LimitSurface.evaluate`, with ``face`` the ptex face index (OpenSubdiv's
     ``Far::PtexIndices``, :meth:`PolyMesh.ptex_of`) and derivatives with respect to its (s, t).
     Points on hole faces raise an error naming the point and the face.

@@ -39,7 +39,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ccproof.errors import CCProofError, check_valence
-from ccproof.inverse._data import (
+from ccproof.inverse.data import (
     CHUNK,
     FIT_DEGREE,
     NMAX,

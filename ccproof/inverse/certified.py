@@ -61,10 +61,11 @@ def _power_nets(k, prec):
     """Power-basis coefficients (arb) of P1, P2, P3: ``[patch][comp][i][j]`` of s^i t^j."""
     from flint import arb, ctx
 
-    from ccproof.algebra.specialize import characteristic_map_patches, subdominant_eigenvalue
-    from ccproof.inverse.implicit import bezier_to_power
+    from ccproof.inverse.data import bezier_to_power
+    from ccproof.tables.numeric import characteristic_arb
 
-    nets = characteristic_map_patches(k, "bezier", "arb", prec + 20)
+    data = characteristic_arb(k, prec + 20)
+    nets = data.bezier
     out = []
     with ctx.workprec(prec + 20):
         for name in ("P1", "P2", "P3"):
@@ -75,7 +76,7 @@ def _power_nets(k, prec):
                 cols = [bezier_to_power([rows[i][j] for i in range(4)]) for j in range(4)]
                 comps.append([[cols[j][i] for j in range(4)] for i in range(4)])
             out.append(comps)
-        lam = +subdominant_eigenvalue(k, "arb", prec + 20)
+        lam = +data.lam
     return out, lam, arb
 
 

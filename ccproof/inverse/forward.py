@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from ccproof.errors import check_valence
-from ccproof.inverse._data import (
+from ccproof.inverse.data import (
     NMAX,
     SAFE_HI,
     SAFE_LO,

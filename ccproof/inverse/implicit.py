@@ -59,6 +59,7 @@ from fractions import Fraction
 from functools import cache, lru_cache
 
 from ccproof.errors import CCProofError, check_valence
+from ccproof.inverse.data import bezier_to_power
 
 #: the patch each net row/column belongs to, which local coordinate is fixed and its value
 _EDGE_SPECS = {
@@ -167,16 +168,6 @@ def determinant(M, zero, one):
         return acc
 
     return minor(0, tuple(range(n)))
-
-
-def bezier_to_power(b):
-    """Power-basis coefficients (constant first) of the cubic with Bezier coefficients b0..b3.
-
-    >>> bezier_to_power([0, 1, 2, 3])
-    [0, 3, 0, 0]
-    """
-    b0, b1, b2, b3 = b
-    return [b0, (b1 - b0) * 3, (b2 - b1 * 2 + b0) * 3, b3 - b2 * 3 + b1 * 3 - b0]
 
 
 # ---------------------------------------------------------------------------------------------

@@ -26,7 +26,7 @@ _WHERE = {
     "alpha_bound": "ccproof.reparam.quadrant",
     "default_alpha": "ccproof.reparam.quadrant",
     "vanishing_map": "ccproof.reparam.quadrant",
-    "characteristic_inverse": "ccproof.reparam.quadrant",
+    "inverse_characteristic_map_derivatives": "ccproof.reparam.quadrant",
     "characteristic_tangent_masks": "ccproof.reparam.corner",
     "corner_tangents": "ccproof.reparam.corner",
 }

@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 from ccproof.errors import CCProofError
-from ccproof.reparam.quadrant import characteristic_inverse, default_alpha, vanishing_map
+from ccproof.reparam.quadrant import default_alpha, inverse_characteristic_map_derivatives, vanishing_map
 from ccproof.reparam.weights import weight_complement, weight_radial, weight_tensor
 
 __all__ = ["PARAMETERIZATIONS", "CORNER_FRAMES", "to_local", "from_local", "quarter_map", "active_points",
@@ -96,7 +96,7 @@ def quarter_map(k, s, t, parameterization, alpha=None, derivatives=1):
         With 2.
     """
     if parameterization == "characteristic":
-        Fo = characteristic_inverse(k, s, t, derivatives)
+        Fo = inverse_characteristic_map_derivatives(k, s, t, derivatives)
         W = weight_tensor(s, t, derivatives)
     elif parameterization == "vanishing":
         Fo = vanishing_map(s, t, _alpha_for(alpha, k), derivatives)

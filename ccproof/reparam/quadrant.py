@@ -30,7 +30,7 @@ __all__ = [
     "default_alpha",
     "check_alpha",
     "vanishing_map",
-    "characteristic_inverse",
+    "inverse_characteristic_map_derivatives",
 ]
 
 
@@ -162,7 +162,7 @@ def _phi_hessian(k, r, s):
     basis of the layer-0 pieces P1, P2 and the scaling Phi(2^e y0) = lam^-e Phi(y0), as in
     :mod:`ccproof.inverse.forward` (swap symmetry for s > r).
     """
-    from ccproof.inverse._data import NMAX, valence_data
+    from ccproof.inverse.data import NMAX, valence_data
 
     D = valence_data(k)
     sw = s > r
@@ -197,7 +197,7 @@ def _phi_hessian(k, r, s):
     return np.where(sw[:, None, None, None], Hs, H0)
 
 
-def characteristic_inverse(k, s, t, derivatives=1):
+def inverse_characteristic_map_derivatives(k, s, t, derivatives=1):
     """F(t) = Phi^-1(t) for valence k in the normalized frame (bmz04 section 4.3) with derivatives.
 
     Phi^-1 comes from :func:`ccproof.inverse.inverse_characteristic_map` (Algorithm 1 with a
@@ -220,7 +220,7 @@ def characteristic_inverse(k, s, t, derivatives=1):
     H : ndarray, shape (n, 2, 2, 2)
         With ``derivatives == 2`` (NaN at the origin).
 
-    >>> F, J = characteristic_inverse(4, np.array([0.3]), np.array([0.2]))   # k = 4: identity
+    >>> F, J = inverse_characteristic_map_derivatives(4, np.array([0.3]), np.array([0.2]))   # k = 4: identity
     >>> np.round(F, 14).tolist(), (np.round(J[0], 14) + 0.0).tolist()
     ([[0.3, 0.2]], [[1.0, 0.0], [0.0, 1.0]])
     """

@@ -233,11 +233,19 @@ class ReparamLimitSurface(LimitSurface):
 
 
 def limit_surface(mesh, alpha=None):
-    """Prepare the evaluation of ``mesh`` in the parameterizations of bmz04 (a QuadMesh or OBJ path).
+    """The limit surface of a mesh: exact evaluation, normals and the parameterizations of bmz04.
+
+    The one entry point for limit surfaces (``ccproof.limit_surface``). A quad mesh gives a
+    :class:`ReparamLimitSurface`: ``evaluate(face, u, v, derivatives, parameterization=...)`` with
+    ``"natural"`` (default; docs/evaluate.md), ``"vanishing"`` or ``"characteristic"`` (bmz04
+    section 4, docs/reparam.md). A :class:`~ccproof.mesh.polymesh.PolyMesh` (triangles, n-gons,
+    creases, corners, holes) gives the tagged evaluator of
+    :func:`ccproof.evaluate.natural_limit_surface` (natural parameterization only).
 
     Parameters
     ----------
-    mesh : QuadMesh or str or os.PathLike
+    mesh : QuadMesh or PolyMesh or str or os.PathLike
+        A path is read with :func:`ccproof.mesh.read_obj` (untagged quad OBJ).
     alpha : float or dict or None
         Exponent of F^alpha for the "vanishing" parameterization: one value for every valence, a
         dict valence -> value (missing valences get the default), or None for
@@ -245,13 +253,30 @@ def limit_surface(mesh, alpha=None):
 
     Returns
     -------
-    ReparamLimitSurface
+    ReparamLimitSurface, or TaggedLimitSurface for a PolyMesh
 
     Raises
     ------
     CCProofError
-        alpha not above -log 2 / log lam(k) for a valence k of an interior extraordinary vertex.
+        alpha not above -log 2 / log lam(k) for a valence k of an interior extraordinary vertex,
+        or alpha given for a PolyMesh.
+
+    Examples
+    --------
+    >>> from ccproof.mesh.examples import k_regular_disk
+    >>> S = limit_surface(k_regular_disk(5, 2))
+    >>> r = S.evaluate([0, 1], [0.1, 0.5], [0.2, 0.5], parameterization="characteristic")
+    >>> r["P"].shape, r["Pu"].shape
+    ((2, 3), (2, 3))
     """
+    from ccproof.mesh.polymesh import PolyMesh
+
+    if isinstance(mesh, PolyMesh):
+        if alpha is not None:
+            raise CCProofError("alpha applies to the parameterizations of quad meshes only, not to a PolyMesh")
+        from ccproof.evaluate.surface import natural_limit_surface
+
+        return natural_limit_surface(mesh)
     if not isinstance(mesh, QuadMesh):
         from ccproof.mesh import read_obj
 

@@ -23,8 +23,8 @@ from pathlib import Path
 from ccproof.algebra.characteristic_map import symbolic_bspline_nets
 from ccproof.algebra.field import integer_form_string
 from ccproof.algebra.specialize import characteristic_map_patches, valence_interval
-from ccproof.errors import check_valence
 from ccproof.tables.format import PATCHES, SCHEMA, arb_to_json, content_hash, table_path
+from ccproof.valence import Valence
 
 DEFAULT_PREC = 128
 DEFAULT_K_RANGE = range(3, 101)
@@ -32,9 +32,10 @@ DEFAULT_INTERVAL_K0 = 40
 
 
 def _parse_valence(k):
-    if isinstance(k, str) and k.startswith(">="):
-        return ">=" + str(check_valence(k[2:]))
-    return check_valence(k)
+    """The int k or the text ``">=K0"`` that :mod:`ccproof.algebra.specialize` takes, from any spelling
+    :meth:`ccproof.valence.Valence.parse` reads."""
+    v = Valence.parse(k)
+    return str(v) if v.interval else v.k
 
 
 def _forms(x, y):
@@ -195,7 +196,28 @@ def _curve_avoids_square(curve, half, depth):
 
 
 def build_table(k, prec=DEFAULT_PREC):
-    """The table dict for valence ``k`` (int) or the interval ``">=K0"`` (see module docstring)."""
+    """Build the certified characteristic-map table of a valence (see module docstring, docs/tables.md).
+
+    Parameters
+    ----------
+    k : int or str or dict or Valence
+        A valence k >= 3, or an interval in any spelling of :class:`ccproof.valence.Valence`
+        (``">=40"``, ``{"min": 40}``).
+    prec : int
+        Bits of the arb enclosures (default 128).
+
+    Returns
+    -------
+    dict
+        The table (schema ``ccproof.table/1``), hashed; :func:`write_table` writes it and
+        :func:`ccproof.tables.numeric.load_table` reads it back.
+
+    Examples
+    --------
+    >>> t = build_table(4, prec=64)
+    >>> t["valence"], t["derived"]["N"], t["float64"]["lam"], t["hash"] == content_hash(t)
+    (4, 3, 0.5, True)
+    """
     from flint import arb, ctx, fmpq
 
     from ccproof.algebra.specialize import subdominant_eigenvalue
@@ -235,7 +257,7 @@ def build_table(k, prec=DEFAULT_PREC):
 
     table = {
         "schema": SCHEMA,
-        "valence": {"min": int(k[2:])} if interval else k,
+        "valence": Valence.parse(k).to_json(),
         "c_definition": "cos(2*pi/k)" + (" for every integer k >= k0" if interval else ""),
         "lam_definition": "(5 + c + sqrt((1 + c)*(9 + c)))/16, the larger root of 16 lam^2 - 2(5 + c) lam + 1",
         "frame": "normalized: e0 -> (1,0), e1 -> (0,1), Phi(1,0) = (1,0) (docs/readings.md R3)",

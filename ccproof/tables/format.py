@@ -1,7 +1,8 @@
 """File format of the certified characteristic-map tables (schema ``ccproof.table/1``).
 
-This module is part of the trusted base: the verifier imports it. It uses only the standard
-library and python-flint (no numpy, no sympy, no float arithmetic in decisions).
+It uses only the standard library, python-flint and :mod:`ccproof.valence` (no numpy, no sympy, no
+float arithmetic in decisions). The trusted verifier does not import it: it reads certificates
+with its own reader (docs/trusted_base.md).
 
 A table is a JSON object; ``docs/tables.md`` has the full grammar and a worked example. The fields
 read by the verifier are:
@@ -146,10 +147,15 @@ def output_dir():
 
 
 def table_filename(valence):
-    """``k007.json`` for k = 7, ``k_ge_40.json`` for the interval k >= 40."""
-    if isinstance(valence, dict):
-        return f"k_ge_{int(valence['min'])}.json"
-    return f"k{int(valence):03d}.json"
+    """``k007.json`` for k = 7, ``k_ge_40.json`` for the interval k >= 40 (any spelling of
+    :meth:`ccproof.valence.Valence.parse`).
+
+    >>> table_filename(7), table_filename({"min": 40}), table_filename(">=40")
+    ('k007.json', 'k_ge_40.json', 'k_ge_40.json')
+    """
+    from ccproof.valence import Valence
+
+    return Valence.parse(valence).stem + ".json"
 
 
 def table_path(valence, directory=None):
@@ -161,12 +167,18 @@ def available_tables(directory=None):
     d = Path(directory or certificates_dir() / "tables")
     ks, intervals = [], []
     if d.is_dir():
+        from ccproof.errors import ValenceError
+        from ccproof.valence import Valence
+
         for p in d.glob("k*.json"):
-            stem = p.stem
-            if stem.startswith("k_ge_") and stem[5:].isdigit():
-                intervals.append(f">={int(stem[5:])}")
-            elif stem[1:].isdigit():
-                ks.append(int(stem[1:]))
+            try:
+                v = Valence.parse(p.name)
+            except ValenceError:
+                continue
+            if v.interval:
+                intervals.append(str(v))
+            else:
+                ks.append(v.k)
     return sorted(ks) + sorted(intervals)
 
 

@@ -8,7 +8,7 @@ from ccproof.algebra.specialize import (
     characteristic_map_patches,
     subdominant_eigenvalue,
 )
-from ccproof.algebra.subdivision import CENTER, subdivision_matrix, two_ring_vertices
+from ccproof.algebra.subdivision import CENTER, ring_subdivision_matrix, two_ring_vertices
 from ccproof.errors import ValenceError
 
 from ._bruteforce import cc_step, level1_value, ring_mesh
@@ -76,7 +76,7 @@ def test_two_ring_vector_is_subdominant_eigenvector(k):
         vals = eigenvector_on_ring(k)
         lam = subdominant_eigenvalue(k, "arb", PREC)
         verts = two_ring_vertices(k)
-        S = subdivision_matrix(k)
+        S = ring_subdivision_matrix(k)
         for i, v in enumerate(verts):
             acc = [arb(0), arb(0)]
             for jj, w in enumerate(S[i]):

@@ -4,7 +4,7 @@ from flint import arb, ctx, fmpq
 
 from ccproof.algebra.specialize import subdominant_eigenvalue
 from ccproof.algebra.spectrum import check_charpoly_factorization, spectral_conditions
-from ccproof.algebra.subdivision import subdivision_matrix, subdivision_matrix_fmpq
+from ccproof.algebra.subdivision import ring_subdivision_matrix, subdivision_matrix_fmpq
 
 
 @pytest.mark.parametrize("k", range(3, 51))
@@ -21,7 +21,7 @@ def test_lam_matches_opensubdiv_limit_tangent_formula(k):
 
 @pytest.mark.parametrize("k", [3, 4, 5, 6, 7, 9, 12, 20, 33])
 def test_lam_is_double_eigenvalue_of_numeric_spectrum(k):
-    S = np.array([[float(x) for x in row] for row in subdivision_matrix(k)])
+    S = np.array([[float(x) for x in row] for row in ring_subdivision_matrix(k)])
     ev = np.sort(np.abs(np.linalg.eigvals(S)))[::-1]
     lam = float(subdominant_eigenvalue(k, "arb").mid())
     assert abs(ev[0] - 1) < 1e-12
@@ -52,7 +52,7 @@ def test_lam_is_a_root_of_multiplicity_two_of_exact_charpoly(k):
 def test_charpoly_factorization_detects_a_wrong_matrix(monkeypatch):
     import ccproof.algebra.subdivision as sub
 
-    real = sub.subdivision_matrix
+    real = sub.ring_subdivision_matrix
 
     def wrong(k, ring="two_ring"):
         from fractions import Fraction
@@ -62,7 +62,7 @@ def test_charpoly_factorization_detects_a_wrong_matrix(monkeypatch):
         S[1][1] -= Fraction(1, 1000)
         return S
 
-    monkeypatch.setattr(sub, "subdivision_matrix", wrong)
+    monkeypatch.setattr(sub, "ring_subdivision_matrix", wrong)
     with pytest.raises(AssertionError):
         check_charpoly_factorization(5)
 

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from flint import arb, ctx, fmpq, fmpq_poly
 
-from ccproof.algebra.subdivision import subdivision_matrix, two_ring_vertices
+from ccproof.algebra.subdivision import ring_subdivision_matrix, two_ring_vertices
 from ccproof.certify.verify import rules, spectrum
 from ccproof.certify.verify import statement as St
 from ccproof.certify.verify.field import QL
@@ -38,7 +38,7 @@ def test_derived_nets_equal_the_sympy_tables(valence):
 def test_eigenvector_of_the_exact_two_ring_matrix(k):
     """v(j, p) = R^j v(0, p) with the derived sector-0 values is an eigenvector of the algebra package's
     exact (6k+1) matrix for lam(k): residual balls contain 0 and are tiny; a perturbed value is not."""
-    S = [[fmpq(x.numerator, x.denominator) for x in row] for row in subdivision_matrix(k)]
+    S = [[fmpq(x.numerator, x.denominator) for x in row] for row in ring_subdivision_matrix(k)]
     verts = two_ring_vertices(k)
     d = St.derivation()
     with ctx.workprec(200):
@@ -75,7 +75,7 @@ def test_block_spectra_equal_numpy_eigenvalues(k):
     """The union of the Fourier blocks' roots (stated characteristic polynomials) is the spectrum of the
     algebra package's two-ring matrix, in floats."""
     assert spectrum.check_block_polynomials()
-    ev = np.sort(np.linalg.eigvals(np.array(subdivision_matrix(k), dtype=float)).real)
+    ev = np.sort(np.linalg.eigvals(np.array(ring_subdivision_matrix(k), dtype=float)).real)
     roots = []
     for m in range(k):
         cm = np.cos(2 * np.pi * m / k)

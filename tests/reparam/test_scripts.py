@@ -19,9 +19,11 @@ def _load(name):
 def test_bench_runs(capsys, monkeypatch, sampling):
     monkeypatch.setenv("CCPROOF_BACKEND", "numpy")  # the script sets it; restored after the test
     _load("bench_reparam").main(["--mesh", "disk:5", "--points", "3000", "--rounds", "1", "--backend", "numpy",
-                                 "--sampling", sampling])
+                                 "--sampling", sampling, "--first-calls", "5" if sampling == "uniform" else ""])
     out = capsys.readouterr().out
     assert "ratio characteristic/natural" in out and "M points/s" in out
+    if sampling == "uniform":
+        assert "k =     5: valence_data" in out and "sympy imported by the numerics: no" in out
 
 
 @pytest.mark.slow

@@ -1,9 +1,21 @@
-"""Per-valence float64 data of the forward and inverse characteristic map (internal).
+"""Per-valence data of the forward and inverse characteristic map, derived from the certified tables.
 
-The one place where the float nets come from: :func:`float_nets` (the certified table of
-:mod:`ccproof.tables` when it exists, otherwise the exact nets rounded once). Everything else in
-this module is derived from those nets and from the exact implicit polynomials of
-:mod:`ccproof.inverse.implicit`, once per valence (cached).
+:func:`valence_data` is the one place where the float data of :mod:`ccproof.inverse` and
+:mod:`ccproof.reparam` comes from. Everything is derived once per valence (cached in memory, a few
+tens of milliseconds, ``scripts/bench_reparam.py``) from the balls of
+:func:`ccproof.tables.numeric.characteristic_arb` (the certified table of k, or for a valence
+without one the exact nets the tables hold, evaluated in arb):
+
+* the float Bezier nets (:func:`float_nets`) and their power-basis coefficients;
+* the tables of lam^n (from the ball of lam);
+* the implicit equations of the boundaries Gamma (``P1:s=0``) and C (``P1:t=1``) used to locate
+  a point: the Sylvester determinant of Definition 5 (bmz04), evaluated in arb at the 10 points of
+  a unisolvent lattice and interpolated exactly (:func:`implicit_boundary`), with the side of the
+  piece decided in arb (:func:`inside_sign`). :mod:`ccproof.inverse.implicit` computes the same
+  polynomials symbolically; it is the independent cross-check in the tests, never used here.
+
+No symbolic computation and no sympy happen here (tests/inverse/test_data.py runs an evaluation in
+a fresh interpreter and checks that sympy is never imported).
 
 Conventions used by the kernels: by the symmetry Phi(v, u) = swap(Phi(u, v)) only points with
 u >= v (face side) and x >= y (image side) are ever evaluated; those lie in P1 (patch index 0)
@@ -33,8 +45,13 @@ BEZ2POW = np.array([[comb(3, i) * comb(3 - i, m - i) * (-1) ** (m - i) if m >= i
 
 def float_nets(k):
     """(lam, Bezier nets (3, 4, 4, 2)) in float64 for valence k: the single source of the float
-    data of this package (certified table when it exists, see :func:`ccproof.tables.numeric.
-    characteristic_nets`)."""
+    nets of :mod:`ccproof.inverse` (certified table when it exists, see
+    :func:`ccproof.tables.numeric.characteristic_nets`).
+
+    >>> lam, bez = float_nets(4)
+    >>> lam, bez.shape
+    (0.5, (3, 4, 4, 2))
+    """
     from ccproof.tables.numeric import characteristic_nets
 
     t = characteristic_nets(k)
@@ -113,17 +130,202 @@ def _arb_pow_table(lam_arb):
     return mant, expo
 
 
+def lstsq_tall(V, B, block=512):
+    """Least-squares solution X (n, r) of V X ~ B for a tall V (m, n), m >> n: corrected semi-normal
+    equations (Gram matrix, then one step of refinement on the residual; Bjorck, *Numerical Methods
+    for Least Squares Problems*, 1996, section 2.2.5), all products in row blocks small enough for
+    OpenBLAS to stay single-threaded. ``np.linalg.lstsq`` on the same (8100, 21) system starts BLAS
+    threads and costs 50x more on a loaded machine; for the first-guess fits here (condition numbers
+    up to 1e7, fit errors ~1e-4) the fitted values of the two agree to 1e-9 (tests/inverse/test_data.py).
+
+    >>> V = np.vander(np.linspace(0, 1, 50), 3)
+    >>> np.allclose(lstsq_tall(V, V @ np.array([[1.0], [2.0], [3.0]])), [[1], [2], [3]])
+    True
+    """
+    m = V.shape[0]
+    G = sum(V[i:i + block].T @ V[i:i + block] for i in range(0, m, block))
+    X = np.linalg.solve(G, sum(V[i:i + block].T @ B[i:i + block] for i in range(0, m, block)))
+    R = B - np.vstack([V[i:i + block] @ X for i in range(0, m, block)])
+    return X + np.linalg.solve(G, sum(V[i:i + block].T @ R[i:i + block] for i in range(0, m, block)))
+
+
 def _eval_power(C, s, t):
     S = np.stack([np.ones_like(s), s, s * s, s**3])
     T = np.stack([np.ones_like(t), t, t * t, t**3])
     return np.einsum("cmn,mp,np->cp", C, S, T)
 
 
+#: the boundary edges used to locate a point: name -> (patch, axis (0: s fixed, 1: t fixed), value)
+BOUNDARY_EDGES = {"P1:s=0": ("P1", 0, 0), "P1:t=1": ("P1", 1, 1)}
+#: the lattice {(a, b): a + b <= 3} on which g is interpolated (unisolvent for total degree 3)
+_LATTICE = monomial_exponents(3)
+
+
+def _edge_points(net, axis, value):
+    a = 3 * value
+    return [net[a][j] for j in range(4)] if axis == 0 else [net[i][a] for i in range(4)]
+
+
+def bezier_to_power(b):
+    """Power-basis coefficients (constant first) of the cubic with Bezier coefficients b0..b3
+    (any ring: floats, ``arb``, ``Fraction``, sympy numbers).
+
+    >>> bezier_to_power([0, 1, 2, 3])
+    [0, 3, 0, 0]
+    """
+    b0, b1, b2, b3 = b
+    return [b0, (b1 - b0) * 3, (b2 - b1 * 2 + b0) * 3, b3 - b2 * 3 + b1 * 3 - b0]
+
+
+@lru_cache(maxsize=1)
+def _lattice_inverse():
+    from flint import arb_mat, fmpq_mat
+
+    V = fmpq_mat([[u**a * v**b for (a, b) in _LATTICE] for (u, v) in _LATTICE])
+    return arb_mat(V.inv())
+
+
+def implicit_boundary(k, edge):
+    """Implicit equation g(u, v) = sum g_ab u^a v^b of a boundary edge, as balls (bmz04 Definition 5).
+
+    g(u, v) = det S(x(w) - u, y(w) - v), the Sylvester determinant of the edge's cubic (x(w), y(w))
+    in the power basis of w, with the formal degree lowered while both leading coefficients are
+    balls containing 0 (k = 4, where every boundary is a straight line). g has total degree 3; it is
+    evaluated in arb at the 10 lattice points (a, b), a + b <= 3, and interpolated with the exact
+    inverse of that lattice's Vandermonde matrix, so the balls contain the exact coefficients.
+
+    Parameters
+    ----------
+    k : int
+        Valence >= 3.
+    edge : str
+        ``"P1:s=0"`` (Gamma, the inner boundary of layer 0) or ``"P1:t=1"`` (C, between P1 and P2).
+
+    Returns
+    -------
+    dict
+        ``{(a, b): arb}`` for a + b <= 3.
+
+    Examples
+    --------
+    >>> g = implicit_boundary(4, "P1:s=0")     # k = 4: the line u = 1/2
+    >>> sorted((ab, float(x.mid()) / float(g[(1, 0)].mid())) for ab, x in g.items() if not x.contains(0))
+    [((0, 0), -0.5), ((1, 0), 1.0)]
+    """
+    from flint import arb_mat, ctx
+
+    from ccproof.tables.numeric import characteristic_arb
+
+    k = check_valence(k)
+    try:
+        patch, axis, value = BOUNDARY_EDGES[edge]
+    except KeyError:
+        raise ValueError(f"unknown boundary edge {edge!r}; choose one of {', '.join(BOUNDARY_EDGES)}") from None
+    data = characteristic_arb(k)
+    pts = _edge_points(data.bezier[patch], axis, value)
+    with ctx.workprec(data.prec + 64):
+        x = bezier_to_power([p[0] for p in pts])
+        y = bezier_to_power([p[1] for p in pts])
+        while len(x) > 2 and x[-1].contains(0) and y[-1].contains(0):
+            x, y = x[:-1], y[:-1]
+        d = len(x) - 1
+        vals = []
+        for u, v in _LATTICE:
+            q = [x[0] - u] + x[1:]
+            r = [y[0] - v] + y[1:]
+            S = [[0] * (2 * d) for _ in range(2 * d)]
+            for i in range(d):
+                for j in range(d + 1):
+                    S[i][i + j] = q[j]
+                    S[d + i][i + j] = r[j]
+            vals.append([arb_mat(S).det()])
+        coeffs = _lattice_inverse() * arb_mat(vals)
+        return {ab: +coeffs[i, 0] for i, ab in enumerate(_LATTICE)}
+
+
+def _bern(i, t):
+    return comb(3, i) * t**i * (1 - t) ** (3 - i)
+
+
+def _bern_d(i, t):
+    d = 0
+    if i > 0:
+        d += i * t ** (i - 1) * (1 - t) ** (3 - i)
+    if i < 3:
+        d -= (3 - i) * t**i * (1 - t) ** (2 - i)
+    return comb(3, i) * d
+
+
+def inside_sign(k, edge, g=None):
+    """Sign (+1 or -1) of :func:`implicit_boundary` g on the side of ``edge`` where its piece lies.
+
+    At w = 0.1, ..., 0.9 along the edge the derivative of g(P(s, t)) in the direction into the
+    piece's domain is enclosed in a ball; all nine must exclude 0 and agree (else ``ValueError``).
+
+    >>> inside_sign(4, "P1:s=0") * float(implicit_boundary(4, "P1:s=0")[(1, 0)].mid()) > 0   # u > 1/2 inside
+    True
+    """
+    from flint import arb, ctx, fmpq
+
+    from ccproof.tables.numeric import characteristic_arb
+
+    k = check_valence(k)
+    patch, axis, value = BOUNDARY_EDGES[edge]
+    g = implicit_boundary(k, edge) if g is None else g
+    data = characteristic_arb(k)
+    net = data.bezier[patch]
+    step = -1 if value == 1 else 1
+    signs = set()
+    with ctx.workprec(data.prec + 64):
+        for n in range(1, 10):
+            w = arb(fmpq(n, 10))
+            s, t = (arb(value), w) if axis == 0 else (w, arb(value))
+            X = Y = DX = DY = arb(0)
+            for i in range(4):
+                for j in range(4):
+                    px, py = net[i][j]
+                    bi, bj = _bern(i, s), _bern(j, t)
+                    dd = (_bern_d(i, s) * bj if axis == 0 else bi * _bern_d(j, t)) * step
+                    X, Y = X + px * bi * bj, Y + py * bi * bj
+                    DX, DY = DX + px * dd, DY + py * dd
+            gu = gv = arb(0)
+            for (a, b), cval in g.items():
+                if a:
+                    gu += cval * a * X ** (a - 1) * Y**b
+                if b:
+                    gv += cval * b * X**a * Y ** (b - 1)
+            der = gu * DX + gv * DY
+            signs.add(1 if der > 0 else (-1 if der < 0 else 0))
+    if len(signs) != 1 or 0 in signs:
+        raise ValueError(f"the sign of g on the inside of {edge} is not decided for k = {k}")
+    return signs.pop()
+
+
+def _normalized_float(g):
+    m = max(abs(float(x.mid())) for x in g.values())
+    return {ab: float(x.mid()) / m for ab, x in g.items()}
+
+
 @lru_cache(maxsize=64)
 def valence_data(k):
-    """The cached :class:`ValenceData` of valence k."""
-    from ccproof.algebra.specialize import subdominant_eigenvalue
-    from ccproof.inverse.implicit import implicit_polynomial, inside_sign
+    """The cached :class:`ValenceData` of valence k, derived from the certified tables (module docstring).
+
+    Parameters
+    ----------
+    k : int
+        Valence >= 3 (any: a valence without its own table uses the exact nets of the tables).
+
+    Returns
+    -------
+    ValenceData
+
+    Examples
+    --------
+    >>> D = valence_data(5)
+    >>> D.bezier.shape, D.fit.shape, round(D.lam, 6)
+    ((3, 4, 4, 2), (2, 2, 21), 0.549988)
+    """
+    from ccproof.tables.numeric import characteristic_arb
 
     k = check_valence(k)
     lam, bez = float_nets(k)
@@ -148,12 +350,14 @@ def valence_data(k):
                         C6[p, 2 + 2 * c, 4 * i + j] = (i + 1) * power[p, c, i + 1, j]
                     if j < 3:
                         C6[p, 3 + 2 * c, 4 * i + j] = (j + 1) * power[p, c, i, j + 1]
-    mant, expo = _arb_pow_table(subdominant_eigenvalue(k, "arb", 128))
+    lam_arb = characteristic_arb(k).lam
+    mant, expo = _arb_pow_table(lam_arb)
 
     # location: Gamma = image of u = 1/2, 0 <= v <= 1/2 (edge s = 0 of P1), the inner boundary of
     # layer 0 on the side x >= y; Gamma / lam is its outer boundary. Separator C = edge t = 1 of P1.
-    gam = implicit_polynomial(k, "P1:s=0", "float")
-    sep = implicit_polynomial(k, "P1:t=1", "float")
+    gam_arb = implicit_boundary(k, "P1:s=0")
+    sep_arb = implicit_boundary(k, "P1:t=1")
+    gam, sep = _normalized_float(gam_arb), _normalized_float(sep_arb)
     exps3 = monomial_exponents(3)
     col3 = {e: i for i, e in enumerate(exps3)}
 
@@ -174,7 +378,7 @@ def valence_data(k):
         s, t = (ss, tt) if p == 0 else (ss[ss >= tt - 0.03], tt[ss >= tt - 0.03])
         xy = _eval_power(power[p], s, t)
         V = monomials(xy[0], xy[1], FIT_DEGREE).T
-        coef, *_ = np.linalg.lstsq(V, np.stack([s, t], 1), rcond=None)
+        coef = lstsq_tall(V, np.stack([s, t], 1))
         fits.append(coef.T)  # (2, M)
     fit = np.array(fits)
 
@@ -185,14 +389,14 @@ def valence_data(k):
     gx = B.T @ bez[0, 0, :, 0]
     xmin, xmax = gx.min(), gx.max()
     log_a = 0.5 * (np.log(xmax) + np.log(xmin) - 2 * np.log(lam))
-    lam_arb = subdominant_eigenvalue(k, "arb", 128)
     m2, e2 = _arb_pow_table(2 * lam_arb)
     with np.errstate(over="ignore", under="ignore"):
         pow_lam = np.ldexp(mant, expo)
         pow_2lam = np.ldexp(m2, e2)
         pow2 = np.ldexp(1.0, np.arange(-NMAX, NMAX + 1))
     return ValenceData(k, lam, bez, power, W, C6, mant, expo, pow_lam, pow_2lam, pow2, 1.0 / np.log(lam),
-                       float(log_a), G, fit, inside_sign(k, "P1:s=0"), inside_sign(k, "P1:t=1"))
+                       float(log_a), G, fit, inside_sign(k, "P1:s=0", gam_arb),
+                       inside_sign(k, "P1:t=1", sep_arb))
 
 
 #: points per block in the vectorized kernels (keeps the temporaries in cache)

@@ -1,0 +1,133 @@
+"""The valence of an extraordinary vertex as a value: one k >= 3, or every k >= k0 (an interval).
+
+The one place where a valence is parsed and printed. The spellings it reads and writes:
+
+=====================  =========================  =============================
+where                  single valence k = 7       interval k >= 40
+=====================  =========================  =============================
+text (command line)    ``"7"``                    ``">=40"`` (also ``"k>=40"``)
+JSON (tables, certs)   ``7``                      ``{"min": 40}``
+file names             ``k007.json``              ``k_ge_40.json``
+=====================  =========================  =============================
+
+:meth:`Valence.parse` reads any of them (and an ``int`` or another :class:`Valence`); ``str``,
+:meth:`Valence.to_json` and :meth:`Valence.stem` write them. Imports nothing from ccproof but
+:mod:`ccproof.errors` (bottom layer). The trusted verifier (``ccproof.certify.verify``) keeps its own
+reader on purpose (it imports nothing of the package outside the trusted base, docs/trusted_base.md).
+
+>>> Valence.parse(">=40"), Valence.parse({"min": 40}) == Valence.parse("k_ge_40.json")
+(Valence('>=40'), True)
+>>> v = Valence.parse(7)
+>>> str(v), v.to_json(), v.stem, v.contains(7), Valence.parse(">=40").contains(1000)
+('7', 7, 'k007', True, True)
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+from ccproof.errors import ValenceError, check_valence
+
+_TEXT_INTERVAL = re.compile(r"^\s*k?\s*>=\s*(\S+)\s*$")
+_STEM = re.compile(r"^k(?:_ge_(\d+)|(\d+))(?:\.json)?$")
+
+
+@dataclass(frozen=True, order=True)
+class Valence:
+    """A single valence ``k`` (``interval=False``) or the interval of every valence >= ``k``.
+
+    Parameters
+    ----------
+    k : int
+        The valence, or the smallest valence of the interval; an integer >= 3.
+    interval : bool
+        True for "every valence >= k".
+
+    Examples
+    --------
+    >>> Valence(5), Valence(40, interval=True)
+    (Valence('5'), Valence('>=40'))
+    >>> sorted([Valence(40, True), Valence(7), Valence(3)])      # single valences first, then intervals
+    [Valence('3'), Valence('7'), Valence('>=40')]
+    >>> Valence.parse(">=2")
+    Traceback (most recent call last):
+    ...
+    ccproof.errors.ValenceError: valence must be an integer >= 3, got '2'
+    """
+
+    interval: bool
+    k: int
+
+    def __init__(self, k, interval=False):
+        object.__setattr__(self, "interval", bool(interval))
+        object.__setattr__(self, "k", check_valence(k))
+
+    @classmethod
+    def parse(cls, value) -> Valence:
+        """Read a valence in any spelling of the module table; raises :class:`~ccproof.errors.ValenceError`.
+
+        >>> [str(Valence.parse(x)) for x in (5, "5", " >= 40 ", {"min": 41}, "k_ge_42", "k007.json")]
+        ['5', '5', '>=40', '>=41', '>=42', '7']
+        >>> Valence.parse({"max": 3})
+        Traceback (most recent call last):
+        ...
+        ccproof.errors.ValenceError: a valence interval must be {"min": k0}, got {'max': 3}
+        """
+        if isinstance(value, Valence):
+            return value
+        if isinstance(value, dict):
+            if set(value) != {"min"} or isinstance(value["min"], bool):
+                raise ValenceError(f'a valence interval must be {{"min": k0}}, got {value!r}')
+            return cls(value["min"], interval=True)
+        if isinstance(value, str):
+            text = value.strip()
+            m = _TEXT_INTERVAL.match(text)
+            if m:
+                return cls(m.group(1), interval=True)
+            m = _STEM.match(text)
+            if m:
+                return cls(int(m.group(1) or m.group(2)), interval=m.group(1) is not None)
+            return cls(text)
+        return cls(value)
+
+    def __str__(self) -> str:
+        return f">={self.k}" if self.interval else str(self.k)
+
+    def __repr__(self) -> str:
+        return f"Valence({str(self)!r})"
+
+    def to_json(self):
+        """``k`` (int) or ``{"min": k0}``: the spelling of tables and certificates.
+
+        >>> Valence.parse(">=40").to_json()
+        {'min': 40}
+        """
+        return {"min": self.k} if self.interval else self.k
+
+    @property
+    def stem(self) -> str:
+        """File name stem: ``k007`` or ``k_ge_40``.
+
+        >>> Valence(12).stem, Valence(40, True).stem
+        ('k012', 'k_ge_40')
+        """
+        return f"k_ge_{self.k}" if self.interval else f"k{self.k:03d}"
+
+    def contains(self, k) -> bool:
+        """Whether the single valence ``k`` is this valence or lies in this interval.
+
+        >>> Valence.parse(">=40").contains(39), Valence(5).contains(5)
+        (False, True)
+        """
+        k = check_valence(k)
+        return k >= self.k if self.interval else k == self.k
+
+
+def parse_valence(value) -> Valence:
+    """:meth:`Valence.parse` as a function (for argparse ``type=``: ``ccproof table '>=40'``).
+
+    >>> parse_valence(">=40")
+    Valence('>=40')
+    """
+    return Valence.parse(value)
