@@ -36,7 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ccproof.apps.dynamics.forces import ClosestPointFinder, Springs, check_points
+from ccproof.apps.dynamics.forces import ModelNearestPoints, Springs, check_points
 from ccproof.apps.dynamics.integrate import ImplicitIntegrator
 from ccproof.apps.dynamics.meshes import paper_initial_model
 from ccproof.apps.dynamics.model import DynamicSurface, Material
@@ -269,7 +269,7 @@ def fit_error(model, P, X, finder=None, per_edge=None, diameter=None):
     if finder is None:
         if per_edge is None:
             per_edge = samples_per_edge(model.mesh.n_faces, X.shape[0], 12)
-        finder = ClosestPointFinder(model, per_edge=per_edge, candidates=4, iterations=12)
+        finder = ModelNearestPoints(model, per_edge=per_edge, candidates=4, iterations=12)
     *_, dist = finder.query(P, X)
     if diameter is None:
         diameter = 2.0 * minimal_enclosing_sphere(X)[1]
@@ -499,7 +499,7 @@ def fit_points(X, init="cube", levels=1, material=None, spring_total=1.0, dt=Non
     try:
         for level in range(levels + 1):
             t0 = time.perf_counter()
-            finder = ClosestPointFinder(model, per_edge=samples_per_edge(model.mesh.n_faces, X.shape[0], 6))
+            finder = ModelNearestPoints(model, per_edge=samples_per_edge(model.mesh.n_faces, X.shape[0], 6))
             integ = ImplicitIntegrator(model, dt, P=P, scheme=scheme, tol=1e-9)
             prev = None
             converged = False

@@ -19,7 +19,7 @@ from scipy.spatial import cKDTree
 
 from ccproof.errors import CCProofError
 
-__all__ = ["Springs", "ClosestPointFinder", "check_points"]
+__all__ = ["Springs", "ModelNearestPoints", "check_points"]
 
 
 def check_points(X, name="point cloud"):
@@ -98,12 +98,12 @@ class Springs:
     def to_nearest(cls, model, P, anchors, stiffness, finder=None):
         """Springs attached to the points of the limit surface (state P) nearest to the anchors."""
         anchors = check_points(anchors, "spring anchors")
-        finder = ClosestPointFinder(model) if finder is None else finder
+        finder = ModelNearestPoints(model) if finder is None else finder
         f, u, v, _, _ = finder.query(P, anchors)
         return cls(model, f, u, v, anchors, stiffness)
 
 
-class ClosestPointFinder:
+class ModelNearestPoints:
     """Nearest points of the limit surface of a model to query points (module docstring).
 
     Parameters
