@@ -105,7 +105,28 @@ def smallest_level(nets, lam, max_level=8):
 
 
 def prove_valence(k, prec=DEFAULT_PREC, progress=True):
-    """Search an injectivity certificate for valence k; returns the certificate dict (docs/certificates.md)."""
+    """Search an injectivity certificate for valence k (bmz04 Appendix A as corrected in docs/appendix_a.md).
+
+    Parameters
+    ----------
+    k : int
+        Valence, k >= 3.
+    prec : int
+        arb precision in bits of every Bernstein coefficient (written into the certificate).
+    progress : bool
+        Show a progress bar over the dyadic cells.
+
+    Returns
+    -------
+    dict
+        The certificate (docs/certificates.md): schema, valence, the level N and the boxes of parts B, D, E.
+        Raises :class:`ProofFailed` when some form is not certainly positive after subdivision.
+
+    >>> from ccproof.certify.verify import verify_certificate
+    >>> cert = prove_valence(4, progress=False)
+    >>> cert["N"], sorted(cert["parts"]), bool(verify_certificate(cert, log=lambda line: None))
+    (3, ['cells', 'corner', 'regularity'], True)
+    """
     k = check_valence(k)
     with ctx.workprec(prec):
         lam = c_lam(k, prec)[1]
@@ -305,7 +326,24 @@ def _parse_k(k):
 def prove_c1(k, prec=DEFAULT_PREC):
     """C1 certificate (Reif's criterion) for valence k or the interval ``">=K0"``: det J_Phi > 0 on
     layer 0 and a star-shaped outer boundary, boxes found by subdivision; the spectral ordering is
-    re-derived by the verifier from the rules (:mod:`ccproof.certify.verify.spectrum`)."""
+    re-derived by the verifier from the rules (:mod:`ccproof.certify.verify.spectrum`).
+
+    Parameters
+    ----------
+    k : int or str
+        A valence k >= 3, or ``">=K0"`` for every k >= K0 (one lam piece covering lam(K0)..lim lam).
+    prec : int
+        arb precision in bits.
+
+    Returns
+    -------
+    dict
+        The certificate (schema ``ccproof.c1/2``).
+
+    >>> cert = prove_c1(5)
+    >>> cert["schema"], sorted(cert["parts"]["star"])
+    ('ccproof.c1/2', ['P1s1', 'P2s1', 'P2t1', 'P3t1'])
+    """
     k = _parse_k(k)
     with ctx.workprec(prec):
         if isinstance(k, dict):

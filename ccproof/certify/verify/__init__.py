@@ -58,8 +58,25 @@ def verify_certificate(cert, log=print, path=None):
 def verify_file(path, log=print, tables_dir=None):
     """Verify one certificate file; logs PASS/FAIL per part, then VERIFIED or FAILED with the reason.
 
-    Returns a :class:`VerifyResult` (true as a bool exactly when every part passed). ``tables_dir`` is
-    accepted for compatibility and ignored: the verifier reads no table."""
+    Parameters
+    ----------
+    path : str or Path
+        A certificate file (JSON, schema ``ccproof.injectivity/2`` or ``ccproof.c1/2``).
+    log : callable
+        Receives each output line (default ``print``).
+    tables_dir : ignored
+        Accepted for compatibility: the verifier reads no table.
+
+    Returns
+    -------
+    VerifyResult
+        True as a bool exactly when every part passed; ``parts`` with their reasons, ``margins``.
+
+    >>> from ccproof.tables.format import certificates_dir
+    >>> res = verify_file(certificates_dir() / "c1" / "k005.json", log=lambda line: None)
+    >>> bool(res), res.schema, res.failures()
+    (True, 'ccproof.c1/2', [])
+    """
     del tables_dir
     t0 = time.perf_counter()
     path = Path(path)

@@ -25,7 +25,12 @@ class VerifyResult:
     """The verdict on one certificate: ``ok`` only when every part passed; ``parts`` in order; ``error``
     names why the file could not be checked at all (malformed, unknown field), else None. True as a bool
     exactly when ``ok``. ``margins`` maps a section (``regularity``, ``cells``, ``corner``, ``star``) to the
-    smallest bound re-checked in this run."""
+    smallest bound re-checked in this run.
+
+    >>> r = VerifyResult(parts=[Part("A", True), Part("B", False, "a coefficient is not above the bound")])
+    >>> bool(r), [p.name for p in r.failures()]
+    (False, ['B'])
+    """
 
     path: str | None = None
     schema: str | None = None
