@@ -43,7 +43,7 @@ def add_arguments(parser):
     )
 
 
-def read_points(path):
+def read_face_uv_csv(path):
     """Read a ``face,u,v`` CSV file; returns (face int64 (n,), u (n,), v (n,))."""
     import numpy as np
 

@@ -25,7 +25,7 @@ import sys
 import time
 
 from ccproof.cli._eval_args import add_arguments as _add_evaluate_arguments
-from ccproof.cli._eval_args import read_points
+from ccproof.cli._eval_args import read_face_uv_csv
 from ccproof.errors import CCProofError
 
 
@@ -99,7 +99,7 @@ def run(args) -> int:
     if args.points is not None and Path(args.points).is_dir():
         sources = point_chunks(args.chunk, shards=args.points)
     elif args.points is not None:
-        sources = point_chunks(args.chunk, arrays=read_points(args.points))
+        sources = point_chunks(args.chunk, arrays=read_face_uv_csv(args.points))
     else:
         if args.samples < 0:
             raise CCProofError(f"--samples must be >= 0, got {args.samples}")

@@ -27,7 +27,7 @@ def add_arguments(parser):
     parser.add_argument("--cells", type=int, default=None, help="cells per face side of the search structure")
 
 
-def read_points(path):
+def read_xyz_csv(path):
     """Read an ``x,y,z`` CSV file; returns an (n, 3) float array."""
     import numpy as np
 
@@ -58,7 +58,7 @@ def run(args):
     from ccproof.evaluate.closest import CELLS, ClosestPointFinder
     from ccproof.evaluate.surface import limit_surface
 
-    X = read_points(args.points)
+    X = read_xyz_csv(args.points)
     S = limit_surface(args.mesh)
     t0 = time.perf_counter()
     finder = ClosestPointFinder(S, cells=args.cells or CELLS)
