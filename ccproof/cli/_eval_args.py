@@ -43,28 +43,38 @@ def add_arguments(parser):
     )
 
 
-def read_face_uv_csv(path):
-    """Read a ``face,u,v`` CSV file; returns (face int64 (n,), u (n,), v (n,))."""
+def read_csv_columns(path, header):
+    """Rows of a CSV file whose first line is exactly ``header`` (e.g. ``("face", "u", "v")``), as floats
+    (n, len(header)); blank lines are skipped; a bad header, row length or value raises
+    :class:`CCProofError` naming the file and line."""
     import numpy as np
 
+    want = ",".join(header)
     with open(path, encoding="utf-8") as fh:
-        header = fh.readline()
-        names = [h.strip().lower() for h in header.strip().split(",")]
-        if names != ["face", "u", "v"]:
-            raise CCProofError(f"{path}: the first line must be the header 'face,u,v', got {header.strip()!r}")
-        faces, us, vs = [], [], []
+        first = fh.readline()
+        if [h.strip().lower() for h in first.strip().split(",")] != list(header):
+            raise CCProofError(f"{path}: the first line must be the header '{want}', got {first.strip()!r}")
+        rows = []
         for no, line in enumerate(fh, start=2):
             if not line.strip():
                 continue
             parts = line.split(",")
-            if len(parts) != 3:
-                raise CCProofError(f"{path}:{no}: expected 3 comma-separated values, got {line.strip()!r}")
+            if len(parts) != len(header):
+                raise CCProofError(f"{path}:{no}: expected {len(header)} comma-separated values, got {line.strip()!r}")
             try:
-                f = int(parts[0])
-                u, v = float(parts[1]), float(parts[2])
+                rows.append([float(x) for x in parts])
             except ValueError:
                 raise CCProofError(f"{path}:{no}: bad value in {line.strip()!r}") from None
-            faces.append(f)
-            us.append(u)
-            vs.append(v)
-    return np.array(faces, dtype=np.int64), np.array(us), np.array(vs)
+    return np.array(rows, dtype=np.float64).reshape(-1, len(header))
+
+
+def read_face_uv_csv(path):
+    """Read a ``face,u,v`` CSV file; returns (face int64 (n,), u (n,), v (n,))."""
+    import numpy as np
+
+    rows = read_csv_columns(path, ("face", "u", "v"))
+    face = rows[:, 0]
+    bad = np.flatnonzero(face != np.round(face))
+    if bad.size:
+        raise CCProofError(f"{path}:{int(bad[0]) + 2}: face must be an integer, got {face[bad[0]]!r}")
+    return face.astype(np.int64), rows[:, 1].copy(), rows[:, 2].copy()

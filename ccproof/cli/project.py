@@ -16,8 +16,6 @@ Example:
 
 from __future__ import annotations
 
-from ccproof.errors import CCProofError
-
 
 def add_arguments(parser):
     parser.add_argument("mesh", help="OBJ mesh (any mesh the limit evaluator accepts)")
@@ -29,25 +27,9 @@ def add_arguments(parser):
 
 def read_xyz_csv(path):
     """Read an ``x,y,z`` CSV file; returns an (n, 3) float array."""
-    import numpy as np
+    from ccproof.cli._eval_args import read_csv_columns
 
-    with open(path, encoding="utf-8") as fh:
-        header = fh.readline()
-        names = [h.strip().lower() for h in header.strip().split(",")]
-        if names != ["x", "y", "z"]:
-            raise CCProofError(f"{path}: the first line must be the header 'x,y,z', got {header.strip()!r}")
-        rows = []
-        for no, line in enumerate(fh, start=2):
-            if not line.strip():
-                continue
-            parts = line.split(",")
-            if len(parts) != 3:
-                raise CCProofError(f"{path}:{no}: expected 3 comma-separated values, got {line.strip()!r}")
-            try:
-                rows.append([float(p) for p in parts])
-            except ValueError:
-                raise CCProofError(f"{path}:{no}: bad value in {line.strip()!r}") from None
-    return np.array(rows, dtype=np.float64).reshape(-1, 3)
+    return read_csv_columns(path, ("x", "y", "z"))
 
 
 def run(args):
