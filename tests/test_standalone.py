@@ -3,7 +3,8 @@
 Greps the package, tests, scripts, docs, README, build files and CI script for references to a
 sibling ``shared`` folder, to design notes that are not in the repository, to item names of an
 outside specification ("spec" and a letter-digit item name) and to issue numbers. The reference data
-under ``tests/data`` is skipped except its READMEs (which describe the data and must stand alone too). Every hit is listed.
+under ``tests/data`` is skipped except its READMEs (which describe the data and must stand alone too).
+Every hit is listed.
 """
 
 import re
