@@ -24,6 +24,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ccproof.errors import MeshError
+from ccproof.mesh.quadmesh import pair_halfedges
 from ccproof.mesh.rules import INFINITE, Complex, Options, refine_complex
 
 __all__ = ["PolyMesh"]
@@ -159,33 +160,7 @@ class PolyMesh:
         nxt = off[face_of] + (loc + 1) % self.sizes[face_of]
         prv = off[face_of] + (loc - 1) % self.sizes[face_of]
         org, dst = idx, idx[nxt]
-        lo, hi = np.minimum(org, dst), np.maximum(org, dst)
-        ukey = lo * n + hi
-        order = np.argsort(ukey, kind="stable")
-        sk = ukey[order]
-        starts = np.flatnonzero(np.r_[True, sk[1:] != sk[:-1]])
-        counts = np.diff(np.r_[starts, H])
-        if (counts > 2).any():
-            g = int(np.flatnonzero(counts > 2)[0])
-            hs = order[starts[g] : starts[g] + counts[g]]
-            raise MeshError(
-                f"non-manifold edge ({int(lo[hs[0]])}, {int(hi[hs[0]])}): shared by {int(counts[g])} faces "
-                f"{sorted(int(face_of[h]) for h in hs)}"
-            )
-        edge_of = np.empty(H, dtype=np.int64)
-        edge_of[order] = np.repeat(np.arange(starts.size), counts)
-        twin = np.full(H, -1, dtype=np.int64)
-        two = starts[counts == 2]
-        h1, h2 = order[two], order[two + 1]
-        same = org[h1] == org[h2]
-        if same.any():
-            i = int(np.flatnonzero(same)[0])
-            a, b = org[h1[i]], dst[h1[i]]
-            raise MeshError(
-                f"inconsistent orientation: faces {int(face_of[h1[i]])} and {int(face_of[h2[i]])} both "
-                f"traverse edge ({int(a)}, {int(b)}) from {int(a)} to {int(b)}"
-            )
-        twin[h1], twin[h2] = h2, h1
+        lo, hi, order, starts, counts, edge_of, twin = pair_halfedges(org, dst, face_of, n)
         first = order[starts]
         self.edges = np.stack([lo[first], hi[first]], axis=1)
         self.edge_index = {(int(a), int(b)): e for e, (a, b) in enumerate(self.edges.tolist())}

@@ -33,6 +33,45 @@ def _edge_str(a, b):
     return f"edge ({int(a)}, {int(b)})"
 
 
+def pair_halfedges(org, dst, face_of, n):
+    """Undirected edges and twins of the half-edges org -> dst (face ``face_of``) of a mesh with n vertices.
+
+    Returns ``(lo, hi, order, starts, counts, edge_of, twin)``: per half-edge the edge's end points
+    (lo < hi); the half-edges sorted by edge (``order``), where each edge starts and how many half-edges
+    it has; the edge of each half-edge and its twin (-1 on the boundary). Raises :class:`MeshError`
+    naming the edge and faces when an edge has more than two faces or two faces traverse it the same way.
+    """
+    H = org.size
+    lo, hi = np.minimum(org, dst), np.maximum(org, dst)
+    ukey = lo * n + hi
+    order = np.argsort(ukey, kind="stable")
+    sk = ukey[order]
+    starts = np.flatnonzero(np.r_[True, sk[1:] != sk[:-1]])
+    counts = np.diff(np.r_[starts, H])
+    if (counts > 2).any():
+        g = int(np.flatnonzero(counts > 2)[0])
+        hs = order[starts[g] : starts[g] + counts[g]]
+        raise MeshError(
+            f"non-manifold {_edge_str(lo[hs[0]], hi[hs[0]])}: shared by {int(counts[g])} faces "
+            f"{sorted(int(face_of[h]) for h in hs)}"
+        )
+    edge_of = np.empty(H, dtype=np.int64)
+    edge_of[order] = np.repeat(np.arange(starts.size), counts)
+    twin = np.full(H, -1, dtype=np.int64)
+    two = starts[counts == 2]
+    h1, h2 = order[two], order[two + 1]
+    same = org[h1] == org[h2]
+    if same.any():
+        i = int(np.flatnonzero(same)[0])
+        a, b = org[h1[i]], dst[h1[i]]
+        raise MeshError(
+            f"inconsistent orientation: faces {int(face_of[h1[i]])} and {int(face_of[h2[i]])} both traverse "
+            f"{_edge_str(a, b)} from {int(a)} to {int(b)}"
+        )
+    twin[h1], twin[h2] = h2, h1
+    return lo, hi, order, starts, counts, edge_of, twin
+
+
 class QuadMesh:
     """An all-quad, manifold, consistently oriented control mesh (bmz04 section 2).
 
@@ -146,34 +185,7 @@ class QuadMesh:
         H = 4 * m
         org = F.reshape(-1)
         dst = np.roll(F, -1, axis=1).reshape(-1)
-        # undirected edges
-        lo, hi = np.minimum(org, dst), np.maximum(org, dst)
-        ukey = lo * n + hi
-        order = np.argsort(ukey, kind="stable")
-        sk = ukey[order]
-        starts = np.flatnonzero(np.r_[True, sk[1:] != sk[:-1]])
-        counts = np.diff(np.r_[starts, H])
-        if (counts > 2).any():
-            g = int(np.flatnonzero(counts > 2)[0])
-            hs = order[starts[g] : starts[g] + counts[g]]
-            raise MeshError(
-                f"non-manifold {_edge_str(lo[hs[0]], hi[hs[0]])}: shared by {int(counts[g])} faces "
-                f"{sorted(int(h) // 4 for h in hs)}"
-            )
-        edge_of = np.empty(H, dtype=np.int64)
-        edge_of[order] = np.repeat(np.arange(starts.size), counts)
-        twin = np.full(H, -1, dtype=np.int64)
-        two = starts[counts == 2]
-        h1, h2 = order[two], order[two + 1]
-        same = org[h1] == org[h2]
-        if same.any():
-            i = int(np.flatnonzero(same)[0])
-            a, b = org[h1[i]], dst[h1[i]]
-            raise MeshError(
-                f"inconsistent orientation: faces {int(h1[i]) // 4} and {int(h2[i]) // 4} both traverse "
-                f"{_edge_str(a, b)} from {int(a)} to {int(b)}"
-            )
-        twin[h1], twin[h2] = h2, h1
+        lo, hi, order, starts, counts, edge_of, twin = pair_halfedges(org, dst, np.arange(H) // 4, n)
         self.twin = twin
         self.edge_of_halfedge = edge_of
         first = order[starts]
