@@ -368,17 +368,7 @@ class LimitSurface:
         return self._locate(f, u, v)
 
     def _locate(self, f, u, v):
-        vf = f.copy()
-        kind = self._vkind[vf]
-        for _ in range(self.split_depth):
-            idx = np.flatnonzero(kind == _SPLIT)
-            if idx.size == 0:
-                break
-            w = vf[idx]
-            half = self._vh[w] * 0.5
-            q = (u[idx] >= self._vu0[w] + half).astype(np.int64) + 2 * (v[idx] >= self._vv0[w] + half)
-            vf[idx] = self._vchild[w, q]
-            kind[idx] = self._vkind[vf[idx]]
+        vf, kind = self._vface_of(f, u, v)
         patch = self._vpatch[vf].copy()
         idx = np.flatnonzero(kind == _CORNER)
         if idx.size:
@@ -501,6 +491,7 @@ class LimitSurface:
 
     # ------------------------------------------------------------------ normals
     def _vface_of(self, f, u, v):
+        """The virtual face holding (u, v) after descending the split faces, and its kind."""
         vf = f.copy()
         kind = self._vkind[vf]
         for _ in range(self.split_depth):
