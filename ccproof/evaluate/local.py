@@ -154,6 +154,18 @@ class LocalTopology:
         return len(fan) == (4 if closed else 2)
 
 
+
+def group_eigenvalues(vals, tol):
+    """Consecutive eigenvalues (sorted by modulus) within ``tol`` of their group's first one, as lists
+    (a defective pair splits by ~sqrt(eps), so it lands in one group)."""
+    groups = []
+    for z in vals:
+        if groups and abs(groups[-1][0] - z) < tol:
+            groups[-1].append(z)
+        else:
+            groups.append([z])
+    return groups
+
 def canonical_ring(topo, f, r):
     """The one-ring of face ``f`` listed from its corner ``r``.
 
@@ -587,12 +599,7 @@ def _tangent_masks_float(A):
     N = Af.shape[0]
     vals = np.linalg.eigvals(Af)
     vals = vals[np.argsort(-np.abs(vals), kind="stable")]
-    groups = []
-    for z in vals:
-        if groups and abs(groups[-1][0] - z) < 1e-6:
-            groups[-1].append(z)
-        else:
-            groups.append([z])
+    groups = group_eigenvalues(vals, 1e-6)
     masks = []
     for g in groups:
         mu = sum(g) / len(g)
@@ -624,12 +631,7 @@ def _tangent_masks(A):
         E = mpmath.eig(M.T, left=False, right=False)
         vals = sorted(E, key=lambda z: -abs(z))
         # group numerically equal eigenvalues (a defective pair splits by ~sqrt(eps))
-        groups = []
-        for z in vals:
-            if groups and abs(groups[-1][0] - z) < 1e-15:
-                groups[-1].append(z)
-            else:
-                groups.append([z])
+        groups = group_eigenvalues(vals, 1e-15)
         masks = []
         for g in groups:
             mu = sum(g) / len(g)
