@@ -154,7 +154,6 @@ class LocalTopology:
         return len(fan) == (4 if closed else 2)
 
 
-
 def group_eigenvalues(vals, tol):
     """Consecutive eigenvalues (sorted by modulus) within ``tol`` of their group's first one, as lists
     (a defective pair splits by ~sqrt(eps), so it lands in one group)."""
