@@ -20,7 +20,7 @@ from ccproof.certify.verify import C1_SCHEMA, SCHEMA
 from ccproof.certify.verify.interval import hull_nets, interval_cells, lam_interval_ok, parameter_nets
 from ccproof.certify.verify.maps import (
     STAR_CURVES,
-    cell_det_poly,
+    cell_det_builder,
     corner_containment,
     corner_det_form,
     regularity_form,
@@ -31,7 +31,7 @@ from ccproof.certify.verify.maps import (
 from ccproof.certify.verify.replay import parse_decimal
 from ccproof.certify.verify.statement import PATCHES, c_lam, derivation, nets_for_valence
 from ccproof.errors import CCProofError, check_valence
-from ccproof.rigorous import bernstein_coefficients, certainly_positive, lower_bound
+from ccproof.rigorous import certainly_positive, lower_bound
 from ccproof.tables.format import certificates_dir
 
 DEFAULT_PREC = 128
@@ -141,8 +141,9 @@ def prove_valence(k, prec=DEFAULT_PREC, progress=True):
             from tqdm import tqdm
 
             it = tqdm(todo, desc=f"k={k} cells", unit="cell", leave=False)
+        build = cell_det_builder(nets, lam, N, prec)
         for l, m, p, q in it:
-            root = bernstein_coefficients(cell_det_poly(nets, lam, N, l, m, p, q, prec))
+            root = build(l, m, p, q)
             cells[f"{l},{m},{p},{q}"] = prove_positive(root, (0, 1), f"cell ({l},{m}) piece ({p},{q})")
         corner = {n: prove_positive(corner_det_form(nets, lam, N, n, prec), (2, 3, 0, 1),
                                     f"corner {n}") for n in PATCHES}

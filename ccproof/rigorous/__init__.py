@@ -19,7 +19,8 @@ Guarantees
 Main entry points: :class:`Poly`, :func:`jacobian_determinant`, :func:`bernstein_coefficients`,
 :class:`BernsteinForm` (``split``, ``restrict``, ``elevate``, ``diff``, ``+ - *``),
 :func:`range_enclosure`, :func:`lower_bound`, :func:`certainly_positive`, :func:`ball_contains`,
-:func:`bernstein_jacobian_determinant`.  See ``docs/rigorous.md``.
+:func:`bernstein_jacobian_determinant`, :class:`TaylorForm` (a Taylor model in one parameter with
+Bernstein coefficients in the other variables, ``truncate``, ``bernstein``).  See ``docs/rigorous.md``.
 """
 
 from ._tensor import ball_contains, exact_fmpq
@@ -33,10 +34,12 @@ from .bernstein import (
     unit_box,
 )
 from .poly import Poly, jacobian_determinant
+from .taylor import TaylorForm, taylor_jacobian_determinant
 
 __all__ = [
     "BernsteinForm",
     "Poly",
+    "TaylorForm",
     "ball_contains",
     "bernstein_coefficients",
     "bernstein_jacobian_determinant",
@@ -45,5 +48,6 @@ __all__ = [
     "jacobian_determinant",
     "lower_bound",
     "range_enclosure",
+    "taylor_jacobian_determinant",
     "unit_box",
 ]

@@ -33,6 +33,7 @@ REVIEWED = {
     ("replay.py", "not bound > 0"): "bound is an exact fmpq",
     ("bernstein.py", "not T.exact_scalar(c) > 0"): "exact_scalar gives an fmpq",
     ("bernstein.py", "not 0 < t < 1"): "t is an exact split fraction",
+    ("taylor.py", "other.prec != self.prec"): "precisions are ints",
     ("maps.py", "(l, m) != (0, 0)"): "ints",
     ("statement.py", "i != r"): "ints",
     ("spectrum.py", "_charpoly_at(rows, fmpq(x)) != _claimed_mode(fmpq(x), c)"): "fmpq determinants (exact)",

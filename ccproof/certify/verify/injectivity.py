@@ -17,12 +17,10 @@ import re
 
 from flint import arb, ctx, fmpq
 
-from ccproof.rigorous import bernstein_coefficients
-
 from .errors import CertificateError
 from .interval import hull_nets, interval_cells, lam_interval_ok, parameter_nets
 from .maps import (
-    cell_det_poly,
+    cell_det_builder,
     corner_containment,
     corner_det_form,
     outer_curves,
@@ -103,8 +101,8 @@ def verify_valence(cert, k, part, log):
     with ctx.workprec(prec):
         lam = c_lam(k, prec)[1]
         check_hypotheses(nets, lam, part)
-        cells = [(f"{l},{m},{p},{q}",
-                  lambda c=(l, m, p, q): bernstein_coefficients(cell_det_poly(nets, lam, N, *c, prec)))
+        build = cell_det_builder(nets, lam, N, prec)
+        cells = [(f"{l},{m},{p},{q}", lambda c=(l, m, p, q): build(*c))
                  for l, m, p, q in required_cells(nets, lam, N, prec, sym)]
         check_parts(parts, nets, lam, N, prec, cells, part, "")
 

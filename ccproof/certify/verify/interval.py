@@ -12,10 +12,17 @@ from __future__ import annotations
 
 from flint import arb, ctx, fmpq, fmpq_poly
 
-from ccproof.rigorous import Poly, bernstein_coefficients, exact_fmpq, jacobian_determinant, range_enclosure
+from ccproof.rigorous import (
+    Poly,
+    TaylorForm,
+    bernstein_coefficients,
+    exact_fmpq,
+    range_enclosure,
+    taylor_jacobian_determinant,
+)
 
 from .errors import CertificateError
-from .maps import cell_geometry, cell_pieces, dyadic_cells, net_form, weight_piece
+from .maps import ORIGIN, cell_geometry, cell_pieces, dyadic_cells, net_form, weight_piece
 from .statement import B2Z, PATCHES
 
 ZBOX = ((fmpq(-1), fmpq(1)), (fmpq(0), fmpq(1)), (fmpq(0), fmpq(1)))  # (zeta, s, t) of part D
@@ -86,34 +93,62 @@ def cell_maps_z(znets, N, l, m, D, prec):
     return out
 
 
+def piece_maps_z(znets, i, name, D, prec):
+    """(X, Y) = lam^i Phi on piece ``name`` of layer i as TaylorForms in (zeta; sigma, tau): the Bezier
+    net entries are the Bernstein coefficients in (sigma, tau), their zeta polynomials the Taylor part."""
+    net = znets[i][name]
+    m = len(net[0][0][0])
+    return [TaylorForm(((m, 4, 4)), [net[a][b][d][e] for e in range(m) for a in range(4) for b in range(4)],
+                       prec).truncate(D) for d in range(2)]
+
+
 def _weight_z(p, X, D):
-    """b(X) on piece p, Horner around the exact midpoint x0 of X's constant term (tighter balls)."""
+    """b(X) on piece p, Horner around the exact midpoint x0 of X's first coefficient (tighter balls)."""
     x0 = exact_fmpq(X.coeffs[0].mid())
     b = weight_piece(p).affine(0, x0, x0 + 1)
-    acc = Poly.constant(b.coeffs[-1], 3, X.prec)
+    acc = TaylorForm.constant(b.coeffs[-1], 2, X.prec)
     for c in b.coeffs[-2::-1]:
         acc = (acc * (X - x0)).truncate(D) + c
     return acc
 
 
+def piece_det_form_z(znets, i, name, p, q, D, prec):
+    """Bernstein form on ZBOX of det dG/d(sigma, tau) on layer i of piece ``name`` for the w piece (p, q),
+    every lam of the interval at once (Taylor model in zeta, truncated to degree D; one form for all the
+    cells of that layer, piece and w piece; y = 2^-i (ORIGIN + (sigma, tau)/2) as in :func:`piece_det_form`)."""
+    with ctx.workprec(prec):
+        X, Y = piece_maps_z(znets, i, name, D, prec)
+        u0, v0 = ORIGIN[name]
+        scale = fmpq(1, 2 ** (i + 1))
+        y1 = (TaylorForm.variable(1, 2, prec) + 2 * u0) * scale
+        y2 = (TaylorForm.variable(2, 2, prec) + 2 * v0) * scale
+        w = (_weight_z(p, X, D) * _weight_z(q, Y, D)).truncate(D)
+        G = [(F + w * (y - F)).truncate(D) for y, F in ((y1, X), (y2, Y))]
+        return taylor_jacobian_determinant(G, (1, 2)).truncate(D).bernstein()
+
+
 def interval_cells(znets, N, D, prec, symmetric=False):
     """Part D for an interval: every (key, build root) with a w piece met by the Bernstein hull of the
-    cell's image over all zeta; the root is det dG/d(s,t) in (zeta, s, t) on ZBOX (Taylor model in zeta)."""
+    cell's image over all zeta; the root is det dG/d(s,t) in (zeta, s, t) on ZBOX: the form of its layer,
+    piece and w piece (:func:`piece_det_form_z`) restricted to the cell's box, times h^2 (h a power of 2)."""
     out = []
-    v = [Poly.variable(a, 3, prec) for a in range(3)]
+    forms = {}
+
+    def build(l, m, p, q):
+        i, name, box = cell_geometry(l, m, N)
+        if (i, name, p, q) not in forms:
+            forms[i, name, p, q] = piece_det_form_z(znets, i, name, p, q, D, prec)
+        h = box[0][1] - box[0][0]
+        with ctx.workprec(prec):
+            return forms[i, name, p, q].restrict((ZBOX[0],) + box) * (h * h)
+
     with ctx.workprec(prec):
         for l, m in dyadic_cells(N, symmetric):
             X, Y = cell_maps_z(znets, N, l, m, D, prec)
             XY = [bernstein_coefficients(F, box=ZBOX) for F in (X, Y)]
-            y1, y2 = (v[1] + l) * fmpq(1, 2**N), (v[2] + m) * fmpq(1, 2**N)
             for p, q in cell_pieces(*XY):
                 if p < 3 and q < 3:
-                    def build(X=X, Y=Y, p=p, q=q, y1=y1, y2=y2):
-                        with ctx.workprec(prec):
-                            w = (_weight_z(p, X, D) * _weight_z(q, Y, D)).truncate(D)
-                            G = [(F + w * (y - F)).truncate(D) for y, F in ((y1, X), (y2, Y))]
-                            return bernstein_coefficients(jacobian_determinant(G, (1, 2)).truncate(D), box=ZBOX)
-                    out.append((f"{l},{m},{p},{q}", build))
+                    out.append((f"{l},{m},{p},{q}", lambda c=(l, m, p, q): build(*c)))
     return out
 
 

@@ -9,7 +9,13 @@ from __future__ import annotations
 
 from flint import ctx, fmpq, fmpq_poly
 
-from ccproof.rigorous import BernsteinForm, Poly, bernstein_jacobian_determinant, jacobian_determinant
+from ccproof.rigorous import (
+    BernsteinForm,
+    Poly,
+    bernstein_coefficients,
+    bernstein_jacobian_determinant,
+    jacobian_determinant,
+)
 
 from .statement import PATCHES
 
@@ -113,6 +119,49 @@ def cell_det_poly(nets, lam, N, l, m, p, q, prec):
         w = weight_piece(p).compose([X]) * weight_piece(q).compose([Y])
         # G = w y + (1 - w) Phi, written X + w (y - X): one product per coordinate
         return jacobian_determinant([X + w * (y1 - X), Y + w * (y2 - Y)])
+
+
+#: layer-0 coordinates (u, v) = ORIGIN + (sigma, tau) / 2 of the local parameters (sigma, tau) of each piece
+ORIGIN = {"P1": (fmpq(1, 2), fmpq(0)), "P2": (fmpq(1, 2), fmpq(1, 2)), "P3": (fmpq(0), fmpq(1, 2))}
+
+
+def piece_det_form(nets, lam, i, name, p, q, prec):
+    """Bernstein form on [0,1]^2 of det dG/d(sigma, tau) on layer i of piece ``name`` for the w piece (p, q)
+    (p, q < 3), in the piece's local parameters: one polynomial for every cell of that layer, piece and w piece.
+    On layer i, Phi = lam^i Phi_0(sigma, tau) and y = 2^-i (ORIGIN + (sigma, tau)/2)."""
+    with ctx.workprec(prec):
+        li = lam**i
+        X = net_form(nets[name], 0, prec).to_poly() * li
+        Y = net_form(nets[name], 1, prec).to_poly() * li
+        s, t = Poly.variable(0, 2), Poly.variable(1, 2)
+        u0, v0 = ORIGIN[name]
+        y1 = (s + 2 * u0) * fmpq(1, 2 ** (i + 1))
+        y2 = (t + 2 * v0) * fmpq(1, 2 ** (i + 1))
+        w = weight_piece(p).compose([X]) * weight_piece(q).compose([Y])
+        return bernstein_coefficients(jacobian_determinant([X + w * (y1 - X), Y + w * (y2 - Y)]))
+
+
+def cell_det_form(piece_form, N, l, m, p, q, prec):
+    """Bernstein form of det dG/d(s, t) on cell (l, m) for the w piece (p, q) in the cell's local (s, t):
+    the piece's form (``piece_form(i, name, p, q)``, :func:`piece_det_form`) restricted to the cell's box
+    (sigma = s0 + h s, tau = t0 + h t) times h^2 (exact: h is a power of 2). Same polynomial as
+    :func:`cell_det_poly` on the cell; restricting one form per piece is the cheap way to get it."""
+    i, name, box = cell_geometry(l, m, N)
+    h = box[0][1] - box[0][0]
+    with ctx.workprec(prec):
+        return piece_form(i, name, p, q).restrict(box) * (h * h)
+
+
+def cell_det_builder(nets, lam, N, prec):
+    """A function (l, m, p, q) -> :func:`cell_det_form`, building each :func:`piece_det_form` once."""
+    forms = {}
+
+    def piece_form(*key):
+        if key not in forms:
+            forms[key] = piece_det_form(nets, lam, *key, prec)
+        return forms[key]
+
+    return lambda l, m, p, q: cell_det_form(piece_form, N, l, m, p, q, prec)
 
 
 def corner_det_form(nets, lam, N, name, prec):
