@@ -17,6 +17,7 @@ from pathlib import Path
 from flint import arb, ctx, fmpq
 
 from ccproof.certify.verify import C1_SCHEMA, SCHEMA
+from ccproof.certify.verify.injectivity import form_patches
 from ccproof.certify.verify.interval import hull_nets, interval_cells, lam_interval_ok, parameter_nets
 from ccproof.certify.verify.maps import (
     STAR_CURVES,
@@ -133,7 +134,7 @@ def prove_valence(k, prec=DEFAULT_PREC, progress=True):
         nets = nets_for_valence(k, prec)
         N = smallest_level(nets, lam)
         regularity = {n: prove_positive(regularity_form(nets, n, prec), (0, 1), f"det J_Phi on {n}")
-                      for n in PATCHES}
+                      for n in form_patches(derivation().symmetric)}
         cells = {}
         todo = required_cells(nets, lam, N, prec, derivation().symmetric)
         it = todo
@@ -146,7 +147,7 @@ def prove_valence(k, prec=DEFAULT_PREC, progress=True):
             root = build(l, m, p, q)
             cells[f"{l},{m},{p},{q}"] = prove_positive(root, (0, 1), f"cell ({l},{m}) piece ({p},{q})")
         corner = {n: prove_positive(corner_det_form(nets, lam, N, n, prec), (2, 3, 0, 1),
-                                    f"corner {n}") for n in PATCHES}
+                                    f"corner {n}") for n in form_patches(derivation().symmetric)}
     return {"schema": SCHEMA, "valence": k, "N": N, "prec": prec,
             "parts": {"regularity": regularity, "cells": cells, "corner": corner}}
 
@@ -185,9 +186,9 @@ def _prove_piece(exact, La, Lb, N, degree, trunc, prec, progress, label):
         if not square_inside_image(nets):
             raise ProofFailed(f"{label}: [0,1/2]^2 not certainly inside Phi([0,1]^2)")
         regularity = {n: prove_positive(regularity_form(nets, n, prec), (0, 1), f"{label} det J_Phi on {n}")
-                      for n in PATCHES}
+                      for n in form_patches(derivation().symmetric)}
         corner = {n: prove_positive(corner_det_form(nets, lam, N, n, prec), (2, 3, 0, 1),
-                                    f"{label} corner {n}") for n in PATCHES}
+                                    f"{label} corner {n}") for n in form_patches(derivation().symmetric)}
         todo = interval_cells(zn, N, trunc, prec, derivation().symmetric)
         it = todo
         if progress:

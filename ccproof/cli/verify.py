@@ -79,7 +79,7 @@ def run(args):
         "" if not bad else "; failed: " + ", ".join(str(r.path) for r in bad)))
     if args.all:
         ok_all = True
-        for label, schema in (("C1 (Reif)", "ccproof.c1/2"), ("injectivity (Appendix A)", "ccproof.injectivity/2")):
+        for label, schema in (("C1 (Reif)", "ccproof.c1/2"), ("injectivity (Appendix A)", "ccproof.injectivity/3")):
             ok, msg = check_coverage([r.valence for r in results if r and r.schema == schema])
             print(f"{label} coverage: {'OK' if ok else 'INCOMPLETE'}: {msg}")
             ok_all &= ok

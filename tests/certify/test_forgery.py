@@ -72,18 +72,19 @@ def test_scaled_nets_with_a_regenerated_certificate(monkeypatch):
         nets = {n: [[tuple(x * arb("1.01") for x in p) for p in row] for row in net]
                 for n, net in St.nets_for_valence(5, 128).items()}
     forged = _prove_with_nets_of(monkeypatch, 5, nets, St.c_lam(5, 128)[1])
-    failed_with(forged, "FAIL  B regularity P1", "is not above the claimed bound")
+    failed_with(forged, "FAIL  B regularity P2", "is not above the claimed bound")
 
 
 def test_asymmetric_perturbation_under_the_symmetry_shortcut(monkeypatch):
-    """P1's nets alone scaled by 1.05 (P3 left alone, so the map is no longer mirror-symmetric) while the
-    prover keeps the shortcut: its boxes describe a map that is not the characteristic map, and the
-    verifier, which derives the nets (and the symmetry) itself, names the part that does not hold."""
+    """P3's nets alone scaled by 1.05 (P1 left alone, so the map is no longer mirror-symmetric) while the
+    prover keeps the shortcut (parts B, D, E on the side u <= v only): its boxes describe a map that is
+    not the characteristic map, and the verifier, which derives the nets (and the symmetry) itself, names
+    the part that does not hold."""
     with ctx.workprec(128):
         nets = St.nets_for_valence(5, 128)
-        nets = dict(nets, P1=[[tuple(x * arb("1.05") for x in p) for p in row] for row in nets["P1"]])
+        nets = dict(nets, P3=[[tuple(x * arb("1.05") for x in p) for p in row] for row in nets["P3"]])
     forged = _prove_with_nets_of(monkeypatch, 5, nets, St.c_lam(5, 128)[1])
-    failed_with(forged, "FAIL  B regularity P1")
+    failed_with(forged, "FAIL  B regularity P3")
 
 
 def test_lam_excluding_the_root(monkeypatch):
@@ -137,15 +138,15 @@ def test_a_faked_summary_is_rejected_and_report_shows_only_verified_numbers(tmp_
     assert _row(p)["ok"] is False and "detPhi" not in _row(p)
     p.write_text(json.dumps(load(5)))
     row = _row(p)
-    claimed = min(float(V.replay.parse_decimal(b["bound"])) for n in St.PATCHES
-                  for b in load(5)["parts"]["regularity"][n])
+    claimed = min(float(V.replay.parse_decimal(b["bound"])) for boxes in load(5)["parts"]["regularity"].values()
+                  for b in boxes)
     assert row["ok"] and abs(row["detPhi"] - 4 * claimed) < 1e-12
 
 
 @pytest.mark.parametrize("bound", ["1e-999999999", "1e999999999", "1" * 5001, "0." + "0" * 70 + "1", "1e-401"])
 def test_huge_tiny_and_overlong_decimals_fail_fast(bound, tmp_path):
     c = load(5)
-    c["parts"]["corner"]["P1"][0]["bound"] = bound
+    c["parts"]["corner"]["P2"][0]["bound"] = bound
     p = tmp_path / "k.json"
     p.write_text(json.dumps(c))
     t = time.perf_counter()

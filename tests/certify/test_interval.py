@@ -149,13 +149,13 @@ def test_widened_to_valence_3_fails(cert):
 
 def test_widened_to_k0_30_fails(cert):
     # lam(30) = 0.651308: the range claim holds, but the bounds claimed for k >= 40 are not established
-    # on the wider range (the hull of the nets grows; det J_Phi's claimed 0.0866 on P1 is no longer below
+    # on the wider range (the hull of the nets grows; det J_Phi's claimed bound on P2 is no longer below
     # every coefficient), so the verifier names the part and stops
     bad = copy.deepcopy(cert)
     bad["pieces"][0]["lam"][0] = "0.6513"
     ok, log = run(bad)
     assert not ok
-    assert "PASS  lam(k) in" in log and "FAIL  [piece 0] B regularity P1" in log, log
+    assert "PASS  lam(k) in" in log and "FAIL  [piece 0] B regularity P2" in log, log
 
 
 def test_pieces_must_be_contiguous(cert):

@@ -45,7 +45,7 @@ def test_box_removed(cert3):
 
 def test_box_removed_from_a_split_part(cert3):
     c = copy.deepcopy(cert3)
-    c["parts"]["regularity"]["P1"] = [{"path": "0L", "bound": "0.001"}]
+    c["parts"]["regularity"]["P2"] = [{"path": "0L", "bound": "0.001"}]
     ok, log = run(c)
     assert not ok and "do not partition" in log
 
@@ -62,7 +62,7 @@ def test_bound_raised_above_true_minimum(cert3):
     c = copy.deepcopy(cert3)
     # the minimum of det J_G / h^2 on the corner is about 0.132 for k = 3 (docs/readings.md R9; the float
     # sampling in test_prover shows the certified bound is within 0.01 of it): claim 0.2 everywhere
-    for name in ("P1", "P2", "P3"):
+    for name in c["parts"]["corner"]:
         for b in c["parts"]["corner"][name]:
             b["bound"] = "0.2"
     ok, log = run(c)
@@ -91,8 +91,8 @@ def test_N_lowered_to_three_for_k8():
         (lambda c: c.update(schema="ccproof.injectivity/1"), "unknown certificate schema"),  # old format: has a table
         (lambda c: c.pop("parts"), "missing field"),
         (lambda c: c.update(valence="5"), "wrong type"),
-        (lambda c: c["parts"]["corner"]["P1"][0].update(path="9Q"), "malformed box path"),
-        (lambda c: c["parts"]["corner"]["P1"][0].update(bound="1/3"), "not a decimal string"),
+        (lambda c: c["parts"]["corner"]["P2"][0].update(path="9Q"), "malformed box path"),
+        (lambda c: c["parts"]["corner"]["P2"][0].update(bound="1/3"), "not a decimal string"),
         (lambda c: c.update(summary={"min_bound_det_J_phi_local": "1"}), "unknown field"),
         (lambda c: c.update(table={"hash": "sha256:0"}), "unknown field"),
         (lambda c: c["parts"].update(extra={}), "unknown field"),

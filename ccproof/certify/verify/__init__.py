@@ -61,7 +61,7 @@ def verify_file(path, log=print, tables_dir=None):
     Parameters
     ----------
     path : str or Path
-        A certificate file (JSON, schema ``ccproof.injectivity/2`` or ``ccproof.c1/2``).
+        A certificate file (JSON, schema ``ccproof.injectivity/3`` or ``ccproof.c1/2``).
     log : callable
         Receives each output line (default ``print``).
     tables_dir : ignored

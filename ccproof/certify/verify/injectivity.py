@@ -32,7 +32,7 @@ from .record import exact_keys, field_of, kname
 from .replay import check_boxes, parse_decimal, parse_path
 from .statement import PATCHES, StatementError, c_lam, derivation, nets_for_valence
 
-SCHEMA = "ccproof.injectivity/2"
+SCHEMA = "ccproof.injectivity/3"
 _CELL_KEY = re.compile(r"[0-9]{1,4},[0-9]{1,4},[0-2],[0-2]")
 
 
@@ -56,13 +56,21 @@ def check_hypotheses(nets, lam, part, tag=""):
          "" if ok and quadrant else ("lam fails" if not ok else "an outer control point may leave the quadrant"))
 
 
+def form_patches(symmetric):
+    """The pieces whose forms parts B and E check: all three, or P2 and P3 under the mirror symmetry
+    (exact, part S), which maps P1's det J_Phi and corner form onto P3's with (s, t) swapped
+    (docs/appendix_a.md section 8), as part D keeps only the cells with l <= m."""
+    return ("P2", "P3") if symmetric else PATCHES
+
+
 def _check_structure(parts, cell_vars):
     """Validate every box list before any arithmetic, so a malformed file fails fast and by name."""
     exact_keys(parts, ("regularity", "cells", "corner"), "parts")
+    patches = form_patches(derivation().symmetric)
     for section, nvars in (("regularity", 2), ("cells", cell_vars), ("corner", 4)):
         sec = field_of(parts, section, dict, "parts")
         if section != "cells":
-            exact_keys(sec, PATCHES, f"parts.{section}")
+            exact_keys(sec, patches, f"parts.{section}")
         for key, boxes in sec.items():
             if section == "cells" and not (isinstance(key, str) and _CELL_KEY.fullmatch(key)):
                 raise CertificateError(f"parts.cells: malformed key {key!r} (expected 'l,m,p,q')")
@@ -147,7 +155,7 @@ def check_parts(parts, nets, lam, N, prec, cells, part, tag):
 
 def _check_sections(parts, sec, label, build, part, tag):
     mins = []
-    for name in PATCHES:
+    for name in form_patches(derivation().symmetric):
         ok, msg, mb = check_boxes(build(name), parts[sec][name], f"{sec} {name}")
         if not ok:
             part(f"{tag}{label[0]} {sec} {name}", False, msg)
