@@ -11,7 +11,8 @@ file names             ``k007.json``              ``k_ge_40.json``
 =====================  =========================  =============================
 
 :meth:`Valence.parse` reads any of them (and an ``int`` or another :class:`Valence`); ``str``,
-:meth:`Valence.to_json` and :meth:`Valence.stem` write them. Imports nothing from ccproof but
+:meth:`Valence.to_json` and :meth:`Valence.stem` write them. :func:`lam_from_c` is the one formula of the
+subdominant eigenvalue lam(k) outside the verifier, in any arithmetic. Imports nothing from ccproof but
 :mod:`ccproof.errors` (bottom layer). The trusted verifier (``ccproof.certify.verify``) keeps its own
 reader on purpose (it imports nothing of the package outside the trusted base, docs/trusted_base.md).
 
@@ -24,8 +25,11 @@ reader on purpose (it imports nothing of the package outside the trusted base, d
 
 from __future__ import annotations
 
+import math
 import re
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 from ccproof.errors import ValenceError, check_valence
 
@@ -131,3 +135,37 @@ def parse_valence(value) -> Valence:
     Valence('>=40')
     """
     return Valence.parse(value)
+
+
+def lam_from_c(c: Any, sqrt: Callable[[Any], Any] = math.sqrt) -> Any:
+    """The subdominant eigenvalue lam = (5 + c + sqrt((1 + c)(9 + c)))/16 of valence k, c = cos(2 pi/k).
+
+    The larger root of 16 lam^2 - 2(5 + c) lam + 1 = 0, the double eigenvalue lam_1 = lam_2 of the
+    Catmull-Clark subdivision matrix (bmz04 section 3, Definition 4; docs/readings.md R2). The one copy
+    of the formula outside the trusted verifier (which keeps its own, docs/trusted_base.md), written once
+    for every arithmetic: ``sqrt`` is the square root of the arithmetic of ``c``.
+
+    Parameters
+    ----------
+    c : float or ndarray or flint.arb or sympy.Expr
+        cos(2 pi/k), or an enclosure of it (an arb ball), or an array of values.
+    sqrt : callable
+        ``math.sqrt`` (default, floats), ``numpy.sqrt`` (arrays), ``flint.arb.sqrt`` (balls: the result
+        encloses lam(c) for every c in the ball) or ``sympy.sqrt`` (exact).
+
+    Returns
+    -------
+    same type as ``c``
+
+    Examples
+    --------
+    >>> lam_from_c(0.0)                         # k = 4
+    0.5
+    >>> import sympy
+    >>> lam_from_c(sympy.Rational(-1, 2), sympy.sqrt)      # k = 3: lam = (9 + sqrt 17)/32
+    sqrt(17)/32 + 9/32
+    >>> from flint import arb
+    >>> lam_from_c(arb(1), arb.sqrt).contains((3 + arb(5).sqrt()) / 8)    # the limit k -> infinity
+    True
+    """
+    return (5 + c + sqrt((1 + c) * (9 + c))) / 16

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 from ccproof.algebra.field import eval_integer_form, subdominant_lam_sympy
 from ccproof.errors import CCProofError, check_valence
+from ccproof.valence import lam_from_c
 
 ARITHMETICS = ("exact", "arb", "float")
 
@@ -52,7 +53,9 @@ def cos_2pi_over_k(k, arithmetic="arb", prec=128):
 
 
 def _lam_from_c_arb(c):
-    return (5 + c + ((1 + c) * (9 + c)).sqrt()) / 16
+    from flint import arb
+
+    return lam_from_c(c, arb.sqrt)
 
 
 def subdominant_eigenvalue(k, arithmetic="arb", prec=128):

@@ -27,6 +27,7 @@ from ccproof.tables.format import (
     table_nets_exact,
     table_path,
 )
+from ccproof.valence import lam_from_c
 
 
 @dataclass(frozen=True)
@@ -118,17 +119,6 @@ class ArbCharacteristic:
 BSPLINE_TO_BEZIER_6 = ((1, 4, 1, 0), (0, 4, 2, 0), (0, 2, 4, 0), (0, 1, 4, 1))
 
 
-def lam_from_c(c):
-    """lam = (5 + c + sqrt((1 + c)(9 + c)))/16, the ``lam_definition`` written in every table (R2),
-    for a ball c (python-flint ``arb``).
-
-    >>> from flint import arb
-    >>> lam_from_c(arb(0))
-    0.500000000000000
-    """
-    return (5 + c + ((1 + c) * (9 + c)).sqrt()) / 16
-
-
 @lru_cache(maxsize=8)
 def _exact_source(directory=None):
     """(exact B-spline nets, hash) of a table: the integer forms are the same in every table."""
@@ -144,8 +134,8 @@ def characteristic_arb(k, prec=128):
 
     From the certified table of valence k when it exists and ``prec`` does not exceed its
     precision; otherwise from the exact nets of a table, evaluated in arb at ``prec`` bits with
-    c = cos(2 pi/k) and :func:`lam_from_c`, then converted to Bezier form with
-    :data:`BSPLINE_TO_BEZIER_6` (no symbolic computation). Raises
+    c = cos(2 pi/k) and lam from :func:`ccproof.valence.lam_from_c` (the table's ``lam_definition``),
+    then converted to Bezier form with :data:`BSPLINE_TO_BEZIER_6` (no symbolic computation). Raises
     :class:`~ccproof.errors.TableNotFoundError` when no table exists at all.
 
     Parameters
@@ -182,7 +172,7 @@ def characteristic_arb(k, prec=128):
     exact, source = _exact_source()
     with ctx.workprec(prec + 32):
         c = arb(fmpq(2, k)).cos_pi()
-        lam = lam_from_c(c)
+        lam = lam_from_c(c, arb.sqrt)
         nets = {}
         for name in PATCHES:
             bs = [[tuple(eval_form_arb(q, c, lam) for q in p) for p in row] for row in exact[name]]
