@@ -29,6 +29,7 @@ import math
 import re
 from collections.abc import Callable
 from dataclasses import dataclass
+from numbers import Integral
 from typing import Any
 
 from ccproof.errors import ValenceError, check_valence
@@ -81,9 +82,7 @@ class Valence:
         if isinstance(value, Valence):
             return value
         if isinstance(value, dict):
-            if set(value) != {"min"} or isinstance(value["min"], bool):
-                raise ValenceError(f'a valence interval must be {{"min": k0}}, got {value!r}')
-            return cls(value["min"], interval=True)
+            return cls.from_json(value)
         if isinstance(value, str):
             text = value.strip()
             m = _TEXT_INTERVAL.match(text)
@@ -93,6 +92,27 @@ class Valence:
             if m:
                 return cls(int(m.group(1) or m.group(2)), interval=m.group(1) is not None)
             return cls(text)
+        return cls(value)
+
+    @classmethod
+    def from_json(cls, value) -> Valence:
+        """Read the JSON spelling only (the ``valence`` field of tables and certificates): an int k >= 3
+        or ``{"min": k0}`` with an int k0 >= 3; anything else (a string, a bool, a float) raises
+        :class:`~ccproof.errors.ValenceError`.
+
+        >>> Valence.from_json(7), Valence.from_json({"min": 40})
+        (Valence('7'), Valence('>=40'))
+        >>> Valence.from_json("7")
+        Traceback (most recent call last):
+        ...
+        ccproof.errors.ValenceError: a valence field must be an int k >= 3 or {"min": k0}, got '7'
+        """
+        if isinstance(value, dict):
+            if set(value) != {"min"} or isinstance(value["min"], bool) or not isinstance(value["min"], Integral):
+                raise ValenceError(f'a valence interval must be {{"min": k0}}, got {value!r}')
+            return cls(value["min"], interval=True)
+        if isinstance(value, bool) or not isinstance(value, Integral):
+            raise ValenceError(f'a valence field must be an int k >= 3 or {{"min": k0}}, got {value!r}')
         return cls(value)
 
     def __str__(self) -> str:

@@ -30,9 +30,10 @@ from ccproof.certify.verify.maps import (
 )
 from ccproof.certify.verify.replay import parse_decimal
 from ccproof.certify.verify.statement import PATCHES, c_lam, derivation, nets_for_valence
-from ccproof.errors import CCProofError, check_valence
+from ccproof.errors import CCProofError, ValenceError, check_valence
 from ccproof.rigorous import bernstein_coefficients, certainly_positive, lower_bound
 from ccproof.tables.format import certificates_dir
+from ccproof.valence import Valence
 
 DEFAULT_PREC = 128
 MAX_DEPTH = 14
@@ -219,9 +220,10 @@ def _waves(k0, ends, N, taylor_degree, truncation_degree, prec, max_pieces, sche
     from ccproof.scale.engine import run_tasks
 
     todo, pieces = [(ends[0], ends[1])], []
+    name = f"k{Valence(k0, interval=True)}"
     while todo:
-        tasks = [(a, b, N, taylor_degree, truncation_degree, prec, f"k>={k0} lam in [{a}, {b}]") for a, b in todo]
-        sweep = run_tasks(piece, tasks, scheduler, desc=f"k>={k0} lam pieces", unit="piece", raise_errors=False,
+        tasks = [(a, b, N, taylor_degree, truncation_degree, prec, f"{name} lam in [{a}, {b}]") for a, b in todo]
+        sweep = run_tasks(piece, tasks, scheduler, desc=f"{name} lam pieces", unit="piece", raise_errors=False,
                           retries=2, deterministic=(ProofFailed,), names=[t[-1] for t in tasks])
         failed = []
         for (a, b), parts in zip(todo, sweep.results):
@@ -252,19 +254,22 @@ def prove_interval(k0, prec=DEFAULT_PREC, progress=True, taylor_degree=3, trunca
     ``scheduler`` (a :func:`ccproof.scale.engine.parse_scheduler` spec or a Client): run the pieces of each
     bisection wave as tasks there; None keeps the serial search. Both give the same certificate.
     """
-    k = _parse_k(f">={k0}" if isinstance(k0, int) else k0)
+    v = Valence(k0, interval=True) if isinstance(k0, int) else Valence.parse(k0)
+    if not v.interval:
+        raise ValenceError(f"prove_interval proves every valence k >= k0: give k0 or '>=K0', got {k0!r}")
+    k = v.to_json()
     exact = derivation().integer_forms("bspline")
-    ends = _lam_range(k["min"], prec)
+    ends = _lam_range(v.k, prec)
     with ctx.workprec(prec):
         La, Lb = parse_decimal(ends[0]), parse_decimal(ends[1])
         N = smallest_level(hull_nets(parameter_nets(exact, La, Lb, 0, taylor_degree, prec), prec),
                            arb(La).union(arb(Lb)))
     todo = [(ends[0], ends[1])] if scheduler is None else []
     pieces = [] if scheduler is None else _pieces_in_waves(
-        k["min"], ends, N, taylor_degree, truncation_degree, prec, max_pieces, scheduler)
+        v.k, ends, N, taylor_degree, truncation_degree, prec, max_pieces, scheduler)
     while todo:
         a, b = todo.pop(0)
-        label = f"k>={k['min']} lam in [{a}, {b}]"
+        label = f"k{v} lam in [{a}, {b}]"
         try:
             parts = _prove_piece(exact, parse_decimal(a), parse_decimal(b), N, taylor_degree, truncation_degree,
                                  prec, progress, label)
@@ -296,16 +301,14 @@ def _summary(parts_list):
     return summary, sum(len(v) for parts in parts_list for sec in parts.values() for v in sec.values())
 
 
-def _kname(k):
-    return f">={k['min']}" if isinstance(k, dict) else str(k)
-
-
 def certificate_path(k, directory=None):
-    """``k005.json`` for a valence, ``k_ge_40.json`` for the interval ``{"min": 40}``/``">=40"``."""
-    if isinstance(k, str) and k.startswith(">="):
-        k = {"min": int(k[2:])}
-    name = f"k_ge_{int(k['min'])}.json" if isinstance(k, dict) else f"k{int(k):03d}.json"
-    return Path(directory or certificates_dir() / "injectivity") / name
+    """``k005.json`` for a valence, ``k_ge_40.json`` for the interval ``{"min": 40}``/``">=40"`` (any spelling
+    of :meth:`ccproof.valence.Valence.parse`), in ``directory`` or the injectivity certificates folder.
+
+    >>> certificate_path(5, "d").as_posix(), certificate_path({"min": 40}, "d").name
+    ('d/k005.json', 'k_ge_40.json')
+    """
+    return Path(directory or certificates_dir() / "injectivity") / (Valence.parse(k).stem + ".json")
 
 
 def write_certificate(cert, path=None):
@@ -313,14 +316,6 @@ def write_certificate(cert, path=None):
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(json.dumps(cert, indent=1, sort_keys=True) + "\n", encoding="ascii")
     return path
-
-
-def _parse_k(k):
-    if isinstance(k, str) and k.strip().startswith(">="):
-        return {"min": check_valence(k.strip()[2:])}
-    if isinstance(k, dict):
-        return {"min": check_valence(k["min"])}
-    return check_valence(k)
 
 
 def prove_c1(k, prec=DEFAULT_PREC):
@@ -344,23 +339,23 @@ def prove_c1(k, prec=DEFAULT_PREC):
     >>> cert["schema"], sorted(cert["parts"]["star"])
     ('ccproof.c1/2', ['P1s1', 'P2s1', 'P2t1', 'P3t1'])
     """
-    k = _parse_k(k)
+    v = Valence.parse(k)
+    k = v.to_json()
     with ctx.workprec(prec):
-        if isinstance(k, dict):
-            ends = _lam_range(k["min"], prec)
+        if v.interval:
+            ends = _lam_range(v.k, prec)
             La, Lb = parse_decimal(ends[0]), parse_decimal(ends[1])
             nets = hull_nets(parameter_nets(derivation().integer_forms("bspline"), La, Lb, 0, 3, prec), prec)
         else:
-            nets = nets_for_valence(k, prec)
+            nets = nets_for_valence(v.k, prec)
         reg = {n: prove_positive(regularity_form(nets, n, prec), (0, 1), f"det J_Phi on {n}") for n in PATCHES}
         star = {c: prove_positive(star_form(nets, c, prec), (0,), f"star {c}") for c in STAR_CURVES}
     parts = {"regularity": reg, "star": star}
-    if isinstance(k, dict):
+    if v.interval:
         return {"schema": C1_SCHEMA, "valence": k, "prec": prec, "pieces": [{"lam": ends, "parts": parts}]}
     return {"schema": C1_SCHEMA, "valence": k, "prec": prec, "parts": parts}
 
 
 def c1_certificate_path(k, directory=None):
-    k = _parse_k(k)
-    name = f"k_ge_{k['min']}.json" if isinstance(k, dict) else f"k{k:03d}.json"
-    return Path(directory or certificates_dir() / "c1") / name
+    """:func:`certificate_path` in the C1 certificates folder."""
+    return Path(directory or certificates_dir() / "c1") / (Valence.parse(k).stem + ".json")

@@ -31,13 +31,6 @@ DEFAULT_K_RANGE = range(3, 101)
 DEFAULT_INTERVAL_K0 = 40
 
 
-def _parse_valence(k):
-    """The int k or the text ``">=K0"`` that :mod:`ccproof.algebra.specialize` takes, from any spelling
-    :meth:`ccproof.valence.Valence.parse` reads."""
-    v = Valence.parse(k)
-    return str(v) if v.interval else v.k
-
-
 def _forms(x, y):
     return [{"form": list(map(list, x.integer_form())), "text": integer_form_string(x.integer_form())},
             {"form": list(map(list, y.integer_form())), "text": integer_form_string(y.integer_form())}]
@@ -223,12 +216,12 @@ def build_table(k, prec=DEFAULT_PREC):
     from ccproof.algebra.specialize import subdominant_eigenvalue
     from ccproof.algebra.spectrum import spectral_conditions
 
-    k = _parse_valence(k)
-    interval = isinstance(k, str)
-    bez = characteristic_map_patches(k, "bezier", "arb", prec)
-    bsp = characteristic_map_patches(k, "bspline", "arb", prec)
+    v = Valence.parse(k)
+    interval = v.interval
+    bez = characteristic_map_patches(v, "bezier", "arb", prec)
+    bsp = characteristic_map_patches(v, "bspline", "arb", prec)
     if interval:
-        k0 = int(k[2:])
+        k0 = v.k
         c, lam = valence_interval(k0, prec)
         with ctx.workprec(prec):
             # all k >= k0: (28 lam - 3)/k - 2(1 - c) lam > 0 follows from 28 lam - 3 > 4 pi^2 lam / k0
@@ -238,9 +231,9 @@ def build_table(k, prec=DEFAULT_PREC):
     else:
         from ccproof.algebra.specialize import cos_2pi_over_k
 
-        c = cos_2pi_over_k(k, "arb", prec)
-        lam = subdominant_eigenvalue(k, "arb", prec)
-        sc = spectral_conditions(k, prec)
+        c = cos_2pi_over_k(v.k, "arb", prec)
+        lam = subdominant_eigenvalue(v.k, "arb", prec)
+        sc = spectral_conditions(v.k, prec)
         spectral = {"argument": "Fourier blocks (exact charpoly check in tests)", "gap": arb_to_json(sc["gap"]),
                     "ok": sc["ok"]}
     derived = _derived(bez, lam, prec)
@@ -257,7 +250,7 @@ def build_table(k, prec=DEFAULT_PREC):
 
     table = {
         "schema": SCHEMA,
-        "valence": Valence.parse(k).to_json(),
+        "valence": v.to_json(),
         "c_definition": "cos(2*pi/k)" + (" for every integer k >= k0" if interval else ""),
         "lam_definition": "(5 + c + sqrt((1 + c)*(9 + c)))/16, the larger root of 16 lam^2 - 2(5 + c) lam + 1",
         "frame": "normalized: e0 -> (1,0), e1 -> (0,1), Phi(1,0) = (1,0) (docs/readings.md R3)",
