@@ -253,6 +253,43 @@ def prove_interval(k0, prec=DEFAULT_PREC, progress=True, taylor_degree=3, trunca
     ~0.02 wide against cell margins of ~4e-4). A piece that fails is bisected (up to ``max_pieces``).
     ``scheduler`` (a :func:`ccproof.scale.engine.parse_scheduler` spec or a Client): run the pieces of each
     bisection wave as tasks there; None keeps the serial search. Both give the same certificate.
+
+    Parameters
+    ----------
+    k0 : int or str or dict or Valence
+        The smallest valence of the interval: an int k0 >= 3 or an interval in any spelling of
+        :meth:`ccproof.valence.Valence.parse` (``">=40"``, ``{"min": 40}``); a single valence such as
+        ``"7"`` raises :class:`~ccproof.errors.ValenceError` (use :func:`prove_valence`).
+    prec : int
+        arb precision in bits of every Bernstein coefficient (written into the certificate).
+    progress : bool
+        Progress bars over the cells of each piece (serial search only).
+    taylor_degree : int
+        Degree in zeta of the Taylor models of the nets.
+    truncation_degree : int
+        zeta degree kept in the Taylor models of the cell determinants (part D).
+    max_pieces : int
+        Most lam pieces of the bisection; :class:`ProofFailed` beyond.
+    scheduler : str or distributed.Client, optional
+        Where the pieces of each bisection wave run (see above).
+
+    Returns
+    -------
+    dict
+        The certificate (docs/certificates.md): ``schema``, ``valence`` = ``{"min": k0}``, the level ``N``,
+        ``prec``, ``parameter`` (the degrees) and ``pieces``, a list in lam order of
+        ``{"lam": [La, Lb], "parts": {"regularity", "cells", "corner"}}`` (decimal strings and boxes).
+        Raises :class:`ProofFailed` when a piece still fails after ``max_pieces`` pieces.
+
+    Notes
+    -----
+    No doctest: the corner level N = 5 is set by the upper end (3 + sqrt 5)/8 = 0.6545 of the lam range,
+    whatever k0 (measured for k0 = 40, 100, 1000), so even a single piece has 231 cells of Taylor-model
+    Bernstein forms: one piece takes about a minute (k0 = 1000, the default degrees) and still ~25 s at
+    ``prec=64, taylor_degree=2, truncation_degree=1``. The published
+    ``k_ge_40.json`` is re-checked in tests/certify/test_interval.py; from the command line::
+
+        ccproof certify '>=40'
     """
     v = Valence(k0, interval=True) if isinstance(k0, int) else Valence.parse(k0)
     if not v.interval:

@@ -496,7 +496,44 @@ def compare(mesh, labels=None, methods=METHODS, levels=3, start_level=1, eval_le
 
 def parameterize(mesh, labels=None, variant="extended", levels=3, start_level=1, eval_level=5, tol=1e-6,
                  max_iter=1000):
-    """hsh10 parameterization of every chart: variant "extended" (c) or "boundary" (b)."""
+    """hsh10 parameterization of every chart: variant "extended" (c) or "boundary" (b).
+
+    The texture minimizing the ARAP energy of the limit surface (hsh10 Eq. 1), optimized level by level
+    (module docstring) and measured with :func:`texture_metrics`; the methods "a", "d" and the
+    comparison are :func:`compare`.
+
+    Parameters
+    ----------
+    mesh : QuadMesh
+        The control mesh; without ``labels`` it must be a disk (one chart).
+    labels : array_like of int, shape (n_faces,), optional
+        Chart label of every face (negative: in no chart); every chart must be a disk.
+    variant : {"extended", "boundary"}
+        hsh10's extended charts (method "c") or boundary rules (method "b").
+    levels, start_level, eval_level : int
+        Last and first optimization level, and the level of the metric samples (docs/hsh10.md A9).
+    tol : float
+        Relative energy decrease per iteration below which a level stops.
+    max_iter : int
+        Iterations per level at most.
+
+    Returns
+    -------
+    MethodResult
+        ``textures``: one :class:`ChartTexture` per chart (``values`` of shape (n_unknowns, 2), the texture
+        coordinates of the chart's control points at level ``level``), ``metrics``: E_angle, E_area,
+        E_stretch (hsh10 section 6), ``iterations``, ``seconds``, flipped control triangles.
+
+    Examples
+    --------
+    A planar grid is developable: its parameterization is an isometry, where E_angle and E_area reach
+    their minimum 2 and E_stretch its minimum 1 (docs/hsh10.md A9):
+
+    >>> from ccproof.mesh.examples import grid
+    >>> res = parameterize(grid(3, 3), levels=1, eval_level=2)
+    >>> res.textures[0].values.shape, [round(e, 6) for e in res.metrics.as_tuple()], res.metrics.flips
+    ((16, 2), [2.0, 2.0, 1.0], 0)
+    """
     if variant not in VARIANTS:
         raise CCProofError(f"unknown variant {variant!r}; expected one of {tuple(VARIANTS)}")
     res, hs = compare(mesh, labels, (VARIANTS[variant],), levels, start_level, eval_level, tol, max_iter)
