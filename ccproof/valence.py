@@ -27,10 +27,10 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from numbers import Integral
-from typing import Any
+from typing import Any, SupportsIndex, TypeAlias
 
 from ccproof.errors import ValenceError, check_valence
 
@@ -64,12 +64,12 @@ class Valence:
     interval: bool
     k: int
 
-    def __init__(self, k, interval=False):
+    def __init__(self, k: SupportsIndex | str, interval: bool = False) -> None:
         object.__setattr__(self, "interval", bool(interval))
         object.__setattr__(self, "k", check_valence(k))
 
     @classmethod
-    def parse(cls, value) -> Valence:
+    def parse(cls, value: ValenceLike) -> Valence:
         """Read a valence in any spelling of the module table; raises :class:`~ccproof.errors.ValenceError`.
 
         >>> [str(Valence.parse(x)) for x in (5, "5", " >= 40 ", {"min": 41}, "k_ge_42", "k007.json")]
@@ -81,7 +81,7 @@ class Valence:
         """
         if isinstance(value, Valence):
             return value
-        if isinstance(value, dict):
+        if isinstance(value, Mapping):
             return cls.from_json(value)
         if isinstance(value, str):
             text = value.strip()
@@ -95,7 +95,7 @@ class Valence:
         return cls(value)
 
     @classmethod
-    def from_json(cls, value) -> Valence:
+    def from_json(cls, value: object) -> Valence:
         """Read the JSON spelling only (the ``valence`` field of tables and certificates): an int k >= 3
         or ``{"min": k0}`` with an int k0 >= 3; anything else (a string, a bool, a float) raises
         :class:`~ccproof.errors.ValenceError`.
@@ -107,7 +107,7 @@ class Valence:
         ...
         ccproof.errors.ValenceError: a valence field must be an int k >= 3 or {"min": k0}, got '7'
         """
-        if isinstance(value, dict):
+        if isinstance(value, Mapping):
             if set(value) != {"min"} or isinstance(value["min"], bool) or not isinstance(value["min"], Integral):
                 raise ValenceError(f'a valence interval must be {{"min": k0}}, got {value!r}')
             return cls(value["min"], interval=True)
@@ -121,7 +121,7 @@ class Valence:
     def __repr__(self) -> str:
         return f"Valence({str(self)!r})"
 
-    def to_json(self):
+    def to_json(self) -> int | dict[str, int]:
         """``k`` (int) or ``{"min": k0}``: the spelling of tables and certificates.
 
         >>> Valence.parse(">=40").to_json()
@@ -138,7 +138,7 @@ class Valence:
         """
         return f"k_ge_{self.k}" if self.interval else f"k{self.k:03d}"
 
-    def contains(self, k) -> bool:
+    def contains(self, k: int) -> bool:
         """Whether the single valence ``k`` is this valence or lies in this interval.
 
         >>> Valence.parse(">=40").contains(39), Valence(5).contains(5)
@@ -148,7 +148,12 @@ class Valence:
         return k >= self.k if self.interval else k == self.k
 
 
-def parse_valence(value) -> Valence:
+#: every spelling :meth:`Valence.parse` reads: an int, a text (``"7"``, ``">=40"``, ``"k_ge_40.json"``), the
+#: JSON ``{"min": k0}`` or a :class:`Valence`
+ValenceLike: TypeAlias = "int | str | Mapping[str, int] | Valence"
+
+
+def parse_valence(value: ValenceLike) -> Valence:
     """:meth:`Valence.parse` as a function (for argparse ``type=``: ``ccproof table '>=40'``).
 
     >>> parse_valence(">=40")

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import Any
 
 from flint import arb, ctx, fmpq
 
@@ -33,7 +34,7 @@ from ccproof.certify.verify.statement import PATCHES, c_lam, derivation, nets_fo
 from ccproof.errors import CCProofError, ValenceError, check_valence
 from ccproof.rigorous import bernstein_coefficients, certainly_positive, lower_bound
 from ccproof.tables.format import certificates_dir
-from ccproof.valence import Valence
+from ccproof.valence import Valence, ValenceLike
 
 DEFAULT_PREC = 128
 MAX_DEPTH = 14
@@ -105,7 +106,7 @@ def smallest_level(nets, lam, max_level=8):
     raise ProofFailed(f"no level N <= {max_level} maps the corner cell into [0,1/6)^2")
 
 
-def prove_valence(k, prec=DEFAULT_PREC, progress=True):
+def prove_valence(k: int, prec: int = DEFAULT_PREC, progress: bool = True) -> dict[str, Any]:
     """Search an injectivity certificate for valence k (bmz04 Appendix A as corrected in docs/appendix_a.md).
 
     Parameters
@@ -243,8 +244,8 @@ def _waves(k0, ends, N, taylor_degree, truncation_degree, prec, max_pieces, sche
     return pieces
 
 
-def prove_interval(k0, prec=DEFAULT_PREC, progress=True, taylor_degree=3, truncation_degree=2, max_pieces=16,
-                   scheduler=None):
+def prove_interval(k0: ValenceLike, prec: int = DEFAULT_PREC, progress: bool = True, taylor_degree: int = 3,
+                   truncation_degree: int = 2, max_pieces: int = 16, scheduler: object = None) -> dict[str, Any]:
     """Appendix-A certificate for every valence k >= k0 at once (docs/appendix_a.md section 6).
 
     lam runs over [La, Lb] with La <= lam(k0) and Lb >= (3 + sqrt 5)/8; the nets are Taylor models in
@@ -355,7 +356,7 @@ def write_certificate(cert, path=None):
     return path
 
 
-def prove_c1(k, prec=DEFAULT_PREC):
+def prove_c1(k: ValenceLike, prec: int = DEFAULT_PREC) -> dict[str, Any]:
     """C1 certificate (Reif's criterion) for valence k or the interval ``">=K0"``: det J_Phi > 0 on
     layer 0 and a star-shaped outer boundary, boxes found by subdivision; the spectral ordering is
     re-derived by the verifier from the rules (:mod:`ccproof.certify.verify.spectrum`).

@@ -19,12 +19,13 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import Any
 
 from ccproof.algebra.characteristic_map import symbolic_bspline_nets
 from ccproof.algebra.field import integer_form_string
 from ccproof.algebra.specialize import characteristic_map_patches, valence_interval
 from ccproof.tables.format import PATCHES, SCHEMA, arb_to_json, content_hash, table_path
-from ccproof.valence import Valence
+from ccproof.valence import Valence, ValenceLike
 
 DEFAULT_PREC = 128
 DEFAULT_K_RANGE = range(3, 101)
@@ -49,8 +50,10 @@ def _derived(nets_bez, lam, prec):
     from ccproof.rigorous import BernsteinForm, bernstein_jacobian_determinant, range_enclosure
 
     with ctx.workprec(prec):
-        det_lo, det_hi = None, None
-        max_lo, max_hi = None, None
+        det_lo: Any = None  # arb balls, once the first patch is done
+        det_hi: Any = None
+        max_lo: Any = None
+        max_hi: Any = None
         for name in PATCHES:
             net = nets_bez[name]
             X = BernsteinForm((4, 4), [net[i][j][0] for i in range(4) for j in range(4)], prec=prec)
@@ -79,7 +82,7 @@ def _derived(nets_bez, lam, prec):
         ]
         half = arb(fmpq(1, 2))
         inside = all(_curve_avoids_square(cv, half, depth=12) for cv in curves)
-        norm_hi = None
+        norm_hi: Any = None
         for cv in curves:
             xs = BernsteinForm((4,), [p[0] for p in cv], prec=prec)
             ys = BernsteinForm((4,), [p[1] for p in cv], prec=prec)
@@ -188,7 +191,7 @@ def _curve_avoids_square(curve, half, depth):
     return _curve_avoids_square(left, half, depth - 1) and _curve_avoids_square(right, half, depth - 1)
 
 
-def build_table(k, prec=DEFAULT_PREC):
+def build_table(k: ValenceLike, prec: int = DEFAULT_PREC) -> dict[str, Any]:
     """Build the certified characteristic-map table of a valence (see module docstring, docs/tables.md).
 
     Parameters

@@ -10,6 +10,7 @@ proof.
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -65,9 +66,21 @@ def _nets(obj, form):
     return arr
 
 
-@lru_cache(maxsize=256)
-def load_table(k, directory=None):
-    """Load the certified table of valence ``k`` (hash-checked) as float64 arrays.
+def load_table(k: int, directory: str | os.PathLike[str] | None = None) -> CharacteristicTable:
+    """Load the certified table of valence ``k`` (hash-checked) as float64 arrays (cached).
+
+    Parameters
+    ----------
+    k : int
+        Valence >= 3.
+    directory : str or os.PathLike, optional
+        Folder of the tables (default: the published ``tables`` folder).
+
+    Returns
+    -------
+    CharacteristicTable
+        ``lam``, ``N`` and the read-only nets ``bspline``, ``bezier`` of shape (3, 4, 4, 2) (patch P1..P3,
+        i, j, coordinate).
 
     Raises :class:`~ccproof.errors.TableNotFoundError` listing the tables that exist.
 
@@ -75,7 +88,11 @@ def load_table(k, directory=None):
     >>> t.lam, t.N, t.bezier.shape
     (0.5, 3, (3, 4, 4, 2))
     """
-    k = check_valence(k)
+    return _load_table(check_valence(k), None if directory is None else os.fspath(directory))
+
+
+@lru_cache(maxsize=256)
+def _load_table(k: int, directory: str | None) -> CharacteristicTable:
     path = table_path(k, directory)
     try:
         obj = read_table_json(path)

@@ -24,8 +24,10 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ccproof.apps.arap.charts import charts_from_labels, check_disk
 from ccproof.apps.arap.hierarchy import ChartHierarchy
@@ -34,6 +36,9 @@ from ccproof.apps.arap.metrics import Metrics, sample_metrics
 from ccproof.apps.arap.samples import build_samples
 from ccproof.apps.arap.solver import LocalGlobal, iterate, system_from_samples, triangle_samples
 from ccproof.errors import CCProofError
+
+if TYPE_CHECKING:
+    from ccproof.mesh import QuadMesh
 
 __all__ = [
     "LevelStats",
@@ -91,7 +96,7 @@ class ChartTexture:
     level: int
     values: np.ndarray
     #: texture unknowns (control level of the method), and the control-level triangles
-    unknowns: np.ndarray = None
+    unknowns: np.ndarray | None = None
 
 
 @dataclass
@@ -102,15 +107,15 @@ class MethodResult:
     textures: list
     seconds: float
     iterations: int
-    metrics: Metrics = None
+    metrics: Metrics | None = None
     flips_control: int = 0
     triangles_control: int = 0
     levels: list = field(default_factory=list)
     #: times the control mesh was subdivided before optimizing (b, c)
     refine: int = 0
     #: per chart (P, UV, Q) limit samples at ``sample_level`` (see :func:`compare`), or None
-    samples: list = None
-    sample_level: int = None
+    samples: list | None = None
+    sample_level: int | None = None
 
     @property
     def name(self):
@@ -432,8 +437,9 @@ def compare(mesh, labels=None, methods=METHODS, levels=3, start_level=1, eval_le
         from tqdm import tqdm
 
         bar = tqdm(total=len(hierarchies) * len(methods), desc="arap", unit="chart")
-    acc = {m: {"texs": [], "secs": 0.0, "its": 0, "lv": [], "met": Metrics(), "fl": 0, "tot": 0, "samples": []}
-           for m in methods}
+    acc: dict[str, dict[str, Any]] = {
+        m: {"texs": [], "secs": 0.0, "its": 0, "lv": [], "met": Metrics(), "fl": 0, "tot": 0, "samples": []}
+        for m in methods}
     try:
         for i, h in enumerate(hierarchies):
             for m in methods:
@@ -494,8 +500,9 @@ def compare(mesh, labels=None, methods=METHODS, levels=3, start_level=1, eval_le
     return out, hierarchies
 
 
-def parameterize(mesh, labels=None, variant="extended", levels=3, start_level=1, eval_level=5, tol=1e-6,
-                 max_iter=1000):
+def parameterize(mesh: QuadMesh, labels: ArrayLike | None = None, variant: Literal["extended", "boundary"] = "extended",
+                 levels: int = 3, start_level: int = 1, eval_level: int = 5, tol: float = 1e-6, max_iter: int = 1000
+                 ) -> MethodResult:
     """hsh10 parameterization of every chart: variant "extended" (c) or "boundary" (b).
 
     The texture minimizing the ARAP energy of the limit surface (hsh10 Eq. 1), optimized level by level
