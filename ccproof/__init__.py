@@ -1,6 +1,7 @@
 """ccproof: Catmull-Clark subdivision surfaces as certified parametric surfaces.
 
-One entry point per capability (``ccproof.__all__``; every name has a docstring with an example):
+One entry point per capability (``ccproof.__all__``; every name has a docstring with an example, but
+``prove_interval``, whose shortest run takes a minute; every function is annotated, docs/api.md):
 
 ==================================  ======================================================================
 capability                          names
