@@ -1,6 +1,7 @@
 """ccproof: Catmull-Clark subdivision surfaces as certified parametric surfaces.
 
-One entry point per capability (``ccproof.__all__``; every name has a docstring with an example):
+One entry point per capability (``ccproof.__all__``; every name has a docstring with an example, but
+``prove_interval``, whose shortest run takes a minute; every function is annotated, docs/api.md):
 
 ==================================  ======================================================================
 capability                          names
@@ -32,9 +33,24 @@ the certified tables; ``apps`` and the command line on top.
 """
 
 from importlib import import_module
+from typing import TYPE_CHECKING
 
 from ccproof.errors import CCProofError, MeshError, TableNotFoundError, ValenceError
 from ccproof.valence import Valence, parse_valence
+
+if TYPE_CHECKING:  # the lazy names of _LAZY below, seen by type checkers (mypy in .ci/run) as what they are
+    from ccproof.apps.arap.core import parameterize
+    from ccproof.apps.dynamics.fit import fit_points
+    from ccproof.certify.prover import prove_c1, prove_interval, prove_valence
+    from ccproof.certify.verify import verify_file
+    from ccproof.certify.verify.errors import CertificateError
+    from ccproof.certify.verify.record import VerifyResult
+    from ccproof.inverse.algorithm import inverse_characteristic_map
+    from ccproof.inverse.forward import characteristic_map
+    from ccproof.mesh import PolyMesh, QuadMesh, read_mesh, read_obj
+    from ccproof.reparam.surface import limit_surface
+    from ccproof.tables.build import build_table
+    from ccproof.tables.numeric import load_table
 
 __version__ = "0.1.0"
 
@@ -89,7 +105,7 @@ _EAGER = {"CCProofError", "MeshError", "TableNotFoundError", "ValenceError", "Va
 assert set(__all__) == _EAGER | set(_LAZY)
 
 
-def __getattr__(name):
+def __getattr__(name: str) -> object:
     if name in _LAZY:
         value = getattr(import_module(_LAZY[name]), name)
         globals()[name] = value
@@ -97,5 +113,5 @@ def __getattr__(name):
     raise AttributeError(f"module 'ccproof' has no attribute {name!r}")
 
 
-def __dir__():
+def __dir__() -> list[str]:
     return sorted(set(globals()) | set(__all__))

@@ -53,7 +53,7 @@ class MeshError(CCProofError):
     """
 
 
-def check_valence(k, *, minimum=3):
+def check_valence(k: object, *, minimum: int = 3) -> int:
     """Return ``k`` as a Python ``int`` after checking it is an integer valence >= ``minimum``.
 
     >>> check_valence(5)
@@ -71,7 +71,7 @@ def check_valence(k, *, minimum=3):
         if isinstance(k, numbers.Integral):
             kk = int(k)
         elif isinstance(k, numbers.Real) and k == k and float(k).is_integer():
-            kk = int(k)
+            kk = int(float(k))
         elif isinstance(k, str) and k.strip().lstrip("+").isdigit():
             kk = int(k)
         else:

@@ -81,7 +81,7 @@ def bench_interval(k0):
         t = time.perf_counter()
         cert = prove_interval(k0, progress=False)
         tc = time.perf_counter() - t
-        path = write_certificate(cert, certificate_path({"min": k0}, d))
+        path = write_certificate(cert, certificate_path(cert["valence"], d))
         t = time.perf_counter()
         ok = verify_file(path, log=lambda s: None)
         tv = time.perf_counter() - t

@@ -41,9 +41,10 @@ def main():
 
     from concurrent.futures import ProcessPoolExecutor
 
-    from ccproof.tables.build import write_table
+    from ccproof.tables.build import DEFAULT_INTERVAL_K0, write_table
+    from ccproof.valence import Valence
 
-    ks = list(range(3, args.kmax + 1)) + [">=40"]
+    ks = [Valence(k) for k in range(3, args.kmax + 1)] + [Valence(DEFAULT_INTERVAL_K0, interval=True)]
     with tempfile.TemporaryDirectory() as d:
         t = time.perf_counter()
         with ProcessPoolExecutor(args.jobs) as ex:

@@ -39,7 +39,7 @@ def main(argv=None):
               f"det J_Phi {s['min_bound_det_J_phi_local']:.4g}, cells {s['min_bound_det_J_G_cells_local']:.4g}, "
               f"corner {s['min_bound_det_J_G_corner_over_h2']:.4g}", flush=True)
         if args.out:
-            write_certificate(cert, certificate_path({"min": k0}, args.out))
+            write_certificate(cert, certificate_path(cert["valence"], args.out))
 
 
 if __name__ == "__main__":

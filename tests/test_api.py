@@ -12,14 +12,20 @@ import pytest
 
 import ccproof
 
-#: names of ccproof.__all__ whose definitions (in modules other engineers are rewriting) still lack an
-#: example; the test fails as soon as one gains an example (then drop it here) or another one lacks it
+#: names of ccproof.__all__ whose docstrings have no example (no call is fast enough to run as a doctest);
+#: the test fails as soon as one gains an example (then drop it here) or another one lacks it
 PENDING_EXAMPLES = {
+    # one lam piece of the k >= k0 proof has 231 cells (N = 5 for every k0): ~1 min, too slow for a doctest
     "prove_interval": "ccproof/certify/prover.py",
+}
+
+#: public functions of ccproof.__all__ whose signatures are not annotated yet, in modules owned elsewhere
+#: (mypy checks the rest of the public API in .ci/run: [tool.mypy] in pyproject.toml)
+PENDING_ANNOTATIONS = {
     "read_obj": "ccproof/mesh/io.py",
     "read_mesh": "ccproof/mesh/io.py",
-    "parameterize": "ccproof/apps/arap/core.py",
-    "fit_points": "ccproof/apps/dynamics/fit.py",
+    # the trusted base is kept as it is reviewed (docs/trusted_base.md)
+    "verify_file": "ccproof/certify/verify/__init__.py",
 }
 
 #: public names defined more than once on purpose (or pending a module being rewritten elsewhere)
@@ -32,8 +38,6 @@ ALLOWED_DUPLICATES = {
     "run": "one per command module",
     # pending: modules other engineers are rewriting
     "canonical_ring": "ccproof.evaluate.local vs ccproof.evaluate.tagged (evaluator being rewritten)",
-    "isoparameter_lines": "ccproof.reparam.plot wraps ccproof.evaluate.plot with a parameterization argument",
-    "plot_isoparameter_lines": "ccproof.reparam.plot wraps ccproof.evaluate.plot with a parameterization argument",
 }
 
 
@@ -57,6 +61,26 @@ def test_every_public_name_has_a_docstring_with_an_example():
     assert missing == set(PENDING_EXAMPLES), (
         f"lacking an example and not listed: {sorted(missing - set(PENDING_EXAMPLES))}; "
         f"listed but documented now (drop them from PENDING_EXAMPLES): {sorted(set(PENDING_EXAMPLES) - missing)}")
+
+
+def test_every_public_function_is_annotated():
+    """Every parameter and the return of every function of ``ccproof.__all__`` carry a type annotation
+    (what mypy then checks: the annotations of an unannotated function would be silently Any)."""
+    missing = {}
+    for name in ccproof.__all__:
+        obj = getattr(ccproof, name)
+        if not inspect.isfunction(obj):
+            continue
+        sig = inspect.signature(obj)
+        bare = [p for p, par in sig.parameters.items() if par.annotation is inspect.Parameter.empty]
+        if sig.return_annotation is inspect.Signature.empty:
+            bare.append("return")
+        if bare:
+            missing[name] = bare
+    pending = set(PENDING_ANNOTATIONS)
+    assert set(missing) == pending, (
+        f"not annotated and not listed: {sorted(set(missing) - pending)}; "
+        f"listed but annotated now (drop them from PENDING_ANNOTATIONS): {sorted(pending - set(missing))}")
 
 
 def test_headline_entry_points_are_the_package_objects():

@@ -20,6 +20,8 @@ from fractions import Fraction
 from sympy import QQ, Rational, sqrt, sympify
 from sympy.polys.fields import field
 
+from ccproof.valence import lam_from_c
+
 #: Q(c) as a sympy rational-function field and its generator.
 QC, C = field("c", QQ)
 
@@ -186,9 +188,9 @@ def integer_form_string(form):
 
 
 def subdominant_lam_sympy(c):
-    """Exact lam(c) = (5 + c + sqrt((1 + c)(9 + c)))/16 as a sympy expression (R2)."""
-    c = sympify(c)
-    return (5 + c + sqrt((1 + c) * (9 + c))) / 16
+    """Exact lam(c) = (5 + c + sqrt((1 + c)(9 + c)))/16 as a sympy expression (R2;
+    :func:`ccproof.valence.lam_from_c` in sympy arithmetic)."""
+    return lam_from_c(sympify(c), sqrt)
 
 
 def eval_integer_form(form, cval, lamval):

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 from ccproof.algebra.field import eval_integer_form, subdominant_lam_sympy
 from ccproof.errors import CCProofError, check_valence
+from ccproof.valence import Valence, lam_from_c
 
 ARITHMETICS = ("exact", "arb", "float")
 
@@ -52,7 +53,9 @@ def cos_2pi_over_k(k, arithmetic="arb", prec=128):
 
 
 def _lam_from_c_arb(c):
-    return (5 + c + ((1 + c) * (9 + c)).sqrt()) / 16
+    from flint import arb
+
+    return lam_from_c(c, arb.sqrt)
 
 
 def subdominant_eigenvalue(k, arithmetic="arb", prec=128):
@@ -101,12 +104,14 @@ def valence_interval(k0, prec=128):
 def specialize(element_form, k, arithmetic="arb", prec=128):
     """Value of an integer form ``(A, B, D)`` (see :meth:`QcLam.integer_form`) at valence k.
 
-    ``k`` may be an int or the string ``">=K0"`` for the interval of valences k >= K0 (then the
-    value is the union over :func:`interval_pieces`).
+    ``k`` may be an int or an interval of valences k >= K0 in any spelling of
+    :meth:`ccproof.valence.Valence.parse` (``">=K0"``, ``{"min": K0}``; then the value is the union over
+    :func:`interval_pieces`).
     """
-    if isinstance(k, str) and k.startswith(">="):
-        return _eval_interval(element_form, interval_pieces(int(k[2:]), 256, prec + 20), prec)
-    values = _field_values(k, arithmetic, prec)
+    v = Valence.parse(k)
+    if v.interval:
+        return _eval_interval(element_form, interval_pieces(v.k, 256, prec + 20), prec)
+    values = _field_values(v, arithmetic, prec)
     return _eval(element_form, values, arithmetic, prec)
 
 
@@ -122,12 +127,14 @@ def _eval_interval(form, boxes, prec):
         return +acc
 
 
-def _field_values(k, arithmetic, prec):
+def _field_values(v, arithmetic, prec):
+    """(c, lam) of the :class:`~ccproof.valence.Valence` ``v`` in ``arithmetic``."""
     _check_arithmetic(arithmetic)
-    if isinstance(k, str) and k.startswith(">="):
+    if v.interval:
         if arithmetic != "arb":
             raise CCProofError("an interval of valences can only be specialized in 'arb' arithmetic")
-        return valence_interval(int(k[2:]), prec)
+        return valence_interval(v.k, prec)
+    k = v.k
     if arithmetic == "exact":
         c = cos_2pi_over_k(k, "exact")
         return c, subdominant_lam_sympy(c)
@@ -177,9 +184,10 @@ def characteristic_map_patches(k, form="bezier", arithmetic="arb", prec=128, pie
 
     Parameters
     ----------
-    k : int or str
-        Valence k >= 3, or ``">=K0"`` for enclosures valid for every valence k >= K0 (arb only;
-        the union of the values on ``pieces`` sub-intervals, see :func:`interval_pieces`).
+    k : int or str or dict or Valence
+        Valence k >= 3, or an interval ``">=K0"`` (any spelling of :meth:`ccproof.valence.Valence.parse`)
+        for enclosures valid for every valence k >= K0 (arb only; the union of the values on ``pieces``
+        sub-intervals, see :func:`interval_pieces`).
     form : {"bezier", "bspline"}
         Bezier net of each piece on its domain, or its uniform cubic B-spline net.
     arithmetic : {"exact", "arb", "float"}
@@ -199,18 +207,17 @@ def characteristic_map_patches(k, form="bezier", arithmetic="arb", prec=128, pie
     """
     from ccproof.algebra.characteristic_map import symbolic_bezier_nets, symbolic_bspline_nets
 
-    if not (isinstance(k, str) and k.startswith(">=")):
-        k = check_valence(k)
+    v = Valence.parse(k)
     if form not in ("bezier", "bspline"):
         raise CCProofError(f"unknown net form {form!r}; use 'bezier' or 'bspline'")
     sym = symbolic_bezier_nets() if form == "bezier" else symbolic_bspline_nets()
-    if isinstance(k, str):
+    if v.interval:
         if arithmetic != "arb":
             raise CCProofError("an interval of valences can only be specialized in 'arb' arithmetic")
-        boxes = interval_pieces(check_valence(k[2:]), pieces, prec + 20)
+        boxes = interval_pieces(v.k, pieces, prec + 20)
         ev = lambda f: _eval_interval(f, boxes, prec)
     else:
-        values = _field_values(k, arithmetic, prec)
+        values = _field_values(v, arithmetic, prec)
         ev = lambda f: _simplify(_eval(f, values, arithmetic, prec), arithmetic)
     return {name: [[tuple(ev(x.integer_form()) for x in p) for p in row] for row in net]
             for name, net in sym.items()}

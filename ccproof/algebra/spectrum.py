@@ -30,6 +30,7 @@ directly for k = 3. The constant eigenvalues 1/8, ..., 1/64 lie below lam(3) > 0
 from __future__ import annotations
 
 from ccproof.errors import check_valence
+from ccproof.valence import lam_from_c
 
 
 def _fmpq_poly(coeffs):
@@ -127,7 +128,7 @@ def spectral_conditions(k, prec=128):
         if k >= 4:
             # next largest cos(2 pi m/k), m = 2 (or the mode m = k/2 ... all below c_1)
             c2 = arb(fmpq(4, k)).cos_pi()
-            lam2 = (5 + c2 + ((1 + c2) * (9 + c2)).sqrt()) / 16
+            lam2 = lam_from_c(c2, arb.sqrt)
             others.append(lam2)
         gap = min((lam - o for o in others), key=lambda z: z.lower())
         ok = bool(disc1 > 0) and bool(lam < 1) and bool(gap > 0)

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import Any
 
 from flint import arb, ctx, fmpq
 
@@ -31,9 +32,10 @@ from ccproof.certify.verify.maps import (
 )
 from ccproof.certify.verify.replay import parse_decimal
 from ccproof.certify.verify.statement import PATCHES, c_lam, derivation, nets_for_valence
-from ccproof.errors import CCProofError, check_valence
+from ccproof.errors import CCProofError, ValenceError, check_valence
 from ccproof.rigorous import certainly_positive, lower_bound
 from ccproof.tables.format import certificates_dir
+from ccproof.valence import Valence, ValenceLike
 
 DEFAULT_PREC = 128
 MAX_DEPTH = 14
@@ -105,7 +107,7 @@ def smallest_level(nets, lam, max_level=8):
     raise ProofFailed(f"no level N <= {max_level} maps the corner cell into [0,1/6)^2")
 
 
-def prove_valence(k, prec=DEFAULT_PREC, progress=True):
+def prove_valence(k: int, prec: int = DEFAULT_PREC, progress: bool = True) -> dict[str, Any]:
     """Search an injectivity certificate for valence k (bmz04 Appendix A as corrected in docs/appendix_a.md).
 
     Parameters
@@ -221,9 +223,10 @@ def _waves(k0, ends, N, taylor_degree, truncation_degree, prec, max_pieces, sche
     from ccproof.scale.engine import run_tasks
 
     todo, pieces = [(ends[0], ends[1])], []
+    name = f"k{Valence(k0, interval=True)}"
     while todo:
-        tasks = [(a, b, N, taylor_degree, truncation_degree, prec, f"k>={k0} lam in [{a}, {b}]") for a, b in todo]
-        sweep = run_tasks(piece, tasks, scheduler, desc=f"k>={k0} lam pieces", unit="piece", raise_errors=False,
+        tasks = [(a, b, N, taylor_degree, truncation_degree, prec, f"{name} lam in [{a}, {b}]") for a, b in todo]
+        sweep = run_tasks(piece, tasks, scheduler, desc=f"{name} lam pieces", unit="piece", raise_errors=False,
                           retries=2, deterministic=(ProofFailed,), names=[t[-1] for t in tasks])
         failed = []
         for (a, b), parts in zip(todo, sweep.results):
@@ -243,8 +246,8 @@ def _waves(k0, ends, N, taylor_degree, truncation_degree, prec, max_pieces, sche
     return pieces
 
 
-def prove_interval(k0, prec=DEFAULT_PREC, progress=True, taylor_degree=3, truncation_degree=2, max_pieces=16,
-                   scheduler=None):
+def prove_interval(k0: ValenceLike, prec: int = DEFAULT_PREC, progress: bool = True, taylor_degree: int = 3,
+                   truncation_degree: int = 2, max_pieces: int = 16, scheduler: object = None) -> dict[str, Any]:
     """Appendix-A certificate for every valence k >= k0 at once (docs/appendix_a.md section 6).
 
     lam runs over [La, Lb] with La <= lam(k0) and Lb >= (3 + sqrt 5)/8; the nets are Taylor models in
@@ -253,20 +256,60 @@ def prove_interval(k0, prec=DEFAULT_PREC, progress=True, taylor_degree=3, trunca
     ~0.02 wide against cell margins of ~4e-4). A piece that fails is bisected (up to ``max_pieces``).
     ``scheduler`` (a :func:`ccproof.scale.engine.parse_scheduler` spec or a Client): run the pieces of each
     bisection wave as tasks there; None keeps the serial search. Both give the same certificate.
+
+    Parameters
+    ----------
+    k0 : int or str or dict or Valence
+        The smallest valence of the interval: an int k0 >= 3 or an interval in any spelling of
+        :meth:`ccproof.valence.Valence.parse` (``">=40"``, ``{"min": 40}``); a single valence such as
+        ``"7"`` raises :class:`~ccproof.errors.ValenceError` (use :func:`prove_valence`).
+    prec : int
+        arb precision in bits of every Bernstein coefficient (written into the certificate).
+    progress : bool
+        Progress bars over the cells of each piece (serial search only).
+    taylor_degree : int
+        Degree in zeta of the Taylor models of the nets.
+    truncation_degree : int
+        zeta degree kept in the Taylor models of the cell determinants (part D).
+    max_pieces : int
+        Most lam pieces of the bisection; :class:`ProofFailed` beyond.
+    scheduler : str or distributed.Client, optional
+        Where the pieces of each bisection wave run (see above).
+
+    Returns
+    -------
+    dict
+        The certificate (docs/certificates.md): ``schema``, ``valence`` = ``{"min": k0}``, the level ``N``,
+        ``prec``, ``parameter`` (the degrees) and ``pieces``, a list in lam order of
+        ``{"lam": [La, Lb], "parts": {"regularity", "cells", "corner"}}`` (decimal strings and boxes).
+        Raises :class:`ProofFailed` when a piece still fails after ``max_pieces`` pieces.
+
+    Notes
+    -----
+    No doctest: the corner level N = 5 is set by the upper end (3 + sqrt 5)/8 = 0.6545 of the lam range,
+    whatever k0 (measured for k0 = 40, 100, 1000), so even a single piece has 231 cells of Taylor-model
+    Bernstein forms: one piece takes about a minute (k0 = 1000, the default degrees) and still ~25 s at
+    ``prec=64, taylor_degree=2, truncation_degree=1``. The published
+    ``k_ge_40.json`` is re-checked in tests/certify/test_interval.py; from the command line::
+
+        ccproof certify '>=40'
     """
-    k = _parse_k(f">={k0}" if isinstance(k0, int) else k0)
+    v = Valence(k0, interval=True) if isinstance(k0, int) else Valence.parse(k0)
+    if not v.interval:
+        raise ValenceError(f"prove_interval proves every valence k >= k0: give k0 or '>=K0', got {k0!r}")
+    k = v.to_json()
     exact = derivation().integer_forms("bspline")
-    ends = _lam_range(k["min"], prec)
+    ends = _lam_range(v.k, prec)
     with ctx.workprec(prec):
         La, Lb = parse_decimal(ends[0]), parse_decimal(ends[1])
         N = smallest_level(hull_nets(parameter_nets(exact, La, Lb, 0, taylor_degree, prec), prec),
                            arb(La).union(arb(Lb)))
     todo = [(ends[0], ends[1])] if scheduler is None else []
     pieces = [] if scheduler is None else _pieces_in_waves(
-        k["min"], ends, N, taylor_degree, truncation_degree, prec, max_pieces, scheduler)
+        v.k, ends, N, taylor_degree, truncation_degree, prec, max_pieces, scheduler)
     while todo:
         a, b = todo.pop(0)
-        label = f"k>={k['min']} lam in [{a}, {b}]"
+        label = f"k{v} lam in [{a}, {b}]"
         try:
             parts = _prove_piece(exact, parse_decimal(a), parse_decimal(b), N, taylor_degree, truncation_degree,
                                  prec, progress, label)
@@ -298,16 +341,14 @@ def _summary(parts_list):
     return summary, sum(len(v) for parts in parts_list for sec in parts.values() for v in sec.values())
 
 
-def _kname(k):
-    return f">={k['min']}" if isinstance(k, dict) else str(k)
-
-
 def certificate_path(k, directory=None):
-    """``k005.json`` for a valence, ``k_ge_40.json`` for the interval ``{"min": 40}``/``">=40"``."""
-    if isinstance(k, str) and k.startswith(">="):
-        k = {"min": int(k[2:])}
-    name = f"k_ge_{int(k['min'])}.json" if isinstance(k, dict) else f"k{int(k):03d}.json"
-    return Path(directory or certificates_dir() / "injectivity") / name
+    """``k005.json`` for a valence, ``k_ge_40.json`` for the interval ``{"min": 40}``/``">=40"`` (any spelling
+    of :meth:`ccproof.valence.Valence.parse`), in ``directory`` or the injectivity certificates folder.
+
+    >>> certificate_path(5, "d").as_posix(), certificate_path({"min": 40}, "d").name
+    ('d/k005.json', 'k_ge_40.json')
+    """
+    return Path(directory or certificates_dir() / "injectivity") / (Valence.parse(k).stem + ".json")
 
 
 def write_certificate(cert, path=None):
@@ -317,15 +358,7 @@ def write_certificate(cert, path=None):
     return path
 
 
-def _parse_k(k):
-    if isinstance(k, str) and k.strip().startswith(">="):
-        return {"min": check_valence(k.strip()[2:])}
-    if isinstance(k, dict):
-        return {"min": check_valence(k["min"])}
-    return check_valence(k)
-
-
-def prove_c1(k, prec=DEFAULT_PREC):
+def prove_c1(k: ValenceLike, prec: int = DEFAULT_PREC) -> dict[str, Any]:
     """C1 certificate (Reif's criterion) for valence k or the interval ``">=K0"``: det J_Phi > 0 on
     layer 0 and a star-shaped outer boundary, boxes found by subdivision; the spectral ordering is
     re-derived by the verifier from the rules (:mod:`ccproof.certify.verify.spectrum`).
@@ -346,23 +379,23 @@ def prove_c1(k, prec=DEFAULT_PREC):
     >>> cert["schema"], sorted(cert["parts"]["star"])
     ('ccproof.c1/2', ['P1s1', 'P2s1', 'P2t1', 'P3t1'])
     """
-    k = _parse_k(k)
+    v = Valence.parse(k)
+    k = v.to_json()
     with ctx.workprec(prec):
-        if isinstance(k, dict):
-            ends = _lam_range(k["min"], prec)
+        if v.interval:
+            ends = _lam_range(v.k, prec)
             La, Lb = parse_decimal(ends[0]), parse_decimal(ends[1])
             nets = hull_nets(parameter_nets(derivation().integer_forms("bspline"), La, Lb, 0, 3, prec), prec)
         else:
-            nets = nets_for_valence(k, prec)
+            nets = nets_for_valence(v.k, prec)
         reg = {n: prove_positive(regularity_form(nets, n, prec), (0, 1), f"det J_Phi on {n}") for n in PATCHES}
         star = {c: prove_positive(star_form(nets, c, prec), (0,), f"star {c}") for c in STAR_CURVES}
     parts = {"regularity": reg, "star": star}
-    if isinstance(k, dict):
+    if v.interval:
         return {"schema": C1_SCHEMA, "valence": k, "prec": prec, "pieces": [{"lam": ends, "parts": parts}]}
     return {"schema": C1_SCHEMA, "valence": k, "prec": prec, "parts": parts}
 
 
 def c1_certificate_path(k, directory=None):
-    k = _parse_k(k)
-    name = f"k_ge_{k['min']}.json" if isinstance(k, dict) else f"k{k:03d}.json"
-    return Path(directory or certificates_dir() / "c1") / name
+    """:func:`certificate_path` in the C1 certificates folder."""
+    return Path(directory or certificates_dir() / "c1") / (Valence.parse(k).stem + ".json")

@@ -46,18 +46,23 @@ def add_arguments(p):
 
 
 def parse_valences(text):
-    from ccproof.errors import CCProofError, check_valence
+    """The valences of the command line: ``K``, ``A-B`` (every K in A..B) or ``'>=K0'`` (one interval),
+    as a list of :class:`~ccproof.valence.Valence`.
+
+    >>> parse_valences("3-5"), parse_valences(">=40")
+    ([Valence('3'), Valence('4'), Valence('5')], [Valence('>=40')])
+    """
+    from ccproof.errors import CCProofError
+    from ccproof.valence import Valence
 
     text = str(text).strip()
-    if text.startswith(">="):
-        return [">=" + str(check_valence(text[2:]))]
-    if "-" in text[1:]:
-        a, b = text.split("-", 1)
-        a, b = check_valence(a), check_valence(b)
-        if b < a:
+    a, dash, b = text.partition("-")
+    if dash and a and ">" not in text:
+        lo, hi = Valence.parse(a), Valence.parse(b)
+        if hi.k < lo.k:
             raise CCProofError(f"empty valence range {text!r}")
-        return list(range(a, b + 1))
-    return [check_valence(text)]
+        return [Valence(k) for k in range(lo.k, hi.k + 1)]
+    return [Valence.parse(text)]
 
 
 def _one(args):
@@ -123,16 +128,16 @@ def run(args):
     ks = parse_valences(args.valences)
     if args.c1:
         return _run_c1(ks, args)
-    if any(isinstance(k, str) for k in ks):
+    if ks[0].interval:
         return _run_interval(ks[0], args)
     from ccproof.certify.prover import certificate_path, claimed_margins, write_certificate
     from ccproof.scale.engine import open_scheduler, run_tasks, scheduler_from_args
 
-    work = [(k, args.prec, args.out, len(ks) == 1) for k in ks]
+    work = [(k.k, args.prec, args.out, len(ks) == 1) for k in ks]
     names = [f"valence {k}" for k in ks]
     with open_scheduler(scheduler_from_args(args), len(ks)) as sched:
-        sweep = run_tasks(_one, work, sched, desc="certify", unit="valence", priority=ks, names=names,
-                          raise_errors=False)
+        sweep = run_tasks(_one, work, sched, desc="certify", unit="valence", priority=[w[0] for w in work],
+                          names=names, raise_errors=False)
         for line in sweep.report(names):
             print(line)
         ok_all = not sweep.errors

@@ -27,19 +27,19 @@ def _row(path):
 
     from ccproof.certify.verify import verify_file
     from ccproof.certify.verify.statement import c_lam
+    from ccproof.valence import Valence
 
     t = time.perf_counter()
     res = verify_file(path, log=lambda s: None)
-    row = {"k": res.valence, "N": res.N, "ok": res.ok, "verify_s": round(time.perf_counter() - t, 1),
-           "path": str(path)}
+    k = None if res.valence is None else Valence.parse(res.valence)  # None: the file has no readable valence
+    row = {"k": k, "N": res.N, "ok": res.ok, "verify_s": round(time.perf_counter() - t, 1), "path": str(path)}
     if not res.ok:
         return row
-    k = res.valence
-    if isinstance(k, dict):
-        lam = f"[{c_lam(k['min'], 64)[1].lower().str(7, radius=False)}, 0.654508]"
+    if k.interval:
+        lam = f"[{c_lam(k.k, 64)[1].lower().str(7, radius=False)}, 0.654508]"
     else:
         with ctx.workprec(64):
-            lam = arb(c_lam(k, 64)[1]).str(7, radius=False)
+            lam = arb(c_lam(k.k, 64)[1]).str(7, radius=False)
     m = res.margins
     row.update(lam=lam, detPhi=float(m["regularity"]) * 4,  # d(s,t)/d(u,v) = 4
                detG_cells=float(m["cells"]) * 4 ** res.N, detG_corner=float(m["corner"]))
@@ -61,7 +61,8 @@ def collect(jobs=1):
         from tqdm import tqdm
 
         rows = [_row(p) for p in tqdm(paths, desc="verify", unit="certificate", leave=False)]
-    return sorted(rows, key=lambda r: (isinstance(r["k"], dict), r["k"]["min"] if isinstance(r["k"], dict) else r["k"]))
+    # single valences by k, then the intervals, then the files without a readable valence
+    return sorted(rows, key=lambda r: (r["k"] is None, () if r["k"] is None else (r["k"].interval, r["k"].k)))
 
 
 def markdown(rows):
@@ -76,7 +77,8 @@ def markdown(rows):
 
 
 def _kname(k):
-    return f">= {k['min']}" if isinstance(k, dict) else str(k)
+    """``5`` or ``>= 40`` (the Markdown table's spelling of a :class:`~ccproof.valence.Valence`)."""
+    return "?" if k is None else f">= {k.k}" if k.interval else str(k)
 
 
 def run(args):
@@ -101,8 +103,8 @@ def run(args):
         import matplotlib.pyplot as plt
 
         rows = [r for r in rows if r["ok"]]
-        single = [r for r in rows if isinstance(r["k"], int)]
-        ks = [r["k"] for r in single]
+        single = [r for r in rows if not r["k"].interval]
+        ks = [r["k"].k for r in single]
         fig, ax = plt.subplots(figsize=(7, 4))
         keys = (("detPhi", "o-", "C0", "min det J_Phi (layer 0, w.r.t. (u,v))"),
                 ("detG_corner", "s-", "C1", "min det J_G / h^2 (corner)"),
@@ -110,8 +112,8 @@ def run(args):
         for key, style, color, label in keys:
             ax.plot(ks, [r[key] for r in single], style, color=color, label=label)
         for r in rows:
-            if isinstance(r["k"], dict):  # the band k >= k0: one bound for all of them
-                k0, k1 = r["k"]["min"], r["k"]["min"] + 25
+            if r["k"].interval:  # the band k >= k0: one bound for all of them
+                k0, k1 = r["k"].k, r["k"].k + 25
                 ax.axvspan(k0, k1, color="0.9", zorder=0)
                 for key, _, color, _ in keys:
                     ax.hlines(r[key], k0, k1, colors=color, linestyles="--")

@@ -31,8 +31,10 @@ def _summary(obj):
     def ball(x):
         return arb_from_json(x, prec).str(12, radius=False)
 
-    v = obj["valence"]
-    name = f"k >= {v['min']}" if isinstance(v, dict) else f"k = {v}"
+    from ccproof.valence import Valence
+
+    v = Valence.parse(obj["valence"])
+    name = f"k >= {v.k}" if v.interval else f"k = {v.k}"
     lines = [
         f"characteristic map table, {name}  ({obj['schema']}, {prec} bits)",
         f"  c = cos(2 pi/k)        {ball(obj['c'])}",
@@ -59,17 +61,19 @@ def _build_one(args):
 def run(args):
     import json
 
-    from ccproof.errors import CCProofError, TableNotFoundError, check_valence
+    from ccproof.errors import CCProofError, TableNotFoundError
     from ccproof.tables.format import describe_available, read_table_json, table_path
+    from ccproof.valence import Valence
 
     if args.all:
         from concurrent.futures import ProcessPoolExecutor
 
         from tqdm import tqdm
 
+        from ccproof.tables.build import DEFAULT_INTERVAL_K0
         from ccproof.tables.format import output_dir
 
-        ks = list(range(3, args.kmax + 1)) + [">=40"]
+        ks = [Valence(k) for k in range(3, args.kmax + 1)] + [Valence(DEFAULT_INTERVAL_K0, interval=True)]
         args.dir = args.dir or str(output_dir() / "tables")
         work = [(k, args.dir) for k in ks]
         with ProcessPoolExecutor(max_workers=max(1, args.jobs)) as ex:
@@ -79,12 +83,8 @@ def run(args):
         return 0
     if args.valence is None:
         raise CCProofError("give a valence K (or '>=K0'), or --all")
-    v = args.valence.strip()
-    if v.startswith(">="):
-        key = {"min": check_valence(v[2:])}
-    else:
-        key = check_valence(v)
-    path = table_path(key, args.dir)
+    v = Valence.parse(args.valence)
+    path = table_path(v, args.dir)
     try:
         obj = read_table_json(path)
     except FileNotFoundError:

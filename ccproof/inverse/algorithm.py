@@ -35,8 +35,10 @@ layer-0 preimage, an exact scaling.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Literal, overload
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ccproof.errors import CCProofError, check_valence
 from ccproof.inverse.data import (
@@ -87,7 +89,17 @@ class InverseResult:
     boxes: list | None = None
 
 
-def inverse_characteristic_map(k, u, v, *, domain="quadrant", full_output=False, rigorous=False, prec=128):
+@overload
+def inverse_characteristic_map(k: int, u: ArrayLike, v: ArrayLike, *, domain: Literal["quadrant", "face"] = ...,
+                               full_output: Literal[False] = False, rigorous: Literal[False] = False, prec: int = ...
+                               ) -> tuple[NDArray[np.float64], NDArray[np.float64]]: ...
+@overload
+def inverse_characteristic_map(k: int, u: ArrayLike, v: ArrayLike, *, domain: Literal["quadrant", "face"] = ...,
+                               full_output: bool = ..., rigorous: bool = ..., prec: int = ...
+                               ) -> tuple[NDArray[np.float64], NDArray[np.float64]] | InverseResult: ...
+def inverse_characteristic_map(k: int, u: ArrayLike, v: ArrayLike, *, domain: Literal["quadrant", "face"] = "quadrant",
+                               full_output: bool = False, rigorous: bool = False, prec: int = 128
+                               ) -> tuple[NDArray[np.float64], NDArray[np.float64]] | InverseResult:
     """Phi^-1(u, v) for valence k, vectorized: bmz04 Algorithm 1 with a guaranteed fallback.
 
     Parameters

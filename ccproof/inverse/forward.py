@@ -14,7 +14,10 @@ underflow before the true result over- or underflows.
 
 from __future__ import annotations
 
+from typing import Literal, overload
+
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ccproof.errors import check_valence
 from ccproof.inverse.data import (
@@ -29,7 +32,14 @@ from ccproof.inverse.data import (
 )
 
 
-def characteristic_map(k, r, s, jacobian=False):
+@overload
+def characteristic_map(k: int, r: ArrayLike, s: ArrayLike, jacobian: Literal[False] = False
+                       ) -> tuple[NDArray[np.float64], NDArray[np.float64]]: ...
+@overload
+def characteristic_map(k: int, r: ArrayLike, s: ArrayLike, jacobian: Literal[True]
+                       ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]: ...
+def characteristic_map(k: int, r: ArrayLike, s: ArrayLike, jacobian: bool = False
+                       ) -> tuple[NDArray[np.float64], ...]:
     """Phi(r, s) for valence k, vectorized over arrays r, s >= 0 (broadcast together).
 
     Parameters
@@ -54,15 +64,15 @@ def characteristic_map(k, r, s, jacobian=False):
     ([1.0, 0.549988354518, 0.0], [0.0, 0.0, 0.0])
     """
     k = check_valence(k)
-    r, s, shape = as_points(r, s, "parameter")
+    ra, sa, shape = as_points(r, s, "parameter")
     D = valence_data(k)
-    n = r.shape[0]
+    n = ra.shape[0]
     X = np.empty(n)
     Y = np.empty(n)
     J = np.empty((n, 2, 2)) if jacobian else None
     for sl in chunks(n):
-        _forward_chunk(D, r[sl], s[sl], X[sl], Y[sl], J[sl] if jacobian else None)
-    if jacobian:
+        _forward_chunk(D, ra[sl], sa[sl], X[sl], Y[sl], None if J is None else J[sl])
+    if J is not None:
         return X.reshape(shape), Y.reshape(shape), J.reshape(shape + (2, 2))
     return X.reshape(shape), Y.reshape(shape)
 

@@ -182,13 +182,51 @@ def read_obj_tagged(path):
 
 
 def read_mesh(path):
-    """Read any polygon mesh: OBJ (with OpenSubdiv tags) directly, other formats through meshio.
+    r"""Read any polygon mesh: OBJ (with OpenSubdiv tags) directly, other formats through meshio.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        ``.obj`` (read by :func:`read_obj_tagged`: triangles, n-gons, creases, corners, holes, boundary
+        modes) or any polygon format meshio reads (``.off``, ``.ply``, ``.stl``, ``.vtk``, ...).
 
     Returns
     -------
     PolyMesh
-        meshio cells of type triangle, quad and polygon are kept in file order (by cell block);
-        other cell types (lines, vertices, volumes) raise a MeshError naming the block.
+        Vertices of shape (n, 3) (2-D points get z = 0); meshio cells of type triangle, quad and
+        polygon are kept in file order (by cell block); other cell types (lines, vertices, volumes)
+        raise a MeshError naming the block.
+
+    Raises
+    ------
+    MeshError
+        A malformed file (its path and line), a cell block that is not polygons, or a mesh that fails
+        the checks of :class:`~ccproof.mesh.polymesh.PolyMesh`.
+
+    Examples
+    --------
+    A square pyramid (a quad and four triangles) as ASCII PLY (through meshio), and an OBJ cube
+    with one crease:
+
+    >>> import os, tempfile
+    >>> d = tempfile.mkdtemp()
+    >>> ply = os.path.join(d, "pyramid.ply")
+    >>> with open(ply, "w") as fh:
+    ...     _ = fh.write("ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\n"
+    ...                  "property float z\nelement face 5\nproperty list uchar int vertex_indices\nend_header\n"
+    ...                  "0 0 0\n1 0 0\n1 1 0\n0 1 0\n0.5 0.5 1\n"
+    ...                  "4 0 3 2 1\n3 0 1 4\n3 1 2 4\n3 2 3 4\n3 3 0 4\n")
+    >>> m = read_mesh(ply)
+    >>> m.n_vertices, m.n_faces, m.vertices.shape, [len(p) for p in m.polygons]
+    (5, 5, (5, 3), [4, 3, 3, 3, 3])
+    >>> from ccproof.mesh.examples import cube
+    >>> obj = os.path.join(d, "cube.obj")
+    >>> write_obj(obj, cube())
+    >>> with open(obj, "a") as fh:
+    ...     _ = fh.write("t crease 2/1/0 0 1 2.5\n")
+    >>> read_mesh(obj).edge_sharpness
+    {(0, 1): 2.5}
+    >>> import shutil; shutil.rmtree(d)
     """
     from ccproof.mesh.polymesh import PolyMesh
 
@@ -217,10 +255,19 @@ def read_mesh(path):
 
 
 def read_obj(path):
-    """Read an all-quad OBJ file into a validated :class:`QuadMesh`.
+    r"""Read an all-quad OBJ file into a validated :class:`QuadMesh`.
 
     Face ``f`` of the mesh is the ``f``-th ``f`` statement of the file and keeps its vertex order
     (corner ``i`` of the face sits at (0,0), (1,0), (1,1), (0,1) for ``i = 0..3``).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+
+    Returns
+    -------
+    QuadMesh
+        ``vertices`` of shape (n, 3) float64 and ``faces`` of shape (m, 4) int64 (0-based), in file order.
 
     Raises
     ------
@@ -228,6 +275,24 @@ def read_obj(path):
         If the file is malformed, a face is not a quad (the message gives its number and source
         line), it has OpenSubdiv tag lines (creases, corners, holes, boundary modes: never
         ignored; use :func:`read_mesh`), or the mesh fails any check of :class:`QuadMesh`.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> from ccproof.mesh.examples import cube
+    >>> d = tempfile.mkdtemp()
+    >>> path = os.path.join(d, "cube.obj")
+    >>> write_obj(path, cube())
+    >>> m = read_obj(path)
+    >>> m.vertices.shape, m.faces.shape, bool((m.vertices == cube().vertices).all())
+    ((8, 3), (6, 4), True)
+    >>> with open(path, "a") as fh:
+    ...     _ = fh.write("f 1 2 3\n")
+    >>> read_obj(path)
+    Traceback (most recent call last):
+    ...
+    ccproof.errors.MeshError: .../cube.obj: face 6 (line 16) has 3 vertices, not 4: ccproof needs an all-quad mesh
+    >>> import shutil; shutil.rmtree(d)
     """
     V, polys, lines = read_obj_polygons(path)
     with open(os.fspath(path), encoding="utf-8", errors="replace") as fh:

@@ -23,6 +23,7 @@ import math
 import numpy as np
 
 from ccproof.errors import CCProofError, check_valence
+from ccproof.valence import lam_from_c
 
 __all__ = [
     "subdominant_lambda",
@@ -35,7 +36,8 @@ __all__ = [
 
 
 def subdominant_lambda(k):
-    """lam(k) = (5 + c + sqrt((1 + c)(9 + c))) / 16, c = cos(2 pi / k) (docs/readings.md R2), as a float.
+    """lam(k) = (5 + c + sqrt((1 + c)(9 + c))) / 16, c = cos(2 pi / k) (docs/readings.md R2), as a float
+    (:func:`ccproof.valence.lam_from_c`; exactly 0.5 for k = 4).
 
     >>> subdominant_lambda(4)
     0.5
@@ -43,8 +45,7 @@ def subdominant_lambda(k):
     k = check_valence(k)
     if k == 4:
         return 0.5
-    c = math.cos(2 * math.pi / k)
-    return (5 + c + math.sqrt((1 + c) * (9 + c))) / 16
+    return lam_from_c(math.cos(2 * math.pi / k))
 
 
 def alpha_bound(k):

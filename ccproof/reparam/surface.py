@@ -33,6 +33,10 @@ first use, per rotation), and their derivatives are rotated back.
 
 from __future__ import annotations
 
+import os
+from collections.abc import Mapping
+from typing import TYPE_CHECKING, Any, overload
+
 import numpy as np
 
 from ccproof.errors import CCProofError
@@ -40,6 +44,10 @@ from ccproof.evaluate.surface import CHUNK, LimitSurface
 from ccproof.mesh import QuadMesh
 from ccproof.reparam.blend import CORNER_FRAMES, PARAMETERIZATIONS, active_points, blend_points
 from ccproof.reparam.quadrant import check_alpha, default_alpha
+
+if TYPE_CHECKING:
+    from ccproof.evaluate.tagged import TaggedLimitSurface
+    from ccproof.mesh.polymesh import PolyMesh
 
 __all__ = ["ReparamLimitSurface", "limit_surface"]
 
@@ -83,7 +91,7 @@ class ReparamLimitSurface(LimitSurface):
     valence of each face corner, 0 where F_i is the identity).
     """
 
-    def __init__(self, mesh: QuadMesh, alpha=None):
+    def __init__(self, mesh: QuadMesh, alpha: float | Mapping[int, float] | None = None) -> None:
         super().__init__(mesh)
         val = np.asarray(mesh.valence, dtype=np.int64)
         code = np.where(mesh.is_boundary_vertex | (val == 4), 0, val)
@@ -98,11 +106,11 @@ class ReparamLimitSurface(LimitSurface):
             else:
                 a = alpha
             self.alpha[k] = check_alpha(a, k)
-        self._tangent_cache = {}
-        self._rotated_cache = {}
+        self._tangent_cache: dict[tuple[int, int], Any] = {}
+        self._rotated_cache: dict[int, LimitSurface] = {}
 
     def evaluate(self, face_ids, u, v, derivatives=1, *, parameterization="natural", chunk=CHUNK, out=None,
-                 backend=None):
+                 backend=None, threads=None):
         """Positions and derivatives at points (face, u, v) in the chosen parameterization.
 
         Parameters
@@ -113,7 +121,7 @@ class ReparamLimitSurface(LimitSurface):
         derivatives : int, 0, 1 or 2
         parameterization : {"natural", "vanishing", "characteristic"}
             bmz04 section 2, 4.2 or 4.3.
-        chunk, out, backend
+        chunk, out, backend, threads
             As in :meth:`ccproof.evaluate.surface.LimitSurface.evaluate`.
 
         Returns
@@ -141,15 +149,16 @@ class ReparamLimitSurface(LimitSurface):
         if derivatives not in (0, 1, 2):
             raise CCProofError(f"derivatives must be 0, 1 or 2, got {derivatives!r}")
         if parameterization == "natural":
-            return super().evaluate(face_ids, u, v, derivatives, chunk=chunk, out=out, backend=backend)
+            return super().evaluate(face_ids, u, v, derivatives, chunk=chunk, out=out, backend=backend,
+                                    threads=threads)
         f, u, v = self._check(face_ids, u, v)
         idx, q, s, t, k = active_points(self.corner_valence, f, u, v, parameterization)
         if idx.size == 0:
-            return super().evaluate(f, u, v, derivatives, chunk=chunk, out=out, backend=backend)
+            return super().evaluate(f, u, v, derivatives, chunk=chunk, out=out, backend=backend, threads=threads)
         res = blend_points(q, s, t, k, parameterization, self.alpha, derivatives)
         u2, v2 = u.copy(), v.copy()
         u2[idx], v2[idx] = res["u"], res["v"]
-        R = super().evaluate(f, u2, v2, derivatives, chunk=chunk, out=out, backend=backend)
+        R = super().evaluate(f, u2, v2, derivatives, chunk=chunk, out=out, backend=backend, threads=threads)
         if derivatives >= 1:
             _chain_rule(R, idx, res["J"], res.get("H"), derivatives)
         m = res["local"].max(axis=1)
@@ -232,7 +241,13 @@ class ReparamLimitSurface(LimitSurface):
         return self._tangent_cache[key]
 
 
-def limit_surface(mesh, alpha=None):
+@overload
+def limit_surface(mesh: QuadMesh | str | os.PathLike[str], alpha: float | Mapping[int, float] | None = None
+                  ) -> ReparamLimitSurface: ...
+@overload
+def limit_surface(mesh: PolyMesh, alpha: None = None) -> TaggedLimitSurface: ...
+def limit_surface(mesh: QuadMesh | PolyMesh | str | os.PathLike[str], alpha: float | Mapping[int, float] | None = None
+                  ) -> ReparamLimitSurface | TaggedLimitSurface:
     """The limit surface of a mesh: exact evaluation, normals and the parameterizations of bmz04.
 
     The one entry point for limit surfaces (``ccproof.limit_surface``). A quad mesh gives a
@@ -277,8 +292,8 @@ def limit_surface(mesh, alpha=None):
         from ccproof.evaluate.surface import natural_limit_surface
 
         return natural_limit_surface(mesh)
-    if not isinstance(mesh, QuadMesh):
-        from ccproof.mesh import read_obj
+    if isinstance(mesh, QuadMesh):
+        return ReparamLimitSurface(mesh, alpha)
+    from ccproof.mesh import read_obj
 
-        mesh = read_obj(mesh)
-    return ReparamLimitSurface(mesh, alpha)
+    return ReparamLimitSurface(read_obj(mesh), alpha)

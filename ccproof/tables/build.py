@@ -19,23 +19,17 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import Any
 
 from ccproof.algebra.characteristic_map import symbolic_bspline_nets
 from ccproof.algebra.field import integer_form_string
 from ccproof.algebra.specialize import characteristic_map_patches, valence_interval
 from ccproof.tables.format import PATCHES, SCHEMA, arb_to_json, content_hash, table_path
-from ccproof.valence import Valence
+from ccproof.valence import Valence, ValenceLike
 
 DEFAULT_PREC = 128
 DEFAULT_K_RANGE = range(3, 101)
 DEFAULT_INTERVAL_K0 = 40
-
-
-def _parse_valence(k):
-    """The int k or the text ``">=K0"`` that :mod:`ccproof.algebra.specialize` takes, from any spelling
-    :meth:`ccproof.valence.Valence.parse` reads."""
-    v = Valence.parse(k)
-    return str(v) if v.interval else v.k
 
 
 def _forms(x, y):
@@ -56,8 +50,10 @@ def _derived(nets_bez, lam, prec):
     from ccproof.rigorous import BernsteinForm, bernstein_jacobian_determinant, range_enclosure
 
     with ctx.workprec(prec):
-        det_lo, det_hi = None, None
-        max_lo, max_hi = None, None
+        det_lo: Any = None  # arb balls, once the first patch is done
+        det_hi: Any = None
+        max_lo: Any = None
+        max_hi: Any = None
         for name in PATCHES:
             net = nets_bez[name]
             X = BernsteinForm((4, 4), [net[i][j][0] for i in range(4) for j in range(4)], prec=prec)
@@ -86,7 +82,7 @@ def _derived(nets_bez, lam, prec):
         ]
         half = arb(fmpq(1, 2))
         inside = all(_curve_avoids_square(cv, half, depth=12) for cv in curves)
-        norm_hi = None
+        norm_hi: Any = None
         for cv in curves:
             xs = BernsteinForm((4,), [p[0] for p in cv], prec=prec)
             ys = BernsteinForm((4,), [p[1] for p in cv], prec=prec)
@@ -195,7 +191,7 @@ def _curve_avoids_square(curve, half, depth):
     return _curve_avoids_square(left, half, depth - 1) and _curve_avoids_square(right, half, depth - 1)
 
 
-def build_table(k, prec=DEFAULT_PREC):
+def build_table(k: ValenceLike, prec: int = DEFAULT_PREC) -> dict[str, Any]:
     """Build the certified characteristic-map table of a valence (see module docstring, docs/tables.md).
 
     Parameters
@@ -223,12 +219,12 @@ def build_table(k, prec=DEFAULT_PREC):
     from ccproof.algebra.specialize import subdominant_eigenvalue
     from ccproof.algebra.spectrum import spectral_conditions
 
-    k = _parse_valence(k)
-    interval = isinstance(k, str)
-    bez = characteristic_map_patches(k, "bezier", "arb", prec)
-    bsp = characteristic_map_patches(k, "bspline", "arb", prec)
+    v = Valence.parse(k)
+    interval = v.interval
+    bez = characteristic_map_patches(v, "bezier", "arb", prec)
+    bsp = characteristic_map_patches(v, "bspline", "arb", prec)
     if interval:
-        k0 = int(k[2:])
+        k0 = v.k
         c, lam = valence_interval(k0, prec)
         with ctx.workprec(prec):
             # all k >= k0: (28 lam - 3)/k - 2(1 - c) lam > 0 follows from 28 lam - 3 > 4 pi^2 lam / k0
@@ -238,9 +234,9 @@ def build_table(k, prec=DEFAULT_PREC):
     else:
         from ccproof.algebra.specialize import cos_2pi_over_k
 
-        c = cos_2pi_over_k(k, "arb", prec)
-        lam = subdominant_eigenvalue(k, "arb", prec)
-        sc = spectral_conditions(k, prec)
+        c = cos_2pi_over_k(v.k, "arb", prec)
+        lam = subdominant_eigenvalue(v.k, "arb", prec)
+        sc = spectral_conditions(v.k, prec)
         spectral = {"argument": "Fourier blocks (exact charpoly check in tests)", "gap": arb_to_json(sc["gap"]),
                     "ok": sc["ok"]}
     derived = _derived(bez, lam, prec)
@@ -257,7 +253,7 @@ def build_table(k, prec=DEFAULT_PREC):
 
     table = {
         "schema": SCHEMA,
-        "valence": Valence.parse(k).to_json(),
+        "valence": v.to_json(),
         "c_definition": "cos(2*pi/k)" + (" for every integer k >= k0" if interval else ""),
         "lam_definition": "(5 + c + sqrt((1 + c)*(9 + c)))/16, the larger root of 16 lam^2 - 2(5 + c) lam + 1",
         "frame": "normalized: e0 -> (1,0), e1 -> (0,1), Phi(1,0) = (1,0) (docs/readings.md R3)",

@@ -215,12 +215,13 @@ def read_table_json(path, *, check_hash=True):
     for key in ("valence", "prec", "c", "lam", "exact", "arb", "hash"):
         if key not in obj:
             raise TableFormatError(f"{path}: missing field {key!r}")
-    v = obj["valence"]
-    if isinstance(v, bool) or not (
-        (isinstance(v, int) and v >= 3)
-        or (isinstance(v, dict) and set(v) == {"min"} and isinstance(v["min"], int) and v["min"] >= 3)
-    ):
-        raise TableFormatError(f"{path}: bad valence field {v!r}")
+    from ccproof.errors import ValenceError
+    from ccproof.valence import Valence
+
+    try:
+        Valence.from_json(obj["valence"])
+    except ValenceError:
+        raise TableFormatError(f"{path}: bad valence field {obj['valence']!r}") from None
     if not isinstance(obj["prec"], int) or isinstance(obj["prec"], bool) or not 32 <= obj["prec"] <= 4096:
         raise TableFormatError(f"{path}: bad precision {obj['prec']!r}")
     if check_hash:

@@ -10,6 +10,7 @@ proof.
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -27,6 +28,7 @@ from ccproof.tables.format import (
     table_nets_exact,
     table_path,
 )
+from ccproof.valence import lam_from_c
 
 
 @dataclass(frozen=True)
@@ -64,9 +66,21 @@ def _nets(obj, form):
     return arr
 
 
-@lru_cache(maxsize=256)
-def load_table(k, directory=None):
-    """Load the certified table of valence ``k`` (hash-checked) as float64 arrays.
+def load_table(k: int, directory: str | os.PathLike[str] | None = None) -> CharacteristicTable:
+    """Load the certified table of valence ``k`` (hash-checked) as float64 arrays (cached).
+
+    Parameters
+    ----------
+    k : int
+        Valence >= 3.
+    directory : str or os.PathLike, optional
+        Folder of the tables (default: the published ``tables`` folder).
+
+    Returns
+    -------
+    CharacteristicTable
+        ``lam``, ``N`` and the read-only nets ``bspline``, ``bezier`` of shape (3, 4, 4, 2) (patch P1..P3,
+        i, j, coordinate).
 
     Raises :class:`~ccproof.errors.TableNotFoundError` listing the tables that exist.
 
@@ -74,7 +88,11 @@ def load_table(k, directory=None):
     >>> t.lam, t.N, t.bezier.shape
     (0.5, 3, (3, 4, 4, 2))
     """
-    k = check_valence(k)
+    return _load_table(check_valence(k), None if directory is None else os.fspath(directory))
+
+
+@lru_cache(maxsize=256)
+def _load_table(k: int, directory: str | None) -> CharacteristicTable:
     path = table_path(k, directory)
     try:
         obj = read_table_json(path)
@@ -118,17 +136,6 @@ class ArbCharacteristic:
 BSPLINE_TO_BEZIER_6 = ((1, 4, 1, 0), (0, 4, 2, 0), (0, 2, 4, 0), (0, 1, 4, 1))
 
 
-def lam_from_c(c):
-    """lam = (5 + c + sqrt((1 + c)(9 + c)))/16, the ``lam_definition`` written in every table (R2),
-    for a ball c (python-flint ``arb``).
-
-    >>> from flint import arb
-    >>> lam_from_c(arb(0))
-    0.500000000000000
-    """
-    return (5 + c + ((1 + c) * (9 + c)).sqrt()) / 16
-
-
 @lru_cache(maxsize=8)
 def _exact_source(directory=None):
     """(exact B-spline nets, hash) of a table: the integer forms are the same in every table."""
@@ -144,8 +151,8 @@ def characteristic_arb(k, prec=128):
 
     From the certified table of valence k when it exists and ``prec`` does not exceed its
     precision; otherwise from the exact nets of a table, evaluated in arb at ``prec`` bits with
-    c = cos(2 pi/k) and :func:`lam_from_c`, then converted to Bezier form with
-    :data:`BSPLINE_TO_BEZIER_6` (no symbolic computation). Raises
+    c = cos(2 pi/k) and lam from :func:`ccproof.valence.lam_from_c` (the table's ``lam_definition``),
+    then converted to Bezier form with :data:`BSPLINE_TO_BEZIER_6` (no symbolic computation). Raises
     :class:`~ccproof.errors.TableNotFoundError` when no table exists at all.
 
     Parameters
@@ -182,7 +189,7 @@ def characteristic_arb(k, prec=128):
     exact, source = _exact_source()
     with ctx.workprec(prec + 32):
         c = arb(fmpq(2, k)).cos_pi()
-        lam = lam_from_c(c)
+        lam = lam_from_c(c, arb.sqrt)
         nets = {}
         for name in PATCHES:
             bs = [[tuple(eval_form_arb(q, c, lam) for q in p) for p in row] for row in exact[name]]

@@ -24,8 +24,10 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ccproof.apps.arap.charts import charts_from_labels, check_disk
 from ccproof.apps.arap.hierarchy import ChartHierarchy
@@ -34,6 +36,9 @@ from ccproof.apps.arap.metrics import Metrics, sample_metrics
 from ccproof.apps.arap.samples import build_samples
 from ccproof.apps.arap.solver import LocalGlobal, iterate, system_from_samples, triangle_samples
 from ccproof.errors import CCProofError
+
+if TYPE_CHECKING:
+    from ccproof.mesh import QuadMesh
 
 __all__ = [
     "LevelStats",
@@ -91,7 +96,7 @@ class ChartTexture:
     level: int
     values: np.ndarray
     #: texture unknowns (control level of the method), and the control-level triangles
-    unknowns: np.ndarray = None
+    unknowns: np.ndarray | None = None
 
 
 @dataclass
@@ -102,15 +107,15 @@ class MethodResult:
     textures: list
     seconds: float
     iterations: int
-    metrics: Metrics = None
+    metrics: Metrics | None = None
     flips_control: int = 0
     triangles_control: int = 0
     levels: list = field(default_factory=list)
     #: times the control mesh was subdivided before optimizing (b, c)
     refine: int = 0
     #: per chart (P, UV, Q) limit samples at ``sample_level`` (see :func:`compare`), or None
-    samples: list = None
-    sample_level: int = None
+    samples: list | None = None
+    sample_level: int | None = None
 
     @property
     def name(self):
@@ -432,8 +437,9 @@ def compare(mesh, labels=None, methods=METHODS, levels=3, start_level=1, eval_le
         from tqdm import tqdm
 
         bar = tqdm(total=len(hierarchies) * len(methods), desc="arap", unit="chart")
-    acc = {m: {"texs": [], "secs": 0.0, "its": 0, "lv": [], "met": Metrics(), "fl": 0, "tot": 0, "samples": []}
-           for m in methods}
+    acc: dict[str, dict[str, Any]] = {
+        m: {"texs": [], "secs": 0.0, "its": 0, "lv": [], "met": Metrics(), "fl": 0, "tot": 0, "samples": []}
+        for m in methods}
     try:
         for i, h in enumerate(hierarchies):
             for m in methods:
@@ -494,9 +500,47 @@ def compare(mesh, labels=None, methods=METHODS, levels=3, start_level=1, eval_le
     return out, hierarchies
 
 
-def parameterize(mesh, labels=None, variant="extended", levels=3, start_level=1, eval_level=5, tol=1e-6,
-                 max_iter=1000):
-    """hsh10 parameterization of every chart: variant "extended" (c) or "boundary" (b)."""
+def parameterize(mesh: QuadMesh, labels: ArrayLike | None = None, variant: Literal["extended", "boundary"] = "extended",
+                 levels: int = 3, start_level: int = 1, eval_level: int = 5, tol: float = 1e-6, max_iter: int = 1000
+                 ) -> MethodResult:
+    """hsh10 parameterization of every chart: variant "extended" (c) or "boundary" (b).
+
+    The texture minimizing the ARAP energy of the limit surface (hsh10 Eq. 1), optimized level by level
+    (module docstring) and measured with :func:`texture_metrics`; the methods "a", "d" and the
+    comparison are :func:`compare`.
+
+    Parameters
+    ----------
+    mesh : QuadMesh
+        The control mesh; without ``labels`` it must be a disk (one chart).
+    labels : array_like of int, shape (n_faces,), optional
+        Chart label of every face (negative: in no chart); every chart must be a disk.
+    variant : {"extended", "boundary"}
+        hsh10's extended charts (method "c") or boundary rules (method "b").
+    levels, start_level, eval_level : int
+        Last and first optimization level, and the level of the metric samples (docs/hsh10.md A9).
+    tol : float
+        Relative energy decrease per iteration below which a level stops.
+    max_iter : int
+        Iterations per level at most.
+
+    Returns
+    -------
+    MethodResult
+        ``textures``: one :class:`ChartTexture` per chart (``values`` of shape (n_unknowns, 2), the texture
+        coordinates of the chart's control points at level ``level``), ``metrics``: E_angle, E_area,
+        E_stretch (hsh10 section 6), ``iterations``, ``seconds``, flipped control triangles.
+
+    Examples
+    --------
+    A planar grid is developable: its parameterization is an isometry, where E_angle and E_area reach
+    their minimum 2 and E_stretch its minimum 1 (docs/hsh10.md A9):
+
+    >>> from ccproof.mesh.examples import grid
+    >>> res = parameterize(grid(3, 3), levels=1, eval_level=2)
+    >>> res.textures[0].values.shape, [round(e, 6) for e in res.metrics.as_tuple()], res.metrics.flips
+    ((16, 2), [2.0, 2.0, 1.0], 0)
+    """
     if variant not in VARIANTS:
         raise CCProofError(f"unknown variant {variant!r}; expected one of {tuple(VARIANTS)}")
     res, hs = compare(mesh, labels, (VARIANTS[variant],), levels, start_level, eval_level, tol, max_iter)

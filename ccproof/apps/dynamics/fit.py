@@ -31,16 +31,20 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Literal
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ccproof.apps.dynamics.forces import ModelNearestPoints, Springs, check_points
 from ccproof.apps.dynamics.integrate import ImplicitIntegrator
 from ccproof.apps.dynamics.meshes import paper_initial_model
 from ccproof.apps.dynamics.model import DynamicSurface, Material
 from ccproof.errors import CCProofError
+from ccproof.mesh import QuadMesh
 
 __all__ = [
     "minimal_enclosing_sphere",
@@ -236,8 +240,8 @@ def _read_ply(path):
         dt = np.dtype([(p[0], bo + p[1]) for p in props])
         if len(body) < nv * dt.itemsize:
             raise CCProofError(f"{path}: truncated vertex list")
-        A = np.frombuffer(body[: nv * dt.itemsize], dtype=dt)
-        return np.stack([A["x"], A["y"], A["z"]], axis=1).astype(np.float64)
+        rec = np.frombuffer(body[: nv * dt.itemsize], dtype=dt)
+        return np.stack([rec["x"], rec["y"], rec["z"]], axis=1).astype(np.float64)
     raise CCProofError(f"{path}: unknown PLY format {fmt!r}")
 
 
@@ -360,26 +364,30 @@ class FitLevel:
 class FitResult:
     """Outcome of :func:`fit_points`; ``mesh`` is in the data's coordinates."""
 
-    mesh: object
-    model: object
+    mesh: QuadMesh | None
+    model: DynamicSurface | None
     levels: list = field(default_factory=list)
-    center: np.ndarray = None
+    center: np.ndarray | None = None
     diameter: float = 0.0
     parameters: dict = field(default_factory=dict)
     #: data -> surface distances of the data points (data units), at the final level
-    data_distances: np.ndarray = None
+    data_distances: np.ndarray | None = None
     #: the limit surface sampled at ``sample_level`` (QuadMesh, data units) and surface -> data report
-    surface: object = None
+    surface: QuadMesh | None = None
     sample_level: int = 0
     surface_report: dict = field(default_factory=dict)
     #: data spacing, stray distance (data units)
     spacing: float = 0.0
     stray_distance: float = 0.0
     warnings: list = field(default_factory=list)
+    #: the final control points in the normalized units of the fit (centre 0, enclosing-sphere diameter 1)
+    normalized_state: np.ndarray | None = None
 
     @property
     def two_sided_error_percent(self):
         """max(data -> surface, surface -> data) in % of the enclosing-sphere diameter (Hausdorff)."""
+        if self.data_distances is None:
+            raise CCProofError("no data distances: this FitResult was not filled by fit_points")
         return 100.0 * max(float(self.data_distances.max()), self.surface_report["max"]) / self.diameter
 
     @property
@@ -400,8 +408,6 @@ class FitResult:
 
 
 def _initial_mesh(init, Xn, init_scale):
-    from ccproof.mesh import QuadMesh
-
     if isinstance(init, str):
         if init != "cube":
             raise CCProofError(f"unknown initial model {init!r} (use 'cube' or a mesh)")
@@ -414,9 +420,13 @@ def _initial_mesh(init, Xn, init_scale):
     return init
 
 
-def fit_points(X, init="cube", levels=1, material=None, spring_total=1.0, dt=None, scheme="massless",
-               max_steps=60, tol=1e-3, init_scale=0.5, truncation=6, progress=False, callback=None,
-               sample_level=None, stray_distance_percent=None, stray_fraction=0.01):
+def fit_points(X: ArrayLike, init: Literal["cube"] | QuadMesh = "cube", levels: int = 1,
+               material: Material | None = None, spring_total: float = 1.0, dt: float | None = None,
+               scheme: Literal["massless", "inertial"] = "massless", max_steps: int = 60, tol: float = 1e-3,
+               init_scale: float = 0.5, truncation: int = 6, progress: bool = False,
+               callback: Callable[[int, int, DynamicSurface, NDArray[np.float64]], object] | None = None,
+               sample_level: int | None = None, stray_distance_percent: float | None = None,
+               stray_fraction: float = 0.01) -> FitResult:
     """Recover a closed surface from range data (module docstring).
 
     Parameters
@@ -460,8 +470,25 @@ def fit_points(X, init="cube", levels=1, material=None, spring_total=1.0, dt=Non
     Returns
     -------
     FitResult
+        ``mesh``: the fitted control mesh (QuadMesh, data coordinates; 98 vertices from the cube, x4 faces
+        per level), ``max_error_percent`` / ``mean_error_percent``: the paper's fit error (data -> limit
+        surface, % of the enclosing-sphere diameter), ``surface``: the limit surface sampled at
+        ``sample_level`` (vertices of shape (n, 3)), ``surface_report`` and ``warnings`` (surface -> data).
+
+    Examples
+    --------
+    500 points on the unit sphere, fitted from the paper's 98-vertex cube model without subdividing; the
+    limit surface (checked independently: the radii of its samples) hugs the sphere:
+
+    >>> import numpy as np
+    >>> X = np.random.default_rng(0).normal(size=(500, 3))
+    >>> X /= np.linalg.norm(X, axis=1, keepdims=True)
+    >>> fit = fit_points(X, levels=0)
+    >>> r = np.linalg.norm(fit.surface.vertices, axis=1)
+    >>> fit.mesh.n_vertices, fit.max_error_percent < 0.5, bool(0.98 < r.min() and r.max() < 1.01), fit.warnings
+    (98, True, True, [])
     """
-    X = check_cloud(X)
+    pts = check_cloud(X)  # (m, 3) float64
     if int(levels) != levels or levels < 0:
         raise CCProofError(f"levels must be an integer >= 0, got {levels!r}")
     if not (spring_total > 0 and math.isfinite(spring_total)):
@@ -471,11 +498,11 @@ def fit_points(X, init="cube", levels=1, material=None, spring_total=1.0, dt=Non
     if dt is None:
         dt = 1000.0 if scheme == "massless" else 10.0
     material = DEFAULT_FIT_MATERIAL if material is None else material
-    centre, radius = minimal_enclosing_sphere(X)
+    centre, radius = minimal_enclosing_sphere(pts)
     diameter = 2.0 * radius
     if not diameter > 0:
         raise CCProofError("the data points all coincide")
-    Xn = (X - centre) / diameter
+    Xn = (pts - centre) / diameter
     if isinstance(init, str):
         mesh0 = _initial_mesh(init, Xn, init_scale)
     else:
@@ -486,7 +513,7 @@ def fit_points(X, init="cube", levels=1, material=None, spring_total=1.0, dt=Non
     mesh0, _ = isolate_extraordinary(mesh0)
     model = DynamicSurface(mesh0, material, levels=truncation)
     P = np.array(mesh0.vertices)
-    k = np.full(X.shape[0], spring_total / X.shape[0])
+    k = np.full(pts.shape[0], spring_total / pts.shape[0])
     result = FitResult(mesh=None, model=None, center=centre, diameter=diameter,
                        parameters={"material": material, "spring_total": spring_total, "dt": dt, "scheme": scheme,
                                    "max_steps": max_steps, "tol": tol, "init_scale": init_scale,
@@ -499,7 +526,7 @@ def fit_points(X, init="cube", levels=1, material=None, spring_total=1.0, dt=Non
     try:
         for level in range(levels + 1):
             t0 = time.perf_counter()
-            finder = ModelNearestPoints(model, per_edge=samples_per_edge(model.mesh.n_faces, X.shape[0], 6))
+            finder = ModelNearestPoints(model, per_edge=samples_per_edge(model.mesh.n_faces, pts.shape[0], 6))
             integ = ImplicitIntegrator(model, dt, P=P, scheme=scheme, tol=1e-9)
             prev = None
             converged = False
@@ -535,7 +562,7 @@ def fit_points(X, init="cube", levels=1, material=None, spring_total=1.0, dt=Non
         if bar is not None:
             bar.close()
     result.model = model
-    result.mesh = model.mesh.with_vertices(P * diameter + centre)
+    result.mesh = mesh = model.mesh.with_vertices(P * diameter + centre)
     result.normalized_state = P
     result.data_distances = err["distances"] * diameter
     for i, lev in enumerate(result.levels):
@@ -544,14 +571,14 @@ def fit_points(X, init="cube", levels=1, material=None, spring_total=1.0, dt=Non
                 f"level {i} stopped at the step cap ({max_steps} steps, --max-steps) before equilibrium "
                 f"(relative energy change > {tol:g}); raise --max-steps or --dt")
     if sample_level is None:
-        nf = result.mesh.n_faces
-        sample_level = next((k for k in (1, 2, 3) if nf * 4**k >= 4 * X.shape[0]), 3)
+        nf = mesh.n_faces
+        sample_level = next((k for k in (1, 2, 3) if nf * 4**k >= 4 * pts.shape[0]), 3)
     result.sample_level = int(sample_level)
     result.surface = limit_surface_mesh(result.mesh, sample_level)
-    result.spacing = data_spacing(X)
+    result.spacing = data_spacing(pts)
     result.stray_distance = (3.0 * result.spacing if stray_distance_percent is None
                              else float(stray_distance_percent) * diameter / 100.0)
-    rep = surface_to_data(result.surface, X, result.stray_distance)
+    rep = surface_to_data(result.surface, pts, result.stray_distance)
     result.surface_report = rep
     if rep["stray_fraction"] > stray_fraction:
         result.warnings.append(
