@@ -14,19 +14,11 @@ import ccproof
 
 #: names of ccproof.__all__ whose docstrings have no example (no call is fast enough to run as a doctest);
 #: the test fails as soon as one gains an example (then drop it here) or another one lacks it
-PENDING_EXAMPLES = {
-    # one lam piece of the k >= k0 proof has 231 cells (N = 5 for every k0): ~1 min, too slow for a doctest
-    "prove_interval": "ccproof/certify/prover.py",
-}
+PENDING_EXAMPLES: dict[str, str] = {}
 
 #: public functions of ccproof.__all__ whose signatures are not annotated yet, in modules owned elsewhere
 #: (mypy checks the rest of the public API in .ci/run: [tool.mypy] in pyproject.toml)
-PENDING_ANNOTATIONS = {
-    "read_obj": "ccproof/mesh/io.py",
-    "read_mesh": "ccproof/mesh/io.py",
-    # the trusted base is kept as it is reviewed (docs/trusted_base.md)
-    "verify_file": "ccproof/certify/verify/__init__.py",
-}
+PENDING_ANNOTATIONS: dict[str, str] = {}
 
 #: public names defined more than once on purpose (or pending a module being rewritten elsewhere)
 ALLOWED_DUPLICATES = {

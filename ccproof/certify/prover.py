@@ -284,15 +284,17 @@ def prove_interval(k0: ValenceLike, prec: int = DEFAULT_PREC, progress: bool = T
         ``{"lam": [La, Lb], "parts": {"regularity", "cells", "corner"}}`` (decimal strings and boxes).
         Raises :class:`ProofFailed` when a piece still fails after ``max_pieces`` pieces.
 
-    Notes
-    -----
-    No doctest: the corner level N = 5 is set by the upper end (3 + sqrt 5)/8 = 0.6545 of the lam range,
-    whatever k0 (measured for k0 = 40, 100, 1000), so even a single piece has 231 cells of Taylor-model
-    Bernstein forms: one piece takes about a minute (k0 = 1000, the default degrees) and still ~25 s at
-    ``prec=64, taylor_degree=2, truncation_degree=1``. The published
-    ``k_ge_40.json`` is re-checked in tests/certify/test_interval.py; from the command line::
+    Examples
+    --------
+    Every k >= 10^6 with a low precision and Taylor degrees (about 5 s; the published certificates use the
+    defaults, ``ccproof certify '>=40'``):
 
-        ccproof certify '>=40'
+    >>> from ccproof.certify.verify import verify_certificate
+    >>> cert = prove_interval(10**6, prec=64, taylor_degree=2, truncation_degree=1, progress=False)
+    >>> cert["valence"], cert["N"], len(cert["pieces"])
+    ({'min': 1000000}, 5, 1)
+    >>> bool(verify_certificate(cert, log=lambda line: None))
+    True
     """
     v = Valence(k0, interval=True) if isinstance(k0, int) else Valence.parse(k0)
     if not v.interval:

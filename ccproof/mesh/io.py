@@ -11,11 +11,15 @@ line continuations with ``\\``; every other statement (``vt``, ``vn``, ``g``, ``
 from __future__ import annotations
 
 import os
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ccproof.errors import MeshError
 from ccproof.mesh.quadmesh import QuadMesh
+
+if TYPE_CHECKING:
+    from ccproof.mesh.polymesh import PolyMesh
 
 __all__ = ["read_obj", "read_obj_polygons", "read_obj_tagged", "read_mesh", "write_obj"]
 
@@ -181,7 +185,7 @@ def read_obj_tagged(path):
         raise MeshError(f"{path}: {exc}") from None
 
 
-def read_mesh(path):
+def read_mesh(path: str | os.PathLike[str]) -> PolyMesh:
     r"""Read any polygon mesh: OBJ (with OpenSubdiv tags) directly, other formats through meshio.
 
     Parameters
@@ -254,7 +258,7 @@ def read_mesh(path):
         raise MeshError(f"{p}: {exc}") from None
 
 
-def read_obj(path):
+def read_obj(path: str | os.PathLike[str]) -> QuadMesh:
     r"""Read an all-quad OBJ file into a validated :class:`QuadMesh`.
 
     Face ``f`` of the mesh is the ``f``-th ``f`` statement of the file and keeps its vertex order

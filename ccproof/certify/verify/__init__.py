@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import json
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 from .c1 import C1_SCHEMA, verify_c1
@@ -55,7 +56,7 @@ def verify_certificate(cert, log=print, path=None):
     return res
 
 
-def verify_file(path, log=print, tables_dir=None):
+def verify_file(path: str | Path, log: Callable[[str], object] = print) -> VerifyResult:
     """Verify one certificate file; logs PASS/FAIL per part, then VERIFIED or FAILED with the reason.
 
     Parameters
@@ -64,8 +65,6 @@ def verify_file(path, log=print, tables_dir=None):
         A certificate file (JSON, schema ``ccproof.injectivity/3`` or ``ccproof.c1/2``).
     log : callable
         Receives each output line (default ``print``).
-    tables_dir : ignored
-        Accepted for compatibility: the verifier reads no table.
 
     Returns
     -------
@@ -77,7 +76,6 @@ def verify_file(path, log=print, tables_dir=None):
     >>> bool(res), res.schema, res.failures()
     (True, 'ccproof.c1/2', [])
     """
-    del tables_dir
     t0 = time.perf_counter()
     path = Path(path)
     try:
