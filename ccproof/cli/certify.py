@@ -19,8 +19,9 @@ at once in the scale variables (rho, kappa) (R9). Floats never decide: every bou
 Where new certificates go by default: the repository's certificates/injectivity/ (certificates/c1/
 with --c1) when ccproof runs from a checkout; for an installed package, which only reads its
 published certificates, $XDG_DATA_HOME/ccproof/certificates/injectivity/ (XDG_DATA_HOME defaults to
-~/.local/share), never inside site-packages. The verifier reads the referenced table from the
-published tables either way.
+~/.local/share), never inside site-packages. The verifier reads no table: it derives the statement
+(c, lam, eigenvector, nets) from k and the Catmull-Clark rules and checks only the boxes of the file
+(docs/trusted_base.md).
 """
 
 from __future__ import annotations
