@@ -47,6 +47,9 @@ def add_arguments(parser):
     from ccproof.scale.engine import add_scheduler_arguments
 
     add_scheduler_arguments(parser)
+    parser.add_argument("--threads", type=int, metavar="T",
+                        help="evaluation threads per process (default: every core when the points are evaluated "
+                        "in this process, 1 per task on a Dask cluster, whose local workers are one per core)")
     parser.add_argument("--chunk", type=int, default=1_000_000, metavar="M",
                         help="points per task (default 1000000); --out FOLDER writes one .npz shard per chunk and "
                         "--points FOLDER reads one (docs/scale-out.md)")
@@ -106,8 +109,13 @@ def run(args) -> int:
         sources = point_chunks(args.chunk, samples=args.samples, seed=args.seed, n_faces=n_faces)
     t2 = time.perf_counter()
     with open_scheduler(sched, len(sources)) as sched:
-        if surface is None and sched.__class__.__name__ == "Scheduler":  # a single chunk runs here after all
+        in_process = sched.__class__.__name__ == "Scheduler"
+        if surface is None and in_process:  # a single chunk runs here after all
             surface = build_surface(mesh, tagged, args.alpha)
+        if args.threads is not None:
+            kwargs["threads"] = args.threads
+        elif not in_process:
+            kwargs["threads"] = 1  # one worker per core already: no second level of threads
         n, names, _ = evaluate_points(ship(build_surface, mesh, tagged, args.alpha), sources, args.derivatives,
                                       kwargs, args.out, sched, local=surface)
     t3 = time.perf_counter()
