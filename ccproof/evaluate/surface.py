@@ -723,8 +723,9 @@ def _vertex_maps(surface):
     frame = (np.zeros(2), np.array([1.0, 0.0]), np.array([0.0, 1.0]))
     for f in range(m):
         b.new_vface(_REGULAR, frame, f)
+    vmap = np.arange(n)
     for f in range(m):
-        b.face(topo, probe, f, frame, 0, f, vid=f, vmap=np.arange(n))
+        b.face(topo, probe, f, frame, 0, f, vid=f, vmap=vmap)
     nets = np.concatenate(b.hot[0] + b.cold[0])
     Wn = np.zeros((surface.n_patches, 17, smax))
     it, sl = np.nonzero(pslot)
