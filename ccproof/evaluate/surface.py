@@ -603,9 +603,10 @@ class LimitSurface:
 
         Everything that depends only on the connectivity (classification, patch domains, the
         locator's tables, the corner schemes) is shared with ``self``; the patch nets and the
-        irregular corners' control points are recomputed as ``W X`` with the sparse linear map ``W``
-        from the control points to them (:func:`_vertex_maps`, computed once per connectivity and
-        shared by all surfaces derived with this method). The result evaluates like
+        irregular corners' control points are recomputed as ``W X`` with the linear map ``W`` from
+        the control points to them (per patch a dense block on its base face's one-ring;
+        :func:`_vertex_maps`, computed once per connectivity and shared by all surfaces derived with
+        this method). The result evaluates like
         ``LimitSurface(mesh.with_vertices(X))`` to round-off, at a fraction of its cost (for the
         moving surfaces of ccproof.apps.dynamics).
 
@@ -680,8 +681,7 @@ def _vertex_maps(surface):
     n, m = mesh.n_vertices, mesh.n_faces
     F = np.asarray(mesh.faces)
     A = sp.csr_matrix((np.ones(4 * m), (F.ravel(), np.repeat(np.arange(m), 4))), shape=(n, m))
-    ring = (A @ ((A.T @ A) > 0)).tocsc() > 0  # ring[v, f]: v in the one-ring of face f
-    ring = ring.tocsc()
+    ring = ((A @ ((A.T @ A) > 0)) > 0).tocsc()  # ring[v, f]: v in the one-ring of face f
     ring.sort_indices()
     G = (ring @ ring.T).tocsr()
     color = np.full(n, -1, dtype=np.int64)
