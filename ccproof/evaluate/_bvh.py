@@ -36,48 +36,74 @@ def build(centres, radii):
     start, count : ndarray of int64, shape (n_nodes,)
         Leaf cells ``order[start : start + count]``.
     """
-    n = centres.shape[0]
-    order = np.arange(n)
-    lo_l, hi_l, child_l, start_l, count_l = [], [], [], [], []
+    centres = np.ascontiguousarray(centres, dtype=np.float64).reshape(-1, 3)
+    radii = np.ascontiguousarray(radii, dtype=np.float64).reshape(-1)
     smin = centres - radii[:, None]
     smax = centres + radii[:, None]
+    order, lo, hi, child, start, count, nn = _build(centres, smin, smax, LEAF)
+    return order, lo[:nn].copy(), hi[:nn].copy(), child[:nn].copy(), start[:nn].copy(), count[:nn].copy()
 
-    def node(s, e):
-        idx = order[s:e]
-        i = len(lo_l)
-        lo_l.append(smin[idx].min(axis=0))
-        hi_l.append(smax[idx].max(axis=0))
-        child_l.append([-1, -1])
-        start_l.append(s)
-        count_l.append(e - s)
-        if e - s > LEAF:
-            c = centres[idx]
-            ax = int(np.argmax(c.max(axis=0) - c.min(axis=0)))
-            mid = (e - s) // 2
-            part = np.argpartition(c[:, ax], mid)
-            order[s:e] = idx[part]
-            a = node(s, s + mid)
-            b = node(s + mid, e)
-            child_l[i] = [a, b]
-        return i
 
-    if n:
-        import sys
+def _build(centres, smin, smax, leaf):
+    """Depth-first construction (pre-order node numbering, left child first) with an explicit stack:
+    a node's box holds its cells' spheres; a node of more than ``leaf`` cells is split at the median of
+    its centres along their widest axis."""
+    n = centres.shape[0]
+    order = np.arange(n)
+    cap = 2 * n + 2
+    lo = np.empty((cap, 3))
+    hi = np.empty((cap, 3))
+    child = np.full((cap, 2), -1, dtype=np.int64)
+    start = np.zeros(cap, dtype=np.int64)
+    count = np.zeros(cap, dtype=np.int64)
+    stack = np.empty((256, 4), dtype=np.int64)  # (s, e, parent, side); depth is about log2(n / leaf)
+    nn = 0
+    top = 0
+    if n > 0:
+        stack[0, 0], stack[0, 1], stack[0, 2], stack[0, 3] = 0, n, -1, 0
+        top = 1
+    while top > 0:
+        top -= 1
+        s, e, parent, side = stack[top, 0], stack[top, 1], stack[top, 2], stack[top, 3]
+        i = nn
+        nn += 1
+        if parent >= 0:
+            child[parent, side] = i
+        start[i] = s
+        count[i] = e - s
+        cmin = np.full(3, np.inf)
+        cmax = np.full(3, -np.inf)
+        for a in range(3):
+            lo[i, a] = np.inf
+            hi[i, a] = -np.inf
+        for q in range(s, e):
+            j = order[q]
+            for a in range(3):
+                lo[i, a] = min(lo[i, a], smin[j, a])
+                hi[i, a] = max(hi[i, a], smax[j, a])
+                cmin[a] = min(cmin[a], centres[j, a])
+                cmax[a] = max(cmax[a], centres[j, a])
+        if e - s > leaf:
+            ax = 0
+            for a in range(1, 3):
+                if cmax[a] - cmin[a] > cmax[ax] - cmin[ax]:
+                    ax = a
+            idx = order[s:e].copy()
+            keys = np.empty(e - s)
+            for q in range(e - s):
+                keys[q] = centres[idx[q], ax]
+            perm = np.argsort(keys)
+            for q in range(e - s):
+                order[s + q] = idx[perm[q]]
+            mid = s + (e - s) // 2
+            stack[top, 0], stack[top, 1], stack[top, 2], stack[top, 3] = mid, e, i, 1
+            stack[top + 1, 0], stack[top + 1, 1], stack[top + 1, 2], stack[top + 1, 3] = s, mid, i, 0
+            top += 2
+    return order, lo, hi, child, start, count, nn
 
-        old = sys.getrecursionlimit()
-        sys.setrecursionlimit(max(old, 10000))
-        try:
-            node(0, n)
-        finally:
-            sys.setrecursionlimit(old)
-    return (
-        order,
-        np.array(lo_l).reshape(-1, 3),
-        np.array(hi_l).reshape(-1, 3),
-        np.array(child_l, dtype=np.int64).reshape(-1, 2),
-        np.array(start_l, dtype=np.int64),
-        np.array(count_l, dtype=np.int64),
-    )
+
+if numba is not None:  # pragma: no branch
+    _build = numba.njit(cache=True, nogil=True)(_build)
 
 
 def _traverse(X, dstar, order, lo, hi, child, start, count, c, nrm, r, h, out_p, out_c, out_lb, cap):

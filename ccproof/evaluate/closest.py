@@ -254,9 +254,12 @@ class ClosestPointFinder:
         A descent in a face covers its start cell and the candidate cells of that face within
         ``cover`` cells of its end cell (default ``COVER``; ``cover >= cells``: the whole face, i.e.
         one descent per point and face, faster but it misses a second local minimum in a face).
+    faces : array_like of int, optional
+        Search only these parameter faces (default: all); e.g. the faces that carry a patch of a
+        finite-element model (ccproof.apps.dynamics). The answers lie on these faces only.
     """
 
-    def __init__(self, surface, cells=CELLS, cover=None):
+    def __init__(self, surface, cells=CELLS, cover=None, faces=None):
         from scipy.spatial import cKDTree
 
         if int(cells) != cells or cells < 1:
@@ -264,12 +267,21 @@ class ClosestPointFinder:
         self.surface = surface
         self.m = m = int(cells)
         self.cover = min(COVER, m) if cover is None else int(cover)
-        nf = parameter_faces(surface)
-        self.n_faces = nf
+        nall = parameter_faces(surface)
+        if faces is None:
+            sel = np.arange(nall)
+        else:
+            sel = np.unique(np.asarray(faces).reshape(-1))
+            if sel.size == 0 or not np.issubdtype(sel.dtype, np.integer) or sel[0] < 0 or sel[-1] >= nall:
+                raise CCProofError(f"faces must be a non-empty list of parameter faces in [0, {nall})")
+            sel = sel.astype(np.int64)
+        self.faces = sel
+        nf = sel.size
+        self.n_faces = nall
         g = 2 * m + 1
         t = np.arange(g) / (2 * m)
         U, V = np.meshgrid(t, t, indexing="ij")  # [i along u, j along v]
-        fu = np.repeat(np.arange(nf), g * g)
+        fu = np.repeat(sel, g * g)
         r = surface.evaluate(fu, np.tile(U.ravel(), nf), np.tile(V.ravel(), nf), 1)
         S = r["P"].reshape(nf, g, g, 3)
         Nrm = _unit_normal(r["Pu"], r["Pv"]).reshape(nf, g, g, 3)
@@ -314,7 +326,7 @@ class ClosestPointFinder:
         # (unbalanced, non-compact nodes: several times faster queries for points far from the surface)
         self._ctree = cKDTree(self._c, balanced_tree=False, compact_nodes=False)
         cid = np.arange(nf * m * m)
-        self._cface = cid // (m * m)
+        self._cface = sel[cid // (m * m)]
         self._ci = (cid // m) % m
         self._cj = cid % m
 
@@ -454,7 +466,7 @@ def _check_points(X):
     return X
 
 
-def closest_points(surface, X, *, cells=CELLS, cover=None, finder=None):
+def closest_points(surface, X, *, cells=CELLS, cover=None, faces=None, finder=None):
     """Globally nearest limit points of ``X`` (shape (n, 3)) on ``surface``.
 
     Parameters
@@ -464,6 +476,8 @@ def closest_points(surface, X, *, cells=CELLS, cover=None, finder=None):
     cells, cover : int
         Cells per face side of the search structure, covering radius of a descent in cells
         (default ``COVER``); see :class:`ClosestPointFinder`.
+    faces : array_like of int, optional
+        Search only these parameter faces (default: all).
     finder : ClosestPointFinder, optional
         A prepared search structure to reuse (then ``surface`` and ``cells`` are ignored).
 
@@ -486,5 +500,5 @@ def closest_points(surface, X, *, cells=CELLS, cover=None, finder=None):
             from ccproof.evaluate.surface import limit_surface
 
             surface = limit_surface(surface)
-        finder = ClosestPointFinder(surface, cells=cells, cover=cover)
+        finder = ClosestPointFinder(surface, cells=cells, cover=cover, faces=faces)
     return finder.query(X)

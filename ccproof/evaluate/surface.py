@@ -164,7 +164,7 @@ class _Builder:
 
     @staticmethod
     def _store(region, nets, origin, doms):
-        block = np.empty((nets.shape[0], 17, 3))
+        block = np.empty((nets.shape[0], 17, nets.shape[-1]))  # 3 coordinates (or probe columns)
         block[:, :16] = nets
         block[:, 16] = origin
         region[0].append(block)
@@ -212,12 +212,12 @@ class _Builder:
         origin = C[0] + scheme.limit_mask @ rel
         L = scheme.layers
         nl = L.shape[0]
-        dev = (L.reshape(-1, L.shape[-1]) @ rel).reshape(nl, 3, 16, 3)  # (n_layers, 3, 16, 3)
+        dev = (L.reshape(-1, L.shape[-1]) @ rel).reshape(nl, 3, 16, -1)  # (n_layers, 3, 16, 3)
         # P_1 lies along the frame's a-axis: code 0 (u-distance >= 1/2, v-distance < 1/2) if a is
         # along u, else code 2; P_2 (diagonal) is code 1; P_3 the other one
         a_along_u = abs(rot[1][0]) > 0
         codes = {1: 0 if a_along_u else 2, 2: 1, 3: 2 if a_along_u else 0}
-        nets = np.empty((nl, 3, 16, 3))
+        nets = np.empty((nl, 3, 16, rel.shape[-1]))
         doms = np.empty((nl, 3, 3))
         for j in (1, 2, 3):
             f0 = _compose(rot, _layer_frame(0, j))
@@ -230,8 +230,8 @@ class _Builder:
             doms[:, codes[j], 1] = corner[1] + (v0 - corner[1]) * sc
             doms[:, codes[j], 2] = h0 * sc
         K = min(HOT_LAYERS, nl)
-        self._store(self.hot, nets[:K].reshape(-1, 16, 3), origin, doms[:K].reshape(-1, 3))
-        self._store(self.cold, nets[K:].reshape(-1, 16, 3), origin, doms[K:].reshape(-1, 3))
+        self._store(self.hot, nets[:K].reshape(-1, 16, rel.shape[-1]), origin, doms[:K].reshape(-1, 3))
+        self._store(self.cold, nets[K:].reshape(-1, 16, rel.shape[-1]), origin, doms[K:].reshape(-1, 3))
         self.vpatch[vid] = self.n_hot
         self.vcold[vid] = self.n_cold - 3 * K  # patch of layer n >= K: vcold + n_hot_total + 3 n + code
         self.n_hot += 3 * K
@@ -596,6 +596,145 @@ class LimitSurface:
 
     def _base_face_of(self, vid):
         return int(self._vbase[vid])
+
+    # ------------------------------------------------------------------ moved control points
+    def with_vertices(self, X):
+        """The limit surface of the same mesh with the control points ``X`` (n_vertices, 3).
+
+        Everything that depends only on the connectivity (classification, patch domains, the
+        locator's tables, the corner schemes) is shared with ``self``; the patch nets and the
+        irregular corners' control points are recomputed as ``W X`` with the linear map ``W`` from
+        the control points to them (per patch a dense block on its base face's one-ring;
+        :func:`_vertex_maps`, computed once per connectivity and shared by all surfaces derived with
+        this method). The result evaluates like
+        ``LimitSurface(mesh.with_vertices(X))`` to round-off, at a fraction of its cost (for the
+        moving surfaces of ccproof.apps.dynamics).
+
+        Parameters
+        ----------
+        X : array_like, shape (n_vertices, 3)
+
+        Returns
+        -------
+        LimitSurface
+
+        Examples
+        --------
+        >>> from ccproof.mesh.examples import cube
+        >>> S = natural_limit_surface(cube())
+        >>> T = S.with_vertices(2.0 * np.asarray(cube().vertices))
+        >>> np.round(T.evaluate([0], [0.0], [0.0])["P"][0], 12).tolist()
+        [-1.0, -1.0, -1.0]
+        """
+        if type(self) is not LimitSurface:
+            raise CCProofError(f"with_vertices is implemented for LimitSurface only, not {type(self).__name__}")
+        mesh = self.mesh.with_vertices(X)  # checks the shape and finiteness (MeshError)
+        maps = self.__dict__.get("_maps")
+        if maps is None:
+            maps = self._maps = _vertex_maps(self)
+        V = mesh.vertices
+        new = object.__new__(LimitSurface)
+        new.__dict__.update(self.__dict__)
+        new.mesh = mesh
+        new._nets = np.ascontiguousarray(maps.apply(maps.nets, V))
+        C = maps.apply(maps.corners, V)
+        new._corner_data = {vid: (self._corner_data[vid][0], C[i, : maps.corner_rows[i]])
+                            for i, vid in enumerate(maps.corner_vids)}
+        new._corner_of_vertex = {v: (sch, new._corner_data[vid][1], vid)
+                                 for v, (sch, _, vid) in self._corner_of_vertex.items()}
+        new._corner_normal = {}
+        return new
+
+
+class _VertexMaps:
+    """Linear maps from the control points to the stored nets and corner rings of a LimitSurface.
+
+    ``nets``, ``corners``: ``(W, idx)`` with ``W`` of shape (k, rows, s) and ``idx`` (k, s) vertex ids
+    (padded with weight 0): item i is ``W[i] @ X[idx[i]]``, of shape (rows, 3).
+    """
+
+    def __init__(self, nets, corners, corner_vids, corner_rows):
+        self.nets, self.corners = nets, corners
+        self.corner_vids, self.corner_rows = corner_vids, corner_rows
+
+    @staticmethod
+    def apply(m, X):
+        W, idx = m
+        return W @ X[idx]
+
+
+def _vertex_maps(surface):
+    """The linear maps of :meth:`LimitSurface.with_vertices`, by probing.
+
+    Every stored net and every corner ring of base face f is a linear function, the same for each
+    coordinate, of the control points of the one-ring of f (the faces sharing a vertex with f: the
+    builder reads nothing else). The vertices are coloured so that no one-ring holds two vertices
+    of the same colour (greedy colouring of the graph "in a common one-ring"); the tables are built
+    once more with the c indicator vectors of the colours as coordinates (c columns instead of x, y,
+    z: the builder treats every column alike), and the coefficient of vertex v in an item of face f
+    is read off the column of v's colour. The cost is about that of one more build (c is 16 to 27
+    on the meshes of ccproof.apps.dynamics).
+    """
+    import scipy.sparse as sp
+
+    mesh = surface.mesh
+    n, m = mesh.n_vertices, mesh.n_faces
+    F = np.asarray(mesh.faces)
+    A = sp.csr_matrix((np.ones(4 * m), (F.ravel(), np.repeat(np.arange(m), 4))), shape=(n, m))
+    ring = ((A @ ((A.T @ A) > 0)) > 0).tocsc()  # ring[v, f]: v in the one-ring of face f
+    ring.sort_indices()
+    G = (ring @ ring.T).tocsr()
+    color = np.full(n, -1, dtype=np.int64)
+    for v in range(n):
+        used = color[G.indices[G.indptr[v] : G.indptr[v + 1]]]
+        free = np.flatnonzero(np.bincount(used[used >= 0], minlength=len(used) + 1) == 0)
+        color[v] = free[0]
+    # base face of every patch and of every corner ring
+    pbase = np.full(surface.n_patches, -1, dtype=np.int64)
+    kind, vp, vb = surface._vkind, surface._vpatch, surface._vbase
+    reg = np.flatnonzero((kind == _REGULAR) & (vp >= 0))
+    pbase[vp[reg]] = vb[reg]
+    for vid in np.flatnonzero(kind == _CORNER):
+        nl = int(surface._vnmax[vid]) + 1
+        k = min(surface.hot_layers, nl)
+        pbase[vp[vid] : vp[vid] + 3 * k] = vb[vid]
+        pbase[surface._vcold[vid] + 3 * k : surface._vcold[vid] + 3 * nl] = vb[vid]
+    if (pbase < 0).any():  # pragma: no cover - would be a bug in the tables
+        raise MeshError(f"internal error: patch {int(np.flatnonzero(pbase < 0)[0])} has no base face")
+    cvids = sorted(surface._corner_data)
+    crows = np.array([surface._corner_data[v][1].shape[0] for v in cvids], dtype=np.int64)
+    cbase = vb[np.array(cvids, dtype=np.int64)] if cvids else np.zeros(0, dtype=np.int64)
+    size = np.diff(ring.indptr)
+    smax = int(size.max())
+
+    def support(base):
+        idx = np.zeros((base.size, smax), dtype=np.int64)
+        slot = np.arange(smax)[None, :] < size[base][:, None]
+        idx[slot] = ring.indices[(ring.indptr[base][:, None] + np.arange(smax)[None, :])[slot]]
+        return idx, slot
+
+    pidx, pslot = support(pbase)
+    cidx, cslot = support(cbase)
+    # one build with the colours' indicator vectors as coordinates (the builder is linear, column by column)
+    probe = np.zeros((n, int(color.max()) + 1))
+    probe[np.arange(n), color] = 1.0
+    b = _Builder()
+    topo = LocalTopology(mesh.faces)
+    frame = (np.zeros(2), np.array([1.0, 0.0]), np.array([0.0, 1.0]))
+    for f in range(m):
+        b.new_vface(_REGULAR, frame, f)
+    vmap = np.arange(n)
+    for f in range(m):
+        b.face(topo, probe, f, frame, 0, f, vid=f, vmap=vmap)
+    nets = np.concatenate(b.hot[0] + b.cold[0])
+    Wn = np.zeros((surface.n_patches, 17, smax))
+    it, sl = np.nonzero(pslot)
+    Wn[it, :, sl] = nets[it, :, color[pidx[it, sl]]]
+    Wc = np.zeros((len(cvids), int(crows.max()) if cvids else 0, smax))
+    for i, vid in enumerate(cvids):
+        sl = np.flatnonzero(cslot[i])
+        Wc[i, : crows[i], sl] = b.corner_data[vid][1][:, color[cidx[i, sl]]].T
+    return _VertexMaps((Wn, pidx), (Wc, cidx), cvids, crows)
 
 
 def _threads(threads, n):

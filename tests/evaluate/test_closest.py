@@ -22,13 +22,15 @@ def surfaces(refdir):
     return {name: limit_surface(refdir / "meshes" / f"{name}.obj") for name in MESHES}
 
 
-def brute_force(S, X, level=6, faces_per_point=4):
-    """Nearest limit point by dense sampling plus grid-search refinement (positions only)."""
-    nf = S.mesh.n_faces
+def brute_force(S, X, level=6, faces_per_point=4, faces=None):
+    """Nearest limit point (on ``faces``, default all) by dense sampling plus grid-search refinement
+    (positions only)."""
+    faces = np.arange(S.mesh.n_faces) if faces is None else np.asarray(faces)
+    nf = faces.size
     L = 2**level
     t = np.arange(L + 1) / L
     U, V = np.meshgrid(t, t, indexing="ij")
-    fu = np.repeat(np.arange(nf), (L + 1) ** 2)
+    fu = np.repeat(faces, (L + 1) ** 2)
     uu, vv = np.tile(U.ravel(), nf), np.tile(V.ravel(), nf)
     T = cKDTree(S.evaluate(fu, uu, vv, 0)["P"])
     _, J = T.query(X, k=min(256, fu.size))
@@ -195,6 +197,24 @@ def test_finder_reuse_and_options(surfaces):
     F = ClosestPointFinder(S)
     c = F(X[:5])
     np.testing.assert_array_equal(c.distance, F.query(X[:5]).distance)
+
+
+def test_restricted_to_faces(surfaces):
+    """``faces=``: the nearest point among the given faces only (brute force over the same faces)."""
+    S = surfaces["sector_k5"]
+    X = _points(S, 40, seed=12)
+    sel = np.arange(0, S.mesh.n_faces, 3)
+    res = closest_points(S, X, faces=sel)
+    assert np.isin(res.face, sel).all()
+    ref, refP = brute_force(S, X, level=5, faces=sel)
+    assert (res.distance <= ref + 1e-12 * (1 + ref)).all()
+    assert (ref <= res.distance + 1e-9).all()
+    full = closest_points(S, X)
+    assert (full.distance <= res.distance + 1e-12).all() and (full.distance < res.distance - 1e-3).any()
+    with pytest.raises(CCProofError, match="faces"):
+        ClosestPointFinder(S, faces=[S.mesh.n_faces])
+    with pytest.raises(CCProofError, match="faces"):
+        ClosestPointFinder(S, faces=[])
 
 
 def test_bad_input(surfaces):

@@ -8,10 +8,10 @@ Pipeline (:func:`fit_points`):
    (centred at the centroid, control cube half-extents ``init_scale`` times the data's half-extents),
    or a user mesh;
 3. evolve with the massless scheme (32) (default) or (31) under data springs: every data point pulls
-   its nearest limit-surface point (re-projected every step), until equilibrium: the total energy
-   (elastic + springs) changes by less than ``tol`` (relative) between steps t - dt and t + dt (the
-   paper's criterion, section 3.4; two steps because (32) advances two interleaved sequences), or
-   ``max_steps``;
+   its nearest limit-surface point (the global closest point, :mod:`ccproof.evaluate.closest`;
+   re-projected every step), until equilibrium: the total energy (elastic + springs) changes by less
+   than ``tol`` (relative) between steps t - dt and t + dt (the paper's criterion, section 3.4; two
+   steps because (32) advances two interleaved sequences), or ``max_steps``;
 4. subdivide globally and rebuild the model (densities rescaled, :meth:`Material.refined`), refit;
    repeat ``levels`` times;
 5. report the paper's fit error: the largest distance of a data point to the limit surface, in % of the
@@ -39,7 +39,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ccproof.apps.dynamics.forces import ModelNearestPoints, Springs, check_points
+from ccproof.apps.dynamics.forces import ModelClosestPoints, Springs, check_points
 from ccproof.apps.dynamics.integrate import ImplicitIntegrator
 from ccproof.apps.dynamics.meshes import paper_initial_model
 from ccproof.apps.dynamics.model import DynamicSurface, Material
@@ -58,7 +58,6 @@ __all__ = [
     "limit_surface_mesh",
     "surface_to_data",
     "data_spacing",
-    "samples_per_edge",
 ]
 
 #: material of the shape-recovery runs, in units where the data's enclosing sphere has diameter 1
@@ -248,32 +247,16 @@ def _read_ply(path):
 # ---------------------------------------------------------------------------- fitting
 
 
-def samples_per_edge(n_faces, n_points, most, budget=50_000):
-    """Samples per face edge of the closest-point initial guesses: ``most`` on small models, fewer on
-    large ones so that the sample count stays about ``max(budget, 16 n_points)`` (memory linear in the
-    data and the mesh, not in their product); at least 2. The Gauss-Newton refinement does the rest.
-
-    >>> samples_per_edge(96, 2000, 12), samples_per_edge(24576, 20000, 12)
-    (12, 4)
-    """
-    target = max(budget, 16 * int(n_points))
-    return int(min(most, max(2, math.ceil(math.sqrt(target / max(int(n_faces), 1))))))
-
-
-def fit_error(model, P, X, finder=None, per_edge=None, diameter=None):
-    """Distances of the data points to the limit surface (nearest points) and the paper's fit error.
-
-    ``per_edge``: samples per face edge of the initial guesses (default :func:`samples_per_edge` with
-    at most 12).
+def fit_error(model, P, X, finder=None, diameter=None):
+    """Distances of the data points to the limit surface (global closest points,
+    :class:`~ccproof.apps.dynamics.forces.ModelClosestPoints`) and the paper's fit error.
 
     Returns a dict: ``max``, ``mean`` (absolute), ``max_percent``, ``mean_percent`` (of the diameter
     of the minimal enclosing sphere of X, or of ``diameter``), ``distances``.
     """
     X = check_points(X)
     if finder is None:
-        if per_edge is None:
-            per_edge = samples_per_edge(model.mesh.n_faces, X.shape[0], 12)
-        finder = ModelNearestPoints(model, per_edge=per_edge, candidates=4, iterations=12)
+        finder = ModelClosestPoints(model)
     *_, dist = finder.query(P, X)
     if diameter is None:
         diameter = 2.0 * minimal_enclosing_sphere(X)[1]
@@ -526,16 +509,14 @@ def fit_points(X: ArrayLike, init: Literal["cube"] | QuadMesh = "cube", levels: 
     try:
         for level in range(levels + 1):
             t0 = time.perf_counter()
-            finder = ModelNearestPoints(model, per_edge=samples_per_edge(model.mesh.n_faces, pts.shape[0], 6))
+            finder = ModelClosestPoints(model)
             integ = ImplicitIntegrator(model, dt, P=P, scheme=scheme, tol=1e-9)
-            prev = None
             converged = False
             cg = 0
             step = 0
             energies = []
             for step in range(1, max_steps + 1):
-                f, u, v, _, _ = finder.query(integ.P, Xn, previous=prev)
-                prev = (f, u, v)
+                f, u, v, _, _ = finder.query(integ.P, Xn)
                 springs = Springs(model, f, u, v, Xn, k)
                 info = integ.step(springs=springs)
                 cg += info.iterations
@@ -552,7 +533,7 @@ def fit_points(X: ArrayLike, init: Literal["cube"] | QuadMesh = "cube", levels: 
             if bar is not None and step < max_steps:
                 bar.update(max_steps - step)
             P = integ.P
-            err = fit_error(model, P, Xn, diameter=1.0)
+            err = fit_error(model, P, Xn, finder=finder, diameter=1.0)
             result.levels.append(FitLevel(model.n_vertices, model.mesh.n_faces, step, converged,
                                           err["max_percent"], err["mean_percent"], time.perf_counter() - t0, cg))
             if level < levels:

@@ -6,20 +6,24 @@ springs is stored as the sparse matrix ``J_S`` (one row ``J(u0, v0)`` per spring
 the anchor points; :class:`~ccproof.apps.dynamics.integrate.ImplicitIntegrator` moves ``k J^T J``
 into the step matrix (semi-implicit).
 
-Range data: every data point pulls the *nearest* point of the limit surface (docs/qmv98.md B7.4, B7.5): the
-surface is sampled densely (a grid per face, evaluated through a precomputed sparse sampling matrix),
-the nearest samples are found with a k-d tree, and each candidate is refined by a projected
-Gauss-Newton iteration on (u, v) inside its face; the closest candidate wins.
+Range data: every data point pulls the *nearest* point of the limit surface (docs/qmv98.md B7.4, B7.5),
+found by the package's global closest-point search (:mod:`ccproof.evaluate.closest`: bounding cylinders
+of sampled cells, a bounding-volume hierarchy, projected Newton descents) on the exact evaluator
+:class:`ccproof.evaluate.LimitSurface` of the current state (:class:`ModelClosestPoints`). The FEM
+model and the evaluator share the face parameter of :class:`ccproof.mesh.QuadMesh` (face ``f``, its
+corner i at (0,0), (1,0), (1,1), (0,1)), so the answer ``(face, u, v)`` is the attachment point of
+the model as it is.
 """
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
-from scipy.spatial import cKDTree
 
 from ccproof.errors import CCProofError
 
-__all__ = ["Springs", "ModelNearestPoints", "check_points"]
+__all__ = ["Springs", "ModelClosestPoints", "closest_cells", "check_points"]
 
 
 def check_points(X, name="point cloud"):
@@ -98,96 +102,60 @@ class Springs:
     def to_nearest(cls, model, P, anchors, stiffness, finder=None):
         """Springs attached to the points of the limit surface (state P) nearest to the anchors."""
         anchors = check_points(anchors, "spring anchors")
-        finder = ModelNearestPoints(model) if finder is None else finder
+        finder = ModelClosestPoints(model) if finder is None else finder
         f, u, v, _, _ = finder.query(P, anchors)
         return cls(model, f, u, v, anchors, stiffness)
 
 
-class ModelNearestPoints:
-    """Nearest points of the limit surface of a model to query points (module docstring).
+def closest_cells(n_faces, budget=25_000, most=8):
+    """Cells per face side of the closest-point search on a model with ``n_faces`` patch faces: about
+    ``budget`` cells in all (the search structure is rebuilt at every correspondence update, so its
+    cost and memory stay bounded on fine meshes), at most ``most``, at least 1.
+
+    >>> closest_cells(96), closest_cells(1536), closest_cells(24576)
+    (8, 4, 1)
+    """
+    return int(min(most, max(1, round(math.sqrt(budget / max(int(n_faces), 1))))))
+
+
+class ModelClosestPoints:
+    """Globally nearest points of the limit surface of a model's state (module docstring).
+
+    The evaluator of the model's mesh is built once; every :meth:`query` moves it to the state ``P``
+    (:meth:`ccproof.evaluate.LimitSurface.with_vertices`, the connectivity's tables re-used) and runs
+    :class:`ccproof.evaluate.closest.ClosestPointFinder` on the faces that carry a patch of the model.
 
     Parameters
     ----------
     model : DynamicSurface
-    per_edge : int
-        Samples per face edge for the initial guess.
-    candidates : int
-        Nearest samples refined per query point (in distinct positions).
-    iterations : int
-        Gauss-Newton iterations.
+    cells : int, optional
+        Cells per face side of the search (default :func:`closest_cells`).
     """
 
-    def __init__(self, model, per_edge=6, candidates=2, iterations=6):
+    def __init__(self, model, cells=None):
+        from ccproof.evaluate import LimitSurface
+
         self.model = model
-        self.per_edge = int(per_edge)
-        self.candidates = int(candidates)
-        self.iterations = int(iterations)
-        self.sf, self.su, self.sv = model.sample_parameters(self.per_edge)
-        self.sample_basis = model.basis(self.sf, self.su, self.sv)["P"]
+        self.faces = np.flatnonzero(model.layout.face_kind > 0)
+        self.cells = closest_cells(self.faces.size) if cells is None else int(cells)
+        self.surface = LimitSurface(model.mesh)
 
-    def query(self, P, X, previous=None):
-        """Nearest limit-surface points to X (m, 3) for the state P.
-
-        Parameters
-        ----------
-        previous : tuple (faces, u, v), optional
-            Earlier attachments, refined as one more candidate (warm start).
+    def query(self, P, X):
+        """Nearest limit-surface points to X (m, 3) for the state P (n, 3).
 
         Returns
         -------
-        faces, u, v : (m,) the attachment parameters
+        faces, u, v : (m,) the attachment parameters (faces with a patch of the model)
         points : (m, 3) the limit-surface points
         dist : (m,) their distances to X
         """
+        from ccproof.evaluate.closest import ClosestPointFinder
+
         X = check_points(X, "query points")
         P = np.asarray(P, dtype=np.float64)
-        S = self.sample_basis @ P
-        tree = cKDTree(S)
-        kq = min(self.candidates, S.shape[0])
-        _, idx = tree.query(X, k=kq)
-        idx = idx.reshape(X.shape[0], kq)
-        F = [self.sf[idx[:, c]] for c in range(kq)]
-        U = [self.su[idx[:, c]] for c in range(kq)]
-        V = [self.sv[idx[:, c]] for c in range(kq)]
-        if previous is not None:
-            F.append(np.asarray(previous[0]))
-            U.append(np.asarray(previous[1], dtype=np.float64))
-            V.append(np.asarray(previous[2], dtype=np.float64))
-        nc = len(F)
-        f = np.concatenate(F)
-        u = np.concatenate(U)
-        v = np.concatenate(V)
-        Xr = np.tile(X, (nc, 1))
-        f, u, v, pts, d = self._newton(P, Xr, f, u, v)
-        d = d.reshape(nc, -1)
-        best = np.argmin(d, axis=0)
-        m = X.shape[0]
-        sel = best * m + np.arange(m)
-        return f[sel], u[sel], v[sel], pts[sel], d[best, np.arange(m)]
-
-    def _newton(self, P, X, f, u, v):
-        ev = self.model.evaluator(P)
-        r = ev.evaluate(f, u, v, 1)
-        best_u, best_v, best_p = u.copy(), v.copy(), r["P"]
-        best_d = np.linalg.norm(r["P"] - X, axis=1)
-        for _ in range(self.iterations):
-            res = r["P"] - X
-            a = np.einsum("ij,ij->i", r["Pu"], r["Pu"])
-            b = np.einsum("ij,ij->i", r["Pu"], r["Pv"])
-            c = np.einsum("ij,ij->i", r["Pv"], r["Pv"])
-            gu = np.einsum("ij,ij->i", r["Pu"], res)
-            gv = np.einsum("ij,ij->i", r["Pv"], res)
-            reg = 1e-12 * (a + c) + 1e-300
-            det = (a + reg) * (c + reg) - b * b
-            ok = det > 0
-            det = np.where(ok, det, 1.0)
-            du = np.where(ok, -((c + reg) * gu - b * gv) / det, 0.0)
-            dv = np.where(ok, -((a + reg) * gv - b * gu) / det, 0.0)
-            u = np.clip(u + du, 0.0, 1.0)
-            v = np.clip(v + dv, 0.0, 1.0)
-            r = ev.evaluate(f, u, v, 1)
-            d = np.linalg.norm(r["P"] - X, axis=1)
-            better = d < best_d
-            best_u[better], best_v[better], best_d[better] = u[better], v[better], d[better]
-            best_p[better] = r["P"][better]
-        return f, best_u, best_v, best_p, best_d
+        if P.shape != (self.model.n_vertices, 3):
+            raise CCProofError(f"control points must have shape ({self.model.n_vertices}, 3), got {P.shape}")
+        S = self.surface.with_vertices(P)
+        faces = None if self.faces.size == self.model.mesh.n_faces else self.faces
+        r = ClosestPointFinder(S, cells=self.cells, faces=faces).query(X)
+        return r.face, r.u, r.v, r.P, r.distance

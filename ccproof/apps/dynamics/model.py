@@ -477,19 +477,6 @@ class DynamicSurface:
         """A :class:`LimitEvaluator` of the limit surface of the state P (default: the mesh's vertices)."""
         return LimitEvaluator(self, self.vertices if P is None else P)
 
-    def sample_parameters(self, per_edge=8):
-        """A grid of ``per_edge x per_edge`` cell-centred parameters on every face with a patch.
-
-        Returns ``faces, u, v`` (flat arrays).
-        """
-        per_edge = int(per_edge)
-        if per_edge < 1:
-            raise CCProofError("per_edge must be >= 1")
-        f = np.flatnonzero(self.layout.face_kind > 0)
-        g = (np.arange(per_edge) + 0.5) / per_edge
-        uu, vv = np.meshgrid(g, g, indexing="ij")
-        return np.repeat(f, uu.size), np.tile(uu.reshape(-1), f.size), np.tile(vv.reshape(-1), f.size)
-
     # ------------------------------------------------------------------ multilevel
     def refine(self, P=None, rescale=True):
         """Rebuild the model on the CC-subdivided mesh (qmv98 section 3.4; docs/qmv98.md B4).
