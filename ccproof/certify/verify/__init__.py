@@ -107,7 +107,7 @@ def check_coverage(valences):
 
     Every k >= 3 must be covered at least once: k = 3..k0-1 each by its own certificate, where k0 is the
     smallest interval certificate {'min': k0}. Interval certificates may overlap each other and single
-    valences (a k >= k0 certificate next to the k >= 40 one, or k = 39 next to k >= 30), since a
+    valences (a k >= k0 certificate next to the k >= 40 one, or k = 39 next to k >= 10), since a
     statement proved twice is still proved; a single valence may appear at most once (a second file
     for the same k is a publishing mistake).
     """
