@@ -28,6 +28,7 @@ Python loop over points, memory bounded by evaluating in chunks.
 from __future__ import annotations
 
 import functools
+import weakref
 
 import numpy as np
 
@@ -130,6 +131,56 @@ def _regular_net_matrix(key):
     return M, np.array(cols, dtype=np.int64)
 
 
+#: per corner scheme, its layer tables in every orientation of a corner frame (see _oriented_layers)
+_ORIENTED = weakref.WeakKeyDictionary()
+
+
+def _oriented_layers(scheme, rot):
+    """The layer deviations of ``scheme`` laid out for a corner frame ``rot`` of any side and origin.
+
+    Returns
+    -------
+    L : ndarray, shape (n_layers * 3 * 16, N)
+        Row ``(n, code, i)``: entry ``i`` of the net of layer ``n``, patch ``code`` (0: the patch
+        along u, 1: the diagonal one, 2: the one along v, bmz04 Fig. 3), in the base orientation.
+    unit : ndarray, shape (n_layers, 3, 3)
+        ``(u0, v0, h)`` of those patches for a corner frame of side 1 with the corner at the origin
+        (dyadic: scaling by the side and shifting by the corner are exact).
+
+    Depends on ``rot`` only through the directions of its axes; computed once per scheme and
+    orientation.
+    """
+    _, a, b = rot
+    side = float(np.abs(a).max())
+    orient = (tuple(int(x) for x in np.sign(a)), tuple(int(x) for x in np.sign(b)))
+    per_scheme = _ORIENTED.setdefault(scheme, {})
+    hit = per_scheme.get(orient)
+    if hit is not None:
+        return hit
+    unit_rot = (np.zeros(2), np.asarray(a, dtype=np.float64) / side, np.asarray(b, dtype=np.float64) / side)
+    Ls = scheme.layers
+    nl, N = Ls.shape[0], Ls.shape[-1]
+    # P_1 lies along the frame's a-axis: code 0 (u-distance >= 1/2, v-distance < 1/2) if a is
+    # along u, else code 2; P_2 (diagonal) is code 1; P_3 the other one
+    a_along_u = abs(unit_rot[1][0]) > 0
+    codes = {1: 0 if a_along_u else 2, 2: 1, 3: 2 if a_along_u else 0}
+    L = np.empty((nl, 3, 16, N))
+    unit = np.empty((nl, 3, 3))
+    sc = 0.5 ** np.arange(nl)  # layer n is layer 0 scaled by 2^-n towards the corner
+    for j in (1, 2, 3):
+        f0 = _compose(unit_rot, _layer_frame(0, j))
+        L[:, codes[j]] = Ls[:, j - 1][:, _net_permutation(f0)]
+        u0, v0, h0 = _domain(f0)
+        unit[:, codes[j], 0] = u0 * sc
+        unit[:, codes[j], 1] = v0 * sc
+        unit[:, codes[j], 2] = h0 * sc
+    L = L.reshape(-1, N)
+    L.setflags(write=False)
+    unit.setflags(write=False)
+    per_scheme[orient] = (L, unit)
+    return L, unit
+
+
 class _Builder:
     """Collects patches and virtual faces while classifying the faces of a mesh."""
 
@@ -210,25 +261,13 @@ class _Builder:
         self.vcorner[vid] = (int(corner[0] > U0), int(corner[1] > V0))
         rel = C - C[0]
         origin = C[0] + scheme.limit_mask @ rel
-        L = scheme.layers
-        nl = L.shape[0]
-        dev = (L.reshape(-1, L.shape[-1]) @ rel).reshape(nl, 3, 16, 3)  # (n_layers, 3, 16, 3)
-        # P_1 lies along the frame's a-axis: code 0 (u-distance >= 1/2, v-distance < 1/2) if a is
-        # along u, else code 2; P_2 (diagonal) is code 1; P_3 the other one
-        a_along_u = abs(rot[1][0]) > 0
-        codes = {1: 0 if a_along_u else 2, 2: 1, 3: 2 if a_along_u else 0}
-        nets = np.empty((nl, 3, 16, 3))
-        doms = np.empty((nl, 3, 3))
-        for j in (1, 2, 3):
-            f0 = _compose(rot, _layer_frame(0, j))
-            perm = _net_permutation(f0)
-            nets[:, codes[j]] = dev[:, j - 1][:, perm]
-            u0, v0, h0 = _domain(f0)
-            # layer n is layer 0 scaled by 2^-n towards the corner (exact: powers of two)
-            sc = 0.5 ** np.arange(nl)
-            doms[:, codes[j], 0] = corner[0] + (u0 - corner[0]) * sc
-            doms[:, codes[j], 1] = corner[1] + (v0 - corner[1]) * sc
-            doms[:, codes[j], 2] = h0 * sc
+        L, unit = _oriented_layers(scheme, rot)
+        nl = unit.shape[0]
+        nets = (L @ rel).reshape(nl, 3, 16, 3)
+        # layer domains: the unit corner frame's scaled by the side H (exact: powers of two)
+        doms = unit * H
+        doms[..., 0] += corner[0]
+        doms[..., 1] += corner[1]
         K = min(HOT_LAYERS, nl)
         self._store(self.hot, nets[:K].reshape(-1, 16, 3), origin, doms[:K].reshape(-1, 3))
         self._store(self.cold, nets[K:].reshape(-1, 16, 3), origin, doms[K:].reshape(-1, 3))
