@@ -505,11 +505,12 @@ def cached_scheme(kind, key, compute):
         try:
             with np.load(path, allow_pickle=False) as z:
                 N = int(z["size"])
-                den = int(str(z["A_den"]))
-                A = flint.fmpq_mat(N, N, [flint.fmpq(int(x), den) for x in z["A_num"].tolist()])
+                den = str(z["A_den"])
+                num = z["A_num"].tolist()
                 sup = z["support"]
-                return CornerScheme(N, A, z["limit_mask"].copy(), z["layers"].copy(),
-                                    None if sup.size == 0 else [int(i) for i in sup])
+                # the exact A is only needed for the tangent masks: converted on first use
+                return CornerScheme(N, functools.partial(_exact_matrix, N, num, den), z["limit_mask"].copy(),
+                                    z["layers"].copy(), None if sup.size == 0 else [int(i) for i in sup])
         except (OSError, ValueError, KeyError):
             pass
     sch = compute()
@@ -528,6 +529,12 @@ def cached_scheme(kind, key, compute):
     return sch
 
 
+def _exact_matrix(N, numerators, denominator):
+    """The exact (N, N) matrix with the given integer numerators (decimal strings) over one denominator."""
+    den = int(denominator)
+    return flint.fmpq_mat(N, N, [flint.fmpq(int(x), den) for x in numerators])
+
+
 class CornerScheme:
     """Exact self-similar evaluation data of one corner configuration (see :func:`corner_scheme`).
 
@@ -536,7 +543,9 @@ class CornerScheme:
     size : int
         N, the number of vertices of the face's one-ring (2k + 8 at an interior vertex of valence k).
     A : flint.fmpq_mat, shape (N, N)
-        Exact subdivision matrix from the one-ring of the face to the one-ring of its child at the corner.
+        Exact subdivision matrix from the one-ring of the face to the one-ring of its child at the
+        corner (a scheme read from the disk cache builds it on first access: the parameter may be a
+        function returning it).
     limit_mask : ndarray, shape (N,)
         Limit position of the corner vertex (exact left eigenvector of ``A`` for 1, rounded).
     layers : ndarray, shape (n_layers, 3, 16, N)
@@ -551,10 +560,16 @@ class CornerScheme:
 
     def __init__(self, size, A, limit_mask, layers, support=None):
         self.size = size
-        self.A = A
+        self._A = A
         self.limit_mask = limit_mask
         self.layers = layers
         self.support = None if support is None or len(support) == size else tuple(support)
+
+    @property
+    def A(self):
+        if callable(self._A):
+            self._A = self._A()
+        return self._A
 
     @property
     def n_layers(self):

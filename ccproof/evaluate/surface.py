@@ -62,35 +62,39 @@ _KEYS = {0: ("P",), 1: ("P", "Pu", "Pv"), 2: ("P", "Pu", "Pv", "Puu", "Puv", "Pv
 
 # ---------------------------------------------------------------------------------- frames
 # A frame maps a face's own parameter (s, t) to the base face's (u, v): (u, v) = o + s a + t b,
-# with a, b axis-aligned of the same length (a power of 2).
+# with a, b axis-aligned of the same length (a power of 2). Frames are tuples of three float pairs
+# (o, a, b): they are composed once per virtual face, so plain floats (every value dyadic, every
+# operation exact) instead of small arrays.
+_C = tuple((float(x), float(y)) for x, y in CORNERS)
+
+
 def _compose(frame, sub):
-    o, a, b = frame
-    so, sa, sb = sub
-    return (o + a * so[0] + b * so[1], a * sa[0] + b * sa[1], a * sb[0] + b * sb[1])
+    (ox, oy), (ax, ay), (bx, by) = frame
+    (p, q), (sa0, sa1), (sb0, sb1) = sub
+    return ((ox + ax * p + bx * q, oy + ay * p + by * q), (ax * sa0 + bx * sa1, ay * sa0 + by * sa1),
+            (ax * sb0 + bx * sb1, ay * sb0 + by * sb1))
 
 
 def _corner_frame(i, scale=1.0):
     """Frame of the square at corner i of [0,1]^2, rotated so that corner i is its origin."""
-    c = np.array(CORNERS, dtype=np.float64)
-    return (c[i] * 1.0, (c[(i + 1) % 4] - c[i]) * scale, (c[(i + 3) % 4] - c[i]) * scale)
+    c, c1, c3 = _C[i], _C[(i + 1) % 4], _C[(i + 3) % 4]
+    return (c, ((c1[0] - c[0]) * scale, (c1[1] - c[1]) * scale), ((c3[0] - c[0]) * scale, (c3[1] - c[1]) * scale))
 
 
 def _child_frame(i):
-    c = np.array(CORNERS, dtype=np.float64)
-    return (c[i], (c[(i + 1) % 4] - c[i]) / 2, (c[(i + 3) % 4] - c[i]) / 2)
+    return _corner_frame(i, 0.5)
 
 
 def _layer_frame(n, j):
     """Frame of patch P_j of layer n in the corner frame (corner at the origin), bmz04 Fig. 3."""
-    c = np.array(CORNERS, dtype=np.float64)
     h = 2.0 ** -(n + 1)
-    return (c[j] * 2.0 * h, (c[(j + 1) % 4] - c[j]) * h, (c[(j + 3) % 4] - c[j]) * h)
+    o, a, b = _corner_frame(j, h)
+    return ((o[0] * 2.0 * h, o[1] * 2.0 * h), a, b)
 
 
 def _domain(frame):
-    o, a, b = frame
-    lo = o + np.minimum(a, 0) + np.minimum(b, 0)
-    return float(lo[0]), float(lo[1]), float(np.abs(a).max())
+    (ox, oy), (ax, ay), (bx, by) = frame
+    return ox + min(ax, 0.0) + min(bx, 0.0), oy + min(ay, 0.0) + min(by, 0.0), max(abs(ax), abs(ay))
 
 
 @functools.lru_cache(maxsize=64)
@@ -108,7 +112,11 @@ def _permutation(ah, bh):
 def _net_permutation(frame):
     """Index map sending a net in the frame's own orientation to the base orientation."""
     _, a, b = frame
-    return _permutation(tuple(int(x) for x in np.sign(a)), tuple(int(x) for x in np.sign(b)))
+    return _permutation(_sign(a), _sign(b))
+
+
+def _sign(x):
+    return (int(x[0] > 0) - int(x[0] < 0), int(x[1] > 0) - int(x[1] < 0))
 
 
 def _stencil_matrix(stencils, ncols):
@@ -151,13 +159,13 @@ def _oriented_layers(scheme, rot):
     orientation.
     """
     _, a, b = rot
-    side = float(np.abs(a).max())
-    orient = (tuple(int(x) for x in np.sign(a)), tuple(int(x) for x in np.sign(b)))
+    side = max(abs(a[0]), abs(a[1]))
+    orient = (_sign(a), _sign(b))
     per_scheme = _ORIENTED.setdefault(scheme, {})
     hit = per_scheme.get(orient)
     if hit is not None:
         return hit
-    unit_rot = (np.zeros(2), np.asarray(a, dtype=np.float64) / side, np.asarray(b, dtype=np.float64) / side)
+    unit_rot = ((0.0, 0.0), (a[0] / side, a[1] / side), (b[0] / side, b[1] / side))
     Ls = scheme.layers
     nl, N = Ls.shape[0], Ls.shape[-1]
     # P_1 lies along the frame's a-axis: code 0 (u-distance >= 1/2, v-distance < 1/2) if a is
@@ -321,7 +329,7 @@ class LimitSurface:
         b = _Builder()
         topo = LocalTopology(mesh.faces)
         X = mesh.vertices
-        base = (np.zeros(2), np.array([1.0, 0.0]), np.array([0.0, 1.0]))
+        base = ((0.0, 0.0), (1.0, 0.0), (0.0, 1.0))
         m = mesh.n_faces
         vmap = np.arange(mesh.n_vertices)
         for f in range(m):  # virtual faces 0..m-1 are the base faces

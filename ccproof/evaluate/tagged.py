@@ -465,7 +465,7 @@ class TaggedLimitSurface(LimitSurface):
     def __init__(self, mesh: PolyMesh):
         self.mesh = mesh
         b = _TaggedBuilder(2 if mesh.options.crease_method == "chaikin" else 1)
-        ident = (np.zeros(2), np.array([1.0, 0.0]), np.array([0.0, 1.0]))
+        ident = ((0.0, 0.0), (1.0, 0.0), (0.0, 1.0))
         P = mesh.n_ptex
         self._ptex_face = np.empty(P, dtype=np.int64)
         for p in range(P):
