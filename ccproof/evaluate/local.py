@@ -487,11 +487,12 @@ def cached_scheme(kind, key, compute):
     """``compute()`` (a CornerScheme or None), kept between runs in a disk cache.
 
     The cache (default ``~/.cache/ccproof/corner_schemes``; environment variable
-    ``CCPROOF_CACHE`` = another folder, or ``off``) holds one ``.npz`` per configuration, named by
-    the SHA-256 of the configuration key and of the sources that compute it; it stores the rounded
-    layers, the limit mask, the support and the exact matrix ``A`` (integer numerators as decimal
-    strings and one denominator), so a cached scheme is the computed one bit for bit. Unreadable
-    or unwritable cache files are ignored (the data are then computed).
+    ``CCPROOF_CACHE`` = another folder, or ``off``) holds two files per configuration, named by
+    the SHA-256 of the configuration key and of the sources that compute it: ``.npy``, one float
+    vector ``[N, n_layers, n_support, limit mask (N), support, layers]`` (read at setup), and
+    ``.A.npz``, the exact matrix ``A`` (integer numerators as decimal strings and one denominator,
+    read only when the tangent masks need it). A cached scheme is the computed one bit for bit.
+    Unreadable or unwritable cache files are ignored (the data are then computed).
     """
     import hashlib
     import os
@@ -500,17 +501,17 @@ def cached_scheme(kind, key, compute):
     if d is None:
         return compute()
     name = hashlib.sha256(f"{kind}|{_code_version()}|{key!r}".encode()).hexdigest()
-    path = d / f"{name}.npz"
-    if path.exists():
+    path, apath = d / f"{name}.npy", d / f"{name}.A.npz"
+    if path.exists() and apath.exists():
         try:
-            with np.load(path, allow_pickle=False) as z:
-                N = int(z["size"])
-                den = str(z["A_den"])
-                num = z["A_num"].tolist()
-                sup = z["support"]
-                # the exact A is only needed for the tangent masks: converted on first use
-                return CornerScheme(N, functools.partial(_exact_matrix, N, num, den), z["limit_mask"].copy(),
-                                    z["layers"].copy(), None if sup.size == 0 else [int(i) for i in sup])
+            z = np.load(path, allow_pickle=False)
+            N, nl, ns = (int(x) for x in z[:3])
+            mask = z[3:3 + N].copy()
+            sup = [int(i) for i in z[3 + N:3 + N + ns]]
+            layers = z[3 + N + ns:].reshape(nl, 3, 16, N).copy()
+            # the exact A is only needed for the tangent masks: read and converted on first use
+            loader = functools.partial(_cached_exact_matrix, apath, N, compute)
+            return CornerScheme(N, loader, mask, layers, sup or None)
         except (OSError, ValueError, KeyError):
             pass
     sch = compute()
@@ -519,20 +520,27 @@ def cached_scheme(kind, key, compute):
     try:
         d.mkdir(parents=True, exist_ok=True)
         num, den = sch.A.numer_denom()
-        tmp = d / f".{name}.{os.getpid()}.npz"
-        np.savez(tmp, size=np.array(sch.size), A_den=np.array(str(den)),
-                 A_num=np.array([str(x) for x in num.entries()]), limit_mask=sch.limit_mask,
-                 layers=sch.layers, support=np.array(sch.support if sch.support else [], dtype=np.int64))
+        tmp = d / f".{name}.{os.getpid()}.A.npz"
+        np.savez(tmp, A_den=np.array(str(den)), A_num=np.array([str(x) for x in num.entries()]))
+        os.replace(tmp, apath)
+        sup = list(sch.support) if sch.support else []
+        head = np.array([sch.size, sch.n_layers, len(sup)] + sup, dtype=np.float64)
+        tmp = d / f".{name}.{os.getpid()}.npy"
+        np.save(tmp, np.concatenate([head[:3], sch.limit_mask, head[3:], sch.layers.reshape(-1)]))
         os.replace(tmp, path)
     except OSError:
         pass
     return sch
 
 
-def _exact_matrix(N, numerators, denominator):
-    """The exact (N, N) matrix with the given integer numerators (decimal strings) over one denominator."""
-    den = int(denominator)
-    return flint.fmpq_mat(N, N, [flint.fmpq(int(x), den) for x in numerators])
+def _cached_exact_matrix(apath, N, compute):
+    """The exact ``A`` of a cached scheme from its ``.A.npz`` (recomputed if that file is gone)."""
+    try:
+        with np.load(apath, allow_pickle=False) as z:
+            den = int(str(z["A_den"]))
+            return flint.fmpq_mat(N, N, [flint.fmpq(int(x), den) for x in z["A_num"].tolist()])
+    except (OSError, ValueError, KeyError):
+        return compute().A
 
 
 class CornerScheme:

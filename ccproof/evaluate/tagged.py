@@ -52,7 +52,7 @@ from ccproof.evaluate.surface import (
     _domain,
     _stencil_matrix,
 )
-from ccproof.mesh.polymesh import PolyMesh, stencil_matrix
+from ccproof.mesh.polymesh import PolyMesh
 from ccproof.mesh.rules import CORNER, CREASE, SMOOTH, Complex, refine_complex, vertex_rule
 
 __all__ = ["TaggedLimitSurface", "tagged_corner_scheme", "canonical_ring"]
@@ -177,7 +177,8 @@ def refine_key(key, n_rule):
 
     Returns
     -------
-    S : scipy.sparse.csr_matrix (float, rows of uncomputable points NaN)
+    S : ndarray, shape (n_points, N)
+        Float stencils (dense: local complexes are small), rows of uncomputable points NaN.
     stencils : tuple of dict or None (exact)
     child : Complex
         The children of all faces, with the child tags (positions are not part of it).
@@ -187,7 +188,10 @@ def refine_key(key, n_rule):
     edges = [e for e, h in enumerate(cx.edges) if cx.org[h] < n_rule or cx.dst(h) < n_rule]
     stencils, children, ces, cvs = refine_complex(cx, vertices=rule, edges=edges)
     child = Complex(children, ces, cvs, cx.options, level=2, n_vertices=len(stencils))
-    return stencil_matrix(stencils, cx.n_vertices), tuple(stencils), child
+    S = _stencil_matrix([{} if st is None else st for st in stencils], cx.n_vertices)
+    S[[i for i, st in enumerate(stencils) if st is None]] = np.nan
+    S.setflags(write=False)
+    return S, tuple(stencils), child
 
 
 @functools.lru_cache(maxsize=1 << 16)
