@@ -50,6 +50,7 @@ from ccproof.evaluate.surface import (
     _child_frame,
     _compose,
     _domain,
+    _net_permutation,
     _stencil_matrix,
 )
 from ccproof.mesh.polymesh import PolyMesh
@@ -436,6 +437,69 @@ class _TaggedBuilder(_Builder):
             )
         return self.split(key, nr, X[ring], frame, depth + 1, semi_depth, base, vid)
 
+    def classify(self, cx, X, jobs):
+        """Classify the quads ``jobs = [(g, frame, base, vid), ...]`` of ``cx`` (positions ``X``).
+
+        The smooth regular ones (:meth:`smooth_regular_patches`) in one vectorized pass, the
+        others face by face (:meth:`tagged_face`).
+        """
+        done = self.smooth_regular_patches(cx, X, jobs)
+        for (g, frame, base, vid), d in zip(jobs, done):
+            if not d:
+                self.tagged_face(cx, X, g, frame, 0, 0, base, vid)
+
+    def smooth_regular_patches(self, cx, X, jobs):
+        """Store the bicubic patches of the quads of ``jobs`` whose four vertices are smooth regular.
+
+        Smooth regular: four faces around the vertex, no boundary, sharp edge or vertex sharpness
+        at it. Such a face's tagged one-ring has no tags and no irregular corner, and its net
+        (:func:`tagged_regular_net`) is its 4 x 4 grid of vertices: gathered here for all of them at
+        once with the half-edge arrays (the same walks as :func:`tagged_regular_net`). Returns a
+        bool array, True for the jobs handled.
+        """
+        if not jobs:
+            return np.zeros(0, dtype=bool)
+        org, nxt, prv, twin = (np.asarray(a, dtype=np.int64) for a in (cx.org, cx.nxt, cx.prv, cx.twin))
+        ok = np.bincount(org, minlength=cx.n_vertices) == 4
+        open_h = twin < 0
+        ok[org[open_h]] = False
+        ok[org[nxt[open_h]]] = False
+        for (a, b_), sh in cx.edge_sharpness.items():
+            if sh > 0.0:
+                ok[a] = ok[b_] = False
+        for v, sh in cx.vertex_sharpness.items():
+            if sh > 0.0:
+                ok[v] = False
+        g = np.array([j[0] for j in jobs], dtype=np.int64)
+        start = np.asarray(cx.start + [org.size], dtype=np.int64)
+        H = start[g][:, None] + np.arange(4)
+        sel = (start[g + 1] - start[g] == 4) & ok[org[np.minimum(H, org.size - 1)]].all(axis=1)
+        idx = np.flatnonzero(sel)
+        if idx.size == 0:
+            return sel
+        H = H[idx]
+        grid = np.empty((idx.size, 16), dtype=np.int64)
+        for s_ in range(4):
+            h = H[:, s_]
+            t = twin[h]
+            cell = [p[0] + 4 * p[1] for p in (_CENTER[s_],) + _SIDES[s_][:3]]
+            grid[:, cell[0]] = org[h]
+            grid[:, cell[1]] = org[nxt[nxt[t]]]
+            grid[:, cell[2]] = org[prv[t]]
+            grid[:, cell[3]] = org[prv[twin[nxt[t]]]]
+        frames = [jobs[i][1] for i in idx]
+        perm = np.array([_net_permutation(f) for f in frames])
+        origin = X[grid].mean(axis=1)
+        nets = X[np.take_along_axis(grid, perm, axis=1)] - origin[:, None, :]
+        self._check_finite(nets, int(jobs[idx[0]][2]))
+        self._store(self.hot, nets, origin, np.array([_domain(f) for f in frames]))
+        for r, i in enumerate(idx):
+            vid = jobs[i][3]
+            self.vkind[vid] = _REGULAR
+            self.vpatch[vid] = self.n_hot + r
+        self.n_hot += idx.size
+        return sel
+
     @staticmethod
     def _check_finite(a, base):
         if not np.isfinite(a).all():  # pragma: no cover - would be a bug in the local refinement
@@ -486,15 +550,15 @@ class TaggedLimitSurface(LimitSurface):
                         vs[v] = math.inf
                 cx = Complex(cx.faces, cx.edge_sharpness, vs, cx.options, level=1, n_vertices=cx.n_vertices)
             X = np.asarray(mesh.vertices)
-            for f in range(mesh.n_faces):
-                self._ptex_face[f] = f
-                b.tagged_face(cx, X, f, ident, 0, 0, f, f)
+            self._ptex_face[:] = np.arange(mesh.n_faces)
+            b.classify(cx, X, [(f, ident, f, f) for f in range(mesh.n_faces)])
             self._finish(b)
             self._hole_ptex = mesh.is_hole[self._ptex_face]
             return
         m1, _ = mesh.refine()
         cx = m1.complex()
         X = np.asarray(m1.vertices)
+        jobs = []
         for f in range(mesh.n_faces):
             k = int(mesh.sizes[f])
             p0 = int(mesh.ptex_start[f])
@@ -509,11 +573,12 @@ class TaggedLimitSurface(LimitSurface):
                     q = int(cu > 0) + 2 * int(cv > 0)
                     c = b.new_vface(_REGULAR, cf, p0)
                     b.vchild[p0][q] = c
-                    b.tagged_face(cx, X, c0 + i, cf, 0, 0, p0, c)
+                    jobs.append((c0 + i, cf, p0, c))
             else:
                 for i in range(k):
                     self._ptex_face[p0 + i] = f
-                    b.tagged_face(cx, X, c0 + i, ident, 0, 0, p0 + i, p0 + i)
+                    jobs.append((c0 + i, ident, p0 + i, p0 + i))
+        b.classify(cx, X, jobs)
         self._finish(b)
         self._hole_ptex = mesh.is_hole[self._ptex_face]
 
