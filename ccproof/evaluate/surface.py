@@ -44,6 +44,7 @@ from ccproof.evaluate.local import (
     regular_net,
 )
 from ccproof.mesh import QuadMesh, limit_normals, limit_positions
+from ccproof.mesh.rules import to_float
 
 __all__ = ["natural_limit_surface", "LimitSurface"]
 
@@ -120,10 +121,11 @@ def _sign(x):
 
 
 def _stencil_matrix(stencils, ncols):
+    """Dense float matrix of exact stencils (dict column -> weight), each entry correctly rounded."""
     M = np.zeros((len(stencils), ncols))
     for r, s in enumerate(stencils):
         for c, w in s.items():
-            M[r, c] += float(w)
+            M[r, c] += to_float(w)
     return M
 
 
