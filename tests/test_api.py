@@ -31,7 +31,6 @@ ALLOWED_DUPLICATES = {
     "add_arguments": "one per command module",
     "run": "one per command module",
     # pending: modules other engineers are rewriting
-    "canonical_ring": "ccproof.evaluate.local vs ccproof.evaluate.tagged (evaluator being rewritten)",
     "isoparameter_lines": "ccproof.reparam.plot wraps ccproof.evaluate.plot with a parameterization argument",
     "plot_isoparameter_lines": "ccproof.reparam.plot wraps ccproof.evaluate.plot with a parameterization argument",
 }

@@ -35,21 +35,28 @@ import numpy as np
 from ccproof.errors import CCProofError, MeshError
 from ccproof.evaluate.bspline import bspline_basis
 from ccproof.evaluate.local import (
+    _CENTER,
+    _SIDES,
     CORNERS,
-    LocalTopology,
+    _child_ring,
+    _has_semi_sharp,
     canonical_ring,
     corner_scheme,
-    local_edges,
-    refine_exact,
-    regular_net,
+    irregular_corners,
+    refine_key,
+    regular_net_matrix,
+    ring_key,
 )
 from ccproof.mesh import QuadMesh, limit_normals, limit_positions
-from ccproof.mesh.rules import to_float
+from ccproof.mesh.rules import Complex, Options
 
 __all__ = ["natural_limit_surface", "LimitSurface"]
 
 #: how many times a face may be subdivided before it must be regular or self-similar
 MAX_DEPTH = 4
+#: local subdivisions allowed in the semi-sharp phase of a tagged mesh (sharpness < 10 decays in
+#: 10 uniform levels)
+MAX_SEMI_DEPTH = 40
 #: points evaluated per chunk (bounds the temporary memory: about 1 kB per point)
 CHUNK = 1 << 15
 #: layers of every corner table stored with the regular patches ("hot" region, for cache locality:
@@ -120,27 +127,6 @@ def _sign(x):
     return (int(x[0] > 0) - int(x[0] < 0), int(x[1] > 0) - int(x[1] < 0))
 
 
-def _stencil_matrix(stencils, ncols):
-    """Dense float matrix of exact stencils (dict column -> weight), each entry correctly rounded."""
-    M = np.zeros((len(stencils), ncols))
-    for r, s in enumerate(stencils):
-        for c, w in s.items():
-            M[r, c] += to_float(w)
-    return M
-
-
-@functools.lru_cache(maxsize=4096)
-def _regular_net_matrix(key):
-    """(16, k) float net matrix of face 0 of the one-ring ``key`` and the k ring positions it uses."""
-    net = regular_net(LocalTopology(key), 0)
-    if net is None:  # pragma: no cover
-        return None, None
-    cols = sorted({v for s in net for v in s})
-    M = _stencil_matrix([{cols.index(v): w for v, w in s.items()} for s in net], len(cols))
-    M.setflags(write=False)
-    return M, np.array(cols, dtype=np.int64)
-
-
 #: per corner scheme, its layer tables in every orientation of a corner frame (see _oriented_layers)
 _ORIENTED = weakref.WeakKeyDictionary()
 
@@ -194,7 +180,9 @@ def _oriented_layers(scheme, rot):
 class _Builder:
     """Collects patches and virtual faces while classifying the faces of a mesh."""
 
-    def __init__(self):
+    def __init__(self, depth_semi=1, what="face"):
+        self.depth_semi = depth_semi  # ring depth refined in the semi-sharp phase (2: Chaikin)
+        self.what = what  # how errors name a base face
         self.hot = ([], [], [])  # nets (k, 17, 3) with the origin as row 16; domains (k, 3)
         self.cold = ([], [], [])
         self.n_hot = 0
@@ -232,35 +220,126 @@ class _Builder:
         region[1].append(doms)
 
     # ------------------------------------------------------------------ classification
-    def face(self, topo, X, f, frame, depth, base_face, vid, vmap=None):
-        F = topo.flat
-        irregular = [i for i in range(4) if not topo.is_regular(F[4 * f + i])]
-        if not irregular:
-            ring, key, _ = canonical_ring(topo, f, 0)
-            M, cols = _regular_net_matrix(key)
-            if M is None:  # pragma: no cover - regular vertices always give a net
-                raise MeshError(f"face {base_face}: no regular B-spline net")
-            Xl = X[np.asarray(ring)[cols]]
-            origin = Xl.mean(axis=0)
+    def classify(self, cx, X, jobs, vmap=None):
+        """Classify the quads ``jobs = [(g, frame, base, vid), ...]`` of ``cx`` (positions ``X``).
+
+        The smooth regular ones (:meth:`smooth_regular_patches`) in one vectorized pass, the
+        others face by face (:meth:`face`). ``vmap``: the mesh vertex of every vertex of ``cx``
+        (records the corner scheme of each irregular vertex, for the vertex normals).
+        """
+        done = self.smooth_regular_patches(cx, X, jobs)
+        for (g, frame, base, vid), d in zip(jobs, done):
+            if not d:
+                self.face(cx, X, g, frame, 0, 0, base, vid, vmap=vmap)
+
+    def smooth_regular_patches(self, cx, X, jobs):
+        """Store the bicubic patches of the quads of ``jobs`` whose four vertices are smooth regular.
+
+        Smooth regular: four faces around the vertex, no boundary, sharp edge or vertex sharpness
+        at it. Such a face's tagged one-ring has no tags and no irregular corner, and its net
+        (:func:`ccproof.evaluate.local.regular_net`) is its 4 x 4 grid of vertices: gathered here
+        for all of them at once with the half-edge arrays (the same walks as
+        :func:`ccproof.evaluate.local.regular_net`). Returns a bool array, True for the jobs handled.
+        """
+        if not jobs:
+            return np.zeros(0, dtype=bool)
+        org, nxt, prv, twin = (np.asarray(a, dtype=np.int64) for a in (cx.org, cx.nxt, cx.prv, cx.twin))
+        ok = np.bincount(org, minlength=cx.n_vertices) == 4
+        open_h = twin < 0
+        ok[org[open_h]] = False
+        ok[org[nxt[open_h]]] = False
+        for (a, b_), sh in cx.edge_sharpness.items():
+            if sh > 0.0:
+                ok[a] = ok[b_] = False
+        for v, sh in cx.vertex_sharpness.items():
+            if sh > 0.0:
+                ok[v] = False
+        g = np.array([j[0] for j in jobs], dtype=np.int64)
+        start = np.asarray(cx.start + [org.size], dtype=np.int64)
+        H = start[g][:, None] + np.arange(4)
+        sel = (start[g + 1] - start[g] == 4) & ok[org[np.minimum(H, org.size - 1)]].all(axis=1)
+        idx = np.flatnonzero(sel)
+        if idx.size == 0:
+            return sel
+        H = H[idx]
+        grid = np.empty((idx.size, 16), dtype=np.int64)
+        for s_ in range(4):
+            h = H[:, s_]
+            t = twin[h]
+            cell = [p[0] + 4 * p[1] for p in (_CENTER[s_],) + _SIDES[s_][:3]]
+            grid[:, cell[0]] = org[h]
+            grid[:, cell[1]] = org[nxt[nxt[t]]]
+            grid[:, cell[2]] = org[prv[t]]
+            grid[:, cell[3]] = org[prv[twin[nxt[t]]]]
+        frames = [jobs[i][1] for i in idx]
+        perm = np.array([_net_permutation(f) for f in frames])
+        origin = X[grid].mean(axis=1)
+        nets = X[np.take_along_axis(grid, perm, axis=1)] - origin[:, None, :]
+        self._check_finite(nets, int(jobs[idx[0]][2]))
+        self._store(self.hot, nets, origin, np.array([_domain(f) for f in frames]))
+        for r, i in enumerate(idx):
+            vid = jobs[i][3]
             self.vkind[vid] = _REGULAR
-            self.vpatch[vid] = self.add_patch(M @ (Xl - origin), origin, frame)
+            self.vpatch[vid] = self.n_hot + r
+        self.n_hot += idx.size
+        return sel
+
+    def face(self, cx, X, g, frame, depth, semi_depth, base, vid, src=None, vmap=None):
+        """Classify quad ``g`` of complex ``cx`` with positions ``X`` (NaN where not exact).
+
+        ``src = (key, n_rule)``: ``cx`` is the child complex of that ring (its rings are cached).
+        ``vmap``: mesh vertex of every vertex of ``cx`` (-1 for new points), or None.
+        """
+
+        def ring_of(r, depth_):
+            if src is not None:
+                return _child_ring(src[0], src[1], g, r, depth_)
+            ring_, faces_, nr_ = canonical_ring(cx, g, r, depth_)
+            return ring_, ring_key(cx, ring_, faces_, nr_), nr_
+
+        ring, key, nr = ring_of(0, 1)
+        if _has_semi_sharp(key):
+            if semi_depth >= MAX_SEMI_DEPTH:
+                raise MeshError(f"{self.what} {base}: semi-sharp creases did not decay in {MAX_SEMI_DEPTH} levels")
+            D = self.depth_semi
+            if D != 1:
+                ring, key, nr = ring_of(0, D)
+            return self.split_face(key, nr, X[ring], frame, depth, semi_depth + 1, base, vid,
+                                   None if vmap is None else vmap[ring])
+        irr = irregular_corners(key)
+        if not irr:
+            M = regular_net_matrix(key)
+            Xl = X[ring]
+            self._check_finite(Xl, base)
+            origin = Xl.mean(axis=0)
+            net = M @ (Xl - origin)
+            self._check_finite(net, base)
+            self.vkind[vid] = _REGULAR
+            self.vpatch[vid] = self.add_patch(net, origin, frame)
             return vid
-        if len(irregular) == 1:
-            r = irregular[0]
-            ring, key, _ = canonical_ring(topo, f, r)
-            scheme = corner_scheme(key)
+        if len(irr) == 1:
+            r = irr[0]
+            ring_r, key_r, _ = ring_of(r, 1)
+            scheme = corner_scheme(key_r)
             if scheme is not None:
-                vid = self.corner_face(scheme, X[ring], r, frame, vid)
-                vertex = int(vmap[F[4 * f + r]]) if vmap is not None else -1
+                C = X[ring_r]
+                self._check_finite(C, base)
+                vid = self.corner_face(scheme, C, r, frame, vid)
+                vertex = -1 if vmap is None else int(vmap[ring_r[0]])
                 if vertex >= 0 and vertex not in self.corner_of_vertex:
-                    self.corner_of_vertex[vertex] = (scheme, X[ring], vid)
+                    self.corner_of_vertex[vertex] = (scheme, C, vid)
                 return vid
         if depth >= MAX_DEPTH:
             raise MeshError(
-                f"face {base_face}: the configuration around it is not supported "
+                f"{self.what} {base}: the configuration around it is not supported "
                 f"(still irregular after {MAX_DEPTH} local subdivisions)"
             )
-        return self.split_face(topo, X, f, frame, depth, base_face, vid, vmap)
+        return self.split_face(key, nr, X[ring], frame, depth + 1, semi_depth, base, vid,
+                               None if vmap is None else vmap[ring])
+
+    def _check_finite(self, a, base):
+        if not np.isfinite(a).all():  # pragma: no cover - would be a bug in the local refinement
+            raise MeshError(f"internal error: {self.what} {base} uses a point outside the exact local refinement")
 
     def corner_face(self, scheme, C, r, frame, vid):
         self.corner_data[vid] = (scheme, C)
@@ -288,33 +367,31 @@ class _Builder:
         self.vnmax[vid] = nl - 1
         return vid
 
-    def split_face(self, topo, X, f, frame, depth, base_face, vid, vmap):
-        ring, key, _ = canonical_ring(topo, f, 0)
-        stencils, children = refine_exact(key)
-        topo1 = LocalTopology(children)
-        # Only the points whose stencils lie inside the one-ring are exact: the vertex points of the
-        # face's own vertices (labels 0..3), the edge points of edges at them and all face points.
-        # The children's one-rings use no other point (the others are set to NaN, so that any use
-        # would show up in the final check of the tables instead of passing silently).
-        X1 = _stencil_matrix([s if s is not None else {} for s in stencils], len(ring)) @ X[ring]
-        n = len(ring)
-        edges, _ = local_edges(key)
-        outer_edges = [n + e for e, h in enumerate(edges) if min(key[h // 4][h % 4], key[h // 4][(h + 1) % 4]) > 3]
-        X1[list(range(4, n)) + outer_edges] = np.nan
-        # base-mesh vertex of every local vertex (vertex points keep their vertex), -1 for new points
-        vmap1 = np.full(len(stencils), -1, dtype=np.int64)
+    def split_face(self, key, nr, Xr, frame, depth, semi_depth, base, vid, vmap=None):
+        """Subdivide the ring ``key`` (positions ``Xr``) once, exactly and locally; classify the
+        four children of its face 0.
+
+        Only the points whose stencils lie inside the ring are exact (the rules at its ``nr`` rule
+        vertices, :func:`ccproof.evaluate.local.refine_key`); the others are NaN, so that any use
+        would show up in the checks of the tables instead of passing silently. ``vmap``: the mesh
+        vertex of every ring vertex (vertex points keep their vertex), or None.
+        """
+        S, _, child = refine_key(key, nr)
+        X1 = S @ Xr
+        vmap1 = None
         if vmap is not None:
-            vmap1[: len(ring)] = vmap[ring]
+            vmap1 = np.full(S.shape[0], -1, dtype=np.int64)
+            vmap1[: len(vmap)] = vmap
         self.vkind[vid] = _SPLIT
-        self.max_depth = max(self.max_depth, depth + 1)
-        U0, V0, H = self.vdom[vid]
+        self.max_depth = max(self.max_depth, depth + semi_depth)
+        U0, V0, _ = self.vdom[vid]
         for i in range(4):
             cf = _compose(frame, _child_frame(i))
             cu, cv, _ = _domain(cf)
             q = int(cu > U0) + 2 * int(cv > V0)
-            child = self.new_vface(_REGULAR, cf, base_face)
-            self.vchild[vid][q] = child
-            self.face(topo1, X1, i, cf, depth + 1, base_face, vid=child, vmap=vmap1)
+            c = self.new_vface(_REGULAR, cf, base)
+            self.vchild[vid][q] = c
+            self.face(child, X1, i, cf, depth, semi_depth, base, c, src=(key, nr), vmap=vmap1)
         return vid
 
 
@@ -329,15 +406,14 @@ class LimitSurface:
     def __init__(self, mesh: QuadMesh):
         self.mesh = mesh
         b = _Builder()
-        topo = LocalTopology(mesh.faces)
+        cx = Complex(mesh.faces, {}, {}, Options(), n_vertices=mesh.n_vertices)
         X = mesh.vertices
         base = ((0.0, 0.0), (1.0, 0.0), (0.0, 1.0))
         m = mesh.n_faces
         vmap = np.arange(mesh.n_vertices)
         for f in range(m):  # virtual faces 0..m-1 are the base faces
             b.new_vface(_REGULAR, base, f)
-        for f in range(m):
-            b.face(topo, X, f, base, 0, f, vid=f, vmap=vmap)
+        b.classify(cx, X, [(f, base, f, f) for f in range(m)], vmap=vmap)
         self._nets = np.ascontiguousarray(np.concatenate(b.hot[0] + b.cold[0]))  # (n_patches, 17, 3)
         if not np.isfinite(self._nets).all():  # pragma: no cover - would be a bug in the classification
             bad = int(np.flatnonzero(~np.isfinite(self._nets).all(axis=(1, 2)))[0])

@@ -6,7 +6,8 @@ subdivision (test_tagged_bruteforce.py); here the shortcuts are switched off to 
 
 import numpy as np
 
-from ccproof.evaluate.tagged import TaggedLimitSurface, _TaggedBuilder
+from ccproof.evaluate.surface import _Builder
+from ccproof.evaluate.tagged import TaggedLimitSurface
 from ccproof.mesh.io import read_mesh
 
 
@@ -18,7 +19,7 @@ def _points(S, n=4000, seed=0):
 
 def _compare(mesh, monkeypatch):
     handled = []
-    shortcut = _TaggedBuilder.smooth_regular_patches
+    shortcut = _Builder.smooth_regular_patches
 
     def counting(self, cx, X, jobs):
         done = shortcut(self, cx, X, jobs)
@@ -26,11 +27,11 @@ def _compare(mesh, monkeypatch):
         return done
 
     with monkeypatch.context() as m:
-        m.setattr(_TaggedBuilder, "smooth_regular_patches", counting)
+        m.setattr(_Builder, "smooth_regular_patches", counting)
         fast = TaggedLimitSurface(mesh)
     assert sum(handled) > 0  # the shortcut is exercised
     with monkeypatch.context() as m:
-        m.setattr(_TaggedBuilder, "smooth_regular_patches", lambda self, cx, X, jobs: np.zeros(len(jobs), bool))
+        m.setattr(_Builder, "smooth_regular_patches", lambda self, cx, X, jobs: np.zeros(len(jobs), bool))
         slow = TaggedLimitSurface(mesh)
     assert fast.n_patches == slow.n_patches
     f, u, v = _points(fast)
