@@ -26,22 +26,53 @@ def _wavy(m, seed=0):
     return m.with_vertices(m.vertices + 0.1 * rng.normal(size=m.vertices.shape))
 
 
+def _exact_operator_in_quad_layout(m):
+    """The exact stencils of ccproof.mesh.rules.refine_complex for the QuadMesh ``m``, as a dense
+    float matrix (each entry rounded once) with the rows in the layout of ccproof.mesh.subdivision."""
+    from ccproof.mesh.polymesh import PolyMesh
+    from ccproof.mesh.rules import to_float
+
+    p = PolyMesh(m.vertices, m.faces)
+    exact = p.subdivision_operator(exact=True)
+    cx = p.complex()
+    n, E = m.n_vertices, m.n_edges
+    eid = {(int(a), int(b)): i for i, (a, b) in enumerate(m.edges)}
+    rows = list(range(n)) + [None] * E + list(range(n + E, n + E + m.n_faces))
+    for e, h in enumerate(cx.edges):
+        a, b = cx.org[h], cx.dst(h)
+        rows[n + eid[(min(a, b), max(a, b))]] = n + e
+    out = np.zeros((len(exact), n))
+    for i, r in enumerate(rows):
+        for j, w in exact[r].items():
+            out[i, j] = to_float(w)
+    return out, exact
+
+
 @pytest.mark.parametrize("make", [cube, lambda: grid(3, 2), lambda: k_regular_disk(7, 2)])
-def test_matrix_equals_function(make):
+def test_vectorized_step_equals_exact_stencils(make):
+    """The vectorized float operator and the exact stencils of the same rules agree to rounding."""
     m = _wavy(make())
-    S = subdivision_matrix(m)
+    S = subdivision_matrix(m).toarray()
+    E, exact = _exact_operator_in_quad_layout(m)
+    assert all(sum(r.values()) == 1 for r in exact)  # affine invariance, exactly
+    # the vectorized entries are float sums of up to k + 1 rounded weights (the vertex's own
+    # weight collects (k - 2)/k and its share of the k face points); a wrong weight is off by >= 1e-3
+    assert np.abs(S - E).max() <= 8 * 2.0**-52
+    assert np.array_equal(S != 0, E != 0)
     m1 = subdivide(m)
-    assert np.allclose(S.sum(axis=1), 1, atol=1e-15, rtol=0)
-    assert np.abs(S @ m.vertices - m1.vertices).max() <= 1e-15 * np.abs(m.vertices).max() * 4
+    assert np.array_equal(m1.vertices, subdivision_matrix(m) @ m.vertices)
     # twice
-    S2 = subdivision_matrix(m1) @ S
+    S2 = subdivision_matrix(m1) @ subdivision_matrix(m)
     assert np.abs(S2 @ m.vertices - subdivide(m1).vertices).max() <= 1e-14
 
 
-def test_bunny_matrix_equals_function(refdir):
+def test_bunny_vectorized_step_equals_exact_stencils(refdir):
     m = read_obj(refdir / "meshes" / "bunny_quads.obj")
     assert m.n_faces == 2036 and m.extraordinary_vertices.size == 103 and not m.is_boundary_vertex.any()
-    assert np.abs(subdivision_matrix(m) @ m.vertices - subdivide(m).vertices).max() < 1e-15
+    S = subdivision_matrix(m)
+    E, _ = _exact_operator_in_quad_layout(m)
+    assert np.abs(S.toarray() - E).max() <= 8 * 2.0**-52
+    assert np.array_equal(S.toarray() != 0, E != 0)
 
 
 @pytest.mark.parametrize("k", [3, 5, 6, 9])
