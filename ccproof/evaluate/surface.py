@@ -190,7 +190,6 @@ class _Builder:
         self.vcold = []
         self.vkind, self.vdom, self.vpatch, self.vchild, self.vcorner, self.vnmax = [], [], [], [], [], []
         self.vbase = []
-        self.max_depth = 0
         self.corner_of_vertex = {}
         self.corner_data = {}  # corner virtual face -> (CornerScheme, ring control points)
 
@@ -383,7 +382,6 @@ class _Builder:
             vmap1 = np.full(S.shape[0], -1, dtype=np.int64)
             vmap1[: len(vmap)] = vmap
         self.vkind[vid] = _SPLIT
-        self.max_depth = max(self.max_depth, depth + semi_depth)
         U0, V0, _ = self.vdom[vid]
         for i in range(4):
             cf = _compose(frame, _child_frame(i))
@@ -414,6 +412,10 @@ class LimitSurface:
         for f in range(m):  # virtual faces 0..m-1 are the base faces
             b.new_vface(_REGULAR, base, f)
         b.classify(cx, X, [(f, base, f, f) for f in range(m)], vmap=vmap)
+        self._finish(b)
+
+    def _finish(self, b):
+        """The evaluation tables from a :class:`_Builder` that has classified every base face."""
         self._nets = np.ascontiguousarray(np.concatenate(b.hot[0] + b.cold[0]))  # (n_patches, 17, 3)
         if not np.isfinite(self._nets).all():  # pragma: no cover - would be a bug in the classification
             bad = int(np.flatnonzero(~np.isfinite(self._nets).all(axis=(1, 2)))[0])
@@ -430,7 +432,10 @@ class LimitSurface:
         vc = np.array(b.vcorner, dtype=bool).reshape(-1, 2)
         self._vcu, self._vcv = vc[:, 0].copy(), vc[:, 1].copy()
         self._vnmax = np.array(b.vnmax, dtype=np.int64)
-        self.split_depth = b.max_depth
+        depth = np.zeros(len(b.vkind), dtype=np.int64)
+        for vid in np.flatnonzero(self._vkind == _SPLIT):  # children are created after their parents
+            depth[self._vchild[vid]] = depth[vid] + 1
+        self.split_depth = int(depth.max())  # the descent steps of _vface_of
         self._corner_of_vertex = b.corner_of_vertex
         self._corner_data = b.corner_data
         self._corner_normal = {}

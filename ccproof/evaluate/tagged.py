@@ -33,7 +33,6 @@ import numpy as np
 
 from ccproof.errors import CCProofError
 from ccproof.evaluate.surface import (
-    _CORNER,
     _REGULAR,
     _SPLIT,
     LimitSurface,
@@ -93,7 +92,6 @@ class TaggedLimitSurface(LimitSurface):
             if k == 4:
                 self._ptex_face[p0] = f
                 b.vkind[p0] = _SPLIT
-                b.max_depth = max(b.max_depth, 1)
                 for i in range(4):
                     cf = _compose(ident, _child_frame(i))
                     cu, cv, _ = _domain(cf)
@@ -108,33 +106,6 @@ class TaggedLimitSurface(LimitSurface):
         b.classify(cx, X, jobs)
         self._finish(b)
         self._hole_ptex = mesh.is_hole[self._ptex_face]
-
-    def _finish(self, b):
-        self._nets = np.ascontiguousarray(np.concatenate(b.hot[0] + b.cold[0]))
-        pd = np.concatenate(b.hot[1] + b.cold[1])
-        self._pu0, self._pv0, self._ph = pd[:, 0].copy(), pd[:, 1].copy(), pd[:, 2].copy()
-        self._vcold = np.array(b.vcold, dtype=np.int64) + b.n_hot
-        self.hot_layers = 3
-        self._vkind = np.array(b.vkind, dtype=np.int8)
-        vd = np.array(b.vdom).reshape(-1, 3)
-        self._vu0, self._vv0, self._vh = vd[:, 0].copy(), vd[:, 1].copy(), vd[:, 2].copy()
-        self._vpatch = np.array(b.vpatch, dtype=np.int64)
-        self._vchild = np.array(b.vchild, dtype=np.int64).reshape(-1, 4)
-        vc = np.array(b.vcorner, dtype=bool).reshape(-1, 2)
-        self._vcu, self._vcv = vc[:, 0].copy(), vc[:, 1].copy()
-        self._vnmax = np.array(b.vnmax, dtype=np.int64)
-        depth = np.zeros(len(b.vkind), dtype=np.int64)
-        for vid in range(len(b.vkind)):  # children are created after their parents
-            for c in b.vchild[vid]:
-                if c >= 0:
-                    depth[c] = depth[vid] + 1
-        self.split_depth = int(depth.max())
-        self._corner_of_vertex = {}
-        self._corner_data = b.corner_data
-        self._corner_normal = {}
-        self._vbase = np.array(b.vbase, dtype=np.int64)
-        self.n_patches = self._nets.shape[0]
-        self.max_layers = int(self._vnmax.max()) + 1 if (self._vkind == _CORNER).any() else 0
 
     @property
     def n_faces(self):
