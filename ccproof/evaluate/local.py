@@ -217,7 +217,9 @@ def ring_key(cx, ring, faces, n_rule):
     return (faces, tuple(sorted(tags)), tuple(vs), cx.options.key())
 
 
+@functools.lru_cache(maxsize=8192)
 def _key_complex(key):
+    """The complex of a ring key (shared by the functions cached per key; not to be modified)."""
     faces, tags, vs, opts = key
     return Complex(faces, dict(tags), dict(vs), Options(*opts), level=1)
 

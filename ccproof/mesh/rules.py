@@ -263,47 +263,46 @@ class Complex:
     """
 
     def __init__(self, faces, edge_sharpness, vertex_sharpness, options, level=0, n_vertices=None):
-        self.faces = [tuple(int(v) for v in f) for f in faces]
+        if isinstance(faces, np.ndarray):
+            faces = faces.tolist()
+        self.faces = [tuple(map(int, f)) for f in faces]
         self.edge_sharpness = edge_sharpness
         self.vertex_sharpness = vertex_sharpness
         self.options = options
         self.level = level
         nv = 1 + max(max(f) for f in self.faces) if n_vertices is None else int(n_vertices)
         self.n_vertices = nv
-        start, he_org = [], []
-        for f in self.faces:
-            start.append(len(he_org))
-            he_org.extend(f)
-        self.start = start
-        self.org = he_org
-        H = len(he_org)
-        self.face_of = [0] * H
-        self.nxt = [0] * H
-        self.prv = [0] * H
+        start, org, face_of, nxt, prv = [], [], [], [], []
         for g, f in enumerate(self.faces):
-            s, n = start[g], len(f)
-            for i in range(n):
-                h = s + i
-                self.face_of[h] = g
-                self.nxt[h] = s + (i + 1) % n
-                self.prv[h] = s + (i - 1) % n
-        directed = {}
-        for h in range(H):
-            directed[(he_org[h], he_org[self.nxt[h]])] = h
-        self.twin = [directed.get((he_org[self.nxt[h]], he_org[h]), -1) for h in range(H)]
+            s, n = len(org), len(f)
+            start.append(s)
+            org.extend(f)
+            face_of.extend([g] * n)
+            nxt.extend(range(s + 1, s + n))
+            nxt.append(s)
+            prv.append(s + n - 1)
+            prv.extend(range(s, s + n - 1))
+        self.start = start
+        self.org = org
+        self.face_of = face_of
+        self.nxt = nxt
+        self.prv = prv
+        dst = [org[x] for x in nxt]
+        directed = dict(zip(zip(org, dst), range(len(org))))
+        self.twin = [directed.get((b, a), -1) for a, b in zip(org, dst)]
         eid, edges, he_edge = {}, [], []
-        for h in range(H):
-            a, b = he_org[h], he_org[self.nxt[h]]
+        for h, (a, b) in enumerate(zip(org, dst)):
             k = (a, b) if a < b else (b, a)
-            if k not in eid:
-                eid[k] = len(edges)
+            e = eid.get(k)
+            if e is None:
+                e = eid[k] = len(edges)
                 edges.append(h)
-            he_edge.append(eid[k])
+            he_edge.append(e)
         self.edge_index = eid
         self.edges = edges
         self.he_edge = he_edge
         corners = [[] for _ in range(nv)]
-        for h, v in enumerate(he_org):
+        for h, v in enumerate(org):
             corners[v].append(h)
         self.corners = corners
         self._fans = {}
