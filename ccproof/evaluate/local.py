@@ -549,8 +549,9 @@ def cached_scheme(kind, key, compute):
 
     The cache (default ``~/.cache/ccproof/corner_schemes``; environment variable
     ``CCPROOF_CACHE`` = another folder, or ``off``) holds two files per configuration, named by
-    the SHA-256 of the configuration key and of the sources that compute it: ``.npy``, one float
-    vector ``[N, n_layers, n_support, limit mask (N), support, layers]`` (read at setup), and
+    the SHA-256 of the configuration key and of the sources that compute it: ``.f64``, one raw
+    little-endian float64 vector ``[N, n_layers, n_support, limit mask (N), support, layers]``
+    (read at setup; no header to parse), and
     ``.A.npz``, the exact matrix ``A`` (integer numerators as decimal strings and one denominator,
     read only when the tangent masks need it). A cached scheme is the computed one bit for bit.
     Unreadable or unwritable cache files are ignored (the data are then computed).
@@ -562,11 +563,13 @@ def cached_scheme(kind, key, compute):
     if d is None:
         return compute()
     name = hashlib.sha256(f"{kind}|{_code_version()}|{key!r}".encode()).hexdigest()
-    path, apath = d / f"{name}.npy", d / f"{name}.A.npz"
+    path, apath = d / f"{name}.f64", d / f"{name}.A.npz"
     if path.exists() and apath.exists():
         try:
-            z = np.load(path, allow_pickle=False)
+            z = np.fromfile(path, dtype="<f8")
             N, nl, ns = (int(x) for x in z[:3])
+            if z.size != 3 + N + ns + nl * 48 * N:
+                raise ValueError("truncated cache file")
             mask = z[3:3 + N].copy()
             sup = [int(i) for i in z[3 + N:3 + N + ns]]
             layers = z[3 + N + ns:].reshape(nl, 3, 16, N).copy()
@@ -586,8 +589,8 @@ def cached_scheme(kind, key, compute):
         os.replace(tmp, apath)
         sup = list(sch.support) if sch.support else []
         head = np.array([sch.size, sch.n_layers, len(sup)] + sup, dtype=np.float64)
-        tmp = d / f".{name}.{os.getpid()}.npy"
-        np.save(tmp, np.concatenate([head[:3], sch.limit_mask, head[3:], sch.layers.reshape(-1)]))
+        tmp = d / f".{name}.{os.getpid()}.f64"
+        np.concatenate([head[:3], sch.limit_mask, head[3:], sch.layers.reshape(-1)]).astype("<f8").tofile(tmp)
         os.replace(tmp, path)
     except OSError:
         pass
