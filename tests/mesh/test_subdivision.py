@@ -148,3 +148,38 @@ def test_reference_step_agrees_with_pygel3d(refdir):
     d1 = cKDTree(m.vertices).query(pos)[0].max()
     d2 = cKDTree(pos).query(m.vertices)[0].max()
     assert max(d1, d2) < 1e-14
+
+
+def test_rule_functions_exact_and_float_from_the_same_code():
+    """Each rule's weights, evaluated with exact_one() and with 1.0 (scalar and vectorized), agree:
+    the float weights are the correctly rounded exact ones, and the exact ones are the textbook
+    fractions (bmz04 Fig. 1)."""
+    from fractions import Fraction
+
+    from ccproof.mesh.rules import (
+        crease_vertex_weights,
+        exact_one,
+        face_point_weight,
+        sharp_edge_weight,
+        smooth_edge_weights,
+        smooth_vertex_weights,
+        to_float,
+    )
+
+    one = exact_one()
+    ks = np.arange(3, 30)
+    vec = smooth_vertex_weights(ks, 1.0)
+    for i, k in enumerate(ks.tolist()):
+        ex = smooth_vertex_weights(k, one)
+        want = [Fraction(k - 2, k), Fraction(1, k * k), Fraction(1, k * k)]
+        assert [Fraction(int(w.p), int(w.q)) for w in ex] == want
+        assert [to_float(w) for w in ex] == [float(Fraction(k - 2, k)), 1 / (k * k), 1 / (k * k)]
+        assert [to_float(w) for w in ex] == [float(v[i]) for v in vec]
+        # in a quad mesh: 1 - 7/(4k) on V (with its share of the k face points), 3/(2k^2), 1/(4k^2)
+        wv, we, wf = ex
+        assert wv + k * wf / 4 == one - one * 7 / (4 * k) and we + 2 * wf / 4 == one * 3 / (2 * k * k)
+    for n in (3, 4, 5, 7):
+        assert to_float(face_point_weight(n, one)) == face_point_weight(n, 1.0) == 1 / n
+    assert [to_float(w) for w in smooth_edge_weights(one)] == list(smooth_edge_weights(1.0)) == [0.25, 0.25]
+    assert to_float(sharp_edge_weight(one)) == sharp_edge_weight(1.0) == 0.5
+    assert [to_float(w) for w in crease_vertex_weights(one)] == list(crease_vertex_weights(1.0)) == [0.75, 0.125]
