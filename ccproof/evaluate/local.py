@@ -570,9 +570,9 @@ def cached_scheme(kind, key, compute):
             N, nl, ns = (int(x) for x in z[:3])
             if z.size != 3 + N + ns + nl * 48 * N:
                 raise ValueError("truncated cache file")
-            mask = z[3:3 + N].copy()
+            mask = z[3:3 + N]  # views of the freshly read vector
             sup = [int(i) for i in z[3 + N:3 + N + ns]]
-            layers = z[3 + N + ns:].reshape(nl, 3, 16, N).copy()
+            layers = z[3 + N + ns:].reshape(nl, 3, 16, N)
             # the exact A is only needed for the tangent masks: read and converted on first use
             loader = functools.partial(_cached_exact_matrix, apath, N, compute)
             return CornerScheme(N, loader, mask, layers, sup or None)

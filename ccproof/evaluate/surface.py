@@ -146,35 +146,43 @@ def _oriented_layers(scheme, rot):
     Depends on ``rot`` only through the directions of its axes; computed once per scheme and
     orientation.
     """
-    _, a, b = rot
-    side = max(abs(a[0]), abs(a[1]))
-    orient = (_sign(a), _sign(b))
+    orient = (_sign(rot[1]), _sign(rot[2]))
     per_scheme = _ORIENTED.setdefault(scheme, {})
     hit = per_scheme.get(orient)
     if hit is not None:
         return hit
-    unit_rot = ((0.0, 0.0), (a[0] / side, a[1] / side), (b[0] / side, b[1] / side))
+    rows, unit0 = _corner_orientation(orient)
     Ls = scheme.layers
     nl, N = Ls.shape[0], Ls.shape[-1]
-    # P_1 lies along the frame's a-axis: code 0 (u-distance >= 1/2, v-distance < 1/2) if a is
-    # along u, else code 2; P_2 (diagonal) is code 1; P_3 the other one
-    a_along_u = abs(unit_rot[1][0]) > 0
-    codes = {1: 0 if a_along_u else 2, 2: 1, 3: 2 if a_along_u else 0}
-    L = np.empty((nl, 3, 16, N))
-    unit = np.empty((nl, 3, 3))
-    sc = 0.5 ** np.arange(nl)  # layer n is layer 0 scaled by 2^-n towards the corner
-    for j in (1, 2, 3):
-        f0 = _compose(unit_rot, _layer_frame(0, j))
-        L[:, codes[j]] = Ls[:, j - 1][:, _net_permutation(f0)]
-        u0, v0, h0 = _domain(f0)
-        unit[:, codes[j], 0] = u0 * sc
-        unit[:, codes[j], 1] = v0 * sc
-        unit[:, codes[j], 2] = h0 * sc
-    L = L.reshape(-1, N)
+    L = Ls.reshape(nl, 48, N)[:, rows].reshape(-1, N)
+    unit = unit0[None] * (0.5 ** np.arange(nl))[:, None, None]  # layer n: layer 0 scaled by 2^-n
     L.setflags(write=False)
     unit.setflags(write=False)
     per_scheme[orient] = (L, unit)
     return L, unit
+
+
+@functools.lru_cache(maxsize=16)
+def _corner_orientation(orient):
+    """Rows of a scheme's layer nets and layer-0 domains for a corner frame with axis directions
+    ``orient`` (see :func:`_oriented_layers`): ``rows`` (48,), row ``16 code + i`` of a layer in the
+    base orientation is row ``rows[16 code + i]`` of its ``3 x 16`` nets ``D[n, j-1]``; ``unit``
+    (3, 3), the domains of the three patches of layer 0 for a unit frame at the origin."""
+    a, b = orient
+    unit_rot = ((0.0, 0.0), (float(a[0]), float(a[1])), (float(b[0]), float(b[1])))
+    # P_1 lies along the frame's a-axis: code 0 (u-distance >= 1/2, v-distance < 1/2) if a is
+    # along u, else code 2; P_2 (diagonal) is code 1; P_3 the other one
+    a_along_u = a[0] != 0
+    codes = {1: 0 if a_along_u else 2, 2: 1, 3: 2 if a_along_u else 0}
+    rows = np.empty(48, dtype=np.int64)
+    unit = np.empty((3, 3))
+    for j in (1, 2, 3):
+        f0 = _compose(unit_rot, _layer_frame(0, j))
+        rows[16 * codes[j]:16 * codes[j] + 16] = 16 * (j - 1) + _net_permutation(f0)
+        unit[codes[j]] = _domain(f0)
+    rows.setflags(write=False)
+    unit.setflags(write=False)
+    return rows, unit
 
 
 class _Builder:
