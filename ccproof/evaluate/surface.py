@@ -127,6 +127,25 @@ def _sign(x):
     return (int(x[0] > 0) - int(x[0] < 0), int(x[1] > 0) - int(x[1] < 0))
 
 
+#: rows x columns x 3 of one product in :func:`_skinny_product` (below OpenBLAS's threading
+#: threshold of 4 * 65536 multiply-adds)
+_SKINNY_BLOCK = 1 << 17
+
+
+def _skinny_product(L, rel):
+    """``L @ rel`` for a tall ``L`` (R, N) and ``rel`` (N, 3), in row blocks small enough for
+    single-threaded BLAS: at setup these products are many and small, and waking BLAS threads for
+    each costs more than the product (much more on a loaded machine). Same sums, same result."""
+    R, N = L.shape
+    step = max(1, _SKINNY_BLOCK // (3 * max(N, 1)))
+    if R <= step:
+        return L @ rel
+    out = np.empty((R, rel.shape[1]))
+    for lo in range(0, R, step):
+        np.matmul(L[lo:lo + step], rel, out=out[lo:lo + step])
+    return out
+
+
 #: per corner scheme, its layer tables in every orientation of a corner frame (see _oriented_layers)
 _ORIENTED = weakref.WeakKeyDictionary()
 
@@ -359,7 +378,7 @@ class _Builder:
         origin = C[0] + scheme.limit_mask @ rel
         L, unit = _oriented_layers(scheme, rot)
         nl = unit.shape[0]
-        nets = (L @ rel).reshape(nl, 3, 16, 3)
+        nets = _skinny_product(L, rel).reshape(nl, 3, 16, 3)
         # layer domains: the unit corner frame's scaled by the side H (exact: powers of two)
         doms = unit * H
         doms[..., 0] += corner[0]
