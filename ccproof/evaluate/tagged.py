@@ -1,8 +1,8 @@
 """Exact limit evaluation on tagged polygon meshes (creases, corners, holes, boundary modes, n-gons).
 
-The patch table of a :class:`~ccproof.mesh.polymesh.PolyMesh` is built like the all-quad one of
-:mod:`ccproof.evaluate.surface` (same arrays, same locator and kernels), from the tagged rules of
-:mod:`ccproof.mesh.rules`:
+The patch table of a :class:`~ccproof.mesh.polymesh.PolyMesh` is built by the builder of the all-quad
+evaluator (:class:`ccproof.evaluate.surface._Builder`: same classification, arrays, locator and
+kernels), from the tagged rules of :mod:`ccproof.mesh.rules`:
 
 1. One global Catmull-Clark step (n-gons become quads; ``TRI_SUB_SMOOTH`` and the
    ``EDGE_AND_CORNER`` corners act here). A quad's ptex face is split into its four level-1
