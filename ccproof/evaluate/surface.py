@@ -204,6 +204,23 @@ def _corner_orientation(orient):
     return rows, unit
 
 
+def _smooth_regular_vertices(cx):
+    """Bool (n_vertices,): the vertices of ``cx`` with four faces and no boundary edge, sharp edge
+    or vertex sharpness (regular for the bicubic patch under any options)."""
+    org, nxt, twin = (np.asarray(a, dtype=np.int64) for a in (cx.org, cx.nxt, cx.twin))
+    ok = np.bincount(org, minlength=cx.n_vertices) == 4
+    open_h = twin < 0
+    ok[org[open_h]] = False
+    ok[org[nxt[open_h]]] = False
+    for (a, b), sh in cx.edge_sharpness.items():
+        if sh > 0.0:
+            ok[a] = ok[b] = False
+    for v, sh in cx.vertex_sharpness.items():
+        if sh > 0.0:
+            ok[v] = False
+    return ok
+
+
 class _Builder:
     """Collects patches and virtual faces while classifying the faces of a mesh."""
 
@@ -250,36 +267,61 @@ class _Builder:
         """Classify the quads ``jobs = [(g, frame, base, vid), ...]`` of ``cx`` (positions ``X``).
 
         The smooth regular ones (:meth:`smooth_regular_patches`) in one vectorized pass, the
-        others face by face (:meth:`face`). ``vmap``: the mesh vertex of every vertex of ``cx``
+        others face by face (:meth:`face`); a quad with three smooth regular corners is first
+        tried as a corner face at the fourth. ``vmap``: the mesh vertex of every vertex of ``cx``
         (records the corner scheme of each irregular vertex, for the vertex normals).
         """
+        if not jobs:
+            return
+        ok = _smooth_regular_vertices(cx)
         done = self.smooth_regular_patches(cx, X, jobs)
-        for (g, frame, base, vid), d in zip(jobs, done):
-            if not d:
-                self.face(cx, X, g, frame, 0, 0, base, vid, vmap=vmap)
+        g = np.array([j[0] for j in jobs], dtype=np.int64)
+        start = np.asarray(cx.start + [len(cx.org)], dtype=np.int64)
+        org = np.asarray(cx.org, dtype=np.int64)
+        quad = start[g + 1] - start[g] == 4
+        corners = ok[org[np.minimum(start[g][:, None] + np.arange(4), org.size - 1)]]
+        single = np.where(quad & (corners.sum(axis=1) == 3), np.argmin(corners, axis=1), -1)
+        for (g_, frame, base, vid), d, r in zip(jobs, done, single.tolist()):
+            if d:
+                continue
+            if r >= 0 and self.corner_at(cx, X, g_, r, frame, base, vid, vmap):
+                continue
+            self.face(cx, X, g_, frame, 0, 0, base, vid, vmap=vmap)
+
+    def corner_at(self, cx, X, g, r, frame, base, vid, vmap=None):
+        """Store quad ``g`` as a corner face at corner ``r`` if that is its classification (its
+        other corners regular, its ring from ``r`` stationary): the path of :meth:`face` for such a
+        face, without listing its ring from corner 0 first (the tags of a ring, hence the
+        semi-sharp test, do not depend on the corner it is listed from). Returns True if stored."""
+        ring_r, faces_r, nr = canonical_ring(cx, g, r)
+        key_r = ring_key(cx, ring_r, faces_r, nr)
+        if _has_semi_sharp(key_r) or irregular_corners(key_r) != (0,):
+            return False
+        scheme = corner_scheme(key_r)
+        if scheme is None:
+            return False
+        C = X[ring_r]
+        self._check_finite(C, base)
+        vid = self.corner_face(scheme, C, r, frame, vid)
+        vertex = -1 if vmap is None else int(vmap[ring_r[0]])
+        if vertex >= 0 and vertex not in self.corner_of_vertex:
+            self.corner_of_vertex[vertex] = (scheme, C, vid)
+        return True
 
     def smooth_regular_patches(self, cx, X, jobs):
         """Store the bicubic patches of the quads of ``jobs`` whose four vertices are smooth regular.
 
-        Smooth regular: four faces around the vertex, no boundary, sharp edge or vertex sharpness
-        at it. Such a face's tagged one-ring has no tags and no irregular corner, and its net
-        (:func:`ccproof.evaluate.local.regular_net`) is its 4 x 4 grid of vertices: gathered here
-        for all of them at once with the half-edge arrays (the same walks as
-        :func:`ccproof.evaluate.local.regular_net`). Returns a bool array, True for the jobs handled.
+        Smooth regular (:func:`_smooth_regular_vertices`): four faces around the vertex, no
+        boundary, sharp edge or vertex sharpness at it. Such a face's tagged one-ring has no tags
+        and no irregular corner, and its net (:func:`ccproof.evaluate.local.regular_net`) is its
+        4 x 4 grid of vertices: gathered here for all of them at once with the half-edge arrays (the
+        same walks as :func:`ccproof.evaluate.local.regular_net`). Returns a bool array, True for
+        the jobs handled.
         """
         if not jobs:
             return np.zeros(0, dtype=bool)
         org, nxt, prv, twin = (np.asarray(a, dtype=np.int64) for a in (cx.org, cx.nxt, cx.prv, cx.twin))
-        ok = np.bincount(org, minlength=cx.n_vertices) == 4
-        open_h = twin < 0
-        ok[org[open_h]] = False
-        ok[org[nxt[open_h]]] = False
-        for (a, b_), sh in cx.edge_sharpness.items():
-            if sh > 0.0:
-                ok[a] = ok[b_] = False
-        for v, sh in cx.vertex_sharpness.items():
-            if sh > 0.0:
-                ok[v] = False
+        ok = _smooth_regular_vertices(cx)
         g = np.array([j[0] for j in jobs], dtype=np.int64)
         start = np.asarray(cx.start + [org.size], dtype=np.int64)
         H = start[g][:, None] + np.arange(4)

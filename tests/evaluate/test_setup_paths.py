@@ -1,4 +1,5 @@
-"""The vectorized setup shortcuts give the surfaces of the face-by-face classification.
+"""The setup shortcuts (smooth regular quads in one vectorized pass, corner faces tried directly at
+their one irregular corner) give the surfaces of the face-by-face classification.
 
 The face-by-face path is the one checked against OpenSubdiv (test_osd_features.py) and brute-force
 subdivision (test_tagged_bruteforce.py); here the shortcuts are switched off to compare.
@@ -18,20 +19,27 @@ def _points(S, n=4000, seed=0):
 
 
 def _compare(mesh, monkeypatch):
-    handled = []
-    shortcut = _Builder.smooth_regular_patches
+    handled, at_corner = [], []
+    shortcut, corner_at = _Builder.smooth_regular_patches, _Builder.corner_at
 
     def counting(self, cx, X, jobs):
         done = shortcut(self, cx, X, jobs)
         handled.append(int(done.sum()))
         return done
 
+    def counting_corner(self, *args, **kwargs):
+        hit = corner_at(self, *args, **kwargs)
+        at_corner.append(hit)
+        return hit
+
     with monkeypatch.context() as m:
         m.setattr(_Builder, "smooth_regular_patches", counting)
+        m.setattr(_Builder, "corner_at", counting_corner)
         fast = TaggedLimitSurface(mesh)
     assert sum(handled) > 0  # the shortcut is exercised
     with monkeypatch.context() as m:
         m.setattr(_Builder, "smooth_regular_patches", lambda self, cx, X, jobs: np.zeros(len(jobs), bool))
+        m.setattr(_Builder, "corner_at", lambda self, *args, **kwargs: False)
         slow = TaggedLimitSurface(mesh)
     assert fast.n_patches == slow.n_patches
     f, u, v = _points(fast)
@@ -39,15 +47,17 @@ def _compare(mesh, monkeypatch):
     diag = mesh.bounding_box_diagonal
     for k in a:
         assert np.abs(a[k] - b[k]).max() <= 1e-14 * diag, k
-    return fast
+    return fast, sum(at_corner)
 
 
 def test_smooth_regular_shortcut_on_quads(bunny_path, monkeypatch):
-    S = _compare(read_mesh(bunny_path), monkeypatch)
-    assert S.n_patches > 2000
+    S, corner_faces = _compare(read_mesh(bunny_path), monkeypatch)
+    assert S.n_patches > 2000 and corner_faces > 300
 
 
 def test_smooth_regular_shortcut_on_polygons_with_tags(refdir, monkeypatch):
     """n-gons (level-1 sub-faces and quad children in four orientations), holes, boundary modes."""
+    corner_faces = 0
     for name in ("catmark_nonquads", "catmark_hole_test2", "catmark_edgecorner", "catmark_edgenone"):
-        _compare(read_mesh(refdir / "osd_features" / "meshes" / f"{name}.obj"), monkeypatch)
+        corner_faces += _compare(read_mesh(refdir / "osd_features" / "meshes" / f"{name}.obj"), monkeypatch)[1]
+    assert corner_faces > 0
