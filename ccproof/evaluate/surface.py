@@ -173,7 +173,7 @@ def _oriented_layers(scheme, rot):
     rows, unit0 = _corner_orientation(orient)
     Ls = scheme.layers
     nl, N = Ls.shape[0], Ls.shape[-1]
-    L = Ls.reshape(nl, 48, N)[:, rows].reshape(-1, N)
+    L = np.take(Ls.reshape(nl, 48, N), rows, axis=1).reshape(-1, N)  # contiguous: the reshape is a view
     unit = unit0[None] * (0.5 ** np.arange(nl))[:, None, None]  # layer n: layer 0 scaled by 2^-n
     L.setflags(write=False)
     unit.setflags(write=False)
