@@ -77,10 +77,13 @@ def _lin(*terms):
 
 def _stencil_matrix(stencils, ncols):
     """Dense float matrix of exact stencils (dict column -> weight), each entry correctly rounded."""
-    M = np.zeros((len(stencils), ncols))
+    rows, cols, vals = [], [], []
     for r, s in enumerate(stencils):
-        for c, w in s.items():
-            M[r, c] += to_float(w)
+        rows.extend([r] * len(s))
+        cols.extend(s)
+        vals.extend(s.values())
+    M = np.zeros((len(stencils), ncols))
+    M[rows, cols] = [to_float(w) for w in vals]  # the columns of one stencil are distinct
     return M
 
 

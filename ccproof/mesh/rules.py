@@ -78,10 +78,11 @@ def _exact(x):
 def to_float(w):
     """Correctly rounded float of an exact weight (int, ``flint.fmpq`` or ``fractions.Fraction``;
     Python's int division of numerator by denominator is correctly rounded)."""
+    q = getattr(w, "q", None)
+    if q is not None:  # flint.fmpq
+        return int(w.p) / int(q)
     if isinstance(w, (int, float)):
         return float(w)
-    if hasattr(w, "q"):
-        return int(w.p) / int(w.q)
     return w.numerator / w.denominator
 
 
