@@ -300,13 +300,19 @@ class _Builder:
         scheme = corner_scheme(key_r)
         if scheme is None:
             return False
+        self.scheme_face(scheme, X, ring_r, r, frame, base, vid, vmap)
+        return True
+
+    def scheme_face(self, scheme, X, ring_r, r, frame, base, vid, vmap=None):
+        """:meth:`corner_face` on the ring ``ring_r`` (listed from the face's irregular corner
+        ``r``), and the first corner scheme of each mesh vertex recorded (``vmap``) for its normal."""
         C = X[ring_r]
         self._check_finite(C, base)
         vid = self.corner_face(scheme, C, r, frame, vid)
         vertex = -1 if vmap is None else int(vmap[ring_r[0]])
         if vertex >= 0 and vertex not in self.corner_of_vertex:
             self.corner_of_vertex[vertex] = (scheme, C, vid)
-        return True
+        return vid
 
     def smooth_regular_patches(self, cx, X, jobs):
         """Store the bicubic patches of the quads of ``jobs`` whose four vertices are smooth regular.
@@ -390,13 +396,7 @@ class _Builder:
             ring_r, key_r, _ = ring_of(r, 1)
             scheme = corner_scheme(key_r)
             if scheme is not None:
-                C = X[ring_r]
-                self._check_finite(C, base)
-                vid = self.corner_face(scheme, C, r, frame, vid)
-                vertex = -1 if vmap is None else int(vmap[ring_r[0]])
-                if vertex >= 0 and vertex not in self.corner_of_vertex:
-                    self.corner_of_vertex[vertex] = (scheme, C, vid)
-                return vid
+                return self.scheme_face(scheme, X, ring_r, r, frame, base, vid, vmap)
         if depth >= MAX_DEPTH:
             raise MeshError(
                 f"{self.what} {base}: the configuration around it is not supported "
