@@ -53,6 +53,7 @@ def test_vectorized_step_equals_exact_stencils(make):
     """The vectorized float operator and the exact stencils of the same rules agree to rounding."""
     m = _wavy(make())
     S = subdivision_matrix(m).toarray()
+    assert np.allclose(S.sum(axis=1), 1, atol=1e-15, rtol=0)
     E, exact = _exact_operator_in_quad_layout(m)
     assert all(sum(r.values()) == 1 for r in exact)  # affine invariance, exactly
     # the vectorized entries are float sums of up to k + 1 rounded weights (the vertex's own
