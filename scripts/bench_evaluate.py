@@ -25,6 +25,7 @@ Measures, in one run:
 The bunny mesh is read from the repository's test data (``tests/data/meshes/bunny_quads.obj``).
 
 Usage: python scripts/bench_evaluate.py [--points 1000000] [--memory-points 10000000] [--quick] [--osd-only]
+[--setup-only]  (``--setup-only``: only the setup times of part 5, ours and OpenSubdiv's)
 """
 
 from __future__ import annotations
@@ -245,7 +246,7 @@ def near_points(S, n, rng):
     return f, s, t, len(pairs)
 
 
-def osd_side_by_side(n, rng, quick=False):
+def osd_side_by_side(n, rng, quick=False, setup_only=False):
     print("\n5. side by side with OpenSubdiv Far (positions + first derivatives)")
     exe = build_osd_driver()
     if exe is None:
@@ -265,6 +266,16 @@ def osd_side_by_side(n, rng, quick=False):
         S = limit_surface(mesh)
         setup = time.perf_counter() - w0
         P = S.n_faces
+        if setup_only:
+            w0 = time.perf_counter()
+            limit_surface(mesh)
+            again = time.perf_counter() - w0
+            one = (np.zeros(1, dtype=np.int64), np.full(1, 0.5), np.full(1, 0.5))
+            osd_setup = min(run_osd(exe, mesh, *one)[0] for _ in range(3))
+            rows.append((label, setup, again, osd_setup))
+            print(f"   {label}: setup ours {setup:.3f} s (first in this process; again {again:.3f} s), "
+                  f"OpenSubdiv {osd_setup:.4f} s: {setup / osd_setup:.1f}x ({again / osd_setup:.1f}x)")
+            continue
         uni = (rng.integers(0, P, n), rng.random(n), rng.random(n))
         fn, sn, tn, npairs = near_points(S, n, rng)
         for dist, (f, s, t) in (("uniform", uni), ("near irregular", (fn, sn, tn))):
@@ -375,7 +386,11 @@ def main(argv=None):
     ap.add_argument("--quick", action="store_true", help="small sizes (smoke test)")
     ap.add_argument("--osd-points", type=int, default=1_000_000)
     ap.add_argument("--osd-only", action="store_true", help="only part 5 (OpenSubdiv side by side)")
+    ap.add_argument("--setup-only", action="store_true", help="only the setup times of part 5")
     args = ap.parse_args(argv)
+    if args.setup_only:
+        osd_side_by_side(0, np.random.default_rng(2024), setup_only=True)
+        return 0
     if args.osd_only:
         osd_side_by_side(args.osd_points if not args.quick else 20_000, np.random.default_rng(2024), args.quick)
         return 0

@@ -29,7 +29,6 @@ ALLOWED_DUPLICATES = {
     "add_arguments": "one per command module",
     "run": "one per command module",
     # pending: modules other engineers are rewriting
-    "canonical_ring": "ccproof.evaluate.local vs ccproof.evaluate.tagged (evaluator being rewritten)",
 }
 
 

@@ -8,8 +8,9 @@ Method (branch and bound on convex hulls of control nets):
   vertices of the faces sharing a vertex with it). Hence the limit surface over a face, or over a
   dyadic sub-square of it, lies in the **convex hull of the one-ring** of that (sub)face. The one-ring
   of a child face is computed from the parent's one-ring alone (the points whose stencils lie in
-  it, as in exact local refinement), here in ``arb`` ball arithmetic from the exact float
-  coordinates of the mesh: every point is an enclosure of the true control point.
+  it: the exact stencils of :func:`ccproof.evaluate.local.refine_key`, the rules of
+  :mod:`ccproof.mesh.rules`), here in ``arb`` ball arithmetic from the exact float coordinates of
+  the mesh: every point is an enclosure of the true control point.
 * A *piece* is a dyadic sub-square (face, level L, box) with its one-ring. Lower bound of the
   distance from X to the piece: the largest of the distance to the box around its points and of the
   half-space bounds ``min_j <a, X - c_j> / |a|`` along the direction ``a = X - P`` of the float
@@ -37,6 +38,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from ccproof.errors import CCProofError
+from ccproof.evaluate.local import canonical_ring, refine_key, ring_key
+from ccproof.mesh.rules import Complex, Options
 
 __all__ = ["CertifiedClosest", "certify_closest"]
 
@@ -97,104 +100,28 @@ def _one_ring_faces(faces, c):
 
 
 def _refine(piece, q, arb):
-    """The child of ``piece`` at corner ``q`` of its centre face (its own one-ring, exact rules)."""
-    faces, pts, c = piece.faces, piece.pts, piece.c
-    C = faces[c]
-    # star of every local vertex: faces (as (g, position)) and edges
-    star = {}
-    for g, F in enumerate(faces):
-        for i, w in enumerate(F):
-            star.setdefault(w, []).append((g, i))
-    cache = {}
+    """The child of ``piece`` at corner ``q`` of its centre face, with its own one-ring.
 
-    def avg(ps):
-        n = len(ps)
-        return [sum((p[k] for p in ps), arb(0)) / n for k in range(3)]
-
-    def face_pt(g):
-        key = ("f", g)
-        if key not in cache:
-            cache[key] = avg([pts[w] for w in faces[g]])
-        return cache[key]
-
-    def edge_faces(a, b):
-        out = []
-        for g, i in star[a]:
-            F = faces[g]
-            if F[(i + 1) % 4] == b or F[(i - 1) % 4] == b:
-                out.append(g)
-        return out
-
-    def edge_pt(a, b):
-        key = ("e", min(a, b), max(a, b))
-        if key not in cache:
-            gs = edge_faces(a, b)
-            if len(gs) == 1:
-                cache[key] = avg([pts[a], pts[b]])
-            else:
-                f0, f1 = face_pt(gs[0]), face_pt(gs[1])
-                cache[key] = [(pts[a][k] + pts[b][k] + f0[k] + f1[k]) / 4 for k in range(3)]
-        return cache[key]
-
-    def vertex_pt(w):
-        key = ("v", w)
-        if key not in cache:
-            gs = star[w]
-            nbrs = []
-            for g, i in gs:
-                F = faces[g]
-                for b in (F[(i + 1) % 4], F[(i - 1) % 4]):
-                    if b not in nbrs:
-                        nbrs.append(b)
-            bnd = [b for b in nbrs if len(edge_faces(w, b)) == 1]
-            V = pts[w]
-            if bnd:
-                if len(bnd) != 2:  # pragma: no cover - QuadMesh guarantees manifold boundaries
-                    raise CCProofError("non-manifold boundary vertex in a local net")
-                e0, e1 = pts[bnd[0]], pts[bnd[1]]
-                cache[key] = [(e0[k] + 6 * V[k] + e1[k]) / 8 for k in range(3)]
-            else:
-                k_ = len(nbrs)
-                Fa = avg([face_pt(g) for g, _ in gs])
-                R = avg([avg([V, pts[b]]) for b in nbrs])
-                cache[key] = [(Fa[k] + 2 * R[k] + (k_ - 3) * V[k]) / k_ for k in range(3)]
-        return cache[key]
-
-    def child_face(g, i):
-        """Child of face g at its corner i, as keys, starting at the vertex point."""
-        F = faces[g]
-        w, nx, pv = F[i], F[(i + 1) % 4], F[(i - 1) % 4]
-        return [("v", w), ("e", min(w, nx), max(w, nx)), ("f", g), ("e", min(w, pv), max(w, pv))]
-
-    # children at the corners of C of the faces at those corners; the child's one-ring among them
-    kids = []
-    for w in C:
-        for g, i in star[w]:
-            kids.append((g, i, child_face(g, i)))
-    own = child_face(c, q)
-    own_set = set(own)
-    ring = [k for k in kids if own_set.intersection(k[2])]
-    ids, new_pts, new_faces = {}, [], []
-    for g, i, keys in ring:
-        F = []
-        for key in keys:
-            if key not in ids:
-                ids[key] = len(new_pts)
-                if key[0] == "v":
-                    new_pts.append(vertex_pt(key[1]))
-                elif key[0] == "e":
-                    new_pts.append(edge_pt(key[1], key[2]))
-                else:
-                    new_pts.append(face_pt(key[1]))
-            F.append(ids[key])
-        if (g, i) == (c, q):
-            r = (0, 3, 2, 1)[q]  # corner 0 of the child at the sub-square's lowest (u, v) corner
-            F = F[r:] + F[:r]
-            new_c = len(new_faces)
-        new_faces.append(tuple(F))
+    The exact stencils of one local step (:func:`ccproof.evaluate.local.refine_key`: the rules of
+    :mod:`ccproof.mesh.rules` in exact rationals) applied to the ball enclosures of the ring's
+    points: every new point is an enclosure of the true control point.
+    """
+    cx = Complex(piece.faces, {}, {}, Options())
+    ring, fk, nr = canonical_ring(cx, piece.c, 0)
+    _, stencils, child = refine_key(ring_key(cx, ring, fk, nr), nr)
+    # child q of the centre face (face 0 of the ring, read from its corner 0) is its child at corner
+    # q; corner r of that child lies at the sub-square's lowest (u, v) corner: the new corner 0
+    cring, cfaces, _ = canonical_ring(child, q, (0, 3, 2, 1)[q])
+    pts = [piece.pts[i] for i in ring]
+    new_pts = []
+    for w in cring:
+        st = stencils[w]
+        if st is None:  # pragma: no cover - the child's one-ring uses only exact points
+            raise CCProofError("internal error: a point of the child's one-ring is outside the local refinement")
+        new_pts.append([sum((pts[j][k] * x for j, x in st.items()), arb(0)) for k in range(3)])
     h = piece.h / 2
     du, dv = ((0, 0), (1, 0), (1, 1), (0, 1))[q]
-    return _Piece(new_faces, new_pts, new_c, piece.face, piece.u0 + du * h, piece.v0 + dv * h, h, piece.level + 1)
+    return _Piece(list(cfaces), new_pts, 0, piece.face, piece.u0 + du * h, piece.v0 + dv * h, h, piece.level + 1)
 
 
 def _bounds(piece, X, a, an, arb):

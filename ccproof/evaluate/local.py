@@ -1,157 +1,56 @@
-"""Exact local Catmull-Clark machinery: one-rings of faces, exact local refinement, patch nets.
+"""Exact local Catmull-Clark machinery: rings of faces, exact local refinement, patch nets, corner schemes.
 
-Everything here works on *local* quad complexes (the faces around one face, in local vertex
-labels) in exact rational arithmetic, and produces the float tables that
-:mod:`ccproof.evaluate.surface` evaluates.
+Everything here works on *local* complexes (:class:`ccproof.mesh.rules.Complex`: the faces around
+one face, in local vertex labels, with their tags) in exact rational arithmetic, and produces the
+float tables that :mod:`ccproof.evaluate.surface` (quad meshes) and :mod:`ccproof.evaluate.tagged`
+(tagged polygon meshes) evaluate; both use these functions, and the rules of
+:mod:`ccproof.mesh.rules`.
 
-* :class:`LocalTopology`: half-edges of any list of consistently oriented quads (no validation;
-  a local complex cut out of a valid mesh is consistent, though its outer vertices may look like
-  boundary or non-manifold vertices: their rules are never used).
-* :func:`canonical_ring`: the *one-ring of a face* (all faces sharing a vertex with it) listed by a
-  deterministic walk that starts at a chosen corner. Two rings with the same key are isomorphic,
-  and the key is the local face list itself: it is the cache key of every exact computation.
-* :func:`refine_exact`: one Catmull-Clark step (R1, boundary rules of :mod:`ccproof.mesh.subdivision`)
-  as exact :class:`fractions.Fraction` stencils, in the layout of :mod:`ccproof.mesh.subdivision`.
-* :func:`regular_net`: the 4 x 4 B-spline net of a face whose four vertices are regular (interior
-  of valence 4, or boundary with two faces), boundary rows completed by the ghost points
-  ``2 B - I`` (which reproduce the boundary rules exactly).
-* :func:`corner_scheme`: for a face with one irregular corner whose one-ring is *self-similar*
-  (the one-ring of its child at that corner is isomorphic to its own), the exact matrix ``A`` of
-  Stam 1998 (for an interior vertex of valence k the (2k+8) x (2k+8) subdivision matrix of the
-  face's one-ring), the exact limit mask ``l`` (left eigenvector of eigenvalue 1), and for every
-  layer ``n`` (bmz04 Fig. 3, R4) the three nets ``M_j A^n`` of the patches P_1, P_2, P_3 of layer n,
-  stored as exact-then-rounded deviations ``D_{n,j} = M_j A^n - 1 l^T``.
+* :func:`canonical_ring`: the *ring of a face* (all faces sharing a vertex with it, or the
+  two-ring) listed by a deterministic walk that starts at a chosen corner; :func:`ring_key` its
+  tagged key (faces, tags at the rule vertices, options). Two rings with the same key are
+  isomorphic; the key is the cache key of every exact computation.
+* :func:`refine_key`: one exact tagged Catmull-Clark step of a ring (:func:`ccproof.mesh.rules.refine_complex`).
+* :func:`regular_net`: the 4 x 4 B-spline net of a face whose corners are regular (smooth of valence
+  4, crease with two faces on the face's side, corner with one), rows across sharp and boundary
+  edges completed by the ghost points ``2 B - I`` (which reproduce the crease rules exactly).
+* :func:`corner_scheme`: for a face with one irregular corner whose ring is *stationary* (the ring
+  of its child at that corner has the same key), the exact matrix ``A`` of Stam 1998 (for an
+  interior vertex of valence k the (2k+8) x (2k+8) subdivision matrix of the face's one-ring),
+  the exact limit mask ``l`` (left eigenvector of eigenvalue 1), and for every layer ``n`` (bmz04
+  Fig. 3, R4) the three nets ``M_j A^n`` of the patches P_1, P_2, P_3 of layer n, stored as
+  exact-then-rounded deviations ``D_{n,j} = M_j A^n - 1 l^T``.
 """
 
 from __future__ import annotations
 
 import functools
-from fractions import Fraction
+import math
 
 import flint
 import numpy as np
 
 from ccproof.errors import MeshError
+from ccproof.mesh.rules import CORNER, CREASE, SMOOTH, Complex, Options, refine_complex, to_float, vertex_rule
 
 __all__ = [
-    "LocalTopology",
     "canonical_ring",
-    "refine_exact",
+    "quad_ring",
+    "ring_key",
+    "refine_key",
     "regular_net",
+    "corner_is_regular",
     "corner_scheme",
     "CornerScheme",
     "CORNERS",
 ]
 
-#: parameter positions of the four corners of a face (ptex convention)
 CORNERS = ((0, 0), (1, 0), (1, 1), (0, 1))
 
 #: smallest deviation kept in a layer table: beyond it the layer equals the limit point in float64
 LAYER_TOLERANCE = 2.0**-60
 #: hard cap on the number of layers of one corner table
 MAX_LAYERS = 400
-
-
-class LocalTopology:
-    """Half-edge topology of a list of consistently oriented quads.
-
-    Parameters
-    ----------
-    faces : array_like of int, shape (m, 4)
-        Vertex labels need not be contiguous.
-
-    Notes
-    -----
-    Half-edge / corner ``h = 4 f + i`` runs from ``faces[f, i]`` to ``faces[f, (i+1) % 4]``.
-    """
-
-    def __init__(self, faces):
-        F = np.asarray(faces, dtype=np.int64).reshape(-1, 4)
-        self.faces = F
-        self.flat = F.reshape(-1).tolist()
-        org = F.reshape(-1)
-        dst = np.roll(F, -1, axis=1).reshape(-1)
-        nv = int(F.max()) + 1
-        key = org * nv + dst
-        rev = dst * nv + org
-        order = np.argsort(key, kind="stable")
-        pos = np.searchsorted(key[order], rev)
-        pos = np.minimum(pos, key.size - 1)
-        hit = key[order][pos] == rev
-        twin = np.where(hit, order[pos], -1)
-        self.twin = twin.tolist()
-        self.n_vertices = nv
-        corners = [[] for _ in range(nv)]
-        for h, v in enumerate(self.flat):
-            corners[v].append(h)
-        self.corners = corners
-
-    @staticmethod
-    def next(h):
-        return h - h % 4 + (h + 1) % 4
-
-    @staticmethod
-    def prev(h):
-        return h - h % 4 + (h + 3) % 4
-
-    def org(self, h):
-        return self.flat[h]
-
-    def dst(self, h):
-        return self.flat[self.next(h)]
-
-    def ccw(self, c):
-        """Next corner counter-clockwise around the same vertex, or -1."""
-        return self.twin[self.prev(c)]
-
-    def cw(self, c):
-        """Next corner clockwise around the same vertex, or -1."""
-        t = self.twin[c]
-        return -1 if t < 0 else self.next(t)
-
-    def fan(self, start):
-        """Corners around ``org(start)``: counter-clockwise from ``start``, then (open fan) clockwise.
-
-        Returns
-        -------
-        corners : list of int
-        closed : bool
-        """
-        out = [start]
-        c = self.ccw(start)
-        while c >= 0 and c != start:
-            out.append(c)
-            c = self.ccw(c)
-        if c == start:
-            return out, True
-        c = self.cw(start)
-        while c >= 0:
-            out.append(c)
-            c = self.cw(c)
-        return out, False
-
-    def ordered_fan(self, v):
-        """Fan of vertex ``v`` in counter-clockwise order (open fans start at the clockwise end).
-
-        Returns ``(corners, closed)``, or ``(None, None)`` if the faces at ``v`` form several fans.
-        """
-        cs = self.corners[v]
-        fan, closed = self.fan(cs[0])
-        if len(fan) != len(cs):
-            return None, None
-        if not closed:
-            c = cs[0]
-            while self.cw(c) >= 0:
-                c = self.cw(c)
-            fan, _ = self.fan(c)
-        return fan, closed
-
-    def is_regular(self, v):
-        """Interior with four faces, or boundary with two faces."""
-        fan, closed = self.ordered_fan(v)
-        if fan is None:
-            return False
-        return len(fan) == (4 if closed else 2)
 
 
 def group_eigenvalues(vals, tol):
@@ -165,60 +64,6 @@ def group_eigenvalues(vals, tol):
             groups.append([z])
     return groups
 
-def canonical_ring(topo, f, r):
-    """The one-ring of face ``f`` listed from its corner ``r``.
-
-    The walk: the four vertices of ``f`` from corner ``r``; then for each of them in that order,
-    the faces around it counter-clockwise from ``f`` (for an open fan, then clockwise from ``f``),
-    each face read from that vertex on; vertices are numbered by first appearance.
-
-    Parameters
-    ----------
-    topo : LocalTopology
-    f, r : int
-
-    Returns
-    -------
-    ring : list of int
-        Vertex labels of ``topo`` in canonical order (``ring[0]`` is corner ``r`` of ``f``).
-    key : tuple of tuple of int
-        The faces of the one-ring in canonical labels; ``key[0] == (0, 1, 2, 3)`` is ``f``.
-    faces : list of int
-        The faces of ``topo`` in the same order as ``key``.
-
-    Examples
-    --------
-    >>> from ccproof.mesh.examples import k_regular_disk
-    >>> ring, key, _ = canonical_ring(LocalTopology(k_regular_disk(5, 3).faces), 0, 0)
-    >>> len(ring), len(key), key[0]       # Stam's 2k+8 points for k = 5
-    (18, 10, (0, 1, 2, 3))
-    """
-    pos = {}
-    ring = []
-
-    def add(v):
-        if v not in pos:
-            pos[v] = len(ring)
-            ring.append(v)
-
-    fv = [topo.flat[4 * f + (r + i) % 4] for i in range(4)]
-    for v in fv:
-        add(v)
-    key, faces, seen = [], [], set()
-    for i in range(4):
-        fan, _ = topo.fan(4 * f + (r + i) % 4)
-        for c in fan:
-            g = c // 4
-            if g in seen:
-                continue
-            seen.add(g)
-            vs = [topo.flat[4 * g + (c + t) % 4] for t in range(4)]
-            for v in vs:
-                add(v)
-            key.append(tuple(pos[v] for v in vs))
-            faces.append(g)
-    return ring, tuple(key), faces
-
 
 def _lin(*terms):
     """Linear combination of stencils: ``_lin((c1, s1), (c2, s2), ...)``."""
@@ -229,104 +74,245 @@ def _lin(*terms):
     return {v: w for v, w in out.items() if w != 0}
 
 
-@functools.lru_cache(maxsize=4096)
-def local_edges(key):
-    """Edges of the local complex ``key`` in the order of :func:`refine_exact` (first half-edge seen).
+
+def _stencil_matrix(stencils, ncols):
+    """Dense float matrix of exact stencils (dict column -> weight), each entry correctly rounded."""
+    rows, cols, vals = [], [], []
+    for r, s in enumerate(stencils):
+        rows.extend([r] * len(s))
+        cols.extend(s)
+        vals.extend(s.values())
+    M = np.zeros((len(stencils), ncols))
+    M[rows, cols] = [to_float(w) for w in vals]  # the columns of one stencil are distinct
+    return M
+
+
+# ------------------------------------------------------------------------------ local rings
+def canonical_ring(cx, g, r, depth=1):
+    """The ``depth``-ring of quad ``g`` of a complex, listed from its corner ``r``.
+
+    Walk: the vertices of ``g`` from corner ``r``; then, layer by layer, for every vertex listed so
+    far (in order), the faces around it counter-clockwise and then clockwise from its corner in the
+    first listed face containing it; each new face read from that vertex on; vertices numbered by
+    first appearance. Complexes with the same key (faces and tags) are isomorphic.
 
     Returns
     -------
-    edges : tuple of int
-        One half-edge ``4 f + i`` per edge (from ``key[f][i]`` to ``key[f][(i+1) % 4]``).
-    edge_of_halfedge : tuple of int
-    """
-    eid, edges, he_edge = {}, [], []
-    for f, face in enumerate(key):
-        for i in range(4):
-            a, b = face[i], face[(i + 1) % 4]
-            e = (min(a, b), max(a, b))
-            if e not in eid:
-                eid[e] = len(edges)
-                edges.append(4 * f + i)
-            he_edge.append(eid[e])
-    return tuple(edges), tuple(he_edge)
-
-
-@functools.lru_cache(maxsize=4096)
-def refine_exact(key):
-    """One exact Catmull-Clark step of the local complex ``key`` (faces in labels 0..N-1).
-
-    Returns
-    -------
-    stencils : tuple of (dict[int, Fraction] or None)
-        New vertex ``i`` as a combination of old vertices; layout of
-        :mod:`ccproof.mesh.subdivision` (vertex points, edge points, face points). ``None`` for the
-        vertex point of a vertex whose faces form several fans in the local complex.
-    children : tuple of tuple of int
-        Child ``4 f + i`` = (vertex point of corner i, edge point, face point, edge point).
+    ring : list of int
+        Vertex labels of ``cx`` in canonical order.
+    faces : tuple of tuple of int
+        The faces in canonical labels; ``faces[0] == (0, 1, 2, 3)`` is ``g``.
+    rule_vertices : int
+        The number of leading ring vertices whose whole fan is in the ring (4 for depth 1).
 
     Examples
     --------
-    >>> S, ch = refine_exact(((0, 1, 2, 3),))
-    >>> S[0] == {0: Fraction(3, 4), 1: Fraction(1, 8), 3: Fraction(1, 8)}, ch[0]
-    (True, (0, 4, 8, 7))
+    >>> from ccproof.mesh.examples import k_regular_disk
+    >>> from ccproof.mesh.rules import Complex, Options
+    >>> cx = Complex(k_regular_disk(5, 3).faces, {}, {}, Options())
+    >>> ring, faces, nr = canonical_ring(cx, 0, 0)
+    >>> len(ring), len(faces), faces[0], nr       # Stam's 2k+8 points for k = 5
+    (18, 10, (0, 1, 2, 3), 4)
     """
-    topo = LocalTopology(key)
-    F = topo.faces
-    n, m = topo.n_vertices, F.shape[0]
-    edges, he_edge = local_edges(key)
-    E = len(edges)
-    q4, q8, q16 = Fraction(1, 4), Fraction(1, 8), Fraction(1, 16)
-    fpts = [{int(v): q4 for v in F[f]} for f in range(m)]
-    epts = []
-    for h in edges:
-        a, b = topo.org(h), topo.dst(h)
-        t = topo.twin[h]
-        if t < 0:
-            epts.append({a: Fraction(1, 2), b: Fraction(1, 2)})
-        else:
-            s = {a: q4, b: q4}
-            for g in (h // 4, t // 4):
-                for v in F[g]:
-                    s[int(v)] = s.get(int(v), 0) + q16
-            epts.append(s)
-    vpts = []
-    for v in range(n):
-        if not topo.corners[v]:
-            vpts.append(None)
-            continue
-        fan, closed = topo.ordered_fan(v)
-        if fan is None:
-            vpts.append(None)
-        elif closed:
-            k = len(fan)
-            s = {v: Fraction(k - 3, k) + Fraction(1, k)}
-            wf, we = Fraction(1, 4 * k * k), Fraction(1, k * k)
-            for c in fan:
-                for u in F[c // 4]:
-                    s[int(u)] = s.get(int(u), 0) + wf
-                e = topo.dst(c)
-                s[e] = s.get(e, 0) + we
-            vpts.append(s)
-        else:
-            e0 = topo.dst(fan[0])
-            e1 = topo.org(topo.prev(fan[-1]))
-            s = {v: Fraction(3, 4)}
-            s[e0] = s.get(e0, 0) + q8
-            s[e1] = s.get(e1, 0) + q8
-            vpts.append(s)
-    stencils = tuple(vpts) + tuple(epts) + tuple(fpts)
-    children = []
-    for f in range(m):
-        fp = n + E + f
-        for i in range(4):
-            h = 4 * f + i
-            children.append((int(F[f, i]), n + he_edge[h], fp, n + he_edge[4 * f + (i + 3) % 4]))
-    return stencils, tuple(children)
+    pos, ring = {}, []
+    twin, prv, nxt, org, face_of, fstart, cfaces = cx.twin, cx.prv, cx.nxt, cx.org, cx.face_of, cx.start, cx.faces
+    s0 = fstart[g]
+    first_corner = {}
+    for i in range(4):
+        h = s0 + (r + i) % 4
+        v = org[h]
+        pos[v] = len(ring)
+        ring.append(v)
+        first_corner[v] = h
+    faces = [(0, 1, 2, 3)]
+    seen = {g}
+    done = 0
+    for _ in range(depth):
+        upto = len(ring)
+        for idx in range(done, upto):
+            c0 = first_corner[ring[idx]]
+            walk = [c0]
+            c = twin[prv[c0]]
+            while c >= 0 and c != c0:
+                walk.append(c)
+                c = twin[prv[c]]
+            if c != c0:
+                t = twin[c0]
+                c = -1 if t < 0 else nxt[t]
+                while c >= 0:
+                    walk.append(c)
+                    t = twin[c]
+                    c = -1 if t < 0 else nxt[t]
+            for c in walk:
+                h = face_of[c]
+                if h in seen:
+                    continue
+                seen.add(h)
+                sh, k = fstart[h], len(cfaces[h])
+                j0 = c - sh
+                vs = []
+                for t in range(k):
+                    hc = sh + (j0 + t) % k
+                    u = org[hc]
+                    q = pos.get(u)
+                    if q is None:
+                        q = pos[u] = len(ring)
+                        ring.append(u)
+                        first_corner[u] = hc
+                    vs.append(q)
+                faces.append(tuple(vs))
+        done = upto
+    return ring, tuple(faces), done
 
 
-# grid positions (i, j) of the 4 x 4 net around a face, i along u: for side s (edge corner s -> s+1)
-# the two outer points next to corner s and corner s+1, the diagonal point at corner s, and the
-# inward normal of the side in grid steps
+def quad_ring(faces, f, r):
+    """The canonical one-ring of quad ``f`` of an untagged quad mesh, read from its corner ``r``.
+
+    Parameters
+    ----------
+    faces : array_like of int, shape (m, 4)
+    f, r : int
+
+    Returns
+    -------
+    ring : list of int
+        Vertex labels in canonical order (``ring[0]`` is corner ``r`` of ``f``).
+    key : tuple
+        The tagged key (:func:`ring_key`) of the ring: the key of :func:`corner_scheme`.
+
+    Examples
+    --------
+    >>> from ccproof.mesh.examples import k_regular_disk
+    >>> ring, key = quad_ring(k_regular_disk(5, 3).faces, 0, 0)
+    >>> len(ring), len(key[0]), key[0][0]       # Stam's 2k+8 points for k = 5
+    (18, 10, (0, 1, 2, 3))
+    """
+    cx = Complex(faces, {}, {}, Options())
+    ring, fk, nr = canonical_ring(cx, f, r)
+    return ring, ring_key(cx, ring, fk, nr)
+
+
+def ring_key(cx, ring, faces, n_rule):
+    """Tagged key of a ring: faces, sharpness of edges at rule vertices, their vertex sharpness."""
+    tags = []
+    rule = set(range(n_rule))
+    seen = set()
+    for f in faces:
+        k = len(f)
+        for i in range(k):
+            a, b = f[i], f[(i + 1) % k]
+            e = (a, b) if a < b else (b, a)
+            if e in seen or (a not in rule and b not in rule):
+                continue
+            seen.add(e)
+            ga, gb = ring[a], ring[b]
+            gk = (ga, gb) if ga < gb else (gb, ga)
+            if cx.twin[cx.edges[cx.edge_index[gk]]] < 0:
+                continue  # boundary edge: infinitely sharp by the topology
+            s = cx.edge_sharpness.get(gk, 0.0)
+            if s > 0.0:
+                tags.append((e, math.inf if s >= 10.0 else s))
+    vs = []
+    for i in range(n_rule):
+        s = cx.vertex_sharpness.get(ring[i], 0.0)
+        if s > 0.0:
+            vs.append((i, math.inf if s >= 10.0 else s))
+    return (faces, tuple(sorted(tags)), tuple(vs), cx.options.key())
+
+
+@functools.lru_cache(maxsize=8192)
+def _key_complex(key):
+    """The complex of a ring key (shared by the functions cached per key; not to be modified)."""
+    faces, tags, vs, opts = key
+    return Complex(faces, dict(tags), dict(vs), Options(*opts), level=1)
+
+
+def _has_semi_sharp(key):
+    return any(0.0 < s < math.inf for _, s in key[1]) or any(0.0 < s < math.inf for _, s in key[2])
+
+
+@functools.lru_cache(maxsize=8192)
+def refine_key(key, n_rule):
+    """One exact tagged step of the ring ``key``, computing the rules at its ``n_rule`` rule vertices.
+
+    Returns
+    -------
+    S : ndarray, shape (n_points, N)
+        Float stencils (dense: local complexes are small), rows of uncomputable points NaN.
+    stencils : tuple of dict or None (exact)
+    child : Complex
+        The children of all faces, with the child tags (positions are not part of it).
+    """
+    cx = _key_complex(key)
+    rule = range(n_rule)
+    edges = [e for e, h in enumerate(cx.edges) if cx.org[h] < n_rule or cx.dst(h) < n_rule]
+    stencils, children, ces, cvs = refine_complex(cx, vertices=rule, edges=edges)
+    child = Complex(children, ces, cvs, cx.options, level=2, n_vertices=len(stencils))
+    S = _stencil_matrix([{} if st is None else st for st in stencils], cx.n_vertices)
+    S[[i for i, st in enumerate(stencils) if st is None]] = np.nan
+    S.setflags(write=False)
+    return S, tuple(stencils), child
+
+
+@functools.lru_cache(maxsize=1 << 16)
+def _child_ring(key, n_rule, g, r, depth):
+    """Ring (ring positions as an index array, tagged key, rule count) of face ``g`` of the child
+    complex of :func:`refine_key` ``(key, n_rule)``, from corner ``r``."""
+    _, _, child = refine_key(key, n_rule)
+    ring, faces, nr = canonical_ring(child, g, r, depth)
+    return np.array(ring, dtype=np.int64), ring_key(child, ring, faces, nr), nr
+
+
+# ------------------------------------------------------------------------------ regularity
+def _corner_info(cx, c):
+    """(rule, sector size, closed, valence) of the corner ``c`` (a rule vertex of ``cx``)."""
+    v = cx.org[c]
+    ve = cx.vertex_edges(v)
+    if ve is None:
+        return None
+    es, _, fan, closed = ve
+    pe = [cx.sharpness(e) for e in es]
+    rule = vertex_rule(cx.vsharp(v), pe)
+    n = 1
+    cur = c
+    while True:  # counter-clockwise: across the incoming edge of cur
+        if cx.sharpness(cx.he_edge[cx.prv[cur]]) > 0.0:
+            break
+        nxt = cx.ccw(cur)
+        if nxt < 0 or nxt == c:
+            break
+        cur, n = nxt, n + 1
+    if cur != c or n == 1:
+        cur = c
+        while True:  # clockwise: across the outgoing edge of cur
+            if cx.sharpness(cx.he_edge[cur]) > 0.0:
+                break
+            nxt = cx.cw(cur)
+            if nxt < 0 or nxt == c:
+                break
+            cur, n = nxt, n + 1
+    return rule, min(n, len(fan)), closed, len(fan)
+
+
+def corner_is_regular(cx, c):
+    """Whether the corner ``c`` of a quad is regular for the bicubic B-spline patch (no semi-sharp tags).
+
+    Smooth rule with a closed fan of 4 faces; crease rule with 2 faces in the corner's sector;
+    corner rule with 1 face in the sector.
+    """
+    info = _corner_info(cx, c)
+    if info is None:
+        return False
+    rule, sector, closed, nf = info
+    if rule == SMOOTH:
+        return closed and nf == 4
+    if rule == CREASE:
+        return sector == 2
+    if rule == CORNER:
+        return sector == 1
+    return False
+
+
 _SIDES = (
     ((1, 0), (2, 0), (0, 0), (0, 1)),
     ((3, 1), (3, 2), (3, 0), (-1, 0)),
@@ -336,43 +322,25 @@ _SIDES = (
 _CENTER = ((1, 1), (2, 1), (2, 2), (1, 2))
 
 
-def regular_net(topo, f):
-    """The 4 x 4 bicubic B-spline net of face ``f`` as stencils over the vertices of ``topo``.
+def regular_net(cx, g):
+    """The 4 x 4 B-spline net of quad ``g`` as integer stencils, or None if a corner is irregular.
 
-    Parameters
-    ----------
-    topo : LocalTopology
-    f : int
-        A face whose four vertices are regular (interior of valence 4 or boundary with two faces).
-
-    Returns
-    -------
-    list of 16 dict or None
-        ``net[i + 4 j]`` (i along the face's u, corner 0 at grid (1, 1)), with integer weights
-        (1 for a vertex, ``2 B - I`` for a ghost point); ``None`` if the face is not regular.
-
-    Examples
-    --------
-    >>> from ccproof.mesh.examples import grid
-    >>> net = regular_net(LocalTopology(grid(3, 3).faces), 4)   # the middle face: no ghosts
-    >>> [min(s) for s in net[:4]]
-    [0, 1, 2, 3]
-    >>> regular_net(LocalTopology(grid(3, 3).faces), 1)[1]      # bottom face: ghost 2*1 - 5
-    {1: 2, 5: -1}
+    Rows across infinitely sharp edges (and boundary edges) of the face are ghost points
+    ``2 B - I``; at a corner-rule corner the diagonal ghost is ``4 V - 2 E1 - 2 E2 + D``.
     """
-    F = topo.flat
-    fv = [F[4 * f + s] for s in range(4)]
-    if not all(topo.is_regular(v) for v in fv):
+    s0 = cx.start[g]
+    if not all(corner_is_regular(cx, s0 + i) for i in range(4)):
         return None
+    fv = [cx.org[s0 + s] for s in range(4)]
     grid = {}
     for s in range(4):
         grid[_CENTER[s]] = {fv[s]: 1}
-    bnd = [topo.twin[4 * f + s] < 0 for s in range(4)]
+    bnd = [cx.sharpness(cx.he_edge[s0 + s]) > 0.0 for s in range(4)]
     for s in range(4):
         if not bnd[s]:
-            t = topo.twin[4 * f + s]
-            grid[_SIDES[s][0]] = {topo.dst(topo.next(t)): 1}
-            grid[_SIDES[s][1]] = {topo.org(topo.prev(t)): 1}
+            t = cx.twin[s0 + s]
+            grid[_SIDES[s][0]] = {cx.dst(cx.nxt[t]): 1}
+            grid[_SIDES[s][1]] = {cx.org[cx.prv[t]]: 1}
 
     def ghost(p, nrm):
         q = (p[0] + nrm[0], p[1] + nrm[1])
@@ -384,26 +352,122 @@ def regular_net(topo, f):
             for p in _SIDES[s][:2]:
                 grid[p] = ghost(p, _SIDES[s][3])
     for s in range(4):
-        sp, sm = s, (s + 3) % 4  # the two sides at corner s
+        sp, sm = s, (s + 3) % 4
         p = _SIDES[s][2]
-        if bnd[sp] and bnd[sm]:
-            return None
         if not bnd[sp] and not bnd[sm]:
-            t = topo.twin[4 * f + s]
-            t2 = topo.twin[topo.next(t)]
+            t = cx.twin[s0 + s]
+            t2 = cx.twin[cx.nxt[t]]
             if t2 < 0:
                 return None
-            grid[p] = {topo.org(topo.prev(t2)): 1}
+            grid[p] = {cx.org[cx.prv[t2]]: 1}
         else:
             grid[p] = ghost(p, _SIDES[sp if bnd[sp] else sm][3])
     return [grid[(i, j)] for j in range(4) for i in range(4)]
+
+
+@functools.lru_cache(maxsize=8192)
+def regular_net_matrix(key):
+    """Float (16, N) matrix of the regular net of face 0 of the ring ``key``, or None."""
+    cx = _key_complex(key)
+    net = regular_net(cx, 0)
+    if net is None:
+        return None
+    return _stencil_matrix(net, cx.n_vertices)
+
+
+@functools.lru_cache(maxsize=8192)
+def irregular_corners(key):
+    cx = _key_complex(key)
+    return tuple(i for i in range(4) if not corner_is_regular(cx, i))
+
+
+# ------------------------------------------------------------------------------ corner schemes
+@functools.lru_cache(maxsize=2048)
+def corner_scheme(key):
+    """:func:`_corner_scheme`, kept between runs (:func:`cached_scheme`)."""
+    return cached_scheme("tagged", key, lambda: _corner_scheme(key))
+
+
+def _corner_scheme(key):
+    """Exact layered-patch data of face 0 of the tagged one-ring ``key`` (irregular corner 0).
+
+    Parameters
+    ----------
+    key : tuple
+        The tagged one-ring (:func:`canonical_ring`, :func:`ring_key`) of a face, read from its
+        irregular corner.
+
+    Returns
+    -------
+    CornerScheme or None
+        ``None`` unless the configuration is stationary (the tagged one-ring of the child at corner
+        0 has the same key) and the three other children are regular patches: such a face must be
+        subdivided once more.
+
+    Notes
+    -----
+    Self-similarity (bmz04 section 3, Stam 1998): with C the control points of the one-ring of the
+    face, ``A^n C`` are those of its level-n child at the corner, the square [0, 2^-n]^2. Layer n
+    (R4) is that square minus [0, 2^-(n+1)]^2; it consists of the level-(n+1) children at the other
+    three corners, regular bicubic patches with nets ``M_j A^n C`` (``M_j``: one step followed by the
+    net of child j). The matrices are built exactly (flint ``fmpq_mat``); ``A^n`` is never rounded,
+    only the final deviations ``M_j A^n - 1 l^T``, whose entries decay like lam^n: they keep full
+    relative precision at every layer, so the derivatives (which grow like (2 lam)^n, bmz04 eq. 3)
+    are as accurate deep down as near the face centre. The limit mask is exact.
+    """
+    _, stencils, child = refine_key(key, 4)
+    N = _key_complex(key).n_vertices
+    ring1, faces1, nr = canonical_ring(child, 0, 0, 1)
+    key1 = ring_key(child, ring1, faces1, nr)
+    if key1 != key:
+        return None
+    rows = [stencils[v] for v in ring1]
+    if any(r is None for r in rows):
+        return None
+    A = _to_fmpq_mat(rows, N)
+    nets = []
+    for j in (1, 2, 3):
+        net = regular_net(child, j)
+        if net is None:
+            return None
+        for s in net:
+            row = {}
+            for v, w in s.items():
+                sv = stencils[v]
+                if sv is None:
+                    return None
+                for u, x in sv.items():
+                    row[u] = row.get(u, 0) + w * x
+            nets.append(row)
+    M = _to_fmpq_mat(nets, N)
+    support = set()
+    for row in nets:
+        support.update(row)
+    todo = list(support)
+    while todo:  # close under A: the rows of A at the support use only the support
+        i = todo.pop()
+        for j in rows[i]:
+            if j not in support:
+                support.add(j)
+                todo.append(j)
+    Bt = (A - flint.fmpq_mat(N, N, [int(i == j) for i in range(N) for j in range(N)])).transpose()
+    for j in range(N):
+        Bt[N - 1, j] = 1
+    rhs = flint.fmpq_mat(N, 1, [0] * (N - 1) + [1])
+    try:
+        lvec = Bt.solve(rhs)
+    except ZeroDivisionError:
+        raise MeshError("corner configuration whose subdivision matrix has a multiple eigenvalue 1") from None
+    l_row = flint.fmpq_mat(1, N, [lvec[i, 0] for i in range(N)])
+    layers = power_layers(M, A, l_row)
+    return CornerScheme(N, A, _fmpq_mat_to_float(l_row)[0], layers, sorted(support))
 
 
 def _to_fmpq_mat(rows, ncols):
     M = flint.fmpq_mat(len(rows), ncols)
     for i, s in enumerate(rows):
         for j, w in s.items():
-            M[i, j] = flint.fmpq(w.numerator, w.denominator) if isinstance(w, Fraction) else w
+            M[i, j] = w  # exact: int or flint.fmpq
     return M
 
 
@@ -457,7 +521,7 @@ def power_layers(M, A, l_row):
     raise MeshError(f"corner configuration of {N} vertices does not converge to its limit point")
 
 
-_SOURCES = ("evaluate/local.py", "evaluate/tagged.py", "mesh/rules.py")
+_SOURCES = ("evaluate/local.py", "mesh/rules.py")  # the code that computes the cached data
 
 
 @functools.lru_cache(maxsize=1)
@@ -487,11 +551,13 @@ def cached_scheme(kind, key, compute):
     """``compute()`` (a CornerScheme or None), kept between runs in a disk cache.
 
     The cache (default ``~/.cache/ccproof/corner_schemes``; environment variable
-    ``CCPROOF_CACHE`` = another folder, or ``off``) holds one ``.npz`` per configuration, named by
-    the SHA-256 of the configuration key and of the sources that compute it; it stores the rounded
-    layers, the limit mask, the support and the exact matrix ``A`` (integer numerators as decimal
-    strings and one denominator), so a cached scheme is the computed one bit for bit. Unreadable
-    or unwritable cache files are ignored (the data are then computed).
+    ``CCPROOF_CACHE`` = another folder, or ``off``) holds two files per configuration, named by
+    the SHA-256 of the configuration key and of the sources that compute it: ``.f64``, one raw
+    little-endian float64 vector ``[N, n_layers, n_support, limit mask (N), support, layers]``
+    (read at setup; no header to parse), and
+    ``.A.npz``, the exact matrix ``A`` (integer numerators as decimal strings and one denominator,
+    read only when the tangent masks need it). A cached scheme is the computed one bit for bit.
+    Unreadable or unwritable cache files are ignored (the data are then computed).
     """
     import hashlib
     import os
@@ -500,16 +566,19 @@ def cached_scheme(kind, key, compute):
     if d is None:
         return compute()
     name = hashlib.sha256(f"{kind}|{_code_version()}|{key!r}".encode()).hexdigest()
-    path = d / f"{name}.npz"
-    if path.exists():
+    path, apath = d / f"{name}.f64", d / f"{name}.A.npz"
+    if path.exists() and apath.exists():
         try:
-            with np.load(path, allow_pickle=False) as z:
-                N = int(z["size"])
-                den = int(str(z["A_den"]))
-                A = flint.fmpq_mat(N, N, [flint.fmpq(int(x), den) for x in z["A_num"].tolist()])
-                sup = z["support"]
-                return CornerScheme(N, A, z["limit_mask"].copy(), z["layers"].copy(),
-                                    None if sup.size == 0 else [int(i) for i in sup])
+            z = np.fromfile(path, dtype="<f8")
+            N, nl, ns = (int(x) for x in z[:3])
+            if z.size != 3 + N + ns + nl * 48 * N:
+                raise ValueError("truncated cache file")
+            mask = z[3:3 + N]  # views of the freshly read vector
+            sup = [int(i) for i in z[3 + N:3 + N + ns]]
+            layers = z[3 + N + ns:].reshape(nl, 3, 16, N)
+            # the exact A is only needed for the tangent masks: read and converted on first use
+            loader = functools.partial(_cached_exact_matrix, apath, N, compute)
+            return CornerScheme(N, loader, mask, layers, sup or None)
         except (OSError, ValueError, KeyError):
             pass
     sch = compute()
@@ -518,14 +587,27 @@ def cached_scheme(kind, key, compute):
     try:
         d.mkdir(parents=True, exist_ok=True)
         num, den = sch.A.numer_denom()
-        tmp = d / f".{name}.{os.getpid()}.npz"
-        np.savez(tmp, size=np.array(sch.size), A_den=np.array(str(den)),
-                 A_num=np.array([str(x) for x in num.entries()]), limit_mask=sch.limit_mask,
-                 layers=sch.layers, support=np.array(sch.support if sch.support else [], dtype=np.int64))
+        tmp = d / f".{name}.{os.getpid()}.A.npz"
+        np.savez(tmp, A_den=np.array(str(den)), A_num=np.array([str(x) for x in num.entries()]))
+        os.replace(tmp, apath)
+        sup = list(sch.support) if sch.support else []
+        head = np.array([sch.size, sch.n_layers, len(sup)] + sup, dtype=np.float64)
+        tmp = d / f".{name}.{os.getpid()}.f64"
+        np.concatenate([head[:3], sch.limit_mask, head[3:], sch.layers.reshape(-1)]).astype("<f8").tofile(tmp)
         os.replace(tmp, path)
     except OSError:
         pass
     return sch
+
+
+def _cached_exact_matrix(apath, N, compute):
+    """The exact ``A`` of a cached scheme from its ``.A.npz`` (recomputed if that file is gone)."""
+    try:
+        with np.load(apath, allow_pickle=False) as z:
+            den = int(str(z["A_den"]))
+            return flint.fmpq_mat(N, N, [flint.fmpq(int(x), den) for x in z["A_num"].tolist()])
+    except (OSError, ValueError, KeyError):
+        return compute().A
 
 
 class CornerScheme:
@@ -536,7 +618,9 @@ class CornerScheme:
     size : int
         N, the number of vertices of the face's one-ring (2k + 8 at an interior vertex of valence k).
     A : flint.fmpq_mat, shape (N, N)
-        Exact subdivision matrix from the one-ring of the face to the one-ring of its child at the corner.
+        Exact subdivision matrix from the one-ring of the face to the one-ring of its child at the
+        corner (a scheme read from the disk cache builds it on first access: the parameter may be a
+        function returning it).
     limit_mask : ndarray, shape (N,)
         Limit position of the corner vertex (exact left eigenvector of ``A`` for 1, rounded).
     layers : ndarray, shape (n_layers, 3, 16, N)
@@ -551,10 +635,16 @@ class CornerScheme:
 
     def __init__(self, size, A, limit_mask, layers, support=None):
         self.size = size
-        self.A = A
+        self._A = A
         self.limit_mask = limit_mask
         self.layers = layers
         self.support = None if support is None or len(support) == size else tuple(support)
+
+    @property
+    def A(self):
+        if callable(self._A):
+            self._A = self._A()
+        return self._A
 
     @property
     def n_layers(self):
@@ -650,76 +740,3 @@ def _tangent_masks(A):
             if len(masks) == 2:
                 return np.array(masks)
     return None
-
-
-@functools.lru_cache(maxsize=1024)
-def corner_scheme(key):
-    """Exact layered-patch data of a face with one irregular corner (:func:`_corner_scheme`),
-    kept between runs in the disk cache of :func:`cached_scheme`."""
-    return cached_scheme("quad", key, lambda: _corner_scheme(key))
-
-
-def _corner_scheme(key):
-    """Exact layered-patch data of a face with one irregular corner, or ``None`` if not self-similar.
-
-    Parameters
-    ----------
-    key : tuple of tuple of int
-        The canonical one-ring (:func:`canonical_ring`) of a face, read from the irregular corner.
-
-    Returns
-    -------
-    CornerScheme or None
-        ``None`` when the one-ring of the child at the corner is not isomorphic to the face's own
-        one-ring, or when one of the three children away from the corner is not a regular patch:
-        such a face must be subdivided once more.
-
-    Notes
-    -----
-    Self-similarity (bmz04 section 3, Stam 1998): with C the control points of the one-ring of the
-    face, ``A^n C`` are those of its level-n child at the corner, the square [0, 2^-n]^2. Layer n
-    (R4) is that square minus [0, 2^-(n+1)]^2; it consists of the level-(n+1) children at the other
-    three corners, regular bicubic patches with nets ``M_j A^n C`` (``M_j``: one step followed by the
-    net of child j). The matrices are built exactly (fractions, flint ``fmpq_mat``); ``A^n`` is
-    never rounded, only the final deviations ``M_j A^n - 1 l^T``, whose entries decay like lam^n:
-    they keep full relative precision at every layer, so the derivatives (which grow like
-    (2 lam)^n, bmz04 eq. 3) are as accurate deep down as near the face centre.
-    """
-    topo = LocalTopology(key)
-    N = topo.n_vertices
-    stencils, children = refine_exact(key)
-    topo1 = LocalTopology(children)
-    ring1, key1, _ = canonical_ring(topo1, 0, 0)
-    if key1 != key:
-        return None
-    rows = [stencils[v] for v in ring1]
-    if any(r is None for r in rows):
-        return None
-    A = _to_fmpq_mat(rows, N)
-    nets = []
-    for j in (1, 2, 3):
-        net = regular_net(topo1, j)
-        if net is None:
-            return None
-        for s in net:
-            row = {}
-            for v, w in s.items():
-                sv = stencils[v]
-                if sv is None:
-                    return None
-                for u, x in sv.items():
-                    row[u] = row.get(u, 0) + w * x
-            nets.append(row)
-    M = _to_fmpq_mat(nets, N)  # (48, N)
-    # limit mask: l (A - I) = 0, sum(l) = 1
-    Bt = (A - flint.fmpq_mat(N, N, [int(i == j) for i in range(N) for j in range(N)])).transpose()
-    for j in range(N):
-        Bt[N - 1, j] = 1
-    rhs = flint.fmpq_mat(N, 1, [0] * (N - 1) + [1])
-    try:
-        lvec = Bt.solve(rhs)
-    except ZeroDivisionError:
-        raise MeshError("corner configuration whose subdivision matrix has a multiple eigenvalue 1") from None
-    l_row = flint.fmpq_mat(1, N, [lvec[i, 0] for i in range(N)])
-    layers = power_layers(M, A, l_row)
-    return CornerScheme(N, A, _fmpq_mat_to_float(l_row)[0], layers)

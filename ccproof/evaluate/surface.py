@@ -28,26 +28,35 @@ Python loop over points, memory bounded by evaluating in chunks.
 from __future__ import annotations
 
 import functools
+import weakref
 
 import numpy as np
 
 from ccproof.errors import CCProofError, MeshError
 from ccproof.evaluate.bspline import bspline_basis
 from ccproof.evaluate.local import (
+    _CENTER,
+    _SIDES,
     CORNERS,
-    LocalTopology,
+    _child_ring,
+    _has_semi_sharp,
     canonical_ring,
     corner_scheme,
-    local_edges,
-    refine_exact,
-    regular_net,
+    irregular_corners,
+    refine_key,
+    regular_net_matrix,
+    ring_key,
 )
 from ccproof.mesh import QuadMesh, limit_normals, limit_positions
+from ccproof.mesh.rules import Complex, Options
 
 __all__ = ["natural_limit_surface", "LimitSurface"]
 
 #: how many times a face may be subdivided before it must be regular or self-similar
 MAX_DEPTH = 4
+#: local subdivisions allowed in the semi-sharp phase of a tagged mesh (sharpness < 10 decays in
+#: 10 uniform levels)
+MAX_SEMI_DEPTH = 40
 #: points evaluated per chunk (bounds the temporary memory: about 1 kB per point)
 CHUNK = 1 << 15
 #: layers of every corner table stored with the regular patches ("hot" region, for cache locality:
@@ -61,35 +70,39 @@ _KEYS = {0: ("P",), 1: ("P", "Pu", "Pv"), 2: ("P", "Pu", "Pv", "Puu", "Puv", "Pv
 
 # ---------------------------------------------------------------------------------- frames
 # A frame maps a face's own parameter (s, t) to the base face's (u, v): (u, v) = o + s a + t b,
-# with a, b axis-aligned of the same length (a power of 2).
+# with a, b axis-aligned of the same length (a power of 2). Frames are tuples of three float pairs
+# (o, a, b): they are composed once per virtual face, so plain floats (every value dyadic, every
+# operation exact) instead of small arrays.
+_C = tuple((float(x), float(y)) for x, y in CORNERS)
+
+
 def _compose(frame, sub):
-    o, a, b = frame
-    so, sa, sb = sub
-    return (o + a * so[0] + b * so[1], a * sa[0] + b * sa[1], a * sb[0] + b * sb[1])
+    (ox, oy), (ax, ay), (bx, by) = frame
+    (p, q), (sa0, sa1), (sb0, sb1) = sub
+    return ((ox + ax * p + bx * q, oy + ay * p + by * q), (ax * sa0 + bx * sa1, ay * sa0 + by * sa1),
+            (ax * sb0 + bx * sb1, ay * sb0 + by * sb1))
 
 
 def _corner_frame(i, scale=1.0):
     """Frame of the square at corner i of [0,1]^2, rotated so that corner i is its origin."""
-    c = np.array(CORNERS, dtype=np.float64)
-    return (c[i] * 1.0, (c[(i + 1) % 4] - c[i]) * scale, (c[(i + 3) % 4] - c[i]) * scale)
+    c, c1, c3 = _C[i], _C[(i + 1) % 4], _C[(i + 3) % 4]
+    return (c, ((c1[0] - c[0]) * scale, (c1[1] - c[1]) * scale), ((c3[0] - c[0]) * scale, (c3[1] - c[1]) * scale))
 
 
 def _child_frame(i):
-    c = np.array(CORNERS, dtype=np.float64)
-    return (c[i], (c[(i + 1) % 4] - c[i]) / 2, (c[(i + 3) % 4] - c[i]) / 2)
+    return _corner_frame(i, 0.5)
 
 
 def _layer_frame(n, j):
     """Frame of patch P_j of layer n in the corner frame (corner at the origin), bmz04 Fig. 3."""
-    c = np.array(CORNERS, dtype=np.float64)
     h = 2.0 ** -(n + 1)
-    return (c[j] * 2.0 * h, (c[(j + 1) % 4] - c[j]) * h, (c[(j + 3) % 4] - c[j]) * h)
+    o, a, b = _corner_frame(j, h)
+    return ((o[0] * 2.0 * h, o[1] * 2.0 * h), a, b)
 
 
 def _domain(frame):
-    o, a, b = frame
-    lo = o + np.minimum(a, 0) + np.minimum(b, 0)
-    return float(lo[0]), float(lo[1]), float(np.abs(a).max())
+    (ox, oy), (ax, ay), (bx, by) = frame
+    return ox + min(ax, 0.0) + min(bx, 0.0), oy + min(ay, 0.0) + min(by, 0.0), max(abs(ax), abs(ay))
 
 
 @functools.lru_cache(maxsize=64)
@@ -107,33 +120,113 @@ def _permutation(ah, bh):
 def _net_permutation(frame):
     """Index map sending a net in the frame's own orientation to the base orientation."""
     _, a, b = frame
-    return _permutation(tuple(int(x) for x in np.sign(a)), tuple(int(x) for x in np.sign(b)))
+    return _permutation(_sign(a), _sign(b))
 
 
-def _stencil_matrix(stencils, ncols):
-    M = np.zeros((len(stencils), ncols))
-    for r, s in enumerate(stencils):
-        for c, w in s.items():
-            M[r, c] += float(w)
-    return M
+def _sign(x):
+    return (int(x[0] > 0) - int(x[0] < 0), int(x[1] > 0) - int(x[1] < 0))
 
 
-@functools.lru_cache(maxsize=4096)
-def _regular_net_matrix(key):
-    """(16, k) float net matrix of face 0 of the one-ring ``key`` and the k ring positions it uses."""
-    net = regular_net(LocalTopology(key), 0)
-    if net is None:  # pragma: no cover
-        return None, None
-    cols = sorted({v for s in net for v in s})
-    M = _stencil_matrix([{cols.index(v): w for v, w in s.items()} for s in net], len(cols))
-    M.setflags(write=False)
-    return M, np.array(cols, dtype=np.int64)
+#: rows x columns x 3 of one product in :func:`_skinny_product` (below OpenBLAS's threading
+#: threshold of 4 * 65536 multiply-adds)
+_SKINNY_BLOCK = 1 << 17
+
+
+def _skinny_product(L, rel):
+    """``L @ rel`` for a tall ``L`` (R, N) and ``rel`` (N, 3), in row blocks small enough for
+    single-threaded BLAS: at setup these products are many and small, and waking BLAS threads for
+    each costs more than the product (much more on a loaded machine). Same sums, same result."""
+    R, N = L.shape
+    step = max(1, _SKINNY_BLOCK // (rel.shape[1] * max(N, 1)))
+    if R <= step:
+        return L @ rel
+    out = np.empty((R, rel.shape[1]))
+    for lo in range(0, R, step):
+        np.matmul(L[lo:lo + step], rel, out=out[lo:lo + step])
+    return out
+
+
+#: per corner scheme, its layer tables in every orientation of a corner frame (see _oriented_layers)
+_ORIENTED = weakref.WeakKeyDictionary()
+
+
+def _oriented_layers(scheme, rot):
+    """The layer deviations of ``scheme`` laid out for a corner frame ``rot`` of any side and origin.
+
+    Returns
+    -------
+    L : ndarray, shape (n_layers * 3 * 16, N)
+        Row ``(n, code, i)``: entry ``i`` of the net of layer ``n``, patch ``code`` (0: the patch
+        along u, 1: the diagonal one, 2: the one along v, bmz04 Fig. 3), in the base orientation.
+    unit : ndarray, shape (n_layers, 3, 3)
+        ``(u0, v0, h)`` of those patches for a corner frame of side 1 with the corner at the origin
+        (dyadic: scaling by the side and shifting by the corner are exact).
+
+    Depends on ``rot`` only through the directions of its axes; computed once per scheme and
+    orientation.
+    """
+    orient = (_sign(rot[1]), _sign(rot[2]))
+    per_scheme = _ORIENTED.setdefault(scheme, {})
+    hit = per_scheme.get(orient)
+    if hit is not None:
+        return hit
+    rows, unit0 = _corner_orientation(orient)
+    Ls = scheme.layers
+    nl, N = Ls.shape[0], Ls.shape[-1]
+    L = np.take(Ls.reshape(nl, 48, N), rows, axis=1).reshape(-1, N)  # contiguous: the reshape is a view
+    unit = unit0[None] * (0.5 ** np.arange(nl))[:, None, None]  # layer n: layer 0 scaled by 2^-n
+    L.setflags(write=False)
+    unit.setflags(write=False)
+    per_scheme[orient] = (L, unit)
+    return L, unit
+
+
+@functools.lru_cache(maxsize=16)
+def _corner_orientation(orient):
+    """Rows of a scheme's layer nets and layer-0 domains for a corner frame with axis directions
+    ``orient`` (see :func:`_oriented_layers`): ``rows`` (48,), row ``16 code + i`` of a layer in the
+    base orientation is row ``rows[16 code + i]`` of its ``3 x 16`` nets ``D[n, j-1]``; ``unit``
+    (3, 3), the domains of the three patches of layer 0 for a unit frame at the origin."""
+    a, b = orient
+    unit_rot = ((0.0, 0.0), (float(a[0]), float(a[1])), (float(b[0]), float(b[1])))
+    # P_1 lies along the frame's a-axis: code 0 (u-distance >= 1/2, v-distance < 1/2) if a is
+    # along u, else code 2; P_2 (diagonal) is code 1; P_3 the other one
+    a_along_u = a[0] != 0
+    codes = {1: 0 if a_along_u else 2, 2: 1, 3: 2 if a_along_u else 0}
+    rows = np.empty(48, dtype=np.int64)
+    unit = np.empty((3, 3))
+    for j in (1, 2, 3):
+        f0 = _compose(unit_rot, _layer_frame(0, j))
+        rows[16 * codes[j]:16 * codes[j] + 16] = 16 * (j - 1) + _net_permutation(f0)
+        unit[codes[j]] = _domain(f0)
+    rows.setflags(write=False)
+    unit.setflags(write=False)
+    return rows, unit
+
+
+def _smooth_regular_vertices(cx):
+    """Bool (n_vertices,): the vertices of ``cx`` with four faces and no boundary edge, sharp edge
+    or vertex sharpness (regular for the bicubic patch under any options)."""
+    org, nxt, twin = (np.asarray(a, dtype=np.int64) for a in (cx.org, cx.nxt, cx.twin))
+    ok = np.bincount(org, minlength=cx.n_vertices) == 4
+    open_h = twin < 0
+    ok[org[open_h]] = False
+    ok[org[nxt[open_h]]] = False
+    for (a, b), sh in cx.edge_sharpness.items():
+        if sh > 0.0:
+            ok[a] = ok[b] = False
+    for v, sh in cx.vertex_sharpness.items():
+        if sh > 0.0:
+            ok[v] = False
+    return ok
 
 
 class _Builder:
     """Collects patches and virtual faces while classifying the faces of a mesh."""
 
-    def __init__(self):
+    def __init__(self, depth_semi=1, what="face"):
+        self.depth_semi = depth_semi  # ring depth refined in the semi-sharp phase (2: Chaikin)
+        self.what = what  # how errors name a base face
         self.hot = ([], [], [])  # nets (k, 17, 3) with the origin as row 16; domains (k, 3)
         self.cold = ([], [], [])
         self.n_hot = 0
@@ -141,7 +234,6 @@ class _Builder:
         self.vcold = []
         self.vkind, self.vdom, self.vpatch, self.vchild, self.vcorner, self.vnmax = [], [], [], [], [], []
         self.vbase = []
-        self.max_depth = 0
         self.corner_of_vertex = {}
         self.corner_data = {}  # corner virtual face -> (CornerScheme, ring control points)
 
@@ -171,35 +263,151 @@ class _Builder:
         region[1].append(doms)
 
     # ------------------------------------------------------------------ classification
-    def face(self, topo, X, f, frame, depth, base_face, vid, vmap=None):
-        F = topo.flat
-        irregular = [i for i in range(4) if not topo.is_regular(F[4 * f + i])]
-        if not irregular:
-            ring, key, _ = canonical_ring(topo, f, 0)
-            M, cols = _regular_net_matrix(key)
-            if M is None:  # pragma: no cover - regular vertices always give a net
-                raise MeshError(f"face {base_face}: no regular B-spline net")
-            Xl = X[np.asarray(ring)[cols]]
-            origin = Xl.mean(axis=0)
+    def classify(self, cx, X, jobs, vmap=None):
+        """Classify the quads ``jobs = [(g, frame, base, vid), ...]`` of ``cx`` (positions ``X``).
+
+        The smooth regular ones (:meth:`smooth_regular_patches`) in one vectorized pass, the
+        others face by face (:meth:`face`); a quad with three smooth regular corners is first
+        tried as a corner face at the fourth. ``vmap``: the mesh vertex of every vertex of ``cx``
+        (records the corner scheme of each irregular vertex, for the vertex normals).
+        """
+        if not jobs:
+            return
+        ok = _smooth_regular_vertices(cx)
+        done = self.smooth_regular_patches(cx, X, jobs)
+        g = np.array([j[0] for j in jobs], dtype=np.int64)
+        start = np.asarray(cx.start + [len(cx.org)], dtype=np.int64)
+        org = np.asarray(cx.org, dtype=np.int64)
+        quad = start[g + 1] - start[g] == 4
+        corners = ok[org[np.minimum(start[g][:, None] + np.arange(4), org.size - 1)]]
+        single = np.where(quad & (corners.sum(axis=1) == 3), np.argmin(corners, axis=1), -1)
+        for (g_, frame, base, vid), d, r in zip(jobs, done, single.tolist()):
+            if d:
+                continue
+            if r >= 0 and self.corner_at(cx, X, g_, r, frame, base, vid, vmap):
+                continue
+            self.face(cx, X, g_, frame, 0, 0, base, vid, vmap=vmap)
+
+    def corner_at(self, cx, X, g, r, frame, base, vid, vmap=None):
+        """Store quad ``g`` as a corner face at corner ``r`` if that is its classification (its
+        other corners regular, its ring from ``r`` stationary): the path of :meth:`face` for such a
+        face, without listing its ring from corner 0 first (the tags of a ring, hence the
+        semi-sharp test, do not depend on the corner it is listed from). Returns True if stored."""
+        ring_r, faces_r, nr = canonical_ring(cx, g, r)
+        key_r = ring_key(cx, ring_r, faces_r, nr)
+        if _has_semi_sharp(key_r) or irregular_corners(key_r) != (0,):
+            return False
+        scheme = corner_scheme(key_r)
+        if scheme is None:
+            return False
+        self.scheme_face(scheme, X, ring_r, r, frame, base, vid, vmap)
+        return True
+
+    def scheme_face(self, scheme, X, ring_r, r, frame, base, vid, vmap=None):
+        """:meth:`corner_face` on the ring ``ring_r`` (listed from the face's irregular corner
+        ``r``), and the first corner scheme of each mesh vertex recorded (``vmap``) for its normal."""
+        C = X[ring_r]
+        self._check_finite(C, base)
+        vid = self.corner_face(scheme, C, r, frame, vid)
+        vertex = -1 if vmap is None else int(vmap[ring_r[0]])
+        if vertex >= 0 and vertex not in self.corner_of_vertex:
+            self.corner_of_vertex[vertex] = (scheme, C, vid)
+        return vid
+
+    def smooth_regular_patches(self, cx, X, jobs):
+        """Store the bicubic patches of the quads of ``jobs`` whose four vertices are smooth regular.
+
+        Smooth regular (:func:`_smooth_regular_vertices`): four faces around the vertex, no
+        boundary, sharp edge or vertex sharpness at it. Such a face's tagged one-ring has no tags
+        and no irregular corner, and its net (:func:`ccproof.evaluate.local.regular_net`) is its
+        4 x 4 grid of vertices: gathered here for all of them at once with the half-edge arrays (the
+        same walks as :func:`ccproof.evaluate.local.regular_net`). Returns a bool array, True for
+        the jobs handled.
+        """
+        if not jobs:
+            return np.zeros(0, dtype=bool)
+        org, nxt, prv, twin = (np.asarray(a, dtype=np.int64) for a in (cx.org, cx.nxt, cx.prv, cx.twin))
+        ok = _smooth_regular_vertices(cx)
+        g = np.array([j[0] for j in jobs], dtype=np.int64)
+        start = np.asarray(cx.start + [org.size], dtype=np.int64)
+        H = start[g][:, None] + np.arange(4)
+        sel = (start[g + 1] - start[g] == 4) & ok[org[np.minimum(H, org.size - 1)]].all(axis=1)
+        idx = np.flatnonzero(sel)
+        if idx.size == 0:
+            return sel
+        H = H[idx]
+        grid = np.empty((idx.size, 16), dtype=np.int64)
+        for s_ in range(4):
+            h = H[:, s_]
+            t = twin[h]
+            cell = [p[0] + 4 * p[1] for p in (_CENTER[s_],) + _SIDES[s_][:3]]
+            grid[:, cell[0]] = org[h]
+            grid[:, cell[1]] = org[nxt[nxt[t]]]
+            grid[:, cell[2]] = org[prv[t]]
+            grid[:, cell[3]] = org[prv[twin[nxt[t]]]]
+        frames = [jobs[i][1] for i in idx]
+        perm = np.array([_net_permutation(f) for f in frames])
+        origin = X[grid].mean(axis=1)
+        nets = X[np.take_along_axis(grid, perm, axis=1)] - origin[:, None, :]
+        self._check_finite(nets, int(jobs[idx[0]][2]))
+        self._store(self.hot, nets, origin, np.array([_domain(f) for f in frames]))
+        for r, i in enumerate(idx):
+            vid = jobs[i][3]
             self.vkind[vid] = _REGULAR
-            self.vpatch[vid] = self.add_patch(M @ (Xl - origin), origin, frame)
+            self.vpatch[vid] = self.n_hot + r
+        self.n_hot += idx.size
+        return sel
+
+    def face(self, cx, X, g, frame, depth, semi_depth, base, vid, src=None, vmap=None):
+        """Classify quad ``g`` of complex ``cx`` with positions ``X`` (NaN where not exact).
+
+        ``src = (key, n_rule)``: ``cx`` is the child complex of that ring (its rings are cached).
+        ``vmap``: mesh vertex of every vertex of ``cx`` (-1 for new points), or None.
+        """
+
+        def ring_of(r, depth_):
+            if src is not None:
+                return _child_ring(src[0], src[1], g, r, depth_)
+            ring_, faces_, nr_ = canonical_ring(cx, g, r, depth_)
+            return ring_, ring_key(cx, ring_, faces_, nr_), nr_
+
+        ring, key, nr = ring_of(0, 1)
+        if _has_semi_sharp(key):
+            if semi_depth >= MAX_SEMI_DEPTH:
+                raise MeshError(f"{self.what} {base}: semi-sharp creases did not decay in {MAX_SEMI_DEPTH} levels")
+            D = self.depth_semi
+            if D != 1:
+                ring, key, nr = ring_of(0, D)
+            return self.split_face(key, nr, X[ring], frame, depth, semi_depth + 1, base, vid,
+                                   None if vmap is None else vmap[ring])
+        irr = irregular_corners(key)
+        if not irr:
+            M = regular_net_matrix(key)
+            Xl = X[ring]
+            self._check_finite(Xl, base)
+            origin = Xl.mean(axis=0)
+            net = M @ (Xl - origin)
+            self._check_finite(net, base)
+            self.vkind[vid] = _REGULAR
+            self.vpatch[vid] = self.add_patch(net, origin, frame)
             return vid
-        if len(irregular) == 1:
-            r = irregular[0]
-            ring, key, _ = canonical_ring(topo, f, r)
-            scheme = corner_scheme(key)
+        if len(irr) == 1:
+            r = irr[0]
+            ring_r, key_r, _ = ring_of(r, 1)
+            scheme = corner_scheme(key_r)
             if scheme is not None:
-                vid = self.corner_face(scheme, X[ring], r, frame, vid)
-                vertex = int(vmap[F[4 * f + r]]) if vmap is not None else -1
-                if vertex >= 0 and vertex not in self.corner_of_vertex:
-                    self.corner_of_vertex[vertex] = (scheme, X[ring], vid)
-                return vid
+                return self.scheme_face(scheme, X, ring_r, r, frame, base, vid, vmap)
         if depth >= MAX_DEPTH:
             raise MeshError(
-                f"face {base_face}: the configuration around it is not supported "
+                f"{self.what} {base}: the configuration around it is not supported "
                 f"(still irregular after {MAX_DEPTH} local subdivisions)"
             )
-        return self.split_face(topo, X, f, frame, depth, base_face, vid, vmap)
+        return self.split_face(key, nr, X[ring], frame, depth + 1, semi_depth, base, vid,
+                               None if vmap is None else vmap[ring])
+
+    def _check_finite(self, a, base):
+        if not np.isfinite(a).all():  # pragma: no cover - would be a bug in the local refinement
+            raise MeshError(f"internal error: {self.what} {base} uses a point outside the exact local refinement")
 
     def corner_face(self, scheme, C, r, frame, vid):
         self.corner_data[vid] = (scheme, C)
@@ -210,25 +418,13 @@ class _Builder:
         self.vcorner[vid] = (int(corner[0] > U0), int(corner[1] > V0))
         rel = C - C[0]
         origin = C[0] + scheme.limit_mask @ rel
-        L = scheme.layers
-        nl = L.shape[0]
-        dev = (L.reshape(-1, L.shape[-1]) @ rel).reshape(nl, 3, 16, -1)  # (n_layers, 3, 16, 3)
-        # P_1 lies along the frame's a-axis: code 0 (u-distance >= 1/2, v-distance < 1/2) if a is
-        # along u, else code 2; P_2 (diagonal) is code 1; P_3 the other one
-        a_along_u = abs(rot[1][0]) > 0
-        codes = {1: 0 if a_along_u else 2, 2: 1, 3: 2 if a_along_u else 0}
-        nets = np.empty((nl, 3, 16, rel.shape[-1]))
-        doms = np.empty((nl, 3, 3))
-        for j in (1, 2, 3):
-            f0 = _compose(rot, _layer_frame(0, j))
-            perm = _net_permutation(f0)
-            nets[:, codes[j]] = dev[:, j - 1][:, perm]
-            u0, v0, h0 = _domain(f0)
-            # layer n is layer 0 scaled by 2^-n towards the corner (exact: powers of two)
-            sc = 0.5 ** np.arange(nl)
-            doms[:, codes[j], 0] = corner[0] + (u0 - corner[0]) * sc
-            doms[:, codes[j], 1] = corner[1] + (v0 - corner[1]) * sc
-            doms[:, codes[j], 2] = h0 * sc
+        L, unit = _oriented_layers(scheme, rot)
+        nl = unit.shape[0]
+        nets = _skinny_product(L, rel).reshape(nl, 3, 16, rel.shape[-1])
+        # layer domains: the unit corner frame's scaled by the side H (exact: powers of two)
+        doms = unit * H
+        doms[..., 0] += corner[0]
+        doms[..., 1] += corner[1]
         K = min(HOT_LAYERS, nl)
         self._store(self.hot, nets[:K].reshape(-1, 16, rel.shape[-1]), origin, doms[:K].reshape(-1, 3))
         self._store(self.cold, nets[K:].reshape(-1, 16, rel.shape[-1]), origin, doms[K:].reshape(-1, 3))
@@ -239,33 +435,30 @@ class _Builder:
         self.vnmax[vid] = nl - 1
         return vid
 
-    def split_face(self, topo, X, f, frame, depth, base_face, vid, vmap):
-        ring, key, _ = canonical_ring(topo, f, 0)
-        stencils, children = refine_exact(key)
-        topo1 = LocalTopology(children)
-        # Only the points whose stencils lie inside the one-ring are exact: the vertex points of the
-        # face's own vertices (labels 0..3), the edge points of edges at them and all face points.
-        # The children's one-rings use no other point (the others are set to NaN, so that any use
-        # would show up in the final check of the tables instead of passing silently).
-        X1 = _stencil_matrix([s if s is not None else {} for s in stencils], len(ring)) @ X[ring]
-        n = len(ring)
-        edges, _ = local_edges(key)
-        outer_edges = [n + e for e, h in enumerate(edges) if min(key[h // 4][h % 4], key[h // 4][(h + 1) % 4]) > 3]
-        X1[list(range(4, n)) + outer_edges] = np.nan
-        # base-mesh vertex of every local vertex (vertex points keep their vertex), -1 for new points
-        vmap1 = np.full(len(stencils), -1, dtype=np.int64)
+    def split_face(self, key, nr, Xr, frame, depth, semi_depth, base, vid, vmap=None):
+        """Subdivide the ring ``key`` (positions ``Xr``) once, exactly and locally; classify the
+        four children of its face 0.
+
+        Only the points whose stencils lie inside the ring are exact (the rules at its ``nr`` rule
+        vertices, :func:`ccproof.evaluate.local.refine_key`); the others are NaN, so that any use
+        would show up in the checks of the tables instead of passing silently. ``vmap``: the mesh
+        vertex of every ring vertex (vertex points keep their vertex), or None.
+        """
+        S, _, child = refine_key(key, nr)
+        X1 = S @ Xr
+        vmap1 = None
         if vmap is not None:
-            vmap1[: len(ring)] = vmap[ring]
+            vmap1 = np.full(S.shape[0], -1, dtype=np.int64)
+            vmap1[: len(vmap)] = vmap
         self.vkind[vid] = _SPLIT
-        self.max_depth = max(self.max_depth, depth + 1)
-        U0, V0, H = self.vdom[vid]
+        U0, V0, _ = self.vdom[vid]
         for i in range(4):
             cf = _compose(frame, _child_frame(i))
             cu, cv, _ = _domain(cf)
             q = int(cu > U0) + 2 * int(cv > V0)
-            child = self.new_vface(_REGULAR, cf, base_face)
-            self.vchild[vid][q] = child
-            self.face(topo1, X1, i, cf, depth + 1, base_face, vid=child, vmap=vmap1)
+            c = self.new_vface(_REGULAR, cf, base)
+            self.vchild[vid][q] = c
+            self.face(child, X1, i, cf, depth, semi_depth, base, c, src=(key, nr), vmap=vmap1)
         return vid
 
 
@@ -280,15 +473,18 @@ class LimitSurface:
     def __init__(self, mesh: QuadMesh):
         self.mesh = mesh
         b = _Builder()
-        topo = LocalTopology(mesh.faces)
+        cx = Complex(mesh.faces, {}, {}, Options(), n_vertices=mesh.n_vertices)
         X = mesh.vertices
-        base = (np.zeros(2), np.array([1.0, 0.0]), np.array([0.0, 1.0]))
+        base = ((0.0, 0.0), (1.0, 0.0), (0.0, 1.0))
         m = mesh.n_faces
         vmap = np.arange(mesh.n_vertices)
         for f in range(m):  # virtual faces 0..m-1 are the base faces
             b.new_vface(_REGULAR, base, f)
-        for f in range(m):
-            b.face(topo, X, f, base, 0, f, vid=f, vmap=vmap)
+        b.classify(cx, X, [(f, base, f, f) for f in range(m)], vmap=vmap)
+        self._finish(b)
+
+    def _finish(self, b):
+        """The evaluation tables from a :class:`_Builder` that has classified every base face."""
         self._nets = np.ascontiguousarray(np.concatenate(b.hot[0] + b.cold[0]))  # (n_patches, 17, 3)
         if not np.isfinite(self._nets).all():  # pragma: no cover - would be a bug in the classification
             bad = int(np.flatnonzero(~np.isfinite(self._nets).all(axis=(1, 2)))[0])
@@ -305,7 +501,10 @@ class LimitSurface:
         vc = np.array(b.vcorner, dtype=bool).reshape(-1, 2)
         self._vcu, self._vcv = vc[:, 0].copy(), vc[:, 1].copy()
         self._vnmax = np.array(b.vnmax, dtype=np.int64)
-        self.split_depth = b.max_depth
+        depth = np.zeros(len(b.vkind), dtype=np.int64)
+        for vid in np.flatnonzero(self._vkind == _SPLIT):  # children are created after their parents
+            depth[self._vchild[vid]] = depth[vid] + 1
+        self.split_depth = int(depth.max())  # the descent steps of _vface_of
         self._corner_of_vertex = b.corner_of_vertex
         self._corner_data = b.corner_data
         self._corner_normal = {}
@@ -719,13 +918,11 @@ def _vertex_maps(surface):
     probe = np.zeros((n, int(color.max()) + 1))
     probe[np.arange(n), color] = 1.0
     b = _Builder()
-    topo = LocalTopology(mesh.faces)
-    frame = (np.zeros(2), np.array([1.0, 0.0]), np.array([0.0, 1.0]))
+    cx = Complex(mesh.faces, {}, {}, Options(), n_vertices=n)
+    frame = ((0.0, 0.0), (1.0, 0.0), (0.0, 1.0))
     for f in range(m):
         b.new_vface(_REGULAR, frame, f)
-    vmap = np.arange(n)
-    for f in range(m):
-        b.face(topo, probe, f, frame, 0, f, vid=f, vmap=vmap)
+    b.classify(cx, probe, [(f, frame, f, f) for f in range(m)], vmap=np.arange(n))
     nets = np.concatenate(b.hot[0] + b.cold[0])
     Wn = np.zeros((surface.n_patches, 17, smax))
     it, sl = np.nonzero(pslot)

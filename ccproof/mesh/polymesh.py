@@ -25,7 +25,7 @@ import scipy.sparse as sp
 
 from ccproof.errors import MeshError
 from ccproof.mesh.quadmesh import pair_halfedges
-from ccproof.mesh.rules import INFINITE, Complex, Options, refine_complex
+from ccproof.mesh.rules import INFINITE, Complex, Options, refine_complex, to_float
 
 __all__ = ["PolyMesh"]
 
@@ -331,8 +331,8 @@ class PolyMesh:
     def subdivision_operator(self, exact=False):
         """The linear operator S of one step: ``refine()[0].vertices == S @ vertices``.
 
-        ``exact=True``: a list of dict rows with :class:`fractions.Fraction` weights (the same
-        stencils the float matrix is rounded from).
+        ``exact=True``: a list of dict rows with exact rational weights (``flint.fmpq``: the
+        same stencils the float matrix is rounded from).
         """
         stencils, _, _, _ = refine_complex(self.complex())
         if exact:
@@ -357,5 +357,5 @@ def stencil_matrix(stencils, ncols):
         for c, w in s.items():
             rows.append(r)
             cols.append(c)
-            vals.append(float(w))
+            vals.append(to_float(w))
     return sp.csr_matrix((vals, (rows, cols)), shape=(len(stencils), ncols))

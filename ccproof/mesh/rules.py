@@ -1,10 +1,14 @@
 """One Catmull-Clark step with OpenSubdiv's Sdc rules (creases, corners, boundary), as exact stencils.
 
 This is the single rule implementation of the tagged meshes: :func:`refine_complex` turns a polygon
-complex with edge and vertex sharpness into the stencils of every new point (exact
-:class:`fractions.Fraction` weights) plus the child faces and their sharpness. The float operator
-``S`` (``V1 == S @ V0``) of :func:`ccproof.mesh.polymesh.PolyMesh.subdivision_operator` and the
-exact local matrices of :mod:`ccproof.evaluate.tagged` are both read from these stencils.
+complex with edge and vertex sharpness into the stencils of every new point (exact rational
+weights, ``flint.fmpq``) plus the child faces and their sharpness. The float operator ``S``
+(``V1 == S @ V0``) of :func:`ccproof.mesh.polymesh.PolyMesh.subdivision_operator` and the exact
+local matrices of :mod:`ccproof.evaluate` are both read from these stencils, and the vectorized
+reference step of :mod:`ccproof.mesh.subdivision` takes its weights from the same rule functions
+(:func:`face_point_weight`, :func:`smooth_edge_weights`, :func:`sharp_edge_weight`,
+:func:`smooth_vertex_weights`, :func:`crease_vertex_weights`), evaluated in floats: one rule
+implementation, exact or float by the number ``one`` it is given.
 
 Rules (Sdc ``SCHEME_CATMARK``, OpenSubdiv 3.6 ``sdc/scheme.h``, ``sdc/catmarkScheme.h``,
 ``sdc/crease.cpp``; sharpness ``s`` is IEEE float32 as in OpenSubdiv, ``s >= 10`` is infinite,
@@ -31,13 +35,14 @@ quad ``(v_k', e_{k,k+1}', f', e_{k-1,k}')``.
 
 from __future__ import annotations
 
+import functools
 import math
-from fractions import Fraction
 
 import numpy as np
 
 __all__ = ["Options", "Complex", "refine_complex", "INFINITE", "BOUNDARY_MODES", "CREASE_METHODS",
-           "TRIANGLE_RULES", "vertex_rule"]
+           "TRIANGLE_RULES", "vertex_rule", "exact_one", "face_point_weight", "smooth_edge_weights",
+           "sharp_edge_weight", "smooth_vertex_weights", "crease_vertex_weights", "to_float"]
 
 #: OpenSubdiv's Sdc::Crease::SHARPNESS_INFINITE: sharpness at or above it is infinite
 INFINITE = 10.0
@@ -49,6 +54,70 @@ SMOOTH, DART, CREASE, CORNER = "smooth", "dart", "crease", "corner"
 
 _F32 = np.float32
 _ONE = _F32(1.0)
+
+
+@functools.lru_cache(maxsize=1)
+def exact_one():
+    """The exact rational 1 (``flint.fmpq``): the ``one`` that makes the rule functions exact.
+
+    python-flint's rationals are used instead of :class:`fractions.Fraction` for speed (the
+    local refinements of the evaluator are exact); imported on first use (``import ccproof``
+    stays cheap).
+    """
+    import flint
+
+    return flint.fmpq(1)
+
+
+def _exact(x):
+    """The exact rational value of a float (a float32 sharpness or the 0.47 triangle weight)."""
+    p, q = float(x).as_integer_ratio()
+    return exact_one() * p / q
+
+
+def to_float(w):
+    """Correctly rounded float of an exact weight (int, ``flint.fmpq`` or ``fractions.Fraction``;
+    Python's int division of numerator by denominator is correctly rounded)."""
+    q = getattr(w, "q", None)
+    if q is not None:  # flint.fmpq
+        return int(w.p) / int(q)
+    if isinstance(w, (int, float)):
+        return float(w)
+    return w.numerator / w.denominator
+
+
+# ------------------------------------------------------------------------------ the rules
+# Each rule's weights, once, for any number type: ``one`` is exact_one() (exact stencils) or 1.0
+# (floats, also with integer numpy arrays for the sizes and valences: the vectorized step).
+def face_point_weight(n, one):
+    """Face point: the centroid; the weight of each of the ``n`` vertices of the face."""
+    return one / n
+
+
+def smooth_edge_weights(one):
+    """Smooth edge point ``(a + b + f0 + f1) / 4``: (weight of each end, of each adjacent face point)."""
+    return one / 4, one / 4
+
+
+def sharp_edge_weight(one):
+    """Sharp (crease or boundary) edge point: the midpoint; the weight of each end."""
+    return one / 2
+
+
+def smooth_vertex_weights(k, one):
+    """Smooth (and dart) vertex point ``((k - 2) V + sum e_j / k + sum f_j / k) / k`` at valence ``k``.
+
+    Returns (weight of V, of each edge neighbour e_j, of each adjacent face point f_j); for quads
+    bmz04 Fig. 1: ``1 - 7/(4k)`` on V, ``3/(2k^2)`` and ``1/(4k^2)`` on the edge and diagonal
+    neighbours.
+    """
+    return one * (k - 2) / k, one / (k * k), one / (k * k)
+
+
+def crease_vertex_weights(one):
+    """Crease (and boundary) vertex point ``(3/4) V + (1/8)(e0 + e1)``: (weight of V, of each of
+    the two neighbours along the crease)."""
+    return one * 3 / 4, one / 8
 
 
 class Options:
@@ -159,9 +228,9 @@ def _fractional_weight(pv, cv, pe, ce, uniform):
             total = _F32(total + _F32(p))
             count += 1
     if count == 0:
-        return Fraction(0)
+        return 0 * exact_one()
     w = _F32(total / _F32(count))
-    return Fraction(1) if w > 1 else Fraction(float(w))
+    return exact_one() if w > 1 else _exact(w)
 
 
 def _add(out, c, s):
@@ -195,47 +264,46 @@ class Complex:
     """
 
     def __init__(self, faces, edge_sharpness, vertex_sharpness, options, level=0, n_vertices=None):
-        self.faces = [tuple(int(v) for v in f) for f in faces]
+        if isinstance(faces, np.ndarray):
+            faces = faces.tolist()
+        self.faces = [tuple(map(int, f)) for f in faces]
         self.edge_sharpness = edge_sharpness
         self.vertex_sharpness = vertex_sharpness
         self.options = options
         self.level = level
         nv = 1 + max(max(f) for f in self.faces) if n_vertices is None else int(n_vertices)
         self.n_vertices = nv
-        start, he_org = [], []
-        for f in self.faces:
-            start.append(len(he_org))
-            he_org.extend(f)
-        self.start = start
-        self.org = he_org
-        H = len(he_org)
-        self.face_of = [0] * H
-        self.nxt = [0] * H
-        self.prv = [0] * H
+        start, org, face_of, nxt, prv = [], [], [], [], []
         for g, f in enumerate(self.faces):
-            s, n = start[g], len(f)
-            for i in range(n):
-                h = s + i
-                self.face_of[h] = g
-                self.nxt[h] = s + (i + 1) % n
-                self.prv[h] = s + (i - 1) % n
-        directed = {}
-        for h in range(H):
-            directed[(he_org[h], he_org[self.nxt[h]])] = h
-        self.twin = [directed.get((he_org[self.nxt[h]], he_org[h]), -1) for h in range(H)]
+            s, n = len(org), len(f)
+            start.append(s)
+            org.extend(f)
+            face_of.extend([g] * n)
+            nxt.extend(range(s + 1, s + n))
+            nxt.append(s)
+            prv.append(s + n - 1)
+            prv.extend(range(s, s + n - 1))
+        self.start = start
+        self.org = org
+        self.face_of = face_of
+        self.nxt = nxt
+        self.prv = prv
+        dst = [org[x] for x in nxt]
+        directed = dict(zip(zip(org, dst), range(len(org))))
+        self.twin = [directed.get((b, a), -1) for a, b in zip(org, dst)]
         eid, edges, he_edge = {}, [], []
-        for h in range(H):
-            a, b = he_org[h], he_org[self.nxt[h]]
+        for h, (a, b) in enumerate(zip(org, dst)):
             k = (a, b) if a < b else (b, a)
-            if k not in eid:
-                eid[k] = len(edges)
+            e = eid.get(k)
+            if e is None:
+                e = eid[k] = len(edges)
                 edges.append(h)
-            he_edge.append(eid[k])
+            he_edge.append(e)
         self.edge_index = eid
         self.edges = edges
         self.he_edge = he_edge
         corners = [[] for _ in range(nv)]
-        for h, v in enumerate(he_org):
+        for h, v in enumerate(org):
             corners[v].append(h)
         self.corners = corners
         self._fans = {}
@@ -323,22 +391,23 @@ class Complex:
 
 def _vertex_mask(cx, v, fan, nb, fpts, rule, sh):
     """Sdc vertex-point mask of ``v`` for one rule (smooth/dart, crease along the sharp edges, corner)."""
+    one = exact_one()
     if rule in (SMOOTH, DART):
-        k = len(fan)
-        m = {v: Fraction(k - 2, k)}
-        wk = Fraction(1, k * k)
+        wv, we, wf = smooth_vertex_weights(len(fan), one)
+        m = {v: wv}
         for c in fan:
-            _add(m, wk, fpts[cx.face_of[c]])
+            _add(m, wf, fpts[cx.face_of[c]])
             u = cx.dst(c)
-            m[u] = m.get(u, 0) + wk
+            m[u] = m.get(u, 0) + we
         return m
     if rule == CREASE:
-        m = {v: Fraction(3, 4)}
+        wv, we = crease_vertex_weights(one)
+        m = {v: wv}
         for u, s in zip(nb, sh):
             if s > 0.0:
-                m[u] = m.get(u, 0) + Fraction(1, 8)
+                m[u] = m.get(u, 0) + we
         return m
-    return {v: Fraction(1)}
+    return {v: one}
 
 
 def refine_complex(cx, vertices=None, edges=None):
@@ -356,7 +425,7 @@ def refine_complex(cx, vertices=None, edges=None):
 
     Returns
     -------
-    stencils : list of (dict[int, Fraction] or None), length n + E + F
+    stencils : list of (dict[int, flint.fmpq] or None), length n + E + F
         New vertex as a combination of old vertices (layout in the module docstring).
     children : list of tuple of 4 int
         Child quads, ``offset(f) + k`` for corner k of face f (offsets = cumulative face sizes).
@@ -370,9 +439,11 @@ def refine_complex(cx, vertices=None, edges=None):
     E = len(cx.edges)
     opts = cx.options
     uniform = opts.crease_method == "uniform"
+    one = exact_one()
+    half = sharp_edge_weight(one)
     fpts = []
     for f in cx.faces:
-        w = Fraction(1, len(f))
+        w = face_point_weight(len(f), one)
         fpts.append({v: w for v in f})
     want_v = range(n) if vertices is None else sorted(set(vertices))
     csharp = {}  # v -> {edge: child sharpness of its half at v}
@@ -410,15 +481,14 @@ def refine_complex(cx, vertices=None, edges=None):
         t = cx.twin[h]
         s = cx.sharpness(e)
         if s > 0.0 and t < 0:
-            epts[e] = {a: Fraction(1, 2), b: Fraction(1, 2)}
+            epts[e] = {a: half, b: half}
             continue
         faces = [cx.face_of[h], cx.face_of[t]]
+        vw, fw = smooth_edge_weights(one)
         if tri_smooth and any(len(cx.faces[g]) == 3 for g in faces):
-            w0, w1 = (Fraction(0.470) if len(cx.faces[g]) == 3 else Fraction(1, 4) for g in faces)
+            w0, w1 = (_exact(0.470) if len(cx.faces[g]) == 3 else fw for g in faces)
             fw = (w0 + w1) / 2
             vw = (1 - 2 * fw) / 2
-        else:
-            fw, vw = Fraction(1, 4), Fraction(1, 4)
         smooth = {a: vw, b: vw}
         for g in faces:
             _add(smooth, fw, fpts[g])
@@ -440,12 +510,12 @@ def refine_complex(cx, vertices=None, edges=None):
                 continue  # an end vertex without a single fan in the complex: not computable
             ca, cb = ends
         if ca > 0.0 and cb > 0.0:
-            epts[e] = {a: Fraction(1, 2), b: Fraction(1, 2)}
+            epts[e] = {a: half, b: half}
             continue
-        pw = Fraction(float(_F32(s)))
+        pw = _exact(_F32(s))
         out = {}
         _add(out, 1 - pw, smooth)
-        _add(out, pw, {a: Fraction(1, 2), b: Fraction(1, 2)})
+        _add(out, pw, {a: half, b: half})
         epts[e] = {u: x for u, x in out.items() if x != 0}
     stencils = vpts + epts + fpts
     children = []

@@ -1,17 +1,24 @@
-"""One reference Catmull-Clark step (bmz04 Fig. 1, docs/readings.md R1) with the standard boundary rules.
+"""One reference Catmull-Clark step of a quad mesh (bmz04 Fig. 1, docs/readings.md R1), vectorized.
 
-Rules (no creases; boundary as OpenSubdiv ``VTX_BOUNDARY_EDGE_ONLY``: every boundary edge is an
-infinitely sharp crease, no vertex is a corner):
+The rules are those of :mod:`ccproof.mesh.rules` (the one rule implementation): this module only
+assembles them over the whole mesh with numpy, taking every weight from the rule functions
+:func:`~ccproof.mesh.rules.face_point_weight`, :func:`~ccproof.mesh.rules.smooth_edge_weights`,
+:func:`~ccproof.mesh.rules.sharp_edge_weight`, :func:`~ccproof.mesh.rules.smooth_vertex_weights` and
+:func:`~ccproof.mesh.rules.crease_vertex_weights` evaluated in floats (the exact stencils of
+:func:`~ccproof.mesh.rules.refine_complex` evaluate the same functions exactly;
+tests/mesh/test_subdivision.py checks that the two operators agree). No creases; boundary as
+OpenSubdiv ``VTX_BOUNDARY_EDGE_ONLY`` (every boundary edge is an infinitely sharp crease, no vertex
+is a corner):
 
 * face point: the mean of the four vertices of the face;
 * interior edge point: the mean of the two endpoints and the two adjacent face points;
-* interior vertex of valence k: ``(F + 2 R + (k - 3) V) / k`` with F the mean of the k adjacent new
-  face points and R the mean of the k midpoints of the adjacent edges; equivalently weights
-  ``1 - 7/(4k)`` on V, ``beta/k = 3/(2k^2)`` on every edge neighbour and ``gamma/k = 1/(4k^2)`` on
-  every face-diagonal neighbour (bmz04: beta = 3/(2k), gamma = 1/(4k));
+* interior vertex of valence k: ``((k - 2) V + sum e_j / k + sum f_j / k) / k`` (e_j the edge
+  neighbours, f_j the new face points); equivalently weights ``1 - 7/(4k)`` on V, ``3/(2k^2)`` on
+  every edge neighbour and ``1/(4k^2)`` on every face-diagonal neighbour (bmz04: beta = 3/(2k),
+  gamma = 1/(4k));
 * boundary edge point: the midpoint of the edge;
-* boundary vertex (any number of faces): the cubic B-spline curve rule ``(e0 + 6 V + e1) / 8`` on
-  its two boundary neighbours e0, e1.
+* boundary vertex (any number of faces): the crease rule ``(e0 + 6 V + e1) / 8`` on its two
+  boundary neighbours e0, e1 (the cubic B-spline curve rule).
 
 Layout of the refined mesh (``n`` vertices, ``E`` edges, ``m`` faces before the step): new vertex
 ``v`` (``v < n``) is the vertex point of old vertex ``v``; ``n + e`` is the edge point of edge ``e``
@@ -27,6 +34,13 @@ import numpy as np
 import scipy.sparse as sp
 
 from ccproof.mesh.quadmesh import QuadMesh
+from ccproof.mesh.rules import (
+    crease_vertex_weights,
+    face_point_weight,
+    sharp_edge_weight,
+    smooth_edge_weights,
+    smooth_vertex_weights,
+)
 
 __all__ = ["subdivide", "subdivision_matrix", "child_faces"]
 
@@ -67,7 +81,7 @@ def _boundary_neighbours(mesh):
 
 
 def subdivide(mesh):
-    """One Catmull-Clark step computed directly from the rules (R1 and the boundary rules).
+    """One Catmull-Clark step: ``subdivision_matrix(mesh) @ mesh.vertices`` on the child faces.
 
     Parameters
     ----------
@@ -89,30 +103,7 @@ def subdivide(mesh):
     >>> m1.vertices[0].tolist(), m1.vertices[8].tolist()   # corner: (e0 + 6 V + e1)/8; face point
     ([0.125, 0.125, 0.0], [0.5, 0.5, 0.0])
     """
-    V, F = mesh.vertices, mesh.faces
-    n = mesh.n_vertices
-    fp = V[F].mean(axis=1)
-    a, b = mesh.edges[:, 0], mesh.edges[:, 1]
-    ef = mesh.edge_faces
-    bnd = mesh.is_boundary_edge
-    ep = np.empty((mesh.n_edges, 3))
-    ep[bnd] = 0.5 * (V[a[bnd]] + V[b[bnd]])
-    it = ~bnd
-    ep[it] = 0.25 * (V[a[it]] + V[b[it]] + fp[ef[it, 0]] + fp[ef[it, 1]])
-    # interior vertices: (F + 2R + (k-3) V)/k
-    org = F.reshape(-1)
-    dst = np.roll(F, -1, axis=1).reshape(-1)
-    k = mesh.valence.astype(np.float64)
-    Fsum = np.zeros((n, 3))
-    np.add.at(Fsum, org, np.repeat(fp, 4, axis=0))
-    Rsum = np.zeros((n, 3))
-    np.add.at(Rsum, org, 0.5 * (V[org] + V[dst]))  # each interior edge at v once (outgoing half-edge)
-    vp = (Fsum / k[:, None] + 2 * Rsum / k[:, None] + (k - 3)[:, None] * V) / k[:, None]
-    bv = mesh.is_boundary_vertex
-    if bv.any():
-        e0, e1 = _boundary_neighbours(mesh)
-        vp[bv] = (V[e0[bv]] + 6 * V[bv] + V[e1[bv]]) / 8
-    return QuadMesh(np.concatenate([vp, ep, fp]), child_faces(mesh))
+    return QuadMesh(subdivision_matrix(mesh) @ mesh.vertices, child_faces(mesh))
 
 
 def subdivision_matrix(mesh):
@@ -145,39 +136,43 @@ def subdivision_matrix(mesh):
         cols.append(c.reshape(-1))
         vals.append(np.broadcast_to(np.asarray(w, dtype=np.float64), r.shape).reshape(-1))
 
+    one = 1.0  # the rule functions in floats (exact_one() would give the exact weights)
+    wq = face_point_weight(4, one)
     # face points
-    add(np.repeat(n + E + np.arange(m), 4), F.reshape(-1), 0.25)
+    add(np.repeat(n + E + np.arange(m), 4), F.reshape(-1), wq)
     # edge points
     a, b = mesh.edges[:, 0], mesh.edges[:, 1]
     er = n + np.arange(E)
     bnd = mesh.is_boundary_edge
-    add(er[bnd], a[bnd], 0.5)
-    add(er[bnd], b[bnd], 0.5)
+    half = sharp_edge_weight(one)
+    add(er[bnd], a[bnd], half)
+    add(er[bnd], b[bnd], half)
     it = ~bnd
-    add(er[it], a[it], 0.25)
-    add(er[it], b[it], 0.25)
-    for s in range(2):
-        add(np.repeat(er[it], 4), F[mesh.edge_faces[it, s]].reshape(-1), 1.0 / 16)
-    # interior vertex points, assembled corner by corner
+    we_end, we_face = smooth_edge_weights(one)
+    add(er[it], a[it], we_end)
+    add(er[it], b[it], we_end)
+    for s in range(2):  # the face point of each adjacent face, spelled out on its vertices
+        add(np.repeat(er[it], 4), F[mesh.edge_faces[it, s]].reshape(-1), we_face * wq)
+    # interior vertex points (smooth rule), assembled corner by corner
     org = F.reshape(-1)
     dst = np.roll(F, -1, axis=1).reshape(-1)
-    k = mesh.valence.astype(np.float64)
     inner = ~mesh.is_boundary_vertex
+    k = np.maximum(mesh.valence.astype(np.int64), 1)  # (unused vertices: valence 0, weights unused)
+    wv, we, wf = smooth_vertex_weights(k, one)
     iv = np.flatnonzero(inner)
-    add(iv, iv, (k[iv] - 3) / k[iv])
-    c = np.flatnonzero(inner[org])  # corners at interior vertices
+    add(iv, iv, wv[iv])
+    c = np.flatnonzero(inner[org])  # corners at interior vertices: one edge and one face each
     v = org[c]
-    kk = k[v]
-    add(np.repeat(v, 4), F[c // 4].reshape(-1), np.repeat(1.0 / (4 * kk * kk), 4))  # F / k
-    add(v, v, 1.0 / (kk * kk))  # 2 R / k: (V + e)/2 per edge, twice, over k^2
-    add(v, dst[c], 1.0 / (kk * kk))
-    # boundary vertex points
+    add(v, dst[c], we[v])
+    add(np.repeat(v, 4), F[c // 4].reshape(-1), np.repeat(wf[v] * wq, 4))
+    # boundary vertex points (crease rule along the boundary)
     bv = np.flatnonzero(mesh.is_boundary_vertex)
     if bv.size:
         e0, e1 = _boundary_neighbours(mesh)
-        add(bv, bv, 0.75)
-        add(bv, e0[bv], 0.125)
-        add(bv, e1[bv], 0.125)
+        wc, wn = crease_vertex_weights(one)
+        add(bv, bv, wc)
+        add(bv, e0[bv], wn)
+        add(bv, e1[bv], wn)
     S = sp.coo_matrix(
         (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(n + E + m, n)
     )

@@ -83,7 +83,7 @@ def characteristic_tangent_masks(k):
     >>> T.shape, bool(abs(T.sum(axis=1)).max() < 1e-14)      # derivatives of a constant vanish
     ((2, 11), True)
     """
-    from ccproof.evaluate.local import LocalTopology, canonical_ring, corner_scheme
+    from ccproof.evaluate.local import corner_scheme, quad_ring
     from ccproof.mesh import limit_positions
     from ccproof.mesh.examples import k_regular_disk
 
@@ -91,7 +91,7 @@ def characteristic_tangent_masks(k):
     if k == 4:
         raise CCProofError("valence 4 is regular: the characteristic parameterization is the natural one there")
     disk = k_regular_disk(k, rings=3)
-    ring, key, _ = canonical_ring(LocalTopology(disk.faces), 0, 0)
+    ring, key = quad_ring(disk.faces, 0, 0)
     scheme = corner_scheme(key)
     N = len(ring)
     A = np.array([[int(x.p) / int(x.q) for x in row] for row in scheme.A.tolist()])

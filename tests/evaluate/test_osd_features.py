@@ -126,20 +126,23 @@ def test_tagged_evaluator_on_the_quad_references(refdir, name):
 
 def test_disk_cache_gives_the_computed_scheme(tmp_path, monkeypatch):
     """A corner scheme read back from the disk cache is the computed one, bit for bit."""
-    from ccproof.evaluate import local, tagged
+    from ccproof.evaluate import local
     from ccproof.mesh.polymesh import PolyMesh
 
     monkeypatch.setenv("CCPROOF_CACHE", str(tmp_path))
     V = [[np.cos(a), np.sin(a), 0.1 * np.cos(3 * a)] for a in np.linspace(0, 2 * np.pi, 5, endpoint=False)]
     m = PolyMesh([[0, 0, 0.3]] + V, [[0, 1 + i, 1 + (i + 1) % 5] for i in range(5)], creases={(0, 1): 12})
-    tagged.tagged_corner_scheme.cache_clear()
+    local.corner_scheme.cache_clear()
     a = TaggedLimitSurface(m)
-    files = sorted(tmp_path.glob("*.npz"))
+    files = sorted(tmp_path.glob("*"))
     assert files
-    tagged.tagged_corner_scheme.cache_clear()
+    local.corner_scheme.cache_clear()
     b = TaggedLimitSurface(m)  # now read from the cache
-    assert sorted(tmp_path.glob("*.npz")) == files
+    assert sorted(tmp_path.glob("*")) == files
     assert np.array_equal(a._nets, b._nets)
     key = next(iter(b._corner_data.values()))[0]
+    computed = next(iter(a._corner_data.values()))[0]
+    assert key is not computed and key.A == computed.A  # the exact matrix, read on first use
+    assert np.array_equal(key.tangent_masks, computed.tangent_masks)
     monkeypatch.setenv("CCPROOF_CACHE", "off")
     assert local._cache_dir() is None and key.A.nrows() == key.size

@@ -26,22 +26,54 @@ def _wavy(m, seed=0):
     return m.with_vertices(m.vertices + 0.1 * rng.normal(size=m.vertices.shape))
 
 
+def _exact_operator_in_quad_layout(m):
+    """The exact stencils of ccproof.mesh.rules.refine_complex for the QuadMesh ``m``, as a dense
+    float matrix (each entry rounded once) with the rows in the layout of ccproof.mesh.subdivision."""
+    from ccproof.mesh.polymesh import PolyMesh
+    from ccproof.mesh.rules import to_float
+
+    p = PolyMesh(m.vertices, m.faces)
+    exact = p.subdivision_operator(exact=True)
+    cx = p.complex()
+    n, E = m.n_vertices, m.n_edges
+    eid = {(int(a), int(b)): i for i, (a, b) in enumerate(m.edges)}
+    rows = list(range(n)) + [None] * E + list(range(n + E, n + E + m.n_faces))
+    for e, h in enumerate(cx.edges):
+        a, b = cx.org[h], cx.dst(h)
+        rows[n + eid[(min(a, b), max(a, b))]] = n + e
+    out = np.zeros((len(exact), n))
+    for i, r in enumerate(rows):
+        for j, w in exact[r].items():
+            out[i, j] = to_float(w)
+    return out, exact
+
+
 @pytest.mark.parametrize("make", [cube, lambda: grid(3, 2), lambda: k_regular_disk(7, 2)])
-def test_matrix_equals_function(make):
+def test_vectorized_step_equals_exact_stencils(make):
+    """The vectorized float operator and the exact stencils of the same rules agree to rounding."""
     m = _wavy(make())
-    S = subdivision_matrix(m)
-    m1 = subdivide(m)
+    S = subdivision_matrix(m).toarray()
     assert np.allclose(S.sum(axis=1), 1, atol=1e-15, rtol=0)
-    assert np.abs(S @ m.vertices - m1.vertices).max() <= 1e-15 * np.abs(m.vertices).max() * 4
+    E, exact = _exact_operator_in_quad_layout(m)
+    assert all(sum(r.values()) == 1 for r in exact)  # affine invariance, exactly
+    # the vectorized entries are float sums of up to k + 1 rounded weights (the vertex's own
+    # weight collects (k - 2)/k and its share of the k face points); a wrong weight is off by >= 1e-3
+    assert np.abs(S - E).max() <= 8 * 2.0**-52
+    assert np.array_equal(S != 0, E != 0)
+    m1 = subdivide(m)
+    assert np.array_equal(m1.vertices, subdivision_matrix(m) @ m.vertices)
     # twice
-    S2 = subdivision_matrix(m1) @ S
+    S2 = subdivision_matrix(m1) @ subdivision_matrix(m)
     assert np.abs(S2 @ m.vertices - subdivide(m1).vertices).max() <= 1e-14
 
 
-def test_bunny_matrix_equals_function(refdir):
+def test_bunny_vectorized_step_equals_exact_stencils(refdir):
     m = read_obj(refdir / "meshes" / "bunny_quads.obj")
     assert m.n_faces == 2036 and m.extraordinary_vertices.size == 103 and not m.is_boundary_vertex.any()
-    assert np.abs(subdivision_matrix(m) @ m.vertices - subdivide(m).vertices).max() < 1e-15
+    S = subdivision_matrix(m)
+    E, _ = _exact_operator_in_quad_layout(m)
+    assert np.abs(S.toarray() - E).max() <= 8 * 2.0**-52
+    assert np.array_equal(S.toarray() != 0, E != 0)
 
 
 @pytest.mark.parametrize("k", [3, 5, 6, 9])
@@ -117,3 +149,38 @@ def test_reference_step_agrees_with_pygel3d(refdir):
     d1 = cKDTree(m.vertices).query(pos)[0].max()
     d2 = cKDTree(pos).query(m.vertices)[0].max()
     assert max(d1, d2) < 1e-14
+
+
+def test_rule_functions_exact_and_float_from_the_same_code():
+    """Each rule's weights, evaluated with exact_one() and with 1.0 (scalar and vectorized), agree:
+    the float weights are the correctly rounded exact ones, and the exact ones are the textbook
+    fractions (bmz04 Fig. 1)."""
+    from fractions import Fraction
+
+    from ccproof.mesh.rules import (
+        crease_vertex_weights,
+        exact_one,
+        face_point_weight,
+        sharp_edge_weight,
+        smooth_edge_weights,
+        smooth_vertex_weights,
+        to_float,
+    )
+
+    one = exact_one()
+    ks = np.arange(3, 30)
+    vec = smooth_vertex_weights(ks, 1.0)
+    for i, k in enumerate(ks.tolist()):
+        ex = smooth_vertex_weights(k, one)
+        want = [Fraction(k - 2, k), Fraction(1, k * k), Fraction(1, k * k)]
+        assert [Fraction(int(w.p), int(w.q)) for w in ex] == want
+        assert [to_float(w) for w in ex] == [float(Fraction(k - 2, k)), 1 / (k * k), 1 / (k * k)]
+        assert [to_float(w) for w in ex] == [float(v[i]) for v in vec]
+        # in a quad mesh: 1 - 7/(4k) on V (with its share of the k face points), 3/(2k^2), 1/(4k^2)
+        wv, we, wf = ex
+        assert wv + k * wf / 4 == one - one * 7 / (4 * k) and we + 2 * wf / 4 == one * 3 / (2 * k * k)
+    for n in (3, 4, 5, 7):
+        assert to_float(face_point_weight(n, one)) == face_point_weight(n, 1.0) == 1 / n
+    assert [to_float(w) for w in smooth_edge_weights(one)] == list(smooth_edge_weights(1.0)) == [0.25, 0.25]
+    assert to_float(sharp_edge_weight(one)) == sharp_edge_weight(1.0) == 0.5
+    assert [to_float(w) for w in crease_vertex_weights(one)] == list(crease_vertex_weights(1.0)) == [0.75, 0.125]

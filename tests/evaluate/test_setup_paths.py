@@ -1,0 +1,63 @@
+"""The setup shortcuts (smooth regular quads in one vectorized pass, corner faces tried directly at
+their one irregular corner) give the surfaces of the face-by-face classification.
+
+The face-by-face path is the one checked against OpenSubdiv (test_osd_features.py) and brute-force
+subdivision (test_tagged_bruteforce.py); here the shortcuts are switched off to compare.
+"""
+
+import numpy as np
+
+from ccproof.evaluate.surface import _Builder
+from ccproof.evaluate.tagged import TaggedLimitSurface
+from ccproof.mesh.io import read_mesh
+
+
+def _points(S, n=4000, seed=0):
+    rng = np.random.default_rng(seed)
+    faces = np.flatnonzero(~S._hole_ptex)
+    return faces[rng.integers(0, faces.size, n)], rng.random(n), rng.random(n)
+
+
+def _compare(mesh, monkeypatch):
+    handled, at_corner = [], []
+    shortcut, corner_at = _Builder.smooth_regular_patches, _Builder.corner_at
+
+    def counting(self, cx, X, jobs):
+        done = shortcut(self, cx, X, jobs)
+        handled.append(int(done.sum()))
+        return done
+
+    def counting_corner(self, *args, **kwargs):
+        hit = corner_at(self, *args, **kwargs)
+        at_corner.append(hit)
+        return hit
+
+    with monkeypatch.context() as m:
+        m.setattr(_Builder, "smooth_regular_patches", counting)
+        m.setattr(_Builder, "corner_at", counting_corner)
+        fast = TaggedLimitSurface(mesh)
+    assert sum(handled) > 0  # the shortcut is exercised
+    with monkeypatch.context() as m:
+        m.setattr(_Builder, "smooth_regular_patches", lambda self, cx, X, jobs: np.zeros(len(jobs), bool))
+        m.setattr(_Builder, "corner_at", lambda self, *args, **kwargs: False)
+        slow = TaggedLimitSurface(mesh)
+    assert fast.n_patches == slow.n_patches
+    f, u, v = _points(fast)
+    a, b = fast.evaluate(f, u, v, 2), slow.evaluate(f, u, v, 2)
+    diag = mesh.bounding_box_diagonal
+    for k in a:
+        assert np.abs(a[k] - b[k]).max() <= 1e-14 * diag, k
+    return fast, sum(at_corner)
+
+
+def test_smooth_regular_shortcut_on_quads(bunny_path, monkeypatch):
+    S, corner_faces = _compare(read_mesh(bunny_path), monkeypatch)
+    assert S.n_patches > 2000 and corner_faces > 300
+
+
+def test_smooth_regular_shortcut_on_polygons_with_tags(refdir, monkeypatch):
+    """n-gons (level-1 sub-faces and quad children in four orientations), holes, boundary modes."""
+    corner_faces = 0
+    for name in ("catmark_nonquads", "catmark_hole_test2", "catmark_edgecorner", "catmark_edgenone"):
+        corner_faces += _compare(read_mesh(refdir / "osd_features" / "meshes" / f"{name}.obj"), monkeypatch)[1]
+    assert corner_faces > 0
