@@ -60,7 +60,7 @@ def _round_down(q, digits=6):
     return f"{m}e{e}"
 
 
-def prove_positive(root, axes, what, max_depth=MAX_DEPTH):
+def _prove_positive(root, axes, what, max_depth=MAX_DEPTH):
     """Adaptive subdivision of a Bernstein form until every leaf is certainly positive.
 
     Returns the list of ``{"path", "bound"}`` leaves. ``axes`` is the cyclic order of split axes.
@@ -99,7 +99,7 @@ def _corners(f):
     return vals
 
 
-def smallest_level(nets, lam, max_level=8):
+def _smallest_level(nets, lam, max_level=8):
     """The smallest N with lam^N max(coordinates) < 1/6 (part A), found by trying N = 1, 2, ..."""
     for N in range(1, max_level + 1):
         if corner_containment(nets, lam, N)[0]:
@@ -134,8 +134,8 @@ def prove_valence(k: int, prec: int = DEFAULT_PREC, progress: bool = True) -> di
     with ctx.workprec(prec):
         lam = c_lam(k, prec)[1]
         nets = nets_for_valence(k, prec)
-        N = smallest_level(nets, lam)
-        regularity = {n: prove_positive(regularity_form(nets, n, prec), (0, 1), f"det J_Phi on {n}")
+        N = _smallest_level(nets, lam)
+        regularity = {n: _prove_positive(regularity_form(nets, n, prec), (0, 1), f"det J_Phi on {n}")
                       for n in form_patches(derivation().symmetric)}
         cells = {}
         todo = required_cells(nets, lam, N, prec, derivation().symmetric)
@@ -147,8 +147,8 @@ def prove_valence(k: int, prec: int = DEFAULT_PREC, progress: bool = True) -> di
         build = cell_det_builder(nets, lam, N, prec)
         for l, m, p, q in it:
             root = build(l, m, p, q)
-            cells[f"{l},{m},{p},{q}"] = prove_positive(root, (0, 1), f"cell ({l},{m}) piece ({p},{q})")
-        corner = {n: prove_positive(corner_det_form(nets, lam, N, n, prec), (2, 3, 0, 1),
+            cells[f"{l},{m},{p},{q}"] = _prove_positive(root, (0, 1), f"cell ({l},{m}) piece ({p},{q})")
+        corner = {n: _prove_positive(corner_det_form(nets, lam, N, n, prec), (2, 3, 0, 1),
                                     f"corner {n}") for n in form_patches(derivation().symmetric)}
     return {"schema": SCHEMA, "valence": k, "N": N, "prec": prec,
             "parts": {"regularity": regularity, "cells": cells, "corner": corner}}
@@ -187,9 +187,9 @@ def _prove_piece(exact, La, Lb, N, degree, trunc, prec, progress, label):
             raise ProofFailed(f"{label}: the corner cell [0, 2^-{N}]^2 is not certainly mapped into [0,1/6)^2")
         if not square_inside_image(nets):
             raise ProofFailed(f"{label}: [0,1/2]^2 not certainly inside Phi([0,1]^2)")
-        regularity = {n: prove_positive(regularity_form(nets, n, prec), (0, 1), f"{label} det J_Phi on {n}")
+        regularity = {n: _prove_positive(regularity_form(nets, n, prec), (0, 1), f"{label} det J_Phi on {n}")
                       for n in form_patches(derivation().symmetric)}
-        corner = {n: prove_positive(corner_det_form(nets, lam, N, n, prec), (2, 3, 0, 1),
+        corner = {n: _prove_positive(corner_det_form(nets, lam, N, n, prec), (2, 3, 0, 1),
                                     f"{label} corner {n}") for n in form_patches(derivation().symmetric)}
         todo = interval_cells(zn, N, trunc, prec, derivation().symmetric)
         it = todo
@@ -197,7 +197,7 @@ def _prove_piece(exact, La, Lb, N, degree, trunc, prec, progress, label):
             from tqdm import tqdm
 
             it = tqdm(todo, desc=f"{label} cells", unit="cell", leave=False)
-        cells = {key: prove_positive(build(), (1, 2, 0), f"{label} cell {key}") for key, build in it}
+        cells = {key: _prove_positive(build(), (1, 2, 0), f"{label} cell {key}") for key, build in it}
     return {"regularity": regularity, "cells": cells, "corner": corner}
 
 
@@ -304,7 +304,7 @@ def prove_interval(k0: ValenceLike, prec: int = DEFAULT_PREC, progress: bool = T
     ends = _lam_range(v.k, prec)
     with ctx.workprec(prec):
         La, Lb = parse_decimal(ends[0]), parse_decimal(ends[1])
-        N = smallest_level(hull_nets(parameter_nets(exact, La, Lb, 0, taylor_degree, prec), prec),
+        N = _smallest_level(hull_nets(parameter_nets(exact, La, Lb, 0, taylor_degree, prec), prec),
                            arb(La).union(arb(Lb)))
     todo = [(ends[0], ends[1])] if scheduler is None else []
     pieces = [] if scheduler is None else _pieces_in_waves(
@@ -390,8 +390,8 @@ def prove_c1(k: ValenceLike, prec: int = DEFAULT_PREC) -> dict[str, Any]:
             nets = hull_nets(parameter_nets(derivation().integer_forms("bspline"), La, Lb, 0, 3, prec), prec)
         else:
             nets = nets_for_valence(v.k, prec)
-        reg = {n: prove_positive(regularity_form(nets, n, prec), (0, 1), f"det J_Phi on {n}") for n in PATCHES}
-        star = {c: prove_positive(star_form(nets, c, prec), (0,), f"star {c}") for c in STAR_CURVES}
+        reg = {n: _prove_positive(regularity_form(nets, n, prec), (0, 1), f"det J_Phi on {n}") for n in PATCHES}
+        star = {c: _prove_positive(star_form(nets, c, prec), (0,), f"star {c}") for c in STAR_CURVES}
     parts = {"regularity": reg, "star": star}
     if v.interval:
         return {"schema": C1_SCHEMA, "valence": k, "prec": prec, "pieces": [{"lam": ends, "parts": parts}]}

@@ -47,11 +47,11 @@ from ccproof.inverse.data import (
     NMAX,
     SAFE_HI,
     SAFE_LO,
-    approx_log,
-    as_points,
-    matmul,
+    _approx_log,
+    _as_points,
+    _matmul,
+    _patch_eval_jac,
     monomials,
-    patch_eval_jac,
     valence_data,
 )
 
@@ -134,7 +134,7 @@ def inverse_characteristic_map(k: int, u: ArrayLike, v: ArrayLike, *, domain: Li
     k = check_valence(k)
     if domain not in ("quadrant", "face"):
         raise CCProofError(f"unknown domain {domain!r}; use 'quadrant' or 'face'")
-    x, y, shape = as_points(u, v, "image")
+    x, y, shape = _as_points(u, v, "image")
     D = valence_data(k)
     npts = x.shape[0]
     R = np.empty(npts)
@@ -181,15 +181,15 @@ def _check_face(x, y, R, S):
     np.minimum(S, 1.0, out=S)
 
 
-def first_layer(D, a, fast=False):
+def _first_layer(D, a, fast=False):
     """Step 1: n0 = floor(log_lam(a / A)) (an approximate log is enough: the band has room)."""
-    n0 = np.floor((approx_log(a) - D.log_a) * D.inv_log_lam)
+    n0 = np.floor((_approx_log(a) - D.log_a) * D.inv_log_lam)
     if not fast:
         np.clip(n0, -NMAX + 4, NMAX - 4, out=n0)
     return n0.astype(np.int64)
 
 
-def scale_lam(D, n, a, b, fast):
+def _scale_lam(D, n, a, b, fast):
     """(a, b) * lam^n for integer arrays n (tables; ldexp on the slow path)."""
     idx = NMAX + n
     if fast:
@@ -203,9 +203,9 @@ def scale_lam(D, n, a, b, fast):
 def locate(D, a, b, fast=True):
     """Steps 1-2 for points a >= b >= 0 with a > 0: returns (n, p, a1, b1, n0): the layer n, the
     piece p (0: P1, 1: P2), (a1, b1) = lam^-n (a, b) and the first-guess layer n0."""
-    n0 = first_layer(D, a, fast)
-    a0, b0 = scale_lam(D, -n0, a, b, fast)
-    V = matmul(D.G, monomials(a0, b0, 3))
+    n0 = _first_layer(D, a, fast)
+    a0, b0 = _scale_lam(D, -n0, a, b, fast)
+    V = _matmul(D.G, monomials(a0, b0, 3))
     inner = V[0] * D.gamma_sign < 0          # t0 inside Gamma: one layer deeper
     outer = (V[1] * D.gamma_sign > 0) & ~inner  # lam t0 outside Gamma: one layer out
     sep = np.where(inner, V[2], np.where(outer, V[4], V[3])) * D.sep_sign
@@ -231,7 +231,7 @@ def _inverse_chunk(D, x, y, R, S, layer, patch):
         if sel.size == 0:
             continue
         X, Y = a1[sel], b1[sel]
-        s0, t0 = matmul(D.fit[q], monomials(X, Y, FIT_DEGREE))
+        s0, t0 = _matmul(D.fit[q], monomials(X, Y, FIT_DEGREE))
         s, t, good = newton(D.C6[q], s0, t0, X, Y)
         s_loc[sel] = s
         t_loc[sel] = t
@@ -283,7 +283,7 @@ def newton(Cp, s, t, X, Y):
 
 
 def _newton_step(Cp, s, t, X, Y, want_step=True):
-    x, y, xs, xt, ys, yt = patch_eval_jac(Cp, s, t)
+    x, y, xs, xt, ys, yt = _patch_eval_jac(Cp, s, t)
     x -= X
     y -= Y
     with np.errstate(all="ignore"):
@@ -305,14 +305,14 @@ def _newton_step(Cp, s, t, X, Y, want_step=True):
 
 
 def _run_fallback(D, x, y, idx, R, S, layer, patch, ver):
-    from ccproof.inverse.fallback import subdivision_inverse
+    from ccproof.inverse.fallback import _subdivision_inverse
 
     xs, ys = x[idx], y[idx]
     sw = ys > xs
     a = np.where(sw, ys, xs)
     b = np.where(sw, xs, ys)
-    n0 = first_layer(D, a)
-    n, p, s_loc, t_loc, verified = subdivision_inverse(D, a, b, n0)
+    n0 = _first_layer(D, a)
+    n, p, s_loc, t_loc, verified = _subdivision_inverse(D, a, b, n0)
     t_loc[(b == 0) & (p == 0)] = 0.0
     r = np.maximum(np.ldexp((s_loc + 1.0) * 0.5, -n), 0.0)
     s = np.maximum(np.ldexp((t_loc + p) * 0.5, -n), 0.0)

@@ -107,7 +107,7 @@ class Edge:
 EDGES = {name: Edge(name, *spec) for name, spec in _EDGE_SPECS.items()}
 
 
-def get_edge(edge):
+def _get_edge(edge):
     if isinstance(edge, Edge):
         return edge
     try:
@@ -235,7 +235,7 @@ def _cleared_cubic(R, values):
     return out, den
 
 
-def reduce_lam(poly):
+def _reduce_lam(poly):
     """Reduce an ``fmpq_mpoly``/``fmpz_mpoly`` in (lam, c, u, v) modulo 16 lam^2 - 2(5+c) lam + 1
     (R2): the result has degree <= 1 in lam and the same value at lam = lam(c)."""
     Q = _qring()
@@ -255,7 +255,7 @@ def symbolic_implicit(edge):
     """
     from ccproof.algebra.characteristic_map import symbolic_bezier_nets
 
-    e = get_edge(edge)
+    e = _get_edge(edge)
     R = _zring()
     _, _, u, v = R.gens()
     pts = e.control_points(symbolic_bezier_nets()[e.patch])
@@ -265,7 +265,7 @@ def symbolic_implicit(edge):
     r = [y[0] - _cpoly(R, dy.coeffs()) * v] + y[1:]
     res = determinant(sylvester_matrix(q, r, R.constant(0)), R.constant(0), R.constant(1))
     den = (dx * dy) ** 3
-    return SymbolicImplicit(e, res, reduce_lam(res), den, tuple(q), tuple(r), dx, dy)
+    return SymbolicImplicit(e, res, _reduce_lam(res), den, tuple(q), tuple(r), dx, dy)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -306,7 +306,7 @@ def implicit_polynomial(k, edge, arithmetic="arb", prec=128):
     (3, 0)
     """
     k = check_valence(k)
-    e = get_edge(edge)
+    e = _get_edge(edge)
     if k == 4:
         g = rational_implicit(e, Fraction(0), Fraction(1, 2))
         if arithmetic == "exact":
@@ -428,7 +428,7 @@ def rational_implicit(edge, c, lam):
     """
     from flint import fmpq, fmpq_mpoly_ctx
 
-    e = get_edge(edge)
+    e = _get_edge(edge)
     pts = e.control_points(rational_nets(c, lam)[e.patch])
     Q = fmpq_mpoly_ctx.get(("u", "v"), "lex")
     u, v = Q.gens()
@@ -444,19 +444,19 @@ def rational_implicit(edge, c, lam):
     return {tuple(int(x) for x in ab): Fraction(int(x.p), int(x.q)) for ab, x in sorted(g.to_dict().items())}
 
 
-def exact_value_rational_c(edge, c, u, v):
+def _exact_value_rational_c(edge, c, u, v):
     """g(u, v) exactly for rational c (valences 3, 4, 6, or a rational pseudo-valence) and
     rational u, v, as ``(alpha, beta, d)`` meaning alpha + beta sqrt(d) with d = (1+c)(9+c)
     (lam = (5 + c + sqrt d)/16). Uses the symbolic numerator (formal degrees).
 
-    >>> a, b, d = exact_value_rational_c("P1:s=1", Fraction(-1, 2), Fraction(1), Fraction(0))
+    >>> a, b, d = _exact_value_rational_c("P1:s=1", Fraction(-1, 2), Fraction(1), Fraction(0))
     >>> d
     Fraction(17, 4)
     """
     from flint import fmpq
 
     c, u, v = Fraction(c), Fraction(u), Fraction(v)
-    sym = symbolic_implicit(get_edge(edge))
+    sym = symbolic_implicit(_get_edge(edge))
     f = lambda x: fmpq(x.numerator, x.denominator)
     # numerator = N0 + N1 lam at (c, u, v) (exact substitution in flint); lam = (5 + c + sqrt d)/16
     rest = sym.numerator.subs({"c": f(c), "u": f(u), "v": f(v)})
@@ -474,10 +474,10 @@ def exact_value_rational_c(edge, c, u, v):
     return alpha, beta, d
 
 
-def sign_quadratic_surd(alpha, beta, d):
+def _sign_quadratic_surd(alpha, beta, d):
     """Exact sign of alpha + beta sqrt(d) for rationals alpha, beta and d >= 0.
 
-    >>> sign_quadratic_surd(Fraction(-3), Fraction(1), Fraction(10)), sign_quadratic_surd(1, -1, 1)
+    >>> _sign_quadratic_surd(Fraction(-3), Fraction(1), Fraction(10)), _sign_quadratic_surd(1, -1, 1)
     (1, 0)
     """
     sa = (alpha > 0) - (alpha < 0)
@@ -511,11 +511,11 @@ def exact_sign(k, edge, u, v, prec=256):
         val = sum(x * u**a * v**b for (a, b), x in g.items())
         return (val > 0) - (val < 0)
     if c is not None:
-        return sign_quadratic_surd(*exact_value_rational_c(edge, c, u, v))
+        return _sign_quadratic_surd(*_exact_value_rational_c(edge, c, u, v))
     from flint import arb, ctx, fmpq
 
     while prec <= 4096:
-        coeffs = _arb_coefficients(k, get_edge(edge).name, prec)
+        coeffs = _arb_coefficients(k, _get_edge(edge).name, prec)
         with ctx.workprec(prec):
             U, V = arb(fmpq(u.numerator, u.denominator)), arb(fmpq(v.numerator, v.denominator))
             val = sum((x * U**a * V**b for (a, b), x in coeffs), arb(0))
@@ -564,7 +564,7 @@ def inside_sign(k, edge, prec=128):
     agree (else :class:`CCProofError`).
     """
     k = check_valence(k)
-    e = get_edge(edge)
+    e = _get_edge(edge)
     if k == 4:
         net = rational_nets(0, Fraction(1, 2))[e.patch]
         g = rational_implicit(e, 0, Fraction(1, 2))
@@ -635,7 +635,7 @@ class FloatImplicit:
         import numpy as np
 
         k = check_valence(k)
-        e = get_edge(edge)
+        e = _get_edge(edge)
         g = implicit_polynomial(k, e, "float")
         c = np.zeros((4, 4))
         for (a, b), x in g.items():

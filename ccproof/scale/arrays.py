@@ -81,7 +81,7 @@ def evaluate_dask(shipped, face, u, v, derivatives=1, **kwargs):
 # ---------------------------------------------------------------- chunks of a point set
 
 
-def sample_chunk(seed, n_faces, count, index):
+def _sample_chunk(seed, n_faces, count, index):
     """Random points of chunk ``index``: uniform face and (u, v), from ``default_rng(seed)`` for chunk 0
     (so one chunk equals the unchunked draw ``f = integers(0, n_faces, count); u = random(count);
     v = random(count)``) and ``default_rng([seed, index])`` for the others."""
@@ -91,13 +91,13 @@ def sample_chunk(seed, n_faces, count, index):
     return rng.integers(0, n_faces, count), rng.random(count), rng.random(count)
 
 
-def chunk_points(source):
-    """The (face, u, v) numpy arrays of one chunk description (see :func:`evaluate_chunk`)."""
+def _chunk_points(source):
+    """The (face, u, v) numpy arrays of one chunk description (see :func:`_evaluate_chunk`)."""
     import numpy as np
 
     kind = source[0]
     if kind == "samples":
-        return sample_chunk(*source[1:])
+        return _sample_chunk(*source[1:])
     if kind == "arrays":
         return tuple(np.asarray(a) for a in source[1:])
     if kind == "shard":
@@ -106,7 +106,7 @@ def chunk_points(source):
     raise CCProofError(f"unknown chunk source {kind!r}")
 
 
-def evaluate_chunk(task, shipped):
+def _evaluate_chunk(task, shipped):
     """One task of ``ccproof eval``: evaluate a chunk of points and write its shard (or return it).
 
     ``task`` is ``{"source": ("samples", seed, n_faces, count, index) | ("arrays", face, u, v) |
@@ -115,7 +115,7 @@ def evaluate_chunk(task, shipped):
     """
     import numpy as np
 
-    f, u, v = chunk_points(task["source"])
+    f, u, v = _chunk_points(task["source"])
     res = _evaluate_block(f, u, v, shipped, task["derivatives"], tuple(sorted(task["kwargs"].items())))
     arrays = {"face": f, "u": u, "v": v}
     arrays.update({n: res[:, j, :] for j, n in enumerate(output_names(task["derivatives"]))})
@@ -125,19 +125,19 @@ def evaluate_chunk(task, shipped):
     return int(f.size)
 
 
-def shard_name(i):
+def _shard_name(i):
     return f"part-{i:05d}.npz"
 
 
-def write_index(folder, sizes, names):
+def _write_index(folder, sizes, names):
     """Write ``index.json`` of a shard folder (``sizes``: points per shard, in order)."""
     folder = Path(folder)
     idx = {"format": SHARDS_FORMAT, "n": int(sum(sizes)), "arrays": list(names),
-           "shards": [{"file": shard_name(i), "n": int(m)} for i, m in enumerate(sizes)]}
+           "shards": [{"file": _shard_name(i), "n": int(m)} for i, m in enumerate(sizes)]}
     (folder / "index.json").write_text(json.dumps(idx, indent=1) + "\n", encoding="utf-8")
 
 
-def shard_index(folder):
+def _shard_index(folder):
     """The parsed ``index.json`` of a shard folder, checked (names the folder and the field)."""
     folder = Path(folder)
     try:
@@ -174,10 +174,10 @@ def write_shards(folder, arrays):
         np.savez(path, **dict(zip(names, blocks)))
         return blocks[0].shape[0]
 
-    writes = [dask.delayed(save)(str(folder / shard_name(i)), *[arrs[n].blocks[i] for n in names])
+    writes = [dask.delayed(save)(str(folder / _shard_name(i)), *[arrs[n].blocks[i] for n in names])
               for i in range(len(chunks))]
     sizes = dask.compute(*writes)
-    write_index(folder, sizes, names)
+    _write_index(folder, sizes, names)
     return folder
 
 
@@ -188,7 +188,7 @@ def read_shards(folder):
     import numpy as np
 
     folder = Path(folder)
-    idx = shard_index(folder)
+    idx = _shard_index(folder)
     names = idx["arrays"]
     with np.load(folder / idx["shards"][0]["file"]) as z:
         protos = {n: z[n] for n in names}
@@ -207,12 +207,12 @@ def read_shards(folder):
 
 
 def point_chunks(chunk, *, arrays=None, shards=None, samples=None, seed=0, n_faces=None):
-    """Chunk sources for :func:`evaluate_chunk` from in-memory arrays (face, u, v), a shard folder, or
-    ``samples`` random points (chunk i from :func:`sample_chunk`); ``chunk`` points per chunk."""
+    """Chunk sources for :func:`_evaluate_chunk` from in-memory arrays (face, u, v), a shard folder, or
+    ``samples`` random points (chunk i from :func:`_sample_chunk`); ``chunk`` points per chunk."""
     if chunk < 1:
         raise CCProofError(f"--chunk must be >= 1, got {chunk}")
     if shards is not None:
-        idx = shard_index(shards)
+        idx = _shard_index(shards)
         return [("shard", str(Path(shards) / s["file"])) for s in idx["shards"]]
     if arrays is not None:
         f, u, v = arrays
@@ -244,14 +244,14 @@ def evaluate_points(shipped, sources, derivatives, kwargs, out, scheduler=None, 
     if folder is not None:
         folder.mkdir(parents=True, exist_ok=True)
     tasks = [{"source": s, "derivatives": derivatives, "kwargs": dict(kwargs),
-              "out": None if folder is None else str(folder / shard_name(i))} for i, s in enumerate(sources)]
-    sweep = run_tasks(evaluate_chunk, tasks, scheduler, shared=[shipped], desc="evaluate", unit="chunk",
+              "out": None if folder is None else str(folder / _shard_name(i))} for i, s in enumerate(sources)]
+    sweep = run_tasks(_evaluate_chunk, tasks, scheduler, shared=[shipped], desc="evaluate", unit="chunk",
                       progress=progress, names=[f"chunk {i}" for i in range(len(tasks))])
     if folder is None:
         arrays = {n: np.concatenate([r[n] for r in sweep.results]) for n in ("face", "u", "v", *names)}
         np.savez(out, **arrays)
         n = int(arrays["face"].size)
     else:
-        write_index(folder, sweep.results, ("face", "u", "v", *names))
+        _write_index(folder, sweep.results, ("face", "u", "v", *names))
         n = int(sum(sweep.results))
     return n, names, sweep

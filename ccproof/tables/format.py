@@ -38,7 +38,7 @@ class TableFormatError(ValueError):
 
 
 # ----------------------------------------------------------------------------- JSON + hash
-def canonical_json(obj):
+def _canonical_json(obj):
     """Canonical serialization used for hashing: sorted keys, no whitespace, ASCII."""
     return json.dumps(obj, sort_keys=True, separators=(",", ":"), ensure_ascii=True)
 
@@ -46,7 +46,7 @@ def canonical_json(obj):
 def content_hash(obj, *, exclude=("hash",)):
     """``"sha256:<hex>"`` of the canonical JSON of ``obj`` without the ``exclude`` keys."""
     body = {k: v for k, v in obj.items() if k not in exclude}
-    return "sha256:" + hashlib.sha256(canonical_json(body).encode("ascii")).hexdigest()
+    return "sha256:" + hashlib.sha256(_canonical_json(body).encode("ascii")).hexdigest()
 
 
 # ----------------------------------------------------------------------------- arb <-> JSON
@@ -87,7 +87,7 @@ def _is_decimal(s):
 
 
 # ----------------------------------------------------------------------------- integer forms
-def check_integer_form(form, where):
+def _check_integer_form(form, where):
     """Validate ``[A, B, D]`` with integer lists and D not the zero polynomial."""
     if not (isinstance(form, list) and len(form) == 3):
         raise TableFormatError(f"{where}: an exact entry must be [A, B, D]")
@@ -99,7 +99,7 @@ def check_integer_form(form, where):
     return form
 
 
-def eval_form_arb(form, c, lam):
+def _eval_form_arb(form, c, lam):
     """(A(c) + B(c) lam)/D(c) in ball arithmetic (Horner); encloses the value for all c, lam in
     the balls (the caller sets the working precision)."""
 
@@ -146,11 +146,11 @@ def output_dir():
     return Path(data_home) / "ccproof" / "certificates"
 
 
-def table_filename(valence):
+def _table_filename(valence):
     """``k007.json`` for k = 7, ``k_ge_40.json`` for the interval k >= 40 (any spelling of
     :meth:`ccproof.valence.Valence.parse`).
 
-    >>> table_filename(7), table_filename({"min": 40}), table_filename(">=40")
+    >>> _table_filename(7), _table_filename({"min": 40}), _table_filename(">=40")
     ('k007.json', 'k_ge_40.json', 'k_ge_40.json')
     """
     from ccproof.valence import Valence
@@ -159,7 +159,7 @@ def table_filename(valence):
 
 
 def table_path(valence, directory=None):
-    return Path(directory or certificates_dir() / "tables") / table_filename(valence)
+    return Path(directory or certificates_dir() / "tables") / _table_filename(valence)
 
 
 def available_tables(directory=None):
@@ -266,7 +266,7 @@ def table_nets_exact(obj):
         if not (isinstance(net, list) and len(net) == 4 and all(isinstance(r, list) and len(r) == 4 for r in net)):
             raise TableFormatError(f"exact net {name} must be 4x4")
         out[name] = [
-            [tuple(check_integer_form(q, f"exact {name}[{i}][{j}]") for q in _pair(p, f"{name}[{i}][{j}]"))
+            [tuple(_check_integer_form(q, f"exact {name}[{i}][{j}]") for q in _pair(p, f"{name}[{i}][{j}]"))
              for j, p in enumerate(row)]
             for i, row in enumerate(net)
         ]
