@@ -48,6 +48,14 @@ class CharacteristicTable:
         Bezier nets of the same pieces.
     hash : str or None
         Content hash of the table file the data came from (None when derived on the fly).
+
+    Examples
+    --------
+    For k = 4 the characteristic map is the identity: the last Bezier point of P2 is (1, 1).
+
+    >>> t = load_table(4)
+    >>> t.lam, t.bezier.shape, t.bezier[1, 3, 3].tolist()
+    (0.5, (3, 4, 4, 2), [1.0, 1.0])
     """
 
     valence: int
@@ -121,6 +129,12 @@ class ArbCharacteristic:
         the exact nets of a table, whose hash is then ``source_hash``).
     source_hash : str
         Hash of the table file the data came from.
+
+    Examples
+    --------
+    >>> a = characteristic_arb(4)
+    >>> a.lam.contains(0.5), a.bezier["P2"][3][3][0].contains(1), a.hash == load_table(4).hash
+    (True, True, True)
     """
 
     valence: int
@@ -209,6 +223,18 @@ def characteristic_nets(k):
     rounded once; ``hash`` is then None). Use :func:`load_table` when the data must come from the
     certified table of k itself.
 
+    Parameters
+    ----------
+    k : int
+        Valence, k >= 3.
+
+    Returns
+    -------
+    CharacteristicTable
+        Nets of shape (3, 4, 4, 2) float64 (docs/readings.md R3, R4).
+
+    Examples
+    --------
     >>> characteristic_nets(4).lam, characteristic_nets(1000).hash
     (0.5, None)
     """
