@@ -26,7 +26,27 @@ _KEYS = {0: ("P",), 1: ("P", "Pu", "Pv"), 2: ("P", "Pu", "Pv", "Puu", "Puv", "Pv
 
 
 def output_names(derivatives):
-    """The result arrays for a derivative order: P; Pu, Pv; Puu, Puv, Pvv."""
+    """The result arrays for a derivative order: P; Pu, Pv; Puu, Puv, Pvv.
+
+    Parameters
+    ----------
+    derivatives : {0, 1, 2}
+        Highest derivative order evaluated.
+
+    Returns
+    -------
+    tuple of str
+
+    Raises
+    ------
+    CCProofError
+        For any other order.
+
+    Examples
+    --------
+    >>> output_names(0), output_names(2)
+    (('P',), ('P', 'Pu', 'Pv', 'Puu', 'Puv', 'Pvv'))
+    """
     if derivatives not in _KEYS:
         raise CCProofError(f"derivatives must be 0, 1 or 2, got {derivatives!r}")
     return _KEYS[derivatives]
@@ -43,6 +63,8 @@ def _evaluate_block(face, u, v, shipped, derivatives, kwargs):
 def evaluate_dask(shipped, face, u, v, derivatives=1, **kwargs):
     """Evaluate the shipped surface at dask arrays of points, one task per chunk (``map_blocks``).
 
+    docs/scale-out.md, "Chunked evaluation".
+
     Parameters
     ----------
     shipped : Shipped
@@ -51,7 +73,7 @@ def evaluate_dask(shipped, face, u, v, derivatives=1, **kwargs):
     u, v : dask or numpy arrays of float, shape (n,)
         Rechunked to the chunks of ``face``.
     derivatives : int
-    **kwargs
+    kwargs
         Passed to ``evaluate`` (e.g. ``parameterization="characteristic"``).
 
     Returns
@@ -59,6 +81,20 @@ def evaluate_dask(shipped, face, u, v, derivatives=1, **kwargs):
     dict of str -> dask array of shape (n, 3)
         ``P`` (and ``Pu``, ``Pv``; ``Puu``, ``Puv``, ``Pvv``), lazy; equal to the bit to
         ``surface.evaluate(face, u, v)`` on the same points.
+
+    Examples
+    --------
+    The limit point at the centre of a face of the cube with corners (+-1, +-1, +-1) is at distance
+    68/81 from the centre (one Catmull-Clark step by hand, then the regular limit mask (16, 4, 1)/36):
+
+    >>> import dask.array as da
+    >>> from ccproof.mesh.examples import cube
+    >>> from ccproof.reparam.surface import limit_surface
+    >>> from ccproof.scale import ship
+    >>> P = evaluate_dask(ship(limit_surface, cube()), da.from_array([0, 0], chunks=1), [0.5, 0.5],
+    ...                   [0.5, 0.5], derivatives=0)["P"]
+    >>> P.chunks[0], bool(abs(abs(P.compute(scheduler="sync")[0, 2]) - 68 / 81) < 1e-12)
+    ((1, 1), True)
     """
     import dask
     import dask.array as da
@@ -157,7 +193,29 @@ def _shard_index(folder):
 def write_shards(folder, arrays):
     """Write a dict of equally chunked dask (or numpy) arrays of length n as a shard folder.
 
-    Each chunk of the first array's chunking becomes one ``part-NNNNN.npz``; returns the folder.
+    Each chunk of the first array's chunking becomes one ``part-NNNNN.npz``, with an ``index.json``
+    (docs/scale-out.md, "Chunked evaluation").
+
+    Parameters
+    ----------
+    folder : str or pathlib.Path
+        Created if missing.
+    arrays : dict of str -> dask or numpy array, shape (n, ...)
+        Equally long arrays; numpy arrays are one shard.
+
+    Returns
+    -------
+    pathlib.Path
+        ``folder``.
+
+    Examples
+    --------
+    >>> import tempfile, numpy as np, dask.array as da
+    >>> d = write_shards(tempfile.mkdtemp(), {"x": da.arange(5, chunks=2)})
+    >>> sorted(p.name for p in d.iterdir())
+    ['index.json', 'part-00000.npz', 'part-00001.npz', 'part-00002.npz']
+    >>> read_shards(d)["x"].compute().tolist()
+    [0, 1, 2, 3, 4]
     """
     import dask
     import dask.array as da
@@ -182,7 +240,25 @@ def write_shards(folder, arrays):
 
 
 def read_shards(folder):
-    """The arrays of a shard folder as dask arrays (one chunk per shard), name -> array."""
+    """The arrays of a shard folder (:func:`write_shards`) as dask arrays, one chunk per shard.
+
+    Parameters
+    ----------
+    folder : str or pathlib.Path
+        A shard folder with its ``index.json``.
+
+    Returns
+    -------
+    dict of str -> dask array, shape (n, ...)
+
+    Examples
+    --------
+    >>> import tempfile, numpy as np
+    >>> d = write_shards(tempfile.mkdtemp(), {"u": np.array([0.25, 0.5])})
+    >>> x = read_shards(d)["u"]
+    >>> x.chunks, x.compute().tolist()
+    (((2,),), [0.25, 0.5])
+    """
     import dask
     import dask.array as da
     import numpy as np
@@ -207,8 +283,39 @@ def read_shards(folder):
 
 
 def point_chunks(chunk, *, arrays=None, shards=None, samples=None, seed=0, n_faces=None):
-    """Chunk sources for :func:`_evaluate_chunk` from in-memory arrays (face, u, v), a shard folder, or
-    ``samples`` random points (chunk i from :func:`_sample_chunk`); ``chunk`` points per chunk."""
+    """Chunk sources for ``ccproof eval``: from arrays (face, u, v), a shard folder, or random samples.
+
+    ``samples`` random points are drawn chunk by chunk (chunk i from its own seeded generator, so the
+    points do not depend on the scheduler); docs/scale-out.md.
+
+    Parameters
+    ----------
+    chunk : int
+        Points per chunk, >= 1.
+    arrays : tuple of three arrays, shape (n,), optional
+        ``(face, u, v)`` in memory.
+    shards : str or pathlib.Path, optional
+        A shard folder holding face, u, v.
+    samples : int, optional
+        Number of random points (needs ``n_faces``).
+    seed : int, optional
+    n_faces : int, optional
+
+    Returns
+    -------
+    list of tuple
+        One source per chunk: ``("arrays", face, u, v)``, ``("shard", path)`` or
+        ``("samples", seed, n_faces, count, index)``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> src = point_chunks(2, arrays=(np.array([0, 1, 2]), np.zeros(3), np.ones(3)))
+    >>> [(s[0], s[1].tolist()) for s in src]
+    [('arrays', [0, 1]), ('arrays', [2])]
+    >>> [s[3] for s in point_chunks(4, samples=10, n_faces=6)]
+    [4, 4, 2]
+    """
     if chunk < 1:
         raise CCProofError(f"--chunk must be >= 1, got {chunk}")
     if shards is not None:
@@ -229,9 +336,46 @@ def evaluate_points(shipped, sources, derivatives, kwargs, out, scheduler=None, 
 
     ``out`` ending in ``.npz`` gathers all points into one file (arrays face, u, v, P, ...); any other
     path is a shard folder (one ``part-NNNNN.npz`` per chunk, written by the worker, and
-    ``index.json``), for point sets that do not fit in memory. ``local`` is the surface already built
-    in this process (used by in-process tasks instead of a rebuild). Returns (number of points,
-    result names, the :class:`~ccproof.scale.engine.Sweep`).
+    ``index.json``), for point sets that do not fit in memory (docs/scale-out.md).
+
+    Parameters
+    ----------
+    shipped : Shipped
+        ``ship(limit_surface, mesh, ...)``.
+    sources : list
+        Chunk sources of :func:`point_chunks`.
+    derivatives : {0, 1, 2}
+    kwargs : dict
+        Passed to the surface's ``evaluate``.
+    out : str or pathlib.Path
+        A ``.npz`` file or a shard folder.
+    scheduler : str or Scheduler or distributed.Client, optional
+        See :func:`ccproof.scale.engine.parse_scheduler`.
+    local : object, optional
+        The surface already built in this process (used by in-process tasks instead of a rebuild).
+    progress : bool, optional
+
+    Returns
+    -------
+    n : int
+        Number of points.
+    names : tuple of str
+        Result names (:func:`output_names`).
+    sweep : Sweep
+
+    Examples
+    --------
+    >>> import os, tempfile, numpy as np
+    >>> from ccproof.mesh.examples import cube
+    >>> from ccproof.reparam.surface import limit_surface
+    >>> from ccproof.scale import ship
+    >>> out = os.path.join(tempfile.mkdtemp(), "p.npz")
+    >>> src = point_chunks(1, arrays=(np.array([0, 0]), np.array([0.5, 0.5]), np.array([0.5, 0.5])))
+    >>> evaluate_points(ship(limit_surface, cube()), src, 0, {}, out, "serial", progress=False)[:2]
+    (2, ('P',))
+    >>> P = np.load(out)["P"]
+    >>> bool(np.all(np.abs(np.abs(P[:, 2]) - 68 / 81) < 1e-12))
+    True
     """
     import numpy as np
 
