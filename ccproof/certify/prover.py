@@ -42,7 +42,25 @@ MAX_DEPTH = 14
 
 
 class ProofFailed(CCProofError):
-    """The search found no certificate (the claim may be false, or needs deeper subdivision)."""
+    """The search found no certificate (the claim may be false, or needs deeper subdivision).
+
+    Raised by :func:`prove_valence`, :func:`prove_interval` and :func:`prove_c1` when a Bernstein form
+    (bmz04 Appendix A; docs/readings.md R7-R9) is negative at a box corner or not certified positive
+    after ``MAX_DEPTH`` splits; the message names the form and the box path.
+
+    Parameters
+    ----------
+    message : str
+
+    Examples
+    --------
+    >>> issubclass(ProofFailed, CCProofError)
+    True
+    >>> raise ProofFailed("det J_Phi on P1: no positive Bernstein bound after 14 splits (path '0101')")
+    Traceback (most recent call last):
+    ...
+    ccproof.certify.prover.ProofFailed: det J_Phi on P1: no positive Bernstein bound after 14 splits (path '0101')
+    """
 
 
 def _round_down(q, digits=6):
@@ -328,8 +346,34 @@ def prove_interval(k0: ValenceLike, prec: int = DEFAULT_PREC, progress: bool = T
 
 
 def claimed_margins(cert):
-    """The smallest bound claimed per section of a certificate this prover just wrote, and its number of
-    boxes (the prover's own claims, printed before the verifier re-checks them; never read back)."""
+    """The smallest bound claimed per section of a certificate, and its number of boxes.
+
+    The prover's own claims, printed before the verifier re-checks them (never read back as evidence;
+    docs/certificates.md).
+
+    Parameters
+    ----------
+    cert : dict
+        An injectivity certificate (one valence, with ``parts``; or an interval, with ``pieces``).
+
+    Returns
+    -------
+    margins : dict of str -> str
+        ``min_bound_det_J_phi_local``, ``min_bound_det_J_G_cells_local``,
+        ``min_bound_det_J_G_corner_over_h2``: the smallest claimed lower bound of each section.
+    n_boxes : int
+        Number of boxes in the certificate.
+
+    Examples
+    --------
+    >>> import json
+    >>> from fractions import Fraction
+    >>> cert = json.loads(certificate_path(5).read_text())
+    >>> margins, n = claimed_margins(cert)
+    >>> bounds = [Fraction(b["bound"]) for s in cert["parts"].values() for v in s.values() for b in v]
+    >>> n == len(bounds), min(Fraction(m) for m in margins.values()) == min(bounds) > 0
+    (True, True)
+    """
     parts_list = [pc["parts"] for pc in cert["pieces"]] if "pieces" in cert else [cert["parts"]]
     return _summary(parts_list)
 
@@ -347,6 +391,19 @@ def certificate_path(k, directory=None):
     """``k005.json`` for a valence, ``k_ge_40.json`` for the interval ``{"min": 40}``/``">=40"`` (any spelling
     of :meth:`ccproof.valence.Valence.parse`), in ``directory`` or the injectivity certificates folder.
 
+    Parameters
+    ----------
+    k : int or str or dict or Valence
+        A valence or an interval of valences.
+    directory : str or pathlib.Path, optional
+        Default: ``certificates_dir() / "injectivity"``.
+
+    Returns
+    -------
+    pathlib.Path
+
+    Examples
+    --------
     >>> certificate_path(5, "d").as_posix(), certificate_path({"min": 40}, "d").name
     ('d/k005.json', 'k_ge_40.json')
     """
@@ -354,6 +411,27 @@ def certificate_path(k, directory=None):
 
 
 def write_certificate(cert, path=None):
+    """Write a certificate as sorted, indented ASCII JSON; returns the path.
+
+    Parameters
+    ----------
+    cert : dict
+        A certificate of :func:`prove_valence`, :func:`prove_interval` or :func:`prove_c1`.
+    path : str or pathlib.Path, optional
+        Default: :func:`certificate_path` of ``cert["valence"]`` (the published folder).
+
+    Returns
+    -------
+    pathlib.Path
+
+    Examples
+    --------
+    >>> import json, tempfile
+    >>> from pathlib import Path
+    >>> p = write_certificate({"valence": 5, "N": 3}, Path(tempfile.mkdtemp()) / "k005.json")
+    >>> json.loads(p.read_text()) == {"valence": 5, "N": 3}
+    True
+    """
     path = Path(path or certificate_path(cert["valence"]))
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(json.dumps(cert, indent=1, sort_keys=True) + "\n", encoding="ascii")
@@ -399,5 +477,22 @@ def prove_c1(k: ValenceLike, prec: int = DEFAULT_PREC) -> dict[str, Any]:
 
 
 def c1_certificate_path(k, directory=None):
-    """:func:`certificate_path` in the C1 certificates folder."""
+    """:func:`certificate_path` in the C1 certificates folder.
+
+    Parameters
+    ----------
+    k : int or str or dict or Valence
+        Any spelling of :meth:`ccproof.valence.Valence.parse`.
+    directory : str or pathlib.Path, optional
+        Default: ``certificates_dir() / "c1"``.
+
+    Returns
+    -------
+    pathlib.Path
+
+    Examples
+    --------
+    >>> c1_certificate_path(5, "d").as_posix(), c1_certificate_path(">=40").parent.name
+    ('d/k005.json', 'c1')
+    """
     return Path(directory or certificates_dir() / "c1") / (Valence.parse(k).stem + ".json")
