@@ -68,7 +68,28 @@ def _monomial_exponents(degree):
 
 
 def monomials(x, y, degree, out=None):
-    """Rows x^a y^b (order of :func:`_monomial_exponents`) as a (M, n) array."""
+    """Rows x^a y^b (order of :func:`_monomial_exponents`: by total degree, then by the power of y).
+
+    The basis of the fitted first guess of bmz04 Algorithm 1 (docs/inverse.md).
+
+    Parameters
+    ----------
+    x, y : ndarray, shape (n,) float64
+    degree : int
+        Total degree.
+    out : ndarray, shape (M, n), optional
+        Filled in place, M = (degree + 1)(degree + 2)/2.
+
+    Returns
+    -------
+    ndarray, shape (M, n) float64
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> monomials(np.array([2.0]), np.array([3.0]), 2).ravel().tolist()    # 1, x, y, x^2, xy, y^2
+    [1.0, 2.0, 3.0, 4.0, 6.0, 9.0]
+    """
     exps = _monomial_exponents(degree)
     n = x.shape[0]
     m = out if out is not None else np.empty((len(exps), n))
@@ -85,7 +106,42 @@ def monomials(x, y, degree, out=None):
 
 @dataclass
 class ValenceData:
-    """Everything the float kernels need for one valence (see module docstring)."""
+    """Everything the float kernels need for one valence (see module docstring), made by :func:`valence_data`.
+
+    bmz04 Algorithm 1 (docs/readings.md R11; docs/inverse.md). Fields (shapes float64 unless noted):
+
+    Attributes
+    ----------
+    k : int
+    lam : float
+    bezier : ndarray, shape (3, 4, 4, 2)
+        Bezier nets of P1, P2, P3.
+    power : ndarray, shape (2, 2, 4, 4)
+        ``[patch P1/P2, component x/y, s power, t power]``.
+    W : ndarray, shape (2, 22, 4)
+        Rows of t-coefficients of q_i(t) (x: 0-3, y: 4-7), q_i'(t) (x: 8-11, y: 12-15),
+        i q_i(t) (x: 16-18, y: 19-21).
+    C6 : ndarray, shape (2, 6, 16)
+        x, y, x_s, x_t, y_s, y_t on the monomials s^i t^j (index 4i + j).
+    pow_mant, pow_exp : ndarray
+        lam^n = pow_mant[n + NMAX] * 2**pow_exp[n + NMAX] (any n, exact range).
+    pow_lam, pow_2lam, pow2 : ndarray
+        lam^n, (2 lam)^n and 2^n as doubles (0 / inf where out of range).
+    inv_log_lam, log_a : float
+        1 / log(lam); log(A) (the first guess puts max(t0) in (lam A, A]).
+    G : ndarray, shape (5, 10)
+        Location rows on the cubic monomials of t0: g_Gamma(t0), g_Gamma(lam t0), g_C(t0 / lam),
+        g_C(t0), g_C(lam t0).
+    fit : ndarray, shape (2, 2, M)
+        First guess of (s, t) of P1 / P2 on the monomials of degree ``FIT_DEGREE``.
+    gamma_sign, sep_sign : int
+
+    Examples
+    --------
+    >>> D = valence_data(4)
+    >>> D.lam, D.C6.shape, D.bezier[1, 3, 3].tolist()        # k = 4: Phi is the identity
+    (0.5, (2, 6, 16), [1.0, 1.0])
+    """
 
     k: int
     lam: float
@@ -170,8 +226,22 @@ def bezier_to_power(b):
     """Power-basis coefficients (constant first) of the cubic with Bezier coefficients b0..b3
     (any ring: floats, ``arb``, ``Fraction``, sympy numbers).
 
+    Parameters
+    ----------
+    b : sequence of 4 scalars
+        Bezier coefficients b0..b3 of a cubic on [0, 1].
+
+    Returns
+    -------
+    list of 4 scalars
+        Power-basis coefficients, constant first (same arithmetic as ``b``).
+
+    Examples
+    --------
     >>> bezier_to_power([0, 1, 2, 3])
     [0, 3, 0, 0]
+    >>> bezier_to_power([1, 1, 1, 1])          # partition of unity
+    [1, 0, 0, 0]
     """
     b0, b1, b2, b3 = b
     return [b0, (b1 - b0) * 3, (b2 - b1 * 2 + b0) * 3, b3 - b2 * 3 + b1 * 3 - b0]
@@ -262,6 +332,22 @@ def inside_sign(k, edge, g=None):
     At w = 0.1, ..., 0.9 along the edge the derivative of g(P(s, t)) in the direction into the
     piece's domain is enclosed in a ball; all nine must exclude 0 and agree (else ``ValueError``).
 
+    Parameters
+    ----------
+    k : int
+        Valence, k >= 3.
+    edge : str
+        A boundary edge name of :data:`BOUNDARY_EDGES` (``"P1:s=0"``, ...; docs/inverse.md).
+    g : dict, optional
+        The balls of :func:`implicit_boundary` (computed when omitted).
+
+    Returns
+    -------
+    int
+        +1 or -1.
+
+    Examples
+    --------
     >>> inside_sign(4, "P1:s=0") * float(implicit_boundary(4, "P1:s=0")[(1, 0)].mid()) > 0   # u > 1/2 inside
     True
     """
@@ -493,7 +579,23 @@ def _horner2(Q, i, s):
 
 
 def chunks(n, size=CHUNK):
-    """Slices covering range(n) in blocks of ``size``."""
+    """Slices covering range(n) in blocks of ``size``.
+
+    Parameters
+    ----------
+    n : int
+    size : int, optional
+        Default ``CHUNK``.
+
+    Yields
+    ------
+    slice
+
+    Examples
+    --------
+    >>> list(chunks(5, 2))
+    [slice(0, 2, None), slice(2, 4, None), slice(4, 5, None)]
+    """
     for i in range(0, n, size):
         yield slice(i, min(i + size, n))
 

@@ -79,9 +79,29 @@ _EDGE_SPECS = {
 
 @dataclass(frozen=True)
 class Edge:
-    """A boundary edge of a layer-0 piece: ``patch`` with local coordinate ``axis`` (0: s, 1: t)
-    fixed at ``value``; ``segment`` is the face segment it is the image of, ``other`` the piece
-    or layer across it."""
+    """A boundary edge of a layer-0 piece (bmz04 Definition 5; docs/inverse.md).
+
+    Parameters
+    ----------
+    name : str
+        ``"<patch>:<s|t>=<0|1>"``, the key of :data:`EDGES`.
+    patch : str
+        ``"P1"``, ``"P2"`` or ``"P3"``.
+    axis : int
+        The local coordinate held fixed (0: s, 1: t).
+    value : int
+        Its value (0 or 1).
+    segment : str
+        The face segment the edge is the image of.
+    other : str
+        The piece or layer across it.
+
+    Examples
+    --------
+    >>> e = EDGES["P1:s=1"]
+    >>> e.patch, e.axis, e.value, e.segment
+    ('P1', 0, 1, 'u = 1, 0 <= v <= 1/2')
+    """
 
     name: str
     patch: str
@@ -126,6 +146,19 @@ def sylvester_matrix(q, r, zero):
     r = r0 + ... + rn x^n given as coefficient lists (constant term first): n rows of q's
     coefficients ``q0 .. qm`` shifted right one column per row, then m rows of r's.
 
+    Parameters
+    ----------
+    q, r : sequence
+        Coefficient lists, constant term first, of degrees m and n (any commutative ring).
+    zero : scalar
+        The zero of that ring.
+
+    Returns
+    -------
+    list of lists, shape (m + n, m + n)
+
+    Examples
+    --------
     >>> sylvester_matrix([1, 2], [3, 4, 5], 0)
     [[1, 2, 0], [0, 1, 2], [3, 4, 5]]
     """
@@ -145,6 +178,19 @@ def determinant(M, zero, one):
     """Exact determinant of a square matrix over a commutative ring (no division): Laplace
     expansion along the rows with the minors memoized by their set of columns (2^n of them).
 
+    Parameters
+    ----------
+    M : sequence of sequences, shape (n, n)
+        Entries in a commutative ring (ints, Fractions, flint polynomials, ...).
+    zero, one : scalar
+        The ring's 0 and 1.
+
+    Returns
+    -------
+    scalar
+
+    Examples
+    --------
     >>> determinant([[1, 2], [3, 4]], 0, 1)
     -2
     """
@@ -177,15 +223,31 @@ def determinant(M, zero, one):
 
 @dataclass(frozen=True)
 class SymbolicImplicit:
-    """g(u, v) = numerator(lam, c, u, v) / denominator(c) for every valence at once.
+    """g(u, v) = numerator(lam, c, u, v) / denominator(c) for every valence at once (bmz04 Definition 5).
 
-    ``resultant``: the Sylvester determinant in Z[lam, c, u, v] of the denominator-cleared cubics
-    (before reduction; equals (-1) times flint's ``resultant`` of the same two polynomials).
-    ``numerator``: ``fmpq_mpoly`` in (lam, c, u, v) of degree <= 1 in lam (reduced modulo
-    16 lam^2 - 2(5+c) lam + 1). ``denominator``: ``fmpz_poly`` in c, = (D_x D_y)^3 where D_x, D_y
-    clear the denominators of the coefficients of x(w), y(w). ``x``, ``y``: the cleared cubics
-    as lists of ``fmpz_mpoly`` in (lam, c, u, v) (power basis in w), ``dx``, ``dy`` their
-    denominators."""
+    Made by :func:`symbolic_implicit` (docs/inverse.md).
+
+    Parameters
+    ----------
+    edge : Edge
+    resultant : flint.fmpz_mpoly
+        The Sylvester determinant in Z[lam, c, u, v] of the denominator-cleared cubics (before
+        reduction; equals (-1) times flint's ``resultant`` of the same two polynomials).
+    numerator : flint.fmpq_mpoly
+        In (lam, c, u, v), of degree <= 1 in lam (reduced modulo 16 lam^2 - 2(5+c) lam + 1).
+    denominator : flint.fmpz_poly
+        In c, = (D_x D_y)^3 where D_x, D_y clear the denominators of the coefficients of x(w), y(w).
+    x, y : tuple of flint.fmpz_mpoly
+        The cleared cubics in (lam, c, u, v) (power basis in w).
+    dx, dy : flint.fmpz_poly
+        Their denominators.
+
+    Examples
+    --------
+    >>> g = symbolic_implicit("P1:s=1")
+    >>> g.edge.name, g.numerator.degrees()[0], len(g.x)
+    ('P1:s=1', 1, 4)
+    """
 
     edge: Edge
     resultant: object
@@ -249,6 +311,17 @@ def _reduce_lam(poly):
 def symbolic_implicit(edge):
     """The implicit polynomial of a boundary edge, symbolic in c and lam (see module docstring).
 
+    Parameters
+    ----------
+    edge : str or Edge
+        A boundary edge (:data:`EDGES`).
+
+    Returns
+    -------
+    SymbolicImplicit
+
+    Examples
+    --------
     >>> g = symbolic_implicit("P1:s=1")
     >>> g.numerator.degrees()[0] <= 1, g.numerator.total_degree() > 0
     (True, True)
@@ -299,6 +372,25 @@ def implicit_polynomial(k, edge, arithmetic="arb", prec=128):
     (balls containing the exact coefficients) or ``"float"`` (midpoints, scaled by a positive
     factor so that the largest |coefficient| is 1; same sign as g everywhere).
 
+    bmz04 Definition 5 specialized to valence k (docs/inverse.md).
+
+    Parameters
+    ----------
+    k : int
+        Valence, k >= 3.
+    edge : str or Edge
+        A boundary edge (:data:`EDGES`).
+    arithmetic : {"arb", "exact", "float"}, optional
+    prec : int, optional
+        Bits of precision of arb coefficients (default 128).
+
+    Returns
+    -------
+    dict of tuple -> scalar
+        ``{(a, b): g_ab}``, total degree <= 3.
+
+    Examples
+    --------
     >>> g = implicit_polynomial(3, "P1:s=0", "float")
     >>> max(abs(x) for x in g.values())
     1.0
@@ -381,7 +473,27 @@ def rational_nets(c, lam):
     """Bezier nets of P1, P2, P3 with c and lam rational (``Fraction``): exact, ``Fraction``s.
 
     Valid for any rational pair with 16 lam^2 - 2 (5 + c) lam + 1 = 0: k = 4 (c = 0, lam = 1/2)
-    and the *rational pseudo-valences* of :data:`RATIONAL_PAIRS` used to test the algebra exactly.
+    and the *rational pseudo-valences* of :data:`RATIONAL_PAIRS` used to test the algebra exactly
+    (bmz04 section 4.3; docs/readings.md R3).
+
+    Parameters
+    ----------
+    c, lam : Fraction or int
+
+    Returns
+    -------
+    dict
+        ``{"P1": net, "P2": net, "P3": net}``, ``net[i][j] = (x, y)`` Fractions, i, j = 0..3.
+
+    Raises
+    ------
+    CCProofError
+        If lam is not a root for c.
+
+    Examples
+    --------
+    >>> rational_nets(0, Fraction(1, 2))["P2"][3][3]            # k = 4: the identity map
+    (Fraction(1, 1), Fraction(1, 1))
     """
     c, lam = Fraction(c), Fraction(lam)
     if 16 * lam * lam - 2 * (5 + c) * lam + 1 != 0:
@@ -423,6 +535,20 @@ def rational_implicit(edge, c, lam):
     Definition 5 over Q with the actual degrees of x(w) - u and y(w) - v (no formal leading
     zeros; for k = 4, whose boundaries are straight lines, this is what gives a non-zero g).
 
+    Parameters
+    ----------
+    edge : str or Edge
+        A boundary edge (:data:`EDGES`).
+    c, lam : Fraction or int
+        A rational pair with 16 lam^2 - 2 (5 + c) lam + 1 = 0 (:func:`rational_nets`).
+
+    Returns
+    -------
+    dict of tuple -> Fraction
+        ``{(a, b): g_ab}``.
+
+    Examples
+    --------
     >>> rational_implicit("P1:t=1", 0, Fraction(1, 2))   # k = 4: the line v = 1/2, as 1/2 - v
     {(0, 0): Fraction(1, 2), (0, 1): Fraction(-1, 1)}
     """
@@ -500,6 +626,24 @@ def exact_sign(k, edge, u, v, prec=256):
     curve with irrational coefficients is then never decided: after 4096 bits a
     :class:`CCProofError` is raised).
 
+    Parameters
+    ----------
+    k : int
+        Valence, k >= 3.
+    edge : str or Edge
+        A boundary edge (:data:`EDGES`).
+    u, v : Fraction or int
+        The point.
+    prec : int, optional
+        Starting bits of precision of the arb evaluation (k other than 3, 4, 6).
+
+    Returns
+    -------
+    int
+        -1, 0 or 1.
+
+    Examples
+    --------
     >>> exact_sign(3, "P1:s=1", 1, 0), exact_sign(3, "P1:s=1", Fraction(1, 2), 0) != 0
     (0, True)
     """
@@ -561,7 +705,30 @@ def inside_sign(k, edge, prec=128):
 
     At w = 0.1, 0.2, ..., 0.9 along the edge, the derivative of g(P(s, t)) in the direction
     pointing into the piece's domain is enclosed in a ball; all nine balls must exclude 0 and
-    agree (else :class:`CCProofError`).
+    agree (else :class:`CCProofError`). docs/inverse.md.
+
+    Parameters
+    ----------
+    k : int
+        Valence, k >= 3.
+    edge : str or Edge
+        A boundary edge (:data:`EDGES`).
+    prec : int, optional
+        Bits of precision (default 128).
+
+    Returns
+    -------
+    int
+        +1 or -1.
+
+    Examples
+    --------
+    For k = 4 the edge P1:s=1 is the line u = 1 and P1 lies at u < 1:
+
+    >>> g = rational_implicit("P1:s=1", 0, Fraction(1, 2))
+    >>> u, v = Fraction(3, 4), Fraction(1, 4)
+    >>> inside_sign(4, "P1:s=1") * sum(x * u**a * v**b for (a, b), x in g.items()) > 0
+    True
     """
     k = check_valence(k)
     e = _get_edge(edge)
@@ -626,6 +793,15 @@ class FloatImplicit:
     where |g| is below a rigorous bound on the rounding error of the Horner evaluation
     (gamma_12 sum |g_ab| |u|^a |v|^b: nested Horner of degree 3 + 3, the standard a-priori bound).
 
+    Parameters
+    ----------
+    k : int
+        Valence, k >= 3.
+    edge : str or Edge
+        A boundary edge (:data:`EDGES`).
+
+    Examples
+    --------
     >>> f = FloatImplicit(4, "P1:s=1")
     >>> f.side([0.5, 1.5, 1.0], [0.2, 0.2, 0.3]).tolist()
     [1, -1, 0]
