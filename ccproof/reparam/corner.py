@@ -100,6 +100,18 @@ def characteristic_tangent_masks(k):
     """Mask T_k, shape (2, 2k+1), with ``T_k @ X[corner_ring(...)]`` = the two limit derivatives
     d(f o Phi^-1)/ds, d/dt at a corner of valence k (module docstring).
 
+    Parameters
+    ----------
+    k : int
+        Valence, k >= 3 (interior corner).
+
+    Returns
+    -------
+    ndarray, shape (2, 2k + 1) float64
+        Rows d/ds, d/dt; columns in the order of :func:`corner_ring`.
+
+    Examples
+    --------
     >>> T = characteristic_tangent_masks(5)
     >>> T.shape, bool(abs(T.sum(axis=1)).max() < 1e-14)      # derivatives of a constant vanish
     ((2, 11), True)
