@@ -428,7 +428,8 @@ def write_certificate(cert, path=None):
     --------
     >>> import json, tempfile
     >>> from pathlib import Path
-    >>> p = write_certificate({"valence": 5, "N": 3}, Path(tempfile.mkdtemp()) / "k005.json")
+    >>> tmp = tempfile.TemporaryDirectory()          # removed when the example ends
+    >>> p = write_certificate({"valence": 5, "N": 3}, Path(tmp.name) / "k005.json")
     >>> json.loads(p.read_text()) == {"valence": 5, "N": 3}
     True
     """

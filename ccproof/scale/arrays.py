@@ -211,7 +211,8 @@ def write_shards(folder, arrays):
     Examples
     --------
     >>> import tempfile, numpy as np, dask.array as da
-    >>> d = write_shards(tempfile.mkdtemp(), {"x": da.arange(5, chunks=2)})
+    >>> tmp = tempfile.TemporaryDirectory()          # removed when the example ends
+    >>> d = write_shards(tmp.name, {"x": da.arange(5, chunks=2)})
     >>> sorted(p.name for p in d.iterdir())
     ['index.json', 'part-00000.npz', 'part-00001.npz', 'part-00002.npz']
     >>> read_shards(d)["x"].compute().tolist()
@@ -254,7 +255,8 @@ def read_shards(folder):
     Examples
     --------
     >>> import tempfile, numpy as np
-    >>> d = write_shards(tempfile.mkdtemp(), {"u": np.array([0.25, 0.5])})
+    >>> tmp = tempfile.TemporaryDirectory()          # removed when the example ends
+    >>> d = write_shards(tmp.name, {"u": np.array([0.25, 0.5])})
     >>> x = read_shards(d)["u"]
     >>> x.chunks, x.compute().tolist()
     (((2,),), [0.25, 0.5])
@@ -369,7 +371,8 @@ def evaluate_points(shipped, sources, derivatives, kwargs, out, scheduler=None, 
     >>> from ccproof.mesh.examples import cube
     >>> from ccproof.reparam.surface import limit_surface
     >>> from ccproof.scale import ship
-    >>> out = os.path.join(tempfile.mkdtemp(), "p.npz")
+    >>> tmp = tempfile.TemporaryDirectory()          # removed when the example ends
+    >>> out = os.path.join(tmp.name, "p.npz")
     >>> src = point_chunks(1, arrays=(np.array([0, 0]), np.array([0.5, 0.5]), np.array([0.5, 0.5])))
     >>> evaluate_points(ship(limit_surface, cube()), src, 0, {}, out, "serial", progress=False)[:2]
     (2, ('P',))

@@ -86,7 +86,8 @@ def read_labels(path, n_faces=None):
     Examples
     --------
     >>> import os, tempfile
-    >>> p = os.path.join(tempfile.mkdtemp(), "labels.txt")
+    >>> tmp = tempfile.TemporaryDirectory()          # removed when the example ends
+    >>> p = os.path.join(tmp.name, "labels.txt")
     >>> write_labels(p, [0, 1, 1])
     >>> read_labels(p).tolist()
     [0, 1, 1]
@@ -124,7 +125,8 @@ def write_labels(path, labels):
     Examples
     --------
     >>> import os, tempfile
-    >>> p = os.path.join(tempfile.mkdtemp(), "labels.txt")
+    >>> tmp = tempfile.TemporaryDirectory()          # removed when the example ends
+    >>> p = os.path.join(tmp.name, "labels.txt")
     >>> write_labels(p, [2, 0])
     >>> open(p).read().splitlines()[1:]
     ['2', '0']

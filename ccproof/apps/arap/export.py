@@ -297,7 +297,8 @@ def write_surface(path, surf: SampledSurface, comment=None):
     >>> from ccproof.apps.arap.core import compare
     >>> res, _ = compare(grid(3, 3), methods=("c",), levels=1, eval_level=3)
     >>> S = sampled_surface(res["c"], level=1)
-    >>> path = os.path.join(tempfile.mkdtemp(), "surface.obj")
+    >>> tmp = tempfile.TemporaryDirectory()          # removed when the example ends
+    >>> path = os.path.join(tmp.name, "surface.obj")
     >>> _ = write_surface(path, S)
     >>> points, uv, cells = read_surface(path)
     >>> bool(np.array_equal(points, S.points) and np.array_equal(uv, S.uv)), cells.shape
@@ -363,7 +364,8 @@ def read_surface(path):
     >>> from ccproof.apps.arap.core import compare
     >>> res, _ = compare(grid(3, 3), methods=("c",), levels=1, eval_level=3)
     >>> S = sampled_surface(res["c"], level=1, cells="quad")
-    >>> path = os.path.join(tempfile.mkdtemp(), "surface.ply")
+    >>> tmp = tempfile.TemporaryDirectory()          # removed when the example ends
+    >>> path = os.path.join(tmp.name, "surface.ply")
     >>> _ = write_surface(path, S)
     >>> points, uv, cells = read_surface(path)
     >>> bool(np.abs(uv - S.uv).max() < 1e-12), cells.shape

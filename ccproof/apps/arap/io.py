@@ -102,7 +102,8 @@ def write_uv_obj(path, mesh, result, comment=None, table=None, transforms=None, 
     >>> from ccproof.mesh.examples import grid
     >>> from ccproof.apps.arap.core import compare
     >>> res, _ = compare(grid(3, 3), methods=("c",), levels=1, eval_level=3)
-    >>> d = tempfile.mkdtemp()
+    >>> tmp = tempfile.TemporaryDirectory()          # removed when the example ends
+    >>> d = tmp.name
     >>> sidecar = write_uv_obj(os.path.join(d, "grid.obj"), grid(3, 3), res["c"])
     >>> sorted(os.listdir(d)), os.path.basename(sidecar)
     (['grid.obj', 'grid.obj.json'], 'grid.obj.json')

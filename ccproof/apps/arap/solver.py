@@ -241,12 +241,6 @@ def iterate(system: LocalGlobal, X0, tol=1e-6, max_iter=200, trace=False, min_it
     E(X, R(X)) is below the last accepted one, else the plain local/global step is taken, so the
     energy still decreases monotonically (``trace`` is not recorded then).
 
-    Returns
-    -------
-    IterationResult
-        ``energies[i]`` is E(X_i, R(X_i)) (after each local step); with ``trace`` also the energy
-        after every global step (``trace``) and the global solve residuals.
-
     Parameters
     ----------
     system : LocalGlobal
@@ -255,6 +249,12 @@ def iterate(system: LocalGlobal, X0, tol=1e-6, max_iter=200, trace=False, min_it
     max_iter, min_iter : int, optional
     trace : bool, optional
     accel : int, optional
+
+    Returns
+    -------
+    IterationResult
+        ``energies[i]`` is E(X_i, R(X_i)) (after each local step); with ``trace`` also the energy
+        after every global step (``trace``) and the global solve residuals.
 
     Examples
     --------

@@ -175,7 +175,8 @@ def read_points(path):
     --------
     >>> import os, tempfile
     >>> import numpy as np
-    >>> p = os.path.join(tempfile.mkdtemp(), "cloud.xyz")
+    >>> tmp = tempfile.TemporaryDirectory()          # removed when the example ends
+    >>> p = os.path.join(tmp.name, "cloud.xyz")
     >>> np.savetxt(p, [[1, 2, 3, 9], [4, 5, 6, 9]])                  # extra columns are ignored
     >>> read_points(p).tolist()
     [[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]]
