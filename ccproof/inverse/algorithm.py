@@ -233,7 +233,8 @@ def locate(D, a, b, fast=True):
     a, b : ndarray, shape (n,) float64
         Points of the half-sector a >= b >= 0, a > 0.
     fast : bool, optional
-        Use the float approximation of log (``_approx_log``) for the first guess of the layer.
+        The fast path: powers of lam as doubles, no clipping of the first-guess layer to the exact
+        range of the power tables (the caller keeps the points in range).
 
     Returns
     -------

@@ -131,7 +131,8 @@ def term_matrix(term):
     Parameters
     ----------
     term : str
-        A key of :data:`TERMS` (``"mass"``, ``"uu1"``, ... : the integrands of qmv98 eq. (8)).
+        A key of :data:`TERMS` (``"mass"``, ``"uu1"``, ... : the integrands of the mass and of the
+    stiffness of qmv98 eq. 20: ``J^T J``, ``J_u^T J_u``, ...).
 
     Returns
     -------

@@ -271,7 +271,7 @@ def fit_error(model, P, X, finder=None, diameter=None):
     """Distances of the data points to the limit surface and the paper's fit error.
 
     Global closest points (:class:`~ccproof.apps.dynamics.forces.ModelClosestPoints`); the error
-    measure of qmv98 section 5 (docs/qmv98.md).
+    measure of qmv98 section 4 (docs/qmv98.md B6).
 
     Parameters
     ----------
@@ -369,7 +369,7 @@ def limit_surface_mesh(mesh, level):
     """The limit surface sampled at ``level``.
 
     The control mesh subdivided ``level`` times with its vertices moved to their exact limit positions
-    (Catmull-Clark limit masks, docs/readings.md R1).
+    (Catmull-Clark limit masks of the subdivision rules of docs/readings.md R1).
 
     Parameters
     ----------
@@ -471,7 +471,7 @@ def surface_to_data(surface, X, stray_distance):
 
 @dataclass
 class FitLevel:
-    """One level of the multilevel fit (qmv98 section 5; docs/qmv98.md).
+    """One level of the multilevel fit (qmv98 section 4.2; docs/qmv98.md B6).
 
     Parameters
     ----------

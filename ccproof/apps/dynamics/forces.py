@@ -72,7 +72,7 @@ class Springs:
 
     Notes
     -----
-    The spring forces of qmv98 section 4 (data fitting, docs/qmv98.md): energy
+    The springs of qmv98 section 3.2 (eq. 27 with a delta kernel; generalized force eq. 21): energy
     sum_i k_i/2 |x(face_i, u_i, v_i) - d0_i|^2.
 
     Examples

@@ -115,7 +115,7 @@ class MatrixSystem:
     Parameters
     ----------
     M, D, K : array_like or scipy.sparse matrix, shape (n, n)
-        Mass, damping and stiffness matrices (qmv98 eq. (29)).
+        Mass, damping and stiffness matrices of ``M p'' + D p' + K p = f_p`` (qmv98 section 3.3).
 
     Examples
     --------
@@ -152,7 +152,8 @@ class MatrixSystem:
 class ModelSystem:
     """Adapter of a :class:`~ccproof.apps.dynamics.model.DynamicSurface` (``M = mu M1, D = gamma M1``).
 
-    The system of qmv98 eq. (29) with the model's assembled or element-by-element operators.
+    The system ``M p'' + D p' + K p = f_p`` of qmv98 section 3.3 with the model's assembled or
+    element-by-element operators.
 
     Parameters
     ----------

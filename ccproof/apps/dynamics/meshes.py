@@ -36,7 +36,7 @@ __all__ = [
 def paper_initial_model(center=(0.0, 0.0, 0.0), half_extent=1.0, subdivisions=2):
     """The cube ``center +- half_extent`` (scalar or per axis) subdivided ``subdivisions`` times.
 
-    The initial model of the fitting examples of qmv98 section 5 (docs/qmv98.md).
+    The initial model of the fitting examples of qmv98 section 4 (docs/qmv98.md B6).
 
     Parameters
     ----------

@@ -51,7 +51,7 @@ def limit_grid(model, P, per_edge=6):
 def draw_surface(ax, model, P, per_edge=5, light=(0.3, -0.5, 0.8), alpha=1.0, edgecolor="none"):
     """Add the limit surface of state P to a 3D axes as shaded quads (yellow normal, green special).
 
-    The figures of qmv98 section 5 (scripts/qmv98_examples.py).
+    The figures of qmv98 section 4 (scripts/qmv98_examples.py).
 
     Parameters
     ----------

@@ -66,7 +66,7 @@ def synthetic_range_data(name, m=None, seed=0, noise=0.0):
     """``m`` points on the synthetic shape ``name`` (default: the paper's size), optional Gaussian noise
     of standard deviation ``noise`` (absolute units).
 
-    The range data of the fitting examples of qmv98 section 5 (docs/qmv98.md).
+    The range data of the fitting examples of qmv98 section 4 (docs/qmv98.md B6).
 
     Parameters
     ----------
