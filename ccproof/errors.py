@@ -10,6 +10,16 @@ is deliberately not a :class:`CCProofError` and has no twin here.
 class CCProofError(ValueError):
     """Base class of the errors ccproof raises for bad input (a ``ValueError``).
 
+    Catch it to handle every input error of the package (docs/api.md, "Errors").
+
+    Parameters
+    ----------
+    message : str
+        What is wrong, naming the offending input (face, edge, vertex, field or valence).
+
+    Examples
+    --------
+
     >>> issubclass(MeshError, CCProofError), issubclass(CCProofError, ValueError)
     (True, True)
     >>> import ccproof
@@ -24,6 +34,14 @@ class CCProofError(ValueError):
 class ValenceError(CCProofError):
     """A valence that is not an integer >= 3.
 
+    Parameters
+    ----------
+    message : str
+        What is wrong, naming the offending value.
+
+    Examples
+    --------
+
     >>> check_valence(2.5)
     Traceback (most recent call last):
     ...
@@ -33,6 +51,14 @@ class ValenceError(CCProofError):
 
 class TableNotFoundError(CCProofError):
     """A certified table that does not exist; the message lists the ones that do.
+
+    Parameters
+    ----------
+    message : str
+        What is wrong, naming the offending valence and listing the tables that exist.
+
+    Examples
+    --------
 
     >>> from ccproof.tables.numeric import load_table
     >>> load_table(200)
@@ -45,6 +71,14 @@ class TableNotFoundError(CCProofError):
 class MeshError(CCProofError):
     """A mesh that is not a valid manifold quad mesh; the message names the element.
 
+    Parameters
+    ----------
+    message : str
+        What is wrong, naming the offending face, edge or vertex.
+
+    Examples
+    --------
+
     >>> from ccproof.mesh import QuadMesh
     >>> QuadMesh([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], [[0, 1, 2, 7]])
     Traceback (most recent call last):
@@ -55,6 +89,27 @@ class MeshError(CCProofError):
 
 def check_valence(k: object, *, minimum: int = 3) -> int:
     """Return ``k`` as a Python ``int`` after checking it is an integer valence >= ``minimum``.
+
+    Parameters
+    ----------
+    k : object
+        The valence: an ``int``, a NumPy integer, an integral float (``5.0``) or a decimal string (``"5"``).
+        ``bool`` is refused.
+    minimum : int, optional
+        Smallest accepted valence (default 3, the smallest valence of a Catmull-Clark vertex).
+
+    Returns
+    -------
+    int
+        ``k`` as a Python integer.
+
+    Raises
+    ------
+    ValenceError
+        If ``k`` is not an integer or is below ``minimum``; the message quotes ``k``.
+
+    Examples
+    --------
 
     >>> check_valence(5)
     5

@@ -156,8 +156,28 @@ ValenceLike: TypeAlias = "int | str | Mapping[str, int] | Valence"
 def parse_valence(value: ValenceLike) -> Valence:
     """:meth:`Valence.parse` as a function (for argparse ``type=``: ``ccproof table '>=40'``).
 
+    Parameters
+    ----------
+    value : int or str or Mapping[str, int] or Valence
+        A single valence (``7``, ``"7"``), an interval ``">=40"`` / ``"k_ge_40.json"`` / ``{"min": 40}``,
+        or a :class:`Valence` (returned unchanged).
+
+    Returns
+    -------
+    Valence
+
+    Raises
+    ------
+    ValenceError
+        If ``value`` names no valence >= 3.
+
+    Examples
+    --------
+
     >>> parse_valence(">=40")
     Valence('>=40')
+    >>> parse_valence({"min": 40}) == parse_valence("k_ge_40.json"), parse_valence("7").k
+    (True, 7)
     """
     return Valence.parse(value)
 

@@ -27,7 +27,7 @@ from fractions import Fraction
 from functools import lru_cache
 
 from ccproof.algebra.field import C, QcLam
-from ccproof.algebra.subdivision import TWO_RING_POSITIONS, canonical, regular_stencil
+from ccproof.algebra.subdivision import TWO_RING_POSITIONS, _regular_stencil, canonical
 
 #: names of the three layer-0 pieces and their domains in the face parameter (u, v) (R4)
 PATCH_DOMAINS = {
@@ -119,11 +119,26 @@ def _solve(matrix, rhs):
 def mode1_eigenvector():
     """Level-0 mode-1 subdominant eigenvector on the two-ring of sector 0, symbolic (steps 1-2).
 
+    bmz04 section 3 (the subdominant eigenvector of the subdivision matrix, Definition 4);
+    docs/readings.md R2, R3 (the normalized frame).
+
     Returns
     -------
     dict
-        ``{(a, b): (x, y)}`` for the positions :data:`TWO_RING_POSITIONS`, entries in Q(c, lam),
-        normalized by x_(1,0) = (1, 0) (not yet scaled so that Phi(1,0) = (1,0)).
+        ``{(a, b): (x, y)}`` for the 6 positions :data:`TWO_RING_POSITIONS`, entries
+        :class:`~ccproof.algebra.field.QcLam` in Q(c, lam), normalized by x_(1,0) = (1, 0) (not yet
+        scaled so that Phi(1,0) = (1,0)).
+
+    Examples
+    --------
+    For k = 4 (c = 0, lam = 1/2) the eigenvector is the linear function of the regular grid,
+    x_(a,b) = (a, b):
+
+    >>> from fractions import Fraction
+    >>> from ccproof.algebra.field import eval_integer_form
+    >>> at4 = lambda q: eval_integer_form(q.integer_form(), 0, Fraction(1, 2))
+    >>> all((at4(x), at4(y)) == p for p, (x, y) in mode1_eigenvector().items())
+    True
     """
     lam = QcLam.lam()
     inner = {(1, 0): _vec(1, 0)}
@@ -131,12 +146,12 @@ def mode1_eigenvector():
     inner[(1, 1)] = (f, f)
     outer = [(2, 0), (2, 1), (1, 2), (2, 2)]
     # S x = lam x on the outer positions: the level-1 vertex at grid position p (computed from
-    # level-0 values by regular_stencil(p)) equals lam times the level-0 value at position p.
+    # level-0 values by _regular_stencil(p)) equals lam times the level-0 value at position p.
     unknown_index = {p: i for i, p in enumerate(outer)}
     nun = 2 * len(outer)
     rows, rhs = [], []
     for p in outer:
-        st = regular_stencil(*p)
+        st = _regular_stencil(*p)
         # linear form: sum_w w R^d x_q ; split into known (inner) and unknown (outer) parts
         coeff = [[_zero() for _ in range(nun)] for _ in range(2)]
         known = (_zero(), _zero())
@@ -174,20 +189,36 @@ def _level1_value(values, A, B):
     d, A2, B2 = canonical(A, B)
     if (A2, B2) == (0, 0):
         return (_zero(), _zero())
-    return _rot(d, _apply_stencil(regular_stencil(A2, B2), values))
+    return _rot(d, _apply_stencil(_regular_stencil(A2, B2), values))
 
 
 @lru_cache(maxsize=1)
 def symbolic_bspline_nets():
     """The B-spline nets of P1, P2, P3 in the normalized frame, symbolic in c and lam (R3, R4).
 
+    bmz04 section 4.3 (the characteristic map as three bicubic pieces of layer 0, Fig. 3);
+    docs/readings.md R3, R4.
+
     Returns
     -------
     dict
-        ``{"P1": net, "P2": net, "P3": net}``; ``net[i][j] = (x, y)`` with entries
-        :class:`~ccproof.algebra.field.QcLam`, i along u (the piece's local s), j along v (t).
+        ``{"P1": net, "P2": net, "P3": net}``; ``net`` is a 4 x 4 nested list, ``net[i][j] = (x, y)``
+        with entries :class:`~ccproof.algebra.field.QcLam`, i along u (the piece's local s), j along v (t).
         Piece P on its domain [u0,u1]x[v0,v1] is the uniform bicubic B-spline of the net with local
         parameters s = (u - u0)/(u1 - u0), t = (v - v0)/(v1 - v0).
+
+    Examples
+    --------
+    For k = 4 the characteristic map is the identity, so the level-1 B-spline net of P1 (domain
+    [1/2, 1] x [0, 1/2]) is the grid of spacing 1/2 with corner (0, -1/2):
+
+    >>> from fractions import Fraction
+    >>> from ccproof.algebra.field import eval_integer_form
+    >>> at4 = lambda q: eval_integer_form(q.integer_form(), 0, Fraction(1, 2))
+    >>> net = symbolic_bspline_nets()["P1"]
+    >>> all((at4(net[i][j][0]), at4(net[i][j][1])) == (Fraction(i, 2), Fraction(j - 1, 2))
+    ...     for i in range(4) for j in range(4))
+    True
     """
     vals = mode1_eigenvector()
     raw = {}
@@ -216,8 +247,29 @@ def bspline_to_bezier(net, ops=None):
     """Convert a 4x4 uniform bicubic B-spline net (any coefficient type) to the Bezier net of the
     same segment: ``bez = M net M^T`` with M = :data:`BSPLINE_TO_BEZIER`.
 
-    Entries of ``net`` may be scalars or 2-tuples (points); weights are Fractions converted with
-    ``ops`` (a callable turning a Fraction into the coefficient type; default: identity).
+    The standard B-spline to Bezier conversion of the middle segment (docs/readings.md R4).
+
+    Parameters
+    ----------
+    net : sequence of sequences, shape (4, 4)
+        ``net[i][j]``: a scalar or a 2-tuple (a point) of any ring type (Fraction, sympy, QcLam, arb).
+    ops : callable, optional
+        Turns a ``Fraction`` weight into the coefficient type; default: identity.
+
+    Returns
+    -------
+    list of lists, shape (4, 4)
+        The Bezier net, entries of the same kind as those of ``net``.
+
+    Examples
+    --------
+    Equally spaced B-spline coefficients 0, 1, 2, 3 (along i) give the linear segment from 1 to 2,
+    whose Bezier coefficients are 1, 4/3, 5/3, 2:
+
+    >>> from fractions import Fraction
+    >>> bez = bspline_to_bezier([[Fraction(i)] * 4 for i in range(4)])
+    >>> [str(row[0]) for row in bez]
+    ['1', '4/3', '5/3', '2']
     """
     conv = ops or (lambda f: f)
     M = [[conv(x) for x in row] for row in BSPLINE_TO_BEZIER]
@@ -238,7 +290,29 @@ def bspline_to_bezier(net, ops=None):
 
 @lru_cache(maxsize=1)
 def symbolic_bezier_nets():
-    """Bezier nets of P1, P2, P3 (same layout as :func:`symbolic_bspline_nets`), symbolic."""
+    """Bezier nets of P1, P2, P3 (same layout as :func:`symbolic_bspline_nets`), symbolic.
+
+    :func:`bspline_to_bezier` of the nets of :func:`symbolic_bspline_nets` (bmz04 section 4.3;
+    docs/readings.md R3, R4); these are the nets the certified tables store.
+
+    Returns
+    -------
+    dict
+        ``{"P1": net, "P2": net, "P3": net}``, ``net[i][j] = (x, y)``, i, j = 0..3, entries
+        :class:`~ccproof.algebra.field.QcLam`.
+
+    Examples
+    --------
+    For k = 4 (the identity map) the Bezier net of P2 on D2 = [1/2, 1]^2 is the uniform grid of D2:
+
+    >>> from fractions import Fraction
+    >>> from ccproof.algebra.field import eval_integer_form
+    >>> at4 = lambda q: eval_integer_form(q.integer_form(), 0, Fraction(1, 2))
+    >>> net = symbolic_bezier_nets()["P2"]
+    >>> all((at4(net[i][j][0]), at4(net[i][j][1])) == (Fraction(3 + i, 6), Fraction(3 + j, 6))
+    ...     for i in range(4) for j in range(4))
+    True
+    """
     from sympy import Rational
 
     conv = lambda f: QcLam(Rational(f.numerator, f.denominator))
@@ -246,8 +320,27 @@ def symbolic_bezier_nets():
 
 
 def symbolic_two_ring_eigenvector():
-    """The level-0 subdominant eigenvector on the sector-0 part of the two-ring, scaled like the
-    nets (Phi(1,0) = (1,0)): ``{(a, b): (x, y)}`` for :data:`TWO_RING_POSITIONS`."""
+    """The level-0 subdominant eigenvector on the sector-0 part of the two-ring, scaled like the nets.
+
+    :func:`mode1_eigenvector` scaled so that Phi(1,0) = (1,0) (bmz04 section 4.3 step 4;
+    docs/readings.md R3).
+
+    Returns
+    -------
+    dict
+        ``{(a, b): (x, y)}`` for the 6 positions :data:`TWO_RING_POSITIONS`, entries
+        :class:`~ccproof.algebra.field.QcLam`.
+
+    Examples
+    --------
+    For k = 4 the scale is 1 and the values are the grid positions:
+
+    >>> from fractions import Fraction
+    >>> from ccproof.algebra.field import eval_integer_form
+    >>> ev = symbolic_two_ring_eigenvector()
+    >>> [eval_integer_form(ev[(2, 1)][i].integer_form(), 0, Fraction(1, 2)) for i in (0, 1)]
+    [Fraction(2, 1), Fraction(1, 1)]
+    """
     vals = mode1_eigenvector()
     nets = symbolic_bspline_nets()
     raw_e0 = _level1_value(vals, 2, 0)

@@ -36,6 +36,18 @@ def _qc(x):
 class QcLam:
     """An element ``a + b*lam`` of Q(c, lam), lam**2 = (5 + c)/8 lam - 1/16.
 
+    The field in which the characteristic map is exact for every valence at once, c = cos(2 pi/k)
+    symbolic and lam the subdominant eigenvalue (bmz04 section 3; docs/readings.md R2, R3).
+
+    Parameters
+    ----------
+    a : int or Fraction or sympy.Rational or element of Q(c) or QcLam, optional
+        The rational part (a :class:`QcLam` is copied, ``b`` then ignored). Default 0.
+    b : int or Fraction or sympy.Rational or element of Q(c), optional
+        The coefficient of lam. Default 0.
+
+    Examples
+    --------
     >>> lam = QcLam.lam()
     >>> lam * lam == QcLam((C + 5) / 8) * lam - QcLam(Rational(1, 16))
     True
@@ -168,7 +180,25 @@ class QcLam:
 
 
 def integer_form_string(form):
-    """Human-readable string ``(A(c) + B(c)*lam)/D(c)`` of an integer form."""
+    """Human-readable string ``(A(c) + B(c)*lam)/D(c)`` of an integer form.
+
+    Parameters
+    ----------
+    form : tuple of three lists of int
+        ``(A, B, D)``, coefficients constant term first, as returned by :meth:`QcLam.integer_form`
+        (the form the certified tables store, docs/tables.md).
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> integer_form_string(QcLam(C / 2 + 1, Rational(1, 3)).integer_form())
+    '((6 + 3*c) + (2)*lam)/(6)'
+    >>> integer_form_string(([0], [-1], [1, 0, 2]))
+    '((0) + (-1)*lam)/(1 + 2*c^2)'
+    """
 
     def poly_str(coeffs):
         terms = []
@@ -187,7 +217,7 @@ def integer_form_string(form):
     return f"(({poly_str(A)}) + ({poly_str(B)})*lam)/({poly_str(D)})"
 
 
-def subdominant_lam_sympy(c):
+def _subdominant_lam_sympy(c):
     """Exact lam(c) = (5 + c + sqrt((1 + c)(9 + c)))/16 as a sympy expression (R2;
     :func:`ccproof.valence.lam_from_c` in sympy arithmetic)."""
     return lam_from_c(sympify(c), sqrt)
@@ -198,6 +228,28 @@ def eval_integer_form(form, cval, lamval):
 
     Works for any ring-like values: ints/Fractions, sympy numbers, ``flint.arb`` balls (the
     result then encloses the exact value for every c, lam in the input balls) or floats.
+
+    Parameters
+    ----------
+    form : tuple of three lists of int
+        ``(A, B, D)``, coefficients constant term first (:meth:`QcLam.integer_form`).
+    cval : scalar
+        The value of c = cos(2 pi/k) (docs/readings.md R2).
+    lamval : scalar
+        The value of lam (same arithmetic as ``cval``).
+
+    Returns
+    -------
+    scalar
+        In the arithmetic of ``cval`` and ``lamval``.
+
+    Examples
+    --------
+    c/2 + 1 + lam/3 at k = 4 (c = 0, lam = 1/2) is 7/6:
+
+    >>> from fractions import Fraction
+    >>> eval_integer_form(QcLam(C / 2 + 1, Rational(1, 3)).integer_form(), Fraction(0), Fraction(1, 2))
+    Fraction(7, 6)
     """
     A, B, D = form
 

@@ -13,7 +13,7 @@ symbolic; here c (and lam, R2) get values:
 
 from __future__ import annotations
 
-from ccproof.algebra.field import eval_integer_form, subdominant_lam_sympy
+from ccproof.algebra.field import _subdominant_lam_sympy, eval_integer_form
 from ccproof.errors import CCProofError, check_valence
 from ccproof.valence import Valence, lam_from_c
 
@@ -33,10 +33,30 @@ def _check_prec(prec):
 def cos_2pi_over_k(k, arithmetic="arb", prec=128):
     """c = cos(2 pi / k) (R2, R3).
 
+    The parameter of the field Q(c, lam) of the characteristic map (docs/readings.md R2, R3).
+
+    Parameters
+    ----------
+    k : int
+        Valence, k >= 3.
+    arithmetic : {"arb", "exact", "float"}, optional
+        A ``flint.arb`` ball (default), a sympy expression or a Python float.
+    prec : int, optional
+        Bits of precision of the arb ball (default 128).
+
+    Returns
+    -------
+    flint.arb or sympy.Expr or float
+
+    Examples
+    --------
     >>> cos_2pi_over_k(6, "exact")
     1/2
     >>> cos_2pi_over_k(4, "arb", 64)
     0
+    >>> import math
+    >>> abs(cos_2pi_over_k(5, "float") - (math.sqrt(5) - 1) / 4) < 1e-15
+    True
     """
     k = check_valence(k)
     _check_arithmetic(arithmetic)
@@ -64,6 +84,21 @@ def subdominant_eigenvalue(k, arithmetic="arb", prec=128):
     The larger root of 16 L^2 - 2(5 + c) L + 1 = 0; the double eigenvalue lam_1 = lam_2 of the
     Catmull-Clark subdivision matrix of valence k (bmz04 section 3, Definition 4).
 
+    Parameters
+    ----------
+    k : int
+        Valence, k >= 3.
+    arithmetic : {"arb", "exact", "float"}, optional
+        A ``flint.arb`` ball (default), a sympy expression or a Python float.
+    prec : int, optional
+        Bits of precision of the arb ball (default 128).
+
+    Returns
+    -------
+    flint.arb or sympy.Expr or float
+
+    Examples
+    --------
     >>> subdominant_eigenvalue(4, "exact")
     1/2
     >>> subdominant_eigenvalue(3, "exact")
@@ -74,7 +109,7 @@ def subdominant_eigenvalue(k, arithmetic="arb", prec=128):
     if arithmetic == "exact":
         from sympy import expand, radsimp
 
-        return expand(radsimp(subdominant_lam_sympy(cos_2pi_over_k(k, "exact"))))
+        return expand(radsimp(_subdominant_lam_sympy(cos_2pi_over_k(k, "exact"))))
     _check_prec(prec)
     from flint import ctx
 
@@ -88,7 +123,29 @@ def subdominant_eigenvalue(k, arithmetic="arb", prec=128):
 def valence_interval(k0, prec=128):
     """Balls ``(c, lam)`` enclosing c = cos(2 pi/k) and lam(k) for every integer k >= k0 (R10).
 
-    c ranges over [cos(2 pi/k0), 1] and lam, increasing in c, over [lam(k0), (3 + sqrt 5)/8].
+    c ranges over [cos(2 pi/k0), 1] and lam, increasing in c, over [lam(k0), (3 + sqrt 5)/8]
+    (docs/readings.md R10: one certificate for every k >= k0).
+
+    Parameters
+    ----------
+    k0 : int
+        Smallest valence of the interval, k0 >= 3.
+    prec : int, optional
+        Bits of precision (default 128).
+
+    Returns
+    -------
+    c, lam : flint.arb
+        The two enclosures.
+
+    Examples
+    --------
+    >>> from flint import arb, fmpq
+    >>> c, lam = valence_interval(40)
+    >>> c.contains(1), c.contains(arb(fmpq(2, 40)).cos_pi()), lam.contains((3 + arb(5).sqrt()) / 8)
+    (True, True, True)
+    >>> lam.contains(subdominant_eigenvalue(1000)), lam.contains(subdominant_eigenvalue(39))
+    (True, False)
     """
     k0 = check_valence(k0)
     _check_prec(prec)
@@ -106,11 +163,37 @@ def specialize(element_form, k, arithmetic="arb", prec=128):
 
     ``k`` may be an int or an interval of valences k >= K0 in any spelling of
     :meth:`ccproof.valence.Valence.parse` (``">=K0"``, ``{"min": K0}``; then the value is the union over
-    :func:`interval_pieces`).
+    :func:`_interval_pieces`, arb only). The specialization of the symbolic characteristic map to one
+    valence (bmz04 section 4.3; docs/readings.md R3, R10).
+
+    Parameters
+    ----------
+    element_form : tuple of three lists of int
+        ``(A, B, D)``, coefficients constant term first: the element (A(c) + B(c) lam)/D(c).
+    k : int or str or dict or Valence
+        Valence k >= 3, or an interval of valences.
+    arithmetic : {"arb", "exact", "float"}, optional
+        Arithmetic of the result (default arb).
+    prec : int, optional
+        Bits of precision of an arb result (default 128).
+
+    Returns
+    -------
+    flint.arb or sympy.Expr or float
+
+    Examples
+    --------
+    The form ``lam`` itself, at k = 4 (lam = 1/2), at k = 5 and on k >= 40:
+
+    >>> lam = ([0], [1], [1])
+    >>> specialize(lam, 4, "exact"), round(specialize(lam, 5, "float"), 12)
+    (1/2, 0.549988354518)
+    >>> specialize(lam, ">=40").contains(subdominant_eigenvalue(40))
+    True
     """
     v = Valence.parse(k)
     if v.interval:
-        return _eval_interval(element_form, interval_pieces(v.k, 256, prec + 20), prec)
+        return _eval_interval(element_form, _interval_pieces(v.k, 256, prec + 20), prec)
     values = _field_values(v, arithmetic, prec)
     return _eval(element_form, values, arithmetic, prec)
 
@@ -137,7 +220,7 @@ def _field_values(v, arithmetic, prec):
     k = v.k
     if arithmetic == "exact":
         c = cos_2pi_over_k(k, "exact")
-        return c, subdominant_lam_sympy(c)
+        return c, _subdominant_lam_sympy(c)
     return cos_2pi_over_k(k, "arb", prec + 20), subdominant_eigenvalue(k, "arb", prec + 20)
 
 
@@ -156,7 +239,7 @@ def _eval(form, values, arithmetic, prec):
     return val if arithmetic == "arb" else float(val.mid())
 
 
-def interval_pieces(k0, pieces, prec=128):
+def _interval_pieces(k0, pieces, prec=128):
     """Cover the valences k >= k0 by ``pieces`` boxes ``(c, lam)`` (uniform in t = 1/k in [0, 1/k0]).
 
     Each box pairs a c-interval [cos(2 pi t_{i+1}), cos(2 pi t_i)] with the lam-interval it maps to
@@ -187,7 +270,7 @@ def characteristic_map_patches(k, form="bezier", arithmetic="arb", prec=128, pie
     k : int or str or dict or Valence
         Valence k >= 3, or an interval ``">=K0"`` (any spelling of :meth:`ccproof.valence.Valence.parse`)
         for enclosures valid for every valence k >= K0 (arb only; the union of the values on ``pieces``
-        sub-intervals, see :func:`interval_pieces`).
+        sub-intervals, see :func:`_interval_pieces`).
     form : {"bezier", "bspline"}
         Bezier net of each piece on its domain, or its uniform cubic B-spline net.
     arithmetic : {"exact", "arb", "float"}
@@ -214,7 +297,7 @@ def characteristic_map_patches(k, form="bezier", arithmetic="arb", prec=128, pie
     if v.interval:
         if arithmetic != "arb":
             raise CCProofError("an interval of valences can only be specialized in 'arb' arithmetic")
-        boxes = interval_pieces(v.k, pieces, prec + 20)
+        boxes = _interval_pieces(v.k, pieces, prec + 20)
         ev = lambda f: _eval_interval(f, boxes, prec)
     else:
         values = _field_values(v, arithmetic, prec)

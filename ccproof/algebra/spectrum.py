@@ -39,7 +39,7 @@ def _fmpq_poly(coeffs):
     return fmpq_poly(coeffs)
 
 
-def chebyshev_t(n):
+def _chebyshev_t(n):
     """T_n as an ``fmpq_poly``."""
     from flint import fmpq_poly
 
@@ -54,8 +54,27 @@ def chebyshev_t(n):
 def charpoly_product_formula(k):
     """det(x I - S) of the (6k+1) two-ring matrix predicted by the Fourier block argument.
 
-    Returns an ``fmpq_poly`` (monic) built only from the closed-form mode factors in the module
-    docstring (no matrix is formed).
+    Built only from the closed-form mode factors in the module docstring (no matrix is formed);
+    the spectrum of the subdivision matrix (bmz04 section 3; docs/readings.md R2).
+
+    Parameters
+    ----------
+    k : int
+        Valence, k >= 3.
+
+    Returns
+    -------
+    flint.fmpq_poly
+        Monic, of degree 6k + 1.
+
+    Examples
+    --------
+    For k = 4 (the regular grid) 1 and 1/2 are eigenvalues:
+
+    >>> from flint import fmpq
+    >>> p = charpoly_product_formula(4)
+    >>> p.degree(), p(1), p(fmpq(1, 2))
+    (25, 0, 0)
     """
     from flint import fmpq
 
@@ -65,7 +84,7 @@ def charpoly_product_formula(k):
     mode0 = (X - 1) * small * (16 * k * X * X - (12 * k - 28) * X + (k - 3))
     # prod_{m=1}^{k-1} (16x^2 - 10x + 1 - 2 c_m x) = (2x)^(k-1) prod (y - c_m)
     #   = (2x)^(k-1) 2^(1-k) (T_k(y) - 1)/(y - 1) = 2^(1-k) [(2x)^k (T_k(y) - 1)] / (16x^2 - 12x + 1)
-    T = chebyshev_t(k)
+    T = _chebyshev_t(k)
     num = _fmpq_poly([0])
     q = 16 * X * X - 10 * X + 1
     for i in range(k + 1):
@@ -83,10 +102,27 @@ def charpoly_product_formula(k):
 
 def check_charpoly_factorization(k):
     """Exact check that the characteristic polynomial of the exact (6k+1) x (6k+1) two-ring matrix
-    equals :func:`charpoly_product_formula` (k). Returns True or raises AssertionError.
+    equals :func:`charpoly_product_formula` (k).
 
-    Cost grows like k^4 (exact charpoly); intended for k up to about 40.
+    Cost grows like k^4 (exact charpoly); intended for k up to about 40 (docs/readings.md R2).
 
+    Parameters
+    ----------
+    k : int
+        Valence, k >= 3.
+
+    Returns
+    -------
+    bool
+        True.
+
+    Raises
+    ------
+    AssertionError
+        If the two polynomials differ.
+
+    Examples
+    --------
     >>> check_charpoly_factorization(5)
     True
     """
@@ -104,11 +140,31 @@ def check_charpoly_factorization(k):
 def spectral_conditions(k, prec=128):
     """Certify 1 = lam_0 > lam_1 = lam_2 = lam(k) > |lam_3| for valence k (arb, outward rounded).
 
-    Returns a dict with the balls ``lam`` (subdominant), ``mu`` (largest mode-0 eigenvalue below 1),
-    ``lam_mode2`` (largest eigenvalue of the other modes m != 0, +-1; None for k = 3), the certified
-    ``gap`` lower bound of lam - max(|other eigenvalues|), and ``ok`` (True only when every
-    inequality is certain). The eigenvalue list is complete by the Fourier block argument
-    (:func:`check_charpoly_factorization`).
+    The eigenvalue conditions of bmz04 section 3 (Definition 4; docs/readings.md R2). The eigenvalue
+    list is complete by the Fourier block argument (:func:`check_charpoly_factorization`).
+
+    Parameters
+    ----------
+    k : int
+        Valence, k >= 3.
+    prec : int, optional
+        Bits of precision (default 128).
+
+    Returns
+    -------
+    dict
+        ``k``; the balls ``lam`` (subdominant), ``mu`` (largest mode-0 eigenvalue below 1),
+        ``lam_mode2`` (largest eigenvalue of the other modes m != 0, +-1; None for k = 3), the certified
+        ``gap`` lower bound of lam - max(|other eigenvalues|); and ``ok`` (True only when every
+        inequality is certain).
+
+    Examples
+    --------
+    For k = 4 the spectrum is that of bicubic B-spline subdivision, 1, 1/2, 1/2, 1/4, ...:
+
+    >>> s = spectral_conditions(4)
+    >>> s["ok"], s["lam"].contains(0.5), s["mu"].contains(0.25), s["gap"].contains(0.25)
+    (True, True, True, True)
     """
     from flint import arb, ctx, fmpq
 

@@ -30,10 +30,22 @@ TWO_RING_POSITIONS = ((1, 0), (2, 0), (1, 1), (2, 1), (1, 2), (2, 2))
 def canonical(a, b):
     """Canonical form of the grid position (a, b) given in the coordinates of some sector.
 
-    Returns ``(delta, a', b')`` with ``a' >= 1, b' >= 0``: the same vertex as position (a', b') of
-    the sector ``delta`` steps further (delta in {-1, 0, 1}, or 2 for the points (a, 0), a < 0, on
-    the edge e_{j+2}), or ``(0, 0, 0)`` for the centre.
+    The indexing of the k-regular complex of bmz04 Definition 2 (docs/readings.md R1).
 
+    Parameters
+    ----------
+    a, b : int
+        Grid position in the coordinates of a sector (sector 0 is the quadrant a >= 1, b >= 0).
+
+    Returns
+    -------
+    tuple of int
+        ``(delta, a', b')`` with ``a' >= 1, b' >= 0``: the same vertex as position (a', b') of
+        the sector ``delta`` steps further (delta in {-1, 0, 1}, or 2 for the points (a, 0), a < 0, on
+        the edge e_{j+2}), or ``(0, 0, 0)`` for the centre.
+
+    Examples
+    --------
     >>> canonical(0, 2)
     (1, 2, 0)
     >>> canonical(1, -1)
@@ -54,7 +66,7 @@ def canonical(a, b):
     raise ValueError(f"grid position ({a}, {b}) is more than one sector away")
 
 
-def regular_stencil(A, B):
+def _regular_stencil(A, B):
     """Level-0 stencil of the level-1 vertex at position (A, B) of a sector, (A, B) != (0, 0).
 
     Returns a list of ``(weight, (a, b))`` with Fraction weights and raw (not canonical) level-0
@@ -88,12 +100,28 @@ def regular_stencil(A, B):
 
 
 def centre_stencil(k):
-    """Weights of the centre rule V' = (F + 2R + (k-3)V)/k (R1) as ``(alpha, beta, gamma)``:
-    alpha on V, beta on each edge neighbour (1, 0) of every sector, gamma on each face neighbour
-    (1, 1). alpha = 1 - 7/(4k), beta = 3/(2k^2), gamma = 1/(4k^2).
+    """Weights of the centre rule V' = (F + 2R + (k-3)V)/k (R1) as ``(alpha, beta, gamma)``.
 
+    alpha on V, beta on each edge neighbour (1, 0) of every sector, gamma on each face neighbour
+    (1, 1): alpha = 1 - 7/(4k), beta = 3/(2k^2), gamma = 1/(4k^2) (bmz04 Fig. 1; docs/readings.md R1).
+
+    Parameters
+    ----------
+    k : int
+        Valence, k >= 3.
+
+    Returns
+    -------
+    tuple of Fraction
+        ``(alpha, beta, gamma)``; alpha + k beta + k gamma = 1.
+
+    Examples
+    --------
     >>> centre_stencil(4)
     (Fraction(9, 16), Fraction(3, 32), Fraction(1, 64))
+    >>> a, b, g = centre_stencil(7)
+    >>> a + 7 * b + 7 * g
+    Fraction(1, 1)
     """
     k = check_valence(k)
     return (1 - Fraction(7, 4 * k), Fraction(3, 2 * k * k), Fraction(1, 4 * k * k))
@@ -102,7 +130,26 @@ def centre_stencil(k):
 def level1_stencil(k, vertex):
     """Level-0 stencil of the level-1 vertex ``vertex`` (``CENTER`` or canonical ``(j, A, B)``).
 
-    Returns a list of ``(weight, level-0 vertex)`` with level-0 vertices in canonical form.
+    One row of the subdivision matrix: the Catmull-Clark rules of bmz04 Fig. 1 (docs/readings.md R1).
+
+    Parameters
+    ----------
+    k : int
+        Valence, k >= 3.
+    vertex : str or tuple of int
+        :data:`CENTER` or a canonical position ``(sector j, A, B)`` (:func:`canonical`).
+
+    Returns
+    -------
+    list of tuple
+        ``(weight, level-0 vertex)`` pairs, weights ``Fraction``, level-0 vertices in canonical form.
+
+    Examples
+    --------
+    The edge point (0, 1, 0) of a regular vertex follows the edge rule 3/8, 3/8, 1/16 x 4:
+
+    >>> sorted(str(w) for w, _ in level1_stencil(4, (0, 1, 0)))
+    ['1/16', '1/16', '1/16', '1/16', '3/8', '3/8']
     """
     k = check_valence(k)
     if vertex == CENTER:
@@ -113,7 +160,7 @@ def level1_stencil(k, vertex):
         return st
     j, A, B = vertex
     out = {}
-    for w, (a, b) in regular_stencil(A, B):
+    for w, (a, b) in _regular_stencil(A, B):
         d, a2, b2 = canonical(a, b)
         key = CENTER if (a2, b2) == (0, 0) else ((j + d) % k, a2, b2)
         out[key] = out.get(key, 0) + w
@@ -121,17 +168,54 @@ def level1_stencil(k, vertex):
 
 
 def two_ring_vertices(k):
-    """The 6k+1 vertices of the two-ring N_2 of Definition 2, in the order used by
-    :func:`ring_subdivision_matrix`: the centre, then sector by sector the positions
-    :data:`TWO_RING_POSITIONS`."""
+    """The 6k+1 vertices of the two-ring N_2 of Definition 2.
+
+    In the order used by :func:`ring_subdivision_matrix`: the centre, then sector by sector the
+    positions :data:`TWO_RING_POSITIONS` (bmz04 Definition 2; docs/readings.md R1).
+
+    Parameters
+    ----------
+    k : int
+        Valence, k >= 3.
+
+    Returns
+    -------
+    list
+        ``[CENTER, (0, 1, 0), (0, 2, 0), ...]``, length 6k + 1.
+
+    Examples
+    --------
+    >>> v = two_ring_vertices(3)
+    >>> len(v), v[:3], v[-1]
+    (19, ['center', (0, 1, 0), (0, 2, 0)], (2, 2, 2))
+    """
     k = check_valence(k)
     return [CENTER] + [(j, a, b) for j in range(k) for (a, b) in TWO_RING_POSITIONS]
 
 
 def stam_vertices(k):
-    """The 2k+8 vertices of Stam's ring of the face of sector 0: the centre, (j, 1, 0) and
-    (j, 1, 1) for every sector j, then the 7 outer vertices of the face's 4x4 net, in the order
-    (2,-1), (2,0), (2,1), (2,2), (1,2), (0,2), (-1,2) of sector-0 grid positions (canonicalized)."""
+    """The 2k+8 vertices of Stam's ring of the face of sector 0.
+
+    The centre, (j, 1, 0) and (j, 1, 1) for every sector j, then the 7 outer vertices of the face's 4x4
+    net, in the order (2,-1), (2,0), (2,1), (2,2), (1,2), (0,2), (-1,2) of sector-0 grid positions
+    (canonicalized); docs/readings.md R12 (Stam's natural parameterization).
+
+    Parameters
+    ----------
+    k : int
+        Valence, k >= 3.
+
+    Returns
+    -------
+    list
+        Length 2k + 8.
+
+    Examples
+    --------
+    >>> v = stam_vertices(3)
+    >>> len(v), v[-1]
+    (14, (1, 2, 1))
+    """
     k = check_valence(k)
     verts = [CENTER]
     for j in range(k):
@@ -181,7 +265,25 @@ def ring_subdivision_matrix(k, ring="two_ring"):
 
 
 def subdivision_matrix_fmpq(k, ring="two_ring"):
-    """:func:`ring_subdivision_matrix` as a ``flint.fmpq_mat`` (exact)."""
+    """:func:`ring_subdivision_matrix` as a ``flint.fmpq_mat`` (exact).
+
+    Parameters
+    ----------
+    k : int
+        Valence, k >= 3.
+    ring : {"two_ring", "stam"}, optional
+        The ring of :func:`ring_subdivision_matrix`.
+
+    Returns
+    -------
+    flint.fmpq_mat, shape (6k+1, 6k+1) or (2k+8, 2k+8)
+
+    Examples
+    --------
+    >>> S = subdivision_matrix_fmpq(4)
+    >>> S.nrows(), S[0, 0]
+    (25, 9/16)
+    """
     from flint import fmpq, fmpq_mat
 
     S = ring_subdivision_matrix(k, ring)

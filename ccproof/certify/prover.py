@@ -42,7 +42,25 @@ MAX_DEPTH = 14
 
 
 class ProofFailed(CCProofError):
-    """The search found no certificate (the claim may be false, or needs deeper subdivision)."""
+    """The search found no certificate (the claim may be false, or needs deeper subdivision).
+
+    Raised by :func:`prove_valence`, :func:`prove_interval` and :func:`prove_c1` when a Bernstein form
+    (bmz04 Appendix A; docs/readings.md R7-R9) is negative at a box corner or not certified positive
+    after ``MAX_DEPTH`` splits; the message names the form and the box path.
+
+    Parameters
+    ----------
+    message : str
+
+    Examples
+    --------
+    >>> issubclass(ProofFailed, CCProofError)
+    True
+    >>> raise ProofFailed("det J_Phi on P1: no positive Bernstein bound after 14 splits (path '0101')")
+    Traceback (most recent call last):
+    ...
+    ccproof.certify.prover.ProofFailed: det J_Phi on P1: no positive Bernstein bound after 14 splits (path '0101')
+    """
 
 
 def _round_down(q, digits=6):
@@ -60,7 +78,7 @@ def _round_down(q, digits=6):
     return f"{m}e{e}"
 
 
-def prove_positive(root, axes, what, max_depth=MAX_DEPTH):
+def _prove_positive(root, axes, what, max_depth=MAX_DEPTH):
     """Adaptive subdivision of a Bernstein form until every leaf is certainly positive.
 
     Returns the list of ``{"path", "bound"}`` leaves. ``axes`` is the cyclic order of split axes.
@@ -99,7 +117,7 @@ def _corners(f):
     return vals
 
 
-def smallest_level(nets, lam, max_level=8):
+def _smallest_level(nets, lam, max_level=8):
     """The smallest N with lam^N max(coordinates) < 1/6 (part A), found by trying N = 1, 2, ..."""
     for N in range(1, max_level + 1):
         if corner_containment(nets, lam, N)[0]:
@@ -134,8 +152,8 @@ def prove_valence(k: int, prec: int = DEFAULT_PREC, progress: bool = True) -> di
     with ctx.workprec(prec):
         lam = c_lam(k, prec)[1]
         nets = nets_for_valence(k, prec)
-        N = smallest_level(nets, lam)
-        regularity = {n: prove_positive(regularity_form(nets, n, prec), (0, 1), f"det J_Phi on {n}")
+        N = _smallest_level(nets, lam)
+        regularity = {n: _prove_positive(regularity_form(nets, n, prec), (0, 1), f"det J_Phi on {n}")
                       for n in form_patches(derivation().symmetric)}
         cells = {}
         todo = required_cells(nets, lam, N, prec, derivation().symmetric)
@@ -147,8 +165,8 @@ def prove_valence(k: int, prec: int = DEFAULT_PREC, progress: bool = True) -> di
         build = cell_det_builder(nets, lam, N, prec)
         for l, m, p, q in it:
             root = build(l, m, p, q)
-            cells[f"{l},{m},{p},{q}"] = prove_positive(root, (0, 1), f"cell ({l},{m}) piece ({p},{q})")
-        corner = {n: prove_positive(corner_det_form(nets, lam, N, n, prec), (2, 3, 0, 1),
+            cells[f"{l},{m},{p},{q}"] = _prove_positive(root, (0, 1), f"cell ({l},{m}) piece ({p},{q})")
+        corner = {n: _prove_positive(corner_det_form(nets, lam, N, n, prec), (2, 3, 0, 1),
                                     f"corner {n}") for n in form_patches(derivation().symmetric)}
     return {"schema": SCHEMA, "valence": k, "N": N, "prec": prec,
             "parts": {"regularity": regularity, "cells": cells, "corner": corner}}
@@ -187,9 +205,9 @@ def _prove_piece(exact, La, Lb, N, degree, trunc, prec, progress, label):
             raise ProofFailed(f"{label}: the corner cell [0, 2^-{N}]^2 is not certainly mapped into [0,1/6)^2")
         if not square_inside_image(nets):
             raise ProofFailed(f"{label}: [0,1/2]^2 not certainly inside Phi([0,1]^2)")
-        regularity = {n: prove_positive(regularity_form(nets, n, prec), (0, 1), f"{label} det J_Phi on {n}")
+        regularity = {n: _prove_positive(regularity_form(nets, n, prec), (0, 1), f"{label} det J_Phi on {n}")
                       for n in form_patches(derivation().symmetric)}
-        corner = {n: prove_positive(corner_det_form(nets, lam, N, n, prec), (2, 3, 0, 1),
+        corner = {n: _prove_positive(corner_det_form(nets, lam, N, n, prec), (2, 3, 0, 1),
                                     f"{label} corner {n}") for n in form_patches(derivation().symmetric)}
         todo = interval_cells(zn, N, trunc, prec, derivation().symmetric)
         it = todo
@@ -197,7 +215,7 @@ def _prove_piece(exact, La, Lb, N, degree, trunc, prec, progress, label):
             from tqdm import tqdm
 
             it = tqdm(todo, desc=f"{label} cells", unit="cell", leave=False)
-        cells = {key: prove_positive(build(), (1, 2, 0), f"{label} cell {key}") for key, build in it}
+        cells = {key: _prove_positive(build(), (1, 2, 0), f"{label} cell {key}") for key, build in it}
     return {"regularity": regularity, "cells": cells, "corner": corner}
 
 
@@ -304,7 +322,7 @@ def prove_interval(k0: ValenceLike, prec: int = DEFAULT_PREC, progress: bool = T
     ends = _lam_range(v.k, prec)
     with ctx.workprec(prec):
         La, Lb = parse_decimal(ends[0]), parse_decimal(ends[1])
-        N = smallest_level(hull_nets(parameter_nets(exact, La, Lb, 0, taylor_degree, prec), prec),
+        N = _smallest_level(hull_nets(parameter_nets(exact, La, Lb, 0, taylor_degree, prec), prec),
                            arb(La).union(arb(Lb)))
     todo = [(ends[0], ends[1])] if scheduler is None else []
     pieces = [] if scheduler is None else _pieces_in_waves(
@@ -328,8 +346,34 @@ def prove_interval(k0: ValenceLike, prec: int = DEFAULT_PREC, progress: bool = T
 
 
 def claimed_margins(cert):
-    """The smallest bound claimed per section of a certificate this prover just wrote, and its number of
-    boxes (the prover's own claims, printed before the verifier re-checks them; never read back)."""
+    """The smallest bound claimed per section of a certificate, and its number of boxes.
+
+    The prover's own claims, printed before the verifier re-checks them (never read back as evidence;
+    docs/certificates.md).
+
+    Parameters
+    ----------
+    cert : dict
+        An injectivity certificate (one valence, with ``parts``; or an interval, with ``pieces``).
+
+    Returns
+    -------
+    margins : dict of str -> str
+        ``min_bound_det_J_phi_local``, ``min_bound_det_J_G_cells_local``,
+        ``min_bound_det_J_G_corner_over_h2``: the smallest claimed lower bound of each section.
+    n_boxes : int
+        Number of boxes in the certificate.
+
+    Examples
+    --------
+    >>> import json
+    >>> from fractions import Fraction
+    >>> cert = json.loads(certificate_path(5).read_text())
+    >>> margins, n = claimed_margins(cert)
+    >>> bounds = [Fraction(b["bound"]) for s in cert["parts"].values() for v in s.values() for b in v]
+    >>> n == len(bounds), min(Fraction(m) for m in margins.values()) == min(bounds) > 0
+    (True, True)
+    """
     parts_list = [pc["parts"] for pc in cert["pieces"]] if "pieces" in cert else [cert["parts"]]
     return _summary(parts_list)
 
@@ -347,6 +391,19 @@ def certificate_path(k, directory=None):
     """``k005.json`` for a valence, ``k_ge_40.json`` for the interval ``{"min": 40}``/``">=40"`` (any spelling
     of :meth:`ccproof.valence.Valence.parse`), in ``directory`` or the injectivity certificates folder.
 
+    Parameters
+    ----------
+    k : int or str or dict or Valence
+        A valence or an interval of valences.
+    directory : str or pathlib.Path, optional
+        Default: ``certificates_dir() / "injectivity"``.
+
+    Returns
+    -------
+    pathlib.Path
+
+    Examples
+    --------
     >>> certificate_path(5, "d").as_posix(), certificate_path({"min": 40}, "d").name
     ('d/k005.json', 'k_ge_40.json')
     """
@@ -354,6 +411,28 @@ def certificate_path(k, directory=None):
 
 
 def write_certificate(cert, path=None):
+    """Write a certificate as sorted, indented ASCII JSON; returns the path.
+
+    Parameters
+    ----------
+    cert : dict
+        A certificate of :func:`prove_valence`, :func:`prove_interval` or :func:`prove_c1`.
+    path : str or pathlib.Path, optional
+        Default: :func:`certificate_path` of ``cert["valence"]`` (the published folder).
+
+    Returns
+    -------
+    pathlib.Path
+
+    Examples
+    --------
+    >>> import json, tempfile
+    >>> from pathlib import Path
+    >>> tmp = tempfile.TemporaryDirectory()          # removed when the example ends
+    >>> p = write_certificate({"valence": 5, "N": 3}, Path(tmp.name) / "k005.json")
+    >>> json.loads(p.read_text()) == {"valence": 5, "N": 3}
+    True
+    """
     path = Path(path or certificate_path(cert["valence"]))
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(json.dumps(cert, indent=1, sort_keys=True) + "\n", encoding="ascii")
@@ -390,8 +469,8 @@ def prove_c1(k: ValenceLike, prec: int = DEFAULT_PREC) -> dict[str, Any]:
             nets = hull_nets(parameter_nets(derivation().integer_forms("bspline"), La, Lb, 0, 3, prec), prec)
         else:
             nets = nets_for_valence(v.k, prec)
-        reg = {n: prove_positive(regularity_form(nets, n, prec), (0, 1), f"det J_Phi on {n}") for n in PATCHES}
-        star = {c: prove_positive(star_form(nets, c, prec), (0,), f"star {c}") for c in STAR_CURVES}
+        reg = {n: _prove_positive(regularity_form(nets, n, prec), (0, 1), f"det J_Phi on {n}") for n in PATCHES}
+        star = {c: _prove_positive(star_form(nets, c, prec), (0,), f"star {c}") for c in STAR_CURVES}
     parts = {"regularity": reg, "star": star}
     if v.interval:
         return {"schema": C1_SCHEMA, "valence": k, "prec": prec, "pieces": [{"lam": ends, "parts": parts}]}
@@ -399,5 +478,22 @@ def prove_c1(k: ValenceLike, prec: int = DEFAULT_PREC) -> dict[str, Any]:
 
 
 def c1_certificate_path(k, directory=None):
-    """:func:`certificate_path` in the C1 certificates folder."""
+    """:func:`certificate_path` in the C1 certificates folder.
+
+    Parameters
+    ----------
+    k : int or str or dict or Valence
+        Any spelling of :meth:`ccproof.valence.Valence.parse`.
+    directory : str or pathlib.Path, optional
+        Default: ``certificates_dir() / "c1"``.
+
+    Returns
+    -------
+    pathlib.Path
+
+    Examples
+    --------
+    >>> c1_certificate_path(5, "d").as_posix(), c1_certificate_path(">=40").parent.name
+    ('d/k005.json', 'c1')
+    """
     return Path(directory or certificates_dir() / "c1") / (Valence.parse(k).stem + ".json")

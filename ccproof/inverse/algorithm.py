@@ -47,11 +47,11 @@ from ccproof.inverse.data import (
     NMAX,
     SAFE_HI,
     SAFE_LO,
-    approx_log,
-    as_points,
-    matmul,
+    _approx_log,
+    _as_points,
+    _matmul,
+    _patch_eval_jac,
     monomials,
-    patch_eval_jac,
     valence_data,
 )
 
@@ -69,14 +69,35 @@ PATCH_NAMES = ("P1", "P2", "P3")
 
 @dataclass
 class InverseResult:
-    """Preimages and diagnostics of :func:`inverse_characteristic_map`.
+    """Preimages and diagnostics of :func:`inverse_characteristic_map` (bmz04 Algorithm 1; docs/inverse.md).
 
-    ``r, s``: the preimage (face parameter). ``layer``: n with y = 2^-n y0, y0 in layer 0 (n < 0
-    outside the face). ``patch``: 0, 1, 2 for P1, P2, P3 (-1 at the origin). ``fallback``: True
-    where the subdivision fallback produced the answer. ``verified``: False only where even the
-    fallback's acceptance test failed (never observed; counted as a failure by the benchmark).
-    ``stats``: counts of points, fallbacks and failures. ``boxes``: with ``rigorous=True``, one
-    :class:`~ccproof.inverse.certified.CertifiedPreimage` per point (flattened order).
+    Parameters
+    ----------
+    r, s : ndarray, shape of the input points, float64
+        The preimage (face parameter).
+    layer : ndarray of int64
+        n with y = 2^-n y0, y0 in layer 0 (n < 0 outside the face; docs/readings.md R4).
+    patch : ndarray of int64
+        0, 1, 2 for P1, P2, P3 (-1 at the origin).
+    fallback : ndarray of bool
+        True where the subdivision fallback produced the answer.
+    verified : ndarray of bool
+        False only where even the fallback's acceptance test failed (never observed; counted as a
+        failure by the benchmark).
+    stats : dict
+        Counts of ``points``, ``fallback`` and ``failures`` (and ``uncertified`` with ``rigorous=True``).
+    boxes : list of CertifiedPreimage or None
+        With ``rigorous=True``, one :class:`~ccproof.inverse.certified.CertifiedPreimage` per point
+        (flattened order).
+
+    Examples
+    --------
+    For k = 4 Phi is the identity: (0.75, 0.25) lies in P1 of layer 0, (0.3, 0.1) = (0.6, 0.2)/2 in
+    P1 of layer 1 and (0.75, 0.75) in P2:
+
+    >>> res = inverse_characteristic_map(4, [0.75, 0.3, 0.75], [0.25, 0.1, 0.75], full_output=True)
+    >>> res.layer.tolist(), res.patch.tolist(), res.stats["fallback"]
+    ([0, 1, 0], [0, 0, 1], 0)
     """
 
     r: np.ndarray
@@ -134,7 +155,7 @@ def inverse_characteristic_map(k: int, u: ArrayLike, v: ArrayLike, *, domain: Li
     k = check_valence(k)
     if domain not in ("quadrant", "face"):
         raise CCProofError(f"unknown domain {domain!r}; use 'quadrant' or 'face'")
-    x, y, shape = as_points(u, v, "image")
+    x, y, shape = _as_points(u, v, "image")
     D = valence_data(k)
     npts = x.shape[0]
     R = np.empty(npts)
@@ -181,15 +202,15 @@ def _check_face(x, y, R, S):
     np.minimum(S, 1.0, out=S)
 
 
-def first_layer(D, a, fast=False):
+def _first_layer(D, a, fast=False):
     """Step 1: n0 = floor(log_lam(a / A)) (an approximate log is enough: the band has room)."""
-    n0 = np.floor((approx_log(a) - D.log_a) * D.inv_log_lam)
+    n0 = np.floor((_approx_log(a) - D.log_a) * D.inv_log_lam)
     if not fast:
         np.clip(n0, -NMAX + 4, NMAX - 4, out=n0)
     return n0.astype(np.int64)
 
 
-def scale_lam(D, n, a, b, fast):
+def _scale_lam(D, n, a, b, fast):
     """(a, b) * lam^n for integer arrays n (tables; ldexp on the slow path)."""
     idx = NMAX + n
     if fast:
@@ -201,11 +222,44 @@ def scale_lam(D, n, a, b, fast):
 
 
 def locate(D, a, b, fast=True):
-    """Steps 1-2 for points a >= b >= 0 with a > 0: returns (n, p, a1, b1, n0): the layer n, the
-    piece p (0: P1, 1: P2), (a1, b1) = lam^-n (a, b) and the first-guess layer n0."""
-    n0 = first_layer(D, a, fast)
-    a0, b0 = scale_lam(D, -n0, a, b, fast)
-    V = matmul(D.G, monomials(a0, b0, 3))
+    """Steps 1-2 of bmz04 Algorithm 1 for points a >= b >= 0 with a > 0: the layer and the piece.
+
+    docs/readings.md R11; the layer and piece tests use the implicit boundaries of docs/inverse.md.
+
+    Parameters
+    ----------
+    D : ValenceData
+        :func:`ccproof.inverse.data.valence_data` of the valence.
+    a, b : ndarray, shape (n,) float64
+        Points of the half-sector a >= b >= 0, a > 0.
+    fast : bool, optional
+        The fast path: powers of lam as doubles, no clipping of the first-guess layer to the exact
+        range of the power tables (the caller keeps the points in range).
+
+    Returns
+    -------
+    n : ndarray, shape (n,) int64
+        The layer.
+    p : ndarray, shape (n,) int64
+        The piece (0: P1, 1: P2).
+    a1, b1 : ndarray, shape (n,) float64
+        lam^-n (a, b), the point scaled into layer 0.
+    n0 : ndarray, shape (n,) int64
+        The first-guess layer.
+
+    Examples
+    --------
+    For k = 4 (Phi the identity, lam = 1/2):
+
+    >>> import numpy as np
+    >>> from ccproof.inverse.data import valence_data
+    >>> n, p, a1, b1, n0 = locate(valence_data(4), np.array([0.75, 0.3]), np.array([0.25, 0.1]))
+    >>> n.tolist(), p.tolist(), a1.tolist(), b1.tolist()
+    ([0, 1], [0, 0], [0.75, 0.6], [0.25, 0.2])
+    """
+    n0 = _first_layer(D, a, fast)
+    a0, b0 = _scale_lam(D, -n0, a, b, fast)
+    V = _matmul(D.G, monomials(a0, b0, 3))
     inner = V[0] * D.gamma_sign < 0          # t0 inside Gamma: one layer deeper
     outer = (V[1] * D.gamma_sign > 0) & ~inner  # lam t0 outside Gamma: one layer out
     sep = np.where(inner, V[2], np.where(outer, V[4], V[3])) * D.sep_sign
@@ -231,7 +285,7 @@ def _inverse_chunk(D, x, y, R, S, layer, patch):
         if sel.size == 0:
             continue
         X, Y = a1[sel], b1[sel]
-        s0, t0 = matmul(D.fit[q], monomials(X, Y, FIT_DEGREE))
+        s0, t0 = _matmul(D.fit[q], monomials(X, Y, FIT_DEGREE))
         s, t, good = newton(D.C6[q], s0, t0, X, Y)
         s_loc[sel] = s
         t_loc[sel] = t
@@ -262,7 +316,37 @@ def _inverse_chunk(D, x, y, R, S, layer, patch):
 
 
 def newton(Cp, s, t, X, Y):
-    """Newton for P(s, t) = (X, Y) on one piece; returns (s, t, accepted)."""
+    """Newton for P(s, t) = (X, Y) on one piece; returns (s, t, accepted).
+
+    Step 3 of bmz04 Algorithm 1 (docs/readings.md R11): Newton's method on the bicubic piece from the
+    fitted first guess.
+
+    Parameters
+    ----------
+    Cp : ndarray, shape (6, 16) float64
+        ``ValenceData.C6[p]``: power-basis coefficients of x, y and their derivatives on piece p.
+    s, t : ndarray, shape (n,) float64
+        Starting local coordinates.
+    X, Y : ndarray, shape (n,) float64
+        Target points in layer 0.
+
+    Returns
+    -------
+    s, t : ndarray, shape (n,) float64
+    accepted : ndarray, shape (n,) bool
+        Whether the iteration converged (else the caller falls back to subdivision).
+
+    Examples
+    --------
+    For k = 4, P1 is u = (1 + s)/2, v = t/2, so (0.75, 0.25) has local coordinates (0.5, 0.5):
+
+    >>> import numpy as np
+    >>> from ccproof.inverse.data import valence_data
+    >>> s, t, ok = newton(valence_data(4).C6[0], np.array([0.3]), np.array([0.7]), np.array([0.75]),
+    ...                   np.array([0.25]))
+    >>> np.round(s, 12).tolist(), np.round(t, 12).tolist(), ok.tolist()
+    ([0.5], [0.5], [True])
+    """
     step = np.full(s.shape, np.inf)
     for i in range(NEWTON_STEPS):
         s, t, step = _newton_step(Cp, s, t, X, Y, i == NEWTON_STEPS - 1)
@@ -283,7 +367,7 @@ def newton(Cp, s, t, X, Y):
 
 
 def _newton_step(Cp, s, t, X, Y, want_step=True):
-    x, y, xs, xt, ys, yt = patch_eval_jac(Cp, s, t)
+    x, y, xs, xt, ys, yt = _patch_eval_jac(Cp, s, t)
     x -= X
     y -= Y
     with np.errstate(all="ignore"):
@@ -305,14 +389,14 @@ def _newton_step(Cp, s, t, X, Y, want_step=True):
 
 
 def _run_fallback(D, x, y, idx, R, S, layer, patch, ver):
-    from ccproof.inverse.fallback import subdivision_inverse
+    from ccproof.inverse.fallback import _subdivision_inverse
 
     xs, ys = x[idx], y[idx]
     sw = ys > xs
     a = np.where(sw, ys, xs)
     b = np.where(sw, xs, ys)
-    n0 = first_layer(D, a)
-    n, p, s_loc, t_loc, verified = subdivision_inverse(D, a, b, n0)
+    n0 = _first_layer(D, a)
+    n, p, s_loc, t_loc, verified = _subdivision_inverse(D, a, b, n0)
     t_loc[(b == 0) & (p == 0)] = 0.0
     r = np.maximum(np.ldexp((s_loc + 1.0) * 0.5, -n), 0.0)
     s = np.maximum(np.ldexp((t_loc + p) * 0.5, -n), 0.0)

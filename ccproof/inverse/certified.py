@@ -33,7 +33,26 @@ from ccproof.errors import CCProofError, check_valence
 class CertifiedPreimage:
     """A box ``(r, s)`` of arb balls that contains Phi^-1(x, y) (when ``certified``).
 
-    ``pieces``: the (layer, patch) pieces that meet the box. ``width``: the largest radius.
+    The Krawczyk (interval Newton) certificate of one preimage (docs/inverse.md, bmz04 section 4.3).
+
+    Parameters
+    ----------
+    r, s : flint.arb
+        The box.
+    certified : bool
+        Whether the Krawczyk test proved that the box contains the preimage.
+    pieces : tuple
+        The (layer, patch) pieces that meet the box.
+    width : float
+        The largest radius.
+
+    Examples
+    --------
+    For k = 4 Phi is the identity:
+
+    >>> c = certify_preimage(4, 0.25, 0.75, 0.25, 0.75)
+    >>> c.certified, c.r.contains(0.25), c.s.contains(0.75), c.width < 1e-30
+    (True, True, True, True)
     """
 
     r: object
@@ -159,6 +178,23 @@ def certify_preimage(k, x, y, r, s, prec=128):
     Returns a :class:`CertifiedPreimage`; ``certified`` is False if the Krawczyk test failed for
     every box size tried (not observed; reported, never hidden).
 
+    Parameters
+    ----------
+    k : int
+        Valence, k >= 3.
+    x, y : float
+        The image point, in the quadrant [0, inf)^2.
+    r, s : float
+        An approximation of the preimage (e.g. from :func:`~ccproof.inverse.inverse_characteristic_map`).
+    prec : int, optional
+        Bits of precision of the arb arithmetic (default 128).
+
+    Returns
+    -------
+    CertifiedPreimage
+
+    Examples
+    --------
     >>> c = certify_preimage(5, 1.0, 0.0, 1.0, 0.0)
     >>> c.certified, c.contains(1.0, 0.0)
     (True, True)

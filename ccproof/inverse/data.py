@@ -6,7 +6,7 @@ tens of milliseconds, ``scripts/bench_reparam.py``) from the balls of
 :func:`ccproof.tables.numeric.characteristic_arb` (the certified table of k, or for a valence
 without one the exact nets the tables hold, evaluated in arb):
 
-* the float Bezier nets (:func:`float_nets`) and their power-basis coefficients;
+* the float Bezier nets (:func:`_float_nets`) and their power-basis coefficients;
 * the tables of lam^n (from the ball of lam);
 * the implicit equations of the boundaries Gamma (``P1:s=0``) and C (``P1:t=1``) used to locate
   a point: the Sylvester determinant of Definition 5 (bmz04), evaluated in arb at the 10 points of
@@ -43,12 +43,12 @@ BEZ2POW = np.array([[comb(3, i) * comb(3 - i, m - i) * (-1) ** (m - i) if m >= i
                      for m in range(4)] for i in range(4)], dtype=float)
 
 
-def float_nets(k):
+def _float_nets(k):
     """(lam, Bezier nets (3, 4, 4, 2)) in float64 for valence k: the single source of the float
     nets of :mod:`ccproof.inverse` (certified table when it exists, see
     :func:`ccproof.tables.numeric.characteristic_nets`).
 
-    >>> lam, bez = float_nets(4)
+    >>> lam, bez = _float_nets(4)
     >>> lam, bez.shape
     (0.5, (3, 4, 4, 2))
     """
@@ -58,7 +58,7 @@ def float_nets(k):
     return float(t.lam), np.asarray(t.bezier, dtype=float)
 
 
-def monomial_exponents(degree):
+def _monomial_exponents(degree):
     """Exponents (a, b) of the monomials x^a y^b of total degree <= degree, in the order in which
     :func:`monomials` builds them (each from an earlier one by one multiplication)."""
     out = [(0, 0)]
@@ -68,8 +68,29 @@ def monomial_exponents(degree):
 
 
 def monomials(x, y, degree, out=None):
-    """Rows x^a y^b (order of :func:`monomial_exponents`) as a (M, n) array."""
-    exps = monomial_exponents(degree)
+    """Rows x^a y^b (order of :func:`_monomial_exponents`: by total degree, then by the power of y).
+
+    The basis of the fitted first guess of bmz04 Algorithm 1 (docs/inverse.md).
+
+    Parameters
+    ----------
+    x, y : ndarray, shape (n,) float64
+    degree : int
+        Total degree.
+    out : ndarray, shape (M, n), optional
+        Filled in place, M = (degree + 1)(degree + 2)/2.
+
+    Returns
+    -------
+    ndarray, shape (M, n) float64
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> monomials(np.array([2.0]), np.array([3.0]), 2).ravel().tolist()    # 1, x, y, x^2, xy, y^2
+    [1.0, 2.0, 3.0, 4.0, 6.0, 9.0]
+    """
+    exps = _monomial_exponents(degree)
     n = x.shape[0]
     m = out if out is not None else np.empty((len(exps), n))
     m[0] = 1.0
@@ -85,7 +106,42 @@ def monomials(x, y, degree, out=None):
 
 @dataclass
 class ValenceData:
-    """Everything the float kernels need for one valence (see module docstring)."""
+    """Everything the float kernels need for one valence (see module docstring), made by :func:`valence_data`.
+
+    bmz04 Algorithm 1 (docs/readings.md R11; docs/inverse.md). Fields (shapes float64 unless noted):
+
+    Attributes
+    ----------
+    k : int
+    lam : float
+    bezier : ndarray, shape (3, 4, 4, 2)
+        Bezier nets of P1, P2, P3.
+    power : ndarray, shape (2, 2, 4, 4)
+        ``[patch P1/P2, component x/y, s power, t power]``.
+    W : ndarray, shape (2, 22, 4)
+        Rows of t-coefficients of q_i(t) (x: 0-3, y: 4-7), q_i'(t) (x: 8-11, y: 12-15),
+        i q_i(t) (x: 16-18, y: 19-21).
+    C6 : ndarray, shape (2, 6, 16)
+        x, y, x_s, x_t, y_s, y_t on the monomials s^i t^j (index 4i + j).
+    pow_mant, pow_exp : ndarray
+        lam^n = pow_mant[n + NMAX] * 2**pow_exp[n + NMAX] (any n, exact range).
+    pow_lam, pow_2lam, pow2 : ndarray
+        lam^n, (2 lam)^n and 2^n as doubles (0 / inf where out of range).
+    inv_log_lam, log_a : float
+        1 / log(lam); log(A) (the first guess puts max(t0) in (lam A, A]).
+    G : ndarray, shape (5, 10)
+        Location rows on the cubic monomials of t0: g_Gamma(t0), g_Gamma(lam t0), g_C(t0 / lam),
+        g_C(t0), g_C(lam t0).
+    fit : ndarray, shape (2, 2, M)
+        First guess of (s, t) of P1 / P2 on the monomials of degree ``FIT_DEGREE``.
+    gamma_sign, sep_sign : int
+
+    Examples
+    --------
+    >>> D = valence_data(4)
+    >>> D.lam, D.C6.shape, D.bezier[1, 3, 3].tolist()        # k = 4: Phi is the identity
+    (0.5, (2, 6, 16), [1.0, 1.0])
+    """
 
     k: int
     lam: float
@@ -130,7 +186,7 @@ def _arb_pow_table(lam_arb):
     return mant, expo
 
 
-def lstsq_tall(V, B, block=512):
+def _lstsq_tall(V, B, block=512):
     """Least-squares solution X (n, r) of V X ~ B for a tall V (m, n), m >> n: corrected semi-normal
     equations (Gram matrix, then one step of refinement on the residual; Bjorck, *Numerical Methods
     for Least Squares Problems*, 1996, section 2.2.5), all products in row blocks small enough for
@@ -139,7 +195,7 @@ def lstsq_tall(V, B, block=512):
     up to 1e7, fit errors ~1e-4) the fitted values of the two agree to 1e-9 (tests/inverse/test_data.py).
 
     >>> V = np.vander(np.linspace(0, 1, 50), 3)
-    >>> np.allclose(lstsq_tall(V, V @ np.array([[1.0], [2.0], [3.0]])), [[1], [2], [3]])
+    >>> np.allclose(_lstsq_tall(V, V @ np.array([[1.0], [2.0], [3.0]])), [[1], [2], [3]])
     True
     """
     m = V.shape[0]
@@ -158,7 +214,7 @@ def _eval_power(C, s, t):
 #: the boundary edges used to locate a point: name -> (patch, axis (0: s fixed, 1: t fixed), value)
 BOUNDARY_EDGES = {"P1:s=0": ("P1", 0, 0), "P1:t=1": ("P1", 1, 1)}
 #: the lattice {(a, b): a + b <= 3} on which g is interpolated (unisolvent for total degree 3)
-_LATTICE = monomial_exponents(3)
+_LATTICE = _monomial_exponents(3)
 
 
 def _edge_points(net, axis, value):
@@ -170,8 +226,22 @@ def bezier_to_power(b):
     """Power-basis coefficients (constant first) of the cubic with Bezier coefficients b0..b3
     (any ring: floats, ``arb``, ``Fraction``, sympy numbers).
 
+    Parameters
+    ----------
+    b : sequence of 4 scalars
+        Bezier coefficients b0..b3 of a cubic on [0, 1].
+
+    Returns
+    -------
+    list of 4 scalars
+        Power-basis coefficients, constant first (same arithmetic as ``b``).
+
+    Examples
+    --------
     >>> bezier_to_power([0, 1, 2, 3])
     [0, 3, 0, 0]
+    >>> bezier_to_power([1, 1, 1, 1])          # partition of unity
+    [1, 0, 0, 0]
     """
     b0, b1, b2, b3 = b
     return [b0, (b1 - b0) * 3, (b2 - b1 * 2 + b0) * 3, b3 - b2 * 3 + b1 * 3 - b0]
@@ -262,6 +332,22 @@ def inside_sign(k, edge, g=None):
     At w = 0.1, ..., 0.9 along the edge the derivative of g(P(s, t)) in the direction into the
     piece's domain is enclosed in a ball; all nine must exclude 0 and agree (else ``ValueError``).
 
+    Parameters
+    ----------
+    k : int
+        Valence, k >= 3.
+    edge : str
+        A boundary edge name of :data:`BOUNDARY_EDGES` (``"P1:s=0"``, ...; docs/inverse.md).
+    g : dict, optional
+        The balls of :func:`implicit_boundary` (computed when omitted).
+
+    Returns
+    -------
+    int
+        +1 or -1.
+
+    Examples
+    --------
     >>> inside_sign(4, "P1:s=0") * float(implicit_boundary(4, "P1:s=0")[(1, 0)].mid()) > 0   # u > 1/2 inside
     True
     """
@@ -328,7 +414,7 @@ def valence_data(k):
     from ccproof.tables.numeric import characteristic_arb
 
     k = check_valence(k)
-    lam, bez = float_nets(k)
+    lam, bez = _float_nets(k)
     power = np.einsum("im,jn,pijc->pcmn", BEZ2POW, BEZ2POW, bez[:2])
     W = np.zeros((2, 22, 4))
     for p in range(2):
@@ -358,7 +444,7 @@ def valence_data(k):
     gam_arb = implicit_boundary(k, "P1:s=0")
     sep_arb = implicit_boundary(k, "P1:t=1")
     gam, sep = _normalized_float(gam_arb), _normalized_float(sep_arb)
-    exps3 = monomial_exponents(3)
+    exps3 = _monomial_exponents(3)
     col3 = {e: i for i, e in enumerate(exps3)}
 
     def row(poly, scale):
@@ -378,7 +464,7 @@ def valence_data(k):
         s, t = (ss, tt) if p == 0 else (ss[ss >= tt - 0.03], tt[ss >= tt - 0.03])
         xy = _eval_power(power[p], s, t)
         V = monomials(xy[0], xy[1], FIT_DEGREE).T
-        coef = lstsq_tall(V, np.stack([s, t], 1))
+        coef = _lstsq_tall(V, np.stack([s, t], 1))
         fits.append(coef.T)  # (2, M)
     fit = np.array(fits)
 
@@ -406,7 +492,7 @@ CHUNK = 16384
 _GEMM_SINGLE = 4 * 65536
 
 
-def matmul(A, B):
+def _matmul(A, B):
     """A @ B for a small A (m x k) and a wide B (k x n), in column blocks small enough for OpenBLAS
     to stay single-threaded."""
     m, k = A.shape
@@ -424,18 +510,18 @@ SAFE_LO = 2.0**-900
 SAFE_HI = 2.0**900
 
 _LN2 = float(np.log(2.0))
-#: quadratic approximation of log(m) on [1/2, 1) (error < 1e-2), used by :func:`approx_log`
+#: quadratic approximation of log(m) on [1/2, 1) (error < 1e-2), used by :func:`_approx_log`
 _LOG_Q = np.polyfit(np.linspace(0.5, 1.0, 200), np.log(np.linspace(0.5, 1.0, 200)), 2)
 
 
-def approx_log(a):
+def _approx_log(a):
     """log(a) to within 1e-2 (a > 0): frexp plus a quadratic; 3x cheaper than np.log."""
     m, e = np.frexp(a)
     c2, c1, c0 = _LOG_Q
     return (c2 * m + c1) * m + (c0 + _LN2 * e)
 
 
-def patch_eval(Wp, s, t, jacobian=False):
+def _patch_eval(Wp, s, t, jacobian=False):
     """P(s, t) of one piece (``Wp`` = ``ValenceData.W[p]``) at arrays s, t (local coordinates).
 
     Returns (x, y) or (x, y, x_s, x_t, y_s, y_t). The t-polynomials q_i(t) of both components
@@ -449,17 +535,17 @@ def patch_eval(Wp, s, t, jacobian=False):
     np.multiply(t, t, out=T[2])
     np.multiply(T[2], t, out=T[3])
     if not jacobian:
-        Q = matmul(Wp[:8], T)
+        Q = _matmul(Wp[:8], T)
         return _horner3(Q, 0, s), _horner3(Q, 4, s)
-    Q = matmul(Wp, T)
+    Q = _matmul(Wp, T)
     return (_horner3(Q, 0, s), _horner3(Q, 4, s), _horner2(Q, 16, s), _horner3(Q, 8, s),
             _horner2(Q, 19, s), _horner3(Q, 12, s))
 
 
-def patch_eval_jac(Cp, s, t):
+def _patch_eval_jac(Cp, s, t):
     """(x, y, x_s, x_t, y_s, y_t) of one piece (``Cp`` = ``ValenceData.C6[p]``): all six are
     combinations of the 16 monomials s^i t^j (i, j <= 3), so one product (6 x 16) @ (16 x n) after
-    12 multiplications; about 25% cheaper than :func:`patch_eval` with ``jacobian=True``."""
+    12 multiplications; about 25% cheaper than :func:`_patch_eval` with ``jacobian=True``."""
     n = s.shape[0]
     M = np.empty((16, n))
     M[0] = 1.0
@@ -471,7 +557,7 @@ def patch_eval_jac(Cp, s, t):
     np.multiply(M[8], s, out=M[12])
     for i in (4, 8, 12):
         np.multiply(M[1:4], M[i], out=M[i + 1:i + 4])
-    return matmul(Cp, M)
+    return _matmul(Cp, M)
 
 
 def _horner3(Q, i, s):
@@ -493,12 +579,28 @@ def _horner2(Q, i, s):
 
 
 def chunks(n, size=CHUNK):
-    """Slices covering range(n) in blocks of ``size``."""
+    """Slices covering range(n) in blocks of ``size``.
+
+    Parameters
+    ----------
+    n : int
+    size : int, optional
+        Default ``CHUNK``.
+
+    Yields
+    ------
+    slice
+
+    Examples
+    --------
+    >>> list(chunks(5, 2))
+    [slice(0, 2, None), slice(2, 4, None), slice(4, 5, None)]
+    """
     for i in range(0, n, size):
         yield slice(i, min(i + size, n))
 
 
-def as_points(u, v, what="point"):
+def _as_points(u, v, what="point"):
     """Broadcast two coordinate arrays to flat float64 arrays; reject NaN, inf and negatives.
 
     Returns (u, v, shape). Raises :class:`~ccproof.errors.CCProofError`.

@@ -79,9 +79,29 @@ _EDGE_SPECS = {
 
 @dataclass(frozen=True)
 class Edge:
-    """A boundary edge of a layer-0 piece: ``patch`` with local coordinate ``axis`` (0: s, 1: t)
-    fixed at ``value``; ``segment`` is the face segment it is the image of, ``other`` the piece
-    or layer across it."""
+    """A boundary edge of a layer-0 piece (bmz04 Definition 5; docs/inverse.md).
+
+    Parameters
+    ----------
+    name : str
+        ``"<patch>:<s|t>=<0|1>"``, the key of :data:`EDGES`.
+    patch : str
+        ``"P1"``, ``"P2"`` or ``"P3"``.
+    axis : int
+        The local coordinate held fixed (0: s, 1: t).
+    value : int
+        Its value (0 or 1).
+    segment : str
+        The face segment the edge is the image of.
+    other : str
+        The piece or layer across it.
+
+    Examples
+    --------
+    >>> e = EDGES["P1:s=1"]
+    >>> e.patch, e.axis, e.value, e.segment
+    ('P1', 0, 1, 'u = 1, 0 <= v <= 1/2')
+    """
 
     name: str
     patch: str
@@ -107,7 +127,7 @@ class Edge:
 EDGES = {name: Edge(name, *spec) for name, spec in _EDGE_SPECS.items()}
 
 
-def get_edge(edge):
+def _get_edge(edge):
     if isinstance(edge, Edge):
         return edge
     try:
@@ -126,6 +146,19 @@ def sylvester_matrix(q, r, zero):
     r = r0 + ... + rn x^n given as coefficient lists (constant term first): n rows of q's
     coefficients ``q0 .. qm`` shifted right one column per row, then m rows of r's.
 
+    Parameters
+    ----------
+    q, r : sequence
+        Coefficient lists, constant term first, of degrees m and n (any commutative ring).
+    zero : scalar
+        The zero of that ring.
+
+    Returns
+    -------
+    list of lists, shape (m + n, m + n)
+
+    Examples
+    --------
     >>> sylvester_matrix([1, 2], [3, 4, 5], 0)
     [[1, 2, 0], [0, 1, 2], [3, 4, 5]]
     """
@@ -145,6 +178,19 @@ def determinant(M, zero, one):
     """Exact determinant of a square matrix over a commutative ring (no division): Laplace
     expansion along the rows with the minors memoized by their set of columns (2^n of them).
 
+    Parameters
+    ----------
+    M : sequence of sequences, shape (n, n)
+        Entries in a commutative ring (ints, Fractions, flint polynomials, ...).
+    zero, one : scalar
+        The ring's 0 and 1.
+
+    Returns
+    -------
+    scalar
+
+    Examples
+    --------
     >>> determinant([[1, 2], [3, 4]], 0, 1)
     -2
     """
@@ -177,15 +223,31 @@ def determinant(M, zero, one):
 
 @dataclass(frozen=True)
 class SymbolicImplicit:
-    """g(u, v) = numerator(lam, c, u, v) / denominator(c) for every valence at once.
+    """g(u, v) = numerator(lam, c, u, v) / denominator(c) for every valence at once (bmz04 Definition 5).
 
-    ``resultant``: the Sylvester determinant in Z[lam, c, u, v] of the denominator-cleared cubics
-    (before reduction; equals (-1) times flint's ``resultant`` of the same two polynomials).
-    ``numerator``: ``fmpq_mpoly`` in (lam, c, u, v) of degree <= 1 in lam (reduced modulo
-    16 lam^2 - 2(5+c) lam + 1). ``denominator``: ``fmpz_poly`` in c, = (D_x D_y)^3 where D_x, D_y
-    clear the denominators of the coefficients of x(w), y(w). ``x``, ``y``: the cleared cubics
-    as lists of ``fmpz_mpoly`` in (lam, c, u, v) (power basis in w), ``dx``, ``dy`` their
-    denominators."""
+    Made by :func:`symbolic_implicit` (docs/inverse.md).
+
+    Parameters
+    ----------
+    edge : Edge
+    resultant : flint.fmpz_mpoly
+        The Sylvester determinant in Z[lam, c, u, v] of the denominator-cleared cubics (before
+        reduction; equals (-1) times flint's ``resultant`` of the same two polynomials).
+    numerator : flint.fmpq_mpoly
+        In (lam, c, u, v), of degree <= 1 in lam (reduced modulo 16 lam^2 - 2(5+c) lam + 1).
+    denominator : flint.fmpz_poly
+        In c, = (D_x D_y)^3 where D_x, D_y clear the denominators of the coefficients of x(w), y(w).
+    x, y : tuple of flint.fmpz_mpoly
+        The cleared cubics in (lam, c, u, v) (power basis in w).
+    dx, dy : flint.fmpz_poly
+        Their denominators.
+
+    Examples
+    --------
+    >>> g = symbolic_implicit("P1:s=1")
+    >>> g.edge.name, g.numerator.degrees()[0], len(g.x)
+    ('P1:s=1', 1, 4)
+    """
 
     edge: Edge
     resultant: object
@@ -235,7 +297,7 @@ def _cleared_cubic(R, values):
     return out, den
 
 
-def reduce_lam(poly):
+def _reduce_lam(poly):
     """Reduce an ``fmpq_mpoly``/``fmpz_mpoly`` in (lam, c, u, v) modulo 16 lam^2 - 2(5+c) lam + 1
     (R2): the result has degree <= 1 in lam and the same value at lam = lam(c)."""
     Q = _qring()
@@ -249,13 +311,24 @@ def reduce_lam(poly):
 def symbolic_implicit(edge):
     """The implicit polynomial of a boundary edge, symbolic in c and lam (see module docstring).
 
+    Parameters
+    ----------
+    edge : str or Edge
+        A boundary edge (:data:`EDGES`).
+
+    Returns
+    -------
+    SymbolicImplicit
+
+    Examples
+    --------
     >>> g = symbolic_implicit("P1:s=1")
     >>> g.numerator.degrees()[0] <= 1, g.numerator.total_degree() > 0
     (True, True)
     """
     from ccproof.algebra.characteristic_map import symbolic_bezier_nets
 
-    e = get_edge(edge)
+    e = _get_edge(edge)
     R = _zring()
     _, _, u, v = R.gens()
     pts = e.control_points(symbolic_bezier_nets()[e.patch])
@@ -265,7 +338,7 @@ def symbolic_implicit(edge):
     r = [y[0] - _cpoly(R, dy.coeffs()) * v] + y[1:]
     res = determinant(sylvester_matrix(q, r, R.constant(0)), R.constant(0), R.constant(1))
     den = (dx * dy) ** 3
-    return SymbolicImplicit(e, res, reduce_lam(res), den, tuple(q), tuple(r), dx, dy)
+    return SymbolicImplicit(e, res, _reduce_lam(res), den, tuple(q), tuple(r), dx, dy)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -299,6 +372,25 @@ def implicit_polynomial(k, edge, arithmetic="arb", prec=128):
     (balls containing the exact coefficients) or ``"float"`` (midpoints, scaled by a positive
     factor so that the largest |coefficient| is 1; same sign as g everywhere).
 
+    bmz04 Definition 5 specialized to valence k (docs/inverse.md).
+
+    Parameters
+    ----------
+    k : int
+        Valence, k >= 3.
+    edge : str or Edge
+        A boundary edge (:data:`EDGES`).
+    arithmetic : {"arb", "exact", "float"}, optional
+    prec : int, optional
+        Bits of precision of arb coefficients (default 128).
+
+    Returns
+    -------
+    dict of tuple -> scalar
+        ``{(a, b): g_ab}``, total degree <= 3.
+
+    Examples
+    --------
     >>> g = implicit_polynomial(3, "P1:s=0", "float")
     >>> max(abs(x) for x in g.values())
     1.0
@@ -306,7 +398,7 @@ def implicit_polynomial(k, edge, arithmetic="arb", prec=128):
     (3, 0)
     """
     k = check_valence(k)
-    e = get_edge(edge)
+    e = _get_edge(edge)
     if k == 4:
         g = rational_implicit(e, Fraction(0), Fraction(1, 2))
         if arithmetic == "exact":
@@ -381,7 +473,27 @@ def rational_nets(c, lam):
     """Bezier nets of P1, P2, P3 with c and lam rational (``Fraction``): exact, ``Fraction``s.
 
     Valid for any rational pair with 16 lam^2 - 2 (5 + c) lam + 1 = 0: k = 4 (c = 0, lam = 1/2)
-    and the *rational pseudo-valences* of :data:`RATIONAL_PAIRS` used to test the algebra exactly.
+    and the *rational pseudo-valences* of :data:`RATIONAL_PAIRS` used to test the algebra exactly
+    (bmz04 section 4.3; docs/readings.md R3).
+
+    Parameters
+    ----------
+    c, lam : Fraction or int
+
+    Returns
+    -------
+    dict
+        ``{"P1": net, "P2": net, "P3": net}``, ``net[i][j] = (x, y)`` Fractions, i, j = 0..3.
+
+    Raises
+    ------
+    CCProofError
+        If lam is not a root for c.
+
+    Examples
+    --------
+    >>> rational_nets(0, Fraction(1, 2))["P2"][3][3]            # k = 4: the identity map
+    (Fraction(1, 1), Fraction(1, 1))
     """
     c, lam = Fraction(c), Fraction(lam)
     if 16 * lam * lam - 2 * (5 + c) * lam + 1 != 0:
@@ -423,12 +535,26 @@ def rational_implicit(edge, c, lam):
     Definition 5 over Q with the actual degrees of x(w) - u and y(w) - v (no formal leading
     zeros; for k = 4, whose boundaries are straight lines, this is what gives a non-zero g).
 
+    Parameters
+    ----------
+    edge : str or Edge
+        A boundary edge (:data:`EDGES`).
+    c, lam : Fraction or int
+        A rational pair with 16 lam^2 - 2 (5 + c) lam + 1 = 0 (:func:`rational_nets`).
+
+    Returns
+    -------
+    dict of tuple -> Fraction
+        ``{(a, b): g_ab}``.
+
+    Examples
+    --------
     >>> rational_implicit("P1:t=1", 0, Fraction(1, 2))   # k = 4: the line v = 1/2, as 1/2 - v
     {(0, 0): Fraction(1, 2), (0, 1): Fraction(-1, 1)}
     """
     from flint import fmpq, fmpq_mpoly_ctx
 
-    e = get_edge(edge)
+    e = _get_edge(edge)
     pts = e.control_points(rational_nets(c, lam)[e.patch])
     Q = fmpq_mpoly_ctx.get(("u", "v"), "lex")
     u, v = Q.gens()
@@ -444,19 +570,19 @@ def rational_implicit(edge, c, lam):
     return {tuple(int(x) for x in ab): Fraction(int(x.p), int(x.q)) for ab, x in sorted(g.to_dict().items())}
 
 
-def exact_value_rational_c(edge, c, u, v):
+def _exact_value_rational_c(edge, c, u, v):
     """g(u, v) exactly for rational c (valences 3, 4, 6, or a rational pseudo-valence) and
     rational u, v, as ``(alpha, beta, d)`` meaning alpha + beta sqrt(d) with d = (1+c)(9+c)
     (lam = (5 + c + sqrt d)/16). Uses the symbolic numerator (formal degrees).
 
-    >>> a, b, d = exact_value_rational_c("P1:s=1", Fraction(-1, 2), Fraction(1), Fraction(0))
+    >>> a, b, d = _exact_value_rational_c("P1:s=1", Fraction(-1, 2), Fraction(1), Fraction(0))
     >>> d
     Fraction(17, 4)
     """
     from flint import fmpq
 
     c, u, v = Fraction(c), Fraction(u), Fraction(v)
-    sym = symbolic_implicit(get_edge(edge))
+    sym = symbolic_implicit(_get_edge(edge))
     f = lambda x: fmpq(x.numerator, x.denominator)
     # numerator = N0 + N1 lam at (c, u, v) (exact substitution in flint); lam = (5 + c + sqrt d)/16
     rest = sym.numerator.subs({"c": f(c), "u": f(u), "v": f(v)})
@@ -474,10 +600,10 @@ def exact_value_rational_c(edge, c, u, v):
     return alpha, beta, d
 
 
-def sign_quadratic_surd(alpha, beta, d):
+def _sign_quadratic_surd(alpha, beta, d):
     """Exact sign of alpha + beta sqrt(d) for rationals alpha, beta and d >= 0.
 
-    >>> sign_quadratic_surd(Fraction(-3), Fraction(1), Fraction(10)), sign_quadratic_surd(1, -1, 1)
+    >>> _sign_quadratic_surd(Fraction(-3), Fraction(1), Fraction(10)), _sign_quadratic_surd(1, -1, 1)
     (1, 0)
     """
     sa = (alpha > 0) - (alpha < 0)
@@ -500,6 +626,24 @@ def exact_sign(k, edge, u, v, prec=256):
     curve with irrational coefficients is then never decided: after 4096 bits a
     :class:`CCProofError` is raised).
 
+    Parameters
+    ----------
+    k : int
+        Valence, k >= 3.
+    edge : str or Edge
+        A boundary edge (:data:`EDGES`).
+    u, v : Fraction or int
+        The point.
+    prec : int, optional
+        Starting bits of precision of the arb evaluation (k other than 3, 4, 6).
+
+    Returns
+    -------
+    int
+        -1, 0 or 1.
+
+    Examples
+    --------
     >>> exact_sign(3, "P1:s=1", 1, 0), exact_sign(3, "P1:s=1", Fraction(1, 2), 0) != 0
     (0, True)
     """
@@ -511,11 +655,11 @@ def exact_sign(k, edge, u, v, prec=256):
         val = sum(x * u**a * v**b for (a, b), x in g.items())
         return (val > 0) - (val < 0)
     if c is not None:
-        return sign_quadratic_surd(*exact_value_rational_c(edge, c, u, v))
+        return _sign_quadratic_surd(*_exact_value_rational_c(edge, c, u, v))
     from flint import arb, ctx, fmpq
 
     while prec <= 4096:
-        coeffs = _arb_coefficients(k, get_edge(edge).name, prec)
+        coeffs = _arb_coefficients(k, _get_edge(edge).name, prec)
         with ctx.workprec(prec):
             U, V = arb(fmpq(u.numerator, u.denominator)), arb(fmpq(v.numerator, v.denominator))
             val = sum((x * U**a * V**b for (a, b), x in coeffs), arb(0))
@@ -561,10 +705,33 @@ def inside_sign(k, edge, prec=128):
 
     At w = 0.1, 0.2, ..., 0.9 along the edge, the derivative of g(P(s, t)) in the direction
     pointing into the piece's domain is enclosed in a ball; all nine balls must exclude 0 and
-    agree (else :class:`CCProofError`).
+    agree (else :class:`CCProofError`). docs/inverse.md.
+
+    Parameters
+    ----------
+    k : int
+        Valence, k >= 3.
+    edge : str or Edge
+        A boundary edge (:data:`EDGES`).
+    prec : int, optional
+        Bits of precision (default 128).
+
+    Returns
+    -------
+    int
+        +1 or -1.
+
+    Examples
+    --------
+    For k = 4 the edge P1:s=1 is the line u = 1 and P1 lies at u < 1:
+
+    >>> g = rational_implicit("P1:s=1", 0, Fraction(1, 2))
+    >>> u, v = Fraction(3, 4), Fraction(1, 4)
+    >>> inside_sign(4, "P1:s=1") * sum(x * u**a * v**b for (a, b), x in g.items()) > 0
+    True
     """
     k = check_valence(k)
-    e = get_edge(edge)
+    e = _get_edge(edge)
     if k == 4:
         net = rational_nets(0, Fraction(1, 2))[e.patch]
         g = rational_implicit(e, 0, Fraction(1, 2))
@@ -626,6 +793,15 @@ class FloatImplicit:
     where |g| is below a rigorous bound on the rounding error of the Horner evaluation
     (gamma_12 sum |g_ab| |u|^a |v|^b: nested Horner of degree 3 + 3, the standard a-priori bound).
 
+    Parameters
+    ----------
+    k : int
+        Valence, k >= 3.
+    edge : str or Edge
+        A boundary edge (:data:`EDGES`).
+
+    Examples
+    --------
     >>> f = FloatImplicit(4, "P1:s=1")
     >>> f.side([0.5, 1.5, 1.0], [0.2, 0.2, 0.3]).tolist()
     [1, -1, 0]
@@ -635,7 +811,7 @@ class FloatImplicit:
         import numpy as np
 
         k = check_valence(k)
-        e = get_edge(edge)
+        e = _get_edge(edge)
         g = implicit_polynomial(k, e, "float")
         c = np.zeros((4, 4))
         for (a, b), x in g.items():

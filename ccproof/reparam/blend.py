@@ -37,7 +37,25 @@ CORNER_FRAMES = np.array([
 
 
 def quarter(u, v):
-    """Index of the corner whose closed quarter contains (u, v) (ties towards the larger index)."""
+    """Index of the corner whose closed quarter contains (u, v) (ties towards the larger index).
+
+    The four corner quarters of the face on which the blend of bmz04 eq. 4 acts (docs/readings.md R6).
+
+    Parameters
+    ----------
+    u, v : ndarray, shape (n,) float64
+        Face parameters in [0, 1]^2.
+
+    Returns
+    -------
+    ndarray, shape (n,) int64
+        0: [0, 1/2]^2 (corner 0), 1: u >= 1/2, v < 1/2, 2: both >= 1/2, 3: u < 1/2, v >= 1/2.
+
+    Examples
+    --------
+    >>> quarter(np.array([0.25, 0.75, 0.75, 0.25, 0.5]), np.array([0.25, 0.25, 0.75, 0.75, 0.5])).tolist()
+    [0, 1, 2, 3, 2]
+    """
     cu = u >= 0.5
     cv = v >= 0.5
     return np.where(cv, np.where(cu, 2, 3), np.where(cu, 1, 0)).astype(np.int64)
@@ -46,6 +64,18 @@ def quarter(u, v):
 def to_local(q, u, v):
     """T_q^-1: face parameter (u, v) -> local (s, t) of corner q (exact in floating point).
 
+    Parameters
+    ----------
+    q : ndarray, shape (n,) int64
+        Corner index (:func:`quarter`).
+    u, v : ndarray, shape (n,) float64
+
+    Returns
+    -------
+    s, t : ndarray, shape (n,) float64
+
+    Examples
+    --------
     >>> to_local(np.array([1]), np.array([0.75]), np.array([0.25]))
     (array([0.25]), array([0.25]))
     """
@@ -57,8 +87,23 @@ def to_local(q, u, v):
 def from_local(q, s, t):
     """T_q: local (s, t) of corner q -> face parameter (u, v).
 
+    Parameters
+    ----------
+    q : ndarray, shape (n,) int64
+        Corner index (:func:`quarter`).
+    s, t : ndarray, shape (n,) float64
+
+    Returns
+    -------
+    u, v : ndarray, shape (n,) float64
+
+    Examples
+    --------
     >>> from_local(np.array([3]), np.array([0.25]), np.array([0.125]))
     (array([0.125]), array([0.75]))
+    >>> u, v = from_local(np.array([2]), *to_local(np.array([2]), np.array([0.9]), np.array([0.7])))
+    >>> np.round([u[0], v[0]], 15).tolist()
+    [0.9, 0.7]
     """
     u = np.where(q == 0, s, np.where(q == 1, 1.0 - t, np.where(q == 2, 1.0 - s, t)))
     v = np.where(q == 0, t, np.where(q == 1, s, np.where(q == 2, 1.0 - t, 1.0 - s)))
@@ -94,6 +139,17 @@ def quarter_map(k, s, t, parameterization, alpha=None, derivatives=1):
         ``DG[:, a, i] = dG_a / dt_i`` (with ``derivatives >= 1``).
     D2G : ndarray, shape (n, 2, 2, 2)
         With 2.
+
+    Notes
+    -----
+    bmz04 eq. 4 (docs/readings.md R5, R6): the weight w vanishes at distance >= 1/2 from the corner
+    (the radial weight of "vanishing"), where G is the identity.
+
+    Examples
+    --------
+    >>> G, DG = quarter_map(5, np.array([0.0, 0.4]), np.array([0.0, 0.45]), "vanishing")
+    >>> G.tolist(), DG[1].tolist()
+    ([[0.0, 0.0], [0.4, 0.45]], [[1.0, 0.0], [0.0, 1.0]])
     """
     if parameterization == "characteristic":
         Fo = inverse_characteristic_map_derivatives(k, s, t, derivatives)
@@ -157,6 +213,16 @@ def active_points(corner_valence, f, u, v, parameterization):
         Their local coordinates in the corner frame.
     k : ndarray of int, shape (a,)
         The corner's valence.
+
+    Examples
+    --------
+    One face whose corner 0 has valence 3: the points near corner 0 are active, the one near the
+    identity corner 2 is not:
+
+    >>> idx, q, s, t, k = active_points(np.array([[3, 0, 0, 0]]), np.array([0, 0, 0]), np.array([0.1, 0.9, 0.3]),
+    ...                                 np.array([0.1, 0.9, 0.4]), "characteristic")
+    >>> idx.tolist(), q.tolist(), s.tolist(), t.tolist(), k.tolist()
+    ([0, 2], [0, 0], [0.1, 0.3], [0.1, 0.4], [3, 3])
     """
     if parameterization not in PARAMETERIZATIONS:
         raise CCProofError(f"unknown parameterization {parameterization!r}; use one of {', '.join(PARAMETERIZATIONS)}")
@@ -177,12 +243,34 @@ def active_points(corner_valence, f, u, v, parameterization):
 def blend_points(q, s, t, k, parameterization, alpha=None, derivatives=1):
     """F_b at active points (output of :func:`active_points`), grouped by valence.
 
+    The blended reparameterization of bmz04 eq. 4 (docs/readings.md R6), :func:`quarter_map` of
+    each corner mapped back to the face frame.
+
+    Parameters
+    ----------
+    q, s, t, k : ndarray, shape (a,)
+        Quarter, local coordinates and valence of the active points (:func:`active_points`).
+    parameterization : {"vanishing", "characteristic"}
+    alpha : float or dict or None, optional
+        Exponent of F^alpha ("vanishing" only).
+    derivatives : int, optional
+        0, 1 or 2.
+
     Returns
     -------
     dict
         ``local`` (a, 2): F_b in the corner frame; ``u``, ``v`` (a,): F_b as a face parameter;
         ``J_local``, ``H_local``: derivatives in the corner frame; ``J``, ``H``: in the face frame;
         ``corner`` (a,) bool: the points at the corner itself.
+
+    Examples
+    --------
+    The corner is fixed; in the frame of corner 0 (the identity) local and face coordinates agree:
+
+    >>> q, s, t, k = np.array([0, 0]), np.array([0.0, 0.3]), np.array([0.0, 0.2]), np.array([3, 3])
+    >>> b = blend_points(q, s, t, k, "vanishing")
+    >>> b["corner"].tolist(), b["local"][0].tolist(), bool(np.all(b["local"][:, 0] == b["u"]))
+    ([True, False], [0.0, 0.0], True)
     """
     a = q.shape[0]
     out = {"local": np.empty((a, 2)), "corner": (s == 0) & (t == 0)}

@@ -42,11 +42,32 @@ def corner_ring(mesh, face, corner):
 
     ``e_0`` is the face's next vertex (local s axis), ``e_1`` its previous vertex (local t axis),
     then counter-clockwise; ``d_j`` is the vertex opposite V in the face between e_j and e_{j+1}
-    (``d_0`` is the face's opposite vertex).
+    (``d_0`` is the face's opposite vertex). The ring of the tangent masks of docs/reparam.md
+    (bmz04 section 4.3, the characteristic parameterization at a corner).
+
+    Parameters
+    ----------
+    mesh : QuadMesh
+    face : int
+    corner : int
+        0..3, the corner of ``face`` at the vertex V (an interior vertex).
 
     Returns
     -------
     ndarray of int, shape (2k + 1,)
+
+    Raises
+    ------
+    CCProofError
+        If V is a boundary vertex.
+
+    Examples
+    --------
+    >>> from ccproof.mesh.examples import cube
+    >>> m = cube()
+    >>> ring, f = corner_ring(m, 0, 0), m.faces[0]
+    >>> ring.size, [int(ring[i]) for i in (0, 1, 2, 4)] == [int(f[i]) for i in (0, 1, 3, 2)]
+    (7, True)
     """
     F = mesh.faces
     v = int(F[face, corner])
@@ -79,6 +100,18 @@ def characteristic_tangent_masks(k):
     """Mask T_k, shape (2, 2k+1), with ``T_k @ X[corner_ring(...)]`` = the two limit derivatives
     d(f o Phi^-1)/ds, d/dt at a corner of valence k (module docstring).
 
+    Parameters
+    ----------
+    k : int
+        Valence, k >= 3 (interior corner).
+
+    Returns
+    -------
+    ndarray, shape (2, 2k + 1) float64
+        Rows d/ds, d/dt; columns in the order of :func:`corner_ring`.
+
+    Examples
+    --------
     >>> T = characteristic_tangent_masks(5)
     >>> T.shape, bool(abs(T.sum(axis=1)).max() < 1e-14)      # derivatives of a constant vanish
     ((2, 11), True)
@@ -120,7 +153,29 @@ def characteristic_tangent_masks(k):
 def corner_tangents(mesh, face, corner):
     """d(f o Phi^-1)/ds and d/dt at corner ``corner`` of ``face`` (local corner frame), shape (2, 3).
 
-    The vertex must be interior with valence != 4.
+    The vertex must be interior with valence != 4: :func:`characteristic_tangent_masks` applied to
+    :func:`corner_ring` (docs/reparam.md; bmz04 section 4.3).
+
+    Parameters
+    ----------
+    mesh : QuadMesh
+    face : int
+    corner : int
+        0..3.
+
+    Returns
+    -------
+    ndarray, shape (2, 3) float64
+
+    Examples
+    --------
+    At a corner of the cube with corners (+-1, +-1, +-1) the tangent plane is orthogonal to the
+    diagonal (1, 1, 1), by symmetry:
+
+    >>> from ccproof.mesh.examples import cube
+    >>> T = corner_tangents(cube(), 0, 0)
+    >>> T.shape, bool(np.abs(T @ np.ones(3)).max() < 1e-14), bool(np.linalg.matrix_rank(T) == 2)
+    ((2, 3), True, True)
     """
     ring = corner_ring(mesh, face, corner)
     k = (ring.size - 1) // 2

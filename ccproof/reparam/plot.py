@@ -76,6 +76,30 @@ def plot_isoparameter_lines(surface, vertex, path, parameterization="natural", n
     The view is the limit tangent plane at the vertex (axes: the direction of the first edge
     neighbour and its normal complement), as in bmz04 Figs. 2, 4, 5 for planar k-regular meshes.
     ``title`` defaults to the parameterization, the vertex, its kind and valence.
+
+    Parameters
+    ----------
+    surface : ReparamLimitSurface
+    vertex : int
+        The vertex whose neighbourhood is drawn.
+    path : str or pathlib.Path
+        Image file (any matplotlib format).
+    parameterization : {"natural", "vanishing", "characteristic"}, optional
+    n_lines : int, optional
+        Isoparameter lines per direction and face.
+    title : str, optional
+
+    Returns
+    -------
+    None
+
+    Examples
+    --------
+    Drawing takes seconds (matplotlib), so this example is not run:
+
+    >>> from ccproof.mesh.examples import cube
+    >>> from ccproof.reparam.surface import limit_surface
+    >>> plot_isoparameter_lines(limit_surface(cube()), 0, "cube.png", "characteristic")   # doctest: +SKIP
     """
     import matplotlib
 

@@ -39,8 +39,22 @@ def subdominant_lambda(k):
     """lam(k) = (5 + c + sqrt((1 + c)(9 + c))) / 16, c = cos(2 pi / k) (docs/readings.md R2), as a float
     (:func:`ccproof.valence.lam_from_c`; exactly 0.5 for k = 4).
 
+    Parameters
+    ----------
+    k : int
+        Valence, k >= 3.
+
+    Returns
+    -------
+    float
+
+    Examples
+    --------
     >>> subdominant_lambda(4)
     0.5
+    >>> import math
+    >>> subdominant_lambda(6) == (5.5 + math.sqrt(1.5 * 9.5)) / 16        # c = 1/2
+    True
     """
     k = check_valence(k)
     if k == 4:
@@ -51,6 +65,17 @@ def subdominant_lambda(k):
 def alpha_bound(k):
     """The lower bound -log 2 / log lam(k) of bmz04 section 4.2 (alpha must exceed it).
 
+    Parameters
+    ----------
+    k : int
+        Valence, k >= 3.
+
+    Returns
+    -------
+    float
+
+    Examples
+    --------
     >>> round(alpha_bound(5), 6), alpha_bound(4)
     (1.159384, 1.0)
     """
@@ -60,6 +85,18 @@ def alpha_bound(k):
 def default_alpha(k):
     """Default exponent of F^alpha for valence k: twice the bound (module docstring).
 
+    Parameters
+    ----------
+    k : int
+        Valence, k >= 3.
+
+    Returns
+    -------
+    float
+        ``2 * alpha_bound(k)``.
+
+    Examples
+    --------
     >>> round(default_alpha(3), 4), round(default_alpha(13), 4)
     (1.5553, 3.0811)
     """
@@ -87,6 +124,18 @@ def check_alpha(alpha, k):
     CCProofError
         alpha not a finite real, not above the bound, or (alpha < 1) a blend that is not one-to-one.
 
+    Parameters
+    ----------
+    alpha : float
+    k : int
+        Valence, k >= 3.
+
+    Returns
+    -------
+    float
+
+    Examples
+    --------
     >>> check_alpha(1.1, 5)  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...

@@ -86,9 +86,35 @@ def _chain_rule(R, idx, J, H, derivatives):
 class ReparamLimitSurface(LimitSurface):
     """Limit surface with the three parameterizations of bmz04 (see the module docstring).
 
-    Attributes (besides those of LimitSurface): ``alpha`` (dict valence -> exponent of F^alpha for
-    every extraordinary interior valence of the mesh), ``corner_valence`` ((n_faces, 4) int: the
-    valence of each face corner, 0 where F_i is the identity).
+    "natural" (Stam's, docs/readings.md R12), "vanishing" (F^alpha blended, bmz04 section 4.2) and
+    "characteristic" (Phi^-1 blended, bmz04 section 4.3, eq. 4); docs/reparam.md. Made by
+    :func:`limit_surface`.
+
+    Parameters
+    ----------
+    mesh : QuadMesh
+        A manifold quad mesh.
+    alpha : float or dict of int -> float, optional
+        Exponent of F^alpha per valence ("vanishing"); default
+        :func:`~ccproof.reparam.quadrant.default_alpha` of each valence.
+
+    Attributes
+    ----------
+    alpha : dict of int -> float
+        Exponent of F^alpha for every extraordinary interior valence of the mesh (besides the
+        attributes of LimitSurface).
+    corner_valence : ndarray, shape (n_faces, 4) int64
+        The valence of each face corner, 0 where F_i is the identity.
+
+    Examples
+    --------
+    Every corner of the cube has valence 3:
+
+    >>> from ccproof.mesh.examples import cube
+    >>> from ccproof.reparam.quadrant import default_alpha
+    >>> S = limit_surface(cube())
+    >>> S.corner_valence[0].tolist(), S.alpha == {3: default_alpha(3)}
+    ([3, 3, 3, 3], True)
     """
 
     def __init__(self, mesh: QuadMesh, alpha: float | Mapping[int, float] | None = None) -> None:

@@ -62,6 +62,16 @@ def bump(x, derivatives=0):
 def bump_complement(x):
     """1 - b(x) with full relative precision near 0 (36 |x|^3 on [0, 1/6]), shape of x.
 
+    Parameters
+    ----------
+    x : array_like, float64
+
+    Returns
+    -------
+    ndarray, shape of ``x`` float64
+
+    Examples
+    --------
     1 - b(x) = 36 x^3 at x = 1e-10 is 3.6e-29, to a relative error below 1e-14, while 1 - b(x) in
     floating point is 0:
 
@@ -81,6 +91,20 @@ def bump_complement(x):
 def weight_complement(s, t, radial):
     """1 - w(s, t) with full relative precision near the corner (w radial or tensor product).
 
+    Parameters
+    ----------
+    s, t : ndarray, shape (n,) float64
+        Local corner coordinates.
+    radial : bool
+        The radial weight of "vanishing" (:func:`weight_radial`) or the tensor-product weight of
+        "characteristic" (:func:`weight_tensor`).
+
+    Returns
+    -------
+    ndarray, shape (n,) float64
+
+    Examples
+    --------
     At (1e-10, 0), 1 - w = 36 (1e-10)^3 = 3.6e-29 to a relative error below 1e-14:
 
     >>> bool(abs(float(weight_complement(np.array([1e-10]), np.array([0.0]), radial=False)[0]) / 3.6e-29 - 1) < 1e-14)
@@ -135,6 +159,19 @@ def weight_radial(s, t, derivatives=0):
     Same conventions as :func:`weight_tensor`. At the origin the gradient and the Hessian are 0
     (b = 1 - 36 rho^3 there, so b'(rho)/rho = -108 rho -> 0 and b''(0) = 0).
 
+    Parameters
+    ----------
+    s, t : ndarray, shape (n,) float64
+    derivatives : int, optional
+        0, 1 or 2.
+
+    Returns
+    -------
+    tuple of ndarray, shape (n,)
+        ``(w,)``; with 1 also ``w_s, w_t``; with 2 also ``w_ss, w_st, w_tt``.
+
+    Examples
+    --------
     >>> [float(v[0]) for v in weight_radial(np.array([0.3]), np.array([0.4]))]
     [0.0]
     """

@@ -26,7 +26,27 @@ _KEYS = {0: ("P",), 1: ("P", "Pu", "Pv"), 2: ("P", "Pu", "Pv", "Puu", "Puv", "Pv
 
 
 def output_names(derivatives):
-    """The result arrays for a derivative order: P; Pu, Pv; Puu, Puv, Pvv."""
+    """The result arrays for a derivative order: P; Pu, Pv; Puu, Puv, Pvv.
+
+    Parameters
+    ----------
+    derivatives : {0, 1, 2}
+        Highest derivative order evaluated.
+
+    Returns
+    -------
+    tuple of str
+
+    Raises
+    ------
+    CCProofError
+        For any other order.
+
+    Examples
+    --------
+    >>> output_names(0), output_names(2)
+    (('P',), ('P', 'Pu', 'Pv', 'Puu', 'Puv', 'Pvv'))
+    """
     if derivatives not in _KEYS:
         raise CCProofError(f"derivatives must be 0, 1 or 2, got {derivatives!r}")
     return _KEYS[derivatives]
@@ -43,6 +63,8 @@ def _evaluate_block(face, u, v, shipped, derivatives, kwargs):
 def evaluate_dask(shipped, face, u, v, derivatives=1, **kwargs):
     """Evaluate the shipped surface at dask arrays of points, one task per chunk (``map_blocks``).
 
+    docs/scale-out.md, "Chunked evaluation".
+
     Parameters
     ----------
     shipped : Shipped
@@ -51,7 +73,7 @@ def evaluate_dask(shipped, face, u, v, derivatives=1, **kwargs):
     u, v : dask or numpy arrays of float, shape (n,)
         Rechunked to the chunks of ``face``.
     derivatives : int
-    **kwargs
+    kwargs
         Passed to ``evaluate`` (e.g. ``parameterization="characteristic"``).
 
     Returns
@@ -59,6 +81,20 @@ def evaluate_dask(shipped, face, u, v, derivatives=1, **kwargs):
     dict of str -> dask array of shape (n, 3)
         ``P`` (and ``Pu``, ``Pv``; ``Puu``, ``Puv``, ``Pvv``), lazy; equal to the bit to
         ``surface.evaluate(face, u, v)`` on the same points.
+
+    Examples
+    --------
+    The limit point at the centre of a face of the cube with corners (+-1, +-1, +-1) is at distance
+    68/81 from the centre (one Catmull-Clark step by hand, then the regular limit mask (16, 4, 1)/36):
+
+    >>> import dask.array as da
+    >>> from ccproof.mesh.examples import cube
+    >>> from ccproof.reparam.surface import limit_surface
+    >>> from ccproof.scale import ship
+    >>> P = evaluate_dask(ship(limit_surface, cube()), da.from_array([0, 0], chunks=1), [0.5, 0.5],
+    ...                   [0.5, 0.5], derivatives=0)["P"]
+    >>> P.chunks[0], bool(abs(abs(P.compute(scheduler="sync")[0, 2]) - 68 / 81) < 1e-12)
+    ((1, 1), True)
     """
     import dask
     import dask.array as da
@@ -81,7 +117,7 @@ def evaluate_dask(shipped, face, u, v, derivatives=1, **kwargs):
 # ---------------------------------------------------------------- chunks of a point set
 
 
-def sample_chunk(seed, n_faces, count, index):
+def _sample_chunk(seed, n_faces, count, index):
     """Random points of chunk ``index``: uniform face and (u, v), from ``default_rng(seed)`` for chunk 0
     (so one chunk equals the unchunked draw ``f = integers(0, n_faces, count); u = random(count);
     v = random(count)``) and ``default_rng([seed, index])`` for the others."""
@@ -91,13 +127,13 @@ def sample_chunk(seed, n_faces, count, index):
     return rng.integers(0, n_faces, count), rng.random(count), rng.random(count)
 
 
-def chunk_points(source):
-    """The (face, u, v) numpy arrays of one chunk description (see :func:`evaluate_chunk`)."""
+def _chunk_points(source):
+    """The (face, u, v) numpy arrays of one chunk description (see :func:`_evaluate_chunk`)."""
     import numpy as np
 
     kind = source[0]
     if kind == "samples":
-        return sample_chunk(*source[1:])
+        return _sample_chunk(*source[1:])
     if kind == "arrays":
         return tuple(np.asarray(a) for a in source[1:])
     if kind == "shard":
@@ -106,7 +142,7 @@ def chunk_points(source):
     raise CCProofError(f"unknown chunk source {kind!r}")
 
 
-def evaluate_chunk(task, shipped):
+def _evaluate_chunk(task, shipped):
     """One task of ``ccproof eval``: evaluate a chunk of points and write its shard (or return it).
 
     ``task`` is ``{"source": ("samples", seed, n_faces, count, index) | ("arrays", face, u, v) |
@@ -115,7 +151,7 @@ def evaluate_chunk(task, shipped):
     """
     import numpy as np
 
-    f, u, v = chunk_points(task["source"])
+    f, u, v = _chunk_points(task["source"])
     res = _evaluate_block(f, u, v, shipped, task["derivatives"], tuple(sorted(task["kwargs"].items())))
     arrays = {"face": f, "u": u, "v": v}
     arrays.update({n: res[:, j, :] for j, n in enumerate(output_names(task["derivatives"]))})
@@ -125,19 +161,19 @@ def evaluate_chunk(task, shipped):
     return int(f.size)
 
 
-def shard_name(i):
+def _shard_name(i):
     return f"part-{i:05d}.npz"
 
 
-def write_index(folder, sizes, names):
+def _write_index(folder, sizes, names):
     """Write ``index.json`` of a shard folder (``sizes``: points per shard, in order)."""
     folder = Path(folder)
     idx = {"format": SHARDS_FORMAT, "n": int(sum(sizes)), "arrays": list(names),
-           "shards": [{"file": shard_name(i), "n": int(m)} for i, m in enumerate(sizes)]}
+           "shards": [{"file": _shard_name(i), "n": int(m)} for i, m in enumerate(sizes)]}
     (folder / "index.json").write_text(json.dumps(idx, indent=1) + "\n", encoding="utf-8")
 
 
-def shard_index(folder):
+def _shard_index(folder):
     """The parsed ``index.json`` of a shard folder, checked (names the folder and the field)."""
     folder = Path(folder)
     try:
@@ -157,7 +193,30 @@ def shard_index(folder):
 def write_shards(folder, arrays):
     """Write a dict of equally chunked dask (or numpy) arrays of length n as a shard folder.
 
-    Each chunk of the first array's chunking becomes one ``part-NNNNN.npz``; returns the folder.
+    Each chunk of the first array's chunking becomes one ``part-NNNNN.npz``, with an ``index.json``
+    (docs/scale-out.md, "Chunked evaluation").
+
+    Parameters
+    ----------
+    folder : str or pathlib.Path
+        Created if missing.
+    arrays : dict of str -> dask or numpy array, shape (n, ...)
+        Equally long arrays; numpy arrays are one shard.
+
+    Returns
+    -------
+    pathlib.Path
+        ``folder``.
+
+    Examples
+    --------
+    >>> import tempfile, numpy as np, dask.array as da
+    >>> tmp = tempfile.TemporaryDirectory()          # removed when the example ends
+    >>> d = write_shards(tmp.name, {"x": da.arange(5, chunks=2)})
+    >>> sorted(p.name for p in d.iterdir())
+    ['index.json', 'part-00000.npz', 'part-00001.npz', 'part-00002.npz']
+    >>> read_shards(d)["x"].compute().tolist()
+    [0, 1, 2, 3, 4]
     """
     import dask
     import dask.array as da
@@ -174,21 +233,40 @@ def write_shards(folder, arrays):
         np.savez(path, **dict(zip(names, blocks)))
         return blocks[0].shape[0]
 
-    writes = [dask.delayed(save)(str(folder / shard_name(i)), *[arrs[n].blocks[i] for n in names])
+    writes = [dask.delayed(save)(str(folder / _shard_name(i)), *[arrs[n].blocks[i] for n in names])
               for i in range(len(chunks))]
     sizes = dask.compute(*writes)
-    write_index(folder, sizes, names)
+    _write_index(folder, sizes, names)
     return folder
 
 
 def read_shards(folder):
-    """The arrays of a shard folder as dask arrays (one chunk per shard), name -> array."""
+    """The arrays of a shard folder (:func:`write_shards`) as dask arrays, one chunk per shard.
+
+    Parameters
+    ----------
+    folder : str or pathlib.Path
+        A shard folder with its ``index.json``.
+
+    Returns
+    -------
+    dict of str -> dask array, shape (n, ...)
+
+    Examples
+    --------
+    >>> import tempfile, numpy as np
+    >>> tmp = tempfile.TemporaryDirectory()          # removed when the example ends
+    >>> d = write_shards(tmp.name, {"u": np.array([0.25, 0.5])})
+    >>> x = read_shards(d)["u"]
+    >>> x.chunks, x.compute().tolist()
+    (((2,),), [0.25, 0.5])
+    """
     import dask
     import dask.array as da
     import numpy as np
 
     folder = Path(folder)
-    idx = shard_index(folder)
+    idx = _shard_index(folder)
     names = idx["arrays"]
     with np.load(folder / idx["shards"][0]["file"]) as z:
         protos = {n: z[n] for n in names}
@@ -207,12 +285,43 @@ def read_shards(folder):
 
 
 def point_chunks(chunk, *, arrays=None, shards=None, samples=None, seed=0, n_faces=None):
-    """Chunk sources for :func:`evaluate_chunk` from in-memory arrays (face, u, v), a shard folder, or
-    ``samples`` random points (chunk i from :func:`sample_chunk`); ``chunk`` points per chunk."""
+    """Chunk sources for ``ccproof eval``: from arrays (face, u, v), a shard folder, or random samples.
+
+    ``samples`` random points are drawn chunk by chunk (chunk i from its own seeded generator, so the
+    points do not depend on the scheduler); docs/scale-out.md.
+
+    Parameters
+    ----------
+    chunk : int
+        Points per chunk, >= 1.
+    arrays : tuple of three arrays, shape (n,), optional
+        ``(face, u, v)`` in memory.
+    shards : str or pathlib.Path, optional
+        A shard folder holding face, u, v.
+    samples : int, optional
+        Number of random points (needs ``n_faces``).
+    seed : int, optional
+    n_faces : int, optional
+
+    Returns
+    -------
+    list of tuple
+        One source per chunk: ``("arrays", face, u, v)``, ``("shard", path)`` or
+        ``("samples", seed, n_faces, count, index)``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> src = point_chunks(2, arrays=(np.array([0, 1, 2]), np.zeros(3), np.ones(3)))
+    >>> [(s[0], s[1].tolist()) for s in src]
+    [('arrays', [0, 1]), ('arrays', [2])]
+    >>> [s[3] for s in point_chunks(4, samples=10, n_faces=6)]
+    [4, 4, 2]
+    """
     if chunk < 1:
         raise CCProofError(f"--chunk must be >= 1, got {chunk}")
     if shards is not None:
-        idx = shard_index(shards)
+        idx = _shard_index(shards)
         return [("shard", str(Path(shards) / s["file"])) for s in idx["shards"]]
     if arrays is not None:
         f, u, v = arrays
@@ -229,9 +338,47 @@ def evaluate_points(shipped, sources, derivatives, kwargs, out, scheduler=None, 
 
     ``out`` ending in ``.npz`` gathers all points into one file (arrays face, u, v, P, ...); any other
     path is a shard folder (one ``part-NNNNN.npz`` per chunk, written by the worker, and
-    ``index.json``), for point sets that do not fit in memory. ``local`` is the surface already built
-    in this process (used by in-process tasks instead of a rebuild). Returns (number of points,
-    result names, the :class:`~ccproof.scale.engine.Sweep`).
+    ``index.json``), for point sets that do not fit in memory (docs/scale-out.md).
+
+    Parameters
+    ----------
+    shipped : Shipped
+        ``ship(limit_surface, mesh, ...)``.
+    sources : list
+        Chunk sources of :func:`point_chunks`.
+    derivatives : {0, 1, 2}
+    kwargs : dict
+        Passed to the surface's ``evaluate``.
+    out : str or pathlib.Path
+        A ``.npz`` file or a shard folder.
+    scheduler : str or Scheduler or distributed.Client, optional
+        See :func:`ccproof.scale.engine.parse_scheduler`.
+    local : object, optional
+        The surface already built in this process (used by in-process tasks instead of a rebuild).
+    progress : bool, optional
+
+    Returns
+    -------
+    n : int
+        Number of points.
+    names : tuple of str
+        Result names (:func:`output_names`).
+    sweep : Sweep
+
+    Examples
+    --------
+    >>> import os, tempfile, numpy as np
+    >>> from ccproof.mesh.examples import cube
+    >>> from ccproof.reparam.surface import limit_surface
+    >>> from ccproof.scale import ship
+    >>> tmp = tempfile.TemporaryDirectory()          # removed when the example ends
+    >>> out = os.path.join(tmp.name, "p.npz")
+    >>> src = point_chunks(1, arrays=(np.array([0, 0]), np.array([0.5, 0.5]), np.array([0.5, 0.5])))
+    >>> evaluate_points(ship(limit_surface, cube()), src, 0, {}, out, "serial", progress=False)[:2]
+    (2, ('P',))
+    >>> P = np.load(out)["P"]
+    >>> bool(np.all(np.abs(np.abs(P[:, 2]) - 68 / 81) < 1e-12))
+    True
     """
     import numpy as np
 
@@ -244,14 +391,14 @@ def evaluate_points(shipped, sources, derivatives, kwargs, out, scheduler=None, 
     if folder is not None:
         folder.mkdir(parents=True, exist_ok=True)
     tasks = [{"source": s, "derivatives": derivatives, "kwargs": dict(kwargs),
-              "out": None if folder is None else str(folder / shard_name(i))} for i, s in enumerate(sources)]
-    sweep = run_tasks(evaluate_chunk, tasks, scheduler, shared=[shipped], desc="evaluate", unit="chunk",
+              "out": None if folder is None else str(folder / _shard_name(i))} for i, s in enumerate(sources)]
+    sweep = run_tasks(_evaluate_chunk, tasks, scheduler, shared=[shipped], desc="evaluate", unit="chunk",
                       progress=progress, names=[f"chunk {i}" for i in range(len(tasks))])
     if folder is None:
         arrays = {n: np.concatenate([r[n] for r in sweep.results]) for n in ("face", "u", "v", *names)}
         np.savez(out, **arrays)
         n = int(arrays["face"].size)
     else:
-        write_index(folder, sweep.results, ("face", "u", "v", *names))
+        _write_index(folder, sweep.results, ("face", "u", "v", *names))
         n = int(sum(sweep.results))
     return n, names, sweep

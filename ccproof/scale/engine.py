@@ -33,11 +33,36 @@ MISSING_EXTRA = ("a Dask scheduler needs the optional extra 'scale': pip install
 
 
 class TaskFailed(CCProofError):
-    """At least one task of a sweep failed after its retries; the message names each one."""
+    """At least one task of a sweep failed after its retries; the message names each one.
+
+    Parameters
+    ----------
+    message : str
+        ``"<m> of <n> task(s) failed: ..."``, one entry per failed task (docs/scale-out.md).
+
+    Examples
+    --------
+    >>> import math
+    >>> run_tasks(math.sqrt, [4.0, -1.0], "serial", deterministic=(ValueError,), progress=False)
+    Traceback (most recent call last):
+    ...
+    ccproof.scale.engine.TaskFailed: 1 of 2 task(s) failed: task 1: FAILED: ValueError: math domain error
+    """
 
 
 def dask_available():
-    """True when ``dask.distributed`` can be imported (the optional extra ``scale``)."""
+    """True when ``dask.distributed`` can be imported (the optional extra ``scale``).
+
+    Returns
+    -------
+    bool
+
+    Examples
+    --------
+    >>> import importlib.util
+    >>> dask_available() == (importlib.util.find_spec("distributed") is not None)
+    True
+    """
     try:
         import distributed  # noqa: F401
     except ImportError:
@@ -47,7 +72,25 @@ def dask_available():
 
 @dataclass(frozen=True)
 class Scheduler:
-    """A parsed scheduler spec: ``kind`` is "serial", "local" or "address"."""
+    """A parsed scheduler spec (:func:`parse_scheduler`).
+
+    Parameters
+    ----------
+    kind : {"serial", "local", "address"}
+    workers : int, optional
+        Worker processes of a local cluster (None: one per core).
+    address : str, optional
+        Address of a running Dask scheduler (``tcp://host:8786``).
+    implicit : bool, optional
+        The default, not asked for: falls back to serial without Dask.
+
+    Examples
+    --------
+    >>> parse_scheduler("local:3")
+    Scheduler(kind='local', workers=3, address=None, implicit=False)
+    >>> str(Scheduler("address", address="tcp://h:8786"))
+    'tcp://h:8786'
+    """
 
     kind: str
     workers: int | None = None
@@ -63,6 +106,26 @@ class Scheduler:
 def parse_scheduler(spec=None, *, serial=False):
     """Parse ``"serial" | "local" | "local:N" | ADDRESS`` (None: "local", one worker per core).
 
+    docs/scale-out.md, "Choosing where tasks run".
+
+    Parameters
+    ----------
+    spec : str or Scheduler or None, optional
+        The spelling of ``--scheduler``; ``"local:1"`` is serial.
+    serial : bool, optional
+        Force the serial scheduler (``--serial``).
+
+    Returns
+    -------
+    Scheduler
+
+    Raises
+    ------
+    CCProofError
+        For a malformed spec, quoting it.
+
+    Examples
+    --------
     >>> [str(parse_scheduler(s)) for s in ("local:3", "local:1", "serial", "tcp://h:8786")]
     ['local:3', 'serial', 'serial', 'tcp://h:8786']
     >>> parse_scheduler("local:0")
@@ -92,7 +155,24 @@ def parse_scheduler(spec=None, *, serial=False):
 
 
 def add_scheduler_arguments(p):
-    """Add ``--scheduler`` and ``--serial`` to an argparse parser."""
+    """Add ``--scheduler`` and ``--serial`` to an argparse parser.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+
+    Returns
+    -------
+    None
+
+    Examples
+    --------
+    >>> import argparse
+    >>> p = argparse.ArgumentParser()
+    >>> add_scheduler_arguments(p)
+    >>> str(scheduler_from_args(p.parse_args(["--scheduler", "local:2"])))
+    'local:2'
+    """
     p.add_argument("--scheduler", default=None, metavar="local[:N]|ADDRESS",
                    help="where the tasks run: local (default: a local Dask cluster with one worker process per "
                         "core), local:N (N worker processes; local:1 runs in process) or the address of a "
@@ -102,7 +182,23 @@ def add_scheduler_arguments(p):
 
 
 def scheduler_from_args(args):
-    """The :class:`Scheduler` of parsed CLI arguments (``--serial``, ``--scheduler``, the older ``--jobs N``)."""
+    """The :class:`Scheduler` of parsed CLI arguments (``--serial``, ``--scheduler``, the older ``--jobs N``).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Any of the attributes ``scheduler``, ``serial``, ``jobs`` (missing ones count as unset).
+
+    Returns
+    -------
+    Scheduler
+
+    Examples
+    --------
+    >>> import argparse
+    >>> str(scheduler_from_args(argparse.Namespace(jobs=4))), str(scheduler_from_args(argparse.Namespace(serial=True)))
+    ('local:4', 'serial')
+    """
     spec = getattr(args, "scheduler", None)
     jobs = getattr(args, "jobs", None)
     if spec is None and jobs is not None:
@@ -112,7 +208,34 @@ def scheduler_from_args(args):
 
 @contextlib.contextmanager
 def client_for(scheduler):
-    """A connected :class:`distributed.Client` for a local or address scheduler (closed on exit)."""
+    """A connected :class:`distributed.Client` for a local or address scheduler (closed on exit).
+
+    A context manager; a local scheduler starts a ``LocalCluster`` of worker processes (one thread each).
+
+    Parameters
+    ----------
+    scheduler : str or Scheduler or distributed.Client
+        A local or address scheduler (:func:`parse_scheduler`); a Client is yielded unchanged.
+
+    Yields
+    ------
+    distributed.Client
+
+    Raises
+    ------
+    CCProofError
+        For the serial scheduler, or when the extra ``scale`` is not installed.
+
+    Examples
+    --------
+    Starting a cluster takes seconds, so the example shows the refusal only:
+
+    >>> with client_for("serial"):
+    ...     pass
+    Traceback (most recent call last):
+    ...
+    ccproof.errors.CCProofError: client_for needs a local or address scheduler, not 'serial'
+    """
     try:
         from distributed import Client, LocalCluster
     except ImportError:
@@ -136,8 +259,27 @@ def client_for(scheduler):
 
 @contextlib.contextmanager
 def open_scheduler(scheduler=None, n_tasks=None):
-    """A scheduler kept open for several sweeps: yields a connected Client, or the serial
-    :class:`Scheduler` (for "serial", for a single local task, or for the default without Dask)."""
+    """A scheduler kept open for several sweeps: yields a connected Client, or the serial :class:`Scheduler`.
+
+    Serial for "serial", for a single local task, or for the default without Dask.
+
+    Parameters
+    ----------
+    scheduler : str or Scheduler or distributed.Client, optional
+        See :func:`parse_scheduler`.
+    n_tasks : int, optional
+        Number of tasks; a single task runs in process.
+
+    Yields
+    ------
+    distributed.Client or Scheduler
+
+    Examples
+    --------
+    >>> with open_scheduler("local:4", n_tasks=1) as s:
+    ...     print(s)
+    serial
+    """
     if scheduler.__class__.__name__ == "Client":
         yield scheduler
         return
@@ -154,8 +296,26 @@ def open_scheduler(scheduler=None, n_tasks=None):
 class Sweep:
     """The outcome of :func:`run_tasks`: one entry of ``results`` per task, in task order.
 
-    ``errors`` maps a task index to the exception it ended with (its result is then None),
-    ``retried`` a task index to what happened to it (an exception retried, a worker lost under it).
+    Parameters
+    ----------
+    results : list
+        One result per task (None for a failed task).
+    errors : dict of int -> Exception
+        Task index -> the exception it ended with.
+    retried : dict of int -> str
+        Task index -> what happened to it (an exception retried, a worker lost under it).
+    scheduler : str
+        The scheduler that ran the sweep.
+    seconds : float
+        Wall-clock time.
+
+    Examples
+    --------
+    >>> import math
+    >>> sw = run_tasks(math.sqrt, [4.0, -1.0], "serial", deterministic=(ValueError,), progress=False,
+    ...                raise_errors=False)
+    >>> sw.results, sorted(sw.errors), sw.scheduler
+    ([2.0, None], [1], 'serial')
     """
 
     results: list
@@ -219,6 +379,16 @@ def run_tasks(fn, tasks, scheduler=None, *, shared=(), retries=2, deterministic=
         Raise :class:`TaskFailed` naming the failed tasks (after all others finished).
     names : sequence of str, optional
         A name per task for the report (default "task i").
+
+    Returns
+    -------
+    Sweep
+
+    Examples
+    --------
+    >>> import math
+    >>> run_tasks(math.factorial, [3, 4, 5], "serial", progress=False).results
+    [6, 24, 120]
     """
     tasks = list(tasks)
     s = scheduler if scheduler.__class__.__name__ == "Client" else parse_scheduler(scheduler)

@@ -22,7 +22,21 @@ MAX_CACHED = 8
 
 
 class Shipped:
-    """A builder call ``builder(*args, **kwargs)`` pickled once and named by the SHA-256 of the bytes."""
+    """A builder call ``builder(*args, **kwargs)`` pickled once and named by the SHA-256 of the bytes.
+
+    Made by :func:`ship`, built by :func:`rebuild` (docs/scale-out.md, "A real cluster").
+
+    Parameters
+    ----------
+    payload : bytes
+        The pickled ``(builder, args, kwargs)``.
+
+    Examples
+    --------
+    >>> from fractions import Fraction
+    >>> ship(Fraction, 1, 3).digest == ship(Fraction, 1, 3).digest != ship(Fraction, 1, 4).digest
+    True
+    """
 
     __slots__ = ("digest", "payload")
 
@@ -41,6 +55,22 @@ def ship(builder, *args, **kwargs):
     """A :class:`Shipped` for ``builder(*args, **kwargs)``; equal content gives the same digest.
 
     ``builder`` must be importable by name (a module-level function or class).
+
+    Parameters
+    ----------
+    builder : callable
+    args, kwargs
+        Picklable arguments.
+
+    Returns
+    -------
+    Shipped
+
+    Examples
+    --------
+    >>> from fractions import Fraction
+    >>> rebuild(ship(Fraction, 2, 6))
+    Fraction(1, 3)
     """
     return Shipped(pickle.dumps((builder, args, kwargs), protocol=5))
 
@@ -48,8 +78,23 @@ def ship(builder, *args, **kwargs):
 def rebuild(shipped, local=None):
     """The object a :class:`Shipped` describes, built at most once per process (cached by digest).
 
-    ``local`` (optional) is the object already built in this process, registered under the digest
-    so that a serial run does not build it twice.
+    Parameters
+    ----------
+    shipped : Shipped
+    local : object, optional
+        The object already built in this process, registered under the digest so that a serial run
+        does not build it twice.
+
+    Returns
+    -------
+    object
+        ``builder(*args, **kwargs)``, the same object on every call in this process.
+
+    Examples
+    --------
+    >>> s = ship(dict, a=1)
+    >>> rebuild(s) is rebuild(s), rebuild(s)
+    (True, {'a': 1})
     """
     obj = _CACHE.get(shipped.digest)
     if obj is None:
@@ -66,5 +111,17 @@ def rebuild(shipped, local=None):
 
 
 def build_counts():
-    """digest -> how many times this process built it (for tests and the benchmark)."""
+    """digest -> how many times this process built it (for tests and the benchmark).
+
+    Returns
+    -------
+    dict of str -> int
+
+    Examples
+    --------
+    >>> s = ship(dict, b=2)
+    >>> _ = rebuild(s), rebuild(s)
+    >>> build_counts()[s.digest]
+    1
+    """
     return dict(_BUILDS)

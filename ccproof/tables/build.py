@@ -273,7 +273,32 @@ def build_table(k: ValenceLike, prec: int = DEFAULT_PREC) -> dict[str, Any]:
 
 
 def write_table(k, directory=None, prec=DEFAULT_PREC):
-    """Build and write the table of ``k``; returns the path."""
+    """Build and write the table of ``k`` (:func:`build_table`); returns the path.
+
+    The file is the JSON of docs/tables.md, keys sorted, ASCII.
+
+    Parameters
+    ----------
+    k : int or str or dict or Valence
+        Valence k >= 3 or an interval ``">=K0"``.
+    directory : str or pathlib.Path, optional
+        Target folder (default ``certificates_dir() / "tables"``, see
+        :func:`ccproof.tables.format.table_path`).
+    prec : int, optional
+        Bits of precision of the arb data.
+
+    Returns
+    -------
+    pathlib.Path
+
+    Examples
+    --------
+    Building a table takes seconds (exact symbolic arithmetic), so this example is not run:
+
+    >>> p = write_table(5, "tables")                                    # doctest: +SKIP
+    >>> read_table_json(p)["hash"] == load_table(5).hash                 # doctest: +SKIP
+    True
+    """
     table = build_table(k, prec)
     path = table_path(table["valence"], directory)
     path.parent.mkdir(parents=True, exist_ok=True)

@@ -19,10 +19,10 @@ import numpy as np
 from ccproof.errors import TableNotFoundError, check_valence
 from ccproof.tables.format import (
     PATCHES,
+    _eval_form_arb,
     arb_from_json,
     available_tables,
     describe_available,
-    eval_form_arb,
     read_table_json,
     table_nets_arb,
     table_nets_exact,
@@ -48,6 +48,14 @@ class CharacteristicTable:
         Bezier nets of the same pieces.
     hash : str or None
         Content hash of the table file the data came from (None when derived on the fly).
+
+    Examples
+    --------
+    For k = 4 the characteristic map is the identity: the last Bezier point of P2 is (1, 1).
+
+    >>> t = load_table(4)
+    >>> t.lam, t.bezier.shape, t.bezier[1, 3, 3].tolist()
+    (0.5, (3, 4, 4, 2), [1.0, 1.0])
     """
 
     valence: int
@@ -121,6 +129,12 @@ class ArbCharacteristic:
         the exact nets of a table, whose hash is then ``source_hash``).
     source_hash : str
         Hash of the table file the data came from.
+
+    Examples
+    --------
+    >>> a = characteristic_arb(4)
+    >>> a.lam.contains(0.5), a.bezier["P2"][3][3][0].contains(1), a.hash == load_table(4).hash
+    (True, True, True)
     """
 
     valence: int
@@ -192,7 +206,7 @@ def characteristic_arb(k, prec=128):
         lam = lam_from_c(c, arb.sqrt)
         nets = {}
         for name in PATCHES:
-            bs = [[tuple(eval_form_arb(q, c, lam) for q in p) for p in row] for row in exact[name]]
+            bs = [[tuple(_eval_form_arb(q, c, lam) for q in p) for p in row] for row in exact[name]]
             rows = [[tuple(sum((M[a] * bs[a][j][comp] for a in range(4)), arb(0)) / 6 for comp in range(2))
                      for j in range(4)] for M in BSPLINE_TO_BEZIER_6]
             nets[name] = [[tuple(sum((M[b] * rows[i][b][comp] for b in range(4)), arb(0)) / 6 for comp in range(2))
@@ -209,6 +223,18 @@ def characteristic_nets(k):
     rounded once; ``hash`` is then None). Use :func:`load_table` when the data must come from the
     certified table of k itself.
 
+    Parameters
+    ----------
+    k : int
+        Valence, k >= 3.
+
+    Returns
+    -------
+    CharacteristicTable
+        Nets of shape (3, 4, 4, 2) float64 (docs/readings.md R3, R4).
+
+    Examples
+    --------
     >>> characteristic_nets(4).lam, characteristic_nets(1000).hash
     (0.5, None)
     """

@@ -46,16 +46,55 @@ __all__ = [
 
 
 class ChartError(CCProofError):
-    """A chart that is not a topological disk, or a malformed chart label file."""
+    """A chart that is not a topological disk, or a malformed chart label file.
+
+    Parameters
+    ----------
+    message : str
+        Names the chart (or the file, line and token).
+
+    Examples
+    --------
+    >>> from ccproof.mesh.examples import cube
+    >>> charts_from_labels(cube(), [0, 0, 0, 0, 0, 0])
+    Traceback (most recent call last):
+    ...
+    ccproof.apps.arap.charts.ChartError: chart 0 is not a topological disk: ...
+    """
 
 
 def read_labels(path, n_faces=None):
     """Read one integer label per face (whitespace separated, ``#`` comments allowed).
 
+    The chart file of ``ccproof arap --charts`` (docs/hsh10.md).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+    n_faces : int, optional
+        Expected number of labels.
+
+    Returns
+    -------
+    ndarray, shape (n_faces,) int64
+
     Raises
     ------
     ChartError
         If a token is not an integer or (when ``n_faces`` is given) the count is wrong.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> tmp = tempfile.TemporaryDirectory()          # removed when the example ends
+    >>> p = os.path.join(tmp.name, "labels.txt")
+    >>> write_labels(p, [0, 1, 1])
+    >>> read_labels(p).tolist()
+    [0, 1, 1]
+    >>> read_labels(p, n_faces=4)
+    Traceback (most recent call last):
+    ...
+    ccproof.apps.arap.charts.ChartError: ...
     """
     vals = []
     with open(os.fspath(path), encoding="utf-8") as fh:
@@ -72,14 +111,52 @@ def read_labels(path, n_faces=None):
 
 
 def write_labels(path, labels):
-    """Write one label per line (readable by :func:`read_labels`)."""
+    """Write one label per line (readable by :func:`read_labels`).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+    labels : array_like of int, shape (n_faces,)
+
+    Returns
+    -------
+    None
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> tmp = tempfile.TemporaryDirectory()          # removed when the example ends
+    >>> p = os.path.join(tmp.name, "labels.txt")
+    >>> write_labels(p, [2, 0])
+    >>> open(p).read().splitlines()[1:]
+    ['2', '0']
+    """
     with open(os.fspath(path), "w", encoding="utf-8") as fh:
         fh.write("# ccproof chart labels: one integer per face, in OBJ face order\n")
         fh.writelines(f"{int(x)}\n" for x in np.asarray(labels).ravel())
 
 
 def face_adjacency(mesh: QuadMesh):
-    """Sparse symmetric face-face adjacency through interior edges, shape (m, m)."""
+    """Sparse symmetric face-face adjacency through interior edges, shape (m, m).
+
+    Parameters
+    ----------
+    mesh : QuadMesh
+
+    Returns
+    -------
+    scipy.sparse matrix, shape (n_faces, n_faces)
+        1 where two faces share an interior edge.
+
+    Examples
+    --------
+    In a 3 x 3 grid the middle face has 4 edge neighbours and the 12 interior edges give 24 entries:
+
+    >>> from ccproof.mesh.examples import grid
+    >>> A = face_adjacency(grid(3, 3))
+    >>> A.shape, A.nnz, A[4].nnz
+    ((9, 9), 24, 4)
+    """
     ef = mesh.edge_faces
     it = ef[:, 1] >= 0
     a, b = ef[it, 0], ef[it, 1]
@@ -90,6 +167,25 @@ def face_adjacency(mesh: QuadMesh):
 def check_disk(mesh: QuadMesh, faces, name="chart"):
     """Raise :class:`ChartError` unless the faces ``faces`` of ``mesh`` form a topological disk.
 
+    Parameters
+    ----------
+    mesh : QuadMesh
+    faces : array_like of int
+        Face indices of the chart.
+    name : str, optional
+        Used in the message.
+
+    Returns
+    -------
+    None
+
+    Raises
+    ------
+    ChartError
+        If the faces are empty, not edge-connected, or not a disk (Euler characteristic, boundary loops).
+
+    Examples
+    --------
     >>> from ccproof.mesh.examples import grid
     >>> m = grid(3, 3)
     >>> check_disk(m, [f for f in range(9) if f != 4], "ring")
@@ -143,6 +239,17 @@ def charts_from_labels(mesh: QuadMesh, labels):
     Returns
     -------
     list of ndarray of int
+
+    Raises
+    ------
+    ChartError
+        Naming the first label whose faces are not a topological disk.
+
+    Examples
+    --------
+    >>> from ccproof.mesh.examples import grid
+    >>> [c.tolist() for c in charts_from_labels(grid(3, 3), [0, 0, 0, 1, 1, 1, -1, -1, -1])]
+    [[0, 1, 2], [3, 4, 5]]
     """
     labels = np.asarray(labels)
     if labels.ndim != 1 or labels.size != mesh.n_faces:
@@ -182,7 +289,26 @@ def split_into_disks(mesh: QuadMesh, labels, min_faces=1):
 
     Each label is split into its connected components (through edges); a component that is not a
     disk is cut in two by the median plane orthogonal to its longest principal axis (face centroids),
-    recursively. Labels are renumbered 0, 1, ... in order of their smallest face.
+    recursively. Labels are renumbered 0, 1, ... in order of their smallest face (docs/hsh10.md).
+
+    Parameters
+    ----------
+    mesh : QuadMesh
+    labels : array_like of int, shape (n_faces,)
+    min_faces : int, optional
+
+    Returns
+    -------
+    ndarray, shape (n_faces,) int64
+
+    Examples
+    --------
+    The closed cube is cut into two disks; a planar grid is one already:
+
+    >>> from ccproof.mesh.examples import cube, grid
+    >>> lab = split_into_disks(cube(), [0] * 6)
+    >>> sorted(set(lab.tolist())), split_into_disks(grid(3, 3), [0] * 9).tolist() == [0] * 9
+    ([0, 1], True)
     """
     labels = np.asarray(labels, dtype=np.int64)
     adj = face_adjacency(mesh)
@@ -213,9 +339,31 @@ def split_into_disks(mesh: QuadMesh, labels, min_faces=1):
 
 
 def merge_small(mesh: QuadMesh, labels, min_faces):
-    """Merge every chart with fewer than ``min_faces`` faces into the neighbouring chart with which
-    it shares the most edges, when the union is a disk (smallest charts first; repeated until no
-    merge applies). Labels are renumbered as in :func:`split_into_disks`."""
+    """Merge every chart with fewer than ``min_faces`` faces into its best neighbour.
+
+    The neighbour is the chart with which it shares the most edges, when the union is a disk
+    (smallest charts first; repeated until no merge applies). Labels are renumbered as in
+    :func:`split_into_disks` (docs/hsh10.md).
+
+    Parameters
+    ----------
+    mesh : QuadMesh
+    labels : array_like of int, shape (n_faces,)
+    min_faces : int
+
+    Returns
+    -------
+    ndarray, shape (n_faces,) int64
+
+    Examples
+    --------
+    The six one-face charts of the cube merge into two disks (five faces cannot close up; the sixth
+    stays):
+
+    >>> from ccproof.mesh.examples import cube
+    >>> sorted(set(merge_small(cube(), range(6), 2).tolist()))
+    [0, 1]
+    """
     labels = np.asarray(labels, dtype=np.int64).copy()
     ef = mesh.edge_faces
     it = ef[:, 1] >= 0
@@ -256,6 +404,21 @@ def segment_by_normals(mesh: QuadMesh, smooth=3, min_faces=20):
     :func:`split_into_disks` and :func:`merge_small` (``min_faces``). Deterministic; documented in
     docs/hsh10.md.
 
+    Parameters
+    ----------
+    mesh : QuadMesh
+    smooth : int, optional
+        Rounds of majority vote.
+    min_faces : int, optional
+        Charts smaller than this are merged (:func:`merge_small`).
+
+    Returns
+    -------
+    ndarray, shape (n_faces,) int64
+        Chart labels 0, 1, ...
+
+    Examples
+    --------
     >>> from ccproof.mesh.examples import cube
     >>> segment_by_normals(cube(), min_faces=1).tolist()
     [0, 1, 2, 3, 4, 5]
@@ -276,8 +439,27 @@ def segment_by_normals(mesh: QuadMesh, smooth=3, min_faces=20):
 def grow_patch(mesh: QuadMesh, seed_face, rings):
     """Faces within ``rings`` steps (through shared vertices) of ``seed_face``, holes filled.
 
-    Returns the sorted face indices of a topological disk (raises :class:`ChartError` if the grown
-    region is not one, e.g. when it wraps around a handle).
+    Parameters
+    ----------
+    mesh : QuadMesh
+    seed_face : int
+    rings : int
+
+    Returns
+    -------
+    ndarray of int64
+        The sorted face indices of a topological disk.
+
+    Raises
+    ------
+    ChartError
+        If the grown region is not a disk (e.g. when it wraps around a handle).
+
+    Examples
+    --------
+    >>> from ccproof.mesh.examples import grid
+    >>> grow_patch(grid(3, 3), 0, 1).tolist(), grow_patch(grid(3, 3), 4, 1).size
+    ([0, 1, 3, 4], 9)
     """
     F = mesh.faces
     m, n = mesh.n_faces, mesh.n_vertices

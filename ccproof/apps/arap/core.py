@@ -73,7 +73,29 @@ METHOD_NAMES = {
 
 @dataclass
 class LevelStats:
-    """What happened at one optimization level."""
+    """What happened at one optimization level (the multi-resolution schedule of hsh10 section 3).
+
+    Parameters
+    ----------
+    level : int
+    samples : int
+        Number of samples of hsh10 Eq. 3 at this level.
+    build_seconds, seconds, seconds_per_iteration : float
+    iterations : int
+    energy_start, energy_end : float
+        ARAP energy before and after.
+    converged : bool
+    regularized : bool
+        Whether the global step needed a regularization.
+
+    Examples
+    --------
+    >>> from ccproof.mesh.examples import grid
+    >>> from ccproof.apps.arap.hierarchy import ChartHierarchy
+    >>> tex, seconds, iterations, stats = run_method(ChartHierarchy(grid(3, 3), range(9)), "c", levels=1)
+    >>> [(s.level, s.converged, s.energy_end < 1e-20) for s in stats]       # a flat grid: isometric
+    [(1, True, True)]
+    """
 
     level: int
     samples: int
@@ -89,7 +111,27 @@ class LevelStats:
 
 @dataclass
 class ChartTexture:
-    """A chart's texture: level-``level`` values on ``E_level`` subdivided with ``rules``."""
+    """A chart's texture: level-``level`` values on ``E_level`` subdivided with ``rules``.
+
+    Parameters
+    ----------
+    hierarchy : ChartHierarchy
+    rules : {"boundary", "extended"}
+        Subdivision rules of the texture (hsh10 section 3; docs/hsh10.md).
+    level : int
+    values : ndarray, shape (n, 2) float64
+        Texture coordinates of the level-``level`` vertices.
+    unknowns : ndarray, shape (n_unknowns, 2) float64, optional
+        Texture unknowns (control level of the method).
+
+    Examples
+    --------
+    >>> from ccproof.mesh.examples import grid
+    >>> from ccproof.apps.arap.hierarchy import ChartHierarchy
+    >>> tex = run_method(ChartHierarchy(grid(3, 3), range(9)), "c", levels=1)[0]
+    >>> tex.rules, tex.level, tex.values.shape[1]
+    ('extended', 0, 2)
+    """
 
     hierarchy: ChartHierarchy
     rules: str
@@ -101,7 +143,31 @@ class ChartTexture:
 
 @dataclass
 class MethodResult:
-    """One method on all charts of a mesh."""
+    """One method on all charts of a mesh (a row of the comparison of hsh10 section 4).
+
+    Parameters
+    ----------
+    method : {"a", "b", "c", "d"}
+    textures : list of ChartTexture
+    seconds : float
+    iterations : int
+    metrics : Metrics, optional
+    flips_control, triangles_control : int, optional
+    levels : list of LevelStats, optional
+    refine : int, optional
+        Times the control mesh was subdivided before optimizing (b, c).
+    samples : list, optional
+        Per chart (P, UV, Q) limit samples at ``sample_level`` (see :func:`compare`).
+    sample_level : int, optional
+
+    Examples
+    --------
+    >>> from ccproof.mesh.examples import grid
+    >>> res, _ = compare(grid(3, 3), methods=("c",), levels=1, eval_level=3)
+    >>> r = res["c"]
+    >>> r.method, len(r.textures), r.metrics.flips
+    ('c', 1, 0)
+    """
 
     method: str
     textures: list
@@ -133,8 +199,32 @@ def _chart_triangles(h: ChartHierarchy):
 
 
 def initial_texture(h: ChartHierarchy, rules):
-    """LSCM of the triangulated chart control mesh at its natural scale; for extended charts the
-    ring unknowns are the conformal extension of it. Shape (n_unknowns, 2)."""
+    """LSCM of the triangulated chart control mesh at its natural scale.
+
+    For extended charts the ring unknowns are the conformal extension of it (the initialization of
+    hsh10 section 3; docs/hsh10.md).
+
+    Parameters
+    ----------
+    h : ChartHierarchy
+    rules : {"boundary", "extended"}
+
+    Returns
+    -------
+    ndarray, shape (n_unknowns, 2) float64
+
+    Examples
+    --------
+    A flat grid is developed isometrically (up to a rigid motion): the side lengths stay 3:
+
+    >>> import numpy as np
+    >>> from ccproof.mesh.examples import grid
+    >>> from ccproof.apps.arap.hierarchy import ChartHierarchy
+    >>> h = ChartHierarchy(grid(3, 3), range(9))
+    >>> X = initial_texture(h, "boundary")
+    >>> X.shape, round(float(np.linalg.norm(X[3] - X[0])), 9)
+    ((16, 2), 3.0)
+    """
     V, Tc = _chart_triangles(h)
     nc = h.n_chart_vertices
     UV = fit_area(lscm(V[:nc], Tc), V[:nc], Tc)
@@ -153,9 +243,33 @@ def optimize_chart(h: ChartHierarchy, rules, X0, levels=3, start_level=1, tol=1e
 
     ``accel``: Anderson acceleration history of :func:`~ccproof.apps.arap.solver.iterate` (0: plain).
 
+    Parameters
+    ----------
+    h : ChartHierarchy
+    rules : {"boundary", "extended"}
+    X0 : ndarray, shape (n_unknowns, 2) float64
+        Initial texture unknowns (:func:`initial_texture`).
+    levels, start_level : int, optional
+        The multi-resolution schedule: sample levels ``start_level .. start_level + levels - 1``.
+    tol : float, optional
+    max_iter : int, optional
+    trace : bool, optional
+    accel : int, optional
+
     Returns
     -------
-    X : (n_unknowns, 2), stats : list of LevelStats, runs : list of IterationResult
+    X : ndarray, shape (n_unknowns, 2) float64
+    stats : list of LevelStats
+    runs : list of IterationResult
+
+    Examples
+    --------
+    >>> from ccproof.mesh.examples import grid
+    >>> from ccproof.apps.arap.hierarchy import ChartHierarchy
+    >>> h = ChartHierarchy(grid(3, 3), range(9))
+    >>> X, stats, runs = optimize_chart(h, "extended", initial_texture(h, "extended"), levels=2)
+    >>> X.shape, [s.level for s in stats], all(s.converged for s in stats)
+    ((16, 2), [1, 2], True)
     """
     if start_level < 0 or levels < start_level:
         raise CCProofError(f"need 0 <= start_level <= levels, got start_level={start_level}, levels={levels}")
@@ -223,7 +337,34 @@ def polygon_arap(V, T, UV0, engine="numpy", tol=1e-6, max_iter=500):
 
     engine "numpy": this package's local/global solver on triangle samples (exactly Liu's energy);
     engine "igl": libigl ``arap_precomputation(dim=2)`` + ``arap_solve`` one iteration at a time.
-    Returns (UV, iterations, converged).
+    The method (a) baseline of docs/hsh10.md.
+
+    Parameters
+    ----------
+    V : ndarray, shape (n, 3) float64
+    T : ndarray, shape (t, 3) int64
+    UV0 : ndarray, shape (n, 2) float64
+        Initial texture.
+    engine : {"numpy", "igl"}, optional
+    tol : float, optional
+    max_iter : int, optional
+
+    Returns
+    -------
+    UV : ndarray, shape (n, 2) float64
+    iterations : int
+    converged : bool
+
+    Examples
+    --------
+    A unit square started 1.3 times too large comes back to its true size:
+
+    >>> import numpy as np
+    >>> from ccproof.apps.arap.lscm import triangulate_quads
+    >>> V = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0.0]])
+    >>> UV, it, ok = polygon_arap(V, triangulate_quads(V, [[0, 1, 2, 3]]), 1.3 * V[:, :2])
+    >>> np.round(UV, 9).tolist(), ok
+    ([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]], True)
     """
     if engine == "igl":
         return _triangle_arap_igl(V, T, UV0, tol, max_iter)
@@ -233,9 +374,37 @@ def polygon_arap(V, T, UV0, engine="numpy", tol=1e-6, max_iter=500):
 
 
 def lift_to_refined(h: ChartHierarchy, X, rules, fine: ChartHierarchy, times):
-    """Texture unknowns of the chart of the ``times`` times refined mesh (``fine``) that give exactly
-    the texture ``X`` of ``h``: the level-``times`` values of ``h`` (its ``E_times`` is the refined
-    chart's ``E_0``), matched by position. Shape (fine.n_unknowns(rules), 2)."""
+    """Texture unknowns of the chart of the ``times`` times refined mesh (``fine``) that give ``X``.
+
+    The level-``times`` values of ``h`` (its ``E_times`` is the refined chart's ``E_0``), matched by
+    position: the same texture on the same limit surface (docs/hsh10.md, "(c) and (d)").
+
+    Parameters
+    ----------
+    h : ChartHierarchy
+    X : ndarray, shape (h.n_unknowns(rules), 2) float64
+    rules : {"boundary", "extended"}
+    fine : ChartHierarchy
+        The chart on :func:`refine_mesh` (mesh, labels, times).
+    times : int
+
+    Returns
+    -------
+    ndarray, shape (fine.n_unknowns(rules), 2) float64
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from ccproof.mesh.examples import grid
+    >>> from ccproof.apps.arap.hierarchy import ChartHierarchy
+    >>> h = ChartHierarchy(grid(3, 3), range(9))
+    >>> fm, _ = refine_mesh(grid(3, 3), None, 1)
+    >>> fine = ChartHierarchy(fm, range(fm.n_faces))
+    >>> X = h.surface.vertices[h.unknown_vertices][:, :2]                     # the identity texture
+    >>> Y = lift_to_refined(h, X, "boundary", fine, 1)
+    >>> bool(np.abs(Y - fine.surface.vertices[fine.unknown_vertices][:, :2]).max() < 1e-12)
+    True
+    """
     from scipy.spatial import cKDTree
 
     L = h.level(times)
@@ -250,10 +419,42 @@ def lift_to_refined(h: ChartHierarchy, X, rules, fine: ChartHierarchy, times):
 
 def run_method(h: ChartHierarchy, method, levels=3, start_level=1, tol=1e-6, max_iter=1000, engine="numpy",
                baseline_level=3, baseline_max_iter=2000, trace=False, X0=None, accel=0):
-    """Run one method on one chart. Returns (ChartTexture, seconds, iterations, level stats).
+    """Run one method of hsh10 section 4 on one chart.
 
     ``X0``: initial texture unknowns of (b) / (c) (default: :func:`initial_texture`); ``accel``:
-    Anderson acceleration of (b) / (c) (:func:`~ccproof.apps.arap.solver.iterate`)."""
+    Anderson acceleration of (b) / (c) (:func:`~ccproof.apps.arap.solver.iterate`). docs/hsh10.md.
+
+    Parameters
+    ----------
+    h : ChartHierarchy
+    method : {"a", "b", "c", "d"}
+    levels, start_level : int, optional
+        The multi-resolution schedule.
+    tol : float, optional
+    max_iter : int, optional
+    engine : {"numpy", "igl"}, optional
+        ARAP engine of method (a).
+    baseline_level, baseline_max_iter : int, optional
+        Level and iterations of the polygon baselines (a), (d).
+    trace : bool, optional
+    X0 : ndarray, shape (n_unknowns, 2), optional
+    accel : int, optional
+
+    Returns
+    -------
+    texture : ChartTexture
+    seconds : float
+    iterations : int
+    stats : list of LevelStats
+
+    Examples
+    --------
+    >>> from ccproof.mesh.examples import grid
+    >>> from ccproof.apps.arap.hierarchy import ChartHierarchy
+    >>> tex, seconds, iterations, stats = run_method(ChartHierarchy(grid(3, 3), range(9)), "c", levels=1)
+    >>> [round(x, 9) for x in texture_metrics(tex, eval_level=3).as_tuple()]
+    [2.0, 2.0, 1.0]
+    """
     t0 = time.perf_counter()
     if method in ("b", "c"):
         rules = "boundary" if method == "b" else "extended"
@@ -295,7 +496,31 @@ def _metric_samples(h: ChartHierarchy, level, rules):
 
 
 def texture_metrics(tex: ChartTexture, eval_level=5, per_sample=False):
-    """A9 metrics of a chart texture at ``eval_level`` (same samples for every method)."""
+    """The metrics of a chart texture at ``eval_level`` (same samples for every method).
+
+    E_angle, E_area, E_stretch of hsh10 section 4 (docs/hsh10.md); an isometry gives 2, 2, 1.
+
+    Parameters
+    ----------
+    tex : ChartTexture
+    eval_level : int, optional
+        Subdivision level of the samples (>= the texture's level).
+    per_sample : bool, optional
+        Also return the per-sample values.
+
+    Returns
+    -------
+    Metrics
+
+    Examples
+    --------
+    >>> from ccproof.mesh.examples import grid
+    >>> from ccproof.apps.arap.hierarchy import ChartHierarchy
+    >>> tex = run_method(ChartHierarchy(grid(3, 3), range(9)), "c", levels=1)[0]
+    >>> m = texture_metrics(tex, eval_level=3)
+    >>> [round(x, 9) for x in m.as_tuple()], m.flips
+    ([2.0, 2.0, 1.0], 0)
+    """
     if eval_level < tex.level:
         raise CCProofError(f"evaluation level {eval_level} is below the texture's level {tex.level}")
     X = tex.hierarchy.subdivide_values(tex.values, tex.rules, tex.level, eval_level)
@@ -304,8 +529,26 @@ def texture_metrics(tex: ChartTexture, eval_level=5, per_sample=False):
 
 
 def control_flips(tex: ChartTexture):
-    """(flipped, total) triangles of the texture's control mesh (chart faces at its level, split
-    along the shorter 3D diagonal); flipped = signed texture area <= 0."""
+    """(flipped, total) triangles of the texture's control mesh.
+
+    Chart faces at its level, split along the shorter 3D diagonal; flipped = signed texture area <= 0
+    (hsh10 section 4).
+
+    Parameters
+    ----------
+    tex : ChartTexture
+
+    Returns
+    -------
+    flipped, total : int
+
+    Examples
+    --------
+    >>> from ccproof.mesh.examples import grid
+    >>> from ccproof.apps.arap.hierarchy import ChartHierarchy
+    >>> control_flips(run_method(ChartHierarchy(grid(3, 3), range(9)), "c", levels=1)[0])   # 9 quads, 2 triangles each
+    (0, 18)
+    """
     L = tex.hierarchy.level(tex.level)
     T = triangulate_quads(L.mesh.vertices, L.chart_faces())
     a = signed_areas(tex.values, T)
@@ -333,8 +576,29 @@ BASE_BYTES = 150e6
 
 
 def refine_mesh(mesh, labels, times):
-    """The control mesh subdivided ``times`` times (the same limit surface) and the labels of the
-    children (child ``4 f + i`` of face ``f`` keeps its label)."""
+    """The control mesh subdivided ``times`` times (the same limit surface) and the children's labels.
+
+    Child ``4 f + i`` of face ``f`` keeps its label.
+
+    Parameters
+    ----------
+    mesh : QuadMesh
+    labels : array_like of int, shape (n_faces,), or None
+    times : int
+
+    Returns
+    -------
+    mesh : QuadMesh
+        With 4**times as many faces.
+    labels : ndarray of int64 or None
+
+    Examples
+    --------
+    >>> from ccproof.mesh.examples import grid
+    >>> m, lab = refine_mesh(grid(3, 3), range(9), 1)
+    >>> m.n_faces, lab[:8].tolist()
+    (36, [0, 0, 0, 0, 1, 1, 1, 1])
+    """
     from ccproof.mesh import subdivide
 
     lab = None if labels is None else np.asarray(labels)
@@ -347,7 +611,26 @@ def refine_mesh(mesh, labels, times):
 
 def auto_refine(mesh, labels, faces_per_chart=1000):
     """The measured default of ``refine``: the smallest r in 0..2 with at least ``faces_per_chart``
-    control faces per chart after r subdivisions (docs/hsh10.md, "(c) and (d)")."""
+    control faces per chart after r subdivisions (docs/hsh10.md, "(c) and (d)").
+
+    Parameters
+    ----------
+    mesh : QuadMesh
+    labels : array_like of int or None
+    faces_per_chart : int, optional
+
+    Returns
+    -------
+    int
+
+    Examples
+    --------
+    9 faces: 36 after one subdivision, 144 after two (the most):
+
+    >>> from ccproof.mesh.examples import grid
+    >>> auto_refine(grid(3, 3), None, 10), auto_refine(grid(3, 3), None, 100), auto_refine(grid(3, 3), None, 10**6)
+    (1, 2, 2)
+    """
     n_charts = len(_charts(mesh, labels))
     per = mesh.n_faces / max(n_charts, 1) if labels is None else (np.asarray(labels) >= 0).sum() / max(n_charts, 1)
     r = 0
@@ -357,10 +640,32 @@ def auto_refine(mesh, labels, faces_per_chart=1000):
 
 
 def estimate_memory(hierarchies, deepest_level, release=True, opt_level=None):
-    """Estimated peak bytes (linear in the faces): :data:`BYTES_PER_FACE` per face of ``E_deepest``
-    (metrics, output) and :data:`OPT_BYTES_PER_FACE` per face of ``E_opt_level`` (optimization), for the
-    largest chart (``release``: charts are processed one at a time) or all charts, plus
-    :data:`BASE_BYTES`."""
+    """Estimated peak bytes of a run (linear in the faces).
+
+    :data:`BYTES_PER_FACE` per face of ``E_deepest`` (metrics, output) and :data:`OPT_BYTES_PER_FACE` per
+    face of ``E_opt_level`` (optimization), for the largest chart (``release``: charts are processed one
+    at a time) or all charts, plus :data:`BASE_BYTES`.
+
+    Parameters
+    ----------
+    hierarchies : list of ChartHierarchy
+    deepest_level : int
+    release : bool, optional
+    opt_level : int, optional
+
+    Returns
+    -------
+    float
+        Bytes.
+
+    Examples
+    --------
+    >>> from ccproof.mesh.examples import grid
+    >>> from ccproof.apps.arap.hierarchy import ChartHierarchy
+    >>> h = ChartHierarchy(grid(3, 3), range(9))
+    >>> estimate_memory([h], 3) == BASE_BYTES + BYTES_PER_FACE * h.n_faces(3)
+    True
+    """
     def need(k, per):
         if k is None:
             return 0.0
@@ -371,7 +676,18 @@ def estimate_memory(hierarchies, deepest_level, release=True, opt_level=None):
 
 
 class MemoryBudgetError(CCProofError):
-    """The estimated memory of a run exceeds the budget (raised before allocating)."""
+    """The estimated memory of a run exceeds the budget (raised before allocating).
+
+    Parameters
+    ----------
+    message : str
+        The estimate and the budget.
+
+    Examples
+    --------
+    >>> issubclass(MemoryBudgetError, CCProofError)
+    True
+    """
 
 
 def compare(mesh, labels=None, methods=METHODS, levels=3, start_level=1, eval_level=5, tol=1e-6, max_iter=1000,
@@ -407,6 +723,15 @@ def compare(mesh, labels=None, methods=METHODS, levels=3, start_level=1, eval_le
     Returns
     -------
     dict method -> MethodResult, and the list of ChartHierarchy of the input mesh (reusable)
+
+    Examples
+    --------
+    A flat grid has an isometric texture, E_angle = E_area = 2, E_stretch = 1 (their minima):
+
+    >>> from ccproof.mesh.examples import grid
+    >>> res, hierarchies = compare(grid(3, 3), methods=("b", "c"), levels=1, eval_level=3)
+    >>> [[round(x, 9) for x in res[m].metrics.as_tuple()] for m in "bc"], len(hierarchies)
+    ([[2.0, 2.0, 1.0], [2.0, 2.0, 1.0]], 1)
     """
     charts = _charts(mesh, labels)
     if hierarchies is None:

@@ -60,6 +60,15 @@ class SampledSurface:
     chart : (n,) chart of every point; cell_chart : (m,) chart of every cell
     scale : float, the packing scale s
     transforms : list of (R (2, 2), t (2,)) per chart
+
+    Examples
+    --------
+    >>> from ccproof.mesh.examples import grid
+    >>> from ccproof.apps.arap.core import compare
+    >>> res, _ = compare(grid(3, 3), methods=("c",), levels=1, eval_level=3)
+    >>> S = sampled_surface(res["c"], level=1)
+    >>> S.points.shape, S.cells.shape, S.cell_type, bool(0 <= S.uv.min() and S.uv.max() <= 1)
+    ((49, 3), (72, 3), 'triangle', True)
     """
 
     points: np.ndarray
@@ -100,6 +109,17 @@ def sample_chart(tex, level):
     Returns
     -------
     P : (n, 3), UV : (n, 2), Q : int (m, 4) in local indices (the chart vertices of ``E_level``)
+
+    Examples
+    --------
+    Level 1 of a 3 x 3 grid has 6 x 6 quads on 7 x 7 vertices:
+
+    >>> from ccproof.mesh.examples import grid
+    >>> from ccproof.apps.arap.core import compare
+    >>> res, _ = compare(grid(3, 3), methods=("c",), levels=1, eval_level=3)
+    >>> P, UV, Q = sample_chart(res["c"].textures[0], 1)
+    >>> P.shape, UV.shape, Q.shape
+    ((49, 3), (49, 2), (36, 4))
     """
     if level < tex.level:
         raise CCProofError(f"output level {level} is below the texture's level {tex.level} (method (d) needs >= 3)")
@@ -136,6 +156,15 @@ def pack_charts(uvs, gap=0.02, rotate=True):
     -------
     transforms : list of (R (2, 2), t (2,)), scale : float
         The packed UVs of chart c are ``scale * (uv_c @ R.T + t)``, inside [0, 1]^2, boxes disjoint.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> uvs = [np.array([[0, 0], [2, 1.0]]), np.array([[5, 5], [6, 8.0]])]
+    >>> transforms, scale = pack_charts(uvs)
+    >>> packed = [scale * (uv @ R.T + t) for uv, (R, t) in zip(uvs, transforms)]
+    >>> all(0 <= p.min() and p.max() <= 1 for p in packed)
+    True
     """
     if not uvs:
         return [], 1.0
@@ -186,9 +215,26 @@ def pack_charts(uvs, gap=0.02, rotate=True):
 def sampled_surface(result, level=3, cells="triangle", gap=0.02):
     """The charts of ``result`` (a :class:`~ccproof.apps.arap.core.MethodResult`) as one sampled mesh.
 
+    Parameters
+    ----------
+    result : MethodResult
+    level : int, optional
+        Subdivision level of the samples.
+    cells : {"triangle", "quad"}, optional
+    gap : float, optional
+        Padding of :func:`pack_charts`.
+
     Returns
     -------
     SampledSurface
+
+    Examples
+    --------
+    >>> from ccproof.mesh.examples import grid
+    >>> from ccproof.apps.arap.core import compare
+    >>> res, _ = compare(grid(3, 3), methods=("c",), levels=1, eval_level=3)
+    >>> sampled_surface(res["c"], level=1, cells="quad").cells.shape
+    (36, 4)
     """
     if cells not in ("triangle", "quad"):
         raise CCProofError(f"cells must be 'triangle' or 'quad', got {cells!r}")
@@ -225,9 +271,39 @@ def _write_rows(fh, tag, A, fmt):
 
 
 def write_surface(path, surf: SampledSurface, comment=None):
-    """Write a :class:`SampledSurface`: ``.obj`` (``v``, ``vt``, ``f i/i ...``; full precision) by
-    this function, any other extension through meshio (point data ``uv`` and ``chart``; for PLY,
-    which has scalar vertex properties only, ``s`` and ``t``)."""
+    """Write a :class:`SampledSurface`.
+
+    ``.obj`` (``v``, ``vt``, ``f i/i ...``; full precision) by this function, any other extension
+    through meshio (point data ``uv`` and ``chart``; for PLY, which has scalar vertex properties only,
+    ``s`` and ``t``). docs/hsh10.md.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+    surf : SampledSurface
+    comment : str, optional
+        A header comment (OBJ).
+
+    Returns
+    -------
+    str
+        ``path``.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> import numpy as np
+    >>> from ccproof.mesh.examples import grid
+    >>> from ccproof.apps.arap.core import compare
+    >>> res, _ = compare(grid(3, 3), methods=("c",), levels=1, eval_level=3)
+    >>> S = sampled_surface(res["c"], level=1)
+    >>> tmp = tempfile.TemporaryDirectory()          # removed when the example ends
+    >>> path = os.path.join(tmp.name, "surface.obj")
+    >>> _ = write_surface(path, S)
+    >>> points, uv, cells = read_surface(path)
+    >>> bool(np.array_equal(points, S.points) and np.array_equal(uv, S.uv)), cells.shape
+    (True, (72, 3))
+    """
     path = os.fspath(path)
     if path.lower().endswith(".obj"):
         ch = surf.cell_chart
@@ -267,7 +343,34 @@ def write_surface(path, surf: SampledSurface, comment=None):
 
 
 def read_surface(path):
-    """Read a written surface back with meshio: (points (n, 3), uv (n, 2), cells (m, k))."""
+    """Read a written surface back with meshio: (points (n, 3), uv (n, 2), cells (m, k)).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A file of :func:`write_surface` (OBJ, PLY or any meshio format).
+
+    Returns
+    -------
+    points : ndarray, shape (n, 3) float64
+    uv : ndarray, shape (n, 2) float64
+    cells : ndarray, shape (m, 3) or (m, 4) int
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> import numpy as np
+    >>> from ccproof.mesh.examples import grid
+    >>> from ccproof.apps.arap.core import compare
+    >>> res, _ = compare(grid(3, 3), methods=("c",), levels=1, eval_level=3)
+    >>> S = sampled_surface(res["c"], level=1, cells="quad")
+    >>> tmp = tempfile.TemporaryDirectory()          # removed when the example ends
+    >>> path = os.path.join(tmp.name, "surface.ply")
+    >>> _ = write_surface(path, S)
+    >>> points, uv, cells = read_surface(path)
+    >>> bool(np.abs(uv - S.uv).max() < 1e-12), cells.shape
+    (True, (36, 4))
+    """
     import meshio
 
     m = meshio.read(os.fspath(path))

@@ -55,7 +55,17 @@ RULES = ("extended", "boundary")
 
 
 class HierarchyError(CCProofError):
-    """An internal consistency check of the chart hierarchy failed."""
+    """An internal consistency check of the chart hierarchy failed.
+
+    Parameters
+    ----------
+    message : str
+
+    Examples
+    --------
+    >>> issubclass(HierarchyError, CCProofError)
+    True
+    """
 
 
 def split_nonmanifold(F, n):
@@ -140,6 +150,16 @@ class Level:
         Chart corners of the boundary rules (one chart face; not a one-face surface corner).
     surface_boundary_nbrs : int (n, 2)
         The two surface-boundary neighbours (crease rule of the surface), -1 elsewhere.
+
+    Examples
+    --------
+    A 2 x 2 chart in the corner of a 3 x 3 grid: at level 1 its 16 faces have 5 x 5 vertices, and
+    three of its four corners are chart corners (the fourth is a corner of the surface):
+
+    >>> from ccproof.mesh.examples import grid
+    >>> L = ChartHierarchy(grid(3, 3), [0, 1, 3, 4]).level(1)
+    >>> L.chart_faces().shape, int(L.chart_vertex.sum()), int(L.corner.sum())
+    ((16, 4), 25, 3)
     """
 
     def __init__(self, mesh: QuadMesh, n_chart_faces: int):
@@ -191,6 +211,18 @@ class ChartHierarchy:
         The whole control mesh (the surface).
     chart_faces : array_like of int
         Face indices of the chart in ``mesh`` (a topological disk; not re-checked here).
+
+    Notes
+    -----
+    hsh10 section 3 (the subdivision hierarchy of a chart; extended charts and boundary rules),
+    docs/hsh10.md.
+
+    Examples
+    --------
+    >>> from ccproof.mesh.examples import grid
+    >>> h = ChartHierarchy(grid(3, 3), [0, 1, 3, 4])
+    >>> h.n_chart_vertices, h.level(2).chart_faces().shape          # 3 x 3 vertices; 4 * 4**2 faces
+    (9, (64, 4))
     """
 
     def __init__(self, mesh: QuadMesh, chart_faces):

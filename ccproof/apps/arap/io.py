@@ -42,7 +42,27 @@ RULE_TEXT = {
 
 
 def layout_offsets(uvs, gap=0.05):
-    """Translations placing the charts' texture boxes left to right (gap relative to the width)."""
+    """Translations placing the charts' texture boxes left to right (gap relative to the width).
+
+    Parameters
+    ----------
+    uvs : list of ndarray, shape (n_c, 2) float64
+    gap : float, optional
+
+    Returns
+    -------
+    list of ndarray, shape (2,) float64
+        One translation per chart.
+
+    Examples
+    --------
+    The second box (width 1) starts after the first one (width 1) and a gap of 0.5:
+
+    >>> import numpy as np
+    >>> offs = layout_offsets([np.array([[0, 0], [1, 1.0]]), np.array([[5, 5], [6, 7.0]])], gap=0.5)
+    >>> [(np.round(o, 9) + 0.0).tolist() for o in offs]
+    [[0.0, 0.0], [-3.5, -5.0]]
+    """
     offs = []
     x = 0.0
     for uv in uvs:
@@ -57,7 +77,36 @@ def write_uv_obj(path, mesh, result, comment=None, table=None, transforms=None, 
 
     ``transforms`` (list of (R, t) per chart) and ``scale``: the packing of
     :func:`~ccproof.apps.arap.export.pack_charts` (texture point ``scale * (uv @ R.T + t)``).
-    Returns the path of the JSON sidecar.
+    The OBJ of ``ccproof arap`` (docs/hsh10.md).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The OBJ file.
+    mesh : QuadMesh
+    result : MethodResult
+    comment : str, optional
+    table : str, optional
+        Text written into the header.
+    transforms : list of (ndarray (2, 2), ndarray (2,)), optional
+    scale : float, optional
+
+    Returns
+    -------
+    str
+        The path of the JSON sidecar.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> from ccproof.mesh.examples import grid
+    >>> from ccproof.apps.arap.core import compare
+    >>> res, _ = compare(grid(3, 3), methods=("c",), levels=1, eval_level=3)
+    >>> tmp = tempfile.TemporaryDirectory()          # removed when the example ends
+    >>> d = tmp.name
+    >>> sidecar = write_uv_obj(os.path.join(d, "grid.obj"), grid(3, 3), res["c"])
+    >>> sorted(os.listdir(d)), os.path.basename(sidecar)
+    (['grid.obj', 'grid.obj.json'], 'grid.obj.json')
     """
     path = os.fspath(path)
     texs = result.textures

@@ -28,7 +28,26 @@ __all__ = ["triangulate_quads", "lscm", "lscm_extend", "signed_areas", "fit_area
 
 
 def triangulate_quads(V, F):
-    """Two triangles per quad, split along the shorter diagonal; triangle 2f, 2f+1 from quad f."""
+    """Two triangles per quad, split along the shorter diagonal; triangle 2f, 2f+1 from quad f.
+
+    Parameters
+    ----------
+    V : ndarray, shape (n, 3) float64
+    F : array_like, shape (m, 4) int
+
+    Returns
+    -------
+    ndarray, shape (2m, 3) int64
+
+    Examples
+    --------
+    A kite whose diagonal 1-3 is the shorter one is split along it:
+
+    >>> import numpy as np
+    >>> V = np.array([[0, 0, 0], [2, -0.5, 0], [4, 0, 0], [2, 0.5, 0.0]])
+    >>> triangulate_quads(V, [[0, 1, 2, 3]]).tolist()
+    [[0, 1, 3], [1, 2, 3]]
+    """
     V = np.asarray(V, dtype=np.float64)
     F = np.asarray(F, dtype=np.int64).reshape(-1, 4)
     d02 = np.linalg.norm(V[F[:, 2]] - V[F[:, 0]], axis=1)
@@ -41,7 +60,24 @@ def triangulate_quads(V, F):
 
 
 def signed_areas(UV, T):
-    """Signed areas of the 2D triangles (positive = counter-clockwise)."""
+    """Signed areas of the 2D triangles (positive = counter-clockwise).
+
+    Parameters
+    ----------
+    UV : ndarray, shape (n, 2) float64
+    T : ndarray, shape (t, 3) int
+
+    Returns
+    -------
+    ndarray, shape (t,) float64
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> UV = np.array([[0, 0], [2, 0], [0, 1.0]])
+    >>> signed_areas(UV, np.array([[0, 1, 2], [0, 2, 1]])).tolist()
+    [1.0, -1.0]
+    """
     a = UV[T[:, 1]] - UV[T[:, 0]]
     b = UV[T[:, 2]] - UV[T[:, 0]]
     return 0.5 * (a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0])
@@ -114,6 +150,17 @@ def lscm(V, T, pins=None):
     Returns
     -------
     (n, 2) texture coordinates (orientation preserving: positive signed areas for a valid map).
+
+    Examples
+    --------
+    A planar square is mapped to a congruent square:
+
+    >>> import numpy as np
+    >>> V = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0.0]])
+    >>> T = triangulate_quads(V, [[0, 1, 2, 3]])
+    >>> UV = lscm(V, T)
+    >>> np.round(signed_areas(UV, T), 9).tolist(), round(float(np.linalg.norm(UV[1] - UV[0])), 9)
+    ([0.5, 0.5], 1.0)
     """
     V = np.asarray(V, dtype=np.float64)
     T = np.asarray(T, dtype=np.int64)
@@ -131,16 +178,62 @@ def lscm(V, T, pins=None):
 
 
 def lscm_extend(V, T, fixed, fixed_uv, reg=1e-9):
-    """Minimize the conformal energy of ``T`` over the vertices not in ``fixed`` (a tiny Tikhonov
-    term keeps vertices that the energy leaves undetermined at a finite place)."""
+    """Minimize the conformal energy of ``T`` over the vertices not in ``fixed``.
+
+    A tiny Tikhonov term keeps vertices that the energy leaves undetermined at a finite place; the
+    conformal extension of the initialization of extended charts (docs/hsh10.md).
+
+    Parameters
+    ----------
+    V : ndarray, shape (n, 3) float64
+    T : ndarray, shape (t, 3) int
+    fixed : ndarray of int
+        Vertices held at ``fixed_uv``.
+    fixed_uv : ndarray, shape (len(fixed), 2) float64
+    reg : float, optional
+
+    Returns
+    -------
+    ndarray, shape (n, 2) float64
+
+    Examples
+    --------
+    A planar square with one edge fixed at its true place is reproduced:
+
+    >>> import numpy as np
+    >>> V = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0.0]])
+    >>> UV = lscm_extend(V, triangulate_quads(V, [[0, 1, 2, 3]]), np.array([0, 1]), np.array([[0, 0], [1, 0.0]]))
+    >>> np.round(UV, 6).tolist()
+    [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]
+    """
     V = np.asarray(V, dtype=np.float64)
     K = _conformal_operator(V, np.asarray(T, dtype=np.int64), V.shape[0])
     return _solve_pinned(K, V.shape[0], fixed, np.asarray(fixed_uv, dtype=np.float64), reg=reg)
 
 
 def fit_area(UV, V, T):
-    """Scale (about the centroid) and, if needed, mirror ``UV`` so that its signed area is positive
-    and equals the surface area of the triangles ``T``."""
+    """Scale (about the centroid) and, if needed, mirror ``UV`` to the surface area of ``T``.
+
+    Its signed area is then positive and equals the surface area of the triangles ``T``.
+
+    Parameters
+    ----------
+    UV : ndarray, shape (n, 2) float64
+    V : ndarray, shape (n, 3) float64
+    T : ndarray, shape (t, 3) int
+
+    Returns
+    -------
+    ndarray, shape (n, 2) float64
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> V = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0.0]])
+    >>> T = triangulate_quads(V, [[0, 1, 2, 3]])
+    >>> float(signed_areas(fit_area(-3 * V[:, :2], V, T), T).sum())
+    1.0
+    """
     UV = np.array(UV, dtype=np.float64, copy=True)
     sa = signed_areas(UV, T).sum()
     if sa < 0:

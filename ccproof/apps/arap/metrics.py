@@ -30,7 +30,25 @@ __all__ = ["singular_values", "jacobians", "Metrics", "sample_metrics", "triangl
 
 
 def singular_values(J):
-    """Singular values s1 >= s2 >= 0 and the determinant of 2x2 matrices J (s, 2, 2)."""
+    """Singular values s1 >= s2 >= 0 and the determinant of 2x2 matrices J (s, 2, 2).
+
+    Closed form (the rotation/reflection split of hsh10 Appendix), used by the metrics of section 4.
+
+    Parameters
+    ----------
+    J : ndarray, shape (s, 2, 2) float64
+
+    Returns
+    -------
+    s1, s2, det : ndarray, shape (s,) float64
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> s1, s2, det = singular_values(np.array([[[2.0, 0], [0, 1]], [[0, -3.0], [3, 0]]]))
+    >>> s1.tolist(), s2.tolist(), det.tolist()
+    ([2.0, 3.0], [1.0, 3.0], [2.0, 9.0])
+    """
     a, b, c, d = J[:, 0, 0], J[:, 0, 1], J[:, 1, 0], J[:, 1, 1]
     Q = np.hypot(0.5 * (a + d), 0.5 * (c - b))
     R = np.hypot(0.5 * (a - d), 0.5 * (c + b))
@@ -38,7 +56,27 @@ def singular_values(J):
 
 
 def jacobians(p1, p2, t1, t2):
-    """grad phi = (t1 t2)(p^1 p^2)^-1 in the isometric frame of (p1, p2), shape (s, 2, 2)."""
+    """grad phi = (t1 t2)(p^1 p^2)^-1 in the isometric frame of (p1, p2), shape (s, 2, 2).
+
+    The Jacobian of the texture map at a sample (hsh10 section 3; docs/hsh10.md A2).
+
+    Parameters
+    ----------
+    p1, p2 : ndarray, shape (s, 3) float64
+        Surface tangents.
+    t1, t2 : ndarray, shape (s, 2) float64
+        Texture tangents.
+
+    Returns
+    -------
+    ndarray, shape (s, 2, 2) float64
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> jacobians(np.array([[1.0, 0, 0]]), np.array([[0, 1.0, 0]]), np.array([[2.0, 0]]), np.array([[0, 3.0]])).tolist()
+    [[[2.0, 0.0], [0.0, 3.0]]]
+    """
     a, b, c = isometric_frames(p1, p2)
     J = np.empty((a.size, 2, 2))
     J[:, :, 0] = t1 / a[:, None]
@@ -48,7 +86,28 @@ def jacobians(p1, p2, t1, t2):
 
 @dataclass
 class Metrics:
-    """Accumulated area-weighted sums; combine charts with ``+``."""
+    """Accumulated area-weighted sums of the metrics of hsh10 section 4; combine charts with ``+``.
+
+    Parameters
+    ----------
+    area, angle_sum, area_sum, stretch_sum, texture_area : float, optional
+    det_sum, invdet_sum : float, optional
+        Sum A_j s1 s2 and sum A_j / (s1 s2): for the rescaled E_area.
+    samples, flips : int, optional
+    arap_sum : float, optional
+        Sum A_j min_R ||grad phi_j - R||^2: the quadrature of hsh10 Eq. 1.
+
+    Examples
+    --------
+    A triangle textured by a similarity of scale 2 keeps its angles (E_angle = 2, the minimum) and
+    distorts the area by s1 s2 + 1/(s1 s2) = 4 + 1/4:
+
+    >>> import numpy as np
+    >>> V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0.0]])
+    >>> m = triangle_metrics(V, 2 * V[:, :2], np.array([[0, 1, 2]]))
+    >>> [round(x, 9) for x in m.as_tuple()[:2]], (m + m).samples
+    ([2.0, 4.25], 2)
+    """
 
     area: float = 0.0
     angle_sum: float = 0.0
@@ -113,10 +172,29 @@ class Metrics:
 def sample_metrics(samples: SampleSet, T, per_sample=False):
     """Metrics of the level-k texture values ``T`` (n_k, 2) on the samples ``samples``.
 
+    Parameters
+    ----------
+    samples : SampleSet
+        Samples of one level (:func:`~ccproof.apps.arap.samples.build_samples`, purpose "metric").
+    T : ndarray, shape (n_k, 2) float64
+    per_sample : bool, optional
+
     Returns
     -------
     Metrics, and with ``per_sample=True`` also a dict of per-sample arrays (s1, s2, det, weight,
     area distortion s1 s2 + 1/(s1 s2)).
+
+    Examples
+    --------
+    The identity texture of a flat grid is an isometry:
+
+    >>> from ccproof.mesh.examples import grid
+    >>> from ccproof.apps.arap.hierarchy import ChartHierarchy
+    >>> from ccproof.apps.arap.samples import build_samples
+    >>> L = ChartHierarchy(grid(3, 3), range(9)).level(1)
+    >>> m = sample_metrics(build_samples(L, "extended", "metric"), L.mesh.vertices[:, :2])
+    >>> [round(x, 9) for x in m.as_tuple()]
+    [2.0, 2.0, 1.0]
     """
     t1, t2 = samples.texture_tangents(T)
     # samples with a degenerate surface frame (zero area element) carry no weight: leave them out
@@ -164,6 +242,14 @@ def triangle_metrics(P, UV, T, per_triangle=False):
     -------
     Metrics, and with ``per_triangle`` a dict of (m,) arrays s1, s2, det, weight, area_distortion
     (``s1 s2 + 1/(s1 s2)``) and stretch (``sqrt((1/s1^2 + 1/s2^2) / 2)``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0.0]])
+    >>> m, d = triangle_metrics(V, np.array([[0, 0], [2, 0], [0, 1.0]]), np.array([[0, 1, 2]]), per_triangle=True)
+    >>> d["s1"].tolist(), d["s2"].tolist(), d["area_distortion"].tolist()
+    ([2.0], [1.0], [2.5])
     """
     P = np.asarray(P, dtype=np.float64)
     UV = np.asarray(UV, dtype=np.float64)

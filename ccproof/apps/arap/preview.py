@@ -24,7 +24,27 @@ __all__ = ["render_preview", "project"]
 def project(points, view=None):
     """Orthographic projection along ``view`` (default: the smallest principal axis of the points).
 
-    Returns (xy (n, 2), depth (n,), view (3,)); larger depth is nearer the viewer.
+    Parameters
+    ----------
+    points : ndarray, shape (n, 3) float64
+    view : array_like, shape (3,), optional
+
+    Returns
+    -------
+    xy : ndarray, shape (n, 2) float64
+    depth : ndarray, shape (n,) float64
+        Larger depth is nearer the viewer.
+    view : ndarray, shape (3,) float64
+
+    Examples
+    --------
+    Points of the plane z = 0 are seen along the z axis, all at the same depth:
+
+    >>> import numpy as np
+    >>> from ccproof.mesh.examples import grid
+    >>> xy, depth, view = project(grid(3, 3).vertices)
+    >>> np.abs(view).round(12).tolist(), float(np.ptp(depth)), xy.shape
+    ([0.0, 0.0, 1.0], 0.0, (16, 2))
     """
     P = np.asarray(points, dtype=np.float64)
     c = P - P.mean(axis=0)
@@ -70,6 +90,16 @@ def render_preview(path, surfaces, names=None, title=None, checks=None, view=Non
     checks : int, optional
         Checkerboard squares across [0, 1] (default: about 5 triangles per square side on the coarsest
         surface, 4 to 24).
+
+    Examples
+    --------
+    Rendering takes seconds (matplotlib), so this example is not run:
+
+    >>> from ccproof.mesh.examples import grid
+    >>> from ccproof.apps.arap.core import compare
+    >>> from ccproof.apps.arap.export import sampled_surface
+    >>> res, _ = compare(grid(3, 3), methods=("c",), levels=1, eval_level=3)
+    >>> render_preview("preview.png", {"c": sampled_surface(res["c"], level=2)})   # doctest: +SKIP
     """
     import matplotlib
 

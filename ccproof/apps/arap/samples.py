@@ -55,7 +55,28 @@ __all__ = [
 
 
 def mask_weights(n):
-    """The tangent-mask weights (alpha_i, beta_i), i = 0 .. n-1, of a valence-``n`` vertex."""
+    """The tangent-mask weights (alpha_i, beta_i), i = 0 .. n-1, of a valence-``n`` vertex.
+
+    The limit tangent masks of hsh10 Eq. 2 (edge neighbours weighted by alpha, face neighbours by beta).
+
+    Parameters
+    ----------
+    n : int
+        Valence, n >= 3.
+
+    Returns
+    -------
+    alpha, beta : ndarray, shape (n,) float64
+
+    Examples
+    --------
+    Derivatives of a constant vanish: both sets of weights sum to 0:
+
+    >>> import numpy as np
+    >>> a, b = mask_weights(5)
+    >>> bool(abs(a.sum()) < 1e-15 and abs(b.sum()) < 1e-15), np.round(mask_weights(4)[0], 6).tolist()
+    (True, [0.333333, 0.0, -0.333333, -0.0])
+    """
     n = int(n)
     i = np.arange(n)
     c = np.cos(np.pi / n)
@@ -76,7 +97,32 @@ def _fan_corners(mesh, verts):
 
 
 def tangent_mask_operators(mesh, verts):
-    """Sparse (len(verts), n) operators of the tangent masks p_1, p_2 at interior vertices ``verts``."""
+    """Sparse (len(verts), n) operators of the tangent masks p_1, p_2 at interior vertices ``verts``.
+
+    hsh10 Eq. 2: ``P1 @ X`` and ``P2 @ X`` are the two limit tangents at the vertices.
+
+    Parameters
+    ----------
+    mesh : QuadMesh
+    verts : array_like of int
+        Interior vertices.
+
+    Returns
+    -------
+    P1, P2 : scipy.sparse matrix, shape (len(verts), n_vertices)
+
+    Examples
+    --------
+    At the middle vertex of a flat 2 x 2 grid of unit squares the tangents are unit and orthogonal:
+
+    >>> import numpy as np
+    >>> from ccproof.mesh.examples import grid
+    >>> m = grid(2, 2)
+    >>> P1, P2 = tangent_mask_operators(m, [4])
+    >>> t1, t2 = (P1 @ m.vertices)[0], (P2 @ m.vertices)[0]
+    >>> round(float(np.linalg.norm(t1)), 12), round(float(np.linalg.norm(t2)), 12), round(float(t1 @ t2), 12)
+    (1.0, 1.0, 0.0)
+    """
     verts = np.asarray(verts, dtype=np.int64)
     F = mesh.faces
     row, j, c = _fan_corners(mesh, verts)
@@ -100,7 +146,30 @@ def tangent_mask_operators(mesh, verts):
 
 
 def limit_operator(level: Level, rules):
-    """Sparse (n, n) limit-position operator on ``E_k`` for ``rules``; rows of chart vertices only."""
+    """Sparse (n, n) limit-position operator on ``E_k`` for ``rules``; rows of chart vertices only.
+
+    Parameters
+    ----------
+    level : Level
+        A level of a :class:`~ccproof.apps.arap.hierarchy.ChartHierarchy`.
+    rules : {"boundary", "extended"}
+
+    Returns
+    -------
+    scipy.sparse matrix, shape (n_k, n_k)
+
+    Examples
+    --------
+    Limit masks are affine combinations: every row of a chart vertex sums to 1, the others are 0:
+
+    >>> import numpy as np
+    >>> from ccproof.mesh.examples import grid
+    >>> from ccproof.apps.arap.hierarchy import ChartHierarchy
+    >>> A = limit_operator(ChartHierarchy(grid(3, 3), range(9)).level(1), "extended")
+    >>> r = np.asarray(A.sum(axis=1)).ravel()
+    >>> A.shape, bool(np.all((np.abs(r - 1) < 1e-12) | (r == 0))), bool((r != 0).any())
+    ((49, 49), True, True)
+    """
     r = _rules(rules)
     mesh = level.mesh
     F = mesh.faces
@@ -146,6 +215,20 @@ def isometric_frames(p1, p2):
     """The isometric images (a, b, c) of the frames: p^_1 = (a, 0), p^_2 = (b, c) (docs/hsh10.md A2).
 
     ``a = |p1|``, ``b = p1.p2 / |p1|``, ``c = |p1 x p2| / |p1|`` (c >= 0).
+
+    Parameters
+    ----------
+    p1, p2 : ndarray, shape (s, 3) float64
+
+    Returns
+    -------
+    a, b, c : ndarray, shape (s,) float64
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> [x.tolist() for x in isometric_frames(np.array([[2.0, 0, 0]]), np.array([[1.0, 1, 0]]))]
+    [[2.0], [1.0], [1.0]]
     """
     a = np.linalg.norm(p1, axis=1)
     b = np.einsum("ij,ij->i", p1, p2) / a
@@ -165,6 +248,15 @@ class SampleSet:
     area_factor : (s,) factor turning ``|det(t1, t2)|`` into the texture area element
     vertex : (s,) level-k vertex of each sample
     corner : (s,) bool, corner sample
+
+    Examples
+    --------
+    >>> from ccproof.mesh.examples import grid
+    >>> from ccproof.apps.arap.hierarchy import ChartHierarchy
+    >>> L = ChartHierarchy(grid(3, 3), range(9)).level(1)
+    >>> S = build_samples(L, "extended")
+    >>> S.p1.shape[1], S.O1.shape == (S.p1.shape[0], L.mesh.n_vertices), bool((S.weight > 0).all())
+    (3, True, True)
     """
 
     p1: np.ndarray
@@ -198,6 +290,20 @@ def build_samples(level: Level, rules, purpose="optimize") -> SampleSet:
         follows the interior rules, i.e. at every chart vertex off the surface boundary for
         extended charts). "metric": the same sampling for every method (mask samples at
         chart-interior vertices, corner samples on the chart boundary), docs/hsh10.md A9 / A11.4.
+
+    Returns
+    -------
+    SampleSet
+
+    Examples
+    --------
+    On a flat grid the surface tangents lie in the plane z = 0:
+
+    >>> from ccproof.mesh.examples import grid
+    >>> from ccproof.apps.arap.hierarchy import ChartHierarchy
+    >>> S = build_samples(ChartHierarchy(grid(3, 3), range(9)).level(1), "extended", "metric")
+    >>> float(abs(S.p1[:, 2]).max()), float(abs(S.p2[:, 2]).max())
+    (0.0, 0.0)
     """
     r = _rules(rules)
     mesh = level.mesh

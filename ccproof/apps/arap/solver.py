@@ -41,7 +41,29 @@ __all__ = ["closest_rotations", "LocalGlobal", "IterationResult", "iterate", "tr
 
 
 def closest_rotations(J, previous=None):
-    """Theorem 1 of hsh10: the rotation closest to each 2x2 matrix of ``J`` (s, 2, 2)."""
+    """Theorem 1 of hsh10: the rotation closest to each 2x2 matrix of ``J`` (s, 2, 2).
+
+    The local step of the local/global iteration (hsh10 Appendix, Theorem 1).
+
+    Parameters
+    ----------
+    J : ndarray, shape (s, 2, 2) float64
+    previous : ndarray, shape (s, 2, 2), optional
+        The previous rotations, kept where J is degenerate (x = a + d and y = c - b both 0).
+
+    Returns
+    -------
+    ndarray, shape (s, 2, 2) float64
+
+    Examples
+    --------
+    A scaling is closest to the identity, a scaled rotation to its rotation:
+
+    >>> import numpy as np
+    >>> R = closest_rotations(np.array([[[2.0, 0], [0, 1]], [[0, -3.0], [3, 0]]]))
+    >>> (R + 0.0).tolist()
+    [[[1.0, 0.0], [0.0, 1.0]], [[0.0, -1.0], [1.0, 0.0]]]
+    """
     a, b, c, d = J[:, 0, 0], J[:, 0, 1], J[:, 1, 0], J[:, 1, 1]
     x = a + d
     y = c - b
@@ -62,7 +84,29 @@ def closest_rotations(J, previous=None):
 
 @dataclass
 class IterationResult:
-    """Outcome of :func:`iterate` at one level."""
+    """Outcome of :func:`iterate` at one level.
+
+    Parameters
+    ----------
+    X : ndarray, shape (n_unknowns, 2) float64
+    iterations : int
+    energies : list of float
+        E(X_i, R(X_i)) after each local step (hsh10 Eq. 3).
+    seconds : float
+    converged : bool
+    trace, residuals : list, optional
+        Energy after each half step (global, local, ...) and global solve residuals, when traced.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from ccproof.apps.arap.lscm import triangulate_quads
+    >>> V = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0.0]])
+    >>> system = LocalGlobal(*triangle_samples(V, triangulate_quads(V, [[0, 1, 2, 3]])))
+    >>> res = iterate(system, 1.3 * V[:, :2])
+    >>> res.converged, res.energies[-1] < 1e-20, np.round(res.X, 9).tolist()
+    (True, True, [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    """
 
     X: np.ndarray
     iterations: int
@@ -81,10 +125,27 @@ class IterationResult:
 class LocalGlobal:
     """The fixed-level system: operators H, matrix L (factorized once), local and global steps.
 
+    The global step of hsh10 section 3 (Eq. 3 as a sparse least-squares problem).
+
     Parameters
     ----------
-    p1, p2 : (s, 3) surface tangents; G1, G2 : sparse (s, N) texture rows; weight : (s,)
-    pin : int, the pinned unknown
+    p1, p2 : ndarray, shape (s, 3) float64
+        Surface tangents.
+    G1, G2 : scipy.sparse matrix, shape (s, N)
+        Texture rows: the texture tangents are ``G1 @ X``, ``G2 @ X``.
+    weight : ndarray, shape (s,) float64
+    pin : int, optional
+        The pinned unknown.
+    factor : bool, optional
+        Factorize L now.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0.0]])
+    >>> system = LocalGlobal(*triangle_samples(V, [[0, 1, 2]]))
+    >>> np.round(iterate(system, 2 * V[:, :2]).X, 9).tolist()      # back to the isometry
+    [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]
     """
 
     def __init__(self, p1, p2, G1, G2, weight, pin=0, factor=True):
@@ -180,11 +241,28 @@ def iterate(system: LocalGlobal, X0, tol=1e-6, max_iter=200, trace=False, min_it
     E(X, R(X)) is below the last accepted one, else the plain local/global step is taken, so the
     energy still decreases monotonically (``trace`` is not recorded then).
 
+    Parameters
+    ----------
+    system : LocalGlobal
+    X0 : ndarray, shape (N, 2) float64
+    tol : float, optional
+    max_iter, min_iter : int, optional
+    trace : bool, optional
+    accel : int, optional
+
     Returns
     -------
     IterationResult
         ``energies[i]`` is E(X_i, R(X_i)) (after each local step); with ``trace`` also the energy
         after every global step (``trace``) and the global solve residuals.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0.0]])
+    >>> res = iterate(LocalGlobal(*triangle_samples(V, [[0, 1, 2]])), 3 * V[:, :2], accel=2)
+    >>> res.converged, round(res.energies[-1], 12)
+    (True, 0.0)
     """
     if accel and not trace:
         return _iterate_anderson(system, X0, tol, max_iter, min_iter, int(accel))
@@ -274,7 +352,24 @@ def _iterate_anderson(system, X0, tol, max_iter, min_iter, m):
 def triangle_samples(V, T):
     """Liu et al. 2008 triangle ARAP as samples: tangents = edge vectors, weight = triangle area.
 
-    Returns p1, p2 (t, 3) and sparse G1, G2 (t, n) with G1 X = X[v1] - X[v0], G2 X = X[v2] - X[v0].
+    Parameters
+    ----------
+    V : ndarray, shape (n, 3) float64
+    T : ndarray, shape (t, 3) int
+
+    Returns
+    -------
+    p1, p2 : ndarray, shape (t, 3) float64
+    G1, G2 : scipy.sparse.csr_matrix, shape (t, n)
+        ``G1 X = X[v1] - X[v0]``, ``G2 X = X[v2] - X[v0]``.
+    weight : ndarray, shape (t,) float64
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> p1, p2, G1, G2, w = triangle_samples(np.array([[0, 0, 0], [2, 0, 0], [0, 1, 0.0]]), [[0, 1, 2]])
+    >>> p1.tolist(), G2.toarray().tolist(), w.tolist()
+    ([[2.0, 0.0, 0.0]], [[-1.0, 0.0, 1.0]], [1.0])
     """
     V = np.asarray(V, dtype=np.float64)
     T = np.asarray(T, dtype=np.int64)
@@ -289,5 +384,31 @@ def triangle_samples(V, T):
 
 
 def system_from_samples(samples: SampleSet, A, pin=0):
-    """The :class:`LocalGlobal` system of level-k samples with unknown->level operator ``A``."""
+    """The :class:`LocalGlobal` system of level-k samples with unknown->level operator ``A``.
+
+    Parameters
+    ----------
+    samples : SampleSet
+        :func:`~ccproof.apps.arap.samples.build_samples` of a level.
+    A : scipy.sparse matrix, shape (n_k, n_unknowns)
+        Level values from the texture unknowns.
+    pin : int, optional
+        The pinned unknown.
+
+    Returns
+    -------
+    LocalGlobal
+
+    Examples
+    --------
+    >>> import scipy.sparse as sp
+    >>> from ccproof.mesh.examples import grid
+    >>> from ccproof.apps.arap.hierarchy import ChartHierarchy
+    >>> from ccproof.apps.arap.samples import build_samples
+    >>> L = ChartHierarchy(grid(3, 3), range(9)).level(1)
+    >>> S = system_from_samples(build_samples(L, "extended"), sp.identity(L.mesh.n_vertices, format="csr"))
+    >>> res = iterate(S, L.mesh.vertices[:, :2])                  # the identity texture is isometric
+    >>> res.converged, res.energies[-1] < 1e-20
+    (True, True)
+    """
     return LocalGlobal(samples.p1, samples.p2, samples.O1 @ A, samples.O2 @ A, samples.weight, pin=pin)

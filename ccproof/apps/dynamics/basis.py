@@ -69,6 +69,17 @@ def _poly_deriv(c, r):
 def gram(r):
     """Exact span Gram matrix ``G_r[a][b] = int_0^1 B_a^(r)(u) B_b^(r)(u) du`` (list of Fractions).
 
+    Parameters
+    ----------
+    r : int
+        Derivative order of both factors (0, 1 or 2).
+
+    Returns
+    -------
+    list of list of Fraction, shape (4, 4)
+
+    Examples
+    --------
     >>> [str(x) for x in gram(2)[0]]
     ['1/3', '-1/2', '0', '1/6']
     """
@@ -90,7 +101,24 @@ def gram(r):
 
 @functools.cache
 def gram_float(r):
-    """:func:`gram` as a read-only float64 (4, 4) array."""
+    """:func:`gram` as a read-only float64 (4, 4) array.
+
+    Parameters
+    ----------
+    r : int
+        Derivative order (0, 1 or 2).
+
+    Returns
+    -------
+    ndarray, shape (4, 4) float64, read-only
+
+    Examples
+    --------
+    The cubic B-splines sum to 1 on [0, 1], so all entries of the r = 0 Gram matrix sum to 1:
+
+    >>> round(float(gram_float(0).sum()), 15), gram_float(0).flags.writeable
+    (1.0, False)
+    """
     G = np.array([[float(x) for x in row] for row in gram(r)])
     G.setflags(write=False)
     return G
@@ -100,6 +128,18 @@ def gram_float(r):
 def term_matrix(term):
     """The 16 x 16 patch matrix of one integrand of :data:`TERMS` on the unit square, unit density.
 
+    Parameters
+    ----------
+    term : str
+        A key of :data:`TERMS` (``"mass"``, ``"uu1"``, ... : the integrands of the mass and of the
+    stiffness of qmv98 eq. 20: ``J^T J``, ``J_u^T J_u``, ...).
+
+    Returns
+    -------
+    ndarray, shape (16, 16) float64
+
+    Examples
+    --------
     >>> K = term_matrix("uu2")
     >>> K.shape, bool(abs(K.sum(axis=1)).max() < 1e-15)       # annihilates translations
     ((16, 16), True)
@@ -113,6 +153,19 @@ def term_matrix(term):
 def basis_1d(x, derivatives=0):
     """Values (and derivatives up to ``derivatives``) of B0..B3 at ``x``: list of arrays (..., 4).
 
+    Parameters
+    ----------
+    x : array_like, float64
+        Parameters in [0, 1].
+    derivatives : int, optional
+
+    Returns
+    -------
+    list of ndarray, shape x.shape + (4,) float64
+        Values, then derivatives 1 .. ``derivatives``.
+
+    Examples
+    --------
     >>> [row.tolist() for row in np.round(basis_1d([0.0], 0)[0] * 6, 12)]
     [[1.0, 4.0, 1.0, 0.0]]
     """
@@ -162,6 +215,17 @@ def patch_rows(u, v, derivatives=0):
 def paper_patch_jacobian(u, v):
     """The paper's 3 x 48 matrix ``J_p(u, v)`` of eq. (2) (x, y, z interleaved, k = 4 i + j).
 
+    Parameters
+    ----------
+    u, v : float
+        Patch parameters in [0, 1].
+
+    Returns
+    -------
+    ndarray, shape (3, 48) float64
+
+    Examples
+    --------
     >>> J = paper_patch_jacobian(0.25, 0.75)
     >>> J.shape, bool(np.allclose(J[1, 1::3].sum(), 1.0)), float(J[0, 1])
     ((3, 48), True, 0.0)

@@ -95,6 +95,18 @@ _DERIV_MAPS = (
 def face_to_sector(corner, u, v):
     """Sector parameters (s, t) of face parameters (u, v) when the EV is corner ``corner`` (array).
 
+    Parameters
+    ----------
+    corner : array_like of int, shape (n,)
+        Corner (0..3) of the face at the extraordinary vertex.
+    u, v : array_like, shape (n,) float64
+
+    Returns
+    -------
+    s, t : ndarray, shape (n,) float64
+
+    Examples
+    --------
     >>> [x.tolist() for x in face_to_sector([1, 2], [0.25, 0.25], [0.5, 0.5])]
     [[0.5, 0.75], [0.75, 0.5]]
     """
@@ -107,7 +119,23 @@ def face_to_sector(corner, u, v):
 
 
 def sector_derivative_maps():
-    """The four 2 x 2 matrices R_c with (d/du, d/dv) = R_c (d/ds, d/dt) (read-only array (4, 2, 2))."""
+    """The four 2 x 2 matrices R_c with (d/du, d/dv) = R_c (d/ds, d/dt) (read-only array (4, 2, 2)).
+
+    The rotations between face and sector parameters of :func:`face_to_sector` (docs/qmv98.md).
+
+    Returns
+    -------
+    ndarray, shape (4, 2, 2) float64, read-only
+
+    Examples
+    --------
+    Quarter turns: R_1 is the rotation by 90 degrees, and four of them are the identity:
+
+    >>> import numpy as np
+    >>> R = sector_derivative_maps()
+    >>> R[1].tolist(), bool(np.array_equal(np.linalg.matrix_power(R[1], 4), np.eye(2)))
+    ([[0.0, -1.0], [1.0, 0.0]], True)
+    """
     R = np.stack(_DERIV_MAPS)
     R.setflags(write=False)
     return R
@@ -116,6 +144,18 @@ def sector_derivative_maps():
 def term_scale(term, level):
     """Per-level factor of a special-element patch at local level ``level`` (docs/qmv98.md B3).
 
+    Parameters
+    ----------
+    term : str
+        A key of :data:`~ccproof.apps.dynamics.basis.TERMS`.
+    level : int
+
+    Returns
+    -------
+    float
+
+    Examples
+    --------
     >>> term_scale("mass", 2), term_scale("uu1", 2), term_scale("uv2", 2)
     (0.0625, 1.0, 16.0)
     """
@@ -160,6 +200,16 @@ class ElementLayout:
         Corner of a special face at its EV; -1 otherwise.
     skipped_ev : int array
         Interior EVs that got no special element (a face of their fan touches the boundary).
+
+    Examples
+    --------
+    The cube subdivided twice: 8 valence-3 vertices, each with a special element of 3 faces; the
+    other 96 - 24 faces are normal:
+
+    >>> from ccproof.apps.dynamics.meshes import paper_initial_model
+    >>> lay = element_layout(paper_initial_model())
+    >>> lay.special_valence.tolist(), lay.normal_faces.size, lay.normal_nets.shape[1]
+    ([3, 3, 3, 3, 3, 3, 3, 3], 72, 16)
     """
 
     normal_faces: np.ndarray
@@ -318,6 +368,18 @@ def isolate_extraordinary(mesh, max_steps=2):
 
     Returns ``(mesh, steps)``.
 
+    Parameters
+    ----------
+    mesh : QuadMesh
+    max_steps : int, optional
+
+    Returns
+    -------
+    mesh : QuadMesh
+    steps : int
+
+    Examples
+    --------
     >>> from ccproof.mesh.examples import cube
     >>> m, steps = isolate_extraordinary(cube())
     >>> m.n_vertices, steps
@@ -363,6 +425,12 @@ class SpecialScheme:
         (alpha along s; patches :data:`SECTOR_PATCHES`).
     limit_row : ndarray (6 n + 1,)
         Limit position mask of the EV ``(n^2 v + 4 sum e + sum d) / (n (n + 5))``.
+
+    Examples
+    --------
+    >>> S = SpecialScheme(5)
+    >>> S.C.shape, S.select.shape, round(float(S.limit_row.sum()), 12), round(float(S.limit_row[0]), 12)
+    ((31, 31), (5, 3, 16), 1.0, 0.5)
     """
 
     def __init__(self, n):
@@ -488,6 +556,17 @@ class SpecialScheme:
 def special_scheme(n):
     """Cached :class:`SpecialScheme` of valence ``n``.
 
+    Parameters
+    ----------
+    n : int
+        Valence, n >= 3.
+
+    Returns
+    -------
+    SpecialScheme
+
+    Examples
+    --------
     >>> S = special_scheme(3)
     >>> S.B.shape, S.C.shape, round(float(S.mass_exact().sum()), 12)     # 1^T M 1 = n (unit density)
     ((37, 19), (19, 19), 3.0)

@@ -158,8 +158,28 @@ def minimal_enclosing_sphere(X, seed=0):
 
 
 def read_points(path):
-    """Read a point cloud: ``.xyz`` (whitespace columns x y z ...), ``.ply`` (ASCII or binary vertex
-    element), ``.obj`` (the ``v`` lines). Returns float64 (m, 3).
+    """Read a point cloud: ``.xyz``, ``.ply`` or ``.obj``.
+
+    ``.xyz``: whitespace columns x y z ...; ``.ply``: ASCII or binary vertex element; ``.obj``: the
+    ``v`` lines. The input of ``ccproof fit`` (docs/qmv98.md).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+
+    Returns
+    -------
+    ndarray, shape (m, 3) float64
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> import numpy as np
+    >>> tmp = tempfile.TemporaryDirectory()          # removed when the example ends
+    >>> p = os.path.join(tmp.name, "cloud.xyz")
+    >>> np.savetxt(p, [[1, 2, 3, 9], [4, 5, 6, 9]])                  # extra columns are ignored
+    >>> read_points(p).tolist()
+    [[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]]
     """
     path = Path(path)
     if not path.exists():
@@ -248,11 +268,39 @@ def _read_ply(path):
 
 
 def fit_error(model, P, X, finder=None, diameter=None):
-    """Distances of the data points to the limit surface (global closest points,
-    :class:`~ccproof.apps.dynamics.forces.ModelClosestPoints`) and the paper's fit error.
+    """Distances of the data points to the limit surface and the paper's fit error.
 
-    Returns a dict: ``max``, ``mean`` (absolute), ``max_percent``, ``mean_percent`` (of the diameter
-    of the minimal enclosing sphere of X, or of ``diameter``), ``distances``.
+    Global closest points (:class:`~ccproof.apps.dynamics.forces.ModelClosestPoints`); the error
+    measure of qmv98 section 4 (docs/qmv98.md B6).
+
+    Parameters
+    ----------
+    model : DynamicSurface
+    P : ndarray, shape (n_vertices, 3) float64
+        The state.
+    X : ndarray, shape (m, 3) float64
+        Data points.
+    finder : ModelClosestPoints, optional
+        Re-used search structure.
+    diameter : float, optional
+        Default: the diameter of the minimal enclosing sphere of X.
+
+    Returns
+    -------
+    dict
+        ``max``, ``mean`` (absolute), ``max_percent``, ``mean_percent`` (of the diameter),
+        ``distances`` (m,).
+
+    Examples
+    --------
+    Building the closest-point search takes seconds (compilation), so this example is not run:
+    for points sampled on the limit surface ``max`` is at rounding level.
+
+    >>> from ccproof.apps.dynamics.meshes import paper_initial_model
+    >>> from ccproof.apps.dynamics.model import DynamicSurface
+    >>> m = DynamicSurface(paper_initial_model())
+    >>> X = limit_surface_mesh(paper_initial_model(), 1).vertices
+    >>> fit_error(m, m.vertices, X)["max"]                               # doctest: +SKIP
     """
     X = check_points(X)
     if finder is None:
@@ -270,8 +318,38 @@ def fit_error(model, P, X, finder=None, diameter=None):
 
 
 def check_cloud(X, min_points=20, flatness=1e-3):
-    """Reject clouds no closed surface can be fitted to: too few points, non-finite, coincident, coplanar
-    or collinear (smallest principal extent below ``flatness`` times the largest). Returns X (m, 3)."""
+    """Reject clouds no closed surface can be fitted to.
+
+    Too few points, non-finite, coincident, coplanar or collinear (smallest principal extent below
+    ``flatness`` times the largest).
+
+    Parameters
+    ----------
+    X : array_like, shape (m, 3)
+    min_points : int, optional
+    flatness : float, optional
+
+    Returns
+    -------
+    ndarray, shape (m, 3) float64
+
+    Raises
+    ------
+    CCProofError
+        Naming the problem.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> check_cloud(np.zeros((30, 3)))
+    Traceback (most recent call last):
+    ...
+    ccproof.errors.CCProofError: the data points all coincide
+    >>> check_cloud(np.c_[np.random.default_rng(0).random((30, 2)), np.zeros(30)])
+    Traceback (most recent call last):
+    ...
+    ccproof.errors.CCProofError: ...
+    """
     X = check_points(X)
     C = X - X.mean(axis=0)
     s = np.linalg.svd(C, compute_uv=False)
@@ -288,8 +366,32 @@ def check_cloud(X, min_points=20, flatness=1e-3):
 
 
 def limit_surface_mesh(mesh, level):
-    """The limit surface sampled at ``level``: the control mesh subdivided ``level`` times with its
-    vertices moved to their exact limit positions (Catmull-Clark limit masks). Returns a QuadMesh."""
+    """The limit surface sampled at ``level``.
+
+    The control mesh subdivided ``level`` times with its vertices moved to their exact limit positions
+    (Catmull-Clark limit masks of the subdivision rules of docs/readings.md R1).
+
+    Parameters
+    ----------
+    mesh : QuadMesh
+    level : int
+
+    Returns
+    -------
+    QuadMesh
+
+    Examples
+    --------
+    The corners of the cube with corners (+-1, +-1, +-1) go to (+-1/2, ...) (mask (n^2 v + 4 sum e +
+    sum d) / (n (n + 5)), n = 3); after one step the face centres go to distance 68/81:
+
+    >>> import numpy as np
+    >>> from ccproof.mesh.examples import cube
+    >>> float(np.abs(limit_surface_mesh(cube(), 0).vertices).max()), limit_surface_mesh(cube(), 1).n_faces
+    (0.5, 24)
+    >>> round(float(np.abs(limit_surface_mesh(cube(), 1).vertices).max()) * 81, 9)
+    68.0
+    """
     from ccproof.mesh import limit_positions, subdivide
 
     m = mesh
@@ -306,7 +408,24 @@ def _vertex_areas(mesh):
 
 
 def data_spacing(X):
-    """Median distance of a data point to its nearest other data point (cKDTree)."""
+    """Median distance of a data point to its nearest other data point (cKDTree).
+
+    Parameters
+    ----------
+    X : ndarray, shape (m, 3) float64
+
+    Returns
+    -------
+    float
+
+    Examples
+    --------
+    Nearest-neighbour distances 1, 1, 2: the median is 1:
+
+    >>> import numpy as np
+    >>> data_spacing(np.array([[0, 0, 0], [1, 0, 0], [3, 0, 0.0]]))
+    1.0
+    """
     from scipy.spatial import cKDTree
 
     d, _ = cKDTree(X).query(X, k=2)
@@ -316,8 +435,29 @@ def data_spacing(X):
 def surface_to_data(surface, X, stray_distance):
     """Surface -> data distances of the vertices of ``surface`` (a sampled limit surface, QuadMesh).
 
-    Returns a dict: ``distances`` (n,), ``areas`` (n,) vertex area weights, ``max``, ``mean``
-    (area-weighted), ``stray_fraction`` (area fraction farther than ``stray_distance``).
+    The second half of the two-sided (Hausdorff) fit error (docs/qmv98.md).
+
+    Parameters
+    ----------
+    surface : QuadMesh
+    X : ndarray, shape (m, 3) float64
+    stray_distance : float
+
+    Returns
+    -------
+    dict
+        ``distances`` (n,), ``areas`` (n,) vertex area weights, ``max``, ``mean`` (area-weighted),
+        ``stray_fraction`` (area fraction farther than ``stray_distance``).
+
+    Examples
+    --------
+    Data that is the surface's vertices moved by 0.01 along z:
+
+    >>> from ccproof.mesh.examples import cube
+    >>> S = limit_surface_mesh(cube(), 1)
+    >>> r = surface_to_data(S, S.vertices + [0, 0, 0.01], 0.005)
+    >>> round(r["max"], 12), round(r["mean"], 12), r["stray_fraction"]
+    (0.01, 0.01, 1.0)
     """
     from scipy.spatial import cKDTree
 
@@ -331,7 +471,24 @@ def surface_to_data(surface, X, stray_distance):
 
 @dataclass
 class FitLevel:
-    """One level of the multilevel fit."""
+    """One level of the multilevel fit (qmv98 section 4.2; docs/qmv98.md B6).
+
+    Parameters
+    ----------
+    n_vertices, n_faces : int
+    steps : int
+        Implicit steps taken.
+    converged : bool
+    max_error_percent, mean_error_percent : float
+    seconds : float
+    cg_iterations : int
+
+    Examples
+    --------
+    >>> lev = FitLevel(98, 96, 10, True, 0.5, 0.1, 1.0, 40)
+    >>> lev.n_faces, lev.converged
+    (96, True)
+    """
 
     n_vertices: int
     n_faces: int
@@ -345,7 +502,39 @@ class FitLevel:
 
 @dataclass
 class FitResult:
-    """Outcome of :func:`fit_points`; ``mesh`` is in the data's coordinates."""
+    """Outcome of :func:`fit_points`; ``mesh`` is in the data's coordinates.
+
+    Parameters
+    ----------
+    mesh : QuadMesh or None
+        The fitted control mesh (data units).
+    model : DynamicSurface or None
+    levels : list of FitLevel
+    center : ndarray, shape (3,), optional
+    diameter : float
+        Diameter of the minimal enclosing sphere of the data.
+    parameters : dict
+    data_distances : ndarray, shape (m,), optional
+        Data -> surface distances at the final level (data units).
+    surface : QuadMesh, optional
+        The limit surface sampled at ``sample_level`` (data units); ``surface_report`` its
+        :func:`surface_to_data`.
+    sample_level : int
+    surface_report : dict
+    spacing, stray_distance : float
+        :func:`data_spacing`, and the distance beyond which surface points count as stray.
+    warnings : list of str
+    normalized_state : ndarray, shape (n, 3), optional
+        Final control points in the normalized units of the fit (centre 0, diameter 1).
+
+    Examples
+    --------
+    Fitting takes seconds, so this example is not run (docs/qmv98.md shows measured fits):
+
+    >>> from ccproof.apps.dynamics.shapes import synthetic_range_data
+    >>> res = fit_points(synthetic_range_data("ellipsoid"))                   # doctest: +SKIP
+    >>> res.mesh, res.levels, res.two_sided_error_percent                      # doctest: +SKIP
+    """
 
     mesh: QuadMesh | None
     model: DynamicSurface | None

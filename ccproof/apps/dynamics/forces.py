@@ -29,6 +29,18 @@ __all__ = ["Springs", "ModelClosestPoints", "closest_cells", "check_points"]
 def check_points(X, name="point cloud"):
     """Validate a point cloud: a finite, non-empty float array of shape (m, 3).
 
+    Parameters
+    ----------
+    X : array_like, shape (m, 3)
+    name : str, optional
+        Used in the messages.
+
+    Returns
+    -------
+    ndarray, shape (m, 3) float64
+
+    Examples
+    --------
     >>> check_points([[0, 0, float("nan")]])
     Traceback (most recent call last):
     ...
@@ -57,6 +69,24 @@ class Springs:
         The other ends d0.
     stiffness : float or array_like (m,)
         Spring constants k >= 0.
+
+    Notes
+    -----
+    The springs of qmv98 section 3.2 (eq. 27 with a delta kernel; generalized force eq. 21): energy
+    sum_i k_i/2 |x(face_i, u_i, v_i) - d0_i|^2.
+
+    Examples
+    --------
+    A spring of constant 3 stretched to length 2 stores 3/2 * 2^2 = 6:
+
+    >>> import numpy as np
+    >>> from ccproof.apps.dynamics.meshes import paper_initial_model
+    >>> from ccproof.apps.dynamics.model import DynamicSurface
+    >>> m = DynamicSurface(paper_initial_model())
+    >>> x = m.evaluator().evaluate(np.array([0]), np.array([0.5]), np.array([0.5]))["P"][0]
+    >>> s = Springs(m, [0], [0.5], [0.5], [x + [0, 0, -2.0]], 3.0)
+    >>> s.count, s.lengths(m.vertices).round(12).tolist(), round(float(s.energy(m.vertices)), 12)
+    (1, [2.0], 6.0)
     """
 
     def __init__(self, model, faces, u, v, anchors, stiffness):
@@ -112,6 +142,18 @@ def closest_cells(n_faces, budget=25_000, most=8):
     ``budget`` cells in all (the search structure is rebuilt at every correspondence update, so its
     cost and memory stay bounded on fine meshes), at most ``most``, at least 1.
 
+    Parameters
+    ----------
+    n_faces : int
+    budget : int, optional
+    most : int, optional
+
+    Returns
+    -------
+    int
+
+    Examples
+    --------
     >>> closest_cells(96), closest_cells(1536), closest_cells(24576)
     (8, 4, 1)
     """
@@ -130,6 +172,18 @@ class ModelClosestPoints:
     model : DynamicSurface
     cells : int, optional
         Cells per face side of the search (default :func:`closest_cells`).
+
+    Examples
+    --------
+    Building the search takes seconds (compilation), so this example is not run; the data points
+    on the limit surface are at distance 0:
+
+    >>> from ccproof.apps.dynamics.meshes import paper_initial_model
+    >>> from ccproof.apps.dynamics.model import DynamicSurface
+    >>> from ccproof.apps.dynamics.fit import limit_surface_mesh
+    >>> m = DynamicSurface(paper_initial_model())
+    >>> X = limit_surface_mesh(m.mesh, 1).vertices                                     # doctest: +SKIP
+    >>> res = ModelClosestPoints(m).query(m.vertices, X)                                 # doctest: +SKIP
     """
 
     def __init__(self, model, cells=None):

@@ -36,6 +36,20 @@ __all__ = [
 def paper_initial_model(center=(0.0, 0.0, 0.0), half_extent=1.0, subdivisions=2):
     """The cube ``center +- half_extent`` (scalar or per axis) subdivided ``subdivisions`` times.
 
+    The initial model of the fitting examples of qmv98 section 4 (docs/qmv98.md B6).
+
+    Parameters
+    ----------
+    center : array_like, shape (3,), optional
+    half_extent : float or array_like, shape (3,), optional
+    subdivisions : int, optional
+
+    Returns
+    -------
+    QuadMesh
+
+    Examples
+    --------
     >>> m = paper_initial_model()
     >>> m.n_vertices, m.n_faces, int((m.valence == 3).sum())
     (98, 96, 8)
@@ -49,19 +63,68 @@ def paper_initial_model(center=(0.0, 0.0, 0.0), half_extent=1.0, subdivisions=2)
 
 
 def open_surface_valence5(height=0.0):
-    """Fig. 6a: 61 vertices, 45 faces, one interior vertex of valence 5 (a 5-regular disk of 3 rings)."""
+    """Fig. 6a of qmv98: 61 vertices, 45 faces, one interior vertex of valence 5 (a 5-regular disk of 3 rings).
+
+    Parameters
+    ----------
+    height : float, optional
+        z of the centre (the disk is planar for 0).
+
+    Returns
+    -------
+    QuadMesh
+
+    Examples
+    --------
+    >>> m = open_surface_valence5()
+    >>> m.n_vertices, m.n_faces, int(m.valence[~m.is_boundary_vertex].max())
+    (61, 45, 5)
+    """
     h = None if not height else (lambda x, y: height * np.exp(-(x * x + y * y) / 4.0))
     m = k_regular_disk(5, rings=3, height=h)
     return m.with_vertices(np.asarray(m.vertices) / 3.0)
 
 
 def torus_32(R=2.0, r=0.75):
-    """Fig. 6b: the 8 x 4 regular torus (32 vertices, 32 faces)."""
+    """Fig. 6b of qmv98: the 8 x 4 regular torus (32 vertices, 32 faces).
+
+    Parameters
+    ----------
+    R, r : float, optional
+        Major and minor radius.
+
+    Returns
+    -------
+    QuadMesh
+
+    Examples
+    --------
+    Closed and regular: every vertex has valence 4, Euler characteristic 0:
+
+    >>> m = torus_32()
+    >>> m.n_vertices, m.n_faces, set(m.valence.tolist()), m.n_vertices - m.n_edges + m.n_faces
+    (32, 32, {4}, 0)
+    """
     return torus(8, 4, R=R, r=r)
 
 
 def flat_sheet(size=2.0):
-    """Fig. 6d: the 9 x 9 vertex sheet (8 x 8 faces) centred at the origin, side ``size``."""
+    """Fig. 6d of qmv98: the 9 x 9 vertex sheet (8 x 8 faces) centred at the origin, side ``size``.
+
+    Parameters
+    ----------
+    size : float, optional
+
+    Returns
+    -------
+    QuadMesh
+
+    Examples
+    --------
+    >>> m = flat_sheet()
+    >>> m.n_vertices, m.n_faces, m.vertices.min(axis=0).tolist(), m.vertices.max(axis=0).tolist()
+    (81, 64, [-1.0, -1.0, 0.0], [1.0, 1.0, 0.0])
+    """
     m = grid(8, 8)
     V = np.asarray(m.vertices).copy()
     V[:, :2] = (V[:, :2] / 8.0 - 0.5) * size

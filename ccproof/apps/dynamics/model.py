@@ -146,6 +146,20 @@ class DynamicSurface:
     Attributes
     ----------
     layout : ccproof.apps.dynamics.elements.ElementLayout
+
+    Examples
+    --------
+    The limit surface of the cube with corners (+-1, +-1, +-1) (twice subdivided: the same surface)
+    passes through the limit point (-1/2, -1/2, -1/2) of a corner (mask (n^2 v + 4 sum e + sum d) /
+    (n (n + 5)), n = 3) and (0, 0, -68/81) of a face centre (one step by hand, then the regular mask):
+
+    >>> import numpy as np
+    >>> from ccproof.apps.dynamics.meshes import paper_initial_model
+    >>> m = DynamicSurface(paper_initial_model())
+    >>> f = np.repeat(np.arange(96), 4)
+    >>> P = m.evaluator().evaluate(f, np.tile([0, 1, 0, 1.0], 96), np.tile([0, 0, 1, 1.0], 96))["P"]
+    >>> [bool(np.isclose(P, x).all(axis=1).any()) for x in ([-0.5, -0.5, -0.5], [0, 0, -68 / 81])]
+    [True, True]
     """
 
     def __init__(self, mesh, material=None, levels=8, face_swap=None):
@@ -529,7 +543,27 @@ class LimitEvaluator:
     """Evaluation of the limit surface of one state P with the patch nets cached.
 
     The nets of the normal faces are gathered once; for the special elements the level-l three-ring
-    positions ``(P_l - 1 l^T) P_ring`` are computed once per level that is asked for.
+    positions ``(P_l - 1 l^T) P_ring`` are computed once per level that is asked for (qmv98 section
+    2.4; docs/qmv98.md). Made by :meth:`DynamicSurface.evaluator`.
+
+    Parameters
+    ----------
+    model : DynamicSurface
+    P : ndarray, shape (n_vertices, 3) float64
+        The state (control points).
+
+    Examples
+    --------
+    A translated state gives the translated surface:
+
+    >>> import numpy as np
+    >>> from ccproof.apps.dynamics.meshes import paper_initial_model
+    >>> m = DynamicSurface(paper_initial_model())
+    >>> f, u, v = np.array([0, 5]), np.array([0.3, 0.0]), np.array([0.6, 0.0])
+    >>> a = LimitEvaluator(m, m.vertices).evaluate(f, u, v)["P"]
+    >>> b = LimitEvaluator(m, m.vertices + [1.0, 2.0, 3.0]).evaluate(f, u, v)["P"]
+    >>> bool(np.allclose(b - a, [1.0, 2.0, 3.0]))
+    True
     """
 
     def __init__(self, model, P):

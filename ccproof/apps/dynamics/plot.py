@@ -17,6 +17,20 @@ def limit_grid(model, P, per_edge=6):
 
     Returns ``faces (F,), grid (F, per_edge + 1, per_edge + 1, 3)``.
 
+    Parameters
+    ----------
+    model : DynamicSurface
+    P : ndarray, shape (n_vertices, 3) float64
+        The state.
+    per_edge : int, optional
+
+    Returns
+    -------
+    faces : ndarray, shape (F,) int64
+    grid : ndarray, shape (F, per_edge + 1, per_edge + 1, 3) float64
+
+    Examples
+    --------
     >>> from ccproof.apps.dynamics.meshes import torus_32
     >>> from ccproof.apps.dynamics.model import DynamicSurface
     >>> m = DynamicSurface(torus_32())
@@ -35,7 +49,36 @@ def limit_grid(model, P, per_edge=6):
 
 
 def draw_surface(ax, model, P, per_edge=5, light=(0.3, -0.5, 0.8), alpha=1.0, edgecolor="none"):
-    """Add the limit surface of state P to a 3D axes as shaded quads (yellow normal, green special)."""
+    """Add the limit surface of state P to a 3D axes as shaded quads (yellow normal, green special).
+
+    The figures of qmv98 section 4 (scripts/qmv98_examples.py).
+
+    Parameters
+    ----------
+    ax : mpl_toolkits.mplot3d.Axes3D
+    model : DynamicSurface
+    P : ndarray, shape (n_vertices, 3) float64
+    per_edge : int, optional
+    light : tuple of 3 float, optional
+        Light direction of the shading.
+    alpha : float, optional
+    edgecolor : str, optional
+
+    Returns
+    -------
+    None
+
+    Examples
+    --------
+    Drawing takes seconds (matplotlib), so this example is not run:
+
+    >>> import matplotlib.pyplot as plt  # doctest: +SKIP
+    >>> from ccproof.apps.dynamics.meshes import torus_32  # doctest: +SKIP
+    >>> from ccproof.apps.dynamics.model import DynamicSurface  # doctest: +SKIP
+    >>> m = DynamicSurface(torus_32())  # doctest: +SKIP
+    >>> ax = plt.figure().add_subplot(projection="3d")                 # doctest: +SKIP
+    >>> draw_surface(ax, m, m.vertices)                                 # doctest: +SKIP
+    """
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
     faces, G = limit_grid(model, P, per_edge)
@@ -56,7 +99,28 @@ def draw_surface(ax, model, P, per_edge=5, light=(0.3, -0.5, 0.8), alpha=1.0, ed
 
 
 def set_equal_axes(ax, pts, margin=0.05):
-    """Equal aspect ratio around the points; no axes drawn."""
+    """Equal aspect ratio around the points; no axes drawn.
+
+    Parameters
+    ----------
+    ax : mpl_toolkits.mplot3d.Axes3D
+    pts : ndarray, shape (n, 3) float64
+    margin : float, optional
+        Relative margin around the bounding cube.
+
+    Returns
+    -------
+    None
+
+    Examples
+    --------
+    Needs matplotlib (seconds to import), so this example is not run:
+
+    >>> import numpy as np  # doctest: +SKIP
+    >>> import matplotlib.pyplot as plt  # doctest: +SKIP
+    >>> ax = plt.figure().add_subplot(projection="3d")                 # doctest: +SKIP
+    >>> set_equal_axes(ax, np.array([[0, 0, 0], [2, 1, 1.0]]))        # doctest: +SKIP
+    """
     pts = np.asarray(pts)
     lo, hi = pts.min(axis=0), pts.max(axis=0)
     c = 0.5 * (lo + hi)
