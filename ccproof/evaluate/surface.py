@@ -653,7 +653,10 @@ class LimitSurface:
                 return out
             from concurrent.futures import ThreadPoolExecutor
 
-            bounds = np.linspace(0, n, nt + 1).astype(np.int64)
+            # many more blocks than threads, taken in turn by the threads: the cost per point varies
+            # (points near irregular vertices go down the layers), so equal halves finish unequally
+            nb = max(nt, min(16 * nt, n // 32768))
+            bounds = np.linspace(0, n, nb + 1).astype(np.int64)
 
             def block(i):
                 lo, hi = bounds[i], bounds[i + 1]
@@ -661,7 +664,7 @@ class LimitSurface:
                        *[a[lo:hi] if a.shape[0] else a for a in arrs])
 
             with ThreadPoolExecutor(nt) as ex:
-                list(ex.map(block, range(nt)))
+                list(ex.map(block, range(nb)))
             return out
         for lo in range(0, n, chunk):
             hi = min(n, lo + chunk)
