@@ -193,4 +193,4 @@ def test_identity_nets_for_every_k_ge_40(monkeypatch):
     certificate for that map; the verifier, which derives the k >= 40 nets itself, rejects it at part B."""
     monkeypatch.setattr(P, "derivation", lambda: _IdentityDerivation())
     forged = P.prove_interval(40, progress=False, max_pieces=1)
-    failed_with(forged, "FAIL  [piece 0] B regularity P1", "is not above the claimed bound")
+    failed_with(forged, "FAIL  [piece 0] B regularity P2", "is not above the claimed bound")
