@@ -159,15 +159,15 @@ class Options:
         return "Options(boundary={!r}, crease_method={!r}, triangle_subdivision={!r})".format(*self.key())
 
 
-def is_sharp(s):
+def _is_sharp(s):
     return s > 0.0
 
 
-def is_infinite(s):
+def _is_infinite(s):
     return s >= INFINITE
 
 
-def is_semi_sharp(s):
+def _is_semi_sharp(s):
     return 0.0 < s < INFINITE
 
 
@@ -185,7 +185,7 @@ def _child_sharpness_at_vertex(edge_sharpness, chaikin):
     """Sdc ``SubdivideEdgeSharpnessesAroundVertex``: child sharpness of every edge at one vertex."""
     if not chaikin or len(edge_sharpness) < 2:
         return [_decrement(s) for s in edge_sharpness]
-    semi = [s for s in edge_sharpness if is_semi_sharp(s)]
+    semi = [s for s in edge_sharpness if _is_semi_sharp(s)]
     if not semi:
         return list(edge_sharpness)
     total = _F32(0.0)
