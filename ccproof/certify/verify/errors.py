@@ -11,7 +11,6 @@ class CertificateError(ValueError):
 
     Examples
     --------
-
     >>> from ccproof.certify.verify import verify_certificate
     >>> verify_certificate({"schema": "ccproof.c1/2", "valence": 2}, log=lambda line: None).error
     'valence 2 outside 3..10^6'
