@@ -40,6 +40,11 @@ B2Z = ((1, 4, 1, 0), (0, 4, 2, 0), (0, 2, 4, 0), (0, 1, 4, 1))
 class StatementError(ValueError):
     """The derivation of the statement failed (cannot happen for the true rules; a tripwire).
 
+    Parameters
+    ----------
+    message : str
+        Which identity or denominator failed.
+
     Examples
     --------
     >>> issubclass(StatementError, ValueError), all(ok for _, ok in derivation().hypotheses)
