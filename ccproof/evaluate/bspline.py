@@ -76,6 +76,22 @@ def eval_patches(nets, s, t, derivatives=0):
     -------
     dict of ndarray, shape (n, 3)
         ``P`` and, as requested, ``Ps, Pt`` and ``Pss, Pst, Ptt`` (derivatives in (s, t)).
+
+    Notes
+    -----
+    The tensor product of :func:`bspline_basis` (a regular Catmull-Clark patch is the uniform bicubic
+    B-spline on its one-ring); docs/evaluate.md "Method", item 1 (regular faces).
+
+    Examples
+    --------
+    Uniform B-splines reproduce linear functions: the net ``(i, j, 0)`` gives ``(1 + s, 1 + t, 0)``.
+
+    >>> import numpy as np
+    >>> j, i = np.mgrid[0:4, 0:4]
+    >>> net = np.stack([i.ravel(), j.ravel(), np.zeros(16)], axis=1)[None].astype(float)
+    >>> out = eval_patches(net, np.array([0.25]), np.array([0.5]), derivatives=1)
+    >>> [(np.round(out[d], 12) + 0.0).tolist() for d in ("P", "Ps", "Pt")]
+    [[[1.25, 1.5, 0.0]], [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]]]
     """
     bs = bspline_basis(s, derivatives)
     bt = bspline_basis(t, derivatives)

@@ -77,7 +77,32 @@ CHUNK = 1 << 16
 
 
 def parameter_faces(surface):
-    """Number of parameter faces (ptex faces) of ``surface``: face ids are ``0 .. parameter_faces - 1``."""
+    """Number of parameter faces (ptex faces) of ``surface``: face ids are ``0 .. parameter_faces - 1``.
+
+    Parameters
+    ----------
+    surface : LimitSurface or TaggedLimitSurface
+        Anything with ``n_ptex_faces`` / ``n_param_faces``, or a ``mesh`` with ``n_ptex_faces``,
+        ``n_ptex`` or ``n_faces``.
+
+    Returns
+    -------
+    int
+        A quad mesh has one parameter face per face; a polygon of n != 4 sides has n (OpenSubdiv's
+        ptex convention, docs/evaluate.md "Conventions").
+
+    Raises
+    ------
+    CCProofError
+        If ``surface`` says none of these.
+
+    Examples
+    --------
+    >>> from ccproof.evaluate import limit_surface
+    >>> from ccproof.mesh.examples import cube
+    >>> parameter_faces(limit_surface(cube()))
+    6
+    """
     for name in ("n_ptex_faces", "n_param_faces"):
         n = getattr(surface, name, None)
         if n is not None:
@@ -109,6 +134,25 @@ class ClosestPoints:
     descents : ndarray of int32, shape (n,)
         Number of Newton descents run for the point (1 when the first one was provably best
         among the candidate cells).
+
+    Notes
+    -----
+    The float path of docs/closest.md ("Float path: method"); no certificate (see
+    :func:`ccproof.evaluate.closest_certified.certify_closest`).
+
+    Examples
+    --------
+    A point of the torus's limit surface is its own nearest point:
+
+    >>> from ccproof.evaluate import limit_surface
+    >>> from ccproof.mesh.examples import torus
+    >>> S = limit_surface(torus())
+    >>> X = S.evaluate([5], [0.25], [0.75])["P"]
+    >>> res = closest_points(S, X, cells=4)
+    >>> isinstance(res, ClosestPoints), res.face.tolist(), res.u.tolist(), res.v.tolist()
+    (True, [5], [0.25], [0.75])
+    >>> bool(res.distance[0] < 1e-12)
+    True
     """
 
     face: np.ndarray
@@ -148,6 +192,21 @@ def newton(surface, X, face, u, v, max_iter=MAX_ITER):
     u, v : ndarray, shape (n,)
     E : ndarray, shape (n,)
         ``|P - X|^2 / 2`` at the result (never larger than at the start).
+
+    Notes
+    -----
+    docs/closest.md "Float path: method" (the local descent of every candidate cell).
+
+    Examples
+    --------
+    Above the centre of the cube's top face (face 1) the descent ends at (1/2, 1/2), where the limit
+    point is (0, 0, 68/81), at distance 94/81 from (0, 0, 2):
+
+    >>> from ccproof.evaluate import limit_surface
+    >>> from ccproof.mesh.examples import cube
+    >>> u, v, E = newton(limit_surface(cube()), [[0.0, 0.0, 2.0]], [1], [0.3], [0.3])
+    >>> u.tolist(), v.tolist(), round(float(2 * E[0] * 81**2), 9)
+    ([0.5], [0.5], 8836.0)
     """
     X = np.asarray(X, dtype=np.float64)
     face = np.asarray(face, dtype=np.int64)
@@ -257,6 +316,22 @@ class ClosestPointFinder:
     faces : array_like of int, optional
         Search only these parameter faces (default: all); e.g. the faces that carry a patch of a
         finite-element model (ccproof.apps.dynamics). The answers lie on these faces only.
+
+    Notes
+    -----
+    Bounding cylinders per cell and a k-d tree of samples, docs/closest.md "Float path: method";
+    :meth:`query` answers like :func:`closest_points`.
+
+    Examples
+    --------
+    >>> from ccproof.evaluate import limit_surface
+    >>> from ccproof.mesh.examples import torus
+    >>> S = limit_surface(torus())
+    >>> finder = ClosestPointFinder(S, cells=4)
+    >>> X = S.evaluate([5, 30], [0.25, 0.5], [0.75, 0.125])["P"]
+    >>> res = finder.query(X)
+    >>> res.face.tolist(), res.u.round(12).tolist(), res.v.round(12).tolist(), bool(res.distance.max() < 1e-12)
+    ([5, 30], [0.25, 0.5], [0.75, 0.125], True)
     """
 
     def __init__(self, surface, cells=CELLS, cover=None, faces=None):

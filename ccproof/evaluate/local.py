@@ -53,7 +53,7 @@ LAYER_TOLERANCE = 2.0**-60
 MAX_LAYERS = 400
 
 
-def group_eigenvalues(vals, tol):
+def _group_eigenvalues(vals, tol):
     """Consecutive eigenvalues (sorted by modulus) within ``tol`` of their group's first one, as lists
     (a defective pair splits by ~sqrt(eps), so it lands in one group)."""
     groups = []
@@ -193,7 +193,39 @@ def quad_ring(faces, f, r):
 
 
 def ring_key(cx, ring, faces, n_rule):
-    """Tagged key of a ring: faces, sharpness of edges at rule vertices, their vertex sharpness."""
+    """Tagged key of a ring: faces, sharpness of edges at rule vertices, their vertex sharpness.
+
+    Parameters
+    ----------
+    cx : Complex
+        The complex the ring was read from (:func:`canonical_ring`).
+    ring : list of int
+        Vertex labels of ``cx`` in canonical order.
+    faces : tuple of tuple of int
+        The ring's faces in canonical (local) labels.
+    n_rule : int
+        Number of leading ring vertices whose rules are computed (their tags enter the key).
+
+    Returns
+    -------
+    tuple
+        ``(faces, edge_tags, vertex_tags, options)``: ``edge_tags`` are ``((a, b), s)`` with local
+        labels ``a < b`` and sharpness ``s`` (``inf`` from 10 on, OpenSubdiv's infinite sharpness),
+        boundary edges left out (sharp by the topology); ``vertex_tags`` are ``(i, s)``;
+        ``options`` is :meth:`ccproof.mesh.rules.Options.key`. Equal keys have equal exact
+        subdivision data (docs/evaluate.md "Method", item 2).
+
+    Examples
+    --------
+    A crease of sharpness 2 on the edge from the centre of the 5-regular disk:
+
+    >>> from ccproof.mesh.examples import k_regular_disk
+    >>> from ccproof.mesh.rules import Complex, Options
+    >>> cx = Complex(k_regular_disk(5, 3).faces, {(0, 1): 2.0}, {}, Options())
+    >>> ring, faces, nr = canonical_ring(cx, 0, 0)
+    >>> ring_key(cx, ring, faces, nr)[1:3]
+    ((((0, 1), 2.0),), ())
+    """
     tags = []
     rule = set(range(n_rule))
     seen = set()
@@ -235,13 +267,37 @@ def _has_semi_sharp(key):
 def refine_key(key, n_rule):
     """One exact tagged step of the ring ``key``, computing the rules at its ``n_rule`` rule vertices.
 
+    Parameters
+    ----------
+    key : tuple
+        A ring key (:func:`ring_key`) with N ring vertices.
+    n_rule : int
+        The rules are computed at ring vertices ``0 .. n_rule - 1`` and at the edges touching them.
+
     Returns
     -------
     S : ndarray, shape (n_points, N)
         Float stencils (dense: local complexes are small), rows of uncomputable points NaN.
+        Row v < N is the vertex point of ring vertex v (docs/evaluate.md "Conventions").
     stencils : tuple of dict or None (exact)
     child : Complex
         The children of all faces, with the child tags (positions are not part of it).
+
+    Notes
+    -----
+    The rules of :mod:`ccproof.mesh.rules` in exact rationals (bmz04 Fig. 1, docs/readings.md R1).
+
+    Examples
+    --------
+    At the centre of valence k = 5 the vertex point keeps ``1 - 7 / (4k) = 13/20`` of the old vertex
+    (``(F + 2R + (k - 3)V) / k``, R1), and every stencil sums to 1:
+
+    >>> import numpy as np
+    >>> from ccproof.mesh.examples import k_regular_disk
+    >>> ring, key = quad_ring(k_regular_disk(5, 3).faces, 0, 0)
+    >>> S, stencils, child = refine_key(key, 4)
+    >>> S.shape, stencils[0][0], np.nansum(S, axis=1)[:4].tolist()
+    ((55, 18), 13/20, [1.0, 1.0, 1.0, 1.0])
     """
     cx = _key_complex(key)
     rule = range(n_rule)
@@ -299,6 +355,26 @@ def corner_is_regular(cx, c):
 
     Smooth rule with a closed fan of 4 faces; crease rule with 2 faces in the corner's sector;
     corner rule with 1 face in the sector.
+
+    Parameters
+    ----------
+    cx : Complex
+    c : int
+        A half-edge (corner) of ``cx``: corner i of face g is ``cx.start[g] + i``.
+
+    Returns
+    -------
+    bool
+
+    Examples
+    --------
+    Face 0 of the 5-regular disk has its corner 0 at the centre (valence 5); the others have valence 4:
+
+    >>> from ccproof.mesh.examples import k_regular_disk
+    >>> from ccproof.mesh.rules import Complex, Options
+    >>> cx = Complex(k_regular_disk(5, 3).faces, {}, {}, Options())
+    >>> [corner_is_regular(cx, cx.start[0] + i) for i in range(4)]
+    [False, True, True, True]
     """
     info = _corner_info(cx, c)
     if info is None:
@@ -327,6 +403,33 @@ def regular_net(cx, g):
 
     Rows across infinitely sharp edges (and boundary edges) of the face are ghost points
     ``2 B - I``; at a corner-rule corner the diagonal ghost is ``4 V - 2 E1 - 2 E2 + D``.
+
+    Parameters
+    ----------
+    cx : Complex
+    g : int
+        A quad of ``cx``.
+
+    Returns
+    -------
+    list of dict or None
+        16 stencils ``{vertex: integer weight}``, net point ``i + 4 j`` (i along the face's u),
+        as :func:`ccproof.evaluate.bspline.eval_patches` takes them; None if a corner is irregular
+        (:func:`corner_is_regular`). docs/evaluate.md "Method", item 1.
+
+    Examples
+    --------
+    On the 4 x 4 grid (vertex ``i + 5 j`` at (i, j)) the net of the inner face 5 is the 4 x 4 block of
+    vertices around it; face 1 on the boundary gets the ghost row ``2 B - I``; the corner face 0 has a
+    boundary vertex with one face, which is irregular:
+
+    >>> from ccproof.mesh.examples import grid
+    >>> from ccproof.mesh.rules import Complex, Options
+    >>> cx = Complex(grid(4, 4).faces, {}, {}, Options())
+    >>> regular_net(cx, 5) == [{i + 5 * j: 1} for j in range(4) for i in range(4)]
+    True
+    >>> regular_net(cx, 1)[:2], regular_net(cx, 0)
+    ([{0: 2, 5: -1}, {1: 2, 6: -1}], None)
     """
     s0 = cx.start[g]
     if not all(corner_is_regular(cx, s0 + i) for i in range(4)):
@@ -366,7 +469,7 @@ def regular_net(cx, g):
 
 
 @functools.lru_cache(maxsize=8192)
-def regular_net_matrix(key):
+def _regular_net_matrix(key):
     """Float (16, N) matrix of the regular net of face 0 of the ring ``key``, or None."""
     cx = _key_complex(key)
     net = regular_net(cx, 0)
@@ -377,6 +480,26 @@ def regular_net_matrix(key):
 
 @functools.lru_cache(maxsize=8192)
 def irregular_corners(key):
+    """The corners of face 0 of the ring ``key`` that are not regular (:func:`corner_is_regular`).
+
+    Parameters
+    ----------
+    key : tuple
+        A ring key (:func:`ring_key`, :func:`quad_ring`).
+
+    Returns
+    -------
+    tuple of int
+        Corner indices in 0..3 (corner 0 is the corner the ring was read from).
+
+    Examples
+    --------
+    >>> from ccproof.mesh.examples import cube, k_regular_disk
+    >>> irregular_corners(quad_ring(k_regular_disk(5, 3).faces, 0, 0)[1])
+    (0,)
+    >>> irregular_corners(quad_ring(cube().faces, 0, 0)[1])   # eight vertices of valence 3
+    (0, 1, 2, 3)
+    """
     cx = _key_complex(key)
     return tuple(i for i in range(4) if not corner_is_regular(cx, i))
 
@@ -384,8 +507,34 @@ def irregular_corners(key):
 # ------------------------------------------------------------------------------ corner schemes
 @functools.lru_cache(maxsize=2048)
 def corner_scheme(key):
-    """:func:`_corner_scheme`, kept between runs (:func:`cached_scheme`)."""
-    return cached_scheme("tagged", key, lambda: _corner_scheme(key))
+    """Exact layered-patch data of face 0 of the ring ``key`` (irregular corner 0), cached.
+
+    :func:`_corner_scheme` (the method: self-similar layers, bmz04 section 3, Stam 1998,
+    docs/readings.md R4 and R12, docs/evaluate.md "Method", item 2), kept in memory and between runs
+    on disk (:func:`_cached_scheme`).
+
+    Parameters
+    ----------
+    key : tuple
+        The tagged one-ring (:func:`canonical_ring`, :func:`ring_key`, :func:`quad_ring`) of a face,
+        read from its irregular corner.
+
+    Returns
+    -------
+    CornerScheme or None
+        None unless the configuration is self-similar with regular other children.
+
+    Examples
+    --------
+    At an interior vertex of valence k the limit mask is ``(k^2 V + 4 sum e + sum d) / (k (k + 5))``:
+    1/2, 4/50 and 1/50 for k = 5; the ring has Stam's 2k + 8 = 18 points and the table 70 layers:
+
+    >>> from ccproof.mesh.examples import k_regular_disk
+    >>> sch = corner_scheme(quad_ring(k_regular_disk(5, 3).faces, 0, 0)[1])
+    >>> sch.size, sch.limit_mask[:3].round(15).tolist(), sch.n_layers
+    (18, [0.5, 0.08, 0.02], 70)
+    """
+    return _cached_scheme("tagged", key, lambda: _corner_scheme(key))
 
 
 def _corner_scheme(key):
@@ -494,9 +643,22 @@ def power_layers(M, A, l_row):
 
     Notes
     -----
-    Exact throughout: with ``A = Ai / a``, ``M = Mi / m`` and ``l = li / c`` (integer matrices and
+    Layer n of docs/readings.md R4 (docs/evaluate.md "Method", item 2). Exact throughout: with
+    ``A = Ai / a``, ``M = Mi / m`` and ``l = li / c`` (integer matrices and
     common denominators) the n-th deviation is ``(c Mi Ai^n - m a^n 1 li^T) / (c m a^n)``; the powers
     are integer matrix products (flint ``fmpz_mat``), and only the final quotients are rounded.
+
+    Examples
+    --------
+    Point 1 moves halfway to point 0 at each step (limit mask ``l = (1, 0)``); every net point is
+    point 1, so the deviation of layer n is ``(-2^-n, 2^-n)``, below ``2^-60`` from n = 61 on:
+
+    >>> import flint
+    >>> A = flint.fmpq_mat(2, 2, [1, 0, flint.fmpq(1, 2), flint.fmpq(1, 2)])
+    >>> M = flint.fmpq_mat(48, 2, [0, 1] * 48)
+    >>> D = power_layers(M, A, flint.fmpq_mat(1, 2, [1, 0]))
+    >>> D.shape, D[3, 0, 0].tolist()
+    ((62, 3, 16, 2), [-0.125, 0.125])
     """
     N = A.nrows()
     Ai, a = A.numer_denom()
@@ -547,7 +709,7 @@ def _cache_dir():
     return Path(d) if d else Path.home() / ".cache" / "ccproof" / "corner_schemes"
 
 
-def cached_scheme(kind, key, compute):
+def _cached_scheme(kind, key, compute):
     """``compute()`` (a CornerScheme or None), kept between runs in a disk cache.
 
     The cache (default ``~/.cache/ccproof/corner_schemes``; environment variable
@@ -631,6 +793,21 @@ class CornerScheme:
         The ring points the surface over the face depends on (closed under ``A``), when fewer
         than all: across an infinitely sharp crease the other sector is decoupled, and its
         eigenvalues must not enter the tangent plane of this one. ``None``: all points.
+
+    Notes
+    -----
+    Self-similar layers (bmz04 section 3, Stam 1998; docs/readings.md R4, R12); the limit mask and
+    the tangent masks (Halstead et al. 1993 at interior vertices) of docs/evaluate.md "Method",
+    item 4.
+
+    Examples
+    --------
+    The tangent masks at the centre of a 5-regular disk annihilate constants (their entries sum to 0):
+
+    >>> from ccproof.mesh.examples import k_regular_disk
+    >>> sch = corner_scheme(quad_ring(k_regular_disk(5, 3).faces, 0, 0)[1])
+    >>> isinstance(sch, CornerScheme), sch.layers.shape[1:], bool(abs(sch.tangent_masks.sum(axis=1)).max() < 1e-12)
+    (True, (3, 16, 18), True)
     """
 
     def __init__(self, size, A, limit_mask, layers, support=None):
@@ -688,7 +865,7 @@ def _tangent_masks_float(A):
     N = Af.shape[0]
     vals = np.linalg.eigvals(Af)
     vals = vals[np.argsort(-np.abs(vals), kind="stable")]
-    groups = group_eigenvalues(vals, 1e-6)
+    groups = _group_eigenvalues(vals, 1e-6)
     masks = []
     for g in groups:
         mu = sum(g) / len(g)
@@ -720,7 +897,7 @@ def _tangent_masks(A):
         E = mpmath.eig(M.T, left=False, right=False)
         vals = sorted(E, key=lambda z: -abs(z))
         # group numerically equal eigenvalues (a defective pair splits by ~sqrt(eps))
-        groups = group_eigenvalues(vals, 1e-15)
+        groups = _group_eigenvalues(vals, 1e-15)
         masks = []
         for g in groups:
             mu = sum(g) / len(g)

@@ -40,11 +40,11 @@ from ccproof.evaluate.local import (
     CORNERS,
     _child_ring,
     _has_semi_sharp,
+    _regular_net_matrix,
     canonical_ring,
     corner_scheme,
     irregular_corners,
     refine_key,
-    regular_net_matrix,
     ring_key,
 )
 from ccproof.mesh import QuadMesh, limit_normals, limit_positions
@@ -382,7 +382,7 @@ class _Builder:
                                    None if vmap is None else vmap[ring])
         irr = irregular_corners(key)
         if not irr:
-            M = regular_net_matrix(key)
+            M = _regular_net_matrix(key)
             Xl = X[ring]
             self._check_finite(Xl, base)
             origin = Xl.mean(axis=0)
@@ -465,9 +465,39 @@ class _Builder:
 class LimitSurface:
     """Exact evaluator of the limit surface of a quad mesh (natural parameterization, bmz04 section 2).
 
-    Build it with :func:`natural_limit_surface`. Attributes: ``mesh``, ``n_patches`` (bicubic patches
-    stored), ``max_layers`` (deepest layer stored at an irregular corner), ``split_depth`` (how many
-    local subdivisions the most irregular face needed).
+    Build it with :func:`natural_limit_surface`.
+
+    Parameters
+    ----------
+    mesh : QuadMesh
+        m faces, n vertices ``(n, 3) float64``.
+
+    Attributes
+    ----------
+    mesh : QuadMesh
+    n_patches : int
+        Bicubic patches stored (17 x 3 floats each: net and origin).
+    max_layers : int
+        Deepest layer stored at an irregular corner.
+    split_depth : int
+        How many local subdivisions the most irregular face needed.
+
+    Notes
+    -----
+    Regular faces are bicubic B-spline patches, faces at one irregular vertex exact self-similar
+    layers (docs/readings.md R4, R12; Stam 1998), other faces are split locally: docs/evaluate.md
+    "Method". :meth:`evaluate` takes ``face, u, v`` of shape (n,) and returns ``P`` (n, 3) and its
+    derivatives.
+
+    Examples
+    --------
+    The cube's corner limit point is ``(9 V + 4 sum e + sum d) / 24 = (-1/2, -1/2, -1/2)`` at
+    ``V = (-1, -1, -1)``; every face has four irregular corners, so it is split once:
+
+    >>> from ccproof.mesh.examples import cube
+    >>> S = LimitSurface(cube())
+    >>> S.evaluate([0], [0.0], [0.0])["P"].round(12).tolist(), S.split_depth
+    ([[-0.5, -0.5, -0.5]], 1)
     """
 
     def __init__(self, mesh: QuadMesh):

@@ -54,6 +54,28 @@ class TaggedLimitSurface(LimitSurface):
     as :meth:`LimitSurface.evaluate`, with ``face`` the ptex face index (OpenSubdiv's
     ``Far::PtexIndices``, :meth:`PolyMesh.ptex_of`) and derivatives with respect to its (s, t).
     Points on hole faces raise an error naming the point and the face.
+
+    Parameters
+    ----------
+    mesh : PolyMesh
+        Polygons with OpenSubdiv's tags (creases, corners, holes, boundary options).
+
+    Notes
+    -----
+    OpenSubdiv's Sdc rules in exact arithmetic (:mod:`ccproof.mesh.rules`), then the method of
+    :class:`LimitSurface`; docs/evaluate.md "Tagged polygon meshes (OpenSubdiv's features)".
+
+    Examples
+    --------
+    An infinitely sharp corner on vertex 0 of the cube is interpolated; the untagged corners keep
+    the smooth limit point (-1/2, -1/2, 1/2) of vertex 4 = (-1, -1, 1):
+
+    >>> from ccproof.mesh import PolyMesh
+    >>> from ccproof.mesh.examples import cube
+    >>> c = cube()
+    >>> S = TaggedLimitSurface(PolyMesh(c.vertices, c.faces.tolist(), corners={0: 10}))
+    >>> S.evaluate([0, 1], [0.0, 0.0], [0.0, 0.0])["P"].round(12).tolist()
+    [[-1.0, -1.0, -1.0], [-0.5, -0.5, 0.5]]
     """
 
     def __init__(self, mesh: PolyMesh):

@@ -57,6 +57,17 @@ def read_obj_polygons(path):
     ------
     MeshError
         On a malformed ``v`` or ``f`` statement or a vertex index out of range (message names the line).
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     path = os.path.join(d, "m.obj")
+    ...     with open(path, "w") as fh:
+    ...         _ = fh.write("v 0 0 0\\nv 1 0 0\\nv 1 1 0\\nv 0 1 0\\nv 2 0 0\\n# two faces\\nf 1 2 3 4\\nf 2 5 3\\n")
+    ...     V, polygons, lines = read_obj_polygons(path)
+    >>> V.shape, polygons, lines
+    ((5, 3), [[0, 1, 2, 3], [1, 4, 2]], [7, 8])
     """
     with open(os.fspath(path), encoding="utf-8", errors="replace") as fh:
         text = fh.read()
@@ -130,6 +141,30 @@ def read_obj_tagged(path):
     ``t creasemethod 0/0/1 normal|chaikin``, ``t smoothtriangles 0/0/1 catmark|smooth``.
     Face-varying tags are ignored; any other tag is an error (never silently ignored). Negative
     sharpness is clamped to 0, as OpenSubdiv does, with the line in the error if it is NaN.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+
+    Returns
+    -------
+    PolyMesh
+        Vertices ``(n, 3) float64``, the polygons in file order, and the tags (tests/data/osd_features
+        describes the grammar; docs/evaluate.md "Tagged polygon meshes (OpenSubdiv's features)").
+
+    Examples
+    --------
+    A quad (one ptex face) and a triangle (three) with an infinitely sharp crease (sharpness >= 10):
+
+    >>> import os, tempfile
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     path = os.path.join(d, "m.obj")
+    ...     with open(path, "w") as fh:
+    ...         _ = fh.write("v 0 0 0\\nv 1 0 0\\nv 1 1 0\\nv 0 1 0\\nv 2 0 0\\nf 1 2 3 4\\nf 2 5 3\\n"
+    ...                      "t crease 2/1/0 1 2 10\\n")
+    ...     m = read_obj_tagged(path)
+    >>> m.n_faces, m.n_ptex, m.edge_sharpness
+    (2, 4, {(1, 2): inf})
     """
     from ccproof.mesh.polymesh import PolyMesh
     from ccproof.mesh.rules import Options
@@ -316,6 +351,30 @@ def write_obj(path, mesh, *, comment=None):
     """Write a :class:`QuadMesh` (or ``(vertices, faces)``) as OBJ with 17 significant digits.
 
     Reading the file back with :func:`read_obj` gives the same arrays bit for bit.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+    mesh : QuadMesh or (vertices, faces)
+        ``vertices (n, 3) float64``, ``faces (m, 4) int`` (0-based; written 1-based).
+    comment : str, optional
+        Written as ``#`` lines at the top.
+
+    Returns
+    -------
+    None
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> import numpy as np
+    >>> from ccproof.mesh.examples import torus
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     path = os.path.join(d, "torus.obj")
+    ...     write_obj(path, torus(), comment="a torus")
+    ...     back = read_obj(path)
+    >>> np.array_equal(back.vertices, torus().vertices), np.array_equal(back.faces, torus().faces)
+    (True, True)
     """
     if isinstance(mesh, QuadMesh):
         V, F = mesh.vertices, mesh.faces

@@ -74,10 +74,37 @@ def limit_positions(mesh: QuadMesh, vertices=None):
 def limit_tangents(mesh: QuadMesh, vertices=None):
     """Limit tangent masks t1, t2 (module docstring), NaN at irregular boundary vertices.
 
+    Parameters
+    ----------
+    mesh : QuadMesh
+    vertices : array_like, shape (n, 3), optional
+        Positions to use instead of ``mesh.vertices`` (same topology).
+
     Returns
     -------
     t1, t2 : ndarray, shape (n, 3)
         Scaled as in the masks (only the plane they span and its orientation are meaningful).
+
+    Notes
+    -----
+    Interior vertices: the eigen tangent masks of Halstead et al. 1993 with
+    ``A = 1 + cos(2 pi / k) + sqrt((1 + cos(2 pi / k)) (9 + cos(2 pi / k)))`` on the edge neighbours and
+    ``cos th_j + cos th_(j+1)`` on the diagonal ones; regular boundary vertices: ``e0 - e2`` and
+    ``(d0 + 4 e1 + d1 - e0 - 4 V - e2) / 6`` (docs/evaluate.md "Method", item 4).
+
+    Examples
+    --------
+    On the planar 2 x 2 grid: at the inner vertex 4 (valence 4, A = 4) the masks have length
+    ``2 A + 4 = 12`` along the grid lines; at the boundary vertex 1 = (1, 0), ``e0 - e2 = (2, 0, 0)``
+    and ``(6 (y = 1) - 0) / 6 = 1`` across; the corner vertex 0 (one face) is NaN:
+
+    >>> import numpy as np
+    >>> from ccproof.mesh.examples import grid
+    >>> t1, t2 = limit_tangents(grid(2, 2))
+    >>> (np.round(t1[4], 12) + 0.0).tolist(), (np.round(t2[4], 12) + 0.0).tolist()
+    ([-12.0, 0.0, 0.0], [0.0, -12.0, 0.0])
+    >>> t1[1].tolist(), t2[1].tolist(), bool(np.isnan(t1[0]).all())
+    ([2.0, 0.0, 0.0], [0.0, 1.0, 0.0], True)
     """
     V = mesh.vertices if vertices is None else np.asarray(vertices, dtype=np.float64)
     F = mesh.faces

@@ -24,7 +24,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ccproof.errors import MeshError
-from ccproof.mesh.quadmesh import pair_halfedges
+from ccproof.mesh.quadmesh import _pair_halfedges
 from ccproof.mesh.rules import INFINITE, Complex, Options, refine_complex, to_float
 
 __all__ = ["PolyMesh"]
@@ -160,7 +160,7 @@ class PolyMesh:
         nxt = off[face_of] + (loc + 1) % self.sizes[face_of]
         prv = off[face_of] + (loc - 1) % self.sizes[face_of]
         org, dst = idx, idx[nxt]
-        lo, hi, order, starts, counts, edge_of, twin = pair_halfedges(org, dst, face_of, n)
+        lo, hi, order, starts, counts, edge_of, twin = _pair_halfedges(org, dst, face_of, n)
         first = order[starts]
         self.edges = np.stack([lo[first], hi[first]], axis=1)
         self.edge_index = {(int(a), int(b)): e for e, (a, b) in enumerate(self.edges.tolist())}
@@ -320,7 +320,7 @@ class PolyMesh:
         """
         cx = self.complex()
         stencils, children, ces, cvs = refine_complex(cx)
-        S = stencil_matrix(stencils, self.n_vertices)
+        S = _stencil_matrix(stencils, self.n_vertices)
         V1 = S @ self.vertices
         holes = np.repeat(self.is_hole, self.sizes)
         m = PolyMesh(V1, children, creases=(list(ces.keys()), list(ces.values())) if ces else None,
@@ -337,7 +337,7 @@ class PolyMesh:
         stencils, _, _, _ = refine_complex(self.complex())
         if exact:
             return stencils
-        return stencil_matrix(stencils, self.n_vertices)
+        return _stencil_matrix(stencils, self.n_vertices)
 
     def __repr__(self):
         return (f"PolyMesh({self.n_vertices} vertices, {self.n_faces} faces, {self.n_ptex} ptex faces, "
@@ -345,7 +345,7 @@ class PolyMesh:
                 f"{int(self.is_hole.sum())} holes, {self.options})")
 
 
-def stencil_matrix(stencils, ncols):
+def _stencil_matrix(stencils, ncols):
     """Float CSR matrix of a list of stencils (dict column -> weight; None rows are NaN)."""
     rows, cols, vals = [], [], []
     for r, s in enumerate(stencils):

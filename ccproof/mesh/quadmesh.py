@@ -33,7 +33,7 @@ def _edge_str(a, b):
     return f"edge ({int(a)}, {int(b)})"
 
 
-def pair_halfedges(org, dst, face_of, n):
+def _pair_halfedges(org, dst, face_of, n):
     """Undirected edges and twins of the half-edges org -> dst (face ``face_of``) of a mesh with n vertices.
 
     Returns ``(lo, hi, order, starts, counts, edge_of, twin)``: per half-edge the edge's end points
@@ -185,7 +185,7 @@ class QuadMesh:
         H = 4 * m
         org = F.reshape(-1)
         dst = np.roll(F, -1, axis=1).reshape(-1)
-        lo, hi, order, starts, counts, edge_of, twin = pair_halfedges(org, dst, np.arange(H) // 4, n)
+        lo, hi, order, starts, counts, edge_of, twin = _pair_halfedges(org, dst, np.arange(H) // 4, n)
         self.twin = twin
         self.edge_of_halfedge = edge_of
         first = order[starts]

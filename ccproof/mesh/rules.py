@@ -63,6 +63,17 @@ def exact_one():
     python-flint's rationals are used instead of :class:`fractions.Fraction` for speed (the
     local refinements of the evaluator are exact); imported on first use (``import ccproof``
     stays cheap).
+
+    Returns
+    -------
+    flint.fmpq
+        The rational 1; pass it as ``one`` to the rule functions below (or ``1.0`` for floats).
+
+    Examples
+    --------
+    >>> one = exact_one()
+    >>> one / 3 * 3 == 1, type(one).__name__
+    (True, 'fmpq')
     """
     import flint
 
@@ -76,8 +87,23 @@ def _exact(x):
 
 
 def to_float(w):
-    """Correctly rounded float of an exact weight (int, ``flint.fmpq`` or ``fractions.Fraction``;
-    Python's int division of numerator by denominator is correctly rounded)."""
+    """Correctly rounded float of an exact weight.
+
+    Parameters
+    ----------
+    w : int, float, flint.fmpq or fractions.Fraction
+
+    Returns
+    -------
+    float
+        Python's int division of numerator by denominator (correctly rounded).
+
+    Examples
+    --------
+    >>> from fractions import Fraction
+    >>> to_float(exact_one() / 3) == 1 / 3, to_float(Fraction(1, 10)) == 0.1, to_float(2)
+    (True, True, 2.0)
+    """
     q = getattr(w, "q", None)
     if q is not None:  # flint.fmpq
         return int(w.p) / int(q)
@@ -90,33 +116,118 @@ def to_float(w):
 # Each rule's weights, once, for any number type: ``one`` is exact_one() (exact stencils) or 1.0
 # (floats, also with integer numpy arrays for the sizes and valences: the vectorized step).
 def face_point_weight(n, one):
-    """Face point: the centroid; the weight of each of the ``n`` vertices of the face."""
+    """Face point: the centroid; the weight of each of the ``n`` vertices of the face.
+
+    Parameters
+    ----------
+    n : int or ndarray of int
+        Face size(s).
+    one : number
+        :func:`exact_one` (exact) or 1.0 (float).
+
+    Returns
+    -------
+    number or ndarray
+        ``one / n`` (bmz04 Fig. 1, docs/readings.md R1).
+
+    Examples
+    --------
+    >>> face_point_weight(4, exact_one()), face_point_weight(3, 1.0) * 3
+    (1/4, 1.0)
+    """
     return one / n
 
 
 def smooth_edge_weights(one):
-    """Smooth edge point ``(a + b + f0 + f1) / 4``: (weight of each end, of each adjacent face point)."""
+    """Smooth edge point ``(a + b + f0 + f1) / 4``: (weight of each end, of each adjacent face point).
+
+    Parameters
+    ----------
+    one : number
+        :func:`exact_one` (exact) or 1.0 (float).
+
+    Returns
+    -------
+    tuple of 2 numbers
+        bmz04 Fig. 1 (docs/readings.md R1).
+
+    Examples
+    --------
+    >>> smooth_edge_weights(exact_one())
+    (1/4, 1/4)
+    """
     return one / 4, one / 4
 
 
 def sharp_edge_weight(one):
-    """Sharp (crease or boundary) edge point: the midpoint; the weight of each end."""
+    """Sharp (crease or boundary) edge point: the midpoint; the weight of each end.
+
+    Parameters
+    ----------
+    one : number
+        :func:`exact_one` (exact) or 1.0 (float).
+
+    Returns
+    -------
+    number
+        OpenSubdiv's Sdc crease rule (docs/evaluate.md "Tagged polygon meshes").
+
+    Examples
+    --------
+    >>> sharp_edge_weight(exact_one()), sharp_edge_weight(1.0)
+    (1/2, 0.5)
+    """
     return one / 2
 
 
 def smooth_vertex_weights(k, one):
     """Smooth (and dart) vertex point ``((k - 2) V + sum e_j / k + sum f_j / k) / k`` at valence ``k``.
 
-    Returns (weight of V, of each edge neighbour e_j, of each adjacent face point f_j); for quads
-    bmz04 Fig. 1: ``1 - 7/(4k)`` on V, ``3/(2k^2)`` and ``1/(4k^2)`` on the edge and diagonal
-    neighbours.
+    Parameters
+    ----------
+    k : int or ndarray of int
+        Valence(s).
+    one : number
+        :func:`exact_one` (exact) or 1.0 (float).
+
+    Returns
+    -------
+    tuple of 3 numbers
+        (weight of V, of each edge neighbour e_j, of each adjacent face point f_j); for quads
+        bmz04 Fig. 1 (docs/readings.md R1): ``1 - 7/(4k)`` on V, ``3/(2k^2)`` and ``1/(4k^2)`` on the
+        edge and diagonal neighbours.
+
+    Examples
+    --------
+    With the face points of quads expanded (each carries 1/4 of its vertices), k = 5 gives
+    ``1 - 7/20``, ``3/50`` and ``1/100``:
+
+    >>> wV, we, wf = smooth_vertex_weights(5, exact_one())
+    >>> wV + 5 * wf / 4, we + 2 * wf / 4, wf / 4
+    (13/20, 3/50, 1/100)
     """
     return one * (k - 2) / k, one / (k * k), one / (k * k)
 
 
 def crease_vertex_weights(one):
-    """Crease (and boundary) vertex point ``(3/4) V + (1/8)(e0 + e1)``: (weight of V, of each of
-    the two neighbours along the crease)."""
+    """Crease (and boundary) vertex point ``(3/4) V + (1/8)(e0 + e1)``.
+
+    Parameters
+    ----------
+    one : number
+        :func:`exact_one` (exact) or 1.0 (float).
+
+    Returns
+    -------
+    tuple of 2 numbers
+        (weight of V, of each of the two neighbours along the crease): the cubic B-spline curve
+        rule, OpenSubdiv's Sdc crease rule (docs/evaluate.md "Conventions").
+
+    Examples
+    --------
+    >>> crease_vertex_weights(exact_one()), crease_vertex_weights(1.0)
+    ((3/4, 1/8), (0.75, 0.125))
+    """
     return one * 3 / 4, one / 8
 
 
@@ -129,6 +240,19 @@ class Options:
         ``VTX_BOUNDARY_EDGE_ONLY`` (default), ``VTX_BOUNDARY_EDGE_AND_CORNER``, ``VTX_BOUNDARY_NONE``.
     crease_method : {"uniform", "chaikin"}
     triangle_subdivision : {"catmark", "smooth"}
+
+    Notes
+    -----
+    OpenSubdiv's ``Sdc::Options`` (docs/evaluate.md "Tagged polygon meshes (OpenSubdiv's features)").
+
+    Examples
+    --------
+    >>> Options().key()
+    ('edge_only', 'uniform', 'catmark')
+    >>> Options(boundary="edges")
+    Traceback (most recent call last):
+    ...
+    ccproof.errors.MeshError: boundary interpolation must be one of (...), got 'edges'
     """
 
     __slots__ = ("boundary", "crease_method", "triangle_subdivision")
@@ -159,15 +283,15 @@ class Options:
         return "Options(boundary={!r}, crease_method={!r}, triangle_subdivision={!r})".format(*self.key())
 
 
-def is_sharp(s):
+def _is_sharp(s):
     return s > 0.0
 
 
-def is_infinite(s):
+def _is_infinite(s):
     return s >= INFINITE
 
 
-def is_semi_sharp(s):
+def _is_semi_sharp(s):
     return 0.0 < s < INFINITE
 
 
@@ -185,7 +309,7 @@ def _child_sharpness_at_vertex(edge_sharpness, chaikin):
     """Sdc ``SubdivideEdgeSharpnessesAroundVertex``: child sharpness of every edge at one vertex."""
     if not chaikin or len(edge_sharpness) < 2:
         return [_decrement(s) for s in edge_sharpness]
-    semi = [s for s in edge_sharpness if is_semi_sharp(s)]
+    semi = [s for s in edge_sharpness if _is_semi_sharp(s)]
     if not semi:
         return list(edge_sharpness)
     total = _F32(0.0)
@@ -207,7 +331,27 @@ def _child_sharpness_at_vertex(edge_sharpness, chaikin):
 
 
 def vertex_rule(vertex_sharpness, edge_sharpness):
-    """Sdc ``DetermineVertexVertexRule``: 'corner', 'crease', 'dart' or 'smooth'."""
+    """Sdc ``DetermineVertexVertexRule``: 'corner', 'crease', 'dart' or 'smooth'.
+
+    Parameters
+    ----------
+    vertex_sharpness : float
+    edge_sharpness : sequence of float
+        Sharpness of the edges at the vertex.
+
+    Returns
+    -------
+    str
+        A sharp vertex or three or more sharp edges: corner; two: crease; one: dart; none: smooth.
+
+    Examples
+    --------
+    >>> import math
+    >>> [vertex_rule(0.0, e) for e in ([0, 0, 0, 0], [math.inf, 0, 0, 0], [2, 0, 2, 0], [1, 1, 1, 0])]
+    ['smooth', 'dart', 'crease', 'corner']
+    >>> vertex_rule(1.0, [0, 0, 0, 0])
+    'corner'
+    """
     if vertex_sharpness > 0.0:
         return CORNER
     n = sum(1 for s in edge_sharpness if s > 0.0)
@@ -261,6 +405,15 @@ class Complex:
     No validation: a complex cut out of a valid mesh has outer vertices whose faces do not all
     belong to it; rules are only correct at vertices whose whole fan is in the complex, and at edges
     whose faces all are. Callers keep track of which new points are exact.
+
+    Examples
+    --------
+    The 2 x 2 grid: 9 vertices, 12 edges, 8 boundary half-edges (no twin):
+
+    >>> from ccproof.mesh.examples import grid
+    >>> cx = Complex(grid(2, 2).faces, {}, {}, Options())
+    >>> cx.n_vertices, len(cx.edges), sum(t < 0 for t in cx.twin)
+    (9, 12, 8)
     """
 
     def __init__(self, faces, edge_sharpness, vertex_sharpness, options, level=0, n_vertices=None):
@@ -434,6 +587,23 @@ def refine_complex(cx, vertices=None, edges=None):
         at computed vertices).
     child_vertex_sharpness : dict[int, float]
         Decremented vertex sharpness of the vertex points.
+
+    Notes
+    -----
+    bmz04 Fig. 1 (docs/readings.md R1) with OpenSubdiv's Sdc crease, corner and boundary rules
+    (docs/evaluate.md "Tagged polygon meshes (OpenSubdiv's features)").
+
+    Examples
+    --------
+    A single quad: its boundary edges are infinitely sharp, so a corner gets the crease rule
+    ``(3/4) V + (1/8)(e0 + e1)``, the edges their midpoints and the face its centroid:
+
+    >>> cx = Complex([[0, 1, 2, 3]], {}, {}, Options())
+    >>> stencils, children, ces, cvs = refine_complex(cx)
+    >>> len(stencils), stencils[0], stencils[4], stencils[8]
+    (9, {0: 3/4, 1: 1/8, 3: 1/8}, {0: 1/2, 1: 1/2}, {0: 1/4, 1: 1/4, 2: 1/4, 3: 1/4})
+    >>> children[0], ces[(0, 4)]
+    ((0, 4, 8, 7), inf)
     """
     n = cx.n_vertices
     E = len(cx.edges)

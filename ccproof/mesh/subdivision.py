@@ -46,8 +46,23 @@ __all__ = ["subdivide", "subdivision_matrix", "child_faces"]
 
 
 def child_faces(mesh):
-    """Faces of the refined mesh, int (4 m, 4), child ``4 f + i`` at corner ``i`` of face ``f``.
+    """Faces of the refined mesh, child ``4 f + i`` at corner ``i`` of face ``f``.
 
+    Parameters
+    ----------
+    mesh : QuadMesh
+        n vertices, E edges, m faces.
+
+    Returns
+    -------
+    ndarray of int64, shape (4 m, 4)
+        Child ``4 f + i`` is ``(vertex point of corner i, edge point of edge (i, i+1), face point
+        of f, edge point of edge (i-1, i))``; new vertices are numbered vertex points ``0..n-1``,
+        edge points ``n..n+E-1`` (order of ``mesh.edges``), face points ``n+E..n+E+m-1``
+        (docs/evaluate.md "Conventions"; bmz04 Fig. 1).
+
+    Examples
+    --------
     >>> import numpy as np
     >>> m = QuadMesh([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], [[0, 1, 2, 3]])
     >>> child_faces(m)[0].tolist()   # vertex 0, edge (0,1), face point, edge (3,0)

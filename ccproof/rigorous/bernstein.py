@@ -39,6 +39,19 @@ class BernsteinForm:
     Build one with :func:`bernstein_coefficients`, or directly from Bezier control values (for
     example the 4 x 4 net of a bicubic patch, row-major, ``shape=(4, 4)``) with this constructor,
     which does no basis conversion; :meth:`to_poly` gives the power form in the box variables.
+
+    Parameters
+    ----------
+    shape : tuple of d int (1 <= d <= 4): ``degrees + 1`` per variable (Farin's tensor Bernstein basis)
+    coeffs : sequence of fmpq-convertible or arb, length ``prod(shape)``
+    box : sequence of d exact pairs (lo, hi), optional: default [0, 1]^d
+    prec : int, optional: bits of the arb balls; None (default) for exact coefficients
+
+    Examples
+    --------
+    >>> b = BernsteinForm((3,), [0, 0, 1])
+    >>> b.to_poly() == Poly.variable(0, 1) ** 2, b.degrees, b.box
+    (True, (2,), ((0, 1),))
     """
 
     __slots__ = ("shape", "coeffs", "box", "prec")
@@ -249,6 +262,21 @@ class BernsteinForm:
 
 
 def unit_box(nvars):
+    """The box [0, 1]^nvars with exact endpoints.
+
+    Parameters
+    ----------
+    nvars : int
+
+    Returns
+    -------
+    tuple of nvars (fmpq, fmpq)
+
+    Examples
+    --------
+    >>> unit_box(2)
+    ((0, 1), (0, 1))
+    """
     return ((fmpq(0), fmpq(1)),) * nvars
 
 
@@ -260,6 +288,24 @@ def bernstein_coefficients(poly, box=None, degrees=None):
     ball input gives balls at ``poly.prec``.  For tight balls on small sub-boxes prefer converting
     once on a large box and then using :meth:`BernsteinForm.split` / :meth:`BernsteinForm.restrict`
     (both numerically stable) over re-expanding the power form on each sub-box.
+
+    Parameters
+    ----------
+    poly : Poly
+    box : sequence of nvars pairs (lo, hi), optional
+    degrees : tuple of int, optional: at least ``poly.degrees`` (higher ones elevate the degree)
+
+    Returns
+    -------
+    BernsteinForm of shape ``degrees + 1``
+
+    Examples
+    --------
+    x^2 on [1, 3] is (1 + 2t)^2 = (1 - t)^2 + 3 * 2t(1 - t) + 9 t^2:
+
+    >>> x = Poly.variable(0, 1)
+    >>> bernstein_coefficients(x**2, box=[(1, 3)]).coeffs, bernstein_coefficients(x, degrees=(2,)).coeffs
+    ([1, 3, 9], [0, 1/2, 1])
     """
     if not isinstance(poly, Poly):
         raise TypeError(f"expected a Poly, got {type(poly).__name__}")
@@ -280,6 +326,22 @@ def range_enclosure(form):
     Exact forms give ``fmpq``; ball forms give zero-radius ``arb`` endpoints rounded outward
     (``lo`` = min of the balls' lower endpoints, ``hi`` = max of upper endpoints); a NaN
     coefficient gives ``(-inf, +inf)``.  Also accepts a plain list of coefficients.
+
+    Parameters
+    ----------
+    form : BernsteinForm or sequence of fmpq / arb
+
+    Returns
+    -------
+    (lo, hi) : fmpq or arb, the range enclosure of the module docstring (docs/rigorous.md "Guarantees")
+
+    Examples
+    --------
+    x (1 - x) has range [0, 1/4] on [0, 1]; its coefficients (0, 1/2, 0) enclose it:
+
+    >>> x = Poly.variable(0, 1)
+    >>> range_enclosure(bernstein_coefficients(x * (1 - x)))
+    (0, 1/2)
     """
     coeffs = _coefficients(form)
     if not coeffs:
@@ -310,6 +372,16 @@ def range_enclosure(form):
 def lower_bound(form):
     """Lower end of :func:`range_enclosure` as an exact ``fmpq`` (``None`` if it is -inf/NaN).
 
+    Parameters
+    ----------
+    form : BernsteinForm or sequence of fmpq / arb
+
+    Returns
+    -------
+    fmpq or None
+
+    Examples
+    --------
     >>> lower_bound([arb(1) / 3, arb(2)]) < fmpq(1, 3)
     True
     """
@@ -323,8 +395,18 @@ def certainly_positive(form):
     """True only when every coefficient is certainly > 0 (so the polynomial is > 0 on the box).
 
     Exact ``fmpq`` coefficients are compared exactly; ``arb`` balls with arb's ``>`` (True only when
-    the whole ball is > 0) and must be finite.  Accepts a form, a list of coefficients or one number.
+    the whole ball is > 0) and must be finite.
 
+    Parameters
+    ----------
+    form : BernsteinForm, sequence of fmpq / arb, or one number
+
+    Returns
+    -------
+    bool
+
+    Examples
+    --------
     >>> certainly_positive([arb(1), arb("0 +/- 0.1")]), certainly_positive(arb("nan"))
     (False, False)
     """
@@ -339,7 +421,26 @@ def certainly_positive(form):
 
 
 def bernstein_jacobian_determinant(forms, axes=None):
-    """Bernstein form of det(d forms[i] / d x_axes[j]) on the forms' common box, in Bernstein arithmetic."""
+    """Bernstein form of det(d forms[i] / d x_axes[j]) on the forms' common box, in Bernstein arithmetic.
+
+    Parameters
+    ----------
+    forms : sequence of n BernsteinForm (1 <= n <= 4), on one box
+    axes : tuple of n distinct int, optional: default ``0 .. n-1``
+
+    Returns
+    -------
+    BernsteinForm: det J, whose positivity gives local injectivity (docs/readings.md R7)
+
+    Examples
+    --------
+    For z^2 = (x^2 - y^2, 2 x y) the determinant is 4 x^2 + 4 y^2:
+
+    >>> x, y = Poly.variable(0, 2), Poly.variable(1, 2)
+    >>> J = bernstein_jacobian_determinant([bernstein_coefficients(x**2 - y**2), bernstein_coefficients(2 * x * y)])
+    >>> J.to_poly() == 4 * x**2 + 4 * y**2, J.coeffs[:3]
+    (True, [0, 0, 4])
+    """
     forms = list(forms)
     n = len(forms)
     axes = tuple(range(n)) if axes is None else tuple(axes)
@@ -386,17 +487,27 @@ def _binomials(n):
 
 
 def power_to_bernstein_matrix(n, d):
-    """(d+1) x (n+1): power coefficients of degree n -> Bernstein coefficients of degree d >= n on [0,1].
+    """(d+1) x (n+1) ``fmpq_mat``: power coefficients of degree n -> Bernstein ones of degree d >= n on [0,1].
 
     b_k = sum_i C(k, i) / C(d, i) a_i.
+
+    Examples
+    --------
+    >>> (power_to_bernstein_matrix(1, 2) * fmpq_mat(2, 1, [0, 1])).entries()   # x in degree 2
+    [0, 1/2, 1]
     """
     return _cached(("p2b", n, d), lambda: _matrix(d + 1, n + 1, lambda k, i: fmpq(_C(k, i), comb(d, i))))
 
 
 def bernstein_to_power_matrix(n):
-    """(n+1) x (n+1): Bernstein coefficients of degree n on [0,1] -> power coefficients.
+    """(n+1) x (n+1) ``fmpq_mat``: Bernstein coefficients of degree n on [0,1] -> power coefficients.
 
-    a_i = sum_k (-1)^(i-k) C(n, i) C(i, k) b_k.
+    a_i = sum_k (-1)^(i-k) C(n, i) C(i, k) b_k (the inverse of :func:`power_to_bernstein_matrix` ``(n, n)``).
+
+    Examples
+    --------
+    >>> (bernstein_to_power_matrix(2) * fmpq_mat(3, 1, [0, 1, 0])).entries()   # 2 x (1 - x)
+    [0, 2, -2]
     """
 
     def entry(i, k):
@@ -406,7 +517,13 @@ def bernstein_to_power_matrix(n):
 
 
 def elevation_matrix(n, d):
-    """(d+1) x (n+1): Bernstein degree elevation n -> d: b'_k = sum_i C(n,i) C(d-n,k-i) / C(d,k) b_i."""
+    """(d+1) x (n+1) ``fmpq_mat``: Bernstein degree elevation n -> d: b'_k = sum_i C(n,i) C(d-n,k-i) / C(d,k) b_i.
+
+    Examples
+    --------
+    >>> (elevation_matrix(1, 3) * fmpq_mat(2, 1, [0, 1])).entries()   # x in degree 3
+    [0, 1/3, 2/3, 1]
+    """
 
     def entry(k, i):
         return fmpq(_C(n, i) * _C(d - n, k - i), comb(d, k))
@@ -418,7 +535,12 @@ def split_matrix(n, t, side):
     """De Casteljau at ``t``: side 0 gives the coefficients on [0, t], side 1 on [t, 1].
 
     side 0: b'_i = sum_{j <= i} C(i, j) t^j (1-t)^(i-j) b_j;
-    side 1: b'_i = sum_{j >= i} C(n-i, j-i) t^(j-i) (1-t)^(n-j) b_j.
+    side 1: b'_i = sum_{j >= i} C(n-i, j-i) t^(j-i) (1-t)^(n-j) b_j.  Exact (n+1) x (n+1) ``fmpq_mat``.
+
+    Examples
+    --------
+    >>> (split_matrix(2, fmpq(1, 2), 0) * fmpq_mat(3, 1, [0, 0, 1])).entries()   # x^2 on [0, 1/2]
+    [0, 0, 1/4]
     """
     s = 1 - t
 
@@ -432,7 +554,13 @@ def split_matrix(n, t, side):
 
 
 def restrict_matrix(n, a, b):
-    """Bernstein coefficients on [0,1] -> on [a, b] (0 <= a < b <= 1, exact)."""
+    """(n+1) x (n+1) ``fmpq_mat``: Bernstein coefficients of degree n on [0,1] -> on [a, b] (0 <= a < b <= 1).
+
+    Examples
+    --------
+    >>> (restrict_matrix(1, fmpq(1, 4), fmpq(1, 2)) * fmpq_mat(2, 1, [0, 1])).entries()   # x
+    [1/4, 1/2]
+    """
 
     def build():
         mat = split_matrix(n, b, 0) if b < 1 else None
@@ -445,7 +573,13 @@ def restrict_matrix(n, a, b):
 
 
 def derivative_matrix(n, h):
-    """n x (n+1) (1 x 1 zero when n = 0): Bernstein coefficients of f' for an interval of width h."""
+    """n x (n+1) ``fmpq_mat`` (1 x 1 zero when n = 0): Bernstein coefficients of f' for an interval of width h.
+
+    Examples
+    --------
+    >>> (derivative_matrix(2, fmpq(1, 2)) * fmpq_mat(3, 1, [0, 0, 1])).entries()   # 4 x^2 on [0, 1/2]
+    [0, 4]
+    """
     if n == 0:
         return _cached(("diff", 0), lambda: fmpq_mat(1, 1, [0]))
     return _cached(

@@ -38,6 +38,21 @@ class Poly:
     polynomial is exact and arb coefficients are refused; with ``prec`` every coefficient is
     converted to an arb ball at ``prec`` bits.
 
+    Parameters
+    ----------
+    terms : dict[tuple of int, number]
+        Exponent tuple (length nvars, 1..4) -> coefficient.
+    nvars : int, optional
+        Default: the length of the exponent tuples.
+    prec : int, optional
+        Bits of the arb balls; None for exact coefficients.
+
+    Notes
+    -----
+    The dense tensor has shape ``degrees + 1`` (row-major); docs/rigorous.md "API".
+
+    Examples
+    --------
     >>> Poly({(1, 0): 3, (0, 2): "1/2"})
     Poly(exact, degrees=(1, 2), {(0, 2): 1/2, (1, 0): 3})
     """
@@ -419,7 +434,31 @@ class Poly:
 
 
 def check_box(box, nvars):
-    """``box`` as a tuple of ``nvars`` pairs ``(lo, hi)`` of fmpq with ``lo < hi``."""
+    """``box`` as a tuple of ``nvars`` pairs ``(lo, hi)`` of fmpq with ``lo < hi``.
+
+    Parameters
+    ----------
+    box : sequence of nvars pairs of exact numbers (int, fmpq, "p/q")
+    nvars : int
+
+    Returns
+    -------
+    tuple of nvars (fmpq, fmpq)
+
+    Raises
+    ------
+    ValueError
+        On a wrong number of intervals or an empty or degenerate one.
+
+    Examples
+    --------
+    >>> check_box([(0, 1), ("1/2", 1)], 2)
+    ((0, 1), (1/2, 1))
+    >>> check_box([(1, 1)], 1)
+    Traceback (most recent call last):
+    ...
+    ValueError: empty or degenerate interval [1, 1]
+    """
     box = tuple(box)
     if len(box) != nvars:
         raise ValueError(f"box with {len(box)} intervals for {nvars} variables")
@@ -446,7 +485,28 @@ _SHIFT = {}
 
 
 def taylor_shift_matrix(n, a, h):
-    """Exact matrix sending the coefficients of p(x) (degree n) to those of p(a + h x)."""
+    """Exact matrix sending the coefficients of p(x) (degree n) to those of p(a + h x).
+
+    Parameters
+    ----------
+    n : int
+    a, h : fmpq
+
+    Returns
+    -------
+    fmpq_mat, shape (n + 1, n + 1)
+        Entry (j, i) is ``C(i, j) a^(i-j) h^j``; the Taylor shift to a box before the Bernstein
+        conversion (docs/rigorous.md "API").
+
+    Examples
+    --------
+    x^2 becomes (1 + 2 x)^2 = 1 + 4 x + 4 x^2:
+
+    >>> taylor_shift_matrix(2, fmpq(1), fmpq(2)) * fmpq_mat(3, 1, [0, 0, 1])
+    [1]
+    [4]
+    [4]
+    """
     key = (n, a, h)
     mat = _SHIFT.get(key)
     if mat is None:
@@ -466,6 +526,21 @@ def jacobian_determinant(components, variables=None):
     """det of ``(d components[i] / d x_{variables[j]})`` for 1 to 4 components (Laplace expansion).
 
     ``variables`` defaults to ``0 .. len(components)-1``; extra variables act as parameters.
+
+    Parameters
+    ----------
+    components : sequence of n Poly (1 <= n <= 4)
+    variables : tuple of n distinct int, optional
+
+    Returns
+    -------
+    Poly
+        det J, whose sign decides local injectivity (docs/readings.md R7; e.g. det J_Phi of the
+        characteristic map).
+
+    Examples
+    --------
+    For z^2 = (x^2 - y^2, 2 x y) (Cauchy-Riemann: det J = |2 z|^2):
 
     >>> x, y = Poly.variable(0, 2), Poly.variable(1, 2)
     >>> jacobian_determinant([x**2 - y**2, 2 * x * y]) == 4 * x**2 + 4 * y**2

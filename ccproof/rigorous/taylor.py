@@ -46,7 +46,30 @@ ZBOX = (T.exact_scalar(-1), T.exact_scalar(1))
 
 class TaylorForm:
     """Polynomial in ``z`` in [-1, 1] (axis 0, power basis) with Bernstein coefficients in ``x`` in
-    [0, 1]^d (axes 1..d), all coefficients ``arb`` balls at ``prec`` bits (see the module docstring)."""
+    [0, 1]^d (axes 1..d), all coefficients ``arb`` balls at ``prec`` bits (see the module docstring).
+
+    Parameters
+    ----------
+    shape : tuple of int, length 1 + d (2..4)
+        ``(z degree + 1, x degrees + 1)``.
+    coeffs : sequence of arb-convertible, length ``prod(shape)`` (row-major)
+    prec : int
+        Bits of the balls.
+
+    Notes
+    -----
+    Taylor models in one parameter for every valence k >= k0 (docs/readings.md R10,
+    docs/appendix_a.md).
+
+    Examples
+    --------
+    x^2 + z y: z-degree 1, Bernstein coefficients in (x, y) of x^2 (0, 0, 1) and of y (0, 1):
+
+    >>> z, x, y = (Poly.variable(i, 3) for i in range(3))
+    >>> f = TaylorForm.from_poly(x * x + z * y, 53)
+    >>> f.shape, [float(c) for c in f.coeffs]
+    ((2, 3, 2), [0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 0.0, 1.0, 0.0, 1.0, 0.0, 1.0])
+    """
 
     __slots__ = ("shape", "coeffs", "prec")
 
@@ -206,6 +229,28 @@ class TaylorForm:
 
 
 def taylor_jacobian_determinant(components, axes):
-    """det of (d components[i] / d x_{axes[j]}) for two components (2 x 2, the parameter z kept)."""
+    """det of (d components[i] / d x_{axes[j]}) for two components (2 x 2, the parameter z kept).
+
+    Parameters
+    ----------
+    components : (TaylorForm, TaylorForm)
+    axes : (int, int)
+        Axes of the x variables (1..d; axis 0 is z).
+
+    Returns
+    -------
+    TaylorForm
+        det J for all k >= k0 at once (docs/readings.md R7, R10).
+
+    Examples
+    --------
+    For (x^2 + z y, y + z x) the determinant is 2 x - z^2: z^0 block (0, 0, 1, 1, 2, 2), z^2 block -1:
+
+    >>> z, x, y = (Poly.variable(i, 3) for i in range(3))
+    >>> f, g = TaylorForm.from_poly(x * x + z * y, 53), TaylorForm.from_poly(y + z * x, 53)
+    >>> J = taylor_jacobian_determinant([f, g], (1, 2))
+    >>> J.shape, [float(c) for c in J.coeffs[:6]], [float(c) for c in J.coeffs[12:]]
+    ((3, 3, 2), [0.0, 0.0, 1.0, 1.0, 2.0, 2.0], [-1.0, -1.0, -1.0, -1.0, -1.0, -1.0])
+    """
     (f, g), (a, b) = components, axes
     return f.diff(a) * g.diff(b) - f.diff(b) * g.diff(a)

@@ -37,7 +37,33 @@ _MALFORMED = (CertificateError, ValueError, TypeError, KeyError, IndexError, Att
 
 
 def verify_certificate(cert, log=print, path=None):
-    """Check a parsed certificate (a dict). Returns a :class:`VerifyResult`; never raises for bad input."""
+    """Check a parsed certificate (a dict). Returns a :class:`VerifyResult`; never raises for bad input.
+
+    Parameters
+    ----------
+    cert : object
+        The parsed JSON (docs/certificates.md); anything else fails with a reason.
+    log : callable (str) -> None
+        Receives a PASS/FAIL line per part.
+    path : str or Path, optional
+        Recorded in the result.
+
+    Returns
+    -------
+    VerifyResult
+
+    Examples
+    --------
+    The C1 certificate of valence 5 (Reif's criterion, docs/certificates.md), then a forged precision:
+
+    >>> import json
+    >>> from ccproof.tables.format import certificates_dir
+    >>> cert = json.loads((certificates_dir() / "c1" / "k005.json").read_text())
+    >>> bool(verify_certificate(cert, log=lambda line: None))
+    True
+    >>> verify_certificate(dict(cert, prec=32), log=lambda line: None).error
+    'prec must lie in 64..1024'
+    """
     res = VerifyResult(path=None if path is None else str(path))
     t0 = time.perf_counter()
     part = Recorder(res, log)
@@ -97,7 +123,24 @@ def verify_file(path: str | Path, log: Callable[[str], object] = print) -> Verif
 
 
 def certificate_files(directory):
-    """The certificate files under ``directory``: ``c1/k*.json`` then ``injectivity/k*.json``."""
+    """The certificate files under ``directory``: ``c1/k*.json`` then ``injectivity/k*.json``.
+
+    Parameters
+    ----------
+    directory : str or Path
+
+    Returns
+    -------
+    list of Path
+        Sorted by name within each folder.
+
+    Examples
+    --------
+    >>> from ccproof.tables.format import certificates_dir
+    >>> files = certificate_files(certificates_dir())
+    >>> files[0].parent.name, files[0].name, files[-1].parent.name
+    ('c1', 'k003.json', 'injectivity')
+    """
     d = Path(directory)
     return sorted((d / "c1").glob("k*.json")) + sorted((d / "injectivity").glob("k*.json"))
 
@@ -110,6 +153,21 @@ def check_coverage(valences):
     valences (a k >= k0 certificate next to the k >= 40 one, or k = 39 next to k >= 10), since a
     statement proved twice is still proved; a single valence may appear at most once (a second file
     for the same k is a publishing mistake).
+
+    Parameters
+    ----------
+    valences : iterable of int or dict ``{"min": k0}``
+
+    Returns
+    -------
+    (bool, str)
+
+    Examples
+    --------
+    >>> check_coverage([3, 4, {"min": 5}])
+    (True, 'every k >= 3 covered (3..4 one by one, k >= 5)')
+    >>> check_coverage([3, {"min": 5}])
+    (False, 'missing valences [4]')
     """
     ints = sorted(v for v in valences if isinstance(v, int))
     tails = sorted({v["min"] for v in valences if isinstance(v, dict)})

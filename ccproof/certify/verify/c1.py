@@ -28,6 +28,34 @@ C1_SCHEMA = "ccproof.c1/2"
 
 
 def verify_c1(cert, k, part, log):
+    """Check a C1 certificate (module docstring: Reif's criterion; docs/certificates.md) into ``part``.
+
+    Parameters
+    ----------
+    cert : dict
+        Schema :data:`C1_SCHEMA`: ``prec`` and ``parts`` (one valence) or ``pieces`` (lam pieces, k >= k0).
+    k : int or dict ``{"min": k0}``
+        From :func:`.record.read_valence`.
+    part : Recorder
+        Receives one :class:`.record.Part` per checked claim.
+    log : callable (str) -> None
+
+    Raises
+    ------
+    CertificateError
+        On a malformed certificate (the caller turns it into FAILED).
+
+    Examples
+    --------
+    >>> import json
+    >>> from ccproof.tables.format import certificates_dir
+    >>> from ccproof.certify.verify.record import Recorder, VerifyResult
+    >>> cert = json.loads((certificates_dir() / "c1" / "k005.json").read_text())
+    >>> res = VerifyResult()
+    >>> verify_c1(cert, 5, Recorder(res, lambda line: None), lambda line: None)
+    >>> bool(res), res.parts[4].name
+    (True, 'det J_Phi > 0 on P1')
+    """
     exact_keys(cert, ("schema", "valence", "prec", "pieces" if isinstance(k, dict) else "parts"), "certificate")
     prec = field_of(cert, "prec", int, "certificate")
     if not 64 <= prec <= 1024:

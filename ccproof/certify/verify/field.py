@@ -33,7 +33,21 @@ def _poly(x):
 
 
 class QL:
-    """An element (a + b lam) / d of F (see the module docstring)."""
+    """An element (a + b lam) / d of F (see the module docstring; docs/readings.md R2).
+
+    Parameters
+    ----------
+    a, b, d : int, fmpq or fmpq_poly in c
+        Numerators and denominator (d != 0); stored in lowest terms with d monic.
+
+    Examples
+    --------
+    At k = 4 (c = 0) the subdominant eigenvalue is lam = 1/2 (16 lam^2 - 10 lam + 1 = 0):
+
+    >>> x = (1 + QL.lam()) / (QL.c() + 2)
+    >>> x.evaluate(arb(0), arb(1) / 2), x.integer_form()
+    (0.750000000000000, [[1], [1], [2, 1]])
+    """
 
     __slots__ = ("a", "b", "d")
 
@@ -124,7 +138,23 @@ class QL:
 
 
 def horner(p, x):
-    """p(x) for an fmpq_poly p and an arb x (ball arithmetic)."""
+    """p(x) for an fmpq_poly p and an arb x (ball arithmetic, Horner's scheme).
+
+    Parameters
+    ----------
+    p : fmpq_poly
+    x : arb
+
+    Returns
+    -------
+    arb
+        A ball containing p(y) for every y in x.
+
+    Examples
+    --------
+    >>> horner(fmpq_poly([1, 2, 3]), arb(2))   # 1 + 2 * 2 + 3 * 4
+    17.0000000000000
+    """
     acc = arb(0)
     for q in reversed(p.coeffs()):
         acc = acc * x + q

@@ -37,7 +37,24 @@ _CELL_KEY = re.compile(r"[0-9]{1,4},[0-9]{1,4},[0-2],[0-2]")
 
 
 def check_derivation(part):
-    """Part S: the statement's identities (once per process; every valence at once)."""
+    """Part S: the statement's identities (once per process; every valence at once).
+
+    Parameters
+    ----------
+    part : Recorder
+
+    Returns
+    -------
+    bool
+        The hypotheses of docs/appendix_a.md section 0 hold exactly in F.
+
+    Examples
+    --------
+    >>> from ccproof.certify.verify.record import Recorder, VerifyResult
+    >>> res = VerifyResult()
+    >>> check_derivation(Recorder(res, lambda line: None)), res.parts[0].message
+    (True, '8 identities in Q(c)[lam] hold exactly (mirror symmetry holds)')
+    """
     d = derivation()
     bad = [name for name, ok in d.hypotheses if not ok]
     part("S statement derived from the rules", not bad,
@@ -47,7 +64,26 @@ def check_derivation(part):
 
 
 def check_hypotheses(nets, lam, part, tag=""):
-    """Part H: 0 < lam < 1, 2 lam^4 < 1 and the outer curve of the face in the closed first quadrant."""
+    """Part H: 0 < lam < 1, 2 lam^4 < 1 and the outer curve of the face in the closed first quadrant.
+
+    Parameters
+    ----------
+    nets : dict[str, 4 x 4 of (arb, arb)]
+    lam : arb
+    part : Recorder
+    tag : str
+        Prefix of the part's name.
+
+    Examples
+    --------
+    >>> from ccproof.certify.verify.record import Recorder, VerifyResult
+    >>> res = VerifyResult()
+    >>> check_hypotheses(nets_for_valence(4, 64), c_lam(4, 64)[1], Recorder(res, lambda line: None))
+    >>> res.parts[0].ok, check_hypotheses(nets_for_valence(4, 64), arb(1), Recorder(res, lambda line: None))
+    (True, None)
+    >>> res.parts[1].ok, res.parts[1].message
+    (False, 'lam fails')
+    """
     exact = outer_curves(derivation().bezier)  # a coordinate that is exactly 0 in F is on the axis
     quadrant = all(q.is_zero() or x >= 0 for cv, ecv in zip(outer_curves(nets), exact) for p, e in zip(cv, ecv)
                    for x, q in zip(p, e))  # arb >= : certainly
@@ -59,7 +95,21 @@ def check_hypotheses(nets, lam, part, tag=""):
 def form_patches(symmetric):
     """The pieces whose forms parts B and E check: all three, or P2 and P3 under the mirror symmetry
     (exact, part S), which maps P1's det J_Phi and corner form onto P3's with (s, t) swapped
-    (docs/appendix_a.md section 8), as part D keeps only the cells with l <= m."""
+    (docs/appendix_a.md section 8), as part D keeps only the cells with l <= m.
+
+    Parameters
+    ----------
+    symmetric : bool
+
+    Returns
+    -------
+    tuple of str
+
+    Examples
+    --------
+    >>> form_patches(True), form_patches(False)
+    (('P2', 'P3'), ('P1', 'P2', 'P3'))
+    """
     return ("P2", "P3") if symmetric else PATCHES
 
 
@@ -84,6 +134,25 @@ def _check_structure(parts, cell_vars):
 
 
 def read_n_prec(cert):
+    """The level N (1..8) and the precision in bits (64..1024) of a certificate.
+
+    Parameters
+    ----------
+    cert : dict
+
+    Returns
+    -------
+    (int, int)
+
+    Examples
+    --------
+    >>> read_n_prec({"N": 3, "prec": 128})
+    (3, 128)
+    >>> read_n_prec({"N": 9, "prec": 128})
+    Traceback (most recent call last):
+    ...
+    ccproof.certify.verify.errors.CertificateError: prec must lie in 64..1024 and N in 1..8
+    """
     N = field_of(cert, "N", int, "certificate")
     prec = field_of(cert, "prec", int, "certificate")
     if not 64 <= prec <= 1024 or not 1 <= N <= 8:
@@ -92,7 +161,28 @@ def read_n_prec(cert):
 
 
 def verify_valence(cert, k, part, log):
-    """One valence k (an int)."""
+    """One valence k (an int): parts S, H, A-E of an injectivity certificate (docs/certificates.md).
+
+    Parameters
+    ----------
+    cert : dict
+        Schema :data:`SCHEMA` with ``N``, ``prec`` and ``parts`` (``regularity``, ``cells``, ``corner``).
+    k : int
+    part : Recorder
+    log : callable (str) -> None
+
+    Raises
+    ------
+    CertificateError
+        On a malformed certificate.
+
+    Examples
+    --------
+    >>> verify_valence({"schema": SCHEMA, "valence": 5, "N": 3, "prec": 128}, 5, None, None)
+    Traceback (most recent call last):
+    ...
+    ccproof.certify.verify.errors.CertificateError: certificate: missing field(s) 'parts'
+    """
     exact_keys(cert, ("schema", "valence", "N", "prec", "parts"), "certificate")
     N, prec = read_n_prec(cert)
     parts = field_of(cert, "parts", dict, "certificate")
@@ -117,7 +207,38 @@ def verify_valence(cert, k, part, log):
 
 def check_parts(parts, nets, lam, N, prec, cells, part, tag):
     """Parts A-E for the arb ``nets`` and ``lam``; ``cells`` lists (key, build root) of every required cell.
-    Stops at the first failed part (it is named; the rest is moot)."""
+    Stops at the first failed part (it is named; the rest is moot).
+
+    Parameters
+    ----------
+    parts : dict
+        ``regularity``, ``cells``, ``corner`` box lists of the certificate.
+    nets : dict[str, 4 x 4 of (arb, arb)]
+    lam : arb
+    N, prec : int
+    cells : list of (str, callable () -> BernsteinForm)
+    part : Recorder
+    tag : str
+
+    Examples
+    --------
+    At k = 4 (Phi the identity) det J_Phi = 1/4 and the corner form's coefficients exceed 0.1, so one
+    root box per piece proves parts B and E; with no cells listed part D has nothing to check:
+
+    >>> from ccproof.certify.verify.record import Recorder, VerifyResult
+    >>> res = VerifyResult()
+    >>> nets, lam = nets_for_valence(4, 64), c_lam(4, 64)[1]
+    >>> box, corner = [{"path": "", "bound": "0.2"}], [{"path": "", "bound": "0.1"}]
+    >>> parts = {"regularity": {"P2": box, "P3": box}, "cells": {}, "corner": {"P2": corner, "P3": corner}}
+    >>> check_parts(parts, nets, lam, 3, 64, [], Recorder(res, lambda line: None), "")
+    >>> [p.name[0] for p in res.parts], all(p.ok for p in res.parts)
+    (['A', 'B', 'C', 'D', 'E'], True)
+    >>> res = VerifyResult()
+    >>> forged = dict(parts, corner={"P2": box, "P3": box})   # claims 0.2 where the form goes down to 0.102
+    >>> check_parts(forged, nets, lam, 3, 64, [], Recorder(res, lambda line: None), "")
+    >>> res.parts[-1].ok
+    False
+    """
     okA, value = corner_containment(nets, lam, N)
     part(f"{tag}A corner cell maps into [0,1/6)^2", okA, "" if okA else f"lam^N * max = {value.str(6)}")
     if part.failed:
@@ -165,7 +286,30 @@ def _check_sections(parts, sec, label, build, part, tag):
 
 
 def verify_interval(cert, k, part, log):
-    """Every valence k >= k0 (``k = {"min": k0}``)."""
+    """Every valence k >= k0 (``k = {"min": k0}``): lam pieces with Taylor models (:mod:`.interval`).
+
+    Parameters
+    ----------
+    cert : dict
+        Schema :data:`SCHEMA` with ``N``, ``prec``, ``parameter`` and ``pieces``.
+    k : dict ``{"min": k0}``
+    part : Recorder
+    log : callable (str) -> None
+
+    Raises
+    ------
+    CertificateError
+        On a malformed certificate.
+
+    Examples
+    --------
+    >>> cert = {"schema": SCHEMA, "valence": {"min": 9}, "N": 3, "prec": 128, "pieces": [],
+    ...         "parameter": {"variable": "c", "taylor_degree": 4, "truncation_degree": 2}}
+    >>> verify_interval(cert, cert["valence"], None, None)
+    Traceback (most recent call last):
+    ...
+    ccproof.certify.verify.errors.CertificateError: parameter must be {'variable': 'lam', ...}
+    """
     exact_keys(cert, ("schema", "valence", "N", "prec", "parameter", "pieces"), "certificate")
     N, prec = read_n_prec(cert)
     param = field_of(cert, "parameter", dict, "certificate")
@@ -215,6 +359,27 @@ def verify_interval(cert, k, part, log):
 
 
 def verify_injectivity(cert, k, part, log):
+    """An injectivity certificate (docs/appendix_a.md): :func:`verify_interval` or :func:`verify_valence`.
+
+    Parameters
+    ----------
+    cert : dict
+    k : int or dict ``{"min": k0}``
+    part : Recorder
+    log : callable (str) -> None
+
+    Returns
+    -------
+    str
+        :func:`.record.kname` of k.
+
+    Examples
+    --------
+    >>> verify_injectivity({"schema": SCHEMA, "valence": 5, "N": 9, "prec": 128, "parts": {}}, 5, None, None)
+    Traceback (most recent call last):
+    ...
+    ccproof.certify.verify.errors.CertificateError: prec must lie in 64..1024 and N in 1..8
+    """
     if isinstance(k, dict):
         verify_interval(cert, k, part, log)
     else:

@@ -37,7 +37,32 @@ def _bern1(p, prec=None):
 def entry_model(form, L, layer, degree, prec):
     """lam^layer (A(c) + B(c) lam)/D(c) for lam = L(zeta), zeta in [-1, 1], c = (16 lam^2 - 10 lam + 1)/(2 lam)
     (R2), as arb coefficients of T(zeta) + [-r, r]: T the exact Taylor polynomial of ``degree`` at 0 and
-    r = max|Bernstein coefficients of num - den T| / min|those of den| (den of one strict sign)."""
+    r = max|Bernstein coefficients of num - den T| / min|those of den| (den of one strict sign).
+
+    Parameters
+    ----------
+    form : [A, B, D], integer coefficient lists in c (:meth:`.field.QL.integer_form`)
+    L : fmpq_poly
+        lam as a polynomial in zeta.
+    layer, degree, prec : int
+
+    Returns
+    -------
+    list of degree + 1 arb
+        Taylor coefficients, the remainder ball added to the constant one (docs/appendix_a.md section 6).
+
+    Examples
+    --------
+    lam^2 for lam = 1/2 + zeta/10: exactly 1/4 + zeta/10 + zeta^2/100; at degree 1 the remainder is the
+    largest Bernstein coefficient of zeta^2/100 on [-1, 1], 1/100:
+
+    >>> L = fmpq_poly([fmpq(1, 2), fmpq(1, 10)])
+    >>> [round(float(x), 15) for x in entry_model([[0], [1], [1]], L, 1, 2, 64)]
+    [0.25, 0.1, 0.01]
+    >>> m = entry_model([[0], [1], [1]], L, 1, 1, 64)
+    >>> float(m[0].mid()), 0.01 <= float(m[0].rad()) < 0.0101
+    (0.25, True)
+    """
     cn, cd = 16 * L * L - 10 * L + 1, 2 * L
     M = max(len(f) for f in form) - 1
 
@@ -60,7 +85,30 @@ def entry_model(form, L, layer, degree, prec):
 def parameter_nets(exact, La, Lb, layer, degree, prec):
     """Bezier nets of lam^layer Phi for every lam in [La, Lb]: net[i][j] = (x, y), each a list of arb
     coefficients of a polynomial in zeta in [-1, 1] (lam = (La + Lb)/2 + zeta (Lb - La)/2), from the
-    table's exact B-spline forms (see :func:`entry_model`)."""
+    table's exact B-spline forms (see :func:`entry_model`).
+
+    Parameters
+    ----------
+    exact : dict[str, 4 x 4 of ([A, B, D], [A, B, D])]
+        :meth:`.statement.Derivation.integer_forms` of the B-spline nets.
+    La, Lb : fmpq
+    layer, degree, prec : int
+
+    Returns
+    -------
+    dict[str, 4 x 4 of (list of arb, list of arb)]
+
+    Examples
+    --------
+    On the one-point interval lam = 1/2 (k = 4) the net is the identity's, (1/2 + i/6, j/6) on P1:
+
+    >>> from ccproof.certify.verify.statement import derivation
+    >>> from ccproof.rigorous import range_enclosure
+    >>> exact, h = derivation().integer_forms(), fmpq(1, 2)    # the one-point interval lam = 1/2: k = 4
+    >>> zn = {i: parameter_nets(exact, h, h, i, 2, 64) for i in (0, 1)}
+    >>> [float(z[0]) for z in zn[0]["P1"][1][1]]
+    [0.6666666666666666, 0.16666666666666666]
+    """
     L = fmpq_poly([(La + Lb) / 2, (Lb - La) / 2])
     out = {}
     with ctx.workprec(prec):
@@ -73,7 +121,27 @@ def parameter_nets(exact, La, Lb, layer, degree, prec):
 
 
 def hull_nets(znets, prec):
-    """arb nets enclosing the zeta-polynomial nets for every zeta in [-1, 1] (Bernstein range)."""
+    """arb nets enclosing the zeta-polynomial nets for every zeta in [-1, 1] (Bernstein range).
+
+    Parameters
+    ----------
+    znets : dict[str, 4 x 4 of (list of arb, list of arb)]
+    prec : int
+
+    Returns
+    -------
+    dict[str, 4 x 4 of (arb, arb)]
+
+    Examples
+    --------
+    >>> from ccproof.certify.verify.statement import derivation
+    >>> from ccproof.rigorous import range_enclosure
+    >>> exact, h = derivation().integer_forms(), fmpq(1, 2)    # the one-point interval lam = 1/2: k = 4
+    >>> zn = {i: parameter_nets(exact, h, h, i, 2, 64) for i in (0, 1)}
+    >>> x, y = hull_nets(zn[0], 64)["P1"][1][1]
+    >>> x.overlaps(arb(2) / 3), y.overlaps(arb(1) / 6)
+    (True, True)
+    """
     def hull(co):
         lo, hi = range_enclosure(_bern1(co, prec))
         return lo.union(hi)
@@ -81,7 +149,30 @@ def hull_nets(znets, prec):
 
 
 def cell_maps_z(znets, N, l, m, D, prec):
-    """(X, Y) = lam^i Phi on cell (l, m) as ball Polys in (zeta, s, t), truncated to degree D in zeta."""
+    """(X, Y) = lam^i Phi on cell (l, m) as ball Polys in (zeta, s, t), truncated to degree D in zeta.
+
+    Parameters
+    ----------
+    znets : dict[int, nets of :func:`parameter_nets`]
+        By layer.
+    N, l, m, D, prec : int
+
+    Returns
+    -------
+    (Poly, Poly)
+
+    Examples
+    --------
+    Cell (1, 0) of level 1 is piece P1 of layer 0, where Phi(s, t) = (1/2 + s/2, t/2) at k = 4:
+
+    >>> from ccproof.certify.verify.statement import derivation
+    >>> from ccproof.rigorous import range_enclosure
+    >>> exact, h = derivation().integer_forms(), fmpq(1, 2)    # the one-point interval lam = 1/2: k = 4
+    >>> zn = {i: parameter_nets(exact, h, h, i, 2, 64) for i in (0, 1)}
+    >>> X, Y = cell_maps_z(zn, 1, 1, 0, 2, 64)
+    >>> float(X(0, 1, 0).mid()), float(Y(0, 0, 1).mid())
+    (1.0, 0.5)
+    """
     i, name, box = cell_geometry(l, m, N)
     out = []
     for d in range(2):
@@ -95,7 +186,29 @@ def cell_maps_z(znets, N, l, m, D, prec):
 
 def piece_maps_z(znets, i, name, D, prec):
     """(X, Y) = lam^i Phi on piece ``name`` of layer i as TaylorForms in (zeta; sigma, tau): the Bezier
-    net entries are the Bernstein coefficients in (sigma, tau), their zeta polynomials the Taylor part."""
+    net entries are the Bernstein coefficients in (sigma, tau), their zeta polynomials the Taylor part.
+
+    Parameters
+    ----------
+    znets : dict[int, nets of :func:`parameter_nets`]
+    i : int
+    name : {"P1", "P2", "P3"}
+    D, prec : int
+
+    Returns
+    -------
+    (TaylorForm, TaylorForm)
+
+    Examples
+    --------
+    >>> from ccproof.certify.verify.statement import derivation
+    >>> from ccproof.rigorous import range_enclosure
+    >>> exact, h = derivation().integer_forms(), fmpq(1, 2)    # the one-point interval lam = 1/2: k = 4
+    >>> zn = {i: parameter_nets(exact, h, h, i, 2, 64) for i in (0, 1)}
+    >>> X, Y = piece_maps_z(zn, 0, "P1", 2, 64)
+    >>> X.shape, [float(c) for c in Y.coeffs[:4]]    # zeta^0 block of y: Bezier ordinates 0, 1/6, 1/3, 1/2
+    ((3, 4, 4), [0.0, 0.16666666666666666, 0.3333333333333333, 0.5])
+    """
     net = znets[i][name]
     m = len(net[0][0][0])
     return [TaylorForm(((m, 4, 4)), [net[a][b][d][e] for e in range(m) for a in range(4) for b in range(4)],
@@ -115,7 +228,30 @@ def _weight_z(p, X, D):
 def piece_det_form_z(znets, i, name, p, q, D, prec):
     """Bernstein form on ZBOX of det dG/d(sigma, tau) on layer i of piece ``name`` for the w piece (p, q),
     every lam of the interval at once (Taylor model in zeta, truncated to degree D; one form for all the
-    cells of that layer, piece and w piece; y = 2^-i (ORIGIN + (sigma, tau)/2) as in :func:`piece_det_form`)."""
+    cells of that layer, piece and w piece; y = 2^-i (ORIGIN + (sigma, tau)/2) as in :func:`piece_det_form`).
+
+    Parameters
+    ----------
+    znets : dict[int, nets of :func:`parameter_nets`]
+    i : int
+    name : {"P1", "P2", "P3"}
+    p, q, D, prec : int
+
+    Returns
+    -------
+    BernsteinForm
+
+    Examples
+    --------
+    At k = 4, Phi = y, so the blend G is y and det = 4^-(i+1):
+
+    >>> from ccproof.certify.verify.statement import derivation
+    >>> from ccproof.rigorous import range_enclosure
+    >>> exact, h = derivation().integer_forms(), fmpq(1, 2)    # the one-point interval lam = 1/2: k = 4
+    >>> zn = {i: parameter_nets(exact, h, h, i, 2, 64) for i in (0, 1)}
+    >>> [round(float(z), 12) for z in range_enclosure(piece_det_form_z(zn, 0, "P1", 2, 2, 2, 64))]
+    [0.25, 0.25]
+    """
     with ctx.workprec(prec):
         X, Y = piece_maps_z(znets, i, name, D, prec)
         u0, v0 = ORIGIN[name]
@@ -130,7 +266,33 @@ def piece_det_form_z(znets, i, name, p, q, D, prec):
 def interval_cells(znets, N, D, prec, symmetric=False):
     """Part D for an interval: every (key, build root) with a w piece met by the Bernstein hull of the
     cell's image over all zeta; the root is det dG/d(s,t) in (zeta, s, t) on ZBOX: the form of its layer,
-    piece and w piece (:func:`piece_det_form_z`) restricted to the cell's box, times h^2 (h a power of 2)."""
+    piece and w piece (:func:`piece_det_form_z`) restricted to the cell's box, times h^2 (h a power of 2).
+
+    Parameters
+    ----------
+    znets : dict[int, nets of :func:`parameter_nets`]
+    N, D, prec : int
+    symmetric : bool
+
+    Returns
+    -------
+    list of (str, callable () -> BernsteinForm)
+        Keys ``"l,m,p,q"``.
+
+    Examples
+    --------
+    The same cells as :func:`.maps.required_cells` for k = 4 at N = 1:
+
+    >>> from ccproof.certify.verify.statement import derivation
+    >>> from ccproof.rigorous import range_enclosure
+    >>> exact, h = derivation().integer_forms(), fmpq(1, 2)    # the one-point interval lam = 1/2: k = 4
+    >>> zn = {i: parameter_nets(exact, h, h, i, 2, 64) for i in (0, 1)}
+    >>> cells = interval_cells(zn, 1, 2, 64)
+    >>> [key for key, _ in cells]
+    ['0,1,0,2', '0,1,1,2', '0,1,2,2', '1,0,2,0', '1,0,2,1', '1,0,2,2', '1,1,2,2']
+    >>> [round(float(z), 12) for z in range_enclosure(cells[-1][1]())]
+    [0.25, 0.25]
+    """
     out = []
     forms = {}
 
@@ -154,7 +316,26 @@ def interval_cells(znets, N, D, prec, symmetric=False):
 
 def lam_interval_ok(k0, La, Lb, prec):
     """[La, Lb] contains lam(k) for every k >= k0: La <= lam(k0) and Lb >= (3 + sqrt 5)/8 = lim lam
-    (lam increases with c = cos(2 pi/k), which increases with k)."""
+    (lam increases with c = cos(2 pi/k), which increases with k).
+
+    Parameters
+    ----------
+    k0 : int
+    La, Lb : fmpq
+    prec : int
+
+    Returns
+    -------
+    bool
+
+    Examples
+    --------
+    lam(5) = 0.5497..., lim lam = 0.6545... (docs/readings.md R2, R10):
+
+    >>> [lam_interval_ok(5, La, Lb, 64) for La, Lb in ((fmpq(1, 2), fmpq(2, 3)), (fmpq(1, 2), fmpq(13, 20)),
+    ...                                                (fmpq(14, 25), fmpq(2, 3)))]
+    [True, False, False]
+    """
     with ctx.workprec(prec):
         c = arb(fmpq(2, k0)).cos_pi()
         lam0 = (5 + c + ((1 + c) * (9 + c)).sqrt()) / 16

@@ -24,7 +24,22 @@ BREAKS = (fmpq(0), fmpq(1, 6), fmpq(1, 3), fmpq(1, 2))  # w pieces (docs/reading
 
 def weight_piece(p):
     """b(x) = B(6x+1) + B(6x) + B(6x-1) on [BREAKS[p], BREAKS[p+1]] (R5) as an exact 1-var Poly;
-    B is the centred uniform cubic B-spline: (4 - 6z^2 + 3|z|^3)/6 on |z| <= 1, (2 - |z|)^3/6 on 1..2."""
+    B is the centred uniform cubic B-spline: (4 - 6z^2 + 3|z|^3)/6 on |z| <= 1, (2 - |z|)^3/6 on 1..2.
+
+    Parameters
+    ----------
+    p : int in 0..2
+
+    Returns
+    -------
+    Poly
+        Degree 3 in x; the weight w is 1 at 0 and 0 from 1/2 on (docs/readings.md R5).
+
+    Examples
+    --------
+    >>> weight_piece(0)(0), weight_piece(2)(fmpq(1, 2)), weight_piece(0)(fmpq(1, 6)) == weight_piece(1)(fmpq(1, 6))
+    (1, 0, True)
+    """
     z = fmpq_poly([0, 6])  # z = 6x
 
     def B(shift, region):  # B(z + shift) on a region where z + shift has one sign/one piece
@@ -48,7 +63,29 @@ def weight_piece(p):
 
 def net_form(net, coord, prec, box=None):
     """Bernstein form (unit box in the local variables) of one coordinate of a 4x4 Bezier net,
-    restricted to ``box`` (dyadic sub-box of [0,1]^2 in the piece's local parameters)."""
+    restricted to ``box`` (dyadic sub-box of [0,1]^2 in the piece's local parameters).
+
+    Parameters
+    ----------
+    net : 4 x 4 of (arb, arb)
+    coord : {0, 1}
+    prec : int
+    box : ((lo, hi), (lo, hi)) of fmpq, optional
+
+    Returns
+    -------
+    BernsteinForm
+        Degrees (3, 3) on [0, 1]^2.
+
+    Examples
+    --------
+    >>> from ccproof.certify.verify.statement import c_lam, nets_for_valence
+    >>> from flint import arb
+    >>> from ccproof.rigorous import range_enclosure
+    >>> nets, (c, lam) = nets_for_valence(4, 64), c_lam(4, 64)   # k = 4: Phi is the identity, lam = 1/2
+    >>> [[float(z) for z in range_enclosure(net_form(nets["P1"], 1, 64, box))] for box in (None, ((0, 1), (0, "1/2")))]
+    [[0.0, 0.5], [0.0, 0.25]]
+    """
     f = BernsteinForm((4, 4), [net[i][j][coord] for i in range(4) for j in range(4)], prec=prec)
     if box is not None:
         f = f.restrict(box)
@@ -56,7 +93,22 @@ def net_form(net, coord, prec, box=None):
 
 
 def cell_geometry(l, m, N):
-    """Layer i, piece name and (s, t) sub-box of the dyadic cell (l, m) != (0, 0) of level N."""
+    """Layer i, piece name and (s, t) sub-box of the dyadic cell (l, m) != (0, 0) of level N.
+
+    Parameters
+    ----------
+    l, m, N : int
+        Cell [l, l+1] x [m, m+1] / 2^N of the face (docs/appendix_a.md, part D).
+
+    Returns
+    -------
+    (int, str, ((fmpq, fmpq), (fmpq, fmpq)))
+
+    Examples
+    --------
+    >>> cell_geometry(1, 0, 1), cell_geometry(1, 0, 2), cell_geometry(3, 1, 2)
+    ((0, 'P1', ((0, 1), (0, 1))), (1, 'P1', ((0, 1), (0, 1))), (0, 'P1', ((1/2, 1), (1/2, 1))))
+    """
     M = max(l, m)
     i = N - 1 - (M.bit_length() - 1)
     scale = fmpq(2**i, 2**N)  # layer-0 coordinates of the cell: [l, l+1] * scale
@@ -73,7 +125,27 @@ def cell_geometry(l, m, N):
 
 
 def cell_pieces(X, Y):
-    """The w pieces (p, q), p, q in 0..3, whose regions the Bezier hull of (X, Y) may meet."""
+    """The w pieces (p, q), p, q in 0..3, whose regions the Bezier hull of (X, Y) may meet.
+
+    Parameters
+    ----------
+    X, Y : BernsteinForm
+        The two coordinates of a map (ball coefficients).
+
+    Returns
+    -------
+    list of (int, int)
+        Pieces of :data:`BREAKS` (p = 3: w = 0).
+
+    Examples
+    --------
+    >>> from ccproof.certify.verify.statement import c_lam, nets_for_valence
+    >>> from flint import arb
+    >>> from ccproof.rigorous import range_enclosure
+    >>> nets, (c, lam) = nets_for_valence(4, 64), c_lam(4, 64)   # k = 4: Phi is the identity, lam = 1/2
+    >>> cell_pieces(net_form(nets["P1"], 0, 64), net_form(nets["P1"], 1, 64))   # x in [1/2, 1], y in [0, 1/2]
+    [(2, 0), (2, 1), (2, 2), (2, 3), (3, 0), (3, 1), (3, 2), (3, 3)]
+    """
     out = []
     rng = []
     for F in (X, Y):
@@ -87,13 +159,49 @@ def cell_pieces(X, Y):
 
 
 def dyadic_cells(N, symmetric):
-    """The cells (l, m) != (0, 0) of level N that part D checks (l <= m only when ``symmetric``)."""
+    """The cells (l, m) != (0, 0) of level N that part D checks (l <= m only when ``symmetric``).
+
+    Parameters
+    ----------
+    N : int
+    symmetric : bool
+
+    Returns
+    -------
+    list of (int, int)
+
+    Examples
+    --------
+    >>> dyadic_cells(1, False), dyadic_cells(1, True)
+    ([(0, 1), (1, 0), (1, 1)], [(0, 1), (1, 1)])
+    """
     return [(l, m) for l in range(2**N) for m in range(2**N) if (l, m) != (0, 0) and not (symmetric and l > m)]
 
 
 def required_cells(nets, lam, N, prec, symmetric=False):
     """Every (l, m, p, q) of part D: cell (l, m) of :func:`dyadic_cells` and w piece (p, q), p, q < 3, met
-    by the Bezier hull of Phi(cell). Pieces with p = 3 or q = 3 have w = 0 (G = Phi, covered by part B)."""
+    by the Bezier hull of Phi(cell). Pieces with p = 3 or q = 3 have w = 0 (G = Phi, covered by part B).
+
+    Parameters
+    ----------
+    nets : dict[str, 4 x 4 of (arb, arb)]
+    lam : arb
+    N, prec : int
+    symmetric : bool
+
+    Returns
+    -------
+    list of (int, int, int, int)
+
+    Examples
+    --------
+    >>> from ccproof.certify.verify.statement import c_lam, nets_for_valence
+    >>> from flint import arb
+    >>> from ccproof.rigorous import range_enclosure
+    >>> nets, (c, lam) = nets_for_valence(4, 64), c_lam(4, 64)   # k = 4: Phi is the identity, lam = 1/2
+    >>> required_cells(nets, lam, 1, 64)
+    [(0, 1, 0, 2), (0, 1, 1, 2), (0, 1, 2, 2), (1, 0, 2, 0), (1, 0, 2, 1), (1, 0, 2, 2), (1, 1, 2, 2)]
+    """
     out = []
     with ctx.workprec(prec):
         for l, m in dyadic_cells(N, symmetric):
@@ -107,7 +215,30 @@ def required_cells(nets, lam, N, prec, symmetric=False):
 
 
 def cell_det_poly(nets, lam, N, l, m, p, q, prec):
-    """det dG/d(s,t) on cell (l, m) for the w piece (p, q) (p, q < 3), local coordinates in [0,1]^2."""
+    """det dG/d(s,t) on cell (l, m) for the w piece (p, q) (p, q < 3), local coordinates in [0,1]^2.
+
+    Parameters
+    ----------
+    nets : dict[str, 4 x 4 of (arb, arb)]
+    lam : arb
+    N, l, m, p, q, prec : int
+
+    Returns
+    -------
+    Poly
+        Ball coefficients; G = w y + (1 - w) Phi is the blend of docs/readings.md R6 (bmz04 eq. 4).
+
+    Examples
+    --------
+    With Phi = y (k = 4) G is y and det dG/d(s, t) = 4^-N:
+
+    >>> from ccproof.certify.verify.statement import c_lam, nets_for_valence
+    >>> from flint import arb
+    >>> from ccproof.rigorous import range_enclosure
+    >>> nets, (c, lam) = nets_for_valence(4, 64), c_lam(4, 64)   # k = 4: Phi is the identity, lam = 1/2
+    >>> cell_det_poly(nets, lam, 1, 1, 0, 2, 2, 64).coeffs[0].overlaps(arb(1) / 4)
+    True
+    """
     i, name, box = cell_geometry(l, m, N)
     with ctx.workprec(prec):
         li = lam**i
@@ -128,7 +259,32 @@ ORIGIN = {"P1": (fmpq(1, 2), fmpq(0)), "P2": (fmpq(1, 2), fmpq(1, 2)), "P3": (fm
 def piece_det_form(nets, lam, i, name, p, q, prec):
     """Bernstein form on [0,1]^2 of det dG/d(sigma, tau) on layer i of piece ``name`` for the w piece (p, q)
     (p, q < 3), in the piece's local parameters: one polynomial for every cell of that layer, piece and w piece.
-    On layer i, Phi = lam^i Phi_0(sigma, tau) and y = 2^-i (ORIGIN + (sigma, tau)/2)."""
+    On layer i, Phi = lam^i Phi_0(sigma, tau) and y = 2^-i (ORIGIN + (sigma, tau)/2).
+
+    Parameters
+    ----------
+    nets : dict[str, 4 x 4 of (arb, arb)]
+    lam : arb
+    i : int
+    name : {"P1", "P2", "P3"}
+    p, q, prec : int
+
+    Returns
+    -------
+    BernsteinForm
+
+    Examples
+    --------
+    With Phi = y (k = 4) the determinant is 4^-(i+1):
+
+    >>> from ccproof.certify.verify.statement import c_lam, nets_for_valence
+    >>> from flint import arb
+    >>> from ccproof.rigorous import range_enclosure
+    >>> nets, (c, lam) = nets_for_valence(4, 64), c_lam(4, 64)   # k = 4: Phi is the identity, lam = 1/2
+    >>> lo, hi = range_enclosure(piece_det_form(nets, lam, 0, "P1", 2, 2, 64))
+    >>> bool(abs(lo - arb(1) / 4) < 1e-12 and abs(hi - arb(1) / 4) < 1e-12)
+    True
+    """
     with ctx.workprec(prec):
         li = lam**i
         X = net_form(nets[name], 0, prec).to_poly() * li
@@ -145,7 +301,28 @@ def cell_det_form(piece_form, N, l, m, p, q, prec):
     """Bernstein form of det dG/d(s, t) on cell (l, m) for the w piece (p, q) in the cell's local (s, t):
     the piece's form (``piece_form(i, name, p, q)``, :func:`piece_det_form`) restricted to the cell's box
     (sigma = s0 + h s, tau = t0 + h t) times h^2 (exact: h is a power of 2). Same polynomial as
-    :func:`cell_det_poly` on the cell; restricting one form per piece is the cheap way to get it."""
+    :func:`cell_det_poly` on the cell; restricting one form per piece is the cheap way to get it.
+
+    Parameters
+    ----------
+    piece_form : callable (i, name, p, q) -> BernsteinForm
+    N, l, m, p, q, prec : int
+
+    Returns
+    -------
+    BernsteinForm
+
+    Examples
+    --------
+    >>> from ccproof.certify.verify.statement import c_lam, nets_for_valence
+    >>> from flint import arb
+    >>> from ccproof.rigorous import range_enclosure
+    >>> nets, (c, lam) = nets_for_valence(4, 64), c_lam(4, 64)   # k = 4: Phi is the identity, lam = 1/2
+    >>> f = piece_det_form(nets, lam, 0, "P1", 2, 2, 64)
+    >>> lo, hi = range_enclosure(cell_det_form(lambda *key: f, 1, 1, 0, 2, 2, 64))   # cell = piece P1
+    >>> bool(abs(lo - arb(1) / 4) < 1e-12 and abs(hi - arb(1) / 4) < 1e-12)
+    True
+    """
     i, name, box = cell_geometry(l, m, N)
     h = box[0][1] - box[0][0]
     with ctx.workprec(prec):
@@ -153,7 +330,28 @@ def cell_det_form(piece_form, N, l, m, p, q, prec):
 
 
 def cell_det_builder(nets, lam, N, prec):
-    """A function (l, m, p, q) -> :func:`cell_det_form`, building each :func:`piece_det_form` once."""
+    """A function (l, m, p, q) -> :func:`cell_det_form`, building each :func:`piece_det_form` once.
+
+    Parameters
+    ----------
+    nets : dict[str, 4 x 4 of (arb, arb)]
+    lam : arb
+    N, prec : int
+
+    Returns
+    -------
+    callable (l, m, p, q) -> BernsteinForm
+
+    Examples
+    --------
+    >>> from ccproof.certify.verify.statement import c_lam, nets_for_valence
+    >>> from flint import arb
+    >>> from ccproof.rigorous import range_enclosure
+    >>> nets, (c, lam) = nets_for_valence(4, 64), c_lam(4, 64)   # k = 4: Phi is the identity, lam = 1/2
+    >>> lo, hi = range_enclosure(cell_det_builder(nets, lam, 1, 64)(1, 0, 2, 2))
+    >>> bool(abs(lo - arb(1) / 4) < 1e-12 and abs(hi - arb(1) / 4) < 1e-12)
+    True
+    """
     forms = {}
 
     def piece_form(*key):
@@ -166,7 +364,33 @@ def cell_det_builder(nets, lam, N, prec):
 
 def corner_det_form(nets, lam, N, name, prec):
     """Bernstein form on [0,1]^4 of det(J_G)/h^2 on layer i >= N of piece ``name`` in (rho, kappa, s, t)
-    (R9 form), computed in Bernstein arithmetic (stays tight for the interval nets of k >= k0)."""
+    (R9 form), computed in Bernstein arithmetic (stays tight for the interval nets of k >= k0).
+
+    Parameters
+    ----------
+    nets : dict[str, 4 x 4 of (arb, arb)]
+    lam : arb
+    N : int
+    name : {"P1", "P2", "P3"}
+    prec : int
+
+    Returns
+    -------
+    BernsteinForm
+        Degrees (1, 1, ., .) in (rho, kappa) (docs/readings.md R9, part E of docs/certificates.md).
+
+    Examples
+    --------
+    At rho = kappa = 0 the Jacobian is I/2, so those coefficients are det = 1/4:
+
+    >>> from ccproof.certify.verify.statement import c_lam, nets_for_valence
+    >>> from flint import arb
+    >>> from ccproof.rigorous import range_enclosure
+    >>> nets, (c, lam) = nets_for_valence(4, 64), c_lam(4, 64)   # k = 4: Phi is the identity, lam = 1/2
+    >>> f = corner_det_form(nets, lam, 2, "P1", 64)
+    >>> f.nvars, f.coeffs[0].overlaps(arb(1) / 4)
+    (4, True)
+    """
     with ctx.workprec(prec):
         def var(axis, c):  # c * x_axis
             return BernsteinForm(tuple(2 if i == axis else 1 for i in range(4)), [0, c], prec=prec)
@@ -190,7 +414,29 @@ def corner_det_form(nets, lam, N, name, prec):
 
 def regularity_form(nets, name, prec):
     """Bernstein form (degree (5,5)) of det J_Phi w.r.t. the local (s, t) of piece ``name`` on layer 0,
-    computed in Bernstein arithmetic (stays tight for the interval nets of k >= k0)."""
+    computed in Bernstein arithmetic (stays tight for the interval nets of k >= k0).
+
+    Parameters
+    ----------
+    nets : dict[str, 4 x 4 of (arb, arb)]
+    name : {"P1", "P2", "P3"}
+    prec : int
+
+    Returns
+    -------
+    BernsteinForm
+
+    Examples
+    --------
+    At k = 4, Phi(s, t) on a piece is the identity scaled by 1/2, so det J_Phi = 1/4:
+
+    >>> from ccproof.certify.verify.statement import c_lam, nets_for_valence
+    >>> from flint import arb
+    >>> from ccproof.rigorous import range_enclosure
+    >>> nets, (c, lam) = nets_for_valence(4, 64), c_lam(4, 64)   # k = 4: Phi is the identity, lam = 1/2
+    >>> [float(z) for z in range_enclosure(regularity_form(nets, "P2", 64))]
+    [0.25, 0.25]
+    """
     with ctx.workprec(prec):
         return bernstein_jacobian_determinant([net_form(nets[name], 0, prec), net_form(nets[name], 1, prec)])
 
@@ -200,7 +446,29 @@ STAR_CURVES = {"P1s1": ("P1", "s", 1), "P2s1": ("P2", "s", 1), "P2t1": ("P2", "t
 
 def star_form(nets, curve, prec):
     """Bernstein form (degree 5) of x y' - y x' along one cubic of the outer boundary, oriented from
-    (1,0) towards (0,1). Positive on all four curves means the outer boundary is star-shaped."""
+    (1,0) towards (0,1). Positive on all four curves means the outer boundary is star-shaped.
+
+    Parameters
+    ----------
+    nets : dict[str, 4 x 4 of (arb, arb)]
+    curve : key of :data:`STAR_CURVES`
+    prec : int
+
+    Returns
+    -------
+    BernsteinForm
+
+    Examples
+    --------
+    At k = 4 the outer boundary is the square's: on u = 1, x y' - y x' = 1 * 1/2:
+
+    >>> from ccproof.certify.verify.statement import c_lam, nets_for_valence
+    >>> from flint import arb
+    >>> from ccproof.rigorous import range_enclosure
+    >>> nets, (c, lam) = nets_for_valence(4, 64), c_lam(4, 64)   # k = 4: Phi is the identity, lam = 1/2
+    >>> [bool(abs(range_enclosure(star_form(nets, cv, 64))[0] - arb(1) / 2) < 1e-12) for cv in STAR_CURVES]
+    [True, True, True, True]
+    """
     name, side, sign = STAR_CURVES[curve]
     net = nets[name]
     pts = [net[3][j] for j in range(4)] if side == "s" else [net[i][3] for i in range(4)]
@@ -212,18 +480,75 @@ def star_form(nets, curve, prec):
 
 
 def corner_containment(nets, lam, N):
-    """Part A: (lam^N * max(all Bezier coordinates) < 1/6 certainly, that ball)."""
+    """Part A: (lam^N * max(all Bezier coordinates) < 1/6 certainly, that ball).
+
+    Parameters
+    ----------
+    nets : dict[str, 4 x 4 of (arb, arb)]
+    lam : arb
+    N : int
+
+    Returns
+    -------
+    (bool, arb)
+
+    Examples
+    --------
+    >>> from ccproof.certify.verify.statement import c_lam, nets_for_valence
+    >>> from flint import arb
+    >>> from ccproof.rigorous import range_enclosure
+    >>> nets, (c, lam) = nets_for_valence(4, 64), c_lam(4, 64)   # k = 4: Phi is the identity, lam = 1/2
+    >>> corner_containment(nets, lam, 3), corner_containment(nets, lam, 2)[0]   # 1/8 < 1/6 < 1/4
+    ((True, 0.125000000000000), False)
+    """
     hull = max((c[d].upper() for n in PATCHES for row in nets[n] for c in row for d in range(2)),
                key=lambda z: z.mid())
     return bool(lam**N * hull < fmpq(1, 6)), lam**N * hull
 
 
 def square_inside_image(nets):
-    """Part C: the images of the outer sides u = 1, v = 1 avoid [0,1/2]^2 (replayed bisection)."""
+    """Part C: the images of the outer sides u = 1, v = 1 avoid [0,1/2]^2 (replayed bisection).
+
+    Parameters
+    ----------
+    nets : dict[str, 4 x 4 of (arb, arb)]
+
+    Returns
+    -------
+    bool
+
+    Examples
+    --------
+    >>> from ccproof.certify.verify.statement import c_lam, nets_for_valence
+    >>> from flint import arb
+    >>> from ccproof.rigorous import range_enclosure
+    >>> nets, (c, lam) = nets_for_valence(4, 64), c_lam(4, 64)   # k = 4: Phi is the identity, lam = 1/2
+    >>> square_inside_image(nets)
+    True
+    """
     return all(_curve_avoids(cv, 40) for cv in outer_curves(nets))
 
 
 def outer_curves(nets):
+    """The four cubic Bezier curves of the outer boundary (u = 1 on P1, P2; v = 1 on P2, P3).
+
+    Parameters
+    ----------
+    nets : dict[str, 4 x 4 of (x, y)]
+
+    Returns
+    -------
+    list of 4 lists of 4 (x, y)
+
+    Examples
+    --------
+    >>> from ccproof.certify.verify.statement import c_lam, nets_for_valence
+    >>> from flint import arb
+    >>> from ccproof.rigorous import range_enclosure
+    >>> nets, (c, lam) = nets_for_valence(4, 64), c_lam(4, 64)   # k = 4: Phi is the identity, lam = 1/2
+    >>> [[float(z) for z in p] for p in outer_curves(nets)[0]]   # u = 1: (1, v) for v = 0..1/2
+    [[1.0, 0.0], [1.0, 0.16666666666666666], [1.0, 0.3333333333333333], [1.0, 0.5]]
+    """
     return [[nets["P1"][3][j] for j in range(4)], [nets["P2"][3][j] for j in range(4)],
             [nets["P2"][i][3] for i in range(4)], [nets["P3"][i][3] for i in range(4)]]
 

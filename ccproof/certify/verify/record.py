@@ -12,7 +12,20 @@ from .errors import CertificateError
 @dataclass
 class Part:
     """One checked claim: ``name``, ``ok``, a ``message`` (the reason when it failed) and, for box parts,
-    the smallest claimed bound that was re-checked (``bound``, an exact fmpq) in local coordinates."""
+    the smallest claimed bound that was re-checked (``bound``, an exact fmpq) in local coordinates.
+
+    Attributes
+    ----------
+    name : str
+    ok : bool
+    message : str
+    bound : fmpq or None
+
+    Examples
+    --------
+    >>> Part("S", False, "not an eigenvector")
+    Part(name='S', ok=False, message='not an eigenvector', bound=None)
+    """
 
     name: str
     ok: bool
@@ -26,6 +39,20 @@ class VerifyResult:
     names why the file could not be checked at all (malformed, unknown field), else None. True as a bool
     exactly when ``ok``. ``margins`` maps a section (``regularity``, ``cells``, ``corner``, ``star``) to the
     smallest bound re-checked in this run.
+
+    Attributes
+    ----------
+    path, schema : str or None
+    valence : int or dict or None
+        k, or ``{"min": k0}`` for every k >= k0.
+    N : int or None
+    parts : list of Part
+    error : str or None
+    seconds : float
+    margins : dict[str, fmpq]
+
+    Examples
+    --------
 
     >>> r = VerifyResult(parts=[Part("A", True), Part("B", False, "a coefficient is not above the bound")])
     >>> bool(r), [p.name for p in r.failures()]
@@ -53,7 +80,23 @@ class VerifyResult:
 
 
 class Recorder:
-    """Collects the parts of a :class:`VerifyResult` and prints each as PASS/FAIL through ``log``."""
+    """Collects the parts of a :class:`VerifyResult` and prints each as PASS/FAIL through ``log``.
+
+    Parameters
+    ----------
+    result : VerifyResult
+    log : callable (str) -> None
+
+    Examples
+    --------
+    >>> r = VerifyResult()
+    >>> rec = Recorder(r, print)
+    >>> rec("A", True, bound=fmpq(1, 3), section="cells"); rec("B", False, "too small")
+      PASS  A
+      FAIL  B: too small
+    >>> rec.failed, r.margins
+    (True, {'cells': 1/3})
+    """
 
     def __init__(self, result, log):
         self.result, self.log = result, log
@@ -71,7 +114,29 @@ class Recorder:
 
 
 def field_of(obj, key, kind, where):
-    """``obj[key]`` of type ``kind`` (bool is never an int here), else :class:`CertificateError`."""
+    """``obj[key]`` of type ``kind`` (bool is never an int here), else :class:`CertificateError`.
+
+    Parameters
+    ----------
+    obj : object (a dict from JSON)
+    key : str
+    kind : type or tuple of types
+    where : str
+        Named in the error.
+
+    Returns
+    -------
+    The value.
+
+    Examples
+    --------
+    >>> field_of({"N": 3}, "N", int, "hints")
+    3
+    >>> field_of({"N": True}, "N", int, "hints")
+    Traceback (most recent call last):
+    ...
+    ccproof.certify.verify.errors.CertificateError: hints: field 'N' has the wrong type
+    """
     if not isinstance(obj, dict) or key not in obj:
         raise CertificateError(f"{where}: missing field {key!r}")
     val = obj[key]
@@ -81,7 +146,26 @@ def field_of(obj, key, kind, where):
 
 
 def exact_keys(obj, keys, where):
-    """Reject unknown and missing keys: nothing in a certificate goes unchecked."""
+    """Reject unknown and missing keys: nothing in a certificate goes unchecked.
+
+    Parameters
+    ----------
+    obj : object (a dict from JSON)
+    keys : sequence of str
+    where : str
+        Named in the error.
+
+    Raises
+    ------
+    CertificateError
+
+    Examples
+    --------
+    >>> exact_keys({"path": "0L", "bound": "1", "x": 0}, ("path", "bound"), "box")
+    Traceback (most recent call last):
+    ...
+    ccproof.certify.verify.errors.CertificateError: box: unknown field(s) 'x' (nothing unchecked ...)
+    """
     if not isinstance(obj, dict):
         raise CertificateError(f"{where} must be an object")
     extra, missing = sorted(set(obj) - set(keys)), sorted(set(keys) - set(obj))
@@ -93,7 +177,22 @@ def exact_keys(obj, keys, where):
 
 
 def read_valence(cert):
-    """An int k >= 3 or ``{"min": k0}`` with k0 >= 3 (at most 10^6, so every derived check stays fast)."""
+    """An int k >= 3 or ``{"min": k0}`` with k0 >= 3 (at most 10^6, so every derived check stays fast).
+
+    Parameters
+    ----------
+    cert : dict
+        The certificate (its ``valence`` field is read).
+
+    Returns
+    -------
+    int or dict
+
+    Examples
+    --------
+    >>> read_valence({"valence": 5}), read_valence({"valence": {"min": 7}})
+    (5, {'min': 7})
+    """
     k = field_of(cert, "valence", (int, dict), "certificate")
     if isinstance(k, dict):
         exact_keys(k, ("min",), "valence")
@@ -106,4 +205,19 @@ def read_valence(cert):
 
 
 def kname(k):
+    """Display name of a valence: ``"5"`` or ``">=7"``.
+
+    Parameters
+    ----------
+    k : int or dict ``{"min": k0}``
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> kname(5), kname({"min": 7})
+    ('5', '>=7')
+    """
     return f">={k['min']}" if isinstance(k, dict) else str(k)

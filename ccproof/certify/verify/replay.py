@@ -25,6 +25,17 @@ def parse_decimal(s):
     """Exact fmpq of a decimal string like ``'0.1234'`` or ``'-15e-4'``, of at most
     :data:`MAX_DECIMAL_CHARS` characters and an exponent of at most :data:`MAX_EXPONENT` in magnitude.
 
+    Parameters
+    ----------
+    s : str
+
+    Returns
+    -------
+    fmpq
+
+    Examples
+    --------
+
     >>> parse_decimal("-15e-4"), parse_decimal("0.25")
     (-3/2000, 1/4)
     """
@@ -44,6 +55,24 @@ def parse_decimal(s):
 
 
 def parse_path(path, nvars):
+    """The halvings of a box path: ``"0L1H"`` is the low half along axis 0, then the high half along 1.
+
+    Parameters
+    ----------
+    path : str
+        At most :data:`MAX_PATH_TOKENS` tokens ``[0-3][LH]`` (docs/certificates.md).
+    nvars : int
+        Axes must be below it.
+
+    Returns
+    -------
+    list of (int, str)
+
+    Examples
+    --------
+    >>> parse_path("0L1H", 2)
+    [(0, 'L'), (1, 'H')]
+    """
     if not isinstance(path, str) or len(path) > 2 * MAX_PATH_TOKENS or _TOKEN.sub("", path) != "":
         raise CertificateError(f"malformed box path {path!r}")
     toks = [(int(a), side) for a, side in _TOKEN.findall(path)]
@@ -53,7 +82,23 @@ def parse_path(path, nvars):
 
 
 def check_partition(paths, nvars):
-    """True iff the leaf paths partition the root box exactly (no gap, no overlap)."""
+    """True iff the leaf paths partition the root box exactly (no gap, no overlap).
+
+    Parameters
+    ----------
+    paths : sequence of str
+        Box paths (:func:`parse_path`).
+    nvars : int
+
+    Returns
+    -------
+    bool
+
+    Examples
+    --------
+    >>> check_partition(["0L", "0H1L", "0H1H"], 2), check_partition(["0L", "0H1L"], 2)
+    (True, False)
+    """
     parsed = [parse_path(p, nvars) for p in paths]
     if len({tuple(p) for p in parsed}) != len(parsed):
         return False
@@ -73,7 +118,33 @@ def check_partition(paths, nvars):
 
 def check_boxes(root, boxes, what):
     """Replay the split paths on the Bernstein form ``root``; each box's coefficients must all be
-    certainly > its claimed bound > 0. Returns (ok, message, min bound)."""
+    certainly > its claimed bound > 0 (de Casteljau halvings of :class:`ccproof.rigorous.BernsteinForm`).
+
+    Parameters
+    ----------
+    root : BernsteinForm
+        Ball coefficients on the root box.
+    boxes : list of dict ``{"path": str, "bound": decimal str}``
+        Must partition the root box (:func:`check_partition`).
+    what : str
+        Named in the messages.
+
+    Returns
+    -------
+    (bool, str, fmpq or None)
+        ok, the reason when not, and the smallest bound.
+
+    Examples
+    --------
+    1 + x on [0, 1]: the halves have Bernstein coefficients (1, 3/2) and (3/2, 2):
+
+    >>> from ccproof.rigorous import Poly, bernstein_coefficients
+    >>> f = bernstein_coefficients(1 + Poly.variable(0, 1)).to_arb(53)
+    >>> check_boxes(f, [{"path": "0L", "bound": "0.9"}, {"path": "0H", "bound": "1.4"}], "test")
+    (True, '', 9/10)
+    >>> check_boxes(f, [{"path": "0L", "bound": "1.1"}, {"path": "0H", "bound": "1.4"}], "test")[0]
+    False
+    """
     if not isinstance(boxes, list) or not boxes:
         return False, f"{what}: no boxes", None
     paths = []

@@ -29,8 +29,23 @@ CENTRE = (0, 0)
 
 
 def canonical(a, b):
-    """``(delta, a', b')``: the position (a, b) of some sector is (a', b') of the sector delta steps on;
-    ``(0, 0, 0)`` is the centre."""
+    """``(delta, a', b')``: the position (a, b) of some sector is (a', b') of the sector delta steps on.
+
+    Parameters
+    ----------
+    a, b : int
+        Grid position in a sector's coordinates (the figure of the module docstring).
+
+    Returns
+    -------
+    (int, int, int)
+        ``(0, 0, 0)`` for the centre; ``a' >= 1, b' >= 0`` otherwise.
+
+    Examples
+    --------
+    >>> canonical(2, 1), canonical(0, 2), canonical(-1, 0), canonical(1, -1)
+    ((0, 2, 1), (1, 2, 0), (2, 1, 0), (-1, 1, 1))
+    """
     if a == 0 and b == 0:
         return (0, 0, 0)
     if a >= 1 and b >= 0:
@@ -51,14 +66,49 @@ def _add(acc, comb, w):
 
 
 def face_point(a, b):
-    """New face point of the level-0 face with lower corner (a, b): {raw position: weight}."""
+    """New face point of the level-0 face with lower corner (a, b): {raw position: weight}.
+
+    Parameters
+    ----------
+    a, b : int
+
+    Returns
+    -------
+    dict[(int, int), fmpq]
+        The mean of the four corners (bmz04 Fig. 1, docs/readings.md R1).
+
+    Examples
+    --------
+    >>> face_point(0, 0)
+    {(0, 0): 1/4, (0, 1): 1/4, (1, 0): 1/4, (1, 1): 1/4}
+    """
     return {(a + i, b + j): fmpq(1, 4) for i in (0, 1) for j in (0, 1)}
 
 
 def level1_rule(A, B):
     """The level-1 vertex at sector-local level-1 position (A, B) != (0, 0) as a combination of level-0
     positions (raw, sector-local), derived from the three rules (the vertex is not the centre, so
-    a vertex point has n = 4)."""
+    a vertex point has n = 4).
+
+    Parameters
+    ----------
+    A, B : int
+        Level-1 position: both odd a face point, one odd an edge point, both even a vertex point.
+
+    Returns
+    -------
+    dict[(int, int), fmpq]
+        Weights summing to 1.
+
+    Examples
+    --------
+    The vertex point of (1, 0) (valence 4): 9/16 on it, 3/32 on edge and 1/64 on diagonal neighbours
+    (bmz04 Fig. 1 at n = 4: ``1 - 7/(4n)``, ``3/(2n^2)``, ``1/(4n^2)``):
+
+    >>> r = level1_rule(2, 0)
+    >>> r[(1, 0)], r[(2, 0)], r[(2, 1)], sum(r.values())
+    (9/16, 3/32, 1/64, 1)
+    """
     if (A, B) == CENTRE:
         raise ValueError("the centre has valence k: use centre_rule")
     half = fmpq(1, 2)
@@ -88,7 +138,26 @@ def level1_rule(A, B):
 
 def centre_rule_mode0(t):
     """The new centre in Fourier mode 0 (every sector equal) for t = 1/k: V' = t (F + 2R) + (1 - 3t) V,
-    with F = the face point of the sector-0 face (0, 0) and R = (V + value(1, 0))/2 (all sectors alike)."""
+    with F = the face point of the sector-0 face (0, 0) and R = (V + value(1, 0))/2 (all sectors alike).
+
+    Parameters
+    ----------
+    t : fmpq
+        1/k.
+
+    Returns
+    -------
+    dict[(int, int), fmpq]
+        Sector-0 weights; (0, 1) is the (1, 0) of the next sector.
+
+    Examples
+    --------
+    k = 5: ``1 - 7/(4k) = 13/20`` on the centre, ``3/(2k) = 1/4 + 1/20`` on the edge and ``1/(4k)`` on the
+    diagonal neighbours of all sectors together:
+
+    >>> centre_rule_mode0(fmpq(1, 5))
+    {(0, 0): 13/20, (0, 1): 1/20, (1, 0): 1/4, (1, 1): 1/20}
+    """
     acc = {CENTRE: 1 - 3 * t}
     _add(acc, face_point(0, 0), t)
     _add(acc, {CENTRE: fmpq(1, 2), (1, 0): fmpq(1, 2)}, 2 * t)
@@ -97,7 +166,27 @@ def centre_rule_mode0(t):
 
 def apply(comb, lookup, zero):
     """Sum of weight * lookup(delta, (a', b')) over a combination of raw positions; the centre is
-    ``lookup(0, (0, 0))``."""
+    ``lookup(0, (0, 0))``.
+
+    Parameters
+    ----------
+    comb : dict[(int, int), weight]
+    lookup : callable (delta, (a', b')) -> value
+        The value at position (a', b') of the sector delta steps on.
+    zero : the zero of the values
+
+    Returns
+    -------
+    value
+
+    Examples
+    --------
+    On the regular grid (k = 4), with x(delta, (a, b)) the x coordinate after ``delta`` quarter turns:
+
+    >>> x = lambda d, p: [p[0], -p[1], -p[0], p[1]][d % 4]
+    >>> apply(face_point(0, 0), x, 0), apply(face_point(-1, 0), x, 0)
+    (1/2, -1/2)
+    """
     acc = zero
     for (a, b), w in comb.items():
         delta, a2, b2 = canonical(a, b)
@@ -107,6 +196,25 @@ def apply(comb, lookup, zero):
 
 def level1_value(A, B, lookup, zero):
     """The level-1 value at any sector-local level-1 position (A, B) != centre, rotated into place:
-    canonicalize to (delta, A', B'), apply the rule in sector delta."""
+    canonicalize to (delta, A', B'), apply the rule in sector delta.
+
+    Parameters
+    ----------
+    A, B : int
+    lookup, zero : as in :func:`apply` (relative to sector delta)
+
+    Returns
+    -------
+    (int, value)
+        ``delta`` and the value in sector delta's frame.
+
+    Examples
+    --------
+    Subdivision of the regular grid halves it: level-1 position (A, B) has x = A/2 in its own sector:
+
+    >>> x = lambda d, p: [p[0], -p[1], -p[0], p[1]][d % 4]
+    >>> level1_value(2, 3, x, 0), level1_value(-1, 2, x, 0)
+    ((0, 1), (1, 1))
+    """
     delta, A2, B2 = canonical(A, B)
     return delta, apply(level1_rule(A2, B2), lookup, zero)

@@ -85,7 +85,18 @@ def _claimed_mode0(x, t):
 
 
 def check_block_polynomials():
-    """True iff both characteristic-polynomial identities of the module docstring hold (exact grid)."""
+    """True iff both characteristic-polynomial identities of the module docstring hold (exact grid).
+
+    Returns
+    -------
+    bool
+        Checked at enough exact points to identify the polynomials (docs/readings.md R2).
+
+    Examples
+    --------
+    >>> check_block_polynomials()
+    True
+    """
     for w in range(1, 20):  # degree <= 18 in w after multiplying by w^6
         rows = _block(w=fmpq(w))
         c = (fmpq(w) + 1 / fmpq(w)) / 2
@@ -101,12 +112,44 @@ def check_block_polynomials():
 
 
 def lam_of(c):
+    """lam = (5 + c + sqrt((1 + c)(9 + c))) / 16, the subdominant eigenvalue at c = cos(2 pi/k) (R2).
+
+    Parameters
+    ----------
+    c : arb
+
+    Returns
+    -------
+    arb
+
+    Examples
+    --------
+    >>> lam_of(arb(0)), lam_of(arb(-1) / 2).overlaps((9 + arb(17).sqrt()) / 32)   # k = 4, k = 3
+    (0.500000000000000, True)
+    """
     return (5 + c + ((1 + c) * (9 + c)).sqrt()) / 16
 
 
 def spectral_ordering(k, prec):
     """(ok, message): 1 = lam_0 > lam_1 = lam_2 = lam(k) > |lam_3|, lam double and non-defective, for the
-    valence k (an int) or every k >= k0 (``{"min": k0}``); assumes :func:`check_block_polynomials`."""
+    valence k (an int) or every k >= k0 (``{"min": k0}``); assumes :func:`check_block_polynomials`.
+
+    Parameters
+    ----------
+    k : int or dict ``{"min": k0}``
+    prec : int
+        Bits of the arb comparisons.
+
+    Returns
+    -------
+    (bool, str)
+        Reif's spectral hypotheses (docs/readings.md R2; bmz04 section 2).
+
+    Examples
+    --------
+    >>> spectral_ordering(5, 64)[0], spectral_ordering({"min": 20}, 64)[0]
+    (True, True)
+    """
     with ctx.workprec(prec):
         if isinstance(k, dict):
             k0 = k["min"]

@@ -38,12 +38,39 @@ B2Z = ((1, 4, 1, 0), (0, 4, 2, 0), (0, 2, 4, 0), (0, 1, 4, 1))
 
 
 class StatementError(ValueError):
-    """The derivation of the statement failed (cannot happen for the true rules; a tripwire)."""
+    """The derivation of the statement failed (cannot happen for the true rules; a tripwire).
+
+    Parameters
+    ----------
+    message : str
+        Which identity or denominator failed.
+
+    Examples
+    --------
+    >>> issubclass(StatementError, ValueError), all(ok for _, ok in derivation().hypotheses)
+    (True, True)
+    """
 
 
 # ------------------------------------------------------------------------ points in F^2
 def rot(delta, p):
-    """R^delta p in the normalized frame, R = [[0, -1], [1, 2c]] (delta in -1..2)."""
+    """R^delta p in the normalized frame, R = [[0, -1], [1, 2c]] (delta in -1..2; docs/readings.md R3).
+
+    Parameters
+    ----------
+    delta : int
+    p : (QL, QL)
+
+    Returns
+    -------
+    (QL, QL)
+
+    Examples
+    --------
+    >>> x, y = rot(1, (QL(1), QL(0)))
+    >>> x == 0, y == 1, [q == w for q, w in zip(rot(-1, rot(1, (QL(1), QL(2)))), (1, 2))]
+    (True, True, [True, True])
+    """
     c2 = 2 * QL.c()
     x, y = p
     for _ in range(delta % 4 if delta >= 0 else 0):
@@ -83,7 +110,27 @@ def _lookup(values):
 
 
 def level1(values, A, B):
-    """Level-1 mode-1 value at sector-local position (A, B) from the level-0 sector-0 ``values``."""
+    """Level-1 mode-1 value at sector-local position (A, B) from the level-0 sector-0 ``values``.
+
+    Parameters
+    ----------
+    values : dict[(int, int), (QL, QL)]
+        The sector-0 two-ring (:data:`TWO_RING`) in the normalized frame.
+    A, B : int
+
+    Returns
+    -------
+    (QL, QL)
+        By :mod:`.rules` (bmz04 Fig. 1), rotated by :func:`rot` (docs/readings.md R3).
+
+    Examples
+    --------
+    The eigenvector is an eigenvector: one step scales it by lam (here at the two-ring point (1, 0)):
+
+    >>> v = derivation().eigenvector
+    >>> [q == QL.lam() * w for q, w in zip(level1(v, 1, 0), v[(1, 0)])]
+    [True, True]
+    """
     if (A, B) == (0, 0):
         return _ZERO
     delta, v = level1_value(A, B, _lookup(values), _ZERO)
@@ -141,7 +188,25 @@ def _eigenvector():
 
 
 def bspline_to_bezier(net):
-    """Bezier net of the uniform bicubic B-spline segment of a 4x4 net of F-points (exact)."""
+    """Bezier net of the uniform bicubic B-spline segment of a 4x4 net of F-points (exact).
+
+    Parameters
+    ----------
+    net : 4 x 4 nested sequence of (QL, QL)
+
+    Returns
+    -------
+    list of 4 lists of 4 (QL, QL)
+        ``B2Z`` (the B-spline to Bezier matrix, / 6) applied in both directions.
+
+    Examples
+    --------
+    A linear net ``(i, j)`` gives the Bezier points ``(1 + i/3, 1 + j/3)`` of the middle segment:
+
+    >>> Z = bspline_to_bezier([[(QL(i), QL(j)) for j in range(4)] for i in range(4)])
+    >>> [q == w for q, w in zip(Z[0][0] + Z[1][2], (1, 1, fmpq(4, 3), fmpq(5, 3)))]
+    [True, True, True, True]
+    """
     def lin(coeffs, pts):
         acc = _ZERO
         for a, p in zip(coeffs, pts):
@@ -173,7 +238,23 @@ def _split_half(curve):
 
 class Derivation:
     """What :func:`derivation` computes: ``eigenvector`` {position: (x, y)}, ``bspline`` and ``bezier``
-    nets {piece: 4x4 of (x, y)} with entries in F, ``symmetric`` and ``hypotheses`` [(name, ok)]."""
+    nets {piece: 4x4 of (x, y)} with entries in F, ``symmetric`` and ``hypotheses`` [(name, ok)].
+
+    Attributes
+    ----------
+    eigenvector : dict[(int, int), (QL, QL)]
+    bspline, bezier : dict[str, 4 x 4 of (QL, QL)]
+        Pieces ``P1, P2, P3`` of layer 0 (docs/readings.md R4).
+    symmetric : bool
+    hypotheses : list of (str, bool)
+        docs/appendix_a.md section 0.
+
+    Examples
+    --------
+    >>> d = derivation()
+    >>> isinstance(d, Derivation), sorted(d.bezier), d.symmetric, len(d.hypotheses)
+    (True, ['P1', 'P2', 'P3'], True, 8)
+    """
 
     def __init__(self, eigenvector, bspline, bezier, symmetric, hypotheses):
         self.eigenvector, self.bspline, self.bezier = eigenvector, bspline, bezier
@@ -194,7 +275,22 @@ class Derivation:
 
 @lru_cache(maxsize=1)
 def derivation():
-    """The statement's maps for every valence at once (module docstring); cached per process."""
+    """The statement's maps for every valence at once (module docstring); cached per process.
+
+    Returns
+    -------
+    Derivation
+        The subdominant eigenvector, the layer-0 nets of the characteristic map in F (bmz04 section 3,
+        docs/readings.md R2-R4) and the hypotheses of docs/appendix_a.md section 0.
+
+    Examples
+    --------
+    The normalization Phi(1, 0) = (1, 0), exact in F:
+
+    >>> x, y = derivation().bezier["P1"][3][0]
+    >>> x == 1, y == 0
+    (True, True)
+    """
     vals = _eigenvector()
     eig_ok = all(e.is_zero() for e in _eigen_equations(vals))
     raw = {n: [[level1(vals, oa + i, ob + j) for j in range(4)] for i in range(4)]
@@ -238,7 +334,26 @@ def derivation():
 
 # ------------------------------------------------------------------------ one valence in arb
 def c_lam(k, prec):
-    """Balls (c, lam) holding cos(2 pi/k) and lam(k) = (5 + c + sqrt((1 + c)(9 + c)))/16."""
+    """Balls (c, lam) holding cos(2 pi/k) and lam(k) = (5 + c + sqrt((1 + c)(9 + c)))/16.
+
+    Parameters
+    ----------
+    k : int
+    prec : int
+        Bits.
+
+    Returns
+    -------
+    (arb, arb)
+        docs/readings.md R2.
+
+    Examples
+    --------
+    k = 4: the regular grid, lam = 1/2; k = 3: lam = (9 + sqrt 17)/32:
+
+    >>> c_lam(4, 53)[1], c_lam(3, 53)[1].overlaps((9 + arb(17).sqrt()) / 32)
+    (0.500000000000000, True)
+    """
     with ctx.workprec(prec):
         c = arb(fmpq(2, k)).cos_pi()
         return c, (5 + c + ((1 + c) * (9 + c)).sqrt()) / 16
@@ -246,7 +361,27 @@ def c_lam(k, prec):
 
 def nets_for_valence(k, prec, which="bezier"):
     """arb nets {piece: 4x4 of (x, y)} of valence k, evaluated from the derived exact forms; raises
-    :class:`StatementError` if a denominator may vanish at c = cos(2 pi/k)."""
+    :class:`StatementError` if a denominator may vanish at c = cos(2 pi/k).
+
+    Parameters
+    ----------
+    k : int
+    prec : int
+    which : {"bezier", "bspline"}
+
+    Returns
+    -------
+    dict[str, 4 x 4 of (arb, arb)]
+
+    Examples
+    --------
+    At k = 4 the characteristic map is the identity: piece P1 = [1/2, 1] x [0, 1/2] has the Bezier
+    points (1/2 + i/6, j/6):
+
+    >>> x, y = nets_for_valence(4, 53)["P1"][1][1]
+    >>> x.overlaps(arb(2) / 3), y.overlaps(arb(1) / 6)
+    (True, True)
+    """
     d = derivation()
     c, lam = c_lam(k, prec)
     nets = d.bezier if which == "bezier" else d.bspline
