@@ -194,3 +194,14 @@ def test_identity_nets_for_every_k_ge_40(monkeypatch):
     monkeypatch.setattr(P, "derivation", lambda: _IdentityDerivation())
     forged = P.prove_interval(40, progress=False, max_pieces=1)
     failed_with(forged, "FAIL  [piece 0] B regularity P2", "is not above the claimed bound")
+
+
+def test_boxes_for_the_mirrored_piece_or_an_old_schema_fail():
+    """Under the mirror symmetry parts B and E check P2 and P3 only: a P1 block (unchecked hints) is
+    refused, not ignored, and so is a file of the previous schema, which listed P1."""
+    c = load(5)
+    c["parts"]["corner"]["P1"] = c["parts"]["corner"]["P2"]
+    failed_with(c, "P1")
+    c = load(5)
+    c["schema"] = "ccproof.injectivity/2"
+    failed_with(c, "unknown certificate schema")

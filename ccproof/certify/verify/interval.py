@@ -57,11 +57,11 @@ def entry_model(form, L, layer, degree, prec):
     largest Bernstein coefficient of zeta^2/100 on [-1, 1], 1/100:
 
     >>> L = fmpq_poly([fmpq(1, 2), fmpq(1, 10)])
-    >>> [round(float(x), 15) for x in entry_model([[0], [1], [1]], L, 1, 2, 64)]
-    [0.25, 0.1, 0.01]
+    >>> [x.str(6, radius=False) for x in entry_model([[0], [1], [1]], L, 1, 2, 64)]
+    ['0.250000', '0.100000', '0.0100000']
     >>> m = entry_model([[0], [1], [1]], L, 1, 1, 64)
-    >>> float(m[0].mid()), 0.01 <= float(m[0].rad()) < 0.0101
-    (0.25, True)
+    >>> m[0].mid().str(6), bool(arb('0.01') <= m[0].rad() < arb('0.0101'))
+    ('0.250000', True)
     """
     cn, cd = 16 * L * L - 10 * L + 1, 2 * L
     M = max(len(f) for f in form) - 1
@@ -106,8 +106,8 @@ def parameter_nets(exact, La, Lb, layer, degree, prec):
     >>> from ccproof.rigorous import range_enclosure
     >>> exact, h = derivation().integer_forms(), fmpq(1, 2)    # the one-point interval lam = 1/2: k = 4
     >>> zn = {i: parameter_nets(exact, h, h, i, 2, 64) for i in (0, 1)}
-    >>> [float(z[0]) for z in zn[0]["P1"][1][1]]
-    [0.6666666666666666, 0.16666666666666666]
+    >>> [z[0].str(6, radius=False) for z in zn[0]["P1"][1][1]]
+    ['0.666667', '0.166667']
     """
     L = fmpq_poly([(La + Lb) / 2, (Lb - La) / 2])
     out = {}
@@ -170,8 +170,8 @@ def cell_maps_z(znets, N, l, m, D, prec):
     >>> exact, h = derivation().integer_forms(), fmpq(1, 2)    # the one-point interval lam = 1/2: k = 4
     >>> zn = {i: parameter_nets(exact, h, h, i, 2, 64) for i in (0, 1)}
     >>> X, Y = cell_maps_z(zn, 1, 1, 0, 2, 64)
-    >>> float(X(0, 1, 0).mid()), float(Y(0, 0, 1).mid())
-    (1.0, 0.5)
+    >>> X(0, 1, 0).mid().str(6), Y(0, 0, 1).mid().str(6)
+    ('1.00000', '0.500000')
     """
     i, name, box = cell_geometry(l, m, N)
     out = []
@@ -206,8 +206,8 @@ def piece_maps_z(znets, i, name, D, prec):
     >>> exact, h = derivation().integer_forms(), fmpq(1, 2)    # the one-point interval lam = 1/2: k = 4
     >>> zn = {i: parameter_nets(exact, h, h, i, 2, 64) for i in (0, 1)}
     >>> X, Y = piece_maps_z(zn, 0, "P1", 2, 64)
-    >>> X.shape, [float(c) for c in Y.coeffs[:4]]    # zeta^0 block of y: Bezier ordinates 0, 1/6, 1/3, 1/2
-    ((3, 4, 4), [0.0, 0.16666666666666666, 0.3333333333333333, 0.5])
+    >>> X.shape, [c.str(6, radius=False) for c in Y.coeffs[:4]]  # zeta^0 of y: ordinates 0, 1/6, 1/3, 1/2
+    ((3, 4, 4), ['0', '0.166667', '0.333333', '0.500000'])
     """
     net = znets[i][name]
     m = len(net[0][0][0])
@@ -249,8 +249,8 @@ def piece_det_form_z(znets, i, name, p, q, D, prec):
     >>> from ccproof.rigorous import range_enclosure
     >>> exact, h = derivation().integer_forms(), fmpq(1, 2)    # the one-point interval lam = 1/2: k = 4
     >>> zn = {i: parameter_nets(exact, h, h, i, 2, 64) for i in (0, 1)}
-    >>> [round(float(z), 12) for z in range_enclosure(piece_det_form_z(zn, 0, "P1", 2, 2, 2, 64))]
-    [0.25, 0.25]
+    >>> [z.str(6, radius=False) for z in range_enclosure(piece_det_form_z(zn, 0, "P1", 2, 2, 2, 64))]
+    ['0.250000', '0.250000']
     """
     with ctx.workprec(prec):
         X, Y = piece_maps_z(znets, i, name, D, prec)
@@ -290,8 +290,8 @@ def interval_cells(znets, N, D, prec, symmetric=False):
     >>> cells = interval_cells(zn, 1, 2, 64)
     >>> [key for key, _ in cells]
     ['0,1,0,2', '0,1,1,2', '0,1,2,2', '1,0,2,0', '1,0,2,1', '1,0,2,2', '1,1,2,2']
-    >>> [round(float(z), 12) for z in range_enclosure(cells[-1][1]())]
-    [0.25, 0.25]
+    >>> [z.str(6, radius=False) for z in range_enclosure(cells[-1][1]())]
+    ['0.250000', '0.250000']
     """
     out = []
     forms = {}

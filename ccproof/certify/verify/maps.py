@@ -83,8 +83,9 @@ def net_form(net, coord, prec, box=None):
     >>> from flint import arb
     >>> from ccproof.rigorous import range_enclosure
     >>> nets, (c, lam) = nets_for_valence(4, 64), c_lam(4, 64)   # k = 4: Phi is the identity, lam = 1/2
-    >>> [[float(z) for z in range_enclosure(net_form(nets["P1"], 1, 64, box))] for box in (None, ((0, 1), (0, "1/2")))]
-    [[0.0, 0.5], [0.0, 0.25]]
+    >>> boxes = (None, ((0, 1), (0, "1/2")))
+    >>> [[z.str(6, radius=False) for z in range_enclosure(net_form(nets["P1"], 1, 64, b))] for b in boxes]
+    [['0', '0.500000'], ['0', '0.250000']]
     """
     f = BernsteinForm((4, 4), [net[i][j][coord] for i in range(4) for j in range(4)], prec=prec)
     if box is not None:
@@ -434,8 +435,8 @@ def regularity_form(nets, name, prec):
     >>> from flint import arb
     >>> from ccproof.rigorous import range_enclosure
     >>> nets, (c, lam) = nets_for_valence(4, 64), c_lam(4, 64)   # k = 4: Phi is the identity, lam = 1/2
-    >>> [float(z) for z in range_enclosure(regularity_form(nets, "P2", 64))]
-    [0.25, 0.25]
+    >>> [z.str(6, radius=False) for z in range_enclosure(regularity_form(nets, "P2", 64))]
+    ['0.250000', '0.250000']
     """
     with ctx.workprec(prec):
         return bernstein_jacobian_determinant([net_form(nets[name], 0, prec), net_form(nets[name], 1, prec)])
@@ -546,8 +547,8 @@ def outer_curves(nets):
     >>> from flint import arb
     >>> from ccproof.rigorous import range_enclosure
     >>> nets, (c, lam) = nets_for_valence(4, 64), c_lam(4, 64)   # k = 4: Phi is the identity, lam = 1/2
-    >>> [[float(z) for z in p] for p in outer_curves(nets)[0]]   # u = 1: (1, v) for v = 0..1/2
-    [[1.0, 0.0], [1.0, 0.16666666666666666], [1.0, 0.3333333333333333], [1.0, 0.5]]
+    >>> [[z.str(6, radius=False) for z in p] for p in outer_curves(nets)[0]]   # u = 1: (1, v) for v = 0..1/2
+    [['1.00000', '0'], ['1.00000', '0.166667'], ['1.00000', '0.333333'], ['1.00000', '0.500000']]
     """
     return [[nets["P1"][3][j] for j in range(4)], [nets["P2"][3][j] for j in range(4)],
             [nets["P2"][i][3] for i in range(4)], [nets["P3"][i][3] for i in range(4)]]
