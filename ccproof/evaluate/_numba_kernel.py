@@ -35,10 +35,16 @@ def _basis(x, B, D, D2):
     D2[3] = x
 
 
-def _evaluate_points(f, u, v, d, vkind, vchild, vu0, vv0, vh, vpatch, vcold, hot_layers, vcu, vcv, vnmax,
+def _evaluate_points(f, u, v, d, refused, vkind, vchild, vu0, vv0, vh, vpatch, vcold, hot_layers, vcu, vcv, vnmax,
                      split_depth, nets, pu0, pv0, ph, P, Pu, Pv, Puu, Puv, Pvv):
-    """Fill P (n, 3) and, for d >= 1, Pu, Pv, for d >= 2, Puu, Puv, Pvv (each (n, 3))."""
+    """Fill P (n, 3) and, for d >= 1, Pu, Pv, for d >= 2, Puu, Puv, Pvv (each (n, 3)).
+
+    Returns -1, or the index of the first point whose face is out of range or ``refused`` (a hole)
+    or whose (u, v) is outside [0, 1]^2 or NaN; the caller then names it (the outputs from that
+    point on are not written).
+    """
     n = f.shape[0]
+    m = refused.shape[0]
     Bs = np.empty(4)
     Ds = np.empty(4)
     D2s = np.empty(4)
@@ -52,6 +58,8 @@ def _evaluate_points(f, u, v, d, vkind, vchild, vu0, vv0, vh, vpatch, vcold, hot
         vf = f[k]
         uu = u[k]
         ww = v[k]
+        if vf < 0 or vf >= m or not (uu >= 0.0 and uu <= 1.0 and ww >= 0.0 and ww <= 1.0) or refused[vf]:
+            return k
         kind = vkind[vf]
         for _ in range(split_depth):
             if kind != _SPLIT:
@@ -141,6 +149,7 @@ def _evaluate_points(f, u, v, d, vkind, vchild, vu0, vv0, vh, vpatch, vcold, hot
                 Puu[k, c] = a3 * g2
                 Puv[k, c] = a4 * g2
                 Pvv[k, c] = a5 * g2
+    return -1
 
 
 if numba is not None:

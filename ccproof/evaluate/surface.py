@@ -549,6 +549,16 @@ class LimitSurface:
 
     # ------------------------------------------------------------------ input checks
     def _check(self, face_ids, u, v):
+        """Face ids and (u, v) as flat int64 / float64 arrays, checked (errors name the point)."""
+        f, u, v = self._check_shapes(face_ids, u, v)
+        self._check_values(f, u, v)
+        return f, u, v
+
+    def _refused_faces(self):
+        """Per face id, whether evaluation refuses it (none here; holes in the tagged evaluator)."""
+        return np.zeros(self.n_faces, dtype=np.bool_)
+
+    def _check_shapes(self, face_ids, u, v):
         f = np.asarray(face_ids)
         u = np.asarray(u, dtype=np.float64)
         v = np.asarray(v, dtype=np.float64)
@@ -565,7 +575,9 @@ class LimitSurface:
                 bad = int(np.flatnonzero(fi != f)[0]) if fi is not None else 0
                 raise CCProofError(f"point {bad}: face id {f[bad].item()!r} is not an integer")
             f = fi
-        f = f.astype(np.int64, copy=False)
+        return f.astype(np.int64, copy=False), u, v
+
+    def _check_values(self, f, u, v):
         m = self.n_faces
         step = 1 << 18  # bounded temporaries
         for lo in range(0, f.size, step):
@@ -665,36 +677,43 @@ class LimitSurface:
         """
         if derivatives not in (0, 1, 2):
             raise CCProofError(f"derivatives must be 0, 1 or 2, got {derivatives!r}")
-        f, u, v = self._check(face_ids, u, v)
+        kernel = _numba_kernel(backend)
+        if kernel is None:
+            f, u, v = self._check(face_ids, u, v)
+        else:  # the compiled kernel checks the values itself, in the threads
+            f, u, v = self._check_shapes(face_ids, u, v)
         n = f.size
         keys = _KEYS[derivatives]
         if out is None:
             out = {k: np.empty((n, 3)) for k in keys}
-        kernel = _numba_kernel(backend)
         if kernel is not None:
             dummy = np.empty((0, 3))
             arrs = [out.get(k, dummy) for k in _KEYS[2]]
-            tables = (self._vkind, self._vchild, self._vu0, self._vv0, self._vh, self._vpatch, self._vcold,
-                      self.hot_layers, self._vcu, self._vcv, self._vnmax, self.split_depth, self._nets,
-                      self._pu0, self._pv0, self._ph)
+            tables = (self._refused_faces(), self._vkind, self._vchild, self._vu0, self._vv0, self._vh,
+                      self._vpatch, self._vcold, self.hot_layers, self._vcu, self._vcv, self._vnmax,
+                      self.split_depth, self._nets, self._pu0, self._pv0, self._ph)
             nt = _threads(threads, n)
             if nt <= 1:
-                kernel(f, u, v, derivatives, *tables, *arrs)
-                return out
-            from concurrent.futures import ThreadPoolExecutor
+                bad = [kernel(f, u, v, derivatives, *tables, *arrs)]
+            else:
+                from concurrent.futures import ThreadPoolExecutor
 
-            # many more blocks than threads, taken in turn by the threads: the cost per point varies
-            # (points near irregular vertices go down the layers), so equal halves finish unequally
-            nb = max(nt, min(16 * nt, n // 32768))
-            bounds = np.linspace(0, n, nb + 1).astype(np.int64)
+                # many more blocks than threads, taken in turn by the threads: the cost per point
+                # varies (points near irregular vertices go down the layers), so equal halves
+                # finish unequally
+                nb = max(nt, min(16 * nt, n // 32768))
+                bounds = np.linspace(0, n, nb + 1).astype(np.int64)
 
-            def block(i):
-                lo, hi = bounds[i], bounds[i + 1]
-                kernel(f[lo:hi], u[lo:hi], v[lo:hi], derivatives, *tables,
-                       *[a[lo:hi] if a.shape[0] else a for a in arrs])
+                def block(i):
+                    lo, hi = bounds[i], bounds[i + 1]
+                    return kernel(f[lo:hi], u[lo:hi], v[lo:hi], derivatives, *tables,
+                                  *[a[lo:hi] if a.shape[0] else a for a in arrs])
 
-            with ThreadPoolExecutor(nt) as ex:
-                list(ex.map(block, range(nb)))
+                with ThreadPoolExecutor(nt) as ex:
+                    bad = list(ex.map(block, range(nb)))
+            if max(bad) >= 0:
+                self._check_values(f, u, v)  # raises, naming the first bad point
+                raise CCProofError("internal error: the compiled kernel refused a point the checks accept")
             return out
         for lo in range(0, n, chunk):
             hi = min(n, lo + chunk)

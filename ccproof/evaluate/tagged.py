@@ -134,8 +134,11 @@ class TaggedLimitSurface(LimitSurface):
         """Number of ptex faces (the valid ``face`` ids)."""
         return self.mesh.n_ptex
 
-    def _check(self, face_ids, u, v):
-        f, u, v = super()._check(face_ids, u, v)
+    def _refused_faces(self):
+        return self._hole_ptex
+
+    def _check_values(self, f, u, v):
+        super()._check_values(f, u, v)
         if self._hole_ptex.any():
             bad = np.flatnonzero(self._hole_ptex[f])
             if bad.size:

@@ -35,6 +35,25 @@ def test_parameter_outside_unit_square(S):
         S.evaluate([0], [np.nan], [0.5])
 
 
+@pytest.mark.parametrize("backend, threads", [("numpy", 1), ("numba", 1), ("numba", 2)])
+def test_bad_point_far_into_a_batch_is_named_by_every_backend(S, backend, threads):
+    """The compiled kernel checks the points itself, block by block in its threads; the message is
+    the same as the numpy path's and names the first bad point of the batch."""
+    if backend == "numba":
+        pytest.importorskip("numba")
+    n = 300_000
+    rng = np.random.default_rng(5)
+    f, u, v = rng.integers(0, 6, n), rng.random(n), rng.random(n)
+    for i, field, bad, msg in [(250_001, "u", 1.5, r"point 250001: u = 1.5 is outside"),
+                               (299_999, "v", np.nan, r"point 299999: v = nan is outside"),
+                               (170_000, "f", 6, r"point 170000: face id 6 out of range \[0, 6\)")]:
+        arrays = {"f": f.copy(), "u": u.copy(), "v": v.copy()}
+        arrays[field][i::997] = bad  # later bad points too: the first one is named
+        ff, uu, vv = arrays.values()
+        with pytest.raises(CCProofError, match=msg):
+            S.evaluate(ff, uu, vv, 1, backend=backend, threads=threads)
+
+
 def test_shapes_and_derivative_order(S):
     with pytest.raises(CCProofError, match="same length"):
         S.evaluate([0, 1], [0.5, 0.5, 0.5], [0.5])
