@@ -39,7 +39,7 @@ from dataclasses import dataclass, field
 
 from ccproof.errors import CCProofError
 from ccproof.evaluate.local import canonical_ring, refine_key, ring_key
-from ccproof.mesh.rules import Complex, Options
+from ccproof.mesh.rules import Complex, Options, crease_limit_weights, smooth_limit_weights
 
 __all__ = ["CertifiedClosest", "certify_closest"]
 
@@ -174,8 +174,9 @@ def _sqrt_lo(s):
 
 
 def _corner_limits(piece, arb):
-    """Limit points (surface points, in arb) of the 4 corners of the piece's centre face: masks
-    ``(k^2 V + 4 sum e + sum d) / (k (k + 5))`` (interior) and ``(e0 + 4 V + e1) / 6`` (boundary)."""
+    """Limit points (surface points, in arb) of the 4 corners of the piece's centre face: the masks
+    of :func:`ccproof.mesh.rules.smooth_limit_weights` (interior) and
+    :func:`ccproof.mesh.rules.crease_limit_weights` (boundary), in balls."""
     faces, pts = piece.faces, piece.pts
     out = []
     for w in faces[piece.c]:
@@ -191,12 +192,13 @@ def _corner_limits(piece, arb):
         bnd = [b for b, n in cnt.items() if n == 1]
         if bnd:
             e0, e1 = pts[bnd[0]], pts[bnd[1]]
-            out.append([(e0[k] + 4 * V[k] + e1[k]) / 6 for k in range(3)])
+            cV, ce = crease_limit_weights(arb(1))
+            out.append([cV * V[k] + ce * (e0[k] + e1[k]) for k in range(3)])
         else:
-            k_ = len(cnt)
+            wV, we, wd = smooth_limit_weights(len(cnt), arb(1))
             se = [sum((pts[b][k] for b in cnt), arb(0)) for k in range(3)]
             sd = [sum((pts[b][k] for b in d), arb(0)) for k in range(3)]
-            out.append([(k_ * k_ * V[k] + 4 * se[k] + sd[k]) / (k_ * (k_ + 5)) for k in range(3)])
+            out.append([wV * V[k] + we * se[k] + wd * sd[k] for k in range(3)])
     return out
 
 

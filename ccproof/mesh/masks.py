@@ -25,7 +25,9 @@ from __future__ import annotations
 import numpy as np
 
 from ccproof.mesh.quadmesh import QuadMesh
+from ccproof.mesh.rules import crease_limit_weights, smooth_limit_weights
 from ccproof.mesh.subdivision import _boundary_neighbours
+from ccproof.valence import lam_from_c
 
 __all__ = ["limit_positions", "limit_tangents", "limit_normals"]
 
@@ -62,12 +64,13 @@ def limit_positions(mesh: QuadMesh, vertices=None):
     dsum = np.zeros((n, 3))
     np.add.at(esum, org, V[e])
     np.add.at(dsum, org, V[d])
-    k = mesh.valence.astype(np.float64)[:, None]
-    L = (k * k * V + 4 * esum + dsum) / (k * (k + 5))
+    wV, we, wd = smooth_limit_weights(mesh.valence.astype(np.float64)[:, None], 1.0)
+    L = wV * V + we * esum + wd * dsum
     bv = mesh.is_boundary_vertex
     if bv.any():
         e0, e1 = _boundary_neighbours(mesh)
-        L[bv] = (V[e0[bv]] + 4 * V[bv] + V[e1[bv]]) / 6
+        cV, ce = crease_limit_weights(1.0)
+        L[bv] = cV * V[bv] + ce * (V[e0[bv]] + V[e1[bv]])
     return L
 
 
@@ -121,8 +124,7 @@ def limit_tangents(mesh: QuadMesh, vertices=None):
     d = F[f, (i + 2) % 4]
     inner = ~mesh.is_boundary_vertex[v]
     k = mesh.valence[v].astype(np.float64)
-    c = np.cos(2 * np.pi / k)
-    A = 1 + c + np.sqrt((1 + c) * (9 + c))
+    A = 16 * lam_from_c(np.cos(2 * np.pi / k), np.sqrt) - 4  # = 1 + c + sqrt((1 + c)(9 + c))
     th = 2 * np.pi * j / k
     th1 = 2 * np.pi * (j + 1) / k
     for t, trig in ((t1, np.cos), (t2, np.sin)):

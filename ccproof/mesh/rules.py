@@ -42,7 +42,8 @@ import numpy as np
 
 __all__ = ["Options", "Complex", "refine_complex", "INFINITE", "BOUNDARY_MODES", "CREASE_METHODS",
            "TRIANGLE_RULES", "vertex_rule", "exact_one", "face_point_weight", "smooth_edge_weights",
-           "sharp_edge_weight", "smooth_vertex_weights", "crease_vertex_weights", "to_float"]
+           "sharp_edge_weight", "smooth_vertex_weights", "crease_vertex_weights", "smooth_limit_weights",
+           "crease_limit_weights", "to_float"]
 
 #: OpenSubdiv's Sdc::Crease::SHARPNESS_INFINITE: sharpness at or above it is infinite
 INFINITE = 10.0
@@ -229,6 +230,60 @@ def crease_vertex_weights(one):
     ((3/4, 1/8), (0.75, 0.125))
     """
     return one * 3 / 4, one / 8
+
+
+# ------------------------------------------------------------------------------ the limit masks
+# The left eigenvectors of eigenvalue 1 of the rules above: where a vertex goes in the limit.
+def smooth_limit_weights(k, one):
+    """Limit position of a smooth interior vertex of valence ``k`` (quads around it).
+
+    ``(k^2 V + 4 sum e_j + sum d_j) / (k (k + 5))`` on the vertex, its edge neighbours e_j and its
+    diagonal neighbours d_j (Halstead, Kass, DeRose 1993; Stam 1998).
+
+    Parameters
+    ----------
+    k : int or ndarray of int
+        Valence(s).
+    one : number
+        :func:`exact_one` (exact), 1.0 (float) or ``flint.arb(1)`` (balls).
+
+    Returns
+    -------
+    tuple of 3 numbers
+        (weight of V, of each e_j, of each d_j).
+
+    Examples
+    --------
+    For k = 4 the bicubic B-spline's ``(16 V + 4 sum e + sum d) / 36``; the weights sum to 1:
+
+    >>> wV, we, wd = smooth_limit_weights(4, exact_one())
+    >>> (wV, we, wd), wV + 4 * we + 4 * wd
+    ((4/9, 1/9, 1/36), 1)
+    """
+    den = one * k * (k + 5)
+    return one * k * k / den, 4 * one / den, one / den
+
+
+def crease_limit_weights(one):
+    """Limit position of a crease (or boundary) vertex: ``(e0 + 4 V + e1) / 6``, the cubic B-spline
+    curve's, on the two neighbours along the crease.
+
+    Parameters
+    ----------
+    one : number
+        :func:`exact_one` (exact), 1.0 (float) or ``flint.arb(1)`` (balls).
+
+    Returns
+    -------
+    tuple of 2 numbers
+        (weight of V, of each of e0, e1).
+
+    Examples
+    --------
+    >>> crease_limit_weights(exact_one()), crease_limit_weights(1.0)[1] == 1 / 6
+    ((2/3, 1/6), True)
+    """
+    return one * 4 / 6, one / 6
 
 
 class Options:

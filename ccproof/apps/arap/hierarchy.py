@@ -47,6 +47,7 @@ from scipy.sparse.csgraph import connected_components
 
 from ccproof.errors import CCProofError, MeshError
 from ccproof.mesh import QuadMesh, child_faces, subdivision_matrix
+from ccproof.mesh.rules import crease_vertex_weights, sharp_edge_weight
 
 __all__ = ["ChartHierarchy", "Level", "HierarchyError", "split_nonmanifold", "RULES"]
 
@@ -327,16 +328,21 @@ class ChartHierarchy:
         v = rows[r_v]
         cor = L.corner[v]
         nb = L.chart_boundary_nbrs[v]
+        # the chart boundary is a crease curve: corners stay, boundary vertices and edges take the
+        # crease rules (one rule set: ccproof.mesh.rules)
+        w_vertex, w_neighbour = crease_vertex_weights(1.0)
+        w_edge = sharp_edge_weight(1.0)
         rr, cc, ww = [r_v[cor]], [v[cor]], [np.ones(int(cor.sum()))]
         cr = ~cor
+        m = int(cr.sum())
         rr += [r_v[cr]] * 3
         cc += [v[cr], nb[cr, 0], nb[cr, 1]]
-        ww += [np.full(int(cr.sum()), 0.75), np.full(int(cr.sum()), 0.125), np.full(int(cr.sum()), 0.125)]
+        ww += [np.full(m, w_vertex), np.full(m, w_neighbour), np.full(m, w_neighbour)]
         r_e = np.flatnonzero(repl_e)
         ed = E.edges[rows[r_e] - n]
         rr += [r_e, r_e]
         cc += [ed[:, 0], ed[:, 1]]
-        ww += [np.full(r_e.size, 0.5)] * 2
+        ww += [np.full(r_e.size, w_edge)] * 2
         extra = sp.coo_matrix(
             (np.concatenate(ww), (np.concatenate(rr), np.concatenate(cc))), shape=SE.shape
         )

@@ -43,6 +43,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ccproof.apps.arap.hierarchy import Level, _rules
+from ccproof.mesh.rules import crease_limit_weights, smooth_limit_weights
 
 __all__ = [
     "mask_weights",
@@ -197,16 +198,11 @@ def limit_operator(level: Level, rules):
     kv = np.flatnonzero(corner)
     rows = np.concatenate([v, v, iv, cv, cv, cv, kv])
     cols = np.concatenate([e, d, iv, cv, nbrs[cv, 0], nbrs[cv, 1], kv])
+    _, we, wd = smooth_limit_weights(k, 1.0)
+    wV = smooth_limit_weights(ki, 1.0)[0]
+    cV, ce = crease_limit_weights(1.0)
     vals = np.concatenate(
-        [
-            4.0 / (k * (k + 5)),
-            1.0 / (k * (k + 5)),
-            ki / (ki + 5),
-            np.full(cv.size, 4.0 / 6),
-            np.full(cv.size, 1.0 / 6),
-            np.full(cv.size, 1.0 / 6),
-            np.ones(kv.size),
-        ]
+        [we, wd, wV, np.full(cv.size, cV), np.full(cv.size, ce), np.full(cv.size, ce), np.ones(kv.size)]
     )
     return sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
 
