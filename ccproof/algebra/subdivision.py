@@ -9,7 +9,9 @@ and the point (a, -b) of sector j is (b, a) of sector j-1 (:func:`canonical`).
 After one subdivision step the level-1 vertex at position (A, B) of a sector sits at the level-0
 parameter (A/2, B/2); its parity tells the rule (R1): both even -> vertex point, one odd -> edge
 point, both odd -> face point. Away from the centre every vertex has valence 4 and the rules are the
-regular tensor-product stencils; the centre rule is V' = (F + 2R + (k-3)V)/k.
+regular tensor-product stencils; the centre rule is V' = (F + 2R + (k-3)V)/k. Every weight is read
+from the one rule implementation, :mod:`ccproof.rule_weights`, in exact ``Fraction`` arithmetic
+(the face points expanded into the vertices of the ring).
 
 The (6k+1) x (6k+1) matrix of Definition 2 acts on the two-ring ``{CENTER} + {(j, a, b): 1 <= a <= 2,
 0 <= b <= 2}``; the (2k+8)-vertex ring of Stam 1998 (one face and its one-ring) is offered as well.
@@ -20,6 +22,9 @@ from __future__ import annotations
 from fractions import Fraction
 
 from ccproof.errors import check_valence
+from ccproof.rule_weights import face_point_weight, smooth_edge_weights, smooth_vertex_weights
+
+_ONE = Fraction(1)
 
 CENTER = "center"
 
@@ -76,27 +81,46 @@ def _regular_stencil(A, B):
     """
     if A == 0 and B == 0:
         raise ValueError("the centre has its own rule (centre_stencil)")
-    F = Fraction
     if A % 2 == 0 and B % 2 == 0:  # vertex point of a valence-4 vertex: 9/16, 3/32, 1/64
         a, b = A // 2, B // 2
         if a == 0 and b == 0:
             raise ValueError("centre")
-        st = [(F(9, 16), (a, b))]
-        st += [(F(3, 32), (a + da, b + db)) for da, db in ((1, 0), (-1, 0), (0, 1), (0, -1))]
-        st += [(F(1, 64), (a + da, b + db)) for da, db in ((1, 1), (-1, 1), (1, -1), (-1, -1))]
+        al, be, ga = _quad_vertex_weights(4)
+        st = [(al, (a, b))]
+        st += [(be, (a + da, b + db)) for da, db in ((1, 0), (-1, 0), (0, 1), (0, -1))]
+        st += [(ga, (a + da, b + db)) for da, db in ((1, 1), (-1, 1), (1, -1), (-1, -1))]
         return st
     if A % 2 == 1 and B % 2 == 1:  # face point: mean of the 4 corners
         a, b = (A - 1) // 2, (B - 1) // 2
-        return [(F(1, 4), (a + da, b + db)) for da in (0, 1) for db in (0, 1)]
+        wf = face_point_weight(4, _ONE)
+        return [(wf, (a + da, b + db)) for da in (0, 1) for db in (0, 1)]
+    end, wing = _quad_edge_weights()
     if A % 2 == 1:  # edge point of the edge (a, b)-(a+1, b): 3/8 ends, 1/16 wings
         a, b = (A - 1) // 2, B // 2
-        st = [(F(3, 8), (a, b)), (F(3, 8), (a + 1, b))]
-        st += [(F(1, 16), (a + da, b + db)) for da in (0, 1) for db in (1, -1)]
+        st = [(end, (a, b)), (end, (a + 1, b))]
+        st += [(wing, (a + da, b + db)) for da in (0, 1) for db in (1, -1)]
         return st
     a, b = A // 2, (B - 1) // 2  # edge point of the edge (a, b)-(a, b+1)
-    st = [(F(3, 8), (a, b)), (F(3, 8), (a, b + 1))]
-    st += [(F(1, 16), (a + da, b + db)) for db in (0, 1) for da in (1, -1)]
+    st = [(end, (a, b)), (end, (a, b + 1))]
+    st += [(wing, (a + da, b + db)) for db in (0, 1) for da in (1, -1)]
     return st
+
+
+def _quad_vertex_weights(k):
+    """The smooth vertex rule of :func:`ccproof.rule_weights.smooth_vertex_weights` at valence ``k``
+    with its quad face points expanded (each is 1/4 of V, e_j, d_j, e_(j+1)): the weights on V, on
+    each edge neighbour and on each diagonal neighbour."""
+    wv, we, wf = smooth_vertex_weights(k, _ONE)
+    q = face_point_weight(4, _ONE)
+    return wv + k * wf * q, we + 2 * wf * q, wf * q
+
+
+def _quad_edge_weights():
+    """The smooth edge rule of :func:`ccproof.rule_weights.smooth_edge_weights` with its two quad face
+    points expanded: the weight of each end and of each of the four wing vertices."""
+    w_end, w_face = smooth_edge_weights(_ONE)
+    q = face_point_weight(4, _ONE)
+    return w_end + 2 * w_face * q, w_face * q
 
 
 def centre_stencil(k):
@@ -124,7 +148,7 @@ def centre_stencil(k):
     Fraction(1, 1)
     """
     k = check_valence(k)
-    return (1 - Fraction(7, 4 * k), Fraction(3, 2 * k * k), Fraction(1, 4 * k * k))
+    return _quad_vertex_weights(k)
 
 
 def level1_stencil(k, vertex):

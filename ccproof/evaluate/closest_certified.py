@@ -39,7 +39,8 @@ from dataclasses import dataclass, field
 
 from ccproof.errors import CCProofError
 from ccproof.evaluate.local import canonical_ring, refine_key, ring_key
-from ccproof.mesh.rules import Complex, Options, crease_limit_weights, smooth_limit_weights
+from ccproof.mesh.rules import Complex, Options
+from ccproof.rule_weights import crease_limit_weights, smooth_limit_weights
 
 __all__ = ["CertifiedClosest", "certify_closest"]
 
@@ -175,8 +176,8 @@ def _sqrt_lo(s):
 
 def _corner_limits(piece, arb):
     """Limit points (surface points, in arb) of the 4 corners of the piece's centre face: the masks
-    of :func:`ccproof.mesh.rules.smooth_limit_weights` (interior) and
-    :func:`ccproof.mesh.rules.crease_limit_weights` (boundary), in balls."""
+    of :func:`ccproof.rule_weights.smooth_limit_weights` (interior) and
+    :func:`ccproof.rule_weights.crease_limit_weights` (boundary), in balls."""
     faces, pts = piece.faces, piece.pts
     out = []
     for w in faces[piece.c]:

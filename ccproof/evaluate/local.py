@@ -683,7 +683,7 @@ def power_layers(M, A, l_row):
     raise MeshError(f"corner configuration of {N} vertices does not converge to its limit point")
 
 
-_SOURCES = ("evaluate/local.py", "mesh/rules.py")  # the code that computes the cached data
+_SOURCES = ("evaluate/local.py", "mesh/rules.py", "rule_weights.py")  # the code that computes the cached data
 
 
 @functools.lru_cache(maxsize=1)

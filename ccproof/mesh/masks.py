@@ -22,11 +22,14 @@ Boundary vertex (the boundary is the cubic B-spline through the boundary vertice
 
 from __future__ import annotations
 
+import math
+from fractions import Fraction
+
 import numpy as np
 
 from ccproof.mesh.quadmesh import QuadMesh
-from ccproof.mesh.rules import crease_limit_weights, smooth_limit_weights
 from ccproof.mesh.subdivision import _boundary_neighbours
+from ccproof.rule_weights import crease_limit_weights, smooth_limit_weights
 from ccproof.valence import lam_from_c
 
 __all__ = ["limit_positions", "limit_tangents", "limit_normals"]
@@ -64,14 +67,23 @@ def limit_positions(mesh: QuadMesh, vertices=None):
     dsum = np.zeros((n, 3))
     np.add.at(esum, org, V[e])
     np.add.at(dsum, org, V[d])
-    wV, we, wd = smooth_limit_weights(mesh.valence.astype(np.float64)[:, None], 1.0)
-    L = wV * V + we * esum + wd * dsum
+    # integer numerators over a common denominator: one rounding, at the division
+    ks = np.unique(mesh.valence)
+    table = np.array([_integer_weights(smooth_limit_weights(int(k), Fraction(1))) for k in ks], dtype=np.float64)
+    nV, ne, nd, den = table[np.searchsorted(ks, mesh.valence)].T[:, :, None]
+    L = (nV * V + ne * esum + nd * dsum) / den
     bv = mesh.is_boundary_vertex
     if bv.any():
         e0, e1 = _boundary_neighbours(mesh)
-        cV, ce = crease_limit_weights(1.0)
-        L[bv] = cV * V[bv] + ce * (V[e0[bv]] + V[e1[bv]])
+        cV, ce, cden = _integer_weights(crease_limit_weights(Fraction(1)))
+        L[bv] = (cV * V[bv] + ce * (V[e0[bv]] + V[e1[bv]])) / cden
     return L
+
+
+def _integer_weights(ws):
+    """Exact weights as integer numerators and their common denominator (last)."""
+    den = math.lcm(*(w.denominator for w in ws))
+    return [int(w * den) for w in ws] + [den]
 
 
 def limit_tangents(mesh: QuadMesh, vertices=None):

@@ -6,9 +6,10 @@ weights, ``flint.fmpq``) plus the child faces and their sharpness. The float ope
 (``V1 == S @ V0``) of :func:`ccproof.mesh.polymesh.PolyMesh.subdivision_operator` and the exact
 local matrices of :mod:`ccproof.evaluate` are both read from these stencils, and the vectorized
 reference step of :mod:`ccproof.mesh.subdivision` takes its weights from the same rule functions
-(:func:`face_point_weight`, :func:`smooth_edge_weights`, :func:`sharp_edge_weight`,
-:func:`smooth_vertex_weights`, :func:`crease_vertex_weights`), evaluated in floats: one rule
-implementation, exact or float by the number ``one`` it is given.
+of :mod:`ccproof.rule_weights` (:func:`face_point_weight`, :func:`smooth_edge_weights`,
+:func:`sharp_edge_weight`, :func:`smooth_vertex_weights`, :func:`crease_vertex_weights`, re-exported
+here), evaluated in floats: one rule implementation, exact or float by the number ``one`` it is
+given. The proof branch's ring matrices (:mod:`ccproof.algebra.subdivision`) read them too.
 
 Rules (Sdc ``SCHEME_CATMARK``, OpenSubdiv 3.6 ``sdc/scheme.h``, ``sdc/catmarkScheme.h``,
 ``sdc/crease.cpp``; sharpness ``s`` is IEEE float32 as in OpenSubdiv, ``s >= 10`` is infinite,
@@ -39,6 +40,16 @@ import functools
 import math
 
 import numpy as np
+
+from ccproof.rule_weights import (
+    crease_limit_weights,
+    crease_vertex_weights,
+    face_point_weight,
+    sharp_edge_weight,
+    smooth_edge_weights,
+    smooth_limit_weights,
+    smooth_vertex_weights,
+)
 
 __all__ = ["Options", "Complex", "refine_complex", "INFINITE", "BOUNDARY_MODES", "CREASE_METHODS",
            "TRIANGLE_RULES", "vertex_rule", "exact_one", "face_point_weight", "smooth_edge_weights",
@@ -111,179 +122,6 @@ def to_float(w):
     if isinstance(w, (int, float)):
         return float(w)
     return w.numerator / w.denominator
-
-
-# ------------------------------------------------------------------------------ the rules
-# Each rule's weights, once, for any number type: ``one`` is exact_one() (exact stencils) or 1.0
-# (floats, also with integer numpy arrays for the sizes and valences: the vectorized step).
-def face_point_weight(n, one):
-    """Face point: the centroid; the weight of each of the ``n`` vertices of the face.
-
-    Parameters
-    ----------
-    n : int or ndarray of int
-        Face size(s).
-    one : number
-        :func:`exact_one` (exact) or 1.0 (float).
-
-    Returns
-    -------
-    number or ndarray
-        ``one / n`` (bmz04 Fig. 1, docs/readings.md R1).
-
-    Examples
-    --------
-    >>> face_point_weight(4, exact_one()), face_point_weight(3, 1.0) * 3
-    (1/4, 1.0)
-    """
-    return one / n
-
-
-def smooth_edge_weights(one):
-    """Smooth edge point ``(a + b + f0 + f1) / 4``: (weight of each end, of each adjacent face point).
-
-    Parameters
-    ----------
-    one : number
-        :func:`exact_one` (exact) or 1.0 (float).
-
-    Returns
-    -------
-    tuple of 2 numbers
-        bmz04 Fig. 1 (docs/readings.md R1).
-
-    Examples
-    --------
-    >>> smooth_edge_weights(exact_one())
-    (1/4, 1/4)
-    """
-    return one / 4, one / 4
-
-
-def sharp_edge_weight(one):
-    """Sharp (crease or boundary) edge point: the midpoint; the weight of each end.
-
-    Parameters
-    ----------
-    one : number
-        :func:`exact_one` (exact) or 1.0 (float).
-
-    Returns
-    -------
-    number
-        OpenSubdiv's Sdc crease rule (docs/evaluate.md "Tagged polygon meshes").
-
-    Examples
-    --------
-    >>> sharp_edge_weight(exact_one()), sharp_edge_weight(1.0)
-    (1/2, 0.5)
-    """
-    return one / 2
-
-
-def smooth_vertex_weights(k, one):
-    """Smooth (and dart) vertex point ``((k - 2) V + sum e_j / k + sum f_j / k) / k`` at valence ``k``.
-
-    Parameters
-    ----------
-    k : int or ndarray of int
-        Valence(s).
-    one : number
-        :func:`exact_one` (exact) or 1.0 (float).
-
-    Returns
-    -------
-    tuple of 3 numbers
-        (weight of V, of each edge neighbour e_j, of each adjacent face point f_j); for quads
-        bmz04 Fig. 1 (docs/readings.md R1): ``1 - 7/(4k)`` on V, ``3/(2k^2)`` and ``1/(4k^2)`` on the
-        edge and diagonal neighbours.
-
-    Examples
-    --------
-    With the face points of quads expanded (each carries 1/4 of its vertices), k = 5 gives
-    ``1 - 7/20``, ``3/50`` and ``1/100``:
-
-    >>> wV, we, wf = smooth_vertex_weights(5, exact_one())
-    >>> wV + 5 * wf / 4, we + 2 * wf / 4, wf / 4
-    (13/20, 3/50, 1/100)
-    """
-    return one * (k - 2) / k, one / (k * k), one / (k * k)
-
-
-def crease_vertex_weights(one):
-    """Crease (and boundary) vertex point ``(3/4) V + (1/8)(e0 + e1)``.
-
-    Parameters
-    ----------
-    one : number
-        :func:`exact_one` (exact) or 1.0 (float).
-
-    Returns
-    -------
-    tuple of 2 numbers
-        (weight of V, of each of the two neighbours along the crease): the cubic B-spline curve
-        rule, OpenSubdiv's Sdc crease rule (docs/evaluate.md "Conventions").
-
-    Examples
-    --------
-    >>> crease_vertex_weights(exact_one()), crease_vertex_weights(1.0)
-    ((3/4, 1/8), (0.75, 0.125))
-    """
-    return one * 3 / 4, one / 8
-
-
-# ------------------------------------------------------------------------------ the limit masks
-# The left eigenvectors of eigenvalue 1 of the rules above: where a vertex goes in the limit.
-def smooth_limit_weights(k, one):
-    """Limit position of a smooth interior vertex of valence ``k`` (quads around it).
-
-    ``(k^2 V + 4 sum e_j + sum d_j) / (k (k + 5))`` on the vertex, its edge neighbours e_j and its
-    diagonal neighbours d_j (Halstead, Kass, DeRose 1993; Stam 1998).
-
-    Parameters
-    ----------
-    k : int or ndarray of int
-        Valence(s).
-    one : number
-        :func:`exact_one` (exact), 1.0 (float) or ``flint.arb(1)`` (balls).
-
-    Returns
-    -------
-    tuple of 3 numbers
-        (weight of V, of each e_j, of each d_j).
-
-    Examples
-    --------
-    For k = 4 the bicubic B-spline's ``(16 V + 4 sum e + sum d) / 36``; the weights sum to 1:
-
-    >>> wV, we, wd = smooth_limit_weights(4, exact_one())
-    >>> (wV, we, wd), wV + 4 * we + 4 * wd
-    ((4/9, 1/9, 1/36), 1)
-    """
-    den = one * k * (k + 5)
-    return one * k * k / den, 4 * one / den, one / den
-
-
-def crease_limit_weights(one):
-    """Limit position of a crease (or boundary) vertex: ``(e0 + 4 V + e1) / 6``, the cubic B-spline
-    curve's, on the two neighbours along the crease.
-
-    Parameters
-    ----------
-    one : number
-        :func:`exact_one` (exact), 1.0 (float) or ``flint.arb(1)`` (balls).
-
-    Returns
-    -------
-    tuple of 2 numbers
-        (weight of V, of each of e0, e1).
-
-    Examples
-    --------
-    >>> crease_limit_weights(exact_one()), crease_limit_weights(1.0)[1] == 1 / 6
-    ((2/3, 1/6), True)
-    """
-    return one * 4 / 6, one / 6
 
 
 class Options:

@@ -1,10 +1,11 @@
 """One reference Catmull-Clark step of a quad mesh (bmz04 Fig. 1, docs/readings.md R1), vectorized.
 
 The rules are those of :mod:`ccproof.mesh.rules` (the one rule implementation): this module only
-assembles them over the whole mesh with numpy, taking every weight from the rule functions
-:func:`~ccproof.mesh.rules.face_point_weight`, :func:`~ccproof.mesh.rules.smooth_edge_weights`,
-:func:`~ccproof.mesh.rules.sharp_edge_weight`, :func:`~ccproof.mesh.rules.smooth_vertex_weights` and
-:func:`~ccproof.mesh.rules.crease_vertex_weights` evaluated in floats (the exact stencils of
+assembles them over the whole mesh with numpy, taking every weight from the rule functions of
+:mod:`ccproof.rule_weights` (:func:`~ccproof.rule_weights.face_point_weight`,
+:func:`~ccproof.rule_weights.smooth_edge_weights`, :func:`~ccproof.rule_weights.sharp_edge_weight`,
+:func:`~ccproof.rule_weights.smooth_vertex_weights` and :func:`~ccproof.rule_weights.crease_vertex_weights`)
+evaluated in floats (the exact stencils of
 :func:`~ccproof.mesh.rules.refine_complex` evaluate the same functions exactly;
 tests/mesh/test_subdivision.py checks that the two operators agree). No creases; boundary as
 OpenSubdiv ``VTX_BOUNDARY_EDGE_ONLY`` (every boundary edge is an infinitely sharp crease, no vertex
@@ -34,7 +35,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ccproof.mesh.quadmesh import QuadMesh
-from ccproof.mesh.rules import (
+from ccproof.rule_weights import (
     crease_vertex_weights,
     face_point_weight,
     sharp_edge_weight,

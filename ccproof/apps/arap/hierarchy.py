@@ -47,7 +47,7 @@ from scipy.sparse.csgraph import connected_components
 
 from ccproof.errors import CCProofError, MeshError
 from ccproof.mesh import QuadMesh, child_faces, subdivision_matrix
-from ccproof.mesh.rules import crease_vertex_weights, sharp_edge_weight
+from ccproof.rule_weights import crease_vertex_weights, sharp_edge_weight
 
 __all__ = ["ChartHierarchy", "Level", "HierarchyError", "split_nonmanifold", "RULES"]
 

@@ -43,7 +43,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ccproof.apps.arap.hierarchy import Level, _rules
-from ccproof.mesh.rules import crease_limit_weights, smooth_limit_weights
+from ccproof.rule_weights import crease_limit_weights, smooth_limit_weights
 
 __all__ = [
     "mask_weights",
