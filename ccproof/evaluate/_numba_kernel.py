@@ -1,4 +1,5 @@
-"""Optional compiled evaluation kernel (numba), the same arithmetic as the numpy path point by point.
+"""Compiled evaluation kernel (numba), the same arithmetic as the numpy path point by point, and the
+compiled Newton descent of the closest points (:func:`ccproof.evaluate.closest.newton`, point by point).
 
 Imported only when numba is installed; :mod:`ccproof.evaluate.surface` falls back to numpy otherwise.
 """
@@ -17,22 +18,23 @@ except ImportError:  # pragma: no cover - optional dependency
 _REGULAR, _CORNER, _SPLIT = 0, 1, 2
 
 
-def _basis(x, B, D, D2):
+def _basis(x, B, r):
+    """Cubic B-spline basis at x and its first two derivatives, into rows r, r + 1, r + 2 of B."""
     t = 1.0 - x
     x2 = x * x
     x3 = x2 * x
-    B[0] = t * t * t / 6
-    B[1] = (3 * x3 - 6 * x2 + 4) / 6
-    B[2] = (-3 * x3 + 3 * x2 + 3 * x + 1) / 6
-    B[3] = x3 / 6
-    D[0] = -0.5 * t * t
-    D[1] = 1.5 * x2 - 2 * x
-    D[2] = -1.5 * x2 + x + 0.5
-    D[3] = 0.5 * x2
-    D2[0] = t
-    D2[1] = 3 * x - 2
-    D2[2] = -3 * x + 1
-    D2[3] = x
+    B[r, 0] = t * t * t / 6
+    B[r, 1] = (3 * x3 - 6 * x2 + 4) / 6
+    B[r, 2] = (-3 * x3 + 3 * x2 + 3 * x + 1) / 6
+    B[r, 3] = x3 / 6
+    B[r + 1, 0] = -0.5 * t * t
+    B[r + 1, 1] = 1.5 * x2 - 2 * x
+    B[r + 1, 2] = -1.5 * x2 + x + 0.5
+    B[r + 1, 3] = 0.5 * x2
+    B[r + 2, 0] = t
+    B[r + 2, 1] = 3 * x - 2
+    B[r + 2, 2] = -3 * x + 1
+    B[r + 2, 3] = x
 
 
 def _evaluate_points(f, u, v, d, refused, vkind, vchild, vu0, vv0, vh, vpatch, vcold, hot_layers, vcu, vcv, vnmax,
@@ -45,15 +47,8 @@ def _evaluate_points(f, u, v, d, refused, vkind, vchild, vu0, vv0, vh, vpatch, v
     """
     n = f.shape[0]
     m = refused.shape[0]
-    Bs = np.empty(4)
-    Ds = np.empty(4)
-    D2s = np.empty(4)
-    Bt = np.empty(4)
-    Dt = np.empty(4)
-    D2t = np.empty(4)
-    T0 = np.empty((4, 3))
-    T1 = np.empty((4, 3))
-    T2 = np.empty((4, 3))
+    B = np.empty((6, 4))  # basis in s (rows 0-2: value, first, second derivative), in t (rows 3-5)
+    T = np.empty((3, 4, 3))
     for k in range(n):
         vf = f[k]
         uu = u[k]
@@ -105,8 +100,8 @@ def _evaluate_points(f, u, v, d, refused, vkind, vchild, vu0, vv0, vh, vpatch, v
         s = min(max((uu - pu0[p]) / h, 0.0), 1.0)
         t = min(max((ww - pv0[p]) / h, 0.0), 1.0)
         g = 1.0 / h
-        _basis(s, Bs, Ds, D2s)
-        _basis(t, Bt, Dt, D2t)
+        _basis(s, B, 0)
+        _basis(t, B, 3)
         for i in range(4):
             for c in range(3):
                 x0 = 0.0
@@ -114,26 +109,26 @@ def _evaluate_points(f, u, v, d, refused, vkind, vchild, vu0, vv0, vh, vpatch, v
                 x2 = 0.0
                 for j in range(4):
                     w = nets[p, i + 4 * j, c]
-                    x0 += Bt[j] * w
+                    x0 += B[3, j] * w
                     if d >= 1:
-                        x1 += Dt[j] * w
+                        x1 += B[4, j] * w
                     if d >= 2:
-                        x2 += D2t[j] * w
-                T0[i, c] = x0
-                T1[i, c] = x1
-                T2[i, c] = x2
+                        x2 += B[5, j] * w
+                T[0, i, c] = x0
+                T[1, i, c] = x1
+                T[2, i, c] = x2
         for c in range(3):
             a0 = 0.0
             for i in range(4):
-                a0 += Bs[i] * T0[i, c]
+                a0 += B[0, i] * T[0, i, c]
             P[k, c] = nets[p, 16, c] + a0
         if d >= 1:
             for c in range(3):
                 a1 = 0.0
                 a2 = 0.0
                 for i in range(4):
-                    a1 += Ds[i] * T0[i, c]
-                    a2 += Bs[i] * T1[i, c]
+                    a1 += B[1, i] * T[0, i, c]
+                    a2 += B[0, i] * T[1, i, c]
                 Pu[k, c] = a1 * g
                 Pv[k, c] = a2 * g
         if d >= 2:
@@ -143,17 +138,126 @@ def _evaluate_points(f, u, v, d, refused, vkind, vchild, vu0, vv0, vh, vpatch, v
                 a4 = 0.0
                 a5 = 0.0
                 for i in range(4):
-                    a3 += D2s[i] * T0[i, c]
-                    a4 += Ds[i] * T1[i, c]
-                    a5 += Bs[i] * T2[i, c]
+                    a3 += B[2, i] * T[0, i, c]
+                    a4 += B[1, i] * T[1, i, c]
+                    a5 += B[0, i] * T[2, i, c]
                 Puu[k, c] = a3 * g2
                 Puv[k, c] = a4 * g2
                 Pvv[k, c] = a5 * g2
     return -1
 
 
+def _dot3(a, i, b, j):
+    """Row i of a (., 3) dot row j of b, summed left to right."""
+    return a[i, 0] * b[j, 0] + a[i, 1] * b[j, 1] + a[i, 2] * b[j, 2]
+
+
+def _free(w, g):
+    """Whether parameter value w in [0, 1] may move with gradient g (not pushed out of the square)."""
+    return not ((w <= 0.0 and g > 0) or (w >= 1.0 and g < 0))
+
+
+def _newton_points(X, face, u, v, max_iter, max_halvings, refused, vkind, vchild, vu0, vv0, vh, vpatch, vcold,
+                   hot_layers, vcu, vcv, vnmax, split_depth, nets, pu0, pv0, ph, E):
+    """The descent of :func:`ccproof.evaluate.closest.newton`, point by point: the same formulas in
+    the same order (u, v updated in place, E filled). The points must be valid (checked by the
+    caller); each evaluation is the batch kernel's on one point."""
+    n = X.shape[0]
+    fk = np.empty(1, dtype=np.int64)  # the one point the kernel evaluates per call
+    uw = np.empty(1)
+    vw = np.empty(1)
+    cur = np.empty((6, 1, 3))  # P, Pu, Pv, Puu, Puv, Pvv at the current (u, v)
+    new = np.empty((6, 1, 3))
+    c0, c1, c2, c3, c4, c5 = cur[0], cur[1], cur[2], cur[3], cur[4], cur[5]
+    n0, n1, n2, n3, n4, n5 = new[0], new[1], new[2], new[3], new[4], new[5]
+    C = cur.reshape(6, 3)  # views: row r of cur_out / new_out
+    Cn = new.reshape(6, 3)
+    R = np.empty((1, 3))
+    Rt = np.empty((1, 3))
+    tiny = 2.0 ** -max_halvings
+    for k in range(n):
+        f = face[k]
+        uk = min(max(u[k], 0.0), 1.0)
+        vk = min(max(v[k], 0.0), 1.0)
+        fk[0], uw[0], vw[0] = f, uk, vk
+        evaluate_points(fk, uw, vw, 2, refused, vkind, vchild, vu0, vv0, vh, vpatch, vcold, hot_layers, vcu, vcv,
+                        vnmax, split_depth, nets, pu0, pv0, ph, c0, c1, c2, c3, c4, c5)
+        for c in range(3):
+            R[0, c] = C[0, c] - X[k, c]
+        Ek = 0.5 * _dot3(R, 0, R, 0)
+        xs = max(abs(X[k, 0]), max(abs(X[k, 1]), abs(X[k, 2])))
+        slack = 1e-13 * Ek + 4e-16 * math.sqrt(2.0 * Ek) * (xs + math.sqrt(2.0 * Ek))
+        alpha = 1.0
+        for _ in range(max_iter):
+            gu, gv = _dot3(C, 1, R, 0), _dot3(C, 2, R, 0)
+            guu, guv, gvv = _dot3(C, 1, C, 1), _dot3(C, 1, C, 2), _dot3(C, 2, C, 2)
+            huu = guu + _dot3(C, 3, R, 0)
+            huv = guv + _dot3(C, 4, R, 0)
+            hvv = gvv + _dot3(C, 5, R, 0)
+            fu = _free(uk, gu)
+            fv = _free(vk, gv)
+            tr = abs(guu) + abs(gvv) + 1e-300
+            pd = (huu > 0) and (hvv > 0) and (huu * hvv - huv * huv > 1e-14 * tr * tr)
+            pd1u = huu > 1e-14 * tr
+            pd1v = hvv > 1e-14 * tr
+            lm = 1e-6 * tr
+            Auu = huu if (pd or (fu and not fv and pd1u)) else guu + lm
+            Avv = hvv if (pd or (fv and not fu and pd1v)) else gvv + lm
+            Auv = huv if pd else guv
+            if fu and fv:
+                det = Auu * Avv - Auv * Auv
+                du = -(Avv * gu - Auv * gv) / det if det != 0.0 else math.nan
+                dv = -(Auu * gv - Auv * gu) / det if det != 0.0 else math.nan
+            else:
+                du = (-gu / Auu if Auu != 0.0 else math.nan) if fu else 0.0
+                dv = (-gv / Avv if Avv != 0.0 else math.nan) if fv else 0.0
+            if not (math.isfinite(du) and math.isfinite(dv)):
+                du, dv = -gu / tr, -gv / tr
+            pg = math.hypot(gu if fu else 0.0, gv if fv else 0.0)
+            al = alpha
+            u0, v0 = uk, vk
+            for _ls in range(max_halvings + 1):
+                nu = min(max(u0 + al * du, 0.0), 1.0)
+                nv = min(max(v0 + al * dv, 0.0), 1.0)
+                moved = (nu != u0) or (nv != v0)
+                uw[0], vw[0] = nu, nv
+                evaluate_points(fk, uw, vw, 2, refused, vkind, vchild, vu0, vv0, vh, vpatch, vcold, hot_layers, vcu,
+                                vcv, vnmax, split_depth, nets, pu0, pv0, ph, n0, n1, n2, n3, n4, n5)
+                for c in range(3):
+                    Rt[0, c] = Cn[0, c] - X[k, c]
+                Et = 0.5 * _dot3(Rt, 0, Rt, 0)
+                pred = gu * (nu - u0) + gv * (nv - v0)
+                gtu, gtv = _dot3(Cn, 1, Rt, 0), _dot3(Cn, 2, Rt, 0)
+                pg_t = math.hypot(gtu if _free(nu, gtu) else 0.0, gtv if _free(nv, gtv) else 0.0)
+                if moved and ((Et <= Ek + 1e-4 * min(pred, 0.0)) or ((Et <= Ek + slack) and (pg_t < 0.5 * pg))):
+                    uk, vk, Ek = nu, nv, Et
+                    for c in range(3):
+                        R[0, c] = Rt[0, c]
+                    for r in range(6):
+                        for c in range(3):
+                            C[r, c] = Cn[r, c]
+                    break
+                if not moved or al <= tiny:
+                    break
+                al *= 0.5
+            step = max(abs(uk - u0), abs(vk - v0))
+            ucorner = max(min(uk, 1.0 - uk), min(vk, 1.0 - vk))
+            nR = math.sqrt(2.0 * Ek)
+            keep = (step > 0) and not ((al >= 1.0) and (step <= 4e-16)) and not (step <= 1e-12 * ucorner)
+            keep = keep and not (pg <= 1e-15 * nR * math.sqrt(guu + gvv))
+            alpha = min(1.0, al * 2.0)
+            if not keep:
+                break
+        u[k] = uk
+        v[k] = vk
+        E[k] = Ek
+
+
 if numba is not None:
     _basis = numba.njit(cache=True, nogil=True)(_basis)
     evaluate_points = numba.njit(cache=True, nogil=True)(_evaluate_points)
+    _dot3 = numba.njit(cache=True, nogil=True, inline="always")(_dot3)
+    _free = numba.njit(cache=True, nogil=True, inline="always")(_free)
+    newton_points = numba.njit(cache=True, nogil=True)(_newton_points)
 else:  # pragma: no cover
-    evaluate_points = None
+    evaluate_points = newton_points = None

@@ -2,9 +2,12 @@
 
 :func:`closest_points` projects a batch of 3-D points ``X`` (shape (n, 3)) onto the limit surface of a
 :class:`~ccproof.evaluate.LimitSurface`: for every point the parameter ``(face, u, v)`` of the nearest
-limit point, the point ``P``, the distance ``|X - P|`` and the unit normal there. It uses only the
+limit point, the point ``P``, the distance ``|X - P|`` and the unit normal there. It needs only the
 evaluator's public :meth:`~ccproof.evaluate.LimitSurface.evaluate` (and the number of parameter
-faces), so it works on every mesh the evaluator accepts.
+faces), so it works on every mesh the evaluator accepts and on any object with that method; on the
+evaluator's own surfaces (natural parameterization, compiled kernel) the Newton descents run
+compiled, point by point, with the numpy descent's formulas in the same order (bit-identical
+results, tests/evaluate/test_newton_compiled.py).
 
 Method (global search, then local refinement):
 
@@ -165,7 +168,8 @@ class ClosestPoints:
 
 
 def _dot(a, b):
-    return np.einsum("ij,ij->i", a, b)
+    """Row-wise dot products of (n, 3) arrays, summed left to right (the compiled descent's order)."""
+    return a[:, 0] * b[:, 0] + a[:, 1] * b[:, 1] + a[:, 2] * b[:, 2]
 
 
 def _unit_normal(Pu, Pv):
@@ -176,7 +180,7 @@ def _unit_normal(Pu, Pv):
     return N
 
 
-def newton(surface, X, face, u, v, max_iter=MAX_ITER):
+def newton(surface, X, face, u, v, max_iter=MAX_ITER, *, backend=None, threads=None):
     """Projected, backtracked Newton descent of ``|P(face, u, v) - X|^2 / 2`` in ``[0, 1]^2``.
 
     Parameters
@@ -186,6 +190,15 @@ def newton(surface, X, face, u, v, max_iter=MAX_ITER):
     face : ndarray of int, shape (n,)
     u, v : ndarray, shape (n,)
         Starting parameters (clipped to [0, 1]).
+    max_iter : int
+        Newton steps at most per point.
+    backend : {None, "numpy", "numba"}
+        As in :meth:`~ccproof.evaluate.LimitSurface.evaluate`: ``None`` runs the compiled descent
+        (the same formulas point by point, in numba) where the surface is evaluated by the compiled
+        kernel in its natural parameterization, else this numpy descent over the whole batch.
+    threads : int, optional
+        Threads of the compiled descent (contiguous blocks, identical results); default all cores
+        for at least 2^13 points.
 
     Returns
     -------
@@ -213,6 +226,9 @@ def newton(surface, X, face, u, v, max_iter=MAX_ITER):
     u = np.clip(np.asarray(u, dtype=np.float64), 0.0, 1.0).copy()
     v = np.clip(np.asarray(v, dtype=np.float64), 0.0, 1.0).copy()
     n = u.size
+    kernel = surface._newton_kernel(backend) if hasattr(surface, "_newton_kernel") else None
+    if kernel is not None:
+        return _newton_compiled(surface, kernel, X, face, u, v, max_iter, threads)
     r = surface.evaluate(face, u, v, 2)
     R = r["P"] - X
     E = 0.5 * _dot(R, R)
@@ -298,6 +314,35 @@ def newton(surface, X, face, u, v, max_iter=MAX_ITER):
         keep &= ~(pg <= 1e-15 * nR * np.sqrt(guu + gvv))
         alpha[a] = np.minimum(1.0, al * 2.0)
         active = a[keep]
+    return u, v, E
+
+
+def _newton_compiled(surface, kernel, X, face, u, v, max_iter, threads):
+    """:func:`newton` by the compiled descent (points checked first: the kernel trusts its input)."""
+    from ccproof.evaluate.surface import _threads
+
+    face, u, v = surface._check(face, u, v)
+    X = np.ascontiguousarray(X.reshape(-1, 3) if X.size else np.zeros((0, 3)))
+    if X.shape[0] != u.size:
+        raise CCProofError(f"X must have one row per point, got {X.shape[0]} rows for {u.size} points")
+    n = u.size
+    E = np.empty(n)
+    tables = (surface._refused_faces(), *surface._kernel_tables())
+    nt = _threads(threads, n * 16)  # a descent costs some 10 to 30 evaluations
+    if nt <= 1:
+        kernel(X, face, u, v, max_iter, MAX_HALVINGS, *tables, E)
+        return u, v, E
+    from concurrent.futures import ThreadPoolExecutor
+
+    nb = max(nt, min(16 * nt, n // 2048))
+    bounds = np.linspace(0, n, nb + 1).astype(np.int64)
+
+    def block(i):
+        lo, hi = bounds[i], bounds[i + 1]
+        kernel(X[lo:hi], face[lo:hi], u[lo:hi], v[lo:hi], max_iter, MAX_HALVINGS, *tables, E[lo:hi])
+
+    with ThreadPoolExecutor(nt) as ex:
+        list(ex.map(block, range(nb)))
     return u, v, E
 
 

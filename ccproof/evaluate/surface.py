@@ -689,9 +689,7 @@ class LimitSurface:
         if kernel is not None:
             dummy = np.empty((0, 3))
             arrs = [out.get(k, dummy) for k in _KEYS[2]]
-            tables = (self._refused_faces(), self._vkind, self._vchild, self._vu0, self._vv0, self._vh,
-                      self._vpatch, self._vcold, self.hot_layers, self._vcu, self._vcv, self._vnmax,
-                      self.split_depth, self._nets, self._pu0, self._pv0, self._ph)
+            tables = (self._refused_faces(), *self._kernel_tables())
             nt = _threads(threads, n)
             if nt <= 1:
                 bad = [kernel(f, u, v, derivatives, *tables, *arrs)]
@@ -719,6 +717,21 @@ class LimitSurface:
             hi = min(n, lo + chunk)
             self._eval_chunk(f[lo:hi], u[lo:hi], v[lo:hi], derivatives, {k: out[k][lo:hi] for k in keys})
         return out
+
+    def _kernel_tables(self):
+        """The patch table as the compiled kernels take it (after the point arrays)."""
+        return (self._vkind, self._vchild, self._vu0, self._vv0, self._vh, self._vpatch, self._vcold,
+                self.hot_layers, self._vcu, self._vcv, self._vnmax, self.split_depth, self._nets, self._pu0,
+                self._pv0, self._ph)
+
+    def _newton_kernel(self, backend=None):
+        """The compiled Newton descent of the closest points on this surface, or None: numpy backend,
+        or a subclass that evaluates another parameterization."""
+        if type(self).evaluate is not LimitSurface.evaluate or _numba_kernel(backend) is None:
+            return None
+        from ccproof.evaluate._numba_kernel import newton_points
+
+        return newton_points
 
     def _eval_chunk(self, f, u, v, d, out):
         patch, s, t, g = self._locate(f, u, v)
