@@ -185,3 +185,133 @@ def candidates(X, dstar, tree, c, nrm, r, h):
         if k <= cap:
             return pid[:k], cid[:k], lb[:k]
         cap = k
+
+
+def cell_bounds(P, Pu, Pv, m, safety, eps):
+    """Bounding cylinders of the ``m x m`` cells of every face (:mod:`ccproof.evaluate.closest`, step 1).
+
+    Parameters
+    ----------
+    P, Pu, Pv : ndarray, shape (nf, 2 m + 1, 2 m + 1, 3)
+        The surface and its first derivatives on the sample grid of each face (index i along u).
+    m : int
+    safety : float
+        Enlargement in units of the largest second difference of a cell's samples.
+    eps : float
+        Added to every margin (round-off of the samples).
+
+    Returns
+    -------
+    c, n : ndarray, shape (nf m^2, 3)
+        Centre sample and unit normal there (from ``Pu x Pv``; where that is not finite, from the
+        cross product of the cell's diagonals, zero where that vanishes too).
+    r, h : ndarray, shape (nf m^2,)
+        Lateral radius and half-height.
+
+    Notes
+    -----
+    Cell ``(f, ci, cj)`` is row ``(f m + ci) m + cj`` and holds the 3 x 3 samples
+    ``P[f, 2 ci + a, 2 cj + b]``. Compiled with numba when it is installed; the numpy reference
+    :func:`cell_bounds_numpy` computes the same bounds (tests/evaluate/test_closest.py).
+    """
+    P = np.ascontiguousarray(P, dtype=np.float64)
+    Pu = np.ascontiguousarray(Pu, dtype=np.float64)
+    Pv = np.ascontiguousarray(Pv, dtype=np.float64)
+    nc = P.shape[0] * m * m
+    c, n, r, h = np.empty((nc, 3)), np.empty((nc, 3)), np.empty(nc), np.empty(nc)
+    _cell_bounds(P, Pu, Pv, int(m), float(safety), float(eps), c, n, r, h)
+    return c, n, r, h
+
+
+def _cross(a0, a1, a2, b0, b1, b2):
+    return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
+
+
+def _cell_bounds(P, Pu, Pv, m, safety, eps, c, n, r, h):
+    nf = P.shape[0]
+    for f in range(nf):
+        for ci in range(m):
+            for cj in range(m):
+                k = (f * m + ci) * m + cj
+                i0, j0 = 2 * ci, 2 * cj
+                x0, x1, x2 = P[f, i0 + 1, j0 + 1, 0], P[f, i0 + 1, j0 + 1, 1], P[f, i0 + 1, j0 + 1, 2]
+                n0, n1, n2 = _cross(Pu[f, i0 + 1, j0 + 1, 0], Pu[f, i0 + 1, j0 + 1, 1], Pu[f, i0 + 1, j0 + 1, 2],
+                                    Pv[f, i0 + 1, j0 + 1, 0], Pv[f, i0 + 1, j0 + 1, 1], Pv[f, i0 + 1, j0 + 1, 2])
+                nn = math.sqrt(n0 * n0 + n1 * n1 + n2 * n2)
+                if nn > 0.0 and math.isfinite(nn):
+                    n0, n1, n2 = n0 / nn, n1 / nn, n2 / nn
+                else:  # a degenerate normal at the centre: the cell's diagonals
+                    d1 = [P[f, i0 + 2, j0 + 2, q] - P[f, i0, j0, q] for q in range(3)]
+                    d2 = [P[f, i0 + 2, j0, q] - P[f, i0, j0 + 2, q] for q in range(3)]
+                    n0, n1, n2 = _cross(d1[0], d1[1], d1[2], d2[0], d2[1], d2[2])
+                    nn = max(math.sqrt(n0 * n0 + n1 * n1 + n2 * n2), 1e-300)
+                    n0, n1, n2 = n0 / nn, n1 / nn, n2 / nn
+                zmax = 0.0
+                rmax = 0.0
+                for a in range(3):
+                    for b in range(3):
+                        w0 = P[f, i0 + a, j0 + b, 0] - x0
+                        w1 = P[f, i0 + a, j0 + b, 1] - x1
+                        w2 = P[f, i0 + a, j0 + b, 2] - x2
+                        z = w0 * n0 + w1 * n1 + w2 * n2
+                        rho = math.sqrt(max(w0 * w0 + w1 * w1 + w2 * w2 - z * z, 0.0))
+                        zmax = max(zmax, abs(z))
+                        rmax = max(rmax, rho)
+                d2 = 0.0  # largest second difference: along u, along v, mixed
+                for b in range(3):
+                    s = 0.0
+                    for q in range(3):
+                        e = P[f, i0, j0 + b, q] - 2 * P[f, i0 + 1, j0 + b, q] + P[f, i0 + 2, j0 + b, q]
+                        s += e * e
+                    d2 = max(d2, math.sqrt(s))
+                for a in range(3):
+                    s = 0.0
+                    for q in range(3):
+                        e = P[f, i0 + a, j0, q] - 2 * P[f, i0 + a, j0 + 1, q] + P[f, i0 + a, j0 + 2, q]
+                        s += e * e
+                    d2 = max(d2, math.sqrt(s))
+                s = 0.0
+                for q in range(3):
+                    e = P[f, i0, j0, q] - P[f, i0, j0 + 2, q] - P[f, i0 + 2, j0, q] + P[f, i0 + 2, j0 + 2, q]
+                    s += e * e
+                d2 = max(d2, math.sqrt(s))
+                margin = safety * d2 + eps
+                c[k, 0], c[k, 1], c[k, 2] = x0, x1, x2
+                n[k, 0], n[k, 1], n[k, 2] = n0, n1, n2
+                r[k] = rmax + margin
+                h[k] = zmax + margin
+
+
+def cell_bounds_numpy(P, Pu, Pv, m, safety, eps):
+    """The numpy reference of :func:`cell_bounds` (same arguments and results)."""
+    nf = P.shape[0]
+    N = np.cross(Pu[:, 1::2, 1::2], Pv[:, 1::2, 1::2])
+    nn = np.linalg.norm(N, axis=-1, keepdims=True)
+    blocks = np.stack(
+        [P[:, i0 : i0 + 2 * m - 1 : 2, j0 : j0 + 2 * m - 1 : 2] for i0 in range(3) for j0 in range(3)], axis=3,
+    )  # (nf, m, m, 9, 3), sample (a, b) -> 3 a + b
+    C = blocks[:, :, :, 4]
+    good = (nn[..., 0] > 0) & np.isfinite(nn[..., 0])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        Nc = np.where(good[..., None], N / np.where(good[..., None], nn, 1.0), 0.0)
+    if not good.all():
+        d1 = blocks[:, :, :, 8] - blocks[:, :, :, 0]
+        d2 = blocks[:, :, :, 6] - blocks[:, :, :, 2]
+        alt = np.cross(d1, d2)
+        alt /= np.maximum(np.linalg.norm(alt, axis=-1, keepdims=True), 1e-300)
+        Nc = np.where(good[..., None], Nc, alt)
+    W = blocks - C[:, :, :, None]
+    z = np.einsum("fijsc,fijc->fijs", W, Nc)
+    rho = np.sqrt(np.maximum(np.einsum("fijsc,fijsc->fijs", W, W) - z * z, 0.0))
+    b = blocks.reshape(nf, m, m, 3, 3, 3)
+    d2u = np.linalg.norm(b[:, :, :, 0] - 2 * b[:, :, :, 1] + b[:, :, :, 2], axis=-1).max(axis=-1)
+    d2v = np.linalg.norm(b[:, :, :, :, 0] - 2 * b[:, :, :, :, 1] + b[:, :, :, :, 2], axis=-1).max(axis=-1)
+    d2x = np.linalg.norm(b[:, :, :, 0, 0] - b[:, :, :, 0, 2] - b[:, :, :, 2, 0] + b[:, :, :, 2, 2], axis=-1)
+    margin = safety * np.maximum(np.maximum(d2u, d2v), d2x) + eps
+    return (C.reshape(-1, 3), Nc.reshape(-1, 3), (rho.max(axis=-1) + margin).reshape(-1),
+            (np.abs(z).max(axis=-1) + margin).reshape(-1))
+
+
+if numba is not None:  # pragma: no branch
+    _cross = numba.njit(cache=True, nogil=True, inline="always")(_cross)
+    _cell_bounds = numba.njit(cache=True, nogil=True)(_cell_bounds)

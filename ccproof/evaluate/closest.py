@@ -403,43 +403,20 @@ class ClosestPointFinder:
         U, V = np.meshgrid(t, t, indexing="ij")  # [i along u, j along v]
         fu = np.repeat(sel, g * g)
         r = surface.evaluate(fu, np.tile(U.ravel(), nf), np.tile(V.ravel(), nf), 1)
-        S = r["P"].reshape(nf, g, g, 3)
-        Nrm = _unit_normal(r["Pu"], r["Pv"]).reshape(nf, g, g, 3)
         self._samples = r["P"]
         self._sample_face = fu
         self._sample_u = np.tile(U.ravel(), nf)
         self._sample_v = np.tile(V.ravel(), nf)
-        # samples, for hand-offs across face edges (queried with surface points only: fast)
-        self._stree = cKDTree(self._samples)
-        # cells: [face, ci, cj] with 3x3 samples S[f, 2ci:2ci+3, 2cj:2cj+3]
-        blocks = np.stack(
-            [S[:, i0 : i0 + 2 * m - 1 : 2, j0 : j0 + 2 * m - 1 : 2] for i0 in range(3) for j0 in range(3)],
-            axis=3,
-        )  # (nf, m, m, 9, 3), sample (i0, j0) -> 3 i0 + j0
-        C = blocks[:, :, :, 4]
-        Nc = Nrm[:, 1::2, 1::2]
-        # a degenerate normal at the centre (e.g. exactly at a singular point): use the cell's diagonals
-        bad = ~np.isfinite(Nc).all(axis=-1)
-        if bad.any():
-            d1 = blocks[:, :, :, 8] - blocks[:, :, :, 0]
-            d2 = blocks[:, :, :, 6] - blocks[:, :, :, 2]
-            alt = np.cross(d1, d2)
-            alt /= np.maximum(np.linalg.norm(alt, axis=-1, keepdims=True), 1e-300)
-            Nc = np.where(bad[..., None], alt, Nc)
-        W = blocks - C[:, :, :, None]
-        z = np.einsum("fijsc,fijc->fijs", W, Nc)
-        rho = np.sqrt(np.maximum(np.einsum("fijsc,fijsc->fijs", W, W) - z * z, 0.0))
-        b = blocks.reshape(nf, m, m, 3, 3, 3)
-        d2u = np.linalg.norm(b[:, :, :, 0] - 2 * b[:, :, :, 1] + b[:, :, :, 2], axis=-1).max(axis=-1)
-        d2v = np.linalg.norm(b[:, :, :, :, 0] - 2 * b[:, :, :, :, 1] + b[:, :, :, :, 2], axis=-1).max(axis=-1)
-        d2x = np.linalg.norm(b[:, :, :, 0, 0] - b[:, :, :, 0, 2] - b[:, :, :, 2, 0] + b[:, :, :, 2, 2], axis=-1)
-        margin = SAFETY * np.maximum(np.maximum(d2u, d2v), d2x)
+        # samples, for hand-offs across face edges (queried with surface points only: fast; the
+        # unbalanced, non-compact tree builds 2.6x faster and answers as fast)
+        self._stree = cKDTree(self._samples, balanced_tree=False, compact_nodes=False)
+        # cells [face, ci, cj]: cylinders around the centre samples (compiled; numpy reference
+        # _bvh.cell_bounds_numpy)
         scale = np.abs(self._samples).max() if self._samples.size else 1.0
-        margin = margin + 1e-13 * scale
-        self._c = C.reshape(-1, 3)
-        self._n = Nc.reshape(-1, 3)
-        self._r = (rho.max(axis=-1) + margin).reshape(-1)
-        self._h = (np.abs(z).max(axis=-1) + margin).reshape(-1)
+        grid = (nf, g, g, 3)
+        self._c, self._n, self._r, self._h = _bvh.cell_bounds(
+            r["P"].reshape(grid), r["Pu"].reshape(grid), r["Pv"].reshape(grid), m, SAFETY, 1e-13 * scale
+        )
         self._R = np.hypot(self._r, self._h)
         self._Rmax = float(self._R.max()) if self._R.size else 0.0
         self._bvh = _bvh.build(self._c, self._R)

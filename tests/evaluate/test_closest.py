@@ -291,3 +291,32 @@ def test_tagged_meshes_never_farther_than_dense_sampling(refdir, name):
     assert r.face.max() < nf
     assert (r.distance - brute).max() <= 1e-12 * diag
     assert (brute - r.distance).max() < 1e-2 * diag
+
+
+@pytest.mark.parametrize("name", ["cube", "sector_k3", "torus_8x6"])
+def test_compiled_cell_bounds_equal_the_numpy_reference(surfaces, name):
+    """The cylinders of the search structure, compiled, against the numpy reference (also on a
+    surface collapsed to a point, where every centre normal needs the fallback and is zero)."""
+    from ccproof.evaluate import _bvh
+
+    S = surfaces[name]
+    m, g = 4, 9
+    nf = S.mesh.n_faces
+    t = np.arange(g) / (2 * m)
+    U, V = np.meshgrid(t, t, indexing="ij")
+    r = S.evaluate(np.repeat(np.arange(nf), g * g), np.tile(U.ravel(), nf), np.tile(V.ravel(), nf), 1)
+    grids = [r[k].reshape(nf, g, g, 3) for k in ("P", "Pu", "Pv")]
+    for P, Pu, Pv in [grids, [np.full_like(grids[0], 0.25), 0 * grids[1], 0 * grids[2]]]:
+        a = _bvh.cell_bounds(P, Pu, Pv, m, 2.0, 1e-13)
+        b = _bvh.cell_bounds_numpy(P, Pu, Pv, m, 2.0, 1e-13)
+        for x, y in zip(a, b):
+            assert x.shape == y.shape
+            np.testing.assert_allclose(x, y, rtol=1e-13, atol=1e-15)
+    # the bounds hold the cell's samples: lateral radius and half-height cover every sample offset
+    c, n, rr, hh = _bvh.cell_bounds(*grids, m, 2.0, 1e-13)
+    P = grids[0]
+    for k in np.random.default_rng(1).integers(0, nf * m * m, 20):
+        f, ci, cj = k // (m * m), (k // m) % m, k % m
+        W = P[f, 2 * ci : 2 * ci + 3, 2 * cj : 2 * cj + 3].reshape(-1, 3) - c[k]
+        z = W @ n[k]
+        assert np.abs(z).max() < hh[k] and np.sqrt(np.maximum((W * W).sum(1) - z * z, 0)).max() < rr[k]
