@@ -211,9 +211,11 @@ def cell_bounds(P, Pu, Pv, m, safety, eps):
     Notes
     -----
     Cell ``(f, ci, cj)`` is row ``(f m + ci) m + cj`` and holds the 3 x 3 samples
-    ``P[f, 2 ci + a, 2 cj + b]``. Compiled with numba when it is installed; the numpy reference
-    :func:`cell_bounds_numpy` computes the same bounds (tests/evaluate/test_closest.py).
+    ``P[f, 2 ci + a, 2 cj + b]``. Compiled with numba; without numba the numpy version
+    :func:`cell_bounds_numpy` (the same bounds, tests/evaluate/test_closest.py) runs instead.
     """
+    if numba is None:  # pragma: no cover - the loop below would run in plain Python
+        return cell_bounds_numpy(P, Pu, Pv, m, safety, eps)
     P = np.ascontiguousarray(P, dtype=np.float64)
     Pu = np.ascontiguousarray(Pu, dtype=np.float64)
     Pv = np.ascontiguousarray(Pv, dtype=np.float64)

@@ -319,7 +319,7 @@ def newton(surface, X, face, u, v, max_iter=MAX_ITER, *, backend=None, threads=N
 
 def _newton_compiled(surface, kernel, X, face, u, v, max_iter, threads):
     """:func:`newton` by the compiled descent (points checked first: the kernel trusts its input)."""
-    from ccproof.evaluate.surface import _threads
+    from ccproof.evaluate.surface import _in_blocks, _threads
 
     face, u, v = surface._check(face, u, v)
     X = np.ascontiguousarray(X.reshape(-1, 3) if X.size else np.zeros((0, 3)))
@@ -328,21 +328,11 @@ def _newton_compiled(surface, kernel, X, face, u, v, max_iter, threads):
     n = u.size
     E = np.empty(n)
     tables = (surface._refused_faces(), *surface._kernel_tables())
-    nt = _threads(threads, n * 16)  # a descent costs some 10 to 30 evaluations
-    if nt <= 1:
-        kernel(X, face, u, v, max_iter, MAX_HALVINGS, *tables, E)
-        return u, v, E
-    from concurrent.futures import ThreadPoolExecutor
 
-    nb = max(nt, min(16 * nt, n // 2048))
-    bounds = np.linspace(0, n, nb + 1).astype(np.int64)
-
-    def block(i):
-        lo, hi = bounds[i], bounds[i + 1]
+    def block(lo, hi):
         kernel(X[lo:hi], face[lo:hi], u[lo:hi], v[lo:hi], max_iter, MAX_HALVINGS, *tables, E[lo:hi])
 
-    with ThreadPoolExecutor(nt) as ex:
-        list(ex.map(block, range(nb)))
+    _in_blocks(block, n, _threads(threads, n * 16), 2048)  # a descent costs some 10 to 30 evaluations
     return u, v, E
 
 

@@ -690,25 +690,12 @@ class LimitSurface:
             dummy = np.empty((0, 3))
             arrs = [out.get(k, dummy) for k in _KEYS[2]]
             tables = (self._refused_faces(), *self._kernel_tables())
-            nt = _threads(threads, n)
-            if nt <= 1:
-                bad = [kernel(f, u, v, derivatives, *tables, *arrs)]
-            else:
-                from concurrent.futures import ThreadPoolExecutor
 
-                # many more blocks than threads, taken in turn by the threads: the cost per point
-                # varies (points near irregular vertices go down the layers), so equal halves
-                # finish unequally
-                nb = max(nt, min(16 * nt, n // 32768))
-                bounds = np.linspace(0, n, nb + 1).astype(np.int64)
+            def block(lo, hi):
+                return kernel(f[lo:hi], u[lo:hi], v[lo:hi], derivatives, *tables,
+                              *[a[lo:hi] if a.shape[0] else a for a in arrs])
 
-                def block(i):
-                    lo, hi = bounds[i], bounds[i + 1]
-                    return kernel(f[lo:hi], u[lo:hi], v[lo:hi], derivatives, *tables,
-                                  *[a[lo:hi] if a.shape[0] else a for a in arrs])
-
-                with ThreadPoolExecutor(nt) as ex:
-                    bad = list(ex.map(block, range(nb)))
+            bad = _in_blocks(block, n, _threads(threads, n), 32768)
             if max(bad) >= 0:
                 self._check_values(f, u, v)  # raises, naming the first bad point
                 raise CCProofError("internal error: the compiled kernel refused a point the checks accept")
@@ -997,6 +984,23 @@ def _vertex_maps(surface):
         sl = np.flatnonzero(cslot[i])
         Wc[i, : crows[i], sl] = b.corner_data[vid][1][:, color[cidx[i, sl]]].T
     return _VertexMaps((Wn, pidx), (Wc, cidx), cvids, crows)
+
+
+def _in_blocks(fn, n, nt, size):
+    """``fn(lo, hi)`` over contiguous blocks of ``range(n)`` on ``nt`` threads; the results in block order.
+
+    Many more blocks than threads (about ``size`` points each, at most 16 per thread), taken in turn:
+    the cost per point varies (points near irregular vertices go down the layers), so equal shares
+    would finish unequally. One thread: a single call on everything.
+    """
+    if nt <= 1:
+        return [fn(0, n)]
+    from concurrent.futures import ThreadPoolExecutor
+
+    nb = max(nt, min(16 * nt, n // size))
+    bounds = np.linspace(0, n, nb + 1).astype(np.int64)
+    with ThreadPoolExecutor(nt) as ex:
+        return list(ex.map(lambda i: fn(bounds[i], bounds[i + 1]), range(nb)))
 
 
 def _threads(threads, n):
