@@ -329,7 +329,7 @@ class ChartHierarchy:
         cor = L.corner[v]
         nb = L.chart_boundary_nbrs[v]
         # the chart boundary is a crease curve: corners stay, boundary vertices and edges take the
-        # crease rules (one rule set: ccproof.mesh.rules)
+        # crease rules (one rule set: ccproof.rule_weights)
         w_vertex, w_neighbour = crease_vertex_weights(1.0)
         w_edge = sharp_edge_weight(1.0)
         rr, cc, ww = [r_v[cor]], [v[cor]], [np.ones(int(cor.sum()))]
