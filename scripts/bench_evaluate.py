@@ -14,13 +14,17 @@ Measures, in one run:
    limit positions, relative to the bounding-box diagonal), extrapolated to the level that would
    reach the accuracy of exact evaluation;
 4. the peak memory beyond inputs and outputs for 10^7 points (tracemalloc);
-5. side by side with OpenSubdiv Far (one thread, isolation level 10, Gregory end caps), on the bunny,
-   a crease shape and a triangle shape: setup times and points/s for 10^6 uniform points and 10^6
-   points near irregular vertices (distance 2^-(12 x) from the vertex, x uniform), ours with the
-   numpy kernel, the compiled kernel on one thread and on all threads; ratios ours / OpenSubdiv,
-   and the largest position difference. The C++ driver is compiled against the system's
-   OpenSubdiv (Debian: ``apt-get install -y libosd-dev g++``); without it this part is skipped
-   with that instruction.
+5. side by side with OpenSubdiv in this process (``scripts/_osd.py`` builds ``scripts/osd_capi.cpp``
+   against the system's OpenSubdiv 3.5+, Debian ``apt-get install -y libosd-dev g++``, and loads it with
+   ctypes; skipped with that instruction without it): Far (adaptive isolation level 10, Gregory end caps,
+   PatchMap, EvaluateBasis) and Bfr (a prepared Surface per face, approximation level 10), on the bunny, a
+   crease shape and a triangle shape. Setup times, and points/s for 10^6 uniform points and 10^6 points
+   within 10^-3 (in u and v) of the corners at extraordinary vertices; Far, Bfr, our numpy and compiled
+   kernels take turns round by round (at least 7 rounds; min, median, max; the 1-minute load before each
+   round), the process pinned to one CPU; the ratio to Far is taken per round. Also this machine's two
+   bounds on one thread (ideal compiled work on one net: compute; read bandwidth / 92 bytes: memory), the
+   fraction of each reached, the two-thread gain of the compiled kernel against the machine's ceiling on
+   ideal work, and the largest position difference.
 
 The bunny mesh is read from the repository's test data (``tests/data/meshes/bunny_quads.obj``).
 
@@ -42,6 +46,7 @@ import numpy as np
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
+sys.path.insert(0, str(Path(__file__).resolve().parent))  # scripts/_osd.py
 
 from ccproof.evaluate import natural_limit_surface as limit_surface  # noqa: E402
 from ccproof.evaluate.local import CORNERS  # noqa: E402
@@ -49,280 +54,246 @@ from ccproof.evaluate.surface import _CORNER, _SPLIT  # noqa: E402
 from ccproof.mesh import limit_normals, limit_positions, read_obj, subdivide  # noqa: E402
 from ccproof.mesh.io import read_mesh  # noqa: E402
 
-OSD_DRIVER = r"""
-// OpenSubdiv Far evaluation driver for scripts/bench_evaluate.py (written by the script).
-// Input (binary, little endian): see write_mesh() in the script. Output: timings on stdout and the
-// evaluated P, Ps, Pt of all points (double, n x 9) in the output file.
-#include <opensubdiv/far/topologyDescriptor.h>
-#include <opensubdiv/far/primvarRefiner.h>
-#include <opensubdiv/far/patchTableFactory.h>
-#include <opensubdiv/far/patchMap.h>
-#include <chrono>
-#include <cstdio>
-#include <cstdint>
-#include <vector>
-
-using namespace OpenSubdiv;
-
-struct V3 {
-    double p[3];
-    void Clear(void * = 0) { p[0] = p[1] = p[2] = 0; }
-    void AddWithWeight(V3 const &s, double w) { p[0] += w * s.p[0]; p[1] += w * s.p[1]; p[2] += w * s.p[2]; }
-};
-
-template <class T> static void rd(FILE *f, T *x, size_t n) {
-    if (n && fread(x, sizeof(T), n, f) != n) { fprintf(stderr, "short read\n"); exit(2); }
-}
-
-int main(int argc, char **argv) {
-    if (argc < 5) { fprintf(stderr, "usage: driver mesh.bin points.bin out.bin level\n"); return 2; }
-    FILE *fm = fopen(argv[1], "rb");
-    int32_t hdr[8];  // nv nf nidx ncrease ncorner nhole boundary flags (1 chaikin, 2 smooth triangles)
-    rd(fm, hdr, 8);
-    int nv = hdr[0], nf = hdr[1], nidx = hdr[2], nc = hdr[3], nk = hdr[4], nh = hdr[5];
-    std::vector<double> X(3 * nv); rd(fm, X.data(), X.size());
-    std::vector<int> sizes(nf), idx(nidx), cre(2 * nc), cor(nk), holes(nh);
-    std::vector<float> cw(nc), kw(nk);
-    rd(fm, sizes.data(), nf); rd(fm, idx.data(), nidx); rd(fm, cre.data(), 2 * nc); rd(fm, cw.data(), nc);
-    rd(fm, cor.data(), nk); rd(fm, kw.data(), nk); rd(fm, holes.data(), nh);
-    fclose(fm);
-    FILE *fp = fopen(argv[2], "rb");
-    int64_t n; rd(fp, &n, 1);
-    std::vector<int32_t> pf(n); std::vector<double> ps(n), pt(n);
-    rd(fp, pf.data(), n); rd(fp, ps.data(), n); rd(fp, pt.data(), n);
-    fclose(fp);
-    int level = atoi(argv[4]);
-
-    auto t0 = std::chrono::steady_clock::now();
-    Sdc::Options so;
-    so.SetVtxBoundaryInterpolation((Sdc::Options::VtxBoundaryInterpolation)hdr[6]);
-    so.SetCreasingMethod(hdr[7] & 1 ? Sdc::Options::CREASE_CHAIKIN : Sdc::Options::CREASE_UNIFORM);
-    so.SetTriangleSubdivision(hdr[7] & 2 ? Sdc::Options::TRI_SUB_SMOOTH : Sdc::Options::TRI_SUB_CATMARK);
-    Far::TopologyDescriptor d;
-    d.numVertices = nv; d.numFaces = nf; d.numVertsPerFace = sizes.data(); d.vertIndicesPerFace = idx.data();
-    d.numCreases = nc; d.creaseVertexIndexPairs = cre.data(); d.creaseWeights = cw.data();
-    d.numCorners = nk; d.cornerVertexIndices = cor.data(); d.cornerWeights = kw.data();
-    d.numHoles = nh; d.holeIndices = holes.data();
-    typedef Far::TopologyRefinerFactory<Far::TopologyDescriptor> Factory;
-    Far::TopologyRefiner *ref = Factory::Create(d, Factory::Options(Sdc::SCHEME_CATMARK, so));
-    Far::PatchTableFactory::Options po(level);
-    po.SetEndCapType(Far::PatchTableFactory::Options::ENDCAP_GREGORY_BASIS);
-    po.SetPatchPrecision<double>();
-    po.useInfSharpPatch = true;
-    po.generateLegacySharpCornerPatches = false;
-    ref->RefineAdaptive(po.GetRefineAdaptiveOptions());
-    Far::PatchTable *tab = Far::PatchTableFactory::Create(*ref, po);
-    int nref = ref->GetNumVerticesTotal(), nloc = tab->GetNumLocalPoints();
-    std::vector<V3> V(nref + nloc);
-    for (int i = 0; i < nv; ++i) for (int c = 0; c < 3; ++c) V[i].p[c] = X[3 * i + c];
-    Far::PrimvarRefinerReal<double> pr(*ref);
-    V3 *src = V.data();
-    for (int l = 1; l <= ref->GetMaxLevel(); ++l) {
-        V3 *dst = src + ref->GetLevel(l - 1).GetNumVertices();
-        pr.Interpolate(l, src, dst);
-        src = dst;
-    }
-    if (nloc) tab->GetLocalPointStencilTable<double>()->UpdateValues(V.data(), V.data() + nref);
-    Far::PatchMap pmap(*tab);
-    auto t1 = std::chrono::steady_clock::now();
-
-    std::vector<double> out(9 * n);
-    double w[20], ws[20], wt[20];
-    for (int64_t i = 0; i < n; ++i) {
-        Far::PatchTable::PatchHandle const *h = pmap.FindPatch(pf[i], ps[i], pt[i]);
-        double *o = &out[9 * i];
-        for (int k = 0; k < 9; ++k) o[k] = 0;
-        if (!h) { for (int k = 0; k < 9; ++k) o[k] = 0.0 / 0.0; continue; }
-        tab->EvaluateBasis(*h, ps[i], pt[i], w, ws, wt);
-        if (tab->GetPatchParam(*h).NonQuadRoot()) {  // EvaluateBasis scales by the depth of the
-            for (int j = 0; j < 20; ++j) { ws[j] *= 0.5; wt[j] *= 0.5; }  // n-gon's level-1 quad
-        }
-        Far::ConstIndexArray cv = tab->GetPatchVertices(*h);
-        for (int j = 0; j < cv.size(); ++j) {
-            double const *p = V[cv[j]].p;
-            for (int c = 0; c < 3; ++c) { o[c] += w[j] * p[c]; o[3 + c] += ws[j] * p[c]; o[6 + c] += wt[j] * p[c]; }
-        }
-    }
-    auto t2 = std::chrono::steady_clock::now();
-    FILE *fo = fopen(argv[3], "wb");
-    fwrite(out.data(), sizeof(double), out.size(), fo);
-    fclose(fo);
-    printf("setup %.6f eval %.6f patches %d\n", std::chrono::duration<double>(t1 - t0).count(),
-           std::chrono::duration<double>(t2 - t1).count(), tab->GetNumPatchesTotal());
-    return 0;
-}
-"""
+# ------------------------------------------------------------------ 5. side by side with OpenSubdiv
+SHAPES = [("bunny", REPO / "tests" / "data" / "meshes" / "bunny_quads.obj"),
+          ("cubes_infsharp", REPO / "tests" / "data" / "osd_features" / "meshes" / "catmark_cubes_infsharp.obj"),
+          ("smoothtris1", REPO / "tests" / "data" / "osd_features" / "meshes" / "catmark_smoothtris1.obj")]
+#: P + Pu + Pv of a bicubic patch: 16-term sums of 3 coordinates for 3 quantities plus the basis
+FLOPS_PER_POINT = 310
+#: bytes per point that must move at least: (face, u, v) in (4 + 16), P, Pu, Pv out (72)
+BYTES_PER_POINT = 92
 
 
-def build_osd_driver():
-    """Compile the OpenSubdiv driver (cached in the temp folder); None with a message if impossible."""
-    import shutil
-    import subprocess
-    import tempfile
-
-    header = Path("/usr/include/opensubdiv/far/patchTable.h")
-    if not header.exists() or shutil.which("g++") is None:
-        print("   OpenSubdiv headers or g++ not found: install them with\n"
-              "       apt-get update && apt-get install -y libosd-dev g++\n"
-              "   (Debian/Ubuntu; elsewhere build OpenSubdiv and put far/ under /usr/include/opensubdiv)."
-              " Skipped.")
-        return None
-    d = Path(tempfile.gettempdir()) / "ccproof_bench_osd"
-    d.mkdir(exist_ok=True)
-    src, exe = d / "driver.cpp", d / "driver"
-    if not exe.exists() or not src.exists() or src.read_text() != OSD_DRIVER:
-        src.write_text(OSD_DRIVER)
-        r = subprocess.run(["g++", "-O2", "-std=c++14", str(src), "-o", str(exe), "-losdCPU"],
-                           capture_output=True, text=True)
-        if r.returncode != 0:
-            print(f"   compiling the OpenSubdiv driver failed:\n{r.stderr[-2000:]}\n   Skipped.")
-            return None
-    return exe
-
-
-def _write_osd_input(d, mesh, f, s, t):
-    """Binary mesh and points files for the driver (layout read by its main())."""
-    flags = int(mesh.options.crease_method == "chaikin") | 2 * int(mesh.options.triangle_subdivision == "smooth")
-    bmode = {"none": 0, "edge_only": 1, "edge_and_corner": 2}[mesh.options.boundary]
-    cre = list(mesh.edge_sharpness.items())
-    cor = list(mesh.vertex_sharpness.items())
-    holes = np.flatnonzero(mesh.is_hole_tagged).astype(np.int32)
-    hdr = np.array([mesh.n_vertices, mesh.n_faces, mesh.indices.size, len(cre), len(cor), holes.size, bmode, flags],
-                   dtype=np.int32)
-    with open(d / "mesh.bin", "wb") as fh:
-        fh.write(hdr.tobytes())
-        fh.write(np.ascontiguousarray(mesh.vertices, dtype=np.float64).tobytes())
-        fh.write(mesh.sizes.astype(np.int32).tobytes())
-        fh.write(mesh.indices.astype(np.int32).tobytes())
-        fh.write(np.array([e for e, _ in cre], dtype=np.int32).reshape(-1).tobytes())
-        fh.write(np.array([min(x, 10.0) for _, x in cre], dtype=np.float32).tobytes())
-        fh.write(np.array([v for v, _ in cor], dtype=np.int32).tobytes())
-        fh.write(np.array([min(x, 10.0) for _, x in cor], dtype=np.float32).tobytes())
-        fh.write(holes.tobytes())
-    with open(d / "points.bin", "wb") as fh:
-        fh.write(np.array([f.size], dtype=np.int64).tobytes())
-        fh.write(f.astype(np.int32).tobytes())
-        fh.write(np.ascontiguousarray(s, dtype=np.float64).tobytes())
-        fh.write(np.ascontiguousarray(t, dtype=np.float64).tobytes())
+def extraordinary_corners(mesh):
+    """(ptex face, corner) pairs whose corner vertex is extraordinary: an interior vertex with other than
+    4 faces, a boundary vertex with other than 2, or the centre of an n-gon (n != 4; valence n after the
+    first step). Ptex corner c of a quad is its vertex c; of the sub-face k of an n-gon, corner 0 is the
+    n-gon's vertex k, corner 2 its centre, corners 1 and 3 edge midpoints (valence 4 or boundary 2)."""
+    fc, bnd = mesh.face_count, mesh.is_boundary_vertex
+    ev = np.where(bnd, fc != 2, fc != 4)
+    faces, corners = [], []
+    for f, poly in enumerate(mesh.polygons):
+        if mesh.is_hole[f]:
+            continue
+        p0 = int(mesh.ptex_start[f])
+        if len(poly) == 4:
+            for c, v in enumerate(poly):
+                if ev[v]:
+                    faces.append(p0)
+                    corners.append(c)
+        else:
+            for k, v in enumerate(poly):
+                if ev[v]:
+                    faces.append(p0 + k)
+                    corners.append(0)
+                faces.append(p0 + k)  # the centre (valence != 4)
+                corners.append(2)
+    return np.array(faces, dtype=np.int64), np.array(corners, dtype=np.int64)
 
 
-def run_osd(exe, mesh, f, s, t, level=10):
-    """(setup seconds, evaluation seconds, P, Ps, Pt) of OpenSubdiv Far on one thread."""
-    import subprocess
-    import tempfile
-
-    with tempfile.TemporaryDirectory() as tmp:
-        d = Path(tmp)
-        _write_osd_input(d, mesh, f, s, t)
-        r = subprocess.run([str(exe), str(d / "mesh.bin"), str(d / "points.bin"), str(d / "out.bin"), str(level)],
-                           capture_output=True, text=True)
-        if r.returncode != 0:
-            raise RuntimeError(f"OpenSubdiv driver failed: {r.stderr}")
-        words = r.stdout.split()
-        out = np.fromfile(d / "out.bin", dtype=np.float64).reshape(-1, 9)
-    return float(words[1]), float(words[3]), out[:, :3], out[:, 3:6], out[:, 6:9]
+def near_ev_points(mesh, n, rng, within=1e-3):
+    """n points within ``within`` (in u and v) of a corner at an extraordinary vertex (uniform over the
+    pairs of :func:`extraordinary_corners` and over the square of side ``within`` at the corner)."""
+    pf, pc = extraordinary_corners(mesh)
+    k = rng.integers(0, pf.size, n)
+    cu, cv = np.array(CORNERS, dtype=np.float64)[pc[k]].T
+    a, b = within * rng.random(n), within * rng.random(n)
+    return pf[k], np.where(cu > 0, 1.0 - a, a), np.where(cv > 0, 1.0 - b, b), pf.size
 
 
-def irregular_corners(S):
-    """(ptex face, corner) pairs whose corner is an irregular (self-similar corner) vertex."""
-    P = S.n_faces
-    out = []
-    for i, (cu, cv) in enumerate(CORNERS):
-        f = np.arange(P)
-        vf, kind = S._vface_of(f, np.full(P, float(cu)), np.full(P, float(cv)))
-        out.extend((int(p), i) for p in f[kind == _CORNER])
-    return out
+def uniform_points(mesh, n, rng):
+    """n points uniform over the ptex faces that are not holes."""
+    ok = np.flatnonzero(np.repeat(~mesh.is_hole, np.where(mesh.sizes == 4, 1, mesh.sizes)))
+    return ok[rng.integers(0, ok.size, n)], rng.random(n), rng.random(n)
 
 
-def near_points(S, n, rng):
-    """n points at distance 2^-(12 x) (x uniform) from irregular corners, in the face."""
-    pairs = irregular_corners(S)
-    pick = rng.integers(0, len(pairs), n)
-    f = np.array([pairs[k][0] for k in pick], dtype=np.int64)
-    c = np.array([CORNERS[pairs[k][1]] for k in pick], dtype=np.float64)
-    r = 2.0 ** (-12 * rng.random(n))
-    a, b = rng.random(n) * r, rng.random(n) * r
-    s = np.where(c[:, 0] > 0, 1.0 - a, a)
-    t = np.where(c[:, 1] > 0, 1.0 - b, b)
-    return f, s, t, len(pairs)
-
-
-def osd_side_by_side(n, rng, quick=False, setup_only=False):
-    print("\n5. side by side with OpenSubdiv Far (positions + first derivatives)")
-    exe = build_osd_driver()
-    if exe is None:
-        return None
+def _loadavg():
     import os
 
-    shapes = [("bunny_quads", REPO / "tests" / "data" / "meshes" / "bunny_quads.obj"),
-              ("crease: catmark_cubes_infsharp", REPO / "tests" / "data" / "osd_features" / "meshes"
-               / "catmark_cubes_infsharp.obj"),
-              ("triangles: catmark_smoothtris1", REPO / "tests" / "data" / "osd_features" / "meshes"
-               / "catmark_smoothtris1.obj")]
-    threads = os.cpu_count() or 1
-    if threads > 1 and _has_numba() and not setup_only:
-        machine_ceiling(threads, quick)
-    rows = []
-    for label, path in shapes:
-        mesh = read_mesh(path)
-        w0 = time.perf_counter()
-        S = limit_surface(mesh)
-        setup = time.perf_counter() - w0
-        P = S.n_faces
-        if setup_only:
+    return os.getloadavg()[0]
+
+
+class _Pinned:
+    """Pin this process to one CPU (the last one it may use) for the one-thread comparisons."""
+
+    def __enter__(self):
+        import os
+
+        self.before = os.sched_getaffinity(0)
+        self.cpu = max(self.before)
+        os.sched_setaffinity(0, {self.cpu})
+        return self
+
+    def __exit__(self, *exc):
+        import os
+
+        os.sched_setaffinity(0, self.before)
+
+
+def interleaved(cases, rounds):
+    """Run every case once per round, in turn, ``rounds`` times; seconds per case and round, and the
+    1-minute load before each round."""
+    times = {name: [] for name in cases}
+    load = []
+    for r in range(rounds):
+        load.append(_loadavg())
+        names = list(cases)
+        names = names[r % len(names):] + names[:r % len(names)]  # rotate who goes first
+        for name in names:
             w0 = time.perf_counter()
-            limit_surface(mesh)
-            again = time.perf_counter() - w0
-            one = (np.zeros(1, dtype=np.int64), np.full(1, 0.5), np.full(1, 0.5))
-            osd_setup = min(run_osd(exe, mesh, *one)[0] for _ in range(3))
-            cold, warm = fresh_process_setups(path)
-            rows.append((label, setup, again, osd_setup, cold, warm))
-            print(f"   {label}: OpenSubdiv {osd_setup:.4f} s; ours, first build in a fresh process: disk cache "
-                  f"empty {cold:.3f} s ({cold / osd_setup:.1f}x), disk cache filled {warm:.3f} s "
-                  f"({warm / osd_setup:.1f}x); in this process {setup:.3f} s ({setup / osd_setup:.1f}x), "
-                  f"again {again:.3f} s ({again / osd_setup:.1f}x)")
+            cases[name]()
+            times[name].append(time.perf_counter() - w0)
+    return times, load
+
+
+def hardware_bounds(quick=False):
+    """The two bounds of this machine for P + Pu + Pv, in points/s on one thread:
+
+    * compute: the evaluator's own arithmetic on one bicubic net held in registers/L1 (the 16-term sums
+      of ``bspline_basis``), compiled, no gather, no table: ideal compiled work;
+    * memory: read bandwidth of one core (summing a 256 MiB array) / BYTES_PER_POINT.
+    """
+    import numba
+
+    @numba.njit(nogil=True, inline="always")
+    def basis(z):
+        w = 1.0 - z
+        z2 = z * z
+        z3 = z2 * z
+        return (w * w * w / 6.0, (3.0 * z3 - 6.0 * z2 + 4.0) / 6.0, (-3.0 * z3 + 3.0 * z2 + 3.0 * z + 1.0) / 6.0,
+                z3 / 6.0, -0.5 * w * w, 1.5 * z2 - 2.0 * z, -1.5 * z2 + z + 0.5, 0.5 * z2)
+
+    @numba.njit(nogil=True)
+    def ideal(s, t, net, P, Pu, Pv):
+        for i in range(s.size):
+            b0, b1, b2, b3, d0, d1, d2, d3 = basis(s[i])
+            c0, c1, c2, c3, e0, e1, e2, e3 = basis(t[i])
+            for c in range(3):
+                a0 = b0 * net[0, c] + b1 * net[1, c] + b2 * net[2, c] + b3 * net[3, c]
+                a1 = b0 * net[4, c] + b1 * net[5, c] + b2 * net[6, c] + b3 * net[7, c]
+                a2 = b0 * net[8, c] + b1 * net[9, c] + b2 * net[10, c] + b3 * net[11, c]
+                a3 = b0 * net[12, c] + b1 * net[13, c] + b2 * net[14, c] + b3 * net[15, c]
+                g0 = d0 * net[0, c] + d1 * net[1, c] + d2 * net[2, c] + d3 * net[3, c]
+                g1 = d0 * net[4, c] + d1 * net[5, c] + d2 * net[6, c] + d3 * net[7, c]
+                g2 = d0 * net[8, c] + d1 * net[9, c] + d2 * net[10, c] + d3 * net[11, c]
+                g3 = d0 * net[12, c] + d1 * net[13, c] + d2 * net[14, c] + d3 * net[15, c]
+                P[i, c] = c0 * a0 + c1 * a1 + c2 * a2 + c3 * a3
+                Pu[i, c] = c0 * g0 + c1 * g1 + c2 * g2 + c3 * g3
+                Pv[i, c] = e0 * a0 + e1 * a1 + e2 * a2 + e3 * a3
+
+    n = 200_000 if quick else 2_000_000
+    rng = np.random.default_rng(1)
+    s, t, net = rng.random(n), rng.random(n), rng.random((16, 3))
+    P, Pu, Pv = (np.empty((n, 3)) for _ in range(3))
+    ideal(s[:4], t[:4], net, P, Pu, Pv)
+    a = np.ones((32 << 20) // (8 if quick else 1))  # 256 MiB (quick: 32 MiB)
+    with _Pinned():
+        times, _ = interleaved({"ideal": lambda: ideal(s, t, net, P, Pu, Pv), "read": lambda: a.sum()},
+                               3 if quick else 7)
+    compute = n / min(times["ideal"])
+    bandwidth = a.nbytes / min(times["read"])
+    return compute, bandwidth / BYTES_PER_POINT, bandwidth
+
+
+def _stats(x):
+    x = np.asarray(x, dtype=float)
+    return float(x.min()), float(np.median(x)), float(x.max())
+
+
+def osd_side_by_side(n, rng, quick=False, setup_only=False, rounds=7):
+    """OpenSubdiv Far and Bfr in this process (scripts/_osd.py, ctypes), alternating with ours round by
+    round on one pinned CPU; returns the table rows."""
+    print("\n5. side by side with OpenSubdiv in this process (positions + first derivatives)")
+    import _osd
+
+    why = _osd.why_unavailable()
+    if why:
+        print(f"   {why}. Skipped.")
+        return None
+    lib = _osd.load()
+    import os
+
+    threads = len(os.sched_getaffinity(0))
+    rounds = 2 if quick else rounds
+    compute = memory = None
+    if _has_numba() and not setup_only:
+        compute, memory, bw = hardware_bounds(quick)
+        print(f"   this machine, one thread: ideal compiled work {compute / 1e6:.1f} M points/s (compute bound); "
+              f"read bandwidth {bw / 2**30:.1f} GiB/s / {BYTES_PER_POINT} B = {memory / 1e6:.1f} M points/s "
+              f"(memory bound)")
+        if threads > 1:
+            machine_ceiling(threads, quick)
+    rows = []
+    for label, path in SHAPES:
+        mesh = read_mesh(path)
+        # setup, in this process: OpenSubdiv Far (refiner + adaptive patch table + patch map + local points),
+        # Bfr (factory + a prepared Surface per face), ours (the evaluator; the disk cache is warm after the
+        # first build); interleaved
+        limit_surface(mesh)
+        st, _ = interleaved({"far": lambda m=mesh: _osd.Evaluator(lib, "far", m).close(),
+                             "bfr": lambda m=mesh: _osd.Evaluator(lib, "bfr", m, approx=10).close(),
+                             "ours": lambda m=mesh: limit_surface(m)}, 3 if quick else rounds)
+        cold, warm = fresh_process_setups(path)
+        far_setup = min(st["far"])
+        print(f"   {label}: setup far {far_setup * 1e3:.1f} ms, bfr {min(st['bfr']) * 1e3:.1f} ms, ours in this "
+              f"process {min(st['ours']) * 1e3:.1f} ms ({min(st['ours']) / far_setup:.1f}x far); ours in a fresh "
+              f"process (imports excluded): disk cache filled {warm * 1e3:.0f} ms ({warm / far_setup:.1f}x), "
+              f"empty {cold * 1e3:.0f} ms ({cold / far_setup:.1f}x)")
+        if setup_only:
+            rows.append((label, far_setup, min(st["ours"]), cold, warm))
             continue
-        uni = (rng.integers(0, P, n), rng.random(n), rng.random(n))
-        fn, sn, tn, npairs = near_points(S, n, rng)
-        for dist, (f, s, t) in (("uniform", uni), ("near irregular", (fn, sn, tn))):
-            runs = [run_osd(exe, mesh, f, s, t) for _ in range(1 if quick else 3)]  # best of 3, as ours
-            osd_setup = min(r[0] for r in runs)
-            osd_eval = min(r[1] for r in runs)
-            _, _, oP, oPs, oPt = runs[0]
-            rate_osd = n / osd_eval
-            res = {}
-            configs = [("numpy", 1)] + ([("numba", 1), ("numba", threads)] if _has_numba() else [])
-            outs = {c: {k: np.empty((n, 3)) for k in ("P", "Pu", "Pv")} for c in configs}
-            for be, _ in configs:
-                S.evaluate(f[:10], s[:10], t[:10], 1, backend=be)  # compile / warm up
-            times = {c: [] for c in configs}
-            # the configurations take turns, so that each sees the same machine; best of 5 (quick: 1)
-            for _ in range(1 if quick else 5):
-                for be, th in configs:
-                    w0 = time.perf_counter()
-                    S.evaluate(f, s, t, 1, out=outs[(be, th)], backend=be, threads=th)
-                    times[(be, th)].append(time.perf_counter() - w0)
-            for c in configs:
-                res[c] = (n / min(times[c]), outs[c])
-            out = res[("numpy", 1)][1]
-            ok = np.isfinite(oP).all(axis=1)
-            dP = np.abs(out["P"][ok] - oP[ok]).max() / mesh.bounding_box_diagonal
-            dD = np.abs(out["Pu"][ok] - oPs[ok]).max() / mesh.bounding_box_diagonal
-            rows.append((label, dist, setup, osd_setup, rate_osd, res, dP, dD))
-            extra = f", {npairs} irregular corners" if dist != "uniform" else ""
-            print(f"   {label}, {dist} ({n:,} points{extra}): setup ours {setup:.3f} s, "
-                  f"OpenSubdiv {osd_setup:.3f} s ({setup / osd_setup:.1f}x)")
-            print(f"      OpenSubdiv Far, 1 thread: {rate_osd / 1e6:6.2f} M points/s")
-            for (be, th), (rate, _) in res.items():
-                print(f"      ours {be:5s} {th} thread{'s' if th > 1 else ' '}: {rate / 1e6:6.2f} M points/s"
-                      f"  = {rate / rate_osd:5.2f} x OpenSubdiv")
-            if ("numba", threads) in res and threads > 1:
-                gain = res[("numba", threads)][0] / res[("numba", 1)][0]
-                med = float(np.median(times[("numba", 1)]) / np.median(times[("numba", threads)]))
-                print(f"      {threads} threads / 1 thread: {gain:.2f}x best, {med:.2f}x median (target >= 1.8x "
-                      f"with 2 threads; this machine's ceiling above)")
-            print(f"      max |P ours - P OpenSubdiv| / diagonal {dP:.1e}, |Ps| {dD:.1e} (OpenSubdiv's end caps"
-                  f" near irregular vertices are approximations)")
+        S = limit_surface(mesh)
+        far = _osd.Evaluator(lib, "far", mesh)
+        bfr = _osd.Evaluator(lib, "bfr", mesh, approx=10)
+        diag = mesh.bounding_box_diagonal
+        fu, su, tu = uniform_points(mesh, n, rng)
+        fn, sn, tn, npairs = near_ev_points(mesh, n, rng)
+        for dist, (f, s, t) in (("uniform", (fu, su, tu)), ("near EVs", (fn, sn, tn))):
+            outs = {k: tuple(np.empty((n, 3)) for _ in range(3)) for k in ("far", "bfr", "numba", "numpy")}
+
+            def ours(be, th, key, f=f, s=s, t=t, outs=outs, S=S):
+                o = outs[key]
+                S.evaluate(f, s, t, 1, out={"P": o[0], "Pu": o[1], "Pv": o[2]}, backend=be, threads=th)
+
+            cases = {"far": lambda f=f, s=s, t=t, o=outs["far"], e=far: e.evaluate(f, s, t, out=o),
+                     "bfr": lambda f=f, s=s, t=t, o=outs["bfr"], e=bfr: e.evaluate(f, s, t, out=o),
+                     "numpy": lambda: ours("numpy", 1, "numpy")}
+            if _has_numba():
+                cases["numba"] = lambda: ours("numba", 1, "numba")
+            for c in cases.values():  # warm up (compile)
+                c()
+            with _Pinned():
+                times, load = interleaved(cases, rounds)
+            rate = {k: n / np.asarray(v) for k, v in times.items()}
+            ratio = {k: rate[k] / rate["far"] for k in rate}  # per round: the same round's Far
+            oP = outs["far"][0]
+            P = outs["numba" if "numba" in outs else "numpy"][0]
+            dP = np.abs(P - oP).max() / diag
+            dB = np.abs(outs["bfr"][0] - oP).max() / diag
+            med_dP = float(np.median(np.abs(P - oP).max(axis=1))) / diag
+            extra = f", {npairs} extraordinary corners" if dist != "uniform" else ""
+            print(f"   {label}, {dist} ({n:,} points{extra}); load {min(load):.2f}-{max(load):.2f}; "
+                  f"{rounds} rounds, one pinned CPU")
+            for k in rate:
+                lo, md, hi = _stats(rate[k])
+                rlo, rmd, rhi = _stats(ratio[k])
+                bounds = ""
+                if compute:
+                    bounds = f"; {md / compute:5.1%} of compute bound, {md / memory:5.1%} of memory bound"
+                print(f"      {k:6s} {md / 1e6:6.2f} M points/s (min {lo / 1e6:.2f}, max {hi / 1e6:.2f}); "
+                      f"/ far: median {rmd:.2f} ({rlo:.2f}-{rhi:.2f}){bounds}")
+            two = None
+            if _has_numba() and threads > 1:
+                t2, _ = interleaved({"1": lambda: ours("numba", 1, "numba"),
+                                     str(threads): lambda: ours("numba", threads, "numba")}, rounds)
+                two = _stats(np.asarray(t2["1"]) / np.asarray(t2[str(threads)]))
+                print(f"      numba {threads} threads / 1 thread: median {two[1]:.2f} ({two[0]:.2f}-{two[2]:.2f})")
+            print(f"      max |P ours - P far| / diagonal {dP:.1e} (median over points {med_dP:.1e}); "
+                  f"bfr (approximation level 10) vs far {dB:.1e}; Far's Gregory end caps at extraordinary "
+                  f"vertices are approximations")
+            rows.append((label, dist, {k: _stats(ratio[k]) for k in rate}, two, load))
+        far.close()
+        bfr.close()
     return rows
 
 
@@ -448,13 +419,15 @@ def main(argv=None):
     ap.add_argument("--quick", action="store_true", help="small sizes (smoke test)")
     ap.add_argument("--osd-points", type=int, default=1_000_000)
     ap.add_argument("--osd-only", action="store_true", help="only part 5 (OpenSubdiv side by side)")
+    ap.add_argument("--rounds", type=int, default=7, help="interleaved rounds of part 5 (at least 7)")
     ap.add_argument("--setup-only", action="store_true", help="only the setup times of part 5")
     args = ap.parse_args(argv)
     if args.setup_only:
         osd_side_by_side(0, np.random.default_rng(2024), setup_only=True)
         return 0
     if args.osd_only:
-        osd_side_by_side(args.osd_points if not args.quick else 20_000, np.random.default_rng(2024), args.quick)
+        osd_side_by_side(args.osd_points if not args.quick else 20_000, np.random.default_rng(2024), args.quick,
+                         rounds=args.rounds)
         return 0
     if args.quick:
         args.points, args.memory_points, args.naive_points, args.pygel_levels = 20_000, 50_000, 200, 2
@@ -572,15 +545,16 @@ def main(argv=None):
         io = sum(a.nbytes for a in (fm, um, vm)) + sum(a.nbytes for a in outm.values())
         print(f"   {be:6s}: {peak / 2**20:8.1f} MiB extra (inputs + outputs: {io / 2**20:.0f} MiB; "
               f"patch tables {S._nets.nbytes / 2**20:.1f} MiB)")
-    osd = osd_side_by_side(args.osd_points if not args.quick else 20_000, rng, args.quick)
+    osd = osd_side_by_side(args.osd_points if not args.quick else 20_000, rng, args.quick, rounds=args.rounds)
     print("\nsummary:")
     for be in backends:
         print(f"   {be}: {rates[be][1] / 1e6:.2f} M points/s (P + first derivatives, single thread, CPU time)")
     if osd:
-        print("   ours / OpenSubdiv Far (1 thread), points/s:")
-        for label, dist, setup, osd_setup, rate_osd, res, _, _ in osd:
-            parts = ", ".join(f"{be} {th}t {rate / rate_osd:.2f}x" for (be, th), (rate, _) in res.items())
-            print(f"      {label:32s} {dist:15s} {parts}; setup {setup / osd_setup:.1f}x OpenSubdiv's")
+        print("   / OpenSubdiv Far, one pinned CPU, median over rounds (min-max):")
+        for label, dist, ratios, two, load in osd:
+            parts = ", ".join(f"{k} {md:.2f} ({lo:.2f}-{hi:.2f})" for k, (lo, md, hi) in ratios.items() if k != "far")
+            tt = f"; 2 threads / 1: {two[1]:.2f}" if two else ""
+            print(f"      {label:15s} {dist:9s} {parts}{tt}; load {min(load):.2f}-{max(load):.2f}")
     return 0
 
 

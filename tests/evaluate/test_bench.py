@@ -18,27 +18,32 @@ def test_bench_quick(capsys, refdir):
 
 
 @pytest.mark.slow
-def test_opensubdiv_driver_agrees_on_regular_points(refdir):
-    """The benchmark's OpenSubdiv driver (system libosd) and ours agree on points in regular patches."""
+@pytest.mark.parametrize("kind", ["far", "bfr"])
+def test_opensubdiv_in_process_agrees_on_regular_points(refdir, kind):
+    """The benchmark's in-process OpenSubdiv (scripts/osd_capi.cpp through ctypes, system libosd) and ours
+    agree on points inside regular patches, positions and (s, t) derivatives, n-gon sub-faces included."""
+    import sys
+
     import numpy as np
 
-    path = Path(__file__).resolve().parents[2] / "scripts" / "bench_evaluate.py"
-    spec = importlib.util.spec_from_file_location("bench_evaluate", path)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    exe = mod.build_osd_driver()
-    if exe is None:
-        pytest.skip("OpenSubdiv (libosd-dev) or g++ not installed")
+    sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "scripts"))
+    import _osd
+
+    if _osd.why_unavailable():
+        pytest.skip(_osd.why_unavailable())
     from ccproof.evaluate import limit_surface
     from ccproof.mesh.io import read_mesh
 
-    mesh = read_mesh(refdir / "osd_features" / "meshes" / "catmark_pyramid_creases1.obj")
-    S = limit_surface(mesh)
-    rng = np.random.default_rng(0)
-    n = 2000
-    f, s, t = rng.integers(0, mesh.n_ptex, n), 0.1 + 0.8 * rng.random(n), 0.1 + 0.8 * rng.random(n)
-    _, _, P, Ps, Pt = mod.run_osd(exe, mesh, f, s, t)
-    r = S.evaluate(f, s, t, 1)
-    diag = mesh.bounding_box_diagonal
-    assert np.abs(r["P"] - P).max() <= 1e-12 * diag
-    assert max(np.abs(r["Pu"] - Ps).max(), np.abs(r["Pv"] - Pt).max()) <= 1e-9 * diag
+    lib = _osd.load()
+    for name in ("catmark_pyramid_creases1", "catmark_smoothtris1", "catmark_nonquads"):
+        mesh = read_mesh(refdir / "osd_features" / "meshes" / f"{name}.obj")
+        S = limit_surface(mesh)
+        rng = np.random.default_rng(0)
+        n = 2000
+        ok = np.flatnonzero(np.repeat(~mesh.is_hole, np.where(mesh.sizes == 4, 1, mesh.sizes)))
+        f, s, t = ok[rng.integers(0, ok.size, n)], 0.1 + 0.8 * rng.random(n), 0.1 + 0.8 * rng.random(n)
+        P, Ps, Pt = _osd.Evaluator(lib, kind, mesh, approx=10).evaluate(f, s, t)
+        r = S.evaluate(f, s, t, 1)
+        diag = mesh.bounding_box_diagonal
+        assert np.abs(r["P"] - P).max() <= 1e-12 * diag, name
+        assert max(np.abs(r["Pu"] - Ps).max(), np.abs(r["Pv"] - Pt).max()) <= 1e-9 * diag, name
