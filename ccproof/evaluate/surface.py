@@ -883,7 +883,7 @@ class LimitSurface:
         maps = self.__dict__.get("_maps")
         if maps is None:
             maps = self._maps = _vertex_maps(self)
-        V = mesh.vertices
+        V = np.where(mesh.is_unused_vertex[:, None], 0.0, mesh.vertices)  # unused: any value, weight 0
         new = object.__new__(LimitSurface)
         new.__dict__.update(self.__dict__)
         new.mesh = mesh

@@ -77,9 +77,6 @@ def test_meshio_input(tmp_path):
 
 
 @pytest.mark.parametrize("kwargs,msg", [
-    ({"faces": [[0, 1, 4, 3], [1, 4, 2, 5], [4, 1, 6]]}, r"non-manifold edge \(1, 4\): shared by 3 faces"),
-    ({"faces": [[0, 1, 3], [1, 2, 4], [4, 5, 1]], "n": 6}, r"non-manifold vertex 1: its faces form 2 separate fans"),
-    ({"faces": [[0, 1, 4, 3], [1, 4, 5, 2]]}, r"inconsistent orientation: faces 0 and 1 both traverse edge \(1, 4\)"),
     ({"creases": {(0, 5): 1.0}}, r"crease on edge \(0, 5\): no such edge in the mesh"),
     ({"creases": {(0, 1): -0.5}}, r"crease on edge \(0, 1\): negative sharpness -0.5"),
     ({"creases": {(0, 1): float("nan")}}, r"crease on edge \(0, 1\): sharpness is NaN"),
@@ -102,6 +99,37 @@ def test_bad_input_names_the_element(kwargs, msg):
     F = kwargs.pop("faces", F)
     with pytest.raises(MeshError, match=msg):
         PolyMesh(V, F, **kwargs)
+
+
+@pytest.mark.parametrize("faces,n,nm_edges,nm_vertices", [
+    ([[0, 1, 4, 3], [1, 4, 2, 5], [4, 1, 6]], 7, [[1, 4]], [1, 4]),  # an edge of three faces
+    ([[0, 1, 3], [1, 2, 4], [4, 5, 1]], 6, [], [1]),  # two fans at vertex 1
+    ([[0, 1, 4, 3], [1, 4, 5, 2]], 6, [[1, 4]], [1, 4]),  # two faces traverse (1, 4) the same way
+    ([[0, 1, 2], [0, 1, 2]], 3, [[0, 1], [0, 2], [1, 2]], [0, 1, 2]),  # a face given twice
+])
+def test_nonmanifold_meshes_are_classified_as_opensubdiv_does(faces, n, nm_edges, nm_vertices):
+    """OpenSubdiv's Vtr::Level: an edge with more than two faces or two faces in the same direction is
+    non-manifold, so are its end vertices and every vertex whose faces form more than one fan."""
+    V = np.random.default_rng(0).random((n, 3))
+    m = PolyMesh(V, faces)
+    assert not m.is_manifold
+    assert m.nonmanifold_edges.tolist() == nm_edges
+    assert np.flatnonzero(m.is_nonmanifold_vertex).tolist() == nm_vertices
+    M = m.manifold  # every fan of a non-manifold vertex on its own, same faces
+    assert M.is_manifold and M.n_faces == m.n_faces and M.n_ptex == m.n_ptex
+    assert np.array_equal(M.vertices, V[m.manifold_vertex_map])
+    for p, q in zip(m.polygons, M.polygons):
+        assert m.manifold_vertex_map[list(q)].tolist() == list(p)
+
+
+def test_unused_vertices_keep_their_indices():
+    V = np.array([[np.nan] * 3, [0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [np.inf, 0, 0]], float)
+    m = PolyMesh(V, [[1, 2, 3, 4]])
+    assert m.is_unused_vertex.tolist() == [True, False, False, False, False, True] and m.is_manifold
+    assert m.bounding_box_diagonal == pytest.approx(np.sqrt(2))
+    V[2, 0] = np.nan
+    with pytest.raises(MeshError, match=r"vertex 2 has a non-finite coordinate"):
+        PolyMesh(V, [[1, 2, 3, 4]])
 
 
 def test_obj_tag_errors(tmp_path):

@@ -1,0 +1,249 @@
+// Reference values of the limit surface from OpenSubdiv (Far/Vtr/Sdc, CPU, double precision).
+//
+// Build (Debian libosd-dev 3.5.0):  g++ -O2 -std=c++14 driver.cpp -o osd_driver -losdCPU
+// Run:                              ./osd_driver MESH.obj|MESH.off SEED > osd_limit_MESH.json
+//
+// Reads the vertices and faces of an OBJ (v/f lines; any /vt/vn suffix ignored) or OFF file, all
+// vertices kept (unused ones too), 0-based in file order. Sdc::SCHEME_CATMARK, VTX_BOUNDARY_EDGE_ONLY,
+// CREASE_UNIFORM, no tags. TopologyRefinerFactory<TopologyDescriptor> (default options: no full
+// topology validation, as OpenSubdiv's own tools), RefineAdaptive(isolation 10, useInfSharpPatch),
+// PatchTableFactory (ENDCAP_GREGORY_BASIS, useInfSharpPatch, generateLegacySharpCornerPatches=false,
+// useSingleCreasePatch=false, double-precision stencils), PrimvarRefiner + local point stencils for
+// the refined points, PatchMap to locate (ptex face, s, t), PatchTable::EvaluateBasis for P and the
+// first and second derivatives. Samples: per ptex face the 5x5 grid s,t in {0,1/4,1/2,3/4,1}, the
+// points (2^-k, 2^-k-1) and their mirror images at each corner for k = 2..12, and 8 random points.
+// Also the level-0 tags OpenSubdiv assigned (non-manifold edges/vertices, sharpness, vertex rule).
+#include <opensubdiv/far/patchMap.h>
+#include <opensubdiv/far/patchTable.h>
+#include <opensubdiv/far/patchTableFactory.h>
+#include <opensubdiv/far/primvarRefiner.h>
+#include <opensubdiv/far/ptexIndices.h>
+#include <opensubdiv/far/topologyDescriptor.h>
+#include <opensubdiv/version.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+using namespace OpenSubdiv;
+typedef Far::TopologyDescriptor Descriptor;
+
+struct Pt {
+    double x[3];
+    void Clear() { x[0] = x[1] = x[2] = 0; }
+    void AddWithWeight(Pt const &p, double w) {
+        for (int i = 0; i < 3; ++i) x[i] += w * p.x[i];
+    }
+};
+
+static void readMesh(const std::string &path, std::vector<double> &V, std::vector<int> &sizes,
+                     std::vector<int> &idx) {
+    std::ifstream in(path);
+    if (!in) { fprintf(stderr, "cannot open %s\n", path.c_str()); exit(2); }
+    bool off = path.size() > 4 && path.substr(path.size() - 4) == ".off";
+    std::string line;
+    if (off) {
+        std::vector<std::string> toks;
+        while (std::getline(in, line)) {
+            size_t h = line.find('#');
+            if (h != std::string::npos) line = line.substr(0, h);
+            std::istringstream ss(line);
+            std::string t;
+            while (ss >> t) toks.push_back(t);
+        }
+        size_t k = 0;
+        if (toks[k] == "OFF") ++k;
+        int nv = atoi(toks[k++].c_str()), nf = atoi(toks[k++].c_str());
+        ++k;  // edges
+        for (int i = 0; i < 3 * nv; ++i) V.push_back(strtod(toks[k++].c_str(), 0));
+        for (int f = 0; f < nf; ++f) {
+            int n = atoi(toks[k++].c_str());
+            sizes.push_back(n);
+            for (int i = 0; i < n; ++i) idx.push_back(atoi(toks[k++].c_str()));
+        }
+        return;
+    }
+    while (std::getline(in, line)) {
+        std::istringstream ss(line);
+        std::string tag;
+        if (!(ss >> tag)) continue;
+        if (tag == "v") {
+            std::string a, b, c;
+            ss >> a >> b >> c;
+            V.push_back(strtod(a.c_str(), 0));
+            V.push_back(strtod(b.c_str(), 0));
+            V.push_back(strtod(c.c_str(), 0));
+        } else if (tag == "f") {
+            std::string t;
+            int n = 0;
+            while (ss >> t) {
+                idx.push_back(atoi(t.substr(0, t.find('/')).c_str()) - 1);
+                ++n;
+            }
+            sizes.push_back(n);
+        }
+    }
+}
+
+static void put(const double *p) {
+    if (!(std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]))) { printf("null"); return; }
+    printf("[%.17g, %.17g, %.17g]", p[0], p[1], p[2]);
+}
+
+int main(int argc, char **argv) {
+    if (argc < 3) { fprintf(stderr, "usage: %s MESH SEED\n", argv[0]); return 2; }
+    std::vector<double> V;
+    std::vector<int> sizes, idx;
+    readMesh(argv[1], V, sizes, idx);
+    int nv = (int)V.size() / 3, nf = (int)sizes.size();
+
+    Sdc::Options sdc;
+    sdc.SetVtxBoundaryInterpolation(Sdc::Options::VTX_BOUNDARY_EDGE_ONLY);
+    sdc.SetCreasingMethod(Sdc::Options::CREASE_UNIFORM);
+    Descriptor desc;
+    desc.numVertices = nv;
+    desc.numFaces = nf;
+    desc.numVertsPerFace = sizes.data();
+    desc.vertIndicesPerFace = idx.data();
+    Far::TopologyRefiner *refiner = Far::TopologyRefinerFactory<Descriptor>::Create(
+        desc, Far::TopologyRefinerFactory<Descriptor>::Options(Sdc::SCHEME_CATMARK, sdc));
+    if (!refiner) { fprintf(stderr, "OpenSubdiv refused the mesh\n"); return 3; }
+
+    // level-0 tags before refinement
+    Far::TopologyLevel const &L0 = refiner->GetLevel(0);
+    std::vector<int> nmVerts, nmEdges;
+    std::vector<float> vSharp(nv);
+    std::vector<int> vRule(nv);
+    for (int v = 0; v < nv; ++v) {
+        if (L0.IsVertexNonManifold(v)) nmVerts.push_back(v);
+        vSharp[v] = L0.GetVertexSharpness(v);
+        vRule[v] = (int)L0.GetVertexRule(v);
+    }
+    for (int e = 0; e < L0.GetNumEdges(); ++e)
+        if (L0.IsEdgeNonManifold(e)) nmEdges.push_back(e);
+    std::vector<int> edgeVerts;
+    std::vector<float> eSharp;
+    for (int e = 0; e < L0.GetNumEdges(); ++e) {
+        Far::ConstIndexArray ev = L0.GetEdgeVertices(e);
+        edgeVerts.push_back(ev[0]);
+        edgeVerts.push_back(ev[1]);
+        eSharp.push_back(L0.GetEdgeSharpness(e));
+    }
+    int nEdges0 = L0.GetNumEdges();
+
+    const int level = 10;
+    Far::TopologyRefiner::AdaptiveOptions aopts(level);
+    aopts.useInfSharpPatch = true;
+    refiner->RefineAdaptive(aopts);
+
+    Far::PatchTableFactory::Options popts(level);
+    popts.SetEndCapType(Far::PatchTableFactory::Options::ENDCAP_GREGORY_BASIS);
+    popts.useInfSharpPatch = true;
+    popts.generateLegacySharpCornerPatches = false;
+    popts.useSingleCreasePatch = false;
+    popts.SetPatchPrecision<double>();
+    Far::PatchTable const *table = Far::PatchTableFactory::Create(*refiner, popts);
+
+    int nRefined = refiner->GetNumVerticesTotal();
+    int nLocal = table->GetNumLocalPoints();
+    std::vector<Pt> verts(nRefined + nLocal);
+    for (int i = 0; i < nv; ++i)
+        for (int j = 0; j < 3; ++j) verts[i].x[j] = V[3 * i + j];
+    Far::PrimvarRefinerReal<double> primvar(*refiner);
+    Pt *src = &verts[0];
+    for (int l = 1; l <= refiner->GetMaxLevel(); ++l) {
+        Pt *dst = src + refiner->GetLevel(l - 1).GetNumVertices();
+        primvar.Interpolate(l, src, dst);
+        src = dst;
+    }
+    if (nLocal) table->GetLocalPointStencilTable<double>()->UpdateValues(&verts[0], &verts[nRefined]);
+
+    Far::PtexIndices ptex(*refiner);
+    Far::PatchMap pmap(*table);
+
+    std::vector<double> S, T;
+    std::vector<int> F;
+    std::mt19937_64 rng(strtoull(argv[2], 0, 10));
+    std::uniform_real_distribution<double> U(0.0, 1.0);
+    int nptex = ptex.GetNumFaces();
+    for (int p = 0; p < nptex; ++p) {
+        for (int i = 0; i <= 4; ++i)
+            for (int j = 0; j <= 4; ++j) { F.push_back(p); S.push_back(i / 4.0); T.push_back(j / 4.0); }
+        for (int k = 2; k <= 12; ++k) {
+            double a = std::ldexp(1.0, -k), b = std::ldexp(1.0, -k - 1);
+            double cs[4][2] = {{a, b}, {1 - a, b}, {1 - b, 1 - a}, {b, 1 - a}};
+            for (auto &c : cs) { F.push_back(p); S.push_back(c[0]); T.push_back(c[1]); }
+        }
+        for (int r = 0; r < 8; ++r) { F.push_back(p); S.push_back(U(rng)); T.push_back(U(rng)); }
+    }
+
+    printf("{\n  \"generator\": \"tests/data/osd_nonmanifold/driver.cpp\",\n");
+    printf("  \"opensubdiv_version\": \"%s\",\n", "3.5.0 (Debian libosd-dev 3.5.0-2, OPENSUBDIV_VERSION_NUMBER 30500)");
+    printf("  \"mesh\": \"%s\",\n", argv[1]);
+    printf("  \"settings\": {\"scheme\": \"CATMARK\", \"boundary\": \"VTX_BOUNDARY_EDGE_ONLY\", \"crease\": \"CREASE_UNIFORM\", "
+           "\"isolation_level\": %d, \"end_cap\": \"ENDCAP_GREGORY_BASIS\", \"useInfSharpPatch\": true, "
+           "\"generateLegacySharpCornerPatches\": false, \"useSingleCreasePatch\": false, \"precision\": \"double\", "
+           "\"seed\": %s},\n", level, argv[2]);
+    printf("  \"num_vertices\": %d, \"num_faces\": %d, \"num_ptex_faces\": %d, \"num_edges\": %d,\n", nv, nf, nptex, nEdges0);
+    printf("  \"nonmanifold_vertices\": [");
+    for (size_t i = 0; i < nmVerts.size(); ++i) printf("%s%d", i ? ", " : "", nmVerts[i]);
+    printf("],\n  \"nonmanifold_edges\": [");
+    for (size_t i = 0; i < nmEdges.size(); ++i)
+        printf("%s[%d, %d]", i ? ", " : "", edgeVerts[2 * nmEdges[i]], edgeVerts[2 * nmEdges[i] + 1]);
+    printf("],\n  \"vertex_sharpness\": [");
+    for (int v = 0; v < nv; ++v) printf("%s%.9g", v ? ", " : "", vSharp[v]);
+    printf("],\n  \"vertex_rule\": [");
+    const char *rules[] = {"unknown", "smooth", "dart", "crease", "", "", "", "", "corner"};
+    for (int v = 0; v < nv; ++v) printf("%s\"%s\"", v ? ", " : "", (vRule[v] >= 0 && vRule[v] <= 8) ? rules[vRule[v]] : "?");
+    printf("],\n  \"edges\": [");
+    for (int e = 0; e < nEdges0; ++e)
+        printf("%s[%d, %d, %.9g]", e ? ", " : "", edgeVerts[2 * e], edgeVerts[2 * e + 1], eSharp[e]);
+    printf("],\n  \"faces\": [");
+    for (int f = 0; f < nf; ++f) printf("%s{\"size\": %d, \"ptex\": %d}", f ? ", " : "", sizes[f], ptex.GetFaceId(f));
+    printf("],\n  \"samples\": [\n");
+    double wP[20], wDs[20], wDt[20], wDss[20], wDst[20], wDtt[20];
+    for (size_t i = 0; i < F.size(); ++i) {
+        double s = S[i], t = T[i];
+        Far::PatchTable::PatchHandle const *h = pmap.FindPatch(F[i], s, t);
+        if (!h) { fprintf(stderr, "no patch at %d %g %g\n", F[i], s, t); return 4; }
+        table->EvaluateBasis(*h, s, t, wP, wDs, wDt, wDss, wDst, wDtt);
+        Far::ConstIndexArray cvs = table->GetPatchVertices(*h);
+        Far::PatchParam param = table->GetPatchParam(*h);
+        Far::PatchDescriptor::Type type = table->GetPatchDescriptor(*h).GetType();
+        double P[3] = {0, 0, 0}, Ps[3] = {0, 0, 0}, Pt[3] = {0, 0, 0}, Pss[3] = {0, 0, 0}, Pst[3] = {0, 0, 0},
+               Ptt[3] = {0, 0, 0};
+        for (int c = 0; c < cvs.size(); ++c) {
+            const double *x = verts[cvs[c]].x;
+            for (int j = 0; j < 3; ++j) {
+                P[j] += wP[c] * x[j];
+                Ps[j] += wDs[c] * x[j];
+                Pt[j] += wDt[c] * x[j];
+                Pss[j] += wDss[c] * x[j];
+                Pst[j] += wDst[c] * x[j];
+                Ptt[j] += wDtt[c] * x[j];
+            }
+        }
+        // EvaluateBasis scales by 2^depth also under an n-gon, whose patches span 2^-(depth-1)
+        // of the ptex sub-face: divide to get derivatives with respect to the ptex (s, t)
+        if (param.NonQuadRoot()) {
+            for (int j = 0; j < 3; ++j) {
+                Ps[j] /= 2; Pt[j] /= 2; Pss[j] /= 4; Pst[j] /= 4; Ptt[j] /= 4;
+            }
+        }
+        bool exact = (type == Far::PatchDescriptor::REGULAR);
+        printf("    {\"ptex\": %d, \"s\": %.17g, \"t\": %.17g, \"exact\": %s, \"patch_depth\": %d, \"P\": ", F[i], s, t,
+               exact ? "true" : "false", param.GetDepth());
+        put(P); printf(", \"Ps\": "); put(Ps); printf(", \"Pt\": "); put(Pt);
+        printf(", \"Pss\": "); put(Pss); printf(", \"Pst\": "); put(Pst); printf(", \"Ptt\": "); put(Ptt);
+        printf("}%s\n", i + 1 < F.size() ? "," : "");
+    }
+    printf("  ]\n}\n");
+    delete table;
+    delete refiner;
+    return 0;
+}
