@@ -396,6 +396,33 @@ class PolyMesh:
         return bool((self.sizes == 4).all())
 
     @property
+    def is_plain_quads(self):
+        """All quads, no tags, manifold: the mesh is a :class:`~ccproof.mesh.QuadMesh` (see :meth:`to_quad_mesh`)."""
+        return self.is_all_quads and not self.has_tags and self.is_manifold
+
+    def to_quad_mesh(self):
+        """The same mesh as a :class:`~ccproof.mesh.QuadMesh` (same vertices, unused ones included, same faces).
+
+        Raises
+        ------
+        MeshError
+            If the mesh is not :attr:`is_plain_quads` (the message says why).
+
+        Examples
+        --------
+        >>> m = PolyMesh([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [9, 9, 9]], [[0, 1, 2, 3]])
+        >>> m.is_plain_quads, m.to_quad_mesh()
+        (True, QuadMesh(5 vertices, 1 faces, 4 boundary edges, 0 extraordinary vertices))
+        """
+        from ccproof.mesh.quadmesh import QuadMesh
+
+        if not self.is_plain_quads:
+            why = ("it has faces that are not quads" if not self.is_all_quads else
+                   "it has OpenSubdiv tags" if self.has_tags else "it is not manifold")
+            raise MeshError(f"not a plain quad mesh: {why}")
+        return QuadMesh(self.vertices, np.array(self.polygons, dtype=np.int64).reshape(-1, 4))
+
+    @property
     def has_tags(self):
         """Creases, corners, holes or non-default options."""
         return bool(self.edge_sharpness or self.vertex_sharpness or self.is_hole.any()
