@@ -24,7 +24,8 @@ from ccproof.evaluate.tagged import TaggedLimitSurface
 from ccproof.mesh import PolyMesh, QuadMesh
 from ccproof.mesh.io import read_mesh
 
-MESHES = ["book4.obj", "two_cubes.obj", "bowtie.obj", "dupface.obj", "flipped.obj", "unused.obj", "prism.off"]
+MESHES = ["book4.obj", "two_cubes.obj", "bowtie.obj", "dupface.obj", "flipped.obj", "unused.obj", "prism.off",
+          "book4_tags.obj", "book4_infpage.obj", "bowtie_none.obj", "two_cubes_creases.obj"]
 
 
 def _path(refdir, name):
@@ -37,14 +38,35 @@ def _ref(refdir, name):
     return json.loads((refdir / "osd_nonmanifold" / f"osd_limit_{stem}.json").read_text())
 
 
-def _exact(d):
+#: where OpenSubdiv's patch is not the limit of its own rules: at a non-manifold vertex that is a corner by
+#: three infinitely sharp edges (vertex sharpness 0), Far::PatchBuilder takes a fan of two faces between
+#: the non-manifold edges for a regular crease patch; the vertex rule keeps the vertex fixed (corner).
+#: mesh -> (vertex, half-width of the excluded square at its ptex corners; the level-10 patch is 2^-10)
+OSD_CORNER_AS_CREASE = {"book4_infpage.obj": (1, 2.0**-10)}
+_CORNER_ST = ((0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0))
+
+
+def _near_vertex(mesh, rows, v, r):
+    """Samples of quad ptex faces within max-norm distance r of a ptex corner at vertex v."""
+    out = []
+    for s in rows:
+        f, _ = mesh.face_of_ptex(s["ptex"])
+        p = mesh.polygons[f]
+        out.append(len(p) == 4 and v in p and max(abs(s["s"] - _CORNER_ST[p.index(v)][0]),
+                                                  abs(s["t"] - _CORNER_ST[p.index(v)][1])) < r)
+    return np.array(out, dtype=bool)
+
+
+def _exact(d, mesh=None, name=None):
     rows = [s for s in d["samples"] if s["exact"]]
+    if name in OSD_CORNER_AS_CREASE:
+        rows = [s for s, near in zip(rows, _near_vertex(mesh, rows, *OSD_CORNER_AS_CREASE[name])) if not near]
     f, s, t = (np.array([r[k] for r in rows]) for k in ("ptex", "s", "t"))
     return f, s, t, {k: np.array([r[k] for r in rows]) for k in ("P", "Ps", "Pt")}
 
 
-def _compare(S, d, diag):
-    f, s, t, ref = _exact(d)
+def _compare(S, d, diag, name=None):
+    f, s, t, ref = _exact(d, S.mesh, name)
     assert f.size >= 0.85 * len(d["samples"])  # most samples are on regular patches
     out = S.evaluate(f, s, t, 1)
     for key, rk, tol in (("P", "P", 1e-12), ("Pu", "Ps", 1e-10), ("Pv", "Pt", 1e-10)):
@@ -63,18 +85,50 @@ def test_mesh_matches_opensubdiv(refdir, name):
     osd_nm = sorted(set(d["nonmanifold_vertices"]) - set(np.flatnonzero(mesh.is_unused_vertex).tolist()))
     assert np.flatnonzero(mesh.is_nonmanifold_vertex).tolist() == osd_nm
     assert sorted(map(sorted, d["nonmanifold_edges"])) == mesh.nonmanifold_edges.tolist()
-    # its sharpening: infinitely sharp vertices are corners on every split copy, crease vertices are not
+    # its sharpening: infinitely sharp vertices are corners on every split copy, crease vertices keep
+    # their own sharpness
     M, vmap = mesh.manifold, mesh.manifold_vertex_map
     for v in osd_nm:
         copies = np.flatnonzero(vmap == v).tolist()
         sharp = [M.vertex_sharpness.get(c, 0.0) for c in copies]
         if d["vertex_sharpness"][v] >= 10:
             assert sharp == [math.inf] * len(copies) and d["vertex_rule"][v] == "corner"
-        else:
-            assert sharp == [0.0] * len(copies) and d["vertex_rule"][v] == "crease"
+        elif d["vertex_rule"][v] == "crease":
+            assert sharp == [d["vertex_sharpness"][v]] * len(copies) == [0.0] * len(copies)
+        elif d["vertex_sharpness"][v] > 0:  # a semi-sharp crease vertex: its own sharpness on every copy
+            assert sharp == [d["vertex_sharpness"][v]] * len(copies)
+        else:  # a corner by three infinitely sharp edges: a corner on every copy
+            assert sharp == [math.inf] * len(copies)
+    # holes (tagged, or OpenSubdiv's implicit ones under boundary mode none): no samples there
+    ptex_hole = np.repeat(mesh.is_hole, np.diff(mesh.ptex_start))
+    assert sorted({s["ptex"] for s in d["samples"]}) == np.flatnonzero(~ptex_hole).tolist()
     S = limit_surface(mesh)
     assert isinstance(S, TaggedLimitSurface)
-    _compare(S, d, mesh.bounding_box_diagonal)
+    _compare(S, d, mesh.bounding_box_diagonal, name)
+
+
+def test_opensubdiv_patch_at_a_corner_by_three_sharp_edges_is_not_its_limit(refdir):
+    """book4_infpage: vertex 1 ends two non-manifold edges and an infinitely sharp page edge, so its
+    rule is the corner rule (Sdc: three sharp edges; OpenSubdiv's own tags say 'corner'): every
+    subdivision step keeps it where it is, its limit is its position (closed form). OpenSubdiv's
+    level-10 "regular" patches of the three other pages put it 2e-5 away; ours put it there exactly."""
+    name = "book4_infpage.obj"
+    d = _ref(refdir, name)
+    mesh = read_mesh(_path(refdir, name))
+    assert d["vertex_rule"][1] == "corner" and d["vertex_sharpness"][1] == 0
+    S = limit_surface(mesh)
+    rows = [s for s in d["samples"] if s["exact"] and s["s"] in (0.0, 1.0) and s["t"] in (0.0, 1.0)]
+    at1 = [s for s, near in zip(rows, _near_vertex(mesh, rows, 1, 1e-300)) if near]
+    assert len(at1) == 6  # a corner sample on each face at vertex 1 of the three pages without the edge
+    ours = S.evaluate([s["ptex"] for s in at1], [s["s"] for s in at1], [s["t"] for s in at1], 0)["P"]
+    assert np.abs(ours - mesh.vertices[1]).max() <= 1e-15 * mesh.bounding_box_diagonal
+    osd = np.array([s["P"] for s in at1])
+    assert np.abs(osd - mesh.vertices[1]).max() > 1e-6 * mesh.bounding_box_diagonal
+    # the page with the sharp edge gets a corner patch there: OpenSubdiv and we agree
+    on_page0 = [s for s in d["samples"] if s["ptex"] in (0, 1) and s["exact"]]
+    f = [s["ptex"] for s in on_page0]
+    P = S.evaluate(f, [s["s"] for s in on_page0], [s["t"] for s in on_page0], 0)["P"]
+    assert np.abs(P - [s["P"] for s in on_page0]).max() <= 1e-12 * mesh.bounding_box_diagonal
 
 
 def test_the_book_has_a_crease_vertex_and_the_duplicate_face_is_accepted(refdir):
@@ -161,18 +215,24 @@ def test_project_command_reads_an_off_file(refdir, tmp_path):
     assert np.abs(r["distance"] - 1e-3).max() <= 1e-9
 
 
-def _fan_mesh(k, z, centre):
-    """k triangles around ``centre`` (closed fan) with rim vertices offset by ``z``."""
-    return [[np.cos(2 * np.pi * i / k), np.sin(2 * np.pi * i / k), z] for i in range(k)]
+def test_unsupported_nonmanifold_configurations_are_refused_by_name(refdir):
+    """The split of the fans is OpenSubdiv's surface only where every rule at a copy is the vertex's rule.
 
-
-def test_unsupported_nonmanifold_configurations_are_refused_by_name():
-    rng = np.random.default_rng(5)
-    # a non-manifold crease vertex (0) with an extra closed cone of faces touching it
-    book = [[0, 1, 2], [1, 0, 3], [0, 1, 4]]  # edge (0, 1) in three faces
-    book += [[1, 5, 2], [1, 3, 6], [1, 4, 7]]  # nothing else at 0 so far: 0 is a corner
-    V = rng.random((14, 3))
-    m = PolyMesh(V, book)
-    assert not m.is_manifold and m.manifold.vertex_sharpness.get(0) == math.inf
-    with pytest.raises(MeshError, match=r"Chaikin creases with a semi-sharp edge at a non-manifold vertex"):
-        PolyMesh(V, book, creases={(0, 2): 1.5}, options={"crease_method": "chaikin"})
+    Where it is not, the mesh is refused with the vertex and the reason (never evaluated differently)."""
+    book = read_mesh(_path(refdir, "book4.obj"))  # vertex 1: a non-manifold crease vertex (spine 0-1-2)
+    V, F = np.array(book.vertices), [list(p) for p in book.polygons]
+    with pytest.raises(MeshError, match=r"non-manifold crease vertex 1: another semi-sharp edge at it"):
+        PolyMesh(V, F, creases={(1, 4): 2.0})
+    with pytest.raises(MeshError, match=r"non-manifold vertex 0: Chaikin creases with a semi-sharp edge"):
+        PolyMesh(V, F, creases={(0, 3): 2.0}, options={"crease_method": "chaikin"})
+    # a closed cone (a tetrahedron) touching the crease vertex: the crease rule along the spine acts on
+    # the cone's fan too, which no manifold vertex reproduces
+    n = len(V)
+    V2 = np.vstack([V, V[1] + [[0.3, 0.1, 0.1], [0.1, 0.3, 0.1], [0.2, 0.2, 0.4]]])
+    cone = [[1, n, n + 1], [1, n + 1, n + 2], [1, n + 2, n], [n, n + 2, n + 1]]
+    with pytest.raises(MeshError, match=r"non-manifold crease vertex 1: a fan of faces \[16, 17, 18\] is not bounded"):
+        PolyMesh(V2, F + cone)
+    # accepted: the same cone at the corner vertex 0 (infinitely sharp: a corner on every fan)
+    cone0 = [[0 if v == 1 else v for v in f] for f in cone]
+    m = PolyMesh(np.vstack([V, V[0] + [[0.3, 0.1, 0.1], [0.1, 0.3, 0.1], [0.2, 0.2, 0.4]]]), F + cone0)
+    assert m.manifold.is_manifold and (m.manifold_vertex_map == 0).sum() == 5  # four pages and the cone
