@@ -277,7 +277,8 @@ def read_off_polygons(path):
     head = tok[0].upper()
     if head.endswith("OFF"):
         if head not in _OFF_KEYWORDS:
-            raise MeshError(f"{p}:{no}: OFF variant {tok[0]!r} is not supported (only 3-D ASCII OFF, COFF, NOFF, STOFF)")
+            raise MeshError(f"{p}:{no}: OFF variant {tok[0]!r} is not supported "
+                            "(only 3-D ASCII OFF, COFF, NOFF, STOFF)")
         if len(tok) > 1 and tok[1].upper() == "BINARY":
             raise MeshError(f"{p}:{no}: binary OFF is not supported (ASCII only)")
         tok = tok[1:]

@@ -11,9 +11,16 @@ Catmull-Clark step: (0,0) = v_k, (1,0) = the edge point of (v_k, v_k+1), (1,1) =
 are the mapping (face, corner) <-> ptex index.
 
 Checks (:class:`~ccproof.errors.MeshError` naming the element otherwise): faces with >= 3 distinct
-vertex indices in range, finite coordinates, every edge in one or two faces traversed in opposite
-directions, the faces around every vertex a single fan, crease tags on existing edges, sharpness
-finite or infinite but not negative and not NaN, hole indices in range.
+vertex indices in range, finite coordinates on every vertex a face uses (unused vertices may hold
+anything and keep their index), crease tags on existing edges, sharpness finite or infinite but not
+negative and not NaN, hole indices in range.
+
+Non-manifold edges and vertices are taken as OpenSubdiv takes them (``Vtr::Level``: an edge with
+more than two faces or two faces in the same direction, e.g. a face given twice; a vertex at such an
+edge or whose faces form several fans; ``Far::TopologyRefinerFactory``: such edges infinitely sharp,
+such vertices infinitely sharp corners but on an interior non-manifold crease). :attr:`PolyMesh.manifold`
+is the mesh the surface is evaluated on: the fans of every non-manifold vertex split apart (see
+:meth:`PolyMesh._split_nonmanifold`), the same faces.
 """
 
 from __future__ import annotations
@@ -46,7 +53,7 @@ def _sharp_value(x, what):
 
 
 class PolyMesh:
-    """A manifold polygon mesh with Sdc tags (OpenSubdiv's ``Far::TopologyDescriptor``).
+    """A polygon mesh with Sdc tags (OpenSubdiv's ``Far::TopologyDescriptor``), manifold or not.
 
     Parameters
     ----------
@@ -65,11 +72,31 @@ class PolyMesh:
         ``boundary`` ('edge_only' | 'edge_and_corner' | 'none'), ``crease_method``
         ('uniform' | 'chaikin'), ``triangle_subdivision`` ('catmark' | 'smooth').
 
+    Attributes
+    ----------
+    is_unused_vertex, is_boundary_vertex, is_nonmanifold_vertex : ndarray of bool, shape (n,)
+    edges : ndarray of int, shape (E, 2)
+        Undirected edges (lo, hi); ``is_boundary_edge``, ``is_nonmanifold_edge`` (E,),
+        ``edge_face_count`` (E,).
+    manifold : PolyMesh
+        ``self`` when :attr:`is_manifold`, else the split mesh (same faces, vertices
+        ``vertices[manifold_vertex_map]``).
+    manifold_vertex_map : ndarray of int, shape (n',)
+
     Examples
     --------
     >>> m = PolyMesh([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 2]])
     >>> m.n_ptex, m.ptex_of(0, 2), m.face_of_ptex(1)
     (3, 2, (0, 1))
+
+    Two triangles touching at vertex 0 (a bow tie): vertex 0 is non-manifold, an infinitely sharp
+    corner; the evaluated mesh has a copy of it (vertex 5) for the second fan:
+
+    >>> b = PolyMesh([[0, 0, 0], [1, 0, 0], [1, 1, 0], [-1, 0, 0], [-1, -1, 0]], [[0, 1, 2], [0, 3, 4]])
+    >>> b.is_manifold, b.is_nonmanifold_vertex.tolist(), b.manifold.polygons, b.manifold_vertex_map.tolist()
+    (False, [True, False, False, False, False], [(0, 1, 2), (5, 3, 4)], [0, 1, 2, 3, 4, 0])
+    >>> b.manifold.vertex_sharpness
+    {0: inf, 5: inf}
     >>> PolyMesh([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 2]], creases=([[0, 2]], [-1]))
     Traceback (most recent call last):
     ...
@@ -289,7 +316,8 @@ class PolyMesh:
                 trail_c = members[self.twin[prv[members]] < 0]
                 if lead_c.size != 1 or trail_c.size != 1 or edge_of[lead_c[0]] == edge_of[prv[trail_c[0]]]:
                     raise MeshError(
-                        f"non-manifold crease vertex {v}: a fan of faces {sorted(self.face_of_halfedge[members].tolist())} "
+                        f"non-manifold crease vertex {v}: a fan of faces "
+                        f"{sorted(self.face_of_halfedge[members].tolist())} "
                         "is not bounded by both non-manifold edges (not supported)")
         if self.options.boundary == "edge_and_corner":
             corner = (self.face_count == 1) & self.is_boundary_vertex & ~nm_v
@@ -317,7 +345,8 @@ class PolyMesh:
             m = PolyMesh(self.vertices[vmap], polys, creases=creases or None, corners=corners or None,
                          holes=np.flatnonzero(self.is_hole), options=opts, _split=False)
         except MeshError as exc:
-            raise MeshError(f"non-manifold mesh not supported after splitting its non-manifold vertices: {exc}") from None
+            raise MeshError(f"non-manifold mesh not supported after splitting its non-manifold vertices: "
+                            f"{exc}") from None
         m.level = self.level
         return m, vmap
 
@@ -515,9 +544,15 @@ class PolyMesh:
         return _stencil_matrix(stencils, self.n_vertices)
 
     def __repr__(self):
+        extra = ""
+        if not self.is_manifold:
+            extra += (f"{int(self.is_nonmanifold_edge.sum())} non-manifold edges, "
+                      f"{int(self.is_nonmanifold_vertex.sum())} non-manifold vertices, ")
+        if self.is_unused_vertex.any():
+            extra += f"{int(self.is_unused_vertex.sum())} unused vertices, "
         return (f"PolyMesh({self.n_vertices} vertices, {self.n_faces} faces, {self.n_ptex} ptex faces, "
                 f"{len(self.edge_sharpness)} creases, {len(self.vertex_sharpness)} corners, "
-                f"{int(self.is_hole.sum())} holes, {self.options})")
+                f"{int(self.is_hole.sum())} holes, {extra}{self.options})")
 
 
 def _expansion(vmap, n):

@@ -51,7 +51,8 @@ def _pair_halfedges(org, dst, face_of, n):
     counts = np.diff(np.r_[starts, H])
     bad = (counts > 2) | ((counts == 2) & (org[order[starts]] == org[order[np.minimum(starts + 1, H - 1)]]))
     if bad.any():  # a face given twice is the likeliest cause: name it
-        dup = _duplicate_face(org, face_of, order[starts[np.flatnonzero(bad)[0]]], order, starts, counts, edge_of_key=ukey)
+        g = int(np.flatnonzero(bad)[0])
+        dup = _duplicate_face(org, face_of, order[starts[g] : starts[g] + counts[g]])
         if dup is not None:
             raise MeshError(f"duplicate face: faces {dup[0]} and {dup[1]} have the same vertices {dup[2]}")
     if (counts > 2).any():
@@ -93,13 +94,12 @@ def _check_used_finite(V, used):
             raise MeshError(f"vertex {v} has a non-finite coordinate: {V[v].tolist()}")
 
 
-def _duplicate_face(org, face_of, h, order, starts, counts, edge_of_key):
-    """Two faces with the same vertex cycle among the faces of half-edge ``h``'s edge, or None.
+def _duplicate_face(org, face_of, hs):
+    """Two faces with the same vertex cycle among the faces of the half-edges ``hs`` (one edge), or None.
 
     Returns ``(f, g, vertices of f)``; the cycle is compared up to rotation and direction.
     """
-    g = int(np.searchsorted(edge_of_key[order[starts]], edge_of_key[h]))
-    faces = sorted({int(face_of[x]) for x in order[starts[g] : starts[g] + counts[g]]})
+    faces = sorted({int(face_of[x]) for x in hs})
     cyc = {}
     for f in faces:
         vs = org[face_of == f].tolist()
@@ -275,7 +275,8 @@ class QuadMesh:
         self.valence = valence
         self.is_boundary_vertex = is_bv
         self.is_unused_vertex = unused
-        for a in (self.is_unused_vertex, self.twin, self.edge_of_halfedge, self.edges, self.edge_faces, self.is_boundary_edge,
+        for a in (self.is_unused_vertex, self.twin, self.edge_of_halfedge, self.edges, self.edge_faces,
+                  self.is_boundary_edge,
                   self.rot, self.fan_ptr, self.fan_corners, self.face_count, self.valence,
                   self.is_boundary_vertex):
             a.setflags(write=False)

@@ -194,7 +194,8 @@ def test_eval_command_reads_every_case(refdir, tmp_path):
         d = _ref(refdir, name)
         f, s, t, ref = _exact(d)
         pts = tmp_path / "p.csv"
-        pts.write_text("face,u,v\n" + "".join(f"{a},{b!r},{c!r}\n" for a, b, c in zip(f.tolist(), s.tolist(), t.tolist())))
+        rows = zip(f.tolist(), s.tolist(), t.tolist())
+        pts.write_text("face,u,v\n" + "".join(f"{a},{b!r},{c!r}\n" for a, b, c in rows))
         out = tmp_path / "o.npz"
         assert main(["eval", str(_path(refdir, name)), "--points", str(pts), "--out", str(out)]) == 0
         P = np.load(out)["P"]

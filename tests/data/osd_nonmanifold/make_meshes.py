@@ -173,7 +173,8 @@ def main():
     write_obj("unused.obj", V, F, "a cube with 2x2 quads per side; unused vertices 0 (7,7,7), 5 (NaN) and the\n"
               "last one")
     tagged = {
-        "book4_tags.obj": ("book4.obj", "book4 with tags: semi-sharp vertex sharpness on the non-manifold crease vertex 1,\n"
+        "book4_tags.obj": ("book4.obj", "book4 with tags: semi-sharp vertex sharpness on the non-manifold crease "
+                           "vertex 1,\n"
                            "a semi-sharp edge at the non-manifold corner vertex 0, a semi-sharp page edge, boundary\n"
                            "interpolation edge-and-corner",
                            ["t corner 1/1/0 1 2.5", "t crease 2/1/0 0 3 1.5", "t crease 2/1/0 4 5 3",
@@ -181,11 +182,13 @@ def main():
         "bowtie_none.obj": ("bowtie.obj", "bowtie with boundary interpolation none and the boundary of the first grid\n"
                             "infinitely sharp: OpenSubdiv's implicit holes around the non-manifold vertex 0",
                             ["t crease 16/1/0 0 1 1 2 2 5 5 8 8 7 7 6 6 3 3 0 10", "t interpolateboundary 1/0/0 0"]),
-        "book4_infpage.obj": ("book4.obj", "book4 with an infinitely sharp page edge at the non-manifold crease vertex 1:\n"
+        "book4_infpage.obj": ("book4.obj", "book4 with an infinitely sharp page edge at the non-manifold crease "
+                              "vertex 1:\n"
                               "three infinitely sharp edges, a corner", ["t crease 2/1/0 1 4 10"]),
         "two_cubes_creases.obj": ("two_cubes.obj", "two_cubes with a semi-sharp and an infinitely sharp edge at the\n"
                                   "non-manifold vertex 0 and a semi-sharp corner elsewhere",
-                                  ["t crease 2/1/0 0 1 2.5", "t crease 2/1/0 0 39 10", "t corner 1/1/0 4 1.5", "t crease 2/1/0 0 3 0.5"]),
+                                  ["t crease 2/1/0 0 1 2.5", "t crease 2/1/0 0 39 10", "t corner 1/1/0 4 1.5",
+                                   "t crease 2/1/0 0 3 0.5"]),
     }
     for name, (base, comment, lines) in tagged.items():
         with open(os.path.join(HERE, base)) as fh:
