@@ -1,9 +1,9 @@
 """Evaluate the Catmull-Clark limit surface of a mesh (OBJ with OpenSubdiv tags, OFF, PLY, STL,
 VTK or any other format meshio reads; non-manifold edges and vertices and unused vertices as
-OpenSubdiv takes them) in one of the parameterizations of bmz04 (triangles, n-gons and tagged meshes: natural only,
-``face`` being the ptex face index): natural (Stam, section 2), vanishing (F^alpha blend,
-section 4.2: derivatives tend to 0 at extraordinary vertices) or characteristic (Phi^-1 blend,
-section 4.3: C1 with a Jacobian of rank 2 at extraordinary vertices).
+OpenSubdiv takes them) in one of the parameterizations of bmz04 (triangles, n-gons, tagged and
+non-manifold meshes: natural only, ``face`` being the ptex face index): natural (Stam, section 2),
+vanishing (F^alpha blend, section 4.2: derivatives tend to 0 at extraordinary vertices) or
+characteristic (Phi^-1 blend, section 4.3: C1 with a Jacobian of rank 2 at extraordinary vertices).
 
 Positions P and derivatives (Pu, Pv; Puu, Puv, Pvv) with respect to each face's own parameter
 (u, v): corner i of the face's OBJ vertex list at (0,0), (1,0), (1,1), (0,1) for i = 0..3 (the ptex

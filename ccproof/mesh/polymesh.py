@@ -215,6 +215,7 @@ class PolyMesh:
         twin = np.full(H, -1, dtype=np.int64)
         twin[h1[~same]], twin[h2[~same]] = h2[~same], h1[~same]
         first = order[starts]
+        self._edge_halfedge = first  # one half-edge of every edge
         self.edges = np.stack([lo[first], hi[first]], axis=1)
         self.edge_index = {(int(a), int(b)): e for e, (a, b) in enumerate(self.edges.tolist())}
         self.edge_face_count = counts
@@ -291,9 +292,11 @@ class PolyMesh:
         edge_of, nm_e, nm_v = self.edge_of_halfedge, self.is_nonmanifold_edge, self.is_nonmanifold_vertex
         chaikin = self.options.crease_method == "chaikin"
         vsharp = {int(v): s for v, s in self.vertex_sharpness.items()}
+        by_vertex = np.argsort(org, kind="stable")  # corners grouped by vertex
+        ptr = np.r_[0, np.cumsum(self.face_count)]
         # OpenSubdiv's sharpening of the non-manifold vertices
         for v in np.flatnonzero(nm_v).tolist():
-            cs = np.flatnonzero(org == v)
+            cs = by_vertex[ptr[v] : ptr[v + 1]]
             es = np.unique(np.r_[edge_of[cs], edge_of[prv[cs]]])
             nm_count = int(nm_e[es].sum())
             bnd = int(self.is_boundary_edge[es].sum())
@@ -332,12 +335,15 @@ class PolyMesh:
             e = self.edge_index[(a, b)]
             if nm_e[e]:
                 continue
-            h = int(np.flatnonzero(edge_of == e)[0])
+            h = int(self._edge_halfedge[e])
             p, q = int(new[h]), int(new[nxt[h]])
             creases[(min(p, q), max(p, q))] = x
+        copies = {}
+        for u in range(n, len(vmap)):
+            copies.setdefault(int(vmap[u]), []).append(u)
         corners = {}
         for v, x in vsharp.items():
-            for u in np.flatnonzero(vmap == v).tolist():
+            for u in [v, *copies.get(v, [])]:
                 corners[u] = x
         polys = [new[self.offsets[f] : self.offsets[f + 1]].tolist() for f in range(self.n_faces)]
         opts = Options("edge_only", self.options.crease_method, self.options.triangle_subdivision)
