@@ -262,9 +262,12 @@ class PolyMesh:
         vertex of its own: the fans are split apart into copies (the first fan keeps the vertex
         index, the others get indices n, n+1, ...), the non-manifold edges become boundary edges,
         sharpened vertices get infinite vertex sharpness. Every rule then acts on the copies as
-        OpenSubdiv's acts on the vertex. Cases where that is not so are refused by name: a crease
-        vertex with a fan not bounded by both non-manifold edges or with another sharp edge of finite
-        sharpness, and Chaikin creases with a semi-sharp edge at a non-manifold vertex.
+        OpenSubdiv's acts on the vertex. A crease vertex with other semi-sharp edges is a corner
+        until the last of them has decayed: its copies get that edge's sharpness as vertex sharpness
+        (same rule at every level, same fractional weight). Cases where no split reproduces the
+        vertex's rule are refused by name: a crease vertex with a fan not bounded by both
+        non-manifold edges, or whose last semi-sharp features have different values, and Chaikin
+        creases with a semi-sharp edge at a non-manifold vertex.
 
         Returns
         -------
@@ -311,8 +314,20 @@ class PolyMesh:
             if any(x == math.inf for x in other):
                 vsharp[v] = math.inf  # three or more infinitely sharp edges: a corner for ever
                 continue
-            if any(x > 0.0 for x in other):
-                raise MeshError(f"non-manifold crease vertex {v}: another semi-sharp edge at it is not supported")
+            semi = [x for x in other if x > 0.0]
+            if semi:
+                # a corner while any of these is sharp (three sharp edges), then the crease rule, blended
+                # with the mean of the features that end at that step: the vertex sharpness T = the
+                # largest of them on every copy gives each copy that schedule and that weight (uniform
+                # decay), provided the features ending last all have T
+                feats = semi + ([vsharp[v]] if vsharp.get(v, 0.0) > 0.0 else [])
+                top = max(feats)
+                last = {x for x in feats if math.ceil(x) == math.ceil(top)}
+                if len(last) > 1:
+                    raise MeshError(
+                        f"non-manifold crease vertex {v}: semi-sharp edges or vertex sharpness {sorted(last)} "
+                        "ending at the same level with different values are not supported")
+                vsharp[v] = top
             for c in set(comp[cs].tolist()):
                 members = cs[comp[cs] == c]
                 lead_c = members[self.twin[members] < 0]  # outgoing half-edge on a singular edge

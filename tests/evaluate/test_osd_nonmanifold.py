@@ -25,7 +25,7 @@ from ccproof.mesh import PolyMesh, QuadMesh
 from ccproof.mesh.io import read_mesh
 
 MESHES = ["book4.obj", "two_cubes.obj", "bowtie.obj", "dupface.obj", "flipped.obj", "unused.obj", "prism.off",
-          "book4_tags.obj", "book4_infpage.obj", "bowtie_none.obj", "two_cubes_creases.obj"]
+          "book4_tags.obj", "book4_infpage.obj", "book4_semipage.obj", "bowtie_none.obj", "two_cubes_creases.obj"]
 
 
 def _path(refdir, name):
@@ -95,10 +95,12 @@ def test_mesh_matches_opensubdiv(refdir, name):
             assert sharp == [math.inf] * len(copies) and d["vertex_rule"][v] == "corner"
         elif d["vertex_rule"][v] == "crease":
             assert sharp == [d["vertex_sharpness"][v]] * len(copies) == [0.0] * len(copies)
-        elif d["vertex_sharpness"][v] > 0:  # a semi-sharp crease vertex: its own sharpness on every copy
-            assert sharp == [d["vertex_sharpness"][v]] * len(copies)
-        else:  # a corner by three infinitely sharp edges: a corner on every copy
-            assert sharp == [math.inf] * len(copies)
+        else:  # a corner by its own sharpness or by three sharp edges, for ever or until they decay
+            at_v = [s for a, b, s in d["edges"] if v in (a, b) and s < 10]
+            others = [s for a, b, s in d["edges"] if v in (a, b) and s >= 10 and sorted((a, b)) not in
+                      sorted(map(sorted, d["nonmanifold_edges"]))]
+            want = math.inf if others else max([d["vertex_sharpness"][v]] + at_v)
+            assert sharp == [want] * len(copies)
     # holes (tagged, or OpenSubdiv's implicit ones under boundary mode none): no samples there
     ptex_hole = np.repeat(mesh.is_hole, np.diff(mesh.ptex_start))
     assert sorted({s["ptex"] for s in d["samples"]}) == np.flatnonzero(~ptex_hole).tolist()
@@ -222,8 +224,9 @@ def test_unsupported_nonmanifold_configurations_are_refused_by_name(refdir):
     Where it is not, the mesh is refused with the vertex and the reason (never evaluated differently)."""
     book = read_mesh(_path(refdir, "book4.obj"))  # vertex 1: a non-manifold crease vertex (spine 0-1-2)
     V, F = np.array(book.vertices), [list(p) for p in book.polygons]
-    with pytest.raises(MeshError, match=r"non-manifold crease vertex 1: another semi-sharp edge at it"):
-        PolyMesh(V, F, creases={(1, 4): 2.0})
+    with pytest.raises(MeshError, match=r"non-manifold crease vertex 1: semi-sharp edges or vertex sharpness "
+                                         r"\[1\.2.*, 1\.5\] ending at the same level with different values"):
+        PolyMesh(V, F, creases={(1, 4): 1.5, (1, 10): 1.2})
     with pytest.raises(MeshError, match=r"non-manifold vertex 0: Chaikin creases with a semi-sharp edge"):
         PolyMesh(V, F, creases={(0, 3): 2.0}, options={"crease_method": "chaikin"})
     # a closed cone (a tetrahedron) touching the crease vertex: the crease rule along the spine acts on
