@@ -267,7 +267,8 @@ class PolyMesh:
         (same rule at every level, same fractional weight). Cases where no split reproduces the
         vertex's rule are refused by name: a crease vertex with a fan not bounded by both
         non-manifold edges, or whose last semi-sharp features have different values, and Chaikin
-        creases with a semi-sharp edge at a non-manifold vertex.
+        creases with semi-sharp edges in more than one fan of a non-manifold vertex or at a crease
+        vertex.
 
         Returns
         -------
@@ -304,10 +305,17 @@ class PolyMesh:
             nm_count = int(nm_e[es].sum())
             bnd = int(self.is_boundary_edge[es].sum())
             other = [self.edge_sharpness.get(tuple(self.edges[e].tolist()), 0.0) for e in es if not nm_e[e]]
+            sharpened = not (nm_count == 2 and bnd == 0 and cs.size > es.size)
             if chaikin and any(0.0 < x < math.inf for x in other):
-                raise MeshError(f"non-manifold vertex {v}: Chaikin creases with a semi-sharp edge at a "
-                                "non-manifold vertex are not supported")
-            if not (nm_count == 2 and bnd == 0 and cs.size > es.size):
+                # Chaikin: the child sharpness at v depends on all semi-sharp edges at v; a copy sees those
+                # of its own fan only, so they must all be in one fan (and v a corner for ever)
+                semi_e = {e for e in es if not nm_e[e]
+                          and 0.0 < self.edge_sharpness.get(tuple(self.edges[e].tolist()), 0.0) < math.inf}
+                fans = {int(comp[c]) for c in cs if edge_of[c] in semi_e or edge_of[prv[c]] in semi_e}
+                if not sharpened or len(fans) > 1:
+                    raise MeshError(f"non-manifold vertex {v}: Chaikin creases with semi-sharp edges at a "
+                                    "non-manifold vertex are supported only in one of its fans, at a corner")
+            if sharpened:
                 vsharp[v] = math.inf
                 continue
             # an interior non-manifold crease: the crease rule along its two non-manifold edges

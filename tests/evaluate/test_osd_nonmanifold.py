@@ -25,7 +25,8 @@ from ccproof.mesh import PolyMesh, QuadMesh
 from ccproof.mesh.io import read_mesh
 
 MESHES = ["book4.obj", "two_cubes.obj", "bowtie.obj", "dupface.obj", "flipped.obj", "unused.obj", "prism.off",
-          "book4_tags.obj", "book4_infpage.obj", "book4_semipage.obj", "bowtie_none.obj", "two_cubes_creases.obj"]
+          "book4_tags.obj", "book4_infpage.obj", "book4_semipage.obj", "bowtie_none.obj", "two_cubes_creases.obj",
+          "two_cubes_chaikin.obj"]
 
 
 def _path(refdir, name):
@@ -227,8 +228,13 @@ def test_unsupported_nonmanifold_configurations_are_refused_by_name(refdir):
     with pytest.raises(MeshError, match=r"non-manifold crease vertex 1: semi-sharp edges or vertex sharpness "
                                          r"\[1\.2.*, 1\.5\] ending at the same level with different values"):
         PolyMesh(V, F, creases={(1, 4): 1.5, (1, 10): 1.2})
-    with pytest.raises(MeshError, match=r"non-manifold vertex 0: Chaikin creases with a semi-sharp edge"):
-        PolyMesh(V, F, creases={(0, 3): 2.0}, options={"crease_method": "chaikin"})
+    chaikin = {"crease_method": "chaikin"}
+    msg = r"non-manifold vertex {}: Chaikin creases with semi-sharp edges at a non-manifold vertex are supported only"
+    with pytest.raises(MeshError, match=msg.format(0)):  # two pages' edges at the corner vertex 0
+        PolyMesh(V, F, creases={(0, 3): 2.0, (0, 9): 1.5}, options=chaikin)
+    with pytest.raises(MeshError, match=msg.format(1)):  # at the crease vertex
+        PolyMesh(V, F, creases={(1, 4): 2.0}, options=chaikin)
+    assert not PolyMesh(V, F, creases={(0, 3): 2.0}, options=chaikin).is_manifold  # one fan: supported
     # a closed cone (a tetrahedron) touching the crease vertex: the crease rule along the spine acts on
     # the cone's fan too, which no manifold vertex reproduces
     n = len(V)

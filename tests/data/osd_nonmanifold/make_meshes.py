@@ -188,6 +188,11 @@ def main():
         "book4_semipage.obj": ("book4.obj", "book4 with semi-sharp page edges (1.5 and 0.7) at the non-manifold crease "
                                "vertex 1:\na corner until they decay, then a crease",
                                ["t crease 2/1/0 1 4 1.5", "t crease 2/1/0 1 10 0.7"]),
+        "two_cubes_chaikin.obj": ("two_cubes.obj", "two_cubes with Chaikin creases: semi-sharp edges 2.5 and 1.5 at "
+                                  "the\n"
+                                  "non-manifold vertex 0, both in the fan of the first cube, and 3 next to them",
+                                  ["t crease 2/1/0 0 1 2.5", "t crease 2/1/0 0 3 1.5", "t crease 2/1/0 1 2 3",
+                                   "t creasemethod 0/0/1 chaikin"]),
         "two_cubes_creases.obj": ("two_cubes.obj", "two_cubes with a semi-sharp and an infinitely sharp edge at the\n"
                                   "non-manifold vertex 0 and a semi-sharp corner elsewhere",
                                   ["t crease 2/1/0 0 1 2.5", "t crease 2/1/0 0 39 10", "t corner 1/1/0 4 1.5",
