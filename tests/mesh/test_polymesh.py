@@ -120,6 +120,16 @@ def test_nonmanifold_meshes_are_classified_as_opensubdiv_does(faces, n, nm_edges
     assert np.array_equal(M.vertices, V[m.manifold_vertex_map])
     for p, q in zip(m.polygons, M.polygons):
         assert m.manifold_vertex_map[list(q)].tolist() == list(p)
+    # one step: the split's step, as a matrix on this mesh's vertices, and its exact rows
+    m1, S = m.refine()
+    assert S.shape == (M.n_vertices + len(M.edges) + M.n_faces, n)
+    assert np.abs(m1.vertices - S @ V).max() <= 1e-15
+    exact = m.subdivision_operator(exact=True)
+    dense = np.zeros(S.shape)
+    for r, row in enumerate(exact):
+        for c, w in row.items():
+            dense[r, c] = int(w.p) / int(w.q)
+    assert np.abs(dense - S.toarray()).max() <= 1e-16
 
 
 def test_unused_vertices_keep_their_indices():
