@@ -10,16 +10,17 @@ Catmull-Clark step: (0,0) = v_k, (1,0) = the edge point of (v_k, v_k+1), (1,1) =
 (0,1) = the edge point of (v_k-1, v_k). :meth:`PolyMesh.ptex_of` and :meth:`PolyMesh.face_of_ptex`
 are the mapping (face, corner) <-> ptex index.
 
-Checks (:class:`~ccproof.errors.MeshError` naming the element otherwise): faces with >= 3 distinct
-vertex indices in range, finite coordinates on every vertex a face uses (unused vertices may hold
-anything and keep their index), crease tags on existing edges, sharpness finite or infinite but not
-negative and not NaN, hole indices in range.
+Checks (:class:`~ccproof.errors.MeshError` naming the element otherwise): faces with >= 3 vertex
+indices in range (a repeated one as OpenSubdiv takes it, below), finite coordinates on every vertex
+a face uses (unused vertices may hold anything and keep their index), crease tags on existing
+edges, sharpness finite or infinite but not negative and not NaN, hole indices in range.
 
 Non-manifold edges and vertices are taken as OpenSubdiv takes them (``Vtr::Level``: an edge with
-more than two faces or two faces in the same direction, e.g. a face given twice; a vertex at such an
-edge or whose faces form several fans; ``Far::TopologyRefinerFactory``: such edges infinitely sharp,
-such vertices infinitely sharp corners but on an interior non-manifold crease). :attr:`PolyMesh.manifold`
-is the mesh the surface is evaluated on: the fans of every non-manifold vertex split apart (see
+more than two faces or two faces in the same direction, e.g. a face given twice, a degenerate edge
+(v, v) and an edge a face holds twice; a vertex at such an edge or whose faces form several fans;
+``Far::TopologyRefinerFactory``: such edges infinitely sharp, such vertices infinitely sharp
+corners but on an interior non-manifold crease). :attr:`PolyMesh.manifold` is the mesh the surface
+is evaluated on: the fans of every non-manifold vertex split apart (see
 :meth:`PolyMesh._split_nonmanifold`), the same faces.
 """
 
@@ -118,9 +119,9 @@ class PolyMesh:
             for v in p:
                 if not 0 <= v < n:
                     raise MeshError(f"face {f} has a vertex index out of range [0, {n}): {p}")
-            if len(set(p)) != len(p):
+            if _split is False and len(set(p)) != len(p):  # (the split mesh: a face still touching itself)
                 r = next(v for v in p if p.count(v) > 1)
-                raise MeshError(f"face {f} repeats vertex {r}: {p}")
+                raise MeshError(f"face {f} repeats vertex {r} within one fan: {p}")
         _check_used_finite(V, [v for p in polys for v in p])
         self.vertices = V
         self.vertices.setflags(write=False)
@@ -210,8 +211,21 @@ class PolyMesh:
         nm_edge = counts > 2
         two = np.flatnonzero(counts == 2)
         h1, h2 = order[starts[two]], order[starts[two] + 1]
-        same = org[h1] == org[h2]
+        same = (org[h1] == org[h2]) | (face_of[h1] == face_of[h2])  # same direction, or twice in one face
         nm_edge[two[same]] = True
+        # a face repeating a vertex: a degenerate edge (v, v), or an edge the face holds twice; OpenSubdiv
+        # gives each such occurrence an edge of its own with one face (a boundary edge), so that both
+        # ends are sharpened (corners)
+        degenerate = lo[order[starts]] == hi[order[starts]]
+        fe = np.unique(edge_of * len(self.polygons) + face_of, return_counts=True)
+        held_twice = np.zeros(starts.size, dtype=bool)
+        held_twice[fe[0][fe[1] > 1] // len(self.polygons)] = True
+        nm_edge |= degenerate | held_twice
+        self._repeat_edge = degenerate | held_twice
+        ends = np.flatnonzero(degenerate | held_twice)
+        self._sharpened_by_degenerate = np.zeros(n, dtype=bool)
+        self._sharpened_by_degenerate[lo[order[starts[ends]]]] = True
+        self._sharpened_by_degenerate[hi[order[starts[ends]]]] = True
         twin = np.full(H, -1, dtype=np.int64)
         twin[h1[~same]], twin[h2[~same]] = h2[~same], h1[~same]
         first = order[starts]
@@ -305,7 +319,7 @@ class PolyMesh:
             nm_count = int(nm_e[es].sum())
             bnd = int(self.is_boundary_edge[es].sum())
             other = [self.edge_sharpness.get(tuple(self.edges[e].tolist()), 0.0) for e in es if not nm_e[e]]
-            sharpened = not (nm_count == 2 and bnd == 0 and cs.size > es.size)
+            sharpened = not (nm_count == 2 and bnd == 0 and cs.size > es.size) or self._sharpened_by_degenerate[v]
             if chaikin and any(0.0 < x < math.inf for x in other):
                 # Chaikin: the child sharpness at v depends on all semi-sharp edges at v; a copy sees those
                 # of its own fan only, so they must all be in one fan (and v a corner for ever)
@@ -431,7 +445,8 @@ class PolyMesh:
         if self.options.boundary != "none":
             return out
         bad_vertex = np.zeros(self.vertices.shape[0], dtype=bool)
-        for e in np.flatnonzero(self.is_boundary_edge):
+        # one-face edges, and OpenSubdiv's one-face edges of a face repeating a vertex
+        for e in np.flatnonzero(self.is_boundary_edge | self._repeat_edge):
             a, b = self.edges[e]
             if not math.isinf(self.edge_sharpness.get((int(a), int(b)), 0.0)):
                 bad_vertex[a] = bad_vertex[b] = True

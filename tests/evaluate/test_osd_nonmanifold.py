@@ -24,9 +24,10 @@ from ccproof.evaluate.tagged import TaggedLimitSurface
 from ccproof.mesh import PolyMesh, QuadMesh
 from ccproof.mesh.io import read_mesh
 
+#: every mesh of tests/data/osd_nonmanifold (README there)
 MESHES = ["book4.obj", "two_cubes.obj", "bowtie.obj", "dupface.obj", "flipped.obj", "unused.obj", "prism.off",
           "book4_tags.obj", "book4_infpage.obj", "book4_semipage.obj", "bowtie_none.obj", "two_cubes_creases.obj",
-          "two_cubes_chaikin.obj"]
+          "two_cubes_chaikin.obj", "collapsed.obj"]
 
 
 def _path(refdir, name):
@@ -68,7 +69,7 @@ def _exact(d, mesh=None, name=None):
 
 def _compare(S, d, diag, name=None):
     f, s, t, ref = _exact(d, S.mesh, name)
-    assert f.size >= 0.85 * len(d["samples"])  # most samples are on regular patches
+    assert f.size >= 0.8 * len(d["samples"])  # most samples are on regular patches
     out = S.evaluate(f, s, t, 1)
     for key, rk, tol in (("P", "P", 1e-12), ("Pu", "Ps", 1e-10), ("Pv", "Pt", 1e-10)):
         err = np.abs(out[key] - ref[rk]).max() / diag
@@ -85,7 +86,9 @@ def test_mesh_matches_opensubdiv(refdir, name):
     # OpenSubdiv's classification (it also tags unused vertices non-manifold: they have no fan)
     osd_nm = sorted(set(d["nonmanifold_vertices"]) - set(np.flatnonzero(mesh.is_unused_vertex).tolist()))
     assert np.flatnonzero(mesh.is_nonmanifold_vertex).tolist() == osd_nm
-    assert sorted(map(sorted, d["nonmanifold_edges"])) == mesh.nonmanifold_edges.tolist()
+    # (OpenSubdiv lists every occurrence of an edge a face repeats as an edge of its own)
+    osd_edges = sorted({tuple(sorted(e)) for e in d["nonmanifold_edges"]})
+    assert osd_edges == list(map(tuple, mesh.nonmanifold_edges.tolist()))
     # its sharpening: infinitely sharp vertices are corners on every split copy, crease vertices keep
     # their own sharpness
     M, vmap = mesh.manifold, mesh.manifold_vertex_map

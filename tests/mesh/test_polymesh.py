@@ -83,7 +83,6 @@ def test_meshio_input(tmp_path):
     ({"corners": {2: -1}}, r"corner on vertex 2: negative sharpness"),
     ({"corners": {9: 1}}, r"corner on vertex 9: out of range"),
     ({"holes": [7]}, r"hole face 7 out of range"),
-    ({"faces": [[0, 1, 1]]}, r"face 0 repeats vertex 1"),
     ({"faces": [[0, 1]]}, r"face 0 has 2 vertices"),
     ({"faces": [[0, 1, 9]]}, r"face 0 has a vertex index out of range"),
     ({"nan": True}, r"vertex 2 has a non-finite coordinate"),
@@ -106,6 +105,7 @@ def test_bad_input_names_the_element(kwargs, msg):
     ([[0, 1, 3], [1, 2, 4], [4, 5, 1]], 6, [], [1]),  # two fans at vertex 1
     ([[0, 1, 4, 3], [1, 4, 5, 2]], 6, [[1, 4]], [1, 4]),  # two faces traverse (1, 4) the same way
     ([[0, 1, 2], [0, 1, 2]], 3, [[0, 1], [0, 2], [1, 2]], [0, 1, 2]),  # a face given twice
+    ([[0, 1, 1], [0, 2, 1]], 3, [[0, 1], [1, 1]], [0, 1]),  # a face repeating a vertex (degenerate edge)
 ])
 def test_nonmanifold_meshes_are_classified_as_opensubdiv_does(faces, n, nm_edges, nm_vertices):
     """OpenSubdiv's Vtr::Level: an edge with more than two faces or two faces in the same direction is

@@ -122,6 +122,22 @@ def bowtie():
     return jitter(V, 0.03), F
 
 
+def collapsed(n=4):
+    """A triangulated n x n grid on a height field in which one interior edge was collapsed the way a
+    careless scan pipeline does it: vertex c replaced by vertex a everywhere, the two triangles of edge
+    (a, c) kept, now with a repeated vertex (degenerate faces)."""
+    V = [[i / n, j / n, 0.2 * math.sin(2.0 * i / n) * math.cos(1.5 * j / n)]
+         for j in range(n + 1) for i in range(n + 1)]
+    F = []
+    for j in range(n):
+        for i in range(n):
+            a, b, c, d = j * (n + 1) + i, j * (n + 1) + i + 1, (j + 1) * (n + 1) + i + 1, (j + 1) * (n + 1) + i
+            F += [[a, b, c], [a, c, d]]
+    a, c = 1 * (n + 1) + 1, 1 * (n + 1) + 2  # the interior edge (6, 7) for n = 4
+    F = [[a if v == c else v for v in f] for f in F]
+    return jitter(V, 0.02), F
+
+
 def with_unused(V, F):
     """Insert unused vertices (one with NaN coordinates) at indices 0, 5 and the end."""
     V = np.asarray(V, dtype=float)
@@ -207,6 +223,9 @@ def main():
     V, F = prism()
     write_off("prism.off", V, F, "a pentagonal prism (two pentagons, four quads) with a four-triangle roof:\n"
               "an OFF file with quads and n-gons")
+    V, F = collapsed()
+    write_obj("collapsed.obj", V, F, "a triangulated 4x4 grid with the interior edge (6, 7) collapsed: vertex 7\n"
+              "replaced by 6 in every face, its two triangles kept with a repeated vertex (7 is now unused)")
 
 
 if __name__ == "__main__":
