@@ -25,7 +25,8 @@ from ccproof.errors import CCProofError
 
 
 def add_arguments(parser):
-    parser.add_argument("mesh", help="mesh file: OBJ (OpenSubdiv tag lines allowed) or any meshio format")
+    parser.add_argument("mesh", help="mesh file: OBJ (OpenSubdiv tag lines allowed), OFF (any polygon size), or "
+                        "any meshio format (PLY, STL, VTK, ...); non-manifold and unused vertices as OpenSubdiv")
     src = parser.add_mutually_exclusive_group(required=True)
     src.add_argument("--points", metavar="CSV", help="CSV file with header face,u,v (face: ptex face index)")
     src.add_argument("--samples", metavar="N", type=int, help="evaluate at N random points")

@@ -1,8 +1,9 @@
-"""Evaluate the Catmull-Clark limit surface of a mesh (OBJ with OpenSubdiv tags, or any meshio
-format) in one of the parameterizations of bmz04 (triangles, n-gons and tagged meshes: natural only,
-``face`` being the ptex face index): natural (Stam, section 2), vanishing (F^alpha blend,
-section 4.2: derivatives tend to 0 at extraordinary vertices) or characteristic (Phi^-1 blend,
-section 4.3: C1 with a Jacobian of rank 2 at extraordinary vertices).
+"""Evaluate the Catmull-Clark limit surface of a mesh (OBJ with OpenSubdiv tags, OFF, PLY, STL,
+VTK or any other format meshio reads; non-manifold edges and vertices and unused vertices as
+OpenSubdiv takes them) in one of the parameterizations of bmz04 (triangles, n-gons, tagged and
+non-manifold meshes: natural only, ``face`` being the ptex face index): natural (Stam, section 2),
+vanishing (F^alpha blend, section 4.2: derivatives tend to 0 at extraordinary vertices) or
+characteristic (Phi^-1 blend, section 4.3: C1 with a Jacobian of rank 2 at extraordinary vertices).
 
 Positions P and derivatives (Pu, Pv; Puu, Puv, Pvv) with respect to each face's own parameter
 (u, v): corner i of the face's OBJ vertex list at (0,0), (1,0), (1,1), (0,1) for i = 0..3 (the ptex
@@ -73,26 +74,26 @@ def run(args) -> int:
 
     import numpy as np
 
-    from ccproof.mesh import QuadMesh
     from ccproof.mesh.io import read_mesh
     from ccproof.scale import evaluate_points, open_scheduler, point_chunks, scheduler_from_args, ship
 
     t0 = time.perf_counter()
-    poly = read_mesh(args.mesh)  # OBJ with OpenSubdiv tags, or any meshio format
-    tagged = not poly.is_all_quads or poly.has_tags
+    poly = read_mesh(args.mesh)  # OBJ with OpenSubdiv tags, OFF, or any meshio format
+    tagged = not poly.is_plain_quads
     if tagged:
         # triangles, n-gons, creases, corners, holes, boundary modes: the natural parameterization
         # of the tagged evaluator, by ptex face (equal to the face index on all-quad meshes)
         if args.parameterization != "natural":
             raise CCProofError(
                 f"{args.mesh}: the {args.parameterization} parameterization needs an untagged all-quad mesh "
-                "(this one has non-quad faces or OpenSubdiv tags); use --parameterization natural"
+                "(this one has non-quad faces, OpenSubdiv tags or non-manifold edges or vertices); use "
+                "--parameterization natural"
             )
         if args.plot:
             raise CCProofError(f"{args.mesh}: --plot needs an untagged all-quad mesh")
         mesh, n_faces, kwargs = poly, poly.n_ptex, {}
     else:
-        mesh = QuadMesh(poly.vertices, np.array(poly.polygons, dtype=np.int64).reshape(-1, 4))
+        mesh = poly.to_quad_mesh()
         n_faces, kwargs = mesh.n_faces, {"parameterization": args.parameterization}
     sched = scheduler_from_args(args)
     # on a cluster each worker builds the surface itself (once); here only for in-process work or --plot

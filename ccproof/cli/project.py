@@ -18,7 +18,8 @@ from __future__ import annotations
 
 
 def add_arguments(parser):
-    parser.add_argument("mesh", help="OBJ mesh (any mesh the limit evaluator accepts)")
+    parser.add_argument("mesh", help="mesh file: OBJ (with OpenSubdiv tags), OFF, PLY, STL, VTK, ... (any mesh "
+                        "'ccproof eval' reads)")
     parser.add_argument("points", help="CSV file with the header x,y,z")
     parser.add_argument("--out", metavar="FILE.npz", required=True, help="output file (numpy .npz)")
     parser.add_argument("--certify", action="store_true", help="add interval-arithmetic verdicts (slow: per point)")

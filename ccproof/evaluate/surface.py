@@ -883,7 +883,7 @@ class LimitSurface:
         maps = self.__dict__.get("_maps")
         if maps is None:
             maps = self._maps = _vertex_maps(self)
-        V = mesh.vertices
+        V = np.where(mesh.is_unused_vertex[:, None], 0.0, mesh.vertices)  # unused: any value, weight 0
         new = object.__new__(LimitSurface)
         new.__dict__.update(self.__dict__)
         new.mesh = mesh
@@ -1046,9 +1046,10 @@ def natural_limit_surface(mesh):
         A QuadMesh gives a :class:`LimitSurface`; a PolyMesh the tagged evaluator
         (:class:`ccproof.evaluate.tagged.TaggedLimitSurface`, ``face`` = ptex face index; on
         untagged all-quad meshes the same numbers as LimitSurface to round-off). A path is read by
-        :func:`ccproof.mesh.io.read_mesh` (OBJ with OpenSubdiv tags, or any meshio format): an
-        untagged all-quad file gives a LimitSurface on a QuadMesh, anything else (triangles,
-        n-gons, creases, corners, holes, boundary modes) the tagged evaluator.
+        :func:`ccproof.mesh.io.read_mesh` (OBJ with OpenSubdiv tags, OFF, or any meshio format): an
+        untagged manifold all-quad file gives a LimitSurface on a QuadMesh, anything else (triangles,
+        n-gons, creases, corners, holes, boundary modes, non-manifold edges and vertices) the
+        tagged evaluator.
 
     Returns
     -------
@@ -1070,10 +1071,10 @@ def natural_limit_surface(mesh):
     from ccproof.mesh.io import read_mesh
 
     mesh = read_mesh(mesh)
-    if mesh.is_all_quads and not mesh.has_tags:
-        # a file holding an untagged all-quad mesh: the QuadMesh evaluator, as before (same numbers
-        # as the tagged one to round-off; ``S.mesh`` is a QuadMesh)
-        return LimitSurface(QuadMesh(mesh.vertices, np.array(mesh.polygons, dtype=np.int64).reshape(-1, 4)))
+    if mesh.is_plain_quads:
+        # a file holding an untagged manifold all-quad mesh: the QuadMesh evaluator, as before (same
+        # numbers as the tagged one to round-off; ``S.mesh`` is a QuadMesh)
+        return LimitSurface(mesh.to_quad_mesh())
     return TaggedLimitSurface(mesh)
 
 

@@ -80,6 +80,8 @@ class TaggedLimitSurface(LimitSurface):
 
     def __init__(self, mesh: PolyMesh):
         self.mesh = mesh
+        # a non-manifold mesh is evaluated on its split (PolyMesh.manifold): same faces and ptex faces
+        mesh = mesh.manifold
         b = _Builder(2 if mesh.options.crease_method == "chaikin" else 1, what="ptex face")
         ident = ((0.0, 0.0), (1.0, 0.0), (0.0, 1.0))
         P = mesh.n_ptex

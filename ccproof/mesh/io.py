@@ -1,4 +1,4 @@
-"""Wavefront OBJ input and output for quad meshes.
+"""Mesh input (one reader, :func:`read_mesh`, for every command and format) and OBJ output.
 
 A thin, faithful reader: it keeps the order of the faces and of the vertices inside each face
 (the face parameterization depends on both) and the size of every polygon, so that a triangle or a
@@ -21,7 +21,7 @@ from ccproof.mesh.quadmesh import QuadMesh
 if TYPE_CHECKING:
     from ccproof.mesh.polymesh import PolyMesh
 
-__all__ = ["read_obj", "read_obj_polygons", "read_obj_tagged", "read_mesh", "write_obj"]
+__all__ = ["read_obj", "read_obj_polygons", "read_obj_tagged", "read_off_polygons", "read_mesh", "write_obj"]
 
 
 def _logical_lines(text):
@@ -220,32 +220,149 @@ def read_obj_tagged(path):
         raise MeshError(f"{path}: {exc}") from None
 
 
-def read_mesh(path: str | os.PathLike[str]) -> PolyMesh:
-    r"""Read any polygon mesh: OBJ (with OpenSubdiv tags) directly, other formats through meshio.
+_OFF_KEYWORDS = ("OFF", "COFF", "NOFF", "CNOFF", "STOFF", "STCOFF", "STNOFF", "STCNOFF")
+
+
+def read_off_polygons(path):
+    r"""Read the vertices and polygons of an ASCII OFF file (any polygon size).
+
+    The Geomview OFF format: an optional keyword line (``OFF``, or ``COFF``/``NOFF``/``STOFF``/... whose
+    vertex lines carry colours, normals or texture coordinates after x y z, ignored here), the counts
+    ``nv nf ne`` (on the keyword line or the next), ``nv`` vertex lines ``x y z [...]``, ``nf`` face
+    lines ``k i_1 .. i_k [colour]`` (0-based). ``#`` starts a comment. meshio's OFF reader takes
+    triangles only; this one keeps quads and n-gons, in file order.
 
     Parameters
     ----------
     path : str or os.PathLike
-        ``.obj`` (read by :func:`read_obj_tagged`: triangles, n-gons, creases, corners, holes, boundary
-        modes) or any polygon format meshio reads (``.off``, ``.ply``, ``.stl``, ``.vtk``, ...).
 
     Returns
     -------
-    PolyMesh
-        Vertices of shape (n, 3) (2-D points get z = 0); meshio cells of type triangle, quad and
-        polygon are kept in file order (by cell block); other cell types (lines, vertices, volumes)
-        raise a MeshError naming the block.
+    vertices : ndarray, shape (n, 3), float64
+    polygons : list of list of int
+        0-based vertex indices of each face, in file order.
+    lines : list of int
+        The (1-based) source line of each face.
 
     Raises
     ------
     MeshError
-        A malformed file (its path and line), a cell block that is not polygons, or a mesh that fails
-        the checks of :class:`~ccproof.mesh.polymesh.PolyMesh`.
+        A binary or higher-dimensional OFF file, missing counts, a short or malformed vertex or face
+        line, or an index out of range (message names the file and the line).
 
     Examples
     --------
-    A square pyramid (a quad and four triangles) as ASCII PLY (through meshio), and an OBJ cube
-    with one crease:
+    >>> import os, tempfile
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     path = os.path.join(d, "m.off")
+    ...     with open(path, "w") as fh:
+    ...         _ = fh.write("OFF\n# a quad and a triangle\n5 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n2 0 0\n"
+    ...                      "4 0 1 2 3\n3 1 4 2\n")
+    ...     V, polygons, lines = read_off_polygons(path)
+    >>> V.shape, polygons, lines
+    ((5, 3), [[0, 1, 2, 3], [1, 4, 2]], [9, 10])
+    """
+    p = os.fspath(path)
+    with open(p, encoding="utf-8", errors="replace") as fh:
+        text = fh.read()
+    rows = []
+    for no, line in enumerate(text.splitlines(), start=1):
+        tok = line.split("#", 1)[0].split()
+        if tok:
+            rows.append((no, tok))
+    if not rows:
+        raise MeshError(f"{p}: empty OFF file")
+    k = 0
+    no, tok = rows[0]
+    head = tok[0].upper()
+    if head.endswith("OFF"):
+        if head not in _OFF_KEYWORDS:
+            raise MeshError(f"{p}:{no}: OFF variant {tok[0]!r} is not supported "
+                            "(only 3-D ASCII OFF, COFF, NOFF, STOFF)")
+        if len(tok) > 1 and tok[1].upper() == "BINARY":
+            raise MeshError(f"{p}:{no}: binary OFF is not supported (ASCII only)")
+        tok = tok[1:]
+        if not tok:
+            k = 1
+            if len(rows) < 2:
+                raise MeshError(f"{p}: no vertex and face counts after {head!r}")
+            no, tok = rows[1]
+    try:
+        nv, nf = int(tok[0]), int(tok[1])
+    except (ValueError, IndexError):
+        raise MeshError(f"{p}:{no}: expected the counts 'vertices faces edges', got {' '.join(tok)!r}") from None
+    if nv < 0 or nf < 0:
+        raise MeshError(f"{p}:{no}: negative counts {nv} {nf}")
+    body = rows[k + 1 :]
+    if len(body) < nv + nf:
+        raise MeshError(f"{p}: the header announces {nv} vertices and {nf} faces, the file has {len(body)} data lines")
+    verts = []
+    for no, tok in body[:nv]:
+        try:
+            verts.append([float(x) for x in tok[:3]])
+        except ValueError:
+            raise MeshError(f"{p}:{no}: bad vertex coordinate in {' '.join(tok)!r}") from None
+        if len(tok) < 3:
+            raise MeshError(f"{p}:{no}: vertex line needs 3 coordinates: {' '.join(tok)!r}")
+    polys, lines = [], []
+    for f, (no, tok) in enumerate(body[nv : nv + nf]):
+        try:
+            size = int(tok[0])
+            idx = [int(x) for x in tok[1 : 1 + size]]
+        except ValueError:
+            raise MeshError(f"{p}:{no}: bad face line {' '.join(tok)!r}") from None
+        if len(idx) != size:
+            raise MeshError(f"{p}:{no}: face {f} announces {size} vertices, has {len(idx)}")
+        for i in idx:
+            if not 0 <= i < nv:
+                raise MeshError(f"{p}:{no}: face {f} refers to vertex {i} of {nv} (0-based)")
+        polys.append(idx)
+        lines.append(no)
+    return np.array(verts, dtype=np.float64).reshape(-1, 3), polys, lines
+
+
+def _check_ply_header(p):
+    """A PLY file starts with the line ``ply`` (lower case: the keywords of the PLY format are compared
+    exactly by its reference reader, Turk's ply.c, and by VTK's); name the problem otherwise."""
+    with open(p, "rb") as fh:
+        first = fh.readline(64).strip()
+    if first == b"ply":
+        return
+    if first.lower() == b"ply":
+        raise MeshError(f"{p}: not a valid PLY file: the header is upper case ({first.decode(errors='replace')!r}); "
+                        "PLY keywords are lower case ('ply', 'format', 'element', 'property', 'end_header')")
+    raise MeshError(f"{p}: not a PLY file: it does not start with the line 'ply'")
+
+
+def read_mesh(path: str | os.PathLike[str]) -> PolyMesh:
+    r"""Read any polygon mesh: the one reader of every command.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        ``.obj``: :func:`read_obj_tagged` (triangles, n-gons, OpenSubdiv tags: creases, corners, holes,
+        boundary modes); ``.off``: :func:`read_off_polygons` (any polygon size; meshio's OFF reader
+        takes triangles only); anything else through meshio (``.ply``, ``.stl``, ``.vtk``, ``.vtu``,
+        ``.msh``, ...; a ``.ply`` must start with the line ``ply``).
+
+    Returns
+    -------
+    PolyMesh
+        Vertices of shape (n, 3) (2-D points get z = 0), all of them in file order (unused ones too,
+        with any coordinates); faces in file order (meshio: by cell block, triangle, quad and
+        polygon blocks); non-manifold edges and vertices as OpenSubdiv takes them.
+
+    Raises
+    ------
+    MeshError
+        Always naming the file: it does not exist or is a folder, a format no reader knows, a
+        malformed file (with the line where we parse it), a cell block that is not polygons, or a
+        mesh that fails the checks of :class:`~ccproof.mesh.polymesh.PolyMesh`.
+
+    Examples
+    --------
+    A square pyramid (a quad and four triangles) as ASCII PLY (through meshio), the same as OFF
+    (our reader), and an OBJ cube with one crease:
 
     >>> import os, tempfile
     >>> d = tempfile.mkdtemp()
@@ -258,6 +375,12 @@ def read_mesh(path: str | os.PathLike[str]) -> PolyMesh:
     >>> m = read_mesh(ply)
     >>> m.n_vertices, m.n_faces, m.vertices.shape, [len(p) for p in m.polygons]
     (5, 5, (5, 3), [4, 3, 3, 3, 3])
+    >>> off = os.path.join(d, "pyramid.off")
+    >>> with open(off, "w") as fh:
+    ...     _ = fh.write("OFF\n5 5 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0.5 0.5 1\n"
+    ...                  "4 0 3 2 1\n3 0 1 4\n3 1 2 4\n3 2 3 4\n3 3 0 4\n")
+    >>> read_mesh(off).polygons == m.polygons
+    True
     >>> from ccproof.mesh.examples import cube
     >>> obj = os.path.join(d, "cube.obj")
     >>> write_obj(obj, cube())
@@ -265,19 +388,31 @@ def read_mesh(path: str | os.PathLike[str]) -> PolyMesh:
     ...     _ = fh.write("t crease 2/1/0 0 1 2.5\n")
     >>> read_mesh(obj).edge_sharpness
     {(0, 1): 2.5}
+    >>> read_mesh(os.path.join(d, "cube.xyz"))
+    Traceback (most recent call last):
+    ...
+    ccproof.errors.MeshError: .../cube.xyz: no such file
     >>> import shutil; shutil.rmtree(d)
     """
     from ccproof.mesh.polymesh import PolyMesh
 
     p = os.fspath(path)
-    if p.lower().endswith(".obj"):
+    if os.path.isdir(p):
+        raise MeshError(f"{p}: is a folder, not a mesh file")
+    if not os.path.exists(p):
+        raise MeshError(f"{p}: no such file")
+    ext = os.path.splitext(p)[1].lower()
+    if ext == ".obj":
         return read_obj_tagged(p)
-    import meshio
-
-    try:
-        mesh = meshio.read(p)
-    except Exception as exc:  # meshio raises many types
-        raise MeshError(f"{p}: meshio cannot read it: {exc}") from None
+    if ext == ".off":
+        V, polys, _ = read_off_polygons(p)
+        try:
+            return PolyMesh(V, polys)
+        except MeshError as exc:
+            raise MeshError(f"{p}: {exc}") from None
+    if ext == ".ply":
+        _check_ply_header(p)
+    mesh = _meshio_read(p, ext)
     polys = []
     for b, block in enumerate(mesh.cells):
         if block.type in ("triangle", "quad") or block.type.startswith("polygon"):
@@ -285,12 +420,45 @@ def read_mesh(path: str | os.PathLike[str]) -> PolyMesh:
         else:
             raise MeshError(f"{p}: cell block {b} has type {block.type!r}: only polygon faces are supported")
     pts = np.asarray(mesh.points, dtype=np.float64)
+    if pts.ndim != 2 or pts.shape[1] not in (2, 3):
+        raise MeshError(f"{p}: points of shape {pts.shape}: expected 2-D or 3-D points")
     if pts.shape[1] == 2:
         pts = np.c_[pts, np.zeros(len(pts))]
     try:
         return PolyMesh(pts, polys)
     except MeshError as exc:
         raise MeshError(f"{p}: {exc}") from None
+
+
+def _meshio_read(p, ext):
+    """meshio's reader of the file's suffix, its failures turned into a MeshError naming the file and
+    the reason. (``meshio.read`` prints its reader's error and calls ``sys.exit(1)``: both are caught
+    here, the printed text becomes the reason; library code neither prints nor exits.)"""
+    import contextlib
+    import io
+
+    import meshio
+
+    fmts = meshio.extension_to_filetypes.get(ext, [])
+    if not fmts:
+        raise MeshError(f"{p}: unknown mesh format {ext or '(no suffix)'!r}: ccproof reads .obj, .off and the "
+                        f"formats of meshio ({', '.join(sorted(meshio.extension_to_filetypes))})")
+    reasons = []
+    for fmt in fmts:
+        buf = io.StringIO()
+        try:
+            with contextlib.redirect_stdout(buf), contextlib.redirect_stderr(buf):
+                return meshio.read(p, file_format=fmt)
+        except SystemExit:
+            text = buf.getvalue().strip()
+            reasons.append(text.splitlines()[0] if text else "meshio gave up")
+        except meshio.ReadError as exc:
+            reasons.append(str(exc).strip() or "meshio.ReadError")
+        except (ValueError, IndexError, KeyError, TypeError, UnicodeDecodeError, EOFError, AssertionError) as exc:
+            # meshio's parsers fail on malformed files with these (its own error type is not used throughout)
+            first = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
+            reasons.append(f"{type(exc).__name__}: {first}" if first else type(exc).__name__)
+    raise MeshError(f"{p}: not a valid {' or '.join(f.upper() for f in fmts)} file: {'; '.join(reasons)}")
 
 
 def read_obj(path: str | os.PathLike[str]) -> QuadMesh:

@@ -68,10 +68,14 @@ def limit_positions(mesh: QuadMesh, vertices=None):
     np.add.at(esum, org, V[e])
     np.add.at(dsum, org, V[d])
     # integer numerators over a common denominator: one rounding, at the division
-    ks = np.unique(mesh.valence)
+    unused = getattr(mesh, "is_unused_vertex", np.zeros(n, dtype=bool))
+    val = np.where(unused, 4, mesh.valence)  # unused vertices (valence 0): NaN below
+    ks = np.unique(val)
     table = np.array([_integer_weights(smooth_limit_weights(int(k), Fraction(1))) for k in ks], dtype=np.float64)
-    nV, ne, nd, den = table[np.searchsorted(ks, mesh.valence)].T[:, :, None]
-    L = (nV * V + ne * esum + nd * dsum) / den
+    nV, ne, nd, den = table[np.searchsorted(ks, val)].T[:, :, None]
+    with np.errstate(invalid="ignore"):
+        L = (nV * V + ne * esum + nd * dsum) / den
+    L[unused] = np.nan
     bv = mesh.is_boundary_vertex
     if bv.any():
         e0, e1 = _boundary_neighbours(mesh)
@@ -87,7 +91,7 @@ def _integer_weights(ws):
 
 
 def limit_tangents(mesh: QuadMesh, vertices=None):
-    """Limit tangent masks t1, t2 (module docstring), NaN at irregular boundary vertices.
+    """Limit tangent masks t1, t2 (module docstring), NaN at irregular boundary and unused vertices.
 
     Parameters
     ----------
@@ -145,7 +149,7 @@ def limit_tangents(mesh: QuadMesh, vertices=None):
         contrib = w_e[:, None] * V[e] + w_d[:, None] * V[d]
         acc = np.zeros((n, 3))
         np.add.at(acc, v[inner], contrib[inner])
-        iv = ~mesh.is_boundary_vertex
+        iv = ~mesh.is_boundary_vertex & ~getattr(mesh, "is_unused_vertex", np.zeros(n, dtype=bool))
         t[iv] = acc[iv]
     rb = np.flatnonzero(mesh.is_boundary_vertex & (mesh.face_count == 2))
     if rb.size:

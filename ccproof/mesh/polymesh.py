@@ -10,10 +10,18 @@ Catmull-Clark step: (0,0) = v_k, (1,0) = the edge point of (v_k, v_k+1), (1,1) =
 (0,1) = the edge point of (v_k-1, v_k). :meth:`PolyMesh.ptex_of` and :meth:`PolyMesh.face_of_ptex`
 are the mapping (face, corner) <-> ptex index.
 
-Checks (:class:`~ccproof.errors.MeshError` naming the element otherwise): faces with >= 3 distinct
-vertex indices in range, finite coordinates, every edge in one or two faces traversed in opposite
-directions, the faces around every vertex a single fan, crease tags on existing edges, sharpness
-finite or infinite but not negative and not NaN, hole indices in range.
+Checks (:class:`~ccproof.errors.MeshError` naming the element otherwise): faces with >= 3 vertex
+indices in range (a repeated one as OpenSubdiv takes it, below), finite coordinates on every vertex
+a face uses (unused vertices may hold anything and keep their index), crease tags on existing
+edges, sharpness finite or infinite but not negative and not NaN, hole indices in range.
+
+Non-manifold edges and vertices are taken as OpenSubdiv takes them (``Vtr::Level``: an edge with
+more than two faces or two faces in the same direction, e.g. a face given twice, a degenerate edge
+(v, v) and an edge a face holds twice; a vertex at such an edge or whose faces form several fans;
+``Far::TopologyRefinerFactory``: such edges infinitely sharp, such vertices infinitely sharp
+corners but on an interior non-manifold crease). :attr:`PolyMesh.manifold` is the mesh the surface
+is evaluated on: the fans of every non-manifold vertex split apart (see
+:meth:`PolyMesh._split_nonmanifold`), the same faces.
 """
 
 from __future__ import annotations
@@ -22,9 +30,10 @@ import math
 
 import numpy as np
 import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
 
 from ccproof.errors import MeshError
-from ccproof.mesh.quadmesh import _pair_halfedges
+from ccproof.mesh.quadmesh import _check_used_finite
 from ccproof.mesh.rules import INFINITE, Complex, Options, refine_complex, to_float
 
 __all__ = ["PolyMesh"]
@@ -45,7 +54,7 @@ def _sharp_value(x, what):
 
 
 class PolyMesh:
-    """A manifold polygon mesh with Sdc tags (OpenSubdiv's ``Far::TopologyDescriptor``).
+    """A polygon mesh with Sdc tags (OpenSubdiv's ``Far::TopologyDescriptor``), manifold or not.
 
     Parameters
     ----------
@@ -64,24 +73,42 @@ class PolyMesh:
         ``boundary`` ('edge_only' | 'edge_and_corner' | 'none'), ``crease_method``
         ('uniform' | 'chaikin'), ``triangle_subdivision`` ('catmark' | 'smooth').
 
+    Attributes
+    ----------
+    is_unused_vertex, is_boundary_vertex, is_nonmanifold_vertex : ndarray of bool, shape (n,)
+    edges : ndarray of int, shape (E, 2)
+        Undirected edges (lo, hi); ``is_boundary_edge``, ``is_nonmanifold_edge`` (E,),
+        ``edge_face_count`` (E,).
+    manifold : PolyMesh
+        ``self`` when :attr:`is_manifold`, else the split mesh (same faces, vertices
+        ``vertices[manifold_vertex_map]``).
+    manifold_vertex_map : ndarray of int, shape (n',)
+
     Examples
     --------
     >>> m = PolyMesh([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 2]])
     >>> m.n_ptex, m.ptex_of(0, 2), m.face_of_ptex(1)
     (3, 2, (0, 1))
+
+    Two triangles touching at vertex 0 (a bow tie): vertex 0 is non-manifold, an infinitely sharp
+    corner; the evaluated mesh has a copy of it (vertex 5) for the second fan:
+
+    >>> b = PolyMesh([[0, 0, 0], [1, 0, 0], [1, 1, 0], [-1, 0, 0], [-1, -1, 0]], [[0, 1, 2], [0, 3, 4]])
+    >>> b.is_manifold, b.is_nonmanifold_vertex.tolist(), b.manifold.polygons, b.manifold_vertex_map.tolist()
+    (False, [True, False, False, False, False], [(0, 1, 2), (5, 3, 4)], [0, 1, 2, 3, 4, 0])
+    >>> b.manifold.vertex_sharpness
+    {0: inf, 5: inf}
     >>> PolyMesh([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 2]], creases=([[0, 2]], [-1]))
     Traceback (most recent call last):
     ...
     ccproof.errors.MeshError: crease on edge (0, 2): negative sharpness -1.0
     """
 
-    def __init__(self, vertices, faces, *, creases=None, corners=None, holes=None, options=None, sizes=None):
+    def __init__(self, vertices, faces, *, creases=None, corners=None, holes=None, options=None, sizes=None,
+                 _split=True):
         V = np.array(vertices, dtype=np.float64)
         if V.ndim != 2 or V.shape[1] != 3:
             raise MeshError(f"vertices must have shape (n, 3), got {V.shape}")
-        bad = np.flatnonzero(~np.isfinite(V).all(axis=1))
-        if bad.size:
-            raise MeshError(f"vertex {int(bad[0])} has a non-finite coordinate: {V[bad[0]].tolist()}")
         polys = self._polygons(faces, sizes)
         if not polys:
             raise MeshError("the mesh has no faces")
@@ -92,9 +119,10 @@ class PolyMesh:
             for v in p:
                 if not 0 <= v < n:
                     raise MeshError(f"face {f} has a vertex index out of range [0, {n}): {p}")
-            if len(set(p)) != len(p):
+            if _split is False and len(set(p)) != len(p):  # (the split mesh: a face still touching itself)
                 r = next(v for v in p if p.count(v) > 1)
-                raise MeshError(f"face {f} repeats vertex {r}: {p}")
+                raise MeshError(f"face {f} repeats vertex {r} within one fan: {p}")
+        _check_used_finite(V, [v for p in polys for v in p])
         self.vertices = V
         self.vertices.setflags(write=False)
         self.polygons = [tuple(p) for p in polys]
@@ -123,6 +151,12 @@ class PolyMesh:
         self.n_ptex = int(self.ptex_start[-1])
         #: subdivision level (0 for input meshes; the TRI_SUB_SMOOTH and EDGE_AND_CORNER rules act at 0)
         self.level = 0
+        if self.is_manifold:
+            self.manifold, self.manifold_vertex_map = self, np.arange(n, dtype=np.int64)
+        elif not _split:
+            raise MeshError("internal: the split of the non-manifold vertices is still non-manifold")
+        else:
+            self.manifold, self.manifold_vertex_map = self._split_nonmanifold()
 
     # ------------------------------------------------------------------ construction helpers
     @staticmethod
@@ -152,6 +186,13 @@ class PolyMesh:
         return out
 
     def _build_topology(self):
+        """Edges, twins and fans; OpenSubdiv's non-manifold edges and vertices (``Vtr::Level``).
+
+        An edge is non-manifold when more than two faces share it or two faces traverse it in the
+        same direction (``completeTopologyFromFaceVertices``; a face given twice is such a case); a
+        vertex is non-manifold when it ends a non-manifold edge or its faces do not form a single
+        fan (``orderVertexFacesAndEdges``). Twins exist only across manifold edges.
+        """
         n = self.vertices.shape[0]
         off, idx = self.offsets, self.indices
         H = idx.size
@@ -160,42 +201,197 @@ class PolyMesh:
         nxt = off[face_of] + (loc + 1) % self.sizes[face_of]
         prv = off[face_of] + (loc - 1) % self.sizes[face_of]
         org, dst = idx, idx[nxt]
-        lo, hi, order, starts, counts, edge_of, twin = _pair_halfedges(org, dst, face_of, n)
+        lo, hi = np.minimum(org, dst), np.maximum(org, dst)
+        order = np.argsort(lo * n + hi, kind="stable")
+        sk = (lo * n + hi)[order]
+        starts = np.flatnonzero(np.r_[True, sk[1:] != sk[:-1]])
+        counts = np.diff(np.r_[starts, H])
+        edge_of = np.empty(H, dtype=np.int64)
+        edge_of[order] = np.repeat(np.arange(starts.size), counts)
+        nm_edge = counts > 2
+        two = np.flatnonzero(counts == 2)
+        h1, h2 = order[starts[two]], order[starts[two] + 1]
+        same = (org[h1] == org[h2]) | (face_of[h1] == face_of[h2])  # same direction, or twice in one face
+        nm_edge[two[same]] = True
+        # a face repeating a vertex: a degenerate edge (v, v), or an edge the face holds twice; OpenSubdiv
+        # gives each such occurrence an edge of its own with one face (a boundary edge), so that both
+        # ends are sharpened (corners)
+        degenerate = lo[order[starts]] == hi[order[starts]]
+        fe = np.unique(edge_of * len(self.polygons) + face_of, return_counts=True)
+        held_twice = np.zeros(starts.size, dtype=bool)
+        held_twice[fe[0][fe[1] > 1] // len(self.polygons)] = True
+        nm_edge |= degenerate | held_twice
+        self._repeat_edge = degenerate | held_twice
+        ends = np.flatnonzero(degenerate | held_twice)
+        self._sharpened_by_degenerate = np.zeros(n, dtype=bool)
+        self._sharpened_by_degenerate[lo[order[starts[ends]]]] = True
+        self._sharpened_by_degenerate[hi[order[starts[ends]]]] = True
+        twin = np.full(H, -1, dtype=np.int64)
+        twin[h1[~same]], twin[h2[~same]] = h2[~same], h1[~same]
         first = order[starts]
+        self._edge_halfedge = first  # one half-edge of every edge
         self.edges = np.stack([lo[first], hi[first]], axis=1)
         self.edge_index = {(int(a), int(b)): e for e, (a, b) in enumerate(self.edges.tolist())}
+        self.edge_face_count = counts
         self.is_boundary_edge = counts == 1
+        self.is_nonmanifold_edge = nm_edge
         self.twin, self.next, self.prev, self.face_of_halfedge = twin, nxt, prv, face_of
         self.edge_of_halfedge = edge_of
-        face_count = np.bincount(org, minlength=n)
-        self.face_count = face_count
-        # fans: rot(c) = twin(prev(c)) is the next corner counter-clockwise around org(c)
+        self.face_count = np.bincount(org, minlength=n)
+        # fans: rot(c) = twin(prev(c)) is the next corner counter-clockwise around org(c); the corners
+        # joined by rot are the fans (OpenSubdiv's spans between singular edges)
         rot = twin[prv]
-        seen = np.zeros(H, dtype=bool)
-        nfans = np.zeros(n, dtype=np.int64)
-        for c0 in range(H):
-            if seen[c0]:
+        ok = np.flatnonzero(rot >= 0)
+        g = sp.coo_matrix((np.ones(ok.size), (ok, rot[ok])), shape=(H, H))
+        ncomp, comp = connected_components(g, directed=False)
+        vertex_of_comp = np.zeros(ncomp, dtype=np.int64)
+        vertex_of_comp[comp] = org
+        nfans = np.bincount(vertex_of_comp, minlength=n)
+        nm_vertex = nfans > 1
+        nm_vertex[self.edges[nm_edge].reshape(-1)] = True
+        self.is_nonmanifold_vertex = nm_vertex
+        self._fan_of_corner = comp
+        self.is_boundary_vertex = np.bincount(org[counts[edge_of] == 1], minlength=n) > 0
+        self.is_unused_vertex = self.face_count == 0
+
+    @property
+    def is_manifold(self):
+        """No non-manifold edge or vertex (OpenSubdiv's definition; see :meth:`_build_topology`)."""
+        return not self.is_nonmanifold_vertex.any()
+
+    @property
+    def nonmanifold_edges(self):
+        """int (k, 2): the non-manifold edges (more than two faces, or two faces in the same direction)."""
+        return self.edges[self.is_nonmanifold_edge]
+
+    def _split_nonmanifold(self):
+        """The manifold mesh on which the limit surface is evaluated, and its vertex map.
+
+        OpenSubdiv (``Far::TopologyRefinerFactory::prepareComponentTagsAndSharpness``) makes every
+        non-manifold edge infinitely sharp and every non-manifold vertex an infinitely sharp corner,
+        except on an interior non-manifold crease (two non-manifold edges, no boundary edge, more
+        faces than edges), whose vertex follows the crease rule along the two non-manifold edges.
+        Its patches (``Far::PatchBuilder``) see, at a non-manifold vertex, only the fan of faces
+        between two singular edges. Both say that each fan of a non-manifold vertex may be a
+        vertex of its own: the fans are split apart into copies (the first fan keeps the vertex
+        index, the others get indices n, n+1, ...), the non-manifold edges become boundary edges,
+        sharpened vertices get infinite vertex sharpness. Every rule then acts on the copies as
+        OpenSubdiv's acts on the vertex. A crease vertex with other semi-sharp edges is a corner
+        until the last of them has decayed: its copies get that edge's sharpness as vertex sharpness
+        (same rule at every level, same fractional weight). Cases where no split reproduces the
+        vertex's rule are refused by name: a crease vertex with a fan not bounded by both
+        non-manifold edges, or whose last semi-sharp features have different values, and Chaikin
+        creases with semi-sharp edges in more than one fan of a non-manifold vertex or at a crease
+        vertex.
+
+        Returns
+        -------
+        PolyMesh
+            Same faces, in order (same ptex faces), vertices ``vertices[vmap]``, all-infinite tags
+            on the split edges, the tags of the mesh and boundary mode ``edge_only`` (the mesh's
+            mode applied: ``edge_and_corner`` corners as vertex sharpness, ``none`` holes as holes).
+        vmap : ndarray of int, shape (n',)
+            Vertex of this mesh of every vertex of the split mesh (``vmap[:n] = arange(n)``).
+        """
+        n, H = self.n_vertices, self.indices.size
+        org, nxt, prv, comp = self.indices, self.next, self.prev, self._fan_of_corner
+        ncomp = int(comp.max()) + 1
+        first_corner = np.full(ncomp, H, dtype=np.int64)
+        np.minimum.at(first_corner, comp, np.arange(H))
+        cv = org[first_corner]
+        o = np.lexsort((first_corner, cv))
+        lead = np.r_[True, cv[o][1:] != cv[o][:-1]]
+        label = np.empty(ncomp, dtype=np.int64)
+        label[o[lead]] = cv[o[lead]]
+        extra = o[~lead]
+        label[extra] = n + np.arange(extra.size)
+        vmap = np.r_[np.arange(n), cv[extra]].astype(np.int64)
+        new = label[comp]
+        edge_of, nm_e, nm_v = self.edge_of_halfedge, self.is_nonmanifold_edge, self.is_nonmanifold_vertex
+        chaikin = self.options.crease_method == "chaikin"
+        vsharp = {int(v): s for v, s in self.vertex_sharpness.items()}
+        by_vertex = np.argsort(org, kind="stable")  # corners grouped by vertex
+        ptr = np.r_[0, np.cumsum(self.face_count)]
+        # OpenSubdiv's sharpening of the non-manifold vertices
+        for v in np.flatnonzero(nm_v).tolist():
+            cs = by_vertex[ptr[v] : ptr[v + 1]]
+            es = np.unique(np.r_[edge_of[cs], edge_of[prv[cs]]])
+            nm_count = int(nm_e[es].sum())
+            bnd = int(self.is_boundary_edge[es].sum())
+            other = [self.edge_sharpness.get(tuple(self.edges[e].tolist()), 0.0) for e in es if not nm_e[e]]
+            sharpened = not (nm_count == 2 and bnd == 0 and cs.size > es.size) or self._sharpened_by_degenerate[v]
+            if chaikin and any(0.0 < x < math.inf for x in other):
+                # Chaikin: the child sharpness at v depends on all semi-sharp edges at v; a copy sees those
+                # of its own fan only, so they must all be in one fan (and v a corner for ever)
+                semi_e = {e for e in es if not nm_e[e]
+                          and 0.0 < self.edge_sharpness.get(tuple(self.edges[e].tolist()), 0.0) < math.inf}
+                fans = {int(comp[c]) for c in cs if edge_of[c] in semi_e or edge_of[prv[c]] in semi_e}
+                if not sharpened or len(fans) > 1:
+                    raise MeshError(f"non-manifold vertex {v}: Chaikin creases with semi-sharp edges at a "
+                                    "non-manifold vertex are supported only in one of its fans, at a corner")
+            if sharpened:
+                vsharp[v] = math.inf
                 continue
-            v = int(org[c0])
-            nfans[v] += 1
-            c = c0
-            while c >= 0 and not seen[c]:
-                seen[c] = True
-                c = int(rot[c])
-            c = int(twin[c0])
-            c = -1 if c < 0 else int(nxt[c])
-            while c >= 0 and not seen[c]:
-                seen[c] = True
-                t = int(twin[c])
-                c = -1 if t < 0 else int(nxt[t])
-        if (nfans > 1).any():
-            v = int(np.flatnonzero(nfans > 1)[0])
-            raise MeshError(
-                f"non-manifold vertex {v}: its faces form {int(nfans[v])} separate fans "
-                f"(faces {sorted(set(face_of[org == v].tolist()))})"
-            )
-        self.is_boundary_vertex = np.bincount(org[twin < 0], minlength=n) > 0
-        self.is_unused_vertex = face_count == 0
+            # an interior non-manifold crease: the crease rule along its two non-manifold edges
+            if any(x == math.inf for x in other):
+                vsharp[v] = math.inf  # three or more infinitely sharp edges: a corner for ever
+                continue
+            semi = [x for x in other if x > 0.0]
+            if semi:
+                # a corner while any of these is sharp (three sharp edges), then the crease rule, blended
+                # with the mean of the features that end at that step: the vertex sharpness T = the
+                # largest of them on every copy gives each copy that schedule and that weight (uniform
+                # decay), provided the features ending last all have T
+                feats = semi + ([vsharp[v]] if vsharp.get(v, 0.0) > 0.0 else [])
+                top = max(feats)
+                last = {x for x in feats if math.ceil(x) == math.ceil(top)}
+                if len(last) > 1:
+                    raise MeshError(
+                        f"non-manifold crease vertex {v}: semi-sharp edges or vertex sharpness {sorted(last)} "
+                        "ending at the same level with different values are not supported")
+                vsharp[v] = top
+            for c in set(comp[cs].tolist()):
+                members = cs[comp[cs] == c]
+                lead_c = members[self.twin[members] < 0]  # outgoing half-edge on a singular edge
+                trail_c = members[self.twin[prv[members]] < 0]
+                if lead_c.size != 1 or trail_c.size != 1 or edge_of[lead_c[0]] == edge_of[prv[trail_c[0]]]:
+                    raise MeshError(
+                        f"non-manifold crease vertex {v}: a fan of faces "
+                        f"{sorted(self.face_of_halfedge[members].tolist())} "
+                        "is not bounded by both non-manifold edges (not supported)")
+        if self.options.boundary == "edge_and_corner":
+            corner = (self.face_count == 1) & self.is_boundary_vertex & ~nm_v
+            for v in np.flatnonzero(corner).tolist():
+                vsharp[v] = math.inf
+        creases = {}
+        hs = np.arange(H)
+        for h in hs[nm_e[edge_of]].tolist():
+            a, b = int(new[h]), int(new[nxt[h]])
+            creases[(min(a, b), max(a, b))] = math.inf
+        for (a, b), x in self.edge_sharpness.items():
+            e = self.edge_index[(a, b)]
+            if nm_e[e]:
+                continue
+            h = int(self._edge_halfedge[e])
+            p, q = int(new[h]), int(new[nxt[h]])
+            creases[(min(p, q), max(p, q))] = x
+        copies = {}
+        for u in range(n, len(vmap)):
+            copies.setdefault(int(vmap[u]), []).append(u)
+        corners = {}
+        for v, x in vsharp.items():
+            for u in [v, *copies.get(v, [])]:
+                corners[u] = x
+        polys = [new[self.offsets[f] : self.offsets[f + 1]].tolist() for f in range(self.n_faces)]
+        opts = Options("edge_only", self.options.crease_method, self.options.triangle_subdivision)
+        try:
+            m = PolyMesh(self.vertices[vmap], polys, creases=creases or None, corners=corners or None,
+                         holes=np.flatnonzero(self.is_hole), options=opts, _split=False)
+        except MeshError as exc:
+            raise MeshError(f"non-manifold mesh not supported after splitting its non-manifold vertices: "
+                            f"{exc}") from None
+        m.level = self.level
+        return m, vmap
 
     def _creases(self, creases):
         out = {}
@@ -249,7 +445,8 @@ class PolyMesh:
         if self.options.boundary != "none":
             return out
         bad_vertex = np.zeros(self.vertices.shape[0], dtype=bool)
-        for e in np.flatnonzero(self.is_boundary_edge):
+        # one-face edges, and OpenSubdiv's one-face edges of a face repeating a vertex
+        for e in np.flatnonzero(self.is_boundary_edge | self._repeat_edge):
             a, b = self.edges[e]
             if not math.isinf(self.edge_sharpness.get((int(a), int(b)), 0.0)):
                 bad_vertex[a] = bad_vertex[b] = True
@@ -272,6 +469,33 @@ class PolyMesh:
         return bool((self.sizes == 4).all())
 
     @property
+    def is_plain_quads(self):
+        """All quads, no tags, manifold: the mesh is a :class:`~ccproof.mesh.QuadMesh` (see :meth:`to_quad_mesh`)."""
+        return self.is_all_quads and not self.has_tags and self.is_manifold
+
+    def to_quad_mesh(self):
+        """The same mesh as a :class:`~ccproof.mesh.QuadMesh` (same vertices, unused ones included, same faces).
+
+        Raises
+        ------
+        MeshError
+            If the mesh is not :attr:`is_plain_quads` (the message says why).
+
+        Examples
+        --------
+        >>> m = PolyMesh([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [9, 9, 9]], [[0, 1, 2, 3]])
+        >>> m.is_plain_quads, m.to_quad_mesh()
+        (True, QuadMesh(5 vertices, 1 faces, 4 boundary edges, 0 extraordinary vertices))
+        """
+        from ccproof.mesh.quadmesh import QuadMesh
+
+        if not self.is_plain_quads:
+            why = ("it has faces that are not quads" if not self.is_all_quads else
+                   "it has OpenSubdiv tags" if self.has_tags else "it is not manifold")
+            raise MeshError(f"not a plain quad mesh: {why}")
+        return QuadMesh(self.vertices, np.array(self.polygons, dtype=np.int64).reshape(-1, 4))
+
+    @property
     def has_tags(self):
         """Creases, corners, holes or non-default options."""
         return bool(self.edge_sharpness or self.vertex_sharpness or self.is_hole.any()
@@ -279,7 +503,9 @@ class PolyMesh:
 
     @property
     def bounding_box_diagonal(self):
-        return float(np.linalg.norm(self.vertices.max(axis=0) - self.vertices.min(axis=0)))
+        """Length of the diagonal of the axis-aligned bounding box of the used vertices."""
+        V = self.vertices[~self.is_unused_vertex] if self.is_unused_vertex.any() else self.vertices
+        return float(np.linalg.norm(V.max(axis=0) - V.min(axis=0)))
 
     def ptex_of(self, face, corner=0):
         """Ptex index of ``(face, corner)`` (``corner`` ignored for quads)."""
@@ -302,7 +528,13 @@ class PolyMesh:
         return f, p - int(self.ptex_start[f])
 
     def complex(self):
-        """The mesh as a :class:`~ccproof.mesh.rules.Complex` at level 0."""
+        """The mesh as a :class:`~ccproof.mesh.rules.Complex` at level 0.
+
+        On a non-manifold mesh, the complex of :attr:`manifold` (labels of its vertices: indices of
+        ``manifold.vertices = vertices[manifold_vertex_map]``).
+        """
+        if self.manifold is not self:
+            return self.manifold.complex()
         return Complex(self.polygons, dict(self.edge_sharpness), dict(self.vertex_sharpness), self.options,
                        level=self.level, n_vertices=self.n_vertices)
 
@@ -316,8 +548,12 @@ class PolyMesh:
             inherited by the children; the options kept (``EDGE_AND_CORNER`` corners carried as
             infinite vertex sharpness).
         S : scipy.sparse.csr_matrix, shape (n + E + m, n)
-            ``refined.vertices == S @ self.vertices``.
+            ``refined.vertices == S @ self.vertices``. On a non-manifold mesh, the step of
+            :attr:`manifold` (n + E + m counted there; the columns are this mesh's vertices).
         """
+        if self.manifold is not self:
+            m, S = self.manifold.refine()
+            return m, (S @ _expansion(self.manifold_vertex_map, self.n_vertices)).tocsr()
         cx = self.complex()
         stencils, children, ces, cvs = refine_complex(cx)
         S = _stencil_matrix(stencils, self.n_vertices)
@@ -335,14 +571,38 @@ class PolyMesh:
         same stencils the float matrix is rounded from).
         """
         stencils, _, _, _ = refine_complex(self.complex())
+        if self.manifold is not self:
+            vmap = self.manifold_vertex_map.tolist()
+            out = []
+            for st in stencils:
+                if st is None:
+                    out.append(None)
+                    continue
+                d = {}
+                for c, w in st.items():
+                    d[vmap[c]] = d.get(vmap[c], 0) + w
+                out.append(d)
+            stencils = out
         if exact:
             return stencils
         return _stencil_matrix(stencils, self.n_vertices)
 
     def __repr__(self):
+        extra = ""
+        if not self.is_manifold:
+            extra += (f"{int(self.is_nonmanifold_edge.sum())} non-manifold edges, "
+                      f"{int(self.is_nonmanifold_vertex.sum())} non-manifold vertices, ")
+        if self.is_unused_vertex.any():
+            extra += f"{int(self.is_unused_vertex.sum())} unused vertices, "
         return (f"PolyMesh({self.n_vertices} vertices, {self.n_faces} faces, {self.n_ptex} ptex faces, "
                 f"{len(self.edge_sharpness)} creases, {len(self.vertex_sharpness)} corners, "
-                f"{int(self.is_hole.sum())} holes, {self.options})")
+                f"{int(self.is_hole.sum())} holes, {extra}{self.options})")
+
+
+def _expansion(vmap, n):
+    """Sparse (len(vmap), n) 0/1 matrix copying vertex ``vmap[i]`` to row i."""
+    k = len(vmap)
+    return sp.csr_matrix((np.ones(k), (np.arange(k), np.asarray(vmap))), shape=(k, n))
 
 
 def _stencil_matrix(stencils, ncols):

@@ -6,12 +6,13 @@ vertex). The constructor checks everything the subdivision and evaluation layers
 :class:`ccproof.errors.MeshError` naming the offending face, edge or vertex otherwise:
 
 * every face is a quadrilateral with four distinct vertex indices in range;
-* coordinates are finite;
+* coordinates are finite at every vertex a face uses (unused vertices are allowed, with any
+  coordinates: they keep their index and have no surface, valence 0 and NaN limits);
 * every edge has one (boundary) or two (interior) faces (edge-manifold);
 * the two faces of an interior edge traverse it in opposite directions (consistent orientation);
 * the faces around every vertex form a single fan, closed (interior vertex) or open (boundary
   vertex): the *link* of every vertex is a simple polygonal line (bmz04: manifold meshes);
-* every interior vertex has valence >= 3, every vertex is used by a face.
+* every interior vertex has valence >= 3.
 
 Half-edge conventions (used throughout ccproof): half-edge ``h = 4 f + i`` runs from
 ``faces[f, i]`` to ``faces[f, (i + 1) % 4]``; it is also the *corner* of face ``f`` at vertex
@@ -48,6 +49,12 @@ def _pair_halfedges(org, dst, face_of, n):
     sk = ukey[order]
     starts = np.flatnonzero(np.r_[True, sk[1:] != sk[:-1]])
     counts = np.diff(np.r_[starts, H])
+    bad = (counts > 2) | ((counts == 2) & (org[order[starts]] == org[order[np.minimum(starts + 1, H - 1)]]))
+    if bad.any():  # a face given twice is the likeliest cause: name it
+        g = int(np.flatnonzero(bad)[0])
+        dup = _duplicate_face(org, face_of, order[starts[g] : starts[g] + counts[g]])
+        if dup is not None:
+            raise MeshError(f"duplicate face: faces {dup[0]} and {dup[1]} have the same vertices {dup[2]}")
     if (counts > 2).any():
         g = int(np.flatnonzero(counts > 2)[0])
         hs = order[starts[g] : starts[g] + counts[g]]
@@ -70,6 +77,40 @@ def _pair_halfedges(org, dst, face_of, n):
         )
     twin[h1], twin[h2] = h2, h1
     return lo, hi, order, starts, counts, edge_of, twin
+
+
+def _check_used_finite(V, used):
+    """MeshError naming the first vertex used by a face whose coordinates are not finite (NaN, inf).
+
+    Unused vertices (common in scans) may hold anything: they do not enter the surface.
+    """
+    bad = ~np.isfinite(V).all(axis=1)
+    if bad.any():
+        mask = np.zeros(V.shape[0], dtype=bool)
+        mask[used] = True
+        hit = np.flatnonzero(bad & mask)
+        if hit.size:
+            v = int(hit[0])
+            raise MeshError(f"vertex {v} has a non-finite coordinate: {V[v].tolist()}")
+
+
+def _duplicate_face(org, face_of, hs):
+    """Two faces with the same vertex cycle among the faces of the half-edges ``hs`` (one edge), or None.
+
+    Returns ``(f, g, vertices of f)``; the cycle is compared up to rotation and direction.
+    """
+    faces = sorted({int(face_of[x]) for x in hs})
+    cyc = {}
+    for f in faces:
+        vs = org[face_of == f].tolist()
+        k = len(vs)
+        rots = [tuple(vs[i:] + vs[:i]) for i in range(k)]
+        rots += [tuple(r[::-1]) for r in rots]
+        key = min(rots)
+        if key in cyc:
+            return cyc[key][0], f, cyc[key][1]
+        cyc[key] = (f, vs)
+    return None
 
 
 class QuadMesh:
@@ -117,14 +158,12 @@ class QuadMesh:
                 raise MeshError("face indices must be integers")
             F = Fi
         F = np.array(F, dtype=np.int64)
-        bad = np.flatnonzero(~np.isfinite(V).all(axis=1))
-        if bad.size:
-            raise MeshError(f"vertex {int(bad[0])} has a non-finite coordinate: {V[bad[0]].tolist()}")
         n = V.shape[0]
         out = np.flatnonzero(((F < 0) | (F >= n)).any(axis=1))
         if out.size:
             f = int(out[0])
             raise MeshError(f"face {f} has a vertex index out of range [0, {n}): {F[f].tolist()}")
+        _check_used_finite(V, F.reshape(-1))
         s = np.sort(F, axis=1)
         rep = np.flatnonzero((s[:, 1:] == s[:, :-1]).any(axis=1))
         if rep.size:
@@ -171,9 +210,7 @@ class QuadMesh:
         V = np.array(vertices, dtype=np.float64)
         if V.shape != self.vertices.shape:
             raise MeshError(f"vertices must have shape {self.vertices.shape}, got {V.shape}")
-        bad = np.flatnonzero(~np.isfinite(V).all(axis=1))
-        if bad.size:
-            raise MeshError(f"vertex {int(bad[0])} has a non-finite coordinate: {V[bad[0]].tolist()}")
+        _check_used_finite(V, self.faces.reshape(-1))
         V.setflags(write=False)
         new.vertices = V
         return new
@@ -197,9 +234,7 @@ class QuadMesh:
 
         # vertices: corners, fans
         face_count = np.bincount(org, minlength=n)
-        unused = np.flatnonzero(face_count == 0)
-        if unused.size:
-            raise MeshError(f"vertex {int(unused[0])} is not used by any face")
+        unused = face_count == 0  # allowed (scans have them): no surface, no valence, indices kept
         # rot(c): next corner counter-clockwise around the same vertex = twin(prev(c))
         prev = (np.arange(H) // 4) * 4 + (np.arange(H) + 3) % 4
         rot = twin[prev]
@@ -217,7 +252,7 @@ class QuadMesh:
         bnd_out = np.bincount(org[twin < 0], minlength=n)
         is_bv = bnd_out > 0
         valence = face_count + is_bv
-        bad = np.flatnonzero(~is_bv & (valence < 3))
+        bad = np.flatnonzero(~is_bv & ~unused & (valence < 3))
         if bad.size:
             v = int(bad[0])
             raise MeshError(f"interior vertex {v} has valence {int(valence[v])} (needs >= 3)")
@@ -239,7 +274,9 @@ class QuadMesh:
         self.face_count = face_count
         self.valence = valence
         self.is_boundary_vertex = is_bv
-        for a in (self.twin, self.edge_of_halfedge, self.edges, self.edge_faces, self.is_boundary_edge,
+        self.is_unused_vertex = unused
+        for a in (self.is_unused_vertex, self.twin, self.edge_of_halfedge, self.edges, self.edge_faces,
+                  self.is_boundary_edge,
                   self.rot, self.fan_ptr, self.fan_corners, self.face_count, self.valence,
                   self.is_boundary_vertex):
             a.setflags(write=False)
@@ -267,8 +304,8 @@ class QuadMesh:
 
     @property
     def extraordinary_vertices(self):
-        """int (e,): interior vertices of valence != 4 (bmz04: extraordinary vertices)."""
-        return np.flatnonzero(~self.is_boundary_vertex & (self.valence != 4))
+        """int (e,): interior vertices of valence != 4 (bmz04: extraordinary vertices); unused vertices are not."""
+        return np.flatnonzero(~self.is_boundary_vertex & ~self.is_unused_vertex & (self.valence != 4))
 
     @property
     def boundary_edges(self):
@@ -278,8 +315,9 @@ class QuadMesh:
 
     @property
     def bounding_box_diagonal(self):
-        """Length of the diagonal of the axis-aligned bounding box of the control points."""
-        return float(np.linalg.norm(self.vertices.max(axis=0) - self.vertices.min(axis=0)))
+        """Length of the diagonal of the axis-aligned bounding box of the used control points."""
+        V = self.vertices[~self.is_unused_vertex] if self.is_unused_vertex.any() else self.vertices
+        return float(np.linalg.norm(V.max(axis=0) - V.min(axis=0)))
 
     def corner_vertex(self, c):
         """Vertex of corner / origin of half-edge ``c`` (array_like of int)."""

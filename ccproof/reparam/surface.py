@@ -286,7 +286,8 @@ def limit_surface(mesh: QuadMesh | PolyMesh | str | os.PathLike[str], alpha: flo
     Parameters
     ----------
     mesh : QuadMesh or PolyMesh or str or os.PathLike
-        A path is read with :func:`ccproof.mesh.read_obj` (untagged quad OBJ).
+        A path is read with :func:`ccproof.mesh.read_mesh` (every format; a plain quad mesh gives
+        the reparameterizable surface, any other mesh the tagged evaluator).
     alpha : float or dict or None
         Exponent of F^alpha for the "vanishing" parameterization: one value for every valence, a
         dict valence -> value (missing valences get the default), or None for
@@ -320,6 +321,9 @@ def limit_surface(mesh: QuadMesh | PolyMesh | str | os.PathLike[str], alpha: flo
         return natural_limit_surface(mesh)
     if isinstance(mesh, QuadMesh):
         return ReparamLimitSurface(mesh, alpha)
-    from ccproof.mesh import read_obj
+    from ccproof.mesh.io import read_mesh
 
-    return ReparamLimitSurface(read_obj(mesh), alpha)
+    poly = read_mesh(mesh)
+    if poly.is_plain_quads:
+        return ReparamLimitSurface(poly.to_quad_mesh(), alpha)
+    return limit_surface(poly, alpha)

@@ -77,16 +77,12 @@ def test_meshio_input(tmp_path):
 
 
 @pytest.mark.parametrize("kwargs,msg", [
-    ({"faces": [[0, 1, 4, 3], [1, 4, 2, 5], [4, 1, 6]]}, r"non-manifold edge \(1, 4\): shared by 3 faces"),
-    ({"faces": [[0, 1, 3], [1, 2, 4], [4, 5, 1]], "n": 6}, r"non-manifold vertex 1: its faces form 2 separate fans"),
-    ({"faces": [[0, 1, 4, 3], [1, 4, 5, 2]]}, r"inconsistent orientation: faces 0 and 1 both traverse edge \(1, 4\)"),
     ({"creases": {(0, 5): 1.0}}, r"crease on edge \(0, 5\): no such edge in the mesh"),
     ({"creases": {(0, 1): -0.5}}, r"crease on edge \(0, 1\): negative sharpness -0.5"),
     ({"creases": {(0, 1): float("nan")}}, r"crease on edge \(0, 1\): sharpness is NaN"),
     ({"corners": {2: -1}}, r"corner on vertex 2: negative sharpness"),
     ({"corners": {9: 1}}, r"corner on vertex 9: out of range"),
     ({"holes": [7]}, r"hole face 7 out of range"),
-    ({"faces": [[0, 1, 1]]}, r"face 0 repeats vertex 1"),
     ({"faces": [[0, 1]]}, r"face 0 has 2 vertices"),
     ({"faces": [[0, 1, 9]]}, r"face 0 has a vertex index out of range"),
     ({"nan": True}, r"vertex 2 has a non-finite coordinate"),
@@ -102,6 +98,48 @@ def test_bad_input_names_the_element(kwargs, msg):
     F = kwargs.pop("faces", F)
     with pytest.raises(MeshError, match=msg):
         PolyMesh(V, F, **kwargs)
+
+
+@pytest.mark.parametrize("faces,n,nm_edges,nm_vertices", [
+    ([[0, 1, 4, 3], [1, 4, 2, 5], [4, 1, 6]], 7, [[1, 4]], [1, 4]),  # an edge of three faces
+    ([[0, 1, 3], [1, 2, 4], [4, 5, 1]], 6, [], [1]),  # two fans at vertex 1
+    ([[0, 1, 4, 3], [1, 4, 5, 2]], 6, [[1, 4]], [1, 4]),  # two faces traverse (1, 4) the same way
+    ([[0, 1, 2], [0, 1, 2]], 3, [[0, 1], [0, 2], [1, 2]], [0, 1, 2]),  # a face given twice
+    ([[0, 1, 1], [0, 2, 1]], 3, [[0, 1], [1, 1]], [0, 1]),  # a face repeating a vertex (degenerate edge)
+])
+def test_nonmanifold_meshes_are_classified_as_opensubdiv_does(faces, n, nm_edges, nm_vertices):
+    """OpenSubdiv's Vtr::Level: an edge with more than two faces or two faces in the same direction is
+    non-manifold, so are its end vertices and every vertex whose faces form more than one fan."""
+    V = np.random.default_rng(0).random((n, 3))
+    m = PolyMesh(V, faces)
+    assert not m.is_manifold
+    assert m.nonmanifold_edges.tolist() == nm_edges
+    assert np.flatnonzero(m.is_nonmanifold_vertex).tolist() == nm_vertices
+    M = m.manifold  # every fan of a non-manifold vertex on its own, same faces
+    assert M.is_manifold and M.n_faces == m.n_faces and M.n_ptex == m.n_ptex
+    assert np.array_equal(M.vertices, V[m.manifold_vertex_map])
+    for p, q in zip(m.polygons, M.polygons):
+        assert m.manifold_vertex_map[list(q)].tolist() == list(p)
+    # one step: the split's step, as a matrix on this mesh's vertices, and its exact rows
+    m1, S = m.refine()
+    assert S.shape == (M.n_vertices + len(M.edges) + M.n_faces, n)
+    assert np.abs(m1.vertices - S @ V).max() <= 1e-15
+    exact = m.subdivision_operator(exact=True)
+    dense = np.zeros(S.shape)
+    for r, row in enumerate(exact):
+        for c, w in row.items():
+            dense[r, c] = int(w.p) / int(w.q)
+    assert np.abs(dense - S.toarray()).max() <= 1e-16
+
+
+def test_unused_vertices_keep_their_indices():
+    V = np.array([[np.nan] * 3, [0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [np.inf, 0, 0]], float)
+    m = PolyMesh(V, [[1, 2, 3, 4]])
+    assert m.is_unused_vertex.tolist() == [True, False, False, False, False, True] and m.is_manifold
+    assert m.bounding_box_diagonal == pytest.approx(np.sqrt(2))
+    V[2, 0] = np.nan
+    with pytest.raises(MeshError, match=r"vertex 2 has a non-finite coordinate"):
+        PolyMesh(V, [[1, 2, 3, 4]])
 
 
 def test_obj_tag_errors(tmp_path):

@@ -68,6 +68,26 @@ def test_inconsistent_orientation():
         QuadMesh(V, F)
 
 
+def test_duplicate_face_has_its_own_message():
+    V = np.random.default_rng(1).random((9, 3))
+    F = [[0, 1, 4, 3], [1, 2, 5, 4], [3, 4, 7, 6], [4, 5, 8, 7], [4, 7, 6, 3]]  # face 4 is face 2 rotated
+    with pytest.raises(MeshError, match=r"duplicate face: faces 2 and 4 have the same vertices \[3, 4, 7, 6\]"):
+        QuadMesh(V, F)
+    F[4] = [3, 6, 7, 4]  # face 2 reversed: also a duplicate (both orientations)
+    with pytest.raises(MeshError, match=r"duplicate face: faces 2 and 4"):
+        QuadMesh(V, F)
+
+
+def test_unused_vertices_are_allowed_and_keep_their_indices():
+    c = cube()
+    V = np.vstack([[np.nan] * 3, c.vertices, [[5.0, 5.0, 5.0]]])
+    m = QuadMesh(V, c.faces + 1)
+    assert m.is_unused_vertex.tolist() == [True] + [False] * 8 + [True]
+    assert m.extraordinary_vertices.tolist() == list(range(1, 9)) and m.valence[0] == 0
+    assert m.bounding_box_diagonal == c.bounding_box_diagonal
+    assert m.one_ring(0)[0].size == 0
+
+
 def test_non_manifold_vertex():
     V = np.zeros((7, 3))
     F = [[0, 1, 2, 3], [0, 4, 5, 6]]  # bow tie: two faces meet at vertex 0 only
@@ -88,5 +108,4 @@ def test_other_bad_faces():
         QuadMesh(np.zeros((6, 3)), [[0, 1, 2, 3], [1, 4, 1, 5]])
     with pytest.raises(MeshError, match="all quads"):
         QuadMesh(np.zeros((4, 3)), [[0, 1, 2]])
-    with pytest.raises(MeshError, match="vertex 4 is not used"):
-        QuadMesh(np.zeros((5, 3)), [[0, 1, 2, 3]])
+    assert QuadMesh(np.zeros((5, 3)), [[0, 1, 2, 3]]).is_unused_vertex.tolist() == [False] * 4 + [True]
