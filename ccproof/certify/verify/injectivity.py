@@ -29,7 +29,7 @@ from .maps import (
     square_inside_image,
 )
 from .record import exact_keys, field_of, kname
-from .replay import check_boxes, parse_decimal, parse_path
+from .replay import check_boxes, parse_decimal, read_boxes
 from .statement import PATCHES, StatementError, c_lam, derivation, nets_for_valence
 
 SCHEMA = "ccproof.injectivity/3"
@@ -114,7 +114,8 @@ def form_patches(symmetric):
 
 
 def _check_structure(parts, cell_vars):
-    """Validate every box list before any arithmetic, so a malformed file fails fast and by name."""
+    """Validate every box list (its partition included) before any arithmetic, so a malformed file fails fast
+    and by name."""
     exact_keys(parts, ("regularity", "cells", "corner"), "parts")
     patches = form_patches(derivation().symmetric)
     for section, nvars in (("regularity", 2), ("cells", cell_vars), ("corner", 4)):
@@ -124,13 +125,7 @@ def _check_structure(parts, cell_vars):
         for key, boxes in sec.items():
             if section == "cells" and not (isinstance(key, str) and _CELL_KEY.fullmatch(key)):
                 raise CertificateError(f"parts.cells: malformed key {key!r} (expected 'l,m,p,q')")
-            if not isinstance(boxes, list) or not boxes:
-                raise CertificateError(f"parts.{section}.{key}: boxes must be a non-empty list")
-            for b in boxes:
-                if not isinstance(b, dict) or set(b) != {"path", "bound"}:
-                    raise CertificateError(f"parts.{section}.{key}: a box must be {{'path', 'bound'}}")
-                parse_path(b["path"], nvars)
-                parse_decimal(b["bound"])
+            read_boxes(boxes, nvars, f"parts.{section}.{key}")  # the partition, before any arithmetic
 
 
 def read_n_prec(cert):
