@@ -153,7 +153,7 @@ def box_tree(paths, nvars):
     >>> box_tree(["0L", "0H1L"], 2)
     Traceback (most recent call last):
     ...
-    ccproof.certify.verify.errors.CertificateError: the boxes do not partition the domain exactly: no box covers '0H1H' (gap)
+    ccproof.certify.verify.errors.CertificateError: the boxes do not partition ...: no box covers '0H1H' (gap)
     """
     if not paths:
         raise CertificateError("no boxes")
@@ -238,7 +238,7 @@ def read_boxes(boxes, nvars, where):
     >>> read_boxes([{"path": "0L", "bound": "0.5"}], 1, "star")
     Traceback (most recent call last):
     ...
-    ccproof.certify.verify.errors.CertificateError: star: the boxes do not partition the domain exactly: no box covers '0H' (gap)
+    ccproof.certify.verify.errors.CertificateError: star: the boxes do not partition ...: no box covers '0H' (gap)
     """
     if not isinstance(boxes, list) or not boxes:
         raise CertificateError(f"{where}: boxes must be a non-empty list")
