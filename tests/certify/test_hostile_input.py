@@ -113,6 +113,9 @@ def hostile(kind, tmp_path):
             for key in c["parts"][sec]:
                 c["parts"][sec][key] = [{"path": random_path(rng, 32, nv), "bound": "0.01"} for _ in range(40)]
         reason = "do not partition"
+    elif kind == "level N = 8":  # a 2.6 KB file that made the verifier list 2^15 cells before failing
+        c["N"] = 8
+        reason = "N in 1..6"
     elif kind == "too many boxes":  # a valid partition of 2^14 boxes: above the per-certificate limit
         c["parts"]["cells"]["0,1,0,0"] = [{"path": q, "bound": "0.01"} for q in complete_tree(14, (0, 1))]
         reason = "boxes"
@@ -124,7 +127,7 @@ def hostile(kind, tmp_path):
 
 KINDS = ["fifo", "link to /dev/zero", "directory", "over the cap", "400 random 64-token corner paths",
          "400 random 32-token corner paths", "a 2000-token path", "every list: random 32-token paths",
-         "too many boxes"]
+         "level N = 8", "too many boxes"]
 
 
 @pytest.mark.parametrize("kind", KINDS)

@@ -34,6 +34,7 @@ from .statement import PATCHES, StatementError, c_lam, derivation, nets_for_vale
 
 SCHEMA = "ccproof.injectivity/3"
 _CELL_KEY = re.compile(r"[0-9]{1,4},[0-9]{1,4},[0-2],[0-2]")
+MAX_LEVEL = 6  # N: every published certificate, every k >= 3, needs at most 5; the required cells grow as 4^N
 
 
 def check_derivation(part):
@@ -129,7 +130,7 @@ def _check_structure(parts, cell_vars):
 
 
 def read_n_prec(cert):
-    """The level N (1..8) and the precision in bits (64..1024) of a certificate.
+    """The level N (1..:data:`MAX_LEVEL`) and the precision in bits (64..1024) of a certificate.
 
     Parameters
     ----------
@@ -143,15 +144,15 @@ def read_n_prec(cert):
     --------
     >>> read_n_prec({"N": 3, "prec": 128})
     (3, 128)
-    >>> read_n_prec({"N": 9, "prec": 128})
+    >>> read_n_prec({"N": 7, "prec": 128})
     Traceback (most recent call last):
     ...
-    ccproof.certify.verify.errors.CertificateError: prec must lie in 64..1024 and N in 1..8
+    ccproof.certify.verify.errors.CertificateError: prec must lie in 64..1024 and N in 1..6
     """
     N = field_of(cert, "N", int, "certificate")
     prec = field_of(cert, "prec", int, "certificate")
-    if not 64 <= prec <= 1024 or not 1 <= N <= 8:
-        raise CertificateError("prec must lie in 64..1024 and N in 1..8")
+    if not 64 <= prec <= 1024 or not 1 <= N <= MAX_LEVEL:
+        raise CertificateError(f"prec must lie in 64..1024 and N in 1..{MAX_LEVEL}")
     return N, prec
 
 
@@ -373,7 +374,7 @@ def verify_injectivity(cert, k, part, log):
     >>> verify_injectivity({"schema": SCHEMA, "valence": 5, "N": 9, "prec": 128, "parts": {}}, 5, None, None)
     Traceback (most recent call last):
     ...
-    ccproof.certify.verify.errors.CertificateError: prec must lie in 64..1024 and N in 1..8
+    ccproof.certify.verify.errors.CertificateError: prec must lie in 64..1024 and N in 1..6
     """
     if isinstance(k, dict):
         verify_interval(cert, k, part, log)
