@@ -96,8 +96,8 @@ def hostile(kind, tmp_path):
         p.mkdir()
         return p, "not a regular file (a directory)"
     c = load("k005.json")
-    if kind == "over the cap":  # a valid certificate padded with blanks beyond the cap
-        p.write_text(json.dumps(c) + " " * V.MAX_FILE_BYTES)
+    if kind == "over the cap":  # a valid certificate padded with blanks beyond the documented 4 MiB
+        p.write_text(json.dumps(c) + " " * 4 * 2**20)
         return p, "larger than"
     if kind == "400 random 64-token corner paths":
         c["parts"]["corner"]["P2"] = [{"path": random_path(rng, 64), "bound": "0.01"} for _ in range(400)]
