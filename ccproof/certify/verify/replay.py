@@ -164,10 +164,11 @@ def box_tree(paths, nvars):
             if "leaf" in node:
                 raise CertificateError(f"the boxes do not partition the domain exactly: {p!r} lies inside "
                                        f"{paths[node['leaf']]!r} (overlap)")
-            if node.setdefault("axis", a) != a:
+            if node.setdefault("axis", a) == a:  # ints
+                node = node.setdefault(side, {})
+            else:
                 raise CertificateError(f"the boxes do not partition the domain exactly: {p!r} splits axis {a} "
                                        f"where another box splits axis {node['axis']} (overlap)")
-            node = node.setdefault(side, {})
         if node:
             raise CertificateError(f"the boxes do not partition the domain exactly: {p!r} contains or repeats "
                                    "another box (overlap)")
