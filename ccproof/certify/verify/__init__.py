@@ -89,6 +89,9 @@ def verify_certificate(cert, log=print, path=None):
 def verify_file(path: str | Path, log: Callable[[str], object] = print) -> VerifyResult:
     """Verify one certificate file; logs PASS/FAIL per part, then VERIFIED or FAILED with the reason.
 
+    Only a regular file of at most :data:`MAX_FILE_BYTES` is read (:func:`read_certificate_bytes`); a
+    FIFO, a device, a directory or a larger file FAILs at once, naming the file.
+
     Parameters
     ----------
     path : str or Path
