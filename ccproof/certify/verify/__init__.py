@@ -160,7 +160,7 @@ def read_certificate_bytes(path, cap=MAX_FILE_BYTES):
     ...
     ccproof.certify.verify.errors.CertificateError: /dev/zero: not a regular file (a character device)
     """
-    fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_NOCTTY", 0))
+    fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOCTTY", 0))  # POSIX flags
     try:
         mode = os.fstat(fd).st_mode
         if not stat.S_ISREG(mode):
