@@ -113,6 +113,16 @@ def hostile(kind, tmp_path):
             for key in c["parts"][sec]:
                 c["parts"][sec][key] = [{"path": random_path(rng, 32, nv), "bound": "0.01"} for _ in range(40)]
         reason = "do not partition"
+    elif kind == "C1: random star paths":
+        c = load("k005.json", "c1")
+        c["parts"]["star"]["P2s1"] = [{"path": random_path(rng, 32, 1), "bound": "0.01"} for _ in range(400)]
+        reason = "parts.star.P2s1: the boxes do not partition"
+    elif kind == "k >= 40: random cell paths":
+        c = load("k_ge_40.json")
+        cells = c["pieces"][-1]["parts"]["cells"]
+        for key in cells:
+            cells[key] = [{"path": random_path(rng, 32, 3), "bound": "0.01"} for _ in range(20)]
+        reason = "do not partition"
     elif kind == "level N = 8":  # a 2.6 KB file that made the verifier list 2^15 cells before failing
         c["N"] = 8
         reason = "N in 1..6"
@@ -127,7 +137,7 @@ def hostile(kind, tmp_path):
 
 KINDS = ["fifo", "link to /dev/zero", "directory", "over the cap", "400 random 64-token corner paths",
          "400 random 32-token corner paths", "a 2000-token path", "every list: random 32-token paths",
-         "level N = 8", "too many boxes"]
+         "C1: random star paths", "k >= 40: random cell paths", "level N = 8", "too many boxes"]
 
 
 @pytest.mark.parametrize("kind", KINDS)
