@@ -17,6 +17,8 @@ standard library and :mod:`ccproof.rigorous`; docs/trusted_base.md lists the mod
 from __future__ import annotations
 
 import json
+import os
+import stat
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -25,11 +27,12 @@ from .c1 import C1_SCHEMA, verify_c1
 from .errors import CertificateError
 from .injectivity import SCHEMA, verify_injectivity
 from .record import Part, Recorder, VerifyResult, read_valence
+from .replay import check_size
 
 __all__ = ["SCHEMA", "C1_SCHEMA", "CertificateError", "Part", "VerifyResult", "verify_certificate", "verify_file",
-           "check_coverage", "certificate_files"]
+           "check_coverage", "certificate_files", "read_certificate_bytes"]
 
-MAX_FILE_BYTES = 64 * 2**20
+MAX_FILE_BYTES = 4 * 2**20  # the published certificates: at most 64 KB; MAX_BOXES boxes take at most ~1 MB
 _KINDS = {SCHEMA: verify_injectivity, C1_SCHEMA: verify_c1}
 #: what a malformed file can raise while it is being read; each ends in FAIL with the reason
 _MALFORMED = (CertificateError, ValueError, TypeError, KeyError, IndexError, AttributeError, RecursionError,
@@ -73,6 +76,7 @@ def verify_certificate(cert, log=print, path=None):
             raise CertificateError(f"unknown certificate schema {str(got)[:60]!r} (expected one of "
                                    f"{', '.join(map(repr, _KINDS))})")
         res.schema = cert["schema"]
+        check_size(cert)
         res.valence = read_valence(cert)
         res.N = cert.get("N") if isinstance(cert.get("N"), int) else None
         _KINDS[res.schema](cert, res.valence, part, log)
@@ -84,6 +88,9 @@ def verify_certificate(cert, log=print, path=None):
 
 def verify_file(path: str | Path, log: Callable[[str], object] = print) -> VerifyResult:
     """Verify one certificate file; logs PASS/FAIL per part, then VERIFIED or FAILED with the reason.
+
+    Only a regular file of at most :data:`MAX_FILE_BYTES` is read (:func:`read_certificate_bytes`); a
+    FIFO, a device, a directory or a larger file FAILs at once, naming the file.
 
     Parameters
     ----------
@@ -105,9 +112,7 @@ def verify_file(path: str | Path, log: Callable[[str], object] = print) -> Verif
     t0 = time.perf_counter()
     path = Path(path)
     try:
-        if path.stat().st_size > MAX_FILE_BYTES:
-            raise CertificateError(f"larger than {MAX_FILE_BYTES >> 20} MiB")
-        cert = json.loads(path.read_text(encoding="ascii"))
+        cert = json.loads(read_certificate_bytes(path).decode("ascii"))
     except (OSError, UnicodeDecodeError, ValueError, RecursionError, CertificateError) as exc:
         res = VerifyResult(path=str(path), error=f"not a readable certificate ({exc})")
     else:
@@ -120,6 +125,62 @@ def verify_file(path: str | Path, log: Callable[[str], object] = print) -> Verif
                                                  for p in res.failures())
         log(f"{'VERIFIED' if res.ok else 'FAILED'} {path} ({res.seconds:.1f} s){why}")
     return res
+
+
+def read_certificate_bytes(path, cap=MAX_FILE_BYTES):
+    """The bytes of a regular file of at most ``cap`` bytes; anything else is refused, without blocking.
+
+    The file is opened non-blocking (a FIFO with no writer does not wait), the open descriptor is
+    checked with ``fstat`` (so a symbolic link is judged by what it points to: ``/dev/zero``, a FIFO,
+    a directory or a device is refused), and at most ``cap + 1`` bytes are read (a file that grows, or
+    reports a wrong size, is still refused above the cap).
+
+    Parameters
+    ----------
+    path : str or Path
+    cap : int
+        Bytes; default :data:`MAX_FILE_BYTES`.
+
+    Returns
+    -------
+    bytes
+
+    Raises
+    ------
+    CertificateError
+        Naming the file and the reason; OSError when it cannot be opened.
+
+    Examples
+    --------
+    >>> from ccproof.tables.format import certificates_dir
+    >>> len(read_certificate_bytes(certificates_dir() / "c1" / "k005.json")) > 100
+    True
+    >>> read_certificate_bytes("/dev/zero")
+    Traceback (most recent call last):
+    ...
+    ccproof.certify.verify.errors.CertificateError: /dev/zero: not a regular file (a character device)
+    """
+    fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOCTTY", 0))  # POSIX flags
+    try:
+        mode = os.fstat(fd).st_mode
+        if not stat.S_ISREG(mode):
+            kind = ("a FIFO" if stat.S_ISFIFO(mode) else "a directory" if stat.S_ISDIR(mode) else
+                    "a character device" if stat.S_ISCHR(mode) else "a block device" if stat.S_ISBLK(mode) else
+                    "a socket" if stat.S_ISSOCK(mode) else "not a file")
+            raise CertificateError(f"{path}: not a regular file ({kind})")
+        chunks, left = [], cap + 1
+        while left > 0:
+            chunk = os.read(fd, min(left, 2**20))
+            if not chunk:
+                break
+            chunks.append(chunk)
+            left -= len(chunk)
+    finally:
+        os.close(fd)
+    data = b"".join(chunks)
+    if len(data) > cap:
+        raise CertificateError(f"{path}: larger than {cap} bytes")
+    return data
 
 
 def certificate_files(directory):

@@ -20,7 +20,7 @@ from .injectivity import check_derivation, check_hypotheses
 from .interval import hull_nets, lam_interval_ok, parameter_nets
 from .maps import STAR_CURVES, regularity_form, star_form
 from .record import exact_keys, field_of, kname
-from .replay import check_boxes, parse_decimal, parse_path
+from .replay import check_boxes, parse_decimal, read_boxes
 from .spectrum import check_block_polynomials, spectral_ordering
 from .statement import PATCHES, StatementError, c_lam, derivation, nets_for_valence
 
@@ -77,15 +77,9 @@ def verify_c1(cert, k, part, log):
         reg, star = field_of(parts, "regularity", dict, "parts"), field_of(parts, "star", dict, "parts")
         exact_keys(reg, PATCHES, "parts.regularity")
         exact_keys(star, tuple(STAR_CURVES), "parts.star")
-        for sec, nv in ((reg, 2), (star, 1)):
-            for boxes in sec.values():
-                if not isinstance(boxes, list) or not boxes:
-                    raise CertificateError("boxes must be a non-empty list")
-                for b in boxes:
-                    if not isinstance(b, dict) or set(b) != {"path", "bound"}:
-                        raise CertificateError("a box must be {'path', 'bound'}")
-                    parse_path(b["path"], nv)
-                    parse_decimal(b["bound"])
+        for label, sec, nv in (("regularity", reg, 2), ("star", star, 1)):
+            for name, boxes in sec.items():
+                read_boxes(boxes, nv, f"parts.{label}.{name}")  # the partition, before any arithmetic
     if ends and (any(not a < b for a, b in ends) or any(ends[i][1] != ends[i + 1][0] for i in range(len(ends) - 1))):
         raise CertificateError("the lam pieces must be increasing and contiguous")  # exact fmpq comparisons
     log(f"C1 certificate for valence {kname(k)} ({prec} bits)")

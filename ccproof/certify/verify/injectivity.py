@@ -29,11 +29,12 @@ from .maps import (
     square_inside_image,
 )
 from .record import exact_keys, field_of, kname
-from .replay import check_boxes, parse_decimal, parse_path
+from .replay import check_boxes, parse_decimal, read_boxes
 from .statement import PATCHES, StatementError, c_lam, derivation, nets_for_valence
 
 SCHEMA = "ccproof.injectivity/3"
 _CELL_KEY = re.compile(r"[0-9]{1,4},[0-9]{1,4},[0-2],[0-2]")
+MAX_LEVEL = 6  # N: every published certificate, every k >= 3, needs at most 5; the required cells grow as 4^N
 
 
 def check_derivation(part):
@@ -114,7 +115,8 @@ def form_patches(symmetric):
 
 
 def _check_structure(parts, cell_vars):
-    """Validate every box list before any arithmetic, so a malformed file fails fast and by name."""
+    """Validate every box list (its partition included) before any arithmetic, so a malformed file fails fast
+    and by name."""
     exact_keys(parts, ("regularity", "cells", "corner"), "parts")
     patches = form_patches(derivation().symmetric)
     for section, nvars in (("regularity", 2), ("cells", cell_vars), ("corner", 4)):
@@ -124,17 +126,11 @@ def _check_structure(parts, cell_vars):
         for key, boxes in sec.items():
             if section == "cells" and not (isinstance(key, str) and _CELL_KEY.fullmatch(key)):
                 raise CertificateError(f"parts.cells: malformed key {key!r} (expected 'l,m,p,q')")
-            if not isinstance(boxes, list) or not boxes:
-                raise CertificateError(f"parts.{section}.{key}: boxes must be a non-empty list")
-            for b in boxes:
-                if not isinstance(b, dict) or set(b) != {"path", "bound"}:
-                    raise CertificateError(f"parts.{section}.{key}: a box must be {{'path', 'bound'}}")
-                parse_path(b["path"], nvars)
-                parse_decimal(b["bound"])
+            read_boxes(boxes, nvars, f"parts.{section}.{key}")  # the partition, before any arithmetic
 
 
 def read_n_prec(cert):
-    """The level N (1..8) and the precision in bits (64..1024) of a certificate.
+    """The level N (1..:data:`MAX_LEVEL`) and the precision in bits (64..1024) of a certificate.
 
     Parameters
     ----------
@@ -148,15 +144,15 @@ def read_n_prec(cert):
     --------
     >>> read_n_prec({"N": 3, "prec": 128})
     (3, 128)
-    >>> read_n_prec({"N": 9, "prec": 128})
+    >>> read_n_prec({"N": 7, "prec": 128})
     Traceback (most recent call last):
     ...
-    ccproof.certify.verify.errors.CertificateError: prec must lie in 64..1024 and N in 1..8
+    ccproof.certify.verify.errors.CertificateError: prec must lie in 64..1024 and N in 1..6
     """
     N = field_of(cert, "N", int, "certificate")
     prec = field_of(cert, "prec", int, "certificate")
-    if not 64 <= prec <= 1024 or not 1 <= N <= 8:
-        raise CertificateError("prec must lie in 64..1024 and N in 1..8")
+    if not 64 <= prec <= 1024 or not 1 <= N <= MAX_LEVEL:
+        raise CertificateError(f"prec must lie in 64..1024 and N in 1..{MAX_LEVEL}")
     return N, prec
 
 
@@ -378,7 +374,7 @@ def verify_injectivity(cert, k, part, log):
     >>> verify_injectivity({"schema": SCHEMA, "valence": 5, "N": 9, "prec": 128, "parts": {}}, 5, None, None)
     Traceback (most recent call last):
     ...
-    ccproof.certify.verify.errors.CertificateError: prec must lie in 64..1024 and N in 1..8
+    ccproof.certify.verify.errors.CertificateError: prec must lie in 64..1024 and N in 1..6
     """
     if isinstance(k, dict):
         verify_interval(cert, k, part, log)

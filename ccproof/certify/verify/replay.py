@@ -18,7 +18,53 @@ _TOKEN = re.compile(r"([0-3])([LH])")
 _DECIMAL = re.compile(r"(-?)([0-9]+)(?:\.([0-9]+))?(?:e(-?[0-9]+))?")
 MAX_DECIMAL_CHARS = 64  # the prover writes at most ~20
 MAX_EXPONENT = 400
-MAX_PATH_TOKENS = 64
+MAX_PATH_TOKENS = 32  # the prover splits at most 14 times (prover.MAX_DEPTH)
+MAX_BOXES = 8192  # per certificate; the published ones hold at most 707
+MAX_JSON_VALUES = 8 * MAX_BOXES  # every JSON value of a certificate (a box is 3); the published: at most 2,863
+
+
+def check_size(cert):
+    """Refuse a parsed certificate above the size limits before anything else is read from it: at most
+    :data:`MAX_JSON_VALUES` JSON values and :data:`MAX_BOXES` boxes (dicts with a ``path``) in all.
+    With paths of at most :data:`MAX_PATH_TOKENS` halvings, these bound the verifier's time and memory
+    (docs/certificates.md, "Bounds").
+
+    Parameters
+    ----------
+    cert : object (parsed JSON)
+
+    Returns
+    -------
+    int
+        The number of boxes.
+
+    Raises
+    ------
+    CertificateError
+
+    Examples
+    --------
+    >>> check_size({"parts": {"P2": [{"path": "", "bound": "1"}]}})
+    1
+    >>> check_size([[0] * 9] * MAX_BOXES)
+    Traceback (most recent call last):
+    ...
+    ccproof.certify.verify.errors.CertificateError: certificate: more than 65536 JSON values
+    """
+    values, boxes, stack = 0, 0, [cert]
+    while stack:
+        v = stack.pop()
+        values += 1
+        if values > MAX_JSON_VALUES:
+            raise CertificateError(f"certificate: more than {MAX_JSON_VALUES} JSON values")
+        if isinstance(v, dict):
+            boxes += "path" in v
+            stack.extend(v.values())
+        elif isinstance(v, list):
+            stack.extend(v)
+    if boxes > MAX_BOXES:
+        raise CertificateError(f"certificate: more than {MAX_BOXES} boxes")
+    return boxes
 
 
 def parse_decimal(s):
@@ -81,8 +127,67 @@ def parse_path(path, nvars):
     return toks
 
 
+def box_tree(paths, nvars):
+    """The split tree of the leaf paths, when they partition the root box exactly; else a
+    :class:`CertificateError` naming the path (no gap, no overlap, no duplicate, one axis per node).
+
+    A cheap combinatorial check, done before any arithmetic. Nodes are dicts: a leaf ``{"leaf": i}``
+    (index into ``paths``), an inner node ``{"axis": a, "L": node, "H": node}``. A valid tree of B
+    leaves has B - 1 inner nodes, so replaying it (:func:`check_boxes`) splits B - 1 times.
+
+    Parameters
+    ----------
+    paths : sequence of str
+        Box paths (:func:`parse_path`).
+    nvars : int
+
+    Returns
+    -------
+    dict
+        The root node.
+
+    Examples
+    --------
+    >>> box_tree(["0L", "0H1L", "0H1H"], 2)["H"]["axis"]
+    1
+    >>> box_tree(["0L", "0H1L"], 2)
+    Traceback (most recent call last):
+    ...
+    ccproof.certify.verify.errors.CertificateError: the boxes do not partition ...: no box covers '0H1H' (gap)
+    """
+    if not paths:
+        raise CertificateError("no boxes")
+    root = {}
+    for i, p in enumerate(paths):
+        node = root
+        for a, side in parse_path(p, nvars):
+            if "leaf" in node:
+                raise CertificateError(f"the boxes do not partition the domain exactly: {p!r} lies inside "
+                                       f"{paths[node['leaf']]!r} (overlap)")
+            if node.setdefault("axis", a) == a:  # ints
+                node = node.setdefault(side, {})
+            else:
+                raise CertificateError(f"the boxes do not partition the domain exactly: {p!r} splits axis {a} "
+                                       f"where another box splits axis {node['axis']} (overlap)")
+        if node:
+            raise CertificateError(f"the boxes do not partition the domain exactly: {p!r} contains or repeats "
+                                   "another box (overlap)")
+        node["leaf"] = i
+    stack = [(root, "")]
+    while stack:
+        node, prefix = stack.pop()
+        if "leaf" not in node:
+            for side in "LH":
+                key = f"{prefix}{node['axis']}{side}"
+                if side not in node:
+                    raise CertificateError(f"the boxes do not partition the domain exactly: no box covers {key!r} "
+                                           "(gap)")
+                stack.append((node[side], key))
+    return root
+
+
 def check_partition(paths, nvars):
-    """True iff the leaf paths partition the root box exactly (no gap, no overlap).
+    """True iff the leaf paths partition the root box exactly (no gap, no overlap): :func:`box_tree`.
 
     Parameters
     ----------
@@ -99,33 +204,77 @@ def check_partition(paths, nvars):
     >>> check_partition(["0L", "0H1L", "0H1H"], 2), check_partition(["0L", "0H1L"], 2)
     (True, False)
     """
-    parsed = [parse_path(p, nvars) for p in paths]
-    if len({tuple(p) for p in parsed}) != len(parsed):
+    try:
+        box_tree(paths, nvars)
+    except CertificateError:
         return False
+    return True
 
-    def rec(group, depth):
-        if any(len(p) == depth for p in group):
-            return len(group) == 1
-        axes = {p[depth][0] for p in group}
-        if len(axes) != 1:
-            return False
-        lo = [p for p in group if p[depth][1] == "L"]
-        hi = [p for p in group if p[depth][1] == "H"]
-        return bool(lo) and bool(hi) and rec(lo, depth + 1) and rec(hi, depth + 1)
 
-    return bool(parsed) and rec(parsed, 0)
+def read_boxes(boxes, nvars, where):
+    """Check a box list before any arithmetic: a non-empty list of ``{"path", "bound"}`` with bounded
+    paths and decimals, each bound > 0, the paths partitioning the root box (:func:`box_tree`).
+
+    Parameters
+    ----------
+    boxes : object (a list from JSON)
+    nvars : int
+    where : str
+        Named in the error.
+
+    Returns
+    -------
+    (dict, list of fmpq)
+        The split tree and the bounds, in the order of ``boxes``.
+
+    Raises
+    ------
+    CertificateError
+
+    Examples
+    --------
+    >>> tree, bounds = read_boxes([{"path": "0L", "bound": "0.5"}, {"path": "0H", "bound": "1e-3"}], 1, "star")
+    >>> tree["axis"], bounds
+    (0, [1/2, 1/1000])
+    >>> read_boxes([{"path": "0L", "bound": "0.5"}], 1, "star")
+    Traceback (most recent call last):
+    ...
+    ccproof.certify.verify.errors.CertificateError: star: the boxes do not partition ...: no box covers '0H' (gap)
+    """
+    if not isinstance(boxes, list) or not boxes:
+        raise CertificateError(f"{where}: boxes must be a non-empty list")
+    if len(boxes) > MAX_BOXES:
+        raise CertificateError(f"{where}: more than {MAX_BOXES} boxes")
+    bounds = []
+    for b in boxes:
+        if not isinstance(b, dict) or set(b) != {"path", "bound"}:
+            raise CertificateError(f"{where}: a box must be {{'path', 'bound'}}")
+        bound = parse_decimal(b["bound"])
+        if not bound > 0:
+            raise CertificateError(f"{where}: box {str(b['path'])[:40]!r} claims a non-positive bound")
+        bounds.append(bound)
+    try:
+        tree = box_tree([b["path"] for b in boxes], nvars)
+    except CertificateError as exc:
+        raise CertificateError(f"{where}: {exc}") from None
+    return tree, bounds
 
 
 def check_boxes(root, boxes, what):
     """Replay the split paths on the Bernstein form ``root``; each box's coefficients must all be
     certainly > its claimed bound > 0 (de Casteljau halvings of :class:`ccproof.rigorous.BernsteinForm`).
 
+    The partition is checked first (:func:`read_boxes`), then the split tree is replayed depth-first with
+    a stack: each inner node is split once (shared prefixes once), a form is dropped as soon as it is
+    split, and the stack holds at most one pending sibling per level, so the memory is O(depth x form
+    size) and the time O(number of boxes x (one split + one check)).
+
     Parameters
     ----------
     root : BernsteinForm
         Ball coefficients on the root box.
     boxes : list of dict ``{"path": str, "bound": decimal str}``
-        Must partition the root box (:func:`check_partition`).
+        Must partition the root box (:func:`box_tree`).
     what : str
         Named in the messages.
 
@@ -145,32 +294,21 @@ def check_boxes(root, boxes, what):
     >>> check_boxes(f, [{"path": "0L", "bound": "1.1"}, {"path": "0H", "bound": "1.4"}], "test")[0]
     False
     """
-    if not isinstance(boxes, list) or not boxes:
-        return False, f"{what}: no boxes", None
-    paths = []
-    min_bound = None
-    cache = {"": root}
-    for b in boxes:
-        if not isinstance(b, dict) or set(b) != {"path", "bound"}:
-            return False, f"{what}: a box must be {{'path', 'bound'}}", None
-        toks = parse_path(b["path"], root.nvars)
-        bound = parse_decimal(b["bound"])
-        if not bound > 0:
-            return False, f"{what}: box {b['path']!r} claims a non-positive bound", None
-        key, f = "", root
-        for a, side in toks:
-            key += f"{a}{side}"
-            if key not in cache:
-                lo, hi = f.split(a)
-                pre = key[:-2]
-                cache[pre + f"{a}L"], cache[pre + f"{a}H"] = lo, hi
-            f = cache[key]
+    try:
+        tree, bounds = read_boxes(boxes, root.nvars, what)
+    except CertificateError as exc:
+        return False, str(exc), None
+    stack = [(tree, root)]
+    while stack:
+        node, f = stack.pop()
+        if "leaf" not in node:
+            lo, hi = f.split(node["axis"])
+            stack.append((node["H"], hi))
+            stack.append((node["L"], lo))
+            continue
+        b, bound = boxes[node["leaf"]], bounds[node["leaf"]]
         if not all(c.is_finite() and c > bound for c in f.coeffs):
             worst = min(f.coeffs, key=lambda c: c.lower())
             return False, (f"{what}: box {b['path']!r}: a Bernstein coefficient ({worst.str(8)}) is not "
                            f"above the claimed bound {b['bound']}"), None
-        paths.append(b["path"])
-        min_bound = bound if min_bound is None or bound < min_bound else min_bound
-    if not check_partition(paths, root.nvars):
-        return False, f"{what}: the boxes do not partition the domain exactly (gap or overlap)", None
-    return True, "", min_bound
+    return True, "", min(bounds)
