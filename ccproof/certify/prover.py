@@ -18,7 +18,7 @@ from typing import Any
 from flint import arb, ctx, fmpq
 
 from ccproof.certify.verify import C1_SCHEMA, SCHEMA
-from ccproof.certify.verify.injectivity import form_patches
+from ccproof.certify.verify.injectivity import MAX_LEVEL, form_patches
 from ccproof.certify.verify.interval import hull_nets, interval_cells, lam_interval_ok, parameter_nets
 from ccproof.certify.verify.maps import (
     STAR_CURVES,
@@ -30,7 +30,7 @@ from ccproof.certify.verify.maps import (
     square_inside_image,
     star_form,
 )
-from ccproof.certify.verify.replay import parse_decimal
+from ccproof.certify.verify.replay import MAX_BOXES, parse_decimal
 from ccproof.certify.verify.statement import PATCHES, c_lam, derivation, nets_for_valence
 from ccproof.errors import CCProofError, ValenceError, check_valence
 from ccproof.rigorous import certainly_positive, lower_bound
@@ -117,8 +117,9 @@ def _corners(f):
     return vals
 
 
-def _smallest_level(nets, lam, max_level=8):
-    """The smallest N with lam^N max(coordinates) < 1/6 (part A), found by trying N = 1, 2, ..."""
+def _smallest_level(nets, lam, max_level=MAX_LEVEL):
+    """The smallest N with lam^N max(coordinates) < 1/6 (part A), found by trying N = 1, 2, ...; at most the
+    verifier's bound on N, so that the prover never writes a certificate the verifier refuses."""
     for N in range(1, max_level + 1):
         if corner_containment(nets, lam, N)[0]:
             return N
@@ -168,6 +169,9 @@ def prove_valence(k: int, prec: int = DEFAULT_PREC, progress: bool = True) -> di
             cells[f"{l},{m},{p},{q}"] = _prove_positive(root, (0, 1), f"cell ({l},{m}) piece ({p},{q})")
         corner = {n: _prove_positive(corner_det_form(nets, lam, N, n, prec), (2, 3, 0, 1),
                                     f"corner {n}") for n in form_patches(derivation().symmetric)}
+    boxes = sum(len(b) for part in (regularity, cells, corner) for b in part.values())
+    if boxes > MAX_BOXES:
+        raise ProofFailed(f"valence {k}: {boxes} boxes, more than the verifier reads ({MAX_BOXES})")
     return {"schema": SCHEMA, "valence": k, "N": N, "prec": prec,
             "parts": {"regularity": regularity, "cells": cells, "corner": corner}}
 
