@@ -26,7 +26,11 @@ import time
 
 from ccproof.cli._eval_args import add_arguments as _add_evaluate_arguments
 from ccproof.cli._eval_args import read_face_uv_csv
+from ccproof.cli._progress import add_progress_argument, progress_enabled
 from ccproof.errors import CCProofError
+
+#: what --plot can write (matplotlib)
+PLOT_SUFFIXES = (".png", ".pdf", ".svg")
 
 
 def add_arguments(parser):
@@ -47,6 +51,7 @@ def add_arguments(parser):
     from ccproof.scale.engine import add_scheduler_arguments
 
     add_scheduler_arguments(parser)
+    add_progress_argument(parser)
     parser.add_argument("--threads", type=int, metavar="T",
                         help="evaluation threads per process (default: every core when the points are evaluated "
                         "in this process, 1 per task on a Dask cluster, whose local workers are one per core)")
@@ -75,8 +80,15 @@ def run(args) -> int:
 
     from ccproof.mesh import QuadMesh
     from ccproof.mesh.io import read_mesh
+    from ccproof.cli._output import atomic, check_file, check_folder, is_folder_request
     from ccproof.scale import evaluate_points, open_scheduler, point_chunks, scheduler_from_args, ship
 
+    # every output checked before any work; paths made absolute (a Dask worker may run elsewhere)
+    shards = is_folder_request(args.out)
+    out_path = check_folder(args.out) if shards else check_file(args.out, (".npz",), hint="(or FOLDER/ for shards)")
+    if args.plot:
+        check_file(args.plot, PLOT_SUFFIXES, "--plot")
+    points = None if args.points is None else Path(args.points).resolve()
     t0 = time.perf_counter()
     poly = read_mesh(args.mesh)  # OBJ with OpenSubdiv tags, or any meshio format
     tagged = not poly.is_all_quads or poly.has_tags
@@ -99,9 +111,9 @@ def run(args) -> int:
     surface = build_surface(mesh, tagged, args.alpha) if sched.kind == "serial" or args.plot else None
     t1 = time.perf_counter()
 
-    if args.points is not None and Path(args.points).is_dir():
-        sources = point_chunks(args.chunk, shards=args.points)
-    elif args.points is not None:
+    if points is not None and points.is_dir():
+        sources = point_chunks(args.chunk, shards=points)
+    elif points is not None:
         sources = point_chunks(args.chunk, arrays=read_face_uv_csv(args.points))
     else:
         if args.samples < 0:
@@ -116,9 +128,13 @@ def run(args) -> int:
             kwargs["threads"] = args.threads
         elif not in_process:
             kwargs["threads"] = 1  # one worker per core already: no second level of threads
-        n, names, _ = evaluate_points(ship(build_surface, mesh, tagged, args.alpha), sources, args.derivatives,
-                                      kwargs, args.out, sched, local=surface)
+        # the file (or each shard and the index) is written under a temporary name, then renamed
+        n, names, sweep = evaluate_points(ship(build_surface, mesh, tagged, args.alpha), sources, args.derivatives,
+                                          kwargs, str(out_path), sched, local=surface,
+                                          progress=progress_enabled(args))
     t3 = time.perf_counter()
+    for line in sweep.report([f"chunk {i}" for i in range(len(sources))]):  # retried or lost tasks
+        print(line)
     out = dict.fromkeys(names)
     if tagged:
         print(f"{args.mesh}: {mesh}; prepared in {t1 - t0:.2f} s")
@@ -140,7 +156,8 @@ def run(args) -> int:
         if vtx is None:
             ev = mesh.extraordinary_vertices
             vtx = int(ev[np.argmax(mesh.valence[ev])]) if ev.size else 0
-        plot_isoparameter_lines(surface, vtx, args.plot, parameterization=args.parameterization)
+        with atomic(Path(args.plot).resolve()) as tmp:
+            plot_isoparameter_lines(surface, vtx, tmp, parameterization=args.parameterization)
         print(f"wrote {args.plot}: isoparameter lines around vertex {vtx} (valence {int(mesh.valence[vtx])})")
     sys.stdout.flush()
     return 0
