@@ -32,7 +32,11 @@ from pathlib import Path
 
 from ccproof.errors import CCProofError
 
-__all__ = ["check_file", "check_folder", "atomic", "write_text", "is_folder_request", "meshio_suffixes"]
+__all__ = ["check_file", "check_folder", "check_outputs", "atomic", "write_text", "is_folder_request",
+           "meshio_suffixes", "PLOT_SUFFIXES"]
+
+#: what a plot option can write (matplotlib)
+PLOT_SUFFIXES = (".png", ".pdf", ".svg")
 
 
 def meshio_suffixes():
@@ -93,6 +97,36 @@ def check_file(path, suffixes, option="--out", *, hint="") -> Path:
     if p.exists() and not os.access(p, os.W_OK):
         raise CCProofError(f"{what}: the file exists and is not writable")
     return p
+
+
+def check_outputs(args, **options):
+    """Check the output files of parsed arguments before any work (:func:`check_file` each).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+    **options
+        Attribute name -> the suffixes it may have: a tuple (empty: any), ``"mesh"`` (``.obj`` and every
+        suffix meshio writes) or ``"plot"`` (:data:`PLOT_SUFFIXES`). Unset options are skipped; the
+        option's name in messages is ``--name-with-dashes``.
+
+    Examples
+    --------
+    >>> import argparse
+    >>> check_outputs(argparse.Namespace(out="x.txt", preview=None), out=(".obj",), preview="plot")
+    Traceback (most recent call last):
+    ...
+    ccproof.errors.CCProofError: --out x.txt: cannot write '.txt' files; use one of .obj
+    """
+    for name, suffixes in options.items():
+        value = getattr(args, name, None)
+        if value is None:
+            continue
+        if suffixes == "mesh":
+            suffixes = (".obj", *(s for s in meshio_suffixes() if s != ".obj"))
+        elif suffixes == "plot":
+            suffixes = PLOT_SUFFIXES
+        check_file(value, suffixes, "--" + name.replace("_", "-"))
 
 
 def check_folder(path, option="--out", *, create=True) -> Path:

@@ -29,9 +29,6 @@ from ccproof.cli._eval_args import read_face_uv_csv
 from ccproof.cli._progress import add_progress_argument, progress_enabled
 from ccproof.errors import CCProofError
 
-#: what --plot can write (matplotlib)
-PLOT_SUFFIXES = (".png", ".pdf", ".svg")
-
 
 def add_arguments(parser):
     _add_evaluate_arguments(parser)
@@ -78,9 +75,9 @@ def run(args) -> int:
 
     import numpy as np
 
+    from ccproof.cli._output import PLOT_SUFFIXES, atomic, check_file, check_folder, is_folder_request
     from ccproof.mesh import QuadMesh
     from ccproof.mesh.io import read_mesh
-    from ccproof.cli._output import atomic, check_file, check_folder, is_folder_request
     from ccproof.scale import evaluate_points, open_scheduler, point_chunks, scheduler_from_args, ship
 
     # every output checked before any work; paths made absolute (a Dask worker may run elsewhere)
@@ -121,7 +118,7 @@ def run(args) -> int:
         sources = point_chunks(args.chunk, samples=args.samples, seed=args.seed, n_faces=n_faces)
     t2 = time.perf_counter()
     with open_scheduler(sched, len(sources)) as sched:
-        in_process = sched.__class__.__name__ == "Scheduler"
+        in_process = getattr(sched, "kind", None) == "serial"  # a Client, or local worker processes without Dask
         if surface is None and in_process:  # a single chunk runs here after all
             surface = build_surface(mesh, tagged, args.alpha)
         if args.threads is not None:

@@ -65,9 +65,11 @@ def run(args) -> int:
 
     from ccproof.apps.dynamics.fit import fit_points, read_points
     from ccproof.apps.dynamics.model import Material
+    from ccproof.cli._output import atomic, check_outputs
     from ccproof.errors import CCProofError
     from ccproof.mesh import read_obj, write_obj
 
+    check_outputs(args, out=(".obj",), surface_out="mesh", errors=(".csv",))  # before any work
     X = read_points(args.points)
     init = args.init
     if init != "cube":
@@ -99,17 +101,20 @@ def run(args) -> int:
     comment = (f"ccproof fit {Path(args.points).name}: {res.mesh.n_vertices} control vertices, max error "
                f"{res.max_error_percent:.3f} %, two-sided {res.two_sided_error_percent:.3f} % of the "
                f"enclosing-sphere diameter")
-    write_obj(args.out, res.mesh, comment=comment)
+    with atomic(args.out) as tmp:
+        write_obj(tmp, res.mesh, comment=comment)
     surf_out = args.surface_out
     if surf_out is None:
         o = Path(args.out)
         surf_out = str(o.with_name(o.stem + "_limit" + (o.suffix or ".obj")))
-    _write_surface(surf_out, res, comment)
+    with atomic(surf_out) as tmp:
+        _write_surface(tmp, res, comment)
     print(f"wrote {args.out} (control mesh) and {surf_out} (limit surface at level {res.sample_level})")
     if args.errors:
         d = res.data_distances
-        np.savetxt(args.errors, np.column_stack([X, d, 100 * d / res.diameter]), delimiter=",",
-                   header="x,y,z,distance,distance_percent_of_diameter", comments="", fmt="%.9g")
+        with atomic(args.errors) as tmp:
+            np.savetxt(tmp, np.column_stack([X, d, 100 * d / res.diameter]), delimiter=",",
+                       header="x,y,z,distance,distance_percent_of_diameter", comments="", fmt="%.9g")
         print(f"wrote {args.errors} (per-point data -> surface distances)")
     return 0
 

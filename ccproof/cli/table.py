@@ -70,11 +70,12 @@ def run(args):
 
         from tqdm import tqdm
 
+        from ccproof.cli._output import check_folder
         from ccproof.tables.build import DEFAULT_INTERVAL_K0
         from ccproof.tables.format import output_dir
 
         ks = [Valence(k) for k in range(3, args.kmax + 1)] + [Valence(DEFAULT_INTERVAL_K0, interval=True)]
-        args.dir = args.dir or str(output_dir() / "tables")
+        args.dir = str(check_folder(args.dir or str(output_dir() / "tables"), "--dir"))  # before any work
         work = [(k, args.dir) for k in ks]
         with ProcessPoolExecutor(max_workers=max(1, args.jobs)) as ex:
             for _ in tqdm(ex.map(_build_one, work), total=len(work), desc="tables", unit="table"):

@@ -553,10 +553,10 @@ MAX_COORDINATE = 1e150
 def _check_points(X):
     """``X`` as a float (n, 3) array; refuses non-finite and too large coordinates, naming the point.
 
-    >>> _check_points([[0.0, 1e200, 0.0]])
+    >>> _check_points([[0.0, 1e200, 0.0]])  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    ccproof.errors.CCProofError: point 0: coordinates [0.0, 1e+200, 0.0] exceed 1e+150 in magnitude (squared distances overflow); scale the data
+    ccproof.errors.CCProofError: point 0: coordinates [0.0, 1e+200, 0.0] exceed 1e+150 in magnitude ...
     """
     X = np.asarray(X, dtype=np.float64)
     if X.ndim != 2 or X.shape[1] != 3:

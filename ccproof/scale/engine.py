@@ -288,6 +288,9 @@ def open_scheduler(scheduler=None, n_tasks=None):
             s.implicit and not dask_available()):
         yield Scheduler("serial")
         return
+    if s.kind == "local" and not dask_available():  # worker processes without Dask (run_tasks)
+        yield s
+        return
     with client_for(s) as client:
         yield client
 
@@ -356,6 +359,60 @@ def _retry_info(keys, retries, dask_scheduler=None):
     return out
 
 
+def _run_pool(call, tasks, shared, workers, retries, priority, sweep, outcomes, progress, desc, unit):
+    """A local scheduler without Dask: ``workers`` processes of :mod:`concurrent.futures` (spawned, so no
+    thread state of this process is copied), with the same retries and report as on a Dask cluster. A
+    task whose worker died (``BrokenProcessPool``: every task still running in that pool) is re-run in
+    a fresh pool, at most ``retries`` times."""
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor, as_completed
+    from concurrent.futures.process import BrokenProcessPool
+
+    order = list(range(len(tasks))) if priority is None else sorted(range(len(tasks)), key=lambda i: -priority[i])
+    used = dict.fromkeys(order, 0)
+    lost = dict.fromkeys(order, 0)
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=len(tasks), desc=desc, unit=unit)
+    pending = order
+    while pending:
+        again = []
+        with ProcessPoolExecutor(max_workers=min(workers, len(pending)),
+                                 mp_context=multiprocessing.get_context("spawn")) as ex:
+            futs = {ex.submit(call, tasks[i], *shared): i for i in pending}
+            for fut in as_completed(futs):
+                i = futs[fut]
+                try:
+                    outcomes[i] = fut.result()
+                except BrokenProcessPool as exc:
+                    lost[i] += 1
+                    if lost[i] + used[i] > retries:
+                        outcomes[i] = (False, exc)
+                    else:
+                        again.append(i)
+                except Exception as exc:  # an unexpected error: retried like on a cluster
+                    used[i] += 1
+                    if lost[i] + used[i] > retries:
+                        outcomes[i] = (False, exc)
+                    else:
+                        again.append(i)
+                if bar is not None and i in outcomes:
+                    bar.update(1)
+        pending = again
+    if bar is not None:
+        bar.close()
+    for i in order:
+        what = []
+        if lost[i]:
+            what.append(f"its worker was lost {lost[i]} time(s); re-run in a new worker")
+        if used[i]:
+            what.append(f"raised an exception {used[i]} time(s); retried")
+        if what:
+            sweep.retried[i] = "; ".join(what)
+
+
 def run_tasks(fn, tasks, scheduler=None, *, shared=(), retries=2, deterministic=(CCProofError,), desc="tasks",
               unit="task", progress=True, priority=None, raise_errors=True, names=None):
     """Map ``fn(task, *shared)`` over ``tasks`` on a scheduler; returns a :class:`Sweep`.
@@ -399,7 +456,10 @@ def run_tasks(fn, tasks, scheduler=None, *, shared=(), retries=2, deterministic=
     t0 = time.perf_counter()
     sweep = Sweep(results=[None] * len(tasks), scheduler=str(s) if isinstance(s, Scheduler) else "client")
     outcomes = {}
-    if isinstance(s, Scheduler) and s.kind == "serial":
+    if isinstance(s, Scheduler) and s.kind == "local" and not dask_available():
+        _run_pool(call, tasks, shared, s.workers, retries, priority, sweep, outcomes,
+                  progress and len(tasks) > 1, desc, unit)
+    elif isinstance(s, Scheduler) and s.kind == "serial":
         it = range(len(tasks))
         if progress and len(tasks) > 1:
             from tqdm import tqdm
