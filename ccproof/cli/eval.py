@@ -53,7 +53,7 @@ def add_arguments(parser):
                         help="evaluation threads per process (default: every core when the points are evaluated "
                         "in this process, 1 per task on a Dask cluster, whose local workers are one per core)")
     parser.add_argument("--chunk", type=int, default=1_000_000, metavar="M",
-                        help="points per task (default 1000000); --out FOLDER writes one .npz shard per chunk and "
+                        help="points per task (default 1000000); --out FOLDER/ writes one .npz shard per chunk and "
                         "--points FOLDER reads one (docs/scale-out.md)")
 
 

@@ -46,12 +46,18 @@ def run(args):
 
     from ccproof.cli._output import atomic, check_file
     from ccproof.cli._progress import progress_enabled
+    from ccproof.errors import CCProofError
     from ccproof.evaluate.closest import CELLS, ClosestPointFinder
+    from ccproof.evaluate.closest import _check_points as check_points
     from ccproof.evaluate.surface import limit_surface
 
     out_path = check_file(args.out, (".npz",))
     progress = progress_enabled(args)
     X = read_xyz_csv(args.points)
+    try:  # non-finite or huge coordinates: refused before the search structure is built
+        check_points(X)
+    except CCProofError as exc:
+        raise CCProofError(f"{args.points}: {exc} (point i is on line i + 2)") from None
     S = limit_surface(args.mesh)
     t0 = time.perf_counter()
     finder = ClosestPointFinder(S, cells=args.cells or CELLS)

@@ -356,7 +356,7 @@ def evaluate_points(shipped, sources, derivatives, kwargs, out, scheduler=None, 
     """Evaluate every chunk (one task each, see :func:`ccproof.scale.engine.run_tasks`) and write ``out``.
 
     ``out`` ending in ``.npz`` gathers all points into one file (arrays face, u, v, P, ...); any other
-    path is a shard folder (one ``part-NNNNN.npz`` per chunk, written by the worker, and
+    path is a shard folder (``ccproof eval`` passes only ``.npz`` names or folders asked for) (one ``part-NNNNN.npz`` per chunk, written by the worker, and
     ``index.json``), for point sets that do not fit in memory (docs/scale-out.md).
 
     Parameters
