@@ -356,8 +356,9 @@ def evaluate_points(shipped, sources, derivatives, kwargs, out, scheduler=None, 
     """Evaluate every chunk (one task each, see :func:`ccproof.scale.engine.run_tasks`) and write ``out``.
 
     ``out`` ending in ``.npz`` gathers all points into one file (arrays face, u, v, P, ...); any other
-    path is a shard folder (``ccproof eval`` passes only ``.npz`` names or folders asked for) (one ``part-NNNNN.npz`` per chunk, written by the worker, and
-    ``index.json``), for point sets that do not fit in memory (docs/scale-out.md).
+    path is a shard folder (one ``part-NNNNN.npz`` per chunk, written by the worker, and ``index.json``),
+    for point sets that do not fit in memory (docs/scale-out.md); ``ccproof eval`` passes only ``.npz``
+    names or folders asked for. Every file is written under a temporary name and renamed when complete.
 
     Parameters
     ----------
