@@ -56,8 +56,8 @@ def _writable_folder(folder: Path, what: str):
 
 
 def _has_suffix(name: str, suffixes) -> bool:
-    low = name.lower()
-    return any(low.endswith(s.lower()) and len(low) > len(s) for s in suffixes)
+    """Case-sensitive, as the writers are (numpy appends ``.npz`` to ``o.NPZ``)."""
+    return any(name.endswith(s) and len(name) > len(s) for s in suffixes)
 
 
 def check_file(path, suffixes, option="--out", *, hint="") -> Path:

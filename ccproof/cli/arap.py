@@ -56,7 +56,9 @@ def add_arguments(parser):
                              "(default: the smallest R in 0..2 giving >= 1000 control faces per chart)")
     parser.add_argument("--max-memory", type=float, default=2.0, metavar="GB",
                         help="refuse runs whose estimated peak memory exceeds this (default 2 GB)")
-    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    from ccproof.cli._progress import add_progress_argument
+
+    add_progress_argument(parser)
     parser.add_argument("--accel", type=int, default=5, metavar="M",
                         help="Anderson acceleration history of (b)/(c), energy-safeguarded (default 5; 0: plain)")
     parser.add_argument("--tol", type=float, default=1e-6, help="relative energy decrease to stop a level")
@@ -124,6 +126,7 @@ def run(args) -> int:
     from ccproof.apps.arap.export import sampled_surface, write_surface
     from ccproof.apps.arap.io import write_uv_obj
     from ccproof.cli._output import atomic, check_outputs, write_text
+    from ccproof.cli._progress import progress_enabled
     from ccproof.errors import CCProofError
     from ccproof.mesh import read_obj
 
@@ -185,7 +188,7 @@ def run(args) -> int:
         results, _ = compare(mesh, labels, methods, levels=args.levels, start_level=args.start_level,
                              eval_level=eval_level, tol=args.tol, max_iter=args.max_iter, engine=engine,
                              refine=refine, sample_level=sample_level, release=True, hierarchies=hierarchies,
-                             max_memory=args.max_memory * 1e9, progress=not args.no_progress, accel=args.accel)
+                             max_memory=args.max_memory * 1e9, progress=progress_enabled(args), accel=args.accel)
     except MemoryBudgetError:
         raise
     except MemoryError as exc:

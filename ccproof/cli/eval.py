@@ -57,17 +57,20 @@ def add_arguments(parser):
                         "--points FOLDER reads one (docs/scale-out.md)")
 
 
-def build_surface(mesh, tagged, alpha=None):
+def build_surface(mesh, tagged, alpha=None, progress=False):
     """The surface ``ccproof eval`` evaluates (module level, so a Dask worker can rebuild it by name):
     the tagged evaluator's natural parameterization for a tagged or non-quad :class:`PolyMesh`, else the
-    reparameterizable surface of an all-quad :class:`QuadMesh`."""
+    reparameterizable surface of an all-quad :class:`QuadMesh`. ``progress``: a bar for the setup, where the
+    constructor draws one (never on a worker)."""
+    from ccproof.cli._progress import progress_kwargs
+
     if tagged:
         from ccproof.evaluate import limit_surface as natural_surface
 
-        return natural_surface(mesh)
+        return natural_surface(mesh, **progress_kwargs(natural_surface, progress))
     from ccproof.reparam.surface import limit_surface
 
-    return limit_surface(mesh, alpha=alpha)
+    return limit_surface(mesh, alpha=alpha, **progress_kwargs(limit_surface, progress))
 
 
 def run(args) -> int:
@@ -105,7 +108,8 @@ def run(args) -> int:
         n_faces, kwargs = mesh.n_faces, {"parameterization": args.parameterization}
     sched = scheduler_from_args(args)
     # on a cluster each worker builds the surface itself (once); here only for in-process work or --plot
-    surface = build_surface(mesh, tagged, args.alpha) if sched.kind == "serial" or args.plot else None
+    progress = progress_enabled(args)
+    surface = build_surface(mesh, tagged, args.alpha, progress) if sched.kind == "serial" or args.plot else None
     t1 = time.perf_counter()
 
     if points is not None and points.is_dir():
@@ -120,7 +124,7 @@ def run(args) -> int:
     with open_scheduler(sched, len(sources)) as sched:
         in_process = getattr(sched, "kind", None) == "serial"  # a Client, or local worker processes without Dask
         if surface is None and in_process:  # a single chunk runs here after all
-            surface = build_surface(mesh, tagged, args.alpha)
+            surface = build_surface(mesh, tagged, args.alpha, progress)
         if args.threads is not None:
             kwargs["threads"] = args.threads
         elif not in_process:
@@ -128,7 +132,7 @@ def run(args) -> int:
         # the file (or each shard and the index) is written under a temporary name, then renamed
         n, names, sweep = evaluate_points(ship(build_surface, mesh, tagged, args.alpha), sources, args.derivatives,
                                           kwargs, str(out_path), sched, local=surface,
-                                          progress=progress_enabled(args))
+                                          progress=progress)
     t3 = time.perf_counter()
     for line in sweep.report([f"chunk {i}" for i in range(len(sources))]):  # retried or lost tasks
         print(line)

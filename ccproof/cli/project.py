@@ -45,7 +45,7 @@ def run(args):
     import numpy as np
 
     from ccproof.cli._output import atomic, check_file
-    from ccproof.cli._progress import progress_enabled
+    from ccproof.cli._progress import progress_enabled, progress_kwargs
     from ccproof.errors import CCProofError
     from ccproof.evaluate.closest import CELLS, ClosestPointFinder
     from ccproof.evaluate.closest import _check_points as check_points
@@ -58,7 +58,7 @@ def run(args):
         check_points(X)
     except CCProofError as exc:
         raise CCProofError(f"{args.points}: {exc} (point i is on line i + 2)") from None
-    S = limit_surface(args.mesh)
+    S = limit_surface(args.mesh, **progress_kwargs(limit_surface, progress))  # a bar for a long setup
     t0 = time.perf_counter()
     finder = ClosestPointFinder(S, cells=args.cells or CELLS)
     starts = range(0, X.shape[0], BATCH)

@@ -18,6 +18,9 @@ def add_arguments(p):
     p.add_argument("--write", action="store_true", help="write docs/certified_valences.md")
     p.add_argument("--jobs", type=int, default=1, help="worker processes (default 1)")
     p.add_argument("--plot", default=None, help="write a PNG plot of the margins against k")
+    from ccproof.cli._progress import add_progress_argument
+
+    add_progress_argument(p)
 
 
 def _row(path):
@@ -46,8 +49,9 @@ def _row(path):
     return row
 
 
-def collect(jobs=1):
-    """One row per injectivity certificate, each from a fresh verifier run."""
+def collect(jobs=1, progress=True):
+    """One row per injectivity certificate, each from a fresh verifier run (a progress bar when ``progress``
+    and ``jobs`` is 1)."""
     from ccproof.certify.verify import certificate_files
     from ccproof.tables.format import certificates_dir
 
@@ -60,7 +64,7 @@ def collect(jobs=1):
     else:
         from tqdm import tqdm
 
-        rows = [_row(p) for p in tqdm(paths, desc="verify", unit="certificate", leave=False)]
+        rows = [_row(p) for p in tqdm(paths, desc="verify", unit="certificate", leave=False, disable=not progress)]
     # single valences by k, then the intervals, then the files without a readable valence
     return sorted(rows, key=lambda r: (r["k"] is None, () if r["k"] is None else (r["k"].interval, r["k"].k)))
 
@@ -91,7 +95,9 @@ def run(args):
         check_file(out, (".md",), "--write")
     if args.plot:
         check_file(args.plot, PLOT_SUFFIXES, "--plot")
-    rows = collect(args.jobs)
+    from ccproof.cli._progress import progress_enabled
+
+    rows = collect(args.jobs, progress_enabled(args))
     md = markdown(rows)
     print(md)
     if args.write:

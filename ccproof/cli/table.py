@@ -20,6 +20,9 @@ def add_arguments(p):
     p.add_argument("--dir", default=None, help="tables folder for --all (default: certificates/tables of the "
                    "checkout, or the user folder of an installed package, never site-packages)")
     p.add_argument("--json", action="store_true", help="print the raw JSON instead of a summary")
+    from ccproof.cli._progress import add_progress_argument
+
+    add_progress_argument(p)
 
 
 def _summary(obj):
@@ -71,6 +74,7 @@ def run(args):
         from tqdm import tqdm
 
         from ccproof.cli._output import check_folder
+        from ccproof.cli._progress import progress_enabled
         from ccproof.tables.build import DEFAULT_INTERVAL_K0
         from ccproof.tables.format import output_dir
 
@@ -78,7 +82,8 @@ def run(args):
         args.dir = str(check_folder(args.dir or str(output_dir() / "tables"), "--dir"))  # before any work
         work = [(k, args.dir) for k in ks]
         with ProcessPoolExecutor(max_workers=max(1, args.jobs)) as ex:
-            for _ in tqdm(ex.map(_build_one, work), total=len(work), desc="tables", unit="table"):
+            for _ in tqdm(ex.map(_build_one, work), total=len(work), desc="tables", unit="table",
+                          disable=not progress_enabled(args)):
                 pass
         print(f"wrote {len(work)} tables; {describe_available(args.dir)}")
         return 0
