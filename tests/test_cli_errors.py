@@ -182,7 +182,8 @@ def test_a_bug_keeps_its_traceback(tmp_path):
 #: a subprocess that runs ``ccproof eval`` with one library function replaced by a stand-in that says
 #: "ready" on stdout and then waits; the test signals it at that moment (no sleeps, no races)
 _STALL = textwrap.dedent("""
-    import sys, time
+    import signal, sys, time
+    signal.signal(signal.SIGINT, signal.default_int_handler)  # as in a terminal (a background job ignores it)
     import {module} as mod
     def stall(*args, **kwargs):
         {before}
@@ -259,3 +260,19 @@ def test_a_corrupt_certificate_is_a_failed_verdict_with_its_reason(tmp_path):
     assert len(failed) == 2
     assert failed[0].startswith("FAILED bad.json: ") and "missing field" in failed[0]
     assert failed[1].startswith("FAILED missing.json: ") and "No such file" in failed[1]
+
+
+def test_a_zero_area_face_gives_a_warning_naming_it(tmp_path):
+    """A mesh whose four vertices coincide has no normal anywhere: ``project`` still answers (distance and
+    point are defined), writes NaN normals and says so in one warning line naming the point and face."""
+    (tmp_path / "zero.obj").write_text("v 0 0 0\nv 0 0 0\nv 0 0 0\nv 0 0 0\nf 1 2 3 4\n")
+    (tmp_path / "xyz.csv").write_text("x,y,z\n0.5,1,0\n")
+    run = _ccproof(["project", "zero.obj", "xyz.csv", "--out", "p.npz"], tmp_path)
+    assert run.returncode == 0, run.stderr
+    lines = run.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("ccproof project: warning: "), run.stderr
+    assert "point 0 on face 0" in lines[0] and "no normal" in lines[0]
+    import numpy as np
+
+    d = np.load(tmp_path / "p.npz")
+    assert np.isnan(d["normal"]).all() and d["distance"][0] == pytest.approx(np.hypot(0.5, 1.0), abs=1e-12)

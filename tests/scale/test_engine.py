@@ -89,3 +89,24 @@ def test_serial_retries_and_failures_are_reported():
     assert set(sweep.retried) == {2} and set(sweep.errors) == {4}
     lines = sweep.report([f"t{i}" for i in range(6)])
     assert lines[0] == "1 task(s) retried; every result is in" and any(ln.startswith("t4: FAILED") for ln in lines)
+
+
+def test_verify_jobs_runs_without_dask(tmp_path):
+    """``ccproof verify --jobs 2`` on an install without Dask (its import fails): worker processes."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    from ccproof.tables.format import certificates_dir
+
+    c1 = certificates_dir() / "c1"
+    files = [str(c1 / "k003.json"), str(c1 / "k004.json")]
+    script = ("import sys; sys.modules['distributed'] = None; sys.modules['dask'] = None\n"
+              "from ccproof.cli import main; sys.exit(main(sys.argv[1:]))")
+    repo = Path(__file__).resolve().parents[2]
+    env = dict(__import__("os").environ, PYTHONPATH=str(repo))
+    run = subprocess.run([sys.executable, "-c", script, "verify", "--jobs", "2", "--quiet", *files], cwd=tmp_path,
+                         env=env, capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stderr
+    assert [ln.split()[0] for ln in run.stdout.splitlines()[:2]] == ["VERIFIED", "VERIFIED"]
+    assert "2 of 2 certificates verified" in run.stdout
