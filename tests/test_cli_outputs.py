@@ -111,3 +111,23 @@ def test_workers_get_absolute_paths(tmp_path, monkeypatch):
     seen.clear()
     assert main(["eval", "cube.obj", "--samples", "4", "--chunk", "2", "--serial", "--out", "rel2/"]) == 0
     assert seen and all(os.path.isabs(t["out"]) for t in seen)
+
+
+def test_eval_prints_the_retry_report(tmp_path, monkeypatch, capsys):
+    """A chunk whose worker was lost (recorded by the task runner) is reported after the sweep."""
+    import ccproof.scale.arrays as arrays
+
+    real = arrays.evaluate_points
+
+    def lost_once(*a, **kw):
+        n, names, sweep = real(*a, **kw)
+        sweep.retried[1] = "its worker was lost 1 time(s); re-run on another worker"
+        return n, names, sweep
+
+    monkeypatch.setattr(arrays, "evaluate_points", lost_once)
+    monkeypatch.chdir(tmp_path)
+    write_obj("cube.obj", cube())
+    assert main(["eval", "cube.obj", "--samples", "4", "--chunk", "2", "--serial", "--out", "o.npz"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert "1 task(s) retried; every result is in" in out
+    assert "chunk 1: its worker was lost 1 time(s); re-run on another worker" in out

@@ -73,6 +73,23 @@ def build_surface(mesh, tagged, alpha=None, progress=False):
     return limit_surface(mesh, alpha=alpha, **progress_kwargs(limit_surface, progress))
 
 
+def _checked_points(path, n_faces):
+    """The (face, u, v) of a CSV file, each point checked (face in range, u and v in [0, 1]) with its line
+    number: the evaluator checks them too, but only chunk by chunk and after the setup."""
+    import numpy as np
+
+    face, u, v = read_face_uv_csv(path)
+    for bad, what in (
+        ((face < 0) | (face >= n_faces), lambda i: f"face id {int(face[i])} out of range [0, {n_faces})"),
+        (~((u >= 0) & (u <= 1)), lambda i: f"u = {float(u[i])!r} is outside [0, 1]"),  # NaN too
+        (~((v >= 0) & (v <= 1)), lambda i: f"v = {float(v[i])!r} is outside [0, 1]"),
+    ):
+        i = np.flatnonzero(bad)
+        if i.size:
+            raise CCProofError(f"{path}:{int(i[0]) + 2}: point {int(i[0])}: {what(int(i[0]))}")
+    return face, u, v
+
+
 def run(args) -> int:
     from pathlib import Path
 
@@ -106,20 +123,20 @@ def run(args) -> int:
     else:
         mesh = QuadMesh(poly.vertices, np.array(poly.polygons, dtype=np.int64).reshape(-1, 4))
         n_faces, kwargs = mesh.n_faces, {"parameterization": args.parameterization}
+    # the points before the surface's setup (seconds on large meshes): a bad point is reported at once
+    if points is not None and points.is_dir():
+        sources = point_chunks(args.chunk, shards=points)
+    elif points is not None:
+        sources = point_chunks(args.chunk, arrays=_checked_points(args.points, n_faces))
+    else:
+        if args.samples < 0:
+            raise CCProofError(f"--samples must be >= 0, got {args.samples}")
+        sources = point_chunks(args.chunk, samples=args.samples, seed=args.seed, n_faces=n_faces)
     sched = scheduler_from_args(args)
     # on a cluster each worker builds the surface itself (once); here only for in-process work or --plot
     progress = progress_enabled(args)
     surface = build_surface(mesh, tagged, args.alpha, progress) if sched.kind == "serial" or args.plot else None
     t1 = time.perf_counter()
-
-    if points is not None and points.is_dir():
-        sources = point_chunks(args.chunk, shards=points)
-    elif points is not None:
-        sources = point_chunks(args.chunk, arrays=read_face_uv_csv(args.points))
-    else:
-        if args.samples < 0:
-            raise CCProofError(f"--samples must be >= 0, got {args.samples}")
-        sources = point_chunks(args.chunk, samples=args.samples, seed=args.seed, n_faces=n_faces)
     t2 = time.perf_counter()
     with open_scheduler(sched, len(sources)) as sched:
         in_process = getattr(sched, "kind", None) == "serial"  # a Client, or local worker processes without Dask
