@@ -207,6 +207,30 @@ def scheduler_from_args(args):
 
 
 @contextlib.contextmanager
+def _sigint_ignored():
+    """Ignore SIGINT while worker processes are started: they inherit the disposition, so a Ctrl-C (sent
+    to the whole process group by a terminal) reaches only this process, which stops them cleanly,
+    instead of a traceback from every worker. Does nothing outside the main thread."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def _ignore_sigint():  # initializer of the worker processes of _run_pool
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+@contextlib.contextmanager
 def client_for(scheduler):
     """A connected :class:`distributed.Client` for a local or address scheduler (closed on exit).
 
@@ -247,8 +271,10 @@ def client_for(scheduler):
     if s.kind == "local":
         import logging
 
-        with LocalCluster(n_workers=s.workers, threads_per_worker=1, processes=True, dashboard_address=None,
-                          silence_logs=logging.ERROR) as cluster, Client(cluster) as client:
+        with _sigint_ignored():  # the workers leave Ctrl-C to this process, which stops them on exit
+            cluster = LocalCluster(n_workers=s.workers, threads_per_worker=1, processes=True,
+                                   dashboard_address=None, silence_logs=logging.ERROR)
+        with cluster, Client(cluster) as client:
             yield client
     elif s.kind == "address":
         with Client(s.address, timeout="30s") as client:
@@ -379,8 +405,9 @@ def _run_pool(call, tasks, shared, workers, retries, priority, sweep, outcomes, 
     pending = order
     while pending:
         again = []
-        with ProcessPoolExecutor(max_workers=min(workers, len(pending)),
-                                 mp_context=multiprocessing.get_context("spawn")) as ex:
+        ex = ProcessPoolExecutor(max_workers=min(workers, len(pending)), initializer=_ignore_sigint,
+                                 mp_context=multiprocessing.get_context("spawn"))
+        try:
             futs = {ex.submit(call, tasks[i], *shared): i for i in pending}
             for fut in as_completed(futs):
                 i = futs[fut]
@@ -400,6 +427,12 @@ def _run_pool(call, tasks, shared, workers, retries, priority, sweep, outcomes, 
                         again.append(i)
                 if bar is not None and i in outcomes:
                     bar.update(1)
+        except BaseException:  # Ctrl-C, SIGTERM: stop the workers now instead of waiting for their tasks
+            for proc in list((getattr(ex, "_processes", None) or {}).values()):
+                proc.terminate()
+            ex.shutdown(wait=False, cancel_futures=True)
+            raise
+        ex.shutdown(wait=True)
         pending = again
     if bar is not None:
         bar.close()
