@@ -12,6 +12,7 @@ import signal
 import subprocess
 import sys
 import textwrap
+import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
@@ -276,3 +277,53 @@ def test_a_zero_area_face_gives_a_warning_naming_it(tmp_path):
 
     d = np.load(tmp_path / "p.npz")
     assert np.isnan(d["normal"]).all() and d["distance"][0] == pytest.approx(np.hypot(0.5, 1.0), abs=1e-12)
+
+
+_SITECUSTOMIZE = '''
+import os
+if os.environ.get("CCPROOF_TEST_STALL"):
+    import pathlib, time
+    import ccproof.scale.arrays as arrays
+    def stall(*args, **kwargs):  # in every worker process too: they all start through this file
+        pathlib.Path(os.environ["CCPROOF_TEST_STALL"], str(os.getpid())).touch()
+        time.sleep(120)
+    arrays._evaluate_block = stall
+if os.environ.get("CCPROOF_TEST_NO_DASK"):
+    import sys
+    sys.modules["distributed"] = None
+'''
+
+
+@pytest.mark.parametrize("workers", ["processes", "dask"])
+def test_ctrl_c_to_the_process_group_with_workers(tmp_path, workers):
+    """A terminal sends Ctrl-C to every process of the foreground group, the workers too: still one line
+    from the command, exit 130, no traceback from any worker, and no index.json (the folder is unfinished);
+    the command does not wait for the workers' tasks."""
+    if workers == "dask":
+        pytest.importorskip("distributed")
+    site = tmp_path / "site"
+    site.mkdir()
+    (site / "sitecustomize.py").write_text(_SITECUSTOMIZE)
+    marks = tmp_path / "stalled"
+    marks.mkdir()
+    (tmp_path / "cube.obj").write_text(CUBE)
+    env = dict(_env(), CCPROOF_TEST_STALL=str(marks), PYTHONPATH=f"{site}{os.pathsep}{REPO}")
+    if workers == "processes":
+        env["CCPROOF_TEST_NO_DASK"] = "1"
+    code = "import signal, sys; signal.signal(signal.SIGINT, signal.default_int_handler)\n" \
+           "from ccproof.cli import main; sys.exit(main(sys.argv[1:]))"
+    proc = subprocess.Popen([sys.executable, "-c", code, "eval", "cube.obj", "--samples", "4", "--chunk", "2",
+                             "--scheduler", "local:2", "--out", "shards/"], cwd=tmp_path, env=env, text=True,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True)
+    try:
+        while len(os.listdir(marks)) < 2 and proc.poll() is None:  # wait until both workers are inside a task
+            time.sleep(0.05)
+        assert proc.poll() is None, proc.communicate()
+        os.killpg(proc.pid, signal.SIGINT)
+        _, err = proc.communicate(timeout=100)  # < the workers' 120 s stall: they were stopped
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+    assert proc.returncode == 130, err
+    assert err.strip() == "ccproof eval: interrupted", err
+    assert not (tmp_path / "shards" / "index.json").exists()

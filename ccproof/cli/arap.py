@@ -121,16 +121,17 @@ def default_eval_level(mesh, labels, levels, with_d):
 
 
 def run(args) -> int:
+    from ccproof.cli._output import atomic, check_outputs, write_text
+
+    check_outputs(args, out="mesh", control_out=(".obj",), labels_out=(), preview="plot")  # before any work
     from ccproof.apps.arap.charts import read_labels, segment_by_normals, write_labels
     from ccproof.apps.arap.core import VARIANTS, MemoryBudgetError, auto_refine, compare
     from ccproof.apps.arap.export import sampled_surface, write_surface
     from ccproof.apps.arap.io import write_uv_obj
-    from ccproof.cli._output import atomic, check_outputs, write_text
     from ccproof.cli._progress import progress_enabled
     from ccproof.errors import CCProofError
     from ccproof.mesh import read_obj
 
-    check_outputs(args, out="mesh", control_out=(".obj",), labels_out=(), preview="plot")  # before any work
     mesh = read_obj(args.mesh)
     if args.charts:
         labels = read_labels(args.charts, mesh.n_faces)

@@ -93,18 +93,20 @@ def _checked_points(path, n_faces):
 def run(args) -> int:
     from pathlib import Path
 
-    import numpy as np
-
     from ccproof.cli._output import PLOT_SUFFIXES, atomic, check_file, check_folder, is_folder_request
-    from ccproof.mesh import QuadMesh
-    from ccproof.mesh.io import read_mesh
-    from ccproof.scale import evaluate_points, open_scheduler, point_chunks, scheduler_from_args, ship
 
-    # every output checked before any work; paths made absolute (a Dask worker may run elsewhere)
+    # every output checked before any work (even the imports); absolute paths (a Dask worker may run elsewhere)
     shards = is_folder_request(args.out)
     out_path = check_folder(args.out) if shards else check_file(args.out, (".npz",), hint="(or FOLDER/ for shards)")
     if args.plot:
         check_file(args.plot, PLOT_SUFFIXES, "--plot")
+
+    import numpy as np
+
+    from ccproof.mesh import QuadMesh
+    from ccproof.mesh.io import read_mesh
+    from ccproof.scale import evaluate_points, open_scheduler, point_chunks, scheduler_from_args, ship
+
     points = None if args.points is None else Path(args.points).resolve()
     t0 = time.perf_counter()
     poly = read_mesh(args.mesh)  # OBJ with OpenSubdiv tags, or any meshio format

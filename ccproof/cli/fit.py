@@ -63,16 +63,17 @@ def add_arguments(p):
 def run(args) -> int:
     from pathlib import Path
 
+    from ccproof.cli._output import atomic, check_outputs
+
+    check_outputs(args, out=(".obj",), surface_out="mesh", errors=(".csv",))  # before any work
     import numpy as np
 
     from ccproof.apps.dynamics.fit import fit_points, read_points
     from ccproof.apps.dynamics.model import Material
-    from ccproof.cli._output import atomic, check_outputs
     from ccproof.cli._progress import progress_enabled
     from ccproof.errors import CCProofError
     from ccproof.mesh import read_obj, write_obj
 
-    check_outputs(args, out=(".obj",), surface_out="mesh", errors=(".csv",))  # before any work
     X = read_points(args.points)
     init = args.init
     if init != "cube":

@@ -42,16 +42,17 @@ def read_xyz_csv(path):
 def run(args):
     import time
 
+    from ccproof.cli._output import atomic, check_file
+
+    out_path = check_file(args.out, (".npz",))  # before any work (even the imports)
     import numpy as np
 
-    from ccproof.cli._output import atomic, check_file
     from ccproof.cli._progress import progress_enabled, progress_kwargs
     from ccproof.errors import CCProofError
     from ccproof.evaluate.closest import CELLS, ClosestPointFinder
     from ccproof.evaluate.closest import _check_points as check_points
     from ccproof.evaluate.surface import limit_surface
 
-    out_path = check_file(args.out, (".npz",))
     progress = progress_enabled(args)
     X = read_xyz_csv(args.points)
     try:  # non-finite or huge coordinates: refused before the search structure is built
