@@ -102,6 +102,8 @@ CASES = [
     ("certify-out-is-a-file", "certify 5 --out afile", "afile", None),
     ("certify-out-under-a-file", "certify 5 --out afile/certs", "afile", None),
     ("certify-empty-range", "certify 5-3 --out c3", "5-3", "c3"),
+    ("certify-prec-the-verifier-rejects", "certify 5 --prec 32 --out c4", "--prec 32", "c4"),
+    ("certify-truncation-degree", "certify >=40 --truncation-degree 9 --out c5", "--truncation-degree 9", "c5"),
     ("table-valence", "table 2", "got '2'", None),
     ("table-corrupt", "table 5 --dir tables", "k005.json", None),
     ("table-dir-under-a-file", "table --all --dir afile/t", "afile", "afile/t"),

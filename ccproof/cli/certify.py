@@ -157,6 +157,7 @@ def run(args):
 
     args.out = str(check_folder(args.out))  # before any proof; absolute, whatever folder a worker runs in
     ks = parse_valences(args.valences)
+    _check_options(args, ks)
     if args.c1:
         return _run_c1(ks, args)
     if ks[0].interval:
@@ -199,6 +200,27 @@ def run(args):
                 print(f"  independent verifier on {p}: {'VERIFIED' if verdict else 'FAILED'} ({seconds:.1f} s){why}")
                 ok_all &= verdict
     return 0 if ok_all else 1
+
+
+def _check_options(args, ks):
+    """Refuse, before any proof, options that would give a certificate ``ccproof verify`` rejects: the
+    precision is asked of the verifier's own reader, the truncation degree against the prover's Taylor
+    degree (the verifier requires 1 <= truncation_degree <= taylor_degree)."""
+    import inspect
+
+    from ccproof.certify.prover import prove_interval
+    from ccproof.certify.verify.errors import CertificateError
+    from ccproof.certify.verify.injectivity import read_n_prec
+    from ccproof.errors import CCProofError
+
+    try:
+        read_n_prec({"N": 1, "prec": args.prec})
+    except CertificateError:
+        raise CCProofError(f"--prec {args.prec}: ccproof verify accepts certificates of 64..1024 bits only") from None
+    taylor = inspect.signature(prove_interval).parameters["taylor_degree"].default
+    if ks[0].interval and not args.c1 and not 1 <= args.truncation_degree <= taylor:
+        raise CCProofError(f"--truncation-degree {args.truncation_degree}: must lie in 1..{taylor} (the Taylor "
+                           "degree of the lam variable), or ccproof verify rejects the certificate")
 
 
 def _failure_reason(res, exc=None):
