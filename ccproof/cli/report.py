@@ -57,9 +57,9 @@ def collect(jobs=1, progress=True):
 
     paths = [p for p in certificate_files(certificates_dir()) if p.parent.name == "injectivity"]
     if jobs > 1:
-        from concurrent.futures import ProcessPoolExecutor
+        from ccproof.scale.engine import process_pool
 
-        with ProcessPoolExecutor(max_workers=jobs) as ex:
+        with process_pool(jobs) as ex:  # Ctrl-C: one line, the workers stopped
             rows = list(ex.map(_row, paths))
     else:
         from tqdm import tqdm

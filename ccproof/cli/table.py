@@ -69,8 +69,6 @@ def run(args):
     from ccproof.valence import Valence
 
     if args.all:
-        from concurrent.futures import ProcessPoolExecutor
-
         from tqdm import tqdm
 
         from ccproof.cli._output import check_folder
@@ -81,7 +79,9 @@ def run(args):
         ks = [Valence(k) for k in range(3, args.kmax + 1)] + [Valence(DEFAULT_INTERVAL_K0, interval=True)]
         args.dir = str(check_folder(args.dir or str(output_dir() / "tables"), "--dir"))  # before any work
         work = [(k, args.dir) for k in ks]
-        with ProcessPoolExecutor(max_workers=max(1, args.jobs)) as ex:
+        from ccproof.scale.engine import process_pool
+
+        with process_pool(max(1, args.jobs)) as ex:  # Ctrl-C: one line, the workers stopped
             for _ in tqdm(ex.map(_build_one, work), total=len(work), desc="tables", unit="table",
                           disable=not progress_enabled(args)):
                 pass

@@ -224,10 +224,51 @@ def _sigint_ignored():
         signal.signal(signal.SIGINT, previous)
 
 
-def _ignore_sigint():  # initializer of the worker processes of _run_pool
+def _ignore_sigint():  # initializer of the worker processes of process_pool
     import signal
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+@contextlib.contextmanager
+def process_pool(workers, context="spawn"):
+    """A :class:`concurrent.futures.ProcessPoolExecutor` whose workers leave Ctrl-C to this process.
+
+    The workers ignore SIGINT (a terminal sends it to the whole process group: no traceback from each
+    worker); when the block ends with an exception (Ctrl-C, SIGTERM raised as one, an error) the workers
+    are terminated at once instead of finishing their tasks, and the pending tasks are cancelled.
+
+    Parameters
+    ----------
+    workers : int
+        Worker processes (>= 1).
+    context : str, optional
+        The multiprocessing start method (default "spawn": no thread state of this process is copied).
+
+    Yields
+    ------
+    concurrent.futures.ProcessPoolExecutor
+
+    Examples
+    --------
+    >>> import math
+    >>> with process_pool(2) as ex:
+    ...     list(ex.map(math.factorial, [3, 4]))
+    [6, 24]
+    """
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    ex = ProcessPoolExecutor(max_workers=workers, initializer=_ignore_sigint,
+                             mp_context=multiprocessing.get_context(context))
+    try:
+        yield ex
+    except BaseException:
+        for proc in list((getattr(ex, "_processes", None) or {}).values()):
+            proc.terminate()
+        ex.shutdown(wait=False, cancel_futures=True)
+        raise
+    ex.shutdown(wait=True)
 
 
 @contextlib.contextmanager
@@ -390,8 +431,7 @@ def _run_pool(call, tasks, shared, workers, retries, priority, sweep, outcomes, 
     thread state of this process is copied), with the same retries and report as on a Dask cluster. A
     task whose worker died (``BrokenProcessPool``: every task still running in that pool) is re-run in
     a fresh pool, at most ``retries`` times."""
-    import multiprocessing
-    from concurrent.futures import ProcessPoolExecutor, as_completed
+    from concurrent.futures import as_completed
     from concurrent.futures.process import BrokenProcessPool
 
     order = list(range(len(tasks))) if priority is None else sorted(range(len(tasks)), key=lambda i: -priority[i])
@@ -405,9 +445,7 @@ def _run_pool(call, tasks, shared, workers, retries, priority, sweep, outcomes, 
     pending = order
     while pending:
         again = []
-        ex = ProcessPoolExecutor(max_workers=min(workers, len(pending)), initializer=_ignore_sigint,
-                                 mp_context=multiprocessing.get_context("spawn"))
-        try:
+        with process_pool(min(workers, len(pending))) as ex:
             futs = {ex.submit(call, tasks[i], *shared): i for i in pending}
             for fut in as_completed(futs):
                 i = futs[fut]
@@ -427,12 +465,6 @@ def _run_pool(call, tasks, shared, workers, retries, priority, sweep, outcomes, 
                         again.append(i)
                 if bar is not None and i in outcomes:
                     bar.update(1)
-        except BaseException:  # Ctrl-C, SIGTERM: stop the workers now instead of waiting for their tasks
-            for proc in list((getattr(ex, "_processes", None) or {}).values()):
-                proc.terminate()
-            ex.shutdown(wait=False, cancel_futures=True)
-            raise
-        ex.shutdown(wait=True)
         pending = again
     if bar is not None:
         bar.close()
