@@ -12,6 +12,7 @@ every number written comes from arb balls. The certificate is re-checked by
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 from typing import Any
 
@@ -439,7 +440,13 @@ def write_certificate(cert, path=None):
     """
     path = Path(path or certificate_path(cert["valence"]))
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(json.dumps(cert, indent=1, sort_keys=True) + "\n", encoding="ascii")
+    # under a temporary name first, renamed when complete: an interrupted write leaves no partial certificate
+    tmp = path.with_name(f".tmp-{os.getpid()}-{path.name}")
+    try:
+        tmp.write_text(json.dumps(cert, indent=1, sort_keys=True) + "\n", encoding="ascii")
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
     return path
 
 

@@ -48,6 +48,9 @@ def build_parser() -> argparse.ArgumentParser:
         ),
         epilog="Run `ccproof COMMAND --help` for the options of one command.",
     )
+    from ccproof import __version__
+
+    parser.add_argument("--version", action="version", version=f"ccproof {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name, (modname, helptext) in _available().items():
         mod = importlib.import_module(modname)
@@ -62,19 +65,88 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _expected_errors():
+    """The exception types that are a user's mistake or a refusal, not a bug: every
+    :class:`~ccproof.errors.CCProofError`, ``OSError`` (a missing file, a permission, a full disk), the
+    trusted verifier's ``CertificateError`` and meshio's reader and writer errors. A module that was
+    never imported cannot have raised, so only the loaded ones are looked up (``--help`` stays fast)."""
+    from ccproof.errors import CCProofError
+
+    types = [CCProofError, OSError]
+    for modname, names in (("ccproof.certify.verify.errors", ("CertificateError",)),
+                           ("meshio._exceptions", ("ReadError", "WriteError"))):
+        mod = sys.modules.get(modname)
+        types += [getattr(mod, n) for n in names if mod is not None and hasattr(mod, n)]
+    return tuple(types)
+
+
+def error_message(exc) -> str:
+    """One line for an expected failure, naming the file for an ``OSError``.
+
+    >>> error_message(FileNotFoundError(2, "No such file or directory", "mesh.obj"))
+    'mesh.obj: no such file or directory'
+    >>> error_message(ValueError("two\\nlines"))
+    'two; lines'
+    """
+    if isinstance(exc, OSError) and exc.strerror:
+        what = exc.strerror[:1].lower() + exc.strerror[1:]
+        if exc.filename is not None and exc.filename2 is not None:
+            text = f"{exc.filename} -> {exc.filename2}: {what}"
+        elif exc.filename is not None:
+            text = f"{exc.filename}: {what}"
+        else:
+            text = what
+    else:
+        text = str(exc) or type(exc).__name__
+    return "; ".join(line.strip() for line in text.splitlines() if line.strip())
+
+
+class _Terminated(KeyboardInterrupt):
+    """SIGTERM, raised like Ctrl-C so that every ``finally`` runs (temporary output files are removed)."""
+
+
+def _terminate(signum, frame):  # pragma: no cover - exercised through a subprocess
+    raise _Terminated
+
+
 def main(argv=None) -> int:
+    """Run one ``ccproof`` command; returns the exit status.
+
+    0: done; 1: a negative verdict (a certificate that fails, an uncertified point); 2: bad input or an
+    expected failure, reported in one line ``ccproof CMD: error: ...`` on stderr; 130: interrupted
+    (Ctrl-C; 143: SIGTERM), no partial output file left. Any other exception is a bug and keeps its traceback.
+    """
     parser = build_parser()
     args = parser.parse_args(argv)
     if not getattr(args, "command", None):
         parser.print_help()
         return 2
-    from ccproof.errors import CCProofError
+    import signal
+    import threading
+
+    if threading.current_thread() is threading.main_thread():
+        previous = signal.signal(signal.SIGTERM, _terminate)
+    else:  # pragma: no cover - main() called from a thread: no handler can be installed
+        previous = None
+    import warnings
+
+    def one_line_warning(message, category, filename, lineno, file=None, line=None):
+        print(f"ccproof {args.command}: warning: {error_message(message)}", file=sys.stderr)
 
     try:
-        return int(args._run(args) or 0)
-    except CCProofError as exc:
-        print(f"ccproof {args.command}: error: {exc}", file=sys.stderr)
+        with warnings.catch_warnings():
+            warnings.showwarning = one_line_warning
+            return int(args._run(args) or 0)
+    except KeyboardInterrupt as exc:
+        terminated = isinstance(exc, _Terminated)
+        print(f"ccproof {args.command}: {'terminated' if terminated else 'interrupted'}", file=sys.stderr)
+        return 143 if terminated else 130
+    except _expected_errors() as exc:
+        print(f"ccproof {args.command}: error: {error_message(exc)}", file=sys.stderr)
         return 2
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -31,7 +31,8 @@ def add_arguments(parser):
     src.add_argument("--points", metavar="CSV", help="CSV file with header face,u,v (face: ptex face index)")
     src.add_argument("--samples", metavar="N", type=int, help="evaluate at N random points")
     parser.add_argument("--derivatives", type=int, choices=(0, 1, 2), default=1, help="derivative order (default 1)")
-    parser.add_argument("--out", metavar="FILE.npz", required=True, help="output file (numpy .npz)")
+    parser.add_argument("--out", metavar="FILE.npz", required=True,
+                        help="output file (numpy .npz), or FOLDER/ for one .npz shard per --chunk points")
     parser.add_argument("--seed", type=int, default=0, help="random seed for --samples (default 0)")
     parser.add_argument(
         "--plot", metavar="FILE.png", help="draw isoparameter lines of the faces around an extraordinary vertex"

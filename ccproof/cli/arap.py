@@ -32,6 +32,7 @@ Example:  ccproof arap bunny_quads.obj --segment normals --baselines --out bunny
 from __future__ import annotations
 
 import json
+import os
 import sys
 
 __all__ = ["add_arguments", "run", "format_table"]
@@ -55,7 +56,9 @@ def add_arguments(parser):
                              "(default: the smallest R in 0..2 giving >= 1000 control faces per chart)")
     parser.add_argument("--max-memory", type=float, default=2.0, metavar="GB",
                         help="refuse runs whose estimated peak memory exceeds this (default 2 GB)")
-    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    from ccproof.cli._progress import add_progress_argument
+
+    add_progress_argument(parser)
     parser.add_argument("--accel", type=int, default=5, metavar="M",
                         help="Anderson acceleration history of (b)/(c), energy-safeguarded (default 5; 0: plain)")
     parser.add_argument("--tol", type=float, default=1e-6, help="relative energy decrease to stop a level")
@@ -118,10 +121,14 @@ def default_eval_level(mesh, labels, levels, with_d):
 
 
 def run(args) -> int:
+    from ccproof.cli._output import atomic, check_outputs, write_text
+
+    check_outputs(args, out="mesh", control_out=(".obj",), labels_out=(), preview="plot")  # before any work
     from ccproof.apps.arap.charts import read_labels, segment_by_normals, write_labels
     from ccproof.apps.arap.core import VARIANTS, MemoryBudgetError, auto_refine, compare
     from ccproof.apps.arap.export import sampled_surface, write_surface
     from ccproof.apps.arap.io import write_uv_obj
+    from ccproof.cli._progress import progress_enabled
     from ccproof.errors import CCProofError
     from ccproof.mesh import read_obj
 
@@ -133,7 +140,8 @@ def run(args) -> int:
     else:
         labels = None
     if args.labels_out and labels is not None:
-        write_labels(args.labels_out, labels)
+        with atomic(args.labels_out) as tmp:
+            write_labels(tmp, labels)
     ours = VARIANTS[args.variant]
     methods = [ours]
     engine = args.engine
@@ -181,7 +189,7 @@ def run(args) -> int:
         results, _ = compare(mesh, labels, methods, levels=args.levels, start_level=args.start_level,
                              eval_level=eval_level, tol=args.tol, max_iter=args.max_iter, engine=engine,
                              refine=refine, sample_level=sample_level, release=True, hierarchies=hierarchies,
-                             max_memory=args.max_memory * 1e9, progress=not args.no_progress, accel=args.accel)
+                             max_memory=args.max_memory * 1e9, progress=progress_enabled(args), accel=args.accel)
     except MemoryBudgetError:
         raise
     except MemoryError as exc:
@@ -216,18 +224,19 @@ def run(args) -> int:
         from ccproof.apps.arap.preview import render_preview
 
         surfs = {m: sampled_surface(r, r.sample_level) for m, r in results.items()}
-        render_preview(args.preview, surfs, {m: r.name for m, r in results.items()}, title=args.mesh)
+        with atomic(args.preview) as tmp:
+            render_preview(tmp, surfs, {m: r.name for m, r in results.items()}, title=args.mesh)
         print(f"wrote {args.preview}")
     if args.out:
-        write_surface(args.out, surf, comment)
+        with atomic(args.out) as tmp:
+            write_surface(tmp, surf, comment)
         wm = surf.metrics()
         info = {"method": ours, "level": surf.level, "cells": surf.cell_type, "uv_scale": surf.scale,
                 "folds": surf.folds(), "seams": "vertices duplicated per chart",
                 "written_triangles": {"E_angle": wm.E_angle, "E_area": wm.E_area, "E_stretch": wm.E_stretch,
                                       "note": "E_area at the natural UV scale: divide the file's UVs by uv_scale"},
                 "table": table}
-        with open(args.out + ".json", "w", encoding="utf-8") as fh:
-            json.dump(info, fh, indent=1)
+        write_text(args.out + ".json", json.dumps(info, indent=1))
         print(f"wrote {args.out} (level {surf.level}: {surf.points.shape[0]} vertices, {surf.cells.shape[0]} "
               f"{surf.cell_type}s, {surf.folds()} folded; written triangles E_angle {wm.E_angle:.6f} "
               f"E_area {wm.E_area:.6f} E_stretch {wm.E_stretch:.6f}) and {args.out}.json")
@@ -235,8 +244,10 @@ def run(args) -> int:
         r = results[ours]
         cmesh = r.textures[0].hierarchy.surface  # with --refine: the refined control mesh the texture lives on
         note = f"\ncontrol mesh: the input subdivided {r.refine} times (Catmull-Clark)" if r.refine else ""
-        side = write_uv_obj(args.control_out, cmesh, r, comment=comment + note, table=table,
-                            transforms=surf.transforms, scale=surf.scale)
+        with atomic(args.control_out) as tmp:
+            side = args.control_out + ".json"
+            os.replace(write_uv_obj(tmp, cmesh, r, comment=comment + note, table=table, transforms=surf.transforms,
+                                    scale=surf.scale), side)
         print(f"wrote {args.control_out} and {side}")
     sys.stdout.flush()
     return 0

@@ -44,6 +44,9 @@ def add_arguments(p):
     p.add_argument("--max-pieces", type=int, default=16,
                    help="for '>=K0': most lam pieces of the bisection (default 16); the pieces of each bisection "
                         "wave run as tasks on --scheduler")
+    from ccproof.cli._progress import add_progress_argument
+
+    add_progress_argument(p)
 
 
 def parse_valences(text):
@@ -62,8 +65,30 @@ def parse_valences(text):
         lo, hi = Valence.parse(a), Valence.parse(b)
         if hi.k < lo.k:
             raise CCProofError(f"empty valence range {text!r}")
+        _verifiable(hi)
         return [Valence(k) for k in range(lo.k, hi.k + 1)]
-    return [Valence.parse(text)]
+    return [_verifiable(Valence.parse(text))]
+
+
+def _verifiable(v):
+    """``v`` if the verifier accepts its valence field, else a :class:`CCProofError` quoting the verifier's
+    bound (asked of the verifier's own reader, so that the two never disagree), before any proof runs.
+
+    >>> from ccproof.valence import Valence
+    >>> _verifiable(Valence(10**9))  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ccproof.errors.CCProofError: valence 1000000000: ... (valence 1000000000 outside 3..10^6)
+    """
+    from ccproof.certify.verify.errors import CertificateError
+    from ccproof.certify.verify.record import read_valence
+    from ccproof.errors import CCProofError
+
+    try:
+        read_valence({"valence": {"min": v.k} if v.interval else v.k})
+    except CertificateError as exc:
+        raise CCProofError(f"valence {v}: ccproof verify would reject its certificate ({exc})") from None
+    return v
 
 
 def _one(args):
@@ -102,8 +127,10 @@ def _run_interval(k, args):
     from ccproof.scale.engine import scheduler_from_args
 
     sched = scheduler_from_args(args)
+    from ccproof.cli._progress import progress_enabled
+
     cert = prove_interval(k, prec=args.prec, truncation_degree=args.truncation_degree, max_pieces=args.max_pieces,
-                          scheduler=None if sched.kind == "serial" else sched)
+                          scheduler=None if sched.kind == "serial" else sched, progress=progress_enabled(args))
     seconds = time.perf_counter() - t0
     path = write_certificate(cert, certificate_path(k, args.out))
     summary, boxes = claimed_margins(cert)
@@ -126,19 +153,25 @@ def run(args):
         from ccproof.tables.format import output_dir
 
         args.out = str(output_dir() / ("c1" if args.c1 else "injectivity"))
+    from ccproof.cli._output import check_folder
+
+    args.out = str(check_folder(args.out))  # before any proof; absolute, whatever folder a worker runs in
     ks = parse_valences(args.valences)
+    _check_options(args, ks)
     if args.c1:
         return _run_c1(ks, args)
     if ks[0].interval:
         return _run_interval(ks[0], args)
     from ccproof.certify.prover import certificate_path, claimed_margins, write_certificate
+    from ccproof.cli._progress import progress_enabled
     from ccproof.scale.engine import open_scheduler, run_tasks, scheduler_from_args
 
-    work = [(k.k, args.prec, args.out, len(ks) == 1) for k in ks]
+    progress = progress_enabled(args)
+    work = [(k.k, args.prec, args.out, len(ks) == 1 and progress) for k in ks]
     names = [f"valence {k}" for k in ks]
     with open_scheduler(scheduler_from_args(args), len(ks)) as sched:
         sweep = run_tasks(_one, work, sched, desc="certify", unit="valence", priority=[w[0] for w in work],
-                          names=names, raise_errors=False)
+                          names=names, raise_errors=False, progress=progress)
         for line in sweep.report(names):
             print(line)
         ok_all = not sweep.errors
@@ -157,15 +190,51 @@ def run(args):
             from ccproof.cli.verify import _check
 
             check = run_tasks(_check, [(str(p), True) for p in written], sched, desc="verify", unit="file",
-                              names=[str(p) for p in written], raise_errors=False)
+                              names=[str(p) for p in written], raise_errors=False, progress=progress)
             for line in check.report([str(p) for p in written]):
                 print(line)
-            for p, res in zip(written, check.results):
+            for i, (p, res) in enumerate(zip(written, check.results)):
                 verdict = bool(res and res[0])
                 seconds = res[0].seconds if res else float("nan")
-                print(f"  independent verifier on {p}: {'VERIFIED' if verdict else 'FAILED'} ({seconds:.1f} s)")
+                why = "" if verdict else f": {_failure_reason(res, check.errors.get(i))}"
+                print(f"  independent verifier on {p}: {'VERIFIED' if verdict else 'FAILED'} ({seconds:.1f} s){why}")
                 ok_all &= verdict
     return 0 if ok_all else 1
+
+
+def _check_options(args, ks):
+    """Refuse, before any proof, options that would give a certificate ``ccproof verify`` rejects: the
+    precision is asked of the verifier's own reader, the truncation degree against the prover's Taylor
+    degree (the verifier requires 1 <= truncation_degree <= taylor_degree)."""
+    import inspect
+
+    from ccproof.certify.prover import prove_interval
+    from ccproof.certify.verify.errors import CertificateError
+    from ccproof.certify.verify.injectivity import read_n_prec
+    from ccproof.errors import CCProofError
+
+    try:
+        read_n_prec({"N": 1, "prec": args.prec})
+    except CertificateError:
+        raise CCProofError(f"--prec {args.prec}: ccproof verify accepts certificates of 64..1024 bits only") from None
+    taylor = inspect.signature(prove_interval).parameters["taylor_degree"].default
+    if ks[0].interval and not args.c1 and not 1 <= args.truncation_degree <= taylor:
+        raise CCProofError(f"--truncation-degree {args.truncation_degree}: must lie in 1..{taylor} (the Taylor "
+                           "degree of the lam variable), or ccproof verify rejects the certificate")
+
+
+def _failure_reason(res, exc=None):
+    """Why a verification failed: the task's exception, the verifier's error or its failed parts.
+
+    >>> _failure_reason(None, OSError("no such file"))
+    'the task failed: OSError: no such file'
+    """
+    if res is None:
+        return f"the task failed: {type(exc).__name__}: {exc}" if exc is not None else "the task failed"
+    r = res[0]
+    if r.error:
+        return r.error
+    return "; ".join(f"{p.name}: {p.message}" if p.message else p.name for p in r.failures()) or "failed"
 
 
 def _recheck(path, args):
@@ -177,8 +246,10 @@ def _recheck(path, args):
     from ccproof.certify.verify import verify_file
 
     t0 = time.perf_counter()
-    ok = bool(verify_file(path, log=lambda s: None))
-    print(f"  independent verifier: {'VERIFIED' if ok else 'FAILED'} ({time.perf_counter() - t0:.1f} s)")
+    res = verify_file(path, log=lambda s: None)
+    ok = bool(res)
+    why = "" if ok else f": {_failure_reason((res,))}"
+    print(f"  independent verifier: {'VERIFIED' if ok else 'FAILED'} ({time.perf_counter() - t0:.1f} s){why}")
     return ok
 
 

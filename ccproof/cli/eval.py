@@ -27,6 +27,7 @@ import time
 
 from ccproof.cli._eval_args import add_arguments as _add_evaluate_arguments
 from ccproof.cli._eval_args import read_face_uv_csv
+from ccproof.cli._progress import add_progress_argument, progress_enabled
 from ccproof.errors import CCProofError
 
 
@@ -48,35 +49,65 @@ def add_arguments(parser):
     from ccproof.scale.engine import add_scheduler_arguments
 
     add_scheduler_arguments(parser)
+    add_progress_argument(parser)
     parser.add_argument("--threads", type=int, metavar="T",
                         help="evaluation threads per process (default: every core when the points are evaluated "
                         "in this process, 1 per task on a Dask cluster, whose local workers are one per core)")
     parser.add_argument("--chunk", type=int, default=1_000_000, metavar="M",
-                        help="points per task (default 1000000); --out FOLDER writes one .npz shard per chunk and "
+                        help="points per task (default 1000000); --out FOLDER/ writes one .npz shard per chunk and "
                         "--points FOLDER reads one (docs/scale-out.md)")
 
 
-def build_surface(mesh, tagged, alpha=None):
+def build_surface(mesh, tagged, alpha=None, progress=False):
     """The surface ``ccproof eval`` evaluates (module level, so a Dask worker can rebuild it by name):
     the tagged evaluator's natural parameterization for a tagged or non-quad :class:`PolyMesh`, else the
-    reparameterizable surface of an all-quad :class:`QuadMesh`."""
+    reparameterizable surface of an all-quad :class:`QuadMesh`. ``progress``: a bar for the setup, where the
+    constructor draws one (never on a worker)."""
+    from ccproof.cli._progress import progress_kwargs
+
     if tagged:
         from ccproof.evaluate import limit_surface as natural_surface
 
-        return natural_surface(mesh)
+        return natural_surface(mesh, **progress_kwargs(natural_surface, progress))
     from ccproof.reparam.surface import limit_surface
 
-    return limit_surface(mesh, alpha=alpha)
+    return limit_surface(mesh, alpha=alpha, **progress_kwargs(limit_surface, progress))
+
+
+def _checked_points(path, n_faces):
+    """The (face, u, v) of a CSV file, each point checked (face in range, u and v in [0, 1]) with its line
+    number: the evaluator checks them too, but only chunk by chunk and after the setup."""
+    import numpy as np
+
+    face, u, v = read_face_uv_csv(path)
+    for bad, what in (
+        ((face < 0) | (face >= n_faces), lambda i: f"face id {int(face[i])} out of range [0, {n_faces})"),
+        (~((u >= 0) & (u <= 1)), lambda i: f"u = {float(u[i])!r} is outside [0, 1]"),  # NaN too
+        (~((v >= 0) & (v <= 1)), lambda i: f"v = {float(v[i])!r} is outside [0, 1]"),
+    ):
+        i = np.flatnonzero(bad)
+        if i.size:
+            raise CCProofError(f"{path}:{int(i[0]) + 2}: point {int(i[0])}: {what(int(i[0]))}")
+    return face, u, v
 
 
 def run(args) -> int:
     from pathlib import Path
+
+    from ccproof.cli._output import PLOT_SUFFIXES, atomic, check_file, check_folder, is_folder_request
+
+    # every output checked before any work (even the imports); absolute paths (a Dask worker may run elsewhere)
+    shards = is_folder_request(args.out)
+    out_path = check_folder(args.out) if shards else check_file(args.out, (".npz",), hint="(or FOLDER/ for shards)")
+    if args.plot:
+        check_file(args.plot, PLOT_SUFFIXES, "--plot")
 
     import numpy as np
 
     from ccproof.mesh.io import read_mesh
     from ccproof.scale import evaluate_points, open_scheduler, point_chunks, scheduler_from_args, ship
 
+    points = None if args.points is None else Path(args.points).resolve()
     t0 = time.perf_counter()
     poly = read_mesh(args.mesh)  # OBJ with OpenSubdiv tags, OFF, or any meshio format
     tagged = not poly.is_plain_quads
@@ -95,31 +126,36 @@ def run(args) -> int:
     else:
         mesh = poly.to_quad_mesh()
         n_faces, kwargs = mesh.n_faces, {"parameterization": args.parameterization}
-    sched = scheduler_from_args(args)
-    # on a cluster each worker builds the surface itself (once); here only for in-process work or --plot
-    surface = build_surface(mesh, tagged, args.alpha) if sched.kind == "serial" or args.plot else None
-    t1 = time.perf_counter()
-
-    if args.points is not None and Path(args.points).is_dir():
-        sources = point_chunks(args.chunk, shards=args.points)
-    elif args.points is not None:
-        sources = point_chunks(args.chunk, arrays=read_face_uv_csv(args.points))
+    # the points before the surface's setup (seconds on large meshes): a bad point is reported at once
+    if points is not None and points.is_dir():
+        sources = point_chunks(args.chunk, shards=points)
+    elif points is not None:
+        sources = point_chunks(args.chunk, arrays=_checked_points(args.points, n_faces))
     else:
         if args.samples < 0:
             raise CCProofError(f"--samples must be >= 0, got {args.samples}")
         sources = point_chunks(args.chunk, samples=args.samples, seed=args.seed, n_faces=n_faces)
+    sched = scheduler_from_args(args)
+    # on a cluster each worker builds the surface itself (once); here only for in-process work or --plot
+    progress = progress_enabled(args)
+    surface = build_surface(mesh, tagged, args.alpha, progress) if sched.kind == "serial" or args.plot else None
+    t1 = time.perf_counter()
     t2 = time.perf_counter()
     with open_scheduler(sched, len(sources)) as sched:
-        in_process = sched.__class__.__name__ == "Scheduler"
+        in_process = getattr(sched, "kind", None) == "serial"  # a Client, or local worker processes without Dask
         if surface is None and in_process:  # a single chunk runs here after all
-            surface = build_surface(mesh, tagged, args.alpha)
+            surface = build_surface(mesh, tagged, args.alpha, progress)
         if args.threads is not None:
             kwargs["threads"] = args.threads
         elif not in_process:
             kwargs["threads"] = 1  # one worker per core already: no second level of threads
-        n, names, _ = evaluate_points(ship(build_surface, mesh, tagged, args.alpha), sources, args.derivatives,
-                                      kwargs, args.out, sched, local=surface)
+        # the file (or each shard and the index) is written under a temporary name, then renamed
+        n, names, sweep = evaluate_points(ship(build_surface, mesh, tagged, args.alpha), sources, args.derivatives,
+                                          kwargs, str(out_path), sched, local=surface,
+                                          progress=progress)
     t3 = time.perf_counter()
+    for line in sweep.report([f"chunk {i}" for i in range(len(sources))]):  # retried or lost tasks
+        print(line)
     out = dict.fromkeys(names)
     if tagged:
         print(f"{args.mesh}: {mesh}; prepared in {t1 - t0:.2f} s")
@@ -141,7 +177,8 @@ def run(args) -> int:
         if vtx is None:
             ev = mesh.extraordinary_vertices
             vtx = int(ev[np.argmax(mesh.valence[ev])]) if ev.size else 0
-        plot_isoparameter_lines(surface, vtx, args.plot, parameterization=args.parameterization)
+        with atomic(Path(args.plot).resolve()) as tmp:
+            plot_isoparameter_lines(surface, vtx, tmp, parameterization=args.parameterization)
         print(f"wrote {args.plot}: isoparameter lines around vertex {vtx} (valence {int(mesh.valence[vtx])})")
     sys.stdout.flush()
     return 0

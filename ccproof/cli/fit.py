@@ -44,7 +44,9 @@ def add_arguments(p):
     p.add_argument("--spring", type=float, default=1.0, help="sum of the data spring constants (default 1)")
     p.add_argument("--truncation", type=int, default=6, help="special-element stiffness level L (default 6)")
     p.add_argument("--init-scale", type=float, default=0.5, help="initial cube size / data box (default 0.5)")
-    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    from ccproof.cli._progress import add_progress_argument
+
+    add_progress_argument(p)
     p.add_argument("--surface-out", default=None,
                    help="write the fitted limit surface sampled at --sample-level (.obj or any meshio format; "
                         "default OUT with _limit before the extension)")
@@ -61,10 +63,14 @@ def add_arguments(p):
 def run(args) -> int:
     from pathlib import Path
 
+    from ccproof.cli._output import atomic, check_outputs
+
+    check_outputs(args, out=(".obj",), surface_out="mesh", errors=(".csv",))  # before any work
     import numpy as np
 
     from ccproof.apps.dynamics.fit import fit_points, read_points
     from ccproof.apps.dynamics.model import Material
+    from ccproof.cli._progress import progress_enabled
     from ccproof.errors import CCProofError
     from ccproof.mesh import read_obj, write_obj
 
@@ -79,7 +85,7 @@ def run(args) -> int:
                         b12=2 * args.rigidity, b22=args.rigidity)
     res = fit_points(X, init=init, levels=args.levels, material=material, spring_total=args.spring, dt=args.dt,
                      scheme=args.scheme, max_steps=args.max_steps, tol=args.tol, init_scale=args.init_scale,
-                     truncation=args.truncation, progress=not args.no_progress, sample_level=args.sample_level,
+                     truncation=args.truncation, progress=progress_enabled(args), sample_level=args.sample_level,
                      stray_distance_percent=args.stray_distance, stray_fraction=args.stray_fraction)
     print(f"data: {X.shape[0]} points from {args.points}; minimal enclosing sphere diameter {res.diameter:.6g}")
     print("level  vertices  faces  steps  equilibrium  max error %  mean error %  seconds")
@@ -99,17 +105,20 @@ def run(args) -> int:
     comment = (f"ccproof fit {Path(args.points).name}: {res.mesh.n_vertices} control vertices, max error "
                f"{res.max_error_percent:.3f} %, two-sided {res.two_sided_error_percent:.3f} % of the "
                f"enclosing-sphere diameter")
-    write_obj(args.out, res.mesh, comment=comment)
+    with atomic(args.out) as tmp:
+        write_obj(tmp, res.mesh, comment=comment)
     surf_out = args.surface_out
     if surf_out is None:
         o = Path(args.out)
         surf_out = str(o.with_name(o.stem + "_limit" + (o.suffix or ".obj")))
-    _write_surface(surf_out, res, comment)
+    with atomic(surf_out) as tmp:
+        _write_surface(tmp, res, comment)
     print(f"wrote {args.out} (control mesh) and {surf_out} (limit surface at level {res.sample_level})")
     if args.errors:
         d = res.data_distances
-        np.savetxt(args.errors, np.column_stack([X, d, 100 * d / res.diameter]), delimiter=",",
-                   header="x,y,z,distance,distance_percent_of_diameter", comments="", fmt="%.9g")
+        with atomic(args.errors) as tmp:
+            np.savetxt(tmp, np.column_stack([X, d, 100 * d / res.diameter]), delimiter=",",
+                       header="x,y,z,distance,distance_percent_of_diameter", comments="", fmt="%.9g")
         print(f"wrote {args.errors} (per-point data -> surface distances)")
     return 0
 

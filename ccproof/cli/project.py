@@ -24,6 +24,13 @@ def add_arguments(parser):
     parser.add_argument("--out", metavar="FILE.npz", required=True, help="output file (numpy .npz)")
     parser.add_argument("--certify", action="store_true", help="add interval-arithmetic verdicts (slow: per point)")
     parser.add_argument("--cells", type=int, default=None, help="cells per face side of the search structure")
+    from ccproof.cli._progress import add_progress_argument
+
+    add_progress_argument(parser)
+
+
+#: points per progress step of the float search (the certified mode steps point by point)
+BATCH = 1000
 
 
 def read_xyz_csv(path):
@@ -36,29 +43,51 @@ def read_xyz_csv(path):
 def run(args):
     import time
 
+    from ccproof.cli._output import atomic, check_file
+
+    out_path = check_file(args.out, (".npz",))  # before any work (even the imports)
     import numpy as np
 
+    from ccproof.cli._progress import progress_enabled, progress_kwargs
+    from ccproof.errors import CCProofError
     from ccproof.evaluate.closest import CELLS, ClosestPointFinder
+    from ccproof.evaluate.closest import _check_points as check_points
     from ccproof.evaluate.surface import limit_surface
 
+    progress = progress_enabled(args)
     X = read_xyz_csv(args.points)
-    S = limit_surface(args.mesh)
+    try:  # non-finite or huge coordinates: refused before the search structure is built
+        check_points(X)
+    except CCProofError as exc:
+        raise CCProofError(f"{args.points}: {exc} (point i is on line i + 2)") from None
+    S = limit_surface(args.mesh, **progress_kwargs(limit_surface, progress))  # a bar for a long setup
     t0 = time.perf_counter()
     finder = ClosestPointFinder(S, cells=args.cells or CELLS)
-    res = finder.query(X)
-    out = {"face": res.face, "u": res.u, "v": res.v, "P": res.P, "distance": res.distance, "normal": res.normal}
+    starts = range(0, X.shape[0], BATCH)
+    if progress and len(starts) > 1:
+        from tqdm import tqdm
+
+        starts = tqdm(starts, desc="project", unit="batch")
+    parts = [finder.query(X[a:a + BATCH]) for a in starts] or [finder.query(X)]  # (no points: empty arrays)
+    out = {k: np.concatenate([getattr(r, k) for r in parts]) for k in ("face", "u", "v", "P", "distance", "normal")}
     msg = f"{X.shape[0]} points projected in {time.perf_counter() - t0:.2f} s"
     if args.certify:
         from ccproof.evaluate.closest_certified import certify_closest
 
         t1 = time.perf_counter()
-        cert = [certify_closest(S, X[i], res.face[i], res.u[i], res.v[i]) for i in range(X.shape[0])]
+        points = range(X.shape[0])
+        if progress:
+            from tqdm import tqdm
+
+            points = tqdm(points, desc="certify", unit="point")
+        cert = [certify_closest(S, X[i], out["face"][i], out["u"][i], out["v"][i]) for i in points]
         out["verdict"] = np.array([c.verdict for c in cert])
         out["distance_lo"] = np.array([c.distance_lo for c in cert])
         out["distance_hi"] = np.array([c.distance_hi for c in cert])
         out["parameter_radius"] = np.array([c.parameter_radius for c in cert])
         counts = {k: int((out["verdict"] == k).sum()) for k in ("certified", "ambiguous", "uncertified")}
         msg += f"; certified mode {time.perf_counter() - t1:.2f} s: {counts}"
-    np.savez(args.out, **out)
+    with atomic(out_path) as tmp:
+        np.savez(tmp, **out)
     print(f"{msg}; wrote {args.out}")
     return 0

@@ -20,6 +20,9 @@ def add_arguments(p):
     p.add_argument("--dir", default=None, help="tables folder for --all (default: certificates/tables of the "
                    "checkout, or the user folder of an installed package, never site-packages)")
     p.add_argument("--json", action="store_true", help="print the raw JSON instead of a summary")
+    from ccproof.cli._progress import add_progress_argument
+
+    add_progress_argument(p)
 
 
 def _summary(obj):
@@ -66,18 +69,21 @@ def run(args):
     from ccproof.valence import Valence
 
     if args.all:
-        from concurrent.futures import ProcessPoolExecutor
-
         from tqdm import tqdm
 
+        from ccproof.cli._output import check_folder
+        from ccproof.cli._progress import progress_enabled
         from ccproof.tables.build import DEFAULT_INTERVAL_K0
         from ccproof.tables.format import output_dir
 
         ks = [Valence(k) for k in range(3, args.kmax + 1)] + [Valence(DEFAULT_INTERVAL_K0, interval=True)]
-        args.dir = args.dir or str(output_dir() / "tables")
+        args.dir = str(check_folder(args.dir or str(output_dir() / "tables"), "--dir"))  # before any work
         work = [(k, args.dir) for k in ks]
-        with ProcessPoolExecutor(max_workers=max(1, args.jobs)) as ex:
-            for _ in tqdm(ex.map(_build_one, work), total=len(work), desc="tables", unit="table"):
+        from ccproof.scale.engine import process_pool
+
+        with process_pool(max(1, args.jobs)) as ex:  # Ctrl-C: one line, the workers stopped
+            for _ in tqdm(ex.map(_build_one, work), total=len(work), desc="tables", unit="table",
+                          disable=not progress_enabled(args)):
                 pass
         print(f"wrote {len(work)} tables; {describe_available(args.dir)}")
         return 0

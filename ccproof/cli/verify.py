@@ -30,14 +30,20 @@ def add_arguments(p):
 
     add_scheduler_arguments(p)
     p.add_argument("--quiet", action="store_true", help="print only the VERIFIED/FAILED line per file")
+    from ccproof.cli._progress import add_progress_argument
+
+    add_progress_argument(p)
 
 
 def _check(args):
-    path, quiet = args
+    """One task: verify a file; ``args`` is ``(path, quiet)`` or ``(absolute path, quiet, name shown)``."""
+    path, quiet, *shown = args
     from ccproof.certify.verify import verify_file
 
     lines = []
     res = verify_file(path, log=lines.append)
+    if shown and shown[0] != path:  # the worker read the absolute path; the lines name the file as given
+        lines = [line.replace(str(path), shown[0], 1) for line in lines]
     if quiet:
         lines = [s for s in lines if s.startswith(("VERIFIED", "FAILED"))]
     return res, lines
@@ -56,13 +62,15 @@ def run(args):
     if not files:
         raise CCProofError("give certificate files or --all")
     from ccproof.certify.verify import VerifyResult
+    from ccproof.cli._progress import progress_enabled
     from ccproof.scale.engine import run_tasks, scheduler_from_args
 
-    work = [(str(f), args.quiet) for f in files]
+    # absolute paths for the workers (a worker of a cluster may run in another folder)
+    work = [(str(f.absolute()), args.quiet, str(f)) for f in files]
     # longest first (the k >= k0 certificates), so that the workers finish together
     size = [f.stat().st_size if f.is_file() else 0 for f in files]
     sweep = run_tasks(_check, work, scheduler_from_args(args), desc="verify", unit="file", priority=size,
-                      names=[str(f) for f in files], raise_errors=False)
+                      names=[str(f) for f in files], raise_errors=False, progress=progress_enabled(args))
     results = []
     for f, out in zip(files, sweep.results):
         if out is None:  # the task itself failed (after its retries): reported, counted as FAILED
@@ -70,6 +78,7 @@ def run(args):
             print(f"FAILED {f}: {res.error}")
         else:
             res, lines = out
+            res.path = str(f)  # as given (the worker read the absolute path)
             print("\n".join(lines))
         results.append(res)
     for line in sweep.report([str(f) for f in files]):

@@ -52,6 +52,7 @@ limit normal).
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -446,6 +447,7 @@ class ClosestPointFinder:
         out.P[:] = r["P"]
         out.distance[:] = np.linalg.norm(X - r["P"], axis=1)
         out.normal[:] = _unit_normal(r["Pu"], r["Pv"])
+        _warn_undefined_normals(out)
         return out
 
     __call__ = query
@@ -543,14 +545,45 @@ class ClosestPointFinder:
         return same & near
 
 
+#: largest coordinate magnitude of a query point: the squared distances of the search must stay finite
+#: in float64 (1e150^2 = 1e300 < 1.8e308); farther points would give an infinite distance to every cell
+MAX_COORDINATE = 1e150
+
+
 def _check_points(X):
+    """``X`` as a float (n, 3) array; refuses non-finite and too large coordinates, naming the point.
+
+    >>> _check_points([[0.0, 1e200, 0.0]])  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ccproof.errors.CCProofError: point 0: coordinates [0.0, 1e+200, 0.0] exceed 1e+150 in magnitude ...
+    """
     X = np.asarray(X, dtype=np.float64)
     if X.ndim != 2 or X.shape[1] != 3:
         raise CCProofError(f"points must have shape (n, 3), got {X.shape}")
     bad = np.flatnonzero(~np.isfinite(X).all(axis=1))
     if bad.size:
         raise CCProofError(f"point {int(bad[0])}: coordinates {X[bad[0]].tolist()} are not finite")
+    bad = np.flatnonzero((np.abs(X) > MAX_COORDINATE).any(axis=1))
+    if bad.size:
+        raise CCProofError(f"point {int(bad[0])}: coordinates {X[bad[0]].tolist()} exceed {MAX_COORDINATE:g} in "
+                           "magnitude (squared distances overflow); scale the data")
     return X
+
+
+class UndefinedNormalWarning(UserWarning):
+    """A nearest point where Pu x Pv = 0 (a face of zero area there): its normal is NaN."""
+
+
+def _warn_undefined_normals(res):
+    """Warn (:class:`UndefinedNormalWarning`), naming the first point and its face, when some normals are
+    NaN; the distances and points stay valid."""
+    bad = np.flatnonzero(~np.isfinite(res.normal).all(axis=1))
+    if bad.size:
+        i = int(bad[0])
+        warnings.warn(f"{bad.size} nearest point(s) have no normal (NaN): Pu x Pv = 0 there, a face of zero area; "
+                      f"first: point {i} on face {int(res.face[i])} at (u, v) = ({res.u[i]:.6g}, {res.v[i]:.6g})",
+                      UndefinedNormalWarning, stacklevel=3)
 
 
 def closest_points(surface, X, *, cells=CELLS, cover=None, faces=None, finder=None):

@@ -25,6 +25,7 @@ _NAMES = {
     "ship": "shipping", "rebuild": "shipping", "Shipped": "shipping", "build_counts": "shipping",
     "evaluate_dask": "arrays", "evaluate_chunks": "arrays", "write_shards": "arrays", "read_shards": "arrays",
     "output_names": "arrays", "point_chunks": "arrays", "evaluate_points": "arrays", "open_scheduler": "engine",
+    "process_pool": "engine",
 }
 __all__ = sorted(_NAMES)
 

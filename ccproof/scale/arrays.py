@@ -157,8 +157,25 @@ def _evaluate_chunk(task, shipped):
     arrays.update({n: res[:, j, :] for j, n in enumerate(output_names(task["derivatives"]))})
     if task["out"] is None:
         return arrays
-    np.savez(task["out"], **arrays)
+    _replace_when_written(task["out"], lambda tmp: np.savez(tmp, **arrays))
     return int(f.size)
+
+
+def _replace_when_written(path, write):
+    """``write(tmp)`` to a hidden name in the folder of ``path``, then rename it onto ``path``: a shard or
+    index interrupted while being written never lies under its final name (the temporary name ends with
+    the final one, so numpy's ``.npz`` is kept)."""
+    import os
+    import uuid
+
+    path = Path(path)
+    tmp = path.with_name(f".tmp-{uuid.uuid4().hex[:8]}-{path.name}")
+    try:
+        write(str(tmp))
+        os.replace(tmp, path)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
 
 
 def _shard_name(i):
@@ -170,7 +187,8 @@ def _write_index(folder, sizes, names):
     folder = Path(folder)
     idx = {"format": SHARDS_FORMAT, "n": int(sum(sizes)), "arrays": list(names),
            "shards": [{"file": _shard_name(i), "n": int(m)} for i, m in enumerate(sizes)]}
-    (folder / "index.json").write_text(json.dumps(idx, indent=1) + "\n", encoding="utf-8")
+    text = json.dumps(idx, indent=1) + "\n"
+    _replace_when_written(folder / "index.json", lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
 
 
 def _shard_index(folder):
@@ -322,7 +340,8 @@ def point_chunks(chunk, *, arrays=None, shards=None, samples=None, seed=0, n_fac
         raise CCProofError(f"--chunk must be >= 1, got {chunk}")
     if shards is not None:
         idx = _shard_index(shards)
-        return [("shard", str(Path(shards) / s["file"])) for s in idx["shards"]]
+        # absolute: a worker of a cluster may run in another folder
+        return [("shard", str(Path(shards).resolve() / s["file"])) for s in idx["shards"]]
     if arrays is not None:
         f, u, v = arrays
         n = len(f)
@@ -337,8 +356,9 @@ def evaluate_points(shipped, sources, derivatives, kwargs, out, scheduler=None, 
     """Evaluate every chunk (one task each, see :func:`ccproof.scale.engine.run_tasks`) and write ``out``.
 
     ``out`` ending in ``.npz`` gathers all points into one file (arrays face, u, v, P, ...); any other
-    path is a shard folder (one ``part-NNNNN.npz`` per chunk, written by the worker, and
-    ``index.json``), for point sets that do not fit in memory (docs/scale-out.md).
+    path is a shard folder (one ``part-NNNNN.npz`` per chunk, written by the worker, and ``index.json``),
+    for point sets that do not fit in memory (docs/scale-out.md); ``ccproof eval`` passes only ``.npz``
+    names or folders asked for. Every file is written under a temporary name and renamed when complete.
 
     Parameters
     ----------
@@ -387,7 +407,7 @@ def evaluate_points(shipped, sources, derivatives, kwargs, out, scheduler=None, 
     if local is not None:
         rebuild(shipped, local=local)
     names = output_names(derivatives)
-    folder = None if str(out).endswith(".npz") else Path(out)
+    folder = None if str(out).endswith(".npz") else Path(out).resolve()  # absolute: workers may run elsewhere
     if folder is not None:
         folder.mkdir(parents=True, exist_ok=True)
     tasks = [{"source": s, "derivatives": derivatives, "kwargs": dict(kwargs),
@@ -396,7 +416,7 @@ def evaluate_points(shipped, sources, derivatives, kwargs, out, scheduler=None, 
                       progress=progress, names=[f"chunk {i}" for i in range(len(tasks))])
     if folder is None:
         arrays = {n: np.concatenate([r[n] for r in sweep.results]) for n in ("face", "u", "v", *names)}
-        np.savez(out, **arrays)
+        _replace_when_written(out, lambda tmp: np.savez(tmp, **arrays))
         n = int(arrays["face"].size)
     else:
         _write_index(folder, sweep.results, ("face", "u", "v", *names))

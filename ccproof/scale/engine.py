@@ -207,6 +207,71 @@ def scheduler_from_args(args):
 
 
 @contextlib.contextmanager
+def _sigint_ignored():
+    """Ignore SIGINT while worker processes are started: they inherit the disposition, so a Ctrl-C (sent
+    to the whole process group by a terminal) reaches only this process, which stops them cleanly,
+    instead of a traceback from every worker. Does nothing outside the main thread."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def _ignore_sigint():  # initializer of the worker processes of process_pool
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+@contextlib.contextmanager
+def process_pool(workers, context="spawn"):
+    """A :class:`concurrent.futures.ProcessPoolExecutor` whose workers leave Ctrl-C to this process.
+
+    The workers ignore SIGINT (a terminal sends it to the whole process group: no traceback from each
+    worker); when the block ends with an exception (Ctrl-C, SIGTERM raised as one, an error) the workers
+    are terminated at once instead of finishing their tasks, and the pending tasks are cancelled.
+
+    Parameters
+    ----------
+    workers : int
+        Worker processes (>= 1).
+    context : str, optional
+        The multiprocessing start method (default "spawn": no thread state of this process is copied).
+
+    Yields
+    ------
+    concurrent.futures.ProcessPoolExecutor
+
+    Examples
+    --------
+    >>> import math
+    >>> with process_pool(2) as ex:
+    ...     list(ex.map(math.factorial, [3, 4]))
+    [6, 24]
+    """
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    ex = ProcessPoolExecutor(max_workers=workers, initializer=_ignore_sigint,
+                             mp_context=multiprocessing.get_context(context))
+    try:
+        yield ex
+    except BaseException:
+        for proc in list((getattr(ex, "_processes", None) or {}).values()):
+            proc.terminate()
+        ex.shutdown(wait=False, cancel_futures=True)
+        raise
+    ex.shutdown(wait=True)
+
+
+@contextlib.contextmanager
 def client_for(scheduler):
     """A connected :class:`distributed.Client` for a local or address scheduler (closed on exit).
 
@@ -247,8 +312,10 @@ def client_for(scheduler):
     if s.kind == "local":
         import logging
 
-        with LocalCluster(n_workers=s.workers, threads_per_worker=1, processes=True, dashboard_address=None,
-                          silence_logs=logging.ERROR) as cluster, Client(cluster) as client:
+        with _sigint_ignored():  # the workers leave Ctrl-C to this process, which stops them on exit
+            cluster = LocalCluster(n_workers=s.workers, threads_per_worker=1, processes=True,
+                                   dashboard_address=None, silence_logs=logging.ERROR)
+        with cluster, Client(cluster) as client:
             yield client
     elif s.kind == "address":
         with Client(s.address, timeout="30s") as client:
@@ -287,6 +354,9 @@ def open_scheduler(scheduler=None, n_tasks=None):
     if s.kind == "serial" or s.kind == "local" and n_tasks is not None and n_tasks <= 1 or (
             s.implicit and not dask_available()):
         yield Scheduler("serial")
+        return
+    if s.kind == "local" and not dask_available():  # worker processes without Dask (run_tasks)
+        yield s
         return
     with client_for(s) as client:
         yield client
@@ -356,6 +426,58 @@ def _retry_info(keys, retries, dask_scheduler=None):
     return out
 
 
+def _run_pool(call, tasks, shared, workers, retries, priority, sweep, outcomes, progress, desc, unit):
+    """A local scheduler without Dask: ``workers`` processes of :mod:`concurrent.futures` (spawned, so no
+    thread state of this process is copied), with the same retries and report as on a Dask cluster. A
+    task whose worker died (``BrokenProcessPool``: every task still running in that pool) is re-run in
+    a fresh pool, at most ``retries`` times."""
+    from concurrent.futures import as_completed
+    from concurrent.futures.process import BrokenProcessPool
+
+    order = list(range(len(tasks))) if priority is None else sorted(range(len(tasks)), key=lambda i: -priority[i])
+    used = dict.fromkeys(order, 0)
+    lost = dict.fromkeys(order, 0)
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=len(tasks), desc=desc, unit=unit)
+    pending = order
+    while pending:
+        again = []
+        with process_pool(min(workers, len(pending))) as ex:
+            futs = {ex.submit(call, tasks[i], *shared): i for i in pending}
+            for fut in as_completed(futs):
+                i = futs[fut]
+                try:
+                    outcomes[i] = fut.result()
+                except BrokenProcessPool as exc:
+                    lost[i] += 1
+                    if lost[i] + used[i] > retries:
+                        outcomes[i] = (False, exc)
+                    else:
+                        again.append(i)
+                except Exception as exc:  # an unexpected error: retried like on a cluster
+                    used[i] += 1
+                    if lost[i] + used[i] > retries:
+                        outcomes[i] = (False, exc)
+                    else:
+                        again.append(i)
+                if bar is not None and i in outcomes:
+                    bar.update(1)
+        pending = again
+    if bar is not None:
+        bar.close()
+    for i in order:
+        what = []
+        if lost[i]:
+            what.append(f"its worker was lost {lost[i]} time(s); re-run in a new worker")
+        if used[i]:
+            what.append(f"raised an exception {used[i]} time(s); retried")
+        if what:
+            sweep.retried[i] = "; ".join(what)
+
+
 def run_tasks(fn, tasks, scheduler=None, *, shared=(), retries=2, deterministic=(CCProofError,), desc="tasks",
               unit="task", progress=True, priority=None, raise_errors=True, names=None):
     """Map ``fn(task, *shared)`` over ``tasks`` on a scheduler; returns a :class:`Sweep`.
@@ -399,7 +521,10 @@ def run_tasks(fn, tasks, scheduler=None, *, shared=(), retries=2, deterministic=
     t0 = time.perf_counter()
     sweep = Sweep(results=[None] * len(tasks), scheduler=str(s) if isinstance(s, Scheduler) else "client")
     outcomes = {}
-    if isinstance(s, Scheduler) and s.kind == "serial":
+    if isinstance(s, Scheduler) and s.kind == "local" and not dask_available():
+        _run_pool(call, tasks, shared, s.workers, retries, priority, sweep, outcomes,
+                  progress and len(tasks) > 1, desc, unit)
+    elif isinstance(s, Scheduler) and s.kind == "serial":
         it = range(len(tasks))
         if progress and len(tasks) > 1:
             from tqdm import tqdm

@@ -18,6 +18,7 @@ from them with Bernstein bounds in arb (never from floats):
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 from typing import Any
 
@@ -302,5 +303,11 @@ def write_table(k, directory=None, prec=DEFAULT_PREC):
     table = build_table(k, prec)
     path = table_path(table["valence"], directory)
     path.parent.mkdir(parents=True, exist_ok=True)
-    Path(path).write_text(json.dumps(table, indent=1, sort_keys=True) + "\n", encoding="ascii")
+    # under a temporary name first, renamed when complete: an interrupted write leaves no partial table
+    tmp = Path(path).with_name(f".tmp-{os.getpid()}-{Path(path).name}")
+    try:
+        tmp.write_text(json.dumps(table, indent=1, sort_keys=True) + "\n", encoding="ascii")
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
     return path

@@ -29,12 +29,15 @@ import json
 import os
 from pathlib import Path
 
+from ccproof.errors import CCProofError
+
 SCHEMA = "ccproof.table/1"
 PATCHES = ("P1", "P2", "P3")
 
 
-class TableFormatError(ValueError):
-    """A table file that is malformed, of an unknown schema, or whose hash does not match.
+class TableFormatError(CCProofError):
+    """A table file that is malformed, of an unknown schema, or whose hash does not match (a
+    :class:`~ccproof.errors.CCProofError`, hence a ``ValueError``).
 
     Parameters
     ----------

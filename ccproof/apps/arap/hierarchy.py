@@ -69,6 +69,33 @@ class HierarchyError(CCProofError):
     """
 
 
+def _refuse_zero_area(mesh, faces):
+    """Raise :class:`~ccproof.errors.MeshError` naming the first of ``faces`` whose two triangles (0, 1, 2)
+    and (0, 2, 3) both have zero area (relative to the mesh's size): the ARAP energy and the distortion
+    metrics (per unit area) are undefined there.
+
+    >>> from ccproof.mesh import QuadMesh
+    >>> m = QuadMesh([[0, 0, 0], [1, 0, 0], [1, 0, 0], [0, 0, 0]], [[0, 1, 2, 3]])
+    >>> _refuse_zero_area(m, [0])
+    Traceback (most recent call last):
+    ...
+    ccproof.errors.MeshError: face 0 (vertices 0, 1, 2, 3) has zero area: ARAP needs faces of positive area
+    """
+    V = np.asarray(mesh.vertices, dtype=np.float64)
+    faces = np.asarray(faces, dtype=np.int64)
+    if faces.size == 0:
+        return
+    P = V[mesh.faces[faces]]
+    a = np.linalg.norm(np.cross(P[:, 1] - P[:, 0], P[:, 2] - P[:, 0]), axis=1)
+    b = np.linalg.norm(np.cross(P[:, 2] - P[:, 0], P[:, 3] - P[:, 0]), axis=1)
+    size = float(np.ptp(V, axis=0).max()) if V.size else 0.0
+    bad = np.flatnonzero(a + b <= 1e-12 * size * size)
+    if bad.size:
+        f = int(faces[bad[0]])
+        raise MeshError(f"face {f} (vertices {', '.join(map(str, mesh.faces[f].tolist()))}) has zero area: "
+                        "ARAP needs faces of positive area")
+
+
 def split_nonmanifold(F, n):
     """Duplicate every vertex whose faces form several fans (edge-manifold, oriented input).
 
@@ -237,6 +264,7 @@ class ChartHierarchy:
         isc = np.zeros(mesh.n_vertices, dtype=bool)
         isc[cv] = True
         ring = np.flatnonzero(~in_chart & isc[Fg].any(axis=1))
+        _refuse_zero_area(mesh, np.r_[chart, ring])
         self.ring_faces = ring
         faces0 = np.r_[chart, ring]
         allv = np.unique(Fg[faces0])

@@ -1,0 +1,47 @@
+"""``--no-progress`` and when a command shows progress bars (tqdm, on stderr).
+
+A bar is shown only when stderr is a terminal and ``--no-progress`` was not given, so that logs,
+pipes and tests get no bar lines.
+
+>>> import argparse
+>>> p = argparse.ArgumentParser()
+>>> add_progress_argument(p)
+>>> progress_enabled(p.parse_args(["--no-progress"]))
+False
+"""
+
+from __future__ import annotations
+
+import sys
+
+
+def add_progress_argument(parser):
+    """Add ``--no-progress`` to a command's parser."""
+    parser.add_argument("--no-progress", action="store_true",
+                        help="no progress bar (bars are shown only when stderr is a terminal)")
+
+
+def progress_enabled(args) -> bool:
+    """True when a progress bar should be drawn: stderr is a terminal and no ``--no-progress``."""
+    if getattr(args, "no_progress", False):
+        return False
+    try:
+        return sys.stderr.isatty()
+    except (AttributeError, ValueError):  # a closed or replaced stderr
+        return False
+
+
+def progress_kwargs(fn, progress):
+    """``{"progress": progress}`` when ``fn`` takes a ``progress`` argument (e.g. a surface constructor
+    whose setup can take seconds), else ``{}``: the hook through which a setup reports its progress.
+
+    >>> progress_kwargs(lambda mesh, progress=True: None, False), progress_kwargs(lambda mesh: None, False)
+    ({'progress': False}, {})
+    """
+    import inspect
+
+    try:
+        params = inspect.signature(fn).parameters
+    except (TypeError, ValueError):  # a builtin without a signature
+        return {}
+    return {"progress": bool(progress)} if "progress" in params else {}
