@@ -263,7 +263,7 @@ def _write_control(args, r, surf, eval_level, comment, table, write_uv_obj):
              "hsh10's optimization under that rule")
     er = exp.excess_ratio()
     what = {"refine": r.refine, "extra_subdivisions": exp.extra, "fold_levels": list(FOLD_LEVELS),
-            "folds": exp.folds, "E_angle": exp.metrics.E_angle, "E_area": exp.metrics.E_area,
+            "folds": exp.folds, "metric_level": exp.level, "E_angle": exp.metrics.E_angle, "E_area": exp.metrics.E_area,
             "E_stretch": exp.metrics.E_stretch, "excess_ratio_to_exact": list(er), "accepted": exp.accepted,
             "tried": [{"extra": e, "folds": f, "E_angle": m.E_angle, "E_area": m.E_area, "E_stretch": m.E_stretch}
                       for e, f, m in exp.tried]}
@@ -272,7 +272,7 @@ def _write_control(args, r, surf, eval_level, comment, table, write_uv_obj):
     print(f"wrote {args.control_out} and {side}: control mesh = the input subdivided {times} times "
           f"({exp.mesh.n_faces} faces), UVs for OpenSubdiv's face-varying 'corners only' rule")
     print(f"  what a subdivision tool will see: folded UV quads at levels {', '.join(map(str, FOLD_LEVELS))}: "
-          f"{', '.join(map(str, exp.folds))}; limit texture at level {eval_level}: E_angle {exp.metrics.E_angle:.6f} "
+          f"{', '.join(map(str, exp.folds))}; limit texture at level {exp.level}: E_angle {exp.metrics.E_angle:.6f} "
           f"E_area {exp.metrics.E_area:.6f} E_stretch {exp.metrics.E_stretch:.6f} (excess {er[0]:.3f}, {er[1]:.3f}, "
           f"{er[2]:.3f} x the exact texture's)")
     if not exp.accepted:

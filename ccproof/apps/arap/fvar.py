@@ -176,6 +176,8 @@ class ControlExport:
         Folded UV quads at the levels :data:`FOLD_LEVELS` of the written control mesh, all charts.
     metrics : Metrics
         The corners-only texture measured like the exact one (same level, same samples).
+    level : int
+        The metric level, on the input mesh.
     exact : Metrics
         The exact texture at the same samples.
     tried : list of (extra, folds, metrics)
@@ -188,6 +190,7 @@ class ControlExport:
     folds: list
     metrics: Metrics
     exact: Metrics
+    level: int = 0
     tried: list = field(default_factory=list)
     #: whether ``extra`` met the criterion (no fold, excess within the ratio) or is the best of those tried
     accepted: bool = False
@@ -215,7 +218,7 @@ def export_control(result, eval_level=5, max_extra=2, max_excess_ratio=1.05, fit
         Method (b) or (c) (level-0 textures).
     eval_level : int
         Metric level on the input mesh (the texture's control mesh is the input refined
-        ``result.refine`` times).
+        ``result.refine`` times); raised to level 1 of the subdivided control mesh where it is below.
     max_extra : int
         Subdivide the texture's control mesh at most this many more times.
     max_excess_ratio : float
@@ -243,21 +246,24 @@ def export_control(result, eval_level=5, max_extra=2, max_excess_ratio=1.05, fit
         raise CCProofError("control UVs need level-0 textures (methods b and c)")
     base = texs[0].hierarchy.surface
     ref = int(getattr(result, "refine", 0))
-    ev = int(eval_level) - ref
     tried = []
-    best = exact = None
+    best = None
+    exacts: dict[int, Metrics] = {}
     mesh = base
+    ok = False
     for extra in range(int(max_extra) + 1):
         if extra:
             mesh, _ = refine_mesh(mesh, None, 1)
-        ev_x = ev - extra
-        if ev_x < 1:
-            break
-        if exact is None:
+        # metric level on the input mesh: eval_level, at least level 1 of the subdivided control mesh
+        e_in = max(int(eval_level), ref + extra + 1)
+        ev, ev_x = e_in - ref, e_in - ref - extra
+        if e_in not in exacts:
             exact = Metrics()
             for tex in texs:
                 exact = exact + texture_metrics(tex, ev)
                 tex.hierarchy.release()
+            exacts[e_in] = exact
+        exact = exacts[e_in]
         folds = np.zeros(len(FOLD_LEVELS), dtype=np.int64)
         met, out = Metrics(), []
         for tex in texs:
@@ -275,7 +281,7 @@ def export_control(result, eval_level=5, max_extra=2, max_excess_ratio=1.05, fit
             hc.release()
             tex.hierarchy.release()
             out.append(ct)
-        exp = ControlExport(mesh, out, extra, folds.tolist(), met, exact)
+        exp = ControlExport(mesh, out, extra, folds.tolist(), met, exact, e_in)
         tried.append((extra, exp.folds, met))
         ex_m = np.subtract(met.as_tuple(), (2.0, 2.0, 1.0))
         ex_e = np.subtract(exact.as_tuple(), (2.0, 2.0, 1.0))
@@ -287,7 +293,7 @@ def export_control(result, eval_level=5, max_extra=2, max_excess_ratio=1.05, fit
             best = (key, exp)
             break
     if best is None:
-        raise CCProofError(f"eval_level {eval_level} is too low for the control UVs (need >= refine + 1)")
+        raise CCProofError(f"max_extra must be >= 0, got {max_extra}")
     exp = best[1]
     exp.tried = tried
     exp.accepted = bool(ok)

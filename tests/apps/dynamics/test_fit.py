@@ -277,3 +277,58 @@ def test_cli_fit_writes_surface_errors_and_warnings(tmp_path, capsys):
 
     m = meshio.read(tmp_path / "lim.vtu")
     assert m.point_data["distance_to_data"].shape == (m.points.shape[0],)
+
+
+# ---------------------------------------------------------------------------- equilibrium
+
+
+def test_fit_stops_at_equilibrium_of_energy_and_error_and_says_why():
+    res = fit_points(synthetic_range_data("ellipsoid", 300), levels=0)
+    lev = res.levels[0]
+    tol = res.parameters["tol"]
+    assert lev.converged and lev.steps < res.parameters["max_steps"]
+    assert lev.energy_change <= tol and lev.error_change <= tol
+    assert lev.reason.startswith(f"equilibrium after {lev.steps} steps")
+    assert not [w for w in res.warnings if "step cap" in w]
+    capped = fit_points(synthetic_range_data("ellipsoid", 300), levels=0, max_steps=4)
+    lev = capped.levels[0]
+    assert not lev.converged and lev.steps == 4
+    assert max(lev.energy_change, lev.error_change) > tol
+    w = [w for w in capped.warnings if "step cap (4 steps" in w]
+    assert w and ("still falling" in w[0] or "rose" in w[0])
+
+
+@pytest.mark.slow
+def test_fit_scanned_bunny_reaches_equilibrium_and_an_independent_two_sided_distance_confirms():
+    from pathlib import Path
+
+    from scipy.spatial import cKDTree
+
+    from ccproof.mesh import subdivide
+    from ccproof.mesh.masks import limit_positions
+
+    path = Path(__file__).resolve().parents[2] / "data" / "meshes" / "bunny_quads.obj"
+    X = read_points(path)
+    res = fit_points(X, levels=1)
+    tol = res.parameters["tol"]
+    for lev in res.levels:  # the stated criterion holds at every level, by default, before the cap
+        assert lev.converged, lev.reason
+        assert lev.energy_change <= tol and lev.error_change <= tol
+        assert lev.steps < res.parameters["max_steps"]
+    assert not [w for w in res.warnings if "step cap" in w]
+    # independent two-sided distance: dense exact limit points of the fitted control mesh (the mesh layer's
+    # subdivision and limit masks, not the closest-point search of the fit), k-d trees both ways
+    m = res.mesh
+    for _ in range(4):
+        m = subdivide(m)
+    S = limit_positions(m)
+    h = float(np.max(np.linalg.norm(S[m.faces[:, 0]] - S[m.faces[:, 2]], axis=1)))  # sample spacing bound
+    d_data = cKDTree(S).query(X)[0]  # >= the true data -> surface distance, by at most h
+    d_surf = cKDTree(X).query(S)[0]  # surface samples -> data
+    D = res.diameter
+    assert 100 * d_data.max() / D >= res.max_error_percent - 1e-9
+    assert 100 * (d_data.max() - h) / D <= res.max_error_percent
+    assert abs(100 * d_surf.max() / D - res.surface_max_percent) <= 100 * h / D
+    two = max(d_data.max(), d_surf.max())
+    assert abs(100 * two / D - res.two_sided_error_percent) <= 100 * h / D
+    assert res.levels[1].max_error_percent < res.levels[0].max_error_percent
