@@ -12,7 +12,8 @@ Pipeline (:func:`fit_points`):
    re-projected every step), until equilibrium: the total energy (elastic + springs) changes by less
    than ``tol`` (relative) between steps t - dt and t + dt (the paper's criterion, section 3.4; two
    steps because (32) advances two interleaved sequences) *and* so does the mean data -> surface
-   distance (the ICP-like tail, tangential sliding, lowers the energy slowly while the error still
+   distance (relative to itself, or to the data spacing of :func:`data_spacing` once it is smaller; the
+   ICP-like tail, tangential sliding, lowers the energy slowly while the error still
    creeps: both must have settled), or ``max_steps`` (default 1000, a safety cap: the bunny scan needs
    about 200 + 100 steps); a level that stops otherwise says why (:attr:`FitLevel.reason`, and a
    warning naming the criterion that failed, the values reached and whether the energy rose);
@@ -218,6 +219,8 @@ def read_points(path):
     else:  # any other mesh format: its vertices (the mesh reader of ccproof eval)
         from ccproof.mesh.io import read_mesh
 
+        if path.stat().st_size == 0:
+            raise CCProofError(f"{path}: empty file (no points)")
         X = np.asarray(read_mesh(path).vertices, dtype=np.float64)
     return check_points(X, f"point cloud {path.name}")
 
@@ -639,8 +642,9 @@ def fit_points(X: ArrayLike, init: Literal["cube"] | QuadMesh = "cube", levels: 
     max_steps : int
         Time steps per level at most (a safety cap, not the usual stop).
     tol : float
-        Equilibrium: relative changes of the total energy and of the mean data -> surface distance
-        between steps t - dt and t + dt both at most ``tol``.
+        Equilibrium: relative changes of the total energy and of the mean data -> surface distance (the
+        latter relative to max(mean distance, data spacing)) between steps t - dt and t + dt both at
+        most ``tol``.
     init_scale : float in (0, 1]
         Size of the initial control cube relative to the data's bounding box.
     truncation : int
@@ -709,6 +713,7 @@ def fit_points(X: ArrayLike, init: Literal["cube"] | QuadMesh = "cube", levels: 
                        parameters={"material": material, "spring_total": spring_total, "dt": dt, "scheme": scheme,
                                    "max_steps": max_steps, "tol": tol, "init_scale": init_scale,
                                    "truncation": truncation, "levels": levels})
+    spacing_n = max(data_spacing(Xn), 1e-300)
     bar = None
     if progress:
         from tqdm import tqdm
@@ -732,7 +737,9 @@ def fit_points(X: ArrayLike, init: Literal["cube"] | QuadMesh = "cube", levels: 
                 cg += info.iterations
                 energies.append(model.energy(integ.P) + springs.energy(integ.P))
                 change = abs(energies[-1] - energies[-3]) / abs(energies[-1]) if len(energies) >= 3 else math.inf
-                err_change = (abs(errors[-1] - errors[-3]) / max(abs(errors[-1]), 1e-300)
+                # relative to the mean error, or to the data spacing once the error is below it (changes
+                # finer than the data's resolution are not progress)
+                err_change = (abs(errors[-1] - errors[-3]) / max(abs(errors[-1]), spacing_n)
                               if len(errors) >= 3 else math.inf)
                 if bar is not None:
                     bar.update(1)
