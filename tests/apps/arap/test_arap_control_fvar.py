@@ -181,3 +181,85 @@ def test_arap_reads_triangle_meshes(tmp_path, capsys):
     cap = capsys.readouterr()
     assert "subdivided once (Catmull-Clark) to 96 quads" in cap.err
     assert out.exists()
+
+
+# ----------------------------------------------------------------------------- OpenSubdiv itself
+
+
+@pytest.fixture(scope="module")
+def osd_driver(tmp_path_factory):
+    import shutil
+    import subprocess
+
+    if shutil.which("g++") is None or not pathlib.Path("/usr/include/opensubdiv/far/primvarRefiner.h").exists():
+        pytest.skip("OpenSubdiv headers (libosd-dev) or g++ not installed")
+    exe = tmp_path_factory.mktemp("osd") / "drv"
+    src = pathlib.Path(__file__).with_name("osd_fvar_driver.cpp")
+    r = subprocess.run(["g++", "-O1", "-std=c++14", str(src), "-o", str(exe), "-losdCPU"], capture_output=True,
+                       text=True)
+    if r.returncode != 0:
+        pytest.skip(f"cannot build the OpenSubdiv driver: {r.stderr[-500:]}")
+    return exe
+
+
+def _osd_subdivide(exe, path, level):
+    """OpenSubdiv's level-``level`` values of the textured faces of an OBJ with v/vt (untextured corners get
+    values of their own)."""
+    import subprocess
+
+    V, F, FT = 0, [], []
+    UV = []
+    for line in pathlib.Path(path).read_text().splitlines():
+        s = line.split()
+        if not s:
+            continue
+        if s[0] == "v":
+            V += 1
+        elif s[0] == "vt":
+            UV.append([float(x) for x in s[1:3]])
+        elif s[0] == "f":
+            F.append([int(c.split("/")[0]) - 1 for c in s[1:]])
+            FT.append([int(c.split("/")[1]) - 1 if "/" in c else -1 for c in s[1:]])
+    ui, n = [], len(UV)
+    for ft in FT:
+        for k in ft:
+            ui.append(k if k >= 0 else n)
+            n += k < 0
+    vals = np.r_[np.array(UV), np.zeros((n - len(UV), 2))]
+    inp = (f"{V} {len(F)} {n} {level}\n" + " ".join(str(len(f)) for f in F) + "\n"
+           + " ".join(str(v) for f in F for v in f) + "\n" + " ".join(map(str, ui)) + "\n"
+           + "\n".join(f"{u:.17g} {v:.17g}" for u, v in vals) + "\n")
+    out = subprocess.run([str(exe)], input=inp, capture_output=True, text=True, check=True).stdout.splitlines()
+    m = int(out[0])
+    U = np.array([[float(x) for x in ln.split()] for ln in out[1 : 1 + m]])
+    faces = [[int(x) for x in ln.split()] for ln in out[2 + m :]]
+    q = 4**level  # uniform refinement of a quad mesh: the children of face f are q f .. q f + q - 1
+    tex = [f for f, ft in enumerate(FT) if ft[0] >= 0]
+    return U, [faces[q * f + c] for f in tex for c in range(q)], FT, np.array(UV), tex
+
+
+def test_opensubdiv_subdivides_the_control_uvs_as_the_rule_and_they_do_not_fold(tmp_path, osd_driver):
+    from scipy.spatial import cKDTree
+
+    from ccproof.apps.arap.core import MethodResult, compare
+    from ccproof.apps.arap.fvar import export_control
+    from ccproof.apps.arap.io import write_uv_obj
+
+    m, chart = M.curved_ev_mesh()
+    labels = np.array([0 if f in set(chart) else -1 for f in range(m.n_faces)])
+    res, _ = compare(m, labels, methods=("c",), levels=2, eval_level=4)
+    exp = export_control(res["c"], eval_level=4, max_extra=0)
+    path = tmp_path / "c.obj"
+    write_uv_obj(path, exp.mesh, MethodResult("c", exp.textures, 0.0, 0))
+    for level in (1, 2, 3):
+        U, faces, FT, UV, tex = _osd_subdivide(osd_driver, path, level)
+        assert folded_triangles(U, faces) == 0, level
+        mine, mf = UV, [FT[f] for f in tex]
+        for _ in range(level):
+            mine, mf = corners_only_step(mine, mf)
+        ours = mine[np.unique(np.asarray(mf))]
+        theirs = U[np.unique(np.asarray(faces))]
+        assert ours.shape == theirs.shape
+        # OpenSubdiv accumulates with float32 weights: agreement to ~1e-8 of the UV extent
+        tol = 1e-7 * float(np.ptp(ours, axis=0).max())
+        assert cKDTree(ours).query(theirs)[0].max() < tol and cKDTree(theirs).query(ours)[0].max() < tol
