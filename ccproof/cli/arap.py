@@ -19,9 +19,9 @@ other extension through meshio (point data "uv"; PLY: "s", "t"); FILE.json holds
 packing scale and the written triangles' own distortion. --control-out FILE.obj writes a control mesh
 with texture control points for the rule every subdivision tool has, OpenSubdiv's face-varying "corners
 only" (FVAR_LINEAR_CORNERS_ONLY; its header says so): fitted to the exact texture and polished by the
-same optimization under that rule, on the texture's control mesh subdivided 0..2 more times (the
-fewest that give no fold at levels 1-3 and every distortion excess within 5 % of the exact texture's);
-it prints the folds and the distortion such a tool will see.
+same optimization under that rule, on the texture's control mesh subdivided 0..--control-extra more times
+(the fewest that give no fold at levels 1-3 and every distortion excess within 5 % of the exact texture's,
+at most --control-max-faces faces); it prints the folds and the distortion such a tool will see.
 
 Input: any mesh `ccproof eval` reads (OBJ, PLY, OFF, STL, VTK, ...). Triangles and n-gons are
 subdivided once with Catmull-Clark first (n quads per n-gon, the same limit surface); --charts labels
@@ -82,6 +82,11 @@ def add_arguments(parser):
     parser.add_argument("--control-out", metavar="UV.obj",
                         help="write a control mesh with texture control points for OpenSubdiv's face-varying "
                              "'corners only' rule (OBJ with vt, plus UV.obj.json; see above)")
+    parser.add_argument("--control-extra", type=int, default=2, metavar="N",
+                        help="--control-out may subdivide the texture's control mesh up to N more times (default 2), "
+                             "not beyond --control-max-faces")
+    parser.add_argument("--control-max-faces", type=int, default=150_000, metavar="F",
+                        help="largest control mesh --control-out writes (default 150000 faces)")
     parser.add_argument("--labels-out", metavar="FILE", help="write the chart labels used")
     parser.add_argument("--preview", metavar="FILE.png",
                         help="render a checkerboard through the UVs and the per-triangle distortion (matplotlib), "
@@ -256,7 +261,8 @@ def _write_control(args, r, surf, eval_level, comment, table, write_uv_obj):
 
     from ccproof.apps.arap.fvar import FOLD_LEVELS, export_control
 
-    exp = export_control(r, eval_level=eval_level, levels=args.levels, accel=args.accel)
+    exp = export_control(r, eval_level=eval_level, levels=args.levels, accel=args.accel, max_extra=args.control_extra,
+                         max_faces=args.control_max_faces)
     times = r.refine + exp.extra
     note = f"\ncontrol mesh: the input subdivided {times} times (Catmull-Clark)" if times else ""
     note += ("\ncontrol UVs: least-squares fit of the exact texture's limit UVs under the rule below, polished by "
@@ -278,4 +284,5 @@ def _write_control(args, r, surf, eval_level, comment, table, write_uv_obj):
     if not exp.accepted:
         print(f"warning: --control-out: no subdivision of 0..{len(exp.tried) - 1} extra gave UVs without folds and "
               f"within 5 % of the exact texture's distortion excess; wrote the best ({exp.extra} extra, "
-              f"{sum(exp.folds)} folded quads); the sampled surface (--out) has the exact UVs", file=sys.stderr)
+              f"{sum(exp.folds)} folded quads); raise --control-extra / --control-max-faces, or use the sampled "
+              f"surface (--out), which has the exact UVs", file=sys.stderr)

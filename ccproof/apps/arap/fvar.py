@@ -12,15 +12,16 @@ corner (``V' = V``), also at a one-face corner of an open surface. These are the
 
 hsh10's extended charts (c) subdivide the texture with the *surface's* rules across the chart boundary
 (chart plus ring, docs/hsh10.md A8): no standard rule reproduces them, and the control UVs of (c) fold
-when a tool subdivides them with its own rule. :func:`corners_only_texture` therefore writes control UVs
-*for* the corners-only rule: per chart, the least-squares fit (uniform weights, sparse normal equations)
-of the corners-only texture's limit UVs to the exact texture's limit UVs at the level-``fit_level``
-vertices of the chart, then polished by hsh10's own optimization with the corners-only rules (kept when
-it does not fold); it counts the folds of the subdivided UVs at levels 1..3 (what a tool renders) and
-measures the fitted texture with the same samples as the exact one (:func:`~ccproof.apps.arap.core.
-texture_metrics`). When the fit on the texture's control mesh folds or its distortion excess is more than
-``max_excess_ratio`` times the exact texture's, the control mesh is subdivided once more (the same limit
-surface, 4x the faces and UVs) and fitted again, up to ``max_extra`` times (:func:`export_control`).
+when a tool subdivides them with its own rule. :func:`export_control` therefore writes control UVs *for*
+the corners-only rule. Per chart: the least-squares fit of the corners-only texture's limit UVs to the
+exact texture's limit UVs at the level-``fit_level`` vertices of the chart (:func:`corners_only_texture`,
+uniform weights, sparse normal equations), polished by hsh10's own optimization under the corners-only
+rules (where that folds, the nearest blend towards the fit that does not). It counts the folds of the
+subdivided UVs at levels 1..3 (what a tool renders, :func:`subdivided_folds`) and measures the texture
+with the same samples as the exact one (:func:`~ccproof.apps.arap.core.texture_metrics`). When the UVs
+on the texture's control mesh fold, or a distortion excess exceeds ``max_excess_ratio`` times the exact
+texture's, the control mesh is subdivided once more (the same limit surface, 4x the faces and UVs) and
+fitted again, up to ``max_extra`` times.
 
 The inner 3 x 3 faces of a flat 5 x 5 grid as one chart: the exact texture is an isometry, and so is the
 corners-only one (on a uniform flat grid every rule reproduces affine functions at the same points):
@@ -204,13 +205,14 @@ class ControlExport:
 
 
 def export_control(result, eval_level=5, max_extra=2, max_excess_ratio=1.05, fit_level=2, levels=3, polish=True,
-                   accel=5):
+                   accel=5, max_faces=None):
     """Corners-only control UVs for every chart of ``result`` (module docstring).
 
     Per chart: the least-squares fit of :func:`corners_only_texture`, then (``polish``) hsh10's
     local/global optimization with the corners-only rules (method (b) on the subdivided control mesh,
     :func:`~ccproof.apps.arap.core.optimize_chart`) started from it; the polished UVs are kept when their
-    subdivision has no fold at :data:`FOLD_LEVELS`, else the fit's.
+    subdivision has no fold at :data:`FOLD_LEVELS`, else the first blend ``Y2 + t (Y_fit - Y2)``, t = 0.25,
+    0.5, 0.75, that has none, else the fit's (or whichever folds least).
 
     Parameters
     ----------
@@ -233,6 +235,8 @@ def export_control(result, eval_level=5, max_extra=2, max_excess_ratio=1.05, fit
     polish : bool
     accel : int
         Anderson acceleration of the polish.
+    max_faces : int, optional
+        Do not subdivide the control mesh beyond this many faces.
 
     Returns
     -------
@@ -253,6 +257,8 @@ def export_control(result, eval_level=5, max_extra=2, max_excess_ratio=1.05, fit
     ok = False
     for extra in range(int(max_extra) + 1):
         if extra:
+            if max_faces is not None and 4 * mesh.n_faces > max_faces:
+                break
             mesh, _ = refine_mesh(mesh, None, 1)
         # metric level on the input mesh: eval_level, at least level 1 of the subdivided control mesh
         e_in = max(int(eval_level), ref + extra + 1)
@@ -272,9 +278,14 @@ def export_control(result, eval_level=5, max_extra=2, max_excess_ratio=1.05, fit
             if polish:
                 top = max(1, int(levels) - ref - extra)
                 Y2, _, _ = optimize_chart(hc, "boundary", Y, levels=top, start_level=1, accel=accel)
-                fo2 = subdivided_folds(hc, Y2)
-                if sum(fo2) == 0 or sum(fo2) < sum(fo):
-                    Y, fo = Y2, fo2
+                # the polished UVs, or the nearest blend towards the fit that does not fold
+                for t in (0.0, 0.25, 0.5, 0.75):
+                    Yt = Y2 + t * (Y - Y2)
+                    fot = subdivided_folds(hc, Yt)
+                    if sum(fot) == 0 or sum(fot) < sum(fo):
+                        Y, fo = Yt, fot
+                        if sum(fot) == 0:
+                            break
             folds += fo
             ct = ChartTexture(hc, "boundary", 0, hc.lift_unknowns(Y, "boundary"), Y)
             met = met + texture_metrics(ct, ev_x)
