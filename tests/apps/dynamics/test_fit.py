@@ -332,3 +332,27 @@ def test_fit_scanned_bunny_reaches_equilibrium_and_an_independent_two_sided_dist
     two = max(d_data.max(), d_surf.max())
     assert abs(100 * two / D - res.two_sided_error_percent) <= 100 * h / D
     assert res.levels[1].max_error_percent < res.levels[0].max_error_percent
+
+
+def test_cli_fit_reads_a_triangle_start_mesh_and_points_from_any_mesh_file(tmp_path, capsys):
+    import meshio
+
+    from ccproof.cli import main
+    from ccproof.mesh import read_obj
+    from ccproof.mesh.examples import cube
+
+    X = synthetic_range_data("bulb", 300, seed=3)
+    pts = tmp_path / "bulb.off"  # points as the vertices of a mesh file read by the mesh reader (meshio)
+    meshio.write(pts, meshio.Mesh(X, [("triangle", np.arange(len(X)).reshape(-1, 3))]))
+    c = cube()
+    V = X.mean(0) + 0.3 * np.asarray(c.vertices)
+    T = np.r_[c.faces[:, [0, 1, 2]], c.faces[:, [0, 2, 3]]]  # the cube as 12 triangles
+    init = tmp_path / "start.ply"
+    meshio.write(init, meshio.Mesh(V, [("triangle", T.astype(np.int32))]))
+    out = tmp_path / "fit.obj"
+    rc = main(["fit", str(pts), "--init", str(init), "--levels", "0",
+               "--max-steps", "3", "--out", str(out), "--no-progress"])
+    cap = capsys.readouterr()
+    assert rc == 0, cap.err
+    assert "not all quads: subdivided once (Catmull-Clark) to 36 quads" in cap.err
+    assert read_obj(out).n_faces >= 36
