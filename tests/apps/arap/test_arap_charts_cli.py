@@ -90,11 +90,14 @@ def test_cli_end_to_end(tmp_path, capsys):
     lines = out.read_text().splitlines()
     side = json.loads((tmp_path / "uv.obj.json").read_text())
     ch = side["charts"][0]
-    assert ch["rules"] == "extended" and len(ch["uv"]) > ch["n_chart_vertices"]  # ring texture points kept
+    # control UVs for the face-varying corners-only rule: chart vertices only, on the control mesh subdivided
+    # as many extra times as the file says
+    assert ch["rules"] == "boundary" and len(ch["uv"]) == ch["n_chart_vertices"]
     vt = [tuple(map(float, ln.split()[1:])) for ln in lines if ln.startswith("vt ")]
     assert len(vt) == len(ch["uv"])
+    q = 4 ** side["table"]["control_out"]["extra_subdivisions"]
     fts = [ln for ln in lines if ln.startswith("f ")]
-    assert sum("/" in ln for ln in fts) == len(chart) and len(fts) == m.n_faces
+    assert sum("/" in ln for ln in fts) == q * len(chart) and len(fts) == q * m.n_faces
     assert side["table"]["c"]["E_area"] < side["table"]["a"]["E_area"]
 
 
