@@ -1,14 +1,18 @@
 """What a user who takes the applications' output elsewhere gets: the numbers of docs/hsh10.md section 8 and
 docs/qmv98.md section 4 ("Equilibrium"), printed, not estimated.
 
-  python scripts/apps_output.py --arap     # bunny, 16 charts: control UVs under OpenSubdiv's corners-only rule
+  python scripts/apps_output.py --arap [--osd]  # bunny, 16 charts: control UVs under the corners-only rule
+                                                # (--osd: folds counted by OpenSubdiv itself too)
   python scripts/apps_output.py --fit      # bunny scan: fit steps, energy, criterion, two-sided error
 
 --arap: for --refine 0 and the default, method (c) on the bunny's 16 normal-segmented charts; then the folds
 (UV quads with a corner triangle of signed area <= 0) of the control UVs subdivided with the face-varying
 "corners only" rule at levels 1-3, and the distortion of that texture at the metric level (the same samples as
 the exact texture): first for the (c) control UVs as they were written before (the chart's own unknowns), then
-for :func:`ccproof.apps.arap.fvar.export_control` (fit + polish under the rule, extra subdivisions).
+for :func:`ccproof.apps.arap.fvar.export_control` (fit + polish under the rule, extra subdivisions), whose
+control mesh is written to --out-dir. With --osd the written files are also subdivided by OpenSubdiv itself
+(Far::PrimvarRefiner, FVAR_LINEAR_CORNERS_ONLY; the driver of tests/apps/arap/osd_fvar_driver.cpp, built
+with g++ -losdCPU) and its folded quads at levels 1-3 are counted the same way.
 --fit: ``fit_points`` with the defaults on the scan's 2,038 vertices, and an independent two-sided distance
 (exact limit points of the fitted control mesh subdivided 4 times, scipy k-d trees both ways).
 """
@@ -17,6 +21,7 @@ from __future__ import annotations
 
 import argparse
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -28,13 +33,79 @@ def _fmt(m):
     return f"E_angle {m.E_angle:.6f}  E_area {m.E_area:.6f}  E_stretch {m.E_stretch:.6f}"
 
 
-def arap(eval_level):
+def _build_osd():
+    import shutil
+    import subprocess
+    import tempfile
+
+    src = Path(__file__).resolve().parents[1] / "tests" / "apps" / "arap" / "osd_fvar_driver.cpp"
+    if shutil.which("g++") is None or not Path("/usr/include/opensubdiv/far/primvarRefiner.h").exists():
+        print("OpenSubdiv headers (apt-get install libosd-dev) or g++ missing: --osd skipped")
+        return None
+    exe = Path(tempfile.mkdtemp()) / "osd_fvar"
+    r = subprocess.run(["g++", "-O2", "-std=c++14", str(src), "-o", str(exe), "-losdCPU"], capture_output=True,
+                       text=True)
+    if r.returncode != 0:
+        print(f"building the OpenSubdiv driver failed: {r.stderr[-500:]}")
+        return None
+    return exe
+
+
+def osd_folds(exe, path, levels=(1, 2, 3)):
+    """Folded UV quads (a corner triangle of signed area <= 0) of the textured faces of an OBJ with v/vt,
+    subdivided by OpenSubdiv's face-varying corners-only rule (uniform refinement: the children of face f at
+    level l are 4^l f .. 4^l f + 4^l - 1)."""
+    import subprocess
+
+    nv, F, FT, UV = 0, [], [], []
+    for line in Path(path).read_text().splitlines():
+        s = line.split()
+        if not s:
+            continue
+        if s[0] == "v":
+            nv += 1
+        elif s[0] == "vt":
+            UV.append(s[1] + " " + s[2])
+        elif s[0] == "f":
+            F.append([int(c.split("/")[0]) - 1 for c in s[1:]])
+            FT.append([int(c.split("/")[1]) - 1 if "/" in c else -1 for c in s[1:]])
+    ui, n = [], len(UV)
+    for ft in FT:
+        for k in ft:
+            ui.append(k if k >= 0 else n)
+            n += k < 0
+    vals = UV + ["0 0"] * (n - len(UV))
+    tex = np.array([f for f, ft in enumerate(FT) if ft[0] >= 0])
+    out = []
+    for lv in levels:
+        inp = "\n".join([f"{nv} {len(F)} {n} {lv}", " ".join(str(len(f)) for f in F),
+                         " ".join(str(v) for f in F for v in f), " ".join(map(str, ui)), "\n".join(vals)]) + "\n"
+        res = subprocess.run([str(exe)], input=inp, capture_output=True, text=True, check=True).stdout
+        lines = res.splitlines()
+        m = int(lines[0])
+        U = np.loadtxt(lines[1 : 1 + m]).reshape(-1, 2)
+        Q = np.loadtxt(lines[2 + m :], dtype=np.int64).reshape(-1, 4)
+        q = 4**lv
+        Q = Q[(q * tex[:, None] + np.arange(q)).ravel()]
+        bad = np.zeros(Q.shape[0], dtype=bool)
+        for i in range(4):
+            a, b, c = U[Q[:, i]], U[Q[:, (i + 1) % 4]], U[Q[:, (i + 3) % 4]]
+            bad |= (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0]) <= 0
+        out.append(int(bad.sum()))
+    return out
+
+
+def arap(eval_level, out_dir, use_osd):
     from ccproof.apps.arap.charts import segment_by_normals
     from ccproof.apps.arap.core import ChartTexture, auto_refine, compare, texture_metrics
     from ccproof.apps.arap.fvar import FOLD_LEVELS, export_control, subdivided_folds
     from ccproof.apps.arap.hierarchy import ChartHierarchy
+    from ccproof.apps.arap.io import write_uv_obj
     from ccproof.apps.arap.metrics import Metrics
     from ccproof.mesh import read_obj
+
+    exe = _build_osd() if use_osd else None
+    out_dir.mkdir(parents=True, exist_ok=True)
 
     mesh = read_obj(BUNNY)
     labels = segment_by_normals(mesh)
@@ -58,6 +129,10 @@ def arap(eval_level):
             hc.release()
             h.release()
         print(f"  (c) control UVs as written before:      {_fmt(met)}   folds {folds.tolist()}")
+        if exe is not None:
+            old = out_dir / f"bunny_control_refine{refine}_before.obj"
+            write_uv_obj(old, r.textures[0].hierarchy.surface, r)  # the former file: (c)'s own unknowns
+            print(f"    OpenSubdiv's folds of that file: {osd_folds(exe, old)}")
         t2 = time.perf_counter()
         exp = export_control(r, eval_level=eval_level, levels=3, max_faces=150_000)  # the CLI's defaults
         t3 = time.perf_counter()
@@ -66,6 +141,11 @@ def arap(eval_level):
         er = exp.excess_ratio()
         print(f"  written: {exp.extra} extra ({exp.mesh.n_faces} control faces), excess / exact "
               f"{er[0]:.3f} {er[1]:.3f} {er[2]:.3f}, within 5 %: {exp.accepted} ({t3 - t2:.1f} s)")
+        path = out_dir / f"bunny_control_refine{refine}.obj"
+        write_uv_obj(path, exp.mesh, replace(r, textures=exp.textures))
+        print(f"  wrote {path}")
+        if exe is not None:
+            print(f"    OpenSubdiv's folds of that file: {osd_folds(exe, path)}")
 
 
 def fit():
@@ -106,13 +186,15 @@ def main(argv=None):
     ap.add_argument("--arap", action="store_true")
     ap.add_argument("--fit", action="store_true")
     ap.add_argument("--eval-level", type=int, default=4, help="metric level of --arap (default 4)")
+    ap.add_argument("--osd", action="store_true", help="--arap: also count folds with OpenSubdiv itself")
+    ap.add_argument("--out-dir", type=Path, default=Path("out/apps_output"), help="control meshes of --arap")
     a = ap.parse_args(argv)
     if not (a.arap or a.fit):
         ap.error("give --arap and/or --fit")
     if a.fit:
         fit()
     if a.arap:
-        arap(a.eval_level)
+        arap(a.eval_level, a.out_dir, a.osd)
 
 
 if __name__ == "__main__":
