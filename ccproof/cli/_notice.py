@@ -11,9 +11,9 @@ __all__ = ["compile_notice", "kernels_cached", "KERNEL_MODULES", "FIRST_COMPILE_
 
 #: the modules whose numba kernels (``cache=True``) the closest-point search and evaluation compile
 KERNEL_MODULES = ("ccproof.evaluate._numba_kernel", "ccproof.evaluate._bvh")
-#: measured first run of ``ccproof fit`` on 500 points with an empty numba cache, minus the same run with the
-#: cache filled (seconds; shared 2-core machine, idle to loaded; docs/qmv98.md)
-FIRST_COMPILE_SECONDS = (160, 250)
+#: the first run's compilation, seconds (docs/qmv98.md: ``ccproof fit`` on 500 points took 391 s with an empty
+#: numba cache and 139 s with it filled, on a loaded 2-core machine): the notice says "a few minutes"
+FIRST_COMPILE_SECONDS = (120, 300)
 
 
 def kernels_cached(modules=KERNEL_MODULES):
@@ -76,6 +76,6 @@ def compile_notice(command, stream=None):
     if kernels_cached():
         return False
     lo, hi = FIRST_COMPILE_SECONDS
-    print(f"ccproof {command}: first run: compiling the numba kernels once (about {lo}-{hi} s on 2 cores; cached "
-          f"on disk for later runs)", file=stream or sys.stderr, flush=True)
+    print(f"ccproof {command}: first run: compiling the numba kernels once (a few minutes, {lo}-{hi} s on 2 cores; "
+          f"cached on disk for later runs)", file=stream or sys.stderr, flush=True)
     return True
