@@ -136,8 +136,11 @@ def arap(eval_level, out_dir, use_osd):
         t2 = time.perf_counter()
         exp = export_control(r, eval_level=eval_level, levels=3, max_faces=150_000)  # the CLI's defaults
         t3 = time.perf_counter()
+        ex = np.subtract(r.metrics.as_tuple(), (2.0, 2.0, 1.0))
         for extra, f, m in exp.tried:
-            print(f"  corners-only UVs, {extra} extra subdivision(s): {_fmt(m)}   folds {f}")
+            ratio = np.subtract(m.as_tuple(), (2.0, 2.0, 1.0)) / ex
+            print(f"  corners-only UVs, {extra} extra subdivision(s): {_fmt(m)}   folds {f}   excess / exact "
+                  f"{ratio[0]:.3f} {ratio[1]:.3f} {ratio[2]:.3f}")
         er = exp.excess_ratio()
         print(f"  written: {exp.extra} extra ({exp.mesh.n_faces} control faces), excess / exact "
               f"{er[0]:.3f} {er[1]:.3f} {er[2]:.3f}, within 5 %: {exp.accepted} ({t3 - t2:.1f} s)")
