@@ -262,7 +262,7 @@ def _write_control(args, r, surf, eval_level, comment, table, write_uv_obj):
     from ccproof.apps.arap.fvar import FOLD_LEVELS, export_control
 
     exp = export_control(r, eval_level=eval_level, levels=args.levels, accel=args.accel, max_extra=args.control_extra,
-                         max_faces=args.control_max_faces)
+                         max_faces=args.control_max_faces, progress=not args.no_progress)
     times = r.refine + exp.extra
     note = f"\ncontrol mesh: the input subdivided {times} times (Catmull-Clark)" if times else ""
     note += ("\ncontrol UVs: least-squares fit of the exact texture's limit UVs under the rule below, polished by "

@@ -205,7 +205,7 @@ class ControlExport:
 
 
 def export_control(result, eval_level=5, max_extra=2, max_excess_ratio=1.05, fit_level=2, levels=3, polish=True,
-                   accel=5, max_faces=None):
+                   accel=5, max_faces=None, progress=False):
     """Corners-only control UVs for every chart of ``result`` (module docstring).
 
     Per chart: the least-squares fit of :func:`corners_only_texture`, then (``polish``) hsh10's
@@ -237,6 +237,8 @@ def export_control(result, eval_level=5, max_extra=2, max_excess_ratio=1.05, fit
         Anderson acceleration of the polish.
     max_faces : int, optional
         Do not subdivide the control mesh beyond this many faces.
+    progress : bool
+        A tqdm progress bar over the charts of each refinement tried.
 
     Returns
     -------
@@ -272,6 +274,11 @@ def export_control(result, eval_level=5, max_extra=2, max_excess_ratio=1.05, fit
         exact = exacts[e_in]
         folds = np.zeros(len(FOLD_LEVELS), dtype=np.int64)
         met, out = Metrics(), []
+        bar = None
+        if progress:
+            from tqdm import tqdm
+
+            bar = tqdm(total=len(texs), desc=f"control UVs, {extra} extra", unit="chart")
         for tex in texs:
             hc, Y = corners_only_texture(tex, extra, fit_level, mesh)
             fo = subdivided_folds(hc, Y)
@@ -292,6 +299,10 @@ def export_control(result, eval_level=5, max_extra=2, max_excess_ratio=1.05, fit
             hc.release()
             tex.hierarchy.release()
             out.append(ct)
+            if bar is not None:
+                bar.update(1)
+        if bar is not None:
+            bar.close()
         exp = ControlExport(mesh, out, extra, folds.tolist(), met, exact, e_in)
         tried.append((extra, exp.folds, met))
         ex_m = np.subtract(met.as_tuple(), (2.0, 2.0, 1.0))
