@@ -13,7 +13,7 @@ verify (the trusted base)           :func:`verify_file` -> :class:`VerifyResult`
 meshes                              :class:`QuadMesh`, :class:`PolyMesh`, :func:`read_obj`, :func:`read_mesh`
 the limit surface of a mesh         :func:`limit_surface` (evaluate, normals, parameterizations)
 the characteristic map, Phi^-1      :func:`characteristic_map`, :func:`inverse_characteristic_map`
-ARAP texture parameterization       :func:`parameterize` (hsh10)
+ARAP texture parameterization       :func:`parameterize` (hsh10), :func:`write_uv_mesh` (for other tools)
 fit a surface to points             :func:`fit_points` (qmv98)
 errors                              :class:`CCProofError` and subclasses; the verifier's own :class:`CertificateError`
 ==================================  ======================================================================
@@ -40,6 +40,7 @@ from ccproof.valence import Valence, parse_valence
 
 if TYPE_CHECKING:  # the lazy names of _LAZY below, seen by type checkers (mypy in .ci/run) as what they are
     from ccproof.apps.arap.core import parameterize
+    from ccproof.apps.arap.export import write_uv_mesh
     from ccproof.apps.dynamics.fit import fit_points
     from ccproof.certify.prover import prove_c1, prove_interval, prove_valence
     from ccproof.certify.verify import verify_file
@@ -72,6 +73,7 @@ _LAZY = {
     "characteristic_map": "ccproof.inverse.forward",
     "inverse_characteristic_map": "ccproof.inverse.algorithm",
     "parameterize": "ccproof.apps.arap.core",
+    "write_uv_mesh": "ccproof.apps.arap.export",
     "fit_points": "ccproof.apps.dynamics.fit",
 }
 
@@ -99,6 +101,7 @@ __all__ = [
     "read_mesh",
     "read_obj",
     "verify_file",
+    "write_uv_mesh",
 ]
 
 _EAGER = {"CCProofError", "MeshError", "TableNotFoundError", "ValenceError", "Valence", "parse_valence"}

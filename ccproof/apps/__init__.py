@@ -1,1 +1,2 @@
-"""ccproof.apps (layer of docs/architecture.md)."""
+"""ccproof.apps (layer of docs/architecture.md): ARAP parameterization (``arap``), dynamic surfaces (``dynamics``),
+and the control mesh both read (``control_mesh``: any mesh ``ccproof eval`` reads, as quads)."""

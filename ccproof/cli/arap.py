@@ -16,8 +16,16 @@ triangle (or --cells quad) mesh whose per-vertex UVs are the parameterization ev
 the limit points; charts packed into [0, 1]^2 without overlap (shelf packing, one common scale);
 seams as duplicated vertices (one UV per chart). FILE.obj is written directly (v, vt, f i/i), any
 other extension through meshio (point data "uv"; PLY: "s", "t"); FILE.json holds the metrics, the
-packing scale and the written triangles' own distortion. --control-out FILE.obj writes the control
-mesh with its texture control points and states the subdivision rule they need.
+packing scale and the written triangles' own distortion. --control-out FILE.obj writes a control mesh
+with texture control points for the rule every subdivision tool has, OpenSubdiv's face-varying "corners
+only" (FVAR_LINEAR_CORNERS_ONLY; its header says so): fitted to the exact texture and polished by the
+same optimization under that rule, on the texture's control mesh subdivided 0..--control-extra more times
+(the fewest that give no fold at levels 1-3 and every distortion excess within 5 % of the exact texture's,
+at most --control-max-faces faces); it prints the folds and the distortion such a tool will see.
+
+Input: any mesh `ccproof eval` reads (OBJ, PLY, OFF, STL, VTK, ...). Triangles and n-gons are
+subdivided once with Catmull-Clark first (n quads per n-gon, the same limit surface); --charts labels
+then name the file's faces, each label carried to its quads.
 
 Scale: charts are processed one at a time; the peak memory is estimated first and a run above
 --max-memory (default 2 GB) stops with an error naming the options that lower it. --refine R (default:
@@ -39,8 +47,9 @@ __all__ = ["add_arguments", "run", "format_table"]
 
 
 def add_arguments(parser):
-    parser.add_argument("mesh", help="all-quad OBJ control mesh")
-    parser.add_argument("--charts", metavar="LABELS", help="chart label file: one integer per face")
+    parser.add_argument("mesh", help="control mesh: any format eval reads; triangles and n-gons are subdivided once "
+                                     "(Catmull-Clark) to quads first")
+    parser.add_argument("--charts", metavar="LABELS", help="chart label file: one integer per face of the file")
     parser.add_argument("--segment", choices=["normals"], help="segment into charts (when no --charts)")
     parser.add_argument("--variant", choices=["extended", "boundary"], default="extended",
                         help="chart boundary treatment: extended charts (c) or boundary rules (b)")
@@ -74,7 +83,13 @@ def add_arguments(parser):
                              "at most 2M triangles)")
     parser.add_argument("--cells", choices=["triangle", "quad"], default="triangle", help="cells of --out")
     parser.add_argument("--control-out", metavar="UV.obj",
-                        help="write the control mesh with texture control points (OBJ with vt, plus UV.obj.json)")
+                        help="write a control mesh with texture control points for OpenSubdiv's face-varying "
+                             "'corners only' rule (OBJ with vt, plus UV.obj.json; see above)")
+    parser.add_argument("--control-extra", type=int, default=2, metavar="N",
+                        help="--control-out may subdivide the texture's control mesh up to N more times (default 2), "
+                             "not beyond --control-max-faces")
+    parser.add_argument("--control-max-faces", type=int, default=150_000, metavar="F",
+                        help="largest control mesh --control-out writes (default 150000 faces)")
     parser.add_argument("--labels-out", metavar="FILE", help="write the chart labels used")
     parser.add_argument("--preview", metavar="FILE.png",
                         help="render a checkerboard through the UVs and the per-triangle distortion (matplotlib), "
@@ -128,13 +143,16 @@ def run(args) -> int:
     from ccproof.apps.arap.core import VARIANTS, MemoryBudgetError, auto_refine, compare
     from ccproof.apps.arap.export import sampled_surface, write_surface
     from ccproof.apps.arap.io import write_uv_obj
+    from ccproof.apps.control_mesh import children_labels, read_control_mesh
     from ccproof.cli._progress import progress_enabled
     from ccproof.errors import CCProofError
-    from ccproof.mesh import read_obj
 
-    mesh = read_obj(args.mesh)
+    mesh, sizes = read_control_mesh(args.mesh)
+    if sizes is not None:
+        print(f"{args.mesh}: {sizes.size} faces, not all quads: subdivided once (Catmull-Clark) to {mesh.n_faces} "
+              f"quads, the same limit surface", file=sys.stderr)
     if args.charts:
-        labels = read_labels(args.charts, mesh.n_faces)
+        labels = children_labels(read_labels(args.charts, mesh.n_faces if sizes is None else sizes.size), sizes)
     elif args.segment == "normals":
         labels = segment_by_normals(mesh)
     else:
@@ -241,13 +259,44 @@ def run(args) -> int:
               f"{surf.cell_type}s, {surf.folds()} folded; written triangles E_angle {wm.E_angle:.6f} "
               f"E_area {wm.E_area:.6f} E_stretch {wm.E_stretch:.6f}) and {args.out}.json")
     if args.control_out:
-        r = results[ours]
-        cmesh = r.textures[0].hierarchy.surface  # with --refine: the refined control mesh the texture lives on
-        note = f"\ncontrol mesh: the input subdivided {r.refine} times (Catmull-Clark)" if r.refine else ""
-        with atomic(args.control_out) as tmp:
-            side = args.control_out + ".json"
-            os.replace(write_uv_obj(tmp, cmesh, r, comment=comment + note, table=table, transforms=surf.transforms,
-                                    scale=surf.scale), side)
-        print(f"wrote {args.control_out} and {side}")
+        _write_control(args, results[ours], surf, eval_level, comment, table, write_uv_obj)
     sys.stdout.flush()
     return 0
+
+
+def _write_control(args, r, surf, eval_level, comment, table, write_uv_obj):
+    """--control-out: control UVs for the face-varying 'corners only' rule, and what a tool will see."""
+    from dataclasses import replace
+
+    from ccproof.apps.arap.fvar import FOLD_LEVELS, export_control
+    from ccproof.cli._output import atomic
+    from ccproof.cli._progress import progress_enabled
+
+    exp = export_control(r, eval_level=eval_level, levels=args.levels, accel=args.accel, max_extra=args.control_extra,
+                         max_faces=args.control_max_faces, progress=progress_enabled(args))
+    times = r.refine + exp.extra
+    note = f"\ncontrol mesh: the input subdivided {times} times (Catmull-Clark)" if times else ""
+    note += ("\ncontrol UVs: least-squares fit of the exact texture's limit UVs under the rule below, polished by "
+             "hsh10's optimization under that rule")
+    er = exp.excess_ratio()
+    what = {"refine": r.refine, "extra_subdivisions": exp.extra, "fold_levels": list(FOLD_LEVELS),
+            "folds": exp.folds, "metric_level": exp.level, "E_angle": exp.metrics.E_angle, "E_area": exp.metrics.E_area,
+            "E_stretch": exp.metrics.E_stretch, "excess_ratio_to_exact": list(er), "accepted": exp.accepted,
+            "tried": [{"extra": e, "folds": f, "E_angle": m.E_angle, "E_area": m.E_area, "E_stretch": m.E_stretch}
+                      for e, f, m in exp.tried]}
+    side = args.control_out + ".json"
+    with atomic(args.control_out) as tmp:
+        os.replace(write_uv_obj(tmp, exp.mesh, replace(r, textures=exp.textures), comment=comment + note,
+                                table=dict(table, control_out=what), transforms=surf.transforms, scale=surf.scale),
+                   side)
+    print(f"wrote {args.control_out} and {side}: control mesh = the input subdivided {times} times "
+          f"({exp.mesh.n_faces} faces), UVs for OpenSubdiv's face-varying 'corners only' rule")
+    print(f"  what a subdivision tool will see: folded UV quads at levels {', '.join(map(str, FOLD_LEVELS))}: "
+          f"{', '.join(map(str, exp.folds))}; limit texture at level {exp.level}: E_angle {exp.metrics.E_angle:.6f} "
+          f"E_area {exp.metrics.E_area:.6f} E_stretch {exp.metrics.E_stretch:.6f} (excess {er[0]:.3f}, {er[1]:.3f}, "
+          f"{er[2]:.3f} x the exact texture's)")
+    if not exp.accepted:
+        print(f"warning: --control-out: no subdivision of 0..{len(exp.tried) - 1} extra gave UVs without folds and "
+              f"within 5 % of the exact texture's distortion excess; wrote the best ({exp.extra} extra, "
+              f"{sum(exp.folds)} folded quads); raise --control-extra / --control-max-faces, or use the sampled "
+              f"surface (--out), which has the exact UVs", file=sys.stderr)

@@ -2,12 +2,16 @@
 
   ccproof fit POINTS.xyz --out fitted.obj                 cube x2 (98 vertices) -> equilibrium -> 386 vertices
   ccproof fit scan.ply --levels 2 --out fitted.obj        two global subdivisions after the first fit
-  ccproof fit bunny.obj --init start.obj --out fit.obj    start from your own (closed, all-quad) control mesh
+  ccproof fit bunny.obj --init start.ply --out fit.obj    start from your own closed control mesh
 
-POINTS: .xyz (x y z per line), .ply (vertex x, y, z; ASCII or binary) or .obj (its vertices). The model
+POINTS: .xyz (x y z per line), .ply (vertex x, y, z; ASCII or binary), .obj or the vertices of any mesh
+file eval reads. --init: any mesh eval reads; triangles and n-gons are subdivided once (Catmull-Clark) to
+quads first (the same limit surface). The model
 starts as the paper's 98-vertex mesh (the cube subdivided twice) inside the data, evolves under data
 springs (every point pulls its nearest limit-surface point) with the massless implicit scheme (32) to
-equilibrium, is subdivided once (386 vertices) and refitted. Printed per level: control vertices, time
+equilibrium (the relative changes of the total energy and of the mean data -> surface distance over two
+steps both <= --tol; --max-steps is a safety cap), is subdivided once (386 vertices) and refitted. Each
+level says why it stopped. Printed per level: control vertices, time
 steps, the paper's fit error (the largest distance of a data point to the limit surface, in % of the
 diameter of the smallest enclosing sphere, Welzl) and the mean distance in the same unit. All material
 parameters are in units where that diameter is 1 and the data springs sum to --spring.
@@ -28,14 +32,18 @@ import sys
 def add_arguments(p):
     p.add_argument("points", help="point cloud: .xyz, .ply or .obj")
     p.add_argument("--out", required=True, help="write the fitted control mesh (OBJ) here")
-    p.add_argument("--init", default="cube", help="'cube' (the paper's 98-vertex model, default) or an OBJ mesh")
+    p.add_argument("--init", default="cube",
+                   help="'cube' (the paper's 98-vertex model, default) or a closed mesh (any format eval reads; "
+                        "triangles and n-gons are subdivided once to quads)")
     p.add_argument("--levels", type=int, default=1, help="global subdivisions after the first fit (default 1)")
     p.add_argument("--scheme", choices=("massless", "inertial"), default="massless",
                    help="time integrator: eq. (32) massless (default) or eq. (31)")
     p.add_argument("--dt", type=float, default=None, help="time step (default 1000 massless, 10 inertial)")
-    p.add_argument("--max-steps", type=int, default=60, help="time steps per level at most (default 60)")
+    p.add_argument("--max-steps", type=int, default=1000,
+                   help="time steps per level at most, a safety cap (default 1000)")
     p.add_argument("--tol", type=float, default=1e-3,
-                   help="equilibrium: relative energy change between steps (default 1e-3)")
+                   help="equilibrium: relative changes of the energy and of the mean data error over two steps "
+                        "(default 1e-3)")
     p.add_argument("--tension", type=float, default=1e-5, help="a11 = a22 (default 1e-5)")
     p.add_argument("--rigidity", type=float, default=1e-6, help="b11 = b22 = b12/2 (default 1e-6)")
     p.add_argument("--damping", type=float, default=1.0, help="gamma (default 1)")
@@ -68,18 +76,24 @@ def run(args) -> int:
     check_outputs(args, out=(".obj",), surface_out="mesh", errors=(".csv",))  # before any work
     import numpy as np
 
+    from ccproof.apps.control_mesh import read_control_mesh
     from ccproof.apps.dynamics.fit import fit_points, read_points
     from ccproof.apps.dynamics.model import Material
+    from ccproof.cli._notice import compile_notice
     from ccproof.cli._progress import progress_enabled
     from ccproof.errors import CCProofError
-    from ccproof.mesh import read_obj, write_obj
+    from ccproof.mesh import write_obj
 
     X = read_points(args.points)
     init = args.init
     if init != "cube":
         if not Path(init).exists():
-            raise CCProofError(f"--init: {init}: no such file (use 'cube' or an OBJ mesh)")
-        init = read_obj(init)
+            raise CCProofError(f"--init: {init}: no such file (use 'cube' or a mesh file)")
+        init, sizes = read_control_mesh(init)
+        if sizes is not None:
+            print(f"--init {args.init}: not all quads: subdivided once (Catmull-Clark) to {init.n_faces} quads",
+                  file=sys.stderr)
+    compile_notice("fit")
     mu = args.mass if args.scheme == "massless" or args.mass > 0 else 1.0
     material = Material(mu=mu, gamma=args.damping, a11=args.tension, a22=args.tension, b11=args.rigidity,
                         b12=2 * args.rigidity, b22=args.rigidity)
@@ -92,6 +106,8 @@ def run(args) -> int:
     for i, lev in enumerate(res.levels):
         print(f"{i:5d}  {lev.n_vertices:8d}  {lev.n_faces:5d}  {lev.steps:5d}  {'yes' if lev.converged else 'no':>11}"
               f"  {lev.max_error_percent:11.3f}  {lev.mean_error_percent:12.4f}  {lev.seconds:7.1f}")
+    for i, lev in enumerate(res.levels):
+        print(f"level {i}: {lev.reason}; energy {lev.energy:.6g}")
     print(f"fit error (max distance to the limit surface, % of the enclosing-sphere diameter): "
           f"{res.max_error_percent:.3f} %   mean: {res.mean_error_percent:.4f} %")
     rep = res.surface_report

@@ -9,6 +9,8 @@
 * :mod:`~ccproof.apps.arap.lscm`: triangulation and LSCM initialization (numpy/scipy);
 * :mod:`~ccproof.apps.arap.metrics`: E_angle, E_area, E_stretch (section 4), flips;
 * :mod:`~ccproof.apps.arap.core`: the methods (a)-(d), multi-resolution schedule, ``compare``;
+* :mod:`~ccproof.apps.arap.export`: the limit surface with exact UVs for other tools (``write_uv_mesh``);
+* :mod:`~ccproof.apps.arap.fvar`: control UVs for OpenSubdiv's face-varying "corners only" rule;
 * :mod:`~ccproof.cli.arap`: ``ccproof arap``.
 
 The names below are loaded lazily (``ccproof --help`` does not import numpy).

@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import os
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 
@@ -43,7 +44,11 @@ from ccproof.apps.arap.metrics import triangle_metrics
 from ccproof.apps.arap.samples import limit_operator
 from ccproof.errors import CCProofError
 
-__all__ = ["SampledSurface", "sample_chart", "pack_charts", "sampled_surface", "write_surface", "read_surface"]
+if TYPE_CHECKING:
+    from ccproof.apps.arap.core import MethodResult
+
+__all__ = ["SampledSurface", "sample_chart", "pack_charts", "sampled_surface", "write_surface", "read_surface",
+           "write_uv_mesh"]
 
 
 @dataclass
@@ -181,9 +186,9 @@ def pack_charts(uvs, gap=0.02, rotate=True):
         Rs.append(R)
         lo.append(a)
         size.append(b - a)
-    size = np.array(size)
-    pad = gap * np.sqrt(max(float(np.prod(size, axis=1).sum()), 1e-300))
-    box = size + 2 * pad
+    sizes = np.array(size)
+    pad = gap * np.sqrt(max(float(np.prod(sizes, axis=1).sum()), 1e-300))
+    box = sizes + 2 * pad
     order = np.argsort(-box[:, 1], kind="stable")
 
     def shelves(width):
@@ -200,12 +205,13 @@ def pack_charts(uvs, gap=0.02, rotate=True):
             row_h = max(row_h, box[i, 1])
         return pos, max(used_w, 1e-300), y + row_h
 
-    best = None
+    best: tuple[float, np.ndarray] | None = None
     for width in np.linspace(box[:, 0].max(), box[:, 0].sum(), 32):
         pos, W, H = shelves(width)
         side = max(W, H)
         if best is None or side < best[0]:
             best = (side, pos)
+    assert best is not None  # 32 widths were tried
     side, pos = best
     scale = 1.0 / side
     transforms = [(R, p + pad - a) for R, p, a in zip(Rs, pos, lo)]
@@ -270,7 +276,7 @@ def _write_rows(fh, tag, A, fmt):
         fh.write("".join(line % tuple(r) for r in A[i : i + _CHUNK].tolist()))
 
 
-def write_surface(path, surf: SampledSurface, comment=None):
+def write_surface(path: str | os.PathLike[str], surf: SampledSurface, comment: str | None = None) -> str:
     """Write a :class:`SampledSurface`.
 
     ``.obj`` (``v``, ``vt``, ``f i/i ...``; full precision) by this function, any other extension
@@ -308,8 +314,8 @@ def write_surface(path, surf: SampledSurface, comment=None):
     if path.lower().endswith(".obj"):
         ch = surf.cell_chart
         with open(path, "w", encoding="utf-8") as fh:
-            for c in (comment or "").splitlines():
-                fh.write(f"# {c}\n")
+            for line in (comment or "").splitlines():
+                fh.write(f"# {line}\n")
             fh.write(f"# limit surface sampled at level {surf.level}: {surf.points.shape[0]} vertices "
                      f"(duplicated per chart at seams), {surf.cells.shape[0]} {surf.cell_type}s, "
                      f"{int(surf.chart.max(initial=-1)) + 1} charts; uv packing scale {surf.scale:.17g}\n")
@@ -383,3 +389,48 @@ def read_surface(path):
     cells = np.concatenate([c.data for c in m.cells])
     return np.asarray(m.points, dtype=np.float64), np.asarray(uv, dtype=np.float64)[:, :2], cells
 
+
+
+def write_uv_mesh(path: str | os.PathLike[str], result: MethodResult, level: int = 3,
+                  cells: Literal["triangle", "quad"] = "triangle", comment: str | None = None) -> SampledSurface:
+    """Write an ARAP parameterization for other tools: the limit surface with its exact UVs.
+
+    The file ``ccproof arap --out`` writes (docs/hsh10.md section 8): the limit positions of the level-``level``
+    vertices of every chart, the parameterization's exact limit UVs there (hsh10's texture rules, not a
+    re-subdivision), charts packed into [0, 1]^2 (:func:`pack_charts`), seams as duplicated vertices. ``.obj``
+    is written directly (``v``, ``vt``, ``f i/i``, 17 significant digits), any other extension through meshio
+    (point data ``uv``; PLY: ``s``, ``t``).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+    result : MethodResult
+        Of :func:`~ccproof.apps.arap.core.parameterize` (or one method of ``compare``).
+    level : int
+        Subdivision level of the samples (4^level triangles pairs per control face).
+    cells : {"triangle", "quad"}
+    comment : str, optional
+        Header comment (OBJ).
+
+    Returns
+    -------
+    SampledSurface
+        What was written: ``points`` (n, 3), ``uv`` (n, 2) packed, ``uv_raw`` (n, 2), ``cells`` (m, 3 or 4),
+        ``scale`` (the packing scale), ``metrics()`` of the written triangles, ``folds()``.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> import numpy as np
+    >>> import ccproof
+    >>> from ccproof.mesh.examples import grid
+    >>> res = ccproof.parameterize(grid(3, 3), levels=1, eval_level=2)
+    >>> tmp = tempfile.TemporaryDirectory()          # removed when the example ends
+    >>> S = ccproof.write_uv_mesh(os.path.join(tmp.name, "uv.obj"), res, level=2)
+    >>> points, uv, tris = read_surface(os.path.join(tmp.name, "uv.obj"))
+    >>> tris.shape, S.folds(), bool(np.array_equal(uv, S.uv))
+    ((288, 3), 0, True)
+    """
+    surf = sampled_surface(result, int(level), cells)
+    write_surface(path, surf, comment)
+    return surf

@@ -175,7 +175,8 @@ class Level:
     chart_boundary_nbrs : int (n, 2)
         The two chart-boundary neighbours of a chart boundary vertex (-1 elsewhere).
     corner : bool (n,)
-        Chart corners of the boundary rules (one chart face; not a one-face surface corner).
+        Chart corners of the boundary rules (one chart face; not a one-face surface corner unless
+        ``surface_corners``).
     surface_boundary_nbrs : int (n, 2)
         The two surface-boundary neighbours (crease rule of the surface), -1 elsewhere.
 
@@ -190,7 +191,7 @@ class Level:
     ((16, 4), 25, 3)
     """
 
-    def __init__(self, mesh: QuadMesh, n_chart_faces: int):
+    def __init__(self, mesh: QuadMesh, n_chart_faces: int, surface_corners: bool = False):
         self.mesh = mesh
         mc = int(n_chart_faces)
         self.n_chart_faces = mc
@@ -216,9 +217,9 @@ class Level:
         nb = np.full((n, 2), -1, dtype=np.int64)
         nb[src, np.arange(src.size) - start[src]] = tgt
         self.chart_boundary_nbrs = nb
-        self.corner = (
-            self.chart_boundary & (cfc == 1) & ~(mesh.is_boundary_vertex & (mesh.face_count == 1))
-        )
+        self.corner = self.chart_boundary & (cfc == 1)
+        if not surface_corners:
+            self.corner &= ~(mesh.is_boundary_vertex & (mesh.face_count == 1))
         self.surface_boundary_nbrs = _boundary_neighbours(mesh)
 
     @property
@@ -239,6 +240,11 @@ class ChartHierarchy:
         The whole control mesh (the surface).
     chart_faces : array_like of int
         Face indices of the chart in ``mesh`` (a topological disk; not re-checked here).
+    surface_corners : bool, optional
+        The boundary rules also keep the one-face corners of the surface itself (``V' = V``), as
+        OpenSubdiv's face-varying "corners only" rule does (``FVAR_LINEAR_CORNERS_ONLY`` with the default
+        ``VTX_BOUNDARY_EDGE_ONLY``: every face-varying value whose span is one face is sharp); default
+        False: they keep the surface's crease rule (hsh10 (b), docs/hsh10.md).
 
     Notes
     -----
@@ -253,8 +259,9 @@ class ChartHierarchy:
     (9, (64, 4))
     """
 
-    def __init__(self, mesh: QuadMesh, chart_faces):
+    def __init__(self, mesh: QuadMesh, chart_faces, surface_corners: bool = False):
         chart = np.asarray(chart_faces, dtype=np.int64)
+        self.surface_corners = bool(surface_corners)
         self.surface = mesh
         self.chart_faces = chart
         Fg = mesh.faces
@@ -287,7 +294,7 @@ class ChartHierarchy:
         self.A0["boundary"] = sp.csr_matrix(
             (np.ones(int(cm.sum())), (np.flatnonzero(cm), orig[cm])), shape=(n0, cv.size)
         )
-        self.levels = [Level(E0, chart.size)]
+        self.levels = [Level(E0, chart.size, self.surface_corners)]
         self.S = {"extended": [], "boundary": []}
         self._A = {"extended": [self.A0["extended"]], "boundary": [self.A0["boundary"]]}
 
@@ -338,7 +345,7 @@ class ChartHierarchy:
         SB = self._boundary_rows(L, SE, rows, chart_rows)
         self.S["extended"].append(SE)
         self.S["boundary"].append(SB)
-        self.levels.append(Level(new, cc.shape[0]))
+        self.levels.append(Level(new, cc.shape[0], self.surface_corners))
 
     @staticmethod
     def _boundary_rows(L: Level, SE, rows, chart_rows):

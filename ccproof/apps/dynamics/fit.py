@@ -11,7 +11,12 @@ Pipeline (:func:`fit_points`):
    its nearest limit-surface point (the global closest point, :mod:`ccproof.evaluate.closest`;
    re-projected every step), until equilibrium: the total energy (elastic + springs) changes by less
    than ``tol`` (relative) between steps t - dt and t + dt (the paper's criterion, section 3.4; two
-   steps because (32) advances two interleaved sequences), or ``max_steps``;
+   steps because (32) advances two interleaved sequences) *and* so does the mean data -> surface
+   distance (relative to itself, or to the data spacing of :func:`data_spacing` once it is smaller; the
+   ICP-like tail, tangential sliding, lowers the energy slowly while the error still
+   creeps: both must have settled), or ``max_steps`` (default 1000, a safety cap: the bunny scan needs
+   about 200 + 100 steps); a level that stops otherwise says why (:attr:`FitLevel.reason`, and a
+   warning naming the criterion that failed, the values reached and whether the energy rose);
 4. subdivide globally and rebuild the model (densities rescaled, :meth:`Material.refined`), refit;
    repeat ``levels`` times;
 5. report the paper's fit error: the largest distance of a data point to the limit surface, in % of the
@@ -158,10 +163,11 @@ def minimal_enclosing_sphere(X, seed=0):
 
 
 def read_points(path):
-    """Read a point cloud: ``.xyz``, ``.ply`` or ``.obj``.
+    """Read a point cloud: ``.xyz``, ``.ply``, ``.obj`` or the vertices of any mesh file.
 
     ``.xyz``: whitespace columns x y z ...; ``.ply``: ASCII or binary vertex element; ``.obj``: the
-    ``v`` lines. The input of ``ccproof fit`` (docs/qmv98.md).
+    ``v`` lines; any other extension: the vertices of :func:`ccproof.mesh.io.read_mesh` (OFF, STL, VTK,
+    ...). The input of ``ccproof fit`` (docs/qmv98.md).
 
     Parameters
     ----------
@@ -210,8 +216,12 @@ def read_points(path):
         X = np.array(rows, dtype=np.float64).reshape(-1, 3)
     elif ext == ".ply":
         X = _read_ply(path)
-    else:
-        raise CCProofError(f"{path}: unknown point-cloud format {ext!r} (use .xyz, .ply or .obj)")
+    else:  # any other mesh format: its vertices (the mesh reader of ccproof eval)
+        from ccproof.mesh.io import read_mesh
+
+        if path.stat().st_size == 0:
+            raise CCProofError(f"{path}: empty file (no points)")
+        X = np.asarray(read_mesh(path).vertices, dtype=np.float64)
     return check_points(X, f"point cloud {path.name}")
 
 
@@ -482,6 +492,13 @@ class FitLevel:
     max_error_percent, mean_error_percent : float
     seconds : float
     cg_iterations : int
+    energy : float
+        Total energy (elastic + springs, normalized units) after the last step.
+    energy_change, error_change : float
+        Relative changes of the total energy and of the mean data -> surface distance between the last
+        step and the one two steps before (the equilibrium criterion of :func:`fit_points`).
+    reason : str
+        Why the level stopped, in words.
 
     Examples
     --------
@@ -498,6 +515,10 @@ class FitLevel:
     mean_error_percent: float
     seconds: float
     cg_iterations: int
+    energy: float = math.nan
+    energy_change: float = math.nan
+    error_change: float = math.nan
+    reason: str = ""
 
 
 @dataclass
@@ -594,7 +615,7 @@ def _initial_mesh(init, Xn, init_scale):
 
 def fit_points(X: ArrayLike, init: Literal["cube"] | QuadMesh = "cube", levels: int = 1,
                material: Material | None = None, spring_total: float = 1.0, dt: float | None = None,
-               scheme: Literal["massless", "inertial"] = "massless", max_steps: int = 60, tol: float = 1e-3,
+               scheme: Literal["massless", "inertial"] = "massless", max_steps: int = 1000, tol: float = 1e-3,
                init_scale: float = 0.5, truncation: int = 6, progress: bool = False,
                callback: Callable[[int, int, DynamicSurface, NDArray[np.float64]], object] | None = None,
                sample_level: int | None = None, stray_distance_percent: float | None = None,
@@ -619,9 +640,11 @@ def fit_points(X: ArrayLike, init: Literal["cube"] | QuadMesh = "cube", levels: 
         (inertial).
     scheme : "massless" (eq. 32) or "inertial" (eq. 31)
     max_steps : int
-        Time steps per level at most.
+        Time steps per level at most (a safety cap, not the usual stop).
     tol : float
-        Equilibrium: relative change of the total energy between steps t - dt and t + dt.
+        Equilibrium: relative changes of the total energy and of the mean data -> surface distance (the
+        latter relative to max(mean distance, data spacing)) between steps t - dt and t + dt both at
+        most ``tol``.
     init_scale : float in (0, 1]
         Size of the initial control cube relative to the data's bounding box.
     truncation : int
@@ -690,6 +713,7 @@ def fit_points(X: ArrayLike, init: Literal["cube"] | QuadMesh = "cube", levels: 
                        parameters={"material": material, "spring_total": spring_total, "dt": dt, "scheme": scheme,
                                    "max_steps": max_steps, "tol": tol, "init_scale": init_scale,
                                    "truncation": truncation, "levels": levels})
+    spacing_n = max(data_spacing(Xn), 1e-300)
     bar = None
     if progress:
         from tqdm import tqdm
@@ -703,28 +727,45 @@ def fit_points(X: ArrayLike, init: Literal["cube"] | QuadMesh = "cube", levels: 
             converged = False
             cg = 0
             step = 0
-            energies = []
+            energies, errors = [], []
+            change = err_change = math.inf
             for step in range(1, max_steps + 1):
-                f, u, v, _, _ = finder.query(integ.P, Xn)
+                f, u, v, _, dist = finder.query(integ.P, Xn)
+                errors.append(float(np.mean(dist)))  # of the state before this step
                 springs = Springs(model, f, u, v, Xn, k)
                 info = integ.step(springs=springs)
                 cg += info.iterations
                 energies.append(model.energy(integ.P) + springs.energy(integ.P))
                 change = abs(energies[-1] - energies[-3]) / abs(energies[-1]) if len(energies) >= 3 else math.inf
+                # relative to the mean error, or to the data spacing once the error is below it (changes
+                # finer than the data's resolution are not progress)
+                err_change = (abs(errors[-1] - errors[-3]) / max(abs(errors[-1]), spacing_n)
+                              if len(errors) >= 3 else math.inf)
                 if bar is not None:
                     bar.update(1)
-                    bar.set_postfix(level=level, dE=f"{change:.1e}")
+                    bar.set_postfix(level=level, dE=f"{change:.1e}", dErr=f"{err_change:.1e}")
                 if callback is not None:
                     callback(level, step, model, integ.P)
-                if change <= tol:
+                if change <= tol and err_change <= tol:
                     converged = True
                     break
+            rises = sum(b > a for a, b in zip(energies[-11:-1], energies[-10:]))
+            if converged:
+                reason = (f"equilibrium after {step} steps: relative energy change {change:.2g} and mean-error "
+                          f"change {err_change:.2g} over two steps, both <= tol {tol:g}")
+            else:
+                failed = [w for w, c in (("energy", change), ("mean data error", err_change)) if not c <= tol]
+                reason = (f"stopped at the step cap ({max_steps} steps, --max-steps) before equilibrium: relative "
+                          f"{' and '.join(failed)} change over two steps {change:.2g} / {err_change:.2g} > tol {tol:g}"
+                          + (f"; the energy rose at {rises} of the last 10 steps (lower --dt)" if rises else
+                             "; the energy was still falling (raise --max-steps)"))
             if bar is not None and step < max_steps:
                 bar.update(max_steps - step)
             P = integ.P
             err = fit_error(model, P, Xn, finder=finder, diameter=1.0)
             result.levels.append(FitLevel(model.n_vertices, model.mesh.n_faces, step, converged,
-                                          err["max_percent"], err["mean_percent"], time.perf_counter() - t0, cg))
+                                          err["max_percent"], err["mean_percent"], time.perf_counter() - t0, cg,
+                                          energies[-1] if energies else math.nan, change, err_change, reason))
             if level < levels:
                 model, A = model.refine(P)
                 P = np.asarray(A @ P)
@@ -737,9 +778,7 @@ def fit_points(X: ArrayLike, init: Literal["cube"] | QuadMesh = "cube", levels: 
     result.data_distances = err["distances"] * diameter
     for i, lev in enumerate(result.levels):
         if not lev.converged:
-            result.warnings.append(
-                f"level {i} stopped at the step cap ({max_steps} steps, --max-steps) before equilibrium "
-                f"(relative energy change > {tol:g}); raise --max-steps or --dt")
+            result.warnings.append(f"level {i} {lev.reason}")
     if sample_level is None:
         nf = mesh.n_faces
         sample_level = next((k for k in (1, 2, 3) if nf * 4**k >= 4 * pts.shape[0]), 3)

@@ -171,7 +171,7 @@ def test_cli_writes_surface_and_control_mesh(tmp_path, capsys):
     info = json.loads((tmp_path / "uv.vtu.json").read_text())
     assert info["folds"] == 0 and info["level"] == 2
     head = ctl.read_text()
-    assert "extended charts" in head and "does NOT reproduce" in head
+    assert "FVAR_LINEAR_CORNERS_ONLY" in head and "does NOT reproduce" not in head
 
 
 # ---------------------------------------------------------------------------- scale and refinement

@@ -127,8 +127,8 @@ def test_bad_point_clouds(tmp_path):
     (tmp_path / "n.xyz").write_text("1 2 nan\n")
     with pytest.raises(CCProofError, match="non-finite"):
         read_points(tmp_path / "n.xyz")
-    (tmp_path / "x.stl").write_text("")
-    with pytest.raises(CCProofError, match="format"):
+    (tmp_path / "x.stl").write_text("")  # other extensions: the vertices of the mesh reader
+    with pytest.raises(CCProofError, match="empty"):
         read_points(tmp_path / "x.stl")
     with pytest.raises(CCProofError, match="no such file"):
         read_points(tmp_path / "missing.xyz")
@@ -277,3 +277,82 @@ def test_cli_fit_writes_surface_errors_and_warnings(tmp_path, capsys):
 
     m = meshio.read(tmp_path / "lim.vtu")
     assert m.point_data["distance_to_data"].shape == (m.points.shape[0],)
+
+
+# ---------------------------------------------------------------------------- equilibrium
+
+
+def test_fit_stops_at_equilibrium_of_energy_and_error_and_says_why():
+    res = fit_points(synthetic_range_data("ellipsoid", 300), levels=0)
+    lev = res.levels[0]
+    tol = res.parameters["tol"]
+    assert lev.converged and lev.steps < res.parameters["max_steps"]
+    assert lev.energy_change <= tol and lev.error_change <= tol
+    assert lev.reason.startswith(f"equilibrium after {lev.steps} steps")
+    assert not [w for w in res.warnings if "step cap" in w]
+    capped = fit_points(synthetic_range_data("ellipsoid", 300), levels=0, max_steps=4)
+    lev = capped.levels[0]
+    assert not lev.converged and lev.steps == 4
+    assert max(lev.energy_change, lev.error_change) > tol
+    w = [w for w in capped.warnings if "step cap (4 steps" in w]
+    assert w and ("still falling" in w[0] or "rose" in w[0])
+
+
+@pytest.mark.slow
+def test_fit_scanned_bunny_reaches_equilibrium_and_an_independent_two_sided_distance_confirms():
+    from pathlib import Path
+
+    from scipy.spatial import cKDTree
+
+    from ccproof.mesh import subdivide
+    from ccproof.mesh.masks import limit_positions
+
+    path = Path(__file__).resolve().parents[2] / "data" / "meshes" / "bunny_quads.obj"
+    X = read_points(path)
+    res = fit_points(X, levels=1)
+    tol = res.parameters["tol"]
+    for lev in res.levels:  # the stated criterion holds at every level, by default, before the cap
+        assert lev.converged, lev.reason
+        assert lev.energy_change <= tol and lev.error_change <= tol
+        assert lev.steps < res.parameters["max_steps"]
+    assert not [w for w in res.warnings if "step cap" in w]
+    # independent two-sided distance: dense exact limit points of the fitted control mesh (the mesh layer's
+    # subdivision and limit masks, not the closest-point search of the fit), k-d trees both ways
+    m = res.mesh
+    for _ in range(4):
+        m = subdivide(m)
+    S = limit_positions(m)
+    h = float(np.max(np.linalg.norm(S[m.faces[:, 0]] - S[m.faces[:, 2]], axis=1)))  # sample spacing bound
+    d_data = cKDTree(S).query(X)[0]  # >= the true data -> surface distance, by at most h
+    d_surf = cKDTree(X).query(S)[0]  # surface samples -> data
+    D = res.diameter
+    assert 100 * d_data.max() / D >= res.max_error_percent - 1e-9
+    assert 100 * (d_data.max() - h) / D <= res.max_error_percent
+    assert abs(100 * d_surf.max() / D - res.surface_max_percent) <= 100 * h / D
+    two = max(d_data.max(), d_surf.max())
+    assert abs(100 * two / D - res.two_sided_error_percent) <= 100 * h / D
+    assert res.levels[1].max_error_percent < res.levels[0].max_error_percent
+
+
+def test_cli_fit_reads_a_triangle_start_mesh_and_points_from_any_mesh_file(tmp_path, capsys):
+    import meshio
+
+    from ccproof.cli import main
+    from ccproof.mesh import read_obj
+    from ccproof.mesh.examples import cube
+
+    X = synthetic_range_data("bulb", 300, seed=3)
+    pts = tmp_path / "bulb.off"  # points as the vertices of a mesh file read by the mesh reader (meshio)
+    meshio.write(pts, meshio.Mesh(X, [("triangle", np.arange(len(X)).reshape(-1, 3))]))
+    c = cube()
+    V = X.mean(0) + 0.3 * np.asarray(c.vertices)
+    T = np.r_[c.faces[:, [0, 1, 2]], c.faces[:, [0, 2, 3]]]  # the cube as 12 triangles
+    init = tmp_path / "start.ply"
+    meshio.write(init, meshio.Mesh(V, [("triangle", T.astype(np.int32))]))
+    out = tmp_path / "fit.obj"
+    rc = main(["fit", str(pts), "--init", str(init), "--levels", "0",
+               "--max-steps", "3", "--out", str(out), "--no-progress"])
+    cap = capsys.readouterr()
+    assert rc == 0, cap.err
+    assert "not all quads: subdivided once (Catmull-Clark) to 36 quads" in cap.err
+    assert read_obj(out).n_faces >= 36

@@ -1,0 +1,322 @@
+"""Control UVs that a standard face-varying subdivision reproduces (OpenSubdiv "corners only").
+
+A tool that subdivides a textured control mesh (OpenSubdiv, Blender, Maya, RenderMan, ...) subdivides the
+UVs with a *face-varying* rule: every chart is a separate mesh of UV values, its boundary a crease.
+OpenSubdiv's ``Sdc::Options::FVAR_LINEAR_CORNERS_ONLY`` (its ``Vtr::FVarLevel``, with the default
+``VTX_BOUNDARY_EDGE_ONLY``) is: interior values follow the vertex's Catmull-Clark rules; a value on a
+chart boundary whose span around its vertex has two or more faces is a smooth crease (edge points of
+chart boundary edges are midpoints, the value becomes ``(e0 + 6 V + e1) / 8`` with ``e0, e1`` its two
+chart-boundary neighbours; limit ``(e0 + 4 V + e1) / 6``); a value whose span is one face is a sharp
+corner (``V' = V``), also at a one-face corner of an open surface. These are the boundary rules of
+:class:`~ccproof.apps.arap.hierarchy.ChartHierarchy` with ``surface_corners=True``.
+
+hsh10's extended charts (c) subdivide the texture with the *surface's* rules across the chart boundary
+(chart plus ring, docs/hsh10.md A8): no standard rule reproduces them, and the control UVs of (c) fold
+when a tool subdivides them with its own rule. :func:`export_control` therefore writes control UVs *for*
+the corners-only rule. Per chart: the least-squares fit of the corners-only texture's limit UVs to the
+exact texture's limit UVs at the level-``fit_level`` vertices of the chart (:func:`corners_only_texture`,
+uniform weights, sparse normal equations), polished by hsh10's own optimization under the corners-only
+rules (where that folds, the nearest blend towards the fit that does not). It counts the folds of the
+subdivided UVs at levels 1..3 (what a tool renders, :func:`subdivided_folds`) and measures the texture
+with the same samples as the exact one (:func:`~ccproof.apps.arap.core.texture_metrics`). When the UVs
+on the texture's control mesh fold, or a distortion excess exceeds ``max_excess_ratio`` times the exact
+texture's, the control mesh is subdivided once more (the same limit surface, 4x the faces and UVs) and
+fitted again, up to ``max_extra`` times.
+
+The inner 3 x 3 faces of a flat 5 x 5 grid as one chart: the exact texture is an isometry, and so is the
+corners-only one (on a uniform flat grid every rule reproduces affine functions at the same points):
+
+>>> import numpy as np
+>>> from ccproof.mesh.examples import grid
+>>> from ccproof.apps.arap.core import compare
+>>> labels = -np.ones(25, dtype=int)
+>>> labels[[6, 7, 8, 11, 12, 13, 16, 17, 18]] = 0
+>>> res, _ = compare(grid(5, 5), labels, methods=("c",), levels=1, eval_level=3)
+>>> exp = export_control(res["c"], eval_level=3)
+>>> exp.extra, exp.folds, [round(x, 9) for x in exp.metrics.as_tuple()]
+(0, [0, 0, 0], [2.0, 2.0, 1.0])
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse.linalg as spla
+
+from ccproof.apps.arap.hierarchy import ChartHierarchy
+from ccproof.apps.arap.lscm import signed_areas
+from ccproof.apps.arap.metrics import Metrics
+from ccproof.apps.arap.samples import limit_operator
+from ccproof.errors import CCProofError
+
+__all__ = ["corners_only_texture", "subdivided_folds", "ControlExport", "export_control", "FOLD_LEVELS",
+           "EXCESS_FLOOR"]
+
+#: distortion excesses below this are not told apart (an isometric exact texture)
+EXCESS_FLOOR = 1e-9
+#: the subdivision levels at which the folds of the subdivided control UVs are counted
+FOLD_LEVELS = (1, 2, 3)
+
+
+def _refined_chart(h: ChartHierarchy, times, mesh=None):
+    """The chart of ``h`` on its control mesh subdivided ``times`` times (children 4^t f .. 4^t f + 4^t - 1)."""
+    from ccproof.apps.arap.core import refine_mesh
+
+    if mesh is None:
+        mesh, _ = refine_mesh(h.surface, None, times)
+    q = 4 ** int(times)
+    faces = (q * h.chart_faces[:, None] + np.arange(q)).ravel()
+    return ChartHierarchy(mesh, faces, surface_corners=True), mesh
+
+
+def corners_only_texture(tex, times=0, fit_level=2, mesh=None):
+    """Corners-only control UVs fitted to a chart texture (module docstring).
+
+    Parameters
+    ----------
+    tex : :class:`~ccproof.apps.arap.core.ChartTexture`
+        A level-0 texture (``rules`` "extended" or "boundary").
+    times : int >= 0
+        Subdivide the chart's control mesh this many times first.
+    fit_level : int >= 1
+        Level (of the subdivided control mesh) of the limit samples of the least-squares fit.
+    mesh : QuadMesh, optional
+        The control mesh subdivided ``times`` times, if already computed.
+
+    Returns
+    -------
+    hierarchy : ChartHierarchy
+        The chart on the subdivided control mesh (boundary rules with ``surface_corners=True``).
+    Y : ndarray, shape (hierarchy.n_chart_vertices, 2) float64
+        The control UVs of its chart vertices.
+
+    Examples
+    --------
+    A texture that is affine on the chart is reproduced exactly (every rule preserves affine functions):
+
+    >>> import numpy as np
+    >>> from ccproof.mesh.examples import grid
+    >>> from ccproof.apps.arap.core import ChartTexture
+    >>> h = ChartHierarchy(grid(4, 4), [5, 6, 9, 10])
+    >>> X = h.surface.vertices[h.unknown_vertices][:, :2] @ np.array([[2.0, 1], [0, 1]])
+    >>> hc, Y = corners_only_texture(ChartTexture(h, "extended", 0, h.lift_unknowns(X, "extended"), X))
+    >>> bool(np.abs(Y - X[: h.n_chart_vertices]).max() < 1e-12)
+    True
+    """
+    if tex.level != 0:
+        raise CCProofError(f"only level-0 textures have control UVs (this one lives at level {tex.level})")
+    h = tex.hierarchy
+    times, fit_level = int(times), int(fit_level)
+    if times < 0 or fit_level < 1:
+        raise CCProofError(f"times must be >= 0 and fit_level >= 1, got {times}, {fit_level}")
+    from ccproof.apps.arap.core import lift_to_refined
+
+    hc, _ = _refined_chart(h, times, mesh)
+    X = lift_to_refined(h, tex.unknowns, tex.rules, hc, times) if times else tex.unknowns
+    L = hc.level(fit_level)
+    cv = np.flatnonzero(L.chart_vertex)
+    U = (limit_operator(L, tex.rules) @ (hc.operator(fit_level, tex.rules) @ X))[cv]
+    A = (limit_operator(L, "boundary") @ hc.operator(fit_level, "boundary")).tocsr()[cv]
+    N = (A.T @ A).tocsc()
+    Y = spla.splu(N).solve(np.asarray(A.T @ U))
+    return hc, Y
+
+
+def subdivided_folds(hierarchy: ChartHierarchy, Y, levels=FOLD_LEVELS):
+    """Folded UV quads of the chart's corners-only subdivision at each of ``levels``.
+
+    A quad folds when one of its four corner triangles has a signed UV area <= 0 (whatever diagonal a
+    tool triangulates along, the quad then has a non-positive triangle or is not convex).
+
+    Parameters
+    ----------
+    hierarchy : ChartHierarchy
+    Y : ndarray, shape (hierarchy.n_chart_vertices, 2) float64
+        Control UVs of the chart vertices.
+    levels : sequence of int
+
+    Returns
+    -------
+    list of int
+
+    Examples
+    --------
+    >>> from ccproof.mesh.examples import grid
+    >>> h = ChartHierarchy(grid(3, 3), range(9))
+    >>> Y = h.surface.vertices[h.unknown_vertices][:, :2]
+    >>> subdivided_folds(h, Y), subdivided_folds(h, Y[:, ::-1])          # mirrored: every quad folds
+    ([0, 0, 0], [36, 144, 576])
+    """
+    out = []
+    X0 = hierarchy.lift_unknowns(Y, "boundary")
+    for lv in levels:
+        X = hierarchy.subdivide_values(X0, "boundary", 0, lv)
+        Q = hierarchy.level(lv).chart_faces()
+        bad = np.zeros(Q.shape[0], dtype=bool)
+        for i in range(4):
+            T = Q[:, [i, (i + 1) % 4, (i + 3) % 4]]
+            bad |= signed_areas(X, T) <= 0
+        out.append(int(bad.sum()))
+    return out
+
+
+@dataclass
+class ControlExport:
+    """Control UVs for the corners-only rule (:func:`export_control`).
+
+    Attributes
+    ----------
+    mesh : QuadMesh
+        The control mesh the UVs belong to (the texture's control mesh subdivided ``extra`` times).
+    textures : list of ChartTexture
+        Per chart: rules "boundary" (corners only), level 0, ``unknowns`` = the control UVs (n_c, 2).
+    extra : int
+        Subdivisions of the texture's control mesh.
+    folds : list of int
+        Folded UV quads at the levels :data:`FOLD_LEVELS` of the written control mesh, all charts.
+    metrics : Metrics
+        The corners-only texture measured like the exact one (same level, same samples).
+    level : int
+        The metric level, on the input mesh.
+    exact : Metrics
+        The exact texture at the same samples.
+    tried : list of (extra, folds, metrics)
+        Every refinement tried.
+    """
+
+    mesh: object
+    textures: list
+    extra: int
+    folds: list
+    metrics: Metrics
+    exact: Metrics
+    level: int = 0
+    tried: list = field(default_factory=list)
+    #: whether ``extra`` met the criterion (no fold, excess within the ratio) or is the best of those tried
+    accepted: bool = False
+
+    def excess_ratio(self):
+        """(E_angle, E_area, E_stretch) excess of the corners-only texture over the exact texture's."""
+        m, e = self.metrics.as_tuple(), self.exact.as_tuple()
+        mins = (2.0, 2.0, 1.0)
+        return tuple((a - z) / (b - z) if b - z > 0 else (1.0 if a - z <= 0 else float("inf"))
+                     for a, b, z in zip(m, e, mins))
+
+
+def export_control(result, eval_level=5, max_extra=2, max_excess_ratio=1.05, fit_level=2, levels=3, polish=True,
+                   accel=5, max_faces=None, progress=False):
+    """Corners-only control UVs for every chart of ``result`` (module docstring).
+
+    Per chart: the least-squares fit of :func:`corners_only_texture`, then (``polish``) hsh10's
+    local/global optimization with the corners-only rules (method (b) on the subdivided control mesh,
+    :func:`~ccproof.apps.arap.core.optimize_chart`) started from it; the polished UVs are kept when their
+    subdivision has no fold at :data:`FOLD_LEVELS`, else the first blend ``Y2 + t (Y_fit - Y2)``, t = 0.25,
+    0.5, 0.75, that has none, else the fit's (or whichever folds least).
+
+    Parameters
+    ----------
+    result : :class:`~ccproof.apps.arap.core.MethodResult`
+        Method (b) or (c) (level-0 textures).
+    eval_level : int
+        Metric level on the input mesh (the texture's control mesh is the input refined
+        ``result.refine`` times); raised to level 1 of the subdivided control mesh where it is below.
+    max_extra : int
+        Subdivide the texture's control mesh at most this many more times.
+    max_excess_ratio : float
+        Accept the first refinement with no fold at :data:`FOLD_LEVELS` and every distortion excess
+        (E_angle - 2, E_area - 2, E_stretch - 1) at most this times the exact texture's (or at most
+        :data:`EXCESS_FLOOR` where the exact texture's excess is below it).
+    fit_level : int
+        Level of the fit's samples (:func:`corners_only_texture`).
+    levels : int
+        Finest optimization level of the polish, counted on the input mesh (at least level 1 of the
+        subdivided control mesh).
+    polish : bool
+    accel : int
+        Anderson acceleration of the polish.
+    max_faces : int, optional
+        Do not subdivide the control mesh beyond this many faces.
+    progress : bool
+        A tqdm progress bar over the charts of each refinement tried.
+
+    Returns
+    -------
+    ControlExport
+        The accepted refinement, or the best one tried (fewest folds, then smallest E_area excess).
+    """
+    from ccproof.apps.arap.core import ChartTexture, optimize_chart, refine_mesh, texture_metrics
+
+    texs = result.textures
+    if not texs or any(t.level != 0 for t in texs):
+        raise CCProofError("control UVs need level-0 textures (methods b and c)")
+    base = texs[0].hierarchy.surface
+    ref = int(getattr(result, "refine", 0))
+    tried = []
+    best = None
+    exacts: dict[int, Metrics] = {}
+    mesh = base
+    ok = False
+    for extra in range(int(max_extra) + 1):
+        if extra:
+            if max_faces is not None and 4 * mesh.n_faces > max_faces:
+                break
+            mesh, _ = refine_mesh(mesh, None, 1)
+        # metric level on the input mesh: eval_level, at least level 1 of the subdivided control mesh
+        e_in = max(int(eval_level), ref + extra + 1)
+        ev, ev_x = e_in - ref, e_in - ref - extra
+        if e_in not in exacts:
+            exact = Metrics()
+            for tex in texs:
+                exact = exact + texture_metrics(tex, ev)
+                tex.hierarchy.release()
+            exacts[e_in] = exact
+        exact = exacts[e_in]
+        folds = np.zeros(len(FOLD_LEVELS), dtype=np.int64)
+        met, out = Metrics(), []
+        bar = None
+        if progress:
+            from tqdm import tqdm
+
+            bar = tqdm(total=len(texs), desc=f"control UVs, {extra} extra", unit="chart")
+        for tex in texs:
+            hc, Y = corners_only_texture(tex, extra, fit_level, mesh)
+            fo = subdivided_folds(hc, Y)
+            if polish:
+                top = max(1, int(levels) - ref - extra)
+                Y2, _, _ = optimize_chart(hc, "boundary", Y, levels=top, start_level=1, accel=accel)
+                # the polished UVs, or the nearest blend towards the fit that does not fold
+                for t in (0.0, 0.25, 0.5, 0.75):
+                    Yt = Y2 + t * (Y - Y2)
+                    fot = subdivided_folds(hc, Yt)
+                    if sum(fot) == 0 or sum(fot) < sum(fo):
+                        Y, fo = Yt, fot
+                        if sum(fot) == 0:
+                            break
+            folds += fo
+            ct = ChartTexture(hc, "boundary", 0, hc.lift_unknowns(Y, "boundary"), Y)
+            met = met + texture_metrics(ct, ev_x)
+            hc.release()
+            tex.hierarchy.release()
+            out.append(ct)
+            if bar is not None:
+                bar.update(1)
+        if bar is not None:
+            bar.close()
+        exp = ControlExport(mesh, out, extra, folds.tolist(), met, exact, e_in)
+        tried.append((extra, exp.folds, met))
+        ex_m = np.subtract(met.as_tuple(), (2.0, 2.0, 1.0))
+        ex_e = np.subtract(exact.as_tuple(), (2.0, 2.0, 1.0))
+        ok = sum(exp.folds) == 0 and bool(np.all(ex_m <= np.maximum(max_excess_ratio * ex_e, EXCESS_FLOOR)))
+        key = (sum(exp.folds), met.E_area)
+        if best is None or key < best[0]:
+            best = (key, exp)
+        if ok:
+            best = (key, exp)
+            break
+    if best is None:
+        raise CCProofError(f"max_extra must be >= 0, got {max_extra}")
+    exp = best[1]
+    exp.tried = tried
+    exp.accepted = bool(ok)
+    return exp

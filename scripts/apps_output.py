@@ -1,0 +1,204 @@
+"""What a user who takes the applications' output elsewhere gets: the numbers of docs/hsh10.md section 8 and
+docs/qmv98.md section 4 ("Equilibrium"), printed, not estimated.
+
+  python scripts/apps_output.py --arap [--osd]  # bunny, 16 charts: control UVs under the corners-only rule
+                                                # (--osd: folds counted by OpenSubdiv itself too)
+  python scripts/apps_output.py --fit      # bunny scan: fit steps, energy, criterion, two-sided error
+
+--arap: for --refine 0 and the default, method (c) on the bunny's 16 normal-segmented charts; then the folds
+(UV quads with a corner triangle of signed area <= 0) of the control UVs subdivided with the face-varying
+"corners only" rule at levels 1-3, and the distortion of that texture at the metric level (the same samples as
+the exact texture): first for the (c) control UVs as they were written before (the chart's own unknowns), then
+for :func:`ccproof.apps.arap.fvar.export_control` (fit + polish under the rule, extra subdivisions), whose
+control mesh is written to --out-dir. With --osd the written files are also subdivided by OpenSubdiv itself
+(Far::PrimvarRefiner, FVAR_LINEAR_CORNERS_ONLY; the driver of tests/apps/arap/osd_fvar_driver.cpp, built
+with g++ -losdCPU) and its folded quads at levels 1-3 are counted the same way.
+--fit: ``fit_points`` with the defaults on the scan's 2,038 vertices, and an independent two-sided distance
+(exact limit points of the fitted control mesh subdivided 4 times, scipy k-d trees both ways).
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+BUNNY = Path(__file__).resolve().parents[1] / "tests" / "data" / "meshes" / "bunny_quads.obj"
+
+
+def _fmt(m):
+    return f"E_angle {m.E_angle:.6f}  E_area {m.E_area:.6f}  E_stretch {m.E_stretch:.6f}"
+
+
+def _build_osd():
+    import shutil
+    import subprocess
+    import tempfile
+
+    src = Path(__file__).resolve().parents[1] / "tests" / "apps" / "arap" / "osd_fvar_driver.cpp"
+    if shutil.which("g++") is None or not Path("/usr/include/opensubdiv/far/primvarRefiner.h").exists():
+        print("OpenSubdiv headers (apt-get install libosd-dev) or g++ missing: --osd skipped")
+        return None
+    exe = Path(tempfile.mkdtemp()) / "osd_fvar"
+    r = subprocess.run(["g++", "-O2", "-std=c++14", str(src), "-o", str(exe), "-losdCPU"], capture_output=True,
+                       text=True)
+    if r.returncode != 0:
+        print(f"building the OpenSubdiv driver failed: {r.stderr[-500:]}")
+        return None
+    return exe
+
+
+def osd_folds(exe, path, levels=(1, 2, 3)):
+    """Folded UV quads (a corner triangle of signed area <= 0) of the textured faces of an OBJ with v/vt,
+    subdivided by OpenSubdiv's face-varying corners-only rule (uniform refinement: the children of face f at
+    level l are 4^l f .. 4^l f + 4^l - 1)."""
+    import subprocess
+
+    nv, F, FT, UV = 0, [], [], []
+    for line in Path(path).read_text().splitlines():
+        s = line.split()
+        if not s:
+            continue
+        if s[0] == "v":
+            nv += 1
+        elif s[0] == "vt":
+            UV.append(s[1] + " " + s[2])
+        elif s[0] == "f":
+            F.append([int(c.split("/")[0]) - 1 for c in s[1:]])
+            FT.append([int(c.split("/")[1]) - 1 if "/" in c else -1 for c in s[1:]])
+    ui, n = [], len(UV)
+    for ft in FT:
+        for k in ft:
+            ui.append(k if k >= 0 else n)
+            n += k < 0
+    vals = UV + ["0 0"] * (n - len(UV))
+    tex = np.array([f for f, ft in enumerate(FT) if ft[0] >= 0])
+    out = []
+    for lv in levels:
+        inp = "\n".join([f"{nv} {len(F)} {n} {lv}", " ".join(str(len(f)) for f in F),
+                         " ".join(str(v) for f in F for v in f), " ".join(map(str, ui)), "\n".join(vals)]) + "\n"
+        res = subprocess.run([str(exe)], input=inp, capture_output=True, text=True, check=True).stdout
+        lines = res.splitlines()
+        m = int(lines[0])
+        U = np.loadtxt(lines[1 : 1 + m]).reshape(-1, 2)
+        Q = np.loadtxt(lines[2 + m :], dtype=np.int64).reshape(-1, 4)
+        q = 4**lv
+        Q = Q[(q * tex[:, None] + np.arange(q)).ravel()]
+        bad = np.zeros(Q.shape[0], dtype=bool)
+        for i in range(4):
+            a, b, c = U[Q[:, i]], U[Q[:, (i + 1) % 4]], U[Q[:, (i + 3) % 4]]
+            bad |= (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0]) <= 0
+        out.append(int(bad.sum()))
+    return out
+
+
+def arap(eval_level, out_dir, use_osd):
+    from ccproof.apps.arap.charts import segment_by_normals
+    from ccproof.apps.arap.core import ChartTexture, auto_refine, compare, texture_metrics
+    from ccproof.apps.arap.fvar import FOLD_LEVELS, export_control, subdivided_folds
+    from ccproof.apps.arap.hierarchy import ChartHierarchy
+    from ccproof.apps.arap.io import write_uv_obj
+    from ccproof.apps.arap.metrics import Metrics
+    from ccproof.mesh import read_obj
+
+    exe = _build_osd() if use_osd else None
+    out_dir.mkdir(parents=True, exist_ok=True)
+
+    mesh = read_obj(BUNNY)
+    labels = segment_by_normals(mesh)
+    print(f"bunny: {mesh.n_faces} faces, {labels.max() + 1} charts; metrics at level {eval_level} "
+          f"(E_angle, E_area minimum 2, E_stretch minimum 1); folds at levels {FOLD_LEVELS}")
+    for refine in (0, auto_refine(mesh, labels)):
+        t0 = time.perf_counter()
+        res, _ = compare(mesh, labels, methods=("c",), levels=3, eval_level=eval_level, refine=refine,
+                         release=True, accel=5)
+        r = res["c"]
+        t1 = time.perf_counter()
+        print(f"\n--refine {refine}: exact texture (c)            {_fmt(r.metrics)}   ({t1 - t0:.1f} s)")
+        folds, met = np.zeros(len(FOLD_LEVELS), dtype=np.int64), Metrics()
+        for tex in r.textures:  # the former --control-out: the chart's (c) unknowns under the corners-only rule
+            h = tex.hierarchy
+            hc = ChartHierarchy(h.surface, h.chart_faces, surface_corners=True)
+            Y = tex.unknowns[: hc.n_chart_vertices]
+            folds += subdivided_folds(hc, Y)
+            met = met + texture_metrics(ChartTexture(hc, "boundary", 0, hc.lift_unknowns(Y, "boundary"), Y),
+                                        eval_level - refine)
+            hc.release()
+            h.release()
+        print(f"  (c) control UVs as written before:      {_fmt(met)}   folds {folds.tolist()}")
+        if exe is not None:
+            old = out_dir / f"bunny_control_refine{refine}_before.obj"
+            write_uv_obj(old, r.textures[0].hierarchy.surface, r)  # the former file: (c)'s own unknowns
+            print(f"    OpenSubdiv's folds of that file: {osd_folds(exe, old)}")
+        t2 = time.perf_counter()
+        exp = export_control(r, eval_level=eval_level, levels=3, max_faces=150_000)  # the CLI's defaults
+        t3 = time.perf_counter()
+        ex = np.subtract(r.metrics.as_tuple(), (2.0, 2.0, 1.0))
+        for extra, f, m in exp.tried:
+            ratio = np.subtract(m.as_tuple(), (2.0, 2.0, 1.0)) / ex
+            print(f"  corners-only UVs, {extra} extra subdivision(s): {_fmt(m)}   folds {f}   excess / exact "
+                  f"{ratio[0]:.3f} {ratio[1]:.3f} {ratio[2]:.3f}")
+        er = exp.excess_ratio()
+        print(f"  written: {exp.extra} extra ({exp.mesh.n_faces} control faces), excess / exact "
+              f"{er[0]:.3f} {er[1]:.3f} {er[2]:.3f}, within 5 %: {exp.accepted} ({t3 - t2:.1f} s)")
+        path = out_dir / f"bunny_control_refine{refine}.obj"
+        write_uv_obj(path, exp.mesh, replace(r, textures=exp.textures))
+        print(f"  wrote {path}")
+        if exe is not None:
+            print(f"    OpenSubdiv's folds of that file: {osd_folds(exe, path)}")
+
+
+def fit():
+    from scipy.spatial import cKDTree
+
+    from ccproof.apps.dynamics.fit import fit_points, read_points
+    from ccproof.mesh import subdivide
+    from ccproof.mesh.masks import limit_positions
+
+    X = read_points(BUNNY)
+    t0 = time.perf_counter()
+    res = fit_points(X, levels=1)
+    t1 = time.perf_counter()
+    print(f"bunny scan: {X.shape[0]} points, defaults (tol {res.parameters['tol']:g}, cap "
+          f"{res.parameters['max_steps']} steps), {t1 - t0:.1f} s")
+    for i, lev in enumerate(res.levels):
+        print(f"  level {i}: {lev.n_vertices} vertices, {lev.steps} steps, energy {lev.energy:.6g}, energy change "
+              f"{lev.energy_change:.2g}, mean-error change {lev.error_change:.2g}, max / mean error "
+              f"{lev.max_error_percent:.3f} / {lev.mean_error_percent:.4f} %: {lev.reason}")
+    print(f"  reported: data -> surface {res.max_error_percent:.3f} %, surface -> data "
+          f"{res.surface_max_percent:.3f} %, two-sided {res.two_sided_error_percent:.3f} % "
+          f"(of the enclosing-sphere diameter)")
+    m = res.mesh
+    for _ in range(4):
+        m = subdivide(m)
+    S = limit_positions(m)
+    h = float(np.max(np.linalg.norm(S[m.faces[:, 0]] - S[m.faces[:, 2]], axis=1)))
+    d1 = cKDTree(S).query(X)[0].max()
+    d2 = cKDTree(X).query(S)[0].max()
+    D = res.diameter
+    print(f"  independent ({S.shape[0]} limit points, spacing <= {100 * h / D:.3f} %): data -> surface "
+          f"{100 * d1 / D:.3f} %, surface -> data {100 * d2 / D:.3f} %, two-sided {100 * max(d1, d2) / D:.3f} %")
+    print(f"  warnings: {res.warnings or 'none'}")
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--arap", action="store_true")
+    ap.add_argument("--fit", action="store_true")
+    ap.add_argument("--eval-level", type=int, default=4, help="metric level of --arap (default 4)")
+    ap.add_argument("--osd", action="store_true", help="--arap: also count folds with OpenSubdiv itself")
+    ap.add_argument("--out-dir", type=Path, default=Path("out/apps_output"), help="control meshes of --arap")
+    a = ap.parse_args(argv)
+    if not (a.arap or a.fit):
+        ap.error("give --arap and/or --fit")
+    if a.fit:
+        fit()
+    if a.arap:
+        arap(a.eval_level, a.out_dir, a.osd)
+
+
+if __name__ == "__main__":
+    main()
