@@ -37,45 +37,55 @@ def _basis(x, B, r):
     B[r + 2, 3] = x
 
 
-def _evaluate_points(f, u, v, d, refused, vkind, vchild, vu0, vv0, vh, vpatch, vcold, hot_layers, vcu, vcv, vnmax,
-                     split_depth, nets, pu0, pv0, ph, P, Pu, Pv, Puu, Puv, Pvv):
-    """Fill P (n, 3) and, for d >= 1, Pu, Pv, for d >= 2, Puu, Puv, Pvv (each (n, 3)).
+def _evaluate_points(f, u, v, d, T, P, Pu, Pv, Puu, Puv, Pvv):
+    """Fill P (n, 3) and, for d >= 1, Pu, Pv, for d >= 2, Puu, Puv, Pvv (each (n, 3)) from the patch
+    table ``T`` (:class:`ccproof.evaluate._table.PatchTable`).
 
-    Returns -1, or the index of the first point whose face is out of range or ``refused`` (a hole)
+    Returns -1, or the index of the first point whose face is out of range or refused (a hole)
     or whose (u, v) is outside [0, 1]^2 or NaN; the caller then names it (the outputs from that
     point on are not written).
     """
     n = f.shape[0]
-    m = refused.shape[0]
+    m = T.refused.shape[0]
     B = np.empty((6, 4))  # basis in s (rows 0-2: value, first, second derivative), in t (rows 3-5)
-    T = np.empty((3, 4, 3))
+    Tm = np.empty((3, 4, 3))
+    W = np.empty((17, 3))  # the point's net, row 16 its origin
     for k in range(n):
-        vf = f[k]
+        pf = f[k]
         uu = u[k]
         ww = v[k]
-        if vf < 0 or vf >= m or not (uu >= 0.0 and uu <= 1.0 and ww >= 0.0 and ww <= 1.0) or refused[vf]:
+        if pf < 0 or pf >= m or not (uu >= 0.0 and uu <= 1.0 and ww >= 0.0 and ww <= 1.0) or T.refused[pf]:
             return k
-        kind = vkind[vf]
-        for _ in range(split_depth):
+        q = 0
+        if uu >= 0.5:
+            q += 1
+        if ww >= 0.5:
+            q += 2
+        job = T.top[pf, q]
+        vf = T.job_root[job]
+        kind = T.kind[vf]
+        for _ in range(T.split_depth):
             if kind != _SPLIT:
                 break
-            half = vh[vf] * 0.5
+            half = T.h[vf] * 0.5
             q = 0
-            if uu >= vu0[vf] + half:
+            if uu >= T.u0[vf] + half:
                 q += 1
-            if ww >= vv0[vf] + half:
+            if ww >= T.v0[vf] + half:
                 q += 2
-            vf = vchild[vf, q]
-            kind = vkind[vf]
-        p = vpatch[vf]
+            vf = T.child[vf, q]
+            kind = T.kind[vf]
         if kind == _CORNER:
-            U0 = vu0[vf]
-            V0 = vv0[vf]
-            H = vh[vf]
-            du = ((U0 + H) - uu if vcu[vf] else uu - U0) / H
-            dv = ((V0 + H) - ww if vcv[vf] else ww - V0) / H
+            U0 = T.u0[vf]
+            V0 = T.v0[vf]
+            H = T.h[vf]
+            cu = T.cu[vf]
+            cv = T.cv[vf]
+            du = ((U0 + H) - uu if cu else uu - U0) / H
+            dv = ((V0 + H) - ww if cv else ww - V0) / H
             mx = max(du, dv)
-            nmax = vnmax[vf]
+            cfg = T.cfg[vf]
+            nmax = T.n_layers[cfg] - 1
             if mx > 0:
                 e = math.frexp(mx)[1]
                 lay = min(max(-e, 0), nmax)
@@ -93,12 +103,39 @@ def _evaluate_points(f, u, v, d, refused, vkind, vchild, vu0, vv0, vh, vpatch, v
                 code = 2
             else:
                 code = 1
-            if lay >= hot_layers:
-                p = vcold[vf]
-            p += 3 * lay + code
-        h = ph[p]
-        s = min(max((uu - pu0[p]) / h, 0.0), 1.0)
-        t = min(max((ww - pv0[p]) / h, 0.0), 1.0)
+            sc = math.ldexp(H, -lay)
+            pu0 = T.unit[cfg, code, 0] * sc + ((U0 + H) if cu else U0)
+            pv0 = T.unit[cfg, code, 1] * sc + ((V0 + H) if cv else V0)
+            h = T.unit[cfg, code, 2] * sc
+            Nc = T.op_size[cfg]
+            o = T.op_start[cfg] + (3 * lay + code) * 16 * Nc
+            q0 = T.job_pts[job] + T.pts[vf]
+            for i in range(16):
+                x0 = 0.0
+                x1 = 0.0
+                x2 = 0.0
+                r = o + i * Nc
+                for j in range(Nc):
+                    w = T.ops[r + j]
+                    x0 += w * T.ring[q0 + j, 0]
+                    x1 += w * T.ring[q0 + j, 1]
+                    x2 += w * T.ring[q0 + j, 2]
+                W[i, 0] = x0
+                W[i, 1] = x1
+                W[i, 2] = x2
+            ci = T.job_corner[job] + T.leaf[vf]
+            for c in range(3):
+                W[16, c] = T.origin[ci, c]
+        else:
+            p = T.job_net[job] + T.leaf[vf]
+            pu0 = T.u0[vf]
+            pv0 = T.v0[vf]
+            h = T.h[vf]
+            for i in range(17):
+                for c in range(3):
+                    W[i, c] = T.nets[p, i, c]
+        s = min(max((uu - pu0) / h, 0.0), 1.0)
+        t = min(max((ww - pv0) / h, 0.0), 1.0)
         g = 1.0 / h
         _basis(s, B, 0)
         _basis(t, B, 3)
@@ -108,27 +145,27 @@ def _evaluate_points(f, u, v, d, refused, vkind, vchild, vu0, vv0, vh, vpatch, v
                 x1 = 0.0
                 x2 = 0.0
                 for j in range(4):
-                    w = nets[p, i + 4 * j, c]
+                    w = W[i + 4 * j, c]
                     x0 += B[3, j] * w
                     if d >= 1:
                         x1 += B[4, j] * w
                     if d >= 2:
                         x2 += B[5, j] * w
-                T[0, i, c] = x0
-                T[1, i, c] = x1
-                T[2, i, c] = x2
+                Tm[0, i, c] = x0
+                Tm[1, i, c] = x1
+                Tm[2, i, c] = x2
         for c in range(3):
             a0 = 0.0
             for i in range(4):
-                a0 += B[0, i] * T[0, i, c]
-            P[k, c] = nets[p, 16, c] + a0
+                a0 += B[0, i] * Tm[0, i, c]
+            P[k, c] = W[16, c] + a0
         if d >= 1:
             for c in range(3):
                 a1 = 0.0
                 a2 = 0.0
                 for i in range(4):
-                    a1 += B[1, i] * T[0, i, c]
-                    a2 += B[0, i] * T[1, i, c]
+                    a1 += B[1, i] * Tm[0, i, c]
+                    a2 += B[0, i] * Tm[1, i, c]
                 Pu[k, c] = a1 * g
                 Pv[k, c] = a2 * g
         if d >= 2:
@@ -138,9 +175,9 @@ def _evaluate_points(f, u, v, d, refused, vkind, vchild, vu0, vv0, vh, vpatch, v
                 a4 = 0.0
                 a5 = 0.0
                 for i in range(4):
-                    a3 += B[2, i] * T[0, i, c]
-                    a4 += B[1, i] * T[1, i, c]
-                    a5 += B[0, i] * T[2, i, c]
+                    a3 += B[2, i] * Tm[0, i, c]
+                    a4 += B[1, i] * Tm[1, i, c]
+                    a5 += B[0, i] * Tm[2, i, c]
                 Puu[k, c] = a3 * g2
                 Puv[k, c] = a4 * g2
                 Pvv[k, c] = a5 * g2
@@ -157,8 +194,7 @@ def _free(w, g):
     return not ((w <= 0.0 and g > 0) or (w >= 1.0 and g < 0))
 
 
-def _newton_points(X, face, u, v, max_iter, max_halvings, refused, vkind, vchild, vu0, vv0, vh, vpatch, vcold,
-                   hot_layers, vcu, vcv, vnmax, split_depth, nets, pu0, pv0, ph, E):
+def _newton_points(X, face, u, v, max_iter, max_halvings, T, E):
     """The descent of :func:`ccproof.evaluate.closest.newton`, point by point: the same formulas in
     the same order (u, v updated in place, E filled). The points must be valid (checked by the
     caller); each evaluation is the batch kernel's on one point."""
@@ -180,8 +216,7 @@ def _newton_points(X, face, u, v, max_iter, max_halvings, refused, vkind, vchild
         uk = min(max(u[k], 0.0), 1.0)
         vk = min(max(v[k], 0.0), 1.0)
         fk[0], uw[0], vw[0] = f, uk, vk
-        evaluate_points(fk, uw, vw, 2, refused, vkind, vchild, vu0, vv0, vh, vpatch, vcold, hot_layers, vcu, vcv,
-                        vnmax, split_depth, nets, pu0, pv0, ph, c0, c1, c2, c3, c4, c5)
+        evaluate_points(fk, uw, vw, 2, T, c0, c1, c2, c3, c4, c5)
         for c in range(3):
             R[0, c] = C[0, c] - X[k, c]
         Ek = 0.5 * _dot3(R, 0, R, 0)
@@ -221,8 +256,7 @@ def _newton_points(X, face, u, v, max_iter, max_halvings, refused, vkind, vchild
                 nv = min(max(v0 + al * dv, 0.0), 1.0)
                 moved = (nu != u0) or (nv != v0)
                 uw[0], vw[0] = nu, nv
-                evaluate_points(fk, uw, vw, 2, refused, vkind, vchild, vu0, vv0, vh, vpatch, vcold, hot_layers, vcu,
-                                vcv, vnmax, split_depth, nets, pu0, pv0, ph, n0, n1, n2, n3, n4, n5)
+                evaluate_points(fk, uw, vw, 2, T, n0, n1, n2, n3, n4, n5)
                 for c in range(3):
                     Rt[0, c] = Cn[0, c] - X[k, c]
                 Et = 0.5 * _dot3(Rt, 0, Rt, 0)

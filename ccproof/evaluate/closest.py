@@ -327,10 +327,10 @@ def _newton_compiled(surface, kernel, X, face, u, v, max_iter, threads):
         raise CCProofError(f"X must have one row per point, got {X.shape[0]} rows for {u.size} points")
     n = u.size
     E = np.empty(n)
-    tables = (surface._refused_faces(), *surface._kernel_tables())
+    table = surface._kernel_table()
 
     def block(lo, hi):
-        kernel(X[lo:hi], face[lo:hi], u[lo:hi], v[lo:hi], max_iter, MAX_HALVINGS, *tables, E[lo:hi])
+        kernel(X[lo:hi], face[lo:hi], u[lo:hi], v[lo:hi], max_iter, MAX_HALVINGS, table, E[lo:hi])
 
     _in_blocks(block, n, _threads(threads, n * 16), 2048)  # a descent costs some 10 to 30 evaluations
     return u, v, E

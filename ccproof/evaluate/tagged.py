@@ -32,15 +32,8 @@ import math
 import numpy as np
 
 from ccproof.errors import CCProofError
-from ccproof.evaluate.surface import (
-    _REGULAR,
-    _SPLIT,
-    LimitSurface,
-    _Builder,
-    _child_frame,
-    _compose,
-    _domain,
-)
+from ccproof.evaluate._table import _Builder, _child_frame, _compose, _domain
+from ccproof.evaluate.surface import LimitSurface
 from ccproof.mesh.polymesh import PolyMesh
 from ccproof.mesh.rules import Complex
 
@@ -78,14 +71,12 @@ class TaggedLimitSurface(LimitSurface):
     [[-1.0, -1.0, -1.0], [-0.5, -0.5, 0.5]]
     """
 
-    def __init__(self, mesh: PolyMesh):
+    def __init__(self, mesh: PolyMesh, *, progress=None):
         self.mesh = mesh
-        b = _Builder(2 if mesh.options.crease_method == "chaikin" else 1, what="ptex face")
+        b = _Builder(2 if mesh.options.crease_method == "chaikin" else 1, what="ptex face", progress=progress)
         ident = ((0.0, 0.0), (1.0, 0.0), (0.0, 1.0))
         P = mesh.n_ptex
         self._ptex_face = np.empty(P, dtype=np.int64)
-        for p in range(P):
-            b.new_vface(_REGULAR, ident, p)
         if mesh.is_all_quads:
             # no global step needed: start on the base mesh, with the one level-0-only rule that
             # can act on quads (EDGE_AND_CORNER sharpens one-face boundary vertices) made explicit
@@ -97,37 +88,39 @@ class TaggedLimitSurface(LimitSurface):
                     if fan is not None and not closed and len(fan) == 1:
                         vs[v] = math.inf
                 cx = Complex(cx.faces, cx.edge_sharpness, vs, cx.options, level=1, n_vertices=cx.n_vertices)
-            X = np.asarray(mesh.vertices)
             self._ptex_face[:] = np.arange(mesh.n_faces)
-            b.classify(cx, X, [(f, ident, f, f) for f in range(mesh.n_faces)])
-            self._finish(b)
+            b.classify(cx, np.asarray(mesh.vertices), [(f, ident, f) for f in range(mesh.n_faces)])
+            top = np.repeat(np.arange(P, dtype=np.int64)[:, None], 4, axis=1)
             self._hole_ptex = mesh.is_hole[self._ptex_face]
+            self._finish(b, top, self._hole_ptex)
             return
         m1, _ = mesh.refine()
         cx = m1.complex()
         X = np.asarray(m1.vertices)
         jobs = []
+        top = np.empty((P, 4), dtype=np.int64)
+        quarters = []
+        for i in range(4):
+            cf = _compose(ident, _child_frame(i))
+            cu, cv, _ = _domain(cf)
+            quarters.append((cf, int(cu > 0) + 2 * int(cv > 0)))
         for f in range(mesh.n_faces):
             k = int(mesh.sizes[f])
             p0 = int(mesh.ptex_start[f])
             c0 = int(mesh.offsets[f])
-            if k == 4:
+            if k == 4:  # the ptex face is the quad: its four level-1 children are its quadrants
                 self._ptex_face[p0] = f
-                b.vkind[p0] = _SPLIT
-                for i in range(4):
-                    cf = _compose(ident, _child_frame(i))
-                    cu, cv, _ = _domain(cf)
-                    q = int(cu > 0) + 2 * int(cv > 0)
-                    c = b.new_vface(_REGULAR, cf, p0)
-                    b.vchild[p0][q] = c
-                    jobs.append((c0 + i, cf, p0, c))
-            else:
+                for i, (cf, q) in enumerate(quarters):
+                    top[p0, q] = len(jobs)
+                    jobs.append((c0 + i, cf, p0))
+            else:  # sub-face i of an n-gon is level-1 child i (same (s, t))
                 for i in range(k):
                     self._ptex_face[p0 + i] = f
-                    jobs.append((c0 + i, ident, p0 + i, p0 + i))
+                    top[p0 + i] = len(jobs)
+                    jobs.append((c0 + i, ident, p0 + i))
         b.classify(cx, X, jobs)
-        self._finish(b)
         self._hole_ptex = mesh.is_hole[self._ptex_face]
+        self._finish(b, top, self._hole_ptex)
 
     @property
     def n_faces(self):
