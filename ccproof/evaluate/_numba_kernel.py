@@ -287,11 +287,118 @@ def _newton_points(X, face, u, v, max_iter, max_halvings, T, E):
         E[k] = Ek
 
 
+def _take_face(c, org, pos, seen, ring, faces, fc, fl, n, nf):
+    """Step of :func:`_ring_walks`: list the face of half-edge ``c`` (read from ``c`` on) unless seen.
+    Returns the new counts ``(n, nf)``, or ``(-1, -1)`` when the arrays are full."""
+    hf = c // 4
+    if seen[hf]:
+        return n, nf
+    if nf >= faces.shape[0]:
+        return -1, -1
+    seen[hf] = True
+    fl[nf] = hf
+    j0 = c - 4 * hf
+    for t in range(4):
+        hc = 4 * hf + (j0 + t) % 4
+        u = org[hc]
+        q = pos[u]
+        if q < 0:
+            if n >= ring.shape[0]:
+                faces[nf, 0] = -1
+                return -1, nf + 1
+            q = n
+            pos[u] = n
+            ring[n] = u
+            fc[n] = hc
+            n += 1
+        faces[nf, t] = q
+    return n, nf + 1
+
+
+def _ring_walks(org, nxt, prv, twin, pos, seen, g, r, rings, nring, faces, nfaces, hashes):
+    """:func:`ccproof.evaluate.local.canonical_ring` (depth 1) of quad ``g[k]`` from corner ``r[k]`` of
+    an all-quad complex (half-edge ``4 f + i`` is corner i of face f), for every k: the same walk.
+
+    Writes the ring (vertex labels, ``rings[k, :nring[k]]``), the faces in ring labels
+    (``faces[k, :nfaces[k]]``, rows of 4) and a 64-bit FNV-1a hash of (nring, faces). ``pos``
+    (n_vertices,) and ``seen`` (n_faces,) are scratch arrays, -1 / False on entry and on return.
+    ``nring[k] = -1`` if the ring does not fit the arrays or the walk does not close (the caller
+    then takes the Python walk).
+    """
+    maxn = rings.shape[1]
+    maxf = faces.shape[1]
+    fc = np.empty(maxn, dtype=np.int64)
+    fl = np.empty(maxf, dtype=np.int64)
+    for k in range(g.shape[0]):
+        gk = g[k]
+        ring = rings[k]
+        fk = faces[k]
+        n = 0
+        nf = 1
+        ok = True
+        seen[gk] = True
+        fl[0] = gk
+        for i in range(4):
+            h = 4 * gk + (r[k] + i) % 4
+            v = org[h]
+            fk[0, i] = i
+            if pos[v] >= 0:
+                ok = False
+                break
+            pos[v] = n
+            ring[n] = v
+            fc[n] = h
+            n += 1
+        idx = 0
+        while ok and idx < 4:
+            c0 = fc[idx]
+            n, nf = _take_face(c0, org, pos, seen, ring, fk, fc, fl, n, nf)
+            c = twin[prv[c0]]
+            steps = 0
+            while n >= 0 and c >= 0 and c != c0 and steps < 4096:  # counter-clockwise
+                n, nf = _take_face(c, org, pos, seen, ring, fk, fc, fl, n, nf)
+                c = twin[prv[c]]
+                steps += 1
+            if n < 0 or steps >= 4096:
+                ok = False
+                break
+            if c != c0:  # an open fan: then clockwise from c0
+                t_ = twin[c0]
+                c = -1 if t_ < 0 else nxt[t_]
+                while n >= 0 and c >= 0 and steps < 4096:
+                    n, nf = _take_face(c, org, pos, seen, ring, fk, fc, fl, n, nf)
+                    t_ = twin[c]
+                    c = -1 if t_ < 0 else nxt[t_]
+                    steps += 1
+                if n < 0 or steps >= 4096:
+                    ok = False
+                    break
+            idx += 1
+        if nf < 0:
+            nf = maxf
+        for i in range(maxn if n < 0 else n):  # reset the scratch arrays
+            if i < maxn and ring[i] >= 0 and pos[ring[i]] == i:
+                pos[ring[i]] = -1
+        for i in range(nf):
+            seen[fl[i]] = False
+        nring[k] = n if ok else -1
+        nfaces[k] = nf
+        hsh = np.uint64(14695981039346656037)
+        prime = np.uint64(1099511628211)
+        hsh = (hsh ^ np.uint64(max(n, 0))) * prime
+        for i in range(nf):
+            for t in range(4):
+                hsh = (hsh ^ np.uint64(fk[i, t] + 1)) * prime
+        hashes[k] = hsh
+
+
 if numba is not None:
     _basis = numba.njit(cache=True, nogil=True)(_basis)
     evaluate_points = numba.njit(cache=True, nogil=True)(_evaluate_points)
     _dot3 = numba.njit(cache=True, nogil=True, inline="always")(_dot3)
     _free = numba.njit(cache=True, nogil=True, inline="always")(_free)
     newton_points = numba.njit(cache=True, nogil=True)(_newton_points)
+    _take_face = numba.njit(cache=True, nogil=True)(_take_face)
+    ring_walks = numba.njit(cache=True, nogil=True)(_ring_walks)
 else:  # pragma: no cover
-    evaluate_points = newton_points = None
+    evaluate_points = newton_points = ring_walks = None

@@ -42,6 +42,7 @@ from ccproof.evaluate.local import (
     CORNERS,
     _child_ring,
     _has_semi_sharp,
+    _key_complex,
     _regular_net_matrix,
     canonical_ring,
     corner_scheme,
@@ -242,21 +243,6 @@ def _smooth_regular_vertices(cx):
 
 
 # ---------------------------------------------------------------------------------- templates
-class _Probe:
-    """The control points of a ring as seen by the builder when it builds a template: vertex ``v``
-    of the complex is row ``pos[v]`` of ``rows`` (the identity: every coordinate a ring point; or
-    the ring positions themselves, for the vertex map)."""
-
-    def __init__(self, ring, rows):
-        self.pos = {int(v): i for i, v in enumerate(ring)}
-        self.rows = rows
-
-    def __getitem__(self, idx):
-        if np.ndim(idx) == 0:
-            return self.rows[self.pos[int(idx)]]
-        return self.rows[[self.pos[int(v)] for v in idx]]
-
-
 class _Template:
     """Virtual faces and leaf operators of one configuration of a job (see the module docstring)."""
 
@@ -355,7 +341,7 @@ class _Builder:
         ok = _smooth_regular_vertices(cx)
         done = self.smooth_regular_patches(cx, X, jobs)
         g = np.array([j[0] for j in jobs], dtype=np.int64)
-        start = np.asarray(cx.start + [len(cx.org)], dtype=np.int64)
+        start = np.append(np.asarray(cx.start, dtype=np.int64), len(cx.org))
         org = np.asarray(cx.org, dtype=np.int64)
         quad = start[g + 1] - start[g] == 4
         corners = ok[org[np.minimum(start[g][:, None] + np.arange(4), org.size - 1)]]
@@ -386,7 +372,7 @@ class _Builder:
         org, nxt, prv, twin = (np.asarray(a, dtype=np.int64) for a in (cx.org, cx.nxt, cx.prv, cx.twin))
         ok = _smooth_regular_vertices(cx)
         g = np.array([j[0] for j in jobs], dtype=np.int64)
-        start = np.asarray(cx.start + [org.size], dtype=np.int64)
+        start = np.append(np.asarray(cx.start, dtype=np.int64), org.size)
         H = start[g][:, None] + np.arange(4)
         sel = (start[g + 1] - start[g] == 4) & ok[org[np.minimum(H, org.size - 1)]].all(axis=1)
         idx = np.flatnonzero(sel)
@@ -422,44 +408,50 @@ class _Builder:
         Returns True if registered."""
         ring_r, faces_r, nr = canonical_ring(cx, g, r)
         key_r = ring_key(cx, ring_r, faces_r, nr)
-        tkey = ("corner", key_r, r, frame)
-        if tkey not in self.templates:
-            if _has_semi_sharp(key_r) or irregular_corners(key_r) != (0,):
-                return False
-            scheme = corner_scheme(key_r)
-            if scheme is None:
-                return False
-
-            def make():
-                t = _Template(len(ring_r))
-                root = t.new_vface(_REGULAR, frame)
-                probe = _Probe(ring_r, np.eye(len(ring_r)))
-                self.scheme_face(t, scheme, probe, ring_r, r, frame, base, root, _Probe(ring_r, np.arange(len(ring_r))))
-                return t
-
-            self._register(tkey, make, (job,), ring_r)
-        else:
-            self._register(tkey, None, (job,), ring_r)
+        if not self._corner_ok(key_r):
+            return False
+        self._register(("corner", key_r, r, frame), functools.partial(self._corner_template, key_r, r, frame, base),
+                       (job,), ring_r)
         return True
 
     def face(self, cx, X, g, frame, base, job, vmap=None):
         """Register quad ``g`` with its ring read from corner 0 (the two-ring when the Chaikin
-        semi-sharp phase needs it), building its template on first use (:meth:`_face`)."""
+        semi-sharp phase needs it), building its template on first use (:meth:`_face_template`)."""
         ring, faces, nr = canonical_ring(cx, g, 0, 1)
         key = ring_key(cx, ring, faces, nr)
         if self.depth_semi != 1 and _has_semi_sharp(key):
             ring, faces, nr = canonical_ring(cx, g, 0, self.depth_semi)
             key = ring_key(cx, ring, faces, nr)
-        tkey = ("face", key, frame)
+        self._register(("face", key, frame), functools.partial(self._face_template, key, frame, base), (job,), ring)
 
-        def make():
-            t = _Template(len(ring))
-            root = t.new_vface(_REGULAR, frame)
-            self._face(t, cx, _Probe(ring, np.eye(len(ring))), g, frame, 0, 0, base, root,
-                       vmap=_Probe(ring, np.arange(len(ring))))
-            return t
+    @staticmethod
+    def _corner_ok(key_r):
+        """Whether a ring read from a face's corner makes the face a corner face at that corner."""
+        if _has_semi_sharp(key_r) or irregular_corners(key_r) != (0,):
+            return False
+        return corner_scheme(key_r) is not None
 
-        self._register(tkey, make, (job,), ring)
+    def _corner_template(self, key_r, r, frame, base):
+        N = _key_complex(key_r).n_vertices
+        t = _Template(N)
+        root = t.new_vface(_REGULAR, frame)
+        self.scheme_face(t, corner_scheme(key_r), np.eye(N), list(range(N)), r, frame, base, root, np.arange(N))
+        return t
+
+    def _face_template(self, key, frame, base):
+        """The template of a face whose ring (read from corner 0) has the tagged key ``key``: the
+        classification run on the key's own complex (the ring in canonical labels: the same walks
+        read the same rings) with the identity as control points."""
+        kc = _key_complex(key)
+        N = kc.n_vertices
+        depth = 1 if self.depth_semi == 1 or len(key[0]) == len(canonical_ring(kc, 0, 0, 1)[1]) else self.depth_semi
+        ring, faces, _ = canonical_ring(kc, 0, 0, depth)
+        if faces != key[0] or ring != list(range(N)):  # pragma: no cover - the premise of the key caches
+            raise MeshError(f"internal error: the ring of {self.what} {base} is not read back from its key")
+        t = _Template(N)
+        root = t.new_vface(_REGULAR, frame)
+        self._face(t, kc, np.eye(N), 0, frame, 0, 0, base, root, vmap=np.arange(N))
+        return t
 
     # ------------------------------------------------------------------ template building
     def _face(self, t, cx, X, g, frame, depth, semi_depth, base, vid, src=None, vmap=None):
