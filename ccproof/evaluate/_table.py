@@ -278,6 +278,13 @@ class _Template:
         self.reg = self.cor = None
 
 
+def _ring_walks():
+    """The compiled ring walk, or None without numba."""
+    from ccproof.evaluate._numba_kernel import ring_walks
+
+    return ring_walks
+
+
 def _progress(progress, total, desc):
     """A tqdm bar on stderr shown after 2 s (None: when stderr is a terminal), or a no-op."""
     if progress is None:
@@ -298,6 +305,71 @@ class _NoBar:
 
     def close(self):
         pass
+
+
+class _Jobs:
+    """The quads to classify: ``g`` (J,) quads of the complex, ``fid`` (J,) index of each one's frame
+    in ``frames``, ``base`` (J,) the ptex face errors name. ``jobs[i]`` is ``(g, frame, base)``."""
+
+    def __init__(self, g, fid, base, frames):
+        self.g = np.asarray(g, dtype=np.int64)
+        self.fid = np.asarray(fid, dtype=np.int64)
+        self.base = np.asarray(base, dtype=np.int64)
+        self.frames = list(frames)
+
+    @classmethod
+    def of(cls, jobs):
+        if isinstance(jobs, cls):
+            return jobs
+        frames, fid = {}, []
+        for j in jobs:
+            fid.append(frames.setdefault(j[1], len(frames)))
+        return cls([j[0] for j in jobs], fid, [j[2] for j in jobs], list(frames))
+
+    def __len__(self):
+        return self.g.size
+
+    def __getitem__(self, i):
+        return int(self.g[i]), self.frames[self.fid[i]], int(self.base[i])
+
+
+class QuadHalfEdges:
+    """Half-edge arrays of an untagged all-quad complex (half-edge ``4 f + i`` is corner i of face f),
+    built with numpy: what the compiled ring walk reads (and the parts of
+    :class:`ccproof.mesh.rules.Complex` that :meth:`_Builder.smooth_regular_patches` reads).
+
+    Parameters
+    ----------
+    faces : array_like of int, shape (m, 4)
+    n_vertices : int
+    options : ccproof.mesh.rules.Options
+
+    Attributes
+    ----------
+    manifold : bool
+        False if a directed edge occurs twice (then the builder takes the Python walk).
+    """
+
+    def __init__(self, faces, n_vertices, options):
+        F = np.asarray(faces, dtype=np.int64).reshape(-1, 4)
+        m = F.shape[0]
+        h = np.arange(4 * m, dtype=np.int64)
+        self.faces = F
+        self.org = F.reshape(-1)
+        self.nxt = h - h % 4 + (h + 1) % 4
+        self.prv = h - h % 4 + (h + 3) % 4
+        nv = self.n_vertices = int(n_vertices)
+        dst = self.org[self.nxt]
+        key = self.org * nv + dst
+        order = np.argsort(key, kind="stable")
+        sk = key[order]
+        self.manifold = not bool((np.diff(sk) == 0).any())
+        rk = dst * nv + self.org
+        i = np.minimum(np.searchsorted(sk, rk), max(sk.size - 1, 0))
+        self.twin = np.where(sk[i] == rk, order[i], -1) if sk.size else np.zeros(0, np.int64)
+        self.start = 4 * np.arange(m, dtype=np.int64)
+        self.edge_sharpness, self.vertex_sharpness = {}, {}
+        self.options = options
 
 
 class _Builder:
@@ -323,39 +395,125 @@ class _Builder:
         t.rings.extend(rings)
 
     def classify(self, cx, X, jobs, vmap=None):
-        """Classify the quads ``jobs = [(g, frame, base), ...]`` of ``cx`` (positions ``X``); job ids
-        are assigned in order. ``vmap``: the mesh vertex of every vertex of ``cx`` (records where the
-        corner faces' vertices are, for the vertex normals).
+        """Classify the quads ``jobs`` (``[(g, frame, base), ...]`` or :class:`_Jobs`) of ``cx`` (a
+        :class:`ccproof.mesh.rules.Complex`, or :class:`QuadHalfEdges` for an untagged all-quad one)
+        with positions ``X``; job ids are assigned in order. ``vmap``: the mesh vertex of every
+        vertex of ``cx`` (records where the corner faces' vertices are, for the vertex normals).
 
         The smooth regular ones (:meth:`smooth_regular_patches`) in one vectorized pass, the others
-        face by face: a quad with three smooth regular corners is first tried as a corner face at
+        by their rings: a quad with three smooth regular corners is first tried as a corner face at
         the fourth (:meth:`corner_at`), anything else reads its ring from corner 0 (:meth:`face`).
+        On a :class:`QuadHalfEdges` the rings are walked by the compiled kernel when numba is
+        installed (:meth:`_walk_all`), else face by face.
         """
+        jobs = _Jobs.of(jobs)
         self.X = X
         self.vmap = vmap
         j0 = self.n_jobs
         self.n_jobs += len(jobs)
-        self.job_base.extend(int(j[2]) for j in jobs)
-        if not jobs:
+        self.job_base.extend(jobs.base.tolist())
+        if not len(jobs):
             return
         ok = _smooth_regular_vertices(cx)
-        done = self.smooth_regular_patches(cx, X, jobs)
-        g = np.array([j[0] for j in jobs], dtype=np.int64)
+        done = np.asarray(self.smooth_regular_patches(cx, X, jobs), dtype=bool)
+        g = jobs.g
         start = np.append(np.asarray(cx.start, dtype=np.int64), len(cx.org))
         org = np.asarray(cx.org, dtype=np.int64)
         quad = start[g + 1] - start[g] == 4
         corners = ok[org[np.minimum(start[g][:, None] + np.arange(4), org.size - 1)]]
         single = np.where(quad & (corners.sum(axis=1) == 3), np.argmin(corners, axis=1), -1)
-        todo = np.flatnonzero(~np.asarray(done, dtype=bool))
+        todo = np.flatnonzero(~done)
+        if isinstance(cx, QuadHalfEdges):
+            if cx.manifold and _ring_walks() is not None:
+                return self._walk_all(cx, jobs, j0, todo, single[todo])
+            from ccproof.mesh.rules import Complex
+
+            cx = Complex(cx.faces, {}, {}, cx.options, n_vertices=cx.n_vertices)
         bar = _progress(self.progress, todo.size, "patch table")
-        for i in todo.tolist():
-            g_, frame, base = jobs[i][:3]
+        for n, i in enumerate(todo.tolist()):
+            g_, frame, base = jobs[i]
             r = int(single[i])
             if not (r >= 0 and self.corner_at(cx, X, g_, r, frame, base, j0 + i, vmap)):
                 self.face(cx, X, g_, frame, base, j0 + i, vmap)
-            if i % 256 == 0:
-                bar.update(min(256, todo.size - i))
+            if n % 256 == 255:
+                bar.update(256)
         bar.close()
+
+    def _walk_all(self, he, jobs, j0, todo, single):
+        """Register the jobs ``todo`` (``single``: the one irregular corner of each, or -1) of an
+        untagged all-quad complex: their rings walked by the compiled kernel
+        (:func:`ccproof.evaluate._numba_kernel.ring_walks`, the walk of
+        :func:`ccproof.evaluate.local.canonical_ring`), grouped by the hash of their faces, each
+        group checked face by face against its first ring and registered with the key of that ring
+        (untagged: the key is the faces and the options)."""
+        walks = _ring_walks()
+        opts = he.options.key()
+        pos = np.full(he.n_vertices, -1, dtype=np.int64)
+        seen = np.zeros(he.faces.shape[0], dtype=np.bool_)
+        bar = _progress(self.progress, todo.size, "patch table")
+        step = 1 << 15
+        fallback = []
+        for lo in range(0, todo.size, step):
+            idx = todo[lo:lo + step]
+            r0 = single[lo:lo + step]
+            retry, fb = self._walk_block(he, walks, pos, seen, jobs, j0, idx, np.maximum(r0, 0), r0 >= 0, opts)
+            fallback.append(fb)
+            if retry.size:  # corner candidates that are not corner faces: from corner 0
+                fallback.append(self._walk_block(he, walks, pos, seen, jobs, j0, retry, np.zeros(retry.size, np.int64),
+                                                 np.zeros(retry.size, bool), opts)[1])
+            bar.update(idx.size)
+        bar.close()
+        fallback = np.concatenate(fallback) if fallback else np.zeros(0, dtype=np.int64)
+        if fallback.size:
+            from ccproof.mesh.rules import Complex
+
+            cx = Complex(he.faces, {}, {}, he.options, n_vertices=he.n_vertices)
+            where = {int(i): n for n, i in enumerate(todo.tolist())}
+            for i in fallback.tolist():
+                g_, frame, base = jobs[i]
+                r_ = int(single[where[i]])
+                if not (r_ >= 0 and self.corner_at(cx, self.X, g_, r_, frame, base, j0 + i, self.vmap)):
+                    self.face(cx, self.X, g_, frame, base, j0 + i, self.vmap)
+
+    def _walk_block(self, he, walks, pos, seen, jobs, j0, idx, r, at_corner, opts, maxn=64, maxf=48):
+        k = idx.size
+        rings = np.full((k, maxn), -1, dtype=np.int32)
+        faces = np.zeros((k, maxf, 4), dtype=np.int64)
+        nring = np.empty(k, dtype=np.int64)
+        nfaces = np.empty(k, dtype=np.int64)
+        hashes = np.empty(k, dtype=np.uint64)
+        walks(he.org, he.nxt, he.prv, he.twin, pos, seen, jobs.g[idx], r, rings, nring, faces, nfaces, hashes)
+        fallback = [idx[nring < 0]]  # a ring beyond the arrays (a valence above ~25): the Python walk
+        sig = np.stack([hashes.view(np.int64), r + 4 * at_corner + 8 * jobs.fid[idx]], axis=1)
+        sig[nring < 0] = -1
+        _, first, inv = np.unique(sig, axis=0, return_index=True, return_inverse=True)
+        inv = inv.reshape(-1)
+        order = np.argsort(inv, kind="stable")
+        bounds = np.searchsorted(inv[order], np.arange(first.size + 1))
+        retry = []
+        for gi in range(first.size):
+            mem = order[bounds[gi]:bounds[gi + 1]]
+            rep = first[gi]
+            if nring[rep] < 0:
+                continue
+            nf, n = int(nfaces[rep]), int(nring[rep])
+            same = (nfaces[mem] == nf) & (nring[mem] == n) & (faces[mem, :nf] == faces[rep, :nf]).all(axis=(1, 2))
+            if not same.all():  # a hash collision: those jobs by the Python walk
+                fallback.append(idx[mem[~same]])
+                mem = mem[same]
+            key = (tuple(map(tuple, faces[rep, :nf].tolist())), (), (), opts)
+            frame = jobs.frames[jobs.fid[idx[rep]]]
+            base = int(jobs.base[idx[rep]])
+            rr = int(r[rep])
+            if at_corner[rep]:
+                if not self._corner_ok(key):
+                    retry.append(idx[mem])
+                    continue
+                tkey, make = ("corner", key, rr, frame), functools.partial(self._corner_template, key, rr, frame, base)
+            else:
+                tkey, make = ("face", key, frame), functools.partial(self._face_template, key, frame, base)
+            self._register(tkey, make, (j0 + idx[mem]).tolist(), rings[mem, :n].ravel())
+        return (np.concatenate(retry) if retry else np.zeros(0, dtype=np.int64)), np.concatenate(fallback)
 
     def smooth_regular_patches(self, cx, X, jobs):
         """Register the quads of ``jobs`` whose four vertices are smooth regular as bicubic patches.
@@ -369,9 +527,10 @@ class _Builder:
         """
         if not jobs:
             return np.zeros(0, dtype=bool)
+        jobs = _Jobs.of(jobs)
         org, nxt, prv, twin = (np.asarray(a, dtype=np.int64) for a in (cx.org, cx.nxt, cx.prv, cx.twin))
         ok = _smooth_regular_vertices(cx)
-        g = np.array([j[0] for j in jobs], dtype=np.int64)
+        g = jobs.g
         start = np.append(np.asarray(cx.start, dtype=np.int64), org.size)
         H = start[g][:, None] + np.arange(4)
         sel = (start[g + 1] - start[g] == 4) & ok[org[np.minimum(H, org.size - 1)]].all(axis=1)
@@ -388,17 +547,14 @@ class _Builder:
             grid[:, cell[1]] = org[nxt[nxt[t]]]
             grid[:, cell[2]] = org[prv[t]]
             grid[:, cell[3]] = org[prv[twin[nxt[t]]]]
-        frames = [jobs[i][1] for i in idx]
-        perm = np.array([_net_permutation(f) for f in frames])
-        grid = np.take_along_axis(grid, perm, axis=1)
+        fid = jobs.fid[idx]
         j0 = self.n_jobs - len(jobs)
-        by_frame = {}
-        for r, f in enumerate(frames):
-            by_frame.setdefault(f, []).append(r)
-        for f, rows in by_frame.items():
-            rows = np.array(rows, dtype=np.int64)
-            self._register(("smooth", f), functools.partial(_smooth_template, f), (j0 + idx[rows]).tolist(),
-                           grid[rows].astype(np.int32).ravel())
+        for k, f in enumerate(jobs.frames):
+            rows = np.flatnonzero(fid == k)
+            if rows.size:
+                ring = grid[rows][:, _net_permutation(f)]  # the grid in the base orientation
+                self._register(("smooth", f), functools.partial(_smooth_template, f), (j0 + idx[rows]).tolist(),
+                               ring.astype(np.int32).ravel())
         return sel
 
     def corner_at(self, cx, X, g, r, frame, base, job, vmap=None):

@@ -37,14 +37,16 @@ from ccproof.evaluate._table import (  # noqa: F401 - _child_frame, _compose, _d
     _SPLIT,
     MAX_DEPTH,
     MAX_SEMI_DEPTH,
+    QuadHalfEdges,
     _Builder,
     _child_frame,
+    _Jobs,
     _compose,
     _domain,
     job_floats,
 )
 from ccproof.mesh import QuadMesh, limit_normals, limit_positions
-from ccproof.mesh.rules import Complex, Options
+from ccproof.mesh.rules import Options
 
 __all__ = ["natural_limit_surface", "LimitSurface"]
 
@@ -97,10 +99,11 @@ class LimitSurface:
     def __init__(self, mesh: QuadMesh, *, progress=None):
         self.mesh = mesh
         b = _Builder(progress=progress)
-        cx = Complex(mesh.faces, {}, {}, Options(), n_vertices=mesh.n_vertices)
+        cx = QuadHalfEdges(mesh.faces, mesh.n_vertices, Options())
         base = ((0.0, 0.0), (1.0, 0.0), (0.0, 1.0))
         m = mesh.n_faces
-        b.classify(cx, mesh.vertices, [(f, base, f) for f in range(m)], vmap=np.arange(mesh.n_vertices))
+        b.classify(cx, mesh.vertices, _Jobs(np.arange(m), np.zeros(m, np.int64), np.arange(m), [base]),
+                   vmap=np.arange(mesh.n_vertices))
         self._finish(b, np.repeat(np.arange(m, dtype=np.int64)[:, None], 4, axis=1), np.zeros(m, dtype=np.bool_))
 
     def _finish(self, b, top, refused):

@@ -32,7 +32,7 @@ import math
 import numpy as np
 
 from ccproof.errors import CCProofError
-from ccproof.evaluate._table import _Builder, _child_frame, _compose, _domain
+from ccproof.evaluate._table import QuadHalfEdges, _Builder, _child_frame, _compose, _domain, _Jobs
 from ccproof.evaluate.surface import LimitSurface
 from ccproof.mesh.polymesh import PolyMesh
 from ccproof.mesh.rules import Complex
@@ -88,37 +88,47 @@ class TaggedLimitSurface(LimitSurface):
                     if fan is not None and not closed and len(fan) == 1:
                         vs[v] = math.inf
                 cx = Complex(cx.faces, cx.edge_sharpness, vs, cx.options, level=1, n_vertices=cx.n_vertices)
+            if not cx.edge_sharpness and not cx.vertex_sharpness:
+                cx = QuadHalfEdges(cx.faces, cx.n_vertices, cx.options)
             self._ptex_face[:] = np.arange(mesh.n_faces)
-            b.classify(cx, np.asarray(mesh.vertices), [(f, ident, f) for f in range(mesh.n_faces)])
+            m = mesh.n_faces
+            b.classify(cx, np.asarray(mesh.vertices), _Jobs(np.arange(m), np.zeros(m, np.int64), np.arange(m), [ident]))
             top = np.repeat(np.arange(P, dtype=np.int64)[:, None], 4, axis=1)
             self._hole_ptex = mesh.is_hole[self._ptex_face]
             self._finish(b, top, self._hole_ptex)
             return
         m1, _ = mesh.refine()
-        cx = m1.complex()
+        if not m1.edge_sharpness and not m1.vertex_sharpness:
+            cx = QuadHalfEdges(np.asarray(m1.polygons, dtype=np.int64), m1.n_vertices, m1.options)
+        else:
+            cx = m1.complex()
         X = np.asarray(m1.vertices)
-        jobs = []
-        top = np.empty((P, 4), dtype=np.int64)
-        quarters = []
+        # jobs: sub-face i of an n-gon is level-1 child i (same (s, t)), its own ptex face; a quad is
+        # one ptex face whose four level-1 children are its quadrants (frames: the child frames)
+        frames = [ident]
+        quarter_q = []
         for i in range(4):
             cf = _compose(ident, _child_frame(i))
             cu, cv, _ = _domain(cf)
-            quarters.append((cf, int(cu > 0) + 2 * int(cv > 0)))
-        for f in range(mesh.n_faces):
-            k = int(mesh.sizes[f])
-            p0 = int(mesh.ptex_start[f])
-            c0 = int(mesh.offsets[f])
-            if k == 4:  # the ptex face is the quad: its four level-1 children are its quadrants
-                self._ptex_face[p0] = f
-                for i, (cf, q) in enumerate(quarters):
-                    top[p0, q] = len(jobs)
-                    jobs.append((c0 + i, cf, p0))
-            else:  # sub-face i of an n-gon is level-1 child i (same (s, t))
-                for i in range(k):
-                    self._ptex_face[p0 + i] = f
-                    top[p0 + i] = len(jobs)
-                    jobs.append((c0 + i, ident, p0 + i))
-        b.classify(cx, X, jobs)
+            frames.append(cf)
+            quarter_q.append(int(cu > 0) + 2 * int(cv > 0))
+        sizes = np.asarray(mesh.sizes, dtype=np.int64)
+        nf = sizes.size
+        face = np.repeat(np.arange(nf), sizes)  # per level-1 child: its base face
+        corner = np.arange(face.size) - np.repeat(np.asarray(mesh.offsets, dtype=np.int64)[:nf], sizes)
+        is_quad = sizes[face] == 4
+        ptex_start = np.asarray(mesh.ptex_start, dtype=np.int64)[:nf]
+        ptex = np.where(is_quad, ptex_start[face], ptex_start[face] + corner)
+        g = np.asarray(mesh.offsets, dtype=np.int64)[:nf][face] + corner
+        fid = np.where(is_quad, 1 + corner, 0)
+        self._ptex_face[ptex] = face
+        top = np.empty((P, 4), dtype=np.int64)
+        jid = np.arange(face.size)
+        nq = np.flatnonzero(~is_quad)
+        top[ptex[nq]] = jid[nq, None]
+        qd = np.flatnonzero(is_quad)
+        top[ptex[qd], np.asarray(quarter_q)[corner[qd]]] = jid[qd]
+        b.classify(cx, X, _Jobs(g, fid, ptex, frames))
         self._hole_ptex = mesh.is_hole[self._ptex_face]
         self._finish(b, top, self._hole_ptex)
 
