@@ -29,8 +29,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ccproof.errors import CCProofError, MeshError
-from ccproof.evaluate.bspline import bspline_basis
+from ccproof.errors import CCProofError
 from ccproof.evaluate._table import (  # noqa: F401 - _child_frame, _compose, _domain: for tagged.py
     _CORNER,
     _REGULAR,
@@ -40,11 +39,12 @@ from ccproof.evaluate._table import (  # noqa: F401 - _child_frame, _compose, _d
     QuadHalfEdges,
     _Builder,
     _child_frame,
-    _Jobs,
     _compose,
     _domain,
+    _Jobs,
     job_floats,
 )
+from ccproof.evaluate.bspline import bspline_basis
 from ccproof.mesh import QuadMesh, limit_normals, limit_positions
 from ccproof.mesh.rules import Options
 
@@ -121,11 +121,21 @@ class LimitSurface:
 
     @property
     def table_bytes(self):
-        """Bytes held by the patch table: the kernel's arrays, the configurations' operators and the
-        jobs' rings (what grows with the mesh; the mesh itself not included)."""
+        """Bytes held by the patch table: the kernel's arrays, the jobs' rings and the configurations'
+        operators (the mesh itself not included); :attr:`configuration_bytes` of them are per
+        configuration, the rest grows with the faces."""
         n = sum(a.nbytes for a in self._table if isinstance(a, np.ndarray))
         n += sum(rings.nbytes + jobs.nbytes for _, jobs, rings in self._groups)
-        return n + self._job_base.nbytes
+        return n + self._job_base.nbytes + sum(t.R.nbytes + t.Q.nbytes + t.O.nbytes for t, _, _ in self._groups)
+
+    @property
+    def configuration_bytes(self):
+        """Bytes of the table held once per configuration (layer operators) or template (leaf
+        operators), shared by all faces of that configuration."""
+        T = self._table
+        n = sum(a.nbytes for a in (T.ops, T.op_start, T.op_size, T.n_layers, T.unit, T.kind, T.child, T.u0,
+                                   T.v0, T.h, T.leaf, T.pts, T.cfg, T.cu, T.cv))
+        return n + sum(t.R.nbytes + t.Q.nbytes + t.O.nbytes for t, _, _ in self._groups)
 
     @property
     def n_faces(self):
