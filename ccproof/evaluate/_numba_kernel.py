@@ -49,7 +49,7 @@ def _evaluate_points(f, u, v, d, T, P, Pu, Pv, Puu, Puv, Pvv):
     m = T.refused.shape[0]
     B = np.empty((6, 4))  # basis in s (rows 0-2: value, first, second derivative), in t (rows 3-5)
     Tm = np.empty((3, 4, 3))
-    W = np.empty((17, 3))  # the point's net, row 16 its origin
+    W = np.empty((1, 17, 3))  # the net of a point in a corner face, row 16 its origin
     for k in range(n):
         pf = f[k]
         uu = u[k]
@@ -120,20 +120,20 @@ def _evaluate_points(f, u, v, d, T, P, Pu, Pv, Puu, Puv, Pvv):
                     x0 += w * T.ring[q0 + j, 0]
                     x1 += w * T.ring[q0 + j, 1]
                     x2 += w * T.ring[q0 + j, 2]
-                W[i, 0] = x0
-                W[i, 1] = x1
-                W[i, 2] = x2
+                W[0, i, 0] = x0
+                W[0, i, 1] = x1
+                W[0, i, 2] = x2
             ci = T.job_corner[job] + T.leaf[vf]
             for c in range(3):
-                W[16, c] = T.origin[ci, c]
+                W[0, 16, c] = T.origin[ci, c]
+            net = W
+            p = 0
         else:
+            net = T.nets
             p = T.job_net[job] + T.leaf[vf]
             pu0 = T.u0[vf]
             pv0 = T.v0[vf]
             h = T.h[vf]
-            for i in range(17):
-                for c in range(3):
-                    W[i, c] = T.nets[p, i, c]
         s = min(max((uu - pu0) / h, 0.0), 1.0)
         t = min(max((ww - pv0) / h, 0.0), 1.0)
         g = 1.0 / h
@@ -145,7 +145,7 @@ def _evaluate_points(f, u, v, d, T, P, Pu, Pv, Puu, Puv, Pvv):
                 x1 = 0.0
                 x2 = 0.0
                 for j in range(4):
-                    w = W[i + 4 * j, c]
+                    w = net[p, i + 4 * j, c]
                     x0 += B[3, j] * w
                     if d >= 1:
                         x1 += B[4, j] * w
@@ -158,7 +158,7 @@ def _evaluate_points(f, u, v, d, T, P, Pu, Pv, Puu, Puv, Pvv):
             a0 = 0.0
             for i in range(4):
                 a0 += B[0, i] * Tm[0, i, c]
-            P[k, c] = W[16, c] + a0
+            P[k, c] = net[p, 16, c] + a0
         if d >= 1:
             for c in range(3):
                 a1 = 0.0

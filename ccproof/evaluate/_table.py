@@ -834,3 +834,96 @@ def job_floats(groups, X, sizes, progress=None):
         if not np.isfinite(a).all():
             raise MeshError(f"internal error: non-finite {name} in the patch table (a non-finite control point?)")
     return nets, origin, ring
+
+
+def catmark_step(mesh):
+    """One Catmull-Clark step of an untagged manifold polygon mesh, vectorized; None otherwise.
+
+    The rules of :func:`ccproof.mesh.rules.refine_complex` for a mesh without tags, holes or
+    non-default options (bmz04 Fig. 1, docs/readings.md R1; boundary edges infinitely sharp: edge
+    midpoints and the crease rule ``(3/4) V + (1/8)(e0 + e1)`` at boundary vertices), in the layout of
+    :meth:`ccproof.mesh.polymesh.PolyMesh.refine`: vertex points (n), edge points (E, edges numbered
+    by first occurrence along the faces' corners), face points (m); child ``offsets[f] + i`` of face
+    f is ``(v_i, edge point (v_i, v_i+1), face point, edge point (v_i-1, v_i))``. Evaluated from the
+    face points (float weights of :mod:`ccproof.rule_weights`), not as stencils of the old vertices:
+    the same values to round-off.
+
+    Parameters
+    ----------
+    mesh : PolyMesh
+
+    Returns
+    -------
+    (X1, F1) or None
+        ``X1`` (n + E + m, 3) float64, ``F1`` (sum of face sizes, 4) int64; None for a tagged mesh
+        (creases, corners, holes, boundary mode "none", smooth triangle subdivision, a one-face
+        boundary vertex under "edge_and_corner"), one with unused vertices, a non-manifold edge or a
+        vertex with more than one boundary edge pair.
+    """
+    from ccproof.rule_weights import crease_vertex_weights, smooth_edge_weights, smooth_vertex_weights
+
+    opts = mesh.options
+    if (mesh.edge_sharpness or mesh.vertex_sharpness or np.asarray(mesh.is_hole).any()
+            or opts.triangle_subdivision != "catmark" or opts.boundary == "none"):
+        return None
+    X = np.asarray(mesh.vertices, dtype=np.float64)
+    idx = np.asarray(mesh.indices, dtype=np.int64)
+    sizes = np.asarray(mesh.sizes, dtype=np.int64)
+    off = np.asarray(mesh.offsets, dtype=np.int64)[:sizes.size]
+    n, m, H = X.shape[0], sizes.size, idx.size
+    face = np.repeat(np.arange(m), sizes)
+    pos = np.arange(H) - off[face]
+    nxt = off[face] + (pos + 1) % sizes[face]
+    prv = off[face] + (pos - 1) % sizes[face]
+    org, dst = idx, idx[nxt]
+    if np.unique(org * n + dst).size != H:  # a directed edge twice: non-manifold or misoriented
+        return None
+    lo, hi = np.minimum(org, dst), np.maximum(org, dst)
+    uniq, first, inv = np.unique(lo * n + hi, return_index=True, return_inverse=True)
+    inv = inv.reshape(-1)
+    E = uniq.size
+    order = np.argsort(first, kind="stable")
+    rank = np.empty(E, dtype=np.int64)
+    rank[order] = np.arange(E)
+    he_edge = rank[inv]  # edge id of every half-edge (first-occurrence order)
+    count = np.bincount(he_edge, minlength=E)
+    if (count > 2).any():
+        return None
+    valence = np.bincount(org, minlength=n)  # faces (outgoing half-edges) at every vertex
+    if (valence == 0).any():
+        return None
+    bnd_h = count[he_edge] == 1  # boundary half-edges
+    nb_out = np.bincount(org[bnd_h], minlength=n)
+    nb_in = np.bincount(dst[bnd_h], minlength=n)
+    if (nb_out > 1).any() or (nb_in != nb_out).any():
+        return None
+    if opts.boundary == "edge_and_corner" and ((nb_out > 0) & (valence == 1)).any():
+        return None  # a one-face corner: sharp from level 1 on (a tagged level-1 mesh)
+    one = 1.0
+    fp = np.add.reduceat(X[idx], off, axis=0) / sizes[:, None] if m else np.zeros((0, 3))
+    # edge points
+    h1 = first[order]  # the first half-edge of every edge, in edge order
+    h2 = np.full(E, -1, dtype=np.int64)
+    second = np.flatnonzero(np.arange(H) != first[inv])
+    h2[he_edge[second]] = second
+    a, b = org[h1], dst[h1]
+    vw, fw = smooth_edge_weights(one)
+    ep = 0.5 * (X[a] + X[b])
+    inner = h2 >= 0
+    ep[inner] = vw * (X[a[inner]] + X[b[inner]]) + fw * (fp[face[h1[inner]]] + fp[face[h2[inner]]])
+    # vertex points
+    vp = np.empty((n, 3))
+    sum_e = np.stack([np.bincount(org, weights=X[dst, c], minlength=n) for c in range(3)], axis=1)
+    sum_f = np.stack([np.bincount(org, weights=fp[face, c], minlength=n) for c in range(3)], axis=1)
+    wv, we, wf = smooth_vertex_weights(valence, one)
+    vp[:] = wv[:, None] * X + we[:, None] * sum_e + wf[:, None] * sum_f
+    bv = np.flatnonzero(nb_out > 0)
+    if bv.size:
+        cw, ce = crease_vertex_weights(one)
+        bn = np.zeros((n, 3))
+        np.add.at(bn, org[bnd_h], X[dst[bnd_h]])
+        np.add.at(bn, dst[bnd_h], X[org[bnd_h]])
+        vp[bv] = cw * X[bv] + ce * bn[bv]
+    X1 = np.concatenate([vp, ep, fp])
+    F1 = np.stack([org, n + he_edge, n + E + face, n + he_edge[prv]], axis=1)
+    return X1, F1

@@ -618,7 +618,7 @@ def _numba_kernel(backend):
     return evaluate_points
 
 
-def natural_limit_surface(mesh):
+def natural_limit_surface(mesh, *, progress=None):
     """Prepare the exact evaluation of the limit surface of ``mesh`` in its natural parameterization.
 
     The package-wide entry point is :func:`ccproof.limit_surface` (the same surfaces, plus the
@@ -633,6 +633,9 @@ def natural_limit_surface(mesh):
         :func:`ccproof.mesh.io.read_mesh` (OBJ with OpenSubdiv tags, or any meshio format): an
         untagged all-quad file gives a LimitSurface on a QuadMesh, anything else (triangles,
         n-gons, creases, corners, holes, boundary modes) the tagged evaluator.
+    progress : bool, optional
+        Show a progress bar (tqdm, on stderr) when the setup takes more than 2 s; default: when
+        stderr is a terminal.
 
     Returns
     -------
@@ -645,20 +648,21 @@ def natural_limit_surface(mesh):
     (1, 3)
     """
     if isinstance(mesh, QuadMesh):
-        return LimitSurface(mesh)
+        return LimitSurface(mesh, progress=progress)
     from ccproof.evaluate.tagged import TaggedLimitSurface
     from ccproof.mesh.polymesh import PolyMesh
 
     if isinstance(mesh, PolyMesh):
-        return TaggedLimitSurface(mesh)
+        return TaggedLimitSurface(mesh, progress=progress)
     from ccproof.mesh.io import read_mesh
 
     mesh = read_mesh(mesh)
     if mesh.is_all_quads and not mesh.has_tags:
         # a file holding an untagged all-quad mesh: the QuadMesh evaluator, as before (same numbers
         # as the tagged one to round-off; ``S.mesh`` is a QuadMesh)
-        return LimitSurface(QuadMesh(mesh.vertices, np.array(mesh.polygons, dtype=np.int64).reshape(-1, 4)))
-    return TaggedLimitSurface(mesh)
+        return LimitSurface(QuadMesh(mesh.vertices, np.array(mesh.polygons, dtype=np.int64).reshape(-1, 4)),
+                            progress=progress)
+    return TaggedLimitSurface(mesh, progress=progress)
 
 
 #: former name, kept importable for ccproof/evaluate/cli.py, ccproof/reparam/cli.py and tests; the

@@ -5,7 +5,8 @@ evaluator (:class:`ccproof.evaluate.surface._Builder`: same classification, arra
 kernels), from the tagged rules of :mod:`ccproof.mesh.rules`:
 
 1. One global Catmull-Clark step (n-gons become quads; ``TRI_SUB_SMOOTH`` and the
-   ``EDGE_AND_CORNER`` corners act here). A quad's ptex face is split into its four level-1
+   ``EDGE_AND_CORNER`` corners act here); on an untagged mesh vectorized
+   (:func:`ccproof.evaluate._table.catmark_step`). A quad's ptex face is split into its four level-1
    children; sub-face k of an n-gon *is* level-1 child k (same (s, t)).
 2. Semi-sharp phase: while an edge at a vertex of the face or the vertex itself has a semi-sharp
    sharpness (0 < s < 10), the face's neighbourhood is refined exactly and locally
@@ -32,7 +33,7 @@ import math
 import numpy as np
 
 from ccproof.errors import CCProofError
-from ccproof.evaluate._table import QuadHalfEdges, _Builder, _child_frame, _compose, _domain, _Jobs
+from ccproof.evaluate._table import QuadHalfEdges, _Builder, _child_frame, _compose, _domain, _Jobs, catmark_step
 from ccproof.evaluate.surface import LimitSurface
 from ccproof.mesh.polymesh import PolyMesh
 from ccproof.mesh.rules import Complex
@@ -97,12 +98,14 @@ class TaggedLimitSurface(LimitSurface):
             self._hole_ptex = mesh.is_hole[self._ptex_face]
             self._finish(b, top, self._hole_ptex)
             return
-        m1, _ = mesh.refine()
-        if not m1.edge_sharpness and not m1.vertex_sharpness:
-            cx = QuadHalfEdges(np.asarray(m1.polygons, dtype=np.int64), m1.n_vertices, m1.options)
+        step = catmark_step(mesh)  # untagged: vectorized, and the level-1 complex as arrays
+        if step is not None:
+            X, F1 = step
+            cx = QuadHalfEdges(F1, X.shape[0], mesh.options)
         else:
+            m1, _ = mesh.refine()
             cx = m1.complex()
-        X = np.asarray(m1.vertices)
+            X = np.asarray(m1.vertices)
         # jobs: sub-face i of an n-gon is level-1 child i (same (s, t)), its own ptex face; a quad is
         # one ptex face whose four level-1 children are its quadrants (frames: the child frames)
         frames = [ident]
