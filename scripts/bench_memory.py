@@ -75,8 +75,8 @@ from ccproof.evaluate.surface import natural_limit_surface
 t1 = time.perf_counter()
 S = natural_limit_surface(sys.argv[1], progress=False)
 t2 = time.perf_counter()
-print(json.dumps({"import_s": t1 - t0, "setup_s": t2 - t1, "n_ptex": int(S.n_faces), "table_bytes": int(S.table_bytes),
-                  "configuration_bytes": int(S.configuration_bytes), "templates": len(S._groups),
+print(json.dumps({"import_s": t1 - t0, "setup_s": t2 - t1, "n_ptex": int(S.n_faces),
+                  "table_bytes": int(S.table_bytes), "configuration_bytes": int(S.configuration_bytes), "templates": len(S._groups),
                   "configurations": len(S._schemes), "peak_rss": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024}))
 """
 
@@ -153,7 +153,8 @@ int main(int argc, char **argv) {
     size_t bytes = (m1.uordblks + m1.hblkhd) - (m0.uordblks + m0.hblkhd);
     struct rusage ru;
     getrusage(RUSAGE_SELF, &ru);
-    printf("%zu %d %d %ld\n", bytes, Far::PtexIndices(*r).GetNumFaces(), pt->GetNumPatchesTotal(), ru.ru_maxrss * 1024L);
+    printf("%zu %d %d %ld\n", bytes, Far::PtexIndices(*r).GetNumFaces(), pt->GetNumPatchesTotal(),
+           ru.ru_maxrss * 1024L);
     delete pt;
     delete r;
     return 0;
@@ -246,7 +247,8 @@ def main(argv=None):
 
 
 def _print_row(row):
-    print(f"level {row['level']}: {row['triangles']} triangles, {row['n_ptex']} ptex faces; setup {row['setup_s']:.2f} s "
+    print(f"level {row['level']}: {row['triangles']} triangles, {row['n_ptex']} ptex faces; "
+          f"setup {row['setup_s']:.2f} s "
           f"(imports {row['import_s']:.2f} s); table {row['table_bytes'] / 1e6:.1f} MB "
           f"({row['configuration_bytes'] / 1e6:.1f} MB in {row['configurations']} configurations and "
           f"{row['templates']} templates); peak RSS of the build {row['peak_rss'] / 1e9:.2f} GB"
