@@ -76,8 +76,9 @@ t1 = time.perf_counter()
 S = natural_limit_surface(sys.argv[1], progress=False)
 t2 = time.perf_counter()
 print(json.dumps({"import_s": t1 - t0, "setup_s": t2 - t1, "n_ptex": int(S.n_faces),
-                  "table_bytes": int(S.table_bytes), "configuration_bytes": int(S.configuration_bytes), "templates": len(S._groups),
-                  "configurations": len(S._schemes), "peak_rss": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024}))
+                  "table_bytes": int(S.table_bytes), "configuration_bytes": int(S.configuration_bytes),
+                  "templates": len(S._groups), "configurations": len(S._schemes),
+                  "peak_rss": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024}))
 """
 
 _EVAL_JOB = r"""
