@@ -67,7 +67,7 @@ class PatchTable(NamedTuple):
 
     Attributes
     ----------
-    top : int64 (P, 4)
+    top : int32 (P, 4) (int64 beyond 2^31 jobs)
         Job of each quadrant ``(u >= 1/2) + 2 (v >= 1/2)`` of every ptex face (all four equal
         unless the ptex face is a quad split into its four level-1 children).
     refused : bool (P,)
@@ -766,7 +766,7 @@ class _Builder:
         c = np.array(corner, dtype=bool).reshape(-1, 2)
         nets, origin, ring = job_floats(groups, self.X, (n_reg, n_cor, n_pts), self.progress)
         T = PatchTable(
-            top=np.ascontiguousarray(top, dtype=np.int64), refused=np.ascontiguousarray(refused, dtype=np.bool_),
+            top=np.ascontiguousarray(top, dtype=np.int32 if J < 2**31 else np.int64), refused=np.ascontiguousarray(refused, dtype=np.bool_),
             job_root=job_root, job_net=job_net, job_corner=job_corner, job_pts=job_pts,
             kind=np.array(kind, dtype=np.int8), child=np.array(child, dtype=np.int64).reshape(-1, 4),
             u0=d[:, 0].copy(), v0=d[:, 1].copy(), h=d[:, 2].copy(), leaf=np.array(leaf, dtype=np.int64),

@@ -106,12 +106,16 @@ class LimitSurface:
                    vmap=np.arange(mesh.n_vertices))
         self._finish(b, np.repeat(np.arange(m, dtype=np.int64)[:, None], 4, axis=1), np.zeros(m, dtype=np.bool_))
 
-    def _finish(self, b, top, refused):
+    def _finish(self, b, top, refused, keep_rings=True):
         """The patch table from a :class:`_Builder` that has classified every job; ``top`` (P, 4) the
-        job of each quadrant of every ptex face, ``refused`` (P,) the ptex faces evaluation refuses."""
+        job of each quadrant of every ptex face, ``refused`` (P,) the ptex faces evaluation refuses;
+        ``keep_rings``: keep the jobs' rings (for :meth:`with_vertices` and :meth:`vertex_normals`)."""
         self._table, self._groups = b.table(top, refused)
         self._schemes = [s for s, _ in b.schemes]
         self._job_base = np.frombuffer(b.job_base, dtype=np.int64).copy() if len(b.job_base) else np.zeros(0, np.int64)
+        if not keep_rings:
+            self._groups = [(t, None, None) for t, _, _ in self._groups]
+            self._job_base = np.zeros(0, np.int64)
         self._vmap = b.vmap
         self._corner_normal = {}
         T = self._table
@@ -125,7 +129,7 @@ class LimitSurface:
         operators (the mesh itself not included); :attr:`configuration_bytes` of them are per
         configuration, the rest grows with the faces."""
         n = sum(a.nbytes for a in self._table if isinstance(a, np.ndarray))
-        n += sum(rings.nbytes + jobs.nbytes for _, jobs, rings in self._groups)
+        n += sum(rings.nbytes + jobs.nbytes for _, jobs, rings in self._groups if rings is not None)
         return n + self._job_base.nbytes + sum(t.R.nbytes + t.Q.nbytes + t.O.nbytes for t, _, _ in self._groups)
 
     @property
@@ -482,7 +486,7 @@ class LimitSurface:
             return out
         T = self._table
         for t, jobs, rings in self._groups:
-            if not jobs.size:
+            if jobs is None or not jobs.size:
                 continue
             for c, pos in enumerate(t.cor_vertex):
                 if pos < 0:

@@ -96,7 +96,7 @@ class TaggedLimitSurface(LimitSurface):
             b.classify(cx, np.asarray(mesh.vertices), _Jobs(np.arange(m), np.zeros(m, np.int64), np.arange(m), [ident]))
             top = np.repeat(np.arange(P, dtype=np.int64)[:, None], 4, axis=1)
             self._hole_ptex = mesh.is_hole[self._ptex_face]
-            self._finish(b, top, self._hole_ptex)
+            self._finish(b, top, self._hole_ptex, keep_rings=False)
             return
         step = catmark_step(mesh)  # untagged: vectorized, and the level-1 complex as arrays
         if step is not None:
@@ -133,7 +133,7 @@ class TaggedLimitSurface(LimitSurface):
         top[ptex[qd], np.asarray(quarter_q)[corner[qd]]] = jid[qd]
         b.classify(cx, X, _Jobs(g, fid, ptex, frames))
         self._hole_ptex = mesh.is_hole[self._ptex_face]
-        self._finish(b, top, self._hole_ptex)
+        self._finish(b, top, self._hole_ptex, keep_rings=False)
 
     @property
     def n_faces(self):
