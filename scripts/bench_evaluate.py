@@ -426,7 +426,7 @@ def naive_point(S, f, u, v):
         Nc = int(T.op_size[cfg])
         o = int(T.op_start[cfg]) + (3 * n + code) * 16 * Nc
         q0 = int(T.job_pts[job] + T.pts[vf])
-        ring = T.ring[q0:q0 + Nc].tolist()
+        ring = [[0.0] * 3] + T.ring[q0:q0 + Nc - 1].tolist()  # row 0 (the vertex) is not stored
         ops = T.ops[o:o + 16 * Nc].tolist()
         net = [[sum(ops[i * Nc + k] * ring[k][c] for k in range(Nc)) for c in range(3)] for i in range(16)]
         origin = T.origin[int(T.job_corner[job] + T.leaf[vf])].tolist()

@@ -109,13 +109,13 @@ def _evaluate_points(f, u, v, d, T, P, Pu, Pv, Puu, Puv, Pvv):
             h = T.unit[cfg, code, 2] * sc
             Nc = T.op_size[cfg]
             o = T.op_start[cfg] + (3 * lay + code) * 16 * Nc
-            q0 = T.job_pts[job] + T.pts[vf]
+            q0 = T.job_pts[job] + T.pts[vf] - 1  # ring row j >= 1 (row 0, the vertex, is 0)
             for i in range(16):
                 x0 = 0.0
                 x1 = 0.0
                 x2 = 0.0
                 r = o + i * Nc
-                for j in range(Nc):
+                for j in range(1, Nc):
                     w = T.ops[r + j]
                     x0 += w * T.ring[q0 + j, 0]
                     x1 += w * T.ring[q0 + j, 1]

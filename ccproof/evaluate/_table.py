@@ -72,7 +72,7 @@ class PatchTable(NamedTuple):
         unless the ptex face is a quad split into its four level-1 children).
     refused : bool (P,)
         Ptex faces evaluation refuses (holes).
-    job_root, job_net, job_corner, job_pts : int64 (J,)
+    job_root, job_net, job_corner, job_pts : int32 (J,) (int64 where the offsets need it)
         Per job: the root virtual face of its template, and the offsets of its regular nets in
         ``nets``, of its corner faces in ``origin``, of its corner rings in ``ring``.
     kind : int8 (T,)
@@ -96,7 +96,7 @@ class PatchTable(NamedTuple):
     origin : float64 (n_corner, 3)
         Limit point of each corner face's irregular corner.
     ring : float64 (n_points, 3)
-        Corner rings relative to their corner vertex (row 0 of each is 0).
+        Corner rings relative to their corner vertex, rows 1 .. Nc - 1 (row 0, the vertex, is 0).
     ops : float64 (sum of n_layers * 48 * Nc,)
         Per configuration its layer operators ``L`` (n_layers, 3, 16, Nc), row ``(n, code, i)`` entry
         i of the net of layer n, patch ``code`` (0 along u, 1 diagonal, 2 along v), base orientation.
@@ -250,7 +250,7 @@ class _Template:
         self.n = n  # ring size N
         self.kind, self.dom, self.child, self.leaf, self.pts, self.cfg, self.corner = [], [], [], [], [], [], []
         self.reg = []  # (17, N) per regular patch
-        self.cor = []  # (Nc + 1, N) per corner face: ring relative to its vertex, then the limit point
+        self.cor = []  # (Nc, N) per corner face: ring relative to its vertex (rows 1..), then the limit point
         self.cor_vertex = []  # ring position of each corner face's vertex (-1: a new point)
         self.n_pts = 0
         self.jobs = array("q")
@@ -673,13 +673,13 @@ class _Builder:
         corner = rot[0]
         t.corner[vid] = (int(corner[0] > U0), int(corner[1] > V0))
         rel = C - C[0]
-        op = np.empty((C.shape[0] + 1, C.shape[1]))
-        op[:-1] = rel
+        op = np.empty((C.shape[0], C.shape[1]))  # row 0 of the relative ring is 0: not stored
+        op[:-1] = rel[1:]
         op[-1] = C[0] + scheme.limit_mask @ rel
         t.leaf[vid] = len(t.cor)
         t.pts[vid] = t.n_pts
         t.cfg[vid] = cfg
-        t.n_pts += C.shape[0]
+        t.n_pts += C.shape[0] - 1
         t.cor.append(op)
         t.cor_vertex.append(int(vmap[ring_r[0]]))
         return vid
@@ -765,9 +765,13 @@ class _Builder:
         d = np.array(dom, dtype=np.float64).reshape(-1, 3)
         c = np.array(corner, dtype=bool).reshape(-1, 2)
         nets, origin, ring = job_floats(groups, self.X, (n_reg, n_cor, n_pts), self.progress)
+        def small(a, bound):  # int32 where it fits (the per-face arrays are the big ones)
+            return np.ascontiguousarray(a, dtype=np.int32 if bound < 2**31 else np.int64)
+
         T = PatchTable(
-            top=np.ascontiguousarray(top, dtype=np.int32 if J < 2**31 else np.int64), refused=np.ascontiguousarray(refused, dtype=np.bool_),
-            job_root=job_root, job_net=job_net, job_corner=job_corner, job_pts=job_pts,
+            top=small(top, J), refused=np.ascontiguousarray(refused, dtype=np.bool_),
+            job_root=small(job_root, n_tv), job_net=small(job_net, n_reg), job_corner=small(job_corner, n_cor),
+            job_pts=small(job_pts, n_pts),
             kind=np.array(kind, dtype=np.int8), child=np.array(child, dtype=np.int64).reshape(-1, 4),
             u0=d[:, 0].copy(), v0=d[:, 1].copy(), h=d[:, 2].copy(), leaf=np.array(leaf, dtype=np.int64),
             pts=np.array(pts, dtype=np.int64), cfg=np.array(cfg, dtype=np.int64),

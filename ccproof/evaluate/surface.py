@@ -281,12 +281,12 @@ class LimitSurface:
                     sel = np.flatnonzero(cfg == c)
                     Nc, nl, st = int(T.op_size[c]), int(T.n_layers[c]), int(T.op_start[c])
                     Lc = T.ops[st:st + nl * 48 * Nc].reshape(nl * 3, 16, Nc)
-                    Q = T.ring[q0[sel][:, None] + np.arange(Nc)]
+                    Q = T.ring[q0[sel][:, None] + np.arange(Nc - 1)]  # rows 1.. (row 0 is 0)
                     rows = idx[sel]
                     Ls = Lc[3 * n[sel] + code[sel]]  # (k, 16, Nc)
                     acc = np.zeros((sel.size, 16, 3))
-                    for j in range(Nc):  # summed in the compiled kernel's order: the same bits
-                        acc += Ls[:, :, j, None] * Q[:, None, j, :]
+                    for j in range(1, Nc):  # summed in the compiled kernel's order: the same bits
+                        acc += Ls[:, :, j, None] * Q[:, None, j - 1, :]
                     N[rows, :16] = acc
                     N[rows, 16] = T.origin[ci[sel]]
         s = np.clip((u - pu0) / h, 0.0, 1.0)
@@ -406,7 +406,7 @@ class LimitSurface:
         T = self._table
         cfg = int(T.cfg[vf])
         q = int(T.job_pts[job] + T.pts[vf])
-        return self._schemes[cfg], T.ring[q:q + int(T.op_size[cfg])]
+        return self._schemes[cfg], np.vstack([np.zeros((1, 3)), T.ring[q:q + int(T.op_size[cfg]) - 1]])
 
     def _eigen_normal(self, job, vf):
         """Unit normal at the irregular corner of corner face ``vf`` of ``job`` from the exact tangent masks."""

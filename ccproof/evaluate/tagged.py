@@ -100,8 +100,8 @@ class TaggedLimitSurface(LimitSurface):
             return
         step = catmark_step(mesh)  # untagged: vectorized, and the level-1 complex as arrays
         if step is not None:
-            X, F1 = step
-            cx = QuadHalfEdges(F1, X.shape[0], mesh.options)
+            X = step[0]
+            cx = QuadHalfEdges(step[1], X.shape[0], mesh.options)
         else:
             m1, _ = mesh.refine()
             cx = m1.complex()
@@ -132,6 +132,7 @@ class TaggedLimitSurface(LimitSurface):
         qd = np.flatnonzero(is_quad)
         top[ptex[qd], np.asarray(quarter_q)[corner[qd]]] = jid[qd]
         b.classify(cx, X, _Jobs(g, fid, ptex, frames))
+        del cx, step, g, fid, ptex, face, corner, is_quad, jid  # before the table's float data
         self._hole_ptex = mesh.is_hole[self._ptex_face]
         self._finish(b, top, self._hole_ptex, keep_rings=False)
 
