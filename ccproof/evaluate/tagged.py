@@ -125,7 +125,7 @@ class TaggedLimitSurface(LimitSurface):
         g = np.asarray(mesh.offsets, dtype=np.int64)[:nf][face] + corner
         fid = np.where(is_quad, 1 + corner, 0)
         self._ptex_face[ptex] = face
-        top = np.empty((P, 4), dtype=np.int64)
+        top = np.empty((P, 4), dtype=np.int32 if len(mesh.indices) < 2**31 else np.int64)
         jid = np.arange(face.size)
         nq = np.flatnonzero(~is_quad)
         top[ptex[nq]] = jid[nq, None]
