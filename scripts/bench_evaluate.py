@@ -428,7 +428,7 @@ def naive_point(S, f, u, v):
         q0 = int(T.job_pts[job] + T.pts[vf])
         ring = [[0.0] * 3] + T.ring[q0:q0 + Nc - 1].tolist()  # row 0 (the vertex) is not stored
         ops = T.ops[o:o + 16 * Nc].tolist()
-        net = [[sum(ops[i * Nc + k] * ring[k][c] for k in range(Nc)) for c in range(3)] for i in range(16)]
+        net = [[sum(ops[16 * k + i] * ring[k][c] for k in range(Nc)) for c in range(3)] for i in range(16)]
         origin = T.origin[int(T.job_corner[job] + T.leaf[vf])].tolist()
         sc = math.ldexp(H, -n)
         pu0 = T.unit[cfg, code, 0] * sc + (U0 + H if T.cu[vf] else U0)

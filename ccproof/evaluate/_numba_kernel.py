@@ -111,18 +111,19 @@ def _evaluate_points(f, u, v, d, T, P, Pu, Pv, Puu, Puv, Pvv):
             o = T.op_start[cfg] + (3 * lay + code) * 16 * Nc
             q0 = T.job_pts[job] + T.pts[vf] - 1  # ring row j >= 1 (row 0, the vertex, is 0)
             for i in range(16):
-                x0 = 0.0
-                x1 = 0.0
-                x2 = 0.0
-                r = o + i * Nc
-                for j in range(1, Nc):
-                    w = T.ops[r + j]
-                    x0 += w * T.ring[q0 + j, 0]
-                    x1 += w * T.ring[q0 + j, 1]
-                    x2 += w * T.ring[q0 + j, 2]
-                W[0, i, 0] = x0
-                W[0, i, 1] = x1
-                W[0, i, 2] = x2
+                W[0, i, 0] = 0.0
+                W[0, i, 1] = 0.0
+                W[0, i, 2] = 0.0
+            for j in range(1, Nc):  # entry (i, c): summed over j in order, the 16 i side by side
+                r0 = T.ring[q0 + j, 0]
+                r1 = T.ring[q0 + j, 1]
+                r2 = T.ring[q0 + j, 2]
+                r = o + 16 * j
+                for i in range(16):
+                    w = T.ops[r + i]
+                    W[0, i, 0] += w * r0
+                    W[0, i, 1] += w * r1
+                    W[0, i, 2] += w * r2
             ci = T.job_corner[job] + T.leaf[vf]
             for c in range(3):
                 W[0, 16, c] = T.origin[ci, c]

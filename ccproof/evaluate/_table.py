@@ -98,8 +98,9 @@ class PatchTable(NamedTuple):
     ring : float64 (n_points, 3)
         Corner rings relative to their corner vertex, rows 1 .. Nc - 1 (row 0, the vertex, is 0).
     ops : float64 (sum of n_layers * 48 * Nc,)
-        Per configuration its layer operators ``L`` (n_layers, 3, 16, Nc), row ``(n, code, i)`` entry
-        i of the net of layer n, patch ``code`` (0 along u, 1 diagonal, 2 along v), base orientation.
+        Per configuration its layer operators ``L`` laid out (n_layers, 3, Nc, 16): ``[n, code, j, i]``
+        the weight of ring point j in entry i of the net of layer n, patch ``code`` (0 along u, 1
+        diagonal, 2 along v), base orientation (the 16 entries of one ring point contiguous).
     op_start, op_size, n_layers : int64 (n_cfg,)
         Offset in ``ops``, ring size Nc and number of layers of each configuration.
     unit : float64 (n_cfg, 3, 3)
@@ -756,7 +757,8 @@ class _Builder:
         off = 0
         for scheme, orient in self.schemes:
             L, u = _oriented_layers(scheme, orient)
-            ops.append(L.reshape(-1))
+            nl_, nc_ = scheme.n_layers, L.shape[1]
+            ops.append(L.reshape(nl_ * 3, 16, nc_).transpose(0, 2, 1).reshape(-1))  # (layer, code, j, i)
             op_start.append(off)
             op_size.append(L.shape[1])
             n_layers.append(scheme.n_layers)

@@ -280,13 +280,13 @@ class LimitSurface:
                 for c in np.unique(cfg).tolist():
                     sel = np.flatnonzero(cfg == c)
                     Nc, nl, st = int(T.op_size[c]), int(T.n_layers[c]), int(T.op_start[c])
-                    Lc = T.ops[st:st + nl * 48 * Nc].reshape(nl * 3, 16, Nc)
+                    Lc = T.ops[st:st + nl * 48 * Nc].reshape(nl * 3, Nc, 16)
                     Q = T.ring[q0[sel][:, None] + np.arange(Nc - 1)]  # rows 1.. (row 0 is 0)
                     rows = idx[sel]
-                    Ls = Lc[3 * n[sel] + code[sel]]  # (k, 16, Nc)
+                    Ls = Lc[3 * n[sel] + code[sel]]  # (k, Nc, 16)
                     acc = np.zeros((sel.size, 16, 3))
                     for j in range(1, Nc):  # summed in the compiled kernel's order: the same bits
-                        acc += Ls[:, :, j, None] * Q[:, None, j - 1, :]
+                        acc += Ls[:, j, :, None] * Q[:, None, j - 1, :]
                     N[rows, :16] = acc
                     N[rows, 16] = T.origin[ci[sel]]
         s = np.clip((u - pu0) / h, 0.0, 1.0)
