@@ -37,6 +37,32 @@ def _basis(x, B, r):
     B[r + 2, 3] = x
 
 
+def _corner_net(T, job, vf, cfg, lay, code, ci, W):
+    """Net ``W[0]`` (17 x 3, row 16 the limit point) of patch ``code`` of layer ``lay`` of corner face
+    ``vf`` of ``job``: ``L[lay, code] @ ring`` summed over the ring points j = 1, 2, ... in order
+    (row 0 of the relative ring is 0), the 16 entries side by side."""
+    Nc = T.op_size[cfg]
+    o = T.op_start[cfg] + (3 * lay + code) * 16 * Nc
+    q0 = T.job_pts[job] + T.pts[vf] - 1  # ring row j >= 1 (row 0, the vertex, is 0)
+    for i in range(16):
+        W[0, i, 0] = 0.0
+        W[0, i, 1] = 0.0
+        W[0, i, 2] = 0.0
+    for j in range(1, Nc):
+        r0 = T.ring[q0 + j, 0]
+        r1 = T.ring[q0 + j, 1]
+        r2 = T.ring[q0 + j, 2]
+        r = o + 16 * j
+        for i in range(16):
+            w = T.ops[r + i]
+            W[0, i, 0] += w * r0
+            W[0, i, 1] += w * r1
+            W[0, i, 2] += w * r2
+    for c in range(3):
+        W[0, 16, c] = T.origin[ci, c]
+    return W
+
+
 def _evaluate_points(f, u, v, d, T, P, Pu, Pv, Puu, Puv, Pvv):
     """Fill P (n, 3) and, for d >= 1, Pu, Pv, for d >= 2, Puu, Puv, Pvv (each (n, 3)) from the patch
     table ``T`` (:class:`ccproof.evaluate._table.PatchTable`).
@@ -107,28 +133,13 @@ def _evaluate_points(f, u, v, d, T, P, Pu, Pv, Puu, Puv, Pvv):
             pu0 = T.unit[cfg, code, 0] * sc + ((U0 + H) if cu else U0)
             pv0 = T.unit[cfg, code, 1] * sc + ((V0 + H) if cv else V0)
             h = T.unit[cfg, code, 2] * sc
-            Nc = T.op_size[cfg]
-            o = T.op_start[cfg] + (3 * lay + code) * 16 * Nc
-            q0 = T.job_pts[job] + T.pts[vf] - 1  # ring row j >= 1 (row 0, the vertex, is 0)
-            for i in range(16):
-                W[0, i, 0] = 0.0
-                W[0, i, 1] = 0.0
-                W[0, i, 2] = 0.0
-            for j in range(1, Nc):  # entry (i, c): summed over j in order, the 16 i side by side
-                r0 = T.ring[q0 + j, 0]
-                r1 = T.ring[q0 + j, 1]
-                r2 = T.ring[q0 + j, 2]
-                r = o + 16 * j
-                for i in range(16):
-                    w = T.ops[r + i]
-                    W[0, i, 0] += w * r0
-                    W[0, i, 1] += w * r1
-                    W[0, i, 2] += w * r2
             ci = T.job_corner[job] + T.leaf[vf]
-            for c in range(3):
-                W[0, 16, c] = T.origin[ci, c]
-            net = W
-            p = 0
+            if lay == 0 and T.hot.shape[0] > 0:  # layer 0 precomputed: the same sums
+                net = T.hot
+                p = 3 * ci + code
+            else:
+                net = _corner_net(T, job, vf, cfg, lay, code, ci, W)
+                p = 0
         else:
             net = T.nets
             p = T.job_net[job] + T.leaf[vf]
@@ -395,6 +406,7 @@ def _ring_walks(org, nxt, prv, twin, pos, seen, g, r, rings, nring, faces, nface
 
 if numba is not None:
     _basis = numba.njit(cache=True, nogil=True)(_basis)
+    _corner_net = numba.njit(cache=True, nogil=True)(_corner_net)
     evaluate_points = numba.njit(cache=True, nogil=True)(_evaluate_points)
     _dot3 = numba.njit(cache=True, nogil=True, inline="always")(_dot3)
     _free = numba.njit(cache=True, nogil=True, inline="always")(_free)

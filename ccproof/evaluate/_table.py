@@ -60,6 +60,9 @@ MAX_DEPTH = 4
 MAX_SEMI_DEPTH = 40
 #: jobs per block when the float data are computed (bounds the temporaries)
 _BLOCK = 1 << 13
+#: largest size of the layer-0 nets of the corner faces kept precomputed (``PatchTable.hot``, 1,224
+#: bytes per corner face); beyond it every corner net is computed at evaluation time
+HOT_BUDGET = 32 << 20
 
 
 class PatchTable(NamedTuple):
@@ -105,6 +108,11 @@ class PatchTable(NamedTuple):
         Offset in ``ops``, ring size Nc and number of layers of each configuration.
     unit : float64 (n_cfg, 3, 3)
         ``(u0, v0, h)`` of the three patches of layer 0 for a corner frame of side 1 at the origin.
+    hot : float64 (3 n_corner, 17, 3) or (0, 17, 3)
+        The nets of layer 0 of every corner face (patch ``3 c + code``, row 16 the limit point),
+        computed like the kernel computes them (the same sums in the same order), kept when they fit
+        :data:`HOT_BUDGET`; empty otherwise. A uniformly random point of a corner face is in layer 0
+        with probability 3/4.
     """
 
     top: np.ndarray
@@ -132,6 +140,7 @@ class PatchTable(NamedTuple):
     op_size: np.ndarray
     n_layers: np.ndarray
     unit: np.ndarray
+    hot: np.ndarray
 
 
 # ---------------------------------------------------------------------------------- frames
@@ -780,7 +789,9 @@ class _Builder:
             cu=c[:, 0].copy(), cv=c[:, 1].copy(), split_depth=depth, nets=nets, origin=origin, ring=ring,
             ops=np.concatenate(ops) if ops else np.zeros(0), op_start=np.array(op_start, dtype=np.int64),
             op_size=np.array(op_size, dtype=np.int64), n_layers=np.array(n_layers, dtype=np.int64),
-            unit=np.array(unit, dtype=np.float64).reshape(-1, 3, 3))
+            unit=np.array(unit, dtype=np.float64).reshape(-1, 3, 3), hot=np.zeros((0, 17, 3)))
+        if 0 < n_cor and n_cor * 3 * 17 * 3 * 8 <= HOT_BUDGET:
+            T = T._replace(hot=layer0_nets(T, groups))
         return T, groups
 
 
@@ -933,3 +944,31 @@ def catmark_step(mesh):
     X1 = np.concatenate([vp, ep, fp])
     F1 = np.stack([org, n + he_edge, n + E + face, n + he_edge[prv]], axis=1)
     return X1, F1
+
+
+def layer0_nets(T, groups):
+    """The nets of layer 0 of every corner face of table ``T`` (see :attr:`PatchTable.hot`): per
+    corner face c and patch code, ``sum_j L[0, code, j] ring[j]`` summed over j = 1, 2, ... in order
+    (the compiled kernel's sums), row 16 the limit point. Shape (3 n_corner, 17, 3)."""
+    hot = np.empty((3 * T.origin.shape[0], 17, 3))
+    for t, jobs, _ in groups:
+        if jobs is None or not jobs.size or not t.O.shape[0]:
+            continue
+        o_reg, o_cor, o_pts = t.offsets
+        nc, npt = t.O.shape[0], t.Q.shape[0]
+        k = jobs.size
+        for vf, kind in enumerate(t.kind):
+            if kind != _CORNER:
+                continue
+            cfg = t.cfg[vf]
+            Nc, st = int(T.op_size[cfg]), int(T.op_start[cfg])
+            ci = o_cor + nc * np.arange(k) + t.leaf[vf]
+            q0 = o_pts + npt * np.arange(k) + t.pts[vf] - 1
+            L0 = T.ops[st:st + 48 * Nc].reshape(3, Nc, 16)
+            for code in range(3):
+                acc = np.zeros((k, 16, 3))
+                for j in range(1, Nc):
+                    acc += L0[code, j][None, :, None] * T.ring[q0 + j][:, None, :]
+                hot[3 * ci + code, :16] = acc
+                hot[3 * ci + code, 16] = T.origin[ci]
+    return hot

@@ -43,6 +43,7 @@ from ccproof.evaluate._table import (  # noqa: F401 - _child_frame, _compose, _d
     _domain,
     _Jobs,
     job_floats,
+    layer0_nets,
 )
 from ccproof.evaluate.bspline import bspline_basis
 from ccproof.mesh import QuadMesh, limit_normals, limit_positions
@@ -277,8 +278,13 @@ class LimitSurface:
             if nets:
                 q0 = T.job_pts[job[idx]] + T.pts[w]
                 cfg = T.cfg[w]
-                for c in np.unique(cfg).tolist():
-                    sel = np.flatnonzero(cfg == c)
+                todo = np.ones(idx.size, dtype=bool)
+                if T.hot.shape[0]:  # layer 0 precomputed (the same sums)
+                    h0 = np.flatnonzero(n == 0)
+                    N[idx[h0]] = T.hot[3 * ci[h0] + code[h0]]
+                    todo[h0] = False
+                for c in np.unique(cfg[todo]).tolist():
+                    sel = np.flatnonzero((cfg == c) & todo)
                     Nc, nl, st = int(T.op_size[c]), int(T.n_layers[c]), int(T.op_start[c])
                     Lc = T.ops[st:st + nl * 48 * Nc].reshape(nl * 3, Nc, 16)
                     Q = T.ring[q0[sel][:, None] + np.arange(Nc - 1)]  # rows 1.. (row 0 is 0)
@@ -570,6 +576,8 @@ class LimitSurface:
         nets, origin, ring = job_floats(self._groups, mesh.vertices, (T.nets.shape[0], T.origin.shape[0],
                                                                       T.ring.shape[0]), progress=False)
         new._table = T._replace(nets=nets, origin=origin, ring=ring)
+        if T.hot.shape[0]:
+            new._table = new._table._replace(hot=layer0_nets(new._table, self._groups))
         new._corner_normal = {}
         return new
 

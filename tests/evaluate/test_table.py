@@ -41,7 +41,7 @@ def _table_bytes(build):
     return S, cur
 
 
-def test_bytes_per_ptex_face_flat_under_refinement_and_depth(refdir):
+def test_bytes_per_ptex_face_flat_under_refinement_and_depth(refdir, monkeypatch):
     """Refining a mesh with extraordinary vertices 1, 2, 3 times before building multiplies the ptex
     faces by 4 each time; the bytes a surface keeps (tracemalloc), less those held once per
     configuration (the layer operators: O(configurations)), per ptex face stay below 4 kB and within
@@ -51,6 +51,9 @@ def test_bytes_per_ptex_face_flat_under_refinement_and_depth(refdir):
     regular patches, about four times a regular face; after more refinements most faces are
     regular); a table of stored layers would cost some 90 layers x 1.2 kB per corner face.
     """
+    from ccproof.evaluate import _table
+
+    monkeypatch.setattr(_table, "HOT_BUDGET", 0)  # no precomputed layer 0 (it is kept on small meshes only)
     mesh = read_obj_tagged(refdir / "osd_features" / "meshes" / "catmark_smoothtris1.obj")
     per_face = []
     m = mesh
@@ -79,6 +82,29 @@ def test_bytes_per_ptex_face_flat_under_refinement_and_depth(refdir):
     after, _ = tracemalloc.get_traced_memory()
     tracemalloc.stop()
     assert after - before < 1 << 12, after - before
+
+
+def test_precomputed_layer_zero_gives_the_same_bits(refdir, monkeypatch):
+    """The layer-0 nets kept precomputed on small meshes are the sums the kernels compute otherwise:
+    the same numbers, bit for bit, on both backends (points in every layer of every corner)."""
+    from ccproof.evaluate import _table
+
+    mesh = read_obj_tagged(refdir / "osd_features" / "meshes" / "catmark_smoothtris1.obj")
+    hot = TaggedLimitSurface(mesh, progress=False)
+    monkeypatch.setattr(_table, "HOT_BUDGET", 0)
+    cold = TaggedLimitSurface(mesh, progress=False)
+    assert hot._table.hot.shape[0] == 3 * hot._table.origin.shape[0] > 0 and cold._table.hot.shape[0] == 0
+    rng = np.random.default_rng(5)
+    n = 20000
+    f = rng.integers(0, mesh.n_ptex, n)
+    u, v = rng.random(n), rng.random(n)
+    u[: n // 2] = np.ldexp(u[: n // 2], -rng.integers(0, 12, n // 2))
+    v[: n // 2] *= u[: n // 2]
+    for backend in ("numpy", "numba"):
+        a = hot.evaluate(f, u, v, 2, backend=backend)
+        b = cold.evaluate(f, u, v, 2, backend=backend)
+        for k in a:
+            assert np.array_equal(a[k], b[k]), (backend, k)
 
 
 # ------------------------------------------------------------------------------ brute force
