@@ -804,6 +804,7 @@ def _smooth_template(frame):
     op[16] = 1.0 / 16
     t.leaf[0] = 0
     t.reg.append(op)
+    t.smooth_grid = np.argsort(_net_permutation(frame))  # ring[:, smooth_grid]: the grid as walked
     return t
 
 
@@ -830,9 +831,18 @@ def job_floats(groups, X, sizes, progress=None):
         N = t.n
         o_reg, o_cor, o_pts = t.offsets
         nr, nc, npt = t.R.shape[0] // 17, t.O.shape[0], t.Q.shape[0]
+        grid = getattr(t, "smooth_grid", None)
         for lo in range(0, jobs.size, _BLOCK):
             R = rings[lo:lo + _BLOCK]
             k = R.shape[0]
+            if grid is not None:  # a smooth regular quad: its grid less the grid's mean, directly
+                origin_ = X[R[:, grid]].mean(axis=1)
+                a = np.empty((k, 17, 3))
+                a[:, :16] = X[R] - origin_[:, None, :]
+                a[:, 16] = origin_
+                nets[o_reg + lo:o_reg + lo + k] = a
+                bar.update(k)
+                continue
             X0 = X[R[:, 0]]
             rel = (X[R] - X0[:, None, :]).transpose(1, 0, 2).reshape(N, 3 * k)  # (N, k * 3)
             if nr:

@@ -218,7 +218,7 @@ def newton(surface, X, face, u, v, max_iter=MAX_ITER, *, backend=None, threads=N
     >>> from ccproof.evaluate import limit_surface
     >>> from ccproof.mesh.examples import cube
     >>> u, v, E = newton(limit_surface(cube()), [[0.0, 0.0, 2.0]], [1], [0.3], [0.3])
-    >>> u.tolist(), v.tolist(), round(float(2 * E[0] * 81**2), 9)
+    >>> u.round(12).tolist(), v.round(12).tolist(), round(float(2 * E[0] * 81**2), 9)
     ([0.5], [0.5], 8836.0)
     """
     X = np.asarray(X, dtype=np.float64)
