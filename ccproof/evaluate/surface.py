@@ -14,15 +14,18 @@ Method (everything below is exact up to floating-point round-off):
   other than two) whose one-ring is self-similar is evaluated by self-similarity (Stam 1998, bmz04
   section 3 and Fig. 3): a point in layer n = floor(-log2 max(u, v)) (corner at the origin) lies in
   one of three regular sub-patches of level n + 1 whose nets are ``M_j A^n C`` (exact matrices of
-  :func:`ccproof.evaluate.local.corner_scheme`, precomputed for every layer), derivatives scaled
-  by 2^(n+1). Points closer to the corner than the last stored layer (where every net equals the
-  limit point to 2^-60 of the one-ring's size) get the limit point and the derivatives of that layer.
+  :func:`ccproof.evaluate.local.corner_scheme`, stored once per configuration for every layer and
+  applied to the face's ring C at evaluation time), derivatives scaled by 2^(n+1). Points closer to
+  the corner than the last layer (where every net equals the limit point to 2^-60 of the one-ring's
+  size) get the limit point and the derivatives of that layer.
 * Any other face (several irregular vertices, or a one-ring that is not yet self-similar, e.g. an
   extraordinary vertex next to the boundary) is subdivided once, exactly and locally; its four
   children are classified again (at most ``MAX_DEPTH`` times; beyond that a MeshError).
 
-At evaluation time a point is a gather of one precomputed 4 x 4 net plus one bicubic evaluation: no
-Python loop over points, memory bounded by evaluating in chunks.
+The patch table (:mod:`ccproof.evaluate._table`) holds per configuration the exact operators and per
+face its control points: at evaluation time a point is a gather of a stored 4 x 4 net (regular
+patches), or one ``16 x N`` product of its layer's operator with its corner face's ring, plus one
+bicubic evaluation: no Python loop over points, memory bounded by evaluating in chunks.
 """
 
 from __future__ import annotations
@@ -72,9 +75,9 @@ class LimitSurface:
     ----------
     mesh : QuadMesh
     n_patches : int
-        Bicubic patches stored (17 x 3 floats each: net and origin).
+        Regular bicubic patches stored (17 x 3 floats each: net and origin).
     max_layers : int
-        Deepest layer stored at an irregular corner.
+        Most layers of a corner configuration (0 without corner faces).
     split_depth : int
         How many local subdivisions the most irregular face needed.
 
