@@ -374,32 +374,46 @@ def _basis(x):
 
 
 def naive_point(S, f, u, v):
-    """One point at a time, plain Python on the same tables: locate, basis, 16-term sums."""
-    vf = f
-    for _ in range(S.split_depth):
-        if S._vkind[vf] != _SPLIT:
+    """One point at a time, plain Python on the same tables: locate, net, basis, 16-term sums."""
+    T = S._table
+    job = int(T.top[f, int(u >= 0.5) + 2 * int(v >= 0.5)])
+    vf = int(T.job_root[job])
+    for _ in range(T.split_depth):
+        if T.kind[vf] != _SPLIT:
             break
-        half = S._vh[vf] * 0.5
-        vf = S._vchild[vf, int(u >= S._vu0[vf] + half) + 2 * int(v >= S._vv0[vf] + half)]
-    p = int(S._vpatch[vf])
-    if S._vkind[vf] == _CORNER:
-        U0, V0, H = S._vu0[vf], S._vv0[vf], S._vh[vf]
-        du = ((U0 + H) - u if S._vcu[vf] else u - U0) / H
-        dv = ((V0 + H) - v if S._vcv[vf] else v - V0) / H
+        half = T.h[vf] * 0.5
+        vf = int(T.child[vf, int(u >= T.u0[vf] + half) + 2 * int(v >= T.v0[vf] + half)])
+    if T.kind[vf] == _CORNER:
+        U0, V0, H = T.u0[vf], T.v0[vf], T.h[vf]
+        du = ((U0 + H) - u if T.cu[vf] else u - U0) / H
+        dv = ((V0 + H) - v if T.cv[vf] else v - V0) / H
         mx = max(du, dv)
-        n = min(max(-math.frexp(mx)[1], 0), int(S._vnmax[vf])) if mx > 0 else int(S._vnmax[vf])
+        cfg = int(T.cfg[vf])
+        nmax = int(T.n_layers[cfg]) - 1
+        n = min(max(-math.frexp(mx)[1], 0), nmax) if mx > 0 else nmax
         du, dv = math.ldexp(du, n), math.ldexp(dv, n)
         a, b = du >= 0.5, dv >= 0.5
-        if n >= S.hot_layers:
-            p = int(S._vcold[vf])
-        p += 3 * n + (0 if (a and not b) else 1 if (a and b) else 2 if b else 1)
-    h = S._ph[p]
-    s = min(max((u - S._pu0[p]) / h, 0.0), 1.0)
-    t = min(max((v - S._pv0[p]) / h, 0.0), 1.0)
+        code = 0 if (a and not b) else 1 if (a and b) else 2 if b else 1
+        Nc = int(T.op_size[cfg])
+        o = int(T.op_start[cfg]) + (3 * n + code) * 16 * Nc
+        q0 = int(T.job_pts[job] + T.pts[vf])
+        ring = [[0.0] * 3] + T.ring[q0:q0 + Nc - 1].tolist()  # row 0 (the vertex) is not stored
+        ops = T.ops[o:o + 16 * Nc].tolist()
+        net = [[sum(ops[16 * k + i] * ring[k][c] for k in range(Nc)) for c in range(3)] for i in range(16)]
+        origin = T.origin[int(T.job_corner[job] + T.leaf[vf])].tolist()
+        sc = math.ldexp(H, -n)
+        pu0 = T.unit[cfg, code, 0] * sc + (U0 + H if T.cu[vf] else U0)
+        pv0 = T.unit[cfg, code, 1] * sc + (V0 + H if T.cv[vf] else V0)
+        h = T.unit[cfg, code, 2] * sc
+    else:
+        p = int(T.job_net[job] + T.leaf[vf])
+        net, origin = T.nets[p, :16].tolist(), T.nets[p, 16].tolist()
+        pu0, pv0, h = T.u0[vf], T.v0[vf], T.h[vf]
+    s = min(max((u - pu0) / h, 0.0), 1.0)
+    t = min(max((v - pv0) / h, 0.0), 1.0)
     Bs, Ds = _basis(s)
     Bt, Dt = _basis(t)
-    net = S._nets[p].tolist()
-    P, Pu, Pv = S._nets[p, 16].tolist(), [0.0] * 3, [0.0] * 3
+    P, Pu, Pv = list(origin), [0.0] * 3, [0.0] * 3
     for j in range(4):
         for i in range(4):
             w = net[i + 4 * j]
@@ -441,7 +455,7 @@ def main(argv=None):
     w0 = time.perf_counter()
     S = limit_surface(mesh)
     print(f"prepare (exact corner tables, local splits): {time.perf_counter() - w0:.2f} s; "
-          f"{S.n_patches} stored patches ({S._nets.nbytes / 2**20:.1f} MiB), deepest layer table "
+          f"{S.n_patches} stored patches, patch table {S.table_bytes / 2**20:.1f} MiB, deepest layer table "
           f"{S.max_layers}, split depth {S.split_depth}")
 
     rng = np.random.default_rng(2024)
@@ -544,7 +558,7 @@ def main(argv=None):
         tracemalloc.stop()
         io = sum(a.nbytes for a in (fm, um, vm)) + sum(a.nbytes for a in outm.values())
         print(f"   {be:6s}: {peak / 2**20:8.1f} MiB extra (inputs + outputs: {io / 2**20:.0f} MiB; "
-              f"patch tables {S._nets.nbytes / 2**20:.1f} MiB)")
+              f"patch table {S.table_bytes / 2**20:.1f} MiB)")
     osd = osd_side_by_side(args.osd_points if not args.quick else 20_000, rng, args.quick, rounds=args.rounds)
     print("\nsummary:")
     for be in backends:

@@ -37,45 +37,81 @@ def _basis(x, B, r):
     B[r + 2, 3] = x
 
 
-def _evaluate_points(f, u, v, d, refused, vkind, vchild, vu0, vv0, vh, vpatch, vcold, hot_layers, vcu, vcv, vnmax,
-                     split_depth, nets, pu0, pv0, ph, P, Pu, Pv, Puu, Puv, Pvv):
-    """Fill P (n, 3) and, for d >= 1, Pu, Pv, for d >= 2, Puu, Puv, Pvv (each (n, 3)).
+def _corner_net(T, job, vf, cfg, lay, code, ci, W):
+    """Net ``W[0]`` (17 x 3, row 16 the limit point) of patch ``code`` of layer ``lay`` of corner face
+    ``vf`` of ``job``: ``L[lay, code] @ ring`` summed over the ring points j = 1, 2, ... in order
+    (row 0 of the relative ring is 0), the 16 entries side by side."""
+    Nc = T.op_size[cfg]
+    o = T.op_start[cfg] + (3 * lay + code) * 16 * Nc
+    q0 = T.job_pts[job] + T.pts[vf] - 1  # ring row j >= 1 (row 0, the vertex, is 0)
+    for i in range(16):
+        W[0, i, 0] = 0.0
+        W[0, i, 1] = 0.0
+        W[0, i, 2] = 0.0
+    for j in range(1, Nc):
+        r0 = T.ring[q0 + j, 0]
+        r1 = T.ring[q0 + j, 1]
+        r2 = T.ring[q0 + j, 2]
+        r = o + 16 * j
+        for i in range(16):
+            w = T.ops[r + i]
+            W[0, i, 0] += w * r0
+            W[0, i, 1] += w * r1
+            W[0, i, 2] += w * r2
+    for c in range(3):
+        W[0, 16, c] = T.origin[ci, c]
+    return W
 
-    Returns -1, or the index of the first point whose face is out of range or ``refused`` (a hole)
+
+def _evaluate_points(f, u, v, d, T, P, Pu, Pv, Puu, Puv, Pvv):
+    """Fill P (n, 3) and, for d >= 1, Pu, Pv, for d >= 2, Puu, Puv, Pvv (each (n, 3)) from the patch
+    table ``T`` (:class:`ccproof.evaluate._table.PatchTable`).
+
+    Returns -1, or the index of the first point whose face is out of range or refused (a hole)
     or whose (u, v) is outside [0, 1]^2 or NaN; the caller then names it (the outputs from that
     point on are not written).
     """
     n = f.shape[0]
-    m = refused.shape[0]
+    m = T.refused.shape[0]
     B = np.empty((6, 4))  # basis in s (rows 0-2: value, first, second derivative), in t (rows 3-5)
-    T = np.empty((3, 4, 3))
+    Tm = np.empty((3, 4, 3))
+    W = np.empty((1, 17, 3))  # the net of a point in a corner face, row 16 its origin
     for k in range(n):
-        vf = f[k]
+        pf = f[k]
         uu = u[k]
         ww = v[k]
-        if vf < 0 or vf >= m or not (uu >= 0.0 and uu <= 1.0 and ww >= 0.0 and ww <= 1.0) or refused[vf]:
+        if pf < 0 or pf >= m or not (uu >= 0.0 and uu <= 1.0 and ww >= 0.0 and ww <= 1.0) or T.refused[pf]:
             return k
-        kind = vkind[vf]
-        for _ in range(split_depth):
+        q = 0
+        if uu >= 0.5:
+            q += 1
+        if ww >= 0.5:
+            q += 2
+        job = T.top[pf, q]
+        vf = T.job_root[job]
+        kind = T.kind[vf]
+        for _ in range(T.split_depth):
             if kind != _SPLIT:
                 break
-            half = vh[vf] * 0.5
+            half = T.h[vf] * 0.5
             q = 0
-            if uu >= vu0[vf] + half:
+            if uu >= T.u0[vf] + half:
                 q += 1
-            if ww >= vv0[vf] + half:
+            if ww >= T.v0[vf] + half:
                 q += 2
-            vf = vchild[vf, q]
-            kind = vkind[vf]
-        p = vpatch[vf]
+            vf = T.child[vf, q]
+            kind = T.kind[vf]
         if kind == _CORNER:
-            U0 = vu0[vf]
-            V0 = vv0[vf]
-            H = vh[vf]
-            du = ((U0 + H) - uu if vcu[vf] else uu - U0) / H
-            dv = ((V0 + H) - ww if vcv[vf] else ww - V0) / H
+            U0 = T.u0[vf]
+            V0 = T.v0[vf]
+            H = T.h[vf]
+            cu = T.cu[vf]
+            cv = T.cv[vf]
+            du = ((U0 + H) - uu if cu else uu - U0) / H
+            dv = ((V0 + H) - ww if cv else ww - V0) / H
             mx = max(du, dv)
-            nmax = vnmax[vf]
+            cfg = T.cfg[vf]
+            nmax = T.n_layers[cfg] - 1
             if mx > 0:
                 e = math.frexp(mx)[1]
                 lay = min(max(-e, 0), nmax)
@@ -93,12 +129,25 @@ def _evaluate_points(f, u, v, d, refused, vkind, vchild, vu0, vv0, vh, vpatch, v
                 code = 2
             else:
                 code = 1
-            if lay >= hot_layers:
-                p = vcold[vf]
-            p += 3 * lay + code
-        h = ph[p]
-        s = min(max((uu - pu0[p]) / h, 0.0), 1.0)
-        t = min(max((ww - pv0[p]) / h, 0.0), 1.0)
+            sc = math.ldexp(H, -lay)
+            pu0 = T.unit[cfg, code, 0] * sc + ((U0 + H) if cu else U0)
+            pv0 = T.unit[cfg, code, 1] * sc + ((V0 + H) if cv else V0)
+            h = T.unit[cfg, code, 2] * sc
+            ci = T.job_corner[job] + T.leaf[vf]
+            if lay == 0 and T.hot.shape[0] > 0:  # layer 0 precomputed: the same sums
+                net = T.hot
+                p = 3 * ci + code
+            else:
+                net = _corner_net(T, job, vf, cfg, lay, code, ci, W)
+                p = 0
+        else:
+            net = T.nets
+            p = T.job_net[job] + T.leaf[vf]
+            pu0 = T.u0[vf]
+            pv0 = T.v0[vf]
+            h = T.h[vf]
+        s = min(max((uu - pu0) / h, 0.0), 1.0)
+        t = min(max((ww - pv0) / h, 0.0), 1.0)
         g = 1.0 / h
         _basis(s, B, 0)
         _basis(t, B, 3)
@@ -108,27 +157,27 @@ def _evaluate_points(f, u, v, d, refused, vkind, vchild, vu0, vv0, vh, vpatch, v
                 x1 = 0.0
                 x2 = 0.0
                 for j in range(4):
-                    w = nets[p, i + 4 * j, c]
+                    w = net[p, i + 4 * j, c]
                     x0 += B[3, j] * w
                     if d >= 1:
                         x1 += B[4, j] * w
                     if d >= 2:
                         x2 += B[5, j] * w
-                T[0, i, c] = x0
-                T[1, i, c] = x1
-                T[2, i, c] = x2
+                Tm[0, i, c] = x0
+                Tm[1, i, c] = x1
+                Tm[2, i, c] = x2
         for c in range(3):
             a0 = 0.0
             for i in range(4):
-                a0 += B[0, i] * T[0, i, c]
-            P[k, c] = nets[p, 16, c] + a0
+                a0 += B[0, i] * Tm[0, i, c]
+            P[k, c] = net[p, 16, c] + a0
         if d >= 1:
             for c in range(3):
                 a1 = 0.0
                 a2 = 0.0
                 for i in range(4):
-                    a1 += B[1, i] * T[0, i, c]
-                    a2 += B[0, i] * T[1, i, c]
+                    a1 += B[1, i] * Tm[0, i, c]
+                    a2 += B[0, i] * Tm[1, i, c]
                 Pu[k, c] = a1 * g
                 Pv[k, c] = a2 * g
         if d >= 2:
@@ -138,9 +187,9 @@ def _evaluate_points(f, u, v, d, refused, vkind, vchild, vu0, vv0, vh, vpatch, v
                 a4 = 0.0
                 a5 = 0.0
                 for i in range(4):
-                    a3 += B[2, i] * T[0, i, c]
-                    a4 += B[1, i] * T[1, i, c]
-                    a5 += B[0, i] * T[2, i, c]
+                    a3 += B[2, i] * Tm[0, i, c]
+                    a4 += B[1, i] * Tm[1, i, c]
+                    a5 += B[0, i] * Tm[2, i, c]
                 Puu[k, c] = a3 * g2
                 Puv[k, c] = a4 * g2
                 Pvv[k, c] = a5 * g2
@@ -157,8 +206,7 @@ def _free(w, g):
     return not ((w <= 0.0 and g > 0) or (w >= 1.0 and g < 0))
 
 
-def _newton_points(X, face, u, v, max_iter, max_halvings, refused, vkind, vchild, vu0, vv0, vh, vpatch, vcold,
-                   hot_layers, vcu, vcv, vnmax, split_depth, nets, pu0, pv0, ph, E):
+def _newton_points(X, face, u, v, max_iter, max_halvings, T, E):
     """The descent of :func:`ccproof.evaluate.closest.newton`, point by point: the same formulas in
     the same order (u, v updated in place, E filled). The points must be valid (checked by the
     caller); each evaluation is the batch kernel's on one point."""
@@ -180,8 +228,7 @@ def _newton_points(X, face, u, v, max_iter, max_halvings, refused, vkind, vchild
         uk = min(max(u[k], 0.0), 1.0)
         vk = min(max(v[k], 0.0), 1.0)
         fk[0], uw[0], vw[0] = f, uk, vk
-        evaluate_points(fk, uw, vw, 2, refused, vkind, vchild, vu0, vv0, vh, vpatch, vcold, hot_layers, vcu, vcv,
-                        vnmax, split_depth, nets, pu0, pv0, ph, c0, c1, c2, c3, c4, c5)
+        evaluate_points(fk, uw, vw, 2, T, c0, c1, c2, c3, c4, c5)
         for c in range(3):
             R[0, c] = C[0, c] - X[k, c]
         Ek = 0.5 * _dot3(R, 0, R, 0)
@@ -221,8 +268,7 @@ def _newton_points(X, face, u, v, max_iter, max_halvings, refused, vkind, vchild
                 nv = min(max(v0 + al * dv, 0.0), 1.0)
                 moved = (nu != u0) or (nv != v0)
                 uw[0], vw[0] = nu, nv
-                evaluate_points(fk, uw, vw, 2, refused, vkind, vchild, vu0, vv0, vh, vpatch, vcold, hot_layers, vcu,
-                                vcv, vnmax, split_depth, nets, pu0, pv0, ph, n0, n1, n2, n3, n4, n5)
+                evaluate_points(fk, uw, vw, 2, T, n0, n1, n2, n3, n4, n5)
                 for c in range(3):
                     Rt[0, c] = Cn[0, c] - X[k, c]
                 Et = 0.5 * _dot3(Rt, 0, Rt, 0)
@@ -253,11 +299,119 @@ def _newton_points(X, face, u, v, max_iter, max_halvings, refused, vkind, vchild
         E[k] = Ek
 
 
+def _take_face(c, org, pos, seen, ring, faces, fc, fl, n, nf):
+    """Step of :func:`_ring_walks`: list the face of half-edge ``c`` (read from ``c`` on) unless seen.
+    Returns the new counts ``(n, nf)``, or ``(-1, -1)`` when the arrays are full."""
+    hf = c // 4
+    if seen[hf]:
+        return n, nf
+    if nf >= faces.shape[0]:
+        return -1, -1
+    seen[hf] = True
+    fl[nf] = hf
+    j0 = c - 4 * hf
+    for t in range(4):
+        hc = 4 * hf + (j0 + t) % 4
+        u = org[hc]
+        q = pos[u]
+        if q < 0:
+            if n >= ring.shape[0]:
+                faces[nf, 0] = -1
+                return -1, nf + 1
+            q = n
+            pos[u] = n
+            ring[n] = u
+            fc[n] = hc
+            n += 1
+        faces[nf, t] = q
+    return n, nf + 1
+
+
+def _ring_walks(org, nxt, prv, twin, pos, seen, g, r, rings, nring, faces, nfaces, hashes):
+    """:func:`ccproof.evaluate.local.canonical_ring` (depth 1) of quad ``g[k]`` from corner ``r[k]`` of
+    an all-quad complex (half-edge ``4 f + i`` is corner i of face f), for every k: the same walk.
+
+    Writes the ring (vertex labels, ``rings[k, :nring[k]]``), the faces in ring labels
+    (``faces[k, :nfaces[k]]``, rows of 4) and a 64-bit FNV-1a hash of (nring, faces). ``pos``
+    (n_vertices,) and ``seen`` (n_faces,) are scratch arrays, -1 / False on entry and on return.
+    ``nring[k] = -1`` if the ring does not fit the arrays or the walk does not close (the caller
+    then takes the Python walk).
+    """
+    maxn = rings.shape[1]
+    maxf = faces.shape[1]
+    fc = np.empty(maxn, dtype=np.int64)
+    fl = np.empty(maxf, dtype=np.int64)
+    for k in range(g.shape[0]):
+        gk = g[k]
+        ring = rings[k]
+        fk = faces[k]
+        n = 0
+        nf = 1
+        ok = True
+        seen[gk] = True
+        fl[0] = gk
+        for i in range(4):
+            h = 4 * gk + (r[k] + i) % 4
+            v = org[h]
+            fk[0, i] = i
+            if pos[v] >= 0:
+                ok = False
+                break
+            pos[v] = n
+            ring[n] = v
+            fc[n] = h
+            n += 1
+        idx = 0
+        while ok and idx < 4:
+            c0 = fc[idx]
+            n, nf = _take_face(c0, org, pos, seen, ring, fk, fc, fl, n, nf)
+            c = twin[prv[c0]]
+            steps = 0
+            while n >= 0 and c >= 0 and c != c0 and steps < 4096:  # counter-clockwise
+                n, nf = _take_face(c, org, pos, seen, ring, fk, fc, fl, n, nf)
+                c = twin[prv[c]]
+                steps += 1
+            if n < 0 or steps >= 4096:
+                ok = False
+                break
+            if c != c0:  # an open fan: then clockwise from c0
+                t_ = twin[c0]
+                c = -1 if t_ < 0 else nxt[t_]
+                while n >= 0 and c >= 0 and steps < 4096:
+                    n, nf = _take_face(c, org, pos, seen, ring, fk, fc, fl, n, nf)
+                    t_ = twin[c]
+                    c = -1 if t_ < 0 else nxt[t_]
+                    steps += 1
+                if n < 0 or steps >= 4096:
+                    ok = False
+                    break
+            idx += 1
+        if nf < 0:
+            nf = maxf
+        for i in range(maxn if n < 0 else n):  # reset the scratch arrays
+            if i < maxn and ring[i] >= 0 and pos[ring[i]] == i:
+                pos[ring[i]] = -1
+        for i in range(nf):
+            seen[fl[i]] = False
+        nring[k] = n if ok else -1
+        nfaces[k] = nf
+        hsh = np.uint64(14695981039346656037)
+        prime = np.uint64(1099511628211)
+        hsh = (hsh ^ np.uint64(max(n, 0))) * prime
+        for i in range(nf):
+            for t in range(4):
+                hsh = (hsh ^ np.uint64(fk[i, t] + 1)) * prime
+        hashes[k] = hsh
+
+
 if numba is not None:
     _basis = numba.njit(cache=True, nogil=True)(_basis)
+    _corner_net = numba.njit(cache=True, nogil=True)(_corner_net)
     evaluate_points = numba.njit(cache=True, nogil=True)(_evaluate_points)
     _dot3 = numba.njit(cache=True, nogil=True, inline="always")(_dot3)
     _free = numba.njit(cache=True, nogil=True, inline="always")(_free)
     newton_points = numba.njit(cache=True, nogil=True)(_newton_points)
+    _take_face = numba.njit(cache=True, nogil=True)(_take_face)
+    ring_walks = numba.njit(cache=True, nogil=True)(_ring_walks)
 else:  # pragma: no cover
-    evaluate_points = newton_points = None
+    evaluate_points = newton_points = ring_walks = None

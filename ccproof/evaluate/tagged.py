@@ -5,7 +5,8 @@ evaluator (:class:`ccproof.evaluate.surface._Builder`: same classification, arra
 kernels), from the tagged rules of :mod:`ccproof.mesh.rules`:
 
 1. One global Catmull-Clark step (n-gons become quads; ``TRI_SUB_SMOOTH`` and the
-   ``EDGE_AND_CORNER`` corners act here). A quad's ptex face is split into its four level-1
+   ``EDGE_AND_CORNER`` corners act here); on an untagged mesh vectorized
+   (:func:`ccproof.evaluate._table.catmark_step`). A quad's ptex face is split into its four level-1
    children; sub-face k of an n-gon *is* level-1 child k (same (s, t)).
 2. Semi-sharp phase: while an edge at a vertex of the face or the vertex itself has a semi-sharp
    sharpness (0 < s < 10), the face's neighbourhood is refined exactly and locally
@@ -32,15 +33,8 @@ import math
 import numpy as np
 
 from ccproof.errors import CCProofError
-from ccproof.evaluate.surface import (
-    _REGULAR,
-    _SPLIT,
-    LimitSurface,
-    _Builder,
-    _child_frame,
-    _compose,
-    _domain,
-)
+from ccproof.evaluate._table import QuadHalfEdges, _Builder, _child_frame, _compose, _domain, _Jobs, catmark_step
+from ccproof.evaluate.surface import LimitSurface
 from ccproof.mesh.polymesh import PolyMesh
 from ccproof.mesh.rules import Complex
 
@@ -78,16 +72,14 @@ class TaggedLimitSurface(LimitSurface):
     [[-1.0, -1.0, -1.0], [-0.5, -0.5, 0.5]]
     """
 
-    def __init__(self, mesh: PolyMesh):
+    def __init__(self, mesh: PolyMesh, *, progress=None):
         self.mesh = mesh
         # a non-manifold mesh is evaluated on its split (PolyMesh.manifold): same faces and ptex faces
         mesh = mesh.manifold
-        b = _Builder(2 if mesh.options.crease_method == "chaikin" else 1, what="ptex face")
+        b = _Builder(2 if mesh.options.crease_method == "chaikin" else 1, what="ptex face", progress=progress)
         ident = ((0.0, 0.0), (1.0, 0.0), (0.0, 1.0))
         P = mesh.n_ptex
         self._ptex_face = np.empty(P, dtype=np.int64)
-        for p in range(P):
-            b.new_vface(_REGULAR, ident, p)
         if mesh.is_all_quads:
             # no global step needed: start on the base mesh, with the one level-0-only rule that
             # can act on quads (EDGE_AND_CORNER sharpens one-face boundary vertices) made explicit
@@ -99,37 +91,52 @@ class TaggedLimitSurface(LimitSurface):
                     if fan is not None and not closed and len(fan) == 1:
                         vs[v] = math.inf
                 cx = Complex(cx.faces, cx.edge_sharpness, vs, cx.options, level=1, n_vertices=cx.n_vertices)
-            X = np.asarray(mesh.vertices)
+            if not cx.edge_sharpness and not cx.vertex_sharpness:
+                cx = QuadHalfEdges(cx.faces, cx.n_vertices, cx.options)
             self._ptex_face[:] = np.arange(mesh.n_faces)
-            b.classify(cx, X, [(f, ident, f, f) for f in range(mesh.n_faces)])
-            self._finish(b)
+            m = mesh.n_faces
+            b.classify(cx, np.asarray(mesh.vertices), _Jobs(np.arange(m), np.zeros(m, np.int64), np.arange(m), [ident]))
+            top = np.repeat(np.arange(P, dtype=np.int64)[:, None], 4, axis=1)
             self._hole_ptex = mesh.is_hole[self._ptex_face]
+            self._finish(b, top, self._hole_ptex, keep_rings=False)
             return
-        m1, _ = mesh.refine()
-        cx = m1.complex()
-        X = np.asarray(m1.vertices)
-        jobs = []
-        for f in range(mesh.n_faces):
-            k = int(mesh.sizes[f])
-            p0 = int(mesh.ptex_start[f])
-            c0 = int(mesh.offsets[f])
-            if k == 4:
-                self._ptex_face[p0] = f
-                b.vkind[p0] = _SPLIT
-                for i in range(4):
-                    cf = _compose(ident, _child_frame(i))
-                    cu, cv, _ = _domain(cf)
-                    q = int(cu > 0) + 2 * int(cv > 0)
-                    c = b.new_vface(_REGULAR, cf, p0)
-                    b.vchild[p0][q] = c
-                    jobs.append((c0 + i, cf, p0, c))
-            else:
-                for i in range(k):
-                    self._ptex_face[p0 + i] = f
-                    jobs.append((c0 + i, ident, p0 + i, p0 + i))
-        b.classify(cx, X, jobs)
-        self._finish(b)
+        step = catmark_step(mesh)  # untagged: vectorized, and the level-1 complex as arrays
+        if step is not None:
+            X = step[0]
+            cx = QuadHalfEdges(step[1], X.shape[0], mesh.options)
+        else:
+            m1, _ = mesh.refine()
+            cx = m1.complex()
+            X = np.asarray(m1.vertices)
+        # jobs: sub-face i of an n-gon is level-1 child i (same (s, t)), its own ptex face; a quad is
+        # one ptex face whose four level-1 children are its quadrants (frames: the child frames)
+        frames = [ident]
+        quarter_q = []
+        for i in range(4):
+            cf = _compose(ident, _child_frame(i))
+            cu, cv, _ = _domain(cf)
+            frames.append(cf)
+            quarter_q.append(int(cu > 0) + 2 * int(cv > 0))
+        sizes = np.asarray(mesh.sizes, dtype=np.int64)
+        nf = sizes.size
+        face = np.repeat(np.arange(nf), sizes)  # per level-1 child: its base face
+        corner = np.arange(face.size) - np.repeat(np.asarray(mesh.offsets, dtype=np.int64)[:nf], sizes)
+        is_quad = sizes[face] == 4
+        ptex_start = np.asarray(mesh.ptex_start, dtype=np.int64)[:nf]
+        ptex = np.where(is_quad, ptex_start[face], ptex_start[face] + corner)
+        g = np.asarray(mesh.offsets, dtype=np.int64)[:nf][face] + corner
+        fid = np.where(is_quad, 1 + corner, 0)
+        self._ptex_face[ptex] = face
+        top = np.empty((P, 4), dtype=np.int32 if len(mesh.indices) < 2**31 else np.int64)
+        jid = np.arange(face.size)
+        nq = np.flatnonzero(~is_quad)
+        top[ptex[nq]] = jid[nq, None]
+        qd = np.flatnonzero(is_quad)
+        top[ptex[qd], np.asarray(quarter_q)[corner[qd]]] = jid[qd]
+        b.classify(cx, X, _Jobs(g, fid, ptex, frames))
+        del cx, step, g, fid, ptex, face, corner, is_quad, jid  # before the table's float data
         self._hole_ptex = mesh.is_hole[self._ptex_face]
+        self._finish(b, top, self._hole_ptex, keep_rings=False)
 
     @property
     def n_faces(self):

@@ -117,8 +117,9 @@ class ReparamLimitSurface(LimitSurface):
     ([3, 3, 3, 3], True)
     """
 
-    def __init__(self, mesh: QuadMesh, alpha: float | Mapping[int, float] | None = None) -> None:
-        super().__init__(mesh)
+    def __init__(self, mesh: QuadMesh, alpha: float | Mapping[int, float] | None = None, *,
+                 progress: bool | None = None) -> None:
+        super().__init__(mesh, progress=progress)
         val = np.asarray(mesh.valence, dtype=np.int64)
         code = np.where(mesh.is_boundary_vertex | (val == 4), 0, val)
         self.corner_valence = code[mesh.faces]
@@ -268,12 +269,12 @@ class ReparamLimitSurface(LimitSurface):
 
 
 @overload
-def limit_surface(mesh: QuadMesh | str | os.PathLike[str], alpha: float | Mapping[int, float] | None = None
-                  ) -> ReparamLimitSurface: ...
+def limit_surface(mesh: QuadMesh | str | os.PathLike[str], alpha: float | Mapping[int, float] | None = None, *,
+                  progress: bool | None = None) -> ReparamLimitSurface: ...
 @overload
-def limit_surface(mesh: PolyMesh, alpha: None = None) -> TaggedLimitSurface: ...
-def limit_surface(mesh: QuadMesh | PolyMesh | str | os.PathLike[str], alpha: float | Mapping[int, float] | None = None
-                  ) -> ReparamLimitSurface | TaggedLimitSurface:
+def limit_surface(mesh: PolyMesh, alpha: None = None, *, progress: bool | None = None) -> TaggedLimitSurface: ...
+def limit_surface(mesh: QuadMesh | PolyMesh | str | os.PathLike[str], alpha: float | Mapping[int, float] | None = None,
+                  *, progress: bool | None = None) -> ReparamLimitSurface | TaggedLimitSurface:
     """The limit surface of a mesh: exact evaluation, normals and the parameterizations of bmz04.
 
     The one entry point for limit surfaces (``ccproof.limit_surface``). A quad mesh gives a
@@ -292,6 +293,9 @@ def limit_surface(mesh: QuadMesh | PolyMesh | str | os.PathLike[str], alpha: flo
         Exponent of F^alpha for the "vanishing" parameterization: one value for every valence, a
         dict valence -> value (missing valences get the default), or None for
         :func:`~ccproof.reparam.quadrant.default_alpha` (twice the bound of bmz04 section 4.2).
+    progress : bool, optional
+        Show a progress bar (tqdm, on stderr) when building the patch table takes more than 2 s;
+        default: when stderr is a terminal.
 
     Returns
     -------
@@ -318,12 +322,12 @@ def limit_surface(mesh: QuadMesh | PolyMesh | str | os.PathLike[str], alpha: flo
             raise CCProofError("alpha applies to the parameterizations of quad meshes only, not to a PolyMesh")
         from ccproof.evaluate.surface import natural_limit_surface
 
-        return natural_limit_surface(mesh)
+        return natural_limit_surface(mesh, progress=progress)
     if isinstance(mesh, QuadMesh):
-        return ReparamLimitSurface(mesh, alpha)
+        return ReparamLimitSurface(mesh, alpha, progress=progress)
     from ccproof.mesh.io import read_mesh
 
     poly = read_mesh(mesh)
     if poly.is_plain_quads:
-        return ReparamLimitSurface(poly.to_quad_mesh(), alpha)
-    return limit_surface(poly, alpha)
+        return ReparamLimitSurface(poly.to_quad_mesh(), alpha, progress=progress)
+    return limit_surface(poly, alpha, progress=progress)

@@ -1,0 +1,984 @@
+"""The patch table of the exact evaluator: per configuration the exact operators, per face its control points.
+
+A *job* is one quad of the complex the classification starts from (a base face of a quad mesh, a
+level-1 sub-face of a tagged polygon mesh), with its frame (where it sits in its ptex face). Its
+*ring* (the faces sharing a vertex with it, :func:`ccproof.evaluate.local.canonical_ring`, listed from
+a corner; the two-ring in the Chaikin semi-sharp phase) has a tagged key, and the key (with the
+frame) determines everything the classification does with the face: which local subdivisions it
+needs, which of the resulting virtual faces are regular bicubic patches and which are self-similar
+corner faces, and every net and corner ring as a linear function of the ring's control points.
+That is a *template*, built once per key by the exact local machinery of
+:mod:`ccproof.evaluate.local` run on the identity (the builder is linear, column by column), and
+shared by every face with that key:
+
+* per template: the tree of virtual faces (split, regular, corner) with their domains in the ptex
+  face, the operators ``(17, N)`` of its regular patches (16 net rows relative to the origin, row 16
+  the origin) and ``(Nc + 1, N)`` of its corner rings (the ring relative to the corner vertex, and
+  the corner's limit point);
+* per *configuration* (a corner scheme and the orientation of the corner in the ptex face): the
+  exact-then-rounded layer operators ``L`` (n_layers, 3, 16, Nc) of
+  :func:`ccproof.evaluate.local.corner_scheme`, shared by every corner face of that configuration;
+* per job: the id of its template and its ring (vertex indices); the float data derived from them
+  (the 17 x 3 nets of its regular patches, the Nc x 3 relative ring and the limit point of its corner
+  faces), so that a regular point costs one gather and a corner point one ``16 x Nc`` product.
+
+Memory: O(control points + ptex faces + configurations): nothing is stored per layer per face; a
+point in layer n of a corner face gets its net as ``L[n, code] @ ring`` at evaluation time.
+"""
+
+from __future__ import annotations
+
+import functools
+import sys
+from array import array
+from typing import NamedTuple
+
+import numpy as np
+
+from ccproof.errors import MeshError
+from ccproof.evaluate.local import (
+    _CENTER,
+    _SIDES,
+    CORNERS,
+    _child_ring,
+    _has_semi_sharp,
+    _key_complex,
+    _regular_net_matrix,
+    canonical_ring,
+    corner_scheme,
+    irregular_corners,
+    refine_key,
+    ring_key,
+)
+
+_REGULAR, _CORNER, _SPLIT = 0, 1, 2
+
+#: how many times a face may be subdivided before it must be regular or self-similar
+MAX_DEPTH = 4
+#: local subdivisions allowed in the semi-sharp phase of a tagged mesh (sharpness < 10 decays in
+#: 10 uniform levels)
+MAX_SEMI_DEPTH = 40
+#: jobs per block when the float data are computed (bounds the temporaries)
+_BLOCK = 1 << 13
+#: largest size of the layer-0 nets of the corner faces kept precomputed (``PatchTable.hot``, 1,224
+#: bytes per corner face); beyond it every corner net is computed at evaluation time
+HOT_BUDGET = 32 << 20
+
+
+class PatchTable(NamedTuple):
+    """The arrays the evaluation kernels read (one argument for numba; see the module docstring).
+
+    Attributes
+    ----------
+    top : int32 (P, 4) (int64 beyond 2^31 jobs)
+        Job of each quadrant ``(u >= 1/2) + 2 (v >= 1/2)`` of every ptex face (all four equal
+        unless the ptex face is a quad split into its four level-1 children).
+    refused : bool (P,)
+        Ptex faces evaluation refuses (holes).
+    job_root, job_net, job_corner, job_pts : int32 (J,) (int64 where the offsets need it)
+        Per job: the root virtual face of its template, and the offsets of its regular nets in
+        ``nets``, of its corner faces in ``origin``, of its corner rings in ``ring``.
+    kind : int8 (T,)
+        Per template virtual face: 0 regular patch, 1 corner face, 2 split into four children.
+    child : int64 (T, 4)
+        Children of a split virtual face by quadrant.
+    u0, v0, h : float64 (T,)
+        Domain of a virtual face in its ptex face (lower-left corner, side: a power of 2).
+    leaf : int64 (T,)
+        Index of a leaf among its template's regular patches or corner faces.
+    pts : int64 (T,)
+        Offset of a corner face's ring among its template's corner rings.
+    cfg : int64 (T,)
+        Configuration of a corner face.
+    cu, cv : bool (T,)
+        Whether a corner face's irregular corner is at ``u0 + h`` (``v0 + h``).
+    split_depth : int
+        Deepest split in any template.
+    nets : float64 (n_regular, 17, 3)
+        Regular patch nets, base orientation, relative to row 16 (the origin).
+    origin : float64 (n_corner, 3)
+        Limit point of each corner face's irregular corner.
+    ring : float64 (n_points, 3)
+        Corner rings relative to their corner vertex, rows 1 .. Nc - 1 (row 0, the vertex, is 0).
+    ops : float64 (sum of n_layers * 48 * Nc,)
+        Per configuration its layer operators ``L`` laid out (n_layers, 3, Nc, 16): ``[n, code, j, i]``
+        the weight of ring point j in entry i of the net of layer n, patch ``code`` (0 along u, 1
+        diagonal, 2 along v), base orientation (the 16 entries of one ring point contiguous).
+    op_start, op_size, n_layers : int64 (n_cfg,)
+        Offset in ``ops``, ring size Nc and number of layers of each configuration.
+    unit : float64 (n_cfg, 3, 3)
+        ``(u0, v0, h)`` of the three patches of layer 0 for a corner frame of side 1 at the origin.
+    hot : float64 (3 n_corner, 17, 3) or (0, 17, 3)
+        The nets of layer 0 of every corner face (patch ``3 c + code``, row 16 the limit point),
+        computed like the kernel computes them (the same sums in the same order), kept when they fit
+        :data:`HOT_BUDGET`; empty otherwise. A uniformly random point of a corner face is in layer 0
+        with probability 3/4.
+    """
+
+    top: np.ndarray
+    refused: np.ndarray
+    job_root: np.ndarray
+    job_net: np.ndarray
+    job_corner: np.ndarray
+    job_pts: np.ndarray
+    kind: np.ndarray
+    child: np.ndarray
+    u0: np.ndarray
+    v0: np.ndarray
+    h: np.ndarray
+    leaf: np.ndarray
+    pts: np.ndarray
+    cfg: np.ndarray
+    cu: np.ndarray
+    cv: np.ndarray
+    split_depth: int
+    nets: np.ndarray
+    origin: np.ndarray
+    ring: np.ndarray
+    ops: np.ndarray
+    op_start: np.ndarray
+    op_size: np.ndarray
+    n_layers: np.ndarray
+    unit: np.ndarray
+    hot: np.ndarray
+
+
+# ---------------------------------------------------------------------------------- frames
+# A frame maps a face's own parameter (s, t) to the base face's (u, v): (u, v) = o + s a + t b,
+# with a, b axis-aligned of the same length (a power of 2). Frames are tuples of three float pairs
+# (o, a, b): they are composed once per virtual face, so plain floats (every value dyadic, every
+# operation exact) instead of small arrays.
+_C = tuple((float(x), float(y)) for x, y in CORNERS)
+
+
+def _compose(frame, sub):
+    (ox, oy), (ax, ay), (bx, by) = frame
+    (p, q), (sa0, sa1), (sb0, sb1) = sub
+    return ((ox + ax * p + bx * q, oy + ay * p + by * q), (ax * sa0 + bx * sa1, ay * sa0 + by * sa1),
+            (ax * sb0 + bx * sb1, ay * sb0 + by * sb1))
+
+
+def _corner_frame(i, scale=1.0):
+    """Frame of the square at corner i of [0,1]^2, rotated so that corner i is its origin."""
+    c, c1, c3 = _C[i], _C[(i + 1) % 4], _C[(i + 3) % 4]
+    return (c, ((c1[0] - c[0]) * scale, (c1[1] - c[1]) * scale), ((c3[0] - c[0]) * scale, (c3[1] - c[1]) * scale))
+
+
+def _child_frame(i):
+    return _corner_frame(i, 0.5)
+
+
+def _layer_frame(n, j):
+    """Frame of patch P_j of layer n in the corner frame (corner at the origin), bmz04 Fig. 3."""
+    h = 2.0 ** -(n + 1)
+    o, a, b = _corner_frame(j, h)
+    return ((o[0] * 2.0 * h, o[1] * 2.0 * h), a, b)
+
+
+def _domain(frame):
+    (ox, oy), (ax, ay), (bx, by) = frame
+    return ox + min(ax, 0.0) + min(bx, 0.0), oy + min(ay, 0.0) + min(by, 0.0), max(abs(ax), abs(ay))
+
+
+@functools.lru_cache(maxsize=64)
+def _permutation(ah, bh):
+    perm = np.empty(16, dtype=np.int64)
+    for q in range(4):
+        for p in range(4):
+            i = int(round(1.5 + (p - 1.5) * ah[0] + (q - 1.5) * bh[0]))
+            j = int(round(1.5 + (p - 1.5) * ah[1] + (q - 1.5) * bh[1]))
+            perm[i + 4 * j] = p + 4 * q
+    perm.setflags(write=False)
+    return perm
+
+
+def _net_permutation(frame):
+    """Index map sending a net in the frame's own orientation to the base orientation."""
+    _, a, b = frame
+    return _permutation(_sign(a), _sign(b))
+
+
+def _sign(x):
+    return (int(x[0] > 0) - int(x[0] < 0), int(x[1] > 0) - int(x[1] < 0))
+
+
+@functools.lru_cache(maxsize=16)
+def _corner_orientation(orient):
+    """Rows of a scheme's layer nets and layer-0 domains for a corner frame with axis directions
+    ``orient``: ``rows`` (48,), row ``16 code + i`` of a layer in the base orientation is row
+    ``rows[16 code + i]`` of its ``3 x 16`` nets ``D[n, j-1]``; ``unit`` (3, 3), the domains of the
+    three patches of layer 0 for a unit frame at the origin."""
+    a, b = orient
+    unit_rot = ((0.0, 0.0), (float(a[0]), float(a[1])), (float(b[0]), float(b[1])))
+    # P_1 lies along the frame's a-axis: code 0 (u-distance >= 1/2, v-distance < 1/2) if a is
+    # along u, else code 2; P_2 (diagonal) is code 1; P_3 the other one
+    a_along_u = a[0] != 0
+    codes = {1: 0 if a_along_u else 2, 2: 1, 3: 2 if a_along_u else 0}
+    rows = np.empty(48, dtype=np.int64)
+    unit = np.empty((3, 3))
+    for j in (1, 2, 3):
+        f0 = _compose(unit_rot, _layer_frame(0, j))
+        rows[16 * codes[j]:16 * codes[j] + 16] = 16 * (j - 1) + _net_permutation(f0)
+        unit[codes[j]] = _domain(f0)
+    rows.setflags(write=False)
+    unit.setflags(write=False)
+    return rows, unit
+
+
+def _oriented_layers(scheme, orient):
+    """The layer operators of ``scheme`` for a corner frame with axis directions ``orient``:
+    ``L`` (n_layers * 3 * 16, N), row ``(n, code, i)`` entry i of the net of layer n, patch ``code``,
+    in the base orientation, and ``unit`` (3, 3) (see :func:`_corner_orientation`)."""
+    rows, unit = _corner_orientation(orient)
+    Ls = scheme.layers
+    nl, N = Ls.shape[0], Ls.shape[-1]
+    return np.take(Ls.reshape(nl, 48, N), rows, axis=1).reshape(-1, N), unit
+
+
+def _smooth_regular_vertices(cx):
+    """Bool (n_vertices,): the vertices of ``cx`` with four faces and no boundary edge, sharp edge
+    or vertex sharpness (regular for the bicubic patch under any options)."""
+    org, nxt, twin = (np.asarray(a, dtype=np.int64) for a in (cx.org, cx.nxt, cx.twin))
+    ok = np.bincount(org, minlength=cx.n_vertices) == 4
+    open_h = twin < 0
+    ok[org[open_h]] = False
+    ok[org[nxt[open_h]]] = False
+    for (a, b), sh in cx.edge_sharpness.items():
+        if sh > 0.0:
+            ok[a] = ok[b] = False
+    for v, sh in cx.vertex_sharpness.items():
+        if sh > 0.0:
+            ok[v] = False
+    return ok
+
+
+# ---------------------------------------------------------------------------------- templates
+class _Template:
+    """Virtual faces and leaf operators of one configuration of a job (see the module docstring)."""
+
+    def __init__(self, n):
+        self.n = n  # ring size N
+        self.kind, self.dom, self.child, self.leaf, self.pts, self.cfg, self.corner = [], [], [], [], [], [], []
+        self.reg = []  # (17, N) per regular patch
+        self.cor = []  # (Nc, N) per corner face: ring relative to its vertex (rows 1..), then the limit point
+        self.cor_vertex = []  # ring position of each corner face's vertex (-1: a new point)
+        self.n_pts = 0
+        self.jobs = array("q")
+        self.rings = array("i")
+
+    def new_vface(self, kind, frame):
+        self.kind.append(kind)
+        self.dom.append(_domain(frame))
+        self.child.append([-1, -1, -1, -1])
+        self.leaf.append(-1)
+        self.pts.append(0)
+        self.cfg.append(-1)
+        self.corner.append((0, 0))
+        return len(self.kind) - 1
+
+    def finish(self):
+        """Freeze the operators: ``R`` (n_reg * 17, N), ``Q`` (n_pts, N), ``O`` (n_corner, N)."""
+        N = self.n
+        self.R = np.concatenate(self.reg).reshape(-1, N) if self.reg else np.zeros((0, N))
+        self.Q = np.concatenate([c[:-1] for c in self.cor]) if self.cor else np.zeros((0, N))
+        self.O = np.array([c[-1] for c in self.cor]).reshape(-1, N)
+        for a in (self.R, self.Q, self.O):
+            if not np.isfinite(a).all():  # pragma: no cover - would be a bug in the local refinement
+                raise MeshError("internal error: a patch uses a point outside the exact local refinement")
+        self.reg = self.cor = None
+
+
+def _ring_walks():
+    """The compiled ring walk, or None without numba."""
+    from ccproof.evaluate._numba_kernel import ring_walks
+
+    return ring_walks
+
+
+def _progress(progress, total, desc):
+    """A tqdm bar on stderr shown after 2 s (None: when stderr is a terminal), or a no-op."""
+    if progress is None:
+        progress = sys.stderr.isatty()
+    if progress:
+        try:
+            from tqdm import tqdm
+        except ImportError:  # pragma: no cover - tqdm is a dependency
+            progress = False
+        else:
+            return tqdm(total=total, desc=desc, unit="face", delay=2, file=sys.stderr, leave=False)
+    return _NoBar()
+
+
+class _NoBar:
+    def update(self, n=1):
+        pass
+
+    def close(self):
+        pass
+
+
+class _Jobs:
+    """The quads to classify: ``g`` (J,) quads of the complex, ``fid`` (J,) index of each one's frame
+    in ``frames``, ``base`` (J,) the ptex face errors name. ``jobs[i]`` is ``(g, frame, base)``."""
+
+    def __init__(self, g, fid, base, frames):
+        self.g = np.asarray(g, dtype=np.int64)
+        self.fid = np.asarray(fid, dtype=np.int64)
+        self.base = np.asarray(base, dtype=np.int64)
+        self.frames = list(frames)
+
+    @classmethod
+    def of(cls, jobs):
+        if isinstance(jobs, cls):
+            return jobs
+        frames, fid = {}, []
+        for j in jobs:
+            fid.append(frames.setdefault(j[1], len(frames)))
+        return cls([j[0] for j in jobs], fid, [j[2] for j in jobs], list(frames))
+
+    def __len__(self):
+        return self.g.size
+
+    def __getitem__(self, i):
+        return int(self.g[i]), self.frames[self.fid[i]], int(self.base[i])
+
+
+class QuadHalfEdges:
+    """Half-edge arrays of an untagged all-quad complex (half-edge ``4 f + i`` is corner i of face f),
+    built with numpy: what the compiled ring walk reads (and the parts of
+    :class:`ccproof.mesh.rules.Complex` that :meth:`_Builder.smooth_regular_patches` reads).
+
+    Parameters
+    ----------
+    faces : array_like of int, shape (m, 4)
+    n_vertices : int
+    options : ccproof.mesh.rules.Options
+
+    Attributes
+    ----------
+    manifold : bool
+        False if a directed edge occurs twice (then the builder takes the Python walk).
+    """
+
+    def __init__(self, faces, n_vertices, options):
+        F = np.asarray(faces, dtype=np.int64).reshape(-1, 4)
+        m = F.shape[0]
+        h = np.arange(4 * m, dtype=np.int64)
+        self.faces = F
+        self.org = F.reshape(-1)
+        self.nxt = h - h % 4 + (h + 1) % 4
+        self.prv = h - h % 4 + (h + 3) % 4
+        nv = self.n_vertices = int(n_vertices)
+        dst = self.org[self.nxt]
+        key = self.org * nv + dst
+        order = np.argsort(key, kind="stable")
+        sk = key[order]
+        self.manifold = not bool((np.diff(sk) == 0).any())
+        rk = dst * nv + self.org
+        i = np.minimum(np.searchsorted(sk, rk), max(sk.size - 1, 0))
+        self.twin = np.where(sk[i] == rk, order[i], -1) if sk.size else np.zeros(0, np.int64)
+        self.start = 4 * np.arange(m, dtype=np.int64)
+        self.edge_sharpness, self.vertex_sharpness = {}, {}
+        self.options = options
+
+
+class _Builder:
+    """Classifies the jobs of a mesh into templates; :meth:`table` assembles the patch table."""
+
+    def __init__(self, depth_semi=1, what="face", progress=None):
+        self.depth_semi = depth_semi  # ring depth refined in the semi-sharp phase (2: Chaikin)
+        self.what = what  # how errors name a base face
+        self.progress = progress
+        self.templates = {}  # template key -> _Template
+        self.configs = {}  # (id(scheme), orientation) -> index
+        self.schemes = []  # per configuration (CornerScheme, orientation)
+        self.n_jobs = 0
+        self.job_base = array("q")
+
+    # ------------------------------------------------------------------ jobs
+    def _register(self, tkey, make, jobs, rings):
+        t = self.templates.get(tkey)
+        if t is None:
+            t = self.templates[tkey] = make()
+            t.finish()
+        t.jobs.extend(jobs)
+        t.rings.extend(rings)
+
+    def classify(self, cx, X, jobs, vmap=None):
+        """Classify the quads ``jobs`` (``[(g, frame, base), ...]`` or :class:`_Jobs`) of ``cx`` (a
+        :class:`ccproof.mesh.rules.Complex`, or :class:`QuadHalfEdges` for an untagged all-quad one)
+        with positions ``X``; job ids are assigned in order. ``vmap``: the mesh vertex of every
+        vertex of ``cx`` (records where the corner faces' vertices are, for the vertex normals).
+
+        The smooth regular ones (:meth:`smooth_regular_patches`) in one vectorized pass, the others
+        by their rings: a quad with three smooth regular corners is first tried as a corner face at
+        the fourth (:meth:`corner_at`), anything else reads its ring from corner 0 (:meth:`face`).
+        On a :class:`QuadHalfEdges` the rings are walked by the compiled kernel when numba is
+        installed (:meth:`_walk_all`), else face by face.
+        """
+        jobs = _Jobs.of(jobs)
+        self.X = X
+        self.vmap = vmap
+        j0 = self.n_jobs
+        self.n_jobs += len(jobs)
+        self.job_base.extend(jobs.base.tolist())
+        if not len(jobs):
+            return
+        ok = _smooth_regular_vertices(cx)
+        done = np.asarray(self.smooth_regular_patches(cx, X, jobs), dtype=bool)
+        g = jobs.g
+        start = np.append(np.asarray(cx.start, dtype=np.int64), len(cx.org))
+        org = np.asarray(cx.org, dtype=np.int64)
+        quad = start[g + 1] - start[g] == 4
+        corners = ok[org[np.minimum(start[g][:, None] + np.arange(4), org.size - 1)]]
+        single = np.where(quad & (corners.sum(axis=1) == 3), np.argmin(corners, axis=1), -1)
+        todo = np.flatnonzero(~done)
+        if isinstance(cx, QuadHalfEdges):
+            if cx.manifold and _ring_walks() is not None:
+                return self._walk_all(cx, jobs, j0, todo, single[todo])
+            from ccproof.mesh.rules import Complex
+
+            cx = Complex(cx.faces, {}, {}, cx.options, n_vertices=cx.n_vertices)
+        bar = _progress(self.progress, todo.size, "patch table")
+        for n, i in enumerate(todo.tolist()):
+            g_, frame, base = jobs[i]
+            r = int(single[i])
+            if not (r >= 0 and self.corner_at(cx, X, g_, r, frame, base, j0 + i, vmap)):
+                self.face(cx, X, g_, frame, base, j0 + i, vmap)
+            if n % 256 == 255:
+                bar.update(256)
+        bar.close()
+
+    def _walk_all(self, he, jobs, j0, todo, single):
+        """Register the jobs ``todo`` (``single``: the one irregular corner of each, or -1) of an
+        untagged all-quad complex: their rings walked by the compiled kernel
+        (:func:`ccproof.evaluate._numba_kernel.ring_walks`, the walk of
+        :func:`ccproof.evaluate.local.canonical_ring`), grouped by the hash of their faces, each
+        group checked face by face against its first ring and registered with the key of that ring
+        (untagged: the key is the faces and the options)."""
+        walks = _ring_walks()
+        opts = he.options.key()
+        pos = np.full(he.n_vertices, -1, dtype=np.int64)
+        seen = np.zeros(he.faces.shape[0], dtype=np.bool_)
+        bar = _progress(self.progress, todo.size, "patch table")
+        step = 1 << 15
+        fallback = []
+        for lo in range(0, todo.size, step):
+            idx = todo[lo:lo + step]
+            r0 = single[lo:lo + step]
+            retry, fb = self._walk_block(he, walks, pos, seen, jobs, j0, idx, np.maximum(r0, 0), r0 >= 0, opts)
+            fallback.append(fb)
+            if retry.size:  # corner candidates that are not corner faces: from corner 0
+                fallback.append(self._walk_block(he, walks, pos, seen, jobs, j0, retry, np.zeros(retry.size, np.int64),
+                                                 np.zeros(retry.size, bool), opts)[1])
+            bar.update(idx.size)
+        bar.close()
+        fallback = np.concatenate(fallback) if fallback else np.zeros(0, dtype=np.int64)
+        if fallback.size:
+            from ccproof.mesh.rules import Complex
+
+            cx = Complex(he.faces, {}, {}, he.options, n_vertices=he.n_vertices)
+            where = {int(i): n for n, i in enumerate(todo.tolist())}
+            for i in fallback.tolist():
+                g_, frame, base = jobs[i]
+                r_ = int(single[where[i]])
+                if not (r_ >= 0 and self.corner_at(cx, self.X, g_, r_, frame, base, j0 + i, self.vmap)):
+                    self.face(cx, self.X, g_, frame, base, j0 + i, self.vmap)
+
+    def _walk_block(self, he, walks, pos, seen, jobs, j0, idx, r, at_corner, opts, maxn=64, maxf=48):
+        k = idx.size
+        rings = np.full((k, maxn), -1, dtype=np.int32)
+        faces = np.zeros((k, maxf, 4), dtype=np.int64)
+        nring = np.empty(k, dtype=np.int64)
+        nfaces = np.empty(k, dtype=np.int64)
+        hashes = np.empty(k, dtype=np.uint64)
+        walks(he.org, he.nxt, he.prv, he.twin, pos, seen, jobs.g[idx], r, rings, nring, faces, nfaces, hashes)
+        fallback = [idx[nring < 0]]  # a ring beyond the arrays (a valence above ~25): the Python walk
+        sig = np.stack([hashes.view(np.int64), r + 4 * at_corner + 8 * jobs.fid[idx]], axis=1)
+        sig[nring < 0] = -1
+        _, first, inv = np.unique(sig, axis=0, return_index=True, return_inverse=True)
+        inv = inv.reshape(-1)
+        order = np.argsort(inv, kind="stable")
+        bounds = np.searchsorted(inv[order], np.arange(first.size + 1))
+        retry = []
+        for gi in range(first.size):
+            mem = order[bounds[gi]:bounds[gi + 1]]
+            rep = first[gi]
+            if nring[rep] < 0:
+                continue
+            nf, n = int(nfaces[rep]), int(nring[rep])
+            same = (nfaces[mem] == nf) & (nring[mem] == n) & (faces[mem, :nf] == faces[rep, :nf]).all(axis=(1, 2))
+            if not same.all():  # a hash collision: those jobs by the Python walk
+                fallback.append(idx[mem[~same]])
+                mem = mem[same]
+            key = (tuple(map(tuple, faces[rep, :nf].tolist())), (), (), opts)
+            frame = jobs.frames[jobs.fid[idx[rep]]]
+            base = int(jobs.base[idx[rep]])
+            rr = int(r[rep])
+            if at_corner[rep]:
+                if not self._corner_ok(key):
+                    retry.append(idx[mem])
+                    continue
+                tkey, make = ("corner", key, rr, frame), functools.partial(self._corner_template, key, rr, frame, base)
+            else:
+                tkey, make = ("face", key, frame), functools.partial(self._face_template, key, frame, base)
+            self._register(tkey, make, (j0 + idx[mem]).tolist(), rings[mem, :n].ravel())
+        return (np.concatenate(retry) if retry else np.zeros(0, dtype=np.int64)), np.concatenate(fallback)
+
+    def smooth_regular_patches(self, cx, X, jobs):
+        """Register the quads of ``jobs`` whose four vertices are smooth regular as bicubic patches.
+
+        Smooth regular (:func:`_smooth_regular_vertices`): four faces around the vertex, no
+        boundary, sharp edge or vertex sharpness at it. Such a face's tagged one-ring has no tags
+        and no irregular corner, and its net (:func:`ccproof.evaluate.local.regular_net`) is its
+        4 x 4 grid of vertices: gathered here for all of them at once with the half-edge arrays (the
+        same walks as :func:`ccproof.evaluate.local.regular_net`); the grid, in the base
+        orientation, is the job's ring. Returns a bool array, True for the jobs handled.
+        """
+        if not jobs:
+            return np.zeros(0, dtype=bool)
+        jobs = _Jobs.of(jobs)
+        org, nxt, prv, twin = (np.asarray(a, dtype=np.int64) for a in (cx.org, cx.nxt, cx.prv, cx.twin))
+        ok = _smooth_regular_vertices(cx)
+        g = jobs.g
+        start = np.append(np.asarray(cx.start, dtype=np.int64), org.size)
+        H = start[g][:, None] + np.arange(4)
+        sel = (start[g + 1] - start[g] == 4) & ok[org[np.minimum(H, org.size - 1)]].all(axis=1)
+        idx = np.flatnonzero(sel)
+        if idx.size == 0:
+            return sel
+        H = H[idx]
+        grid = np.empty((idx.size, 16), dtype=np.int64)
+        for s_ in range(4):
+            h = H[:, s_]
+            t = twin[h]
+            cell = [p[0] + 4 * p[1] for p in (_CENTER[s_],) + _SIDES[s_][:3]]
+            grid[:, cell[0]] = org[h]
+            grid[:, cell[1]] = org[nxt[nxt[t]]]
+            grid[:, cell[2]] = org[prv[t]]
+            grid[:, cell[3]] = org[prv[twin[nxt[t]]]]
+        fid = jobs.fid[idx]
+        j0 = self.n_jobs - len(jobs)
+        for k, f in enumerate(jobs.frames):
+            rows = np.flatnonzero(fid == k)
+            if rows.size:
+                ring = grid[rows][:, _net_permutation(f)]  # the grid in the base orientation
+                self._register(("smooth", f), functools.partial(_smooth_template, f), (j0 + idx[rows]).tolist(),
+                               ring.astype(np.int32).ravel())
+        return sel
+
+    def corner_at(self, cx, X, g, r, frame, base, job, vmap=None):
+        """Register quad ``g`` as a corner face at corner ``r`` if that is its classification (its
+        other corners regular, its ring from ``r`` stationary), with its ring listed from ``r`` (the
+        tags of a ring, hence the semi-sharp test, do not depend on the corner it is listed from).
+        Returns True if registered."""
+        ring_r, faces_r, nr = canonical_ring(cx, g, r)
+        key_r = ring_key(cx, ring_r, faces_r, nr)
+        if not self._corner_ok(key_r):
+            return False
+        self._register(("corner", key_r, r, frame), functools.partial(self._corner_template, key_r, r, frame, base),
+                       (job,), ring_r)
+        return True
+
+    def face(self, cx, X, g, frame, base, job, vmap=None):
+        """Register quad ``g`` with its ring read from corner 0 (the two-ring when the Chaikin
+        semi-sharp phase needs it), building its template on first use (:meth:`_face_template`)."""
+        ring, faces, nr = canonical_ring(cx, g, 0, 1)
+        key = ring_key(cx, ring, faces, nr)
+        if self.depth_semi != 1 and _has_semi_sharp(key):
+            ring, faces, nr = canonical_ring(cx, g, 0, self.depth_semi)
+            key = ring_key(cx, ring, faces, nr)
+        self._register(("face", key, frame), functools.partial(self._face_template, key, frame, base), (job,), ring)
+
+    @staticmethod
+    def _corner_ok(key_r):
+        """Whether a ring read from a face's corner makes the face a corner face at that corner."""
+        if _has_semi_sharp(key_r) or irregular_corners(key_r) != (0,):
+            return False
+        return corner_scheme(key_r) is not None
+
+    def _corner_template(self, key_r, r, frame, base):
+        N = _key_complex(key_r).n_vertices
+        t = _Template(N)
+        root = t.new_vface(_REGULAR, frame)
+        self.scheme_face(t, corner_scheme(key_r), np.eye(N), list(range(N)), r, frame, base, root, np.arange(N))
+        return t
+
+    def _face_template(self, key, frame, base):
+        """The template of a face whose ring (read from corner 0) has the tagged key ``key``: the
+        classification run on the key's own complex (the ring in canonical labels: the same walks
+        read the same rings) with the identity as control points."""
+        kc = _key_complex(key)
+        N = kc.n_vertices
+        depth = 1 if self.depth_semi == 1 or len(key[0]) == len(canonical_ring(kc, 0, 0, 1)[1]) else self.depth_semi
+        ring, faces, _ = canonical_ring(kc, 0, 0, depth)
+        if faces != key[0] or ring != list(range(N)):  # pragma: no cover - the premise of the key caches
+            raise MeshError(f"internal error: the ring of {self.what} {base} is not read back from its key")
+        t = _Template(N)
+        root = t.new_vface(_REGULAR, frame)
+        self._face(t, kc, np.eye(N), 0, frame, 0, 0, base, root, vmap=np.arange(N))
+        return t
+
+    # ------------------------------------------------------------------ template building
+    def _face(self, t, cx, X, g, frame, depth, semi_depth, base, vid, src=None, vmap=None):
+        """Classify quad ``g`` of complex ``cx`` with positions ``X`` (NaN where not exact) into
+        virtual face ``vid`` of template ``t``.
+
+        ``src = (key, n_rule)``: ``cx`` is the child complex of that ring (its rings are cached).
+        ``vmap``: ring position of every vertex of ``cx`` (-1 for new points).
+        """
+
+        def ring_of(r, depth_):
+            if src is not None:
+                return _child_ring(src[0], src[1], g, r, depth_)
+            ring_, faces_, nr_ = canonical_ring(cx, g, r, depth_)
+            return ring_, ring_key(cx, ring_, faces_, nr_), nr_
+
+        ring, key, nr = ring_of(0, 1)
+        if _has_semi_sharp(key):
+            if semi_depth >= MAX_SEMI_DEPTH:
+                raise MeshError(f"{self.what} {base}: semi-sharp creases did not decay in {MAX_SEMI_DEPTH} levels")
+            D = self.depth_semi
+            if D != 1:
+                ring, key, nr = ring_of(0, D)
+            return self.split_face(t, key, nr, X[ring], frame, depth, semi_depth + 1, base, vid, vmap[ring])
+        irr = irregular_corners(key)
+        if not irr:
+            M = _regular_net_matrix(key)
+            Xl = X[ring]
+            origin = Xl.mean(axis=0)
+            op = np.empty((17, Xl.shape[1]))
+            op[:16] = (M @ (Xl - origin))[_net_permutation(frame)]
+            op[16] = origin
+            t.kind[vid] = _REGULAR
+            t.leaf[vid] = len(t.reg)
+            t.reg.append(op)
+            return vid
+        if len(irr) == 1:
+            r = irr[0]
+            ring_r, key_r, _ = ring_of(r, 1)
+            scheme = corner_scheme(key_r)
+            if scheme is not None:
+                return self.scheme_face(t, scheme, X, ring_r, r, frame, base, vid, vmap)
+        if depth >= MAX_DEPTH:
+            raise MeshError(
+                f"{self.what} {base}: the configuration around it is not supported "
+                f"(still irregular after {MAX_DEPTH} local subdivisions)"
+            )
+        return self.split_face(t, key, nr, X[ring], frame, depth + 1, semi_depth, base, vid, vmap[ring])
+
+    def scheme_face(self, t, scheme, X, ring_r, r, frame, base, vid, vmap):
+        """Virtual face ``vid`` of ``t`` is a corner face of ``scheme`` at its corner ``r``, ring
+        ``X[ring_r]`` (listed from that corner)."""
+        C = X[ring_r]
+        rot = _compose(frame, _corner_frame(r))
+        orient = (_sign(rot[1]), _sign(rot[2]))
+        ck = (id(scheme), orient)
+        cfg = self.configs.get(ck)
+        if cfg is None:
+            cfg = self.configs[ck] = len(self.schemes)
+            self.schemes.append((scheme, orient))
+        t.kind[vid] = _CORNER
+        U0, V0, H = t.dom[vid]
+        corner = rot[0]
+        t.corner[vid] = (int(corner[0] > U0), int(corner[1] > V0))
+        rel = C - C[0]
+        op = np.empty((C.shape[0], C.shape[1]))  # row 0 of the relative ring is 0: not stored
+        op[:-1] = rel[1:]
+        op[-1] = C[0] + scheme.limit_mask @ rel
+        t.leaf[vid] = len(t.cor)
+        t.pts[vid] = t.n_pts
+        t.cfg[vid] = cfg
+        t.n_pts += C.shape[0] - 1
+        t.cor.append(op)
+        t.cor_vertex.append(int(vmap[ring_r[0]]))
+        return vid
+
+    def split_face(self, t, key, nr, Xr, frame, depth, semi_depth, base, vid, vmap):
+        """Subdivide the ring ``key`` (positions ``Xr``) once, exactly and locally; classify the
+        four children of its face 0 into new virtual faces of ``t``.
+
+        Only the points whose stencils lie inside the ring are exact (the rules at its ``nr`` rule
+        vertices, :func:`ccproof.evaluate.local.refine_key`); the others are NaN, so that any use
+        would show up in the checks of the tables instead of passing silently. ``vmap``: the ring
+        position of every ring vertex (vertex points keep their vertex).
+        """
+        S, _, child = refine_key(key, nr)
+        X1 = S @ Xr
+        vmap1 = np.full(S.shape[0], -1, dtype=np.int64)
+        vmap1[: len(vmap)] = vmap
+        t.kind[vid] = _SPLIT
+        U0, V0, _ = t.dom[vid]
+        for i in range(4):
+            cf = _compose(frame, _child_frame(i))
+            cu, cv, _ = _domain(cf)
+            q = int(cu > U0) + 2 * int(cv > V0)
+            c = t.new_vface(_REGULAR, cf)
+            t.child[vid][q] = c
+            self._face(t, child, X1, i, cf, depth, semi_depth, base, c, src=(key, nr), vmap=vmap1)
+        return vid
+
+    # ------------------------------------------------------------------ assembly
+    def table(self, top, refused):
+        """The :class:`PatchTable` (floats from the positions given to :meth:`classify`), and the
+        template groups ``[(template, jobs, rings)]`` that :func:`job_floats` recomputes from."""
+        temps = list(self.templates.values())
+        J = self.n_jobs
+        job_root = np.full(J, -1, dtype=np.int64)
+        job_net = np.zeros(J, dtype=np.int64)
+        job_corner = np.zeros(J, dtype=np.int64)
+        job_pts = np.zeros(J, dtype=np.int64)
+        kind, child, dom, leaf, pts, cfg, corner = [], [], [], [], [], [], []
+        n_tv = n_reg = n_cor = n_pts = 0
+        groups = []
+        depth = 0
+        for t in temps:
+            jobs = np.frombuffer(t.jobs, dtype=np.int64) if len(t.jobs) else np.zeros(0, np.int64)
+            rings = np.frombuffer(t.rings, dtype=np.int32).reshape(-1, t.n) if len(t.rings) else \
+                np.zeros((0, t.n), np.int32)
+            k = jobs.size
+            job_root[jobs] = n_tv
+            nr, nc = t.R.shape[0] // 17, t.O.shape[0]
+            job_net[jobs] = n_reg + nr * np.arange(k)
+            job_corner[jobs] = n_cor + nc * np.arange(k)
+            job_pts[jobs] = n_pts + t.n_pts * np.arange(k)
+            t.offsets = (n_reg, n_cor, n_pts)
+            n_reg += nr * k
+            n_cor += nc * k
+            n_pts += t.n_pts * k
+            kind += t.kind
+            child += [[c + n_tv if c >= 0 else -1 for c in ch] for ch in t.child]
+            dom += t.dom
+            leaf += t.leaf
+            pts += t.pts
+            cfg += t.cfg
+            corner += t.corner
+            dv = np.zeros(len(t.kind), dtype=np.int64)
+            for v, ch in enumerate(t.child):  # children are created after their parents
+                if t.kind[v] == _SPLIT:
+                    dv[ch] = dv[v] + 1
+            depth = max(depth, int(dv.max()))
+            n_tv += len(t.kind)
+            groups.append((t, jobs, rings))
+        if (job_root < 0).any():  # pragma: no cover - would be a bug in the classification
+            raise MeshError(f"internal error: job {int(np.flatnonzero(job_root < 0)[0])} was not classified")
+        ops, op_start, op_size, n_layers, unit = [], [], [], [], []
+        off = 0
+        for scheme, orient in self.schemes:
+            L, u = _oriented_layers(scheme, orient)
+            nl_, nc_ = scheme.n_layers, L.shape[1]
+            ops.append(L.reshape(nl_ * 3, 16, nc_).transpose(0, 2, 1).reshape(-1))  # (layer, code, j, i)
+            op_start.append(off)
+            op_size.append(L.shape[1])
+            n_layers.append(scheme.n_layers)
+            unit.append(u)
+            off += L.size
+        d = np.array(dom, dtype=np.float64).reshape(-1, 3)
+        c = np.array(corner, dtype=bool).reshape(-1, 2)
+        nets, origin, ring = job_floats(groups, self.X, (n_reg, n_cor, n_pts), self.progress)
+        def small(a, bound):  # int32 where it fits (the per-face arrays are the big ones)
+            return np.ascontiguousarray(a, dtype=np.int32 if bound < 2**31 else np.int64)
+
+        T = PatchTable(
+            top=small(top, J), refused=np.ascontiguousarray(refused, dtype=np.bool_),
+            job_root=small(job_root, n_tv), job_net=small(job_net, n_reg), job_corner=small(job_corner, n_cor),
+            job_pts=small(job_pts, n_pts),
+            kind=np.array(kind, dtype=np.int8), child=np.array(child, dtype=np.int64).reshape(-1, 4),
+            u0=d[:, 0].copy(), v0=d[:, 1].copy(), h=d[:, 2].copy(), leaf=np.array(leaf, dtype=np.int64),
+            pts=np.array(pts, dtype=np.int64), cfg=np.array(cfg, dtype=np.int64),
+            cu=c[:, 0].copy(), cv=c[:, 1].copy(), split_depth=depth, nets=nets, origin=origin, ring=ring,
+            ops=np.concatenate(ops) if ops else np.zeros(0), op_start=np.array(op_start, dtype=np.int64),
+            op_size=np.array(op_size, dtype=np.int64), n_layers=np.array(n_layers, dtype=np.int64),
+            unit=np.array(unit, dtype=np.float64).reshape(-1, 3, 3), hot=np.zeros((0, 17, 3)))
+        if 0 < n_cor and n_cor * 3 * 17 * 3 * 8 <= HOT_BUDGET:
+            T = T._replace(hot=layer0_nets(T, groups))
+        return T, groups
+
+
+def _smooth_template(frame):
+    """The template of a smooth regular quad: its ring is its 4 x 4 grid in the base orientation."""
+    t = _Template(16)
+    t.new_vface(_REGULAR, frame)
+    op = np.empty((17, 16))
+    op[:16] = np.eye(16) - 1.0 / 16
+    op[16] = 1.0 / 16
+    t.leaf[0] = 0
+    t.reg.append(op)
+    t.smooth_grid = np.argsort(_net_permutation(frame))  # ring[:, smooth_grid]: the grid as walked
+    return t
+
+
+def job_floats(groups, X, sizes, progress=None):
+    """The float data of every job from the positions ``X`` of the complex its rings index.
+
+    Per template group, in blocks of jobs: ``rel = X[ring] - X[ring[0]]`` (J, N, 3), then the
+    template's operators applied to it (one matrix product per block); the affine rows (patch
+    origins, corner limit points) add ``X[ring[0]]`` back.
+
+    Returns
+    -------
+    nets : ndarray (n_regular, 17, 3)
+    origin : ndarray (n_corner, 3)
+    ring : ndarray (n_points, 3)
+    """
+    X = np.asarray(X, dtype=np.float64)
+    n_reg, n_cor, n_pts = sizes
+    nets = np.empty((n_reg, 17, 3))
+    origin = np.empty((n_cor, 3))
+    ring = np.empty((n_pts, 3))
+    bar = _progress(progress, sum(g[1].size for g in groups), "patch data")
+    for t, jobs, rings in groups:
+        N = t.n
+        o_reg, o_cor, o_pts = t.offsets
+        nr, nc, npt = t.R.shape[0] // 17, t.O.shape[0], t.Q.shape[0]
+        grid = getattr(t, "smooth_grid", None)
+        for lo in range(0, jobs.size, _BLOCK):
+            R = rings[lo:lo + _BLOCK]
+            k = R.shape[0]
+            if grid is not None:  # a smooth regular quad: its grid less the grid's mean, directly
+                origin_ = X[R[:, grid]].mean(axis=1)
+                a = np.empty((k, 17, 3))
+                a[:, :16] = X[R] - origin_[:, None, :]
+                a[:, 16] = origin_
+                nets[o_reg + lo:o_reg + lo + k] = a
+                bar.update(k)
+                continue
+            X0 = X[R[:, 0]]
+            rel = (X[R] - X0[:, None, :]).transpose(1, 0, 2).reshape(N, 3 * k)  # (N, k * 3)
+            if nr:
+                a = (t.R @ rel).reshape(nr, 17, k, 3).transpose(2, 0, 1, 3)
+                a[:, :, 16] += X0[:, None, :]
+                nets[o_reg + nr * lo:o_reg + nr * (lo + k)] = a.reshape(-1, 17, 3)
+            if nc:
+                ring[o_pts + npt * lo:o_pts + npt * (lo + k)] = \
+                    (t.Q @ rel).reshape(npt, k, 3).transpose(1, 0, 2).reshape(-1, 3)
+                b = (t.O @ rel).reshape(nc, k, 3).transpose(1, 0, 2)
+                b += X0[:, None, :]
+                origin[o_cor + nc * lo:o_cor + nc * (lo + k)] = b.reshape(-1, 3)
+            bar.update(k)
+    bar.close()
+    for name, a in (("nets", nets), ("origin", origin), ("ring", ring)):
+        if not np.isfinite(a).all():
+            raise MeshError(f"internal error: non-finite {name} in the patch table (a non-finite control point?)")
+    return nets, origin, ring
+
+
+def catmark_step(mesh):
+    """One Catmull-Clark step of an untagged manifold polygon mesh, vectorized; None otherwise.
+
+    The rules of :func:`ccproof.mesh.rules.refine_complex` for a mesh without tags, holes or
+    non-default options (bmz04 Fig. 1, docs/readings.md R1; boundary edges infinitely sharp: edge
+    midpoints and the crease rule ``(3/4) V + (1/8)(e0 + e1)`` at boundary vertices), in the layout of
+    :meth:`ccproof.mesh.polymesh.PolyMesh.refine`: vertex points (n), edge points (E, edges numbered
+    by first occurrence along the faces' corners), face points (m); child ``offsets[f] + i`` of face
+    f is ``(v_i, edge point (v_i, v_i+1), face point, edge point (v_i-1, v_i))``. Evaluated from the
+    face points (float weights of :mod:`ccproof.rule_weights`), not as stencils of the old vertices:
+    the same values to round-off.
+
+    Parameters
+    ----------
+    mesh : PolyMesh
+
+    Returns
+    -------
+    (X1, F1) or None
+        ``X1`` (n + E + m, 3) float64, ``F1`` (sum of face sizes, 4) int64; None for a tagged mesh
+        (creases, corners, holes, boundary mode "none", smooth triangle subdivision, a one-face
+        boundary vertex under "edge_and_corner"), one with unused vertices, a non-manifold edge or a
+        vertex with more than one boundary edge pair.
+    """
+    from ccproof.rule_weights import crease_vertex_weights, smooth_edge_weights, smooth_vertex_weights
+
+    opts = mesh.options
+    if (mesh.edge_sharpness or mesh.vertex_sharpness or np.asarray(mesh.is_hole).any()
+            or opts.triangle_subdivision != "catmark" or opts.boundary == "none"):
+        return None
+    X = np.asarray(mesh.vertices, dtype=np.float64)
+    idx = np.asarray(mesh.indices, dtype=np.int64)
+    sizes = np.asarray(mesh.sizes, dtype=np.int64)
+    off = np.asarray(mesh.offsets, dtype=np.int64)[:sizes.size]
+    n, m, H = X.shape[0], sizes.size, idx.size
+    face = np.repeat(np.arange(m), sizes)
+    pos = np.arange(H) - off[face]
+    nxt = off[face] + (pos + 1) % sizes[face]
+    prv = off[face] + (pos - 1) % sizes[face]
+    org, dst = idx, idx[nxt]
+    if np.unique(org * n + dst).size != H:  # a directed edge twice: non-manifold or misoriented
+        return None
+    lo, hi = np.minimum(org, dst), np.maximum(org, dst)
+    uniq, first, inv = np.unique(lo * n + hi, return_index=True, return_inverse=True)
+    inv = inv.reshape(-1)
+    E = uniq.size
+    order = np.argsort(first, kind="stable")
+    rank = np.empty(E, dtype=np.int64)
+    rank[order] = np.arange(E)
+    he_edge = rank[inv]  # edge id of every half-edge (first-occurrence order)
+    count = np.bincount(he_edge, minlength=E)
+    if (count > 2).any():
+        return None
+    valence = np.bincount(org, minlength=n)  # faces (outgoing half-edges) at every vertex
+    if (valence == 0).any():
+        return None
+    bnd_h = count[he_edge] == 1  # boundary half-edges
+    nb_out = np.bincount(org[bnd_h], minlength=n)
+    nb_in = np.bincount(dst[bnd_h], minlength=n)
+    if (nb_out > 1).any() or (nb_in != nb_out).any():
+        return None
+    if opts.boundary == "edge_and_corner" and ((nb_out > 0) & (valence == 1)).any():
+        return None  # a one-face corner: sharp from level 1 on (a tagged level-1 mesh)
+    one = 1.0
+    fp = np.add.reduceat(X[idx], off, axis=0) / sizes[:, None] if m else np.zeros((0, 3))
+    # edge points
+    h1 = first[order]  # the first half-edge of every edge, in edge order
+    h2 = np.full(E, -1, dtype=np.int64)
+    second = np.flatnonzero(np.arange(H) != first[inv])
+    h2[he_edge[second]] = second
+    a, b = org[h1], dst[h1]
+    vw, fw = smooth_edge_weights(one)
+    ep = 0.5 * (X[a] + X[b])
+    inner = h2 >= 0
+    ep[inner] = vw * (X[a[inner]] + X[b[inner]]) + fw * (fp[face[h1[inner]]] + fp[face[h2[inner]]])
+    # vertex points
+    vp = np.empty((n, 3))
+    sum_e = np.stack([np.bincount(org, weights=X[dst, c], minlength=n) for c in range(3)], axis=1)
+    sum_f = np.stack([np.bincount(org, weights=fp[face, c], minlength=n) for c in range(3)], axis=1)
+    wv, we, wf = smooth_vertex_weights(valence, one)
+    vp[:] = wv[:, None] * X + we[:, None] * sum_e + wf[:, None] * sum_f
+    bv = np.flatnonzero(nb_out > 0)
+    if bv.size:
+        cw, ce = crease_vertex_weights(one)
+        bn = np.zeros((n, 3))
+        np.add.at(bn, org[bnd_h], X[dst[bnd_h]])
+        np.add.at(bn, dst[bnd_h], X[org[bnd_h]])
+        vp[bv] = cw * X[bv] + ce * bn[bv]
+    X1 = np.concatenate([vp, ep, fp])
+    F1 = np.stack([org, n + he_edge, n + E + face, n + he_edge[prv]], axis=1)
+    return X1, F1
+
+
+def layer0_nets(T, groups):
+    """The nets of layer 0 of every corner face of table ``T`` (see :attr:`PatchTable.hot`): per
+    corner face c and patch code, ``sum_j L[0, code, j] ring[j]`` summed over j = 1, 2, ... in order
+    (the compiled kernel's sums), row 16 the limit point. Shape (3 n_corner, 17, 3)."""
+    hot = np.empty((3 * T.origin.shape[0], 17, 3))
+    for t, jobs, _ in groups:
+        if jobs is None or not jobs.size or not t.O.shape[0]:
+            continue
+        o_reg, o_cor, o_pts = t.offsets
+        nc, npt = t.O.shape[0], t.Q.shape[0]
+        k = jobs.size
+        for vf, kind in enumerate(t.kind):
+            if kind != _CORNER:
+                continue
+            cfg = t.cfg[vf]
+            Nc, st = int(T.op_size[cfg]), int(T.op_start[cfg])
+            ci = o_cor + nc * np.arange(k) + t.leaf[vf]
+            q0 = o_pts + npt * np.arange(k) + t.pts[vf] - 1
+            L0 = T.ops[st:st + 48 * Nc].reshape(3, Nc, 16)
+            for code in range(3):
+                acc = np.zeros((k, 16, 3))
+                for j in range(1, Nc):
+                    acc += L0[code, j][None, :, None] * T.ring[q0 + j][:, None, :]
+                hot[3 * ci + code, :16] = acc
+                hot[3 * ci + code, 16] = T.origin[ci]
+    return hot
