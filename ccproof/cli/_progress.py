@@ -29,19 +29,3 @@ def progress_enabled(args) -> bool:
         return sys.stderr.isatty()
     except (AttributeError, ValueError):  # a closed or replaced stderr
         return False
-
-
-def progress_kwargs(fn, progress):
-    """``{"progress": progress}`` when ``fn`` takes a ``progress`` argument (e.g. a surface constructor
-    whose setup can take seconds), else ``{}``: the hook through which a setup reports its progress.
-
-    >>> progress_kwargs(lambda mesh, progress=True: None, False), progress_kwargs(lambda mesh: None, False)
-    ({'progress': False}, {})
-    """
-    import inspect
-
-    try:
-        params = inspect.signature(fn).parameters
-    except (TypeError, ValueError):  # a builtin without a signature
-        return {}
-    return {"progress": bool(progress)} if "progress" in params else {}

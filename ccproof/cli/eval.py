@@ -63,15 +63,13 @@ def build_surface(mesh, tagged, alpha=None, progress=False):
     the tagged evaluator's natural parameterization for a tagged or non-quad :class:`PolyMesh`, else the
     reparameterizable surface of an all-quad :class:`QuadMesh`. ``progress``: a bar for the setup, where the
     constructor draws one (never on a worker)."""
-    from ccproof.cli._progress import progress_kwargs
-
     if tagged:
         from ccproof.evaluate import limit_surface as natural_surface
 
-        return natural_surface(mesh, **progress_kwargs(natural_surface, progress))
+        return natural_surface(mesh, progress=progress)
     from ccproof.reparam.surface import limit_surface
 
-    return limit_surface(mesh, alpha=alpha, **progress_kwargs(limit_surface, progress))
+    return limit_surface(mesh, alpha=alpha, progress=progress)
 
 
 def _checked_points(path, n_faces):

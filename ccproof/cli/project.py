@@ -48,7 +48,7 @@ def run(args):
     out_path = check_file(args.out, (".npz",))  # before any work (even the imports)
     import numpy as np
 
-    from ccproof.cli._progress import progress_enabled, progress_kwargs
+    from ccproof.cli._progress import progress_enabled
     from ccproof.errors import CCProofError
     from ccproof.evaluate.closest import CELLS, ClosestPointFinder
     from ccproof.evaluate.closest import _check_points as check_points
@@ -60,7 +60,7 @@ def run(args):
         check_points(X)
     except CCProofError as exc:
         raise CCProofError(f"{args.points}: {exc} (point i is on line i + 2)") from None
-    S = limit_surface(args.mesh, **progress_kwargs(limit_surface, progress))  # a bar for a long setup
+    S = limit_surface(args.mesh, progress=progress)  # a bar for a long setup
     t0 = time.perf_counter()
     finder = ClosestPointFinder(S, cells=args.cells or CELLS)
     starts = range(0, X.shape[0], BATCH)

@@ -573,7 +573,7 @@ class PolyMesh:
         stencils, _, _, _ = refine_complex(self.complex())
         if self.manifold is not self:
             vmap = self.manifold_vertex_map.tolist()
-            out = []
+            out: list[dict | None] = []
             for st in stencils:
                 if st is None:
                     out.append(None)

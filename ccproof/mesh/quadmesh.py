@@ -100,7 +100,7 @@ def _duplicate_face(org, face_of, hs):
     Returns ``(f, g, vertices of f)``; the cycle is compared up to rotation and direction.
     """
     faces = sorted({int(face_of[x]) for x in hs})
-    cyc = {}
+    cyc: dict = {}
     for f in faces:
         vs = org[face_of == f].tolist()
         k = len(vs)

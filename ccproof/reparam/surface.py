@@ -330,4 +330,6 @@ def limit_surface(mesh: QuadMesh | PolyMesh | str | os.PathLike[str], alpha: flo
     poly = read_mesh(mesh)
     if poly.is_plain_quads:
         return ReparamLimitSurface(poly.to_quad_mesh(), alpha, progress=progress)
-    return limit_surface(poly, alpha, progress=progress)
+    if alpha is not None:
+        raise CCProofError(f"alpha applies to the parameterizations of plain quad meshes only, not to {mesh}")
+    return limit_surface(poly, progress=progress)
