@@ -25,12 +25,13 @@ from .c1 import C1_SCHEMA, verify_c1
 from .errors import CertificateError
 from .injectivity import SCHEMA, verify_injectivity
 from .record import Part, Recorder, VerifyResult, read_valence
+from .tagged_c1 import TAGGED_SCHEMA, verify_tagged
 
-__all__ = ["SCHEMA", "C1_SCHEMA", "CertificateError", "Part", "VerifyResult", "verify_certificate", "verify_file",
+__all__ = ["SCHEMA", "C1_SCHEMA", "TAGGED_SCHEMA", "CertificateError", "Part", "VerifyResult", "verify_certificate", "verify_file",
            "check_coverage", "certificate_files"]
 
 MAX_FILE_BYTES = 64 * 2**20
-_KINDS = {SCHEMA: verify_injectivity, C1_SCHEMA: verify_c1}
+_KINDS = {SCHEMA: verify_injectivity, C1_SCHEMA: verify_c1, TAGGED_SCHEMA: None}
 #: what a malformed file can raise while it is being read; each ends in FAIL with the reason
 _MALFORMED = (CertificateError, ValueError, TypeError, KeyError, IndexError, AttributeError, RecursionError,
               OverflowError, ZeroDivisionError)
@@ -73,6 +74,10 @@ def verify_certificate(cert, log=print, path=None):
             raise CertificateError(f"unknown certificate schema {str(got)[:60]!r} (expected one of "
                                    f"{', '.join(map(repr, _KINDS))})")
         res.schema = cert["schema"]
+        if res.schema == TAGGED_SCHEMA:  # a configuration name instead of a valence (docs/tagged_c1.md)
+            res.valence = verify_tagged(cert, part, log)
+            res.seconds = time.perf_counter() - t0
+            return res
         res.valence = read_valence(cert)
         res.N = cert.get("N") if isinstance(cert.get("N"), int) else None
         _KINDS[res.schema](cert, res.valence, part, log)
@@ -123,7 +128,8 @@ def verify_file(path: str | Path, log: Callable[[str], object] = print) -> Verif
 
 
 def certificate_files(directory):
-    """The certificate files under ``directory``: ``c1/k*.json`` then ``injectivity/k*.json``.
+    """The certificate files under ``directory``: ``c1/k*.json``, the tagged configurations'
+    ``c1/{dart,crease,corner}/*.json``, then ``injectivity/k*.json``.
 
     Parameters
     ----------
@@ -142,7 +148,8 @@ def certificate_files(directory):
     ('c1', 'k003.json', 'injectivity')
     """
     d = Path(directory)
-    return sorted((d / "c1").glob("k*.json")) + sorted((d / "injectivity").glob("k*.json"))
+    tagged = sorted(f for fam in ("dart", "crease", "corner") for f in (d / "c1" / fam).glob("[kn]*.json"))
+    return sorted((d / "c1").glob("k*.json")) + tagged + sorted((d / "injectivity").glob("k*.json"))
 
 
 def check_coverage(valences):

@@ -1,0 +1,295 @@
+"""Certificates for tagged configurations (schema ``ccproof.tagged-c1/1``): "not C1" by a witness (trusted).
+
+The statement is derived from the configuration name alone (:mod:`.tagged`: the sector matrix S from
+OpenSubdiv's rules, its exact spectrum). A ``"not C1"`` certificate names a control net
+P = (x, y, z) whose three coordinates are eigenvectors of S, with eigenvalues alpha, beta, gamma,
+alpha >= gamma > 0 and beta >= gamma, and a sharp ray r and a quadrant q. The verifier derives each
+eigenvector itself (exactly for a rational eigenvalue, given its values on the crease points; in arb
+for an irrational simple eigenvalue, whose crease values are exactly 0 because it is no eigenvalue of
+the crease block) and checks:
+
+* B (boundary segment): x = y = 0 on every crease point of r's limit curve (the centre and ray r; for a
+  crease centre both sharp rays; exact rationals), z's limit position at v is 0 (the crease limit mask
+  (e0 + 4 V + e1)/6 of a crease centre, V of a corner) and the limit position (z(C) + 4 z(r1) + z(r2))/6
+  of r's first point is not 0. Every limit point of that curve is an affine combination of crease
+  points, so the curve lies on the z-axis; it joins v = 0 to the limit of r's first point at every
+  level m (scaled by gamma^m != 0), so the limit surface contains a segment of the z-axis ending at v.
+  A C1 surface (with boundary) at v has e_z in its tangent plane T_v.
+* N (normal): at the regular vertex (1, 1) of quadrant q the limit tangents are the B-spline masks
+  T_a = sum w'(a) w(b) P(a, b), T_b = sum w(a) w'(b) P(a, b), w = (1, 4, 1)/6, w' = (-1, 0, 1)/2, and
+  J_xy = T_a(x) T_b(y) - T_b(x) T_a(y) is certainly not 0. Since S^m P = (alpha^m x, beta^m y, gamma^m z),
+  the normal at the level-m copy p_m of that vertex is (beta^m gamma^m J_yz, gamma^m alpha^m J_zx,
+  alpha^m beta^m J_xy); divided by alpha^m beta^m its z-component is J_xy and the others stay bounded
+  (gamma <= alpha, beta), so every limit n of the unit normals at p_m -> v has n_z != 0.
+
+A C1 surface at v would have a continuous unit normal, n(v) = lim n(p_m), orthogonal to T_v, which
+holds e_z: n_z = 0, a contradiction. So the limit surface of this control net is not C1 at v.
+
+A ``"C1"`` certificate is checked for the spectral part of the generalized Reif criterion
+(:func:`.tagged.leading_spectrum`); the characteristic-map part for tagged sectors is not implemented,
+so no such certificate passes (docs/tagged_c1.md).
+"""
+
+from __future__ import annotations
+
+from flint import arb, arb_mat, ctx, fmpq, fmpq_mat, fmpq_poly
+
+from .errors import CertificateError
+from .record import exact_keys, field_of
+from .replay import parse_decimal
+from .tagged import (crease_block, crease_points, eigenvalues, labels, leading_spectrum, parse_configuration,
+                     sector_matrix, sharp_rays)
+
+TAGGED_SCHEMA = "ccproof.tagged-c1/1"
+STATEMENTS = ("C1", "not C1")
+_W = (fmpq(1, 6), fmpq(4, 6), fmpq(1, 6))
+_DW = (fmpq(-1, 2), fmpq(0), fmpq(1, 2))
+
+
+def verify_tagged(cert, part, log):
+    """Check a tagged-configuration certificate (module docstring) into ``part``.
+
+    Parameters
+    ----------
+    cert : dict
+        ``schema``, ``configuration``, ``statement``, ``prec`` and, for ``"not C1"``, ``witness``.
+    part : Recorder
+    log : callable (str) -> None
+
+    Returns
+    -------
+    str
+        The configuration name (for the verdict).
+
+    Raises
+    ------
+    CertificateError
+        On a malformed certificate.
+
+    Examples
+    --------
+    >>> import json
+    >>> from ccproof.tables.format import certificates_dir
+    >>> from ccproof.certify.verify.record import Recorder, VerifyResult
+    >>> cert = json.loads((certificates_dir() / "c1" / "crease" / "n005.json").read_text())
+    >>> res = VerifyResult()
+    >>> verify_tagged(cert, Recorder(res, lambda line: None), lambda line: None), bool(res)
+    ('crease:5', True)
+    """
+    statement = field_of(cert, "statement", str, "certificate")
+    if statement not in STATEMENTS:
+        raise CertificateError(f"statement must be one of {STATEMENTS}, got {statement[:20]!r}")
+    keys = ("schema", "configuration", "statement", "prec") + (("witness",) if statement == "not C1" else ())
+    exact_keys(cert, keys, "certificate")
+    name = field_of(cert, "configuration", str, "certificate")
+    fam, n = parse_configuration(name)
+    prec = field_of(cert, "prec", int, "certificate")
+    if not 64 <= prec <= 1024:
+        raise CertificateError("prec must lie in 64..1024")
+    log(f"{statement} certificate for {name} ({prec} bits)")
+    S = sector_matrix(fam, n)
+    ok = all(sum((S[i, j] for j in range(S.ncols())), fmpq(0)) == 1 for i in range(S.nrows()))
+    part("S sector matrix derived from the rules", ok, f"{S.nrows()} points, rows sum to 1 (exact)")
+    if statement == "C1":
+        ok, msg, _ = leading_spectrum(fam, n, prec)
+        part("spectral part of the generalized Reif criterion", ok, msg)
+        part("characteristic map regular and injective on the sector", False,
+             "not implemented for tagged sectors: no C1 certificate can pass yet")
+        return name
+    if fam == "dart":
+        raise CertificateError("witnesses are defined for crease and corner sectors only")
+    w = field_of(cert, "witness", dict, "certificate")
+    exact_keys(w, ("x", "y", "z", "ray", "quadrant"), "witness")
+    r, q = field_of(w, "ray", int, "witness"), field_of(w, "quadrant", int, "witness")
+    if r not in sharp_rays(fam, n) or not 0 <= q < n:
+        raise CertificateError(f"witness: ray {r} is not sharp or quadrant {q} outside 0..{n - 1}")
+    with ctx.workprec(prec):
+        vecs, vals = {}, {}
+        for c in ("x", "y", "z"):
+            val, vec, msg = _eigenvector(fam, n, field_of(w, c, dict, "witness"), c, prec)
+            part(f"{c}: eigenvector of S", vec is not None, msg)
+            if vec is None:
+                return name
+            vals[c], vecs[c] = val, vec
+        ok, msg = _ordering(fam, n, vals["x"], vals["y"], vals["z"], prec)
+        part("G generic: alpha = lam1, beta = lam2, gamma = the crease block's largest eigenvalue below 1; "
+             "no Jordan block at |lam| >= gamma", ok, msg)
+        if not ok:
+            return name
+        _check_boundary(fam, n, r, vecs, part)
+        J = _jacobian(fam, n, q, vecs["x"], vecs["y"])
+        ok = J > 0 or J < 0
+        part(f"N normal at vertex (1,1) of quadrant {q}: J_xy != 0", ok, f"J_xy = {J.str(6)}")
+        if not part.failed:
+            log(f"  the limit surface of this net is not C1 at the {fam} vertex: normals along the level-m "
+                f"copies of quadrant {q}'s (1,1) tend to n_z != 0, yet e_z lies in T_v (ray {r})")
+    return name
+
+
+def _same(t, v):
+    """Is the eigenvalue v (fmpq, or the arb ball of an irrational root) the root t[0] of factor t[1]?"""
+    if isinstance(v, fmpq):
+        return t[1].degree() == 1 and -t[1][0] / t[1][1] == v
+    return t[1].degree() > 1 and t[0].real.overlaps(v) and t[0].imag.is_zero()
+
+
+def _ordering(fam, n, a, b, g, prec):
+    """(ok, message): a = lam1 >= b = lam2 >= every other |lam| (1 simple, ties only with b itself), g the
+    largest eigenvalue below 1 of the crease block, and every eigenvalue of modulus possibly >= g non-defective."""
+    ev = eigenvalues(fam, n, prec)  # each root once per unit of algebraic multiplicity
+    one = fmpq_poly([-1, 1])
+    if sum(1 for t in ev if t[1] == one) != 1:
+        return False, "eigenvalue 1 is not simple"
+    rest = [t for t in ev if t[1] != one]
+    ia = next((i for i, t in enumerate(rest) if _same(t, a)), None)
+    if ia is None:
+        return False, "alpha is not an eigenvalue"
+    rest_b = rest[:ia] + rest[ia + 1:]
+    ib = next((i for i, t in enumerate(rest_b) if _same(t, b)), None)
+    if ib is None:
+        return False, "beta is not an eigenvalue (distinct from alpha's copy)"
+    others = rest_b[:ib] + rest_b[ib + 1:]
+    if not (abs(rest[ia][0]) >= abs(rest_b[ib][0]) or rest[ia][1] == rest_b[ib][1]):
+        return False, "alpha >= beta is not certain"
+    bad = [t for t in others if not (_same(t, b) or abs(t[0]) < abs(rest_b[ib][0]))]  # certainly below beta
+    if bad:
+        return False, f"an eigenvalue ({bad[0][0].str(6)}) is not certainly below beta (lam1, lam2 not alpha, beta)"
+    cfac = [p for p, _ in crease_block(fam, n).charpoly().factor()[1]]
+    if any(p.degree() > 1 for p in cfac):
+        return False, "the crease block has irrational eigenvalues"
+    croots = [-p[0] / p[1] for p in cfac]
+    below = [r for r in croots if r < 1]
+    if not isinstance(g, fmpq) or not below or g != max(below):
+        return False, f"gamma is not the crease block's largest eigenvalue below 1 ({max(below) if below else None})"
+    defective = [t for t in rest if t[3] > 1 and not abs(t[0]) < g]  # Jordan blocks that could reach gamma
+    if defective:
+        return False, f"a Jordan block at |lam| >= gamma: {defective[0][1]} (minimal polynomial multiplicity " \
+                      f"{defective[0][3]})"
+    return True, f"alpha = {_str(a)}, beta = {_str(b)}, gamma = {g}; 1 simple; no Jordan block at |lam| >= gamma"
+
+
+def _str(v):
+    return str(v) if isinstance(v, fmpq) else v.str(8)
+
+
+def _eigenvector(fam, n, spec, c, prec):
+    """(eigenvalue, vector, message); vector None with the reason when the claim fails."""
+    exact_keys(spec, ("eigenvalue", "crease", "pivot") if "pivot" in spec else ("eigenvalue", "crease"), c)
+    crease = field_of(spec, "crease", list, c)
+    cp = crease_points(fam, n)
+    if len(crease) != len(cp):
+        raise CertificateError(f"{c}: crease values must be {len(cp)} decimals")
+    cval = [parse_decimal(v) for v in crease]
+    S = sector_matrix(fam, n)
+    m = S.nrows()
+    ev = spec["eigenvalue"]
+    if isinstance(ev, str):  # rational eigenvalue: exact
+        lam = parse_decimal(ev)
+        vec = _solve_exact(S, lam, cp, cval)
+        if vec is None:
+            return lam, None, f"no eigenvector for {lam} with the given crease values"
+        return lam, vec, f"eigenvalue {lam}; S v = {lam} v exactly"
+    lo_hi = field_of(spec, "eigenvalue", list, c)
+    if len(lo_hi) != 2:
+        raise CertificateError(f"{c}: eigenvalue must be a decimal or [low, high]")
+    lo, hi = parse_decimal(lo_hi[0]), parse_decimal(lo_hi[1])
+    inside = [t for t in eigenvalues(fam, n, prec) if t[0].real > lo and t[0].real < hi]
+    near = [t for t in eigenvalues(fam, n, prec) if t[0].real.overlaps(arb(lo).union(arb(hi)))]
+    if len(inside) != 1 or len(near) != 1 or not inside[0][0].imag.is_zero() or inside[0][2] != 1:
+        return None, None, f"[{lo}, {hi}] does not isolate one simple real eigenvalue of {fam}:{n}"
+    z, p = inside[0][0], inside[0][1]
+    if any(v != 0 for v in cval):
+        return None, None, "an irrational eigenvalue's eigenvector vanishes on the crease points"
+    if p.gcd(crease_block(fam, n).charpoly()).degree() > 0:
+        return None, None, "the eigenvalue is one of the crease block's"
+    pivot = field_of(spec, "pivot", int, c)
+    free = [i for i in range(m) if i not in cp]
+    if pivot not in free:
+        raise CertificateError(f"{c}: pivot must index a non-crease point")
+    # rows and columns of the non-crease points, the pivot coordinate set to 1 and its row dropped
+    rest = [i for i in free if i != pivot]
+    lam = z.real
+    A = arb_mat([[arb(S[i, j]) - (lam if i == j else 0) for j in rest] for i in rest])
+    b = arb_mat([[-arb(S[i, pivot])] for i in rest])
+    try:
+        sol = A.solve(b)
+    except ZeroDivisionError:
+        return None, None, f"the system for the eigenvector of {lam.str(8)} (pivot {pivot}) is not certainly regular"
+    vec = [arb(0)] * m
+    vec[pivot] = arb(1)
+    for k, i in enumerate(rest):
+        vec[i] = sol[k, 0]
+    return lam, vec, f"eigenvalue {lam.str(10)} (simple root of {p}); vector in arb, pivot {labels(fam, n)[pivot]}"
+
+
+def _solve_exact(S, lam, cp, cval):
+    m = S.nrows()
+    free = [i for i in range(m) if i not in cp]
+    # (S - lam) v = 0 with v fixed on cp: unknowns v[free]; rows of cp must hold with the given values
+    rows = []
+    for i in range(m):
+        rhs = -sum((S[i, j] * cval[k] for k, j in enumerate(cp)), fmpq(0)) + (lam * cval[cp.index(i)] if i in cp
+                                                                               else fmpq(0))
+        rows.append([S[i, j] - (lam if i == j else 0) for j in free] + [rhs])
+    R, rank = fmpq_mat(rows).rref()
+    nf = len(free)
+    vec = [fmpq(0)] * m
+    for k, j in enumerate(cp):
+        vec[j] = cval[k]
+    for r in range(rank):
+        lead = next(c for c in range(nf + 1) if R[r, c] != 0)
+        if lead == nf:
+            return None  # inconsistent
+        vec[free[lead]] = R[r, nf] / R[r, lead]  # free variables (non-pivot columns) stay 0
+    if all(v == 0 for v in vec):
+        return None
+    Sv = S * fmpq_mat([[v] for v in vec])
+    return vec if all(Sv[i, 0] == lam * vec[i] for i in range(m)) else None
+
+
+def _check_boundary(fam, n, r, vecs, part):
+    pts = labels(fam, n)
+    rays = sharp_rays(fam, n) if fam == "crease" else (r,)
+    on_curve = [0] + [pts.index(("r", s, a, 0)) for s in rays for a in (1, 2)]
+    zero_xy = all(_exact_zero(vecs[c][i]) for c in ("x", "y") for i in on_curve)
+    z = vecs["z"]
+    r1, r2 = pts.index(("r", r, 1, 0)), pts.index(("r", r, 2, 0))
+    exact = all(isinstance(z[i], fmpq) for i in on_curve)
+    at_v = (z[0] if fam == "corner" else (z[pts.index(("r", 0, 1, 0))] + 4 * z[0] + z[pts.index(("r", n, 1, 0))]) / 6
+            ) if exact else None
+    leave = (z[0] + 4 * z[r1] + z[r2]) / 6 if exact else None
+    ok = zero_xy and exact and at_v == 0 and leave != 0
+    part(f"B boundary segment: ray {r}'s limit curve lies on the z-axis and leaves v", ok,
+         f"x = y = 0 on its crease points, limit z at v = 0, limit z of ray {r}'s first point = {leave}" if ok
+         else "x or y not exactly 0 on the curve, or z's limit curve does not start at v = 0 and leave it")
+
+
+def _exact_zero(v):
+    return isinstance(v, fmpq) and v == 0 or isinstance(v, arb) and v.is_zero()
+
+
+def _jacobian(fam, n, q, x, y):
+    pts = labels(fam, n)
+
+    def index(a, b):
+        if (a, b) == (0, 0):
+            return 0
+        if b == 0:
+            return pts.index(("r", q, a, 0))
+        if a == 0:
+            return pts.index(("r", (q + 1) % n if fam == "dart" else q + 1, b, 0))
+        return pts.index(("q", q, a, b))
+
+    def tangent(v, da, db):
+        acc = arb(0)
+        for a in range(3):
+            for b in range(3):
+                acc += arb((da[a] * db[b])) * v[index(a, b)]
+        return acc
+
+    xa, xb = tangent(x, _DW, _W), tangent(x, _W, _DW)
+    ya, yb = tangent(y, _DW, _W), tangent(y, _W, _DW)
+    return xa * yb - xb * ya
+
+
+__all__ = ["TAGGED_SCHEMA", "verify_tagged"]
