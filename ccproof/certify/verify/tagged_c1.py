@@ -25,9 +25,16 @@ the crease block) and checks:
 A C1 surface at v would have a continuous unit normal, n(v) = lim n(p_m), orthogonal to T_v, which
 holds e_z: n_z = 0, a contradiction. So the limit surface of this control net is not C1 at v.
 
+G (generic): alpha = lam1 and beta = lam2 are the two leading eigenvalues of S below 1 (every other
+eigenvalue certainly smaller in modulus than beta, or beta itself), gamma is the crease block's largest
+eigenvalue below 1 (the tangent of the crease curve of a generic net), and no eigenvalue of modulus
+possibly >= gamma is defective. Then the witness is not a degenerate net: for every net whose
+lam1-, lam2- and gamma-coefficients a1, a2, a3 are linearly independent the same leading terms give
+the same contradiction (docs/tagged_c1.md), an open dense set of nets.
+
 A ``"C1"`` certificate is checked for the spectral part of the generalized Reif criterion
-(:func:`.tagged.leading_spectrum`); the characteristic-map part for tagged sectors is not implemented,
-so no such certificate passes (docs/tagged_c1.md).
+(:func:`.tagged.leading_spectrum`) and for a tangent plane that sees the crease; the characteristic-map
+part for tagged sectors is not implemented, so no such certificate passes (docs/tagged_c1.md).
 """
 
 from __future__ import annotations
@@ -91,8 +98,14 @@ def verify_tagged(cert, part, log):
     ok = all(sum((S[i, j] for j in range(S.ncols())), fmpq(0)) == 1 for i in range(S.nrows()))
     part("S sector matrix derived from the rules", ok, f"{S.nrows()} points, rows sum to 1 (exact)")
     if statement == "C1":
-        ok, msg, _ = leading_spectrum(fam, n, prec)
+        ok, msg, lead = leading_spectrum(fam, n, prec)
         part("spectral part of the generalized Reif criterion", ok, msg)
+        if ok and fam != "dart":
+            cpoly = crease_block(fam, n).charpoly()
+            ok = any(t[1].gcd(cpoly).degree() > 0 for t in lead[1:3])
+            part("the tangent plane sees the crease: lam1 or lam2 is an eigenvalue of the crease block", ok,
+                 "" if ok else "both eigenvectors vanish on the crease points, so the characteristic map "
+                 "sends the sharp edges to v (not injective)")
         part("characteristic map regular and injective on the sector", False,
              "not implemented for tagged sectors: no C1 certificate can pass yet")
         return name
