@@ -255,6 +255,7 @@ def crease_block(fam, n):
     return fmpq_mat([[S[i, j] for j in cp] for i in cp])
 
 
+@lru_cache(maxsize=64)
 def eigenvalues(fam, n, prec):
     """Every eigenvalue as (acb enclosure, its factor, algebraic multiplicity, minimal-poly multiplicity),
     each root listed once per unit of algebraic multiplicity; isolated by arb (``complex_roots``), real
@@ -281,7 +282,7 @@ def eigenvalues(fam, n, prec):
         for p, e, g in exact_spectrum(fam, n):
             for z, _ in p.complex_roots():
                 out += [(acb(z), p, e, g)] * e
-    return out
+    return tuple(out)
 
 
 def _key(item):  # ordering for display and for choosing candidates; every decision is re-checked in arb

@@ -15,12 +15,14 @@ the crease block) and checks:
   points, so the curve lies on the z-axis; it joins v = 0 to the limit of r's first point at every
   level m (scaled by gamma^m != 0), so the limit surface contains a segment of the z-axis ending at v.
   A C1 surface (with boundary) at v has e_z in its tangent plane T_v.
-* N (normal): at the regular vertex (1, 1) of quadrant q the limit tangents are the B-spline masks
-  T_a = sum w'(a) w(b) P(a, b), T_b = sum w(a) w'(b) P(a, b), w = (1, 4, 1)/6, w' = (-1, 0, 1)/2, and
-  J_xy = T_a(x) T_b(y) - T_b(x) T_a(y) is certainly not 0. Since S^m P = (alpha^m x, beta^m y, gamma^m z),
-  the normal at the level-m copy p_m of that vertex is (beta^m gamma^m J_yz, gamma^m alpha^m J_zx,
-  alpha^m beta^m J_xy); divided by alpha^m beta^m its z-component is J_xy and the others stay bounded
-  (gamma <= alpha, beta), so every limit n of the unit normals at p_m -> v has n_z != 0.
+* N (normal): at the regular vertex (1, 1) of quadrant q (valence 4, smooth edges: its 1-ring evolves
+  by the regular rules alone) the limit tangents are the B-spline masks T_a = sum w'(a) w(b) P(a, b),
+  T_b = sum w(a) w'(b) P(a, b), w = (1, 4, 1)/6, w' = (-1, 0, 1)/2, and J_xy = T_a(x) T_b(y) - T_b(x) T_a(y)
+  is certainly not 0. S^m P = (alpha^m x, beta^m y, gamma^m z + m gamma^(m-1) u), u = (S - gamma) z (0 for an
+  eigenvector; a generalized z needs gamma < beta, and u vanishes on the crease points so the boundary
+  curve of B is unchanged). The normal at the level-m copy p_m of that vertex, divided by
+  alpha^m beta^m, has the z-component J_xy and x-, y-components O(m (gamma/beta)^m) (or bounded when
+  gamma = beta and z is an eigenvector), so every limit n of the unit normals at p_m -> v has n_z != 0.
 
 A C1 surface at v would have a continuous unit normal, n(v) = lim n(p_m), orthogonal to T_v, which
 holds e_z: n_z = 0, a contradiction. So the limit surface of this control net is not C1 at v.
@@ -28,7 +30,7 @@ holds e_z: n_z = 0, a contradiction. So the limit surface of this control net is
 G (generic): alpha = lam1 and beta = lam2 are the two leading eigenvalues of S below 1 (every other
 eigenvalue certainly smaller in modulus than beta, or beta itself), gamma is the crease block's largest
 eigenvalue below 1 (the tangent of the crease curve of a generic net), and no eigenvalue of modulus
-possibly >= gamma is defective. Then the witness is not a degenerate net: for every net whose
+possibly >= beta is defective (a Jordan block below beta adds terms o(beta^m)). Then the witness is not a degenerate net: for every net whose
 lam1-, lam2- and gamma-coefficients a1, a2, a3 are linearly independent the same leading terms give
 the same contradiction (docs/tagged_c1.md), an open dense set of nets.
 
@@ -119,14 +121,14 @@ def verify_tagged(cert, part, log):
     with ctx.workprec(prec):
         vecs, vals = {}, {}
         for c in ("x", "y", "z"):
-            val, vec, msg = _eigenvector(fam, n, field_of(w, c, dict, "witness"), c, prec)
-            part(f"{c}: eigenvector of S", vec is not None, msg)
+            val, vec, msg = _eigenvector(fam, n, field_of(w, c, dict, "witness"), c, prec, c == "z")
+            part(f"{c}: {'(generalized) ' if c == 'z' else ''}eigenvector of S", vec is not None, msg)
             if vec is None:
                 return name
             vals[c], vecs[c] = val, vec
-        ok, msg = _ordering(fam, n, vals["x"], vals["y"], vals["z"], prec)
+        ok, msg = _ordering(fam, n, vals["x"], vals["y"], vals["z"], prec, "generalized" in msgs_z(part))
         part("G generic: alpha = lam1, beta = lam2, gamma = the crease block's largest eigenvalue below 1; "
-             "no Jordan block at |lam| >= gamma", ok, msg)
+             "no Jordan block at |lam| >= beta; gamma < beta for a generalized z", ok, msg)
         if not ok:
             return name
         _check_boundary(fam, n, r, vecs, part)
@@ -146,9 +148,10 @@ def _same(t, v):
     return t[1].degree() > 1 and t[0].real.overlaps(v) and t[0].imag.is_zero()
 
 
-def _ordering(fam, n, a, b, g, prec):
+def _ordering(fam, n, a, b, g, prec, generalized):
     """(ok, message): a = lam1 >= b = lam2 >= every other |lam| (1 simple, ties only with b itself), g the
-    largest eigenvalue below 1 of the crease block, and every eigenvalue of modulus possibly >= g non-defective."""
+    largest eigenvalue below 1 of the crease block, every eigenvalue of modulus possibly >= b non-defective,
+    and g < b when z is a generalized eigenvector."""
     ev = eigenvalues(fam, n, prec)  # each root once per unit of algebraic multiplicity
     one = fmpq_poly([-1, 1])
     if sum(1 for t in ev if t[1] == one) != 1:
@@ -174,19 +177,29 @@ def _ordering(fam, n, a, b, g, prec):
     below = [r for r in croots if r < 1]
     if not isinstance(g, fmpq) or not below or g != max(below):
         return False, f"gamma is not the crease block's largest eigenvalue below 1 ({max(below) if below else None})"
-    defective = [t for t in rest if t[3] > 1 and not abs(t[0]) < g]  # Jordan blocks that could reach gamma
+    beta = abs(rest_b[ib][0])
+    defective = [t for t in rest if t[3] > 1 and not abs(t[0]) < beta]  # Jordan blocks that could reach beta
     if defective:
-        return False, f"a Jordan block at |lam| >= gamma: {defective[0][1]} (minimal polynomial multiplicity " \
+        return False, f"a Jordan block at |lam| >= beta: {defective[0][1]} (minimal polynomial multiplicity " \
                       f"{defective[0][3]})"
-    return True, f"alpha = {_str(a)}, beta = {_str(b)}, gamma = {g}; 1 simple; no Jordan block at |lam| >= gamma"
+    if generalized and not arb(g) < beta:
+        return False, "z is a generalized eigenvector but gamma < beta is not certain"
+    return True, (f"alpha = {_str(a)}, beta = {_str(b)}, gamma = {g}{' (Jordan chain)' if generalized else ''}; "
+                  "1 simple; no Jordan block at |lam| >= beta")
 
 
 def _str(v):
     return str(v) if isinstance(v, fmpq) else v.str(8)
 
 
-def _eigenvector(fam, n, spec, c, prec):
-    """(eigenvalue, vector, message); vector None with the reason when the claim fails."""
+def msgs_z(part):
+    """The message of the z part just recorded (it says whether z is a generalized eigenvector)."""
+    return part.result.parts[-1].message
+
+
+def _eigenvector(fam, n, spec, c, prec, chain=False):
+    """(eigenvalue, vector, message); vector None with the reason when the claim fails. With ``chain``
+    a rational eigenvalue may also have a generalized eigenvector z: (S - lam)^2 z = 0, (S - lam) z != 0."""
     exact_keys(spec, ("eigenvalue", "crease", "pivot") if "pivot" in spec else ("eigenvalue", "crease"), c)
     crease = field_of(spec, "crease", list, c)
     cp = crease_points(fam, n)
@@ -198,10 +211,18 @@ def _eigenvector(fam, n, spec, c, prec):
     ev = spec["eigenvalue"]
     if isinstance(ev, str):  # rational eigenvalue: exact
         lam = parse_decimal(ev)
-        vec = _solve_exact(S, lam, cp, cval)
+        A = S - lam * fmpq_mat([[1 if i == j else 0 for j in range(m)] for i in range(m)])
+        vec = _solve_exact(A, cp, cval)
+        if vec is not None:
+            return lam, vec, f"eigenvalue {lam}; S v = {lam} v exactly"
+        vec = _solve_exact(A * A, cp, cval) if chain else None
         if vec is None:
             return lam, None, f"no eigenvector for {lam} with the given crease values"
-        return lam, vec, f"eigenvalue {lam}; S v = {lam} v exactly"
+        u = A * fmpq_mat([[v] for v in vec])
+        if any(u[i, 0] != 0 for i in cp):
+            return lam, None, f"(S - {lam}) z is not 0 on the crease points"
+        return lam, vec, f"eigenvalue {lam}; (S - {lam})^2 z = 0 exactly, (S - {lam}) z != 0 vanishes on the crease " \
+                         "(generalized)"
     lo_hi = field_of(spec, "eigenvalue", list, c)
     if len(lo_hi) != 2:
         raise CertificateError(f"{c}: eigenvalue must be a decimal or [low, high]")
@@ -235,15 +256,12 @@ def _eigenvector(fam, n, spec, c, prec):
     return lam, vec, f"eigenvalue {lam.str(10)} (simple root of {p}); vector in arb, pivot {labels(fam, n)[pivot]}"
 
 
-def _solve_exact(S, lam, cp, cval):
-    m = S.nrows()
+def _solve_exact(A, cp, cval):
+    """A vector v with A v = 0 exactly and v = cval on the points cp (free unknowns 0), or None."""
+    m = A.nrows()
     free = [i for i in range(m) if i not in cp]
-    # (S - lam) v = 0 with v fixed on cp: unknowns v[free]; rows of cp must hold with the given values
-    rows = []
-    for i in range(m):
-        rhs = -sum((S[i, j] * cval[k] for k, j in enumerate(cp)), fmpq(0)) + (lam * cval[cp.index(i)] if i in cp
-                                                                               else fmpq(0))
-        rows.append([S[i, j] - (lam if i == j else 0) for j in free] + [rhs])
+    rows = [[A[i, j] for j in free] + [-sum((A[i, j] * cval[k] for k, j in enumerate(cp)), fmpq(0))]
+            for i in range(m)]
     R, rank = fmpq_mat(rows).rref()
     nf = len(free)
     vec = [fmpq(0)] * m
@@ -256,8 +274,8 @@ def _solve_exact(S, lam, cp, cval):
         vec[free[lead]] = R[r, nf] / R[r, lead]  # free variables (non-pivot columns) stay 0
     if all(v == 0 for v in vec):
         return None
-    Sv = S * fmpq_mat([[v] for v in vec])
-    return vec if all(Sv[i, 0] == lam * vec[i] for i in range(m)) else None
+    Av = A * fmpq_mat([[v] for v in vec])
+    return vec if all(Av[i, 0] == 0 for i in range(m)) else None
 
 
 def _check_boundary(fam, n, r, vecs, part):
