@@ -9,7 +9,8 @@
   ccproof certify 3-39 --c1      C1 certificates (Reif's criterion: spectrum, regular and injective
   ccproof certify '>=40' --c1    characteristic map) for valences 3..39 and for every k >= 40 at once
   ccproof certify crease:1-30 --c1   tagged configurations (dart:K, crease:N, corner:N; docs/tagged_c1.md):
-                                 a "not C1" certificate with a witness where one is found, written to
+                                 a "not C1" certificate with a witness where one is found, else a "C1"
+                                 certificate (characteristic map regular and injective), written to
                                  certificates/c1/FAMILY/; the others reported as undecided with the reason
   ccproof certify '>=40'         the Appendix-A statement for every k >= 40 in one certificate: lam is a
                                  variable (Taylor models in zeta, lam = mid + zeta * half-width), see
@@ -129,12 +130,15 @@ def _print_summary(summary):
 def _run_tagged(args):
     import time
 
-    from ccproof.certify.tagged import configurations, prove_tagged, write_tagged
+    from ccproof.certify.tagged import configurations, prove_tagged, prove_tagged_c1, write_tagged
 
     ok_all = True
     for name in configurations(args.valences):
         t0 = time.perf_counter()
         cert, why = prove_tagged(name, prec=args.prec)
+        if cert is None:
+            cert, why_c1 = prove_tagged_c1(name, prec=args.prec)
+            why = why_c1 if cert is not None else f"{why}; C1 attempt: {why_c1}"
         seconds = time.perf_counter() - t0
         if cert is None:
             print(f"{name}: {why} ({seconds:.1f} s); no certificate written")

@@ -56,6 +56,9 @@ REVIEWED = {
                                                  "conservative",
     ("tagged_c1.py", "u[i, 0] != 0"): "fmpq_mat entries (exact)",
     ("tagged_c1.py", "R[r, c] != 0"): "fmpq_mat entries (exact)",
+    ("tagged_c1.py", "not 0 <= pv < m"): "ints",
+    ("tagged_map.py", 'fam != "dart"'): "strings",
+    ("tagged_map.py", "S[i, j] != 0"): "fmpq_mat entries (exact)",
     ("maps.py", "not (hi < BREAKS[p] or (p < 3 and lo > BREAKS[p + 1]))"): (
         "keeps a piece unless the hull is certainly outside it: conservative"),
 }

@@ -171,10 +171,42 @@ def test_regular_boundary_normal_does_contain_the_boundary_tangent():
     assert c[-1] < 1e-6 and c[-1] < c[10] * 1e-3
 
 
+@pytest.mark.parametrize("fam,n,rate", [("crease", 3, (0.5 / 0.5797) ** 10), ("corner", 1, 0.5 ** 10)])
+def test_certified_c1_normal_converges_onto_the_boundary_tangent(fam, n, rate):
+    """Where the certificate says "C1" the same measure tends to 0, geometrically: over 10 steps it
+    shrinks at least like (lam2 / lam1)^10 (with a factor 2 of slack for the transient), or has reached
+    rounding level (corner:1 is a bilinear-like B-spline corner: 0 after a few steps)."""
+    c = _normal_vs_boundary(fam, n, 60)
+    assert c[-1] < 1e-3 and (c[-1] < 2 * rate * c[-11] or c[-1] < 1e-12), c[-12:]
+
+
+def test_certified_c1_dart_normals_agree_across_the_crease():
+    """dart:5 (certified C1): the control-net normals at the (1,1) vertices of the quadrants on both sides
+    of the sharp ray converge to one direction (the surface has a crease along the ray, yet not at v)."""
+    M = library_matrix("dart", 5)
+    pts = labels("dart", 5)
+    idx = {p: i for i, p in enumerate(pts)}
+    P = np.random.default_rng(5).normal(size=(len(pts), 3))
+
+    def normal(q):
+        a01, a10 = idx[("r", (q + 1) % 5, 1, 0)], idx[("r", q, 1, 0)]
+        a21, a12 = idx[("q", q, 2, 1)], idx[("q", q, 1, 2)]
+        v = np.cross(P[a21] - P[a01], P[a12] - P[a10])
+        return v / np.linalg.norm(v)
+
+    gaps = []
+    for _ in range(80):
+        P = M @ P
+        P = (P - P[0]) / np.abs(P - P[0]).max()
+        gaps.append(np.linalg.norm(normal(0) - normal(4)))
+    assert gaps[-1] < 1e-2 and gaps[-1] < 0.1 * gaps[20], gaps[::10]
+
+
 # ----------------------------------------------------------------------- certificates and forgeries
 def _cert(name):
     fam, n = name.split(":")
-    return json.loads((certificates_dir() / "c1" / fam / f"n{int(n):03d}.json").read_text())
+    stem = f"{'k' if fam == 'dart' else 'n'}{int(n):03d}.json"
+    return json.loads((certificates_dir() / "c1" / fam / stem).read_text())
 
 
 def _fails(cert, why):
@@ -202,7 +234,7 @@ def test_forgery_relabelled_configuration():
 def test_forgery_another_configurations_data():
     cert = _cert("crease:5")
     other = _cert("crease:6")
-    _fails(dict(cert, witness=other["witness"]), "isolate")
+    _fails(dict(cert, witness=other["witness"]), "x: eigenvector")  # its lam1 or its pivot do not fit
 
 
 def test_forgery_identity_map():
@@ -234,8 +266,8 @@ def test_forgery_refutation_of_a_c1_candidate():
 
 
 def test_forgery_c1_claim_for_a_refuted_configuration():
-    res = _fails({"schema": TAGGED_SCHEMA, "configuration": "crease:5", "statement": "C1", "prec": 128},
-                 "sends the sharp edges to v")
+    """crease:3's C1 certificate relabelled crease:5 (refuted): the spectral part alone would pass."""
+    res = _fails(dict(_cert("crease:3"), configuration="crease:5"), "sends the sharp edges to v")
     assert res.parts[1].ok  # the spectral part alone would have passed: it decides nothing
 
 
@@ -252,3 +284,26 @@ def test_verify_json_prints_configuration_statement_verdict():
     assert [(o["configuration"], o["statement"], o["verdict"]) for o in objs] == [
         ("smooth:5", "C1", "VERIFIED"), ("crease:5", "not C1", "VERIFIED")]
     assert all(o["parts"] for o in objs)
+
+
+def test_c1_certificates_verify_and_resist_forgeries():
+    cert = _cert("crease:3")
+    assert cert["statement"] == "C1" and verify_certificate(cert, **QUIET)
+    _fails(dict(cert, configuration="crease:5"), "sends the sharp edges to v")
+    _fails(dict(cert, configuration="crease:4"), "Jordan block")
+    forged = copy.deepcopy(cert)
+    forged["map"]["y"] = forged["map"]["x"]  # x twice: not lam2's eigenvector
+    _fails(forged, "not the eigenvalue")
+    forged = copy.deepcopy(_cert("crease:2"))
+    forged["map"]["y"] = forged["map"]["x"]  # the double eigenvalue: the same vector twice, det J = 0
+    _fails(forged, "regularity")
+    forged = copy.deepcopy(cert)
+    box = forged["parts"]["regularity"]["0:P2"][0]
+    box["bound"] = "1e3"
+    _fails(forged, "not above the claimed bound")
+    forged = copy.deepcopy(cert)
+    forged["parts"]["winding"]["axis"] = "+y"
+    _fails(forged, "not allowed")
+    forged = copy.deepcopy(cert)
+    forged["map"]["orientation"] = -forged["map"]["orientation"]
+    _fails(forged, "regularity")

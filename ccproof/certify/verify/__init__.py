@@ -27,8 +27,8 @@ from .injectivity import SCHEMA, verify_injectivity
 from .record import Part, Recorder, VerifyResult, read_valence
 from .tagged_c1 import TAGGED_SCHEMA, verify_tagged
 
-__all__ = ["SCHEMA", "C1_SCHEMA", "TAGGED_SCHEMA", "CertificateError", "Part", "VerifyResult", "verify_certificate", "verify_file",
-           "check_coverage", "certificate_files"]
+__all__ = ["SCHEMA", "C1_SCHEMA", "TAGGED_SCHEMA", "CertificateError", "Part", "VerifyResult", "verify_certificate",
+           "verify_file", "check_coverage", "certificate_files"]
 
 MAX_FILE_BYTES = 64 * 2**20
 _KINDS = {SCHEMA: verify_injectivity, C1_SCHEMA: verify_c1, TAGGED_SCHEMA: None}

@@ -20,9 +20,9 @@ centre takes the smooth rule, a crease centre the crease rule along its two shar
 from __future__ import annotations
 
 import re
-from functools import lru_cache
+from functools import cache, lru_cache
 
-from flint import acb, arb, ctx, fmpq, fmpq_mat, fmpq_poly
+from flint import acb, ctx, fmpq, fmpq_mat, fmpq_poly
 
 from .errors import CertificateError
 from .rules import CENTRE, canonical, level1_rule
@@ -127,7 +127,7 @@ def _index(fam, n):
     return idx, at
 
 
-@lru_cache(maxsize=None)
+@cache
 def sector_matrix(fam, n):
     """The exact subdivision matrix S of the configuration: level-1 point i = sum_j S[i, j] level-0 point j.
 
@@ -184,7 +184,7 @@ def _centre_row(fam, n, idx):
     return row
 
 
-@lru_cache(maxsize=None)
+@cache
 def exact_spectrum(fam, n):
     """The characteristic polynomial's irreducible factors over Q with their multiplicities in the
     characteristic and in the minimal polynomial (exact; an eigenvalue is non-defective iff the two
@@ -319,7 +319,7 @@ def leading_spectrum(fam, n, prec):
         if len(one) != 1:
             return False, f"{name}: eigenvalue 1 has multiplicity {len(one)}", ev[:4]
         rest = [t for t in ev if t[1] != fmpq_poly([-1, 1])]
-        if any(not abs(t[0]) < 1 for t in rest):  # noqa: the reviewed list: "certainly < 1" wanted
+        if any(not abs(t[0]) < 1 for t in rest):  # reviewed (tests/certify/test_arb_comparisons.py)
             return False, f"{name}: an eigenvalue other than 1 is not certainly inside the unit disc", ev[:4]
         l1, l2, l3 = rest[0], rest[1], rest[2]
         for lab, t in (("lam1", l1), ("lam2", l2)):

@@ -30,9 +30,10 @@ holds e_z: n_z = 0, a contradiction. So the limit surface of this control net is
 G (generic): alpha = lam1 and beta = lam2 are the two leading eigenvalues of S below 1 (every other
 eigenvalue certainly smaller in modulus than beta, or beta itself), gamma is the crease block's largest
 eigenvalue below 1 (the tangent of the crease curve of a generic net), and no eigenvalue of modulus
-possibly >= beta is defective (a Jordan block below beta adds terms o(beta^m)). Then the witness is not a degenerate net: for every net whose
-lam1-, lam2- and gamma-coefficients a1, a2, a3 are linearly independent the same leading terms give
-the same contradiction (docs/tagged_c1.md), an open dense set of nets.
+possibly >= beta is defective (a Jordan block below beta adds terms o(beta^m)). Then the witness is not
+a degenerate net: for every net whose lam1-, lam2- and gamma-coefficients a1, a2, a3 are linearly
+independent the same leading terms give the same contradiction (docs/tagged_c1.md), an open dense set
+of nets.
 
 A ``"C1"`` certificate is checked for the spectral part of the generalized Reif criterion
 (:func:`.tagged.leading_spectrum`) and for a tangent plane that sees the crease; the characteristic-map
@@ -46,8 +47,17 @@ from flint import arb, arb_mat, ctx, fmpq, fmpq_mat, fmpq_poly
 from .errors import CertificateError
 from .record import exact_keys, field_of
 from .replay import parse_decimal
-from .tagged import (crease_block, crease_points, eigenvalues, labels, leading_spectrum, parse_configuration,
-                     sector_matrix, sharp_rays)
+from .tagged import (
+    crease_block,
+    crease_points,
+    eigenvalues,
+    labels,
+    leading_spectrum,
+    parse_configuration,
+    sector_matrix,
+    sharp_rays,
+)
+from .tagged_map import check_map
 
 TAGGED_SCHEMA = "ccproof.tagged-c1/1"
 STATEMENTS = ("C1", "not C1")
@@ -88,7 +98,8 @@ def verify_tagged(cert, part, log):
     statement = field_of(cert, "statement", str, "certificate")
     if statement not in STATEMENTS:
         raise CertificateError(f"statement must be one of {STATEMENTS}, got {statement[:20]!r}")
-    keys = ("schema", "configuration", "statement", "prec") + (("witness",) if statement == "not C1" else ())
+    keys = ("schema", "configuration", "statement", "prec") + (("witness",) if statement == "not C1" else
+                                                                ("map", "parts"))
     exact_keys(cert, keys, "certificate")
     name = field_of(cert, "configuration", str, "certificate")
     fam, n = parse_configuration(name)
@@ -108,8 +119,25 @@ def verify_tagged(cert, part, log):
             part("the tangent plane sees the crease: lam1 or lam2 is an eigenvalue of the crease block", ok,
                  "" if ok else "both eigenvectors vanish on the crease points, so the characteristic map "
                  "sends the sharp edges to v (not injective)")
-        part("characteristic map regular and injective on the sector", False,
-             "not implemented for tagged sectors: no C1 certificate can pass yet")
+        if part.failed:
+            return name
+        mp = field_of(cert, "map", dict, "certificate")
+        exact_keys(mp, ("x", "y", "orientation"), "map")
+        orient = mp["orientation"]
+        if orient not in (1, -1) or isinstance(orient, bool):
+            raise CertificateError("map.orientation must be 1 or -1")
+        with ctx.workprec(prec):
+            vecs, vals = {}, {}
+            for c, t in (("x", lead[1]), ("y", lead[2])):
+                val, vec, msg = eigenvector_of(fam, n, field_of(mp, c, dict, "map"), c, prec)
+                ok = vec is not None and _same(t, val)
+                part(f"{c}: eigenvector of lam{'1' if c == 'x' else '2'}", ok,
+                     msg if vec is not None and ok else msg if vec is None else "not the eigenvalue of lam1 / lam2")
+                if not ok:
+                    return name
+                vals[c], vecs[c] = val, vec
+            check_map(fam, n, vecs["x"], vecs["y"], vals["x"], vals["y"], orient,
+                      field_of(cert, "parts", dict, "certificate"), prec, part)
         return name
     if fam == "dart":
         raise CertificateError("witnesses are defined for crease and corner sectors only")
@@ -121,7 +149,7 @@ def verify_tagged(cert, part, log):
     with ctx.workprec(prec):
         vecs, vals = {}, {}
         for c in ("x", "y", "z"):
-            val, vec, msg = _eigenvector(fam, n, field_of(w, c, dict, "witness"), c, prec, c == "z")
+            val, vec, msg = eigenvector_of(fam, n, field_of(w, c, dict, "witness"), c, prec, c == "z")
             part(f"{c}: {'(generalized) ' if c == 'z' else ''}eigenvector of S", vec is not None, msg)
             if vec is None:
                 return name
@@ -197,12 +225,12 @@ def msgs_z(part):
     return part.result.parts[-1].message
 
 
-def _eigenvector(fam, n, spec, c, prec, chain=False):
+def eigenvector_of(fam, n, spec, c, prec, chain=False):
     """(eigenvalue, vector, message); vector None with the reason when the claim fails. With ``chain``
     a rational eigenvalue may also have a generalized eigenvector z: (S - lam)^2 z = 0, (S - lam) z != 0."""
     exact_keys(spec, ("eigenvalue", "crease", "pivot") if "pivot" in spec else ("eigenvalue", "crease"), c)
     crease = field_of(spec, "crease", list, c)
-    cp = crease_points(fam, n)
+    cp = crease_points(fam, n) if fam != "dart" else []  # a dart's sharp ray is no closed block
     if len(crease) != len(cp):
         raise CertificateError(f"{c}: crease values must be {len(cp)} decimals")
     cval = [parse_decimal(v) for v in crease]
@@ -212,6 +240,11 @@ def _eigenvector(fam, n, spec, c, prec, chain=False):
     if isinstance(ev, str):  # rational eigenvalue: exact
         lam = parse_decimal(ev)
         A = S - lam * fmpq_mat([[1 if i == j else 0 for j in range(m)] for i in range(m)])
+        if "pivot" in spec:  # one more fixed coordinate: 1 at the pivot
+            pv = field_of(spec, "pivot", int, c)
+            if not 0 <= pv < m or pv in cp:
+                raise CertificateError(f"{c}: pivot must index a non-crease point")
+            cp, cval = cp + [pv], cval + [fmpq(1)]
         vec = _solve_exact(A, cp, cval)
         if vec is not None:
             return lam, vec, f"eigenvalue {lam}; S v = {lam} v exactly"
@@ -234,26 +267,48 @@ def _eigenvector(fam, n, spec, c, prec, chain=False):
     z, p = inside[0][0], inside[0][1]
     if any(v != 0 for v in cval):
         return None, None, "an irrational eigenvalue's eigenvector vanishes on the crease points"
-    if p.gcd(crease_block(fam, n).charpoly()).degree() > 0:
+    if cp and p.gcd(crease_block(fam, n).charpoly()).degree() > 0:
         return None, None, "the eigenvalue is one of the crease block's"
     pivot = field_of(spec, "pivot", int, c)
     free = [i for i in range(m) if i not in cp]
     if pivot not in free:
         raise CertificateError(f"{c}: pivot must index a non-crease point")
-    # rows and columns of the non-crease points, the pivot coordinate set to 1 and its row dropped
-    rest = [i for i in free if i != pivot]
     lam = z.real
-    A = arb_mat([[arb(S[i, j]) - (lam if i == j else 0) for j in rest] for i in rest])
-    b = arb_mat([[-arb(S[i, pivot])] for i in rest])
     try:
-        sol = A.solve(b)
+        sol = bordered_solve(S, free, pivot, lam)
     except ZeroDivisionError:
         return None, None, f"the system for the eigenvector of {lam.str(8)} (pivot {pivot}) is not certainly regular"
     vec = [arb(0)] * m
-    vec[pivot] = arb(1)
-    for k, i in enumerate(rest):
+    for k, i in enumerate(free):
         vec[i] = sol[k, 0]
     return lam, vec, f"eigenvalue {lam.str(10)} (simple root of {p}); vector in arb, pivot {labels(fam, n)[pivot]}"
+
+
+def bordered_solve(S, free, pivot, lam):
+    """Enclosure of the eigenvector v of the simple eigenvalue lam (a ball) on the coordinates ``free``
+    with v[pivot] = 1: the bordered system [[S - lam, e_pivot], [e_pivot^T, 0]] (v, mu) = (0, 1) on the
+    rows and columns ``free``. Raises ZeroDivisionError unless arb proves it regular for every lam of the
+    ball. Regular at the exact lam, it has one solution; the eigenvector v* (geometric multiplicity 1)
+    gives the kernel vector (v*, 0) if v*[pivot] = 0, so v*[pivot] != 0 and (v* / v*[pivot], 0) is it.
+
+    Returns
+    -------
+    arb_mat, shape (len(free) + 1, 1)
+        v on ``free`` (in that order), then mu (an enclosure of 0).
+
+    Examples
+    --------
+    >>> from flint import fmpq_mat
+    >>> sol = bordered_solve(fmpq_mat([[2, 1], [1, 2]]), [0, 1], 0, arb(3))
+    >>> [sol[i, 0].str(3) for i in range(3)]
+    ['1.00', '1.00', '0']
+    """
+    k = len(free)
+    pos = free.index(pivot)
+    rows = [[arb(S[i, j]) - (lam if i == j else 0) for j in free] + [arb(1 if r == pos else 0)]
+            for r, i in enumerate(free)]
+    rows.append([arb(1 if c == pos else 0) for c in range(k)] + [arb(0)])
+    return arb_mat(rows).solve(arb_mat([[0]] * k + [[1]]))
 
 
 def _solve_exact(A, cp, cval):
@@ -315,7 +370,7 @@ def _jacobian(fam, n, q, x, y):
         acc = arb(0)
         for a in range(3):
             for b in range(3):
-                acc += arb((da[a] * db[b])) * v[index(a, b)]
+                acc += arb(da[a] * db[b]) * v[index(a, b)]
         return acc
 
     xa, xb = tangent(x, _DW, _W), tangent(x, _W, _DW)
