@@ -233,7 +233,7 @@ def prove_tagged(name, prec=DEFAULT_PREC):
     >>> cert["statement"], cert["witness"]["z"]["eigenvalue"]
     ('not C1', '0.5')
     >>> prove_tagged("crease:4")[1]
-    'undecided: crease:4: lam2 = 1/2 lies in a Jordan block (multiplicity 2, minimal polynomial multiplicity 2)'
+    'undecided: crease:4: lam2 = 1/2 lies in a Jordan block (algebraic multiplicity 2, geometric 1); no witness candidate'
     """
     fam, n = parse_configuration(name)
     ok, msg, _ = leading_spectrum(fam, n, prec)

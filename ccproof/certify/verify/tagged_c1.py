@@ -206,10 +206,10 @@ def _ordering(fam, n, a, b, g, prec, generalized):
     if not isinstance(g, fmpq) or not below or g != max(below):
         return False, f"gamma is not the crease block's largest eigenvalue below 1 ({max(below) if below else None})"
     beta = abs(rest_b[ib][0])
-    defective = [t for t in rest if t[3] > 1 and not abs(t[0]) < beta]  # Jordan blocks that could reach beta
+    defective = [t for t in rest if t[3] < t[2] and not abs(t[0]) < beta]  # Jordan blocks that could reach beta
     if defective:
-        return False, f"a Jordan block at |lam| >= beta: {defective[0][1]} (minimal polynomial multiplicity " \
-                      f"{defective[0][3]})"
+        return False, f"a Jordan block at |lam| >= beta: {defective[0][1]} (algebraic multiplicity " \
+                      f"{defective[0][2]}, geometric {defective[0][3]})"
     if generalized and not arb(g) < beta:
         return False, "z is a generalized eigenvector but gamma < beta is not certain"
     return True, (f"alpha = {_str(a)}, beta = {_str(b)}, gamma = {g}{' (Jordan chain)' if generalized else ''}; "
