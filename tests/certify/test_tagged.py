@@ -9,6 +9,8 @@ import sys
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from ccproof.certify.verify import TAGGED_SCHEMA, certificate_files, verify_certificate
 from ccproof.certify.verify.tagged import eigenvalues, labels, sector_matrix
@@ -307,3 +309,42 @@ def test_c1_certificates_verify_and_resist_forgeries():
     forged = copy.deepcopy(cert)
     forged["map"]["orientation"] = -forged["map"]["orientation"]
     _fails(forged, "regularity")
+
+
+# ----------------------------------------------------------------------- mutations end in a verdict
+ODD = [None, True, -1, 0, 2**70, 1.5, "", "x", "1e-999999999", "9" * 100, [], {}, [[]], {"a": 1}, "0L" * 200]
+
+
+def _paths(obj, prefix=()):
+    yield prefix
+    items = obj.items() if isinstance(obj, dict) else enumerate(obj) if isinstance(obj, list) else ()
+    for k, v in items:
+        yield from _paths(v, prefix + (k,))
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.data())
+def test_mutated_tagged_certificates_end_in_a_verdict(data):
+    """Any deletion, retyping or alteration of a field of a tagged certificate ends in FAILED with a
+    reason (or, rarely, still VERIFIED), never in an exception."""
+    base = data.draw(st.sampled_from([_cert("crease:5"), _cert("crease:3")]))
+    path = data.draw(st.sampled_from(list(_paths(base))))
+    op = data.draw(st.sampled_from(["delete", "retype", "alter"]))
+    value = data.draw(st.sampled_from(ODD))
+    cert = copy.deepcopy(base)
+    if not path:
+        cert = value
+    else:
+        parent = cert
+        for key in path[:-1]:
+            parent = parent[key]
+        last = path[-1]
+        if op == "delete":
+            del parent[last]
+        elif op == "alter" and isinstance(parent[last], str):
+            parent[last] = parent[last][::-1] + "1"
+        else:
+            parent[last] = value
+    res = verify_certificate(cert, **QUIET)  # must not raise
+    if not res:
+        assert res.error or any(p.name for p in res.failures())
