@@ -1,10 +1,12 @@
-"""Prover for tagged configurations (untrusted): classify and write "not C1" witnesses.
+"""Prover for tagged configurations (untrusted): "not C1" witnesses and "C1" characteristic maps.
 
 For ``crease:N``, ``corner:N`` and ``dart:K`` (docs/tagged_c1.md) the prover reads the spectrum the
 verifier derives (:mod:`ccproof.certify.verify.tagged`), tries witness nets made of eigenvectors
-(:mod:`ccproof.certify.verify.tagged_c1`) and keeps the first that the verifier accepts. Where no
-witness is found the configuration is reported with the verifier's spectral reason and no file is
-written: a C1 claim needs the characteristic-map part, which is not implemented for tagged sectors.
+(:mod:`ccproof.certify.verify.tagged_c1`) and keeps the first that the verifier accepts
+(:func:`prove_tagged`); else :func:`prove_tagged_c1` builds the characteristic map's Bernstein forms
+(:mod:`ccproof.certify.verify.tagged_map`) and subdivides them until they are certainly positive.
+Floats only choose (pivots, isolating intervals); every certificate is re-checked by the verifier
+before it is returned. Where neither works the configuration is reported with the reason.
 """
 
 from __future__ import annotations
@@ -260,8 +262,6 @@ def prove_tagged(name, prec=DEFAULT_PREC):
             if not any(p.name.startswith("N ") for p in res.failures()):
                 break  # only the normal depends on the quadrant
     witness = f"; no witness ({why[0]})" if why else "; no witness candidate"
-    if ok:
-        return None, f"undecided: {msg}{witness}; the characteristic-map part is not checked for tagged sectors"
     return None, f"undecided: {msg}{witness}"
 
 
@@ -384,6 +384,8 @@ def _prove_map(name, fam, n, specs, prec):
         cert["map"]["orientation"] = orient
         a1, a2 = -_arb(lx).log(), -_arb(ly).log()
         axes = {"crease": ("-x", "+x"), "corner": ("-y", "-x")}.get(fam, ("+x", "-x", "+y", "-y"))
+        if fam == "dart" and lx == ly:  # isotropic: any ray is an orbit
+            axes += ([2, 1], [1, 2], [-1, 2], [3, 1])
         last = None
         for axis in axes:
             parts, last = _c1_parts(name, nets, n, orient, a1, a2, axis, prec)
@@ -403,8 +405,10 @@ def _c1_parts(name, nets, n, orient, a1, a2, axis, prec):
     from ccproof.certify.verify.tagged_map import PIECES, _curve, transversal_form
     from ccproof.rigorous import BernsteinForm
 
+    from ccproof.certify.verify.tagged_map import AXES
+
     parts = {"regularity": {}, "transversal": {}, "winding": {"axis": axis, "boxes": {}}}
-    along, sgn = (0 if axis[1] == "x" else 1), (1 if axis[0] == "+" else -1)
+    a, b = AXES[axis] if isinstance(axis, str) else axis
     with ctx.workprec(prec):
         try:
             for q in range(n):
@@ -415,8 +419,8 @@ def _c1_parts(name, nets, n, orient, a1, a2, axis, prec):
                     parts["transversal"][f"{q}:{c}"] = _prove_positive(
                         transversal_form(nets[q], c, a1, a2, prec) * orient, (0,), f"{name} transversality {q}:{c}")
                     pts = _curve(nets[q], c)
-                    A = BernsteinForm((4,), [pt[along] * sgn for pt in pts], prec=prec)
-                    P = BernsteinForm((4,), [pt[1 - along] for pt in pts], prec=prec)
+                    A = BernsteinForm((4,), [pt[0] * a + pt[1] * b for pt in pts], prec=prec)
+                    P = BernsteinForm((4,), [pt[1] * a - pt[0] * b for pt in pts], prec=prec)
                     parts["winding"]["boxes"][f"{q}:{c}"] = _winding_paths(A, P)
         except (ProofFailed, CCProofError) as exc:
             return None, str(exc)

@@ -348,3 +348,14 @@ def test_mutated_tagged_certificates_end_in_a_verdict(data):
     res = verify_certificate(cert, **QUIET)  # must not raise
     if not res:
         assert res.error or any(p.name for p in res.failures())
+
+
+def test_dart_certificates_and_the_rotated_axis():
+    """A dart's winding may be counted on any ray only when lam1 = lam2 (D is a multiple of the identity):
+    dart:4 uses one; the same ray on dart:5 (lam1 > lam2: the ray is no orbit) is refused."""
+    cert4, cert5 = _cert("dart:4"), _cert("dart:5")
+    assert verify_certificate(cert4, **QUIET) and verify_certificate(cert5, **QUIET)
+    assert isinstance(cert4["parts"]["winding"]["axis"], list)
+    forged = copy.deepcopy(cert5)
+    forged["parts"]["winding"]["axis"] = [2, 1]
+    _fails(forged, "not allowed")

@@ -150,10 +150,14 @@ def transversal_form(nets, curve, a1, a2, prec):
         return X * Y.diff(0) * a1 - Y * X.diff(0) * a2
 
 
-def crossings(nets, curve, paths, axis, prec):
-    """How often one outer cubic crosses the half-axis H (``axis``: "+x", "-y", ...), from a partition of
-    [0, 1] into boxes each certainly off H or certainly on its side of the line with a sign change of the
-    other coordinate at most once (all crossings of H have one direction by transversality).
+AXES = {"+x": (1, 0), "-x": (-1, 0), "+y": (0, 1), "-y": (0, -1)}
+
+
+def crossings(nets, curve, paths, direction, prec):
+    """How often one outer cubic crosses the half-line H = {t d : t > 0} (``direction`` d = (a, b), ints),
+    from a partition of [0, 1] into boxes each certainly off H (the other coordinate -b X + a Y of one
+    sign, or a X + b Y < 0) or certainly on its side (a X + b Y > 0), where a sign change of -b X + a Y
+    between the box's ends is exactly one crossing (all crossings of an orbit have one direction by T).
 
     Returns
     -------
@@ -161,14 +165,13 @@ def crossings(nets, curve, paths, axis, prec):
         The count, or the reason why a box decides nothing.
     """
     pts = _curve(nets, curve)
-    along = 0 if axis[1] == "x" else 1
-    sgn = 1 if axis[0] == "+" else -1
+    a, b = direction
     if not check_partition(paths, 1):
         return f"{curve}: the boxes do not partition [0, 1]"
     count = 0
     with ctx.workprec(prec):
-        A = BernsteinForm((4,), [p[along] * sgn for p in pts], prec=prec)
-        P = BernsteinForm((4,), [p[1 - along] for p in pts], prec=prec)
+        A = BernsteinForm((4,), [p[0] * a + p[1] * b for p in pts], prec=prec)
+        P = BernsteinForm((4,), [p[1] * a - p[0] * b for p in pts], prec=prec)
         for path in paths:
             fa, fp = A, P
             for ax, side in parse_path(path, 1):
@@ -269,18 +272,23 @@ def check_map(fam, n, vx, vy, lam1, lam2, orient, parts, prec, part):
         # the D-angle along Gamma is monotone (T); the counts below say it turns by exactly the sector's
         # angle: from -y to +y through x > 0 (x < 0 when the orientation is -1), from +x to +y through the
         # first quadrant (the other three when -1), once around for a dart
-        want = ({("+x", 1): 1, ("-x", 1): 0, ("+x", -1): 0, ("-x", -1): 1} if fam == "crease" else
-                {("-x", 1): 0, ("-y", 1): 0, ("-x", -1): 1, ("-y", -1): 1} if fam == "corner" else
-                {(a, o): 1 for a in ("+x", "-x", "+y", "-y") for o in (1, -1)}).get((axis, orient))
+        # a dart with lam1 = lam2 (D a multiple of the identity) may name any ray [a, b] (every ray is an orbit)
+        ray = (isinstance(axis, list) and len(axis) == 2 and all(type(c) is int and abs(c) <= 16 for c in axis)
+               and axis != [0, 0] and fam == "dart" and isinstance(lam1, fmpq) and lam1 == lam2)
+        want = 1 if ray else ({("+x", 1): 1, ("-x", 1): 0, ("+x", -1): 0, ("-x", -1): 1} if fam == "crease" else
+                              {("-x", 1): 0, ("-y", 1): 0, ("-x", -1): 1, ("-y", -1): 1} if fam == "corner" else
+                              {(a, o): 1 for a in AXES for o in (1, -1)}).get((axis, orient)) \
+            if isinstance(axis, str) else None
         if want is None:
-            raise CertificateError(f"parts.winding.axis {str(axis)[:8]!r} is not allowed for {fam}")
+            raise CertificateError(f"parts.winding.axis {str(axis)[:12]!r} is not allowed for {fam}")
+        direction = tuple(axis) if ray else AXES[axis]
         total = 0
         for key in curves:
             q, c = key.split(":")
             paths = win["boxes"][key]
             if not isinstance(paths, list) or not paths or not all(isinstance(p, str) for p in paths):
                 raise CertificateError(f"parts.winding.{key} must be a list of paths")
-            got = crossings(nets[int(q)], c, paths, axis, prec)
+            got = crossings(nets[int(q)], c, paths, direction, prec)
             if isinstance(got, str):
                 part(f"W the outer curve crosses the {axis} half-axis {want} time(s)", False, got)
                 return
