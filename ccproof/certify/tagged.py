@@ -125,10 +125,10 @@ def _interior_candidates(fam, n, prec):
 def _pivot(fam, n, z, prec):
     """A point where the eigenvector of the simple eigenvalue z is large (numerical choice only; the
     verifier proves the bordered system regular)."""
+    import numpy as np
+
     from ccproof.certify.verify.tagged import sector_matrix
     from ccproof.certify.verify.tagged_c1 import bordered_solve
-
-    import numpy as np
 
     S = sector_matrix(fam, n)
     cp = crease_points(fam, n) if fam != "dart" else []
@@ -402,10 +402,8 @@ def _prove_map(name, fam, n, specs, prec):
 def _c1_parts(name, nets, n, orient, a1, a2, axis, prec):
     from ccproof.certify.prover import ProofFailed, _prove_positive
     from ccproof.certify.verify.maps import STAR_CURVES, regularity_form
-    from ccproof.certify.verify.tagged_map import PIECES, _curve, transversal_form
+    from ccproof.certify.verify.tagged_map import AXES, PIECES, _curve, transversal_form
     from ccproof.rigorous import BernsteinForm
-
-    from ccproof.certify.verify.tagged_map import AXES
 
     parts = {"regularity": {}, "transversal": {}, "winding": {"axis": axis, "boxes": {}}}
     a, b = AXES[axis] if isinstance(axis, str) else axis

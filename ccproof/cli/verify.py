@@ -90,6 +90,7 @@ def run(args):
     from ccproof.errors import CCProofError
     from ccproof.tables.format import certificates_dir
 
+    as_json = getattr(args, "json", False)  # callers that build their own args may omit it
     files = [Path(f) for f in args.files]
     if args.all:
         files += certificate_files(certificates_dir())
@@ -107,15 +108,15 @@ def run(args):
     for f, out in zip(files, sweep.results):
         if out is None:  # the task itself failed (after its retries): reported, counted as FAILED
             res = VerifyResult(path=str(f), error=f"not checked: {sweep.errors[len(results)]!r}")
-            print(json.dumps(summary(res)) if args.json else f"FAILED {f}: {res.error}")
+            print(json.dumps(summary(res)) if as_json else f"FAILED {f}: {res.error}")
         else:
             res, lines = out
-            print(json.dumps(summary(res)) if args.json else "\n".join(lines))
+            print(json.dumps(summary(res)) if as_json else "\n".join(lines))
         results.append(res)
-    for line in [] if args.json else sweep.report([str(f) for f in files]):
+    for line in [] if as_json else sweep.report([str(f) for f in files]):
         print(line)
     bad = [r for r in results if not r]
-    if args.json:
+    if as_json:
         return 0 if not bad else 1
     print(f"{len(results) - len(bad)} of {len(results)} certificates verified" + (
         "" if not bad else "; failed: " + ", ".join(str(r.path) for r in bad)))
