@@ -100,7 +100,8 @@ def tagged_table():
         res = verify_file(path, log=lambda line: None)
         row = summary(res)
         spec = next((p["message"] for p in row["parts"] if p["name"].startswith(("G ", "spectral"))), "")
-        body += (f"| {row['configuration']} | {row['statement']} | {row['verdict']} | {spec.split(';')[0]} | "
+        spec = spec.removeprefix(f"{row['configuration']}: ").removeprefix("1 simple; ").split(";")[0]
+        body += (f"| {row['configuration']} | {row['statement']} | {row['verdict']} | {spec} | "
                  f"{row['seconds']:.1f} |\n")
     return head + body
 

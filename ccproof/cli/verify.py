@@ -25,6 +25,7 @@ FAILED with the reason and the others are still checked; the exit status is 0 on
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 
 def add_arguments(p):
@@ -49,9 +50,13 @@ def summary(res):
     from ccproof.certify.verify import C1_SCHEMA, SCHEMA, TAGGED_SCHEMA
 
     v = res.valence
-    if res.schema == TAGGED_SCHEMA:
+    if res.schema == TAGGED_SCHEMA:  # the statement the verifier checked, as the file states it
         config = v if isinstance(v, str) else None
-        statement = "not C1" if any(p.name.startswith("N ") for p in res.parts) else "C1"
+        try:
+            statement = json.loads(Path(res.path).read_text()).get("statement") if res.path else None
+        except (OSError, ValueError, AttributeError):
+            statement = None
+        statement = statement if statement in ("C1", "not C1") else None
     else:
         config = None if v is None else f"smooth:>={v['min']}" if isinstance(v, dict) else f"smooth:{v}"
         statement = {SCHEMA: "injective", C1_SCHEMA: "C1"}.get(res.schema)

@@ -38,7 +38,7 @@ _OFFSET = {"P1": (0, -1), "P2": (0, 0), "P3": (-1, 0)}  # level-1 position of B-
 _B2Z = ((1, 4, 1, 0), (0, 4, 2, 0), (0, 2, 4, 0), (0, 1, 4, 1))  # uniform cubic B-spline -> Bezier, times 6
 
 
-def level1(fam, n, v):
+def level1_values(fam, n, v):
     """``value(q, A, B)``: the level-1 value of the vector v (on :func:`.tagged.labels`) at position
     (A, B), -1 <= A, B <= 3, of quadrant q (ghost values across a sharp ray).
 
@@ -50,7 +50,7 @@ def level1(fam, n, v):
     >>> pts = labels("crease", 2)
     >>> v = [fmpq(p[2]) if p[0] == "r" and p[1] == 0 else fmpq(-p[2]) if p[0] == "r" and p[1] == 2 else
     ...      fmpq(p[2]) if p[0] == "q" and p[1] == 0 else fmpq(-p[3]) if p[0] == "q" else fmpq(0) for p in pts]
-    >>> val = level1("crease", 2, v)
+    >>> val = level1_values("crease", 2, v)
     >>> [val(0, a, b) for a, b in ((3, 0), (2, 2), (1, -1))]
     [3/2, 1, 1/2]
     """
@@ -110,7 +110,7 @@ def quadrant_nets(fam, n, vx, vy, q, prec):
     >>> x.str(5, radius=False), y.str(5, radius=False)
     ('1.0000', '1.0000')
     """
-    X, Y = level1(fam, n, vx), level1(fam, n, vy)
+    X, Y = level1_values(fam, n, vx), level1_values(fam, n, vy)
     out = {}
     with ctx.workprec(prec):
         for name in PIECES:
@@ -204,7 +204,7 @@ def rays_on_axes(fam, n, vx, vy):
     >>> rays_on_axes("corner", 1, vx, vy)[0]
     True
     """
-    X, Y = level1(fam, n, vx), level1(fam, n, vy)
+    X, Y = level1_values(fam, n, vx), level1_values(fam, n, vy)
     r0 = [(X(0, a, 0), Y(0, a, 0)) for a in range(4)]
     rn = [(X(n - 1, 0, b), Y(n - 1, 0, b)) for b in range(4)]
 
