@@ -1,4 +1,4 @@
-"""Certificates for tagged configurations (schema ``ccproof.tagged-c1/1``): "not C1" by a witness (trusted).
+"""Certificates for tagged configurations (schema ``ccproof.tagged-c1/1``): "C1" and "not C1" (trusted).
 
 The statement is derived from the configuration name alone (:mod:`.tagged`: the sector matrix S from
 OpenSubdiv's rules, its exact spectrum). A ``"not C1"`` certificate names a control net
@@ -35,9 +35,11 @@ a degenerate net: for every net whose lam1-, lam2- and gamma-coefficients a1, a2
 independent the same leading terms give the same contradiction (docs/tagged_c1.md), an open dense set
 of nets.
 
-A ``"C1"`` certificate is checked for the spectral part of the generalized Reif criterion
-(:func:`.tagged.leading_spectrum`) and for a tangent plane that sees the crease; the characteristic-map
-part for tagged sectors is not implemented, so no such certificate passes (docs/tagged_c1.md).
+A ``"C1"`` certificate (the generalized Reif criterion for a sector): the spectral part
+(:func:`.tagged.leading_spectrum`: 1 simple, lam1 >= lam2 > |others| real and non-defective), a tangent
+plane that sees the crease (lam1 or lam2 an eigenvalue of the crease block), the eigenvectors x of lam1
+and y of lam2 (hints: ``map``), and the characteristic map Phi = (X, Y) regular and injective on the
+sector (:func:`.tagged_map.check_map` on the boxes of ``parts``; docs/tagged_c1.md).
 """
 
 from __future__ import annotations
@@ -71,7 +73,7 @@ def verify_tagged(cert, part, log):
     Parameters
     ----------
     cert : dict
-        ``schema``, ``configuration``, ``statement``, ``prec`` and, for ``"not C1"``, ``witness``.
+        ``schema``, ``configuration``, ``statement``, ``prec`` and ``witness`` (``"not C1"``) or ``map``, ``parts`` (``"C1"``).
     part : Recorder
     log : callable (str) -> None
 
