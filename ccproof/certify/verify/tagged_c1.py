@@ -73,7 +73,8 @@ def verify_tagged(cert, part, log):
     Parameters
     ----------
     cert : dict
-        ``schema``, ``configuration``, ``statement``, ``prec`` and ``witness`` (``"not C1"``) or ``map``, ``parts`` (``"C1"``).
+        ``schema``, ``configuration``, ``statement``, ``prec``; ``witness`` (``"not C1"``) or
+        ``map`` and ``parts`` (``"C1"``).
     part : Recorder
     log : callable (str) -> None
 
