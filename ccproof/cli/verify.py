@@ -5,7 +5,9 @@
                                   then the valence coverage of each statement: both the C1 and the
                                   injectivity (Appendix A) certificates must cover every k >= 3
                                   (k = 3..k0-1 one by one, each once; interval certificates k >= k0
-                                  may overlap each other and single valences)
+                                  may overlap each other and single valences); per tagged family
+                                  (dart, crease, corner) which N are certified C1 and not C1, each
+                                  configuration at most once
   ccproof verify FILE --json     one JSON object per file: "configuration" ("smooth:5", "smooth:>=40",
                                   "crease:5"), "statement" ("C1", "not C1", "injective"), "verdict"
                                   ("VERIFIED" or "FAILED"), "parts" (name, ok, message), "error"
@@ -76,6 +78,29 @@ def _check(args):
     return res, lines
 
 
+def tagged_coverage(results):
+    """(ok, lines): per tagged family, the N certified C1 and not C1; ok unless a configuration has two
+    verified certificates (a statement and its negation, or a publishing mistake).
+
+    >>> from ccproof.certify.verify import VerifyResult, Part
+    >>> r = VerifyResult(schema="ccproof.tagged-c1/1", valence="crease:5", parts=[Part("S", True)])
+    >>> tagged_coverage([r, r])[0], tagged_coverage([r])[0]
+    (False, True)
+    """
+    ok_all, lines = True, []
+    for fam in ("dart", "crease", "corner"):
+        rows = [(int(r.valence.split(":")[1]), summary(r)["statement"]) for r in results
+                if r and isinstance(r.valence, str) and r.valence.startswith(fam + ":")]
+        ns = [n for n, _ in rows]
+        twice = sorted({n for n in ns if ns.count(n) > 1})
+        c1, not_c1 = (sorted(n for n, st in rows if st == want) for want in ("C1", "not C1"))
+        lines.append(f"{fam}: {'OK' if not twice else 'CONTRADICTORY'}: C1 for {_ranges(c1) or 'none'}, not C1 for "
+                     f"{_ranges(not_c1) or 'none'}" + (f"; certified twice: {twice}" if twice else "")
+                     + "; the others are undecided (docs/tagged_c1.md lists the reasons)")
+        ok_all &= not twice
+    return ok_all, lines
+
+
 def _ranges(ns):
     """``[1, 2, 3, 5]`` -> ``'1-3, 5'``."""
     out, i = [], 0
@@ -131,11 +156,9 @@ def run(args):
             ok, msg = check_coverage([r.valence for r in results if r and r.schema == schema])
             print(f"{label} coverage: {'OK' if ok else 'INCOMPLETE'}: {msg}")
             ok_all &= ok
-        for fam in ("dart", "crease", "corner"):
-            got = sorted(int(r.valence.split(":")[1]) for r in results if r and isinstance(r.valence, str)
-                         and r.valence.startswith(fam + ":"))
-            print(f"{fam}: not C1 certified for {_ranges(got) or 'none'}; every other {fam} 1..100 is undecided "
-                  f"(docs/tagged_c1.md lists the reasons)")
+        ok, lines = tagged_coverage(results)
+        print("\n".join(lines))
+        ok_all &= ok
         if not ok_all:
             return 1
     return 0 if not bad else 1
