@@ -18,7 +18,7 @@ PARTS = ("tables", "injectivity", "c1")
 
 
 class BuildPyWithCertificates(build_py):
-    """``build_py`` that also copies ``certificates/{tables,injectivity,c1}/*.json`` into the build."""
+    """``build_py`` that also copies ``certificates/{tables,injectivity,c1}/**/*.json`` into the build."""
 
     def run(self):
         super().run()
@@ -33,8 +33,9 @@ class BuildPyWithCertificates(build_py):
             shutil.rmtree(dst)
         for part in PARTS:
             (dst / part).mkdir(parents=True)
-            for f in sorted((src / part).glob("*.json")):
-                shutil.copy2(f, dst / part / f.name)
+            for f in sorted((src / part).rglob("*.json")):  # c1/ has one folder per tagged family
+                (dst / part / f.relative_to(src / part)).parent.mkdir(parents=True, exist_ok=True)
+                shutil.copy2(f, dst / part / f.relative_to(src / part))
 
 
 setup(cmdclass={"build_py": BuildPyWithCertificates})

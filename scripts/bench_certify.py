@@ -10,6 +10,11 @@ totals (wall clock) with the ratio certify/verify, against the targets (all of 3
                                                        (targets certify <= 5 min, verify <= 1 min)
     python scripts/bench_certify.py --verify-all      `ccproof verify --all` on 2 processes (target
                                                        <= 90 s), and the share of the statement derivation
+    python scripts/bench_certify.py --tagged 2        what the tagged certificates (certificates/c1/{dart,
+                                                       crease,corner}/) add to `verify --all`: the smooth
+                                                       ones and the tagged ones verified on JOBS fresh
+                                                       processes, alternating, ROUNDS rounds: the ratio
+                                                       (all) / (smooth) (target <= 2), per family seconds
 
 Certificates go to a temporary folder; the published ones are not touched.
 """
@@ -48,7 +53,11 @@ def main():
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--interval", type=int, default=None, metavar="K0", help="bench the k >= K0 certificate")
     ap.add_argument("--verify-all", action="store_true", help="time `ccproof verify --all --jobs JOBS`")
+    ap.add_argument("--tagged", type=int, default=None, metavar="ROUNDS",
+                    help="what the tagged certificates add to verify --all (ROUNDS alternating rounds)")
     args = ap.parse_args()
+    if args.tagged is not None:
+        return bench_tagged(args.jobs, args.tagged)
     if args.verify_all:
         return bench_verify_all(args.jobs)
     if args.interval is not None:
@@ -99,6 +108,50 @@ def _derivation_seconds(_):
     derivation()
     check_block_polynomials()
     return time.perf_counter() - t
+
+
+def _verify_path(path):
+    from ccproof.certify.verify import verify_file
+
+    t = time.perf_counter()
+    ok = bool(verify_file(path, log=lambda s: None))
+    return path, ok, time.perf_counter() - t
+
+
+def bench_tagged(jobs, rounds):
+    """Wall clock of verifying the smooth certificates and the tagged ones, each on ``jobs`` fresh
+    processes, alternating round by round; prints min, median, max of (smooth + tagged) / smooth."""
+    import os
+    import statistics
+    from pathlib import Path
+
+    from ccproof.certify.verify import certificate_files
+    from ccproof.tables.format import certificates_dir
+
+    files = [str(f) for f in certificate_files(certificates_dir())]
+    tagged = [f for f in files if Path(f).parent.name in ("dart", "crease", "corner")]
+    smooth = [f for f in files if f not in tagged]
+    ratios, fam_s, loads = [], {}, []
+    for r in range(rounds):
+        wall = {}
+        for name, group in (("smooth", smooth), ("tagged", tagged)):
+            loads.append(os.getloadavg()[0])
+            t = time.perf_counter()
+            with ProcessPoolExecutor(jobs) as ex:
+                res = list(ex.map(_verify_path, group))
+            wall[name] = time.perf_counter() - t
+            assert all(ok for _, ok, _ in res), [p for p, ok, _ in res if not ok]
+            if name == "tagged":
+                for p, _, dt in res:
+                    fam_s.setdefault(Path(p).parent.name, []).append(dt)
+        ratios.append((wall["smooth"] + wall["tagged"]) / wall["smooth"])
+        print(f"round {r}: smooth {len(smooth)} files {wall['smooth']:.1f} s, tagged {len(tagged)} files "
+              f"{wall['tagged']:.1f} s, (all) / (smooth) = {ratios[-1]:.2f}")
+    print(f"(all) / (smooth) over {rounds} rounds: min {min(ratios):.2f}, median {statistics.median(ratios):.2f}, "
+          f"max {max(ratios):.2f} (target <= 2); load average {min(loads):.1f}..{max(loads):.1f}")
+    for fam, ts in sorted(fam_s.items()):
+        print(f"  {fam}: {len(ts) // rounds} files, {sum(ts) / rounds:.1f} s of process time per round, "
+              f"max {max(ts):.1f} s")
 
 
 def bench_verify_all(jobs):

@@ -8,6 +8,10 @@
                                  for 2 local workers or a running Dask scheduler (docs/scale-out.md)
   ccproof certify 3-39 --c1      C1 certificates (Reif's criterion: spectrum, regular and injective
   ccproof certify '>=40' --c1    characteristic map) for valences 3..39 and for every k >= 40 at once
+  ccproof certify crease:1-30 --c1   tagged configurations (dart:K, crease:N, corner:N; docs/tagged_c1.md):
+                                 a "not C1" certificate with a witness where one is found, else a "C1"
+                                 certificate (characteristic map regular and injective), written to
+                                 certificates/c1/FAMILY/; the others reported as undecided with the reason
   ccproof certify '>=40'         the Appendix-A statement for every k >= 40 in one certificate: lam is a
                                  variable (Taylor models in zeta, lam = mid + zeta * half-width), see
                                  docs/appendix_a.md section 6
@@ -25,6 +29,8 @@ published certificates, $XDG_DATA_HOME/ccproof/certificates/injectivity/ (XDG_DA
 """
 
 from __future__ import annotations
+
+from ccproof.errors import CCProofError
 
 
 def add_arguments(p):
@@ -148,7 +154,37 @@ def _print_summary(summary):
     print(f"  min det J_G / h^2 bound, corner    {float_str(summary['min_bound_det_J_G_corner_over_h2'])}")
 
 
+def _run_tagged(args):
+    import time
+
+    from ccproof.certify.tagged import configurations, prove_tagged, prove_tagged_c1, write_tagged
+
+    ok_all = True
+    for name in configurations(args.valences):
+        t0 = time.perf_counter()
+        cert, why = prove_tagged(name, prec=args.prec)
+        if cert is None:
+            cert, why_c1 = prove_tagged_c1(name, prec=args.prec)
+            why = why_c1 if cert is not None else f"{why}; C1 attempt: {why_c1}"
+        seconds = time.perf_counter() - t0
+        if cert is None:
+            print(f"{name}: {why} ({seconds:.1f} s); no certificate written")
+            continue
+        path = write_tagged(cert, args.out)
+        print(f"{name}: {why}; certificate written to {path} ({seconds:.1f} s)")
+        ok_all &= _recheck(path, args)
+    return 0 if ok_all else 1
+
+
 def run(args):
+    if ":" in str(args.valences):
+        if not args.c1:
+            raise CCProofError("tagged configurations (FAMILY:N) are certified with --c1")
+        if args.out is None:
+            from ccproof.tables.format import output_dir
+
+            args.out = str(output_dir() / "c1")
+        return _run_tagged(args)
     if args.out is None:
         from ccproof.tables.format import output_dir
 

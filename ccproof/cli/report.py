@@ -4,6 +4,8 @@
   ccproof report --jobs 2        the same on 2 processes
   ccproof report --write         also write it as Markdown to docs/certified_valences.md
   ccproof report --plot F.png    plot the margins against k
+  ccproof report --tagged        re-verify the tagged certificates (certificates/c1/{dart,crease,corner}/)
+                                 and print configuration, statement, verdict and the spectral reason
 
 Every number comes from the verifier's run (its VerifyResult): the smallest bound it re-checked per
 part (det J_Phi and det J_G in the local coordinates of their boxes, det J_G / h^2 on the corner cell)
@@ -21,6 +23,8 @@ def add_arguments(p):
     from ccproof.cli._progress import add_progress_argument
 
     add_progress_argument(p)
+    p.add_argument("--tagged", action="store_true",
+                   help="the table of the tagged configurations (dart, crease, corner; docs/tagged_c1.md) instead")
 
 
 def _row(path):
@@ -85,6 +89,27 @@ def _kname(k):
     return "?" if k is None else f">= {k.k}" if k.interval else str(k)
 
 
+def tagged_table():
+    """Markdown table of the tagged certificates, each re-verified in this run (the reason column is the
+    verifier's message on the spectrum: lam1, lam2 and, for a witness, gamma)."""
+    from ccproof.certify.verify import certificate_files, verify_file
+    from ccproof.cli.verify import summary
+    from ccproof.tables.format import certificates_dir
+
+    head = "| configuration | statement | verdict | spectrum (re-derived) | verify s |\n|---|---|---|---|---|\n"
+    body = ""
+    for path in certificate_files(certificates_dir()):
+        if path.parent.name not in ("dart", "crease", "corner"):
+            continue
+        res = verify_file(path, log=lambda line: None)
+        row = summary(res)
+        spec = next((p["message"] for p in row["parts"] if p["name"].startswith(("G ", "spectral"))), "")
+        spec = spec.removeprefix(f"{row['configuration']}: ").removeprefix("1 simple; ").split(";")[0]
+        body += (f"| {row['configuration']} | {row['statement']} | {row['verdict']} | {spec} | "
+                 f"{row['seconds']:.1f} |\n")
+    return head + body
+
+
 def run(args):
     from pathlib import Path
 
@@ -97,6 +122,9 @@ def run(args):
         check_file(args.plot, PLOT_SUFFIXES, "--plot")
     from ccproof.cli._progress import progress_enabled
 
+    if args.tagged:
+        print(tagged_table())
+        return 0
     rows = collect(args.jobs, progress_enabled(args))
     md = markdown(rows)
     print(md)

@@ -5,7 +5,12 @@
                                   then the valence coverage of each statement: both the C1 and the
                                   injectivity (Appendix A) certificates must cover every k >= 3
                                   (k = 3..k0-1 one by one, each once; interval certificates k >= k0
-                                  may overlap each other and single valences)
+                                  may overlap each other and single valences); per tagged family
+                                  (dart, crease, corner) which N are certified C1 and not C1, each
+                                  configuration at most once
+  ccproof verify FILE --json     one JSON object per file: "configuration" ("smooth:5", "smooth:>=40",
+                                  "crease:5"), "statement" ("C1", "not C1", "injective"), "verdict"
+                                  ("VERIFIED" or "FAILED"), "parts" (name, ok, message), "error"
   ccproof verify --all            runs on a local Dask cluster (one worker per core) by default;
   ccproof verify --all --serial   in this process; --scheduler local:2 | tcp://host:8786 elsewhere
                                   (the workers read the files: a remote cluster needs them on a shared
@@ -21,6 +26,9 @@ FAILED with the reason and the others are still checked; the exit status is 0 on
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
+
 
 def add_arguments(p):
     p.add_argument("files", nargs="*", help="certificate files")
@@ -33,6 +41,33 @@ def add_arguments(p):
     from ccproof.cli._progress import add_progress_argument
 
     add_progress_argument(p)
+    p.add_argument("--json", action="store_true",
+                   help="print one JSON object per file (configuration, statement, verdict, parts) instead")
+
+
+def summary(res):
+    """The JSON object of one verdict (``--json``): configuration, statement, verdict, parts.
+
+    >>> from ccproof.certify.verify import VerifyResult, Part
+    >>> summary(VerifyResult(path="k005.json", schema="ccproof.c1/2", valence=5, parts=[Part("S", True)]))["statement"]
+    'C1'
+    """
+    from ccproof.certify.verify import C1_SCHEMA, SCHEMA, TAGGED_SCHEMA
+
+    v = res.valence
+    if res.schema == TAGGED_SCHEMA:  # the statement the verifier checked, as the file states it
+        config = v if isinstance(v, str) else None
+        try:
+            statement = json.loads(Path(res.path).read_text()).get("statement") if res.path else None
+        except (OSError, ValueError, AttributeError):
+            statement = None
+        statement = statement if statement in ("C1", "not C1") else None
+    else:
+        config = None if v is None else f"smooth:>={v['min']}" if isinstance(v, dict) else f"smooth:{v}"
+        statement = {SCHEMA: "injective", C1_SCHEMA: "C1"}.get(res.schema)
+    return {"path": res.path, "configuration": config, "statement": statement,
+            "verdict": "VERIFIED" if res.ok else "FAILED", "error": res.error, "seconds": round(res.seconds, 3),
+            "parts": [{"name": p.name, "ok": p.ok, "message": p.message} for p in res.parts]}
 
 
 def _check(args):
@@ -49,6 +84,41 @@ def _check(args):
     return res, lines
 
 
+def tagged_coverage(results):
+    """(ok, lines): per tagged family, the N certified C1 and not C1; ok unless a configuration has two
+    verified certificates (a statement and its negation, or a publishing mistake).
+
+    >>> from ccproof.certify.verify import VerifyResult, Part
+    >>> r = VerifyResult(schema="ccproof.tagged-c1/1", valence="crease:5", parts=[Part("S", True)])
+    >>> tagged_coverage([r, r])[0], tagged_coverage([r])[0]
+    (False, True)
+    """
+    ok_all, lines = True, []
+    for fam in ("dart", "crease", "corner"):
+        rows = [(int(r.valence.split(":")[1]), summary(r)["statement"]) for r in results
+                if r and isinstance(r.valence, str) and r.valence.startswith(fam + ":")]
+        ns = [n for n, _ in rows]
+        twice = sorted({n for n in ns if ns.count(n) > 1})
+        c1, not_c1 = (sorted(n for n, st in rows if st == want) for want in ("C1", "not C1"))
+        lines.append(f"{fam}: {'OK' if not twice else 'CONTRADICTORY'}: C1 for {_ranges(c1) or 'none'}, not C1 for "
+                     f"{_ranges(not_c1) or 'none'}" + (f"; certified twice: {twice}" if twice else "")
+                     + "; the others are undecided (docs/tagged_c1.md lists the reasons)")
+        ok_all &= not twice
+    return ok_all, lines
+
+
+def _ranges(ns):
+    """``[1, 2, 3, 5]`` -> ``'1-3, 5'``."""
+    out, i = [], 0
+    while i < len(ns):
+        j = i
+        while j + 1 < len(ns) and ns[j + 1] == ns[j] + 1:
+            j += 1
+        out.append(str(ns[i]) if i == j else f"{ns[i]}-{ns[j]}")
+        i = j + 1
+    return ", ".join(out)
+
+
 def run(args):
     from pathlib import Path
 
@@ -56,6 +126,7 @@ def run(args):
     from ccproof.errors import CCProofError
     from ccproof.tables.format import certificates_dir
 
+    as_json = getattr(args, "json", False)  # callers that build their own args may omit it
     files = [Path(f) for f in args.files]
     if args.all:
         files += certificate_files(certificates_dir())
@@ -75,15 +146,17 @@ def run(args):
     for f, out in zip(files, sweep.results):
         if out is None:  # the task itself failed (after its retries): reported, counted as FAILED
             res = VerifyResult(path=str(f), error=f"not checked: {sweep.errors[len(results)]!r}")
-            print(f"FAILED {f}: {res.error}")
+            print(json.dumps(summary(res)) if as_json else f"FAILED {f}: {res.error}")
         else:
             res, lines = out
             res.path = str(f)  # as given (the worker read the absolute path)
-            print("\n".join(lines))
+            print(json.dumps(summary(res)) if as_json else "\n".join(lines))
         results.append(res)
-    for line in sweep.report([str(f) for f in files]):
+    for line in [] if as_json else sweep.report([str(f) for f in files]):
         print(line)
     bad = [r for r in results if not r]
+    if as_json:
+        return 0 if not bad else 1
     print(f"{len(results) - len(bad)} of {len(results)} certificates verified" + (
         "" if not bad else "; failed: " + ", ".join(str(r.path) for r in bad)))
     if args.all:
@@ -92,6 +165,9 @@ def run(args):
             ok, msg = check_coverage([r.valence for r in results if r and r.schema == schema])
             print(f"{label} coverage: {'OK' if ok else 'INCOMPLETE'}: {msg}")
             ok_all &= ok
+        ok, lines = tagged_coverage(results)
+        print("\n".join(lines))
+        ok_all &= ok
         if not ok_all:
             return 1
     return 0 if not bad else 1

@@ -43,6 +43,22 @@ REVIEWED = {
     ("injectivity.py", "not a < b"): "fmpq (exact decimals)",
     ("c1.py", "not a < b"): "fmpq (exact decimals)",
     ("interval.py", "not (all(c > 0 for c in db) or all(c < 0 for c in db))"): "fmpq Bernstein coefficients",
+    ("tagged.py", "S[i, j] != 0"): "fmpq_mat entries (exact)",
+    ("tagged.py", "not abs(t[0]) < 1"): "fails unless every eigenvalue is certainly inside the unit disc: conservative",
+    ("tagged_c1.py", "sum(1 for t in ev if t[1] == one) != 1"): "ints (fmpq_poly equality is exact)",
+    ("tagged_c1.py", "g != max(below)"): "fmpq (exact roots of the crease block)",
+    ("tagged_c1.py", "not arb(g) < beta"): "fails unless gamma < beta certainly: conservative",
+    ("tagged_c1.py", "inside[0][2] != 1"): "ints (multiplicities)",
+    ("tagged_c1.py", "leave != 0"): "fmpq (exact crease values)",
+    ("tagged_c1.py", 'fam != "dart"'): "strings",
+    ("tagged_c1.py", "v != 0"): "fmpq (exact decimals)",
+    ("tagged_c1.py", "not abs(t[0]) < beta"): "counts as a Jordan block that could reach beta unless certainly below: "
+                                                 "conservative",
+    ("tagged_c1.py", "u[i, 0] != 0"): "fmpq_mat entries (exact)",
+    ("tagged_c1.py", "R[r, c] != 0"): "fmpq_mat entries (exact)",
+    ("tagged_c1.py", "not 0 <= pv < m"): "ints",
+    ("tagged_map.py", 'fam != "dart"'): "strings",
+    ("tagged_map.py", "S[i, j] != 0"): "fmpq_mat entries (exact)",
     ("maps.py", "not (hi < BREAKS[p] or (p < 3 and lo > BREAKS[p + 1]))"): (
         "keeps a piece unless the hull is certainly outside it: conservative"),
 }

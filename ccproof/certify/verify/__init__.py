@@ -28,12 +28,13 @@ from .errors import CertificateError
 from .injectivity import SCHEMA, verify_injectivity
 from .record import Part, Recorder, VerifyResult, read_valence
 from .replay import check_size
+from .tagged_c1 import TAGGED_SCHEMA, verify_tagged
 
-__all__ = ["SCHEMA", "C1_SCHEMA", "CertificateError", "Part", "VerifyResult", "verify_certificate", "verify_file",
-           "check_coverage", "certificate_files", "read_certificate_bytes"]
+__all__ = ["SCHEMA", "C1_SCHEMA", "TAGGED_SCHEMA", "CertificateError", "Part", "VerifyResult", "verify_certificate",
+           "verify_file", "check_coverage", "certificate_files", "read_certificate_bytes"]
 
 MAX_FILE_BYTES = 4 * 2**20  # the published certificates: at most 64 KB; MAX_BOXES boxes take at most ~1 MB
-_KINDS = {SCHEMA: verify_injectivity, C1_SCHEMA: verify_c1}
+_KINDS = {SCHEMA: verify_injectivity, C1_SCHEMA: verify_c1, TAGGED_SCHEMA: None}
 #: what a malformed file can raise while it is being read; each ends in FAIL with the reason
 _MALFORMED = (CertificateError, ValueError, TypeError, KeyError, IndexError, AttributeError, RecursionError,
               OverflowError, ZeroDivisionError)
@@ -77,6 +78,10 @@ def verify_certificate(cert, log=print, path=None):
                                    f"{', '.join(map(repr, _KINDS))})")
         res.schema = cert["schema"]
         check_size(cert)
+        if res.schema == TAGGED_SCHEMA:  # a configuration name instead of a valence (docs/tagged_c1.md)
+            res.valence = verify_tagged(cert, part, log)
+            res.seconds = time.perf_counter() - t0
+            return res
         res.valence = read_valence(cert)
         res.N = cert.get("N") if isinstance(cert.get("N"), int) else None
         _KINDS[res.schema](cert, res.valence, part, log)
@@ -184,7 +189,8 @@ def read_certificate_bytes(path, cap=MAX_FILE_BYTES):
 
 
 def certificate_files(directory):
-    """The certificate files under ``directory``: ``c1/k*.json`` then ``injectivity/k*.json``.
+    """The certificate files under ``directory``: ``c1/k*.json``, the tagged configurations'
+    ``c1/{dart,crease,corner}/*.json``, then ``injectivity/k*.json``.
 
     Parameters
     ----------
@@ -203,7 +209,8 @@ def certificate_files(directory):
     ('c1', 'k003.json', 'injectivity')
     """
     d = Path(directory)
-    return sorted((d / "c1").glob("k*.json")) + sorted((d / "injectivity").glob("k*.json"))
+    tagged = sorted(f for fam in ("dart", "crease", "corner") for f in (d / "c1" / fam).glob("[kn]*.json"))
+    return sorted((d / "c1").glob("k*.json")) + tagged + sorted((d / "injectivity").glob("k*.json"))
 
 
 def check_coverage(valences):

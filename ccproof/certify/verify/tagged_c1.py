@@ -1,0 +1,384 @@
+"""Certificates for tagged configurations (schema ``ccproof.tagged-c1/1``): "C1" and "not C1" (trusted).
+
+The statement is derived from the configuration name alone (:mod:`.tagged`: the sector matrix S from
+OpenSubdiv's rules, its exact spectrum). A ``"not C1"`` certificate names a control net
+P = (x, y, z) whose three coordinates are eigenvectors of S, with eigenvalues alpha, beta, gamma,
+alpha >= gamma > 0 and beta >= gamma, and a sharp ray r and a quadrant q. The verifier derives each
+eigenvector itself (exactly for a rational eigenvalue, given its values on the crease points; in arb
+for an irrational simple eigenvalue, whose crease values are exactly 0 because it is no eigenvalue of
+the crease block) and checks:
+
+* B (boundary segment): x = y = 0 on every crease point of r's limit curve (the centre and ray r; for a
+  crease centre both sharp rays; exact rationals), z's limit position at v is 0 (the crease limit mask
+  (e0 + 4 V + e1)/6 of a crease centre, V of a corner) and the limit position (z(C) + 4 z(r1) + z(r2))/6
+  of r's first point is not 0. Every limit point of that curve is an affine combination of crease
+  points, so the curve lies on the z-axis; it joins v = 0 to the limit of r's first point at every
+  level m (scaled by gamma^m != 0), so the limit surface contains a segment of the z-axis ending at v.
+  A C1 surface (with boundary) at v has e_z in its tangent plane T_v.
+* N (normal): at the regular vertex (1, 1) of quadrant q (valence 4, smooth edges: its 1-ring evolves
+  by the regular rules alone) the limit tangents are the B-spline masks T_a = sum w'(a) w(b) P(a, b),
+  T_b = sum w(a) w'(b) P(a, b), w = (1, 4, 1)/6, w' = (-1, 0, 1)/2, and J_xy = T_a(x) T_b(y) - T_b(x) T_a(y)
+  is certainly not 0. S^m P = (alpha^m x, beta^m y, gamma^m z + m gamma^(m-1) u), u = (S - gamma) z (0 for an
+  eigenvector; a generalized z needs gamma < beta, and u vanishes on the crease points so the boundary
+  curve of B is unchanged). The normal at the level-m copy p_m of that vertex, divided by
+  alpha^m beta^m, has the z-component J_xy and x-, y-components O(m (gamma/beta)^m) (or bounded when
+  gamma = beta and z is an eigenvector), so every limit n of the unit normals at p_m -> v has n_z != 0.
+
+A C1 surface at v would have a continuous unit normal, n(v) = lim n(p_m), orthogonal to T_v, which
+holds e_z: n_z = 0, a contradiction. So the limit surface of this control net is not C1 at v.
+
+G (generic): alpha = lam1 and beta = lam2 are the two leading eigenvalues of S below 1 (every other
+eigenvalue certainly smaller in modulus than beta, or beta itself), gamma is the crease block's largest
+eigenvalue below 1 (the tangent of the crease curve of a generic net), and no eigenvalue of modulus
+possibly >= beta is defective (a Jordan block below beta adds terms o(beta^m)). Then the witness is not
+a degenerate net: for every net whose lam1-, lam2- and gamma-coefficients a1, a2, a3 are linearly
+independent the same leading terms give the same contradiction (docs/tagged_c1.md), an open dense set
+of nets.
+
+A ``"C1"`` certificate (the generalized Reif criterion for a sector): the spectral part
+(:func:`.tagged.leading_spectrum`: 1 simple, lam1 >= lam2 > |others| real and non-defective), a tangent
+plane that sees the crease (lam1 or lam2 an eigenvalue of the crease block), the eigenvectors x of lam1
+and y of lam2 (hints: ``map``), and the characteristic map Phi = (X, Y) regular and injective on the
+sector (:func:`.tagged_map.check_map` on the boxes of ``parts``; docs/tagged_c1.md).
+"""
+
+from __future__ import annotations
+
+from flint import arb, arb_mat, ctx, fmpq, fmpq_mat, fmpq_poly
+
+from .errors import CertificateError
+from .record import exact_keys, field_of
+from .replay import parse_decimal
+from .tagged import (
+    crease_block,
+    crease_points,
+    eigenvalues,
+    labels,
+    leading_spectrum,
+    parse_configuration,
+    sector_matrix,
+    sharp_rays,
+)
+from .tagged_map import check_map
+
+TAGGED_SCHEMA = "ccproof.tagged-c1/1"
+STATEMENTS = ("C1", "not C1")
+_W = (fmpq(1, 6), fmpq(4, 6), fmpq(1, 6))
+_DW = (fmpq(-1, 2), fmpq(0), fmpq(1, 2))
+
+
+def verify_tagged(cert, part, log):
+    """Check a tagged-configuration certificate (module docstring) into ``part``.
+
+    Parameters
+    ----------
+    cert : dict
+        ``schema``, ``configuration``, ``statement``, ``prec``; ``witness`` (``"not C1"``) or
+        ``map`` and ``parts`` (``"C1"``).
+    part : Recorder
+    log : callable (str) -> None
+
+    Returns
+    -------
+    str
+        The configuration name (for the verdict).
+
+    Raises
+    ------
+    CertificateError
+        On a malformed certificate.
+
+    Examples
+    --------
+    >>> import json
+    >>> from ccproof.tables.format import certificates_dir
+    >>> from ccproof.certify.verify.record import Recorder, VerifyResult
+    >>> cert = json.loads((certificates_dir() / "c1" / "crease" / "n005.json").read_text())
+    >>> res = VerifyResult()
+    >>> verify_tagged(cert, Recorder(res, lambda line: None), lambda line: None), bool(res)
+    ('crease:5', True)
+    """
+    statement = field_of(cert, "statement", str, "certificate")
+    if statement not in STATEMENTS:
+        raise CertificateError(f"statement must be one of {STATEMENTS}, got {statement[:20]!r}")
+    keys = ("schema", "configuration", "statement", "prec") + (("witness",) if statement == "not C1" else
+                                                                ("map", "parts"))
+    exact_keys(cert, keys, "certificate")
+    name = field_of(cert, "configuration", str, "certificate")
+    fam, n = parse_configuration(name)
+    prec = field_of(cert, "prec", int, "certificate")
+    if not 64 <= prec <= 1024:
+        raise CertificateError("prec must lie in 64..1024")
+    log(f"{statement} certificate for {name} ({prec} bits)")
+    S = sector_matrix(fam, n)
+    ok = all(sum((S[i, j] for j in range(S.ncols())), fmpq(0)) == 1 for i in range(S.nrows()))
+    part("S sector matrix derived from the rules", ok, f"{S.nrows()} points, rows sum to 1 (exact)")
+    if statement == "C1":
+        ok, msg, lead = leading_spectrum(fam, n, prec)
+        part("spectral part of the generalized Reif criterion", ok, msg)
+        if ok and fam != "dart":
+            cpoly = crease_block(fam, n).charpoly()
+            ok = any(t[1].gcd(cpoly).degree() > 0 for t in lead[1:3])
+            part("the tangent plane sees the crease: lam1 or lam2 is an eigenvalue of the crease block", ok,
+                 "" if ok else "both eigenvectors vanish on the crease points, so the characteristic map "
+                 "sends the sharp edges to v (not injective)")
+        if part.failed:
+            return name
+        mp = field_of(cert, "map", dict, "certificate")
+        exact_keys(mp, ("x", "y", "orientation"), "map")
+        orient = mp["orientation"]
+        if orient not in (1, -1) or isinstance(orient, bool):
+            raise CertificateError("map.orientation must be 1 or -1")
+        with ctx.workprec(prec):
+            vecs, vals = {}, {}
+            for c, t in (("x", lead[1]), ("y", lead[2])):
+                val, vec, msg = eigenvector_of(fam, n, field_of(mp, c, dict, "map"), c, prec)
+                ok = vec is not None and _same(t, val)
+                part(f"{c}: eigenvector of lam{'1' if c == 'x' else '2'}", ok,
+                     msg if vec is not None and ok else msg if vec is None else "not the eigenvalue of lam1 / lam2")
+                if not ok:
+                    return name
+                vals[c], vecs[c] = val, vec
+            check_map(fam, n, vecs["x"], vecs["y"], vals["x"], vals["y"], orient,
+                      field_of(cert, "parts", dict, "certificate"), prec, part)
+        return name
+    if fam == "dart":
+        raise CertificateError("witnesses are defined for crease and corner sectors only")
+    w = field_of(cert, "witness", dict, "certificate")
+    exact_keys(w, ("x", "y", "z", "ray", "quadrant"), "witness")
+    r, q = field_of(w, "ray", int, "witness"), field_of(w, "quadrant", int, "witness")
+    if r not in sharp_rays(fam, n) or not 0 <= q < n:
+        raise CertificateError(f"witness: ray {r} is not sharp or quadrant {q} outside 0..{n - 1}")
+    with ctx.workprec(prec):
+        vecs, vals = {}, {}
+        for c in ("x", "y", "z"):
+            val, vec, msg = eigenvector_of(fam, n, field_of(w, c, dict, "witness"), c, prec, c == "z")
+            part(f"{c}: {'(generalized) ' if c == 'z' else ''}eigenvector of S", vec is not None, msg)
+            if vec is None:
+                return name
+            vals[c], vecs[c] = val, vec
+        ok, msg = _ordering(fam, n, vals["x"], vals["y"], vals["z"], prec, "generalized" in msgs_z(part))
+        part("G generic: alpha = lam1, beta = lam2, gamma = the crease block's largest eigenvalue below 1; "
+             "no Jordan block at |lam| >= beta; gamma < beta for a generalized z", ok, msg)
+        if not ok:
+            return name
+        _check_boundary(fam, n, r, vecs, part)
+        J = _jacobian(fam, n, q, vecs["x"], vecs["y"])
+        ok = J > 0 or J < 0
+        part(f"N normal at vertex (1,1) of quadrant {q}: J_xy != 0", ok, f"J_xy = {J.str(6)}")
+        if not part.failed:
+            log(f"  the limit surface of this net is not C1 at the {fam} vertex: normals along the level-m "
+                f"copies of quadrant {q}'s (1,1) tend to n_z != 0, yet e_z lies in T_v (ray {r})")
+    return name
+
+
+def _same(t, v):
+    """Is the eigenvalue v (fmpq, or the arb ball of an irrational root) the root t[0] of factor t[1]?"""
+    if isinstance(v, fmpq):
+        return t[1].degree() == 1 and -t[1][0] / t[1][1] == v
+    return t[1].degree() > 1 and t[0].real.overlaps(v) and t[0].imag.is_zero()
+
+
+def _ordering(fam, n, a, b, g, prec, generalized):
+    """(ok, message): a = lam1 >= b = lam2 >= every other |lam| (1 simple, ties only with b itself), g the
+    largest eigenvalue below 1 of the crease block, every eigenvalue of modulus possibly >= b non-defective,
+    and g < b when z is a generalized eigenvector."""
+    ev = eigenvalues(fam, n, prec)  # each root once per unit of algebraic multiplicity
+    one = fmpq_poly([-1, 1])
+    if sum(1 for t in ev if t[1] == one) != 1:
+        return False, "eigenvalue 1 is not simple"
+    rest = [t for t in ev if t[1] != one]
+    ia = next((i for i, t in enumerate(rest) if _same(t, a)), None)
+    if ia is None:
+        return False, "alpha is not an eigenvalue"
+    rest_b = rest[:ia] + rest[ia + 1:]
+    ib = next((i for i, t in enumerate(rest_b) if _same(t, b)), None)
+    if ib is None:
+        return False, "beta is not an eigenvalue (distinct from alpha's copy)"
+    others = rest_b[:ib] + rest_b[ib + 1:]
+    if not (abs(rest[ia][0]) >= abs(rest_b[ib][0]) or rest[ia][1] == rest_b[ib][1]):
+        return False, "alpha >= beta is not certain"
+    bad = [t for t in others if not (_same(t, b) or abs(t[0]) < abs(rest_b[ib][0]))]  # certainly below beta
+    if bad:
+        return False, f"an eigenvalue ({bad[0][0].str(6)}) is not certainly below beta (lam1, lam2 not alpha, beta)"
+    cfac = [p for p, _ in crease_block(fam, n).charpoly().factor()[1]]
+    if any(p.degree() > 1 for p in cfac):
+        return False, "the crease block has irrational eigenvalues"
+    croots = [-p[0] / p[1] for p in cfac]
+    below = [r for r in croots if r < 1]
+    if not isinstance(g, fmpq) or not below or g != max(below):
+        return False, f"gamma is not the crease block's largest eigenvalue below 1 ({max(below) if below else None})"
+    beta = abs(rest_b[ib][0])
+    defective = [t for t in rest if t[3] < t[2] and not abs(t[0]) < beta]  # Jordan blocks that could reach beta
+    if defective:
+        return False, f"a Jordan block at |lam| >= beta: {defective[0][1]} (algebraic multiplicity " \
+                      f"{defective[0][2]}, geometric {defective[0][3]})"
+    if generalized and not arb(g) < beta:
+        return False, "z is a generalized eigenvector but gamma < beta is not certain"
+    return True, (f"alpha = {_str(a)}, beta = {_str(b)}, gamma = {g}{' (Jordan chain)' if generalized else ''}; "
+                  "1 simple; no Jordan block at |lam| >= beta")
+
+
+def _str(v):
+    return str(v) if isinstance(v, fmpq) else v.str(8)
+
+
+def msgs_z(part):
+    """The message of the z part just recorded (it says whether z is a generalized eigenvector)."""
+    return part.result.parts[-1].message
+
+
+def eigenvector_of(fam, n, spec, c, prec, chain=False):
+    """(eigenvalue, vector, message); vector None with the reason when the claim fails. With ``chain``
+    a rational eigenvalue may also have a generalized eigenvector z: (S - lam)^2 z = 0, (S - lam) z != 0."""
+    exact_keys(spec, ("eigenvalue", "crease", "pivot") if "pivot" in spec else ("eigenvalue", "crease"), c)
+    crease = field_of(spec, "crease", list, c)
+    cp = crease_points(fam, n) if fam != "dart" else []  # a dart's sharp ray is no closed block
+    if len(crease) != len(cp):
+        raise CertificateError(f"{c}: crease values must be {len(cp)} decimals")
+    cval = [parse_decimal(v) for v in crease]
+    S = sector_matrix(fam, n)
+    m = S.nrows()
+    ev = spec["eigenvalue"]
+    if isinstance(ev, str):  # rational eigenvalue: exact
+        lam = parse_decimal(ev)
+        A = S - lam * fmpq_mat([[1 if i == j else 0 for j in range(m)] for i in range(m)])
+        if "pivot" in spec:  # one more fixed coordinate: 1 at the pivot
+            pv = field_of(spec, "pivot", int, c)
+            if not 0 <= pv < m or pv in cp:
+                raise CertificateError(f"{c}: pivot must index a non-crease point")
+            cp, cval = cp + [pv], cval + [fmpq(1)]
+        vec = _solve_exact(A, cp, cval)
+        if vec is not None:
+            return lam, vec, f"eigenvalue {lam}; S v = {lam} v exactly"
+        vec = _solve_exact(A * A, cp, cval) if chain else None
+        if vec is None:
+            return lam, None, f"no eigenvector for {lam} with the given crease values"
+        u = A * fmpq_mat([[v] for v in vec])
+        if any(u[i, 0] != 0 for i in cp):
+            return lam, None, f"(S - {lam}) z is not 0 on the crease points"
+        return lam, vec, f"eigenvalue {lam}; (S - {lam})^2 z = 0 exactly, (S - {lam}) z != 0 vanishes on the crease " \
+                         "(generalized)"
+    lo_hi = field_of(spec, "eigenvalue", list, c)
+    if len(lo_hi) != 2:
+        raise CertificateError(f"{c}: eigenvalue must be a decimal or [low, high]")
+    lo, hi = parse_decimal(lo_hi[0]), parse_decimal(lo_hi[1])
+    inside = [t for t in eigenvalues(fam, n, prec) if t[0].real > lo and t[0].real < hi]
+    near = [t for t in eigenvalues(fam, n, prec) if t[0].real.overlaps(arb(lo).union(arb(hi)))]
+    if len(inside) != 1 or len(near) != 1 or not inside[0][0].imag.is_zero() or inside[0][2] != 1:
+        return None, None, f"[{lo}, {hi}] does not isolate one simple real eigenvalue of {fam}:{n}"
+    z, p = inside[0][0], inside[0][1]
+    if any(v != 0 for v in cval):
+        return None, None, "an irrational eigenvalue's eigenvector vanishes on the crease points"
+    if cp and p.gcd(crease_block(fam, n).charpoly()).degree() > 0:
+        return None, None, "the eigenvalue is one of the crease block's"
+    pivot = field_of(spec, "pivot", int, c)
+    free = [i for i in range(m) if i not in cp]
+    if pivot not in free:
+        raise CertificateError(f"{c}: pivot must index a non-crease point")
+    lam = z.real
+    try:
+        sol = bordered_solve(S, free, pivot, lam)
+    except ZeroDivisionError:
+        return None, None, f"the system for the eigenvector of {lam.str(8)} (pivot {pivot}) is not certainly regular"
+    vec = [arb(0)] * m
+    for k, i in enumerate(free):
+        vec[i] = sol[k, 0]
+    return lam, vec, f"eigenvalue {lam.str(10)} (simple root of {p}); vector in arb, pivot {labels(fam, n)[pivot]}"
+
+
+def bordered_solve(S, free, pivot, lam):
+    """Enclosure of the eigenvector v of the simple eigenvalue lam (a ball) on the coordinates ``free``
+    with v[pivot] = 1: the bordered system [[S - lam, e_pivot], [e_pivot^T, 0]] (v, mu) = (0, 1) on the
+    rows and columns ``free``. Raises ZeroDivisionError unless arb proves it regular for every lam of the
+    ball. Regular at the exact lam, it has one solution; the eigenvector v* (geometric multiplicity 1)
+    gives the kernel vector (v*, 0) if v*[pivot] = 0, so v*[pivot] != 0 and (v* / v*[pivot], 0) is it.
+
+    Returns
+    -------
+    arb_mat, shape (len(free) + 1, 1)
+        v on ``free`` (in that order), then mu (an enclosure of 0).
+
+    Examples
+    --------
+    >>> from flint import fmpq_mat
+    >>> sol = bordered_solve(fmpq_mat([[2, 1], [1, 2]]), [0, 1], 0, arb(3))
+    >>> [sol[i, 0].str(3) for i in range(3)]
+    ['1.00', '1.00', '0']
+    """
+    k = len(free)
+    pos = free.index(pivot)
+    rows = [[arb(S[i, j]) - (lam if i == j else 0) for j in free] + [arb(1 if r == pos else 0)]
+            for r, i in enumerate(free)]
+    rows.append([arb(1 if c == pos else 0) for c in range(k)] + [arb(0)])
+    return arb_mat(rows).solve(arb_mat([[0]] * k + [[1]]))
+
+
+def _solve_exact(A, cp, cval):
+    """A vector v with A v = 0 exactly and v = cval on the points cp (free unknowns 0), or None."""
+    m = A.nrows()
+    free = [i for i in range(m) if i not in cp]
+    rows = [[A[i, j] for j in free] + [-sum((A[i, j] * cval[k] for k, j in enumerate(cp)), fmpq(0))]
+            for i in range(m)]
+    R, rank = fmpq_mat(rows).rref()
+    nf = len(free)
+    vec = [fmpq(0)] * m
+    for k, j in enumerate(cp):
+        vec[j] = cval[k]
+    for r in range(rank):
+        lead = next(c for c in range(nf + 1) if R[r, c] != 0)
+        if lead == nf:
+            return None  # inconsistent
+        vec[free[lead]] = R[r, nf] / R[r, lead]  # free variables (non-pivot columns) stay 0
+    if all(v == 0 for v in vec):
+        return None
+    Av = A * fmpq_mat([[v] for v in vec])
+    return vec if all(Av[i, 0] == 0 for i in range(m)) else None
+
+
+def _check_boundary(fam, n, r, vecs, part):
+    pts = labels(fam, n)
+    rays = sharp_rays(fam, n) if fam == "crease" else (r,)
+    on_curve = [0] + [pts.index(("r", s, a, 0)) for s in rays for a in (1, 2)]
+    zero_xy = all(_exact_zero(vecs[c][i]) for c in ("x", "y") for i in on_curve)
+    z = vecs["z"]
+    r1, r2 = pts.index(("r", r, 1, 0)), pts.index(("r", r, 2, 0))
+    exact = all(isinstance(z[i], fmpq) for i in on_curve)
+    at_v = (z[0] if fam == "corner" else (z[pts.index(("r", 0, 1, 0))] + 4 * z[0] + z[pts.index(("r", n, 1, 0))]) / 6
+            ) if exact else None
+    leave = (z[0] + 4 * z[r1] + z[r2]) / 6 if exact else None
+    ok = zero_xy and exact and at_v == 0 and leave != 0
+    part(f"B boundary segment: ray {r}'s limit curve lies on the z-axis and leaves v", ok,
+         f"x = y = 0 on its crease points, limit z at v = 0, limit z of ray {r}'s first point = {leave}" if ok
+         else "x or y not exactly 0 on the curve, or z's limit curve does not start at v = 0 and leave it")
+
+
+def _exact_zero(v):
+    return isinstance(v, fmpq) and v == 0 or isinstance(v, arb) and v.is_zero()
+
+
+def _jacobian(fam, n, q, x, y):
+    pts = labels(fam, n)
+
+    def index(a, b):
+        if (a, b) == (0, 0):
+            return 0
+        if b == 0:
+            return pts.index(("r", q, a, 0))
+        if a == 0:
+            return pts.index(("r", (q + 1) % n if fam == "dart" else q + 1, b, 0))
+        return pts.index(("q", q, a, b))
+
+    def tangent(v, da, db):
+        acc = arb(0)
+        for a in range(3):
+            for b in range(3):
+                acc += arb(da[a] * db[b]) * v[index(a, b)]
+        return acc
+
+    xa, xb = tangent(x, _DW, _W), tangent(x, _W, _DW)
+    ya, yb = tangent(y, _DW, _W), tangent(y, _W, _DW)
+    return xa * yb - xb * ya
+
+
+__all__ = ["TAGGED_SCHEMA", "verify_tagged"]

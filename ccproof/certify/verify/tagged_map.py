@@ -1,0 +1,300 @@
+"""The characteristic map of a tagged sector and the checks of a "C1" certificate (trusted).
+
+Phi = (X, Y), X and Y the limit functions of the eigenvectors x, y of lam1 >= lam2 (:mod:`.tagged_c1`
+derives and checks them). On quadrant q the layer-0 pieces P1 = [1/2,1] x [0,1/2], P2 = [1/2,1]^2,
+P3 = [0,1/2] x [1/2,1] are uniform bicubic B-spline patches of the level-1 net S v: each is a level-1
+face none of whose corners is the centre, with four regular vertices (valence 4, or a regular crease
+vertex on a sharp ray, whose patch is the B-spline patch with the ghost row 2 P(a, 0) - P(a, 1): the
+crease rules (1,6,1)/8 and (1,1)/2 are the tensor rules on that extended grid, which keeps the
+linear extrapolation). Level-1 values off the two-ring (positions 3 and -1) come from
+:func:`.rules.level1_rule` in the right quadrant and from the crease rules on a sharp ray.
+
+Checks (docs/tagged_c1.md): R det J_Phi > 0 on every piece (times the certificate's orientation
++-1); T the outer curve Gamma (sides u = 1, v = 1, quadrants in order) is transversal to the flow
+D^t p = (lam1^t x, lam2^t y): a1 X Y' - a2 Y X' > 0 with a_i = -ln lam_i; W Gamma crosses the D-orbit
+H (a half-axis, named by the certificate) the expected number of times: a dart's closed curve once
+(winding number 1); a crease sector's curve, from the -y to the +y half-axis, once for H = +x and
+never for H = -x (it stays in x > 0; mirrored for orientation -1); a corner's, from +x to +y, never
+for H = -x or -y (once each for orientation -1: the image is the other three quadrants); E the sharp
+rays map onto the half-axes (crease: X = 0 on them, Y < 0 on ray 0, Y > 0 on ray N; corner: Y = 0
+and X > 0 on ray 0, X = 0 and Y > 0 on ray N).
+"""
+
+from __future__ import annotations
+
+from flint import arb, ctx, fmpq
+
+from ccproof.rigorous import BernsteinForm
+
+from .errors import CertificateError
+from .maps import STAR_CURVES, regularity_form
+from .record import exact_keys
+from .replay import check_boxes, check_partition, parse_path
+from .rules import CENTRE, canonical, level1_rule
+from .tagged import labels, sector_matrix, sharp_rays
+
+PIECES = ("P1", "P2", "P3")
+_OFFSET = {"P1": (0, -1), "P2": (0, 0), "P3": (-1, 0)}  # level-1 position of B-spline net[0][0]
+_B2Z = ((1, 4, 1, 0), (0, 4, 2, 0), (0, 2, 4, 0), (0, 1, 4, 1))  # uniform cubic B-spline -> Bezier, times 6
+
+
+def level1_values(fam, n, v):
+    """``value(q, A, B)``: the level-1 value of the vector v (on :func:`.tagged.labels`) at position
+    (A, B), -1 <= A, B <= 3, of quadrant q (ghost values across a sharp ray).
+
+    Examples
+    --------
+    The regular boundary with the linear vector x = a (on quadrant 0, a along ray 0): level 1 halves it,
+    and the ghost row across ray 0 continues it linearly:
+
+    >>> pts = labels("crease", 2)
+    >>> v = [fmpq(p[2]) if p[0] == "r" and p[1] == 0 else fmpq(-p[2]) if p[0] == "r" and p[1] == 2 else
+    ...      fmpq(p[2]) if p[0] == "q" and p[1] == 0 else fmpq(-p[3]) if p[0] == "q" else fmpq(0) for p in pts]
+    >>> val = level1_values("crease", 2, v)
+    >>> [val(0, a, b) for a, b in ((3, 0), (2, 2), (1, -1))]
+    [3/2, 1, 1/2]
+    """
+    S = sector_matrix(fam, n)
+    pts = labels(fam, n)
+    idx = {p: i for i, p in enumerate(pts)}
+    sharp = sharp_rays(fam, n)
+    one = [sum((S[i, j] * v[j] for j in range(len(pts)) if S[i, j] != 0), 0 * v[0]) for i in range(len(pts))]
+
+    def quad(s):
+        return s % n if fam == "dart" else s
+
+    def level0(q, a, b):
+        delta, a2, b2 = canonical(a, b)
+        if (a2, b2) == CENTRE:
+            return v[0]
+        s = quad(q + delta)
+        return v[idx[("r", s, a2, 0) if b2 == 0 else ("q", s, a2, b2)]]
+
+    def value(q, A, B):
+        if (A, B) == (0, 0):
+            return one[0]
+        if B == -1 and q in sharp:  # across the sharp ray q: the ghost row
+            return 2 * value(q, A, 0) - value(q, A, 1)
+        if A == -1 and quad(q + 1) in sharp:  # across the sharp ray q + 1: the ghost column
+            return 2 * value(q, 0, B) - value(q, 1, B)
+        delta, A2, B2 = canonical(A, B)
+        s = quad(q + delta)
+        key = ("r", s, A2, 0) if B2 == 0 else ("q", s, A2, B2)
+        if key in idx:
+            return one[idx[key]]
+        if B2 == 0 and s in sharp:  # (3, 0) on a sharp ray: the midpoint of level-0 (1,0), (2,0)
+            return (v[idx[("r", s, 1, 0)]] + v[idx[("r", s, 2, 0)]]) / 2
+        acc = 0 * v[0]
+        for (a, b), w in level1_rule(A2, B2).items():
+            acc += level0(s, a, b) * w
+        return acc
+    return value
+
+
+def _lin(coeffs, pts):
+    x = sum((p[0] * fmpq(c, 6) for c, p in zip(coeffs, pts) if c), arb(0))
+    y = sum((p[1] * fmpq(c, 6) for c, p in zip(coeffs, pts) if c), arb(0))
+    return (x, y)
+
+
+def quadrant_nets(fam, n, vx, vy, q, prec):
+    """Bezier nets {P1, P2, P3: 4 x 4 of (arb, arb)} of Phi = (X, Y) on quadrant q.
+
+    Examples
+    --------
+    >>> from flint import fmpq
+    >>> pts = labels("corner", 1)
+    >>> vx = [fmpq(p[2]) if p[0] == "r" and p[1] == 0 or p[0] == "q" else fmpq(0) for p in pts]
+    >>> vy = [fmpq(p[2]) if p[0] == "r" and p[1] == 1 else fmpq(p[3]) if p[0] == "q" else fmpq(0) for p in pts]
+    >>> x, y = quadrant_nets("corner", 1, vx, vy, 0, 64)["P2"][3][3]   # the corner (1, 1) of the face
+    >>> x.str(5, radius=False), y.str(5, radius=False)
+    ('1.0000', '1.0000')
+    """
+    X, Y = level1_values(fam, n, vx), level1_values(fam, n, vy)
+    out = {}
+    with ctx.workprec(prec):
+        for name in PIECES:
+            oa, ob = _OFFSET[name]
+            net = [[(arb(X(q, oa + i, ob + j)), arb(Y(q, oa + i, ob + j))) for j in range(4)] for i in range(4)]
+            tmp = [[_lin(_B2Z[i], [net[r][j] for r in range(4)]) for j in range(4)] for i in range(4)]
+            out[name] = [[_lin(_B2Z[j], tmp[i]) for j in range(4)] for i in range(4)]
+    return out
+
+
+def _curve(nets, curve):
+    name, side, sign = STAR_CURVES[curve]
+    net = nets[name]
+    pts = [net[3][j] for j in range(4)] if side == "s" else [net[i][3] for i in range(4)]
+    return pts if sign > 0 else pts[::-1]  # oriented counterclockwise (from ray q towards ray q + 1)
+
+
+def transversal_form(nets, curve, a1, a2, prec):
+    """Bernstein form (degree 5) of a1 X Y' - a2 Y X' along one outer cubic, oriented counterclockwise.
+
+    Examples
+    --------
+    For the identity map and a1 = a2 = 1 this is the star form x y' - y x' (1/2 on u = 1 of P1 here):
+
+    >>> from flint import fmpq
+    >>> pts = labels("corner", 1)
+    >>> vx = [fmpq(p[2]) if p[0] == "r" and p[1] == 0 or p[0] == "q" else fmpq(0) for p in pts]
+    >>> vy = [fmpq(p[2]) if p[0] == "r" and p[1] == 1 else fmpq(p[3]) if p[0] == "q" else fmpq(0) for p in pts]
+    >>> f = transversal_form(quadrant_nets("corner", 1, vx, vy, 0, 64), "P1s1", arb(1), arb(1), 64)
+    >>> f.coeffs[0].str(5, radius=False)
+    '0.50000'
+    """
+    pts = _curve(nets, curve)
+    with ctx.workprec(prec):
+        X = BernsteinForm((4,), [p[0] for p in pts], prec=prec)
+        Y = BernsteinForm((4,), [p[1] for p in pts], prec=prec)
+        return X * Y.diff(0) * a1 - Y * X.diff(0) * a2
+
+
+AXES = {"+x": (1, 0), "-x": (-1, 0), "+y": (0, 1), "-y": (0, -1)}
+
+
+def crossings(nets, curve, paths, direction, prec):
+    """How often one outer cubic crosses the half-line H = {t d : t > 0} (``direction`` d = (a, b), ints),
+    from a partition of [0, 1] into boxes each certainly off H (the other coordinate -b X + a Y of one
+    sign, or a X + b Y < 0) or certainly on its side (a X + b Y > 0), where a sign change of -b X + a Y
+    between the box's ends is exactly one crossing (all crossings of an orbit have one direction by T).
+
+    Returns
+    -------
+    int or str
+        The count, or the reason why a box decides nothing.
+    """
+    pts = _curve(nets, curve)
+    a, b = direction
+    if not check_partition(paths, 1):
+        return f"{curve}: the boxes do not partition [0, 1]"
+    count = 0
+    with ctx.workprec(prec):
+        A = BernsteinForm((4,), [p[0] * a + p[1] * b for p in pts], prec=prec)
+        P = BernsteinForm((4,), [p[1] * a - p[0] * b for p in pts], prec=prec)
+        for path in paths:
+            fa, fp = A, P
+            for ax, side in parse_path(path, 1):
+                fa, fp = (f.split(ax)[0 if side == "L" else 1] for f in (fa, fp))
+            if all(c > 0 for c in fp.coeffs) or all(c < 0 for c in fp.coeffs) or all(c < 0 for c in fa.coeffs):
+                continue
+            if not all(c > 0 for c in fa.coeffs):
+                return f"{curve}: box {path!r} decides nothing"
+            s0, s1 = fp.coeffs[0], fp.coeffs[-1]
+            if (s0 < 0 and s1 > 0) or (s0 > 0 and s1 < 0):
+                count += 1
+            elif not ((s0 < 0 and s1 < 0) or (s0 > 0 and s1 > 0)):
+                return f"{curve}: box {path!r}: the sign at an end is not certain"
+    return count
+
+
+def rays_on_axes(fam, n, vx, vy):
+    """(ok, message): the sharp rays' layer-0 segments lie on the half-axes (E in the module docstring).
+
+    On a sharp ray the limit curve of the layer-0 segment is the cubic B-spline segment of the level-1
+    ray values at positions 0..3 (the ghost row drops out), so X = 0 there when those values are exactly
+    0, and the sign of Y follows from the segment's Bezier points.
+
+    Examples
+    --------
+    >>> from flint import fmpq
+    >>> pts = labels("corner", 1)
+    >>> vx = [fmpq(p[2]) if p[0] == "r" and p[1] == 0 or p[0] == "q" else fmpq(0) for p in pts]
+    >>> vy = [fmpq(p[2]) if p[0] == "r" and p[1] == 1 else fmpq(p[3]) if p[0] == "q" else fmpq(0) for p in pts]
+    >>> rays_on_axes("corner", 1, vx, vy)[0]
+    True
+    """
+    X, Y = level1_values(fam, n, vx), level1_values(fam, n, vy)
+    r0 = [(X(0, a, 0), Y(0, a, 0)) for a in range(4)]
+    rn = [(X(n - 1, 0, b), Y(n - 1, 0, b)) for b in range(4)]
+
+    def zero(vals):
+        return all(isinstance(z, fmpq) and z == 0 or isinstance(z, arb) and z.is_zero() for z in vals)
+
+    def bez(vals):  # Bezier points of the segment [1, 2] of the B-spline with these values
+        return [sum((arb(z) * fmpq(c, 6) for c, z in zip(row, vals) if c), arb(0)) for row in _B2Z]
+
+    if fam == "crease":
+        ok = (zero([p[0] for p in r0 + rn]) and all(z < 0 for z in bez([p[1] for p in r0]))
+              and all(z > 0 for z in bez([p[1] for p in rn])))
+        return ok, "X = 0 on both sharp rays, Y < 0 on ray 0 and Y > 0 on ray N" if ok else \
+            "the sharp rays are not mapped onto the negative and positive Y half-axes"
+    ok = (zero([p[1] for p in r0]) and all(z > 0 for z in bez([p[0] for p in r0]))
+          and zero([p[0] for p in rn]) and all(z > 0 for z in bez([p[1] for p in rn])))
+    return ok, "ray 0 onto the positive X half-axis, ray N onto the positive Y half-axis" if ok else \
+        "the sharp rays are not mapped onto the positive half-axes"
+
+
+def check_map(fam, n, vx, vy, lam1, lam2, orient, parts, prec, part):
+    """Run R, T, W, E (module docstring) on the hints ``parts`` into ``part``.
+
+    Parameters
+    ----------
+    parts : dict
+        ``{"regularity": {"q:P": boxes}, "transversal": {"q:curve": boxes}, "winding": {"q:curve": [path]}}``.
+    """
+    with ctx.workprec(prec):
+        a1, a2 = -arb(lam1).log(), -arb(lam2).log()
+        nets = [quadrant_nets(fam, n, vx, vy, q, prec) for q in range(n)]
+        regs = [f"{q}:{p}" for q in range(n) for p in PIECES]
+        curves = [f"{q}:{c}" for q in range(n) for c in STAR_CURVES]
+        exact_keys(parts, ("regularity", "transversal", "winding"), "parts")
+        exact_keys(parts["winding"], ("axis", "boxes"), "parts.winding")
+        for sec, got, keys in (("regularity", parts["regularity"], regs),
+                               ("transversal", parts["transversal"], curves),
+                               ("winding.boxes", parts["winding"]["boxes"], curves)):
+            if not isinstance(got, dict) or set(got) != set(keys):
+                raise CertificateError(f"parts.{sec} must have exactly the keys {keys[:3]}... ({len(keys)})")
+        worst = None
+        for key in regs:
+            q, name = key.split(":")
+            f = regularity_form(nets[int(q)], name, prec) * orient
+            ok, msg, mb = check_boxes(f, parts["regularity"][key], f"regularity {key}")
+            if not ok:
+                part("R det J_Phi > 0 on every piece", False, msg)
+                return
+            worst = mb if worst is None or mb < worst else worst
+        part("R det J_Phi > 0 on every piece", True, f"{len(regs)} pieces, min bound {worst} (local s,t)", worst,
+             "regularity")
+        worst = None
+        for key in curves:
+            q, c = key.split(":")
+            f = transversal_form(nets[int(q)], c, a1, a2, prec) * orient
+            ok, msg, mb = check_boxes(f, parts["transversal"][key], f"transversal {key}")
+            if not ok:
+                part("T the outer curve is transversal to the flow of diag(lam1, lam2)", False, msg)
+                return
+            worst = mb if worst is None or mb < worst else worst
+        part("T the outer curve is transversal to the flow of diag(lam1, lam2)", True, f"min bound {worst}", worst,
+             "transversal")
+        win = parts["winding"]
+        axis = win.get("axis")
+        # the D-angle along Gamma is monotone (T); the counts below say it turns by exactly the sector's
+        # angle: from -y to +y through x > 0 (x < 0 when the orientation is -1), from +x to +y through the
+        # first quadrant (the other three when -1), once around for a dart
+        # a dart with lam1 = lam2 (D a multiple of the identity) may name any ray [a, b] (every ray is an orbit)
+        ray = (isinstance(axis, list) and len(axis) == 2 and all(type(c) is int and abs(c) <= 16 for c in axis)
+               and axis != [0, 0] and fam == "dart" and isinstance(lam1, fmpq) and lam1 == lam2)
+        want = 1 if ray else ({("+x", 1): 1, ("-x", 1): 0, ("+x", -1): 0, ("-x", -1): 1} if fam == "crease" else
+                              {("-x", 1): 0, ("-y", 1): 0, ("-x", -1): 1, ("-y", -1): 1} if fam == "corner" else
+                              {(a, o): 1 for a in AXES for o in (1, -1)}).get((axis, orient)) \
+            if isinstance(axis, str) else None
+        if want is None:
+            raise CertificateError(f"parts.winding.axis {str(axis)[:12]!r} is not allowed for {fam}")
+        direction = tuple(axis) if ray else AXES[axis]
+        total = 0
+        for key in curves:
+            q, c = key.split(":")
+            paths = win["boxes"][key]
+            if not isinstance(paths, list) or not paths or not all(isinstance(p, str) for p in paths):
+                raise CertificateError(f"parts.winding.{key} must be a list of paths")
+            got = crossings(nets[int(q)], c, paths, direction, prec)
+            if isinstance(got, str):
+                part(f"W the outer curve crosses the {axis} half-axis {want} time(s)", False, got)
+                return
+            total += got
+        part(f"W the outer curve crosses the {axis} half-axis {want} time(s)", total == want,
+             f"{total} crossing(s)")
+        if fam != "dart":
+            ok, msg = rays_on_axes(fam, n, vx, vy)
+            part("E the sharp rays map onto half-axes", ok, msg)
