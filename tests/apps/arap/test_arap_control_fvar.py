@@ -137,6 +137,31 @@ def test_control_out_does_not_fold_under_corners_only(tmp_path, capsys, refine):
         assert max(co["excess_ratio_to_exact"]) <= 1.05
 
 
+@pytest.mark.slow
+def test_default_refine_control_out_meets_the_target(tmp_path, capsys):
+    """At the default --refine (and the default --control-extra / --control-max-faces) the written control mesh
+    is accepted: no folded UV triangle at levels 1-3 under the independent rule above, every distortion excess
+    within 5 % of the exact texture's, no warning, within the face budget."""
+    m, mp, lp = _case(tmp_path)
+    out = tmp_path / "ctl.obj"
+    rc = main(["arap", str(mp), "--charts", str(lp), "--levels", "2", "--eval-level", "4", "--control-out", str(out),
+               "--no-progress"])
+    assert rc == 0
+    text = capsys.readouterr().out
+    assert "warning: --control-out" not in text
+    V, UV, FT = read_fvar_obj(out)
+    assert 0 < len(FT) <= 150_000
+    U, F = UV, FT
+    for level in (1, 2, 3):
+        U, F = corners_only_step(U, F)
+        assert folded_triangles(U, F) == 0, level
+    co = json.loads(pathlib.Path(str(out) + ".json").read_text())["table"]["control_out"]
+    assert co["refine"] == 2  # the automatic choice on this 80-face mesh
+    assert co["accepted"] is True, co
+    assert co["folds"] == [0, 0, 0]
+    assert len(co["excess_ratio_to_exact"]) == 3 and max(co["excess_ratio_to_exact"]) <= 1.05, co
+
+
 def test_library_rule_is_the_independent_rule(tmp_path):
     """The boundary rules with surface_corners=True subdivide the written UVs exactly as the rule above."""
     from ccproof.apps.arap.core import compare
