@@ -137,6 +137,19 @@ def test_control_out_does_not_fold_under_corners_only(tmp_path, capsys, refine):
         assert max(co["excess_ratio_to_exact"]) <= 1.05
 
 
+def test_control_out_says_when_the_face_budget_stops_it(tmp_path, capsys):
+    m, mp, lp = _case(tmp_path)
+    out = tmp_path / "ctl.obj"
+    rc = main(["arap", str(mp), "--charts", str(lp), "--levels", "2", "--eval-level", "4", "--refine", "0",
+               "--control-out", str(out), "--control-max-faces", "400", "--no-progress"])
+    assert rc == 0
+    err = capsys.readouterr().err
+    # 80 faces: 1 extra subdivision gives 320 <= 400 faces, 2 extra would give 1280
+    assert "the next, 2 extra, needs 1280 faces > --control-max-faces 400" in err
+    co = json.loads(pathlib.Path(str(out) + ".json").read_text())["table"]["control_out"]
+    assert [t["extra"] for t in co["tried"]] == [0, 1] and co["accepted"] is False
+
+
 @pytest.mark.slow
 def test_default_refine_control_out_meets_the_target(tmp_path, capsys):
     """At the default --refine (and the default --control-extra / --control-max-faces) the written control mesh
