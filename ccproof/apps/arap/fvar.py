@@ -21,7 +21,8 @@ subdivided UVs at levels 1..3 (what a tool renders, :func:`subdivided_folds`) an
 with the same samples as the exact one (:func:`~ccproof.apps.arap.core.texture_metrics`). When the UVs
 on the texture's control mesh fold, or a distortion excess exceeds ``max_excess_ratio`` times the exact
 texture's, the control mesh is subdivided once more (the same limit surface, 4x the faces and UVs) and
-fitted again, up to ``max_extra`` times.
+fitted again, up to ``max_extra`` times. :func:`metric_polish` minimizes instead the distortion the metrics
+measure (optional in :func:`export_control`: it trades E_angle against E_area and E_stretch).
 
 The inner 3 x 3 faces of a flat 5 x 5 grid as one chart: the exact texture is an isometry, and so is the
 corners-only one (on a uniform flat grid every rule reproduces affine functions at the same points):
@@ -50,8 +51,8 @@ from ccproof.apps.arap.metrics import Metrics
 from ccproof.apps.arap.samples import limit_operator
 from ccproof.errors import CCProofError
 
-__all__ = ["corners_only_texture", "subdivided_folds", "ControlExport", "export_control", "FOLD_LEVELS",
-           "EXCESS_FLOOR"]
+__all__ = ["corners_only_texture", "subdivided_folds", "metric_polish", "ControlExport", "export_control",
+           "FOLD_LEVELS", "EXCESS_FLOOR"]
 
 #: distortion excesses below this are not told apart (an isometric exact texture)
 EXCESS_FLOOR = 1e-9
