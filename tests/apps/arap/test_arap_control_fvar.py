@@ -302,3 +302,32 @@ def test_opensubdiv_subdivides_the_control_uvs_as_the_rule_and_they_do_not_fold(
         # OpenSubdiv accumulates with float32 weights: agreement to ~1e-8 of the UV extent
         tol = 1e-7 * float(np.ptp(ours, axis=0).max())
         assert cKDTree(ours).query(theirs)[0].max() < tol and cKDTree(theirs).query(ours)[0].max() < tol
+
+
+def test_metric_energy_is_the_measured_distortion_and_its_gradient_matches_differences():
+    """The energy metric_polish minimizes, from the invariants |J|^2 and det J, equals the excesses that
+    texture_metrics computes from the singular values; its gradient equals central differences."""
+    from ccproof.apps.arap.core import ChartTexture, texture_metrics
+    from ccproof.apps.arap.fvar import _metric_energy, _metric_system
+    from ccproof.apps.arap.hierarchy import ChartHierarchy
+
+    m, chart = M.curved_ev_mesh()
+    h = ChartHierarchy(m, chart, surface_corners=True)
+    P = m.vertices[h.unknown_vertices[: h.n_chart_vertices]]
+    Y = P[:, :2] @ np.array([[1.0, 0.2], [-0.1, 0.9]]) + 0.01 * np.sin(7 * P[:, 2:3])
+    B1, B2, w = _metric_system(h, 2)
+    wa, wr, ws = 0.7, 1.3, 2.0
+    val, grad = _metric_energy(B1, B2, w, (wa, wr, ws))(Y.ravel())
+    mt = texture_metrics(ChartTexture(h, "boundary", 0, h.lift_unknowns(Y, "boundary"), Y), 2)
+    assert mt.flips == 0
+    ref = mt.area * (wa * (mt.E_angle - 2) + wr * (mt.E_area - 2) + ws * (mt.E_stretch**2 - 1) / 2)
+    assert abs(val - ref) < 1e-9 * abs(ref)
+    f = _metric_energy(B1, B2, w, (wa, wr, ws))
+    rng = np.random.default_rng(1)
+    for _ in range(3):
+        d = rng.standard_normal(Y.size)
+        e = 1e-6
+        fd = (f(Y.ravel() + e * d)[0] - f(Y.ravel() - e * d)[0]) / (2 * e)
+        assert abs(fd - grad @ d) < 1e-5 * max(1.0, abs(fd))
+    # a folded texture is outside the energy's domain
+    assert f(Y[:, ::-1].ravel())[0] == np.inf
