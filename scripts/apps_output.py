@@ -3,7 +3,10 @@ docs/qmv98.md section 4 ("Equilibrium"), printed, not estimated.
 
   python scripts/apps_output.py --arap [--osd]  # bunny, 16 charts: control UVs under the corners-only rule
                                                 # (--osd: folds counted by OpenSubdiv itself too)
+  python scripts/apps_output.py --arap --metric --refines 0   # the same with export_control(metric=True)
   python scripts/apps_output.py --fit      # bunny scan: fit steps, energy, criterion, two-sided error
+  python scripts/apps_output.py --fit-table  # docs/qmv98.md section 4's tables: synthetic data and the bunny,
+                                             # defaults and the regularization a = 1e-4, 1e-5, 1e-6 (b = a / 10)
 
 --arap: for --refine 0 and the default, method (c) on the bunny's 16 normal-segmented charts; then the folds
 (UV quads with a corner triangle of signed area <= 0) of the control UVs subdivided with the face-varying
@@ -95,7 +98,7 @@ def osd_folds(exe, path, levels=(1, 2, 3)):
     return out
 
 
-def arap(eval_level, out_dir, use_osd):
+def arap(eval_level, out_dir, use_osd, refines=("0", "auto"), metric=False):
     from ccproof.apps.arap.charts import segment_by_normals
     from ccproof.apps.arap.core import ChartTexture, auto_refine, compare, texture_metrics
     from ccproof.apps.arap.fvar import FOLD_LEVELS, export_control, subdivided_folds
@@ -111,7 +114,7 @@ def arap(eval_level, out_dir, use_osd):
     labels = segment_by_normals(mesh)
     print(f"bunny: {mesh.n_faces} faces, {labels.max() + 1} charts; metrics at level {eval_level} "
           f"(E_angle, E_area minimum 2, E_stretch minimum 1); folds at levels {FOLD_LEVELS}")
-    for refine in (0, auto_refine(mesh, labels)):
+    for refine in [auto_refine(mesh, labels) if r == "auto" else int(r) for r in refines]:
         t0 = time.perf_counter()
         res, _ = compare(mesh, labels, methods=("c",), levels=3, eval_level=eval_level, refine=refine,
                          release=True, accel=5)
@@ -134,7 +137,8 @@ def arap(eval_level, out_dir, use_osd):
             write_uv_obj(old, r.textures[0].hierarchy.surface, r)  # the former file: (c)'s own unknowns
             print(f"    OpenSubdiv's folds of that file: {osd_folds(exe, old)}")
         t2 = time.perf_counter()
-        exp = export_control(r, eval_level=eval_level, levels=3, max_faces=150_000)  # the CLI's defaults
+        # the CLI's defaults (--metric: then also the polish for the metrics' own energy)
+        exp = export_control(r, eval_level=eval_level, levels=3, max_faces=150_000, metric=metric)
         t3 = time.perf_counter()
         ex = np.subtract(r.metrics.as_tuple(), (2.0, 2.0, 1.0))
         for extra, f, m in exp.tried:
@@ -144,7 +148,7 @@ def arap(eval_level, out_dir, use_osd):
         er = exp.excess_ratio()
         print(f"  written: {exp.extra} extra ({exp.mesh.n_faces} control faces), excess / exact "
               f"{er[0]:.3f} {er[1]:.3f} {er[2]:.3f}, within 5 %: {exp.accepted} ({t3 - t2:.1f} s)")
-        path = out_dir / f"bunny_control_refine{refine}.obj"
+        path = out_dir / f"bunny_control_refine{refine}{'_metric' if metric else ''}.obj"
         write_uv_obj(path, exp.mesh, replace(r, textures=exp.textures))
         print(f"  wrote {path}")
         if exe is not None:
@@ -184,20 +188,50 @@ def fit():
     print(f"  warnings: {res.warnings or 'none'}")
 
 
+def fit_table(names, scales):
+    """The rows of docs/qmv98.md section 4: max / mean data -> surface error in % of the enclosing-sphere
+    diameter at 98 and 386 control vertices, and the steps of each level, for ``fit_points`` with the defaults
+    and with the regularization scaled (a = s, b = s / 10)."""
+    from dataclasses import replace as dc_replace
+
+    from ccproof.apps.dynamics.fit import DEFAULT_FIT_MATERIAL, fit_points, read_points
+    from ccproof.apps.dynamics.shapes import synthetic_range_data
+
+    for name in names:
+        X = read_points(BUNNY) if name == "bunny" else synthetic_range_data(name)
+        for a in scales:
+            mat = dc_replace(DEFAULT_FIT_MATERIAL, a11=a, a22=a, b11=a / 10, b12=a / 5, b22=a / 10)
+            t0 = time.perf_counter()
+            res = fit_points(X, levels=1, material=mat)
+            dt = time.perf_counter() - t0
+            print(f"{name} ({X.shape[0]} points), a = {a:g}, b = {a / 10:g}: " + " | ".join(
+                f"{lev.n_vertices} vertices {lev.max_error_percent:.2f} / {lev.mean_error_percent:.3f} "
+                f"({lev.steps}{'*' if lev.steps >= res.parameters['max_steps'] else ''})" for lev in res.levels)
+                + f"   {dt:.1f} s", flush=True)
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--arap", action="store_true")
     ap.add_argument("--fit", action="store_true")
+    ap.add_argument("--fit-table", action="store_true", help="the tables of docs/qmv98.md section 4")
+    ap.add_argument("--shapes", default="bulb,ellipsoid,superquadric,bunny", help="--fit-table: data sets")
+    ap.add_argument("--scales", default="1e-5,1e-4,1e-6", help="--fit-table: values of a (b = a / 10)")
     ap.add_argument("--eval-level", type=int, default=4, help="metric level of --arap (default 4)")
     ap.add_argument("--osd", action="store_true", help="--arap: also count folds with OpenSubdiv itself")
+    ap.add_argument("--refines", default="0,auto", help="--arap: the --refine values (default 0,auto)")
+    ap.add_argument("--metric", action="store_true",
+                    help="--arap: export_control(metric=True), the metrics' own energy after the ARAP polish")
     ap.add_argument("--out-dir", type=Path, default=Path("out/apps_output"), help="control meshes of --arap")
     a = ap.parse_args(argv)
-    if not (a.arap or a.fit):
-        ap.error("give --arap and/or --fit")
+    if not (a.arap or a.fit or a.fit_table):
+        ap.error("give --arap, --fit and/or --fit-table")
     if a.fit:
         fit()
+    if a.fit_table:
+        fit_table(a.shapes.split(","), [float(x) for x in a.scales.split(",")])
     if a.arap:
-        arap(a.eval_level, a.out_dir, a.osd)
+        arap(a.eval_level, a.out_dir, a.osd, a.refines.split(","), a.metric)
 
 
 if __name__ == "__main__":

@@ -420,6 +420,8 @@ def read_mesh(path: str | os.PathLike[str]) -> PolyMesh:
         else:
             raise MeshError(f"{p}: cell block {b} has type {block.type!r}: only polygon faces are supported")
     pts = np.asarray(mesh.points, dtype=np.float64)
+    if pts.size == 0:
+        raise MeshError(f"{p}: the file has no vertices (an empty mesh)")
     if pts.ndim != 2 or pts.shape[1] not in (2, 3):
         raise MeshError(f"{p}: points of shape {pts.shape}: expected 2-D or 3-D points")
     if pts.shape[1] == 2:

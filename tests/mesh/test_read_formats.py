@@ -77,6 +77,23 @@ def test_unreadable_files_name_the_file_and_the_reason(tmp_path, capsys, name, t
     assert capsys.readouterr() == ("", "")  # nothing printed (meshio prints before it exits)
 
 
+@pytest.mark.parametrize("name,data,msg", [
+    ("zero.stl", b"", r"zero\.stl: (the file has no vertices|not a valid STL file)"),
+    ("ascii.stl", b"solid empty\nendsolid empty\n", r"ascii\.stl: the file has no vertices \(an empty mesh\)"),
+    ("solid.stl", b"solid\n", r"solid\.stl: the file has no vertices \(an empty mesh\)"),
+    ("bin0.stl", b"\0" * 80 + (0).to_bytes(4, "little"), r"bin0\.stl: the file has no vertices \(an empty mesh\)"),
+    ("hdr.stl", b"\0" * 80, r"hdr\.stl: not a valid STL file"),
+    ("short.stl", b"\0" * 80 + (1).to_bytes(4, "little"), r"short\.stl: the file has no vertices"),
+])
+def test_empty_stl_is_a_mesh_error_naming_the_file(tmp_path, capsys, name, data, msg):
+    p = tmp_path / name
+    p.write_bytes(data)
+    with pytest.raises(MeshError, match=msg) as err:
+        read_mesh(p)
+    assert str(p) in str(err.value)
+    assert capsys.readouterr() == ("", "")
+
+
 def test_missing_file_and_folder(tmp_path):
     with pytest.raises(MeshError, match=r"nope\.obj: no such file"):
         read_mesh(tmp_path / "nope.obj")

@@ -137,6 +137,45 @@ def test_control_out_does_not_fold_under_corners_only(tmp_path, capsys, refine):
         assert max(co["excess_ratio_to_exact"]) <= 1.05
 
 
+def test_control_out_says_when_the_face_budget_stops_it(tmp_path, capsys):
+    m, mp, lp = _case(tmp_path)
+    out = tmp_path / "ctl.obj"
+    rc = main(["arap", str(mp), "--charts", str(lp), "--levels", "2", "--eval-level", "4", "--refine", "0",
+               "--control-out", str(out), "--control-max-faces", "400", "--no-progress"])
+    assert rc == 0
+    err = capsys.readouterr().err
+    # 80 faces: 1 extra subdivision gives 320 <= 400 faces, 2 extra would give 1280
+    assert "the next, 2 extra, needs 1280 faces > --control-max-faces 400" in err
+    co = json.loads(pathlib.Path(str(out) + ".json").read_text())["table"]["control_out"]
+    assert [t["extra"] for t in co["tried"]] == [0, 1] and co["accepted"] is False
+
+
+@pytest.mark.slow
+def test_default_refine_control_out_meets_the_target(tmp_path, capsys):
+    """At the default --refine (and the default --control-extra / --control-max-faces) the written control mesh
+    is accepted: no folded UV triangle at levels 1-3 under the independent rule above, every distortion excess
+    within 5 % of the exact texture's, no warning, within the face budget."""
+    m, mp, lp = _case(tmp_path)
+    out = tmp_path / "ctl.obj"
+    rc = main(["arap", str(mp), "--charts", str(lp), "--levels", "2", "--eval-level", "4", "--control-out", str(out),
+               "--no-progress"])
+    assert rc == 0
+    cap = capsys.readouterr()
+    assert "what a subdivision tool will see" in cap.out
+    assert "warning: --control-out" not in cap.out + cap.err
+    V, UV, FT = read_fvar_obj(out)
+    assert 0 < len(FT) <= 150_000
+    U, F = UV, FT
+    for level in (1, 2, 3):
+        U, F = corners_only_step(U, F)
+        assert folded_triangles(U, F) == 0, level
+    co = json.loads(pathlib.Path(str(out) + ".json").read_text())["table"]["control_out"]
+    assert co["refine"] == 2  # the automatic choice on this 80-face mesh
+    assert co["accepted"] is True, co
+    assert co["folds"] == [0, 0, 0]
+    assert len(co["excess_ratio_to_exact"]) == 3 and max(co["excess_ratio_to_exact"]) <= 1.05, co
+
+
 def test_library_rule_is_the_independent_rule(tmp_path):
     """The boundary rules with surface_corners=True subdivide the written UVs exactly as the rule above."""
     from ccproof.apps.arap.core import compare
@@ -263,3 +302,32 @@ def test_opensubdiv_subdivides_the_control_uvs_as_the_rule_and_they_do_not_fold(
         # OpenSubdiv accumulates with float32 weights: agreement to ~1e-8 of the UV extent
         tol = 1e-7 * float(np.ptp(ours, axis=0).max())
         assert cKDTree(ours).query(theirs)[0].max() < tol and cKDTree(theirs).query(ours)[0].max() < tol
+
+
+def test_metric_energy_is_the_measured_distortion_and_its_gradient_matches_differences():
+    """The energy metric_polish minimizes, from the invariants |J|^2 and det J, equals the excesses that
+    texture_metrics computes from the singular values; its gradient equals central differences."""
+    from ccproof.apps.arap.core import ChartTexture, texture_metrics
+    from ccproof.apps.arap.fvar import _metric_energy, _metric_system
+    from ccproof.apps.arap.hierarchy import ChartHierarchy
+
+    m, chart = M.curved_ev_mesh()
+    h = ChartHierarchy(m, chart, surface_corners=True)
+    P = m.vertices[h.unknown_vertices[: h.n_chart_vertices]]
+    Y = P[:, :2] @ np.array([[1.0, 0.2], [-0.1, 0.9]]) + 0.01 * np.sin(7 * P[:, 2:3])
+    B1, B2, w = _metric_system(h, 2)
+    wa, wr, ws = 0.7, 1.3, 2.0
+    val, grad = _metric_energy(B1, B2, w, (wa, wr, ws))(Y.ravel())
+    mt = texture_metrics(ChartTexture(h, "boundary", 0, h.lift_unknowns(Y, "boundary"), Y), 2)
+    assert mt.flips == 0
+    ref = mt.area * (wa * (mt.E_angle - 2) + wr * (mt.E_area - 2) + ws * (mt.E_stretch**2 - 1) / 2)
+    assert abs(val - ref) < 1e-9 * abs(ref)
+    f = _metric_energy(B1, B2, w, (wa, wr, ws))
+    rng = np.random.default_rng(1)
+    for _ in range(3):
+        d = rng.standard_normal(Y.size)
+        e = 1e-6
+        fd = (f(Y.ravel() + e * d)[0] - f(Y.ravel() - e * d)[0]) / (2 * e)
+        assert abs(fd - grad @ d) < 1e-5 * max(1.0, abs(fd))
+    # a folded texture is outside the energy's domain
+    assert f(Y[:, ::-1].ravel())[0] == np.inf
