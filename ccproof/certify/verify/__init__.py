@@ -34,7 +34,8 @@ __all__ = ["SCHEMA", "C1_SCHEMA", "TAGGED_SCHEMA", "CertificateError", "Part", "
            "verify_file", "check_coverage", "certificate_files", "read_certificate_bytes"]
 
 MAX_FILE_BYTES = 4 * 2**20  # the published certificates: at most 64 KB; MAX_BOXES boxes take at most ~1 MB
-_KINDS = {SCHEMA: verify_injectivity, C1_SCHEMA: verify_c1, TAGGED_SCHEMA: None}
+_KINDS = {SCHEMA: verify_injectivity, C1_SCHEMA: verify_c1}  # certificates of a valence
+_SCHEMAS = (*_KINDS, TAGGED_SCHEMA)
 #: what a malformed file can raise while it is being read; each ends in FAIL with the reason
 _MALFORMED = (CertificateError, ValueError, TypeError, KeyError, IndexError, AttributeError, RecursionError,
               OverflowError, ZeroDivisionError)
@@ -72,10 +73,10 @@ def verify_certificate(cert, log=print, path=None):
     t0 = time.perf_counter()
     part = Recorder(res, log)
     try:
-        if not isinstance(cert, dict) or cert.get("schema") not in _KINDS:
+        if not isinstance(cert, dict) or cert.get("schema") not in _SCHEMAS:
             got = cert.get("schema") if isinstance(cert, dict) else None
             raise CertificateError(f"unknown certificate schema {str(got)[:60]!r} (expected one of "
-                                   f"{', '.join(map(repr, _KINDS))})")
+                                   f"{', '.join(map(repr, _SCHEMAS))})")
         res.schema = cert["schema"]
         check_size(cert)
         if res.schema == TAGGED_SCHEMA:  # a configuration name instead of a valence (docs/tagged_c1.md)
