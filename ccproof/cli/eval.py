@@ -110,6 +110,9 @@ def run(args) -> int:
     points = None if args.points is None else Path(args.points).resolve()
     t0 = time.perf_counter()
     poly = read_mesh(args.mesh)  # OBJ with OpenSubdiv tags, OFF, or any meshio format
+    from ccproof.cli._notice import compile_notice
+
+    compile_notice("eval")
     tagged = not poly.is_plain_quads
     if tagged:
         # triangles, n-gons, creases, corners, holes, boundary modes: the natural parameterization
