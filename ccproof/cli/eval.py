@@ -110,9 +110,6 @@ def run(args) -> int:
     points = None if args.points is None else Path(args.points).resolve()
     t0 = time.perf_counter()
     poly = read_mesh(args.mesh)  # OBJ with OpenSubdiv tags, OFF, or any meshio format
-    from ccproof.cli._notice import compile_notice
-
-    compile_notice("eval")
     tagged = not poly.is_plain_quads
     if tagged:
         # triangles, n-gons, creases, corners, holes, boundary modes: the natural parameterization
@@ -139,6 +136,9 @@ def run(args) -> int:
             raise CCProofError(f"--samples must be >= 0, got {args.samples}")
         sources = point_chunks(args.chunk, samples=args.samples, seed=args.seed, n_faces=n_faces)
     sched = scheduler_from_args(args)
+    from ccproof.cli._notice import compile_notice
+
+    compile_notice("eval")  # after the input checks: an error stays one line
     # on a cluster each worker builds the surface itself (once); here only for in-process work or --plot
     progress = progress_enabled(args)
     surface = build_surface(mesh, tagged, args.alpha, progress) if sched.kind == "serial" or args.plot else None
