@@ -7,13 +7,22 @@ import importlib.util
 import os
 import sys
 
-__all__ = ["compile_notice", "kernels_cached", "KERNEL_MODULES", "FIRST_COMPILE_SECONDS"]
+__all__ = ["compile_notice", "kernels_cached", "KERNEL_MODULES", "FIRST_COMPILE_SECONDS", "COMMAND_KERNELS"]
 
 #: the modules whose numba kernels (``cache=True``) the closest-point search and evaluation compile
 KERNEL_MODULES = ("ccproof.evaluate._numba_kernel", "ccproof.evaluate._bvh")
 #: the first run's compilation, seconds (docs/qmv98.md: ``ccproof fit`` on 500 points took 391 s with an empty
 #: numba cache and 139 s with it filled, on a loaded 2-core machine): the notice says "a few minutes"
 FIRST_COMPILE_SECONDS = (120, 300)
+_EVAL = "ccproof.evaluate._numba_kernel:_evaluate_points"
+#: per command, the kernels its first run compiles (``module`` or ``module:function``) and the expected
+#: compile time in seconds (measured with an empty ``NUMBA_CACHE_DIR`` on a loaded 2-core machine:
+#: docs/evaluate.md "First run")
+COMMAND_KERNELS = {
+    "fit": (KERNEL_MODULES, FIRST_COMPILE_SECONDS),
+    "eval": ((_EVAL,), (30, 90)),
+    "project": ((_EVAL, "ccproof.evaluate._numba_kernel:_newton_points", "ccproof.evaluate._bvh"), (90, 240)),
+}
 
 
 def kernels_cached(modules=KERNEL_MODULES):
@@ -24,6 +33,7 @@ def kernels_cached(modules=KERNEL_MODULES):
     Parameters
     ----------
     modules : sequence of str
+        Module names (any cached kernel of the module counts) or ``module:function`` (that function's).
 
     Returns
     -------
@@ -38,15 +48,17 @@ def kernels_cached(modules=KERNEL_MODULES):
     if importlib.util.find_spec("numba") is None:
         return True
     root = os.environ.get("NUMBA_CACHE_DIR")
-    for name in modules:
+    for entry in modules:
+        name, _, func = entry.partition(":")
         spec = importlib.util.find_spec(name)
         if spec is None or spec.origin is None:
             continue
         stem = name.rsplit(".", 1)[-1]
+        pattern = f"{stem}.{func}-*.nbi" if func else f"{stem}.*.nbi"
         if root:
-            hits = glob.glob(os.path.join(glob.escape(root), "**", f"{stem}.*.nbi"), recursive=True)
+            hits = glob.glob(os.path.join(glob.escape(root), "**", pattern), recursive=True)
         else:
-            hits = glob.glob(os.path.join(glob.escape(os.path.dirname(spec.origin)), "__pycache__", f"{stem}.*.nbi"))
+            hits = glob.glob(os.path.join(glob.escape(os.path.dirname(spec.origin)), "__pycache__", pattern))
         if not hits:
             return False
     return True
@@ -58,7 +70,8 @@ def compile_notice(command, stream=None):
     Parameters
     ----------
     command : str
-        The subcommand, for the message.
+        The subcommand, for the message; its kernels and expected time from :data:`COMMAND_KERNELS`
+        (another name: every kernel module, a few minutes).
     stream : file, optional
         Default ``sys.stderr``.
 
@@ -73,9 +86,10 @@ def compile_notice(command, stream=None):
     >>> compile_notice("fit", io.StringIO()) in (True, False)
     True
     """
-    if kernels_cached():
+    modules, (lo, hi) = COMMAND_KERNELS.get(command, (KERNEL_MODULES, FIRST_COMPILE_SECONDS))
+    if kernels_cached(modules):
         return False
-    lo, hi = FIRST_COMPILE_SECONDS
-    print(f"ccproof {command}: first run: compiling the numba kernels once (a few minutes, {lo}-{hi} s on 2 cores; "
+    about = "under a minute" if hi <= 60 else "about a minute" if hi <= 120 else "a few minutes"
+    print(f"ccproof {command}: first run: compiling the numba kernels once ({about}, {lo}-{hi} s on 2 cores; "
           f"cached on disk for later runs)", file=stream or sys.stderr, flush=True)
     return True

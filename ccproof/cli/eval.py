@@ -134,6 +134,9 @@ def run(args) -> int:
             raise CCProofError(f"--samples must be >= 0, got {args.samples}")
         sources = point_chunks(args.chunk, samples=args.samples, seed=args.seed, n_faces=n_faces)
     sched = scheduler_from_args(args)
+    from ccproof.cli._notice import compile_notice
+
+    compile_notice("eval")  # after the input checks: an error stays one line
     # on a cluster each worker builds the surface itself (once); here only for in-process work or --plot
     progress = progress_enabled(args)
     surface = build_surface(mesh, tagged, args.alpha, progress) if sched.kind == "serial" or args.plot else None

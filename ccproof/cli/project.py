@@ -61,6 +61,9 @@ def run(args):
     except CCProofError as exc:
         raise CCProofError(f"{args.points}: {exc} (point i is on line i + 2)") from None
     S = limit_surface(args.mesh, progress=progress)  # a bar for a long setup
+    from ccproof.cli._notice import compile_notice
+
+    compile_notice("project")  # after the input checks: an error stays one line
     t0 = time.perf_counter()
     finder = ClosestPointFinder(S, cells=args.cells or CELLS)
     starts = range(0, X.shape[0], BATCH)

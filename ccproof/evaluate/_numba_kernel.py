@@ -16,38 +16,75 @@ except ImportError:  # pragma: no cover - optional dependency
     numba = None
 
 _REGULAR, _CORNER, _SPLIT = 0, 1, 2
+#: corner nets (layers beyond the precomputed ones) kept per kernel call: slots (a power of 2, 408 bytes each)
+_CACHE_SLOTS = 16384
+#: calls on fewer points compute every corner net (no cache to allocate)
+_CACHE_MIN = 256
+#: multiplier spreading the patch keys over the slots (Knuth's multiplicative hash)
+_HASH = 2654435761
 
 
-def _basis(x, B, r):
-    """Cubic B-spline basis at x and its first two derivatives, into rows r, r + 1, r + 2 of B."""
+def _basis(x):
+    """Cubic B-spline basis at x, its first and second derivatives: twelve scalars (4 each; the formulas of
+    :func:`ccproof.evaluate.bspline.bspline_basis`)."""
     t = 1.0 - x
     x2 = x * x
     x3 = x2 * x
-    B[r, 0] = t * t * t / 6
-    B[r, 1] = (3 * x3 - 6 * x2 + 4) / 6
-    B[r, 2] = (-3 * x3 + 3 * x2 + 3 * x + 1) / 6
-    B[r, 3] = x3 / 6
-    B[r + 1, 0] = -0.5 * t * t
-    B[r + 1, 1] = 1.5 * x2 - 2 * x
-    B[r + 1, 2] = -1.5 * x2 + x + 0.5
-    B[r + 1, 3] = 0.5 * x2
-    B[r + 2, 0] = t
-    B[r + 2, 1] = 3 * x - 2
-    B[r + 2, 2] = -3 * x + 1
-    B[r + 2, 3] = x
+    return (t * t * t / 6, (3 * x3 - 6 * x2 + 4) / 6, (-3 * x3 + 3 * x2 + 3 * x + 1) / 6, x3 / 6,
+            -0.5 * t * t, 1.5 * x2 - 2 * x, -1.5 * x2 + x + 0.5, 0.5 * x2,
+            t, 3 * x - 2, -3 * x + 1, x)
 
 
-def _corner_net(T, job, vf, cfg, lay, code, ci, W):
-    """Net ``W[0]`` (17 x 3, row 16 the limit point) of patch ``code`` of layer ``lay`` of corner face
+def _sum4(a0, a1, a2, a3, w0, w1, w2, w3):
+    """``sum_j a_j w_j`` from 0.0, left to right (the order of the numpy path's contractions)."""
+    return (((0.0 + a0 * w0) + a1 * w1) + a2 * w2) + a3 * w3
+
+
+def _bicubic(net, p, s, t, g, d, k, P, Pu, Pv, Puu, Puv, Pvv):
+    """Row k of P (and of the derivatives up to order d) from the bicubic net ``net[p]`` (17 x 3, row
+    16 the origin) at (s, t), derivatives scaled by g per order; in registers: the columns
+    ``T_r[i] = sum_j B_r(t)_j net[i + 4 j]`` then ``sum_i B(s)_i T_r[i]``, each sum from 0.0 left to right."""
+    s0, s1, s2, s3, s4, s5, s6, s7, s8, s9, s10, s11 = _basis(s)
+    t0, t1, t2, t3, t4, t5, t6, t7, t8, t9, t10, t11 = _basis(t)
+    g2 = g * g
+    for c in range(3):
+        w0, w1, w2, w3 = net[p, 0, c], net[p, 4, c], net[p, 8, c], net[p, 12, c]
+        x0 = _sum4(t0, t1, t2, t3, w0, w1, w2, w3)
+        w4, w5, w6, w7 = net[p, 1, c], net[p, 5, c], net[p, 9, c], net[p, 13, c]
+        y0 = _sum4(t0, t1, t2, t3, w4, w5, w6, w7)
+        w8, w9, w10, w11 = net[p, 2, c], net[p, 6, c], net[p, 10, c], net[p, 14, c]
+        z0 = _sum4(t0, t1, t2, t3, w8, w9, w10, w11)
+        w12, w13, w14, w15 = net[p, 3, c], net[p, 7, c], net[p, 11, c], net[p, 15, c]
+        q0 = _sum4(t0, t1, t2, t3, w12, w13, w14, w15)
+        P[k, c] = net[p, 16, c] + _sum4(s0, s1, s2, s3, x0, y0, z0, q0)
+        if d >= 1:
+            x1 = _sum4(t4, t5, t6, t7, w0, w1, w2, w3)
+            y1 = _sum4(t4, t5, t6, t7, w4, w5, w6, w7)
+            z1 = _sum4(t4, t5, t6, t7, w8, w9, w10, w11)
+            q1 = _sum4(t4, t5, t6, t7, w12, w13, w14, w15)
+            Pu[k, c] = _sum4(s4, s5, s6, s7, x0, y0, z0, q0) * g
+            Pv[k, c] = _sum4(s0, s1, s2, s3, x1, y1, z1, q1) * g
+            if d >= 2:
+                x2 = _sum4(t8, t9, t10, t11, w0, w1, w2, w3)
+                y2 = _sum4(t8, t9, t10, t11, w4, w5, w6, w7)
+                z2 = _sum4(t8, t9, t10, t11, w8, w9, w10, w11)
+                q2 = _sum4(t8, t9, t10, t11, w12, w13, w14, w15)
+                Puu[k, c] = _sum4(s8, s9, s10, s11, x0, y0, z0, q0) * g2
+                Puv[k, c] = _sum4(s4, s5, s6, s7, x1, y1, z1, q1) * g2
+                Pvv[k, c] = _sum4(s0, s1, s2, s3, x2, y2, z2, q2) * g2
+
+
+def _corner_net(T, job, vf, cfg, lay, code, ci, W, s):
+    """Net ``W[s]`` (17 x 3, row 16 the limit point) of patch ``code`` of layer ``lay`` of corner face
     ``vf`` of ``job``: ``L[lay, code] @ ring`` summed over the ring points j = 1, 2, ... in order
     (row 0 of the relative ring is 0), the 16 entries side by side."""
     Nc = T.op_size[cfg]
     o = T.op_start[cfg] + (3 * lay + code) * 16 * Nc
     q0 = T.job_pts[job] + T.pts[vf] - 1  # ring row j >= 1 (row 0, the vertex, is 0)
     for i in range(16):
-        W[0, i, 0] = 0.0
-        W[0, i, 1] = 0.0
-        W[0, i, 2] = 0.0
+        W[s, i, 0] = 0.0
+        W[s, i, 1] = 0.0
+        W[s, i, 2] = 0.0
     for j in range(1, Nc):
         r0 = T.ring[q0 + j, 0]
         r1 = T.ring[q0 + j, 1]
@@ -55,11 +92,11 @@ def _corner_net(T, job, vf, cfg, lay, code, ci, W):
         r = o + 16 * j
         for i in range(16):
             w = T.ops[r + i]
-            W[0, i, 0] += w * r0
-            W[0, i, 1] += w * r1
-            W[0, i, 2] += w * r2
+            W[s, i, 0] += w * r0
+            W[s, i, 1] += w * r1
+            W[s, i, 2] += w * r2
     for c in range(3):
-        W[0, 16, c] = T.origin[ci, c]
+        W[s, 16, c] = T.origin[ci, c]
     return W
 
 
@@ -73,9 +110,17 @@ def _evaluate_points(f, u, v, d, T, P, Pu, Pv, Puu, Puv, Pvv):
     """
     n = f.shape[0]
     m = T.refused.shape[0]
-    B = np.empty((6, 4))  # basis in s (rows 0-2: value, first, second derivative), in t (rows 3-5)
-    Tm = np.empty((3, 4, 3))
     W = np.empty((1, 17, 3))  # the net of a point in a corner face, row 16 its origin
+    # the corner nets computed in this call, by patch (a direct-mapped cache: a net is the same sums
+    # whether computed or found, so the results do not depend on the cache, the blocks or the threads)
+    ns = 0
+    if n >= _CACHE_MIN:
+        ns = _CACHE_SLOTS
+    cache = np.empty((ns, 17, 3))
+    tags = np.full(ns, -1, dtype=np.int64)
+    lm = 1
+    for c in range(T.n_layers.shape[0]):
+        lm = max(lm, T.n_layers[c])
     for k in range(n):
         pf = f[k]
         uu = u[k]
@@ -137,8 +182,15 @@ def _evaluate_points(f, u, v, d, T, P, Pu, Pv, Puu, Puv, Pvv):
             if lay == 0 and T.hot.shape[0] > 0:  # layer 0 precomputed: the same sums
                 net = T.hot
                 p = 3 * ci + code
+            elif ns > 0:
+                key = 3 * (lm * ci + lay) + code
+                p = (key * _HASH) & (ns - 1)
+                if tags[p] != key:
+                    _corner_net(T, job, vf, cfg, lay, code, ci, cache, p)
+                    tags[p] = key
+                net = cache
             else:
-                net = _corner_net(T, job, vf, cfg, lay, code, ci, W)
+                net = _corner_net(T, job, vf, cfg, lay, code, ci, W, 0)
                 p = 0
         else:
             net = T.nets
@@ -149,50 +201,7 @@ def _evaluate_points(f, u, v, d, T, P, Pu, Pv, Puu, Puv, Pvv):
         s = min(max((uu - pu0) / h, 0.0), 1.0)
         t = min(max((ww - pv0) / h, 0.0), 1.0)
         g = 1.0 / h
-        _basis(s, B, 0)
-        _basis(t, B, 3)
-        for i in range(4):
-            for c in range(3):
-                x0 = 0.0
-                x1 = 0.0
-                x2 = 0.0
-                for j in range(4):
-                    w = net[p, i + 4 * j, c]
-                    x0 += B[3, j] * w
-                    if d >= 1:
-                        x1 += B[4, j] * w
-                    if d >= 2:
-                        x2 += B[5, j] * w
-                Tm[0, i, c] = x0
-                Tm[1, i, c] = x1
-                Tm[2, i, c] = x2
-        for c in range(3):
-            a0 = 0.0
-            for i in range(4):
-                a0 += B[0, i] * Tm[0, i, c]
-            P[k, c] = net[p, 16, c] + a0
-        if d >= 1:
-            for c in range(3):
-                a1 = 0.0
-                a2 = 0.0
-                for i in range(4):
-                    a1 += B[1, i] * Tm[0, i, c]
-                    a2 += B[0, i] * Tm[1, i, c]
-                Pu[k, c] = a1 * g
-                Pv[k, c] = a2 * g
-        if d >= 2:
-            g2 = g * g
-            for c in range(3):
-                a3 = 0.0
-                a4 = 0.0
-                a5 = 0.0
-                for i in range(4):
-                    a3 += B[2, i] * Tm[0, i, c]
-                    a4 += B[1, i] * Tm[1, i, c]
-                    a5 += B[0, i] * Tm[2, i, c]
-                Puu[k, c] = a3 * g2
-                Puv[k, c] = a4 * g2
-                Pvv[k, c] = a5 * g2
+        _bicubic(net, p, s, t, g, d, k, P, Pu, Pv, Puu, Puv, Pvv)
     return -1
 
 
@@ -405,8 +414,10 @@ def _ring_walks(org, nxt, prv, twin, pos, seen, g, r, rings, nring, faces, nface
 
 
 if numba is not None:
-    _basis = numba.njit(cache=True, nogil=True)(_basis)
     _corner_net = numba.njit(cache=True, nogil=True)(_corner_net)
+    _basis = numba.njit(cache=True, nogil=True, inline="always")(_basis)
+    _sum4 = numba.njit(cache=True, nogil=True, inline="always")(_sum4)
+    _bicubic = numba.njit(cache=True, nogil=True, inline="always")(_bicubic)
     evaluate_points = numba.njit(cache=True, nogil=True)(_evaluate_points)
     _dot3 = numba.njit(cache=True, nogil=True, inline="always")(_dot3)
     _free = numba.njit(cache=True, nogil=True, inline="always")(_free)

@@ -365,7 +365,8 @@ class LimitSurface:
                 return kernel(f[lo:hi], u[lo:hi], v[lo:hi], derivatives, table,
                               *[a[lo:hi] if a.shape[0] else a for a in arrs])
 
-            bad = _in_blocks(block, n, _threads(threads, n), 32768)
+            # few blocks: each kernel call computes the corner nets it meets once (a cache per call)
+            bad = _in_blocks(block, n, _threads(threads, n), 32768, per_thread=4)
             if max(bad) >= 0:
                 self._check_values(f, u, v)  # raises, naming the first bad point
                 raise CCProofError("internal error: the compiled kernel refused a point the checks accept")
@@ -586,18 +587,18 @@ class LimitSurface:
         return new
 
 
-def _in_blocks(fn, n, nt, size):
+def _in_blocks(fn, n, nt, size, per_thread=16):
     """``fn(lo, hi)`` over contiguous blocks of ``range(n)`` on ``nt`` threads; the results in block order.
 
-    Many more blocks than threads (about ``size`` points each, at most 16 per thread), taken in turn:
-    the cost per point varies (points near irregular vertices go down the layers), so equal shares
-    would finish unequally. One thread: a single call on everything.
+    More blocks than threads (about ``size`` points each, at most ``per_thread`` per thread), taken in
+    turn: the cost per point varies (points near irregular vertices go down the layers), so equal
+    shares would finish unequally. One thread: a single call on everything.
     """
     if nt <= 1:
         return [fn(0, n)]
     from concurrent.futures import ThreadPoolExecutor
 
-    nb = max(nt, min(16 * nt, n // size))
+    nb = max(nt, min(per_thread * nt, n // size))
     bounds = np.linspace(0, n, nb + 1).astype(np.int64)
     with ThreadPoolExecutor(nt) as ex:
         return list(ex.map(lambda i: fn(bounds[i], bounds[i + 1]), range(nb)))
