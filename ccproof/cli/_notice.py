@@ -67,13 +67,17 @@ def kernels_cached(modules=KERNEL_MODULES):
 def compile_notice(command, stream=None):
     """Print one line to stderr when the kernels are not compiled yet (first run after install).
 
+    Like the progress bars, the line goes to a terminal only: with ``stream=None`` and a stderr that is not
+    a terminal (a pipe, a log file, a test) nothing is printed, so that a command's stderr holds only its
+    verdict, warnings and errors.
+
     Parameters
     ----------
     command : str
         The subcommand, for the message; its kernels and expected time from :data:`COMMAND_KERNELS`
         (another name: every kernel module, a few minutes).
     stream : file, optional
-        Default ``sys.stderr``.
+        Default ``sys.stderr`` when it is a terminal.
 
     Returns
     -------
@@ -86,10 +90,16 @@ def compile_notice(command, stream=None):
     >>> compile_notice("fit", io.StringIO()) in (True, False)
     True
     """
+    if stream is None:
+        try:
+            if not sys.stderr.isatty():
+                return False
+        except (AttributeError, ValueError):  # a closed or replaced stderr
+            return False
     modules, (lo, hi) = COMMAND_KERNELS.get(command, (KERNEL_MODULES, FIRST_COMPILE_SECONDS))
     if kernels_cached(modules):
         return False
     about = "under a minute" if hi <= 60 else "about a minute" if hi <= 120 else "a few minutes"
     print(f"ccproof {command}: first run: compiling the numba kernels once ({about}, {lo}-{hi} s on 2 cores; "
-          f"cached on disk for later runs)", file=stream or sys.stderr, flush=True)
+          f"cached on disk for later runs)", file=sys.stderr if stream is None else stream, flush=True)
     return True
