@@ -90,12 +90,10 @@ def compile_notice(command, stream=None):
     >>> compile_notice("fit", io.StringIO()) in (True, False)
     True
     """
-    if stream is None:
-        try:
-            if not sys.stderr.isatty():
-                return False
-        except (AttributeError, ValueError):  # a closed or replaced stderr
-            return False
+    from ccproof.cli._progress import stderr_is_terminal
+
+    if stream is None and not stderr_is_terminal():
+        return False
     modules, (lo, hi) = COMMAND_KERNELS.get(command, (KERNEL_MODULES, FIRST_COMPILE_SECONDS))
     if kernels_cached(modules):
         return False

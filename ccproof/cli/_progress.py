@@ -21,11 +21,14 @@ def add_progress_argument(parser):
                         help="no progress bar (bars are shown only when stderr is a terminal)")
 
 
-def progress_enabled(args) -> bool:
-    """True when a progress bar should be drawn: stderr is a terminal and no ``--no-progress``."""
-    if getattr(args, "no_progress", False):
-        return False
+def stderr_is_terminal() -> bool:
+    """Whether stderr is a terminal (False for a pipe, a file, a closed or replaced stream)."""
     try:
         return sys.stderr.isatty()
     except (AttributeError, ValueError):  # a closed or replaced stderr
         return False
+
+
+def progress_enabled(args) -> bool:
+    """True when a progress bar should be drawn: stderr is a terminal and no ``--no-progress``."""
+    return not getattr(args, "no_progress", False) and stderr_is_terminal()
