@@ -245,28 +245,30 @@ def check_map(fam, n, vx, vy, lam1, lam2, orient, parts, prec, part):
                                ("winding.boxes", parts["winding"]["boxes"], curves)):
             if not isinstance(got, dict) or set(got) != set(keys):
                 raise CertificateError(f"parts.{sec} must have exactly the keys {keys[:3]}... ({len(keys)})")
-        worst = None
-        for key in regs:
-            q, name = key.split(":")
-            f = regularity_form(nets[int(q)], name, prec) * orient
-            ok, msg, mb = check_boxes(f, parts["regularity"][key], f"regularity {key}")
-            if not ok:
-                part("R det J_Phi > 0 on every piece", False, msg)
-                return
-            worst = mb if worst is None or mb < worst else worst
-        part("R det J_Phi > 0 on every piece", True, f"{len(regs)} pieces, min bound {worst} (local s,t)", worst,
-             "regularity")
-        worst = None
-        for key in curves:
-            q, c = key.split(":")
-            f = transversal_form(nets[int(q)], c, a1, a2, prec) * orient
-            ok, msg, mb = check_boxes(f, parts["transversal"][key], f"transversal {key}")
-            if not ok:
-                part("T the outer curve is transversal to the flow of diag(lam1, lam2)", False, msg)
-                return
-            worst = mb if worst is None or mb < worst else worst
-        part("T the outer curve is transversal to the flow of diag(lam1, lam2)", True, f"min bound {worst}", worst,
-             "transversal")
+
+        def replay(hint, keys, form, title):
+            """Replay the boxes of ``parts[hint]`` on ``form(quadrant, name) * orient`` for every key; the
+            smallest bound, or None after a FAIL recorded under ``title``."""
+            worst = None
+            for key in keys:
+                q, name = key.split(":")
+                ok, msg, mb = check_boxes(form(nets[int(q)], name) * orient, parts[hint][key], f"{hint} {key}")
+                if not ok:
+                    part(title, False, msg)
+                    return None
+                worst = mb if worst is None or mb < worst else worst
+            return worst
+
+        title = "R det J_Phi > 0 on every piece"
+        worst = replay("regularity", regs, lambda net, name: regularity_form(net, name, prec), title)
+        if worst is None:
+            return
+        part(title, True, f"{len(regs)} pieces, min bound {worst} (local s,t)", worst, "regularity")
+        title = "T the outer curve is transversal to the flow of diag(lam1, lam2)"
+        worst = replay("transversal", curves, lambda net, c: transversal_form(net, c, a1, a2, prec), title)
+        if worst is None:
+            return
+        part(title, True, f"min bound {worst}", worst, "transversal")
         win = parts["winding"]
         axis = win.get("axis")
         # the D-angle along Gamma is monotone (T); the counts below say it turns by exactly the sector's
