@@ -264,9 +264,15 @@ def process_pool(workers, context="spawn"):
     try:
         yield ex
     except BaseException:
+        manager = getattr(ex, "_executor_manager_thread", None)
         for proc in list((getattr(ex, "_processes", None) or {}).values()):
             proc.terminate()
         ex.shutdown(wait=False, cancel_futures=True)
+        # The pool's manager thread sees the terminated workers, marks the pool broken and closes its
+        # wake-up pipe. Wait for it here (a few ms): Python 3.11's exit hook would otherwise race it and
+        # write to the closing pipe ("Exception ignored ... Bad file descriptor" after our one line).
+        if manager is not None:
+            manager.join(timeout=30)
         raise
     ex.shutdown(wait=True)
 
