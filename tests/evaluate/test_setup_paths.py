@@ -9,8 +9,8 @@ subdivision (test_tagged_bruteforce.py); here the shortcuts are switched off to 
 import numpy as np
 
 from ccproof.evaluate import _table
-from ccproof.evaluate.surface import _Builder
-from ccproof.evaluate.tagged import TaggedLimitSurface
+from ccproof.evaluate._table import _Builder
+from ccproof.evaluate.surface import LimitSurface
 from ccproof.mesh.io import read_mesh
 
 
@@ -34,18 +34,18 @@ def _compare(mesh, monkeypatch):
         at_corner.append(hit)
         return hit
 
-    compiled = TaggedLimitSurface(mesh)  # untagged rings walked by the compiled kernel (with numba)
+    compiled = LimitSurface(mesh)  # untagged rings walked by the compiled kernel (with numba)
     with monkeypatch.context() as m:
         m.setattr(_table, "_ring_walks", lambda: None)  # the Python walk, face by face
         m.setattr(_Builder, "smooth_regular_patches", counting)
         m.setattr(_Builder, "corner_at", counting_corner)
-        fast = TaggedLimitSurface(mesh)
+        fast = LimitSurface(mesh)
     assert sum(handled) > 0  # the shortcut is exercised
     with monkeypatch.context() as m:
         m.setattr(_table, "_ring_walks", lambda: None)
         m.setattr(_Builder, "smooth_regular_patches", lambda self, cx, X, jobs: np.zeros(len(jobs), bool))
         m.setattr(_Builder, "corner_at", lambda self, *args, **kwargs: False)
-        slow = TaggedLimitSurface(mesh)
+        slow = LimitSurface(mesh)
     assert fast.n_patches == slow.n_patches
     f, u, v = _points(fast)
     a, b = fast.evaluate(f, u, v, 2), slow.evaluate(f, u, v, 2)
