@@ -288,8 +288,17 @@ class _Template:
         self.reg = self.cor = None
 
 
-def _ring_walks():
-    """The compiled ring walk, or None without numba."""
+#: jobs from which the compiled ring walk pays for loading numba and its cached kernel (~1 to 1.5 s in a
+#: fresh process, against ~0.15 ms per job for the Python walk); below, the Python walk, unless the
+#: compiled kernels are loaded already
+COMPILED_WALK_MIN = 8192
+
+
+def _ring_walks(n_jobs):
+    """The compiled ring walk for ``n_jobs`` rings, or None: the Python walk (numba not installed, or
+    fewer than :data:`COMPILED_WALK_MIN` jobs in a process that has not loaded the kernels)."""
+    if n_jobs < COMPILED_WALK_MIN and "ccproof.evaluate._numba_kernel" not in sys.modules:
+        return None
     from ccproof.evaluate._numba_kernel import ring_walks
 
     return ring_walks
@@ -434,7 +443,7 @@ class _Builder:
         single = np.where(quad & (corners.sum(axis=1) == 3), np.argmin(corners, axis=1), -1)
         todo = np.flatnonzero(~done)
         if isinstance(cx, QuadHalfEdges):
-            if cx.manifold and _ring_walks() is not None:
+            if cx.manifold and _ring_walks(todo.size) is not None:
                 return self._walk_all(cx, jobs, j0, todo, single[todo])
             from ccproof.mesh.rules import Complex
 
@@ -456,7 +465,7 @@ class _Builder:
         :func:`ccproof.evaluate.local.canonical_ring`), grouped by the hash of their faces, each
         group checked face by face against its first ring and registered with the key of that ring
         (untagged: the key is the faces and the options)."""
-        walks = _ring_walks()
+        walks = _ring_walks(todo.size)
         opts = he.options.key()
         pos = np.full(he.n_vertices, -1, dtype=np.int64)
         seen = np.zeros(he.faces.shape[0], dtype=np.bool_)

@@ -29,11 +29,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components
 
 from ccproof.errors import MeshError
-from ccproof.mesh.quadmesh import _check_used_finite
+from ccproof.mesh.quadmesh import _check_used_finite, connected_components
 from ccproof.mesh.rules import INFINITE, Complex, Options, refine_complex, to_float
 
 __all__ = ["PolyMesh"]
@@ -242,8 +240,7 @@ class PolyMesh:
         # joined by rot are the fans (OpenSubdiv's spans between singular edges)
         rot = twin[prv]
         ok = np.flatnonzero(rot >= 0)
-        g = sp.coo_matrix((np.ones(ok.size), (ok, rot[ok])), shape=(H, H))
-        ncomp, comp = connected_components(g, directed=False)
+        ncomp, comp = connected_components(H, ok, rot[ok])
         vertex_of_comp = np.zeros(ncomp, dtype=np.int64)
         vertex_of_comp[comp] = org
         nfans = np.bincount(vertex_of_comp, minlength=n)
@@ -602,6 +599,8 @@ class PolyMesh:
 def _expansion(vmap, n):
     """Sparse (len(vmap), n) 0/1 matrix copying vertex ``vmap[i]`` to row i."""
     k = len(vmap)
+    import scipy.sparse as sp
+
     return sp.csr_matrix((np.ones(k), (np.arange(k), np.asarray(vmap))), shape=(k, n))
 
 
@@ -618,4 +617,6 @@ def _stencil_matrix(stencils, ncols):
             rows.append(r)
             cols.append(c)
             vals.append(to_float(w))
+    import scipy.sparse as sp
+
     return sp.csr_matrix((vals, (rows, cols)), shape=(len(stencils), ncols))

@@ -34,15 +34,17 @@ def _compare(mesh, monkeypatch):
         at_corner.append(hit)
         return hit
 
-    compiled = LimitSurface(mesh)  # untagged rings walked by the compiled kernel (with numba)
     with monkeypatch.context() as m:
-        m.setattr(_table, "_ring_walks", lambda: None)  # the Python walk, face by face
+        m.setattr(_table, "COMPILED_WALK_MIN", 0)
+        compiled = LimitSurface(mesh)  # untagged rings walked by the compiled kernel (with numba)
+    with monkeypatch.context() as m:
+        m.setattr(_table, "_ring_walks", lambda n: None)  # the Python walk, face by face
         m.setattr(_Builder, "smooth_regular_patches", counting)
         m.setattr(_Builder, "corner_at", counting_corner)
         fast = LimitSurface(mesh)
     assert sum(handled) > 0  # the shortcut is exercised
     with monkeypatch.context() as m:
-        m.setattr(_table, "_ring_walks", lambda: None)
+        m.setattr(_table, "_ring_walks", lambda n: None)
         m.setattr(_Builder, "smooth_regular_patches", lambda self, cx, X, jobs: np.zeros(len(jobs), bool))
         m.setattr(_Builder, "corner_at", lambda self, *args, **kwargs: False)
         slow = LimitSurface(mesh)
