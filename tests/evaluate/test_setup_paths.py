@@ -71,3 +71,24 @@ def test_smooth_regular_shortcut_on_polygons_with_tags(refdir, monkeypatch):
     for name in ("catmark_nonquads", "catmark_hole_test2", "catmark_edgecorner", "catmark_edgenone"):
         corner_faces += _compare(read_mesh(refdir / "osd_features" / "meshes" / f"{name}.obj"), monkeypatch)[1]
     assert corner_faces > 0
+
+
+def test_setup_in_a_fresh_process_loads_no_heavy_module(bunny_path, refdir):
+    """What `ccproof eval` does before evaluating (imports, read, build) loads neither scipy, numba, tqdm nor
+    meshio on an OBJ (the lazy imports that keep its setup near the floor of a Python process)."""
+    import json
+    import os
+    import subprocess
+    import sys
+
+    code = ("import sys, json; from ccproof.mesh.io import read_mesh; "
+            "from ccproof.evaluate import natural_limit_surface as ls\n"
+            "for p in sys.argv[1:]: ls(read_mesh(p), progress=False)\n"
+            "print(json.dumps(sorted({m.split('.')[0] for m in sys.modules} & "
+            "{'scipy', 'numba', 'llvmlite', 'tqdm', 'meshio', 'sympy', 'matplotlib'})))")
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    env = dict(os.environ, PYTHONPATH=root + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    paths = [str(bunny_path), str(refdir / "osd_features" / "meshes" / "catmark_cubes_infsharp.obj")]
+    out = subprocess.run([sys.executable, "-c", code, *paths], env=env, check=True, capture_output=True,
+                         text=True, timeout=600).stdout
+    assert json.loads(out.strip().splitlines()[-1]) == []
