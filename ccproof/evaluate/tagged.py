@@ -98,7 +98,7 @@ def build_tagged(mesh: PolyMesh, progress=None):
         X = step[0]
         cx = QuadHalfEdges(step[1], X.shape[0], mesh.options)
     else:
-        m1, _ = mesh.refine()
+        m1, _ = mesh.refine(operator=False)
         cx = m1.complex()
         X = np.asarray(m1.vertices)
     # jobs: sub-face i of an n-gon is level-1 child i (same (s, t)), its own ptex face; a quad is

@@ -535,8 +535,13 @@ class PolyMesh:
         return Complex(self.polygons, dict(self.edge_sharpness), dict(self.vertex_sharpness), self.options,
                        level=self.level, n_vertices=self.n_vertices)
 
-    def refine(self):
+    def refine(self, operator=True):
         """One Catmull-Clark step with the tagged rules (layout of :mod:`ccproof.mesh.rules`).
+
+        Parameters
+        ----------
+        operator : bool
+            Also return the step's sparse matrix (False: None instead, and scipy is not imported).
 
         Returns
         -------
@@ -544,17 +549,19 @@ class PolyMesh:
             All quads; child ``offsets[f] + k`` is corner k of face f; sharpness decayed; holes
             inherited by the children; the options kept (``EDGE_AND_CORNER`` corners carried as
             infinite vertex sharpness).
-        S : scipy.sparse.csr_matrix, shape (n + E + m, n)
+        S : scipy.sparse.csr_matrix, shape (n + E + m, n), or None
             ``refined.vertices == S @ self.vertices``. On a non-manifold mesh, the step of
             :attr:`manifold` (n + E + m counted there; the columns are this mesh's vertices).
         """
         if self.manifold is not self:
-            m, S = self.manifold.refine()
+            m, S = self.manifold.refine(operator)
+            if not operator:
+                return m, None
             return m, (S @ _expansion(self.manifold_vertex_map, self.n_vertices)).tocsr()
         cx = self.complex()
         stencils, children, ces, cvs = refine_complex(cx)
-        S = _stencil_matrix(stencils, self.n_vertices)
-        V1 = S @ self.vertices
+        S = _stencil_matrix(stencils, self.n_vertices) if operator else None
+        V1 = _apply_stencils(stencils, np.asarray(self.vertices, dtype=np.float64))
         holes = np.repeat(self.is_hole, self.sizes)
         m = PolyMesh(V1, children, creases=(list(ces.keys()), list(ces.values())) if ces else None,
                      corners=cvs or None, holes=np.flatnonzero(holes), options=self.options)
@@ -602,6 +609,31 @@ def _expansion(vmap, n):
     import scipy.sparse as sp
 
     return sp.csr_matrix((np.ones(k), (np.arange(k), np.asarray(vmap))), shape=(k, n))
+
+
+def _apply_stencils(stencils, X):
+    """``S @ X`` for the float matrix S of :func:`_stencil_matrix`, without building it: each row summed
+    over its columns in increasing order, from 0, as the CSR product does (the same bits)."""
+    n = len(stencils)
+    width = max((len(s) for s in stencils if s is not None), default=0)
+    cols = np.zeros((n, max(width, 1)), dtype=np.int64)
+    vals = np.zeros((n, max(width, 1)))
+    size = np.zeros(n, dtype=np.int64)
+    bad = []
+    for r, s in enumerate(stencils):
+        if s is None:
+            bad.append(r)
+            continue
+        items = sorted(s.items())
+        size[r] = len(items)
+        cols[r, :len(items)] = [c for c, _ in items]
+        vals[r, :len(items)] = [to_float(w) for _, w in items]
+    out = np.zeros((n, X.shape[1]))
+    for k in range(width):  # only the rows' own columns: an unused vertex may hold NaN
+        rows = np.flatnonzero(size > k)
+        out[rows] += vals[rows, k, None] * X[cols[rows, k]]
+    out[bad] = np.nan
+    return out
 
 
 def _stencil_matrix(stencils, ncols):

@@ -88,7 +88,8 @@ def test_setup_in_a_fresh_process_loads_no_heavy_module(bunny_path, refdir):
             "{'scipy', 'numba', 'llvmlite', 'tqdm', 'meshio', 'sympy', 'matplotlib'})))")
     root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
     env = dict(os.environ, PYTHONPATH=root + os.pathsep + os.environ.get("PYTHONPATH", ""))
-    paths = [str(bunny_path), str(refdir / "osd_features" / "meshes" / "catmark_cubes_infsharp.obj")]
+    paths = [str(bunny_path)] + [str(refdir / "osd_features" / "meshes" / f"catmark_{name}.obj")
+                                 for name in ("cubes_infsharp", "smoothtris1", "chaikin1", "nonquads")]
     out = subprocess.run([sys.executable, "-c", code, *paths], env=env, check=True, capture_output=True,
                          text=True, timeout=600).stdout
     assert json.loads(out.strip().splitlines()[-1]) == []

@@ -214,3 +214,16 @@ def test_quad_reader_refuses_tags(refdir):
 
     with pytest.raises(MeshError, match=r"catmark_cube_creases0.obj:\d+: OpenSubdiv tag 'crease'"):
         read_obj(refdir / "osd_features" / "meshes" / "catmark_cube_creases0.obj")
+
+
+def test_refine_without_the_operator_gives_the_same_vertices():
+    """refine(operator=False) (the evaluator's setup: no scipy) sums each stencil as the sparse product does."""
+    V = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0.3], [2, 0.5, 0.1], [np.nan, 0, 0]])
+    m = PolyMesh(V, [[0, 1, 2, 3], [1, 4, 2]], creases={(1, 2): 1.5}, options={"triangle_subdivision": "smooth"})
+    m1, S = m.refine()
+    m2, none = m.refine(operator=False)
+    assert none is None
+    assert np.array_equal(m1.vertices, m2.vertices, equal_nan=True)
+    used = ~m2.is_unused_vertex  # the unused NaN vertex stays unused; it enters no used vertex's stencil
+    assert used.sum() == 13 and np.isfinite(m2.vertices[used]).all()
+    assert np.array_equal(m1.vertices[used], (S @ np.where(np.isnan(V), 0.0, V))[used])
