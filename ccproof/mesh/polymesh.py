@@ -26,6 +26,8 @@ is evaluated on: the fans of every non-manifold vertex split apart (see
 
 from __future__ import annotations
 
+import functools
+import itertools
 import math
 
 import numpy as np
@@ -107,26 +109,33 @@ class PolyMesh:
         V = np.array(vertices, dtype=np.float64)
         if V.ndim != 2 or V.shape[1] != 3:
             raise MeshError(f"vertices must have shape (n, 3), got {V.shape}")
-        polys = self._polygons(faces, sizes)
-        if not polys:
+        # the faces as flat arrays (indices, offsets): no Python object per face (memory on large scans)
+        idx, sz = self._flat_faces(faces, sizes)
+        if not sz.size:
             raise MeshError("the mesh has no faces")
         n = V.shape[0]
-        for f, p in enumerate(polys):
-            if len(p) < 3:
-                raise MeshError(f"face {f} has {len(p)} vertices (needs >= 3): {p}")
-            for v in p:
-                if not 0 <= v < n:
-                    raise MeshError(f"face {f} has a vertex index out of range [0, {n}): {p}")
-            if _split is False and len(set(p)) != len(p):  # (the split mesh: a face still touching itself)
-                r = next(v for v in p if p.count(v) > 1)
-                raise MeshError(f"face {f} repeats vertex {r} within one fan: {p}")
-        _check_used_finite(V, [v for p in polys for v in p])
+        off = np.r_[0, np.cumsum(sz)].astype(np.int64)
+        short = np.flatnonzero(sz < 3)
+        bad = np.flatnonzero((idx < 0) | (idx >= n))
+        f_bad = int(np.searchsorted(off[1:], bad[0], side="right")) if bad.size else sz.size
+        if short.size and short[0] <= f_bad:
+            f = int(short[0])
+            raise MeshError(f"face {f} has {int(sz[f])} vertices (needs >= 3): {idx[off[f]:off[f + 1]].tolist()}")
+        if bad.size:
+            raise MeshError(f"face {f_bad} has a vertex index out of range [0, {n}): "
+                            f"{idx[off[f_bad]:off[f_bad + 1]].tolist()}")
+        if _split is False:  # (the split mesh: a face still touching itself)
+            for f in range(sz.size):
+                p = idx[off[f]:off[f + 1]].tolist()
+                if len(set(p)) != len(p):
+                    r = next(v for v in p if p.count(v) > 1)
+                    raise MeshError(f"face {f} repeats vertex {r} within one fan: {p}")
+        _check_used_finite(V, idx)
         self.vertices = V
         self.vertices.setflags(write=False)
-        self.polygons = [tuple(p) for p in polys]
-        self.sizes = np.array([len(p) for p in polys], dtype=np.int64)
-        self.offsets = np.r_[0, np.cumsum(self.sizes)].astype(np.int64)
-        self.indices = np.array([v for p in polys for v in p], dtype=np.int64)
+        self.sizes = sz
+        self.offsets = off
+        self.indices = idx
         if options is None:
             options = Options()
         elif isinstance(options, dict):
@@ -135,7 +144,7 @@ class PolyMesh:
         self._build_topology()
         self.edge_sharpness = self._creases(creases)
         self.vertex_sharpness = self._corners(corners)
-        m = len(polys)
+        m = int(sz.size)
         hole = np.zeros(m, dtype=bool)
         for f in [] if holes is None else list(holes):
             fi = int(f)
@@ -157,21 +166,42 @@ class PolyMesh:
             self.manifold, self.manifold_vertex_map = self._split_nonmanifold()
 
     # ------------------------------------------------------------------ construction helpers
+    @functools.cached_property
+    def polygons(self):
+        """The faces as tuples of vertex indices (built on first use from :attr:`indices`, :attr:`offsets`)."""
+        flat = self.indices.tolist()
+        off = self.offsets.tolist()
+        return [tuple(flat[a:b]) for a, b in zip(off[:-1], off[1:])]
+
+    @functools.cached_property
+    def edge_index(self):
+        """``{(a, b): e}`` for every edge ``e`` (a < b) of :attr:`edges` (built on first use)."""
+        return {(int(a), int(b)): e for e, (a, b) in enumerate(self.edges.tolist())}
+
     @staticmethod
-    def _polygons(faces, sizes):
+    def _flat_faces(faces, sizes):
+        """``(indices, sizes)``, int64 arrays, of the ``faces`` argument (see the class docstring)."""
         if sizes is not None:
             idx = np.asarray(faces, dtype=np.int64).reshape(-1)
             sz = np.asarray(sizes, dtype=np.int64).reshape(-1)
             if (sz < 0).any() or sz.sum() != idx.size:
                 raise MeshError(f"face sizes sum to {int(sz.sum())}, but there are {idx.size} indices")
-            off = np.r_[0, np.cumsum(sz)]
-            return [idx[off[f] : off[f + 1]].tolist() for f in range(sz.size)]
+            return idx, sz
         if isinstance(faces, tuple) and len(faces) == 2 and np.ndim(faces[0]) == 1 and np.ndim(faces[1]) == 1:
             idx = np.asarray(faces[0], dtype=np.int64)
             off = np.asarray(faces[1], dtype=np.int64)
             if off.size == 0 or off[0] != 0 or off[-1] != idx.size or (np.diff(off) < 0).any():
                 raise MeshError("offsets must start at 0, be non-decreasing and end at len(indices)")
-            return [idx[off[f] : off[f + 1]].tolist() for f in range(off.size - 1)]
+            return idx, np.diff(off)
+        if isinstance(faces, np.ndarray) and faces.ndim == 2 and np.issubdtype(faces.dtype, np.integer):
+            return faces.astype(np.int64).reshape(-1), np.full(faces.shape[0], faces.shape[1], dtype=np.int64)
+        polys = PolyMesh._polygons(faces)
+        sz = np.fromiter((len(p) for p in polys), dtype=np.int64, count=len(polys))
+        idx = np.fromiter(itertools.chain.from_iterable(polys), dtype=np.int64, count=int(sz.sum()))
+        return idx, sz
+
+    @staticmethod
+    def _polygons(faces):
         out = []
         for f, p in enumerate(faces):
             q = np.asarray(p)
@@ -194,7 +224,7 @@ class PolyMesh:
         n = self.vertices.shape[0]
         off, idx = self.offsets, self.indices
         H = idx.size
-        face_of = np.repeat(np.arange(len(self.polygons)), self.sizes)
+        face_of = np.repeat(np.arange(self.sizes.size), self.sizes)
         loc = np.arange(H) - off[face_of]
         nxt = off[face_of] + (loc + 1) % self.sizes[face_of]
         prv = off[face_of] + (loc - 1) % self.sizes[face_of]
@@ -215,9 +245,9 @@ class PolyMesh:
         # gives each such occurrence an edge of its own with one face (a boundary edge), so that both
         # ends are sharpened (corners)
         degenerate = lo[order[starts]] == hi[order[starts]]
-        fe = np.unique(edge_of * len(self.polygons) + face_of, return_counts=True)
+        fe = np.unique(edge_of * self.sizes.size + face_of, return_counts=True)
         held_twice = np.zeros(starts.size, dtype=bool)
-        held_twice[fe[0][fe[1] > 1] // len(self.polygons)] = True
+        held_twice[fe[0][fe[1] > 1] // self.sizes.size] = True
         nm_edge |= degenerate | held_twice
         self._repeat_edge = degenerate | held_twice
         ends = np.flatnonzero(degenerate | held_twice)
@@ -229,7 +259,6 @@ class PolyMesh:
         first = order[starts]
         self._edge_halfedge = first  # one half-edge of every edge
         self.edges = np.stack([lo[first], hi[first]], axis=1)
-        self.edge_index = {(int(a), int(b)): e for e, (a, b) in enumerate(self.edges.tolist())}
         self.edge_face_count = counts
         self.is_boundary_edge = counts == 1
         self.is_nonmanifold_edge = nm_edge
@@ -379,10 +408,10 @@ class PolyMesh:
         for v, x in vsharp.items():
             for u in [v, *copies.get(v, [])]:
                 corners[u] = x
-        polys = [new[self.offsets[f] : self.offsets[f + 1]].tolist() for f in range(self.n_faces)]
         opts = Options("edge_only", self.options.crease_method, self.options.triangle_subdivision)
         try:
-            m = PolyMesh(self.vertices[vmap], polys, creases=creases or None, corners=corners or None,
+            m = PolyMesh(self.vertices[vmap], np.asarray(new, dtype=np.int64), sizes=self.sizes,
+                         creases=creases or None, corners=corners or None,
                          holes=np.flatnonzero(self.is_hole), options=opts, _split=False)
         except MeshError as exc:
             raise MeshError(f"non-manifold mesh not supported after splitting its non-manifold vertices: "
@@ -437,7 +466,7 @@ class PolyMesh:
 
     def _implicit_holes(self):
         """``VTX_BOUNDARY_NONE``: faces at a boundary vertex with a boundary edge not tagged infinite."""
-        m = len(self.polygons)
+        m = self.sizes.size
         out = np.zeros(m, dtype=bool)
         if self.options.boundary != "none":
             return out
@@ -459,7 +488,7 @@ class PolyMesh:
 
     @property
     def n_faces(self):
-        return len(self.polygons)
+        return int(self.sizes.size)
 
     @property
     def is_all_quads(self):
@@ -490,7 +519,7 @@ class PolyMesh:
             why = ("it has faces that are not quads" if not self.is_all_quads else
                    "it has OpenSubdiv tags" if self.has_tags else "it is not manifold")
             raise MeshError(f"not a plain quad mesh: {why}")
-        return QuadMesh(self.vertices, np.array(self.polygons, dtype=np.int64).reshape(-1, 4))
+        return QuadMesh(self.vertices, self.indices.reshape(-1, 4))
 
     @property
     def has_tags(self):
