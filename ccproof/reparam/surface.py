@@ -40,6 +40,7 @@ import os
 import threading
 import weakref
 from collections.abc import Mapping
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -86,6 +87,7 @@ def _chain_rule(R, idx, J, H, derivatives):
     _put_rows(R["Pv"], idx, Pu * J[:, 0, 1, None] + Pv * J[:, 1, 1, None])
 
 
+@dataclass(frozen=True, eq=True, repr=False)
 class Parameterization:
     """A parameterization of the limit surface, as a value: bmz04 section 2, 4.2 or 4.3.
 
@@ -119,34 +121,28 @@ class Parameterization:
     {5: 2.5}
     """
 
-    __slots__ = ("kind", "alpha")
+    kind: str
+    alpha: float | Mapping[int, float] | None = None
 
-    def __init__(self, kind: str, alpha: float | Mapping[int, float] | None = None) -> None:
-        if kind not in PARAMETERIZATIONS:
-            raise CCProofError(f"unknown parameterization {kind!r}; use one of {', '.join(PARAMETERIZATIONS)}")
-        if alpha is not None and kind != "vanishing":
-            raise CCProofError(f"alpha applies to the vanishing parameterization only, not to {kind!r}")
-        object.__setattr__(self, "kind", kind)
-        object.__setattr__(self, "alpha", dict(alpha) if isinstance(alpha, Mapping) else alpha)
+    def __post_init__(self) -> None:
+        if self.kind not in PARAMETERIZATIONS:
+            raise CCProofError(f"unknown parameterization {self.kind!r}; use one of {', '.join(PARAMETERIZATIONS)}")
+        if self.alpha is not None and self.kind != "vanishing":
+            raise CCProofError(f"alpha applies to the vanishing parameterization only, not to {self.kind!r}")
+        if isinstance(self.alpha, Mapping):
+            object.__setattr__(self, "alpha", dict(self.alpha))  # a copy: the value does not change
 
-    def __setattr__(self, name, value):
-        raise AttributeError("a Parameterization is immutable")
-
-    def __repr__(self):
+    def __repr__(self) -> str:
         return f"Parameterization({self.kind!r}" + ("" if self.alpha is None else f", alpha={self.alpha!r}") + ")"
 
-    def __eq__(self, other):
-        return isinstance(other, Parameterization) and (self.kind, self.alpha) == (other.kind, other.alpha)
+    def __hash__(self) -> int:
+        return hash((self.kind, self._alpha_key()))
 
-    def __hash__(self):
-        a = tuple(sorted(self.alpha.items())) if isinstance(self.alpha, dict) else self.alpha
-        return hash((self.kind, a))
-
-    def __reduce__(self):
-        return (Parameterization, (self.kind, self.alpha))
+    def _alpha_key(self) -> Any:
+        return tuple(sorted(self.alpha.items())) if isinstance(self.alpha, dict) else self.alpha
 
     # ------------------------------------------------------------------ per surface
-    def alphas(self, surface) -> dict[int, float]:
+    def alphas(self, surface: LimitSurface) -> dict[int, float]:
         """The exponent of F^alpha for every extraordinary interior valence of ``surface``'s mesh, checked.
 
         Raises
@@ -156,7 +152,7 @@ class Parameterization:
             of an untagged all-quad mesh.
         """
         st = _state(surface)
-        key = tuple(sorted(self.alpha.items())) if isinstance(self.alpha, dict) else self.alpha
+        key = self._alpha_key()
         if key not in st.alphas:
             out = {}
             for k in st.kinds:
@@ -170,7 +166,9 @@ class Parameterization:
             st.alphas[key] = out
         return dict(st.alphas[key])
 
-    def evaluate_on(self, surface, f, u, v, derivatives=1, *, chunk=CHUNK, out=None, backend=None, threads=None):
+    def evaluate_on(self, surface: LimitSurface, f: np.ndarray, u: np.ndarray, v: np.ndarray, derivatives: int = 1,
+                    *, chunk: int = CHUNK, out: dict[str, np.ndarray] | None = None, backend: str | None = None,
+                    threads: int | None = None) -> dict[str, np.ndarray]:
         """f o F_b at points the surface has checked: what ``surface.evaluate(..., parameterization=self)`` returns.
 
         Called by :meth:`ccproof.evaluate.surface.LimitSurface.evaluate` with ``f`` (n,) int64 and
@@ -208,7 +206,8 @@ class Parameterization:
             self._fix_corner_limits(surface, f[idx], idx, q, m, res, R, derivatives)
         return R
 
-    def _fix_corner_limits(self, surface, f, idx, q, m, res, R, derivatives):
+    def _fix_corner_limits(self, surface: LimitSurface, f: np.ndarray, idx: np.ndarray, q: np.ndarray,
+                           m: np.ndarray, res: dict[str, Any], R: dict[str, np.ndarray], derivatives: int) -> None:
         """Limit derivatives at the corner and beyond the evaluator's deepest layer (module doc).
 
         ``f``, ``q``, ``m``: face, quarter and max local coordinate of the active points ``idx``."""
@@ -245,6 +244,7 @@ class _SurfaceState:
     """What the parameterizations derive from one surface (cached, dropped with the surface)."""
 
     def __init__(self, mesh: QuadMesh) -> None:
+        self.mesh = mesh
         self.corner_valence = corner_valence(mesh)
         self.kinds = sorted({int(k) for k in np.unique(self.corner_valence) if k > 0})
         self.alphas: dict[Any, dict[int, float]] = {}
@@ -256,7 +256,7 @@ _STATES: weakref.WeakKeyDictionary[LimitSurface, _SurfaceState] = weakref.WeakKe
 _LOCK = threading.Lock()
 
 
-def _state(surface) -> _SurfaceState:
+def _state(surface: LimitSurface) -> _SurfaceState:
     if not isinstance(surface.mesh, QuadMesh):
         raise CCProofError("the vanishing and characteristic parameterizations need an untagged all-quad mesh "
                            f"(a QuadMesh), not a {type(surface.mesh).__name__}")
@@ -293,7 +293,7 @@ def corner_valence(mesh: QuadMesh) -> np.ndarray:
     return code[mesh.faces]
 
 
-def corner_derivatives(surface, face, corner):
+def corner_derivatives(surface: LimitSurface, face: int, corner: int) -> np.ndarray:
     """D(f o Phi^-1)(0) at corner ``corner`` of ``face``: rows d/ds, d/dt in the corner frame, (2, 3).
 
     See :mod:`ccproof.reparam.corner`. Only for interior vertices of valence != 4.
@@ -303,20 +303,21 @@ def corner_derivatives(surface, face, corner):
     if key not in st.tangents:
         from ccproof.reparam.corner import corner_tangents
 
-        st.tangents[key] = corner_tangents(surface.mesh, *key)
+        st.tangents[key] = corner_tangents(st.mesh, *key)
     return st.tangents[key]
 
 
-def _rotated(surface, q):
+def _rotated(surface: LimitSurface, q: int) -> LimitSurface:
     """The same surface with every face's vertex list rotated by q (corner q becomes corner 0)."""
     st = _state(surface)
     if q not in st.rotated:
-        F = np.roll(surface.mesh.faces, -q, axis=1)
-        st.rotated[q] = LimitSurface(QuadMesh(surface.mesh.vertices, F), progress=False)
+        mesh = st.mesh
+        st.rotated[q] = LimitSurface(QuadMesh(mesh.vertices, np.roll(mesh.faces, -q, axis=1)), progress=False)
     return st.rotated[q]
 
 
-def _eval_in_corner_frame(surface, q, f, rows, sel, res, R, d, backend):
+def _eval_in_corner_frame(surface: LimitSurface, q: int, f: np.ndarray, rows: np.ndarray, sel: np.ndarray,
+                          res: dict[str, Any], R: dict[str, np.ndarray], d: int, backend: str | None) -> None:
     """Rows ``rows`` of R (active points ``sel`` of ``res``) evaluated in the frame of corner q."""
     S = _rotated(surface, q)
     G = res["local"][sel]
