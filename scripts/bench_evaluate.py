@@ -304,7 +304,8 @@ _FLOORS = {"python -c pass": "pass", "python -c 'import numpy'": "import numpy",
 
 
 def fresh_process_setup(rounds=7):
-    """Setup in a fresh process, imports included: ours (``python -c``: imports, read the OBJ, build) with the
+    """Setup in a fresh process, imports included (our modules' bytecode written once, as an installed package
+    has it): ours (``python -c``: imports, read the OBJ, build) with the
     per-configuration disk cache filled and empty (a new folder every round) against OpenSubdiv Far's driver
     (``scripts/osd_setup_driver.cpp``: a program that reads the same OBJ, refines adaptively to level 10 and
     builds the patch table, its local points and the patch map), each process timed end to end from here
@@ -323,6 +324,9 @@ def fresh_process_setup(rounds=7):
         return None
     exe = str(_osd.setup_driver())
     env = dict(os.environ, PYTHONPATH=str(REPO) + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    # our modules' bytecode, as an installed package has it (pip compiles on install): without it every
+    # fresh process compiles our sources again (~0.1 s); the first run below writes __pycache__
+    env.pop("PYTHONDONTWRITEBYTECODE", None)
 
     def run(cmd, cache=None):
         e = env if cache is None else dict(env, CCPROOF_CACHE=cache)
@@ -347,7 +351,7 @@ def fresh_process_setup(rounds=7):
             ok = int(n_ptex) == mesh.n_ptex and np.abs(np.array(p, dtype=float) - P).max() <= 1e-12
             if not ok:
                 raise RuntimeError(f"osd_setup_driver reads {path.name} differently from the C API: {out}")
-            run([sys.executable, "-c", _OURS_SETUP, str(path)], filled)  # fills the cache
+            run([sys.executable, "-c", _OURS_SETUP, str(path)], filled)  # fills the cache (and __pycache__)
             folders = iter(range(1 << 30))
 
             def empty(path=path, folders=folders, label=label):
