@@ -78,16 +78,19 @@ def build_tagged(mesh: PolyMesh, progress=None):
     if mesh.is_all_quads:
         # no global step needed: start on the base mesh, with the one level-0-only rule that
         # can act on quads (EDGE_AND_CORNER sharpens one-face boundary vertices) made explicit
-        cx = mesh.complex()
-        if mesh.options.boundary == "edge_and_corner":
-            vs = dict(cx.vertex_sharpness)
-            for v in range(mesh.n_vertices):
-                fan, closed = cx.fan(v)
-                if fan is not None and not closed and len(fan) == 1:
-                    vs[v] = math.inf
-            cx = Complex(cx.faces, cx.edge_sharpness, vs, cx.options, level=1, n_vertices=cx.n_vertices)
-        if not cx.edge_sharpness and not cx.vertex_sharpness:
-            cx = QuadHalfEdges(cx.faces, cx.n_vertices, cx.options)
+        if not mesh.has_tags:  # untagged: the half-edge arrays directly (no Python complex)
+            cx = QuadHalfEdges(mesh.indices.reshape(-1, 4), mesh.n_vertices, mesh.options)
+        else:
+            cx = mesh.complex()
+            if mesh.options.boundary == "edge_and_corner":
+                vs = dict(cx.vertex_sharpness)
+                for v in range(mesh.n_vertices):
+                    fan, closed = cx.fan(v)
+                    if fan is not None and not closed and len(fan) == 1:
+                        vs[v] = math.inf
+                cx = Complex(cx.faces, cx.edge_sharpness, vs, cx.options, level=1, n_vertices=cx.n_vertices)
+            if not cx.edge_sharpness and not cx.vertex_sharpness:
+                cx = QuadHalfEdges(cx.faces, cx.n_vertices, cx.options)
         ptex_face[:] = np.arange(mesh.n_faces)
         m = mesh.n_faces
         b.classify(cx, np.asarray(mesh.vertices), _Jobs(np.arange(m), np.zeros(m, np.int64), np.arange(m), [ident]))
