@@ -821,7 +821,7 @@ def job_floats(groups, X, sizes, progress=None):
     """The float data of every job from the positions ``X`` of the complex its rings index.
 
     Per template group, in blocks of jobs: ``rel = X[ring] - X[ring[0]]`` (J, N, 3), then the
-    template's operators applied to it (one matrix product per block); the affine rows (patch
+    template's operators applied to it (one stacked matrix product per block); the affine rows (patch
     origins, corner limit points) add ``X[ring[0]]`` back.
 
     Returns
@@ -837,7 +837,6 @@ def job_floats(groups, X, sizes, progress=None):
     ring = np.empty((n_pts, 3))
     bar = _progress(progress, sum(g[1].size for g in groups), "patch data")
     for t, jobs, rings in groups:
-        N = t.n
         o_reg, o_cor, o_pts = t.offsets
         nr, nc, npt = t.R.shape[0] // 17, t.O.shape[0], t.Q.shape[0]
         grid = getattr(t, "smooth_grid", None)
@@ -853,15 +852,15 @@ def job_floats(groups, X, sizes, progress=None):
                 bar.update(k)
                 continue
             X0 = X[R[:, 0]]
-            rel = (X[R] - X0[:, None, :]).transpose(1, 0, 2).reshape(N, 3 * k)  # (N, k * 3)
+            rel = X[R] - X0[:, None, :]  # (k, N, 3); the operators applied job by job (stacked products
+            # write the (job, row, xyz) layout of the table directly: no transposed copies)
             if nr:
-                a = (t.R @ rel).reshape(nr, 17, k, 3).transpose(2, 0, 1, 3)
+                a = np.matmul(t.R, rel).reshape(k, nr, 17, 3)
                 a[:, :, 16] += X0[:, None, :]
                 nets[o_reg + nr * lo:o_reg + nr * (lo + k)] = a.reshape(-1, 17, 3)
             if nc:
-                ring[o_pts + npt * lo:o_pts + npt * (lo + k)] = \
-                    (t.Q @ rel).reshape(npt, k, 3).transpose(1, 0, 2).reshape(-1, 3)
-                b = (t.O @ rel).reshape(nc, k, 3).transpose(1, 0, 2)
+                np.matmul(t.Q, rel, out=ring[o_pts + npt * lo:o_pts + npt * (lo + k)].reshape(k, npt, 3))
+                b = np.matmul(t.O, rel)
                 b += X0[:, None, :]
                 origin[o_cor + nc * lo:o_cor + nc * (lo + k)] = b.reshape(-1, 3)
             bar.update(k)
