@@ -410,8 +410,14 @@ class _Builder:
         if t is None:
             t = self.templates[tkey] = make()
             t.finish()
-        t.jobs.extend(jobs)
-        t.rings.extend(rings)
+        if isinstance(jobs, np.ndarray):  # whole blocks of jobs: as bytes (extend would iterate in Python)
+            t.jobs.frombytes(np.ascontiguousarray(jobs, dtype=np.int64).tobytes())
+        else:
+            t.jobs.extend(jobs)
+        if isinstance(rings, np.ndarray):
+            t.rings.frombytes(np.ascontiguousarray(rings, dtype=np.intc).tobytes())
+        else:
+            t.rings.extend(rings)
 
     def classify(self, cx, X, jobs, vmap=None):
         """Classify the quads ``jobs`` (``[(g, frame, base), ...]`` or :class:`_Jobs`) of ``cx`` (a
@@ -531,7 +537,7 @@ class _Builder:
                 tkey, make = ("corner", key, rr, frame), functools.partial(self._corner_template, key, rr, frame, base)
             else:
                 tkey, make = ("face", key, frame), functools.partial(self._face_template, key, frame, base)
-            self._register(tkey, make, (j0 + idx[mem]).tolist(), rings[mem, :n].ravel())
+            self._register(tkey, make, j0 + idx[mem], rings[mem, :n].ravel())
         return (np.concatenate(retry) if retry else np.zeros(0, dtype=np.int64)), np.concatenate(fallback)
 
     def smooth_regular_patches(self, cx, X, jobs):
@@ -572,7 +578,7 @@ class _Builder:
             rows = np.flatnonzero(fid == k)
             if rows.size:
                 ring = grid[rows][:, _net_permutation(f)]  # the grid in the base orientation
-                self._register(("smooth", f), functools.partial(_smooth_template, f), (j0 + idx[rows]).tolist(),
+                self._register(("smooth", f), functools.partial(_smooth_template, f), j0 + idx[rows],
                                ring.astype(np.int32).ravel())
         return sel
 
