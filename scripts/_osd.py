@@ -69,6 +69,30 @@ def load():
     return lib
 
 
+DRIVER = Path(__file__).with_name("osd_setup_driver.cpp")
+
+
+def setup_driver():
+    """Path of the compiled ``scripts/osd_setup_driver.cpp`` (Far's setup as a program: a fresh process
+    reading an OBJ file), built once per source version into the temp folder; RuntimeError without
+    OpenSubdiv or g++."""
+    why = why_unavailable()
+    if why:
+        raise RuntimeError(why)
+    code = DRIVER.read_bytes()
+    d = Path(tempfile.gettempdir()) / "ccproof_osd_capi"
+    d.mkdir(exist_ok=True)
+    exe = d / f"osd_setup_driver-{hashlib.sha256(code).hexdigest()[:16]}"
+    if not exe.exists():
+        tmp = exe.with_suffix(".tmp")
+        r = subprocess.run(["g++", "-O2", "-std=c++14", str(DRIVER), "-o", str(tmp), "-losdCPU"],
+                           capture_output=True, text=True)
+        if r.returncode != 0:
+            raise RuntimeError(f"compiling {DRIVER.name} failed:\n{r.stderr[-2000:]}")
+        tmp.replace(exe)
+    return exe
+
+
 def _ptr(a, typ):
     return a.ctypes.data_as(ctypes.POINTER(typ))
 

@@ -29,8 +29,11 @@ Measures, in one run:
 The bunny mesh is read from the repository's test data (``tests/data/meshes/bunny_quads.obj``).
 
 Usage: python scripts/bench_evaluate.py [--points 1000000] [--memory-points 10000000] [--quick] [--osd-only]
-[--setup-only]  (``--setup-only``: only the setup times of part 5, ours and OpenSubdiv's; ours as the
-first build in a fresh process with the per-configuration disk cache empty and filled, and in this process)
+[--setup-only]  (``--setup-only``: only the setup in a fresh process, imports and reading the OBJ included:
+ours, ``python -c`` with the per-configuration disk cache filled and empty, against OpenSubdiv Far's setup as
+a program of its own, ``scripts/osd_setup_driver.cpp``, reading the same OBJ; every process timed from start
+to exit, in turn round by round; and the floors of a Python process: ``python -c pass``, numpy's import,
+ours)
 """
 
 from __future__ import annotations
@@ -200,7 +203,7 @@ def _stats(x):
     return float(x.min()), float(np.median(x)), float(x.max())
 
 
-def osd_side_by_side(n, rng, quick=False, setup_only=False, rounds=7):
+def osd_side_by_side(n, rng, quick=False, rounds=7):
     """OpenSubdiv Far and Bfr in this process (scripts/_osd.py, ctypes), alternating with ours round by
     round on one pinned CPU; returns the table rows."""
     print("\n5. side by side with OpenSubdiv in this process (positions + first derivatives)")
@@ -216,7 +219,7 @@ def osd_side_by_side(n, rng, quick=False, setup_only=False, rounds=7):
     threads = len(os.sched_getaffinity(0))
     rounds = 2 if quick else rounds
     compute = memory = None
-    if _has_numba() and not setup_only:
+    if _has_numba():
         compute, memory, bw = hardware_bounds(quick)
         print(f"   this machine, one thread: ideal compiled work {compute / 1e6:.1f} M points/s (compute bound); "
               f"read bandwidth {bw / 2**30:.1f} GiB/s / {BYTES_PER_POINT} B = {memory / 1e6:.1f} M points/s "
@@ -233,15 +236,10 @@ def osd_side_by_side(n, rng, quick=False, setup_only=False, rounds=7):
         st, _ = interleaved({"far": lambda m=mesh: _osd.Evaluator(lib, "far", m).close(),
                              "bfr": lambda m=mesh: _osd.Evaluator(lib, "bfr", m, approx=10).close(),
                              "ours": lambda m=mesh: limit_surface(m)}, 3 if quick else rounds)
-        cold, warm = fresh_process_setups(path)
         far_setup = min(st["far"])
-        print(f"   {label}: setup far {far_setup * 1e3:.1f} ms, bfr {min(st['bfr']) * 1e3:.1f} ms, ours in this "
-              f"process {min(st['ours']) * 1e3:.1f} ms ({min(st['ours']) / far_setup:.1f}x far); ours in a fresh "
-              f"process (imports excluded): disk cache filled {warm * 1e3:.0f} ms ({warm / far_setup:.1f}x), "
-              f"empty {cold * 1e3:.0f} ms ({cold / far_setup:.1f}x)")
-        if setup_only:
-            rows.append((label, far_setup, min(st["ours"]), cold, warm))
-            continue
+        print(f"   {label}: setup in this process (mesh read, imports done): far {far_setup * 1e3:.1f} ms, bfr "
+              f"{min(st['bfr']) * 1e3:.1f} ms, ours {min(st['ours']) * 1e3:.1f} ms "
+              f"({min(st['ours']) / far_setup:.1f}x far; in a fresh process: --setup-only)")
         S = limit_surface(mesh)
         far = _osd.Evaluator(lib, "far", mesh)
         bfr = _osd.Evaluator(lib, "bfr", mesh, approx=10)
@@ -297,21 +295,86 @@ def osd_side_by_side(n, rng, quick=False, setup_only=False, rounds=7):
     return rows
 
 
-def fresh_process_setups(path):
-    """Setup seconds of the first build in a fresh process (imports excluded), with the per-configuration
-    disk cache empty (a new folder: every exact layer table computed) and then filled by that run."""
+#: our side of the fresh-process setup: what ``ccproof eval`` does before evaluating (imports, reading the
+#: file, building the patch table), in a ``python -c`` of its own
+_OURS_SETUP = ("import sys; from ccproof.mesh.io import read_mesh; "
+               "from ccproof.evaluate import natural_limit_surface as ls; ls(read_mesh(sys.argv[1]), progress=False)")
+_FLOORS = {"python -c pass": "pass", "python -c 'import numpy'": "import numpy",
+           "our imports": "from ccproof.mesh.io import read_mesh; from ccproof.evaluate import natural_limit_surface"}
+
+
+def fresh_process_setup(rounds=7):
+    """Setup in a fresh process, imports included (our modules' bytecode written once, as an installed package
+    has it): ours (``python -c``: imports, read the OBJ, build) with the
+    per-configuration disk cache filled and empty (a new folder every round) against OpenSubdiv Far's driver
+    (``scripts/osd_setup_driver.cpp``: a program that reads the same OBJ, refines adaptively to level 10 and
+    builds the patch table, its local points and the patch map), each process timed end to end from here
+    (start to exit), round by round in turn; ratios per round. Also the floors of a Python process."""
     import os
     import subprocess
     import tempfile
 
-    code = ("import sys, time; from ccproof.mesh.io import read_mesh; "
-            "from ccproof.evaluate import natural_limit_surface as ls; m = read_mesh(sys.argv[1]); "
-            "w0 = time.perf_counter(); ls(m); print(time.perf_counter() - w0)")
-    with tempfile.TemporaryDirectory() as d:
-        env = dict(os.environ, CCPROOF_CACHE=d)
-        out = [float(subprocess.run([sys.executable, "-c", code, str(path)], env=env, check=True,
-                                    capture_output=True, text=True).stdout) for _ in range(2)]
-    return out[0], out[1]
+    import _osd
+
+    print("\nsetup in a fresh process, imports and reading the OBJ included (ours: python -c; Far: "
+          "scripts/osd_setup_driver.cpp), each timed from start to exit")
+    why = _osd.why_unavailable()
+    if why:
+        print(f"   {why}. Skipped.")
+        return None
+    exe = str(_osd.setup_driver())
+    env = dict(os.environ, PYTHONPATH=str(REPO) + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    # our modules' bytecode, as an installed package has it (pip compiles on install): without it every
+    # fresh process compiles our sources again (~0.1 s); the first run below writes __pycache__
+    env.pop("PYTHONDONTWRITEBYTECODE", None)
+
+    def run(cmd, cache=None):
+        e = env if cache is None else dict(env, CCPROOF_CACHE=cache)
+        w0 = time.perf_counter()
+        r = subprocess.run(cmd, env=e, capture_output=True, text=True)
+        dt = time.perf_counter() - w0
+        if r.returncode != 0:
+            raise RuntimeError(f"{cmd[0]} failed: {r.stderr[-2000:]}")
+        return dt, r.stdout
+
+    rows = []
+    with tempfile.TemporaryDirectory() as filled, tempfile.TemporaryDirectory() as root:
+        for label, path in SHAPES:
+            # the driver reads the OBJ itself: check that it sees the mesh of the in-process C API
+            mesh = read_mesh(path)
+            _, out = run([exe, str(path), "0", "0.3", "0.6"])
+            n_ptex, _, *p = out.split()
+            lib = _osd.load()
+            ref = _osd.Evaluator(lib, "far", mesh)
+            P = ref.evaluate(np.array([0]), np.array([0.3]), np.array([0.6]))[0][0]
+            ref.close()
+            ok = int(n_ptex) == mesh.n_ptex and np.abs(np.array(p, dtype=float) - P).max() <= 1e-12
+            if not ok:
+                raise RuntimeError(f"osd_setup_driver reads {path.name} differently from the C API: {out}")
+            run([sys.executable, "-c", _OURS_SETUP, str(path)], filled)  # fills the cache (and __pycache__)
+            folders = iter(range(1 << 30))
+
+            def empty(path=path, folders=folders, label=label):
+                d = os.path.join(root, f"{label}-{next(folders)}")  # a new, empty cache every round
+                return run([sys.executable, "-c", _OURS_SETUP, str(path)], d)
+
+            cases = {"far": lambda path=path: run([exe, str(path), "0", "0.5", "0.5"]),
+                     "filled": lambda path=path: run([sys.executable, "-c", _OURS_SETUP, str(path)], filled),
+                     "empty": empty}
+            times, load = interleaved(cases, rounds)
+            far = np.asarray(times["far"])
+            r_f = _stats(np.asarray(times["filled"]) / far)
+            r_e = _stats(np.asarray(times["empty"]) / far)
+            print(f"   {label} ({mesh.n_faces} faces, {mesh.n_ptex} ptex faces); {rounds} rounds, load "
+                  f"{min(load):.2f}-{max(load):.2f}: far {_stats(far)[1] * 1e3:.1f} ms (median); ours, disk cache "
+                  f"filled {_stats(times['filled'])[1] * 1e3:.0f} ms, empty {_stats(times['empty'])[1] * 1e3:.0f} ms; "
+                  f"ours / far: filled median {r_f[1]:.1f}x (min {r_f[0]:.1f}, max {r_f[2]:.1f}), empty median "
+                  f"{r_e[1]:.1f}x (min {r_e[0]:.1f}, max {r_e[2]:.1f})")
+            rows.append((label, _stats(far), r_f, r_e))
+    fl, load = interleaved({k: (lambda c=c: run([sys.executable, "-c", c])) for k, c in _FLOORS.items()}, rounds)
+    print("   floors of a Python process (median): " + ", ".join(f"{k} {_stats(v)[1] * 1e3:.0f} ms"
+                                                             for k, v in fl.items()))
+    return rows
 
 
 def machine_ceiling(threads, quick=False):
@@ -437,7 +500,7 @@ def main(argv=None):
     ap.add_argument("--setup-only", action="store_true", help="only the setup times of part 5")
     args = ap.parse_args(argv)
     if args.setup_only:
-        osd_side_by_side(0, np.random.default_rng(2024), setup_only=True)
+        fresh_process_setup(args.rounds)
         return 0
     if args.osd_only:
         osd_side_by_side(args.osd_points if not args.quick else 20_000, np.random.default_rng(2024), args.quick,

@@ -126,7 +126,7 @@ def main(argv=None):
         return
 
     from ccproof.evaluate._numba_kernel import evaluate_points
-    from ccproof.reparam import limit_surface
+    from ccproof.reparam import corner_valence, limit_surface
     from ccproof.reparam.blend import face_map
 
     if args.backend == "numba" and evaluate_points is None:
@@ -140,7 +140,7 @@ def main(argv=None):
     if args.sampling == "uniform":
         f = rng.integers(0, mesh.n_faces, n)
     else:
-        pool = np.flatnonzero(S.corner_valence.any(axis=1))
+        pool = np.flatnonzero(corner_valence(mesh).any(axis=1))
         f = pool[rng.integers(0, pool.size, n)]
     u, v = rng.random(n), rng.random(n)
     names = ("natural", "vanishing", "characteristic")
@@ -149,7 +149,8 @@ def main(argv=None):
         a = time.perf_counter()
         S.evaluate(f, u, v, args.derivatives, parameterization=p)
         warm[p] = time.perf_counter() - a
-    act = {p: float(face_map(S.corner_valence[f], u, v, p, S.alpha)["active"].mean()) for p in names[1:]}
+    cv, alpha = corner_valence(mesh)[f], S.parameterizations["vanishing"].alphas(S)
+    act = {p: float(face_map(cv, u, v, p, alpha)["active"].mean()) for p in names[1:]}
     times = {p: [] for p in names}
     for _ in range(args.rounds):
         for p in names:

@@ -14,8 +14,7 @@ from numpy.typing import NDArray
 import ccproof
 from ccproof.apps.arap.core import MethodResult
 from ccproof.apps.dynamics.fit import FitResult
-from ccproof.evaluate.tagged import TaggedLimitSurface
-from ccproof.reparam.surface import ReparamLimitSurface
+from ccproof.evaluate.surface import LimitSurface
 from ccproof.tables.numeric import CharacteristicTable
 
 F64 = NDArray[np.float64]
@@ -33,8 +32,8 @@ def _public_api_types(quad: ccproof.QuadMesh, poly: ccproof.PolyMesh) -> None:
     assert_type(ccproof.characteristic_map(5, [0.5], [0.25]), tuple[F64, F64])
     assert_type(ccproof.characteristic_map(5, [0.5], [0.25], jacobian=True), tuple[F64, F64, F64])
     assert_type(ccproof.inverse_characteristic_map(5, [0.5], [0.25]), tuple[F64, F64])
-    assert_type(ccproof.limit_surface(quad), ReparamLimitSurface)
-    assert_type(ccproof.limit_surface("mesh.obj", alpha=2.5), ReparamLimitSurface)
-    assert_type(ccproof.limit_surface(poly), TaggedLimitSurface)
+    assert_type(ccproof.limit_surface(quad), LimitSurface)
+    assert_type(ccproof.limit_surface("mesh.obj", alpha=2.5), LimitSurface)
+    assert_type(ccproof.limit_surface(poly), LimitSurface)
     assert_type(ccproof.parameterize(quad, variant="boundary"), MethodResult)
     assert_type(ccproof.fit_points(np.zeros((10, 3)), levels=0), FitResult)

@@ -5,8 +5,9 @@ triangles or n-gons (any format of :func:`ccproof.mesh.io.read_mesh`: OBJ, PLY, 
 subdivided once with the Catmull-Clark rules first: every n-gon becomes n quads and the limit surface is
 unchanged (it is the step every Catmull-Clark evaluator takes on such a mesh anyway). Vertices that no face
 uses (common in scans) are dropped, the others keep their order. Meshes with OpenSubdiv tags (creases,
-corners, holes, boundary modes) are refused: the applications use the untagged
-rules.
+corners, holes, boundary modes) are refused: the applications use the untagged rules; so are non-manifold
+meshes (OpenSubdiv makes their non-manifold edges and vertices infinitely sharp, which the untagged rules
+of an all-quad control mesh cannot express; ``ccproof eval`` evaluates them).
 """
 
 from __future__ import annotations
@@ -41,7 +42,7 @@ def read_control_mesh(path: str | os.PathLike[str]) -> tuple[QuadMesh, np.ndarra
     Raises
     ------
     MeshError
-        What :func:`~ccproof.mesh.io.read_mesh` raises, or a mesh with OpenSubdiv tags.
+        What :func:`~ccproof.mesh.io.read_mesh` raises, a mesh with OpenSubdiv tags, or a non-manifold mesh.
 
     Examples
     --------
@@ -76,20 +77,25 @@ def read_control_mesh(path: str | os.PathLike[str]) -> tuple[QuadMesh, np.ndarra
     if poly.has_tags:
         raise MeshError(f"{os.fspath(path)}: OpenSubdiv tags (creases, corners, holes or boundary modes) are not "
                         "supported here: the applications use the untagged Catmull-Clark rules")
+    if not poly.is_manifold:
+        e, v = poly.nonmanifold_edges, np.flatnonzero(poly.is_nonmanifold_vertex)
+        what = f"non-manifold edge ({e[0, 0]}, {e[0, 1]})" if len(e) else f"non-manifold vertex {int(v[0])}"
+        raise MeshError(f"{os.fspath(path)}: {what}: non-manifold meshes are not supported here (OpenSubdiv makes "
+                        "them infinitely sharp, which the applications' untagged rules cannot express); "
+                        "`ccproof eval` evaluates them")
     sizes = np.asarray(poly.sizes, dtype=np.int64)
-    idx = np.concatenate([np.asarray(p, dtype=np.int64) for p in poly.polygons])
+    idx = np.asarray(poly.indices, dtype=np.int64)
     used = np.unique(idx)
     if used.size < poly.n_vertices:  # unused vertices (a subdivision step cannot even place them): dropped
         from ccproof.mesh.polymesh import PolyMesh
 
         new = np.full(poly.n_vertices, -1, dtype=np.int64)
         new[used] = np.arange(used.size)
-        polys = np.split(new[idx], np.cumsum(sizes)[:-1])
-        poly = PolyMesh(np.asarray(poly.vertices)[used], [p.tolist() for p in polys])
+        poly = PolyMesh(np.asarray(poly.vertices)[used], new[idx], sizes=sizes)
     if poly.is_all_quads:
-        return QuadMesh(poly.vertices, np.asarray(poly.polygons, dtype=np.int64).reshape(-1, 4)), None
-    fine, _ = poly.refine()
-    V, F = np.asarray(fine.vertices, dtype=np.float64), np.asarray(fine.polygons, dtype=np.int64).reshape(-1, 4)
+        return QuadMesh(poly.vertices, poly.indices.reshape(-1, 4)), None
+    fine, _ = poly.refine(operator=False)
+    V, F = np.asarray(fine.vertices, dtype=np.float64), fine.indices.reshape(-1, 4)
     return QuadMesh(V, F), sizes
 
 

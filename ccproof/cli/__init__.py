@@ -18,7 +18,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "certify": ("ccproof.cli.certify", "prove injectivity for a valence and write a certificate"),
     "verify": ("ccproof.cli.verify", "re-check certificates with the trusted verifier"),
     "report": ("ccproof.cli.report", "table of every certified valence"),
-    "eval": ("ccproof.cli.eval", "evaluate the limit surface of a quad mesh (natural or bmz04 parameterizations)"),
+    "eval": ("ccproof.cli.eval", "evaluate the limit surface of a mesh (natural; bmz04 ones on quad meshes)"),
     "project": ("ccproof.cli.project", "nearest points of the limit surface to 3-D points (closest points)"),
     "invert": ("ccproof.cli.invert", "invert the characteristic map at a point"),
     "arap": ("ccproof.cli.arap", "ARAP parameterization of a subdivision surface (hsh10)"),

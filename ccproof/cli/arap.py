@@ -25,7 +25,8 @@ at most --control-max-faces faces); it prints the folds and the distortion such 
 
 Input: any mesh `ccproof eval` reads (OBJ, PLY, OFF, STL, VTK, ...). Triangles and n-gons are
 subdivided once with Catmull-Clark first (n quads per n-gon, the same limit surface); --charts labels
-then name the file's faces, each label carried to its quads.
+then name the file's faces, each label carried to its quads. Unused vertices are dropped; OpenSubdiv
+tags and non-manifold edges or vertices are refused by name (untagged rules only).
 
 Scale: charts are processed one at a time; the peak memory is estimated first and a run above
 --max-memory (default 2 GB) stops with an error naming the options that lower it. --refine R (default:

@@ -6,7 +6,8 @@
 
 POINTS: .xyz (x y z per line), .ply (vertex x, y, z; ASCII or binary), .obj or the vertices of any mesh
 file eval reads. --init: any mesh eval reads; triangles and n-gons are subdivided once (Catmull-Clark) to
-quads first (the same limit surface). The model
+quads first (the same limit surface); unused vertices are dropped, OpenSubdiv tags and non-manifold meshes
+refused by name. The model
 starts as the paper's 98-vertex mesh (the cube subdivided twice) inside the data, evolves under data
 springs (every point pulls its nearest limit-surface point) with the massless implicit scheme (32) to
 equilibrium (the relative changes of the total energy and of the mean data -> surface distance over two

@@ -288,8 +288,17 @@ class _Template:
         self.reg = self.cor = None
 
 
-def _ring_walks():
-    """The compiled ring walk, or None without numba."""
+#: jobs from which the compiled ring walk pays for loading numba and its cached kernel (~1 to 1.5 s in a
+#: fresh process, against ~0.15 ms per job for the Python walk); below, the Python walk, unless the
+#: compiled kernels are loaded already
+COMPILED_WALK_MIN = 8192
+
+
+def _ring_walks(n_jobs):
+    """The compiled ring walk for ``n_jobs`` rings, or None: the Python walk (numba not installed, or
+    fewer than :data:`COMPILED_WALK_MIN` jobs in a process that has not loaded the kernels)."""
+    if n_jobs < COMPILED_WALK_MIN and "ccproof.evaluate._numba_kernel" not in sys.modules:
+        return None
     from ccproof.evaluate._numba_kernel import ring_walks
 
     return ring_walks
@@ -401,8 +410,14 @@ class _Builder:
         if t is None:
             t = self.templates[tkey] = make()
             t.finish()
-        t.jobs.extend(jobs)
-        t.rings.extend(rings)
+        if isinstance(jobs, np.ndarray):  # whole blocks of jobs: as bytes (extend would iterate in Python)
+            t.jobs.frombytes(np.ascontiguousarray(jobs, dtype=np.int64).tobytes())
+        else:
+            t.jobs.extend(jobs)
+        if isinstance(rings, np.ndarray):
+            t.rings.frombytes(np.ascontiguousarray(rings, dtype=np.intc).tobytes())
+        else:
+            t.rings.extend(rings)
 
     def classify(self, cx, X, jobs, vmap=None):
         """Classify the quads ``jobs`` (``[(g, frame, base), ...]`` or :class:`_Jobs`) of ``cx`` (a
@@ -434,7 +449,7 @@ class _Builder:
         single = np.where(quad & (corners.sum(axis=1) == 3), np.argmin(corners, axis=1), -1)
         todo = np.flatnonzero(~done)
         if isinstance(cx, QuadHalfEdges):
-            if cx.manifold and _ring_walks() is not None:
+            if cx.manifold and _ring_walks(todo.size) is not None:
                 return self._walk_all(cx, jobs, j0, todo, single[todo])
             from ccproof.mesh.rules import Complex
 
@@ -456,7 +471,7 @@ class _Builder:
         :func:`ccproof.evaluate.local.canonical_ring`), grouped by the hash of their faces, each
         group checked face by face against its first ring and registered with the key of that ring
         (untagged: the key is the faces and the options)."""
-        walks = _ring_walks()
+        walks = _ring_walks(todo.size)
         opts = he.options.key()
         pos = np.full(he.n_vertices, -1, dtype=np.int64)
         seen = np.zeros(he.faces.shape[0], dtype=np.bool_)
@@ -522,7 +537,7 @@ class _Builder:
                 tkey, make = ("corner", key, rr, frame), functools.partial(self._corner_template, key, rr, frame, base)
             else:
                 tkey, make = ("face", key, frame), functools.partial(self._face_template, key, frame, base)
-            self._register(tkey, make, (j0 + idx[mem]).tolist(), rings[mem, :n].ravel())
+            self._register(tkey, make, j0 + idx[mem], rings[mem, :n].ravel())
         return (np.concatenate(retry) if retry else np.zeros(0, dtype=np.int64)), np.concatenate(fallback)
 
     def smooth_regular_patches(self, cx, X, jobs):
@@ -563,7 +578,7 @@ class _Builder:
             rows = np.flatnonzero(fid == k)
             if rows.size:
                 ring = grid[rows][:, _net_permutation(f)]  # the grid in the base orientation
-                self._register(("smooth", f), functools.partial(_smooth_template, f), (j0 + idx[rows]).tolist(),
+                self._register(("smooth", f), functools.partial(_smooth_template, f), j0 + idx[rows],
                                ring.astype(np.int32).ravel())
         return sel
 
@@ -812,7 +827,7 @@ def job_floats(groups, X, sizes, progress=None):
     """The float data of every job from the positions ``X`` of the complex its rings index.
 
     Per template group, in blocks of jobs: ``rel = X[ring] - X[ring[0]]`` (J, N, 3), then the
-    template's operators applied to it (one matrix product per block); the affine rows (patch
+    template's operators applied to it (one stacked matrix product per block); the affine rows (patch
     origins, corner limit points) add ``X[ring[0]]`` back.
 
     Returns
@@ -828,7 +843,6 @@ def job_floats(groups, X, sizes, progress=None):
     ring = np.empty((n_pts, 3))
     bar = _progress(progress, sum(g[1].size for g in groups), "patch data")
     for t, jobs, rings in groups:
-        N = t.n
         o_reg, o_cor, o_pts = t.offsets
         nr, nc, npt = t.R.shape[0] // 17, t.O.shape[0], t.Q.shape[0]
         grid = getattr(t, "smooth_grid", None)
@@ -844,15 +858,15 @@ def job_floats(groups, X, sizes, progress=None):
                 bar.update(k)
                 continue
             X0 = X[R[:, 0]]
-            rel = (X[R] - X0[:, None, :]).transpose(1, 0, 2).reshape(N, 3 * k)  # (N, k * 3)
+            rel = X[R] - X0[:, None, :]  # (k, N, 3); the operators applied job by job (stacked products
+            # write the (job, row, xyz) layout of the table directly: no transposed copies)
             if nr:
-                a = (t.R @ rel).reshape(nr, 17, k, 3).transpose(2, 0, 1, 3)
+                a = np.matmul(t.R, rel).reshape(k, nr, 17, 3)
                 a[:, :, 16] += X0[:, None, :]
                 nets[o_reg + nr * lo:o_reg + nr * (lo + k)] = a.reshape(-1, 17, 3)
             if nc:
-                ring[o_pts + npt * lo:o_pts + npt * (lo + k)] = \
-                    (t.Q @ rel).reshape(npt, k, 3).transpose(1, 0, 2).reshape(-1, 3)
-                b = (t.O @ rel).reshape(nc, k, 3).transpose(1, 0, 2)
+                np.matmul(t.Q, rel, out=ring[o_pts + npt * lo:o_pts + npt * (lo + k)].reshape(k, npt, 3))
+                b = np.matmul(t.O, rel)
                 b += X0[:, None, :]
                 origin[o_cor + nc * lo:o_cor + nc * (lo + k)] = b.reshape(-1, 3)
             bar.update(k)

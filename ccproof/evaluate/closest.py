@@ -59,6 +59,7 @@ import numpy as np
 
 from ccproof.errors import CCProofError
 from ccproof.evaluate import _bvh
+from ccproof.evaluate._parallel import in_blocks, threads_for
 
 __all__ = ["ClosestPoints", "ClosestPointFinder", "closest_points", "parameter_faces"]
 
@@ -85,7 +86,7 @@ def parameter_faces(surface):
 
     Parameters
     ----------
-    surface : LimitSurface or TaggedLimitSurface
+    surface : LimitSurface
         Anything with ``n_ptex_faces`` / ``n_param_faces``, or a ``mesh`` with ``n_ptex_faces``,
         ``n_ptex`` or ``n_faces``.
 
@@ -320,8 +321,6 @@ def newton(surface, X, face, u, v, max_iter=MAX_ITER, *, backend=None, threads=N
 
 def _newton_compiled(surface, kernel, X, face, u, v, max_iter, threads):
     """:func:`newton` by the compiled descent (points checked first: the kernel trusts its input)."""
-    from ccproof.evaluate.surface import _in_blocks, _threads
-
     face, u, v = surface._check(face, u, v)
     X = np.ascontiguousarray(X.reshape(-1, 3) if X.size else np.zeros((0, 3)))
     if X.shape[0] != u.size:
@@ -333,7 +332,7 @@ def _newton_compiled(surface, kernel, X, face, u, v, max_iter, threads):
     def block(lo, hi):
         kernel(X[lo:hi], face[lo:hi], u[lo:hi], v[lo:hi], max_iter, MAX_HALVINGS, table, E[lo:hi])
 
-    _in_blocks(block, n, _threads(threads, n * 16), 2048)  # a descent costs some 10 to 30 evaluations
+    in_blocks(block, n, threads_for(threads, n * 16), 2048)  # a descent costs some 10 to 30 evaluations
     return u, v, E
 
 
@@ -591,7 +590,7 @@ def closest_points(surface, X, *, cells=CELLS, cover=None, faces=None, finder=No
 
     Parameters
     ----------
-    surface : LimitSurface (or an OBJ path / QuadMesh, passed to :func:`~ccproof.evaluate.limit_surface`)
+    surface : LimitSurface
     X : array_like, shape (n, 3)
     cells, cover : int
         Cells per face side of the search structure, covering radius of a descent in cells
@@ -617,8 +616,7 @@ def closest_points(surface, X, *, cells=CELLS, cover=None, faces=None, finder=No
     """
     if finder is None:
         if not hasattr(surface, "evaluate"):
-            from ccproof.evaluate.surface import limit_surface
-
-            surface = limit_surface(surface)
+            raise CCProofError(f"closest_points takes a limit surface (ccproof.limit_surface(mesh)), "
+                               f"not {type(surface).__name__}")
         finder = ClosestPointFinder(surface, cells=cells, cover=cover, faces=faces)
     return finder.query(X)

@@ -33,23 +33,20 @@ from __future__ import annotations
 import numpy as np
 
 from ccproof.errors import CCProofError
-from ccproof.evaluate._table import (  # noqa: F401 - _child_frame, _compose, _domain: for tagged.py
+from ccproof.evaluate._parallel import in_blocks, threads_for
+from ccproof.evaluate._table import (
     _CORNER,
     _REGULAR,
     _SPLIT,
-    MAX_DEPTH,
-    MAX_SEMI_DEPTH,
     QuadHalfEdges,
     _Builder,
-    _child_frame,
-    _compose,
-    _domain,
     _Jobs,
     job_floats,
     layer0_nets,
 )
 from ccproof.evaluate.bspline import bspline_basis
 from ccproof.mesh import QuadMesh, limit_normals, limit_positions
+from ccproof.mesh.polymesh import PolyMesh
 from ccproof.mesh.rules import Options
 
 __all__ = ["natural_limit_surface", "LimitSurface"]
@@ -62,18 +59,27 @@ _KEYS = {0: ("P",), 1: ("P", "Pu", "Pv"), 2: ("P", "Pu", "Pv", "Puu", "Puv", "Pv
 
 
 class LimitSurface:
-    """Exact evaluator of the limit surface of a quad mesh (natural parameterization, bmz04 section 2).
+    """Exact evaluator of the limit surface of a mesh (natural parameterization, bmz04 section 2).
 
-    Build it with :func:`natural_limit_surface`.
+    The one evaluator: quad meshes and tagged polygon meshes share its table, locator and kernels;
+    other parameterizations are values passed to :meth:`evaluate`. Build it with
+    :func:`ccproof.limit_surface` or :func:`natural_limit_surface`.
 
     Parameters
     ----------
-    mesh : QuadMesh
-        m faces, n vertices ``(n, 3) float64``.
+    mesh : QuadMesh or PolyMesh
+        A QuadMesh: m faces, n vertices ``(n, 3) float64``, ``face`` = face index. A PolyMesh
+        (triangles, n-gons, OpenSubdiv's tags, non-manifold edges and vertices): ``face`` = ptex face
+        index (OpenSubdiv's ``Far::PtexIndices``, :meth:`PolyMesh.ptex_of`), derivatives with respect
+        to its (s, t); points on hole faces raise an error naming the point and the face
+        (:mod:`ccproof.evaluate.tagged`; docs/evaluate.md "Tagged polygon meshes").
 
     Attributes
     ----------
-    mesh : QuadMesh
+    mesh : QuadMesh or PolyMesh
+    parameterizations : dict of str -> parameterization value
+        The names :meth:`evaluate` accepts besides ``"natural"`` (empty here; ``ccproof.limit_surface``
+        records ``"vanishing"`` and ``"characteristic"``, :class:`ccproof.reparam.Parameterization`).
     n_patches : int
         Regular bicubic patches stored (17 x 3 floats each: net and origin).
     max_layers : int
@@ -97,11 +103,27 @@ class LimitSurface:
     >>> S = LimitSurface(cube())
     >>> S.evaluate([0], [0.0], [0.0])["P"].round(12).tolist(), S.split_depth
     ([[-0.5, -0.5, -0.5]], 1)
+
+    An infinitely sharp corner on vertex 0 of the cube is interpolated; the untagged corners keep
+    the smooth limit point (-1/2, -1/2, 1/2) of vertex 4 = (-1, -1, 1):
+
+    >>> c = cube()
+    >>> T = LimitSurface(PolyMesh(c.vertices, c.faces.tolist(), corners={0: 10}))
+    >>> T.evaluate([0, 1], [0.0, 0.0], [0.0, 0.0])["P"].round(12).tolist()
+    [[-1.0, -1.0, -1.0], [-0.5, -0.5, 0.5]]
     """
 
-
-    def __init__(self, mesh: QuadMesh, *, progress=None):
+    def __init__(self, mesh: QuadMesh | PolyMesh, *, progress=None):
         self.mesh = mesh
+        if isinstance(mesh, PolyMesh):
+            from ccproof.evaluate.tagged import build_tagged
+
+            b, top, self._hole_ptex, self._ptex_face = build_tagged(mesh, progress)
+            self._finish(b, top, self._hole_ptex, keep_rings=False)
+            return
+        if not isinstance(mesh, QuadMesh):
+            raise CCProofError(f"LimitSurface takes a QuadMesh or a PolyMesh, not {type(mesh).__name__}")
+        self._hole_ptex = self._ptex_face = None
         b = _Builder(progress=progress)
         cx = QuadHalfEdges(mesh.faces, mesh.n_vertices, Options())
         base = ((0.0, 0.0), (1.0, 0.0), (0.0, 1.0))
@@ -122,6 +144,7 @@ class LimitSurface:
             self._job_base = np.zeros(0, np.int64)
         self._vmap = b.vmap
         self._corner_normal = {}
+        self.parameterizations = {}
         T = self._table
         self.split_depth = T.split_depth
         self.n_patches = T.nets.shape[0]
@@ -148,7 +171,7 @@ class LimitSurface:
     @property
     def n_faces(self):
         """Number of (ptex) faces: the valid ``face`` ids of :meth:`evaluate`."""
-        return self.mesh.n_faces
+        return self.mesh.n_ptex if self._ptex_face is not None else self.mesh.n_faces
 
     # ------------------------------------------------------------------ input checks
     def _check(self, face_ids, u, v):
@@ -158,7 +181,9 @@ class LimitSurface:
         return f, u, v
 
     def _refused_faces(self):
-        """Per face id, whether evaluation refuses it (none here; holes in the tagged evaluator)."""
+        """Per face id, whether evaluation refuses it (the ptex faces of holes)."""
+        if self._hole_ptex is not None:
+            return self._hole_ptex
         return np.zeros(self.n_faces, dtype=np.bool_)
 
     def _check_shapes(self, face_ids, u, v):
@@ -194,6 +219,13 @@ class LimitSurface:
                 if bad.size:
                     i = lo + int(bad[0])
                     raise CCProofError(f"point {i}: {name} = {float(x[i])!r} is outside [0, 1]")
+        if self._hole_ptex is not None and self._hole_ptex.any():
+            bad = np.flatnonzero(self._hole_ptex[f])
+            if bad.size:
+                i = int(bad[0])
+                raise CCProofError(
+                    f"point {i}: ptex face {int(f[i])} (face {int(self._ptex_face[f[i]])}) is a hole"
+                )
         return f, u, v
 
     # ------------------------------------------------------------------ evaluation
@@ -302,8 +334,9 @@ class LimitSurface:
         t = np.clip((v - pv0) / h, 0.0, 1.0)
         return patch, s, t, 1.0 / h, N
 
-    def evaluate(self, face_ids, u, v, derivatives=1, *, chunk=CHUNK, out=None, backend=None, threads=None):
-        """Positions and derivatives of the limit surface at points (face, u, v).
+    def evaluate(self, face_ids, u, v, derivatives=1, *, parameterization="natural", chunk=CHUNK, out=None,
+                 backend=None, threads=None):
+        """Positions and derivatives of the limit surface at points (face, u, v), in a parameterization.
 
         Parameters
         ----------
@@ -311,6 +344,13 @@ class LimitSurface:
         u, v : array_like of float, shape (n,)
             Face parameters in [0, 1] (corner i of the face at (0,0), (1,0), (1,1), (0,1)).
         derivatives : int, 0, 1 or 2
+        parameterization : str or parameterization value
+            ``"natural"`` (default: bmz04 section 2, the evaluator's own); a name recorded in
+            :attr:`parameterizations` (``ccproof.limit_surface`` records ``"vanishing"`` and
+            ``"characteristic"`` on quad meshes); or a value such as
+            :class:`ccproof.reparam.Parameterization` (bmz04 section 4), which this method applies
+            around its natural evaluation by calling ``parameterization.evaluate_on(self, face, u, v,
+            derivatives, ...)`` with the checked points.
         chunk : int
             Points per chunk (memory beyond the outputs is about 1 kB per chunk point).
         out : dict of ndarray, optional
@@ -333,7 +373,8 @@ class LimitSurface:
         Raises
         ------
         CCProofError
-            Face id out of range or not an integer, (u, v) outside [0, 1]^2 or NaN (names the point).
+            Face id out of range or not an integer, (u, v) outside [0, 1]^2 or NaN (names the point);
+            a parameterization name this surface does not know.
 
         Examples
         --------
@@ -347,6 +388,10 @@ class LimitSurface:
         """
         if derivatives not in (0, 1, 2):
             raise CCProofError(f"derivatives must be 0, 1 or 2, got {derivatives!r}")
+        if not (isinstance(parameterization, str) and parameterization == "natural"):
+            p = self._parameterization(parameterization)
+            f, u, v = self._check(face_ids, u, v)
+            return p.evaluate_on(self, f, u, v, derivatives, chunk=chunk, out=out, backend=backend, threads=threads)
         kernel = _numba_kernel(backend)
         if kernel is None:
             f, u, v = self._check(face_ids, u, v)
@@ -366,7 +411,7 @@ class LimitSurface:
                               *[a[lo:hi] if a.shape[0] else a for a in arrs])
 
             # few blocks: each kernel call computes the corner nets it meets once (a cache per call)
-            bad = _in_blocks(block, n, _threads(threads, n), 32768, per_thread=4)
+            bad = in_blocks(block, n, threads_for(threads, n), 32768, per_thread=4)
             if max(bad) >= 0:
                 self._check_values(f, u, v)  # raises, naming the first bad point
                 raise CCProofError("internal error: the compiled kernel refused a point the checks accept")
@@ -376,14 +421,29 @@ class LimitSurface:
             self._eval_chunk(f[lo:hi], u[lo:hi], v[lo:hi], derivatives, {k: out[k][lo:hi] for k in keys})
         return out
 
+    def _parameterization(self, p):
+        """The parameterization value of ``evaluate(..., parameterization=p)``: a name looked up in
+        :attr:`parameterizations`, or a value with an ``evaluate_on`` method."""
+        if isinstance(p, str):
+            if p not in self.parameterizations:
+                known = ", ".join(["natural", *self.parameterizations])
+                hint = ("" if self.parameterizations else
+                        " (ccproof.limit_surface names vanishing and characteristic on quad meshes)")
+                raise CCProofError(f"unknown parameterization {p!r} for this surface; use one of {known}{hint}")
+            return self.parameterizations[p]
+        if not callable(getattr(p, "evaluate_on", None)):
+            raise CCProofError(f"parameterization must be a name or a value with an evaluate_on method "
+                               f"(ccproof.reparam.Parameterization), got {p!r}")
+        return p
+
     def _kernel_table(self):
         """The patch table as the compiled kernels take it (one :class:`PatchTable` argument)."""
         return self._table
 
     def _newton_kernel(self, backend=None):
-        """The compiled Newton descent of the closest points on this surface, or None: numpy backend,
-        or a subclass that evaluates another parameterization."""
-        if type(self).evaluate is not LimitSurface.evaluate or _numba_kernel(backend) is None:
+        """The compiled Newton descent of the closest points on this surface (natural parameterization),
+        or None: numpy backend."""
+        if _numba_kernel(backend) is None:
             return None
         from ccproof.evaluate._numba_kernel import newton_points
 
@@ -486,8 +546,22 @@ class LimitSurface:
 
     # ------------------------------------------------------------------ vertices
     def vertex_limits(self):
-        """Exact limit positions of the control vertices (masks), shape (n_vertices, 3)."""
-        return limit_positions(self.mesh)
+        """Exact limit positions of the control vertices, shape (n_vertices, 3).
+
+        Quad meshes: the masks of :func:`ccproof.mesh.limit_positions`. Tagged meshes: evaluated at
+        the ptex corner (0, 0) of a sub-face at the vertex, or at the quad corner (hole faces
+        included: holes do not change the surface of the other faces); NaN at unused vertices.
+        """
+        if self._ptex_face is None:
+            return limit_positions(self.mesh)
+        from ccproof.evaluate.tagged import vertex_corners
+
+        out = np.full((self.mesh.n_vertices, 3), np.nan)
+        f, u, v, verts = vertex_corners(self.mesh)
+        r = {"P": np.empty((f.size, 3))}
+        self._eval_chunk(f, u, v, 0, r)
+        out[verts] = r["P"]
+        return out
 
     def _corner_of_vertex(self):
         """Mesh vertex -> ``(job, vf)`` of one corner face whose irregular corner is that vertex."""
@@ -512,8 +586,19 @@ class LimitSurface:
         Eigen masks (:func:`ccproof.mesh.limit_normals`) at interior and regular boundary vertices;
         at other boundary vertices the tangent masks of the exact corner matrix
         (:attr:`ccproof.evaluate.local.CornerScheme.tangent_masks`), oriented like ``Pu x Pv``.
-        NaN where the tangent plane is not determined by the dominant eigenvectors.
+        NaN where the tangent plane is not determined by the dominant eigenvectors. Tagged meshes:
+        each vertex takes the normal (:meth:`normals`) of its first face corner that is not on a
+        hole; NaN where the tangent plane is not determined or the vertex has only hole faces.
         """
+        if self._ptex_face is not None:
+            from ccproof.evaluate.tagged import vertex_corners
+
+            out = np.full((self.mesh.n_vertices, 3), np.nan)
+            f, u, v, verts = vertex_corners(self.mesh)
+            keep = ~self._hole_ptex[f]
+            f, u, v, verts = f[keep][::-1], u[keep][::-1], v[keep][::-1], verts[keep][::-1]
+            out[verts] = self.normals(f, u, v)  # reversed: the first corner of a vertex is written last
+            return out
         Nn = limit_normals(self.mesh)
         bad = np.flatnonzero(np.isnan(Nn).any(axis=1))
         if not bad.size:
@@ -570,13 +655,14 @@ class LimitSurface:
         >>> np.round(T.evaluate([0], [0.0], [0.0])["P"][0], 12).tolist()
         [-1.0, -1.0, -1.0]
         """
-        if type(self) is not LimitSurface:
-            raise CCProofError(f"with_vertices is implemented for LimitSurface only, not {type(self).__name__}")
+        if self._ptex_face is not None:
+            raise CCProofError("with_vertices is implemented for the surfaces of quad meshes only, not of a PolyMesh")
         mesh = self.mesh.with_vertices(X)  # checks the shape and finiteness (MeshError)
         V = np.where(mesh.is_unused_vertex[:, None], 0.0, mesh.vertices)  # unused: any value, weight 0
         new = object.__new__(LimitSurface)
         new.__dict__.update(self.__dict__)
         new.mesh = mesh
+        new.parameterizations = dict(self.parameterizations)
         T = self._table
         nets, origin, ring = job_floats(self._groups, V, (T.nets.shape[0], T.origin.shape[0],
                                                                       T.ring.shape[0]), progress=False)
@@ -585,37 +671,6 @@ class LimitSurface:
             new._table = new._table._replace(hot=layer0_nets(new._table, self._groups))
         new._corner_normal = {}
         return new
-
-
-def _in_blocks(fn, n, nt, size, per_thread=16):
-    """``fn(lo, hi)`` over contiguous blocks of ``range(n)`` on ``nt`` threads; the results in block order.
-
-    More blocks than threads (about ``size`` points each, at most ``per_thread`` per thread), taken in
-    turn: the cost per point varies (points near irregular vertices go down the layers), so equal
-    shares would finish unequally. One thread: a single call on everything.
-    """
-    if nt <= 1:
-        return [fn(0, n)]
-    from concurrent.futures import ThreadPoolExecutor
-
-    nb = max(nt, min(per_thread * nt, n // size))
-    bounds = np.linspace(0, n, nb + 1).astype(np.int64)
-    with ThreadPoolExecutor(nt) as ex:
-        return list(ex.map(lambda i: fn(bounds[i], bounds[i + 1]), range(nb)))
-
-
-def _threads(threads, n):
-    """Number of threads for n points (see :meth:`LimitSurface.evaluate`)."""
-    import os
-
-    if threads is None:
-        if n < 1 << 17:
-            return 1
-        threads = int(os.environ.get("CCPROOF_THREADS", os.cpu_count() or 1))
-    threads = int(threads)
-    if threads < 1:
-        raise CCProofError(f"threads must be >= 1, got {threads}")
-    return max(1, min(threads, n // 1024 or 1))
 
 
 def _numba_kernel(backend):
@@ -644,13 +699,12 @@ def natural_limit_surface(mesh, *, progress=None):
     Parameters
     ----------
     mesh : QuadMesh, PolyMesh, or str or os.PathLike
-        A QuadMesh gives a :class:`LimitSurface`; a PolyMesh the tagged evaluator
-        (:class:`ccproof.evaluate.tagged.TaggedLimitSurface`, ``face`` = ptex face index; on
-        untagged all-quad meshes the same numbers as LimitSurface to round-off). A path is read by
+        A QuadMesh or a PolyMesh (tagged: ``face`` = ptex face index; on untagged all-quad meshes the
+        same numbers as the QuadMesh to round-off). A path is read by
         :func:`ccproof.mesh.io.read_mesh` (OBJ with OpenSubdiv tags, OFF, or any meshio format): an
         untagged manifold all-quad file gives a LimitSurface on a QuadMesh, anything else (triangles,
-        n-gons, creases, corners, holes, boundary modes, non-manifold edges and vertices) the
-        tagged evaluator.
+        n-gons, creases, corners, holes, boundary modes, non-manifold edges and vertices) one on the
+        PolyMesh.
     progress : bool, optional
         Show a progress bar (tqdm, on stderr) when the setup takes more than 2 s; default: when
         stderr is a terminal.
@@ -665,13 +719,8 @@ def natural_limit_surface(mesh, *, progress=None):
     >>> natural_limit_surface(torus()).evaluate([0], [0.5], [0.5])["P"].shape
     (1, 3)
     """
-    if isinstance(mesh, QuadMesh):
+    if isinstance(mesh, (QuadMesh, PolyMesh)):
         return LimitSurface(mesh, progress=progress)
-    from ccproof.evaluate.tagged import TaggedLimitSurface
-    from ccproof.mesh.polymesh import PolyMesh
-
-    if isinstance(mesh, PolyMesh):
-        return TaggedLimitSurface(mesh, progress=progress)
     from ccproof.mesh.io import read_mesh
 
     mesh = read_mesh(mesh)
@@ -679,7 +728,7 @@ def natural_limit_surface(mesh, *, progress=None):
         # a file holding an untagged manifold all-quad mesh: the QuadMesh evaluator, as before (same
         # numbers as the tagged one to round-off; ``S.mesh`` is a QuadMesh)
         return LimitSurface(mesh.to_quad_mesh(), progress=progress)
-    return TaggedLimitSurface(mesh, progress=progress)
+    return LimitSurface(mesh, progress=progress)
 
 
 #: former name, kept importable for ccproof/evaluate/cli.py, ccproof/reparam/cli.py and tests; the

@@ -69,9 +69,25 @@ def read_obj_polygons(path):
     >>> V.shape, polygons, lines
     ((5, 3), [[0, 1, 2, 3], [1, 4, 2]], [7, 8])
     """
+    V, idx, sizes, lines, _ = _read_obj_arrays(path)
+    off = np.r_[0, np.cumsum(sizes)].tolist()
+    flat = idx.tolist()
+    return V, [flat[a:b] for a, b in zip(off[:-1], off[1:])], lines.tolist()
+
+
+def _read_obj_arrays(path, tags=False):
+    """The vertices and polygons of an OBJ file as flat arrays (no Python object per face or vertex).
+
+    Returns ``V`` (n, 3) float64, ``indices`` (sum of sizes,) int64 (0-based), ``sizes`` (m,) int64,
+    ``lines`` (m,) int64 (the 1-based source line of each polygon) and, with ``tags``, the ``t`` lines
+    (:func:`_parse_tags`) of the same text, else None.
+    """
+    from array import array
+
     with open(os.fspath(path), encoding="utf-8", errors="replace") as fh:
         text = fh.read()
-    verts, polys, lines = [], [], []
+    verts, idx, sizes, lines = array("d"), array("q"), array("q"), array("q")
+    nv = 0
     for no, line in _logical_lines(text):
         s = line.split("#", 1)[0].split()
         if not s:
@@ -81,11 +97,11 @@ def read_obj_polygons(path):
             if len(s) < 4:
                 raise MeshError(f"{path}:{no}: vertex statement needs 3 coordinates: {line.strip()!r}")
             try:
-                verts.append([float(x) for x in s[1:4]])
+                verts.extend([float(s[1]), float(s[2]), float(s[3])])
             except ValueError:
                 raise MeshError(f"{path}:{no}: bad vertex coordinate in {line.strip()!r}") from None
+            nv += 1
         elif tag == "f":
-            idx = []
             for tok in s[1:]:
                 try:
                     i = int(tok.split("/", 1)[0])
@@ -93,16 +109,21 @@ def read_obj_polygons(path):
                     raise MeshError(f"{path}:{no}: bad face index {tok!r}") from None
                 if i == 0:
                     raise MeshError(f"{path}:{no}: OBJ indices are 1-based, got 0")
-                idx.append(i - 1 if i > 0 else len(verts) + i)
-            polys.append(idx)
+                idx.append(i - 1 if i > 0 else nv + i)
+            sizes.append(len(s) - 1)
             lines.append(no)
-    n = len(verts)
-    for f, (poly, no) in enumerate(zip(polys, lines)):
-        for i in poly:
-            if not 0 <= i < n:
-                raise MeshError(f"{path}:{no}: face {f} refers to vertex {i + 1} (1-based) of {n}")
-    V = np.array(verts, dtype=np.float64).reshape(-1, 3)
-    return V, polys, lines
+    parsed = _parse_tags(path, text) if tags else None
+    del text
+    I = np.frombuffer(idx, dtype=np.int64).copy() if len(idx) else np.zeros(0, dtype=np.int64)
+    del idx
+    S = np.frombuffer(sizes, dtype=np.int64).copy() if len(sizes) else np.zeros(0, dtype=np.int64)
+    L = np.frombuffer(lines, dtype=np.int64).copy() if len(lines) else np.zeros(0, dtype=np.int64)
+    bad = np.flatnonzero((I < 0) | (I >= nv))
+    if bad.size:
+        f = int(np.searchsorted(np.cumsum(S), bad[0], side="right"))
+        raise MeshError(f"{path}:{int(L[f])}: face {f} refers to vertex {int(I[bad[0]]) + 1} (1-based) of {nv}")
+    V = np.frombuffer(verts, dtype=np.float64).copy().reshape(-1, 3) if nv else np.zeros((0, 3))
+    return V, I, S, L, parsed
 
 
 def _parse_tags(path, text):
@@ -169,9 +190,7 @@ def read_obj_tagged(path):
     from ccproof.mesh.polymesh import PolyMesh
     from ccproof.mesh.rules import Options
 
-    V, polys, lines = read_obj_polygons(path)
-    with open(os.fspath(path), encoding="utf-8", errors="replace") as fh:
-        tags = _parse_tags(path, fh.read())
+    V, indices, sizes, _, tags = _read_obj_arrays(path, tags=True)
     creases, corners, holes = {}, {}, []
     opts = {}
     for no, name, ints, floats, strings in tags:
@@ -214,8 +233,8 @@ def read_obj_tagged(path):
         else:
             raise MeshError(f"{where}: not supported (hierarchical edits and unknown tags are refused)")
     try:
-        return PolyMesh(V, polys, creases=creases or None, corners=corners or None, holes=holes or None,
-                        options=Options(**opts))
+        return PolyMesh(V, indices, sizes=sizes, creases=creases or None, corners=corners or None,
+                        holes=holes or None, options=Options(**opts))
     except MeshError as exc:
         raise MeshError(f"{path}: {exc}") from None
 

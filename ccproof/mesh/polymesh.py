@@ -26,14 +26,14 @@ is evaluated on: the fans of every non-manifold vertex split apart (see
 
 from __future__ import annotations
 
+import functools
+import itertools
 import math
 
 import numpy as np
-import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components
 
 from ccproof.errors import MeshError
-from ccproof.mesh.quadmesh import _check_used_finite
+from ccproof.mesh.quadmesh import _check_used_finite, connected_components
 from ccproof.mesh.rules import INFINITE, Complex, Options, refine_complex, to_float
 
 __all__ = ["PolyMesh"]
@@ -109,26 +109,33 @@ class PolyMesh:
         V = np.array(vertices, dtype=np.float64)
         if V.ndim != 2 or V.shape[1] != 3:
             raise MeshError(f"vertices must have shape (n, 3), got {V.shape}")
-        polys = self._polygons(faces, sizes)
-        if not polys:
+        # the faces as flat arrays (indices, offsets): no Python object per face (memory on large scans)
+        idx, sz = self._flat_faces(faces, sizes)
+        if not sz.size:
             raise MeshError("the mesh has no faces")
         n = V.shape[0]
-        for f, p in enumerate(polys):
-            if len(p) < 3:
-                raise MeshError(f"face {f} has {len(p)} vertices (needs >= 3): {p}")
-            for v in p:
-                if not 0 <= v < n:
-                    raise MeshError(f"face {f} has a vertex index out of range [0, {n}): {p}")
-            if _split is False and len(set(p)) != len(p):  # (the split mesh: a face still touching itself)
-                r = next(v for v in p if p.count(v) > 1)
-                raise MeshError(f"face {f} repeats vertex {r} within one fan: {p}")
-        _check_used_finite(V, [v for p in polys for v in p])
+        off = np.r_[0, np.cumsum(sz)].astype(np.int64)
+        short = np.flatnonzero(sz < 3)
+        bad = np.flatnonzero((idx < 0) | (idx >= n))
+        f_bad = int(np.searchsorted(off[1:], bad[0], side="right")) if bad.size else sz.size
+        if short.size and short[0] <= f_bad:
+            f = int(short[0])
+            raise MeshError(f"face {f} has {int(sz[f])} vertices (needs >= 3): {idx[off[f]:off[f + 1]].tolist()}")
+        if bad.size:
+            raise MeshError(f"face {f_bad} has a vertex index out of range [0, {n}): "
+                            f"{idx[off[f_bad]:off[f_bad + 1]].tolist()}")
+        if _split is False:  # (the split mesh: a face still touching itself)
+            for f in range(sz.size):
+                p = idx[off[f]:off[f + 1]].tolist()
+                if len(set(p)) != len(p):
+                    r = next(v for v in p if p.count(v) > 1)
+                    raise MeshError(f"face {f} repeats vertex {r} within one fan: {p}")
+        _check_used_finite(V, idx)
         self.vertices = V
         self.vertices.setflags(write=False)
-        self.polygons = [tuple(p) for p in polys]
-        self.sizes = np.array([len(p) for p in polys], dtype=np.int64)
-        self.offsets = np.r_[0, np.cumsum(self.sizes)].astype(np.int64)
-        self.indices = np.array([v for p in polys for v in p], dtype=np.int64)
+        self.sizes = sz
+        self.offsets = off
+        self.indices = idx
         if options is None:
             options = Options()
         elif isinstance(options, dict):
@@ -137,7 +144,7 @@ class PolyMesh:
         self._build_topology()
         self.edge_sharpness = self._creases(creases)
         self.vertex_sharpness = self._corners(corners)
-        m = len(polys)
+        m = int(sz.size)
         hole = np.zeros(m, dtype=bool)
         for f in [] if holes is None else list(holes):
             fi = int(f)
@@ -159,21 +166,42 @@ class PolyMesh:
             self.manifold, self.manifold_vertex_map = self._split_nonmanifold()
 
     # ------------------------------------------------------------------ construction helpers
+    @functools.cached_property
+    def polygons(self):
+        """The faces as tuples of vertex indices (built on first use from :attr:`indices`, :attr:`offsets`)."""
+        flat = self.indices.tolist()
+        off = self.offsets.tolist()
+        return [tuple(flat[a:b]) for a, b in zip(off[:-1], off[1:])]
+
+    @functools.cached_property
+    def edge_index(self):
+        """``{(a, b): e}`` for every edge ``e`` (a < b) of :attr:`edges` (built on first use)."""
+        return {(int(a), int(b)): e for e, (a, b) in enumerate(self.edges.tolist())}
+
     @staticmethod
-    def _polygons(faces, sizes):
+    def _flat_faces(faces, sizes):
+        """``(indices, sizes)``, int64 arrays, of the ``faces`` argument (see the class docstring)."""
         if sizes is not None:
             idx = np.asarray(faces, dtype=np.int64).reshape(-1)
             sz = np.asarray(sizes, dtype=np.int64).reshape(-1)
             if (sz < 0).any() or sz.sum() != idx.size:
                 raise MeshError(f"face sizes sum to {int(sz.sum())}, but there are {idx.size} indices")
-            off = np.r_[0, np.cumsum(sz)]
-            return [idx[off[f] : off[f + 1]].tolist() for f in range(sz.size)]
+            return idx, sz
         if isinstance(faces, tuple) and len(faces) == 2 and np.ndim(faces[0]) == 1 and np.ndim(faces[1]) == 1:
             idx = np.asarray(faces[0], dtype=np.int64)
             off = np.asarray(faces[1], dtype=np.int64)
             if off.size == 0 or off[0] != 0 or off[-1] != idx.size or (np.diff(off) < 0).any():
                 raise MeshError("offsets must start at 0, be non-decreasing and end at len(indices)")
-            return [idx[off[f] : off[f + 1]].tolist() for f in range(off.size - 1)]
+            return idx, np.diff(off)
+        if isinstance(faces, np.ndarray) and faces.ndim == 2 and np.issubdtype(faces.dtype, np.integer):
+            return faces.astype(np.int64).reshape(-1), np.full(faces.shape[0], faces.shape[1], dtype=np.int64)
+        polys = PolyMesh._polygons(faces)
+        sz = np.fromiter((len(p) for p in polys), dtype=np.int64, count=len(polys))
+        idx = np.fromiter(itertools.chain.from_iterable(polys), dtype=np.int64, count=int(sz.sum()))
+        return idx, sz
+
+    @staticmethod
+    def _polygons(faces):
         out = []
         for f, p in enumerate(faces):
             q = np.asarray(p)
@@ -196,7 +224,7 @@ class PolyMesh:
         n = self.vertices.shape[0]
         off, idx = self.offsets, self.indices
         H = idx.size
-        face_of = np.repeat(np.arange(len(self.polygons)), self.sizes)
+        face_of = np.repeat(np.arange(self.sizes.size), self.sizes)
         loc = np.arange(H) - off[face_of]
         nxt = off[face_of] + (loc + 1) % self.sizes[face_of]
         prv = off[face_of] + (loc - 1) % self.sizes[face_of]
@@ -217,9 +245,9 @@ class PolyMesh:
         # gives each such occurrence an edge of its own with one face (a boundary edge), so that both
         # ends are sharpened (corners)
         degenerate = lo[order[starts]] == hi[order[starts]]
-        fe = np.unique(edge_of * len(self.polygons) + face_of, return_counts=True)
+        fe = np.unique(edge_of * self.sizes.size + face_of, return_counts=True)
         held_twice = np.zeros(starts.size, dtype=bool)
-        held_twice[fe[0][fe[1] > 1] // len(self.polygons)] = True
+        held_twice[fe[0][fe[1] > 1] // self.sizes.size] = True
         nm_edge |= degenerate | held_twice
         self._repeat_edge = degenerate | held_twice
         ends = np.flatnonzero(degenerate | held_twice)
@@ -231,7 +259,6 @@ class PolyMesh:
         first = order[starts]
         self._edge_halfedge = first  # one half-edge of every edge
         self.edges = np.stack([lo[first], hi[first]], axis=1)
-        self.edge_index = {(int(a), int(b)): e for e, (a, b) in enumerate(self.edges.tolist())}
         self.edge_face_count = counts
         self.is_boundary_edge = counts == 1
         self.is_nonmanifold_edge = nm_edge
@@ -242,8 +269,7 @@ class PolyMesh:
         # joined by rot are the fans (OpenSubdiv's spans between singular edges)
         rot = twin[prv]
         ok = np.flatnonzero(rot >= 0)
-        g = sp.coo_matrix((np.ones(ok.size), (ok, rot[ok])), shape=(H, H))
-        ncomp, comp = connected_components(g, directed=False)
+        ncomp, comp = connected_components(H, ok, rot[ok])
         vertex_of_comp = np.zeros(ncomp, dtype=np.int64)
         vertex_of_comp[comp] = org
         nfans = np.bincount(vertex_of_comp, minlength=n)
@@ -382,10 +408,10 @@ class PolyMesh:
         for v, x in vsharp.items():
             for u in [v, *copies.get(v, [])]:
                 corners[u] = x
-        polys = [new[self.offsets[f] : self.offsets[f + 1]].tolist() for f in range(self.n_faces)]
         opts = Options("edge_only", self.options.crease_method, self.options.triangle_subdivision)
         try:
-            m = PolyMesh(self.vertices[vmap], polys, creases=creases or None, corners=corners or None,
+            m = PolyMesh(self.vertices[vmap], np.asarray(new, dtype=np.int64), sizes=self.sizes,
+                         creases=creases or None, corners=corners or None,
                          holes=np.flatnonzero(self.is_hole), options=opts, _split=False)
         except MeshError as exc:
             raise MeshError(f"non-manifold mesh not supported after splitting its non-manifold vertices: "
@@ -440,7 +466,7 @@ class PolyMesh:
 
     def _implicit_holes(self):
         """``VTX_BOUNDARY_NONE``: faces at a boundary vertex with a boundary edge not tagged infinite."""
-        m = len(self.polygons)
+        m = self.sizes.size
         out = np.zeros(m, dtype=bool)
         if self.options.boundary != "none":
             return out
@@ -462,7 +488,7 @@ class PolyMesh:
 
     @property
     def n_faces(self):
-        return len(self.polygons)
+        return int(self.sizes.size)
 
     @property
     def is_all_quads(self):
@@ -493,7 +519,7 @@ class PolyMesh:
             why = ("it has faces that are not quads" if not self.is_all_quads else
                    "it has OpenSubdiv tags" if self.has_tags else "it is not manifold")
             raise MeshError(f"not a plain quad mesh: {why}")
-        return QuadMesh(self.vertices, np.array(self.polygons, dtype=np.int64).reshape(-1, 4))
+        return QuadMesh(self.vertices, self.indices.reshape(-1, 4))
 
     @property
     def has_tags(self):
@@ -538,8 +564,13 @@ class PolyMesh:
         return Complex(self.polygons, dict(self.edge_sharpness), dict(self.vertex_sharpness), self.options,
                        level=self.level, n_vertices=self.n_vertices)
 
-    def refine(self):
+    def refine(self, operator=True):
         """One Catmull-Clark step with the tagged rules (layout of :mod:`ccproof.mesh.rules`).
+
+        Parameters
+        ----------
+        operator : bool
+            Also return the step's sparse matrix (False: None instead, and scipy is not imported).
 
         Returns
         -------
@@ -547,17 +578,19 @@ class PolyMesh:
             All quads; child ``offsets[f] + k`` is corner k of face f; sharpness decayed; holes
             inherited by the children; the options kept (``EDGE_AND_CORNER`` corners carried as
             infinite vertex sharpness).
-        S : scipy.sparse.csr_matrix, shape (n + E + m, n)
+        S : scipy.sparse.csr_matrix, shape (n + E + m, n), or None
             ``refined.vertices == S @ self.vertices``. On a non-manifold mesh, the step of
             :attr:`manifold` (n + E + m counted there; the columns are this mesh's vertices).
         """
         if self.manifold is not self:
-            m, S = self.manifold.refine()
+            m, S = self.manifold.refine(operator)
+            if not operator:
+                return m, None
             return m, (S @ _expansion(self.manifold_vertex_map, self.n_vertices)).tocsr()
         cx = self.complex()
         stencils, children, ces, cvs = refine_complex(cx)
-        S = _stencil_matrix(stencils, self.n_vertices)
-        V1 = S @ self.vertices
+        S = _stencil_matrix(stencils, self.n_vertices) if operator else None
+        V1 = _apply_stencils(stencils, np.asarray(self.vertices, dtype=np.float64))
         holes = np.repeat(self.is_hole, self.sizes)
         m = PolyMesh(V1, children, creases=(list(ces.keys()), list(ces.values())) if ces else None,
                      corners=cvs or None, holes=np.flatnonzero(holes), options=self.options)
@@ -602,7 +635,34 @@ class PolyMesh:
 def _expansion(vmap, n):
     """Sparse (len(vmap), n) 0/1 matrix copying vertex ``vmap[i]`` to row i."""
     k = len(vmap)
+    import scipy.sparse as sp
+
     return sp.csr_matrix((np.ones(k), (np.arange(k), np.asarray(vmap))), shape=(k, n))
+
+
+def _apply_stencils(stencils, X):
+    """``S @ X`` for the float matrix S of :func:`_stencil_matrix`, without building it: each row summed
+    over its columns in increasing order, from 0, as the CSR product does (the same bits)."""
+    n = len(stencils)
+    width = max((len(s) for s in stencils if s is not None), default=0)
+    cols = np.zeros((n, max(width, 1)), dtype=np.int64)
+    vals = np.zeros((n, max(width, 1)))
+    size = np.zeros(n, dtype=np.int64)
+    bad = []
+    for r, s in enumerate(stencils):
+        if s is None:
+            bad.append(r)
+            continue
+        items = sorted(s.items())
+        size[r] = len(items)
+        cols[r, :len(items)] = [c for c, _ in items]
+        vals[r, :len(items)] = [to_float(w) for _, w in items]
+    out = np.zeros((n, X.shape[1]))
+    for k in range(width):  # only the rows' own columns: an unused vertex may hold NaN
+        rows = np.flatnonzero(size > k)
+        out[rows] += vals[rows, k, None] * X[cols[rows, k]]
+    out[bad] = np.nan
+    return out
 
 
 def _stencil_matrix(stencils, ncols):
@@ -618,4 +678,6 @@ def _stencil_matrix(stencils, ncols):
             rows.append(r)
             cols.append(c)
             vals.append(to_float(w))
+    import scipy.sparse as sp
+
     return sp.csr_matrix((vals, (rows, cols)), shape=(len(stencils), ncols))

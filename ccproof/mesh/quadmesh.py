@@ -22,8 +22,6 @@ Half-edge conventions (used throughout ccproof): half-edge ``h = 4 f + i`` runs 
 from __future__ import annotations
 
 import numpy as np
-import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components
 
 from ccproof.errors import MeshError
 
@@ -112,6 +110,49 @@ def _duplicate_face(org, face_of, hs):
         cyc[key] = (f, vs)
     return None
 
+
+
+def connected_components(n, a, b):
+    """Connected components of the undirected graph on ``range(n)`` with the edges ``(a[i], b[i])``.
+
+    Hooking and pointer jumping in numpy (the mesh's fans: ``scipy.sparse.csgraph`` would cost its
+    import, ~0.2 s, in every process that reads a mesh).
+
+    Parameters
+    ----------
+    n : int
+    a, b : ndarray of int, shape (m,)
+
+    Returns
+    -------
+    ncomp : int
+    label : ndarray of int64, shape (n,)
+        Component of every node, numbered in the order of their smallest node (as
+        ``scipy.sparse.csgraph.connected_components`` numbers them).
+
+    Examples
+    --------
+    >>> ncomp, label = connected_components(6, np.array([4, 1, 5]), np.array([1, 4, 3]))
+    >>> ncomp, label.tolist()
+    (4, [0, 1, 2, 3, 1, 3])
+    """
+    lab = np.arange(n, dtype=np.int64)
+    a = np.asarray(a, dtype=np.int64)
+    b = np.asarray(b, dtype=np.int64)
+    while a.size:
+        la, lb = lab[a], lab[b]
+        lo, hi = np.minimum(la, lb), np.maximum(la, lb)
+        diff = lo != hi
+        if not diff.any():
+            break
+        np.minimum.at(lab, hi[diff], lo[diff])  # hook: hi and lo are roots, lo < hi (no cycles)
+        while True:  # shortcut every node to its root
+            nxt = lab[lab]
+            if np.array_equal(nxt, lab):
+                break
+            lab = nxt
+    roots, label = np.unique(lab, return_inverse=True)
+    return int(roots.size), label.astype(np.int64, copy=False)
 
 class QuadMesh:
     """An all-quad, manifold, consistently oriented control mesh (bmz04 section 2).
@@ -239,8 +280,7 @@ class QuadMesh:
         prev = (np.arange(H) // 4) * 4 + (np.arange(H) + 3) % 4
         rot = twin[prev]
         ok = rot >= 0
-        g = sp.coo_matrix((np.ones(int(ok.sum())), (np.arange(H)[ok], rot[ok])), shape=(H, H))
-        ncomp, label = connected_components(g, directed=False)
+        ncomp, label = connected_components(H, np.arange(H)[ok], rot[ok])
         pairs = np.unique(org * ncomp + label)
         nfans = np.bincount(pairs // ncomp, minlength=n)
         if (nfans > 1).any():

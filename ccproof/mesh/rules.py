@@ -37,6 +37,7 @@ quad ``(v_k', e_{k,k+1}', f', e_{k-1,k}')``.
 from __future__ import annotations
 
 import functools
+import itertools
 import math
 
 import numpy as np
@@ -58,6 +59,10 @@ __all__ = ["Options", "Complex", "refine_complex", "INFINITE", "BOUNDARY_MODES",
 
 #: OpenSubdiv's Sdc::Crease::SHARPNESS_INFINITE: sharpness at or above it is infinite
 INFINITE = 10.0
+
+#: complexes of at least this many faces get their half-edge lists from numpy (the whole mesh); the many
+#: small local complexes of the evaluator keep the plain loop (faster below this size)
+_VECTORIZED_FACES = 64
 BOUNDARY_MODES = ("edge_only", "edge_and_corner", "none")
 CREASE_METHODS = ("uniform", "chaikin")
 TRIANGLE_RULES = ("catmark", "smooth")
@@ -319,6 +324,10 @@ class Complex:
         self.level = level
         nv = 1 + max(max(f) for f in self.faces) if n_vertices is None else int(n_vertices)
         self.n_vertices = nv
+        self._fans = {}
+        if len(self.faces) >= _VECTORIZED_FACES:
+            self._topology_numpy()
+            return
         start, org, face_of, nxt, prv = [], [], [], [], []
         for g, f in enumerate(self.faces):
             s, n = len(org), len(f)
@@ -352,7 +361,44 @@ class Complex:
         for h, v in enumerate(org):
             corners[v].append(h)
         self.corners = corners
-        self._fans = {}
+
+    def _topology_numpy(self):
+        """The lists of ``__init__`` computed with numpy (large complexes: the whole mesh): the same
+        values (twins: the last half-edge of a repeated directed edge, as the dict of the loop keeps;
+        edges numbered by first occurrence; corners of a vertex in increasing order)."""
+        nv = self.n_vertices
+        sizes = np.fromiter(map(len, self.faces), dtype=np.int64, count=len(self.faces))
+        org = np.fromiter(itertools.chain.from_iterable(self.faces), dtype=np.int64, count=int(sizes.sum()))
+        H = org.size
+        start = np.r_[0, np.cumsum(sizes)[:-1]].astype(np.int64)
+        face_of = np.repeat(np.arange(sizes.size, dtype=np.int64), sizes)
+        pos = np.arange(H, dtype=np.int64) - start[face_of]
+        nxt = start[face_of] + (pos + 1) % sizes[face_of]
+        prv = start[face_of] + (pos - 1) % sizes[face_of]
+        dst = org[nxt]
+        key = org * nv + dst
+        order = np.argsort(key, kind="stable")
+        sk = key[order]
+        rk = dst * nv + org
+        i = np.searchsorted(sk, rk, side="right") - 1  # the last half-edge with that directed key
+        ok = i >= 0
+        ok[ok] = sk[i[ok]] == rk[ok]
+        twin = np.where(ok, order[np.maximum(i, 0)], -1)
+        lo, hi = np.minimum(org, dst), np.maximum(org, dst)
+        ukey, first, inv = np.unique(lo * nv + hi, return_index=True, return_inverse=True)
+        by_first = np.argsort(first, kind="stable")
+        rank = np.empty(ukey.size, dtype=np.int64)
+        rank[by_first] = np.arange(ukey.size)
+        edges = first[by_first]
+        self.start, self.org, self.face_of = start.tolist(), org.tolist(), face_of.tolist()
+        self.nxt, self.prv, self.twin = nxt.tolist(), prv.tolist(), twin.tolist()
+        self.edges = edges.tolist()
+        self.he_edge = rank[inv.reshape(-1)].tolist()
+        self.edge_index = dict(zip(zip(lo[edges].tolist(), hi[edges].tolist()), range(edges.size)))
+        by_vertex = np.argsort(org, kind="stable")
+        bounds = np.r_[0, np.cumsum(np.bincount(org, minlength=nv))].tolist()
+        flat = by_vertex.tolist()
+        self.corners = [flat[a:b] for a, b in zip(bounds[:-1], bounds[1:])]
 
     # -------------------------------------------------------------- topology
     def dst(self, h):

@@ -32,7 +32,6 @@ quarter turns and scaled by 1/2).
 from __future__ import annotations
 
 import numpy as np
-import scipy.sparse as sp
 
 from ccproof.mesh.quadmesh import QuadMesh
 from ccproof.rule_weights import (
@@ -189,6 +188,8 @@ def subdivision_matrix(mesh):
         add(bv, bv, wc)
         add(bv, e0[bv], wn)
         add(bv, e1[bv], wn)
+    import scipy.sparse as sp
+
     S = sp.coo_matrix(
         (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(n + E + m, n)
     )

@@ -16,7 +16,8 @@ Names are loaded lazily (``ccproof --help`` stays numpy-free).
 from importlib import import_module
 
 _WHERE = {
-    "ReparamLimitSurface": "ccproof.reparam.surface",
+    "Parameterization": "ccproof.reparam.surface",
+    "corner_valence": "ccproof.reparam.surface",
     "limit_surface": "ccproof.reparam.surface",
     "face_map": "ccproof.reparam.blend",
     "PARAMETERIZATIONS": "ccproof.reparam.blend",

@@ -329,7 +329,7 @@ def face_map(corner_valence, u, v, parameterization, alpha=None, derivatives=1):
         near the corner, unlike ``u``, ``v`` near a corner at 1), ``J_local``, ``H_local`` the
         derivatives in that frame, ``corner`` (n,) bool: the points exactly at a non-identity
         corner (where J is not defined: see
-        :meth:`ccproof.reparam.surface.ReparamLimitSurface.evaluate`).
+        :meth:`ccproof.reparam.surface.Parameterization.evaluate_on`).
 
     Examples
     --------

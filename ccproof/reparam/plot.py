@@ -19,9 +19,9 @@ def isoparameter_lines(surface, vertex, parameterization="natural", n_lines=16, 
 
     Parameters
     ----------
-    surface : ReparamLimitSurface or LimitSurface
-        A surface of an all-quad mesh; a plain :class:`~ccproof.evaluate.surface.LimitSurface` has
-        the natural parameterization only.
+    surface : LimitSurface
+        A surface of an all-quad mesh (from ``ccproof.limit_surface`` for the names "vanishing" and
+        "characteristic"; any quad mesh's surface takes a :class:`ccproof.reparam.Parameterization`).
     vertex : int
     parameterization : {"natural", "vanishing", "characteristic"}
         The parameterization whose lines u = const, v = const are drawn (bmz04 Figs. 2, 4, 5).
@@ -79,7 +79,7 @@ def plot_isoparameter_lines(surface, vertex, path, parameterization="natural", n
 
     Parameters
     ----------
-    surface : ReparamLimitSurface
+    surface : LimitSurface
     vertex : int
         The vertex whose neighbourhood is drawn.
     path : str or pathlib.Path

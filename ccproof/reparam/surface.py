@@ -1,8 +1,11 @@
 """The differentiable parameterizations of bmz04 section 4 on real meshes: f o F_b.
 
-:func:`limit_surface` returns a :class:`ReparamLimitSurface`, a
-:class:`~ccproof.evaluate.surface.LimitSurface` whose :meth:`~ReparamLimitSurface.evaluate` takes
-``parameterization="natural" | "vanishing" | "characteristic"``:
+:class:`Parameterization` is a value (as OpenSubdiv's ``Bfr::Parameterization``) passed to the one
+public evaluation, ``surface.evaluate(face, u, v, derivatives, parameterization=p)`` of
+:class:`~ccproof.evaluate.surface.LimitSurface`, which applies it around its natural evaluation
+(:meth:`Parameterization.evaluate_on`, through the evaluator's public ``evaluate`` and ``locate``
+only). :func:`limit_surface` (``ccproof.limit_surface``) records the values by name in the surface's
+``parameterizations``, so that ``parameterization="vanishing"`` works as well:
 
 * ``natural``: the evaluator's own parameterization (Stam; bmz04 section 2);
 * ``vanishing``: f o F_b with F_i = F^alpha and w = b(|t|) (section 4.2);
@@ -34,8 +37,11 @@ first use, per rotation), and their derivatives are rotated back.
 from __future__ import annotations
 
 import os
+import threading
+import weakref
 from collections.abc import Mapping
-from typing import TYPE_CHECKING, Any, overload
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -46,12 +52,10 @@ from ccproof.reparam.blend import CORNER_FRAMES, PARAMETERIZATIONS, active_point
 from ccproof.reparam.quadrant import check_alpha, default_alpha
 
 if TYPE_CHECKING:
-    from ccproof.evaluate.tagged import TaggedLimitSurface
     from ccproof.mesh.polymesh import PolyMesh
 
-__all__ = ["ReparamLimitSurface", "limit_surface"]
+__all__ = ["Parameterization", "corner_valence", "limit_surface", "named_parameterizations"]
 
-_KEYS = {0: ("P",), 1: ("P", "Pu", "Pv"), 2: ("P", "Pu", "Pv", "Puu", "Puv", "Pvv")}
 #: points whose preimage is this close to the corner (local max-norm) are checked against the
 #: evaluator's deepest stored layer (every corner stores more than 40 layers)
 _DEEP = 2.0**-30
@@ -83,109 +87,112 @@ def _chain_rule(R, idx, J, H, derivatives):
     _put_rows(R["Pv"], idx, Pu * J[:, 0, 1, None] + Pv * J[:, 1, 1, None])
 
 
-class ReparamLimitSurface(LimitSurface):
-    """Limit surface with the three parameterizations of bmz04 (see the module docstring).
+@dataclass(frozen=True, eq=True, repr=False)
+class Parameterization:
+    """A parameterization of the limit surface, as a value: bmz04 section 2, 4.2 or 4.3.
 
-    "natural" (Stam's, docs/readings.md R12), "vanishing" (F^alpha blended, bmz04 section 4.2) and
-    "characteristic" (Phi^-1 blended, bmz04 section 4.3, eq. 4); docs/reparam.md. Made by
-    :func:`limit_surface`.
+    Passed to the one public evaluation, ``surface.evaluate(face, u, v, derivatives,
+    parameterization=p)`` (:meth:`ccproof.evaluate.surface.LimitSurface.evaluate`), as OpenSubdiv's
+    ``Bfr::Parameterization`` is a value passed to its evaluation: the evaluator stays the natural one,
+    and the map F_b is applied around its public :meth:`~ccproof.evaluate.surface.LimitSurface.evaluate`
+    and :meth:`~ccproof.evaluate.surface.LimitSurface.locate` (see the module docstring). The value
+    does not depend on a mesh; what it derives from a surface (the corner valences, the checked
+    exponents, the rotated surfaces near corners at 1, the corner tangents) is cached per surface,
+    and goes with it.
 
     Parameters
     ----------
-    mesh : QuadMesh
-        A manifold quad mesh.
+    kind : {"natural", "vanishing", "characteristic"}
     alpha : float or dict of int -> float, optional
-        Exponent of F^alpha per valence ("vanishing"); default
-        :func:`~ccproof.reparam.quadrant.default_alpha` of each valence.
-
-    Attributes
-    ----------
-    alpha : dict of int -> float
-        Exponent of F^alpha for every extraordinary interior valence of the mesh (besides the
-        attributes of LimitSurface).
-    corner_valence : ndarray, shape (n_faces, 4) int64
-        The valence of each face corner, 0 where F_i is the identity.
+        Exponent of F^alpha ("vanishing"): one value for every valence, a dict valence -> value
+        (missing valences get the default), or None for
+        :func:`~ccproof.reparam.quadrant.default_alpha` (twice the bound of bmz04 section 4.2).
 
     Examples
     --------
-    Every corner of the cube has valence 3:
-
-    >>> from ccproof.mesh.examples import cube
-    >>> from ccproof.reparam.quadrant import default_alpha
-    >>> S = limit_surface(cube())
-    >>> S.corner_valence[0].tolist(), S.alpha == {3: default_alpha(3)}
-    ([3, 3, 3, 3], True)
+    >>> from ccproof.evaluate.surface import LimitSurface
+    >>> from ccproof.mesh.examples import k_regular_disk
+    >>> S = LimitSurface(k_regular_disk(5, 2))
+    >>> p = Parameterization("characteristic")
+    >>> r = S.evaluate([0], [0.0], [0.0], parameterization=p)
+    >>> bool(np.linalg.norm(np.cross(r["Pu"][0], r["Pv"][0])) > 0.1)   # rank 2 at the vertex
+    True
+    >>> Parameterization("vanishing", 2.5).alphas(S)
+    {5: 2.5}
     """
 
-    def __init__(self, mesh: QuadMesh, alpha: float | Mapping[int, float] | None = None, *,
-                 progress: bool | None = None) -> None:
-        super().__init__(mesh, progress=progress)
-        val = np.asarray(mesh.valence, dtype=np.int64)
-        code = np.where(mesh.is_boundary_vertex | (val == 4), 0, val)
-        self.corner_valence = code[mesh.faces]
-        kinds = sorted({int(k) for k in np.unique(code) if k > 0})
-        self.alpha = {}
-        for k in kinds:
-            if alpha is None:
-                a = default_alpha(k)
-            elif isinstance(alpha, dict):
-                a = alpha[k] if k in alpha else default_alpha(k)
-            else:
-                a = alpha
-            self.alpha[k] = check_alpha(a, k)
-        self._tangent_cache: dict[tuple[int, int], Any] = {}
-        self._rotated_cache: dict[int, LimitSurface] = {}
+    kind: str
+    alpha: float | Mapping[int, float] | None = None
 
-    def evaluate(self, face_ids, u, v, derivatives=1, *, parameterization="natural", chunk=CHUNK, out=None,
-                 backend=None, threads=None):
-        """Positions and derivatives at points (face, u, v) in the chosen parameterization.
+    def __post_init__(self) -> None:
+        if self.kind not in PARAMETERIZATIONS:
+            raise CCProofError(f"unknown parameterization {self.kind!r}; use one of {', '.join(PARAMETERIZATIONS)}")
+        if self.alpha is not None and self.kind != "vanishing":
+            raise CCProofError(f"alpha applies to the vanishing parameterization only, not to {self.kind!r}")
+        if isinstance(self.alpha, Mapping):
+            object.__setattr__(self, "alpha", dict(self.alpha))  # a copy: the value does not change
 
-        Parameters
-        ----------
-        face_ids : array_like of int, shape (n,)
-        u, v : array_like of float, shape (n,)
-            Face parameters in [0, 1] (corner i of the face at (0,0), (1,0), (1,1), (0,1)).
-        derivatives : int, 0, 1 or 2
-        parameterization : {"natural", "vanishing", "characteristic"}
-            bmz04 section 2, 4.2 or 4.3.
-        chunk, out, backend, threads
-            As in :meth:`ccproof.evaluate.surface.LimitSurface.evaluate`.
+    def __repr__(self) -> str:
+        return f"Parameterization({self.kind!r}" + ("" if self.alpha is None else f", alpha={self.alpha!r}") + ")"
+
+    def __hash__(self) -> int:
+        return hash((self.kind, self._alpha_key()))
+
+    def _alpha_key(self) -> Any:
+        return tuple(sorted(self.alpha.items())) if isinstance(self.alpha, dict) else self.alpha
+
+    # ------------------------------------------------------------------ per surface
+    def alphas(self, surface: LimitSurface) -> dict[int, float]:
+        """The exponent of F^alpha for every extraordinary interior valence of ``surface``'s mesh, checked.
+
+        Raises
+        ------
+        CCProofError
+            alpha not above -log 2 / log lam(k) for a valence k of the mesh; a surface that is not
+            of an untagged all-quad mesh.
+        """
+        st = _state(surface)
+        key = self._alpha_key()
+        if key not in st.alphas:
+            out = {}
+            for k in st.kinds:
+                if self.alpha is None:
+                    a = default_alpha(k)
+                elif isinstance(self.alpha, dict):
+                    a = self.alpha[k] if k in self.alpha else default_alpha(k)
+                else:
+                    a = self.alpha
+                out[k] = check_alpha(a, k)
+            st.alphas[key] = out
+        return dict(st.alphas[key])
+
+    def evaluate_on(self, surface: LimitSurface, f: np.ndarray, u: np.ndarray, v: np.ndarray, derivatives: int = 1,
+                    *, chunk: int = CHUNK, out: dict[str, np.ndarray] | None = None, backend: str | None = None,
+                    threads: int | None = None) -> dict[str, np.ndarray]:
+        """f o F_b at points the surface has checked: what ``surface.evaluate(..., parameterization=self)`` returns.
+
+        Called by :meth:`ccproof.evaluate.surface.LimitSurface.evaluate` with ``f`` (n,) int64 and
+        ``u``, ``v`` (n,) float64 already checked; uses only the surface's public ``evaluate`` (natural)
+        and ``locate``.
 
         Returns
         -------
         dict of ndarray, shape (n, 3)
             ``P``; ``Pu``, ``Pv`` with ``derivatives >= 1``; ``Puu``, ``Puv``, ``Pvv`` with 2:
             derivatives of f o F_b with respect to the face's own (u, v).
-
-        Raises
-        ------
-        CCProofError
-            Unknown parameterization; face id out of range; (u, v) outside [0, 1]^2 or NaN.
-
-        Examples
-        --------
-        >>> from ccproof.mesh.examples import k_regular_disk
-        >>> S = limit_surface(k_regular_disk(5, 2))
-        >>> r = S.evaluate([0], [0.0], [0.0], parameterization="characteristic")
-        >>> bool(np.linalg.norm(np.cross(r["Pu"][0], r["Pv"][0])) > 0.1)   # rank 2 at the vertex
-        True
         """
-        if parameterization not in PARAMETERIZATIONS:
-            raise CCProofError(
-                f"unknown parameterization {parameterization!r}; use one of {', '.join(PARAMETERIZATIONS)}")
-        if derivatives not in (0, 1, 2):
-            raise CCProofError(f"derivatives must be 0, 1 or 2, got {derivatives!r}")
-        if parameterization == "natural":
-            return super().evaluate(face_ids, u, v, derivatives, chunk=chunk, out=out, backend=backend,
-                                    threads=threads)
-        f, u, v = self._check(face_ids, u, v)
-        idx, q, s, t, k = active_points(self.corner_valence, f, u, v, parameterization)
+        kw = {"chunk": chunk, "out": out, "backend": backend, "threads": threads}
+        if self.kind == "natural":
+            return surface.evaluate(f, u, v, derivatives, **kw)
+        st = _state(surface)
+        alpha = self.alphas(surface)
+        idx, q, s, t, k = active_points(st.corner_valence, f, u, v, self.kind)
         if idx.size == 0:
-            return super().evaluate(f, u, v, derivatives, chunk=chunk, out=out, backend=backend, threads=threads)
-        res = blend_points(q, s, t, k, parameterization, self.alpha, derivatives)
+            return surface.evaluate(f, u, v, derivatives, **kw)
+        res = blend_points(q, s, t, k, self.kind, alpha, derivatives)
         u2, v2 = u.copy(), v.copy()
         u2[idx], v2[idx] = res["u"], res["v"]
-        R = super().evaluate(f, u2, v2, derivatives, chunk=chunk, out=out, backend=backend, threads=threads)
+        R = surface.evaluate(f, u2, v2, derivatives, **kw)
         if derivatives >= 1:
             _chain_rule(R, idx, res["J"], res.get("H"), derivatives)
         m = res["local"].max(axis=1)
@@ -194,36 +201,13 @@ class ReparamLimitSurface(LimitSurface):
         for qq in (1, 2, 3):
             sel = np.flatnonzero((q == qq) & (m < _NEAR))
             if sel.size:
-                self._eval_in_corner_frame(qq, f[idx[sel]], idx[sel], sel, res, R, derivatives, backend)
+                _eval_in_corner_frame(surface, qq, f[idx[sel]], idx[sel], sel, res, R, derivatives, backend)
         if derivatives >= 1:
-            self._fix_corner_limits(f[idx], idx, q, m, res, R, parameterization, derivatives)
+            self._fix_corner_limits(surface, f[idx], idx, q, m, res, R, derivatives)
         return R
 
-    def _rotated(self, q):
-        """The same surface with every face's vertex list rotated by q (corner q becomes corner 0)."""
-        if q not in self._rotated_cache:
-            F = np.roll(self.mesh.faces, -q, axis=1)
-            self._rotated_cache[q] = LimitSurface(QuadMesh(self.mesh.vertices, F))
-        return self._rotated_cache[q]
-
-    def _eval_in_corner_frame(self, q, f, rows, sel, res, R, d, backend):
-        """Rows ``rows`` of R (active points ``sel`` of ``res``) evaluated in the frame of corner q."""
-        S = self._rotated(q)
-        G = res["local"][sel]
-        Rl = LimitSurface.evaluate(S, f, G[:, 0], G[:, 1], d, backend=backend)
-        R["P"][rows] = Rl["P"]
-        if d == 0:
-            return
-        _chain_rule(Rl, np.arange(sel.size), res["J_local"][sel], res["H_local"][sel] if d >= 2 else None, d)
-        A = CORNER_FRAMES[q]  # d/du_i = sum_b A[i, b] d/ds_b
-        R["Pu"][rows] = A[0, 0] * Rl["Pu"] + A[0, 1] * Rl["Pv"]
-        R["Pv"][rows] = A[1, 0] * Rl["Pu"] + A[1, 1] * Rl["Pv"]
-        if d >= 2:
-            L = {(0, 0): Rl["Puu"], (0, 1): Rl["Puv"], (1, 0): Rl["Puv"], (1, 1): Rl["Pvv"]}
-            for key, i, j in (("Puu", 0, 0), ("Puv", 0, 1), ("Pvv", 1, 1)):
-                R[key][rows] = sum(A[i, b] * A[j, c] * L[(b, c)] for b in range(2) for c in range(2))
-
-    def _fix_corner_limits(self, f, idx, q, m, res, R, parameterization, derivatives):
+    def _fix_corner_limits(self, surface: LimitSurface, f: np.ndarray, idx: np.ndarray, q: np.ndarray,
+                           m: np.ndarray, res: dict[str, Any], R: dict[str, np.ndarray], derivatives: int) -> None:
         """Limit derivatives at the corner and beyond the evaluator's deepest layer (module doc).
 
         ``f``, ``q``, ``m``: face, quarter and max local coordinate of the active points ``idx``."""
@@ -235,19 +219,19 @@ class ReparamLimitSurface(LimitSurface):
         for qq in range(4):
             sel = cand[q[cand] == qq]
             if sel.size:
-                S = self if qq == 0 else self._rotated(qq)
-                scale[q[cand] == qq] = S._locate(f[sel], loc[sel, 0], loc[sel, 1])[3]
+                S = surface if qq == 0 else _rotated(surface, qq)
+                scale[q[cand] == qq] = S.locate(f[sel], loc[sel, 0], loc[sel, 1])[3]
         # a point inside a stored layer of side h has max(local) >= h, i.e. m * scale >= 1
         fix = cand[(m[cand] * scale < 1.0) | res["corner"][cand]]
         if fix.size == 0:
             return
         rows = idx[fix]
-        if parameterization == "vanishing":
+        if self.kind == "vanishing":
             R["Pu"][rows] = 0.0
             R["Pv"][rows] = 0.0
         else:
             for row, ff, qq in zip(rows.tolist(), f[fix].tolist(), q[fix].tolist()):
-                D = self.corner_derivatives(ff, qq)  # (2, 3): d/ds, d/dt in the corner frame
+                D = corner_derivatives(surface, ff, qq)  # (2, 3): d/ds, d/dt in the corner frame
                 A = CORNER_FRAMES[qq]
                 R["Pu"][row] = A[0, 0] * D[0] + A[0, 1] * D[1]
                 R["Pv"][row] = A[1, 0] * D[0] + A[1, 1] * D[1]
@@ -255,34 +239,125 @@ class ReparamLimitSurface(LimitSurface):
             for key in ("Puu", "Puv", "Pvv"):
                 R[key][rows] = np.nan
 
-    def corner_derivatives(self, face, corner):
-        """D(f o Phi^-1)(0) at corner ``corner`` of ``face``: rows d/ds, d/dt in the corner frame, (2, 3).
 
-        See :mod:`ccproof.reparam.corner`. Only for interior vertices of valence != 4.
-        """
-        key = (int(face), int(corner))
-        if key not in self._tangent_cache:
-            from ccproof.reparam.corner import corner_tangents
+class _SurfaceState:
+    """What the parameterizations derive from one surface (cached, dropped with the surface)."""
 
-            self._tangent_cache[key] = corner_tangents(self.mesh, *key)
-        return self._tangent_cache[key]
+    def __init__(self, mesh: QuadMesh) -> None:
+        self.mesh = mesh
+        self.corner_valence = corner_valence(mesh)
+        self.kinds = sorted({int(k) for k in np.unique(self.corner_valence) if k > 0})
+        self.alphas: dict[Any, dict[int, float]] = {}
+        self.rotated: dict[int, LimitSurface] = {}
+        self.tangents: dict[tuple[int, int], Any] = {}
 
 
-@overload
-def limit_surface(mesh: QuadMesh | str | os.PathLike[str], alpha: float | Mapping[int, float] | None = None, *,
-                  progress: bool | None = None) -> ReparamLimitSurface: ...
-@overload
-def limit_surface(mesh: PolyMesh, alpha: None = None, *, progress: bool | None = None) -> TaggedLimitSurface: ...
+_STATES: weakref.WeakKeyDictionary[LimitSurface, _SurfaceState] = weakref.WeakKeyDictionary()
+_LOCK = threading.Lock()
+
+
+def _state(surface: LimitSurface) -> _SurfaceState:
+    if not isinstance(surface.mesh, QuadMesh):
+        raise CCProofError("the vanishing and characteristic parameterizations need an untagged all-quad mesh "
+                           f"(a QuadMesh), not a {type(surface.mesh).__name__}")
+    with _LOCK:
+        st = _STATES.get(surface)
+        if st is None:
+            st = _STATES[surface] = _SurfaceState(surface.mesh)
+    return st
+
+
+def corner_valence(mesh: QuadMesh) -> np.ndarray:
+    """The valence of every face corner where F_b is not the identity, 0 elsewhere.
+
+    Parameters
+    ----------
+    mesh : QuadMesh
+
+    Returns
+    -------
+    ndarray of int64, shape (n_faces, 4)
+        The valence of corner i of face f if that vertex is an interior vertex of valence != 4, else
+        0 (valence-4 and boundary vertices: the natural parameterization is kept there).
+
+    Examples
+    --------
+    Every corner of the cube has valence 3:
+
+    >>> from ccproof.mesh.examples import cube
+    >>> corner_valence(cube())[0].tolist()
+    [3, 3, 3, 3]
+    """
+    val = np.asarray(mesh.valence, dtype=np.int64)
+    code = np.where(mesh.is_boundary_vertex | (val == 4), 0, val)
+    return code[mesh.faces]
+
+
+def corner_derivatives(surface: LimitSurface, face: int, corner: int) -> np.ndarray:
+    """D(f o Phi^-1)(0) at corner ``corner`` of ``face``: rows d/ds, d/dt in the corner frame, (2, 3).
+
+    See :mod:`ccproof.reparam.corner`. Only for interior vertices of valence != 4.
+    """
+    st = _state(surface)
+    key = (int(face), int(corner))
+    if key not in st.tangents:
+        from ccproof.reparam.corner import corner_tangents
+
+        st.tangents[key] = corner_tangents(st.mesh, *key)
+    return st.tangents[key]
+
+
+def _rotated(surface: LimitSurface, q: int) -> LimitSurface:
+    """The same surface with every face's vertex list rotated by q (corner q becomes corner 0)."""
+    st = _state(surface)
+    if q not in st.rotated:
+        mesh = st.mesh
+        st.rotated[q] = LimitSurface(QuadMesh(mesh.vertices, np.roll(mesh.faces, -q, axis=1)), progress=False)
+    return st.rotated[q]
+
+
+def _eval_in_corner_frame(surface: LimitSurface, q: int, f: np.ndarray, rows: np.ndarray, sel: np.ndarray,
+                          res: dict[str, Any], R: dict[str, np.ndarray], d: int, backend: str | None) -> None:
+    """Rows ``rows`` of R (active points ``sel`` of ``res``) evaluated in the frame of corner q."""
+    S = _rotated(surface, q)
+    G = res["local"][sel]
+    Rl = S.evaluate(f, G[:, 0], G[:, 1], d, backend=backend)
+    R["P"][rows] = Rl["P"]
+    if d == 0:
+        return
+    _chain_rule(Rl, np.arange(sel.size), res["J_local"][sel], res["H_local"][sel] if d >= 2 else None, d)
+    A = CORNER_FRAMES[q]  # d/du_i = sum_b A[i, b] d/ds_b
+    R["Pu"][rows] = A[0, 0] * Rl["Pu"] + A[0, 1] * Rl["Pv"]
+    R["Pv"][rows] = A[1, 0] * Rl["Pu"] + A[1, 1] * Rl["Pv"]
+    if d >= 2:
+        L = {(0, 0): Rl["Puu"], (0, 1): Rl["Puv"], (1, 0): Rl["Puv"], (1, 1): Rl["Pvv"]}
+        for key, i, j in (("Puu", 0, 0), ("Puv", 0, 1), ("Pvv", 1, 1)):
+            R[key][rows] = sum(A[i, b] * A[j, c] * L[(b, c)] for b in range(2) for c in range(2))
+
+
+def named_parameterizations(alpha: float | Mapping[int, float] | None = None) -> dict[str, Parameterization]:
+    """The parameterizations ``ccproof.limit_surface`` names on a quad mesh's surface (its ``parameterizations``).
+
+    ``surface.evaluate(..., parameterization="vanishing")`` looks the name up there.
+
+    >>> sorted(named_parameterizations(2.5).items())
+    [('characteristic', Parameterization('characteristic')), ('vanishing', Parameterization('vanishing', alpha=2.5))]
+    """
+    return {"vanishing": Parameterization("vanishing", alpha), "characteristic": Parameterization("characteristic")}
+
+
 def limit_surface(mesh: QuadMesh | PolyMesh | str | os.PathLike[str], alpha: float | Mapping[int, float] | None = None,
-                  *, progress: bool | None = None) -> ReparamLimitSurface | TaggedLimitSurface:
+                  *, progress: bool | None = None) -> LimitSurface:
     """The limit surface of a mesh: exact evaluation, normals and the parameterizations of bmz04.
 
-    The one entry point for limit surfaces (``ccproof.limit_surface``). A quad mesh gives a
-    :class:`ReparamLimitSurface`: ``evaluate(face, u, v, derivatives, parameterization=...)`` with
-    ``"natural"`` (default; docs/evaluate.md), ``"vanishing"`` or ``"characteristic"`` (bmz04
-    section 4, docs/reparam.md). A :class:`~ccproof.mesh.polymesh.PolyMesh` (triangles, n-gons,
-    creases, corners, holes) gives the tagged evaluator of
-    :func:`ccproof.evaluate.natural_limit_surface` (natural parameterization only).
+    The one entry point for limit surfaces (``ccproof.limit_surface``): the exact evaluator of
+    :func:`ccproof.evaluate.natural_limit_surface`, whose ``evaluate(face, u, v, derivatives,
+    parameterization=...)`` takes ``"natural"`` (default; docs/evaluate.md) and, on an untagged
+    all-quad mesh, ``"vanishing"`` or ``"characteristic"`` (bmz04 section 4, docs/reparam.md): the
+    names of the :class:`Parameterization` values this function records in the surface's
+    ``parameterizations`` (with ``alpha``). A :class:`Parameterization` value can be passed instead
+    of a name, on any quad mesh's surface. Tagged meshes (triangles, n-gons, creases, corners, holes)
+    have the natural parameterization only.
 
     Parameters
     ----------
@@ -299,13 +374,13 @@ def limit_surface(mesh: QuadMesh | PolyMesh | str | os.PathLike[str], alpha: flo
 
     Returns
     -------
-    ReparamLimitSurface, or TaggedLimitSurface for a PolyMesh
+    LimitSurface
 
     Raises
     ------
     CCProofError
         alpha not above -log 2 / log lam(k) for a valence k of an interior extraordinary vertex,
-        or alpha given for a PolyMesh.
+        or alpha given for a tagged mesh.
 
     Examples
     --------
@@ -315,21 +390,22 @@ def limit_surface(mesh: QuadMesh | PolyMesh | str | os.PathLike[str], alpha: flo
     >>> r["P"].shape, r["Pu"].shape
     ((2, 3), (2, 3))
     """
+    from ccproof.evaluate.surface import natural_limit_surface
     from ccproof.mesh.polymesh import PolyMesh
 
+    if not isinstance(mesh, (QuadMesh, PolyMesh)):
+        from ccproof.mesh.io import read_mesh
+
+        poly = read_mesh(mesh)
+        if not poly.is_plain_quads and alpha is not None:
+            raise CCProofError(f"alpha applies to the parameterizations of plain quad meshes only, not to {mesh}")
+        mesh = poly.to_quad_mesh() if poly.is_plain_quads else poly
     if isinstance(mesh, PolyMesh):
         if alpha is not None:
             raise CCProofError("alpha applies to the parameterizations of quad meshes only, not to a PolyMesh")
-        from ccproof.evaluate.surface import natural_limit_surface
-
         return natural_limit_surface(mesh, progress=progress)
-    if isinstance(mesh, QuadMesh):
-        return ReparamLimitSurface(mesh, alpha, progress=progress)
-    from ccproof.mesh.io import read_mesh
-
-    poly = read_mesh(mesh)
-    if poly.is_plain_quads:
-        return ReparamLimitSurface(poly.to_quad_mesh(), alpha, progress=progress)
-    if alpha is not None:
-        raise CCProofError(f"alpha applies to the parameterizations of plain quad meshes only, not to {mesh}")
-    return limit_surface(poly, progress=progress)
+    S = natural_limit_surface(mesh, progress=progress)
+    named = named_parameterizations(alpha)
+    named["vanishing"].alphas(S)  # checked now: a bad alpha is an error of this call
+    S.parameterizations = named
+    return S

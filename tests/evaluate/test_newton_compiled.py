@@ -66,10 +66,11 @@ def test_compiled_descent_checks_its_points():
         newton(S, np.zeros((3, 3)), [0, 1], [0.5, 0.5], [0.5, 0.5])
 
 
-def test_reparameterized_surfaces_keep_the_numpy_descent():
-    """A surface evaluated in another parameterization must not be descended in the natural one."""
-    S = limit_surface(torus())  # evaluate(..., parameterization=...): another evaluate than the kernel's
-    assert S._newton_kernel() is None
+def test_reparameterizable_surfaces_take_the_compiled_descent():
+    """A parameterization is an argument of evaluate, not a kind of surface: the surface of
+    ccproof.limit_surface is the natural evaluator, descended by the compiled kernel."""
+    S = limit_surface(torus())  # named parameterizations recorded; its evaluate defaults to natural
+    assert S._newton_kernel() is not None
     assert natural_limit_surface(torus())._newton_kernel() is not None
     X = natural_limit_surface(torus()).evaluate([3, 7], [0.2, 0.9], [0.4, 0.1], 0)["P"]
     res = closest_points(S, X)

@@ -16,8 +16,9 @@ import pytest
 
 from ccproof.errors import CCProofError
 from ccproof.evaluate import limit_surface
-from ccproof.evaluate.tagged import TaggedLimitSurface
+from ccproof.evaluate.surface import LimitSurface
 from ccproof.mesh.io import read_obj_tagged
+from ccproof.mesh.polymesh import PolyMesh
 
 FAST = ["cube_creases0", "cube_corner2", "cube_corner4", "dart_edgeonly", "edgecorner", "edgenone",
         "hole_test2", "nonquads", "pyramid_creases1", "chaikin1", "cubes_infsharp"]
@@ -50,7 +51,7 @@ def _rows(d):
 def test_shape_matches_opensubdiv(refdir, name):
     d = _ref(refdir, name)
     mesh, S = _surface(refdir, name)
-    assert isinstance(S, TaggedLimitSurface) or not mesh.has_tags
+    assert isinstance(S.mesh, PolyMesh) or not mesh.has_tags
     assert mesh.n_ptex == d["num_ptex_faces"]
     assert [f["ptex"] for f in d["faces"]] == mesh.ptex_start[:-1].tolist()
     rows = _rows(d)
@@ -109,7 +110,7 @@ def test_tagged_evaluator_on_the_quad_references(refdir, name):
 
     d = json.loads((refdir / f"osd_limit_{name}.json").read_text())
     mesh = read_mesh(refdir / "meshes" / f"{name}.obj")
-    S = TaggedLimitSurface(mesh)
+    S = LimitSurface(mesh)
     rows = []
     for s in d["samples"]:
         q = s if not s["endcap"] else (s["deep"] if not s["deep"]["endcap"] else None)
@@ -127,17 +128,16 @@ def test_tagged_evaluator_on_the_quad_references(refdir, name):
 def test_disk_cache_gives_the_computed_scheme(tmp_path, monkeypatch):
     """A corner scheme read back from the disk cache is the computed one, bit for bit."""
     from ccproof.evaluate import local
-    from ccproof.mesh.polymesh import PolyMesh
 
     monkeypatch.setenv("CCPROOF_CACHE", str(tmp_path))
     V = [[np.cos(a), np.sin(a), 0.1 * np.cos(3 * a)] for a in np.linspace(0, 2 * np.pi, 5, endpoint=False)]
     m = PolyMesh([[0, 0, 0.3]] + V, [[0, 1 + i, 1 + (i + 1) % 5] for i in range(5)], creases={(0, 1): 12})
     local.corner_scheme.cache_clear()
-    a = TaggedLimitSurface(m)
+    a = LimitSurface(m)
     files = sorted(tmp_path.glob("*"))
     assert files
     local.corner_scheme.cache_clear()
-    b = TaggedLimitSurface(m)  # now read from the cache
+    b = LimitSurface(m)  # now read from the cache
     assert sorted(tmp_path.glob("*")) == files
     for x, y in zip(a._table, b._table):
         assert np.array_equal(x, y)

@@ -20,7 +20,6 @@ from ccproof.cli import main
 from ccproof.errors import MeshError
 from ccproof.evaluate import limit_surface
 from ccproof.evaluate.surface import LimitSurface
-from ccproof.evaluate.tagged import TaggedLimitSurface
 from ccproof.mesh import PolyMesh, QuadMesh
 from ccproof.mesh.io import read_mesh
 
@@ -109,7 +108,7 @@ def test_mesh_matches_opensubdiv(refdir, name):
     ptex_hole = np.repeat(mesh.is_hole, np.diff(mesh.ptex_start))
     assert sorted({s["ptex"] for s in d["samples"]}) == np.flatnonzero(~ptex_hole).tolist()
     S = limit_surface(mesh)
-    assert isinstance(S, TaggedLimitSurface)
+    assert isinstance(S.mesh, PolyMesh)
     _compare(S, d, mesh.bounding_box_diagonal, name)
 
 
@@ -160,9 +159,9 @@ def test_unused_vertices_both_evaluators(refdir):
     assert isinstance(S, LimitSurface) and isinstance(S.mesh, QuadMesh)
     diag = poly.bounding_box_diagonal
     _compare(S, d, diag)
-    _compare(TaggedLimitSurface(poly), d, diag)
+    _compare(LimitSurface(poly), d, diag)
     # vertex limits and normals by input index: NaN at the unused ones, OpenSubdiv's corner values elsewhere
-    for T in (S, TaggedLimitSurface(poly)):
+    for T in (S, LimitSurface(poly)):
         L, N = T.vertex_limits(), T.vertex_normals()
         assert np.isnan(L[[0, 5, 28]]).all() and np.isnan(N[[0, 5, 28]]).all()
         corners = [s for s in d["samples"] if s["exact"] and s["s"] in (0.0, 1.0) and s["t"] in (0.0, 1.0)]

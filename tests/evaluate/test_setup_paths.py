@@ -9,8 +9,8 @@ subdivision (test_tagged_bruteforce.py); here the shortcuts are switched off to 
 import numpy as np
 
 from ccproof.evaluate import _table
-from ccproof.evaluate.surface import _Builder
-from ccproof.evaluate.tagged import TaggedLimitSurface
+from ccproof.evaluate._table import _Builder
+from ccproof.evaluate.surface import LimitSurface
 from ccproof.mesh.io import read_mesh
 
 
@@ -34,18 +34,20 @@ def _compare(mesh, monkeypatch):
         at_corner.append(hit)
         return hit
 
-    compiled = TaggedLimitSurface(mesh)  # untagged rings walked by the compiled kernel (with numba)
     with monkeypatch.context() as m:
-        m.setattr(_table, "_ring_walks", lambda: None)  # the Python walk, face by face
+        m.setattr(_table, "COMPILED_WALK_MIN", 0)
+        compiled = LimitSurface(mesh)  # untagged rings walked by the compiled kernel (with numba)
+    with monkeypatch.context() as m:
+        m.setattr(_table, "_ring_walks", lambda n: None)  # the Python walk, face by face
         m.setattr(_Builder, "smooth_regular_patches", counting)
         m.setattr(_Builder, "corner_at", counting_corner)
-        fast = TaggedLimitSurface(mesh)
+        fast = LimitSurface(mesh)
     assert sum(handled) > 0  # the shortcut is exercised
     with monkeypatch.context() as m:
-        m.setattr(_table, "_ring_walks", lambda: None)
+        m.setattr(_table, "_ring_walks", lambda n: None)
         m.setattr(_Builder, "smooth_regular_patches", lambda self, cx, X, jobs: np.zeros(len(jobs), bool))
         m.setattr(_Builder, "corner_at", lambda self, *args, **kwargs: False)
-        slow = TaggedLimitSurface(mesh)
+        slow = LimitSurface(mesh)
     assert fast.n_patches == slow.n_patches
     f, u, v = _points(fast)
     a, b = fast.evaluate(f, u, v, 2), slow.evaluate(f, u, v, 2)
@@ -69,3 +71,25 @@ def test_smooth_regular_shortcut_on_polygons_with_tags(refdir, monkeypatch):
     for name in ("catmark_nonquads", "catmark_hole_test2", "catmark_edgecorner", "catmark_edgenone"):
         corner_faces += _compare(read_mesh(refdir / "osd_features" / "meshes" / f"{name}.obj"), monkeypatch)[1]
     assert corner_faces > 0
+
+
+def test_setup_in_a_fresh_process_loads_no_heavy_module(bunny_path, refdir):
+    """What `ccproof eval` does before evaluating (imports, read, build) loads neither scipy, numba, tqdm nor
+    meshio on an OBJ (the lazy imports that keep its setup near the floor of a Python process)."""
+    import json
+    import os
+    import subprocess
+    import sys
+
+    code = ("import sys, json; from ccproof.mesh.io import read_mesh; "
+            "from ccproof.evaluate import natural_limit_surface as ls\n"
+            "for p in sys.argv[1:]: ls(read_mesh(p), progress=False)\n"
+            "print(json.dumps(sorted({m.split('.')[0] for m in sys.modules} & "
+            "{'scipy', 'numba', 'llvmlite', 'tqdm', 'meshio', 'sympy', 'matplotlib'})))")
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    env = dict(os.environ, PYTHONPATH=root + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    paths = [str(bunny_path)] + [str(refdir / "osd_features" / "meshes" / f"catmark_{name}.obj")
+                                 for name in ("cubes_infsharp", "smoothtris1", "chaikin1", "nonquads")]
+    out = subprocess.run([sys.executable, "-c", code, *paths], env=env, check=True, capture_output=True,
+                         text=True, timeout=600).stdout
+    assert json.loads(out.strip().splitlines()[-1]) == []

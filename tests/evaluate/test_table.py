@@ -19,7 +19,7 @@ import pytest
 
 from ccproof.evaluate import limit_surface
 from ccproof.evaluate.local import CORNERS
-from ccproof.evaluate.tagged import TaggedLimitSurface
+from ccproof.evaluate.surface import LimitSurface
 from ccproof.mesh.examples import k_regular_disk
 from ccproof.mesh.io import read_obj_tagged
 from ccproof.mesh.polymesh import PolyMesh
@@ -59,7 +59,7 @@ def test_bytes_per_ptex_face_flat_under_refinement_and_depth(refdir, monkeypatch
     m = mesh
     for _ in range(3):
         m, _ = m.refine()
-        S, cur = _table_bytes(lambda m=m: TaggedLimitSurface(m, progress=False))
+        S, cur = _table_bytes(lambda m=m: LimitSurface(m, progress=False))
         assert S.table_bytes <= cur
         per_face.append((cur - S.configuration_bytes) / m.n_ptex)
     print("bytes per ptex face after 1, 2, 3 refinements:", [round(b) for b in per_face])
@@ -90,9 +90,9 @@ def test_precomputed_layer_zero_gives_the_same_bits(refdir, monkeypatch):
     from ccproof.evaluate import _table
 
     mesh = read_obj_tagged(refdir / "osd_features" / "meshes" / "catmark_smoothtris1.obj")
-    hot = TaggedLimitSurface(mesh, progress=False)
+    hot = LimitSurface(mesh, progress=False)
     monkeypatch.setattr(_table, "HOT_BUDGET", 0)
-    cold = TaggedLimitSurface(mesh, progress=False)
+    cold = LimitSurface(mesh, progress=False)
     assert hot._table.hot.shape[0] == 3 * hot._table.origin.shape[0] > 0 and cold._table.hot.shape[0] == 0
     rng = np.random.default_rng(5)
     n = 20000

@@ -95,5 +95,5 @@ def test_with_vertices_bad_input():
     from ccproof.mesh.polymesh import PolyMesh
 
     tagged = natural_limit_surface(PolyMesh(cube().vertices, [list(f) for f in cube().faces]))
-    with pytest.raises(CCProofError, match="LimitSurface only"):
+    with pytest.raises(CCProofError, match="quad meshes only, not of a PolyMesh"):
         tagged.with_vertices(cube().vertices)

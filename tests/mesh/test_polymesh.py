@@ -214,3 +214,43 @@ def test_quad_reader_refuses_tags(refdir):
 
     with pytest.raises(MeshError, match=r"catmark_cube_creases0.obj:\d+: OpenSubdiv tag 'crease'"):
         read_obj(refdir / "osd_features" / "meshes" / "catmark_cube_creases0.obj")
+
+
+def test_refine_without_the_operator_gives_the_same_vertices():
+    """refine(operator=False) (the evaluator's setup: no scipy) sums each stencil as the sparse product does."""
+    V = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0.3], [2, 0.5, 0.1], [np.nan, 0, 0]])
+    m = PolyMesh(V, [[0, 1, 2, 3], [1, 4, 2]], creases={(1, 2): 1.5}, options={"triangle_subdivision": "smooth"})
+    m1, S = m.refine()
+    m2, none = m.refine(operator=False)
+    assert none is None
+    assert np.array_equal(m1.vertices, m2.vertices, equal_nan=True)
+    used = ~m2.is_unused_vertex  # the unused NaN vertex stays unused; it enters no used vertex's stencil
+    assert used.sum() == 13 and np.isfinite(m2.vertices[used]).all()
+    assert np.array_equal(m1.vertices[used], (S @ np.where(np.isnan(V), 0.0, V))[used])
+
+
+def test_complex_topology_numpy_equals_the_loop(refdir, monkeypatch):
+    """The numpy construction of a large Complex's half-edge lists gives the loop's lists exactly (twins,
+    edge numbering by first occurrence, corners), on the OpenSubdiv shapes, their refinements and
+    non-manifold meshes (a directed edge repeated: the last one is the twin, as the loop's dict keeps)."""
+    from ccproof.mesh import rules
+    from ccproof.mesh.io import read_mesh
+
+    names = ["osd_features/meshes/catmark_nonquads.obj", "osd_features/meshes/catmark_smoothtris1.obj",
+             "meshes/bunny_quads.obj", "osd_nonmanifold/meshes/book4.obj", "osd_nonmanifold/meshes/dupface.obj",
+             "osd_nonmanifold/meshes/flipped.obj", "osd_nonmanifold/meshes/collapsed.obj"]
+    attrs = ("start", "org", "face_of", "nxt", "prv", "twin", "edges", "he_edge", "edge_index", "corners")
+    n = 0
+    for name in names:
+        m = read_mesh(refdir / name)
+        faces = [list(p) for p in m.polygons]
+        cases = [faces, [list(f) for f in m.manifold.refine(operator=False)[0].polygons]]
+        for F in cases:
+            monkeypatch.setattr(rules, "_VECTORIZED_FACES", 1 << 30)
+            a = rules.Complex(F, {}, {}, m.options, n_vertices=None)
+            monkeypatch.setattr(rules, "_VECTORIZED_FACES", 1)
+            b = rules.Complex(F, {}, {}, m.options, n_vertices=None)
+            for k in attrs:
+                assert getattr(a, k) == getattr(b, k), (name, k)
+            n += 1
+    assert n == 2 * len(names)

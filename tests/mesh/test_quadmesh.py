@@ -109,3 +109,18 @@ def test_other_bad_faces():
     with pytest.raises(MeshError, match="all quads"):
         QuadMesh(np.zeros((4, 3)), [[0, 1, 2]])
     assert QuadMesh(np.zeros((5, 3)), [[0, 1, 2, 3]]).is_unused_vertex.tolist() == [False] * 4 + [True]
+
+
+def test_connected_components_agree_with_scipy():
+    """The numpy components of the fans against scipy's graph search (labels in the same order)."""
+    import scipy.sparse as sp
+    from scipy.sparse.csgraph import connected_components as scipy_components
+
+    from ccproof.mesh.quadmesh import connected_components
+
+    rng = np.random.default_rng(7)
+    for n, m in ((1, 0), (10, 0), (50, 30), (200, 150), (1000, 990), (3000, 6000)):
+        a, b = rng.integers(0, n, m), rng.integers(0, n, m)
+        ref = scipy_components(sp.coo_matrix((np.ones(m), (a, b)), shape=(n, n)), directed=False)
+        got = connected_components(n, a, b)
+        assert got[0] == ref[0] and np.array_equal(got[1], ref[1]), (n, m)

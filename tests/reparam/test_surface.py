@@ -15,7 +15,7 @@ import ccproof
 from ccproof.errors import CCProofError
 from ccproof.mesh import QuadMesh, limit_normals, write_obj
 from ccproof.mesh.examples import grid, k_regular_disk
-from ccproof.reparam import limit_surface
+from ccproof.reparam import Parameterization, corner_valence, limit_surface
 from ccproof.reparam.blend import face_map
 from ccproof.reparam.corner import _left_masks, characteristic_tangent_masks
 from ccproof.reparam.quadrant import alpha_bound, default_alpha
@@ -79,7 +79,7 @@ def test_vanishing_user_alpha():
     k = 7
     a = 1.5 * alpha_bound(k)
     S = limit_surface(disk(k), alpha=a)
-    assert S.alpha == {7: a}
+    assert S.parameterizations["vanishing"].alphas(S) == {7: a}
     m = np.arange(20, 36)
     n = np.linalg.norm(diagonal(S, m, "vanishing")["Pu"], axis=1)
     slope = np.polyfit(m, np.log2(n), 1)[0]
@@ -135,7 +135,7 @@ def test_same_points_and_chain_rule():
     u, v = rng.uniform(1e-3, 1 - 1e-3, n), rng.uniform(1e-3, 1 - 1e-3, n)
     for param in ("vanishing", "characteristic"):
         r = S.evaluate(f, u, v, 2, parameterization=param)
-        y = face_map(S.corner_valence[f], u, v, param, S.alpha)
+        y = face_map(corner_valence(S.mesh)[f], u, v, param, S.parameterizations["vanishing"].alphas(S))
         nat = S.evaluate(f, y["u"], y["v"], 0)
         assert np.abs(r["P"] - nat["P"]).max() < 1e-14  # bitwise, but for points evaluated in a corner frame
         far = ~(y["active"] & (y["quarter"] > 0) & (y["local"].max(axis=1) < 2.0**-8))
@@ -189,7 +189,7 @@ def test_tangent_continuity_across_edges(param, k):
     na, nb = np.cross(a["Pu"], a["Pv"]), np.cross(b["Pu"], b["Pv"])
     good = (np.linalg.norm(na, axis=1) > 1e-8) & (np.linalg.norm(nb, axis=1) > 1e-8)
     if param == "natural":  # not differentiable at the extraordinary vertex itself
-        irregular = S.corner_valence > 0
+        irregular = corner_valence(S.mesh) > 0
         at_ev = np.concatenate([(lam_pts == 0) & irregular[f, i] | (lam_pts == 1) & irregular[f, (i + 1) % 4]
                                 for f, i, _, _ in _edge_pairs(S.mesh)])
         good &= ~at_ev
@@ -210,7 +210,7 @@ def test_boundary_and_regular_corners_are_identity():
         for key in nat:
             assert np.array_equal(r[key], nat[key])
     D = limit_surface(k_regular_disk(5, 2))
-    assert (D.corner_valence[D.mesh.is_boundary_vertex[D.mesh.faces]] == 0).all()
+    assert (corner_valence(D.mesh)[D.mesh.is_boundary_vertex[D.mesh.faces]] == 0).all()
 
 
 def test_bad_input():
@@ -227,7 +227,8 @@ def test_bad_input():
         limit_surface(disk(5), alpha=1.0)
     with pytest.raises(CCProofError, match="not above the bound"):
         limit_surface(disk(5), alpha={5: alpha_bound(5)})
-    assert limit_surface(disk(5), alpha={3: 2.0}).alpha == {5: default_alpha(5)}
+    S5 = limit_surface(disk(5), alpha={3: 2.0})
+    assert S5.parameterizations["vanishing"].alphas(S5) == {5: default_alpha(5)}
 
 
 def test_top_level_and_out_argument():
@@ -269,3 +270,42 @@ def test_positions_do_not_depend_on_the_derivative_order():
         p0 = S.evaluate(f, u, v, 0, parameterization=param)["P"]
         for d in (1, 2):
             assert np.array_equal(S.evaluate(f, u, v, d, parameterization=param)["P"], p0)
+
+
+def test_parameterization_is_a_value():
+    """The value passed to the evaluator of any quad mesh gives the named parameterization's bits;
+    the natural value is the evaluator's own; names unknown to a surface and tagged meshes are refused."""
+    from ccproof.evaluate import natural_limit_surface
+    from ccproof.mesh import PolyMesh
+
+    mesh = disk(5, roll_seed=5)
+    S, N = limit_surface(mesh, alpha=2.5), natural_limit_surface(mesh)
+    rng = np.random.default_rng(6)
+    f = rng.integers(0, mesh.n_faces, 400)
+    u = np.concatenate([rng.random(200), 1 - 2.0 ** -rng.uniform(5, 40, 200)])
+    v = np.concatenate([rng.random(200), 2.0 ** -rng.uniform(5, 40, 200)])
+    for p in (Parameterization("vanishing", 2.5), Parameterization("characteristic")):
+        a = S.evaluate(f, u, v, 2, parameterization=p.kind)
+        b = N.evaluate(f, u, v, 2, parameterization=p)
+        for key in a:
+            assert np.array_equal(a[key], b[key], equal_nan=True), (p, key)
+    nat = N.evaluate(f, u, v, 2)
+    r = N.evaluate(f, u, v, 2, parameterization=Parameterization("natural"))
+    assert all(np.array_equal(r[k], nat[k]) for k in nat)
+    assert Parameterization("vanishing", {5: 2.5}) == Parameterization("vanishing", {5: 2.5})
+    with pytest.raises(CCProofError, match="unknown parameterization 'vanishing' for this surface"):
+        N.evaluate(f, u, v, parameterization="vanishing")
+    with pytest.raises(CCProofError, match="evaluate_on"):
+        N.evaluate(f, u, v, parameterization=3)
+    with pytest.raises(CCProofError, match="unknown parameterization"):
+        Parameterization("smooth")
+    with pytest.raises(CCProofError, match="alpha applies to the vanishing"):
+        Parameterization("characteristic", alpha=2.0)
+    with pytest.raises(CCProofError, match="not above the bound"):
+        N.evaluate(f, u, v, parameterization=Parameterization("vanishing", 1.0))
+    tri = PolyMesh([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0.5]], [[0, 1, 2], [1, 3, 2]])
+    T = ccproof.limit_surface(tri)
+    with pytest.raises(CCProofError, match="unknown parameterization 'characteristic'"):
+        T.evaluate([0], [0.1], [0.1], parameterization="characteristic")
+    with pytest.raises(CCProofError, match="need an untagged all-quad mesh"):
+        T.evaluate([0], [0.1], [0.1], parameterization=Parameterization("characteristic"))

@@ -1,0 +1,48 @@
+"""The control mesh of arap and fit: every mesh eval reads where the untagged rules are sound.
+
+Independent expectations: the refined mesh's limit surface equals the file's (exact evaluation of
+both, the tagged evaluator on the file, the quad evaluator on the control mesh); refusals name the
+culprit.
+"""
+
+import numpy as np
+import pytest
+
+from ccproof.apps.control_mesh import read_control_mesh
+from ccproof.errors import MeshError
+from ccproof.evaluate import natural_limit_surface
+from ccproof.mesh.io import read_mesh
+
+
+def test_nonmanifold_meshes_are_refused_by_name(refdir):
+    for name, what in (("book4.obj", "non-manifold edge"), ("bowtie.obj", "non-manifold vertex")):
+        with pytest.raises(MeshError, match=what + ".*`ccproof eval` evaluates them"):
+            read_control_mesh(refdir / "osd_nonmanifold" / "meshes" / name)
+
+
+def test_unused_vertices_and_polygons_give_the_files_limit_surface(refdir, tmp_path):
+    """unused.obj (unused vertices, quads) and a pentagonal cap on a prism of quads and triangles with an
+    unused vertex: the control mesh's limit points at the file's vertices equal the tagged evaluator's on
+    the file."""
+    k = 5
+    a = 2 * np.pi * np.arange(k) / k
+    V = np.vstack([np.c_[np.cos(a), np.sin(a), np.zeros(k)], np.c_[np.cos(a), np.sin(a), np.ones(k)],
+                   [[9.0, 9.0, 9.0]], [[0.1, 0.0, 1.6]]])
+    faces = [list(range(k))[::-1]] + [[i, (i + 1) % k, k + (i + 1) % k, k + i] for i in range(k)]
+    faces += [[k + i, k + (i + 1) % k, 2 * k + 1] for i in range(k)]
+    ngon = tmp_path / "capped.obj"
+    ngon.write_text("".join(f"v {x!r} {y!r} {z!r}\n" for x, y, z in V.tolist())
+                    + "".join("f " + " ".join(str(i + 1) for i in f) + "\n" for f in faces))
+    checked = 0
+    for path in (refdir / "osd_nonmanifold" / "meshes" / "unused.obj", ngon):
+        poly = read_mesh(path)
+        assert not poly.has_tags and poly.is_unused_vertex.any()
+        checked += not poly.is_all_quads
+        mesh, sizes = read_control_mesh(path)
+        assert mesh.n_vertices <= poly.n_vertices + (0 if sizes is None else int(sizes.sum()) + len(poly.edges))
+        ref = natural_limit_surface(poly).vertex_limits()
+        got = natural_limit_surface(mesh).vertex_limits()
+        used = np.flatnonzero(~poly.is_unused_vertex)
+        # the control mesh keeps the used vertices first, in their order (dropped unused ones shift them)
+        assert np.abs(got[:used.size] - ref[used]).max() <= 1e-13 * poly.bounding_box_diagonal, path.name
+    assert checked == 1
