@@ -1,0 +1,370 @@
+/* The evaluation kernel of the patch table in C99 (built by setup.py as the optional extension ``ccproof.evaluate._clib``, loaded with ctypes by ccproof/evaluate/_ckernel.py).
+ *
+ * The same arithmetic as the numba kernel (ccproof/evaluate/_numba_kernel.py, evaluate_points) and the
+ * numpy path, point by point: the same sums in the same order, compiled without floating-point
+ * contraction (-ffp-contract=off: no FMA) and without reassociation, so that every backend gives the
+ * same bits. What differs is the layout of the work: the bicubic sums run over the 12 contiguous
+ * doubles (4 control points x 3 coordinates) of one net row at a time, which the compiler vectorizes
+ * (each lane its own sum, in the same order), and the per-dimension variants (derivatives 0, 1, 2)
+ * are compiled separately.
+ *
+ * Threads: the kernel holds no global state; every call allocates its own corner-net cache, so
+ * concurrent calls on disjoint blocks of points (ctypes releases the GIL) are safe and their
+ * results do not depend on the blocks (a net is the same sums whether computed or found in the cache).
+ */
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define CCP_REGULAR 0
+#define CCP_CORNER 1
+#define CCP_SPLIT 2
+/* corner nets kept per call (a power of 2; 408 bytes each) and the smallest call that uses the cache */
+#define CCP_CACHE_SLOTS 16384
+#define CCP_CACHE_MIN 256
+#define CCP_HASH 2654435761u
+#define CCP_NET 51 /* 17 x 3 doubles: 16 net rows relative to row 16, the origin */
+
+#if defined(__GNUC__)
+#define CCP_INLINE static inline __attribute__((always_inline))
+#else
+#define CCP_INLINE static inline
+#endif
+
+#if defined(__GNUC__) && defined(__x86_64__) && defined(__linux__) && !defined(CCP_NO_CLONES)
+/* one binary for every x86-64 machine: the loader picks the widest variant the CPU runs */
+#define CCP_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
+#else
+#define CCP_CLONES
+#endif
+
+/* The patch table (ccproof.evaluate._table.PatchTable), as pointers into its numpy arrays. The five
+ * per-face offset arrays are int32 or int64 (``wide``); every other integer array is int64, except
+ * ``kind`` (int8) and the bools (one byte). Field order and types: _ckernel.py, _Table. */
+typedef struct {
+    const void *top, *job_root, *job_net, *job_corner, *job_pts;
+    int64_t wide[5];
+    const uint8_t *refused;
+    const int8_t *kind;
+    const int64_t *child;
+    const double *u0, *v0, *h;
+    const int64_t *leaf, *pts, *cfg;
+    const uint8_t *cu, *cv;
+    int64_t split_depth;
+    int64_t n_ptex;
+    int64_t max_layers; /* max(1, max n_layers): the cache key's stride */
+    const double *nets, *origin, *ring, *ops;
+    const int64_t *op_start, *op_size, *n_layers;
+    const double *unit;
+    const double *hot;
+    int64_t n_hot; /* rows of ``hot`` (0: none) */
+} ccp_table;
+
+CCP_INLINE int64_t ld(const void *a, int64_t wide, int64_t i) {
+    return wide ? ((const int64_t *)a)[i] : (int64_t)((const int32_t *)a)[i];
+}
+
+/* Cubic B-spline basis at x and its first and second derivatives (bspline_basis's formulas, the same
+ * operations in the same order as the numba kernel's _basis). */
+CCP_INLINE void basis(double x, double *b) {
+    double t = 1.0 - x, x2 = x * x, x3 = x2 * x;
+    b[0] = t * t * t / 6;
+    b[1] = (3 * x3 - 6 * x2 + 4) / 6;
+    b[2] = (-3 * x3 + 3 * x2 + 3 * x + 1) / 6;
+    b[3] = x3 / 6;
+    b[4] = -0.5 * t * t;
+    b[5] = 1.5 * x2 - 2 * x;
+    b[6] = -1.5 * x2 + x + 0.5;
+    b[7] = 0.5 * x2;
+    b[8] = t;
+    b[9] = 3 * x - 2;
+    b[10] = -3 * x + 1;
+    b[11] = x;
+}
+
+#if defined(__GNUC__)
+/* Four doubles, the lanes of one SIMD register (AVX2; two SSE2 registers or half an AVX-512 one): each
+ * lane its own IEEE operations, the same as the scalar code's. */
+typedef double v4d __attribute__((vector_size(32), aligned(8)));
+
+CCP_INLINE v4d ld4(const double *p) {
+    v4d r;
+    memcpy(&r, p, sizeof r);
+    return r;
+}
+
+CCP_INLINE v4d splat(double x) { return (v4d){x, x, x, x}; }
+
+#if defined(__clang__)
+#define CCP_SHUF(a, b, i, j, k, l) __builtin_shufflevector(a, b, i, j, k, l)
+#else
+#define CCP_SHUF(a, b, i, j, k, l) __builtin_shuffle(a, b, (v4di){i, j, k, l})
+typedef int64_t v4di __attribute__((vector_size(32)));
+#endif
+
+/* The columns sum_j b_j net[i + 4 j, c] of the 4 x 4 x 3 net, as (i, c) lanes: three vectors of 4 lanes,
+ * lanes 3 i + c, each summed over j = 0..3 from 0.0 in order; returned rearranged as X[i] = the three
+ * coordinates of column i (lane 3 unused). */
+CCP_INLINE void columns(const double *net, const double *b, v4d *X) {
+    v4d b0 = splat(b[0]), b1 = splat(b[1]), b2 = splat(b[2]), b3 = splat(b[3]), z = splat(0.0), T[3];
+    for (int m = 0; m < 3; m++)
+        T[m] = (((z + b0 * ld4(net + 4 * m)) + b1 * ld4(net + 12 + 4 * m)) + b2 * ld4(net + 24 + 4 * m)) +
+               b3 * ld4(net + 36 + 4 * m);
+    X[0] = T[0];
+    X[1] = CCP_SHUF(T[0], T[1], 3, 4, 5, 6);
+    X[2] = CCP_SHUF(T[1], T[2], 2, 3, 4, 5);
+    X[3] = CCP_SHUF(T[2], T[2], 1, 2, 3, 3);
+}
+
+/* sum_i a_i X[i] from 0.0, left to right, for the three coordinates at once */
+CCP_INLINE v4d sum4v(const double *a, const v4d *X) {
+    return (((splat(0.0) + splat(a[0]) * X[0]) + splat(a[1]) * X[1]) + splat(a[2]) * X[2]) + splat(a[3]) * X[3];
+}
+
+CCP_INLINE void put3(double *dst, v4d x) { memcpy(dst, &x, 3 * sizeof(double)); }
+
+/* basis(x) with its four divisions by 6 as one vector division (the same IEEE operations lane by lane) */
+CCP_INLINE void basisv(double x, double *b) {
+    double t = 1.0 - x, x2 = x * x, x3 = x2 * x;
+    v4d n = {t * t * t, 3 * x3 - 6 * x2 + 4, -3 * x3 + 3 * x2 + 3 * x + 1, x3};
+    v4d q = n / splat(6.0);
+    memcpy(b, &q, sizeof q);
+    b[4] = -0.5 * t * t;
+    b[5] = 1.5 * x2 - 2 * x;
+    b[6] = -1.5 * x2 + x + 0.5;
+    b[7] = 0.5 * x2;
+    b[8] = t;
+    b[9] = 3 * x - 2;
+    b[10] = -3 * x + 1;
+    b[11] = x;
+}
+
+/* Row k of P and of the derivatives up to order D from the net (17 x 3) at (s, t), derivatives scaled
+ * by g per order (D a compile-time constant in each caller): the columns T_r[i] = sum_j B_r(t)_j
+ * net[i + 4 j], then sum_i B(s)_i T_r[i], each sum from 0.0 left to right (the numba kernel's order). */
+CCP_INLINE void bicubic(const double *net, double s, double t, double g, const int D, int64_t k, double *P,
+                        double *Pu, double *Pv, double *Puu, double *Puv, double *Pvv) {
+    double bs[12], bt[12];
+    v4d T0[4], T1[4], T2[4];
+    basisv(s, bs);
+    basisv(t, bt);
+    columns(net, bt, T0);
+    put3(P + 3 * k, (v4d){net[48], net[49], net[50], 0.0} + sum4v(bs, T0));
+    if (D >= 1) {
+        v4d gg = splat(g);
+        columns(net, bt + 4, T1);
+        put3(Pu + 3 * k, sum4v(bs + 4, T0) * gg);
+        put3(Pv + 3 * k, sum4v(bs, T1) * gg);
+    }
+    if (D >= 2) {
+        v4d g2 = splat(g * g);
+        columns(net, bt + 8, T2);
+        put3(Puu + 3 * k, sum4v(bs + 8, T0) * g2);
+        put3(Puv + 3 * k, sum4v(bs + 4, T1) * g2);
+        put3(Pvv + 3 * k, sum4v(bs, T2) * g2);
+    }
+}
+#else
+/* sum_j a_j w_j from 0.0, left to right */
+CCP_INLINE double sum4(const double *a, double w0, double w1, double w2, double w3) {
+    return (((0.0 + a[0] * w0) + a[1] * w1) + a[2] * w2) + a[3] * w3;
+}
+
+/* The columns T[3 i + c] = sum_j b_j net[i + 4 j, c] (12 lanes, each summed over j in order). */
+CCP_INLINE void columns(const double *net, const double *b, double *T) {
+    for (int k = 0; k < 12; k++)
+        T[k] = (((0.0 + b[0] * net[k]) + b[1] * net[12 + k]) + b[2] * net[24 + k]) + b[3] * net[36 + k];
+}
+
+/* Row k of P and of the derivatives up to order D (see the vector version above). */
+CCP_INLINE void bicubic(const double *net, double s, double t, double g, const int D, int64_t k, double *P,
+                        double *Pu, double *Pv, double *Puu, double *Puv, double *Pvv) {
+    double bs[12], bt[12], T0[12], T1[12], T2[12];
+    basis(s, bs);
+    basis(t, bt);
+    columns(net, bt, T0);
+    for (int c = 0; c < 3; c++)
+        P[3 * k + c] = net[48 + c] + sum4(bs, T0[c], T0[3 + c], T0[6 + c], T0[9 + c]);
+    if (D >= 1) {
+        columns(net, bt + 4, T1);
+        for (int c = 0; c < 3; c++) {
+            Pu[3 * k + c] = sum4(bs + 4, T0[c], T0[3 + c], T0[6 + c], T0[9 + c]) * g;
+            Pv[3 * k + c] = sum4(bs, T1[c], T1[3 + c], T1[6 + c], T1[9 + c]) * g;
+        }
+    }
+    if (D >= 2) {
+        double g2 = g * g;
+        columns(net, bt + 8, T2);
+        for (int c = 0; c < 3; c++) {
+            Puu[3 * k + c] = sum4(bs + 8, T0[c], T0[3 + c], T0[6 + c], T0[9 + c]) * g2;
+            Puv[3 * k + c] = sum4(bs + 4, T1[c], T1[3 + c], T1[6 + c], T1[9 + c]) * g2;
+            Pvv[3 * k + c] = sum4(bs, T2[c], T2[3 + c], T2[6 + c], T2[9 + c]) * g2;
+        }
+    }
+}
+#endif
+
+/* Net W (17 x 3, row 16 the limit point) of patch ``code`` of layer ``lay`` of the corner face ``vf`` of
+ * ``job``: L[lay, code] @ ring summed over the ring points j = 1, 2, ... in order, from 0.0. */
+static void corner_net(const ccp_table *T, int64_t job, int64_t vf, int64_t cfg, int64_t lay, int64_t code,
+                       int64_t ci, double *W) {
+    int64_t Nc = T->op_size[cfg];
+    const double *op = T->ops + T->op_start[cfg] + (3 * lay + code) * 16 * Nc;
+    const double *rg = T->ring + 3 * (ld(T->job_pts, T->wide[4], job) + T->pts[vf] - 1);
+    double a0[16], a1[16], a2[16];
+    for (int i = 0; i < 16; i++) a0[i] = a1[i] = a2[i] = 0.0;
+    for (int64_t j = 1; j < Nc; j++) {
+        double r0 = rg[3 * j], r1 = rg[3 * j + 1], r2 = rg[3 * j + 2];
+        const double *w = op + 16 * j;
+        for (int i = 0; i < 16; i++) {
+            a0[i] += w[i] * r0;
+            a1[i] += w[i] * r1;
+            a2[i] += w[i] * r2;
+        }
+    }
+    for (int i = 0; i < 16; i++) {
+        W[3 * i] = a0[i];
+        W[3 * i + 1] = a1[i];
+        W[3 * i + 2] = a2[i];
+    }
+    for (int c = 0; c < 3; c++) W[48 + c] = T->origin[3 * ci + c];
+}
+
+typedef struct {
+    double *nets;  /* CCP_CACHE_SLOTS x 51, allocated on first use */
+    int64_t *tags; /* key + 1 of the net in each slot, 0: empty */
+    int failed;
+} ccp_cache;
+
+/* The net of point (pf, uu, ww), its parameter (s, t) in the patch and the scale g = 1 / h; W: the
+ * scratch net of a corner point when there is no cache. Returns NULL for a point evaluation refuses. */
+CCP_INLINE const double *locate(const ccp_table *T, int64_t pf, double uu, double ww, int use_cache,
+                                   ccp_cache *C, double *W, double *s, double *t, double *g) {
+    if (pf < 0 || pf >= T->n_ptex || !(uu >= 0.0 && uu <= 1.0 && ww >= 0.0 && ww <= 1.0) || T->refused[pf])
+        return NULL;
+    int64_t q = (uu >= 0.5) + 2 * (ww >= 0.5);
+    int64_t job = ld(T->top, T->wide[0], 4 * pf + q);
+    int64_t vf = ld(T->job_root, T->wide[1], job);
+    int kind = T->kind[vf];
+    for (int64_t it = 0; it < T->split_depth && kind == CCP_SPLIT; it++) {
+        double half = T->h[vf] * 0.5;
+        q = (uu >= T->u0[vf] + half) + 2 * (ww >= T->v0[vf] + half);
+        vf = T->child[4 * vf + q];
+        kind = T->kind[vf];
+    }
+    const double *net;
+    double pu0, pv0, h;
+    if (kind == CCP_CORNER) {
+        double U0 = T->u0[vf], V0 = T->v0[vf], H = T->h[vf];
+        int cu = T->cu[vf], cv = T->cv[vf];
+        double du = (cu ? (U0 + H) - uu : uu - U0) / H;
+        double dv = (cv ? (V0 + H) - ww : ww - V0) / H;
+        double mx = du >= dv ? du : dv;
+        int64_t cfg = T->cfg[vf];
+        int64_t nmax = T->n_layers[cfg] - 1, lay;
+        if (mx > 0) {
+            int e;
+            frexp(mx, &e);
+            lay = -(int64_t)e;
+            if (lay < 0) lay = 0;
+            if (lay > nmax) lay = nmax;
+        } else {
+            lay = nmax;
+        }
+        du = ldexp(du, (int)lay);
+        dv = ldexp(dv, (int)lay);
+        int a = du >= 0.5, b = dv >= 0.5;
+        int64_t code = (a && !b) ? 0 : (a && b) ? 1 : b ? 2 : 1;
+        double sc = ldexp(H, -(int)lay);
+        const double *un = T->unit + 9 * cfg + 3 * code;
+        pu0 = un[0] * sc + (cu ? (U0 + H) : U0);
+        pv0 = un[1] * sc + (cv ? (V0 + H) : V0);
+        h = un[2] * sc;
+        int64_t ci = ld(T->job_corner, T->wide[3], job) + T->leaf[vf];
+        if (lay == 0 && T->n_hot > 0) {
+            net = T->hot + CCP_NET * (3 * ci + code);
+        } else if (use_cache && !C->failed) {
+            if (C->nets == NULL) {
+                C->nets = (double *)malloc(sizeof(double) * CCP_NET * CCP_CACHE_SLOTS);
+                C->tags = (int64_t *)calloc(CCP_CACHE_SLOTS, sizeof(int64_t));
+                if (C->nets == NULL || C->tags == NULL) C->failed = 1;
+            }
+            if (C->failed) {
+                corner_net(T, job, vf, cfg, lay, code, ci, W);
+                net = W;
+            } else {
+                int64_t key = 3 * (T->max_layers * ci + lay) + code;
+                int64_t p = (int64_t)(((uint64_t)key * CCP_HASH) & (CCP_CACHE_SLOTS - 1));
+                net = C->nets + CCP_NET * p;
+                if (C->tags[p] != key + 1) {
+                    corner_net(T, job, vf, cfg, lay, code, ci, C->nets + CCP_NET * p);
+                    C->tags[p] = key + 1;
+                }
+            }
+        } else {
+            corner_net(T, job, vf, cfg, lay, code, ci, W);
+            net = W;
+        }
+    } else {
+        net = T->nets + CCP_NET * (ld(T->job_net, T->wide[2], job) + T->leaf[vf]);
+        pu0 = T->u0[vf];
+        pv0 = T->v0[vf];
+        h = T->h[vf];
+    }
+    double x = (uu - pu0) / h, y = (ww - pv0) / h;
+    x = 0.0 > x ? 0.0 : x; /* min(max(x, 0.0), 1.0) with Python's max and min */
+    y = 0.0 > y ? 0.0 : y;
+    *s = 1.0 < x ? 1.0 : x;
+    *t = 1.0 < y ? 1.0 : y;
+    *g = 1.0 / h;
+    return net;
+}
+
+CCP_INLINE int64_t run(const ccp_table *T, int64_t n, const int64_t *f, const double *u, const double *v,
+                          const int D, double *P, double *Pu, double *Pv, double *Puu, double *Puv, double *Pvv) {
+    ccp_cache C = {NULL, NULL, 0};
+    double W[CCP_NET];
+    int use_cache = n >= CCP_CACHE_MIN;
+    int64_t bad = -1;
+    for (int64_t k = 0; k < n; k++) {
+        double s, t, g;
+        const double *net = locate(T, f[k], u[k], v[k], use_cache, &C, W, &s, &t, &g);
+        if (net == NULL) {
+            bad = k;
+            break;
+        }
+        bicubic(net, s, t, g, D, k, P, Pu, Pv, Puu, Puv, Pvv);
+    }
+    free(C.nets);
+    free(C.tags);
+    return bad;
+}
+
+CCP_CLONES static int64_t run0(const ccp_table *T, int64_t n, const int64_t *f, const double *u, const double *v,
+                               double *P) {
+    return run(T, n, f, u, v, 0, P, NULL, NULL, NULL, NULL, NULL);
+}
+
+CCP_CLONES static int64_t run1(const ccp_table *T, int64_t n, const int64_t *f, const double *u, const double *v,
+                               double *P, double *Pu, double *Pv) {
+    return run(T, n, f, u, v, 1, P, Pu, Pv, NULL, NULL, NULL);
+}
+
+CCP_CLONES static int64_t run2(const ccp_table *T, int64_t n, const int64_t *f, const double *u, const double *v,
+                               double *P, double *Pu, double *Pv, double *Puu, double *Puv, double *Pvv) {
+    return run(T, n, f, u, v, 2, P, Pu, Pv, Puu, Puv, Pvv);
+}
+
+/* Fill P (n x 3) and, for d >= 1, Pu, Pv, for d >= 2, Puu, Puv, Pvv (n x 3 each, C order) at the points
+ * (f[k], u[k], v[k]). Returns -1, or the index of the first point whose face is out of range or refused
+ * or whose (u, v) is outside [0, 1]^2 or NaN (the outputs from that point on are not written). */
+int64_t ccp_evaluate(const ccp_table *T, int64_t n, const int64_t *f, const double *u, const double *v, int64_t d,
+                     double *P, double *Pu, double *Pv, double *Puu, double *Puv, double *Pvv) {
+    if (d <= 0) return run0(T, n, f, u, v, P);
+    if (d == 1) return run1(T, n, f, u, v, P, Pu, Pv);
+    return run2(T, n, f, u, v, P, Pu, Pv, Puu, Puv, Pvv);
+}
+
+/* The layout this file was compiled with: the binding refuses a library whose structure differs. */
+int64_t ccp_abi(void) { return 1000 * (int64_t)sizeof(ccp_table) + 1; }
