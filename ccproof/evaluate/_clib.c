@@ -28,8 +28,10 @@
 
 #if defined(__GNUC__)
 #define CCP_INLINE static inline __attribute__((always_inline))
+#define CCP_PREFETCH(p) __builtin_prefetch(p)
 #else
 #define CCP_INLINE static inline
+#define CCP_PREFETCH(p) ((void)(p))
 #endif
 
 #if defined(__GNUC__) && defined(__x86_64__) && defined(__linux__) && !defined(CCP_NO_CLONES)
@@ -232,10 +234,37 @@ static void corner_net(const ccp_table *T, int64_t job, int64_t vf, int64_t cfg,
 }
 
 typedef struct {
-    double *nets;  /* CCP_CACHE_SLOTS x 51, allocated on first use */
-    int64_t *tags; /* key + 1 of the net in each slot, 0: empty */
+    double *nets;   /* CCP_CACHE_SLOTS x 51, allocated on first use */
+    int64_t *tags;  /* key + 1 of the net in each slot, 0: empty */
+    int64_t *stamp; /* the block that last took the slot's net (a pending point reads it) */
+    int64_t block;  /* the current block */
     int failed;
 } ccp_cache;
+
+/* locate's answer when a point needs a slot whose net a pending point of this block still reads */
+static const double CCP_BUSY[1] = {0.0};
+
+/* 2^k for -1022 <= k <= 1023 (an exact power of two: scaling by it is ldexp while the result is normal;
+ * here k is a layer, at most a few hundred) */
+CCP_INLINE double pow2(int64_t k) {
+    uint64_t b = (uint64_t)(1023 + k) << 52;
+    double x;
+    memcpy(&x, &b, sizeof x);
+    return x;
+}
+
+/* The exponent e of frexp(x) (x = m 2^e, 1/2 <= m < 1) for x > 0 */
+CCP_INLINE int64_t expo(double x) {
+    uint64_t b;
+    memcpy(&b, &x, sizeof b);
+    int64_t f = (int64_t)((b >> 52) & 0x7ff);
+    if (f == 0) { /* subnormal */
+        int e;
+        frexp(x, &e);
+        return e;
+    }
+    return f - 1022;
+}
 
 /* The net of point (pf, uu, ww), its parameter (s, t) in the patch and the scale g = 1 / h; W: the
  * scratch net of a corner point when there is no cache. Returns NULL for a point evaluation refuses. */
@@ -264,19 +293,19 @@ CCP_INLINE const double *locate(const ccp_table *T, int64_t pf, double uu, doubl
         int64_t cfg = T->cfg[vf];
         int64_t nmax = T->n_layers[cfg] - 1, lay;
         if (mx > 0) {
-            int e;
-            frexp(mx, &e);
-            lay = -(int64_t)e;
+            int64_t e = expo(mx);
+            lay = -e;
             if (lay < 0) lay = 0;
             if (lay > nmax) lay = nmax;
         } else {
             lay = nmax;
         }
-        du = ldexp(du, (int)lay);
-        dv = ldexp(dv, (int)lay);
+        double up = pow2(lay); /* exact scalings: ldexp(du, lay), ldexp(dv, lay), ldexp(H, -lay) */
+        du = du * up;
+        dv = dv * up;
         int a = du >= 0.5, b = dv >= 0.5;
         int64_t code = (a && !b) ? 0 : (a && b) ? 1 : b ? 2 : 1;
-        double sc = ldexp(H, -(int)lay);
+        double sc = H * pow2(-lay);
         const double *un = T->unit + 9 * cfg + 3 * code;
         pu0 = un[0] * sc + (cu ? (U0 + H) : U0);
         pv0 = un[1] * sc + (cv ? (V0 + H) : V0);
@@ -288,7 +317,8 @@ CCP_INLINE const double *locate(const ccp_table *T, int64_t pf, double uu, doubl
             if (C->nets == NULL) {
                 C->nets = (double *)malloc(sizeof(double) * CCP_NET * CCP_CACHE_SLOTS);
                 C->tags = (int64_t *)calloc(CCP_CACHE_SLOTS, sizeof(int64_t));
-                if (C->nets == NULL || C->tags == NULL) C->failed = 1;
+                C->stamp = (int64_t *)calloc(CCP_CACHE_SLOTS, sizeof(int64_t));
+                if (C->nets == NULL || C->tags == NULL || C->stamp == NULL) C->failed = 1;
             }
             if (C->failed) {
                 corner_net(T, job, vf, cfg, lay, code, ci, W);
@@ -298,9 +328,11 @@ CCP_INLINE const double *locate(const ccp_table *T, int64_t pf, double uu, doubl
                 int64_t p = (int64_t)(((uint64_t)key * CCP_HASH) & (CCP_CACHE_SLOTS - 1));
                 net = C->nets + CCP_NET * p;
                 if (C->tags[p] != key + 1) {
+                    if (C->stamp[p] == C->block) return CCP_BUSY;
                     corner_net(T, job, vf, cfg, lay, code, ci, C->nets + CCP_NET * p);
                     C->tags[p] = key + 1;
                 }
+                C->stamp[p] = C->block;
             }
         } else {
             corner_net(T, job, vf, cfg, lay, code, ci, W);
@@ -312,32 +344,53 @@ CCP_INLINE const double *locate(const ccp_table *T, int64_t pf, double uu, doubl
         pv0 = T->v0[vf];
         h = T->h[vf];
     }
+#if defined(__GNUC__)
+    v4d qq = (v4d){uu - pu0, ww - pv0, 1.0, 1.0} / splat(h); /* three divisions in one */
+    double x = qq[0], y = qq[1];
+    *g = qq[2];
+#else
     double x = (uu - pu0) / h, y = (ww - pv0) / h;
+    *g = 1.0 / h;
+#endif
     x = 0.0 > x ? 0.0 : x; /* min(max(x, 0.0), 1.0) with Python's max and min */
     y = 0.0 > y ? 0.0 : y;
     *s = 1.0 < x ? 1.0 : x;
     *t = 1.0 < y ? 1.0 : y;
-    *g = 1.0 / h;
     return net;
 }
 
+/* Points per block: the first pass locates them (and prefetches their nets), the second evaluates them. */
+#define CCP_BLOCK 32
+
 CCP_INLINE int64_t run(const ccp_table *T, int64_t n, const int64_t *f, const double *u, const double *v,
-                          const int D, double *P, double *Pu, double *Pv, double *Puu, double *Puv, double *Pvv) {
-    ccp_cache C = {NULL, NULL, 0};
-    double W[CCP_NET];
+                       const int D, double *P, double *Pu, double *Pv, double *Puu, double *Puv, double *Pvv) {
+    ccp_cache C = {NULL, NULL, NULL, 1, 0};
+    double W[CCP_NET], S[CCP_BLOCK], Tt[CCP_BLOCK], G[CCP_BLOCK];
+    const double *N[CCP_BLOCK];
     int use_cache = n >= CCP_CACHE_MIN;
-    int64_t bad = -1;
-    for (int64_t k = 0; k < n; k++) {
-        double s, t, g;
-        const double *net = locate(T, f[k], u[k], v[k], use_cache, &C, W, &s, &t, &g);
-        if (net == NULL) {
-            bad = k;
-            break;
+    int64_t bad = -1, k = 0;
+    while (k < n && bad < 0) {
+        int64_t k0 = k;
+        int m = 0;
+        C.block++;
+        while (k < n && m < CCP_BLOCK) {
+            const double *net = locate(T, f[k], u[k], v[k], use_cache, &C, W, S + m, Tt + m, G + m);
+            if (net == NULL) {
+                bad = k;
+                break;
+            }
+            if (net == CCP_BUSY) break; /* evaluate the pending points first; this one opens the next block */
+            N[m++] = net;
+            k++;
+            if (net == W) break; /* the scratch net: evaluated before the next point overwrites it */
+            for (int i = 0; i < CCP_NET; i += 8) CCP_PREFETCH(net + i);
+            CCP_PREFETCH(net + CCP_NET - 1);
         }
-        bicubic(net, s, t, g, D, k, P, Pu, Pv, Puu, Puv, Pvv);
+        for (int i = 0; i < m; i++) bicubic(N[i], S[i], Tt[i], G[i], D, k0 + i, P, Pu, Pv, Puu, Puv, Pvv);
     }
     free(C.nets);
     free(C.tags);
+    free(C.stamp);
     return bad;
 }
 
