@@ -4,9 +4,9 @@
 Measures, in one run:
 
 1. points per second for positions + first derivatives at 10^6 random (face, u, v) on
-   ``bunny_quads.obj`` (2,036 quads, 103 extraordinary vertices), for the numpy kernel and, when
-   numba is installed, the compiled kernel; wall-clock and CPU-time rates (the CPU-time rate is
-   the single-thread rate even on a loaded machine);
+   ``bunny_quads.obj`` (2,036 quads, 103 extraordinary vertices), for every backend of this install
+   (numpy; numba where installed; the C kernel where built); wall-clock and CPU-time rates (the
+   CPU-time rate is the single-thread rate even on a loaded machine);
 2. (a) a straightforward per-point implementation (Python loop over points, the same tables)
    on a subsample, extrapolated to the same number of points: ratio;
 3. (b) uniform Catmull-Clark subdivision with pygel3d (if installed) level by level: time,
@@ -19,12 +19,13 @@ Measures, in one run:
    ctypes; skipped with that instruction without it): Far (adaptive isolation level 10, Gregory end caps,
    PatchMap, EvaluateBasis) and Bfr (a prepared Surface per face, approximation level 10), on the bunny, a
    crease shape and a triangle shape. Setup times, and points/s for 10^6 uniform points and 10^6 points
-   within 10^-3 (in u and v) of the corners at extraordinary vertices; Far, Bfr, our numpy and compiled
-   kernels take turns round by round (at least 7 rounds; min, median, max; the 1-minute load before each
-   round), the process pinned to one CPU; the ratio to Far is taken per round. Also this machine's two
-   bounds on one thread (ideal compiled work on one net: compute; read bandwidth / 92 bytes: memory), the
-   fraction of each reached, the two-thread gain of the compiled kernel against the machine's ceiling on
-   ideal work, and the largest position difference.
+   within 10^-3 (in u and v) of the corners at extraordinary vertices; Far, Bfr, our numpy path and
+   compiled kernels (C and numba) take turns round by round (at least 7 rounds; min, median, max; the
+   1-minute load before each round), the process pinned to one CPU; the ratio to Far is taken per round.
+   Also this machine's two bounds on one thread (ideal compiled work on one net, ``scripts/bench_ideal.c``
+   built with gcc -O3 -march=native -ffast-math: compute; read bandwidth / 92 bytes: memory), the fraction
+   of each reached, the two-thread gain of the default kernel against the machine's ceiling on the same
+   ideal work split over the threads, and the largest position difference.
 
 The bunny mesh is read from the repository's test data (``tests/data/meshes/bunny_quads.obj``).
 
@@ -50,7 +51,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))  # scripts/_osd.py
 
 from ccproof.evaluate import natural_limit_surface as limit_surface  # noqa: E402
 from ccproof.evaluate.local import CORNERS  # noqa: E402
-from ccproof.evaluate.surface import _CORNER, _SPLIT  # noqa: E402
+from ccproof.evaluate.surface import _CORNER, _SPLIT, available_backends  # noqa: E402
 from ccproof.mesh import limit_normals, limit_positions, read_obj, subdivide  # noqa: E402
 from ccproof.mesh.io import read_mesh  # noqa: E402
 
@@ -146,13 +147,64 @@ def interleaved(cases, rounds):
     return times, load
 
 
+def _ideal_c():
+    """``ideal(s, t, net, P, Pu, Pv)`` compiled from ``scripts/bench_ideal.c`` with gcc (-O3 -march=native
+    -ffast-math) into the temp folder, or None without gcc."""
+    import ctypes
+    import hashlib
+    import shutil
+    import subprocess
+    import tempfile
+
+    src = Path(__file__).with_name("bench_ideal.c")
+    if shutil.which("gcc") is None:
+        return None
+    code = src.read_bytes()
+    so = Path(tempfile.gettempdir()) / f"ccproof_bench_ideal-{hashlib.sha256(code).hexdigest()[:16]}.so"
+    if not so.exists():
+        tmp = so.with_suffix(".tmp.so")
+        r = subprocess.run(["gcc", "-O3", "-march=native", "-ffast-math", "-shared", "-fPIC", str(src), "-o",
+                            str(tmp)], capture_output=True, text=True)
+        if r.returncode != 0:
+            return None
+        tmp.replace(so)
+    lib = ctypes.CDLL(str(so))
+    lib.ideal.argtypes = [ctypes.c_int64] + [ctypes.c_void_p] * 6
+    lib.ideal.restype = None
+
+    def ideal(s, t, net, P, Pu, Pv):
+        lib.ideal(s.size, *(a.ctypes.data for a in (s, t, net, P, Pu, Pv)))
+
+    return ideal
+
+
 def hardware_bounds(quick=False):
     """The two bounds of this machine for P + Pu + Pv, in points/s on one thread:
 
     * compute: the evaluator's own arithmetic on one bicubic net held in registers/L1 (the 16-term sums
-      of ``bspline_basis``), compiled, no gather, no table: ideal compiled work;
+      of ``bspline_basis``), compiled with every freedom (scripts/bench_ideal.c: gcc -O3 -march=native
+      -ffast-math, vectorized across points; numba without gcc), no gather, no table: ideal compiled work;
     * memory: read bandwidth of one core (summing a 256 MiB array) / BYTES_PER_POINT.
     """
+    ideal = _ideal_c()
+    if ideal is None:
+        ideal = _ideal_numba()
+    n = 200_000 if quick else 2_000_000
+    rng = np.random.default_rng(1)
+    s, t, net = rng.random(n), rng.random(n), rng.random((16, 3))
+    P, Pu, Pv = (np.empty((n, 3)) for _ in range(3))
+    ideal(s[:4], t[:4], net, P, Pu, Pv)
+    a = np.ones((32 << 20) // (8 if quick else 1))  # 256 MiB (quick: 32 MiB)
+    with _Pinned():
+        times, _ = interleaved({"ideal": lambda: ideal(s, t, net, P, Pu, Pv), "read": lambda: a.sum()},
+                               3 if quick else 7)
+    compute = n / min(times["ideal"])
+    bandwidth = a.nbytes / min(times["read"])
+    return compute, bandwidth / BYTES_PER_POINT, bandwidth
+
+
+def _ideal_numba():
+    """The ideal loop of :func:`hardware_bounds` in numba (scalar: no fastmath), where gcc is missing."""
     import numba
 
     @numba.njit(nogil=True, inline="always")
@@ -181,18 +233,7 @@ def hardware_bounds(quick=False):
                 Pu[i, c] = c0 * g0 + c1 * g1 + c2 * g2 + c3 * g3
                 Pv[i, c] = e0 * a0 + e1 * a1 + e2 * a2 + e3 * a3
 
-    n = 200_000 if quick else 2_000_000
-    rng = np.random.default_rng(1)
-    s, t, net = rng.random(n), rng.random(n), rng.random((16, 3))
-    P, Pu, Pv = (np.empty((n, 3)) for _ in range(3))
-    ideal(s[:4], t[:4], net, P, Pu, Pv)
-    a = np.ones((32 << 20) // (8 if quick else 1))  # 256 MiB (quick: 32 MiB)
-    with _Pinned():
-        times, _ = interleaved({"ideal": lambda: ideal(s, t, net, P, Pu, Pv), "read": lambda: a.sum()},
-                               3 if quick else 7)
-    compute = n / min(times["ideal"])
-    bandwidth = a.nbytes / min(times["read"])
-    return compute, bandwidth / BYTES_PER_POINT, bandwidth
+    return ideal
 
 
 def _stats(x):
@@ -216,13 +257,15 @@ def osd_side_by_side(n, rng, quick=False, setup_only=False, rounds=7):
     threads = len(os.sched_getaffinity(0))
     rounds = 2 if quick else rounds
     compute = memory = None
-    if _has_numba() and not setup_only:
+    if not setup_only:
         compute, memory, bw = hardware_bounds(quick)
         print(f"   this machine, one thread: ideal compiled work {compute / 1e6:.1f} M points/s (compute bound); "
               f"read bandwidth {bw / 2**30:.1f} GiB/s / {BYTES_PER_POINT} B = {memory / 1e6:.1f} M points/s "
               f"(memory bound)")
         if threads > 1:
             machine_ceiling(threads, quick)
+    default = available_backends()[0]  # what evaluate uses without backend=
+    print(f"   backends: {', '.join(available_backends())} (default {default})")
     rows = []
     for label, path in SHAPES:
         mesh = read_mesh(path)
@@ -249,7 +292,7 @@ def osd_side_by_side(n, rng, quick=False, setup_only=False, rounds=7):
         fu, su, tu = uniform_points(mesh, n, rng)
         fn, sn, tn, npairs = near_ev_points(mesh, n, rng)
         for dist, (f, s, t) in (("uniform", (fu, su, tu)), ("near EVs", (fn, sn, tn))):
-            outs = {k: tuple(np.empty((n, 3)) for _ in range(3)) for k in ("far", "bfr", "numba", "numpy")}
+            outs = {k: tuple(np.empty((n, 3)) for _ in range(3)) for k in ("far", "bfr", "c", "numba", "numpy")}
 
             def ours(be, th, key, f=f, s=s, t=t, outs=outs, S=S):
                 o = outs[key]
@@ -260,6 +303,8 @@ def osd_side_by_side(n, rng, quick=False, setup_only=False, rounds=7):
                      "numpy": lambda: ours("numpy", 1, "numpy")}
             if _has_numba():
                 cases["numba"] = lambda: ours("numba", 1, "numba")
+            if "c" in available_backends():
+                cases["c"] = lambda: ours("c", 1, "c")
             for c in cases.values():  # warm up (compile)
                 c()
             with _Pinned():
@@ -267,7 +312,7 @@ def osd_side_by_side(n, rng, quick=False, setup_only=False, rounds=7):
             rate = {k: n / np.asarray(v) for k, v in times.items()}
             ratio = {k: rate[k] / rate["far"] for k in rate}  # per round: the same round's Far
             oP = outs["far"][0]
-            P = outs["numba" if "numba" in outs else "numpy"][0]
+            P = outs[default][0]
             dP = np.abs(P - oP).max() / diag
             dB = np.abs(outs["bfr"][0] - oP).max() / diag
             med_dP = float(np.median(np.abs(P - oP).max(axis=1))) / diag
@@ -283,11 +328,11 @@ def osd_side_by_side(n, rng, quick=False, setup_only=False, rounds=7):
                 print(f"      {k:6s} {md / 1e6:6.2f} M points/s (min {lo / 1e6:.2f}, max {hi / 1e6:.2f}); "
                       f"/ far: median {rmd:.2f} ({rlo:.2f}-{rhi:.2f}){bounds}")
             two = None
-            if _has_numba() and threads > 1:
-                t2, _ = interleaved({"1": lambda: ours("numba", 1, "numba"),
-                                     str(threads): lambda: ours("numba", threads, "numba")}, rounds)
+            if default != "numpy" and threads > 1:
+                t2, _ = interleaved({"1": lambda: ours(default, 1, default),
+                                     str(threads): lambda: ours(default, threads, default)}, rounds)
                 two = _stats(np.asarray(t2["1"]) / np.asarray(t2[str(threads)]))
-                print(f"      numba {threads} threads / 1 thread: median {two[1]:.2f} ({two[0]:.2f}-{two[2]:.2f})")
+                print(f"      {default} {threads} threads / 1 thread: median {two[1]:.2f} ({two[0]:.2f}-{two[2]:.2f})")
             print(f"      max |P ours - P far| / diagonal {dP:.1e} (median over points {med_dP:.1e}); "
                   f"bfr (approximation level 10) vs far {dB:.1e}; Far's Gregory end caps at extraordinary "
                   f"vertices are approximations")
@@ -315,31 +360,43 @@ def fresh_process_setups(path):
 
 
 def machine_ceiling(threads, quick=False):
-    """What this machine gives ``threads`` threads on ideal work: a compiled loop of arithmetic in
-    registers (no memory traffic, no shared data), split into equal parts; interleaved, best of 5
-    and median, as for the evaluator. Clock boost with one busy core and neighbours on shared
-    hardware lower it below ``threads``."""
+    """What this machine gives ``threads`` threads on ideal work: the compute bound's loop
+    (scripts/bench_ideal.c; numba arithmetic without gcc) split into equal parts, one per thread;
+    interleaved, best of 5 and median, as for the evaluator. Clock boost with one busy core and
+    neighbours on shared hardware lower it below ``threads``."""
     from concurrent.futures import ThreadPoolExecutor
 
-    import numba
+    ideal = _ideal_c()
+    if ideal is None:
+        import numba
 
-    @numba.njit(nogil=True)
-    def work(m, x):
-        acc = 0.0
-        for i in range(m):
-            acc += (x * i) % 1.7 + 1.0 / (1.0 + i)
-        return acc
+        @numba.njit(nogil=True)
+        def work(m, x):
+            acc = 0.0
+            for i in range(m):
+                acc += (x * i) % 1.7 + 1.0 / (1.0 + i)
+            return acc
 
-    m = 2_000_000 if quick else 30_000_000
-    work(10, 1.0)
+        m = 2_000_000 if quick else 30_000_000
+        work(10, 1.0)
+        one, part = (lambda: work(m, 1.1)), (lambda i: work(m // threads, 1.1 + 0.01 * i))
+    else:
+        m = 400_000 if quick else 4_000_000
+        rng = np.random.default_rng(2)
+        s, t, net = rng.random(m), rng.random(m), rng.random((16, 3))
+        P, Pu, Pv = (np.empty((m, 3)) for _ in range(3))
+        cuts = np.linspace(0, m, threads + 1).astype(int)
+        one = lambda: ideal(s, t, net, P, Pu, Pv)  # noqa: E731
+        part = lambda i: ideal(*(a[cuts[i]:cuts[i + 1]] for a in (s, t)), net,  # noqa: E731
+                               *(a[cuts[i]:cuts[i + 1]] for a in (P, Pu, Pv)))
     t1, tn = [], []
     with ThreadPoolExecutor(threads) as ex:
         for _ in range(1 if quick else 5):
             w0 = time.perf_counter()
-            work(m, 1.1)
+            one()
             t1.append(time.perf_counter() - w0)
             w0 = time.perf_counter()
-            list(ex.map(lambda x: work(m // threads, x), [1.1 + 0.01 * i for i in range(threads)]))
+            list(ex.map(part, range(threads)))
             tn.append(time.perf_counter() - w0)
     print(f"   this machine's ceiling: {threads} threads / 1 thread on ideal compiled work: "
           f"{min(t1) / min(tn):.2f}x best, {float(np.median(t1) / np.median(tn)):.2f}x median")
@@ -462,14 +519,9 @@ def main(argv=None):
     n = args.points
     f = rng.integers(0, mesh.n_faces, n)
     u, v = rng.random(n), rng.random(n)
-    backends = ["numpy"]
-    try:
-        import numba  # noqa: F401
-
-        backends.append("numba")
-        S.evaluate(f[:10], u[:10], v[:10], 1, backend="numba")  # compile (cached on disk)
-    except ImportError:
-        print("numba not installed: compiled kernel skipped")
+    backends = available_backends()[::-1]  # numpy first: the reference
+    for be in backends:
+        S.evaluate(f[:10], u[:10], v[:10], 1, backend=be)  # numba: compile (cached on disk)
     rates = {}
     ref = None
     print(f"\n1. positions + first derivatives at {n:,} random points (best of 3)")
