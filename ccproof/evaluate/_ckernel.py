@@ -13,6 +13,7 @@ from __future__ import annotations
 import ctypes
 import importlib.machinery
 import os
+import threading
 
 import numpy as np
 
@@ -35,6 +36,10 @@ class _Table(ctypes.Structure):
 
 _LIB = None
 _TRIED = False
+#: the version of the kernel's interface (``ccp_abi`` in _clib.c)
+_ABI = 2
+#: calls on fewer points use no corner-net cache (CCP_CACHE_MIN in _clib.c)
+_CACHE_MIN = 256
 
 
 def load():
@@ -59,10 +64,12 @@ def load():
             continue
         lib.ccp_abi.restype = _I
         lib.ccp_abi.argtypes = []
-        if lib.ccp_abi() != 1000 * ctypes.sizeof(_Table) + 1:  # built from another version of _clib.c
+        if lib.ccp_abi() != 1000 * ctypes.sizeof(_Table) + _ABI:  # built from another version of _clib.c
             continue
         lib.ccp_evaluate.restype = _I
-        lib.ccp_evaluate.argtypes = [ctypes.POINTER(_Table), _I, _P, _P, _P, _I, _P, _P, _P, _P, _P, _P]
+        lib.ccp_evaluate.argtypes = [ctypes.POINTER(_Table), _I, _P, _P, _P, _I, _P, _P, _P, _P, _P, _P, _P]
+        lib.ccp_cache_words.restype = _I
+        lib.ccp_cache_words.argtypes = []
         _LIB = lib
         break
     return _LIB
@@ -75,8 +82,9 @@ def _addr(a):
 class CTable:
     """The patch table (:class:`ccproof.evaluate._table.PatchTable`) as the C kernel reads it.
 
-    Holds the arrays in the dtypes the kernel reads (the table's own arrays where they already are) and
-    the ``ccp_table`` structure pointing into them; pickles as the table it was made from.
+    Holds the arrays in the dtypes the kernel reads (the table's own arrays where they already are), the
+    ``ccp_table`` structure pointing into them, and the corner-net caches of the calls (7.3 MB each, one
+    per concurrent call, kept for the next calls); pickles as the table it was made from.
 
     Parameters
     ----------
@@ -120,6 +128,19 @@ class CTable:
         self._keep = keep
         self.struct = s
         self.ref = ctypes.byref(s)
+        self._caches = []  # corner-net caches not in use (one per concurrent call, kept between calls)
+        self._lock = threading.Lock()
+
+    def take_cache(self, lib):
+        """A corner-net cache for one call (:meth:`give_cache` it back after the call)."""
+        with self._lock:
+            if self._caches:
+                return self._caches.pop()
+        return np.zeros(lib.ccp_cache_words())  # the kernel's layout; zero: empty
+
+    def give_cache(self, cache):
+        with self._lock:
+            self._caches.append(cache)
 
     def __reduce__(self):
         return CTable, (self.table,)
@@ -133,4 +154,10 @@ def evaluate_block(lib, ct, f, u, v, d, outs):
     outside [0, 1]^2 or NaN); the outputs from that point on are not written.
     """
     ptrs = [None if a is None else _addr(a) for a in outs]
-    return int(lib.ccp_evaluate(ct.ref, f.size, _addr(f), _addr(u), _addr(v), d, *ptrs))
+    if f.size < _CACHE_MIN:
+        return int(lib.ccp_evaluate(ct.ref, f.size, _addr(f), _addr(u), _addr(v), d, *ptrs, None))
+    cache = ct.take_cache(lib)
+    try:
+        return int(lib.ccp_evaluate(ct.ref, f.size, _addr(f), _addr(u), _addr(v), d, *ptrs, _addr(cache)))
+    finally:
+        ct.give_cache(cache)

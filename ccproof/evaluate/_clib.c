@@ -8,9 +8,13 @@
  * (each lane its own sum, in the same order), and the per-dimension variants (derivatives 0, 1, 2)
  * are compiled separately.
  *
- * Threads: the kernel holds no global state; every call allocates its own corner-net cache, so
- * concurrent calls on disjoint blocks of points (ctypes releases the GIL) are safe and their
- * results do not depend on the blocks (a net is the same sums whether computed or found in the cache).
+ * Points are taken in blocks of CCP_BLOCK: the first pass locates them (patch, parameter, scale) and
+ * prefetches their nets, the second evaluates them. Corner nets of layers beyond the precomputed one are
+ * kept in a cache the caller owns (one per thread, kept between calls on the same table).
+ *
+ * Threads: the kernel holds no global state; concurrent calls on disjoint blocks of points (ctypes
+ * releases the GIL), each with its own cache, are safe, and their results do not depend on the blocks
+ * or the caches (a net is the same sums whether computed or found in the cache).
  */
 #include <math.h>
 #include <stdint.h>
@@ -21,7 +25,9 @@
 #define CCP_CORNER 1
 #define CCP_SPLIT 2
 /* corner nets kept per call (a power of 2; 408 bytes each) and the smallest call that uses the cache */
+#ifndef CCP_CACHE_SLOTS
 #define CCP_CACHE_SLOTS 16384
+#endif
 #define CCP_CACHE_MIN 256
 #define CCP_HASH 2654435761u
 #define CCP_NET 51 /* 17 x 3 doubles: 16 net rows relative to row 16, the origin */
@@ -233,16 +239,14 @@ static void corner_net(const ccp_table *T, int64_t job, int64_t vf, int64_t cfg,
     for (int c = 0; c < 3; c++) W[48 + c] = T->origin[3 * ci + c];
 }
 
-typedef struct {
-    double *nets;   /* CCP_CACHE_SLOTS x 51, allocated on first use */
-    int64_t *tags;  /* key + 1 of the net in each slot, 0: empty */
-    int64_t *stamp; /* the block that last took the slot's net (a pending point reads it) */
-    int64_t block;  /* the current block */
-    int failed;
-} ccp_cache;
-
-/* locate's answer when a point needs a slot whose net a pending point of this block still reads */
-static const double CCP_BUSY[1] = {0.0};
+/* The corner-net cache (the caller's buffer of CCP_CACHE_WORDS doubles, zero when new, kept between calls
+ * on the same table by one thread at a time): word 0 the last block number, then CCP_CACHE_SLOTS slots of
+ * CCP_SLOT words, each [key + 1 (0: empty), the block that last took it, 3 unused, the net (51)]: the tag
+ * shares the net's first cache line. */
+#define CCP_SLOT 56
+#define CCP_CACHE_WORDS (8 + CCP_SLOT * CCP_CACHE_SLOTS)
+/* locate's answer for a point whose net is a corner net beyond the precomputed layer */
+static const double CCP_DEEP[1] = {0.0};
 
 /* 2^k for -1022 <= k <= 1023 (an exact power of two: scaling by it is ldexp while the result is normal;
  * here k is a layer, at most a few hundred) */
@@ -266,10 +270,16 @@ CCP_INLINE int64_t expo(double x) {
     return f - 1022;
 }
 
-/* The net of point (pf, uu, ww), its parameter (s, t) in the patch and the scale g = 1 / h; W: the
- * scratch net of a corner point when there is no cache. Returns NULL for a point evaluation refuses. */
-CCP_INLINE const double *locate(const ccp_table *T, int64_t pf, double uu, double ww, int use_cache,
-                                   ccp_cache *C, double *W, double *s, double *t, double *g) {
+/* A point whose net is a corner net of a layer beyond the precomputed one: what corner_net needs. */
+typedef struct {
+    int64_t job, vf, cfg, lay, code, ci;
+} ccp_deep;
+
+/* The net of point (pf, uu, ww), its parameter (s, t) in the patch and the scale g = 1 / h. Returns NULL
+ * for a point evaluation refuses, and CCP_DEEP for a corner net of a layer beyond the precomputed one,
+ * with what computes it in *dp (resolved by the caller: cache or scratch). */
+CCP_INLINE const double *locate(const ccp_table *T, int64_t pf, double uu, double ww, ccp_deep *dp, double *s,
+                                double *t, double *g) {
     if (pf < 0 || pf >= T->n_ptex || !(uu >= 0.0 && uu <= 1.0 && ww >= 0.0 && ww <= 1.0) || T->refused[pf])
         return NULL;
     int64_t q = (uu >= 0.5) + 2 * (ww >= 0.5);
@@ -313,30 +323,14 @@ CCP_INLINE const double *locate(const ccp_table *T, int64_t pf, double uu, doubl
         int64_t ci = ld(T->job_corner, T->wide[3], job) + T->leaf[vf];
         if (lay == 0 && T->n_hot > 0) {
             net = T->hot + CCP_NET * (3 * ci + code);
-        } else if (use_cache && !C->failed) {
-            if (C->nets == NULL) {
-                C->nets = (double *)malloc(sizeof(double) * CCP_NET * CCP_CACHE_SLOTS);
-                C->tags = (int64_t *)calloc(CCP_CACHE_SLOTS, sizeof(int64_t));
-                C->stamp = (int64_t *)calloc(CCP_CACHE_SLOTS, sizeof(int64_t));
-                if (C->nets == NULL || C->tags == NULL || C->stamp == NULL) C->failed = 1;
-            }
-            if (C->failed) {
-                corner_net(T, job, vf, cfg, lay, code, ci, W);
-                net = W;
-            } else {
-                int64_t key = 3 * (T->max_layers * ci + lay) + code;
-                int64_t p = (int64_t)(((uint64_t)key * CCP_HASH) & (CCP_CACHE_SLOTS - 1));
-                net = C->nets + CCP_NET * p;
-                if (C->tags[p] != key + 1) {
-                    if (C->stamp[p] == C->block) return CCP_BUSY;
-                    corner_net(T, job, vf, cfg, lay, code, ci, C->nets + CCP_NET * p);
-                    C->tags[p] = key + 1;
-                }
-                C->stamp[p] = C->block;
-            }
         } else {
-            corner_net(T, job, vf, cfg, lay, code, ci, W);
-            net = W;
+            dp->job = job;
+            dp->vf = vf;
+            dp->cfg = cfg;
+            dp->lay = lay;
+            dp->code = code;
+            dp->ci = ci;
+            net = CCP_DEEP;
         }
     } else {
         net = T->nets + CCP_NET * (ld(T->job_net, T->wide[2], job) + T->leaf[vf]);
@@ -363,61 +357,98 @@ CCP_INLINE const double *locate(const ccp_table *T, int64_t pf, double uu, doubl
 #define CCP_BLOCK 32
 
 CCP_INLINE int64_t run(const ccp_table *T, int64_t n, const int64_t *f, const double *u, const double *v,
-                       const int D, double *P, double *Pu, double *Pv, double *Puu, double *Puv, double *Pvv) {
-    ccp_cache C = {NULL, NULL, NULL, 1, 0};
-    double W[CCP_NET], S[CCP_BLOCK], Tt[CCP_BLOCK], G[CCP_BLOCK];
+                       const int D, double *P, double *Pu, double *Pv, double *Puu, double *Puv, double *Pvv,
+                       double *cache) {
+    int64_t *base = n >= CCP_CACHE_MIN ? (int64_t *)cache : NULL;
+    double S[CCP_BLOCK], Tt[CCP_BLOCK], G[CCP_BLOCK];
+    double W[CCP_BLOCK][CCP_NET]; /* the corner nets of a block without a cache */
     const double *N[CCP_BLOCK];
-    int use_cache = n >= CCP_CACHE_MIN;
-    int64_t bad = -1, k = 0;
+    ccp_deep dp[CCP_BLOCK];
+    int64_t *slot[CCP_BLOCK];
+    int64_t key[CCP_BLOCK];
+    int64_t bad = -1, k = 0, block = base != NULL ? base[0] : 0;
     while (k < n && bad < 0) {
         int64_t k0 = k;
         int m = 0;
-        C.block++;
-        while (k < n && m < CCP_BLOCK) {
-            const double *net = locate(T, f[k], u[k], v[k], use_cache, &C, W, S + m, Tt + m, G + m);
+        /* pass 1: locate, prefetch the nets (or the cache slots of the deep corner nets) */
+        for (; k < n && m < CCP_BLOCK; k++, m++) {
+            const double *net = locate(T, f[k], u[k], v[k], dp + m, S + m, Tt + m, G + m);
             if (net == NULL) {
                 bad = k;
                 break;
             }
-            if (net == CCP_BUSY) break; /* evaluate the pending points first; this one opens the next block */
-            N[m++] = net;
-            k++;
-            if (net == W) break; /* the scratch net: evaluated before the next point overwrites it */
+            N[m] = net;
+            if (net == CCP_DEEP) {
+                if (base == NULL) continue;
+                key[m] = 3 * (T->max_layers * dp[m].ci + dp[m].lay) + dp[m].code;
+                slot[m] = base + 8 + CCP_SLOT * (int64_t)(((uint64_t)key[m] * CCP_HASH) & (CCP_CACHE_SLOTS - 1));
+                net = (const double *)slot[m];
+            }
             for (int i = 0; i < CCP_NET; i += 8) CCP_PREFETCH(net + i);
-            CCP_PREFETCH(net + CCP_NET - 1);
+            CCP_PREFETCH(net + CCP_NET + 4);
         }
-        for (int i = 0; i < m; i++) bicubic(N[i], S[i], Tt[i], G[i], D, k0 + i, P, Pu, Pv, Puu, Puv, Pvv);
+        /* pass 2: the deep corner nets (found in the cache, or computed), then the bicubics in order; a
+         * slot taken by an earlier point of this block and wanted by another net: the points before are
+         * evaluated first */
+        int i0 = 0;
+        block++;
+        for (int i = 0; i < m; i++) {
+            if (N[i] != CCP_DEEP) continue;
+            const ccp_deep *d = dp + i;
+            if (base == NULL) {
+                corner_net(T, d->job, d->vf, d->cfg, d->lay, d->code, d->ci, W[i]);
+                N[i] = W[i];
+                continue;
+            }
+            int64_t *sl = slot[i];
+            if (sl[0] != key[i] + 1) {
+                if (sl[1] == block) {
+                    for (; i0 < i; i0++) bicubic(N[i0], S[i0], Tt[i0], G[i0], D, k0 + i0, P, Pu, Pv, Puu, Puv, Pvv);
+                    block++;
+                }
+                corner_net(T, d->job, d->vf, d->cfg, d->lay, d->code, d->ci, (double *)(sl + 5));
+                sl[0] = key[i] + 1;
+            }
+            sl[1] = block;
+            N[i] = (const double *)(sl + 5);
+        }
+        for (; i0 < m; i0++) bicubic(N[i0], S[i0], Tt[i0], G[i0], D, k0 + i0, P, Pu, Pv, Puu, Puv, Pvv);
     }
-    free(C.nets);
-    free(C.tags);
-    free(C.stamp);
+    if (base != NULL) base[0] = block;
     return bad;
 }
 
 CCP_CLONES static int64_t run0(const ccp_table *T, int64_t n, const int64_t *f, const double *u, const double *v,
-                               double *P) {
-    return run(T, n, f, u, v, 0, P, NULL, NULL, NULL, NULL, NULL);
+                               double *P, double *cache) {
+    return run(T, n, f, u, v, 0, P, NULL, NULL, NULL, NULL, NULL, cache);
 }
 
 CCP_CLONES static int64_t run1(const ccp_table *T, int64_t n, const int64_t *f, const double *u, const double *v,
-                               double *P, double *Pu, double *Pv) {
-    return run(T, n, f, u, v, 1, P, Pu, Pv, NULL, NULL, NULL);
+                               double *P, double *Pu, double *Pv, double *cache) {
+    return run(T, n, f, u, v, 1, P, Pu, Pv, NULL, NULL, NULL, cache);
 }
 
 CCP_CLONES static int64_t run2(const ccp_table *T, int64_t n, const int64_t *f, const double *u, const double *v,
-                               double *P, double *Pu, double *Pv, double *Puu, double *Puv, double *Pvv) {
-    return run(T, n, f, u, v, 2, P, Pu, Pv, Puu, Puv, Pvv);
+                               double *P, double *Pu, double *Pv, double *Puu, double *Puv, double *Pvv,
+                               double *cache) {
+    return run(T, n, f, u, v, 2, P, Pu, Pv, Puu, Puv, Pvv, cache);
 }
 
 /* Fill P (n x 3) and, for d >= 1, Pu, Pv, for d >= 2, Puu, Puv, Pvv (n x 3 each, C order) at the points
- * (f[k], u[k], v[k]). Returns -1, or the index of the first point whose face is out of range or refused
- * or whose (u, v) is outside [0, 1]^2 or NaN (the outputs from that point on are not written). */
+ * (f[k], u[k], v[k]). ``cache``: NULL, or ccp_cache_words() doubles, zero when new, used by one call at a
+ * time and only with this table (it keeps the corner nets of layers beyond the precomputed one; the results
+ * are the same bits with or without it). Returns -1, or the index of the first point whose face is out of
+ * range or refused or whose (u, v) is outside [0, 1]^2 or NaN (the outputs from that point on are not
+ * written). */
 int64_t ccp_evaluate(const ccp_table *T, int64_t n, const int64_t *f, const double *u, const double *v, int64_t d,
-                     double *P, double *Pu, double *Pv, double *Puu, double *Puv, double *Pvv) {
-    if (d <= 0) return run0(T, n, f, u, v, P);
-    if (d == 1) return run1(T, n, f, u, v, P, Pu, Pv);
-    return run2(T, n, f, u, v, P, Pu, Pv, Puu, Puv, Pvv);
+                     double *P, double *Pu, double *Pv, double *Puu, double *Puv, double *Pvv, double *cache) {
+    if (d <= 0) return run0(T, n, f, u, v, P, cache);
+    if (d == 1) return run1(T, n, f, u, v, P, Pu, Pv, cache);
+    return run2(T, n, f, u, v, P, Pu, Pv, Puu, Puv, Pvv, cache);
 }
 
+/* The size of a corner-net cache, in doubles. */
+int64_t ccp_cache_words(void) { return CCP_CACHE_WORDS; }
+
 /* The layout this file was compiled with: the binding refuses a library whose structure differs. */
-int64_t ccp_abi(void) { return 1000 * (int64_t)sizeof(ccp_table) + 1; }
+int64_t ccp_abi(void) { return 1000 * (int64_t)sizeof(ccp_table) + 2; }
