@@ -17,7 +17,7 @@ import threading
 
 import numpy as np
 
-__all__ = ["load", "CTable", "evaluate_block"]
+__all__ = ["load", "CTable", "evaluate_block", "ring_walks"]
 
 _P = ctypes.c_void_p
 _I = ctypes.c_int64
@@ -70,6 +70,8 @@ def load():
         lib.ccp_evaluate.argtypes = [ctypes.POINTER(_Table), _I, _P, _P, _P, _I, _P, _P, _P, _P, _P, _P, _P]
         lib.ccp_cache_words.restype = _I
         lib.ccp_cache_words.argtypes = []
+        lib.ccp_ring_walks.restype = _I
+        lib.ccp_ring_walks.argtypes = [_P] * 6 + [_I, _P, _P, _P, _I, _P, _P, _I, _P, _P]
         _LIB = lib
         break
     return _LIB
@@ -161,3 +163,26 @@ def evaluate_block(lib, ct, f, u, v, d, outs):
         return int(lib.ccp_evaluate(ct.ref, f.size, _addr(f), _addr(u), _addr(v), d, *ptrs, _addr(cache)))
     finally:
         ct.give_cache(cache)
+
+
+def _arg(a, dtype, name):
+    """The address of ``a``, which the kernel reads or writes in place: it must be C-contiguous ``dtype``."""
+    if not (isinstance(a, np.ndarray) and a.dtype == dtype and a.flags.c_contiguous):
+        raise TypeError(f"ring_walks: {name} must be a C-contiguous {np.dtype(dtype).name} array")
+    return _addr(a)
+
+
+def ring_walks(org, nxt, prv, twin, pos, seen, g, r, rings, nring, faces, nfaces, hashes):
+    """The ring walk of :func:`ccproof.evaluate._numba_kernel.ring_walks` (the same arguments and results)
+    in C: ``ccp_ring_walks`` of ``_clib.c``. Requires :func:`load` to have found the library."""
+    lib = load()
+    k, maxn = rings.shape
+    maxf = faces.shape[1]
+    i64 = np.int64
+    org, nxt, prv, twin, g, r = (np.ascontiguousarray(a, dtype=i64) for a in (org, nxt, prv, twin, g, r))  # read
+    ptrs = [_addr(a) for a in (org, nxt, prv, twin)] + [_arg(pos, i64, "pos"), _arg(seen, np.bool_, "seen")]
+    rc = lib.ccp_ring_walks(*ptrs, k, _addr(g), _addr(r), _arg(rings, np.int32, "rings"), maxn,
+                            _arg(nring, i64, "nring"), _arg(faces, i64, "faces"), maxf, _arg(nfaces, i64, "nfaces"),
+                            _arg(hashes, np.uint64, "hashes"))
+    if rc != 0:
+        raise MemoryError("ring_walks: no memory for the walk's scratch arrays")

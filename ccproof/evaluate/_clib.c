@@ -452,3 +452,129 @@ int64_t ccp_cache_words(void) { return CCP_CACHE_WORDS; }
 
 /* The layout this file was compiled with: the binding refuses a library whose structure differs. */
 int64_t ccp_abi(void) { return 1000 * (int64_t)sizeof(ccp_table) + 2; }
+
+/* ------------------------------------------------------------------------------------------------------------
+ * The ring walk of the table's setup (the numba kernel's _ring_walks, ccproof/evaluate/_numba_kernel.py, step
+ * for step): the canonical depth-1 ring of quad g[k] of an all-quad complex from its corner r[k]. */
+
+/* Step of the walk: list the face of half-edge c (read from c on) unless seen. Returns 0, or -1 when the
+ * arrays are full (*n = -1; *nf = -1 when the faces are full, else one more). */
+static int take_face(int64_t c, const int64_t *org, int64_t *pos, uint8_t *seen, int32_t *ring, int64_t maxn,
+                     int64_t *faces, int64_t maxf, int64_t *fc, int64_t *fl, int64_t *n, int64_t *nf) {
+    int64_t hf = c / 4;
+    if (seen[hf]) return 0;
+    if (*nf >= maxf) {
+        *n = -1;
+        *nf = -1;
+        return -1;
+    }
+    seen[hf] = 1;
+    fl[*nf] = hf;
+    int64_t j0 = c - 4 * hf;
+    for (int64_t t = 0; t < 4; t++) {
+        int64_t hc = 4 * hf + (j0 + t) % 4;
+        int64_t uu = org[hc];
+        int64_t q = pos[uu];
+        if (q < 0) {
+            if (*n >= maxn) {
+                faces[4 * *nf] = -1;
+                *n = -1;
+                *nf += 1;
+                return -1;
+            }
+            q = *n;
+            pos[uu] = *n;
+            ring[*n] = (int32_t)uu;
+            fc[*n] = hc;
+            *n += 1;
+        }
+        faces[4 * *nf + t] = q;
+    }
+    *nf += 1;
+    return 0;
+}
+
+/* For every k < nk: the ring of quad g[k] from corner r[k] (vertex labels rings[k, :nring[k]], rows of maxn),
+ * its faces in ring labels (faces[k, :nfaces[k]], rows of maxf x 4) and a 64-bit FNV-1a hash of (nring,
+ * faces); nring[k] = -1 when the ring does not fit the arrays or the walk does not close. pos (n_vertices)
+ * and seen (n_faces) are scratch, -1 / 0 on entry and on return. Returns 0, or -1 when the scratch arrays
+ * could not be allocated (nothing written). */
+int64_t ccp_ring_walks(const int64_t *org, const int64_t *nxt, const int64_t *prv, const int64_t *twin, int64_t *pos,
+                       uint8_t *seen, int64_t nk, const int64_t *g, const int64_t *r, int32_t *rings, int64_t maxn,
+                       int64_t *nring, int64_t *faces, int64_t maxf, int64_t *nfaces, uint64_t *hashes) {
+    int64_t *fc = (int64_t *)malloc(sizeof(int64_t) * (size_t)(maxn > 0 ? maxn : 1));
+    int64_t *fl = (int64_t *)malloc(sizeof(int64_t) * (size_t)(maxf > 0 ? maxf : 1));
+    if (fc == NULL || fl == NULL) {
+        free(fc);
+        free(fl);
+        return -1;
+    }
+    for (int64_t k = 0; k < nk; k++) {
+        int64_t gk = g[k];
+        int32_t *ring = rings + maxn * k;
+        int64_t *fk = faces + 4 * maxf * k;
+        int64_t n = 0, nf = 1;
+        int ok = 1;
+        seen[gk] = 1;
+        fl[0] = gk;
+        for (int64_t i = 0; i < 4; i++) {
+            int64_t h = 4 * gk + (r[k] + i) % 4;
+            int64_t vv = org[h];
+            fk[i] = i;
+            if (pos[vv] >= 0) {
+                ok = 0;
+                break;
+            }
+            pos[vv] = n;
+            ring[n] = (int32_t)vv;
+            fc[n] = h;
+            n++;
+        }
+        int64_t idx = 0;
+        while (ok && idx < 4) {
+            int64_t c0 = fc[idx];
+            take_face(c0, org, pos, seen, ring, maxn, fk, maxf, fc, fl, &n, &nf);
+            int64_t c = twin[prv[c0]];
+            int64_t steps = 0;
+            while (n >= 0 && c >= 0 && c != c0 && steps < 4096) { /* counter-clockwise */
+                take_face(c, org, pos, seen, ring, maxn, fk, maxf, fc, fl, &n, &nf);
+                c = twin[prv[c]];
+                steps++;
+            }
+            if (n < 0 || steps >= 4096) {
+                ok = 0;
+                break;
+            }
+            if (c != c0) { /* an open fan: then clockwise from c0 */
+                int64_t t_ = twin[c0];
+                c = t_ < 0 ? -1 : nxt[t_];
+                while (n >= 0 && c >= 0 && steps < 4096) {
+                    take_face(c, org, pos, seen, ring, maxn, fk, maxf, fc, fl, &n, &nf);
+                    t_ = twin[c];
+                    c = t_ < 0 ? -1 : nxt[t_];
+                    steps++;
+                }
+                if (n < 0 || steps >= 4096) {
+                    ok = 0;
+                    break;
+                }
+            }
+            idx++;
+        }
+        if (nf < 0) nf = maxf;
+        int64_t top = n < 0 ? maxn : n;
+        for (int64_t i = 0; i < top; i++) /* reset the scratch arrays */
+            if (i < maxn && ring[i] >= 0 && pos[ring[i]] == i) pos[ring[i]] = -1;
+        for (int64_t i = 0; i < nf; i++) seen[fl[i]] = 0;
+        nring[k] = ok ? n : -1;
+        nfaces[k] = nf;
+        uint64_t hsh = 14695981039346656037ull, prime = 1099511628211ull;
+        hsh = (hsh ^ (uint64_t)(n > 0 ? n : 0)) * prime;
+        for (int64_t i = 0; i < nf; i++)
+            for (int64_t t = 0; t < 4; t++) hsh = (hsh ^ (uint64_t)(fk[4 * i + t] + 1)) * prime;
+        hashes[k] = hsh;
+    }
+    free(fc);
+    free(fl);
+    return 0;
+}

@@ -289,7 +289,12 @@ class _Template:
 
 
 def _ring_walks():
-    """The compiled ring walk, or None without numba."""
+    """The compiled ring walk: the C kernel's where the install built it (no numba import), else numba's,
+    or None without either."""
+    from ccproof.evaluate import _ckernel
+
+    if _ckernel.load() is not None:
+        return _ckernel.ring_walks
     from ccproof.evaluate._numba_kernel import ring_walks
 
     return ring_walks

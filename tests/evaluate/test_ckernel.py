@@ -134,3 +134,30 @@ def test_the_c_backend_loads_without_numba():
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
                        cwd=Path(__file__).resolve().parents[2])
     assert r.stdout.split() == ["c", "False", "False"], r.stdout + r.stderr
+
+
+@pytest.mark.parametrize("maxn, maxf", [(64, 48), (9, 5)])
+def test_ring_walks_equal_the_numba_walk(maxn, maxf):
+    """The setup's ring walk in C (no numba import) against the numba walk, step for step: the same rings,
+    faces and hashes, on closed and open fans, and when the rings overflow the arrays."""
+    pytest.importorskip("numba")
+    from ccproof.evaluate import _ckernel
+    from ccproof.evaluate._numba_kernel import ring_walks
+    from ccproof.evaluate._table import QuadHalfEdges
+    from ccproof.mesh.examples import k_regular_disk, l_shape
+    from ccproof.mesh.rules import Options
+
+    for m in (read_obj(DATA / "meshes" / "bunny_quads.obj"), l_shape(), k_regular_disk(5)):
+        he = QuadHalfEdges(m.faces, m.n_vertices, Options())
+        g = np.arange(m.n_faces, dtype=np.int64)
+        r = np.random.default_rng(0).integers(0, 4, g.size)
+        res = []
+        for walk in (ring_walks, _ckernel.ring_walks):
+            pos, seen = np.full(m.n_vertices, -1, np.int64), np.zeros(m.n_faces, bool)
+            out = (np.full((g.size, maxn), -1, np.int32), np.empty(g.size, np.int64),
+                   np.zeros((g.size, maxf, 4), np.int64), np.empty(g.size, np.int64), np.empty(g.size, np.uint64))
+            walk(he.org, he.nxt, he.prv, he.twin, pos, seen, g, r, *out)
+            assert (pos == -1).all() and not seen.any()  # the scratch arrays restored
+            res.append(out)
+        for a, b in zip(*res):
+            assert np.array_equal(a, b)
