@@ -25,12 +25,14 @@ Measures, in one run:
    Also this machine's two bounds on one thread (ideal compiled work on one net, ``scripts/bench_ideal.c``
    built with gcc -O3 -march=native -ffast-math: compute; read bandwidth / 92 bytes: memory), the fraction
    of each reached, the two-thread gain of the default kernel against the machine's ceiling on the same
-   ideal work split over the threads, and the largest position difference.
+   ideal work split over the threads, and the largest position difference;
+6. start-up in fresh processes, ours (each compiled backend) and OpenSubdiv Far's: seconds and peak resident
+   memory (VmHWM) after importing, loading the kernel, the setup and one evaluation of 10^6 points.
 
 The bunny mesh is read from the repository's test data (``tests/data/meshes/bunny_quads.obj``).
 
 Usage: python scripts/bench_evaluate.py [--points 1000000] [--memory-points 10000000] [--quick] [--osd-only]
-[--setup-only]  (``--setup-only``: only the setup times of part 5, ours and OpenSubdiv's; ours as the
+[--setup-only] [--startup]  (``--setup-only``: only the setup times of part 5, ours and OpenSubdiv's; ours as the
 first build in a fresh process with the per-configuration disk cache empty and filled, and in this process)
 """
 
@@ -342,6 +344,105 @@ def osd_side_by_side(n, rng, quick=False, setup_only=False, rounds=7):
     return rows
 
 
+_STARTUP_OURS = """
+import json, sys, time
+t = [time.perf_counter()]
+def hwm():
+    return int([x for x in open("/proc/self/status") if x.startswith("VmHWM")][0].split()[1]) / 1024
+m = [hwm()]
+import numpy as np
+t.append(time.perf_counter()); m.append(hwm())
+import ccproof.evaluate.surface as surface
+from ccproof.mesh.io import read_mesh
+t.append(time.perf_counter()); m.append(hwm())
+name = surface._compiled_kernel(None)[0]
+t.append(time.perf_counter()); m.append(hwm())
+S = surface.natural_limit_surface(read_mesh(sys.argv[1]))
+t.append(time.perf_counter()); m.append(hwm())
+d = np.load(sys.argv[2])
+f, s, u = d["f"], d["s"], d["t"]
+t.append(time.perf_counter()); m.append(hwm())
+S.evaluate(f, s, u, 1, threads=1)
+t.append(time.perf_counter()); m.append(hwm())
+print(json.dumps({"t": t, "m": m, "backend": name, "numba": "numba" in sys.modules, "scipy": "scipy" in sys.modules}))
+"""
+
+_STARTUP_OSD = """
+import json, sys, time
+t = [time.perf_counter()]
+def hwm():
+    return int([x for x in open("/proc/self/status") if x.startswith("VmHWM")][0].split()[1]) / 1024
+m = [hwm()]
+import numpy as np
+t.append(time.perf_counter()); m.append(hwm())
+sys.path.insert(0, sys.argv[3])
+import _osd
+lib = _osd.load()
+t.append(time.perf_counter()); m.append(hwm())
+t.append(time.perf_counter()); m.append(hwm())
+d = np.load(sys.argv[1], allow_pickle=True)
+far = _osd.Evaluator(lib, "far", d["mesh"].item())
+t.append(time.perf_counter()); m.append(hwm())
+d = np.load(sys.argv[2])
+f, s, u = d["f"], d["s"], d["t"]
+t.append(time.perf_counter()); m.append(hwm())
+far.evaluate(f, s, u)
+t.append(time.perf_counter()); m.append(hwm())
+print(json.dumps({"t": t, "m": m, "backend": "far"}))
+"""
+
+
+def startup_and_memory(path, n, rng, env_backends=("c", "numba")):
+    """Fresh processes, ours against OpenSubdiv Far: the steps import numpy, import (ours: the evaluator
+    and the mesh reader; Far: the compiled C API), kernel load (ours: the backend choice), setup (the
+    mesh, read by ours, given as arrays to Far), the points, then one evaluation of ``n`` points (P + Pu +
+    Pv, one thread); seconds and the peak resident memory (VmHWM of /proc/self/status, MiB) after each."""
+    import json
+    import os
+    import subprocess
+    import tempfile
+
+    import _osd
+
+    print(f"\n6. start-up and memory in fresh processes ({n:,} points, P + Pu + Pv, one thread); "
+          f"load {_loadavg():.2f}")
+    mesh = read_mesh(path)
+    f, s, t = uniform_points(mesh, n, rng)
+    with tempfile.TemporaryDirectory() as d:
+        pts = os.path.join(d, "points.npz")
+        np.savez(pts, f=f, s=s, t=t)
+        runs = {}
+        env0 = {k: v for k, v in os.environ.items() if k != "CCPROOF_BACKEND"}
+        for be in env_backends:
+            if be != "numpy" and be not in available_backends():
+                continue
+            env = dict(env0, CCPROOF_BACKEND=be, PYTHONPATH=os.pathsep.join([str(REPO), env0.get("PYTHONPATH", "")]))
+            r = subprocess.run([sys.executable, "-c", _STARTUP_OURS, str(path), pts], capture_output=True, text=True,
+                               env=env, check=True)
+            runs[f"ours ({be})"] = json.loads(r.stdout)
+        if not _osd.why_unavailable():
+            arr = os.path.join(d, "mesh.npz")
+            np.savez(arr, mesh=np.array(_osd.mesh_arrays(mesh), dtype=object))
+            r = subprocess.run([sys.executable, "-c", _STARTUP_OSD, arr, pts, str(Path(__file__).resolve().parent)],
+                               capture_output=True, text=True, env=env0, check=True)
+            runs["OpenSubdiv Far"] = json.loads(r.stdout)
+    steps = ["import numpy", "import", "kernel load", "setup", "points", "evaluate"]
+    for name, r in runs.items():
+        tt, mm = r["t"], r["m"]
+        parts = ", ".join(f"{st} {tt[i + 1] - tt[i]:.3f} s -> {mm[i + 1]:.0f} MiB" for i, st in enumerate(steps))
+        extra = f" (numba imported: {r['numba']}, scipy: {r['scipy']})" if "numba" in r else ""
+        print(f"   {name}: {parts}{extra}")
+    base = runs.get("OpenSubdiv Far")
+    for name, r in runs.items():
+        if base is None or r is base:
+            continue
+        imp = (r["t"][3] - r["t"][1], r["m"][3] - r["m"][1])
+        print(f"   {name}: import + kernel load {imp[0]:.3f} s, +{imp[1]:.0f} MiB above numpy; peak "
+              f"{r['m'][-1]:.0f} MiB vs OpenSubdiv's {base['m'][-1]:.0f} MiB (+{r['m'][-1] - base['m'][-1]:.0f} MiB); "
+              f"before evaluating {r['m'][-3]:.0f} vs {base['m'][-3]:.0f} MiB")
+    return runs
+
+
 def fresh_process_setups(path):
     """Setup seconds of the first build in a fresh process (imports excluded), with the per-configuration
     disk cache empty (a new folder: every exact layer table computed) and then filled by that run."""
@@ -492,13 +593,19 @@ def main(argv=None):
     ap.add_argument("--osd-only", action="store_true", help="only part 5 (OpenSubdiv side by side)")
     ap.add_argument("--rounds", type=int, default=7, help="interleaved rounds of part 5 (at least 7)")
     ap.add_argument("--setup-only", action="store_true", help="only the setup times of part 5")
+    ap.add_argument("--startup", action="store_true",
+                    help="only part 6: start-up times and peak memory in fresh processes, ours and OpenSubdiv's")
     args = ap.parse_args(argv)
     if args.setup_only:
         osd_side_by_side(0, np.random.default_rng(2024), setup_only=True)
         return 0
+    if args.startup:
+        startup_and_memory(SHAPES[0][1], 1_000_000 if not args.quick else 20_000, np.random.default_rng(2024))
+        return 0
     if args.osd_only:
         osd_side_by_side(args.osd_points if not args.quick else 20_000, np.random.default_rng(2024), args.quick,
                          rounds=args.rounds)
+        startup_and_memory(SHAPES[0][1], 1_000_000 if not args.quick else 20_000, np.random.default_rng(2024))
         return 0
     if args.quick:
         args.points, args.memory_points, args.naive_points, args.pygel_levels = 20_000, 50_000, 200, 2
@@ -612,6 +719,7 @@ def main(argv=None):
         print(f"   {be:6s}: {peak / 2**20:8.1f} MiB extra (inputs + outputs: {io / 2**20:.0f} MiB; "
               f"patch table {S.table_bytes / 2**20:.1f} MiB)")
     osd = osd_side_by_side(args.osd_points if not args.quick else 20_000, rng, args.quick, rounds=args.rounds)
+    startup_and_memory(SHAPES[0][1], 1_000_000 if not args.quick else 20_000, rng)
     print("\nsummary:")
     for be in backends:
         print(f"   {be}: {rates[be][1] / 1e6:.2f} M points/s (P + first derivatives, single thread, CPU time)")
