@@ -297,8 +297,13 @@ CCP_INLINE const double *locate(const ccp_table *T, int64_t pf, double uu, doubl
     if (kind == CCP_CORNER) {
         double U0 = T->u0[vf], V0 = T->v0[vf], H = T->h[vf];
         int cu = T->cu[vf], cv = T->cv[vf];
+#if defined(__GNUC__)
+        v4d dd = (v4d){cu ? (U0 + H) - uu : uu - U0, cv ? (V0 + H) - ww : ww - V0, 1.0, 1.0} / splat(H);
+        double du = dd[0], dv = dd[1];
+#else
         double du = (cu ? (U0 + H) - uu : uu - U0) / H;
         double dv = (cv ? (V0 + H) - ww : ww - V0) / H;
+#endif
         double mx = du >= dv ? du : dv;
         int64_t cfg = T->cfg[vf];
         int64_t nmax = T->n_layers[cfg] - 1, lay;
@@ -313,8 +318,8 @@ CCP_INLINE const double *locate(const ccp_table *T, int64_t pf, double uu, doubl
         double up = pow2(lay); /* exact scalings: ldexp(du, lay), ldexp(dv, lay), ldexp(H, -lay) */
         du = du * up;
         dv = dv * up;
-        int a = du >= 0.5, b = dv >= 0.5;
-        int64_t code = (a && !b) ? 0 : (a && b) ? 1 : b ? 2 : 1;
+        static const int64_t codes[4] = {1, 2, 0, 1}; /* (a, b): (0, 0) 1, (0, 1) 2, (1, 0) 0, (1, 1) 1 */
+        int64_t code = codes[2 * (du >= 0.5) + (dv >= 0.5)];
         double sc = H * pow2(-lay);
         const double *un = T->unit + 9 * cfg + 3 * code;
         pu0 = un[0] * sc + (cu ? (U0 + H) : U0);
