@@ -56,11 +56,12 @@ class BuildExtC(build_ext):
                 ext.extra_compile_args = ["-std=c99", "-O3", "-ffp-contract=off", "-fno-math-errno", "-Wno-psabi"]
             else:  # MSVC: strict floating point keeps the order of the sums
                 ext.extra_compile_args = ["/O2", "/fp:strict"]
-                ext.define_macros = [("CCP_NO_CLONES", "1")]
+                ext.define_macros = [*ext.define_macros, ("CCP_NO_CLONES", "1")]
         super().build_extensions()
 
 
 setup(
     cmdclass={"build_py": BuildPyWithCertificates, "build_ext": BuildExtC},
-    ext_modules=[Extension("ccproof.evaluate._clib", ["ccproof/evaluate/_clib.c"], optional=True)],
+    ext_modules=[Extension("ccproof.evaluate._clib", ["ccproof/evaluate/_clib.c"], optional=True,
+                           define_macros=[("CCP_PYTHON_MODULE", "1")])],
 )

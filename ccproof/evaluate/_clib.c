@@ -16,6 +16,10 @@
  * releases the GIL), each with its own cache, are safe, and their results do not depend on the blocks
  * or the caches (a net is the same sums whether computed or found in the cache).
  */
+#ifdef CCP_PYTHON_MODULE /* built by setup.py: also an (empty) importable module, as tools that walk packages expect */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+#endif
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -583,3 +587,12 @@ int64_t ccp_ring_walks(const int64_t *org, const int64_t *nxt, const int64_t *pr
     free(fl);
     return 0;
 }
+
+#ifdef CCP_PYTHON_MODULE
+static struct PyModuleDef ccp_module = {PyModuleDef_HEAD_INIT, "_clib",
+                                        "The C evaluation kernel: loaded with ctypes by ccproof.evaluate._ckernel "
+                                        "(nothing to call from Python).",
+                                        -1, NULL, NULL, NULL, NULL, NULL};
+
+PyMODINIT_FUNC PyInit__clib(void) { return PyModule_Create(&ccp_module); }
+#endif
