@@ -134,6 +134,10 @@ def test_the_c_backend_loads_without_numba():
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
                        cwd=Path(__file__).resolve().parents[2])
     assert r.stdout.split() == ["c", "False", "False"], r.stdout + r.stderr
+    code = "import sys; import ccproof.evaluate; print('numba' in sys.modules, 'scipy' in sys.modules)"
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                       cwd=Path(__file__).resolve().parents[2])
+    assert r.stdout.split() == ["False", "False"], r.stdout + r.stderr
 
 
 @pytest.mark.parametrize("maxn, maxf", [(64, 48), (9, 5)])
