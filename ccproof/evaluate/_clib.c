@@ -8,8 +8,9 @@
  * (each lane its own sum, in the same order), and the per-dimension variants (derivatives 0, 1, 2)
  * are compiled separately.
  *
- * Points are taken in blocks of CCP_BLOCK: the first pass locates them (patch, parameter, scale) and
- * prefetches their nets, the second evaluates them. Corner nets of layers beyond the precomputed one are
+ * Points are taken in blocks of CCP_BLOCK: the first pass finds their virtual faces (one loop: the
+ * table reads of different points overlap), then their patches, parameters and scales, and prefetches
+ * their nets; the second evaluates them. Corner nets of layers beyond the precomputed one are
  * kept in a cache the caller owns (one per thread, kept between calls on the same table).
  *
  * Threads: the kernel holds no global state; concurrent calls on disjoint blocks of points (ctypes
@@ -282,10 +283,11 @@ typedef struct {
 /* The net of point (pf, uu, ww), its parameter (s, t) in the patch and the scale g = 1 / h. Returns NULL
  * for a point evaluation refuses, and CCP_DEEP for a corner net of a layer beyond the precomputed one,
  * with what computes it in *dp (resolved by the caller: cache or scratch). */
-CCP_INLINE const double *locate(const ccp_table *T, int64_t pf, double uu, double ww, ccp_deep *dp, double *s,
-                                double *t, double *g) {
+/* The job and virtual face of point (pf, uu, ww); returns the face's kind, or -1 for a point evaluation
+ * refuses. */
+CCP_INLINE int find_face(const ccp_table *T, int64_t pf, double uu, double ww, int64_t *jb, int64_t *vfc) {
     if (pf < 0 || pf >= T->n_ptex || !(uu >= 0.0 && uu <= 1.0 && ww >= 0.0 && ww <= 1.0) || T->refused[pf])
-        return NULL;
+        return -1;
     int64_t q = (uu >= 0.5) + 2 * (ww >= 0.5);
     int64_t job = ld(T->top, T->wide[0], 4 * pf + q);
     int64_t vf = ld(T->job_root, T->wide[1], job);
@@ -296,6 +298,14 @@ CCP_INLINE const double *locate(const ccp_table *T, int64_t pf, double uu, doubl
         vf = T->child[4 * vf + q];
         kind = T->kind[vf];
     }
+    *jb = job;
+    *vfc = vf;
+    return kind;
+}
+
+/* The net of a point in virtual face vf (kind ``kind``) of ``job`` (find_face), its (s, t) and g. */
+CCP_INLINE const double *locate(const ccp_table *T, int64_t job, int64_t vf, int kind, double uu, double ww,
+                                ccp_deep *dp, double *s, double *t, double *g) {
     const double *net;
     double pu0, pv0, h;
     if (kind == CCP_CORNER) {
@@ -379,21 +389,28 @@ CCP_INLINE int64_t run(const ccp_table *T, int64_t n, const int64_t *f, const do
     while (k < n && bad < 0) {
         int64_t k0 = k;
         int m = 0;
-        /* pass 1: locate, prefetch the nets (or the cache slots of the deep corner nets) */
+        /* pass 1: the virtual faces of the block's points (independent table reads, overlapped), then their
+         * patches, prefetching the nets (or the cache slots of the deep corner nets) */
+        int64_t JB[CCP_BLOCK], VF[CCP_BLOCK];
+        int KD[CCP_BLOCK];
         for (; k < n && m < CCP_BLOCK; k++, m++) {
-            const double *net = locate(T, f[k], u[k], v[k], dp + m, S + m, Tt + m, G + m);
-            if (net == NULL) {
+            KD[m] = find_face(T, f[k], u[k], v[k], JB + m, VF + m);
+            if (KD[m] < 0) {
                 bad = k;
                 break;
             }
-            N[m] = net;
+        }
+        for (int i = 0; i < m; i++) {
+            int64_t kk = k0 + i;
+            const double *net = locate(T, JB[i], VF[i], KD[i], u[kk], v[kk], dp + i, S + i, Tt + i, G + i);
+            N[i] = net;
             if (net == CCP_DEEP) {
                 if (base == NULL) continue;
-                key[m] = 3 * (T->max_layers * dp[m].ci + dp[m].lay) + dp[m].code;
-                slot[m] = base + 8 + CCP_SLOT * (int64_t)(((uint64_t)key[m] * CCP_HASH) & (CCP_CACHE_SLOTS - 1));
-                net = (const double *)slot[m];
+                key[i] = 3 * (T->max_layers * dp[i].ci + dp[i].lay) + dp[i].code;
+                slot[i] = base + 8 + CCP_SLOT * (int64_t)(((uint64_t)key[i] * CCP_HASH) & (CCP_CACHE_SLOTS - 1));
+                net = (const double *)slot[i];
             }
-            for (int i = 0; i < CCP_NET; i += 8) CCP_PREFETCH(net + i);
+            for (int j = 0; j < CCP_NET; j += 8) CCP_PREFETCH(net + j);
             CCP_PREFETCH(net + CCP_NET + 4);
         }
         /* pass 2: the deep corner nets (found in the cache, or computed), then the bicubics in order; a
