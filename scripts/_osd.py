@@ -123,7 +123,7 @@ class Evaluator:
 
     def __init__(self, lib, kind, mesh, level=10, approx=0):
         self.lib, self.kind = lib, kind
-        a = self._arrays = mesh_arrays(mesh)
+        a = self._arrays = mesh if isinstance(mesh, dict) else mesh_arrays(mesh)  # a dict: mesh_arrays' result
         args = [a["nv"], _ptr(a["X"], ctypes.c_double), a["nf"], _ptr(a["sizes"], ctypes.c_int),
                 _ptr(a["idx"], ctypes.c_int), a["cw"].size, _ptr(a["cre"], ctypes.c_int),
                 _ptr(a["cw"], ctypes.c_float), a["cor"].size, _ptr(a["cor"], ctypes.c_int),

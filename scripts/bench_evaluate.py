@@ -4,9 +4,9 @@
 Measures, in one run:
 
 1. points per second for positions + first derivatives at 10^6 random (face, u, v) on
-   ``bunny_quads.obj`` (2,036 quads, 103 extraordinary vertices), for the numpy kernel and, when
-   numba is installed, the compiled kernel; wall-clock and CPU-time rates (the CPU-time rate is
-   the single-thread rate even on a loaded machine);
+   ``bunny_quads.obj`` (2,036 quads, 103 extraordinary vertices), for every backend of this install
+   (numpy; numba where installed; the C kernel where built); wall-clock and CPU-time rates (the
+   CPU-time rate is the single-thread rate even on a loaded machine);
 2. (a) a straightforward per-point implementation (Python loop over points, the same tables)
    on a subsample, extrapolated to the same number of points: ratio;
 3. (b) uniform Catmull-Clark subdivision with pygel3d (if installed) level by level: time,
@@ -19,12 +19,15 @@ Measures, in one run:
    ctypes; skipped with that instruction without it): Far (adaptive isolation level 10, Gregory end caps,
    PatchMap, EvaluateBasis) and Bfr (a prepared Surface per face, approximation level 10), on the bunny, a
    crease shape and a triangle shape. Setup times, and points/s for 10^6 uniform points and 10^6 points
-   within 10^-3 (in u and v) of the corners at extraordinary vertices; Far, Bfr, our numpy and compiled
-   kernels take turns round by round (at least 7 rounds; min, median, max; the 1-minute load before each
-   round), the process pinned to one CPU; the ratio to Far is taken per round. Also this machine's two
-   bounds on one thread (ideal compiled work on one net: compute; read bandwidth / 92 bytes: memory), the
-   fraction of each reached, the two-thread gain of the compiled kernel against the machine's ceiling on
-   ideal work, and the largest position difference.
+   within 10^-3 (in u and v) of the corners at extraordinary vertices; Far, Bfr, our numpy path and
+   compiled kernels (C and numba) take turns round by round (at least 7 rounds; min, median, max; the
+   1-minute load before each round), the process pinned to one CPU; the ratio to Far is taken per round.
+   Also this machine's two bounds on one thread (ideal compiled work on one net, ``scripts/bench_ideal.c``
+   built with gcc -O3 -march=native -ffast-math: compute; read bandwidth / 92 bytes: memory), the fraction
+   of each reached, the two-thread gain of the default kernel against the machine's ceiling on the same
+   ideal work split over the threads, and the largest position difference;
+6. start-up in fresh processes, ours (each compiled backend) and OpenSubdiv Far's: seconds and peak resident
+   memory (VmHWM) after importing, loading the kernel, the setup and one evaluation of 10^6 points.
 
 The bunny mesh is read from the repository's test data (``tests/data/meshes/bunny_quads.obj``).
 
@@ -34,6 +37,7 @@ ours, ``python -c`` with the per-configuration disk cache filled and empty, agai
 a program of its own, ``scripts/osd_setup_driver.cpp``, reading the same OBJ; every process timed from start
 to exit, in turn round by round; and the floors of a Python process: ``python -c pass``, numpy's import,
 ours)
+[--startup]  (``--startup``: only part 6, start-up and peak memory of fresh processes, ours against Far)
 """
 
 from __future__ import annotations
@@ -53,7 +57,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))  # scripts/_osd.py
 
 from ccproof.evaluate import natural_limit_surface as limit_surface  # noqa: E402
 from ccproof.evaluate.local import CORNERS  # noqa: E402
-from ccproof.evaluate.surface import _CORNER, _SPLIT  # noqa: E402
+from ccproof.evaluate.surface import _CORNER, _SPLIT, available_backends  # noqa: E402
 from ccproof.mesh import limit_normals, limit_positions, read_obj, subdivide  # noqa: E402
 from ccproof.mesh.io import read_mesh  # noqa: E402
 
@@ -149,13 +153,64 @@ def interleaved(cases, rounds):
     return times, load
 
 
+def _ideal_c():
+    """``ideal(s, t, net, P, Pu, Pv)`` compiled from ``scripts/bench_ideal.c`` with gcc (-O3 -march=native
+    -ffast-math) into the temp folder, or None without gcc."""
+    import ctypes
+    import hashlib
+    import shutil
+    import subprocess
+    import tempfile
+
+    src = Path(__file__).with_name("bench_ideal.c")
+    if shutil.which("gcc") is None:
+        return None
+    code = src.read_bytes()
+    so = Path(tempfile.gettempdir()) / f"ccproof_bench_ideal-{hashlib.sha256(code).hexdigest()[:16]}.so"
+    if not so.exists():
+        tmp = so.with_suffix(".tmp.so")
+        r = subprocess.run(["gcc", "-O3", "-march=native", "-ffast-math", "-shared", "-fPIC", str(src), "-o",
+                            str(tmp)], capture_output=True, text=True)
+        if r.returncode != 0:
+            return None
+        tmp.replace(so)
+    lib = ctypes.CDLL(str(so))
+    lib.ideal.argtypes = [ctypes.c_int64] + [ctypes.c_void_p] * 6
+    lib.ideal.restype = None
+
+    def ideal(s, t, net, P, Pu, Pv):
+        lib.ideal(s.size, *(a.ctypes.data for a in (s, t, net, P, Pu, Pv)))
+
+    return ideal
+
+
 def hardware_bounds(quick=False):
     """The two bounds of this machine for P + Pu + Pv, in points/s on one thread:
 
     * compute: the evaluator's own arithmetic on one bicubic net held in registers/L1 (the 16-term sums
-      of ``bspline_basis``), compiled, no gather, no table: ideal compiled work;
+      of ``bspline_basis``), compiled with every freedom (scripts/bench_ideal.c: gcc -O3 -march=native
+      -ffast-math, vectorized across points; numba without gcc), no gather, no table: ideal compiled work;
     * memory: read bandwidth of one core (summing a 256 MiB array) / BYTES_PER_POINT.
     """
+    ideal = _ideal_c()
+    if ideal is None:
+        ideal = _ideal_numba()
+    n = 200_000 if quick else 2_000_000
+    rng = np.random.default_rng(1)
+    s, t, net = rng.random(n), rng.random(n), rng.random((16, 3))
+    P, Pu, Pv = (np.empty((n, 3)) for _ in range(3))
+    ideal(s[:4], t[:4], net, P, Pu, Pv)
+    a = np.ones((32 << 20) // (8 if quick else 1))  # 256 MiB (quick: 32 MiB)
+    with _Pinned():
+        times, _ = interleaved({"ideal": lambda: ideal(s, t, net, P, Pu, Pv), "read": lambda: a.sum()},
+                               3 if quick else 7)
+    compute = n / min(times["ideal"])
+    bandwidth = a.nbytes / min(times["read"])
+    return compute, bandwidth / BYTES_PER_POINT, bandwidth
+
+
+def _ideal_numba():
+    """The ideal loop of :func:`hardware_bounds` in numba (scalar: no fastmath), where gcc is missing."""
     import numba
 
     @numba.njit(nogil=True, inline="always")
@@ -184,18 +239,7 @@ def hardware_bounds(quick=False):
                 Pu[i, c] = c0 * g0 + c1 * g1 + c2 * g2 + c3 * g3
                 Pv[i, c] = e0 * a0 + e1 * a1 + e2 * a2 + e3 * a3
 
-    n = 200_000 if quick else 2_000_000
-    rng = np.random.default_rng(1)
-    s, t, net = rng.random(n), rng.random(n), rng.random((16, 3))
-    P, Pu, Pv = (np.empty((n, 3)) for _ in range(3))
-    ideal(s[:4], t[:4], net, P, Pu, Pv)
-    a = np.ones((32 << 20) // (8 if quick else 1))  # 256 MiB (quick: 32 MiB)
-    with _Pinned():
-        times, _ = interleaved({"ideal": lambda: ideal(s, t, net, P, Pu, Pv), "read": lambda: a.sum()},
-                               3 if quick else 7)
-    compute = n / min(times["ideal"])
-    bandwidth = a.nbytes / min(times["read"])
-    return compute, bandwidth / BYTES_PER_POINT, bandwidth
+    return ideal
 
 
 def _stats(x):
@@ -218,14 +262,14 @@ def osd_side_by_side(n, rng, quick=False, rounds=7):
 
     threads = len(os.sched_getaffinity(0))
     rounds = 2 if quick else rounds
-    compute = memory = None
-    if _has_numba():
-        compute, memory, bw = hardware_bounds(quick)
-        print(f"   this machine, one thread: ideal compiled work {compute / 1e6:.1f} M points/s (compute bound); "
-              f"read bandwidth {bw / 2**30:.1f} GiB/s / {BYTES_PER_POINT} B = {memory / 1e6:.1f} M points/s "
-              f"(memory bound)")
-        if threads > 1:
-            machine_ceiling(threads, quick)
+    compute, memory, bw = hardware_bounds(quick)
+    print(f"   this machine, one thread: ideal compiled work {compute / 1e6:.1f} M points/s (compute bound); "
+          f"read bandwidth {bw / 2**30:.1f} GiB/s / {BYTES_PER_POINT} B = {memory / 1e6:.1f} M points/s "
+          f"(memory bound)")
+    if threads > 1:
+        machine_ceiling(threads, quick)
+    default = available_backends()[0]  # what evaluate uses without backend=
+    print(f"   backends: {', '.join(available_backends())} (default {default})")
     rows = []
     for label, path in SHAPES:
         mesh = read_mesh(path)
@@ -247,7 +291,7 @@ def osd_side_by_side(n, rng, quick=False, rounds=7):
         fu, su, tu = uniform_points(mesh, n, rng)
         fn, sn, tn, npairs = near_ev_points(mesh, n, rng)
         for dist, (f, s, t) in (("uniform", (fu, su, tu)), ("near EVs", (fn, sn, tn))):
-            outs = {k: tuple(np.empty((n, 3)) for _ in range(3)) for k in ("far", "bfr", "numba", "numpy")}
+            outs = {k: tuple(np.empty((n, 3)) for _ in range(3)) for k in ("far", "bfr", "c", "numba", "numpy")}
 
             def ours(be, th, key, f=f, s=s, t=t, outs=outs, S=S):
                 o = outs[key]
@@ -258,6 +302,8 @@ def osd_side_by_side(n, rng, quick=False, rounds=7):
                      "numpy": lambda: ours("numpy", 1, "numpy")}
             if _has_numba():
                 cases["numba"] = lambda: ours("numba", 1, "numba")
+            if "c" in available_backends():
+                cases["c"] = lambda: ours("c", 1, "c")
             for c in cases.values():  # warm up (compile)
                 c()
             with _Pinned():
@@ -265,7 +311,7 @@ def osd_side_by_side(n, rng, quick=False, rounds=7):
             rate = {k: n / np.asarray(v) for k, v in times.items()}
             ratio = {k: rate[k] / rate["far"] for k in rate}  # per round: the same round's Far
             oP = outs["far"][0]
-            P = outs["numba" if "numba" in outs else "numpy"][0]
+            P = outs[default][0]
             dP = np.abs(P - oP).max() / diag
             dB = np.abs(outs["bfr"][0] - oP).max() / diag
             med_dP = float(np.median(np.abs(P - oP).max(axis=1))) / diag
@@ -281,11 +327,11 @@ def osd_side_by_side(n, rng, quick=False, rounds=7):
                 print(f"      {k:6s} {md / 1e6:6.2f} M points/s (min {lo / 1e6:.2f}, max {hi / 1e6:.2f}); "
                       f"/ far: median {rmd:.2f} ({rlo:.2f}-{rhi:.2f}){bounds}")
             two = None
-            if _has_numba() and threads > 1:
-                t2, _ = interleaved({"1": lambda: ours("numba", 1, "numba"),
-                                     str(threads): lambda: ours("numba", threads, "numba")}, rounds)
+            if default != "numpy" and threads > 1:
+                t2, _ = interleaved({"1": lambda: ours(default, 1, default),
+                                     str(threads): lambda: ours(default, threads, default)}, rounds)
                 two = _stats(np.asarray(t2["1"]) / np.asarray(t2[str(threads)]))
-                print(f"      numba {threads} threads / 1 thread: median {two[1]:.2f} ({two[0]:.2f}-{two[2]:.2f})")
+                print(f"      {default} {threads} threads / 1 thread: median {two[1]:.2f} ({two[0]:.2f}-{two[2]:.2f})")
             print(f"      max |P ours - P far| / diagonal {dP:.1e} (median over points {med_dP:.1e}); "
                   f"bfr (approximation level 10) vs far {dB:.1e}; Far's Gregory end caps at extraordinary "
                   f"vertices are approximations")
@@ -293,6 +339,105 @@ def osd_side_by_side(n, rng, quick=False, rounds=7):
         far.close()
         bfr.close()
     return rows
+
+
+_STARTUP_OURS = """
+import json, sys, time
+t = [time.perf_counter()]
+def hwm():
+    return int([x for x in open("/proc/self/status") if x.startswith("VmHWM")][0].split()[1]) / 1024
+m = [hwm()]
+import numpy as np
+t.append(time.perf_counter()); m.append(hwm())
+import ccproof.evaluate.surface as surface
+from ccproof.mesh.io import read_mesh
+t.append(time.perf_counter()); m.append(hwm())
+name = surface._compiled_kernel(None)[0]
+t.append(time.perf_counter()); m.append(hwm())
+S = surface.natural_limit_surface(read_mesh(sys.argv[1]))
+t.append(time.perf_counter()); m.append(hwm())
+d = np.load(sys.argv[2])
+f, s, u = d["f"], d["s"], d["t"]
+t.append(time.perf_counter()); m.append(hwm())
+S.evaluate(f, s, u, 1, threads=1)
+t.append(time.perf_counter()); m.append(hwm())
+print(json.dumps({"t": t, "m": m, "backend": name, "numba": "numba" in sys.modules, "scipy": "scipy" in sys.modules}))
+"""
+
+_STARTUP_OSD = """
+import json, sys, time
+t = [time.perf_counter()]
+def hwm():
+    return int([x for x in open("/proc/self/status") if x.startswith("VmHWM")][0].split()[1]) / 1024
+m = [hwm()]
+import numpy as np
+t.append(time.perf_counter()); m.append(hwm())
+sys.path.insert(0, sys.argv[3])
+import _osd
+lib = _osd.load()
+t.append(time.perf_counter()); m.append(hwm())
+t.append(time.perf_counter()); m.append(hwm())
+d = np.load(sys.argv[1], allow_pickle=True)
+far = _osd.Evaluator(lib, "far", d["mesh"].item())
+t.append(time.perf_counter()); m.append(hwm())
+d = np.load(sys.argv[2])
+f, s, u = d["f"], d["s"], d["t"]
+t.append(time.perf_counter()); m.append(hwm())
+far.evaluate(f, s, u)
+t.append(time.perf_counter()); m.append(hwm())
+print(json.dumps({"t": t, "m": m, "backend": "far"}))
+"""
+
+
+def startup_and_memory(path, n, rng, env_backends=("c", "numba")):
+    """Fresh processes, ours against OpenSubdiv Far: the steps import numpy, import (ours: the evaluator
+    and the mesh reader; Far: the compiled C API), kernel load (ours: the backend choice), setup (the
+    mesh, read by ours, given as arrays to Far), the points, then one evaluation of ``n`` points (P + Pu +
+    Pv, one thread); seconds and the peak resident memory (VmHWM of /proc/self/status, MiB) after each."""
+    import json
+    import os
+    import subprocess
+    import tempfile
+
+    import _osd
+
+    print(f"\n6. start-up and memory in fresh processes ({n:,} points, P + Pu + Pv, one thread); "
+          f"load {_loadavg():.2f}")
+    mesh = read_mesh(path)
+    f, s, t = uniform_points(mesh, n, rng)
+    with tempfile.TemporaryDirectory() as d:
+        pts = os.path.join(d, "points.npz")
+        np.savez(pts, f=f, s=s, t=t)
+        runs = {}
+        env0 = {k: v for k, v in os.environ.items() if k != "CCPROOF_BACKEND"}
+        for be in env_backends:
+            if be != "numpy" and be not in available_backends():
+                continue
+            env = dict(env0, CCPROOF_BACKEND=be, PYTHONPATH=os.pathsep.join([str(REPO), env0.get("PYTHONPATH", "")]))
+            r = subprocess.run([sys.executable, "-c", _STARTUP_OURS, str(path), pts], capture_output=True, text=True,
+                               env=env, check=True)
+            runs[f"ours ({be})"] = json.loads(r.stdout)
+        if not _osd.why_unavailable():
+            arr = os.path.join(d, "mesh.npz")
+            np.savez(arr, mesh=np.array(_osd.mesh_arrays(mesh), dtype=object))
+            r = subprocess.run([sys.executable, "-c", _STARTUP_OSD, arr, pts, str(Path(__file__).resolve().parent)],
+                               capture_output=True, text=True, env=env0, check=True)
+            runs["OpenSubdiv Far"] = json.loads(r.stdout)
+    steps = ["import numpy", "import", "kernel load", "setup", "points", "evaluate"]
+    for name, r in runs.items():
+        tt, mm = r["t"], r["m"]
+        parts = ", ".join(f"{st} {tt[i + 1] - tt[i]:.3f} s -> {mm[i + 1]:.0f} MiB" for i, st in enumerate(steps))
+        extra = f" (numba imported: {r['numba']}, scipy: {r['scipy']})" if "numba" in r else ""
+        print(f"   {name}: {parts}{extra}")
+    base = runs.get("OpenSubdiv Far")
+    for name, r in runs.items():
+        if base is None or r is base:
+            continue
+        imp = (r["t"][3] - r["t"][1], r["m"][3] - r["m"][1])
+        print(f"   {name}: import + kernel load {imp[0]:.3f} s, +{imp[1]:.0f} MiB above numpy; peak "
+              f"{r['m'][-1]:.0f} MiB vs OpenSubdiv's {base['m'][-1]:.0f} MiB (+{r['m'][-1] - base['m'][-1]:.0f} MiB); "
+              f"before evaluating {r['m'][-3]:.0f} vs {base['m'][-3]:.0f} MiB")
+    return runs
 
 
 #: our side of the fresh-process setup: what ``ccproof eval`` does before evaluating (imports, reading the
@@ -378,31 +523,43 @@ def fresh_process_setup(rounds=7):
 
 
 def machine_ceiling(threads, quick=False):
-    """What this machine gives ``threads`` threads on ideal work: a compiled loop of arithmetic in
-    registers (no memory traffic, no shared data), split into equal parts; interleaved, best of 5
-    and median, as for the evaluator. Clock boost with one busy core and neighbours on shared
-    hardware lower it below ``threads``."""
+    """What this machine gives ``threads`` threads on ideal work: the compute bound's loop
+    (scripts/bench_ideal.c; numba arithmetic without gcc) split into equal parts, one per thread;
+    interleaved, best of 5 and median, as for the evaluator. Clock boost with one busy core and
+    neighbours on shared hardware lower it below ``threads``."""
     from concurrent.futures import ThreadPoolExecutor
 
-    import numba
+    ideal = _ideal_c()
+    if ideal is None:
+        import numba
 
-    @numba.njit(nogil=True)
-    def work(m, x):
-        acc = 0.0
-        for i in range(m):
-            acc += (x * i) % 1.7 + 1.0 / (1.0 + i)
-        return acc
+        @numba.njit(nogil=True)
+        def work(m, x):
+            acc = 0.0
+            for i in range(m):
+                acc += (x * i) % 1.7 + 1.0 / (1.0 + i)
+            return acc
 
-    m = 2_000_000 if quick else 30_000_000
-    work(10, 1.0)
+        m = 2_000_000 if quick else 30_000_000
+        work(10, 1.0)
+        one, part = (lambda: work(m, 1.1)), (lambda i: work(m // threads, 1.1 + 0.01 * i))
+    else:
+        m = 400_000 if quick else 4_000_000
+        rng = np.random.default_rng(2)
+        s, t, net = rng.random(m), rng.random(m), rng.random((16, 3))
+        P, Pu, Pv = (np.empty((m, 3)) for _ in range(3))
+        cuts = np.linspace(0, m, threads + 1).astype(int)
+        one = lambda: ideal(s, t, net, P, Pu, Pv)  # noqa: E731
+        part = lambda i: ideal(*(a[cuts[i]:cuts[i + 1]] for a in (s, t)), net,  # noqa: E731
+                               *(a[cuts[i]:cuts[i + 1]] for a in (P, Pu, Pv)))
     t1, tn = [], []
     with ThreadPoolExecutor(threads) as ex:
         for _ in range(1 if quick else 5):
             w0 = time.perf_counter()
-            work(m, 1.1)
+            one()
             t1.append(time.perf_counter() - w0)
             w0 = time.perf_counter()
-            list(ex.map(lambda x: work(m // threads, x), [1.1 + 0.01 * i for i in range(threads)]))
+            list(ex.map(part, range(threads)))
             tn.append(time.perf_counter() - w0)
     print(f"   this machine's ceiling: {threads} threads / 1 thread on ideal compiled work: "
           f"{min(t1) / min(tn):.2f}x best, {float(np.median(t1) / np.median(tn)):.2f}x median")
@@ -498,13 +655,19 @@ def main(argv=None):
     ap.add_argument("--osd-only", action="store_true", help="only part 5 (OpenSubdiv side by side)")
     ap.add_argument("--rounds", type=int, default=7, help="interleaved rounds of part 5 (at least 7)")
     ap.add_argument("--setup-only", action="store_true", help="only the setup times of part 5")
+    ap.add_argument("--startup", action="store_true",
+                    help="only part 6: start-up times and peak memory in fresh processes, ours and OpenSubdiv's")
     args = ap.parse_args(argv)
     if args.setup_only:
         fresh_process_setup(args.rounds)
         return 0
+    if args.startup:
+        startup_and_memory(SHAPES[0][1], 1_000_000 if not args.quick else 20_000, np.random.default_rng(2024))
+        return 0
     if args.osd_only:
         osd_side_by_side(args.osd_points if not args.quick else 20_000, np.random.default_rng(2024), args.quick,
                          rounds=args.rounds)
+        startup_and_memory(SHAPES[0][1], 1_000_000 if not args.quick else 20_000, np.random.default_rng(2024))
         return 0
     if args.quick:
         args.points, args.memory_points, args.naive_points, args.pygel_levels = 20_000, 50_000, 200, 2
@@ -525,14 +688,9 @@ def main(argv=None):
     n = args.points
     f = rng.integers(0, mesh.n_faces, n)
     u, v = rng.random(n), rng.random(n)
-    backends = ["numpy"]
-    try:
-        import numba  # noqa: F401
-
-        backends.append("numba")
-        S.evaluate(f[:10], u[:10], v[:10], 1, backend="numba")  # compile (cached on disk)
-    except ImportError:
-        print("numba not installed: compiled kernel skipped")
+    backends = available_backends()[::-1]  # numpy first: the reference
+    for be in backends:
+        S.evaluate(f[:10], u[:10], v[:10], 1, backend=be)  # numba: compile (cached on disk)
     rates = {}
     ref = None
     print(f"\n1. positions + first derivatives at {n:,} random points (best of 3)")
@@ -623,6 +781,7 @@ def main(argv=None):
         print(f"   {be:6s}: {peak / 2**20:8.1f} MiB extra (inputs + outputs: {io / 2**20:.0f} MiB; "
               f"patch table {S.table_bytes / 2**20:.1f} MiB)")
     osd = osd_side_by_side(args.osd_points if not args.quick else 20_000, rng, args.quick, rounds=args.rounds)
+    startup_and_memory(SHAPES[0][1], 1_000_000 if not args.quick else 20_000, rng)
     print("\nsummary:")
     for be in backends:
         print(f"   {be}: {rates[be][1] / 1e6:.2f} M points/s (P + first derivatives, single thread, CPU time)")

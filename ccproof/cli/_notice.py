@@ -1,4 +1,8 @@
-"""A one-line notice before the first run compiles the numba kernels (they are cached on disk afterwards)."""
+"""A one-line notice before the first run compiles the numba kernels (they are cached on disk afterwards).
+
+Where the install built the C evaluation kernel (``ccproof/evaluate/_clib.c``) and the backend is the
+automatic one or ``c``, evaluation compiles nothing: ``eval`` prints no notice, and ``project`` and ``fit``
+count only their other kernels (the closest points' Newton descent and search structure stay numba)."""
 
 from __future__ import annotations
 
@@ -7,7 +11,8 @@ import importlib.util
 import os
 import sys
 
-__all__ = ["compile_notice", "kernels_cached", "KERNEL_MODULES", "FIRST_COMPILE_SECONDS", "COMMAND_KERNELS"]
+__all__ = ["compile_notice", "kernels_cached", "c_kernel_evaluates", "KERNEL_MODULES", "FIRST_COMPILE_SECONDS",
+           "COMMAND_KERNELS"]
 
 #: the modules whose numba kernels (``cache=True``) the closest-point search and evaluation compile
 KERNEL_MODULES = ("ccproof.evaluate._numba_kernel", "ccproof.evaluate._bvh")
@@ -64,6 +69,24 @@ def kernels_cached(modules=KERNEL_MODULES):
     return True
 
 
+def c_kernel_evaluates():
+    """Whether evaluation runs on the C kernel (compiled at install: nothing to compile at run time).
+
+    True when the backend (``CCPROOF_BACKEND``, default automatic) is the automatic one or ``c`` and the
+    install built the kernel.
+
+    Examples
+    --------
+    >>> isinstance(c_kernel_evaluates(), bool)
+    True
+    """
+    if os.environ.get("CCPROOF_BACKEND", "auto") not in ("auto", "c"):
+        return False
+    from ccproof.evaluate._ckernel import load
+
+    return load() is not None
+
+
 def compile_notice(command, stream=None):
     """Print one line to stderr when the kernels are not compiled yet (first run after install).
 
@@ -75,7 +98,8 @@ def compile_notice(command, stream=None):
     ----------
     command : str
         The subcommand, for the message; its kernels and expected time from :data:`COMMAND_KERNELS`
-        (another name: every kernel module, a few minutes).
+        (another name: every kernel module, a few minutes), less the numba evaluation kernel when
+        :func:`c_kernel_evaluates`.
     stream : file, optional
         Default ``sys.stderr`` when it is a terminal.
 
@@ -95,6 +119,8 @@ def compile_notice(command, stream=None):
     if stream is None and not stderr_is_terminal():
         return False
     modules, (lo, hi) = COMMAND_KERNELS.get(command, (KERNEL_MODULES, FIRST_COMPILE_SECONDS))
+    if c_kernel_evaluates():
+        modules = tuple(m for m in modules if m != _EVAL)
     if kernels_cached(modules):
         return False
     about = "under a minute" if hi <= 60 else "about a minute" if hi <= 120 else "a few minutes"

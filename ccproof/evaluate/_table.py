@@ -288,15 +288,20 @@ class _Template:
         self.reg = self.cor = None
 
 
-#: jobs from which the compiled ring walk pays for loading numba and its cached kernel (~1 to 1.5 s in a
+#: jobs from which the numba ring walk pays for loading numba and its cached kernel (~1 to 1.5 s in a
 #: fresh process, against ~0.15 ms per job for the Python walk); below, the Python walk, unless the
-#: compiled kernels are loaded already
+#: numba kernels are loaded already. The C kernel's walk (loaded in milliseconds) is taken at any size.
 COMPILED_WALK_MIN = 8192
 
 
 def _ring_walks(n_jobs):
-    """The compiled ring walk for ``n_jobs`` rings, or None: the Python walk (numba not installed, or
-    fewer than :data:`COMPILED_WALK_MIN` jobs in a process that has not loaded the kernels)."""
+    """The compiled ring walk for ``n_jobs`` rings: the C kernel's where the install built it (no numba
+    import), else numba's, or None: the Python walk (neither installed, or fewer than
+    :data:`COMPILED_WALK_MIN` jobs in a process that has not loaded the numba kernels)."""
+    from ccproof.evaluate import _ckernel
+
+    if _ckernel.load() is not None:
+        return _ckernel.ring_walks
     if n_jobs < COMPILED_WALK_MIN and "ccproof.evaluate._numba_kernel" not in sys.modules:
         return None
     from ccproof.evaluate._numba_kernel import ring_walks

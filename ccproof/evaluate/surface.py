@@ -49,7 +49,7 @@ from ccproof.mesh import QuadMesh, limit_normals, limit_positions
 from ccproof.mesh.polymesh import PolyMesh
 from ccproof.mesh.rules import Options
 
-__all__ = ["natural_limit_surface", "LimitSurface"]
+__all__ = ["natural_limit_surface", "LimitSurface", "available_backends"]
 
 
 #: points evaluated per chunk (bounds the temporary memory: about 1 kB per point)
@@ -355,11 +355,12 @@ class LimitSurface:
             Points per chunk (memory beyond the outputs is about 1 kB per chunk point).
         out : dict of ndarray, optional
             Preallocated outputs (shape (n, 3) each) to fill.
-        backend : {None, "numpy", "numba"}
-            ``None``: the compiled kernel if numba is installed (and the environment variable
-            ``CCPROOF_BACKEND`` is not ``numpy``), else numpy. Both compute the same formulas.
+        backend : {None, "c", "numba", "numpy"}
+            ``None``: the environment variable ``CCPROOF_BACKEND`` if set, else the C kernel
+            (``ccproof/evaluate/_clib.c``) where the install built it, else the numba kernel where
+            numba is installed, else numpy. All compute the same sums in the same order (the same bits).
         threads : int, optional
-            Threads for the compiled kernel (it releases the GIL; the points are split into
+            Threads for the compiled kernels (they release the GIL; the points are split into
             contiguous blocks, the results are identical). Default: all cores
             (``os.cpu_count()``, or the environment variable ``CCPROOF_THREADS``) for batches of
             at least 2^17 points, else 1. The numpy path always runs on one thread.
@@ -392,7 +393,7 @@ class LimitSurface:
             p = self._parameterization(parameterization)
             f, u, v = self._check(face_ids, u, v)
             return p.evaluate_on(self, f, u, v, derivatives, chunk=chunk, out=out, backend=backend, threads=threads)
-        kernel = _numba_kernel(backend)
+        name, kernel = _compiled_kernel(backend)
         if kernel is None:
             f, u, v = self._check(face_ids, u, v)
         else:  # the compiled kernel checks the values itself, in the threads
@@ -402,19 +403,40 @@ class LimitSurface:
         if out is None:
             out = {k: np.empty((n, 3)) for k in keys}
         if kernel is not None:
-            dummy = np.empty((0, 3))
-            arrs = [out.get(k, dummy) for k in _KEYS[2]]
-            table = self._kernel_table()
+            back = []  # (key, temporary): outputs the C kernel cannot write in place
+            if name == "c":
+                from ccproof.evaluate._ckernel import evaluate_block
 
-            def block(lo, hi):
-                return kernel(f[lo:hi], u[lo:hi], v[lo:hi], derivatives, table,
-                              *[a[lo:hi] if a.shape[0] else a for a in arrs])
+                f, u, v = (np.ascontiguousarray(a) for a in (f, u, v))
+                arrs = []
+                for k in _KEYS[2]:
+                    a = out.get(k) if k in keys else None
+                    if a is not None and not (isinstance(a, np.ndarray) and a.dtype == np.float64
+                                              and a.shape == (n, 3) and a.flags.c_contiguous):
+                        back.append((k, np.empty((n, 3))))
+                        a = back[-1][1]
+                    arrs.append(a)
+                table = self._c_table()
+
+                def block(lo, hi):
+                    return evaluate_block(kernel, table, f[lo:hi], u[lo:hi], v[lo:hi], derivatives,
+                                          [None if a is None else a[lo:hi] for a in arrs])
+            else:
+                dummy = np.empty((0, 3))
+                arrs = [out.get(k, dummy) for k in _KEYS[2]]
+                table = self._kernel_table()
+
+                def block(lo, hi):
+                    return kernel(f[lo:hi], u[lo:hi], v[lo:hi], derivatives, table,
+                                  *[a[lo:hi] if a.shape[0] else a for a in arrs])
 
             # few blocks: each kernel call computes the corner nets it meets once (a cache per call)
             bad = in_blocks(block, n, threads_for(threads, n), 32768, per_thread=4)
             if max(bad) >= 0:
                 self._check_values(f, u, v)  # raises, naming the first bad point
                 raise CCProofError("internal error: the compiled kernel refused a point the checks accept")
+            for k, a in back:
+                out[k][...] = a
             return out
         for lo in range(0, n, chunk):
             hi = min(n, lo + chunk)
@@ -439,6 +461,16 @@ class LimitSurface:
     def _kernel_table(self):
         """The patch table as the compiled kernels take it (one :class:`PatchTable` argument)."""
         return self._table
+
+    def _c_table(self):
+        """The patch table as the C kernel reads it (:class:`ccproof.evaluate._ckernel.CTable`, made
+        once per table and kept)."""
+        ct = self.__dict__.get("_ctable")
+        if ct is None or ct.table is not self._table:
+            from ccproof.evaluate._ckernel import CTable
+
+            ct = self._ctable = CTable(self._table)
+        return ct
 
     def _newton_kernel(self, backend=None):
         """The compiled Newton descent of the closest points on this surface (natural parameterization),
@@ -673,16 +705,70 @@ class LimitSurface:
         return new
 
 
-def _numba_kernel(backend):
-    """The compiled kernel for ``backend`` (None: automatic), or None for the numpy path."""
+_BACKENDS = ("auto", "c", "numba", "numpy")
+
+
+def available_backends():
+    """The evaluation backends this install can run, in the order the automatic choice takes them.
+
+    ``"c"`` where the install built the C kernel (``ccproof/evaluate/_clib.c``), ``"numba"`` where numba
+    is installed (not imported here), and always ``"numpy"`` (the reference the tests compare with).
+
+    Returns
+    -------
+    list of str
+
+    Examples
+    --------
+    >>> available_backends()[-1]
+    'numpy'
+    """
+    import importlib.util
+
+    from ccproof.evaluate._ckernel import load
+
+    return (["c"] if load() is not None else []) + \
+        (["numba"] if importlib.util.find_spec("numba") is not None else []) + ["numpy"]
+
+
+def _backend_name(backend):
+    """``backend`` (None: ``CCPROOF_BACKEND``, else automatic) checked."""
     import os
 
     if backend is None:
         backend = os.environ.get("CCPROOF_BACKEND", "auto")
+    if backend not in _BACKENDS:
+        raise CCProofError(f"unknown backend {backend!r} (use 'c', 'numba' or 'numpy')")
+    return backend
+
+
+def _compiled_kernel(backend):
+    """``(name, kernel)`` for ``backend`` (None: automatic): ``("c", library)`` (the C kernel, where it was
+    built: :mod:`ccproof.evaluate._ckernel`), ``("numba", evaluate_points)``, or ``("numpy", None)``.
+    The automatic choice takes them in that order; imports numba only when the C kernel is missing."""
+    backend = _backend_name(backend)
+    if backend == "numpy":
+        return "numpy", None
+    if backend in ("auto", "c"):
+        from ccproof.evaluate._ckernel import load
+
+        lib = load()
+        if lib is not None:
+            return "c", lib
+        if backend == "c":
+            raise CCProofError("backend 'c' requested but the C kernel was not built (reinstall with a C compiler, "
+                               "or run `python setup.py build_ext --inplace` in a checkout)")
+    kernel = _numba_kernel("numba" if backend == "numba" else "auto")
+    return ("numba", kernel) if kernel is not None else ("numpy", None)
+
+
+def _numba_kernel(backend):
+    """The numba kernel for ``backend`` (None: automatic), or None for the numpy path (also when numba
+    is not installed and the backend is automatic). The closest points' Newton descent uses it with
+    any backend but numpy."""
+    backend = _backend_name(backend)
     if backend == "numpy":
         return None
-    if backend not in ("auto", "numba"):
-        raise CCProofError(f"unknown backend {backend!r} (use 'numpy' or 'numba')")
     from ccproof.evaluate._numba_kernel import evaluate_points
 
     if evaluate_points is None and backend == "numba":

@@ -9,15 +9,18 @@ import numpy as np
 import pytest
 
 from ccproof.evaluate import natural_limit_surface
+from ccproof.evaluate.surface import available_backends
 from ccproof.mesh import read_obj
 
-pytest.importorskip("numba")
-
 DATA = Path(__file__).resolve().parents[1] / "data" / "meshes"
+#: the cache's size and hash in both compiled kernels (_numba_kernel.py, _clib.c): the slots the test fills
+CACHE_SLOTS, HASH = 16384, 2654435761
 
 
-def test_cached_corner_nets_are_the_same_bits():
-    from ccproof.evaluate import _numba_kernel as K
+@pytest.mark.parametrize("backend", ["c", "numba"])
+def test_cached_corner_nets_are_the_same_bits(backend):
+    if backend not in available_backends():
+        pytest.skip(f"backend {backend!r} not available in this install")
 
     S = natural_limit_surface(read_obj(DATA / "bunny_quads.obj"))
     rng = np.random.default_rng(7)
@@ -36,13 +39,13 @@ def test_cached_corner_nets_are_the_same_bits():
     f, u, v, patch = f[keep], u[keep], v[keep], patch[keep]
     deep = patch >= S.n_patches
     keys = np.unique(patch) - S.n_patches  # the kernel's cache keys: 3 (max_layers corner + layer) + code
-    slots = (keys * K._HASH) & (K._CACHE_SLOTS - 1)
+    slots = (keys * HASH) & (CACHE_SLOTS - 1)
     assert keys.size > 5000 and np.unique(slots).size < keys.size  # slots shared: nets evicted and recomputed
     ref = S.evaluate(f, u, v, 2, backend="numpy")
-    one = S.evaluate(f, u, v, 2, backend="numba", threads=1)  # one call: the cache on
-    three = S.evaluate(f, u, v, 2, backend="numba", threads=3)
+    one = S.evaluate(f, u, v, 2, backend=backend, threads=1)  # one call: the cache on
+    three = S.evaluate(f, u, v, 2, backend=backend, threads=3)
     k = np.flatnonzero(deep)[:200]
-    single = [S.evaluate(f[i:i + 1], u[i:i + 1], v[i:i + 1], 2, backend="numba") for i in k]  # the cache off
+    single = [S.evaluate(f[i:i + 1], u[i:i + 1], v[i:i + 1], 2, backend=backend) for i in k]  # the cache off
     for key in ref:
         assert np.array_equal(ref[key], one[key]), key
         assert np.array_equal(one[key], three[key]), key

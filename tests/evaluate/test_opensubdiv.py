@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from ccproof.evaluate import limit_surface
+from ccproof.evaluate.surface import available_backends
 from ccproof.mesh import read_obj
 
 MESHES = ["cube", "sector_k3", "sector_k5", "sector_k6", "torus_8x6"]
@@ -37,12 +38,7 @@ def _exact_samples(d):
 
 
 def _backends():
-    try:
-        import numba  # noqa: F401
-
-        return ["numpy", "numba"]
-    except ImportError:
-        return ["numpy"]
+    return available_backends()
 
 
 @functools.cache

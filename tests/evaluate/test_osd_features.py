@@ -16,7 +16,7 @@ import pytest
 
 from ccproof.errors import CCProofError
 from ccproof.evaluate import limit_surface
-from ccproof.evaluate.surface import LimitSurface
+from ccproof.evaluate.surface import LimitSurface, available_backends
 from ccproof.mesh.io import read_obj_tagged
 from ccproof.mesh.polymesh import PolyMesh
 
@@ -86,8 +86,10 @@ def test_holes_are_refused_by_name(refdir):
         S.evaluate([0, hole], [0.5, 0.5], [0.5, 0.5])
 
 
-def test_backends_and_threads_agree_on_tagged_meshes(refdir):
-    pytest.importorskip("numba")
+@pytest.mark.parametrize("backend", ["c", "numba"])
+def test_backends_and_threads_agree_on_tagged_meshes(refdir, backend):
+    if backend not in available_backends():
+        pytest.skip(f"backend {backend!r} not available in this install")
     mesh, S = _surface(refdir, "pyramid_creases1")
     rng = np.random.default_rng(3)
     n = 5000
@@ -96,8 +98,8 @@ def test_backends_and_threads_agree_on_tagged_meshes(refdir):
     s[:500] = 0.5 ** rng.integers(0, 80, 500)  # deep layers at corners
     t[:500] = s[:500] * rng.random(500)
     a = S.evaluate(f, s, t, 2, backend="numpy")
-    b = S.evaluate(f, s, t, 2, backend="numba", threads=1)
-    c = S.evaluate(f, s, t, 2, backend="numba", threads=3)
+    b = S.evaluate(f, s, t, 2, backend=backend, threads=1)
+    c = S.evaluate(f, s, t, 2, backend=backend, threads=3)
     for k in a:
         assert np.array_equal(a[k], b[k]), k
         assert np.array_equal(b[k], c[k]), k

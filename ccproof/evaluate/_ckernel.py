@@ -1,0 +1,188 @@
+"""The C evaluation kernel (``_clib.c``), loaded with ctypes: the default backend where it was built.
+
+``setup.py`` builds ``ccproof/evaluate/_clib.c`` as the optional extension ``ccproof.evaluate._clib`` (a
+plain shared library: no Python API, so loading it imports nothing); an install without a compiler skips
+it and :meth:`ccproof.evaluate.surface.LimitSurface.evaluate` falls back to the numba kernel, then to
+numpy. The kernel computes the same sums in the same order as the numba kernel and the numpy path
+(compiled without floating-point contraction), so all backends give the same bits. A ctypes call
+releases the GIL: threads evaluate blocks of points in parallel.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import importlib.machinery
+import os
+import threading
+
+import numpy as np
+
+__all__ = ["load", "CTable", "evaluate_block", "ring_walks"]
+
+_P = ctypes.c_void_p
+_I = ctypes.c_int64
+
+
+class _Table(ctypes.Structure):
+    """``ccp_table`` of ``_clib.c`` (the same fields in the same order)."""
+
+    _fields_ = [("top", _P), ("job_root", _P), ("job_net", _P), ("job_corner", _P), ("job_pts", _P),
+                ("wide", _I * 5), ("refused", _P), ("kind", _P), ("child", _P), ("u0", _P), ("v0", _P),
+                ("h", _P), ("leaf", _P), ("pts", _P), ("cfg", _P), ("cu", _P), ("cv", _P),
+                ("split_depth", _I), ("n_ptex", _I), ("max_layers", _I), ("nets", _P), ("origin", _P),
+                ("ring", _P), ("ops", _P), ("op_start", _P), ("op_size", _P), ("n_layers", _P), ("unit", _P),
+                ("hot", _P), ("n_hot", _I)]
+
+
+_LIB = None
+_TRIED = False
+#: the version of the kernel's interface (``ccp_abi`` in _clib.c)
+_ABI = 2
+#: calls on fewer points use no corner-net cache (CCP_CACHE_MIN in _clib.c)
+_CACHE_MIN = 256
+
+
+def load():
+    """The loaded library (``ctypes.CDLL``), or None when the extension was not built (or is stale).
+
+    Looks for ``_clib`` with this interpreter's extension suffixes next to this module; the environment
+    variable ``CCPROOF_CLIB`` names another file (tests, benchmarks). Loaded once per process.
+    """
+    global _LIB, _TRIED
+    if _TRIED:
+        return _LIB
+    _TRIED = True
+    here = os.path.dirname(os.path.abspath(__file__))
+    paths = [os.environ["CCPROOF_CLIB"]] if os.environ.get("CCPROOF_CLIB") else \
+        [os.path.join(here, "_clib" + s) for s in importlib.machinery.EXTENSION_SUFFIXES]
+    for p in paths:
+        if not os.path.isfile(p):
+            continue
+        try:
+            lib = ctypes.CDLL(p)
+        except OSError:
+            continue
+        lib.ccp_abi.restype = _I
+        lib.ccp_abi.argtypes = []
+        if lib.ccp_abi() != 1000 * ctypes.sizeof(_Table) + _ABI:  # built from another version of _clib.c
+            continue
+        lib.ccp_evaluate.restype = _I
+        lib.ccp_evaluate.argtypes = [ctypes.POINTER(_Table), _I, _P, _P, _P, _I, _P, _P, _P, _P, _P, _P, _P]
+        lib.ccp_cache_words.restype = _I
+        lib.ccp_cache_words.argtypes = []
+        lib.ccp_ring_walks.restype = _I
+        lib.ccp_ring_walks.argtypes = [_P] * 6 + [_I, _P, _P, _P, _I, _P, _P, _I, _P, _P]
+        _LIB = lib
+        break
+    return _LIB
+
+
+def _addr(a):
+    return a.ctypes.data if a.size else None
+
+
+class CTable:
+    """The patch table (:class:`ccproof.evaluate._table.PatchTable`) as the C kernel reads it.
+
+    Holds the arrays in the dtypes the kernel reads (the table's own arrays where they already are), the
+    ``ccp_table`` structure pointing into them, and the corner-net caches of the calls (7.3 MB each, one
+    per concurrent call, kept for the next calls); pickles as the table it was made from.
+
+    Parameters
+    ----------
+    table : PatchTable
+    """
+
+    def __init__(self, table):
+        self.table = T = table
+        keep = {}
+
+        def arr(name, dtype):
+            a = np.ascontiguousarray(getattr(T, name), dtype=dtype)
+            keep[name] = a
+            return _addr(a)
+
+        def offsets(name):  # int32 or int64, as the table stores them
+            a = getattr(T, name)
+            a = np.ascontiguousarray(a, dtype=np.int32 if a.dtype == np.int32 else np.int64)
+            keep[name] = a
+            return _addr(a), int(a.dtype == np.int64)
+
+        s = _Table()
+        wide = []
+        for name in ("top", "job_root", "job_net", "job_corner", "job_pts"):
+            p, w = offsets(name)
+            setattr(s, name, p)
+            wide.append(w)
+        s.wide = (_I * 5)(*wide)
+        s.refused = arr("refused", np.bool_)
+        s.kind = arr("kind", np.int8)
+        for name in ("child", "leaf", "pts", "cfg", "op_start", "op_size", "n_layers"):
+            setattr(s, name, arr(name, np.int64))
+        for name in ("u0", "v0", "h", "nets", "origin", "ring", "ops", "unit", "hot"):
+            setattr(s, name, arr(name, np.float64))
+        s.cu = arr("cu", np.bool_)  # one byte each, 0 or 1
+        s.cv = arr("cv", np.bool_)
+        s.split_depth = int(T.split_depth)
+        s.n_ptex = int(T.refused.shape[0])
+        s.max_layers = max(1, int(T.n_layers.max()) if T.n_layers.size else 1)
+        s.n_hot = int(T.hot.shape[0])
+        self._keep = keep
+        self.struct = s
+        self.ref = ctypes.byref(s)
+        self._caches = []  # corner-net caches not in use (one per concurrent call, kept between calls)
+        self._lock = threading.Lock()
+
+    def take_cache(self, lib):
+        """A corner-net cache for one call (:meth:`give_cache` it back after the call)."""
+        with self._lock:
+            if self._caches:
+                return self._caches.pop()
+        return np.zeros(lib.ccp_cache_words())  # the kernel's layout; zero: empty
+
+    def give_cache(self, cache):
+        with self._lock:
+            self._caches.append(cache)
+
+    def __reduce__(self):
+        return CTable, (self.table,)
+
+
+def evaluate_block(lib, ct, f, u, v, d, outs):
+    """Evaluate points ``f, u, v`` (contiguous int64 / float64, shape (n,)) into ``outs`` (the arrays
+    P, Pu, Pv, Puu, Puv, Pvv: contiguous float64 (n, 3), or None beyond derivative order ``d``).
+
+    Returns -1, or the index of the first point the kernel refuses (face out of range or a hole, (u, v)
+    outside [0, 1]^2 or NaN); the outputs from that point on are not written.
+    """
+    ptrs = [None if a is None else _addr(a) for a in outs]
+    if f.size < _CACHE_MIN:
+        return int(lib.ccp_evaluate(ct.ref, f.size, _addr(f), _addr(u), _addr(v), d, *ptrs, None))
+    cache = ct.take_cache(lib)
+    try:
+        return int(lib.ccp_evaluate(ct.ref, f.size, _addr(f), _addr(u), _addr(v), d, *ptrs, _addr(cache)))
+    finally:
+        ct.give_cache(cache)
+
+
+def _arg(a, dtype, name):
+    """The address of ``a``, which the kernel reads or writes in place: it must be C-contiguous ``dtype``."""
+    if not (isinstance(a, np.ndarray) and a.dtype == dtype and a.flags.c_contiguous):
+        raise TypeError(f"ring_walks: {name} must be a C-contiguous {np.dtype(dtype).name} array")
+    return _addr(a)
+
+
+def ring_walks(org, nxt, prv, twin, pos, seen, g, r, rings, nring, faces, nfaces, hashes):
+    """The ring walk of :func:`ccproof.evaluate._numba_kernel.ring_walks` (the same arguments and results)
+    in C: ``ccp_ring_walks`` of ``_clib.c``. Requires :func:`load` to have found the library."""
+    lib = load()
+    k, maxn = rings.shape
+    maxf = faces.shape[1]
+    i64 = np.int64
+    org, nxt, prv, twin, g, r = (np.ascontiguousarray(a, dtype=i64) for a in (org, nxt, prv, twin, g, r))  # read
+    ptrs = [_addr(a) for a in (org, nxt, prv, twin)] + [_arg(pos, i64, "pos"), _arg(seen, np.bool_, "seen")]
+    rc = lib.ccp_ring_walks(*ptrs, k, _addr(g), _addr(r), _arg(rings, np.int32, "rings"), maxn,
+                            _arg(nring, i64, "nring"), _arg(faces, i64, "faces"), maxf, _arg(nfaces, i64, "nfaces"),
+                            _arg(hashes, np.uint64, "hashes"))
+    if rc != 0:
+        raise MemoryError("ring_walks: no memory for the walk's scratch arrays")

@@ -1,0 +1,615 @@
+/* The evaluation kernel of the patch table in C99 (built by setup.py as the optional extension ``ccproof.evaluate._clib``, loaded with ctypes by ccproof/evaluate/_ckernel.py).
+ *
+ * The same arithmetic as the numba kernel (ccproof/evaluate/_numba_kernel.py, evaluate_points) and the
+ * numpy path, point by point: the same sums in the same order, compiled without floating-point
+ * contraction (-ffp-contract=off: no FMA) and without reassociation, so that every backend gives the
+ * same bits. What differs is the layout of the work: the bicubic sums run over the 12 contiguous
+ * doubles (4 control points x 3 coordinates) of one net row at a time, which the compiler vectorizes
+ * (each lane its own sum, in the same order), and the per-dimension variants (derivatives 0, 1, 2)
+ * are compiled separately.
+ *
+ * Points are taken in blocks of CCP_BLOCK: the first pass finds their virtual faces (one loop: the
+ * table reads of different points overlap), then their patches, parameters and scales, and prefetches
+ * their nets; the second evaluates them. Corner nets of layers beyond the precomputed one are
+ * kept in a cache the caller owns (one per thread, kept between calls on the same table).
+ *
+ * Threads: the kernel holds no global state; concurrent calls on disjoint blocks of points (ctypes
+ * releases the GIL), each with its own cache, are safe, and their results do not depend on the blocks
+ * or the caches (a net is the same sums whether computed or found in the cache).
+ */
+#ifdef CCP_PYTHON_MODULE /* built by setup.py: also an (empty) importable module, as tools that walk packages expect */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+#endif
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define CCP_REGULAR 0
+#define CCP_CORNER 1
+#define CCP_SPLIT 2
+/* corner nets kept per call (a power of 2; 408 bytes each) and the smallest call that uses the cache */
+#ifndef CCP_CACHE_SLOTS
+#define CCP_CACHE_SLOTS 16384
+#endif
+#define CCP_CACHE_MIN 256
+#define CCP_HASH 2654435761u
+#define CCP_NET 51 /* 17 x 3 doubles: 16 net rows relative to row 16, the origin */
+
+#if defined(__GNUC__)
+#define CCP_INLINE static inline __attribute__((always_inline))
+#define CCP_PREFETCH(p) __builtin_prefetch(p)
+#else
+#define CCP_INLINE static inline
+#define CCP_PREFETCH(p) ((void)(p))
+#endif
+
+#if defined(__GNUC__) && defined(__x86_64__) && defined(__linux__) && !defined(CCP_NO_CLONES)
+/* one binary for every x86-64 machine: the loader picks the widest variant the CPU runs */
+#define CCP_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
+#else
+#define CCP_CLONES
+#endif
+
+/* The patch table (ccproof.evaluate._table.PatchTable), as pointers into its numpy arrays. The five
+ * per-face offset arrays are int32 or int64 (``wide``); every other integer array is int64, except
+ * ``kind`` (int8) and the bools (one byte). Field order and types: _ckernel.py, _Table. */
+typedef struct {
+    const void *top, *job_root, *job_net, *job_corner, *job_pts;
+    int64_t wide[5];
+    const uint8_t *refused;
+    const int8_t *kind;
+    const int64_t *child;
+    const double *u0, *v0, *h;
+    const int64_t *leaf, *pts, *cfg;
+    const uint8_t *cu, *cv;
+    int64_t split_depth;
+    int64_t n_ptex;
+    int64_t max_layers; /* max(1, max n_layers): the cache key's stride */
+    const double *nets, *origin, *ring, *ops;
+    const int64_t *op_start, *op_size, *n_layers;
+    const double *unit;
+    const double *hot;
+    int64_t n_hot; /* rows of ``hot`` (0: none) */
+} ccp_table;
+
+CCP_INLINE int64_t ld(const void *a, int64_t wide, int64_t i) {
+    return wide ? ((const int64_t *)a)[i] : (int64_t)((const int32_t *)a)[i];
+}
+
+/* Cubic B-spline basis at x and its first and second derivatives (bspline_basis's formulas, the same
+ * operations in the same order as the numba kernel's _basis). */
+CCP_INLINE void basis(double x, double *b) {
+    double t = 1.0 - x, x2 = x * x, x3 = x2 * x;
+    b[0] = t * t * t / 6;
+    b[1] = (3 * x3 - 6 * x2 + 4) / 6;
+    b[2] = (-3 * x3 + 3 * x2 + 3 * x + 1) / 6;
+    b[3] = x3 / 6;
+    b[4] = -0.5 * t * t;
+    b[5] = 1.5 * x2 - 2 * x;
+    b[6] = -1.5 * x2 + x + 0.5;
+    b[7] = 0.5 * x2;
+    b[8] = t;
+    b[9] = 3 * x - 2;
+    b[10] = -3 * x + 1;
+    b[11] = x;
+}
+
+#if defined(__GNUC__)
+/* Four doubles, the lanes of one SIMD register (AVX2; two SSE2 registers or half an AVX-512 one): each
+ * lane its own IEEE operations, the same as the scalar code's. */
+typedef double v4d __attribute__((vector_size(32), aligned(8)));
+
+CCP_INLINE v4d ld4(const double *p) {
+    v4d r;
+    memcpy(&r, p, sizeof r);
+    return r;
+}
+
+CCP_INLINE v4d splat(double x) { return (v4d){x, x, x, x}; }
+
+#if defined(__clang__)
+#define CCP_SHUF(a, b, i, j, k, l) __builtin_shufflevector(a, b, i, j, k, l)
+#else
+#define CCP_SHUF(a, b, i, j, k, l) __builtin_shuffle(a, b, (v4di){i, j, k, l})
+typedef int64_t v4di __attribute__((vector_size(32)));
+#endif
+
+/* The columns sum_j b_j net[i + 4 j, c] of the 4 x 4 x 3 net, as (i, c) lanes: three vectors of 4 lanes,
+ * lanes 3 i + c, each summed over j = 0..3 from 0.0 in order; returned rearranged as X[i] = the three
+ * coordinates of column i (lane 3 unused). */
+CCP_INLINE void columns(const double *net, const double *b, v4d *X) {
+    v4d b0 = splat(b[0]), b1 = splat(b[1]), b2 = splat(b[2]), b3 = splat(b[3]), z = splat(0.0), T[3];
+    for (int m = 0; m < 3; m++)
+        T[m] = (((z + b0 * ld4(net + 4 * m)) + b1 * ld4(net + 12 + 4 * m)) + b2 * ld4(net + 24 + 4 * m)) +
+               b3 * ld4(net + 36 + 4 * m);
+    X[0] = T[0];
+    X[1] = CCP_SHUF(T[0], T[1], 3, 4, 5, 6);
+    X[2] = CCP_SHUF(T[1], T[2], 2, 3, 4, 5);
+    X[3] = CCP_SHUF(T[2], T[2], 1, 2, 3, 3);
+}
+
+/* sum_i a_i X[i] from 0.0, left to right, for the three coordinates at once */
+CCP_INLINE v4d sum4v(const double *a, const v4d *X) {
+    return (((splat(0.0) + splat(a[0]) * X[0]) + splat(a[1]) * X[1]) + splat(a[2]) * X[2]) + splat(a[3]) * X[3];
+}
+
+CCP_INLINE void put3(double *dst, v4d x) { memcpy(dst, &x, 3 * sizeof(double)); }
+
+/* basis(x) with its four divisions by 6 as one vector division (the same IEEE operations lane by lane) */
+CCP_INLINE void basisv(double x, double *b) {
+    double t = 1.0 - x, x2 = x * x, x3 = x2 * x;
+    v4d n = {t * t * t, 3 * x3 - 6 * x2 + 4, -3 * x3 + 3 * x2 + 3 * x + 1, x3};
+    v4d q = n / splat(6.0);
+    memcpy(b, &q, sizeof q);
+    b[4] = -0.5 * t * t;
+    b[5] = 1.5 * x2 - 2 * x;
+    b[6] = -1.5 * x2 + x + 0.5;
+    b[7] = 0.5 * x2;
+    b[8] = t;
+    b[9] = 3 * x - 2;
+    b[10] = -3 * x + 1;
+    b[11] = x;
+}
+
+/* Row k of P and of the derivatives up to order D from the net (17 x 3) at (s, t), derivatives scaled
+ * by g per order (D a compile-time constant in each caller): the columns T_r[i] = sum_j B_r(t)_j
+ * net[i + 4 j], then sum_i B(s)_i T_r[i], each sum from 0.0 left to right (the numba kernel's order). */
+CCP_INLINE void bicubic(const double *net, double s, double t, double g, const int D, int64_t k, double *P,
+                        double *Pu, double *Pv, double *Puu, double *Puv, double *Pvv) {
+    double bs[12], bt[12];
+    v4d T0[4], T1[4], T2[4];
+    basisv(s, bs);
+    basisv(t, bt);
+    columns(net, bt, T0);
+    put3(P + 3 * k, (v4d){net[48], net[49], net[50], 0.0} + sum4v(bs, T0));
+    if (D >= 1) {
+        v4d gg = splat(g);
+        columns(net, bt + 4, T1);
+        put3(Pu + 3 * k, sum4v(bs + 4, T0) * gg);
+        put3(Pv + 3 * k, sum4v(bs, T1) * gg);
+    }
+    if (D >= 2) {
+        v4d g2 = splat(g * g);
+        columns(net, bt + 8, T2);
+        put3(Puu + 3 * k, sum4v(bs + 8, T0) * g2);
+        put3(Puv + 3 * k, sum4v(bs + 4, T1) * g2);
+        put3(Pvv + 3 * k, sum4v(bs, T2) * g2);
+    }
+}
+#else
+/* sum_j a_j w_j from 0.0, left to right */
+CCP_INLINE double sum4(const double *a, double w0, double w1, double w2, double w3) {
+    return (((0.0 + a[0] * w0) + a[1] * w1) + a[2] * w2) + a[3] * w3;
+}
+
+/* The columns T[3 i + c] = sum_j b_j net[i + 4 j, c] (12 lanes, each summed over j in order). */
+CCP_INLINE void columns(const double *net, const double *b, double *T) {
+    for (int k = 0; k < 12; k++)
+        T[k] = (((0.0 + b[0] * net[k]) + b[1] * net[12 + k]) + b[2] * net[24 + k]) + b[3] * net[36 + k];
+}
+
+/* Row k of P and of the derivatives up to order D (see the vector version above). */
+CCP_INLINE void bicubic(const double *net, double s, double t, double g, const int D, int64_t k, double *P,
+                        double *Pu, double *Pv, double *Puu, double *Puv, double *Pvv) {
+    double bs[12], bt[12], T0[12], T1[12], T2[12];
+    basis(s, bs);
+    basis(t, bt);
+    columns(net, bt, T0);
+    for (int c = 0; c < 3; c++)
+        P[3 * k + c] = net[48 + c] + sum4(bs, T0[c], T0[3 + c], T0[6 + c], T0[9 + c]);
+    if (D >= 1) {
+        columns(net, bt + 4, T1);
+        for (int c = 0; c < 3; c++) {
+            Pu[3 * k + c] = sum4(bs + 4, T0[c], T0[3 + c], T0[6 + c], T0[9 + c]) * g;
+            Pv[3 * k + c] = sum4(bs, T1[c], T1[3 + c], T1[6 + c], T1[9 + c]) * g;
+        }
+    }
+    if (D >= 2) {
+        double g2 = g * g;
+        columns(net, bt + 8, T2);
+        for (int c = 0; c < 3; c++) {
+            Puu[3 * k + c] = sum4(bs + 8, T0[c], T0[3 + c], T0[6 + c], T0[9 + c]) * g2;
+            Puv[3 * k + c] = sum4(bs + 4, T1[c], T1[3 + c], T1[6 + c], T1[9 + c]) * g2;
+            Pvv[3 * k + c] = sum4(bs, T2[c], T2[3 + c], T2[6 + c], T2[9 + c]) * g2;
+        }
+    }
+}
+#endif
+
+/* Net W (17 x 3, row 16 the limit point) of patch ``code`` of layer ``lay`` of the corner face ``vf`` of
+ * ``job``: L[lay, code] @ ring summed over the ring points j = 1, 2, ... in order, from 0.0. */
+static void corner_net(const ccp_table *T, int64_t job, int64_t vf, int64_t cfg, int64_t lay, int64_t code,
+                       int64_t ci, double *W) {
+    int64_t Nc = T->op_size[cfg];
+    const double *op = T->ops + T->op_start[cfg] + (3 * lay + code) * 16 * Nc;
+    const double *rg = T->ring + 3 * (ld(T->job_pts, T->wide[4], job) + T->pts[vf] - 1);
+    double a0[16], a1[16], a2[16];
+    for (int i = 0; i < 16; i++) a0[i] = a1[i] = a2[i] = 0.0;
+    for (int64_t j = 1; j < Nc; j++) {
+        double r0 = rg[3 * j], r1 = rg[3 * j + 1], r2 = rg[3 * j + 2];
+        const double *w = op + 16 * j;
+        for (int i = 0; i < 16; i++) {
+            a0[i] += w[i] * r0;
+            a1[i] += w[i] * r1;
+            a2[i] += w[i] * r2;
+        }
+    }
+    for (int i = 0; i < 16; i++) {
+        W[3 * i] = a0[i];
+        W[3 * i + 1] = a1[i];
+        W[3 * i + 2] = a2[i];
+    }
+    for (int c = 0; c < 3; c++) W[48 + c] = T->origin[3 * ci + c];
+}
+
+/* The corner-net cache (the caller's buffer of CCP_CACHE_WORDS doubles, zero when new, kept between calls
+ * on the same table by one thread at a time): word 0 the last block number, then CCP_CACHE_SLOTS slots of
+ * CCP_SLOT words, each [key + 1 (0: empty), the block that last took it, 3 unused, the net (51)]: the tag
+ * shares the net's first cache line. */
+#define CCP_SLOT 56
+#define CCP_CACHE_WORDS (8 + CCP_SLOT * CCP_CACHE_SLOTS)
+/* locate's answer for a point whose net is a corner net beyond the precomputed layer */
+static const double CCP_DEEP[1] = {0.0};
+
+/* 2^k for -1022 <= k <= 1023 (an exact power of two: scaling by it is ldexp while the result is normal;
+ * here k is a layer, at most a few hundred) */
+CCP_INLINE double pow2(int64_t k) {
+    uint64_t b = (uint64_t)(1023 + k) << 52;
+    double x;
+    memcpy(&x, &b, sizeof x);
+    return x;
+}
+
+/* The exponent e of frexp(x) (x = m 2^e, 1/2 <= m < 1) for x > 0 */
+CCP_INLINE int64_t expo(double x) {
+    uint64_t b;
+    memcpy(&b, &x, sizeof b);
+    int64_t f = (int64_t)((b >> 52) & 0x7ff);
+    if (f == 0) { /* subnormal */
+        int e;
+        frexp(x, &e);
+        return e;
+    }
+    return f - 1022;
+}
+
+/* A point whose net is a corner net of a layer beyond the precomputed one: what corner_net needs. */
+typedef struct {
+    int64_t job, vf, cfg, lay, code, ci;
+} ccp_deep;
+
+/* The net of point (pf, uu, ww), its parameter (s, t) in the patch and the scale g = 1 / h. Returns NULL
+ * for a point evaluation refuses, and CCP_DEEP for a corner net of a layer beyond the precomputed one,
+ * with what computes it in *dp (resolved by the caller: cache or scratch). */
+/* The job and virtual face of point (pf, uu, ww); returns the face's kind, or -1 for a point evaluation
+ * refuses. */
+CCP_INLINE int find_face(const ccp_table *T, int64_t pf, double uu, double ww, int64_t *jb, int64_t *vfc) {
+    if (pf < 0 || pf >= T->n_ptex || !(uu >= 0.0 && uu <= 1.0 && ww >= 0.0 && ww <= 1.0) || T->refused[pf])
+        return -1;
+    int64_t q = (uu >= 0.5) + 2 * (ww >= 0.5);
+    int64_t job = ld(T->top, T->wide[0], 4 * pf + q);
+    int64_t vf = ld(T->job_root, T->wide[1], job);
+    int kind = T->kind[vf];
+    for (int64_t it = 0; it < T->split_depth && kind == CCP_SPLIT; it++) {
+        double half = T->h[vf] * 0.5;
+        q = (uu >= T->u0[vf] + half) + 2 * (ww >= T->v0[vf] + half);
+        vf = T->child[4 * vf + q];
+        kind = T->kind[vf];
+    }
+    *jb = job;
+    *vfc = vf;
+    return kind;
+}
+
+/* The net of a point in virtual face vf (kind ``kind``) of ``job`` (find_face), its (s, t) and g. */
+CCP_INLINE const double *locate(const ccp_table *T, int64_t job, int64_t vf, int kind, double uu, double ww,
+                                ccp_deep *dp, double *s, double *t, double *g) {
+    const double *net;
+    double pu0, pv0, h;
+    if (kind == CCP_CORNER) {
+        double U0 = T->u0[vf], V0 = T->v0[vf], H = T->h[vf];
+        int cu = T->cu[vf], cv = T->cv[vf];
+#if defined(__GNUC__)
+        v4d dd = (v4d){cu ? (U0 + H) - uu : uu - U0, cv ? (V0 + H) - ww : ww - V0, 1.0, 1.0} / splat(H);
+        double du = dd[0], dv = dd[1];
+#else
+        double du = (cu ? (U0 + H) - uu : uu - U0) / H;
+        double dv = (cv ? (V0 + H) - ww : ww - V0) / H;
+#endif
+        double mx = du >= dv ? du : dv;
+        int64_t cfg = T->cfg[vf];
+        int64_t nmax = T->n_layers[cfg] - 1, lay;
+        if (mx > 0) {
+            int64_t e = expo(mx);
+            lay = -e;
+            if (lay < 0) lay = 0;
+            if (lay > nmax) lay = nmax;
+        } else {
+            lay = nmax;
+        }
+        double up = pow2(lay); /* exact scalings: ldexp(du, lay), ldexp(dv, lay), ldexp(H, -lay) */
+        du = du * up;
+        dv = dv * up;
+        static const int64_t codes[4] = {1, 2, 0, 1}; /* (a, b): (0, 0) 1, (0, 1) 2, (1, 0) 0, (1, 1) 1 */
+        int64_t code = codes[2 * (du >= 0.5) + (dv >= 0.5)];
+        double sc = H * pow2(-lay);
+        const double *un = T->unit + 9 * cfg + 3 * code;
+        pu0 = un[0] * sc + (cu ? (U0 + H) : U0);
+        pv0 = un[1] * sc + (cv ? (V0 + H) : V0);
+        h = un[2] * sc;
+        int64_t ci = ld(T->job_corner, T->wide[3], job) + T->leaf[vf];
+        if (lay == 0 && T->n_hot > 0) {
+            net = T->hot + CCP_NET * (3 * ci + code);
+        } else {
+            dp->job = job;
+            dp->vf = vf;
+            dp->cfg = cfg;
+            dp->lay = lay;
+            dp->code = code;
+            dp->ci = ci;
+            net = CCP_DEEP;
+        }
+    } else {
+        net = T->nets + CCP_NET * (ld(T->job_net, T->wide[2], job) + T->leaf[vf]);
+        pu0 = T->u0[vf];
+        pv0 = T->v0[vf];
+        h = T->h[vf];
+    }
+#if defined(__GNUC__)
+    v4d qq = (v4d){uu - pu0, ww - pv0, 1.0, 1.0} / splat(h); /* three divisions in one */
+    double x = qq[0], y = qq[1];
+    *g = qq[2];
+#else
+    double x = (uu - pu0) / h, y = (ww - pv0) / h;
+    *g = 1.0 / h;
+#endif
+    x = 0.0 > x ? 0.0 : x; /* min(max(x, 0.0), 1.0) with Python's max and min */
+    y = 0.0 > y ? 0.0 : y;
+    *s = 1.0 < x ? 1.0 : x;
+    *t = 1.0 < y ? 1.0 : y;
+    return net;
+}
+
+/* Points per block: the first pass locates them (and prefetches their nets), the second evaluates them. */
+#define CCP_BLOCK 32
+
+CCP_INLINE int64_t run(const ccp_table *T, int64_t n, const int64_t *f, const double *u, const double *v,
+                       const int D, double *P, double *Pu, double *Pv, double *Puu, double *Puv, double *Pvv,
+                       double *cache) {
+    int64_t *base = n >= CCP_CACHE_MIN ? (int64_t *)cache : NULL;
+    double S[CCP_BLOCK], Tt[CCP_BLOCK], G[CCP_BLOCK];
+    double W[CCP_BLOCK][CCP_NET]; /* the corner nets of a block without a cache */
+    const double *N[CCP_BLOCK];
+    ccp_deep dp[CCP_BLOCK];
+    int64_t *slot[CCP_BLOCK];
+    int64_t key[CCP_BLOCK];
+    int64_t bad = -1, k = 0, block = base != NULL ? base[0] : 0;
+    while (k < n && bad < 0) {
+        int64_t k0 = k;
+        int m = 0;
+        /* pass 1: the virtual faces of the block's points (independent table reads, overlapped), then their
+         * patches, prefetching the nets (or the cache slots of the deep corner nets) */
+        int64_t JB[CCP_BLOCK], VF[CCP_BLOCK];
+        int KD[CCP_BLOCK];
+        for (; k < n && m < CCP_BLOCK; k++, m++) {
+            KD[m] = find_face(T, f[k], u[k], v[k], JB + m, VF + m);
+            if (KD[m] < 0) {
+                bad = k;
+                break;
+            }
+        }
+        for (int i = 0; i < m; i++) {
+            int64_t kk = k0 + i;
+            const double *net = locate(T, JB[i], VF[i], KD[i], u[kk], v[kk], dp + i, S + i, Tt + i, G + i);
+            N[i] = net;
+            if (net == CCP_DEEP) {
+                if (base == NULL) continue;
+                key[i] = 3 * (T->max_layers * dp[i].ci + dp[i].lay) + dp[i].code;
+                slot[i] = base + 8 + CCP_SLOT * (int64_t)(((uint64_t)key[i] * CCP_HASH) & (CCP_CACHE_SLOTS - 1));
+                net = (const double *)slot[i];
+            }
+            for (int j = 0; j < CCP_NET; j += 8) CCP_PREFETCH(net + j);
+            CCP_PREFETCH(net + CCP_NET + 4);
+        }
+        /* pass 2: the deep corner nets (found in the cache, or computed), then the bicubics in order; a
+         * slot taken by an earlier point of this block and wanted by another net: the points before are
+         * evaluated first */
+        int i0 = 0;
+        block++;
+        for (int i = 0; i < m; i++) {
+            if (N[i] != CCP_DEEP) continue;
+            const ccp_deep *d = dp + i;
+            if (base == NULL) {
+                corner_net(T, d->job, d->vf, d->cfg, d->lay, d->code, d->ci, W[i]);
+                N[i] = W[i];
+                continue;
+            }
+            int64_t *sl = slot[i];
+            if (sl[0] != key[i] + 1) {
+                if (sl[1] == block) {
+                    for (; i0 < i; i0++) bicubic(N[i0], S[i0], Tt[i0], G[i0], D, k0 + i0, P, Pu, Pv, Puu, Puv, Pvv);
+                    block++;
+                }
+                corner_net(T, d->job, d->vf, d->cfg, d->lay, d->code, d->ci, (double *)(sl + 5));
+                sl[0] = key[i] + 1;
+            }
+            sl[1] = block;
+            N[i] = (const double *)(sl + 5);
+        }
+        for (; i0 < m; i0++) bicubic(N[i0], S[i0], Tt[i0], G[i0], D, k0 + i0, P, Pu, Pv, Puu, Puv, Pvv);
+    }
+    if (base != NULL) base[0] = block;
+    return bad;
+}
+
+CCP_CLONES static int64_t run0(const ccp_table *T, int64_t n, const int64_t *f, const double *u, const double *v,
+                               double *P, double *cache) {
+    return run(T, n, f, u, v, 0, P, NULL, NULL, NULL, NULL, NULL, cache);
+}
+
+CCP_CLONES static int64_t run1(const ccp_table *T, int64_t n, const int64_t *f, const double *u, const double *v,
+                               double *P, double *Pu, double *Pv, double *cache) {
+    return run(T, n, f, u, v, 1, P, Pu, Pv, NULL, NULL, NULL, cache);
+}
+
+CCP_CLONES static int64_t run2(const ccp_table *T, int64_t n, const int64_t *f, const double *u, const double *v,
+                               double *P, double *Pu, double *Pv, double *Puu, double *Puv, double *Pvv,
+                               double *cache) {
+    return run(T, n, f, u, v, 2, P, Pu, Pv, Puu, Puv, Pvv, cache);
+}
+
+/* Fill P (n x 3) and, for d >= 1, Pu, Pv, for d >= 2, Puu, Puv, Pvv (n x 3 each, C order) at the points
+ * (f[k], u[k], v[k]). ``cache``: NULL, or ccp_cache_words() doubles, zero when new, used by one call at a
+ * time and only with this table (it keeps the corner nets of layers beyond the precomputed one; the results
+ * are the same bits with or without it). Returns -1, or the index of the first point whose face is out of
+ * range or refused or whose (u, v) is outside [0, 1]^2 or NaN (the outputs from that point on are not
+ * written). */
+int64_t ccp_evaluate(const ccp_table *T, int64_t n, const int64_t *f, const double *u, const double *v, int64_t d,
+                     double *P, double *Pu, double *Pv, double *Puu, double *Puv, double *Pvv, double *cache) {
+    if (d <= 0) return run0(T, n, f, u, v, P, cache);
+    if (d == 1) return run1(T, n, f, u, v, P, Pu, Pv, cache);
+    return run2(T, n, f, u, v, P, Pu, Pv, Puu, Puv, Pvv, cache);
+}
+
+/* The size of a corner-net cache, in doubles. */
+int64_t ccp_cache_words(void) { return CCP_CACHE_WORDS; }
+
+/* The layout this file was compiled with: the binding refuses a library whose structure differs. */
+int64_t ccp_abi(void) { return 1000 * (int64_t)sizeof(ccp_table) + 2; }
+
+/* ------------------------------------------------------------------------------------------------------------
+ * The ring walk of the table's setup (the numba kernel's _ring_walks, ccproof/evaluate/_numba_kernel.py, step
+ * for step): the canonical depth-1 ring of quad g[k] of an all-quad complex from its corner r[k]. */
+
+/* Step of the walk: list the face of half-edge c (read from c on) unless seen. Returns 0, or -1 when the
+ * arrays are full (*n = -1; *nf = -1 when the faces are full, else one more). */
+static int take_face(int64_t c, const int64_t *org, int64_t *pos, uint8_t *seen, int32_t *ring, int64_t maxn,
+                     int64_t *faces, int64_t maxf, int64_t *fc, int64_t *fl, int64_t *n, int64_t *nf) {
+    int64_t hf = c / 4;
+    if (seen[hf]) return 0;
+    if (*nf >= maxf) {
+        *n = -1;
+        *nf = -1;
+        return -1;
+    }
+    seen[hf] = 1;
+    fl[*nf] = hf;
+    int64_t j0 = c - 4 * hf;
+    for (int64_t t = 0; t < 4; t++) {
+        int64_t hc = 4 * hf + (j0 + t) % 4;
+        int64_t uu = org[hc];
+        int64_t q = pos[uu];
+        if (q < 0) {
+            if (*n >= maxn) {
+                faces[4 * *nf] = -1;
+                *n = -1;
+                *nf += 1;
+                return -1;
+            }
+            q = *n;
+            pos[uu] = *n;
+            ring[*n] = (int32_t)uu;
+            fc[*n] = hc;
+            *n += 1;
+        }
+        faces[4 * *nf + t] = q;
+    }
+    *nf += 1;
+    return 0;
+}
+
+/* For every k < nk: the ring of quad g[k] from corner r[k] (vertex labels rings[k, :nring[k]], rows of maxn),
+ * its faces in ring labels (faces[k, :nfaces[k]], rows of maxf x 4) and a 64-bit FNV-1a hash of (nring,
+ * faces); nring[k] = -1 when the ring does not fit the arrays or the walk does not close. pos (n_vertices)
+ * and seen (n_faces) are scratch, -1 / 0 on entry and on return. Returns 0, or -1 when the scratch arrays
+ * could not be allocated (nothing written). */
+int64_t ccp_ring_walks(const int64_t *org, const int64_t *nxt, const int64_t *prv, const int64_t *twin, int64_t *pos,
+                       uint8_t *seen, int64_t nk, const int64_t *g, const int64_t *r, int32_t *rings, int64_t maxn,
+                       int64_t *nring, int64_t *faces, int64_t maxf, int64_t *nfaces, uint64_t *hashes) {
+    int64_t *fc = (int64_t *)malloc(sizeof(int64_t) * (size_t)(maxn > 0 ? maxn : 1));
+    int64_t *fl = (int64_t *)malloc(sizeof(int64_t) * (size_t)(maxf > 0 ? maxf : 1));
+    if (fc == NULL || fl == NULL) {
+        free(fc);
+        free(fl);
+        return -1;
+    }
+    for (int64_t k = 0; k < nk; k++) {
+        int64_t gk = g[k];
+        int32_t *ring = rings + maxn * k;
+        int64_t *fk = faces + 4 * maxf * k;
+        int64_t n = 0, nf = 1;
+        int ok = 1;
+        seen[gk] = 1;
+        fl[0] = gk;
+        for (int64_t i = 0; i < 4; i++) {
+            int64_t h = 4 * gk + (r[k] + i) % 4;
+            int64_t vv = org[h];
+            fk[i] = i;
+            if (pos[vv] >= 0) {
+                ok = 0;
+                break;
+            }
+            pos[vv] = n;
+            ring[n] = (int32_t)vv;
+            fc[n] = h;
+            n++;
+        }
+        int64_t idx = 0;
+        while (ok && idx < 4) {
+            int64_t c0 = fc[idx];
+            take_face(c0, org, pos, seen, ring, maxn, fk, maxf, fc, fl, &n, &nf);
+            int64_t c = twin[prv[c0]];
+            int64_t steps = 0;
+            while (n >= 0 && c >= 0 && c != c0 && steps < 4096) { /* counter-clockwise */
+                take_face(c, org, pos, seen, ring, maxn, fk, maxf, fc, fl, &n, &nf);
+                c = twin[prv[c]];
+                steps++;
+            }
+            if (n < 0 || steps >= 4096) {
+                ok = 0;
+                break;
+            }
+            if (c != c0) { /* an open fan: then clockwise from c0 */
+                int64_t t_ = twin[c0];
+                c = t_ < 0 ? -1 : nxt[t_];
+                while (n >= 0 && c >= 0 && steps < 4096) {
+                    take_face(c, org, pos, seen, ring, maxn, fk, maxf, fc, fl, &n, &nf);
+                    t_ = twin[c];
+                    c = t_ < 0 ? -1 : nxt[t_];
+                    steps++;
+                }
+                if (n < 0 || steps >= 4096) {
+                    ok = 0;
+                    break;
+                }
+            }
+            idx++;
+        }
+        if (nf < 0) nf = maxf;
+        int64_t top = n < 0 ? maxn : n;
+        for (int64_t i = 0; i < top; i++) /* reset the scratch arrays */
+            if (i < maxn && ring[i] >= 0 && pos[ring[i]] == i) pos[ring[i]] = -1;
+        for (int64_t i = 0; i < nf; i++) seen[fl[i]] = 0;
+        nring[k] = ok ? n : -1;
+        nfaces[k] = nf;
+        uint64_t hsh = 14695981039346656037ull, prime = 1099511628211ull;
+        hsh = (hsh ^ (uint64_t)(n > 0 ? n : 0)) * prime;
+        for (int64_t i = 0; i < nf; i++)
+            for (int64_t t = 0; t < 4; t++) hsh = (hsh ^ (uint64_t)(fk[4 * i + t] + 1)) * prime;
+        hashes[k] = hsh;
+    }
+    free(fc);
+    free(fl);
+    return 0;
+}
+
+#ifdef CCP_PYTHON_MODULE
+static struct PyModuleDef ccp_module = {PyModuleDef_HEAD_INIT, "_clib",
+                                        "The C evaluation kernel: loaded with ctypes by ccproof.evaluate._ckernel "
+                                        "(nothing to call from Python).",
+                                        -1, NULL, NULL, NULL, NULL, NULL};
+
+PyMODINIT_FUNC PyInit__clib(void) { return PyModule_Create(&ccp_module); }
+#endif
