@@ -57,9 +57,11 @@ from .tagged import (
     leading_spectrum,
     parse_configuration,
     sector_matrix,
+    sector_rows,
     sharp_rays,
 )
 from .tagged_map import check_map
+from .tagged_modes import MIN_N, mode_spectrum, mode_vector
 
 TAGGED_SCHEMA = "ccproof.tagged-c1/1"
 STATEMENTS = ("C1", "not C1")
@@ -110,9 +112,9 @@ def verify_tagged(cert, part, log):
     if not 64 <= prec <= 1024:
         raise CertificateError("prec must lie in 64..1024")
     log(f"{statement} certificate for {name} ({prec} bits)")
-    S = sector_matrix(fam, n)
-    ok = all(sum((S[i, j] for j in range(S.ncols())), fmpq(0)) == 1 for i in range(S.nrows()))
-    part("S sector matrix derived from the rules", ok, f"{S.nrows()} points, rows sum to 1 (exact)")
+    rows = sector_rows(fam, n)
+    ok = all(sum(row.values(), fmpq(0)) == 1 for row in rows)
+    part("S sector matrix derived from the rules", ok, f"{len(rows)} points, rows sum to 1 (exact)")
     if statement == "C1":
         ok, msg, lead = leading_spectrum(fam, n, prec)
         part("spectral part of the generalized Reif criterion", ok, msg)
@@ -149,6 +151,10 @@ def verify_tagged(cert, part, log):
     r, q = field_of(w, "ray", int, "witness"), field_of(w, "quadrant", int, "witness")
     if r not in sharp_rays(fam, n) or not 0 <= q < n:
         raise CertificateError(f"witness: ray {r} is not sharp or quadrant {q} outside 0..{n - 1}")
+    if n >= MIN_N:  # the spectrum and the eigenvectors through the sine modes (tagged_modes), O(N)
+        with ctx.workprec(prec):
+            _verify_witness_modes(fam, n, w, r, q, part, log)
+        return name
     with ctx.workprec(prec):
         vecs, vals = {}, {}
         for c in ("x", "y", "z"):
@@ -170,6 +176,83 @@ def verify_tagged(cert, part, log):
             log(f"  the limit surface of this net is not C1 at the {fam} vertex: normals along the level-m "
                 f"copies of quadrant {q}'s (1,1) tend to n_z != 0, yet e_z lies in T_v (ray {r})")
     return name
+
+
+def _verify_witness_modes(fam, n, w, r, q, part, log):
+    """The parts of a "not C1" witness for crease:N, corner:N, N >= MIN_N, from :mod:`.tagged_modes`:
+    x and y eigenvectors of simple mode roots (closed form), z's existence from its crease values, G, B, N."""
+    ev = mode_spectrum(fam, n)
+    vecs, at = {}, {}
+    for c in ("x", "y"):
+        spec = field_of(w, c, dict, "witness")
+        exact_keys(spec, ("eigenvalue", "crease", "pivot"), c)
+        crease, lo_hi = field_of(spec, "crease", list, c), field_of(spec, "eigenvalue", list, c)
+        if len(crease) != 5 or len(lo_hi) != 2:
+            raise CertificateError(f"{c}: crease values must be 5 decimals and the eigenvalue [low, high]")
+        if any(parse_decimal(v) != 0 for v in crease):
+            part(f"{c}: eigenvector of S", False, "an irrational eigenvalue's eigenvector vanishes on the crease points")
+            return
+        lo, hi = parse_decimal(lo_hi[0]), parse_decimal(lo_hi[1])
+        inside = [i for i, t in enumerate(ev) if t[0].real > lo and t[0].real < hi]
+        near = [i for i, t in enumerate(ev) if t[0].real.overlaps(arb(lo).union(arb(hi)))]
+        i = inside[0] if len(inside) == 1 and near == inside else None
+        if i is None or not ev[i][0].imag.is_zero() or ev[i][3] is None:
+            part(f"{c}: eigenvector of S", False, f"[{lo}, {hi}] does not isolate one simple real root of a mode")
+            return
+        pivot = field_of(spec, "pivot", int, c)
+        if not 0 <= pivot < len(ev) or pivot in crease_points(fam, n):
+            raise CertificateError(f"{c}: pivot must index a non-crease point")
+        f = mode_vector(fam, n, ev[i][3], ev[i][0].real)
+        if f is None:
+            part(f"{c}: eigenvector of S", False, "no pivot makes the bordered 6 x 6 system certainly regular")
+            return
+        if not abs(f[pivot]) > 0:
+            part(f"{c}: eigenvector of S", False, f"the eigenvector is not certainly non-zero at the pivot {pivot}")
+            return
+        vecs[c] = [v if isinstance(v, fmpq) else (v / f[pivot]).real for v in f]
+        at[c] = i
+        part(f"{c}: eigenvector of S", True, f"eigenvalue {ev[i][0].real.str(10)} = lam(cos({ev[i][3]} pi/{n})), "
+             f"simple; closed form in mode {ev[i][3]} (the bordered 6 x 6 system proved regular), pivot "
+             f"{labels(fam, n)[pivot]}")
+    spec = field_of(w, "z", dict, "witness")
+    exact_keys(spec, ("eigenvalue", "crease"), "z")
+    g, cval = field_of(spec, "eigenvalue", str, "z"), field_of(spec, "crease", list, "z")
+    if len(cval) != 5:
+        raise CertificateError("z: crease values must be 5 decimals")
+    g, cval = parse_decimal(g), [parse_decimal(v) for v in cval]
+    C = crease_block(fam, n)
+    Cc = C * fmpq_mat([[v] for v in cval])
+    at_g = [t for t in ev if t[2] == "I" and (t[1] == g if t[1] is not None else t[0].real.overlaps(arb(g)))]
+    ok = any(v != 0 for v in cval) and all(Cc[i, 0] == g * cval[i] for i in range(5)) and len(at_g) <= 1
+    part("z: (generalized) eigenvector of S", ok,
+         f"eigenvalue {g}: C c = {g} c exactly on the crease points, and {g} is at most a simple eigenvalue of I, so "
+         f"some z with these crease values has (S - {g})^2 z = 0 and (S - {g}) z = 0 on the crease points" if ok else
+         f"the crease values are no eigenvector of the crease block for {g}, or {g} is possibly a multiple eigenvalue of I")
+    if not ok:
+        return
+    ia, ib = at["x"], at["y"]
+    one = [t for t in ev if not abs(t[0]) < 1]
+    beta = ev[ib][0].real
+    others = [t for i, t in enumerate(ev) if i not in (ia, ib) and t[1] != 1]
+    below = [t[1] for t in ev if t[2] == "C" and t[1] is not None and t[1] < 1]
+    ok = (ia != ib and len(one) == 1 and one[0][1] == 1 and one[0][2] == "C" and ev[ia][0].real >= beta
+          and all(abs(t[0]) < beta for t in others) and below and g == max(below) and arb(g) < beta)
+    part("G generic: alpha = lam1, beta = lam2, gamma = the crease block's largest eigenvalue below 1; "
+         "no Jordan block at |lam| >= beta; gamma < beta for a generalized z", ok,
+         f"alpha = {ev[ia][0].real.str(8)} > beta = {beta.str(8)} > |every other| (each simple), 1 simple; "
+         f"gamma = {g} < beta" if ok else "alpha, beta are not the two leading eigenvalues below 1 (certainly), "
+         "or gamma is not the crease block's largest below 1 or not below beta")
+    if not ok:
+        return
+    vecs["z"] = [cval[cp.index(i)] if i in cp else None for i, cp in
+                 ((i, crease_points(fam, n)) for i in range(len(ev)))]
+    _check_boundary(fam, n, r, vecs, part)
+    J = _jacobian(fam, n, q, vecs["x"], vecs["y"])
+    ok = J > 0 or J < 0
+    part(f"N normal at vertex (1,1) of quadrant {q}: J_xy != 0", ok, f"J_xy = {J.str(6)}")
+    if not part.failed:
+        log(f"  the limit surface of this net is not C1 at the {fam} vertex: normals along the level-m copies of "
+            f"quadrant {q}'s (1,1) tend to n_z != 0, yet e_z lies in T_v (ray {r})")
 
 
 def _same(t, v):
