@@ -26,6 +26,7 @@ from ccproof.certify.verify.tagged import (
     parse_configuration,
     sharp_rays,
 )
+from ccproof.certify.verify.tagged_modes import MIN_N, mode_spectrum, mode_vector
 from ccproof.errors import CCProofError
 
 DEFAULT_PREC = 128
@@ -122,6 +123,25 @@ def _interior_candidates(fam, n, prec):
     return out
 
 
+def _mode_candidates(fam, n, prec):
+    """The two largest mode roots (crease, corner, N >= MIN_N) with intervals and pivots, from the closed
+    forms of :mod:`ccproof.certify.verify.tagged_modes` (floats choose; the verifier decides)."""
+    with ctx.workprec(prec):
+        ev = mode_spectrum(fam, n)
+        roots = sorted((i for i, t in enumerate(ev) if t[3] is not None and t[0].imag.is_zero()),
+                       key=lambda i: -float(ev[i][0].real.mid()))
+        out = []
+        for i in roots[:2]:
+            z = ev[i][0]
+            f = mode_vector(fam, n, ev[i][3], z.real)
+            if f is None:
+                return []
+            pivot = max((k for k, v in enumerate(f) if not isinstance(v, fmpq)), key=lambda k: float(abs(f[k]).mid()))
+            others = [t[0] for k, t in enumerate(ev) if k != i]
+            out.append((float(z.real.mid()), z, _interval(z, others), pivot))
+    return out
+
+
 def _pivot(fam, n, z, prec):
     """A point where the eigenvector of the simple eigenvalue z is large (numerical choice only; the
     verifier proves the bordered system regular)."""
@@ -173,14 +193,15 @@ def witness_candidates(name, prec=DEFAULT_PREC):
     if fam == "dart":
         return []
     pts = labels(fam, n)
-    inner = _interior_candidates(fam, n, prec)
+    modes = n >= MIN_N  # the verifier's closed forms: no exact spectrum, no pivot search
+    inner = _mode_candidates(fam, n, prec) if modes else _interior_candidates(fam, n, prec)
     creases = _crease_vectors(fam, n)
     top = max(g for g, _ in creases) if creases else None
     creases = [(g, v) for g, v in creases if g == top]  # the verifier wants gamma = the crease block's largest
     zero = ["0"] * len(crease_points(fam, n))
 
     def irr(t):
-        pv = _pivot(fam, n, t[1], prec)
+        pv = t[3] if modes else _pivot(fam, n, t[1], prec)
         return None if pv is None else {"eigenvalue": t[2], "crease": zero, "pivot": pv}
 
     def rat(g, v):
@@ -194,7 +215,7 @@ def witness_candidates(name, prec=DEFAULT_PREC):
                 if float(g.p) / float(g.q) <= inner[1][0] and _decimal_exact(g) and all(_decimal_exact(c) for c in v):
                     for r in sharp_rays(fam, n):
                         out.append({"x": x, "y": y, "z": rat(g, v), "ray": r})
-    if fam == "corner" and inner:
+    if fam == "corner" and inner and not modes:
         x = irr(inner[0])
         half = [(g, v) for g, v in creases if g == fmpq(1, 2)]
         if x and len(half) >= 2:
@@ -249,7 +270,6 @@ def prove_tagged(name, prec=DEFAULT_PREC):
      no witness candidate'
     """
     fam, n = parse_configuration(name)
-    ok, msg, _ = leading_spectrum(fam, n, prec)
     why = []
     for w in witness_candidates(name, prec):
         for q in range(n):
@@ -262,7 +282,7 @@ def prove_tagged(name, prec=DEFAULT_PREC):
             if not any(p.name.startswith("N ") for p in res.failures()):
                 break  # only the normal depends on the quadrant
     witness = f"; no witness ({why[0]})" if why else "; no witness candidate"
-    return None, f"undecided: {msg}{witness}"
+    return None, f"undecided: {leading_spectrum(fam, n, prec)[1]}{witness}"
 
 
 def write_tagged(cert, out_dir):

@@ -236,7 +236,7 @@ def test_forgery_relabelled_configuration():
 def test_forgery_another_configurations_data():
     cert = _cert("crease:5")
     other = _cert("crease:6")
-    _fails(dict(cert, witness=other["witness"]), "x: eigenvector")  # its lam1 or its pivot do not fit
+    _fails(dict(cert, witness=other["witness"]), "does not isolate")  # its lam2 does not fit
 
 
 def test_forgery_identity_map():

@@ -223,11 +223,13 @@ def _verify_witness_modes(fam, n, w, r, q, part, log):
     C = crease_block(fam, n)
     Cc = C * fmpq_mat([[v] for v in cval])
     at_g = [t for t in ev if t[2] == "I" and (t[1] == g if t[1] is not None else t[0].real.overlaps(arb(g)))]
-    ok = any(v != 0 for v in cval) and all(Cc[i, 0] == g * cval[i] for i in range(5)) and len(at_g) <= 1
+    why = (f"no eigenvector for {g} with the given crease values (C c = {g} c, c != 0 fails)"
+           if all(v == 0 for v in cval) or any(Cc[i, 0] != g * cval[i] for i in range(5)) else
+           f"{g} is possibly a multiple eigenvalue of I" if len(at_g) > 1 else None)
+    ok = why is None
     part("z: (generalized) eigenvector of S", ok,
          f"eigenvalue {g}: C c = {g} c exactly on the crease points, and {g} is at most a simple eigenvalue of I, so "
-         f"some z with these crease values has (S - {g})^2 z = 0 and (S - {g}) z = 0 on the crease points" if ok else
-         f"the crease values are no eigenvector of the crease block for {g}, or {g} is possibly a multiple eigenvalue of I")
+         f"some z with these crease values has (S - {g})^2 z = 0 and (S - {g}) z = 0 on the crease points" if ok else why)
     if not ok:
         return
     ia, ib = at["x"], at["y"]
@@ -235,14 +237,18 @@ def _verify_witness_modes(fam, n, w, r, q, part, log):
     beta = ev[ib][0].real
     others = [t for i, t in enumerate(ev) if i not in (ia, ib) and t[1] != 1]
     below = [t[1] for t in ev if t[2] == "C" and t[1] is not None and t[1] < 1]
-    ok = (ia != ib and len(one) == 1 and one[0][1] == 1 and one[0][2] == "C" and ev[ia][0].real >= beta
-          and all(abs(t[0]) < beta for t in others) and below and g == max(below) and arb(g) < beta)
+    why = ("x and y are the same eigenvector (beta is not an eigenvalue distinct from alpha)" if ia == ib else
+           "eigenvalue 1 is not simple" if len(one) != 1 or one[0][1] != 1 or one[0][2] != "C" else
+           "alpha >= beta is not certain" if not ev[ia][0].real >= beta else
+           "an eigenvalue is not certainly below beta (lam1, lam2 not alpha, beta)"
+           if not all(abs(t[0]) < beta for t in others) else
+           f"gamma is not the crease block's largest eigenvalue below 1 ({max(below) if below else None})"
+           if not below or g != max(below) else "gamma < beta is not certain" if not arb(g) < beta else None)
     part("G generic: alpha = lam1, beta = lam2, gamma = the crease block's largest eigenvalue below 1; "
-         "no Jordan block at |lam| >= beta; gamma < beta for a generalized z", ok,
+         "no Jordan block at |lam| >= beta; gamma < beta for a generalized z", why is None,
          f"alpha = {ev[ia][0].real.str(8)} > beta = {beta.str(8)} > |every other| (each simple), 1 simple; "
-         f"gamma = {g} < beta" if ok else "alpha, beta are not the two leading eigenvalues below 1 (certainly), "
-         "or gamma is not the crease block's largest below 1 or not below beta")
-    if not ok:
+         f"gamma = {g} < beta" if why is None else why)
+    if why is not None:
         return
     vecs["z"] = [cval[cp.index(i)] if i in cp else None for i, cp in
                  ((i, crease_points(fam, n)) for i in range(len(ev)))]
