@@ -250,8 +250,8 @@ def _verify_witness_modes(fam, n, w, r, q, part, log):
          f"gamma = {g} < beta" if why is None else why)
     if why is not None:
         return
-    vecs["z"] = [cval[cp.index(i)] if i in cp else None for i, cp in
-                 ((i, crease_points(fam, n)) for i in range(len(ev)))]
+    cp = crease_points(fam, n)
+    vecs["z"] = [cval[cp.index(i)] if i in cp else None for i in range(len(ev))]  # B reads the crease points only
     _check_boundary(fam, n, r, vecs, part)
     J = _jacobian(fam, n, q, vecs["x"], vecs["y"])
     ok = J > 0 or J < 0
