@@ -26,7 +26,7 @@ from ccproof.certify.verify.tagged import (
     parse_configuration,
     sharp_rays,
 )
-from ccproof.certify.verify.tagged_modes import MIN_N, mode_spectrum, mode_vector
+from ccproof.certify.verify.tagged_modes import MIN_N, even_vector, mode_spectrum, mode_vector
 from ccproof.errors import CCProofError
 
 DEFAULT_PREC = 128
@@ -282,6 +282,8 @@ def prove_tagged(name, prec=DEFAULT_PREC):
             if not any(p.name.startswith("N ") for p in res.failures()):
                 break  # only the normal depends on the quadrant
     witness = f"; no witness ({why[0]})" if why else "; no witness candidate"
+    if fam == "dart":
+        return None, "undecided: no witness form for darts"
     return None, f"undecided: {leading_spectrum(fam, n, prec)[1]}{witness}"
 
 
@@ -368,6 +370,12 @@ def prove_tagged_c1(name, prec=DEFAULT_PREC):
     ('C1', 'C1')
     """
     fam, n = parse_configuration(name)
+    if fam == "dart" and n >= MIN_N:  # the verifier's mode route: no exact spectrum of the whole matrix
+        specs, entries = _dart_specs(n, prec)
+        if specs is None:
+            return None, "undecided: no isolated lam1 > lam2 or no regular pivot"
+        cert, last = _prove_map(name, fam, n, specs, prec, entries)
+        return (cert, "C1") if cert is not None else (None, f"undecided: {last}")
     ok, msg, lead = leading_spectrum(fam, n, prec)
     if not ok:
         return None, f"undecided: {msg}"
@@ -383,7 +391,45 @@ def prove_tagged_c1(name, prec=DEFAULT_PREC):
     return None, f"undecided: {last}"
 
 
-def _prove_map(name, fam, n, specs, prec):
+def _dart_vector(k, i, ev, pivot):
+    """The eigenvector of entry i of the dart's mode spectrum as the verifier derives it, or None."""
+    lam = ev[i][0].real
+    if ev[i][3] is not None:
+        f = mode_vector("dart", k, ev[i][3], lam)
+        if f is None or not abs(f[pivot]) > 0:
+            return None
+        return [v if isinstance(v, fmpq) else (v / f[pivot]).real for v in f]
+    try:
+        return even_vector(k, lam, pivot)
+    except ZeroDivisionError:
+        return None
+
+
+def _dart_specs(k, prec):
+    """Map coordinates (x for lam1, y for lam2) of dart:k, K >= MIN_N: isolating intervals and pivots where
+    the vector is large (floats choose; the verifier decides)."""
+    with ctx.workprec(prec):
+        ev = mode_spectrum("dart", k)
+        rest = sorted((i for i, t in enumerate(ev) if abs(t[0]) < 1), key=lambda i: -float(abs(ev[i][0]).mid()))
+        pts = labels("dart", k)
+        out = []
+        for i in rest[:2]:
+            trial = [pts.index(("q", q, 1, 1)) for q in range(k)] + [pts.index(("r", r, 1, 0)) for r in range(1, k)]
+            vec = next((v for v in (_dart_vector(k, i, ev, p) for p in trial) if v is not None), None)
+            if vec is None:
+                return None, None
+            # the largest coordinate among the one-ring points (the left eigenvector vanishes on the outer
+            # ring, where the bordered system is singular)
+            order = sorted(trial, key=lambda j: -float(abs(vec[j]).mid()))[:24]
+            pivot = next((j for j in order if _dart_vector(k, i, ev, j) is not None), None)
+            if pivot is None:
+                return None, None
+            others = [t[0] for j, t in enumerate(ev) if j != i]
+            out.append({"eigenvalue": _interval(ev[i][0], others), "crease": [], "pivot": pivot})
+    return tuple(out), rest[:2]
+
+
+def _prove_map(name, fam, n, specs, prec, entries=None):
     from flint import arb as _arb
 
     from ccproof.certify.verify.maps import regularity_form
@@ -395,9 +441,16 @@ def _prove_map(name, fam, n, specs, prec):
     from ccproof.certify.verify.tagged_c1 import eigenvector_of
 
     with ctx.workprec(prec):
-        (lx, vx, mx), (ly, vy, my) = (eigenvector_of(fam, n, s, c, prec) for s, c in zip(specs, "xy"))
-        if vx is None or vy is None:
-            return None, mx if vx is None else my
+        if entries is not None:  # a dart's mode spectrum entries of lam1, lam2
+            ev = mode_spectrum("dart", n)
+            lx, ly = (ev[i][0].real for i in entries)
+            vx, vy = (_dart_vector(n, i, ev, s["pivot"]) for i, s in zip(entries, specs))
+            if vx is None or vy is None:
+                return None, "no eigenvector at the chosen pivot"
+        else:
+            (lx, vx, mx), (ly, vy, my) = (eigenvector_of(fam, n, s, c, prec) for s, c in zip(specs, "xy"))
+            if vx is None or vy is None:
+                return None, mx if vx is None else my
         nets = [quadrant_nets(fam, n, vx, vy, q, prec) for q in range(n)]
         mid = regularity_form(nets[0], "P2", prec).coeffs[12]
         orient = 1 if mid > 0 else -1

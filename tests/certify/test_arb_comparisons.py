@@ -75,7 +75,12 @@ REVIEWED = {
     ("tagged_modes.py", "w != 0"): "fmpq rule weights (exact)",
     ("tagged_modes.py", "R[r, c] != 0"): "fmpq_mat entries (exact)",
     ("tagged_modes.py", "x != 0"): "fmpq folded weights (exact)",
-    ("tagged_map.py", "S[i, j] != 0"): "fmpq_mat entries (exact)",
+    ("tagged_c1.py", "ev[one[0]][1] != 1"): "fmpq or None (the exact value of a rational eigenvalue)",
+    ("tagged_c1.py", "not l1.real > l2.real"): "fails unless lam1 > lam2 certainly: conservative",
+    ("tagged_modes.py", "rows[refl[i]] != {refl[j]: x for j, x in rows[i].items()}"): "dicts of fmpq weights (exact)",
+    ("tagged_modes.py", "{j: x for j, x in ring.items() if x != 0} != {j: x for j, x in rows[i].items() if j != 0}"):
+        "dicts of fmpq weights (exact)",
+    ("tagged_modes.py", "j != 0"): "ints (column indices)",
     ("maps.py", "not (hi < BREAKS[p] or (p < 3 and lo > BREAKS[p + 1]))"): (
         "keeps a piece unless the hull is certainly outside it: conservative"),
 }

@@ -61,7 +61,7 @@ from .tagged import (
     sharp_rays,
 )
 from .tagged_map import check_map
-from .tagged_modes import MIN_N, mode_spectrum, mode_vector
+from .tagged_modes import MIN_N, even_vector, mode_spectrum, mode_vector
 
 TAGGED_SCHEMA = "ccproof.tagged-c1/1"
 STATEMENTS = ("C1", "not C1")
@@ -115,6 +115,10 @@ def verify_tagged(cert, part, log):
     rows = sector_rows(fam, n)
     ok = all(sum(row.values(), fmpq(0)) == 1 for row in rows)
     part("S sector matrix derived from the rules", ok, f"{len(rows)} points, rows sum to 1 (exact)")
+    if statement == "C1" and fam == "dart" and n >= MIN_N:  # the odd half through the modes (tagged_modes)
+        with ctx.workprec(prec):
+            _verify_dart_c1(cert, n, prec, part)
+        return name
     if statement == "C1":
         ok, msg, lead = leading_spectrum(fam, n, prec)
         part("spectral part of the generalized Reif criterion", ok, msg)
@@ -126,11 +130,7 @@ def verify_tagged(cert, part, log):
                  "sends the sharp edges to v (not injective)")
         if part.failed:
             return name
-        mp = field_of(cert, "map", dict, "certificate")
-        exact_keys(mp, ("x", "y", "orientation"), "map")
-        orient = mp["orientation"]
-        if orient not in (1, -1) or isinstance(orient, bool):
-            raise CertificateError("map.orientation must be 1 or -1")
+        mp, orient = _map_field(cert)
         with ctx.workprec(prec):
             vecs, vals = {}, {}
             for c, t in (("x", lead[1]), ("y", lead[2])):
@@ -176,6 +176,71 @@ def verify_tagged(cert, part, log):
             log(f"  the limit surface of this net is not C1 at the {fam} vertex: normals along the level-m "
                 f"copies of quadrant {q}'s (1,1) tend to n_z != 0, yet e_z lies in T_v (ray {r})")
     return name
+
+
+def _map_field(cert):
+    mp = field_of(cert, "map", dict, "certificate")
+    exact_keys(mp, ("x", "y", "orientation"), "map")
+    orient = mp["orientation"]
+    if orient not in (1, -1) or isinstance(orient, bool):
+        raise CertificateError("map.orientation must be 1 or -1")
+    return mp, orient
+
+
+def _verify_dart_c1(cert, k, prec, part):
+    """A dart's "C1" certificate, K >= MIN_N: the spectral part from :func:`.tagged_modes.mode_spectrum`
+    (every eigenvalue enclosed, S_E's exactly, the odd half's through the modes), lam1 and lam2 each
+    isolated (so simple), x and y in closed form (odd) or from S_E (even), then the map's parts."""
+    ev = mode_spectrum("dart", k)
+    one = [i for i, t in enumerate(ev) if not abs(t[0]) < 1]
+    rest = sorted((i for i in range(len(ev)) if i not in one), key=lambda i: -abs(ev[i][0]).mid())
+    i1, i2 = rest[0], rest[1]
+    l1, l2 = ev[i1][0], ev[i2][0]
+    why = ("eigenvalue 1 is not simple" if len(one) != 1 or ev[one[0]][1] != 1 else
+           "lam1 or lam2 is not certainly real and positive" if not all(
+               z.imag.is_zero() and z.real > 0 for z in (l1, l2)) else
+           "lam1 > lam2 is not certain" if not l1.real > l2.real else
+           "|lam3| is not certainly below lam2" if not all(abs(ev[i][0]) < l2.real for i in rest[2:]) else None)
+    part("spectral part of the generalized Reif criterion", why is None,
+         f"dart:{k}: 1 simple; lam1 = {l1.real.str(5, radius=False)} ({'mode ' + str(ev[i1][3]) if ev[i1][3] else 'even'})"
+         f" > lam2 = {l2.real.str(5, radius=False)} ({'mode ' + str(ev[i2][3]) if ev[i2][3] else 'even'}), each simple"
+         f" > |lam3| = {abs(ev[rest[2]][0]).str(5, radius=False)}" if why is None else f"dart:{k}: {why}")
+    if why is not None:
+        return
+    mp, orient = _map_field(cert)
+    vecs = {}
+    for c, i in (("x", i1), ("y", i2)):
+        spec = field_of(mp, c, dict, "map")
+        exact_keys(spec, ("eigenvalue", "crease", "pivot"), c)
+        lo_hi, pivot = field_of(spec, "eigenvalue", list, c), field_of(spec, "pivot", int, c)
+        if field_of(spec, "crease", list, c) or len(lo_hi) != 2 or not 0 <= pivot < len(ev):
+            raise CertificateError(f"{c}: a dart's coordinate is an interval, crease [] and a pivot 0..{len(ev) - 1}")
+        lo, hi = parse_decimal(lo_hi[0]), parse_decimal(lo_hi[1])
+        inside = [j for j, t in enumerate(ev) if t[0].real > lo and t[0].real < hi]
+        near = [j for j, t in enumerate(ev) if t[0].real.overlaps(arb(lo).union(arb(hi)))]
+        lam = ev[i][0].real
+        if inside != [i] or near != [i]:
+            part(f"{c}: eigenvector of lam{'1' if c == 'x' else '2'}", False,
+                 f"[{lo}, {hi}] does not isolate lam{'1' if c == 'x' else '2'}: not the eigenvalue of lam1 / lam2")
+            return
+        if ev[i][3] is not None:  # odd: closed form, normalized at the pivot
+            f = mode_vector("dart", k, ev[i][3], lam)
+            ok = f is not None and abs(f[pivot]) > 0
+            vec = [v if isinstance(v, fmpq) else (v / f[pivot]).real for v in f] if ok else None
+            how = f"closed form in mode {ev[i][3]} (odd)"
+        else:
+            try:
+                vec, how = even_vector(k, lam, pivot), "even: the bordered system on S_E proved regular"
+            except ZeroDivisionError:
+                vec = None
+        part(f"{c}: eigenvector of lam{'1' if c == 'x' else '2'}", vec is not None,
+             f"eigenvalue {lam.str(10)}, simple; {how}, pivot {labels('dart', k)[pivot]}" if vec is not None else
+             f"the eigenvector is not certainly non-zero at the pivot {pivot} (or its system not certainly regular)")
+        if vec is None:
+            return
+        vecs[c] = vec
+    check_map("dart", k, vecs["x"], vecs["y"], l1.real, l2.real, orient, field_of(cert, "parts", dict, "certificate"),
+              prec, part)
 
 
 def _verify_witness_modes(fam, n, w, r, q, part, log):

@@ -31,7 +31,7 @@ from .maps import STAR_CURVES, regularity_form
 from .record import exact_keys
 from .replay import check_boxes, check_partition, parse_path
 from .rules import CENTRE, canonical, level1_rule
-from .tagged import labels, sector_matrix, sharp_rays
+from .tagged import labels, sector_rows, sharp_rays
 
 PIECES = ("P1", "P2", "P3")
 _OFFSET = {"P1": (0, -1), "P2": (0, 0), "P3": (-1, 0)}  # level-1 position of B-spline net[0][0]
@@ -54,11 +54,10 @@ def level1_values(fam, n, v):
     >>> [val(0, a, b) for a, b in ((3, 0), (2, 2), (1, -1))]
     [3/2, 1, 1/2]
     """
-    S = sector_matrix(fam, n)
     pts = labels(fam, n)
     idx = {p: i for i, p in enumerate(pts)}
     sharp = sharp_rays(fam, n)
-    one = [sum((S[i, j] * v[j] for j in range(len(pts)) if S[i, j] != 0), 0 * v[0]) for i in range(len(pts))]
+    one = [sum((w * v[j] for j, w in row.items()), 0 * v[0]) for row in sector_rows(fam, n)]  # S v, sparse
 
     def quad(s):
         return s % n if fam == "dart" else s

@@ -26,15 +26,23 @@ characteristic polynomial of the 6N + 3 points (docs/tagged_c1.md, "Spectrum in 
    :func:`.spectrum.check_block_polynomials`). So mode j has 1/8..1/64, lam(c_j) and 1/(16 lam(c_j)),
    c_j = cos(pi j/N), lam(c) = (5 + c + sqrt((1 + c)(9 + c)))/16 (:func:`.spectrum.lam_of`).
 
+**Darts** (:func:`check_dart`, K >= MIN_N): S commutes with the reflection R in the sharp ray 0 (checked
+row by row), so the even and the odd vectors are invariant; every row but the centre's and ray 0's is
+the smooth rule of the K-regular ring, and those R-invariant rows vanish on odd vectors as L's do, so S
+is L on the odd vectors: modes w_j = exp(2 pi i j/K), 1 <= j < K/2, and the odd parts of w = 1 (and -1
+for even K), as above. The even part S_E (one row per R-orbit, about 3K + 3) keeps its exact
+characteristic polynomial (a rank-2 change of the smooth even operator in the two rows of ray 0).
+
 :func:`mode_spectrum` lists every eigenvalue of S once per unit of algebraic multiplicity with an
-enclosure; :func:`mode_vector` gives the eigenvector of a simple eigenvalue of mode j in closed form.
+enclosure; :func:`mode_vector` gives the eigenvector of a simple eigenvalue of mode j in closed form,
+:func:`even_vector` a dart's even eigenvector from S_E.
 """
 
 from __future__ import annotations
 
 from functools import cache
 
-from flint import acb, acb_mat, arb, fmpq, fmpq_mat
+from flint import acb, acb_mat, arb, arb_mat, fmpq, fmpq_mat
 
 from .errors import CertificateError
 from .rules import CENTRE, TWO_RING, canonical, level1_rule
@@ -56,10 +64,12 @@ def ring_stencil():
 
     Examples
     --------
-    The edge point of a ray: its ends (the centre dropped) and the two face points beside it:
+    The edge point of a ray (level-1 (1, 0)): 3/8 on its end (1, 0), 1/16 on the far corners of the two
+    faces beside it; the centre's 3/8 is dropped:
 
-    >>> sorted(ring_stencil()[0].items())[:2]
-    [((-1, (1, 1)), 1/16), ((0, (1, 0)), 3/8)]
+    >>> row = ring_stencil()[0]
+    >>> row[(0, (1, 0))], row[(-1, (1, 0))], row[(-1, (1, 1))], sum(row.values())
+    (3/8, 1/16, 1/16, 5/8)
     """
     out = []
     for pos in TWO_RING:
@@ -206,15 +216,16 @@ def mode_spectrum(fam, n):
     Parameters
     ----------
     fam : str
-        ``"crease"`` or ``"corner"``.
+        ``"crease"``, ``"corner"`` or ``"dart"``.
     n : int
-        N >= :data:`MIN_N`.
+        N or K >= :data:`MIN_N`.
 
     Returns
     -------
     list of (acb, fmpq or None, str, int or None)
         (enclosure, the exact value when rational, where from: ``"C"`` the crease block, ``"I"`` the
-        rest, mode j for the roots lam(c_j) and 1/(16 lam(c_j)), else None); 6N + 3 entries.
+        rest; for a dart ``"E"`` the even part, ``"O"`` the odd part; mode j for the roots lam(c_j) and
+        1/(16 lam(c_j)), else None); one entry per point.
 
     Examples
     --------
@@ -222,30 +233,39 @@ def mode_spectrum(fam, n):
     >>> len(ev), max(ev, key=lambda t: t[0].real.mid() if t[1] != 1 else 0)[3]
     (33, 1)
     """
-    extra = check_structure(fam, n)
-    out = [(z, q, "C", None) for z, q in _roots(crease_block(fam, n))]
+    if fam == "dart":  # the even part exactly (S_E's factors), the odd part through the modes w = exp(2 pi i j/K)
+        _, _, extra, fac = check_dart(n)
+        out, tag, modes = [], "O", range(1, (n + 1) // 2)
+        for p, e in fac:
+            out += [(acb(z), -p[0] / p[1] if p.degree() == 1 else None, "E", None)
+                    for z, _ in p.complex_roots()] * e
+    else:
+        extra, tag, modes = check_structure(fam, n), "I", range(1, n)
+        out = [(z, q, "C", None) for z, q in _roots(crease_block(fam, n))]
     for M in extra:
-        out += [(z, q, "I", None) for z, q in _roots(M)]
-    for j in range(1, n):
-        lam = lam_of(arb(fmpq(j, n)).cos_pi())
-        out += [(acb(lam), None, "I", j), (acb(1 / (16 * lam)), None, "I", j)]
-        out += [(acb(s), s, "I", None) for s in _SMALL]
+        out += [(z, q, tag, None) for z, q in _roots(M)]
+    ring = n if fam == "dart" else 2 * n
+    for j in modes:
+        lam = lam_of(arb(fmpq(2 * j, ring)).cos_pi())
+        out += [(acb(lam), None, tag, j), (acb(1 / (16 * lam)), None, tag, j)]
+        out += [(acb(s), s, tag, None) for s in _SMALL]
     return out
 
 
-def _power(j, t, n):
-    """w_j^t = exp(i pi j t / N), each power from its own angle."""
-    a = arb(fmpq(j * t % (2 * n), n))
+def _unit(num, den):
+    """exp(i pi num/den), each from its own angle (no powers accumulate error)."""
+    a = arb(fmpq(num % (2 * den), den))
     return acb(a.cos_pi(), a.sin_pi())
 
 
 def mode_vector(fam, n, j, lam):
-    """The eigenvector of S for a simple eigenvalue lam (an arb ball) of mode j: 0 on the crease points,
-    f = v - v o R on the others (v(t, p) = w_j^t v^(p), v^ from the bordered 6 x 6 system of B(w_j)).
+    """The eigenvector of S for a simple eigenvalue lam (an arb ball) of mode j, as f = v - v o R on the ring
+    points (v(t, p) = w^t v^(p), w = exp(2 pi i j/M) on the ring of M = 2N sectors, or M = K for a dart;
+    v^ from the bordered 6 x 6 system of B(w)) and 0 on the crease points (dart: the centre).
 
     Returns
     -------
-    list of acb or None
+    list of acb or fmpq, or None
         None where no pivot of v^ makes the bordered system certainly regular. Not normalized: a complex
         multiple of the real eigenvector.
 
@@ -257,8 +277,8 @@ def mode_vector(fam, n, j, lam):
     >>> len(f), f[0]
     (33, 0)
     """
-    w = _power(j, 1, n)
-    B = _block(w)
+    ring = n if fam == "dart" else 2 * n
+    B = _block(_unit(2 * j, ring))
     vh = None
     for pv in range(6):  # the first pivot that arb proves regular (the bordered-system argument of tagged_c1)
         rows = [[B[i][k] - (lam if i == k else 0) for k in range(6)] + [acb(int(i == pv))] for i in range(6)]
@@ -271,18 +291,94 @@ def mode_vector(fam, n, j, lam):
         break
     if vh is None:
         return None
-    cp = set(crease_points(fam, n))
+    skip = {0} if fam == "dart" else set(crease_points(fam, n))
     out = []
     for i, p in enumerate(labels(fam, n)):
-        if i in cp:
+        if i in skip:
             out.append(fmpq(0))
             continue
         t, pos = p[1], p[2:]
         if pos[1] == 0:
-            out.append(vh[_POS[pos]] * (_power(j, t, n) - _power(j, -t, n)))
+            out.append(vh[_POS[pos]] * (_unit(2 * j * t, ring) - _unit(-2 * j * t, ring)))
         else:
-            out.append(vh[_POS[pos]] * _power(j, t, n) - vh[_POS[(pos[1], pos[0])]] * _power(j, -t - 1, n))
+            out.append(vh[_POS[pos]] * _unit(2 * j * t, ring) - vh[_POS[(pos[1], pos[0])]] * _unit(-2 * j * (t + 1), ring))
     return out
 
 
-__all__ = ["MIN_N", "check_ring", "check_structure", "mode_spectrum", "mode_vector", "ring_stencil"]
+def _dart_reflect(p, k):
+    if p == ("C",):
+        return p
+    return ("r", -p[1] % k, p[2], p[3]) if p[0] == "r" else ("q", (-p[1] - 1) % k, p[3], p[2])
+
+
+@cache
+def check_dart(k):
+    """Raise unless dart:k's S commutes with the reflection R in the sharp ray and is the ring rule on every
+    point but the centre and ray 0 (exact); then S is L on the odd vectors and S_E on the even ones.
+
+    Returns
+    -------
+    (fmpq_mat, tuple of int, tuple of fmpq_mat, list)
+        S_E on one representative per R-orbit, the representative's row in S_E of each point, the odd
+        blocks of the modes w = 1 (and w = -1 for even k), and the factors of S_E's characteristic polynomial.
+
+    Examples
+    --------
+    >>> SE, rep, blocks, fac = check_dart(5)
+    >>> SE.nrows(), len(rep), [M.nrows() for M in blocks]
+    (18, 31, [1])
+    """
+    if k < MIN_N:
+        raise CertificateError(f"dart:{k}: the mode structure is used for K >= {MIN_N}")
+    check_ring()
+    pts, rows = labels("dart", k), sector_rows("dart", k)
+    idx = {p: i for i, p in enumerate(pts)}
+    refl = [idx[_dart_reflect(p, k)] for p in pts]
+    for i, p in enumerate(pts):
+        if rows[refl[i]] != {refl[j]: x for j, x in rows[i].items()}:
+            raise CertificateError(f"dart:{k}: the rules do not commute with the reflection at {p}")
+        if p == ("C",) or p[:2] == ("r", 0):
+            continue  # R-invariant rows: 0 on odd vectors, as L's
+        ring = {}
+        for (d, q), x in ring_stencil()[_POS[p[2:]]].items():
+            j = idx[("r" if q[1] == 0 else "q", (p[1] + d) % k) + q]
+            ring[j] = ring.get(j, 0) + x
+        if {j: x for j, x in ring.items() if x != 0} != {j: x for j, x in rows[i].items() if j != 0}:
+            raise CertificateError(f"dart:{k}: the row of {p} is not the ring rule")
+    reps = [i for i in range(len(pts)) if i <= refl[i]]
+    rep = [0] * len(pts)
+    for a, i in enumerate(reps):
+        rep[i] = rep[refl[i]] = a
+    SE = fmpq_mat(len(reps), len(reps))
+    for a, i in enumerate(reps):
+        for j, x in rows[i].items():
+            SE[a, rep[j]] += x
+    blocks = [M for M, _ in [_odd_block(1)] + ([_odd_block(-1)] if k % 2 == 0 else []) if M is not None]
+    if 6 * ((k + 1) // 2 - 1) + sum(M.nrows() for M in blocks) != len(pts) - len(reps):
+        raise CertificateError(f"dart:{k}: the modes do not account for every odd vector")
+    return SE, tuple(rep), tuple(blocks), SE.charpoly().factor()[1]
+
+
+def even_vector(k, lam, pivot):
+    """The eigenvector (arb, 1 at ``pivot``) of dart:k for a simple eigenvalue lam of S_E: the bordered
+    system on S_E (as :func:`.tagged_c1.bordered_solve`), spread over each R-orbit. Raises
+    ZeroDivisionError unless arb proves the system regular.
+
+    Examples
+    --------
+    >>> lam = max(t[0].real for t in mode_spectrum("dart", 5) if t[2] == "E" and t[1] != 1)
+    >>> v = even_vector(5, lam, 7)
+    >>> pts = labels("dart", 5)
+    >>> v[7], v[pts.index(("r", 1, 1, 0))].overlaps(v[pts.index(("r", 4, 1, 0))])
+    (1.00000000000000, True)
+    """
+    SE, rep, _, _ = check_dart(k)
+    m, pv = SE.nrows(), rep[pivot]
+    rows = [[arb(SE[i, c]) - (lam if i == c else 0) for c in range(m)] + [arb(int(i == pv))] for i in range(m)]
+    rows.append([arb(int(c == pv)) for c in range(m)] + [arb(0)])
+    sol = arb_mat(rows).solve(arb_mat([[0]] * m + [[1]]))
+    return [sol[rep[i], 0] for i in range(len(rep))]
+
+
+__all__ = ["MIN_N", "check_dart", "check_ring", "check_structure", "even_vector", "mode_spectrum", "mode_vector",
+           "ring_stencil"]
