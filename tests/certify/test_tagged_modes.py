@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 from flint import ctx, fmpq
 
-from ccproof.certify.verify import verify_certificate
 from ccproof.certify.verify import tagged_modes as tm
+from ccproof.certify.verify import verify_certificate
 from ccproof.certify.verify.errors import CertificateError
 from ccproof.certify.verify.tagged import crease_points, eigenvalues, sector_matrix
 from ccproof.certify.verify.tagged_c1 import bordered_solve
@@ -106,6 +106,8 @@ def _fails(cert, why):
 def test_published_certificates_up_to_100_verify():
     for name in ("crease:41", "crease:77", "crease:100", "corner:41", "corner:100"):
         assert verify_certificate(_cert(name), **QUIET), name
+    for k in (41, 100):
+        assert verify_certificate(_dart(k), **QUIET), k
 
 
 def test_forgery_relabelled_configuration():
@@ -174,3 +176,81 @@ def test_forgery_z_not_the_crease_tangent():
     _fails(cert, "no eigenvector for 1/2")
     cert["witness"]["z"] = {"eigenvalue": "0.5", "crease": ["0", "0", "0", "0", "0"]}
     _fails(cert, "no eigenvector for 1/2")
+
+
+# ----------------------------------------------------------------------- darts: odd half by modes, even half exact
+@pytest.mark.parametrize("k", [5, 8, 45])
+def test_dart_mode_spectrum_equals_numpy_on_the_library_matrix(k):
+    with ctx.workprec(128):
+        ours = _floats(tm.mode_spectrum("dart", k))
+    num = np.sort_complex(np.linalg.eigvals(library_matrix("dart", k)).round(6))
+    assert len(ours) == len(num) == 6 * k + 1
+    assert np.max(np.abs(ours - num)) < 1e-5
+
+
+@pytest.mark.parametrize("k", [6, 9])
+def test_dart_mode_spectrum_equals_the_exact_characteristic_polynomial(k):
+    with ctx.workprec(128):
+        assert np.array_equal(_floats(tm.mode_spectrum("dart", k)), _floats(eigenvalues("dart", k, 128)))
+
+
+@pytest.mark.parametrize("k", [7, 12])
+def test_dart_vectors_equal_the_exact_route(k):
+    """x (odd, closed form) and y (even, from S_E) against the whole matrix's bordered solve."""
+    from ccproof.certify.verify.tagged import labels
+
+    with ctx.workprec(128):
+        ev = tm.mode_spectrum("dart", k)
+        rest = sorted((i for i, t in enumerate(ev) if abs(t[0]) < 1), key=lambda i: -float(abs(ev[i][0]).mid()))
+        S = sector_matrix("dart", k)
+        free = list(range(S.nrows()))
+        for i in rest[:2]:
+            lam = ev[i][0].real
+            pv = labels("dart", k).index(("q", 1, 1, 1))
+            if ev[i][3] is not None:
+                f = tm.mode_vector("dart", k, ev[i][3], lam)
+                ours = [v / f[pv] if not isinstance(v, fmpq) else v for v in f]
+                ours = [v.real if not isinstance(v, fmpq) else v for v in ours]
+            else:
+                ours = tm.even_vector(k, lam, pv)
+            ref = bordered_solve(S, free, pv, lam)
+            assert max(abs(float((ref[j, 0] - ours[j]).mid())) for j in free) < 1e-30
+
+
+def test_dart_structure_check_fails_on_a_changed_rule(monkeypatch):
+    """A rule that breaks the reflection symmetry (one weight moved on one side) is refused."""
+    rows = list(tm.sector_rows("dart", 7))
+    i = 30
+    row = dict(rows[i])
+    a, b = sorted(row)[:2]
+    row[a], row[b] = row[a] + fmpq(1, 64), row[b] - fmpq(1, 64)
+    rows[i] = row
+    monkeypatch.setattr(tm, "sector_rows", lambda fam, n: tuple(rows))
+    tm.check_dart.cache_clear()
+    with pytest.raises(CertificateError, match="reflection"):
+        tm.check_dart(7)
+    monkeypatch.undo()
+    tm.check_dart.cache_clear()
+    assert tm.check_dart(7)
+
+
+def _dart(k):
+    return json.loads((certificates_dir() / "c1" / "dart" / f"k{k:03d}.json").read_text())
+
+
+def test_dart_forgeries():
+    cert = _dart(40)
+    assert verify_certificate(cert, **QUIET)
+    _fails(dict(cert, configuration="dart:20"), "does not isolate lam")
+    forged = copy.deepcopy(cert)
+    forged["map"]["x"], forged["map"]["y"] = forged["map"]["y"], forged["map"]["x"]
+    _fails(forged, "not the eigenvalue of lam1 / lam2")
+    forged = copy.deepcopy(cert)
+    forged["map"]["x"]["pivot"] = 0  # the centre: the odd vector vanishes there
+    _fails(forged, "not certainly non-zero at the pivot")
+    forged = copy.deepcopy(cert)
+    forged["map"]["orientation"] = -forged["map"]["orientation"]
+    _fails(forged, "regularity")
+    forged = copy.deepcopy(cert)
+    forged["map"]["y"]["crease"] = ["0"]
+    _fails(forged, "crease []")

@@ -1,7 +1,9 @@
 """Certificates for tagged configurations (schema ``ccproof.tagged-c1/1``): "C1" and "not C1" (trusted).
 
 The statement is derived from the configuration name alone (:mod:`.tagged`: the sector matrix S from
-OpenSubdiv's rules, its exact spectrum). A ``"not C1"`` certificate names a control net
+OpenSubdiv's rules, its exact spectrum; for N, K >= 5 the same spectrum and the leading eigenvectors
+through the modes of :mod:`.tagged_modes`, in O(N) for creases and corners). A ``"not C1"``
+certificate names a control net
 P = (x, y, z) whose three coordinates are eigenvectors of S, with eigenvalues alpha, beta, gamma,
 alpha >= gamma > 0 and beta >= gamma, and a sharp ray r and a quadrant q. The verifier derives each
 eigenvector itself (exactly for a rational eigenvalue, given its values on the crease points; in arb
@@ -187,6 +189,10 @@ def _map_field(cert):
     return mp, orient
 
 
+def _where(t):
+    return f"mode {t[3]}" if t[3] else "even"
+
+
 def _verify_dart_c1(cert, k, prec, part):
     """A dart's "C1" certificate, K >= MIN_N: the spectral part from :func:`.tagged_modes.mode_spectrum`
     (every eigenvalue enclosed, S_E's exactly, the odd half's through the modes), lam1 and lam2 each
@@ -202,8 +208,8 @@ def _verify_dart_c1(cert, k, prec, part):
            "lam1 > lam2 is not certain" if not l1.real > l2.real else
            "|lam3| is not certainly below lam2" if not all(abs(ev[i][0]) < l2.real for i in rest[2:]) else None)
     part("spectral part of the generalized Reif criterion", why is None,
-         f"dart:{k}: 1 simple; lam1 = {l1.real.str(5, radius=False)} ({'mode ' + str(ev[i1][3]) if ev[i1][3] else 'even'})"
-         f" > lam2 = {l2.real.str(5, radius=False)} ({'mode ' + str(ev[i2][3]) if ev[i2][3] else 'even'}), each simple"
+         f"dart:{k}: 1 simple; lam1 = {l1.real.str(5, radius=False)} ({_where(ev[i1])}) > lam2 = "
+         f"{l2.real.str(5, radius=False)} ({_where(ev[i2])}), each simple"
          f" > |lam3| = {abs(ev[rest[2]][0]).str(5, radius=False)}" if why is None else f"dart:{k}: {why}")
     if why is not None:
         return
@@ -255,7 +261,8 @@ def _verify_witness_modes(fam, n, w, r, q, part, log):
         if len(crease) != 5 or len(lo_hi) != 2:
             raise CertificateError(f"{c}: crease values must be 5 decimals and the eigenvalue [low, high]")
         if any(parse_decimal(v) != 0 for v in crease):
-            part(f"{c}: eigenvector of S", False, "an irrational eigenvalue's eigenvector vanishes on the crease points")
+            part(f"{c}: eigenvector of S", False,
+                 "an irrational eigenvalue's eigenvector vanishes on the crease points")
             return
         lo, hi = parse_decimal(lo_hi[0]), parse_decimal(lo_hi[1])
         inside = [i for i, t in enumerate(ev) if t[0].real > lo and t[0].real < hi]
@@ -294,7 +301,8 @@ def _verify_witness_modes(fam, n, w, r, q, part, log):
     ok = why is None
     part("z: (generalized) eigenvector of S", ok,
          f"eigenvalue {g}: C c = {g} c exactly on the crease points, and {g} is at most a simple eigenvalue of I, so "
-         f"some z with these crease values has (S - {g})^2 z = 0 and (S - {g}) z = 0 on the crease points" if ok else why)
+         f"some z with these crease values has (S - {g})^2 z = 0 and (S - {g}) z = 0 on the crease points"
+         if ok else why)
     if not ok:
         return
     ia, ib = at["x"], at["y"]

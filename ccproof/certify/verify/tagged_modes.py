@@ -301,7 +301,8 @@ def mode_vector(fam, n, j, lam):
         if pos[1] == 0:
             out.append(vh[_POS[pos]] * (_unit(2 * j * t, ring) - _unit(-2 * j * t, ring)))
         else:
-            out.append(vh[_POS[pos]] * _unit(2 * j * t, ring) - vh[_POS[(pos[1], pos[0])]] * _unit(-2 * j * (t + 1), ring))
+            out.append(vh[_POS[pos]] * _unit(2 * j * t, ring)
+                       - vh[_POS[(pos[1], pos[0])]] * _unit(-2 * j * (t + 1), ring))
     return out
 
 
