@@ -57,7 +57,12 @@ def level1_values(fam, n, v):
     pts = labels(fam, n)
     idx = {p: i for i, p in enumerate(pts)}
     sharp = sharp_rays(fam, n)
-    one = [sum((w * v[j] for j, w in row.items()), 0 * v[0]) for row in sector_rows(fam, n)]  # S v, sparse
+    rows, memo = sector_rows(fam, n), {}
+
+    def one(i):  # (S v)[i], sparse, on demand (a quadrant reads a few of them)
+        if i not in memo:
+            memo[i] = sum((w * v[j] for j, w in rows[i].items()), 0 * v[0])
+        return memo[i]
 
     def quad(s):
         return s % n if fam == "dart" else s
@@ -71,7 +76,7 @@ def level1_values(fam, n, v):
 
     def value(q, A, B):
         if (A, B) == (0, 0):
-            return one[0]
+            return one(0)
         if B == -1 and q in sharp:  # across the sharp ray q: the ghost row
             return 2 * value(q, A, 0) - value(q, A, 1)
         if A == -1 and quad(q + 1) in sharp:  # across the sharp ray q + 1: the ghost column
@@ -80,7 +85,7 @@ def level1_values(fam, n, v):
         s = quad(q + delta)
         key = ("r", s, A2, 0) if B2 == 0 else ("q", s, A2, B2)
         if key in idx:
-            return one[idx[key]]
+            return one(idx[key])
         if B2 == 0 and s in sharp:  # (3, 0) on a sharp ray: the midpoint of level-0 (1,0), (2,0)
             return (v[idx[("r", s, 1, 0)]] + v[idx[("r", s, 2, 0)]]) / 2
         acc = 0 * v[0]
