@@ -81,6 +81,7 @@ REVIEWED = {
     ("tagged_modes.py", "{j: x for j, x in ring.items() if x != 0} != {j: x for j, x in rows[i].items() if j != 0}"):
         "dicts of fmpq weights (exact)",
     ("tagged_modes.py", "j != 0"): "ints (column indices)",
+    ("tagged_modes.py", "SE[a, b] != 0"): "fmpq_mat entries (exact)",
     ("maps.py", "not (hi < BREAKS[p] or (p < 3 and lo > BREAKS[p + 1]))"): (
         "keeps a piece unless the hull is certainly outside it: conservative"),
 }

@@ -31,7 +31,10 @@ row by row), so the even and the odd vectors are invariant; every row but the ce
 the smooth rule of the K-regular ring, and those R-invariant rows vanish on odd vectors as L's do, so S
 is L on the odd vectors: modes w_j = exp(2 pi i j/K), 1 <= j < K/2, and the odd parts of w = 1 (and -1
 for even K), as above. The even part S_E (one row per R-orbit, about 3K + 3) keeps its exact
-characteristic polynomial (a rank-2 change of the smooth even operator in the two rows of ray 0).
+characteristic polynomial on the one-ring (centre, (1,0), (1,1): closed under the rules, checked; a
+rank-2 change of the smooth even operator in the two rows of ray 0); on the rest, S_E is block
+triangular below it, and its eigenvalues there are bounded in modulus by the exact infinity norm
+(15/64 for every K).
 
 :func:`mode_spectrum` lists every eigenvalue of S once per unit of algebraic multiplicity with an
 enclosure; :func:`mode_vector` gives the eigenvector of a simple eigenvalue of mode j in closed form,
@@ -234,11 +237,12 @@ def mode_spectrum(fam, n):
     (33, 1)
     """
     if fam == "dart":  # the even part exactly (S_E's factors), the odd part through the modes w = exp(2 pi i j/K)
-        _, _, extra, fac = check_dart(n)
+        _, _, extra, fac, (_, outer), bound = check_dart(n)
         out, tag, modes = [], "O", range(1, (n + 1) // 2)
         for p, e in fac:
             out += [(acb(z), -p[0] / p[1] if p.degree() == 1 else None, "E", None)
                     for z, _ in p.complex_roots()] * e
+        out += [(acb(arb(0, bound), arb(0, bound)), None, "E", None)] * len(outer)  # |z| <= bound, each
     else:
         extra, tag, modes = check_structure(fam, n), "I", range(1, n)
         out = [(z, q, "C", None) for z, q in _roots(crease_block(fam, n))]
@@ -319,15 +323,17 @@ def check_dart(k):
 
     Returns
     -------
-    (fmpq_mat, tuple of int, tuple of fmpq_mat, list)
+    (fmpq_mat, tuple of int, tuple of fmpq_mat, list, (tuple, tuple), fmpq)
         S_E on one representative per R-orbit, the representative's row in S_E of each point, the odd
-        blocks of the modes w = 1 (and w = -1 for even k), and the factors of S_E's characteristic polynomial.
+        blocks of the modes w = 1 (and w = -1 for even k), the factors of the characteristic polynomial of
+        S_E on the one-ring (closed under the rules: checked), the rows of S_E on the one-ring and on the
+        rest (outer), and the infinity norm of S_E on the outer rows, a bound on their eigenvalues' moduli.
 
     Examples
     --------
-    >>> SE, rep, blocks, fac = check_dart(5)
-    >>> SE.nrows(), len(rep), [M.nrows() for M in blocks]
-    (18, 31, [1])
+    >>> SE, rep, blocks, fac, (inner, outer), bound = check_dart(5)
+    >>> SE.nrows(), len(rep), [M.nrows() for M in blocks], len(outer), bound
+    (18, 31, [1], 11, 15/64)
     """
     if k < MIN_N:
         raise CertificateError(f"dart:{k}: the mode structure is used for K >= {MIN_N}")
@@ -357,13 +363,21 @@ def check_dart(k):
     blocks = [M for M, _ in [_odd_block(1)] + ([_odd_block(-1)] if k % 2 == 0 else []) if M is not None]
     if 6 * ((k + 1) // 2 - 1) + sum(M.nrows() for M in blocks) != len(pts) - len(reps):
         raise CertificateError(f"dart:{k}: the modes do not account for every odd vector")
-    return SE, tuple(rep), tuple(blocks), SE.charpoly().factor()[1]
+    # the one-ring (centre, (1,0), (1,1)) is closed: S_E = [[S_in, 0], [*, S_out]], rho(S_out) <= |S_out|_inf
+    inner = [a for a, i in enumerate(reps) if pts[i] == ("C",) or pts[i][2:] in ((1, 0), (1, 1))]
+    outer = [a for a in range(len(reps)) if a not in inner]
+    if any(SE[a, b] != 0 for a in inner for b in outer):
+        raise CertificateError(f"dart:{k}: the one-ring is not closed under the rules")
+    bound = max(sum((abs(SE[a, b]) for b in outer), fmpq(0)) for a in outer)
+    S_in = fmpq_mat([[SE[a, b] for b in inner] for a in inner])
+    return SE, tuple(rep), tuple(blocks), S_in.charpoly().factor()[1], (tuple(inner), tuple(outer)), bound
 
 
 def even_vector(k, lam, pivot):
     """The eigenvector (arb, 1 at ``pivot``) of dart:k for a simple eigenvalue lam of S_E: the bordered
-    system on S_E (as :func:`.tagged_c1.bordered_solve`), spread over each R-orbit. Raises
-    ZeroDivisionError unless arb proves the system regular.
+    system (as :func:`.tagged_c1.bordered_solve`) on the one-ring rows of S_E when the pivot lies there,
+    then the rest from (lam - S_out) y_out = X y_in (S_E is block triangular), spread over each R-orbit.
+    Raises ZeroDivisionError unless arb proves the systems regular.
 
     Examples
     --------
@@ -373,12 +387,20 @@ def even_vector(k, lam, pivot):
     >>> v[7], v[pts.index(("r", 1, 1, 0))].overlaps(v[pts.index(("r", 4, 1, 0))])
     (1.00000000000000, True)
     """
-    SE, rep, _, _ = check_dart(k)
-    m, pv = SE.nrows(), rep[pivot]
-    rows = [[arb(SE[i, c]) - (lam if i == c else 0) for c in range(m)] + [arb(int(i == pv))] for i in range(m)]
+    SE, rep, _, _, (inner, outer), _ = check_dart(k)
+    if rep[pivot] not in inner:  # the whole of S_E
+        inner, outer = tuple(range(SE.nrows())), ()
+    m, pv = len(inner), inner.index(rep[pivot])
+    rows = [[arb(SE[a, b]) - (lam if a == b else 0) for b in inner] + [arb(int(i == pv))] for i, a in enumerate(inner)]
     rows.append([arb(int(c == pv)) for c in range(m)] + [arb(0)])
     sol = arb_mat(rows).solve(arb_mat([[0]] * m + [[1]]))
-    return [sol[rep[i], 0] for i in range(len(rep))]
+    y = {a: sol[i, 0] for i, a in enumerate(inner)}
+    if outer:  # (lam - S_out) y_out = X y_in: regular since rho(S_out) <= bound < lam (the caller checks lam)
+        A = arb_mat([[(lam if a == b else 0) - arb(SE[a, b]) for b in outer] for a in outer])
+        rhs = arb_mat([[sum((arb(SE[a, b]) * y[b] for b in inner if SE[a, b] != 0), arb(0))] for a in outer])
+        sol = A.solve(rhs)
+        y.update({a: sol[i, 0] for i, a in enumerate(outer)})
+    return [y[rep[i]] for i in range(len(rep))]
 
 
 __all__ = ["MIN_N", "check_dart", "check_ring", "check_structure", "even_vector", "mode_spectrum", "mode_vector",
