@@ -34,7 +34,7 @@ for even K), as above. The even part S_E (one row per R-orbit, about 3K + 3) kee
 characteristic polynomial on the one-ring (centre, (1,0), (1,1): closed under the rules, checked; a
 rank-2 change of the smooth even operator in the two rows of ray 0); on the rest, S_E is block
 triangular below it, and its eigenvalues there are bounded in modulus by the exact infinity norm
-(15/64 for every K).
+(15/64 for each K = 5..100).
 
 :func:`mode_spectrum` lists every eigenvalue of S once per unit of algebraic multiplicity with an
 enclosure; :func:`mode_vector` gives the eigenvector of a simple eigenvalue of mode j in closed form,
