@@ -26,6 +26,7 @@ from ccproof.certify.verify.tagged import (
     parse_configuration,
     sharp_rays,
 )
+from ccproof.certify.verify.tagged_modes import MIN_N, even_vector, mode_spectrum, mode_vector
 from ccproof.errors import CCProofError
 
 DEFAULT_PREC = 128
@@ -122,6 +123,25 @@ def _interior_candidates(fam, n, prec):
     return out
 
 
+def _mode_candidates(fam, n, prec):
+    """The two largest mode roots (crease, corner, N >= MIN_N) with intervals and pivots, from the closed
+    forms of :mod:`ccproof.certify.verify.tagged_modes` (floats choose; the verifier decides)."""
+    with ctx.workprec(prec):
+        ev = mode_spectrum(fam, n)
+        roots = sorted((i for i, t in enumerate(ev) if t[3] is not None and t[0].imag.is_zero()),
+                       key=lambda i: -float(ev[i][0].real.mid()))
+        out = []
+        for i in roots[:2]:
+            z = ev[i][0]
+            f = mode_vector(fam, n, ev[i][3], z.real)
+            if f is None:
+                return []
+            pivot = max((k for k, v in enumerate(f) if not isinstance(v, fmpq)), key=lambda k: float(abs(f[k]).mid()))
+            others = [t[0] for k, t in enumerate(ev) if k != i]
+            out.append((float(z.real.mid()), z, _interval(z, others), pivot))
+    return out
+
+
 def _pivot(fam, n, z, prec):
     """A point where the eigenvector of the simple eigenvalue z is large (numerical choice only; the
     verifier proves the bordered system regular)."""
@@ -173,14 +193,15 @@ def witness_candidates(name, prec=DEFAULT_PREC):
     if fam == "dart":
         return []
     pts = labels(fam, n)
-    inner = _interior_candidates(fam, n, prec)
+    modes = n >= MIN_N  # the verifier's closed forms: no exact spectrum, no pivot search
+    inner = _mode_candidates(fam, n, prec) if modes else _interior_candidates(fam, n, prec)
     creases = _crease_vectors(fam, n)
     top = max(g for g, _ in creases) if creases else None
     creases = [(g, v) for g, v in creases if g == top]  # the verifier wants gamma = the crease block's largest
     zero = ["0"] * len(crease_points(fam, n))
 
     def irr(t):
-        pv = _pivot(fam, n, t[1], prec)
+        pv = t[3] if modes else _pivot(fam, n, t[1], prec)
         return None if pv is None else {"eigenvalue": t[2], "crease": zero, "pivot": pv}
 
     def rat(g, v):
@@ -194,7 +215,7 @@ def witness_candidates(name, prec=DEFAULT_PREC):
                 if float(g.p) / float(g.q) <= inner[1][0] and _decimal_exact(g) and all(_decimal_exact(c) for c in v):
                     for r in sharp_rays(fam, n):
                         out.append({"x": x, "y": y, "z": rat(g, v), "ray": r})
-    if fam == "corner" and inner:
+    if fam == "corner" and inner and not modes:
         x = irr(inner[0])
         half = [(g, v) for g, v in creases if g == fmpq(1, 2)]
         if x and len(half) >= 2:
@@ -249,7 +270,6 @@ def prove_tagged(name, prec=DEFAULT_PREC):
      no witness candidate'
     """
     fam, n = parse_configuration(name)
-    ok, msg, _ = leading_spectrum(fam, n, prec)
     why = []
     for w in witness_candidates(name, prec):
         for q in range(n):
@@ -262,7 +282,9 @@ def prove_tagged(name, prec=DEFAULT_PREC):
             if not any(p.name.startswith("N ") for p in res.failures()):
                 break  # only the normal depends on the quadrant
     witness = f"; no witness ({why[0]})" if why else "; no witness candidate"
-    return None, f"undecided: {msg}{witness}"
+    if fam == "dart":
+        return None, "undecided: no witness form for darts"
+    return None, f"undecided: {leading_spectrum(fam, n, prec)[1]}{witness}"
 
 
 def write_tagged(cert, out_dir):
@@ -348,6 +370,12 @@ def prove_tagged_c1(name, prec=DEFAULT_PREC):
     ('C1', 'C1')
     """
     fam, n = parse_configuration(name)
+    if fam == "dart" and n >= MIN_N:  # the verifier's mode route: no exact spectrum of the whole matrix
+        specs, entries = _dart_specs(n, prec)
+        if specs is None:
+            return None, "undecided: no isolated lam1 > lam2 or no regular pivot"
+        cert, last = _prove_map(name, fam, n, specs, prec, entries)
+        return (cert, "C1") if cert is not None else (None, f"undecided: {last}")
     ok, msg, lead = leading_spectrum(fam, n, prec)
     if not ok:
         return None, f"undecided: {msg}"
@@ -363,7 +391,45 @@ def prove_tagged_c1(name, prec=DEFAULT_PREC):
     return None, f"undecided: {last}"
 
 
-def _prove_map(name, fam, n, specs, prec):
+def _dart_vector(k, i, ev, pivot):
+    """The eigenvector of entry i of the dart's mode spectrum as the verifier derives it, or None."""
+    lam = ev[i][0].real
+    if ev[i][3] is not None:
+        f = mode_vector("dart", k, ev[i][3], lam)
+        if f is None or not abs(f[pivot]) > 0:
+            return None
+        return [v if isinstance(v, fmpq) else (v / f[pivot]).real for v in f]
+    try:
+        return even_vector(k, lam, pivot)
+    except ZeroDivisionError:
+        return None
+
+
+def _dart_specs(k, prec):
+    """Map coordinates (x for lam1, y for lam2) of dart:k, K >= MIN_N: isolating intervals and pivots where
+    the vector is large (floats choose; the verifier decides)."""
+    with ctx.workprec(prec):
+        ev = mode_spectrum("dart", k)
+        rest = sorted((i for i, t in enumerate(ev) if abs(t[0]) < 1), key=lambda i: -float(abs(ev[i][0]).mid()))
+        pts = labels("dart", k)
+        out = []
+        for i in rest[:2]:
+            trial = [pts.index(("q", q, 1, 1)) for q in range(k)] + [pts.index(("r", r, 1, 0)) for r in range(1, k)]
+            vec = next((v for v in (_dart_vector(k, i, ev, p) for p in trial) if v is not None), None)
+            if vec is None:
+                return None, None
+            # the largest coordinate among the one-ring points (the left eigenvector vanishes on the outer
+            # ring, where the bordered system is singular)
+            order = sorted(trial, key=lambda j: -float(abs(vec[j]).mid()))[:24]
+            pivot = next((j for j in order if _dart_vector(k, i, ev, j) is not None), None)
+            if pivot is None:
+                return None, None
+            others = [t[0] for j, t in enumerate(ev) if j != i]
+            out.append({"eigenvalue": _interval(ev[i][0], others), "crease": [], "pivot": pivot})
+    return tuple(out), rest[:2]
+
+
+def _prove_map(name, fam, n, specs, prec, entries=None):
     from flint import arb as _arb
 
     from ccproof.certify.verify.maps import regularity_form
@@ -375,9 +441,16 @@ def _prove_map(name, fam, n, specs, prec):
     from ccproof.certify.verify.tagged_c1 import eigenvector_of
 
     with ctx.workprec(prec):
-        (lx, vx, mx), (ly, vy, my) = (eigenvector_of(fam, n, s, c, prec) for s, c in zip(specs, "xy"))
-        if vx is None or vy is None:
-            return None, mx if vx is None else my
+        if entries is not None:  # a dart's mode spectrum entries of lam1, lam2
+            ev = mode_spectrum("dart", n)
+            lx, ly = (ev[i][0].real for i in entries)
+            vx, vy = (_dart_vector(n, i, ev, s["pivot"]) for i, s in zip(entries, specs))
+            if vx is None or vy is None:
+                return None, "no eigenvector at the chosen pivot"
+        else:
+            (lx, vx, mx), (ly, vy, my) = (eigenvector_of(fam, n, s, c, prec) for s, c in zip(specs, "xy"))
+            if vx is None or vy is None:
+                return None, mx if vx is None else my
         nets = [quadrant_nets(fam, n, vx, vy, q, prec) for q in range(n)]
         mid = regularity_form(nets[0], "P2", prec).coeffs[12]
         orient = 1 if mid > 0 else -1

@@ -7,7 +7,8 @@
                                   (k = 3..k0-1 one by one, each once; interval certificates k >= k0
                                   may overlap each other and single valences); per tagged family
                                   (dart, crease, corner) which N are certified C1 and not C1, each
-                                  configuration at most once
+                                  configuration at most once, and every crease:1-100, corner:1-100,
+                                  dart:2-100 certified or one of the undecided (docs/tagged_c1.md)
   ccproof verify FILE --json     one JSON object per file: "configuration" ("smooth:5", "smooth:>=40",
                                   "crease:5"), "statement" ("C1", "not C1", "injective"), "verdict"
                                   ("VERIFIED" or "FAILED"), "parts" (name, ok, message), "error"
@@ -84,14 +85,25 @@ def _check(args):
     return res, lines
 
 
+# The tagged configurations that verify --all requires, per family: every N (K for darts) in the range has
+# a verified certificate ("C1" or "not C1") or is one of the undecided configurations of docs/tagged_c1.md
+# (a Jordan block among lam1, lam2; dart:2, lam2 < 0).
+TAGGED_TARGET = {"dart": (2, 100), "crease": (1, 100), "corner": (1, 100)}
+TAGGED_UNDECIDED = {"dart": (2,), "crease": (1, 4), "corner": (2, 4)}
+
+
 def tagged_coverage(results):
     """(ok, lines): per tagged family, the N certified C1 and not C1; ok unless a configuration has two
-    verified certificates (a statement and its negation, or a publishing mistake).
+    verified certificates (a statement and its negation, or a publishing mistake) or an N of
+    :data:`TAGGED_TARGET` is neither certified nor one of :data:`TAGGED_UNDECIDED`.
 
     >>> from ccproof.certify.verify import VerifyResult, Part
     >>> r = VerifyResult(schema="ccproof.tagged-c1/1", valence="crease:5", parts=[Part("S", True)])
-    >>> tagged_coverage([r, r])[0], tagged_coverage([r])[0]
-    (False, True)
+    >>> ok, lines = tagged_coverage([r, r])
+    >>> ok, lines[1][:40]
+    (False, 'crease: CONTRADICTORY: certified twice: ')
+    >>> tagged_coverage([r])[1][1][:60]
+    'crease: INCOMPLETE: no certificate for 2-3, 6-100; C1 for no'
     """
     ok_all, lines = True, []
     for fam in ("dart", "crease", "corner"):
@@ -99,11 +111,14 @@ def tagged_coverage(results):
                 if r and isinstance(r.valence, str) and r.valence.startswith(fam + ":")]
         ns = [n for n, _ in rows]
         twice = sorted({n for n in ns if ns.count(n) > 1})
+        lo, hi = TAGGED_TARGET[fam]
+        missing = [n for n in range(lo, hi + 1) if n not in ns and n not in TAGGED_UNDECIDED[fam]]
         c1, not_c1 = (sorted(n for n, st in rows if st == want) for want in ("C1", "not C1"))
-        lines.append(f"{fam}: {'OK' if not twice else 'CONTRADICTORY'}: C1 for {_ranges(c1) or 'none'}, not C1 for "
-                     f"{_ranges(not_c1) or 'none'}" + (f"; certified twice: {twice}" if twice else "")
-                     + "; the others are undecided (docs/tagged_c1.md lists the reasons)")
-        ok_all &= not twice
+        status = (f"CONTRADICTORY: certified twice: {twice}; " if twice else
+                  f"INCOMPLETE: no certificate for {_ranges(missing)}; " if missing else f"OK ({fam}:{lo}-{hi}): ")
+        lines.append(f"{fam}: {status}C1 for {_ranges(c1) or 'none'}, not C1 for {_ranges(not_c1) or 'none'}; "
+                     f"undecided: {_ranges(list(TAGGED_UNDECIDED[fam]))} (docs/tagged_c1.md lists the reasons)")
+        ok_all &= not twice and not missing
     return ok_all, lines
 
 

@@ -58,7 +58,30 @@ REVIEWED = {
     ("tagged_c1.py", "R[r, c] != 0"): "fmpq_mat entries (exact)",
     ("tagged_c1.py", "not 0 <= pv < m"): "ints",
     ("tagged_map.py", 'fam != "dart"'): "strings",
-    ("tagged_map.py", "S[i, j] != 0"): "fmpq_mat entries (exact)",
+    ("tagged.py", "w != 0"): "fmpq rule weights (exact)",
+    ("tagged_c1.py", "not abs(f[pivot]) > 0"): "fails unless the pivot coordinate is certainly non-zero: conservative",
+    ("tagged_c1.py", "not abs(t[0]) < 1"): "collects every eigenvalue possibly on or outside the unit circle; exactly "
+                                           "one (the crease block's exact 1) is allowed: conservative",
+    ("tagged_c1.py", "parse_decimal(v) != 0"): "fmpq (exact decimals)",
+    ("tagged_c1.py", "one[0][1] != 1"): "fmpq or None (the exact value of a rational eigenvalue)",
+    ("tagged_c1.py", 'one[0][2] != "C"'): "strings",
+    ("tagged_c1.py", "not ev[ia][0].real >= beta"): "fails unless alpha >= beta certainly: conservative",
+    ("tagged_c1.py", "Cc[i, 0] != g * cval[i]"): "fmpq_mat entries and fmpq (exact)",
+    ("tagged_modes.py", "B * K != K * M"): "fmpq_mat (exact)",
+    ("tagged_modes.py", "image != mirrored"): "dicts of fmpq weights with int keys (exact)",
+    ("tagged_modes.py", "{j: x for j, x in folded.items() if x != 0} != {j: x for j, x in rows[i].items() if j not in "
+                        "cp}"): "dicts of fmpq weights (exact)",
+    ("tagged_modes.py", "_charpoly_at(rows, fmpq(x)) != _claimed_mode(fmpq(x), c)"): "fmpq determinants (exact)",
+    ("tagged_modes.py", "w != 0"): "fmpq rule weights (exact)",
+    ("tagged_modes.py", "R[r, c] != 0"): "fmpq_mat entries (exact)",
+    ("tagged_modes.py", "x != 0"): "fmpq folded weights (exact)",
+    ("tagged_c1.py", "ev[one[0]][1] != 1"): "fmpq or None (the exact value of a rational eigenvalue)",
+    ("tagged_c1.py", "not l1.real > l2.real"): "fails unless lam1 > lam2 certainly: conservative",
+    ("tagged_modes.py", "rows[refl[i]] != {refl[j]: x for j, x in rows[i].items()}"): "dicts of fmpq weights (exact)",
+    ("tagged_modes.py", "{j: x for j, x in ring.items() if x != 0} != {j: x for j, x in rows[i].items() if j != 0}"):
+        "dicts of fmpq weights (exact)",
+    ("tagged_modes.py", "j != 0"): "ints (column indices)",
+    ("tagged_modes.py", "SE[a, b] != 0"): "fmpq_mat entries (exact)",
     ("maps.py", "not (hi < BREAKS[p] or (p < 3 and lo > BREAKS[p + 1]))"): (
         "keeps a piece unless the hull is certainly outside it: conservative"),
 }

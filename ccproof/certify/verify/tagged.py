@@ -128,6 +128,46 @@ def _index(fam, n):
 
 
 @cache
+def sector_rows(fam, n):
+    """The rows of the sector matrix S as sparse dicts (column index -> weight), from the rules.
+
+    Parameters
+    ----------
+    fam : str
+        ``"dart"``, ``"crease"`` or ``"corner"``.
+    n : int
+        K or N.
+
+    Returns
+    -------
+    tuple of dict[int, fmpq]
+        One per point of :func:`labels` (level-1 point i = sum_j row_i[j] level-0 point j).
+
+    Examples
+    --------
+    The crease centre (e0 + 6 V + e1)/8 (rays 0 and 2 start at indices 1 and 5):
+
+    >>> sector_rows("crease", 2)[0]
+    {0: 3/4, 1: 1/8, 5: 1/8}
+    """
+    pts = labels(fam, n)
+    idx, at = _index(fam, n)
+    rows = []
+    sharp = sharp_rays(fam, n)
+    half, eighth = fmpq(1, 2), fmpq(1, 8)
+    for p in pts:
+        if p == ("C",):
+            row = _centre_row(fam, n, idx)
+        elif p[0] == "r" and p[1] in sharp:
+            e1, e2 = idx[("r", p[1], 1, 0)], idx[("r", p[1], 2, 0)]
+            row = {0: half, e1: half} if p[2] == 1 else {0: eighth, e1: 6 * eighth, e2: eighth}
+        else:  # a smooth ray (its b = -1 side is quadrant r - 1) or a quadrant point: the rule in that quadrant
+            row = at(p[1], level1_rule(*p[2:]))
+        rows.append({j: w for j, w in row.items() if w != 0})
+    return tuple(rows)
+
+
+@cache
 def sector_matrix(fam, n):
     """The exact subdivision matrix S of the configuration: level-1 point i = sum_j S[i, j] level-0 point j.
 
@@ -141,7 +181,7 @@ def sector_matrix(fam, n):
     Returns
     -------
     flint.fmpq_mat, shape (m, m)
-        m = len(labels(fam, n)); rows sum to 1.
+        m = len(labels(fam, n)); rows sum to 1 (:func:`sector_rows`, dense).
 
     Examples
     --------
@@ -151,24 +191,9 @@ def sector_matrix(fam, n):
     >>> [S[0, j] for j in range(7)], S[1, 0], S[1, 1]
     ([3/4, 1/8, 0, 0, 0, 1/8, 0], 1/2, 1/2)
     """
-    pts = labels(fam, n)
-    idx, at = _index(fam, n)
-    m = len(pts)
-    rows = []
-    sharp = sharp_rays(fam, n)
-    half, eighth = fmpq(1, 2), fmpq(1, 8)
-    for p in pts:
-        if p == ("C",):
-            row = _centre_row(fam, n, idx)
-        elif p[0] == "r" and p[1] in sharp:
-            e1, e2 = idx[("r", p[1], 1, 0)], idx[("r", p[1], 2, 0)]
-            row = {0: half, e1: half} if p[2] == 1 else {0: eighth, e1: 6 * eighth, e2: eighth}
-        elif p[0] == "r":  # a smooth ray: the rule in quadrant r (its b = -1 side is quadrant r - 1)
-            row = at(p[1], level1_rule(*p[2:]))
-        else:
-            row = at(p[1], level1_rule(*p[2:]))
-        rows.append([row.get(j, fmpq(0)) for j in range(m)])
-    return fmpq_mat(rows)
+    rows = sector_rows(fam, n)
+    m = len(rows)
+    return fmpq_mat([[row.get(j, fmpq(0)) for j in range(m)] for row in rows])
 
 
 def _centre_row(fam, n, idx):

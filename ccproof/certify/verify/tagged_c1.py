@@ -1,7 +1,9 @@
 """Certificates for tagged configurations (schema ``ccproof.tagged-c1/1``): "C1" and "not C1" (trusted).
 
 The statement is derived from the configuration name alone (:mod:`.tagged`: the sector matrix S from
-OpenSubdiv's rules, its exact spectrum). A ``"not C1"`` certificate names a control net
+OpenSubdiv's rules, its exact spectrum; for N, K >= 5 the same spectrum and the leading eigenvectors
+through the modes of :mod:`.tagged_modes`, in O(N) for creases and corners). A ``"not C1"``
+certificate names a control net
 P = (x, y, z) whose three coordinates are eigenvectors of S, with eigenvalues alpha, beta, gamma,
 alpha >= gamma > 0 and beta >= gamma, and a sharp ray r and a quadrant q. The verifier derives each
 eigenvector itself (exactly for a rational eigenvalue, given its values on the crease points; in arb
@@ -57,9 +59,11 @@ from .tagged import (
     leading_spectrum,
     parse_configuration,
     sector_matrix,
+    sector_rows,
     sharp_rays,
 )
 from .tagged_map import check_map
+from .tagged_modes import MIN_N, even_vector, mode_spectrum, mode_vector
 
 TAGGED_SCHEMA = "ccproof.tagged-c1/1"
 STATEMENTS = ("C1", "not C1")
@@ -110,9 +114,13 @@ def verify_tagged(cert, part, log):
     if not 64 <= prec <= 1024:
         raise CertificateError("prec must lie in 64..1024")
     log(f"{statement} certificate for {name} ({prec} bits)")
-    S = sector_matrix(fam, n)
-    ok = all(sum((S[i, j] for j in range(S.ncols())), fmpq(0)) == 1 for i in range(S.nrows()))
-    part("S sector matrix derived from the rules", ok, f"{S.nrows()} points, rows sum to 1 (exact)")
+    rows = sector_rows(fam, n)
+    ok = all(sum(row.values(), fmpq(0)) == 1 for row in rows)
+    part("S sector matrix derived from the rules", ok, f"{len(rows)} points, rows sum to 1 (exact)")
+    if statement == "C1" and fam == "dart" and n >= MIN_N:  # the odd half through the modes (tagged_modes)
+        with ctx.workprec(prec):
+            _verify_dart_c1(cert, n, prec, part)
+        return name
     if statement == "C1":
         ok, msg, lead = leading_spectrum(fam, n, prec)
         part("spectral part of the generalized Reif criterion", ok, msg)
@@ -124,11 +132,7 @@ def verify_tagged(cert, part, log):
                  "sends the sharp edges to v (not injective)")
         if part.failed:
             return name
-        mp = field_of(cert, "map", dict, "certificate")
-        exact_keys(mp, ("x", "y", "orientation"), "map")
-        orient = mp["orientation"]
-        if orient not in (1, -1) or isinstance(orient, bool):
-            raise CertificateError("map.orientation must be 1 or -1")
+        mp, orient = _map_field(cert)
         with ctx.workprec(prec):
             vecs, vals = {}, {}
             for c, t in (("x", lead[1]), ("y", lead[2])):
@@ -149,6 +153,10 @@ def verify_tagged(cert, part, log):
     r, q = field_of(w, "ray", int, "witness"), field_of(w, "quadrant", int, "witness")
     if r not in sharp_rays(fam, n) or not 0 <= q < n:
         raise CertificateError(f"witness: ray {r} is not sharp or quadrant {q} outside 0..{n - 1}")
+    if n >= MIN_N:  # the spectrum and the eigenvectors through the sine modes (tagged_modes), O(N)
+        with ctx.workprec(prec):
+            _verify_witness_modes(fam, n, w, r, q, part, log)
+        return name
     with ctx.workprec(prec):
         vecs, vals = {}, {}
         for c in ("x", "y", "z"):
@@ -170,6 +178,160 @@ def verify_tagged(cert, part, log):
             log(f"  the limit surface of this net is not C1 at the {fam} vertex: normals along the level-m "
                 f"copies of quadrant {q}'s (1,1) tend to n_z != 0, yet e_z lies in T_v (ray {r})")
     return name
+
+
+def _map_field(cert):
+    mp = field_of(cert, "map", dict, "certificate")
+    exact_keys(mp, ("x", "y", "orientation"), "map")
+    orient = mp["orientation"]
+    if orient not in (1, -1) or isinstance(orient, bool):
+        raise CertificateError("map.orientation must be 1 or -1")
+    return mp, orient
+
+
+def _where(t):
+    return f"mode {t[3]}" if t[3] else "even"
+
+
+def _verify_dart_c1(cert, k, prec, part):
+    """A dart's "C1" certificate, K >= MIN_N: the spectral part from :func:`.tagged_modes.mode_spectrum`
+    (every eigenvalue enclosed, S_E's exactly, the odd half's through the modes), lam1 and lam2 each
+    isolated (so simple), x and y in closed form (odd) or from S_E (even), then the map's parts."""
+    ev = mode_spectrum("dart", k)
+    one = [i for i, t in enumerate(ev) if not abs(t[0]) < 1]
+    rest = sorted((i for i in range(len(ev)) if i not in one), key=lambda i: -abs(ev[i][0]).mid())
+    i1, i2 = rest[0], rest[1]
+    l1, l2 = ev[i1][0], ev[i2][0]
+    why = ("eigenvalue 1 is not simple" if len(one) != 1 or ev[one[0]][1] != 1 else
+           "lam1 or lam2 is not certainly real and positive" if not all(
+               z.imag.is_zero() and z.real > 0 for z in (l1, l2)) else
+           "lam1 > lam2 is not certain" if not l1.real > l2.real else
+           "|lam3| is not certainly below lam2" if not all(abs(ev[i][0]) < l2.real for i in rest[2:]) else None)
+    part("spectral part of the generalized Reif criterion", why is None,
+         f"dart:{k}: 1 simple; lam1 = {l1.real.str(5, radius=False)} ({_where(ev[i1])}) > lam2 = "
+         f"{l2.real.str(5, radius=False)} ({_where(ev[i2])}), each simple"
+         f" > |lam3| = {abs(ev[rest[2]][0]).str(5, radius=False)}" if why is None else f"dart:{k}: {why}")
+    if why is not None:
+        return
+    mp, orient = _map_field(cert)
+    vecs = {}
+    for c, i in (("x", i1), ("y", i2)):
+        spec = field_of(mp, c, dict, "map")
+        exact_keys(spec, ("eigenvalue", "crease", "pivot"), c)
+        lo_hi, pivot = field_of(spec, "eigenvalue", list, c), field_of(spec, "pivot", int, c)
+        if field_of(spec, "crease", list, c) or len(lo_hi) != 2 or not 0 <= pivot < len(ev):
+            raise CertificateError(f"{c}: a dart's coordinate is an interval, crease [] and a pivot 0..{len(ev) - 1}")
+        lo, hi = parse_decimal(lo_hi[0]), parse_decimal(lo_hi[1])
+        inside = [j for j, t in enumerate(ev) if t[0].real > lo and t[0].real < hi]
+        near = [j for j, t in enumerate(ev) if t[0].real.overlaps(arb(lo).union(arb(hi)))]
+        lam = ev[i][0].real
+        if inside != [i] or near != [i]:
+            part(f"{c}: eigenvector of lam{'1' if c == 'x' else '2'}", False,
+                 f"[{lo}, {hi}] does not isolate lam{'1' if c == 'x' else '2'}: not the eigenvalue of lam1 / lam2")
+            return
+        if ev[i][3] is not None:  # odd: closed form, normalized at the pivot
+            f = mode_vector("dart", k, ev[i][3], lam)
+            ok = f is not None and abs(f[pivot]) > 0
+            vec = [v if isinstance(v, fmpq) else (v / f[pivot]).real for v in f] if ok else None
+            how = f"closed form in mode {ev[i][3]} (odd)"
+        else:
+            try:
+                vec, how = even_vector(k, lam, pivot), "even: the bordered system on S_E proved regular"
+            except ZeroDivisionError:
+                vec = None
+        part(f"{c}: eigenvector of lam{'1' if c == 'x' else '2'}", vec is not None,
+             f"eigenvalue {lam.str(10)}, simple; {how}, pivot {labels('dart', k)[pivot]}" if vec is not None else
+             f"the eigenvector is not certainly non-zero at the pivot {pivot} (or its system not certainly regular)")
+        if vec is None:
+            return
+        vecs[c] = vec
+    check_map("dart", k, vecs["x"], vecs["y"], l1.real, l2.real, orient, field_of(cert, "parts", dict, "certificate"),
+              prec, part)
+
+
+def _verify_witness_modes(fam, n, w, r, q, part, log):
+    """The parts of a "not C1" witness for crease:N, corner:N, N >= MIN_N, from :mod:`.tagged_modes`:
+    x and y eigenvectors of simple mode roots (closed form), z's existence from its crease values, G, B, N."""
+    ev = mode_spectrum(fam, n)
+    vecs, at = {}, {}
+    for c in ("x", "y"):
+        spec = field_of(w, c, dict, "witness")
+        exact_keys(spec, ("eigenvalue", "crease", "pivot"), c)
+        crease, lo_hi = field_of(spec, "crease", list, c), field_of(spec, "eigenvalue", list, c)
+        if len(crease) != 5 or len(lo_hi) != 2:
+            raise CertificateError(f"{c}: crease values must be 5 decimals and the eigenvalue [low, high]")
+        if any(parse_decimal(v) != 0 for v in crease):
+            part(f"{c}: eigenvector of S", False,
+                 "an irrational eigenvalue's eigenvector vanishes on the crease points")
+            return
+        lo, hi = parse_decimal(lo_hi[0]), parse_decimal(lo_hi[1])
+        inside = [i for i, t in enumerate(ev) if t[0].real > lo and t[0].real < hi]
+        near = [i for i, t in enumerate(ev) if t[0].real.overlaps(arb(lo).union(arb(hi)))]
+        i = inside[0] if len(inside) == 1 and near == inside else None
+        if i is None or not ev[i][0].imag.is_zero() or ev[i][3] is None:
+            part(f"{c}: eigenvector of S", False, f"[{lo}, {hi}] does not isolate one simple real root of a mode")
+            return
+        pivot = field_of(spec, "pivot", int, c)
+        if not 0 <= pivot < len(ev) or pivot in crease_points(fam, n):
+            raise CertificateError(f"{c}: pivot must index a non-crease point")
+        f = mode_vector(fam, n, ev[i][3], ev[i][0].real)
+        if f is None:
+            part(f"{c}: eigenvector of S", False, "no pivot makes the bordered 6 x 6 system certainly regular")
+            return
+        if not abs(f[pivot]) > 0:
+            part(f"{c}: eigenvector of S", False, f"the eigenvector is not certainly non-zero at the pivot {pivot}")
+            return
+        vecs[c] = [v if isinstance(v, fmpq) else (v / f[pivot]).real for v in f]
+        at[c] = i
+        part(f"{c}: eigenvector of S", True, f"eigenvalue {ev[i][0].real.str(10)} = lam(cos({ev[i][3]} pi/{n})), "
+             f"simple; closed form in mode {ev[i][3]} (the bordered 6 x 6 system proved regular), pivot "
+             f"{labels(fam, n)[pivot]}")
+    spec = field_of(w, "z", dict, "witness")
+    exact_keys(spec, ("eigenvalue", "crease"), "z")
+    g, cval = field_of(spec, "eigenvalue", str, "z"), field_of(spec, "crease", list, "z")
+    if len(cval) != 5:
+        raise CertificateError("z: crease values must be 5 decimals")
+    g, cval = parse_decimal(g), [parse_decimal(v) for v in cval]
+    C = crease_block(fam, n)
+    Cc = C * fmpq_mat([[v] for v in cval])
+    at_g = [t for t in ev if t[2] == "I" and (t[1] == g if t[1] is not None else t[0].real.overlaps(arb(g)))]
+    why = (f"no eigenvector for {g} with the given crease values (C c = {g} c, c != 0 fails)"
+           if all(v == 0 for v in cval) or any(Cc[i, 0] != g * cval[i] for i in range(5)) else
+           f"{g} is possibly a multiple eigenvalue of I" if len(at_g) > 1 else None)
+    ok = why is None
+    part("z: (generalized) eigenvector of S", ok,
+         f"eigenvalue {g}: C c = {g} c exactly on the crease points, and {g} is at most a simple eigenvalue of I, so "
+         f"some z with these crease values has (S - {g})^2 z = 0 and (S - {g}) z = 0 on the crease points"
+         if ok else why)
+    if not ok:
+        return
+    ia, ib = at["x"], at["y"]
+    one = [t for t in ev if not abs(t[0]) < 1]
+    beta = ev[ib][0].real
+    others = [t for i, t in enumerate(ev) if i not in (ia, ib) and t[1] != 1]
+    below = [t[1] for t in ev if t[2] == "C" and t[1] is not None and t[1] < 1]
+    why = ("x and y are the same eigenvector (beta is not an eigenvalue distinct from alpha)" if ia == ib else
+           "eigenvalue 1 is not simple" if len(one) != 1 or one[0][1] != 1 or one[0][2] != "C" else
+           "alpha >= beta is not certain" if not ev[ia][0].real >= beta else
+           "an eigenvalue is not certainly below beta (lam1, lam2 not alpha, beta)"
+           if not all(abs(t[0]) < beta for t in others) else
+           f"gamma is not the crease block's largest eigenvalue below 1 ({max(below) if below else None})"
+           if not below or g != max(below) else "gamma < beta is not certain" if not arb(g) < beta else None)
+    part("G generic: alpha = lam1, beta = lam2, gamma = the crease block's largest eigenvalue below 1; "
+         "no Jordan block at |lam| >= beta; gamma < beta for a generalized z", why is None,
+         f"alpha = {ev[ia][0].real.str(8)} > beta = {beta.str(8)} > |every other| (each simple), 1 simple; "
+         f"gamma = {g} < beta" if why is None else why)
+    if why is not None:
+        return
+    cp = crease_points(fam, n)
+    vecs["z"] = [cval[cp.index(i)] if i in cp else None for i in range(len(ev))]  # B reads the crease points only
+    _check_boundary(fam, n, r, vecs, part)
+    J = _jacobian(fam, n, q, vecs["x"], vecs["y"])
+    ok = J > 0 or J < 0
+    part(f"N normal at vertex (1,1) of quadrant {q}: J_xy != 0", ok, f"J_xy = {J.str(6)}")
+    if not part.failed:
+        log(f"  the limit surface of this net is not C1 at the {fam} vertex: normals along the level-m copies of "
+            f"quadrant {q}'s (1,1) tend to n_z != 0, yet e_z lies in T_v (ray {r})")
 
 
 def _same(t, v):

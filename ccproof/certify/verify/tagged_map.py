@@ -31,7 +31,7 @@ from .maps import STAR_CURVES, regularity_form
 from .record import exact_keys
 from .replay import check_boxes, check_partition, parse_path
 from .rules import CENTRE, canonical, level1_rule
-from .tagged import labels, sector_matrix, sharp_rays
+from .tagged import labels, sector_rows, sharp_rays
 
 PIECES = ("P1", "P2", "P3")
 _OFFSET = {"P1": (0, -1), "P2": (0, 0), "P3": (-1, 0)}  # level-1 position of B-spline net[0][0]
@@ -54,11 +54,15 @@ def level1_values(fam, n, v):
     >>> [val(0, a, b) for a, b in ((3, 0), (2, 2), (1, -1))]
     [3/2, 1, 1/2]
     """
-    S = sector_matrix(fam, n)
     pts = labels(fam, n)
     idx = {p: i for i, p in enumerate(pts)}
     sharp = sharp_rays(fam, n)
-    one = [sum((S[i, j] * v[j] for j in range(len(pts)) if S[i, j] != 0), 0 * v[0]) for i in range(len(pts))]
+    rows, memo = sector_rows(fam, n), {}
+
+    def one(i):  # (S v)[i], sparse, on demand (a quadrant reads a few of them)
+        if i not in memo:
+            memo[i] = sum((w * v[j] for j, w in rows[i].items()), 0 * v[0])
+        return memo[i]
 
     def quad(s):
         return s % n if fam == "dart" else s
@@ -72,7 +76,7 @@ def level1_values(fam, n, v):
 
     def value(q, A, B):
         if (A, B) == (0, 0):
-            return one[0]
+            return one(0)
         if B == -1 and q in sharp:  # across the sharp ray q: the ghost row
             return 2 * value(q, A, 0) - value(q, A, 1)
         if A == -1 and quad(q + 1) in sharp:  # across the sharp ray q + 1: the ghost column
@@ -81,7 +85,7 @@ def level1_values(fam, n, v):
         s = quad(q + delta)
         key = ("r", s, A2, 0) if B2 == 0 else ("q", s, A2, B2)
         if key in idx:
-            return one[idx[key]]
+            return one(idx[key])
         if B2 == 0 and s in sharp:  # (3, 0) on a sharp ray: the midpoint of level-0 (1,0), (2,0)
             return (v[idx[("r", s, 1, 0)]] + v[idx[("r", s, 2, 0)]]) / 2
         acc = 0 * v[0]
