@@ -3,7 +3,7 @@ docs/qmv98.md section 4 ("Equilibrium"), printed, not estimated.
 
   python scripts/apps_output.py --arap [--osd]  # bunny, 16 charts: control UVs under the corners-only rule
                                                 # (--osd: folds counted by OpenSubdiv itself too)
-  python scripts/apps_output.py --arap --metric --refines 0   # the same with export_control(metric=True)
+  python scripts/apps_output.py --arap --metric off   # without the minimax (export_control(metric=False))
   python scripts/apps_output.py --fit      # bunny scan: fit steps, energy, criterion, two-sided error
   python scripts/apps_output.py --fit-table  # docs/qmv98.md section 4's tables: synthetic data and the bunny,
                                              # defaults and the regularization a = 1e-4, 1e-5, 1e-6 (b = a / 10)
@@ -98,7 +98,7 @@ def osd_folds(exe, path, levels=(1, 2, 3)):
     return out
 
 
-def arap(eval_level, out_dir, use_osd, refines=("0", "auto"), metric=False):
+def arap(eval_level, out_dir, use_osd, refines=("0", "auto"), metric="auto"):
     from ccproof.apps.arap.charts import segment_by_normals
     from ccproof.apps.arap.core import ChartTexture, auto_refine, compare, texture_metrics
     from ccproof.apps.arap.fvar import FOLD_LEVELS, export_control, subdivided_folds
@@ -137,18 +137,24 @@ def arap(eval_level, out_dir, use_osd, refines=("0", "auto"), metric=False):
             write_uv_obj(old, r.textures[0].hierarchy.surface, r)  # the former file: (c)'s own unknowns
             print(f"    OpenSubdiv's folds of that file: {osd_folds(exe, old)}")
         t2 = time.perf_counter()
-        # the CLI's defaults (--metric: then also the polish for the metrics' own energy)
+        # the CLI's defaults (--metric on / off: the minimax on every refinement that misses the target / never)
         exp = export_control(r, eval_level=eval_level, levels=3, max_faces=150_000, metric=metric)
         t3 = time.perf_counter()
         ex = np.subtract(r.metrics.as_tuple(), (2.0, 2.0, 1.0))
         for extra, f, m in exp.tried:
+            if extra == exp.extra and exp.arap_metrics is not None:
+                a = exp.arap_metrics
+                ratio = np.subtract(a.as_tuple(), (2.0, 2.0, 1.0)) / ex
+                print(f"  corners-only UVs, {extra} extra subdivision(s), ARAP polish alone: {_fmt(a)}   excess / "
+                      f"exact {ratio[0]:.3f} {ratio[1]:.3f} {ratio[2]:.3f}")
+                print(f"    minimax per chart (None: ARAP polish, else metric_polish weights): {exp.chart_weights}")
             ratio = np.subtract(m.as_tuple(), (2.0, 2.0, 1.0)) / ex
             print(f"  corners-only UVs, {extra} extra subdivision(s): {_fmt(m)}   folds {f}   excess / exact "
                   f"{ratio[0]:.3f} {ratio[1]:.3f} {ratio[2]:.3f}")
         er = exp.excess_ratio()
         print(f"  written: {exp.extra} extra ({exp.mesh.n_faces} control faces), excess / exact "
               f"{er[0]:.3f} {er[1]:.3f} {er[2]:.3f}, within 5 %: {exp.accepted} ({t3 - t2:.1f} s)")
-        path = out_dir / f"bunny_control_refine{refine}{'_metric' if metric else ''}.obj"
+        path = out_dir / f"bunny_control_refine{refine}{'' if metric == 'auto' else '_metric_' + str(metric)}.obj"
         write_uv_obj(path, exp.mesh, replace(r, textures=exp.textures))
         print(f"  wrote {path}")
         if exe is not None:
@@ -220,8 +226,10 @@ def main(argv=None):
     ap.add_argument("--eval-level", type=int, default=4, help="metric level of --arap (default 4)")
     ap.add_argument("--osd", action="store_true", help="--arap: also count folds with OpenSubdiv itself")
     ap.add_argument("--refines", default="0,auto", help="--arap: the --refine values (default 0,auto)")
-    ap.add_argument("--metric", action="store_true",
-                    help="--arap: export_control(metric=True), the metrics' own energy after the ARAP polish")
+    ap.add_argument("--metric", choices=("auto", "on", "off"), default="auto",
+                    help="--arap: export_control(metric=...): the minimax over metric-energy candidates on the last "
+                         "refinement allowed where the ARAP polish misses the target (auto, default), on every "
+                         "refinement that misses it (on), never (off)")
     ap.add_argument("--out-dir", type=Path, default=Path("out/apps_output"), help="control meshes of --arap")
     a = ap.parse_args(argv)
     if not (a.arap or a.fit or a.fit_table):
@@ -231,7 +239,7 @@ def main(argv=None):
     if a.fit_table:
         fit_table(a.shapes.split(","), [float(x) for x in a.scales.split(",")])
     if a.arap:
-        arap(a.eval_level, a.out_dir, a.osd, a.refines.split(","), a.metric)
+        arap(a.eval_level, a.out_dir, a.osd, a.refines.split(","), {"auto": "auto", "on": True, "off": False}[a.metric])
 
 
 if __name__ == "__main__":
