@@ -26,9 +26,9 @@ distortion the metrics measure is minimized (:func:`metric_polish`) with a few w
 (:data:`METRIC_WEIGHTS`), and every chart keeps the candidate (ARAP polish or one of these) that makes the
 largest of the three global excess ratios smallest (a minimax over the charts' choices: one weighting only
 trades E_angle against E_area and E_stretch, mixing them across charts balances the three).
-The excess sits at the chart boundary's concave corners (a value whose span has k of the vertex's n faces,
-k / n > 1/2): the rule keeps the boundary a smooth crease there, a texture angle of pi where the surface's is
-2 pi k / n, which costs a fixed amount per corner in units of the local control face's area.
+The excess sits mostly at the chart boundary's concave corners (a value whose span has k of its vertex's n
+faces, k / n > 1/2): the rule keeps the boundary a smooth crease there, a texture angle of pi where the
+surface's is 2 pi k / n, which costs a fixed amount per corner in units of the local control faces' area.
 
 The inner 3 x 3 faces of a flat 5 x 5 grid as one chart: the exact texture is an isometry, and so is the
 corners-only one (on a uniform flat grid every rule reproduces affine functions at the same points):
