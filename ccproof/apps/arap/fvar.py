@@ -459,7 +459,7 @@ def export_control(result, eval_level=5, max_extra=2, max_excess_ratio=1.05, fit
         The minimax over :func:`metric_polish` candidates: "auto" on the last refinement allowed (by
         ``max_extra`` and ``max_faces``) when the ARAP polish misses the criterion there; True on every
         refinement whose ARAP polish misses it; False never. It costs ``len(METRIC_WEIGHTS)`` L-BFGS runs per
-        chart (the bunny at its default refinement: about 4x the rest of the export).
+        chart (the bunny at its default refinement: 1,249 s against 198-514 s without it, on a loaded machine).
     metric_iter : int
         L-BFGS iterations of each candidate per chart.
 
