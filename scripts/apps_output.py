@@ -3,7 +3,7 @@ docs/qmv98.md section 4 ("Equilibrium"), printed, not estimated.
 
   python scripts/apps_output.py --arap [--osd]  # bunny, 16 charts: control UVs under the corners-only rule
                                                 # (--osd: folds counted by OpenSubdiv itself too)
-  python scripts/apps_output.py --arap --metric --refines 0   # the same with export_control(metric=True)
+  python scripts/apps_output.py --arap --metric off   # without the minimax (export_control(metric=False))
   python scripts/apps_output.py --fit      # bunny scan: fit steps, energy, criterion, two-sided error
   python scripts/apps_output.py --fit-table  # docs/qmv98.md section 4's tables: synthetic data and the bunny,
                                              # defaults and the regularization a = 1e-4, 1e-5, 1e-6 (b = a / 10)
@@ -98,7 +98,7 @@ def osd_folds(exe, path, levels=(1, 2, 3)):
     return out
 
 
-def arap(eval_level, out_dir, use_osd, refines=("0", "auto"), metric=False):
+def arap(eval_level, out_dir, use_osd, refines=("0", "auto"), metric="auto"):
     from ccproof.apps.arap.charts import segment_by_normals
     from ccproof.apps.arap.core import ChartTexture, auto_refine, compare, texture_metrics
     from ccproof.apps.arap.fvar import FOLD_LEVELS, export_control, subdivided_folds
@@ -137,22 +137,97 @@ def arap(eval_level, out_dir, use_osd, refines=("0", "auto"), metric=False):
             write_uv_obj(old, r.textures[0].hierarchy.surface, r)  # the former file: (c)'s own unknowns
             print(f"    OpenSubdiv's folds of that file: {osd_folds(exe, old)}")
         t2 = time.perf_counter()
-        # the CLI's defaults (--metric: then also the polish for the metrics' own energy)
+        # the CLI's defaults (--metric on / off: the minimax on every refinement that misses the target / never)
         exp = export_control(r, eval_level=eval_level, levels=3, max_faces=150_000, metric=metric)
         t3 = time.perf_counter()
         ex = np.subtract(r.metrics.as_tuple(), (2.0, 2.0, 1.0))
         for extra, f, m in exp.tried:
+            if extra == exp.extra and exp.arap_metrics is not None:
+                a = exp.arap_metrics
+                ratio = np.subtract(a.as_tuple(), (2.0, 2.0, 1.0)) / ex
+                print(f"  corners-only UVs, {extra} extra subdivision(s), ARAP polish alone: {_fmt(a)}   excess / "
+                      f"exact {ratio[0]:.3f} {ratio[1]:.3f} {ratio[2]:.3f}")
+                print(f"    minimax per chart (None: ARAP polish, else metric_polish weights): {exp.chart_weights}")
             ratio = np.subtract(m.as_tuple(), (2.0, 2.0, 1.0)) / ex
             print(f"  corners-only UVs, {extra} extra subdivision(s): {_fmt(m)}   folds {f}   excess / exact "
                   f"{ratio[0]:.3f} {ratio[1]:.3f} {ratio[2]:.3f}")
         er = exp.excess_ratio()
         print(f"  written: {exp.extra} extra ({exp.mesh.n_faces} control faces), excess / exact "
               f"{er[0]:.3f} {er[1]:.3f} {er[2]:.3f}, within 5 %: {exp.accepted} ({t3 - t2:.1f} s)")
-        path = out_dir / f"bunny_control_refine{refine}{'_metric' if metric else ''}.obj"
+        path = out_dir / f"bunny_control_refine{refine}{'' if metric == 'auto' else '_metric_' + str(metric)}.obj"
         write_uv_obj(path, exp.mesh, replace(r, textures=exp.textures))
         print(f"  wrote {path}")
         if exe is not None:
             print(f"    OpenSubdiv's folds of that file: {osd_folds(exe, path)}")
+
+
+def band(eval_level, chart, weights):
+    """docs/hsh10.md section 8.1, "Where the excess sits": one chart of the bunny at the default refinement, its
+    corners-only UVs on the control mesh subdivided once more (fit + ARAP polish, as export_control): per metric
+    sample, matched to the exact texture's by position, the excess over the exact texture's by graph distance
+    to the chart boundary and by the nearest chart-boundary vertex's type (k chart faces of its n); then the
+    chart's three excess ratios after metric_polish with E_angle's weight times each of ``weights``."""
+    import scipy.sparse as sp
+    from scipy.sparse.csgraph import dijkstra
+    from scipy.spatial import cKDTree
+
+    from ccproof.apps.arap.charts import segment_by_normals
+    from ccproof.apps.arap.core import ChartTexture, auto_refine, compare, optimize_chart, refine_mesh, texture_metrics
+    from ccproof.apps.arap.fvar import corners_only_texture, metric_polish
+    from ccproof.mesh import read_obj
+
+    mesh = read_obj(BUNNY)
+    labels = segment_by_normals(mesh)
+    ref = auto_refine(mesh, labels)
+    res, _ = compare(mesh, labels, methods=("c",), levels=3, eval_level=eval_level, refine=ref, release=True, accel=5)
+    tex = res["c"].textures[chart]
+    h = tex.hierarchy
+    ev, evx = eval_level - ref, eval_level - ref - 1
+    hc, Y = corners_only_texture(tex, 1, 2, refine_mesh(h.surface, None, 1)[0])
+    Yp, _, _ = optimize_chart(hc, "boundary", Y, levels=max(1, 3 - ref - 1), start_level=1, accel=5)
+
+    def samples(hh, lev, rules, X):
+        m, d = texture_metrics(ChartTexture(hh, rules, 0, hh.lift_unknowns(X, rules), X), lev, per_sample=True)
+        s1, s2, w = d["s1"], d["s2"], d["weight"]
+        ex = np.stack([w * (s1 / s2 + s2 / s1 - 2), w * (d["area_distortion"] - 2)], 1)
+        return m, hh.level(lev).mesh.vertices[d["vertex"]], ex, w
+
+    me, Pe, exe, we = samples(h, ev, "extended", tex.unknowns)
+    mp, Pp, exp_, _ = samples(hc, evx, "boundary", Yp)
+    E = np.subtract(me.as_tuple(), (2.0, 2.0, 1.0))
+    print(f"chart {chart}: {h.chart_faces.size} faces at --refine {ref}, {hc.chart_faces.size} with 1 extra; ARAP "
+          f"polish excess / exact {np.round(np.subtract(mp.as_tuple(), (2.0, 2.0, 1.0)) / E, 3)}")
+    L = h.level(ev)
+    e, n = L.mesh.edges, L.mesh.n_vertices
+    G = sp.coo_matrix((np.ones(len(e)), (e[:, 0], e[:, 1])), shape=(n, n)).tocsr()
+    dist = dijkstra(G, directed=False, indices=np.flatnonzero(L.chart_boundary), min_only=True, unweighted=True)
+    dist /= 2**ev  # in faces of the texture's control mesh
+    tree = cKDTree(L.mesh.vertices)
+    de, dp = dist[tree.query(Pe)[1]], dist[tree.query(Pp)[1]]
+    A = me.area
+    print("  distance to the chart boundary (control faces): share of the area; (corners-only - exact) E_angle, "
+          "E_area excess / the chart's exact excess")
+    edges = [0, 0.01, 0.3, 0.6, 1.1, 2.1, 5.1, np.inf]
+    for lo, hi in zip(edges[:-1], edges[1:]):
+        se, sp_ = (de >= lo) & (de < hi), (dp >= lo) & (dp < hi)
+        diff = (exp_[sp_].sum(0) - exe[se].sum(0)) / A / E[:2]
+        print(f"    [{lo:4.2f}, {hi:4.2f}): area {we[se].sum() / A:.3f}  {np.round(diff, 4)}")
+    L0 = h.level(0)
+    bv = np.flatnonzero(L0.chart_boundary)
+    typ = np.array([f"{a} of {b}" for a, b in zip(L0.chart_face_count[bv], L0.mesh.face_count[bv])])
+    tb = cKDTree(L0.mesh.vertices[bv])
+    ne, np_ = tb.query(Pe)[1], tb.query(Pp)[1]
+    print("  nearest chart-boundary vertex (k chart faces of n), samples within 1 face: count, (corners-only - "
+          "exact) E_angle, E_area excess in 1e-6 of the chart's area and / the chart's exact excess")
+    for t in sorted(set(typ)):
+        sel = np.flatnonzero(typ == t)
+        d = (exp_[np.isin(np_, sel) & (dp <= 1.01)].sum(0) - exe[np.isin(ne, sel) & (de <= 1.01)].sum(0)) / A
+        print(f"    {t}: {sel.size:4d}  {np.round(d * 1e6, 2)}  {np.round(d / E[:2], 4)}")
+    for wa in weights:
+        Z = metric_polish(hc, Yp, evx, (wa / E[0], 1 / E[1], 1 / E[2]))
+        m = texture_metrics(ChartTexture(hc, "boundary", 0, hc.lift_unknowns(Z, "boundary"), Z), evx)
+        print(f"  metric_polish, E_angle weight x {wa}: excess / exact "
+              f"{np.round(np.subtract(m.as_tuple(), (2.0, 2.0, 1.0)) / E, 3)}")
 
 
 def fit():
@@ -214,24 +289,30 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--arap", action="store_true")
     ap.add_argument("--fit", action="store_true")
+    ap.add_argument("--band", type=int, metavar="CHART", help="where the corners-only excess sits, on that chart")
+    ap.add_argument("--band-weights", default="1,1.3,1.45,1.6,2,3", help="--band: E_angle weights of metric_polish")
     ap.add_argument("--fit-table", action="store_true", help="the tables of docs/qmv98.md section 4")
     ap.add_argument("--shapes", default="bulb,ellipsoid,superquadric,bunny", help="--fit-table: data sets")
     ap.add_argument("--scales", default="1e-5,1e-4,1e-6", help="--fit-table: values of a (b = a / 10)")
     ap.add_argument("--eval-level", type=int, default=4, help="metric level of --arap (default 4)")
     ap.add_argument("--osd", action="store_true", help="--arap: also count folds with OpenSubdiv itself")
     ap.add_argument("--refines", default="0,auto", help="--arap: the --refine values (default 0,auto)")
-    ap.add_argument("--metric", action="store_true",
-                    help="--arap: export_control(metric=True), the metrics' own energy after the ARAP polish")
+    ap.add_argument("--metric", choices=("auto", "on", "off"), default="auto",
+                    help="--arap: export_control(metric=...): the minimax over metric-energy candidates on the last "
+                         "refinement allowed where the ARAP polish misses the target (auto, default), on every "
+                         "refinement that misses it (on), never (off)")
     ap.add_argument("--out-dir", type=Path, default=Path("out/apps_output"), help="control meshes of --arap")
     a = ap.parse_args(argv)
-    if not (a.arap or a.fit or a.fit_table):
-        ap.error("give --arap, --fit and/or --fit-table")
+    if not (a.arap or a.fit or a.fit_table or a.band is not None):
+        ap.error("give --arap, --band, --fit and/or --fit-table")
+    if a.band is not None:
+        band(a.eval_level, a.band, [float(x) for x in a.band_weights.split(",")])
     if a.fit:
         fit()
     if a.fit_table:
         fit_table(a.shapes.split(","), [float(x) for x in a.scales.split(",")])
     if a.arap:
-        arap(a.eval_level, a.out_dir, a.osd, a.refines.split(","), a.metric)
+        arap(a.eval_level, a.out_dir, a.osd, a.refines.split(","), {"auto": "auto", "on": True, "off": False}[a.metric])
 
 
 if __name__ == "__main__":

@@ -21,7 +21,9 @@ with texture control points for the rule every subdivision tool has, OpenSubdiv'
 only" (FVAR_LINEAR_CORNERS_ONLY; its header says so): fitted to the exact texture and polished by the
 same optimization under that rule, on the texture's control mesh subdivided 0..--control-extra more times
 (the fewest that give no fold at levels 1-3 and every distortion excess within 5 % of the exact texture's,
-at most --control-max-faces faces); it prints the folds and the distortion such a tool will see.
+at most --control-max-faces faces; where the last one allowed misses that, each chart takes the polish or a
+minimization of the measured distortion, whichever makes the largest excess ratio smallest); it prints the
+folds and the distortion such a tool will see.
 
 Input: any mesh `ccproof eval` reads (OBJ, PLY, OFF, STL, VTK, ...). Triangles and n-gons are
 subdivided once with Catmull-Clark first (n quads per n-gon, the same limit surface); --charts labels
@@ -279,12 +281,20 @@ def _write_control(args, r, surf, eval_level, comment, table, write_uv_obj):
     note = f"\ncontrol mesh: the input subdivided {times} times (Catmull-Clark)" if times else ""
     note += ("\ncontrol UVs: least-squares fit of the exact texture's limit UVs under the rule below, polished by "
              "hsh10's optimization under that rule")
+    if exp.arap_metrics is not None:
+        k = sum(w is not None for w in exp.chart_weights)
+        note += (f"; in {k} of {len(exp.chart_weights)} charts then minimizing the measured distortion (weights "
+                 "chosen per chart for the smallest largest excess ratio)")
     er = exp.excess_ratio()
     what = {"refine": r.refine, "extra_subdivisions": exp.extra, "fold_levels": list(FOLD_LEVELS),
             "folds": exp.folds, "metric_level": exp.level, "E_angle": exp.metrics.E_angle, "E_area": exp.metrics.E_area,
             "E_stretch": exp.metrics.E_stretch, "excess_ratio_to_exact": list(er), "accepted": exp.accepted,
             "tried": [{"extra": e, "folds": f, "E_angle": m.E_angle, "E_area": m.E_area, "E_stretch": m.E_stretch}
                       for e, f, m in exp.tried]}
+    if exp.arap_metrics is not None:
+        a = exp.arap_metrics
+        what["minimax"] = {"chart_weights": [None if w is None else list(w) for w in exp.chart_weights],
+                           "arap_polish_alone": {"E_angle": a.E_angle, "E_area": a.E_area, "E_stretch": a.E_stretch}}
     side = args.control_out + ".json"
     with atomic(args.control_out) as tmp:
         os.replace(write_uv_obj(tmp, exp.mesh, replace(r, textures=exp.textures), comment=comment + note,

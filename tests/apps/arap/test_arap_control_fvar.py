@@ -148,6 +148,10 @@ def test_control_out_says_when_the_face_budget_stops_it(tmp_path, capsys):
     assert "the next, 2 extra, needs 1280 faces > --control-max-faces 400" in err
     co = json.loads(pathlib.Path(str(out) + ".json").read_text())["table"]["control_out"]
     assert [t["extra"] for t in co["tried"]] == [0, 1] and co["accepted"] is False
+    # the last refinement allowed missed the target with the ARAP polish: the minimax ran there, and says so
+    mm = co["minimax"]
+    assert len(mm["chart_weights"]) == 1 and max(co["excess_ratio_to_exact"]) > 1.05
+    assert "minimizing the measured distortion" in out.read_text()
 
 
 @pytest.mark.slow
@@ -331,3 +335,89 @@ def test_metric_energy_is_the_measured_distortion_and_its_gradient_matches_diffe
         assert abs(fd - grad @ d) < 1e-5 * max(1.0, abs(fd))
     # a folded texture is outside the energy's domain
     assert f(Y[:, ::-1].ravel())[0] == np.inf
+
+
+# ----------------------------------------------------------------------------- the minimax over candidates
+def _global_ratios(parts, exact):
+    """The three excess ratios of a sum of per-chart metrics, from the raw sums (E_stretch: Sander's L2 stretch
+    times the square root of the texture-to-surface area ratio)."""
+    A = sum(p.area for p in parts)
+    ang = sum(p.angle_sum for p in parts) / A
+    are = sum(p.area_sum for p in parts) / A
+    st = np.sqrt(sum(p.stretch_sum for p in parts) / A) * np.sqrt(sum(p.texture_area for p in parts) / A)
+    e = exact
+    ex = (e.angle_sum / e.area - 2, e.area_sum / e.area - 2,
+          np.sqrt(e.stretch_sum / e.area) * np.sqrt(e.texture_area / e.area) - 1)
+    return np.array([(ang - 2) / ex[0], (are - 2) / ex[1], (st - 1) / ex[2]])
+
+
+def _metrics(area, e_angle, e_area, e_stretch):
+    from ccproof.apps.arap.metrics import Metrics
+
+    return Metrics(area=area, angle_sum=area * e_angle, area_sum=area * e_area, stretch_sum=area * e_stretch**2,
+                   texture_area=area)
+
+
+def test_minimax_choice_mixes_charts_to_the_brute_force_optimum():
+    """Two equal charts, each with a polish high in E_angle and a candidate high in E_area: no uniform choice
+    meets 1.05, one chart on each does (brute force over the 4 choices, computed here from the raw sums)."""
+    import itertools
+
+    from ccproof.apps.arap.fvar import _minimax_choice
+
+    exact = _metrics(2.0, 2.01, 2.01, 1.01)
+    cands = [[_metrics(1.0, 2.0110, 2.0098, 1.0104), _metrics(1.0, 2.0098, 2.0110, 1.0104)] for _ in range(2)]
+    ch = _minimax_choice(exact, cands)
+    got = _global_ratios([c[j] for c, j in zip(cands, ch)], exact).max()
+    brute = min(_global_ratios([c[j] for c, j in zip(cands, js)], exact).max()
+                for js in itertools.product(range(2), repeat=2))
+    uniform = min(_global_ratios([c[j] for c in cands], exact).max() for j in range(2))
+    assert sorted(ch) == [0, 1] and abs(got - brute) < 1e-12 and got <= 1.05 < uniform
+
+
+def test_minimax_choice_is_no_worse_than_any_uniform_choice_and_locally_optimal():
+    from ccproof.apps.arap.fvar import _minimax_choice
+
+    rng = np.random.default_rng(7)
+    exact = _metrics(10.0, 2.01, 2.01, 1.01)
+    for _ in range(5):
+        cands = [[_metrics(a, 2 + 0.01 * rng.uniform(0.8, 1.3), 2 + 0.01 * rng.uniform(0.8, 1.3),
+                           1 + 0.01 * rng.uniform(0.8, 1.3)) for _ in range(int(rng.integers(1, 4)))]
+                 for a in rng.uniform(0.5, 2, size=6)]
+        ch = _minimax_choice(exact, cands)
+        worst = _global_ratios([c[j] for c, j in zip(cands, ch)], exact).max()
+        for j in range(3):
+            uni = [c[j] if j < len(c) else c[0] for c in cands]
+            assert worst <= _global_ratios(uni, exact).max() + 1e-12
+        for i, c in enumerate(cands):
+            for j in range(len(c)):
+                alt = [cc[jj] for cc, jj in zip(cands, ch)]
+                alt[i] = c[j]
+                assert _global_ratios(alt, exact).max() >= worst - 1e-12
+
+
+def test_export_control_minimax_keeps_no_fold_and_does_not_raise_the_largest_ratio(tmp_path):
+    """metric=True on a chart whose ARAP polish misses the target: the largest excess ratio does not rise, the
+    written UVs have no folded triangle at levels 1-3 under the independent rule, and the ARAP-only metrics are
+    those of metric=False."""
+    from ccproof.apps.arap.core import MethodResult, compare
+    from ccproof.apps.arap.fvar import METRIC_WEIGHTS, export_control
+    from ccproof.apps.arap.io import write_uv_obj
+
+    m, chart = M.curved_ev_mesh()
+    labels = np.array([0 if f in set(chart) else -1 for f in range(m.n_faces)])
+    res, _ = compare(m, labels, methods=("c",), levels=2, eval_level=4)
+    plain = export_control(res["c"], eval_level=4, max_extra=0, metric=False)
+    auto = export_control(res["c"], eval_level=4, max_extra=0)  # the last refinement allowed misses: it runs
+    assert not plain.accepted and plain.arap_metrics is None and plain.chart_weights == [None]
+    assert auto.arap_metrics is not None and auto.arap_metrics.as_tuple() == plain.metrics.as_tuple()
+    assert auto.chart_weights[0] in METRIC_WEIGHTS
+    assert max(auto.excess_ratio()) < max(plain.excess_ratio())
+    assert auto.folds == [0, 0, 0]
+    path = tmp_path / "mm.obj"
+    write_uv_obj(path, auto.mesh, MethodResult("c", auto.textures, 0.0, 0))
+    _, UV, FT = read_fvar_obj(path)
+    U, F = UV, FT
+    for level in (1, 2, 3):
+        U, F = corners_only_step(U, F)
+        assert folded_triangles(U, F) == 0, level
