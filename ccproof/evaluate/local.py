@@ -27,7 +27,6 @@ from __future__ import annotations
 import functools
 import math
 
-import flint
 import numpy as np
 
 from ccproof.errors import MeshError
@@ -564,6 +563,7 @@ def _corner_scheme(key):
     relative precision at every layer, so the derivatives (which grow like (2 lam)^n, bmz04 eq. 3)
     are as accurate deep down as near the face centre. The limit mask is exact.
     """
+    import flint  # imported where exact matrices are built: not on a filled disk cache
     _, stencils, child = refine_key(key, 4)
     N = _key_complex(key).n_vertices
     ring1, faces1, nr = canonical_ring(child, 0, 0, 1)
@@ -613,6 +613,7 @@ def _corner_scheme(key):
 
 
 def _to_fmpq_mat(rows, ncols):
+    import flint  # imported where exact matrices are built: not on a filled disk cache
     M = flint.fmpq_mat(len(rows), ncols)
     for i, s in enumerate(rows):
         for j, w in s.items():
@@ -660,6 +661,7 @@ def power_layers(M, A, l_row):
     >>> D.shape, D[3, 0, 0].tolist()
     ((62, 3, 16, 2), [-0.125, 0.125])
     """
+    import flint  # imported where exact matrices are built: not on a filled disk cache
     N = A.nrows()
     Ai, a = A.numer_denom()
     Mi, m = M.numer_denom()
@@ -764,6 +766,7 @@ def _cached_scheme(kind, key, compute):
 
 def _cached_exact_matrix(apath, N, compute):
     """The exact ``A`` of a cached scheme from its ``.A.npz`` (recomputed if that file is gone)."""
+    import flint  # imported where exact matrices are built: not on a filled disk cache
     try:
         with np.load(apath, allow_pickle=False) as z:
             den = int(str(z["A_den"]))
@@ -839,6 +842,7 @@ class CornerScheme:
         ``None`` when the second eigenspace has several directions (the tangent plane would depend
         on the direction of approach).
         """
+        import flint  # imported where exact matrices are built: not on a filled disk cache
         A = self.A
         if self.support is not None:
             idx = self.support
