@@ -12,12 +12,13 @@ docs/tagged_c1.md ("Not covered yet"):
 * the exact reflection identity B(1/w) R_w = R_w B(w) (R_w: ray p -> v^(p), quadrant (a, b) ->
   v^(b, a) / w) on rational points, which makes f odd in theta, so H has a zero of order >= 4 at 0;
 * the bordered systems regular on the whole disc |theta| <= rho (acb boxes), so H is analytic there;
-* the winding number of H along |theta| = rho (each arc's image in a disc that misses 0).
+* the winding number of H along |theta| = rho (each arc's image in a disc that misses 0, by a centred
+  form: H at the arc's start plus a Cauchy bound of |H'| from a crude bound of |H| on a larger circle).
 
 If the winding number is 4, theta = 0 is H's only zero in the disc: J_xy != 0 for every N > pi/rho.
 Prints one line per item.
 
-  python scripts/tagged_c1_limit.py [--rho 0.2] [--arcs 128] [--box 0.05]
+  python scripts/tagged_c1_limit.py [--rho 0.2] [--arcs 512] [--outer 0.3] [--outer-arcs 2048] [--box 0.05]
 """
 
 from __future__ import annotations
@@ -113,28 +114,44 @@ def disc_regular(rho, box):
     return ok, total
 
 
-def winding(rho, arcs):
-    """The winding number of H along |theta| = rho, or None if an arc's image is not certainly off 0."""
-    turn = arb(0)
+def bound_on_circle(radius, arcs):
+    """An upper bound of |H| on |theta| = radius (balls covering the arcs; a crude bound is enough)."""
+    top = arb(0)
     for k in range(arcs):
-        a0, a1 = arb(2 * k) / arcs, arb(2 * k + 2) / arcs  # in units of pi
-        mid, half = (a0 + a1) / 2, (a1 - a0) / 2
-        ball = acb(arb(0), (mid + arb(0, half.mid())) * arb.pi()).exp() * rho  # covers the arc
-        img = H(ball)
-        centre = acb(img.real.mid(), img.imag.mid())
-        if not abs(img - centre) < abs(centre):  # the arc's image lies in a disc that misses 0
-            return None
-        h0 = H(acb(arb(0), a0 * arb.pi()).exp() * rho)
-        h1 = H(acb(arb(0), a1 * arb.pi()).exp() * rho)
-        turn += (h1 / h0).arg()  # the change of arg along the arc: within (-pi, pi)
-    return turn / (2 * arb.pi())
+        mid, half = arb(2 * k + 1) / arcs, arb(1) / arcs  # in units of pi
+        ball = acb(arb(0), (mid + arb(0, half.mid())) * arb.pi()).exp() * radius  # covers the arc
+        top = top.max(arb(abs(H(ball)).upper()))
+    return top
+
+
+def winding(rho, arcs, outer, outer_arcs):
+    """The winding number of H along |theta| = rho by a centred form, or None if an arc is not certain.
+
+    H is analytic on |theta| <= outer (the caller proves the bordered systems regular there), so by the
+    Cauchy formula |H'| <= M outer / (outer - rho)^2 on |theta| = rho, M >= |H| on |theta| = outer. Each arc
+    from z_k to z_(k+1) (length 2 pi rho / arcs) has its image within |H'| * length of H(z_k); if that is
+    less than |H(z_k)|, the image lies in a disc that misses 0 and the turn along the arc is the principal
+    argument of H(z_(k+1)) / H(z_k).
+    """
+    M = bound_on_circle(outer, outer_arcs)
+    slope = M * outer / (outer - arb(rho)) ** 2
+    length = 2 * arb.pi() * rho / arcs
+    pts = [H(acb(arb(0), arb(2 * k) / arcs * arb.pi()).exp() * rho) for k in range(arcs + 1)]
+    turn = arb(0)
+    for h0, h1 in zip(pts, pts[1:]):
+        if not slope * length < abs(h0):
+            return None, M
+        turn += (h1 / h0).arg()
+    return turn / (2 * arb.pi()), M
 
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--rho", type=float, default=0.2)
-    ap.add_argument("--arcs", type=int, default=128)
+    ap.add_argument("--arcs", type=int, default=512)
     ap.add_argument("--box", type=float, default=0.05)
+    ap.add_argument("--outer", type=float, default=0.3, help="radius of the circle bounding |H| (Cauchy)")
+    ap.add_argument("--outer-arcs", type=int, default=2048)
     ap.add_argument("--prec", type=int, default=128)
     args = ap.parse_args(argv)
     ctx.prec = args.prec
@@ -142,12 +159,12 @@ def main(argv=None):
     for n in (101, 1000, 10**6):
         th = arb.pi() / n
         print(f"N = {n}: H(pi/N) / theta^4 = {(H(acb(th)) / th ** 4).str(10)}")
-    ok, total = disc_regular(args.rho, args.box)
-    print(f"|theta| <= {args.rho}: bordered systems of modes 1 and 2 proved regular on {ok} of {total} boxes "
+    ok, total = disc_regular(args.outer, args.box)
+    print(f"|theta| <= {args.outer}: bordered systems of modes 1 and 2 proved regular on {ok} of {total} boxes "
           f"(side {args.box})")
-    wn = winding(args.rho, args.arcs)
-    print(f"winding number of H along |theta| = {args.rho} ({args.arcs} arcs): "
-          f"{'not certified' if wn is None else wn.str(6)}")
+    wn, M = winding(args.rho, args.arcs, args.outer, args.outer_arcs)
+    print(f"|H| <= {M.str(4)} on |theta| = {args.outer}; winding number of H along |theta| = {args.rho} "
+          f"({args.arcs} arcs): {'not certified' if wn is None else wn.str(6)}")
 
 
 if __name__ == "__main__":
