@@ -464,10 +464,12 @@ class TaggedHalfEdges:
 
         Returns
         -------
-        ndarray of float64, shape (k, 4 maxf + n_rule)
+        ndarray of float64, shape (k, 4 f + n_rule)
+            ``f``: the most faces of a ring in the block (at most ``maxf``).
         """
-        k, maxf = faces.shape[0], faces.shape[1]
         ok = nring >= 0
+        faces = faces[:, :max(int(np.where(ok, nfaces, 0).max(initial=0)), 1)]  # the slots some ring uses
+        k, maxf = faces.shape[0], faces.shape[1]
         a = faces
         b = np.roll(faces, -1, axis=2)
         live = (np.arange(maxf)[None, :] < np.where(ok, nfaces, 0)[:, None])[:, :, None]
@@ -487,19 +489,16 @@ class TaggedHalfEdges:
 
 
 def _row_hash(a):
-    """An int64 hash of every row of a 2-d array: its 8-byte words, each mixed by splitmix64's
-    finalizer (float tags differ in their high bits), combined position by position."""
+    """An int64 hash of every row of a 2-d array: each 8-byte word salted with its column and mixed by
+    splitmix64's finalizer (float tags differ in their high bits), the words' mixes summed per row."""
     w = np.ascontiguousarray(a).view(np.uint64).reshape(a.shape[0], -1)
-    h = np.full(a.shape[0], 14695981039346656037, dtype=np.uint64)
     c1, c2, c3 = np.uint64(0xBF58476D1CE4E5B9), np.uint64(0x94D049BB133111EB), np.uint64(0x9E3779B97F4A7C15)
-    s30, s27, s31 = np.uint64(30), np.uint64(27), np.uint64(31)
     with np.errstate(over="ignore"):
-        for j in range(w.shape[1]):
-            z = (h ^ w[:, j]) + c3
-            z = (z ^ (z >> s30)) * c1
-            z = (z ^ (z >> s27)) * c2
-            h = z ^ (z >> s31)
-    return h.view(np.int64)
+        z = w + (np.arange(1, w.shape[1] + 1, dtype=np.uint64) * c3)[None, :]
+        z = (z ^ (z >> np.uint64(30))) * c1
+        z = (z ^ (z >> np.uint64(27))) * c2
+        z ^= z >> np.uint64(31)
+        return z.sum(axis=1, dtype=np.uint64).view(np.int64)
 
 
 class _Builder:
