@@ -433,7 +433,7 @@ class TaggedHalfEdges:
         he.options = cx.options
         keys, vals = [], []
         for (a, b), s in cx.edge_sharpness.items():
-            if s > 0.0 and (a, b) in cx.edge_index and cx.twin[cx.edges[cx.edge_index[(a, b)]]] >= 0:
+            if a < b and s > 0.0 and (a, b) in cx.edge_index and cx.twin[cx.edges[cx.edge_index[(a, b)]]] >= 0:
                 keys.append(min(a, b) * nv + max(a, b))
                 vals.append(math.inf if s >= 10.0 else float(s))
         order = np.argsort(np.asarray(keys, dtype=np.int64), kind="stable")

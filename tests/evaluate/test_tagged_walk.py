@@ -145,3 +145,16 @@ def test_polymesh_with_vertex_tags(monkeypatch):
     (bc, *_), (bp, *_), walked = _both(mesh, monkeypatch)
     assert "TaggedHalfEdges" in walked
     assert _classification(bc) == _classification(bp)
+
+
+@pytest.mark.parametrize("name", ["catmark_pyramid_creases1", "catmark_xord_boundary", "catmark_hole_test2"])
+def test_compiled_walk_on_refined_tagged_meshes(name, monkeypatch):
+    """Refined three times (the tags carried by the tagged step): hundreds of rings sharing keys, grouped."""
+    _needs_walk()
+    mesh = read_obj_tagged(MESHES / f"{name}.obj")
+    for _ in range(3):
+        mesh = mesh.refine(operator=False)[0]
+    (bc, *_), (bp, *_), walked = _both(mesh, monkeypatch)
+    assert bc.n_jobs > 200
+    assert "TaggedHalfEdges" in walked and "python" not in walked
+    assert _classification(bc) == _classification(bp)
