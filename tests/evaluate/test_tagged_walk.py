@@ -18,12 +18,13 @@ from ccproof.evaluate._ckernel import load
 from ccproof.evaluate._table import TaggedHalfEdges, _Builder
 from ccproof.evaluate.tagged import build_tagged
 from ccproof.mesh.examples import k_regular_disk
-from ccproof.mesh.io import read_obj_tagged
+from ccproof.mesh.io import read_mesh, read_obj_tagged
 from ccproof.mesh.polymesh import PolyMesh
 from ccproof.mesh.rules import Complex, Options
 
 MESHES = Path(__file__).resolve().parents[1] / "data" / "osd_features" / "meshes"
 NAMES = sorted(p.stem for p in MESHES.glob("*.obj"))
+NONMANIFOLD = Path(__file__).resolve().parents[1] / "data" / "osd_nonmanifold" / "meshes"
 
 
 def _classification(b):
@@ -75,6 +76,19 @@ def test_compiled_walk_gives_the_python_keys_and_rings(name, monkeypatch):
     if mesh.has_tags or mesh.manifold is not mesh:
         assert "TaggedHalfEdges" in walked or all(k[0] == "smooth" for k in bc.templates)
     if mesh.options.crease_method != "chaikin":  # no ring left to the Python walk (no hash collision)
+        assert "python" not in walked
+
+
+@pytest.mark.parametrize("name", sorted(p.name for p in NONMANIFOLD.iterdir() if p.suffix in (".obj", ".off")))
+def test_compiled_walk_on_nonmanifold_meshes(name, monkeypatch):
+    """Non-manifold edges and vertices, unused vertices, duplicated and flipped faces: walked on the
+    split (the same faces and ptex faces), the same classification both ways."""
+    _needs_walk()
+    mesh = read_mesh(NONMANIFOLD / name)
+    (bc, topc, *_), (bp, topp, *_), walked = _both(mesh, monkeypatch)
+    assert np.array_equal(topc, topp)
+    assert _classification(bc) == _classification(bp)
+    if mesh.options.crease_method != "chaikin":
         assert "python" not in walked
 
 
