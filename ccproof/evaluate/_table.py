@@ -29,6 +29,7 @@ point in layer n of a corner face gets its net as ``L[n, code] @ ring`` at evalu
 from __future__ import annotations
 
 import functools
+import math
 import sys
 from array import array
 from typing import NamedTuple
@@ -396,6 +397,110 @@ class QuadHalfEdges:
         self.options = options
 
 
+class TaggedHalfEdges:
+    """The half-edge arrays of a tagged all-quad :class:`ccproof.mesh.rules.Complex` (half-edge
+    ``4 f + i`` is corner i of face f) with its tags as arrays: what the compiled ring walk reads,
+    and what :meth:`ring_tags` hashes into the ring's signature.
+
+    Built by :meth:`of` (None where the complex is not all quads in that layout).
+
+    Attributes
+    ----------
+    cx : ccproof.mesh.rules.Complex
+        The complex (its keys: :func:`ccproof.evaluate.local.ring_key`; the Python walk's fallback).
+    org, nxt, prv, twin : ndarray of int64, shape (4 m,)
+    edge_keys : ndarray of int64, shape (e,)
+        ``a * n_vertices + b`` (``a < b``) of the interior edges with sharpness, sorted.
+    edge_values : ndarray of float64, shape (e,)
+        Their sharpness (``inf`` from 10 on, as in the keys).
+    vertex_values : ndarray of float64, shape (n_vertices,)
+        Vertex sharpness (0 where none; ``inf`` from 10 on).
+    """
+
+    @classmethod
+    def of(cls, cx):
+        m = len(cx.faces)
+        if m == 0 or len(cx.org) != 4 * m:
+            return None
+        start = np.asarray(cx.start, dtype=np.int64)
+        if not np.array_equal(start[:m], 4 * np.arange(m, dtype=np.int64)):
+            return None
+        he = cls()
+        he.cx = cx
+        he.org, he.nxt, he.prv, he.twin = (np.asarray(a, dtype=np.int64) for a in (cx.org, cx.nxt, cx.prv, cx.twin))
+        he.faces = he.org.reshape(-1, 4)
+        he.n_vertices = nv = int(cx.n_vertices)
+        he.options = cx.options
+        keys, vals = [], []
+        for (a, b), s in cx.edge_sharpness.items():
+            if a < b and s > 0.0 and (a, b) in cx.edge_index and cx.twin[cx.edges[cx.edge_index[(a, b)]]] >= 0:
+                keys.append(min(a, b) * nv + max(a, b))
+                vals.append(math.inf if s >= 10.0 else float(s))
+        order = np.argsort(np.asarray(keys, dtype=np.int64), kind="stable")
+        he.edge_keys = np.asarray(keys, dtype=np.int64)[order]
+        he.edge_values = np.asarray(vals, dtype=np.float64)[order]
+        vv = np.zeros(nv, dtype=np.float64)
+        for v, s in cx.vertex_sharpness.items():
+            if s > 0.0 and 0 <= v < nv:
+                vv[v] = math.inf if s >= 10.0 else float(s)
+        he.vertex_values = vv
+        return he
+
+    def ring_tags(self, rings, nring, faces, nfaces, n_rule=4):
+        """The tags of walked rings as rows of floats: per face slot ``(i, t)`` the sharpness of
+        edge ``t`` of ring face ``i`` when it touches one of the first ``n_rule`` ring vertices
+        (0 otherwise, and for boundary edges), then the vertex sharpness of those vertices. Rings
+        with equal faces have equal keys (:func:`ccproof.evaluate.local.ring_key`) exactly when
+        these rows are equal.
+
+        Parameters
+        ----------
+        rings : ndarray of int32, shape (k, maxn)
+        nring : ndarray of int64, shape (k,)
+            Negative for a ring the walk gave up on (its row is zeros).
+        faces : ndarray of int64, shape (k, maxf, 4)
+            Local labels.
+        nfaces : ndarray of int64, shape (k,)
+
+        Returns
+        -------
+        ndarray of float64, shape (k, 4 f + n_rule)
+            ``f``: the most faces of a ring in the block (at most ``maxf``).
+        """
+        ok = nring >= 0
+        faces = faces[:, :max(int(np.where(ok, nfaces, 0).max(initial=0)), 1)]  # the slots some ring uses
+        k, maxf = faces.shape[0], faces.shape[1]
+        a = faces
+        b = np.roll(faces, -1, axis=2)
+        live = (np.arange(maxf)[None, :] < np.where(ok, nfaces, 0)[:, None])[:, :, None]
+        rule = live & ((a < n_rule) | (b < n_rule))
+        rows = np.arange(k)[:, None, None]
+        ga = rings[rows, np.clip(a, 0, rings.shape[1] - 1)].astype(np.int64)
+        gb = rings[rows, np.clip(b, 0, rings.shape[1] - 1)].astype(np.int64)
+        out = np.zeros((k, 4 * maxf + n_rule), dtype=np.float64)
+        if self.edge_keys.size:
+            ek = np.minimum(ga, gb) * self.n_vertices + np.maximum(ga, gb)
+            i = np.minimum(np.searchsorted(self.edge_keys, ek), self.edge_keys.size - 1)
+            hit = rule & (self.edge_keys[i] == ek)
+            out[:, :4 * maxf] = np.where(hit, self.edge_values[i], 0.0).reshape(k, -1)
+        v = rings[:, :n_rule].astype(np.int64)
+        out[:, 4 * maxf:] = np.where(ok[:, None] & (v >= 0), self.vertex_values[np.maximum(v, 0)], 0.0)
+        return out
+
+
+def _row_hash(a):
+    """An int64 hash of every row of a 2-d array: each 8-byte word salted with its column and mixed by
+    splitmix64's finalizer (float tags differ in their high bits), the words' mixes summed per row."""
+    w = np.ascontiguousarray(a).view(np.uint64).reshape(a.shape[0], -1)
+    c1, c2, c3 = np.uint64(0xBF58476D1CE4E5B9), np.uint64(0x94D049BB133111EB), np.uint64(0x9E3779B97F4A7C15)
+    with np.errstate(over="ignore"):
+        z = w + (np.arange(1, w.shape[1] + 1, dtype=np.uint64) * c3)[None, :]
+        z = (z ^ (z >> np.uint64(30))) * c1
+        z = (z ^ (z >> np.uint64(27))) * c2
+        z ^= z >> np.uint64(31)
+        return z.sum(axis=1, dtype=np.uint64).view(np.int64)
+
+
 class _Builder:
     """Classifies the jobs of a mesh into templates; :meth:`table` assembles the patch table."""
 
@@ -459,6 +564,10 @@ class _Builder:
             from ccproof.mesh.rules import Complex
 
             cx = Complex(cx.faces, {}, {}, cx.options, n_vertices=cx.n_vertices)
+        elif todo.size and _ring_walks(todo.size) is not None:
+            he = TaggedHalfEdges.of(cx)
+            if he is not None:
+                return self._walk_all(he, jobs, j0, todo, single[todo])
         bar = _progress(self.progress, todo.size, "patch table")
         for n, i in enumerate(todo.tolist()):
             g_, frame, base = jobs[i]
@@ -471,11 +580,14 @@ class _Builder:
 
     def _walk_all(self, he, jobs, j0, todo, single):
         """Register the jobs ``todo`` (``single``: the one irregular corner of each, or -1) of an
-        untagged all-quad complex: their rings walked by the compiled kernel
-        (:func:`ccproof.evaluate._numba_kernel.ring_walks`, the walk of
-        :func:`ccproof.evaluate.local.canonical_ring`), grouped by the hash of their faces, each
-        group checked face by face against its first ring and registered with the key of that ring
-        (untagged: the key is the faces and the options)."""
+        all-quad complex (:class:`QuadHalfEdges` or :class:`TaggedHalfEdges`): their rings walked
+        by the compiled kernel (:func:`ccproof.evaluate._numba_kernel.ring_walks`, the walk of
+        :func:`ccproof.evaluate.local.canonical_ring`), grouped by the hash of their faces and of
+        their tags (:meth:`TaggedHalfEdges.ring_tags`), each group checked face by face and tag by
+        tag against its first ring and registered with the key of that ring
+        (:func:`ccproof.evaluate.local.ring_key`; untagged: the faces and the options). Rings the
+        walk cannot classify (beyond its arrays; a semi-sharp ring that needs the Chaikin two-ring)
+        take the Python walk."""
         walks = _ring_walks(todo.size)
         opts = he.options.key()
         pos = np.full(he.n_vertices, -1, dtype=np.int64)
@@ -497,7 +609,8 @@ class _Builder:
         if fallback.size:
             from ccproof.mesh.rules import Complex
 
-            cx = Complex(he.faces, {}, {}, he.options, n_vertices=he.n_vertices)
+            cx = he.cx if isinstance(he, TaggedHalfEdges) else Complex(he.faces, {}, {}, he.options,
+                                                                       n_vertices=he.n_vertices)
             where = {int(i): n for n, i in enumerate(todo.tolist())}
             for i in fallback.tolist():
                 g_, frame, base = jobs[i]
@@ -514,7 +627,12 @@ class _Builder:
         hashes = np.empty(k, dtype=np.uint64)
         walks(he.org, he.nxt, he.prv, he.twin, pos, seen, jobs.g[idx], r, rings, nring, faces, nfaces, hashes)
         fallback = [idx[nring < 0]]  # a ring beyond the arrays (a valence above ~25): the Python walk
-        sig = np.stack([hashes.view(np.int64), r + 4 * at_corner + 8 * jobs.fid[idx]], axis=1)
+        tagged = isinstance(he, TaggedHalfEdges)
+        cols = [hashes.view(np.int64), r + 4 * at_corner + 8 * jobs.fid[idx]]
+        if tagged:
+            tv = he.ring_tags(rings, nring, faces, nfaces)
+            cols.append(_row_hash(tv))
+        sig = np.stack(cols, axis=1)
         sig[nring < 0] = -1
         _, first, inv = np.unique(sig, axis=0, return_index=True, return_inverse=True)
         inv = inv.reshape(-1)
@@ -528,10 +646,19 @@ class _Builder:
                 continue
             nf, n = int(nfaces[rep]), int(nring[rep])
             same = (nfaces[mem] == nf) & (nring[mem] == n) & (faces[mem, :nf] == faces[rep, :nf]).all(axis=(1, 2))
+            if tagged:
+                same &= (tv[mem] == tv[rep]).all(axis=1)
             if not same.all():  # a hash collision: those jobs by the Python walk
                 fallback.append(idx[mem[~same]])
                 mem = mem[same]
-            key = (tuple(map(tuple, faces[rep, :nf].tolist())), (), (), opts)
+            ftup = tuple(map(tuple, faces[rep, :nf].tolist()))
+            if tagged:
+                key = ring_key(he.cx, rings[rep, :n].tolist(), ftup, 4)
+                if self.depth_semi != 1 and _has_semi_sharp(key) and not at_corner[rep]:
+                    fallback.append(idx[mem])  # the Chaikin phase reads the two-ring: the Python walk
+                    continue
+            else:
+                key = (ftup, (), (), opts)
             frame = jobs.frames[jobs.fid[idx[rep]]]
             base = int(jobs.base[idx[rep]])
             rr = int(r[rep])
