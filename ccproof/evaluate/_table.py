@@ -41,7 +41,9 @@ from ccproof.evaluate.local import (
     _CENTER,
     _SIDES,
     CORNERS,
+    _cache_dir,
     _child_ring,
+    _code_version,
     _has_semi_sharp,
     _key_complex,
     _regular_net_matrix,
@@ -263,6 +265,7 @@ class _Template:
         self.reg = []  # (17, N) per regular patch
         self.cor = []  # (Nc, N) per corner face: ring relative to its vertex (rows 1..), then the limit point
         self.cor_vertex = []  # ring position of each corner face's vertex (-1: a new point)
+        self.schemes = []  # per configuration used (``cfg``: index here): (corner key, orientation)
         self.n_pts = 0
         self.jobs = array("q")
         self.rings = array("i")
@@ -287,6 +290,114 @@ class _Template:
             if not np.isfinite(a).all():  # pragma: no cover - would be a bug in the local refinement
                 raise MeshError("internal error: a patch uses a point outside the exact local refinement")
         self.reg = self.cor = None
+
+
+def _finished(t):
+    t.finish()
+    return t
+
+
+@functools.lru_cache(maxsize=1)
+def _template_version():
+    """Hash of the sources that define a template (:func:`_code_version` and this module)."""
+    import hashlib
+    from pathlib import Path
+
+    return hashlib.sha256((_code_version() + "|").encode() + Path(__file__).read_bytes()).hexdigest()[:16]
+
+
+def _template_arrays(t):
+    """The float data of a finished template as named arrays (the ``.tpl.npz`` payload, digest aside)."""
+    import json
+
+    V = len(t.kind)
+    return {
+        "meta": np.array([t.n, t.n_pts], dtype=np.int64),
+        "kind": np.array(t.kind, dtype=np.int64), "dom": np.array(t.dom, dtype=np.float64).reshape(V, 3),
+        "child": np.array(t.child, dtype=np.int64).reshape(V, 4), "leaf": np.array(t.leaf, dtype=np.int64),
+        "pts": np.array(t.pts, dtype=np.int64), "cfg": np.array(t.cfg, dtype=np.int64),
+        "corner": np.array(t.corner, dtype=np.int64).reshape(V, 2),
+        "cor_vertex": np.array(t.cor_vertex, dtype=np.int64), "R": t.R, "Q": t.Q, "O": t.O,
+        "schemes": np.frombuffer(json.dumps(t.schemes).encode(), dtype=np.uint8),
+    }
+
+
+def _digest(arrays):
+    import hashlib
+
+    h = hashlib.sha256()
+    for name in sorted(arrays):
+        a = np.ascontiguousarray(arrays[name])
+        h.update(f"{name}|{a.dtype.str}|{a.shape}|".encode())
+        h.update(a.tobytes())
+    return h.hexdigest()
+
+
+def _tuples(x):
+    return tuple(_tuples(y) for y in x) if isinstance(x, list) else x
+
+
+def _read_template(path):
+    """The template stored at ``path``; ValueError if the file does not hold exactly what was written."""
+    import json
+
+    with np.load(path, allow_pickle=False) as z:
+        a = {k: z[k] for k in z.files}
+    if str(a.pop("digest", "")) != _digest(a):
+        raise ValueError(f"{path}: digest mismatch")
+    N, n_pts = (int(x) for x in a["meta"])
+    t = _Template(N)
+    t.kind, t.leaf, t.pts, t.cfg = (a[k].tolist() for k in ("kind", "leaf", "pts", "cfg"))
+    t.dom = [tuple(d) for d in a["dom"].tolist()]
+    t.child = a["child"].tolist()
+    t.corner = [tuple(c) for c in a["corner"].tolist()]
+    t.cor_vertex = a["cor_vertex"].tolist()
+    t.n_pts = n_pts
+    t.R, t.Q, t.O = a["R"], a["Q"], a["O"]
+    t.schemes = [(_tuples(k), _tuples(o)) for k, o in json.loads(a["schemes"].tobytes().decode())]
+    t.reg = t.cor = None
+    V = len(t.kind)
+    if not (len(t.leaf) == len(t.pts) == len(t.cfg) == len(t.dom) == len(t.child) == len(t.corner) == V
+            and t.R.shape[1:] == t.Q.shape[1:] == t.O.shape[1:] == (N,)):
+        raise ValueError(f"{path}: inconsistent shapes")
+    return t
+
+
+def _cached_template(tkey, depth_semi, make):
+    """``make()`` finished (a :class:`_Template`), kept between runs in the disk cache of
+    :func:`ccproof.evaluate.local.corner_scheme` (same folder, ``CCPROOF_CACHE``).
+
+    One file per template, ``SHA-256(key, depth_semi, sources).tpl.npz``: its integer and float
+    arrays (the virtual faces, the leaf operators ``R``, ``Q``, ``O``, the corner keys of its
+    configurations) and the SHA-256 of all of them, checked on read; a missing, unreadable or
+    corrupt file is rebuilt (exact local refinement) and rewritten atomically. A cached template
+    is the built one bit for bit; with every file present a setup does no exact arithmetic.
+    """
+    import hashlib
+    import os
+    import zipfile
+
+    d = _cache_dir()
+    if d is None:
+        return _finished(make())
+    name = hashlib.sha256(f"template|{_template_version()}|{depth_semi}|{tkey!r}".encode()).hexdigest()
+    path = d / f"{name}.tpl.npz"
+    if path.exists():
+        try:
+            return _read_template(path)
+        except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile):
+            pass
+    t = _finished(make())
+    a = _template_arrays(t)
+    a["digest"] = np.array(_digest(a))
+    try:
+        d.mkdir(parents=True, exist_ok=True)
+        tmp = d / f".{name}.{os.getpid()}.tpl.npz"
+        np.savez(tmp, **a)
+        os.replace(tmp, path)
+    except OSError:
+        pass
+    return t
 
 
 #: jobs from which the numba ring walk pays for loading numba and its cached kernel (~1 to 1.5 s in a
@@ -514,12 +625,24 @@ class _Builder:
         self.n_jobs = 0
         self.job_base = array("q")
 
+    def _config(self, key_r, orient):
+        """The table's configuration index of the corner scheme of ``key_r`` in orientation ``orient``."""
+        scheme = corner_scheme(key_r)
+        ck = (id(scheme), orient)
+        cfg = self.configs.get(ck)
+        if cfg is None:
+            cfg = self.configs[ck] = len(self.schemes)
+            self.schemes.append((scheme, orient))
+        return cfg
+
     # ------------------------------------------------------------------ jobs
     def _register(self, tkey, make, jobs, rings):
         t = self.templates.get(tkey)
         if t is None:
-            t = self.templates[tkey] = make()
-            t.finish()
+            t = self.templates[tkey] = _cached_template(tkey, self.depth_semi, make) \
+                if tkey[0] != "smooth" else _finished(make())
+            glob = [self._config(skey, orient) for skey, orient in t.schemes]
+            t.cfg = [glob[c] if c >= 0 else -1 for c in t.cfg]  # the template's configurations: the table's
         if isinstance(jobs, np.ndarray):  # whole blocks of jobs: as bytes (extend would iterate in Python)
             t.jobs.frombytes(np.ascontiguousarray(jobs, dtype=np.int64).tobytes())
         else:
@@ -748,7 +871,7 @@ class _Builder:
         N = _key_complex(key_r).n_vertices
         t = _Template(N)
         root = t.new_vface(_REGULAR, frame)
-        self.scheme_face(t, corner_scheme(key_r), np.eye(N), list(range(N)), r, frame, base, root, np.arange(N))
+        self.scheme_face(t, key_r, np.eye(N), list(range(N)), r, frame, base, root, np.arange(N))
         return t
 
     def _face_template(self, key, frame, base):
@@ -804,9 +927,8 @@ class _Builder:
         if len(irr) == 1:
             r = irr[0]
             ring_r, key_r, _ = ring_of(r, 1)
-            scheme = corner_scheme(key_r)
-            if scheme is not None:
-                return self.scheme_face(t, scheme, X, ring_r, r, frame, base, vid, vmap)
+            if corner_scheme(key_r) is not None:
+                return self.scheme_face(t, key_r, X, ring_r, r, frame, base, vid, vmap)
         if depth >= MAX_DEPTH:
             raise MeshError(
                 f"{self.what} {base}: the configuration around it is not supported "
@@ -814,17 +936,18 @@ class _Builder:
             )
         return self.split_face(t, key, nr, X[ring], frame, depth + 1, semi_depth, base, vid, vmap[ring])
 
-    def scheme_face(self, t, scheme, X, ring_r, r, frame, base, vid, vmap):
-        """Virtual face ``vid`` of ``t`` is a corner face of ``scheme`` at its corner ``r``, ring
-        ``X[ring_r]`` (listed from that corner)."""
+    def scheme_face(self, t, key_r, X, ring_r, r, frame, base, vid, vmap):
+        """Virtual face ``vid`` of ``t`` is a corner face of the scheme of ``key_r``
+        (:func:`ccproof.evaluate.local.corner_scheme`) at its corner ``r``, ring ``X[ring_r]``
+        (listed from that corner)."""
+        scheme = corner_scheme(key_r)
         C = X[ring_r]
         rot = _compose(frame, _corner_frame(r))
         orient = (_sign(rot[1]), _sign(rot[2]))
-        ck = (id(scheme), orient)
-        cfg = self.configs.get(ck)
-        if cfg is None:
-            cfg = self.configs[ck] = len(self.schemes)
-            self.schemes.append((scheme, orient))
+        src = (key_r, orient)
+        cfg = t.schemes.index(src) if src in t.schemes else len(t.schemes)
+        if cfg == len(t.schemes):
+            t.schemes.append(src)
         t.kind[vid] = _CORNER
         U0, V0, H = t.dom[vid]
         corner = rot[0]
