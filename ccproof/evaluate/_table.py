@@ -306,31 +306,28 @@ def _template_version():
     return hashlib.sha256((_code_version() + "|").encode() + Path(__file__).read_bytes()).hexdigest()[:16]
 
 
-def _template_arrays(t):
-    """The float data of a finished template as named arrays (the ``.tpl.npz`` payload, digest aside)."""
+_TPL_MAGIC = 20261202.0  # first value of a template file (the format below)
+
+
+def _template_bytes(t):
+    """A finished template as bytes: one little-endian float64 vector ``[magic, N, n_pts, V, n_reg,
+    n_cor, len(json)]``, then per virtual face ``kind``, ``dom`` (3), ``child`` (4), ``leaf``,
+    ``pts``, ``cfg``, ``corner`` (2), then ``cor_vertex`` (n_cor), ``R`` (17 n_reg, N), ``Q``
+    (n_pts, N), ``O`` (n_cor, N) (integers are exact in float64), then the JSON of the corner keys
+    and orientations of its configurations, then the SHA-256 of all that (32 bytes)."""
+    import hashlib
     import json
 
-    V = len(t.kind)
-    return {
-        "meta": np.array([t.n, t.n_pts], dtype=np.int64),
-        "kind": np.array(t.kind, dtype=np.int64), "dom": np.array(t.dom, dtype=np.float64).reshape(V, 3),
-        "child": np.array(t.child, dtype=np.int64).reshape(V, 4), "leaf": np.array(t.leaf, dtype=np.int64),
-        "pts": np.array(t.pts, dtype=np.int64), "cfg": np.array(t.cfg, dtype=np.int64),
-        "corner": np.array(t.corner, dtype=np.int64).reshape(V, 2),
-        "cor_vertex": np.array(t.cor_vertex, dtype=np.int64), "R": t.R, "Q": t.Q, "O": t.O,
-        "schemes": np.frombuffer(json.dumps(t.schemes).encode(), dtype=np.uint8),
-    }
-
-
-def _digest(arrays):
-    import hashlib
-
-    h = hashlib.sha256()
-    for name in sorted(arrays):
-        a = np.ascontiguousarray(arrays[name])
-        h.update(f"{name}|{a.dtype.str}|{a.shape}|".encode())
-        h.update(a.tobytes())
-    return h.hexdigest()
+    V, N = len(t.kind), t.n
+    js = json.dumps(t.schemes).encode()
+    ints = np.array([t.kind, t.leaf, t.pts, t.cfg], dtype=np.float64).reshape(4, V)
+    body = np.concatenate([
+        [_TPL_MAGIC, N, t.n_pts, V, t.R.shape[0] // 17, t.O.shape[0], len(js)],
+        np.array(t.dom, dtype=np.float64).reshape(-1), np.array(t.child, dtype=np.float64).reshape(-1),
+        ints.reshape(-1), np.array(t.corner, dtype=np.float64).reshape(-1),
+        np.array(t.cor_vertex, dtype=np.float64), t.R.reshape(-1), t.Q.reshape(-1), t.O.reshape(-1),
+    ]).astype("<f8").tobytes() + js
+    return body + hashlib.sha256(body).digest()
 
 
 def _tuples(x):
@@ -338,28 +335,42 @@ def _tuples(x):
 
 
 def _read_template(path):
-    """The template stored at ``path``; ValueError if the file does not hold exactly what was written."""
+    """The template stored at ``path`` (:func:`_template_bytes`); ValueError unless the file holds
+    exactly what was written (digest, magic, sizes)."""
+    import hashlib
     import json
 
-    with np.load(path, allow_pickle=False) as z:
-        a = {k: z[k] for k in z.files}
-    if str(a.pop("digest", "")) != _digest(a):
+    b = path.read_bytes()
+    body, digest = b[:-32], b[-32:]
+    if len(b) < 32 + 56 or hashlib.sha256(body).digest() != digest:
         raise ValueError(f"{path}: digest mismatch")
-    N, n_pts = (int(x) for x in a["meta"])
+    head = np.frombuffer(body, dtype="<f8", count=7)
+    if head[0] != _TPL_MAGIC:
+        raise ValueError(f"{path}: not a template file")
+    N, n_pts, V, n_reg, n_cor, n_js = (int(x) for x in head[1:])
+    n = 7 + 13 * V + n_cor + (17 * n_reg + n_pts + n_cor) * N
+    if len(body) != 8 * n + n_js:
+        raise ValueError(f"{path}: sizes do not match its header")
+    z = np.frombuffer(body, dtype="<f8", count=n)
+    o = 7
+
+    def take(k):
+        nonlocal o
+        o += k
+        return z[o - k:o]
+
     t = _Template(N)
-    t.kind, t.leaf, t.pts, t.cfg = (a[k].tolist() for k in ("kind", "leaf", "pts", "cfg"))
-    t.dom = [tuple(d) for d in a["dom"].tolist()]
-    t.child = a["child"].tolist()
-    t.corner = [tuple(c) for c in a["corner"].tolist()]
-    t.cor_vertex = a["cor_vertex"].tolist()
+    t.dom = [tuple(d) for d in take(3 * V).reshape(V, 3).tolist()]
+    t.child = take(4 * V).astype(np.int64).reshape(V, 4).tolist()
+    t.kind, t.leaf, t.pts, t.cfg = take(4 * V).astype(np.int64).reshape(4, V).tolist()
+    t.corner = [tuple(c) for c in take(2 * V).astype(np.int64).reshape(V, 2).tolist()]
+    t.cor_vertex = take(n_cor).astype(np.int64).tolist()
+    t.R = take(17 * n_reg * N).reshape(-1, N)
+    t.Q = take(n_pts * N).reshape(-1, N)
+    t.O = take(n_cor * N).reshape(-1, N)
     t.n_pts = n_pts
-    t.R, t.Q, t.O = a["R"], a["Q"], a["O"]
-    t.schemes = [(_tuples(k), _tuples(o)) for k, o in json.loads(a["schemes"].tobytes().decode())]
+    t.schemes = [(_tuples(k), _tuples(o_)) for k, o_ in json.loads(body[8 * n:].decode())]
     t.reg = t.cor = None
-    V = len(t.kind)
-    if not (len(t.leaf) == len(t.pts) == len(t.cfg) == len(t.dom) == len(t.child) == len(t.corner) == V
-            and t.R.shape[1:] == t.Q.shape[1:] == t.O.shape[1:] == (N,)):
-        raise ValueError(f"{path}: inconsistent shapes")
     return t
 
 
@@ -367,33 +378,29 @@ def _cached_template(tkey, depth_semi, make):
     """``make()`` finished (a :class:`_Template`), kept between runs in the disk cache of
     :func:`ccproof.evaluate.local.corner_scheme` (same folder, ``CCPROOF_CACHE``).
 
-    One file per template, ``SHA-256(key, depth_semi, sources).tpl.npz``: its integer and float
-    arrays (the virtual faces, the leaf operators ``R``, ``Q``, ``O``, the corner keys of its
-    configurations) and the SHA-256 of all of them, checked on read; a missing, unreadable or
-    corrupt file is rebuilt (exact local refinement) and rewritten atomically. A cached template
-    is the built one bit for bit; with every file present a setup does no exact arithmetic.
+    One file per template, ``SHA-256(key, depth_semi, sources).tpl`` (:func:`_template_bytes`: the
+    virtual faces, the leaf operators ``R``, ``Q``, ``O``, the corner keys of its configurations,
+    and the SHA-256 of all of it, checked on read with the header's sizes); a missing, unreadable or
+    corrupt file is rebuilt (exact local refinement) and rewritten atomically. A cached template is
+    the built one bit for bit; with every file present a setup does no exact local step.
     """
     import hashlib
     import os
-    import zipfile
 
     d = _cache_dir()
     if d is None:
         return _finished(make())
     name = hashlib.sha256(f"template|{_template_version()}|{depth_semi}|{tkey!r}".encode()).hexdigest()
-    path = d / f"{name}.tpl.npz"
-    if path.exists():
-        try:
-            return _read_template(path)
-        except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile):
-            pass
+    path = d / f"{name}.tpl"
+    try:
+        return _read_template(path)
+    except (OSError, ValueError, UnicodeDecodeError):  # missing or corrupt: rebuilt
+        pass
     t = _finished(make())
-    a = _template_arrays(t)
-    a["digest"] = np.array(_digest(a))
     try:
         d.mkdir(parents=True, exist_ok=True)
-        tmp = d / f".{name}.{os.getpid()}.tpl.npz"
-        np.savez(tmp, **a)
+        tmp = d / f".{name}.{os.getpid()}.tpl"
+        tmp.write_bytes(_template_bytes(t))
         os.replace(tmp, path)
     except OSError:
         pass
