@@ -41,7 +41,9 @@ from ccproof.evaluate.local import (
     _CENTER,
     _SIDES,
     CORNERS,
+    _cache_dir,
     _child_ring,
+    _code_version,
     _has_semi_sharp,
     _key_complex,
     _regular_net_matrix,
@@ -263,6 +265,7 @@ class _Template:
         self.reg = []  # (17, N) per regular patch
         self.cor = []  # (Nc, N) per corner face: ring relative to its vertex (rows 1..), then the limit point
         self.cor_vertex = []  # ring position of each corner face's vertex (-1: a new point)
+        self.schemes = []  # per configuration used (``cfg``: index here): (corner key, orientation)
         self.n_pts = 0
         self.jobs = array("q")
         self.rings = array("i")
@@ -287,6 +290,121 @@ class _Template:
             if not np.isfinite(a).all():  # pragma: no cover - would be a bug in the local refinement
                 raise MeshError("internal error: a patch uses a point outside the exact local refinement")
         self.reg = self.cor = None
+
+
+def _finished(t):
+    t.finish()
+    return t
+
+
+@functools.lru_cache(maxsize=1)
+def _template_version():
+    """Hash of the sources that define a template (:func:`_code_version` and this module)."""
+    import hashlib
+    from pathlib import Path
+
+    return hashlib.sha256((_code_version() + "|").encode() + Path(__file__).read_bytes()).hexdigest()[:16]
+
+
+_TPL_MAGIC = 20261202.0  # first value of a template file (the format below)
+
+
+def _template_bytes(t):
+    """A finished template as bytes: one little-endian float64 vector ``[magic, N, n_pts, V, n_reg,
+    n_cor, len(json)]``, then per virtual face ``kind``, ``dom`` (3), ``child`` (4), ``leaf``,
+    ``pts``, ``cfg``, ``corner`` (2), then ``cor_vertex`` (n_cor), ``R`` (17 n_reg, N), ``Q``
+    (n_pts, N), ``O`` (n_cor, N) (integers are exact in float64), then the JSON of the corner keys
+    and orientations of its configurations, then the SHA-256 of all that (32 bytes)."""
+    import hashlib
+    import json
+
+    V, N = len(t.kind), t.n
+    js = json.dumps(t.schemes).encode()
+    ints = np.array([t.kind, t.leaf, t.pts, t.cfg], dtype=np.float64).reshape(4, V)
+    body = np.concatenate([
+        [_TPL_MAGIC, N, t.n_pts, V, t.R.shape[0] // 17, t.O.shape[0], len(js)],
+        np.array(t.dom, dtype=np.float64).reshape(-1), np.array(t.child, dtype=np.float64).reshape(-1),
+        ints.reshape(-1), np.array(t.corner, dtype=np.float64).reshape(-1),
+        np.array(t.cor_vertex, dtype=np.float64), t.R.reshape(-1), t.Q.reshape(-1), t.O.reshape(-1),
+    ]).astype("<f8").tobytes() + js
+    return body + hashlib.sha256(body).digest()
+
+
+def _tuples(x):
+    return tuple(_tuples(y) for y in x) if isinstance(x, list) else x
+
+
+def _read_template(path):
+    """The template stored at ``path`` (:func:`_template_bytes`); ValueError unless the file holds
+    exactly what was written (digest, magic, sizes)."""
+    import hashlib
+    import json
+
+    b = path.read_bytes()
+    body, digest = b[:-32], b[-32:]
+    if len(b) < 32 + 56 or hashlib.sha256(body).digest() != digest:
+        raise ValueError(f"{path}: digest mismatch")
+    head = np.frombuffer(body, dtype="<f8", count=7)
+    if head[0] != _TPL_MAGIC:
+        raise ValueError(f"{path}: not a template file")
+    N, n_pts, V, n_reg, n_cor, n_js = (int(x) for x in head[1:])
+    n = 7 + 13 * V + n_cor + (17 * n_reg + n_pts + n_cor) * N
+    if len(body) != 8 * n + n_js:
+        raise ValueError(f"{path}: sizes do not match its header")
+    z = np.frombuffer(body, dtype="<f8", count=n)
+    o = 7
+
+    def take(k):
+        nonlocal o
+        o += k
+        return z[o - k:o]
+
+    t = _Template(N)
+    t.dom = [tuple(d) for d in take(3 * V).reshape(V, 3).tolist()]
+    t.child = take(4 * V).astype(np.int64).reshape(V, 4).tolist()
+    t.kind, t.leaf, t.pts, t.cfg = take(4 * V).astype(np.int64).reshape(4, V).tolist()
+    t.corner = [tuple(c) for c in take(2 * V).astype(np.int64).reshape(V, 2).tolist()]
+    t.cor_vertex = take(n_cor).astype(np.int64).tolist()
+    t.R = take(17 * n_reg * N).reshape(-1, N)
+    t.Q = take(n_pts * N).reshape(-1, N)
+    t.O = take(n_cor * N).reshape(-1, N)
+    t.n_pts = n_pts
+    t.schemes = [(_tuples(k), _tuples(o_)) for k, o_ in json.loads(body[8 * n:].decode())]
+    t.reg = t.cor = None
+    return t
+
+
+def _cached_template(tkey, depth_semi, make):
+    """``make()`` finished (a :class:`_Template`), kept between runs in the disk cache of
+    :func:`ccproof.evaluate.local.corner_scheme` (same folder, ``CCPROOF_CACHE``).
+
+    One file per template, ``SHA-256(key, depth_semi, sources).tpl`` (:func:`_template_bytes`: the
+    virtual faces, the leaf operators ``R``, ``Q``, ``O``, the corner keys of its configurations,
+    and the SHA-256 of all of it, checked on read with the header's sizes); a missing, unreadable or
+    corrupt file is rebuilt (exact local refinement) and rewritten atomically. A cached template is
+    the built one bit for bit; with every file present a setup does no exact local step.
+    """
+    import hashlib
+    import os
+
+    d = _cache_dir()
+    if d is None:
+        return _finished(make())
+    name = hashlib.sha256(f"template|{_template_version()}|{depth_semi}|{tkey!r}".encode()).hexdigest()
+    path = d / f"{name}.tpl"
+    try:
+        return _read_template(path)
+    except (OSError, ValueError, UnicodeDecodeError):  # missing or corrupt: rebuilt
+        pass
+    t = _finished(make())
+    try:
+        d.mkdir(parents=True, exist_ok=True)
+        tmp = d / f".{name}.{os.getpid()}.tpl"
+        tmp.write_bytes(_template_bytes(t))
+        os.replace(tmp, path)
+    except OSError:
+        pass
+    return t
 
 
 #: jobs from which the numba ring walk pays for loading numba and its cached kernel (~1 to 1.5 s in a
@@ -514,12 +632,24 @@ class _Builder:
         self.n_jobs = 0
         self.job_base = array("q")
 
+    def _config(self, key_r, orient):
+        """The table's configuration index of the corner scheme of ``key_r`` in orientation ``orient``."""
+        scheme = corner_scheme(key_r)
+        ck = (id(scheme), orient)
+        cfg = self.configs.get(ck)
+        if cfg is None:
+            cfg = self.configs[ck] = len(self.schemes)
+            self.schemes.append((scheme, orient))
+        return cfg
+
     # ------------------------------------------------------------------ jobs
     def _register(self, tkey, make, jobs, rings):
         t = self.templates.get(tkey)
         if t is None:
-            t = self.templates[tkey] = make()
-            t.finish()
+            t = self.templates[tkey] = _cached_template(tkey, self.depth_semi, make) \
+                if tkey[0] != "smooth" else _finished(make())
+            glob = [self._config(skey, orient) for skey, orient in t.schemes]
+            t.cfg = [glob[c] if c >= 0 else -1 for c in t.cfg]  # the template's configurations: the table's
         if isinstance(jobs, np.ndarray):  # whole blocks of jobs: as bytes (extend would iterate in Python)
             t.jobs.frombytes(np.ascontiguousarray(jobs, dtype=np.int64).tobytes())
         else:
@@ -748,7 +878,7 @@ class _Builder:
         N = _key_complex(key_r).n_vertices
         t = _Template(N)
         root = t.new_vface(_REGULAR, frame)
-        self.scheme_face(t, corner_scheme(key_r), np.eye(N), list(range(N)), r, frame, base, root, np.arange(N))
+        self.scheme_face(t, key_r, np.eye(N), list(range(N)), r, frame, base, root, np.arange(N))
         return t
 
     def _face_template(self, key, frame, base):
@@ -804,9 +934,8 @@ class _Builder:
         if len(irr) == 1:
             r = irr[0]
             ring_r, key_r, _ = ring_of(r, 1)
-            scheme = corner_scheme(key_r)
-            if scheme is not None:
-                return self.scheme_face(t, scheme, X, ring_r, r, frame, base, vid, vmap)
+            if corner_scheme(key_r) is not None:
+                return self.scheme_face(t, key_r, X, ring_r, r, frame, base, vid, vmap)
         if depth >= MAX_DEPTH:
             raise MeshError(
                 f"{self.what} {base}: the configuration around it is not supported "
@@ -814,17 +943,18 @@ class _Builder:
             )
         return self.split_face(t, key, nr, X[ring], frame, depth + 1, semi_depth, base, vid, vmap[ring])
 
-    def scheme_face(self, t, scheme, X, ring_r, r, frame, base, vid, vmap):
-        """Virtual face ``vid`` of ``t`` is a corner face of ``scheme`` at its corner ``r``, ring
-        ``X[ring_r]`` (listed from that corner)."""
+    def scheme_face(self, t, key_r, X, ring_r, r, frame, base, vid, vmap):
+        """Virtual face ``vid`` of ``t`` is a corner face of the scheme of ``key_r``
+        (:func:`ccproof.evaluate.local.corner_scheme`) at its corner ``r``, ring ``X[ring_r]``
+        (listed from that corner)."""
+        scheme = corner_scheme(key_r)
         C = X[ring_r]
         rot = _compose(frame, _corner_frame(r))
         orient = (_sign(rot[1]), _sign(rot[2]))
-        ck = (id(scheme), orient)
-        cfg = self.configs.get(ck)
-        if cfg is None:
-            cfg = self.configs[ck] = len(self.schemes)
-            self.schemes.append((scheme, orient))
+        src = (key_r, orient)
+        cfg = t.schemes.index(src) if src in t.schemes else len(t.schemes)
+        if cfg == len(t.schemes):
+            t.schemes.append(src)
         t.kind[vid] = _CORNER
         U0, V0, H = t.dom[vid]
         corner = rot[0]
