@@ -56,6 +56,10 @@ FILES = {
     "nanpoint.csv": "x,y,z\nnan,0,0\n",
     "points.xyz": "0 0 0\n1 0 0\n0 1 0\n0 0 1\n",
     "afile": "not a folder\n",
+    # two quads, the first one a hole (OpenSubdiv's tag line), and all of them holes
+    "holes.obj": "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nv 1 1 0\nv 2 1 0\nf 1 2 5 4\nf 2 3 6 5\nt hole 1/0/0 0\n",
+    "allholes.obj": "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\nt hole 1/0/0 0\n",
+    "inhole.csv": "face,u,v\n1,0.5,0.5\n0,0.5,0.5\n",
     "tables/k005.json": '{"schema": "ccproof.table/1"',
 }
 
@@ -82,6 +86,8 @@ CASES = [
     ("plot-bad-suffix", "eval cube.obj --samples 3 --out o16.npz --plot p.txt", "p.txt", "o16.npz"),
     ("parameterization-on-triangles", "eval triangle.obj --samples 3 --parameterization vanishing --out o17.npz",
      "triangle.obj", "o17.npz"),
+    ("point-in-a-hole", "eval holes.obj --points inhole.csv --out o18.npz", "inhole.csv:3", "o18.npz"),
+    ("every-face-a-hole", "eval allholes.obj --samples 3 --out o19.npz", "allholes.obj", "o19.npz"),
     ("project-missing-mesh", "project missing.obj xyz.csv --out p1.npz", "missing.obj", "p1.npz"),
     ("project-header", "project cube.obj uv.csv --out p2.npz", "uv.csv", "p2.npz"),
     ("project-point-1e200", "project cube.obj far.csv --out p3.npz", "point 1", "p3.npz"),
@@ -335,3 +341,23 @@ def test_ctrl_c_to_the_process_group_with_workers(tmp_path, workers):
     assert lines[-1] == "ccproof eval: interrupted" and "Traceback" not in err, err
     assert all(ln.startswith("ccproof eval: warning: ") for ln in lines[:-1]), err
     assert not (tmp_path / "shards" / "index.json").exists()
+
+
+def test_holes_are_skipped_by_samples_and_project(tmp_path):
+    """A mesh with a hole face: ``eval --samples`` draws only from the faces that have a surface, and
+    ``project`` finds the nearest point on them (the hole face 0 lies nearer to the point)."""
+    import numpy as np
+
+    (tmp_path / "holes.obj").write_text(FILES["holes.obj"])
+    (tmp_path / "xyz.csv").write_text("x,y,z\n0.2,0.5,0.1\n")
+    run = _ccproof(["eval", "holes.obj", "--samples", "50", "--serial", "--out", "o.npz"], tmp_path)
+    assert run.returncode == 0, run.stderr
+    d = np.load(tmp_path / "o.npz")
+    assert d["face"].tolist() == [1] * 50 and np.isfinite(d["P"]).all()
+    run = _ccproof(["project", "holes.obj", "xyz.csv", "--out", "p.npz"], tmp_path)
+    assert run.returncode == 0, run.stderr
+    p = np.load(tmp_path / "p.npz")
+    assert p["face"].tolist() == [1]
+    # the limit surface of face 1 alone is a patch of the plane z = 0 with x >= 1 (its left edge is the
+    # boundary curve next to the hole, x(u=0) >= 1 up to the curve's bulge): the distance is at least 0.8 - a bit
+    assert abs(p["P"][0, 2]) < 1e-12 and p["distance"][0] > 0.5

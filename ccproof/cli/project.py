@@ -60,12 +60,19 @@ def run(args):
         check_points(X)
     except CCProofError as exc:
         raise CCProofError(f"{args.points}: {exc} (point i is on line i + 2)") from None
-    S = limit_surface(args.mesh, progress=progress)  # a bar for a long setup
+    from ccproof.cli._eval_args import evaluable_ptex_faces
+    from ccproof.mesh.io import read_mesh
+
+    poly = read_mesh(args.mesh)
+    evaluable = evaluable_ptex_faces(poly)  # holes (tagged, or boundary mode none) have no surface
+    if evaluable is not None and evaluable.size == 0:
+        raise CCProofError(f"{args.mesh}: every face is a hole: there is no limit surface to project onto")
+    S = limit_surface(poly.to_quad_mesh() if poly.is_plain_quads else poly, progress=progress)  # a bar if long
     from ccproof.cli._notice import compile_notice
 
     compile_notice("project")  # after the input checks: an error stays one line
     t0 = time.perf_counter()
-    finder = ClosestPointFinder(S, cells=args.cells or CELLS)
+    finder = ClosestPointFinder(S, cells=args.cells or CELLS, faces=evaluable)
     starts = range(0, X.shape[0], BATCH)
     if progress and len(starts) > 1:
         from tqdm import tqdm
