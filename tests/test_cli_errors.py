@@ -95,6 +95,8 @@ CASES = [
     ("project-nan-point", "project cube.obj nanpoint.csv --out p5.npz", "point 0", "p5.npz"),
     ("project-out-suffix", "project cube.obj xyz.csv --out p6.csv", "'.csv'", "p6.csv"),
     ("project-out-is-a-folder", "project cube.obj xyz.csv --out meshdir", "meshdir", None),
+    ("project-cells-zero", "project cube.obj xyz.csv --cells 0 --out p7.npz", "--cells", "p7.npz"),
+    ("project-certify-tagged", "project holes.obj xyz.csv --certify --out p8.npz", "--certify", "p8.npz"),
     ("arap-missing-mesh", "arap missing.obj --out a1.obj", "missing.obj", "a1.obj"),
     ("arap-out-suffix", "arap cube.obj --out a2.txt", "'.txt'", "a2.txt"),
     ("arap-zero-area-face", "arap zeroarea.obj --no-progress --out a3.obj", "face 0", "a3.obj"),
