@@ -104,6 +104,10 @@ def run(args) -> int:
     out_path = check_folder(args.out) if shards else check_file(args.out, (".npz",), hint="(or FOLDER/ for shards)")
     if args.plot:
         check_file(args.plot, PLOT_SUFFIXES, "--plot")
+    if args.alpha is not None and args.parameterization != "vanishing":
+        raise CCProofError(f"--alpha is the exponent of --parameterization vanishing, not of {args.parameterization}")
+    if args.threads is not None and args.threads < 1:
+        raise CCProofError(f"--threads must be >= 1, got {args.threads}")
 
     import numpy as np
 
@@ -131,6 +135,8 @@ def run(args) -> int:
             raise CCProofError(f"{args.mesh}: every face is a hole: there is no limit surface to evaluate")
     else:
         mesh, evaluable = poly.to_quad_mesh(), None
+        if args.plot and args.plot_vertex is not None and not 0 <= args.plot_vertex < mesh.n_vertices:
+            raise CCProofError(f"--plot-vertex {args.plot_vertex} out of range [0, {mesh.n_vertices})")
         n_faces, kwargs = mesh.n_faces, {"parameterization": args.parameterization}
     # the points before the surface's setup (seconds on large meshes): a bad point is reported at once
     if points is not None and points.is_dir():
