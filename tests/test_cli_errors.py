@@ -108,7 +108,8 @@ CASES = [
     ("arap-preview-suffix", "arap cube.obj --preview a5.txt", "a5.txt", "a5.txt"),
     ("arap-levels-below-start", "arap cube.obj --levels 0 --out a6.obj", "--levels 0", "a6.obj"),
     ("arap-refine-negative", "arap cube.obj --refine -1 --out a7.obj", "--refine", "a7.obj"),
-    ("arap-refine-above-default-eval-level", "arap cube.obj --segment normals --refine 7 --out a8.obj", "--eval-level", "a8.obj"),
+    ("arap-refine-above-default-eval-level", "arap cube.obj --segment normals --refine 7 --out a8.obj",
+     "--eval-level", "a8.obj"),
     ("fit-missing-points", "fit missing.xyz --out f1.obj", "missing.xyz", "f1.obj"),
     ("fit-out-suffix", "fit points.xyz --out f2.ply", "'.ply'", "f2.ply"),
     ("fit-errors-missing-folder", "fit points.xyz --out f3.obj --errors nodir/e.csv", "nodir", "f3.obj"),
@@ -124,6 +125,8 @@ CASES = [
     ("table-dir-under-a-file", "table --all --dir afile/t", "afile", "afile/t"),
     ("report-plot-suffix", "report --plot r.txt", "r.txt", "r.txt"),
     ("invert-not-a-number", "invert 5 x 0.1", "'x'", None),
+    # the way out named as the command line spells it (not the Python keyword)
+    ("invert-outside-the-face", "invert 5 5 5 --domain face", "--domain quadrant", None),
 ]
 
 
