@@ -378,3 +378,18 @@ def test_holes_are_skipped_by_samples_and_project(tmp_path):
     # the limit surface of face 1 alone is a patch of the plane z = 0 with x >= 1 (its left edge is the
     # boundary curve next to the hole, x(u=0) >= 1 up to the curve's bulge): the distance is at least 0.8 - a bit
     assert abs(p["P"][0, 2]) < 1e-12 and p["distance"][0] > 0.5
+
+
+def test_fit_warnings_name_the_command(tmp_path):
+    """A warning of ``fit`` (a level stopped at the step cap, a surface that strays from the data) is one line
+    ``ccproof fit: warning: ...``, as every warning of the command line."""
+    import numpy as np
+
+    g = np.random.default_rng(0).normal(size=(60, 3))
+    np.savetxt(tmp_path / "sphere.xyz", g / np.linalg.norm(g, axis=1)[:, None])
+    run = _ccproof(["fit", "sphere.xyz", "--out", "f.obj", "--max-steps", "2", "--levels", "0", "--no-progress"],
+                   tmp_path)
+    assert run.returncode == 0, run.stderr
+    lines = run.stderr.strip().splitlines()
+    assert lines and all(ln.startswith("ccproof fit: warning: ") for ln in lines), run.stderr
+    assert any("step cap (2 steps" in ln for ln in lines)

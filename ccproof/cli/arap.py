@@ -314,7 +314,7 @@ def _write_control(args, r, surf, eval_level, comment, table, write_uv_obj):
         nxt = r.textures[0].hierarchy.surface.n_faces * 4 ** (last + 1)
         why = (f" (the next, {last + 1} extra, needs {nxt} faces > --control-max-faces {args.control_max_faces})"
                if last < args.control_extra and nxt > args.control_max_faces else "")
-        print(f"warning: --control-out: no subdivision of 0..{last} extra gave UVs without folds and "
+        print(f"ccproof arap: warning: --control-out: no subdivision of 0..{last} extra gave UVs without folds and "
               f"within 5 % of the exact texture's distortion excess{why}; wrote the best ({exp.extra} extra, "
               f"{sum(exp.folds)} folded quads); raise --control-extra / --control-max-faces, or use the sampled "
               f"surface (--out), which has the exact UVs", file=sys.stderr)
