@@ -128,6 +128,9 @@ CASES = [
     ("table-valence", "table 2", "got '2'", None),
     ("table-corrupt", "table 5 --dir tables", "k005.json", None),
     ("table-dir-under-a-file", "table --all --dir afile/t", "afile", "afile/t"),
+    ("table-kmax-below-3", "table --all --kmax 2 --dir t2", "--kmax", "t2"),
+    ("table-jobs-zero", "table --all --jobs 0 --dir t3", "--jobs", "t3"),
+    ("report-jobs-zero", "report --jobs 0", "--jobs", None),
     ("report-plot-suffix", "report --plot r.txt", "r.txt", "r.txt"),
     ("invert-not-a-number", "invert 5 x 0.1", "'x'", None),
     # the way out named as the command line spells it (not the Python keyword)

@@ -114,7 +114,10 @@ def run(args):
     from pathlib import Path
 
     from ccproof.cli._output import PLOT_SUFFIXES, atomic, check_file, write_text
+    from ccproof.errors import CCProofError
 
+    if args.jobs < 1:
+        raise CCProofError(f"--jobs must be >= 1, got {args.jobs}")
     out = Path("docs/certified_valences.md")
     if args.write:  # every output checked before the certificates are re-verified
         check_file(out, (".md",), "--write")
