@@ -396,3 +396,14 @@ def test_fit_warnings_name_the_command(tmp_path):
     lines = run.stderr.strip().splitlines()
     assert lines and all(ln.startswith("ccproof fit: warning: ") for ln in lines), run.stderr
     assert any("step cap (2 steps" in ln for ln in lines)
+
+
+def test_the_command_list_names_what_each_command_does():
+    """``ccproof --help``: certify also writes C1 certificates (smooth and tagged), report has the tagged
+    table, eval reads any mesh (the help text of each is the user's first reading)."""
+    run = _ccproof(["--help"], REPO)
+    assert run.returncode == 0
+    lines = {ln.split()[0]: ln for ln in run.stdout.splitlines() if ln.startswith("    ") and ln.split()}
+    assert "C1" in lines["certify"] and "crease" in lines["certify"]
+    assert "--tagged" in lines["report"]
+    assert "any mesh" in lines["eval"]
