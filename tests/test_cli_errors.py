@@ -131,6 +131,7 @@ CASES = [
     ("table-kmax-below-3", "table --all --kmax 2 --dir t2", "--kmax", "t2"),
     ("table-jobs-zero", "table --all --jobs 0 --dir t3", "--jobs", "t3"),
     ("report-jobs-zero", "report --jobs 0", "--jobs", None),
+    ("report-tagged-plot", "report --tagged --plot r2.png", "--plot", "r2.png"),
     ("report-plot-suffix", "report --plot r.txt", "r.txt", "r.txt"),
     ("invert-not-a-number", "invert 5 x 0.1", "'x'", None),
     # the way out named as the command line spells it (not the Python keyword)
