@@ -56,6 +56,10 @@ FILES = {
     "nanpoint.csv": "x,y,z\nnan,0,0\n",
     "points.xyz": "0 0 0\n1 0 0\n0 1 0\n0 0 1\n",
     "afile": "not a folder\n",
+    # two quads, the first one a hole (OpenSubdiv's tag line), and all of them holes
+    "holes.obj": "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nv 1 1 0\nv 2 1 0\nf 1 2 5 4\nf 2 3 6 5\nt hole 1/0/0 0\n",
+    "allholes.obj": "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\nt hole 1/0/0 0\n",
+    "inhole.csv": "face,u,v\n1,0.5,0.5\n0,0.5,0.5\n",
     "tables/k005.json": '{"schema": "ccproof.table/1"',
 }
 
@@ -82,6 +86,12 @@ CASES = [
     ("plot-bad-suffix", "eval cube.obj --samples 3 --out o16.npz --plot p.txt", "p.txt", "o16.npz"),
     ("parameterization-on-triangles", "eval triangle.obj --samples 3 --parameterization vanishing --out o17.npz",
      "triangle.obj", "o17.npz"),
+    ("point-in-a-hole", "eval holes.obj --points inhole.csv --out o18.npz", "inhole.csv:3", "o18.npz"),
+    ("every-face-a-hole", "eval allholes.obj --samples 3 --out o19.npz", "allholes.obj", "o19.npz"),
+    ("alpha-without-vanishing", "eval cube.obj --samples 3 --alpha 3 --out o20.npz", "--alpha", "o20.npz"),
+    ("threads-zero", "eval cube.obj --samples 3 --threads 0 --out o21.npz", "--threads", "o21.npz"),
+    ("plot-vertex-out-of-range", "eval cube.obj --samples 3 --plot p.png --plot-vertex 8 --out o22.npz",
+     "--plot-vertex 8", "o22.npz"),
     ("project-missing-mesh", "project missing.obj xyz.csv --out p1.npz", "missing.obj", "p1.npz"),
     ("project-header", "project cube.obj uv.csv --out p2.npz", "uv.csv", "p2.npz"),
     ("project-point-1e200", "project cube.obj far.csv --out p3.npz", "point 1", "p3.npz"),
@@ -89,11 +99,17 @@ CASES = [
     ("project-nan-point", "project cube.obj nanpoint.csv --out p5.npz", "point 0", "p5.npz"),
     ("project-out-suffix", "project cube.obj xyz.csv --out p6.csv", "'.csv'", "p6.csv"),
     ("project-out-is-a-folder", "project cube.obj xyz.csv --out meshdir", "meshdir", None),
+    ("project-cells-zero", "project cube.obj xyz.csv --cells 0 --out p7.npz", "--cells", "p7.npz"),
+    ("project-certify-tagged", "project holes.obj xyz.csv --certify --out p8.npz", "--certify", "p8.npz"),
     ("arap-missing-mesh", "arap missing.obj --out a1.obj", "missing.obj", "a1.obj"),
     ("arap-out-suffix", "arap cube.obj --out a2.txt", "'.txt'", "a2.txt"),
     ("arap-zero-area-face", "arap zeroarea.obj --no-progress --out a3.obj", "face 0", "a3.obj"),
     ("arap-missing-charts", "arap cube.obj --charts missing.txt --out a4.obj", "missing.txt", "a4.obj"),
     ("arap-preview-suffix", "arap cube.obj --preview a5.txt", "a5.txt", "a5.txt"),
+    ("arap-levels-below-start", "arap cube.obj --levels 0 --out a6.obj", "--levels 0", "a6.obj"),
+    ("arap-refine-negative", "arap cube.obj --refine -1 --out a7.obj", "--refine", "a7.obj"),
+    ("arap-refine-above-default-eval-level", "arap cube.obj --segment normals --refine 7 --out a8.obj",
+     "--eval-level", "a8.obj"),
     ("fit-missing-points", "fit missing.xyz --out f1.obj", "missing.xyz", "f1.obj"),
     ("fit-out-suffix", "fit points.xyz --out f2.ply", "'.ply'", "f2.ply"),
     ("fit-errors-missing-folder", "fit points.xyz --out f3.obj --errors nodir/e.csv", "nodir", "f3.obj"),
@@ -104,11 +120,22 @@ CASES = [
     ("certify-empty-range", "certify 5-3 --out c3", "5-3", "c3"),
     ("certify-prec-the-verifier-rejects", "certify 5 --prec 32 --out c4", "--prec 32", "c4"),
     ("certify-truncation-degree", "certify >=40 --truncation-degree 9 --out c5", "--truncation-degree 9", "c5"),
+    ("certify-tagged-without-c1", "certify dart:7 --out c6", "dart:7", "c6"),
+    ("certify-tagged-size", "certify crease:0 --c1 --out c7",
+     "error: configuration 'crease:0': crease:N needs 1 <= N", "c7"),
+    ("certify-tagged-family", "certify foo:3 --c1 --out c8", "error: configuration 'foo:3' is not dart:K", "c8"),
+    ("certify-tagged-not-a-number", "certify crease:x --c1 --out c9", "FAMILY:N", "c9"),
     ("table-valence", "table 2", "got '2'", None),
     ("table-corrupt", "table 5 --dir tables", "k005.json", None),
     ("table-dir-under-a-file", "table --all --dir afile/t", "afile", "afile/t"),
+    ("table-kmax-below-3", "table --all --kmax 2 --dir t2", "--kmax", "t2"),
+    ("table-jobs-zero", "table --all --jobs 0 --dir t3", "--jobs", "t3"),
+    ("report-jobs-zero", "report --jobs 0", "--jobs", None),
+    ("report-tagged-plot", "report --tagged --plot r2.png", "--plot", "r2.png"),
     ("report-plot-suffix", "report --plot r.txt", "r.txt", "r.txt"),
     ("invert-not-a-number", "invert 5 x 0.1", "'x'", None),
+    # the way out named as the command line spells it (not the Python keyword)
+    ("invert-outside-the-face", "invert 5 5 5 --domain face", "--domain quadrant", None),
 ]
 
 
@@ -335,3 +362,49 @@ def test_ctrl_c_to_the_process_group_with_workers(tmp_path, workers):
     assert lines[-1] == "ccproof eval: interrupted" and "Traceback" not in err, err
     assert all(ln.startswith("ccproof eval: warning: ") for ln in lines[:-1]), err
     assert not (tmp_path / "shards" / "index.json").exists()
+
+
+def test_holes_are_skipped_by_samples_and_project(tmp_path):
+    """A mesh with a hole face: ``eval --samples`` draws only from the faces that have a surface, and
+    ``project`` finds the nearest point on them (the hole face 0 lies nearer to the point)."""
+    import numpy as np
+
+    (tmp_path / "holes.obj").write_text(FILES["holes.obj"])
+    (tmp_path / "xyz.csv").write_text("x,y,z\n0.2,0.5,0.1\n")
+    run = _ccproof(["eval", "holes.obj", "--samples", "50", "--serial", "--out", "o.npz"], tmp_path)
+    assert run.returncode == 0, run.stderr
+    d = np.load(tmp_path / "o.npz")
+    assert d["face"].tolist() == [1] * 50 and np.isfinite(d["P"]).all()
+    run = _ccproof(["project", "holes.obj", "xyz.csv", "--out", "p.npz"], tmp_path)
+    assert run.returncode == 0, run.stderr
+    p = np.load(tmp_path / "p.npz")
+    assert p["face"].tolist() == [1]
+    # the limit surface of face 1 alone is a patch of the plane z = 0 with x >= 1 (its left edge is the
+    # boundary curve next to the hole, x(u=0) >= 1 up to the curve's bulge): the distance is at least 0.8 - a bit
+    assert abs(p["P"][0, 2]) < 1e-12 and p["distance"][0] > 0.5
+
+
+def test_fit_warnings_name_the_command(tmp_path):
+    """A warning of ``fit`` (a level stopped at the step cap, a surface that strays from the data) is one line
+    ``ccproof fit: warning: ...``, as every warning of the command line."""
+    import numpy as np
+
+    g = np.random.default_rng(0).normal(size=(60, 3))
+    np.savetxt(tmp_path / "sphere.xyz", g / np.linalg.norm(g, axis=1)[:, None])
+    run = _ccproof(["fit", "sphere.xyz", "--out", "f.obj", "--max-steps", "2", "--levels", "0", "--no-progress"],
+                   tmp_path)
+    assert run.returncode == 0, run.stderr
+    lines = run.stderr.strip().splitlines()
+    assert lines and all(ln.startswith("ccproof fit: warning: ") for ln in lines), run.stderr
+    assert any("step cap (2 steps" in ln for ln in lines)
+
+
+def test_the_command_list_names_what_each_command_does():
+    """``ccproof --help``: certify also writes C1 certificates (smooth and tagged), report has the tagged
+    table, eval reads any mesh (the help text of each is the user's first reading)."""
+    run = _ccproof(["--help"], REPO)
+    assert run.returncode == 0
+    lines = {ln.split()[0]: ln for ln in run.stdout.splitlines() if ln.startswith("    ") and ln.split()}
+    assert "C1" in lines["certify"] and "crease" in lines["certify"]
+    assert "--tagged" in lines["report"]
+    assert "any mesh" in lines["eval"]

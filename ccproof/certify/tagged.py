@@ -57,12 +57,15 @@ def configurations(text):
     a, dash, b = rng.partition("-")
     try:
         lo, hi = int(a), int(b if dash else a)
-        names = [f"{fam}:{n}" for n in range(lo, hi + 1)]
-        for name in names:
-            parse_configuration(name)
-    except (ValueError, TypeError) as exc:
+    except ValueError:
         raise CCProofError(f"configuration {text!r}: expected FAMILY:N or FAMILY:A-B with FAMILY one of "
-                           f"dart, crease, corner ({exc})") from None
+                           "dart, crease, corner") from None
+    names = [f"{fam}:{n}" for n in range(lo, hi + 1)]
+    for name in names:
+        try:
+            parse_configuration(name)
+        except (ValueError, TypeError) as exc:  # names the configuration and what is wrong with it
+            raise CCProofError(str(exc) if name == text else f"{text!r}: {exc}") from None
     if not colon or not names:
         raise CCProofError(f"configuration {text!r}: empty or without a family")
     return names

@@ -15,10 +15,10 @@ import sys
 #: name -> (module, one-line help)
 COMMANDS: dict[str, tuple[str, str]] = {
     "table": ("ccproof.cli.table", "print or regenerate the certified characteristic-map tables"),
-    "certify": ("ccproof.cli.certify", "prove injectivity for a valence and write a certificate"),
+    "certify": ("ccproof.cli.certify", "prove injectivity or C1 (smooth, dart, crease, corner)"),
     "verify": ("ccproof.cli.verify", "re-check certificates with the trusted verifier"),
-    "report": ("ccproof.cli.report", "table of every certified valence"),
-    "eval": ("ccproof.cli.eval", "evaluate the limit surface of a mesh (natural; bmz04 ones on quad meshes)"),
+    "report": ("ccproof.cli.report", "table of every certified valence (or --tagged)"),
+    "eval": ("ccproof.cli.eval", "evaluate the limit surface of any mesh (bmz04's on quads)"),
     "project": ("ccproof.cli.project", "nearest points of the limit surface to 3-D points (closest points)"),
     "invert": ("ccproof.cli.invert", "invert the characteristic map at a point"),
     "arap": ("ccproof.cli.arap", "ARAP parameterization of a subdivision surface (hsh10)"),

@@ -45,6 +45,24 @@ def add_arguments(parser):
     )
 
 
+def evaluable_ptex_faces(poly):
+    """The ptex faces of a :class:`~ccproof.mesh.polymesh.PolyMesh` that have a limit surface (not in a
+    hole face, tagged or implied by the boundary mode), int64 (m,); None when every ptex face has one.
+
+    >>> from ccproof.mesh.polymesh import PolyMesh
+    >>> m = PolyMesh([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [2, 0, 0]], [[0, 1, 2, 3], [1, 4, 2]],
+    ...              holes=[0])
+    >>> evaluable_ptex_faces(m).tolist()
+    [1, 2, 3]
+    """
+    import numpy as np
+
+    if not poly.is_hole.any():
+        return None
+    counts = np.diff(poly.ptex_start)
+    return np.repeat(~poly.is_hole, counts).nonzero()[0].astype(np.int64)
+
+
 def read_csv_columns(path, header):
     """Rows of a CSV file whose first line is exactly ``header`` (e.g. ``("face", "u", "v")``), as floats
     (n, len(header)); blank lines are skipped; a bad header, row length or value raises

@@ -150,6 +150,22 @@ def run(args) -> int:
     from ccproof.cli._progress import progress_enabled
     from ccproof.errors import CCProofError
 
+    # the options among themselves, before any work
+    refine = None
+    if args.refine != "auto":
+        try:
+            refine = int(args.refine)
+        except ValueError:
+            refine = -1
+        if refine < 0:
+            raise CCProofError(f"--refine must be auto or an integer >= 0, got {args.refine!r}")
+    if args.start_level < 0:
+        raise CCProofError(f"--start-level must be >= 0, got {args.start_level}")
+    if args.levels is not None and args.levels < args.start_level:
+        raise CCProofError(f"--levels {args.levels} is below --start-level {args.start_level}")
+    if args.eval_level is not None and refine is not None and args.eval_level < refine:
+        raise CCProofError(f"--eval-level {args.eval_level} is below --refine {refine} (the metrics are sampled "
+                           "on the refined mesh)")
     mesh, sizes = read_control_mesh(args.mesh)
     if sizes is not None:
         print(f"{args.mesh}: {sizes.size} faces, not all quads: subdivided once (Catmull-Clark) to {mesh.n_faces} "
@@ -179,13 +195,7 @@ def run(args) -> int:
                 engine = "numpy"
     elif engine == "auto":
         engine = "numpy"
-    if args.refine == "auto":
-        refine = auto_refine(mesh, labels)
-    else:
-        try:
-            refine = int(args.refine)
-        except ValueError:
-            raise CCProofError(f"--refine must be auto or an integer >= 0, got {args.refine!r}") from None
+    refine = auto_refine(mesh, labels) if refine is None else refine
     from ccproof.apps.arap.core import _charts, estimate_memory
     from ccproof.apps.arap.hierarchy import ChartHierarchy
 
@@ -199,6 +209,9 @@ def run(args) -> int:
     eval_level = args.eval_level
     if eval_level is None:
         eval_level = default_eval_level(mesh, labels, args.levels, "d" in methods)
+        if eval_level < refine:
+            raise CCProofError(f"--refine {refine} is above the metrics' level {eval_level} (the default "
+                               "--eval-level); give --eval-level >= --refine")
     out_level = args.out_level
     if out_level is None:
         n = mesh.n_faces if labels is None else int((labels >= 0).sum())
@@ -311,7 +324,7 @@ def _write_control(args, r, surf, eval_level, comment, table, write_uv_obj):
         nxt = r.textures[0].hierarchy.surface.n_faces * 4 ** (last + 1)
         why = (f" (the next, {last + 1} extra, needs {nxt} faces > --control-max-faces {args.control_max_faces})"
                if last < args.control_extra and nxt > args.control_max_faces else "")
-        print(f"warning: --control-out: no subdivision of 0..{last} extra gave UVs without folds and "
+        print(f"ccproof arap: warning: --control-out: no subdivision of 0..{last} extra gave UVs without folds and "
               f"within 5 % of the exact texture's distortion excess{why}; wrote the best ({exp.extra} extra, "
               f"{sum(exp.folds)} folded quads); raise --control-extra / --control-max-faces, or use the sampled "
               f"surface (--out), which has the exact UVs", file=sys.stderr)

@@ -179,7 +179,7 @@ def _run_tagged(args):
 def run(args):
     if ":" in str(args.valences):
         if not args.c1:
-            raise CCProofError("tagged configurations (FAMILY:N) are certified with --c1")
+            raise CCProofError(f"{args.valences}: tagged configurations (FAMILY:N) are certified with --c1")
         if args.out is None:
             from ccproof.tables.format import output_dir
 

@@ -11,8 +11,9 @@ convention of OpenSubdiv). The reparameterizations change (u, v) only in the qua
 an interior vertex of valence != 4; every parameterization covers the same surface.
 
 Points come from a CSV file with the header ``face,u,v`` (0-based face index) or are drawn at
-random (--samples N, uniform face and (u, v)). The output .npz holds the arrays P, Pu, Pv (and
-Puu, Puv, Pvv with --derivatives 2), each of shape (n, 3) in the order of the points, and face, u, v.
+random (--samples N, uniform face and (u, v); faces in holes have no surface and are not drawn).
+The output .npz holds the arrays P, Pu, Pv (and Puu, Puv, Pvv with --derivatives 2), each of shape
+(n, 3) in the order of the points, and face, u, v.
 
 Examples:
   ccproof eval bunny.obj --samples 1000000 --out bunny.npz --plot ev.png
@@ -26,7 +27,7 @@ import sys
 import time
 
 from ccproof.cli._eval_args import add_arguments as _add_evaluate_arguments
-from ccproof.cli._eval_args import read_face_uv_csv
+from ccproof.cli._eval_args import evaluable_ptex_faces, read_face_uv_csv
 from ccproof.cli._progress import add_progress_argument, progress_enabled
 from ccproof.errors import CCProofError
 
@@ -72,14 +73,18 @@ def build_surface(mesh, tagged, alpha=None, progress=False):
     return limit_surface(mesh, alpha=alpha, progress=progress)
 
 
-def _checked_points(path, n_faces):
-    """The (face, u, v) of a CSV file, each point checked (face in range, u and v in [0, 1]) with its line
-    number: the evaluator checks them too, but only chunk by chunk and after the setup."""
+def _checked_points(path, n_faces, evaluable=None):
+    """The (face, u, v) of a CSV file, each point checked (face in range and not in a hole, u and v in
+    [0, 1]) with its line number: the evaluator checks them too, but only chunk by chunk and after the
+    setup. ``evaluable``: the ptex faces outside holes (None: all)."""
     import numpy as np
 
     face, u, v = read_face_uv_csv(path)
+    inside = (face >= 0) & (face < n_faces)
+    hole = inside & ~np.isin(face, evaluable) if evaluable is not None else np.zeros(face.shape, bool)
     for bad, what in (
-        ((face < 0) | (face >= n_faces), lambda i: f"face id {int(face[i])} out of range [0, {n_faces})"),
+        (~inside, lambda i: f"face id {int(face[i])} out of range [0, {n_faces})"),
+        (hole, lambda i: f"face id {int(face[i])} lies in a hole of the mesh (it has no limit surface)"),
         (~((u >= 0) & (u <= 1)), lambda i: f"u = {float(u[i])!r} is outside [0, 1]"),  # NaN too
         (~((v >= 0) & (v <= 1)), lambda i: f"v = {float(v[i])!r} is outside [0, 1]"),
     ):
@@ -99,6 +104,10 @@ def run(args) -> int:
     out_path = check_folder(args.out) if shards else check_file(args.out, (".npz",), hint="(or FOLDER/ for shards)")
     if args.plot:
         check_file(args.plot, PLOT_SUFFIXES, "--plot")
+    if args.alpha is not None and args.parameterization != "vanishing":
+        raise CCProofError(f"--alpha is the exponent of --parameterization vanishing, not of {args.parameterization}")
+    if args.threads is not None and args.threads < 1:
+        raise CCProofError(f"--threads must be >= 1, got {args.threads}")
 
     import numpy as np
 
@@ -121,18 +130,24 @@ def run(args) -> int:
         if args.plot:
             raise CCProofError(f"{args.mesh}: --plot needs an untagged all-quad mesh")
         mesh, n_faces, kwargs = poly, poly.n_ptex, {}
+        evaluable = evaluable_ptex_faces(poly)  # holes (tagged, or boundary mode none) have no surface
+        if evaluable is not None and evaluable.size == 0:
+            raise CCProofError(f"{args.mesh}: every face is a hole: there is no limit surface to evaluate")
     else:
-        mesh = poly.to_quad_mesh()
+        mesh, evaluable = poly.to_quad_mesh(), None
+        if args.plot and args.plot_vertex is not None and not 0 <= args.plot_vertex < mesh.n_vertices:
+            raise CCProofError(f"--plot-vertex {args.plot_vertex} out of range [0, {mesh.n_vertices})")
         n_faces, kwargs = mesh.n_faces, {"parameterization": args.parameterization}
     # the points before the surface's setup (seconds on large meshes): a bad point is reported at once
     if points is not None and points.is_dir():
         sources = point_chunks(args.chunk, shards=points)
     elif points is not None:
-        sources = point_chunks(args.chunk, arrays=_checked_points(args.points, n_faces))
+        sources = point_chunks(args.chunk, arrays=_checked_points(args.points, n_faces, evaluable))
     else:
         if args.samples < 0:
             raise CCProofError(f"--samples must be >= 0, got {args.samples}")
-        sources = point_chunks(args.chunk, samples=args.samples, seed=args.seed, n_faces=n_faces)
+        sources = point_chunks(args.chunk, samples=args.samples, seed=args.seed,
+                               n_faces=n_faces if evaluable is None else evaluable)
     sched = scheduler_from_args(args)
     from ccproof.cli._notice import compile_notice
 

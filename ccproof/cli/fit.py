@@ -118,7 +118,7 @@ def run(args) -> int:
           f"(data spacing {100 * res.spacing / res.diameter:.3f} %)")
     print(f"two-sided (Hausdorff) error: {res.two_sided_error_percent:.3f} % of the enclosing-sphere diameter")
     for w in res.warnings:
-        print(f"warning: {w}", file=sys.stderr)
+        print(f"ccproof fit: warning: {w}", file=sys.stderr)
     comment = (f"ccproof fit {Path(args.points).name}: {res.mesh.n_vertices} control vertices, max error "
                f"{res.max_error_percent:.3f} %, two-sided {res.two_sided_error_percent:.3f} % of the "
                f"enclosing-sphere diameter")

@@ -5,7 +5,8 @@ parameter (face, u, v) (ptex face; corner i of the face at (0,0), (1,0), (1,1), 
 P, the distance |X - P| and the unit normal there. The search is global (bounding cylinders over
 sampled cells, a bounding-volume hierarchy, best-first projected Newton descents), see
 docs/closest.md. The output .npz holds the arrays face (n,), u (n,), v (n,), P (n, 3),
-distance (n,), normal (n, 3) in the order of the points; with --certify also verdict (n,) of
+distance (n,), normal (n, 3) in the order of the points; with --certify (untagged all-quad meshes
+only) also verdict (n,) of
 strings ('certified', 'ambiguous', 'uncertified'), distance_lo, distance_hi (n,) (a rigorous
 enclosure of the distance where certified) and parameter_radius (n,) (the nearest parameter
 lies within this max-norm radius of (u, v) in the same face, where certified).
@@ -22,7 +23,8 @@ def add_arguments(parser):
                         "'ccproof eval' reads)")
     parser.add_argument("points", help="CSV file with the header x,y,z")
     parser.add_argument("--out", metavar="FILE.npz", required=True, help="output file (numpy .npz)")
-    parser.add_argument("--certify", action="store_true", help="add interval-arithmetic verdicts (slow: per point)")
+    parser.add_argument("--certify", action="store_true",
+                        help="add interval-arithmetic verdicts (slow: per point; untagged all-quad meshes only)")
     parser.add_argument("--cells", type=int, default=None, help="cells per face side of the search structure")
     from ccproof.cli._progress import add_progress_argument
 
@@ -60,12 +62,24 @@ def run(args):
         check_points(X)
     except CCProofError as exc:
         raise CCProofError(f"{args.points}: {exc} (point i is on line i + 2)") from None
-    S = limit_surface(args.mesh, progress=progress)  # a bar for a long setup
+    if args.cells is not None and args.cells < 1:
+        raise CCProofError(f"--cells must be >= 1, got {args.cells}")
+    from ccproof.cli._eval_args import evaluable_ptex_faces
+    from ccproof.mesh.io import read_mesh
+
+    poly = read_mesh(args.mesh)
+    if args.certify and not poly.is_plain_quads:  # before the search: certify_closest needs a QuadMesh
+        raise CCProofError(f"{args.mesh}: --certify needs an untagged manifold all-quad mesh (this one has "
+                           "non-quad faces, OpenSubdiv tags or non-manifold edges or vertices); drop --certify")
+    evaluable = evaluable_ptex_faces(poly)  # holes (tagged, or boundary mode none) have no surface
+    if evaluable is not None and evaluable.size == 0:
+        raise CCProofError(f"{args.mesh}: every face is a hole: there is no limit surface to project onto")
+    S = limit_surface(poly.to_quad_mesh() if poly.is_plain_quads else poly, progress=progress)  # a bar if long
     from ccproof.cli._notice import compile_notice
 
     compile_notice("project")  # after the input checks: an error stays one line
     t0 = time.perf_counter()
-    finder = ClosestPointFinder(S, cells=args.cells or CELLS)
+    finder = ClosestPointFinder(S, cells=CELLS if args.cells is None else args.cells, faces=evaluable)
     starts = range(0, X.shape[0], BATCH)
     if progress and len(starts) > 1:
         from tqdm import tqdm

@@ -114,7 +114,13 @@ def run(args):
     from pathlib import Path
 
     from ccproof.cli._output import PLOT_SUFFIXES, atomic, check_file, write_text
+    from ccproof.errors import CCProofError
 
+    if args.jobs < 1:
+        raise CCProofError(f"--jobs must be >= 1, got {args.jobs}")
+    if args.tagged and (args.write or args.plot):
+        raise CCProofError(f"{'--write' if args.write else '--plot'} applies to the table of the valences, not to "
+                           "--tagged")
     out = Path("docs/certified_valences.md")
     if args.write:  # every output checked before the certificates are re-verified
         check_file(out, (".md",), "--write")

@@ -69,6 +69,10 @@ def run(args):
     from ccproof.valence import Valence
 
     if args.all:
+        if args.kmax < 3:
+            raise CCProofError(f"--kmax must be >= 3 (the smallest valence), got {args.kmax}")
+        if args.jobs < 1:
+            raise CCProofError(f"--jobs must be >= 1, got {args.jobs}")
         from tqdm import tqdm
 
         from ccproof.cli._output import check_folder
@@ -81,7 +85,7 @@ def run(args):
         work = [(k, args.dir) for k in ks]
         from ccproof.scale.engine import process_pool
 
-        with process_pool(max(1, args.jobs)) as ex:  # Ctrl-C: one line, the workers stopped
+        with process_pool(args.jobs) as ex:  # Ctrl-C: one line, the workers stopped
             for _ in tqdm(ex.map(_build_one, work), total=len(work), desc="tables", unit="table",
                           disable=not progress_enabled(args)):
                 pass

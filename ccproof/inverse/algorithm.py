@@ -196,8 +196,8 @@ def _check_face(x, y, R, S):
         i = int(np.flatnonzero(out)[0])
         raise CCProofError(
             f"point ({float(x[i])!r}, {float(y[i])!r}) is outside the image Phi([0,1]^2) of the face (its "
-            f"preimage in the quadrant is ({float(R[i])!r}, {float(S[i])!r})); use domain='quadrant' for "
-            "the extension")
+            f"preimage in the quadrant is ({float(R[i])!r}, {float(S[i])!r})); the quadrant domain (the "
+            "default; ccproof invert --domain quadrant) gives the extension")
     np.minimum(R, 1.0, out=R)
     np.minimum(S, 1.0, out=S)
 

@@ -120,10 +120,14 @@ def evaluate_dask(shipped, face, u, v, derivatives=1, **kwargs):
 def _sample_chunk(seed, n_faces, count, index):
     """Random points of chunk ``index``: uniform face and (u, v), from ``default_rng(seed)`` for chunk 0
     (so one chunk equals the unchunked draw ``f = integers(0, n_faces, count); u = random(count);
-    v = random(count)``) and ``default_rng([seed, index])`` for the others."""
+    v = random(count)``) and ``default_rng([seed, index])`` for the others. ``n_faces`` may also be an
+    array of the face ids to draw from (uniformly)."""
     import numpy as np
 
     rng = np.random.default_rng(seed if index == 0 else [seed, index])
+    if np.ndim(n_faces):  # the faces to draw from (a mesh with holes: the others), uniformly
+        faces = np.asarray(n_faces, dtype=np.int64)
+        return faces[rng.integers(0, faces.size, count)], rng.random(count), rng.random(count)
     return rng.integers(0, n_faces, count), rng.random(count), rng.random(count)
 
 
@@ -319,7 +323,8 @@ def point_chunks(chunk, *, arrays=None, shards=None, samples=None, seed=0, n_fac
     samples : int, optional
         Number of random points (needs ``n_faces``).
     seed : int, optional
-    n_faces : int, optional
+    n_faces : int or array of int, optional
+        Faces ``0 .. n_faces - 1``, or the ids of the faces to draw from (e.g. all but the holes).
 
     Returns
     -------
