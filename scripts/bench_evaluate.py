@@ -851,7 +851,7 @@ def main(argv=None):
               f"patch table {S.table_bytes / 2**20:.1f} MiB)")
     osd = osd_side_by_side(args.osd_points if not args.quick else 20_000, rng, args.quick, rounds=args.rounds)
     startup_and_memory(SHAPES[0][1], 1_000_000 if not args.quick else 20_000, rng)
-    import_over_numpy(args.rounds)
+    import_over_numpy(args.rounds if not args.quick else 2)
     print("\nsummary:")
     for be in backends:
         print(f"   {be}: {rates[be][1] / 1e6:.2f} M points/s (P + first derivatives, single thread, CPU time)")
