@@ -28,6 +28,9 @@ Measures, in one run:
    ideal work split over the threads, and the largest position difference;
 6. start-up in fresh processes, ours (each compiled backend) and OpenSubdiv Far's: seconds and peak resident
    memory (VmHWM) after importing, loading the kernel, the setup and one evaluation of 10^6 points.
+   Then what ``import ccproof`` (with the evaluator and the mesh reader) and the kernel load add over
+   ``python -c 'import numpy'`` (fresh processes in turn, round by round: seconds from start to exit and
+   peak memory, per round against the floor of the same round), against the target of 0.3 s and 50 MiB.
 
 The bunny mesh is read from the repository's test data (``tests/data/meshes/bunny_quads.obj``).
 
@@ -37,7 +40,8 @@ ours, ``python -c`` with the per-configuration disk cache filled and empty, agai
 a program of its own, ``scripts/osd_setup_driver.cpp``, reading the same OBJ; every process timed from start
 to exit, in turn round by round; and the floors of a Python process: ``python -c pass``, numpy's import,
 ours)
-[--startup]  (``--startup``: only part 6, start-up and peak memory of fresh processes, ours against Far)
+[--startup]  (``--startup``: only part 6, start-up and peak memory of fresh processes, ours against Far, and
+the import's cost over ``python -c 'import numpy'``)
 """
 
 from __future__ import annotations
@@ -440,6 +444,70 @@ def startup_and_memory(path, n, rng, env_backends=("c", "numba")):
     return runs
 
 
+#: the import targets: a fresh ``python -c`` that imports numpy (the floor), against one that also imports
+#: ccproof, the evaluator and the mesh reader and loads the evaluation kernel (the backend choice); each prints
+#: its peak resident memory (VmHWM, MiB) as it exits
+_HWM = "print(int([x for x in open('/proc/self/status') if x.startswith('VmHWM')][0].split()[1]) / 1024)"
+_IMPORT_FLOOR = "import numpy; " + _HWM
+_IMPORT_OURS = ("import numpy, ccproof, ccproof.evaluate.surface as s; from ccproof.mesh.io import read_mesh; "
+                "s._compiled_kernel(None); " + _HWM)
+#: what the import and the kernel load may add over ``python -c 'import numpy'``: seconds, MiB
+IMPORT_TARGET = (0.3, 50.0)
+
+
+def import_over_numpy(rounds=7, backends=("c", "numba")):
+    """What ``import ccproof`` with the evaluator and the mesh reader and the kernel load add over
+    ``python -c 'import numpy'``: fresh processes, each timed from start to exit here, the floor and ours
+    (per backend, ``CCPROOF_BACKEND``) in turn round by round; per round the difference of the seconds and of
+    the peak resident memory (VmHWM) against the floor of the same round; min, median, max. Our modules'
+    bytecode is written once before (as an installed package has it).
+
+    Returns
+    -------
+    dict
+        backend -> ((min, median, max) added seconds, (min, median, max) added MiB).
+    """
+    import os
+    import subprocess
+
+    env = dict(os.environ, PYTHONPATH=str(REPO) + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    env.pop("PYTHONDONTWRITEBYTECODE", None)
+    env.pop("CCPROOF_BACKEND", None)
+    mem = {}
+
+    def run(code, name, backend=None):
+        e = env if backend is None else dict(env, CCPROOF_BACKEND=backend)
+        r = subprocess.run([sys.executable, "-c", code], env=e, capture_output=True, text=True)
+        if r.returncode != 0:
+            raise RuntimeError(f"{name} failed: {r.stderr[-2000:]}")
+        mem.setdefault(name, []).append(float(r.stdout.split()[-1]))
+
+    cases = {"numpy": lambda: run(_IMPORT_FLOOR, "numpy")}
+    for be in backends:
+        if be not in available_backends():
+            continue
+        run(_IMPORT_OURS, "warm-up", be)  # writes our bytecode
+        cases[be] = lambda be=be: run(_IMPORT_OURS, be, be)
+    mem.clear()
+    times, load = interleaved(cases, rounds)
+    floor_t, floor_m = np.asarray(times["numpy"]), np.asarray(mem["numpy"])
+    print(f"   import ccproof (evaluator, mesh reader) + kernel load over python -c 'import numpy' (fresh processes, "
+          f"{rounds} rounds in turn, load {min(load):.2f}-{max(load):.2f}; python -c 'import numpy': median "
+          f"{np.median(floor_t):.3f} s, {np.median(floor_m):.0f} MiB):")
+    out = {}
+    for be in cases:
+        if be == "numpy":
+            continue
+        dt = _stats(np.asarray(times[be]) - floor_t)
+        dm = _stats(np.asarray(mem[be]) - floor_m)
+        met = dt[1] <= IMPORT_TARGET[0] and dm[1] <= IMPORT_TARGET[1]
+        print(f"   {be}: +{dt[1]:.3f} s (min {dt[0]:.3f}, max {dt[2]:.3f}), +{dm[1]:.0f} MiB (min {dm[0]:.0f}, max "
+              f"{dm[2]:.0f}); target <= {IMPORT_TARGET[0]} s and <= {IMPORT_TARGET[1]:.0f} MiB (median): "
+              f"{'met' if met else 'not met'}")
+        out[be] = (dt, dm)
+    return out
+
+
 #: our side of the fresh-process setup: what ``ccproof eval`` does before evaluating (imports, reading the
 #: file, building the patch table), in a ``python -c`` of its own
 _OURS_SETUP = ("import sys; from ccproof.mesh.io import read_mesh; "
@@ -663,6 +731,7 @@ def main(argv=None):
         return 0
     if args.startup:
         startup_and_memory(SHAPES[0][1], 1_000_000 if not args.quick else 20_000, np.random.default_rng(2024))
+        import_over_numpy(args.rounds)
         return 0
     if args.osd_only:
         osd_side_by_side(args.osd_points if not args.quick else 20_000, np.random.default_rng(2024), args.quick,
@@ -782,6 +851,7 @@ def main(argv=None):
               f"patch table {S.table_bytes / 2**20:.1f} MiB)")
     osd = osd_side_by_side(args.osd_points if not args.quick else 20_000, rng, args.quick, rounds=args.rounds)
     startup_and_memory(SHAPES[0][1], 1_000_000 if not args.quick else 20_000, rng)
+    import_over_numpy(args.rounds if not args.quick else 2)
     print("\nsummary:")
     for be in backends:
         print(f"   {be}: {rates[be][1] / 1e6:.2f} M points/s (P + first derivatives, single thread, CPU time)")

@@ -292,7 +292,14 @@ CCP_INLINE int find_face(const ccp_table *T, int64_t pf, double uu, double ww, i
     int64_t job = ld(T->top, T->wide[0], 4 * pf + q);
     int64_t vf = ld(T->job_root, T->wide[1], job);
     int kind = T->kind[vf];
-    for (int64_t it = 0; it < T->split_depth && kind == CCP_SPLIT; it++) {
+    if (T->split_depth > 0) { /* the first level without a branch on the kind (mixed points mispredict it) */
+        double half = T->h[vf] * 0.5;
+        q = (uu >= T->u0[vf] + half) + 2 * (ww >= T->v0[vf] + half);
+        int64_t c = T->child[4 * vf + q], sp = -(int64_t)(kind == CCP_SPLIT); /* c = -1 unless split */
+        vf ^= (vf ^ c) & sp;
+        kind = T->kind[vf];
+    }
+    for (int64_t it = 1; it < T->split_depth && kind == CCP_SPLIT; it++) {
         double half = T->h[vf] * 0.5;
         q = (uu >= T->u0[vf] + half) + 2 * (ww >= T->v0[vf] + half);
         vf = T->child[4 * vf + q];
@@ -400,10 +407,13 @@ CCP_INLINE int64_t run(const ccp_table *T, int64_t n, const int64_t *f, const do
                 break;
             }
         }
+        int DL[CCP_BLOCK], nd = 0; /* the points with deep corner nets, in order */
         for (int i = 0; i < m; i++) {
             int64_t kk = k0 + i;
             const double *net = locate(T, JB[i], VF[i], KD[i], u[kk], v[kk], dp + i, S + i, Tt + i, G + i);
             N[i] = net;
+            DL[nd] = i;
+            nd += net == CCP_DEEP;
             if (net == CCP_DEEP) {
                 if (base == NULL) continue;
                 key[i] = 3 * (T->max_layers * dp[i].ci + dp[i].lay) + dp[i].code;
@@ -413,13 +423,13 @@ CCP_INLINE int64_t run(const ccp_table *T, int64_t n, const int64_t *f, const do
             for (int j = 0; j < CCP_NET; j += 8) CCP_PREFETCH(net + j);
             CCP_PREFETCH(net + CCP_NET + 4);
         }
-        /* pass 2: the deep corner nets (found in the cache, or computed), then the bicubics in order; a
-         * slot taken by an earlier point of this block and wanted by another net: the points before are
-         * evaluated first */
+        /* pass 2: the deep corner nets (found in the cache, or computed; only the points of DL, without a
+         * branch per point on whether a net is deep), then the bicubics in order; a slot taken by an
+         * earlier point of this block and wanted by another net: the points before are evaluated first */
         int i0 = 0;
         block++;
-        for (int i = 0; i < m; i++) {
-            if (N[i] != CCP_DEEP) continue;
+        for (int jd = 0; jd < nd; jd++) {
+            int i = DL[jd];
             const ccp_deep *d = dp + i;
             if (base == NULL) {
                 corner_net(T, d->job, d->vf, d->cfg, d->lay, d->code, d->ci, W[i]);
