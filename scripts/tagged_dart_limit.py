@@ -1,0 +1,346 @@
+#!/usr/bin/env python
+"""Explore ``dart:K`` for every large K at once (not trusted; no certificate is written).
+
+A C1 certificate for every K >= K0 needs (docs/tagged_c1.md, "A plan for every dart K >= 101"):
+
+(a) the spectrum for all K: lam1 = lam(cos(2 pi/K)) (odd mode 1, closed form) and lam2, the
+    leading root of the even one-ring block S_in below 1, with lam1 > lam2 > |every other|;
+(b) the characteristic map (x, y) regular and injective uniformly in K.
+
+The even one-ring block is the smooth even operator S0 with ONE row changed (ray 0's (1,0): the sharp
+edge midpoint (C + e_0)/2 instead of the smooth edge rule), so S_in = S0 + e_0 d^T and every eigenvalue
+of S_in that is none of S0 solves F(lam) = d^T (lam - S0)^-1 e_0 = 1. Through the Fourier modes of S0,
+
+    F(lam) = (1/K) [ (K - 1) + n*/(4 lam) (sum_j 1/(c* - c_j) - 1/(c* - 1)) + g0(lam, K) ],
+
+c_j = cos(2 pi j/K), c* = (16 lam^2 - 10 lam + 1)/(2 lam) (so lam = lam(c*)), n* = 4 (1 - c*)(lam - 1/4)
+- (1 + c*), g0 the mode-0 term (a 3 x 3 resolvent), and the classical sum over the K-th roots of unity
+sum_{j=0}^{K-1} 1/(cos phi - c_j) = -K cot(K phi/2)/sin phi (c* = cos phi). With phi = 2 sigma/K,
+h = 1/K, the equation F = 1 becomes G(sigma, h) = 0,
+
+    G = -sigma cot(sigma)/sinc(phi) + 1/sinc(phi/2)^2 + 2 sigma^2 h^2 (g0 - 1) 4 lam/n*,
+
+analytic in (sigma, h) near h = 0, with the limit tan(sigma) = sigma: lam2 = lam(cos(2 sigma/K)) with
+sigma -> 4.4934 (between pi and 2 pi, i.e. lam(cos(4 pi/K)) < lam2 < lam(cos(2 pi/K)) = lam1).
+
+The script prints, one block per item:
+
+A. the closed form of F against the exact resolvent d^T (lam - S0)^-1 e_0 (fmpq, one-ring matrices
+   built here from the rules, independently of the trusted base) at rational lam, K = 5..30;
+B. sigma(K), lam1, lam2, lam(cos(4 pi/K)) and the scaled gaps for K = 101 .. 10^6 and the limit;
+C. a bracket of sigma for every K >= K0 at once: G(sigma_lo, h) and G(sigma_hi, h) of certain opposite
+   signs on arb boxes covering h in [0, 1/K0];
+D. the winding number of 1 - F along the circle |lam| = r (r between lam(cos(4 pi/K)) and lam2): 0
+   means lam2 is the only eigenvalue of S_in of modulus > r besides 1 (floats, adaptive; a measurement);
+E. the characteristic map at K = 101, 202, 404 (x the odd mode-1 vector, y the even vector of lam2 by
+   inverse iteration on the sparse S): K times the least Bernstein coefficient of det J_Phi per piece
+   and of the transversality forms, and where along the ring the minimum sits; its convergence is what
+   a uniform-in-K map certificate must exploit.
+
+  python scripts/tagged_dart_limit.py [--k0 101] [--skip-map]
+"""
+
+from __future__ import annotations
+
+import argparse
+import cmath
+import math
+
+from flint import acb, arb, ctx, fmpq, fmpq_mat
+
+_HALF, _EIGHTH = fmpq(1, 2), fmpq(1, 8)
+
+
+# --- A. the one-ring matrices from the rules (C, e_0..e_{K-1}, f_0..f_{K-1}) --------------------------
+
+def one_ring(k, dart):
+    """The smooth one-ring operator (dart=False) or the dart's (ray 0 sharp), exact, 2k + 1 rows."""
+    m = 2 * k + 1
+    S = fmpq_mat(m, m)
+    e, f = (lambda r: 1 + r % k), (lambda q: 1 + k + q % k)
+    S[0, 0] = 1 - fmpq(7, 4 * k)
+    for r in range(k):
+        S[0, e(r)] += fmpq(3, 2 * k * k)
+        S[0, f(r)] += fmpq(1, 4 * k * k)
+        S[f(r), 0] += fmpq(1, 4)
+        S[f(r), e(r)] += fmpq(1, 4)
+        S[f(r), e(r + 1)] += fmpq(1, 4)
+        S[f(r), f(r)] += fmpq(1, 4)
+        if dart and r == 0:
+            S[e(0), 0] += _HALF
+            S[e(0), e(0)] += _HALF
+            continue
+        S[e(r), 0] += fmpq(3, 8)
+        S[e(r), e(r)] += fmpq(3, 8)
+        for j in (e(r - 1), e(r + 1), f(r - 1), f(r)):
+            S[e(r), j] += fmpq(1, 16)
+    return S
+
+
+def g0(lam, h):
+    """The mode-0 term d . (lam - B0)^-1 (0, 1, 0) (B0 on (C, E, F); h = 1/K may be a ball)."""
+    B0 = [[1 - 7 * h / 4, 3 * h / 2, h / 4], [fmpq(3, 8), _HALF, _EIGHTH], [fmpq(1, 4), _HALF, fmpq(1, 4)]]
+    # Cramer: u = (lam - B0)^-1 (0, 1, 0)
+    M = [[(lam if i == j else 0) - B0[i][j] for j in range(3)] for i in range(3)]
+
+    def det3(A):
+        return (A[0][0] * (A[1][1] * A[2][2] - A[1][2] * A[2][1]) - A[0][1] * (A[1][0] * A[2][2] - A[1][2] * A[2][0])
+                + A[0][2] * (A[1][0] * A[2][1] - A[1][1] * A[2][0]))
+    D = det3(M)
+    rhs = [0, 1, 0]
+    u = [det3([[rhs[i] if j == c else M[i][j] for j in range(3)] for i in range(3)]) / D for c in range(3)]
+    return u[0] / 8 - u[2] / 8
+
+
+def cstar(lam):
+    return (16 * lam * lam - 10 * lam + 1) / (2 * lam)
+
+
+def f_closed(lam, k):
+    """F(lam) for dart:k by the closed form (acb; lam complex allowed)."""
+    lam = acb(lam)
+    cs = cstar(lam)
+    phi = cs.acos()
+    n = 4 * (1 - cs) * (lam - fmpq(1, 4)) - (1 + cs)
+    s = -k * (k * phi / 2).cot() / phi.sin()
+    return ((k - 1) + n / (4 * lam) * (s - 1 / (cs - 1)) + g0(lam, fmpq(1, k))) / k
+
+
+def f_exact(lam, k):
+    """d^T (lam - S0)^-1 e_0 from the one-ring matrices (fmpq)."""
+    S0, Sd = one_ring(k, False), one_ring(k, True)
+    m = S0.nrows()
+    d = [Sd[1, j] - S0[1, j] for j in range(m)]
+    A = fmpq_mat([[(lam if i == j else 0) - S0[i, j] for j in range(m)] for i in range(m)])
+    u = A.solve(fmpq_mat([[int(i == 1)] for i in range(m)]))
+    return sum((d[j] * u[j, 0] for j in range(m)), fmpq(0))
+
+
+def part_a():
+    worst = arb(0)
+    for k in range(5, 31):
+        for lam in (fmpq(2, 5), fmpq(3, 5), fmpq(13, 20), fmpq(7, 10), fmpq(3, 2)):
+            ex, cl = f_exact(lam, k), f_closed(lam, k)
+            err = abs(cl - acb(ex))
+            if not err < arb("1e-20"):
+                print(f"A  MISMATCH K={k} lam={lam}: exact {ex}, closed {cl}")
+                return
+            worst = max(worst, err.mid())
+    print(f"A  closed-form F = exact resolvent at lam in {{2/5, 3/5, 13/20, 7/10, 3/2}}, K = 5..30: "
+          f"max |difference| {float(worst):.1e} (128 bits)")
+
+
+# --- B, C. the scaled secular function G(sigma, h) ------------------------------------------------
+
+def lam_of(c):
+    return (5 + c + ((1 + c) * (9 + c)).sqrt()) / 16
+
+
+def h2g0(sigma, h, lam):
+    """h^2 g0(lam, h) at lam = lam(cos(2 sigma h)), analytic at h = 0.
+
+    B0's mode-0 block has, at h = 0, the eigenvalue lam(1) of the limit: det(lam - B0) = det0 + h det(R) with
+    det0 = (lam - 1)(lam^2 - 3 lam/4 + 1/16) = -(lam - 1) lam sigma^2 h^2 sinc(sigma h)^2/4 (lam = lam(c) solves
+    lam^2 - (5 + c) lam/8 + 1/16 = 0), so det/h is regular; g0 = (u0 - u2)/8 by Cramer, u2 det = O(1).
+    """
+    q = fmpq(1, 4)
+    R = [[fmpq(7, 4), fmpq(-3, 2), -q], [fmpq(-3, 8), lam - _HALF, -_EIGHTH], [-q, -_HALF, lam - q]]
+    det_r = (R[0][0] * (R[1][1] * R[2][2] - R[1][2] * R[2][1]) - R[0][1] * (R[1][0] * R[2][2] - R[1][2] * R[2][0])
+             + R[0][2] * (R[1][0] * R[2][1] - R[1][1] * R[2][0]))
+    det_h = -(lam - 1) * lam * sigma ** 2 * h * (sigma * h).sinc() ** 2 / 4 + det_r
+    m00, m01, m02, m20, m21, m22 = lam - 1 + 7 * h / 4, -3 * h / 2, -h / 4, -q, -_HALF, lam - q
+    u0_det = -(m01 * m22 - m02 * m21)       # = O(h)
+    u2_det = -(m00 * m21 - m01 * m20)
+    return h * (u0_det - u2_det) / (8 * det_h)
+
+
+def big_g(sigma, h):
+    """G(sigma, h) (arb balls allowed for both; h = 0 gives the limit 1 - sigma cot sigma)."""
+    phi = 2 * sigma * h
+    cs = phi.cos()
+    lam = lam_of(cs)
+    n = 4 * (1 - cs) * (lam - fmpq(1, 4)) - (1 + cs)
+    return (-sigma / sigma.tan() / phi.sinc() + 1 / (phi / 2).sinc() ** 2
+            + 2 * sigma ** 2 * (h2g0(sigma, h, lam) - h ** 2) * 4 * lam / n)
+
+
+def sigma_of(h, lo=4.0, hi=4.6):
+    a, b = arb(lo), arb(hi)
+    ga = big_g(a, h)
+    for _ in range(200):
+        m = (a + b) / 2
+        gm = big_g(m.mid(), h)
+        if (gm > 0) == (ga > 0):
+            a, ga = m.mid(), gm
+        else:
+            b = m.mid()
+    return (a + b) / 2
+
+
+def part_b(ks):
+    print("B  K        sigma(K)        lam1            lam2            lam(cos 4pi/K)  K^2(lam1-lam2)  K^2(lam2-lam(c2))")
+    for k in ks:
+        h = arb(0) if k is None else arb(fmpq(1, k))
+        s = sigma_of(h)
+        if k is None:
+            print(f"   limit    {s.str(12, radius=False)}  (root of tan s = s in (pi, 3 pi/2))")
+            continue
+        l1, l2s = lam_of((2 * arb.pi() * h).cos()), lam_of((4 * arb.pi() * h).cos())
+        l2 = lam_of((2 * s * h).cos())
+        print(f"   {k:<8} {s.str(12, radius=False)}  {l1.str(12, radius=False)}  {l2.str(12, radius=False)}  "
+              f"{l2s.str(12, radius=False)}  {((l1 - l2) * k * k).str(8, radius=False)}      "
+              f"{((l2 - l2s) * k * k).str(8, radius=False)}")
+
+
+def part_c(k0, lo="4.45", hi="4.51", boxes=64):
+    """G(lo, h) < 0 < G(hi, h) for every h in [0, 1/k0]: h-boxes as arb balls (untrusted demonstration)."""
+    s_lo, s_hi = arb(lo), arb(hi)
+    fails = 0
+    for i in range(boxes):
+        a, b = fmpq(i, boxes * k0), fmpq(i + 1, boxes * k0)
+        h = arb((a + b) / 2, (b - a) / 2)
+        gl, gh = big_g(s_lo, h), big_g(s_hi, h)
+        if not (gl < 0 and gh > 0):
+            fails += 1
+            print(f"C  box {i}: G(lo) = {gl}, G(hi) = {gh}")
+    print(f"C  sigma in ({lo}, {hi}) for every K >= {k0}: G(lo, h) < 0 < G(hi, h) certain on {boxes - fails}/{boxes} "
+          f"h-boxes covering [0, 1/{k0}] (so lam2 = lam(cos(2 sigma/K)) lies strictly between lam(cos 4pi/K) and lam1)")
+
+
+# --- D. the winding number of 1 - F on |lam| = r ----------------------------------------------------
+
+def _cot(z):
+    """cot z, stable for large |Im z|."""
+    if z.imag > 0:
+        e = cmath.exp(2j * z)
+        return 1j * (1 + e) / (e - 1) if abs(e) > 0 else -1j
+    e = cmath.exp(-2j * z)
+    return -1j * (1 + e) / (e - 1)
+
+
+def _f_float(lam, k):
+    cs = (16 * lam * lam - 10 * lam + 1) / (2 * lam)
+    phi = cmath.acos(cs)
+    n = 4 * (1 - cs) * (lam - 0.25) - (1 + cs)
+    h = 1 / k
+    B0 = [[1 - 7 * h / 4, 3 * h / 2, h / 4], [3 / 8, 1 / 2, 1 / 8], [1 / 4, 1 / 2, 1 / 4]]
+    M = [[(lam if i == j else 0) - B0[i][j] for j in range(3)] for i in range(3)]
+    det = (M[0][0] * (M[1][1] * M[2][2] - M[1][2] * M[2][1]) - M[0][1] * (M[1][0] * M[2][2] - M[1][2] * M[2][0])
+           + M[0][2] * (M[1][0] * M[2][1] - M[1][1] * M[2][0]))
+    u0 = -(M[0][1] * M[2][2] - M[0][2] * M[2][1]) / det  # Cramer, column (0, 1, 0)
+    u2 = -(M[0][0] * M[2][1] - M[0][1] * M[2][0]) / det
+    gz = u0 / 8 - u2 / 8
+    s = -k * _cot(k * phi / 2) / cmath.sin(phi)
+    return ((k - 1) + n / (4 * lam) * (s - 1 / (cs - 1)) + gz) / k
+
+
+def winding(k, sigma_r=5.4, max_step=0.3):
+    """The winding number of 1 - F(lam) along |lam| = r = lam(cos(2 sigma_r/K)), adaptive in the angle."""
+    r = (5 + math.cos(2 * sigma_r / k) + math.sqrt((1 + math.cos(2 * sigma_r / k)) * (9 + math.cos(2 * sigma_r / k)))) / 16
+    total, pts = 0.0, 0
+
+    def val(t):
+        return 1 - _f_float(r * cmath.exp(1j * t), k)
+    ts = sorted({2 * math.pi * i / 256 for i in range(257)}
+                | {t for i in range(1, int(2 * math.log2(k)) + 12) for t in (2 * math.pi * 2.0 ** -i,
+                                                                              2 * math.pi * (1 - 2.0 ** -i))})
+    vs = [val(t) for t in ts]
+    stack = [(ts[i], vs[i], ts[i + 1], vs[i + 1]) for i in range(len(ts) - 1)]
+    while stack:
+        a, fa, b, fb = stack.pop()
+        d = cmath.phase(fb / fa)
+        if abs(d) > max_step and b - a > 1e-15:
+            m = (a + b) / 2
+            fm = val(m)
+            stack += [(m, fm, b, fb), (a, fa, m, fm)]
+            continue
+        total += d
+        pts += 1
+    return r, total / (2 * math.pi), pts
+
+
+def part_d(ks):
+    for k in ks:
+        r, w, pts = winding(k)
+        print(f"D  K = {k:<8} r = {r:.12f}: winding number of 1 - F on |lam| = r: {w:+.6f} ({pts} arcs)")
+    for k in ks[:2]:  # the same measurement must see lam2 once the circle passes inside it (sigma_r < sigma(K))
+        r, w, pts = winding(k, sigma_r=4.0)
+        print(f"D  control: K = {k:<5} r = lam(cos(8/K)) = {r:.12f} (between lam2 and lam1): winding {w:+.6f} "
+              f"({pts} arcs; expected +1: S_in has no eigenvalue outside but 1, S0 has 1 and lam1)")
+
+
+# --- E. the characteristic map at large K -----------------------------------------------------------
+
+def part_e(ks):
+    import numpy as np
+    import scipy.sparse as sp
+    import scipy.sparse.linalg as spl
+
+    from ccproof.certify.verify.maps import STAR_CURVES, regularity_form
+    from ccproof.certify.verify.tagged import labels, sector_rows
+    from ccproof.certify.verify.tagged_map import PIECES, quadrant_nets, transversal_form
+    from ccproof.rigorous import range_enclosure
+
+    for k in ks:
+        h = arb(fmpq(1, k))
+        s = sigma_of(h)
+        l1, l2 = lam_of((2 * arb.pi() * h).cos()), lam_of((2 * s * h).cos())
+        pts, rows = labels("dart", k), sector_rows("dart", k)
+        m = len(pts)
+        S = sp.csr_matrix(([float(w) for row in rows for w in row.values()],
+                           ([i for i, row in enumerate(rows) for _ in row], [j for row in rows for j in row])), shape=(m, m))
+        vecs = []
+        for lam, parity in ((float(l1.mid()), -1), (float(l2.mid()), 1)):
+            # inverse iteration from a vector of the right parity under the reflection in ray 0
+            v = np.array([math.sin(2 * math.pi * p[1] / k) if parity < 0 and p[0] != "C" else 1.0 for p in pts])
+            lu = spl.splu((S - (lam + 1e-12) * sp.identity(m)).tocsc())
+            for _ in range(6):
+                v = lu.solve(v)
+                v /= np.abs(v).max()
+            res = np.abs(S @ v - lam * v).max()
+            # x = 1 at ray K/4's (1,0) (sin theta = 1 there), y = 1 at ray K/2's (1,0) (theta = pi)
+            v /= v[pts.index(("r", round(k / (4 if parity < 0 else 2)), 1, 0))]
+            vecs.append(v)
+        sig = float(s.mid())
+        prof = [(f, vecs[1][pts.index(("r", round(f * k), 1, 0))],
+                 (math.cos(sig * (1 - 2 * round(f * k) / k)) / math.cos(sig) - 1) / (1 / math.cos(sig) - 1))
+                for f in (0.0, 0.05, 0.1, 0.25, 0.4)]
+        print(f"E  K = {k:<4} y at ray r's (1,0) against the limit profile (cos(sigma (1 - theta/pi))/cos sigma - 1), "
+              "scaled to 1 at theta = pi: " + "; ".join(f"theta/2pi {f:.2f}: {a:.5f} vs {b:.5f}" for f, a, b in prof))
+        x, y = ([arb(float(z)) for z in v] for v in vecs)
+        a1, a2 = -l1.log(), -l2.log()
+        with ctx.workprec(64):
+            nets = [quadrant_nets("dart", k, x, y, q, 64) for q in range(k)]
+            reg = [(min(range_enclosure(regularity_form(nets[q], p, 64))[0] for p in PIECES), q) for q in range(k)]
+            sign = 1 if max(reg)[0] > 0 else -1
+            reg = [(v * sign, q) for v, q in reg]
+            tra = [(min(range_enclosure(transversal_form(nets[q], c, a1, a2, 64))[0] for c in STAR_CURVES) * sign, q)
+                   for q in range(k)]
+        near = {0, 1, 2, k - 1, k - 2, k - 3}
+        for title, vals in (("det J_Phi", reg), ("transversality", tra)):
+            inner = min((v, q) for v, q in vals if q not in near)
+            edge = {q: v for v, q in vals if q in near}
+            prof = " ".join(f"{f:.2f}:{float((vals[round(f * k)][0] * k).mid()):.5f}" for f in (0.1, 0.25, 0.4, 0.5))
+            print(f"E  K = {k:<4} {title:<14} K*min over quadrants 3..K-4: {float((inner[0] * k).mid()):.6f} "
+                  f"(theta/2pi = {inner[1] / k:.3f}); K^3*min at quadrants 0, 1, 2: "
+                  + " ".join(f"{float((edge[q] * k ** 3).mid()):.4f}" for q in (0, 1, 2))
+                  + f"; K*min at theta/2pi {prof}; not positive: {sum(1 for v, _ in vals if not v > 0)}")
+        print(f"E  K = {k:<4} |S v - lam v| <= {res:.1e}, orientation {sign:+d}")
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--k0", type=int, default=101)
+    ap.add_argument("--skip-map", action="store_true")
+    args = ap.parse_args(argv)
+    ctx.prec = 128
+    part_a()
+    part_b([101, 200, 1000, 10 ** 4, 10 ** 6, None])
+    part_c(args.k0)
+    part_d([101, 1000, 10 ** 4, 10 ** 6])
+    if not args.skip_map:
+        part_e([101, 202, 404])
+
+
+if __name__ == "__main__":
+    main()
