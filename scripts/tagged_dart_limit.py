@@ -178,7 +178,8 @@ def sigma_of(h, lo=4.0, hi=4.6):
 
 
 def part_b(ks):
-    print("B  K        sigma(K)        lam1            lam2            lam(cos 4pi/K)  K^2(lam1-lam2)  K^2(lam2-lam(c2))")
+    print("B  K        sigma(K)        lam1            lam2            lam(cos 4pi/K)  "
+          "K^2(lam1-lam2)  K^2(lam2-lam(c2))")
     for k in ks:
         h = arb(0) if k is None else arb(fmpq(1, k))
         s = sigma_of(h)
@@ -192,8 +193,9 @@ def part_b(ks):
               f"{((l2 - l2s) * k * k).str(8, radius=False)}")
 
 
-def part_c(k0, lo="4.45", hi="4.51", boxes=64):
-    """G(lo, h) < 0 < G(hi, h) for every h in [0, 1/k0]: h-boxes as arb balls (untrusted demonstration)."""
+def part_c(k0, lo="4.45", hi="4.51", boxes=64, quiet=False):
+    """G(lo, h) < 0 < G(hi, h) for every h in [0, 1/k0]: h-boxes as arb balls (untrusted demonstration);
+    ``quiet``: return the number of boxes where both signs are certain instead of printing."""
     s_lo, s_hi = arb(lo), arb(hi)
     fails = 0
     for i in range(boxes):
@@ -202,7 +204,10 @@ def part_c(k0, lo="4.45", hi="4.51", boxes=64):
         gl, gh = big_g(s_lo, h), big_g(s_hi, h)
         if not (gl < 0 and gh > 0):
             fails += 1
-            print(f"C  box {i}: G(lo) = {gl}, G(hi) = {gh}")
+            if not quiet:
+                print(f"C  box {i}: G(lo) = {gl}, G(hi) = {gh}")
+    if quiet:
+        return boxes - fails
     print(f"C  sigma in ({lo}, {hi}) for every K >= {k0}: G(lo, h) < 0 < G(hi, h) certain on {boxes - fails}/{boxes} "
           f"h-boxes covering [0, 1/{k0}] (so lam2 = lam(cos(2 sigma/K)) lies strictly between lam(cos 4pi/K) and lam1)")
 
@@ -236,7 +241,8 @@ def _f_float(lam, k):
 
 def winding(k, sigma_r=5.4, max_step=0.3):
     """The winding number of 1 - F(lam) along |lam| = r = lam(cos(2 sigma_r/K)), adaptive in the angle."""
-    r = (5 + math.cos(2 * sigma_r / k) + math.sqrt((1 + math.cos(2 * sigma_r / k)) * (9 + math.cos(2 * sigma_r / k)))) / 16
+    c = math.cos(2 * sigma_r / k)
+    r = (5 + c + math.sqrt((1 + c) * (9 + c))) / 16
     total, pts = 0.0, 0
 
     def val(t):
@@ -287,8 +293,8 @@ def part_e(ks):
         l1, l2 = lam_of((2 * arb.pi() * h).cos()), lam_of((2 * s * h).cos())
         pts, rows = labels("dart", k), sector_rows("dart", k)
         m = len(pts)
-        S = sp.csr_matrix(([float(w) for row in rows for w in row.values()],
-                           ([i for i, row in enumerate(rows) for _ in row], [j for row in rows for j in row])), shape=(m, m))
+        ij = ([i for i, row in enumerate(rows) for _ in row], [j for row in rows for j in row])
+        S = sp.csr_matrix(([float(w) for row in rows for w in row.values()], ij), shape=(m, m))
         vecs = []
         for lam, parity in ((float(l1.mid()), -1), (float(l2.mid()), 1)):
             # inverse iteration from a vector of the right parity under the reflection in ray 0
