@@ -32,7 +32,7 @@ C. a bracket of sigma for every K >= K0 at once: G(sigma_lo, h) and G(sigma_hi, 
    signs on arb boxes covering h in [0, 1/K0];
 D. the winding number of 1 - F along the circle |lam| = r (r between lam(cos(4 pi/K)) and lam2): 0
    means lam2 is the only eigenvalue of S_in of modulus > r besides 1 (floats, adaptive; a measurement);
-E. the characteristic map at K = 101, 202, 404 (x the odd mode-1 vector, y the even vector of lam2 by
+E. the characteristic map at K = 101, 202, 404, 808 (x the odd mode-1 vector, y the even vector of lam2 by
    inverse iteration on the sparse S): K times the least Bernstein coefficient of det J_Phi per piece
    and of the transversality forms, and where along the ring the minimum sits; its convergence is what
    a uniform-in-K map certificate must exploit.
@@ -345,7 +345,7 @@ def main(argv=None):
     part_c(args.k0)
     part_d([101, 1000, 10 ** 4, 10 ** 6])
     if not args.skip_map:
-        part_e([101, 202, 404])
+        part_e([101, 202, 404, 808])
 
 
 if __name__ == "__main__":
