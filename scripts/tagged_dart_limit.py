@@ -35,9 +35,13 @@ D. the winding number of 1 - F along the circle |lam| = r (r between lam(cos(4 p
 E. the characteristic map at K = 101, 202, 404, 808 (x the odd mode-1 vector, y the even vector of lam2 by
    inverse iteration on the sparse S): K times the least Bernstein coefficient of det J_Phi per piece
    and of the transversality forms, and where along the ring the minimum sits; its convergence is what
-   a uniform-in-K map certificate must exploit.
+   a uniform-in-K map certificate must exploit;
+F. the same map from closed forms (x the mode-1 vector; y = y_C u(p) + Re(beta (v^(p) e^(i phi (t - K/2)) + its
+   mirror image in ray K/2)), exact on every point: |S y - lam2 y| is printed) at K = 1000, 4000, 16000:
+   the quadrants next to the sharp ray (K^3 min det J, and over (2 pi q)^2) against the bulk (K min det J
+   over theta^2), which must match for a two-regime argument.
 
-  python scripts/tagged_dart_limit.py [--k0 101] [--skip-map]
+  python scripts/tagged_dart_limit.py [--k0 101] [--skip-map]   (about 45 s, 0.9 GB at K = 16000)
 """
 
 from __future__ import annotations
@@ -334,6 +338,80 @@ def part_e(ks):
         print(f"E  K = {k:<4} |S v - lam v| <= {res:.1e}, orientation {sign:+d}")
 
 
+def closed_form_vectors(k):
+    """x and y of dart:k in closed form (floats), with |S y - lam2 y|.
+
+    x is the odd mode-1 vector f = v - v o R (:func:`.tagged_modes.mode_vector`). y is, on every point
+    but the centre, y_C u(p) + Re(beta (v^(p) e^(i phi (t - K/2)) + v^(p') e^(i phi (t' - K/2)))): u = (lam2 -
+    B(1))^-1 kappa (kappa the centre's weights in the ring rows), v^ the eigenvector of lam2 in the 6 x 6
+    block B(e^(i phi)), (t', p') the mirror image of (t, p) in ray K/2 (ray K - t; quadrant K - 1 - t with
+    (a, b) swapped), phi = 2 sigma/K. The three real unknowns (y_C, Re beta, Im beta) are the null vector
+    of S - lam2 on these three columns; the residual says whether the form is exact.
+    """
+    import numpy as np
+    import scipy.sparse as sp
+
+    from ccproof.certify.verify.tagged import labels, sector_rows
+    from ccproof.certify.verify.tagged_modes import _POS, _block, mode_vector, ring_stencil
+
+    def cv(z):
+        return complex(float(z.real.mid()), float(z.imag.mid())) if isinstance(z, acb) else complex(float(z))
+
+    h = arb(fmpq(1, k))
+    s = sigma_of(h)
+    l1, l2 = lam_of((2 * arb.pi() * h).cos()), lam_of((2 * s * h).cos())
+    lam, phi = float(l2.mid()), float((2 * s * h).mid())
+    pts, rows = labels("dart", k), sector_rows("dart", k)
+    m = len(pts)
+    kappa = np.array([1 - sum(float(w) for w in ring_stencil()[i].values()) for i in range(6)])
+    u = np.linalg.solve(lam * np.eye(6) - np.array([[cv(z).real for z in r] for r in _block(fmpq(1))]), kappa)
+    Bw = np.array([[cv(z) for z in r] for r in _block(acb(math.cos(phi), math.sin(phi)))])
+    ev, V = np.linalg.eig(Bw)
+    vh = V[:, int(np.argmin(abs(ev - lam)))]
+    cols = np.zeros((m, 3))
+    cols[0, 0] = 1
+    for i, p in enumerate(pts[1:], 1):
+        t, pos = p[1], p[2:]
+        tm, pm = (k - t if t else k, pos) if pos[1] == 0 else (k - 1 - t, (pos[1], pos[0]))
+        a = vh[_POS[pos]] * cmath.exp(1j * phi * (t - k / 2)) + vh[_POS[pm]] * cmath.exp(1j * phi * (tm - k / 2))
+        cols[i] = (u[_POS[pos]], a.real, a.imag)
+    ij = ([i for i, row in enumerate(rows) for _ in row], [j for row in rows for j in row])
+    S = sp.csr_matrix(([float(w) for row in rows for w in row.values()], ij), shape=(m, m))
+    R = S @ cols - lam * cols
+    _, sv, vt = np.linalg.svd(R, full_matrices=False)
+    y = cols @ vt[-1]
+    y /= y[pts.index(("r", round(k / 2), 1, 0))]
+    res = float(np.abs(S @ y - lam * y).max())
+    f = mode_vector("dart", k, 1, l1)
+    piv = f[pts.index(("r", round(k / 4), 1, 0))]
+    x = [0.0 if isinstance(z, fmpq) else float((z / piv).real.mid()) for z in f]
+    return x, [float(z) for z in y], l1, l2, res
+
+
+def part_f(ks, bulk=(0.01, 0.02, 0.05, 0.1, 0.25, 0.5), layer=6):
+    """The three regimes of det J_Phi at large K from the closed forms: the quadrants q < ``layer`` next to
+    the sharp ray (K^3 min), the bulk at theta/2pi in ``bulk`` (K min and K min/theta^2)."""
+    from ccproof.certify.verify.maps import regularity_form
+    from ccproof.certify.verify.tagged_map import PIECES, quadrant_nets
+    from ccproof.rigorous import range_enclosure
+
+    for k in ks:
+        x, y, l1, l2, res = closed_form_vectors(k)
+        xs, ys = [arb(z) for z in x], [arb(z) for z in y]
+        with ctx.workprec(64):
+            def low(q, k=k, xs=xs, ys=ys):
+                nets = quadrant_nets("dart", k, xs, ys, q, 64)
+                return float(min(range_enclosure(regularity_form(nets, p, 64))[0] for p in PIECES).mid())
+            near = [low(q) * k ** 3 for q in range(layer)]
+            far = [(f, low(round(f * k)) * k, round(f * k) / k) for f in bulk]
+        print(f"F  K = {k:<6} closed-form y: |S y - lam2 y| <= {res:.1e}; det J_Phi: K^3 min at quadrants "
+              f"0..{layer - 1}: "
+              + " ".join(f"{v:.3f}" for v in near) + "; K^3 min/(2 pi q)^2 (q >= 1): "
+              + " ".join(f"{v / (2 * math.pi * q) ** 2:.4f}" for q, v in enumerate(near) if q)
+              + "; bulk K min at theta/2pi (K min/theta^2): "
+              + " ".join(f"{f}: {v:.4f} ({v / (2 * math.pi * g) ** 2:.4f})" for f, v, g in far))
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--k0", type=int, default=101)
@@ -346,6 +424,7 @@ def main(argv=None):
     part_d([101, 1000, 10 ** 4, 10 ** 6])
     if not args.skip_map:
         part_e([101, 202, 404, 808])
+        part_f([1000, 4000, 16000], bulk=(0.002, 0.005, 0.01, 0.02, 0.05, 0.1, 0.25, 0.5), layer=8)
 
 
 if __name__ == "__main__":

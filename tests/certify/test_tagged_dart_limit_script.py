@@ -68,3 +68,22 @@ def test_the_uniform_bracket_holds_and_a_wrong_one_fails():
     with ctx.workprec(128):
         assert mod.part_c(101, boxes=16, quiet=True) == 16
         assert mod.part_c(101, lo="4.30", hi="4.45", boxes=16, quiet=True) == 0  # sigma(K) > 4.45 for K >= 101
+
+
+def test_closed_form_y_is_the_verifiers_even_vector():
+    # the script's y (three columns, a null vector of S - lam2 on them) against the verifier's even_vector
+    # (bordered system on S_E's one-ring, then the outer rows), both normalized at ray K/2's (1,0)
+    from ccproof.certify.verify.tagged import labels
+    from ccproof.certify.verify.tagged_modes import even_vector
+
+    mod = _load()
+    k = 40
+    with ctx.workprec(128):
+        x, y, l1, l2, res = mod.closed_form_vectors(k)
+        assert res < 1e-12
+        pts = labels("dart", k)
+        at = pts.index(("r", k // 2, 1, 0))
+        even = [z.real for z, q, src, _ in mode_spectrum("dart", k) if src == "E" and q != 1 and z.imag.contains(0)]
+        lam2 = max(even, key=lambda r: r.mid())
+        ref = even_vector(k, lam2, at)
+        assert max(abs(float(r.mid()) - v) for r, v in zip(ref, y)) < 1e-10
