@@ -32,6 +32,9 @@ C. a bracket of sigma for every K >= K0 at once: G(sigma_lo, h) and G(sigma_hi, 
    signs on arb boxes covering h in [0, 1/K0];
 D. the winding number of 1 - F along the circle |lam| = r (r between lam(cos(4 pi/K)) and lam2): 0
    means lam2 is the only eigenvalue of S_in of modulus > r besides 1 (floats, adaptive; a measurement);
+D'. the same for every K >= K0 at once: Re(1 - F) > 0 on the whole circle, on arb/acb boxes in three
+   regions of variables that include h = 1/K = 0 (see the comment above :func:`region_n`), and mode 0's
+   second and third eigenvalues below r;
 E. the characteristic map at K = 101, 202, 404, 808 (x the odd mode-1 vector, y the even vector of lam2 by
    inverse iteration on the sparse S): K times the least Bernstein coefficient of det J_Phi per piece
    and of the transversality forms, and where along the ring the minimum sits; its convergence is what
@@ -279,6 +282,192 @@ def part_d(ks):
               f"({pts} arcs; expected +1: S_in has no eigenvalue outside but 1, S0 has 1 and lam1)")
 
 
+# --- D'. Re(1 - F) > 0 on |lam| = r for every K >= K0 at once (arb/acb boxes; untrusted) -------------
+#
+# 1 - F = h (1 - g0) + n*/(4 lam) (cot(K phi/2)/sin phi + h/(c* - 1)), c* = 8 lam - 5 + 1/(2 lam) = cos phi
+# (even in phi), on lam = r e^(it), r = lam(cos(2 sigma_r h)), t in [0, pi] (the lower half by conjugation).
+# If Re(1 - F) > 0 on the whole circle, its winding number is 0. Three regions, each analytic in its own
+# variables over boxes that include h = 0 (K = infinity):
+#   N  t = tau h^2, tau in [0, tau1]: h (1 - F) in (tau, h), sigma = K phi/2 from sigma^2 = D A(h^2 D)/2;
+#   I  t in [tau1 h^2, t0]: v = sqrt(t), w = h/v in [0, 1/sqrt(tau1)]: v (1 - F) in (v, w), with
+#      cot(K phi/2) = -i + a ball of radius 2 e^(-2T)/(1 - e^(-2T)), T = Im(K phi/2) >= Im(phi/v)/(2w);
+#   F  t in [t0, pi]: 1 - F in (t, h), cot as in I with T >= Im(phi) K0/2.
+
+_SIG_R = fmpq(27, 5)  # sigma_r = 5.4: between sigma(K) < 4.51 and 2 pi
+
+
+def _e1(z):
+    """(e^z - 1)/z = e^(z/2) sinc(i z/2) (acb, analytic at 0)."""
+    return (z / 2).exp() * (acb(0, 1) * z / 2).sinc()
+
+
+def _asin_ratio_sq(x, terms=40):
+    """A(x) = (asin(s)/s)^2 with s^2 = x/2, by its series in y = x/2 (coefficients <= 1, so the tail is at
+    most |y|^terms/(1 - |y|); |y| < 9/10 required)."""
+    y = x / 2
+    acc, c = acb(0), fmpq(1)
+    for n in range(terms):
+        acc += c / (2 * n + 1) * y ** n
+        c = c * (2 * n + 1) / (2 * n + 2)
+    tail = abs(y) ** terms / (1 - abs(y))
+    if not abs(y) < fmpq(9, 10):
+        raise ValueError("asin series: |x/2| >= 9/10")
+    s = acc + acb(arb(0, tail.upper()), arb(0, tail.upper()))
+    return s * s
+
+
+def _det_r(lam):
+    q = fmpq(1, 4)
+    R = [[fmpq(7, 4), fmpq(-3, 2), -q], [fmpq(-3, 8), lam - _HALF, -_EIGHTH], [-q, -_HALF, lam - q]]
+    return (R[0][0] * (R[1][1] * R[2][2] - R[1][2] * R[2][1]) - R[0][1] * (R[1][0] * R[2][2] - R[1][2] * R[2][0])
+            + R[0][2] * (R[1][0] * R[2][1] - R[1][1] * R[2][0]))
+
+
+def _g0_num(lam, h):
+    """u0 det - u2 det (Cramer numerators of the mode-0 resolvent column, g0 = (that)/(8 det))."""
+    q = fmpq(1, 4)
+    m00, m01, m02, m20, m21, m22 = lam - 1 + 7 * h / 4, -3 * h / 2, -h / 4, -q, -_HALF, lam - q
+    return -(m01 * m22 - m02 * m21) + (m00 * m21 - m01 * m20)
+
+
+def _cot_far(T):
+    """cot z for Im z >= T > 0: -i plus a ball."""
+    e = (-2 * T).exp()
+    rad = (2 * e / (1 - e)).upper()
+    return acb(arb(0, rad), arb(-1, rad))
+
+
+def _ball(lo, hi):
+    lo, hi = fmpq(lo), fmpq(hi)
+    return arb((lo + hi) / 2, (hi - lo) / 2)
+
+
+def region_n(tau, h):
+    """Re of h (1 - F) on the box (tau, h) (arb balls)."""
+    r = lam_of((2 * _SIG_R * h).cos())
+    e = acb(0, 1) * tau * h * h
+    lam = r * e.exp()
+    D = (2 * _SIG_R ** 2 * (_SIG_R * h).sinc() ** 2 - 8 * r * acb(0, 1) * tau * _e1(e)
+         + acb(0, 1) * tau * _e1(-e) / (2 * r))
+    sig = (D * _asin_ratio_sq(h * h * D) / 2).sqrt()
+    n = 4 * h * h * D * (lam - fmpq(1, 4)) - (2 - h * h * D)
+    h2g0 = h * _g0_num(lam, h) / (8 * (-(lam - 1) * lam * h * D / 8 + _det_r(lam)))
+    val = h * h - h2g0 + n / (4 * lam) * (sig.cot() / (2 * sig * (2 * sig * h).sinc()) - 1 / D)
+    return val.real
+
+
+def region_i(v, w):
+    """Re of v (1 - F) on the box (v, w) (arb balls, v, w >= 0)."""
+    h = v * w
+    r = lam_of((2 * _SIG_R * h).cos())
+    e = acb(0, 1) * v * v
+    lam = r * e.exp()
+    D = (2 * _SIG_R ** 2 * w * w * (_SIG_R * h).sinc() ** 2 - 8 * r * acb(0, 1) * _e1(e)
+         + acb(0, 1) * _e1(-e) / (2 * r))
+    psi = (2 * D * _asin_ratio_sq(v * v * D)).sqrt()
+    if not psi.imag > 0:
+        psi = -psi
+    if not psi.imag > 0:
+        return arb(0, 1)  # undecided
+    T = psi.imag.lower() / (2 * arb(w.upper()))
+    cot = _cot_far(T) if w.upper() > 0 else acb(0, -1)
+    n = 4 * v * v * D * (lam - fmpq(1, 4)) - (2 - v * v * D)
+    # v h g0 = v w num/(8 (a v + b w)), a = -(lam - 1) lam D/8, b = det R; bound it where v, w touch 0
+    a, b, num = -(lam - 1) * lam * D / 8, _det_r(lam), _g0_num(lam, h)
+    if v.lower() > 0 or w.lower() > 0:
+        vhg0 = v * w * num / (8 * (a * v + b * w))
+    else:  # |a v + b w| >= max(al v - be w, ga w - de v) >= m (v + ...) : |v w/(a v + b w)| <= v_hi/m
+        al, be, ga, de = abs(a.imag).lower(), abs(b.imag).upper(), abs(b.real).lower(), abs(a.real).upper()
+        m = (al * ga - be * de) / (al + de)
+        if not m > 0:
+            return arb(0, 1)
+        bound = (arb(v.upper()) / m * abs(num) / 8).upper()
+        vhg0 = acb(arb(0, bound), arb(0, bound))
+    val = v * h - vhg0 + n / (4 * lam) * (cot / (psi * (v * psi).sinc()) - w / D)
+    return val.real
+
+
+def region_f(t, h, k0):
+    """Re of 1 - F on the box (t, h), h in [0, 1/k0]."""
+    r = lam_of((2 * _SIG_R * h).cos())
+    lam = r * (acb(0, 1) * t).exp()
+    cs = 8 * lam - 5 + 1 / (2 * lam)
+    # any root of cos phi = c* will do (the expression is even and 2 pi-periodic in phi for integer K);
+    # off the real axis phi = i acosh(c*) (acosh's cut is the real (-inf, 1]); near lam = -r, c* is close
+    # to the real (-inf, -1]: phi = pi + i acosh(-c*) there
+    if cs.imag > 0 or cs.imag < 0:
+        phi = acb(0, 1) * cs.acosh()
+    else:
+        phi = acb.pi() + acb(0, 1) * (-cs).acosh() if cs.real < -1 else cs.acos()
+    if not phi.imag > 0:
+        phi = -phi
+    if not phi.imag > 0:
+        return arb(0, 1)
+    cot = _cot_far(phi.imag.lower() * k0 / 2)
+    n = 4 * (1 - cs) * (lam - fmpq(1, 4)) - (1 + cs)
+    val = h * (1 - g0(lam, h)) + n / (4 * lam) * (cot / phi.sin() + h / (cs - 1))
+    return val.real
+
+
+def _cover(fn, xs, ys, depth=8):
+    """Bisect the boxes [x0, x1] x [y0, y1] (fmpq ends) until fn is certainly > 0 on each; returns
+    (boxes, least lower bound) or raises with the first box that fails at the depth limit."""
+    stack = [(x0, x1, y0, y1, 0) for x0, x1 in zip(xs, xs[1:]) for y0, y1 in zip(ys, ys[1:])]
+    count, worst = 0, None
+    while stack:
+        x0, x1, y0, y1, d = stack.pop()
+        val = fn(_ball(x0, x1), _ball(y0, y1))
+        if val > 0:
+            count += 1
+            worst = val.lower() if worst is None or val.lower() < worst else worst
+            continue
+        if d >= depth:
+            raise ValueError(f"box [{x0}, {x1}] x [{y0}, {y1}] undecided: {val}")
+        xm, ym = (x0 + x1) / 2, (y0 + y1) / 2
+        if d % 2 == 0:
+            stack += [(x0, xm, y0, y1, d + 1), (xm, x1, y0, y1, d + 1)]
+        else:
+            stack += [(x0, x1, y0, ym, d + 1), (x0, x1, ym, y1, d + 1)]
+    return count, worst
+
+
+def part_d_uniform(k0=101, tau1=50, v0=None, nx=40, ny=4):
+    """Print D' (raises ValueError where a box stays undecided). Regions: N for t <= tau1 h^2, I for
+    tau1 h^2 <= t <= v0^2 (v0 = 2/5 by default), F for t >= v0^2."""
+    v0 = fmpq(2, 5) if v0 is None else v0
+    h0 = fmpq(1, k0)
+    w1 = fmpq(math.ceil(10 ** 4 / math.sqrt(tau1)) + 1, 10 ** 4)  # w <= w1 covers every t >= tau1 h^2
+    assert w1 * w1 * tau1 >= 1
+    t_pi = fmpq(355, 113)  # > pi; boxes beyond pi are harmless (the circle continues)
+    grid = (lambda a, b, n: [a + (b - a) * fmpq(i, n) for i in range(n + 1)])
+    res = {}
+    res["N"] = _cover(region_n, grid(fmpq(0), fmpq(tau1), nx), grid(fmpq(0), h0, ny))
+    res["I"] = _cover(region_i, grid(fmpq(0), v0, nx), grid(fmpq(0), w1, ny))
+    res["F"] = _cover(lambda t, h: region_f(t, h, k0), grid(v0 * v0, t_pi, nx), grid(fmpq(0), h0, ny))
+    for name, (count, worst) in res.items():
+        print(f"D' region {name}: Re > 0 certain on {count} boxes, least lower bound {worst}")
+    # S0's even eigenvalues outside the circle: 1 and lam(cos(2 pi/K)) only. Modes j >= 2 give lam(cos(2 pi j/K))
+    # <= lam(cos(4 pi/K)) < r (sigma_r < 2 pi) and 1/(16 lam) <= 1/4; mode 0's block has det(x - B0) =
+    # (x - 1) Q(x), Q(x) = x^2 - 3x/4 + 1/16 + h l(x) (det R = (x - 1) l(x)); both roots of Q lie below r when
+    # Q(r) > 0 and Q'(r) > 0, and Q(r)/h = l(r) - (r/4) sigma_r^2 h sinc(sigma_r h)^2 on r = lam(cos(2 sigma_r h))
+    if not _det_r(fmpq(1)) == 0:
+        raise ValueError("det R does not vanish at 1")
+
+    def ell(z):  # det R is quadratic in x with the root 1: l = det R/(x - 1) is linear
+        return _det_r(z) / (z - 1)
+    ok = 0
+    for i in range(ny * 4):
+        h = _ball(h0 * i / (ny * 4), h0 * (i + 1) / (ny * 4))
+        r = lam_of((2 * _SIG_R * h).cos())
+        q_over_h = ell(r) - r / 4 * _SIG_R ** 2 * h * (_SIG_R * h).sinc() ** 2
+        dq = 2 * r - fmpq(3, 4) + h * (ell(r + 1) - ell(r))  # l is linear: l' = l(r + 1) - l(r)
+        ok += bool(q_over_h > 0 and dq > 0)
+    print(f"D' mode 0: both roots of Q below r on {ok}/{ny * 4} h-boxes (so S0 has exactly 1 and lam(cos(2 pi/K)) "
+          "outside the circle among its even eigenvalues)")
+    print(f"D' so Re(1 - F) > 0 on |lam| = lam(cos(2 x 5.4/K)) for every K >= {k0}: the winding number is 0, and "
+          "S_in has no eigenvalue outside that circle but 1 and lam2")
+
+
 # --- E. the characteristic map at large K -----------------------------------------------------------
 
 def part_e(ks):
@@ -422,6 +611,7 @@ def main(argv=None):
     part_b([101, 200, 1000, 10 ** 4, 10 ** 6, None])
     part_c(args.k0)
     part_d([101, 1000, 10 ** 4, 10 ** 6])
+    part_d_uniform(args.k0)
     if not args.skip_map:
         part_e([101, 202, 404, 808])
         part_f([1000, 4000, 16000], bulk=(0.002, 0.005, 0.01, 0.02, 0.05, 0.1, 0.25, 0.5), layer=8)

@@ -87,3 +87,38 @@ def test_closed_form_y_is_the_verifiers_even_vector():
         lam2 = max(even, key=lambda r: r.mid())
         ref = even_vector(k, lam2, at)
         assert max(abs(float(r.mid()) - v) for r, v in zip(ref, y)) < 1e-10
+
+
+def test_re_one_minus_f_positive_on_the_circle_for_every_k_and_not_inside_lam2(monkeypatch, capsys):
+    # Re(1 - F) > 0 on |lam| = lam(cos(10.8/K)) for every K >= 101 (three regions of boxes); on the circle
+    # through sigma = 4 (between lam2 and lam1) the winding number is +1, so Re(1 - F) <= 0 somewhere and
+    # the same cover must fail
+    mod = _load()
+    with ctx.workprec(128):
+        mod.part_d_uniform(101)
+        out = capsys.readouterr().out
+        assert "region N: Re > 0" in out and "region I: Re > 0" in out and "region F: Re > 0" in out
+        assert "on 16/16 h-boxes" in out
+        monkeypatch.setattr(mod, "_SIG_R", fmpq(4))
+        with pytest.raises(ValueError, match="undecided"):
+            mod.part_d_uniform(101)
+
+
+def test_the_regions_agree_with_the_float_closed_form():
+    # region N is h (1 - F), region I is v (1 - F) with t = v^2, w = h/v, region F is 1 - F: each against the
+    # plain closed form in floats at K = 200
+    import cmath
+
+    mod = _load()
+    k, h = 200, 1 / 200
+    c = math.cos(10.8 / k)
+    r = (5 + c + math.sqrt((1 + c) * (9 + c))) / 16
+
+    def ref(t):
+        return (1 - mod._f_float(r * cmath.exp(1j * t), k)).real
+
+    with ctx.workprec(128):
+        hb = arb(fmpq(1, k))
+        assert abs(float(mod.region_n(arb(3), hb).mid()) - h * ref(3 * h * h)) < 1e-9
+        assert abs(float(mod.region_i(arb("0.2"), hb / arb("0.2")).mid()) - 0.2 * ref(0.04)) < 1e-9
+        assert abs(float(mod.region_f(arb("1.5"), hb, 101).mid()) - ref(1.5)) < 1e-9
