@@ -44,7 +44,7 @@ F. the same map from closed forms (x the mode-1 vector; y = y_C u(p) + Re(beta (
    the quadrants next to the sharp ray (K^3 min det J, and over (2 pi q)^2) against the bulk (K min det J
    over theta^2), which must match for a two-regime argument.
 
-  python scripts/tagged_dart_limit.py [--k0 101] [--skip-map]   (about 45 s, 0.9 GB at K = 16000)
+  python scripts/tagged_dart_limit.py [--k0 101] [--skip-map]   (about 60 s, 0.94 GB: K = 16000 in F)
 """
 
 from __future__ import annotations
