@@ -21,6 +21,13 @@ __all__ = ["load", "CTable", "evaluate_block", "ring_walks"]
 
 _P = ctypes.c_void_p
 _I = ctypes.c_int64
+#: most layers of corner nets precomputed (CCP_LAYER_NETS in _clib.c)
+_LAYER_NETS = 4
+#: the bytes the precomputed corner nets of layers 1, 2, ... may take together (layer 0 is the table's own
+#: ``hot``): a point in layer n of a corner face reads its net there instead of the kernel's corner-net cache
+LAYER_NETS_BUDGET = 4 << 20
+#: the largest grid of cells (``ccp_grid``: 128 bytes per ptex face) the binding makes
+GRID_BUDGET = 32 << 20
 
 
 class _Table(ctypes.Structure):
@@ -31,13 +38,14 @@ class _Table(ctypes.Structure):
                 ("h", _P), ("leaf", _P), ("pts", _P), ("cfg", _P), ("cu", _P), ("cv", _P),
                 ("split_depth", _I), ("n_ptex", _I), ("max_layers", _I), ("nets", _P), ("origin", _P),
                 ("ring", _P), ("ops", _P), ("op_start", _P), ("op_size", _P), ("n_layers", _P), ("unit", _P),
-                ("hot", _P), ("n_hot", _I)]
+                ("hot", _P), ("n_hot", _I), ("layer_nets", _P * _LAYER_NETS), ("n_layer_nets", _I),
+                ("grid", _P)]
 
 
 _LIB = None
 _TRIED = False
 #: the version of the kernel's interface (``ccp_abi`` in _clib.c)
-_ABI = 2
+_ABI = 3
 #: calls on fewer points use no corner-net cache (CCP_CACHE_MIN in _clib.c)
 _CACHE_MIN = 256
 
@@ -70,6 +78,10 @@ def load():
         lib.ccp_evaluate.argtypes = [ctypes.POINTER(_Table), _I, _P, _P, _P, _I, _P, _P, _P, _P, _P, _P, _P]
         lib.ccp_cache_words.restype = _I
         lib.ccp_cache_words.argtypes = []
+        lib.ccp_corner_nets.restype = _I
+        lib.ccp_corner_nets.argtypes = [ctypes.POINTER(_Table), _I, _I, _P]
+        lib.ccp_grid.restype = _I
+        lib.ccp_grid.argtypes = [ctypes.POINTER(_Table), _P]
         lib.ccp_ring_walks.restype = _I
         lib.ccp_ring_walks.argtypes = [_P] * 6 + [_I, _P, _P, _P, _I, _P, _P, _I, _P, _P]
         _LIB = lib
@@ -91,10 +103,16 @@ class CTable:
     Parameters
     ----------
     table : PatchTable
+    layers : int, optional
+        Layers of corner nets to keep precomputed, 1 to 4 (layer 0 is the table's ``hot``; the others are
+        computed here by the kernel's own sums, ``ccp_corner_nets``). Default: as many as
+        :data:`LAYER_NETS_BUDGET` allows; none where the table has no ``hot``. The results are the same bits
+        for any number.
     """
 
-    def __init__(self, table):
+    def __init__(self, table, layers=None, grid=None):
         self.table = T = table
+        self.layers, self.grid = layers, grid
         keep = {}
 
         def arr(name, dtype):
@@ -130,6 +148,26 @@ class CTable:
         self._keep = keep
         self.struct = s
         self.ref = ctypes.byref(s)
+        if s.n_hot:  # the corner nets of layers 0 (the table's) to n - 1 (computed here)
+            n = layers if layers is not None else 1 + min(2, LAYER_NETS_BUDGET // max(1, T.hot.nbytes))
+            if not 1 <= n <= _LAYER_NETS:
+                raise ValueError(f"layers must be 1 to {_LAYER_NETS}, got {n}")
+            nets = [keep["hot"]]
+            lib = load()
+            for lay in range(1, n):
+                w = np.empty_like(keep["hot"])
+                if lib.ccp_corner_nets(self.ref, T.job_root.shape[0], lay, _addr(w)) != 0:
+                    raise MemoryError("ccp_corner_nets: a job's tree of virtual faces is too deep")  # pragma: no cover
+                nets.append(w)
+            keep["layer_nets"] = nets
+            s.layer_nets = (_P * _LAYER_NETS)(*[_addr(a) for a in nets])
+            s.n_layer_nets = n
+        n_ptex = T.refused.shape[0]
+        if grid if grid is not None else (0 < n_ptex and 128 * n_ptex <= GRID_BUDGET):
+            g = np.empty(16 * n_ptex, dtype=np.int64)
+            if load().ccp_grid(self.ref, _addr(g)) == 0:
+                keep["grid"] = g
+                s.grid = _addr(g)
         self._caches = []  # corner-net caches not in use (one per concurrent call, kept between calls)
         self._lock = threading.Lock()
 
@@ -145,7 +183,7 @@ class CTable:
             self._caches.append(cache)
 
     def __reduce__(self):
-        return CTable, (self.table,)
+        return CTable, (self.table, self.layers, self.grid)
 
 
 def evaluate_block(lib, ct, f, u, v, d, outs):
