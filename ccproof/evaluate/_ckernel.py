@@ -39,7 +39,7 @@ class _Table(ctypes.Structure):
                 ("split_depth", _I), ("n_ptex", _I), ("max_layers", _I), ("nets", _P), ("origin", _P),
                 ("ring", _P), ("ops", _P), ("op_start", _P), ("op_size", _P), ("n_layers", _P), ("unit", _P),
                 ("hot", _P), ("n_hot", _I), ("layer_nets", _P * _LAYER_NETS), ("n_layer_nets", _I),
-                ("grid", _P)]
+                ("grid", _P), ("inv_h", _P), ("inv_unit", _P)]
 
 
 _LIB = None
@@ -93,6 +93,18 @@ def _addr(a):
     return a.ctypes.data if a.size else None
 
 
+def _powers_of_two(a):
+    """Whether every value of ``a`` is a power of two whose reciprocal is a normal double (dividing by it is
+    then multiplying by the reciprocal, bit for bit).
+
+    >>> _powers_of_two(np.array([1.0, 0.5, 2.0 ** -40])), _powers_of_two(np.array([0.75]))
+    (True, False)
+    """
+    a = np.asarray(a, dtype=np.float64)
+    m, e = np.frexp(a)
+    return bool(np.all((m == 0.5) & (e >= -1020) & (e <= 1020)))
+
+
 class CTable:
     """The patch table (:class:`ccproof.evaluate._table.PatchTable`) as the C kernel reads it.
 
@@ -110,14 +122,18 @@ class CTable:
         for any number.
     """
 
-    def __init__(self, table, layers=None, grid=None):
+    def __init__(self, table, layers=None, grid=None, reciprocals=None):
         self.table = T = table
-        self.layers, self.grid = layers, grid
+        self.layers, self.grid, self.reciprocals = layers, grid, reciprocals
         keep = {}
 
         def arr(name, dtype):
             a = np.ascontiguousarray(getattr(T, name), dtype=dtype)
             keep[name] = a
+            return _addr(a)
+
+        def arr_of(name, a):
+            keep[name] = a = np.ascontiguousarray(a, dtype=np.float64)
             return _addr(a)
 
         def offsets(name):  # int32 or int64, as the table stores them
@@ -168,6 +184,12 @@ class CTable:
             if load().ccp_grid(self.ref, _addr(g)) == 0:
                 keep["grid"] = g
                 s.grid = _addr(g)
+        sides = T.unit[:, :, 2].reshape(-1)
+        if reciprocals if reciprocals is not None else (_powers_of_two(T.h) and _powers_of_two(sides)):
+            if not (_powers_of_two(T.h) and _powers_of_two(sides)):
+                raise ValueError("reciprocals need every side of the table to be a power of two")
+            s.inv_h = arr_of("inv_h", 1.0 / T.h)
+            s.inv_unit = arr_of("inv_unit", 1.0 / sides)
         self._caches = []  # corner-net caches not in use (one per concurrent call, kept between calls)
         self._lock = threading.Lock()
 
@@ -183,7 +205,7 @@ class CTable:
             self._caches.append(cache)
 
     def __reduce__(self):
-        return CTable, (self.table, self.layers, self.grid)
+        return CTable, (self.table, self.layers, self.grid, self.reciprocals)
 
 
 def evaluate_block(lib, ct, f, u, v, d, outs):

@@ -81,6 +81,10 @@ typedef struct {
     /* NULL, or per ptex face its 4 x 4 cells (row (v) major): job << CCP_VF_BITS | the virtual face that holds
      * the cell (ccp_grid) */
     const int64_t *grid;
+    /* NULL, or 1 / h per virtual face and 1 / (the patch side of ``unit``) per configuration and code (3 per
+     * configuration), where every side is a power of two (the binding checks): then dividing by a side is
+     * multiplying by its reciprocal, bit for bit (both the exact quotient, rounded once) */
+    const double *inv_h, *inv_unit;
 } ccp_table;
 
 CCP_INLINE int64_t ld(const void *a, int64_t wide, int64_t i) {
@@ -341,17 +345,25 @@ CCP_INLINE int find_face(const ccp_table *T, int64_t pf, double uu, double ww, i
 CCP_INLINE const double *locate(const ccp_table *T, int64_t job, int64_t vf, int kind, double uu, double ww,
                                 ccp_deep *dp, double *s, double *t, double *g) {
     const double *net;
-    double pu0, pv0, h;
+    double pu0, pv0, h, gi = 0.0;
     if (kind == CCP_CORNER) {
         double U0 = T->u0[vf], V0 = T->v0[vf], H = T->h[vf];
         int cu = T->cu[vf], cv = T->cv[vf];
+        double du, dv;
+        if (T->inv_h != NULL) {
+            double r = T->inv_h[vf];
+            du = (cu ? (U0 + H) - uu : uu - U0) * r;
+            dv = (cv ? (V0 + H) - ww : ww - V0) * r;
+        } else {
 #if defined(__GNUC__)
-        v4d dd = (v4d){cu ? (U0 + H) - uu : uu - U0, cv ? (V0 + H) - ww : ww - V0, 1.0, 1.0} / splat(H);
-        double du = dd[0], dv = dd[1];
+            v4d dd = (v4d){cu ? (U0 + H) - uu : uu - U0, cv ? (V0 + H) - ww : ww - V0, 1.0, 1.0} / splat(H);
+            du = dd[0];
+            dv = dd[1];
 #else
-        double du = (cu ? (U0 + H) - uu : uu - U0) / H;
-        double dv = (cv ? (V0 + H) - ww : ww - V0) / H;
+            du = (cu ? (U0 + H) - uu : uu - U0) / H;
+            dv = (cv ? (V0 + H) - ww : ww - V0) / H;
 #endif
+        }
         double mx = du >= dv ? du : dv;
         int64_t cfg = T->cfg[vf];
         int64_t nmax = T->n_layers[cfg] - 1, lay;
@@ -373,6 +385,7 @@ CCP_INLINE const double *locate(const ccp_table *T, int64_t job, int64_t vf, int
         pu0 = un[0] * sc + (cu ? (U0 + H) : U0);
         pv0 = un[1] * sc + (cv ? (V0 + H) : V0);
         h = un[2] * sc;
+        if (T->inv_h != NULL) gi = T->inv_unit[3 * cfg + code] * T->inv_h[vf] * up; /* 1 / h, exactly */
         int64_t ci = ld(T->job_corner, T->wide[3], job) + T->leaf[vf];
         if (lay < T->n_layer_nets) {
             net = T->layer_nets[lay] + CCP_NET * (3 * ci + code);
@@ -390,6 +403,16 @@ CCP_INLINE const double *locate(const ccp_table *T, int64_t job, int64_t vf, int
         pu0 = T->u0[vf];
         pv0 = T->v0[vf];
         h = T->h[vf];
+        if (T->inv_h != NULL) gi = T->inv_h[vf];
+    }
+    if (T->inv_h != NULL) {
+        double x = (uu - pu0) * gi, y = (ww - pv0) * gi;
+        *g = gi;
+        x = 0.0 > x ? 0.0 : x;
+        y = 0.0 > y ? 0.0 : y;
+        *s = 1.0 < x ? 1.0 : x;
+        *t = 1.0 < y ? 1.0 : y;
+        return net;
     }
 #if defined(__GNUC__)
     v4d qq = (v4d){uu - pu0, ww - pv0, 1.0, 1.0} / splat(h); /* three divisions in one */

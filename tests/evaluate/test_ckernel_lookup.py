@@ -1,9 +1,10 @@
 """The C kernel's lookup structures (ccproof/evaluate/_ckernel.py, CTable): the corner nets of layers 1 to 3
-kept precomputed and the grid of 4 x 4 cells per ptex face that finds a point's job and virtual face in one
-read. With any number of precomputed layers, with and without the grid, the kernel gives the bits of the
-numpy path (the independent array formulation of the same sums), on points in every layer at the corners,
-on the cells' borders and next to them, on meshes whose faces split 1 to 5 levels deep; and the layer-0
-nets the kernel computes equal the table's own (computed with numpy)."""
+kept precomputed, the grid of 4 x 4 cells per ptex face that finds a point's job and virtual face in one
+read, and the reciprocals of the sides (powers of two) that turn the kernel's divisions by them into
+multiplications. With any number of precomputed layers, with and without the grid and the reciprocals, the
+kernel gives the bits of the numpy path (the independent array formulation of the same sums), on points in
+every layer at the corners, on the cells' borders and next to them, on meshes whose faces split 1 to 5
+levels deep; and the layer-0 nets the kernel computes equal the table's own (computed with numpy)."""
 
 from __future__ import annotations
 
@@ -59,15 +60,23 @@ def _points(S, n, seed):
     return f, u, v
 
 
+_REF = {}
+
+
 @pytest.mark.parametrize("layers", [1, 2, 3, 4])
 @pytest.mark.parametrize("grid", [False, True])
-def test_every_lookup_gives_the_numpy_bits(surface, layers, grid):
+@pytest.mark.parametrize("reciprocals", [False, True])
+def test_every_lookup_gives_the_numpy_bits(surface, layers, grid, reciprocals):
     from ccproof.evaluate import _ckernel
 
-    f, u, v = _points(surface, 9000, layers)
-    ref = surface.evaluate(f, u, v, 2, backend="numpy")
-    ct = _ckernel.CTable(surface._table, layers=layers, grid=grid)
+    f, u, v = _points(surface, 9000, 1)
+    if id(surface) not in _REF:
+        _REF.clear()
+        _REF[id(surface)] = surface.evaluate(f, u, v, 2, backend="numpy")
+    ref = _REF[id(surface)]
+    ct = _ckernel.CTable(surface._table, layers=layers, grid=grid, reciprocals=reciprocals)
     assert ct.struct.n_layer_nets == layers and bool(ct.struct.grid) == grid
+    assert bool(ct.struct.inv_h) == bool(ct.struct.inv_unit) == reciprocals
     lib = _ckernel.load()
     for lo, hi in ((0, f.size), (5, 200)):  # a call with the corner-net cache, one below its threshold
         outs = [np.full((hi - lo, 3), np.nan) for _ in _KEYS]
@@ -81,7 +90,7 @@ def test_default_lookup_and_threads(surface):
     f, u, v = _points(surface, 6000, 7)
     ref = surface.evaluate(f, u, v, 1, backend="numpy")
     ct = surface._c_table()
-    assert ct.struct.grid and ct.struct.n_layer_nets == 3
+    assert ct.struct.grid and ct.struct.n_layer_nets == 3 and ct.struct.inv_h
     for threads in (1, 3):
         got = surface.evaluate(f, u, v, 1, backend="c", threads=threads)
         assert all(np.array_equal(ref[k], got[k]) for k in ref), threads
@@ -108,3 +117,14 @@ def test_a_wrong_number_of_layers_is_refused(surface):
     for bad in (0, 5):
         with pytest.raises(ValueError, match="layers must be 1 to 4"):
             _ckernel.CTable(surface._table, layers=bad)
+
+
+def test_reciprocals_need_powers_of_two(surface):
+    from ccproof.evaluate import _ckernel
+
+    T = surface._table
+    assert _ckernel._powers_of_two(T.h) and _ckernel._powers_of_two(T.unit[:, :, 2])
+    odd = T._replace(h=T.h * 0.75)  # not a power of two: the default takes the divisions
+    assert not _ckernel.CTable(odd, layers=1).struct.inv_h
+    with pytest.raises(ValueError, match="power of two"):
+        _ckernel.CTable(odd, layers=1, reciprocals=True)
