@@ -567,8 +567,14 @@ int64_t ccp_corner_nets(const ccp_table *T, int64_t n_jobs, int64_t lay, double 
 /* The grid of ``grid`` (16 n_ptex entries): per ptex face and cell (i, j) of its 4 x 4 cells (u in [i / 4, (i + 1)
  * / 4), the last closed, v likewise, entry 16 face + 4 j + i), the job of the cell's quadrant and the
  * smallest virtual face of that job that holds the whole cell (the kernel's comparisons at the cell's centre;
- * virtual faces are dyadic squares, so every point of the cell makes the same choices down to it). Refused
- * faces get 0. Returns 0, or -1 when a virtual face's number does not fit CCP_VF_BITS. */
+ * virtual faces are dyadic squares, so every point of the cell makes the same choices down to it; a child that
+ * does not hold the whole cell is not taken). Refused faces get 0. Returns 0, -1 when a virtual face's number
+ * does not fit CCP_VF_BITS, or -2 when a job's face does not hold a whole cell (no grid then). */
+CCP_INLINE int holds(const ccp_table *T, int64_t vf, int64_t i, int64_t j) {
+    return T->u0[vf] <= 0.25 * i && T->u0[vf] + T->h[vf] >= 0.25 * (i + 1) && T->v0[vf] <= 0.25 * j &&
+           T->v0[vf] + T->h[vf] >= 0.25 * (j + 1);
+}
+
 int64_t ccp_grid(const ccp_table *T, int64_t *grid) {
     for (int64_t pf = 0; pf < T->n_ptex; pf++)
         for (int64_t j = 0; j < 4; j++)
@@ -579,9 +585,12 @@ int64_t ccp_grid(const ccp_table *T, int64_t *grid) {
                 double uu = (i + 0.5) / 4, ww = (j + 0.5) / 4;
                 int64_t job = ld(T->top, T->wide[0], 4 * pf + (uu >= 0.5) + 2 * (ww >= 0.5));
                 int64_t vf = ld(T->job_root, T->wide[1], job);
-                while (T->kind[vf] == CCP_SPLIT && T->h[vf] >= 0.5) { /* children of side >= 1/4 */
+                if (!holds(T, vf, i, j)) return -2;
+                while (T->kind[vf] == CCP_SPLIT) {
                     double half = T->h[vf] * 0.5;
-                    vf = T->child[4 * vf + (uu >= T->u0[vf] + half) + 2 * (ww >= T->v0[vf] + half)];
+                    int64_t c = T->child[4 * vf + (uu >= T->u0[vf] + half) + 2 * (ww >= T->v0[vf] + half)];
+                    if (!holds(T, c, i, j)) break;
+                    vf = c;
                 }
                 if (vf >= (1 << CCP_VF_BITS)) return -1;
                 *e = job << CCP_VF_BITS | vf;

@@ -128,3 +128,14 @@ def test_reciprocals_need_powers_of_two(surface):
     assert not _ckernel.CTable(odd, layers=1).struct.inv_h
     with pytest.raises(ValueError, match="power of two"):
         _ckernel.CTable(odd, layers=1, reciprocals=True)
+
+
+def test_no_grid_where_a_face_does_not_hold_whole_cells(surface):
+    """The grid is made only where every job's face holds whole cells (dyadic squares, as the table builds
+    them); a table whose faces were shifted by a third of a cell gets none (the kernel then walks the splits)."""
+    from ccproof.evaluate import _ckernel
+
+    T = surface._table
+    assert _ckernel.CTable(T, layers=1, grid=True).struct.grid
+    shifted = T._replace(u0=T.u0 + 1.0 / 12)
+    assert not _ckernel.CTable(shifted, layers=1, grid=True).struct.grid
