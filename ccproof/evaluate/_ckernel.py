@@ -17,6 +17,8 @@ import threading
 
 import numpy as np
 
+from ccproof.errors import CCProofError
+
 __all__ = ["load", "CTable", "evaluate_block", "ring_walks"]
 
 _P = ctypes.c_void_p
@@ -117,9 +119,23 @@ class CTable:
     table : PatchTable
     layers : int, optional
         Layers of corner nets to keep precomputed, 1 to 4 (layer 0 is the table's ``hot``; the others are
-        computed here by the kernel's own sums, ``ccp_corner_nets``). Default: as many as
-        :data:`LAYER_NETS_BUDGET` allows; none where the table has no ``hot``. The results are the same bits
-        for any number.
+        computed here by the kernel's own sums, ``ccp_corner_nets``). Default: 3, fewer where they would
+        exceed :data:`LAYER_NETS_BUDGET`; none where the table has no ``hot``.
+    grid : bool, optional
+        Make the grid of 4 x 4 cells per ptex face (``ccp_grid``: a point's job and virtual face in one
+        read). Default: where it takes at most :data:`GRID_BUDGET` bytes. None is made (whatever ``grid``
+        says) where a job's face does not hold whole cells.
+    reciprocals : bool, optional
+        Store the reciprocals of the sides (1 / h per virtual face, of the corner patches' unit sides) so that
+        the kernel multiplies instead of dividing. Default: where every side is a power of two (then the two
+        give the same bits).
+
+    The results are the same bits with any of these.
+
+    Raises
+    ------
+    CCProofError
+        ``layers`` outside 1 to 4; ``reciprocals=True`` on a table with a side that is not a power of two.
     """
 
     def __init__(self, table, layers=None, grid=None, reciprocals=None):
@@ -167,14 +183,15 @@ class CTable:
         if s.n_hot:  # the corner nets of layers 0 (the table's) to n - 1 (computed here)
             n = layers if layers is not None else 1 + min(2, LAYER_NETS_BUDGET // max(1, T.hot.nbytes))
             if not 1 <= n <= _LAYER_NETS:
-                raise ValueError(f"layers must be 1 to {_LAYER_NETS}, got {n}")
+                raise CCProofError(f"layers must be 1 to {_LAYER_NETS}, got {n}")
             nets = [keep["hot"]]
             lib = load()
             for lay in range(1, n):
                 w = np.empty_like(keep["hot"])
                 if lib.ccp_corner_nets(self.ref, T.job_root.shape[0], lay, _addr(w)) != 0:
-                    raise MemoryError("ccp_corner_nets: a job's tree of virtual faces is too deep")  # pragma: no cover
+                    break  # a tree of virtual faces deeper than the walk's stack: the cache serves these layers
                 nets.append(w)
+            n = len(nets)
             keep["layer_nets"] = nets
             s.layer_nets = (_P * _LAYER_NETS)(*[_addr(a) for a in nets])
             s.n_layer_nets = n
@@ -187,7 +204,7 @@ class CTable:
         sides = T.unit[:, :, 2].reshape(-1)
         if reciprocals if reciprocals is not None else (_powers_of_two(T.h) and _powers_of_two(sides)):
             if not (_powers_of_two(T.h) and _powers_of_two(sides)):
-                raise ValueError("reciprocals need every side of the table to be a power of two")
+                raise CCProofError("reciprocals need every side of the table to be a power of two")
             s.inv_h = arr_of("inv_h", 1.0 / T.h)
             s.inv_unit = arr_of("inv_unit", 1.0 / sides)
         self._caches = []  # corner-net caches not in use (one per concurrent call, kept between calls)

@@ -536,18 +536,19 @@ int64_t ccp_evaluate(const ccp_table *T, int64_t n, const int64_t *f, const doub
 /* The size of a corner-net cache, in doubles. */
 int64_t ccp_cache_words(void) { return CCP_CACHE_WORDS; }
 
+#define CCP_STACK 256
 /* The nets of layer ``lay`` of every corner face of the table's ``n_jobs`` jobs (W: 3 n_corner x 17 x 3 doubles,
  * row 3 ci + code the net of patch ``code`` of corner face ci; rows of corner faces with fewer layers are zero):
  * the same sums as the corner nets the kernel computes at evaluation time (corner_net), for
  * ``layer_nets``. Returns 0, or -1 when a job's tree of virtual faces is deeper than the walk's stack. */
 int64_t ccp_corner_nets(const ccp_table *T, int64_t n_jobs, int64_t lay, double *W) {
     for (int64_t job = 0; job < n_jobs; job++) {
-        int64_t stack[64], ns = 0;
+        int64_t stack[CCP_STACK], ns = 0; /* 3 more per level: 44 levels of splits at most in a table */
         stack[ns++] = ld(T->job_root, T->wide[1], job);
         while (ns > 0) {
             int64_t vf = stack[--ns];
             if (T->kind[vf] == CCP_SPLIT) {
-                if (ns + 4 > 64) return -1;
+                if (ns + 4 > CCP_STACK) return -1;
                 for (int q = 0; q < 4; q++) stack[ns++] = T->child[4 * vf + q];
             } else if (T->kind[vf] == CCP_CORNER) {
                 int64_t cfg = T->cfg[vf], ci = ld(T->job_corner, T->wide[3], job) + T->leaf[vf];
@@ -586,7 +587,7 @@ int64_t ccp_grid(const ccp_table *T, int64_t *grid) {
                 int64_t job = ld(T->top, T->wide[0], 4 * pf + (uu >= 0.5) + 2 * (ww >= 0.5));
                 int64_t vf = ld(T->job_root, T->wide[1], job);
                 if (!holds(T, vf, i, j)) return -2;
-                while (T->kind[vf] == CCP_SPLIT) {
+                for (int64_t it = 0; it < T->split_depth && T->kind[vf] == CCP_SPLIT; it++) {
                     double half = T->h[vf] * 0.5;
                     int64_t c = T->child[4 * vf + (uu >= T->u0[vf] + half) + 2 * (ww >= T->v0[vf] + half)];
                     if (!holds(T, c, i, j)) break;

@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from ccproof.errors import CCProofError
 from ccproof.evaluate import natural_limit_surface
 from ccproof.evaluate.surface import available_backends
 from ccproof.mesh import read_obj
@@ -115,7 +116,7 @@ def test_a_wrong_number_of_layers_is_refused(surface):
     from ccproof.evaluate import _ckernel
 
     for bad in (0, 5):
-        with pytest.raises(ValueError, match="layers must be 1 to 4"):
+        with pytest.raises(CCProofError, match="layers must be 1 to 4"):
             _ckernel.CTable(surface._table, layers=bad)
 
 
@@ -126,7 +127,7 @@ def test_reciprocals_need_powers_of_two(surface):
     assert _ckernel._powers_of_two(T.h) and _ckernel._powers_of_two(T.unit[:, :, 2])
     odd = T._replace(h=T.h * 0.75)  # not a power of two: the default takes the divisions
     assert not _ckernel.CTable(odd, layers=1).struct.inv_h
-    with pytest.raises(ValueError, match="power of two"):
+    with pytest.raises(CCProofError, match="power of two"):
         _ckernel.CTable(odd, layers=1, reciprocals=True)
 
 
@@ -139,3 +140,20 @@ def test_no_grid_where_a_face_does_not_hold_whole_cells(surface):
     assert _ckernel.CTable(T, layers=1, grid=True).struct.grid
     shifted = T._replace(u0=T.u0 + 1.0 / 12)
     assert not _ckernel.CTable(shifted, layers=1, grid=True).struct.grid
+
+
+def test_a_tree_deeper_than_the_walk_falls_back_to_the_cache():
+    """A table whose split faces are their own children (a tree without end: deeper than any table the
+    builder makes) gets no precomputed layers beyond 0 and a finite grid walk, instead of an error or a
+    hang."""
+    from ccproof.evaluate import _ckernel
+
+    S = natural_limit_surface(read_mesh(MESHES / "catmark_cubes_infsharp.obj"))
+    T = S._table
+    split = np.flatnonzero(T.kind == 2)
+    assert split.size
+    child = T.child.copy()
+    child[split] = split[:, None]
+    ct = _ckernel.CTable(T._replace(child=child), layers=3, grid=True)
+    assert ct.struct.n_layer_nets == 1 and ct.struct.grid
+    assert _ckernel.CTable(T, layers=3).struct.n_layer_nets == 3
