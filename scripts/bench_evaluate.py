@@ -24,8 +24,13 @@ Measures, in one run:
    1-minute load before each round), the process pinned to one CPU; the ratio to Far is taken per round.
    Also this machine's two bounds on one thread (ideal compiled work on one net, ``scripts/bench_ideal.c``
    built with gcc -O3 -march=native -ffast-math: compute; read bandwidth / 92 bytes: memory), the fraction
-   of each reached, the two-thread gain of the default kernel against the machine's ceiling on the same
-   ideal work split over the threads, and the largest position difference;
+   of each reached, and the largest position difference; then, unpinned, the default kernel on all CPUs
+   against one thread next to this machine's ceiling: ideal compiled work of the same shape (the same
+   points, each reading its face id, u, v and writing P, Pu, Pv; ``ideal_points`` of bench_ideal.c) on one
+   thread against split into equal parts over the threads, in the same interleaved rounds (2 x rounds + 1),
+   the ratio taken per round; with the CPU seconds of the threaded run over the one-thread run (what each
+   core loses when all are busy) and the threads' occupancy (CPU over threads x wall: idling, imbalance,
+   other processes);
 6. start-up in fresh processes, ours (each compiled backend) and OpenSubdiv Far's: seconds and peak resident
    memory (VmHWM) after importing, loading the kernel, the setup and one evaluation of 10^6 points.
    Then what ``import ccproof`` (with the evaluator and the mesh reader) and the kernel load add over
@@ -40,6 +45,8 @@ ours, ``python -c`` with the per-configuration disk cache filled and empty, agai
 a program of its own, ``scripts/osd_setup_driver.cpp``, reading the same OBJ; every process timed from start
 to exit, in turn round by round; and the floors of a Python process: ``python -c pass``, numpy's import,
 ours)
+[--threads-only]  (only part 5's threads against one thread with the machine's ceiling; no OpenSubdiv;
+about a minute)
 [--startup]  (``--startup``: only part 6, start-up and peak memory of fresh processes, ours against Far, and
 the import's cost over ``python -c 'import numpy'``)
 """
@@ -48,6 +55,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 import sys
 import time
 import tracemalloc
@@ -157,9 +165,9 @@ def interleaved(cases, rounds):
     return times, load
 
 
-def _ideal_c():
-    """``ideal(s, t, net, P, Pu, Pv)`` compiled from ``scripts/bench_ideal.c`` with gcc (-O3 -march=native
-    -ffast-math) into the temp folder, or None without gcc."""
+def _ideal_lib():
+    """``scripts/bench_ideal.c`` compiled with gcc (-O3 -march=native -ffast-math) into the temp folder and
+    loaded (ctypes), or None without gcc."""
     import ctypes
     import hashlib
     import shutil
@@ -172,7 +180,7 @@ def _ideal_c():
     code = src.read_bytes()
     so = Path(tempfile.gettempdir()) / f"ccproof_bench_ideal-{hashlib.sha256(code).hexdigest()[:16]}.so"
     if not so.exists():
-        tmp = so.with_suffix(".tmp.so")
+        tmp = so.with_suffix(f".{os.getpid()}.tmp.so")
         r = subprocess.run(["gcc", "-O3", "-march=native", "-ffast-math", "-shared", "-fPIC", str(src), "-o",
                             str(tmp)], capture_output=True, text=True)
         if r.returncode != 0:
@@ -181,6 +189,17 @@ def _ideal_c():
     lib = ctypes.CDLL(str(so))
     lib.ideal.argtypes = [ctypes.c_int64] + [ctypes.c_void_p] * 6
     lib.ideal.restype = None
+    lib.ideal_points.argtypes = [ctypes.c_int64] + [ctypes.c_void_p] * 7
+    lib.ideal_points.restype = None
+    return lib
+
+
+def _ideal_c():
+    """``ideal(s, t, net, P, Pu, Pv)`` of ``scripts/bench_ideal.c`` (see :func:`_ideal_lib`), or None without
+    gcc."""
+    lib = _ideal_lib()
+    if lib is None:
+        return None
 
     def ideal(s, t, net, P, Pu, Pv):
         lib.ideal(s.size, *(a.ctypes.data for a in (s, t, net, P, Pu, Pv)))
@@ -270,8 +289,6 @@ def osd_side_by_side(n, rng, quick=False, rounds=7):
     print(f"   this machine, one thread: ideal compiled work {compute / 1e6:.1f} M points/s (compute bound); "
           f"read bandwidth {bw / 2**30:.1f} GiB/s / {BYTES_PER_POINT} B = {memory / 1e6:.1f} M points/s "
           f"(memory bound)")
-    if threads > 1:
-        machine_ceiling(threads, quick)
     default = available_backends()[0]  # what evaluate uses without backend=
     print(f"   backends: {', '.join(available_backends())} (default {default})")
     rows = []
@@ -332,10 +349,8 @@ def osd_side_by_side(n, rng, quick=False, rounds=7):
                       f"/ far: median {rmd:.2f} ({rlo:.2f}-{rhi:.2f}){bounds}")
             two = None
             if default != "numpy" and threads > 1:
-                t2, _ = interleaved({"1": lambda: ours(default, 1, default),
-                                     str(threads): lambda: ours(default, threads, default)}, rounds)
-                two = _stats(np.asarray(t2["1"]) / np.asarray(t2[str(threads)]))
-                print(f"      {default} {threads} threads / 1 thread: median {two[1]:.2f} ({two[0]:.2f}-{two[2]:.2f})")
+                two = two_threads(lambda th: ours(default, th, default), f, s, t, threads, 2 * rounds + 1)
+                _print_two(two, threads)
             print(f"      max |P ours - P far| / diagonal {dP:.1e} (median over points {med_dP:.1e}); "
                   f"bfr (approximation level 10) vs far {dB:.1e}; Far's Gregory end caps at extraordinary "
                   f"vertices are approximations")
@@ -590,47 +605,101 @@ def fresh_process_setup(rounds=7):
     return rows
 
 
-def machine_ceiling(threads, quick=False):
-    """What this machine gives ``threads`` threads on ideal work: the compute bound's loop
-    (scripts/bench_ideal.c; numba arithmetic without gcc) split into equal parts, one per thread;
-    interleaved, best of 5 and median, as for the evaluator. Clock boost with one busy core and
-    neighbours on shared hardware lower it below ``threads``."""
+def two_threads(ours, f, s, t, threads, rounds):
+    """``threads`` threads against one, for the default kernel and for this machine's ceiling, in the same
+    interleaved rounds (the order rotating): ``ours(th)`` evaluates the points ``f, s, t`` on ``th`` threads;
+    the ceiling is ideal compiled work of the same shape (``ideal_points`` of scripts/bench_ideal.c: the same
+    points, each reading its face id, u and v and writing P, Pu, Pv, the arithmetic of one bicubic net held
+    in L1) on one thread against the points split into ``threads`` equal contiguous parts, one per thread
+    (ctypes releases the GIL). Per round: the wall-clock ratio (1 thread / n), the process CPU seconds of
+    the n-thread run over the 1-thread run (above 1: each core does less per second when all are busy,
+    e.g. a lower clock, shared caches or memory, or a host's hyperthread sibling) and the n-thread run's CPU
+    seconds over n times its wall-clock seconds (below 1: threads idle or descheduled: load imbalance,
+    serial parts, other processes). The ratio is about n x that occupancy / that CPU factor.
+
+    Returns
+    -------
+    dict
+        ``"ours"``, ``"ceiling"`` -> dict with ``"speedup"``, ``"cpu"``, ``"busy"``: (min, median, max) over
+        the rounds.
+    """
     from concurrent.futures import ThreadPoolExecutor
 
-    ideal = _ideal_c()
-    if ideal is None:
-        import numba
+    lib = _ideal_lib()
+    n = f.size
+    nets = np.random.default_rng(3).random((16, 16, 3))
+    outs = [np.empty((n, 3)) for _ in range(3)]
+    if lib is not None:
+        def ideal(lo, hi):
+            lib.ideal_points(hi - lo, *(a[lo:].ctypes.data for a in (f, s, t)), nets.ctypes.data,
+                             *(o[lo:].ctypes.data for o in outs))
+    else:  # numba's scalar loop on one net (nogil)
+        loop = _ideal_numba()
 
-        @numba.njit(nogil=True)
-        def work(m, x):
-            acc = 0.0
-            for i in range(m):
-                acc += (x * i) % 1.7 + 1.0 / (1.0 + i)
-            return acc
-
-        m = 2_000_000 if quick else 30_000_000
-        work(10, 1.0)
-        one, part = (lambda: work(m, 1.1)), (lambda i: work(m // threads, 1.1 + 0.01 * i))
-    else:
-        m = 400_000 if quick else 4_000_000
-        rng = np.random.default_rng(2)
-        s, t, net = rng.random(m), rng.random(m), rng.random((16, 3))
-        P, Pu, Pv = (np.empty((m, 3)) for _ in range(3))
-        cuts = np.linspace(0, m, threads + 1).astype(int)
-        one = lambda: ideal(s, t, net, P, Pu, Pv)  # noqa: E731
-        part = lambda i: ideal(*(a[cuts[i]:cuts[i + 1]] for a in (s, t)), net,  # noqa: E731
-                               *(a[cuts[i]:cuts[i + 1]] for a in (P, Pu, Pv)))
-    t1, tn = [], []
+        def ideal(lo, hi):
+            loop(s[lo:hi], t[lo:hi], nets[0], *(o[lo:hi] for o in outs))
+    cuts = np.linspace(0, n, threads + 1).astype(np.int64)
     with ThreadPoolExecutor(threads) as ex:
-        for _ in range(1 if quick else 5):
-            w0 = time.perf_counter()
-            one()
-            t1.append(time.perf_counter() - w0)
-            w0 = time.perf_counter()
-            list(ex.map(part, range(threads)))
-            tn.append(time.perf_counter() - w0)
-    print(f"   this machine's ceiling: {threads} threads / 1 thread on ideal compiled work: "
-          f"{min(t1) / min(tn):.2f}x best, {float(np.median(t1) / np.median(tn)):.2f}x median")
+        cases = {"ceiling 1": lambda: ideal(0, n),
+                 f"ceiling {threads}": lambda: list(ex.map(ideal, cuts[:-1], cuts[1:])),
+                 "ours 1": lambda: ours(1), f"ours {threads}": lambda: ours(threads)}
+        for c in cases.values():  # warm up (thread pools, caches, pages)
+            c()
+        wall = {k: [] for k in cases}
+        cpu = {k: [] for k in cases}
+        for r in range(rounds):
+            names = list(cases)
+            names = names[r % len(names):] + names[:r % len(names)]
+            for k in names:
+                c0, w0 = time.process_time(), time.perf_counter()
+                cases[k]()
+                wall[k].append(time.perf_counter() - w0)
+                cpu[k].append(time.process_time() - c0)
+    out = {}
+    for who in ("ours", "ceiling"):
+        w1, wn = np.asarray(wall[f"{who} 1"]), np.asarray(wall[f"{who} {threads}"])
+        c1, cn = np.asarray(cpu[f"{who} 1"]), np.asarray(cpu[f"{who} {threads}"])
+        out[who] = {"speedup": _stats(w1 / wn), "cpu": _stats(cn / np.maximum(c1, 1e-9)),
+                    "busy": _stats(cn / (threads * wn))}
+    return out
+
+
+def threads_only(n, rng, rounds=7):
+    """Only the two-thread comparison of part 5 (:func:`two_threads`, ``2 rounds + 1`` rounds) on the rows of
+    part 5 (the same shapes and points), without OpenSubdiv."""
+    threads = len(os.sched_getaffinity(0))
+    default = available_backends()[0]
+    print(f"\n{threads} threads against one ({n:,} points, P + Pu + Pv, backend {default}); load {_loadavg():.2f}")
+    if threads < 2 or default == "numpy":
+        print("   one CPU, or no compiled kernel: skipped")
+        return None
+    rows = []
+    for label, path in SHAPES:
+        mesh = read_mesh(path)
+        S = limit_surface(mesh)
+        pts = {"uniform": uniform_points(mesh, n, rng), "near EVs": near_ev_points(mesh, n, rng)[:3]}
+        for dist, (f, s, t) in pts.items():
+            o = {k: np.empty((n, 3)) for k in ("P", "Pu", "Pv")}
+
+            def ours(th, f=f, s=s, t=t, o=o, S=S):
+                S.evaluate(f, s, t, 1, out=o, threads=th)
+
+            l0 = _loadavg()
+            two = two_threads(ours, f, s, t, threads, 2 * rounds + 1)
+            print(f"   {label}, {dist}; load {l0:.2f}-{_loadavg():.2f}")
+            _print_two(two, threads)
+            rows.append((label, dist, two))
+    return rows
+
+
+def _print_two(two, threads):
+    o, c = two["ours"], two["ceiling"]
+    print(f"      {threads} threads / 1 thread, median (min-max) over interleaved rounds: C kernel "
+          f"{o['speedup'][1]:.2f} ({o['speedup'][0]:.2f}-{o['speedup'][2]:.2f}); this machine's ceiling "
+          f"(ideal compiled work, same points and traffic) {c['speedup'][1]:.2f} "
+          f"({c['speedup'][0]:.2f}-{c['speedup'][2]:.2f})")
+    print(f"         CPU seconds {threads} threads / 1: C kernel {o['cpu'][1]:.2f}, ceiling {c['cpu'][1]:.2f}; "
+          f"threads busy (CPU / ({threads} x wall)): C kernel {o['busy'][1]:.2f}, ceiling {c['busy'][1]:.2f}")
 
 
 def _has_numba():
@@ -723,11 +792,16 @@ def main(argv=None):
     ap.add_argument("--osd-only", action="store_true", help="only part 5 (OpenSubdiv side by side)")
     ap.add_argument("--rounds", type=int, default=7, help="interleaved rounds of part 5 (at least 7)")
     ap.add_argument("--setup-only", action="store_true", help="only the setup times of part 5")
+    ap.add_argument("--threads-only", action="store_true",
+                    help="only part 5's two threads against one, with this machine's ceiling (no OpenSubdiv)")
     ap.add_argument("--startup", action="store_true",
                     help="only part 6: start-up times and peak memory in fresh processes, ours and OpenSubdiv's")
     args = ap.parse_args(argv)
     if args.setup_only:
         fresh_process_setup(args.rounds)
+        return 0
+    if args.threads_only:
+        threads_only(args.osd_points if not args.quick else 20_000, np.random.default_rng(2024), args.rounds)
         return 0
     if args.startup:
         startup_and_memory(SHAPES[0][1], 1_000_000 if not args.quick else 20_000, np.random.default_rng(2024))
@@ -859,7 +933,8 @@ def main(argv=None):
         print("   / OpenSubdiv Far, one pinned CPU, median over rounds (min-max):")
         for label, dist, ratios, two, load in osd:
             parts = ", ".join(f"{k} {md:.2f} ({lo:.2f}-{hi:.2f})" for k, (lo, md, hi) in ratios.items() if k != "far")
-            tt = f"; 2 threads / 1: {two[1]:.2f}" if two else ""
+            tt = (f"; 2 threads / 1: {two['ours']['speedup'][1]:.2f} (ceiling {two['ceiling']['speedup'][1]:.2f})"
+                  if two else "")
             print(f"      {label:15s} {dist:9s} {parts}{tt}; load {min(load):.2f}-{max(load):.2f}")
     return 0
 

@@ -17,10 +17,19 @@ import threading
 
 import numpy as np
 
+from ccproof.errors import CCProofError
+
 __all__ = ["load", "CTable", "evaluate_block", "ring_walks"]
 
 _P = ctypes.c_void_p
 _I = ctypes.c_int64
+#: most layers of corner nets precomputed (CCP_LAYER_NETS in _clib.c)
+_LAYER_NETS = 4
+#: the bytes the precomputed corner nets of layers 1, 2, ... may take together (layer 0 is the table's own
+#: ``hot``): a point in layer n of a corner face reads its net there instead of the kernel's corner-net cache
+LAYER_NETS_BUDGET = 4 << 20
+#: the largest grid of cells (``ccp_grid``: 128 bytes per ptex face) the binding makes
+GRID_BUDGET = 32 << 20
 
 
 class _Table(ctypes.Structure):
@@ -31,13 +40,14 @@ class _Table(ctypes.Structure):
                 ("h", _P), ("leaf", _P), ("pts", _P), ("cfg", _P), ("cu", _P), ("cv", _P),
                 ("split_depth", _I), ("n_ptex", _I), ("max_layers", _I), ("nets", _P), ("origin", _P),
                 ("ring", _P), ("ops", _P), ("op_start", _P), ("op_size", _P), ("n_layers", _P), ("unit", _P),
-                ("hot", _P), ("n_hot", _I)]
+                ("hot", _P), ("n_hot", _I), ("layer_nets", _P * _LAYER_NETS), ("n_layer_nets", _I),
+                ("grid", _P), ("inv_h", _P), ("inv_unit", _P)]
 
 
 _LIB = None
 _TRIED = False
 #: the version of the kernel's interface (``ccp_abi`` in _clib.c)
-_ABI = 2
+_ABI = 3
 #: calls on fewer points use no corner-net cache (CCP_CACHE_MIN in _clib.c)
 _CACHE_MIN = 256
 
@@ -70,6 +80,10 @@ def load():
         lib.ccp_evaluate.argtypes = [ctypes.POINTER(_Table), _I, _P, _P, _P, _I, _P, _P, _P, _P, _P, _P, _P]
         lib.ccp_cache_words.restype = _I
         lib.ccp_cache_words.argtypes = []
+        lib.ccp_corner_nets.restype = _I
+        lib.ccp_corner_nets.argtypes = [ctypes.POINTER(_Table), _I, _I, _P]
+        lib.ccp_grid.restype = _I
+        lib.ccp_grid.argtypes = [ctypes.POINTER(_Table), _P]
         lib.ccp_ring_walks.restype = _I
         lib.ccp_ring_walks.argtypes = [_P] * 6 + [_I, _P, _P, _P, _I, _P, _P, _I, _P, _P]
         _LIB = lib
@@ -79,6 +93,18 @@ def load():
 
 def _addr(a):
     return a.ctypes.data if a.size else None
+
+
+def _powers_of_two(a):
+    """Whether every value of ``a`` is a power of two whose reciprocal is a normal double (dividing by it is
+    then multiplying by the reciprocal, bit for bit).
+
+    >>> _powers_of_two(np.array([1.0, 0.5, 2.0 ** -40])), _powers_of_two(np.array([0.75]))
+    (True, False)
+    """
+    a = np.asarray(a, dtype=np.float64)
+    m, e = np.frexp(a)
+    return bool(np.all((m == 0.5) & (e >= -1020) & (e <= 1020)))
 
 
 class CTable:
@@ -91,15 +117,39 @@ class CTable:
     Parameters
     ----------
     table : PatchTable
+    layers : int, optional
+        Layers of corner nets to keep precomputed, 1 to 4 (layer 0 is the table's ``hot``; the others are
+        computed here by the kernel's own sums, ``ccp_corner_nets``). Default: 3, fewer where they would
+        exceed :data:`LAYER_NETS_BUDGET`; none where the table has no ``hot``.
+    grid : bool, optional
+        Make the grid of 4 x 4 cells per ptex face (``ccp_grid``: a point's job and virtual face in one
+        read). Default: where it takes at most :data:`GRID_BUDGET` bytes. None is made (whatever ``grid``
+        says) where a job's face does not hold whole cells.
+    reciprocals : bool, optional
+        Store the reciprocals of the sides (1 / h per virtual face, of the corner patches' unit sides) so that
+        the kernel multiplies instead of dividing. Default: where every side is a power of two (then the two
+        give the same bits).
+
+    The results are the same bits with any of these.
+
+    Raises
+    ------
+    CCProofError
+        ``layers`` outside 1 to 4; ``reciprocals=True`` on a table with a side that is not a power of two.
     """
 
-    def __init__(self, table):
+    def __init__(self, table, layers=None, grid=None, reciprocals=None):
         self.table = T = table
+        self.layers, self.grid, self.reciprocals = layers, grid, reciprocals
         keep = {}
 
         def arr(name, dtype):
             a = np.ascontiguousarray(getattr(T, name), dtype=dtype)
             keep[name] = a
+            return _addr(a)
+
+        def arr_of(name, a):
+            keep[name] = a = np.ascontiguousarray(a, dtype=np.float64)
             return _addr(a)
 
         def offsets(name):  # int32 or int64, as the table stores them
@@ -130,6 +180,33 @@ class CTable:
         self._keep = keep
         self.struct = s
         self.ref = ctypes.byref(s)
+        if s.n_hot:  # the corner nets of layers 0 (the table's) to n - 1 (computed here)
+            n = layers if layers is not None else 1 + min(2, LAYER_NETS_BUDGET // max(1, T.hot.nbytes))
+            if not 1 <= n <= _LAYER_NETS:
+                raise CCProofError(f"layers must be 1 to {_LAYER_NETS}, got {n}")
+            nets = [keep["hot"]]
+            lib = load()
+            for lay in range(1, n):
+                w = np.empty_like(keep["hot"])
+                if lib.ccp_corner_nets(self.ref, T.job_root.shape[0], lay, _addr(w)) != 0:
+                    break  # a tree of virtual faces deeper than the walk's stack: the cache serves these layers
+                nets.append(w)
+            n = len(nets)
+            keep["layer_nets"] = nets
+            s.layer_nets = (_P * _LAYER_NETS)(*[_addr(a) for a in nets])
+            s.n_layer_nets = n
+        n_ptex = T.refused.shape[0]
+        if grid if grid is not None else (0 < n_ptex and 128 * n_ptex <= GRID_BUDGET):
+            g = np.empty(16 * n_ptex, dtype=np.int64)
+            if load().ccp_grid(self.ref, _addr(g)) == 0:
+                keep["grid"] = g
+                s.grid = _addr(g)
+        sides = T.unit[:, :, 2].reshape(-1)
+        if reciprocals if reciprocals is not None else (_powers_of_two(T.h) and _powers_of_two(sides)):
+            if not (_powers_of_two(T.h) and _powers_of_two(sides)):
+                raise CCProofError("reciprocals need every side of the table to be a power of two")
+            s.inv_h = arr_of("inv_h", 1.0 / T.h)
+            s.inv_unit = arr_of("inv_unit", 1.0 / sides)
         self._caches = []  # corner-net caches not in use (one per concurrent call, kept between calls)
         self._lock = threading.Lock()
 
@@ -145,7 +222,7 @@ class CTable:
             self._caches.append(cache)
 
     def __reduce__(self):
-        return CTable, (self.table,)
+        return CTable, (self.table, self.layers, self.grid, self.reciprocals)
 
 
 def evaluate_block(lib, ct, f, u, v, d, outs):

@@ -36,6 +36,8 @@
 #define CCP_CACHE_MIN 256
 #define CCP_HASH 2654435761u
 #define CCP_NET 51 /* 17 x 3 doubles: 16 net rows relative to row 16, the origin */
+#define CCP_LAYER_NETS 4 /* most layers of corner nets kept precomputed */
+#define CCP_VF_BITS 24 /* bits of the virtual face in a grid cell */
 
 #if defined(__GNUC__)
 #define CCP_INLINE static inline __attribute__((always_inline))
@@ -72,6 +74,17 @@ typedef struct {
     const double *unit;
     const double *hot;
     int64_t n_hot; /* rows of ``hot`` (0: none) */
+    /* the nets of layers 0 .. n_layer_nets - 1 of every corner face, per layer 3 n_corner x 17 x 3 (layer 0:
+     * ``hot``; the others filled by ccp_corner_nets when the binding makes the table) */
+    const double *layer_nets[CCP_LAYER_NETS];
+    int64_t n_layer_nets;
+    /* NULL, or per ptex face its 4 x 4 cells (row (v) major): job << CCP_VF_BITS | the virtual face that holds
+     * the cell (ccp_grid) */
+    const int64_t *grid;
+    /* NULL, or 1 / h per virtual face and 1 / (the patch side of ``unit``) per configuration and code (3 per
+     * configuration), where every side is a power of two (the binding checks): then dividing by a side is
+     * multiplying by its reciprocal, bit for bit (both the exact quotient, rounded once) */
+    const double *inv_h, *inv_unit;
 } ccp_table;
 
 CCP_INLINE int64_t ld(const void *a, int64_t wide, int64_t i) {
@@ -288,10 +301,28 @@ typedef struct {
 CCP_INLINE int find_face(const ccp_table *T, int64_t pf, double uu, double ww, int64_t *jb, int64_t *vfc) {
     if (pf < 0 || pf >= T->n_ptex || !(uu >= 0.0 && uu <= 1.0 && ww >= 0.0 && ww <= 1.0) || T->refused[pf])
         return -1;
-    int64_t q = (uu >= 0.5) + 2 * (ww >= 0.5);
-    int64_t job = ld(T->top, T->wide[0], 4 * pf + q);
-    int64_t vf = ld(T->job_root, T->wide[1], job);
-    int kind = T->kind[vf];
+    int64_t q, job, vf;
+    int kind;
+    if (T->grid != NULL) { /* the cell's job and virtual face in one read, then the splits finer than the cell */
+        int64_t e = T->grid[16 * pf + 4 * ((ww >= 0.25) + (ww >= 0.5) + (ww >= 0.75)) + (uu >= 0.25) + (uu >= 0.5) +
+                            (uu >= 0.75)];
+        job = e >> CCP_VF_BITS;
+        vf = e & ((1 << CCP_VF_BITS) - 1);
+        kind = T->kind[vf];
+        for (int64_t it = 0; it < T->split_depth && kind == CCP_SPLIT; it++) {
+            double half = T->h[vf] * 0.5;
+            q = (uu >= T->u0[vf] + half) + 2 * (ww >= T->v0[vf] + half);
+            vf = T->child[4 * vf + q];
+            kind = T->kind[vf];
+        }
+        *jb = job;
+        *vfc = vf;
+        return kind;
+    }
+    q = (uu >= 0.5) + 2 * (ww >= 0.5);
+    job = ld(T->top, T->wide[0], 4 * pf + q);
+    vf = ld(T->job_root, T->wide[1], job);
+    kind = T->kind[vf];
     if (T->split_depth > 0) { /* the first level without a branch on the kind (mixed points mispredict it) */
         double half = T->h[vf] * 0.5;
         q = (uu >= T->u0[vf] + half) + 2 * (ww >= T->v0[vf] + half);
@@ -314,17 +345,25 @@ CCP_INLINE int find_face(const ccp_table *T, int64_t pf, double uu, double ww, i
 CCP_INLINE const double *locate(const ccp_table *T, int64_t job, int64_t vf, int kind, double uu, double ww,
                                 ccp_deep *dp, double *s, double *t, double *g) {
     const double *net;
-    double pu0, pv0, h;
+    double pu0, pv0, h, gi = 0.0;
     if (kind == CCP_CORNER) {
         double U0 = T->u0[vf], V0 = T->v0[vf], H = T->h[vf];
         int cu = T->cu[vf], cv = T->cv[vf];
+        double du, dv;
+        if (T->inv_h != NULL) {
+            double r = T->inv_h[vf];
+            du = (cu ? (U0 + H) - uu : uu - U0) * r;
+            dv = (cv ? (V0 + H) - ww : ww - V0) * r;
+        } else {
 #if defined(__GNUC__)
-        v4d dd = (v4d){cu ? (U0 + H) - uu : uu - U0, cv ? (V0 + H) - ww : ww - V0, 1.0, 1.0} / splat(H);
-        double du = dd[0], dv = dd[1];
+            v4d dd = (v4d){cu ? (U0 + H) - uu : uu - U0, cv ? (V0 + H) - ww : ww - V0, 1.0, 1.0} / splat(H);
+            du = dd[0];
+            dv = dd[1];
 #else
-        double du = (cu ? (U0 + H) - uu : uu - U0) / H;
-        double dv = (cv ? (V0 + H) - ww : ww - V0) / H;
+            du = (cu ? (U0 + H) - uu : uu - U0) / H;
+            dv = (cv ? (V0 + H) - ww : ww - V0) / H;
 #endif
+        }
         double mx = du >= dv ? du : dv;
         int64_t cfg = T->cfg[vf];
         int64_t nmax = T->n_layers[cfg] - 1, lay;
@@ -346,9 +385,10 @@ CCP_INLINE const double *locate(const ccp_table *T, int64_t job, int64_t vf, int
         pu0 = un[0] * sc + (cu ? (U0 + H) : U0);
         pv0 = un[1] * sc + (cv ? (V0 + H) : V0);
         h = un[2] * sc;
+        if (T->inv_h != NULL) gi = T->inv_unit[3 * cfg + code] * T->inv_h[vf] * up; /* 1 / h, exactly */
         int64_t ci = ld(T->job_corner, T->wide[3], job) + T->leaf[vf];
-        if (lay == 0 && T->n_hot > 0) {
-            net = T->hot + CCP_NET * (3 * ci + code);
+        if (lay < T->n_layer_nets) {
+            net = T->layer_nets[lay] + CCP_NET * (3 * ci + code);
         } else {
             dp->job = job;
             dp->vf = vf;
@@ -363,6 +403,16 @@ CCP_INLINE const double *locate(const ccp_table *T, int64_t job, int64_t vf, int
         pu0 = T->u0[vf];
         pv0 = T->v0[vf];
         h = T->h[vf];
+        if (T->inv_h != NULL) gi = T->inv_h[vf];
+    }
+    if (T->inv_h != NULL) {
+        double x = (uu - pu0) * gi, y = (ww - pv0) * gi;
+        *g = gi;
+        x = 0.0 > x ? 0.0 : x;
+        y = 0.0 > y ? 0.0 : y;
+        *s = 1.0 < x ? 1.0 : x;
+        *t = 1.0 < y ? 1.0 : y;
+        return net;
     }
 #if defined(__GNUC__)
     v4d qq = (v4d){uu - pu0, ww - pv0, 1.0, 1.0} / splat(h); /* three divisions in one */
@@ -486,8 +536,71 @@ int64_t ccp_evaluate(const ccp_table *T, int64_t n, const int64_t *f, const doub
 /* The size of a corner-net cache, in doubles. */
 int64_t ccp_cache_words(void) { return CCP_CACHE_WORDS; }
 
+#define CCP_STACK 256
+/* The nets of layer ``lay`` of every corner face of the table's ``n_jobs`` jobs (W: 3 n_corner x 17 x 3 doubles,
+ * row 3 ci + code the net of patch ``code`` of corner face ci; rows of corner faces with fewer layers are zero):
+ * the same sums as the corner nets the kernel computes at evaluation time (corner_net), for
+ * ``layer_nets``. Returns 0, or -1 when a job's tree of virtual faces is deeper than the walk's stack. */
+int64_t ccp_corner_nets(const ccp_table *T, int64_t n_jobs, int64_t lay, double *W) {
+    for (int64_t job = 0; job < n_jobs; job++) {
+        int64_t stack[CCP_STACK], ns = 0; /* 3 more per level: 44 levels of splits at most in a table */
+        stack[ns++] = ld(T->job_root, T->wide[1], job);
+        while (ns > 0) {
+            int64_t vf = stack[--ns];
+            if (T->kind[vf] == CCP_SPLIT) {
+                if (ns + 4 > CCP_STACK) return -1;
+                for (int q = 0; q < 4; q++) stack[ns++] = T->child[4 * vf + q];
+            } else if (T->kind[vf] == CCP_CORNER) {
+                int64_t cfg = T->cfg[vf], ci = ld(T->job_corner, T->wide[3], job) + T->leaf[vf];
+                for (int64_t code = 0; code < 3; code++) {
+                    double *w = W + CCP_NET * (3 * ci + code);
+                    if (lay < T->n_layers[cfg])
+                        corner_net(T, job, vf, cfg, lay, code, ci, w);
+                    else
+                        memset(w, 0, CCP_NET * sizeof(double));
+                }
+            }
+        }
+    }
+    return 0;
+}
+
+/* The grid of ``grid`` (16 n_ptex entries): per ptex face and cell (i, j) of its 4 x 4 cells (u in [i / 4, (i + 1)
+ * / 4), the last closed, v likewise, entry 16 face + 4 j + i), the job of the cell's quadrant and the
+ * smallest virtual face of that job that holds the whole cell (the kernel's comparisons at the cell's centre;
+ * virtual faces are dyadic squares, so every point of the cell makes the same choices down to it; a child that
+ * does not hold the whole cell is not taken). Refused faces get 0. Returns 0, -1 when a virtual face's number
+ * does not fit CCP_VF_BITS, or -2 when a job's face does not hold a whole cell (no grid then). */
+CCP_INLINE int holds(const ccp_table *T, int64_t vf, int64_t i, int64_t j) {
+    return T->u0[vf] <= 0.25 * i && T->u0[vf] + T->h[vf] >= 0.25 * (i + 1) && T->v0[vf] <= 0.25 * j &&
+           T->v0[vf] + T->h[vf] >= 0.25 * (j + 1);
+}
+
+int64_t ccp_grid(const ccp_table *T, int64_t *grid) {
+    for (int64_t pf = 0; pf < T->n_ptex; pf++)
+        for (int64_t j = 0; j < 4; j++)
+            for (int64_t i = 0; i < 4; i++) {
+                int64_t *e = grid + 16 * pf + 4 * j + i;
+                *e = 0;
+                if (T->refused[pf]) continue;
+                double uu = (i + 0.5) / 4, ww = (j + 0.5) / 4;
+                int64_t job = ld(T->top, T->wide[0], 4 * pf + (uu >= 0.5) + 2 * (ww >= 0.5));
+                int64_t vf = ld(T->job_root, T->wide[1], job);
+                if (!holds(T, vf, i, j)) return -2;
+                for (int64_t it = 0; it < T->split_depth && T->kind[vf] == CCP_SPLIT; it++) {
+                    double half = T->h[vf] * 0.5;
+                    int64_t c = T->child[4 * vf + (uu >= T->u0[vf] + half) + 2 * (ww >= T->v0[vf] + half)];
+                    if (!holds(T, c, i, j)) break;
+                    vf = c;
+                }
+                if (vf >= (1 << CCP_VF_BITS)) return -1;
+                *e = job << CCP_VF_BITS | vf;
+            }
+    return 0;
+}
+
 /* The layout this file was compiled with: the binding refuses a library whose structure differs. */
-int64_t ccp_abi(void) { return 1000 * (int64_t)sizeof(ccp_table) + 2; }
+int64_t ccp_abi(void) { return 1000 * (int64_t)sizeof(ccp_table) + 3; }
 
 /* ------------------------------------------------------------------------------------------------------------
  * The ring walk of the table's setup (the numba kernel's _ring_walks, ccproof/evaluate/_numba_kernel.py, step
