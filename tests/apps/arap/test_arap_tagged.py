@@ -1,0 +1,149 @@
+"""ARAP on tagged and non-manifold meshes: the surface it parameterizes is the surface ``ccproof eval`` evaluates.
+
+Independent path: the limit points the application writes (its own stationary masks on its own chart levels,
+:mod:`ccproof.apps.control_mesh`) are compared with the evaluator's table (:class:`~ccproof.evaluate.LimitSurface`
+on the file's :class:`~ccproof.mesh.polymesh.PolyMesh`, which refines semi-sharp features, darts and n-gons
+its own way: local exact subdivision and eigen-analysis of corner configurations) at the ptex coordinates of
+every corner of every level-k chart face, derived here from the face numbering alone.
+"""
+
+import numpy as np
+import pytest
+
+from ccproof.apps.arap.charts import segment_by_normals
+from ccproof.apps.arap.core import compare
+from ccproof.apps.arap.export import sample_chart
+from ccproof.apps.control_mesh import TaggedQuadMesh, read_control_mesh, subdivide_control, tagged_step
+from ccproof.evaluate import LimitSurface
+from ccproof.mesh.io import read_mesh
+
+CORNERS = np.array([(0, 0), (1, 0), (1, 1), (0, 1)], dtype=float)
+
+
+def _child(frame, i):
+    """Frame (origin o, matrix A: (s, t) -> o + A (s, t)) of child i (corner i of the quad, child's corner 0)."""
+    o, A = frame
+    c = CORNERS[i]
+    cols = np.c_[(CORNERS[(i + 1) % 4] - c) / 2, (CORNERS[(i + 3) % 4] - c) / 2]
+    return o + A @ c, A @ cols
+
+
+def _control_frames(poly, n_control, origin):
+    """Ptex face and frame of every control face of read_control_mesh (global steps: 0 if origin is None)."""
+    ident = (np.zeros(2), np.eye(2))
+    if origin is None:
+        return [(int(poly.ptex_of(f)), ident) for f in range(n_control)]
+    first = int(np.asarray(poly.sizes).sum())
+    steps = 1 + int(round(np.log(n_control / first) / np.log(4)))
+    assert first * 4 ** (steps - 1) == n_control
+    offsets = np.asarray(poly.offsets)
+    out = []
+    for c in range(n_control):
+        digits = []
+        for _ in range(steps - 1):
+            digits.append(c % 4)
+            c //= 4
+        f = int(np.searchsorted(offsets, c, side="right") - 1)
+        k = c - int(offsets[f])
+        if poly.sizes[f] == 4:
+            ptex, fr = int(poly.ptex_start[f]), _child(ident, k)
+        else:
+            ptex, fr = int(poly.ptex_start[f]) + k, ident
+        for d in reversed(digits):
+            fr = _child(fr, d)
+        out.append((ptex, fr))
+    return out
+
+
+def _check_samples(path, level=2, methods=("c", "b"), text=None, tmp_path=None):
+    if text is not None:  # a variant of the file, written next to the test
+        p = tmp_path / path.name
+        p.write_text(text)
+        path = p
+    poly = read_mesh(path)
+    mesh, origin = read_control_mesh(path)
+    assert isinstance(mesh, TaggedQuadMesh)
+    labels = segment_by_normals(mesh)
+    res, hs = compare(mesh, labels, methods, levels=1, eval_level=level, sample_level=level)
+    frames = _control_frames(poly, mesh.n_faces, origin)
+    S = LimitSurface(poly)
+    worst = 0.0
+    for m in methods:
+        assert all(np.isfinite(x) for x in res[m].metrics.as_tuple()), (path.name, m)
+        for tex in res[m].textures:
+            h = tex.hierarchy
+            P, UV, Q = sample_chart(tex, level)
+            assert np.isfinite(UV).all()
+            faces, us, vs, idx = [], [], [], []
+            for t in range(Q.shape[0]):
+                c, digits = t, []
+                for _ in range(level):
+                    digits.append(c % 4)
+                    c //= 4
+                ptex, fr = frames[int(h.chart_faces[c])]
+                for d in reversed(digits):
+                    fr = _child(fr, d)
+                for j in range(4):
+                    uv = fr[0] + fr[1] @ CORNERS[j]
+                    faces.append(ptex)
+                    us.append(uv[0])
+                    vs.append(uv[1])
+                    idx.append(Q[t, j])
+            ref = S.evaluate(faces, us, vs, 0)["P"]
+            worst = max(worst, float(np.abs(P[idx] - ref).max()))
+    assert worst <= 1e-12 * poly.bounding_box_diagonal, (path.name, worst)
+    return mesh, res
+
+
+@pytest.mark.parametrize("name", ["catmark_cube_creases0", "catmark_cubes_infsharp", "catmark_dart_edgeonly",
+                                  "catmark_edgecorner", "catmark_cube_corner4", "catmark_nonquads"])
+def test_arap_limit_samples_are_the_evaluators(refdir, name):
+    _check_samples(refdir / "osd_features" / "meshes" / f"{name}.obj")
+
+
+@pytest.mark.parametrize("name", ["book4", "bowtie", "two_cubes_creases"])
+def test_arap_on_nonmanifold_meshes(refdir, name):
+    _check_samples(refdir / "osd_nonmanifold" / "meshes" / f"{name}.obj")
+
+
+def test_arap_with_holes(refdir, tmp_path):
+    """catmark_hole_test2 (holes, boundary interpolation) with its crease of sharpness 7.5 made infinite (7.5
+    needs 8 global steps: refused by name, below)."""
+    path = refdir / "osd_features" / "meshes" / "catmark_hole_test2.obj"
+    text = path.read_text()
+    assert "t crease 2/1/0 6 7 7.5" in text
+    mesh, res = _check_samples(path, text=text.replace("6 7 7.5", "6 7 10"), tmp_path=tmp_path)
+    assert mesh.hole.any()
+    for tex in res["c"].textures:
+        assert not mesh.hole[tex.hierarchy.chart_faces].any()
+
+
+def test_tagged_step_is_the_rules_operator(refdir):
+    """The vectorized tagged step equals mesh/rules' exact stencils (PolyMesh.subdivision_operator) on a mesh
+    with infinitely sharp creases, a corner and boundaries."""
+    from ccproof.mesh.polymesh import PolyMesh
+
+    mesh, _ = read_control_mesh(refdir / "osd_features" / "meshes" / "catmark_cubes_infsharp.obj")
+    for m in (mesh, subdivide_control(mesh)):
+        se = m.edges[m.sharp_edge]
+        poly = PolyMesh(m.vertices, m.faces, creases=(se, np.full(len(se), 10.0)),
+                        corners=(np.flatnonzero(m.sharp_vertex), 10.0) if m.sharp_vertex.any() else None)
+        poly.level = 1
+        ref = poly.subdivision_operator().toarray()
+        got = tagged_step(m)[0].toarray()
+        assert got.shape == ref.shape
+        n, E = m.n_vertices, m.n_edges
+        eid = poly.complex().edge_index  # the rules number the edges by first appearance
+        perm = [eid[(min(a, b), max(a, b))] for a, b in m.edges.tolist()]
+        rows = np.r_[np.arange(n), n + np.asarray(perm), n + E + np.arange(m.n_faces)]
+        # the float assembly of the smooth rows (edge and face weights summed in floats) may differ from the
+        # correctly rounded exact weight by an ulp; a wrong rule differs by >= 1/64
+        assert np.abs(got - ref[rows]).max() <= 1e-15
+        assert m.sharp_edge.any()
+
+
+def test_semi_sharp_beyond_the_cap_is_refused_by_name(refdir):
+    from ccproof.errors import MeshError
+
+    with pytest.raises(MeshError, match=r"edge \(6, 7\) of sharpness 7.5 decays in 8 Catmull-Clark steps"):
+        read_control_mesh(refdir / "osd_features" / "meshes" / "catmark_hole_test2.obj")
