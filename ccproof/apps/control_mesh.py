@@ -73,6 +73,8 @@ class TaggedQuadMesh(QuadMesh):
         Over ``edges``: the tagged interior edges.
     sharp_vertex : ndarray of bool, shape (n,)
     hole : ndarray of bool, shape (m,)
+    global_steps : int
+        The Catmull-Clark steps :func:`read_control_mesh` took on the file (0 otherwise).
 
     Examples
     --------
@@ -92,6 +94,7 @@ class TaggedQuadMesh(QuadMesh):
         self.hole = np.zeros(self.n_faces, dtype=bool)
         if holes is not None:
             self.hole[np.asarray(holes, dtype=np.int64)] = True
+        self.global_steps = 0
 
     @property
     def has_tags(self):
@@ -296,7 +299,9 @@ def subdivide_control(mesh: QuadMesh) -> QuadMesh:
 
 def _sharpest_semi_sharp(poly):
     """``(words, s)`` of the largest semi-sharp tag (0 < s < 10) of a PolyMesh, or None."""
-    tags = [(s, f"edge ({a}, {b})") for (a, b), s in sorted(poly.edge_sharpness.items()) if 0.0 < s < 10.0]
+    bnd = set(map(tuple, poly.edges[poly.is_boundary_edge].tolist()))  # sharp anyway: the tag does nothing
+    tags = [(s, f"edge ({a}, {b})") for (a, b), s in sorted(poly.edge_sharpness.items())
+            if 0.0 < s < 10.0 and (a, b) not in bnd]
     tags += [(s, f"vertex {v}") for v, s in sorted(poly.vertex_sharpness.items()) if 0.0 < s < 10.0]
     if not tags:
         return None
@@ -421,6 +426,7 @@ def _tagged_control_mesh(poly, name):
     sv = new[np.asarray(sharp_v, dtype=np.int64)]
     mesh = TaggedQuadMesh(np.asarray(pm.vertices)[used], new[idx].reshape(-1, 4), sharp_edges=se[(se >= 0).all(axis=1)],
                           sharp_vertices=sv[sv >= 0], holes=np.flatnonzero(pm.is_hole))
+    mesh.global_steps = steps
     return mesh, (origin if steps else None)
 
 

@@ -173,9 +173,11 @@ def run(args) -> int:
     mesh, origin = read_control_mesh(args.mesh)
     n_file = mesh.n_faces if origin is None else int(origin.max()) + 1
     if origin is not None:
-        why = "semi-sharp tags or faces that are not quads"
-        print(f"{args.mesh}: {n_file} faces with {why}: subdivided (Catmull-Clark) to {mesh.n_faces} quads, the "
-              f"same limit surface", file=sys.stderr)
+        steps = getattr(mesh, "global_steps", 1)
+        what = ("not all quads: subdivided once" if steps == 1 else
+                f"semi-sharp tags: subdivided {steps} times")
+        print(f"{args.mesh}: {n_file} faces, {what} (Catmull-Clark) to {mesh.n_faces} quads, the same limit "
+              f"surface", file=sys.stderr)
     if args.control_out and getattr(mesh, "has_tags", False):
         raise CCProofError(f"{args.mesh}: --control-out writes an untagged OBJ control mesh, and this mesh has "
                            "OpenSubdiv tags or non-manifold edges or vertices (its surface needs them); use --out")

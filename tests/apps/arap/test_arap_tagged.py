@@ -147,3 +147,35 @@ def test_semi_sharp_beyond_the_cap_is_refused_by_name(refdir):
 
     with pytest.raises(MeshError, match=r"edge \(6, 7\) of sharpness 7.5 decays in 8 Catmull-Clark steps"):
         read_control_mesh(refdir / "osd_features" / "meshes" / "catmark_hole_test2.obj")
+
+
+@pytest.mark.parametrize("name", ["osd_features/meshes/catmark_cube_creases0.obj",
+                                  "osd_nonmanifold/meshes/book4_infpage.obj"])
+def test_arap_command_on_tagged_meshes(refdir, tmp_path, capsys, name):
+    """``ccproof arap MESH --segment normals --out``: finite metrics, a readable output whose points lie on the
+    evaluator's surface (each written point is a limit point: its nearest ptex corner evaluation agrees)."""
+    import json
+
+    from ccproof.apps.arap.export import read_surface
+    from ccproof.cli import main
+
+    out = tmp_path / "uv.obj"
+    assert main(["arap", str(refdir / name), "--segment", "normals", "--levels", "1", "--eval-level", "3",
+                 "--refine", "0", "--out-level", "1", "--out", str(out), "--no-progress"]) == 0
+    cap = capsys.readouterr()
+    assert "E_angle" in cap.out or "angle" in cap.out
+    points, uv, cells = read_surface(out)
+    assert np.isfinite(points).all() and np.isfinite(uv).all() and cells.size
+    assert uv.min() >= -1e-12 and uv.max() <= 1 + 1e-12
+    flat = json.dumps(json.loads((tmp_path / "uv.obj.json").read_text()))
+    assert "NaN" not in flat and "Infinity" not in flat
+    # the written points are limit points of the file's surface: every corner limit of the file's faces is
+    # among them (charts cover every face; level 1 keeps the level-0 corners)
+    poly = read_mesh(refdir / name)
+    S = LimitSurface(poly)
+    from ccproof.evaluate.tagged import vertex_corners
+
+    f, u, v, _ = vertex_corners(poly)
+    ref = S.evaluate(f, u, v, 0)["P"]
+    d = np.min(np.linalg.norm(ref[:, None, :] - points[None, :, :], axis=2), axis=1)
+    assert d.max() <= 1e-6 * poly.bounding_box_diagonal  # the OBJ writes %.9g-ish decimals
