@@ -61,7 +61,7 @@ FILES = {
     "allholes.obj": "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\nt hole 1/0/0 0\n",
     "inhole.csv": "face,u,v\n1,0.5,0.5\n0,0.5,0.5\n",
     "semisharp.obj": "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nv 1 1 0\nv 2 1 0\nf 1 2 5 4\nf 2 3 6 5\n"
-                     "t crease 2/1/0 1 4 9.5\n",
+                     "t crease 2/1/0 1 4 9.5\nt creasemethod 0/0/1 chaikin\n",
     "tables/k005.json": '{"schema": "ccproof.table/1"',
 }
 

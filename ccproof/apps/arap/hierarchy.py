@@ -45,7 +45,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
-from ccproof.apps.control_mesh import tagged_step, tags_of, vertex_rules
+from ccproof.apps.control_mesh import edge_values, tagged_step, tags_of, vertex_rules
 from ccproof.errors import CCProofError, MeshError
 from ccproof.mesh import QuadMesh, child_faces
 from ccproof.rule_weights import crease_vertex_weights, sharp_edge_weight
@@ -148,17 +148,6 @@ def split_nonmanifold(F, n):
     return newid[inv].reshape(m, 4), orig
 
 
-def _edges_in(mesh, label, pairs, n_labels):
-    """Bool over ``mesh.edges``: interior edges whose end labels ``label[a], label[b]`` are among ``pairs``."""
-    pairs = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
-    if not pairs.size:
-        return np.zeros(mesh.n_edges, dtype=bool)
-    la, lb = label[mesh.edges[:, 0]], label[mesh.edges[:, 1]]
-    key = np.minimum(la, lb) * n_labels + np.maximum(la, lb)
-    ref = np.minimum(pairs[:, 0], pairs[:, 1]) * n_labels + np.maximum(pairs[:, 0], pairs[:, 1])
-    return np.isin(key, ref) & ~mesh.is_boundary_edge
-
-
 def _boundary_neighbours(mesh):
     F = mesh.faces
     org = F.ravel()
@@ -191,14 +180,14 @@ class Level:
         ``surface_corners``).
     surface_boundary_nbrs : int (n, 2)
         The two surface-boundary neighbours (crease rule of the surface), -1 elsewhere.
-    sharp_edge : bool (n_edges,), sharp_vertex : bool (n,)
-        Infinitely sharp interior edges and vertices of a tagged surface
-        (:class:`~ccproof.apps.control_mesh.TaggedQuadMesh`); all False on an untagged one.
+    edge_sharpness : float (n_edges,), vertex_sharpness : float (n,)
+        Sharpness of the interior edges and of the vertices of a tagged surface at this level
+        (:class:`~ccproof.apps.control_mesh.TaggedQuadMesh`; ``inf`` infinitely sharp); 0 on an untagged one.
     has_tags : bool
-    smooth, corner_rule, crease_rule, dart_rule : bool (n,)
-        The surface's stationary vertex rules (:func:`~ccproof.apps.control_mesh.vertex_rules`; smooth: no
-        sharp or boundary edge, not a sharp vertex); ``crease_nbrs`` (n, 2) the two sharp neighbours of a
-        crease vertex (the surface-boundary neighbours on an untagged surface).
+    smooth, corner_rule, crease_rule, dart_rule, stationary : bool (n,)
+        The surface's vertex rules (:func:`~ccproof.apps.control_mesh.vertex_rules`; smooth: no sharp or
+        boundary edge, not a sharp vertex; stationary: no semi-sharp tag at the vertex); ``crease_nbrs``
+        (n, 2) the two sharp neighbours of a crease vertex.
 
     Examples
     --------
@@ -211,15 +200,15 @@ class Level:
     ((16, 4), 25, 3)
     """
 
-    def __init__(self, mesh: QuadMesh, n_chart_faces: int, surface_corners: bool = False, sharp_edge=None,
-                 sharp_vertex=None):
+    def __init__(self, mesh: QuadMesh, n_chart_faces: int, surface_corners: bool = False, edge_sharpness=None,
+                 vertex_sharpness=None):
         self.mesh = mesh
-        if sharp_edge is None:
-            sharp_edge, sharp_vertex = tags_of(mesh)
-        self.sharp_edge, self.sharp_vertex = sharp_edge, sharp_vertex
-        self.has_tags = bool(sharp_edge.any() or sharp_vertex.any())
-        ns, self.corner_rule, self.crease_rule, self.dart_rule, self.crease_nbrs = vertex_rules(
-            mesh, sharp_edge, sharp_vertex)
+        if edge_sharpness is None:
+            edge_sharpness, vertex_sharpness = tags_of(mesh)
+        self.edge_sharpness, self.vertex_sharpness = edge_sharpness, vertex_sharpness
+        self.has_tags = bool((edge_sharpness > 0).any() or (vertex_sharpness > 0).any())
+        ns, self.corner_rule, self.crease_rule, self.dart_rule, self.crease_nbrs, self.stationary = vertex_rules(
+            mesh, edge_sharpness, vertex_sharpness)
         self.smooth = (ns == 0) & ~self.corner_rule
         mc = int(n_chart_faces)
         self.n_chart_faces = mc
@@ -314,10 +303,11 @@ class ChartHierarchy:
         #: unknown of every vertex of E_0 (duplicated outer vertices share one)
         self.orig0 = orig
         E0 = QuadMesh(mesh.vertices[gid[orig]], F0)
-        se, sv = tags_of(mesh)
+        es, vs = tags_of(mesh)
         g0 = gid[orig]  # the control vertex of every vertex of E_0
-        se0 = _edges_in(E0, g0, mesh.edges[se], mesh.n_vertices)
-        sv0 = sv[g0]
+        sharp = es > 0
+        es0 = edge_values(E0, mesh.edges[sharp], es[sharp], g0, mesh.n_vertices)
+        vs0 = vs[g0]
         n0 = orig.size
         self.A0 = {
             "extended": sp.csr_matrix((np.ones(n0), (np.arange(n0), orig)), shape=(n0, gid.size)),
@@ -326,7 +316,7 @@ class ChartHierarchy:
         self.A0["boundary"] = sp.csr_matrix(
             (np.ones(int(cm.sum())), (np.flatnonzero(cm), orig[cm])), shape=(n0, cv.size)
         )
-        self.levels = [Level(E0, chart.size, self.surface_corners, se0, sv0)]
+        self.levels = [Level(E0, chart.size, self.surface_corners, es0, vs0)]
         self.S = {"extended": [], "boundary": []}
         self._A = {"extended": [self.A0["extended"]], "boundary": [self.A0["boundary"]]}
 
@@ -345,7 +335,7 @@ class ChartHierarchy:
         L = self.levels[-1]
         E = L.mesh
         n, ne, m = E.n_vertices, E.n_edges, E.n_faces
-        S, child_se, child_sv = tagged_step(E, L.sharp_edge, L.sharp_vertex)  # subdivision_matrix without tags
+        S, (ce, cs), (cv, cvs) = tagged_step(E, L.edge_sharpness, L.vertex_sharpness)  # untagged: subdivision_matrix
         CF = child_faces(E)
         mc = L.n_chart_faces
         cc = CF[: 4 * mc]
@@ -377,9 +367,14 @@ class ChartHierarchy:
         SB = self._boundary_rows(L, SE, rows, chart_rows)
         self.S["extended"].append(SE)
         self.S["boundary"].append(SB)
-        se = _edges_in(new, rows, child_se, S.shape[0])
-        sv = np.isin(rows, child_sv)
-        self.levels.append(Level(new, cc.shape[0], self.surface_corners, se, sv))
+        es = edge_values(new, ce, cs, rows, S.shape[0])
+        vs = np.zeros(rows.size)
+        if cv.size:
+            srt = np.argsort(cv)
+            pos = np.minimum(np.searchsorted(cv[srt], rows), cv.size - 1)
+            hit = cv[srt][pos] == rows
+            vs[hit] = cvs[srt][pos[hit]]
+        self.levels.append(Level(new, cc.shape[0], self.surface_corners, es, vs))
 
     @staticmethod
     def _boundary_rows(L: Level, SE, rows, chart_rows):

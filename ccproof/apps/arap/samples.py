@@ -45,6 +45,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ccproof.apps.arap.hierarchy import HierarchyError, Level, _rules
+from ccproof.apps.control_mesh import moving_limit_rows
 from ccproof.rule_weights import crease_limit_weights, smooth_limit_weights
 
 __all__ = [
@@ -231,8 +232,9 @@ def limit_operator(level: Level, rules):
 
     Interior (smooth) vertices: ``(n^2 V + 4 sum e + sum f) / (n (n + 5))``; crease vertices (the surface
     boundary, an infinitely sharp crease, the chart boundary of the boundary rules):
-    ``(e0 + 4 V + e1) / 6`` along it; corners: ``V``; darts: :func:`dart_limit_mask`. Exact: the rules of
-    a tagged level are stationary (:mod:`ccproof.apps.control_mesh`).
+    ``(e0 + 4 V + e1) / 6`` along it; corners: ``V``; darts: :func:`dart_limit_mask`; vertices with
+    semi-sharp tags: :func:`~ccproof.apps.control_mesh.moving_limit_rows` (subdivided until stationary). All
+    exact (rounded once).
 
     Parameters
     ----------
@@ -261,13 +263,15 @@ def limit_operator(level: Level, rules):
     F = mesh.faces
     n = mesh.n_vertices
     dart = np.zeros(n, dtype=bool)
+    moving = np.zeros(n, dtype=bool)  # semi-sharp tags: not stationary
     if r == "extended":
         inner = level.chart_vertex & ~mesh.is_boundary_vertex
         crease = level.chart_vertex & mesh.is_boundary_vertex
         nbrs = level.surface_boundary_nbrs
         corner = np.zeros(n, dtype=bool)
         if level.has_tags:  # the surface's stationary rules (on an untagged surface the same sets)
-            cvx = level.chart_vertex
+            cvx = level.chart_vertex & level.stationary
+            moving = level.chart_vertex & ~level.stationary
             inner, crease, corner = cvx & level.smooth, cvx & level.crease_rule, cvx & level.corner_rule
             dart, nbrs = cvx & level.dart_rule, level.crease_nbrs
     else:
@@ -276,7 +280,8 @@ def limit_operator(level: Level, rules):
         crease = level.chart_boundary & ~corner
         nbrs = level.chart_boundary_nbrs
         if level.has_tags:  # chart-interior vertices follow the surface's rules
-            ci = level.chart_interior
+            ci = level.chart_interior & level.stationary
+            moving = level.chart_interior & ~level.stationary
             inner = ci & level.smooth
             corner = corner | (ci & level.corner_rule)
             dart = ci & level.dart_rule
@@ -302,9 +307,13 @@ def limit_operator(level: Level, rules):
         [we, wd, wV, np.full(cv.size, cV), np.full(cv.size, ce), np.full(cv.size, ce), np.ones(kv.size)]
     )
     out = sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
+    mv = np.flatnonzero(moving)
+    if mv.size:
+        place = sp.csr_matrix((np.ones(mv.size), (mv, np.arange(mv.size))), shape=(n, mv.size))
+        out = (out + place @ moving_limit_rows(mesh, mv, level.edge_sharpness, level.vertex_sharpness)).tocsr()
     dv = np.flatnonzero(dart)
     if dv.size:
-        se = level.sharp_edge | mesh.is_boundary_edge
+        se = (level.edge_sharpness > 0) | mesh.is_boundary_edge
         a, b = mesh.edges[se, 0], mesh.edges[se, 1]
         far = np.full(n, -1, dtype=np.int64)
         far[a], far[b] = b, a

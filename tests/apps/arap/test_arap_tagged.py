@@ -96,38 +96,34 @@ def _check_samples(path, level=2, methods=("c", "b"), text=None, tmp_path=None):
 
 
 @pytest.mark.parametrize("name", ["catmark_cube_creases0", "catmark_cubes_infsharp", "catmark_dart_edgeonly",
-                                  "catmark_edgecorner", "catmark_cube_corner4", "catmark_nonquads"])
+                                  "catmark_edgecorner", "catmark_cube_corner4", "catmark_nonquads",
+                                  "catmark_pyramid_creases1", "catmark_hole_test2", "catmark_chaikin1"])
 def test_arap_limit_samples_are_the_evaluators(refdir, name):
-    _check_samples(refdir / "osd_features" / "meshes" / f"{name}.obj")
+    mesh, res = _check_samples(refdir / "osd_features" / "meshes" / f"{name}.obj")
+    if name == "catmark_hole_test2":  # holes are in no chart; the 7.5 crease stays a tag (no global step)
+        assert mesh.hole.any() and mesh.global_steps == 0 and mesh.edge_sharpness.max() == 7.5
+        for tex in res["c"].textures:
+            assert not mesh.hole[tex.hierarchy.chart_faces].any()
 
 
-@pytest.mark.parametrize("name", ["book4", "bowtie", "two_cubes_creases"])
+@pytest.mark.parametrize("name", ["book4", "bowtie", "two_cubes_creases", "book4_semipage", "book4_tags"])
 def test_arap_on_nonmanifold_meshes(refdir, name):
     _check_samples(refdir / "osd_nonmanifold" / "meshes" / f"{name}.obj")
 
 
-def test_arap_with_holes(refdir, tmp_path):
-    """catmark_hole_test2 (holes, boundary interpolation) with its crease of sharpness 7.5 made infinite (7.5
-    needs 8 global steps: refused by name, below)."""
-    path = refdir / "osd_features" / "meshes" / "catmark_hole_test2.obj"
-    text = path.read_text()
-    assert "t crease 2/1/0 6 7 7.5" in text
-    mesh, res = _check_samples(path, text=text.replace("6 7 7.5", "6 7 10"), tmp_path=tmp_path)
-    assert mesh.hole.any()
-    for tex in res["c"].textures:
-        assert not mesh.hole[tex.hierarchy.chart_faces].any()
-
-
-def test_tagged_step_is_the_rules_operator(refdir):
-    """The vectorized tagged step equals mesh/rules' exact stencils (PolyMesh.subdivision_operator) on a mesh
-    with infinitely sharp creases, a corner and boundaries."""
+@pytest.mark.parametrize("name", ["catmark_cubes_infsharp", "catmark_hole_test2", "catmark_pyramid_creases1"])
+def test_tagged_step_is_the_rules_operator(refdir, name):
+    """The tagged step (vectorized rows, local fans at semi-sharp tags) equals mesh/rules' stencils of the
+    whole mesh (PolyMesh.subdivision_operator) on meshes with infinitely sharp and semi-sharp creases, corners
+    and boundaries, at two levels."""
     from ccproof.mesh.polymesh import PolyMesh
 
-    mesh, _ = read_control_mesh(refdir / "osd_features" / "meshes" / "catmark_cubes_infsharp.obj")
+    mesh, _ = read_control_mesh(refdir / "osd_features" / "meshes" / f"{name}.obj")
     for m in (mesh, subdivide_control(mesh)):
-        se = m.edges[m.sharp_edge]
-        poly = PolyMesh(m.vertices, m.faces, creases=(se, np.full(len(se), 10.0)),
-                        corners=(np.flatnonzero(m.sharp_vertex), 10.0) if m.sharp_vertex.any() else None)
+        se = m.edge_sharpness > 0
+        sv = np.flatnonzero(m.vertex_sharpness > 0)
+        poly = PolyMesh(m.vertices, m.faces, creases=(m.edges[se], np.minimum(m.edge_sharpness[se], 10.0)),
+                        corners=(sv, np.minimum(m.vertex_sharpness[sv], 10.0)) if sv.size else None)
         poly.level = 1
         ref = poly.subdivision_operator().toarray()
         got = tagged_step(m)[0].toarray()
@@ -139,14 +135,19 @@ def test_tagged_step_is_the_rules_operator(refdir):
         # the float assembly of the smooth rows (edge and face weights summed in floats) may differ from the
         # correctly rounded exact weight by an ulp; a wrong rule differs by >= 1/64
         assert np.abs(got - ref[rows]).max() <= 1e-15
-        assert m.sharp_edge.any()
+        assert se.any()
 
 
-def test_semi_sharp_beyond_the_cap_is_refused_by_name(refdir):
+def test_chaikin_semi_sharp_beyond_the_cap_is_refused_by_name(refdir, tmp_path):
+    """Chaikin's semi-sharp rule needs every edge at both ends: resolved by global steps, refused by name
+    beyond the cap (catmark_hole_test2's 7.5 crease with CREASE_CHAIKIN: 8 steps)."""
     from ccproof.errors import MeshError
 
-    with pytest.raises(MeshError, match=r"edge \(6, 7\) of sharpness 7.5 decays in 8 Catmull-Clark steps"):
-        read_control_mesh(refdir / "osd_features" / "meshes" / "catmark_hole_test2.obj")
+    p = tmp_path / "hole_chaikin.obj"
+    p.write_text((refdir / "osd_features" / "meshes" / "catmark_hole_test2.obj").read_text()
+                 + "t creasemethod 0/0/1 chaikin\n")
+    with pytest.raises(MeshError, match=r"edge \(6, 7\) of sharpness 7.5 with CREASE_CHAIKIN decays in 8 "):
+        read_control_mesh(p)
 
 
 @pytest.mark.parametrize("name", ["osd_features/meshes/catmark_cube_creases0.obj",
