@@ -8,18 +8,24 @@ uses (common in scans) are dropped, the others keep their order.
 
 Meshes with OpenSubdiv tags (creases, corners, holes, boundary modes) and non-manifold meshes (which
 OpenSubdiv, and :attr:`~ccproof.mesh.polymesh.PolyMesh.manifold`, turn into tagged manifold ones: their
-non-manifold edges and vertices infinitely sharp) become a :class:`TaggedQuadMesh`: the rules of
-:mod:`ccproof.mesh.rules` (OpenSubdiv's Sdc) are applied to the whole mesh, one global step at a time
-(:meth:`PolyMesh.refine <ccproof.mesh.polymesh.PolyMesh.refine>`), while a face is not a quad or a
-sharpness is semi-sharp (0 < s < 10: it decays by 1 per step, after ceil(s) steps it is 0); what remains
-are infinitely sharp edges and vertices and hole faces, whose rules are *stationary* (the same at every
-further level): an infinitely sharp edge's edge point is its midpoint, a vertex with two sharp edges takes
-the crease rule ``(3/4) V + (1/8)(e0 + e1)``, with more (or a sharp vertex) it stays (corner), with one
-(a dart) or none the smooth rule. :func:`tagged_step` is that step as a sparse operator on any quad mesh
-with those tags (the chart levels of ARAP, :func:`subdivide_control`). ``EDGE_AND_CORNER`` corners and
-``TRI_SUB_SMOOTH`` act at level 0 only: they are made explicit (sharp vertices) or taken by the first
-global step. The limit surface is the one ``ccproof eval`` evaluates (tests/apps/test_control_mesh.py
-compares them).
+non-manifold edges and vertices infinitely sharp) become a :class:`TaggedQuadMesh` (edge and vertex
+sharpness, hole faces), subdivided by the rules of :mod:`ccproof.mesh.rules` (OpenSubdiv's Sdc):
+
+* :func:`tagged_step` is one step as a sparse operator on any quad mesh with those tags (the chart levels
+  of ARAP, :func:`subdivide_control`): infinite tags are *stationary* (the same rules at every level: an
+  infinitely sharp edge's point is its midpoint, a vertex with two sharp edges takes the crease rule
+  ``(3/4) V + (1/8)(e0 + e1)``, with more or a sharp vertex it stays, with one (a dart) or none the smooth
+  rule); at a semi-sharp edge or vertex (0 < s < 10, ``CREASE_UNIFORM``: s - 1 per step) the rows are the
+  exact stencils of :func:`ccproof.mesh.rules.refine_complex` on the vertex's fan.
+* Limit positions: closed-form masks at stationary vertices (:mod:`ccproof.apps.arap.samples`), and
+  :func:`moving_limit_rows` (the fan subdivided until stationary, then the exact eigenvector) elsewhere.
+* ``CREASE_CHAIKIN`` semi-sharp tags (Chaikin's rule at a vertex needs all the edges at both ends of an
+  edge) are resolved by global steps (:meth:`PolyMesh.refine <ccproof.mesh.polymesh.PolyMesh.refine>`,
+  ceil(s) of them, at most :data:`MAX_TAGGED_FACES` faces); ``EDGE_AND_CORNER`` corners and
+  ``TRI_SUB_SMOOTH`` act at level 0 only: they are made explicit (sharp vertices) or taken by the first
+  global step.
+
+The limit surface is the one ``ccproof eval`` evaluates (tests/apps/arap/test_arap_tagged.py compares them).
 """
 
 from __future__ import annotations
@@ -160,10 +166,10 @@ def refuse_tags(mesh, name):
     >>> from ccproof.mesh.examples import grid
     >>> g = grid(2, 2)
     >>> refuse_tags(g, "g.obj")            # a plain QuadMesh: nothing to refuse
-    >>> refuse_tags(TaggedQuadMesh(g.vertices, g.faces, holes=[3]), "g.obj")
+    >>> refuse_tags(TaggedQuadMesh(g.vertices, g.faces, holes=[3]), "g.obj")  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    ccproof.errors.MeshError: g.obj: face 3 is a hole: this command uses the untagged Catmull-Clark rules (`ccproof arap` and `ccproof eval` take tags)
+    ccproof.errors.MeshError: g.obj: face 3 is a hole: this command uses the untagged Catmull-Clark rules (...)
     """
     if not getattr(mesh, "has_tags", False):
         return

@@ -28,11 +28,11 @@ folds and the distortion such a tool will see.
 Input: any mesh `ccproof eval` reads (OBJ, PLY, OFF, STL, VTK, ...), with the surface `ccproof eval`
 evaluates. Triangles and n-gons are subdivided once with Catmull-Clark first (n quads per n-gon, the same
 limit surface); --charts labels then name the file's faces, each label carried to its quads. Unused
-vertices are dropped. OpenSubdiv tags (creases, corners, holes, boundary modes) and non-manifold edges
-and vertices (infinitely sharp, as OpenSubdiv makes them) follow OpenSubdiv's rules: a semi-sharp tag
-(sharpness s < 10) is resolved by ceil(s) global Catmull-Clark steps first (refused by name beyond
-200,000 faces); hole faces belong to no chart. --control-out needs an untagged mesh (its OBJ carries no
-tags).
+vertices are dropped. OpenSubdiv tags (creases, corners, holes, boundary modes, semi-sharp edges and
+vertices) and non-manifold edges and vertices (infinitely sharp, as OpenSubdiv makes them) follow
+OpenSubdiv's rules on every level; with the Chaikin crease method a semi-sharp tag (sharpness s < 10) is
+resolved by ceil(s) global Catmull-Clark steps first (refused by name beyond 200,000 faces); hole faces
+belong to no chart. --control-out needs an untagged mesh (its OBJ carries no tags).
 
 Scale: charts are processed one at a time; the peak memory is estimated first and a run above
 --max-memory (default 2 GB) stops with an error naming the options that lower it. --refine R (default:
@@ -175,7 +175,7 @@ def run(args) -> int:
     if origin is not None:
         steps = getattr(mesh, "global_steps", 1)
         what = ("not all quads: subdivided once" if steps == 1 else
-                f"semi-sharp tags: subdivided {steps} times")
+                f"semi-sharp Chaikin tags: subdivided {steps} times")
         print(f"{args.mesh}: {n_file} faces, {what} (Catmull-Clark) to {mesh.n_faces} quads, the same limit "
               f"surface", file=sys.stderr)
     if args.control_out and getattr(mesh, "has_tags", False):

@@ -6,10 +6,9 @@
 
 POINTS: .xyz (x y z per line), .ply (vertex x, y, z; ASCII or binary), .obj or the vertices of any mesh
 file eval reads. --init: any mesh eval reads; triangles and n-gons are subdivided once (Catmull-Clark) to
-quads first (the same limit surface); unused vertices are dropped; semi-sharp OpenSubdiv tags are resolved
-by global Catmull-Clark steps (as `ccproof arap` does); a mesh whose surface still needs tags (infinitely
-sharp edges or corners, holes, non-manifold edges or vertices) is refused by name: the fit's elements use
-the untagged rules. The model
+quads first (the same limit surface); unused vertices are dropped; a mesh whose surface needs OpenSubdiv
+tags (creases, corners, holes, boundary modes, non-manifold edges or vertices; `ccproof arap` takes them)
+is refused by name: the fit's elements use the untagged rules. The model
 starts as the paper's 98-vertex mesh (the cube subdivided twice) inside the data, evolves under data
 springs (every point pulls its nearest limit-surface point) with the massless implicit scheme (32) to
 equilibrium (the relative changes of the total energy and of the mean data -> surface distance over two
@@ -95,7 +94,7 @@ def run(args) -> int:
         init, origin = read_control_mesh(init)
         refuse_tags(init, f"--init {args.init}")
         if origin is not None:
-            print(f"--init {args.init}: not all quads or semi-sharp tags: subdivided (Catmull-Clark) to "
+            print(f"--init {args.init}: not all quads (or semi-sharp Chaikin tags): subdivided (Catmull-Clark) to "
                   f"{init.n_faces} quads", file=sys.stderr)
     compile_notice("fit")
     mu = args.mass if args.scheme == "massless" or args.mass > 0 else 1.0

@@ -21,7 +21,7 @@ def test_nonmanifold_meshes_become_tagged_and_fit_refuses_them_by_name(refdir):
     from ccproof.apps.control_mesh import TaggedQuadMesh, refuse_tags
     from ccproof.evaluate import LimitSurface
 
-    for name, what in (("book4.obj", r"vertex \d+ is an"), ("bowtie.obj", r"vertex \d+ is an")):
+    for name, what in (("book4.obj", r"vertex \d+ is a sharp corner"), ("bowtie.obj", r"vertex \d+ is a sharp corner")):
         path = refdir / "osd_nonmanifold" / "meshes" / name
         mesh, origin = read_control_mesh(path)
         poly = read_mesh(path)
