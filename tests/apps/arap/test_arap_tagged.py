@@ -180,3 +180,28 @@ def test_arap_command_on_tagged_meshes(refdir, tmp_path, capsys, name):
     ref = S.evaluate(f, u, v, 0)["P"]
     d = np.min(np.linalg.norm(ref[:, None, :] - points[None, :, :], axis=2), axis=1)
     assert d.max() <= 1e-6 * poly.bounding_box_diagonal  # the OBJ writes %.9g-ish decimals
+
+
+@pytest.mark.parametrize("name", ["catmark_hole_test2", "catmark_cube_creases0", "catmark_cubes_infsharp",
+                                  "catmark_dart_edgeonly", "catmark_cube_corner4", "catmark_inf_crease1",
+                                  "catmark_edgecorner", "catmark_xord_boundary", "catmark_helmet",
+                                  "catmark_edgenone"])
+def test_limit_masks_are_opensubdivs_vertex_limits(refdir, name):
+    """The limit masks of every control vertex (stationary: closed forms and the dart's eigenvector; semi-sharp:
+    the fan subdivided until stationary) against OpenSubdiv's own vertex limits (Far::PrimvarRefiner::Limit
+    after local refinement until the sharpness has decayed, stored in tests/data/osd_features with their
+    provenance)."""
+    import json
+
+    from ccproof.apps.arap.hierarchy import Level
+    from ccproof.apps.arap.samples import limit_operator
+
+    d = json.loads((refdir / "osd_features" / f"osd_limit_{name}.json").read_text())
+    mesh, origin = read_control_mesh(refdir / "osd_features" / "meshes" / f"{name}.obj")
+    assert origin is None and mesh.n_vertices == d["num_vertices"]  # the file's vertices, in order
+    P = limit_operator(Level(mesh, mesh.n_faces), "extended") @ mesh.vertices
+    ref = np.array([x if x is not None else [np.nan] * 3 for x in d["vertex_limit"]], dtype=float)
+    ok = ~np.isnan(ref).any(axis=1)
+    ok[d["vertices_without_surface"]] = False
+    assert ok.sum() >= 0.4 * ok.size  # (edgenone: the boundary vertices have no surface)
+    assert np.abs(P[ok] - ref[ok]).max() <= 1e-13 * d["limit_bbox_diagonal"], name
