@@ -97,13 +97,22 @@ def _check_samples(path, level=2, methods=("c", "b"), text=None, tmp_path=None):
 
 @pytest.mark.parametrize("name", ["catmark_cube_creases0", "catmark_cubes_infsharp", "catmark_dart_edgeonly",
                                   "catmark_edgecorner", "catmark_cube_corner4", "catmark_nonquads",
-                                  "catmark_pyramid_creases1", "catmark_hole_test2", "catmark_chaikin1"])
+                                  "catmark_pyramid_creases1", "catmark_hole_test2",
+                                  pytest.param("catmark_chaikin1", marks=pytest.mark.slow)])
 def test_arap_limit_samples_are_the_evaluators(refdir, name):
     mesh, res = _check_samples(refdir / "osd_features" / "meshes" / f"{name}.obj")
     if name == "catmark_hole_test2":  # holes are in no chart; the 7.5 crease stays a tag (no global step)
         assert mesh.hole.any() and mesh.global_steps == 0 and mesh.edge_sharpness.max() == 7.5
         for tex in res["c"].textures:
             assert not mesh.hole[tex.hierarchy.chart_faces].any()
+
+
+def test_arap_with_chaikin_creases(refdir, tmp_path):
+    """CREASE_CHAIKIN semi-sharp tags: resolved by global steps (catmark_cube_creases0 with Chaikin's rule: two
+    steps, 96 faces, no tag left)."""
+    path = refdir / "osd_features" / "meshes" / "catmark_cube_creases0.obj"
+    mesh, _ = _check_samples(path, text=path.read_text() + "t creasemethod 0/0/1 chaikin\n", tmp_path=tmp_path)
+    assert mesh.global_steps == 2 and mesh.n_faces == 96 and not mesh.has_tags
 
 
 @pytest.mark.parametrize("name", ["book4", "bowtie", "two_cubes_creases", "book4_semipage", "book4_tags"])
