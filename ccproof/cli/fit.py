@@ -94,8 +94,10 @@ def run(args) -> int:
         init, origin = read_control_mesh(init)
         refuse_tags(init, f"--init {args.init}")
         if origin is not None:
-            print(f"--init {args.init}: not all quads (or semi-sharp Chaikin tags): subdivided (Catmull-Clark) to "
-                  f"{init.n_faces} quads", file=sys.stderr)
+            steps = getattr(init, "global_steps", 1)
+            what = ("not all quads: subdivided once" if steps == 1 else
+                    f"semi-sharp Chaikin tags: subdivided {steps} times")
+            print(f"--init {args.init}: {what} (Catmull-Clark) to {init.n_faces} quads", file=sys.stderr)
     compile_notice("fit")
     mu = args.mass if args.scheme == "massless" or args.mass > 0 else 1.0
     material = Material(mu=mu, gamma=args.damping, a11=args.tension, a22=args.tension, b11=args.rigidity,
