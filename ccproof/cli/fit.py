@@ -35,8 +35,8 @@ def add_arguments(p):
     p.add_argument("points", help="point cloud: .xyz, .ply or .obj")
     p.add_argument("--out", required=True, help="write the fitted control mesh (OBJ) here")
     p.add_argument("--init", default="cube",
-                   help="'cube' (the paper's 98-vertex model, default) or a closed mesh (any format eval reads; "
-                        "triangles and n-gons are subdivided once to quads)")
+                   help="'cube' (the paper's 98-vertex model, default) or a closed mesh (any format eval reads, "
+                        "without OpenSubdiv tags: refused by name; triangles and n-gons are subdivided once to quads)")
     p.add_argument("--levels", type=int, default=1, help="global subdivisions after the first fit (default 1)")
     p.add_argument("--scheme", choices=("massless", "inertial"), default="massless",
                    help="time integrator: eq. (32) massless (default) or eq. (31)")
