@@ -8,16 +8,19 @@ Its control points are the level-k surface points ``P^k`` restricted to ``E_k``.
 Why one ring is enough (docs/hsh10.md A11.5): a level-(k+1) vertex of ``E_{k+1}`` is a vertex point of a
 level-k *chart* vertex, an edge point of an edge with a chart end point, or a face point of an
 ``E_k`` face; all three stencils (full fan of a chart vertex, the two faces of such an edge, the
-four face vertices) lie in ``E_k``, and the mesh layer's rules there are the global ones. This is
-asserted at every refinement (:class:`HierarchyError` otherwise). Vertices of ``E_k`` outside the
+four face vertices) lie in ``E_k``, and the mesh layer's rules there are the global ones. On a tagged
+surface (:class:`~ccproof.apps.control_mesh.TaggedQuadMesh`) every level carries the sharpness of its edges
+and vertices (decayed level by level) and the rules are :func:`~ccproof.apps.control_mesh.tagged_step`'s:
+a vertex rule needs the vertex's edges and fan, a ``CREASE_UNIFORM`` edge rule its own sharpness and two
+faces, all in ``E_k`` for the points kept. This is asserted at every refinement (:class:`HierarchyError` otherwise). Vertices of ``E_k`` outside the
 chart whose faces form several fans are duplicated so that ``E_k`` is a valid
 :class:`~ccproof.mesh.QuadMesh`; the duplicates share one unknown.
 
 Three linear subdivision operators act on values attached to the vertices of ``E_k``:
 
 * ``S_E[k]`` (*extended chart*, hsh10 section 3.2 (c), and the surface itself): the surface rules
-  (mesh layer: interior Catmull-Clark, crease rules on the surface boundary). Exact on chart
-  vertices and the ring.
+  (mesh layer: interior Catmull-Clark, crease rules on the surface boundary; OpenSubdiv's tags).
+  Exact on chart vertices and the ring.
 * ``S_B[k]`` (*boundary rules*, hsh10 section 3.2 (b)): the chart as a surface with boundary. Chart
   boundary edges get the midpoint rule, chart boundary vertices the cubic B-spline crease rule
   ``(e0 + 6 V + e1) / 8`` on their two chart-boundary neighbours, except *corners* (one chart face,
