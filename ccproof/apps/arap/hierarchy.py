@@ -13,8 +13,8 @@ surface (:class:`~ccproof.apps.control_mesh.TaggedQuadMesh`) every level carries
 and vertices (decayed level by level) and the rules are :func:`~ccproof.apps.control_mesh.tagged_step`'s:
 a vertex rule needs the vertex's edges and fan, a ``CREASE_UNIFORM`` edge rule its own sharpness and two
 faces, all in ``E_k`` for the points kept. This is asserted at every refinement (:class:`HierarchyError`
-otherwise). Vertices of ``E_k`` outside the chart whose faces form several fans are duplicated so that ``E_k`` is a valid
-:class:`~ccproof.mesh.QuadMesh`; the duplicates share one unknown.
+otherwise). Vertices of ``E_k`` outside the chart whose faces form several fans are duplicated so that
+``E_k`` is a valid :class:`~ccproof.mesh.QuadMesh`; the duplicates share one unknown.
 
 Three linear subdivision operators act on values attached to the vertices of ``E_k``:
 
