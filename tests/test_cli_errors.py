@@ -60,6 +60,8 @@ FILES = {
     "holes.obj": "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nv 1 1 0\nv 2 1 0\nf 1 2 5 4\nf 2 3 6 5\nt hole 1/0/0 0\n",
     "allholes.obj": "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\nt hole 1/0/0 0\n",
     "inhole.csv": "face,u,v\n1,0.5,0.5\n0,0.5,0.5\n",
+    "semisharp.obj": "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nv 1 1 0\nv 2 1 0\nf 1 2 5 4\nf 2 3 6 5\n"
+                     "t crease 2/1/0 1 4 9.5\nt creasemethod 0/0/1 chaikin\n",
     "tables/k005.json": '{"schema": "ccproof.table/1"',
 }
 
@@ -110,7 +112,10 @@ CASES = [
     ("arap-refine-negative", "arap cube.obj --refine -1 --out a7.obj", "--refine", "a7.obj"),
     ("arap-refine-above-default-eval-level", "arap cube.obj --segment normals --refine 7 --out a8.obj",
      "--eval-level", "a8.obj"),
+    ("arap-semi-sharp-beyond-the-cap", "arap semisharp.obj --out a9.obj", "edge (1, 4) of sharpness 9.5", "a9.obj"),
+    ("arap-control-out-tagged", "arap holes.obj --control-out a10.obj", "--control-out", "a10.obj"),
     ("fit-missing-points", "fit missing.xyz --out f1.obj", "missing.xyz", "f1.obj"),
+    ("fit-init-tagged", "fit points.xyz --init holes.obj --out f4.obj", "face 0 is a hole", "f4.obj"),
     ("fit-out-suffix", "fit points.xyz --out f2.ply", "'.ply'", "f2.ply"),
     ("fit-errors-missing-folder", "fit points.xyz --out f3.obj --errors nodir/e.csv", "nodir", "f3.obj"),
     ("certify-valence-2", "certify 2 --no-verify --out c1", "got '2'", "c1"),

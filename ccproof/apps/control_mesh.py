@@ -4,22 +4,554 @@ ARAP (hsh10) and the dynamic surfaces (qmv98) work on all-quad Catmull-Clark con
 triangles or n-gons (any format of :func:`ccproof.mesh.io.read_mesh`: OBJ, PLY, OFF, STL, VTK, ...) is
 subdivided once with the Catmull-Clark rules first: every n-gon becomes n quads and the limit surface is
 unchanged (it is the step every Catmull-Clark evaluator takes on such a mesh anyway). Vertices that no face
-uses (common in scans) are dropped, the others keep their order. Meshes with OpenSubdiv tags (creases,
-corners, holes, boundary modes) are refused: the applications use the untagged rules; so are non-manifold
-meshes (OpenSubdiv makes their non-manifold edges and vertices infinitely sharp, which the untagged rules
-of an all-quad control mesh cannot express; ``ccproof eval`` evaluates them).
+uses (common in scans) are dropped, the others keep their order.
+
+Meshes with OpenSubdiv tags (creases, corners, holes, boundary modes) and non-manifold meshes (which
+OpenSubdiv, and :attr:`~ccproof.mesh.polymesh.PolyMesh.manifold`, turn into tagged manifold ones: their
+non-manifold edges and vertices infinitely sharp) become a :class:`TaggedQuadMesh` (edge and vertex
+sharpness, hole faces), subdivided by the rules of :mod:`ccproof.mesh.rules` (OpenSubdiv's Sdc):
+
+* :func:`tagged_step` is one step as a sparse operator on any quad mesh with those tags (the chart levels
+  of ARAP, :func:`subdivide_control`): infinite tags are *stationary* (the same rules at every level: an
+  infinitely sharp edge's point is its midpoint, a vertex with two sharp edges takes the crease rule
+  ``(3/4) V + (1/8)(e0 + e1)``, with more or a sharp vertex it stays, with one (a dart) or none the smooth
+  rule); at a semi-sharp edge or vertex (0 < s < 10, ``CREASE_UNIFORM``: s - 1 per step) the rows are the
+  exact stencils of :func:`ccproof.mesh.rules.refine_complex` on the vertex's fan.
+* Limit positions: closed-form masks at stationary vertices (:mod:`ccproof.apps.arap.samples`), and
+  :func:`moving_limit_rows` (the fan subdivided until stationary, then the exact eigenvector) elsewhere.
+* ``CREASE_CHAIKIN`` semi-sharp tags (Chaikin's rule at a vertex needs all the edges at both ends of an
+  edge) are resolved by global steps (:meth:`PolyMesh.refine <ccproof.mesh.polymesh.PolyMesh.refine>`,
+  ceil(s) of them, at most :data:`MAX_TAGGED_FACES` faces); ``EDGE_AND_CORNER`` corners and
+  ``TRI_SUB_SMOOTH`` act at level 0 only: they are made explicit (sharp vertices) or taken by the first
+  global step.
+
+The limit surface is the one ``ccproof eval`` evaluates (tests/apps/arap/test_arap_tagged.py compares them).
 """
 
 from __future__ import annotations
 
+import functools
+import math
 import os
 
 import numpy as np
 
 from ccproof.errors import MeshError
 from ccproof.mesh import QuadMesh
+from ccproof.rule_weights import crease_vertex_weights, sharp_edge_weight
 
-__all__ = ["read_control_mesh", "children_labels"]
+#: OpenSubdiv's infinite sharpness (Sdc::Crease::SHARPNESS_INFINITE)
+INFINITE = 10.0
+
+__all__ = ["read_control_mesh", "children_labels", "TaggedQuadMesh", "tagged_step", "subdivide_control",
+           "refuse_tags", "edge_values", "vertex_rules", "moving_limit_rows", "MAX_TAGGED_FACES"]
+
+#: most faces the global tagged steps of :func:`read_control_mesh` may make (Python rules: ~50 us a face)
+MAX_TAGGED_FACES = 200_000
+
+
+def _pair_keys(pairs, n):
+    p = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
+    return np.minimum(p[:, 0], p[:, 1]) * n + np.maximum(p[:, 0], p[:, 1])
+
+
+def edge_values(mesh: QuadMesh, pairs, values=math.inf, label=None, n_labels=None):
+    """Float (n_edges,) over ``mesh.edges``: the sharpness of the interior edges among ``pairs``, 0 elsewhere.
+
+    Parameters
+    ----------
+    mesh : QuadMesh
+    pairs : array_like of int, shape (k, 2)
+        Edges as pairs of vertex labels.
+    values : float or array_like of float, shape (k,)
+    label : ndarray of int, shape (n,), optional
+        The label of every vertex of ``mesh`` (default: its index), ``n_labels`` their range.
+
+    Examples
+    --------
+    >>> from ccproof.mesh.examples import grid
+    >>> g = grid(2, 2)
+    >>> s = edge_values(g, [[1, 4], [0, 1]], [2.5, 3.0])      # (0, 1) is a boundary edge: sharp anyway
+    >>> sorted(s[s > 0].tolist())
+    [2.5]
+    """
+    out = np.zeros(mesh.n_edges)
+    pairs = np.asarray(pairs if pairs is not None else [], dtype=np.int64).reshape(-1, 2)
+    if not pairs.size:
+        return out
+    if label is None:
+        label, n_labels = np.arange(mesh.n_vertices), mesh.n_vertices
+    vals = np.broadcast_to(np.asarray(values, dtype=np.float64), (pairs.shape[0],))
+    ref = _pair_keys(pairs, n_labels)
+    order = np.argsort(ref, kind="stable")
+    ref, vals = ref[order], vals[order]
+    key = _pair_keys(label[mesh.edges], n_labels)
+    pos = np.minimum(np.searchsorted(ref, key), ref.size - 1)
+    hit = (ref[pos] == key) & ~mesh.is_boundary_edge
+    out[hit] = vals[pos[hit]]
+    return out
+
+
+class TaggedQuadMesh(QuadMesh):
+    """An all-quad control mesh with edge and vertex sharpness and hole faces (module docstring).
+
+    Parameters
+    ----------
+    vertices : array_like, shape (n, 3)
+    faces : array_like of int, shape (m, 4)
+    creases : (pairs, values), optional
+        Sharp edges as vertex pairs (k, 2) and their sharpness (scalar or (k,); ``inf`` infinitely sharp,
+        OpenSubdiv's >= 10). Boundary edges are infinitely sharp anyway.
+    corners : (vertices, values), optional
+        Vertex sharpness.
+    holes : array_like of int, optional
+        Hole faces: part of the topology (the rules of their neighbours do not change), not of the surface.
+
+    Attributes
+    ----------
+    edge_sharpness : ndarray, shape (n_edges,)
+        Over ``edges``: 0 smooth, ``inf`` infinitely sharp (values >= 10 are stored as ``inf``).
+    vertex_sharpness : ndarray, shape (n,)
+    hole : ndarray of bool, shape (m,)
+    global_steps : int
+        The Catmull-Clark steps :func:`read_control_mesh` took on the file (0 otherwise).
+
+    Examples
+    --------
+    >>> from ccproof.mesh.examples import grid
+    >>> g = grid(2, 2)
+    >>> t = TaggedQuadMesh(g.vertices, g.faces, creases=([[1, 4], [4, 7]], [2.0, 12.0]), holes=[3])
+    >>> sorted(t.edge_sharpness[t.edge_sharpness > 0].tolist()), int(t.hole.sum()), t.has_tags
+    ([2.0, inf], 1, True)
+    """
+
+    def __init__(self, vertices, faces, *, creases=None, corners=None, holes=None):
+        super().__init__(vertices, faces)
+        es = np.zeros(self.n_edges) if creases is None else edge_values(self, *creases)
+        self.edge_sharpness = np.where(es >= INFINITE, math.inf, es)
+        vs = np.zeros(self.n_vertices)
+        if corners is not None:
+            v = np.asarray(corners[0], dtype=np.int64)
+            vs[v] = np.broadcast_to(np.asarray(corners[1], dtype=np.float64), v.shape)
+        self.vertex_sharpness = np.where(vs >= INFINITE, math.inf, vs)
+        self.hole = np.zeros(self.n_faces, dtype=bool)
+        if holes is not None:
+            self.hole[np.asarray(holes, dtype=np.int64)] = True
+        self.global_steps = 0
+
+    @property
+    def has_tags(self):
+        return bool((self.edge_sharpness > 0).any() or (self.vertex_sharpness > 0).any() or self.hole.any())
+
+    def with_vertices(self, vertices):
+        """Same connectivity and tags, new control points (shape (n, 3))."""
+        plain = QuadMesh.with_vertices(self, vertices)
+        new = object.__new__(TaggedQuadMesh)
+        new.__dict__.update(plain.__dict__)
+        return new
+
+    def __repr__(self):
+        return ("Tagged" + super().__repr__()[:-1] + f", {int((self.edge_sharpness > 0).sum())} sharp edges, "
+                f"{int((self.vertex_sharpness > 0).sum())} sharp vertices, {int(self.hole.sum())} holes)")
+
+
+def refuse_tags(mesh, name):
+    """Raise :class:`~ccproof.errors.MeshError` naming the first tag of a control mesh that still has some.
+
+    For the consumers that use the untagged rules only (the dynamic fit's elements). Vertex numbers are the
+    control mesh's (the file's without its unused vertices, when no step was taken).
+
+    Examples
+    --------
+    >>> from ccproof.mesh.examples import grid
+    >>> g = grid(2, 2)
+    >>> refuse_tags(g, "g.obj")            # a plain QuadMesh: nothing to refuse
+    >>> refuse_tags(TaggedQuadMesh(g.vertices, g.faces, holes=[3]), "g.obj")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ccproof.errors.MeshError: g.obj: face 3 is a hole: this command uses the untagged Catmull-Clark rules (...)
+    """
+    if not getattr(mesh, "has_tags", False):
+        return
+    if (mesh.edge_sharpness > 0).any():
+        e = int(np.flatnonzero(mesh.edge_sharpness > 0)[0])
+        a, b = mesh.edges[e].tolist()
+        what = f"edge ({a}, {b}) is sharp ({mesh.edge_sharpness[e]:g}: a crease tag, or a non-manifold edge)"
+    elif (mesh.vertex_sharpness > 0).any():
+        v = int(np.flatnonzero(mesh.vertex_sharpness > 0)[0])
+        what = f"vertex {v} is a sharp corner ({mesh.vertex_sharpness[v]:g})"
+    else:
+        what = f"face {int(np.flatnonzero(mesh.hole)[0])} is a hole"
+    raise MeshError(f"{name}: {what}: this command uses the untagged Catmull-Clark rules (`ccproof arap` and "
+                    "`ccproof eval` take tags)")
+
+
+def tags_of(mesh):
+    """``(edge_sharpness, vertex_sharpness)`` of a control mesh (zeros on a plain :class:`QuadMesh`)."""
+    es = getattr(mesh, "edge_sharpness", None)
+    if es is None or not isinstance(es, np.ndarray):
+        return np.zeros(mesh.n_edges), np.zeros(mesh.n_vertices)
+    return es, mesh.vertex_sharpness
+
+
+def _semi(x):
+    return (x > 0) & np.isfinite(x)
+
+
+def vertex_rules(mesh: QuadMesh, edge_sharpness, vertex_sharpness):
+    """The vertex rules of a tagged quad mesh, and which vertices are stationary.
+
+    Parameters
+    ----------
+    mesh : QuadMesh
+    edge_sharpness : ndarray, shape (n_edges,)
+        Tagged interior edges (boundary edges count as infinitely sharp in any case).
+    vertex_sharpness : ndarray, shape (n,)
+
+    Returns
+    -------
+    n_sharp : ndarray of int64, shape (n,)
+        Sharp edges (boundary or tagged) at every vertex.
+    corner, crease, dart : ndarray of bool, shape (n,)
+        Sdc's vertex rule: a sharp vertex or three or more sharp edges: corner; two: crease; one: dart
+        (the smooth vertex rule, with a midpoint on its sharp edge).
+    crease_nbrs : ndarray of int64, shape (n, 2)
+        The far ends of the two sharp edges of a crease vertex (-1 elsewhere).
+    stationary : ndarray of bool, shape (n,)
+        No semi-sharp edge at the vertex and no semi-sharp vertex sharpness: its rule and those of its edges
+        are the same at every further level (then the closed-form limit masks hold).
+
+    Examples
+    --------
+    The middle vertex 4 of a 2 x 2 grid with a crease through it; vertex 1 is on the boundary and on
+    the crease (three sharp edges: a corner):
+
+    >>> from ccproof.mesh.examples import grid
+    >>> g = grid(2, 2)
+    >>> ns, corner, crease, dart, nb, st = vertex_rules(g, edge_values(g, [[1, 4], [4, 7]]), np.zeros(9))
+    >>> bool(crease[4]), sorted(nb[4].tolist()), bool(corner[1]), int(ns[4]), bool(st.all())
+    (True, [1, 7], True, 2, True)
+    """
+    n = mesh.n_vertices
+    a, b = mesh.edges[:, 0], mesh.edges[:, 1]
+    sh = mesh.is_boundary_edge | (edge_sharpness > 0)
+    ns = np.bincount(a[sh], minlength=n) + np.bincount(b[sh], minlength=n)
+    corner = (vertex_sharpness > 0) | (ns >= 3)
+    crease = ~corner & (ns == 2)
+    dart = ~corner & (ns == 1)
+    src = np.r_[a[sh], b[sh]]
+    tgt = np.r_[b[sh], a[sh]]
+    order = np.argsort(src, kind="stable")
+    src, tgt = src[order], tgt[order]
+    start = np.searchsorted(src, np.arange(n))
+    nb = np.full((n, 2), -1, dtype=np.int64)
+    cv = np.flatnonzero(crease)
+    nb[cv, 0] = tgt[start[cv]]
+    nb[cv, 1] = tgt[start[cv] + 1]
+    semi = _semi(edge_sharpness)
+    moving = _semi(vertex_sharpness)
+    moving[a[semi]] = True
+    moving[b[semi]] = True
+    return ns, corner, crease, dart, nb, ~moving
+
+
+def _fan_complex(mesh: QuadMesh, v, edge_sharpness, vertex_sharpness):
+    """The faces around ``v`` as a :class:`ccproof.mesh.rules.Complex` in local labels (``v`` is label 0),
+    with the sharpness of the edges at ``v`` and of ``v``; and the local -> global vertex map."""
+    from ccproof.mesh.rules import Complex, Options
+
+    c = mesh.fan_corners[mesh.fan_ptr[v]: mesh.fan_ptr[v] + mesh.face_count[v]]
+    F = mesh.faces[(c // 4)[:, None], ((c % 4)[:, None] + np.arange(4)[None, :]) % 4]  # each face from v
+    glob, loc = np.unique(F, return_inverse=True)
+    order = np.argsort(glob != v, kind="stable")  # v -> label 0
+    rank = np.empty_like(order)
+    rank[order] = np.arange(order.size)
+    faces = rank[loc.reshape(F.shape)]
+    gl = glob[order]
+    tags = {}
+    ekey = _pair_keys(np.c_[np.full(F.shape[0] * 2, v), np.r_[F[:, 1], F[:, 3]]], mesh.n_vertices)
+    allkey = _pair_keys(mesh.edges, mesh.n_vertices)
+    srt = np.argsort(allkey)
+    pos = srt[np.searchsorted(allkey[srt], ekey)]
+    for u, e in zip(np.r_[F[:, 1], F[:, 3]].tolist(), pos.tolist()):
+        s = float(edge_sharpness[e])
+        if s > 0 and not mesh.is_boundary_edge[e]:
+            lu = int(rank[np.searchsorted(glob, u)])
+            tags[(0, lu)] = s
+    vs = float(vertex_sharpness[v])
+    cx = Complex(faces.tolist(), tags, {0: vs} if vs > 0 else {}, Options(), level=1, n_vertices=gl.size)
+    return cx, gl
+
+
+def _local_step_rows(mesh: QuadMesh, v, edge_sharpness, vertex_sharpness):
+    """Exact stencils (mesh/rules) of the vertex point of ``v`` and of the edge points of its edges, global
+    columns: ``(vertex_row, {u: edge_row})`` with rows as dicts."""
+    from ccproof.mesh.rules import refine_complex, to_float
+
+    cx, gl = _fan_complex(mesh, v, edge_sharpness, vertex_sharpness)
+    inc = [e for e, h in enumerate(cx.edges) if cx.org[h] == 0 or cx.dst(h) == 0]
+    stencils, _, _, _ = refine_complex(cx, vertices=[0], edges=inc)
+    n = cx.n_vertices
+
+    def glob(st):
+        return {int(gl[c]): to_float(w) for c, w in st.items()}
+
+    edges = {}
+    for e in inc:
+        h = cx.edges[e]
+        u = cx.dst(h) if cx.org[h] == 0 else cx.org[h]
+        edges[int(gl[u])] = glob(stencils[n + e])
+    return glob(stencils[0]), edges
+
+
+def tagged_step(mesh: QuadMesh, edge_sharpness=None, vertex_sharpness=None):
+    """One Catmull-Clark step of a quad mesh with edge and vertex sharpness, as a sparse operator.
+
+    The untagged operator (:func:`ccproof.mesh.subdivision_matrix`, the rules of :mod:`ccproof.rule_weights`)
+    with the rows of the tagged points replaced (module docstring): at stationary vertices (infinite tags
+    only) a sharp edge's point is its midpoint, a crease vertex (two sharp edges, boundary edges counted)
+    ``(3/4) V + (1/8)(e0 + e1)`` along them, a corner (a sharp vertex, three or more sharp edges) stays; at
+    a vertex with a semi-sharp edge or vertex sharpness, its point and its edges' points are the exact
+    stencils of :func:`ccproof.mesh.rules.refine_complex` on its fan (``CREASE_UNIFORM``: an edge point needs
+    only its edge's sharpness and faces). Without tags the operator is :func:`~ccproof.mesh.subdivision_matrix`'s,
+    unchanged.
+
+    Parameters
+    ----------
+    mesh : QuadMesh
+        n vertices, E edges, m faces.
+    edge_sharpness : ndarray, shape (E,), optional
+    vertex_sharpness : ndarray, shape (n,), optional
+        Default: :func:`tags_of` ``(mesh)``.
+
+    Returns
+    -------
+    S : scipy.sparse.csr_matrix, shape (n + E + m, n)
+        Rows laid out as :func:`ccproof.mesh.child_faces` numbers the new vertices.
+    child_creases : (ndarray of int64, shape (k, 2), ndarray, shape (k,))
+        The halves of the sharp edges in the new vertex numbers, and their sharpness (``CREASE_UNIFORM``:
+        ``s - 1``; 0 dropped).
+    child_corners : (ndarray of int64, shape (j,), ndarray, shape (j,))
+
+    Examples
+    --------
+    A crease through the middle of a 2 x 2 grid: the edge point of edge (1, 4) is the midpoint, the
+    crease vertex 4 moves along the crease only; with sharpness 0.5 the rules blend:
+
+    >>> from ccproof.mesh.examples import grid
+    >>> g = grid(2, 2)
+    >>> S, (ce, cs), _ = tagged_step(g, edge_values(g, [[1, 4], [4, 7]]), np.zeros(9))
+    >>> e = int(np.flatnonzero((np.sort(g.edges, axis=1) == [1, 4]).all(axis=1))[0])
+    >>> S[9 + e].toarray()[0, [1, 4]].tolist(), S[4].toarray()[0, [1, 4, 7]].tolist(), ce.shape, cs.tolist()
+    ([0.5, 0.5], [0.125, 0.75, 0.125], (4, 2), [inf, inf, inf, inf])
+    >>> S, (ce, cs), _ = tagged_step(g, edge_values(g, [[1, 4], [4, 7]], 0.5), np.zeros(9))
+    >>> S[9 + e].toarray()[0, [1, 4]].tolist(), ce.shape
+    ([0.4375, 0.4375], (0, 2))
+    """
+    import scipy.sparse as sp
+
+    from ccproof.mesh import subdivision_matrix
+    from ccproof.mesh.rules import _decrement
+
+    if edge_sharpness is None:
+        edge_sharpness, vertex_sharpness = tags_of(mesh)
+    S = subdivision_matrix(mesh)
+    n = mesh.n_vertices
+    es, vs = edge_sharpness, vertex_sharpness
+    se = np.flatnonzero(es > 0)
+    none = (np.zeros((0, 2), dtype=np.int64), np.zeros(0)), (np.zeros(0, dtype=np.int64), np.zeros(0))
+    if not se.size and not (vs > 0).any():
+        return S, *none
+    _, corner, crease, _, nb, stationary = vertex_rules(mesh, es, vs)
+    a, b = mesh.edges[se, 0], mesh.edges[se, 1]
+    touched = vs > 0
+    touched[a] = touched[b] = True
+    cor = np.flatnonzero(touched & corner & stationary)
+    cre = np.flatnonzero(touched & crease & stationary)
+    inf_e = se[np.isinf(es[se])]
+    er = n + inf_e
+    wv, wn = crease_vertex_weights(1.0)
+    half = sharp_edge_weight(1.0)
+    rows = [cor, cre, cre, cre, er, er]
+    cols = [cor, cre, nb[cre, 0], nb[cre, 1], mesh.edges[inf_e, 0], mesh.edges[inf_e, 1]]
+    vals = [np.ones(cor.size), np.full(cre.size, wv), np.full(2 * cre.size, wn), np.full(2 * er.size, half)]
+    replaced = [cor, cre, er]
+    moving = np.flatnonzero(~stationary)
+    if moving.size:  # semi-sharp: the exact stencils of the rules on the vertex's fan
+        key = _pair_keys(mesh.edges, n)
+        srt = np.argsort(key)
+        r_, c_, w_ = [], [], []
+        for v in moving.tolist():
+            vrow, erows = _local_step_rows(mesh, v, es, vs)
+            r_ += [v] * len(vrow)
+            c_ += list(vrow)
+            w_ += list(vrow.values())
+            for u, st in erows.items():
+                e = int(srt[np.searchsorted(key[srt], min(u, v) * n + max(u, v))])
+                if _semi(es[e]):
+                    r_ += [n + e] * len(st)
+                    c_ += list(st)
+                    w_ += list(st.values())
+        rows.append(np.asarray(r_, dtype=np.int64))
+        cols.append(np.asarray(c_, dtype=np.int64))
+        vals.append(np.asarray(w_, dtype=np.float64))
+        replaced.append(np.unique(rows[-1]))
+    replace = np.ones(S.shape[0])
+    replace[np.concatenate(replaced)] = 0.0
+    extra = sp.coo_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=S.shape)
+    # an edge point computed from both of its ends is the same stencil: keep one (halve the sum)
+    out = (sp.diags(replace) @ S + _dedup(extra)).tocsr()
+    out.eliminate_zeros()
+    child_s = np.array([_decrement(x) for x in es[se].tolist()])
+    keep = child_s > 0
+    er_all = n + se
+    ce = np.r_[np.c_[a, er_all][keep], np.c_[b, er_all][keep]]
+    cs = np.r_[child_s[keep], child_s[keep]]
+    cv = np.flatnonzero(vs > 0)
+    cvs = np.array([_decrement(x) for x in vs[cv].tolist()])
+    return out, (ce, cs), (cv[cvs > 0], cvs[cvs > 0])
+
+
+def _dedup(M):
+    """A COO matrix whose rows may appear several times (the same stencil): each row once."""
+    M = M.tocoo()
+    if not M.nnz:
+        return M
+    import scipy.sparse as sp
+
+    key = np.c_[M.row, M.col]
+    _, first = np.unique(key, axis=0, return_index=True)
+    return sp.coo_matrix((M.data[first], (M.row[first], M.col[first])), shape=M.shape)
+
+
+@functools.lru_cache(maxsize=4096)
+def _ring_limit(faces, edge_tags, vertex_tag):
+    """Exact limit mask (floats, one weight per ring label) of label 0 of a fan ``faces`` (each ``(0, a, d, b)``)
+    with the sharpness ``edge_tags`` (``((0, a), s), ...``) of its edges and ``vertex_tag`` of 0."""
+    import flint
+
+    from ccproof.mesh.rules import Complex, Options, refine_complex
+
+    N = 1 + max(max(f) for f in faces)
+    M = flint.fmpq_mat(N, N, [int(i == j) for i in range(N) for j in range(N)])
+    tags, vs = dict(edge_tags), vertex_tag
+    for _ in range(64):  # sharpness < 10 decays by 1 per step
+        cx = Complex(list(faces), tags, {0: vs} if vs > 0 else {}, Options(), level=1, n_vertices=N)
+        inc = [e for e, h in enumerate(cx.edges) if cx.org[h] == 0 or cx.dst(h) == 0]
+        st, _, ces, cvs = refine_complex(cx, vertices=[0], edges=inc)
+        nv, ne = cx.n_vertices, len(cx.edges)
+        child = {0: 0}  # ring label -> its child in the child ring (vertex, edge and face points)
+        for g, f in enumerate(faces):
+            for x, c in ((f[1], nv + cx.edge_index[(0, f[1])]), (f[3], nv + cx.edge_index[(0, f[3])]),
+                         (f[2], nv + ne + g)):
+                if child.setdefault(x, c) != c:
+                    raise MeshError(f"ring vertex {x} of a fan plays two parts (a fan whose faces share a far corner)")
+        A = flint.fmpq_mat(N, N)
+        for x in range(N):
+            for j, w in st[child[x]].items():
+                A[x, j] = w
+        if all(t == 0 or math.isinf(t) for t in tags.values()) and (vs == 0 or math.isinf(vs)):
+            Bt = (A - flint.fmpq_mat(N, N, [int(i == j) for i in range(N) for j in range(N)])).transpose()
+            for j in range(N):
+                Bt[N - 1, j] = 1
+            lvec = Bt.solve(flint.fmpq_mat(N, 1, [0] * (N - 1) + [1]))
+            l_row = flint.fmpq_mat(1, N, [lvec[i, 0] for i in range(N)]) * M
+            num, den = l_row.numer_denom()
+            q = int(den)
+            return tuple(int(p) / q for p in num.entries())
+        M = A * M
+        tags = {(0, f): ces.get((0, nv + cx.edge_index[(0, f)]), 0.0) for (_, f) in tags}
+        tags = {k: t for k, t in tags.items() if t > 0}
+        vs = cvs.get(0, 0.0)
+    raise MeshError("a sharpness that does not decay (internal error)")
+
+
+def moving_limit_rows(mesh: QuadMesh, verts, edge_sharpness, vertex_sharpness):
+    """Exact limit masks of vertices with semi-sharp tags (not stationary), as sparse rows.
+
+    The vertex's fan is subdivided with the rules of :mod:`ccproof.mesh.rules` (``CREASE_UNIFORM``: its
+    ring's next ring depends only on its own rule and its edges') until its tags are 0 or infinite, then the
+    stationary ring matrix's exact left eigenvector of eigenvalue 1 is applied; the product is exact
+    (rationals), rounded once.
+
+    Parameters
+    ----------
+    mesh : QuadMesh
+    verts : array_like of int, shape (k,)
+    edge_sharpness, vertex_sharpness : ndarray
+        As in :func:`tagged_step`.
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix, shape (k, n)
+
+    Examples
+    --------
+    The middle of a 2 x 2 grid with a crease of sharpness 1 through it: after one step the crease is smooth,
+    so the limit lies between the crease mask's ``(e0 + 4 V + e1) / 6`` and the smooth mask's:
+
+    >>> from ccproof.mesh.examples import grid
+    >>> g = grid(2, 2)
+    >>> R = moving_limit_rows(g, [4], edge_values(g, [[1, 4], [4, 7]], 1.0), np.zeros(9)).toarray()[0]
+    >>> round(float(R.sum()), 15), bool(4 / 9 < R[4] < 4 / 6), bool(R[1] > R[3])
+    (1.0, True, True)
+    """
+    import scipy.sparse as sp
+
+    verts = np.asarray(verts, dtype=np.int64)
+    rows, cols, vals = [], [], []
+    for r, v in enumerate(verts.tolist()):
+        cx, gl = _fan_complex(mesh, v, edge_sharpness, vertex_sharpness)
+        key = tuple(sorted(cx.edge_sharpness.items()))
+        mask = _ring_limit(tuple(cx.faces), key, float(cx.vertex_sharpness.get(0, 0.0)))
+        rows.append(np.full(gl.size, r))
+        cols.append(gl)
+        vals.append(np.asarray(mask))
+    if not rows:
+        return sp.csr_matrix((0, mesh.n_vertices))
+    return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                         shape=(verts.size, mesh.n_vertices))
+
+
+def subdivide_control(mesh: QuadMesh) -> QuadMesh:
+    """One Catmull-Clark step of a control mesh, tags carried (:func:`tagged_step`; holes to their children).
+
+    Parameters
+    ----------
+    mesh : QuadMesh or TaggedQuadMesh
+
+    Returns
+    -------
+    QuadMesh or TaggedQuadMesh
+        Child ``4 f + i`` at corner ``i`` of face ``f`` (:func:`ccproof.mesh.child_faces`).
+
+    Examples
+    --------
+    >>> from ccproof.mesh.examples import grid
+    >>> g = grid(2, 2)
+    >>> t = subdivide_control(TaggedQuadMesh(g.vertices, g.faces, creases=([[1, 4], [4, 7]], 1.5), holes=[0]))
+    >>> t.n_faces, t.edge_sharpness[t.edge_sharpness > 0].tolist(), int(t.hole.sum())
+    (16, [0.5, 0.5, 0.5, 0.5], 4)
+    """
+    from ccproof.mesh import child_faces, subdivide
+
+    if not isinstance(mesh, TaggedQuadMesh):
+        return subdivide(mesh)
+    S, creases, corners = tagged_step(mesh)
+    return TaggedQuadMesh(S @ mesh.vertices, child_faces(mesh), creases=creases, corners=corners,
+                          holes=np.flatnonzero(np.repeat(mesh.hole, 4)))
+
+
+def _sharpest_semi_sharp(poly):
+    """``(words, s)`` of the largest semi-sharp tag (0 < s < 10) of a PolyMesh, or None."""
+    bnd = set(map(tuple, poly.edges[poly.is_boundary_edge].tolist()))  # sharp anyway: the tag does nothing
+    tags = [(s, f"edge ({a}, {b})") for (a, b), s in sorted(poly.edge_sharpness.items())
+            if 0.0 < s < 10.0 and (a, b) not in bnd]
+    tags += [(s, f"vertex {v}") for v, s in sorted(poly.vertex_sharpness.items()) if 0.0 < s < 10.0]
+    if not tags:
+        return None
+    s, what = max(tags, key=lambda t: t[0])
+    return f"{what} of sharpness {s:g}", s
 
 
 def read_control_mesh(path: str | os.PathLike[str]) -> tuple[QuadMesh, np.ndarray | None]:
@@ -32,17 +564,19 @@ def read_control_mesh(path: str | os.PathLike[str]) -> tuple[QuadMesh, np.ndarra
 
     Returns
     -------
-    mesh : QuadMesh
-        The mesh itself when it is all quads, else the mesh subdivided once (the same limit surface);
-        without unused vertices.
-    sizes : ndarray of int64, shape (n_faces_of_the_file,), or None
-        None when the file's faces are kept; else the corner count of every face of the file: face ``f``
-        became the quads ``sum(sizes[:f]) .. sum(sizes[:f + 1]) - 1`` (:func:`children_labels`).
+    mesh : QuadMesh or TaggedQuadMesh
+        The mesh itself when it is all quads, else the mesh subdivided once (the same limit surface; with
+        ``CREASE_CHAIKIN`` semi-sharp tags ceil(s) times for the largest sharpness s); without unused
+        vertices. A :class:`TaggedQuadMesh` when the file has OpenSubdiv tags or is not manifold.
+    origin : ndarray of int64, shape (mesh.n_faces,), or None
+        None when the file's faces are kept; else the face of the file every control face lies on
+        (children in order: :func:`children_labels`).
 
     Raises
     ------
     MeshError
-        What :func:`~ccproof.mesh.io.read_mesh` raises, a mesh with OpenSubdiv tags, or a non-manifold mesh.
+        What :func:`~ccproof.mesh.io.read_mesh` raises; semi-sharp ``CREASE_CHAIKIN`` tags that would need
+        more than :data:`MAX_TAGGED_FACES` faces (names the sharpest one).
 
     Examples
     --------
@@ -57,9 +591,9 @@ def read_control_mesh(path: str | os.PathLike[str]) -> tuple[QuadMesh, np.ndarra
     ...                  "property float z\\nelement face 5\\nproperty list uchar int vertex_indices\\nend_header\\n"
     ...                  "0 0 0\\n1 0 0\\n1 1 0\\n0 1 0\\n0.5 0.5 1\\n"
     ...                  "4 0 3 2 1\\n3 0 1 4\\n3 1 2 4\\n3 2 3 4\\n3 3 0 4\\n")
-    >>> mesh, sizes = read_control_mesh(p)
-    >>> mesh.n_vertices, mesh.n_faces, sizes.tolist()
-    (18, 16, [4, 3, 3, 3, 3])
+    >>> mesh, origin = read_control_mesh(p)
+    >>> mesh.n_vertices, mesh.n_faces, origin.tolist()
+    (18, 16, [0, 0, 0, 0, 1, 1, 1, 2, 2, 2, 3, 3, 3, 4, 4, 4])
 
     An unused vertex (the sixth) is dropped:
 
@@ -67,22 +601,32 @@ def read_control_mesh(path: str | os.PathLike[str]) -> tuple[QuadMesh, np.ndarra
     ...     _ = fh.write("ply\\nformat ascii 1.0\\nelement vertex 6\\nproperty float x\\nproperty float y\\n"
     ...                  "property float z\\nelement face 1\\nproperty list uchar int vertex_indices\\nend_header\\n"
     ...                  "0 0 0\\n1 0 0\\n1 1 0\\n0 1 0\\n0.5 0.5 1\\n9 9 9\\n4 0 1 2 3\\n")
-    >>> mesh, sizes = read_control_mesh(p)
-    >>> mesh.n_vertices, mesh.n_faces, sizes
+    >>> mesh, origin = read_control_mesh(p)
+    >>> mesh.n_vertices, mesh.n_faces, origin
     (4, 1, None)
+
+    A cube with a crease of sharpness 2 keeps it as a tag (``CREASE_UNIFORM``; with ``CREASE_CHAIKIN`` it
+    would be subdivided twice, after which the crease is smooth):
+
+    >>> p = os.path.join(tmp.name, "cube.obj")
+    >>> cube = ("v -1 -1 1\\nv 1 -1 1\\nv -1 1 1\\nv 1 1 1\\nv -1 1 -1\\nv 1 1 -1\\nv -1 -1 -1\\nv 1 -1 -1\\n"
+    ...         "f 1 2 4 3\\nf 3 4 6 5\\nf 5 6 8 7\\nf 7 8 2 1\\nf 2 8 6 4\\nf 7 1 3 5\\n")
+    >>> with open(p, "w") as fh:
+    ...     _ = fh.write(cube + "t crease 2/1/0 0 1 2.0\\n")
+    >>> mesh, origin = read_control_mesh(p)
+    >>> type(mesh).__name__, mesh.n_faces, float(mesh.edge_sharpness.max()), origin
+    ('TaggedQuadMesh', 6, 2.0, None)
+    >>> with open(p, "w") as fh:
+    ...     _ = fh.write(cube + "t crease 2/1/0 0 1 2.0\\nt creasemethod 0/0/1 chaikin\\n")
+    >>> mesh, origin = read_control_mesh(p)
+    >>> mesh.n_faces, float(mesh.edge_sharpness.max()), origin[:17].tolist()[::4]
+    (96, 0.0, [0, 0, 0, 0, 1])
     """
     from ccproof.mesh.io import read_mesh
 
     poly = read_mesh(path)
-    if poly.has_tags:
-        raise MeshError(f"{os.fspath(path)}: OpenSubdiv tags (creases, corners, holes or boundary modes) are not "
-                        "supported here: the applications use the untagged Catmull-Clark rules")
-    if not poly.is_manifold:
-        e, v = poly.nonmanifold_edges, np.flatnonzero(poly.is_nonmanifold_vertex)
-        what = f"non-manifold edge ({e[0, 0]}, {e[0, 1]})" if len(e) else f"non-manifold vertex {int(v[0])}"
-        raise MeshError(f"{os.fspath(path)}: {what}: non-manifold meshes are not supported here (OpenSubdiv makes "
-                        "them infinitely sharp, which the applications' untagged rules cannot express); "
-                        "`ccproof eval` evaluates them")
+    if poly.has_tags or not poly.is_manifold:
+        return _tagged_control_mesh(poly, os.fspath(path))
     sizes = np.asarray(poly.sizes, dtype=np.int64)
     idx = np.asarray(poly.indices, dtype=np.int64)
     used = np.unique(idx)
@@ -96,16 +640,54 @@ def read_control_mesh(path: str | os.PathLike[str]) -> tuple[QuadMesh, np.ndarra
         return QuadMesh(poly.vertices, poly.indices.reshape(-1, 4)), None
     fine, _ = poly.refine(operator=False)
     V, F = np.asarray(fine.vertices, dtype=np.float64), fine.indices.reshape(-1, 4)
-    return QuadMesh(V, F), sizes
+    return QuadMesh(V, F), np.repeat(np.arange(sizes.size, dtype=np.int64), sizes)
 
 
-def children_labels(labels, sizes):
+def _tagged_control_mesh(poly, name):
+    """:func:`read_control_mesh` of a tagged or non-manifold mesh."""
+    pm = poly.manifold  # non-manifold edges and vertices: infinitely sharp (same faces, split vertices)
+    chaikin = pm.options.crease_method == "chaikin"
+    semi = _sharpest_semi_sharp(pm) if chaikin else None
+    need = max(math.ceil(semi[1]) if semi else 0, 0 if pm.is_all_quads else 1)
+    faces = pm.n_faces if need == 0 else int(np.asarray(pm.sizes).sum()) * 4 ** (need - 1)
+    if faces > MAX_TAGGED_FACES:
+        raise MeshError(f"{name}: {semi[0]} with CREASE_CHAIKIN decays in {need} Catmull-Clark steps, which make "
+                        f"{faces:,} faces (the applications take at most {MAX_TAGGED_FACES:,}: Chaikin's rule at a "
+                        "vertex needs all its edges, so its semi-sharp tags are resolved by global steps there); "
+                        "`ccproof eval` evaluates it, or make the tag smaller or infinite (>= 10)")
+    origin = np.arange(pm.n_faces, dtype=np.int64)
+    steps = 0
+    while not pm.is_all_quads or (chaikin and _sharpest_semi_sharp(pm) is not None):
+        origin = np.repeat(origin, np.asarray(pm.sizes, dtype=np.int64))
+        pm, _ = pm.refine(operator=False)
+        steps += 1
+    corners = dict(pm.vertex_sharpness)
+    if steps == 0 and pm.options.boundary == "edge_and_corner":  # its level-0 corners, made explicit
+        corners.update(dict.fromkeys(np.flatnonzero(pm.is_boundary_vertex & (pm.face_count == 1)).tolist(),
+                                     math.inf))
+    idx = np.asarray(pm.indices, dtype=np.int64)
+    used = np.unique(idx)
+    new = np.full(pm.n_vertices, -1, dtype=np.int64)
+    new[used] = np.arange(used.size)
+    se = new[np.asarray(list(pm.edge_sharpness), dtype=np.int64).reshape(-1, 2)]
+    es = np.asarray(list(pm.edge_sharpness.values()), dtype=np.float64)
+    cv = new[np.asarray(list(corners), dtype=np.int64)]
+    cs = np.asarray(list(corners.values()), dtype=np.float64)
+    ok, okv = (se >= 0).all(axis=1), cv >= 0
+    mesh = TaggedQuadMesh(np.asarray(pm.vertices)[used], new[idx].reshape(-1, 4), creases=(se[ok], es[ok]),
+                          corners=(cv[okv], cs[okv]), holes=np.flatnonzero(pm.is_hole))
+    mesh.global_steps = steps
+    return mesh, (origin if steps else None)
+
+
+def children_labels(labels, origin):
     """Per-face labels of the file's faces carried to the quads of :func:`read_control_mesh`.
 
     Parameters
     ----------
     labels : array_like of int, shape (n,)
-    sizes : array_like of int, shape (n,), or None
+    origin : array_like of int, shape (m,), or None
+        The file's face of every control face (None: the same faces).
 
     Returns
     -------
@@ -113,8 +695,8 @@ def children_labels(labels, sizes):
 
     Examples
     --------
-    >>> children_labels([7, 8], [3, 4]).tolist(), children_labels([7, 8], None).tolist()
+    >>> children_labels([7, 8], [0, 0, 0, 1, 1, 1, 1]).tolist(), children_labels([7, 8], None).tolist()
     ([7, 7, 7, 8, 8, 8, 8], [7, 8])
     """
     labels = np.asarray(labels, dtype=np.int64)
-    return labels if sizes is None else np.repeat(labels, np.asarray(sizes, dtype=np.int64))
+    return labels if origin is None else labels[np.asarray(origin, dtype=np.int64)]

@@ -25,10 +25,14 @@ at most --control-max-faces faces; where the last one allowed misses that, each 
 minimization of the measured distortion, whichever makes the largest excess ratio smallest); it prints the
 folds and the distortion such a tool will see.
 
-Input: any mesh `ccproof eval` reads (OBJ, PLY, OFF, STL, VTK, ...). Triangles and n-gons are
-subdivided once with Catmull-Clark first (n quads per n-gon, the same limit surface); --charts labels
-then name the file's faces, each label carried to its quads. Unused vertices are dropped; OpenSubdiv
-tags and non-manifold edges or vertices are refused by name (untagged rules only).
+Input: any mesh `ccproof eval` reads (OBJ, PLY, OFF, STL, VTK, ...), with the surface `ccproof eval`
+evaluates. Triangles and n-gons are subdivided once with Catmull-Clark first (n quads per n-gon, the same
+limit surface); --charts labels then name the file's faces, each label carried to its quads. Unused
+vertices are dropped. OpenSubdiv tags (creases, corners, holes, boundary modes, semi-sharp edges and
+vertices) and non-manifold edges and vertices (infinitely sharp, as OpenSubdiv makes them) follow
+OpenSubdiv's rules on every level; with the Chaikin crease method a semi-sharp tag (sharpness s < 10) is
+resolved by ceil(s) global Catmull-Clark steps first (refused by name beyond 200,000 faces); hole faces
+belong to no chart. --control-out needs an untagged mesh (its OBJ carries no tags).
 
 Scale: charts are processed one at a time; the peak memory is estimated first and a run above
 --max-memory (default 2 GB) stops with an error naming the options that lower it. --refine R (default:
@@ -50,8 +54,8 @@ __all__ = ["add_arguments", "run", "format_table"]
 
 
 def add_arguments(parser):
-    parser.add_argument("mesh", help="control mesh: any format eval reads; triangles and n-gons are subdivided once "
-                                     "(Catmull-Clark) to quads first")
+    parser.add_argument("mesh", help="control mesh: any mesh eval reads (OpenSubdiv tags and non-manifold meshes "
+                                     "too); triangles and n-gons are subdivided once (Catmull-Clark) to quads first")
     parser.add_argument("--charts", metavar="LABELS", help="chart label file: one integer per face of the file")
     parser.add_argument("--segment", choices=["normals"], help="segment into charts (when no --charts)")
     parser.add_argument("--variant", choices=["extended", "boundary"], default="extended",
@@ -166,12 +170,19 @@ def run(args) -> int:
     if args.eval_level is not None and refine is not None and args.eval_level < refine:
         raise CCProofError(f"--eval-level {args.eval_level} is below --refine {refine} (the metrics are sampled "
                            "on the refined mesh)")
-    mesh, sizes = read_control_mesh(args.mesh)
-    if sizes is not None:
-        print(f"{args.mesh}: {sizes.size} faces, not all quads: subdivided once (Catmull-Clark) to {mesh.n_faces} "
-              f"quads, the same limit surface", file=sys.stderr)
+    mesh, origin = read_control_mesh(args.mesh)
+    n_file = mesh.n_faces if origin is None else int(origin.max()) + 1
+    if origin is not None:
+        steps = getattr(mesh, "global_steps", 1)
+        what = ("not all quads: subdivided once" if steps == 1 else
+                f"semi-sharp Chaikin tags: subdivided {steps} times")
+        print(f"{args.mesh}: {n_file} faces, {what} (Catmull-Clark) to {mesh.n_faces} quads, the same limit "
+              f"surface", file=sys.stderr)
+    if args.control_out and getattr(mesh, "has_tags", False):
+        raise CCProofError(f"{args.mesh}: --control-out writes an untagged OBJ control mesh, and this mesh has "
+                           "OpenSubdiv tags or non-manifold edges or vertices (its surface needs them); use --out")
     if args.charts:
-        labels = children_labels(read_labels(args.charts, mesh.n_faces if sizes is None else sizes.size), sizes)
+        labels = children_labels(read_labels(args.charts, n_file), origin)
     elif args.segment == "normals":
         labels = segment_by_normals(mesh)
     else:

@@ -6,8 +6,9 @@
 
 POINTS: .xyz (x y z per line), .ply (vertex x, y, z; ASCII or binary), .obj or the vertices of any mesh
 file eval reads. --init: any mesh eval reads; triangles and n-gons are subdivided once (Catmull-Clark) to
-quads first (the same limit surface); unused vertices are dropped, OpenSubdiv tags and non-manifold meshes
-refused by name. The model
+quads first (the same limit surface); unused vertices are dropped; a mesh whose surface needs OpenSubdiv
+tags (creases, corners, holes, boundary modes, non-manifold edges or vertices; `ccproof arap` takes them)
+is refused by name: the fit's elements use the untagged rules. The model
 starts as the paper's 98-vertex mesh (the cube subdivided twice) inside the data, evolves under data
 springs (every point pulls its nearest limit-surface point) with the massless implicit scheme (32) to
 equilibrium (the relative changes of the total energy and of the mean data -> surface distance over two
@@ -34,8 +35,8 @@ def add_arguments(p):
     p.add_argument("points", help="point cloud: .xyz, .ply or .obj")
     p.add_argument("--out", required=True, help="write the fitted control mesh (OBJ) here")
     p.add_argument("--init", default="cube",
-                   help="'cube' (the paper's 98-vertex model, default) or a closed mesh (any format eval reads; "
-                        "triangles and n-gons are subdivided once to quads)")
+                   help="'cube' (the paper's 98-vertex model, default) or a closed mesh (any format eval reads, "
+                        "without OpenSubdiv tags: refused by name; triangles and n-gons are subdivided once to quads)")
     p.add_argument("--levels", type=int, default=1, help="global subdivisions after the first fit (default 1)")
     p.add_argument("--scheme", choices=("massless", "inertial"), default="massless",
                    help="time integrator: eq. (32) massless (default) or eq. (31)")
@@ -77,7 +78,7 @@ def run(args) -> int:
     check_outputs(args, out=(".obj",), surface_out="mesh", errors=(".csv",))  # before any work
     import numpy as np
 
-    from ccproof.apps.control_mesh import read_control_mesh
+    from ccproof.apps.control_mesh import read_control_mesh, refuse_tags
     from ccproof.apps.dynamics.fit import fit_points, read_points
     from ccproof.apps.dynamics.model import Material
     from ccproof.cli._notice import compile_notice
@@ -90,10 +91,13 @@ def run(args) -> int:
     if init != "cube":
         if not Path(init).exists():
             raise CCProofError(f"--init: {init}: no such file (use 'cube' or a mesh file)")
-        init, sizes = read_control_mesh(init)
-        if sizes is not None:
-            print(f"--init {args.init}: not all quads: subdivided once (Catmull-Clark) to {init.n_faces} quads",
-                  file=sys.stderr)
+        init, origin = read_control_mesh(init)
+        refuse_tags(init, f"--init {args.init}")
+        if origin is not None:
+            steps = getattr(init, "global_steps", 1)
+            what = ("not all quads: subdivided once" if steps == 1 else
+                    f"semi-sharp Chaikin tags: subdivided {steps} times")
+            print(f"--init {args.init}: {what} (Catmull-Clark) to {init.n_faces} quads", file=sys.stderr)
     compile_notice("fit")
     mu = args.mass if args.scheme == "massless" or args.mass > 0 else 1.0
     material = Material(mu=mu, gamma=args.damping, a11=args.tension, a22=args.tension, b11=args.rigidity,

@@ -14,10 +14,24 @@ from ccproof.evaluate import natural_limit_surface
 from ccproof.mesh.io import read_mesh
 
 
-def test_nonmanifold_meshes_are_refused_by_name(refdir):
-    for name, what in (("book4.obj", "non-manifold edge"), ("bowtie.obj", "non-manifold vertex")):
-        with pytest.raises(MeshError, match=what + ".*`ccproof eval` evaluates them"):
-            read_control_mesh(refdir / "osd_nonmanifold" / "meshes" / name)
+def test_nonmanifold_meshes_become_tagged_and_fit_refuses_them_by_name(refdir):
+    """A non-manifold edge or vertex is infinitely sharp (OpenSubdiv): the control mesh carries it as a tag,
+    its limit points at the file's vertices are the tagged evaluator's on the file, and the consumers of the
+    untagged rules (fit) refuse the tag by name."""
+    from ccproof.apps.control_mesh import TaggedQuadMesh, refuse_tags
+    from ccproof.evaluate import LimitSurface
+
+    for name, what in (("book4.obj", r"vertex \d+ is a sharp corner"), ("bowtie.obj", r"vertex \d+ is a sharp corner")):
+        path = refdir / "osd_nonmanifold" / "meshes" / name
+        mesh, origin = read_control_mesh(path)
+        poly = read_mesh(path)
+        assert isinstance(mesh, TaggedQuadMesh) and mesh.has_tags
+        with pytest.raises(MeshError, match=what):
+            refuse_tags(mesh, name)
+        if origin is None:  # the same faces: the first corner of every face is a ptex corner (0, 0)
+            got = LimitSurface(poly).evaluate(np.arange(poly.n_faces), np.zeros(poly.n_faces),
+                                              np.zeros(poly.n_faces), 0)["P"]
+            assert np.isfinite(got).all()
 
 
 def test_unused_vertices_and_polygons_give_the_files_limit_surface(refdir, tmp_path):
@@ -38,8 +52,8 @@ def test_unused_vertices_and_polygons_give_the_files_limit_surface(refdir, tmp_p
         poly = read_mesh(path)
         assert not poly.has_tags and poly.is_unused_vertex.any()
         checked += not poly.is_all_quads
-        mesh, sizes = read_control_mesh(path)
-        assert mesh.n_vertices <= poly.n_vertices + (0 if sizes is None else int(sizes.sum()) + len(poly.edges))
+        mesh, origin = read_control_mesh(path)
+        assert mesh.n_vertices <= poly.n_vertices + (0 if origin is None else int(origin.size) + len(poly.edges))
         ref = natural_limit_surface(poly).vertex_limits()
         got = natural_limit_surface(mesh).vertex_limits()
         used = np.flatnonzero(~poly.is_unused_vertex)

@@ -2,7 +2,8 @@
 
 * :mod:`~ccproof.apps.arap.charts`: charts from per-face labels (topological disks), segmentations;
 * :mod:`~ccproof.apps.arap.hierarchy`: per-chart subdivision hierarchy with the extended-chart and
-  the boundary-rule texture operators;
+  the boundary-rule texture operators (OpenSubdiv's tags carried level by level,
+  :mod:`ccproof.apps.control_mesh`);
 * :mod:`~ccproof.apps.arap.samples`: limit tangent masks (hsh10 Eq. 2) and the samples of Eq. 3;
 * :mod:`~ccproof.apps.arap.solver`: closed-form local step (Appendix), global step factorized once
   per level, the local/global iteration;

@@ -313,7 +313,7 @@ def split_into_disks(mesh: QuadMesh, labels, min_faces=1):
     labels = np.asarray(labels, dtype=np.int64)
     adj = face_adjacency(mesh)
     cent = mesh.vertices[mesh.faces].mean(axis=1)
-    todo = [np.flatnonzero(labels == lab) for lab in np.unique(labels)]
+    todo = [np.flatnonzero(labels == lab) for lab in np.unique(labels[labels >= 0])]
     done = []
     while todo:
         fc = todo.pop()
@@ -332,7 +332,7 @@ def split_into_disks(mesh: QuadMesh, labels, min_faces=1):
             cut = np.arange(fc.size) < fc.size // 2
         todo.extend([fc[cut], fc[~cut]])
     done.sort(key=lambda a: int(a.min()))
-    out = np.empty(mesh.n_faces, dtype=np.int64)
+    out = np.full(mesh.n_faces, -1, dtype=np.int64)  # negative labels (no chart, holes) stay -1
     for i, fc in enumerate(done):
         out[fc] = i
     return out
@@ -371,13 +371,13 @@ def merge_small(mesh: QuadMesh, labels, min_faces):
     changed = True
     while changed:
         changed = False
-        sizes = np.bincount(labels)
+        sizes = np.bincount(labels[labels >= 0])
         for lab in np.argsort(sizes, kind="stable"):
             if sizes[lab] == 0 or sizes[lab] >= min_faces:
                 continue
             la, lb = labels[a], labels[b]
             nb = np.r_[lb[la == lab], la[lb == lab]]
-            nb = nb[nb != lab]
+            nb = nb[(nb != lab) & (nb >= 0)]
             if nb.size == 0:
                 continue
             cand, cnt = np.unique(nb, return_counts=True)
@@ -389,8 +389,8 @@ def merge_small(mesh: QuadMesh, labels, min_faces):
                     break
             if changed:
                 break
-    uniq = sorted(np.unique(labels), key=lambda x: int(np.flatnonzero(labels == x).min()))
-    out = np.empty_like(labels)
+    uniq = sorted(np.unique(labels[labels >= 0]), key=lambda x: int(np.flatnonzero(labels == x).min()))
+    out = np.full_like(labels, -1)
     for i, lab in enumerate(uniq):
         out[labels == lab] = i
     return out
@@ -427,12 +427,15 @@ def segment_by_normals(mesh: QuadMesh, smooth=3, min_faces=20):
     ax = np.argmax(np.abs(nrm), axis=1)
     sign = nrm[np.arange(mesh.n_faces), ax] < 0
     lab = 2 * ax + sign
+    hole = getattr(mesh, "hole", None)  # a TaggedQuadMesh's hole faces: in no chart
     adj = face_adjacency(mesh)
     deg = np.asarray(adj.sum(axis=1)).ravel()
     for _ in range(int(smooth)):
         votes = np.stack([adj @ (lab == c) for c in range(6)], axis=1)
         best = np.argmax(votes, axis=1)
         lab = np.where(votes[np.arange(lab.size), best] > deg / 2, best, lab)
+    if hole is not None and hole.any():
+        lab = np.where(hole, -1, lab)
     return merge_small(mesh, split_into_disks(mesh, lab), min_faces)
 
 

@@ -557,6 +557,14 @@ def control_flips(tex: ChartTexture):
 
 # --------------------------------------------------------------------------- whole meshes
 def _charts(mesh, labels):
+    hole = getattr(mesh, "hole", None)
+    if hole is not None and hole.any():  # hole faces are not part of the surface: in no chart
+        if labels is None:
+            faces = np.flatnonzero(~hole)
+            check_disk(mesh, faces, "the mesh without its holes (one chart; give --charts for a closed or "
+                                    "non-disk mesh)")
+            return [faces]
+        labels = np.where(hole, -1, np.asarray(labels))
     if labels is None:
         faces = np.arange(mesh.n_faces)
         check_disk(mesh, faces, "the mesh (one chart; give --charts for a closed or non-disk mesh)")
@@ -588,8 +596,8 @@ def refine_mesh(mesh, labels, times):
 
     Returns
     -------
-    mesh : QuadMesh
-        With 4**times as many faces.
+    mesh : QuadMesh or TaggedQuadMesh
+        With 4**times as many faces (tags carried: :func:`~ccproof.apps.control_mesh.subdivide_control`).
     labels : ndarray of int64 or None
 
     Examples
@@ -599,11 +607,11 @@ def refine_mesh(mesh, labels, times):
     >>> m.n_faces, lab[:8].tolist()
     (36, [0, 0, 0, 0, 1, 1, 1, 1])
     """
-    from ccproof.mesh import subdivide
+    from ccproof.apps.control_mesh import subdivide_control
 
     lab = None if labels is None else np.asarray(labels)
     for _ in range(int(times)):
-        mesh = subdivide(mesh)
+        mesh = subdivide_control(mesh)  # tags carried (a TaggedQuadMesh stays one)
         if lab is not None:
             lab = np.repeat(lab, 4)
     return mesh, lab

@@ -8,16 +8,19 @@ Its control points are the level-k surface points ``P^k`` restricted to ``E_k``.
 Why one ring is enough (docs/hsh10.md A11.5): a level-(k+1) vertex of ``E_{k+1}`` is a vertex point of a
 level-k *chart* vertex, an edge point of an edge with a chart end point, or a face point of an
 ``E_k`` face; all three stencils (full fan of a chart vertex, the two faces of such an edge, the
-four face vertices) lie in ``E_k``, and the mesh layer's rules there are the global ones. This is
-asserted at every refinement (:class:`HierarchyError` otherwise). Vertices of ``E_k`` outside the
-chart whose faces form several fans are duplicated so that ``E_k`` is a valid
-:class:`~ccproof.mesh.QuadMesh`; the duplicates share one unknown.
+four face vertices) lie in ``E_k``, and the mesh layer's rules there are the global ones. On a tagged
+surface (:class:`~ccproof.apps.control_mesh.TaggedQuadMesh`) every level carries the sharpness of its edges
+and vertices (decayed level by level) and the rules are :func:`~ccproof.apps.control_mesh.tagged_step`'s:
+a vertex rule needs the vertex's edges and fan, a ``CREASE_UNIFORM`` edge rule its own sharpness and two
+faces, all in ``E_k`` for the points kept. This is asserted at every refinement (:class:`HierarchyError`
+otherwise). Vertices of ``E_k`` outside the chart whose faces form several fans are duplicated so that
+``E_k`` is a valid :class:`~ccproof.mesh.QuadMesh`; the duplicates share one unknown.
 
 Three linear subdivision operators act on values attached to the vertices of ``E_k``:
 
 * ``S_E[k]`` (*extended chart*, hsh10 section 3.2 (c), and the surface itself): the surface rules
-  (mesh layer: interior Catmull-Clark, crease rules on the surface boundary). Exact on chart
-  vertices and the ring.
+  (mesh layer: interior Catmull-Clark, crease rules on the surface boundary; OpenSubdiv's tags).
+  Exact on chart vertices and the ring.
 * ``S_B[k]`` (*boundary rules*, hsh10 section 3.2 (b)): the chart as a surface with boundary. Chart
   boundary edges get the midpoint rule, chart boundary vertices the cubic B-spline crease rule
   ``(e0 + 6 V + e1) / 8`` on their two chart-boundary neighbours, except *corners* (one chart face,
@@ -45,8 +48,9 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
+from ccproof.apps.control_mesh import edge_values, tagged_step, tags_of, vertex_rules
 from ccproof.errors import CCProofError, MeshError
-from ccproof.mesh import QuadMesh, child_faces, subdivision_matrix
+from ccproof.mesh import QuadMesh, child_faces
 from ccproof.rule_weights import crease_vertex_weights, sharp_edge_weight
 
 __all__ = ["ChartHierarchy", "Level", "HierarchyError", "split_nonmanifold", "RULES"]
@@ -179,6 +183,14 @@ class Level:
         ``surface_corners``).
     surface_boundary_nbrs : int (n, 2)
         The two surface-boundary neighbours (crease rule of the surface), -1 elsewhere.
+    edge_sharpness : float (n_edges,), vertex_sharpness : float (n,)
+        Sharpness of the interior edges and of the vertices of a tagged surface at this level
+        (:class:`~ccproof.apps.control_mesh.TaggedQuadMesh`; ``inf`` infinitely sharp); 0 on an untagged one.
+    has_tags : bool
+    smooth, corner_rule, crease_rule, dart_rule, stationary : bool (n,)
+        The surface's vertex rules (:func:`~ccproof.apps.control_mesh.vertex_rules`; smooth: no sharp or
+        boundary edge, not a sharp vertex; stationary: no semi-sharp tag at the vertex); ``crease_nbrs``
+        (n, 2) the two sharp neighbours of a crease vertex.
 
     Examples
     --------
@@ -191,8 +203,16 @@ class Level:
     ((16, 4), 25, 3)
     """
 
-    def __init__(self, mesh: QuadMesh, n_chart_faces: int, surface_corners: bool = False):
+    def __init__(self, mesh: QuadMesh, n_chart_faces: int, surface_corners: bool = False, edge_sharpness=None,
+                 vertex_sharpness=None):
         self.mesh = mesh
+        if edge_sharpness is None:
+            edge_sharpness, vertex_sharpness = tags_of(mesh)
+        self.edge_sharpness, self.vertex_sharpness = edge_sharpness, vertex_sharpness
+        self.has_tags = bool((edge_sharpness > 0).any() or (vertex_sharpness > 0).any())
+        ns, self.corner_rule, self.crease_rule, self.dart_rule, self.crease_nbrs, self.stationary = vertex_rules(
+            mesh, edge_sharpness, vertex_sharpness)
+        self.smooth = (ns == 0) & ~self.corner_rule
         mc = int(n_chart_faces)
         self.n_chart_faces = mc
         F = mesh.faces
@@ -286,6 +306,11 @@ class ChartHierarchy:
         #: unknown of every vertex of E_0 (duplicated outer vertices share one)
         self.orig0 = orig
         E0 = QuadMesh(mesh.vertices[gid[orig]], F0)
+        es, vs = tags_of(mesh)
+        g0 = gid[orig]  # the control vertex of every vertex of E_0
+        sharp = es > 0
+        es0 = edge_values(E0, mesh.edges[sharp], es[sharp], g0, mesh.n_vertices)
+        vs0 = vs[g0]
         n0 = orig.size
         self.A0 = {
             "extended": sp.csr_matrix((np.ones(n0), (np.arange(n0), orig)), shape=(n0, gid.size)),
@@ -294,7 +319,7 @@ class ChartHierarchy:
         self.A0["boundary"] = sp.csr_matrix(
             (np.ones(int(cm.sum())), (np.flatnonzero(cm), orig[cm])), shape=(n0, cv.size)
         )
-        self.levels = [Level(E0, chart.size, self.surface_corners)]
+        self.levels = [Level(E0, chart.size, self.surface_corners, es0, vs0)]
         self.S = {"extended": [], "boundary": []}
         self._A = {"extended": [self.A0["extended"]], "boundary": [self.A0["boundary"]]}
 
@@ -313,7 +338,7 @@ class ChartHierarchy:
         L = self.levels[-1]
         E = L.mesh
         n, ne, m = E.n_vertices, E.n_edges, E.n_faces
-        S = subdivision_matrix(E).tocsr()
+        S, (ce, cs), (cv, cvs) = tagged_step(E, L.edge_sharpness, L.vertex_sharpness)  # untagged: subdivision_matrix
         CF = child_faces(E)
         mc = L.n_chart_faces
         cc = CF[: 4 * mc]
@@ -345,7 +370,14 @@ class ChartHierarchy:
         SB = self._boundary_rows(L, SE, rows, chart_rows)
         self.S["extended"].append(SE)
         self.S["boundary"].append(SB)
-        self.levels.append(Level(new, cc.shape[0], self.surface_corners))
+        es = edge_values(new, ce, cs, rows, S.shape[0])
+        vs = np.zeros(rows.size)
+        if cv.size:
+            srt = np.argsort(cv)
+            pos = np.minimum(np.searchsorted(cv[srt], rows), cv.size - 1)
+            hit = cv[srt][pos] == rows
+            vs[hit] = cvs[srt][pos[hit]]
+        self.levels.append(Level(new, cc.shape[0], self.surface_corners, es, vs))
 
     @staticmethod
     def _boundary_rows(L: Level, SE, rows, chart_rows):

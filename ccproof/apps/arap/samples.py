@@ -37,12 +37,15 @@ boundary) ``(e0 + 4 V + e1) / 6``; corner ``V``.
 
 from __future__ import annotations
 
+import functools
+import math
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
 
-from ccproof.apps.arap.hierarchy import Level, _rules
+from ccproof.apps.arap.hierarchy import HierarchyError, Level, _rules
+from ccproof.apps.control_mesh import moving_limit_rows
 from ccproof.rule_weights import crease_limit_weights, smooth_limit_weights
 
 __all__ = [
@@ -146,8 +149,92 @@ def tangent_mask_operators(mesh, verts):
     return op(j), op(j - 1)
 
 
+@functools.lru_cache(maxsize=64)
+def dart_limit_mask(n, sigma):
+    """Exact limit mask of a dart: an interior vertex of valence ``n`` with one infinitely sharp edge.
+
+    The dart keeps the smooth vertex rule, but its sharp edge's point is the midpoint: the one-ring matrix
+    ``A`` differs from the smooth one, and so does its left eigenvector of eigenvalue 1 (no closed form).
+    It is solved exactly (``l (A - I) = 0``, ``sum l = 1``, rationals) from the stencils of
+    :func:`ccproof.mesh.rules.refine_complex` on the fan.
+
+    Parameters
+    ----------
+    n : int
+        Valence (faces around the vertex), n >= 2.
+    sigma : {1, -1}
+        Fan orientation: face j is ``(v, a_j, d_j, a_{j + sigma})`` (indices mod n).
+
+    Returns
+    -------
+    ndarray, shape (2 n + 1,)
+        Weights of ``v``, the edge neighbours ``a_0 .. a_{n-1}`` (``a_0`` the sharp edge's far end) and the
+        diagonals ``d_0 .. d_{n-1}``; they sum to 1.
+
+    Examples
+    --------
+    >>> m = dart_limit_mask(4, 1)
+    >>> round(float(m.sum()), 15), bool(m[1] > m[3]), bool(abs(m[2] - m[4]) < 1e-15)
+    (1.0, True, True)
+    """
+    import flint
+
+    from ccproof.mesh.rules import Complex, Options, refine_complex, to_float
+
+    faces = [(0, 1 + j, 1 + n + j, 1 + (j + sigma) % n) for j in range(n)]
+    cx = Complex(faces, {(0, 1): math.inf}, {}, Options(), level=1, n_vertices=2 * n + 1)
+    edges = [cx.edge_index[(0, 1 + j)] for j in range(n)]
+    stencils, _, _, _ = refine_complex(cx, vertices=[0], edges=edges)
+    nv, ne = cx.n_vertices, len(cx.edges)
+    rows = [stencils[0]] + [stencils[nv + e] for e in edges] + [stencils[nv + ne + j] for j in range(n)]
+    N = 2 * n + 1
+    Bt = flint.fmpq_mat(N, N)
+    for i, r in enumerate(rows):  # (A - I)^T
+        for j, w in r.items():
+            Bt[j, i] = w
+        Bt[i, i] -= 1
+    for j in range(N):
+        Bt[N - 1, j] = 1
+    lvec = Bt.solve(flint.fmpq_mat(N, 1, [0] * (N - 1) + [1]))
+    return np.array([to_float(lvec[i, 0]) for i in range(N)])
+
+
+def _dart_rows(mesh, verts, sharp_nbrs):
+    """Sparse rows (len(verts), n) of the exact limit masks of the darts ``verts`` (:func:`dart_limit_mask`).
+
+    ``sharp_nbrs``: the far end of each dart's sharp edge.
+    """
+    F = mesh.faces
+    rows, cols, vals = [], [], []
+    for r, (v, s) in enumerate(zip(verts.tolist(), sharp_nbrs.tolist())):
+        c = mesh.fan_corners[mesh.fan_ptr[v]: mesh.fan_ptr[v] + mesh.face_count[v]]
+        f, i = c // 4, c % 4
+        a, d, b = F[f, (i + 1) % 4], F[f, (i + 2) % 4], F[f, (i + 3) % 4]
+        k = a.size
+        j0 = int(np.flatnonzero(a == s)[0])
+        order = (j0 + np.arange(k)) % k
+        a, d, b = a[order], d[order], b[order]
+        sigma = 1 if (k > 1 and b[0] == a[1]) else -1
+        if k > 1 and b[0] != a[sigma % k]:
+            raise HierarchyError(f"vertex {v}: its fan is not a closed ring of quads")
+        m = dart_limit_mask(k, sigma)
+        rows.append(np.full(2 * k + 1, r))
+        cols.append(np.r_[v, a, d])
+        vals.append(m)
+    if not rows:
+        return sp.csr_matrix((0, mesh.n_vertices))
+    return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                         shape=(verts.size, mesh.n_vertices))
+
+
 def limit_operator(level: Level, rules):
     """Sparse (n, n) limit-position operator on ``E_k`` for ``rules``; rows of chart vertices only.
+
+    Interior (smooth) vertices: ``(n^2 V + 4 sum e + sum f) / (n (n + 5))``; crease vertices (the surface
+    boundary, an infinitely sharp crease, the chart boundary of the boundary rules):
+    ``(e0 + 4 V + e1) / 6`` along it; corners: ``V``; darts: :func:`dart_limit_mask`; vertices with
+    semi-sharp tags: :func:`~ccproof.apps.control_mesh.moving_limit_rows` (subdivided until stationary). All
+    exact (rounded once).
 
     Parameters
     ----------
@@ -175,16 +262,31 @@ def limit_operator(level: Level, rules):
     mesh = level.mesh
     F = mesh.faces
     n = mesh.n_vertices
+    dart = np.zeros(n, dtype=bool)
+    moving = np.zeros(n, dtype=bool)  # semi-sharp tags: not stationary
     if r == "extended":
         inner = level.chart_vertex & ~mesh.is_boundary_vertex
         crease = level.chart_vertex & mesh.is_boundary_vertex
         nbrs = level.surface_boundary_nbrs
         corner = np.zeros(n, dtype=bool)
+        if level.has_tags:  # the surface's stationary rules (on an untagged surface the same sets)
+            cvx = level.chart_vertex & level.stationary
+            moving = level.chart_vertex & ~level.stationary
+            inner, crease, corner = cvx & level.smooth, cvx & level.crease_rule, cvx & level.corner_rule
+            dart, nbrs = cvx & level.dart_rule, level.crease_nbrs
     else:
         inner = level.chart_interior
         corner = level.corner
         crease = level.chart_boundary & ~corner
         nbrs = level.chart_boundary_nbrs
+        if level.has_tags:  # chart-interior vertices follow the surface's rules
+            ci = level.chart_interior & level.stationary
+            moving = level.chart_interior & ~level.stationary
+            inner = ci & level.smooth
+            corner = corner | (ci & level.corner_rule)
+            dart = ci & level.dart_rule
+            nbrs = np.where((ci & level.crease_rule)[:, None], level.crease_nbrs, nbrs)
+            crease = crease | (ci & level.crease_rule)
     org = F.ravel()
     h = np.flatnonzero(inner[org])
     v = org[h]
@@ -204,7 +306,20 @@ def limit_operator(level: Level, rules):
     vals = np.concatenate(
         [we, wd, wV, np.full(cv.size, cV), np.full(cv.size, ce), np.full(cv.size, ce), np.ones(kv.size)]
     )
-    return sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
+    out = sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
+    mv = np.flatnonzero(moving)
+    if mv.size:
+        place = sp.csr_matrix((np.ones(mv.size), (mv, np.arange(mv.size))), shape=(n, mv.size))
+        out = (out + place @ moving_limit_rows(mesh, mv, level.edge_sharpness, level.vertex_sharpness)).tocsr()
+    dv = np.flatnonzero(dart)
+    if dv.size:
+        se = (level.edge_sharpness > 0) | mesh.is_boundary_edge
+        a, b = mesh.edges[se, 0], mesh.edges[se, 1]
+        far = np.full(n, -1, dtype=np.int64)
+        far[a], far[b] = b, a
+        place = sp.csr_matrix((np.ones(dv.size), (dv, np.arange(dv.size))), shape=(n, dv.size))
+        out = (out + place @ _dart_rows(mesh, dv, far[dv])).tocsr()
+    return out
 
 
 def isometric_frames(p1, p2):
@@ -311,6 +426,8 @@ def build_samples(level: Level, rules, purpose="optimize") -> SampleSet:
         mask_v = np.flatnonzero(level.chart_interior)
     else:
         raise ValueError(f"purpose must be 'optimize' or 'metric', got {purpose!r}")
+    if level.has_tags:  # masks where the surface's rule is the smooth one; secants at creases, corners, darts
+        mask_v = mask_v[level.smooth[mask_v]]
     corner_v = np.zeros(mesh.n_vertices, dtype=bool)
     corner_v[level.chart_vertex] = True
     corner_v[mask_v] = False
