@@ -245,8 +245,8 @@ def winding(rho, arcs, R, M):
     >>> wn, why = winding(fmpq(1, 5), 512, fmpq(3, 10), arb("0.0261"))
     >>> wn.contains(4), why
     (True, None)
-    >>> winding(fmpq(1, 5), 256, fmpq(3, 10), arb("0.0261"))[1][:40]
-    "arc 0 of 256: |H'| * length = [0.00384 "
+    >>> winding(fmpq(1, 5), 256, fmpq(3, 10), arb("0.0261"))[1][:37]
+    "arc 0 of 256: |H'| * length = [0.0038"
     """
     slope = M * R / (R - rho) ** 2  # |H'| on |theta| = rho (Cauchy on |theta| = R)
     length = 2 * arb.pi() * rho / arcs
