@@ -196,7 +196,7 @@ def check_disc(R, side):
     >>> check_disc(fmpq(1, 10), fmpq(1, 10))
     4
     """
-    m = -(-R.p * side.q // (R.q * side.p))  # ceil(R / side)
+    m = int(-(-R.p * side.q // (R.q * side.p)))  # ceil(R / side)
     count = 0
     for u in range(-m, m):
         for v in range(-m, m):
