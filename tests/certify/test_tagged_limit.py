@@ -209,7 +209,8 @@ def test_coverage_counts_the_interval(tmp_path):
     assert line(singles[1:] + [_result(tmp_path, "crease:>=5", "not C1")]).startswith("crease: OK")  # 5 by the tail
     assert line(singles[:-2] + [tail]).startswith("crease: INCOMPLETE: no certificate for 2-3")
     c1 = _result(tmp_path, "crease:40", "C1")
-    assert line([c1, _result(tmp_path, "crease:>=16", "not C1")]).startswith("crease: CONTRADICTORY: certified twice: [40]")
+    clash = line([c1, _result(tmp_path, "crease:>=16", "not C1")])
+    assert clash.startswith("crease: CONTRADICTORY: certified twice: [40]")
 
 
 def test_verify_json_and_certify_on_the_command_line(tmp_path):
