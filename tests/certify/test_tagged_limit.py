@@ -228,3 +228,22 @@ def test_verify_json_and_certify_on_the_command_line(tmp_path):
     out = subprocess.run([sys.executable, "-m", "ccproof.cli", "certify", "crease:>=1", "--c1", "--out",
                           str(tmp_path)], capture_output=True, text=True, timeout=300)
     assert out.returncode == 2 and "error:" in out.stderr and "N0" in out.stderr
+
+
+@pytest.mark.parametrize("path,value", [
+    (("limit", "rho"), 0.2), (("limit", "rho"), "-0.2"), (("limit", "rho"), "1e-400"), (("limit", "box"), "1e-30"),
+    (("limit", "box"), "0"), (("limit", "arcs"), True), (("limit", "arcs"), 0), (("limit", "outer_arcs"), "512"),
+    (("limit", "R"), "2"), (("limit",), []), (("limit", "extra"), 1), (("witness", "z", "crease"), ["0"] * 4),
+    (("witness", "z", "crease"), [0, 0, 0, 0, 1]), (("witness", "z", "eigenvalue"), ["0.5", "0.5"]),
+    (("witness", "z", "eigenvalue"), "0"), (("witness",), {"z": None}), (("prec",), 10**9),
+    (("configuration",), "crease:>=99999999"), (("configuration",), "crease:>=0101x"), (("statement",), None),
+])
+def test_malformed_interval_records_fail_with_a_reason(path, value):
+    """Hostile values in every field end in FAILED with a reason, never an exception (and at once)."""
+    cert = copy.deepcopy(_tail("crease"))
+    obj = cert
+    for key in path[:-1]:
+        obj = obj[key]
+    obj[path[-1]] = value
+    res = verify_certificate(cert, **QUIET)
+    assert not res and (res.error or res.failures())
