@@ -40,7 +40,7 @@ def _fails(cert, why):
 def test_published_interval_certificates_verify(fam):
     res = verify_certificate(_tail(fam), **QUIET)
     assert res and res.valence == f"{fam}:>=101"
-    assert [p.name.split(":")[0].split(" ")[0] for p in res.parts] == ["S", "range", "z", "G", "B", "N", "N", "N", "N"]
+    assert [p.name.split(":")[0].split(" ")[0] for p in res.parts] == ["S", "range", "z", "G", "B", "N", "x,", "N", "N"]
 
 
 def test_parse_configuration_of_an_interval():

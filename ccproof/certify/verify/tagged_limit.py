@@ -384,8 +384,9 @@ def _check_tail(fam, n0, g, cval, rho, R, side, arcs, outer, part, log):
         return
     got = check_disc(R, side)
     ok = isinstance(got, int)
-    part(f"N analytic: the bordered systems of modes 1 and 2 regular on |theta| <= {R}", ok,
-         f"{got} boxes of side {side}, (1 + c)(9 + c) in the right half-plane" if ok else
+    part(f"x, y and N analytic: the bordered systems of modes 1 and 2 regular on |theta| <= {R}", ok,
+         f"{got} boxes of side {side}, (1 + c)(9 + c) in the right half-plane: x, y = f(pi/N), f(2 pi/N) are the "
+         "eigenvectors of alpha, beta for every N >= 7 and H is analytic on the disc" if ok else
          f"box {got}: not proved regular, or (1 + c)(9 + c) not certainly in the right half-plane")
     if not ok:
         return
