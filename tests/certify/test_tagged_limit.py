@@ -247,3 +247,13 @@ def test_malformed_interval_records_fail_with_a_reason(path, value):
     obj[path[-1]] = value
     res = verify_certificate(cert, **QUIET)
     assert not res and (res.error or res.failures())
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("fam", ["crease", "corner"])
+def test_the_interval_argument_alone_covers_every_n_from_seven(fam):
+    """rho = 0.45 > pi/7 with R = 0.5 on a finer grid: every N >= 7 (the window's least N), about 13 s each."""
+    lim = {"rho": "0.45", "R": "0.5", "arcs": 4096, "outer_arcs": 8192, "box": "0.0125"}
+    res = verify_certificate(dict(_tail(fam), configuration=f"{fam}:>=7", limit=lim), **QUIET)
+    assert res, res.failures()
+    _fails(dict(_tail(fam), configuration=f"{fam}:>=7", limit=dict(lim, R="0.55")), "not proved regular")
