@@ -286,9 +286,9 @@ def uniform_spectrum(fam, n0, g, C, blocks):
            or any(M.charpoly()(g) == 0 for M in blocks) else None)
     if why is not None:
         return False, f"every N >= {n0}: {why}"
-    return True, (f"every N >= {n0}: 1 simple (crease block); alpha = lam(cos(pi/N)) > beta = lam(cos(2 pi/N)) >= "
-                  f"{b0.str(6, radius=False)} > every other eigenvalue (<= {max(others, key=lambda x: x.mid()).str(4)}"
-                  f", each simple); gamma = {g} < beta, at most simple in I (only at c = {cg})")
+    return True, (f"every N >= {n0}: alpha = lam(cos(pi/N)) > beta = lam(cos(2 pi/N)) >= {b0.str(6, radius=False)} > "
+                  f"every other eigenvalue (<= {max(others, key=lambda x: x.mid()).str(4)}, each simple), 1 simple "
+                  f"(crease block); gamma = {g} < beta, at most simple in I (only at c = {cg})")
 
 
 def verify_tail(cert, fam, n0, part, log):
