@@ -298,8 +298,10 @@ def prove_tagged(name, prec=DEFAULT_PREC):
     return None, f"undecided: {leading_spectrum(fam, n, prec)[1]}{witness}"
 
 
-# hints of the interval certificate, tried in turn: rho, R, arcs on |theta| = rho, arcs on |theta| = R, box side
-LIMIT_HINTS = (("0.2", "0.3", 512, 2048, "0.05"), ("0.2", "0.3", 2048, 4096, "0.025"))
+# hints of the interval certificate, tried in turn: rho, R, arcs on |theta| = rho, arcs on |theta| = R, box side;
+# rho = 0.2 serves N0 >= 16 (about 1 s), 0.3 N0 >= 11 (3 s), 0.45 every N0 >= 7 (13 s; docs/tagged_c1.md)
+LIMIT_HINTS = (("0.2", "0.3", 512, 2048, "0.05"), ("0.3", "0.4", 1024, 4096, "0.05"),
+               ("0.45", "0.5", 4096, 8192, "0.0125"))
 _Z = {"crease": ["0", "-0.5", "-1", "0.5", "1"], "corner": ["0", "0.5", "1", "0", "0"]}
 
 
