@@ -3,8 +3,9 @@
 
 The witness's part N needs J_xy != 0 at the vertex (1,1) of quadrant 0, where x and y are the real
 eigenvectors of the modes 1 and 2 (w = exp(i theta), exp(2 i theta), theta = pi/N). J_xy tends to 0
-with theta. This script computes, in arb / acb (python-flint), the quantities of the plan in
-docs/tagged_c1.md ("Not covered yet"):
+with theta. This script computes, in arb / acb (python-flint), independently of the verifier's
+ccproof/certify/verify/tagged_limit.py (which checks them for the certificates crease:>=N0, corner:>=N0),
+the quantities of docs/tagged_c1.md ("Every N >= N0 in one certificate"):
 
 * H(theta) = T_a(f1) T_b(f2) - T_b(f1) T_a(f2), f_j the sector values of v - v o R for the mode
   vector v(t, p) = w^t v^(p) of mode j, v^ from the bordered 6 x 6 system of B(w) with v^(1,0) = 1

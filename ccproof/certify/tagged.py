@@ -50,10 +50,16 @@ def configurations(text):
 
     Examples
     --------
-    >>> configurations("corner:2-4"), configurations("dart:5")
-    (['corner:2', 'corner:3', 'corner:4'], ['dart:5'])
+    >>> configurations("corner:2-4"), configurations("dart:5"), configurations("crease:>=101")
+    (['corner:2', 'corner:3', 'corner:4'], ['dart:5'], ['crease:>=101'])
     """
     fam, colon, rng = str(text).partition(":")
+    if rng.startswith(">="):  # every N >= N0 in one certificate (tagged_limit)
+        try:
+            parse_configuration(str(text))
+        except (ValueError, TypeError) as exc:
+            raise CCProofError(str(exc)) from None
+        return [str(text)]
     a, dash, b = rng.partition("-")
     try:
         lo, hi = int(a), int(b if dash else a)
@@ -273,6 +279,8 @@ def prove_tagged(name, prec=DEFAULT_PREC):
      no witness candidate'
     """
     fam, n = parse_configuration(name)
+    if isinstance(n, dict):
+        return prove_tagged_limit(name, prec)
     why = []
     for w in witness_candidates(name, prec):
         for q in range(n):
@@ -290,12 +298,47 @@ def prove_tagged(name, prec=DEFAULT_PREC):
     return None, f"undecided: {leading_spectrum(fam, n, prec)[1]}{witness}"
 
 
+# hints of the interval certificate, tried in turn: rho, R, arcs on |theta| = rho, arcs on |theta| = R, box side;
+# rho = 0.2 serves N0 >= 16 (about 1 s), 0.3 N0 >= 11 (3 s), 0.45 every N0 >= 7 (13 s; docs/tagged_c1.md)
+LIMIT_HINTS = (("0.2", "0.3", 512, 2048, "0.05"), ("0.3", "0.4", 1024, 4096, "0.05"),
+               ("0.45", "0.5", 4096, 8192, "0.0125"))
+_Z = {"crease": ["0", "-0.5", "-1", "0.5", "1"], "corner": ["0", "0.5", "1", "0", "0"]}
+
+
+def prove_tagged_limit(name, prec=DEFAULT_PREC):
+    """A verified "not C1" certificate for every N >= N0 at once (``"crease:>=101"``, ``"corner:>=101"``;
+    :mod:`ccproof.certify.verify.tagged_limit`), or None with the reason.
+
+    The witness is fixed (modes 1 and 2, the crease tangent z of eigenvalue 1/2, ray 0, quadrant 0); the
+    prover only picks the hints (:data:`LIMIT_HINTS`) and keeps the first set the verifier accepts.
+
+    Examples
+    --------
+    >>> cert, why = prove_tagged_limit("corner:>=101")
+    >>> cert["limit"]["rho"], why
+    ('0.2', 'not C1 for every N >= 101 (the limit of H(theta) along |theta| = 0.2)')
+    """
+    fam, n = parse_configuration(name)
+    if fam not in _Z or not isinstance(n, dict):
+        return None, f"undecided: {name}: interval certificates are defined for crease:>=N0 and corner:>=N0"
+    why = "no hints"
+    for rho, R, arcs, outer, box in LIMIT_HINTS:
+        cert = {"schema": TAGGED_SCHEMA, "configuration": name, "statement": "not C1", "prec": prec,
+                "witness": {"z": {"eigenvalue": "0.5", "crease": _Z[fam]}},
+                "limit": {"rho": rho, "R": R, "arcs": arcs, "outer_arcs": outer, "box": box}}
+        res = verify_certificate(cert, log=lambda line: None)
+        if res:
+            return cert, f"not C1 for every N >= {n['min']} (the limit of H(theta) along |theta| = {rho})"
+        why = res.error or "; ".join(f"{p.name.split(':')[0]}: {p.message}" for p in res.failures())
+    return None, f"undecided: {why}"
+
+
 def write_tagged(cert, out_dir):
-    """Write ``out_dir/FAMILY/nNNN.json`` (``kKKK`` for darts); returns the path."""
+    """Write ``out_dir/FAMILY/nNNN.json`` (``kKKK`` for darts, ``n_ge_N0`` for every N >= N0); returns the path."""
     fam, n = parse_configuration(cert["configuration"])
     d = Path(out_dir) / fam
     d.mkdir(parents=True, exist_ok=True)
-    path = d / f"{'k' if fam == 'dart' else 'n'}{n:03d}.json"
+    path = d / (f"n_ge_{n['min']}.json" if isinstance(n, dict) else f"{'k' if fam == 'dart' else 'n'}{n:03d}.json")
     path.write_text(json.dumps(cert, indent=1) + "\n")
     return path
 
@@ -373,6 +416,8 @@ def prove_tagged_c1(name, prec=DEFAULT_PREC):
     ('C1', 'C1')
     """
     fam, n = parse_configuration(name)
+    if isinstance(n, dict):
+        return None, "undecided: no C1 certificate for an interval of configurations"
     if fam == "dart" and n >= MIN_N:  # the verifier's mode route: no exact spectrum of the whole matrix
         specs, entries = _dart_specs(n, prec)
         if specs is None:

@@ -12,6 +12,9 @@
                                  a "not C1" certificate with a witness where one is found, else a "C1"
                                  certificate (characteristic map regular and injective), written to
                                  certificates/c1/FAMILY/; the others reported as undecided with the reason
+  ccproof certify 'crease:>=101' --c1   every N >= 101 at once (crease or corner, "not C1": one witness shape,
+                                 the normal's limit checked on a disc in theta = pi/N), written to
+                                 certificates/c1/FAMILY/n_ge_101.json
   ccproof certify '>=40'         the Appendix-A statement for every k >= 40 in one certificate: lam is a
                                  variable (Taylor models in zeta, lam = mid + zeta * half-width), see
                                  docs/appendix_a.md section 6

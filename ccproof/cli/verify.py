@@ -8,10 +8,11 @@
                                   may overlap each other and single valences); per tagged family
                                   (dart, crease, corner) which N are certified C1 and not C1, each
                                   configuration at most once, and every crease:1-100, corner:1-100,
-                                  dart:2-100 certified or one of the undecided (docs/tagged_c1.md)
+                                  dart:2-100 certified or one of the undecided (docs/tagged_c1.md), and
+                                  every N >= 101 of crease and corner ('crease:>=101', 'corner:>=101')
   ccproof verify FILE --json     one JSON object per file: "configuration" ("smooth:5", "smooth:>=40",
-                                  "crease:5"), "statement" ("C1", "not C1", "injective"), "verdict"
-                                  ("VERIFIED" or "FAILED"), "parts" (name, ok, message), "error"
+                                  "crease:5", "crease:>=101"), "statement" ("C1", "not C1", "injective"),
+                                  "verdict" ("VERIFIED" or "FAILED"), "parts" (name, ok, message), "error"
   ccproof verify --all            runs on a local Dask cluster (one worker per core) by default;
   ccproof verify --all --serial   in this process; --scheduler local:2 | tcp://host:8786 elsewhere
                                   (the workers read the files: a remote cluster needs them on a shared
@@ -90,12 +91,16 @@ def _check(args):
 # (a Jordan block among lam1, lam2; dart:2, lam2 < 0).
 TAGGED_TARGET = {"dart": (2, 100), "crease": (1, 100), "corner": (1, 100)}
 TAGGED_UNDECIDED = {"dart": (2,), "crease": (1, 4), "corner": (2, 4)}
+# the families whose every N must be covered: a certificate FAMILY:>=N0 (N0 at most the range's end + 1)
+TAGGED_EVERY = ("crease", "corner")
 
 
 def tagged_coverage(results):
     """(ok, lines): per tagged family, the N certified C1 and not C1; ok unless a configuration has two
     verified certificates (a statement and its negation, or a publishing mistake) or an N of
-    :data:`TAGGED_TARGET` is neither certified nor one of :data:`TAGGED_UNDECIDED`.
+    :data:`TAGGED_TARGET` is neither certified nor one of :data:`TAGGED_UNDECIDED`; for the families of
+    :data:`TAGGED_EVERY` every N: a verified ``FAMILY:>=N0`` with N0 at most the range's end + 1 (its
+    statement must agree with every single certificate of an N >= N0).
 
     >>> from ccproof.certify.verify import VerifyResult, Part
     >>> r = VerifyResult(schema="ccproof.tagged-c1/1", valence="crease:5", parts=[Part("S", True)])
@@ -103,22 +108,35 @@ def tagged_coverage(results):
     >>> ok, lines[1][:40]
     (False, 'crease: CONTRADICTORY: certified twice: ')
     >>> tagged_coverage([r])[1][1][:60]
-    'crease: INCOMPLETE: no certificate for 2-3, 6-100; C1 for no'
+    'crease: INCOMPLETE: no certificate for 2-3, 6-100, >= 101; C'
     """
     ok_all, lines = True, []
     for fam in ("dart", "crease", "corner"):
-        rows = [(int(r.valence.split(":")[1]), summary(r)["statement"]) for r in results
-                if r and isinstance(r.valence, str) and r.valence.startswith(fam + ":")]
+        rows, tails = [], []
+        for r in results:
+            if r and isinstance(r.valence, str) and r.valence.startswith(fam + ":"):
+                n, st = r.valence.split(":")[1], summary(r)["statement"]
+                if n.startswith(">="):
+                    tails.append((int(n[2:]), st))
+                else:
+                    rows.append((int(n), st))
         ns = [n for n, _ in rows]
         twice = sorted({n for n in ns if ns.count(n) > 1})
         lo, hi = TAGGED_TARGET[fam]
-        missing = [n for n in range(lo, hi + 1) if n not in ns and n not in TAGGED_UNDECIDED[fam]]
+        n0 = min((t for t, _ in tails), default=None)
+        end = hi if n0 is None else min(hi, n0 - 1)
+        missing = [n for n in range(lo, end + 1) if n not in ns and n not in TAGGED_UNDECIDED[fam]]
+        clash = sorted(n for n, st in rows for t, st_t in tails if n >= t and st != st_t)
+        every = fam in TAGGED_EVERY
         c1, not_c1 = (sorted(n for n, st in rows if st == want) for want in ("C1", "not C1"))
-        status = (f"CONTRADICTORY: certified twice: {twice}; " if twice else
-                  f"INCOMPLETE: no certificate for {_ranges(missing)}; " if missing else f"OK ({fam}:{lo}-{hi}): ")
-        lines.append(f"{fam}: {status}C1 for {_ranges(c1) or 'none'}, not C1 for {_ranges(not_c1) or 'none'}; "
+        not_c1 = _ranges(not_c1) + "".join(f", >= {t}" for t, st in sorted(tails) if st == "not C1")
+        gap = [] if n0 is not None and n0 <= hi + 1 or not every else [f">= {hi + 1}"]
+        status = (f"CONTRADICTORY: certified twice: {twice or clash}; " if twice or clash else
+                  f"INCOMPLETE: no certificate for {', '.join(filter(None, [_ranges(missing)] + gap))}; "
+                  if missing or gap else f"OK ({fam}:{lo}-{hi}{', every N' if every else ''}): ")
+        lines.append(f"{fam}: {status}C1 for {_ranges(c1) or 'none'}, not C1 for {not_c1.lstrip(', ') or 'none'}; "
                      f"undecided: {_ranges(list(TAGGED_UNDECIDED[fam]))} (docs/tagged_c1.md lists the reasons)")
-        ok_all &= not twice and not missing
+        ok_all &= not twice and not clash and not missing and not gap
     return ok_all, lines
 
 

@@ -84,6 +84,23 @@ REVIEWED = {
     ("tagged_modes.py", "SE[a, b] != 0"): "fmpq_mat entries (exact)",
     ("maps.py", "not (hi < BREAKS[p] or (p < 3 and lo > BREAKS[p + 1]))"): (
         "keeps a piece unless the hull is certainly outside it: conservative"),
+    ("tagged_limit.py", "not disc.real > 0"): "refuses the box unless Re (1 + c)(9 + c) > 0 certainly: conservative",
+    ("tagged_limit.py", 'field_of(cert, "statement", str, "certificate") != "not C1"'): "strings",
+    ("tagged_limit.py", "out.setdefault(key, rel) != rel"): "dicts of fmpq weights (exact)",
+    ("tagged_limit.py", "C != crease_block(fam, WINDOW[1])"): "fmpq_mat (exact)",
+    ("tagged_limit.py", "blocks[0] != blocks[1]"): "tuples of fmpq_mat (exact)",
+    ("tagged_limit.py", "_mul(_block(1 / w), _reflection(w)) != _mul(_reflection(w), _block(w))"):
+        "lists of fmpq (w is an exact rational)",
+    ("tagged_limit.py", "not slope * length < abs(h0)"): "fails unless the arc's image certainly misses 0: "
+                                                         "conservative",
+    ("tagged_limit.py", "g != 0"): "fmpq (exact decimal)",
+    ("tagged_limit.py", "sum(row.values(), fmpq(0)) != 1"): "fmpq (exact)",
+    ("tagged_limit.py", "x != 0"): "fmpq (exact)",
+    ("tagged_limit.py", "croots.count(1) != 1"): "ints (fmpq roots compared exactly)",
+    ("tagged_limit.py", "not lam_of(arb(1)) < 1"): "fails unless lam(1) < 1 certainly: conservative",
+    ("tagged_limit.py", "v != 0"): "fmpq (exact decimals)",
+    ("tagged_limit.py", "g != max(below)"): "fmpq (exact roots of the crease block)",
+    ("tagged_limit.py", "not arb(g) < b0"): "fails unless gamma < beta certainly: conservative",
 }
 
 

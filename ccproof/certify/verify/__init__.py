@@ -26,9 +26,11 @@ from pathlib import Path
 from .c1 import C1_SCHEMA, verify_c1
 from .errors import CertificateError
 from .injectivity import SCHEMA, verify_injectivity
-from .record import Part, Recorder, VerifyResult, read_valence
+from .record import Part, Recorder, VerifyResult, field_of, read_valence
 from .replay import check_size
+from .tagged import parse_configuration
 from .tagged_c1 import TAGGED_SCHEMA, verify_tagged
+from .tagged_limit import verify_tail
 
 __all__ = ["SCHEMA", "C1_SCHEMA", "TAGGED_SCHEMA", "CertificateError", "Part", "VerifyResult", "verify_certificate",
            "verify_file", "check_coverage", "certificate_files", "read_certificate_bytes"]
@@ -80,7 +82,9 @@ def verify_certificate(cert, log=print, path=None):
         res.schema = cert["schema"]
         check_size(cert)
         if res.schema == TAGGED_SCHEMA:  # a configuration name instead of a valence (docs/tagged_c1.md)
-            res.valence = verify_tagged(cert, part, log)
+            fam, n = parse_configuration(field_of(cert, "configuration", str, "certificate"))
+            res.valence = verify_tail(cert, fam, n["min"], part, log) if isinstance(n, dict) else verify_tagged(
+                cert, part, log)  # FAMILY:>=N0: every N >= N0 at once (tagged_limit)
             res.seconds = time.perf_counter() - t0
             return res
         res.valence = read_valence(cert)

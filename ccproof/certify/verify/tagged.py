@@ -31,20 +31,23 @@ FAMILIES = ("dart", "crease", "corner")
 RAY_POS = ((1, 0), (2, 0))
 QUAD_POS = ((1, 1), (2, 1), (1, 2), (2, 2))
 MAX_SIZE = 100  # N, K at most this (exact characteristic polynomials of 6K + 1 rows)
-_NAME = re.compile(r"(dart|crease|corner):([0-9]{1,3})")
+_NAME = re.compile(r"(dart|crease|corner):(>=)?([0-9]{1,7})")
+MAX_TAIL = 10**6  # FAMILY:>=N0 needs N0 at most this
 
 
 def parse_configuration(name):
-    """``(family, n)`` from a configuration name such as ``"crease:4"``.
+    """``(family, n)`` from a configuration name such as ``"crease:4"``, or ``(family, {"min": N0})`` for
+    every N >= N0 at once (``"crease:>=101"``; :mod:`.tagged_limit`).
 
     Parameters
     ----------
     name : str
-        ``"dart:K"`` (K >= 2), ``"crease:N"`` or ``"corner:N"`` (N >= 1), at most :data:`MAX_SIZE`.
+        ``"dart:K"`` (K >= 2), ``"crease:N"`` or ``"corner:N"`` (N >= 1), at most :data:`MAX_SIZE`;
+        ``"FAMILY:>=N0"`` with 2 <= N0 <= :data:`MAX_TAIL`.
 
     Returns
     -------
-    (str, int)
+    (str, int or dict)
 
     Raises
     ------
@@ -53,8 +56,8 @@ def parse_configuration(name):
 
     Examples
     --------
-    >>> parse_configuration("dart:5")
-    ('dart', 5)
+    >>> parse_configuration("dart:5"), parse_configuration("crease:>=101")
+    (('dart', 5), ('crease', {'min': 101}))
     >>> parse_configuration("dart:1")
     Traceback (most recent call last):
     ...
@@ -62,8 +65,12 @@ def parse_configuration(name):
     """
     m = _NAME.fullmatch(name) if isinstance(name, str) else None
     if m is None:
-        raise CertificateError(f"configuration {str(name)[:40]!r} is not dart:K, crease:N or corner:N")
-    fam, n = m.group(1), int(m.group(2))
+        raise CertificateError(f"configuration {str(name)[:40]!r} is not dart:K, crease:N or corner:N (or FAMILY:>=N0)")
+    fam, n = m.group(1), int(m.group(3))
+    if m.group(2):
+        if not 2 <= n <= MAX_TAIL:
+            raise CertificateError(f"configuration {name!r}: {fam}:>=N0 needs 2 <= N0 <= {MAX_TAIL}")
+        return fam, {"min": n}
     lo = 2 if fam == "dart" else 1
     if not lo <= n <= MAX_SIZE:
         raise CertificateError(f"configuration {name!r}: {fam}:{'K' if fam == 'dart' else 'N'} needs "
