@@ -49,9 +49,8 @@ from ccproof.inverse.data import (
     SAFE_LO,
     _approx_log,
     _as_points,
-    _matmul,
     _patch_eval_jac,
-    monomials,
+    polynomial_rows,
     valence_data,
 )
 
@@ -259,7 +258,7 @@ def locate(D, a, b, fast=True):
     """
     n0 = _first_layer(D, a, fast)
     a0, b0 = _scale_lam(D, -n0, a, b, fast)
-    V = _matmul(D.G, monomials(a0, b0, 3))
+    V = polynomial_rows(D.G, a0, b0, 3)
     inner = V[0] * D.gamma_sign < 0          # t0 inside Gamma: one layer deeper
     outer = (V[1] * D.gamma_sign > 0) & ~inner  # lam t0 outside Gamma: one layer out
     sep = np.where(inner, V[2], np.where(outer, V[4], V[3])) * D.sep_sign
@@ -285,7 +284,7 @@ def _inverse_chunk(D, x, y, R, S, layer, patch):
         if sel.size == 0:
             continue
         X, Y = a1[sel], b1[sel]
-        s0, t0 = _matmul(D.fit[q], monomials(X, Y, FIT_DEGREE))
+        s0, t0 = polynomial_rows(D.fit[q], X, Y, FIT_DEGREE)
         s, t, good = newton(D.C6[q], s0, t0, X, Y)
         s_loc[sel] = s
         t_loc[sel] = t
