@@ -13,8 +13,9 @@ x >= y and swap back at the end):
    the outer side: the *scaling relation* Phi(y/2) = lam Phi(y) turns the outer boundary test into
    the inner one, so a single cubic (and its sign convention) serves every layer. The piece (P1
    or P2) is the side of the separator C = Phi(1/2 <= u <= 1, v = 1/2) (edge t = 1 of P1). All
-   five values (Gamma at t0 and lam t0, C at t0 scaled by 1/lam, 1, lam) are one small matrix
-   product with the ten cubic monomials of t0.
+   five values (Gamma at t0 and lam t0, C at t0 scaled by 1/lam, 1, lam) are cubics in t0,
+   evaluated together by nested Horner, point by point (no BLAS: a point's bits do not depend on
+   its batch).
 3. **Newton** on P_j(s, t) = lam^-n t from a first guess: a least-squares polynomial of total
    degree 5 in (x, y) fitted to the local coordinates of P_j (error 1e-5 .. 2e-4), instead of the
    paper's (u, v) (which needs 4 to 6 steps). Two Newton steps, then more only for the points
