@@ -122,8 +122,10 @@ def test_dask_evaluation_equals_numpy_to_the_bit_and_builds_once_per_worker(clus
 
 
 def test_dask_evaluations_of_one_surface_never_take_each_others_blocks(cluster, refdir):
-    """Blocks of an earlier evaluation of the same surface still held on the cluster (other points,
-    derivatives or parameterization, the same chunks) are not the result of a later one."""
+    """While the result of an evaluation is held, the scheduler keeps its tasks (``compute(sync=True)``
+    releases its result asynchronously, after it returns); a later evaluation of the same surface on the
+    same chunks (other parameterization, derivatives or points) must not get them. The blocks of both
+    had the same keys, and the characteristic evaluation returned the natural values."""
     import dask.array as da
 
     from ccproof.mesh import read_obj
@@ -137,18 +139,18 @@ def test_dask_evaluations_of_one_surface_never_take_each_others_blocks(cluster, 
     local = limit_surface(mesh)
     client = cluster[1]
     face = da.from_array(f, chunks=1000)
-    first = evaluate_dask(shipped, face, u, v, derivatives=1, parameterization="natural")
-    held = dict(zip(first, client.persist(list(first.values()))))
-    distributed.wait(distributed.futures_of(list(held.values())))
-    cases = [(face, u, v, 1, "characteristic"), (face, u, v, 0, "natural"), (face, v, u, 1, "natural")]
-    for ff, uu, vv, d, par in cases:
-        got = client.compute(evaluate_dask(shipped, ff, uu, vv, derivatives=d, parameterization=par), sync=True)
+    held = client.compute(evaluate_dask(shipped, face, u, v, derivatives=1, parameterization="natural"))
+    first = held.result()
+    held_p = client.persist(evaluate_dask(shipped, face, u, v, derivatives=0, parameterization="natural")["P"])
+    cases = [(u, v, 1, "characteristic"), (u, v, 0, "characteristic"), (v, u, 1, "natural")]
+    for uu, vv, d, par in cases:
+        got = client.compute(evaluate_dask(shipped, face, uu, vv, derivatives=d, parameterization=par), sync=True)
         ref = local.evaluate(f, uu, vv, derivatives=d, parameterization=par)
         for name in ref:
             assert np.array_equal(got[name], ref[name]), (par, d, name)
-    # and the held blocks are still the natural evaluation
-    assert np.array_equal(client.compute(held["Pu"], sync=True), local.evaluate(f, u, v, derivatives=1)["Pu"])
-    del held
+    assert np.array_equal(first["Pu"], local.evaluate(f, u, v, derivatives=1)["Pu"])
+    assert np.array_equal(client.compute(held_p, sync=True), first["P"])
+    del held, held_p
 
 
 def test_digest_is_content(refdir):
