@@ -13,8 +13,9 @@ x >= y and swap back at the end):
    the outer side: the *scaling relation* Phi(y/2) = lam Phi(y) turns the outer boundary test into
    the inner one, so a single cubic (and its sign convention) serves every layer. The piece (P1
    or P2) is the side of the separator C = Phi(1/2 <= u <= 1, v = 1/2) (edge t = 1 of P1). All
-   five values (Gamma at t0 and lam t0, C at t0 scaled by 1/lam, 1, lam) are one small matrix
-   product with the ten cubic monomials of t0.
+   five values (Gamma at t0 and lam t0, C at t0 scaled by 1/lam, 1, lam) are cubics in t0,
+   evaluated together by nested Horner, point by point (no BLAS: a point's bits do not depend on
+   its batch).
 3. **Newton** on P_j(s, t) = lam^-n t from a first guess: a least-squares polynomial of total
    degree 5 in (x, y) fitted to the local coordinates of P_j (error 1e-5 .. 2e-4), instead of the
    paper's (u, v) (which needs 4 to 6 steps). Two Newton steps, then more only for the points
@@ -49,9 +50,8 @@ from ccproof.inverse.data import (
     SAFE_LO,
     _approx_log,
     _as_points,
-    _matmul,
     _patch_eval_jac,
-    monomials,
+    polynomial_rows,
     valence_data,
 )
 
@@ -259,7 +259,7 @@ def locate(D, a, b, fast=True):
     """
     n0 = _first_layer(D, a, fast)
     a0, b0 = _scale_lam(D, -n0, a, b, fast)
-    V = _matmul(D.G, monomials(a0, b0, 3))
+    V = polynomial_rows(D.G, a0, b0, 3)
     inner = V[0] * D.gamma_sign < 0          # t0 inside Gamma: one layer deeper
     outer = (V[1] * D.gamma_sign > 0) & ~inner  # lam t0 outside Gamma: one layer out
     sep = np.where(inner, V[2], np.where(outer, V[4], V[3])) * D.sep_sign
@@ -285,7 +285,7 @@ def _inverse_chunk(D, x, y, R, S, layer, patch):
         if sel.size == 0:
             continue
         X, Y = a1[sel], b1[sel]
-        s0, t0 = _matmul(D.fit[q], monomials(X, Y, FIT_DEGREE))
+        s0, t0 = polynomial_rows(D.fit[q], X, Y, FIT_DEGREE)
         s, t, good = newton(D.C6[q], s0, t0, X, Y)
         s_loc[sel] = s
         t_loc[sel] = t

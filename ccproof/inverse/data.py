@@ -487,23 +487,55 @@ def valence_data(k):
 
 #: points per block in the vectorized kernels (keeps the temporaries in cache)
 CHUNK = 16384
-#: OpenBLAS runs a product m x k times k x n single-threaded when m n k <= 4 * 65536; above that it
-#: starts threads, which for these tiny products only costs time (and a lot on a loaded machine)
-_GEMM_SINGLE = 4 * 65536
 
 
-def _matmul(A, B):
-    """A @ B for a small A (m x k) and a wide B (k x n), in column blocks small enough for OpenBLAS
-    to stay single-threaded."""
-    m, k = A.shape
-    n = B.shape[1]
-    step = max(256, _GEMM_SINGLE // max(1, m * k))
-    if n <= step:
-        return A @ B
-    out = np.empty((m, n))
-    for i in range(0, n, step):
-        np.matmul(A, B[:, i:i + step], out=out[:, i:i + step])
+def polynomial_rows(C, x, y, degree):
+    """Rows of bivariate polynomials at points (x, y), point by point: nested Horner, no BLAS.
+
+    Row r is ``sum C[r, i] x^a y^b`` over the monomials x^a y^b of :func:`monomials` (order of
+    :func:`_monomial_exponents`), evaluated as ``(...(h_d(y) x + h_{d-1}(y)) x + ...) + h_0(y)`` with
+    ``h_a(y) = sum_b C[r, (a, b)] y^b`` by Horner's rule in y. Every product and sum is numpy's
+    elementwise one (no BLAS, no fused multiply-add), so a point's bits depend on that point only:
+    not on the size of the batch nor on the point's place in it. (A BLAS product ``C @ monomials``
+    does not promise that: OpenBLAS takes another kernel for a single column and edge kernels for the
+    last columns of a block, which made the inverse of a point depend on the points inverted with it.)
+
+    Parameters
+    ----------
+    C : ndarray, shape (m, M) float64
+        Coefficients, M = (degree + 1)(degree + 2)/2.
+    x, y : ndarray, shape (n,) float64
+    degree : int
+        Total degree.
+
+    Returns
+    -------
+    ndarray, shape (m, n) float64
+
+    Examples
+    --------
+    1 + 2x + 3y + 4x^2 + 5xy + 6y^2 at (2, 3) is 1 + 4 + 9 + 16 + 30 + 54 = 114:
+
+    >>> C = np.arange(1.0, 7.0)[None, :]
+    >>> polynomial_rows(C, np.array([2.0]), np.array([3.0]), 2).tolist()
+    [[114.0]]
+    >>> bool(np.array_equal(polynomial_rows(C, np.array([2.0, 0.5]), np.array([3.0, 0.25]), 2)[:, 1:],
+    ...                     polynomial_rows(C, np.array([0.5]), np.array([0.25]), 2)))
+    True
+    """
+    col = {e: i for i, e in enumerate(_monomial_exponents(degree))}
+    out = np.repeat(C[:, col[(degree, 0)], None], x.shape[0], axis=1)
+    for a in range(degree - 1, -1, -1):
+        h = C[:, col[(a, degree - a)], None] * y  # h_a(y), degree - a >= 1
+        for b in range(degree - a - 1, -1, -1):
+            h += C[:, col[(a, b)], None]
+            if b:
+                h *= y
+        out *= x
+        out += h
     return out
+
+
 #: blocks whose points all have max(u, v) in [SAFE_LO, SAFE_HI] scale with the double tables
 #: (plain products); others with mantissa/exponent tables and ldexp (exact range, 30x slower)
 SAFE_LO = 2.0**-900
@@ -525,39 +557,64 @@ def _patch_eval(Wp, s, t, jacobian=False):
     """P(s, t) of one piece (``Wp`` = ``ValenceData.W[p]``) at arrays s, t (local coordinates).
 
     Returns (x, y) or (x, y, x_s, x_t, y_s, y_t). The t-polynomials q_i(t) of both components
-    (and their t- and s-derivative coefficients) come out of one small matrix product, then
-    Horner in s.
+    (and their t- and s-derivative coefficients) by Horner's rule in t, all rows at once, then
+    Horner in s: point by point, so a point's bits do not depend on the other points of the batch.
     """
-    n = s.shape[0]
-    T = np.empty((4, n))
-    T[0] = 1.0
-    T[1] = t
-    np.multiply(t, t, out=T[2])
-    np.multiply(T[2], t, out=T[3])
+    W = Wp[:8] if not jacobian else Wp
+    Q = _horner_rows(W, t)
     if not jacobian:
-        Q = _matmul(Wp[:8], T)
         return _horner3(Q, 0, s), _horner3(Q, 4, s)
-    Q = _matmul(Wp, T)
     return (_horner3(Q, 0, s), _horner3(Q, 4, s), _horner2(Q, 16, s), _horner3(Q, 8, s),
             _horner2(Q, 19, s), _horner3(Q, 12, s))
 
 
+def _horner_rows(W, t):
+    """Row r: the cubic ``W[r, 0] + W[r, 1] t + W[r, 2] t^2 + W[r, 3] t^3`` by Horner's rule, shape (rows, n)."""
+    Q = W[:, 3, None] * t
+    for j in (2, 1, 0):
+        Q += W[:, j, None]
+        if j:
+            Q *= t
+    return Q
+
+
 def _patch_eval_jac(Cp, s, t):
-    """(x, y, x_s, x_t, y_s, y_t) of one piece (``Cp`` = ``ValenceData.C6[p]``): all six are
-    combinations of the 16 monomials s^i t^j (i, j <= 3), so one product (6 x 16) @ (16 x n) after
-    12 multiplications; about 25% cheaper than :func:`_patch_eval` with ``jacobian=True``."""
-    n = s.shape[0]
-    M = np.empty((16, n))
-    M[0] = 1.0
-    M[1] = t
-    np.multiply(t, t, out=M[2])
-    np.multiply(M[2], t, out=M[3])
-    M[4] = s
-    np.multiply(s, s, out=M[8])
-    np.multiply(M[8], s, out=M[12])
-    for i in (4, 8, 12):
-        np.multiply(M[1:4], M[i], out=M[i + 1:i + 4])
-    return _matmul(Cp, M)
+    """(x, y, x_s, x_t, y_s, y_t) of one piece (``Cp`` = ``ValenceData.C6[p]``), shape (6, n).
+
+    The t-polynomials of x, y (cubics) and of x_t, y_t (quadratics) for each power of s by Horner's
+    rule in t, then Horner in s, with the s-derivative carried along (x_s, y_s). Point by point (no
+    BLAS), so a point's bits do not depend on the other points of the batch.
+    """
+    C = Cp.reshape(6, 4, 4)  # [output, power of s, power of t]; outputs x, y, x_s, x_t, y_s, y_t
+    q = C[0:2, :, 3, None] * t  # (2, 4, n): q_i(t) of x and y
+    q += C[0:2, :, 2, None]
+    q *= t
+    q += C[0:2, :, 1, None]
+    q *= t
+    q += C[0:2, :, 0, None]
+    qt = C[3::2, :, 2, None] * t  # (2, 4, n): the t-derivatives
+    qt += C[3::2, :, 1, None]
+    qt *= t
+    qt += C[3::2, :, 0, None]
+    out = np.empty((6, s.shape[0]))
+    P, Ps, Pt = out[0:2], out[2::2], out[3::2]
+    np.multiply(q[:, 3], s, out=P)
+    P += q[:, 2]  # q3 s + q2
+    np.multiply(q[:, 3], s, out=Ps)
+    Ps += P  # 2 q3 s + q2
+    P *= s
+    P += q[:, 1]
+    Ps *= s
+    Ps += P  # 3 q3 s^2 + 2 q2 s + q1
+    P *= s
+    P += q[:, 0]
+    np.multiply(qt[:, 3], s, out=Pt)
+    Pt += qt[:, 2]
+    Pt *= s
+    Pt += qt[:, 1]
+    Pt *= s
+    Pt += qt[:, 0]
+    return out
 
 
 def _horner3(Q, i, s):

@@ -99,6 +99,7 @@ def evaluate_dask(shipped, face, u, v, derivatives=1, **kwargs):
     import dask
     import dask.array as da
     import numpy as np
+    from dask.base import tokenize
 
     face = da.asarray(face)
     u = da.asarray(u).rechunk(face.chunks)
@@ -108,9 +109,13 @@ def evaluate_dask(shipped, face, u, v, derivatives=1, **kwargs):
                            f"{v.shape}")
     names = output_names(derivatives)
     ref = dask.delayed(shipped, pure=True, traverse=False)
-    arr = da.map_blocks(_evaluate_block, face, u, v, ref, derivatives, tuple(sorted(kwargs.items())),
+    kw = tuple(sorted(kwargs.items()))
+    # the keys name everything the result depends on: a cluster still holding the blocks of an earlier
+    # evaluation of the same surface (other points, derivatives or parameterization) must not return them
+    token = tokenize(shipped.digest, face.name, u.name, v.name, derivatives, kw)
+    arr = da.map_blocks(_evaluate_block, face, u, v, ref, derivatives, kw,
                         new_axis=[1, 2], chunks=(face.chunks[0], (len(names),), (3,)), dtype=np.float64,
-                        meta=np.empty((0, len(names), 3)), name=f"evaluate-{shipped.digest[:12]}")
+                        meta=np.empty((0, len(names), 3)), name=f"evaluate-{shipped.digest[:12]}-{token}")
     return {n: arr[:, j, :] for j, n in enumerate(names)}
 
 

@@ -120,6 +120,51 @@ def test_forced_fallback_gives_the_same_answers(k, monkeypatch):
     assert err <= 1e-14
 
 
+def _same_bits(a, b):
+    return np.ascontiguousarray(a).tobytes() == np.ascontiguousarray(b).tobytes()
+
+
+def _in_batches(fn, x, y, bounds):
+    parts = [fn(x[lo:hi], y[lo:hi]) for lo, hi in bounds]
+    return [np.concatenate([p[i] for p in parts]) for i in range(len(parts[0]))]
+
+
+@pytest.mark.parametrize("k", [3, 5, 8])
+def test_a_point_does_not_depend_on_its_batch(k, monkeypatch):
+    """The inverse, its fallback and the forward map with its Jacobian give every point the same bits
+    alone, in batches of any size (1, 2, 3, ... points: a BLAS product takes other kernels for them)
+    and at any place in its batch (reversed order)."""
+    rng = np.random.default_rng(17)
+    x = np.r_[rng.random(400), clustered_images(k, rng, 200)[0]]
+    y = np.r_[rng.random(400), clustered_images(k, rng, 200)[1]]
+    n = x.size
+    cuts = np.unique(np.r_[0, np.cumsum(rng.integers(1, 12, n)), n])
+    bounds = [(lo, hi) for lo, hi in zip(cuts[:-1], cuts[1:]) if lo < n]
+    rev = np.arange(n)[::-1]
+
+    def forward(a, b):
+        X, Y, J = characteristic_map(k, a, b, jacobian=True)
+        return X, Y, J.reshape(-1, 4)
+
+    def inverse(a, b):
+        return inverse_characteristic_map(k, a, b)
+
+    for fn in (inverse, forward):
+        whole = fn(x, y)
+        alone = _in_batches(fn, x, y, [(i, i + 1) for i in range(0, n, 7)])
+        assert all(_same_bits(w[::7], a) for w, a in zip(whole, alone)), fn.__name__
+        assert all(_same_bits(w, a) for w, a in zip(whole, _in_batches(fn, x, y, bounds))), fn.__name__
+        assert all(_same_bits(w[rev], a) for w, a in zip(whole, fn(x[rev], y[rev]))), fn.__name__
+    # every point through the subdivision fallback: the same bits alone and in the batch
+    monkeypatch.setattr(alg, "NEWTON_STEPS", 0)
+    monkeypatch.setattr(alg, "EXTRA_STEPS", 0)
+    monkeypatch.setattr(alg, "STEP_TOL", -1.0)
+    sub = slice(0, n, 10)
+    whole = inverse(x[sub], y[sub])
+    alone = _in_batches(inverse, x[sub], y[sub], [(i, i + 1) for i in range(0, x[sub].size, 3)])
+    assert all(_same_bits(w[::3], a) for w, a in zip(whole, alone))
+
+
 def test_newton_failure_is_caught(monkeypatch):
     """A location that is wrong (piece flipped) makes Newton leave the piece: the fallback fixes it."""
     real = alg.locate

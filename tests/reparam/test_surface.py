@@ -309,3 +309,34 @@ def test_parameterization_is_a_value():
         T.evaluate([0], [0.1], [0.1], parameterization="characteristic")
     with pytest.raises(CCProofError, match="need an untagged all-quad mesh"):
         T.evaluate([0], [0.1], [0.1], parameterization=Parameterization("characteristic"))
+
+
+@pytest.mark.parametrize("param", ["natural", "vanishing", "characteristic"])
+def test_a_point_does_not_depend_on_its_batch_or_the_threads(param):
+    """Every parameterization gives a point the same bits alone, in batches of any size, at any place
+    in its batch and on 1 or 2 threads (what makes chunked and distributed evaluations equal an
+    evaluation of all points at once). Points near and at the corners of valence 3, 5 and boundary."""
+    S = limit_surface(disk(5, roll_seed=2))
+    rng = np.random.default_rng(8)
+    n = 3000
+    f = rng.integers(0, S.mesh.n_faces, n)
+    u = np.concatenate([rng.random(n // 2), 2.0 ** -rng.uniform(1, 40, n // 2)])
+    v = np.concatenate([rng.random(n // 2), rng.random(n // 2) * 2.0 ** -rng.uniform(0, 30, n // 2)])
+    u[:60], v[:60] = rng.choice([0.0, 1.0], 60), rng.choice([0.0, 1.0], 60)  # at the corners
+    flip = rng.random(n) < 0.5
+    u[flip], v[flip] = 1.0 - u[flip], v[flip]
+    whole = S.evaluate(f, u, v, 2, parameterization=param)
+
+    def same(r, rows=slice(None)):
+        return all(np.ascontiguousarray(whole[k][rows]).tobytes() == np.ascontiguousarray(r[k]).tobytes()
+                   for k in whole)
+
+    cuts = np.unique(np.r_[0, np.cumsum(rng.integers(1, 40, n)), n])
+    parts = [S.evaluate(f[a:b], u[a:b], v[a:b], 2, parameterization=param) for a, b in zip(cuts[:-1], cuts[1:])
+             if a < n]
+    assert same({k: np.concatenate([p[k] for p in parts]) for k in whole})
+    for i in range(0, n, 97):
+        assert same(S.evaluate(f[i:i + 1], u[i:i + 1], v[i:i + 1], 2, parameterization=param), slice(i, i + 1)), i
+    rev = np.arange(n)[::-1]
+    assert same(S.evaluate(f[rev], u[rev], v[rev], 2, parameterization=param), rev)
+    assert same(S.evaluate(f, u, v, 2, parameterization=param, threads=2))

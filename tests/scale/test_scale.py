@@ -103,17 +103,13 @@ def test_dask_evaluation_equals_numpy_to_the_bit_and_builds_once_per_worker(clus
     v[:50] = rng.choice([0.0, 1.0], 50)
     shipped = ship(limit_surface, mesh)
     local = limit_surface(mesh)
-    bounds = ((0, 1000), (1000, 3000), (3000, 6000))
     for par in ("natural", "characteristic"):
         out = evaluate_dask(shipped, da.from_array(f, chunks=(1000, 2000, 3000)), u, v, derivatives=2,
                             parameterization=par)
         got = cluster[1].compute(out, sync=True)
         assert set(got) == {"P", "Pu", "Pv", "Puu", "Puv", "Pvv"}
-        if par == "natural":  # point by point independent: one numpy call on all points
-            ref = local.evaluate(f, u, v, derivatives=2, parameterization=par)
-        else:  # the inverse of Phi rounds the last bit by batch (BLAS blocking): numpy on the same chunks
-            parts = [local.evaluate(f[a:b], u[a:b], v[a:b], derivatives=2, parameterization=par) for a, b in bounds]
-            ref = {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
+        # a point's bits do not depend on the other points of its chunk: one numpy call on all points
+        ref = local.evaluate(f, u, v, derivatives=2, parameterization=par)
         for name in got:
             a, b = np.ascontiguousarray(got[name]), np.ascontiguousarray(ref[name])
             if a.tobytes() != b.tobytes():  # say which points differ and by how much (not a byte dump)
@@ -123,6 +119,38 @@ def test_dask_evaluation_equals_numpy_to_the_bit_and_builds_once_per_worker(clus
     counts = cluster[1].run(build_counts)
     per_worker = [c.get(shipped.digest, 0) for c in counts.values()]
     assert max(per_worker) == 1 and sum(per_worker) >= 1  # 6 chunks, at most one build per worker
+
+
+def test_dask_evaluations_of_one_surface_never_take_each_others_blocks(cluster, refdir):
+    """While the result of an evaluation is held, the scheduler keeps its tasks (``compute(sync=True)``
+    releases its result asynchronously, after it returns); a later evaluation of the same surface on the
+    same chunks (other parameterization, derivatives or points) must not get them. The blocks of both
+    had the same keys, and the characteristic evaluation returned the natural values."""
+    import dask.array as da
+
+    from ccproof.mesh import read_obj
+    from ccproof.reparam.surface import limit_surface
+
+    mesh = read_obj(refdir / "meshes" / "sector_k5.obj")
+    rng = np.random.default_rng(11)
+    n = 3000
+    f, u, v = rng.integers(0, mesh.n_faces, n), rng.random(n) * 0.5, rng.random(n) * 0.5
+    shipped = ship(limit_surface, mesh)
+    local = limit_surface(mesh)
+    client = cluster[1]
+    face = da.from_array(f, chunks=1000)
+    held = client.compute(evaluate_dask(shipped, face, u, v, derivatives=1, parameterization="natural"))
+    first = held.result()
+    held_p = client.persist(evaluate_dask(shipped, face, u, v, derivatives=0, parameterization="natural")["P"])
+    cases = [(u, v, 1, "characteristic"), (u, v, 0, "characteristic"), (v, u, 1, "natural")]
+    for uu, vv, d, par in cases:
+        got = client.compute(evaluate_dask(shipped, face, uu, vv, derivatives=d, parameterization=par), sync=True)
+        ref = local.evaluate(f, uu, vv, derivatives=d, parameterization=par)
+        for name in ref:
+            assert np.array_equal(got[name], ref[name]), (par, d, name)
+    assert np.array_equal(first["Pu"], local.evaluate(f, u, v, derivatives=1)["Pu"])
+    assert np.array_equal(client.compute(held_p, sync=True), first["P"])
+    del held, held_p
 
 
 def test_digest_is_content(refdir):
