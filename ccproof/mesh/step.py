@@ -1,9 +1,8 @@
 """The Catmull-Clark step with OpenSubdiv's Sdc rules, vectorized, as one sparse operator.
 
-:func:`catmark_operator` is the step of every vectorized caller: the untagged quad step of
-:func:`ccproof.mesh.subdivision_matrix`, the applications' tagged step
-(:func:`ccproof.apps.control_mesh.tagged_step`) and the polygon step of
-:meth:`ccproof.mesh.polymesh.PolyMesh.refine`'s callers that want floats. It assembles, over the whole
+:func:`catmark_operator` is the step of the sparse-operator callers: the untagged quad step of
+:func:`ccproof.mesh.subdivision_matrix` and the applications' tagged step
+(:func:`ccproof.apps.control_mesh.tagged_step`). It assembles, over the whole
 mesh with numpy, the rules that :func:`ccproof.mesh.rules.refine_complex` states as exact stencils
 (the independent reference of the tests; the weights come from the same rule functions of
 :mod:`ccproof.rule_weights`, evaluated in floats):
@@ -308,36 +307,66 @@ def catmark_operator(n, indices, sizes, *, edge_of_halfedge=None, edge_sharpness
     # every weight is a sum of terms coef * t / d (coef a dyadic float: 1, a fractional weight, a sharpness;
     # t / d a rule's rational weight): summed exactly as integers over the row's common denominator, then
     # divided once (the correctly rounded weight, as refine_complex's to_float of its exact stencil)
-    rows, cols, cfs, nums, dens = [], [], [], [], []
+    rows, cols, vals = [], [], []
+
+    def scaled(r, coef, t, d):
+        """``coef * t / d`` times the common denominator ``R[r]`` of row ``r``: exact (a dyadic times an integer)."""
+        q, bad = np.divmod(R[r], d)
+        if bad.any():
+            raise AssertionError("internal: a rule weight's denominator does not divide its row's")
+        return coef * (t * q).astype(np.float64)
 
     def add(r, c, coef, t, d):
-        r, c, coef, t, d = np.broadcast_arrays(np.asarray(r, dtype=np.int64), np.asarray(c, dtype=np.int64),
-                                               np.asarray(coef, dtype=np.float64), np.asarray(t, dtype=np.int64),
-                                               np.asarray(d, dtype=np.int64))
-        for lst, x in ((rows, r), (cols, c), (cfs, coef), (nums, t), (dens, d)):
-            lst.append(x.reshape(-1))
+        r = np.asarray(r, dtype=np.int64)
+        rows.append(r)
+        cols.append(np.broadcast_to(np.asarray(c, dtype=np.int64), r.shape))
+        vals.append(np.broadcast_to(scaled(r, coef, t, d), r.shape))
+
+    def add_faces(r, f, x):
+        """Row ``r`` gets ``x`` on every vertex of face ``f`` (a face point spelled out)."""
+        for j in range(int(sz[f].max()) if f.size else 0):
+            sel = sz[f] > j
+            if sel.all():
+                rows.append(r)
+                cols.append(idx[off[f] + j])
+                vals.append(x)
+            else:
+                rows.append(r[sel])
+                cols.append(idx[off[f[sel]] + j])
+                vals.append(x[sel])
 
     one = Fraction(1)  # the rule functions in exact rationals, one value per distinct size or valence
     face_t, face_d = _ratios(lambda x: face_point_weight(x, one), sz)  # (m,)
+    kk = np.maximum(k, 1)
+    (wv_t, wv_d), (we_t, we_d), (wf_t, wf_d) = (
+        _ratios(lambda x, i=i: smooth_vertex_weights(x, one)[i], kk) for i in range(3))
+    wcv, wcn = crease_vertex_weights(one)
+    half = sharp_edge_weight(one)
+    vw0, fw0 = smooth_edge_weights(one)
+    # the common denominator of every row: a face's; at a vertex, of its smooth, crease and corner
+    # weights; at an edge, of the midpoint's and the smooth rule's
+    lf = np.ones(n, dtype=np.int64)
+    if H:
+        used = np.flatnonzero(k > 0)
+        lf[used] = np.lcm.reduceat(face_d[face[fan]], ptr[used])
+    R = np.concatenate([
+        np.lcm.reduce([wv_d, we_d, wf_d * lf, np.full(n, wcv.denominator), np.full(n, wcn.denominator)]),
+        np.lcm.reduce([np.full(E, half.denominator), np.full(E, vw0.denominator),
+                       fw0.denominator * face_d[face[h1]], fw0.denominator * np.where(two, face_d[face[h2]], 1)]),
+        face_d]).astype(np.int64)
     # face points
-    add(n + E + face, idx, 1.0, face_t[face], face_d[face])
+    rows.append(n + E + face)  # (R = the face's denominator: the weight's numerator)
+    cols.append(idx)
+    vals.append(face_t[face].astype(np.float64))
     # vertex points: smooth masks
     sm = np.flatnonzero(a_smooth != 0)
     if sm.size:
-        kk = np.maximum(k, 1)
-        (wv_t, wv_d), (we_t, we_d), (wf_t, wf_d) = (
-            _ratios(lambda x, i=i: smooth_vertex_weights(x, one)[i], kk) for i in range(3))
         add(sm, sm, a_smooth[sm], wv_t[sm], wv_d[sm])
         c = np.flatnonzero(a_smooth[org] != 0)  # corners at those vertices: one edge and one face each
         v = org[c]
         add(v, dst[c], a_smooth[v], we_t[v], we_d[v])
         f = face[c]
-        reps = sz[f]
-        vr = np.repeat(v, reps)
-        fr = np.repeat(f, reps)
-        within = np.arange(reps.sum()) - np.repeat(np.r_[0, np.cumsum(reps)][:-1], reps)
-        add(vr, idx[off[fr] + within], a_smooth[vr], wf_t[vr] * face_t[fr], wf_d[vr] * face_d[fr])
-    wcv, wcn = crease_vertex_weights(one)
+        add_faces(v, f, scaled(v, a_smooth[v], wf_t[v] * face_t[f], wf_d[v] * face_d[f]))
     for coef, sh in ((a_crease_p, pe), (a_crease_c, ce)):
         cr = np.flatnonzero(coef != 0)
         if not cr.size:
@@ -348,7 +377,6 @@ def catmark_operator(n, indices, sizes, *, edge_of_halfedge=None, edge_sharpness
     co = np.flatnonzero(a_corner != 0)
     add(co, co, a_corner[co], 1, 1)
     # edge points
-    half = sharp_edge_weight(one)
     er = n + np.arange(E)
     if chaikin:  # the child sharpness of the edge's half at each end
         ce_end = np.zeros((E, 2))
@@ -365,7 +393,6 @@ def catmark_operator(n, indices, sizes, *, edge_of_halfedge=None, edge_sharpness
         add(er[ms], end[ms], pw[ms], half.numerator, half.denominator)
     smooth_e = np.flatnonzero((pw != 1.0) & two)
     if smooth_e.size:
-        vw0, fw0 = smooth_edge_weights(one)
         f1, f2 = face[h1[smooth_e]], face[h2[smooth_e]]
         q = 1.0 - pw[smooth_e]  # exact: pw is a float32 value in [0, 1]
         cv_e = q.copy()
@@ -385,20 +412,9 @@ def catmark_operator(n, indices, sizes, *, edge_of_halfedge=None, edge_sharpness
         add(r, a[smooth_e], cv_e, t_v, d_v)
         add(r, b[smooth_e], cv_e, t_v, d_v)
         for g in (f1, f2):
-            reps = sz[g]
-            rr = np.repeat(r, reps)
-            gg = np.repeat(g, reps)
-            within = np.arange(reps.sum()) - np.repeat(np.r_[0, np.cumsum(reps)][:-1], reps)
-            add(rr, idx[off[gg] + within], np.repeat(cf_e, reps), np.repeat(t_f, reps) * face_t[gg],
-                np.repeat(d_f, reps) * face_d[gg])
-    rows, cols, cfs, nums, dens = (np.concatenate(x) for x in (rows, cols, cfs, nums, dens))
-    nz = cfs != 0
-    rows, cols, cfs, nums, dens = rows[nz], cols[nz], cfs[nz], nums[nz], dens[nz]
-    R = np.ones(n + E + m, dtype=np.int64)  # the common denominator of every row
-    np.lcm.at(R, rows, dens)
-    vals = cfs * (nums * (R[rows] // dens)).astype(np.float64)  # exact: dyadic coef times an integer
-    S = sp.coo_matrix((vals, (rows, cols)), shape=(n + E + m, n)).tocsr()
-    S.sum_duplicates()
+            add_faces(r, g, scaled(r, cf_e, t_f * face_t[g], d_f * face_d[g]))
+    rows, cols, vals = (np.concatenate(x) for x in (rows, cols, vals))
+    S = sp.coo_matrix((vals, (rows, cols)), shape=(n + E + m, n)).tocsr()  # sums the terms, exactly
     S.data /= R[np.repeat(np.arange(n + E + m), np.diff(S.indptr))]
     S.eliminate_zeros()
     faces = np.stack([org, n + he_edge, n + E + face, n + he_edge[prv]], axis=1)
