@@ -78,3 +78,24 @@ def test_a_forged_weight_is_caught(refdir):
     x = to_float(w)
     forged = x + math.ulp(x)
     assert S[0, c] == x != forged
+
+
+@pytest.mark.slow
+def test_bench_step_runs(capsys):
+    """Smoke test of scripts/bench_step.py (one round, a small icosphere): it prints every ratio."""
+    import importlib.util
+    import sys
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[2] / "scripts" / "bench_step.py"
+    spec = importlib.util.spec_from_file_location("bench_step", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    argv = sys.argv
+    sys.argv = ["bench_step.py", "--rounds", "1", "--tri-levels", "1"]
+    try:
+        mod.main()
+    finally:
+        sys.argv = argv
+    out = capsys.readouterr().out
+    assert out.count("new/old") == 8
