@@ -322,17 +322,20 @@ def catmark_operator(n, indices, sizes, *, edge_of_halfedge=None, edge_sharpness
         cols.append(np.broadcast_to(np.asarray(c, dtype=np.int64), r.shape))
         vals.append(np.broadcast_to(scaled(r, coef, t, d), r.shape))
 
-    def add_faces(r, f, x):
-        """Row ``r`` gets ``x`` on every vertex of face ``f`` (a face point spelled out)."""
-        for j in range(int(sz[f].max()) if f.size else 0):
+    def add_face_rest(r, h, x):
+        """Row ``r`` gets ``x`` on every vertex of the face of half-edge ``h`` but ``org(h)``, ``dst(h)``
+        (the rest of a face point spelled out; the caller merges those two into its own terms)."""
+        f = face[h]
+        for j in range(2, int(sz[f].max()) if f.size else 0):
             sel = sz[f] > j
+            hj = off[f] + (pos[h] + j) % sz[f]
             if sel.all():
                 rows.append(r)
-                cols.append(idx[off[f] + j])
+                cols.append(idx[hj])
                 vals.append(x)
             else:
                 rows.append(r[sel])
-                cols.append(idx[off[f[sel]] + j])
+                cols.append(idx[hj[sel]])
                 vals.append(x[sel])
 
     one = Fraction(1)  # the rule functions in exact rationals, one value per distinct size or valence
@@ -361,12 +364,19 @@ def catmark_operator(n, indices, sizes, *, edge_of_halfedge=None, edge_sharpness
     # vertex points: smooth masks
     sm = np.flatnonzero(a_smooth != 0)
     if sm.size:
-        add(sm, sm, a_smooth[sm], wv_t[sm], wv_d[sm])
         c = np.flatnonzero(a_smooth[org] != 0)  # corners at those vertices: one edge and one face each
         v = org[c]
-        add(v, dst[c], a_smooth[v], we_t[v], we_d[v])
         f = face[c]
-        add_faces(v, f, scaled(v, a_smooth[v], wf_t[v] * face_t[f], wf_d[v] * face_d[f]))
+        xf = scaled(v, a_smooth[v], wf_t[v] * face_t[f], wf_d[v] * face_d[f])  # each vertex of the face
+        diag = np.bincount(v, weights=xf, minlength=n)  # v is in each of its faces
+        diag[sm] += scaled(sm, a_smooth[sm], wv_t[sm], wv_d[sm])
+        rows.append(sm)
+        cols.append(sm)
+        vals.append(diag[sm])
+        rows.append(v)  # the edge neighbour of the corner, which is also the next vertex of its face
+        cols.append(dst[c])
+        vals.append(scaled(v, a_smooth[v], we_t[v], we_d[v]) + xf)
+        add_face_rest(v, c, xf)
     for coef, sh in ((a_crease_p, pe), (a_crease_c, ce)):
         cr = np.flatnonzero(coef != 0)
         if not cr.size:
@@ -409,10 +419,15 @@ def catmark_operator(n, indices, sizes, *, edge_of_halfedge=None, edge_sharpness
             cv_e[tri] = q[tri] * (1 - 2 * fw) / 2
             cf_e[tri] = q[tri] * fw
         r = er[smooth_e]
-        add(r, a[smooth_e], cv_e, t_v, d_v)
-        add(r, b[smooth_e], cv_e, t_v, d_v)
-        for g in (f1, f2):
-            add_faces(r, g, scaled(r, cf_e, t_f * face_t[g], d_f * face_d[g]))
+        x1 = scaled(r, cf_e, t_f * face_t[f1], d_f * face_d[f1])  # each vertex of the faces
+        x2 = scaled(r, cf_e, t_f * face_t[f2], d_f * face_d[f2])
+        xend = scaled(r, cv_e, t_v, d_v) + x1 + x2  # the ends are in both faces
+        for end in (a, b):
+            rows.append(r)
+            cols.append(end[smooth_e])
+            vals.append(xend)
+        add_face_rest(r, h1[smooth_e], x1)
+        add_face_rest(r, h2[smooth_e], x2)
     rows, cols, vals = (np.concatenate(x) for x in (rows, cols, vals))
     S = sp.coo_matrix((vals, (rows, cols)), shape=(n + E + m, n)).tocsr()  # sums the terms, exactly
     S.data /= R[np.repeat(np.arange(n + E + m), np.diff(S.indptr))]
