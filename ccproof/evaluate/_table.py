@@ -1151,7 +1151,7 @@ def catmark_step(mesh):
     face points (float weights of :mod:`ccproof.rule_weights`), not as stencils of the old vertices:
     the same values to round-off. This is the one step not built on
     :func:`ccproof.mesh.step.catmark_operator` (``S @ X``): assembling the operator costs the setup
-    of a triangle mesh about 25 % more (median; ``scripts/bench_step.py``); the same child faces and vertex
+    of a triangle mesh 2 to 27 % more (median 8 %; ``scripts/bench_step.py``); the same child faces and vertex
     numbering.
 
     Parameters
