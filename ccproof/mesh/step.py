@@ -25,6 +25,13 @@ is the vertex point of ``v``, ``n + e`` the edge point of edge ``e``, ``n + E + 
 of face ``f``; child ``offsets[f] + k`` of face ``f`` is ``(v_k', e_{k,k+1}', f', e_{k-1,k}')``.
 The mesh must be manifold (:attr:`ccproof.mesh.polymesh.PolyMesh.manifold` is); an unused vertex
 gets an empty row.
+
+Every weight is the correctly rounded value of the exact stencil: a row's terms (a dyadic coefficient, 1
+or a float32 fractional weight or sharpness, times a rule's rational weight) are scaled by the row's
+common denominator ``R`` (``8 k^2 lcm(face sizes)`` at a vertex of valence k, ``4 lcm(s0, s1)`` at an
+edge, ``s`` at a face), which makes each an integer times a dyadic, summed exactly in float64, and
+divided by ``R`` once. That holds while ``R`` times the float32 coefficients' 2^24 stays below 2^53
+(every real valence and face size); ``TRI_SUB_SMOOTH``'s 0.47 enters as a float weight.
 """
 
 from __future__ import annotations

@@ -120,7 +120,7 @@ def subdivision_matrix(mesh):
     Returns
     -------
     scipy.sparse.csr_matrix, shape (n + E + m, n)
-        Rows laid out as in the module docstring; every row sums to 1.
+        Rows laid out as in the module docstring; every row sums to 1 but an unused vertex's (empty).
 
     Examples
     --------
