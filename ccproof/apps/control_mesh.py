@@ -12,11 +12,11 @@ non-manifold edges and vertices infinitely sharp) become a :class:`TaggedQuadMes
 sharpness, hole faces), subdivided by the rules of :mod:`ccproof.mesh.rules` (OpenSubdiv's Sdc):
 
 * :func:`tagged_step` is one step as a sparse operator on any quad mesh with those tags (the chart levels
-  of ARAP, :func:`subdivide_control`): infinite tags are *stationary* (the same rules at every level: an
-  infinitely sharp edge's point is its midpoint, a vertex with two sharp edges takes the crease rule
-  ``(3/4) V + (1/8)(e0 + e1)``, with more or a sharp vertex it stays, with one (a dart) or none the smooth
-  rule); at a semi-sharp edge or vertex (0 < s < 10, ``CREASE_UNIFORM``: s - 1 per step) the rows are the
-  exact stencils of :func:`ccproof.mesh.rules.refine_complex` on the vertex's fan.
+  of ARAP, :func:`subdivide_control`): :func:`ccproof.mesh.step.catmark_operator`, the one vectorized step.
+  Infinite tags are *stationary* (the same rules at every level: an infinitely sharp edge's point is its
+  midpoint, a vertex with two sharp edges takes the crease rule ``(3/4) V + (1/8)(e0 + e1)``, with more or a
+  sharp vertex it stays, with one (a dart) or none the smooth rule); semi-sharp tags (0 < s < 10,
+  ``CREASE_UNIFORM``: s - 1 per step) blend these with Sdc's fractional weights.
 * Limit positions: closed-form masks at stationary vertices (:mod:`ccproof.apps.arap.samples`), and
   :func:`moving_limit_rows` (the fan subdivided until stationary, then the exact eigenvector) elsewhere.
 * ``CREASE_CHAIKIN`` semi-sharp tags (Chaikin's rule at a vertex needs all the edges at both ends of an
@@ -38,7 +38,6 @@ import numpy as np
 
 from ccproof.errors import MeshError
 from ccproof.mesh import QuadMesh
-from ccproof.rule_weights import crease_vertex_weights, sharp_edge_weight
 
 #: OpenSubdiv's infinite sharpness (Sdc::Crease::SHARPNESS_INFINITE)
 INFINITE = 10.0
@@ -283,38 +282,15 @@ def _fan_complex(mesh: QuadMesh, v, edge_sharpness, vertex_sharpness):
     return cx, gl
 
 
-def _local_step_rows(mesh: QuadMesh, v, edge_sharpness, vertex_sharpness):
-    """Exact stencils (mesh/rules) of the vertex point of ``v`` and of the edge points of its edges, global
-    columns: ``(vertex_row, {u: edge_row})`` with rows as dicts."""
-    from ccproof.mesh.rules import refine_complex, to_float
-
-    cx, gl = _fan_complex(mesh, v, edge_sharpness, vertex_sharpness)
-    inc = [e for e, h in enumerate(cx.edges) if cx.org[h] == 0 or cx.dst(h) == 0]
-    stencils, _, _, _ = refine_complex(cx, vertices=[0], edges=inc)
-    n = cx.n_vertices
-
-    def glob(st):
-        return {int(gl[c]): to_float(w) for c, w in st.items()}
-
-    edges = {}
-    for e in inc:
-        h = cx.edges[e]
-        u = cx.dst(h) if cx.org[h] == 0 else cx.org[h]
-        edges[int(gl[u])] = glob(stencils[n + e])
-    return glob(stencils[0]), edges
-
-
 def tagged_step(mesh: QuadMesh, edge_sharpness=None, vertex_sharpness=None):
     """One Catmull-Clark step of a quad mesh with edge and vertex sharpness, as a sparse operator.
 
-    The untagged operator (:func:`ccproof.mesh.subdivision_matrix`, the rules of :mod:`ccproof.rule_weights`)
-    with the rows of the tagged points replaced (module docstring): at stationary vertices (infinite tags
-    only) a sharp edge's point is its midpoint, a crease vertex (two sharp edges, boundary edges counted)
-    ``(3/4) V + (1/8)(e0 + e1)`` along them, a corner (a sharp vertex, three or more sharp edges) stays; at
-    a vertex with a semi-sharp edge or vertex sharpness, its point and its edges' points are the exact
-    stencils of :func:`ccproof.mesh.rules.refine_complex` on its fan (``CREASE_UNIFORM``: an edge point needs
-    only its edge's sharpness and faces). Without tags the operator is :func:`~ccproof.mesh.subdivision_matrix`'s,
-    unchanged.
+    :func:`ccproof.mesh.step.catmark_operator` (the one vectorized step; ``CREASE_UNIFORM``, boundary
+    ``EDGE_ONLY``) in the quad mesh's edge numbering: a sharp edge's point is its midpoint (blended with the
+    smooth rule below sharpness 1), a crease vertex (two sharp edges, boundary edges counted)
+    ``(3/4) V + (1/8)(e0 + e1)`` along them, a corner (a sharp vertex, three or more sharp edges) stays,
+    with Sdc's fractional weight where the rule changes. Without tags the operator is
+    :func:`~ccproof.mesh.subdivision_matrix`'s.
 
     Parameters
     ----------
@@ -348,80 +324,18 @@ def tagged_step(mesh: QuadMesh, edge_sharpness=None, vertex_sharpness=None):
     >>> S[9 + e].toarray()[0, [1, 4]].tolist(), ce.shape
     ([0.4375, 0.4375], (0, 2))
     """
-    import scipy.sparse as sp
-
-    from ccproof.mesh import subdivision_matrix
-    from ccproof.mesh.rules import _decrement
+    from ccproof.mesh.step import catmark_operator
 
     if edge_sharpness is None:
         edge_sharpness, vertex_sharpness = tags_of(mesh)
-    S = subdivision_matrix(mesh)
+    es = np.asarray(edge_sharpness, dtype=np.float64)
+    vs = np.asarray(vertex_sharpness, dtype=np.float64)
     n = mesh.n_vertices
-    es, vs = edge_sharpness, vertex_sharpness
-    se = np.flatnonzero(es > 0)
-    none = (np.zeros((0, 2), dtype=np.int64), np.zeros(0)), (np.zeros(0, dtype=np.int64), np.zeros(0))
-    if not se.size and not (vs > 0).any():
-        return S, *none
-    _, corner, crease, _, nb, stationary = vertex_rules(mesh, es, vs)
-    a, b = mesh.edges[se, 0], mesh.edges[se, 1]
-    touched = vs > 0
-    touched[a] = touched[b] = True
-    cor = np.flatnonzero(touched & corner & stationary)
-    cre = np.flatnonzero(touched & crease & stationary)
-    inf_e = se[np.isinf(es[se])]
-    er = n + inf_e
-    wv, wn = crease_vertex_weights(1.0)
-    half = sharp_edge_weight(1.0)
-    rows = [cor, cre, cre, cre, er, er]
-    cols = [cor, cre, nb[cre, 0], nb[cre, 1], mesh.edges[inf_e, 0], mesh.edges[inf_e, 1]]
-    vals = [np.ones(cor.size), np.full(cre.size, wv), np.full(2 * cre.size, wn), np.full(2 * er.size, half)]
-    replaced = [cor, cre, er]
-    moving = np.flatnonzero(~stationary)
-    if moving.size:  # semi-sharp: the exact stencils of the rules on the vertex's fan
-        key = _pair_keys(mesh.edges, n)
-        srt = np.argsort(key)
-        r_, c_, w_ = [], [], []
-        for v in moving.tolist():
-            vrow, erows = _local_step_rows(mesh, v, es, vs)
-            r_ += [v] * len(vrow)
-            c_ += list(vrow)
-            w_ += list(vrow.values())
-            for u, st in erows.items():
-                e = int(srt[np.searchsorted(key[srt], min(u, v) * n + max(u, v))])
-                if _semi(es[e]):
-                    r_ += [n + e] * len(st)
-                    c_ += list(st)
-                    w_ += list(st.values())
-        rows.append(np.asarray(r_, dtype=np.int64))
-        cols.append(np.asarray(c_, dtype=np.int64))
-        vals.append(np.asarray(w_, dtype=np.float64))
-        replaced.append(np.unique(rows[-1]))
-    replace = np.ones(S.shape[0])
-    replace[np.concatenate(replaced)] = 0.0
-    extra = sp.coo_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=S.shape)
-    # an edge point computed from both of its ends is the same stencil: keep one (halve the sum)
-    out = (sp.diags(replace) @ S + _dedup(extra)).tocsr()
-    out.eliminate_zeros()
-    child_s = np.array([_decrement(x) for x in es[se].tolist()])
-    keep = child_s > 0
-    er_all = n + se
-    ce = np.r_[np.c_[a, er_all][keep], np.c_[b, er_all][keep]]
-    cs = np.r_[child_s[keep], child_s[keep]]
-    cv = np.flatnonzero(vs > 0)
-    cvs = np.array([_decrement(x) for x in vs[cv].tolist()])
-    return out, (ce, cs), (cv[cvs > 0], cvs[cvs > 0])
-
-
-def _dedup(M):
-    """A COO matrix whose rows may appear several times (the same stencil): each row once."""
-    M = M.tocoo()
-    if not M.nnz:
-        return M
-    import scipy.sparse as sp
-
-    key = np.c_[M.row, M.col]
-    _, first = np.unique(key, axis=0, return_index=True)
-    return sp.coo_matrix((M.data[first], (M.row[first], M.col[first])), shape=M.shape)
+    st = catmark_operator(n, mesh.faces.reshape(-1), np.full(mesh.n_faces, 4, dtype=np.int64),
+                          edge_of_halfedge=mesh.edge_of_halfedge, edge_sharpness=es, vertex_sharpness=vs)
+    pairs, cs = st.child_creases
+    tagged = es[pairs[:, 1] - n] > 0  # the halves of the tagged edges (boundary edges are sharp anyway)
+    return st.S, (pairs[tagged], cs[tagged]), st.child_corners
 
 
 @functools.lru_cache(maxsize=4096)

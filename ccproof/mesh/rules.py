@@ -5,11 +5,13 @@ complex with edge and vertex sharpness into the stencils of every new point (exa
 weights, ``flint.fmpq``) plus the child faces and their sharpness. The float operator ``S``
 (``V1 == S @ V0``) of :func:`ccproof.mesh.polymesh.PolyMesh.subdivision_operator` and the exact
 local matrices of :mod:`ccproof.evaluate` are both read from these stencils, and the vectorized
-reference step of :mod:`ccproof.mesh.subdivision` takes its weights from the same rule functions
+step of :mod:`ccproof.mesh.step` (behind :mod:`ccproof.mesh.subdivision`; tests/mesh/test_step.py checks it
+against these stencils bit for bit) takes its weights from the same rule functions
 of :mod:`ccproof.rule_weights` (:func:`face_point_weight`, :func:`smooth_edge_weights`,
 :func:`sharp_edge_weight`, :func:`smooth_vertex_weights`, :func:`crease_vertex_weights`, re-exported
-here), evaluated in floats: one rule implementation, exact or float by the number ``one`` it is
-given. The proof branch's ring matrices (:mod:`ccproof.algebra.subdivision`) read them too.
+here; :mod:`ccproof.mesh.step` evaluates them exactly and rounds each row once): one rule
+implementation, exact or float by the number ``one`` it is given. The proof branch's ring matrices
+(:mod:`ccproof.algebra.subdivision`) read them too.
 
 Rules (Sdc ``SCHEME_CATMARK``, OpenSubdiv 3.6 ``sdc/scheme.h``, ``sdc/catmarkScheme.h``,
 ``sdc/crease.cpp``; sharpness ``s`` is IEEE float32 as in OpenSubdiv, ``s >= 10`` is infinite,

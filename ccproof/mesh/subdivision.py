@@ -1,13 +1,9 @@
-"""One reference Catmull-Clark step of a quad mesh (bmz04 Fig. 1, docs/readings.md R1), vectorized.
+"""One Catmull-Clark step of a quad mesh (bmz04 Fig. 1, docs/readings.md R1), vectorized.
 
-The rules are those of :mod:`ccproof.mesh.rules` (the one rule implementation): this module only
-assembles them over the whole mesh with numpy, taking every weight from the rule functions of
-:mod:`ccproof.rule_weights` (:func:`~ccproof.rule_weights.face_point_weight`,
-:func:`~ccproof.rule_weights.smooth_edge_weights`, :func:`~ccproof.rule_weights.sharp_edge_weight`,
-:func:`~ccproof.rule_weights.smooth_vertex_weights` and :func:`~ccproof.rule_weights.crease_vertex_weights`)
-evaluated in floats (the exact stencils of
-:func:`~ccproof.mesh.rules.refine_complex` evaluate the same functions exactly;
-tests/mesh/test_subdivision.py checks that the two operators agree). No creases; boundary as
+The operator is :func:`ccproof.mesh.step.catmark_operator` (the one vectorized step, with the rules of
+:mod:`ccproof.rule_weights`; every weight correctly rounded from its exact value) without tags, in the
+edge numbering of the :class:`QuadMesh` (tests/mesh/test_step.py checks it against the exact stencils of
+:func:`~ccproof.mesh.rules.refine_complex`, tests/mesh/test_subdivision.py against pygel3d). No creases; boundary as
 OpenSubdiv ``VTX_BOUNDARY_EDGE_ONLY`` (every boundary edge is an infinitely sharp crease, no vertex
 is a corner):
 
@@ -34,13 +30,6 @@ from __future__ import annotations
 import numpy as np
 
 from ccproof.mesh.quadmesh import QuadMesh
-from ccproof.rule_weights import (
-    crease_vertex_weights,
-    face_point_weight,
-    sharp_edge_weight,
-    smooth_edge_weights,
-    smooth_vertex_weights,
-)
 
 __all__ = ["subdivide", "subdivision_matrix", "child_faces"]
 
@@ -131,7 +120,7 @@ def subdivision_matrix(mesh):
     Returns
     -------
     scipy.sparse.csr_matrix, shape (n + E + m, n)
-        Rows laid out as in the module docstring; every row sums to 1.
+        Rows laid out as in the module docstring; every row sums to 1 but an unused vertex's (empty).
 
     Examples
     --------
@@ -141,56 +130,8 @@ def subdivision_matrix(mesh):
     >>> S.shape, np.allclose(S.sum(axis=1), 1)
     ((9, 4), True)
     """
-    F = mesh.faces
-    n, E, m = mesh.n_vertices, mesh.n_edges, mesh.n_faces
-    rows, cols, vals = [], [], []
+    from ccproof.mesh.step import catmark_operator
 
-    def add(r, c, w):
-        r, c = np.broadcast_arrays(np.asarray(r), np.asarray(c))
-        rows.append(r.reshape(-1))
-        cols.append(c.reshape(-1))
-        vals.append(np.broadcast_to(np.asarray(w, dtype=np.float64), r.shape).reshape(-1))
-
-    one = 1.0  # the rule functions in floats (exact_one() would give the exact weights)
-    wq = face_point_weight(4, one)
-    # face points
-    add(np.repeat(n + E + np.arange(m), 4), F.reshape(-1), wq)
-    # edge points
-    a, b = mesh.edges[:, 0], mesh.edges[:, 1]
-    er = n + np.arange(E)
-    bnd = mesh.is_boundary_edge
-    half = sharp_edge_weight(one)
-    add(er[bnd], a[bnd], half)
-    add(er[bnd], b[bnd], half)
-    it = ~bnd
-    we_end, we_face = smooth_edge_weights(one)
-    add(er[it], a[it], we_end)
-    add(er[it], b[it], we_end)
-    for s in range(2):  # the face point of each adjacent face, spelled out on its vertices
-        add(np.repeat(er[it], 4), F[mesh.edge_faces[it, s]].reshape(-1), we_face * wq)
-    # interior vertex points (smooth rule), assembled corner by corner
-    org = F.reshape(-1)
-    dst = np.roll(F, -1, axis=1).reshape(-1)
-    inner = ~mesh.is_boundary_vertex
-    k = np.maximum(mesh.valence.astype(np.int64), 1)  # (unused vertices: valence 0, weights unused)
-    wv, we, wf = smooth_vertex_weights(k, one)
-    iv = np.flatnonzero(inner)
-    add(iv, iv, wv[iv])
-    c = np.flatnonzero(inner[org])  # corners at interior vertices: one edge and one face each
-    v = org[c]
-    add(v, dst[c], we[v])
-    add(np.repeat(v, 4), F[c // 4].reshape(-1), np.repeat(wf[v] * wq, 4))
-    # boundary vertex points (crease rule along the boundary)
-    bv = np.flatnonzero(mesh.is_boundary_vertex)
-    if bv.size:
-        e0, e1 = _boundary_neighbours(mesh)
-        wc, wn = crease_vertex_weights(one)
-        add(bv, bv, wc)
-        add(bv, e0[bv], wn)
-        add(bv, e1[bv], wn)
-    import scipy.sparse as sp
-
-    S = sp.coo_matrix(
-        (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(n + E + m, n)
-    )
-    return S.tocsr()
+    m = mesh.n_faces
+    return catmark_operator(mesh.n_vertices, mesh.faces.reshape(-1), np.full(m, 4, dtype=np.int64),
+                            edge_of_halfedge=mesh.edge_of_halfedge).S

@@ -1,0 +1,448 @@
+"""The Catmull-Clark step with OpenSubdiv's Sdc rules, vectorized, as one sparse operator.
+
+:func:`catmark_operator` is the step of the sparse-operator callers: the untagged quad step of
+:func:`ccproof.mesh.subdivision_matrix` and the applications' tagged step
+(:func:`ccproof.apps.control_mesh.tagged_step`). It assembles, over the whole
+mesh with numpy, the rules that :func:`ccproof.mesh.rules.refine_complex` states as exact stencils
+(the independent reference of the tests; the weights come from the same rule functions of
+:mod:`ccproof.rule_weights`, evaluated in floats):
+
+* face point: the centroid;
+* edge point: boundary edges are infinitely sharp (the midpoint); an interior edge of sharpness
+  ``s``: smooth ``(a + b + f0 + f1) / 4`` if ``s <= 0`` (``TRI_SUB_SMOOTH`` at level 0: face weight
+  0.47 at a triangle), the midpoint if both child halves stay sharp, else
+  ``s * midpoint + (1 - s) * smooth``;
+* vertex point: Sdc's rule of the vertex (a sharp vertex or three or more sharp edges: corner; two:
+  crease along them; one or none: smooth); when the child's rule differs,
+  ``w * parent mask + (1 - w) * child mask`` with Sdc's fractional weight ``w`` (float32, summed in
+  the order of the vertex's fan, as :func:`~ccproof.mesh.rules.refine_complex` sums);
+* child sharpness: ``CREASE_UNIFORM`` ``s - 1``, ``CREASE_CHAIKIN`` the average rule at each end;
+  vertex sharpness ``s - 1``; ``VTX_BOUNDARY_EDGE_AND_CORNER`` makes a one-face boundary vertex an
+  infinitely sharp corner at level 0; holes pass to the children.
+
+Layout (that of :mod:`ccproof.mesh.rules` and :mod:`ccproof.mesh.subdivision`): new vertex ``v < n``
+is the vertex point of ``v``, ``n + e`` the edge point of edge ``e``, ``n + E + f`` the face point
+of face ``f``; child ``offsets[f] + k`` of face ``f`` is ``(v_k', e_{k,k+1}', f', e_{k-1,k}')``.
+The mesh must be manifold (:attr:`ccproof.mesh.polymesh.PolyMesh.manifold` is); an unused vertex
+gets an empty row.
+
+Every weight is the correctly rounded value of the exact stencil: a row's terms (a dyadic coefficient, 1
+or a float32 fractional weight or sharpness, times a rule's rational weight) are scaled by the row's
+common denominator ``R`` (``8 k^2 lcm(face sizes)`` at a vertex of valence k, ``4 lcm(s0, s1)`` at an
+edge, ``s`` at a face), which makes each an integer times a dyadic, summed exactly in float64, and
+divided by ``R`` once. That holds while ``R`` times the float32 coefficients' 2^24 stays below 2^53
+(every real valence and face size); ``TRI_SUB_SMOOTH``'s 0.47 enters as a float weight.
+"""
+
+from __future__ import annotations
+
+from fractions import Fraction
+from typing import NamedTuple
+
+import numpy as np
+
+from ccproof.errors import MeshError
+from ccproof.rule_weights import (
+    crease_vertex_weights,
+    face_point_weight,
+    sharp_edge_weight,
+    smooth_edge_weights,
+    smooth_vertex_weights,
+)
+
+__all__ = ["catmark_operator", "Step"]
+
+#: OpenSubdiv's Sdc::Crease::SHARPNESS_INFINITE
+INFINITE = 10.0
+_F32 = np.float32
+
+
+class Step(NamedTuple):
+    """The result of :func:`catmark_operator`.
+
+    Attributes
+    ----------
+    S : scipy.sparse.csr_matrix, shape (n + E + m, n)
+        ``V1 = S @ V0``.
+    faces : ndarray of int64, shape (H, 4)
+        The child quads (H = sum of the face sizes).
+    edges : ndarray of int64, shape (E, 2)
+        The parent edges ``(a, b)`` in the numbering of the edge points (``a`` the origin of the
+        edge's first half-edge).
+    child_creases : (ndarray of int64, shape (k, 2), ndarray of float64, shape (k,))
+        Sharp child edges ``(v, n + e)`` (the halves of sharp parent edges) and their sharpness.
+    child_corners : (ndarray of int64, shape (j,), ndarray of float64, shape (j,))
+        Sharp child vertices and their sharpness.
+    child_holes : ndarray of bool, shape (H,)
+    """
+
+    S: object
+    faces: np.ndarray
+    edges: np.ndarray
+    child_creases: tuple
+    child_corners: tuple
+    child_holes: np.ndarray
+
+
+def _decrement(s):
+    """Sdc's uniform decay of float32 sharpness values (0 at or below 1, infinite stays)."""
+    s = np.asarray(s, dtype=np.float64)
+    out = np.where(s > 1.0, (s.astype(_F32) - _F32(1.0)).astype(np.float64), 0.0)
+    return np.where(np.isinf(s), np.inf, out)
+
+
+def _f32_sums(seg, val, n):
+    """Per segment ``seg`` (sorted in summation order), the float32 sum of ``val`` taken left to right
+    from float32 0 (Sdc's loops), and the count of terms."""
+    count = np.bincount(seg, minlength=n)
+    start = np.r_[0, np.cumsum(count)][:-1]
+    rank = np.arange(seg.size) - start[seg]
+    total = np.zeros(n, dtype=_F32)
+    for j in range(int(count.max()) if seg.size else 0):
+        sel = rank == j
+        total[seg[sel]] = total[seg[sel]] + val[sel].astype(_F32)
+    return total, count
+
+
+def _ratios(rule, x):
+    """``(numerators, denominators)``, int64 arrays like ``x``, of the exact rule weight ``rule(x_i)``."""
+    x = np.asarray(x, dtype=np.int64)
+    u, inv = np.unique(x, return_inverse=True)
+    w = [rule(int(v)) for v in u.tolist()]
+    t = np.array([q.numerator for q in w], dtype=np.int64)
+    d = np.array([q.denominator for q in w], dtype=np.int64)
+    return t[inv.reshape(x.shape)], d[inv.reshape(x.shape)]
+
+
+def catmark_operator(n, indices, sizes, *, edge_of_halfedge=None, edge_sharpness=None, vertex_sharpness=None,
+                     options=None, level=0, holes=None):
+    """One Catmull-Clark step of a tagged manifold polygon mesh, as a sparse operator (module docstring).
+
+    Parameters
+    ----------
+    n : int
+        Number of vertices.
+    indices : array_like of int, shape (H,)
+        The faces' vertices, face after face, counter-clockwise.
+    sizes : array_like of int, shape (m,)
+        Face sizes (>= 3).
+    edge_of_halfedge : array_like of int, shape (H,), optional
+        The edge of every half-edge (the edge points' numbering, 0..E-1); default: numbered by first
+        occurrence along the faces (:class:`ccproof.mesh.rules.Complex`'s numbering).
+    edge_sharpness : ndarray, shape (E,), or dict[(int, int), float], optional
+        Sharpness per edge of that numbering, or a dict keyed by ``(min, max)`` vertex pairs; ``>= 10``
+        infinite. Boundary edges are infinitely sharp whatever the tag.
+    vertex_sharpness : ndarray, shape (n,), or dict[int, float], optional
+    options : ccproof.mesh.rules.Options, optional
+    level : int
+        The level of the mesh (``TRI_SUB_SMOOTH`` and ``EDGE_AND_CORNER`` act at level 0).
+    holes : array_like of bool, shape (m,), optional
+
+    Returns
+    -------
+    Step
+        ``S`` (n + E + m, n), the child faces, the edges, the child tags and holes.
+
+    Notes
+    -----
+    bmz04 Fig. 1 (docs/readings.md R1) with OpenSubdiv's Sdc crease, corner and boundary rules
+    (``sdc/catmarkScheme.h``, ``sdc/crease.cpp``; docs/evaluate.md "Tagged polygon meshes").
+
+    Examples
+    --------
+    One quad: corners take the crease rule along the boundary, edges their midpoints:
+
+    >>> st = catmark_operator(4, [0, 1, 2, 3], [4])
+    >>> st.S.shape, st.S[0].toarray()[0].tolist(), st.S[4].toarray()[0].tolist(), st.faces[0].tolist()
+    ((9, 4), [0.75, 0.125, 0.0, 0.125], [0.5, 0.5, 0.0, 0.0], [0, 4, 8, 7])
+
+    A crease of sharpness 0.5 across the middle of two quads blends its edge point (half the midpoint,
+    half the smooth rule); its halves are smooth after the step, those of the boundary edges stay sharp:
+
+    >>> st = catmark_operator(6, [0, 1, 4, 3, 1, 2, 5, 4], [4, 4], edge_sharpness={(1, 4): 0.5})
+    >>> e = int(np.flatnonzero((st.edges == [1, 4]).all(axis=1))[0])
+    >>> st.S[6 + e].toarray()[0].tolist(), len(st.child_creases[1]), 2 * (len(st.edges) - 1)
+    ([0.03125, 0.4375, 0.03125, 0.03125, 0.4375, 0.03125], 12, 12)
+    """
+    import scipy.sparse as sp
+
+    from ccproof.mesh.rules import Options
+
+    opts = Options() if options is None else options
+    chaikin = opts.crease_method == "chaikin"
+    idx = np.asarray(indices, dtype=np.int64).reshape(-1)
+    sz = np.asarray(sizes, dtype=np.int64).reshape(-1)
+    m, H = sz.size, idx.size
+    off = np.r_[0, np.cumsum(sz)].astype(np.int64)
+    face = np.repeat(np.arange(m), sz)
+    pos = np.arange(H) - off[face]
+    nxt = off[face] + (pos + 1) % sz[face]
+    prv = off[face] + (pos - 1) % sz[face]
+    org, dst = idx, idx[nxt]
+    lo, hi = np.minimum(org, dst), np.maximum(org, dst)
+    if edge_of_halfedge is None:
+        _, first, inv = np.unique(lo * n + hi, return_index=True, return_inverse=True)
+        order = np.argsort(first, kind="stable")
+        rank = np.empty(first.size, dtype=np.int64)
+        rank[order] = np.arange(first.size)
+        he_edge = rank[inv.reshape(-1)]
+    else:
+        he_edge = np.asarray(edge_of_halfedge, dtype=np.int64).reshape(-1)
+    E = int(he_edge.max()) + 1 if H else 0
+    count = np.bincount(he_edge, minlength=E)
+    if (count > 2).any():
+        e = int(np.flatnonzero(count > 2)[0])
+        h = int(np.flatnonzero(he_edge == e)[0])
+        raise MeshError(f"edge ({int(lo[h])}, {int(hi[h])}) has {int(count[e])} faces: the step needs a manifold "
+                        "mesh (take PolyMesh.manifold)")
+    by_edge = np.argsort(he_edge, kind="stable")
+    estart = np.r_[0, np.cumsum(count)][:-1]
+    h1 = by_edge[estart]
+    h2 = np.where(count == 2, by_edge[np.minimum(estart + 1, H - 1)], -1)
+    twin = np.full(H, -1, dtype=np.int64)
+    two = h2 >= 0
+    twin[h1[two]], twin[h2[two]] = h2[two], h1[two]
+    a, b = org[h1], dst[h1]
+    bnd_e = ~two
+    # tags
+    if isinstance(edge_sharpness, dict):
+        es = np.zeros(E)
+        if edge_sharpness:
+            keys = np.array(list(edge_sharpness.keys()), dtype=np.int64).reshape(-1, 2)
+            kk = np.minimum(keys[:, 0], keys[:, 1]) * n + np.maximum(keys[:, 0], keys[:, 1])
+            ek = np.minimum(a, b) * n + np.maximum(a, b)
+            srt = np.argsort(ek)
+            p = np.minimum(np.searchsorted(ek[srt], kk), E - 1)
+            ok = ek[srt][p] == kk
+            es[srt[p[ok]]] = np.asarray(list(edge_sharpness.values()), dtype=np.float64)[ok]
+    elif edge_sharpness is None:
+        es = np.zeros(E)
+    else:
+        es = np.array(edge_sharpness, dtype=np.float64).reshape(E)
+    es = np.where(es >= INFINITE, np.inf, np.maximum(es, 0.0))
+    es[bnd_e] = np.inf
+    if isinstance(vertex_sharpness, dict):
+        vs = np.zeros(n)
+        if vertex_sharpness:
+            vs[np.array(list(vertex_sharpness), dtype=np.int64)] = list(vertex_sharpness.values())
+    elif vertex_sharpness is None:
+        vs = np.zeros(n)
+    else:
+        vs = np.array(vertex_sharpness, dtype=np.float64).reshape(n)
+    vs = np.where(vs >= INFINITE, np.inf, np.maximum(vs, 0.0))
+    # fans: corners around each vertex counter-clockwise, from the clockwise-most (boundary) or the
+    # smallest corner (interior): the order of refine_complex's sums
+    k = np.bincount(org, minlength=n)  # faces at each vertex
+    rot = twin[prv]
+    start = np.full(n, H, dtype=np.int64)
+    np.minimum.at(start, org, np.arange(H))
+    bh = np.flatnonzero(twin < 0)
+    start[org[bh]] = bh
+    is_bv = np.zeros(n, dtype=bool)
+    is_bv[org[bh]] = True
+    ptr = np.r_[0, np.cumsum(k)]
+    fan = np.empty(H, dtype=np.int64)
+    cur = start.copy()
+    for j in range(int(k.max()) if n else 0):
+        sel = np.flatnonzero(k > j)
+        if (cur[sel] < 0).any():
+            v = int(sel[cur[sel] < 0][0])
+            raise MeshError(f"vertex {v}: its faces form more than one fan (take PolyMesh.manifold)")
+        fan[ptr[sel] + j] = cur[sel]
+        cur[sel] = rot[cur[sel]]
+    # incidences (vertex, edge) in fan order: the outgoing edge of every corner, then for a boundary
+    # vertex the incoming boundary edge
+    fv = org[fan]
+    inc_v = np.r_[fv, dst[bh]]
+    inc_e = np.r_[he_edge[fan], he_edge[bh]]
+    inc_u = np.r_[dst[fan], org[bh]]
+    inc_o = np.r_[np.arange(H), H + np.arange(bh.size)]
+    o = np.lexsort((inc_o, inc_v))
+    inc_v, inc_e, inc_u = inc_v[o], inc_e[o], inc_u[o]
+    pe = es[inc_e]
+    # child sharpness of every edge at every vertex (Sdc SubdivideEdgeSharpnessesAroundVertex)
+    ce = _decrement(pe)
+    if chaikin:
+        semi = (pe > 0) & np.isfinite(pe)
+        total, nsemi = _f32_sums(inc_v[semi], pe[semi], n)
+        nedge = np.bincount(inc_v, minlength=n)
+        many = semi & (nsemi[inc_v] >= 2) & (nedge[inc_v] >= 2)
+        if many.any():
+            s32 = pe[many].astype(_F32)
+            avg = ((total[inc_v[many]] - s32) / (nsemi[inc_v[many]] - 1).astype(_F32)).astype(_F32)
+            c = (_F32(0.75) * s32 + _F32(0.25) * avg).astype(_F32) - _F32(1.0)
+            ce[many] = np.where(c > 0, c.astype(np.float64), 0.0)
+    # vertex rules
+    pv = vs.copy()
+    if opts.boundary == "edge_and_corner" and level == 0:
+        pv[is_bv & (k == 1)] = np.inf
+    cv = _decrement(pv)
+    np_ = np.bincount(inc_v[pe > 0], minlength=n)
+    nc_ = np.bincount(inc_v[ce > 0], minlength=n)
+    SMOOTH, CREASE, CORNER = 0, 2, 3
+
+    def rule(sv, ns):
+        r = np.where(ns >= 3, CORNER, np.where(ns == 2, CREASE, SMOOTH))
+        return np.where(sv > 0, CORNER, r)
+
+    prule, crule = rule(pv, np_), rule(cv, nc_)
+    blend = (prule != SMOOTH) & (crule != prule)
+    # Sdc ComputeFractionalWeightAtVertex (float32, in fan order)
+    if chaikin:
+        hit = (pe > 0) & (ce <= 0)
+    else:
+        hit = (pe > 0) & (pe <= 1)
+    hit &= blend[inc_v]
+    vhit = blend & (pv > 0) & (cv <= 0)
+    seg = np.r_[np.flatnonzero(vhit), inc_v[hit]]
+    val = np.r_[pv[vhit], pe[hit]]
+    oo = np.argsort(seg, kind="stable")  # the vertex's own sharpness first, then its edges in fan order
+    total, cnt = _f32_sums(seg[oo], val[oo], n)
+    w = np.zeros(n)
+    has = cnt > 0
+    w32 = (total[has] / cnt[has].astype(_F32)).astype(_F32)
+    w[has] = np.minimum(w32.astype(np.float64), 1.0)
+    cp = np.where(blend, w, 1.0)  # weight of the parent's mask
+    cc = np.where(blend, 1.0 - w, 0.0)  # of the child's
+    a_smooth = np.where(prule == SMOOTH, 1.0, 0.0) + np.where(blend & (crule == SMOOTH), cc, 0.0)
+    a_crease_p = np.where(prule == CREASE, cp, 0.0)
+    a_crease_c = np.where(blend & (crule == CREASE), cc, 0.0)
+    a_corner = np.where(prule == CORNER, cp, 0.0) + np.where(blend & (crule == CORNER), cc, 0.0)
+    for x in (a_smooth, a_crease_p, a_crease_c, a_corner):
+        x[k == 0] = 0.0  # unused vertices: no row
+
+    # every weight is a sum of terms coef * t / d (coef a dyadic float: 1, a fractional weight, a sharpness;
+    # t / d a rule's rational weight): summed exactly as integers over the row's common denominator, then
+    # divided once (the correctly rounded weight, as refine_complex's to_float of its exact stencil)
+    rows, cols, vals = [], [], []
+
+    def scaled(r, coef, t, d):
+        """``coef * t / d`` times the common denominator ``R[r]`` of row ``r``: exact (a dyadic times an integer)."""
+        q, bad = np.divmod(R[r], d)
+        if bad.any():
+            raise AssertionError("internal: a rule weight's denominator does not divide its row's")
+        return coef * (t * q).astype(np.float64)
+
+    def add(r, c, coef, t, d):
+        r = np.asarray(r, dtype=np.int64)
+        rows.append(r)
+        cols.append(np.broadcast_to(np.asarray(c, dtype=np.int64), r.shape))
+        vals.append(np.broadcast_to(scaled(r, coef, t, d), r.shape))
+
+    def add_face_rest(r, h, x):
+        """Row ``r`` gets ``x`` on every vertex of the face of half-edge ``h`` but ``org(h)``, ``dst(h)``
+        (the rest of a face point spelled out; the caller merges those two into its own terms)."""
+        f = face[h]
+        for j in range(2, int(sz[f].max()) if f.size else 0):
+            sel = sz[f] > j
+            hj = off[f] + (pos[h] + j) % sz[f]
+            if sel.all():
+                rows.append(r)
+                cols.append(idx[hj])
+                vals.append(x)
+            else:
+                rows.append(r[sel])
+                cols.append(idx[hj[sel]])
+                vals.append(x[sel])
+
+    one = Fraction(1)  # the rule functions in exact rationals, one value per distinct size or valence
+    face_t, face_d = _ratios(lambda x: face_point_weight(x, one), sz)  # (m,)
+    kk = np.maximum(k, 1)
+    (wv_t, wv_d), (we_t, we_d), (wf_t, wf_d) = (
+        _ratios(lambda x, i=i: smooth_vertex_weights(x, one)[i], kk) for i in range(3))
+    wcv, wcn = crease_vertex_weights(one)
+    half = sharp_edge_weight(one)
+    vw0, fw0 = smooth_edge_weights(one)
+    # the common denominator of every row: a face's; at a vertex, of its smooth, crease and corner
+    # weights; at an edge, of the midpoint's and the smooth rule's
+    lf = np.ones(n, dtype=np.int64)
+    if H:
+        used = np.flatnonzero(k > 0)
+        lf[used] = np.lcm.reduceat(face_d[face[fan]], ptr[used])
+    R = np.concatenate([
+        np.lcm.reduce([wv_d, we_d, wf_d * lf, np.full(n, wcv.denominator), np.full(n, wcn.denominator)]),
+        np.lcm.reduce([np.full(E, half.denominator), np.full(E, vw0.denominator),
+                       fw0.denominator * face_d[face[h1]], fw0.denominator * np.where(two, face_d[face[h2]], 1)]),
+        face_d]).astype(np.int64)
+    # face points
+    rows.append(n + E + face)  # (R = the face's denominator: the weight's numerator)
+    cols.append(idx)
+    vals.append(face_t[face].astype(np.float64))
+    # vertex points: smooth masks
+    sm = np.flatnonzero(a_smooth != 0)
+    if sm.size:
+        c = np.flatnonzero(a_smooth[org] != 0)  # corners at those vertices: one edge and one face each
+        v = org[c]
+        f = face[c]
+        xf = scaled(v, a_smooth[v], wf_t[v] * face_t[f], wf_d[v] * face_d[f])  # each vertex of the face
+        diag = np.bincount(v, weights=xf, minlength=n)  # v is in each of its faces
+        diag[sm] += scaled(sm, a_smooth[sm], wv_t[sm], wv_d[sm])
+        rows.append(sm)
+        cols.append(sm)
+        vals.append(diag[sm])
+        rows.append(v)  # the edge neighbour of the corner, which is also the next vertex of its face
+        cols.append(dst[c])
+        vals.append(scaled(v, a_smooth[v], we_t[v], we_d[v]) + xf)
+        add_face_rest(v, c, xf)
+    for coef, sh in ((a_crease_p, pe), (a_crease_c, ce)):
+        cr = np.flatnonzero(coef != 0)
+        if not cr.size:
+            continue
+        add(cr, cr, coef[cr], wcv.numerator, wcv.denominator)
+        sel = (coef[inc_v] != 0) & (sh > 0)
+        add(inc_v[sel], inc_u[sel], coef[inc_v[sel]], wcn.numerator, wcn.denominator)
+    co = np.flatnonzero(a_corner != 0)
+    add(co, co, a_corner[co], 1, 1)
+    # edge points
+    er = n + np.arange(E)
+    if chaikin:  # the child sharpness of the edge's half at each end
+        ce_end = np.zeros((E, 2))
+        first_end = inc_v == a[inc_e]
+        ce_end[inc_e[first_end], 0] = ce[first_end]
+        ce_end[inc_e[~first_end], 1] = ce[~first_end]
+        both = (ce_end > 0).all(axis=1)
+    else:
+        both = _decrement(es) > 0
+    mid = (es > 0) & (bnd_e | both)
+    pw = np.where(mid, 1.0, np.where(es > 0, es.astype(_F32).astype(np.float64), 0.0))  # weight of the midpoint
+    ms = np.flatnonzero(pw != 0)
+    for end in (a, b):
+        add(er[ms], end[ms], pw[ms], half.numerator, half.denominator)
+    smooth_e = np.flatnonzero((pw != 1.0) & two)
+    if smooth_e.size:
+        f1, f2 = face[h1[smooth_e]], face[h2[smooth_e]]
+        q = 1.0 - pw[smooth_e]  # exact: pw is a float32 value in [0, 1]
+        cv_e = q.copy()
+        cf_e = q.copy()
+        t_v, d_v, t_f, d_f = vw0.numerator, vw0.denominator, fw0.numerator, fw0.denominator
+        tri = np.zeros(smooth_e.size, dtype=bool)
+        if opts.triangle_subdivision == "smooth" and level == 0:
+            tri = (sz[f1] == 3) | (sz[f2] == 3)
+        t_v, d_v, t_f, d_f = (np.where(tri, 1, x) for x in (t_v, d_v, t_f, d_f))
+        if tri.any():  # TRI_SUB_SMOOTH: face weight (w0 + w1) / 2, w = 0.47 at a triangle (a float weight)
+            w0 = np.where(sz[f1[tri]] == 3, 0.470, float(fw0))
+            w1 = np.where(sz[f2[tri]] == 3, 0.470, float(fw0))
+            fw = (w0 + w1) / 2
+            cv_e[tri] = q[tri] * (1 - 2 * fw) / 2
+            cf_e[tri] = q[tri] * fw
+        r = er[smooth_e]
+        x1 = scaled(r, cf_e, t_f * face_t[f1], d_f * face_d[f1])  # each vertex of the faces
+        x2 = scaled(r, cf_e, t_f * face_t[f2], d_f * face_d[f2])
+        xend = scaled(r, cv_e, t_v, d_v) + x1 + x2  # the ends are in both faces
+        for end in (a, b):
+            rows.append(r)
+            cols.append(end[smooth_e])
+            vals.append(xend)
+        add_face_rest(r, h1[smooth_e], x1)
+        add_face_rest(r, h2[smooth_e], x2)
+    rows, cols, vals = (np.concatenate(x) for x in (rows, cols, vals))
+    S = sp.coo_matrix((vals, (rows, cols)), shape=(n + E + m, n)).tocsr()  # sums the terms, exactly
+    S.data /= R[np.repeat(np.arange(n + E + m), np.diff(S.indptr))]
+    S.eliminate_zeros()
+    faces = np.stack([org, n + he_edge, n + E + face, n + he_edge[prv]], axis=1)
+    keep = ce > 0
+    child_creases = (np.stack([inc_v[keep], n + inc_e[keep]], axis=1).reshape(-1, 2), ce[keep])
+    cvs = np.where(k > 0, cv, 0.0)
+    sharp_v = np.flatnonzero(cvs > 0)
+    child_holes = np.zeros(H, dtype=bool) if holes is None else np.repeat(np.asarray(holes, dtype=bool), sz)
+    return Step(S, faces, np.stack([a, b], axis=1), child_creases, (sharp_v, cvs[sharp_v]), child_holes)

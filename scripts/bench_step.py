@@ -1,0 +1,373 @@
+#!/usr/bin/env python
+"""A/B benchmark of the one vectorized Catmull-Clark step (:func:`ccproof.mesh.step.catmark_operator`).
+
+Against the implementations it replaced, kept below verbatim as baselines (the evaluator's untagged
+polygon step from face points, the untagged quad operator assembled in floats, the applications'
+tagged step with ``refine_complex`` on the fans of semi-sharp vertices), in one process, taking turns
+round by round (min, median, max of the ratio new / old per round; the 1-minute load before each round):
+
+1. the setup of the evaluator (``natural_limit_surface`` of the file, the disk cache filled by the
+   warm-up) on bunny_quads, catmark_cubes_infsharp and catmark_smoothtris1 and on an icosphere of
+   triangles (``--tri-levels``: scan-like, the mesh the untagged polygon step serves), with the
+   evaluator's polygon step from face points (``catmark_step``, kept) as "old" and the same step as
+   ``catmark_operator(...).S @ X`` as "new" (the measurement behind keeping the former);
+2. the step alone: ``catmark_step`` on that icosphere (the same two), ``subdivision_matrix`` on
+   bunny_quads subdivided once, ``tagged_step`` on catmark_cubes_infsharp and catmark_pyramid_creases1
+   (semi-sharp) subdivided twice (the former code as "old", the operator as "new").
+
+Usage: python scripts/bench_step.py [--rounds 7] [--tri-levels 4]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import time
+from pathlib import Path
+
+import numpy as np
+
+from ccproof.apps.control_mesh import (
+    _fan_complex,
+    _pair_keys,
+    _semi,
+    read_control_mesh,
+    subdivide_control,
+    tags_of,
+    vertex_rules,
+)
+from ccproof.mesh import QuadMesh, subdivide
+from ccproof.mesh.subdivision import _boundary_neighbours
+from ccproof.rule_weights import (
+    crease_vertex_weights,
+    face_point_weight,
+    sharp_edge_weight,
+    smooth_edge_weights,
+    smooth_vertex_weights,
+)
+
+REPO = Path(__file__).resolve().parent.parent
+DATA = REPO / "tests" / "data"
+
+
+# ------------------------------------------------------------------ the baselines (the former code)
+def old_catmark_step(mesh):
+    from ccproof.rule_weights import crease_vertex_weights, smooth_edge_weights, smooth_vertex_weights
+
+    opts = mesh.options
+    if (mesh.edge_sharpness or mesh.vertex_sharpness or np.asarray(mesh.is_hole).any()
+            or opts.triangle_subdivision != "catmark" or opts.boundary == "none"):
+        return None
+    X = np.asarray(mesh.vertices, dtype=np.float64)
+    idx = np.asarray(mesh.indices, dtype=np.int64)
+    sizes = np.asarray(mesh.sizes, dtype=np.int64)
+    off = np.asarray(mesh.offsets, dtype=np.int64)[:sizes.size]
+    n, m, H = X.shape[0], sizes.size, idx.size
+    face = np.repeat(np.arange(m), sizes)
+    pos = np.arange(H) - off[face]
+    nxt = off[face] + (pos + 1) % sizes[face]
+    prv = off[face] + (pos - 1) % sizes[face]
+    org, dst = idx, idx[nxt]
+    if np.unique(org * n + dst).size != H:  # a directed edge twice: non-manifold or misoriented
+        return None
+    lo, hi = np.minimum(org, dst), np.maximum(org, dst)
+    uniq, first, inv = np.unique(lo * n + hi, return_index=True, return_inverse=True)
+    inv = inv.reshape(-1)
+    E = uniq.size
+    order = np.argsort(first, kind="stable")
+    rank = np.empty(E, dtype=np.int64)
+    rank[order] = np.arange(E)
+    he_edge = rank[inv]  # edge id of every half-edge (first-occurrence order)
+    count = np.bincount(he_edge, minlength=E)
+    if (count > 2).any():
+        return None
+    valence = np.bincount(org, minlength=n)  # faces (outgoing half-edges) at every vertex
+    if (valence == 0).any():
+        return None
+    bnd_h = count[he_edge] == 1  # boundary half-edges
+    nb_out = np.bincount(org[bnd_h], minlength=n)
+    nb_in = np.bincount(dst[bnd_h], minlength=n)
+    if (nb_out > 1).any() or (nb_in != nb_out).any():
+        return None
+    if opts.boundary == "edge_and_corner" and ((nb_out > 0) & (valence == 1)).any():
+        return None  # a one-face corner: sharp from level 1 on (a tagged level-1 mesh)
+    one = 1.0
+    fp = np.add.reduceat(X[idx], off, axis=0) / sizes[:, None] if m else np.zeros((0, 3))
+    # edge points
+    h1 = first[order]  # the first half-edge of every edge, in edge order
+    h2 = np.full(E, -1, dtype=np.int64)
+    second = np.flatnonzero(np.arange(H) != first[inv])
+    h2[he_edge[second]] = second
+    a, b = org[h1], dst[h1]
+    vw, fw = smooth_edge_weights(one)
+    ep = 0.5 * (X[a] + X[b])
+    inner = h2 >= 0
+    ep[inner] = vw * (X[a[inner]] + X[b[inner]]) + fw * (fp[face[h1[inner]]] + fp[face[h2[inner]]])
+    # vertex points
+    vp = np.empty((n, 3))
+    sum_e = np.stack([np.bincount(org, weights=X[dst, c], minlength=n) for c in range(3)], axis=1)
+    sum_f = np.stack([np.bincount(org, weights=fp[face, c], minlength=n) for c in range(3)], axis=1)
+    wv, we, wf = smooth_vertex_weights(valence, one)
+    vp[:] = wv[:, None] * X + we[:, None] * sum_e + wf[:, None] * sum_f
+    bv = np.flatnonzero(nb_out > 0)
+    if bv.size:
+        cw, ce = crease_vertex_weights(one)
+        bn = np.zeros((n, 3))
+        np.add.at(bn, org[bnd_h], X[dst[bnd_h]])
+        np.add.at(bn, dst[bnd_h], X[org[bnd_h]])
+        vp[bv] = cw * X[bv] + ce * bn[bv]
+    X1 = np.concatenate([vp, ep, fp])
+    F1 = np.stack([org, n + he_edge, n + E + face, n + he_edge[prv]], axis=1)
+    return X1, F1
+
+
+def old_subdivision_matrix(mesh):
+    F = mesh.faces
+    n, E, m = mesh.n_vertices, mesh.n_edges, mesh.n_faces
+    rows, cols, vals = [], [], []
+
+    def add(r, c, w):
+        r, c = np.broadcast_arrays(np.asarray(r), np.asarray(c))
+        rows.append(r.reshape(-1))
+        cols.append(c.reshape(-1))
+        vals.append(np.broadcast_to(np.asarray(w, dtype=np.float64), r.shape).reshape(-1))
+
+    one = 1.0  # the rule functions in floats (exact_one() would give the exact weights)
+    wq = face_point_weight(4, one)
+    # face points
+    add(np.repeat(n + E + np.arange(m), 4), F.reshape(-1), wq)
+    # edge points
+    a, b = mesh.edges[:, 0], mesh.edges[:, 1]
+    er = n + np.arange(E)
+    bnd = mesh.is_boundary_edge
+    half = sharp_edge_weight(one)
+    add(er[bnd], a[bnd], half)
+    add(er[bnd], b[bnd], half)
+    it = ~bnd
+    we_end, we_face = smooth_edge_weights(one)
+    add(er[it], a[it], we_end)
+    add(er[it], b[it], we_end)
+    for s in range(2):  # the face point of each adjacent face, spelled out on its vertices
+        add(np.repeat(er[it], 4), F[mesh.edge_faces[it, s]].reshape(-1), we_face * wq)
+    # interior vertex points (smooth rule), assembled corner by corner
+    org = F.reshape(-1)
+    dst = np.roll(F, -1, axis=1).reshape(-1)
+    inner = ~mesh.is_boundary_vertex
+    k = np.maximum(mesh.valence.astype(np.int64), 1)  # (unused vertices: valence 0, weights unused)
+    wv, we, wf = smooth_vertex_weights(k, one)
+    iv = np.flatnonzero(inner)
+    add(iv, iv, wv[iv])
+    c = np.flatnonzero(inner[org])  # corners at interior vertices: one edge and one face each
+    v = org[c]
+    add(v, dst[c], we[v])
+    add(np.repeat(v, 4), F[c // 4].reshape(-1), np.repeat(wf[v] * wq, 4))
+    # boundary vertex points (crease rule along the boundary)
+    bv = np.flatnonzero(mesh.is_boundary_vertex)
+    if bv.size:
+        e0, e1 = _boundary_neighbours(mesh)
+        wc, wn = crease_vertex_weights(one)
+        add(bv, bv, wc)
+        add(bv, e0[bv], wn)
+        add(bv, e1[bv], wn)
+    import scipy.sparse as sp
+
+    S = sp.coo_matrix(
+        (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(n + E + m, n)
+    )
+    return S.tocsr()
+
+
+def _local_step_rows(mesh: QuadMesh, v, edge_sharpness, vertex_sharpness):
+    from ccproof.mesh.rules import refine_complex, to_float
+
+    cx, gl = _fan_complex(mesh, v, edge_sharpness, vertex_sharpness)
+    inc = [e for e, h in enumerate(cx.edges) if cx.org[h] == 0 or cx.dst(h) == 0]
+    stencils, _, _, _ = refine_complex(cx, vertices=[0], edges=inc)
+    n = cx.n_vertices
+
+    def glob(st):
+        return {int(gl[c]): to_float(w) for c, w in st.items()}
+
+    edges = {}
+    for e in inc:
+        h = cx.edges[e]
+        u = cx.dst(h) if cx.org[h] == 0 else cx.org[h]
+        edges[int(gl[u])] = glob(stencils[n + e])
+    return glob(stencils[0]), edges
+
+
+def old_tagged_step(mesh: QuadMesh, edge_sharpness=None, vertex_sharpness=None):
+    import scipy.sparse as sp
+
+    from ccproof.mesh.rules import _decrement
+
+    if edge_sharpness is None:
+        edge_sharpness, vertex_sharpness = tags_of(mesh)
+    S = old_subdivision_matrix(mesh)
+    n = mesh.n_vertices
+    es, vs = edge_sharpness, vertex_sharpness
+    se = np.flatnonzero(es > 0)
+    none = (np.zeros((0, 2), dtype=np.int64), np.zeros(0)), (np.zeros(0, dtype=np.int64), np.zeros(0))
+    if not se.size and not (vs > 0).any():
+        return S, *none
+    _, corner, crease, _, nb, stationary = vertex_rules(mesh, es, vs)
+    a, b = mesh.edges[se, 0], mesh.edges[se, 1]
+    touched = vs > 0
+    touched[a] = touched[b] = True
+    cor = np.flatnonzero(touched & corner & stationary)
+    cre = np.flatnonzero(touched & crease & stationary)
+    inf_e = se[np.isinf(es[se])]
+    er = n + inf_e
+    wv, wn = crease_vertex_weights(1.0)
+    half = sharp_edge_weight(1.0)
+    rows = [cor, cre, cre, cre, er, er]
+    cols = [cor, cre, nb[cre, 0], nb[cre, 1], mesh.edges[inf_e, 0], mesh.edges[inf_e, 1]]
+    vals = [np.ones(cor.size), np.full(cre.size, wv), np.full(2 * cre.size, wn), np.full(2 * er.size, half)]
+    replaced = [cor, cre, er]
+    moving = np.flatnonzero(~stationary)
+    if moving.size:  # semi-sharp: the exact stencils of the rules on the vertex's fan
+        key = _pair_keys(mesh.edges, n)
+        srt = np.argsort(key)
+        r_, c_, w_ = [], [], []
+        for v in moving.tolist():
+            vrow, erows = _local_step_rows(mesh, v, es, vs)
+            r_ += [v] * len(vrow)
+            c_ += list(vrow)
+            w_ += list(vrow.values())
+            for u, st in erows.items():
+                e = int(srt[np.searchsorted(key[srt], min(u, v) * n + max(u, v))])
+                if _semi(es[e]):
+                    r_ += [n + e] * len(st)
+                    c_ += list(st)
+                    w_ += list(st.values())
+        rows.append(np.asarray(r_, dtype=np.int64))
+        cols.append(np.asarray(c_, dtype=np.int64))
+        vals.append(np.asarray(w_, dtype=np.float64))
+        replaced.append(np.unique(rows[-1]))
+    replace = np.ones(S.shape[0])
+    replace[np.concatenate(replaced)] = 0.0
+    extra = sp.coo_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=S.shape)
+    # an edge point computed from both of its ends is the same stencil: keep one (halve the sum)
+    out = (sp.diags(replace) @ S + _dedup(extra)).tocsr()
+    out.eliminate_zeros()
+    child_s = np.array([_decrement(x) for x in es[se].tolist()])
+    keep = child_s > 0
+    er_all = n + se
+    ce = np.r_[np.c_[a, er_all][keep], np.c_[b, er_all][keep]]
+    cs = np.r_[child_s[keep], child_s[keep]]
+    cv = np.flatnonzero(vs > 0)
+    cvs = np.array([_decrement(x) for x in vs[cv].tolist()])
+    return out, (ce, cs), (cv[cvs > 0], cvs[cvs > 0])
+
+
+def _dedup(M):
+    M = M.tocoo()
+    if not M.nnz:
+        return M
+    import scipy.sparse as sp
+
+    key = np.c_[M.row, M.col]
+    _, first = np.unique(key, axis=0, return_index=True)
+    return sp.coo_matrix((M.data[first], (M.row[first], M.col[first])), shape=M.shape)
+
+
+# ------------------------------------------------------------------ the runs
+def operator_catmark_step(mesh):
+    """``catmark_step`` as a wrapper of the one operator: the same cases refused, then ``S @ X``."""
+    from ccproof.mesh.step import catmark_operator
+
+    if old_catmark_step(mesh) is None:
+        return None
+    st = catmark_operator(mesh.n_vertices, mesh.indices, mesh.sizes)
+    return st.S @ np.asarray(mesh.vertices, dtype=np.float64), st.faces
+
+
+def _icosphere(levels):
+    """An icosphere: the icosahedron's triangles split ``levels`` times, projected to the sphere."""
+    t = (1 + 5 ** 0.5) / 2
+    V = [[-1, t, 0], [1, t, 0], [-1, -t, 0], [1, -t, 0], [0, -1, t], [0, 1, t], [0, -1, -t], [0, 1, -t],
+         [t, 0, -1], [t, 0, 1], [-t, 0, -1], [-t, 0, 1]]
+    F = [[0, 11, 5], [0, 5, 1], [0, 1, 7], [0, 7, 10], [0, 10, 11], [1, 5, 9], [5, 11, 4], [11, 10, 2],
+         [10, 7, 6], [7, 1, 8], [3, 9, 4], [3, 4, 2], [3, 2, 6], [3, 6, 8], [3, 8, 9], [4, 9, 5], [2, 4, 11],
+         [6, 2, 10], [8, 6, 7], [9, 8, 1]]
+    V = [np.array(v, dtype=float) / np.linalg.norm(v) for v in V]
+    for _ in range(levels):
+        mid, G = {}, []
+        for a, b, c in F:
+            m = []
+            for p, q in ((a, b), (b, c), (c, a)):
+                k = (min(p, q), max(p, q))
+                if k not in mid:
+                    x = V[p] + V[q]
+                    V.append(x / np.linalg.norm(x))
+                    mid[k] = len(V) - 1
+                m.append(mid[k])
+            G += [[a, m[0], m[2]], [b, m[1], m[0]], [c, m[2], m[1]], m]
+        F = G
+    return np.array(V), np.array(F)
+
+
+def _stats(r):
+    return f"min {min(r):.3f}  median {statistics.median(r):.3f}  max {max(r):.3f}"
+
+
+def _ab(name, old, new, rounds):
+    ratios, loads, t_old, t_new = [], [], [], []
+    old(), new()  # warm-up (imports, the disk cache)
+    for i in range(rounds):
+        loads.append(os.getloadavg()[0])
+        pair = [(old, t_old), (new, t_new)] if i % 2 == 0 else [(new, t_new), (old, t_old)]
+        for f, acc in pair:
+            t0 = time.perf_counter()
+            f()
+            acc.append(time.perf_counter() - t0)
+        ratios.append(t_new[-1] / t_old[-1])
+    print(f"{name:52s} old {min(t_old) * 1e3:8.1f} ms  new {min(t_new) * 1e3:8.1f} ms  new/old {_stats(ratios)}"
+          f"  (load {min(loads):.1f}-{max(loads):.1f})", flush=True)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--rounds", type=int, default=7)
+    ap.add_argument("--tri-levels", type=int, default=4)
+    a = ap.parse_args()
+    import ccproof.evaluate.tagged as tagged
+    from ccproof.apps.control_mesh import tagged_step
+    from ccproof.evaluate._table import catmark_step
+    from ccproof.evaluate.surface import natural_limit_surface
+    from ccproof.mesh import PolyMesh, subdivision_matrix
+    from ccproof.mesh.io import read_mesh
+
+    V, F = _icosphere(a.tri_levels)
+    sphere = PolyMesh(V, F)
+    print(f"icosphere: {F.shape[0]:,} triangles; {os.cpu_count()} cpus; rounds {a.rounds}", flush=True)
+
+    def setup(path_or_mesh, step):
+        def run():
+            tagged.catmark_step = step
+            try:
+                natural_limit_surface(path_or_mesh, progress=False)
+            finally:
+                tagged.catmark_step = catmark_step
+        return run
+
+    files = [("bunny_quads", DATA / "meshes" / "bunny_quads.obj"),
+             ("cubes_infsharp", DATA / "osd_features" / "meshes" / "catmark_cubes_infsharp.obj"),
+             ("smoothtris1", DATA / "osd_features" / "meshes" / "catmark_smoothtris1.obj")]
+    for name, p in files + [(f"icosphere ({F.shape[0]:,} triangles)", sphere)]:
+        _ab(f"setup {name}", setup(p, catmark_step), setup(p, operator_catmark_step), a.rounds)
+    _ab("catmark_step icosphere", lambda: catmark_step(sphere), lambda: operator_catmark_step(sphere), a.rounds)
+    bunny = read_mesh(DATA / "meshes" / "bunny_quads.obj").to_quad_mesh()
+    b1 = subdivide(bunny)
+    _ab(f"subdivision_matrix bunny level 1 ({b1.n_faces:,} quads)", lambda: old_subdivision_matrix(b1),
+        lambda: subdivision_matrix(b1), a.rounds)
+    for name in ("catmark_cubes_infsharp", "catmark_pyramid_creases1"):
+        m, _ = read_control_mesh(DATA / "osd_features" / "meshes" / f"{name}.obj")
+        m = subdivide_control(subdivide_control(m))
+        _ab(f"tagged_step {name} level 2 ({m.n_faces:,} quads)", lambda m=m: old_tagged_step(m),
+            lambda m=m: tagged_step(m), a.rounds)
+
+
+if __name__ == "__main__":
+    main()
