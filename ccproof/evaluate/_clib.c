@@ -9,8 +9,9 @@
  * are compiled separately.
  *
  * Points are taken in blocks of CCP_BLOCK: the first pass finds their virtual faces (one loop: the
- * table reads of different points overlap), then their patches, parameters and scales, and prefetches
- * their nets; the second evaluates them. Corner nets of layers beyond the precomputed one are
+ * table reads of different points overlap), then their patches, parameters and scales and the basis
+ * functions at the parameters (the divisions by 6 overlap the table reads), and prefetches their nets;
+ * the second evaluates them. Corner nets of layers beyond the precomputed one are
  * kept in a cache the caller owns (one per thread, kept between calls on the same table).
  *
  * Threads: the kernel holds no global state; concurrent calls on disjoint blocks of points (ctypes
@@ -109,7 +110,7 @@ CCP_INLINE void basis(double x, double *b) {
     b[11] = x;
 }
 
-#if defined(__GNUC__)
+#if defined(__GNUC__) && !defined(CCP_SCALAR) /* CCP_SCALAR: the portable code below (to check it) */
 /* Four doubles, the lanes of one SIMD register (AVX2; two SSE2 registers or half an AVX-512 one): each
  * lane its own IEEE operations, the same as the scalar code's. */
 typedef double v4d __attribute__((vector_size(32), aligned(8)));
@@ -166,15 +167,13 @@ CCP_INLINE void basisv(double x, double *b) {
     b[11] = x;
 }
 
-/* Row k of P and of the derivatives up to order D from the net (17 x 3) at (s, t), derivatives scaled
- * by g per order (D a compile-time constant in each caller): the columns T_r[i] = sum_j B_r(t)_j
- * net[i + 4 j], then sum_i B(s)_i T_r[i], each sum from 0.0 left to right (the numba kernel's order). */
-CCP_INLINE void bicubic(const double *net, double s, double t, double g, const int D, int64_t k, double *P,
-                        double *Pu, double *Pv, double *Puu, double *Puv, double *Pvv) {
-    double bs[12], bt[12];
+/* Row k of P and of the derivatives up to order D from the net (17 x 3) at (s, t), given the basis functions
+ * bs = basis(s) and bt = basis(t), derivatives scaled by g per order (D a compile-time constant in each
+ * caller): the columns T_r[i] = sum_j B_r(t)_j net[i + 4 j], then sum_i B(s)_i T_r[i], each sum from 0.0
+ * left to right (the numba kernel's order). */
+CCP_INLINE void bicubic(const double *net, const double *bs, const double *bt, double g, const int D, int64_t k,
+                        double *P, double *Pu, double *Pv, double *Puu, double *Puv, double *Pvv) {
     v4d T0[4], T1[4], T2[4];
-    basisv(s, bs);
-    basisv(t, bt);
     columns(net, bt, T0);
     put3(P + 3 * k, (v4d){net[48], net[49], net[50], 0.0} + sum4v(bs, T0));
     if (D >= 1) {
@@ -204,11 +203,9 @@ CCP_INLINE void columns(const double *net, const double *b, double *T) {
 }
 
 /* Row k of P and of the derivatives up to order D (see the vector version above). */
-CCP_INLINE void bicubic(const double *net, double s, double t, double g, const int D, int64_t k, double *P,
-                        double *Pu, double *Pv, double *Puu, double *Puv, double *Pvv) {
-    double bs[12], bt[12], T0[12], T1[12], T2[12];
-    basis(s, bs);
-    basis(t, bt);
+CCP_INLINE void bicubic(const double *net, const double *bs, const double *bt, double g, const int D, int64_t k,
+                        double *P, double *Pu, double *Pv, double *Puu, double *Puv, double *Pvv) {
+    double T0[12], T1[12], T2[12];
     columns(net, bt, T0);
     for (int c = 0; c < 3; c++)
         P[3 * k + c] = net[48 + c] + sum4(bs, T0[c], T0[3 + c], T0[6 + c], T0[9 + c]);
@@ -355,7 +352,7 @@ CCP_INLINE const double *locate(const ccp_table *T, int64_t job, int64_t vf, int
             du = (cu ? (U0 + H) - uu : uu - U0) * r;
             dv = (cv ? (V0 + H) - ww : ww - V0) * r;
         } else {
-#if defined(__GNUC__)
+#if defined(__GNUC__) && !defined(CCP_SCALAR)
             v4d dd = (v4d){cu ? (U0 + H) - uu : uu - U0, cv ? (V0 + H) - ww : ww - V0, 1.0, 1.0} / splat(H);
             du = dd[0];
             dv = dd[1];
@@ -414,7 +411,7 @@ CCP_INLINE const double *locate(const ccp_table *T, int64_t job, int64_t vf, int
         *t = 1.0 < y ? 1.0 : y;
         return net;
     }
-#if defined(__GNUC__)
+#if defined(__GNUC__) && !defined(CCP_SCALAR)
     v4d qq = (v4d){uu - pu0, ww - pv0, 1.0, 1.0} / splat(h); /* three divisions in one */
     double x = qq[0], y = qq[1];
     *g = qq[2];
@@ -432,11 +429,18 @@ CCP_INLINE const double *locate(const ccp_table *T, int64_t job, int64_t vf, int
 /* Points per block: the first pass locates them (and prefetches their nets), the second evaluates them. */
 #define CCP_BLOCK 32
 
+#if defined(__GNUC__) && !defined(CCP_SCALAR)
+#define BASIS basisv
+#else
+#define BASIS basis
+#endif
+
 CCP_INLINE int64_t run(const ccp_table *T, int64_t n, const int64_t *f, const double *u, const double *v,
                        const int D, double *P, double *Pu, double *Pv, double *Puu, double *Puv, double *Pvv,
                        double *cache) {
     int64_t *base = n >= CCP_CACHE_MIN ? (int64_t *)cache : NULL;
     double S[CCP_BLOCK], Tt[CCP_BLOCK], G[CCP_BLOCK];
+    double BS[CCP_BLOCK][12], BT[CCP_BLOCK][12]; /* the basis functions at the block's (s, t) */
     double W[CCP_BLOCK][CCP_NET]; /* the corner nets of a block without a cache */
     const double *N[CCP_BLOCK];
     ccp_deep dp[CCP_BLOCK];
@@ -462,6 +466,8 @@ CCP_INLINE int64_t run(const ccp_table *T, int64_t n, const int64_t *f, const do
             int64_t kk = k0 + i;
             const double *net = locate(T, JB[i], VF[i], KD[i], u[kk], v[kk], dp + i, S + i, Tt + i, G + i);
             N[i] = net;
+            BASIS(S[i], BS[i]);
+            BASIS(Tt[i], BT[i]);
             DL[nd] = i;
             nd += net == CCP_DEEP;
             if (net == CCP_DEEP) {
@@ -489,7 +495,7 @@ CCP_INLINE int64_t run(const ccp_table *T, int64_t n, const int64_t *f, const do
             int64_t *sl = slot[i];
             if (sl[0] != key[i] + 1) {
                 if (sl[1] == block) {
-                    for (; i0 < i; i0++) bicubic(N[i0], S[i0], Tt[i0], G[i0], D, k0 + i0, P, Pu, Pv, Puu, Puv, Pvv);
+                    for (; i0 < i; i0++) bicubic(N[i0], BS[i0], BT[i0], G[i0], D, k0 + i0, P, Pu, Pv, Puu, Puv, Pvv);
                     block++;
                 }
                 corner_net(T, d->job, d->vf, d->cfg, d->lay, d->code, d->ci, (double *)(sl + 5));
@@ -498,7 +504,7 @@ CCP_INLINE int64_t run(const ccp_table *T, int64_t n, const int64_t *f, const do
             sl[1] = block;
             N[i] = (const double *)(sl + 5);
         }
-        for (; i0 < m; i0++) bicubic(N[i0], S[i0], Tt[i0], G[i0], D, k0 + i0, P, Pu, Pv, Puu, Puv, Pvv);
+        for (; i0 < m; i0++) bicubic(N[i0], BS[i0], BT[i0], G[i0], D, k0 + i0, P, Pu, Pv, Puu, Puv, Pvv);
     }
     if (base != NULL) base[0] = block;
     return bad;
