@@ -77,6 +77,34 @@ def test_threads_and_calls_do_not_change_the_bits(surface):
         assert np.array_equal(one[k], o), k
 
 
+def test_a_call_writes_only_its_own_rows(surface):
+    """The kernel stores a point's three coordinates with four-lane stores, the fourth on the next row, which
+    the next point then writes: a call must still leave the row after its last point alone. Calls in
+    reverse order into one array (a stray write lands on a row already written), and a call into the middle
+    of an array of sentinels."""
+    from ccproof.evaluate import _ckernel
+
+    f, u, v = _points(surface, 5000, 13)
+    one = surface.evaluate(f, u, v, 2, backend="c", threads=1)
+    lib, ct = _ckernel.load(), surface._c_table()
+    for d in (0, 1, 2):
+        keys = ("P", "Pu", "Pv", "Puu", "Puv", "Pvv")[:3 * d if d else 1]
+        outs = [np.zeros((f.size, 3)) for _ in range(6)]
+        cuts = [0, 1, 2, 33, 300, 301, 2000, f.size]
+        for lo, hi in reversed(list(zip(cuts[:-1], cuts[1:]))):
+            got = [o[lo:hi] if i < len(keys) else None for i, o in enumerate(outs)]
+            assert _ckernel.evaluate_block(lib, ct, f[lo:hi], u[lo:hi], v[lo:hi], d, got) == -1
+        for k, o in zip(keys, outs):
+            assert np.array_equal(one[k], o), (d, k)
+        for lo, hi in ((10, 11), (10, 43), (10, 400)):
+            outs = [np.full((f.size, 3), -7.0) for _ in range(6)]
+            got = [o[lo:hi] if i < len(keys) else None for i, o in enumerate(outs)]
+            assert _ckernel.evaluate_block(lib, ct, f[lo:hi], u[lo:hi], v[lo:hi], d, got) == -1
+            for k, o in zip(keys, outs):
+                assert np.array_equal(one[k][lo:hi], o[lo:hi]), (d, k, lo, hi)
+                assert np.all(o[:lo] == -7.0) and np.all(o[hi:] == -7.0), (d, k, lo, hi)
+
+
 def test_inputs_and_outputs_in_other_layouts(surface):
     f, u, v = _points(surface, 3000, 5)
     ref = surface.evaluate(f, u, v, 1, backend="numpy")
