@@ -9,8 +9,9 @@
  * are compiled separately.
  *
  * Points are taken in blocks of CCP_BLOCK: the first pass finds their virtual faces (one loop: the
- * table reads of different points overlap), then their patches, parameters and scales, and prefetches
- * their nets; the second evaluates them. Corner nets of layers beyond the precomputed one are
+ * table reads of different points overlap), then their patches, parameters and scales and the basis
+ * functions at the parameters (the divisions by 6 overlap the table reads), and prefetches their nets;
+ * the second evaluates them. Corner nets of layers beyond the precomputed one are
  * kept in a cache the caller owns (one per thread, kept between calls on the same table).
  *
  * Threads: the kernel holds no global state; concurrent calls on disjoint blocks of points (ctypes
@@ -109,7 +110,7 @@ CCP_INLINE void basis(double x, double *b) {
     b[11] = x;
 }
 
-#if defined(__GNUC__)
+#if defined(__GNUC__) && !defined(CCP_SCALAR) /* CCP_SCALAR: the portable code below (to check it) */
 /* Four doubles, the lanes of one SIMD register (AVX2; two SSE2 registers or half an AVX-512 one): each
  * lane its own IEEE operations, the same as the scalar code's. */
 typedef double v4d __attribute__((vector_size(32), aligned(8)));
@@ -148,7 +149,14 @@ CCP_INLINE v4d sum4v(const double *a, const v4d *X) {
     return (((splat(0.0) + splat(a[0]) * X[0]) + splat(a[1]) * X[1]) + splat(a[2]) * X[2]) + splat(a[3]) * X[3];
 }
 
-CCP_INLINE void put3(double *dst, v4d x) { memcpy(dst, &x, 3 * sizeof(double)); }
+/* The three coordinates of x at dst; with ``more`` (row dst is not the output's last) all four lanes, one
+ * store: the fourth lands on the next row's first coordinate, which the next point writes after this one. */
+CCP_INLINE void put3(double *dst, v4d x, int more) {
+    if (more)
+        memcpy(dst, &x, sizeof x);
+    else
+        memcpy(dst, &x, 3 * sizeof(double));
+}
 
 /* basis(x) with its four divisions by 6 as one vector division (the same IEEE operations lane by lane) */
 CCP_INLINE void basisv(double x, double *b) {
@@ -166,29 +174,27 @@ CCP_INLINE void basisv(double x, double *b) {
     b[11] = x;
 }
 
-/* Row k of P and of the derivatives up to order D from the net (17 x 3) at (s, t), derivatives scaled
- * by g per order (D a compile-time constant in each caller): the columns T_r[i] = sum_j B_r(t)_j
- * net[i + 4 j], then sum_i B(s)_i T_r[i], each sum from 0.0 left to right (the numba kernel's order). */
-CCP_INLINE void bicubic(const double *net, double s, double t, double g, const int D, int64_t k, double *P,
-                        double *Pu, double *Pv, double *Puu, double *Puv, double *Pvv) {
-    double bs[12], bt[12];
+/* Row k of P and of the derivatives up to order D from the net (17 x 3) at (s, t), given the basis functions
+ * bs = basis(s) and bt = basis(t), derivatives scaled by g per order (D a compile-time constant in each
+ * caller): the columns T_r[i] = sum_j B_r(t)_j net[i + 4 j], then sum_i B(s)_i T_r[i], each sum from 0.0
+ * left to right (the numba kernel's order). */
+CCP_INLINE void bicubic(const double *net, const double *bs, const double *bt, double g, const int D, int64_t k,
+                        int more, double *P, double *Pu, double *Pv, double *Puu, double *Puv, double *Pvv) {
     v4d T0[4], T1[4], T2[4];
-    basisv(s, bs);
-    basisv(t, bt);
     columns(net, bt, T0);
-    put3(P + 3 * k, (v4d){net[48], net[49], net[50], 0.0} + sum4v(bs, T0));
+    put3(P + 3 * k, (v4d){net[48], net[49], net[50], 0.0} + sum4v(bs, T0), more);
     if (D >= 1) {
         v4d gg = splat(g);
         columns(net, bt + 4, T1);
-        put3(Pu + 3 * k, sum4v(bs + 4, T0) * gg);
-        put3(Pv + 3 * k, sum4v(bs, T1) * gg);
+        put3(Pu + 3 * k, sum4v(bs + 4, T0) * gg, more);
+        put3(Pv + 3 * k, sum4v(bs, T1) * gg, more);
     }
     if (D >= 2) {
         v4d g2 = splat(g * g);
         columns(net, bt + 8, T2);
-        put3(Puu + 3 * k, sum4v(bs + 8, T0) * g2);
-        put3(Puv + 3 * k, sum4v(bs + 4, T1) * g2);
-        put3(Pvv + 3 * k, sum4v(bs, T2) * g2);
+        put3(Puu + 3 * k, sum4v(bs + 8, T0) * g2, more);
+        put3(Puv + 3 * k, sum4v(bs + 4, T1) * g2, more);
+        put3(Pvv + 3 * k, sum4v(bs, T2) * g2, more);
     }
 }
 #else
@@ -204,11 +210,10 @@ CCP_INLINE void columns(const double *net, const double *b, double *T) {
 }
 
 /* Row k of P and of the derivatives up to order D (see the vector version above). */
-CCP_INLINE void bicubic(const double *net, double s, double t, double g, const int D, int64_t k, double *P,
-                        double *Pu, double *Pv, double *Puu, double *Puv, double *Pvv) {
-    double bs[12], bt[12], T0[12], T1[12], T2[12];
-    basis(s, bs);
-    basis(t, bt);
+CCP_INLINE void bicubic(const double *net, const double *bs, const double *bt, double g, const int D, int64_t k,
+                        int more, double *P, double *Pu, double *Pv, double *Puu, double *Puv, double *Pvv) {
+    double T0[12], T1[12], T2[12];
+    (void)more;
     columns(net, bt, T0);
     for (int c = 0; c < 3; c++)
         P[3 * k + c] = net[48 + c] + sum4(bs, T0[c], T0[3 + c], T0[6 + c], T0[9 + c]);
@@ -341,6 +346,17 @@ CCP_INLINE int find_face(const ccp_table *T, int64_t pf, double uu, double ww, i
     return kind;
 }
 
+/* c ? a : b without a branch (the corner sides cu, cv of a face are 0 or 1 in no order: a branch on them
+ * mispredicts): the bits of a or of b, both computed. */
+CCP_INLINE double pick(int c, double a, double b) {
+    uint64_t x, y, m = (uint64_t)0 - (uint64_t)(c != 0);
+    memcpy(&x, &a, sizeof x);
+    memcpy(&y, &b, sizeof y);
+    x = (x & m) | (y & ~m);
+    memcpy(&a, &x, sizeof a);
+    return a;
+}
+
 /* The net of a point in virtual face vf (kind ``kind``) of ``job`` (find_face), its (s, t) and g. */
 CCP_INLINE const double *locate(const ccp_table *T, int64_t job, int64_t vf, int kind, double uu, double ww,
                                 ccp_deep *dp, double *s, double *t, double *g) {
@@ -350,18 +366,20 @@ CCP_INLINE const double *locate(const ccp_table *T, int64_t job, int64_t vf, int
         double U0 = T->u0[vf], V0 = T->v0[vf], H = T->h[vf];
         int cu = T->cu[vf], cv = T->cv[vf];
         double du, dv;
+        /* the distances to the irregular corner */
+        double au = pick(cu, (U0 + H) - uu, uu - U0), av = pick(cv, (V0 + H) - ww, ww - V0);
         if (T->inv_h != NULL) {
             double r = T->inv_h[vf];
-            du = (cu ? (U0 + H) - uu : uu - U0) * r;
-            dv = (cv ? (V0 + H) - ww : ww - V0) * r;
+            du = au * r;
+            dv = av * r;
         } else {
-#if defined(__GNUC__)
-            v4d dd = (v4d){cu ? (U0 + H) - uu : uu - U0, cv ? (V0 + H) - ww : ww - V0, 1.0, 1.0} / splat(H);
+#if defined(__GNUC__) && !defined(CCP_SCALAR)
+            v4d dd = (v4d){au, av, 1.0, 1.0} / splat(H);
             du = dd[0];
             dv = dd[1];
 #else
-            du = (cu ? (U0 + H) - uu : uu - U0) / H;
-            dv = (cv ? (V0 + H) - ww : ww - V0) / H;
+            du = au / H;
+            dv = av / H;
 #endif
         }
         double mx = du >= dv ? du : dv;
@@ -382,8 +400,8 @@ CCP_INLINE const double *locate(const ccp_table *T, int64_t job, int64_t vf, int
         int64_t code = codes[2 * (du >= 0.5) + (dv >= 0.5)];
         double sc = H * pow2(-lay);
         const double *un = T->unit + 9 * cfg + 3 * code;
-        pu0 = un[0] * sc + (cu ? (U0 + H) : U0);
-        pv0 = un[1] * sc + (cv ? (V0 + H) : V0);
+        pu0 = un[0] * sc + pick(cu, U0 + H, U0);
+        pv0 = un[1] * sc + pick(cv, V0 + H, V0);
         h = un[2] * sc;
         if (T->inv_h != NULL) gi = T->inv_unit[3 * cfg + code] * T->inv_h[vf] * up; /* 1 / h, exactly */
         int64_t ci = ld(T->job_corner, T->wide[3], job) + T->leaf[vf];
@@ -414,7 +432,7 @@ CCP_INLINE const double *locate(const ccp_table *T, int64_t job, int64_t vf, int
         *t = 1.0 < y ? 1.0 : y;
         return net;
     }
-#if defined(__GNUC__)
+#if defined(__GNUC__) && !defined(CCP_SCALAR)
     v4d qq = (v4d){uu - pu0, ww - pv0, 1.0, 1.0} / splat(h); /* three divisions in one */
     double x = qq[0], y = qq[1];
     *g = qq[2];
@@ -432,11 +450,18 @@ CCP_INLINE const double *locate(const ccp_table *T, int64_t job, int64_t vf, int
 /* Points per block: the first pass locates them (and prefetches their nets), the second evaluates them. */
 #define CCP_BLOCK 32
 
+#if defined(__GNUC__) && !defined(CCP_SCALAR)
+#define BASIS basisv
+#else
+#define BASIS basis
+#endif
+
 CCP_INLINE int64_t run(const ccp_table *T, int64_t n, const int64_t *f, const double *u, const double *v,
                        const int D, double *P, double *Pu, double *Pv, double *Puu, double *Puv, double *Pvv,
                        double *cache) {
     int64_t *base = n >= CCP_CACHE_MIN ? (int64_t *)cache : NULL;
     double S[CCP_BLOCK], Tt[CCP_BLOCK], G[CCP_BLOCK];
+    double BS[CCP_BLOCK][12], BT[CCP_BLOCK][12]; /* the basis functions at the block's (s, t) */
     double W[CCP_BLOCK][CCP_NET]; /* the corner nets of a block without a cache */
     const double *N[CCP_BLOCK];
     ccp_deep dp[CCP_BLOCK];
@@ -462,6 +487,8 @@ CCP_INLINE int64_t run(const ccp_table *T, int64_t n, const int64_t *f, const do
             int64_t kk = k0 + i;
             const double *net = locate(T, JB[i], VF[i], KD[i], u[kk], v[kk], dp + i, S + i, Tt + i, G + i);
             N[i] = net;
+            BASIS(S[i], BS[i]);
+            BASIS(Tt[i], BT[i]);
             DL[nd] = i;
             nd += net == CCP_DEEP;
             if (net == CCP_DEEP) {
@@ -489,7 +516,7 @@ CCP_INLINE int64_t run(const ccp_table *T, int64_t n, const int64_t *f, const do
             int64_t *sl = slot[i];
             if (sl[0] != key[i] + 1) {
                 if (sl[1] == block) {
-                    for (; i0 < i; i0++) bicubic(N[i0], S[i0], Tt[i0], G[i0], D, k0 + i0, P, Pu, Pv, Puu, Puv, Pvv);
+                    for (; i0 < i; i0++) bicubic(N[i0], BS[i0], BT[i0], G[i0], D, k0 + i0, k0 + i0 + 1 < n, P, Pu, Pv, Puu, Puv, Pvv);
                     block++;
                 }
                 corner_net(T, d->job, d->vf, d->cfg, d->lay, d->code, d->ci, (double *)(sl + 5));
@@ -498,7 +525,7 @@ CCP_INLINE int64_t run(const ccp_table *T, int64_t n, const int64_t *f, const do
             sl[1] = block;
             N[i] = (const double *)(sl + 5);
         }
-        for (; i0 < m; i0++) bicubic(N[i0], S[i0], Tt[i0], G[i0], D, k0 + i0, P, Pu, Pv, Puu, Puv, Pvv);
+        for (; i0 < m; i0++) bicubic(N[i0], BS[i0], BT[i0], G[i0], D, k0 + i0, k0 + i0 + 1 < n, P, Pu, Pv, Puu, Puv, Pvv);
     }
     if (base != NULL) base[0] = block;
     return bad;

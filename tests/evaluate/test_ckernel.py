@@ -6,6 +6,7 @@ and outputs in other layouts, pickling, refused points)."""
 from __future__ import annotations
 
 import pickle
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -75,6 +76,65 @@ def test_threads_and_calls_do_not_change_the_bits(surface):
         assert _ckernel.evaluate_block(lib, ct, f[lo:hi], u[lo:hi], v[lo:hi], 2, [o[lo:hi] for o in outs]) == -1
     for k, o in zip(("P", "Pu", "Pv", "Puu", "Puv", "Pvv"), outs):
         assert np.array_equal(one[k], o), k
+
+
+def test_a_call_writes_only_its_own_rows(surface):
+    """The kernel stores a point's three coordinates with four-lane stores, the fourth on the next row, which
+    the next point then writes: a call must still leave the row after its last point alone. Calls in
+    reverse order into one array (a stray write lands on a row already written), and a call into the middle
+    of an array of sentinels."""
+    from ccproof.evaluate import _ckernel
+
+    f, u, v = _points(surface, 5000, 13)
+    one = surface.evaluate(f, u, v, 2, backend="c", threads=1)
+    lib, ct = _ckernel.load(), surface._c_table()
+    for d in (0, 1, 2):
+        keys = ("P", "Pu", "Pv", "Puu", "Puv", "Pvv")[:3 * d if d else 1]
+        outs = [np.zeros((f.size, 3)) for _ in range(6)]
+        cuts = [0, 1, 2, 33, 300, 301, 2000, f.size]
+        for lo, hi in reversed(list(zip(cuts[:-1], cuts[1:]))):
+            got = [o[lo:hi] if i < len(keys) else None for i, o in enumerate(outs)]
+            assert _ckernel.evaluate_block(lib, ct, f[lo:hi], u[lo:hi], v[lo:hi], d, got) == -1
+        for k, o in zip(keys, outs):
+            assert np.array_equal(one[k], o), (d, k)
+        for lo, hi in ((10, 11), (10, 43), (10, 400)):
+            outs = [np.full((f.size, 3), -7.0) for _ in range(6)]
+            got = [o[lo:hi] if i < len(keys) else None for i, o in enumerate(outs)]
+            assert _ckernel.evaluate_block(lib, ct, f[lo:hi], u[lo:hi], v[lo:hi], d, got) == -1
+            for k, o in zip(keys, outs):
+                assert np.array_equal(one[k][lo:hi], o[lo:hi]), (d, k, lo, hi)
+                assert np.all(o[:lo] == -7.0) and np.all(o[hi:] == -7.0), (d, k, lo, hi)
+
+
+@pytest.mark.skipif(shutil.which("gcc") is None, reason="no gcc to build the portable variant")
+def test_the_portable_code_gives_the_same_bits(surface, tmp_path):
+    """_clib.c built with -DCCP_SCALAR -DCCP_NO_CLONES (the scalar code that compilers without GNU vector
+    extensions use, one variant for every CPU), with setup.py's flags, against the numpy path."""
+    import ctypes
+
+    from ccproof.evaluate import _ckernel
+
+    src = Path(_ckernel.__file__).with_name("_clib.c")
+    lib_path = tmp_path / "clib_scalar.so"
+    subprocess.run(["gcc", "-shared", "-fPIC", "-std=c99", "-O3", "-ffp-contract=off", "-fno-math-errno",
+                    "-Wno-psabi", "-DCCP_SCALAR", "-DCCP_NO_CLONES", str(src), "-o", str(lib_path)], check=True)
+    lib = ctypes.CDLL(str(lib_path))
+    lib.ccp_evaluate.restype = ctypes.c_int64
+    lib.ccp_evaluate.argtypes = [ctypes.POINTER(_ckernel._Table), ctypes.c_int64] + [ctypes.c_void_p] * 3 + \
+        [ctypes.c_int64] + [ctypes.c_void_p] * 7
+    f, u, v = _points(surface, 6000, 17)
+    ref = surface.evaluate(f, u, v, 2, backend="numpy")
+    ct = surface._c_table()
+    for d in (0, 1, 2):
+        keys = ("P", "Pu", "Pv", "Puu", "Puv", "Pvv")[:3 * d if d else 1]
+        outs = [np.full((f.size, 3), np.nan) for _ in keys]
+        ptrs = [o.ctypes.data for o in outs] + [None] * (6 - len(outs))
+        cache = np.zeros(_ckernel.load().ccp_cache_words())
+        fi = np.ascontiguousarray(f, dtype=np.int64)
+        assert lib.ccp_evaluate(ct.ref, f.size, fi.ctypes.data, u.ctypes.data, v.ctypes.data, d, *ptrs,
+                                cache.ctypes.data) == -1
+        for k, o in zip(keys, outs):
+            assert np.array_equal(ref[k].view(np.int64), o.view(np.int64)), (d, k)
 
 
 def test_inputs_and_outputs_in_other_layouts(surface):
