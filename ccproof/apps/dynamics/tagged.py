@@ -38,7 +38,7 @@ from ccproof.apps.control_mesh import INFINITE, edge_values, moving_limit_rows, 
 from ccproof.apps.dynamics.basis import TERMS, patch_rows, term_matrix
 from ccproof.errors import MeshError
 
-__all__ = ["TaggedElement", "regular_corners", "MASS_LEVELS", "MAX_DEPTH"]
+__all__ = ["TaggedElement", "tagged_layout", "regular_corners", "MASS_LEVELS", "MAX_DEPTH"]
 
 #: depth to which the mass of a tagged element is summed before its exact constant tail
 MASS_LEVELS = 20
@@ -417,3 +417,80 @@ class TaggedElement:
             n0 = len(self.leaves)
             self._grow(self._built + 1)
             self._new = n0
+
+
+def tagged_layout(mesh):
+    """The element layout of a tagged control mesh: normal, special, tagged (kind 3) and hole (kind 0) faces.
+
+    A face is normal when its four corners are interior, smooth (no sharp edge, no vertex sharpness) and of
+    valence 4; special when it lies in the fan of a smooth interior extraordinary vertex whose fan has no hole
+    and all of whose other fan corners are such regular vertices; a hole carries no patch; every other face is
+    a tagged element (:class:`TaggedElement`). Without tags this is :func:`element_layout
+    <ccproof.apps.dynamics.elements.element_layout>`'s layout except that boundary faces, faces with two
+    extraordinary vertices and the fans of skipped extraordinary vertices become tagged elements.
+
+    Parameters
+    ----------
+    mesh : QuadMesh or TaggedQuadMesh
+
+    Returns
+    -------
+    layout : ElementLayout
+        ``face_kind`` 3 for tagged faces, ``face_element`` their index in ``tagged_faces``.
+    tagged_faces : ndarray of int64, shape (k,)
+
+    Examples
+    --------
+    The cube: every face has four valence-3 corners, so with one infinitely sharp edge all six faces are
+    tagged elements:
+
+    >>> from ccproof.mesh.examples import cube
+    >>> from ccproof.apps.control_mesh import TaggedQuadMesh
+    >>> c = cube()
+    >>> lay, tf = tagged_layout(TaggedQuadMesh(c.vertices, c.faces, creases=([c.faces[0][:2]], [10.0])))
+    >>> tf.tolist(), lay.face_kind.tolist()
+    ([0, 1, 2, 3, 4, 5], [3, 3, 3, 3, 3, 3])
+    """
+    from ccproof.apps.control_mesh import tags_of, vertex_rules
+    from ccproof.apps.dynamics.elements import ElementLayout, _normal_nets, _two_ring
+
+    es, vs = tags_of(mesh)
+    ns = vertex_rules(mesh, es, vs)[0]
+    hole = getattr(mesh, "hole", np.zeros(mesh.n_faces, dtype=bool))
+    smooth = ~mesh.is_boundary_vertex & (ns == 0) & (vs == 0)
+    regular = smooth & (mesh.valence == 4)
+    F = mesh.faces
+    m = mesh.n_faces
+    kind = np.full(m, 3, dtype=np.int64)
+    kind[hole] = 0
+    elem = np.full(m, -1, dtype=np.int64)
+    sector = np.full(m, -1, dtype=np.int64)
+    corner = np.full(m, -1, dtype=np.int64)
+    normal = np.flatnonzero(regular[F].all(axis=1) & ~hole)
+    kind[normal] = 1
+    elem[normal] = np.arange(normal.size)
+    evs, vals, rings, sfaces, scorners = [], [], [], [], []
+    for ev in np.flatnonzero(smooth & (mesh.valence != 4)):
+        fan = mesh.fan_corners[mesh.fan_ptr[ev]: mesh.fan_ptr[ev + 1]] // 4
+        others = F[fan][F[fan] != ev]
+        if hole[fan].any() or not regular[others].all():
+            continue
+        ring, f, c = _two_ring(mesh, ev)
+        e = len(evs)
+        evs.append(int(ev))
+        vals.append(int(mesh.valence[ev]))
+        rings.append(ring)
+        sfaces.append(f)
+        scorners.append(c)
+        kind[f] = 2
+        elem[f] = e
+        sector[f] = np.arange(f.size)
+        corner[f] = c
+    tagged = np.flatnonzero(kind == 3)
+    elem[tagged] = np.arange(tagged.size)
+    lay = ElementLayout(normal_faces=normal, normal_nets=_normal_nets(mesh, normal),
+                        special_ev=np.array(evs, dtype=np.int64), special_valence=np.array(vals, dtype=np.int64),
+                        special_rings=tuple(rings), special_faces=tuple(sfaces), special_corners=tuple(scorners),
+                        face_kind=kind, face_element=elem, face_sector=sector, face_corner=corner,
+                        skipped_ev=np.zeros(0, dtype=np.int64))
+    return lay, tagged
