@@ -1,0 +1,120 @@
+"""Tagged elements (creases, corners, boundaries, holes, non-manifold meshes): the model's surface is the one
+``ccproof eval`` evaluates, its matrices are the special elements' where both apply, and its mass converges to
+brute-force quadrature on the globally subdivided mesh."""
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from ccproof.apps.control_mesh import TaggedQuadMesh, read_control_mesh, subdivide_control, tagged_step, tags_of
+from ccproof.apps.dynamics.meshes import paper_initial_model
+from ccproof.apps.dynamics.model import DynamicSurface, Material
+from ccproof.apps.dynamics.tagged import TaggedElement
+from ccproof.evaluate import LimitSurface
+from ccproof.mesh.io import read_mesh
+
+ANISO = Material(mu=1.0, gamma=1.0, a11=1.0, a22=2.0, b11=3.0, b12=5.0, b22=7.0)
+
+
+def _embed(n, ids, X):
+    out = np.zeros((n, n))
+    out[np.ix_(ids, ids)] += X
+    return out
+
+
+def test_tagged_element_is_the_special_element_without_tags():
+    """On the untagged cube x2, the tagged elements of the three faces around a valence-3 vertex have the special
+    element's matrices: the mass (Stein solution) to 1e-14 and the stiffness truncated at the same level, with
+    anisotropic material (the sector rotations exchange a11/a22, b11/b22), to 1e-12 relative."""
+    mesh = paper_initial_model()
+    L = 4
+    model = DynamicSurface(mesh, ANISO, levels=L)
+    lay = model.layout
+    ring, Ms, Ks = model.special_element_matrices()[0]
+    n = mesh.n_vertices
+    es, vs = np.zeros(mesh.n_edges), np.zeros(n)
+    M = np.zeros((n, n))
+    K = np.zeros((n, n))
+    for f in lay.special_faces[0].tolist():
+        el = TaggedElement(mesh, f, es, vs, levels=L)
+        Me, Ke = el.matrices(lambda swap: ANISO.term_coefficients(swap=swap))
+        M += _embed(n, el.ids, Me)
+        K += _embed(n, el.ids, Ke)
+    assert np.abs(M - _embed(n, ring, Ms)).max() <= 1e-14
+    assert np.abs(K - _embed(n, ring, Ks)).max() <= 1e-12 * np.abs(Ks).max()
+
+
+def _points(nf, rng, k=8):
+    """k random points per face plus points near (and on) the corners, down to 2^-40."""
+    f = np.repeat(np.arange(nf), k + 4)
+    u = np.tile(np.r_[rng.random(k), 1e-6, 2.0**-40, 1.0 - 1e-9, 0.5], nf)
+    v = np.tile(np.r_[rng.random(k), 3e-6, 0.0, 1.0, 2.0**-30], nf)
+    return f, u, v
+
+
+@pytest.mark.parametrize("path", ["osd_features/meshes/catmark_cube_creases0",
+                                  pytest.param("osd_features/meshes/catmark_cubes_infsharp", marks=pytest.mark.slow),
+                                  "osd_features/meshes/catmark_dart_edgeonly",
+                                  "osd_features/meshes/catmark_hole_test2",
+                                  "osd_nonmanifold/meshes/book4", "osd_nonmanifold/meshes/bowtie"])
+def test_model_is_the_evaluators_surface(refdir, path):
+    """Limit positions and first derivatives of the model (its evaluator and its rows J) at points of every face
+    with a patch equal ``LimitSurface`` on the file's mesh (tags, holes, non-manifold edges and vertices) to
+    1e-12 of the diagonal; hole faces carry no patch."""
+    file = refdir / f"{path}.obj"
+    poly = read_mesh(file)
+    mesh, origin = read_control_mesh(file)
+    assert isinstance(mesh, TaggedQuadMesh) and origin is None  # all quads: control face f = ptex face f
+    model = DynamicSurface(mesh, levels=3)
+    kind = model.layout.face_kind
+    assert (kind == 3).any()
+    assert ((kind == 0) == mesh.hole).all()
+    faces = np.flatnonzero(kind > 0)
+    f, u, v = _points(faces.size, np.random.default_rng(7))
+    f = faces[f]
+    ref = LimitSurface(poly).evaluate(np.array([poly.ptex_of(x) for x in f]), u, v, 1)
+    got = model.evaluate(f, u, v, 1)
+    J = model.basis(f, u, v, 1)
+    tol = 1e-12 * poly.bounding_box_diagonal
+    corner = (u == 2.0**-40) & (v == 0.0)  # 2^-40 from a corner: the derivatives need depth 40
+    for k in ("P", "Pu", "Pv"):
+        assert np.abs(got[k] - ref[k]).max() <= tol, k
+        assert np.abs(J[k] @ mesh.vertices - ref[k]).max() <= tol, k
+    assert corner.any()
+
+
+def test_tagged_mass_converges_to_quadrature(refdir):
+    """x^T M x of the tagged elements of catmark_dart_edgeonly (a dart, a crease, boundaries and corners) for a
+    random scalar field x against the bilinear quadrature of the globally subdivided mesh (tagged steps, level
+    k): the error falls by about 4 per level (O(h^2)) and is below 1e-3 relative at k = 5."""
+    mesh, _ = read_control_mesh(refdir / "osd_features/meshes/catmark_dart_edgeonly.obj")
+    model = DynamicSurface(mesh, levels=2)
+    x = np.random.default_rng(3).random(mesh.n_vertices)
+    exact = float(x @ (model.assemble(1.0, 0.0) @ x))
+    Mb = np.array([[4, 2, 1, 2], [2, 4, 2, 1], [1, 2, 4, 2], [2, 1, 2, 4]]) / 36.0
+    m, X, errs = mesh, x, []
+    for k in range(1, 6):
+        S, _, _ = tagged_step(m, *tags_of(m))
+        X = S @ X
+        m = subdivide_control(m)
+        keep = ~np.repeat(mesh.hole, 4**k)
+        Q = X[m.faces[keep]]
+        errs.append(abs(4.0**-k * float(np.einsum("fi,ij,fj->", Q, Mb, Q)) - exact))
+    ratios = [errs[i] / errs[i + 1] for i in range(len(errs) - 1)]
+    assert all(3.0 < r < 5.0 for r in ratios[1:]), ratios
+    assert errs[-1] < 1e-3 * exact
+
+
+def test_refine_keeps_the_tagged_surface(refdir):
+    """One tagged step and a rebuild (DynamicSurface.refine) leave the limit surface unchanged (child 4 f + i at
+    corner i, half the parameter), and the child model is tagged too."""
+    mesh, _ = read_control_mesh(refdir / "osd_features/meshes/catmark_dart_edgeonly.obj")
+    model = DynamicSurface(mesh, levels=2)
+    fine, A = model.refine()
+    assert isinstance(fine.mesh, TaggedQuadMesh) and sp.issparse(A)
+    rng = np.random.default_rng(5)
+    s, t = rng.random(20), rng.random(20)
+    f = rng.integers(0, mesh.n_faces, 20)
+    P = model.evaluate(f, 0.5 * s, 0.5 * t)["P"]  # child 0 of face f: corner 0, same axes, half size
+    Q = fine.evaluate(4 * f, s, t)["P"]
+    assert np.abs(P - Q).max() <= 1e-12
