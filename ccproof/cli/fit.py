@@ -94,6 +94,8 @@ def run(args) -> int:
         if not Path(init).exists():
             raise CCProofError(f"--init: {init}: no such file (use 'cube' or a mesh file)")
         init, origin = read_control_mesh(init)
+        if getattr(init, "hole", np.zeros(1, dtype=bool)).all():
+            raise CCProofError(f"--init {args.init}: every face is a hole (no surface to fit)")
         if origin is not None:
             steps = getattr(init, "global_steps", 1)
             what = ("not all quads: subdivided once" if steps == 1 else

@@ -101,7 +101,7 @@ def test_tagged_mass_converges_to_quadrature(refdir):
         Q = X[m.faces[keep]]
         errs.append(abs(4.0**-k * float(np.einsum("fi,ij,fj->", Q, Mb, Q)) - exact))
     ratios = [errs[i] / errs[i + 1] for i in range(len(errs) - 1)]
-    assert all(3.0 < r < 5.0 for r in ratios[1:]), ratios
+    assert all(3.8 < r < 4.3 for r in ratios[1:]), ratios
     assert errs[-1] < 1e-3 * exact
 
 
@@ -118,3 +118,33 @@ def test_refine_keeps_the_tagged_surface(refdir):
     P = model.evaluate(f, 0.5 * s, 0.5 * t)["P"]  # child 0 of face f: corner 0, same axes, half size
     Q = fine.evaluate(4 * f, s, t)["P"]
     assert np.abs(P - Q).max() <= 1e-12
+
+
+@pytest.mark.parametrize("path,levels", [("osd_features/meshes/catmark_dart_edgeonly", 1),
+                                         ("osd_nonmanifold/meshes/book4", 0)])
+def test_cli_fit_on_a_tagged_start_mesh(refdir, tmp_path, capsys, path, levels):
+    """``ccproof fit --init TAGGED.obj`` runs to completion (a dart, creases and boundaries refined once; a
+    non-manifold book), reports finite errors and writes a control mesh that reads back with the same faces and
+    tags, its limit surface and the per-point errors."""
+    from ccproof.apps.dynamics.shapes import synthetic_range_data
+    from ccproof.cli import main
+
+    init = refdir / f"{path}.obj"
+    start, _ = read_control_mesh(init)
+    X = synthetic_range_data("ellipsoid", 200, seed=1) * 2.0
+    pts = tmp_path / "pts.xyz"
+    np.savetxt(pts, X)
+    out, errs = tmp_path / "fit.obj", tmp_path / "errors.csv"
+    rc = main(["fit", str(pts), "--init", str(init), "--levels", str(levels), "--max-steps", "3", "--out", str(out),
+               "--errors", str(errs), "--no-progress"])
+    cap = capsys.readouterr()
+    assert rc == 0, cap.err
+    back, _ = read_control_mesh(out)
+    assert isinstance(back, TaggedQuadMesh) and back.n_faces == start.n_faces * 4**levels
+    n_sharp = int((start.edge_sharpness > 0).sum()) * 2**levels
+    assert int((back.edge_sharpness > 0).sum()) == n_sharp
+    assert int((back.vertex_sharpness > 0).sum()) >= int((start.vertex_sharpness > 0).sum())
+    E = np.loadtxt(errs, delimiter=",", skiprows=1)
+    assert E.shape[0] == X.shape[0] and np.isfinite(E).all()
+    assert read_mesh(tmp_path / "fit_limit.obj").n_vertices > 0
+    assert "fit error" in cap.out
