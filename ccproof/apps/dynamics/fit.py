@@ -44,12 +44,12 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ccproof.apps.control_mesh import TaggedQuadMesh
 from ccproof.apps.dynamics.forces import ModelClosestPoints, Springs, check_points
 from ccproof.apps.dynamics.integrate import ImplicitIntegrator
 from ccproof.apps.dynamics.meshes import paper_initial_model
 from ccproof.apps.dynamics.model import DynamicSurface, Material
 from ccproof.errors import CCProofError
-from ccproof.apps.control_mesh import TaggedQuadMesh
 from ccproof.mesh import QuadMesh
 
 __all__ = [

@@ -381,7 +381,7 @@ class TaggedElement:
                 out["P"][at] = node.base[None, :]
                 todo &= ~at
         while True:
-            for depth, o, A, W, base in self.leaves:
+            for _, o, A, W, base in self.leaves:
                 if not todo.any():
                     return out
                 Ai = np.linalg.inv(A)
@@ -414,9 +414,7 @@ class TaggedElement:
                     out["P"][at] = node.base[None, :]
                     todo &= ~at
                 return out
-            n0 = len(self.leaves)
             self._grow(self._built + 1)
-            self._new = n0
 
 
 def tagged_layout(mesh):
