@@ -361,6 +361,9 @@ class DynamicSurface:
         increment, and the geometric estimate of the neglected tail (``inf`` when the rigidity
         series diverges, n >= 5). With ``P`` the same numbers are given as energies
         ``1/2 tr(P_e^T X P_e)`` of the element's ring.
+
+        Then one record per tagged element: ``{"face", "levels", "stiffness": {...}}`` with the same numbers for
+        its whole stiffness, the ratio measured between its last two depth increments (no closed form).
         """
         from ccproof.algebra.specialize import subdominant_eigenvalue
 
@@ -391,7 +394,7 @@ class DynamicSurface:
                 rec[group] = {"ratio": ratio, "truncated": a, "last_level": b, "tail_estimate": tail}
             out.append(rec)
         for el in self.tagged_elements():
-            K, last, ratio = el.truncation(self._tagged_coefficients(el.face))
+            K, last, ratio = el.truncation(self._tagged_coefficients(el.face), P)
             tail = last * ratio / (1 - ratio) if ratio < 1 else math.inf
             out.append({"face": el.face, "levels": self.levels,
                         "stiffness": {"ratio": ratio, "truncated": K, "last_level": last, "tail_estimate": tail}})

@@ -352,8 +352,9 @@ class TaggedElement:
             M += 4.0 ** (-node.depth) * np.outer(node.base, node.base)
         return M, K
 
-    def truncation(self, coefficients):
-        """``(norm of K(L), norm of its depth-L increment, ratio of the last two increments)``."""
+    def truncation(self, coefficients, P=None):
+        """``(K(L), its depth-L increment, ratio of the last two increments)`` as Frobenius norms, or with ``P``
+        (control points (n, 3) of the whole mesh) as energies ``1/2 tr(P_e^T X P_e)``."""
         incs = {}
         for depth, _, A, W, _ in self.leaves:
             if 1 <= depth <= self.levels:
@@ -363,9 +364,16 @@ class TaggedElement:
                 incs[depth] = incs.get(depth, 0.0) + X
         _, K = self.matrices(coefficients)
         L = self.levels
-        last = float(np.linalg.norm(incs.get(L, 0.0)))
-        prev = float(np.linalg.norm(incs.get(L - 1, 0.0)))
-        return float(np.linalg.norm(K)), last, (last / prev if prev > 0 else 0.0)
+        if P is None:
+            def size(X):
+                return float(np.linalg.norm(X))
+        else:
+            Pe = np.asarray(P, dtype=np.float64)[self.ids]
+
+            def size(X):
+                return 0.5 * float(np.sum(Pe * (np.asarray(X) @ Pe))) if np.ndim(X) else 0.0
+        last, prev = size(incs.get(L, 0.0)), size(incs.get(L - 1, 0.0))
+        return size(K), last, (last / prev if prev > 0 else 0.0)
 
     # ------------------------------------------------------------------ evaluation
     def rows(self, u, v, derivatives=0):

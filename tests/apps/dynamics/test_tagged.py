@@ -148,3 +148,17 @@ def test_cli_fit_on_a_tagged_start_mesh(refdir, tmp_path, capsys, path, levels):
     assert E.shape[0] == X.shape[0] and np.isfinite(E).all()
     assert read_mesh(tmp_path / "fit_limit.obj").n_vertices > 0
     assert "fit error" in cap.out
+
+
+def test_truncation_report_of_tagged_elements(refdir):
+    """Every tagged element has a record; its depth-L increment is the difference of the stiffness energies
+    truncated at L and L - 1 (two models), and the truncated energies are >= 0."""
+    mesh, _ = read_control_mesh(refdir / "osd_features/meshes/catmark_dart_edgeonly.obj")
+    P = np.asarray(mesh.vertices)
+    a = [r for r in DynamicSurface(mesh, levels=3).truncation_report(P) if "face" in r]
+    b = [r for r in DynamicSurface(mesh, levels=4).truncation_report(P) if "face" in r]
+    assert len(a) == len(b) == mesh.n_faces
+    for ra, rb in zip(a, b):
+        sa, sb = ra["stiffness"], rb["stiffness"]
+        assert sa["truncated"] >= 0 and sb["truncated"] >= 0
+        assert abs(sb["truncated"] - sa["truncated"] - sb["last_level"]) <= 1e-12 * max(sb["truncated"], 1e-300)
