@@ -207,7 +207,9 @@ class ModelClosestPoints:
         self.model = model
         self.faces = np.flatnonzero(model.layout.face_kind > 0)
         self.cells = closest_cells(self.faces.size) if cells is None else int(cells)
-        self.surface = LimitSurface(_evaluated_mesh(model.mesh))
+        evaluated = _evaluated_mesh(model.mesh)
+        self._tagged = evaluated is not model.mesh
+        self.surface = LimitSurface(evaluated)
 
     def query(self, P, X):
         """Nearest limit-surface points to X (m, 3) for the state P (n, 3).
@@ -225,7 +227,7 @@ class ModelClosestPoints:
         P = np.asarray(P, dtype=np.float64)
         if P.shape != (self.model.n_vertices, 3):
             raise CCProofError(f"control points must have shape ({self.model.n_vertices}, 3), got {P.shape}")
-        if self.surface.mesh is self.model.mesh:
+        if not self._tagged:
             S = self.surface.with_vertices(P)
         else:  # a tagged mesh: a PolyMesh surface, rebuilt for the state (its configurations are cached)
             S = LimitSurface(_evaluated_mesh(self.model.mesh.with_vertices(P)))
