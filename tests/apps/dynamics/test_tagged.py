@@ -60,7 +60,8 @@ def _points(nf, rng, k=8):
 def test_model_is_the_evaluators_surface(refdir, path):
     """Limit positions and first derivatives of the model (its evaluator and its rows J) at points of every face
     with a patch equal ``LimitSurface`` on the file's mesh (tags, holes, non-manifold edges and vertices) to
-    1e-12 of the diagonal; hole faces carry no patch."""
+    1e-12 of the diagonal (derivatives: of the larger of the diagonal and the gradient); hole faces carry no
+    patch."""
     file = refdir / f"{path}.obj"
     poly = read_mesh(file)
     mesh, origin = read_control_mesh(file)
@@ -75,11 +76,15 @@ def test_model_is_the_evaluators_surface(refdir, path):
     ref = LimitSurface(poly).evaluate(np.array([poly.ptex_of(x) for x in f]), u, v, 1)
     got = model.evaluate(f, u, v, 1)
     J = model.basis(f, u, v, 1)
-    tol = 1e-12 * poly.bounding_box_diagonal
+    # derivatives: relative to the gradient where it exceeds the diagonal (at some corners of
+    # catmark_cubes_infsharp it is unbounded: |Pu| = 2e4 at 2^-40 from one, where both evaluators round)
+    grad = np.linalg.norm(ref["Pu"], axis=1) + np.linalg.norm(ref["Pv"], axis=1)
+    diag = poly.bounding_box_diagonal
     corner = (u == 2.0**-40) & (v == 0.0)  # 2^-40 from a corner: the derivatives need depth 40
     for k in ("P", "Pu", "Pv"):
-        assert np.abs(got[k] - ref[k]).max() <= tol, k
-        assert np.abs(J[k] @ mesh.vertices - ref[k]).max() <= tol, k
+        tol = 1e-12 * (diag if k == "P" else np.maximum(diag, grad))
+        assert (np.abs(got[k] - ref[k]).max(axis=1) <= tol).all(), k
+        assert (np.abs(J[k] @ mesh.vertices - ref[k]).max(axis=1) <= tol).all(), k
     assert corner.any()
 
 
