@@ -167,3 +167,33 @@ def test_truncation_report_of_tagged_elements(refdir):
         sa, sb = ra["stiffness"], rb["stiffness"]
         assert sa["truncated"] >= 0 and sb["truncated"] >= 0
         assert abs(sb["truncated"] - sa["truncated"] - sb["last_level"]) <= 1e-12 * max(sb["truncated"], 1e-300)
+
+
+def test_model_on_a_tagged_mesh_with_triangles(refdir):
+    """catmark_pyramid_creases1 (triangles, creases, corners) is subdivided once by read_control_mesh; the model's
+    limit points equal ``LimitSurface`` on the file at the ptex coordinates of the quads (a quad's child k is the
+    corner-k quarter of its ptex face, a triangle's child k is ptex face ``ptex_start + k``) to 1e-12."""
+    file = refdir / "osd_features/meshes/catmark_pyramid_creases1.obj"
+    poly = read_mesh(file)
+    mesh, origin = read_control_mesh(file)
+    assert isinstance(mesh, TaggedQuadMesh) and origin is not None and mesh.global_steps == 1
+    model = DynamicSurface(mesh, levels=3)
+    C = np.array([(0, 0), (1, 0), (1, 1), (0, 1)], dtype=float)
+    rng = np.random.default_rng(2)
+    f = np.repeat(np.arange(mesh.n_faces), 6)
+    u, v = rng.random(f.size), rng.random(f.size)
+    offsets, sizes = np.asarray(poly.offsets), np.asarray(poly.sizes)
+    pt, pu, pv = [], [], []
+    for c, a, b in zip(f.tolist(), u, v):
+        g = int(origin[c])
+        k = c - int(offsets[g])
+        if sizes[g] == 4:
+            w = C[k] + (C[(k + 1) % 4] - C[k]) / 2 * a + (C[(k + 3) % 4] - C[k]) / 2 * b
+            pt.append(int(poly.ptex_start[g]))
+        else:
+            w = np.array([a, b])
+            pt.append(int(poly.ptex_start[g]) + k)
+        pu.append(w[0])
+        pv.append(w[1])
+    ref = LimitSurface(poly).evaluate(pt, pu, pv, 0)["P"]
+    assert np.abs(model.evaluate(f, u, v)["P"] - ref).max() <= 1e-12 * poly.bounding_box_diagonal
