@@ -115,7 +115,7 @@ CASES = [
     ("arap-semi-sharp-beyond-the-cap", "arap semisharp.obj --out a9.obj", "edge (1, 4) of sharpness 9.5", "a9.obj"),
     ("arap-control-out-tagged", "arap holes.obj --control-out a10.obj", "--control-out", "a10.obj"),
     ("fit-missing-points", "fit missing.xyz --out f1.obj", "missing.xyz", "f1.obj"),
-    ("fit-init-tagged", "fit points.xyz --init holes.obj --out f4.obj", "face 0 is a hole", "f4.obj"),
+    ("fit-init-every-face-a-hole", "fit points.xyz --init allholes.obj --out f4.obj", "allholes.obj", "f4.obj"),
     ("fit-out-suffix", "fit points.xyz --out f2.ply", "'.ply'", "f2.ply"),
     ("fit-errors-missing-folder", "fit points.xyz --out f3.obj --errors nodir/e.csv", "nodir", "f3.obj"),
     ("certify-valence-2", "certify 2 --no-verify --out c1", "got '2'", "c1"),

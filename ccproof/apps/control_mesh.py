@@ -157,7 +157,7 @@ class TaggedQuadMesh(QuadMesh):
 def refuse_tags(mesh, name):
     """Raise :class:`~ccproof.errors.MeshError` naming the first tag of a control mesh that still has some.
 
-    For the consumers that use the untagged rules only (the dynamic fit's elements). Vertex numbers are the
+    For a consumer that uses the untagged rules only (none of the commands now). Vertex numbers are the
     control mesh's (the file's without its unused vertices, when no step was taken).
 
     Examples

@@ -6,9 +6,10 @@
 
 POINTS: .xyz (x y z per line), .ply (vertex x, y, z; ASCII or binary), .obj or the vertices of any mesh
 file eval reads. --init: any mesh eval reads; triangles and n-gons are subdivided once (Catmull-Clark) to
-quads first (the same limit surface); unused vertices are dropped; a mesh whose surface needs OpenSubdiv
-tags (creases, corners, holes, boundary modes, non-manifold edges or vertices; `ccproof arap` takes them)
-is refused by name: the fit's elements use the untagged rules. The model
+quads first (the same limit surface); unused vertices are dropped; OpenSubdiv tags (infinitely sharp and
+semi-sharp creases and corners, holes, boundary modes) and non-manifold edges and vertices (infinitely
+sharp) are kept: faces near them are tagged elements whose surface is the one `ccproof eval` evaluates
+(hole faces carry no patch; the fitted OBJ keeps the tags as `t` lines). The model
 starts as the paper's 98-vertex mesh (the cube subdivided twice) inside the data, evolves under data
 springs (every point pulls its nearest limit-surface point) with the massless implicit scheme (32) to
 equilibrium (the relative changes of the total energy and of the mean data -> surface distance over two
@@ -35,8 +36,9 @@ def add_arguments(p):
     p.add_argument("points", help="point cloud: .xyz, .ply or .obj")
     p.add_argument("--out", required=True, help="write the fitted control mesh (OBJ) here")
     p.add_argument("--init", default="cube",
-                   help="'cube' (the paper's 98-vertex model, default) or a closed mesh (any format eval reads, "
-                        "without OpenSubdiv tags: refused by name; triangles and n-gons are subdivided once to quads)")
+                   help="'cube' (the paper's 98-vertex model, default) or a mesh (any format eval reads, with "
+                        "OpenSubdiv tags and non-manifold edges and vertices; triangles and n-gons are subdivided "
+                        "once to quads)")
     p.add_argument("--levels", type=int, default=1, help="global subdivisions after the first fit (default 1)")
     p.add_argument("--scheme", choices=("massless", "inertial"), default="massless",
                    help="time integrator: eq. (32) massless (default) or eq. (31)")
@@ -78,7 +80,7 @@ def run(args) -> int:
     check_outputs(args, out=(".obj",), surface_out="mesh", errors=(".csv",))  # before any work
     import numpy as np
 
-    from ccproof.apps.control_mesh import read_control_mesh, refuse_tags
+    from ccproof.apps.control_mesh import read_control_mesh
     from ccproof.apps.dynamics.fit import fit_points, read_points
     from ccproof.apps.dynamics.model import Material
     from ccproof.cli._notice import compile_notice
@@ -92,7 +94,8 @@ def run(args) -> int:
         if not Path(init).exists():
             raise CCProofError(f"--init: {init}: no such file (use 'cube' or a mesh file)")
         init, origin = read_control_mesh(init)
-        refuse_tags(init, f"--init {args.init}")
+        if getattr(init, "hole", np.zeros(1, dtype=bool)).all():
+            raise CCProofError(f"--init {args.init}: every face is a hole (no surface to fit)")
         if origin is not None:
             steps = getattr(init, "global_steps", 1)
             what = ("not all quads: subdivided once" if steps == 1 else

@@ -539,7 +539,9 @@ def read_obj(path: str | os.PathLike[str]) -> QuadMesh:
 def write_obj(path, mesh, *, comment=None):
     """Write a :class:`QuadMesh` (or ``(vertices, faces)``) as OBJ with 17 significant digits.
 
-    Reading the file back with :func:`read_obj` gives the same arrays bit for bit.
+    Reading the file back with :func:`read_obj` gives the same arrays bit for bit. A mesh with tags (the
+    applications' tagged control mesh: arrays ``edge_sharpness``, ``vertex_sharpness``, ``hole``) gets
+    OpenSubdiv's tag lines (``t crease``, ``t corner``, ``t hole``; infinite sharpness as 10).
 
     Parameters
     ----------
@@ -576,3 +578,23 @@ def write_obj(path, mesh, *, comment=None):
         fh.write(f"# {V.shape[0]} vertices, {F.shape[0]} faces\n")
         fh.writelines(f"v {x:.17g} {y:.17g} {z:.17g}\n" for x, y, z in V.tolist())
         fh.writelines("f " + " ".join(str(i + 1) for i in row) + "\n" for row in F.tolist())
+        fh.writelines(_tag_lines(mesh))
+
+
+def _tag_lines(mesh):
+    """OpenSubdiv tag lines of a mesh with ``edge_sharpness`` (over ``edges``), ``vertex_sharpness`` and ``hole``
+    arrays (a tagged control mesh of the applications); none for a plain mesh. Infinite sharpness is written 10."""
+    es = getattr(mesh, "edge_sharpness", None)
+    if not isinstance(es, np.ndarray):
+        return []
+    out = []
+    for e in np.flatnonzero(es > 0).tolist():
+        a, b = mesh.edges[e].tolist()
+        out.append(f"t crease 2/1/0 {a} {b} {min(float(es[e]), 10.0)!r}\n")
+    vs = mesh.vertex_sharpness
+    for v in np.flatnonzero(vs > 0).tolist():
+        out.append(f"t corner 1/1/0 {v} {min(float(vs[v]), 10.0)!r}\n")
+    holes = np.flatnonzero(mesh.hole).tolist()
+    if holes:
+        out.append(f"t hole {len(holes)}/0/0 " + " ".join(map(str, holes)) + "\n")
+    return out

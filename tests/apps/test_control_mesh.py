@@ -14,10 +14,10 @@ from ccproof.evaluate import natural_limit_surface
 from ccproof.mesh.io import read_mesh
 
 
-def test_nonmanifold_meshes_become_tagged_and_fit_refuses_them_by_name(refdir):
+def test_nonmanifold_meshes_become_tagged_and_refuse_tags_names_them(refdir):
     """A non-manifold edge or vertex is infinitely sharp (OpenSubdiv): the control mesh carries it as a tag,
-    its limit points at the file's vertices are the tagged evaluator's on the file, and the consumers of the
-    untagged rules (fit) refuse the tag by name."""
+    its limit points at the file's vertices are the tagged evaluator's on the file, and a consumer of the
+    untagged rules (refuse_tags) names the tag."""
     from ccproof.apps.control_mesh import TaggedQuadMesh, refuse_tags
     from ccproof.evaluate import LimitSurface
 

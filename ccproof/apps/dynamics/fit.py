@@ -44,6 +44,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ccproof.apps.control_mesh import TaggedQuadMesh
 from ccproof.apps.dynamics.forces import ModelClosestPoints, Springs, check_points
 from ccproof.apps.dynamics.integrate import ImplicitIntegrator
 from ccproof.apps.dynamics.meshes import paper_initial_model
@@ -383,7 +384,8 @@ def limit_surface_mesh(mesh, level):
 
     Parameters
     ----------
-    mesh : QuadMesh
+    mesh : QuadMesh or TaggedQuadMesh
+        A tagged mesh is subdivided with its tags and its hole faces are left out.
     level : int
 
     Returns
@@ -402,8 +404,18 @@ def limit_surface_mesh(mesh, level):
     >>> round(float(np.abs(limit_surface_mesh(cube(), 1).vertices).max()) * 81, 9)
     68.0
     """
-    from ccproof.mesh import limit_positions, subdivide
+    from ccproof.mesh import QuadMesh, limit_positions, subdivide
 
+    if isinstance(mesh, TaggedQuadMesh):  # tagged steps, exact limit masks with the tags; holes left out
+        from ccproof.apps.control_mesh import moving_limit_rows, subdivide_control
+
+        m = mesh
+        for _ in range(int(level)):
+            m = subdivide_control(m)
+        R = moving_limit_rows(m, np.arange(m.n_vertices), m.edge_sharpness, m.vertex_sharpness)
+        F = m.faces[~m.hole]
+        used, inv = np.unique(F, return_inverse=True)
+        return QuadMesh((R @ m.vertices)[used], inv.reshape(F.shape))
     m = mesh
     for _ in range(int(level)):
         m = subdivide(m)
@@ -705,7 +717,8 @@ def fit_points(X: ArrayLike, init: Literal["cube"] | QuadMesh = "cube", levels: 
         mesh0 = mesh0.with_vertices((np.asarray(mesh0.vertices) - centre) / diameter)
     from ccproof.apps.dynamics.elements import isolate_extraordinary
 
-    mesh0, _ = isolate_extraordinary(mesh0)
+    if not isinstance(mesh0, TaggedQuadMesh):  # tagged elements take any face (docs/qmv98.md)
+        mesh0, _ = isolate_extraordinary(mesh0)
     model = DynamicSurface(mesh0, material, levels=truncation)
     P = np.array(mesh0.vertices)
     k = np.full(pts.shape[0], spring_total / pts.shape[0])

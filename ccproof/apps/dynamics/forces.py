@@ -160,6 +160,21 @@ def closest_cells(n_faces, budget=25_000, most=8):
     return int(min(most, max(1, round(math.sqrt(budget / max(int(n_faces), 1))))))
 
 
+def _evaluated_mesh(mesh):
+    """The mesh :class:`~ccproof.evaluate.LimitSurface` evaluates for a control mesh: a tagged one as a
+    :class:`~ccproof.mesh.polymesh.PolyMesh` with its creases, corners and holes (all quads: ptex face = face)."""
+    from ccproof.apps.control_mesh import TaggedQuadMesh
+
+    if not isinstance(mesh, TaggedQuadMesh):
+        return mesh
+    from ccproof.mesh.polymesh import PolyMesh
+
+    e = np.flatnonzero(mesh.edge_sharpness > 0)
+    v = np.flatnonzero(mesh.vertex_sharpness > 0)
+    return PolyMesh(mesh.vertices, mesh.faces, creases=(mesh.edges[e], np.minimum(mesh.edge_sharpness[e], 10.0)),
+                    corners=(v, np.minimum(mesh.vertex_sharpness[v], 10.0)), holes=np.flatnonzero(mesh.hole))
+
+
 class ModelClosestPoints:
     """Globally nearest points of the limit surface of a model's state (module docstring).
 
@@ -192,7 +207,9 @@ class ModelClosestPoints:
         self.model = model
         self.faces = np.flatnonzero(model.layout.face_kind > 0)
         self.cells = closest_cells(self.faces.size) if cells is None else int(cells)
-        self.surface = LimitSurface(model.mesh)
+        evaluated = _evaluated_mesh(model.mesh)
+        self._tagged = evaluated is not model.mesh
+        self.surface = LimitSurface(evaluated)
 
     def query(self, P, X):
         """Nearest limit-surface points to X (m, 3) for the state P (n, 3).
@@ -203,13 +220,17 @@ class ModelClosestPoints:
         points : (m, 3) the limit-surface points
         dist : (m,) their distances to X
         """
+        from ccproof.evaluate import LimitSurface
         from ccproof.evaluate.closest import ClosestPointFinder
 
         X = check_points(X, "query points")
         P = np.asarray(P, dtype=np.float64)
         if P.shape != (self.model.n_vertices, 3):
             raise CCProofError(f"control points must have shape ({self.model.n_vertices}, 3), got {P.shape}")
-        S = self.surface.with_vertices(P)
+        if not self._tagged:
+            S = self.surface.with_vertices(P)
+        else:  # a tagged mesh: a PolyMesh surface, rebuilt for the state (its configurations are cached)
+            S = LimitSurface(_evaluated_mesh(self.model.mesh.with_vertices(P)))
         faces = None if self.faces.size == self.model.mesh.n_faces else self.faces
         r = ClosestPointFinder(S, cells=self.cells, faces=faces).query(X)
         return r.face, r.u, r.v, r.P, r.distance

@@ -172,7 +172,14 @@ class DynamicSurface:
         self.mesh = mesh
         self.material = material
         self.levels = int(levels)
-        self.layout = element_layout(mesh)
+        from ccproof.apps.control_mesh import TaggedQuadMesh
+        from ccproof.apps.dynamics.tagged import tagged_layout
+
+        if isinstance(mesh, TaggedQuadMesh):
+            self.layout, self.tagged_faces = tagged_layout(mesh)
+        else:
+            self.layout, self.tagged_faces = element_layout(mesh), np.zeros(0, dtype=np.int64)
+        self._tagged = None
         if face_swap is None:
             face_swap = np.zeros(mesh.n_faces, dtype=bool)
         face_swap = np.asarray(face_swap, dtype=bool)
@@ -180,7 +187,8 @@ class DynamicSurface:
             raise CCProofError(f"face_swap must have shape ({mesh.n_faces},), got {face_swap.shape}")
         self.face_swap = face_swap
         if self.layout.n_patch_faces == 0:
-            raise CCProofError("the mesh has no face with a limit patch (every face touches the boundary)")
+            raise CCProofError("the mesh has no face with a limit patch (every face touches the boundary or is a "
+                               "hole)")
         self._pattern = None
         self._special_cache = None
 
@@ -208,8 +216,26 @@ class DynamicSurface:
     def _normal_swap(self):
         return self.face_swap[self.layout.normal_faces]
 
+    def tagged_elements(self):
+        """The :class:`~ccproof.apps.dynamics.tagged.TaggedElement` of every tagged face (built once)."""
+        if self._tagged is None:
+            from ccproof.apps.control_mesh import tags_of
+            from ccproof.apps.dynamics.tagged import TaggedElement
+
+            es, vs = tags_of(self.mesh)
+            self._tagged = [TaggedElement(self.mesh, f, es, vs, self.levels) for f in self.tagged_faces.tolist()]
+        return self._tagged
+
+    def _tagged_coefficients(self, f):
+        return lambda swap: self.material.term_coefficients(swap=bool(swap) ^ bool(self.face_swap[f]))
+
     def special_element_matrices(self):
-        """Per special element: ``(ring, unit mass (exact), material stiffness (levels 1..L))``."""
+        """Per special element, then per tagged element: ``(control set, unit mass, material stiffness)``.
+
+        Special elements: the EV's two-ring, the mass exact (Stein), the stiffness of levels 1..L; tagged
+        elements (:mod:`ccproof.apps.dynamics.tagged`): the face's two-ring, the mass to rounding, the
+        stiffness to depth L.
+        """
         if self._special_cache is None:
             out = []
             lay = self.layout
@@ -224,6 +250,9 @@ class DynamicSurface:
                         if coef[t]:
                             K += coef[t] * sums[t][j]
                 out.append((lay.special_rings[e], S.mass_exact(), K))
+            for el in self.tagged_elements():
+                M, K = el.matrices(self._tagged_coefficients(el.face))
+                out.append((el.ids, M, K))
             self._special_cache = out
         return self._special_cache
 
@@ -234,7 +263,7 @@ class DynamicSurface:
             nets = lay.normal_nets
             r = [np.repeat(nets, 16, axis=1).reshape(-1)]
             c = [np.tile(nets, (1, 16)).reshape(-1)]
-            for ring in lay.special_rings:
+            for ring, _, _ in self.special_element_matrices():
                 r.append(np.repeat(ring, ring.size))
                 c.append(np.tile(ring, ring.size))
             self._pattern = (np.concatenate(r), np.concatenate(c))
@@ -332,6 +361,9 @@ class DynamicSurface:
         increment, and the geometric estimate of the neglected tail (``inf`` when the rigidity
         series diverges, n >= 5). With ``P`` the same numbers are given as energies
         ``1/2 tr(P_e^T X P_e)`` of the element's ring.
+
+        Then one record per tagged element: ``{"face", "levels", "stiffness": {...}}`` with the same numbers for
+        its whole stiffness, the ratio measured between its last two depth increments (no closed form).
         """
         from ccproof.algebra.specialize import subdominant_eigenvalue
 
@@ -361,6 +393,11 @@ class DynamicSurface:
                 tail = b * ratio / (1 - ratio) if ratio < 1 else math.inf
                 rec[group] = {"ratio": ratio, "truncated": a, "last_level": b, "tail_estimate": tail}
             out.append(rec)
+        for el in self.tagged_elements():
+            K, last, ratio = el.truncation(self._tagged_coefficients(el.face), P)
+            tail = last * ratio / (1 - ratio) if ratio < 1 else math.inf
+            out.append({"face": el.face, "levels": self.levels,
+                        "stiffness": {"ratio": ratio, "truncated": K, "last_level": last, "tail_estimate": tail}})
         return out
 
     # ------------------------------------------------------------------ evaluation
@@ -370,7 +407,7 @@ class DynamicSurface:
         kind = lay.face_kind[faces]
         if (kind == 0).any():
             f = int(faces[np.flatnonzero(kind == 0)[0]])
-            raise CCProofError(f"face {f} carries no limit patch (it touches the boundary)")
+            raise CCProofError(f"face {f} carries no limit patch (it touches the boundary or is a hole)")
         groups = []
         nrm = np.flatnonzero(kind == 1)
         if nrm.size:
@@ -379,6 +416,17 @@ class DynamicSurface:
         spc = np.flatnonzero(kind == 2)
         if spc.size:
             groups += self._special_rows(spc, faces[spc], u[spc], v[spc], derivatives)
+        groups += self._tagged_rows(np.flatnonzero(kind == 3), faces, u, v, derivatives)
+        return groups
+
+    def _tagged_rows(self, pts, faces, u, v, derivatives):
+        groups = []
+        els = self.tagged_elements()
+        el_of = self.layout.face_element[faces[pts]]
+        for e in np.unique(el_of).tolist():
+            g = pts[el_of == e]
+            rows = els[e].rows(u[g], v[g], derivatives)
+            groups.append((g, np.broadcast_to(els[e].ids, (g.size, els[e].ids.size)), rows))
         return groups
 
     def _special_locate(self, faces, u, v):
@@ -510,14 +558,18 @@ class DynamicSurface:
         A : scipy.sparse.csr_matrix
             The global subdivision matrix (``q = A p``, qmv98 section 2.5.1).
         """
+        from ccproof.apps.control_mesh import TaggedQuadMesh, subdivide_control, tagged_step
         from ccproof.mesh import subdivide, subdivision_matrix
 
         mesh = self.mesh if P is None else self.mesh.with_vertices(P)
-        A = subdivision_matrix(mesh)
+        if isinstance(mesh, TaggedQuadMesh):  # the tagged step, tags carried
+            A, step = tagged_step(mesh)[0], subdivide_control
+        else:
+            A, step = subdivision_matrix(mesh), subdivide
         mat = self.material.refined() if rescale else self.material
         # child 4 f + i of face f is rotated by i quarter turns (ccproof.mesh.subdivision)
         swap = np.repeat(self.face_swap, 4) ^ np.tile(np.array([False, True, False, True]), mesh.n_faces)
-        return DynamicSurface(subdivide(mesh), mat, self.levels, face_swap=swap), A
+        return DynamicSurface(step(mesh), mat, self.levels, face_swap=swap), A
 
 
 
@@ -602,7 +654,7 @@ class LimitEvaluator:
         kind = lay.face_kind[faces]
         if (kind == 0).any():
             f = int(faces[np.flatnonzero(kind == 0)[0]])
-            raise CCProofError(f"face {f} carries no limit patch (it touches the boundary)")
+            raise CCProofError(f"face {f} carries no limit patch (it touches the boundary or is a hole)")
         names = ["P"] + (["Pu", "Pv"] if derivatives >= 1 else []) + (["Puu", "Puv", "Pvv"] if derivatives >= 2 else [])
         out = {k: np.zeros((faces.size, 3)) for k in names}
         nrm = np.flatnonzero(kind == 1)
@@ -614,6 +666,10 @@ class LimitEvaluator:
         spc = np.flatnonzero(kind == 2)
         if spc.size:
             self._special(faces[spc], u[spc], v[spc], derivatives, out, spc)
+        for g, ids, rows in model._tagged_rows(np.flatnonzero(kind == 3), faces, u, v, derivatives):
+            Pe = self.P[ids[0]]
+            for k in names:
+                out[k][g] = rows[k] @ Pe
         return out
 
     def _special(self, faces, u, v, derivatives, out, pts):
