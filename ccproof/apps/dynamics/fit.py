@@ -409,13 +409,15 @@ def limit_surface_mesh(mesh, level):
     if isinstance(mesh, TaggedQuadMesh):  # tagged steps, exact limit masks with the tags; holes left out
         from ccproof.apps.control_mesh import moving_limit_rows, subdivide_control
 
-        m = mesh
+        t: QuadMesh = mesh
         for _ in range(int(level)):
-            m = subdivide_control(m)
-        R = moving_limit_rows(m, np.arange(m.n_vertices), m.edge_sharpness, m.vertex_sharpness)
-        F = m.faces[~m.hole]
+            t = subdivide_control(t)  # a TaggedQuadMesh stays one
+        if not isinstance(t, TaggedQuadMesh):  # pragma: no cover - subdivide_control keeps the type
+            raise TypeError("subdivide_control lost the tags")
+        R = moving_limit_rows(t, np.arange(t.n_vertices), t.edge_sharpness, t.vertex_sharpness)
+        F = t.faces[~t.hole]
         used, inv = np.unique(F, return_inverse=True)
-        return QuadMesh((R @ m.vertices)[used], inv.reshape(F.shape))
+        return QuadMesh((R @ t.vertices)[used], inv.reshape(F.shape))
     m = mesh
     for _ in range(int(level)):
         m = subdivide(m)
