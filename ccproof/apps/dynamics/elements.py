@@ -281,6 +281,31 @@ def _two_ring(mesh, ev):
     return np.r_[ev, ring], f, c
 
 
+def _special_elements(mesh, evs, kind, elem, sector, corner):
+    """The special elements of the extraordinary vertices ``evs``, marked in the face arrays (in place).
+
+    Face f of EV ``evs[e]``'s fan gets ``kind[f] = 2``, ``elem[f] = e``, its sector and the corner of the EV.
+
+    Returns
+    -------
+    dict
+        The ``special_*`` fields of :class:`ElementLayout`.
+    """
+    rings, sfaces, scorners = [], [], []
+    for e, ev in enumerate(evs):
+        ring, f, c = _two_ring(mesh, ev)
+        rings.append(ring)
+        sfaces.append(f)
+        scorners.append(c)
+        kind[f] = 2
+        elem[f] = e
+        sector[f] = np.arange(f.size)
+        corner[f] = c
+    return dict(special_ev=np.array(evs, dtype=np.int64),
+                special_valence=np.asarray(mesh.valence, dtype=np.int64)[np.array(evs, dtype=np.int64)],
+                special_rings=tuple(rings), special_faces=tuple(sfaces), special_corners=tuple(scorners))
+
+
 def element_layout(mesh):
     """Assign normal and special elements to the faces of ``mesh`` (module docstring).
 
@@ -328,32 +353,14 @@ def element_layout(mesh):
     elem[normal] = np.arange(normal.size)
     nets = _normal_nets(mesh, normal)
 
-    evs, vals, rings, sfaces, scorners, skipped = [], [], [], [], [], []
+    evs, skipped = [], []
     for ev in np.flatnonzero(is_ev):
-        corners = mesh.fan_corners[mesh.fan_ptr[ev] : mesh.fan_ptr[ev + 1]]
-        fan_faces = corners // 4
-        if not all_interior[fan_faces].all():
-            skipped.append(int(ev))
-            continue
-        ring, f, c = _two_ring(mesh, ev)
-        e = len(evs)
-        evs.append(int(ev))
-        vals.append(int(mesh.valence[ev]))
-        rings.append(ring)
-        sfaces.append(f)
-        scorners.append(c)
-        kind[f] = 2
-        elem[f] = e
-        sector[f] = np.arange(f.size)
-        corner[f] = c
+        fan_faces = mesh.fan_corners[mesh.fan_ptr[ev] : mesh.fan_ptr[ev + 1]] // 4
+        (evs if all_interior[fan_faces].all() else skipped).append(int(ev))
     lay = ElementLayout(
         normal_faces=normal,
         normal_nets=nets,
-        special_ev=np.array(evs, dtype=np.int64),
-        special_valence=np.array(vals, dtype=np.int64),
-        special_rings=tuple(rings),
-        special_faces=tuple(sfaces),
-        special_corners=tuple(scorners),
+        **_special_elements(mesh, evs, kind, elem, sector, corner),
         face_kind=kind,
         face_element=elem,
         face_sector=sector,

@@ -458,7 +458,7 @@ def tagged_layout(mesh):
     ([0, 1, 2, 3, 4, 5], [3, 3, 3, 3, 3, 3])
     """
     from ccproof.apps.control_mesh import tags_of, vertex_rules
-    from ccproof.apps.dynamics.elements import ElementLayout, _normal_nets, _two_ring
+    from ccproof.apps.dynamics.elements import ElementLayout, _normal_nets, _special_elements
 
     es, vs = tags_of(mesh)
     ns = vertex_rules(mesh, es, vs)[0]
@@ -475,28 +475,16 @@ def tagged_layout(mesh):
     normal = np.flatnonzero(regular[F].all(axis=1) & ~hole)
     kind[normal] = 1
     elem[normal] = np.arange(normal.size)
-    evs, vals, rings, sfaces, scorners = [], [], [], [], []
+    evs = []
     for ev in np.flatnonzero(smooth & (mesh.valence != 4)):
         fan = mesh.fan_corners[mesh.fan_ptr[ev]: mesh.fan_ptr[ev + 1]] // 4
         others = F[fan][F[fan] != ev]
-        if hole[fan].any() or not regular[others].all():
-            continue
-        ring, f, c = _two_ring(mesh, ev)
-        e = len(evs)
-        evs.append(int(ev))
-        vals.append(int(mesh.valence[ev]))
-        rings.append(ring)
-        sfaces.append(f)
-        scorners.append(c)
-        kind[f] = 2
-        elem[f] = e
-        sector[f] = np.arange(f.size)
-        corner[f] = c
+        if not hole[fan].any() and regular[others].all():
+            evs.append(int(ev))
+    specials = _special_elements(mesh, evs, kind, elem, sector, corner)
     tagged = np.flatnonzero(kind == 3)
     elem[tagged] = np.arange(tagged.size)
-    lay = ElementLayout(normal_faces=normal, normal_nets=_normal_nets(mesh, normal),
-                        special_ev=np.array(evs, dtype=np.int64), special_valence=np.array(vals, dtype=np.int64),
-                        special_rings=tuple(rings), special_faces=tuple(sfaces), special_corners=tuple(scorners),
+    lay = ElementLayout(normal_faces=normal, normal_nets=_normal_nets(mesh, normal), **specials,
                         face_kind=kind, face_element=elem, face_sector=sector, face_corner=corner,
                         skipped_ev=np.zeros(0, dtype=np.int64))
     return lay, tagged
