@@ -34,7 +34,7 @@ import numpy as np
 
 from ccproof.errors import MeshError
 from ccproof.mesh.quadmesh import _check_used_finite, connected_components
-from ccproof.mesh.rules import INFINITE, Complex, Options, refine_complex, to_float
+from ccproof.mesh.rules import INFINITE, Complex, Options, refine_complex
 
 __all__ = ["PolyMesh"]
 
@@ -567,6 +567,10 @@ class PolyMesh:
     def refine(self, operator=True):
         """One Catmull-Clark step with the tagged rules (layout of :mod:`ccproof.mesh.rules`).
 
+        The step is :func:`ccproof.mesh.step.catmark_operator` (vectorized; each weight the correctly
+        rounded value of :func:`~ccproof.mesh.rules.refine_complex`'s exact stencil, the reference of
+        ``tests/mesh/test_step.py`` and of ``subdivision_operator(exact=True)``).
+
         Parameters
         ----------
         operator : bool
@@ -577,9 +581,10 @@ class PolyMesh:
         PolyMesh
             All quads; child ``offsets[f] + k`` is corner k of face f; sharpness decayed; holes
             inherited by the children; the options kept (``EDGE_AND_CORNER`` corners carried as
-            infinite vertex sharpness).
+            infinite vertex sharpness). The vertex point of an unused vertex is NaN (it stays unused).
         S : scipy.sparse.csr_matrix, shape (n + E + m, n), or None
-            ``refined.vertices == S @ self.vertices``. On a non-manifold mesh, the step of
+            ``refined.vertices == S @ self.vertices`` (bit for bit: each row summed in increasing
+            columns); an unused vertex's row is NaN at column 0. On a non-manifold mesh, the step of
             :attr:`manifold` (n + E + m counted there; the columns are this mesh's vertices).
         """
         if self.manifold is not self:
@@ -587,22 +592,50 @@ class PolyMesh:
             if not operator:
                 return m, None
             return m, (S @ _expansion(self.manifold_vertex_map, self.n_vertices)).tocsr()
-        cx = self.complex()
-        stencils, children, ces, cvs = refine_complex(cx)
-        S = _stencil_matrix(stencils, self.n_vertices) if operator else None
-        V1 = _apply_stencils(stencils, np.asarray(self.vertices, dtype=np.float64))
-        holes = np.repeat(self.is_hole, self.sizes)
-        m = PolyMesh(V1, children, creases=(list(ces.keys()), list(ces.values())) if ces else None,
-                     corners=cvs or None, holes=np.flatnonzero(holes), options=self.options)
+        from ccproof.mesh.step import _decrement, apply_csr
+
+        st = self._step(sparse=False)
+        n = self.n_vertices
+        unused = np.flatnonzero(self.is_unused_vertex)
+        V1 = apply_csr(st.csr, self.vertices)
+        V1[unused] = np.nan
+        # child vertex sharpness: the step's (used vertices), and an unused vertex's tag decayed
+        cvs = np.zeros(n)
+        cvs[st.child_corners[0]] = st.child_corners[1]
+        if unused.size and self.vertex_sharpness:
+            vs = np.array([self.vertex_sharpness.get(v, 0.0) for v in unused.tolist()])
+            cvs[unused] = _decrement(vs)
+        sharp_v = np.flatnonzero(cvs > 0)
+        pairs, ces = st.child_creases
+        m = PolyMesh(V1, st.faces, creases=(pairs, ces) if ces.size else None,
+                     corners=(sharp_v, cvs[sharp_v]) if sharp_v.size else None,
+                     holes=np.flatnonzero(st.child_holes), options=self.options)
         m.level = self.level + 1
+        S = _with_unused_rows(st.csr, unused, n) if operator else None
         return m, S
+
+    def _step(self, **kwargs):
+        """:func:`ccproof.mesh.step.catmark_operator` of this manifold mesh with its tags (keyword
+        arguments passed on), edges numbered as :class:`~ccproof.mesh.rules.Complex` numbers them."""
+        from ccproof.mesh.step import catmark_operator
+
+        return catmark_operator(self.n_vertices, self.indices, self.sizes, edge_sharpness=self.edge_sharpness,
+                                vertex_sharpness=self.vertex_sharpness, options=self.options, level=self.level,
+                                holes=self.is_hole, **kwargs)
 
     def subdivision_operator(self, exact=False):
         """The linear operator S of one step: ``refine()[0].vertices == S @ vertices``.
 
-        ``exact=True``: a list of dict rows with exact rational weights (``flint.fmpq``: the
-        same stencils the float matrix is rounded from).
+        ``exact=False``: the float matrix of :func:`ccproof.mesh.step.catmark_operator`, every weight
+        the correctly rounded exact one (on a non-manifold mesh the copies of a vertex summed exactly
+        before rounding); an unused vertex's row is NaN at column 0. ``exact=True``: a list of dict
+        rows with exact rational weights (``flint.fmpq``: :func:`~ccproof.mesh.rules.refine_complex`'s
+        stencils, the reference the float matrix is checked against; None for an unused vertex).
         """
+        if not exact:
+            M = self.manifold
+            st = M._step(columns=self.manifold_vertex_map, n_columns=self.n_vertices, sparse=False)
+            return _with_unused_rows(st.csr, np.flatnonzero(M.is_unused_vertex), self.n_vertices)
         stencils, _, _, _ = refine_complex(self.complex())
         if self.manifold is not self:
             vmap = self.manifold_vertex_map.tolist()
@@ -616,9 +649,7 @@ class PolyMesh:
                     d[vmap[c]] = d.get(vmap[c], 0) + w
                 out.append(d)
             stencils = out
-        if exact:
-            return stencils
-        return _stencil_matrix(stencils, self.n_vertices)
+        return stencils
 
     def __repr__(self):
         extra = ""
@@ -640,44 +671,17 @@ def _expansion(vmap, n):
     return sp.csr_matrix((np.ones(k), (np.arange(k), np.asarray(vmap))), shape=(k, n))
 
 
-def _apply_stencils(stencils, X):
-    """``S @ X`` for the float matrix S of :func:`_stencil_matrix`, without building it: each row summed
-    over its columns in increasing order, from 0, as the CSR product does (the same bits)."""
-    n = len(stencils)
-    width = max((len(s) for s in stencils if s is not None), default=0)
-    cols = np.zeros((n, max(width, 1)), dtype=np.int64)
-    vals = np.zeros((n, max(width, 1)))
-    size = np.zeros(n, dtype=np.int64)
-    bad = []
-    for r, s in enumerate(stencils):
-        if s is None:
-            bad.append(r)
-            continue
-        items = sorted(s.items())
-        size[r] = len(items)
-        cols[r, :len(items)] = [c for c, _ in items]
-        vals[r, :len(items)] = [to_float(w) for _, w in items]
-    out = np.zeros((n, X.shape[1]))
-    for k in range(width):  # only the rows' own columns: an unused vertex may hold NaN
-        rows = np.flatnonzero(size > k)
-        out[rows] += vals[rows, k, None] * X[cols[rows, k]]
-    out[bad] = np.nan
-    return out
-
-
-def _stencil_matrix(stencils, ncols):
-    """Float CSR matrix of a list of stencils (dict column -> weight; None rows are NaN)."""
-    rows, cols, vals = [], [], []
-    for r, s in enumerate(stencils):
-        if s is None:
-            rows.append(r)
-            cols.append(0)
-            vals.append(np.nan)
-            continue
-        for c, w in s.items():
-            rows.append(r)
-            cols.append(c)
-            vals.append(to_float(w))
+def _with_unused_rows(csr, unused, ncols):
+    """The scipy CSR matrix of the CSR arrays ``csr`` with NaN at column 0 of the (empty) rows ``unused``
+    (an unused vertex has no vertex point)."""
     import scipy.sparse as sp
 
-    return sp.csr_matrix((vals, (rows, cols)), shape=(len(stencils), ncols))
+    indptr, indices, data = csr
+    N = indptr.size - 1
+    if unused.size:  # empty rows: the NaN entries go after the entries of the rows before them
+        rows = np.r_[np.repeat(np.arange(N), np.diff(indptr)), unused]
+        o = np.argsort(rows, kind="stable")
+        indices = np.r_[indices, np.zeros(unused.size, dtype=np.int64)][o]
+        data = np.r_[data, np.full(unused.size, np.nan)][o]
+        indptr = np.r_[0, np.cumsum(np.bincount(rows, minlength=N))]
+    return sp.csr_matrix((data, indices, indptr), shape=(N, ncols))

@@ -31,7 +31,9 @@ or a float32 fractional weight or sharpness, times a rule's rational weight) are
 common denominator ``R`` (``8 k^2 lcm(face sizes)`` at a vertex of valence k, ``4 lcm(s0, s1)`` at an
 edge, ``s`` at a face), which makes each an integer times a dyadic, summed exactly in float64, and
 divided by ``R`` once. That holds while ``R`` times the float32 coefficients' 2^24 stays below 2^53
-(every real valence and face size); ``TRI_SUB_SMOOTH``'s 0.47 enters as a float weight.
+(every real valence and face size). ``TRI_SUB_SMOOTH``'s 0.47 (a float64 weight) times a float32 midpoint
+weight needs more bits: those edge points' weights are computed in rationals, once per distinct midpoint
+weight and pair of face sizes, and rounded once (:func:`_tri_smooth_rows`).
 """
 
 from __future__ import annotations
@@ -50,7 +52,7 @@ from ccproof.rule_weights import (
     smooth_vertex_weights,
 )
 
-__all__ = ["catmark_operator", "Step"]
+__all__ = ["catmark_operator", "Step", "apply_csr"]
 
 #: OpenSubdiv's Sdc::Crease::SHARPNESS_INFINITE
 INFINITE = 10.0
@@ -74,6 +76,9 @@ class Step(NamedTuple):
     child_corners : (ndarray of int64, shape (j,), ndarray of float64, shape (j,))
         Sharp child vertices and their sharpness.
     child_holes : ndarray of bool, shape (H,)
+    csr : (ndarray of int64, shape (N + 1,), ndarray of int64, shape (nnz,), ndarray of float64, shape (nnz,))
+        ``S`` as CSR arrays ``(indptr, indices, data)`` (N = n + E + m rows, increasing columns in each
+        row, no zero): what ``S`` wraps, and the operator without scipy (:func:`apply_csr`).
     """
 
     S: object
@@ -82,6 +87,7 @@ class Step(NamedTuple):
     child_creases: tuple
     child_corners: tuple
     child_holes: np.ndarray
+    csr: tuple
 
 
 def _decrement(s):
@@ -104,6 +110,113 @@ def _f32_sums(seg, val, n):
     return total, count
 
 
+def _csr(rows, cols, vals, R, ncols):
+    """CSR arrays ``(indptr, indices, data)`` of the terms ``vals`` at ``(rows, cols)``: the terms of an
+    entry summed (exactly: integers times dyadics), divided by the row's common denominator ``R[row]``
+    once, zeros dropped; columns increasing in each row."""
+    N = R.size
+    key = rows * max(ncols, 1) + cols
+    order = np.argsort(key, kind="stable")
+    key = key[order]
+    start = np.flatnonzero(np.r_[True, key[1:] != key[:-1]]) if key.size else np.zeros(0, dtype=np.int64)
+    data = np.add.reduceat(vals[order], start) if key.size else np.zeros(0)
+    r = key[start] // max(ncols, 1)
+    data = data / R[r]
+    keep = data != 0
+    r, data = r[keep], data[keep]
+    indptr = np.r_[0, np.cumsum(np.bincount(r, minlength=N))].astype(np.int64)
+    return indptr, (key[start] % max(ncols, 1))[keep].astype(np.int64), data
+
+
+def _tri_smooth_rows(te, n, a, b, h1, h2, pw, face, sz, off, pos, idx, columns):
+    """The rows of the ``TRI_SUB_SMOOTH`` edge points ``te`` as final, correctly rounded weights.
+
+    Their face weight ``(w0 + w1) / 2`` (``w = 0.47`` at a triangle, a float64 weight: 2^-54 granular)
+    with a float32 midpoint weight ``pw`` needs more bits than the integer scaling holds: each entry's
+    exact value is a sum ``c0 * end + c1 * rest1 + c2 * rest2`` of the row's three exact weights (an end,
+    any other vertex of the first face, of the second; c counts the terms a column gathers: copies of a
+    vertex merged by ``columns``), computed in rationals once per distinct (pw, face sizes, counts) and
+    rounded once.
+
+    Returns
+    -------
+    rows, cols : ndarray of int64, shape (k,)
+    vals : ndarray of float64, shape (k,)
+    """
+    one = Fraction(1)
+    half = sharp_edge_weight(one)
+    vw0, fw0 = smooth_edge_weights(one)
+    s1, s2 = sz[face[h1[te]]], sz[face[h2[te]]]
+    combo, cinv = np.unique(np.stack([pw[te], s1, s2], axis=1), axis=0, return_inverse=True)
+    cinv = cinv.reshape(-1)
+    # terms: (edge position, column, kind 0 end / 1 first face / 2 second face)
+    t_e, t_c, t_k = [np.arange(te.size)] * 2, [a[te], b[te]], [np.zeros(te.size, dtype=np.int64)] * 2
+    for kind, h in ((1, h1[te]), (2, h2[te])):
+        f = face[h]
+        for j in range(2, int(sz[f].max())):
+            sel = np.flatnonzero(sz[f] > j)
+            t_e.append(sel)
+            t_c.append(idx[off[f[sel]] + (pos[h[sel]] + j) % sz[f[sel]]])
+            t_k.append(np.full(sel.size, kind, dtype=np.int64))
+    t_e, t_c, t_k = (np.concatenate(x) for x in (t_e, t_c, t_k))
+    if columns is not None:
+        t_c = np.asarray(columns, dtype=np.int64)[t_c]
+    ncol = int(t_c.max()) + 1
+    key = t_e * ncol + t_c
+    ukey, ginv = np.unique(key, return_inverse=True)
+    ginv = ginv.reshape(-1)
+    counts = np.zeros((ukey.size, 3), dtype=np.int64)
+    np.add.at(counts, (ginv, t_k), 1)
+    ge = ukey // ncol
+    spec, sinv = np.unique(np.c_[cinv[ge], counts], axis=0, return_inverse=True)
+    tri_w = Fraction(0.470)
+    w = []
+    for ci, c0, c1, c2 in spec.tolist():
+        p, x1, x2 = combo[ci]
+        P = Fraction(float(p))
+        fw = sum((tri_w if x == 3 else fw0) for x in (x1, x2)) / 2
+        vw = (1 - 2 * fw) / 2
+        rest1 = (1 - P) * fw * face_point_weight(int(x1), one)
+        rest2 = (1 - P) * fw * face_point_weight(int(x2), one)
+        end = P * half + (1 - P) * vw + rest1 + rest2
+        w.append(float(c0 * end + c1 * rest1 + c2 * rest2))
+    return n + te[ge], ukey % ncol, np.asarray(w, dtype=np.float64)[sinv.reshape(-1)]
+
+
+def apply_csr(csr, X, out=None):
+    """``S @ X`` for ``S`` given as CSR arrays (:attr:`Step.csr`), summed as scipy's sparse product does.
+
+    Each row is summed over its stored entries in order (increasing columns), from 0: the bits of
+    ``S @ X``, without scipy; only the stored entries' rows of ``X`` are read (an unused vertex may
+    hold NaN).
+
+    Parameters
+    ----------
+    csr : (indptr (N + 1,), indices (nnz,), data (nnz,))
+    X : ndarray, shape (n_columns, d)
+    out : ndarray, shape (N, d), optional
+        Written into (zeroed first).
+
+    Returns
+    -------
+    ndarray of float64, shape (N, d)
+    """
+    indptr, indices, data = csr
+    X = np.asarray(X, dtype=np.float64)
+    N = indptr.size - 1
+    size = np.diff(indptr)
+    if out is None:
+        out = np.zeros((N, X.shape[1]))
+    else:
+        out[...] = 0.0
+    rows = np.flatnonzero(size > 0)
+    for k in range(int(size.max()) if N else 0):
+        rows = rows[size[rows] > k]
+        j = indptr[rows] + k
+        out[rows] += data[j, None] * X[indices[j]]
+    return out
+
+
 def _ratios(rule, x):
     """``(numerators, denominators)``, int64 arrays like ``x``, of the exact rule weight ``rule(x_i)``."""
     x = np.asarray(x, dtype=np.int64)
@@ -115,7 +228,7 @@ def _ratios(rule, x):
 
 
 def catmark_operator(n, indices, sizes, *, edge_of_halfedge=None, edge_sharpness=None, vertex_sharpness=None,
-                     options=None, level=0, holes=None):
+                     options=None, level=0, holes=None, columns=None, n_columns=None, sparse=True):
     """One Catmull-Clark step of a tagged manifold polygon mesh, as a sparse operator (module docstring).
 
     Parameters
@@ -137,11 +250,19 @@ def catmark_operator(n, indices, sizes, *, edge_of_halfedge=None, edge_sharpness
     level : int
         The level of the mesh (``TRI_SUB_SMOOTH`` and ``EDGE_AND_CORNER`` act at level 0).
     holes : array_like of bool, shape (m,), optional
+    columns : array_like of int, shape (n,), optional
+        The column of every vertex (default: its index): vertices sharing a column have their terms
+        summed exactly, before the one division (the copies of a split non-manifold vertex:
+        :meth:`ccproof.mesh.polymesh.PolyMesh.subdivision_operator`).
+    n_columns : int, optional
+        Number of columns (default: ``max(columns) + 1``, or n).
+    sparse : bool
+        Build ``S`` (scipy); False: ``S`` is None and scipy is not imported (``csr`` holds the operator).
 
     Returns
     -------
     Step
-        ``S`` (n + E + m, n), the child faces, the edges, the child tags and holes.
+        ``S`` (n + E + m, n_columns) and its arrays, the child faces, the edges, the child tags and holes.
 
     Notes
     -----
@@ -164,8 +285,6 @@ def catmark_operator(n, indices, sizes, *, edge_of_halfedge=None, edge_sharpness
     >>> st.S[6 + e].toarray()[0].tolist(), len(st.child_creases[1]), 2 * (len(st.edges) - 1)
     ([0.03125, 0.4375, 0.03125, 0.03125, 0.4375, 0.03125], 12, 12)
     """
-    import scipy.sparse as sp
-
     from ccproof.mesh.rules import Options
 
     opts = Options() if options is None else options
@@ -353,6 +472,7 @@ def catmark_operator(n, indices, sizes, *, edge_of_halfedge=None, edge_sharpness
     wcv, wcn = crease_vertex_weights(one)
     half = sharp_edge_weight(one)
     vw0, fw0 = smooth_edge_weights(one)
+    ncols = (n if columns is None else int(np.max(columns, initial=-1)) + 1) if n_columns is None else int(n_columns)
     # the common denominator of every row: a face's; at a vertex, of its smooth, crease and corner
     # weights; at an edge, of the midpoint's and the smooth rule's
     lf = np.ones(n, dtype=np.int64)
@@ -405,30 +525,20 @@ def catmark_operator(n, indices, sizes, *, edge_of_halfedge=None, edge_sharpness
         both = _decrement(es) > 0
     mid = (es > 0) & (bnd_e | both)
     pw = np.where(mid, 1.0, np.where(es > 0, es.astype(_F32).astype(np.float64), 0.0))  # weight of the midpoint
-    ms = np.flatnonzero(pw != 0)
+    tri_e = np.zeros(E, dtype=bool)  # TRI_SUB_SMOOTH's edges (level 0, a triangle on a side), not both sharp
+    if opts.triangle_subdivision == "smooth" and level == 0 and two.any():
+        tri_e[two] = ((sz[face[h1[two]]] == 3) | (sz[face[h2[two]]] == 3)) & (pw[two] != 1.0)
+    ms = np.flatnonzero((pw != 0) & ~tri_e)
     for end in (a, b):
         add(er[ms], end[ms], pw[ms], half.numerator, half.denominator)
-    smooth_e = np.flatnonzero((pw != 1.0) & two)
+    smooth_e = np.flatnonzero((pw != 1.0) & two & ~tri_e)
     if smooth_e.size:
         f1, f2 = face[h1[smooth_e]], face[h2[smooth_e]]
         q = 1.0 - pw[smooth_e]  # exact: pw is a float32 value in [0, 1]
-        cv_e = q.copy()
-        cf_e = q.copy()
-        t_v, d_v, t_f, d_f = vw0.numerator, vw0.denominator, fw0.numerator, fw0.denominator
-        tri = np.zeros(smooth_e.size, dtype=bool)
-        if opts.triangle_subdivision == "smooth" and level == 0:
-            tri = (sz[f1] == 3) | (sz[f2] == 3)
-        t_v, d_v, t_f, d_f = (np.where(tri, 1, x) for x in (t_v, d_v, t_f, d_f))
-        if tri.any():  # TRI_SUB_SMOOTH: face weight (w0 + w1) / 2, w = 0.47 at a triangle (a float weight)
-            w0 = np.where(sz[f1[tri]] == 3, 0.470, float(fw0))
-            w1 = np.where(sz[f2[tri]] == 3, 0.470, float(fw0))
-            fw = (w0 + w1) / 2
-            cv_e[tri] = q[tri] * (1 - 2 * fw) / 2
-            cf_e[tri] = q[tri] * fw
         r = er[smooth_e]
-        x1 = scaled(r, cf_e, t_f * face_t[f1], d_f * face_d[f1])  # each vertex of the faces
-        x2 = scaled(r, cf_e, t_f * face_t[f2], d_f * face_d[f2])
-        xend = scaled(r, cv_e, t_v, d_v) + x1 + x2  # the ends are in both faces
+        x1 = scaled(r, q, fw0.numerator * face_t[f1], fw0.denominator * face_d[f1])  # each vertex of the faces
+        x2 = scaled(r, q, fw0.numerator * face_t[f2], fw0.denominator * face_d[f2])
+        xend = scaled(r, q, vw0.numerator, vw0.denominator) + x1 + x2  # the ends are in both faces
         for end in (a, b):
             rows.append(r)
             cols.append(end[smooth_e])
@@ -436,13 +546,22 @@ def catmark_operator(n, indices, sizes, *, edge_of_halfedge=None, edge_sharpness
         add_face_rest(r, h1[smooth_e], x1)
         add_face_rest(r, h2[smooth_e], x2)
     rows, cols, vals = (np.concatenate(x) for x in (rows, cols, vals))
-    S = sp.coo_matrix((vals, (rows, cols)), shape=(n + E + m, n)).tocsr()  # sums the terms, exactly
-    S.data /= R[np.repeat(np.arange(n + E + m), np.diff(S.indptr))]
-    S.eliminate_zeros()
+    if columns is not None:
+        cols = np.asarray(columns, dtype=np.int64)[cols]
+    if tri_e.any():  # final weights: these rows are not divided
+        tr, tc, tv = _tri_smooth_rows(np.flatnonzero(tri_e), n, a, b, h1, h2, pw, face, sz, off, pos, idx, columns)
+        rows, cols, vals = np.r_[rows, tr], np.r_[cols, tc], np.r_[vals, tv]
+        R[n + np.flatnonzero(tri_e)] = 1
+    csr = _csr(rows, cols, vals, R, ncols)
+    S = None
+    if sparse:
+        import scipy.sparse as sp
+
+        S = sp.csr_matrix((csr[2], csr[1], csr[0]), shape=(n + E + m, ncols))
     faces = np.stack([org, n + he_edge, n + E + face, n + he_edge[prv]], axis=1)
     keep = ce > 0
     child_creases = (np.stack([inc_v[keep], n + inc_e[keep]], axis=1).reshape(-1, 2), ce[keep])
     cvs = np.where(k > 0, cv, 0.0)
     sharp_v = np.flatnonzero(cvs > 0)
     child_holes = np.zeros(H, dtype=bool) if holes is None else np.repeat(np.asarray(holes, dtype=bool), sz)
-    return Step(S, faces, np.stack([a, b], axis=1), child_creases, (sharp_v, cvs[sharp_v]), child_holes)
+    return Step(S, faces, np.stack([a, b], axis=1), child_creases, (sharp_v, cvs[sharp_v]), child_holes, csr)

@@ -4,8 +4,12 @@ refine_complex states every Sdc rule as exact rationals, one vertex and one edge
 python-flint); catmark_operator assembles them over the whole mesh with numpy in floats. On every mesh of
 tests/data/osd_features and tests/data/osd_nonmanifold (creases, corners, semi-sharp and Chaikin tags,
 boundary modes, triangle rules, holes, n-gons, non-manifold splits), at levels 0, 1 and 2 (each level the
-exact PolyMesh.refine of the one before): the same child faces, the same child tags, and every row equal, bit for bit,
+PolyMesh.refine of the one before): the same child faces, the same child tags, and every row equal, bit for bit,
 to the correctly rounded exact stencil.
+
+PolyMesh.refine and PolyMesh.subdivision_operator are that step: against the child mesh built from the
+exact stencils (each row rounded, then summed in increasing columns from 0; the children and tags of
+refine_complex; unused vertices NaN), the same vertices bit for bit, faces, tags, holes, options and level.
 """
 
 import math
@@ -14,6 +18,7 @@ import numpy as np
 import pytest
 
 from ccproof.mesh.io import read_mesh
+from ccproof.mesh.polymesh import PolyMesh
 from ccproof.mesh.rules import refine_complex, to_float
 from ccproof.mesh.step import catmark_operator
 
@@ -56,16 +61,122 @@ def _check_level(pm):
     got_cvs = dict(zip(st.child_corners[0].tolist(), st.child_corners[1].tolist()))
     assert got_cvs == {v: s for v, s in cvs.items() if cx.corners[v]}
     assert np.array_equal(st.child_holes, np.repeat(pm.is_hole, pm.sizes))
+    _check_refine(pm, stencils, children, ces, cvs)
     return checked
+
+
+def _rounded_rows(stencils):
+    """The exact stencils rounded: per row, the sorted columns and their float weights (None: unused)."""
+    return [None if st is None else sorted((c, to_float(w)) for c, w in st.items()) for st in stencils]
+
+
+def _reference_child(pm, stencils, children, ces, cvs):
+    """The child mesh from refine_complex's output: each new vertex the sum, in increasing columns from 0,
+    of the rounded weights times the parent's vertices (NaN for an unused vertex)."""
+    X = np.asarray(pm.vertices)
+    V1 = np.zeros((len(stencils), 3))
+    for r, row in enumerate(_rounded_rows(stencils)):
+        if row is None:
+            V1[r] = np.nan
+            continue
+        acc = np.zeros(3)
+        for c, w in row:
+            acc = acc + w * X[c]
+        V1[r] = acc
+    ref = PolyMesh(V1, children, creases=(list(ces), list(ces.values())) if ces else None, corners=cvs or None,
+                   holes=np.flatnonzero(np.repeat(pm.is_hole, pm.sizes)), options=pm.options)
+    ref.level = pm.level + 1
+    return ref
+
+
+def _same_matrix(S, rows):
+    """``S`` (scipy) holds exactly ``rows`` (:func:`_rounded_rows`; NaN at column 0 for None), bit for bit."""
+    S = S.tocsr()
+    assert S.shape[0] == len(rows)
+    for r, want in enumerate(rows):
+        a, b = S.indptr[r], S.indptr[r + 1]
+        got = list(zip(S.indices[a:b].tolist(), S.data[a:b].tolist()))
+        if want is None:
+            assert len(got) == 1 and got[0][0] == 0 and math.isnan(got[0][1]), (r, got)
+            continue
+        assert got == [(c, w) for c, w in want if w != 0], (r, got, want)
+
+
+def _check_refine(pm, stencils, children, ces, cvs):
+    """PolyMesh.refine (with and without the operator) against the reference child, bit for bit."""
+    ref = _reference_child(pm, stencils, children, ces, cvs)
+    m1, S = pm.refine()
+    m2, none = pm.refine(operator=False)
+    assert none is None
+    for m in (m1, m2):
+        assert m.vertices.tobytes() == ref.vertices.tobytes()
+        assert np.array_equal(m.indices, ref.indices) and np.array_equal(m.sizes, ref.sizes)
+        assert list(m.edge_sharpness.items()) == list(ref.edge_sharpness.items())  # the same order, too
+        assert list(m.vertex_sharpness.items()) == list(ref.vertex_sharpness.items())
+        assert np.array_equal(m.is_hole, ref.is_hole) and np.array_equal(m.is_hole_tagged, ref.is_hole_tagged)
+        assert m.options == ref.options and m.level == ref.level
+    rows = _rounded_rows(stencils)
+    _same_matrix(S, rows)
+    _same_matrix(pm.subdivision_operator(), rows)
+    used = ~m1.is_unused_vertex
+    assert (S @ np.nan_to_num(pm.vertices))[used].tobytes() == m1.vertices[used].tobytes()
 
 
 @pytest.mark.parametrize("folder,name", CASES)
 def test_rows_equal_the_exact_stencils(refdir, folder, name):
-    pm = read_mesh(refdir / folder / "meshes" / name).manifold
+    mesh = read_mesh(refdir / folder / "meshes" / name)
+    if not mesh.is_manifold:  # the operator on the input's vertices: a vertex's copies merged exactly
+        exact = mesh.subdivision_operator(exact=True)
+        _same_matrix(mesh.subdivision_operator(), [None if r is None else sorted((c, to_float(w)) for c, w in r.items())
+                                                   for r in exact])
+    pm = mesh.manifold
     for _ in range(3):
         assert _check_level(pm) > 0
         if pm.n_faces > 2000:
             break
+        pm, _ = pm.refine(operator=False)
+
+
+@pytest.mark.parametrize("options", [
+    {"boundary": "edge_and_corner", "triangle_subdivision": "smooth"},
+    {"boundary": "none", "crease_method": "chaikin", "triangle_subdivision": "smooth"},
+    {"crease_method": "chaikin"},
+])
+def test_refine_with_an_unused_tagged_vertex(options):
+    """An unused vertex holding NaN and a sharpness tag (the step skips it, refine_complex decays its tag),
+    a quad, two triangles, a pentagon, a semi-sharp crease, a semi-sharp corner and a hole, under each
+    boundary mode, crease method and triangle rule: refine equals the reference at levels 0, 1 and 2."""
+    V = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0.3], [2, 0.5, 0.1], [np.nan, 0, 0], [0.5, -1, 0.2],
+         [-1, 0.5, 0.1], [-0.8, 1.4, 0]]
+    faces = [[0, 1, 2, 3], [1, 4, 2], [0, 6, 1], [0, 3, 8, 7, 0][:-1], [3, 2, 8]]
+    pm = PolyMesh(V, faces, creases={(1, 2): 1.5, (0, 3): 2.25, (0, 1): 0.75}, corners={5: 3.0, 3: 0.5, 2: 1.25},
+                  holes=[2], options=options)
+    for level in range(3):
+        assert _check_level(pm) > 0
+        assert pm.level == level and (level == 0 or pm.vertex_sharpness.get(5) == 3.0 - level)
+        assert np.isnan(pm.vertices[5]).any() and pm.is_unused_vertex[5]
+        pm, _ = pm.refine(operator=False)
+
+
+def test_subdivision_operator_merges_the_copies_exactly():
+    """A face touching itself at vertex 0 (two fans: a copy, 8, on the split mesh) next to triangles with
+    TRI_SUB_SMOOTH and semi-sharp edges: the edge point of (1, 2) holds both copies, that of (0, 1) the
+    end 0 and its copy in the hexagon; the operator on the input's vertices is refine_complex's stencil
+    with the copies' exact weights summed, rounded once."""
+    V = np.random.default_rng(1).random((8, 3))
+    # (0, 1) at 0.25: there the end's and its copy's weights rounded apart and summed differ from their
+    # exact sum rounded (checked with Fractions when the test was written)
+    mesh = PolyMesh(V, [[0, 1, 2, 0, 3, 4], [2, 1, 7], [1, 0, 6]], creases={(1, 2): 0.5, (0, 1): 0.25},
+                    options={"triangle_subdivision": "smooth"})
+    assert not mesh.is_manifold and mesh.manifold.polygons[0] == (0, 1, 2, 8, 3, 4)
+    exact = mesh.subdivision_operator(exact=True)
+    e = mesh.manifold.n_vertices + mesh.manifold.complex().edge_index[(1, 2)]
+    assert set(exact[e]) == {0, 1, 2, 3, 4, 7}
+    _same_matrix(mesh.subdivision_operator(),
+                 [None if r is None else sorted((c, to_float(w)) for c, w in r.items()) for r in exact])
+    pm = mesh.manifold
+    for _ in range(3):
+        assert _check_level(pm) > 0
         pm, _ = pm.refine(operator=False)
 
 
