@@ -147,8 +147,11 @@ def _tri_smooth_rows(te, n, a, b, h1, h2, pw, face, sz, off, pos, idx, columns):
     half = sharp_edge_weight(one)
     vw0, fw0 = smooth_edge_weights(one)
     s1, s2 = sz[face[h1[te]]], sz[face[h2[te]]]
-    combo, cinv = np.unique(np.stack([pw[te], s1, s2], axis=1), axis=0, return_inverse=True)
+    pws, pinv = np.unique(pw[te], return_inverse=True)
+    B = int(max(s1.max(), s2.max())) + 1
+    ckey, cinv = np.unique((pinv.reshape(-1) * B + s1) * B + s2, return_inverse=True)
     cinv = cinv.reshape(-1)
+    combo = [(float(pws[x // (B * B)]), int(x // B % B), int(x % B)) for x in ckey.tolist()]
     # terms: (edge position, column, kind 0 end / 1 first face / 2 second face)
     t_e, t_c, t_k = [np.arange(te.size)] * 2, [a[te], b[te]], [np.zeros(te.size, dtype=np.int64)] * 2
     for kind, h in ((1, h1[te]), (2, h2[te])):
@@ -168,12 +171,15 @@ def _tri_smooth_rows(te, n, a, b, h1, h2, pw, face, sz, off, pos, idx, columns):
     counts = np.zeros((ukey.size, 3), dtype=np.int64)
     np.add.at(counts, (ginv, t_k), 1)
     ge = ukey // ncol
-    spec, sinv = np.unique(np.c_[cinv[ge], counts], axis=0, return_inverse=True)
+    C = int(counts.max()) + 1
+    spec, sinv = np.unique(((cinv[ge] * C + counts[:, 0]) * C + counts[:, 1]) * C + counts[:, 2],
+                           return_inverse=True)
     tri_w = Fraction(0.470)
     w = []
-    for ci, c0, c1, c2 in spec.tolist():
+    for x in spec.tolist():
+        ci, c0, c1, c2 = x // C ** 3, x // C ** 2 % C, x // C % C, x % C
         p, x1, x2 = combo[ci]
-        P = Fraction(float(p))
+        P = Fraction(p)
         fw = sum((tri_w if x == 3 else fw0) for x in (x1, x2)) / 2
         vw = (1 - 2 * fw) / 2
         rest1 = (1 - P) * fw * face_point_weight(int(x1), one)
