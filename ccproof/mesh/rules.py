@@ -2,11 +2,12 @@
 
 This is the single rule implementation of the tagged meshes: :func:`refine_complex` turns a polygon
 complex with edge and vertex sharpness into the stencils of every new point (exact rational
-weights, ``flint.fmpq``) plus the child faces and their sharpness. The float operator ``S``
-(``V1 == S @ V0``) of :func:`ccproof.mesh.polymesh.PolyMesh.subdivision_operator` and the exact
-local matrices of :mod:`ccproof.evaluate` are both read from these stencils, and the vectorized
-step of :mod:`ccproof.mesh.step` (behind :mod:`ccproof.mesh.subdivision`; tests/mesh/test_step.py checks it
-against these stencils bit for bit) takes its weights from the same rule functions
+weights, ``flint.fmpq``) plus the child faces and their sharpness: the exact reference. The exact rows
+of :func:`ccproof.mesh.polymesh.PolyMesh.subdivision_operator` (``exact=True``) and the exact
+local matrices of :mod:`ccproof.evaluate` are read from these stencils; the float step (``V1 == S @ V0``:
+:meth:`~ccproof.mesh.polymesh.PolyMesh.refine`, ``subdivision_operator()``, :mod:`ccproof.mesh.subdivision`)
+is the vectorized step of :mod:`ccproof.mesh.step` (tests/mesh/test_step.py checks it and ``refine``
+against these stencils bit for bit), which takes its weights from the same rule functions
 of :mod:`ccproof.rule_weights` (:func:`face_point_weight`, :func:`smooth_edge_weights`,
 :func:`sharp_edge_weight`, :func:`smooth_vertex_weights`, :func:`crease_vertex_weights`, re-exported
 here; :mod:`ccproof.mesh.step` evaluates them exactly and rounds each row once): one rule

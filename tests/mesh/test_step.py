@@ -210,3 +210,25 @@ def test_bench_step_runs(capsys):
         sys.argv = argv
     out = capsys.readouterr().out
     assert out.count("new/old") == 8
+
+
+@pytest.mark.slow
+def test_bench_refine_runs(capsys):
+    """Smoke test of scripts/bench_refine.py (one round, small icospheres): the two refines agree on every
+    mesh (it stops otherwise) and it prints every ratio."""
+    import importlib.util
+    import sys
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[2] / "scripts" / "bench_refine.py"
+    spec = importlib.util.spec_from_file_location("bench_refine", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    argv = sys.argv
+    sys.argv = ["bench_refine.py", "--rounds", "1", "--tri-levels", "2", "--setup-levels", "1"]
+    try:
+        mod.main()
+    finally:
+        sys.argv = argv
+    out = capsys.readouterr().out
+    assert out.count("new/old") == 7
