@@ -179,12 +179,12 @@ def _tri_smooth_rows(te, n, a, b, h1, h2, pw, face, sz, off, pos, idx, columns):
     w = []
     for x in spec.tolist():
         ci, c0, c1, c2 = x // C ** 3, x // C ** 2 % C, x // C % C, x % C
-        p, x1, x2 = combo[ci]
+        p, z1, z2 = combo[ci]
         P = Fraction(p)
-        fw = sum((tri_w if x == 3 else fw0) for x in (x1, x2)) / 2
+        fw = ((tri_w if z1 == 3 else fw0) + (tri_w if z2 == 3 else fw0)) / 2
         vw = (1 - 2 * fw) / 2
-        rest1 = (1 - P) * fw * face_point_weight(int(x1), one)
-        rest2 = (1 - P) * fw * face_point_weight(int(x2), one)
+        rest1 = (1 - P) * fw * face_point_weight(z1, one)
+        rest2 = (1 - P) * fw * face_point_weight(z2, one)
         end = P * half + (1 - P) * vw + rest1 + rest2
         w.append(float(c0 * end + c1 * rest1 + c2 * rest2))
     return n + te[ge], ukey % ncol, np.asarray(w, dtype=np.float64)[sinv.reshape(-1)]
