@@ -161,7 +161,7 @@ def test_tagged_model_moves_its_evaluator_without_a_rebuild(refdir, monkeypatch)
     monkeypatch.setattr(LimitSurface, "__init__", lambda self, *a, **k: (builds.append(1), init(self, *a, **k))[1])
     rng = np.random.default_rng(6)
     V = np.asarray(mesh.vertices)
-    for trial in range(2):
+    for _ in range(2):
         P = V + 0.05 * rng.standard_normal(V.shape)
         X = LimitSurface(_evaluated_mesh(mesh)).evaluate(rng.integers(0, mesh.n_faces, 60), rng.random(60),
                                                          rng.random(60))["P"] + 0.05 * rng.standard_normal((60, 3))
