@@ -10,6 +10,9 @@ matrix), tests/data/osd_features/meshes/catmark_helmet.obj refined twice with it
 semi-sharp creases) and tests/data/osd_nonmanifold/meshes/two_cubes_creases.obj refined twice
 (non-manifold, all quads).
 
+Also printed: the table's bytes per ptex face (less those held once per configuration) and, of them,
+the jobs' rings that ``with_vertices`` needs (kept on PolyMesh surfaces for it).
+
 Usage: ``python scripts/bench_with_vertices.py [--rounds 5]``
 """
 
@@ -80,8 +83,12 @@ def main(argv=None):
             S.with_vertices(X)
             moved.append(time.perf_counter() - t)
         a, b = statistics.median(fresh), statistics.median(moved)
+        rings = sum(r.nbytes + j.nbytes for _, j, r in S._groups)  # what with_vertices needs kept
+        P = S.n_faces
         print(f"{label}: fresh build {a * 1e3:.1f} ms, with_vertices {b * 1e3:.2f} ms (first {first * 1e3:.1f} ms), "
-              f"ratio {a / b:.0f}x (medians of {args.rounds} interleaved rounds)", flush=True)
+              f"ratio {a / b:.1f}x (medians of {args.rounds} interleaved rounds); table "
+              f"{(S.table_bytes - S.configuration_bytes) / P:.0f} bytes per ptex face beyond the configurations, "
+              f"of which the kept rings {rings / P:.0f}", flush=True)
 
 
 if __name__ == "__main__":
