@@ -669,8 +669,8 @@ class LimitSurface:
         the jobs' rings) is shared with ``self``; only the float data of the jobs (regular nets,
         corner rings and limit points: the templates' linear operators applied to the rings) are
         recomputed. The result evaluates like a fresh build on the mesh with the new control points
-        (the same operations on the same data, hence the same numbers bit for bit), at a fraction of
-        its cost (for the moving surfaces of ccproof.apps.dynamics and ccproof.apps.arap).
+        (the same operations on the same data; on PolyMesh surfaces tested bit for bit), at a fraction
+        of its cost (for the moving surfaces of ccproof.apps.dynamics).
 
         A :class:`~ccproof.mesh.polymesh.PolyMesh` surface (tags, n-gons, holes, non-manifold): ``X``
         are the PolyMesh's own vertices. The rings index the vertices the builder classified: those
