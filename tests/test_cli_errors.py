@@ -113,7 +113,6 @@ CASES = [
     ("arap-refine-above-default-eval-level", "arap cube.obj --segment normals --refine 7 --out a8.obj",
      "--eval-level", "a8.obj"),
     ("arap-semi-sharp-beyond-the-cap", "arap semisharp.obj --out a9.obj", "edge (1, 4) of sharpness 9.5", "a9.obj"),
-    ("arap-control-out-tagged", "arap holes.obj --control-out a10.obj", "--control-out", "a10.obj"),
     ("fit-missing-points", "fit missing.xyz --out f1.obj", "missing.xyz", "f1.obj"),
     ("fit-init-every-face-a-hole", "fit points.xyz --init allholes.obj --out f4.obj", "allholes.obj", "f4.obj"),
     ("fit-out-suffix", "fit points.xyz --out f2.ply", "'.ply'", "f2.ply"),

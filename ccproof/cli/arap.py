@@ -32,7 +32,10 @@ vertices are dropped. OpenSubdiv tags (creases, corners, holes, boundary modes, 
 vertices) and non-manifold edges and vertices (infinitely sharp, as OpenSubdiv makes them) follow
 OpenSubdiv's rules on every level; with the Chaikin crease method a semi-sharp tag (sharpness s < 10) is
 resolved by ceil(s) global Catmull-Clark steps first (refused by name beyond 200,000 faces); hole faces
-belong to no chart. --control-out needs an untagged mesh (its OBJ carries no tags).
+belong to no chart. --control-out on such a mesh writes the control mesh the UVs belong to (the quads above,
+subdivided as the UVs need, non-manifold vertices split) with its creases, corners and holes as OpenSubdiv's
+OBJ tag lines ('t crease 2/1/0 a b s', 't corner 1/1/0 v s', 't hole k/0/0 f ...'; 0-based, infinitely sharp
+as 10): reading it back (ccproof eval, OpenSubdiv) gives the same tags and the same limit surface.
 
 Scale: charts are processed one at a time; the peak memory is estimated first and a run above
 --max-memory (default 2 GB) stops with an error naming the options that lower it. --refine R (default:
@@ -91,7 +94,8 @@ def add_arguments(parser):
     parser.add_argument("--cells", choices=["triangle", "quad"], default="triangle", help="cells of --out")
     parser.add_argument("--control-out", metavar="UV.obj",
                         help="write a control mesh with texture control points for OpenSubdiv's face-varying "
-                             "'corners only' rule (OBJ with vt, plus UV.obj.json; see above)")
+                             "'corners only' rule (OBJ with vt, plus UV.obj.json; a tagged or non-manifold input's "
+                             "tags as OpenSubdiv 't crease/corner/hole' lines; see above)")
     parser.add_argument("--control-extra", type=int, default=2, metavar="N",
                         help="--control-out may subdivide the texture's control mesh up to N more times (default 2), "
                              "not beyond --control-max-faces")
@@ -178,9 +182,6 @@ def run(args) -> int:
                 f"semi-sharp Chaikin tags: subdivided {steps} times")
         print(f"{args.mesh}: {n_file} faces, {what} (Catmull-Clark) to {mesh.n_faces} quads, the same limit "
               f"surface", file=sys.stderr)
-    if args.control_out and getattr(mesh, "has_tags", False):
-        raise CCProofError(f"{args.mesh}: --control-out writes an untagged OBJ control mesh, and this mesh has "
-                           "OpenSubdiv tags or non-manifold edges or vertices (its surface needs them); use --out")
     if args.charts:
         labels = children_labels(read_labels(args.charts, n_file), origin)
     elif args.segment == "normals":
@@ -324,8 +325,13 @@ def _write_control(args, r, surf, eval_level, comment, table, write_uv_obj):
         os.replace(write_uv_obj(tmp, exp.mesh, replace(r, textures=exp.textures), comment=comment + note,
                                 table=dict(table, control_out=what), transforms=surf.transforms, scale=surf.scale),
                    side)
+    tags = ""
+    if getattr(exp.mesh, "has_tags", False):
+        m = exp.mesh
+        tags = (f", tags as OpenSubdiv 't' lines: {int((m.edge_sharpness > 0).sum())} sharp edges, "
+                f"{int((m.vertex_sharpness > 0).sum())} sharp vertices, {int(m.hole.sum())} holes")
     print(f"wrote {args.control_out} and {side}: control mesh = the input subdivided {times} times "
-          f"({exp.mesh.n_faces} faces), UVs for OpenSubdiv's face-varying 'corners only' rule")
+          f"({exp.mesh.n_faces} faces{tags}), UVs for OpenSubdiv's face-varying 'corners only' rule")
     print(f"  what a subdivision tool will see: folded UV quads at levels {', '.join(map(str, FOLD_LEVELS))}: "
           f"{', '.join(map(str, exp.folds))}; limit texture at level {exp.level}: E_angle {exp.metrics.E_angle:.6f} "
           f"E_area {exp.metrics.E_area:.6f} E_stretch {exp.metrics.E_stretch:.6f} (excess {er[0]:.3f}, {er[1]:.3f}, "

@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ccproof.errors import CCProofError
+from ccproof.errors import CCProofError, MeshError
 from ccproof.evaluate._parallel import in_blocks, threads_for
 from ccproof.evaluate._table import (
     _CORNER,
@@ -41,6 +41,7 @@ from ccproof.evaluate._table import (
     QuadHalfEdges,
     _Builder,
     _Jobs,
+    catmark_step,
     job_floats,
     layer0_nets,
 )
@@ -119,7 +120,7 @@ class LimitSurface:
             from ccproof.evaluate.tagged import build_tagged
 
             b, top, self._hole_ptex, self._ptex_face = build_tagged(mesh, progress)
-            self._finish(b, top, self._hole_ptex, keep_rings=False)
+            self._finish(b, top, self._hole_ptex, keep_job_base=False)
             return
         if not isinstance(mesh, QuadMesh):
             raise CCProofError(f"LimitSurface takes a QuadMesh or a PolyMesh, not {type(mesh).__name__}")
@@ -132,16 +133,16 @@ class LimitSurface:
                    vmap=np.arange(mesh.n_vertices))
         self._finish(b, np.repeat(np.arange(m, dtype=np.int64)[:, None], 4, axis=1), np.zeros(m, dtype=np.bool_))
 
-    def _finish(self, b, top, refused, keep_rings=True):
+    def _finish(self, b, top, refused, keep_job_base=True):
         """The patch table from a :class:`_Builder` that has classified every job; ``top`` (P, 4) the
-        job of each quadrant of every ptex face, ``refused`` (P,) the ptex faces evaluation refuses;
-        ``keep_rings``: keep the jobs' rings (for :meth:`with_vertices` and :meth:`vertex_normals`)."""
+        job of each quadrant of every ptex face, ``refused`` (P,) the ptex faces evaluation refuses.
+        The jobs' rings are kept (:meth:`with_vertices` recomputes the float data from them);
+        ``keep_job_base``: keep the base face of every job (the quad-mesh :meth:`vertex_normals`)."""
         self._table, self._groups = b.table(top, refused)
         self._schemes = [s for s, _ in b.schemes]
-        self._job_base = np.frombuffer(b.job_base, dtype=np.int64).copy() if len(b.job_base) else np.zeros(0, np.int64)
-        if not keep_rings:
-            self._groups = [(t, None, None) for t, _, _ in self._groups]
-            self._job_base = np.zeros(0, np.int64)
+        self._job_base = np.frombuffer(b.job_base, dtype=np.int64).copy() if len(b.job_base) and keep_job_base \
+            else np.zeros(0, np.int64)
+        self._moving = {}  # shared by the surfaces with_vertices derives: the step operator of a tagged mesh
         self._vmap = b.vmap
         self._corner_normal = {}
         self.parameterizations = {}
@@ -667,13 +668,23 @@ class LimitSurface:
         Everything that depends only on the connectivity (classification, templates, configurations,
         the jobs' rings) is shared with ``self``; only the float data of the jobs (regular nets,
         corner rings and limit points: the templates' linear operators applied to the rings) are
-        recomputed. The result evaluates like ``LimitSurface(mesh.with_vertices(X))`` (the same
-        operations on the same data), at a fraction of its cost (for the moving surfaces of
-        ccproof.apps.dynamics).
+        recomputed. The result evaluates like a fresh build on the mesh with the new control points
+        (the same operations on the same data; on PolyMesh surfaces tested bit for bit), at a fraction
+        of its cost (for the moving surfaces of ccproof.apps.dynamics).
+
+        A :class:`~ccproof.mesh.polymesh.PolyMesh` surface (tags, n-gons, holes, non-manifold): ``X``
+        are the PolyMesh's own vertices. The rings index the vertices the builder classified: those
+        of :attr:`PolyMesh.manifold <ccproof.mesh.polymesh.PolyMesh.manifold>` (``X[manifold_vertex_map]``)
+        on an all-quad mesh, else its level-1 vertices, recomputed as the build computes them (the
+        vectorized untagged step :func:`ccproof.evaluate._table.catmark_step`, or the tagged step's
+        float stencil matrix :meth:`PolyMesh.subdivision_operator`, assembled on the first call and
+        shared by the derived surfaces; its product sums every row in increasing column order, as
+        :meth:`PolyMesh.refine` applies the stencils).
 
         Parameters
         ----------
         X : array_like, shape (n_vertices, 3)
+            Unused vertices may hold anything (they do not enter the surface).
 
         Returns
         -------
@@ -686,11 +697,20 @@ class LimitSurface:
         >>> T = S.with_vertices(2.0 * np.asarray(cube().vertices))
         >>> np.round(T.evaluate([0], [0.0], [0.0])["P"][0], 12).tolist()
         [-1.0, -1.0, -1.0]
+
+        A cube with an infinitely sharp corner at vertex 0 (a PolyMesh), moved by 1 along x:
+
+        >>> c = cube()
+        >>> T = LimitSurface(PolyMesh(c.vertices, c.faces.tolist(), corners={0: 10}))
+        >>> T.with_vertices(np.asarray(c.vertices) + [1, 0, 0]).evaluate([0], [0.0], [0.0])["P"].round(12).tolist()
+        [[0.0, -1.0, -1.0]]
         """
         if self._ptex_face is not None:
-            raise CCProofError("with_vertices is implemented for the surfaces of quad meshes only, not of a PolyMesh")
-        mesh = self.mesh.with_vertices(X)  # checks the shape and finiteness (MeshError)
-        V = np.where(mesh.is_unused_vertex[:, None], 0.0, mesh.vertices)  # unused: any value, weight 0
+            mesh = _polymesh_with_vertices(self.mesh, X)  # checks the shape and finiteness (MeshError)
+            V = self._classified_positions(mesh)
+        else:
+            mesh = self.mesh.with_vertices(X)  # checks the shape and finiteness (MeshError)
+            V = np.where(mesh.is_unused_vertex[:, None], 0.0, mesh.vertices)  # unused: any value, weight 0
         new = object.__new__(LimitSurface)
         new.__dict__.update(self.__dict__)
         new.mesh = mesh
@@ -703,6 +723,49 @@ class LimitSurface:
             new._table = new._table._replace(hot=layer0_nets(new._table, self._groups))
         new._corner_normal = {}
         return new
+
+    def _classified_positions(self, mesh):
+        """The positions (N, 3) of the vertices the jobs' rings of a PolyMesh surface index, for the
+        PolyMesh ``mesh`` (this surface's mesh with new vertices), computed as
+        :func:`ccproof.evaluate.tagged.build_tagged` computes them."""
+        man = mesh.manifold
+        if man.is_all_quads:  # the builder starts on the (split) base mesh
+            return np.asarray(man.vertices, dtype=np.float64)
+        step = catmark_step(man)  # untagged: the vectorized step (None: the tagged step below)
+        if step is not None:
+            return step[0]
+        S = self._moving.get("step")
+        if S is None:
+            S = self._moving["step"] = man.subdivision_operator()
+            S.sort_indices()  # each row summed in increasing column order: refine's sums
+        return S @ np.asarray(man.vertices, dtype=np.float64)
+
+
+def _polymesh_with_vertices(mesh, X):
+    """The PolyMesh ``mesh`` with the vertices ``X`` (n_vertices, 3): its connectivity, tags and
+    topology arrays shared, the vertices of its :attr:`~PolyMesh.manifold` split gathered from
+    ``X`` (``X[manifold_vertex_map]``). MeshError for a wrong shape or a non-finite used vertex."""
+    import copy
+
+    from ccproof.mesh.quadmesh import _check_used_finite
+
+    V = np.array(X, dtype=np.float64)
+    if V.shape != mesh.vertices.shape:
+        raise MeshError(f"vertices must have shape {mesh.vertices.shape}, got {V.shape}")
+    _check_used_finite(V, mesh.indices)
+    V.setflags(write=False)
+    new = copy.copy(mesh)
+    new.vertices = V
+    if mesh.manifold is mesh:
+        new.manifold = new
+    else:
+        man = copy.copy(mesh.manifold)
+        Vm = V[mesh.manifold_vertex_map]
+        Vm.setflags(write=False)
+        man.vertices = Vm
+        man.manifold = man
+        new.manifold = man
+    return new
 
 
 _BACKENDS = ("auto", "c", "numba", "numpy")

@@ -10,6 +10,7 @@ line continuations with ``\\``; every other statement (``vt``, ``vn``, ``g``, ``
 
 from __future__ import annotations
 
+import contextlib
 import os
 from typing import TYPE_CHECKING
 
@@ -21,7 +22,8 @@ from ccproof.mesh.quadmesh import QuadMesh
 if TYPE_CHECKING:
     from ccproof.mesh.polymesh import PolyMesh
 
-__all__ = ["read_obj", "read_obj_polygons", "read_obj_tagged", "read_off_polygons", "read_mesh", "write_obj"]
+__all__ = ["read_obj", "read_obj_polygons", "read_obj_tagged", "read_off_polygons", "read_mesh", "write_obj",
+           "obj_tag_lines", "atomic_path"]
 
 
 def _logical_lines(text):
@@ -541,7 +543,8 @@ def write_obj(path, mesh, *, comment=None):
 
     Reading the file back with :func:`read_obj` gives the same arrays bit for bit. A mesh with tags (the
     applications' tagged control mesh: arrays ``edge_sharpness``, ``vertex_sharpness``, ``hole``) gets
-    OpenSubdiv's tag lines (``t crease``, ``t corner``, ``t hole``; infinite sharpness as 10).
+    OpenSubdiv's tag lines (:func:`obj_tag_lines`). The file is written atomically (:func:`atomic_path`):
+    an existing ``path`` is replaced only by a complete file.
 
     Parameters
     ----------
@@ -571,19 +574,64 @@ def write_obj(path, mesh, *, comment=None):
         V, F = mesh.vertices, mesh.faces
     else:
         V, F = np.asarray(mesh[0], dtype=np.float64), np.asarray(mesh[1], dtype=np.int64)
-    with open(os.fspath(path), "w", encoding="utf-8") as fh:
+    with atomic_path(path) as tmp, open(tmp, "w", encoding="utf-8") as fh:
         if comment:
             for c in str(comment).splitlines():
                 fh.write(f"# {c}\n")
         fh.write(f"# {V.shape[0]} vertices, {F.shape[0]} faces\n")
         fh.writelines(f"v {x:.17g} {y:.17g} {z:.17g}\n" for x, y, z in V.tolist())
         fh.writelines("f " + " ".join(str(i + 1) for i in row) + "\n" for row in F.tolist())
-        fh.writelines(_tag_lines(mesh))
+        fh.writelines(obj_tag_lines(mesh))
 
 
-def _tag_lines(mesh):
-    """OpenSubdiv tag lines of a mesh with ``edge_sharpness`` (over ``edges``), ``vertex_sharpness`` and ``hole``
-    arrays (a tagged control mesh of the applications); none for a plain mesh. Infinite sharpness is written 10."""
+@contextlib.contextmanager
+def atomic_path(path):
+    """Yield a temporary path in the folder of ``path``; move it onto ``path`` (``os.replace``) when the
+    block ends normally, remove it otherwise (``path`` is then left as it was). The library's writers use
+    it; the commands' outputs go through ``ccproof.cli._output.atomic`` (the same, plus its checks).
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     p = os.path.join(d, "a.txt")
+    ...     with atomic_path(p) as tmp, open(tmp, "w") as fh:
+    ...         _ = fh.write("done")
+    ...     try:
+    ...         with atomic_path(p) as tmp, open(tmp, "w") as fh:
+    ...             raise KeyboardInterrupt
+    ...     except KeyboardInterrupt:
+    ...         pass
+    ...     open(p).read(), os.listdir(d)
+    ('done', ['a.txt'])
+    """
+    import uuid
+
+    folder, name = os.path.split(os.path.abspath(os.fspath(path)))
+    tmp = os.path.join(folder, f".tmp-{uuid.uuid4().hex[:8]}-{name}")  # created by the writer: the usual mode
+    try:
+        yield tmp
+        os.replace(tmp, path)
+    finally:
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(tmp)
+
+
+def obj_tag_lines(mesh):
+    """OpenSubdiv's OBJ tag lines of a tagged control mesh, as :func:`read_obj_tagged` reads them.
+
+    Parameters
+    ----------
+    mesh : QuadMesh
+        With arrays ``edge_sharpness`` (over ``edges``), ``vertex_sharpness`` and ``hole`` (the applications'
+        :class:`~ccproof.apps.control_mesh.TaggedQuadMesh`); none for a plain mesh.
+
+    Returns
+    -------
+    list of str
+        ``t crease 2/1/0 a b s`` per sharp edge, ``t corner 1/1/0 v s`` per sharp vertex (0-based vertices,
+        the sharpness exactly (``repr``), infinite sharpness as 10), one ``t hole k/0/0 f ...`` line.
+    """
     es = getattr(mesh, "edge_sharpness", None)
     if not isinstance(es, np.ndarray):
         return []

@@ -94,6 +94,10 @@ def test_with_vertices_bad_input():
         S.with_vertices(X)
     from ccproof.mesh.polymesh import PolyMesh
 
-    tagged = natural_limit_surface(PolyMesh(cube().vertices, [list(f) for f in cube().faces]))
-    with pytest.raises(CCProofError, match="quad meshes only, not of a PolyMesh"):
-        tagged.with_vertices(cube().vertices)
+    tagged = natural_limit_surface(PolyMesh(cube().vertices, [list(f) for f in cube().faces], corners={0: 10}))
+    with pytest.raises(MeshError, match="shape"):
+        tagged.with_vertices(np.zeros((3, 3)))
+    with pytest.raises(MeshError, match="vertex 3"):
+        tagged.with_vertices(X)
+    with pytest.raises(CCProofError, match="shape"):  # MeshError is a CCProofError
+        tagged.with_vertices(np.zeros((8, 2)))

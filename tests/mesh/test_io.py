@@ -72,3 +72,50 @@ def test_bad_index(tmp_path):
 def test_quadmesh_from_polygons_rejects_pentagon():
     with pytest.raises(MeshError, match="face 1 has 5 vertices"):
         QuadMesh.from_polygons(np.zeros((6, 3)), [[0, 1, 2, 3], [0, 1, 2, 3, 4]])
+
+
+def test_tagged_writers_are_atomic(tmp_path, monkeypatch):
+    """write_obj (tags included) and the arap control-mesh writer replace a file only by a complete one: a
+    failure while writing leaves the old file and no temporary file; a success leaves the new file only,
+    with the usual permissions, and its tags read back."""
+    import os
+
+    from ccproof.apps.control_mesh import TaggedQuadMesh
+    from ccproof.mesh import io
+    from ccproof.mesh.examples import cube
+    from ccproof.mesh.io import read_obj_tagged, write_obj
+
+    c = cube()
+    t = TaggedQuadMesh(c.vertices, c.faces, creases=([c.faces[0][:2]], [2.5]), corners=([3], [np.inf]), holes=[5])
+    p = tmp_path / "m.obj"
+    p.write_text("old\n")
+    ref = tmp_path / "ref.txt"
+    ref.write_text("x")
+
+    def boom(mesh):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(io, "obj_tag_lines", boom)
+    with pytest.raises(KeyboardInterrupt):
+        write_obj(p, t)
+    assert p.read_text() == "old\n" and sorted(os.listdir(tmp_path)) == ["m.obj", "ref.txt"]
+    monkeypatch.undo()
+    write_obj(p, t)
+    assert sorted(os.listdir(tmp_path)) == ["m.obj", "ref.txt"]
+    assert os.stat(p).st_mode & 0o777 == os.stat(ref).st_mode & 0o777
+    back = read_obj_tagged(p)
+    assert back.edge_sharpness == {tuple(sorted(c.faces[0][:2].tolist())): 2.5}
+    assert list(back.vertex_sharpness) == [3] and back.vertex_sharpness[3] >= 10  # infinitely sharp
+    assert back.is_hole_tagged.tolist() == [False] * 5 + [True]
+
+    from ccproof.apps.arap import io as arap_io
+    from ccproof.apps.arap.core import compare
+    from ccproof.mesh.examples import grid
+
+    res, _ = compare(grid(3, 3), methods=("c",), levels=1, eval_level=3)
+    q = tmp_path / "uv.obj"
+    q.write_text("old uv\n")
+    monkeypatch.setattr(io, "obj_tag_lines", boom)
+    with pytest.raises(KeyboardInterrupt):
+        arap_io.write_uv_obj(q, grid(3, 3), res["c"])
+    assert q.read_text() == "old uv\n" and sorted(os.listdir(tmp_path)) == ["m.obj", "ref.txt", "uv.obj"]

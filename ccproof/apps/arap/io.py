@@ -6,7 +6,10 @@ use is written in the header (:data:`RULE_TEXT`).
 
 The OBJ holds the control mesh (``v``), the texture control points of every chart (``vt``; packed
 with the transforms of :func:`~ccproof.apps.arap.export.pack_charts` when given, else laid side by
-side at their natural ARAP scale) and the chart faces as ``f v/vt``.
+side at their natural ARAP scale), the chart faces as ``f v/vt`` and, for a tagged control mesh
+(:class:`~ccproof.apps.control_mesh.TaggedQuadMesh`), its creases, corners and holes as OpenSubdiv's
+``t`` lines (:func:`ccproof.mesh.io.obj_tag_lines`: read back by :func:`ccproof.mesh.io.read_obj_tagged`,
+the same tags and surface).
 Faces in no chart are written without texture. For extended charts the texture of a chart also
 has control points on the ring of faces around it (hsh10 section 3.2): they are written as extra
 ``vt`` lines that no face uses, and the JSON sidecar (``<out>.json``) lists, for every chart, the
@@ -77,13 +80,14 @@ def write_uv_obj(path, mesh, result, comment=None, table=None, transforms=None, 
 
     ``transforms`` (list of (R, t) per chart) and ``scale``: the packing of
     :func:`~ccproof.apps.arap.export.pack_charts` (texture point ``scale * (uv @ R.T + t)``).
-    The OBJ of ``ccproof arap`` (docs/hsh10.md).
+    The OBJ of ``ccproof arap`` (docs/hsh10.md); a tagged mesh's tags as ``t`` lines. Both files are written
+    atomically (a temporary file in the same folder, then ``os.replace``).
 
     Parameters
     ----------
     path : str or os.PathLike
         The OBJ file.
-    mesh : QuadMesh
+    mesh : QuadMesh or TaggedQuadMesh
     result : MethodResult
     comment : str, optional
     table : str, optional
@@ -141,7 +145,9 @@ def write_uv_obj(path, mesh, result, comment=None, table=None, transforms=None, 
             }
         )
         base += uv.shape[0]
-    with open(path, "w", encoding="utf-8") as fh:
+    from ccproof.mesh.io import atomic_path, obj_tag_lines
+
+    with atomic_path(path) as tmp, open(tmp, "w", encoding="utf-8") as fh:
         for c in (comment or "").splitlines():
             fh.write(f"# {c}\n")
         for r in sorted({t.rules for t in texs}):
@@ -154,8 +160,9 @@ def write_uv_obj(path, mesh, result, comment=None, table=None, transforms=None, 
                 fh.write("f " + " ".join(f"{a + 1}/{b + 1}" for a, b in zip(F[f], face_vt[f])) + "\n")
             else:
                 fh.write("f " + " ".join(str(a + 1) for a in F[f]) + "\n")
+        fh.writelines(obj_tag_lines(mesh))
     side = path + ".json"
-    with open(side, "w", encoding="utf-8") as fh:
+    with atomic_path(side) as tmp, open(tmp, "w", encoding="utf-8") as fh:
         json.dump({"method": result.method, "rules": {r: RULE_TEXT[r] for r in {t.rules for t in texs}},
                    "uv_scale": float(scale), "charts": charts_json, "table": table or {}}, fh)
     return side

@@ -207,9 +207,7 @@ class ModelClosestPoints:
         self.model = model
         self.faces = np.flatnonzero(model.layout.face_kind > 0)
         self.cells = closest_cells(self.faces.size) if cells is None else int(cells)
-        evaluated = _evaluated_mesh(model.mesh)
-        self._tagged = evaluated is not model.mesh
-        self.surface = LimitSurface(evaluated)
+        self.surface = LimitSurface(_evaluated_mesh(model.mesh))
 
     def query(self, P, X):
         """Nearest limit-surface points to X (m, 3) for the state P (n, 3).
@@ -220,17 +218,14 @@ class ModelClosestPoints:
         points : (m, 3) the limit-surface points
         dist : (m,) their distances to X
         """
-        from ccproof.evaluate import LimitSurface
         from ccproof.evaluate.closest import ClosestPointFinder
 
         X = check_points(X, "query points")
         P = np.asarray(P, dtype=np.float64)
         if P.shape != (self.model.n_vertices, 3):
             raise CCProofError(f"control points must have shape ({self.model.n_vertices}, 3), got {P.shape}")
-        if not self._tagged:
-            S = self.surface.with_vertices(P)
-        else:  # a tagged mesh: a PolyMesh surface, rebuilt for the state (its configurations are cached)
-            S = LimitSurface(_evaluated_mesh(self.model.mesh.with_vertices(P)))
+        # quad or tagged (a PolyMesh with the model's vertices, in order): the same numbers as a fresh build
+        S = self.surface.with_vertices(P)
         faces = None if self.faces.size == self.model.mesh.n_faces else self.faces
         r = ClosestPointFinder(S, cells=self.cells, faces=faces).query(X)
         return r.face, r.u, r.v, r.P, r.distance

@@ -213,3 +213,85 @@ def test_limit_masks_are_opensubdivs_vertex_limits(refdir, name):
     ok[d["vertices_without_surface"]] = False
     assert ok.sum() >= 0.4 * ok.size  # (edgenone: the boundary vertices have no surface)
     assert np.abs(P[ok] - ref[ok]).max() <= 1e-13 * d["limit_bbox_diagonal"], name
+
+
+def _written_frames(poly, origin, n_control, times, n_written):
+    """Ptex face and frame of every face of a control mesh written after ``times`` more subdivisions of the
+    control mesh of read_control_mesh (child 4 c + i of face c: its corner i, as read_control_mesh numbers)."""
+    frames = _control_frames(poly, n_control, origin)
+    out = []
+    for c in range(n_written):
+        digits = []
+        for _ in range(times):
+            digits.append(c % 4)
+            c //= 4
+        ptex, fr = frames[c]
+        for d in reversed(digits):
+            fr = _child(fr, d)
+        out.append((ptex, fr))
+    return out
+
+
+@pytest.mark.parametrize("name", ["osd_features/meshes/catmark_cube_creases0.obj",  # semi-sharp creases
+                                  "osd_features/meshes/catmark_pyramid_creases1.obj",  # triangles: a global step
+                                  "osd_features/meshes/catmark_hole_test2.obj",  # holes, a 7.5 crease
+                                  "osd_nonmanifold/meshes/book4.obj"])  # non-manifold: split, sharp
+def test_control_out_on_tagged_meshes_reads_back_with_its_tags_and_surface(refdir, tmp_path, capsys, name):
+    """``--control-out`` on a tagged or non-manifold mesh: the written OBJ, read back, is the control mesh the
+    UVs belong to (read_control_mesh of the input, subdivided with its tags as often as the sidecar says) with
+    the same vertices bit for bit and the same creases, corners and holes; its limit surface (the evaluator on
+    the written file) is the input file's at the ptex points derived from the face numbering alone."""
+    import json
+
+    from ccproof.cli import main
+    from ccproof.mesh.io import read_obj_tagged
+
+    src = refdir / name
+    out = tmp_path / "ctl.obj"
+    assert main(["arap", str(src), "--segment", "normals", "--levels", "1", "--eval-level", "3", "--refine", "0",
+                 "--control-extra", "1", "--control-out", str(out), "--no-progress"]) == 0
+    cap = capsys.readouterr()
+    assert "tags as OpenSubdiv 't' lines" in cap.out
+    side = json.loads((tmp_path / "ctl.obj.json").read_text())["table"]["control_out"]
+    times = side["refine"] + side["extra_subdivisions"]
+    start, origin = read_control_mesh(src)
+    expect = start
+    for _ in range(times):
+        expect = subdivide_control(expect)
+    assert any(line.startswith("t ") for line in out.read_text().splitlines())
+    back, back_origin = read_control_mesh(out)
+    assert back_origin is None and isinstance(back, TaggedQuadMesh)
+    assert np.array_equal(back.faces, expect.faces) and np.array_equal(back.vertices, expect.vertices)
+    for k in ("edge_sharpness", "vertex_sharpness", "hole"):
+        assert np.array_equal(getattr(back, k), getattr(expect, k)), k
+    assert back.has_tags
+    # the same limit surface: the written file against the input file, each through the evaluator
+    poly_in, poly_out = read_mesh(src), read_obj_tagged(out)
+    assert poly_out.is_all_quads and poly_out.n_faces == expect.n_faces
+    S_in, S_out = LimitSurface(poly_in), LimitSurface(poly_out)
+    frames = _written_frames(poly_in, origin, start.n_faces, times, poly_out.n_faces)
+    rng = np.random.default_rng(3)
+    faces = np.flatnonzero(~poly_out.is_hole)
+    assert faces.size
+    st = np.r_[CORNERS, rng.random((3, 2))]
+    f_out = np.repeat(faces, st.shape[0])
+    s_out, t_out = np.tile(st[:, 0], faces.size), np.tile(st[:, 1], faces.size)
+    f_in, s_in, t_in = [], [], []
+    for f, s, t in zip(f_out.tolist(), s_out.tolist(), t_out.tolist()):
+        ptex, (o, A) = frames[f]
+        p = o + A @ np.array([s, t])
+        f_in.append(ptex)
+        s_in.append(p[0])
+        t_in.append(p[1])
+    a = S_out.evaluate(poly_out.ptex_start[f_out], s_out, t_out, 0)["P"]
+    b = S_in.evaluate(f_in, s_in, t_in, 0)["P"]
+    assert np.abs(a - b).max() <= 1e-12 * poly_in.bounding_box_diagonal, np.abs(a - b).max()
+
+
+def test_control_out_help_names_the_tags(capsys):
+    from ccproof.cli import main
+
+    with pytest.raises(SystemExit):
+        main(["arap", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "tags as OpenSubdiv 't crease/corner/hole' lines" in text

@@ -141,3 +141,38 @@ def test_to_nearest_and_bad_input():
         ModelClosestPoints(model).query(P[:5], X)
     with pytest.raises(CCProofError, match="non-finite coordinate at point 2"):
         ModelClosestPoints(model).query(P, np.r_[X[:2], [[np.nan, 0, 0]]])
+
+
+def test_tagged_model_moves_its_evaluator_without_a_rebuild(refdir, monkeypatch):
+    """On a tagged control mesh (creases, a dart, boundaries) the evaluator is built once and moved to every
+    state (``LimitSurface.with_vertices``: no build per query); the answers are those of a finder on a surface
+    built from scratch on the moved mesh, bit for bit, and the attachment points are the FEM model's own
+    limit points (its tagged elements, not ccproof.evaluate)."""
+    from ccproof.apps.control_mesh import read_control_mesh
+    from ccproof.apps.dynamics.forces import _evaluated_mesh
+    from ccproof.evaluate import LimitSurface
+    from ccproof.evaluate.closest import ClosestPointFinder
+
+    mesh, _ = read_control_mesh(refdir / "osd_features/meshes/catmark_dart_edgeonly.obj")
+    model = DynamicSurface(mesh, levels=2)
+    finder = ModelClosestPoints(model)
+    builds = []
+    init = LimitSurface.__init__
+    monkeypatch.setattr(LimitSurface, "__init__", lambda self, *a, **k: (builds.append(1), init(self, *a, **k))[1])
+    rng = np.random.default_rng(6)
+    V = np.asarray(mesh.vertices)
+    for _ in range(2):
+        P = V + 0.05 * rng.standard_normal(V.shape)
+        X = LimitSurface(_evaluated_mesh(mesh)).evaluate(rng.integers(0, mesh.n_faces, 60), rng.random(60),
+                                                         rng.random(60))["P"] + 0.05 * rng.standard_normal((60, 3))
+        builds.clear()
+        f, u, v, pts, dist = finder.query(P, X)
+        assert not builds  # moved, not rebuilt
+        fresh = LimitSurface(_evaluated_mesh(mesh.with_vertices(P)))
+        faces = np.flatnonzero(model.layout.face_kind > 0)
+        r = ClosestPointFinder(fresh, cells=finder.cells,
+                               faces=None if faces.size == mesh.n_faces else faces).query(X)
+        for a, b in ((f, r.face), (u, r.u), (v, r.v), (pts, r.P), (dist, r.distance)):
+            assert np.array_equal(a, b)
+        own = model.evaluate(f, u, v, 0, P=P)["P"]
+        assert np.abs(own - pts).max() < 1e-12 * (1 + np.abs(P).max())
