@@ -33,7 +33,8 @@ import math
 import numpy as np
 
 from ccproof.errors import MeshError
-from ccproof.mesh.quadmesh import _check_used_finite, connected_components
+from ccproof.mesh.halfedges import HalfEdges
+from ccproof.mesh.quadmesh import _check_used_finite
 from ccproof.mesh.rules import INFINITE, Complex, Options, refine_complex, to_float
 
 __all__ = ["PolyMesh"]
@@ -214,7 +215,8 @@ class PolyMesh:
         return out
 
     def _build_topology(self):
-        """Edges, twins and fans; OpenSubdiv's non-manifold edges and vertices (``Vtr::Level``).
+        """Edges, twins and fans (:class:`~ccproof.mesh.halfedges.HalfEdges`, built once: ``self.halfedges``);
+        OpenSubdiv's non-manifold edges and vertices (``Vtr::Level``).
 
         An edge is non-manifold when more than two faces share it or two faces traverse it in the
         same direction (``completeTopologyFromFaceVertices``; a face given twice is such a case); a
@@ -222,62 +224,24 @@ class PolyMesh:
         fan (``orderVertexFacesAndEdges``). Twins exist only across manifold edges.
         """
         n = self.vertices.shape[0]
-        off, idx = self.offsets, self.indices
-        H = idx.size
-        face_of = np.repeat(np.arange(self.sizes.size), self.sizes)
-        loc = np.arange(H) - off[face_of]
-        nxt = off[face_of] + (loc + 1) % self.sizes[face_of]
-        prv = off[face_of] + (loc - 1) % self.sizes[face_of]
-        org, dst = idx, idx[nxt]
-        lo, hi = np.minimum(org, dst), np.maximum(org, dst)
-        order = np.argsort(lo * n + hi, kind="stable")
-        sk = (lo * n + hi)[order]
-        starts = np.flatnonzero(np.r_[True, sk[1:] != sk[:-1]])
-        counts = np.diff(np.r_[starts, H])
-        edge_of = np.empty(H, dtype=np.int64)
-        edge_of[order] = np.repeat(np.arange(starts.size), counts)
-        nm_edge = counts > 2
-        two = np.flatnonzero(counts == 2)
-        h1, h2 = order[starts[two]], order[starts[two] + 1]
-        same = (org[h1] == org[h2]) | (face_of[h1] == face_of[h2])  # same direction, or twice in one face
-        nm_edge[two[same]] = True
+        he = self.halfedges = HalfEdges(self.indices, self.offsets, n, self.options)
         # a face repeating a vertex: a degenerate edge (v, v), or an edge the face holds twice; OpenSubdiv
         # gives each such occurrence an edge of its own with one face (a boundary edge), so that both
         # ends are sharpened (corners)
-        degenerate = lo[order[starts]] == hi[order[starts]]
-        fe = np.unique(edge_of * self.sizes.size + face_of, return_counts=True)
-        held_twice = np.zeros(starts.size, dtype=bool)
-        held_twice[fe[0][fe[1] > 1] // self.sizes.size] = True
-        nm_edge |= degenerate | held_twice
-        self._repeat_edge = degenerate | held_twice
-        ends = np.flatnonzero(degenerate | held_twice)
+        self._repeat_edge = he.repeat_edge
         self._sharpened_by_degenerate = np.zeros(n, dtype=bool)
-        self._sharpened_by_degenerate[lo[order[starts[ends]]]] = True
-        self._sharpened_by_degenerate[hi[order[starts[ends]]]] = True
-        twin = np.full(H, -1, dtype=np.int64)
-        twin[h1[~same]], twin[h2[~same]] = h2[~same], h1[~same]
-        first = order[starts]
-        self._edge_halfedge = first  # one half-edge of every edge
-        self.edges = np.stack([lo[first], hi[first]], axis=1)
-        self.edge_face_count = counts
-        self.is_boundary_edge = counts == 1
-        self.is_nonmanifold_edge = nm_edge
-        self.twin, self.next, self.prev, self.face_of_halfedge = twin, nxt, prv, face_of
-        self.edge_of_halfedge = edge_of
-        self.face_count = np.bincount(org, minlength=n)
-        # fans: rot(c) = twin(prev(c)) is the next corner counter-clockwise around org(c); the corners
-        # joined by rot are the fans (OpenSubdiv's spans between singular edges)
-        rot = twin[prv]
-        ok = np.flatnonzero(rot >= 0)
-        ncomp, comp = connected_components(H, ok, rot[ok])
-        vertex_of_comp = np.zeros(ncomp, dtype=np.int64)
-        vertex_of_comp[comp] = org
-        nfans = np.bincount(vertex_of_comp, minlength=n)
-        nm_vertex = nfans > 1
-        nm_vertex[self.edges[nm_edge].reshape(-1)] = True
-        self.is_nonmanifold_vertex = nm_vertex
-        self._fan_of_corner = comp
-        self.is_boundary_vertex = np.bincount(org[counts[edge_of] == 1], minlength=n) > 0
+        self._sharpened_by_degenerate[he.edges[he.repeat_edge].reshape(-1)] = True
+        self._edge_halfedge = he.edge_halfedge  # one half-edge of every edge
+        self.edges = he.edges
+        self.edge_face_count = he.edge_face_count
+        self.is_boundary_edge = he.edge_face_count == 1
+        self.is_nonmanifold_edge = he.is_nonmanifold_edge
+        self.twin, self.next, self.prev, self.face_of_halfedge = he.twin, he.nxt, he.prv, he.face_of
+        self.edge_of_halfedge = he.edge_of
+        self.face_count = he.face_count
+        self.is_nonmanifold_vertex = he.is_nonmanifold_vertex
+        self._fan_of_corner = he.fan_of_corner
+        self.is_boundary_vertex = he.is_boundary_vertex
         self.is_unused_vertex = self.face_count == 0
 
     @property
