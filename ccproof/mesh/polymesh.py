@@ -84,6 +84,9 @@ class PolyMesh:
         ``self`` when :attr:`is_manifold`, else the split mesh (same faces, vertices
         ``vertices[manifold_vertex_map]``).
     manifold_vertex_map : ndarray of int, shape (n',)
+    halfedges : HalfEdges
+        The topology (:class:`~ccproof.mesh.halfedges.HalfEdges`: ``twin``, ``next``, ``prev``, ``edges``
+        ... above are its arrays), with the edge and vertex sharpness as its tag arrays.
 
     Examples
     --------
@@ -104,6 +107,9 @@ class PolyMesh:
     ...
     ccproof.errors.MeshError: crease on edge (0, 2): negative sharpness -1.0
     """
+
+    #: the one topology (:class:`~ccproof.mesh.halfedges.HalfEdges`), with the tags as arrays
+    halfedges: HalfEdges
 
     def __init__(self, vertices, faces, *, creases=None, corners=None, holes=None, options=None, sizes=None,
                  _split=True):
@@ -145,6 +151,8 @@ class PolyMesh:
         self._build_topology()
         self.edge_sharpness = self._creases(creases)
         self.vertex_sharpness = self._corners(corners)
+        if self.edge_sharpness or self.vertex_sharpness:  # the tags as arrays on the one topology
+            self.halfedges = self.halfedges.with_tags(self.edge_sharpness, self.vertex_sharpness)
         m = int(sz.size)
         hole = np.zeros(m, dtype=bool)
         for f in [] if holes is None else list(holes):
@@ -224,7 +232,8 @@ class PolyMesh:
         fan (``orderVertexFacesAndEdges``). Twins exist only across manifold edges.
         """
         n = self.vertices.shape[0]
-        he = self.halfedges = HalfEdges(self.indices, self.offsets, n, self.options)
+        he = HalfEdges(self.indices, self.offsets, n, self.options)
+        self.halfedges = he
         # a face repeating a vertex: a degenerate edge (v, v), or an edge the face holds twice; OpenSubdiv
         # gives each such occurrence an edge of its own with one face (a boundary edge), so that both
         # ends are sharpened (corners)

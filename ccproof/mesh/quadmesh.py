@@ -16,7 +16,8 @@ vertex). The constructor checks everything the subdivision and evaluation layers
 
 Half-edge conventions (used throughout ccproof): half-edge ``h = 4 f + i`` runs from
 ``faces[f, i]`` to ``faces[f, (i + 1) % 4]``; it is also the *corner* of face ``f`` at vertex
-``faces[f, i]``. ``twin[h]`` is the opposite half-edge, ``-1`` on the boundary.
+``faces[f, i]``. ``twin[h]`` is the opposite half-edge, ``-1`` on the boundary. The arrays are those
+of the mesh's :class:`~ccproof.mesh.halfedges.HalfEdges` (``mesh.halfedges``, built once).
 """
 
 from __future__ import annotations
@@ -25,6 +26,7 @@ import numpy as np
 
 from ccproof.errors import MeshError
 from ccproof.mesh.halfedges import HalfEdges, connected_components
+from ccproof.mesh.rules import Options
 
 __all__ = ["QuadMesh", "connected_components"]
 
@@ -208,7 +210,7 @@ class QuadMesh:
         F = self.faces
         n, m = self.vertices.shape[0], F.shape[0]
         H = 4 * m
-        he = self.halfedges = HalfEdges.from_quads(F, n)
+        he = self.halfedges = HalfEdges.from_quads(F, n, Options())
         _check_pairing(he)
         org, twin = he.org, he.twin
         self.twin = twin
