@@ -487,7 +487,7 @@ def QuadHalfEdges(faces, n_vertices, options):
     n_vertices : int
     options : ccproof.mesh.rules.Options
     """
-    return HalfEdges.from_quads(faces, n_vertices, options)
+    return HalfEdges.from_quads(faces, n_vertices, options, edges=False)
 
 
 class TaggedHalfEdges(HalfEdges):

@@ -93,7 +93,7 @@ def build_tagged(mesh: PolyMesh, progress=None):
     step = catmark_step(mesh)  # untagged: vectorized, and the level-1 mesh as half-edge arrays
     if step is not None:
         X = step[0]
-        he = HalfEdges.from_quads(step[1], X.shape[0], mesh.options)
+        he = HalfEdges.from_quads(step[1], X.shape[0], mesh.options, edges=False)
     else:  # tagged: the level-1 mesh's own topology, with its tags (no Python complex of the mesh)
         m1, _ = mesh.refine(operator=False)
         he = TaggedHalfEdges.of(m1.halfedges)

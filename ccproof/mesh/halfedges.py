@@ -77,6 +77,8 @@ class HalfEdges:
     n_vertices : int
     options : ccproof.mesh.rules.Options, optional
         The Sdc options the tags are read under (the evaluator's keys carry them).
+    edges : bool
+        Keep the undirected edge arrays (else computed again on first use; see :meth:`from_quads`).
 
     Attributes
     ----------
@@ -109,57 +111,110 @@ class HalfEdges:
     True
     """
 
-    def __init__(self, indices, offsets, n_vertices, options=None):
+    def __init__(self, indices, offsets, n_vertices, options=None, edges=True):
         org = np.asarray(indices, dtype=np.int64).reshape(-1)
         off = np.asarray(offsets, dtype=np.int64).reshape(-1)
-        n = self.n_vertices = int(n_vertices)
+        self.n_vertices = int(n_vertices)
         sizes = np.diff(off)
         H = org.size
         self.offsets, self.sizes, self.start = off, sizes, off[:-1]
         self.org = org
         self.options = options
-        face_of = np.repeat(np.arange(sizes.size, dtype=np.int64), sizes)
-        if sizes.size and (sizes == sizes[0]).all():  # one face size (all quads): no per-corner modulo
-            k = int(sizes[0])
+        #: the one face size of every face (4: all quads), or 0 (mixed sizes)
+        self.uniform = int(sizes[0]) if sizes.size and (sizes == sizes[0]).all() else 0
+        if self.uniform:  # no per-corner face index needed
+            k = self.uniform
             h = np.arange(H, dtype=np.int64)
             loc = h % k
-            nxt = h - loc + (loc + 1) % k
-            prv = h - loc + (loc - 1) % k
+            h -= loc
+            self.nxt = h + (loc + 1) % k
+            self.prv = h + (loc - 1) % k
+            del h, loc
         else:
+            face_of = self.face_of
             loc = np.arange(H, dtype=np.int64) - off[face_of]
-            nxt = off[face_of] + (loc + 1) % sizes[face_of]
-            prv = off[face_of] + (loc - 1) % sizes[face_of]
-        dst = org[nxt]
-        lo, hi = np.minimum(org, dst), np.maximum(org, dst)
-        key = lo * n + hi
-        order = np.argsort(key, kind="stable")
-        sk = key[order]
-        starts = np.flatnonzero(np.r_[True, sk[1:] != sk[:-1]]) if H else np.zeros(0, dtype=np.int64)
-        counts = np.diff(np.r_[starts, H])
-        edge_of = np.empty(H, dtype=np.int64)
-        edge_of[order] = np.repeat(np.arange(starts.size), counts)
-        two = np.flatnonzero(counts == 2)
-        h1, h2 = order[starts[two]], order[starts[two] + 1]
-        same = (org[h1] == org[h2]) | (face_of[h1] == face_of[h2])  # same direction, or twice in one face
-        twin = np.full(H, -1, dtype=np.int64)
-        twin[h1[~same]], twin[h2[~same]] = h2[~same], h1[~same]
-        first = order[starts]
-        self.nxt, self.prv, self.twin, self.face_of, self.edge_of = nxt, prv, twin, face_of, edge_of
-        self.edge_halfedge = first
-        self.edges = np.stack([lo[first], hi[first]], axis=1)
-        self.edge_face_count = counts
-        self._order, self._starts, self._same = order, starts, two[same]
+            self.nxt = off[face_of] + (loc + 1) % sizes[face_of]
+            self.prv = off[face_of] + (loc - 1) % sizes[face_of]
+            del loc
+        pairing = self._pair()
+        self.twin = pairing["twin"]
         #: every edge has one or two faces, traversed in opposite directions by different faces
-        self.edge_manifold = bool(not (counts > 2).any() and not self._same.size)
+        self.edge_manifold = bool(not (pairing["edge_face_count"] > 2).any() and not pairing["same"].size)
+        if edges:
+            self.__dict__["_pairing"] = pairing
         self.edge_keys = np.zeros(0, dtype=np.int64)
         self.edge_values = np.zeros(0, dtype=np.float64)
         self.vertex_values = None
 
+    def _pair(self):
+        """The undirected edges (sorted by ``lo * n + hi``, a stable sort of the half-edges) and the twins."""
+        org, n = self.org, self.n_vertices
+        H = org.size
+        dst = org[self.nxt]
+        lo = np.minimum(org, dst)
+        hi = np.maximum(org, dst)
+        del dst
+        key = lo * n + hi
+        order = np.argsort(key, kind="stable")
+        sk = key[order]
+        del key
+        starts = np.flatnonzero(np.r_[True, sk[1:] != sk[:-1]]) if H else np.zeros(0, dtype=np.int64)
+        del sk
+        counts = np.diff(np.r_[starts, H])
+        two = np.flatnonzero(counts == 2)
+        h1, h2 = order[starts[two]], order[starts[two] + 1]
+        if self.uniform:
+            f1, f2 = h1 // self.uniform, h2 // self.uniform
+        else:
+            f1, f2 = self.face_of[h1], self.face_of[h2]
+        same = (org[h1] == org[h2]) | (f1 == f2)  # same direction, or twice in one face
+        twin = np.full(H, -1, dtype=np.int64)
+        twin[h1[~same]], twin[h2[~same]] = h2[~same], h1[~same]
+        del h1, h2, f1, f2
+        edge_of = np.empty(H, dtype=np.int64)
+        edge_of[order] = np.repeat(np.arange(starts.size), counts)
+        first = order[starts]
+        return {"twin": twin, "edge_of": edge_of, "edges": np.stack([lo[first], hi[first]], axis=1),
+                "edge_face_count": counts, "edge_halfedge": first, "same": two[same]}
+
+    @functools.cached_property
+    def _pairing(self):
+        return self._pair()
+
+    @functools.cached_property
+    def face_of(self):
+        """int64 (H,): the face of every half-edge."""
+        return np.repeat(np.arange(self.sizes.size, dtype=np.int64), self.sizes)
+
+    @property
+    def edge_of(self):
+        return self._pairing["edge_of"]
+
+    @property
+    def edges(self):
+        return self._pairing["edges"]
+
+    @property
+    def edge_face_count(self):
+        return self._pairing["edge_face_count"]
+
+    @property
+    def edge_halfedge(self):
+        return self._pairing["edge_halfedge"]
+
+    @property
+    def _same(self):
+        return self._pairing["same"]
+
     @classmethod
-    def from_quads(cls, faces, n_vertices, options=None):
-        """The half-edges of an all-quad mesh given as an ``(m, 4)`` array (half-edge ``4 f + i``)."""
+    def from_quads(cls, faces, n_vertices, options=None, edges=True):
+        """The half-edges of an all-quad mesh given as an ``(m, 4)`` array (half-edge ``4 f + i``).
+
+        ``edges=False``: the edge arrays (``edges``, ``edge_of``, ...) are not kept but recomputed on
+        first use (what the ring walk reads, ``org``, ``nxt``, ``prv``, ``twin``, costs no more memory).
+        """
         F = np.asarray(faces, dtype=np.int64).reshape(-1, 4)
-        return cls(F.reshape(-1), 4 * np.arange(F.shape[0] + 1, dtype=np.int64), n_vertices, options)
+        return cls(F.reshape(-1), 4 * np.arange(F.shape[0] + 1, dtype=np.int64), n_vertices, options, edges)
 
     # ------------------------------------------------------------------ tags
     def with_tags(self, edge_sharpness=None, vertex_sharpness=None, vertex_values=None):
@@ -169,7 +224,7 @@ class HalfEdges:
         by the topology)."""
         new = object.__new__(type(self))
         new.__dict__.update(self.__dict__)
-        new.__dict__.pop("has_tags", None)
+        new.__dict__.pop("has_tags", None)  # (the cached arrays are shared)
         nv = self.n_vertices
         keys = np.zeros(0, dtype=np.int64)
         vals = np.zeros(0, dtype=np.float64)

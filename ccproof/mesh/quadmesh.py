@@ -39,7 +39,12 @@ def _check_pairing(he):
     """Raise :class:`MeshError` naming the edge and faces when an edge of the half-edges ``he``
     (:class:`~ccproof.mesh.halfedges.HalfEdges`) has more than two faces or two faces traverse it the
     same way (a face given twice, the likeliest cause, named as such)."""
-    org, face_of, order, starts, counts = he.org, he.face_of, he._order, he._starts, he.edge_face_count
+    counts = he.edge_face_count
+    if not (counts > 2).any() and not he._same.size:
+        return
+    org, face_of = he.org, he.face_of
+    order = np.argsort(he.edge_of, kind="stable")  # the half-edges by edge
+    starts = np.r_[0, np.cumsum(counts)[:-1]]
     H = org.size
     dst = org[he.nxt]
     bad = (counts > 2) | ((counts == 2) & (org[order[starts]] == org[order[np.minimum(starts + 1, H - 1)]]))
@@ -219,7 +224,7 @@ class QuadMesh:
         first, counts = he.edge_halfedge, he.edge_face_count
         self.edge_faces = np.full((counts.size, 2), -1, dtype=np.int64)
         self.edge_faces[:, 0] = first // 4
-        self.edge_faces[counts == 2, 1] = he._order[he._starts[counts == 2] + 1] // 4
+        self.edge_faces[counts == 2, 1] = twin[first[counts == 2]] // 4
         self.is_boundary_edge = counts == 1
 
         # vertices: corners, fans
