@@ -790,13 +790,13 @@ class _Builder:
                 fallback.append(idx[mem[~same]])
                 mem = mem[same]
             ftup = tuple(map(tuple, faces[rep, :nf].tolist()))
-            if tagged:
+            if tagged and tv[rep].any():
                 key = ring_key(_ring_complex(he, rings[rep, :n], ftup), list(range(n)), ftup, 4)
-                if self.depth_semi != 1 and _has_semi_sharp(key) and not at_corner[rep]:
-                    fallback.append(idx[mem])  # the Chaikin phase reads the two-ring: the Python walk
-                    continue
-            else:
+            else:  # untagged, or no tag at the rule vertices (a zero row): the key of the faces alone
                 key = (ftup, (), (), opts)
+            if tagged and self.depth_semi != 1 and _has_semi_sharp(key) and not at_corner[rep]:
+                fallback.append(idx[mem])  # the Chaikin phase reads the two-ring: the Python walk
+                continue
             frame = jobs.frames[jobs.fid[idx[rep]]]
             base = int(jobs.base[idx[rep]])
             rr = int(r[rep])
