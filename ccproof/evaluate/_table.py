@@ -28,6 +28,7 @@ point in layer n of a corner face gets its net as ``L[n, code] @ ring`` at evalu
 
 from __future__ import annotations
 
+import bisect
 import functools
 import sys
 from array import array
@@ -53,7 +54,6 @@ from ccproof.evaluate.local import (
     ring_key,
 )
 from ccproof.mesh.halfedges import HalfEdges
-from ccproof.mesh.rules import Complex
 
 _REGULAR, _CORNER, _SPLIT = 0, 1, 2
 
@@ -556,69 +556,85 @@ class TaggedHalfEdges(HalfEdges):
         return out
 
 
-def _ring_complex(he, ring, faces):
-    """The complex of one walked ring alone (its tags read from ``he``, a
-    :class:`~ccproof.mesh.halfedges.HalfEdges`): what :func:`ccproof.evaluate.local.ring_key` reads to
-    key the ring, ``ring_key(cx, list(range(len(ring))), faces, n_rule)``.
+class _ComplexView:
+    """A :class:`~ccproof.mesh.halfedges.HalfEdges` read through the part of the interface of
+    :class:`ccproof.mesh.rules.Complex` that :func:`ccproof.evaluate.local.canonical_ring` and
+    :func:`ccproof.evaluate.local.ring_key` use (``org``, ``nxt``, ``prv``, ``twin``, ``face_of``,
+    ``start``, ``len(faces[f])``, ``edges``, ``edge_index``, ``edge_sharpness.get``,
+    ``vertex_sharpness.get``, ``options``), in the mesh's own labels.
 
-    Parameters
-    ----------
-    he : HalfEdges
-    ring : ndarray of int, shape (N,)
-        The mesh vertex of every local label.
-    faces : tuple of tuple of int
-        The ring's faces in local labels.
-
-    Returns
-    -------
-    ccproof.mesh.rules.Complex
-        The faces, the sharpness of their interior mesh edges and of their vertices, in local labels.
-        Its rule vertices (their whole fans in the ring) see the mesh's boundary and tags.
+    No copy and no Python object per face or half-edge: the arrays are read through memoryviews
+    (Python ints and floats at the speed of list indexing), an edge or a tag is found by bisection
+    in the sorted edge keys (``a * n + b``) and tag keys. Twins are the mesh's (across manifold
+    edges), the tags its tag arrays (sharpness ``inf`` from 10 on, as the keys hold it).
     """
-    ring = np.asarray(ring, dtype=np.int64)
-    es: dict = {}
-    if he.edge_keys.size:
-        a = np.fromiter((x for f in faces for x in f), dtype=np.int64)
-        b = np.fromiter((f[(i + 1) % len(f)] for f in faces for i in range(len(f))), dtype=np.int64)
-        sh = he.edge_sharpness_at(ring[a], ring[b])
-        for x, y, v in zip(a[sh > 0].tolist(), b[sh > 0].tolist(), sh[sh > 0].tolist()):
-            es[(x, y) if x < y else (y, x)] = v
-    vs: dict = {}
-    if he.vertex_values is not None:
-        vv = he.vertex_values[ring]
-        vs = {int(i): float(vv[i]) for i in np.flatnonzero(vv > 0.0)}
-    return Complex(faces, es, vs, he.options, level=1, n_vertices=ring.size)
+
+    def __init__(self, he):
+        def mv(a):
+            return memoryview(np.ascontiguousarray(a))
+
+        self.org, self.nxt, self.prv, self.twin = mv(he.org), mv(he.nxt), mv(he.prv), mv(he.twin)
+        self.face_of, self.start = mv(he.face_of), mv(he.start)
+        self.faces = _FaceSizes(mv(he.sizes))
+        self.edges = mv(he.edge_halfedge)
+        n = he.n_vertices
+        self.edge_index = _Sorted(mv(he.edges[:, 0] * n + he.edges[:, 1]), None, n)
+        self.edge_sharpness = _Sorted(mv(he.edge_keys), mv(he.edge_values), n)
+        self.vertex_sharpness = _VertexTags(None if he.vertex_values is None else mv(he.vertex_values))
+        self.options = he.options
+        self.n_vertices = n
 
 
-def _cut_complex(he, g, depth):
-    """The complex of the faces around face ``g`` of ``he`` (:class:`~ccproof.mesh.halfedges.HalfEdges`),
-    cut out with their tags: the faces at the vertices of its ``depth - 1``-ring (``depth`` 1: the
-    faces sharing a vertex with ``g``), so that :func:`ccproof.evaluate.local.canonical_ring` of depth
-    up to ``depth`` walks there as in the whole mesh.
+class _FaceSizes:
+    """``len(faces[f])``: the size of face f (a range of that length)."""
 
-    Returns
-    -------
-    cx : ccproof.mesh.rules.Complex
-        Local labels 0 .. k-1 (in increasing mesh vertex), faces in increasing mesh face.
-    g_local : int
-        ``g`` in ``cx``.
-    labels : ndarray of int64, shape (k,)
-        The mesh vertex of every local label.
-    """
-    def corners(fs):
-        sz = he.sizes[fs]
-        return np.arange(int(sz.sum()), dtype=np.int64) + np.repeat(he.start[fs] - np.r_[0, np.cumsum(sz)[:-1]], sz)
+    def __init__(self, sizes):
+        self._s = sizes
 
-    fs = np.array([g], dtype=np.int64)
-    for _ in range(depth):
-        fs = he.faces_around(np.unique(he.org[corners(fs)]))
-    labels, loc = np.unique(he.org[corners(fs)], return_inverse=True)
-    loc = loc.reshape(-1).tolist()
-    faces, o = [], 0
-    for k in he.sizes[fs].tolist():
-        faces.append(tuple(loc[o:o + k]))
-        o += k
-    return _ring_complex(he, labels, faces), int(np.searchsorted(fs, g)), labels
+    def __getitem__(self, f):
+        return range(self._s[f])
+
+    def __len__(self):
+        return len(self._s)
+
+
+class _Sorted:
+    """A mapping ``(a, b) -> value`` (``a < b``) over sorted keys ``a * n + b``: ``values[i]``, or the
+    index ``i`` itself when ``values`` is None (an edge's id)."""
+
+    def __init__(self, keys, values, n):
+        self._k, self._v, self._n = keys, values, n
+
+    def _find(self, ab):
+        k = ab[0] * self._n + ab[1]
+        i = bisect.bisect_left(self._k, k)
+        return i if i < len(self._k) and self._k[i] == k else -1
+
+    def __getitem__(self, ab):
+        i = self._find(ab)
+        if i < 0:
+            raise KeyError(ab)
+        return i if self._v is None else self._v[i]
+
+    def __contains__(self, ab):
+        return self._find(ab) >= 0
+
+    def get(self, ab, default=None):
+        i = self._find(ab)
+        return default if i < 0 else (i if self._v is None else self._v[i])
+
+
+class _VertexTags:
+    """``get(v, default)``: the vertex sharpness of v (``default`` where 0 or untagged)."""
+
+    def __init__(self, values):
+        self._v = values
+
+    def get(self, v, default=None):
+        if self._v is None:
+            return default
+        s = self._v[v]
+        return s if s > 0.0 else default
 
 
 def _row_hash(a):
@@ -685,8 +701,7 @@ class _Builder:
         by their rings: a quad with three smooth regular corners is first tried as a corner face at
         the fourth (:meth:`corner_at`), anything else reads its ring from corner 0 (:meth:`face`).
         The rings of an all-quad mesh are walked by the compiled kernel where it is there
-        (:meth:`_walk_all`), else face by face in a small complex cut out around each face
-        (:func:`_cut_complex`).
+        (:meth:`_walk_all`), else face by face on the mesh read as a complex (:class:`_ComplexView`).
         """
         jobs = _Jobs.of(jobs)
         self.X = X
@@ -711,15 +726,15 @@ class _Builder:
             return self._walk_all(he, jobs, j0, todo, single[todo])
         self._python_walk(he, jobs, j0, todo, single[todo])
 
-    def _python_walk(self, he, jobs, j0, todo, single):
+    def _python_walk(self, he, jobs, j0, todo, single, view=None):
         """Register the jobs ``todo`` (``single``: the one irregular corner of each, or -1) face by face:
-        :meth:`corner_at` or :meth:`face` on the complex cut out around each (:func:`_cut_complex`)."""
+        :meth:`corner_at` or :meth:`face` on the mesh read as a complex (:class:`_ComplexView`)."""
+        cx = _ComplexView(he) if view is None else view
         bar = _progress(self.progress, todo.size, "patch table")
         for n, (i, r) in enumerate(zip(todo.tolist(), single.tolist())):
             g_, frame, base = jobs[i]
-            cx, gl, labels = _cut_complex(he, g_, self.depth_semi)
-            if not (r >= 0 and self.corner_at(cx, self.X, gl, r, frame, base, j0 + i, self.vmap, labels=labels)):
-                self.face(cx, self.X, gl, frame, base, j0 + i, self.vmap, labels=labels)
+            if not (r >= 0 and self.corner_at(cx, self.X, g_, r, frame, base, j0 + i, self.vmap)):
+                self.face(cx, self.X, g_, frame, base, j0 + i, self.vmap)
             if n % 256 == 255:
                 bar.update(256)
         bar.close()
@@ -731,11 +746,12 @@ class _Builder:
         of :func:`ccproof.evaluate.local.canonical_ring`), grouped by the hash of their faces and of
         their tags (:meth:`TaggedHalfEdges.ring_tags`), each group checked face by face and tag by
         tag against its first ring and registered with the key of that ring
-        (:func:`ccproof.evaluate.local.ring_key` on the complex of that ring alone,
-        :func:`_ring_complex`; untagged: the faces and the options). Rings the walk cannot classify
+        (:func:`ccproof.evaluate.local.ring_key` on the mesh read as a complex, :class:`_ComplexView`;
+        untagged: the faces and the options). Rings the walk cannot classify
         (beyond its arrays; a semi-sharp ring that needs the Chaikin two-ring) take the Python walk."""
         walks = _ring_walks(todo.size)
         opts = he.options.key()
+        view = _ComplexView(he) if isinstance(he, TaggedHalfEdges) else None  # (keys of tagged rings)
         pos = np.full(he.n_vertices, -1, dtype=np.int64)
         seen = np.zeros(he.n_faces, dtype=np.bool_)
         bar = _progress(self.progress, todo.size, "patch table")
@@ -744,19 +760,19 @@ class _Builder:
         for lo in range(0, todo.size, step):
             idx = todo[lo:lo + step]
             r0 = single[lo:lo + step]
-            retry, fb = self._walk_block(he, walks, pos, seen, jobs, j0, idx, np.maximum(r0, 0), r0 >= 0, opts)
+            retry, fb = self._walk_block(he, walks, pos, seen, jobs, j0, idx, np.maximum(r0, 0), r0 >= 0, opts, view)
             fallback.append(fb)
             if retry.size:  # corner candidates that are not corner faces: from corner 0
                 fallback.append(self._walk_block(he, walks, pos, seen, jobs, j0, retry, np.zeros(retry.size, np.int64),
-                                                 np.zeros(retry.size, bool), opts)[1])
+                                                 np.zeros(retry.size, bool), opts, view)[1])
             bar.update(idx.size)
         bar.close()
         fallback = np.concatenate(fallback) if fallback else np.zeros(0, dtype=np.int64)
         if fallback.size:
             where = {int(i): n for n, i in enumerate(todo.tolist())}
-            self._python_walk(he, jobs, j0, fallback, single[[where[i] for i in fallback.tolist()]])
+            self._python_walk(he, jobs, j0, fallback, single[[where[i] for i in fallback.tolist()]], view)
 
-    def _walk_block(self, he, walks, pos, seen, jobs, j0, idx, r, at_corner, opts, maxn=64, maxf=48):
+    def _walk_block(self, he, walks, pos, seen, jobs, j0, idx, r, at_corner, opts, view=None, maxn=64, maxf=48):
         k = idx.size
         rings = np.full((k, maxn), -1, dtype=np.int32)
         faces = np.zeros((k, maxf, 4), dtype=np.int64)
@@ -790,9 +806,9 @@ class _Builder:
                 fallback.append(idx[mem[~same]])
                 mem = mem[same]
             ftup = tuple(map(tuple, faces[rep, :nf].tolist()))
-            if tagged and tv[rep].any():
-                key = ring_key(_ring_complex(he, rings[rep, :n], ftup), list(range(n)), ftup, 4)
-            else:  # untagged, or no tag at the rule vertices (a zero row): the key of the faces alone
+            if tagged:
+                key = ring_key(view, rings[rep, :n].tolist(), ftup, 4)
+            else:
                 key = (ftup, (), (), opts)
             if tagged and self.depth_semi != 1 and _has_semi_sharp(key) and not at_corner[rep]:
                 fallback.append(idx[mem])  # the Chaikin phase reads the two-ring: the Python walk
@@ -852,31 +868,29 @@ class _Builder:
                                ring.astype(np.int32).ravel())
         return sel
 
-    def corner_at(self, cx, X, g, r, frame, base, job, vmap=None, labels=None):
-        """Register quad ``g`` of the complex ``cx`` as a corner face at corner ``r`` if that is its
-        classification (its other corners regular, its ring from ``r`` stationary), with its ring
-        listed from ``r`` (the tags of a ring, hence the semi-sharp test, do not depend on the corner
-        it is listed from). ``labels``: the mesh vertex of every vertex of ``cx`` (None: the same).
-        Returns True if registered."""
+    def corner_at(self, cx, X, g, r, frame, base, job, vmap=None):
+        """Register quad ``g`` of ``cx`` (a :class:`_ComplexView` of the mesh, or a complex) as a corner
+        face at corner ``r`` if that is its classification (its other corners regular, its ring from
+        ``r`` stationary), with its ring listed from ``r`` (the tags of a ring, hence the semi-sharp
+        test, do not depend on the corner it is listed from). Returns True if registered."""
         ring_r, faces_r, nr = canonical_ring(cx, g, r)
         key_r = ring_key(cx, ring_r, faces_r, nr)
         if not self._corner_ok(key_r):
             return False
         self._register(("corner", key_r, r, frame), functools.partial(self._corner_template, key_r, r, frame, base),
-                       (job,), ring_r if labels is None else labels[ring_r].tolist())
+                       (job,), ring_r)
         return True
 
-    def face(self, cx, X, g, frame, base, job, vmap=None, labels=None):
-        """Register quad ``g`` of the complex ``cx`` with its ring read from corner 0 (the two-ring when
-        the Chaikin semi-sharp phase needs it), building its template on first use
-        (:meth:`_face_template`). ``labels``: as in :meth:`corner_at`."""
+    def face(self, cx, X, g, frame, base, job, vmap=None):
+        """Register quad ``g`` of ``cx`` (as in :meth:`corner_at`) with its ring read from corner 0 (the
+        two-ring when the Chaikin semi-sharp phase needs it), building its template on first use
+        (:meth:`_face_template`)."""
         ring, faces, nr = canonical_ring(cx, g, 0, 1)
         key = ring_key(cx, ring, faces, nr)
         if self.depth_semi != 1 and _has_semi_sharp(key):
             ring, faces, nr = canonical_ring(cx, g, 0, self.depth_semi)
             key = ring_key(cx, ring, faces, nr)
-        self._register(("face", key, frame), functools.partial(self._face_template, key, frame, base), (job,),
-                       ring if labels is None else labels[ring].tolist())
+        self._register(("face", key, frame), functools.partial(self._face_template, key, frame, base), (job,), ring)
 
     @staticmethod
     def _corner_ok(key_r):
