@@ -16,7 +16,11 @@ triangles (scan-like; untagged: the vectorized step) and the same icosphere with
 loop and ``triangle_subdivision="smooth"``, one level coarser (tagged: the tagged step and the tagged walk), and
 ``bunny_quads`` (an all-quad mesh).
 
-Usage: python scripts/bench_topology.py --old DIR --new DIR [--rounds 5] [--reps 3] [--tri-levels 4]
+``--tables``: instead, whether both trees build the same patch tables, bit for bit (a SHA-256 of every array of
+``PatchTable``), on every mesh of ``tests/data`` (``osd_features``, ``osd_nonmanifold``, ``meshes``) and on five
+feature meshes refined twice, with the compiled ring walk and with the Python walk.
+
+Usage: python scripts/bench_topology.py --old DIR --new DIR [--rounds 5] [--reps 3] [--tri-levels 4] [--tables]
 """
 
 from __future__ import annotations
@@ -108,6 +112,56 @@ print(json.dumps(out))
 """
 
 
+TABLES = r"""
+import hashlib, json, sys
+from pathlib import Path
+import numpy as np
+sys.path.insert(0, sys.argv[1])
+import ccproof
+assert ccproof.__file__.startswith(sys.argv[1]), ccproof.__file__
+from ccproof.evaluate import _table
+from ccproof.evaluate.surface import LimitSurface
+from ccproof.mesh.io import read_mesh, read_obj_tagged
+
+data = Path(sys.argv[2])
+if sys.argv[3] == "python":
+    _table._ring_walks = lambda n: None
+feat = data / "osd_features" / "meshes"
+meshes = [(p.name, read_obj_tagged(p)) for p in sorted(feat.glob("*.obj"))]
+meshes += [(p.name, read_mesh(p)) for p in sorted((data / "osd_nonmanifold" / "meshes").iterdir())
+           if p.suffix in (".obj", ".off")]
+meshes += [(p.name, read_mesh(p)) for p in sorted((data / "meshes").glob("*.obj"))]
+for name in ("catmark_pyramid_creases1", "catmark_xord_boundary", "catmark_hole_test2", "catmark_chaikin1",
+             "catmark_smoothtris1"):
+    m = read_obj_tagged(feat / f"{name}.obj")
+    meshes.append((name + " refined twice", m.refine(operator=False)[0].refine(operator=False)[0]))
+out = {}
+for name, m in meshes:
+    T = LimitSurface(m)._table
+    h = hashlib.sha256()
+    for f in T._fields:
+        a = getattr(T, f)
+        h.update(f.encode())
+        h.update(np.ascontiguousarray(a).tobytes() if isinstance(a, np.ndarray) else repr(a).encode())
+    out[name] = h.hexdigest()
+print(json.dumps(out))
+"""
+
+
+def _tables(a):
+    for walk in ("compiled", "python"):
+        res = []
+        for tree in (a.old, a.new):
+            r = subprocess.run([sys.executable, "-c", TABLES, str(tree.resolve()), str(REPO / "tests" / "data"), walk],
+                               capture_output=True, text=True, env=dict(os.environ, PYTHONPATH=str(tree)), cwd="/")
+            if r.returncode:
+                sys.exit(f"{tree}: {r.stderr}")
+            res.append(json.loads(r.stdout.strip().splitlines()[-1]))
+        same = [k for k in res[0] if res[0][k] == res[1].get(k)]
+        print(f"{walk} walk: {len(same)} of {len(res[0])} patch tables the same bits"
+              + ("" if len(same) == len(res[0]) else f"; different: {sorted(set(res[0]) - set(same))}"))
+
+
 def _run(tree, a):
     env = dict(os.environ, PYTHONPATH=str(tree))
     r = subprocess.run([sys.executable, "-c", WORKER, str(tree.resolve()), "-", str(REPO / "tests" / "data"),
@@ -124,7 +178,10 @@ def main():
     ap.add_argument("--rounds", type=int, default=5)
     ap.add_argument("--reps", type=int, default=3)
     ap.add_argument("--tri-levels", type=int, default=4)
+    ap.add_argument("--tables", action="store_true")
     a = ap.parse_args()
+    if a.tables:
+        return _tables(a)
     res = {"old": [], "new": []}
     loads = []
     for i in range(a.rounds):
