@@ -147,16 +147,11 @@ def vertex_corners(mesh: PolyMesh):
     """
     from ccproof.evaluate.local import CORNERS
 
-    faces, us, vs, verts = [], [], [], []
-    for f, p in enumerate(mesh.polygons):
-        for i, v in enumerate(p):
-            if len(p) == 4:
-                faces.append(int(mesh.ptex_start[f]))
-                us.append(float(CORNERS[i][0]))
-                vs.append(float(CORNERS[i][1]))
-            else:
-                faces.append(int(mesh.ptex_start[f]) + i)
-                us.append(0.0)
-                vs.append(0.0)
-            verts.append(v)
-    return np.array(faces, dtype=np.int64), np.array(us), np.array(vs), np.array(verts, dtype=np.int64)
+    sizes = np.asarray(mesh.sizes, dtype=np.int64)
+    face = np.repeat(np.arange(sizes.size), sizes)
+    corner = np.arange(face.size) - np.asarray(mesh.offsets, dtype=np.int64)[face]
+    quad = sizes[face] == 4
+    st = np.asarray(CORNERS, dtype=np.float64)[np.where(quad, corner, 0)]
+    ptex = np.asarray(mesh.ptex_start, dtype=np.int64)[face] + np.where(quad, 0, corner)
+    return (ptex, np.where(quad, st[:, 0], 0.0), np.where(quad, st[:, 1], 0.0),
+            np.asarray(mesh.indices, dtype=np.int64).copy())

@@ -269,7 +269,7 @@ class HalfEdges:
         ek = self.edges[:, 0] * self.n_vertices + self.edges[:, 1]  # sorted (edge numbering)
         k = lo * self.n_vertices + hi
         i = np.minimum(np.searchsorted(ek, k), ek.size - 1)
-        return np.where(ek[i] == k, i, -1)
+        return np.where((ek[i] == k) & (lo >= 0) & (hi < self.n_vertices), i, -1)
 
     def edge_sharpness_at(self, a, b):
         """float64: the tag sharpness of the vertex pairs ``(a, b)`` (0 where untagged, boundary or no edge)."""

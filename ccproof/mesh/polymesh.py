@@ -367,8 +367,9 @@ class PolyMesh:
         for h in hs[nm_e[edge_of]].tolist():
             a, b = int(new[h]), int(new[nxt[h]])
             creases[(min(a, b), max(a, b))] = math.inf
-        for (a, b), x in self.edge_sharpness.items():
-            e = self.edge_index[(a, b)]
+        tagged = list(self.edge_sharpness.items())
+        eids = self.halfedges.edge_index_of([a for (a, _), _ in tagged], [b for (_, b), _ in tagged]).tolist()
+        for (_, x), e in zip(tagged, eids):
             if nm_e[e]:
                 continue
             h = int(self._edge_halfedge[e])
@@ -403,15 +404,28 @@ class PolyMesh:
             E = np.asarray(E).reshape(-1, 2)
             S = np.broadcast_to(np.asarray(S, dtype=object), (E.shape[0],))
             items = [((a, b), s) for (a, b), s in zip(E.tolist(), S.tolist())]
-        for (a, b), s in items:
-            a, b = int(a), int(b)
-            what = f"crease on edge ({a}, {b})"
-            sv = _sharp_value(s, what)
+        # the values checked item by item, the edges looked up at once (no dict of all the mesh's edges);
+        # the first bad item, in order, named
+        ab, sv, err = [], [], None
+        try:
+            for (a, b), s in items:
+                a, b = int(a), int(b)
+                x = _sharp_value(s, f"crease on edge ({a}, {b})")
+                ab.append((a, b))
+                sv.append(x)
+        except (MeshError, TypeError, ValueError) as exc:  # raised after any missing edge before it
+            err = exc
+        A = np.array(ab, dtype=np.int64).reshape(-1, 2)
+        missing = np.flatnonzero(self.halfedges.edge_index_of(A[:, 0], A[:, 1]) < 0)
+        if missing.size:
+            a, b = ab[int(missing[0])]
+            raise MeshError(f"crease on edge ({a}, {b}): no such edge in the mesh")
+        if err is not None:
+            raise err
+        for (a, b), x in zip(ab, sv):
             k = (min(a, b), max(a, b))
-            if k not in self.edge_index:
-                raise MeshError(f"{what}: no such edge in the mesh")
-            if sv > 0:
-                out[k] = sv
+            if x > 0:
+                out[k] = x
             else:
                 out.pop(k, None)
         return out
@@ -449,10 +463,7 @@ class PolyMesh:
             a, b = self.edges[e]
             if not math.isinf(self.edge_sharpness.get((int(a), int(b)), 0.0)):
                 bad_vertex[a] = bad_vertex[b] = True
-        for f, p in enumerate(self.polygons):
-            if bad_vertex[list(p)].any():
-                out[f] = True
-        return out
+        return np.logical_or.reduceat(bad_vertex[self.indices], self.offsets[:-1])
 
     # ------------------------------------------------------------------ accessors
     @property
