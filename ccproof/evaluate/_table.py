@@ -1177,7 +1177,7 @@ def catmark_step(mesh):
     the same values to round-off. This is the one step not built on
     :func:`ccproof.mesh.step.catmark_operator` (``S @ X``): assembling the operator costs the setup
     of a triangle mesh 2 to 27 % more (median 8 %; ``scripts/bench_step.py``); the same child faces and vertex
-    numbering.
+    numbering. The topology is the mesh's own (``mesh.halfedges``), not paired again.
 
     Parameters
     ----------
@@ -1198,28 +1198,20 @@ def catmark_step(mesh):
             or opts.triangle_subdivision != "catmark" or opts.boundary == "none"):
         return None
     X = np.asarray(mesh.vertices, dtype=np.float64)
-    idx = np.asarray(mesh.indices, dtype=np.int64)
-    sizes = np.asarray(mesh.sizes, dtype=np.int64)
-    off = np.asarray(mesh.offsets, dtype=np.int64)[:sizes.size]
-    n, m, H = X.shape[0], sizes.size, idx.size
-    face = np.repeat(np.arange(m), sizes)
-    pos = np.arange(H) - off[face]
-    nxt = off[face] + (pos + 1) % sizes[face]
-    prv = off[face] + (pos - 1) % sizes[face]
-    org, dst = idx, idx[nxt]
-    if np.unique(org * n + dst).size != H:  # a directed edge twice: non-manifold or misoriented
+    he = mesh.halfedges  # the mesh's own topology: no pairing of the half-edges again
+    idx, sizes, off = he.org, he.sizes, he.start
+    n, m = X.shape[0], sizes.size
+    face, prv = he.face_of, he.prv
+    org, dst = idx, idx[he.nxt]
+    if not he.edge_manifold:  # a directed edge twice (non-manifold or misoriented), a face holding an edge twice
         return None
-    lo, hi = np.minimum(org, dst), np.maximum(org, dst)
-    uniq, first, inv = np.unique(lo * n + hi, return_index=True, return_inverse=True)
-    inv = inv.reshape(-1)
-    E = uniq.size
-    order = np.argsort(first, kind="stable")
+    first = he.edge_halfedge  # the first half-edge of every edge (edges sorted by their vertices)
+    E = first.size
+    order = np.argsort(first, kind="stable")  # edges by first occurrence along the faces' corners
     rank = np.empty(E, dtype=np.int64)
     rank[order] = np.arange(E)
-    he_edge = rank[inv]  # edge id of every half-edge (first-occurrence order)
-    count = np.bincount(he_edge, minlength=E)
-    if (count > 2).any():
-        return None
+    he_edge = rank[he.edge_of]  # edge id of every half-edge (first-occurrence order)
+    count = he.edge_face_count[order]
     valence = np.bincount(org, minlength=n)  # faces (outgoing half-edges) at every vertex
     if (valence == 0).any():
         return None
@@ -1234,9 +1226,7 @@ def catmark_step(mesh):
     fp = np.add.reduceat(X[idx], off, axis=0) / sizes[:, None] if m else np.zeros((0, 3))
     # edge points
     h1 = first[order]  # the first half-edge of every edge, in edge order
-    h2 = np.full(E, -1, dtype=np.int64)
-    second = np.flatnonzero(np.arange(H) != first[inv])
-    h2[he_edge[second]] = second
+    h2 = he.twin[h1]  # the other one (-1 on the boundary)
     a, b = org[h1], dst[h1]
     vw, fw = smooth_edge_weights(one)
     ep = 0.5 * (X[a] + X[b])
