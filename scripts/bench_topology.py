@@ -18,7 +18,8 @@ loop and ``triangle_subdivision="smooth"``, one level coarser (tagged: the tagge
 
 ``--tables``: instead, whether both trees build the same patch tables, bit for bit (a SHA-256 of every array of
 ``PatchTable``), on every mesh of ``tests/data`` (``osd_features``, ``osd_nonmanifold``, ``meshes``) and on five
-feature meshes refined twice, with the compiled ring walk and with the Python walk.
+feature meshes refined twice, with the compiled ring walk and with the Python walk; and whether the untagged step
+(``catmark_step``) gives the same bits on every polygon mesh of these without its tags.
 
 Usage: python scripts/bench_topology.py --old DIR --new DIR [--rounds 5] [--reps 3] [--tri-levels 4] [--tables]
 """
@@ -144,6 +145,14 @@ for name, m in meshes:
         h.update(f.encode())
         h.update(np.ascontiguousarray(a).tobytes() if isinstance(a, np.ndarray) else repr(a).encode())
     out[name] = h.hexdigest()
+from ccproof.evaluate._table import catmark_step
+from ccproof.mesh import PolyMesh
+
+for name, m in meshes:  # the untagged step on the polygons without their tags
+    if isinstance(m, PolyMesh):
+        r = catmark_step(PolyMesh(m.vertices, [list(q) for q in m.polygons]))
+        h = hashlib.sha256(b"None" if r is None else r[0].tobytes() + r[1].tobytes())
+        out["catmark_step " + name] = h.hexdigest()
 print(json.dumps(out))
 """
 
@@ -158,7 +167,7 @@ def _tables(a):
                 sys.exit(f"{tree}: {r.stderr}")
             res.append(json.loads(r.stdout.strip().splitlines()[-1]))
         same = [k for k in res[0] if res[0][k] == res[1].get(k)]
-        print(f"{walk} walk: {len(same)} of {len(res[0])} patch tables the same bits"
+        print(f"{walk} walk: {len(same)} of {len(res[0])} patch tables and untagged steps the same bits"
               + ("" if len(same) == len(res[0]) else f"; different: {sorted(set(res[0]) - set(same))}"))
 
 
