@@ -8,7 +8,7 @@ and the template disk cache filled), then times ``--reps`` setups of each mesh i
 (``natural_limit_surface``, as ``ccproof eval`` builds a surface; the median is the round's time) and
 measures one more under ``tracemalloc`` (the peak of Python allocations during the setup, numpy's included);
 the same for ``build_tagged`` alone on the polygon meshes (the topology, the first step and the classification:
-the setup less the patch table's float data).
+the setup less the patch table's float data), and for ``catmark_step`` alone on the untagged icosphere.
 
 Meshes: ``catmark_cubes_infsharp`` (tagged quads, infinitely sharp creases) as read and refined twice
 (the tagged level-1 path on a bigger mesh), ``catmark_smoothtris1`` (tagged triangles), an icosphere of
@@ -109,6 +109,10 @@ for name, m in meshes.items():
     out[name] = measure(lambda: natural_limit_surface(m, progress=False))
     if isinstance(m, PolyMesh):
         out[name + ": build_tagged"] = measure(lambda: build_tagged(m, False))
+    if isinstance(m, PolyMesh) and not m.has_tags and not m.is_all_quads:
+        from ccproof.evaluate._table import catmark_step
+
+        out[name + ": catmark_step"] = measure(lambda: catmark_step(m))
 print(json.dumps(out))
 """
 
