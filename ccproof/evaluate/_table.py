@@ -28,8 +28,8 @@ point in layer n of a corner face gets its net as ``L[n, code] @ ring`` at evalu
 
 from __future__ import annotations
 
+import bisect
 import functools
-import math
 import sys
 from array import array
 from typing import NamedTuple
@@ -53,6 +53,7 @@ from ccproof.evaluate.local import (
     refine_key,
     ring_key,
 )
+from ccproof.mesh.halfedges import HalfEdges
 
 _REGULAR, _CORNER, _SPLIT = 0, 1, 2
 
@@ -238,20 +239,20 @@ def _oriented_layers(scheme, orient):
     return np.take(Ls.reshape(nl, 48, N), rows, axis=1).reshape(-1, N), unit
 
 
-def _smooth_regular_vertices(cx):
-    """Bool (n_vertices,): the vertices of ``cx`` with four faces and no boundary edge, sharp edge
-    or vertex sharpness (regular for the bicubic patch under any options)."""
-    org, nxt, twin = (np.asarray(a, dtype=np.int64) for a in (cx.org, cx.nxt, cx.twin))
-    ok = np.bincount(org, minlength=cx.n_vertices) == 4
+def _smooth_regular_vertices(he):
+    """Bool (n_vertices,): the vertices of ``he`` (:class:`~ccproof.mesh.halfedges.HalfEdges`) with
+    four faces and no boundary edge, sharp edge or vertex sharpness (regular for the bicubic patch
+    under any options)."""
+    org, nxt, twin = he.org, he.nxt, he.twin
+    ok = np.bincount(org, minlength=he.n_vertices) == 4
     open_h = twin < 0
     ok[org[open_h]] = False
     ok[org[nxt[open_h]]] = False
-    for (a, b), sh in cx.edge_sharpness.items():
-        if sh > 0.0:
-            ok[a] = ok[b] = False
-    for v, sh in cx.vertex_sharpness.items():
-        if sh > 0.0:
-            ok[v] = False
+    if he.edge_keys.size:  # (the tags of interior edges: boundary ones are out already)
+        ok[he.edge_keys // he.n_vertices] = False
+        ok[he.edge_keys % he.n_vertices] = False
+    if he.vertex_values is not None:
+        ok[he.vertex_values > 0.0] = False
     return ok
 
 
@@ -476,93 +477,42 @@ class _Jobs:
         return int(self.g[i]), self.frames[self.fid[i]], int(self.base[i])
 
 
-class QuadHalfEdges:
-    """Half-edge arrays of an untagged all-quad complex (half-edge ``4 f + i`` is corner i of face f),
-    built with numpy: what the compiled ring walk reads (and the parts of
-    :class:`ccproof.mesh.rules.Complex` that :meth:`_Builder.smooth_regular_patches` reads).
+def QuadHalfEdges(faces, n_vertices, options):
+    """The :class:`~ccproof.mesh.halfedges.HalfEdges` of an untagged all-quad complex given as an
+    ``(m, 4)`` array (half-edge ``4 f + i`` is corner i of face f): ``HalfEdges.from_quads``.
 
     Parameters
     ----------
     faces : array_like of int, shape (m, 4)
     n_vertices : int
     options : ccproof.mesh.rules.Options
-
-    Attributes
-    ----------
-    manifold : bool
-        False if a directed edge occurs twice (then the builder takes the Python walk).
     """
-
-    def __init__(self, faces, n_vertices, options):
-        F = np.asarray(faces, dtype=np.int64).reshape(-1, 4)
-        m = F.shape[0]
-        h = np.arange(4 * m, dtype=np.int64)
-        self.faces = F
-        self.org = F.reshape(-1)
-        self.nxt = h - h % 4 + (h + 1) % 4
-        self.prv = h - h % 4 + (h + 3) % 4
-        nv = self.n_vertices = int(n_vertices)
-        dst = self.org[self.nxt]
-        key = self.org * nv + dst
-        order = np.argsort(key, kind="stable")
-        sk = key[order]
-        self.manifold = not bool((np.diff(sk) == 0).any())
-        rk = dst * nv + self.org
-        i = np.minimum(np.searchsorted(sk, rk), max(sk.size - 1, 0))
-        self.twin = np.where(sk[i] == rk, order[i], -1) if sk.size else np.zeros(0, np.int64)
-        self.start = 4 * np.arange(m, dtype=np.int64)
-        self.edge_sharpness, self.vertex_sharpness = {}, {}
-        self.options = options
+    return HalfEdges.from_quads(faces, n_vertices, options, edges=False)
 
 
-class TaggedHalfEdges:
-    """The half-edge arrays of a tagged all-quad :class:`ccproof.mesh.rules.Complex` (half-edge
-    ``4 f + i`` is corner i of face f) with its tags as arrays: what the compiled ring walk reads,
-    and what :meth:`ring_tags` hashes into the ring's signature.
+class TaggedHalfEdges(HalfEdges):
+    """A tagged all-quad :class:`~ccproof.mesh.halfedges.HalfEdges` as the tagged ring walk reads it:
+    the same arrays (shared, not copied; tags as ``edge_keys``, ``edge_values``, ``vertex_values``),
+    plus :meth:`ring_tags`, which hashes the tags of walked rings into their signatures.
 
-    Built by :meth:`of` (None where the complex is not all quads in that layout).
-
-    Attributes
-    ----------
-    cx : ccproof.mesh.rules.Complex
-        The complex (its keys: :func:`ccproof.evaluate.local.ring_key`; the Python walk's fallback).
-    org, nxt, prv, twin : ndarray of int64, shape (4 m,)
-    edge_keys : ndarray of int64, shape (e,)
-        ``a * n_vertices + b`` (``a < b``) of the interior edges with sharpness, sorted.
-    edge_values : ndarray of float64, shape (e,)
-        Their sharpness (``inf`` from 10 on, as in the keys).
-    vertex_values : ndarray of float64, shape (n_vertices,)
-        Vertex sharpness (0 where none; ``inf`` from 10 on).
+    Built by :meth:`of` from a mesh's :class:`~ccproof.mesh.halfedges.HalfEdges` (no copy) or from a
+    :class:`ccproof.mesh.rules.Complex` (its faces and tags; None where it is not all quads).
     """
 
     @classmethod
-    def of(cls, cx):
+    def of(cls, src):
+        if isinstance(src, HalfEdges):
+            he = object.__new__(cls)
+            he.__dict__.update(src.__dict__)
+            if he.vertex_values is None:
+                he.vertex_values = np.zeros(he.n_vertices, dtype=np.float64)
+            return he
+        cx = src
         m = len(cx.faces)
-        if m == 0 or len(cx.org) != 4 * m:
+        if m == 0 or len(cx.org) != 4 * m or any(len(f) != 4 for f in cx.faces):
             return None
-        start = np.asarray(cx.start, dtype=np.int64)
-        if not np.array_equal(start[:m], 4 * np.arange(m, dtype=np.int64)):
-            return None
-        he = cls()
-        he.cx = cx
-        he.org, he.nxt, he.prv, he.twin = (np.asarray(a, dtype=np.int64) for a in (cx.org, cx.nxt, cx.prv, cx.twin))
-        he.faces = he.org.reshape(-1, 4)
-        he.n_vertices = nv = int(cx.n_vertices)
-        he.options = cx.options
-        keys, vals = [], []
-        for (a, b), s in cx.edge_sharpness.items():
-            if a < b and s > 0.0 and (a, b) in cx.edge_index and cx.twin[cx.edges[cx.edge_index[(a, b)]]] >= 0:
-                keys.append(min(a, b) * nv + max(a, b))
-                vals.append(math.inf if s >= 10.0 else float(s))
-        order = np.argsort(np.asarray(keys, dtype=np.int64), kind="stable")
-        he.edge_keys = np.asarray(keys, dtype=np.int64)[order]
-        he.edge_values = np.asarray(vals, dtype=np.float64)[order]
-        vv = np.zeros(nv, dtype=np.float64)
-        for v, s in cx.vertex_sharpness.items():
-            if s > 0.0 and 0 <= v < nv:
-                vv[v] = math.inf if s >= 10.0 else float(s)
-        he.vertex_values = vv
-        return he
+        base = HalfEdges.from_quads(cx.faces, cx.n_vertices, cx.options)
+        return cls.of(base.with_tags(cx.edge_sharpness, cx.vertex_sharpness))
 
     def ring_tags(self, rings, nring, faces, nfaces, n_rule=4):
         """The tags of walked rings as rows of floats: per face slot ``(i, t)`` the sharpness of
@@ -604,6 +554,87 @@ class TaggedHalfEdges:
         v = rings[:, :n_rule].astype(np.int64)
         out[:, 4 * maxf:] = np.where(ok[:, None] & (v >= 0), self.vertex_values[np.maximum(v, 0)], 0.0)
         return out
+
+
+class _ComplexView:
+    """A :class:`~ccproof.mesh.halfedges.HalfEdges` read through the part of the interface of
+    :class:`ccproof.mesh.rules.Complex` that :func:`ccproof.evaluate.local.canonical_ring` and
+    :func:`ccproof.evaluate.local.ring_key` use (``org``, ``nxt``, ``prv``, ``twin``, ``face_of``,
+    ``start``, ``len(faces[f])``, ``edges``, ``edge_index``, ``edge_sharpness.get``,
+    ``vertex_sharpness.get``, ``options``), in the mesh's own labels.
+
+    No copy and no Python object per face or half-edge: the arrays are read through memoryviews
+    (Python ints and floats at the speed of list indexing), an edge or a tag is found by bisection
+    in the sorted edge keys (``a * n + b``) and tag keys. Twins are the mesh's (across manifold
+    edges), the tags its tag arrays (sharpness ``inf`` from 10 on, as the keys hold it).
+    """
+
+    def __init__(self, he):
+        def mv(a):
+            return memoryview(np.ascontiguousarray(a))
+
+        self.org, self.nxt, self.prv, self.twin = mv(he.org), mv(he.nxt), mv(he.prv), mv(he.twin)
+        self.face_of, self.start = mv(he.face_of), mv(he.start)
+        self.faces = _FaceSizes(mv(he.sizes))
+        self.edges = mv(he.edge_halfedge)
+        n = he.n_vertices
+        self.edge_index = _Sorted(mv(he.edges[:, 0] * n + he.edges[:, 1]), None, n)
+        self.edge_sharpness = _Sorted(mv(he.edge_keys), mv(he.edge_values), n)
+        self.vertex_sharpness = _VertexTags(None if he.vertex_values is None else mv(he.vertex_values))
+        self.options = he.options
+        self.n_vertices = n
+
+
+class _FaceSizes:
+    """``len(faces[f])``: the size of face f (a range of that length)."""
+
+    def __init__(self, sizes):
+        self._s = sizes
+
+    def __getitem__(self, f):
+        return range(self._s[f])
+
+    def __len__(self):
+        return len(self._s)
+
+
+class _Sorted:
+    """A mapping ``(a, b) -> value`` (``a < b``) over sorted keys ``a * n + b``: ``values[i]``, or the
+    index ``i`` itself when ``values`` is None (an edge's id)."""
+
+    def __init__(self, keys, values, n):
+        self._k, self._v, self._n = keys, values, n
+
+    def _find(self, ab):
+        k = ab[0] * self._n + ab[1]
+        i = bisect.bisect_left(self._k, k)
+        return i if i < len(self._k) and self._k[i] == k else -1
+
+    def __getitem__(self, ab):
+        i = self._find(ab)
+        if i < 0:
+            raise KeyError(ab)
+        return i if self._v is None else self._v[i]
+
+    def __contains__(self, ab):
+        return self._find(ab) >= 0
+
+    def get(self, ab, default=None):
+        i = self._find(ab)
+        return default if i < 0 else (i if self._v is None else self._v[i])
+
+
+class _VertexTags:
+    """``get(v, default)``: the vertex sharpness of v (``default`` where 0 or untagged)."""
+
+    def __init__(self, values):
+        self._v = values
+
+    def get(self, v, default=None):
+        if self._v is None:
+            return default
+        s = self._v[v]
+        return s if s > 0.0 else default
 
 
 def _row_hash(a):
@@ -659,17 +690,18 @@ class _Builder:
         else:
             t.rings.extend(rings)
 
-    def classify(self, cx, X, jobs, vmap=None):
-        """Classify the quads ``jobs`` (``[(g, frame, base), ...]`` or :class:`_Jobs`) of ``cx`` (a
-        :class:`ccproof.mesh.rules.Complex`, or :class:`QuadHalfEdges` for an untagged all-quad one)
-        with positions ``X``; job ids are assigned in order. ``vmap``: the mesh vertex of every
-        vertex of ``cx`` (records where the corner faces' vertices are, for the vertex normals).
+    def classify(self, he, X, jobs, vmap=None):
+        """Classify the quads ``jobs`` (``[(g, frame, base), ...]`` or :class:`_Jobs`) of the mesh with
+        half-edges ``he`` (:class:`~ccproof.mesh.halfedges.HalfEdges`; a :class:`TaggedHalfEdges` for
+        the tagged walk: its tags enter the rings' keys) with positions ``X``; job ids are assigned in
+        order. ``vmap``: the mesh vertex of every vertex of ``he`` (records where the corner faces'
+        vertices are, for the vertex normals).
 
         The smooth regular ones (:meth:`smooth_regular_patches`) in one vectorized pass, the others
         by their rings: a quad with three smooth regular corners is first tried as a corner face at
         the fourth (:meth:`corner_at`), anything else reads its ring from corner 0 (:meth:`face`).
-        On a :class:`QuadHalfEdges` the rings are walked by the compiled kernel when numba is
-        installed (:meth:`_walk_all`), else face by face.
+        The rings of an all-quad mesh are walked by the compiled kernel where it is there
+        (:meth:`_walk_all`), else face by face on the mesh read as a complex (:class:`_ComplexView`).
         """
         jobs = _Jobs.of(jobs)
         self.X = X
@@ -679,76 +711,68 @@ class _Builder:
         self.job_base.extend(jobs.base.tolist())
         if not len(jobs):
             return
-        ok = _smooth_regular_vertices(cx)
-        done = np.asarray(self.smooth_regular_patches(cx, X, jobs), dtype=bool)
+        ok = _smooth_regular_vertices(he)
+        done = np.asarray(self.smooth_regular_patches(he, X, jobs), dtype=bool)
         g = jobs.g
-        start = np.append(np.asarray(cx.start, dtype=np.int64), len(cx.org))
-        org = np.asarray(cx.org, dtype=np.int64)
+        start = np.append(he.start, he.org.size)
+        org = he.org
         quad = start[g + 1] - start[g] == 4
         corners = ok[org[np.minimum(start[g][:, None] + np.arange(4), org.size - 1)]]
         single = np.where(quad & (corners.sum(axis=1) == 3), np.argmin(corners, axis=1), -1)
         todo = np.flatnonzero(~done)
-        if isinstance(cx, QuadHalfEdges):
-            if cx.manifold and _ring_walks(todo.size) is not None:
-                return self._walk_all(cx, jobs, j0, todo, single[todo])
-            from ccproof.mesh.rules import Complex
+        tagged = isinstance(he, TaggedHalfEdges)
+        walkable = he.edge_manifold and bool((he.sizes == 4).all()) and (todo.size or not tagged)
+        if walkable and _ring_walks(todo.size) is not None:
+            return self._walk_all(he, jobs, j0, todo, single[todo])
+        self._python_walk(he, jobs, j0, todo, single[todo])
 
-            cx = Complex(cx.faces, {}, {}, cx.options, n_vertices=cx.n_vertices)
-        elif todo.size and _ring_walks(todo.size) is not None:
-            he = TaggedHalfEdges.of(cx)
-            if he is not None:
-                return self._walk_all(he, jobs, j0, todo, single[todo])
+    def _python_walk(self, he, jobs, j0, todo, single, view=None):
+        """Register the jobs ``todo`` (``single``: the one irregular corner of each, or -1) face by face:
+        :meth:`corner_at` or :meth:`face` on the mesh read as a complex (:class:`_ComplexView`)."""
+        cx = _ComplexView(he) if view is None else view
         bar = _progress(self.progress, todo.size, "patch table")
-        for n, i in enumerate(todo.tolist()):
+        for n, (i, r) in enumerate(zip(todo.tolist(), single.tolist())):
             g_, frame, base = jobs[i]
-            r = int(single[i])
-            if not (r >= 0 and self.corner_at(cx, X, g_, r, frame, base, j0 + i, vmap)):
-                self.face(cx, X, g_, frame, base, j0 + i, vmap)
+            if not (r >= 0 and self.corner_at(cx, self.X, g_, r, frame, base, j0 + i, self.vmap)):
+                self.face(cx, self.X, g_, frame, base, j0 + i, self.vmap)
             if n % 256 == 255:
                 bar.update(256)
         bar.close()
 
     def _walk_all(self, he, jobs, j0, todo, single):
         """Register the jobs ``todo`` (``single``: the one irregular corner of each, or -1) of an
-        all-quad complex (:class:`QuadHalfEdges` or :class:`TaggedHalfEdges`): their rings walked
-        by the compiled kernel (:func:`ccproof.evaluate._numba_kernel.ring_walks`, the walk of
-        :func:`ccproof.evaluate.local.canonical_ring`), grouped by the hash of their faces and of
+        all-quad mesh (:class:`~ccproof.mesh.halfedges.HalfEdges`, or :class:`TaggedHalfEdges`): their
+        rings walked by the compiled kernel (:func:`ccproof.evaluate._numba_kernel.ring_walks`, the walk
+        of :func:`ccproof.evaluate.local.canonical_ring`), grouped by the hash of their faces and of
         their tags (:meth:`TaggedHalfEdges.ring_tags`), each group checked face by face and tag by
         tag against its first ring and registered with the key of that ring
-        (:func:`ccproof.evaluate.local.ring_key`; untagged: the faces and the options). Rings the
-        walk cannot classify (beyond its arrays; a semi-sharp ring that needs the Chaikin two-ring)
-        take the Python walk."""
+        (:func:`ccproof.evaluate.local.ring_key` on the mesh read as a complex, :class:`_ComplexView`;
+        untagged: the faces and the options). Rings the walk cannot classify
+        (beyond its arrays; a semi-sharp ring that needs the Chaikin two-ring) take the Python walk."""
         walks = _ring_walks(todo.size)
         opts = he.options.key()
+        view = _ComplexView(he) if isinstance(he, TaggedHalfEdges) else None  # (keys of tagged rings)
         pos = np.full(he.n_vertices, -1, dtype=np.int64)
-        seen = np.zeros(he.faces.shape[0], dtype=np.bool_)
+        seen = np.zeros(he.n_faces, dtype=np.bool_)
         bar = _progress(self.progress, todo.size, "patch table")
         step = 1 << 15
         fallback = []
         for lo in range(0, todo.size, step):
             idx = todo[lo:lo + step]
             r0 = single[lo:lo + step]
-            retry, fb = self._walk_block(he, walks, pos, seen, jobs, j0, idx, np.maximum(r0, 0), r0 >= 0, opts)
+            retry, fb = self._walk_block(he, walks, pos, seen, jobs, j0, idx, np.maximum(r0, 0), r0 >= 0, opts, view)
             fallback.append(fb)
             if retry.size:  # corner candidates that are not corner faces: from corner 0
                 fallback.append(self._walk_block(he, walks, pos, seen, jobs, j0, retry, np.zeros(retry.size, np.int64),
-                                                 np.zeros(retry.size, bool), opts)[1])
+                                                 np.zeros(retry.size, bool), opts, view)[1])
             bar.update(idx.size)
         bar.close()
         fallback = np.concatenate(fallback) if fallback else np.zeros(0, dtype=np.int64)
         if fallback.size:
-            from ccproof.mesh.rules import Complex
-
-            cx = he.cx if isinstance(he, TaggedHalfEdges) else Complex(he.faces, {}, {}, he.options,
-                                                                       n_vertices=he.n_vertices)
             where = {int(i): n for n, i in enumerate(todo.tolist())}
-            for i in fallback.tolist():
-                g_, frame, base = jobs[i]
-                r_ = int(single[where[i]])
-                if not (r_ >= 0 and self.corner_at(cx, self.X, g_, r_, frame, base, j0 + i, self.vmap)):
-                    self.face(cx, self.X, g_, frame, base, j0 + i, self.vmap)
+            self._python_walk(he, jobs, j0, fallback, single[[where[i] for i in fallback.tolist()]], view)
 
-    def _walk_block(self, he, walks, pos, seen, jobs, j0, idx, r, at_corner, opts, maxn=64, maxf=48):
+    def _walk_block(self, he, walks, pos, seen, jobs, j0, idx, r, at_corner, opts, view=None, maxn=64, maxf=48):
         k = idx.size
         rings = np.full((k, maxn), -1, dtype=np.int32)
         faces = np.zeros((k, maxf, 4), dtype=np.int64)
@@ -783,12 +807,12 @@ class _Builder:
                 mem = mem[same]
             ftup = tuple(map(tuple, faces[rep, :nf].tolist()))
             if tagged:
-                key = ring_key(he.cx, rings[rep, :n].tolist(), ftup, 4)
-                if self.depth_semi != 1 and _has_semi_sharp(key) and not at_corner[rep]:
-                    fallback.append(idx[mem])  # the Chaikin phase reads the two-ring: the Python walk
-                    continue
+                key = ring_key(view, rings[rep, :n].tolist(), ftup, 4)
             else:
                 key = (ftup, (), (), opts)
+            if tagged and self.depth_semi != 1 and _has_semi_sharp(key) and not at_corner[rep]:
+                fallback.append(idx[mem])  # the Chaikin phase reads the two-ring: the Python walk
+                continue
             frame = jobs.frames[jobs.fid[idx[rep]]]
             base = int(jobs.base[idx[rep]])
             rr = int(r[rep])
@@ -815,10 +839,10 @@ class _Builder:
         if not jobs:
             return np.zeros(0, dtype=bool)
         jobs = _Jobs.of(jobs)
-        org, nxt, prv, twin = (np.asarray(a, dtype=np.int64) for a in (cx.org, cx.nxt, cx.prv, cx.twin))
+        org, nxt, prv, twin = cx.org, cx.nxt, cx.prv, cx.twin
         ok = _smooth_regular_vertices(cx)
         g = jobs.g
-        start = np.append(np.asarray(cx.start, dtype=np.int64), org.size)
+        start = np.append(cx.start, org.size)
         H = start[g][:, None] + np.arange(4)
         sel = (start[g + 1] - start[g] == 4) & ok[org[np.minimum(H, org.size - 1)]].all(axis=1)
         idx = np.flatnonzero(sel)
@@ -845,10 +869,10 @@ class _Builder:
         return sel
 
     def corner_at(self, cx, X, g, r, frame, base, job, vmap=None):
-        """Register quad ``g`` as a corner face at corner ``r`` if that is its classification (its
-        other corners regular, its ring from ``r`` stationary), with its ring listed from ``r`` (the
-        tags of a ring, hence the semi-sharp test, do not depend on the corner it is listed from).
-        Returns True if registered."""
+        """Register quad ``g`` of ``cx`` (a :class:`_ComplexView` of the mesh, or a complex) as a corner
+        face at corner ``r`` if that is its classification (its other corners regular, its ring from
+        ``r`` stationary), with its ring listed from ``r`` (the tags of a ring, hence the semi-sharp
+        test, do not depend on the corner it is listed from). Returns True if registered."""
         ring_r, faces_r, nr = canonical_ring(cx, g, r)
         key_r = ring_key(cx, ring_r, faces_r, nr)
         if not self._corner_ok(key_r):
@@ -858,8 +882,9 @@ class _Builder:
         return True
 
     def face(self, cx, X, g, frame, base, job, vmap=None):
-        """Register quad ``g`` with its ring read from corner 0 (the two-ring when the Chaikin
-        semi-sharp phase needs it), building its template on first use (:meth:`_face_template`)."""
+        """Register quad ``g`` of ``cx`` (as in :meth:`corner_at`) with its ring read from corner 0 (the
+        two-ring when the Chaikin semi-sharp phase needs it), building its template on first use
+        (:meth:`_face_template`)."""
         ring, faces, nr = canonical_ring(cx, g, 0, 1)
         key = ring_key(cx, ring, faces, nr)
         if self.depth_semi != 1 and _has_semi_sharp(key):
@@ -1152,7 +1177,7 @@ def catmark_step(mesh):
     the same values to round-off. This is the one step not built on
     :func:`ccproof.mesh.step.catmark_operator` (``S @ X``): assembling the operator costs the setup
     of a triangle mesh 2 to 27 % more (median 8 %; ``scripts/bench_step.py``); the same child faces and vertex
-    numbering.
+    numbering. The topology is the mesh's own (``mesh.halfedges``), not paired again.
 
     Parameters
     ----------
@@ -1173,28 +1198,20 @@ def catmark_step(mesh):
             or opts.triangle_subdivision != "catmark" or opts.boundary == "none"):
         return None
     X = np.asarray(mesh.vertices, dtype=np.float64)
-    idx = np.asarray(mesh.indices, dtype=np.int64)
-    sizes = np.asarray(mesh.sizes, dtype=np.int64)
-    off = np.asarray(mesh.offsets, dtype=np.int64)[:sizes.size]
-    n, m, H = X.shape[0], sizes.size, idx.size
-    face = np.repeat(np.arange(m), sizes)
-    pos = np.arange(H) - off[face]
-    nxt = off[face] + (pos + 1) % sizes[face]
-    prv = off[face] + (pos - 1) % sizes[face]
-    org, dst = idx, idx[nxt]
-    if np.unique(org * n + dst).size != H:  # a directed edge twice: non-manifold or misoriented
+    he = mesh.halfedges  # the mesh's own topology: no pairing of the half-edges again
+    idx, sizes, off = he.org, he.sizes, he.start
+    n, m = X.shape[0], sizes.size
+    face, prv = he.face_of, he.prv
+    org, dst = idx, idx[he.nxt]
+    if not he.edge_manifold:  # a directed edge twice (non-manifold or misoriented), a face holding an edge twice
         return None
-    lo, hi = np.minimum(org, dst), np.maximum(org, dst)
-    uniq, first, inv = np.unique(lo * n + hi, return_index=True, return_inverse=True)
-    inv = inv.reshape(-1)
-    E = uniq.size
-    order = np.argsort(first, kind="stable")
+    first = he.edge_halfedge  # the first half-edge of every edge (edges sorted by their vertices)
+    E = first.size
+    order = np.argsort(first, kind="stable")  # edges by first occurrence along the faces' corners
     rank = np.empty(E, dtype=np.int64)
     rank[order] = np.arange(E)
-    he_edge = rank[inv]  # edge id of every half-edge (first-occurrence order)
-    count = np.bincount(he_edge, minlength=E)
-    if (count > 2).any():
-        return None
+    he_edge = rank[he.edge_of]  # edge id of every half-edge (first-occurrence order)
+    count = he.edge_face_count[order]
     valence = np.bincount(org, minlength=n)  # faces (outgoing half-edges) at every vertex
     if (valence == 0).any():
         return None
@@ -1209,9 +1226,7 @@ def catmark_step(mesh):
     fp = np.add.reduceat(X[idx], off, axis=0) / sizes[:, None] if m else np.zeros((0, 3))
     # edge points
     h1 = first[order]  # the first half-edge of every edge, in edge order
-    h2 = np.full(E, -1, dtype=np.int64)
-    second = np.flatnonzero(np.arange(H) != first[inv])
-    h2[he_edge[second]] = second
+    h2 = he.twin[h1]  # the other one (-1 on the boundary)
     a, b = org[h1], dst[h1]
     vw, fw = smooth_edge_weights(one)
     ep = 0.5 * (X[a] + X[b])

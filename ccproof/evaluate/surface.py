@@ -38,7 +38,6 @@ from ccproof.evaluate._table import (
     _CORNER,
     _REGULAR,
     _SPLIT,
-    QuadHalfEdges,
     _Builder,
     _Jobs,
     catmark_step,
@@ -48,7 +47,6 @@ from ccproof.evaluate._table import (
 from ccproof.evaluate.bspline import bspline_basis
 from ccproof.mesh import QuadMesh, limit_normals, limit_positions
 from ccproof.mesh.polymesh import PolyMesh
-from ccproof.mesh.rules import Options
 
 __all__ = ["natural_limit_surface", "LimitSurface", "available_backends"]
 
@@ -126,7 +124,7 @@ class LimitSurface:
             raise CCProofError(f"LimitSurface takes a QuadMesh or a PolyMesh, not {type(mesh).__name__}")
         self._hole_ptex = self._ptex_face = None
         b = _Builder(progress=progress)
-        cx = QuadHalfEdges(mesh.faces, mesh.n_vertices, Options())
+        cx = mesh.halfedges  # the mesh's own topology (untagged, default options)
         base = ((0.0, 0.0), (1.0, 0.0), (0.0, 1.0))
         m = mesh.n_faces
         b.classify(cx, mesh.vertices, _Jobs(np.arange(m), np.zeros(m, np.int64), np.arange(m), [base]),

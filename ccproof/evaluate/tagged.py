@@ -33,9 +33,9 @@ import math
 
 import numpy as np
 
-from ccproof.evaluate._table import QuadHalfEdges, _Builder, _child_frame, _compose, _domain, _Jobs, catmark_step
+from ccproof.evaluate._table import TaggedHalfEdges, _Builder, _child_frame, _compose, _domain, _Jobs, catmark_step
+from ccproof.mesh.halfedges import HalfEdges
 from ccproof.mesh.polymesh import PolyMesh
-from ccproof.mesh.rules import Complex
 
 __all__ = ["build_tagged", "vertex_corners"]
 
@@ -78,31 +78,25 @@ def build_tagged(mesh: PolyMesh, progress=None):
     if mesh.is_all_quads:
         # no global step needed: start on the base mesh, with the one level-0-only rule that
         # can act on quads (EDGE_AND_CORNER sharpens one-face boundary vertices) made explicit
-        if not mesh.has_tags:  # untagged: the half-edge arrays directly (no Python complex)
-            cx = QuadHalfEdges(mesh.indices.reshape(-1, 4), mesh.n_vertices, mesh.options)
-        else:
-            cx = mesh.complex()
+        he = mesh.halfedges
+        if mesh.edge_sharpness or mesh.vertex_sharpness or mesh.options.boundary == "edge_and_corner":
+            vv = he.vertex_tags().copy()
             if mesh.options.boundary == "edge_and_corner":
-                vs = dict(cx.vertex_sharpness)
-                for v in range(mesh.n_vertices):
-                    fan, closed = cx.fan(v)
-                    if fan is not None and not closed and len(fan) == 1:
-                        vs[v] = math.inf
-                cx = Complex(cx.faces, cx.edge_sharpness, vs, cx.options, level=1, n_vertices=cx.n_vertices)
-            if not cx.edge_sharpness and not cx.vertex_sharpness:
-                cx = QuadHalfEdges(cx.faces, cx.n_vertices, cx.options)
+                vv[(he.face_count == 1) & he.is_boundary_vertex] = math.inf
+            if mesh.edge_sharpness or vv.any():  # tagged: the tags enter the rings' keys
+                he = TaggedHalfEdges.of(he.with_tags(mesh.edge_sharpness, vertex_values=vv))
         ptex_face[:] = np.arange(mesh.n_faces)
         m = mesh.n_faces
-        b.classify(cx, np.asarray(mesh.vertices), _Jobs(np.arange(m), np.zeros(m, np.int64), np.arange(m), [ident]))
+        b.classify(he, np.asarray(mesh.vertices), _Jobs(np.arange(m), np.zeros(m, np.int64), np.arange(m), [ident]))
         top = np.repeat(np.arange(P, dtype=np.int64)[:, None], 4, axis=1)
         return b, top, mesh.is_hole[ptex_face], ptex_face
-    step = catmark_step(mesh)  # untagged: vectorized, and the level-1 complex as arrays
+    step = catmark_step(mesh)  # untagged: vectorized, and the level-1 mesh as half-edge arrays
     if step is not None:
         X = step[0]
-        cx = QuadHalfEdges(step[1], X.shape[0], mesh.options)
-    else:
+        he = HalfEdges.from_quads(step[1], X.shape[0], mesh.options, edges=False)
+    else:  # tagged: the level-1 mesh's own topology, with its tags (no Python complex of the mesh)
         m1, _ = mesh.refine(operator=False)
-        cx = m1.complex()
+        he = TaggedHalfEdges.of(m1.halfedges)
         X = np.asarray(m1.vertices)
     # jobs: sub-face i of an n-gon is level-1 child i (same (s, t)), its own ptex face; a quad is
     # one ptex face whose four level-1 children are its quadrants (frames: the child frames)
@@ -129,8 +123,8 @@ def build_tagged(mesh: PolyMesh, progress=None):
     top[ptex[nq]] = jid[nq, None]
     qd = np.flatnonzero(is_quad)
     top[ptex[qd], np.asarray(quarter_q)[corner[qd]]] = jid[qd]
-    b.classify(cx, X, _Jobs(g, fid, ptex, frames))
-    del cx, step, g, fid, ptex, face, corner, is_quad, jid  # before the table's float data
+    b.classify(he, X, _Jobs(g, fid, ptex, frames))
+    del he, step, g, fid, ptex, face, corner, is_quad, jid  # before the table's float data
     return b, top, mesh.is_hole[ptex_face], ptex_face
 
 
@@ -153,16 +147,11 @@ def vertex_corners(mesh: PolyMesh):
     """
     from ccproof.evaluate.local import CORNERS
 
-    faces, us, vs, verts = [], [], [], []
-    for f, p in enumerate(mesh.polygons):
-        for i, v in enumerate(p):
-            if len(p) == 4:
-                faces.append(int(mesh.ptex_start[f]))
-                us.append(float(CORNERS[i][0]))
-                vs.append(float(CORNERS[i][1]))
-            else:
-                faces.append(int(mesh.ptex_start[f]) + i)
-                us.append(0.0)
-                vs.append(0.0)
-            verts.append(v)
-    return np.array(faces, dtype=np.int64), np.array(us), np.array(vs), np.array(verts, dtype=np.int64)
+    sizes = np.asarray(mesh.sizes, dtype=np.int64)
+    face = np.repeat(np.arange(sizes.size), sizes)
+    corner = np.arange(face.size) - np.asarray(mesh.offsets, dtype=np.int64)[face]
+    quad = sizes[face] == 4
+    st = np.asarray(CORNERS, dtype=np.float64)[np.where(quad, corner, 0)]
+    ptex = np.asarray(mesh.ptex_start, dtype=np.int64)[face] + np.where(quad, 0, corner)
+    return (ptex, np.where(quad, st[:, 0], 0.0), np.where(quad, st[:, 1], 0.0),
+            np.asarray(mesh.indices, dtype=np.int64).copy())

@@ -33,7 +33,8 @@ import math
 import numpy as np
 
 from ccproof.errors import MeshError
-from ccproof.mesh.quadmesh import _check_used_finite, connected_components
+from ccproof.mesh.halfedges import HalfEdges
+from ccproof.mesh.quadmesh import _check_used_finite
 from ccproof.mesh.rules import INFINITE, Complex, Options, refine_complex
 
 __all__ = ["PolyMesh"]
@@ -83,6 +84,9 @@ class PolyMesh:
         ``self`` when :attr:`is_manifold`, else the split mesh (same faces, vertices
         ``vertices[manifold_vertex_map]``).
     manifold_vertex_map : ndarray of int, shape (n',)
+    halfedges : HalfEdges
+        The topology (:class:`~ccproof.mesh.halfedges.HalfEdges`: ``twin``, ``next``, ``prev``, ``edges``
+        ... above are its arrays), with the edge and vertex sharpness as its tag arrays.
 
     Examples
     --------
@@ -103,6 +107,9 @@ class PolyMesh:
     ...
     ccproof.errors.MeshError: crease on edge (0, 2): negative sharpness -1.0
     """
+
+    #: the one topology (:class:`~ccproof.mesh.halfedges.HalfEdges`), with the tags as arrays
+    halfedges: HalfEdges
 
     def __init__(self, vertices, faces, *, creases=None, corners=None, holes=None, options=None, sizes=None,
                  _split=True):
@@ -144,6 +151,8 @@ class PolyMesh:
         self._build_topology()
         self.edge_sharpness = self._creases(creases)
         self.vertex_sharpness = self._corners(corners)
+        if self.edge_sharpness or self.vertex_sharpness:  # the tags as arrays on the one topology
+            self.halfedges = self.halfedges.with_tags(self.edge_sharpness, self.vertex_sharpness)
         m = int(sz.size)
         hole = np.zeros(m, dtype=bool)
         for f in [] if holes is None else list(holes):
@@ -214,7 +223,8 @@ class PolyMesh:
         return out
 
     def _build_topology(self):
-        """Edges, twins and fans; OpenSubdiv's non-manifold edges and vertices (``Vtr::Level``).
+        """Edges, twins and fans (:class:`~ccproof.mesh.halfedges.HalfEdges`, built once: ``self.halfedges``);
+        OpenSubdiv's non-manifold edges and vertices (``Vtr::Level``).
 
         An edge is non-manifold when more than two faces share it or two faces traverse it in the
         same direction (``completeTopologyFromFaceVertices``; a face given twice is such a case); a
@@ -222,62 +232,25 @@ class PolyMesh:
         fan (``orderVertexFacesAndEdges``). Twins exist only across manifold edges.
         """
         n = self.vertices.shape[0]
-        off, idx = self.offsets, self.indices
-        H = idx.size
-        face_of = np.repeat(np.arange(self.sizes.size), self.sizes)
-        loc = np.arange(H) - off[face_of]
-        nxt = off[face_of] + (loc + 1) % self.sizes[face_of]
-        prv = off[face_of] + (loc - 1) % self.sizes[face_of]
-        org, dst = idx, idx[nxt]
-        lo, hi = np.minimum(org, dst), np.maximum(org, dst)
-        order = np.argsort(lo * n + hi, kind="stable")
-        sk = (lo * n + hi)[order]
-        starts = np.flatnonzero(np.r_[True, sk[1:] != sk[:-1]])
-        counts = np.diff(np.r_[starts, H])
-        edge_of = np.empty(H, dtype=np.int64)
-        edge_of[order] = np.repeat(np.arange(starts.size), counts)
-        nm_edge = counts > 2
-        two = np.flatnonzero(counts == 2)
-        h1, h2 = order[starts[two]], order[starts[two] + 1]
-        same = (org[h1] == org[h2]) | (face_of[h1] == face_of[h2])  # same direction, or twice in one face
-        nm_edge[two[same]] = True
+        he = HalfEdges(self.indices, self.offsets, n, self.options)
+        self.halfedges = he
         # a face repeating a vertex: a degenerate edge (v, v), or an edge the face holds twice; OpenSubdiv
         # gives each such occurrence an edge of its own with one face (a boundary edge), so that both
         # ends are sharpened (corners)
-        degenerate = lo[order[starts]] == hi[order[starts]]
-        fe = np.unique(edge_of * self.sizes.size + face_of, return_counts=True)
-        held_twice = np.zeros(starts.size, dtype=bool)
-        held_twice[fe[0][fe[1] > 1] // self.sizes.size] = True
-        nm_edge |= degenerate | held_twice
-        self._repeat_edge = degenerate | held_twice
-        ends = np.flatnonzero(degenerate | held_twice)
+        self._repeat_edge = he.repeat_edge
         self._sharpened_by_degenerate = np.zeros(n, dtype=bool)
-        self._sharpened_by_degenerate[lo[order[starts[ends]]]] = True
-        self._sharpened_by_degenerate[hi[order[starts[ends]]]] = True
-        twin = np.full(H, -1, dtype=np.int64)
-        twin[h1[~same]], twin[h2[~same]] = h2[~same], h1[~same]
-        first = order[starts]
-        self._edge_halfedge = first  # one half-edge of every edge
-        self.edges = np.stack([lo[first], hi[first]], axis=1)
-        self.edge_face_count = counts
-        self.is_boundary_edge = counts == 1
-        self.is_nonmanifold_edge = nm_edge
-        self.twin, self.next, self.prev, self.face_of_halfedge = twin, nxt, prv, face_of
-        self.edge_of_halfedge = edge_of
-        self.face_count = np.bincount(org, minlength=n)
-        # fans: rot(c) = twin(prev(c)) is the next corner counter-clockwise around org(c); the corners
-        # joined by rot are the fans (OpenSubdiv's spans between singular edges)
-        rot = twin[prv]
-        ok = np.flatnonzero(rot >= 0)
-        ncomp, comp = connected_components(H, ok, rot[ok])
-        vertex_of_comp = np.zeros(ncomp, dtype=np.int64)
-        vertex_of_comp[comp] = org
-        nfans = np.bincount(vertex_of_comp, minlength=n)
-        nm_vertex = nfans > 1
-        nm_vertex[self.edges[nm_edge].reshape(-1)] = True
-        self.is_nonmanifold_vertex = nm_vertex
-        self._fan_of_corner = comp
-        self.is_boundary_vertex = np.bincount(org[counts[edge_of] == 1], minlength=n) > 0
+        self._sharpened_by_degenerate[he.edges[he.repeat_edge].reshape(-1)] = True
+        self._edge_halfedge = he.edge_halfedge  # one half-edge of every edge
+        self.edges = he.edges
+        self.edge_face_count = he.edge_face_count
+        self.is_boundary_edge = he.edge_face_count == 1
+        self.is_nonmanifold_edge = he.is_nonmanifold_edge
+        self.twin, self.next, self.prev, self.face_of_halfedge = he.twin, he.nxt, he.prv, he.face_of
+        self.edge_of_halfedge = he.edge_of
+        self.face_count = he.face_count
+        self.is_nonmanifold_vertex = he.is_nonmanifold_vertex
+        self._fan_of_corner = he.fan_of_corner
+        self.is_boundary_vertex = he.is_boundary_vertex
         self.is_unused_vertex = self.face_count == 0
 
     @property
@@ -394,8 +367,9 @@ class PolyMesh:
         for h in hs[nm_e[edge_of]].tolist():
             a, b = int(new[h]), int(new[nxt[h]])
             creases[(min(a, b), max(a, b))] = math.inf
-        for (a, b), x in self.edge_sharpness.items():
-            e = self.edge_index[(a, b)]
+        tagged = list(self.edge_sharpness.items())
+        eids = self.halfedges.edge_index_of([a for (a, _), _ in tagged], [b for (_, b), _ in tagged]).tolist()
+        for (_, x), e in zip(tagged, eids):
             if nm_e[e]:
                 continue
             h = int(self._edge_halfedge[e])
@@ -430,15 +404,28 @@ class PolyMesh:
             E = np.asarray(E).reshape(-1, 2)
             S = np.broadcast_to(np.asarray(S, dtype=object), (E.shape[0],))
             items = [((a, b), s) for (a, b), s in zip(E.tolist(), S.tolist())]
-        for (a, b), s in items:
-            a, b = int(a), int(b)
-            what = f"crease on edge ({a}, {b})"
-            sv = _sharp_value(s, what)
+        # the values checked item by item, the edges looked up at once (no dict of all the mesh's edges);
+        # the first bad item, in order, named
+        ab, sv, err = [], [], None
+        try:
+            for (a, b), s in items:
+                a, b = int(a), int(b)
+                x = _sharp_value(s, f"crease on edge ({a}, {b})")
+                ab.append((a, b))
+                sv.append(x)
+        except (MeshError, TypeError, ValueError) as exc:  # raised after any missing edge before it
+            err = exc
+        A = np.array(ab, dtype=np.int64).reshape(-1, 2)
+        missing = np.flatnonzero(self.halfedges.edge_index_of(A[:, 0], A[:, 1]) < 0)
+        if missing.size:
+            a, b = ab[int(missing[0])]
+            raise MeshError(f"crease on edge ({a}, {b}): no such edge in the mesh")
+        if err is not None:
+            raise err
+        for (a, b), x in zip(ab, sv):
             k = (min(a, b), max(a, b))
-            if k not in self.edge_index:
-                raise MeshError(f"{what}: no such edge in the mesh")
-            if sv > 0:
-                out[k] = sv
+            if x > 0:
+                out[k] = x
             else:
                 out.pop(k, None)
         return out
@@ -476,10 +463,7 @@ class PolyMesh:
             a, b = self.edges[e]
             if not math.isinf(self.edge_sharpness.get((int(a), int(b)), 0.0)):
                 bad_vertex[a] = bad_vertex[b] = True
-        for f, p in enumerate(self.polygons):
-            if bad_vertex[list(p)].any():
-                out[f] = True
-        return out
+        return np.logical_or.reduceat(bad_vertex[self.indices], self.offsets[:-1])
 
     # ------------------------------------------------------------------ accessors
     @property

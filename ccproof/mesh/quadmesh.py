@@ -16,7 +16,8 @@ vertex). The constructor checks everything the subdivision and evaluation layers
 
 Half-edge conventions (used throughout ccproof): half-edge ``h = 4 f + i`` runs from
 ``faces[f, i]`` to ``faces[f, (i + 1) % 4]``; it is also the *corner* of face ``f`` at vertex
-``faces[f, i]``. ``twin[h]`` is the opposite half-edge, ``-1`` on the boundary.
+``faces[f, i]``. ``twin[h]`` is the opposite half-edge, ``-1`` on the boundary. The arrays are those
+of the mesh's :class:`~ccproof.mesh.halfedges.HalfEdges` (``mesh.halfedges``, built once).
 """
 
 from __future__ import annotations
@@ -24,29 +25,28 @@ from __future__ import annotations
 import numpy as np
 
 from ccproof.errors import MeshError
+from ccproof.mesh.halfedges import HalfEdges, connected_components
+from ccproof.mesh.rules import Options
 
-__all__ = ["QuadMesh"]
+__all__ = ["QuadMesh", "connected_components"]
 
 
 def _edge_str(a, b):
     return f"edge ({int(a)}, {int(b)})"
 
 
-def _pair_halfedges(org, dst, face_of, n):
-    """Undirected edges and twins of the half-edges org -> dst (face ``face_of``) of a mesh with n vertices.
-
-    Returns ``(lo, hi, order, starts, counts, edge_of, twin)``: per half-edge the edge's end points
-    (lo < hi); the half-edges sorted by edge (``order``), where each edge starts and how many half-edges
-    it has; the edge of each half-edge and its twin (-1 on the boundary). Raises :class:`MeshError`
-    naming the edge and faces when an edge has more than two faces or two faces traverse it the same way.
-    """
+def _check_pairing(he):
+    """Raise :class:`MeshError` naming the edge and faces when an edge of the half-edges ``he``
+    (:class:`~ccproof.mesh.halfedges.HalfEdges`) has more than two faces or two faces traverse it the
+    same way (a face given twice, the likeliest cause, named as such)."""
+    counts = he.edge_face_count
+    if not (counts > 2).any() and not he._same.size:
+        return
+    org, face_of = he.org, he.face_of
+    order = np.argsort(he.edge_of, kind="stable")  # the half-edges by edge
+    starts = np.r_[0, np.cumsum(counts)[:-1]]
     H = org.size
-    lo, hi = np.minimum(org, dst), np.maximum(org, dst)
-    ukey = lo * n + hi
-    order = np.argsort(ukey, kind="stable")
-    sk = ukey[order]
-    starts = np.flatnonzero(np.r_[True, sk[1:] != sk[:-1]])
-    counts = np.diff(np.r_[starts, H])
+    dst = org[he.nxt]
     bad = (counts > 2) | ((counts == 2) & (org[order[starts]] == org[order[np.minimum(starts + 1, H - 1)]]))
     if bad.any():  # a face given twice is the likeliest cause: name it
         g = int(np.flatnonzero(bad)[0])
@@ -56,13 +56,11 @@ def _pair_halfedges(org, dst, face_of, n):
     if (counts > 2).any():
         g = int(np.flatnonzero(counts > 2)[0])
         hs = order[starts[g] : starts[g] + counts[g]]
+        lo, hi = he.edges[g]
         raise MeshError(
-            f"non-manifold {_edge_str(lo[hs[0]], hi[hs[0]])}: shared by {int(counts[g])} faces "
+            f"non-manifold {_edge_str(lo, hi)}: shared by {int(counts[g])} faces "
             f"{sorted(int(face_of[h]) for h in hs)}"
         )
-    edge_of = np.empty(H, dtype=np.int64)
-    edge_of[order] = np.repeat(np.arange(starts.size), counts)
-    twin = np.full(H, -1, dtype=np.int64)
     two = starts[counts == 2]
     h1, h2 = order[two], order[two + 1]
     same = org[h1] == org[h2]
@@ -73,8 +71,6 @@ def _pair_halfedges(org, dst, face_of, n):
             f"inconsistent orientation: faces {int(face_of[h1[i]])} and {int(face_of[h2[i]])} both traverse "
             f"{_edge_str(a, b)} from {int(a)} to {int(b)}"
         )
-    twin[h1], twin[h2] = h2, h1
-    return lo, hi, order, starts, counts, edge_of, twin
 
 
 def _check_used_finite(V, used):
@@ -111,48 +107,6 @@ def _duplicate_face(org, face_of, hs):
     return None
 
 
-
-def connected_components(n, a, b):
-    """Connected components of the undirected graph on ``range(n)`` with the edges ``(a[i], b[i])``.
-
-    Hooking and pointer jumping in numpy (the mesh's fans: ``scipy.sparse.csgraph`` would cost its
-    import, ~0.2 s, in every process that reads a mesh).
-
-    Parameters
-    ----------
-    n : int
-    a, b : ndarray of int, shape (m,)
-
-    Returns
-    -------
-    ncomp : int
-    label : ndarray of int64, shape (n,)
-        Component of every node, numbered in the order of their smallest node (as
-        ``scipy.sparse.csgraph.connected_components`` numbers them).
-
-    Examples
-    --------
-    >>> ncomp, label = connected_components(6, np.array([4, 1, 5]), np.array([1, 4, 3]))
-    >>> ncomp, label.tolist()
-    (4, [0, 1, 2, 3, 1, 3])
-    """
-    lab = np.arange(n, dtype=np.int64)
-    a = np.asarray(a, dtype=np.int64)
-    b = np.asarray(b, dtype=np.int64)
-    while a.size:
-        la, lb = lab[a], lab[b]
-        lo, hi = np.minimum(la, lb), np.maximum(la, lb)
-        diff = lo != hi
-        if not diff.any():
-            break
-        np.minimum.at(lab, hi[diff], lo[diff])  # hook: hi and lo are roots, lo < hi (no cycles)
-        while True:  # shortcut every node to its root
-            nxt = lab[lab]
-            if np.array_equal(nxt, lab):
-                break
-            lab = nxt
-    roots, label = np.unique(lab, return_inverse=True)
-    return int(roots.size), label.astype(np.int64, copy=False)
 
 class QuadMesh:
     """An all-quad, manifold, consistently oriented control mesh (bmz04 section 2).
@@ -261,28 +215,24 @@ class QuadMesh:
         F = self.faces
         n, m = self.vertices.shape[0], F.shape[0]
         H = 4 * m
-        org = F.reshape(-1)
-        dst = np.roll(F, -1, axis=1).reshape(-1)
-        lo, hi, order, starts, counts, edge_of, twin = _pair_halfedges(org, dst, np.arange(H) // 4, n)
+        he = self.halfedges = HalfEdges.from_quads(F, n, Options())
+        _check_pairing(he)
+        org, twin = he.org, he.twin
         self.twin = twin
-        self.edge_of_halfedge = edge_of
-        first = order[starts]
-        self.edges = np.stack([lo[first], hi[first]], axis=1)
-        self.edge_faces = np.full((starts.size, 2), -1, dtype=np.int64)
+        self.edge_of_halfedge = he.edge_of
+        self.edges = he.edges
+        first, counts = he.edge_halfedge, he.edge_face_count
+        self.edge_faces = np.full((counts.size, 2), -1, dtype=np.int64)
         self.edge_faces[:, 0] = first // 4
-        self.edge_faces[counts == 2, 1] = order[starts[counts == 2] + 1] // 4
+        self.edge_faces[counts == 2, 1] = twin[first[counts == 2]] // 4
         self.is_boundary_edge = counts == 1
 
         # vertices: corners, fans
-        face_count = np.bincount(org, minlength=n)
+        face_count = he.face_count
         unused = face_count == 0  # allowed (scans have them): no surface, no valence, indices kept
         # rot(c): next corner counter-clockwise around the same vertex = twin(prev(c))
-        prev = (np.arange(H) // 4) * 4 + (np.arange(H) + 3) % 4
-        rot = twin[prev]
-        ok = rot >= 0
-        ncomp, label = connected_components(H, np.arange(H)[ok], rot[ok])
-        pairs = np.unique(org * ncomp + label)
-        nfans = np.bincount(pairs // ncomp, minlength=n)
+        rot = twin[he.prv]
+        nfans = he.n_fans
         if (nfans > 1).any():
             v = int(np.flatnonzero(nfans > 1)[0])
             raise MeshError(

@@ -1,0 +1,362 @@
+"""The one topology type of ccproof: the half-edge arrays of a polygon mesh, built once with numpy.
+
+A :class:`HalfEdges` is what OpenSubdiv's ``Vtr::Level`` is to its meshes: flat arrays, no Python
+object per face. :class:`~ccproof.mesh.polymesh.PolyMesh` and :class:`~ccproof.mesh.quadmesh.QuadMesh`
+build their topology through it (``mesh.halfedges``); the evaluator reads it (the compiled ring walk
+reads ``org``, ``nxt``, ``prv``, ``twin``; the tagged walk the tag arrays); a level-1 all-quad mesh
+of the evaluator's own step is one built from its ``(m, 4)`` faces (:meth:`HalfEdges.from_quads`).
+
+Conventions: half-edge ``h = offsets[f] + i`` is corner i of face f, running from ``indices[h]`` to
+the face's next corner (for an all-quad mesh ``h = 4 f + i``). Non-manifold edges (more than two
+faces, two faces traversing it the same way, a face holding it twice, a degenerate edge ``(v, v)``)
+get no twin: twins exist only across manifold edges (OpenSubdiv's ``Vtr::Level``).
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+
+import numpy as np
+
+__all__ = ["HalfEdges", "connected_components"]
+
+
+def connected_components(n, a, b):
+    """Connected components of the undirected graph on ``range(n)`` with the edges ``(a[i], b[i])``.
+
+    Hooking and pointer jumping in numpy (the mesh's fans: ``scipy.sparse.csgraph`` would cost its
+    import, ~0.2 s, in every process that reads a mesh).
+
+    Parameters
+    ----------
+    n : int
+    a, b : ndarray of int, shape (m,)
+
+    Returns
+    -------
+    ncomp : int
+    label : ndarray of int64, shape (n,)
+        Component of every node, numbered in the order of their smallest node (as
+        ``scipy.sparse.csgraph.connected_components`` numbers them).
+
+    Examples
+    --------
+    >>> ncomp, label = connected_components(6, np.array([4, 1, 5]), np.array([1, 4, 3]))
+    >>> ncomp, label.tolist()
+    (4, [0, 1, 2, 3, 1, 3])
+    """
+    lab = np.arange(n, dtype=np.int64)
+    a = np.asarray(a, dtype=np.int64)
+    b = np.asarray(b, dtype=np.int64)
+    while a.size:
+        la, lb = lab[a], lab[b]
+        lo, hi = np.minimum(la, lb), np.maximum(la, lb)
+        diff = lo != hi
+        if not diff.any():
+            break
+        np.minimum.at(lab, hi[diff], lo[diff])  # hook: hi and lo are roots, lo < hi (no cycles)
+        while True:  # shortcut every node to its root
+            nxt = lab[lab]
+            if np.array_equal(nxt, lab):
+                break
+            lab = nxt
+    roots, label = np.unique(lab, return_inverse=True)
+    return int(roots.size), label.astype(np.int64, copy=False)
+
+
+class HalfEdges:
+    """The half-edge arrays of a polygon mesh (any face sizes, manifold or not), with optional tags.
+
+    Parameters
+    ----------
+    indices : array_like of int, shape (H,)
+        The faces' vertex indices, face after face (counter-clockwise).
+    offsets : array_like of int, shape (m + 1,)
+        Face f is ``indices[offsets[f]:offsets[f + 1]]``.
+    n_vertices : int
+    options : ccproof.mesh.rules.Options, optional
+        The Sdc options the tags are read under (the evaluator's keys carry them).
+    edges : bool
+        Keep the undirected edge arrays (else computed again on first use; see :meth:`from_quads`).
+
+    Attributes
+    ----------
+    org, nxt, prv, twin, face_of, edge_of : ndarray of int64, shape (H,)
+        Origin vertex, next and previous half-edge in the face, opposite half-edge (-1 on the
+        boundary and across non-manifold edges), face, undirected edge.
+    start, sizes : ndarray of int64, shape (m,)
+        First half-edge and number of corners of every face.
+    edges : ndarray of int64, shape (E, 2)
+        Undirected edges ``(lo, hi)``, numbered in the order of ``lo * n + hi``.
+    edge_face_count : ndarray of int64, shape (E,)
+        Half-edges (face corners) on every edge.
+    edge_halfedge : ndarray of int64, shape (E,)
+        The smallest half-edge of every edge.
+    edge_keys : ndarray of int64, shape (e,)
+        Tags: ``a * n_vertices + b`` (``a < b``) of the interior edges with sharpness, sorted.
+    edge_values : ndarray of float64, shape (e,)
+        Their sharpness (``inf`` from 10 on, OpenSubdiv's infinite sharpness).
+    vertex_values : ndarray of float64, shape (n_vertices,)
+        Vertex sharpness (0 where none; ``inf`` from 10 on).
+
+    Examples
+    --------
+    Two quads sharing the edge (1, 4):
+
+    >>> he = HalfEdges([0, 1, 4, 3, 1, 2, 5, 4], [0, 4, 8], 6)
+    >>> he.twin.tolist(), he.edges.shape, int(he.edge_face_count.max())
+    ([-1, 7, -1, -1, -1, -1, -1, 1], (7, 2), 2)
+    >>> HalfEdges.from_quads([[0, 1, 4, 3], [1, 2, 5, 4]], 6).twin.tolist() == he.twin.tolist()
+    True
+    """
+
+    def __init__(self, indices, offsets, n_vertices, options=None, edges=True):
+        org = np.asarray(indices, dtype=np.int64).reshape(-1)
+        off = np.asarray(offsets, dtype=np.int64).reshape(-1)
+        self.n_vertices = int(n_vertices)
+        sizes = np.diff(off)
+        H = org.size
+        self.offsets, self.sizes, self.start = off, sizes, off[:-1]
+        self.org = org
+        self.options = options
+        #: the one face size of every face (4: all quads), or 0 (mixed sizes)
+        self.uniform = int(sizes[0]) if sizes.size and (sizes == sizes[0]).all() else 0
+        if self.uniform:  # no per-corner face index needed
+            k = self.uniform
+            h = np.arange(H, dtype=np.int64)
+            loc = h % k
+            h -= loc
+            self.nxt = h + (loc + 1) % k
+            self.prv = h + (loc - 1) % k
+            del h, loc
+        else:
+            face_of = self.face_of
+            loc = np.arange(H, dtype=np.int64) - off[face_of]
+            self.nxt = off[face_of] + (loc + 1) % sizes[face_of]
+            self.prv = off[face_of] + (loc - 1) % sizes[face_of]
+            del loc
+        pairing = self._pair()
+        self.twin = pairing["twin"]
+        #: every edge has one or two faces, traversed in opposite directions by different faces
+        self.edge_manifold = bool(not (pairing["edge_face_count"] > 2).any() and not pairing["same"].size)
+        if edges:
+            self.__dict__["_pairing"] = pairing
+        self.edge_keys = np.zeros(0, dtype=np.int64)
+        self.edge_values = np.zeros(0, dtype=np.float64)
+        self.vertex_values = None
+
+    def _pair(self):
+        """The undirected edges (sorted by ``lo * n + hi``, a stable sort of the half-edges) and the twins."""
+        org, n = self.org, self.n_vertices
+        H = org.size
+        dst = org[self.nxt]
+        lo = np.minimum(org, dst)
+        hi = np.maximum(org, dst)
+        del dst
+        key = lo * n + hi
+        order = np.argsort(key, kind="stable")
+        sk = key[order]
+        del key
+        starts = np.flatnonzero(np.r_[True, sk[1:] != sk[:-1]]) if H else np.zeros(0, dtype=np.int64)
+        del sk
+        counts = np.diff(np.r_[starts, H])
+        two = np.flatnonzero(counts == 2)
+        h1, h2 = order[starts[two]], order[starts[two] + 1]
+        if self.uniform:
+            f1, f2 = h1 // self.uniform, h2 // self.uniform
+        else:
+            f1, f2 = self.face_of[h1], self.face_of[h2]
+        same = (org[h1] == org[h2]) | (f1 == f2)  # same direction, or twice in one face
+        twin = np.full(H, -1, dtype=np.int64)
+        twin[h1[~same]], twin[h2[~same]] = h2[~same], h1[~same]
+        del h1, h2, f1, f2
+        edge_of = np.empty(H, dtype=np.int64)
+        edge_of[order] = np.repeat(np.arange(starts.size), counts)
+        first = order[starts]
+        return {"twin": twin, "edge_of": edge_of, "edges": np.stack([lo[first], hi[first]], axis=1),
+                "edge_face_count": counts, "edge_halfedge": first, "same": two[same]}
+
+    @functools.cached_property
+    def _pairing(self):
+        return self._pair()
+
+    @functools.cached_property
+    def face_of(self):
+        """int64 (H,): the face of every half-edge."""
+        return np.repeat(np.arange(self.sizes.size, dtype=np.int64), self.sizes)
+
+    @property
+    def edge_of(self):
+        return self._pairing["edge_of"]
+
+    @property
+    def edges(self):
+        return self._pairing["edges"]
+
+    @property
+    def edge_face_count(self):
+        return self._pairing["edge_face_count"]
+
+    @property
+    def edge_halfedge(self):
+        return self._pairing["edge_halfedge"]
+
+    @property
+    def _same(self):
+        return self._pairing["same"]
+
+    @classmethod
+    def from_quads(cls, faces, n_vertices, options=None, edges=True):
+        """The half-edges of an all-quad mesh given as an ``(m, 4)`` array (half-edge ``4 f + i``).
+
+        ``edges=False``: the edge arrays (``edges``, ``edge_of``, ...) are not kept but recomputed on
+        first use (what the ring walk reads, ``org``, ``nxt``, ``prv``, ``twin``, costs no more memory).
+        """
+        F = np.asarray(faces, dtype=np.int64).reshape(-1, 4)
+        return cls(F.reshape(-1), 4 * np.arange(F.shape[0] + 1, dtype=np.int64), n_vertices, options, edges)
+
+    # ------------------------------------------------------------------ tags
+    def with_tags(self, edge_sharpness=None, vertex_sharpness=None, vertex_values=None):
+        """The same arrays (shared, not copied) with the tags of ``edge_sharpness`` (dict ``{(a, b): s}``)
+        and ``vertex_sharpness`` (dict ``{v: s}``) or ``vertex_values`` (float (n_vertices,)) as tag
+        arrays (see the class docstring); sharpness on boundary or non-manifold edges is left out (sharp
+        by the topology)."""
+        new = object.__new__(type(self))
+        new.__dict__.update(self.__dict__)
+        new.__dict__.pop("has_tags", None)  # (the cached arrays are shared)
+        nv = self.n_vertices
+        keys = np.zeros(0, dtype=np.int64)
+        vals = np.zeros(0, dtype=np.float64)
+        if edge_sharpness:
+            ab = np.array(list(edge_sharpness.keys()), dtype=np.int64).reshape(-1, 2)
+            s = np.array(list(edge_sharpness.values()), dtype=np.float64)
+            a, b = ab.min(axis=1), ab.max(axis=1)
+            k = a * nv + b
+            e = self.edge_index_of(a, b)
+            ok = (s > 0.0) & (e >= 0)
+            ok[ok] = self.twin[self.edge_halfedge[e[ok]]] >= 0
+            order = np.argsort(k[ok], kind="stable")
+            keys = k[ok][order]
+            vals = np.where(s[ok] >= 10.0, math.inf, s[ok])[order]
+        new.edge_keys, new.edge_values = keys, vals
+        if vertex_values is None and vertex_sharpness:
+            vertex_values = np.zeros(nv, dtype=np.float64)
+            vs = np.array(list(vertex_sharpness.keys()), dtype=np.int64)
+            x = np.array(list(vertex_sharpness.values()), dtype=np.float64)
+            ok = (x > 0.0) & (vs >= 0) & (vs < nv)
+            vertex_values[vs[ok]] = np.where(x[ok] >= 10.0, math.inf, x[ok])
+        elif vertex_values is not None:
+            vertex_values = np.where(vertex_values >= 10.0, math.inf, np.maximum(vertex_values, 0.0))
+        new.vertex_values = vertex_values
+        return new
+
+    @functools.cached_property
+    def has_tags(self):
+        """Edge or vertex tags present (boundary edges do not count: sharp by the topology)."""
+        return bool(self.edge_keys.size or (self.vertex_values is not None and self.vertex_values.any()))
+
+    def vertex_tags(self):
+        """float64 (n_vertices,): the vertex sharpness (zeros when untagged)."""
+        return self.vertex_values if self.vertex_values is not None else np.zeros(self.n_vertices)
+
+    def edge_index_of(self, a, b):
+        """The edge ids of the vertex pairs ``(a, b)`` (arrays of int, either order), -1 where no edge."""
+        a, b = np.asarray(a, dtype=np.int64), np.asarray(b, dtype=np.int64)
+        lo, hi = np.minimum(a, b), np.maximum(a, b)
+        if not self.edges.shape[0]:
+            return np.full(lo.shape, -1, dtype=np.int64)
+        ek = self.edges[:, 0] * self.n_vertices + self.edges[:, 1]  # sorted (edge numbering)
+        k = lo * self.n_vertices + hi
+        i = np.minimum(np.searchsorted(ek, k), ek.size - 1)
+        return np.where((ek[i] == k) & (lo >= 0) & (hi < self.n_vertices), i, -1)
+
+    def edge_sharpness_at(self, a, b):
+        """float64: the tag sharpness of the vertex pairs ``(a, b)`` (0 where untagged, boundary or no edge)."""
+        a, b = np.asarray(a, dtype=np.int64), np.asarray(b, dtype=np.int64)
+        if not self.edge_keys.size:
+            return np.zeros(np.broadcast(a, b).shape)
+        k = np.minimum(a, b) * self.n_vertices + np.maximum(a, b)
+        i = np.minimum(np.searchsorted(self.edge_keys, k), self.edge_keys.size - 1)
+        return np.where(self.edge_keys[i] == k, self.edge_values[i], 0.0)
+
+    # ------------------------------------------------------------------ sizes
+    @property
+    def n_faces(self):
+        return int(self.sizes.size)
+
+    @property
+    def faces(self):
+        """int64 (m, 4): the faces of an all-quad mesh (a view of ``org``); ValueError otherwise."""
+        if self.org.size != 4 * self.sizes.size or not (self.sizes == 4).all():
+            raise ValueError("not an all-quad mesh")
+        return self.org.reshape(-1, 4)
+
+    @functools.cached_property
+    def face_count(self):
+        """int64 (n_vertices,): faces (corners) at every vertex."""
+        return np.bincount(self.org, minlength=self.n_vertices)
+
+    # ------------------------------------------------------------------ OpenSubdiv's non-manifold elements
+    @functools.cached_property
+    def repeat_edge(self):
+        """bool (E,): degenerate edges ``(v, v)`` and edges a face holds twice (OpenSubdiv gives each such
+        occurrence an edge of its own with one face, a boundary edge)."""
+        m = max(self.n_faces, 1)
+        degenerate = self.edges[:, 0] == self.edges[:, 1]
+        fe = np.unique(self.edge_of * m + self.face_of, return_counts=True)
+        held_twice = np.zeros(self.edges.shape[0], dtype=bool)
+        held_twice[fe[0][fe[1] > 1] // m] = True
+        return degenerate | held_twice
+
+    @functools.cached_property
+    def is_nonmanifold_edge(self):
+        """bool (E,): more than two faces, two faces in the same direction, or a :attr:`repeat_edge`."""
+        nm = self.edge_face_count > 2
+        nm[self._same] = True
+        return nm | self.repeat_edge
+
+    @functools.cached_property
+    def fan_of_corner(self):
+        """int64 (H,): the fan of every corner (``rot(c) = twin(prv(c))`` joins the corners of a fan:
+        OpenSubdiv's spans between singular edges), numbered in the order of their smallest corner."""
+        rot = self.twin[self.prv]
+        ok = np.flatnonzero(rot >= 0)
+        return connected_components(self.org.size, ok, rot[ok])[1]
+
+    @functools.cached_property
+    def n_fans(self):
+        """int64 (n_vertices,): fans of faces at every vertex (0 for an unused vertex)."""
+        comp = self.fan_of_corner
+        ncomp = int(comp.max()) + 1 if comp.size else 0
+        vertex_of_comp = np.zeros(ncomp, dtype=np.int64)
+        vertex_of_comp[comp] = self.org
+        return np.bincount(vertex_of_comp, minlength=self.n_vertices)
+
+    @functools.cached_property
+    def is_nonmanifold_vertex(self):
+        """bool (n_vertices,): several fans, or an end of a non-manifold edge."""
+        nm = self.n_fans > 1
+        nm[self.edges[self.is_nonmanifold_edge].reshape(-1)] = True
+        return nm
+
+    @functools.cached_property
+    def is_boundary_vertex(self):
+        """bool (n_vertices,): an end of an edge with one face."""
+        one = self.edge_face_count[self.edge_of] == 1
+        return np.bincount(self.org[one], minlength=self.n_vertices) > 0
+
+    @functools.cached_property
+    def vertex_corners(self):
+        """``(ptr, corners)``: the corners of vertex v are ``corners[ptr[v]:ptr[v + 1]]``, increasing."""
+        ptr = np.r_[0, np.cumsum(self.face_count)].astype(np.int64)
+        return ptr, np.argsort(self.org, kind="stable")
+
+    def faces_around(self, vertices):
+        """int64: the faces at any of ``vertices`` (sorted, distinct)."""
+        ptr, corners = self.vertex_corners
+        v = np.asarray(vertices, dtype=np.int64)
+        if v.size == 1:
+            return np.unique(self.face_of[corners[ptr[v[0]]:ptr[v[0] + 1]]])
+        cs = np.concatenate([corners[ptr[x]:ptr[x + 1]] for x in v.tolist()])
+        return np.unique(self.face_of[cs])
