@@ -29,43 +29,54 @@ the eigenvector of lam2; for other sigma it is a family of vectors analytic in (
 are checked against the verifier's exact per-K eigenvectors (`even_vector`, `mode_vector`) by
 tests/certify/test_tagged_dart_charmap_script.py.
 
-**Dividing by h exactly.** At h = 0 every value is rho(p) times a function of s (rho = v^(0), the
-eigenvector of B(1) for L0; the centre is 0): X = sin(2 pi s) R(u, v), Y = g(s) R(u, v) on each piece, so
-det J_Phi = 0 identically, for every sigma. det J_Phi is bilinear in (X, Y), so for fixed (s, sigma) its
-Bernstein coefficients c(h) satisfy c(0) = 0 and, by the mean value theorem, c(h)/h lies in
-{c'(tau): 0 <= tau <= h}, c' = D(X', Y) + D(X, Y') (D the Jacobian's Bernstein form, ' = d/dh). The
-script evaluates X, Y and their h-derivatives as dual numbers (value, d/dh) in acb on a box
-s in [s_a, s_b], h in [0, 1/K0], sigma in [sigma_lo, sigma_hi], so K det J_Phi >= min of c' on the box,
-with no interval division by a ball containing 0. sigma(h) itself need not be differentiable in this
-argument: for each fixed sigma the family is analytic in h, and the true map is the member sigma = sigma(h).
-The same holds for the transversality form a1 X Y' - a2 Y X' along the outer curves (a_i = -ln lam_i,
-a1 = a2 at h = 0).
+**Dividing by h exactly.** Every value is a function of the angle of its mode: v^(theta) with theta = 2 pi h
+(x) or 2 sigma h (y), v^(-theta) = conj v^(theta). Three regions of quadrants q (and their mirror images
+K - 1 - q under the reflection in the sharp ray, which keeps det J_Phi: x is odd, y even):
 
-What it prints (``python scripts/tagged_dart_charmap.py``):
+* bulk, s = q/K in [s0, 1/2]: x = E X+ + E^-1 X-, y = Y0 + F Y+ + F^-1 Y- (E = e^(2 pi i s), F = e^(i sigma (2s - 1))),
+  so det J_Phi = sum_ij a_i(s) b_j(s) D_ij(h) with D_ij = D(X_i, Y_j) (D the bilinear Jacobian in Bernstein
+  form). At h = 0 every basis net is a multiple of one real net R (rho = v^(0) on the two-ring, 0 at the
+  centre): D_ij(0) = 0 exactly. The Taylor coefficients of D_ij in h come from acb_series arithmetic (the
+  bordered systems solved order by order), the remainder from Cauchy's estimate on |h| = r (the whole
+  computation in acb on boxes covering the complex square [-r, r]^2, which also proves it analytic there):
+  K det J_Phi = sum_ij a_i b_j (sum_(m=1..n) d_ijm h^(m-1) + rho_ij), |rho_ij| <= M_ij h^n/(r^(n+1)(1 - h/r)).
+* layer, q = 0..T-1 (the quadrants whose stencils reach the sharp ray; y reflected there): each net is an
+  analytic function of h alone. x = theta_x Z1 + O(h^3), y = theta_y sin(sigma) Z1 + O(h^2) with Z1 the
+  theta-derivative of Im(v^(theta) e^(i theta t)) at 0 (the mode-0 part alpha U + cos(sigma) Re(...) is even in h
+  and vanishes at h = 0), so x's and y's first-order nets are proportional and det J_Phi = O(h^3):
+  K^3 det J_Phi is a Taylor model in h with its h^0..h^2 coefficients 0 exactly.
+* middle, T <= q <= s0 K: the bulk's K det J_Phi = F(s, h) is analytic at (0, 0) with no terms of total degree
+  below 2 (F(q h, h) = O(h^2) for every q, as in the layer), so with w = h/s = 1/q in [0, 1/T],
+  G = F/s^2 = K^3 det J_Phi/q^2 is a function of (s, w): the exponentials a_i b_j expanded in s (tails bounded),
+  the coefficients of s^0, s^1 and s^0 h dropped (0 exactly).
 
-A. the closed forms against the exact per-K vectors at K = 12, 40, 101 (and 150 with --k150);
-B. the local nets against the verifier's ``quadrant_nets`` on a bulk quadrant;
+sigma(h) itself need not be differentiable: for each fixed sigma the family is analytic in h, and the true
+map is the member sigma = sigma(h), which lies in [4.484, 4.4935] for every K >= 101 (part C); the script
+covers that interval by sigma-boxes.
+
+What it prints (``python scripts/tagged_dart_charmap.py``, about 2 minutes):
+
+A. the closed forms against the verifier's exact per-K vectors (``mode_vector``, ``even_vector``) and
+   nets (``quadrant_nets``: bulk quadrants and the layer quadrants 0, 1, 2) at K = 12, 40, 101 (--exact);
 C. the bracket of sigma for every K >= K0 (G(lo, h) < 0 < G(hi, h), tagged_dart_limit.part_c);
-D. the bulk: K det J_Phi > 0 on every piece and the transversality form > 0 on every outer curve, for
-   s in [s0, 1/2] and every K >= K0 (the reflection in the sharp ray maps quadrant q to K - 1 - q and keeps
-   det J_Phi: x is odd, y even, the orientation flips twice), with box counts and the least lower bounds;
-E. controls that must fail: y with the sign of its mode-0 part flipped (a perturbed eigenvector), and the
-   smooth valence's even vector (alpha = 0: no kink at the sharp ray) with the dart's orientation;
-F. measurements of the boundary layer (quadrants q = 0..T next to the sharp ray: K^3 det J_Phi) from the
-   same closed forms (floats; no proof).
+D. det J_Phi > 0 on every piece of every quadrant for every K >= K0: bulk, middle, layer, with box counts,
+   least lower bounds, and the enclosures of the coefficients that are 0 exactly;
+E. controls that must fail: the smooth valence's mode-1 map (y = +cos) with the dart's orientation, and the
+   family's member at sigma in [4.99, 5] (not an eigenvector: its det J_Phi changes sign near s = 0.1).
+
+Not shown here: the transversality and winding parts (T, W) of injectivity, uniformly in K.
 """
 
 from __future__ import annotations
 
 import argparse
 import importlib.util
-import math
 import time
 from pathlib import Path
 
 from flint import acb, acb_mat, acb_series, arb, ctx, fmpq, fmpq_mat
 
-from ccproof.certify.verify.rules import CENTRE, TWO_RING, canonical, level1_rule
+from ccproof.certify.verify.rules import CENTRE, canonical, level1_rule
 from ccproof.certify.verify.tagged_modes import _POS, ring_stencil
 from ccproof.rigorous import BernsteinForm, bernstein_jacobian_determinant
 
@@ -135,7 +146,8 @@ def l0():
 
 
 def big_u(lam):
-    """U(lam) (6 values of lam's type) = adj(lam - B(1)) kappa / ((lam - 1/8)(lam - 1/16)(lam - 1/32)(lam - 1/64)(lam - 1/(16 L0)))."""
+    """U(lam) (6 values of lam's type) = adj(lam - B(1)) kappa divided by
+    (lam - 1/8)(lam - 1/16)(lam - 1/32)(lam - 1/64)(lam - 1/(16 L0))."""
     den = (lam - fmpq(1, 8)) * (lam - fmpq(1, 16)) * (lam - fmpq(1, 32)) * (lam - fmpq(1, 64)) * (lam - l0()[1])
     out = []
     for p in _NPOLY:
@@ -366,7 +378,8 @@ def disc_bounds(sigma, r, grid=4, prec=128, **control):
                 im = _ball(-r + 2 * r * fmpq(b, grid), -r + 2 * r * fmpq(b + 1, grid))
                 fam = Family(acb(re, im), sigma, **control)
                 nets = basis_nets(fam)
-                forms = {(name, piece): _real_forms(net, prec) for name, pn in nets.items() for piece, net in pn.items()}
+                forms = {(name, piece): _real_forms(net, prec)
+                         for name, pn in nets.items() for piece, net in pn.items()}
                 for i in XB:
                     for j in YB:
                         for piece in PIECES:
@@ -441,6 +454,259 @@ def cover_bulk(T, M, s0, k0, sigma, r, n, pieces=16, depth=10):
     return count, worst, failed
 
 
+# --- the middle region: s = q/K in [T/K, s0], K det J_Phi/s^2 as a function of (s, w = h/s) ---------------
+
+def _omegas(sigma):
+    """a_i(s) b_j(s) = c_ij e^(i omega_ij s): {(i, j): (c_ij, omega_ij)} (acb, arb)."""
+    tp, es = 2 * arb.pi(), acb(0, sigma).exp()
+    a = {"X+": tp, "X-": -tp}
+    b = {"Y0": (acb(1), arb(0)), "Y+": (1 / es, 2 * sigma), "Y-": (es, -2 * sigma)}
+    return {(i, j): (b[j][0], a[i] + b[j][1]) for i in XB for j in YB}
+
+
+def middle_coeffs(T, sigma, L=24):
+    """e[(m, l)][piece] = sum_ij d_ijm c_ij (i omega_ij)^l/l! (Bernstein coefficient lists, acb): the
+    coefficient of s^l h^(m-1) in K det J_Phi = sum_ij a_i(s) b_j(s) sum_m d_ijm h^(m-1), for m = 1, 2 and
+    l <= L (the terms m >= 3 are evaluated directly)."""
+    om = _omegas(sigma)
+    out = {}
+    for m in (1, 2):
+        for l in range(L + 1):
+            for piece in PIECES:
+                acc = None
+                for (i, j), (c, w) in om.items():
+                    f = c * (acb(0, w) ** l) / arb.fac_ui(l)
+                    v = [f * z for z in T[(i, j, piece)][m]]
+                    acc = v if acc is None else [x + y for x, y in zip(acc, v)]
+                out[(m, l, piece)] = acc
+    return out
+
+
+def middle_box(T, E, M, s_lo, s_hi, w_lo, w_hi, sigma, r, n, L=24, prec=128):
+    """(lower, upper) bounds of G = K det J_Phi/s^2 (= K^3 det J_Phi/q^2 at s = q h) on s in [s_lo, s_hi],
+    w = h/s in [w_lo, w_hi] (s_lo >= 0): the m = 1 part sum_(l >= 2) e_1l s^(l-2), the m = 2 part
+    w sum_(l >= 1) e_2l s^(l-1) (the coefficients e_10, e_11, e_20 being 0 exactly), the m >= 3 parts
+    a_i(s) b_j(s) d_ijm s^(m-3) w^(m-1), the tails of the exponential series (|omega s|^(L+1)/(L+1)!, with
+    the factor 1/(1 - |omega s|/(L + 2))) and the Cauchy remainder M_ij s^(n-2) w^n/(r^(n+1) (1 - h/r))."""
+    with ctx.workprec(prec):
+        s, w = _ball(s_lo, s_hi), _ball(w_lo, w_hi)
+        om = _omegas(sigma)
+        wmax = max((abs(x[1]).upper() for x in om.values()), key=lambda x: x)
+        z = wmax * arb(fmpq(s_hi))
+        if not z < L + 2:
+            raise ValueError("s too large for the exponential series")
+        # the tails of the exponential series, divided by s^2 (m = 1) and s (m = 2): |c_ij| = 1 and
+        # sum_(l > L) |omega s|^l/l! <= |omega s|^(L+1)/(L+1)!/(1 - |omega s|/(L + 2))
+        geo = z ** (L - 1) / arb.fac_ui(L + 1) / (1 - z / (L + 2))
+        h_hi = arb(fmpq(s_hi)) * arb(fmpq(w_hi))
+        ctail = arb(fmpq(s_hi)) ** (n - 2) * arb(fmpq(w_hi)) ** n / (arb(r) ** (n + 1) * (1 - h_hi / r))
+        ab = {k: c * acb(0, w_ * s).exp() for k, (c, w_) in om.items()}
+        low, high = None, None
+        for piece in PIECES:
+            ncoef = len(T[("X+", "Y0", piece)][1])
+            dmax = {m: max((abs(c).upper() for key in T if key[2] == piece for c in T[key][m]), key=lambda x: x)
+                    for m in (1, 2)}
+            rad1 = 6 * dmax[1] * wmax ** 2 * geo
+            rad2 = 6 * dmax[2] * wmax * geo * z * arb(fmpq(w_hi))
+            rem = sum((M[(i, j, piece)] * ctail for i in XB for j in YB), arb(0))
+            rad = (rad1 + rad2 + rem).upper()
+            for c in range(ncoef):
+                g1 = acb(0)
+                for l in range(L, 1, -1):
+                    g1 = g1 * s + E[(1, l, piece)][c]
+                g2 = acb(0)
+                for l in range(L, 0, -1):
+                    g2 = g2 * s + E[(2, l, piece)][c]
+                g = g1 + w * g2
+                for m in range(3, n + 1):
+                    g += sum((ab[k] * T[k + (piece,)][m][c] for k in ab), acb(0)) * s ** (m - 3) * w ** (m - 1)
+                v = g.real + arb(0, rad)
+                low = v.lower() if low is None or v.lower() < low else low
+                high = v.upper() if high is None or v.upper() > high else high
+        return low, high
+
+
+def cover_middle(T, E, M, s0, k0, t_layer, sigma, r, n, depth=14):
+    """Bisect (s, w) in [0, s0] x [0, 1/t_layer] (boxes with s w > 1/k0 throughout lie outside: K >= k0) until
+    :func:`middle_box` is certainly positive. Returns (boxes proved, least lower bound, undecided boxes)."""
+    h1 = fmpq(1, k0)
+    stack = [(fmpq(0), s0, fmpq(0), fmpq(1, t_layer), 0)]
+    count, worst, failed = 0, None, []
+    while stack:
+        a, b, c, d, dep = stack.pop()
+        if a * c >= h1:
+            continue
+        low = middle_box(T, E, M, a, b, c, d, sigma, r, n)[0]
+        if low > 0:
+            count += 1
+            worst = low if worst is None or low < worst else worst
+            continue
+        if dep >= depth:
+            failed.append((a, b, c, d))
+            continue
+        if dep % 2 == 0:
+            m = (a + b) / 2
+            stack += [(m, b, c, d, dep + 1), (a, m, c, d, dep + 1)]
+        else:
+            m = (c + d) / 2
+            stack += [(a, b, m, d, dep + 1), (a, b, c, m, dep + 1)]
+    return count, worst, failed
+
+
+# --- the boundary layer: quadrants q = 0..T next to the sharp ray -----------------------------------
+
+def layer_level0(fam, q):
+    """(x(t, p), y(t, p), x_C, y_C) at integer sectors t (any sign) for the layer quadrant q, as analytic
+    functions of h (fam.h of any type): x = (v^(p) w^t - v^(p~) w^(-t-eps))/(2i) (one mode, every t),
+    y = alpha U(p) + (v^_y(p) e^(i sigma (2 h t - 1)) + v^_y(p~) e^(-i sigma (2 h (t + eps) - 1)))/2 for t >= 0
+    and y's reflection in ray 0 for t < 0 (ray t -> ray -t, quadrant t (a, b) -> quadrant -t-1 (b, a))."""
+    h, sig = fam.h, fam.sigma
+    i2 = acb(0, 2)
+    eis = acb(0, 1) * sig
+
+    def eps(pos):
+        return 0 if pos[1] == 0 else 1
+
+    def x(t, pos):
+        return (fam.vx[_POS[pos]] * (h * (fam.ix * t)).exp()
+                - fam.vx[_POS[_swap(pos)]] * (h * (fam.ix * (-t - eps(pos)))).exp()) / i2
+
+    def y(t, pos):
+        if t < 0:
+            t, pos = (-t, pos) if pos[1] == 0 else (-t - 1, _swap(pos))
+        return (fam.alpha * fam.U[_POS[pos]]
+                + (fam.vy[_POS[pos]] * (h * (2 * eis * t) - eis).exp()
+                   + fam.vy[_POS[_swap(pos)]] * (eis - h * (2 * eis * (t + eps(pos)))).exp()) / 2)
+    return x, y, fam.zero, fam.yc
+
+
+def layer_value(level0, centre, lam, q, zero):
+    """``value(A, B)``: level-1 values of layer quadrant q >= 0 (ray 0 sharp; as tagged_map.level1_values:
+    lam times the level-0 value on the two-ring, the ghost row 2 P(A, 0) - P(A, 1) across ray 0, the sharp
+    edge's midpoint at ray 0's (3, 0), the level-1 rules elsewhere)."""
+    def lev0(d, a, b):
+        dd, a2, b2 = canonical(a, b)
+        return centre if (a2, b2) == CENTRE else level0(d + dd, (a2, b2))
+
+    def value(A, B):
+        if (A, B) == (0, 0):
+            return lam * centre
+        if B == -1 and q == 0:
+            return 2 * value(A, 0) - value(A, 1)
+        d, A2, B2 = canonical(A, B)
+        t = q + d
+        if (A2, B2) in _POS:
+            return lam * level0(t, (A2, B2))
+        if B2 == 0 and t == 0:
+            return (level0(0, (1, 0)) + level0(0, (2, 0))) / 2
+        acc = zero
+        for (a, b), w in level1_rule(A2, B2).items():
+            acc = acc + lev0(t, a, b) * w
+        return acc
+    return value
+
+
+def layer_nets(fam, q):
+    """{piece: (X net, Y net)} (4 x 4 Bezier, values of fam.h's type) of layer quadrant q."""
+    x, y, xc, yc = layer_level0(fam, q)
+    VX = layer_value(x, xc, fam.lam1, q, fam.zero)
+    VY = layer_value(y, yc, fam.lam2, q, fam.zero)
+    out = {}
+    for name in PIECES:
+        oa, ob = _OFFSET[name]
+        out[name] = tuple(_bezier([[V(oa + i, ob + j) for j in range(4)] for i in range(4)], fam.zero)
+                          for V in (VX, VY))
+    return out
+
+
+def layer_taylor(q, sigma, n, prec=128):
+    """{piece: [Bernstein coefficients (arb) of det J_Phi's h^m, m = 0..n]} of layer quadrant q (real parts:
+    the values are real for real h)."""
+    with ctx.workprec(prec):
+        fam = Family(acb_series([0, 1], prec=n + 1), sigma)
+        out = {}
+        for piece, (X, Y) in layer_nets(fam, q).items():
+            fx = [BernsteinForm((4, 4), [_coeffs(X[i][j], n + 1)[m].real for i in range(4) for j in range(4)],
+                                prec=prec) for m in range(n + 1)]
+            fy = [BernsteinForm((4, 4), [_coeffs(Y[i][j], n + 1)[m].real for i in range(4) for j in range(4)],
+                                prec=prec) for m in range(n + 1)]
+            coeffs = []
+            for m in range(n + 1):
+                acc = None
+                for k in range(m + 1):
+                    d = _jac(fx[k], fy[m - k])
+                    acc = d if acc is None else [a + b for a, b in zip(acc, d)]
+                coeffs.append(acc)
+            out[piece] = coeffs
+        return out
+
+
+def layer_disc(q, sigma, r, grid=12, prec=128):
+    """{piece: M} with |det J_Phi(h)| <= M (every Bernstein coefficient) for complex h in [-r, r]^2."""
+    M = {}
+    with ctx.workprec(prec):
+        for a in range(grid):
+            for b in range(grid):
+                re = _ball(-r + 2 * r * fmpq(a, grid), -r + 2 * r * fmpq(a + 1, grid))
+                im = _ball(-r + 2 * r * fmpq(b, grid), -r + 2 * r * fmpq(b + 1, grid))
+                fam = Family(acb(re, im), sigma)
+                for piece, (X, Y) in layer_nets(fam, q).items():
+                    d = complex_det(_real_forms(X, prec), _real_forms(Y, prec))
+                    bound = max((abs(z).upper() for z in d), key=lambda x: x)
+                    if not bound.is_finite():
+                        raise ZeroDivisionError(f"layer disc box {a}, {b}: no bound")
+                    M[piece] = bound if piece not in M or bound > M[piece] else M[piece]
+    return M
+
+
+def layer_box(T, M, h_lo, h_hi, r, n, order=3, prec=128):
+    """(lower, upper) bounds of K^order det J_Phi on h in [h_lo, h_hi] from the Taylor model (the
+    coefficients of h^0 .. h^(order-1) being 0 exactly)."""
+    with ctx.workprec(prec):
+        h = _ball(h_lo, h_hi)
+        tail = arb(fmpq(h_hi)) ** (n + 1 - order) / (arb(r) ** (n + 1) * (1 - arb(fmpq(h_hi)) / r))
+        low, high = None, None
+        for piece, coeffs in T.items():
+            rad = (M[piece] * tail).upper()
+            for c in range(len(coeffs[0])):
+                acc = arb(0)
+                for m in range(n, order - 1, -1):
+                    acc = acc * h + coeffs[m][c]
+                acc += arb(0, rad)
+                low = acc.lower() if low is None or acc.lower() < low else low
+                high = acc.upper() if high is None or acc.upper() > high else high
+        return low, high
+
+
+SIGMA_LO, SIGMA_HI = fmpq(4484, 1000), fmpq(44935, 10000)  # sigma(K) for every K >= 101 (part C)
+R_CAUCHY = fmpq(1, 32)  # the radius of the complex h-disc of the Cauchy remainders
+
+
+def cover_layer(q, k0, r=R_CAUCHY, n=14, sig_boxes=10, depth=8):
+    """K^3 det J_Phi > 0 on layer quadrant q for every h in (0, 1/k0] and sigma in [SIGMA_LO, SIGMA_HI]:
+    ``sig_boxes`` sigma-boxes, h bisected. Returns (boxes proved, least lower bound, undecided, max |h^m
+    coefficient|, m = 0, 1, 2)."""
+    M = layer_disc(q, _ball(SIGMA_LO, SIGMA_HI), r)
+    edges = [SIGMA_LO + (SIGMA_HI - SIGMA_LO) * fmpq(i, sig_boxes) for i in range(sig_boxes + 1)]
+    count, worst, failed, zero = 0, None, [], 0.0
+    for a, b in zip(edges, edges[1:]):
+        T = layer_taylor(q, _ball(a, b), n)
+        zero = max([zero] + [float(abs(z).upper()) for pc in T for m in range(3) for z in T[pc][m]])
+        stack = [(fmpq(0), fmpq(1, k0), 0)]
+        while stack:
+            lo, hi, d = stack.pop()
+            low = layer_box(T, M, lo, hi, r, n)[0]
+            if low > 0:
+                count += 1
+                worst = low if worst is None or low < worst else worst
+            elif d >= depth:
+                failed.append((a, b, lo, hi))
+            else:
+                m = (lo + hi) / 2
+                stack += [(m, hi, d + 1), (lo, m, d + 1)]
+    return count, worst, failed, zero
+
+
 # --- the printed parts ------------------------------------------------------------------------------
 
 def exact_check(k):
@@ -469,7 +735,7 @@ def exact_check(k):
     err_y = max(float(abs(a - b / yf[py]).upper()) for a, b in zip(ye, yf))
     err_x = max(float(abs(a - b / xf[px]).upper()) for a, b in zip(xe, xf))
     err_l = float(abs(lam2 - acb(fam.lam2).real).upper())
-    err_n = 0.0
+    err_n, err_layer = 0.0, 0.0
     for q in (3, (k - 1) // 2):
         ref = quadrant_nets("dart", k, xf, yf, q, ctx.prec)
         x, y, yc = fam.values(fmpq(q, k))
@@ -477,18 +743,23 @@ def exact_check(k):
         ny = piece_nets(y, yc, acb(fam.lam2).real, arb(0))
         err_n = max([err_n] + [float(abs(ref[n][i][j][c] - (nx, ny)[c][n][i][j]).upper())
                                for n in PIECES for i in range(4) for j in range(4) for c in (0, 1)])
-    return err_l, err_x, err_y, err_n
+    for q in range(3):
+        ref, mine = quadrant_nets("dart", k, xf, yf, q, ctx.prec), layer_nets(fam, q)
+        err_layer = max([err_layer] + [float(abs(ref[n][i][j][c] - acb(mine[n][c][i][j])).upper())
+                                       for n in PIECES for i in range(4) for j in range(4) for c in (0, 1)])
+    return err_l, err_x, err_y, err_n, err_layer
 
 
-SIGMA_LO, SIGMA_HI = fmpq(4484, 1000), fmpq(44935, 10000)  # sigma(K) for every K >= 101 (part C)
-
-
-def bulk(k0, s0, sig_boxes=10, n=12, r=fmpq(1, 32), grid=12, depth=10, sig_lo=SIGMA_LO, sig_hi=SIGMA_HI, **control):
+def bulk(k0, s0, t_layer=0, sig_boxes=10, n=12, r=R_CAUCHY, grid=12, depth=10, sig_lo=SIGMA_LO, sig_hi=SIGMA_HI,
+         **control):
     """Cover sigma in [sig_lo, sig_hi] by ``sig_boxes`` boxes and prove K det J_Phi > 0 on each for
-    s in [s0, 1/2], h in (0, 1/k0]. Returns (total boxes, least lower bound, undecided boxes, max |D_ij0|)."""
+    s in [s0, 1/2], h in (0, 1/k0]; with ``t_layer`` also the middle region (q from t_layer to s0 K).
+    Returns (boxes, least lower bound, undecided boxes, max |D_ij0|, [middle boxes, least lower bound of
+    K^3 det J/q^2, undecided], max |e_10|, |e_11|, |e_20|)."""
     sigma_all = _ball(sig_lo, sig_hi) if not control.get("smooth") else arb.pi()
     M = disc_bounds(sigma_all, r, grid=grid, **control)
     total, worst, failed, zero = 0, None, [], 0.0
+    mid, mzero = [0, None, []], 0.0
     edges = [sig_lo + (sig_hi - sig_lo) * fmpq(i, sig_boxes) for i in range(sig_boxes + 1)]
     for a, b in zip(edges, edges[1:]):
         sig = _ball(a, b) if not control.get("smooth") else arb.pi()
@@ -500,23 +771,33 @@ def bulk(k0, s0, sig_boxes=10, n=12, r=fmpq(1, 32), grid=12, depth=10, sig_lo=SI
         worst = w if worst is None or (w is not None and w < worst) else worst
         if control.get("smooth"):
             break
-    return total, worst, failed, zero
+        if t_layer:
+            E = middle_coeffs(T, sig)
+            mzero = max([mzero] + [float(abs(z).upper()) for key in ((1, 0), (1, 1), (2, 0)) for p in PIECES
+                                   for z in E[key + (p,)]])
+            c, w, f = cover_middle(T, E, M, s0, k0, t_layer, sig, r, n)
+            mid[0] += c
+            mid[2] += f
+            mid[1] = w if mid[1] is None or (w is not None and w < mid[1]) else mid[1]
+    return total, worst, failed, zero, mid, mzero
 
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--k0", type=int, default=101)
     ap.add_argument("--s0", default="1/20")
+    ap.add_argument("--t", type=int, default=3, help="layer quadrants 0..T-1; the middle region from q = T (>= 3)")
     ap.add_argument("--exact", default="12,40,101", help="K for part A (comma-separated)")
     args = ap.parse_args(argv)
     ctx.prec = 128
     s0 = fmpq(*map(int, args.s0.split("/")))
     for k in map(int, args.exact.split(",")):
         t = time.time()
-        el, ex, ey, en = exact_check(k)
-        print(f"A  K = {k}: closed forms against the verifier's exact vectors: |lam2 - lam(cos(2 sigma h))| <= {el:.1e}, "
+        el, ex, ey, en, ea = exact_check(k)
+        print(f"A  K = {k}: closed forms against the verifier's exact vectors: "
+              f"|lam2 - lam(cos(2 sigma h))| <= {el:.1e}, "
               f"x (mode_vector) {ex:.1e}, y (even_vector) {ey:.1e}, Bezier nets of quadrants 3 and (K-1)/2 "
-              f"(quadrant_nets) {en:.1e} ({time.time() - t:.1f} s)")
+              f"(quadrant_nets) {en:.1e}, layer nets of quadrants 0, 1, 2 {ea:.1e} ({time.time() - t:.1f} s)")
     lim = _limit_script()
     t = time.time()
     ok = lim.part_c(args.k0, lo="4.484", hi="4.4935", boxes=64, quiet=True)  # the ends of SIGMA_LO, SIGMA_HI
@@ -525,20 +806,29 @@ def main(argv=None):
     if ok != 64:
         raise SystemExit("C failed")
     t = time.time()
-    total, worst, failed, zero = bulk(args.k0, s0)
-    print(f"D  bulk: K det J_Phi >= {float(worst):.3g} > 0 on every piece for s = q/K in [{s0}, 1/2] and every K >= {args.k0} "
-          f"(orientation +1): {total} (s, h)-boxes over 10 sigma-boxes, {len(failed)} undecided; Taylor order 12 in h, "
-          f"Cauchy radius 1/32; the h^0 coefficients (0 exactly) enclosed in |.| <= {zero:.1e} ({time.time() - t:.1f} s)")
+    total, worst, failed, zero, mid, mzero = bulk(args.k0, s0, t_layer=args.t)
+    print(f"D  bulk: K det J_Phi >= {float(worst):.3g} > 0 on every piece for s = q/K in [{s0}, 1/2] and every "
+          f"K >= {args.k0} (orientation +1): {total} (s, h)-boxes over 10 sigma-boxes, {len(failed)} undecided; Taylor "
+          f"order 12 in h, Cauchy radius 1/32; the h^0 coefficients (0 exactly) enclosed in |.| <= {zero:.1e}")
+    print(f"D  middle: K^3 det J_Phi/q^2 >= {float(mid[1]):.3g} > 0 for {args.t} <= q <= {s0} K and every "
+          f"K >= {args.k0}: "
+          f"{mid[0]} (s, w = 1/q)-boxes, {len(mid[2])} undecided; the coefficients of s^0, s^1 and s^0 h (0 exactly) "
+          f"enclosed in |.| <= {mzero:.1e} ({time.time() - t:.1f} s for bulk and middle)")
+    for q in range(args.t):
+        t = time.time()
+        count, worst, failed, zero = cover_layer(q, args.k0)
+        print(f"D  layer: quadrant {q}: K^3 det J_Phi >= {float(worst):.3g} > 0 for every K >= {args.k0}: {count} "
+              f"(sigma, h)-boxes, {len(failed)} undecided; Taylor order 14, the h^0..h^2 coefficients (0 exactly) "
+              f"enclosed in |.| <= {zero:.1e} ({time.time() - t:.1f} s)")
     t = time.time()
-    total, worst, failed, _ = bulk(args.k0, s0, sig_boxes=1, depth=4, smooth=True)
-    print(f"E  control (the smooth valence's mode-1 map, y = +cos, with the dart's orientation): {total} boxes proved, "
-          f"{len(failed)} undecided ({time.time() - t:.1f} s)")
+    total, worst, failed, _, _, _ = bulk(args.k0, s0, sig_boxes=1, depth=4, smooth=True)
+    print(f"E  control (the smooth valence's mode-1 map, y = +cos, with the dart's orientation): {total} boxes "
+          f"proved, {len(failed)} undecided ({time.time() - t:.1f} s)")
     t = time.time()
-    total, worst, failed, _ = bulk(args.k0, s0, sig_boxes=1, depth=4, sig_lo=fmpq(499, 100), sig_hi=fmpq(5))
+    total, worst, failed, _, _, _ = bulk(args.k0, s0, sig_boxes=1, depth=4, sig_lo=fmpq(499, 100), sig_hi=fmpq(5))
     print(f"E  control (y the family's member at sigma in [4.99, 5], not an eigenvector): {total} boxes proved, "
-          f"{len(failed)} undecided, from s = {float(min(f[0] for f in failed)):.4f} to {float(max(f[1] for f in failed)):.4f} "
-          f"({time.time() - t:.1f} s)")
-
+          f"{len(failed)} undecided, from s = {float(min(f[0] for f in failed)):.4f} to "
+          f"{float(max(f[1] for f in failed)):.4f} ({time.time() - t:.1f} s)")
 
 if __name__ == "__main__":
     main()
