@@ -60,11 +60,14 @@ A. the closed forms against the verifier's exact per-K vectors (``mode_vector``,
    nets (``quadrant_nets``: bulk quadrants and the layer quadrants 0, 1, 2) at K = 12, 40, 101 (--exact);
 C. the bracket of sigma for every K >= K0 (G(lo, h) < 0 < G(hi, h), tagged_dart_limit.part_c);
 D. det J_Phi > 0 on every piece of every quadrant for every K >= K0: bulk, middle, layer, with box counts,
-   least lower bounds, and the enclosures of the coefficients that are 0 exactly;
+   least lower bounds, and the enclosures of the coefficients that are 0 exactly (printed before T);
 E. controls that must fail: the smooth valence's mode-1 map (y = +cos) with the dart's orientation, and the
    family's member at sigma in [4.99, 5] (not an eigenvector: its det J_Phi changes sign near s = 0.1).
 
-Not shown here: the transversality and winding parts (T, W) of injectivity, uniformly in K.
+T. the transversality part of injectivity, a1 X Y' - a2 Y X' > 0 along the four outer curves of every
+   quadrant, in the same three regions.
+
+Not shown here: the winding part W of injectivity uniformly in K (docs/tagged_c1.md, item 6).
 """
 
 from __future__ import annotations
@@ -397,6 +400,11 @@ def _ball(lo, hi):
     return arb((lo + hi) / 2, (hi - lo) / 2)
 
 
+def _parts(T):
+    """The pieces (or outer curves) that a Taylor dict keyed (i, j, part) covers."""
+    return sorted({key[2] for key in T})
+
+
 def kdet_box(T, M, s_lo, s_hi, h_lo, h_hi, sigma, r, n, prec=128):
     """(lower, upper) bounds of K det J_Phi over the three pieces' Bernstein coefficients, for s in [s_lo, s_hi] and
     h in [h_lo, h_hi] (0 < h_hi < r): sum_ij a_i(s) b_j(s) (sum_(m=1..n) d_ijm h^(m-1) + rho_ij) with
@@ -408,7 +416,7 @@ def kdet_box(T, M, s_lo, s_hi, h_lo, h_hi, sigma, r, n, prec=128):
         hr = arb(fmpq(h_hi)) / r
         tail = arb(fmpq(h_hi)) ** n / (arb(r) ** (n + 1) * (1 - hr))
         low, high = None, None
-        for piece in PIECES:
+        for piece in _parts(T):
             tot = None
             for i in XB:
                 for j in YB:
@@ -472,7 +480,7 @@ def middle_coeffs(T, sigma, L=24):
     out = {}
     for m in (1, 2):
         for l in range(L + 1):
-            for piece in PIECES:
+            for piece in _parts(T):
                 acc = None
                 for (i, j), (c, w) in om.items():
                     f = c * (acb(0, w) ** l) / arb.fac_ui(l)
@@ -502,8 +510,8 @@ def middle_box(T, E, M, s_lo, s_hi, w_lo, w_hi, sigma, r, n, L=24, prec=128):
         ctail = arb(fmpq(s_hi)) ** (n - 2) * arb(fmpq(w_hi)) ** n / (arb(r) ** (n + 1) * (1 - h_hi / r))
         ab = {k: c * acb(0, w_ * s).exp() for k, (c, w_) in om.items()}
         low, high = None, None
-        for piece in PIECES:
-            ncoef = len(T[("X+", "Y0", piece)][1])
+        for piece in _parts(T):
+            ncoef = len(T[("X+", "Y0", piece)][1])  # the pieces' (or curves') Bernstein coefficients
             dmax = {m: max((abs(c).upper() for key in T if key[2] == piece for c in T[key][m]), key=lambda x: x)
                     for m in (1, 2)}
             rad1 = 6 * dmax[1] * wmax ** 2 * geo
@@ -698,15 +706,15 @@ SIGMA_LO, SIGMA_HI = fmpq(4484, 1000), fmpq(44935, 10000)  # sigma(K) for every 
 R_CAUCHY = fmpq(1, 32)  # the radius of the complex h-disc of the Cauchy remainders
 
 
-def cover_layer(q, k0, r=R_CAUCHY, n=14, sig_boxes=10, depth=8):
+def cover_layer(q, k0, r=R_CAUCHY, n=14, sig_boxes=10, depth=8, what="det"):
     """K^3 det J_Phi > 0 on layer quadrant q for every h in (0, 1/k0] and sigma in [SIGMA_LO, SIGMA_HI]:
     ``sig_boxes`` sigma-boxes, h bisected. Returns (boxes proved, least lower bound, undecided, max |h^m
     coefficient|, m = 0, 1, 2)."""
-    M = layer_disc(q, _ball(SIGMA_LO, SIGMA_HI), r)
+    M = (layer_disc if what == "det" else layer_trans_disc)(q, _ball(SIGMA_LO, SIGMA_HI), r)
     edges = [SIGMA_LO + (SIGMA_HI - SIGMA_LO) * fmpq(i, sig_boxes) for i in range(sig_boxes + 1)]
     count, worst, failed, zero = 0, None, [], 0.0
     for a, b in zip(edges, edges[1:]):
-        T = layer_taylor(q, _ball(a, b), n)
+        T = (layer_taylor if what == "det" else layer_trans_taylor)(q, _ball(a, b), n)
         zero = max([zero] + [float(abs(z).upper()) for pc in T for m in range(3) for z in T[pc][m]])
         stack = [(fmpq(0), fmpq(1, k0), 0)]
         while stack:
@@ -721,6 +729,129 @@ def cover_layer(q, k0, r=R_CAUCHY, n=14, sig_boxes=10, depth=8):
                 m = (lo + hi) / 2
                 stack += [(m, hi, d + 1), (lo, m, d + 1)]
     return count, worst, failed, zero
+
+
+# --- transversality: a1 X Y' - a2 Y X' along the outer curves, the same three regions -------------------
+
+_BIN3, _BIN2, _BIN5 = (1, 3, 3, 1), (1, 2, 1), (1, 5, 10, 10, 5, 1)
+
+
+def curve_points(nets, name):
+    """The 4 Bezier points of one outer curve (CURVES) of a quadrant's nets {piece: 4 x 4}, counterclockwise."""
+    piece, side, sign = CURVES[name]
+    net = nets[piece]
+    pts = [net[3][j] for j in range(4)] if side == "s" else [net[i][3] for i in range(4)]
+    return pts if sign > 0 else pts[::-1]
+
+
+def _bprod(f, g):
+    """Bernstein coefficients (degree 5) of f g' for cubic Bezier values f, g (any ring)."""
+    gd = [3 * (g[i + 1] - g[i]) for i in range(3)]
+    out = []
+    for k in range(6):
+        acc = 0 * f[0]
+        for i in range(max(0, k - 2), min(3, k) + 1):
+            acc = acc + f[i] * gd[k - i] * fmpq(_BIN3[i] * _BIN2[k - i], _BIN5[k])
+        out.append(acc)
+    return out
+
+
+def _series_curves(nets, n):
+    """{curve: [order m: 4 acb]} of one coordinate's nets {piece: 4 x 4 acb_series}."""
+    out = {}
+    for name in CURVES:
+        pts = [_coeffs(z, n + 1) for z in curve_points(nets, name)]
+        out[name] = [[pts[p][m] for p in range(4)] for m in range(n + 1)]
+    return out
+
+
+def _trans_series(xc, yc, A1, A2, n):
+    """Taylor coefficients of a1 X Y' - a2 Y X' from the coordinates' (xc, yc: [m: 4 values]) and a_i's."""
+    P = [None] * (n + 1)
+    Q = [None] * (n + 1)
+    for m in range(n + 1):
+        for k in range(m + 1):
+            p, q = _bprod(xc[k], yc[m - k]), _bprod(yc[m - k], xc[k])
+            P[m] = p if P[m] is None else [a + b for a, b in zip(P[m], p)]
+            Q[m] = q if Q[m] is None else [a + b for a, b in zip(Q[m], q)]
+    out = []
+    for m in range(n + 1):
+        acc = [0 * P[0][0]] * 6
+        for u in range(m + 1):
+            acc = [a + A1[u] * p - A2[u] * q for a, p, q in zip(acc, P[m - u], Q[m - u])]
+        out.append(acc)
+    return out
+
+
+def taylor_trans(sigma, n, prec=128, **control):
+    """As :func:`taylor_dets` for T_ij = a1 X_i Y_j' - a2 Y_j X_i' along the outer curves (a_i = -ln lam_i):
+    {(i, j, curve): [coefficient list of h^m, m = 0..n]}; T_ij(0) = 0 exactly (a1 = a2, both parts multiples
+    of one real curve at h = 0)."""
+    with ctx.workprec(prec):
+        fam = Family(acb_series([0, 1], prec=n + 1), sigma, **control)
+        nets = basis_nets(fam)
+        A1, A2 = (_coeffs(-lam.log(), n + 1) for lam in (fam.lam1, fam.lam2))
+        curves = {b: _series_curves(nets[b], n) for b in nets}
+        return {(i, j, c): _trans_series(curves[i][c], curves[j][c], A1, A2, n)
+                for i in XB for j in YB for c in CURVES}
+
+
+def disc_trans(sigma, r, grid=12, prec=128, **control):
+    """As :func:`disc_bounds` for the T_ij of :func:`taylor_trans`."""
+    M = {}
+    with ctx.workprec(prec):
+        for a in range(grid):
+            for b in range(grid):
+                re = _ball(-r + 2 * r * fmpq(a, grid), -r + 2 * r * fmpq(a + 1, grid))
+                im = _ball(-r + 2 * r * fmpq(b, grid), -r + 2 * r * fmpq(b + 1, grid))
+                fam = Family(acb(re, im), sigma, **control)
+                nets = basis_nets(fam)
+                a1, a2 = -acb(fam.lam1).log(), -acb(fam.lam2).log()
+                for i in XB:
+                    for j in YB:
+                        for c in CURVES:
+                            X, Y = curve_points(nets[i], c), curve_points(nets[j], c)
+                            t = [a1 * p - a2 * q for p, q in zip(_bprod(X, Y), _bprod(Y, X))]
+                            bound = max((abs(z).upper() for z in t), key=lambda x: x)
+                            if not bound.is_finite():
+                                raise ZeroDivisionError(f"disc box {a}, {b}: no bound")
+                            key = (i, j, c)
+                            M[key] = bound if key not in M or bound > M[key] else M[key]
+    return M
+
+
+def layer_trans_taylor(q, sigma, n, prec=128):
+    """{curve: [coefficients (arb) of h^m]} of a1 X Y' - a2 Y X' on layer quadrant q (h^0..h^2: 0 exactly)."""
+    with ctx.workprec(prec):
+        fam = Family(acb_series([0, 1], prec=n + 1), sigma)
+        nets = layer_nets(fam, q)
+        A1, A2 = ([z.real for z in _coeffs(-lam.log(), n + 1)] for lam in (fam.lam1, fam.lam2))
+        xs = _series_curves({p: nets[p][0] for p in PIECES}, n)
+        ys = _series_curves({p: nets[p][1] for p in PIECES}, n)
+        real = {c: ([[z.real for z in pts] for pts in xs[c]], [[z.real for z in pts] for pts in ys[c]]) for c in CURVES}
+        return {c: _trans_series(real[c][0], real[c][1], A1, A2, n) for c in CURVES}
+
+
+def layer_trans_disc(q, sigma, r, grid=12, prec=128):
+    """{curve: M} with |a1 X Y' - a2 Y X'| <= M on complex h in [-r, r]^2 for layer quadrant q."""
+    M = {}
+    with ctx.workprec(prec):
+        for a in range(grid):
+            for b in range(grid):
+                re = _ball(-r + 2 * r * fmpq(a, grid), -r + 2 * r * fmpq(a + 1, grid))
+                im = _ball(-r + 2 * r * fmpq(b, grid), -r + 2 * r * fmpq(b + 1, grid))
+                fam = Family(acb(re, im), sigma)
+                nets = layer_nets(fam, q)
+                a1, a2 = -acb(fam.lam1).log(), -acb(fam.lam2).log()
+                for c in CURVES:
+                    X = curve_points({p: nets[p][0] for p in PIECES}, c)
+                    Y = curve_points({p: nets[p][1] for p in PIECES}, c)
+                    t = [a1 * p - a2 * q_ for p, q_ in zip(_bprod(X, Y), _bprod(Y, X))]
+                    bound = max((abs(z).upper() for z in t), key=lambda x: x)
+                    if not bound.is_finite():
+                        raise ZeroDivisionError(f"layer disc box {a}, {b}: no bound")
+                    M[c] = bound if c not in M or bound > M[c] else M[c]
+    return M
 
 
 # --- the printed parts ------------------------------------------------------------------------------
@@ -767,19 +898,19 @@ def exact_check(k):
 
 
 def bulk(k0, s0, t_layer=0, sig_boxes=10, n=12, r=R_CAUCHY, grid=12, depth=10, sig_lo=SIGMA_LO, sig_hi=SIGMA_HI,
-         **control):
+         what="det", **control):
     """Cover sigma in [sig_lo, sig_hi] by ``sig_boxes`` boxes and prove K det J_Phi > 0 on each for
     s in [s0, 1/2], h in (0, 1/k0]; with ``t_layer`` also the middle region (q from t_layer to s0 K).
     Returns (boxes, least lower bound, undecided boxes, max |D_ij0|, [middle boxes, least lower bound of
     K^3 det J/q^2, undecided], max |e_10|, |e_11|, |e_20|)."""
     sigma_all = _ball(sig_lo, sig_hi) if not control.get("smooth") else arb.pi()
-    M = disc_bounds(sigma_all, r, grid=grid, **control)
+    M = (disc_bounds if what == "det" else disc_trans)(sigma_all, r, grid=grid, **control)
     total, worst, failed, zero = 0, None, [], 0.0
     mid, mzero = [0, None, []], 0.0
     edges = [sig_lo + (sig_hi - sig_lo) * fmpq(i, sig_boxes) for i in range(sig_boxes + 1)]
     for a, b in zip(edges, edges[1:]):
         sig = _ball(a, b) if not control.get("smooth") else arb.pi()
-        T = taylor_dets(sig, n, **control)
+        T = (taylor_dets if what == "det" else taylor_trans)(sig, n, **control)
         zero = max([zero] + [float(abs(z).upper()) for v in T.values() for z in v[0]])
         c, w, f = cover_bulk(T, M, s0, k0, sig, r, n, depth=depth)
         total += c
@@ -789,7 +920,7 @@ def bulk(k0, s0, t_layer=0, sig_boxes=10, n=12, r=R_CAUCHY, grid=12, depth=10, s
             break
         if t_layer:
             E = middle_coeffs(T, sig)
-            mzero = max([mzero] + [float(abs(z).upper()) for key in ((1, 0), (1, 1), (2, 0)) for p in PIECES
+            mzero = max([mzero] + [float(abs(z).upper()) for key in ((1, 0), (1, 1), (2, 0)) for p in _parts(T)
                                    for z in E[key + (p,)]])
             c, w, f = cover_middle(T, E, M, s0, k0, t_layer, sig, r, n)
             mid[0] += c
@@ -836,6 +967,18 @@ def main(argv=None):
         print(f"D  layer: quadrant {q}: K^3 det J_Phi >= {float(worst):.3g} > 0 for every K >= {args.k0}: {count} "
               f"(sigma, h)-boxes, {len(failed)} undecided; Taylor order 14, the h^0..h^2 coefficients (0 exactly) "
               f"enclosed in |.| <= {zero:.1e} ({time.time() - t:.1f} s)")
+    t = time.time()
+    total, worst, failed, zero, mid, mzero = bulk(args.k0, s0, t_layer=args.t, what="trans")
+    print(f"T  bulk: K (a1 X Y' - a2 Y X') >= {float(worst):.3g} > 0 on the four outer curves for s in [{s0}, 1/2], "
+          f"K >= {args.k0}: {total} boxes, {len(failed)} undecided; h^0 coefficients enclosed in |.| <= {zero:.1e}")
+    print(f"T  middle: K^3 (a1 X Y' - a2 Y X')/q^2 >= {float(mid[1]):.3g} > 0 for {args.t} <= q <= {s0} K: {mid[0]} "
+          f"boxes, {len(mid[2])} undecided; exact zeros enclosed in |.| <= {mzero:.1e} ({time.time() - t:.1f} s)")
+    for q in range(args.t):
+        t = time.time()
+        count, worst, failed, zero = cover_layer(q, args.k0, what="trans")
+        print(f"T  layer: quadrant {q}: K^3 (a1 X Y' - a2 Y X') >= {float(worst):.3g} > 0 for every K >= {args.k0}: "
+              f"{count} boxes, {len(failed)} undecided; h^0..h^2 enclosed in |.| <= {zero:.1e} "
+              f"({time.time() - t:.1f} s)")
     t = time.time()
     total, worst, failed, _, _, _ = bulk(args.k0, s0, sig_boxes=1, depth=4, smooth=True)
     print(f"E  control (the smooth valence's mode-1 map, y = +cos, with the dart's orientation): {total} boxes "

@@ -144,3 +144,42 @@ def test_layer_quadrant_zero_against_the_verifier():
                 assert got.overlaps(want * k * k), (p, c, got, want * k * k)
         lo, hi = mod.layer_box(T, M, h, h, r, n)
         assert lo > 0
+
+
+@pytest.mark.slow
+def test_transversality_models_enclose_the_verifiers_forms():
+    # a1 X Y' - a2 Y X' along the four outer curves: the bulk model at (q/K, 1/K) and the layer model of
+    # quadrant 0 against the verifier's transversal_form on its own nets (K = 101), then one box of each
+    from ccproof.certify.verify.tagged_map import transversal_form
+    mod = _load()
+    k = 101
+    with ctx.workprec(128):
+        sig = mod._limit_script().sigma_of(arb(fmpq(1, k)))
+        fam = mod.Family(acb(arb(fmpq(1, k))), sig)
+        a1, a2 = -acb(fam.lam1).real.log(), -acb(fam.lam2).real.log()
+        pts = labels("dart", k)
+        ev = mode_spectrum("dart", k)
+        lam2 = max((z.real for z, r, src, _ in ev if src == "E" and r != 1 and z.imag.contains(0)),
+                   key=lambda r: r.mid())
+        lam1 = max((z[0].real for z in ev if z[3] == 1), key=lambda r: r.mid())
+        py, px = pts.index(("r", k // 2, 1, 0)), pts.index(("r", k // 4, 1, 0))
+        sx, sy = fam.values(fmpq(k // 4, k))[0](0, (1, 0)), fam.values(fmpq(k // 2, k))[1](0, (1, 0))
+        f = mode_vector("dart", k, 1, lam1)
+        x = [arb(0)] + [(z / f[px]).real * sx for z in f[1:]]
+        y = [v * sy for v in even_vector(k, lam2, py)]
+        r, n = mod.R_CAUCHY, 12
+        T = mod.taylor_trans(sig, n)
+        M = mod.disc_trans(mod._ball(mod.SIGMA_LO, mod.SIGMA_HI), r)
+        h = fmpq(1, k)
+        for q in (30, 50):
+            nets = quadrant_nets("dart", k, x, y, q, 128)
+            want = min(min(c.lower() for c in transversal_form(nets, cv, a1, a2, 128).coeffs) for cv in mod.CURVES)
+            lo, hi = mod.kdet_box(T, M, fmpq(q, k), fmpq(q, k), h, h, sig, r, n)
+            assert lo <= want * k <= hi and lo > 0, (q, lo, want * k, hi)
+        TL = mod.layer_trans_taylor(0, sig, 14)
+        ML = mod.layer_trans_disc(0, mod._ball(mod.SIGMA_LO, mod.SIGMA_HI), r)
+        assert all(abs(z) < 1e-25 for c in TL for m in range(3) for z in TL[c][m])
+        nets = quadrant_nets("dart", k, x, y, 0, 128)
+        want = min(min(c.lower() for c in transversal_form(nets, cv, a1, a2, 128).coeffs) for cv in mod.CURVES)
+        lo, hi = mod.layer_box(TL, ML, h, h, r, 14)
+        assert lo <= want * k ** 3 <= hi and lo > 0, (lo, want * k ** 3, hi)
