@@ -54,7 +54,7 @@ sigma(h) itself need not be differentiable: for each fixed sigma the family is a
 map is the member sigma = sigma(h), which lies in [4.484, 4.4935] for every K >= 101 (part C); the script
 covers that interval by sigma-boxes.
 
-What it prints (``python scripts/tagged_dart_charmap.py``, about 2 minutes):
+What it prints (``python scripts/tagged_dart_charmap.py``, about 70 s):
 
 A. the closed forms against the verifier's exact per-K vectors (``mode_vector``, ``even_vector``) and
    nets (``quadrant_nets``: bulk quadrants and the layer quadrants 0, 1, 2) at K = 12, 40, 101 (--exact);
@@ -65,9 +65,13 @@ E. controls that must fail: the smooth valence's mode-1 map (y = +cos) with the 
    family's member at sigma in [4.99, 5] (not an eigenvector: its det J_Phi changes sign near s = 0.1).
 
 T. the transversality part of injectivity, a1 X Y' - a2 Y X' > 0 along the four outer curves of every
-   quadrant, in the same three regions.
+   quadrant, in the same three regions;
+W. the winding part: Y < 0 on the outer curves for s in [0, 1/4] (layer: K Y, and K^2 Y at ray 0's end point;
+   middle: Y/s; bulk: Y), X > 0 for s in [1/4, 7/20], Y > 0 for s in [7/20, 1/2], so Gamma crosses the
+   half-axis Y = 0, X > 0 exactly once (all crossings upwards by T) and its mirror half only where X < 0.
 
-Not shown here: the winding part W of injectivity uniformly in K (docs/tagged_c1.md, item 6).
+Everything here is untrusted: the coefficients that the arguments above make 0 are dropped, not checked
+exactly, and the spectral part is tagged_dart_limit.py's (docs/tagged_c1.md, items 3 and 6).
 """
 
 from __future__ import annotations
@@ -854,6 +858,245 @@ def layer_trans_disc(q, sigma, r, grid=12, prec=128):
     return M
 
 
+# --- winding: the signs of X and Y along the outer curves -------------------------------------------
+#
+# Gamma crosses the half-axis H = {Y = 0, X > 0} exactly once when, on the half s in [0, 1/2] (the other half
+# is its mirror image X -> -X): Y < 0 for s in [0, s_a] (ray 0's end point included), Y > 0 for s in
+# [s_b, 1/2], X > 0 for s in [s_a, s_b]; by T every crossing of H goes the same way (Y increasing), so Y
+# changes sign exactly once on [s_a, s_b], and the mirror half meets Y = 0 only where X < 0.
+
+def coord_taylor(sigma, n, coord, prec=128):
+    """{(basis part, curve): [order m: 4 acb]}: Taylor coefficients in h of the outer curves' Bezier points of
+    the basis parts of x (coord "x": X+, X-) or y ("y": Y0, Y+, Y-)."""
+    with ctx.workprec(prec):
+        fam = Family(acb_series([0, 1], prec=n + 1), sigma)
+        nets = basis_nets(fam)
+        return {(b, c): pts for b in (XB if coord == "x" else YB) for c, pts in _series_curves(nets[b], n).items()}
+
+
+def coord_disc(sigma, r, coord, grid=12, prec=128):
+    """{(basis part, curve): M}, |Bezier point| <= M on complex h in [-r, r]^2."""
+    M = {}
+    with ctx.workprec(prec):
+        for a in range(grid):
+            for b in range(grid):
+                re = _ball(-r + 2 * r * fmpq(a, grid), -r + 2 * r * fmpq(a + 1, grid))
+                im = _ball(-r + 2 * r * fmpq(b, grid), -r + 2 * r * fmpq(b + 1, grid))
+                nets = basis_nets(Family(acb(re, im), sigma))
+                for part in (XB if coord == "x" else YB):
+                    for c in CURVES:
+                        bound = max((abs(acb(z)).upper() for z in curve_points(nets[part], c)), key=lambda x: x)
+                        if not bound.is_finite():
+                            raise ZeroDivisionError(f"disc box {a}, {b}: no bound")
+                        key = (part, c)
+                        M[key] = bound if key not in M or bound > M[key] else M[key]
+    return M
+
+
+def _coord_factors(coord, s, sigma):
+    if coord == "x":
+        E = acb(0, 2 * arb.pi() * s).exp()
+        return {"X+": E, "X-": 1 / E}
+    F = acb(0, sigma * (2 * s - 1)).exp()
+    return {"Y0": acb(1), "Y+": F, "Y-": 1 / F}
+
+
+def coord_box(T, M, s_lo, s_hi, h_lo, h_hi, sigma, r, n, coord, prec=128):
+    """(lower, upper) bounds of X or Y on every outer curve's Bezier points, s in [s_lo, s_hi], h in
+    [h_lo, h_hi] (a bulk quadrant)."""
+    with ctx.workprec(prec):
+        s, h = _ball(s_lo, s_hi), _ball(h_lo, h_hi)
+        fac = _coord_factors(coord, s, sigma)
+        hr = arb(fmpq(h_hi)) / r
+        tail = hr ** (n + 1) / (1 - hr)
+        low, high = None, None
+        for c in CURVES:
+            for p in range(4):
+                tot = acb(0)
+                for part, f in fac.items():
+                    acc = acb(0)
+                    for m in range(n, -1, -1):
+                        acc = acc * h + T[(part, c)][m][p]
+                    rad = (M[(part, c)] * tail).upper()
+                    tot += f * (acc + acb(arb(0, rad), arb(0, rad)))
+                v = tot.real
+                low = v.lower() if low is None or v.lower() < low else low
+                high = v.upper() if high is None or v.upper() > high else high
+        return low, high
+
+
+def cover_sign(T, M, s_lo, s_hi, k0, sigma, r, n, coord, sign, pieces=8, depth=10):
+    """Bisect [s_lo, s_hi] x [0, 1/k0] until sign * coordinate > 0 certainly on every curve point."""
+    h1 = fmpq(1, k0)
+    stack = [(s_lo + (s_hi - s_lo) * fmpq(i, pieces), s_lo + (s_hi - s_lo) * fmpq(i + 1, pieces), 0, h1, 0)
+             for i in range(pieces)]
+    count, failed = 0, []
+    while stack:
+        a, b, ha, hb, d = stack.pop()
+        lo, hi = coord_box(T, M, a, b, ha, hb, sigma, r, n, coord)
+        if (sign > 0 and lo > 0) or (sign < 0 and hi < 0):
+            count += 1
+            continue
+        if d >= depth:
+            failed.append((a, b, ha, hb))
+            continue
+        if d % 2 == 0:
+            m = (a + b) / 2
+            stack += [(m, b, ha, hb, d + 1), (a, m, ha, hb, d + 1)]
+        else:
+            m = (ha + hb) / 2
+            stack += [(a, b, m, hb, d + 1), (a, b, ha, m, d + 1)]
+    return count, failed
+
+
+def ymid_box(T, M, s_lo, s_hi, w_lo, w_hi, sigma, r, n, L=24, prec=128):
+    """(lower, upper) bounds of Y/s on every outer curve point, s in [s_lo, s_hi], w = h/s in [w_lo, w_hi]:
+    the h^0 part sum_j b_j(s) Y_j0 = sum_(l >= 1) (...) s^l (its s^0 coefficient is y at K = infinity and s = 0:
+    0 exactly) divided by s termwise, the parts h^m, m >= 1, as b_j(s) Y_jm s^(m-1) w^m, and the tails."""
+    with ctx.workprec(prec):
+        s, w = _ball(s_lo, s_hi), _ball(w_lo, w_hi)
+        es = acb(0, sigma).exp()
+        om = {"Y0": (acb(1), arb(0)), "Y+": (1 / es, 2 * sigma), "Y-": (es, -2 * sigma)}
+        fac = _coord_factors("y", s, sigma)
+        z = 2 * abs(sigma).upper() * arb(fmpq(s_hi))
+        if not z < L + 2:
+            raise ValueError("s too large for the exponential series")
+        geo = z ** L / arb.fac_ui(L + 1) / (1 - z / (L + 2)) * 2 * abs(sigma).upper()
+        h_hi = arb(fmpq(s_hi)) * arb(fmpq(w_hi))
+        ctail = arb(fmpq(s_hi)) ** n * arb(fmpq(w_hi)) ** (n + 1) / (arb(r) ** (n + 1) * (1 - h_hi / r))
+        low, high = None, None
+        for c in CURVES:
+            y0max = max((abs(T[(j, c)][0][p]).upper() for j in YB for p in range(4)), key=lambda x: x)
+            rad = (3 * y0max * geo + sum((M[(j, c)] * ctail for j in YB), arb(0))).upper()
+            for p in range(4):
+                g = acb(0)
+                for l in range(L, 0, -1):
+                    coef = sum((cj * acb(0, wj) ** l / arb.fac_ui(l) * T[(j, c)][0][p] for j, (cj, wj) in om.items()),
+                               acb(0))
+                    g = g * s + coef
+                for m in range(1, n + 1):
+                    g += sum((fac[j] * T[(j, c)][m][p] for j in YB), acb(0)) * s ** (m - 1) * w ** m
+                v = g.real + arb(0, rad)
+                low = v.lower() if low is None or v.lower() < low else low
+                high = v.upper() if high is None or v.upper() > high else high
+        return low, high
+
+
+def ymid_zero(T, sigma):
+    """max |sum_j c_j Y_j0| over the curve points: Y at h = 0, s = 0 (0 exactly), as enclosed."""
+    es = acb(0, sigma).exp()
+    c = {"Y0": acb(1), "Y+": 1 / es, "Y-": es}
+    return max(float(abs(sum((c[j] * T[(j, cv)][0][p] for j in YB), acb(0))).upper())
+               for cv in CURVES for p in range(4))
+
+
+def cover_ymid(T, M, s0, k0, t_layer, sigma, r, n, depth=12):
+    """Bisect (s, w) in [0, s0] x [0, 1/t_layer] (boxes with s w > 1/k0 throughout skipped) until Y/s < 0."""
+    h1 = fmpq(1, k0)
+    stack = [(fmpq(0), s0, fmpq(0), fmpq(1, t_layer), 0)]
+    count, failed = 0, []
+    while stack:
+        a, b, c, d, dep = stack.pop()
+        if a * c >= h1:
+            continue
+        if ymid_box(T, M, a, b, c, d, sigma, r, n)[1] < 0:
+            count += 1
+            continue
+        if dep >= depth:
+            failed.append((a, b, c, d))
+            continue
+        if dep % 2 == 0:
+            m = (a + b) / 2
+            stack += [(m, b, c, d, dep + 1), (a, m, c, d, dep + 1)]
+        else:
+            m = (c + d) / 2
+            stack += [(a, b, m, d, dep + 1), (a, b, c, m, dep + 1)]
+    return count, failed
+
+
+S_A, S_B = fmpq(1, 4), fmpq(7, 20)  # Y < 0 up to S_A, X > 0 on [S_A, S_B] (Y's zero near s = 0.30), Y > 0 after S_B
+
+
+def winding(k0, s0, t_layer, s_a=S_A, s_b=S_B, sig_boxes=10, n=12, r=R_CAUCHY):
+    """The sign conditions of W for every K >= k0: {check: (boxes, undecided)} and the exact zeros' enclosures."""
+    sig_all = _ball(SIGMA_LO, SIGMA_HI)
+    MX, MY = coord_disc(sig_all, r, "x"), coord_disc(sig_all, r, "y")
+    edges = [SIGMA_LO + (SIGMA_HI - SIGMA_LO) * fmpq(i, sig_boxes) for i in range(sig_boxes + 1)]
+    out = {key: [0, []] for key in ("Y<0 bulk", "X>0 bulk", "Y>0 bulk", "Y<0 middle", "Y<0 layer")}
+    zeros = {"middle": 0.0, "layer": 0.0}
+    layer = {q: layer_coord(q, sig_all, n + 2, r) for q in range(t_layer)}  # the disc bounds, sigma-wide
+    for a, b in zip(edges, edges[1:]):
+        sig = _ball(a, b)
+        TX, TY = coord_taylor(sig, n, "x"), coord_taylor(sig, n, "y")
+        for key, (T, M, lo, hi, coord, sign) in {
+                "Y<0 bulk": (TY, MY, s0, s_a, "y", -1), "X>0 bulk": (TX, MX, s_a, s_b, "x", 1),
+                "Y>0 bulk": (TY, MY, s_b, fmpq(1, 2), "y", 1)}.items():
+            c, f = cover_sign(T, M, lo, hi, k0, sig, r, n, coord, sign)
+            out[key][0] += c
+            out[key][1] += f
+        zeros["middle"] = max(zeros["middle"], ymid_zero(TY, sig))
+        c, f = cover_ymid(TY, MY, s0, k0, t_layer, sig, r, n)
+        out["Y<0 middle"][0] += c
+        out["Y<0 middle"][1] += f
+        for q in range(t_layer):
+            T, _ = layer_coord(q, sig, n + 2, r, grid=0)
+            stack = [(fmpq(0), fmpq(1, k0), 0)]
+            while stack:
+                lo, hi, d = stack.pop()
+                up, z = layer_y_upper(T, layer[q][1], q, lo, hi, r, n + 2)
+                zeros["layer"] = max(zeros["layer"], z)
+                if up < 0:
+                    out["Y<0 layer"][0] += 1
+                elif d >= 8:
+                    out["Y<0 layer"][1].append((q, lo, hi))
+                else:
+                    m = (lo + hi) / 2
+                    stack += [(m, hi, d + 1), (lo, m, d + 1)]
+    return out, zeros
+
+
+def layer_coord(q, sigma, n, r, grid=12, prec=128):
+    """(Taylor coefficients {curve: [m: 4 arb]}, disc bounds {curve: M}) of Y on layer quadrant q's outer curves."""
+    with ctx.workprec(prec):
+        fam = Family(acb_series([0, 1], prec=n + 1), sigma)
+        nets = layer_nets(fam, q)
+        ys = _series_curves({p: nets[p][1] for p in PIECES}, n)
+        T = {c: [[z.real for z in pts] for pts in ys[c]] for c in CURVES}
+        M = {}
+        for a in range(grid):
+            for b in range(grid):
+                re = _ball(-r + 2 * r * fmpq(a, grid), -r + 2 * r * fmpq(a + 1, grid))
+                im = _ball(-r + 2 * r * fmpq(b, grid), -r + 2 * r * fmpq(b + 1, grid))
+                nets = layer_nets(Family(acb(re, im), sigma), q)
+                for c in CURVES:
+                    bound = max((abs(acb(z)).upper() for z in curve_points({p: nets[p][1] for p in PIECES}, c)),
+                                key=lambda x: x)
+                    if not bound.is_finite():
+                        raise ZeroDivisionError(f"layer disc box {a}, {b}: no bound")
+                    M[c] = bound if c not in M or bound > M[c] else M[c]
+        return T, M
+
+
+def layer_y_upper(T, M, q, h_lo, h_hi, r, n, prec=128):
+    """The largest upper bound of K Y over layer quadrant q's outer-curve points (K^2 Y at ray 0's end point,
+    quadrant 0, curve P1s1, point 0), h in [h_lo, h_hi]; the dropped coefficients are 0 exactly (y = O(h),
+    and O(h^2) on ray 0 where x, hence y's first order, vanishes)."""
+    with ctx.workprec(prec):
+        h = _ball(h_lo, h_hi)
+        hr = arb(fmpq(h_hi)) / r
+        high, zero = None, 0.0
+        for c in CURVES:
+            for p in range(4):
+                order = 2 if (q == 0 and c == "P1s1" and p == 0) else 1
+                zero = max([zero] + [float(abs(T[c][m][p]).upper()) for m in range(order)])
+                acc = arb(0)
+                for m in range(n, order - 1, -1):
+                    acc = acc * h + T[c][m][p]
+                acc += arb(0, (M[c] * hr ** (n + 1) / (1 - hr) / arb(fmpq(h_hi)) ** order).upper())
+                high = acc.upper() if high is None or acc.upper() > high else high
+        return high, zero
+
+
 # --- the printed parts ------------------------------------------------------------------------------
 
 def exact_check(k):
@@ -979,6 +1222,17 @@ def main(argv=None):
         print(f"T  layer: quadrant {q}: K^3 (a1 X Y' - a2 Y X') >= {float(worst):.3g} > 0 for every K >= {args.k0}: "
               f"{count} boxes, {len(failed)} undecided; h^0..h^2 enclosed in |.| <= {zero:.1e} "
               f"({time.time() - t:.1f} s)")
+    t = time.time()
+    res, zeros = winding(args.k0, s0, args.t)
+    print(f"W  signs on the outer curves for every K >= {args.k0}: "
+          + "; ".join(f"{key}: {c} boxes, {len(f)} undecided" for key, (c, f) in res.items())
+          + f" (bulk: Y < 0 for s in [{s0}, 1/4], X > 0 for s in [1/4, 7/20], Y > 0 for s in [7/20, 1/2]; middle: "
+          f"Y/s < 0 for {args.t} <= q <= {s0} K; layer: K Y < 0 on quadrants 0..{args.t - 1}, K^2 Y < 0 at ray 0's end "
+          f"point); the exact zeros enclosed in |.| <= {zeros['middle']:.1e} (middle, Y at s = h = 0), "
+          f"{zeros['layer']:.1e} (layer) ({time.time() - t:.1f} s)")
+    if all(not f for _, f in res.values()):
+        print("W  so Gamma crosses the half-axis Y = 0, X > 0 exactly once (upwards, by T), and its mirror half "
+              "meets Y = 0 only where X < 0: winding number 1")
     t = time.time()
     total, worst, failed, _, _, _ = bulk(args.k0, s0, sig_boxes=1, depth=4, smooth=True)
     print(f"E  control (the smooth valence's mode-1 map, y = +cos, with the dart's orientation): {total} boxes "

@@ -183,3 +183,26 @@ def test_transversality_models_enclose_the_verifiers_forms():
         want = min(min(c.lower() for c in transversal_form(nets, cv, a1, a2, 128).coeffs) for cv in mod.CURVES)
         lo, hi = mod.layer_box(TL, ML, h, h, r, 14)
         assert lo <= want * k ** 3 <= hi and lo > 0, (lo, want * k ** 3, hi)
+
+
+@pytest.mark.slow
+def test_winding_signs_and_their_controls():
+    # the sign conditions of W hold for every K >= 101; the exact zeros are tiny at a point sigma; and Y
+    # really changes sign between s_a and s_b (the zero that W counts), checked on the verifier's own y at K = 101
+    mod = _load()
+    k = 101
+    with ctx.workprec(128):
+        res, zeros = mod.winding(k, fmpq(1, 20), 3, sig_boxes=2)
+        assert all(c > 0 and not f for c, f in res.values()), res
+        sig = mod._limit_script().sigma_of(arb(fmpq(1, k)))
+        T, _ = mod.layer_coord(0, sig, 14, mod.R_CAUCHY, grid=0)
+        assert all(abs(T[c][0][p]) < 1e-25 for c in mod.CURVES for p in range(4))
+        assert abs(T["P1s1"][1][0]) < 1e-25  # ray 0's end point: y = O(h^2)
+        TY = mod.coord_taylor(sig, 12, "y")
+        assert mod.ymid_zero(TY, sig) < 1e-25
+        y = even_vector(k, max((z.real for z, r, src, _ in mode_spectrum("dart", k)
+                                if src == "E" and r != 1 and z.imag.contains(0)), key=lambda r: r.mid()),
+                        labels("dart", k).index(("r", k // 2, 1, 0)))
+        pts = labels("dart", k)
+        assert y[pts.index(("r", 25, 1, 0))] < 0 < y[pts.index(("r", 35, 1, 0))]
+        assert y[pts.index(("r", 0, 1, 0))] < 0
