@@ -206,3 +206,35 @@ def test_winding_signs_and_their_controls():
         pts = labels("dart", k)
         assert y[pts.index(("r", 25, 1, 0))] < 0 < y[pts.index(("r", 35, 1, 0))]
         assert y[pts.index(("r", 0, 1, 0))] < 0
+
+
+@pytest.mark.slow
+def test_the_reflection_keeps_det_j_so_half_the_quadrants_suffice():
+    # the scripts prove quadrants q <= (K-1)/2 only; quadrant K-1-q is the mirror image (x odd, y even, the
+    # pieces P1 <-> P3 with (u, v) swapped), so its det J_Phi coefficients are the same multiset: the verifier's
+    # own nets at K = 101 (odd) and 40 (even)
+    for k, qs in ((101, (0, 1, 7, 30, 50)), (40, (0, 3, 19))):
+        with ctx.workprec(128):
+            for q in qs:
+                a, b = _verifier_kdet(k, q), _verifier_kdet(k, k - 1 - q)
+                va = sorted(float(c.mid()) for p in PIECES for c in a[p])
+                vb = sorted(float(c.mid()) for p in PIECES for c in b[p])
+                assert max(abs(x - y) for x, y in zip(va, vb)) < 1e-20 * k ** 3, (k, q)
+                assert min(va) > 0
+
+
+def test_the_dropped_coefficients_vanish_at_a_point_sigma():
+    # the script drops D_ij's h^0 coefficient (bulk), T_ij's h^0, and the middle's s^0, s^1, s^0 h
+    # coefficients as 0 exactly; at a point sigma their enclosures must be tiny, while the first kept ones are not
+    mod = _load()
+    with ctx.workprec(128):
+        sig = mod._limit_script().sigma_of(arb(fmpq(1, 500)))
+        T = mod.taylor_dets(sig, 6)
+        assert all(abs(z) < 1e-25 for v in T.values() for z in v[0])
+        E = mod.middle_coeffs(T, sig, L=4)
+        for key in ((1, 0), (1, 1), (2, 0)):
+            assert all(abs(z) < 1e-25 for p in PIECES for z in E[key + (p,)])
+        assert min(max(abs(z.real) for z in E[(1, 2, p)]) for p in PIECES) > 1  # K^3 det J/q^2 -> about 6..7
+        Tt = mod.taylor_trans(sig, 6)
+        assert all(abs(z) < 1e-25 for v in Tt.values() for z in v[0])
+        assert any(abs(z) > 0.1 for v in Tt.values() for z in v[1])
