@@ -168,8 +168,13 @@ def big_u(lam):
 
 
 def lam_of(c):
-    """lam(c) = (5 + c + sqrt((1 + c)(9 + c)))/16 (acb, arb or acb_series)."""
-    return (5 + c + ((1 + c) * (9 + c)).sqrt()) / 16
+    """lam(c) = (5 + c + sqrt((1 + c)(9 + c)))/16 (acb, arb or acb_series). On an acb ball the square root's
+    argument must lie in the right half-plane (off the principal branch's cut, so the value is analytic
+    there: the Cauchy bounds need that); ZeroDivisionError otherwise."""
+    arg = (1 + c) * (9 + c)
+    if isinstance(arg, acb) and not arg.real > 0:
+        raise ZeroDivisionError("sqrt((1 + c)(9 + c)): the argument is not certainly off the branch cut")
+    return (5 + c + arg.sqrt()) / 16
 
 
 def _block(w):
@@ -180,6 +185,28 @@ def _block(w):
         for (d, pos), x in row.items():
             rows[i][_POS[pos]] = rows[i][_POS[pos]] + powers[d] * x
     return rows
+
+
+def _hvar(n):
+    """The series variable h to order n. python-flint truncates every series to ``ctx.cap`` terms (10 by
+    default) whatever its ``prec``: the callers run under :func:`series_cap` so that no order is lost."""
+    if ctx.cap < n + 1:
+        raise ValueError(f"ctx.cap = {ctx.cap} < {n + 1}: series would be truncated silently")
+    return acb_series([0, 1], prec=n + 1)
+
+
+class series_cap:
+    """Context manager: ctx.cap >= n + 1 inside (restored after)."""
+
+    def __init__(self, n):
+        self.n = n
+
+    def __enter__(self):
+        self.old = ctx.cap
+        ctx.cap = max(self.old, self.n + 1)
+
+    def __exit__(self, *exc):
+        ctx.cap = self.old
 
 
 def _coeffs(z, n):
@@ -353,8 +380,8 @@ def taylor_dets(sigma, n, prec=128, **control):
     """The Taylor coefficients in h of D_ij = D(X_i, Y_j) for the basis parts X_i (X+, X-) and Y_j (Y0, Y+, Y-):
     {(i, j, piece): [coefficient list (acb) of h^m, m = 0..n]}. D is bilinear, so the coefficient of h^m is
     sum_(k + l = m) D(X_i,k, Y_j,l) of the nets' own Taylor coefficients (acb_series, rigorous)."""
-    with ctx.workprec(prec):
-        fam = Family(acb_series([0, 1], prec=n + 1), sigma, **control)
+    with ctx.workprec(prec), series_cap(n):
+        fam = Family(_hvar(n), sigma, **control)
         nets = basis_nets(fam)
         forms = {(name, piece, m): _real_forms([[_coeffs(z, n + 1)[m] for z in row] for row in net], prec)
                  for name, pn in nets.items() for piece, net in pn.items() for m in range(n + 1)}
@@ -634,8 +661,8 @@ def layer_nets(fam, q):
 def layer_taylor(q, sigma, n, prec=128):
     """{piece: [Bernstein coefficients (arb) of det J_Phi's h^m, m = 0..n]} of layer quadrant q (real parts:
     the values are real for real h)."""
-    with ctx.workprec(prec):
-        fam = Family(acb_series([0, 1], prec=n + 1), sigma)
+    with ctx.workprec(prec), series_cap(n):
+        fam = Family(_hvar(n), sigma)
         out = {}
         for piece, (X, Y) in layer_nets(fam, q).items():
             fx = [BernsteinForm((4, 4), [_coeffs(X[i][j], n + 1)[m].real for i in range(4) for j in range(4)],
@@ -791,8 +818,8 @@ def taylor_trans(sigma, n, prec=128, **control):
     """As :func:`taylor_dets` for T_ij = a1 X_i Y_j' - a2 Y_j X_i' along the outer curves (a_i = -ln lam_i):
     {(i, j, curve): [coefficient list of h^m, m = 0..n]}; T_ij(0) = 0 exactly (a1 = a2, both parts multiples
     of one real curve at h = 0)."""
-    with ctx.workprec(prec):
-        fam = Family(acb_series([0, 1], prec=n + 1), sigma, **control)
+    with ctx.workprec(prec), series_cap(n):
+        fam = Family(_hvar(n), sigma, **control)
         nets = basis_nets(fam)
         A1, A2 = (_coeffs(-lam.log(), n + 1) for lam in (fam.lam1, fam.lam2))
         curves = {b: _series_curves(nets[b], n) for b in nets}
@@ -810,6 +837,8 @@ def disc_trans(sigma, r, grid=12, prec=128, **control):
                 im = _ball(-r + 2 * r * fmpq(b, grid), -r + 2 * r * fmpq(b + 1, grid))
                 fam = Family(acb(re, im), sigma, **control)
                 nets = basis_nets(fam)
+                if not (acb(fam.lam1).real > 0 and acb(fam.lam2).real > 0):
+                    raise ZeroDivisionError("log lam: not certainly off the branch cut")
                 a1, a2 = -acb(fam.lam1).log(), -acb(fam.lam2).log()
                 for i in XB:
                     for j in YB:
@@ -826,8 +855,8 @@ def disc_trans(sigma, r, grid=12, prec=128, **control):
 
 def layer_trans_taylor(q, sigma, n, prec=128):
     """{curve: [coefficients (arb) of h^m]} of a1 X Y' - a2 Y X' on layer quadrant q (h^0..h^2: 0 exactly)."""
-    with ctx.workprec(prec):
-        fam = Family(acb_series([0, 1], prec=n + 1), sigma)
+    with ctx.workprec(prec), series_cap(n):
+        fam = Family(_hvar(n), sigma)
         nets = layer_nets(fam, q)
         A1, A2 = ([z.real for z in _coeffs(-lam.log(), n + 1)] for lam in (fam.lam1, fam.lam2))
         xs = _series_curves({p: nets[p][0] for p in PIECES}, n)
@@ -846,6 +875,8 @@ def layer_trans_disc(q, sigma, r, grid=12, prec=128):
                 im = _ball(-r + 2 * r * fmpq(b, grid), -r + 2 * r * fmpq(b + 1, grid))
                 fam = Family(acb(re, im), sigma)
                 nets = layer_nets(fam, q)
+                if not (acb(fam.lam1).real > 0 and acb(fam.lam2).real > 0):
+                    raise ZeroDivisionError("log lam: not certainly off the branch cut")
                 a1, a2 = -acb(fam.lam1).log(), -acb(fam.lam2).log()
                 for c in CURVES:
                     X = curve_points({p: nets[p][0] for p in PIECES}, c)
@@ -868,8 +899,8 @@ def layer_trans_disc(q, sigma, r, grid=12, prec=128):
 def coord_taylor(sigma, n, coord, prec=128):
     """{(basis part, curve): [order m: 4 acb]}: Taylor coefficients in h of the outer curves' Bezier points of
     the basis parts of x (coord "x": X+, X-) or y ("y": Y0, Y+, Y-)."""
-    with ctx.workprec(prec):
-        fam = Family(acb_series([0, 1], prec=n + 1), sigma)
+    with ctx.workprec(prec), series_cap(n):
+        fam = Family(_hvar(n), sigma)
         nets = basis_nets(fam)
         return {(b, c): pts for b in (XB if coord == "x" else YB) for c, pts in _series_curves(nets[b], n).items()}
 
@@ -1057,8 +1088,8 @@ def winding(k0, s0, t_layer, s_a=S_A, s_b=S_B, sig_boxes=10, n=12, r=R_CAUCHY):
 
 def layer_coord(q, sigma, n, r, grid=12, prec=128):
     """(Taylor coefficients {curve: [m: 4 arb]}, disc bounds {curve: M}) of Y on layer quadrant q's outer curves."""
-    with ctx.workprec(prec):
-        fam = Family(acb_series([0, 1], prec=n + 1), sigma)
+    with ctx.workprec(prec), series_cap(n):
+        fam = Family(_hvar(n), sigma)
         nets = layer_nets(fam, q)
         ys = _series_curves({p: nets[p][1] for p in PIECES}, n)
         T = {c: [[z.real for z in pts] for pts in ys[c]] for c in CURVES}

@@ -238,3 +238,22 @@ def test_the_dropped_coefficients_vanish_at_a_point_sigma():
         Tt = mod.taylor_trans(sig, 6)
         assert all(abs(z) < 1e-25 for v in Tt.values() for z in v[0])
         assert any(abs(z) > 0.1 for v in Tt.values() for z in v[1])
+
+
+def test_series_are_not_truncated_silently():
+    # python-flint cuts every series to ctx.cap terms whatever its length: the script must refuse that, and
+    # under series_cap its order-12 coefficients must be there (the x-mode's v^(1,1) has a nonzero h^11 term)
+    mod = _load()
+    with ctx.workprec(128):
+        old = ctx.cap
+        try:
+            ctx.cap = 10
+            with pytest.raises(ValueError):
+                mod._hvar(12)
+            with mod.series_cap(12):
+                fam = mod.Family(mod._hvar(12), arb("4.49"))
+                c = mod._coeffs(fam.vx[2], 13)
+            assert ctx.cap == 10
+            assert abs(c[11]) > 1e-6 and abs(c[12]) > 1e-6
+        finally:
+            ctx.cap = old
