@@ -566,14 +566,14 @@ def middle_box(T, E, M, s_lo, s_hi, w_lo, w_hi, sigma, r, n, L=24, prec=128):
 
 
 def cover_middle(T, E, M, s0, k0, t_layer, sigma, r, n, depth=14):
-    """Bisect (s, w) in [0, s0] x [0, 1/t_layer] (boxes with s w > 1/k0 throughout lie outside: K >= k0) until
+    """Bisect (s, w) in [0, s0] x [0, 1/t_layer] (boxes with s w > 1/k0 throughout lie outside: K < k0) until
     :func:`middle_box` is certainly positive. Returns (boxes proved, least lower bound, undecided boxes)."""
     h1 = fmpq(1, k0)
     stack = [(fmpq(0), s0, fmpq(0), fmpq(1, t_layer), 0)]
     count, worst, failed = 0, None, []
     while stack:
         a, b, c, d, dep = stack.pop()
-        if a * c >= h1:
+        if a * c > h1:  # the whole box has h = s w > 1/k0 (K < k0)
             continue
         low = middle_box(T, E, M, a, b, c, d, sigma, r, n)[0]
         if low > 0:
@@ -1028,7 +1028,7 @@ def cover_ymid(T, M, s0, k0, t_layer, sigma, r, n, depth=12):
     count, failed = 0, []
     while stack:
         a, b, c, d, dep = stack.pop()
-        if a * c >= h1:
+        if a * c > h1:  # the whole box has h = s w > 1/k0 (K < k0)
             continue
         if ymid_box(T, M, a, b, c, d, sigma, r, n)[1] < 0:
             count += 1
