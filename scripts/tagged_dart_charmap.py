@@ -54,7 +54,7 @@ sigma(h) itself need not be differentiable: for each fixed sigma the family is a
 map is the member sigma = sigma(h), which lies in [4.484, 4.4935] for every K >= 101 (part C); the script
 covers that interval by sigma-boxes.
 
-What it prints (``python scripts/tagged_dart_charmap.py``, about 70 s):
+What it prints (``python scripts/tagged_dart_charmap.py``, about 70 s; Z first: the exact facts in Q(sqrt 5)):
 
 A. the closed forms against the verifier's exact per-K vectors (``mode_vector``, ``even_vector``) and
    nets (``quadrant_nets``: bulk quadrants and the layer quadrants 0, 1, 2) at K = 12, 40, 101 (--exact);
@@ -733,6 +733,90 @@ def corner_dets(sigma, k, s):
     return out
 
 
+class QL0:
+    """a + b L0 in Q(L0) = Q(sqrt 5), L0 = lam(1) = (6 + sqrt 20)/16 the root of 16 x^2 - 12 x + 1 = 0 (exact)."""
+
+    __slots__ = ("a", "b")
+
+    def __init__(self, a, b=0):
+        self.a, self.b = fmpq(a), fmpq(b)
+
+    @staticmethod
+    def lift(z):
+        return z if isinstance(z, QL0) else QL0(z)
+
+    def __add__(self, o):
+        o = QL0.lift(o)
+        return QL0(self.a + o.a, self.b + o.b)
+
+    __radd__ = __add__
+
+    def __neg__(self):
+        return QL0(-self.a, -self.b)
+
+    def __sub__(self, o):
+        return self + (-QL0.lift(o))
+
+    def __mul__(self, o):
+        o = QL0.lift(o)
+        bb = self.b * o.b  # L0^2 = (12 L0 - 1)/16
+        return QL0(self.a * o.a - bb / 16, self.a * o.b + self.b * o.a + bb * fmpq(12, 16))
+
+    __rmul__ = __mul__
+
+    def inv(self):
+        # (a + b L0)(a + b L0') = a^2 + a b (L0 + L0') + b^2 L0 L0' = a^2 + 3 a b/4 + b^2/16, L0' = 3/4 - L0
+        n = self.a * self.a + self.a * self.b * fmpq(3, 4) + self.b * self.b / 16
+        return QL0((self.a + self.b * fmpq(3, 4)) / n, -self.b / n)
+
+    def __truediv__(self, o):
+        return self * QL0.lift(o).inv()
+
+    def __eq__(self, o):
+        o = QL0.lift(o)
+        return self.a == o.a and self.b == o.b
+
+    def is_zero(self):
+        return self.a == 0 and self.b == 0
+
+
+def exact_zeros():
+    """Check exactly (in Q(L0)) the facts the dropped coefficients rest on: L0 is an eigenvalue of B(1) with
+    eigenvector rho (rho(1,0) = 1) and rho(a, b) = rho(b, a); adj(L0 - B(1)) kappa = N(L0) is a multiple of rho
+    (so U(L0) = U(1,0) rho and alpha(0) U(L0) = -cos(sigma) rho). Returns rho (6 QL0)."""
+    L = QL0(0, 1)
+    A = [[(L if i == k else QL0(0)) - _B1[i, k] for k in range(6)] for i in range(6)]
+    # rho: solve A rho = 0 with rho(1,0) = 1: drop row 0 (rank 5 since L0 is simple: checked by the solve)
+    M = [[A[i][k] for k in range(1, 6)] + [-A[i][0]] for i in range(1, 6)]
+    for c in range(5):  # Gauss-Jordan over Q(L0)
+        piv = next(r for r in range(c, 5) if not M[r][c].is_zero())
+        M[c], M[piv] = M[piv], M[c]
+        inv = M[c][c].inv()
+        M[c] = [z * inv for z in M[c]]
+        for r in range(5):
+            if r != c and not M[r][c].is_zero():
+                f = M[r][c]
+                M[r] = [z - f * w for z, w in zip(M[r], M[c])]
+    rho = [QL0(1)] + [M[r][5] for r in range(5)]
+    if not all(sum((A[i][k] * rho[k] for k in range(6)), QL0(0)).is_zero() for i in range(6)):
+        raise AssertionError("rho is no eigenvector of B(1) for L0")
+    pos = {p: k for p, k in _POS.items()}
+    if not all(rho[pos[(a, b)]] == rho[pos[(b, a)]] for (a, b) in pos if b > 0 and (b, a) in pos):
+        raise AssertionError("rho is not symmetric in (a, b)")
+    N = [sum((c * L0pow for c, L0pow in zip(p, _powers(L, len(p)))), QL0(0)) for p in _NPOLY]
+    if not all((N[k] - N[0] * rho[k]).is_zero() for k in range(6)) or N[0].is_zero():
+        raise AssertionError("adj(L0 - B(1)) kappa is not a non-zero multiple of rho")
+    return rho
+
+
+def _powers(x, n):
+    out, acc = [], QL0(1)
+    for _ in range(n):
+        out.append(acc)
+        acc = acc * x
+    return out
+
+
 SIGMA_LO, SIGMA_HI = fmpq(4484, 1000), fmpq(44935, 10000)  # sigma(K) for every K >= 101 (part C)
 R_CAUCHY = fmpq(1, 32)  # the radius of the complex h-disc of the Cauchy remainders
 
@@ -1219,6 +1303,11 @@ def main(argv=None):
               f"|lam2 - lam(cos(2 sigma h))| <= {el:.1e}, "
               f"x (mode_vector) {ex:.1e}, y (even_vector) {ey:.1e}, Bezier nets of quadrants 3 and (K-1)/2 "
               f"(quadrant_nets) {en:.1e}, layer nets of quadrants 0, 1, 2 {ea:.1e} ({time.time() - t:.1f} s)")
+    rho = exact_zeros()
+    print("Z  exact in Q(sqrt 5): rho = v^(0) is the eigenvector of B(1) for L0 = (6 + sqrt 20)/16 with "
+          "rho(a, b) = rho(b, a), and adj(L0 - B(1)) kappa is a non-zero multiple of rho (the facts the dropped "
+          "coefficients rest on); rho = (" + ", ".join(f"{float(z.a) + float(z.b) * 0.6545084971874737:.6f}"
+                                                      for z in rho) + ")")
     lim = _limit_script()
     t = time.time()
     ok = lim.part_c(args.k0, lo="4.484", hi="4.4935", boxes=64, quiet=True)  # the ends of SIGMA_LO, SIGMA_HI

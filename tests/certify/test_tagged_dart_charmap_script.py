@@ -257,3 +257,16 @@ def test_series_are_not_truncated_silently():
             assert abs(c[11]) > 1e-6 and abs(c[12]) > 1e-6
         finally:
             ctx.cap = old
+
+
+def test_the_exact_facts_behind_the_dropped_coefficients():
+    # rho in Q(sqrt 5) (exact Gauss-Jordan) is the script's v^ at h = 0 for both modes (acb bordered solve)
+    mod = _load()
+    with ctx.workprec(128):
+        rho = mod.exact_zeros()
+        L0 = (6 + arb(20).sqrt()) / 16
+        fam = mod.Family(acb(0), arb("4.49"))
+        for z, vx, vy in zip(rho, fam.vx, fam.vy):
+            want = arb(z.a) + arb(z.b) * L0
+            assert abs(acb(vx) - want) < 1e-30 and abs(acb(vy) - want) < 1e-30
+        assert rho[2] == mod.QL0(-4, 8)  # rho(1,1) = sqrt 5 - 1 = -4 + 8 L0
