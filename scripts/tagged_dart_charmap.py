@@ -54,7 +54,8 @@ sigma(h) itself need not be differentiable: for each fixed sigma the family is a
 map is the member sigma = sigma(h), which lies in [4.484, 4.4935] for every K >= 101 (part C); the script
 covers that interval by sigma-boxes.
 
-What it prints (``python scripts/tagged_dart_charmap.py``, about 70 s; Z first: the exact facts in Q(sqrt 5)):
+What it prints (``python scripts/tagged_dart_charmap.py``, about 130 s; Z first: the exact facts in Q(sqrt 5)
+and the exact zeros):
 
 A. the closed forms against the verifier's exact per-K vectors (``mode_vector``, ``even_vector``) and
    nets (``quadrant_nets``: bulk quadrants and the layer quadrants 0, 1, 2) at K = 12, 40, 101 (--exact);
@@ -70,14 +71,19 @@ W. the winding part: Y < 0 on the outer curves for s in [0, 1/4] (layer: K Y, an
    middle: Y/s; bulk: Y), X > 0 for s in [1/4, 7/20], Y > 0 for s in [7/20, 1/2], so Gamma crosses the
    half-axis Y = 0, X > 0 exactly once (all crossings upwards by T) and its mirror half only where X < 0.
 
-Everything here is untrusted: the coefficients that the arguments above make 0 are dropped, not checked
-exactly, and the spectral part is tagged_dart_limit.py's (docs/tagged_c1.md, items 3 and 6).
+Z. the coefficients that the arguments above make 0 are dropped from the Taylor models; each of them is
+   computed in exact arithmetic (Q(sqrt 5, i), as a polynomial in 2 pi, 2 sigma, cos sigma, sin sigma, ln L0
+   checked on a grid) and found 0 by scripts/tagged_dart_zeros.py, which this script runs first.
+
+Everything here is untrusted (a script, not the verifier); the spectral part is tagged_dart_limit.py's
+(docs/tagged_c1.md, items 3 and 6).
 """
 
 from __future__ import annotations
 
 import argparse
 import importlib.util
+import sys
 import time
 from pathlib import Path
 
@@ -97,6 +103,14 @@ CURVES = {"P1s1": ("P1", "s", 1), "P2s1": ("P2", "s", 1), "P2t1": ("P2", "t", -1
 def _limit_script():
     path = Path(__file__).resolve().parent / "tagged_dart_limit.py"
     spec = importlib.util.spec_from_file_location("tagged_dart_limit", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def _zeros_script():
+    path = Path(__file__).resolve().parent / "tagged_dart_zeros.py"
+    spec = importlib.util.spec_from_file_location("tagged_dart_zeros", path)
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)
     return mod
@@ -1308,6 +1322,13 @@ def main(argv=None):
           "rho(a, b) = rho(b, a), and adj(L0 - B(1)) kappa is a non-zero multiple of rho (the facts the dropped "
           "coefficients rest on); rho = (" + ", ".join(f"{float(z.a) + float(z.b) * 0.6545084971874737:.6f}"
                                                       for z in rho) + ")")
+    t = time.time()
+    zmod = _zeros_script()
+    total = zmod.check_all(sys.modules[__name__])
+    print(f"Z  the dropped Taylor coefficients, computed exactly in Q(sqrt 5, i) (tagged_dart_zeros.py; grid a, b in "
+          f"{zmod.GRID_AB}, c, t, l in {zmod.GRID_CT}): " + zmod.report(total) + f" ({time.time() - t:.1f} s)")
+    if any(bad for _, bad in total.values()):
+        raise SystemExit("Z failed: a dropped coefficient is not 0")
     lim = _limit_script()
     t = time.time()
     ok = lim.part_c(args.k0, lo="4.484", hi="4.4935", boxes=64, quiet=True)  # the ends of SIGMA_LO, SIGMA_HI

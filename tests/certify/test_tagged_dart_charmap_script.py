@@ -270,3 +270,75 @@ def test_the_exact_facts_behind_the_dropped_coefficients():
             want = arb(z.a) + arb(z.b) * L0
             assert abs(acb(vx) - want) < 1e-30 and abs(acb(vy) - want) < 1e-30
         assert rho[2] == mod.QL0(-4, 8)  # rho(1,1) = sqrt 5 - 1 = -4 + 8 L0
+
+
+def _load_zeros():
+    spec = importlib.util.spec_from_file_location("tagged_dart_zeros", SCRIPTS / "tagged_dart_zeros.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def _qf(z):
+    r5 = arb(5).sqrt()
+    return acb(arb(z.p) + arb(z.q) * r5, arb(z.r) + arb(z.u) * r5)
+
+
+def test_the_exact_series_are_the_acb_familys():
+    # the exact Series (Q(sqrt 5, i), a = 1, b = 1, c = t = 1) against the script's acb_series Family at sigma = 1/2
+    # (so b = 2 sigma = 1): y's h^m coefficients equal, x's scaled by (2 pi)^m (x is a function of a h),
+    # alpha by cos(1/2) (alpha is c times a function of b h); an independent route: flint's acb_series solve
+    zmod, mod = _load_zeros(), _load()
+    ex = zmod.ExactFamily(mod, 1, 1, 1, 1)
+    with ctx.workprec(128), mod.series_cap(3):
+        fam = mod.Family(mod._hvar(2), arb(fmpq(1, 2)))
+        tp = 2 * arb.pi()
+        for k in range(6):
+            cy, cx = mod._coeffs(fam.vy[k], 3), mod._coeffs(fam.vx[k], 3)
+            for m in range(3):
+                assert abs(cy[m] - _qf(ex.vy[k].c[m])) < 1e-30
+                assert abs(cx[m] - tp ** m * _qf(ex.vx[k].c[m])) < 1e-30
+        ca = mod._coeffs(fam.alpha, 3)
+        for m in range(3):
+            assert abs(ca[m] - arb(fmpq(1, 2)).cos() * _qf(ex.alpha.c[m])) < 1e-30
+        assert abs(mod._coeffs(fam.lam2, 3)[2] - _qf(ex.lam2.c[2])) < 1e-30
+        assert abs(_qf(ex.lam2.c[2])) > 0.01  # lam's h^2 term is there
+
+
+def test_the_dropped_coefficients_are_exactly_zero_at_one_grid_point():
+    zmod, mod = _load_zeros(), _load()
+    res = zmod.check_point(mod, 1, 2, 1, 2)
+    assert len(res) == 8 and all(n > 0 and bad == 0 for n, bad in res.values()), res
+
+
+def test_the_exact_zero_check_refuses_a_perturbed_rule_or_family():
+    # perturb the ring rule (a weight moved between mirror-image positions, row sums kept) or flip alpha:
+    # the dropped coefficients are then not 0, and the exact check must say so
+    zmod, mod = _load_zeros(), _load()
+    from ccproof.certify.verify.tagged_modes import ring_stencil
+
+    def moved(row, src, dst):
+        e = fmpq(1, 64)
+        st = [dict(r) for r in ring_stencil()]
+        st[row][src] -= e
+        st[row][dst] = st[row].get(dst, fmpq(0)) + e
+        return st
+    # B(1) no longer symmetric in (a, b) (the row of (2, 1) no longer the mirror of the row of (1, 2)): v^(0) is
+    # no longer symmetric, X- no longer a multiple of X+ at h = 0, D_ij(0) != 0
+    res = zmod.check_point(mod, 1, 2, 1, 2, stencil=moved(3, (0, (2, 1)), (0, (2, 0))))
+    assert res["bulk det: D_ij h^0"][1] > 0 and res["bulk T: T_ij h^0"][1] > 0, res
+    # the row of (2, 2) weighs (1, 2) and (2, 1) unequally: v^(0) stays symmetric ((2, 2) enters no other row), but
+    # the reflection identity B(1/w) R_w = R_w B(w) breaks, and with it the h-orders (layer, middle)
+    res = zmod.check_point(mod, 1, 2, 1, 2, stencil=moved(5, (0, (1, 2)), (0, (2, 1))))
+    assert res["bulk det: D_ij h^0"][1] == 0
+    assert res["layer det: h^0, h^1, h^2"][1] > 0 and res["middle det: e_10, e_11, e_20"][1] > 0, res
+    # alpha -> -alpha: y's mode-0 part no longer cancels at h = 0
+    res = zmod.check_point(mod, 1, 2, 1, 2, flip_alpha=True)
+    assert res["layer det: h^0, h^1, h^2"][1] > 0 and res["W middle: Y(s = h = 0)"][1] > 0, res
+
+
+@pytest.mark.slow
+def test_every_dropped_coefficient_is_exactly_zero_on_the_whole_grid():
+    zmod, mod = _load_zeros(), _load()
+    res = zmod.check_all(mod)
+    assert len(res) == 8 and all(n > 0 and bad == 0 for n, bad in res.values()), res
