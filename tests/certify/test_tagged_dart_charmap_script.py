@@ -342,3 +342,53 @@ def test_every_dropped_coefficient_is_exactly_zero_on_the_whole_grid():
     zmod, mod = _load_zeros(), _load()
     res = zmod.check_all(mod)
     assert len(res) == 8 and all(n > 0 and bad == 0 for n, bad in res.values()), res
+
+
+def test_the_exact_nets_are_the_acb_familys_nets():
+    # the exact basis nets (bulk) and layer nets against the script's own (acb_series, sigma = 1/2, b = 1): x's
+    # h^m coefficient scales by (2 pi)^m; Y0 and the layer's y are linear in (cos sigma, sin sigma),
+    # y = cos y(1, 0) + sin y(0, 1); the bulk's Y+, Y- do not depend on them
+    zmod, mod = _load_zeros(), _load()
+    exs = [zmod.ExactFamily(mod, 1, 1, c, t) for c, t in ((1, 0), (0, 1))]
+
+    def exact_y(zs, m):  # zs: the two exact Series (c, t) = (1, 0), (0, 1)
+        return co * _qf(zs[0].c[m]) + si * _qf(zs[1].c[m])
+    with ctx.workprec(128), mod.series_cap(3):
+        half = arb(fmpq(1, 2))
+        co, si, tp = half.cos(), half.sin(), 2 * arb.pi()
+        fam = mod.Family(mod._hvar(2), half)
+        mine = mod.basis_nets(fam)
+        ex = [{n: mod.piece_nets(f, c, lam, e.zero) for n, (f, c, lam) in e.parts().items()} for e in exs]
+        worst = 0.0
+        for name in mine:
+            for p in mod.PIECES:
+                for i in range(4):
+                    for j in range(4):
+                        got = mod._coeffs(mine[name][p][i][j], 3)
+                        for m in range(3):
+                            if name.startswith("X"):
+                                want = tp ** m * _qf(ex[0][name][p][i][j].c[m])
+                            elif name != "Y0":
+                                want = _qf(ex[0][name][p][i][j].c[m])
+                            else:
+                                want = exact_y([ex[0][name][p][i][j], ex[1][name][p][i][j]], m)
+                            worst = max(worst, float(abs(got[m] - want).upper()))
+        for q in range(3):
+            ln = mod.layer_nets(fam, q)
+            el = []
+            for e in exs:
+                x, y = e.layer_level0(q)
+                el.append({p: mod._bezier([[mod.layer_value(y, e.yc, e.lam2, q, e.zero)(mod._OFFSET[p][0] + i,
+                                                                                            mod._OFFSET[p][1] + j)
+                                             for j in range(4)] for i in range(4)], e.zero) for p in mod.PIECES})
+                x0 = {p: mod._bezier([[mod.layer_value(x, e.zero, e.lam1, q, e.zero)(mod._OFFSET[p][0] + i,
+                                                                                     mod._OFFSET[p][1] + j)
+                                       for j in range(4)] for i in range(4)], e.zero) for p in mod.PIECES}
+            for p in mod.PIECES:
+                for i in range(4):
+                    for j in range(4):
+                        gx, gy = mod._coeffs(ln[p][0][i][j], 3), mod._coeffs(ln[p][1][i][j], 3)
+                        for m in range(3):
+                            worst = max(worst, float(abs(gx[m] - tp ** m * _qf(x0[p][i][j].c[m])).upper()),
+                                        float(abs(gy[m] - exact_y([el[0][p][i][j], el[1][p][i][j]], m)).upper()))
+        assert worst < 1e-30, worst
