@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ccproof.errors import CCProofError, MeshError
+from ccproof.errors import CCProofError
 from ccproof.evaluate._parallel import in_blocks, threads_for
 from ccproof.evaluate._table import (
     _CORNER,
@@ -703,11 +703,10 @@ class LimitSurface:
         >>> T.with_vertices(np.asarray(c.vertices) + [1, 0, 0]).evaluate([0], [0.0], [0.0])["P"].round(12).tolist()
         [[0.0, -1.0, -1.0]]
         """
+        mesh = self.mesh.with_vertices(X)  # checks the shape and finiteness (MeshError); topology shared
         if self._ptex_face is not None:
-            mesh = _polymesh_with_vertices(self.mesh, X)  # checks the shape and finiteness (MeshError)
             V = self._classified_positions(mesh)
         else:
-            mesh = self.mesh.with_vertices(X)  # checks the shape and finiteness (MeshError)
             V = np.where(mesh.is_unused_vertex[:, None], 0.0, mesh.vertices)  # unused: any value, weight 0
         new = object.__new__(LimitSurface)
         new.__dict__.update(self.__dict__)
@@ -737,33 +736,6 @@ class LimitSurface:
             S = self._moving["step"] = man.subdivision_operator()
             S.sort_indices()  # each row summed in increasing column order: refine's sums
         return S @ np.asarray(man.vertices, dtype=np.float64)
-
-
-def _polymesh_with_vertices(mesh, X):
-    """The PolyMesh ``mesh`` with the vertices ``X`` (n_vertices, 3): its connectivity, tags and
-    topology arrays shared, the vertices of its :attr:`~PolyMesh.manifold` split gathered from
-    ``X`` (``X[manifold_vertex_map]``). MeshError for a wrong shape or a non-finite used vertex."""
-    import copy
-
-    from ccproof.mesh.quadmesh import _check_used_finite
-
-    V = np.array(X, dtype=np.float64)
-    if V.shape != mesh.vertices.shape:
-        raise MeshError(f"vertices must have shape {mesh.vertices.shape}, got {V.shape}")
-    _check_used_finite(V, mesh.indices)
-    V.setflags(write=False)
-    new = copy.copy(mesh)
-    new.vertices = V
-    if mesh.manifold is mesh:
-        new.manifold = new
-    else:
-        man = copy.copy(mesh.manifold)
-        Vm = V[mesh.manifold_vertex_map]
-        Vm.setflags(write=False)
-        man.vertices = Vm
-        man.manifold = man
-        new.manifold = man
-    return new
 
 
 _BACKENDS = ("auto", "c", "numba", "numpy")
