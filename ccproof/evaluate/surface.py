@@ -117,8 +117,10 @@ class LimitSurface:
         if isinstance(mesh, PolyMesh):
             from ccproof.evaluate.tagged import build_tagged
 
-            b, top, self._hole_ptex, self._ptex_face = build_tagged(mesh, progress)
+            keep: dict = {}  # the tagged step, kept for with_vertices
+            b, top, self._hole_ptex, self._ptex_face = build_tagged(mesh, progress, keep)
             self._finish(b, top, self._hole_ptex, keep_job_base=False)
+            self._moving = keep
             return
         if not isinstance(mesh, QuadMesh):
             raise CCProofError(f"LimitSurface takes a QuadMesh or a PolyMesh, not {type(mesh).__name__}")
@@ -140,7 +142,7 @@ class LimitSurface:
         self._schemes = [s for s, _ in b.schemes]
         self._job_base = np.frombuffer(b.job_base, dtype=np.int64).copy() if len(b.job_base) and keep_job_base \
             else np.zeros(0, np.int64)
-        self._moving = {}  # shared by the surfaces with_vertices derives: the step operator of a tagged mesh
+        self._moving = {}  # shared by the surfaces with_vertices derives: the tagged step (build_tagged's keep)
         self._vmap = b.vmap
         self._corner_normal = {}
         self.parameterizations = {}
@@ -674,10 +676,10 @@ class LimitSurface:
         are the PolyMesh's own vertices. The rings index the vertices the builder classified: those
         of :attr:`PolyMesh.manifold <ccproof.mesh.polymesh.PolyMesh.manifold>` (``X[manifold_vertex_map]``)
         on an all-quad mesh, else its level-1 vertices, recomputed as the build computes them (the
-        vectorized untagged step :func:`ccproof.evaluate._table.catmark_step`, or the tagged step's
-        float stencil matrix :meth:`PolyMesh.subdivision_operator`, assembled on the first call and
-        shared by the derived surfaces; its product sums every row in increasing column order, as
-        :meth:`PolyMesh.refine` applies the stencils).
+        vectorized untagged step :func:`ccproof.evaluate._table.catmark_step`, or the tagged step that
+        the build ran, kept by it as CSR arrays (:class:`ccproof.mesh.step.PackedCSR`, about 1 % of the
+        table; shared by the derived surfaces) and applied as :meth:`PolyMesh.refine` applies it: no
+        move repeats the step).
 
         Parameters
         ----------
@@ -731,11 +733,9 @@ class LimitSurface:
         step = catmark_step(man)  # untagged: the vectorized step (None: the tagged step below)
         if step is not None:
             return step[0]
-        S = self._moving.get("step")
-        if S is None:
-            S = self._moving["step"] = man.subdivision_operator()
-            S.sort_indices()  # each row summed in increasing column order: refine's sums
-        return S @ np.asarray(man.vertices, dtype=np.float64)
+        V1 = self._moving["step"].apply(man.vertices)  # the build's step, kept (build_tagged)
+        V1[np.flatnonzero(man.is_unused_vertex)] = np.nan  # as PolyMesh.refine: an unused vertex has no vertex point
+        return V1
 
 
 _BACKENDS = ("auto", "c", "numba", "numpy")

@@ -615,8 +615,9 @@ class PolyMesh:
 
         Parameters
         ----------
-        operator : bool
-            Also return the step's sparse matrix (False: None instead, and scipy is not imported).
+        operator : bool or "csr"
+            Also return the step's sparse matrix (False: None instead, and scipy is not imported;
+            ``"csr"``: the step's CSR arrays, below, without scipy).
 
         Returns
         -------
@@ -628,11 +629,15 @@ class PolyMesh:
             ``refined.vertices == S @ self.vertices`` (bit for bit: each row summed in increasing
             columns); an unused vertex's row is NaN at column 0. On a non-manifold mesh, the step of
             :attr:`manifold` (n + E + m counted there; the columns are this mesh's vertices).
+            With ``operator="csr"``: ``(indptr, indices, data)`` (:attr:`ccproof.mesh.step.Step.csr`) of the
+            step of :attr:`manifold`, its columns that mesh's vertices, an unused vertex's row empty:
+            ``refined.vertices == apply_csr(csr, manifold.vertices)`` (:func:`ccproof.mesh.step.apply_csr`)
+            but on the unused vertices' rows (NaN there).
         """
         if self.manifold is not self:
             m, S = self.manifold.refine(operator)
-            if not operator:
-                return m, None
+            if not operator or operator == "csr":
+                return m, S
             return m, (S @ _expansion(self.manifold_vertex_map, self.n_vertices)).tocsr()
         from ccproof.mesh.step import _decrement, apply_csr
 
@@ -653,6 +658,8 @@ class PolyMesh:
                      corners=(sharp_v, cvs[sharp_v]) if sharp_v.size else None,
                      holes=np.flatnonzero(st.child_holes), options=self.options)
         m.level = self.level + 1
+        if operator == "csr":
+            return m, st.csr
         S = _with_unused_rows(st.csr, unused, n) if operator else None
         return m, S
 
