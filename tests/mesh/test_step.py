@@ -236,10 +236,11 @@ def test_bench_refine_runs(capsys):
 
 def test_pack_csr_restores_the_bits():
     """PackedCSR: the weights told apart by their bits (-0.0, 0.0, NaN payloads), codes widened past 256
-    distinct weights; apply sums like scipy's product (checked against scipy here)."""
+    distinct weights; apply (scipy's product) gives the bits of apply_csr (numpy) and of scipy on the
+    unpacked int64 arrays."""
     import scipy.sparse as sp
 
-    from ccproof.mesh.step import pack_csr
+    from ccproof.mesh.step import apply_csr, pack_csr
 
     rng = np.random.default_rng(5)
     for k in (3, 300):
@@ -255,4 +256,6 @@ def test_pack_csr_restores_the_bits():
         assert np.array_equal(p.csr[0], csr[0]) and np.array_equal(p.csr[1], csr[1])
         assert p.nbytes < sum(a.nbytes for a in csr)
         X = rng.standard_normal((30, 3))
-        assert np.array_equal(p.apply(X), sp.csr_matrix((data, csr[1], csr[0]), shape=(40, 30)) @ X)
+        Y = p.apply(X)
+        assert np.array_equal(Y, apply_csr(csr, X))
+        assert np.array_equal(Y, sp.csr_matrix((data, csr[1], csr[0]), shape=(40, 30)) @ X)
