@@ -102,7 +102,7 @@ def build_tagged(mesh: PolyMesh, progress=None, keep=None):
         he = HalfEdges.from_quads(step[1], X.shape[0], mesh.options, edges=False)
     else:  # tagged: the level-1 mesh's own topology, with its tags (no Python complex of the mesh)
         m1, csr = mesh.refine(operator="csr")
-        if keep is not None:  # the step, for with_vertices (small: ~1 % of the table)
+        if keep is not None:  # the step, for with_vertices (small: docs/evaluate.md)
             keep["step"] = pack_csr(csr)
         del csr
         he = TaggedHalfEdges.of(m1.halfedges)
