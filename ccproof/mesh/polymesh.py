@@ -559,7 +559,7 @@ class PolyMesh:
         Raises
         ------
         MeshError
-            A shape other than ``vertices.shape``, or a non-finite coordinate on a vertex a face uses
+            A shape other than this mesh's ``vertices.shape``, or a non-finite coordinate on a vertex a face uses
             (the message names the first such vertex).
 
         Examples
