@@ -3,7 +3,7 @@
 The reference is the evaluator built from scratch on a PolyMesh constructed anew from the moved
 vertices and the mesh's polygons and tags (its own topology, split, level-1 step and patch table).
 ``with_vertices`` recomputes the positions the rings index (the split base vertices, the vectorized
-untagged step, or the tagged step's stencil matrix) and the table's float data from the kept rings:
+untagged step, or the tagged step kept by the build) and the table's float data from the kept rings:
 the same operations on the same numbers, so positions and all derivatives agree bit for bit.
 """
 
