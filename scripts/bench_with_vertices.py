@@ -3,10 +3,11 @@
 For each mesh: a surface is built once; then, ``--rounds`` times in turn, a fresh build
 ``LimitSurface(PolyMesh(X, polygons, tags))`` (the constructor included, as a caller without
 ``with_vertices`` pays it) and ``S.with_vertices(X)`` on new random control points X; the medians and
-the ratio are printed. The first ``with_vertices`` of a tagged non-quad mesh assembles the step's
-stencil matrix (printed apart, as "first"). Meshes: an icosphere of 1,280 / 5,120 triangles (untagged:
-the vectorized level-1 step), the same with an infinitely sharp crease loop (tagged: the stencil
-matrix), tests/data/osd_features/meshes/catmark_helmet.obj refined twice with its tags (all quads,
+the ratio are printed. The first ``with_vertices`` is printed apart, as "first" (on a tagged non-quad
+mesh it once assembled the step's stencil matrix; the build keeps the step now: scripts/bench_first_move.py).
+Meshes: an icosphere of 1,280 / 5,120 triangles (untagged: the vectorized level-1 step), the same with an
+infinitely sharp crease loop (tagged: the kept tagged step),
+tests/data/osd_features/meshes/catmark_helmet.obj refined twice with its tags (all quads,
 semi-sharp creases) and tests/data/osd_nonmanifold/meshes/two_cubes_creases.obj refined twice
 (non-manifold, all quads).
 

@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ccproof.errors import CCProofError, MeshError
+from ccproof.errors import CCProofError
 from ccproof.evaluate._parallel import in_blocks, threads_for
 from ccproof.evaluate._table import (
     _CORNER,
@@ -117,8 +117,10 @@ class LimitSurface:
         if isinstance(mesh, PolyMesh):
             from ccproof.evaluate.tagged import build_tagged
 
-            b, top, self._hole_ptex, self._ptex_face = build_tagged(mesh, progress)
+            keep: dict = {}  # the tagged step, kept for with_vertices
+            b, top, self._hole_ptex, self._ptex_face = build_tagged(mesh, progress, keep)
             self._finish(b, top, self._hole_ptex, keep_job_base=False)
+            self._moving = keep
             return
         if not isinstance(mesh, QuadMesh):
             raise CCProofError(f"LimitSurface takes a QuadMesh or a PolyMesh, not {type(mesh).__name__}")
@@ -140,7 +142,7 @@ class LimitSurface:
         self._schemes = [s for s, _ in b.schemes]
         self._job_base = np.frombuffer(b.job_base, dtype=np.int64).copy() if len(b.job_base) and keep_job_base \
             else np.zeros(0, np.int64)
-        self._moving = {}  # shared by the surfaces with_vertices derives: the step operator of a tagged mesh
+        self._moving = {}  # shared by the surfaces with_vertices derives: the tagged step (build_tagged's keep)
         self._vmap = b.vmap
         self._corner_normal = {}
         self.parameterizations = {}
@@ -674,10 +676,10 @@ class LimitSurface:
         are the PolyMesh's own vertices. The rings index the vertices the builder classified: those
         of :attr:`PolyMesh.manifold <ccproof.mesh.polymesh.PolyMesh.manifold>` (``X[manifold_vertex_map]``)
         on an all-quad mesh, else its level-1 vertices, recomputed as the build computes them (the
-        vectorized untagged step :func:`ccproof.evaluate._table.catmark_step`, or the tagged step's
-        float stencil matrix :meth:`PolyMesh.subdivision_operator`, assembled on the first call and
-        shared by the derived surfaces; its product sums every row in increasing column order, as
-        :meth:`PolyMesh.refine` applies the stencils).
+        vectorized untagged step :func:`ccproof.evaluate._table.catmark_step`, or the tagged step that
+        the build ran, kept by it as CSR arrays (:class:`ccproof.mesh.step.PackedCSR`, 24 bytes per ptex
+        face on a tagged triangle mesh, docs/evaluate.md; shared by the derived surfaces) and applied as
+        :meth:`PolyMesh.refine` applies it: no move repeats the step).
 
         Parameters
         ----------
@@ -703,11 +705,10 @@ class LimitSurface:
         >>> T.with_vertices(np.asarray(c.vertices) + [1, 0, 0]).evaluate([0], [0.0], [0.0])["P"].round(12).tolist()
         [[0.0, -1.0, -1.0]]
         """
+        mesh = self.mesh.with_vertices(X)  # checks the shape and finiteness (MeshError); topology shared
         if self._ptex_face is not None:
-            mesh = _polymesh_with_vertices(self.mesh, X)  # checks the shape and finiteness (MeshError)
             V = self._classified_positions(mesh)
         else:
-            mesh = self.mesh.with_vertices(X)  # checks the shape and finiteness (MeshError)
             V = np.where(mesh.is_unused_vertex[:, None], 0.0, mesh.vertices)  # unused: any value, weight 0
         new = object.__new__(LimitSurface)
         new.__dict__.update(self.__dict__)
@@ -732,38 +733,9 @@ class LimitSurface:
         step = catmark_step(man)  # untagged: the vectorized step (None: the tagged step below)
         if step is not None:
             return step[0]
-        S = self._moving.get("step")
-        if S is None:
-            S = self._moving["step"] = man.subdivision_operator()
-            S.sort_indices()  # each row summed in increasing column order: refine's sums
-        return S @ np.asarray(man.vertices, dtype=np.float64)
-
-
-def _polymesh_with_vertices(mesh, X):
-    """The PolyMesh ``mesh`` with the vertices ``X`` (n_vertices, 3): its connectivity, tags and
-    topology arrays shared, the vertices of its :attr:`~PolyMesh.manifold` split gathered from
-    ``X`` (``X[manifold_vertex_map]``). MeshError for a wrong shape or a non-finite used vertex."""
-    import copy
-
-    from ccproof.mesh.quadmesh import _check_used_finite
-
-    V = np.array(X, dtype=np.float64)
-    if V.shape != mesh.vertices.shape:
-        raise MeshError(f"vertices must have shape {mesh.vertices.shape}, got {V.shape}")
-    _check_used_finite(V, mesh.indices)
-    V.setflags(write=False)
-    new = copy.copy(mesh)
-    new.vertices = V
-    if mesh.manifold is mesh:
-        new.manifold = new
-    else:
-        man = copy.copy(mesh.manifold)
-        Vm = V[mesh.manifold_vertex_map]
-        Vm.setflags(write=False)
-        man.vertices = Vm
-        man.manifold = man
-        new.manifold = man
-    return new
+        V1 = self._moving["step"].apply(man.vertices)  # the build's step, kept (build_tagged)
+        V1[np.flatnonzero(man.is_unused_vertex)] = np.nan  # as PolyMesh.refine: an unused vertex has no vertex point
+        return V1
 
 
 _BACKENDS = ("auto", "c", "numba", "numpy")

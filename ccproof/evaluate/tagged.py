@@ -36,11 +36,12 @@ import numpy as np
 from ccproof.evaluate._table import TaggedHalfEdges, _Builder, _child_frame, _compose, _domain, _Jobs, catmark_step
 from ccproof.mesh.halfedges import HalfEdges
 from ccproof.mesh.polymesh import PolyMesh
+from ccproof.mesh.step import pack_csr
 
 __all__ = ["build_tagged", "vertex_corners"]
 
 
-def build_tagged(mesh: PolyMesh, progress=None):
+def build_tagged(mesh: PolyMesh, progress=None, keep=None):
     """Classify every ptex face of a tagged polygon mesh (steps 1-3 of the module docstring).
 
     Parameters
@@ -50,6 +51,11 @@ def build_tagged(mesh: PolyMesh, progress=None):
         mesh is classified on its split (:attr:`PolyMesh.manifold`: same faces and ptex faces).
     progress : bool, optional
         As in :class:`ccproof.evaluate.surface.LimitSurface`.
+    keep : dict, optional
+        Receives, where the build runs the tagged level-1 step (a tagged mesh that is not all quads),
+        that step under ``"step"`` (:class:`~ccproof.mesh.step.PackedCSR`, the columns the vertices of
+        :attr:`PolyMesh.manifold`): what :meth:`LimitSurface.with_vertices
+        <ccproof.evaluate.surface.LimitSurface.with_vertices>` re-applies to moved vertices.
 
     Returns
     -------
@@ -95,7 +101,10 @@ def build_tagged(mesh: PolyMesh, progress=None):
         X = step[0]
         he = HalfEdges.from_quads(step[1], X.shape[0], mesh.options, edges=False)
     else:  # tagged: the level-1 mesh's own topology, with its tags (no Python complex of the mesh)
-        m1, _ = mesh.refine(operator=False)
+        m1, csr = mesh.refine(operator="csr")
+        if keep is not None:  # the step, for with_vertices (small: docs/evaluate.md)
+            keep["step"] = pack_csr(csr)
+        del csr
         he = TaggedHalfEdges.of(m1.halfedges)
         X = np.asarray(m1.vertices)
     # jobs: sub-face i of an n-gon is level-1 child i (same (s, t)), its own ptex face; a quad is

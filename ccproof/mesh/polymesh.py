@@ -537,6 +537,64 @@ class PolyMesh:
         f = int(np.searchsorted(self.ptex_start, p, side="right") - 1)
         return f, p - int(self.ptex_start[f])
 
+    def with_vertices(self, vertices):
+        """The same mesh with the control points ``vertices``: connectivity, tags and topology re-used.
+
+        Nothing that depends only on the connectivity is rebuilt: the new mesh shares this one's
+        :attr:`halfedges` (with its tag arrays), face arrays, tags, holes, options and
+        :attr:`manifold_vertex_map`; on a non-manifold mesh its :attr:`manifold` is this one's split mesh
+        (sharing that one's topology the same way) with the vertices ``vertices[manifold_vertex_map]``.
+        The result equals ``PolyMesh(vertices, faces, creases=..., corners=..., holes=..., options=...)``
+        built anew, without the topology, the checks of the faces and tags, and the split.
+
+        Parameters
+        ----------
+        vertices : array_like, shape (n_vertices, 3)
+            Unused vertices may hold anything (NaN, inf): they keep their index and enter nothing.
+
+        Returns
+        -------
+        PolyMesh
+
+        Raises
+        ------
+        MeshError
+            A shape other than this mesh's ``vertices.shape``, or a non-finite coordinate on a vertex a face uses
+            (the message names the first such vertex).
+
+        Examples
+        --------
+        >>> m = PolyMesh([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 2]], creases={(0, 1): 2.0})
+        >>> m2 = m.with_vertices([[0, 0, 0], [2, 0, 0], [0, 2, 0]])
+        >>> m2.vertices[1].tolist(), m2.halfedges is m.halfedges, m2.edge_sharpness, m.vertices[1].tolist()
+        ([2.0, 0.0, 0.0], True, {(0, 1): 2.0}, [1.0, 0.0, 0.0])
+        >>> m.with_vertices([[0, 0, 0], [float("nan"), 0, 0], [0, 1, 0]])
+        Traceback (most recent call last):
+        ...
+        ccproof.errors.MeshError: vertex 1 has a non-finite coordinate: [nan, 0.0, 0.0]
+        """
+        V = np.array(vertices, dtype=np.float64)
+        if V.shape != self.vertices.shape:
+            raise MeshError(f"vertices must have shape {self.vertices.shape}, got {V.shape}")
+        _check_used_finite(V, self.indices)
+        V.setflags(write=False)
+        new = self._replace_vertices(V)
+        if self.manifold is self:
+            new.manifold = new
+        else:
+            Vm = V[self.manifold_vertex_map]
+            Vm.setflags(write=False)
+            new.manifold = self.manifold._replace_vertices(Vm)
+            new.manifold.manifold = new.manifold
+        return new
+
+    def _replace_vertices(self, V):
+        """A shallow copy (every attribute shared) with the checked, read-only vertices ``V``."""
+        new = object.__new__(PolyMesh)
+        new.__dict__.update(self.__dict__)
+        new.vertices = V
+        return new
+
     def complex(self):
         """The mesh as a :class:`~ccproof.mesh.rules.Complex` at level 0.
 
@@ -557,8 +615,9 @@ class PolyMesh:
 
         Parameters
         ----------
-        operator : bool
-            Also return the step's sparse matrix (False: None instead, and scipy is not imported).
+        operator : bool or "csr"
+            Also return the step's sparse matrix (False: None instead, and scipy is not imported;
+            ``"csr"``: the step's CSR arrays, below, without scipy).
 
         Returns
         -------
@@ -570,11 +629,15 @@ class PolyMesh:
             ``refined.vertices == S @ self.vertices`` (bit for bit: each row summed in increasing
             columns); an unused vertex's row is NaN at column 0. On a non-manifold mesh, the step of
             :attr:`manifold` (n + E + m counted there; the columns are this mesh's vertices).
+            With ``operator="csr"``: ``(indptr, indices, data)`` (:attr:`ccproof.mesh.step.Step.csr`) of the
+            step of :attr:`manifold`, its columns that mesh's vertices, an unused vertex's row empty:
+            ``refined.vertices == apply_csr(csr, manifold.vertices)`` (:func:`ccproof.mesh.step.apply_csr`)
+            but on the unused vertices' rows (NaN there).
         """
         if self.manifold is not self:
             m, S = self.manifold.refine(operator)
-            if not operator:
-                return m, None
+            if not operator or operator == "csr":
+                return m, S
             return m, (S @ _expansion(self.manifold_vertex_map, self.n_vertices)).tocsr()
         from ccproof.mesh.step import _decrement, apply_csr
 
@@ -595,6 +658,8 @@ class PolyMesh:
                      corners=(sharp_v, cvs[sharp_v]) if sharp_v.size else None,
                      holes=np.flatnonzero(st.child_holes), options=self.options)
         m.level = self.level + 1
+        if operator == "csr":
+            return m, st.csr
         S = _with_unused_rows(st.csr, unused, n) if operator else None
         return m, S
 

@@ -3,7 +3,7 @@
 The reference is the evaluator built from scratch on a PolyMesh constructed anew from the moved
 vertices and the mesh's polygons and tags (its own topology, split, level-1 step and patch table).
 ``with_vertices`` recomputes the positions the rings index (the split base vertices, the vectorized
-untagged step, or the tagged step's stencil matrix) and the table's float data from the kept rings:
+untagged step, or the tagged step kept by the build) and the table's float data from the kept rings:
 the same operations on the same numbers, so positions and all derivatives agree bit for bit.
 """
 
@@ -100,25 +100,46 @@ def test_tagged_with_vertices_equals_a_fresh_build_bit_for_bit(refdir, folder, n
     assert _same(S.mesh.vertices, V)
 
 
-def test_tagged_with_vertices_paths(refdir):
+def test_tagged_with_vertices_paths(refdir, monkeypatch):
     """Which positions the rings index: the split base vertices (all quads), the vectorized untagged
-    step (no operator stored), the tagged step's stencil matrix (stored once, shared when chained)."""
+    step (nothing kept), the tagged step (kept by the build, shared when chained, never recomputed)."""
     feats = refdir / "osd_features" / "meshes"
     from ccproof.evaluate._table import catmark_step
+    from ccproof.mesh.step import PackedCSR
 
     assert catmark_step(_read(refdir, "", "pyramid")) is not None  # the vectorized path is tested above
     quads = LimitSurface(read_mesh(refdir / "osd_nonmanifold" / "meshes" / "book4.obj"), progress=False)
     untagged = LimitSurface(read_mesh(refdir / "osd_nonmanifold" / "meshes" / "prism.off"), progress=False)
     tagged = LimitSurface(read_mesh(feats / "catmark_pyramid_creases1.obj"), progress=False)
+    assert set(tagged._moving) == {"step"}  # kept by the build, before any move
+    step = tagged._moving["step"]
+    assert isinstance(step, PackedCSR)
     for S in (quads, untagged, tagged):
         T = S.with_vertices(np.asarray(S.mesh.vertices) * 2.0)
+        assert T._moving is S._moving
         T.with_vertices(np.asarray(S.mesh.vertices) * 3.0)
     assert not quads._moving and not untagged._moving
-    assert set(tagged._moving) == {"step"}
-    # the stored operator is the step's: it maps the vertices to the level-1 vertices of refine
+    assert set(tagged._moving) == {"step"} and tagged._moving["step"] is step
+    # the kept step is the step's: as a matrix, the float stencil matrix of subdivision_operator, and it
+    # maps the vertices to the level-1 vertices of refine
     X = np.asarray(tagged.mesh.vertices)
+    M = tagged.mesh.subdivision_operator().toarray()
+    indptr, indices, data = step.csr
+    K = np.zeros_like(M)
+    K[np.repeat(np.arange(indptr.size - 1), np.diff(indptr)), indices] = data
+    assert np.array_equal(K, M)
     m1, _ = tagged.mesh.refine(operator=False)
-    assert np.array_equal(tagged._moving["step"] @ X, m1.vertices)
+    assert np.array_equal(step.apply(X), m1.vertices)
+    # a move never runs the step again
+    import ccproof.mesh.step as st
+
+    calls = []
+    real = st.catmark_operator
+    monkeypatch.setattr(st, "catmark_operator", lambda *a, **k: calls.append(1) or real(*a, **k))
+    tagged.with_vertices(X * 4.0)
+    assert not calls
+    tagged.mesh.refine(operator=False)  # (the patch does count the step)
+    assert calls
 
 
 def test_tagged_with_vertices_bad_input(refdir):

@@ -232,3 +232,30 @@ def test_bench_refine_runs(capsys):
         sys.argv = argv
     out = capsys.readouterr().out
     assert out.count("new/old") == 7
+
+
+def test_pack_csr_restores_the_bits():
+    """PackedCSR: the weights told apart by their bits (-0.0, 0.0, NaN payloads), codes widened past 256
+    distinct weights; apply (scipy's product) gives the bits of apply_csr (numpy) and of scipy on the
+    unpacked int64 arrays."""
+    import scipy.sparse as sp
+
+    from ccproof.mesh.step import apply_csr, pack_csr
+
+    rng = np.random.default_rng(5)
+    for k in (3, 300):
+        A = sp.random(40, 30, density=0.3, random_state=rng, format="csr")
+        A.sort_indices()
+        pool = np.r_[-0.0, 0.0, rng.standard_normal(k - 2)]
+        data = pool[rng.integers(0, k, A.nnz)]
+        data[:k] = pool  # every weight present (nnz = 360)
+        csr = (A.indptr.astype(np.int64), A.indices.astype(np.int64), data)
+        p = pack_csr(csr)
+        assert p.codes.dtype == (np.uint8 if k <= 256 else np.uint16) and p.indices.dtype == np.int32
+        assert np.array_equal(p.csr[2].view(np.int64), data.view(np.int64))
+        assert np.array_equal(p.csr[0], csr[0]) and np.array_equal(p.csr[1], csr[1])
+        assert p.nbytes < sum(a.nbytes for a in csr)
+        X = rng.standard_normal((30, 3))
+        Y = p.apply(X)
+        assert np.array_equal(Y, apply_csr(csr, X))
+        assert np.array_equal(Y, sp.csr_matrix((data, csr[1], csr[0]), shape=(40, 30)) @ X)
