@@ -477,19 +477,6 @@ class _Jobs:
         return int(self.g[i]), self.frames[self.fid[i]], int(self.base[i])
 
 
-def QuadHalfEdges(faces, n_vertices, options):
-    """The :class:`~ccproof.mesh.halfedges.HalfEdges` of an untagged all-quad complex given as an
-    ``(m, 4)`` array (half-edge ``4 f + i`` is corner i of face f): ``HalfEdges.from_quads``.
-
-    Parameters
-    ----------
-    faces : array_like of int, shape (m, 4)
-    n_vertices : int
-    options : ccproof.mesh.rules.Options
-    """
-    return HalfEdges.from_quads(faces, n_vertices, options, edges=False)
-
-
 class TaggedHalfEdges(HalfEdges):
     """A tagged all-quad :class:`~ccproof.mesh.halfedges.HalfEdges` as the tagged ring walk reads it:
     the same arrays (shared, not copied; tags as ``edge_keys``, ``edge_values``, ``vertex_values``),
