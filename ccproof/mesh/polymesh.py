@@ -415,7 +415,8 @@ class PolyMesh:
                 sv.append(x)
         except (MeshError, TypeError, ValueError) as exc:  # raised after any missing edge before it
             err = exc
-        A = np.array(ab, dtype=np.int64).reshape(-1, 2)
+        n = self.n_vertices  # (a vertex id out of range, even beyond int64, is no edge: -1)
+        A = np.array([(a if 0 <= a < n else -1, b if 0 <= b < n else -1) for a, b in ab], dtype=np.int64).reshape(-1, 2)
         missing = np.flatnonzero(self.halfedges.edge_index_of(A[:, 0], A[:, 1]) < 0)
         if missing.size:
             a, b = ab[int(missing[0])]
