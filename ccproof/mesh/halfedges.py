@@ -278,9 +278,10 @@ class HalfEdges:
         a, b = np.asarray(a, dtype=np.int64), np.asarray(b, dtype=np.int64)
         if not self.edge_keys.size:
             return np.zeros(np.broadcast(a, b).shape)
-        k = np.minimum(a, b) * self.n_vertices + np.maximum(a, b)
+        lo, hi = np.minimum(a, b), np.maximum(a, b)
+        k = lo * self.n_vertices + hi
         i = np.minimum(np.searchsorted(self.edge_keys, k), self.edge_keys.size - 1)
-        return np.where(self.edge_keys[i] == k, self.edge_values[i], 0.0)
+        return np.where((self.edge_keys[i] == k) & (lo >= 0) & (hi < self.n_vertices), self.edge_values[i], 0.0)
 
     # ------------------------------------------------------------------ sizes
     @property

@@ -88,5 +88,6 @@ def test_with_tags_takes_an_edge_once_in_either_order():
     t = he.with_tags({(1, 4): 2.0, (4, 1): 3.5, (0, 5): 1.0, (0, 1): 4.0})
     assert t.edge_keys.tolist() == [1 * 6 + 4] and t.edge_values.tolist() == [3.5]
     assert t.edge_sharpness_at([4, 1, 0], [1, 4, 1]).tolist() == [3.5, 3.5, 0.0]
+    assert t.edge_sharpness_at([0, 2], [10, -2]).tolist() == [0.0, 0.0]  # no vertex 10 or -2 (keys 10 = 1 * 6 + 4)
     t = he.with_tags({(4, 1): 12.0, (1, 4): 0.0})
     assert t.edge_keys.size == 0 and not t.has_tags
