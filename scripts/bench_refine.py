@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_step import _icosphere  # noqa: E402
+from bench_step import _icosphere, _stats  # noqa: E402
 
 from ccproof.mesh import PolyMesh  # noqa: E402
 from ccproof.mesh.rules import refine_complex, to_float  # noqa: E402
@@ -82,10 +82,6 @@ def _same(a, b):
             and np.array_equal(a.sizes, b.sizes) and list(a.edge_sharpness.items()) == list(b.edge_sharpness.items())
             and list(a.vertex_sharpness.items()) == list(b.vertex_sharpness.items())
             and np.array_equal(a.is_hole, b.is_hole) and a.options == b.options and a.level == b.level)
-
-
-def _stats(r):
-    return f"min {min(r):.3f}  median {statistics.median(r):.3f}  max {max(r):.3f}"
 
 
 def _ab(name, old, new, rounds):

@@ -477,42 +477,24 @@ class _Jobs:
         return int(self.g[i]), self.frames[self.fid[i]], int(self.base[i])
 
 
-def QuadHalfEdges(faces, n_vertices, options):
-    """The :class:`~ccproof.mesh.halfedges.HalfEdges` of an untagged all-quad complex given as an
-    ``(m, 4)`` array (half-edge ``4 f + i`` is corner i of face f): ``HalfEdges.from_quads``.
-
-    Parameters
-    ----------
-    faces : array_like of int, shape (m, 4)
-    n_vertices : int
-    options : ccproof.mesh.rules.Options
-    """
-    return HalfEdges.from_quads(faces, n_vertices, options, edges=False)
-
-
 class TaggedHalfEdges(HalfEdges):
     """A tagged all-quad :class:`~ccproof.mesh.halfedges.HalfEdges` as the tagged ring walk reads it:
     the same arrays (shared, not copied; tags as ``edge_keys``, ``edge_values``, ``vertex_values``),
     plus :meth:`ring_tags`, which hashes the tags of walked rings into their signatures.
 
-    Built by :meth:`of` from a mesh's :class:`~ccproof.mesh.halfedges.HalfEdges` (no copy) or from a
-    :class:`ccproof.mesh.rules.Complex` (its faces and tags; None where it is not all quads).
+    Built by :meth:`of` from a mesh's :class:`~ccproof.mesh.halfedges.HalfEdges` (no copy).
     """
 
     @classmethod
     def of(cls, src):
-        if isinstance(src, HalfEdges):
-            he = object.__new__(cls)
-            he.__dict__.update(src.__dict__)
-            if he.vertex_values is None:
-                he.vertex_values = np.zeros(he.n_vertices, dtype=np.float64)
-            return he
-        cx = src
-        m = len(cx.faces)
-        if m == 0 or len(cx.org) != 4 * m or any(len(f) != 4 for f in cx.faces):
-            return None
-        base = HalfEdges.from_quads(cx.faces, cx.n_vertices, cx.options)
-        return cls.of(base.with_tags(cx.edge_sharpness, cx.vertex_sharpness))
+        """The view of the half-edges ``src`` (:class:`~ccproof.mesh.halfedges.HalfEdges`, its tags
+        from :meth:`~ccproof.mesh.halfedges.HalfEdges.with_tags`): its arrays shared, ``vertex_values``
+        zeros where it has none."""
+        he = object.__new__(cls)
+        he.__dict__.update(src.__dict__)
+        if he.vertex_values is None:
+            he.vertex_values = np.zeros(he.n_vertices, dtype=np.float64)
+        return he
 
     def ring_tags(self, rings, nring, faces, nfaces, n_rule=4):
         """The tags of walked rings as rows of floats: per face slot ``(i, t)`` the sharpness of

@@ -221,7 +221,8 @@ class HalfEdges:
         """The same arrays (shared, not copied) with the tags of ``edge_sharpness`` (dict ``{(a, b): s}``)
         and ``vertex_sharpness`` (dict ``{v: s}``) or ``vertex_values`` (float (n_vertices,)) as tag
         arrays (see the class docstring); sharpness on boundary or non-manifold edges is left out (sharp
-        by the topology)."""
+        by the topology), pairs that are no edge too; an edge given as ``(a, b)`` and ``(b, a)`` takes the
+        later value (as :class:`~ccproof.mesh.polymesh.PolyMesh` reads its creases)."""
         new = object.__new__(type(self))
         new.__dict__.update(self.__dict__)
         new.__dict__.pop("has_tags", None)  # (the cached arrays are shared)
@@ -231,14 +232,15 @@ class HalfEdges:
         if edge_sharpness:
             ab = np.array(list(edge_sharpness.keys()), dtype=np.int64).reshape(-1, 2)
             s = np.array(list(edge_sharpness.values()), dtype=np.float64)
-            a, b = ab.min(axis=1), ab.max(axis=1)
-            k = a * nv + b
-            e = self.edge_index_of(a, b)
-            ok = (s > 0.0) & (e >= 0)
-            ok[ok] = self.twin[self.edge_halfedge[e[ok]]] >= 0
-            order = np.argsort(k[ok], kind="stable")
-            keys = k[ok][order]
-            vals = np.where(s[ok] >= 10.0, math.inf, s[ok])[order]
+            e = self.edge_index_of(ab[:, 0], ab[:, 1])
+            at = np.flatnonzero(e >= 0)
+            order = np.argsort(e[at], kind="stable")  # by edge (= by key), in the given order within one
+            es = e[at][order]
+            at = at[order][np.r_[es[1:] != es[:-1], True]] if es.size else at  # the last value of each edge
+            ok = s[at] > 0.0
+            at = at[ok][self.twin[self.edge_halfedge[e[at[ok]]]] >= 0]
+            keys = self.edges[e[at], 0] * nv + self.edges[e[at], 1]
+            vals = np.where(s[at] >= 10.0, math.inf, s[at])
         new.edge_keys, new.edge_values = keys, vals
         if vertex_values is None and vertex_sharpness:
             vertex_values = np.zeros(nv, dtype=np.float64)
@@ -276,9 +278,10 @@ class HalfEdges:
         a, b = np.asarray(a, dtype=np.int64), np.asarray(b, dtype=np.int64)
         if not self.edge_keys.size:
             return np.zeros(np.broadcast(a, b).shape)
-        k = np.minimum(a, b) * self.n_vertices + np.maximum(a, b)
+        lo, hi = np.minimum(a, b), np.maximum(a, b)
+        k = lo * self.n_vertices + hi
         i = np.minimum(np.searchsorted(self.edge_keys, k), self.edge_keys.size - 1)
-        return np.where(self.edge_keys[i] == k, self.edge_values[i], 0.0)
+        return np.where((self.edge_keys[i] == k) & (lo >= 0) & (hi < self.n_vertices), self.edge_values[i], 0.0)
 
     # ------------------------------------------------------------------ sizes
     @property

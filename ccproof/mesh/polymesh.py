@@ -415,7 +415,8 @@ class PolyMesh:
                 sv.append(x)
         except (MeshError, TypeError, ValueError) as exc:  # raised after any missing edge before it
             err = exc
-        A = np.array(ab, dtype=np.int64).reshape(-1, 2)
+        n = self.n_vertices  # (a vertex id out of range, even beyond int64, is no edge: -1)
+        A = np.array([(a if 0 <= a < n else -1, b if 0 <= b < n else -1) for a, b in ab], dtype=np.int64).reshape(-1, 2)
         missing = np.flatnonzero(self.halfedges.edge_index_of(A[:, 0], A[:, 1]) < 0)
         if missing.size:
             a, b = ab[int(missing[0])]
@@ -626,19 +627,21 @@ class PolyMesh:
             inherited by the children; the options kept (``EDGE_AND_CORNER`` corners carried as
             infinite vertex sharpness). The vertex point of an unused vertex is NaN (it stays unused).
         S : scipy.sparse.csr_matrix, shape (n + E + m, n), or None
-            ``refined.vertices == S @ self.vertices`` (bit for bit: each row summed in increasing
-            columns); an unused vertex's row is NaN at column 0. On a non-manifold mesh, the step of
-            :attr:`manifold` (n + E + m counted there; the columns are this mesh's vertices).
+            ``refined.vertices == S @ self.vertices`` (bit for bit on a manifold mesh: each row summed
+            in increasing columns); an unused vertex's row is NaN at column 0. On a non-manifold mesh,
+            :meth:`subdivision_operator`: the step of :attr:`manifold` (n + E + m counted there) with the
+            copies of a vertex summed exactly into its column; the child is :attr:`manifold`'s, which
+            ``S @ self.vertices`` equals up to rounding (the copies' weights merged, other column order).
             With ``operator="csr"``: ``(indptr, indices, data)`` (:attr:`ccproof.mesh.step.Step.csr`) of the
             step of :attr:`manifold`, its columns that mesh's vertices, an unused vertex's row empty:
             ``refined.vertices == apply_csr(csr, manifold.vertices)`` (:func:`ccproof.mesh.step.apply_csr`)
             but on the unused vertices' rows (NaN there).
         """
         if self.manifold is not self:
-            m, S = self.manifold.refine(operator)
-            if not operator or operator == "csr":
-                return m, S
-            return m, (S @ _expansion(self.manifold_vertex_map, self.n_vertices)).tocsr()
+            if operator == "csr":
+                return self.manifold.refine(operator)
+            m, _ = self.manifold.refine(operator=False)
+            return m, (self.subdivision_operator() if operator else None)
         from ccproof.mesh.step import _decrement, apply_csr
 
         st = self._step(sparse=False)
@@ -673,7 +676,8 @@ class PolyMesh:
                                 holes=self.is_hole, **kwargs)
 
     def subdivision_operator(self, exact=False):
-        """The linear operator S of one step: ``refine()[0].vertices == S @ vertices``.
+        """The linear operator S of one step: ``refine()[0].vertices == S @ vertices`` (bit for bit on a
+        manifold mesh; on a non-manifold one up to rounding: the child is the split mesh's).
 
         ``exact=False``: the float matrix of :func:`ccproof.mesh.step.catmark_operator`, every weight
         the correctly rounded exact one (on a non-manifold mesh the copies of a vertex summed exactly
@@ -710,14 +714,6 @@ class PolyMesh:
         return (f"PolyMesh({self.n_vertices} vertices, {self.n_faces} faces, {self.n_ptex} ptex faces, "
                 f"{len(self.edge_sharpness)} creases, {len(self.vertex_sharpness)} corners, "
                 f"{int(self.is_hole.sum())} holes, {extra}{self.options})")
-
-
-def _expansion(vmap, n):
-    """Sparse (len(vmap), n) 0/1 matrix copying vertex ``vmap[i]`` to row i."""
-    k = len(vmap)
-    import scipy.sparse as sp
-
-    return sp.csr_matrix((np.ones(k), (np.arange(k), np.asarray(vmap))), shape=(k, n))
 
 
 def _with_unused_rows(csr, unused, ncols):

@@ -207,12 +207,12 @@ def test_ring_walks_equal_the_numba_walk(maxn, maxf):
     pytest.importorskip("numba")
     from ccproof.evaluate import _ckernel
     from ccproof.evaluate._numba_kernel import ring_walks
-    from ccproof.evaluate._table import QuadHalfEdges
     from ccproof.mesh.examples import k_regular_disk, l_shape
+    from ccproof.mesh.halfedges import HalfEdges
     from ccproof.mesh.rules import Options
 
     for m in (read_obj(DATA / "meshes" / "bunny_quads.obj"), l_shape(), k_regular_disk(5)):
-        he = QuadHalfEdges(m.faces, m.n_vertices, Options())
+        he = HalfEdges.from_quads(m.faces, m.n_vertices, Options(), edges=False)
         g = np.arange(m.n_faces, dtype=np.int64)
         r = np.random.default_rng(0).integers(0, 4, g.size)
         res = []

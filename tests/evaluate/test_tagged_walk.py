@@ -18,9 +18,10 @@ from ccproof.evaluate._ckernel import load
 from ccproof.evaluate._table import TaggedHalfEdges, _Builder
 from ccproof.evaluate.tagged import build_tagged
 from ccproof.mesh.examples import k_regular_disk
+from ccproof.mesh.halfedges import HalfEdges
 from ccproof.mesh.io import read_mesh, read_obj_tagged
 from ccproof.mesh.polymesh import PolyMesh
-from ccproof.mesh.rules import Complex, Options
+from ccproof.mesh.rules import Options
 
 MESHES = Path(__file__).resolve().parents[1] / "data" / "osd_features" / "meshes"
 NAMES = sorted(p.stem for p in MESHES.glob("*.obj"))
@@ -107,12 +108,11 @@ def test_ring_tags_separate_the_keys():
     row lists the sharpness (inf from 10 on) of the edges at the rule vertices only."""
     if load() is None:
         pytest.skip("no C kernel")
-    faces = k_regular_disk(5, 3).faces
+    disk = k_regular_disk(5, 3)
     rows = []
     for s in (2.0, 12.0, 0.0):
-        cx = Complex(faces, {(0, 1): s} if s else {}, {}, Options())
-        he = TaggedHalfEdges.of(cx)
-        assert he is not None
+        base = HalfEdges.from_quads(disk.faces, disk.n_vertices, Options())
+        he = TaggedHalfEdges.of(base.with_tags({(0, 1): s} if s else {}))
         k, maxn, maxf = 1, 64, 48
         rings = np.full((k, maxn), -1, dtype=np.int32)
         fc = np.zeros((k, maxf, 4), dtype=np.int64)
@@ -134,11 +134,6 @@ def test_row_hash_separates_permuted_tags():
     rows[2, 1] = 1.0
     h = _table._row_hash(rows)
     assert len(set(h.tolist())) == 3
-
-
-def test_a_nonquad_complex_is_not_walked():
-    cx = Complex([(0, 1, 2), (0, 2, 3)], {}, {}, Options())
-    assert TaggedHalfEdges.of(cx) is None
 
 
 def test_semi_sharp_chaikin_rings_fall_back(monkeypatch):

@@ -79,3 +79,15 @@ def test_nonmanifold_flags_of_a_bow_tie():
     assert he.is_nonmanifold_vertex.tolist() == [True, False, False, False, False]
     assert he.n_fans.tolist() == [2, 1, 1, 1, 1]
     assert not he.is_nonmanifold_edge.any() and he.edge_manifold
+
+
+def test_with_tags_takes_an_edge_once_in_either_order():
+    """An edge given as (a, b) and as (b, a): one tag, the later one (as a dict of ``(min, max)`` keys
+    built in that order would hold it); a pair that is no edge, a zero and a boundary edge are left out."""
+    he = HalfEdges([0, 1, 4, 3, 1, 2, 5, 4], [0, 4, 8], 6)
+    t = he.with_tags({(1, 4): 2.0, (4, 1): 3.5, (0, 5): 1.0, (0, 1): 4.0})
+    assert t.edge_keys.tolist() == [1 * 6 + 4] and t.edge_values.tolist() == [3.5]
+    assert t.edge_sharpness_at([4, 1, 0], [1, 4, 1]).tolist() == [3.5, 3.5, 0.0]
+    assert t.edge_sharpness_at([0, 2], [10, -2]).tolist() == [0.0, 0.0]  # no vertex 10 or -2 (keys 10 = 1 * 6 + 4)
+    t = he.with_tags({(4, 1): 12.0, (1, 4): 0.0})
+    assert t.edge_keys.size == 0 and not t.has_tags

@@ -78,6 +78,8 @@ def test_meshio_input(tmp_path):
 
 @pytest.mark.parametrize("kwargs,msg", [
     ({"creases": {(0, 5): 1.0}}, r"crease on edge \(0, 5\): no such edge in the mesh"),
+    ({"creases": {(0, 2 ** 64): 1.0}}, r"crease on edge \(0, 18446744073709551616\): no such edge in the mesh"),
+    ({"creases": {(0, 1): 1.0, (-2 ** 63, 2): 1.0}}, r"crease on edge \(-9223372036854775808, 2\): no such edge"),
     ({"creases": {(0, 1): -0.5}}, r"crease on edge \(0, 1\): negative sharpness -0.5"),
     ({"creases": {(0, 1): float("nan")}}, r"crease on edge \(0, 1\): sharpness is NaN"),
     ({"corners": {2: -1}}, r"corner on vertex 2: negative sharpness"),

@@ -127,8 +127,11 @@ def test_rows_equal_the_exact_stencils(refdir, folder, name):
     mesh = read_mesh(refdir / folder / "meshes" / name)
     if not mesh.is_manifold:  # the operator on the input's vertices: a vertex's copies merged exactly
         exact = mesh.subdivision_operator(exact=True)
-        _same_matrix(mesh.subdivision_operator(), [None if r is None else sorted((c, to_float(w)) for c, w in r.items())
-                                                   for r in exact])
+        rows = [None if r is None else sorted((c, to_float(w)) for c, w in r.items()) for r in exact]
+        _same_matrix(mesh.subdivision_operator(), rows)
+        m1, S = mesh.refine()  # refine's operator is that one too; its child is the split mesh's
+        _same_matrix(S, rows)
+        assert m1.vertices.tobytes() == mesh.manifold.refine(operator=False)[0].vertices.tobytes()
     pm = mesh.manifold
     for _ in range(3):
         assert _check_level(pm) > 0
@@ -172,8 +175,9 @@ def test_subdivision_operator_merges_the_copies_exactly():
     exact = mesh.subdivision_operator(exact=True)
     e = mesh.manifold.n_vertices + mesh.manifold.complex().edge_index[(1, 2)]
     assert set(exact[e]) == {0, 1, 2, 3, 4, 7}
-    _same_matrix(mesh.subdivision_operator(),
-                 [None if r is None else sorted((c, to_float(w)) for c, w in r.items()) for r in exact])
+    rows = [None if r is None else sorted((c, to_float(w)) for c, w in r.items()) for r in exact]
+    _same_matrix(mesh.subdivision_operator(), rows)
+    _same_matrix(mesh.refine()[1], rows)
     pm = mesh.manifold
     for _ in range(3):
         assert _check_level(pm) > 0

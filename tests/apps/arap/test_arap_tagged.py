@@ -235,7 +235,9 @@ def _written_frames(poly, origin, n_control, times, n_written):
 @pytest.mark.parametrize("name", ["osd_features/meshes/catmark_cube_creases0.obj",  # semi-sharp creases
                                   "osd_features/meshes/catmark_pyramid_creases1.obj",  # triangles: a global step
                                   "osd_features/meshes/catmark_hole_test2.obj",  # holes, a 7.5 crease
-                                  "osd_nonmanifold/meshes/book4.obj"])  # non-manifold: split, sharp
+                                  "osd_nonmanifold/meshes/book4.obj",  # non-manifold: split, sharp
+                                  "osd_features/meshes/catmark_edgecorner.obj",  # EDGE_AND_CORNER boundary
+                                  "osd_features/meshes/catmark_edgenone.obj"])  # boundary NONE
 def test_control_out_on_tagged_meshes_reads_back_with_its_tags_and_surface(refdir, tmp_path, capsys, name):
     """``--control-out`` on a tagged or non-manifold mesh: the written OBJ, read back, is the control mesh the
     UVs belong to (read_control_mesh of the input, subdivided with its tags as often as the sidecar says) with
