@@ -332,7 +332,8 @@ def tagged_step(mesh: QuadMesh, edge_sharpness=None, vertex_sharpness=None):
     vs = np.asarray(vertex_sharpness, dtype=np.float64)
     n = mesh.n_vertices
     st = catmark_operator(n, mesh.faces.reshape(-1), np.full(mesh.n_faces, 4, dtype=np.int64),
-                          edge_of_halfedge=mesh.edge_of_halfedge, edge_sharpness=es, vertex_sharpness=vs)
+                          halfedges=mesh.halfedges, edge_of_halfedge=mesh.edge_of_halfedge, edge_sharpness=es,
+                          vertex_sharpness=vs)
     pairs, cs = st.child_creases
     tagged = es[pairs[:, 1] - n] > 0  # the halves of the tagged edges (boundary edges are sharp anyway)
     return st.S, (pairs[tagged], cs[tagged]), st.child_corners

@@ -668,10 +668,12 @@ class PolyMesh:
 
     def _step(self, **kwargs):
         """:func:`ccproof.mesh.step.catmark_operator` of this manifold mesh with its tags (keyword
-        arguments passed on), edges numbered as :class:`~ccproof.mesh.rules.Complex` numbers them."""
+        arguments passed on), edges numbered as :class:`~ccproof.mesh.rules.Complex` numbers them; the step
+        reads :attr:`halfedges` (no second pairing)."""
         from ccproof.mesh.step import catmark_operator
 
-        return catmark_operator(self.n_vertices, self.indices, self.sizes, edge_sharpness=self.edge_sharpness,
+        return catmark_operator(self.n_vertices, self.indices, self.sizes, halfedges=self.halfedges,
+                                edge_sharpness=self.edge_sharpness,
                                 vertex_sharpness=self.vertex_sharpness, options=self.options, level=self.level,
                                 holes=self.is_hole, **kwargs)
 

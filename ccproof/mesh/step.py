@@ -319,8 +319,9 @@ def _ratios(rule, x):
     return t[inv.reshape(x.shape)], d[inv.reshape(x.shape)]
 
 
-def catmark_operator(n, indices, sizes, *, edge_of_halfedge=None, edge_sharpness=None, vertex_sharpness=None,
-                     options=None, level=0, holes=None, columns=None, n_columns=None, sparse=True):
+def catmark_operator(n, indices, sizes, *, halfedges=None, edge_of_halfedge=None, edge_sharpness=None,
+                     vertex_sharpness=None, options=None, level=0, holes=None, columns=None, n_columns=None,
+                     sparse=True):
     """One Catmull-Clark step of a tagged manifold polygon mesh, as a sparse operator (module docstring).
 
     Parameters
@@ -331,9 +332,15 @@ def catmark_operator(n, indices, sizes, *, edge_of_halfedge=None, edge_sharpness
         The faces' vertices, face after face, counter-clockwise.
     sizes : array_like of int, shape (m,)
         Face sizes (>= 3).
+    halfedges : ccproof.mesh.halfedges.HalfEdges, optional
+        The half-edges of this mesh (built from ``indices``, ``sizes``, ``n``: the caller's
+        ``mesh.halfedges``): its ``nxt``, ``prv``, ``twin`` and edges are read instead of pairing the
+        half-edges again (the numbering of the edge points stays ``edge_of_halfedge``'s or the default).
+        Not read when it has a non-manifold edge (the half-edges are then paired here).
     edge_of_halfedge : array_like of int, shape (H,), optional
         The edge of every half-edge (the edge points' numbering, 0..E-1); default: numbered by first
-        occurrence along the faces (:class:`ccproof.mesh.rules.Complex`'s numbering).
+        occurrence along the faces (:class:`ccproof.mesh.rules.Complex`'s numbering). With
+        ``halfedges``, a renumbering of its edges (``halfedges.edge_of`` itself: the QuadMesh numbering).
     edge_sharpness : ndarray, shape (E,), or dict[(int, int), float], optional
         Sharpness per edge of that numbering, or a dict keyed by ``(min, max)`` vertex pairs; ``>= 10``
         infinite. Boundary edges are infinitely sharp whatever the tag.
@@ -385,34 +392,61 @@ def catmark_operator(n, indices, sizes, *, edge_of_halfedge=None, edge_sharpness
     sz = np.asarray(sizes, dtype=np.int64).reshape(-1)
     m, H = sz.size, idx.size
     off = np.r_[0, np.cumsum(sz)].astype(np.int64)
-    face = np.repeat(np.arange(m), sz)
+    he = halfedges
+    if he is not None and (he.org.size != H or he.sizes.size != m or he.n_vertices != n):
+        raise ValueError("halfedges: not the half-edges of this mesh")
+    face = None if he is None else he.__dict__.get("face_of")  # (built by HalfEdges on mixed face sizes)
+    if face is None:
+        face = np.repeat(np.arange(m), sz)
     pos = np.arange(H) - off[face]
-    nxt = off[face] + (pos + 1) % sz[face]
-    prv = off[face] + (pos - 1) % sz[face]
-    org, dst = idx, idx[nxt]
-    lo, hi = np.minimum(org, dst), np.maximum(org, dst)
-    if edge_of_halfedge is None:
-        _, first, inv = np.unique(lo * n + hi, return_index=True, return_inverse=True)
-        order = np.argsort(first, kind="stable")
-        rank = np.empty(first.size, dtype=np.int64)
-        rank[order] = np.arange(first.size)
-        he_edge = rank[inv.reshape(-1)]
+    if he is None:
+        nxt = off[face] + (pos + 1) % sz[face]
+        prv = off[face] + (pos - 1) % sz[face]
     else:
-        he_edge = np.asarray(edge_of_halfedge, dtype=np.int64).reshape(-1)
-    E = int(he_edge.max()) + 1 if H else 0
-    count = np.bincount(he_edge, minlength=E)
-    if (count > 2).any():
-        e = int(np.flatnonzero(count > 2)[0])
-        h = int(np.flatnonzero(he_edge == e)[0])
-        raise MeshError(f"edge ({int(lo[h])}, {int(hi[h])}) has {int(count[e])} faces: the step needs a manifold "
-                        "mesh (take PolyMesh.manifold)")
-    by_edge = np.argsort(he_edge, kind="stable")
-    estart = np.r_[0, np.cumsum(count)][:-1]
-    h1 = by_edge[estart]
-    h2 = np.where(count == 2, by_edge[np.minimum(estart + 1, H - 1)], -1)
-    twin = np.full(H, -1, dtype=np.int64)
-    two = h2 >= 0
-    twin[h1[two]], twin[h2[two]] = h2[two], h1[two]
+        nxt, prv = he.nxt, he.prv
+    org, dst = idx, idx[nxt]
+    if he is not None and he.edge_manifold:
+        # the mesh's pairing: twins across its manifold edges, each edge's smallest half-edge ``first``
+        twin, first = he.twin, he.edge_halfedge
+        if edge_of_halfedge is None:  # numbered by first occurrence: the order of the edges' first half-edges
+            is_first = np.zeros(H, dtype=bool)
+            is_first[first] = True
+            renum = (np.cumsum(is_first) - 1)[first]
+            he_edge = renum[he.edge_of]
+        else:
+            he_edge = np.asarray(edge_of_halfedge, dtype=np.int64).reshape(-1)
+            renum = he_edge[first]
+        E = first.size
+        h1 = np.empty(E, dtype=np.int64)
+        h1[renum] = first  # the smallest half-edge of every edge
+        count = np.empty(E, dtype=np.int64)
+        count[renum] = he.edge_face_count
+        h2 = np.where(count == 2, twin[h1], -1)
+        two = h2 >= 0
+    else:
+        lo, hi = np.minimum(org, dst), np.maximum(org, dst)
+        if edge_of_halfedge is None:
+            _, first, inv = np.unique(lo * n + hi, return_index=True, return_inverse=True)
+            order = np.argsort(first, kind="stable")
+            rank = np.empty(first.size, dtype=np.int64)
+            rank[order] = np.arange(first.size)
+            he_edge = rank[inv.reshape(-1)]
+        else:
+            he_edge = np.asarray(edge_of_halfedge, dtype=np.int64).reshape(-1)
+        E = int(he_edge.max()) + 1 if H else 0
+        count = np.bincount(he_edge, minlength=E)
+        if (count > 2).any():
+            e = int(np.flatnonzero(count > 2)[0])
+            h = int(np.flatnonzero(he_edge == e)[0])
+            raise MeshError(f"edge ({int(lo[h])}, {int(hi[h])}) has {int(count[e])} faces: the step needs a "
+                            "manifold mesh (take PolyMesh.manifold)")
+        by_edge = np.argsort(he_edge, kind="stable")
+        estart = np.r_[0, np.cumsum(count)][:-1]
+        h1 = by_edge[estart]
+        h2 = np.where(count == 2, by_edge[np.minimum(estart + 1, H - 1)], -1)
+        twin = np.full(H, -1, dtype=np.int64)
+        two = h2 >= 0
+        twin[h1[two]], twin[h2[two]] = h2[two], h1[two]
     a, b = org[h1], dst[h1]
     bnd_e = ~two
     # tags

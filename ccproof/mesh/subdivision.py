@@ -134,4 +134,4 @@ def subdivision_matrix(mesh):
 
     m = mesh.n_faces
     return catmark_operator(mesh.n_vertices, mesh.faces.reshape(-1), np.full(m, 4, dtype=np.int64),
-                            edge_of_halfedge=mesh.edge_of_halfedge).S
+                            halfedges=mesh.halfedges, edge_of_halfedge=mesh.edge_of_halfedge).S

@@ -184,6 +184,45 @@ def test_subdivision_operator_merges_the_copies_exactly():
         pm, _ = pm.refine(operator=False)
 
 
+def _same_step(x, y):
+    assert x.faces.tobytes() == y.faces.tobytes() and x.edges.tobytes() == y.edges.tobytes()
+    for u, v in zip(x.csr, y.csr):
+        assert u.dtype == v.dtype and u.tobytes() == v.tobytes()
+    for u, v in zip(x.child_creases + x.child_corners, y.child_creases + y.child_corners):
+        assert u.tobytes() == v.tobytes()
+    assert np.array_equal(x.child_holes, y.child_holes)
+
+
+@pytest.mark.parametrize("folder,name", CASES)
+def test_the_mesh_halfedges_give_the_step_of_its_own_pairing(refdir, folder, name):
+    """catmark_operator reading the mesh's HalfEdges (what PolyMesh.refine and the QuadMesh steps pass)
+    against it pairing the half-edges itself (its own code, not HalfEdges'), at levels 0 and 1: the same
+    arrays bit for bit in the first-occurrence numbering and in HalfEdges' sorted one (the QuadMesh
+    numbering), and the edges of each numbering where that numbering puts them."""
+    pm = read_mesh(refdir / folder / "meshes" / name).manifold
+    for _ in range(2):
+        he = pm.halfedges
+        assert he.edge_manifold
+        kw = dict(edge_sharpness=dict(pm.edge_sharpness), vertex_sharpness=dict(pm.vertex_sharpness),
+                  options=pm.options, level=pm.level, holes=pm.is_hole, sparse=False)
+        paired = catmark_operator(pm.n_vertices, pm.indices, pm.sizes, **kw)
+        _same_step(catmark_operator(pm.n_vertices, pm.indices, pm.sizes, halfedges=he, **kw), paired)
+        cx = pm.complex()  # edges numbered by first occurrence, each as its first half-edge
+        assert [[cx.org[h], cx.org[cx.nxt[h]]] for h in cx.edges] == paired.edges.tolist()
+        sorted_paired = catmark_operator(pm.n_vertices, pm.indices, pm.sizes, edge_of_halfedge=he.edge_of, **kw)
+        got = catmark_operator(pm.n_vertices, pm.indices, pm.sizes, halfedges=he, edge_of_halfedge=he.edge_of, **kw)
+        _same_step(got, sorted_paired)
+        assert np.array_equal(np.sort(got.edges, axis=1), he.edges)
+        pm, _ = pm.refine(operator=False)
+
+
+def test_halfedges_of_another_mesh_are_refused():
+    pm = PolyMesh(np.zeros((5, 3)), [[0, 1, 2, 3], [1, 4, 2]])
+    other = PolyMesh(np.zeros((5, 3)), [[0, 1, 2, 3]])
+    with pytest.raises(ValueError, match="not the half-edges"):
+        catmark_operator(pm.n_vertices, pm.indices, pm.sizes, halfedges=other.halfedges)
+
+
 def test_a_forged_weight_is_caught(refdir):
     """The comparison can fail: a stencil with one weight moved by 1 ulp is told apart."""
     pm = read_mesh(refdir / "osd_features" / "meshes" / "catmark_pyramid_creases1.obj").manifold
