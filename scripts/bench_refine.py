@@ -16,14 +16,28 @@ each pair's child meshes are compared (vertices bit for bit, faces, tags, holes)
    refines once with ``refine(operator=False)``), the former refine patched in as "old".
 
 Usage: python scripts/bench_refine.py [--rounds 5] [--tri-levels 6] [--setup-levels 5]
+
+``--before REV`` (e.g. ``main``) instead compares this tree's ``refine(operator=False)`` against the one of
+the git revision REV (exported with ``git archive``, the compiled kernel copied over): each round runs one
+fresh worker process per tree, alternating which goes first, on the icosphere of ``--tri-levels``,
+the step alone on it (``PolyMesh._step``: the operator, without the child mesh's construction),
+catmark_cubes_infsharp at levels 0 and 2, and ``subdivision_matrix`` of the QuadMesh of the icosphere of
+``--tri-levels`` - 1 refined once; a worker times ``--reps`` calls of each and keeps the fastest, and in
+the first round measures the tracemalloc peak of one more call. Printed per mesh: the times of both trees
+(min / median over the rounds), new / old per round (min, median, max), the peaks; the children (and
+matrices) of the two trees are compared bit for bit first (it stops otherwise).
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import os
+import shutil
 import statistics
+import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -100,12 +114,120 @@ def _ab(name, old, new, rounds):
           f"new/old {_stats(ratios)}  (load {min(loads):.1f}-{max(loads):.1f})", flush=True)
 
 
+# ------------------------------------------------------------------ --before: this tree against a revision
+ROOT = Path(__file__).resolve().parents[1]
+
+WORKER = r"""
+import hashlib, json, sys, time, tracemalloc
+import numpy as np
+sys.path.insert(0, __SCRIPTS__)
+from bench_step import _icosphere
+from ccproof.mesh import PolyMesh, QuadMesh, subdivision_matrix
+from ccproof.mesh.io import read_mesh
+
+def digest(*arrays):
+    h = hashlib.sha256()
+    for a in arrays:
+        h.update(np.ascontiguousarray(a).tobytes())
+    return h.hexdigest()
+
+def child(pm):
+    m, _ = pm.refine(operator=False)
+    tags = repr((list(m.edge_sharpness.items()), list(m.vertex_sharpness.items()), m.options, m.level))
+    return digest(m.vertices, m.indices, m.sizes, m.is_hole, np.frombuffer(tags.encode(), dtype=np.uint8))
+
+def step(pm):
+    st = pm._step(sparse=False)
+    return digest(*st.csr, st.faces, st.edges)
+
+def matrix(qm):
+    S = subdivision_matrix(qm)
+    return digest(S.indptr, S.indices, S.data)
+
+cases = []
+V, F = _icosphere(__TRI__)
+sphere = PolyMesh(V, F)
+cases.append((f"refine icosphere ({F.shape[0]:,} triangles)", child, sphere))
+cases.append(("its step alone (PolyMesh._step)", step, sphere))
+for lv in (0, 2):
+    pm = read_mesh(__DATA__ + "/catmark_cubes_infsharp.obj").manifold
+    for _ in range(lv):
+        pm, _ = pm.refine(operator=False)
+    cases.append((f"refine catmark_cubes_infsharp level {lv} ({pm.n_faces:,} faces)", child, pm))
+V, F = _icosphere(__TRI__ - 1)
+q, _ = PolyMesh(V, F).refine(operator=False)
+qm = QuadMesh(q.vertices, q.indices.reshape(-1, 4))
+cases.append((f"subdivision_matrix icosphere quads ({qm.n_faces:,} quads)", matrix, qm))
+out = {}
+for name, f, x in cases:
+    key = f(x)  # warm-up (imports) and the result's digest
+    ts = []
+    for _ in range(__REPS__):
+        t = time.perf_counter(); f(x); ts.append(time.perf_counter() - t)
+    r = {"t": min(ts), "digest": key}
+    if __MEMORY__:
+        tracemalloc.start()
+        a = tracemalloc.get_traced_memory()[0]
+        f(x)
+        r["peak"] = tracemalloc.get_traced_memory()[1] - a
+        tracemalloc.stop()
+    out[name] = r
+print(json.dumps(out))
+"""
+
+
+def _worker(tree, tri, reps, memory):
+    code = WORKER
+    for key, value in (("SCRIPTS", str(ROOT / "scripts")), ("DATA", str(DATA / "osd_features" / "meshes")),
+                       ("TRI", tri), ("REPS", reps), ("MEMORY", memory)):
+        code = code.replace(f"__{key}__", repr(value))
+    env = {"PYTHONPATH": str(tree), "PATH": "/usr/bin:/bin", "HOME": str(Path.home())}
+    p = subprocess.run([sys.executable, "-c", code], cwd=tree, env=env, capture_output=True, text=True)
+    if p.returncode:
+        raise SystemExit(f"the worker in {tree} failed:\n{p.stderr}")
+    return json.loads(p.stdout.strip().splitlines()[-1])
+
+
+def before_main(a):
+    """``--before``: this tree's refine against the revision's, one fresh worker per tree and round."""
+    rev = subprocess.run(["git", "rev-parse", "--short", a.before], cwd=ROOT, capture_output=True, text=True,
+                         check=True).stdout.strip()
+    print(f"{os.cpu_count()} cpus; rounds {a.rounds}, {a.reps} calls per worker (the fastest kept)", flush=True)
+    with tempfile.TemporaryDirectory() as tmp:
+        old = Path(tmp)
+        tar = subprocess.run(["git", "archive", a.before], cwd=ROOT, capture_output=True, check=True).stdout
+        subprocess.run(["tar", "-x", "-C", str(old)], input=tar, check=True)
+        for so in (ROOT / "ccproof" / "evaluate").glob("_clib*.so"):
+            shutil.copy(so, old / "ccproof" / "evaluate" / so.name)
+        trees = {"old": old, "new": ROOT}
+        res: dict = {k: [] for k in trees}
+        loads = []
+        for i in range(a.rounds):
+            loads.append(os.getloadavg()[0])
+            for name in (list(trees) if i % 2 == 0 else list(trees)[::-1]):
+                res[name].append(_worker(trees[name], a.tri_levels, a.reps, i == 0))
+    print(f"old: {a.before} = {rev}, new: this tree (load {min(loads):.1f}-{max(loads):.1f})")
+    for case in res["new"][0]:
+        if {r[case]["digest"] for k in trees for r in res[k]} != {res["new"][0][case]["digest"]}:
+            raise SystemExit(f"{case}: the two trees' results differ")
+        t = {k: [r[case]["t"] for r in res[k]] for k in trees}
+        ratios = [x / y for x, y in zip(t["new"], t["old"])]
+        print(f"{case:55s} old {min(t['old']) * 1e3:7.1f} / {statistics.median(t['old']) * 1e3:7.1f} ms  "
+              f"new {min(t['new']) * 1e3:7.1f} / {statistics.median(t['new']) * 1e3:7.1f} ms (min / median)  "
+              f"new/old {_stats(ratios)}  tracemalloc peak old {res['old'][0][case]['peak'] / 2**20:.1f} MiB, "
+              f"new {res['new'][0][case]['peak'] / 2**20:.1f} MiB", flush=True)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--rounds", type=int, default=5)
     ap.add_argument("--tri-levels", type=int, default=6)
     ap.add_argument("--setup-levels", type=int, default=5)
+    ap.add_argument("--before", default=None, help="a git revision: compare against its refine (see above)")
+    ap.add_argument("--reps", type=int, default=3, help="with --before: calls per worker and mesh")
     a = ap.parse_args()
+    if a.before is not None:
+        return before_main(a)
     from ccproof.evaluate.surface import natural_limit_surface
     from ccproof.mesh.io import read_mesh
 
