@@ -277,6 +277,24 @@ def test_bench_refine_runs(capsys):
     assert out.count("new/old") == 7
 
 
+@pytest.mark.slow
+def test_bench_refine_before_runs():
+    """Smoke test of scripts/bench_refine.py --before HEAD (one round, small icospheres): the workers of both
+    trees run and agree bit for bit (it stops otherwise), and every case is printed."""
+    import shutil
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[2]
+    if shutil.which("git") is None or not (root / ".git").exists():
+        pytest.skip("not a git checkout")
+    p = subprocess.run([sys.executable, str(root / "scripts" / "bench_refine.py"), "--before", "HEAD", "--rounds", "1",
+                        "--reps", "1", "--tri-levels", "2"], cwd=root, capture_output=True, text=True)
+    assert p.returncode == 0, p.stderr + p.stdout
+    assert p.stdout.count("new/old") == 5 and p.stdout.count("tracemalloc peak") == 5
+
+
 def test_pack_csr_restores_the_bits():
     """PackedCSR: the weights told apart by their bits (-0.0, 0.0, NaN payloads), codes widened past 256
     distinct weights; apply (scipy's product) gives the bits of apply_csr (numpy) and of scipy on the
