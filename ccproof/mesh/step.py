@@ -3,7 +3,9 @@
 :func:`catmark_operator` is the float step of every caller: :meth:`ccproof.mesh.polymesh.PolyMesh.refine`
 and ``subdivision_operator()`` (the tagged polygon meshes; the evaluator's setup refines with it), the
 untagged quad step of :func:`ccproof.mesh.subdivision_matrix` and the applications' tagged step
-(:func:`ccproof.apps.control_mesh.tagged_step`). It assembles, over the whole
+(:func:`ccproof.apps.control_mesh.tagged_step`); each caller passes its mesh's
+:class:`~ccproof.mesh.halfedges.HalfEdges` (``halfedges=``), which the step reads instead of pairing the
+half-edges again. It assembles, over the whole
 mesh with numpy, the rules that :func:`ccproof.mesh.rules.refine_complex` states as exact stencils
 (the independent reference of the tests; the weights come from the same rule functions of
 :mod:`ccproof.rule_weights`, evaluated in floats):
