@@ -13,7 +13,8 @@ each pair's child meshes are compared (vertices bit for bit, faces, tags, holes)
    creases and corners) subdivided twice, catmark_chaikin1 (semi-sharp, ``CREASE_CHAIKIN``);
 2. the evaluator's setup (``natural_limit_surface``, the disk cache filled by the warm-up) of an
    icosphere with ``TRI_SUB_SMOOTH`` (``--setup-levels``, default 5: a tagged triangle mesh, whose setup
-   refines once with ``refine(operator=False)``), the former refine patched in as "old".
+   refines once with ``refine(operator="csr")``), the former refine patched in as "old" (its CSR arrays
+   built from the same stencils: the same bits).
 
 Usage: python scripts/bench_refine.py [--rounds 5] [--tri-levels 6] [--setup-levels 5]
 
@@ -78,9 +79,20 @@ def _apply_stencils(stencils, X):
     return out
 
 
+def _stencil_csr(stencils):
+    """The CSR arrays ``(indptr, indices, data)`` of the stencils' rounded weights (increasing columns, no
+    zero; an unused vertex's row empty): the operator the former code had for ``operator="csr"``."""
+    rows = [[] if st is None else sorted((c, to_float(w)) for c, w in st.items() if w != 0) for st in stencils]
+    indptr = np.r_[0, np.cumsum([len(r) for r in rows])].astype(np.int64)
+    indices = np.array([c for r in rows for c, _ in r], dtype=np.int64)
+    data = np.array([w for r in rows for _, w in r], dtype=np.float64)
+    return indptr, indices, data
+
+
 def old_refine(self, operator=False):
-    """The former ``PolyMesh.refine`` of a manifold mesh, ``operator=False``."""
-    assert self.manifold is self and not operator
+    """The former ``PolyMesh.refine`` of a manifold mesh, ``operator=False`` or ``"csr"`` (the evaluator's
+    tagged setup asks for the step's CSR arrays: built from the same stencils)."""
+    assert self.manifold is self and operator in (False, "csr")
     cx = self.complex()
     stencils, children, ces, cvs = refine_complex(cx)
     V1 = _apply_stencils(stencils, np.asarray(self.vertices, dtype=np.float64))
@@ -88,7 +100,7 @@ def old_refine(self, operator=False):
     m = PolyMesh(V1, children, creases=(list(ces.keys()), list(ces.values())) if ces else None,
                  corners=cvs or None, holes=np.flatnonzero(holes), options=self.options)
     m.level = self.level + 1
-    return m, None
+    return m, (_stencil_csr(stencils) if operator == "csr" else None)
 
 
 def _same(a, b):
