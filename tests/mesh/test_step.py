@@ -216,6 +216,16 @@ def test_the_mesh_halfedges_give_the_step_of_its_own_pairing(refdir, folder, nam
         pm, _ = pm.refine(operator=False)
 
 
+def test_halfedges_with_a_non_manifold_edge_are_not_read():
+    """Three faces on the edge (0, 1): the step pairs the half-edges itself and refuses the mesh."""
+    from ccproof.errors import MeshError
+
+    pm = PolyMesh(np.zeros((5, 3)), [[0, 1, 2], [1, 0, 3], [0, 1, 4]])
+    assert not pm.halfedges.edge_manifold
+    with pytest.raises(MeshError, match=r"edge \(0, 1\) has 3 faces"):
+        catmark_operator(pm.n_vertices, pm.indices, pm.sizes, halfedges=pm.halfedges)
+
+
 def test_halfedges_of_another_mesh_are_refused():
     pm = PolyMesh(np.zeros((5, 3)), [[0, 1, 2, 3], [1, 4, 2]])
     other = PolyMesh(np.zeros((5, 3)), [[0, 1, 2, 3]])
