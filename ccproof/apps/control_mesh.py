@@ -124,8 +124,8 @@ class TaggedQuadMesh(QuadMesh):
     ([2.0, inf], 1, True)
     """
 
-    def __init__(self, vertices, faces, *, creases=None, corners=None, holes=None):
-        super().__init__(vertices, faces)
+    def __init__(self, vertices, faces, *, creases=None, corners=None, holes=None, _halfedges=None):
+        super().__init__(vertices, faces, _halfedges=_halfedges)
         es = np.zeros(self.n_edges) if creases is None else edge_values(self, *creases)
         self.edge_sharpness = np.where(es >= INFINITE, math.inf, es)
         vs = np.zeros(self.n_vertices)
@@ -551,11 +551,11 @@ def read_control_mesh(path: str | os.PathLike[str]) -> tuple[QuadMesh, np.ndarra
         new = np.full(poly.n_vertices, -1, dtype=np.int64)
         new[used] = np.arange(used.size)
         poly = PolyMesh(np.asarray(poly.vertices)[used], new[idx], sizes=sizes)
+    # the PolyMesh's half-edges are the QuadMesh's (QuadMesh.from_polymesh): each topology built once
     if poly.is_all_quads:
-        return QuadMesh(poly.vertices, poly.indices.reshape(-1, 4)), None
+        return QuadMesh.from_polymesh(poly), None
     fine, _ = poly.refine(operator=False)
-    V, F = np.asarray(fine.vertices, dtype=np.float64), fine.indices.reshape(-1, 4)
-    return QuadMesh(V, F), np.repeat(np.arange(sizes.size, dtype=np.int64), sizes)
+    return QuadMesh.from_polymesh(fine), np.repeat(np.arange(sizes.size, dtype=np.int64), sizes)
 
 
 def _tagged_control_mesh(poly, name):
@@ -589,8 +589,11 @@ def _tagged_control_mesh(poly, name):
     cv = new[np.asarray(list(corners), dtype=np.int64)]
     cs = np.asarray(list(corners.values()), dtype=np.float64)
     ok, okv = (se >= 0).all(axis=1), cv >= 0
-    mesh = TaggedQuadMesh(np.asarray(pm.vertices)[used], new[idx].reshape(-1, 4), creases=(se[ok], es[ok]),
-                          corners=(cv[okv], cs[okv]), holes=np.flatnonzero(pm.is_hole))
+    tags = {"creases": (se[ok], es[ok]), "corners": (cv[okv], cs[okv]), "holes": np.flatnonzero(pm.is_hole)}
+    if used.size == pm.n_vertices:  # the same vertices and faces: pm's half-edges shared (built once)
+        mesh = TaggedQuadMesh.from_polymesh(pm, **tags)
+    else:
+        mesh = TaggedQuadMesh(np.asarray(pm.vertices)[used], new[idx].reshape(-1, 4), **tags)
     mesh.global_steps = steps
     return mesh, (origin if steps else None)
 

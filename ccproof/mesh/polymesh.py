@@ -112,7 +112,7 @@ class PolyMesh:
     halfedges: HalfEdges
 
     def __init__(self, vertices, faces, *, creases=None, corners=None, holes=None, options=None, sizes=None,
-                 _split=True):
+                 _split=True, _halfedges=None):
         V = np.array(vertices, dtype=np.float64)
         if V.ndim != 2 or V.shape[1] != 3:
             raise MeshError(f"vertices must have shape (n, 3), got {V.shape}")
@@ -148,7 +148,7 @@ class PolyMesh:
         elif isinstance(options, dict):
             options = Options(**options)
         self.options = options
-        self._build_topology()
+        self._build_topology(_halfedges)
         self.edge_sharpness = self._creases(creases)
         self.vertex_sharpness = self._corners(corners)
         if self.edge_sharpness or self.vertex_sharpness:  # the tags as arrays on the one topology
@@ -222,7 +222,7 @@ class PolyMesh:
             out.append([int(v) for v in q])
         return out
 
-    def _build_topology(self):
+    def _build_topology(self, he=None):
         """Edges, twins and fans (:class:`~ccproof.mesh.halfedges.HalfEdges`, built once: ``self.halfedges``);
         OpenSubdiv's non-manifold edges and vertices (``Vtr::Level``).
 
@@ -230,9 +230,15 @@ class PolyMesh:
         same direction (``completeTopologyFromFaceVertices``; a face given twice is such a case); a
         vertex is non-manifold when it ends a non-manifold edge or its faces do not form a single
         fan (``orderVertexFacesAndEdges``). Twins exist only across manifold edges.
+
+        ``he``: the untagged half-edges of these faces under these options, built elsewhere (a
+        :class:`~ccproof.mesh.QuadMesh`'s, :func:`~ccproof.mesh.quadmesh.shared_halfedges`), shared; built here
+        when None (or when they do not match).
         """
         n = self.vertices.shape[0]
-        he = HalfEdges(self.indices, self.offsets, n, self.options)
+        if (he is None or he.has_tags or he.options != self.options or he.n_vertices != n
+                or not np.array_equal(he.offsets, self.offsets) or not np.array_equal(he.org, self.indices)):
+            he = HalfEdges(self.indices, self.offsets, n, self.options)
         self.halfedges = he
         # a face repeating a vertex: a degenerate edge (v, v), or an edge the face holds twice; OpenSubdiv
         # gives each such occurrence an edge of its own with one face (a boundary edge), so that both
@@ -485,7 +491,8 @@ class PolyMesh:
         return self.is_all_quads and not self.has_tags and self.is_manifold
 
     def to_quad_mesh(self):
-        """The same mesh as a :class:`~ccproof.mesh.QuadMesh` (same vertices, unused ones included, same faces).
+        """The same mesh as a :class:`~ccproof.mesh.QuadMesh` (same vertices, unused ones included, same faces,
+        this mesh's :attr:`halfedges` shared: :meth:`QuadMesh.from_polymesh <ccproof.mesh.QuadMesh.from_polymesh>`).
 
         Raises
         ------
@@ -504,7 +511,7 @@ class PolyMesh:
             why = ("it has faces that are not quads" if not self.is_all_quads else
                    "it has OpenSubdiv tags" if self.has_tags else "it is not manifold")
             raise MeshError(f"not a plain quad mesh: {why}")
-        return QuadMesh(self.vertices, self.indices.reshape(-1, 4))
+        return QuadMesh.from_polymesh(self)  # this mesh's half-edges, shared (the topology built once)
 
     @property
     def has_tags(self):

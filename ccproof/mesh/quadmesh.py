@@ -108,6 +108,36 @@ def _duplicate_face(org, face_of, hs):
 
 
 
+def _untagged(he):
+    """The half-edges ``he`` without tags, under the default options (the same arrays, shared; ``he`` itself
+    when it has neither): the topology of a :class:`QuadMesh`."""
+    if not he.has_tags and he.options == Options():
+        return he
+    new = he.with_tags()
+    new.options = Options()
+    return new
+
+
+def shared_halfedges(mesh, faces, n_vertices):
+    """``mesh.halfedges`` (untagged, default options: :func:`_untagged`) when ``faces`` (int (m, 4)) and
+    ``n_vertices`` are the faces and vertex count of ``mesh`` (a QuadMesh or an all-quad PolyMesh), else None.
+
+    For a mesh made from the same faces (new control points, a sub-mesh that is the whole mesh): pass it as
+    ``QuadMesh(vertices, faces, _halfedges=...)`` and the topology is not built again (the checks are made).
+
+    >>> from ccproof.mesh.examples import grid
+    >>> g = grid(2, 2)
+    >>> shared_halfedges(g, g.faces.copy(), g.n_vertices) is g.halfedges, shared_halfedges(g, g.faces[:2], 9)
+    (True, None)
+    """
+    he = mesh.halfedges
+    F = np.asarray(faces)
+    if (int(n_vertices) != he.n_vertices or F.shape != (he.n_faces, 4) or he.uniform != 4
+            or not np.array_equal(F.reshape(-1), he.org)):
+        return None
+    return _untagged(he)
+
+
 class QuadMesh:
     """An all-quad, manifold, consistently oriented control mesh (bmz04 section 2).
 
@@ -138,7 +168,7 @@ class QuadMesh:
     ccproof.errors.MeshError: face 0 repeats vertex 2: [0, 1, 2, 2]
     """
 
-    def __init__(self, vertices, faces):
+    def __init__(self, vertices, faces, *, _halfedges=None):
         V = np.array(vertices, dtype=np.float64)
         if V.ndim != 2 or V.shape[1] != 3:
             raise MeshError(f"vertices must have shape (n, 3), got {V.shape}")
@@ -169,7 +199,7 @@ class QuadMesh:
         self.faces = F
         self.vertices.setflags(write=False)
         self.faces.setflags(write=False)
-        self._build_topology()
+        self._build_topology(_halfedges)
 
     # ------------------------------------------------------------------ construction
     @classmethod
@@ -198,6 +228,34 @@ class QuadMesh:
         faces = np.array(polygons, dtype=np.int64).reshape(-1, 4)
         return cls(vertices, faces)
 
+    @classmethod
+    def from_polymesh(cls, poly, **kwargs):
+        """The all-quad manifold :class:`~ccproof.mesh.polymesh.PolyMesh` ``poly`` as a QuadMesh (``cls``): same
+        vertices and faces, its :class:`~ccproof.mesh.halfedges.HalfEdges` shared (not built again).
+
+        Every check of the constructor is made (on the shared arrays); ``kwargs`` go to the constructor of
+        ``cls`` (the tags of :class:`~ccproof.apps.control_mesh.TaggedQuadMesh`). The half-edges are the
+        ones :meth:`HalfEdges.from_quads` builds from the same faces (an all-quad mesh's offsets are
+        ``4 f``), without ``poly``'s tags and options (a QuadMesh is untagged: a view sharing the arrays).
+
+        Raises
+        ------
+        MeshError
+            ``poly`` not all quads or not manifold, or a check of the constructor.
+
+        Examples
+        --------
+        >>> from ccproof.mesh.polymesh import PolyMesh
+        >>> p = PolyMesh([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], [[0, 1, 2, 3]])
+        >>> q = QuadMesh.from_polymesh(p)
+        >>> q.halfedges.twin is p.halfedges.twin, q.faces.tolist()
+        (True, [[0, 1, 2, 3]])
+        """
+        if not poly.is_all_quads or not poly.is_manifold:
+            raise MeshError("not an all-quad manifold mesh: " +
+                            ("it has faces that are not quads" if not poly.is_all_quads else "it is not manifold"))
+        return cls(poly.vertices, poly.indices.reshape(-1, 4), _halfedges=_untagged(poly.halfedges), **kwargs)
+
     def with_vertices(self, vertices):
         """Same connectivity, new control points (shape (n, 3)); the topology is re-used."""
         new = object.__new__(QuadMesh)
@@ -211,11 +269,15 @@ class QuadMesh:
         return new
 
     # ------------------------------------------------------------------ topology
-    def _build_topology(self):
+    def _build_topology(self, he=None):
+        """The fans and the checks of the module docstring on the half-edges ``he`` (those of the same faces,
+        e.g. a :class:`~ccproof.mesh.polymesh.PolyMesh`'s: :meth:`from_polymesh`), built here when None."""
         F = self.faces
         n, m = self.vertices.shape[0], F.shape[0]
         H = 4 * m
-        he = self.halfedges = HalfEdges.from_quads(F, n, Options())
+        if he is None:
+            he = HalfEdges.from_quads(F, n, Options())
+        self.halfedges = he
         _check_pairing(he)
         org, twin = he.org, he.twin
         self.twin = twin

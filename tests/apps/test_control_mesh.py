@@ -60,3 +60,53 @@ def test_unused_vertices_and_polygons_give_the_files_limit_surface(refdir, tmp_p
         # the control mesh keeps the used vertices first, in their order (dropped unused ones shift them)
         assert np.abs(got[:used.size] - ref[used]).max() <= 1e-13 * poly.bounding_box_diagonal, path.name
     assert checked == 1
+
+
+@pytest.mark.parametrize("name", ["osd_features/meshes/catmark_cube_creases0.obj",
+                                  "osd_features/meshes/catmark_hole_test2.obj",
+                                  "osd_nonmanifold/meshes/book4_infpage.obj", "meshes/torus_8x6.obj"])
+def test_control_mesh_shares_the_files_topology(refdir, monkeypatch, name):
+    """read_control_mesh takes the file's half-edges when it keeps the file's faces (no copy, no second build):
+    every array and tag equals the one the constructor builds anew from the same faces and tags, and the
+    evaluated PolyMesh of fit (dynamics forces) shares them too with the same tag arrays."""
+    from ccproof.apps.control_mesh import TaggedQuadMesh
+    from ccproof.apps.dynamics.forces import _evaluated_mesh
+    from ccproof.mesh import QuadMesh
+    from ccproof.mesh.halfedges import HalfEdges
+    from ccproof.mesh.polymesh import PolyMesh
+
+    file = read_mesh(refdir / name)
+    built = []
+    init = HalfEdges.__init__
+    monkeypatch.setattr(HalfEdges, "__init__", lambda self, *a, **k: built.append(init(self, *a, **k)))
+    mesh, origin = read_control_mesh(refdir / name)
+    poly = file.manifold
+    # the file's topology, built once (shared, not built again), and a non-manifold file's split mesh (new vertices)
+    assert origin is None and len(built) == (1 if poly is file else 2)
+    assert np.array_equal(mesh.faces.reshape(-1), poly.indices)  # (the meshes chosen keep the file's faces)
+    monkeypatch.undo()
+    assert not mesh.halfedges.has_tags and mesh.halfedges.options == QuadMesh(*_square()).halfedges.options
+    if isinstance(mesh, TaggedQuadMesh):
+        e, v = np.flatnonzero(mesh.edge_sharpness > 0), np.flatnonzero(mesh.vertex_sharpness > 0)
+        fresh = TaggedQuadMesh(np.array(mesh.vertices), np.array(mesh.faces),
+                               creases=(mesh.edges[e], mesh.edge_sharpness[e]),
+                               corners=(v, mesh.vertex_sharpness[v]), holes=np.flatnonzero(mesh.hole))
+        for k in ("edge_sharpness", "vertex_sharpness", "hole"):
+            assert np.array_equal(getattr(mesh, k), getattr(fresh, k)), k
+        ev = _evaluated_mesh(mesh)
+        assert ev.halfedges.twin is mesh.halfedges.twin  # shared
+        ref = PolyMesh(np.array(mesh.vertices), np.array(mesh.faces), creases=ev.edge_sharpness,
+                       corners=ev.vertex_sharpness, holes=np.flatnonzero(mesh.hole))
+        assert ref.halfedges.twin is not mesh.halfedges.twin
+        for k in ("edge_keys", "edge_values", "twin", "edges", "fan_of_corner", "is_nonmanifold_vertex"):
+            assert np.array_equal(getattr(ev.halfedges, k), getattr(ref.halfedges, k)), k
+        assert np.array_equal(ev.halfedges.vertex_tags(), ref.halfedges.vertex_tags())
+        assert np.array_equal(ev.is_hole, ref.is_hole)
+    else:
+        fresh = QuadMesh(np.array(mesh.vertices), np.array(mesh.faces))
+    for k in ("twin", "edges", "edge_faces", "fan_corners", "valence", "is_boundary_vertex"):
+        assert np.array_equal(getattr(mesh, k), getattr(fresh, k)), k
+
+
+def _square():
+    return [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], [[0, 1, 2, 3]]

@@ -124,3 +124,59 @@ def test_connected_components_agree_with_scipy():
         ref = scipy_components(sp.coo_matrix((np.ones(m), (a, b)), shape=(n, n)), directed=False)
         got = connected_components(n, a, b)
         assert got[0] == ref[0] and np.array_equal(got[1], ref[1]), (n, m)
+
+
+_TOPOLOGY = ("twin", "edge_of_halfedge", "edges", "edge_faces", "is_boundary_edge", "rot", "fan_ptr", "fan_corners",
+             "face_count", "valence", "is_boundary_vertex", "is_unused_vertex", "faces", "vertices")
+
+
+def _same_quadmesh(a, b):
+    for name in _TOPOLOGY:
+        x, y = getattr(a, name), getattr(b, name)
+        assert x.dtype == y.dtype and np.array_equal(x, y), name
+
+
+@pytest.mark.parametrize("name", ["cube", "torus_8x6", "sector_k5", "bunny_quads"])
+def test_from_polymesh_shares_the_topology_and_equals_the_constructor(refdir, name):
+    """``QuadMesh.from_polymesh`` (and ``to_quad_mesh``) take the PolyMesh's half-edges, not built again, and give
+    every array the constructor builds from the same faces, bit for bit, and the same evaluated surface."""
+    from ccproof.evaluate import LimitSurface
+    from ccproof.mesh.io import read_mesh
+
+    p = read_mesh(refdir / "meshes" / f"{name}.obj")
+    q = p.to_quad_mesh()
+    assert q.halfedges is p.halfedges and q.twin is p.twin
+    fresh = QuadMesh(p.vertices, p.indices.reshape(-1, 4))
+    assert fresh.halfedges is not p.halfedges
+    _same_quadmesh(q, fresh)
+    rng = np.random.default_rng(1)
+    f, u, v = rng.integers(0, q.n_faces, 50), rng.random(50), rng.random(50)
+    a, b = LimitSurface(q).evaluate(f, u, v, 1), LimitSurface(fresh).evaluate(f, u, v, 1)
+    assert all(np.array_equal(a[k], b[k]) for k in b)
+
+
+def test_from_polymesh_makes_the_constructors_checks():
+    """A pillow (two quads on the same four vertices) is a manifold PolyMesh, but no QuadMesh: the shared path
+    refuses it as the constructor does (every interior vertex of valence 2)."""
+    from ccproof.mesh.polymesh import PolyMesh
+
+    V = np.random.default_rng(0).normal(size=(4, 3))
+    p = PolyMesh(V, [[0, 1, 2, 3], [3, 2, 1, 0]])
+    assert p.is_plain_quads
+    with pytest.raises(MeshError, match=r"interior vertex \d has valence 2"):
+        p.to_quad_mesh()
+    with pytest.raises(MeshError, match="faces that are not quads"):
+        QuadMesh.from_polymesh(PolyMesh(V, [[0, 1, 2], [0, 2, 3]]))
+
+
+def test_shared_halfedges_only_for_the_same_faces():
+    from ccproof.mesh.quadmesh import shared_halfedges
+
+    g = grid(2, 2)
+    assert shared_halfedges(g, np.array(g.faces), g.n_vertices) is g.halfedges
+    assert shared_halfedges(g, np.array(g.faces), g.n_vertices + 1) is None  # one more vertex
+    assert shared_halfedges(g, np.roll(g.faces, 1, axis=1), g.n_vertices) is None  # other corners first
+    assert shared_halfedges(g, g.faces[:3], g.n_vertices) is None
+    s = QuadMesh(g.vertices + 1.0, g.faces, _halfedges=shared_halfedges(g, g.faces, g.n_vertices))
+    assert s.halfedges is g.halfedges
+    _same_quadmesh(s.with_vertices(g.vertices), g)

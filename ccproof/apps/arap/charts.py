@@ -30,6 +30,7 @@ from scipy.sparse.csgraph import connected_components
 
 from ccproof.errors import CCProofError, MeshError
 from ccproof.mesh import QuadMesh
+from ccproof.mesh.quadmesh import shared_halfedges
 
 __all__ = [
     "ChartError",
@@ -200,7 +201,8 @@ def check_disk(mesh: QuadMesh, faces, name="chart"):
     used, local = np.unique(F, return_inverse=True)
     local = local.reshape(F.shape)
     try:
-        sub = QuadMesh(mesh.vertices[used], local)
+        # the whole mesh (a single chart): its topology shared, not built again
+        sub = QuadMesh(mesh.vertices[used], local, _halfedges=shared_halfedges(mesh, local, used.size))
     except MeshError as exc:
         raise ChartError(f"{name} is not a topological disk: {exc} (vertex numbers local to the chart)") from None
     ncomp, _ = connected_components(face_adjacency(sub), directed=False)

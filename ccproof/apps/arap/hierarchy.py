@@ -51,6 +51,7 @@ from scipy.sparse.csgraph import connected_components
 from ccproof.apps.control_mesh import edge_values, tagged_step, tags_of, vertex_rules
 from ccproof.errors import CCProofError, MeshError
 from ccproof.mesh import QuadMesh, child_faces
+from ccproof.mesh.quadmesh import shared_halfedges
 from ccproof.rule_weights import crease_vertex_weights, sharp_edge_weight
 
 __all__ = ["ChartHierarchy", "Level", "HierarchyError", "split_nonmanifold", "RULES"]
@@ -305,7 +306,7 @@ class ChartHierarchy:
         self.n_chart_vertices = cv.size
         #: unknown of every vertex of E_0 (duplicated outer vertices share one)
         self.orig0 = orig
-        E0 = QuadMesh(mesh.vertices[gid[orig]], F0)
+        E0 = QuadMesh(mesh.vertices[gid[orig]], F0, _halfedges=shared_halfedges(mesh, F0, orig.size))
         es, vs = tags_of(mesh)
         g0 = gid[orig]  # the control vertex of every vertex of E_0
         sharp = es > 0

@@ -405,6 +405,7 @@ def limit_surface_mesh(mesh, level):
     68.0
     """
     from ccproof.mesh import QuadMesh, limit_positions, subdivide
+    from ccproof.mesh.quadmesh import shared_halfedges
 
     if isinstance(mesh, TaggedQuadMesh):  # tagged steps, exact limit masks with the tags; holes left out
         from ccproof.apps.control_mesh import moving_limit_rows, subdivide_control
@@ -417,7 +418,8 @@ def limit_surface_mesh(mesh, level):
         R = moving_limit_rows(t, np.arange(t.n_vertices), t.edge_sharpness, t.vertex_sharpness)
         F = t.faces[~t.hole]
         used, inv = np.unique(F, return_inverse=True)
-        return QuadMesh((R @ t.vertices)[used], inv.reshape(F.shape))
+        F = inv.reshape(F.shape)  # no holes, no unused vertex: t's faces, its topology shared
+        return QuadMesh((R @ t.vertices)[used], F, _halfedges=shared_halfedges(t, F, used.size))
     m = mesh
     for _ in range(int(level)):
         m = subdivide(m)

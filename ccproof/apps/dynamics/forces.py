@@ -172,7 +172,8 @@ def _evaluated_mesh(mesh):
     e = np.flatnonzero(mesh.edge_sharpness > 0)
     v = np.flatnonzero(mesh.vertex_sharpness > 0)
     return PolyMesh(mesh.vertices, mesh.faces, creases=(mesh.edges[e], np.minimum(mesh.edge_sharpness[e], 10.0)),
-                    corners=(v, np.minimum(mesh.vertex_sharpness[v], 10.0)), holes=np.flatnonzero(mesh.hole))
+                    corners=(v, np.minimum(mesh.vertex_sharpness[v], 10.0)), holes=np.flatnonzero(mesh.hole),
+                    _halfedges=mesh.halfedges)  # the same faces: the control mesh's topology, shared
 
 
 class ModelClosestPoints:

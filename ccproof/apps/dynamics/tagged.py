@@ -61,12 +61,15 @@ def _prv(h):
 class _Local:
     """A small quad mesh with its tags (local labels): faces (m, 4), edge/vertex sharpness."""
 
-    def __init__(self, faces, creases, corners):
+    def __init__(self, faces, creases, corners, like=None):
         from ccproof.mesh import QuadMesh
+        from ccproof.mesh.quadmesh import shared_halfedges
 
         self.faces = np.asarray(faces, dtype=np.int64).reshape(-1, 4)
         n = int(self.faces.max()) + 1
-        self.mesh = QuadMesh(np.zeros((n, 3)), self.faces)
+        # ``like``: a mesh whose topology is shared when the faces are its faces (a two-ring that is the whole mesh)
+        he = None if like is None else shared_halfedges(like, self.faces, n)
+        self.mesh = QuadMesh(np.zeros((n, 3)), self.faces, _halfedges=he)
         pairs, vals = creases
         self.es = edge_values(self.mesh, pairs, vals) if len(pairs) else np.zeros(self.mesh.n_edges)
         self.es = np.where(self.es >= INFINITE, np.inf, self.es)
@@ -274,7 +277,7 @@ class TaggedElement:
         cv = np.flatnonzero(vertex_sharpness > 0)
         okv = new[cv] >= 0
         loc = _Local(inv.reshape(-1, 4), (pairs[ok], edge_sharpness[sel][ok]),
-                     (new[cv[okv]], vertex_sharpness[cv][okv]))
+                     (new[cv[okv]], vertex_sharpness[cv][okv]), like=mesh)
         g = int(np.flatnonzero(ring == self.face)[0])
         self.leaves = []
         self._pending = []  # irregular nodes at the deepest built level
