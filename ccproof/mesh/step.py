@@ -336,8 +336,9 @@ def catmark_operator(n, indices, sizes, *, halfedges=None, edge_of_halfedge=None
         Face sizes (>= 3).
     halfedges : ccproof.mesh.halfedges.HalfEdges, optional
         The half-edges of this mesh (built from ``indices``, ``sizes``, ``n``: the caller's
-        ``mesh.halfedges``): its ``nxt``, ``prv``, ``twin`` and edges are read instead of pairing the
-        half-edges again (the numbering of the edge points stays ``edge_of_halfedge``'s or the default).
+        ``mesh.halfedges``; ValueError when its vertices, face sizes or corners, in order, are not these):
+        its ``nxt``, ``prv``, ``twin`` and edges are read instead of pairing the half-edges again (the
+        numbering of the edge points stays ``edge_of_halfedge``'s or the default).
         Not read when it has a non-manifold edge (the half-edges are then paired here).
     edge_of_halfedge : array_like of int, shape (H,), optional
         The edge of every half-edge (the edge points' numbering, 0..E-1); default: numbered by first
@@ -395,8 +396,9 @@ def catmark_operator(n, indices, sizes, *, halfedges=None, edge_of_halfedge=None
     m, H = sz.size, idx.size
     off = np.r_[0, np.cumsum(sz)].astype(np.int64)
     he = halfedges
-    if he is not None and (he.org.size != H or he.sizes.size != m or he.n_vertices != n):
-        raise ValueError("halfedges: not the half-edges of this mesh")
+    if he is not None and (he.org.size != H or he.sizes.size != m or he.n_vertices != n
+                           or not np.array_equal(he.sizes, sz) or not np.array_equal(he.org, idx)):
+        raise ValueError("halfedges: not the half-edges of this mesh")  # (its twins would be other half-edges')
     face = None if he is None else he.__dict__.get("face_of")  # (built by HalfEdges on mixed face sizes)
     if face is None:
         face = np.repeat(np.arange(m), sz)

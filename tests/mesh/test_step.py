@@ -233,6 +233,23 @@ def test_halfedges_of_another_mesh_are_refused():
         catmark_operator(pm.n_vertices, pm.indices, pm.sizes, halfedges=other.halfedges)
 
 
+def test_halfedges_of_the_same_size_but_other_faces_are_refused():
+    """The half-edges of a mesh with as many vertices, faces and half-edges: its faces each started one
+    corner later (the same surface, other half-edge numbers), or the faces in another order; the step
+    refuses them (ValueError) rather than reading twins that belong to other half-edges."""
+    from ccproof.mesh.examples import grid
+
+    g = grid(3, 3)
+    F = np.asarray(g.faces)
+    sz = np.full(F.shape[0], 4)
+    for F2 in (np.roll(F, 1, axis=1), F[::-1]):
+        assert F2.size == F.size and not np.array_equal(F2, F)
+        with pytest.raises(ValueError, match="not the half-edges"):
+            catmark_operator(g.n_vertices, F2.reshape(-1), sz, halfedges=g.halfedges)
+    # the faces' own half-edges are read (the comparison is not always refusing)
+    catmark_operator(g.n_vertices, F.reshape(-1), sz, halfedges=g.halfedges)
+
+
 def test_a_forged_weight_is_caught(refdir):
     """The comparison can fail: a stencil with one weight moved by 1 ulp is told apart."""
     pm = read_mesh(refdir / "osd_features" / "meshes" / "catmark_pyramid_creases1.obj").manifold
