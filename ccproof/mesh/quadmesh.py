@@ -271,12 +271,14 @@ class QuadMesh:
     # ------------------------------------------------------------------ topology
     def _build_topology(self, he=None):
         """The fans and the checks of the module docstring on the half-edges ``he`` (those of the same faces,
-        e.g. a :class:`~ccproof.mesh.polymesh.PolyMesh`'s: :meth:`from_polymesh`), built here when None."""
+        e.g. a :class:`~ccproof.mesh.polymesh.PolyMesh`'s: :meth:`from_polymesh`), built here when None or
+        when they are not the half-edges of these faces (other vertex count, corners or face order)."""
         F = self.faces
         n, m = self.vertices.shape[0], F.shape[0]
         H = 4 * m
-        if he is None:
-            he = HalfEdges.from_quads(F, n, Options())
+        if (he is None or he.n_vertices != n or he.org.size != H or (H and he.uniform != 4)
+                or not np.array_equal(he.org, F.reshape(-1))):
+            he = HalfEdges.from_quads(F, n, Options())  # (not these faces' half-edges, in this order: not taken)
         self.halfedges = he
         _check_pairing(he)
         org, twin = he.org, he.twin

@@ -180,3 +180,15 @@ def test_shared_halfedges_only_for_the_same_faces():
     s = QuadMesh(g.vertices + 1.0, g.faces, _halfedges=shared_halfedges(g, g.faces, g.n_vertices))
     assert s.halfedges is g.halfedges
     _same_quadmesh(s.with_vertices(g.vertices), g)
+
+
+def test_halfedges_of_other_faces_are_not_taken():
+    """``_halfedges=`` of a mesh with the same counts but other faces (each face started one corner later,
+    or the faces in another order): the QuadMesh builds its own topology, every array as the constructor
+    without it builds it (not the other faces' twins and fans)."""
+    g = grid(3, 3)
+    F = np.asarray(g.faces)
+    for F2 in (np.roll(F, 1, axis=1), F[::-1].copy()):
+        q = QuadMesh(g.vertices, F2, _halfedges=g.halfedges)
+        assert q.halfedges is not g.halfedges
+        _same_quadmesh(q, QuadMesh(g.vertices, F2))
