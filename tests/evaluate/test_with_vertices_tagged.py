@@ -151,3 +151,33 @@ def test_tagged_with_vertices_bad_input(refdir):
     X[2, 0] = np.inf
     with pytest.raises(MeshError, match="vertex 2"):
         S.with_vertices(X)
+
+
+def test_kept_step_with_more_than_256_distinct_weights():
+    """A triangulated 10 x 10 grid whose 280 interior edges each carry their own semi-sharpness in (0, 1):
+    the kept step has hundreds of distinct weights (two-byte codes); the moved surface still equals a fresh
+    build bit for bit (table float arrays, positions and derivatives)."""
+    k = 10
+    xs, ys = np.meshgrid(np.arange(k + 1), np.arange(k + 1))
+    V = np.c_[xs.ravel(), ys.ravel(), 0.1 * np.sin(xs.ravel() + ys.ravel())].astype(np.float64)
+    F = []
+    for i in range(k):
+        for j in range(k):
+            a = i * (k + 1) + j
+            F += [[a, a + 1, a + k + 2], [a, a + k + 2, a + k + 1]]
+    plain = PolyMesh(V, F)
+    inner = np.flatnonzero(~plain.is_boundary_edge)
+    creases = {(int(plain.edges[e, 0]), int(plain.edges[e, 1])): float(s)
+               for e, s in zip(inner, np.linspace(0.05, 0.95, inner.size))}
+    S = LimitSurface(PolyMesh(V, F, creases=creases), progress=False)
+    step = S._moving["step"]
+    assert step.weights.size > 256 and step.codes.dtype == np.uint16
+    X = V + 0.1 * np.random.default_rng(2).standard_normal(V.shape)
+    T = S.with_vertices(X)
+    R = LimitSurface(PolyMesh(X, F, creases=creases), progress=False)
+    for name in ("nets", "origin", "ring", "hot"):
+        assert np.array_equal(getattr(T._table, name), getattr(R._table, name)), name
+    f, u, v = _points(np.random.default_rng(3), S, T.mesh, per_face=4)
+    a, b = T.evaluate(f, u, v, 2), R.evaluate(f, u, v, 2)
+    for name in a:
+        assert np.array_equal(a[name], b[name]), name

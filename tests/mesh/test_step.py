@@ -233,6 +233,20 @@ def test_halfedges_of_another_mesh_are_refused():
         catmark_operator(pm.n_vertices, pm.indices, pm.sizes, halfedges=other.halfedges)
 
 
+def test_pack_csr_widens_the_indices_past_int32():
+    """Indices that do not fit 32 bits (a column index 2**31, or 2**31 stored entries in indptr) stay int64;
+    one below the limit is packed to int32. Small arrays stand for the huge mesh (only the values matter)."""
+    from ccproof.mesh.step import pack_csr
+
+    data = np.array([0.25, 0.5, 0.25])
+    for top, want in ((2**31 - 2, np.int32), (2**31 - 1, np.int64), (2**31, np.int64)):
+        csr = (np.array([0, 3], dtype=np.int64), np.array([0, 1, top], dtype=np.int64), data)
+        p = pack_csr(csr)
+        assert p.indices.dtype == want and p.indptr.dtype == want
+        assert int(p.indices[-1]) == top
+    p = pack_csr((np.array([0, 3, 2**31], dtype=np.int64), np.array([0, 1, 2]), data))
+    assert p.indptr.dtype == np.int64 and int(p.indptr[-1]) == 2**31
+
 def test_halfedges_of_the_same_size_but_other_faces_are_refused():
     """The half-edges of a mesh with as many vertices, faces and half-edges: its faces each started one
     corner later (the same surface, other half-edge numbers), or the faces in another order; the step
