@@ -256,3 +256,26 @@ def test_complex_topology_numpy_equals_the_loop(refdir, monkeypatch):
                 assert getattr(a, k) == getattr(b, k), (name, k)
             n += 1
     assert n == 2 * len(names)
+
+
+def test_shared_halfedges_taken_only_when_they_are_the_meshs():
+    """``PolyMesh(..., _halfedges=he)`` takes ``he`` only when it is the untagged pairing of these faces under these
+    options; half-edges of the faces rolled by one corner or in reverse order, tagged ones, or ones under other
+    options are not taken: the mesh builds its own, every array as the constructor without ``he``."""
+    from ccproof.mesh.examples import grid
+    from ccproof.mesh.rules import Options
+
+    g = grid(3, 3)
+    F = np.asarray(g.faces)
+    V = np.asarray(g.vertices)
+    assert PolyMesh(V, F, _halfedges=g.halfedges).halfedges is g.halfedges  # the same faces: taken
+    tagged = PolyMesh(V, F, creases={(5, 6): 2.0})
+    assert tagged.halfedges.has_tags
+    cases = [(np.roll(F, 1, axis=1), {}, g.halfedges), (F[::-1].copy(), {}, g.halfedges),
+             (F, {}, tagged.halfedges), (F, {"options": Options(boundary="edge_and_corner")}, g.halfedges)]
+    for F2, kw, he in cases:
+        got, ref = PolyMesh(V, F2, _halfedges=he, **kw), PolyMesh(V, F2, **kw)
+        assert got.halfedges is not he
+        for k in ("org", "twin", "nxt", "prv", "edges", "edge_of", "edge_keys", "edge_values"):
+            assert np.array_equal(getattr(got.halfedges, k), getattr(ref.halfedges, k)), k
+        assert got.halfedges.options == ref.halfedges.options == (kw.get("options") or Options())
