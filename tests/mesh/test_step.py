@@ -20,7 +20,7 @@ import pytest
 from ccproof.mesh.io import read_mesh
 from ccproof.mesh.polymesh import PolyMesh
 from ccproof.mesh.rules import refine_complex, to_float
-from ccproof.mesh.step import catmark_operator
+from ccproof.mesh.step import apply_csr, catmark_operator
 
 FEATURES = ["catmark_chaikin1.obj", "catmark_cube_corner2.obj", "catmark_cube_corner4.obj",
             "catmark_cube_creases0.obj", "catmark_cubes_infsharp.obj", "catmark_dart_edgeonly.obj",
@@ -102,6 +102,15 @@ def _same_matrix(S, rows):
         assert got == [(c, w) for c, w in want if w != 0], (r, got, want)
 
 
+def _same_csr(csr, rows):
+    """The CSR arrays ``csr`` hold exactly ``rows`` (:func:`_rounded_rows`; an empty row for None), bit for bit."""
+    indptr, indices, data = csr
+    assert indptr.size == len(rows) + 1
+    for r, want in enumerate(rows):
+        got = list(zip(indices[indptr[r]:indptr[r + 1]].tolist(), data[indptr[r]:indptr[r + 1]].tolist()))
+        assert got == ([] if want is None else [(c, w) for c, w in want if w != 0]), r
+
+
 def _check_refine(pm, stencils, children, ces, cvs):
     """PolyMesh.refine (with and without the operator) against the reference child, bit for bit."""
     ref = _reference_child(pm, stencils, children, ces, cvs)
@@ -120,6 +129,12 @@ def _check_refine(pm, stencils, children, ces, cvs):
     _same_matrix(pm.subdivision_operator(), rows)
     used = ~m1.is_unused_vertex
     assert (S @ np.nan_to_num(pm.vertices))[used].tobytes() == m1.vertices[used].tobytes()
+    # operator="csr": the same child, the step's CSR arrays (an unused vertex's row empty), which apply_csr
+    # maps to the child's vertices
+    m3, csr = pm.refine(operator="csr")
+    assert m3.vertices.tobytes() == ref.vertices.tobytes() and np.array_equal(m3.indices, ref.indices)
+    _same_csr(csr, rows)
+    assert apply_csr(csr, pm.vertices)[used].tobytes() == ref.vertices[used].tobytes()
 
 
 @pytest.mark.parametrize("folder,name", CASES)
@@ -132,6 +147,9 @@ def test_rows_equal_the_exact_stencils(refdir, folder, name):
         m1, S = mesh.refine()  # refine's operator is that one too; its child is the split mesh's
         _same_matrix(S, rows)
         assert m1.vertices.tobytes() == mesh.manifold.refine(operator=False)[0].vertices.tobytes()
+        m3, csr = mesh.refine(operator="csr")  # the split mesh's step, its columns the split mesh's vertices
+        assert m3.vertices.tobytes() == m1.vertices.tobytes()
+        _same_csr(csr, _rounded_rows(refine_complex(mesh.manifold.complex())[0]))
     pm = mesh.manifold
     for _ in range(3):
         assert _check_level(pm) > 0
