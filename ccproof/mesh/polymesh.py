@@ -553,7 +553,8 @@ class PolyMesh:
         :attr:`manifold_vertex_map`; on a non-manifold mesh its :attr:`manifold` is this one's split mesh
         (sharing that one's topology the same way) with the vertices ``vertices[manifold_vertex_map]``.
         The result equals ``PolyMesh(vertices, faces, creases=..., corners=..., holes=..., options=...)``
-        built anew, without the topology, the checks of the faces and tags, and the split.
+        built anew, without the topology, the checks of the faces and tags, and the split; but for
+        :attr:`level`, which it keeps (a refined mesh's level-0 rules stay off: the constructor's mesh is at 0).
 
         Parameters
         ----------
