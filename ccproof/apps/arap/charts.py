@@ -200,22 +200,38 @@ def check_disk(mesh: QuadMesh, faces, name="chart"):
     F = mesh.faces[faces]
     used, local = np.unique(F, return_inverse=True)
     local = local.reshape(F.shape)
+    key = (local.shape, local.astype(np.int64).tobytes())
+    why = _DISKS.get(key)
+    if why is None:
+        if len(_DISKS) >= _DISKS_MAX:
+            _DISKS.clear()
+        why = _DISKS[key] = _not_a_disk(mesh, local, used.size)
+    if why:
+        raise ChartError(f"{name} is not a topological disk: {why}")
+
+
+#: the verdicts of :func:`check_disk` by the chart's local faces (its topology): "" for a disk, else the reason
+_DISKS: dict = {}
+#: how many verdicts :data:`_DISKS` keeps before it is emptied
+_DISKS_MAX = 4096
+
+
+def _not_a_disk(mesh, local, n):
+    """Why the quads ``local`` ((k, 4), labels 0..n-1) are not a topological disk, or "" when they are one."""
     try:
         # the whole mesh (a single chart): its topology shared, not built again
-        sub = QuadMesh(mesh.vertices[used], local, _halfedges=shared_halfedges(mesh, local, used.size))
+        sub = QuadMesh(np.zeros((n, 3)), local, _halfedges=shared_halfedges(mesh, local, n))
     except MeshError as exc:
-        raise ChartError(f"{name} is not a topological disk: {exc} (vertex numbers local to the chart)") from None
+        return f"{exc} (vertex numbers local to the chart)"
     ncomp, _ = connected_components(face_adjacency(sub), directed=False)
     if ncomp != 1:
-        raise ChartError(f"{name} is not a topological disk: it has {ncomp} connected components")
+        return f"it has {ncomp} connected components"
     chi = sub.n_vertices - sub.n_edges + sub.n_faces
     if chi != 1:
         nb = _boundary_loops(sub)
-        raise ChartError(
-            f"{name} is not a topological disk: Euler characteristic V - E + F = {chi} "
-            f"({sub.n_vertices} - {sub.n_edges} + {sub.n_faces}), {nb} boundary loops"
-        )
-    return sub
+        return (f"Euler characteristic V - E + F = {chi} "
+                f"({sub.n_vertices} - {sub.n_edges} + {sub.n_faces}), {nb} boundary loops")
+    return ""
 
 
 def _boundary_loops(mesh: QuadMesh):

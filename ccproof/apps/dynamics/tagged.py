@@ -81,6 +81,7 @@ class _Local:
         key = np.minimum(m.edges[:, 0], m.edges[:, 1]) * n + np.maximum(m.edges[:, 0], m.edges[:, 1])
         self._edge = dict(zip(key.tolist(), range(key.size)))
         self._n = n
+        self._children = {}
         sharp = m.is_boundary_edge | (self.es > 0)
         self.sharp = sharp
         self.n_sharp = np.bincount(m.edges[sharp].reshape(-1), minlength=n)
@@ -91,6 +92,23 @@ class _Local:
 
     def edge(self, a, b):
         return self._edge[min(a, b) * self._n + max(a, b)]
+
+    def children(self, g):
+        """The tagged step of this mesh (sparse (n', n)) and the four children of face ``g``: each
+        ``(sub-mesh of its two-ring, the step's rows it keeps, its face in the sub-mesh)``; computed once."""
+        if g not in self._children:
+            from ccproof.mesh import child_faces
+
+            S, creases, corners = tagged_step(self.mesh, self.es, self.vs)
+            CF = child_faces(self.mesh)
+            kids = []
+            for i in range(4):
+                c = 4 * g + i
+                keep = _two_ring_faces(CF, c)
+                sub, used = _restrict(CF, creases, corners, keep)
+                kids.append((sub, used, int(np.flatnonzero(keep == c)[0])))
+            self._children[g] = (S, kids)
+        return self._children[g]
 
     def is_sharp(self, a, b):
         return bool(self.sharp[self.edge(a, b)])
@@ -202,8 +220,31 @@ class _Node:
         self.w = w  # face parameter of the irregular corner whose limit point is ``base``
 
 
-def _restrict(faces, creases, corners, keep_faces, R):
-    """The sub-mesh of ``keep_faces`` (order kept), relabelled, with its tags and rows."""
+#: the small meshes already built, by their exact local faces and tags (:func:`_local`)
+_LOCALS: dict = {}
+#: how many small meshes :data:`_LOCALS` keeps before it is emptied
+_LOCALS_MAX = 4096
+
+
+def _local(faces, pairs, vals, cv, cs, like=None):
+    """The :class:`_Local` of these local faces and tags: built once, then reused while it is cached.
+
+    The key is the exact arrays (faces (m, 4), crease pairs (k, 2) and values (k,), corner labels (j,) and
+    values (j,), their bytes and dtypes), so a reused mesh is the one a new build would give; a ``_Local``
+    is never changed once built (its children, :meth:`_Local.children`, are cached on it too).
+    """
+    arrays = [np.ascontiguousarray(a) for a in (faces, pairs, vals, cv, cs)]
+    key = tuple((a.dtype.str, a.shape, a.tobytes()) for a in arrays)
+    loc = _LOCALS.get(key)
+    if loc is None:
+        if len(_LOCALS) >= _LOCALS_MAX:
+            _LOCALS.clear()
+        loc = _LOCALS[key] = _Local(arrays[0], (arrays[1], arrays[2]), (arrays[3], arrays[4]), like=like)
+    return loc
+
+
+def _restrict(faces, creases, corners, keep_faces):
+    """The sub-mesh of ``keep_faces`` (order kept), relabelled, with its tags; and its vertices (the rows kept)."""
     sub = faces[keep_faces]
     used, inv = np.unique(sub, return_inverse=True)
     new = np.full(faces.max() + 1, -1, dtype=np.int64)
@@ -214,9 +255,8 @@ def _restrict(faces, creases, corners, keep_faces, R):
     cv, cs = corners
     cv = np.asarray(cv, dtype=np.int64)
     okv = new[cv] >= 0 if cv.size else np.zeros(0, dtype=bool)
-    loc = _Local(inv.reshape(-1, 4), (new[pairs[ok]], np.asarray(vals)[ok]),
-                 (new[cv[okv]], np.asarray(cs)[okv]))
-    return loc, R[used]
+    loc = _local(inv.reshape(-1, 4), new[pairs[ok]], np.asarray(vals)[ok], new[cv[okv]], np.asarray(cs)[okv])
+    return loc, used
 
 
 class TaggedElement:
@@ -276,8 +316,8 @@ class TaggedElement:
         ok = (pairs >= 0).all(axis=1)
         cv = np.flatnonzero(vertex_sharpness > 0)
         okv = new[cv] >= 0
-        loc = _Local(inv.reshape(-1, 4), (pairs[ok], edge_sharpness[sel][ok]),
-                     (new[cv[okv]], vertex_sharpness[cv][okv]), like=mesh)
+        loc = _local(inv.reshape(-1, 4), pairs[ok], edge_sharpness[sel][ok], new[cv[okv]],
+                     vertex_sharpness[cv][okv], like=mesh)
         g = int(np.flatnonzero(ring == self.face)[0])
         self.leaves = []
         self._pending = []  # irregular nodes at the deepest built level
@@ -311,21 +351,13 @@ class TaggedElement:
             self._built += 1
 
     def _children(self, node):
-        from ccproof.mesh import child_faces
-
-        loc = node.loc
-        S, creases, corners = tagged_step(loc.mesh, loc.es, loc.vs)
-        CF = child_faces(loc.mesh)
+        S, kids = node.loc.children(node.g)
         R = S @ node.R
         out = []
-        for i in range(4):
-            c = 4 * node.g + i
-            keep = _two_ring_faces(CF, c)
-            sub, Rc = _restrict(CF, creases, corners, keep, R)
-            gc = int(np.flatnonzero(keep == c)[0])
+        for i, (sub, used, gc) in enumerate(kids):
             ci = _CORNERS[i]
             cols = np.c_[(_CORNERS[(i + 1) % 4] - ci) / 2, (_CORNERS[(i + 3) % 4] - ci) / 2]
-            out.append(_Node(sub, gc, Rc, node.base, node.o + node.A @ ci, node.A @ cols, node.depth + 1,
+            out.append(_Node(sub, gc, R[used], node.base, node.o + node.A @ ci, node.A @ cols, node.depth + 1,
                              node.w))
         return out
 
