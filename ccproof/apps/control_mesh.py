@@ -43,7 +43,8 @@ from ccproof.mesh import QuadMesh
 INFINITE = 10.0
 
 __all__ = ["read_control_mesh", "children_labels", "TaggedQuadMesh", "tagged_step", "subdivide_control",
-           "refuse_tags", "edge_values", "vertex_rules", "moving_limit_rows", "MAX_TAGGED_FACES"]
+           "refuse_tags", "edge_values", "vertex_rules", "moving_limit_rows", "MAX_TAGGED_FACES", "copy_labels",
+           "merged_copies", "write_control_obj"]
 
 #: most faces the global tagged steps of :func:`read_control_mesh` may make (Python rules: ~50 us a face)
 MAX_TAGGED_FACES = 200_000
@@ -114,6 +115,11 @@ class TaggedQuadMesh(QuadMesh):
     hole : ndarray of bool, shape (m,)
     global_steps : int
         The Catmull-Clark steps :func:`read_control_mesh` took on the file (0 otherwise).
+    file_vertex : ndarray of int64, shape (n,), or None
+        On the split mesh of a non-manifold file (:func:`read_control_mesh`): the vertex every control
+        vertex is a copy of, labels ``0 .. r-1`` (without global steps the file's used vertices in the
+        file's order; after them the vertices of the file's refined mesh, :func:`copy_labels`). None
+        when every control vertex is its own (a manifold file, or any other construction).
 
     Examples
     --------
@@ -137,6 +143,7 @@ class TaggedQuadMesh(QuadMesh):
         if holes is not None:
             self.hole[np.asarray(holes, dtype=np.int64)] = True
         self.global_steps = 0
+        self.file_vertex = None
 
     @property
     def has_tags(self):
@@ -572,9 +579,20 @@ def _tagged_control_mesh(poly, name):
                         "`ccproof eval` evaluates it, or make the tag smaller or infinite (>= 10)")
     origin = np.arange(pm.n_faces, dtype=np.int64)
     steps = 0
+    split = pm is not poly  # copies of the file's vertices (their labels: file_vertex below)
+    if split:
+        import scipy.sparse as sp
+
+        vm = np.asarray(poly.manifold_vertex_map, dtype=np.int64)
+        C = sp.csr_matrix((np.ones(vm.size), (np.arange(vm.size), vm)), shape=(vm.size, poly.n_vertices))
+        kinds = None
     while not pm.is_all_quads or (chaikin and _sharpest_semi_sharp(pm) is not None):
         origin = np.repeat(origin, np.asarray(pm.sizes, dtype=np.int64))
-        pm, _ = pm.refine(operator=False)
+        if split:
+            kinds = (pm.n_vertices, pm.n_vertices + len(pm.edges))
+        pm, S = pm.refine(operator=split)
+        if split:
+            C = (S @ C).tocsr()
         steps += 1
     corners = dict(pm.vertex_sharpness)
     if steps == 0 and pm.options.boundary == "edge_and_corner":  # its level-0 corners, made explicit
@@ -595,7 +613,136 @@ def _tagged_control_mesh(poly, name):
     else:
         mesh = TaggedQuadMesh(np.asarray(pm.vertices)[used], new[idx].reshape(-1, 4), **tags)
     mesh.global_steps = steps
+    if split and steps == 0:  # the file's used vertices, in the file's order
+        mesh.file_vertex = np.unique(vm[used], return_inverse=True)[1].astype(np.int64)
+    elif split:
+        mesh.file_vertex = copy_labels(C[used], kinds=kinds, rows=used)
     return mesh, (origin if steps else None)
+
+
+def copy_labels(C, kinds=None, rows=None):
+    """Labels of the rows of a sparse matrix: rows with the same entries (the same point for every state) and
+    the same kind get one label.
+
+    Parameters
+    ----------
+    C : scipy.sparse matrix, shape (n, r)
+        Every control point as a combination of free points (a subdivision operator times the 0/1
+        expansion of the copies).
+    kinds : (int, int), optional
+        The step layout (:func:`ccproof.mesh.child_faces`): rows below ``kinds[0]`` are vertex points,
+        below ``kinds[1]`` edge points, the rest face points; points of different kinds never share a label
+        (a degenerate face's edge point can equal a corner's vertex point and still be another vertex).
+    rows : array_like of int, shape (n,), optional
+        The step-layout index of every row of ``C`` (default: its index).
+
+    Returns
+    -------
+    ndarray of int64, shape (n,)
+        Labels ``0 .. k-1`` in the order of first appearance.
+
+    Examples
+    --------
+    >>> import scipy.sparse as sp
+    >>> C = sp.csr_matrix(np.array([[1, 0], [0.5, 0.5], [1, 0], [0.5, 0.5]]))
+    >>> copy_labels(C).tolist(), copy_labels(C, kinds=(1, 4)).tolist()
+    ([0, 1, 0, 1], [0, 1, 2, 1])
+    """
+    C = C.tocsr(copy=True)
+    C.sum_duplicates()
+    C.sort_indices()
+    rows = np.arange(C.shape[0]) if rows is None else np.asarray(rows, dtype=np.int64)
+    kind = np.zeros(C.shape[0], dtype=np.int64) if kinds is None else (
+        (rows >= kinds[0]).astype(np.int64) + (rows >= kinds[1]))
+    seen: dict = {}
+    out = np.empty(C.shape[0], dtype=np.int64)
+    ptr, ind, dat = C.indptr, C.indices, C.data
+    for i in range(C.shape[0]):
+        key = (int(kind[i]), ind[ptr[i]:ptr[i + 1]].tobytes(), dat[ptr[i]:ptr[i + 1]].tobytes())
+        out[i] = seen.setdefault(key, len(seen))
+    return out
+
+
+def merged_copies(mesh, file_vertex):
+    """A control mesh with its copies merged: one vertex per label (the file's numbering).
+
+    Parameters
+    ----------
+    mesh : QuadMesh or TaggedQuadMesh
+        n vertices, m faces; copies at the same position.
+    file_vertex : array_like of int, shape (n,)
+        Labels ``0 .. r-1`` (:attr:`TaggedQuadMesh.file_vertex`).
+
+    Returns
+    -------
+    vertices : ndarray, shape (r, 3)
+        The first copy's position for every label.
+    faces : ndarray of int64, shape (m, 4)
+    tag_lines : list of str
+        OpenSubdiv's OBJ tag lines (:func:`ccproof.mesh.io.obj_tag_lines`) in the merged numbering: a sharp
+        edge's largest sharpness over its copies, likewise for vertices; the holes.
+
+    Examples
+    --------
+    Two quads sharing only vertex 0, split into copies 0 and 4:
+
+    >>> from ccproof.mesh import QuadMesh
+    >>> q = QuadMesh([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 0], [-1, 0, 0], [-1, -1, 0],
+    ...               [0, -1, 0]], [[0, 1, 2, 3], [4, 5, 6, 7]])
+    >>> V, F, t = merged_copies(q, [0, 1, 2, 3, 0, 4, 5, 6])
+    >>> V.shape, F.tolist(), t
+    ((7, 3), [[0, 1, 2, 3], [0, 4, 5, 6]], [])
+    """
+    lab = np.asarray(file_vertex, dtype=np.int64)
+    _, first = np.unique(lab, return_index=True)
+    V = np.asarray(mesh.vertices)[first]
+    F = lab[np.asarray(mesh.faces)]
+    es = getattr(mesh, "edge_sharpness", None)
+    if not isinstance(es, np.ndarray):
+        return V, F, []
+    lines = []
+    e = np.flatnonzero(es > 0)
+    pairs = np.sort(lab[mesh.edges[e]], axis=1)
+    best: dict = {}
+    for (a, b), v in zip(pairs.tolist(), es[e].tolist()):
+        best[(a, b)] = max(best.get((a, b), 0.0), v)
+    lines += [f"t crease 2/1/0 {a} {b} {min(v, 10.0)!r}\n" for (a, b), v in sorted(best.items())]
+    vbest: dict = {}
+    vs = mesh.vertex_sharpness
+    for v in np.flatnonzero(vs > 0).tolist():
+        vbest[int(lab[v])] = max(vbest.get(int(lab[v]), 0.0), float(vs[v]))
+    lines += [f"t corner 1/1/0 {v} {min(s, 10.0)!r}\n" for v, s in sorted(vbest.items())]
+    holes = np.flatnonzero(mesh.hole).tolist()
+    if holes:
+        lines.append(f"t hole {len(holes)}/0/0 " + " ".join(map(str, holes)) + "\n")
+    return V, F, lines
+
+
+def write_control_obj(path, mesh, *, comment=None):
+    """Write a control mesh as OBJ (:func:`ccproof.mesh.write_obj`), its copies merged
+    (:func:`merged_copies`) when it has a ``file_vertex`` labelling: a non-manifold file's fitted mesh gets
+    the file's vertices and faces back.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+    mesh : QuadMesh or TaggedQuadMesh
+    comment : str, optional
+
+    Returns
+    -------
+    None
+    """
+    from ccproof.mesh import write_obj
+
+    lab = getattr(mesh, "file_vertex", None)
+    if lab is None:
+        write_obj(path, mesh, comment=comment)
+        return
+    V, F, lines = merged_copies(mesh, lab)
+    write_obj(path, (V, F), comment=comment)
+    with open(path, "a", encoding="utf-8") as fh:
+        fh.writelines(lines)
 
 
 def children_labels(labels, origin):

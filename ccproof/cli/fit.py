@@ -80,13 +80,12 @@ def run(args) -> int:
     check_outputs(args, out=(".obj",), surface_out="mesh", errors=(".csv",))  # before any work
     import numpy as np
 
-    from ccproof.apps.control_mesh import read_control_mesh
+    from ccproof.apps.control_mesh import read_control_mesh, write_control_obj
     from ccproof.apps.dynamics.fit import fit_points, read_points
     from ccproof.apps.dynamics.model import Material
     from ccproof.cli._notice import compile_notice
     from ccproof.cli._progress import progress_enabled
     from ccproof.errors import CCProofError
-    from ccproof.mesh import write_obj
 
     X = read_points(args.points)
     init = args.init
@@ -126,11 +125,13 @@ def run(args) -> int:
     print(f"two-sided (Hausdorff) error: {res.two_sided_error_percent:.3f} % of the enclosing-sphere diameter")
     for w in res.warnings:
         print(f"ccproof fit: warning: {w}", file=sys.stderr)
-    comment = (f"ccproof fit {Path(args.points).name}: {res.mesh.n_vertices} control vertices, max error "
+    fv = getattr(res.mesh, "file_vertex", None)  # a non-manifold --init: its copies written as one vertex
+    n_written = res.mesh.n_vertices if fv is None else int(fv.max()) + 1
+    comment = (f"ccproof fit {Path(args.points).name}: {n_written} control vertices, max error "
                f"{res.max_error_percent:.3f} %, two-sided {res.two_sided_error_percent:.3f} % of the "
                f"enclosing-sphere diameter")
-    with atomic(args.out) as tmp:
-        write_obj(tmp, res.mesh, comment=comment)
+    with atomic(args.out) as tmp:  # a non-manifold --init: the copies merged, the file's numbering
+        write_control_obj(tmp, res.mesh, comment=comment)
     surf_out = args.surface_out
     if surf_out is None:
         o = Path(args.out)

@@ -44,7 +44,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ccproof.apps.control_mesh import TaggedQuadMesh
+from ccproof.apps.control_mesh import TaggedQuadMesh, copy_labels
 from ccproof.apps.dynamics.forces import ModelClosestPoints, Springs, check_points
 from ccproof.apps.dynamics.integrate import ImplicitIntegrator
 from ccproof.apps.dynamics.meshes import paper_initial_model
@@ -544,7 +544,9 @@ class FitResult:
     Parameters
     ----------
     mesh : QuadMesh or None
-        The fitted control mesh (data units).
+        The fitted control mesh (data units). From a non-manifold start mesh: the split mesh, its
+        ``file_vertex`` labelling the copies of one vertex (which the fit keeps at one point;
+        :func:`ccproof.apps.control_mesh.write_control_obj` writes it merged, in the file's numbering).
     model : DynamicSurface or None
     levels : list of FitLevel
     center : ndarray, shape (3,), optional
@@ -725,6 +727,8 @@ def fit_points(X: ArrayLike, init: Literal["cube"] | QuadMesh = "cube", levels: 
         mesh0, _ = isolate_extraordinary(mesh0)
     model = DynamicSurface(mesh0, material, levels=truncation)
     P = np.array(mesh0.vertices)
+    # a non-manifold file's split mesh: the copies of one file vertex are one free point (docs/qmv98.md)
+    copies = getattr(mesh0, "file_vertex", None)
     k = np.full(pts.shape[0], spring_total / pts.shape[0])
     result = FitResult(mesh=None, model=None, center=centre, diameter=diameter,
                        parameters={"material": material, "spring_total": spring_total, "dt": dt, "scheme": scheme,
@@ -740,7 +744,7 @@ def fit_points(X: ArrayLike, init: Literal["cube"] | QuadMesh = "cube", levels: 
         for level in range(levels + 1):
             t0 = time.perf_counter()
             finder = ModelClosestPoints(model)
-            integ = ImplicitIntegrator(model, dt, P=P, scheme=scheme, tol=1e-9)
+            integ = ImplicitIntegrator(model, dt, P=P, scheme=scheme, tol=1e-9, copies=copies)
             converged = False
             cg = 0
             step = 0
@@ -784,13 +788,21 @@ def fit_points(X: ArrayLike, init: Literal["cube"] | QuadMesh = "cube", levels: 
                                           err["max_percent"], err["mean_percent"], time.perf_counter() - t0, cg,
                                           energies[-1] if energies else math.nan, change, err_change, reason))
             if level < levels:
+                coarse = model.mesh
                 model, A = model.refine(P)
                 P = np.asarray(A @ P)
+                if copies is not None:  # the children of the copies that are one point of the refined file
+                    import scipy.sparse as sp
+
+                    E = sp.csr_matrix((np.ones(copies.size), (np.arange(copies.size), copies)))
+                    copies = copy_labels(A @ E, kinds=(coarse.n_vertices, coarse.n_vertices + coarse.n_edges))
     finally:
         if bar is not None:
             bar.close()
     result.model = model
     result.mesh = mesh = model.mesh.with_vertices(P * diameter + centre)
+    if copies is not None:
+        mesh.file_vertex = copies
     result.normalized_state = P
     result.data_distances = err["distances"] * diameter
     for i, lev in enumerate(result.levels):

@@ -241,6 +241,12 @@ class ImplicitIntegrator:
         Relative CG tolerance per step.
     matrix_free : bool
         Element-by-element products instead of the assembled matrix.
+    copies : array_like of int, shape (n,), optional
+        Rows of the state that are one point (the copies of one vertex of a non-manifold file,
+        :func:`ccproof.apps.control_mesh.read_control_mesh`): ``copies[i]`` is the label of row i, the
+        labels ``0 .. r-1``. The state is then ``P = E Y`` (``E`` the 0/1 (n, r) matrix of the labels) and
+        each step solves ``E^T A E Y = E^T b`` for the r free points (forces, stiffness and mass pulled
+        back by ``E^T``), so the copies move together. None (default): every row is free.
 
     Attributes
     ----------
@@ -260,7 +266,8 @@ class ImplicitIntegrator:
     (0.1, True)
     """
 
-    def __init__(self, system, dt, P=None, P_prev=None, scheme="inertial", tol=1e-10, matrix_free=False):
+    def __init__(self, system, dt, P=None, P_prev=None, scheme="inertial", tol=1e-10, matrix_free=False,
+                 copies=None):
         from ccproof.apps.dynamics.model import DynamicSurface
 
         if isinstance(system, DynamicSurface):
@@ -296,6 +303,17 @@ class ImplicitIntegrator:
             self._c = (0.0, 1.0, 2.0 * dt)
         self._A = None
         self._diag = None
+        self._E = None
+        if copies is not None:
+            lab = np.asarray(copies, dtype=np.int64).reshape(-1)
+            n = self.P.shape[0]
+            if lab.shape[0] != n or (lab < 0).any():
+                raise CCProofError(f"copies must be {n} labels >= 0")
+            r = int(lab.max()) + 1 if n else 0
+            self._E = sp.csr_matrix((np.ones(n), (np.arange(n), lab)), shape=(n, r))
+            used, self._first = np.unique(lab, return_index=True)  # the first row of every label
+            if used.size != r:
+                raise CCProofError("copies: every label 0 .. max must be used")
 
     def _base(self):
         if self.matrix_free:
@@ -329,6 +347,19 @@ class ImplicitIntegrator:
         d = diag + cK * np.asarray(Js.multiply(Js).T @ kw).reshape(-1)
         return apply, d
 
+    def _reduced_operator(self, springs):
+        """``(apply, diag)`` of ``E^T A E`` (the step matrix on the free points, ``copies``)."""
+        E, ET = self._E, self._E.T.tocsr()
+        if not self.matrix_free:
+            A, _ = self._base()
+            if springs is not None and springs.count:
+                A = A + self._c[2] * springs.matrix()
+            Ar = (ET @ A @ E).tocsr()
+            return (lambda Y: Ar @ Y), Ar.diagonal()
+        apply, diag = self.system_operator(springs)
+        # Jacobi preconditioner: the copies' diagonals summed (the coupling between copies left out)
+        return (lambda Y: ET @ apply(E @ Y)), np.asarray(ET @ diag).reshape(-1)
+
     def step(self, force=None, springs=None):
         """Advance one step; ``force`` (n, k) is the generalized force f_p(t+dt), ``springs`` a Springs."""
         P, Pp = self.P, self.P_prev
@@ -341,9 +372,15 @@ class ImplicitIntegrator:
                 + 4 * self.system.mass_apply(P)
         else:
             rhs = 2 * dt * F + self.system.damping_apply(Pp)
-        apply, diag = self.system_operator(springs)
         X0 = 2 * P - Pp  # linear extrapolation as the starting guess
-        Pn, info = pcg(apply, rhs, diag, X0=X0, tol=self.tol)
+        if self._E is None:
+            apply, diag = self.system_operator(springs)
+            Pn, info = pcg(apply, rhs, diag, X0=X0, tol=self.tol)
+        else:
+            apply, diag = self._reduced_operator(springs)
+            E = self._E
+            Y, info = pcg(apply, np.asarray(E.T @ rhs), diag, X0=X0[self._first], tol=self.tol)
+            Pn = np.asarray(E @ Y)
         if not info["residual"] <= 10 * self.tol:
             warnings.warn(f"CG stopped at relative residual {info['residual']:.2e} > {self.tol:.1e} "
                           f"after {info['iterations']} iterations", RuntimeWarning, stacklevel=2)
