@@ -445,7 +445,8 @@ def subdivide_control(mesh: QuadMesh) -> QuadMesh:
     Returns
     -------
     QuadMesh or TaggedQuadMesh
-        Child ``4 f + i`` at corner ``i`` of face ``f`` (:func:`ccproof.mesh.child_faces`).
+        Child ``4 f + i`` at corner ``i`` of face ``f`` (:func:`ccproof.mesh.child_faces`); a
+        ``file_vertex`` labelling carried to the children (:func:`copy_labels`).
 
     Examples
     --------
@@ -460,8 +461,15 @@ def subdivide_control(mesh: QuadMesh) -> QuadMesh:
     if not isinstance(mesh, TaggedQuadMesh):
         return subdivide(mesh)
     S, creases, corners = tagged_step(mesh)
-    return TaggedQuadMesh(S @ mesh.vertices, child_faces(mesh), creases=creases, corners=corners,
-                          holes=np.flatnonzero(np.repeat(mesh.hole, 4)))
+    child = TaggedQuadMesh(S @ mesh.vertices, child_faces(mesh), creases=creases, corners=corners,
+                           holes=np.flatnonzero(np.repeat(mesh.hole, 4)))
+    lab = getattr(mesh, "file_vertex", None)
+    if lab is not None:  # the children of the copies that are one vertex of the refined file
+        import scipy.sparse as sp
+
+        E = sp.csr_matrix((np.ones(lab.size), (np.arange(lab.size), lab)))
+        child.file_vertex = copy_labels(S @ E, kinds=(mesh.n_vertices, mesh.n_vertices + mesh.n_edges))
+    return child
 
 
 def _sharpest_semi_sharp(poly):

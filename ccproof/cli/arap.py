@@ -33,7 +33,8 @@ vertices) and non-manifold edges and vertices (infinitely sharp, as OpenSubdiv m
 OpenSubdiv's rules on every level; with the Chaikin crease method a semi-sharp tag (sharpness s < 10) is
 resolved by ceil(s) global Catmull-Clark steps first (refused by name beyond 200,000 faces); hole faces
 belong to no chart. --control-out on such a mesh writes the control mesh the UVs belong to (the quads above,
-subdivided as the UVs need, non-manifold vertices split) with its creases, corners and holes as OpenSubdiv's
+subdivided as the UVs need, a non-manifold vertex's split copies written as one vertex: without a subdivision
+the file's vertices in its numbering) with its creases, corners and holes as OpenSubdiv's
 OBJ tag lines ('t crease 2/1/0 a b s', 't corner 1/1/0 v s', 't hole k/0/0 f ...'; 0-based, infinitely sharp
 as 10): reading it back (ccproof eval, OpenSubdiv) gives the same tags and the same limit surface.
 

@@ -9,8 +9,9 @@ file eval reads. --init: any mesh eval reads; triangles and n-gons are subdivide
 quads first (the same limit surface); unused vertices are dropped; OpenSubdiv tags (infinitely sharp and
 semi-sharp creases and corners, holes, boundary modes) and non-manifold edges and vertices (infinitely
 sharp) are kept: faces near them are tagged elements whose surface is the one `ccproof eval` evaluates
-(hole faces carry no patch; the fitted OBJ keeps the tags as `t` lines). The model
-starts as the paper's 98-vertex mesh (the cube subdivided twice) inside the data, evolves under data
+(hole faces carry no patch; the fitted OBJ keeps the tags as `t` lines); the copies of a non-manifold
+vertex (one per fan) move as one point and are written as one vertex (an all-quad file at --levels 0: its
+own vertices and faces, in its numbering). The model starts as the paper's 98-vertex mesh (the cube subdivided twice) inside the data, evolves under data
 springs (every point pulls its nearest limit-surface point) with the massless implicit scheme (32) to
 equilibrium (the relative changes of the total energy and of the mean data -> surface distance over two
 steps both <= --tol; --max-steps is a safety cap), is subdivided once (386 vertices) and refitted. Each

@@ -147,6 +147,14 @@ def write_uv_obj(path, mesh, result, comment=None, table=None, transforms=None, 
         base += uv.shape[0]
     from ccproof.mesh.io import atomic_path, obj_tag_lines
 
+    tag_lines = obj_tag_lines(mesh)
+    lab = getattr(mesh, "file_vertex", None)
+    if lab is not None:  # a non-manifold file's split mesh: its copies written as one vertex (the file's numbering)
+        from ccproof.apps.control_mesh import merged_copies
+
+        V, F, tag_lines = merged_copies(mesh, lab)
+        for ch in charts_json:
+            ch["vertices"] = lab[np.asarray(ch["vertices"], dtype=np.int64)].tolist()
     with atomic_path(path) as tmp, open(tmp, "w", encoding="utf-8") as fh:
         for c in (comment or "").splitlines():
             fh.write(f"# {c}\n")
@@ -160,7 +168,7 @@ def write_uv_obj(path, mesh, result, comment=None, table=None, transforms=None, 
                 fh.write("f " + " ".join(f"{a + 1}/{b + 1}" for a, b in zip(F[f], face_vt[f])) + "\n")
             else:
                 fh.write("f " + " ".join(str(a + 1) for a in F[f]) + "\n")
-        fh.writelines(obj_tag_lines(mesh))
+        fh.writelines(tag_lines)
     side = path + ".json"
     with atomic_path(side) as tmp, open(tmp, "w", encoding="utf-8") as fh:
         json.dump({"method": result.method, "rules": {r: RULE_TEXT[r] for r in {t.rules for t in texs}},
