@@ -44,7 +44,7 @@ INFINITE = 10.0
 
 __all__ = ["read_control_mesh", "children_labels", "TaggedQuadMesh", "tagged_step", "subdivide_control",
            "refuse_tags", "edge_values", "vertex_rules", "moving_limit_rows", "MAX_TAGGED_FACES", "copy_labels",
-           "merged_copies", "write_control_obj"]
+           "merged_copies", "merge_labels", "write_control_obj"]
 
 #: most faces the global tagged steps of :func:`read_control_mesh` may make (Python rules: ~50 us a face)
 MAX_TAGGED_FACES = 200_000
@@ -726,10 +726,31 @@ def merged_copies(mesh, file_vertex):
     return V, F, lines
 
 
+def merge_labels(mesh):
+    """The ``file_vertex`` labels a writer merges a control mesh's copies by, or None (write it as it is).
+
+    None also when a merged face would repeat a vertex (a file with degenerate faces, e.g. an edge collapsed to a
+    point: its split mesh, read back, is not split the same way again); such a mesh is written split.
+
+    Parameters
+    ----------
+    mesh : QuadMesh or TaggedQuadMesh
+
+    Returns
+    -------
+    ndarray of int64, shape (n,), or None
+    """
+    lab = getattr(mesh, "file_vertex", None)
+    if lab is None:
+        return None
+    F = np.sort(lab[np.asarray(mesh.faces)], axis=1)
+    return None if (F[:, 1:] == F[:, :-1]).any() else lab
+
+
 def write_control_obj(path, mesh, *, comment=None):
     """Write a control mesh as OBJ (:func:`ccproof.mesh.write_obj`), its copies merged
-    (:func:`merged_copies`) when it has a ``file_vertex`` labelling: a non-manifold file's fitted mesh gets
-    the file's vertices and faces back.
+    (:func:`merged_copies`) when it has a ``file_vertex`` labelling (:func:`merge_labels`): a non-manifold
+    file's fitted mesh gets the file's vertices and faces back.
 
     Parameters
     ----------
@@ -743,7 +764,7 @@ def write_control_obj(path, mesh, *, comment=None):
     """
     from ccproof.mesh import write_obj
 
-    lab = getattr(mesh, "file_vertex", None)
+    lab = merge_labels(mesh)
     if lab is None:
         write_obj(path, mesh, comment=comment)
         return

@@ -4,21 +4,21 @@
   ccproof fit scan.ply --levels 2 --out fitted.obj        two global subdivisions after the first fit
   ccproof fit bunny.obj --init start.ply --out fit.obj    start from your own closed control mesh
 
-POINTS: .xyz (x y z per line), .ply (vertex x, y, z; ASCII or binary), .obj or the vertices of any mesh
-file eval reads. --init: any mesh eval reads; triangles and n-gons are subdivided once (Catmull-Clark) to
-quads first (the same limit surface); unused vertices are dropped; OpenSubdiv tags (infinitely sharp and
-semi-sharp creases and corners, holes, boundary modes) and non-manifold edges and vertices (infinitely
-sharp) are kept: faces near them are tagged elements whose surface is the one `ccproof eval` evaluates
-(hole faces carry no patch; the fitted OBJ keeps the tags as `t` lines); the copies of a non-manifold
-vertex (one per fan) move as one point and are written as one vertex (an all-quad file at --levels 0: its
-own vertices and faces, in its numbering). The model starts as the paper's 98-vertex mesh (the cube subdivided twice) inside the data, evolves under data
-springs (every point pulls its nearest limit-surface point) with the massless implicit scheme (32) to
-equilibrium (the relative changes of the total energy and of the mean data -> surface distance over two
-steps both <= --tol; --max-steps is a safety cap), is subdivided once (386 vertices) and refitted. Each
-level says why it stopped. Printed per level: control vertices, time
-steps, the paper's fit error (the largest distance of a data point to the limit surface, in % of the
-diameter of the smallest enclosing sphere, Welzl) and the mean distance in the same unit. All material
-parameters are in units where that diameter is 1 and the data springs sum to --spring.
+POINTS: .xyz (x y z per line), .ply (vertex x, y, z; ASCII or binary), .obj or the vertices of any mesh file
+eval reads. --init: any mesh eval reads; triangles and n-gons are subdivided once (Catmull-Clark) to quads
+first (the same limit surface); unused vertices are dropped; OpenSubdiv tags (infinitely sharp and semi-sharp
+creases and corners, holes, boundary modes) and non-manifold edges and vertices (infinitely sharp) are kept:
+faces near them are tagged elements whose surface is the one `ccproof eval` evaluates (hole faces carry no
+patch; the fitted OBJ keeps the tags as `t` lines); the copies of a non-manifold vertex (one per fan) move as
+one point and are written as one vertex (an all-quad file at --levels 0: its own vertices and faces, in its
+numbering). The model starts as the paper's 98-vertex mesh (the cube subdivided twice) inside the data,
+evolves under data springs (every point pulls its nearest limit-surface point) with the massless implicit
+scheme (32) to equilibrium (the relative changes of the total energy and of the mean data -> surface distance
+over two steps both <= --tol; --max-steps is a safety cap), is subdivided once (386 vertices) and refitted.
+Each level says why it stopped. Printed per level: control vertices, time steps, the paper's fit error (the
+largest distance of a data point to the limit surface, in % of the diameter of the smallest enclosing sphere,
+Welzl) and the mean distance in the same unit. All material parameters are in units where that diameter is 1
+and the data springs sum to --spring.
 
 The other direction is reported too: the limit surface sampled at --sample-level (written to
 --surface-out, default OUT with "_limit" before the extension) and the distance of every sample to its
@@ -81,7 +81,7 @@ def run(args) -> int:
     check_outputs(args, out=(".obj",), surface_out="mesh", errors=(".csv",))  # before any work
     import numpy as np
 
-    from ccproof.apps.control_mesh import read_control_mesh, write_control_obj
+    from ccproof.apps.control_mesh import merge_labels, read_control_mesh, write_control_obj
     from ccproof.apps.dynamics.fit import fit_points, read_points
     from ccproof.apps.dynamics.model import Material
     from ccproof.cli._notice import compile_notice
@@ -126,7 +126,7 @@ def run(args) -> int:
     print(f"two-sided (Hausdorff) error: {res.two_sided_error_percent:.3f} % of the enclosing-sphere diameter")
     for w in res.warnings:
         print(f"ccproof fit: warning: {w}", file=sys.stderr)
-    fv = getattr(res.mesh, "file_vertex", None)  # a non-manifold --init: its copies written as one vertex
+    fv = merge_labels(res.mesh)  # a non-manifold --init: its copies written as one vertex
     n_written = res.mesh.n_vertices if fv is None else int(fv.max()) + 1
     comment = (f"ccproof fit {Path(args.points).name}: {n_written} control vertices, max error "
                f"{res.max_error_percent:.3f} %, two-sided {res.two_sided_error_percent:.3f} % of the "

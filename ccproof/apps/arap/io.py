@@ -148,9 +148,10 @@ def write_uv_obj(path, mesh, result, comment=None, table=None, transforms=None, 
     from ccproof.mesh.io import atomic_path, obj_tag_lines
 
     tag_lines = obj_tag_lines(mesh)
-    lab = getattr(mesh, "file_vertex", None)
+    from ccproof.apps.control_mesh import merge_labels, merged_copies
+
+    lab = merge_labels(mesh)
     if lab is not None:  # a non-manifold file's split mesh: its copies written as one vertex (the file's numbering)
-        from ccproof.apps.control_mesh import merged_copies
 
         V, F, tag_lines = merged_copies(mesh, lab)
         for ch in charts_json:

@@ -44,7 +44,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ccproof.apps.control_mesh import TaggedQuadMesh, copy_labels
+from ccproof.apps.control_mesh import TaggedQuadMesh
 from ccproof.apps.dynamics.forces import ModelClosestPoints, Springs, check_points
 from ccproof.apps.dynamics.integrate import ImplicitIntegrator
 from ccproof.apps.dynamics.meshes import paper_initial_model
@@ -788,14 +788,10 @@ def fit_points(X: ArrayLike, init: Literal["cube"] | QuadMesh = "cube", levels: 
                                           err["max_percent"], err["mean_percent"], time.perf_counter() - t0, cg,
                                           energies[-1] if energies else math.nan, change, err_change, reason))
             if level < levels:
-                coarse = model.mesh
                 model, A = model.refine(P)
                 P = np.asarray(A @ P)
                 if copies is not None:  # the children of the copies that are one point of the refined file
-                    import scipy.sparse as sp
-
-                    E = sp.csr_matrix((np.ones(copies.size), (np.arange(copies.size), copies)))
-                    copies = copy_labels(A @ E, kinds=(coarse.n_vertices, coarse.n_vertices + coarse.n_edges))
+                    copies = model.mesh.file_vertex  # (subdivide_control: copy_labels)
     finally:
         if bar is not None:
             bar.close()
