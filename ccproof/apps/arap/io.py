@@ -80,8 +80,10 @@ def write_uv_obj(path, mesh, result, comment=None, table=None, transforms=None, 
 
     ``transforms`` (list of (R, t) per chart) and ``scale``: the packing of
     :func:`~ccproof.apps.arap.export.pack_charts` (texture point ``scale * (uv @ R.T + t)``).
-    The OBJ of ``ccproof arap`` (docs/hsh10.md); a tagged mesh's tags as ``t`` lines. Both files are written
-    atomically (a temporary file in the same folder, then ``os.replace``).
+    The OBJ of ``ccproof arap`` (docs/hsh10.md); a tagged mesh's tags as ``t`` lines; a non-manifold file's
+    split copies of a vertex as one vertex (:func:`~ccproof.apps.control_mesh.merge_labels`; the sidecar's chart
+    ``vertices`` in that numbering). Both files are written atomically (a temporary file in the same folder,
+    then ``os.replace``).
 
     Parameters
     ----------
@@ -145,14 +147,12 @@ def write_uv_obj(path, mesh, result, comment=None, table=None, transforms=None, 
             }
         )
         base += uv.shape[0]
+    from ccproof.apps.control_mesh import merge_labels, merged_copies
     from ccproof.mesh.io import atomic_path, obj_tag_lines
 
     tag_lines = obj_tag_lines(mesh)
-    from ccproof.apps.control_mesh import merge_labels, merged_copies
-
     lab = merge_labels(mesh)
     if lab is not None:  # a non-manifold file's split mesh: its copies written as one vertex (the file's numbering)
-
         V, F, tag_lines = merged_copies(mesh, lab)
         for ch in charts_json:
             ch["vertices"] = lab[np.asarray(ch["vertices"], dtype=np.int64)].tolist()
