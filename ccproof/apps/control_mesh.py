@@ -739,6 +739,22 @@ def merge_labels(mesh):
     Returns
     -------
     ndarray of int64, shape (n,), or None
+
+    Examples
+    --------
+    Two quads sharing only vertex 0 (split into copies 0 and 4); a labelling that would merge two corners of
+    one face is refused:
+
+    >>> t = TaggedQuadMesh([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 0], [-1, 0, 0], [-1, -1, 0],
+    ...                     [0, -1, 0]], [[0, 1, 2, 3], [4, 5, 6, 7]])
+    >>> merge_labels(t) is None
+    True
+    >>> t.file_vertex = np.array([0, 1, 2, 3, 0, 4, 5, 6])
+    >>> merge_labels(t).tolist()
+    [0, 1, 2, 3, 0, 4, 5, 6]
+    >>> t.file_vertex = np.array([0, 1, 2, 0, 3, 4, 5, 6])
+    >>> merge_labels(t) is None
+    True
     """
     lab = getattr(mesh, "file_vertex", None)
     if lab is None:
