@@ -228,7 +228,7 @@ class HalfEdges:
         half-edge) is ``(org h, n + k(h), n + E + f(h), n + k(prv h))``, its half-edges ``4 h + j``.
         Twins follow from the parent's (``4 h`` and ``4 nxt(twin h) + 3``, ``4 h + 1`` and
         ``4 nxt(h) + 2``); the child's edges are the halves ``(v, n + k)`` of the parent's, sorted by
-        vertex then edge (one sort of 2E keys), then the ``(n + k, n + E + f)``, which come sorted.
+        vertex then edge (one stable sort of the 2E ends), then the ``(n + k, n + E + f)``, which come sorted.
 
         Parameters
         ----------
@@ -276,26 +276,25 @@ class HalfEdges:
                           np.where(tp >= 0, 4 * tp, -1)], axis=1)
         del t, tp
         # edges of the first kind: (v, n + k), v an end of parent edge k; sorted by (v, k)
-        a, b = org[h1], org[nxt[h1]]
-        ends = np.r_[a, b]
-        kk = np.r_[np.arange(E, dtype=np.int64), np.arange(E, dtype=np.int64)]
-        order = np.argsort(ends * E + kk)  # (distinct keys: no degenerate edge on a manifold mesh)
+        ends = np.stack([org[h1], org[nxt[h1]]], axis=1).reshape(-1)  # item 2 k + s: end s of edge k
+        order = np.argsort(ends, kind="stable")  # by vertex, then (stable) by edge
         rank1 = np.empty(2 * E, dtype=np.int64)
         rank1[order] = np.arange(2 * E, dtype=np.int64)
+        a_end, b_end = rank1[0::2], rank1[1::2]  # the child edge (a_k, n + k), and (b_k, n + k)
         # edges of the second kind: (n + k, n + E + f), by k then f (the faces' order is their half-edges')
         start2 = 2 * E + np.r_[0, np.cumsum(cnt_k)[:-1]].astype(np.int64)
         ex2 = start2[se] + ~is_first  # the second kind of edge through the edge point of h, in h's face
         p = prv
-        cedge = np.stack([np.where(is_first, rank1[se], rank1[E + se]), ex2, ex2[p],
-                          np.where(is_first[p], rank1[E + se[p]], rank1[se[p]])], axis=1)
+        cedge = np.stack([np.where(is_first, a_end[se], b_end[se]), ex2, ex2[p],
+                          np.where(is_first[p], b_end[se[p]], a_end[se[p]])], axis=1)
         E1 = 2 * E + H
         edges = np.empty((E1, 2), dtype=np.int64)
         edges[:2 * E, 0] = ends[order]
-        edges[:2 * E, 1] = n + kk[order]
+        edges[:2 * E, 1] = n + order // 2
         edges[cedge[:, 1], 0] = n + se
         edges[cedge[:, 1], 1] = n + E + face
         efc = np.full(E1, 2, dtype=np.int64)
-        efc[:2 * E] = cnt_k[kk[order]]
+        efc[:2 * E] = cnt_k[order // 2]
         eh = np.full(E1, 4 * H, dtype=np.int64)
         for j in range(4):  # (an edge has at most one half-edge of each column j: distinct indices)
             col = cedge[:, j]
