@@ -232,7 +232,8 @@ class PolyMesh:
         fan (``orderVertexFacesAndEdges``). Twins exist only across manifold edges.
 
         ``he``: the untagged half-edges of these faces under these options, built elsewhere (a
-        :class:`~ccproof.mesh.QuadMesh`'s, :func:`~ccproof.mesh.quadmesh.shared_halfedges`), shared; built here
+        :class:`~ccproof.mesh.QuadMesh`'s, :func:`~ccproof.mesh.quadmesh.shared_halfedges`, or derived from the parent's
+        by :meth:`refine`: :meth:`HalfEdges.refined <ccproof.mesh.halfedges.HalfEdges.refined>`), shared; built here
         when None (or when they do not match).
         """
         n = self.vertices.shape[0]
