@@ -26,7 +26,10 @@ catmark_cubes_infsharp at levels 0 and 2, and ``subdivision_matrix`` of the Quad
 ``--tri-levels`` - 1 refined once; a worker times ``--reps`` calls of each and keeps the fastest, and in
 the first round measures the tracemalloc peak of one more call. Printed per mesh: the times of both trees
 (min / median over the rounds), new / old per round (min, median, max), the peaks; the children (and
-matrices) of the two trees are compared bit for bit first (it stops otherwise).
+matrices) of the two trees are compared bit for bit first (it stops otherwise). The workers get glibc's
+``MALLOC_*`` environment variables (e.g. ``MALLOC_MMAP_THRESHOLD_=1073741824``: the cases run in one process, and
+by default the large arrays a case frees raise glibc's mmap threshold for the next one, whose time then
+depends on what ran before it).
 """
 
 from __future__ import annotations
@@ -194,6 +197,9 @@ def _worker(tree, tri, reps, memory):
                        ("TRI", tri), ("REPS", reps), ("MEMORY", memory)):
         code = code.replace(f"__{key}__", repr(value))
     env = {"PYTHONPATH": str(tree), "PATH": "/usr/bin:/bin", "HOME": str(Path.home())}
+    # glibc's allocator settings passed on (e.g. MALLOC_MMAP_THRESHOLD_: a fixed threshold, so that what a case
+    # frees does not change how the next one's large arrays are allocated)
+    env.update({k: v for k, v in os.environ.items() if k.startswith("MALLOC_")})
     p = subprocess.run([sys.executable, "-c", code], cwd=tree, env=env, capture_output=True, text=True)
     if p.returncode:
         raise SystemExit(f"the worker in {tree} failed:\n{p.stderr}")

@@ -2,8 +2,9 @@
 """``HalfEdges`` constructions of one ``ccproof arap`` or ``ccproof fit`` run, with the options of
 tests/test_cli_topology_builds.py: how many, how many distinct topologies, how many built again.
 
-``HalfEdges.__init__`` is wrapped (views are no constructions) and each construction's topology recorded
-(vertex count, ``org``, ``offsets``). Run it with ``PYTHONPATH`` at the source tree to count (an old tree from
+``HalfEdges.__init__`` and ``HalfEdges.refined`` (where the tree has it: a refined mesh's topology derived
+from its parent's) are wrapped (views are no constructions) and each construction's topology recorded (vertex
+count, ``org``, ``offsets``). Run it with ``PYTHONPATH`` at the source tree to count (an old tree from
 ``git archive`` for the counts before a change).
 
 Usage: python scripts/count_topology_builds.py {arap,fit} MESH
@@ -30,6 +31,15 @@ def main():
         seen.append((self.n_vertices, np.asarray(self.org).tobytes(), np.asarray(self.offsets).tobytes()))
 
     HalfEdges.__init__ = counted
+    if hasattr(HalfEdges, "refined"):  # a refined mesh's topology derived from its parent's: a construction too
+        refined = HalfEdges.refined.__func__
+
+        def counted_refined(cls, *a, **k):
+            he = refined(cls, *a, **k)
+            seen.append((he.n_vertices, np.asarray(he.org).tobytes(), np.asarray(he.offsets).tobytes()))
+            return he
+
+        HalfEdges.refined = classmethod(counted_refined)
     from ccproof.apps.dynamics.shapes import synthetic_range_data
     from ccproof.cli import main as cli
 

@@ -1,9 +1,10 @@
 """Every command builds the topology of its mesh once: ``HalfEdges`` constructions counted per command.
 
-A counter wraps :meth:`ccproof.mesh.halfedges.HalfEdges.__init__` (views made by ``with_tags`` or
-``TaggedHalfEdges.of`` share the arrays and are not constructions) and records the topology of every
-construction (vertex count, face corners, offsets). The file's topology (read from the OBJ text here, not by
-ccproof) must be built exactly once per command, and so must the all-quad control mesh of ``arap`` and
+A counter wraps :meth:`ccproof.mesh.halfedges.HalfEdges.__init__` and
+:meth:`~ccproof.mesh.halfedges.HalfEdges.refined` (a refined mesh's topology derived from its parent's; views
+made by ``with_tags`` or ``TaggedHalfEdges.of`` share the arrays and are not constructions) and records the
+topology of every construction (vertex count, face corners, offsets). The file's topology (read from the OBJ
+text here, not by ccproof) must be built exactly once per command, and so must the all-quad control mesh of ``arap`` and
 ``fit`` (the level-1 mesh of a triangle mesh: a new mesh, +1). ``eval`` and ``project`` build nothing else
 (a triangle mesh: +1, the evaluator's level-1 step). Before sharing, a quad mesh's topology was built twice
 by eval and project (a PolyMesh, then a QuadMesh of the same faces); the counts are in docs/evaluate.md.
@@ -53,6 +54,14 @@ def builds(monkeypatch):
         seen.append(_key(self.n_vertices, self.org, self.offsets))
 
     monkeypatch.setattr(HalfEdges, "__init__", counted)
+    refined = HalfEdges.refined.__func__
+
+    def counted_refined(cls, *args, **kwargs):  # a refined mesh's topology derived from its parent's: built too
+        he = refined(cls, *args, **kwargs)
+        seen.append(_key(he.n_vertices, he.org, he.offsets))
+        return he
+
+    monkeypatch.setattr(HalfEdges, "refined", classmethod(counted_refined))
     from ccproof.apps.arap import charts
     from ccproof.apps.dynamics import tagged
 

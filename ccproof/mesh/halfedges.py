@@ -216,6 +216,127 @@ class HalfEdges:
         F = np.asarray(faces, dtype=np.int64).reshape(-1, 4)
         return cls(F.reshape(-1), 4 * np.arange(F.shape[0] + 1, dtype=np.int64), n_vertices, options, edges)
 
+    @classmethod
+    def refined(cls, parent, options=None):
+        """The half-edges of the all-quad child of one Catmull-Clark step of ``parent``, derived from its
+        arrays (OpenSubdiv's ``Vtr::QuadRefinement``), equal to those paired from the child's faces.
+
+        The child is the one of :meth:`ccproof.mesh.polymesh.PolyMesh.refine`
+        (:func:`ccproof.mesh.step.catmark_operator`'s layout): vertex ``v < n`` the vertex point of v,
+        ``n + k`` the edge point of edge k numbered by first occurrence (the order of the edges'
+        smallest half-edges), ``n + E + f`` the face point of face f; child face ``h`` (a parent
+        half-edge) is ``(org h, n + k(h), n + E + f(h), n + k(prv h))``, its half-edges ``4 h + j``.
+        Twins follow from the parent's (``4 h`` and ``4 nxt(twin h) + 3``, ``4 h + 1`` and
+        ``4 nxt(h) + 2``); the child's edges are the halves ``(v, n + k)`` of the parent's, sorted by
+        vertex then edge (one stable sort of the 2E ends), then the ``(n + k, n + E + f)``, which come sorted.
+
+        Parameters
+        ----------
+        parent : HalfEdges
+            A manifold mesh's: every edge with one or two faces in opposite directions, one fan at
+            every vertex (ValueError otherwise: pair the child's faces instead).
+        options : ccproof.mesh.rules.Options, optional
+            The child's options (``parent.options`` when None).
+
+        Returns
+        -------
+        HalfEdges
+            Untagged (the caller adds the child's tags with :meth:`with_tags`).
+
+        Examples
+        --------
+        >>> p = HalfEdges([0, 1, 4, 3, 1, 2, 5, 4], [0, 4, 8], 6)
+        >>> c = HalfEdges.refined(p)
+        >>> q = HalfEdges(c.org, c.offsets, c.n_vertices)
+        >>> all(np.array_equal(getattr(c, a), getattr(q, a)) for a in ("twin", "edges", "edge_of", "fan_of_corner"))
+        True
+        """
+        if not parent.edge_manifold or (parent.n_fans > 1).any():
+            raise ValueError("HalfEdges.refined: the parent is not manifold")
+        n, H, m = parent.n_vertices, parent.org.size, parent.sizes.size
+        org, nxt, prv, twin = parent.org, parent.nxt, parent.prv, parent.twin
+        first, cnt = parent.edge_halfedge, parent.edge_face_count
+        E = first.size
+        h = np.arange(H, dtype=np.int64)
+        # the edges numbered by first occurrence (catmark_operator's numbering): k = rank of the smallest half-edge
+        is_first = np.zeros(H, dtype=bool)
+        is_first[first] = True
+        renum = (np.cumsum(is_first) - 1)[first]
+        se = renum[parent.edge_of]  # (H,): the step's edge of every half-edge
+        h1 = np.empty(E, dtype=np.int64)
+        h1[renum] = first
+        cnt_k = np.empty(E, dtype=np.int64)
+        cnt_k[renum] = cnt
+        N = n + E + m
+        face = h // parent.uniform if parent.uniform else parent.face_of
+        corg = np.stack([org, n + se, n + E + face, n + se[prv]], axis=1)
+        # twins: across the parent's edges (the halves at org h) and inside the parent's face
+        t, tp = twin, twin[prv]
+        ctwin = np.stack([np.where(t >= 0, 4 * nxt[np.maximum(t, 0)] + 3, -1), 4 * nxt + 2, 4 * prv + 1,
+                          np.where(tp >= 0, 4 * tp, -1)], axis=1)
+        del t, tp
+        # edges of the first kind: (v, n + k), v an end of parent edge k; sorted by (v, k)
+        ends = np.stack([org[h1], org[nxt[h1]]], axis=1).reshape(-1)  # item 2 k + s: end s of edge k
+        order = np.argsort(ends, kind="stable")  # by vertex, then (stable) by edge
+        rank1 = np.empty(2 * E, dtype=np.int64)
+        rank1[order] = np.arange(2 * E, dtype=np.int64)
+        a_end, b_end = rank1[0::2], rank1[1::2]  # the child edge (a_k, n + k), and (b_k, n + k)
+        # edges of the second kind: (n + k, n + E + f), by k then f (the faces' order is their half-edges')
+        start2 = 2 * E + np.r_[0, np.cumsum(cnt_k)[:-1]].astype(np.int64)
+        ex2 = start2[se] + ~is_first  # the second kind of edge through the edge point of h, in h's face
+        p = prv
+        cedge = np.stack([np.where(is_first, a_end[se], b_end[se]), ex2, ex2[p],
+                          np.where(is_first[p], b_end[se[p]], a_end[se[p]])], axis=1)
+        E1 = 2 * E + H
+        edges = np.empty((E1, 2), dtype=np.int64)
+        edges[:2 * E, 0] = ends[order]
+        edges[:2 * E, 1] = n + order // 2
+        edges[cedge[:, 1], 0] = n + se
+        edges[cedge[:, 1], 1] = n + E + face
+        efc = np.full(E1, 2, dtype=np.int64)
+        efc[:2 * E] = cnt_k[order // 2]
+        eh = np.full(E1, 4 * H, dtype=np.int64)
+        for j in range(4):  # (an edge has at most one half-edge of each column j: distinct indices)
+            col = cedge[:, j]
+            eh[col] = np.minimum(eh[col], 4 * h + j)
+        # fans: one per child vertex (a manifold parent's child is manifold), numbered by smallest corner
+        mc = np.full(N, 4 * H, dtype=np.int64)
+        pmin = np.full(n, H, dtype=np.int64)
+        np.minimum.at(pmin, org, h)
+        used = pmin < H
+        mc[:n][used] = 4 * pmin[used]
+        ek = np.minimum(4 * h1 + 1, 4 * nxt[h1] + 3)
+        two = cnt_k == 2
+        h2 = np.where(two, twin[h1], 0)
+        mc[n:n + E] = np.where(two, np.minimum(ek, np.minimum(4 * h2 + 1, 4 * nxt[h2] + 3)), ek)
+        mc[n + E:] = 4 * parent.start + 2
+        first_c = np.zeros(4 * H, dtype=bool)
+        first_c[mc[mc < 4 * H]] = True
+        label = np.cumsum(first_c) - 1
+        corg = corg.reshape(-1)
+        new = object.__new__(cls)
+        new.n_vertices = N
+        new.offsets = 4 * np.arange(H + 1, dtype=np.int64)
+        new.sizes = np.full(H, 4, dtype=np.int64)
+        new.start = new.offsets[:-1]
+        new.org = corg
+        new.options = parent.options if options is None else options
+        new.uniform = 4 if H else 0
+        loc = np.arange(4 * H, dtype=np.int64) % 4
+        new.nxt = np.arange(4 * H, dtype=np.int64) + np.where(loc == 3, -3, 1)
+        new.prv = np.arange(4 * H, dtype=np.int64) + np.where(loc == 0, 3, -1)
+        new.twin = ctwin.reshape(-1)
+        new.edge_manifold = True
+        new.__dict__["_pairing"] = {"twin": new.twin, "edge_of": cedge.reshape(-1), "edges": edges,
+                                    "edge_face_count": efc, "edge_halfedge": eh,
+                                    "same": np.zeros(0, dtype=np.int64)}
+        new.__dict__["repeat_edge"] = np.zeros(E1, dtype=bool)
+        new.__dict__["fan_of_corner"] = label[mc[corg]]
+        new.edge_keys = np.zeros(0, dtype=np.int64)
+        new.edge_values = np.zeros(0, dtype=np.float64)
+        new.vertex_values = None
+        return new
+
     # ------------------------------------------------------------------ tags
     def with_tags(self, edge_sharpness=None, vertex_sharpness=None, vertex_values=None):
         """The same arrays (shared, not copied) with the tags of ``edge_sharpness`` (dict ``{(a, b): s}``)

@@ -232,7 +232,8 @@ class PolyMesh:
         fan (``orderVertexFacesAndEdges``). Twins exist only across manifold edges.
 
         ``he``: the untagged half-edges of these faces under these options, built elsewhere (a
-        :class:`~ccproof.mesh.QuadMesh`'s, :func:`~ccproof.mesh.quadmesh.shared_halfedges`), shared; built here
+        :class:`~ccproof.mesh.QuadMesh`'s, :func:`~ccproof.mesh.quadmesh.shared_halfedges`, or derived from the parent's
+        by :meth:`refine`: :meth:`HalfEdges.refined <ccproof.mesh.halfedges.HalfEdges.refined>`), shared; built here
         when None (or when they do not match).
         """
         n = self.vertices.shape[0]
@@ -665,9 +666,13 @@ class PolyMesh:
             cvs[unused] = _decrement(vs)
         sharp_v = np.flatnonzero(cvs > 0)
         pairs, ces = st.child_creases
+        he = self.halfedges
+        # the child's topology derived from this mesh's (no pairing of the child's half-edges); paired
+        # again by the constructor when this mesh's half-edges are anything unusual
+        child_he = HalfEdges.refined(he, self.options) if he.edge_manifold and self.is_manifold else None
         m = PolyMesh(V1, st.faces, creases=(pairs, ces) if ces.size else None,
                      corners=(sharp_v, cvs[sharp_v]) if sharp_v.size else None,
-                     holes=np.flatnonzero(st.child_holes), options=self.options)
+                     holes=np.flatnonzero(st.child_holes), options=self.options, _halfedges=child_he)
         m.level = self.level + 1
         if operator == "csr":
             return m, st.csr
