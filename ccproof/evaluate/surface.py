@@ -37,7 +37,6 @@ from ccproof.evaluate._parallel import in_blocks, threads_for
 from ccproof.evaluate._table import (
     _CORNER,
     _REGULAR,
-    _SPLIT,
     _Builder,
     _Jobs,
     catmark_step,
@@ -45,6 +44,7 @@ from ccproof.evaluate._table import (
     layer0_nets,
 )
 from ccproof.evaluate.bspline import bspline_basis
+from ccproof.evaluate.patch_map import PatchMap
 from ccproof.mesh import QuadMesh, limit_normals, limit_positions
 from ccproof.mesh.polymesh import PolyMesh
 
@@ -85,6 +85,8 @@ class LimitSurface:
         Most layers of a corner configuration (0 without corner faces).
     split_depth : int
         How many local subdivisions the most irregular face needed.
+    patch_map : ccproof.evaluate.patch_map.PatchMap
+        Locates points (face, u, v) in the patch table (OpenSubdiv ``Far::PatchMap``); :meth:`locate`.
 
     Notes
     -----
@@ -148,8 +150,9 @@ class LimitSurface:
         self.parameterizations = {}
         T = self._table
         self.split_depth = T.split_depth
-        self.n_patches = T.nets.shape[0]
-        self.max_layers = int(T.n_layers.max()) if T.n_layers.size else 0
+        self.patch_map = PatchMap(T)
+        self.n_patches = self.patch_map.n_patches
+        self.max_layers = self.patch_map.max_layers
 
     @property
     def table_bytes(self):
@@ -230,8 +233,6 @@ class LimitSurface:
         return f, u, v
 
     # ------------------------------------------------------------------ evaluation
-
-    # ------------------------------------------------------------------ evaluation
     def locate(self, face_ids, u, v):
         """The patch of every point and the point's parameter in it.
 
@@ -249,70 +250,25 @@ class LimitSurface:
         f, u, v = self._check(face_ids, u, v)
         return self._locate(f, u, v)
 
-    def _vface_of(self, f, u, v):
-        """The job of every point, the template virtual face holding it after descending the splits,
-        and that face's kind."""
-        T = self._table
-        q = (u >= 0.5).astype(np.int64) + 2 * (v >= 0.5)
-        job = T.top[f, q]
-        vf = T.job_root[job]
-        kind = T.kind[vf]
-        for _ in range(T.split_depth):
-            idx = np.flatnonzero(kind == _SPLIT)
-            if idx.size == 0:
-                break
-            w = vf[idx]
-            half = T.h[w] * 0.5
-            q = (u[idx] >= T.u0[w] + half).astype(np.int64) + 2 * (v[idx] >= T.v0[w] + half)
-            vf[idx] = T.child[w, q]
-            kind[idx] = T.kind[vf[idx]]
-        return job, vf, kind
-
-    def _corner_layer(self, vf, u, v):
-        """Layer ``n`` and patch ``code`` of points (u, v) in corner faces ``vf``, and the patch
-        domains ``(u0, v0, h)`` (exact: dyadic; bmz04 Fig. 3)."""
-        T = self._table
-        U0, V0, H = T.u0[vf], T.v0[vf], T.h[vf]
-        du = np.where(T.cu[vf], (U0 + H) - u, u - U0) / H  # exact: dyadic, Sterbenz
-        dv = np.where(T.cv[vf], (V0 + H) - v, v - V0) / H
-        mx = np.maximum(du, dv)
-        _, e = np.frexp(mx)  # mx in [2^(e-1), 2^e): layer n = -e
-        cfg = T.cfg[vf]
-        nmax = T.n_layers[cfg] - 1
-        n = np.where(mx > 0, np.clip(-e, 0, nmax), nmax)
-        du, dv = np.ldexp(du, n), np.ldexp(dv, n)
-        a, b = du >= 0.5, dv >= 0.5
-        code = np.where(a & ~b, 0, np.where(a & b, 1, np.where(b, 2, 1)))
-        unit = T.unit[cfg, code]
-        sc = np.ldexp(H, -n)
-        pu0 = unit[:, 0] * sc + np.where(T.cu[vf], U0 + H, U0)
-        pv0 = unit[:, 1] * sc + np.where(T.cv[vf], V0 + H, V0)
-        return n, code, pu0, pv0, unit[:, 2] * sc
-
     def _locate(self, f, u, v):
-        patch, s, t, g, _ = self._point_nets(f, u, v, nets=False)
-        return patch, s, t, g
+        loc = self.patch_map.locate(f, u, v)
+        return loc.patch, loc.s, loc.t, loc.scale
 
     def _point_nets(self, f, u, v, nets=True):
         """Patch ids, parameters (s, t), scales ``1 / h`` and (``nets``) the nets (n, 17, 3) of the
         points: a gather for regular patches, ``L[n, code] @ ring`` for the layers of corner faces."""
         T = self._table
-        job, vf, kind = self._vface_of(f, u, v)
-        patch = T.job_net[job] + T.leaf[vf]
-        pu0, pv0, h = T.u0[vf], T.v0[vf], T.h[vf]
+        loc = self.patch_map.locate(f, u, v)
         N = None
         if nets:
             N = np.empty((f.size, 17, 3))
-            reg = np.flatnonzero(kind == _REGULAR)
-            N[reg] = T.nets[patch[reg]]
-        idx = np.flatnonzero(kind == _CORNER)
-        if idx.size:
-            w = vf[idx]
-            n, code, pu0[idx], pv0[idx], h[idx] = self._corner_layer(w, u[idx], v[idx])
-            ci = T.job_corner[job[idx]] + T.leaf[w]
-            patch[idx] = self.n_patches + 3 * (self.max_layers * ci + n) + code
-            if nets:
-                q0 = T.job_pts[job[idx]] + T.pts[w]
+            reg = np.flatnonzero(loc.kind == _REGULAR)
+            N[reg] = T.nets[loc.patch[reg]]
+            idx = loc.corner
+            if idx.size:
+                w = loc.vface[idx]
+                n, code, ci = loc.layer, loc.code, loc.corner_face
+                q0 = T.job_pts[loc.job[idx]] + T.pts[w]
                 cfg = T.cfg[w]
                 todo = np.ones(idx.size, dtype=bool)
                 if T.hot.shape[0]:  # layer 0 precomputed (the same sums)
@@ -331,9 +287,7 @@ class LimitSurface:
                         acc += Ls[:, j, :, None] * Q[:, None, j - 1, :]
                     N[rows, :16] = acc
                     N[rows, 16] = T.origin[ci[sel]]
-        s = np.clip((u - pu0) / h, 0.0, 1.0)
-        t = np.clip((v - pv0) / h, 0.0, 1.0)
-        return patch, s, t, 1.0 / h, N
+        return loc.patch, loc.s, loc.t, loc.scale, N
 
     def evaluate(self, face_ids, u, v, derivatives=1, *, parameterization="natural", chunk=CHUNK, out=None,
                  backend=None, threads=None):
@@ -548,7 +502,7 @@ class LimitSurface:
         f, u, v = self._check(face_ids, u, v)
         r = self.evaluate(f, u, v, 1)
         N = np.cross(r["Pu"], r["Pv"])
-        job, vf, kind = self._vface_of(f, u, v)
+        job, vf, kind = self.patch_map.faces(f, u, v)
         idx = np.flatnonzero(kind == _CORNER)
         if idx.size:
             T = self._table

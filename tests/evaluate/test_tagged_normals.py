@@ -96,7 +96,7 @@ def _subdominant(S, p, c):
     from ccproof.evaluate.local import _fmpq_mat_to_float
     from ccproof.evaluate.surface import _CORNER
 
-    job, vf, kind = S._vface_of(np.array([p]), np.array([c[0]]), np.array([c[1]]))
+    job, vf, kind = S.patch_map.faces(np.array([p]), np.array([c[0]]), np.array([c[1]]))
     assert kind[0] == _CORNER
     scheme, _ = S._corner_leaf(int(job[0]), int(vf[0]))
     A = _fmpq_mat_to_float(scheme.A)
