@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import shutil
 import statistics
 import subprocess
 import sys
@@ -26,6 +25,8 @@ import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "scripts"))
+from _trees import export_revision  # noqa: E402
 
 SNIPPET = r"""
 import json, sys, time, tracemalloc
@@ -91,14 +92,9 @@ def main(argv=None):
     ap.add_argument("--rounds", type=int, default=4)
     ap.add_argument("--levels", type=int, nargs="+", default=[4, 5])
     args = ap.parse_args(argv)
-    rev = subprocess.run(["git", "rev-parse", "--short", args.before], cwd=ROOT, capture_output=True, text=True,
-                         check=True).stdout.strip()
     with tempfile.TemporaryDirectory() as tmp:
         old = Path(tmp)
-        tar = subprocess.run(["git", "archive", args.before], cwd=ROOT, capture_output=True, check=True).stdout
-        subprocess.run(["tar", "-x", "-C", str(old)], input=tar, check=True)
-        for so in (ROOT / "ccproof" / "evaluate").glob("_clib*.so"):
-            shutil.copy(so, old / "ccproof" / "evaluate" / so.name)
+        rev = export_revision(args.before, old)
         trees = {f"before ({args.before} = {rev})": old, "after (this tree)": ROOT}
         res: dict = {k: [] for k in trees}
         for i in range(args.rounds):

@@ -37,7 +37,6 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import shutil
 import statistics
 import subprocess
 import sys
@@ -48,6 +47,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _trees import export_revision  # noqa: E402
 from bench_step import _icosphere, _stats  # noqa: E402
 
 from ccproof.mesh import PolyMesh  # noqa: E402
@@ -208,15 +208,10 @@ def _worker(tree, tri, reps, memory):
 
 def before_main(a):
     """``--before``: this tree's refine against the revision's, one fresh worker per tree and round."""
-    rev = subprocess.run(["git", "rev-parse", "--short", a.before], cwd=ROOT, capture_output=True, text=True,
-                         check=True).stdout.strip()
     print(f"{os.cpu_count()} cpus; rounds {a.rounds}, {a.reps} calls per worker (the fastest kept)", flush=True)
     with tempfile.TemporaryDirectory() as tmp:
         old = Path(tmp)
-        tar = subprocess.run(["git", "archive", a.before], cwd=ROOT, capture_output=True, check=True).stdout
-        subprocess.run(["tar", "-x", "-C", str(old)], input=tar, check=True)
-        for so in (ROOT / "ccproof" / "evaluate").glob("_clib*.so"):
-            shutil.copy(so, old / "ccproof" / "evaluate" / so.name)
+        rev = export_revision(a.before, old)
         trees = {"old": old, "new": ROOT}
         res: dict = {k: [] for k in trees}
         loads = []
