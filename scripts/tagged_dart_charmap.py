@@ -87,17 +87,55 @@ import sys
 import time
 from pathlib import Path
 
-from flint import acb, acb_mat, acb_series, arb, ctx, fmpq, fmpq_mat
+from flint import acb, arb, ctx, fmpq
 
-from ccproof.certify.verify.rules import CENTRE, canonical, level1_rule
-from ccproof.certify.verify.tagged_modes import _POS, ring_stencil
-from ccproof.rigorous import BernsteinForm, bernstein_jacobian_determinant
+from ccproof.certify.verify.dart_curves import (  # noqa: F401 (re-exported for the tests)
+    coord_box,
+    coord_disc,
+    coord_taylor,
+    disc_trans,
+    layer_coord,
+    layer_trans_disc,
+    layer_trans_taylor,
+    layer_y_upper,
+    taylor_trans,
+    ymid_box,
+    ymid_zero,
+)
+from ccproof.certify.verify.dart_family import (  # noqa: F401 (re-exported for the tests)
+    PIECES,
+    Family,
+    _ball,
+    _parts,
+    bordered,
+    layer_nets,
+    piece_nets,
+)
+from ccproof.certify.verify.dart_regularity import (  # noqa: F401 (re-exported for the tests)
+    disc_bounds,
+    kdet_box,
+    layer_box,
+    layer_disc,
+    layer_taylor,
+    middle_box,
+    middle_coeffs,
+    taylor_dets,
+)
+from ccproof.certify.verify.dart_zeros import (  # noqa: F401 (re-exported for the tests)
+    exact_zeros,
+)
 
-_B2Z = ((1, 4, 1, 0), (0, 4, 2, 0), (0, 2, 4, 0), (0, 1, 4, 1))  # uniform cubic B-spline -> Bezier, times 6
-_OFFSET = {"P1": (0, -1), "P2": (0, 0), "P3": (-1, 0)}  # as tagged_map: level-1 position of net[0][0]
-PIECES = ("P1", "P2", "P3")
 # the outer curves of a quadrant's layer 0, as tagged_map/maps.STAR_CURVES: (piece, side, orientation)
-CURVES = {"P1s1": ("P1", "s", 1), "P2s1": ("P2", "s", 1), "P2t1": ("P2", "t", -1), "P3t1": ("P3", "t", -1)}
+
+
+def __getattr__(name):
+    """The family, R, T and W functions now live in the trusted base (ccproof.certify.verify.dart_*); the
+    tests and tagged_dart_zeros.py that load this script reach them through it."""
+    from ccproof.certify.verify import dart_curves, dart_family, dart_regularity, dart_zeros
+    for mod in (dart_family, dart_regularity, dart_curves, dart_zeros):
+        if hasattr(mod, name):
+            return getattr(mod, name)
+    raise AttributeError(name)
 
 
 def _limit_script():
@@ -118,367 +156,60 @@ def _zeros_script():
 
 # --- U(lam) = (lam - L0) (lam - B(1))^-1 kappa, a rational function regular at L0 ------------------
 
-def _kappa():
-    return [1 - sum(ring_stencil()[i].values()) for i in range(6)]
-
-
-def _adj_kappa_polys():
-    """N(lam) = adj(lam - B(1)) kappa as 6 exact polynomials (coefficient lists, degree <= 5), by
-    interpolation at lam = 1..6 and checked at lam = 7, 8 (B(1)'s eigenvalues are below 1)."""
-    B1 = fmpq_mat([[sum((x for (d, pos), x in ring_stencil()[i].items() if _POS[pos] == k), fmpq(0))
-                    for k in range(6)] for i in range(6)])
-    kap = fmpq_mat([[z] for z in _kappa()])
-
-    def n_at(lam):
-        M = fmpq_mat([[(lam if i == k else 0) - B1[i, k] for k in range(6)] for i in range(6)])
-        sol = M.solve(kap)
-        d = M.det()
-        return [d * sol[i, 0] for i in range(6)]
-    xs = [fmpq(i) for i in range(1, 7)]
-    vals = [n_at(x) for x in xs]
-    polys = []
-    for comp in range(6):
-        coeffs = [fmpq(0)] * 6
-        for a, xa in enumerate(xs):  # Lagrange basis, expanded
-            basis, den = [fmpq(1)], fmpq(1)
-            for b, xb in enumerate(xs):
-                if b != a:
-                    basis = [fmpq(0)] + basis
-                    for i in range(len(basis) - 1):
-                        basis[i] -= xb * basis[i + 1]
-                    den *= xa - xb
-            for i, c in enumerate(basis):
-                coeffs[i] += vals[a][comp] * c / den
-        polys.append(coeffs)
-    for x in (fmpq(7), fmpq(8)):
-        got = [sum((c * x ** i for i, c in enumerate(p)), fmpq(0)) for p in polys]
-        if got != n_at(x):
-            raise AssertionError("adj(lam - B(1)) kappa is not a polynomial of degree <= 5")
-    return polys, B1
-
-
-_NPOLY, _B1 = _adj_kappa_polys()
-
-
-def l0():
-    """L0 = lam(1) = (6 + sqrt 20)/16 and 1/(16 L0) = (6 - sqrt 20)/16 at the current precision."""
-    r = arb(20).sqrt()
-    return (6 + r) / 16, (6 - r) / 16
-
-
-def big_u(lam):
-    """U(lam) (6 values of lam's type) = adj(lam - B(1)) kappa divided by
-    (lam - 1/8)(lam - 1/16)(lam - 1/32)(lam - 1/64)(lam - 1/(16 L0))."""
-    den = (lam - fmpq(1, 8)) * (lam - fmpq(1, 16)) * (lam - fmpq(1, 32)) * (lam - fmpq(1, 64)) * (lam - l0()[1])
-    out = []
-    for p in _NPOLY:
-        acc = lam * 0
-        for c in reversed(p):
-            acc = acc * lam + c
-        out.append(acc / den)
-    return out
 
 
 
 
-def lam_of(c):
-    """lam(c) = (5 + c + sqrt((1 + c)(9 + c)))/16 (acb, arb or acb_series). On an acb ball the square root's
-    argument must lie in the right half-plane (off the principal branch's cut, so the value is analytic
-    there: the Cauchy bounds need that); ZeroDivisionError otherwise."""
-    arg = (1 + c) * (9 + c)
-    if isinstance(arg, acb) and not arg.real > 0:
-        raise ZeroDivisionError("sqrt((1 + c)(9 + c)): the argument is not certainly off the branch cut")
-    return (5 + c + arg.sqrt()) / 16
 
 
-def _block(w):
-    """B(w) (6 x 6 of w's type): entries sum x w^delta, delta in -1..2."""
-    powers = {-1: 1 / w, 0: w * 0 + 1, 1: w, 2: w * w}
-    rows = [[w * 0 for _ in range(6)] for _ in range(6)]
-    for i, row in enumerate(ring_stencil()):
-        for (d, pos), x in row.items():
-            rows[i][_POS[pos]] = rows[i][_POS[pos]] + powers[d] * x
-    return rows
 
 
-def _hvar(n):
-    """The series variable h to order n. python-flint truncates every series to ``ctx.cap`` terms (10 by
-    default) whatever its ``prec``: the callers run under :func:`series_cap` so that no order is lost."""
-    if ctx.cap < n + 1:
-        raise ValueError(f"ctx.cap = {ctx.cap} < {n + 1}: series would be truncated silently")
-    return acb_series([0, 1], prec=n + 1)
 
 
-class series_cap:
-    """Context manager: ctx.cap >= n + 1 inside (restored after)."""
-
-    def __init__(self, n):
-        self.n = n
-
-    def __enter__(self):
-        self.old = ctx.cap
-        ctx.cap = max(self.old, self.n + 1)
-
-    def __exit__(self, *exc):
-        ctx.cap = self.old
 
 
-def _coeffs(z, n):
-    c = z.coeffs()
-    return [acb(c[i]) if i < len(c) else acb(0) for i in range(n)]
 
 
-def bordered(w, lam, pivot=0):
-    """v^ (6 values of w's type): B(w) v^ = lam v^, v^[pivot] = 1, from the bordered 7 x 7 system A v = e_7.
-
-    For acb balls arb proves A regular on the whole ball (ZeroDivisionError otherwise). For power series
-    in h (acb_series) the Taylor coefficients follow from A_0 v_k = -sum_(j >= 1) A_j v_(k-j), A_0 the
-    system at h = 0 (proved regular by arb)."""
-    B = _block(w)
-    A = [[(B[i][k] - lam) if i == k else B[i][k] for k in range(6)] + [w * 0 + int(i == pivot)] for i in range(6)]
-    A.append([w * 0 + int(k == pivot) for k in range(6)] + [w * 0])
-    if not isinstance(w, acb_series):
-        sol = acb_mat(A).solve(acb_mat([[0]] * 6 + [[1]]))
-        return [sol[i, 0] for i in range(6)]
-    n = w.prec
-    Ak = [acb_mat([[_coeffs(A[i][k], n)[m] for k in range(7)] for i in range(7)]) for m in range(n)]
-    inv0 = Ak[0].inv()
-    vs = [inv0 * acb_mat([[0]] * 6 + [[1]])]
-    for m in range(1, n):
-        rhs = acb_mat(7, 1)
-        for j in range(1, m + 1):
-            rhs -= Ak[j] * vs[m - j]
-        vs.append(inv0 * rhs)
-    return [acb_series([vs[m][i, 0] for m in range(n)], prec=n) for i in range(6)]
 
 
-def _swap(pos):
-    return pos if pos[1] == 0 else (pos[1], pos[0])
 
 
-class Family:
-    """x and y of dart:K at one h (an acb ball, or the series variable: acb_series [0, 1]) and one sigma,
-    split by their dependence on s:
-
-        x = E X+ + E^-1 X-,  y = Y0 + F Y+ + F^-1 Y-,  E = e^(2 pi i s), F = e^(i sigma (2 s - 1)),
-
-    each basis part a function ``part(delta, pos)`` of the offset delta and the two-ring position (the level-0
-    value at sector K s + delta), with its centre value; analytic in h (no Re or Im: the conjugate of a mode
-    is written as the mode of 1/w with the positions (a, b) swapped).
-
-    Parameters
-    ----------
-    h : acb or acb_series
-    sigma : arb
-    flip_mode0, smooth : bool
-        controls: alpha -> -alpha (a perturbed eigenvector), alpha = 0 (no kink at the sharp ray)
-    """
-
-    def __init__(self, h, sigma, flip_mode0=False, smooth=False):
-        self.h, self.sigma = h, sigma
-        one, pi = h * 0 + 1, arb.pi()
-        self.zero = h * 0
-        self.ix, self.iy = acb(0, 2) * pi, acb(0, 2) * sigma   # w_x = e^(ix h), w_y = e^(iy h)
-        self.lam1 = lam_of((h * (2 * pi)).cos())
-        self.vx = bordered((h * self.ix).exp(), self.lam1)
-        self.lam2 = lam_of((h * (2 * sigma)).cos())
-        self.vy = bordered((h * self.iy).exp(), self.lam2)
-        self.U = big_u(self.lam2)
-        lam, L0 = self.lam2, l0()[0]
-        self.alpha = -(lam - fmpq(1, 2)) * sigma.cos() * one / ((lam - fmpq(1, 2)) * self.U[0] - (lam - L0) / 2)
-        if flip_mode0:
-            self.alpha = -self.alpha
-        self.sign = 1
-        if smooth:  # with sigma = pi: y = Re(v^ e^(2 pi i s)), the smooth valence's mode-1 cosine
-            self.alpha, self.sign = self.zero, -1
-        self.yc = self.alpha * (lam - L0)
-        self._exp = {}
-
-    def _e(self, c, k):  # e^(c k h), memoized
-        if (c, k) not in self._exp:
-            self._exp[(c, k)] = (self.h * ((self.ix if c == "x" else self.iy) * k)).exp()
-        return self._exp[(c, k)]
-
-    def parts(self):
-        """{name: (level0(delta, pos), centre, lam)} for X+, X-, Y0, Y+, Y-."""
-        i2 = acb(0, 2)
-        vx, vy = self.vx, self.vy
-
-        def eps(pos):
-            return 0 if pos[1] == 0 else 1
-        return {
-            "X+": (lambda d, p: vx[_POS[p]] * self._e("x", d) / i2, self.zero, self.lam1),
-            "X-": (lambda d, p: -vx[_POS[_swap(p)]] * self._e("x", -d - eps(p)) / i2, self.zero, self.lam1),
-            "Y0": (lambda d, p: self.alpha * self.U[_POS[p]], self.yc, self.lam2),
-            "Y+": (lambda d, p: vy[_POS[p]] * self._e("y", d) * self.sign / 2, self.zero, self.lam2),
-            "Y-": (lambda d, p: vy[_POS[_swap(p)]] * self._e("y", -d - eps(p)) * self.sign / 2, self.zero, self.lam2),
-        }
-
-    def values(self, s):
-        """(x, y): level0(delta, pos) at the quadrant K s, and the centre values (real h and s only)."""
-        E, F = acb(0, 2 * arb.pi() * s).exp(), acb(0, self.sigma * (2 * s - 1)).exp()
-        P = self.parts()
-
-        def x(d, p):
-            return (E * P["X+"][0](d, p) + P["X-"][0](d, p) / E).real
-
-        def y(d, p):
-            return (P["Y0"][0](d, p) + F * P["Y+"][0](d, p) + P["Y-"][0](d, p) / F).real
-        return x, y, acb(self.yc).real
 
 
-def local_value(level0, centre, lam, zero):
-    """``value(A, B)``: the level-1 value at position (A, B) of a bulk quadrant (no sharp ray within reach):
-    lam times the level-0 value on the two-ring (the vector is an eigenvector of every ring row), the
-    level-1 rule of :mod:`.rules` elsewhere; ``level0(delta, pos)`` the level-0 value of sector q + delta."""
-    def lev0(d, a, b):
-        dd, a2, b2 = canonical(a, b)
-        return centre if (a2, b2) == CENTRE else level0(d + dd, (a2, b2))
-
-    def value(A, B):
-        if (A, B) == (0, 0):
-            return lam * centre
-        d, A2, B2 = canonical(A, B)
-        if (A2, B2) in _POS:
-            return lam * level0(d, (A2, B2))
-        acc = zero
-        for (a, b), w in level1_rule(A2, B2).items():
-            acc = acc + lev0(d, a, b) * w
-        return acc
-    return value
 
 
-def _bezier(net, zero):
-    """4 x 4 B-spline control values -> Bezier (one coordinate, any ring)."""
-    tmp = [[sum((net[r][j] * fmpq(c, 6) for c, r in zip(_B2Z[i], range(4)) if c), zero) for j in range(4)]
-           for i in range(4)]
-    return [[sum((tmp[i][r] * fmpq(c, 6) for c, r in zip(_B2Z[j], range(4)) if c), zero) for j in range(4)]
-            for i in range(4)]
 
 
-def piece_nets(level0, centre, lam, zero):
-    """{piece: 4 x 4 Bezier net} of one coordinate (or one basis part) on a bulk quadrant."""
-    V = local_value(level0, centre, lam, zero)
-    return {name: _bezier([[V(_OFFSET[name][0] + i, _OFFSET[name][1] + j) for j in range(4)] for i in range(4)], zero)
-            for name in PIECES}
+
+
+
+
+
+
+
+
 
 
 # --- Taylor models in h of det J_Phi on the bulk --------------------------------------------------
 
-XB, YB = ("X+", "X-"), ("Y0", "Y+", "Y-")
 
 
-def _real_forms(net, prec):
-    """(Re, Im) Bernstein forms of a 4 x 4 acb net."""
-    return tuple(BernsteinForm((4, 4), [getattr(acb(net[i][j]), part) for i in range(4) for j in range(4)], prec=prec)
-                 for part in ("real", "imag"))
 
 
-def _jac(a, b):
-    return bernstein_jacobian_determinant([a, b]).coeffs
 
 
-def complex_det(fa, fb):
-    """Bernstein coefficients (acb) of the bilinear D(A, B) = det d(A, B)/d(u, v) for complex nets given by
-    their (Re, Im) forms."""
-    rr, ii, ri, ir = _jac(fa[0], fb[0]), _jac(fa[1], fb[1]), _jac(fa[0], fb[1]), _jac(fa[1], fb[0])
-    return [acb(a - b, c + d) for a, b, c, d in zip(rr, ii, ri, ir)]
 
 
-def basis_nets(fam):
-    """{basis part: {piece: 4 x 4 net}} of the family's five basis parts."""
-    return {name: piece_nets(f, c, lam, fam.zero) for name, (f, c, lam) in fam.parts().items()}
 
 
-def taylor_dets(sigma, n, prec=128, **control):
-    """The Taylor coefficients in h of D_ij = D(X_i, Y_j) for the basis parts X_i (X+, X-) and Y_j (Y0, Y+, Y-):
-    {(i, j, piece): [coefficient list (acb) of h^m, m = 0..n]}. D is bilinear, so the coefficient of h^m is
-    sum_(k + l = m) D(X_i,k, Y_j,l) of the nets' own Taylor coefficients (acb_series, rigorous)."""
-    with ctx.workprec(prec), series_cap(n):
-        fam = Family(_hvar(n), sigma, **control)
-        nets = basis_nets(fam)
-        forms = {(name, piece, m): _real_forms([[_coeffs(z, n + 1)[m] for z in row] for row in net], prec)
-                 for name, pn in nets.items() for piece, net in pn.items() for m in range(n + 1)}
-        out = {}
-        for i in XB:
-            for j in YB:
-                for piece in PIECES:
-                    coeffs = []
-                    for m in range(n + 1):
-                        acc = None
-                        for k in range(m + 1):
-                            d = complex_det(forms[(i, piece, k)], forms[(j, piece, m - k)])
-                            acc = d if acc is None else [a + b for a, b in zip(acc, d)]
-                        coeffs.append(acc)
-                    out[(i, j, piece)] = coeffs
-        return out
 
 
-def disc_bounds(sigma, r, grid=4, prec=128, **control):
-    """M with |D_ij(h)| <= M[(i, j, piece)] (every Bernstein coefficient) for every complex h in the square
-    [-r, r]^2 (grid x grid acb boxes; every system on each box proved regular by arb, so D_ij is analytic
-    on the disc |h| <= r). Raises ZeroDivisionError where a box decides nothing."""
-    M = {}
-    with ctx.workprec(prec):
-        for a in range(grid):
-            for b in range(grid):
-                re = _ball(-r + 2 * r * fmpq(a, grid), -r + 2 * r * fmpq(a + 1, grid))
-                im = _ball(-r + 2 * r * fmpq(b, grid), -r + 2 * r * fmpq(b + 1, grid))
-                fam = Family(acb(re, im), sigma, **control)
-                nets = basis_nets(fam)
-                forms = {(name, piece): _real_forms(net, prec)
-                         for name, pn in nets.items() for piece, net in pn.items()}
-                for i in XB:
-                    for j in YB:
-                        for piece in PIECES:
-                            d = complex_det(forms[(i, piece)], forms[(j, piece)])
-                            bound = max((abs(z).upper() for z in d), key=lambda x: x)
-                            if not bound.is_finite():
-                                raise ZeroDivisionError(f"disc box {a}, {b}: no bound")
-                            key = (i, j, piece)
-                            M[key] = bound if key not in M or bound > M[key] else M[key]
-    return M
 
 
-def _ball(lo, hi):
-    lo, hi = fmpq(lo), fmpq(hi)
-    return arb((lo + hi) / 2, (hi - lo) / 2)
 
 
-def _parts(T):
-    """The pieces (or outer curves) that a Taylor dict keyed (i, j, part) covers."""
-    return sorted({key[2] for key in T})
 
 
-def kdet_box(T, M, s_lo, s_hi, h_lo, h_hi, sigma, r, n, prec=128):
-    """(lower, upper) bounds of K det J_Phi over the three pieces' Bernstein coefficients, for s in [s_lo, s_hi] and
-    h in [h_lo, h_hi] (0 < h_hi < r): sum_ij a_i(s) b_j(s) (sum_(m=1..n) d_ijm h^(m-1) + rho_ij) with
-    |rho_ij| <= M_ij h^n/(r^(n+1) (1 - h/r)) (Cauchy on |h| = r), the m = 0 terms being 0 exactly."""
-    with ctx.workprec(prec):
-        s, h = _ball(s_lo, s_hi), _ball(h_lo, h_hi)
-        E, F = acb(0, 2 * arb.pi() * s).exp(), acb(0, sigma * (2 * s - 1)).exp()
-        a, b = {"X+": E, "X-": 1 / E}, {"Y0": acb(1), "Y+": F, "Y-": 1 / F}
-        hr = arb(fmpq(h_hi)) / r
-        tail = arb(fmpq(h_hi)) ** n / (arb(r) ** (n + 1) * (1 - hr))
-        low, high = None, None
-        for piece in _parts(T):
-            tot = None
-            for i in XB:
-                for j in YB:
-                    coeffs, rad = T[(i, j, piece)], (M[(i, j, piece)] * tail).upper()
-                    w = a[i] * b[j]
-                    vals = []
-                    for c in range(len(coeffs[1])):
-                        acc = acb(0)
-                        for m in range(n, 0, -1):
-                            acc = acc * h + coeffs[m][c]
-                        vals.append(w * (acc + acb(arb(0, rad), arb(0, rad))))
-                    tot = vals if tot is None else [x + y for x, y in zip(tot, vals)]
-            lo = min((z.real.lower() for z in tot), key=lambda x: x)
-            hi = max((z.real.upper() for z in tot), key=lambda x: x)
-            low = lo if low is None or lo < low else low
-            high = hi if high is None or hi > high else high
-        return low, high
 
 
 def cover_bulk(T, M, s0, k0, sigma, r, n, pieces=16, depth=10):
@@ -509,74 +240,10 @@ def cover_bulk(T, M, s0, k0, sigma, r, n, pieces=16, depth=10):
 
 # --- the middle region: s = q/K in [T/K, s0], K det J_Phi/s^2 as a function of (s, w = h/s) ---------------
 
-def _omegas(sigma):
-    """a_i(s) b_j(s) = c_ij e^(i omega_ij s): {(i, j): (c_ij, omega_ij)} (acb, arb)."""
-    tp, es = 2 * arb.pi(), acb(0, sigma).exp()
-    a = {"X+": tp, "X-": -tp}
-    b = {"Y0": (acb(1), arb(0)), "Y+": (1 / es, 2 * sigma), "Y-": (es, -2 * sigma)}
-    return {(i, j): (b[j][0], a[i] + b[j][1]) for i in XB for j in YB}
 
 
-def middle_coeffs(T, sigma, L=24):
-    """e[(m, l)][piece] = sum_ij d_ijm c_ij (i omega_ij)^l/l! (Bernstein coefficient lists, acb): the
-    coefficient of s^l h^(m-1) in K det J_Phi = sum_ij a_i(s) b_j(s) sum_m d_ijm h^(m-1), for m = 1, 2 and
-    l <= L (the terms m >= 3 are evaluated directly)."""
-    om = _omegas(sigma)
-    out = {}
-    for m in (1, 2):
-        for l in range(L + 1):
-            for piece in _parts(T):
-                acc = None
-                for (i, j), (c, w) in om.items():
-                    f = c * (acb(0, w) ** l) / arb.fac_ui(l)
-                    v = [f * z for z in T[(i, j, piece)][m]]
-                    acc = v if acc is None else [x + y for x, y in zip(acc, v)]
-                out[(m, l, piece)] = acc
-    return out
 
 
-def middle_box(T, E, M, s_lo, s_hi, w_lo, w_hi, sigma, r, n, L=24, prec=128):
-    """(lower, upper) bounds of G = K det J_Phi/s^2 (= K^3 det J_Phi/q^2 at s = q h) on s in [s_lo, s_hi],
-    w = h/s in [w_lo, w_hi] (s_lo >= 0): the m = 1 part sum_(l >= 2) e_1l s^(l-2), the m = 2 part
-    w sum_(l >= 1) e_2l s^(l-1) (the coefficients e_10, e_11, e_20 being 0 exactly), the m >= 3 parts
-    a_i(s) b_j(s) d_ijm s^(m-3) w^(m-1), the tails of the exponential series (|omega s|^(L+1)/(L+1)!, with
-    the factor 1/(1 - |omega s|/(L + 2))) and the Cauchy remainder M_ij s^(n-2) w^n/(r^(n+1) (1 - h/r))."""
-    with ctx.workprec(prec):
-        s, w = _ball(s_lo, s_hi), _ball(w_lo, w_hi)
-        om = _omegas(sigma)
-        wmax = max((abs(x[1]).upper() for x in om.values()), key=lambda x: x)
-        z = wmax * arb(fmpq(s_hi))
-        if not z < L + 2:
-            raise ValueError("s too large for the exponential series")
-        # the tails of the exponential series, divided by s^2 (m = 1) and s (m = 2): |c_ij| = 1 and
-        # sum_(l > L) |omega s|^l/l! <= |omega s|^(L+1)/(L+1)!/(1 - |omega s|/(L + 2))
-        geo = z ** (L - 1) / arb.fac_ui(L + 1) / (1 - z / (L + 2))
-        h_hi = arb(fmpq(s_hi)) * arb(fmpq(w_hi))
-        ctail = arb(fmpq(s_hi)) ** (n - 2) * arb(fmpq(w_hi)) ** n / (arb(r) ** (n + 1) * (1 - h_hi / r))
-        ab = {k: c * acb(0, w_ * s).exp() for k, (c, w_) in om.items()}
-        low, high = None, None
-        for piece in _parts(T):
-            ncoef = len(T[("X+", "Y0", piece)][1])  # the pieces' (or curves') Bernstein coefficients
-            dmax = {m: max((abs(c).upper() for key in T if key[2] == piece for c in T[key][m]), key=lambda x: x)
-                    for m in (1, 2)}
-            rad1 = 6 * dmax[1] * wmax ** 2 * geo
-            rad2 = 6 * dmax[2] * wmax * geo * z * arb(fmpq(w_hi))
-            rem = sum((M[(i, j, piece)] * ctail for i in XB for j in YB), arb(0))
-            rad = (rad1 + rad2 + rem).upper()
-            for c in range(ncoef):
-                g1 = acb(0)
-                for l in range(L, 1, -1):
-                    g1 = g1 * s + E[(1, l, piece)][c]
-                g2 = acb(0)
-                for l in range(L, 0, -1):
-                    g2 = g2 * s + E[(2, l, piece)][c]
-                g = g1 + w * g2
-                for m in range(3, n + 1):
-                    g += sum((ab[k] * T[k + (piece,)][m][c] for k in ab), acb(0)) * s ** (m - 3) * w ** (m - 1)
-                v = g.real + arb(0, rad)
-                low = v.lower() if low is None or v.lower() < low else low
-                high = v.upper() if high is None or v.upper() > high else high
-        return low, high
 
 
 def cover_middle(T, E, M, s0, k0, t_layer, sigma, r, n, depth=14):
@@ -608,127 +275,16 @@ def cover_middle(T, E, M, s0, k0, t_layer, sigma, r, n, depth=14):
 
 # --- the boundary layer: quadrants q = 0..T next to the sharp ray -----------------------------------
 
-def layer_level0(fam, q):
-    """(x(t, p), y(t, p), x_C, y_C) at integer sectors t (any sign) for the layer quadrant q, as analytic
-    functions of h (fam.h of any type): x = (v^(p) w^t - v^(p~) w^(-t-eps))/(2i) (one mode, every t),
-    y = alpha U(p) + (v^_y(p) e^(i sigma (2 h t - 1)) + v^_y(p~) e^(-i sigma (2 h (t + eps) - 1)))/2 for t >= 0
-    and y's reflection in ray 0 for t < 0 (ray t -> ray -t, quadrant t (a, b) -> quadrant -t-1 (b, a))."""
-    h, sig = fam.h, fam.sigma
-    i2 = acb(0, 2)
-    eis = acb(0, 1) * sig
-
-    def eps(pos):
-        return 0 if pos[1] == 0 else 1
-
-    def x(t, pos):
-        return (fam.vx[_POS[pos]] * (h * (fam.ix * t)).exp()
-                - fam.vx[_POS[_swap(pos)]] * (h * (fam.ix * (-t - eps(pos)))).exp()) / i2
-
-    def y(t, pos):
-        if t < 0:
-            t, pos = (-t, pos) if pos[1] == 0 else (-t - 1, _swap(pos))
-        return (fam.alpha * fam.U[_POS[pos]]
-                + (fam.vy[_POS[pos]] * (h * (2 * eis * t) - eis).exp()
-                   + fam.vy[_POS[_swap(pos)]] * (eis - h * (2 * eis * (t + eps(pos)))).exp()) / 2)
-    return x, y, fam.zero, fam.yc
 
 
-def layer_value(level0, centre, lam, q, zero):
-    """``value(A, B)``: level-1 values of layer quadrant q >= 0 (ray 0 sharp; as tagged_map.level1_values:
-    lam times the level-0 value on the two-ring, the ghost row 2 P(A, 0) - P(A, 1) across ray 0, the sharp
-    edge's midpoint at ray 0's (3, 0), the level-1 rules elsewhere)."""
-    def lev0(d, a, b):
-        dd, a2, b2 = canonical(a, b)
-        return centre if (a2, b2) == CENTRE else level0(d + dd, (a2, b2))
-
-    def value(A, B):
-        if (A, B) == (0, 0):
-            return lam * centre
-        if B == -1 and q == 0:
-            return 2 * value(A, 0) - value(A, 1)
-        d, A2, B2 = canonical(A, B)
-        t = q + d
-        if (A2, B2) in _POS:
-            return lam * level0(t, (A2, B2))
-        if B2 == 0 and t == 0:
-            return (level0(0, (1, 0)) + level0(0, (2, 0))) / 2
-        acc = zero
-        for (a, b), w in level1_rule(A2, B2).items():
-            acc = acc + lev0(t, a, b) * w
-        return acc
-    return value
 
 
-def layer_nets(fam, q):
-    """{piece: (X net, Y net)} (4 x 4 Bezier, values of fam.h's type) of layer quadrant q."""
-    x, y, xc, yc = layer_level0(fam, q)
-    VX = layer_value(x, xc, fam.lam1, q, fam.zero)
-    VY = layer_value(y, yc, fam.lam2, q, fam.zero)
-    out = {}
-    for name in PIECES:
-        oa, ob = _OFFSET[name]
-        out[name] = tuple(_bezier([[V(oa + i, ob + j) for j in range(4)] for i in range(4)], fam.zero)
-                          for V in (VX, VY))
-    return out
 
 
-def layer_taylor(q, sigma, n, prec=128):
-    """{piece: [Bernstein coefficients (arb) of det J_Phi's h^m, m = 0..n]} of layer quadrant q (real parts:
-    the values are real for real h)."""
-    with ctx.workprec(prec), series_cap(n):
-        fam = Family(_hvar(n), sigma)
-        out = {}
-        for piece, (X, Y) in layer_nets(fam, q).items():
-            fx = [BernsteinForm((4, 4), [_coeffs(X[i][j], n + 1)[m].real for i in range(4) for j in range(4)],
-                                prec=prec) for m in range(n + 1)]
-            fy = [BernsteinForm((4, 4), [_coeffs(Y[i][j], n + 1)[m].real for i in range(4) for j in range(4)],
-                                prec=prec) for m in range(n + 1)]
-            coeffs = []
-            for m in range(n + 1):
-                acc = None
-                for k in range(m + 1):
-                    d = _jac(fx[k], fy[m - k])
-                    acc = d if acc is None else [a + b for a, b in zip(acc, d)]
-                coeffs.append(acc)
-            out[piece] = coeffs
-        return out
 
 
-def layer_disc(q, sigma, r, grid=12, prec=128):
-    """{piece: M} with |det J_Phi(h)| <= M (every Bernstein coefficient) for complex h in [-r, r]^2."""
-    M = {}
-    with ctx.workprec(prec):
-        for a in range(grid):
-            for b in range(grid):
-                re = _ball(-r + 2 * r * fmpq(a, grid), -r + 2 * r * fmpq(a + 1, grid))
-                im = _ball(-r + 2 * r * fmpq(b, grid), -r + 2 * r * fmpq(b + 1, grid))
-                fam = Family(acb(re, im), sigma)
-                for piece, (X, Y) in layer_nets(fam, q).items():
-                    d = complex_det(_real_forms(X, prec), _real_forms(Y, prec))
-                    bound = max((abs(z).upper() for z in d), key=lambda x: x)
-                    if not bound.is_finite():
-                        raise ZeroDivisionError(f"layer disc box {a}, {b}: no bound")
-                    M[piece] = bound if piece not in M or bound > M[piece] else M[piece]
-    return M
 
 
-def layer_box(T, M, h_lo, h_hi, r, n, order=3, prec=128):
-    """(lower, upper) bounds of K^order det J_Phi on h in [h_lo, h_hi] from the Taylor model (the
-    coefficients of h^0 .. h^(order-1) being 0 exactly)."""
-    with ctx.workprec(prec):
-        h = _ball(h_lo, h_hi)
-        tail = arb(fmpq(h_hi)) ** (n + 1 - order) / (arb(r) ** (n + 1) * (1 - arb(fmpq(h_hi)) / r))
-        low, high = None, None
-        for piece, coeffs in T.items():
-            rad = (M[piece] * tail).upper()
-            for c in range(len(coeffs[0])):
-                acc = arb(0)
-                for m in range(n, order - 1, -1):
-                    acc = acc * h + coeffs[m][c]
-                acc += arb(0, rad)
-                low = acc.lower() if low is None or acc.lower() < low else low
-                high = acc.upper() if high is None or acc.upper() > high else high
-        return low, high
 
 
 def corner_dets(sigma, k, s):
@@ -747,88 +303,10 @@ def corner_dets(sigma, k, s):
     return out
 
 
-class QL0:
-    """a + b L0 in Q(L0) = Q(sqrt 5), L0 = lam(1) = (6 + sqrt 20)/16 the root of 16 x^2 - 12 x + 1 = 0 (exact)."""
-
-    __slots__ = ("a", "b")
-
-    def __init__(self, a, b=0):
-        self.a, self.b = fmpq(a), fmpq(b)
-
-    @staticmethod
-    def lift(z):
-        return z if isinstance(z, QL0) else QL0(z)
-
-    def __add__(self, o):
-        o = QL0.lift(o)
-        return QL0(self.a + o.a, self.b + o.b)
-
-    __radd__ = __add__
-
-    def __neg__(self):
-        return QL0(-self.a, -self.b)
-
-    def __sub__(self, o):
-        return self + (-QL0.lift(o))
-
-    def __mul__(self, o):
-        o = QL0.lift(o)
-        bb = self.b * o.b  # L0^2 = (12 L0 - 1)/16
-        return QL0(self.a * o.a - bb / 16, self.a * o.b + self.b * o.a + bb * fmpq(12, 16))
-
-    __rmul__ = __mul__
-
-    def inv(self):
-        # (a + b L0)(a + b L0') = a^2 + a b (L0 + L0') + b^2 L0 L0' = a^2 + 3 a b/4 + b^2/16, L0' = 3/4 - L0
-        n = self.a * self.a + self.a * self.b * fmpq(3, 4) + self.b * self.b / 16
-        return QL0((self.a + self.b * fmpq(3, 4)) / n, -self.b / n)
-
-    def __truediv__(self, o):
-        return self * QL0.lift(o).inv()
-
-    def __eq__(self, o):
-        o = QL0.lift(o)
-        return self.a == o.a and self.b == o.b
-
-    def is_zero(self):
-        return self.a == 0 and self.b == 0
 
 
-def exact_zeros():
-    """Check exactly (in Q(L0)) the facts the dropped coefficients rest on: L0 is an eigenvalue of B(1) with
-    eigenvector rho (rho(1,0) = 1) and rho(a, b) = rho(b, a); adj(L0 - B(1)) kappa = N(L0) is a multiple of rho
-    (so U(L0) = U(1,0) rho and alpha(0) U(L0) = -cos(sigma) rho). Returns rho (6 QL0)."""
-    L = QL0(0, 1)
-    A = [[(L if i == k else QL0(0)) - _B1[i, k] for k in range(6)] for i in range(6)]
-    # rho: solve A rho = 0 with rho(1,0) = 1: drop row 0 (rank 5 since L0 is simple: checked by the solve)
-    M = [[A[i][k] for k in range(1, 6)] + [-A[i][0]] for i in range(1, 6)]
-    for c in range(5):  # Gauss-Jordan over Q(L0)
-        piv = next(r for r in range(c, 5) if not M[r][c].is_zero())
-        M[c], M[piv] = M[piv], M[c]
-        inv = M[c][c].inv()
-        M[c] = [z * inv for z in M[c]]
-        for r in range(5):
-            if r != c and not M[r][c].is_zero():
-                f = M[r][c]
-                M[r] = [z - f * w for z, w in zip(M[r], M[c])]
-    rho = [QL0(1)] + [M[r][5] for r in range(5)]
-    if not all(sum((A[i][k] * rho[k] for k in range(6)), QL0(0)).is_zero() for i in range(6)):
-        raise AssertionError("rho is no eigenvector of B(1) for L0")
-    pos = {p: k for p, k in _POS.items()}
-    if not all(rho[pos[(a, b)]] == rho[pos[(b, a)]] for (a, b) in pos if b > 0 and (b, a) in pos):
-        raise AssertionError("rho is not symmetric in (a, b)")
-    N = [sum((c * L0pow for c, L0pow in zip(p, _powers(L, len(p)))), QL0(0)) for p in _NPOLY]
-    if not all((N[k] - N[0] * rho[k]).is_zero() for k in range(6)) or N[0].is_zero():
-        raise AssertionError("adj(L0 - B(1)) kappa is not a non-zero multiple of rho")
-    return rho
 
 
-def _powers(x, n):
-    out, acc = [], QL0(1)
-    for _ in range(n):
-        out.append(acc)
-        acc = acc * x
-    return out
 
 
 SIGMA_LO, SIGMA_HI = fmpq(4484, 1000), fmpq(44935, 10000)  # sigma(K) for every K >= 101 (part C)
@@ -862,129 +340,22 @@ def cover_layer(q, k0, r=R_CAUCHY, n=14, sig_boxes=10, depth=8, what="det"):
 
 # --- transversality: a1 X Y' - a2 Y X' along the outer curves, the same three regions -------------------
 
-_BIN3, _BIN2, _BIN5 = (1, 3, 3, 1), (1, 2, 1), (1, 5, 10, 10, 5, 1)
 
 
-def curve_points(nets, name):
-    """The 4 Bezier points of one outer curve (CURVES) of a quadrant's nets {piece: 4 x 4}, counterclockwise."""
-    piece, side, sign = CURVES[name]
-    net = nets[piece]
-    pts = [net[3][j] for j in range(4)] if side == "s" else [net[i][3] for i in range(4)]
-    return pts if sign > 0 else pts[::-1]
 
 
-def _bprod(f, g):
-    """Bernstein coefficients (degree 5) of f g' for cubic Bezier values f, g (any ring)."""
-    gd = [3 * (g[i + 1] - g[i]) for i in range(3)]
-    out = []
-    for k in range(6):
-        acc = 0 * f[0]
-        for i in range(max(0, k - 2), min(3, k) + 1):
-            acc = acc + f[i] * gd[k - i] * fmpq(_BIN3[i] * _BIN2[k - i], _BIN5[k])
-        out.append(acc)
-    return out
 
 
-def _series_curves(nets, n):
-    """{curve: [order m: 4 acb]} of one coordinate's nets {piece: 4 x 4 acb_series}."""
-    out = {}
-    for name in CURVES:
-        pts = [_coeffs(z, n + 1) for z in curve_points(nets, name)]
-        out[name] = [[pts[p][m] for p in range(4)] for m in range(n + 1)]
-    return out
 
 
-def _trans_series(xc, yc, A1, A2, n):
-    """Taylor coefficients of a1 X Y' - a2 Y X' from the coordinates' (xc, yc: [m: 4 values]) and a_i's."""
-    P = [None] * (n + 1)
-    Q = [None] * (n + 1)
-    for m in range(n + 1):
-        for k in range(m + 1):
-            p, q = _bprod(xc[k], yc[m - k]), _bprod(yc[m - k], xc[k])
-            P[m] = p if P[m] is None else [a + b for a, b in zip(P[m], p)]
-            Q[m] = q if Q[m] is None else [a + b for a, b in zip(Q[m], q)]
-    out = []
-    for m in range(n + 1):
-        acc = [0 * P[0][0]] * 6
-        for u in range(m + 1):
-            acc = [a + A1[u] * p - A2[u] * q for a, p, q in zip(acc, P[m - u], Q[m - u])]
-        out.append(acc)
-    return out
 
 
-def taylor_trans(sigma, n, prec=128, **control):
-    """As :func:`taylor_dets` for T_ij = a1 X_i Y_j' - a2 Y_j X_i' along the outer curves (a_i = -ln lam_i):
-    {(i, j, curve): [coefficient list of h^m, m = 0..n]}; T_ij(0) = 0 exactly (a1 = a2, both parts multiples
-    of one real curve at h = 0)."""
-    with ctx.workprec(prec), series_cap(n):
-        fam = Family(_hvar(n), sigma, **control)
-        nets = basis_nets(fam)
-        A1, A2 = (_coeffs(-lam.log(), n + 1) for lam in (fam.lam1, fam.lam2))
-        curves = {b: _series_curves(nets[b], n) for b in nets}
-        return {(i, j, c): _trans_series(curves[i][c], curves[j][c], A1, A2, n)
-                for i in XB for j in YB for c in CURVES}
 
 
-def disc_trans(sigma, r, grid=12, prec=128, **control):
-    """As :func:`disc_bounds` for the T_ij of :func:`taylor_trans`."""
-    M = {}
-    with ctx.workprec(prec):
-        for a in range(grid):
-            for b in range(grid):
-                re = _ball(-r + 2 * r * fmpq(a, grid), -r + 2 * r * fmpq(a + 1, grid))
-                im = _ball(-r + 2 * r * fmpq(b, grid), -r + 2 * r * fmpq(b + 1, grid))
-                fam = Family(acb(re, im), sigma, **control)
-                nets = basis_nets(fam)
-                if not (acb(fam.lam1).real > 0 and acb(fam.lam2).real > 0):
-                    raise ZeroDivisionError("log lam: not certainly off the branch cut")
-                a1, a2 = -acb(fam.lam1).log(), -acb(fam.lam2).log()
-                for i in XB:
-                    for j in YB:
-                        for c in CURVES:
-                            X, Y = curve_points(nets[i], c), curve_points(nets[j], c)
-                            t = [a1 * p - a2 * q for p, q in zip(_bprod(X, Y), _bprod(Y, X))]
-                            bound = max((abs(z).upper() for z in t), key=lambda x: x)
-                            if not bound.is_finite():
-                                raise ZeroDivisionError(f"disc box {a}, {b}: no bound")
-                            key = (i, j, c)
-                            M[key] = bound if key not in M or bound > M[key] else M[key]
-    return M
 
 
-def layer_trans_taylor(q, sigma, n, prec=128):
-    """{curve: [coefficients (arb) of h^m]} of a1 X Y' - a2 Y X' on layer quadrant q (h^0..h^2: 0 exactly)."""
-    with ctx.workprec(prec), series_cap(n):
-        fam = Family(_hvar(n), sigma)
-        nets = layer_nets(fam, q)
-        A1, A2 = ([z.real for z in _coeffs(-lam.log(), n + 1)] for lam in (fam.lam1, fam.lam2))
-        xs = _series_curves({p: nets[p][0] for p in PIECES}, n)
-        ys = _series_curves({p: nets[p][1] for p in PIECES}, n)
-        real = {c: ([[z.real for z in pts] for pts in xs[c]], [[z.real for z in pts] for pts in ys[c]]) for c in CURVES}
-        return {c: _trans_series(real[c][0], real[c][1], A1, A2, n) for c in CURVES}
 
 
-def layer_trans_disc(q, sigma, r, grid=12, prec=128):
-    """{curve: M} with |a1 X Y' - a2 Y X'| <= M on complex h in [-r, r]^2 for layer quadrant q."""
-    M = {}
-    with ctx.workprec(prec):
-        for a in range(grid):
-            for b in range(grid):
-                re = _ball(-r + 2 * r * fmpq(a, grid), -r + 2 * r * fmpq(a + 1, grid))
-                im = _ball(-r + 2 * r * fmpq(b, grid), -r + 2 * r * fmpq(b + 1, grid))
-                fam = Family(acb(re, im), sigma)
-                nets = layer_nets(fam, q)
-                if not (acb(fam.lam1).real > 0 and acb(fam.lam2).real > 0):
-                    raise ZeroDivisionError("log lam: not certainly off the branch cut")
-                a1, a2 = -acb(fam.lam1).log(), -acb(fam.lam2).log()
-                for c in CURVES:
-                    X = curve_points({p: nets[p][0] for p in PIECES}, c)
-                    Y = curve_points({p: nets[p][1] for p in PIECES}, c)
-                    t = [a1 * p - a2 * q_ for p, q_ in zip(_bprod(X, Y), _bprod(Y, X))]
-                    bound = max((abs(z).upper() for z in t), key=lambda x: x)
-                    if not bound.is_finite():
-                        raise ZeroDivisionError(f"layer disc box {a}, {b}: no bound")
-                    M[c] = bound if c not in M or bound > M[c] else M[c]
-    return M
 
 
 # --- winding: the signs of X and Y along the outer curves -------------------------------------------
@@ -994,64 +365,12 @@ def layer_trans_disc(q, sigma, r, grid=12, prec=128):
 # [s_b, 1/2], X > 0 for s in [s_a, s_b]; by T every crossing of H goes the same way (Y increasing), so Y
 # changes sign exactly once on [s_a, s_b], and the mirror half meets Y = 0 only where X < 0.
 
-def coord_taylor(sigma, n, coord, prec=128):
-    """{(basis part, curve): [order m: 4 acb]}: Taylor coefficients in h of the outer curves' Bezier points of
-    the basis parts of x (coord "x": X+, X-) or y ("y": Y0, Y+, Y-)."""
-    with ctx.workprec(prec), series_cap(n):
-        fam = Family(_hvar(n), sigma)
-        nets = basis_nets(fam)
-        return {(b, c): pts for b in (XB if coord == "x" else YB) for c, pts in _series_curves(nets[b], n).items()}
 
 
-def coord_disc(sigma, r, coord, grid=12, prec=128):
-    """{(basis part, curve): M}, |Bezier point| <= M on complex h in [-r, r]^2."""
-    M = {}
-    with ctx.workprec(prec):
-        for a in range(grid):
-            for b in range(grid):
-                re = _ball(-r + 2 * r * fmpq(a, grid), -r + 2 * r * fmpq(a + 1, grid))
-                im = _ball(-r + 2 * r * fmpq(b, grid), -r + 2 * r * fmpq(b + 1, grid))
-                nets = basis_nets(Family(acb(re, im), sigma))
-                for part in (XB if coord == "x" else YB):
-                    for c in CURVES:
-                        bound = max((abs(acb(z)).upper() for z in curve_points(nets[part], c)), key=lambda x: x)
-                        if not bound.is_finite():
-                            raise ZeroDivisionError(f"disc box {a}, {b}: no bound")
-                        key = (part, c)
-                        M[key] = bound if key not in M or bound > M[key] else M[key]
-    return M
 
 
-def _coord_factors(coord, s, sigma):
-    if coord == "x":
-        E = acb(0, 2 * arb.pi() * s).exp()
-        return {"X+": E, "X-": 1 / E}
-    F = acb(0, sigma * (2 * s - 1)).exp()
-    return {"Y0": acb(1), "Y+": F, "Y-": 1 / F}
 
 
-def coord_box(T, M, s_lo, s_hi, h_lo, h_hi, sigma, r, n, coord, prec=128):
-    """(lower, upper) bounds of X or Y on every outer curve's Bezier points, s in [s_lo, s_hi], h in
-    [h_lo, h_hi] (a bulk quadrant)."""
-    with ctx.workprec(prec):
-        s, h = _ball(s_lo, s_hi), _ball(h_lo, h_hi)
-        fac = _coord_factors(coord, s, sigma)
-        hr = arb(fmpq(h_hi)) / r
-        tail = hr ** (n + 1) / (1 - hr)
-        low, high = None, None
-        for c in CURVES:
-            for p in range(4):
-                tot = acb(0)
-                for part, f in fac.items():
-                    acc = acb(0)
-                    for m in range(n, -1, -1):
-                        acc = acc * h + T[(part, c)][m][p]
-                    rad = (M[(part, c)] * tail).upper()
-                    tot += f * (acc + acb(arb(0, rad), arb(0, rad)))
-                v = tot.real
-                low = v.lower() if low is None or v.lower() < low else low
-                high = v.upper() if high is None or v.upper() > high else high
-        return low, high
 
 
 def cover_sign(T, M, s_lo, s_hi, k0, sigma, r, n, coord, sign, pieces=8, depth=10):
@@ -1078,45 +397,8 @@ def cover_sign(T, M, s_lo, s_hi, k0, sigma, r, n, coord, sign, pieces=8, depth=1
     return count, failed
 
 
-def ymid_box(T, M, s_lo, s_hi, w_lo, w_hi, sigma, r, n, L=24, prec=128):
-    """(lower, upper) bounds of Y/s on every outer curve point, s in [s_lo, s_hi], w = h/s in [w_lo, w_hi]:
-    the h^0 part sum_j b_j(s) Y_j0 = sum_(l >= 1) (...) s^l (its s^0 coefficient is y at K = infinity and s = 0:
-    0 exactly) divided by s termwise, the parts h^m, m >= 1, as b_j(s) Y_jm s^(m-1) w^m, and the tails."""
-    with ctx.workprec(prec):
-        s, w = _ball(s_lo, s_hi), _ball(w_lo, w_hi)
-        es = acb(0, sigma).exp()
-        om = {"Y0": (acb(1), arb(0)), "Y+": (1 / es, 2 * sigma), "Y-": (es, -2 * sigma)}
-        fac = _coord_factors("y", s, sigma)
-        z = 2 * abs(sigma).upper() * arb(fmpq(s_hi))
-        if not z < L + 2:
-            raise ValueError("s too large for the exponential series")
-        geo = z ** L / arb.fac_ui(L + 1) / (1 - z / (L + 2)) * 2 * abs(sigma).upper()
-        h_hi = arb(fmpq(s_hi)) * arb(fmpq(w_hi))
-        ctail = arb(fmpq(s_hi)) ** n * arb(fmpq(w_hi)) ** (n + 1) / (arb(r) ** (n + 1) * (1 - h_hi / r))
-        low, high = None, None
-        for c in CURVES:
-            y0max = max((abs(T[(j, c)][0][p]).upper() for j in YB for p in range(4)), key=lambda x: x)
-            rad = (3 * y0max * geo + sum((M[(j, c)] * ctail for j in YB), arb(0))).upper()
-            for p in range(4):
-                g = acb(0)
-                for l in range(L, 0, -1):
-                    coef = sum((cj * acb(0, wj) ** l / arb.fac_ui(l) * T[(j, c)][0][p] for j, (cj, wj) in om.items()),
-                               acb(0))
-                    g = g * s + coef
-                for m in range(1, n + 1):
-                    g += sum((fac[j] * T[(j, c)][m][p] for j in YB), acb(0)) * s ** (m - 1) * w ** m
-                v = g.real + arb(0, rad)
-                low = v.lower() if low is None or v.lower() < low else low
-                high = v.upper() if high is None or v.upper() > high else high
-        return low, high
 
 
-def ymid_zero(T, sigma):
-    """max |sum_j c_j Y_j0| over the curve points: Y at h = 0, s = 0 (0 exactly), as enclosed."""
-    es = acb(0, sigma).exp()
-    c = {"Y0": acb(1), "Y+": 1 / es, "Y-": es}
-    return max(float(abs(sum((c[j] * T[(j, cv)][0][p] for j in YB), acb(0))).upper())
-               for cv in CURVES for p in range(4))
 
 
 def cover_ymid(T, M, s0, k0, t_layer, sigma, r, n, depth=12):
@@ -1184,46 +466,8 @@ def winding(k0, s0, t_layer, s_a=S_A, s_b=S_B, sig_boxes=10, n=12, r=R_CAUCHY):
     return out, zeros
 
 
-def layer_coord(q, sigma, n, r, grid=12, prec=128):
-    """(Taylor coefficients {curve: [m: 4 arb]}, disc bounds {curve: M}) of Y on layer quadrant q's outer curves."""
-    with ctx.workprec(prec), series_cap(n):
-        fam = Family(_hvar(n), sigma)
-        nets = layer_nets(fam, q)
-        ys = _series_curves({p: nets[p][1] for p in PIECES}, n)
-        T = {c: [[z.real for z in pts] for pts in ys[c]] for c in CURVES}
-        M = {}
-        for a in range(grid):
-            for b in range(grid):
-                re = _ball(-r + 2 * r * fmpq(a, grid), -r + 2 * r * fmpq(a + 1, grid))
-                im = _ball(-r + 2 * r * fmpq(b, grid), -r + 2 * r * fmpq(b + 1, grid))
-                nets = layer_nets(Family(acb(re, im), sigma), q)
-                for c in CURVES:
-                    bound = max((abs(acb(z)).upper() for z in curve_points({p: nets[p][1] for p in PIECES}, c)),
-                                key=lambda x: x)
-                    if not bound.is_finite():
-                        raise ZeroDivisionError(f"layer disc box {a}, {b}: no bound")
-                    M[c] = bound if c not in M or bound > M[c] else M[c]
-        return T, M
 
 
-def layer_y_upper(T, M, q, h_lo, h_hi, r, n, prec=128):
-    """The largest upper bound of K Y over layer quadrant q's outer-curve points (K^2 Y at ray 0's end point,
-    quadrant 0, curve P1s1, point 0), h in [h_lo, h_hi]; the dropped coefficients are 0 exactly (y = O(h),
-    and O(h^2) on ray 0 where x, hence y's first order, vanishes)."""
-    with ctx.workprec(prec):
-        h = _ball(h_lo, h_hi)
-        hr = arb(fmpq(h_hi)) / r
-        high, zero = None, 0.0
-        for c in CURVES:
-            for p in range(4):
-                order = 2 if (q == 0 and c == "P1s1" and p == 0) else 1
-                zero = max([zero] + [float(abs(T[c][m][p]).upper()) for m in range(order)])
-                acc = arb(0)
-                for m in range(n, order - 1, -1):
-                    acc = acc * h + T[c][m][p]
-                acc += arb(0, (M[c] * hr ** (n + 1) / (1 - hr) / arb(fmpq(h_hi)) ** order).upper())
-                high = acc.upper() if high is None or acc.upper() > high else high
-        return high, zero
 
 
 # --- the printed parts ------------------------------------------------------------------------------

@@ -1,0 +1,431 @@
+"""The characteristic map of ``dart:K`` for every K >= K0 as one family analytic in h = 1/K (trusted).
+
+x is the odd mode-1 eigenvector, y the even eigenvector of lam2 = lam(cos(2 sigma/K)) (docs/tagged_c1.md,
+"A plan for every dart K >= 101", items 4 and 6). Let v^_x(h) solve the bordered 6 x 6 system of the
+Fourier block B(w), w = e^(2 pi i h), for lam1 = lam(cos(2 pi h)) with v^(1,0) = 1, and v^_y(sigma, h) the
+same for w = e^(i phi), phi = 2 sigma h, lam = lam(cos phi). With s = t/K the angular position of quadrant
+t and delta the offset of a stencil point from it,
+
+    x(t, p) = Im(v^_x(p) e^(2 pi i s) e^(2 pi i delta h)),                x(centre) = 0,
+    y(t, p) = alpha U(p) + Re(v^_y(p) e^(i sigma (2 s - 1)) e^(2 i sigma delta h)),  y(centre) = alpha (lam - L0),
+
+L0 = lam(1), U(lam) = (lam - L0) (lam - B(1))^-1 kappa (kappa the centre's weights in the ring rows; the pole
+at L0 divided out exactly, :func:`big_u`) and alpha from the sharp midpoint's row. For sigma = sigma(K) (the
+root of the secular equation, :mod:`.dart_spectrum`) this is the eigenvector of lam2; for other sigma a family
+analytic in (sigma, h) near h = 0. The functions below take h as an acb ball (a point or a box of the complex
+h-square: the disc bounds) or as the power-series variable (acb_series: the Taylor coefficients), and build
+the Bezier nets of a bulk quadrant (:func:`basis_nets`, split by the dependence on s) and of the layer
+quadrants next to the sharp ray (:func:`layer_nets`: ghost rows, the sharp midpoint).
+"""
+
+from __future__ import annotations
+
+from flint import acb, acb_mat, acb_series, arb, ctx, fmpq, fmpq_mat
+
+from ccproof.rigorous import BernsteinForm, bernstein_jacobian_determinant
+
+from .rules import CENTRE, canonical, level1_rule
+from .tagged_modes import _POS, ring_stencil
+
+_B2Z = ((1, 4, 1, 0), (0, 4, 2, 0), (0, 2, 4, 0), (0, 1, 4, 1))  # uniform cubic B-spline -> Bezier, times 6
+
+
+_OFFSET = {"P1": (0, -1), "P2": (0, 0), "P3": (-1, 0)}  # as tagged_map: level-1 position of net[0][0]
+
+
+PIECES = ("P1", "P2", "P3")
+
+
+CURVES = {"P1s1": ("P1", "s", 1), "P2s1": ("P2", "s", 1), "P2t1": ("P2", "t", -1), "P3t1": ("P3", "t", -1)}
+
+
+def _kappa():
+    return [1 - sum(ring_stencil()[i].values()) for i in range(6)]
+
+
+def _adj_kappa_polys():
+    """N(lam) = adj(lam - B(1)) kappa as 6 exact polynomials (coefficient lists, degree <= 5), by
+    interpolation at lam = 1..6 and checked at lam = 7, 8 (B(1)'s eigenvalues are below 1)."""
+    B1 = fmpq_mat([[sum((x for (d, pos), x in ring_stencil()[i].items() if _POS[pos] == k), fmpq(0))
+                    for k in range(6)] for i in range(6)])
+    kap = fmpq_mat([[z] for z in _kappa()])
+
+    def n_at(lam):
+        M = fmpq_mat([[(lam if i == k else 0) - B1[i, k] for k in range(6)] for i in range(6)])
+        sol = M.solve(kap)
+        d = M.det()
+        return [d * sol[i, 0] for i in range(6)]
+    xs = [fmpq(i) for i in range(1, 7)]
+    vals = [n_at(x) for x in xs]
+    polys = []
+    for comp in range(6):
+        coeffs = [fmpq(0)] * 6
+        for a, xa in enumerate(xs):  # Lagrange basis, expanded
+            basis, den = [fmpq(1)], fmpq(1)
+            for b, xb in enumerate(xs):
+                if b != a:
+                    basis = [fmpq(0)] + basis
+                    for i in range(len(basis) - 1):
+                        basis[i] -= xb * basis[i + 1]
+                    den *= xa - xb
+            for i, c in enumerate(basis):
+                coeffs[i] += vals[a][comp] * c / den
+        polys.append(coeffs)
+    for x in (fmpq(7), fmpq(8)):
+        got = [sum((c * x ** i for i, c in enumerate(p)), fmpq(0)) for p in polys]
+        if got != n_at(x):
+            raise AssertionError("adj(lam - B(1)) kappa is not a polynomial of degree <= 5")
+    return polys, B1
+
+
+_NPOLY, _B1 = _adj_kappa_polys()
+
+
+def l0():
+    """L0 = lam(1) = (6 + sqrt 20)/16 and 1/(16 L0) = (6 - sqrt 20)/16 at the current precision."""
+    r = arb(20).sqrt()
+    return (6 + r) / 16, (6 - r) / 16
+
+
+def big_u(lam):
+    """U(lam) (6 values of lam's type) = adj(lam - B(1)) kappa divided by
+    (lam - 1/8)(lam - 1/16)(lam - 1/32)(lam - 1/64)(lam - 1/(16 L0))."""
+    den = (lam - fmpq(1, 8)) * (lam - fmpq(1, 16)) * (lam - fmpq(1, 32)) * (lam - fmpq(1, 64)) * (lam - l0()[1])
+    out = []
+    for p in _NPOLY:
+        acc = lam * 0
+        for c in reversed(p):
+            acc = acc * lam + c
+        out.append(acc / den)
+    return out
+
+
+def lam_of(c):
+    """lam(c) = (5 + c + sqrt((1 + c)(9 + c)))/16 (acb, arb or acb_series). On an acb ball the square root's
+    argument must lie in the right half-plane (off the principal branch's cut, so the value is analytic
+    there: the Cauchy bounds need that); ZeroDivisionError otherwise."""
+    arg = (1 + c) * (9 + c)
+    if isinstance(arg, acb) and not arg.real > 0:
+        raise ZeroDivisionError("sqrt((1 + c)(9 + c)): the argument is not certainly off the branch cut")
+    return (5 + c + arg.sqrt()) / 16
+
+
+def _block(w):
+    """B(w) (6 x 6 of w's type): entries sum x w^delta, delta in -1..2."""
+    powers = {-1: 1 / w, 0: w * 0 + 1, 1: w, 2: w * w}
+    rows = [[w * 0 for _ in range(6)] for _ in range(6)]
+    for i, row in enumerate(ring_stencil()):
+        for (d, pos), x in row.items():
+            rows[i][_POS[pos]] = rows[i][_POS[pos]] + powers[d] * x
+    return rows
+
+
+def _hvar(n):
+    """The series variable h to order n. python-flint truncates every series to ``ctx.cap`` terms (10 by
+    default) whatever its ``prec``: the callers run under :func:`series_cap` so that no order is lost."""
+    if ctx.cap < n + 1:
+        raise ValueError(f"ctx.cap = {ctx.cap} < {n + 1}: series would be truncated silently")
+    return acb_series([0, 1], prec=n + 1)
+
+
+class series_cap:
+    """Context manager: ctx.cap >= n + 1 inside (restored after)."""
+
+    def __init__(self, n):
+        self.n = n
+
+    def __enter__(self):
+        self.old = ctx.cap
+        ctx.cap = max(self.old, self.n + 1)
+
+    def __exit__(self, *exc):
+        ctx.cap = self.old
+
+
+def _coeffs(z, n):
+    c = z.coeffs()
+    return [acb(c[i]) if i < len(c) else acb(0) for i in range(n)]
+
+
+def bordered(w, lam, pivot=0):
+    """v^ (6 values of w's type): B(w) v^ = lam v^, v^[pivot] = 1, from the bordered 7 x 7 system A v = e_7.
+
+    For acb balls arb proves A regular on the whole ball (ZeroDivisionError otherwise). For power series
+    in h (acb_series) the Taylor coefficients follow from A_0 v_k = -sum_(j >= 1) A_j v_(k-j), A_0 the
+    system at h = 0 (proved regular by arb)."""
+    B = _block(w)
+    A = [[(B[i][k] - lam) if i == k else B[i][k] for k in range(6)] + [w * 0 + int(i == pivot)] for i in range(6)]
+    A.append([w * 0 + int(k == pivot) for k in range(6)] + [w * 0])
+    if not isinstance(w, acb_series):
+        sol = acb_mat(A).solve(acb_mat([[0]] * 6 + [[1]]))
+        return [sol[i, 0] for i in range(6)]
+    n = w.prec
+    Ak = [acb_mat([[_coeffs(A[i][k], n)[m] for k in range(7)] for i in range(7)]) for m in range(n)]
+    inv0 = Ak[0].inv()
+    vs = [inv0 * acb_mat([[0]] * 6 + [[1]])]
+    for m in range(1, n):
+        rhs = acb_mat(7, 1)
+        for j in range(1, m + 1):
+            rhs -= Ak[j] * vs[m - j]
+        vs.append(inv0 * rhs)
+    return [acb_series([vs[m][i, 0] for m in range(n)], prec=n) for i in range(6)]
+
+
+def _swap(pos):
+    return pos if pos[1] == 0 else (pos[1], pos[0])
+
+
+class Family:
+    """x and y of dart:K at one h (an acb ball, or the series variable: acb_series [0, 1]) and one sigma,
+    split by their dependence on s:
+
+        x = E X+ + E^-1 X-,  y = Y0 + F Y+ + F^-1 Y-,  E = e^(2 pi i s), F = e^(i sigma (2 s - 1)),
+
+    each basis part a function ``part(delta, pos)`` of the offset delta and the two-ring position (the level-0
+    value at sector K s + delta), with its centre value; analytic in h (no Re or Im: the conjugate of a mode
+    is written as the mode of 1/w with the positions (a, b) swapped).
+
+    Parameters
+    ----------
+    h : acb or acb_series
+    sigma : arb
+    flip_mode0, smooth : bool
+        controls: alpha -> -alpha (a perturbed eigenvector), alpha = 0 (no kink at the sharp ray)
+    """
+
+    def __init__(self, h, sigma, flip_mode0=False, smooth=False):
+        self.h, self.sigma = h, sigma
+        one, pi = h * 0 + 1, arb.pi()
+        self.zero = h * 0
+        self.ix, self.iy = acb(0, 2) * pi, acb(0, 2) * sigma   # w_x = e^(ix h), w_y = e^(iy h)
+        self.lam1 = lam_of((h * (2 * pi)).cos())
+        self.vx = bordered((h * self.ix).exp(), self.lam1)
+        self.lam2 = lam_of((h * (2 * sigma)).cos())
+        self.vy = bordered((h * self.iy).exp(), self.lam2)
+        self.U = big_u(self.lam2)
+        lam, L0 = self.lam2, l0()[0]
+        self.alpha = -(lam - fmpq(1, 2)) * sigma.cos() * one / ((lam - fmpq(1, 2)) * self.U[0] - (lam - L0) / 2)
+        if flip_mode0:
+            self.alpha = -self.alpha
+        self.sign = 1
+        if smooth:  # with sigma = pi: y = Re(v^ e^(2 pi i s)), the smooth valence's mode-1 cosine
+            self.alpha, self.sign = self.zero, -1
+        self.yc = self.alpha * (lam - L0)
+        self._exp = {}
+
+    def _e(self, c, k):  # e^(c k h), memoized
+        if (c, k) not in self._exp:
+            self._exp[(c, k)] = (self.h * ((self.ix if c == "x" else self.iy) * k)).exp()
+        return self._exp[(c, k)]
+
+    def parts(self):
+        """{name: (level0(delta, pos), centre, lam)} for X+, X-, Y0, Y+, Y-."""
+        i2 = acb(0, 2)
+        vx, vy = self.vx, self.vy
+
+        def eps(pos):
+            return 0 if pos[1] == 0 else 1
+        return {
+            "X+": (lambda d, p: vx[_POS[p]] * self._e("x", d) / i2, self.zero, self.lam1),
+            "X-": (lambda d, p: -vx[_POS[_swap(p)]] * self._e("x", -d - eps(p)) / i2, self.zero, self.lam1),
+            "Y0": (lambda d, p: self.alpha * self.U[_POS[p]], self.yc, self.lam2),
+            "Y+": (lambda d, p: vy[_POS[p]] * self._e("y", d) * self.sign / 2, self.zero, self.lam2),
+            "Y-": (lambda d, p: vy[_POS[_swap(p)]] * self._e("y", -d - eps(p)) * self.sign / 2, self.zero, self.lam2),
+        }
+
+    def values(self, s):
+        """(x, y): level0(delta, pos) at the quadrant K s, and the centre values (real h and s only)."""
+        E, F = acb(0, 2 * arb.pi() * s).exp(), acb(0, self.sigma * (2 * s - 1)).exp()
+        P = self.parts()
+
+        def x(d, p):
+            return (E * P["X+"][0](d, p) + P["X-"][0](d, p) / E).real
+
+        def y(d, p):
+            return (P["Y0"][0](d, p) + F * P["Y+"][0](d, p) + P["Y-"][0](d, p) / F).real
+        return x, y, acb(self.yc).real
+
+
+def local_value(level0, centre, lam, zero):
+    """``value(A, B)``: the level-1 value at position (A, B) of a bulk quadrant (no sharp ray within reach):
+    lam times the level-0 value on the two-ring (the vector is an eigenvector of every ring row), the
+    level-1 rule of :mod:`.rules` elsewhere; ``level0(delta, pos)`` the level-0 value of sector q + delta."""
+    def lev0(d, a, b):
+        dd, a2, b2 = canonical(a, b)
+        return centre if (a2, b2) == CENTRE else level0(d + dd, (a2, b2))
+
+    def value(A, B):
+        if (A, B) == (0, 0):
+            return lam * centre
+        d, A2, B2 = canonical(A, B)
+        if (A2, B2) in _POS:
+            return lam * level0(d, (A2, B2))
+        acc = zero
+        for (a, b), w in level1_rule(A2, B2).items():
+            acc = acc + lev0(d, a, b) * w
+        return acc
+    return value
+
+
+def _bezier(net, zero):
+    """4 x 4 B-spline control values -> Bezier (one coordinate, any ring)."""
+    tmp = [[sum((net[r][j] * fmpq(c, 6) for c, r in zip(_B2Z[i], range(4)) if c), zero) for j in range(4)]
+           for i in range(4)]
+    return [[sum((tmp[i][r] * fmpq(c, 6) for c, r in zip(_B2Z[j], range(4)) if c), zero) for j in range(4)]
+            for i in range(4)]
+
+
+def piece_nets(level0, centre, lam, zero):
+    """{piece: 4 x 4 Bezier net} of one coordinate (or one basis part) on a bulk quadrant."""
+    V = local_value(level0, centre, lam, zero)
+    return {name: _bezier([[V(_OFFSET[name][0] + i, _OFFSET[name][1] + j) for j in range(4)] for i in range(4)], zero)
+            for name in PIECES}
+
+
+XB, YB = ("X+", "X-"), ("Y0", "Y+", "Y-")
+
+
+def _real_forms(net, prec):
+    """(Re, Im) Bernstein forms of a 4 x 4 acb net."""
+    return tuple(BernsteinForm((4, 4), [getattr(acb(net[i][j]), part) for i in range(4) for j in range(4)], prec=prec)
+                 for part in ("real", "imag"))
+
+
+def _jac(a, b):
+    return bernstein_jacobian_determinant([a, b]).coeffs
+
+
+def complex_det(fa, fb):
+    """Bernstein coefficients (acb) of the bilinear D(A, B) = det d(A, B)/d(u, v) for complex nets given by
+    their (Re, Im) forms."""
+    rr, ii, ri, ir = _jac(fa[0], fb[0]), _jac(fa[1], fb[1]), _jac(fa[0], fb[1]), _jac(fa[1], fb[0])
+    return [acb(a - b, c + d) for a, b, c, d in zip(rr, ii, ri, ir)]
+
+
+def basis_nets(fam):
+    """{basis part: {piece: 4 x 4 net}} of the family's five basis parts."""
+    return {name: piece_nets(f, c, lam, fam.zero) for name, (f, c, lam) in fam.parts().items()}
+
+
+def _ball(lo, hi):
+    lo, hi = fmpq(lo), fmpq(hi)
+    return arb((lo + hi) / 2, (hi - lo) / 2)
+
+
+def _parts(T):
+    """The pieces (or outer curves) that a Taylor dict keyed (i, j, part) covers."""
+    return sorted({key[2] for key in T})
+
+
+def layer_level0(fam, q):
+    """(x(t, p), y(t, p), x_C, y_C) at integer sectors t (any sign) for the layer quadrant q, as analytic
+    functions of h (fam.h of any type): x = (v^(p) w^t - v^(p~) w^(-t-eps))/(2i) (one mode, every t),
+    y = alpha U(p) + (v^_y(p) e^(i sigma (2 h t - 1)) + v^_y(p~) e^(-i sigma (2 h (t + eps) - 1)))/2 for t >= 0
+    and y's reflection in ray 0 for t < 0 (ray t -> ray -t, quadrant t (a, b) -> quadrant -t-1 (b, a))."""
+    h, sig = fam.h, fam.sigma
+    i2 = acb(0, 2)
+    eis = acb(0, 1) * sig
+
+    def eps(pos):
+        return 0 if pos[1] == 0 else 1
+
+    def x(t, pos):
+        return (fam.vx[_POS[pos]] * (h * (fam.ix * t)).exp()
+                - fam.vx[_POS[_swap(pos)]] * (h * (fam.ix * (-t - eps(pos)))).exp()) / i2
+
+    def y(t, pos):
+        if t < 0:
+            t, pos = (-t, pos) if pos[1] == 0 else (-t - 1, _swap(pos))
+        return (fam.alpha * fam.U[_POS[pos]]
+                + (fam.vy[_POS[pos]] * (h * (2 * eis * t) - eis).exp()
+                   + fam.vy[_POS[_swap(pos)]] * (eis - h * (2 * eis * (t + eps(pos)))).exp()) / 2)
+    return x, y, fam.zero, fam.yc
+
+
+def layer_value(level0, centre, lam, q, zero):
+    """``value(A, B)``: level-1 values of layer quadrant q >= 0 (ray 0 sharp; as tagged_map.level1_values:
+    lam times the level-0 value on the two-ring, the ghost row 2 P(A, 0) - P(A, 1) across ray 0, the sharp
+    edge's midpoint at ray 0's (3, 0), the level-1 rules elsewhere)."""
+    def lev0(d, a, b):
+        dd, a2, b2 = canonical(a, b)
+        return centre if (a2, b2) == CENTRE else level0(d + dd, (a2, b2))
+
+    def value(A, B):
+        if (A, B) == (0, 0):
+            return lam * centre
+        if B == -1 and q == 0:
+            return 2 * value(A, 0) - value(A, 1)
+        d, A2, B2 = canonical(A, B)
+        t = q + d
+        if (A2, B2) in _POS:
+            return lam * level0(t, (A2, B2))
+        if B2 == 0 and t == 0:
+            return (level0(0, (1, 0)) + level0(0, (2, 0))) / 2
+        acc = zero
+        for (a, b), w in level1_rule(A2, B2).items():
+            acc = acc + lev0(t, a, b) * w
+        return acc
+    return value
+
+
+def layer_nets(fam, q):
+    """{piece: (X net, Y net)} (4 x 4 Bezier, values of fam.h's type) of layer quadrant q."""
+    x, y, xc, yc = layer_level0(fam, q)
+    VX = layer_value(x, xc, fam.lam1, q, fam.zero)
+    VY = layer_value(y, yc, fam.lam2, q, fam.zero)
+    out = {}
+    for name in PIECES:
+        oa, ob = _OFFSET[name]
+        out[name] = tuple(_bezier([[V(oa + i, ob + j) for j in range(4)] for i in range(4)], fam.zero)
+                          for V in (VX, VY))
+    return out
+
+
+_BIN3, _BIN2, _BIN5 = (1, 3, 3, 1), (1, 2, 1), (1, 5, 10, 10, 5, 1)
+
+
+def curve_points(nets, name):
+    """The 4 Bezier points of one outer curve (CURVES) of a quadrant's nets {piece: 4 x 4}, counterclockwise."""
+    piece, side, sign = CURVES[name]
+    net = nets[piece]
+    pts = [net[3][j] for j in range(4)] if side == "s" else [net[i][3] for i in range(4)]
+    return pts if sign > 0 else pts[::-1]
+
+
+def _bprod(f, g):
+    """Bernstein coefficients (degree 5) of f g' for cubic Bezier values f, g (any ring)."""
+    gd = [3 * (g[i + 1] - g[i]) for i in range(3)]
+    out = []
+    for k in range(6):
+        acc = 0 * f[0]
+        for i in range(max(0, k - 2), min(3, k) + 1):
+            acc = acc + f[i] * gd[k - i] * fmpq(_BIN3[i] * _BIN2[k - i], _BIN5[k])
+        out.append(acc)
+    return out
+
+
+def _series_curves(nets, n):
+    """{curve: [order m: 4 acb]} of one coordinate's nets {piece: 4 x 4 acb_series}."""
+    out = {}
+    for name in CURVES:
+        pts = [_coeffs(z, n + 1) for z in curve_points(nets, name)]
+        out[name] = [[pts[p][m] for p in range(4)] for m in range(n + 1)]
+    return out
+
+
+def _trans_series(xc, yc, A1, A2, n):
+    """Taylor coefficients of a1 X Y' - a2 Y X' from the coordinates' (xc, yc: [m: 4 values]) and a_i's."""
+    P = [None] * (n + 1)
+    Q = [None] * (n + 1)
+    for m in range(n + 1):
+        for k in range(m + 1):
+            p, q = _bprod(xc[k], yc[m - k]), _bprod(yc[m - k], xc[k])
+            P[m] = p if P[m] is None else [a + b for a, b in zip(P[m], p)]
+            Q[m] = q if Q[m] is None else [a + b for a, b in zip(Q[m], q)]
+    out = []
+    for m in range(n + 1):
+        acc = [0 * P[0][0]] * 6
+        for u in range(m + 1):
+            acc = [a + A1[u] * p - A2[u] * q for a, p, q in zip(acc, P[m - u], Q[m - u])]
+        out.append(acc)
+    return out

@@ -1,0 +1,241 @@
+"""R for every dart K >= K0: det J_Phi of the family's nets as Taylor models in h (trusted).
+
+Three regions of quadrants q (docs/tagged_c1.md, item 6, "Dividing by h exactly"): the bulk s = q/K in
+[s0, 1/2] (K det J_Phi), the middle (K^3 det J_Phi/q^2 as a function of s and w = 1/q) and the layer
+quadrants 0..T-1 (K^3 det J_Phi). The Taylor coefficients come from acb_series arithmetic, the remainders
+from Cauchy's estimate on the complex h-square [-r, r]^2 (:func:`disc_bounds`, :func:`layer_disc`); the
+coefficients that vanish exactly (:mod:`.dart_zeros`) are dropped.
+"""
+
+from __future__ import annotations
+
+from flint import acb, arb, ctx, fmpq
+
+from ccproof.rigorous import BernsteinForm
+
+from .dart_family import (
+    PIECES,
+    XB,
+    YB,
+    Family,
+    _ball,
+    _coeffs,
+    _hvar,
+    _jac,
+    _parts,
+    _real_forms,
+    basis_nets,
+    complex_det,
+    layer_nets,
+    series_cap,
+)
+
+
+def taylor_dets(sigma, n, prec=128, **control):
+    """The Taylor coefficients in h of D_ij = D(X_i, Y_j) for the basis parts X_i (X+, X-) and Y_j (Y0, Y+, Y-):
+    {(i, j, piece): [coefficient list (acb) of h^m, m = 0..n]}. D is bilinear, so the coefficient of h^m is
+    sum_(k + l = m) D(X_i,k, Y_j,l) of the nets' own Taylor coefficients (acb_series, rigorous)."""
+    with ctx.workprec(prec), series_cap(n):
+        fam = Family(_hvar(n), sigma, **control)
+        nets = basis_nets(fam)
+        forms = {(name, piece, m): _real_forms([[_coeffs(z, n + 1)[m] for z in row] for row in net], prec)
+                 for name, pn in nets.items() for piece, net in pn.items() for m in range(n + 1)}
+        out = {}
+        for i in XB:
+            for j in YB:
+                for piece in PIECES:
+                    coeffs = []
+                    for m in range(n + 1):
+                        acc = None
+                        for k in range(m + 1):
+                            d = complex_det(forms[(i, piece, k)], forms[(j, piece, m - k)])
+                            acc = d if acc is None else [a + b for a, b in zip(acc, d)]
+                        coeffs.append(acc)
+                    out[(i, j, piece)] = coeffs
+        return out
+
+
+def disc_bounds(sigma, r, grid=4, prec=128, **control):
+    """M with |D_ij(h)| <= M[(i, j, piece)] (every Bernstein coefficient) for every complex h in the square
+    [-r, r]^2 (grid x grid acb boxes; every system on each box proved regular by arb, so D_ij is analytic
+    on the disc |h| <= r). Raises ZeroDivisionError where a box decides nothing."""
+    M = {}
+    with ctx.workprec(prec):
+        for a in range(grid):
+            for b in range(grid):
+                re = _ball(-r + 2 * r * fmpq(a, grid), -r + 2 * r * fmpq(a + 1, grid))
+                im = _ball(-r + 2 * r * fmpq(b, grid), -r + 2 * r * fmpq(b + 1, grid))
+                fam = Family(acb(re, im), sigma, **control)
+                nets = basis_nets(fam)
+                forms = {(name, piece): _real_forms(net, prec)
+                         for name, pn in nets.items() for piece, net in pn.items()}
+                for i in XB:
+                    for j in YB:
+                        for piece in PIECES:
+                            d = complex_det(forms[(i, piece)], forms[(j, piece)])
+                            bound = max((abs(z).upper() for z in d), key=lambda x: x)
+                            if not bound.is_finite():
+                                raise ZeroDivisionError(f"disc box {a}, {b}: no bound")
+                            key = (i, j, piece)
+                            M[key] = bound if key not in M or bound > M[key] else M[key]
+    return M
+
+
+def kdet_box(T, M, s_lo, s_hi, h_lo, h_hi, sigma, r, n, prec=128):
+    """(lower, upper) bounds of K det J_Phi over the three pieces' Bernstein coefficients, for s in [s_lo, s_hi] and
+    h in [h_lo, h_hi] (0 < h_hi < r): sum_ij a_i(s) b_j(s) (sum_(m=1..n) d_ijm h^(m-1) + rho_ij) with
+    |rho_ij| <= M_ij h^n/(r^(n+1) (1 - h/r)) (Cauchy on |h| = r), the m = 0 terms being 0 exactly."""
+    with ctx.workprec(prec):
+        s, h = _ball(s_lo, s_hi), _ball(h_lo, h_hi)
+        E, F = acb(0, 2 * arb.pi() * s).exp(), acb(0, sigma * (2 * s - 1)).exp()
+        a, b = {"X+": E, "X-": 1 / E}, {"Y0": acb(1), "Y+": F, "Y-": 1 / F}
+        hr = arb(fmpq(h_hi)) / r
+        tail = arb(fmpq(h_hi)) ** n / (arb(r) ** (n + 1) * (1 - hr))
+        low, high = None, None
+        for piece in _parts(T):
+            tot = None
+            for i in XB:
+                for j in YB:
+                    coeffs, rad = T[(i, j, piece)], (M[(i, j, piece)] * tail).upper()
+                    w = a[i] * b[j]
+                    vals = []
+                    for c in range(len(coeffs[1])):
+                        acc = acb(0)
+                        for m in range(n, 0, -1):
+                            acc = acc * h + coeffs[m][c]
+                        vals.append(w * (acc + acb(arb(0, rad), arb(0, rad))))
+                    tot = vals if tot is None else [x + y for x, y in zip(tot, vals)]
+            lo = min((z.real.lower() for z in tot), key=lambda x: x)
+            hi = max((z.real.upper() for z in tot), key=lambda x: x)
+            low = lo if low is None or lo < low else low
+            high = hi if high is None or hi > high else high
+        return low, high
+
+
+def _omegas(sigma):
+    """a_i(s) b_j(s) = c_ij e^(i omega_ij s): {(i, j): (c_ij, omega_ij)} (acb, arb)."""
+    tp, es = 2 * arb.pi(), acb(0, sigma).exp()
+    a = {"X+": tp, "X-": -tp}
+    b = {"Y0": (acb(1), arb(0)), "Y+": (1 / es, 2 * sigma), "Y-": (es, -2 * sigma)}
+    return {(i, j): (b[j][0], a[i] + b[j][1]) for i in XB for j in YB}
+
+
+def middle_coeffs(T, sigma, L=24):
+    """e[(m, l)][piece] = sum_ij d_ijm c_ij (i omega_ij)^l/l! (Bernstein coefficient lists, acb): the
+    coefficient of s^l h^(m-1) in K det J_Phi = sum_ij a_i(s) b_j(s) sum_m d_ijm h^(m-1), for m = 1, 2 and
+    l <= L (the terms m >= 3 are evaluated directly)."""
+    om = _omegas(sigma)
+    out = {}
+    for m in (1, 2):
+        for l in range(L + 1):
+            for piece in _parts(T):
+                acc = None
+                for (i, j), (c, w) in om.items():
+                    f = c * (acb(0, w) ** l) / arb.fac_ui(l)
+                    v = [f * z for z in T[(i, j, piece)][m]]
+                    acc = v if acc is None else [x + y for x, y in zip(acc, v)]
+                out[(m, l, piece)] = acc
+    return out
+
+
+def middle_box(T, E, M, s_lo, s_hi, w_lo, w_hi, sigma, r, n, L=24, prec=128):
+    """(lower, upper) bounds of G = K det J_Phi/s^2 (= K^3 det J_Phi/q^2 at s = q h) on s in [s_lo, s_hi],
+    w = h/s in [w_lo, w_hi] (s_lo >= 0): the m = 1 part sum_(l >= 2) e_1l s^(l-2), the m = 2 part
+    w sum_(l >= 1) e_2l s^(l-1) (the coefficients e_10, e_11, e_20 being 0 exactly), the m >= 3 parts
+    a_i(s) b_j(s) d_ijm s^(m-3) w^(m-1), the tails of the exponential series (|omega s|^(L+1)/(L+1)!, with
+    the factor 1/(1 - |omega s|/(L + 2))) and the Cauchy remainder M_ij s^(n-2) w^n/(r^(n+1) (1 - h/r))."""
+    with ctx.workprec(prec):
+        s, w = _ball(s_lo, s_hi), _ball(w_lo, w_hi)
+        om = _omegas(sigma)
+        wmax = max((abs(x[1]).upper() for x in om.values()), key=lambda x: x)
+        z = wmax * arb(fmpq(s_hi))
+        if not z < L + 2:
+            raise ValueError("s too large for the exponential series")
+        # the tails of the exponential series, divided by s^2 (m = 1) and s (m = 2): |c_ij| = 1 and
+        # sum_(l > L) |omega s|^l/l! <= |omega s|^(L+1)/(L+1)!/(1 - |omega s|/(L + 2))
+        geo = z ** (L - 1) / arb.fac_ui(L + 1) / (1 - z / (L + 2))
+        h_hi = arb(fmpq(s_hi)) * arb(fmpq(w_hi))
+        ctail = arb(fmpq(s_hi)) ** (n - 2) * arb(fmpq(w_hi)) ** n / (arb(r) ** (n + 1) * (1 - h_hi / r))
+        ab = {k: c * acb(0, w_ * s).exp() for k, (c, w_) in om.items()}
+        low, high = None, None
+        for piece in _parts(T):
+            ncoef = len(T[("X+", "Y0", piece)][1])  # the pieces' (or curves') Bernstein coefficients
+            dmax = {m: max((abs(c).upper() for key in T if key[2] == piece for c in T[key][m]), key=lambda x: x)
+                    for m in (1, 2)}
+            rad1 = 6 * dmax[1] * wmax ** 2 * geo
+            rad2 = 6 * dmax[2] * wmax * geo * z * arb(fmpq(w_hi))
+            rem = sum((M[(i, j, piece)] * ctail for i in XB for j in YB), arb(0))
+            rad = (rad1 + rad2 + rem).upper()
+            for c in range(ncoef):
+                g1 = acb(0)
+                for l in range(L, 1, -1):
+                    g1 = g1 * s + E[(1, l, piece)][c]
+                g2 = acb(0)
+                for l in range(L, 0, -1):
+                    g2 = g2 * s + E[(2, l, piece)][c]
+                g = g1 + w * g2
+                for m in range(3, n + 1):
+                    g += sum((ab[k] * T[k + (piece,)][m][c] for k in ab), acb(0)) * s ** (m - 3) * w ** (m - 1)
+                v = g.real + arb(0, rad)
+                low = v.lower() if low is None or v.lower() < low else low
+                high = v.upper() if high is None or v.upper() > high else high
+        return low, high
+
+
+def layer_taylor(q, sigma, n, prec=128):
+    """{piece: [Bernstein coefficients (arb) of det J_Phi's h^m, m = 0..n]} of layer quadrant q (real parts:
+    the values are real for real h)."""
+    with ctx.workprec(prec), series_cap(n):
+        fam = Family(_hvar(n), sigma)
+        out = {}
+        for piece, (X, Y) in layer_nets(fam, q).items():
+            fx = [BernsteinForm((4, 4), [_coeffs(X[i][j], n + 1)[m].real for i in range(4) for j in range(4)],
+                                prec=prec) for m in range(n + 1)]
+            fy = [BernsteinForm((4, 4), [_coeffs(Y[i][j], n + 1)[m].real for i in range(4) for j in range(4)],
+                                prec=prec) for m in range(n + 1)]
+            coeffs = []
+            for m in range(n + 1):
+                acc = None
+                for k in range(m + 1):
+                    d = _jac(fx[k], fy[m - k])
+                    acc = d if acc is None else [a + b for a, b in zip(acc, d)]
+                coeffs.append(acc)
+            out[piece] = coeffs
+        return out
+
+
+def layer_disc(q, sigma, r, grid=12, prec=128):
+    """{piece: M} with |det J_Phi(h)| <= M (every Bernstein coefficient) for complex h in [-r, r]^2."""
+    M = {}
+    with ctx.workprec(prec):
+        for a in range(grid):
+            for b in range(grid):
+                re = _ball(-r + 2 * r * fmpq(a, grid), -r + 2 * r * fmpq(a + 1, grid))
+                im = _ball(-r + 2 * r * fmpq(b, grid), -r + 2 * r * fmpq(b + 1, grid))
+                fam = Family(acb(re, im), sigma)
+                for piece, (X, Y) in layer_nets(fam, q).items():
+                    d = complex_det(_real_forms(X, prec), _real_forms(Y, prec))
+                    bound = max((abs(z).upper() for z in d), key=lambda x: x)
+                    if not bound.is_finite():
+                        raise ZeroDivisionError(f"layer disc box {a}, {b}: no bound")
+                    M[piece] = bound if piece not in M or bound > M[piece] else M[piece]
+    return M
+
+
+def layer_box(T, M, h_lo, h_hi, r, n, order=3, prec=128):
+    """(lower, upper) bounds of K^order det J_Phi on h in [h_lo, h_hi] from the Taylor model (the
+    coefficients of h^0 .. h^(order-1) being 0 exactly)."""
+    with ctx.workprec(prec):
+        h = _ball(h_lo, h_hi)
+        tail = arb(fmpq(h_hi)) ** (n + 1 - order) / (arb(r) ** (n + 1) * (1 - arb(fmpq(h_hi)) / r))
+        low, high = None, None
+        for piece, coeffs in T.items():
+            rad = (M[piece] * tail).upper()
+            for c in range(len(coeffs[0])):
+                acc = arb(0)
+                for m in range(n, order - 1, -1):
+                    acc = acc * h + coeffs[m][c]
+                acc += arb(0, rad)
+                low = acc.lower() if low is None or acc.lower() < low else low
+                high = acc.upper() if high is None or acc.upper() > high else high
+        return low, high
