@@ -20,12 +20,33 @@ quadrants next to the sharp ray (:func:`layer_nets`: ghost rows, the sharp midpo
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 from flint import acb, acb_mat, acb_series, arb, ctx, fmpq, fmpq_mat
 
 from ccproof.rigorous import BernsteinForm, bernstein_jacobian_determinant
 
 from .rules import CENTRE, canonical, level1_rule
 from .tagged_modes import _POS, ring_stencil
+
+
+@dataclass(frozen=True)
+class TaylorHints:
+    """The record's ``taylor`` hints (docs/certificates.md, "Every dart K >= K0"): they only choose orders and
+    boxes; every coefficient and bound is derived from them.
+
+    r : fmpq, the Cauchy radius (the complex h-square [-r, r]^2); disc_grid : int, grid x grid acb boxes
+    covering it; sigma_boxes : int, equal boxes of the sigma bracket; order, layer_order : int, Taylor orders
+    in h (bulk and middle; layer); exp_order : int, the middle's expansion of a_i(s) b_j(s) in s.
+    """
+
+    r: fmpq
+    disc_grid: int
+    sigma_boxes: int
+    order: int
+    layer_order: int
+    exp_order: int
+
 
 _B2Z = ((1, 4, 1, 0), (0, 4, 2, 0), (0, 2, 4, 0), (0, 1, 4, 1))  # uniform cubic B-spline -> Bezier, times 6
 
