@@ -1,16 +1,315 @@
-"""Exact facts behind the dropped Taylor coefficients of the dart family (trusted; Q(sqrt 5), exact).
+"""The Taylor coefficients that the dart family's models drop, computed exactly and checked to be 0 (trusted).
 
-L0 = lam(1) = (6 + sqrt 20)/16 is an eigenvalue of B(1) with a symmetric eigenvector rho, and
-adj(L0 - B(1)) kappa is a non-zero multiple of rho (:func:`exact_zeros`): what makes the family's
-coefficients of low order vanish at h = 0 (docs/tagged_c1.md, item 6, "The dropped coefficients").
+The Taylor models of det J_Phi (R), the transversality form (T) and the winding signs (W) of ``dart:K`` for
+every K >= K0 drop their lowest coefficients as exactly 0 (docs/tagged_c1.md, "A plan for every dart
+K >= 101", item 6, part Z). :func:`check_zeros` computes every dropped coefficient in exact arithmetic and
+checks that it is 0; :func:`exact_zeros` checks the facts in Q(sqrt 5) they rest on (L0 = lam(1) is an
+eigenvalue of B(1) with a symmetric eigenvector rho, and adj(L0 - B(1)) kappa is a non-zero multiple of rho).
+
+**The dropped coefficients** (every piece P1, P2, P3; every outer curve; x's parts X+-, y's Y0, Y+-):
+
+=========================== ==========================================================================
+bulk det                    D_ij's h^0 coefficient (D_ij = det d(X_i, Y_j)/d(u, v)), every (i, j)
+middle det                  e_10, e_11, e_20: the s^0 h^0, s^1 h^0, s^0 h^1 coefficients of K det J_Phi
+layer det, q = 0, 1, 2      det J_Phi's h^0, h^1, h^2
+bulk T                      T_ij's h^0, every (i, j)
+middle T                    e_10, e_11, e_20 of K (a1 X Y' - a2 Y X')
+layer T, q = 0, 1, 2        h^0, h^1, h^2 of a1 X Y' - a2 Y X'
+W middle                    Y at s = h = 0 on every curve point
+W layer, q = 0, 1, 2        Y's h^0 on every curve point, and h^1 at ray 0's end point (q = 0, P1s1, point 0)
+=========================== ==========================================================================
+
+**The degree argument (why a finite grid suffices).** Let a = 2 pi (x's angle unit), b = 2 sigma (y's),
+c = cos(sigma), t = sin(sigma), l = ln L0. Every value of the family is a power series in (a h, b h, a s, b s)
+with coefficients polynomial in (c, t, l) over Q(sqrt 5, i):
+
+* x = E X+ + E^-1 X-, E = e^(i a s), and X+- are power series in a h (v^_x solves the bordered system of
+  B(e^(i a h)) at lam(cos(a h)), whose Taylor coefficient of h^m is a^m times a constant; the offsets
+  e^(i a delta h) likewise). No c, t, l.
+* y = Y0 + F Y+ + F^-1 Y-, F = e^(i sigma (2 s - 1)) = e^(i b s) (c - i t), F^-1 = e^(-i b s) (c + i t); Y+- are
+  power series in b h; Y0 = alpha U(lam2), alpha = -c (lam2 - 1/2)/((lam2 - 1/2) U(1,0) - (lam2 - L0)/2), a
+  power series in b h times c. So y is homogeneous linear in (c, t); the layer's y (ray 0 at s = 0, sector t
+  at s = t h, integer offsets) is the same with s = t h, so a power series in (a h, b h) times (c, t).
+* a_i = -ln lam_i = -l - ln(lam_i/L0), lam_i/L0 = 1 + (a power series in a h, resp. b h, without constant):
+  affine in l.
+
+Each dropped quantity is bilinear in (x, y) (det J_Phi, Y X', X Y'), times a_i for T, or linear in y (W), with
+exact rational Bezier and patch weights. Its coefficient of s^k h^m is therefore a polynomial in
+(a, b, c, t, l) with coefficients in Q(sqrt 5, i), of degree <= k + m in a and <= k + m in b (a monomial
+(a h)^i (a s)^j (b h)^i' (b s)^j' contributes to s^k h^m only if i + i' = m, j + j' = k), homogeneous of
+degree <= 1 in (c, t) and of degree <= 1 in l. Every dropped coefficient has k + m <= 2 (the middle's K det
+J_Phi = det J_Phi / h: its e_10, e_11, e_20 are det J_Phi's s^0 h^1, s^1 h^1, s^0 h^2; the layer's h^m have
+k = 0, m <= 2). A polynomial P of degree <= 2 in a, <= 2 in b and <= 1 in each of c, t, l that vanishes on
+the grid a, b in {1, 2, 3}, c, t, l in {1, 2} is 0: as a polynomial in a of degree <= 2 it has three roots for
+each fixed (b, c, t, l) of the grid, so each of its coefficients (polynomials in (b, c, t, l)) vanishes on the
+smaller grid; repeat for b (three points), c, t, l (two points). So every dropped coefficient is 0 at the
+true (2 pi, 2 sigma, cos sigma, sin sigma, ln L0) for every sigma: the check does not use the sigma bracket.
+On the grid c^2 + t^2 = 1 need not hold: the identities used (y linear in (c, t)) are polynomial.
+
+**The exact arithmetic.** At a grid point each quantity is a power series in h truncated after h^2 with
+coefficients in Q(theta) = Q(sqrt 5, i), theta = sqrt 5 + i, m(theta) = 0, m(x) = x^4 - 8 x^2 + 36. The ring
+Q(theta)[h]/(h^3) is represented as Q[x]/(m^3) (fmpq_poly modulo m^3, all in C): theta~, the root of m in
+Q[x]/(m^3) lifting x (by Newton's step, checked m(theta~) = 0 at import), and h = m(x). theta -> theta~,
+h -> m(x) is an isomorphism (e(theta~) is a unit for e != 0, so sum e_k(theta~) m^k = 0 mod m^3 forces
+e_0 = e_1 = e_2 = 0; both sides have dimension 12), and h^0 .. h^(k-1) of an element all vanish exactly when
+m^k divides its representative: the checks are polynomial remainders, the coefficients themselves are read
+off only where one is not 0 (:meth:`QS.coeffs`). Truncated series are exact here: e^(i k h) = 1 + i k h -
+k^2 h^2/2, and sqrt(20 (1 + z)) = 2 sqrt 5 (1 + z/2 - z^2/8), ln(1 + z) = z - z^2/2 for z in (h) (z^3 = 0).
+The bordered 7 x 7 systems are solved by Gauss-Jordan over the ring (unit pivots: the system at h = 0 is
+regular), U from the exact polynomials of :mod:`.dart_family`, alpha, and the level-1 nets by the family's
+own assembly (``piece_nets``, ``layer_value``, ``_bezier``; exact fmpq weights). det J_Phi's h^m coefficient
+is a polynomial of degree <= (5, 5) in the patch parameters (u, v): it is checked on the 6 x 6 grid u, v in
+{0, 1/5, ..., 1}; the transversality form's and the curve points' coefficients are checked as the
+Bernstein coefficients themselves. Parts that depend on fewer of (a, b, c, t) (X's nets on a, Y+-'s on b)
+are computed once and counted at every grid point they belong to.
 """
 
 from __future__ import annotations
 
-from flint import fmpq
+import itertools
 
-from .dart_family import _B1, _NPOLY
-from .tagged_modes import _POS
+from flint import fmpq, fmpq_poly
+
+from .dart_family import (
+    _B1,
+    _NPOLY,
+    _OFFSET,
+    CURVES,
+    PIECES,
+    XB,
+    YB,
+    _bezier,
+    _bprod,
+    curve_points,
+    layer_value,
+    piece_nets,
+)
+from .errors import CertificateError
+from .tagged_modes import _POS, ring_stencil
+
+GRID_AB = (1, 2, 3)  # degree <= 2 in a and in b
+GRID_CT = (1, 2)  # degree <= 1 in c, t, l
+
+ROWS = ("bulk det: D_ij h^0", "middle det: e_10, e_11, e_20", "bulk T: T_ij h^0", "middle T: e_10, e_11, e_20",
+        "W middle: Y(s = h = 0)", "layer det: h^0, h^1, h^2", "layer T: h^0, h^1, h^2",
+        "W layer: Y h^0 (h^1 at ray 0's end)")
+
+# --- Q(sqrt 5, i)[h]/(h^3) as Q[x]/(m^3) ---------------------------------------------------------------------
+
+_X = fmpq_poly([0, 1])
+_MOD = [fmpq_poly([1]), _X ** 4 - 8 * _X ** 2 + 36]  # m^0, m, m^2, m^3: h^k divides exactly when m^k does
+_MOD += [_MOD[1] ** 2, _MOD[1] ** 3]
+_M3 = _MOD[3]
+
+
+def _inv_raw(p):
+    g, s, _ = p.xgcd(_M3)
+    if g.degree() != 0:
+        raise ZeroDivisionError("not a unit of Q(sqrt 5, i)[h]/(h^3)")
+    s = (s / g[0]) % _M3
+    if (s * p) % _M3 != 1:
+        raise ZeroDivisionError("not a unit of Q(sqrt 5, i)[h]/(h^3)")
+    return s
+
+
+def _lift_theta():
+    th = _X
+    for _ in range(2):  # Newton: m(th) = 0 mod m^2, then mod m^4
+        th = (th - _MOD[1](th) * _inv_raw(_MOD[1].derivative()(th) % _M3)) % _M3
+    if not (_MOD[1](th) % _M3).is_zero() or not ((th - _X) % _MOD[1]).is_zero():
+        raise AssertionError("theta~ is not the root of m in Q[x]/(m^3) lifting x")
+    return th
+
+
+_TH = _lift_theta()
+
+
+def _raw(z):
+    return z.p if isinstance(z, QS) else fmpq_poly([fmpq(z)])
+
+
+class QF:
+    """p + q sqrt 5 + i (r + u sqrt 5) (fmpq components): one coefficient of a :class:`QS`, for reading."""
+
+    __slots__ = ("p", "q", "r", "u")
+
+    def __init__(self, e):  # e: a polynomial in theta, degree < 4; theta^2 = 4 + 2 i sqrt 5, theta^3 = 2 sqrt 5 + 14 i
+        c = [e[k] for k in range(4)]
+        self.p, self.q, self.r, self.u = c[0] + 4 * c[2], c[1] + 2 * c[3], c[1] + 14 * c[3], 2 * c[2]
+
+    def is_zero(self):
+        return self.p == 0 and self.q == 0 and self.r == 0 and self.u == 0
+
+
+class QS:
+    """A power series in h truncated after h^2 with coefficients in Q(sqrt 5, i), exact: the class of the
+    fmpq_poly ``p`` (degree < 12) in Q[x]/(m^3) (module docstring).
+
+    Examples
+    --------
+    >>> e = QS(1) + I * 3 * H - H * H * fmpq(9, 2)  # e^(3 i h)
+    >>> [(z.p, z.r) for z in e.c], (e * (QS(1) - I * 3 * H - H * H * fmpq(9, 2))).c[2].p
+    ([(1, 0), (0, 3), (-9/2, 0)], 0)
+    """
+
+    __slots__ = ("p",)
+
+    def __init__(self, p=0):
+        self.p = p if isinstance(p, fmpq_poly) else fmpq_poly([fmpq(p)])
+
+    def __add__(self, o):
+        return QS(self.p + _raw(o))
+
+    __radd__ = __add__
+
+    def __sub__(self, o):
+        return QS(self.p - _raw(o))
+
+    def __rsub__(self, o):
+        return QS(_raw(o) - self.p)
+
+    def __neg__(self):
+        return QS(-self.p)
+
+    def __mul__(self, o):
+        if isinstance(o, QS):
+            return QS((self.p * o.p) % _M3)
+        return QS(self.p * fmpq(o))
+
+    __rmul__ = __mul__
+
+    def inv(self):
+        return QS(_inv_raw(self.p))
+
+    def __truediv__(self, o):
+        return self * o.inv() if isinstance(o, QS) else QS(self.p / fmpq(o))
+
+    def __rtruediv__(self, o):
+        return QS(o) * self.inv()
+
+    def is_zero(self):
+        return self.p.is_zero()
+
+    def vanishes(self, k):
+        """True iff the coefficients of h^0 .. h^(k-1) are all 0."""
+        return (self.p % _MOD[k]).is_zero()
+
+    def coeffs(self):
+        """[e_0, e_1, e_2]: the coefficients of h^0, h^1, h^2 as polynomials in theta (degree < 4)."""
+        return _coeffs(self.p)
+
+    @property
+    def c(self):
+        """[QF of h^0, h^1, h^2]."""
+        return [QF(e) for e in self.coeffs()]
+
+
+def _coeffs(p):
+    out, r = [], p
+    for k in range(3):
+        e = r % _MOD[1]
+        out.append(e)
+        if k < 2:
+            r, rem = divmod((r - e(_TH)) % _MOD[3 - k], _MOD[1])
+            if not rem.is_zero():
+                raise AssertionError("h-coefficients: not divisible by h")
+    return out
+
+
+ONE = QS(1)
+H = QS(_MOD[1])  # h
+I = QS(((_TH ** 3 - 2 * _TH) / 12) % _M3)  # i = (theta^3 - 2 theta)/12
+SQRT20 = (QS(_TH) - I) * 2  # 2 sqrt 5
+if not ((I * I + 1).is_zero() and (SQRT20 * SQRT20 - 20).is_zero() and (H * H * H).is_zero()):
+    raise AssertionError("i, sqrt 5, h in Q[x]/(m^3)")
+L0 = (SQRT20 + 6) / 16  # lam(1), the root of 16 x^2 - 12 x + 1 with the + sign
+L0_LOW = (6 - SQRT20) / 16  # 1/(16 L0)
+_IH, _H2 = I * H, H * H
+
+
+_EXP = {}
+
+
+def _exp_i(k):
+    """e^(i k h) = 1 + i k h - k^2 h^2/2 (k an fmpq; memoized, QS is never changed in place)."""
+    k = fmpq(k)
+    if k not in _EXP:
+        _EXP[k] = ONE + _IH * k - _H2 * (k * k / 2)
+    return _EXP[k]
+
+
+def lam_series(k):
+    """lam(cos(k h)) = (5 + c + sqrt((1 + c)(9 + c)))/16, c = cos(k h) = 1 - k^2 h^2/2, the root expanded at 20."""
+    c = ONE - _H2 * (fmpq(k) ** 2 / 2)
+    g = (c + 1) * (c + 9)
+    z = g / 20 - 1
+    root = SQRT20 * (ONE + z / 2 - z * z / 8)
+    if not z.vanishes(1) or not (root * root - g).is_zero():
+        raise CertificateError("sqrt((1 + c)(9 + c)) at h = 0 is not 2 sqrt 5")
+    return (c + 5 + root) / 16
+
+
+def _log_ratio(lam):
+    """ln(lam/L0) = z - z^2/2, z = lam/L0 - 1 in (h)."""
+    z = lam / L0 - 1
+    if not z.vanishes(1):
+        raise CertificateError("lam(0) != L0")
+    return z - z * z / 2
+
+
+def _solve(A, b):
+    """Gauss-Jordan over Q(sqrt 5, i)[h]/(h^3) with unit pivots; ZeroDivisionError if A(h = 0) is singular."""
+    n = len(A)
+    M = [list(A[i]) + [b[i]] for i in range(n)]
+    for c in range(n):
+        piv = next((r for r in range(c, n) if not M[r][c].vanishes(1)), None)
+        if piv is None:
+            raise ZeroDivisionError("singular bordered system")
+        M[c], M[piv] = M[piv], M[c]
+        inv = M[c][c].inv()
+        M[c] = [z * inv for z in M[c]]
+        for r in range(n):
+            if r != c and not M[r][c].is_zero():
+                f = M[r][c]
+                M[r] = [z - f * w for z, w in zip(M[r], M[c])]
+    return [M[r][n] for r in range(n)]
+
+
+def bordered(k, lam, stencil):
+    """v^ (6 QS): B(e^(i k h)) v^ = lam v^, v^(1,0) = 1 (the bordered 7 x 7 system A v = e_7)."""
+    B = [[QS(0) for _ in range(6)] for _ in range(6)]
+    for i, row in enumerate(stencil):
+        for (d, pos), x in row.items():
+            B[i][_POS[pos]] = B[i][_POS[pos]] + _exp_i(fmpq(k) * d) * fmpq(x)
+    A = [[(B[i][j] - lam) if i == j else B[i][j] for j in range(6)] + [QS(int(i == 0))] for i in range(6)]
+    A.append([QS(int(j == 0)) for j in range(6)] + [QS(0)])
+    return _solve(A, [QS(0)] * 6 + [QS(1)])[:6]
+
+
+class _Mode:
+    """lam(cos(k h)) and v^ for one angle unit k (and U(lam) for y's mode)."""
+
+    def __init__(self, k, stencil, with_u=False):
+        self.k = fmpq(k)
+        self.lam = lam_series(self.k)
+        self.v = bordered(self.k, self.lam, stencil)
+        if with_u:
+            lam = self.lam
+            den = (lam - fmpq(1, 8)) * (lam - fmpq(1, 16)) * (lam - fmpq(1, 32)) * (lam - fmpq(1, 64)) * (lam - L0_LOW)
+            self.U = []
+            for p in _NPOLY:
+                acc = QS(0)
+                for coef in reversed(p):
+                    acc = acc * lam + fmpq(coef)
+                self.U.append(acc / den)
+
+
+def _eps(pos):
+    return 0 if pos[1] == 0 else 1
+
+
+def _sw(p):
+    return p if p[1] == 0 else (p[1], p[0])
 
 
 class QL0:
@@ -69,7 +368,9 @@ def exact_zeros():
     # rho: solve A rho = 0 with rho(1,0) = 1: drop row 0 (rank 5 since L0 is simple: checked by the solve)
     M = [[A[i][k] for k in range(1, 6)] + [-A[i][0]] for i in range(1, 6)]
     for c in range(5):  # Gauss-Jordan over Q(L0)
-        piv = next(r for r in range(c, 5) if not M[r][c].is_zero())
+        piv = next((r for r in range(c, 5) if not M[r][c].is_zero()), None)
+        if piv is None:
+            raise CertificateError("L0 is not a simple eigenvalue of B(1)")
         M[c], M[piv] = M[piv], M[c]
         inv = M[c][c].inv()
         M[c] = [z * inv for z in M[c]]
@@ -79,13 +380,13 @@ def exact_zeros():
                 M[r] = [z - f * w for z, w in zip(M[r], M[c])]
     rho = [QL0(1)] + [M[r][5] for r in range(5)]
     if not all(sum((A[i][k] * rho[k] for k in range(6)), QL0(0)).is_zero() for i in range(6)):
-        raise AssertionError("rho is no eigenvector of B(1) for L0")
+        raise CertificateError("rho is no eigenvector of B(1) for L0")
     pos = {p: k for p, k in _POS.items()}
     if not all(rho[pos[(a, b)]] == rho[pos[(b, a)]] for (a, b) in pos if b > 0 and (b, a) in pos):
-        raise AssertionError("rho is not symmetric in (a, b)")
+        raise CertificateError("rho is not symmetric in (a, b)")
     N = [sum((c * L0pow for c, L0pow in zip(p, _powers(L, len(p)))), QL0(0)) for p in _NPOLY]
     if not all((N[k] - N[0] * rho[k]).is_zero() for k in range(6)) or N[0].is_zero():
-        raise AssertionError("adj(L0 - B(1)) kappa is not a non-zero multiple of rho")
+        raise CertificateError("adj(L0 - B(1)) kappa is not a non-zero multiple of rho")
     return rho
 
 
@@ -95,3 +396,264 @@ def _powers(x, n):
         out.append(acc)
         acc = acc * x
     return out
+
+
+class ExactFamily:
+    """The family of :class:`.dart_family.Family` at one grid point (a, b, c, t), exact (:class:`QS` in h).
+
+    Parameters
+    ----------
+    a, b : int or fmpq
+        the angle units of x's mode (2 pi) and of y's mode (2 sigma)
+    c, t : int or fmpq
+        stand-ins for cos(sigma), sin(sigma)
+    stencil : list of dict, optional
+        the ring rows (``ring_stencil()``; a perturbed rule for the tests)
+    flip_alpha : bool
+        alpha -> -alpha (a perturbed family: the checks must fail)
+
+    Examples
+    --------
+    >>> fam = ExactFamily(1, 2, 1, 2)
+    >>> fam.vx[0].c[0].p, fam.lam1.c[1].is_zero(), (fam.yc.c[0].p, fam.yc.c[1].p)
+    (1, True, (0, 0))
+    """
+
+    def __init__(self, a, b, c, t, stencil=None, flip_alpha=False, _modes=None):
+        stencil = ring_stencil() if stencil is None else stencil
+        self.a, self.b, self.c, self.t = fmpq(a), fmpq(b), fmpq(c), fmpq(t)
+        mx, my = _modes or (_Mode(a, stencil), _Mode(b, stencil, with_u=True))
+        self.zero = QS(0)
+        self.lam1, self.lam2, self.vx, self.vy, self.U = mx.lam, my.lam, mx.v, my.v, my.U
+        lam = self.lam2
+        half = lam - fmpq(1, 2)
+        self.alpha = -(half * self.c) / (half * self.U[0] - (lam - L0) / 2)
+        if flip_alpha:
+            self.alpha = -self.alpha
+        self.yc = self.alpha * (lam - L0)
+        self.em, self.ep = QS(self.c) - I * self.t, QS(self.c) + I * self.t  # e^(-i sigma), e^(i sigma)
+
+    def parts(self):
+        """{basis part: (level0(delta, pos), centre, lam)} as :meth:`.dart_family.Family.parts`, exact."""
+        vx, vy, a, b = self.vx, self.vy, self.a, self.b
+        i2 = I * 2
+        return {
+            "X+": (lambda d, p: vx[_POS[p]] * _exp_i(a * d) / i2, self.zero, self.lam1),
+            "X-": (lambda d, p: -(vx[_POS[_sw(p)]] * _exp_i(-a * (d + _eps(p)))) / i2, self.zero, self.lam1),
+            "Y0": (lambda d, p: self.alpha * self.U[_POS[p]], self.yc, self.lam2),
+            "Y+": (lambda d, p: vy[_POS[p]] * _exp_i(b * d) / 2, self.zero, self.lam2),
+            "Y-": (lambda d, p: vy[_POS[_sw(p)]] * _exp_i(-b * (d + _eps(p))) / 2, self.zero, self.lam2),
+        }
+
+    def layer_level0(self, q):
+        """(x(t, pos), y(t, pos)) as :func:`.dart_family.layer_level0` (y reflected in ray 0 for t < 0)."""
+        vx, vy, a, b = self.vx, self.vy, self.a, self.b
+        i2 = I * 2
+
+        def x(t, pos):
+            return (vx[_POS[pos]] * _exp_i(a * t) - vx[_POS[_sw(pos)]] * _exp_i(-a * (t + _eps(pos)))) / i2
+
+        def y(t, pos):
+            if t < 0:
+                t, pos = (-t, pos) if pos[1] == 0 else (-t - 1, _sw(pos))
+            return (self.alpha * self.U[_POS[pos]]
+                    + (vy[_POS[pos]] * _exp_i(b * t) * self.em
+                       + vy[_POS[_sw(pos)]] * _exp_i(-b * (t + _eps(pos))) * self.ep) / 2)
+        return x, y
+
+    def layer_nets(self, q, coordinate):
+        """{piece: 4 x 4 Bezier net} of x (coordinate 0) or y (1) on layer quadrant q."""
+        f = self.layer_level0(q)[coordinate]
+        V = layer_value(f, self.zero if coordinate == 0 else self.yc, self.lam1 if coordinate == 0 else self.lam2,
+                        q, self.zero)
+        return {name: _bezier([[V(_OFFSET[name][0] + i, _OFFSET[name][1] + j) for j in range(4)] for i in range(4)],
+                              self.zero) for name in PIECES}
+
+
+# --- det J as a polynomial in the patch parameters (u, v), on the 6 x 6 grid; raw fmpq_poly below -------
+
+_GRID = [fmpq(k, 5) for k in range(6)]
+_BERN = [[(1 - u) ** 3, 3 * u * (1 - u) ** 2, 3 * u * u * (1 - u), u ** 3] for u in _GRID]
+_DBERN = [[-3 * (1 - u) ** 2, 3 * (1 - u) ** 2 - 6 * u * (1 - u), 6 * u * (1 - u) - 3 * u * u, 3 * u * u]
+          for u in _GRID]
+_UV = [(fmpq(i, 5), fmpq(j, 5)) for i in range(6) for j in range(6)]
+
+
+def _lin(ps, ws):
+    acc = fmpq_poly([0])
+    for p, w in zip(ps, ws):
+        if w != 0:
+            acc += p * w
+    return acc
+
+
+def _partials(net):
+    """[(X_u, X_v) at each (u, v) of the grid] (raw) of a 4 x 4 Bezier net of QS (tensor-product sums)."""
+    P = [[net[i][j].p for j in range(4)] for i in range(4)]
+    cols = [[P[i][j] for i in range(4)] for j in range(4)]
+    bu = [[_lin(cols[j], _BERN[u]) for j in range(4)] for u in range(6)]
+    du = [[_lin(cols[j], _DBERN[u]) for j in range(4)] for u in range(6)]
+    return [(_lin(du[u], _BERN[v]), _lin(bu[u], _DBERN[v])) for u in range(6) for v in range(6)]
+
+
+def _det(px, py):
+    """[X_u Y_v - X_v Y_u at each (u, v)] (raw, reduced)."""
+    return [(xu * yv - xv * yu) % _M3 for (xu, xv), (yu, yv) in zip(px, py)]
+
+
+class _Tally:
+    """{row: [checked, non-zero]}; with ``stop`` the first non-zero coefficient raises CertificateError."""
+
+    def __init__(self, stop, ells):
+        self.rows = {row: [0, 0] for row in ROWS}
+        self.stop, self.ells = stop, ells
+
+    def _at(self, kind, k):
+        if kind == "uv":
+            return f"(u, v) = ({_UV[k][0]}, {_UV[k][1]})"
+        if kind == "mid":  # two items per (u, v): S, S'
+            return f"{'e_10, e_20' if k % 2 == 0 else 'e_11'} at (u, v) = ({_UV[k // 2][0]}, {_UV[k // 2][1]})"
+        if kind == "midT":
+            return f"{'e_10, e_20' if k % 2 == 0 else 'e_11'} at l = {self.ells[k // 12]}, coefficient {k // 2 % 6}"
+        if kind == "coef":
+            return f"l = {self.ells[k // 6]}, coefficient {k % 6}"
+        return f"point {k}"
+
+    def add(self, row, items, where, kind):
+        """items: [(raw element, the h-orders that must be 0)]; where, kind: the items' place, for the reason."""
+        for k, (p, orders) in enumerate(items):
+            self.rows[row][0] += len(orders)
+            if (p % _MOD[max(orders) + 1]).is_zero():
+                continue
+            cs = _coeffs(p % _M3)
+            bad = [m for m in orders if not cs[m].is_zero()]
+            self.rows[row][1] += len(bad)
+            if bad and self.stop:
+                raise CertificateError(f"dropped coefficient not 0: row '{row}', h^{bad[0]} coefficient "
+                                       f"at {where}, {self._at(kind, k)}")
+
+
+def _raws(zs):
+    return [z.p for z in zs]
+
+
+def _trans(xs, ys, A):
+    """a1 X Y' - a2 Y X' (raw; degree-5 Bernstein coefficients, for every l one after the other)."""
+    P, Q = _bprod(xs, ys), _bprod(ys, xs)
+    return [(A1 * p - A2 * q).p for A1, A2 in A for p, q in zip(P, Q)]
+
+
+def _middle(G, fam):
+    """The middle's items from {(i, j): [raw G_ij at each place]}: sum_ij a_i(s) b_j(s) G_ij(h)/h with
+    a_i b_j = c_ij e^(i omega_ij s), c_ij = 1, e^(-i sigma), e^(i sigma) (Y0, Y+, Y-), omega_ij = +-a + (0, b, -b):
+    e_10, e_20 are h^1, h^2 of S = sum c_ij G_ij, e_11 is h^1 of S' = sum c_ij i omega_ij G_ij. Items alternate
+    (S, orders 1, 2), (S', order 1) per place."""
+    cj = {"Y0": (ONE, 0), "Y+": (fam.em, fam.b), "Y-": (fam.ep, -fam.b)}
+    om = {"X+": fam.a, "X-": -fam.a}
+    f0 = {ij: cj[ij[1]][0].p for ij in G}
+    f1 = {ij: (cj[ij[1]][0] * I * (om[ij[0]] + cj[ij[1]][1])).p for ij in G}
+    items = []
+    for k in range(len(next(iter(G.values())))):
+        s = s1 = fmpq_poly([0])
+        for ij, vals in G.items():
+            s += f0[ij] * vals[k]
+            s1 += f1[ij] * vals[k]
+        items += [(s, (1, 2)), (s1, (1,))]
+    return items
+
+
+def _check_point(fam, ells, tally, cache):
+    a, b, c, t = fam.a, fam.b, fam.c, fam.t
+    pt = f"(a, b, c, t) = ({a}, {b}, {c}, {t})"
+    keys = {"X+": ("X+", a), "X-": ("X-", a), "Y0": ("Y0", b, c), "Y+": ("Y+", b), "Y-": ("Y-", b)}
+    parts, nets, part = None, {}, {}
+    for name, key in keys.items():  # X's nets depend on a only, Y+-'s on b, Y0's on (b, c)
+        if key not in cache:
+            parts = parts or fam.parts()
+            n = piece_nets(*parts[name], fam.zero)
+            cache[key] = (n, {p: _partials(n[p]) for p in PIECES})
+        nets[name], part[name] = cache[key]
+    A = [(-_log_ratio(fam.lam1) - ell, -_log_ratio(fam.lam2) - ell) for ell in ells]  # a_i = -l - ln(lam_i/L0)
+    for piece in PIECES:
+        G = {(i, j): _det(part[i][piece], part[j][piece]) for i in XB for j in YB}
+        for (i, j), vals in G.items():
+            tally.add(ROWS[0], [(v, (0,)) for v in vals], f"{pt}, {piece}, D({i}, {j})", "uv")
+        tally.add(ROWS[1], _middle(G, fam), f"{pt}, {piece}", "mid")
+    for curve in CURVES:
+        pts = {n: curve_points(nets[n], curve) for n in nets}
+        G = {(i, j): _trans(pts[i], pts[j], A) for i in XB for j in YB}
+        for (i, j), vals in G.items():
+            tally.add(ROWS[2], [(v, (0,)) for v in vals],
+                      f"{pt}, {curve}, T({i}, {j})", "coef")
+        tally.add(ROWS[3], _middle(G, fam), f"{pt}, {curve}", "midT")
+        tally.add(ROWS[4], [((pts["Y0"][p] + pts["Y+"][p] * fam.em + pts["Y-"][p] * fam.ep).p, (0,)) for p in range(4)],
+                  f"{pt}, {curve}", "point")
+    for q in range(3):
+        if ("LX", a, q) not in cache:
+            xn = fam.layer_nets(q, 0)
+            cache[("LX", a, q)] = (xn, {p: _partials(xn[p]) for p in PIECES})
+        if ("LY", b, c, t, q) not in cache:  # y's layer nets depend on (b, c, t)
+            yn = fam.layer_nets(q, 1)
+            cache[("LY", b, c, t, q)] = (yn, {p: _partials(yn[p]) for p in PIECES})
+        (xn, xp), (yn, yp) = cache[("LX", a, q)], cache[("LY", b, c, t, q)]
+        for piece in PIECES:
+            tally.add(ROWS[5], [(v, (0, 1, 2)) for v in _det(xp[piece], yp[piece])],
+                      f"{pt}, q = {q}, {piece}", "uv")
+        for curve in CURVES:
+            xs, ys = curve_points(xn, curve), curve_points(yn, curve)
+            tally.add(ROWS[6], [(v, (0, 1, 2)) for v in _trans(xs, ys, A)],
+                      f"{pt}, q = {q}, {curve}", "coef")
+            end = q == 0 and curve == "P1s1"  # ray 0's end point: h^1 too
+            tally.add(ROWS[7], [(y.p, (0, 1) if end and k == 0 else (0,)) for k, y in enumerate(ys)],
+                      f"{pt}, q = {q}, {curve}", "point")
+    return tally
+
+
+def _run(points, ells, stencil, flip_alpha, stop):
+    stencil = ring_stencil() if stencil is None else stencil
+    tally, modes, cache = _Tally(stop, ells), {}, {}
+    for a, b, c, t in points:
+        if ("x", a) not in modes:
+            modes[("x", a)] = _Mode(a, stencil)
+        if ("y", b) not in modes:
+            modes[("y", b)] = _Mode(b, stencil, with_u=True)
+        fam = ExactFamily(a, b, c, t, stencil, flip_alpha, _modes=(modes[("x", a)], modes[("y", b)]))
+        _check_point(fam, ells, tally, cache)
+    return tally
+
+
+GRID = tuple(itertools.product(GRID_AB, GRID_AB, GRID_CT, GRID_CT))  # (a, b, c, t); l runs over GRID_CT
+
+
+def count_zeros(points=GRID, ells=GRID_CT, stencil=None, flip_alpha=False):
+    """{row: (coefficients checked, non-zero among them)} at the grid points ``points`` (a, b, c, t) and
+    l in ``ells``; ``stencil`` and ``flip_alpha`` perturb the rule or the family (the checks must then find
+    non-zero coefficients).
+
+    Examples
+    --------
+    >>> res = count_zeros(points=[(1, 2, 1, 2)])
+    >>> res["bulk det: D_ij h^0"], sum(n for n, _ in res.values()), sum(bad for _, bad in res.values())
+    ((648, 0), 2873, 0)
+    """
+    return {row: tuple(v) for row, v in _run(points, ells, stencil, flip_alpha, stop=False).rows.items()}
+
+
+def check_zeros(*, _stencil=None, _flip_alpha=False) -> str:
+    """Check exactly that every dropped Taylor coefficient of the dart family is 0 (module docstring: the
+    rows, and the degree argument for the grid a, b in {1, 2, 3}, c, t, l in {1, 2}), after
+    :func:`exact_zeros`' facts. Returns a one-line summary with the counts per row; raises CertificateError
+    naming the row, grid point and place of the first non-zero coefficient. ``_stencil`` and ``_flip_alpha``
+    are perturbations for the tests.
+
+    Examples
+    --------
+    >>> check_zeros()
+    'dropped coefficients exactly 0 on the grid a, b in (1, 2, 3), c, t, l in (1, 2): ... 103428 in all ...'
+    """
+    exact_zeros()
+    rows = _run(GRID, GRID_CT, _stencil, _flip_alpha, stop=True).rows
+    return (f"dropped coefficients exactly 0 on the grid a, b in {GRID_AB}, c, t, l in {GRID_CT}: "
+            + "; ".join(f"{row} {n}" for row, (n, _) in rows.items())
+            + f"; {sum(n for n, _ in rows.values())} in all (and rho = v^(0) is B(1)'s symmetric eigenvector for "
+            "L0 = (6 + sqrt 20)/16, adj(L0 - B(1)) kappa a non-zero multiple of it)")
