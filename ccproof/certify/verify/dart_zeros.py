@@ -648,8 +648,8 @@ def check_zeros(*, _stencil=None, _flip_alpha=False) -> str:
 
     Examples
     --------
-    >>> check_zeros()
-    'dropped coefficients exactly 0 on the grid a, b in (1, 2, 3), c, t, l in (1, 2): ... 103428 in all ...'
+    >>> print(check_zeros())
+    dropped coefficients exactly 0 on the grid a, b in (1, 2, 3), c, t, l in (1, 2): ... 103428 in all ...
     """
     exact_zeros()
     rows = _run(GRID, GRID_CT, _stencil, _flip_alpha, stop=True).rows
