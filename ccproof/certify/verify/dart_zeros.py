@@ -537,10 +537,15 @@ def _raws(zs):
     return [z.p for z in zs]
 
 
-def _trans(xs, ys, A):
-    """a1 X Y' - a2 Y X' (raw; degree-5 Bernstein coefficients, for every l one after the other)."""
-    P, Q = _bprod(xs, ys), _bprod(ys, xs)
-    return [(A1 * p - A2 * q).p for A1, A2 in A for p, q in zip(P, Q)]
+def _xy(xs, ys):
+    """(X Y', Y X'): the degree-5 Bernstein coefficients (raw, reduced) from the curves' cubic Bezier points."""
+    xs, ys = _raws(xs), _raws(ys)
+    return [z % _M3 for z in _bprod(xs, ys)], [z % _M3 for z in _bprod(ys, xs)]
+
+
+def _trans(PQ, A):
+    """a1 X Y' - a2 Y X' (raw; the Bernstein coefficients, for every l one after the other)."""
+    return [(a1 * p - a2 * q) % _M3 for a1, a2 in A for p, q in zip(*PQ)]
 
 
 def _middle(G, fam):
@@ -573,7 +578,7 @@ def _check_point(fam, ells, tally, cache):
             n = piece_nets(*parts[name], fam.zero)
             cache[key] = (n, {p: _partials(n[p]) for p in PIECES})
         nets[name], part[name] = cache[key]
-    A = [(-_log_ratio(fam.lam1) - ell, -_log_ratio(fam.lam2) - ell) for ell in ells]  # a_i = -l - ln(lam_i/L0)
+    A = [((-_log_ratio(fam.lam1) - ell).p, (-_log_ratio(fam.lam2) - ell).p) for ell in ells]  # -l - ln(lam_i/L0)
     for piece in PIECES:
         G = {(i, j): _det(part[i][piece], part[j][piece]) for i in XB for j in YB}
         for (i, j), vals in G.items():
@@ -581,7 +586,10 @@ def _check_point(fam, ells, tally, cache):
         tally.add(ROWS[1], _middle(G, fam), f"{pt}, {piece}", "mid")
     for curve in CURVES:
         pts = {n: curve_points(nets[n], curve) for n in nets}
-        G = {(i, j): _trans(pts[i], pts[j], A) for i in XB for j in YB}
+        for i, j in itertools.product(XB, YB):  # X Y', Y X' depend on (a, b) or (a, b, c) only
+            if (keys[i], keys[j], curve) not in cache:
+                cache[(keys[i], keys[j], curve)] = _xy(pts[i], pts[j])
+        G = {(i, j): _trans(cache[(keys[i], keys[j], curve)], A) for i in XB for j in YB}
         for (i, j), vals in G.items():
             tally.add(ROWS[2], [(v, (0,)) for v in vals],
                       f"{pt}, {curve}, T({i}, {j})", "coef")
@@ -601,7 +609,7 @@ def _check_point(fam, ells, tally, cache):
                       f"{pt}, q = {q}, {piece}", "uv")
         for curve in CURVES:
             xs, ys = curve_points(xn, curve), curve_points(yn, curve)
-            tally.add(ROWS[6], [(v, (0, 1, 2)) for v in _trans(xs, ys, A)],
+            tally.add(ROWS[6], [(v, (0, 1, 2)) for v in _trans(_xy(xs, ys), A)],
                       f"{pt}, q = {q}, {curve}", "coef")
             end = q == 0 and curve == "P1s1"  # ray 0's end point: h^1 too
             tally.add(ROWS[7], [(y.p, (0, 1) if end and k == 0 else (0,)) for k, y in enumerate(ys)],
