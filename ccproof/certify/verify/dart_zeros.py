@@ -1,67 +1,44 @@
-"""The Taylor coefficients that the dart family's models drop, computed exactly and checked to be 0 (trusted).
+"""The Taylor coefficients that the dart family's models drop, computed exactly and checked 0 (trusted).
 
-The Taylor models of det J_Phi (R), the transversality form (T) and the winding signs (W) of ``dart:K`` for
-every K >= K0 drop their lowest coefficients as exactly 0 (docs/tagged_c1.md, "A plan for every dart
-K >= 101", item 6, part Z). :func:`check_zeros` computes every dropped coefficient in exact arithmetic and
-checks that it is 0; :func:`exact_zeros` checks the facts in Q(sqrt 5) they rest on (L0 = lam(1) is an
-eigenvalue of B(1) with a symmetric eigenvector rho, and adj(L0 - B(1)) kappa is a non-zero multiple of rho).
+The Taylor models of det J_Phi (R), transversality (T) and winding (W) of ``dart:K``, every K >= K0, drop their
+lowest coefficients as 0 (docs/tagged_c1.md, "A plan for every dart K >= 101", item 6, part Z).
+:func:`check_zeros` computes each exactly and checks it is 0, after :func:`exact_zeros`. The rows (:data:`ROWS`;
+every piece, outer curve, basis part X+-, Y0, Y+-): D_ij = det d(X_i, Y_j)/d(u, v) and T_ij at h^0; the
+middle's e_10, e_11, e_20 (s^0 h^0, s^1 h^0, s^0 h^1) of K det J_Phi and of K (a1 X Y' - a2 Y X'); Y at
+s = h = 0; on the layer quadrants q = 0, 1, 2 the h^0, h^1, h^2 of det J_Phi and of a1 X Y' - a2 Y X', and
+Y's h^0 on every curve point (h^1 too at ray 0's end point: q = 0, P1s1, point 0).
 
-**The dropped coefficients** (every piece P1, P2, P3; every outer curve; x's parts X+-, y's Y0, Y+-):
+**The degree argument (why the grid suffices).** Let a = 2 pi, b = 2 sigma (x's and y's angle units),
+c = cos(sigma), t = sin(sigma), l = ln L0. (i) x = E X+ + E^-1 X-, E = e^(i a s), X+- power series in a h
+(v^_x solves the bordered system of B(e^(i a h)) at lam(cos(a h)); the offsets e^(i a delta h)); no c, t, l.
+(ii) y = Y0 + F Y+ + F^-1 Y-, F = e^(i sigma (2 s - 1)) = e^(i b s) (c - i t), F^-1 = e^(-i b s) (c + i t),
+Y+- power series in b h, Y0 = alpha U(lam2), alpha = -c (lam2 - 1/2)/((lam2 - 1/2) U(1,0) - (lam2 - L0)/2):
+so y is a power series in (b h, b s) homogeneous linear in (c, t); the layer's values are these at s = t h
+(t the integer sector). (iii) a_i = -ln lam_i = -l - ln(lam_i/L0), the log a power series in a h (b h)
+without constant: affine in l. Every dropped quantity is bilinear in (x, y) (det J_Phi, X Y', Y X'; times
+a_i for T) or linear in y (W), with exact rational weights, and a monomial (a h)^i (a s)^j (b h)^i' (b s)^j'
+reaches s^k h^m only if i + i' = m, j + j' = k. So its coefficient of s^k h^m is a polynomial in
+(a, b, c, t, l) over Q(sqrt 5, i) of degree <= k + m in a and in b and <= 1 in each of c, t, l. Every dropped
+coefficient has k + m <= 2 (the middle's e_10, e_11, e_20 are det J_Phi's s^0 h^1, s^1 h^1, s^0 h^2, as
+K det J_Phi = det J_Phi/h; the layer's have k = 0, m <= 2). A polynomial of degree <= 2 in a, <= 2 in b,
+<= 1 in each of c, t, l vanishing on a, b in {1, 2, 3}, c, t, l in {1, 2} is 0 (in a: three roots for each
+fixed (b, c, t, l) of the grid, so each coefficient vanishes on the smaller grid; then b, c, t, l). Hence
+every dropped coefficient is 0 at (2 pi, 2 sigma, cos sigma, sin sigma, ln L0) for every sigma: no sigma
+bracket is used (nor c^2 + t^2 = 1: the identities are polynomial).
 
-=========================== ==========================================================================
-bulk det                    D_ij's h^0 coefficient (D_ij = det d(X_i, Y_j)/d(u, v)), every (i, j)
-middle det                  e_10, e_11, e_20: the s^0 h^0, s^1 h^0, s^0 h^1 coefficients of K det J_Phi
-layer det, q = 0, 1, 2      det J_Phi's h^0, h^1, h^2
-bulk T                      T_ij's h^0, every (i, j)
-middle T                    e_10, e_11, e_20 of K (a1 X Y' - a2 Y X')
-layer T, q = 0, 1, 2        h^0, h^1, h^2 of a1 X Y' - a2 Y X'
-W middle                    Y at s = h = 0 on every curve point
-W layer, q = 0, 1, 2        Y's h^0 on every curve point, and h^1 at ray 0's end point (q = 0, P1s1, point 0)
-=========================== ==========================================================================
-
-**The degree argument (why a finite grid suffices).** Let a = 2 pi (x's angle unit), b = 2 sigma (y's),
-c = cos(sigma), t = sin(sigma), l = ln L0. Every value of the family is a power series in (a h, b h, a s, b s)
-with coefficients polynomial in (c, t, l) over Q(sqrt 5, i):
-
-* x = E X+ + E^-1 X-, E = e^(i a s), and X+- are power series in a h (v^_x solves the bordered system of
-  B(e^(i a h)) at lam(cos(a h)), whose Taylor coefficient of h^m is a^m times a constant; the offsets
-  e^(i a delta h) likewise). No c, t, l.
-* y = Y0 + F Y+ + F^-1 Y-, F = e^(i sigma (2 s - 1)) = e^(i b s) (c - i t), F^-1 = e^(-i b s) (c + i t); Y+- are
-  power series in b h; Y0 = alpha U(lam2), alpha = -c (lam2 - 1/2)/((lam2 - 1/2) U(1,0) - (lam2 - L0)/2), a
-  power series in b h times c. So y is homogeneous linear in (c, t); the layer's y (ray 0 at s = 0, sector t
-  at s = t h, integer offsets) is the same with s = t h, so a power series in (a h, b h) times (c, t).
-* a_i = -ln lam_i = -l - ln(lam_i/L0), lam_i/L0 = 1 + (a power series in a h, resp. b h, without constant):
-  affine in l.
-
-Each dropped quantity is bilinear in (x, y) (det J_Phi, Y X', X Y'), times a_i for T, or linear in y (W), with
-exact rational Bezier and patch weights. Its coefficient of s^k h^m is therefore a polynomial in
-(a, b, c, t, l) with coefficients in Q(sqrt 5, i), of degree <= k + m in a and <= k + m in b (a monomial
-(a h)^i (a s)^j (b h)^i' (b s)^j' contributes to s^k h^m only if i + i' = m, j + j' = k), homogeneous of
-degree <= 1 in (c, t) and of degree <= 1 in l. Every dropped coefficient has k + m <= 2 (the middle's K det
-J_Phi = det J_Phi / h: its e_10, e_11, e_20 are det J_Phi's s^0 h^1, s^1 h^1, s^0 h^2; the layer's h^m have
-k = 0, m <= 2). A polynomial P of degree <= 2 in a, <= 2 in b and <= 1 in each of c, t, l that vanishes on
-the grid a, b in {1, 2, 3}, c, t, l in {1, 2} is 0: as a polynomial in a of degree <= 2 it has three roots for
-each fixed (b, c, t, l) of the grid, so each of its coefficients (polynomials in (b, c, t, l)) vanishes on the
-smaller grid; repeat for b (three points), c, t, l (two points). So every dropped coefficient is 0 at the
-true (2 pi, 2 sigma, cos sigma, sin sigma, ln L0) for every sigma: the check does not use the sigma bracket.
-On the grid c^2 + t^2 = 1 need not hold: the identities used (y linear in (c, t)) are polynomial.
-
-**The exact arithmetic.** At a grid point each quantity is a power series in h truncated after h^2 with
-coefficients in Q(theta) = Q(sqrt 5, i), theta = sqrt 5 + i, m(theta) = 0, m(x) = x^4 - 8 x^2 + 36. The ring
-Q(theta)[h]/(h^3) is represented as Q[x]/(m^3) (fmpq_poly modulo m^3, all in C): theta~, the root of m in
-Q[x]/(m^3) lifting x (by Newton's step, checked m(theta~) = 0 at import), and h = m(x). theta -> theta~,
-h -> m(x) is an isomorphism (e(theta~) is a unit for e != 0, so sum e_k(theta~) m^k = 0 mod m^3 forces
-e_0 = e_1 = e_2 = 0; both sides have dimension 12), and h^0 .. h^(k-1) of an element all vanish exactly when
-m^k divides its representative: the checks are polynomial remainders, the coefficients themselves are read
-off only where one is not 0 (:meth:`QS.coeffs`). Truncated series are exact here: e^(i k h) = 1 + i k h -
-k^2 h^2/2, and sqrt(20 (1 + z)) = 2 sqrt 5 (1 + z/2 - z^2/8), ln(1 + z) = z - z^2/2 for z in (h) (z^3 = 0).
-The bordered 7 x 7 systems are solved by Gauss-Jordan over the ring (unit pivots: the system at h = 0 is
-regular), U from the exact polynomials of :mod:`.dart_family`, alpha, and the level-1 nets by the family's
-own assembly (``piece_nets``, ``layer_value``, ``_bezier``; exact fmpq weights). det J_Phi's h^m coefficient
-is a polynomial of degree <= (5, 5) in the patch parameters (u, v): it is checked on the 6 x 6 grid u, v in
-{0, 1/5, ..., 1}; the transversality form's and the curve points' coefficients are checked as the
-Bernstein coefficients themselves. Parts that depend on fewer of (a, b, c, t) (X's nets on a, Y+-'s on b)
-are computed once and counted at every grid point they belong to.
+**The exact arithmetic.** Q(theta) = Q(sqrt 5, i), theta = sqrt 5 + i, m(theta) = 0, m(x) = x^4 - 8 x^2 + 36.
+Series in h truncated after h^2 over Q(theta), the ring Q(theta)[h]/(h^3), are held as Q[x]/(m^3) (fmpq_poly
+modulo m^3: the arithmetic in C): theta -> theta~, the root of m lifting x (Newton; m(theta~) = 0 mod m^3
+checked at import), h -> m(x). This is an isomorphism (e(theta~) is a unit for e != 0 in Q(theta), so
+sum e_k(theta~) m^k = 0 mod m^3 forces e_0 = e_1 = e_2 = 0; both have dimension 12), and h^0 .. h^(k-1) all
+vanish exactly when m^k divides the representative: the checks are remainders, the coefficients are read
+off (:meth:`QS.coeffs`) only where one is not 0. Truncations are exact: e^(i k h) = 1 + i k h - k^2 h^2/2,
+sqrt(20 (1 + z)) = 2 sqrt 5 (1 + z/2 - z^2/8), ln(1 + z) = z - z^2/2 for z in (h). The bordered 7 x 7 systems
+are solved by Gauss-Jordan over the ring (unit pivots), U from :mod:`.dart_family`'s exact polynomials, and
+the nets by the family's own assembly (``piece_nets``, ``layer_value``, ``_bezier``). det J_Phi's h^m
+coefficient, of degree <= (5, 5) in the patch parameters (u, v), is checked on the 6 x 6 grid u, v in
+{0, 1/5, ..., 1}; T's and the curve points' as the Bernstein coefficients. Parts depending on fewer of
+(a, b, c, t) (X's nets on a, Y+-'s on b, Y0's on (b, c)) are computed once, counted at each grid point.
 """
 
 from __future__ import annotations
@@ -70,20 +47,8 @@ import itertools
 
 from flint import fmpq, fmpq_poly
 
-from .dart_family import (
-    _B1,
-    _NPOLY,
-    _OFFSET,
-    CURVES,
-    PIECES,
-    XB,
-    YB,
-    _bezier,
-    _bprod,
-    curve_points,
-    layer_value,
-    piece_nets,
-)
+from . import dart_family as _df
+from .dart_family import CURVES, PIECES, XB, YB, curve_points
 from .errors import CertificateError
 from .tagged_modes import _POS, ring_stencil
 
@@ -103,10 +68,7 @@ _M3 = _MOD[3]
 
 
 def _inv_raw(p):
-    g, s, _ = p.xgcd(_M3)
-    if g.degree() != 0:
-        raise ZeroDivisionError("not a unit of Q(sqrt 5, i)[h]/(h^3)")
-    s = (s / g[0]) % _M3
+    s = p.xgcd(_M3)[1] % _M3
     if (s * p) % _M3 != 1:
         raise ZeroDivisionError("not a unit of Q(sqrt 5, i)[h]/(h^3)")
     return s
@@ -184,9 +146,6 @@ class QS:
     def __truediv__(self, o):
         return self * o.inv() if isinstance(o, QS) else QS(self.p / fmpq(o))
 
-    def __rtruediv__(self, o):
-        return QS(o) * self.inv()
-
     def is_zero(self):
         return self.p.is_zero()
 
@@ -224,10 +183,7 @@ if not ((I * I + 1).is_zero() and (SQRT20 * SQRT20 - 20).is_zero() and (H * H * 
     raise AssertionError("i, sqrt 5, h in Q[x]/(m^3)")
 L0 = (SQRT20 + 6) / 16  # lam(1), the root of 16 x^2 - 12 x + 1 with the + sign
 L0_LOW = (6 - SQRT20) / 16  # 1/(16 L0)
-_IH, _H2 = I * H, H * H
-
-
-_EXP = {}
+_IH, _H2, _EXP = I * H, H * H, {}
 
 
 def _exp_i(k):
@@ -257,14 +213,15 @@ def _log_ratio(lam):
     return z - z * z / 2
 
 
-def _solve(A, b):
-    """Gauss-Jordan over Q(sqrt 5, i)[h]/(h^3) with unit pivots; ZeroDivisionError if A(h = 0) is singular."""
+def _solve(A, b, unit=lambda z: not z.vanishes(1)):
+    """Gauss-Jordan with pivots that are units (over Q(sqrt 5, i)[h]/(h^3): A(h = 0) regular; or over Q(L0)
+    with ``unit`` = non-zero); ZeroDivisionError if there is none."""
     n = len(A)
     M = [list(A[i]) + [b[i]] for i in range(n)]
     for c in range(n):
-        piv = next((r for r in range(c, n) if not M[r][c].vanishes(1)), None)
+        piv = next((r for r in range(c, n) if unit(M[r][c])), None)
         if piv is None:
-            raise ZeroDivisionError("singular bordered system")
+            raise ZeroDivisionError("singular system")
         M[c], M[piv] = M[piv], M[c]
         inv = M[c][c].inv()
         M[c] = [z * inv for z in M[c]]
@@ -297,7 +254,7 @@ class _Mode:
             lam = self.lam
             den = (lam - fmpq(1, 8)) * (lam - fmpq(1, 16)) * (lam - fmpq(1, 32)) * (lam - fmpq(1, 64)) * (lam - L0_LOW)
             self.U = []
-            for p in _NPOLY:
+            for p in _df._NPOLY:
                 acc = QS(0)
                 for coef in reversed(p):
                     acc = acc * lam + fmpq(coef)
@@ -308,8 +265,7 @@ def _eps(pos):
     return 0 if pos[1] == 0 else 1
 
 
-def _sw(p):
-    return p if p[1] == 0 else (p[1], p[0])
+_sw = _df._swap
 
 
 class QL0:
@@ -364,38 +320,26 @@ def exact_zeros():
     eigenvector rho (rho(1,0) = 1) and rho(a, b) = rho(b, a); adj(L0 - B(1)) kappa = N(L0) is a multiple of rho
     (so U(L0) = U(1,0) rho and alpha(0) U(L0) = -cos(sigma) rho). Returns rho (6 QL0)."""
     L = QL0(0, 1)
-    A = [[(L if i == k else QL0(0)) - _B1[i, k] for k in range(6)] for i in range(6)]
+    A = [[(L if i == k else QL0(0)) - _df._B1[i, k] for k in range(6)] for i in range(6)]
     # rho: solve A rho = 0 with rho(1,0) = 1: drop row 0 (rank 5 since L0 is simple: checked by the solve)
-    M = [[A[i][k] for k in range(1, 6)] + [-A[i][0]] for i in range(1, 6)]
-    for c in range(5):  # Gauss-Jordan over Q(L0)
-        piv = next((r for r in range(c, 5) if not M[r][c].is_zero()), None)
-        if piv is None:
-            raise CertificateError("L0 is not a simple eigenvalue of B(1)")
-        M[c], M[piv] = M[piv], M[c]
-        inv = M[c][c].inv()
-        M[c] = [z * inv for z in M[c]]
-        for r in range(5):
-            if r != c and not M[r][c].is_zero():
-                f = M[r][c]
-                M[r] = [z - f * w for z, w in zip(M[r], M[c])]
-    rho = [QL0(1)] + [M[r][5] for r in range(5)]
+    try:
+        rho = [QL0(1)] + _solve([[A[i][k] for k in range(1, 6)] for i in range(1, 6)], [-A[i][0] for i in range(1, 6)],
+                                unit=lambda z: not z.is_zero())
+    except ZeroDivisionError:
+        raise CertificateError("L0 is not a simple eigenvalue of B(1)") from None
     if not all(sum((A[i][k] * rho[k] for k in range(6)), QL0(0)).is_zero() for i in range(6)):
         raise CertificateError("rho is no eigenvector of B(1) for L0")
     pos = {p: k for p, k in _POS.items()}
     if not all(rho[pos[(a, b)]] == rho[pos[(b, a)]] for (a, b) in pos if b > 0 and (b, a) in pos):
         raise CertificateError("rho is not symmetric in (a, b)")
-    N = [sum((c * L0pow for c, L0pow in zip(p, _powers(L, len(p)))), QL0(0)) for p in _NPOLY]
+    N = []
+    for p in _df._NPOLY:  # Horner
+        N.append(QL0(0))
+        for coef in reversed(p):
+            N[-1] = N[-1] * L + coef
     if not all((N[k] - N[0] * rho[k]).is_zero() for k in range(6)) or N[0].is_zero():
         raise CertificateError("adj(L0 - B(1)) kappa is not a non-zero multiple of rho")
     return rho
-
-
-def _powers(x, n):
-    out, acc = [], QL0(1)
-    for _ in range(n):
-        out.append(acc)
-        acc = acc * x
-    return out
 
 
 class ExactFamily:
@@ -403,14 +347,10 @@ class ExactFamily:
 
     Parameters
     ----------
-    a, b : int or fmpq
-        the angle units of x's mode (2 pi) and of y's mode (2 sigma)
-    c, t : int or fmpq
-        stand-ins for cos(sigma), sin(sigma)
-    stencil : list of dict, optional
-        the ring rows (``ring_stencil()``; a perturbed rule for the tests)
-    flip_alpha : bool
-        alpha -> -alpha (a perturbed family: the checks must fail)
+    a, b, c, t : int or fmpq
+        the angle units of x's mode (2 pi) and y's (2 sigma); stand-ins for cos(sigma), sin(sigma)
+    stencil : list of dict, optional; flip_alpha : bool
+        perturbations for the tests: the ring rows (``ring_stencil()``), alpha -> -alpha
 
     Examples
     --------
@@ -464,10 +404,10 @@ class ExactFamily:
     def layer_nets(self, q, coordinate):
         """{piece: 4 x 4 Bezier net} of x (coordinate 0) or y (1) on layer quadrant q."""
         f = self.layer_level0(q)[coordinate]
-        V = layer_value(f, self.zero if coordinate == 0 else self.yc, self.lam1 if coordinate == 0 else self.lam2,
-                        q, self.zero)
-        return {name: _bezier([[V(_OFFSET[name][0] + i, _OFFSET[name][1] + j) for j in range(4)] for i in range(4)],
-                              self.zero) for name in PIECES}
+        V = _df.layer_value(f, (self.zero, self.yc)[coordinate], (self.lam1, self.lam2)[coordinate], q, self.zero)
+        off = _df._OFFSET
+        return {n: _df._bezier([[V(off[n][0] + i, off[n][1] + j) for j in range(4)] for i in range(4)], self.zero)
+                for n in PIECES}
 
 
 # --- det J as a polynomial in the patch parameters (u, v), on the 6 x 6 grid; raw fmpq_poly below -------
@@ -476,7 +416,7 @@ _GRID = [fmpq(k, 5) for k in range(6)]
 _BERN = [[(1 - u) ** 3, 3 * u * (1 - u) ** 2, 3 * u * u * (1 - u), u ** 3] for u in _GRID]
 _DBERN = [[-3 * (1 - u) ** 2, 3 * (1 - u) ** 2 - 6 * u * (1 - u), 6 * u * (1 - u) - 3 * u * u, 3 * u * u]
           for u in _GRID]
-_UV = [(fmpq(i, 5), fmpq(j, 5)) for i in range(6) for j in range(6)]
+_UV = [f"({i}/5, {j}/5)" for i in range(6) for j in range(6)]
 
 
 def _lin(ps, ws):
@@ -509,15 +449,10 @@ class _Tally:
         self.stop, self.ells = stop, ells
 
     def _at(self, kind, k):
-        if kind == "uv":
-            return f"(u, v) = ({_UV[k][0]}, {_UV[k][1]})"
-        if kind == "mid":  # two items per (u, v): S, S'
-            return f"{'e_10, e_20' if k % 2 == 0 else 'e_11'} at (u, v) = ({_UV[k // 2][0]}, {_UV[k // 2][1]})"
-        if kind == "midT":
-            return f"{'e_10, e_20' if k % 2 == 0 else 'e_11'} at l = {self.ells[k // 12]}, coefficient {k // 2 % 6}"
-        if kind == "coef":
-            return f"l = {self.ells[k // 6]}, coefficient {k % 6}"
-        return f"point {k}"
+        e = "e_10, e_20" if k % 2 == 0 else "e_11"  # the middle's items alternate S, S'
+        return {"uv": lambda: f"(u, v) = {_UV[k]}", "mid": lambda: f"{e} at (u, v) = {_UV[k // 2]}",
+                "midT": lambda: f"{e} at l = {self.ells[k // 12]}, coefficient {k // 2 % 6}",
+                "coef": lambda: f"l = {self.ells[k // 6]}, coefficient {k % 6}", "point": lambda: f"point {k}"}[kind]()
 
     def add(self, row, items, where, kind):
         """items: [(raw element, the h-orders that must be 0)]; where, kind: the items' place, for the reason."""
@@ -533,14 +468,10 @@ class _Tally:
                                        f"at {where}, {self._at(kind, k)}")
 
 
-def _raws(zs):
-    return [z.p for z in zs]
-
-
 def _xy(xs, ys):
     """(X Y', Y X'): the degree-5 Bernstein coefficients (raw, reduced) from the curves' cubic Bezier points."""
-    xs, ys = _raws(xs), _raws(ys)
-    return [z % _M3 for z in _bprod(xs, ys)], [z % _M3 for z in _bprod(ys, xs)]
+    xs, ys = [z.p for z in xs], [z.p for z in ys]
+    return [z % _M3 for z in _df._bprod(xs, ys)], [z % _M3 for z in _df._bprod(ys, xs)]
 
 
 def _trans(PQ, A):
@@ -567,17 +498,21 @@ def _middle(G, fam):
     return items
 
 
+def _nets(cache, key, make):
+    """(nets, their partials) {piece: ...} under ``key``, made once."""
+    if key not in cache:
+        n = make()
+        cache[key] = (n, {p: _partials(n[p]) for p in PIECES})
+    return cache[key]
+
+
 def _check_point(fam, ells, tally, cache):
     a, b, c, t = fam.a, fam.b, fam.c, fam.t
     pt = f"(a, b, c, t) = ({a}, {b}, {c}, {t})"
     keys = {"X+": ("X+", a), "X-": ("X-", a), "Y0": ("Y0", b, c), "Y+": ("Y+", b), "Y-": ("Y-", b)}
-    parts, nets, part = None, {}, {}
+    nets, part = {}, {}
     for name, key in keys.items():  # X's nets depend on a only, Y+-'s on b, Y0's on (b, c)
-        if key not in cache:
-            parts = parts or fam.parts()
-            n = piece_nets(*parts[name], fam.zero)
-            cache[key] = (n, {p: _partials(n[p]) for p in PIECES})
-        nets[name], part[name] = cache[key]
+        nets[name], part[name] = _nets(cache, key, lambda name=name: _df.piece_nets(*fam.parts()[name], fam.zero))
     A = [((-_log_ratio(fam.lam1) - ell).p, (-_log_ratio(fam.lam2) - ell).p) for ell in ells]  # -l - ln(lam_i/L0)
     for piece in PIECES:
         G = {(i, j): _det(part[i][piece], part[j][piece]) for i in XB for j in YB}
@@ -591,22 +526,15 @@ def _check_point(fam, ells, tally, cache):
                 cache[(keys[i], keys[j], curve)] = _xy(pts[i], pts[j])
         G = {(i, j): _trans(cache[(keys[i], keys[j], curve)], A) for i in XB for j in YB}
         for (i, j), vals in G.items():
-            tally.add(ROWS[2], [(v, (0,)) for v in vals],
-                      f"{pt}, {curve}, T({i}, {j})", "coef")
+            tally.add(ROWS[2], [(v, (0,)) for v in vals], f"{pt}, {curve}, T({i}, {j})", "coef")
         tally.add(ROWS[3], _middle(G, fam), f"{pt}, {curve}", "midT")
         tally.add(ROWS[4], [((pts["Y0"][p] + pts["Y+"][p] * fam.em + pts["Y-"][p] * fam.ep).p, (0,)) for p in range(4)],
                   f"{pt}, {curve}", "point")
     for q in range(3):
-        if ("LX", a, q) not in cache:
-            xn = fam.layer_nets(q, 0)
-            cache[("LX", a, q)] = (xn, {p: _partials(xn[p]) for p in PIECES})
-        if ("LY", b, c, t, q) not in cache:  # y's layer nets depend on (b, c, t)
-            yn = fam.layer_nets(q, 1)
-            cache[("LY", b, c, t, q)] = (yn, {p: _partials(yn[p]) for p in PIECES})
-        (xn, xp), (yn, yp) = cache[("LX", a, q)], cache[("LY", b, c, t, q)]
+        xn, xp = _nets(cache, ("LX", a, q), lambda q=q: fam.layer_nets(q, 0))
+        yn, yp = _nets(cache, ("LY", b, c, t, q), lambda q=q: fam.layer_nets(q, 1))  # y's depend on (b, c, t)
         for piece in PIECES:
-            tally.add(ROWS[5], [(v, (0, 1, 2)) for v in _det(xp[piece], yp[piece])],
-                      f"{pt}, q = {q}, {piece}", "uv")
+            tally.add(ROWS[5], [(v, (0, 1, 2)) for v in _det(xp[piece], yp[piece])], f"{pt}, q = {q}, {piece}", "uv")
         for curve in CURVES:
             xs, ys = curve_points(xn, curve), curve_points(yn, curve)
             tally.add(ROWS[6], [(v, (0, 1, 2)) for v in _trans(_xy(xs, ys), A)],
