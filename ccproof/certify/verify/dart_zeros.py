@@ -99,9 +99,6 @@ class QF:
         c = [e[k] for k in range(4)]
         self.p, self.q, self.r, self.u = c[0] + 4 * c[2], c[1] + 2 * c[3], c[1] + 14 * c[3], 2 * c[2]
 
-    def is_zero(self):
-        return self.p == 0 and self.q == 0 and self.r == 0 and self.u == 0
-
 
 class QS:
     """A power series in h truncated after h^2 with coefficients in Q(sqrt 5, i), exact: the class of the
@@ -194,7 +191,7 @@ def _exp_i(k):
     return _EXP[k]
 
 
-def lam_series(k):
+def _lam_series(k):
     """lam(cos(k h)) = (5 + c + sqrt((1 + c)(9 + c)))/16, c = cos(k h) = 1 - k^2 h^2/2, the root expanded at 20."""
     c = ONE - _H2 * (fmpq(k) ** 2 / 2)
     g = (c + 1) * (c + 9)
@@ -232,7 +229,7 @@ def _solve(A, b, unit=lambda z: not z.vanishes(1)):
     return [M[r][n] for r in range(n)]
 
 
-def bordered(k, lam, stencil):
+def _bordered(k, lam, stencil):
     """v^ (6 QS): B(e^(i k h)) v^ = lam v^, v^(1,0) = 1 (the bordered 7 x 7 system A v = e_7)."""
     B = [[QS(0) for _ in range(6)] for _ in range(6)]
     for i, row in enumerate(stencil):
@@ -248,17 +245,18 @@ class _Mode:
 
     def __init__(self, k, stencil, with_u=False):
         self.k = fmpq(k)
-        self.lam = lam_series(self.k)
-        self.v = bordered(self.k, self.lam, stencil)
+        self.lam = _lam_series(self.k)
+        self.v = _bordered(self.k, self.lam, stencil)
         if with_u:
             lam = self.lam
             den = (lam - fmpq(1, 8)) * (lam - fmpq(1, 16)) * (lam - fmpq(1, 32)) * (lam - fmpq(1, 64)) * (lam - L0_LOW)
-            self.U = []
-            for p in _df._NPOLY:
-                acc = QS(0)
-                for coef in reversed(p):
-                    acc = acc * lam + fmpq(coef)
-                self.U.append(acc / den)
+            self.U = [_horner(p, lam, QS(0)) / den for p in _df._NPOLY]
+
+
+def _horner(p, x, acc):
+    for coef in reversed(p):
+        acc = acc * x + coef
+    return acc
 
 
 def _eps(pos):
@@ -318,7 +316,14 @@ class QL0:
 def exact_zeros():
     """Check exactly (in Q(L0)) the facts the dropped coefficients rest on: L0 is an eigenvalue of B(1) with
     eigenvector rho (rho(1,0) = 1) and rho(a, b) = rho(b, a); adj(L0 - B(1)) kappa = N(L0) is a multiple of rho
-    (so U(L0) = U(1,0) rho and alpha(0) U(L0) = -cos(sigma) rho). Returns rho (6 QL0)."""
+    (so U(L0) = U(1,0) rho and alpha(0) U(L0) = -cos(sigma) rho). Returns rho (6 QL0), CertificateError if not.
+
+    Examples
+    --------
+    >>> rho = exact_zeros()
+    >>> rho[0] == 1, rho[2] == QL0(-4, 8), rho[2] * rho[2] + rho[2] * 2 == 4  # rho(1,1) = sqrt 5 - 1
+    (True, True, True)
+    """
     L = QL0(0, 1)
     A = [[(L if i == k else QL0(0)) - _df._B1[i, k] for k in range(6)] for i in range(6)]
     # rho: solve A rho = 0 with rho(1,0) = 1: drop row 0 (rank 5 since L0 is simple: checked by the solve)
@@ -332,11 +337,7 @@ def exact_zeros():
     pos = {p: k for p, k in _POS.items()}
     if not all(rho[pos[(a, b)]] == rho[pos[(b, a)]] for (a, b) in pos if b > 0 and (b, a) in pos):
         raise CertificateError("rho is not symmetric in (a, b)")
-    N = []
-    for p in _df._NPOLY:  # Horner
-        N.append(QL0(0))
-        for coef in reversed(p):
-            N[-1] = N[-1] * L + coef
+    N = [_horner(p, L, QL0(0)) for p in _df._NPOLY]
     if not all((N[k] - N[0] * rho[k]).is_zero() for k in range(6)) or N[0].is_zero():
         raise CertificateError("adj(L0 - B(1)) kappa is not a non-zero multiple of rho")
     return rho
@@ -355,8 +356,8 @@ class ExactFamily:
     Examples
     --------
     >>> fam = ExactFamily(1, 2, 1, 2)
-    >>> fam.vx[0].c[0].p, fam.lam1.c[1].is_zero(), (fam.yc.c[0].p, fam.yc.c[1].p)
-    (1, True, (0, 0))
+    >>> fam.vx[0].c[0].p, fam.lam1.c[1].p, (fam.yc.c[0].p, fam.yc.c[1].p)
+    (1, 0, (0, 0))
     """
 
     def __init__(self, a, b, c, t, stencil=None, flip_alpha=False, _modes=None):
@@ -562,9 +563,8 @@ GRID = tuple(itertools.product(GRID_AB, GRID_AB, GRID_CT, GRID_CT))  # (a, b, c,
 
 
 def count_zeros(points=GRID, ells=GRID_CT, stencil=None, flip_alpha=False):
-    """{row: (coefficients checked, non-zero among them)} at the grid points ``points`` (a, b, c, t) and
-    l in ``ells``; ``stencil`` and ``flip_alpha`` perturb the rule or the family (the checks must then find
-    non-zero coefficients).
+    """{row: (coefficients checked, non-zero among them)} at the points (a, b, c, t) and l in ``ells``;
+    ``stencil`` and ``flip_alpha`` perturb the rule or the family (then some must be non-zero).
 
     Examples
     --------
@@ -576,11 +576,10 @@ def count_zeros(points=GRID, ells=GRID_CT, stencil=None, flip_alpha=False):
 
 
 def check_zeros(*, _stencil=None, _flip_alpha=False) -> str:
-    """Check exactly that every dropped Taylor coefficient of the dart family is 0 (module docstring: the
-    rows, and the degree argument for the grid a, b in {1, 2, 3}, c, t, l in {1, 2}), after
-    :func:`exact_zeros`' facts. Returns a one-line summary with the counts per row; raises CertificateError
-    naming the row, grid point and place of the first non-zero coefficient. ``_stencil`` and ``_flip_alpha``
-    are perturbations for the tests.
+    """Check exactly that every dropped Taylor coefficient of the dart family is 0 on the grid of the degree
+    argument (module docstring), after :func:`exact_zeros`: a one-line summary with the counts per row, or
+    CertificateError naming the row, grid point and place of the first non-zero one (``_stencil``,
+    ``_flip_alpha``: perturbations for the tests).
 
     Examples
     --------
