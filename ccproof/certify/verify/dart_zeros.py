@@ -588,6 +588,8 @@ def check_zeros(*, _stencil=None, _flip_alpha=False) -> str:
     """
     exact_zeros()
     rows = _run(GRID, GRID_CT, _stencil, _flip_alpha, stop=True).rows
+    if not all(n > 0 for n, _ in rows.values()):
+        raise CertificateError("a row of dropped coefficients checked nothing")
     return (f"dropped coefficients exactly 0 on the grid a, b in {GRID_AB}, c, t, l in {GRID_CT}: "
             + "; ".join(f"{row} {n}" for row, (n, _) in rows.items())
             + f"; {sum(n for n, _ in rows.values())} in all (and rho = v^(0) is B(1)'s symmetric eigenvector for "
