@@ -125,3 +125,12 @@ def test_family_at_the_exact_lam2_is_even_vector_and_x_is_mode_vector(k):
     f = mode_vector("dart", k, 1, lam1)
     xs = [acb(0)] + [acb(x(p[1], p[2:])) * acb(0, 2) for p in pts[1:]]
     assert all(abs(a - b) < 1e-25 for a, b in zip(xs, f))
+
+
+def test_the_limit_h_0_is_the_secular_limit_tan_sigma_sigma():
+    """At h = 0 the scaled centre residual is (3/2 + rho(1,1)/4)(sin(sigma)/sigma - cos(sigma)), rho = v^(0)
+    (here (5 + sqrt 5)/4): its zero is the root 4.4934 of tan s = s, the limit of sigma(K)."""
+    factor = (5 + arb(5).sqrt()) / 4
+    for s in (arb("4.3"), arb("4.6"), arb(2)):
+        r = E.scaled_centre_residual(Family(acb(0), s))
+        assert abs(r - factor * (s.sin() / s - s.cos())) < 1e-30

@@ -177,6 +177,8 @@ def check_crease_row(points=W_POINTS):
         raise CertificateError(f"{points} values of w cannot show an identity of degree {W_POINTS - 1}")
     p = _charpoly_claimed()
     N = [fmpq_poly(c) for c in _NPOLY]
+    if any(n.degree() > 5 for n in N):
+        raise CertificateError("U's numerator has degree > 5: the degree bound of the identity fails")
     h = fmpq(1, 2)
     a1 = (_X - h) * N[_E10] - p / 2
     a2 = (_X - fmpq(1, 8)) * N[_E20] - fmpq(3, 4) * N[_E10] - p / 8
@@ -216,10 +218,13 @@ def scaled_centre_residual(fam):
     (True, True, True)
     """
     h, sigma, lam = fam.h, fam.sigma, fam.lam2
+    _denominators(fam)
     sh = h * sigma
     sinc = sh.sinc()
     _nonzero(sinc, "sinc(sigma h)")
     c = (2 * sh).cos()
+    if not ((1 + c) * (9 + c)).real > 0:
+        raise ZeroDivisionError("sqrt((1 + c)(9 + c)): the argument is not certainly off the branch cut")
     root = ((1 + c) * (9 + c)).sqrt()
     _nonzero(root + arb(20).sqrt(), "sqrt((1 + c)(9 + c)) + sqrt 20")
     dl = -(sigma * sigma * h * sinc * sinc / 8) * (1 + (c + 11) / (root + arb(20).sqrt()))  # (lam - L0)/h
@@ -233,19 +238,25 @@ def scaled_centre_residual(fam):
     return out
 
 
-def _guard(fam, tol):
-    """Raise unless the Family computes the lemma's formula at this (sigma, h): the denominators of U and alpha
-    certainly non-zero, v^(1,0) = 1, y(C) = alpha (lam - L0), ray 0's sharp midpoint row and the ring rows of
-    sector 1 satisfied (balls containing 0, radii below tol; they are identities, items 1 and 2)."""
+def _denominators(fam):
+    """ZeroDivisionError unless U's denominator, alpha's a1 and lam - 1/2 (alpha != 0) are certainly non-zero
+    and U, v^ finite (then the family is analytic on the ball: items 1b, 2, 3)."""
     lam, L0, L1 = fam.lam2, *l0()
     den = lam - L1
     for s in _SMALL:
         den *= lam - s
     _nonzero(den, "U's denominator")
-    a1 = (lam - fmpq(1, 2)) * fam.U[_E10] - (lam - L0) / 2
-    _nonzero(a1, "alpha's denominator a1")
+    _nonzero((lam - fmpq(1, 2)) * fam.U[_E10] - (lam - L0) / 2, "alpha's denominator a1")
     _nonzero(lam - fmpq(1, 2), "lam - 1/2")
-    _nonzero(8 * lam - 1, "8 lam - 1")
+    if not all(z.is_finite() for z in list(fam.U) + list(fam.vy) + list(fam.vx)):
+        raise ZeroDivisionError("U or a bordered solution is not finite")
+
+
+def _guard(fam, tol):
+    """Raise unless the Family computes the lemma's formula at this (sigma, h): v^(1,0) = 1, y(C) =
+    alpha (lam - L0), ray 0's two sharp rows and the ring rows of sector 1 satisfied (balls containing 0,
+    radii below tol; they are identities, items 1 and 2)."""
+    lam, L0 = fam.lam2, l0()[0]
     _, y, _, yc = layer_level0(fam, 0)
     kap = _kappa()
     res = [fam.vy[_E10] - 1, yc - fam.alpha * (lam - L0),
