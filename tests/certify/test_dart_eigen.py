@@ -134,3 +134,32 @@ def test_the_limit_h_0_is_the_secular_limit_tan_sigma_sigma():
     for s in (arb("4.3"), arb("4.6"), arb(2)):
         r = E.scaled_centre_residual(Family(acb(0), s))
         assert abs(r - factor * (s.sin() / s - s.cos())) < 1e-30
+
+
+def _script():
+    import importlib.util
+    from pathlib import Path
+    path = Path(__file__).resolve().parents[2] / "scripts" / "tagged_dart_limit.py"
+    spec = importlib.util.spec_from_file_location("tagged_dart_limit", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+@pytest.mark.parametrize("k", [101, 1000, 10**4, 10**6])
+def test_the_centre_residual_vanishes_at_the_root_of_the_secular_equation(k):
+    """The zero of r/h in sigma at h = 1/K (bisection) is the root of the untrusted script's G (an independent
+    closed form: the secular equation of the one-ring resolvent), where no per-K exact computation reaches."""
+    ctx.prec = 128
+    h = acb(fmpq(1, k))
+    a, b = arb(LO), arb(HI)
+    ra = E.scaled_centre_residual(Family(h, a)).real
+    for _ in range(45):
+        m = arb(((a + b) / 2).mid())
+        rm = E.scaled_centre_residual(Family(h, m)).real
+        if (rm > 0) == (ra > 0):
+            a, ra = m, rm
+        else:
+            b = m
+    root = _script().sigma_of(arb(fmpq(1, k)))
+    assert abs(a - root) < 1e-11
