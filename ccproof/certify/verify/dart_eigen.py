@@ -342,7 +342,7 @@ def check_eigenvector(sig_lo, sig_hi, k0, prec, balls=64, family=Family):
                                        f"change over the bracket (at sig_lo {lo.str(3)}, at sig_hi {hi.str(3)})")
         return (f"eigenvector lemma for every K >= {k0}: ring rows and ray 0's rows identically (exact: reach, "
                 f"mode 0, crease row at {W_POINTS} w), centre residual changes sign on ({sig_lo}, {sig_hi}) on "
-                f"{balls} h-balls, the family regular on the whole bracket")
+                f"{balls} h-balls, the family (x's and y's bordered systems, U, alpha) regular on the whole bracket")
     finally:
         ctx.prec = old
 
