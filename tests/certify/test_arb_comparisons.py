@@ -21,6 +21,21 @@ EXACT_ATTRS = {"nvars", "shape", "box", "MAX_VARS", "ncols"}
 
 #: (file, source text of the node) -> why its meaning on balls is the intended one
 REVIEWED = {
+    ("dart_curves.py", "not z < L + 2"): "refuses unless |omega s| < L + 2 certainly: conservative",
+    ("dart_regularity.py", "not z < L + 2"): "refuses unless |omega s| < L + 2 certainly: conservative",
+    ("dart_eigen.py", "B1.charpoly() != p"): "fmpq_poly (exact)",
+    ("dart_eigen.py", "B * Ms[-1] + c[0] * eye != fmpq_mat(n, n)"): "fmpq_mat (exact)",
+    ("dart_eigen.py", "not ((1 + c) * (9 + c)).real > 0"): "refuses unless Re > 0 certainly: conservative",
+    ("dart_eigen.py", "lhs != p * kap[i]"): "fmpq_poly (exact)",
+    ("dart_eigen.py", "not box.cos() < 0"): "refuses unless cos sigma < 0 certainly on the bracket: conservative",
+    ("dart_eigen.py", "P % q != 0"): "fmpq_poly (exact)",
+    # a guard that the family's code matches the lemma's identities (it FAILs a flipped alpha); the lemma is
+    # proved by the exact checks and the sign change, not by this test
+    ("dart_eigen.py", "z.contains(0)"): "a guard (above), never the proof",
+    ("dart_family.py", "got != n_at(x)"): "lists of fmpq (exact)",
+    ("dart_family.py", "not arg.real > 0"): "refuses unless certainly off the cut: conservative",
+    ("dart_zeros.py", "(s * p) % _M3 != 1"): "fmpq_poly (exact)",
+    ("dart_zeros.py", "w != 0"): "fmpq Bernstein weights (exact)",
     ("field.py", "g != 0"): "fmpq_poly (exact)",
     ("field.py", "a != 0"): "fmpq_poly (exact)",
     ("injectivity.py", 'param["variable"] != "lam"'): "strings",

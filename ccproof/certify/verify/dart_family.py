@@ -121,7 +121,7 @@ def big_u(lam):
     return out
 
 
-def lam_of(c):
+def _lam_principal(c):
     """lam(c) = (5 + c + sqrt((1 + c)(9 + c)))/16 (acb, arb or acb_series). On an acb ball the square root's
     argument must lie in the right half-plane (off the principal branch's cut, so the value is analytic
     there: the Cauchy bounds need that); ZeroDivisionError otherwise."""
@@ -219,9 +219,9 @@ class Family:
         one, pi = h * 0 + 1, arb.pi()
         self.zero = h * 0
         self.ix, self.iy = acb(0, 2) * pi, acb(0, 2) * sigma   # w_x = e^(ix h), w_y = e^(iy h)
-        self.lam1 = lam_of((h * (2 * pi)).cos())
+        self.lam1 = _lam_principal((h * (2 * pi)).cos())
         self.vx = bordered((h * self.ix).exp(), self.lam1)
-        self.lam2 = lam_of((h * (2 * sigma)).cos())
+        self.lam2 = _lam_principal((h * (2 * sigma)).cos())
         self.vy = bordered((h * self.iy).exp(), self.lam2)
         self.U = big_u(self.lam2)
         lam, L0 = self.lam2, l0()[0]
