@@ -26,6 +26,7 @@ from .dart_family import (
     layer_nets,
     series_cap,
 )
+from .dart_regularity import kdet_box, layer_box, middle_box, middle_coeffs
 
 
 def taylor_trans(sigma, n, prec=128, **control):
@@ -244,3 +245,142 @@ def layer_y_upper(T, M, q, h_lo, h_hi, r, n, prec=128):
                 acc += arb(0, (M[c] * hr ** (n + 1) / (1 - hr) / arb(fmpq(h_hi)) ** order).upper())
                 high = acc.upper() if high is None or acc.upper() > high else high
         return high, zero
+
+
+# --- the evaluators a dart:>=K0 record's leaves are replayed on ------------------------------------------
+
+def _span(low, high):
+    return arb(low).union(arb(high))
+
+
+def layer_y_bounds(T, M, q, h_lo, h_hi, r, n, prec=128):
+    """(lower, upper) bounds of K Y over layer quadrant q's outer-curve points (K^2 Y at ray 0's end point of
+    quadrant 0), h in [h_lo, h_hi]: :func:`layer_y_upper` with both ends."""
+    with ctx.workprec(prec):
+        h = _ball(h_lo, h_hi)
+        hr = arb(fmpq(h_hi)) / r
+        low = high = None
+        for c in CURVES:
+            for p in range(4):
+                order = 2 if (q == 0 and c == "P1s1" and p == 0) else 1
+                acc = arb(0)
+                for m in range(n, order - 1, -1):
+                    acc = acc * h + T[c][m][p]
+                acc += arb(0, (M[c] * hr ** (n + 1) / (1 - hr) / arb(fmpq(h_hi)) ** order).upper())
+                low = acc.lower() if low is None or acc.lower() < low else low
+                high = acc.upper() if high is None or acc.upper() > high else high
+        return low, high
+
+
+class CurveModels:
+    """T's and W's Taylor models for every K >= K0: disc bounds over the whole sigma bracket, one
+    :class:`CurveBox` per sigma box (the parameters as :class:`.dart_regularity.RegularityModels`).
+
+    Examples
+    --------
+    >>> from flint import fmpq
+    >>> from ccproof.certify.verify.dart_family import TaylorHints
+    >>> hints = TaylorHints(r=fmpq(1, 32), disc_grid=6, sigma_boxes=10, order=12, layer_order=14, exp_order=24)
+    >>> box = CurveModels(fmpq(4484, 1000), fmpq(44935, 10000), hints, 0, 128).sigma_box(0)
+    >>> box.x_bulk([(fmpq(1, 4), fmpq(26, 100)), (fmpq(0), fmpq(1, 101))]) > 0  # X > 0 there, every K >= 101
+    True
+    """
+
+    def __init__(self, sig_lo, sig_hi, hints, layer, prec):
+        self.hints, self.layer, self.prec = hints, layer, prec
+        self.edges = [fmpq(sig_lo) + (fmpq(sig_hi) - fmpq(sig_lo)) * fmpq(i, hints.sigma_boxes)
+                      for i in range(hints.sigma_boxes + 1)]
+        r, g = hints.r, hints.disc_grid
+        with ctx.workprec(prec):
+            sig_all = _ball(sig_lo, sig_hi)
+            self.MT = disc_trans(sig_all, r, grid=g, prec=prec)
+            self.MX, self.MY = coord_disc(sig_all, r, "x", grid=g, prec=prec), coord_disc(sig_all, r, "y", grid=g,
+                                                                                        prec=prec)
+            self.MTL = {q: layer_trans_disc(q, sig_all, r, grid=g, prec=prec) for q in range(layer)}
+            self.MYL = {q: layer_coord(q, sig_all, hints.layer_order, r, grid=g, prec=prec)[1] for q in range(layer)}
+        self._boxes = {}
+
+    def sigma_box(self, i):
+        """The models on sigma box i (cached)."""
+        if not 0 <= i < self.hints.sigma_boxes:
+            raise IndexError(f"sigma box {i} of {self.hints.sigma_boxes}")
+        if i not in self._boxes:
+            self._boxes[i] = CurveBox(self, i)
+        return self._boxes[i]
+
+
+class CurveBox:
+    """The Taylor coefficients of T and of X, Y on one sigma box; each evaluator returns one arb containing
+    every value of the region's scaled quantity (every curve's Bernstein coefficient, or every outer-curve
+    Bezier point) on the box."""
+
+    def __init__(self, models, i):
+        self.m, hn, prec = models, models.hints, models.prec
+        with ctx.workprec(prec):
+            self.sigma = _ball(models.edges[i], models.edges[i + 1])
+            self.T = taylor_trans(self.sigma, hn.order, prec=prec)
+            self.E = middle_coeffs(self.T, self.sigma, L=hn.exp_order)
+            self.TX = coord_taylor(self.sigma, hn.order, "x", prec=prec)
+            self.TY = coord_taylor(self.sigma, hn.order, "y", prec=prec)
+            self.TL = {q: layer_trans_taylor(q, self.sigma, hn.layer_order, prec=prec) for q in range(models.layer)}
+            self.YL = {q: layer_coord(q, self.sigma, hn.layer_order, hn.r, grid=0, prec=prec)[0]
+                       for q in range(models.layer)}
+
+    def _h_ok(self, h_hi):
+        if not (h_hi >= 0 and h_hi < self.m.hints.r):
+            raise ZeroDivisionError(f"h up to {h_hi} is not inside the Cauchy disc of radius {self.m.hints.r}")
+
+    def transversal_bulk(self, box):
+        """K (a1 X Y' - a2 Y X') on the four outer curves, (s, h) in the box."""
+        (s_lo, s_hi), (h_lo, h_hi) = box
+        self._h_ok(h_hi)
+        hn = self.m.hints
+        return _span(*kdet_box(self.T, self.m.MT, s_lo, s_hi, h_lo, h_hi, self.sigma, hn.r, hn.order,
+                               prec=self.m.prec))
+
+    def transversal_middle(self, box):
+        """K^3 (a1 X Y' - a2 Y X')/q^2 as a function of (s, w = 1/q) in the box."""
+        (s_lo, s_hi), (w_lo, w_hi) = box
+        self._h_ok(s_hi * w_hi)
+        hn = self.m.hints
+        return _span(*middle_box(self.T, self.E, self.m.MT, s_lo, s_hi, w_lo, w_hi, self.sigma, hn.r, hn.order,
+                                 L=hn.exp_order, prec=self.m.prec))
+
+    def transversal_layer(self, q, box):
+        """K^3 (a1 X Y' - a2 Y X') on layer quadrant q's outer curves, h in the box."""
+        ((h_lo, h_hi),) = box
+        self._h_ok(h_hi)
+        hn = self.m.hints
+        return _span(*layer_box(self.TL[q], self.m.MTL[q], h_lo, h_hi, hn.r, hn.layer_order, prec=self.m.prec))
+
+    def _coord(self, box, coord):
+        (s_lo, s_hi), (h_lo, h_hi) = box
+        self._h_ok(h_hi)
+        hn = self.m.hints
+        T, M = (self.TX, self.m.MX) if coord == "x" else (self.TY, self.m.MY)
+        return _span(*coord_box(T, M, s_lo, s_hi, h_lo, h_hi, self.sigma, hn.r, hn.order, coord,
+                                prec=self.m.prec))
+
+    def x_bulk(self, box):
+        """X on every outer-curve Bezier point, (s, h) in the box."""
+        return self._coord(box, "x")
+
+    def y_bulk(self, box):
+        """Y on every outer-curve Bezier point, (s, h) in the box."""
+        return self._coord(box, "y")
+
+    def y_middle(self, box):
+        """Y/s on every outer-curve Bezier point, (s, w) in the box."""
+        (s_lo, s_hi), (w_lo, w_hi) = box
+        self._h_ok(s_hi * w_hi)
+        hn = self.m.hints
+        return _span(*ymid_box(self.TY, self.m.MY, s_lo, s_hi, w_lo, w_hi, self.sigma, hn.r, hn.order,
+                               L=hn.exp_order, prec=self.m.prec))
+
+    def y_layer(self, q, box):
+        """K Y on layer quadrant q's outer-curve points (K^2 Y at ray 0's end point of quadrant 0), h in the box."""
+        ((h_lo, h_hi),) = box
+        self._h_ok(h_hi)
+        hn = self.m.hints
+        return _span(*layer_y_bounds(self.YL[q], self.m.MYL[q], q, h_lo, h_hi, hn.r, hn.layer_order,
+                                     prec=self.m.prec))

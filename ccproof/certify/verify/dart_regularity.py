@@ -239,3 +239,95 @@ def layer_box(T, M, h_lo, h_hi, r, n, order=3, prec=128):
                 low = acc.lower() if low is None or acc.lower() < low else low
                 high = acc.upper() if high is None or acc.upper() > high else high
         return low, high
+
+
+# --- the evaluators a dart:>=K0 record's leaves are replayed on ------------------------------------------
+
+def _span(low, high):
+    """The arb ball [low, high] (both arb points or balls: their hull)."""
+    return arb(low).union(arb(high))
+
+
+def _sigma_edges(sig_lo, sig_hi, boxes):
+    return [fmpq(sig_lo) + (fmpq(sig_hi) - fmpq(sig_lo)) * fmpq(i, boxes) for i in range(boxes + 1)]
+
+
+class RegularityModels:
+    """R's Taylor models for every K >= K0: the disc bounds over the whole sigma bracket, and one
+    :class:`RegularityBox` per sigma box.
+
+    Parameters
+    ----------
+    sig_lo, sig_hi : fmpq
+        The bracket of sigma(K) (shown by the spectrum and the eigenvector lemma).
+    hints : TaylorHints
+    layer : int
+        T: the layer quadrants are 0..T-1.
+    prec : int
+
+    Examples
+    --------
+    >>> from flint import fmpq
+    >>> from ccproof.certify.verify.dart_family import TaylorHints
+    >>> hints = TaylorHints(r=fmpq(1, 32), disc_grid=6, sigma_boxes=10, order=12, layer_order=14, exp_order=24)
+    >>> box = RegularityModels(fmpq(4484, 1000), fmpq(44935, 10000), hints, 0, 128).sigma_box(0)
+    >>> box.bulk([(fmpq(1, 4), fmpq(26, 100)), (fmpq(0), fmpq(1, 101))]) > 0  # K det J_Phi, every K >= 101
+    True
+    """
+
+    def __init__(self, sig_lo, sig_hi, hints, layer, prec):
+        self.hints, self.layer, self.prec = hints, layer, prec
+        self.edges = _sigma_edges(sig_lo, sig_hi, hints.sigma_boxes)
+        with ctx.workprec(prec):
+            sig_all = _ball(sig_lo, sig_hi)
+            self.M = disc_bounds(sig_all, hints.r, grid=hints.disc_grid, prec=prec)
+            self.ML = {q: layer_disc(q, sig_all, hints.r, grid=hints.disc_grid, prec=prec) for q in range(layer)}
+        self._boxes = {}
+
+    def sigma_box(self, i):
+        """The models on sigma box i of ``hints.sigma_boxes`` equal boxes of the bracket (cached)."""
+        if not 0 <= i < self.hints.sigma_boxes:
+            raise IndexError(f"sigma box {i} of {self.hints.sigma_boxes}")
+        if i not in self._boxes:
+            self._boxes[i] = RegularityBox(self, i)
+        return self._boxes[i]
+
+
+class RegularityBox:
+    """The Taylor coefficients on one sigma box; each evaluator returns one arb containing every Bernstein
+    coefficient of the three pieces of the region's scaled det J_Phi on the box (a list of (lo, hi) fmpq)."""
+
+    def __init__(self, models, i):
+        self.m, hints, prec = models, models.hints, models.prec
+        with ctx.workprec(prec):
+            self.sigma = _ball(models.edges[i], models.edges[i + 1])
+            self.T = taylor_dets(self.sigma, hints.order, prec=prec)
+            self.E = middle_coeffs(self.T, self.sigma, L=hints.exp_order)
+            self.TL = {q: layer_taylor(q, self.sigma, hints.layer_order, prec=prec) for q in range(models.layer)}
+
+    def _h_ok(self, h_hi):
+        if not (h_hi >= 0 and h_hi < self.m.hints.r):
+            raise ZeroDivisionError(f"h up to {h_hi} is not inside the Cauchy disc of radius {self.m.hints.r}")
+
+    def bulk(self, box):
+        """K det J_Phi on (s, h) in the box (the bulk, s in [s0, 1/2])."""
+        (s_lo, s_hi), (h_lo, h_hi) = box
+        self._h_ok(h_hi)
+        hn = self.m.hints
+        return _span(*kdet_box(self.T, self.m.M, s_lo, s_hi, h_lo, h_hi, self.sigma, hn.r, hn.order,
+                               prec=self.m.prec))
+
+    def middle(self, box):
+        """K^3 det J_Phi/q^2 as a function of (s, w = 1/q) in the box (the middle)."""
+        (s_lo, s_hi), (w_lo, w_hi) = box
+        self._h_ok(s_hi * w_hi)
+        hn = self.m.hints
+        return _span(*middle_box(self.T, self.E, self.m.M, s_lo, s_hi, w_lo, w_hi, self.sigma, hn.r, hn.order,
+                                 L=hn.exp_order, prec=self.m.prec))
+
+    def layer(self, q, box):
+        """K^3 det J_Phi of layer quadrant q on h in the box."""
+        ((h_lo, h_hi),) = box
+        self._h_ok(h_hi)
+        hn = self.m.hints
+        return _span(*layer_box(self.TL[q], self.m.ML[q], h_lo, h_hi, hn.r, hn.layer_order, prec=self.m.prec))
