@@ -97,13 +97,13 @@ from ccproof.certify.verify.dart_curves import (  # noqa: F401 (re-exported for 
     layer_coord,
     layer_trans_disc,
     layer_trans_taylor,
-    layer_y_upper,
     taylor_trans,
     ymid_box,
-    ymid_zero,
 )
 from ccproof.certify.verify.dart_family import (  # noqa: F401 (re-exported for the tests)
+    CURVES,
     PIECES,
+    YB,
     Family,
     _ball,
     _parts,
@@ -399,6 +399,35 @@ def cover_sign(T, M, s_lo, s_hi, k0, sigma, r, n, coord, sign, pieces=8, depth=1
 
 
 
+
+
+# float diagnostics of the exact zeros' enclosures (printed only; the trusted evaluators drop them)
+def ymid_zero(T, sigma):
+    """max |sum_j c_j Y_j0| over the curve points: Y at h = 0, s = 0 (0 exactly), as enclosed."""
+    es = acb(0, sigma).exp()
+    c = {"Y0": acb(1), "Y+": 1 / es, "Y-": es}
+    return max(float(abs(sum((c[j] * T[(j, cv)][0][p] for j in YB), acb(0))).upper())
+               for cv in CURVES for p in range(4))
+
+
+def layer_y_upper(T, M, q, h_lo, h_hi, r, n, prec=128):
+    """The largest upper bound of K Y over layer quadrant q's outer-curve points (K^2 Y at ray 0's end point,
+    quadrant 0, curve P1s1, point 0), h in [h_lo, h_hi]; the dropped coefficients are 0 exactly (y = O(h),
+    and O(h^2) on ray 0 where x, hence y's first order, vanishes)."""
+    with ctx.workprec(prec):
+        h = _ball(h_lo, h_hi)
+        hr = arb(fmpq(h_hi)) / r
+        high, zero = None, 0.0
+        for c in CURVES:
+            for p in range(4):
+                order = 2 if (q == 0 and c == "P1s1" and p == 0) else 1
+                zero = max([zero] + [float(abs(T[c][m][p]).upper()) for m in range(order)])
+                acc = arb(0)
+                for m in range(n, order - 1, -1):
+                    acc = acc * h + T[c][m][p]
+                acc += arb(0, (M[c] * hr ** (n + 1) / (1 - hr) / arb(fmpq(h_hi)) ** order).upper())
+                high = acc.upper() if high is None or acc.upper() > high else high
+        return high, zero
 
 
 def cover_ymid(T, M, s0, k0, t_layer, sigma, r, n, depth=12):

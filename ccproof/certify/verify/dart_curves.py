@@ -197,12 +197,6 @@ def ymid_box(T, M, s_lo, s_hi, w_lo, w_hi, sigma, r, n, L=24, prec=128):
         return low, high
 
 
-def ymid_zero(T, sigma):
-    """max |sum_j c_j Y_j0| over the curve points: Y at h = 0, s = 0 (0 exactly), as enclosed."""
-    es = acb(0, sigma).exp()
-    c = {"Y0": acb(1), "Y+": 1 / es, "Y-": es}
-    return max(float(abs(sum((c[j] * T[(j, cv)][0][p] for j in YB), acb(0))).upper())
-               for cv in CURVES for p in range(4))
 
 
 def layer_coord(q, sigma, n, r, grid=12, prec=128):
@@ -227,24 +221,6 @@ def layer_coord(q, sigma, n, r, grid=12, prec=128):
         return T, M
 
 
-def layer_y_upper(T, M, q, h_lo, h_hi, r, n, prec=128):
-    """The largest upper bound of K Y over layer quadrant q's outer-curve points (K^2 Y at ray 0's end point,
-    quadrant 0, curve P1s1, point 0), h in [h_lo, h_hi]; the dropped coefficients are 0 exactly (y = O(h),
-    and O(h^2) on ray 0 where x, hence y's first order, vanishes)."""
-    with ctx.workprec(prec):
-        h = _ball(h_lo, h_hi)
-        hr = arb(fmpq(h_hi)) / r
-        high, zero = None, 0.0
-        for c in CURVES:
-            for p in range(4):
-                order = 2 if (q == 0 and c == "P1s1" and p == 0) else 1
-                zero = max([zero] + [float(abs(T[c][m][p]).upper()) for m in range(order)])
-                acc = arb(0)
-                for m in range(n, order - 1, -1):
-                    acc = acc * h + T[c][m][p]
-                acc += arb(0, (M[c] * hr ** (n + 1) / (1 - hr) / arb(fmpq(h_hi)) ** order).upper())
-                high = acc.upper() if high is None or acc.upper() > high else high
-        return high, zero
 
 
 # --- the evaluators a dart:>=K0 record's leaves are replayed on ------------------------------------------
@@ -255,7 +231,8 @@ def _span(low, high):
 
 def layer_y_bounds(T, M, q, h_lo, h_hi, r, n, prec=128):
     """(lower, upper) bounds of K Y over layer quadrant q's outer-curve points (K^2 Y at ray 0's end point of
-    quadrant 0), h in [h_lo, h_hi]: :func:`layer_y_upper` with both ends."""
+    quadrant 0), h in [h_lo, h_hi]; the coefficients below h^order are dropped (0 exactly: y = O(h), and O(h^2) at ray
+    0's end point where x, hence y's first order, vanishes)."""
     with ctx.workprec(prec):
         h = _ball(h_lo, h_hi)
         hr = arb(fmpq(h_hi)) / r
