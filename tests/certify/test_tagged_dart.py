@@ -4,10 +4,10 @@ bound raised past the enclosure, or a claim that is false, is refused."""
 import pytest
 from flint import arb, fmpq
 
-from ccproof.certify.tagged_dart import cover
+from ccproof.certify.tagged_dart import cover, map_covers
 from ccproof.certify.verify.dart_curves import CurveModels
 from ccproof.certify.verify.dart_family import TaylorHints
-from ccproof.certify.verify.dart_trees import read_tree, replay_tree
+from ccproof.certify.verify.dart_trees import read_tree, replay_map, replay_tree
 from ccproof.certify.verify.errors import CertificateError
 
 H = (fmpq(0), fmpq(1, 101))
@@ -41,3 +41,48 @@ def test_negative_claims_and_the_layer(box0):
 def test_a_false_claim_stays_undecided():
     with pytest.raises(ValueError, match="undecided"):
         cover([(fmpq(-1), fmpq(1))], lambda b: arb(b[0][0]).union(arb(b[0][1])), 1, [1], max_depth=4)
+
+
+def _hints(grid=12):
+    return TaylorHints(r=fmpq(1, 32), disc_grid=grid, sigma_boxes=10, order=12, layer_order=14, exp_order=24)
+
+
+def _regions():
+    return dict(k0=101, sig_lo=fmpq(4484, 1000), sig_hi=fmpq(44935, 10000), s0=fmpq(1, 20), layer=3,
+                winding=(fmpq(1, 4), fmpq(7, 20)), prec=128)
+
+
+def test_malformed_map_parts_fail_before_any_model_is_built():
+    r = _regions()
+    tree = {"grid": [1, 1], "leaves": [{"cell": [0, 0], "path": "", "bound": "1"}]}
+    ltree = {"grid": [1], "leaves": [{"cell": [0], "path": "", "bound": "1"}]}
+    cov = {"bulk": [tree] * 10, "middle": [tree] * 10, "layer": {q: [ltree] * 10 for q in "012"}}
+    signs = {"Y<0 bulk": [tree] * 10, "X>0 bulk": [tree] * 10, "Y>0 bulk": [tree] * 10, "Y<0 middle": [tree] * 10,
+             "Y<0 layer": {q: [ltree] * 10 for q in "012"}}
+    parts = {"regularity": cov, "transversal": cov, "winding": signs}
+    with pytest.raises(CertificateError, match="wrong sign"):  # the Y<0 lists need negative bounds
+        replay_map(parts, hints=_hints(), **r)
+    with pytest.raises(CertificateError, match="one tree per sigma box"):
+        replay_map(dict(parts, regularity=dict(cov, bulk=[tree] * 9)), hints=_hints(), **r)
+    with pytest.raises(CertificateError):
+        replay_map(dict(parts, extra=1), hints=_hints(), **r)
+    with pytest.raises(CertificateError, match="s0 < s_a"):
+        replay_map(parts, hints=_hints(), **dict(r, winding=(fmpq(1, 30), fmpq(7, 20))))
+    with pytest.raises(CertificateError, match="T >= 3"):
+        replay_map(parts, hints=_hints(), **dict(r, layer=2))
+
+
+@pytest.mark.slow
+def test_the_whole_map_part_for_every_k_from_101_round_trips():
+    """R, T and W for every K >= 101 (3,239 leaves: the scripts' covers) written by the prover and replayed
+    by the trusted trees on fresh models; a bulk tree with its last cell's leaves dropped FAILs."""
+    r = _regions()
+    parts = map_covers(r["k0"], r["sig_lo"], r["sig_hi"], _hints(), r["s0"], r["layer"], r["winding"])
+    summary = replay_map(parts, hints=_hints(), **r)
+    assert summary["R bulk"][0] == 1643 and summary["R bulk"][1] > 0
+    assert summary["Y<0 layer 0"][1] < 0
+    tree = parts["regularity"]["bulk"][3]
+    last = max(leaf["cell"][0] for leaf in tree["leaves"])
+    tree["leaves"] = [leaf for leaf in tree["leaves"] if leaf["cell"][0] != last]
+    with pytest.raises(CertificateError, match="no leaf"):
+        replay_map(parts, hints=_hints(), **r)

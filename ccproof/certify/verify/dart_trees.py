@@ -20,7 +20,10 @@ from __future__ import annotations
 
 from flint import arb, fmpq
 
+from .dart_curves import CurveModels
+from .dart_regularity import RegularityModels
 from .errors import CertificateError
+from .record import exact_keys
 from .replay import box_tree, parse_decimal, parse_path
 
 MAX_GRID = 64  # cells per axis
@@ -199,3 +202,99 @@ def replay_tree(leaves, evaluate, sign, where):
         count += 1
         least = bound if least is None or abs(bound) < abs(least) else least
     return count, least
+
+
+def replay_map(parts, k0, sig_lo, sig_hi, hints, s0, layer, winding, prec):
+    """Step 6 of a ``dart:>=K0`` record: every tree of R, T and W (``parts``: the record's ``parts``) read
+    against the root its region fixes and replayed on the trusted models, sigma box by sigma box.
+
+    Parameters
+    ----------
+    parts : object (parsed JSON)
+        ``{"regularity": cover, "transversal": cover, "winding": signs}`` (docs/certificates.md).
+    k0 : int
+    sig_lo, sig_hi : fmpq
+        The bracket of sigma(K) (shown by the spectrum and the eigenvector lemma, not here).
+    hints : TaylorHints
+    s0 : fmpq
+        The bulk is s in [s0, 1/2]; the middle is (s, w) in [0, s0] x [0, 1/layer].
+    layer : int
+        T >= 3: the layer quadrants 0..T-1.
+    winding : (fmpq, fmpq)
+        (s_a, s_b), s0 < s_a < s_b < 1/2.
+    prec : int
+
+    Returns
+    -------
+    dict
+        {list name: (leaves evaluated, least bound)}.
+
+    Raises
+    ------
+    CertificateError
+        Naming the list and the leaf.
+
+    Examples
+    --------
+    >>> from flint import fmpq
+    >>> from ccproof.certify.verify.dart_family import TaylorHints
+    >>> hints = TaylorHints(fmpq(1, 32), 12, 10, 12, 14, 24)
+    >>> replay_map({}, 101, fmpq(4484, 1000), fmpq(44935, 10000), hints, fmpq(1, 20), 3, (fmpq(1, 4), fmpq(7, 20)), 128)
+    Traceback (most recent call last):
+    ...
+    ccproof.certify.verify.errors.CertificateError: parts: ...
+    """
+    s_a, s_b = winding
+    half, h0 = fmpq(1, 2), fmpq(1, k0)
+    if not (0 < s0 < s_a < s_b < half and layer >= 3 and h0 < hints.r and s0 / layer < hints.r):
+        raise CertificateError("regions: need 0 < s0 < s_a < s_b < 1/2, T >= 3, 1/K0 < r and s0/T < r")
+    exact_keys(parts, ("regularity", "transversal", "winding"), "parts")
+    reg, tra, win = parts["regularity"], parts["transversal"], parts["winding"]
+    for name, obj in (("regularity", reg), ("transversal", tra)):
+        exact_keys(obj, ("bulk", "middle", "layer"), name)
+    exact_keys(win, ("Y<0 bulk", "X>0 bulk", "Y>0 bulk", "Y<0 middle", "Y<0 layer"), "winding")
+    quads = tuple(str(q) for q in range(layer))
+    for name, obj in (("regularity layer", reg["layer"]), ("transversal layer", tra["layer"]),
+                      ("winding Y<0 layer", win["Y<0 layer"])):
+        exact_keys(obj, quads, name)
+    bulk, middle = [(s0, half), (fmpq(0), h0)], [(fmpq(0), s0), (fmpq(0), fmpq(1, layer))]
+    hroot = [(fmpq(0), h0)]
+    lists = [("R bulk", reg["bulk"], bulk, "bulk", 1, False), ("R middle", reg["middle"], middle, "middle", 1, True),
+             ("T bulk", tra["bulk"], bulk, "transversal_bulk", 1, False),
+             ("T middle", tra["middle"], middle, "transversal_middle", 1, True),
+             ("Y<0 bulk", win["Y<0 bulk"], [(s0, s_a), (fmpq(0), h0)], "y_bulk", -1, False),
+             ("X>0 bulk", win["X>0 bulk"], [(s_a, s_b), (fmpq(0), h0)], "x_bulk", 1, False),
+             ("Y>0 bulk", win["Y>0 bulk"], [(s_b, half), (fmpq(0), h0)], "y_bulk", 1, False),
+             ("Y<0 middle", win["Y<0 middle"], middle, "y_middle", -1, True)]
+    for q in quads:
+        lists += [(f"R layer {q}", reg["layer"][q], hroot, ("layer", int(q)), 1, False),
+                  (f"T layer {q}", tra["layer"][q], hroot, ("transversal_layer", int(q)), 1, False),
+                  (f"Y<0 layer {q}", win["Y<0 layer"][q], hroot, ("y_layer", int(q)), -1, False)]
+    read = {}
+    total = 0
+    for name, trees, root, _, sign, out in lists:  # every tree checked before any model is built
+        if not isinstance(trees, list) or len(trees) != hints.sigma_boxes:
+            raise CertificateError(f"{name}: one tree per sigma box ({hints.sigma_boxes}) is needed")
+        read[name] = [read_tree(t, root, f"{name}, sigma box {i}", sign, k0=k0, outside=out)
+                      for i, t in enumerate(trees)]
+        total += sum(len(x) for x in read[name])
+    if total > MAX_LEAVES:
+        raise CertificateError(f"more than {MAX_LEAVES} leaves in all ({total})")
+    models = (RegularityModels(sig_lo, sig_hi, hints, layer, prec), CurveModels(sig_lo, sig_hi, hints, layer, prec))
+    summary = {}
+    for i in range(hints.sigma_boxes):
+        boxes = (models[0].sigma_box(i), models[1].sigma_box(i))
+        for name, _, _, method, sign, _ in lists:
+            owner = boxes[0] if name.startswith("R ") else boxes[1]
+            if isinstance(method, tuple):
+                fn, q = getattr(owner, method[0]), method[1]
+
+                def evaluate(box, fn=fn, q=q):
+                    return fn(q, box)
+            else:
+                evaluate = getattr(owner, method)
+            count, least = replay_tree(read[name][i], evaluate, sign, f"{name}, sigma box {i}")
+            old = summary.get(name, (0, None))
+            best = least if old[1] is None or (least is not None and abs(least) < abs(old[1])) else old[1]
+            summary[name] = (old[0] + count, best)
+    return summary
