@@ -279,6 +279,10 @@ def prove_tagged(name, prec=DEFAULT_PREC):
      no witness candidate'
     """
     fam, n = parse_configuration(name)
+    if isinstance(n, dict) and fam == "dart":  # every K >= K0, "C1" (verified by the caller: about a minute)
+        from ccproof.certify.tagged_dart import prove_dart_tail
+
+        return prove_dart_tail(name, prec)
     if isinstance(n, dict):
         return prove_tagged_limit(name, prec)
     why = []
@@ -334,11 +338,13 @@ def prove_tagged_limit(name, prec=DEFAULT_PREC):
 
 
 def write_tagged(cert, out_dir):
-    """Write ``out_dir/FAMILY/nNNN.json`` (``kKKK`` for darts, ``n_ge_N0`` for every N >= N0); returns the path."""
+    """Write ``out_dir/FAMILY/nNNN.json`` (``kKKK`` for darts; ``n_ge_N0``, ``k_ge_K0`` for every N >= N0, K >= K0);
+    returns the path."""
     fam, n = parse_configuration(cert["configuration"])
     d = Path(out_dir) / fam
     d.mkdir(parents=True, exist_ok=True)
-    path = d / (f"n_ge_{n['min']}.json" if isinstance(n, dict) else f"{'k' if fam == 'dart' else 'n'}{n:03d}.json")
+    letter = "k" if fam == "dart" else "n"
+    path = d / (f"{letter}_ge_{n['min']}.json" if isinstance(n, dict) else f"{letter}{n:03d}.json")
     path.write_text(json.dumps(cert, indent=1) + "\n")
     return path
 

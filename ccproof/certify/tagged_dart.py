@@ -145,3 +145,78 @@ def map_covers(k0, sig_lo, sig_hi, hints, s0, layer, winding, prec=128, progress
         if progress is not None:
             progress(f"sigma box {i + 1}/{hints.sigma_boxes}")
     return out
+
+
+#: the hints of a ``dart:>=K0`` record (docs/tagged_c1.md, "A plan for every dart K >= 101", the scripts' values)
+DART_HINTS = {"sigma": ("4.484", "4.4935"), "sigma_h": 16, "circle": "5.4", "mode0_h": 16, "tau1": "50", "v0": "0.4",
+              "taylor": {"r": "0.03125", "disc_grid": 12, "sigma_boxes": 10, "order": 12, "layer_order": 14,
+                         "exp_order": 24},
+              "regions": {"s0": "1/20", "layer": 3, "winding": ["1/4", "7/20"]}}
+
+
+def spectrum_covers(k0, sig_r, tau1, v0, prec=128):
+    """The trees of Re(1 - F) > 0 over the regions N, I, F (:mod:`ccproof.certify.verify.dart_spectrum`)."""
+    from flint import ctx
+
+    from ccproof.certify.verify.dart_spectrum import SpectralRegions, region_roots
+
+    roots = region_roots(k0, tau1, v0)
+    with ctx.workprec(prec):
+        reg = SpectralRegions(sig_r, k0)
+        return {name: cover(roots[name], fn, 1, [40, 4]) for name, fn in (("N", reg.n), ("I", reg.i), ("F", reg.f))}
+
+
+def prove_dart_tail(name, prec=128, hints=None, progress=None):
+    """The ``dart:>=K0`` "C1" record (docs/certificates.md): the hints and every cover, or None with the reason.
+
+    The record is not verified here: ``ccproof certify`` re-checks the written file with the verifier.
+
+    Parameters
+    ----------
+    name : str
+        ``"dart:>=K0"``.
+    prec : int
+    hints : dict, optional
+        :data:`DART_HINTS` by default.
+    progress : callable (str) -> None, optional
+
+    Returns
+    -------
+    (dict or None, str)
+    """
+    from ccproof.certify.verify.dart_family import TaylorHints
+    from ccproof.certify.verify.replay import parse_decimal
+    from ccproof.certify.verify.tagged import parse_configuration
+    from ccproof.certify.verify.tagged_c1 import TAGGED_SCHEMA
+
+    fam, n = parse_configuration(name)
+    if fam != "dart" or not isinstance(n, dict):
+        return None, f"undecided: {name}: not dart:>=K0"
+    k0 = n["min"]
+    hn = dict(DART_HINTS if hints is None else hints)
+    t = hn["taylor"]
+    th = TaylorHints(parse_decimal(t["r"]), t["disc_grid"], t["sigma_boxes"], t["order"], t["layer_order"],
+                     t["exp_order"])
+    rg = hn["regions"]
+
+    def frac(s):
+        a, b = s.split("/")
+        return fmpq(int(a), int(b))
+    sig_lo, sig_hi = (parse_decimal(s) for s in hn["sigma"])
+    try:
+        re = spectrum_covers(k0, parse_decimal(hn["circle"]), parse_decimal(hn["tau1"]), parse_decimal(hn["v0"]), prec)
+        if progress is not None:
+            progress("spectrum: regions N, I, F covered")
+        parts = map_covers(k0, sig_lo, sig_hi, th, frac(rg["s0"]), rg["layer"], tuple(frac(s) for s in rg["winding"]),
+                           prec=prec, progress=progress)
+    except (ValueError, ZeroDivisionError, CertificateError) as exc:
+        return None, f"undecided: {name}: {exc}"
+    cert = {"schema": TAGGED_SCHEMA, "configuration": name, "statement": "C1", "prec": prec,
+            "map": {"orientation": 1},
+            "spectrum": {"sigma": list(hn["sigma"]), "sigma_h": hn["sigma_h"], "circle": hn["circle"],
+                         "mode0_h": hn["mode0_h"], "tau1": hn["tau1"], "v0": hn["v0"], "re": re},
+            "taylor": dict(t), "regions": {"s0": rg["s0"], "layer": rg["layer"], "winding": list(rg["winding"])},
+            "parts": parts}
+    leaves = sum(len(tr["leaves"]) for tr in re.values())
+    return cert, (f"C1 for every K >= {k0} (spectral trees {leaves} leaves; map covers for {t['sigma_boxes']} "
+                  "sigma boxes)")

@@ -92,7 +92,7 @@ def _check(args):
 TAGGED_TARGET = {"dart": (2, 100), "crease": (1, 100), "corner": (1, 100)}
 TAGGED_UNDECIDED = {"dart": (2,), "crease": (1, 4), "corner": (2, 4)}
 # the families whose every N must be covered: a certificate FAMILY:>=N0 (N0 at most the range's end + 1)
-TAGGED_EVERY = ("crease", "corner")
+TAGGED_EVERY = ("dart", "crease", "corner")
 
 
 def tagged_coverage(results):
@@ -129,12 +129,13 @@ def tagged_coverage(results):
         clash = sorted(n for n, st in rows for t, st_t in tails if n >= t and st != st_t)
         every = fam in TAGGED_EVERY
         c1, not_c1 = (sorted(n for n, st in rows if st == want) for want in ("C1", "not C1"))
+        c1 = _ranges(c1) + "".join(f", >= {t}" for t, st in sorted(tails) if st == "C1")
         not_c1 = _ranges(not_c1) + "".join(f", >= {t}" for t, st in sorted(tails) if st == "not C1")
         gap = [] if n0 is not None and n0 <= hi + 1 or not every else [f">= {hi + 1}"]
         status = (f"CONTRADICTORY: certified twice: {twice or clash}; " if twice or clash else
                   f"INCOMPLETE: no certificate for {', '.join(filter(None, [_ranges(missing)] + gap))}; "
                   if missing or gap else f"OK ({fam}:{lo}-{hi}{', every N' if every else ''}): ")
-        lines.append(f"{fam}: {status}C1 for {_ranges(c1) or 'none'}, not C1 for {not_c1.lstrip(', ') or 'none'}; "
+        lines.append(f"{fam}: {status}C1 for {c1.lstrip(', ') or 'none'}, not C1 for {not_c1.lstrip(', ') or 'none'}; "
                      f"undecided: {_ranges(list(TAGGED_UNDECIDED[fam]))} (docs/tagged_c1.md lists the reasons)")
         ok_all &= not twice and not clash and not missing and not gap
     return ok_all, lines

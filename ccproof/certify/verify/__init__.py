@@ -24,6 +24,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from .c1 import C1_SCHEMA, verify_c1
+from .dart_tail import verify_dart_tail
 from .errors import CertificateError
 from .injectivity import SCHEMA, verify_injectivity
 from .record import Part, Recorder, VerifyResult, field_of, read_valence
@@ -83,8 +84,12 @@ def verify_certificate(cert, log=print, path=None):
         check_size(cert)
         if res.schema == TAGGED_SCHEMA:  # a configuration name instead of a valence (docs/tagged_c1.md)
             fam, n = parse_configuration(field_of(cert, "configuration", str, "certificate"))
-            res.valence = verify_tail(cert, fam, n["min"], part, log) if isinstance(n, dict) else verify_tagged(
-                cert, part, log)  # FAMILY:>=N0: every N >= N0 at once (tagged_limit)
+            if not isinstance(n, dict):
+                res.valence = verify_tagged(cert, part, log)
+            elif fam == "dart":  # every K >= K0 at once, "C1" (dart_tail)
+                res.valence = verify_dart_tail(cert, n["min"], part, log)
+            else:  # every N >= N0 at once, "not C1" (tagged_limit)
+                res.valence = verify_tail(cert, fam, n["min"], part, log)
             res.seconds = time.perf_counter() - t0
             return res
         res.valence = read_valence(cert)

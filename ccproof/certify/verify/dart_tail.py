@@ -1,0 +1,205 @@
+"""Every ``dart:K`` with K >= K0 in one "C1" certificate: the record and its steps in order (trusted).
+
+The grammar is docs/certificates.md, "Every dart K >= K0 in one certificate"; the argument is
+docs/tagged_c1.md, "A plan for every dart K >= 101". The statement is fixed by the configuration: for every
+K >= K0, 1 simple, lam1 = lam(cos(2 pi/K)) > lam2 = lam(cos(2 sigma(K)/K)) > |every other eigenvalue|, both
+simple; x the odd mode-1 eigenvector, y the even eigenvector of lam2 (y = 1 at ray K/2, orientation +1);
+det J_Phi > 0 on every piece of every quadrant, the transversality forms > 0 on the outer curves, and the
+outer curve crosses {Y = 0, X > 0} once. The record holds hints only. The steps, each a part:
+
+1. **Record** (:func:`read_record`): exactly the grammar's keys, every number in its range, the three
+   spectral trees read against the roots their regions fix (:func:`.dart_spectrum.region_roots`), before any
+   arithmetic on them.
+2. **Construction** (:func:`.dart_spectrum.check_construction`): S for every K >= 7 from one window.
+3. **Exact zeros** (:func:`.dart_zeros.check_zeros`): every coefficient the Taylor models drop is 0.
+4. **Spectrum** (:mod:`.dart_spectrum`): the identities of the secular equation, mode 0's roots below the
+   circle, Re(1 - F) > 0 on every leaf of N, I, F: only 1, lam1 and one even eigenvalue outside the circle.
+5. **Eigenvector lemma** (:func:`.dart_eigen.check_eigenvector`): that even eigenvalue is
+   lam(cos(2 sigma*/K)), sigma* in the bracket, and the family member there (and x) are the eigenvectors.
+6. **Map** (:func:`.dart_trees.replay_map`): R, T and W on every leaf, sigma box by sigma box.
+7. **Conclusion**: the reflection in ray 0 (x odd, y even) carries the quadrants q <= (K - 1)/2 to the
+   rest; with 2 to 6 the generalized Reif criterion holds for every K >= K0.
+"""
+
+from __future__ import annotations
+
+from flint import ctx, fmpq
+
+from .dart_eigen import check_eigenvector
+from .dart_family import TaylorHints
+from .dart_spectrum import SpectralRegions, check_construction, check_mode0, check_ranges, check_secular, region_roots
+from .dart_trees import MAX_LEAVES, read_tree, replay_map, replay_tree
+from .dart_zeros import check_zeros
+from .errors import CertificateError
+from .record import exact_keys, field_of
+from .replay import parse_decimal
+
+MIN_K0 = 101  # the regions need 1/K0 < r, and the covers are shown from 101 on
+MAX_BALLS = 8192
+_KEYS = ("schema", "configuration", "statement", "prec", "map", "spectrum", "taylor", "regions", "parts")
+_SPECTRUM = ("sigma", "sigma_h", "circle", "mode0_h", "tau1", "v0", "re")
+_TAYLOR = {"disc_grid": (1, 64), "sigma_boxes": (1, 256), "order": (3, 24), "layer_order": (3, 24),
+           "exp_order": (2, 64)}
+
+
+def _fraction(s, where):
+    if not isinstance(s, str) or len(s) > 40 or s.count("/") != 1:
+        raise CertificateError(f"{where}: a fraction 'INT/INT' is needed")
+    a, b = s.split("/")
+    if not (a.isdigit() and b.isdigit() and int(b) > 0):
+        raise CertificateError(f"{where}: a fraction 'INT/INT' is needed")
+    return fmpq(int(a), int(b))
+
+
+def _int(obj, key, lo, hi, where):
+    v = field_of(obj, key, int, where)
+    if not lo <= v <= hi:
+        raise CertificateError(f"{where}: {key} must lie in {lo}..{hi}")
+    return v
+
+
+def read_record(cert, k0):
+    """Step 1: the record's hints as exact numbers and the spectral trees read (no arithmetic on forms).
+
+    Parameters
+    ----------
+    cert : dict
+    k0 : int
+
+    Returns
+    -------
+    dict
+        prec, sig_lo, sig_hi, sig_r, sigma_h, mode0_h, tau1, v0, re (name -> leaves), hints (TaylorHints),
+        s0, layer, winding, parts.
+
+    Raises
+    ------
+    CertificateError
+        Naming the field.
+    """
+    if not MIN_K0 <= k0 <= 10**6:
+        raise CertificateError(f"dart:>={k0}: the interval certificate needs {MIN_K0} <= K0 <= 10^6")
+    exact_keys(cert, _KEYS, "certificate")
+    if field_of(cert, "statement", str, "certificate") != "C1":
+        raise CertificateError("dart:>=K0 is certified \"C1\" only (its statement is fixed by the configuration)")
+    out = {"prec": _int(cert, "prec", 64, 1024, "certificate")}
+    m = field_of(cert, "map", dict, "certificate")
+    exact_keys(m, ("orientation",), "map")
+    if field_of(m, "orientation", int, "map") != 1:
+        raise CertificateError("map: the statement fixes orientation +1 (x sine-like, y = 1 at ray K/2)")
+    sp = field_of(cert, "spectrum", dict, "certificate")
+    exact_keys(sp, _SPECTRUM, "spectrum")
+    sig = field_of(sp, "sigma", list, "spectrum")
+    if len(sig) != 2:
+        raise CertificateError("spectrum: sigma must be [lo, hi]")
+    out["sig_lo"], out["sig_hi"] = (parse_decimal(s) for s in sig)
+    out["sig_r"], out["tau1"], out["v0"] = (parse_decimal(field_of(sp, k, str, "spectrum"))
+                                            for k in ("circle", "tau1", "v0"))
+    out["sigma_h"] = _int(sp, "sigma_h", 1, MAX_BALLS, "spectrum")
+    out["mode0_h"] = _int(sp, "mode0_h", 1, MAX_BALLS, "spectrum")
+    check_ranges(k0, out["sig_lo"], out["sig_hi"], out["sig_r"], out["tau1"], out["v0"])
+    re = field_of(sp, "re", dict, "spectrum")
+    exact_keys(re, ("N", "I", "F"), "spectrum re")
+    roots = region_roots(k0, out["tau1"], out["v0"])
+    out["re"] = {name: read_tree(re[name], roots[name], f"spectrum re {name}", 1) for name in ("N", "I", "F")}
+    if sum(len(v) for v in out["re"].values()) > MAX_LEAVES:
+        raise CertificateError(f"spectrum: more than {MAX_LEAVES} leaves")
+    ty = field_of(cert, "taylor", dict, "certificate")
+    exact_keys(ty, ("r", *_TAYLOR), "taylor")
+    r = parse_decimal(field_of(ty, "r", str, "taylor"))
+    if not fmpq(1, k0) < r <= fmpq(1, 8):
+        raise CertificateError("taylor: need 1/K0 < r <= 1/8")
+    out["hints"] = TaylorHints(r, *(_int(ty, k, lo, hi, "taylor") for k, (lo, hi) in _TAYLOR.items()))
+    rg = field_of(cert, "regions", dict, "certificate")
+    exact_keys(rg, ("s0", "layer", "winding"), "regions")
+    out["s0"] = _fraction(rg["s0"], "regions s0")
+    out["layer"] = _int(rg, "layer", 3, 64, "regions")
+    win = field_of(rg, "winding", list, "regions")
+    if len(win) != 2:
+        raise CertificateError("regions: winding must be [s_a, s_b]")
+    out["winding"] = tuple(_fraction(s, "regions winding") for s in win)
+    out["parts"] = field_of(cert, "parts", dict, "certificate")
+    return out
+
+
+def verify_dart_tail(cert, k0, part, log):
+    """Check a ``"dart:>=K0"`` "C1" certificate (module docstring) into ``part``.
+
+    Parameters
+    ----------
+    cert : dict
+    k0 : int
+    part : Recorder
+    log : callable (str) -> None
+
+    Returns
+    -------
+    str
+        The configuration name.
+
+    Raises
+    ------
+    CertificateError
+        On a malformed record (step 1).
+    """
+    rec = read_record(cert, k0)
+    name = f"dart:>={k0}"
+    log(f"C1 certificate for {name} ({rec['prec']} bits)")
+    with ctx.workprec(rec["prec"]):
+        _steps(rec, k0, part, log)
+    return name
+
+
+def _attempt(part, title, fn):
+    try:
+        msg = fn()
+    except (CertificateError, ZeroDivisionError, ValueError) as exc:
+        part(title, False, str(exc))
+        return False
+    part(title, True, msg)
+    return True
+
+
+def _spectrum(rec, k0):
+    check_secular()
+    least0 = check_mode0(rec["sig_r"], k0, rec["mode0_h"])
+    regions = SpectralRegions(rec["sig_r"], k0)
+    counts = {}
+    for name, fn in (("N", regions.n), ("I", regions.i), ("F", regions.f)):
+        counts[name] = replay_tree(rec["re"][name], fn, 1, f"spectrum re {name}")
+    return (f"secular identities exact; mode 0's roots real and below r on {rec['mode0_h']} h-balls (Q(r)/h >= "
+            f"{float(least0):.3g}); Re(1 - F) > 0 on |lam| = lam(cos(2 x {rec['sig_r']}/K)): "
+            + ", ".join(f"{n} {c} leaves (>= {float(b):.3g})" for n, (c, b) in counts.items())
+            + ": 1, lam1 and one even eigenvalue outside the circle, each simple")
+
+
+def _map(rec, k0):
+    out = replay_map(rec["parts"], k0, rec["sig_lo"], rec["sig_hi"], rec["hints"], rec["s0"], rec["layer"],
+                     rec["winding"], rec["prec"])
+    return "; ".join(f"{n} {c} (>= {float(b):.3g})" if b is not None else f"{n} {c}" for n, (c, b) in out.items())
+
+
+def _steps(rec, k0, part, log):
+    def construction():
+        _, bound = check_construction()
+        return (f"dart:7 and dart:8: one row per window class, the same in both; centre row (1 - 7h/4, 3h^2/2, "
+                f"h^2/4) for K = 7..12; R-symmetric, odd part the ring modes, one-ring closed, outer bound {bound}")
+
+    steps = [
+        ("S sector matrices of every K >= 7 from one window", construction),
+        ("Z dropped Taylor coefficients are 0 (exact, Q(sqrt 5, i))", check_zeros),
+        (f"G spectrum for every K >= {k0}", lambda: _spectrum(rec, k0)),
+        (f"E eigenvectors: y at sigma* in ({rec['sig_lo']}, {rec['sig_hi']}) and x span lam2, lam1",
+         lambda: check_eigenvector(rec["sig_lo"], rec["sig_hi"], k0, rec["prec"], balls=rec["sigma_h"])),
+        (f"M characteristic map regular (R), transversal (T), winding once (W) for every K >= {k0}",
+         lambda: _map(rec, k0)),
+    ]
+    for title, fn in steps:
+        if not _attempt(part, title, fn):
+            return
+    part(f"C generalized Reif criterion for every K >= {k0}", True,
+         "1 simple, lam1 > lam2 > |every other|, both simple; the reflection in ray 0 carries the quadrants "
+         "q <= (K - 1)/2 to the rest (x odd, y even): Phi regular and injective, so dart:K is C1")
+
+
+__all__ = ["MIN_K0", "read_record", "verify_dart_tail"]
