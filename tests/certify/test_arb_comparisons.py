@@ -32,6 +32,28 @@ REVIEWED = {
     # a guard that the family's code matches the lemma's identities (it FAILs a flipped alpha); the lemma is
     # proved by the exact checks and the sign change, not by this test
     ("dart_eigen.py", "z.contains(0)"): "a guard (above), never the proof",
+    ("dart_spectrum.py", "classes[0] != classes[1]"): "dicts of fmpq rows (exact)",
+    ("dart_spectrum.py", "det2 != w * w * lam * lam - (5 * w * w + c2) * lam / 8 + w * w / 16"): "fmpq_mpoly (exact)",
+    ("dart_spectrum.py", "64 * lam * g_num != 64 * lam * det2 + n2 * w * w"): "fmpq_mpoly (exact)",
+    ("dart_spectrum.py", "8 * P * 2 != -(2 * lam - lc)"): "fmpq_mpoly (exact)",
+    ("dart_spectrum.py", "not abs(y) < fmpq(9, 10)"): "refuses unless |y| < 9/10 certainly: conservative",
+    ("dart_spectrum.py", "not T > 0"): "refuses unless T > 0 certainly: conservative",
+    ("dart_spectrum.py", "not 4 * arb(sig_r) < pi * k0"): "refuses unless certainly: conservative",
+    ("dart_spectrum.py", "full != (x - 1) * (x * x - 3 * x / 4 + fmpq(1, 16)) + hv * detR"): "fmpq_poly (exact)",
+    ("dart_spectrum.py", "rem != 0"): "fmpq_poly (exact)",
+    ("dart_spectrum.py", "key != _C"): "tuples",
+    # the sign of a square root is a choice (the expressions are even in it); _cot_far then refuses unless
+    # the imaginary part is certainly positive
+    ("dart_spectrum.py", "not psi.imag > 0"): "a choice of root, re-checked by _cot_far: conservative",
+    ("dart_spectrum.py", "not phi.imag > 0"): "a choice of root, re-checked by _cot_far: conservative",
+    ("dart_spectrum.py", "out.setdefault(key, rel) != rel"): "dicts of fmpq rows (exact)",
+    ("dart_spectrum.py", "x != 0"): "fmpq weights (exact)",
+    ("dart_spectrum.py", "not m > 0"): "refuses unless m > 0 certainly: conservative",
+    ("dart_spectrum.py", "not -1 <= key[1] <= 1"): "ints",
+    ("dart_tail.py", "not lo <= v <= hi"): "ints",
+    ("dart_tail.py", 'field_of(cert, "statement", str, "certificate") != "C1"'): "strings",
+    ("dart_tail.py", 'field_of(m, "orientation", int, "map") != 1'): "ints",
+    ("dart_tail.py", 's.count("/") != 1'): "ints",
     ("dart_family.py", "got != n_at(x)"): "lists of fmpq (exact)",
     ("dart_family.py", "not arg.real > 0"): "refuses unless certainly off the cut: conservative",
     ("dart_zeros.py", "(s * p) % _M3 != 1"): "fmpq_poly (exact)",
