@@ -18,7 +18,7 @@ from ccproof.certify.tagged_dart import cover, spectrum_covers
 from ccproof.certify.verify.dart_spectrum import (
     SpectralRegions,
     check_construction,
-    check_mode0,
+    check_mode0_roots,
     check_ranges,
     check_secular,
     lam_circle,
@@ -131,9 +131,9 @@ def test_count_outside_the_circle_numpy(k):
 
 
 def test_mode0_and_ranges_refuse():
-    assert check_mode0(SIG_R, 101, 16) > 0
+    assert check_mode0_roots(SIG_R, 101, 16) > 0
     with pytest.raises(CertificateError, match="below r"):
-        check_mode0(fmpq(10), 7, 4)  # r below mode 0's second root at K = 7
+        check_mode0_roots(fmpq(10), 7, 4)  # r below mode 0's second root at K = 7
     with pytest.raises(CertificateError, match="sigma_hi < sigma_r"):
         check_ranges(101, fmpq(4484, 1000), fmpq(55, 10), SIG_R, fmpq(50), fmpq(2, 5))
     with pytest.raises(CertificateError, match="pi < sigma_lo"):

@@ -128,7 +128,7 @@ def test_window_check_refuses_a_row_that_depends_on_n(monkeypatch):
 def test_forgery_statement_and_family():
     cert = _tail("crease")
     _fails(dict(cert, statement="C1"), 'certified "not C1" only')
-    _fails(dict(cert, configuration="dart:>=101"), "defined for crease and corner")
+    _fails(dict(cert, configuration="dart:>=101"), 'dart:>=K0 is certified "C1" only')
     per_n = json.loads((certificates_dir() / "c1" / "crease" / "n100.json").read_text())
     _fails(dict(cert, witness=per_n["witness"]), "witness")  # a single configuration's witness: unknown keys
     _fails(dict(per_n, configuration="crease:>=101"), "missing field(s) 'limit'")  # a witness of N = 100

@@ -41,7 +41,7 @@ count shown here. The argument, with what is checked where:
    (modes 1 and K - 1, one even and one odd combination); modes j >= 2 lie below r, 1/(16 lam) <= 1/4 < r,
    and mode 0's other two, the roots of Q = det(x - B0)/(x - 1) = P + h l (l = det R/(x - 1), linear:
    exact), are real and below r: disc(Q) > 0, Q(r)/h > 0 and Q'(r) > 0 on h-balls covering [0, 1/K0]
-   (:func:`check_mode0`). None lies on the circle. If Re(1 - F) > 0 on |lam| = r (the record's trees over
+   (:func:`check_mode0_roots`). None lies on the circle. If Re(1 - F) > 0 on |lam| = r (the record's trees over
    the regions N, I, F below, for t = arg lam in [0, pi]; the lower half by conjugation), 1 - F does not
    wind, so the one-ring operators of S and S0 have equally many eigenvalues outside the circle: 3. The
    odd part is the same for both (lam1, once), so the even one-ring has exactly two: 1 and, by the
@@ -289,14 +289,14 @@ def _ball(lo, hi):
     return arb((fmpq(lo) + fmpq(hi)) / 2, (fmpq(hi) - fmpq(lo)) / 2)
 
 
-def check_mode0(sig_r, k0, balls):
+def check_mode0_roots(sig_r, k0, balls):
     """Raise unless on ``balls`` h-balls covering [0, 1/k0]: disc(Q) > 0, Q(r)/h > 0, Q'(r) > 0 and
     Q(1) > 0 (mode 0's other eigenvalues real, below r; 1 simple). Returns the least Q(r)/h.
 
     Examples
     --------
     >>> from flint import fmpq
-    >>> check_mode0(fmpq(27, 5), 101, 16) > 0
+    >>> check_mode0_roots(fmpq(27, 5), 101, 16) > 0
     True
     """
     ell = _ell()
@@ -470,5 +470,5 @@ def check_ranges(k0, sig_lo, sig_hi, sig_r, tau1, v0):
         raise CertificateError("spectrum: need tau1 > 0 and 0 < v0^2 < pi")
 
 
-__all__ = ["SpectralRegions", "T_PI", "WINDOW", "b0", "check_construction", "check_mode0", "check_ranges",
+__all__ = ["SpectralRegions", "T_PI", "WINDOW", "b0", "check_construction", "check_mode0_roots", "check_ranges",
            "check_secular", "lam_circle", "mode0_parts", "region_roots", "w1_of"]

@@ -27,7 +27,14 @@ from flint import ctx, fmpq
 
 from .dart_eigen import check_eigenvector
 from .dart_family import TaylorHints
-from .dart_spectrum import SpectralRegions, check_construction, check_mode0, check_ranges, check_secular, region_roots
+from .dart_spectrum import (
+    SpectralRegions,
+    check_construction,
+    check_mode0_roots,
+    check_ranges,
+    check_secular,
+    region_roots,
+)
 from .dart_trees import MAX_LEAVES, read_tree, replay_map, replay_tree
 from .dart_zeros import check_zeros
 from .errors import CertificateError
@@ -79,9 +86,9 @@ def read_record(cert, k0):
     """
     if not MIN_K0 <= k0 <= 10**6:
         raise CertificateError(f"dart:>={k0}: the interval certificate needs {MIN_K0} <= K0 <= 10^6")
-    exact_keys(cert, _KEYS, "certificate")
     if field_of(cert, "statement", str, "certificate") != "C1":
         raise CertificateError("dart:>=K0 is certified \"C1\" only (its statement is fixed by the configuration)")
+    exact_keys(cert, _KEYS, "certificate")
     out = {"prec": _int(cert, "prec", 64, 1024, "certificate")}
     m = field_of(cert, "map", dict, "certificate")
     exact_keys(m, ("orientation",), "map")
@@ -162,15 +169,15 @@ def _attempt(part, title, fn):
 
 def _spectrum(rec, k0):
     check_secular()
-    least0 = check_mode0(rec["sig_r"], k0, rec["mode0_h"])
+    least0 = check_mode0_roots(rec["sig_r"], k0, rec["mode0_h"])
     regions = SpectralRegions(rec["sig_r"], k0)
     counts = {}
     for name, fn in (("N", regions.n), ("I", regions.i), ("F", regions.f)):
         counts[name] = replay_tree(rec["re"][name], fn, 1, f"spectrum re {name}")
-    return (f"secular identities exact; mode 0's roots real and below r on {rec['mode0_h']} h-balls (Q(r)/h >= "
-            f"{float(least0):.3g}); Re(1 - F) > 0 on |lam| = lam(cos(2 x {rec['sig_r']}/K)): "
-            + ", ".join(f"{n} {c} leaves (>= {float(b):.3g})" for n, (c, b) in counts.items())
-            + ": 1, lam1 and one even eigenvalue outside the circle, each simple")
+    return (f"every K >= {k0}: 1, lam1 = lam(cos(2 pi/K)) and one even eigenvalue (lam2) outside |lam| = "
+            f"lam(cos(2 x {rec['sig_r']}/K)), each simple; secular identities exact; mode 0's roots real and below "
+            f"r on {rec['mode0_h']} h-balls (Q(r)/h >= {float(least0):.3g}); Re(1 - F) > 0: "
+            + ", ".join(f"{n} {c} leaves (>= {float(b):.3g})" for n, (c, b) in counts.items()))
 
 
 def _map(rec, k0):
