@@ -128,7 +128,8 @@ def bench_tagged(jobs, rounds):
     from ccproof.certify.verify import certificate_files
     from ccproof.tables.format import certificates_dir
 
-    files = [str(f) for f in certificate_files(certificates_dir())]
+    # largest file first, as `ccproof verify --all` schedules them (so that the workers finish together)
+    files = sorted((str(f) for f in certificate_files(certificates_dir())), key=lambda f: -Path(f).stat().st_size)
     tagged = [f for f in files if Path(f).parent.name in ("dart", "crease", "corner")]
     smooth = [f for f in files if f not in tagged]
     ratios, fam_s, loads = [], {}, []

@@ -7,8 +7,8 @@ search. :func:`cover` bisects each grid cell of a region's root until the region
 leaves in the record's grammar (docs/certificates.md, "Every dart K >= K0 in one certificate"): a path of
 halvings per leaf, a bound a little inside the leaf's enclosure (floats choose the bound; the verifier
 decides), and ``outside`` leaves in the middle region where no K >= K0 lies. :func:`map_covers` builds the
-covers of R, T and W for every sigma box. The spectrum's trees and the record around them are not written
-yet: no ``dart:>=K0`` certificate exists (docs/tagged_c1.md, "What remains before a certificate").
+covers of R, T and W for every sigma box, :func:`spectrum_covers` those of Re(1 - F) over the regions N, I,
+F, and :func:`prove_dart_tail` the whole record (``ccproof certify 'dart:>=101' --c1``).
 """
 
 from __future__ import annotations
