@@ -9,9 +9,7 @@ coefficients that vanish exactly (:mod:`.dart_zeros`) are dropped.
 
 from __future__ import annotations
 
-from flint import acb, arb, ctx, fmpq
-
-from ccproof.rigorous import BernsteinForm
+from flint import acb, acb_mat, arb, ctx, fmpq
 
 from .dart_family import (
     PIECES,
@@ -21,11 +19,9 @@ from .dart_family import (
     _ball,
     _coeffs,
     _hvar,
-    _jac,
     _parts,
-    _real_forms,
     basis_nets,
-    complex_det,
+    det_series,
     layer_nets,
     series_cap,
 )
@@ -38,21 +34,10 @@ def taylor_dets(sigma, n, prec=128, **control):
     with ctx.workprec(prec), series_cap(n):
         fam = Family(_hvar(n), sigma, **control)
         nets = basis_nets(fam)
-        forms = {(name, piece, m): _real_forms([[_coeffs(z, n + 1)[m] for z in row] for row in net], prec)
-                 for name, pn in nets.items() for piece, net in pn.items() for m in range(n + 1)}
-        out = {}
-        for i in XB:
-            for j in YB:
-                for piece in PIECES:
-                    coeffs = []
-                    for m in range(n + 1):
-                        acc = None
-                        for k in range(m + 1):
-                            d = complex_det(forms[(i, piece, k)], forms[(j, piece, m - k)])
-                            acc = d if acc is None else [a + b for a, b in zip(acc, d)]
-                        coeffs.append(acc)
-                    out[(i, j, piece)] = coeffs
-        return out
+        series = {(name, piece): [[[_coeffs(z, n + 1)[m] for z in row] for row in net] for m in range(n + 1)]
+                  for name, pn in nets.items() for piece, net in pn.items()}
+        return {(i, j, piece): det_series(series[(i, piece)], series[(j, piece)], n)
+                for i in XB for j in YB for piece in PIECES}
 
 
 def disc_bounds(sigma, r, grid=4, prec=128, **control):
@@ -67,12 +52,12 @@ def disc_bounds(sigma, r, grid=4, prec=128, **control):
                 im = _ball(-r + 2 * r * fmpq(b, grid), -r + 2 * r * fmpq(b + 1, grid))
                 fam = Family(acb(re, im), sigma, **control)
                 nets = basis_nets(fam)
-                forms = {(name, piece): _real_forms(net, prec)
+                forms = {(name, piece): [[[acb(z) for z in row] for row in net]]
                          for name, pn in nets.items() for piece, net in pn.items()}
                 for i in XB:
                     for j in YB:
                         for piece in PIECES:
-                            d = complex_det(forms[(i, piece)], forms[(j, piece)])
+                            d = det_series(forms[(i, piece)], forms[(j, piece)], 0)[0]
                             bound = max((abs(z).upper() for z in d), key=lambda x: x)
                             if not bound.is_finite():
                                 raise ZeroDivisionError(f"disc box {a}, {b}: no bound")
@@ -81,32 +66,39 @@ def disc_bounds(sigma, r, grid=4, prec=128, **control):
     return M
 
 
-def kdet_box(T, M, s_lo, s_hi, h_lo, h_hi, sigma, r, n, prec=128):
+def kdet_matrices(T, n):
+    """{piece: [D_1, ..., D_n]}, D_m an acb_mat with d_ijm at row c (the Bernstein coefficient), column ij (in the
+    order of XB x YB): Horner's rule in h on all of them at once, then one product with the column (a_i b_j)."""
+    ijs = [(i, j) for i in XB for j in YB]
+    return {piece: [acb_mat([[T[(i, j, piece)][m][c] for (i, j) in ijs]
+                             for c in range(len(T[(XB[0], YB[0], piece)][1]))]) for m in range(1, n + 1)]
+            for piece in _parts(T)}
+
+
+def kdet_box(T, M, s_lo, s_hi, h_lo, h_hi, sigma, r, n, prec=128, mats=None):
     """(lower, upper) bounds of K det J_Phi over the three pieces' Bernstein coefficients, for s in [s_lo, s_hi] and
     h in [h_lo, h_hi] (0 < h_hi < r): sum_ij a_i(s) b_j(s) (sum_(m=1..n) d_ijm h^(m-1) + rho_ij) with
-    |rho_ij| <= M_ij h^n/(r^(n+1) (1 - h/r)) (Cauchy on |h| = r), the m = 0 terms being 0 exactly."""
+    |rho_ij| <= M_ij h^n/(r^(n+1) (1 - h/r)) (Cauchy on |h| = r), the m = 0 terms being 0 exactly; Horner's
+    rule runs on the matrices of :func:`kdet_matrices` (``mats`` when given), and the real part of a_i b_j rho_ij
+    is at most (|Re a_i b_j| + |Im a_i b_j|) |rho_ij|."""
     with ctx.workprec(prec):
+        mats = kdet_matrices(T, n) if mats is None else mats
         s, h = _ball(s_lo, s_hi), _ball(h_lo, h_hi)
         E, F = acb(0, 2 * arb.pi() * s).exp(), acb(0, sigma * (2 * s - 1)).exp()
         a, b = {"X+": E, "X-": 1 / E}, {"Y0": acb(1), "Y+": F, "Y-": 1 / F}
         hr = arb(fmpq(h_hi)) / r
         tail = arb(fmpq(h_hi)) ** n / (arb(r) ** (n + 1) * (1 - hr))
+        ws = [(i, j, a[i] * b[j]) for i in XB for j in YB]
         low, high = None, None
-        for piece in _parts(T):
-            tot = None
-            for i in XB:
-                for j in YB:
-                    coeffs, rad = T[(i, j, piece)], (M[(i, j, piece)] * tail).upper()
-                    w = a[i] * b[j]
-                    vals = []
-                    for c in range(len(coeffs[1])):
-                        acc = acb(0)
-                        for m in range(n, 0, -1):
-                            acc = acc * h + coeffs[m][c]
-                        vals.append(w * (acc + acb(arb(0, rad), arb(0, rad))))
-                    tot = vals if tot is None else [x + y for x, y in zip(tot, vals)]
-            lo = min((z.real.lower() for z in tot), key=lambda x: x)
-            hi = max((z.real.upper() for z in tot), key=lambda x: x)
+        for piece, Ds in mats.items():
+            rho = sum(((abs(w.real) + abs(w.imag)) * (M[(i, j, piece)] * tail) for i, j, w in ws), arb(0))
+            acc = Ds[-1]
+            for D in reversed(Ds[:-1]):
+                acc = acc * acb(h) + D
+            vals = [sum((acc[c, k] * w for k, (_, _, w) in enumerate(ws)), acb(0)).real + arb(0, rho.upper())
+                    for c in range(acc.nrows())]
+            lo = min((z.lower() for z in vals), key=lambda x: x)
+            hi = max((z.upper() for z in vals), key=lambda x: x)
             low = lo if low is None or lo < low else low
             high = hi if high is None or hi > high else high
         return low, high
@@ -189,18 +181,9 @@ def layer_taylor(q, sigma, n, prec=128):
         fam = Family(_hvar(n), sigma)
         out = {}
         for piece, (X, Y) in layer_nets(fam, q).items():
-            fx = [BernsteinForm((4, 4), [_coeffs(X[i][j], n + 1)[m].real for i in range(4) for j in range(4)],
-                                prec=prec) for m in range(n + 1)]
-            fy = [BernsteinForm((4, 4), [_coeffs(Y[i][j], n + 1)[m].real for i in range(4) for j in range(4)],
-                                prec=prec) for m in range(n + 1)]
-            coeffs = []
-            for m in range(n + 1):
-                acc = None
-                for k in range(m + 1):
-                    d = _jac(fx[k], fy[m - k])
-                    acc = d if acc is None else [a + b for a, b in zip(acc, d)]
-                coeffs.append(acc)
-            out[piece] = coeffs
+            fx, fy = ([[[acb(_coeffs(Z[i][j], n + 1)[m].real) for j in range(4)] for i in range(4)]
+                       for m in range(n + 1)] for Z in (X, Y))
+            out[piece] = [[z.real for z in c] for c in det_series(fx, fy, n)]
         return out
 
 
@@ -214,7 +197,7 @@ def layer_disc(q, sigma, r, grid=12, prec=128):
                 im = _ball(-r + 2 * r * fmpq(b, grid), -r + 2 * r * fmpq(b + 1, grid))
                 fam = Family(acb(re, im), sigma)
                 for piece, (X, Y) in layer_nets(fam, q).items():
-                    d = complex_det(_real_forms(X, prec), _real_forms(Y, prec))
+                    d = det_series([[[acb(z) for z in row] for row in X]], [[[acb(z) for z in row] for row in Y]], 0)[0]
                     bound = max((abs(z).upper() for z in d), key=lambda x: x)
                     if not bound.is_finite():
                         raise ZeroDivisionError(f"layer disc box {a}, {b}: no bound")
@@ -302,6 +285,7 @@ class RegularityBox:
         with ctx.workprec(prec):
             self.sigma = _ball(models.edges[i], models.edges[i + 1])
             self.T = taylor_dets(self.sigma, hints.order, prec=prec)
+            self.mats = kdet_matrices(self.T, hints.order)
             self.E = middle_coeffs(self.T, self.sigma, L=hints.exp_order)
             self.TL = {q: layer_taylor(q, self.sigma, hints.layer_order, prec=prec) for q in range(models.layer)}
 
@@ -315,7 +299,7 @@ class RegularityBox:
         self._h_ok(h_hi)
         hn = self.m.hints
         return _span(*kdet_box(self.T, self.m.M, s_lo, s_hi, h_lo, h_hi, self.sigma, hn.r, hn.order,
-                               prec=self.m.prec))
+                               prec=self.m.prec, mats=self.mats))
 
     def middle(self, box):
         """K^3 det J_Phi/q^2 as a function of (s, w = 1/q) in the box (the middle)."""
