@@ -77,7 +77,7 @@ def layer_trans_taylor(q, sigma, n, prec=128):
         xs = _series_curves({p: nets[p][0] for p in PIECES}, n)
         ys = _series_curves({p: nets[p][1] for p in PIECES}, n)
         real = {c: ([[z.real for z in pts] for pts in xs[c]], [[z.real for z in pts] for pts in ys[c]]) for c in CURVES}
-        return {c: _trans_series(real[c][0], real[c][1], A1, A2, n) for c in CURVES}
+        return {c: [[z.real for z in row] for row in _trans_series(real[c][0], real[c][1], A1, A2, n)] for c in CURVES}
 
 
 def layer_trans_disc(q, sigma, r, grid=12, prec=128):

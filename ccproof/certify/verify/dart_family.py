@@ -481,19 +481,24 @@ def _series_curves(nets, n):
     return out
 
 
+def _curve_packed(c, deriv):
+    """acb_poly with the h^m coefficient curve (4 Bezier values) at x^(6 m + i), scaled by C(3, i); or its
+    derivative (3 (c_(i+1) - c_i), scaled by C(2, i))."""
+    out = [acb(0)] * (6 * len(c))
+    for m, pts in enumerate(c):
+        for i in range(3 if deriv else 4):
+            out[6 * m + i] = 3 * _BIN2[i] * (acb(pts[i + 1]) - acb(pts[i])) if deriv else _BIN3[i] * acb(pts[i])
+    return acb_poly(out)
+
+
 def _trans_series(xc, yc, A1, A2, n):
-    """Taylor coefficients of a1 X Y' - a2 Y X' from the coordinates' (xc, yc: [m: 4 values]) and a_i's."""
-    P = [None] * (n + 1)
-    Q = [None] * (n + 1)
-    for m in range(n + 1):
-        for k in range(m + 1):
-            p, q = _bprod(xc[k], yc[m - k]), _bprod(yc[m - k], xc[k])
-            P[m] = p if P[m] is None else [a + b for a, b in zip(P[m], p)]
-            Q[m] = q if Q[m] is None else [a + b for a, b in zip(Q[m], q)]
-    out = []
-    for m in range(n + 1):
-        acc = [0 * P[0][0]] * 6
-        for u in range(m + 1):
-            acc = [a + A1[u] * p - A2[u] * q for a, p, q in zip(acc, P[m - u], Q[m - u])]
-        out.append(acc)
-    return out
+    """Taylor coefficients of a1 X Y' - a2 Y X' from the coordinates' (xc, yc: [m: 4 values]) and a_i's: the
+    Cauchy products in h of the degree-5 Bernstein products f g' (scaled coefficients convolve, then divide by
+    C(5, k)) as acb_poly products, h packed with stride 6."""
+    a1 = acb_poly([acb(A1[m]) if k == 0 else acb(0) for m in range(n + 1) for k in range(6)])
+    a2 = acb_poly([acb(A2[m]) if k == 0 else acb(0) for m in range(n + 1) for k in range(6)])
+    P = a1 * (_curve_packed(xc, False) * _curve_packed(yc, True)) - a2 * (_curve_packed(yc, False)
+                                                                         * _curve_packed(xc, True))
+    c = P.coeffs()
+    c += [acb(0)] * max(0, 6 * (n + 1) - len(c))
+    return [[c[6 * m + k] / _BIN5[k] for k in range(6)] for m in range(n + 1)]
