@@ -17,7 +17,7 @@
                                  certificates/c1/FAMILY/n_ge_101.json
   ccproof certify 'dart:>=101' --c1   every dart K >= 101 at once ("C1": spectrum through a secular equation,
                                  the eigenvectors and the characteristic map as analytic families in h = 1/K;
-                                 about 1 minute, then 1 more for the verifier), certificates/c1/dart/k_ge_101.json
+                                 about 30 s, then 20 s for the verifier), certificates/c1/dart/k_ge_101.json
   ccproof certify '>=40'         the Appendix-A statement for every k >= 40 in one certificate: lam is a
                                  variable (Taylor models in zeta, lam = mid + zeta * half-width), see
                                  docs/appendix_a.md section 6
