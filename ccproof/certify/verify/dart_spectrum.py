@@ -27,10 +27,11 @@ count shown here. The argument, with what is checked where:
    F = d^T (lam - S0)^-1 e_0. In the Fourier modes of S0 (mode j != 0: the 2 x 2 block B1(w) of the ring
    stencil on (1,0), (1,1), closed: checked; mode 0: the 3 x 3 block B0(h) on (C, E, F))
 
-       F = (1/K) [ sum_{j=1}^{K-1} g(lam, c_j) + g0(lam, h) ],   g = e^(d_e(w)) + ... = 1 + n*/(4 lam (c* - c)),
+       F = (1/K) [ sum_{j=1}^{K-1} g(lam, c_j) + g0(lam, h) ],   g = d_e(w) e^ + d_f(w) f^ = 1 + n*/(4 lam (c* - c)),
 
-   c* = 8 lam - 5 + 1/(2 lam), n* = 4 (1 - c*)(lam - 1/4) - (1 + c*) (:func:`check_secular`: the identity
-   of g in Q(lam, w), exact with fmpq_mpoly), and by the classical partial fractions of K z^(K-1)/(z^K - 1)
+   (e^, f^) = (lam - B1(w))^-1 (1, 0), d_e, d_f the sums of d's ray and quadrant weights times w^delta, g0 the
+   same with B0 and (0, 1, 0), c* = 8 lam - 5 + 1/(2 lam), n* = 4 (1 - c*)(lam - 1/4) - (1 + c*)
+   (:func:`check_secular`: the identity of g in Q(lam, w), exact with fmpq_mpoly), and by the classical partial fractions of K z^(K-1)/(z^K - 1)
    (a stated lemma) sum_{j=0}^{K-1} 1/(cos phi - c_j) = -K cot(K phi/2)/sin phi, c* = cos phi. So
 
        1 - F = h (1 - g0) + n*/(4 lam) (cot(K phi/2)/sin phi + h/(c* - 1)).
@@ -40,7 +41,8 @@ count shown here. The argument, with what is checked where:
 4. **The count.** S0's eigenvalues of modulus >= r: 1 (mode 0; simple: Q(1) > 0 below), lam(c_1) twice
    (modes 1 and K - 1, one even and one odd combination); modes j >= 2 lie below r, 1/(16 lam) <= 1/4 < r,
    and mode 0's other two, the roots of Q = det(x - B0)/(x - 1) = P + h l (l = det R/(x - 1), linear:
-   exact), are real and below r: disc(Q) > 0, Q(r)/h > 0 and Q'(r) > 0 on h-balls covering [0, 1/K0]
+   exact), are real, positive and below r: disc(Q) > 0, Q(0) > 0 > Q'(0), Q(r)/h > 0 and Q'(r) > 0 on h-balls
+   covering [0, 1/K0]
    (:func:`check_mode0_roots`). None lies on the circle. If Re(1 - F) > 0 on |lam| = r (the record's trees over
    the regions N, I, F below, for t = arg lam in [0, pi]; the lower half by conjugation), 1 - F does not
    wind, so the one-ring operators of S and S0 have equally many eigenvalues outside the circle: 3. The
@@ -290,8 +292,8 @@ def _ball(lo, hi):
 
 
 def check_mode0_roots(sig_r, k0, balls):
-    """Raise unless on ``balls`` h-balls covering [0, 1/k0]: disc(Q) > 0, Q(r)/h > 0, Q'(r) > 0 and
-    Q(1) > 0 (mode 0's other eigenvalues real, below r; 1 simple). Returns the least Q(r)/h.
+    """Raise unless on ``balls`` h-balls covering [0, 1/k0]: disc(Q) > 0, Q(0) > 0 and Q'(0) < 0 (both roots
+    real and positive), Q(r)/h > 0, Q'(r) > 0 (both below r) and Q(1) > 0 (1 simple). Returns the least Q(r)/h.
 
     Examples
     --------
@@ -308,7 +310,7 @@ def check_mode0_roots(sig_r, k0, balls):
         r = lam_circle(sr, h)
         q_over_h = l0 + l1 * r - r / 4 * sr ** 2 * h * (sr * h).sinc() ** 2  # P(r) = -r sigma_r^2 h^2 sinc^2/4
         b, c = -fmpq(3, 4) + h * l1, fmpq(1, 16) + h * l0
-        ok = (b * b - 4 * c > 0 and q_over_h > 0 and 2 * r + b > 0 and 1 + b + c > 0)
+        ok = (b * b - 4 * c > 0 and c > 0 and b < 0 and q_over_h > 0 and 2 * r + b > 0 and 1 + b + c > 0)
         if not ok:
             raise CertificateError(f"mode 0: h-ball {i}: Q's roots are not certainly real and below r, or Q(1) = 0")
         least = q_over_h.lower() if least is None else min(least, q_over_h.lower())
