@@ -32,7 +32,8 @@ count shown here. The argument, with what is checked where:
    (e^, f^) = (lam - B1(w))^-1 (1, 0), d_e, d_f the sums of d's ray and quadrant weights times w^delta, g0 the
    same with B0 and (0, 1, 0), c* = 8 lam - 5 + 1/(2 lam), n* = 4 (1 - c*)(lam - 1/4) - (1 + c*)
    (:func:`check_secular`: the identity of g in Q(lam, w), exact with fmpq_mpoly), and by the classical
-   partial fractions of K z^(K-1)/(z^K - 1) (a stated lemma) sum_{j=0}^{K-1} 1/(cos phi - c_j) = -K cot(K phi/2)/sin phi, c* = cos phi. So
+   partial fractions of K z^(K-1)/(z^K - 1) (a stated lemma) sum_{j=0}^{K-1} 1/(cos phi - c_j) =
+   -K cot(K phi/2)/sin phi, c* = cos phi. So
 
        1 - F = h (1 - g0) + n*/(4 lam) (cot(K phi/2)/sin phi + h/(c* - 1)).
 
