@@ -68,7 +68,7 @@ def disc_bounds(sigma, r, grid=4, prec=128, **control):
 
 def kdet_matrices(T, n):
     """{piece: [D_1, ..., D_n]}, D_m an acb_mat with d_ijm at row c (the Bernstein coefficient), column ij (in the
-    order of XB x YB): Horner's rule in h on all of them at once, then one product with the column (a_i b_j)."""
+    order of XB x YB): Horner's rule in h runs on all of them at once (:func:`kdet_box`)."""
     ijs = [(i, j) for i in XB for j in YB]
     return {piece: [acb_mat([[T[(i, j, piece)][m][c] for (i, j) in ijs]
                              for c in range(len(T[(XB[0], YB[0], piece)][1]))]) for m in range(1, n + 1)]
