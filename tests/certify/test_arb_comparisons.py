@@ -48,6 +48,7 @@ REVIEWED = {
     ("dart_spectrum.py", "not phi.imag > 0"): "a choice of root, re-checked by _cot_far: conservative",
     ("dart_spectrum.py", "out.setdefault(key, rel) != rel"): "dicts of fmpq rows (exact)",
     ("dart_spectrum.py", "x != 0"): "fmpq weights (exact)",
+    ("dart_spectrum.py", "not tau1 > 0"): "fmpq (exact)",
     ("dart_spectrum.py", "not m > 0"): "refuses unless m > 0 certainly: conservative",
     ("dart_spectrum.py", "not -1 <= key[1] <= 1"): "ints",
     ("dart_tail.py", "not lo <= v <= hi"): "ints",

@@ -139,3 +139,6 @@ def test_mode0_and_ranges_refuse():
     with pytest.raises(CertificateError, match="pi < sigma_lo"):
         check_ranges(101, fmpq(3), fmpq(4), SIG_R, fmpq(50), fmpq(2, 5))
     assert w1_of(fmpq(50)) ** 2 * 50 >= 1 > (w1_of(fmpq(50)) - fmpq(1, 1024)) ** 2 * 50
+    # a forger's tiny tau1: region I's root must still reach w = 1/sqrt(tau1) (no cap on w1)
+    tiny = fmpq(1, 10**20)
+    assert w1_of(tiny) ** 2 * tiny >= 1

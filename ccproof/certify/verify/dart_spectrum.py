@@ -69,6 +69,7 @@ from functools import cache
 
 from flint import acb, arb, fmpq, fmpq_mpoly_ctx, fmpq_poly
 
+from .dart_family import _ball, _kappa
 from .errors import CertificateError
 from .tagged import labels, sector_rows
 from .tagged_modes import _POS, _roots, check_dart, check_ring, ring_stencil
@@ -156,10 +157,6 @@ def check_construction():
         if d.get(mirror, 0) != d[key]:
             raise CertificateError("dart: d is not invariant under the reflection in ray 0")
     return d, bound
-
-
-def _kappa():
-    return [1 - sum(row.values()) for row in ring_stencil()]
 
 
 def _b1(w):
@@ -286,10 +283,6 @@ def lam_circle(sig_r, h):
     """r = lam(cos(2 sigma_r h)) (arb; 2 sigma_r h < pi/2 keeps (1 + c)(9 + c) > 0)."""
     c = (2 * sig_r * h).cos()
     return (5 + c + ((1 + c) * (9 + c)).sqrt()) / 16
-
-
-def _ball(lo, hi):
-    return arb((fmpq(lo) + fmpq(hi)) / 2, (fmpq(hi) - fmpq(lo)) / 2)
 
 
 def check_mode0_roots(sig_r, k0, balls):
@@ -439,8 +432,12 @@ def w1_of(tau1):
     >>> w1_of(fmpq(50))
     145/1024
     """
-    m = 0
-    lo, hi = 0, W_DEN * 10**6
+    if not tau1 > 0:
+        raise CertificateError("spectrum: tau1 must be > 0")
+    hi = 1
+    while fmpq(hi * hi) * tau1 < W_DEN * W_DEN:  # doubling: no cap, so w1^2 tau1 >= 1 whatever tau1 is
+        hi *= 2
+    lo = 0
     while lo < hi:  # the least m with m^2 tau1 >= W_DEN^2
         m = (lo + hi) // 2
         if fmpq(m * m) * tau1 >= W_DEN * W_DEN:

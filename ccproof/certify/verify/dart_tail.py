@@ -23,7 +23,7 @@ outer curve crosses {Y = 0, X > 0} once. The record holds hints only. The steps,
 
 from __future__ import annotations
 
-from flint import ctx, fmpq
+from flint import arb, ctx, fmpq
 
 from .dart_eigen import check_eigenvector
 from .dart_family import TaylorHints
@@ -176,14 +176,19 @@ def _spectrum(rec, k0):
         counts[name] = replay_tree(rec["re"][name], fn, 1, f"spectrum re {name}")
     return (f"every K >= {k0}: 1, lam1 = lam(cos(2 pi/K)) and one even eigenvalue (lam2) outside |lam| = "
             f"lam(cos(2 x {rec['sig_r']}/K)), each simple; secular identities exact; mode 0's roots real and below "
-            f"r on {rec['mode0_h']} h-balls (Q(r)/h >= {float(least0):.3g}); Re(1 - F) > 0: "
-            + ", ".join(f"{n} {c} leaves (>= {float(b):.3g})" for n, (c, b) in counts.items()))
+            f"r on {rec['mode0_h']} h-balls (Q(r)/h >= {least0.str(3, radius=False)}); Re(1 - F) > 0: "
+            + ", ".join(f"{n} {c} leaves (>= {_show(b)})" for n, (c, b) in counts.items()))
 
 
 def _map(rec, k0):
     out = replay_map(rec["parts"], k0, rec["sig_lo"], rec["sig_hi"], rec["hints"], rec["s0"], rec["layer"],
                      rec["winding"], rec["prec"])
-    return "; ".join(f"{n} {c} (>= {float(b):.3g})" if b is not None else f"{n} {c}" for n, (c, b) in out.items())
+    return "; ".join(f"{n} {c} (>= {_show(b)})" if b is not None else f"{n} {c}" for n, (c, b) in out.items())
+
+
+def _show(q):
+    """A bound (fmpq) to 3 digits for the message (arb's decimal printing: no float)."""
+    return arb(q).str(3, radius=False)
 
 
 def _steps(rec, k0, part, log):
