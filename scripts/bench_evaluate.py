@@ -67,6 +67,7 @@ import numpy as np
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 sys.path.insert(0, str(Path(__file__).resolve().parent))  # scripts/_osd.py
+from _bench import missing, ratio_line  # noqa: E402
 
 from ccproof.evaluate import natural_limit_surface as limit_surface  # noqa: E402
 from ccproof.evaluate.local import CORNERS  # noqa: E402
@@ -279,7 +280,7 @@ def osd_side_by_side(n, rng, quick=False, rounds=7):
 
     why = _osd.why_unavailable()
     if why:
-        print(f"   {why}. Skipped.")
+        missing("OpenSubdiv", why)
         return None
     lib = _osd.load()
     import os
@@ -794,13 +795,34 @@ def naive_point(S, f, u, v):
     return P, Pu, Pv
 
 
+def smoke(n=20_000, rounds=2):
+    """The test suite's run: each backend against numpy on the bunny (interleaved rounds), then OpenSubdiv side by
+    side (or the line saying it is missing)."""
+    mesh = read_mesh(SHAPES[0][1])
+    S = limit_surface(mesh)
+    rng = np.random.default_rng(0)
+    f, u, v = uniform_points(mesh, n, rng)
+    backends = available_backends()
+    for be in backends:
+        S.evaluate(f[:10], u[:10], v[:10], 1, backend=be)  # numba: compile (cached on disk)
+    times, load = interleaved({be: (lambda be=be: S.evaluate(f, u, v, 1, backend=be, threads=1)) for be in backends},
+                              rounds)
+    for be in backends[:-1]:
+        print(ratio_line(f"bunny P + Pu + Pv, {n:,} points, {be}/numpy time:",
+                         np.array(times[be]) / np.array(times["numpy"]), load))
+    osd_side_by_side(n, rng, True, rounds=rounds)
+    return 0
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--points", type=int, default=1_000_000)
     ap.add_argument("--memory-points", type=int, default=10_000_000)
     ap.add_argument("--naive-points", type=int, default=2000)
     ap.add_argument("--pygel-levels", type=int, default=5)
-    ap.add_argument("--quick", action="store_true", help="small sizes (smoke test)")
+    ap.add_argument("--quick", action="store_true", help="small sizes")
+    ap.add_argument("--smoke", action="store_true",
+                    help="the test suite's run: 20,000 points, each backend against numpy and OpenSubdiv, 2 rounds")
     ap.add_argument("--osd-points", type=int, default=1_000_000)
     ap.add_argument("--osd-only", action="store_true", help="only part 5 (OpenSubdiv side by side)")
     ap.add_argument("--rounds", type=int, default=7, help="interleaved rounds of part 5 (at least 7)")
@@ -810,6 +832,8 @@ def main(argv=None):
     ap.add_argument("--startup", action="store_true",
                     help="only part 6: start-up times and peak memory in fresh processes, ours and OpenSubdiv's")
     args = ap.parse_args(argv)
+    if args.smoke:
+        return smoke()
     if args.setup_only:
         fresh_process_setup(args.rounds)
         return 0
