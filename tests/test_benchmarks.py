@@ -69,9 +69,8 @@ def _private_uses(source: str) -> list[str]:
     tree = ast.parse(source)
     for node in ast.walk(tree):
         if isinstance(node, ast.ImportFrom) and (node.module or "").split(".")[0] == "ccproof":
-            parts = node.module.split(".") + [a.name for a in node.names]
             found += [f"from {node.module} import {a.name}" for a in node.names
-                      if any(p.startswith("_") and not p.startswith("__") for p in parts)]
+                      if any(p.startswith("_") and not p.startswith("__") for p in [*node.module.split("."), a.name])]
         elif isinstance(node, ast.Import):
             found += [f"import {a.name}" for a in node.names if a.name.split(".")[0] == "ccproof"
                       and any(p.startswith("_") and not p.startswith("__") for p in a.name.split("."))]
