@@ -47,6 +47,8 @@ SMOKE = {
 #: a ratio line: min / median / max of per-round ratios and the load, on one line
 RATIO = re.compile(r"\bmin\s+[-+0-9.eE]+\s+median\s+[-+0-9.eE]+\s+max\s+[-+0-9.eE]+.*\bload\b")
 MISSING = re.compile(r"^baseline missing: ", re.M)
+#: a private name of ccproof on a line of code that does not parse alone
+PRIVATE_IN_LINE = re.compile(r"(from ccproof\S* import .*\b_[a-z]\w*|ccproof\.\S*\._[a-z]|\w\._[a-z]\w*)")
 #: attributes of NamedTuples (documented public API despite the underscore)
 NAMEDTUPLE_API = {"_fields", "_replace", "_asdict", "_make"}
 
@@ -82,8 +84,7 @@ def _private_uses(source: str) -> list[str]:
             try:
                 found += _private_uses(node.value)
             except SyntaxError:  # a fragment with placeholders: look at its lines
-                found += [ln.strip() for ln in node.value.splitlines()
-                          if re.search(r"(from ccproof\S* import .*\b_[a-z]\w*|ccproof\.\S*\._[a-z]|\w\._[a-z]\w*)", ln)]
+                found += [ln.strip() for ln in node.value.splitlines() if PRIVATE_IN_LINE.search(ln)]
     return found
 
 
