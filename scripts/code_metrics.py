@@ -3,7 +3,7 @@
 
 Four counts, each with the list behind it (``--list``):
 
-* files longer than ``--max-file`` lines (default 600);
+* files longer than ``--max-file`` lines (default 600): the Python and the C sources (``*.py``, ``*.c``);
 * functions and methods (nested ones included) longer than ``--max-function`` lines (default 80), from the
   ``def`` line to the last line of the body, decorators not counted;
 * functions with more than ``--max-params`` parameters (default 10): positional-only, ordinary and
@@ -168,6 +168,11 @@ def measure(package_dir: Path, max_file: int = 600, max_function: int = 80, max_
     modules = {module_name(p, package_dir) for p in files}
     res: dict = {"files": len(files), "lines": 0, "long_files": [], "long_functions": [], "long_params": [],
                  "private_imports": [], "private_modules": []}
+    for path in sorted(package_dir.rglob("*.c")):  # C sources count for the file lengths only
+        n_lines = len(path.read_text(encoding="utf-8").splitlines())
+        res["lines"] += n_lines
+        if n_lines > max_file:
+            res["long_files"].append((str(path.relative_to(package_dir.parent)), n_lines))
     for path in files:
         text = path.read_text(encoding="utf-8")
         rel = str(path.relative_to(package_dir.parent))
@@ -194,7 +199,7 @@ def measure(package_dir: Path, max_file: int = 600, max_function: int = 80, max_
 
 def summary(m: dict) -> list[str]:
     """The counts as printed lines."""
-    return [f"package: {m['files']} files, {m['lines']} lines",
+    return [f"package: {m['files']} Python files, {m['lines']} lines (with the C sources)",
             f"files > 600 lines: {len(m['long_files'])}",
             f"functions > 80 lines: {len(m['long_functions'])}",
             f"functions with > 10 parameters: {len(m['long_params'])}",

@@ -33,6 +33,7 @@ def package(tmp_path):
     long_file = "".join(f"y{i} = {i}\n" for i in range(601))  # 601 lines: counted
     (pkg / "long.py").write_text(long_file)
     (pkg / "edge.py").write_text("".join(f"y{i} = {i}\n" for i in range(600)))  # 600 lines: not counted
+    (pkg / "kernel.c").write_text("int x;\n" * 700)  # a C source: counted for its length
     a = (_function("f81", 81) + _function("f80", 80)
          + _function("p11", 2, ", ".join(f"a{i}" for i in range(11)))
          + _function("p10", 2, ", ".join(f"a{i}" for i in range(10)))
@@ -52,7 +53,7 @@ def package(tmp_path):
 
 def test_counts_of_a_known_package(package):
     m = _load().measure(package)
-    assert [f for f, _ in m["long_files"]] == ["pkg/long.py"]
+    assert sorted(f for f, _ in m["long_files"]) == ["pkg/kernel.c", "pkg/long.py"]
     assert sorted(name for _, name, _, _ in m["long_functions"]) == ["f81"]
     assert sorted((name, n) for _, name, n, _ in m["long_params"]) == [("p11", 11), ("p_star", 11)]
     assert sorted((r["module"], r["from"], r["name"]) for r in m["private_imports"]) == [
@@ -63,6 +64,6 @@ def test_counts_of_a_known_package(package):
 def test_the_command_line_prints_the_four_counts(package):
     out = subprocess.run([sys.executable, str(SCRIPT), str(package), "--list"], capture_output=True, text=True,
                          check=True).stdout
-    assert "files > 600 lines: 1" in out and "functions > 80 lines: 1" in out
+    assert "files > 600 lines: 2" in out and "functions > 80 lines: 1" in out
     assert "functions with > 10 parameters: 2" in out and "private names used across modules: 2" in out
     assert "function pkg/a.py:1 f81: 81 lines" in out
