@@ -7,7 +7,7 @@ same projected Newton (to the same accuracy; not global: it keeps the nearest sa
 Prints rates (points per second, preparation excluded and included), the ratio, the agreement of
 the distances, and the certified mode's cost per point on a few points.
 
-    python scripts/bench_project.py [--n 1000000] [--level 5] [--certify 5] [--baseline-n 100000] [--rounds 5]
+    python scripts/bench_project.py [--n 1000000] [--level 5] [--certify 5] [--baseline-n 100000] [--rounds 3]
     python scripts/bench_project.py --smoke          the torus, 200 points (the test suite's run)
 """
 
@@ -37,7 +37,7 @@ def main(argv=None):
     ap.add_argument("--certify", type=int, default=5, help="points for the certified mode")
     ap.add_argument("--baseline-n", type=int, default=100_000,
                     help="the baseline runs on the first N points only (its rate is per point)")
-    ap.add_argument("--rounds", type=int, default=5, help="interleaved rounds of ours and the baseline")
+    ap.add_argument("--rounds", type=int, default=3, help="interleaved rounds of ours and the baseline")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--smoke", action="store_true",
                     help="the torus of ccproof.mesh.examples, 200 points, 2 rounds (the test suite's run)")
