@@ -46,11 +46,12 @@ def main(argv=None):
     ap.add_argument("--mesh", default=str(ROOT / "tests" / "data" / "meshes" / "bunny_quads.obj"))
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--skip", nargs="*", default=[], choices=["certify", "verify", "eval"])
-    ap.add_argument("--smoke", action="store_true", help="one worker, 40,000 points, no certify or verify (the test "
-                    "suite's run)")
+    ap.add_argument("--smoke", action="store_true",
+                    help="one worker, 40,000 points on catmark_smoothtris1, no certify or verify (the suite's run)")
     args = ap.parse_args(argv)
     if args.smoke:
         args.workers, args.points, args.chunk, args.skip = 1, 4e4, 20_000, ["certify", "verify"]
+        args.mesh = str(ROOT / "tests" / "data" / "osd_features" / "meshes" / "catmark_smoothtris1.obj")
     sys.path.insert(0, str(Path(__file__).resolve().parent))
     from _bench import load, missing, ratio_line
 
