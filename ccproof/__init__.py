@@ -11,7 +11,8 @@ the table of a valence              :func:`load_table` (float64 view), :func:`bu
 certify                             :func:`prove_valence`, :func:`prove_interval`, :func:`prove_c1`
 verify (the trusted base)           :func:`verify_file` -> :class:`VerifyResult` (parts and reasons)
 meshes                              :class:`QuadMesh`, :class:`PolyMesh`, :func:`read_obj`, :func:`read_mesh`
-the limit surface of a mesh         :func:`limit_surface` (evaluate, normals, parameterizations)
+the limit surface of a mesh         :func:`limit_surface` -> :class:`LimitSurface` (evaluate, normals),
+                                    :class:`Parameterization` (values), :class:`PatchTable` (its arrays)
 the characteristic map, Phi^-1      :func:`characteristic_map`, :func:`inverse_characteristic_map`
 ARAP texture parameterization       :func:`parameterize` (hsh10), :func:`write_uv_mesh` (for other tools)
 fit a surface to points             :func:`fit_points` (qmv98)
@@ -46,10 +47,11 @@ if TYPE_CHECKING:  # the lazy names of _LAZY below, seen by type checkers (mypy 
     from ccproof.certify.verify import verify_file
     from ccproof.certify.verify.errors import CertificateError
     from ccproof.certify.verify.record import VerifyResult
+    from ccproof.evaluate import LimitSurface, PatchTable
     from ccproof.inverse.algorithm import inverse_characteristic_map
     from ccproof.inverse.forward import characteristic_map
     from ccproof.mesh import PolyMesh, QuadMesh, read_mesh, read_obj
-    from ccproof.reparam.surface import limit_surface
+    from ccproof.reparam.surface import Parameterization, limit_surface
     from ccproof.tables.build import build_table
     from ccproof.tables.numeric import load_table
 
@@ -70,6 +72,9 @@ _LAZY = {
     "read_obj": "ccproof.mesh",
     "read_mesh": "ccproof.mesh",
     "limit_surface": "ccproof.reparam.surface",
+    "LimitSurface": "ccproof.evaluate",
+    "Parameterization": "ccproof.reparam",
+    "PatchTable": "ccproof.evaluate",
     "characteristic_map": "ccproof.inverse.forward",
     "inverse_characteristic_map": "ccproof.inverse.algorithm",
     "parameterize": "ccproof.apps.arap.core",
@@ -80,7 +85,10 @@ _LAZY = {
 __all__ = [
     "CCProofError",
     "CertificateError",
+    "LimitSurface",
     "MeshError",
+    "Parameterization",
+    "PatchTable",
     "PolyMesh",
     "QuadMesh",
     "TableNotFoundError",

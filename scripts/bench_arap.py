@@ -251,6 +251,35 @@ def scale_runs(args, engine):
     return out
 
 
+def smoke(args):
+    """The test suite's run: (c) against (d) on a small curved disk; the ratio and the load."""
+    import tempfile
+
+    from ccproof.mesh.examples import k_regular_disk
+
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from _bench import load, missing, ratio_line
+
+    try:
+        import igl  # noqa: F401
+
+        engine = "igl"
+    except ImportError:
+        engine = "numpy"
+        missing("libigl", "pip install libigl; baseline (d) runs on the numpy engine")
+    mesh = k_regular_disk(5, rings=3, height=lambda x, y: 0.15 * (x**2 - 0.5 * y**2))
+    with tempfile.TemporaryDirectory() as d:
+        path = Path(d) / "disk.obj"
+        path.write_text("".join(f"v {x!r} {y!r} {z!r}\n" for x, y, z in mesh.vertices.tolist())
+                        + "".join("f " + " ".join(str(i + 1) for i in f) + "\n" for f in mesh.faces.tolist()))
+        m = read_obj(path)
+    load0 = load()
+    r = run_case("5-regular disk, charts by segment_by_normals", m, charts_from_labels(m, segment_by_normals(m)),
+                 engine, args.tol, 2)
+    print(ratio_line("time (c)/(d) to convergence:", [r["c_total_seconds"] / r["d_total_seconds"]], [load0, load()]))
+    return 0
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--scale", action="store_true", help="the user-facing runs (module docstring)")
@@ -268,7 +297,11 @@ def main(argv=None):
     ap.add_argument("--repeat", type=int, default=15, help="iterations timed per chart and level")
     ap.add_argument("--patch", action="store_true", help="also the open patch (one chart)")
     ap.add_argument("--out", default="out/bench_arap.json")
+    ap.add_argument("--smoke", action="store_true",
+                    help="a 5-regular disk (3 rings) instead of the bunny, 2 repeats, no file (the test suite's run)")
     args = ap.parse_args(argv)
+    if args.smoke:
+        return smoke(args)
     if args.one:
         return one_run(args)
     engine = args.engine

@@ -20,6 +20,8 @@ Certificates go to a temporary folder; the published ones are not touched.
 """
 
 import argparse
+import os
+import sys
 import tempfile
 import time
 from concurrent.futures import ProcessPoolExecutor
@@ -46,6 +48,24 @@ def _verify(args):
     return k, ok, time.perf_counter() - t
 
 
+def smoke():
+    """The test suite's run: valence 3 certified and verified in this process, once; the ratio."""
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    from _bench import load, ratio_line
+
+    ratios, loads = [], []
+    with tempfile.TemporaryDirectory() as d:
+        for _ in range(1):
+            loads.append(load())
+            _, N, boxes, tc = _certify((3, d))
+            _, ok, tv = _verify((3, d))
+            if not ok:
+                raise SystemExit("valence 3: the certificate written does not verify")
+            ratios.append(tc / tv)
+    print(f"valence 3: N = {N}, {boxes} boxes, certify {tc:.2f} s, verify {tv:.2f} s")
+    print(ratio_line("valence 3 certify/verify:", ratios, loads))
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--kmin", type=int, default=3)
@@ -55,7 +75,10 @@ def main():
     ap.add_argument("--verify-all", action="store_true", help="time `ccproof verify --all --jobs JOBS`")
     ap.add_argument("--tagged", type=int, default=None, metavar="ROUNDS",
                     help="what the tagged certificates add to verify --all (ROUNDS alternating rounds)")
+    ap.add_argument("--smoke", action="store_true", help="valence 3, in this process (the test suite's run)")
     args = ap.parse_args()
+    if args.smoke:
+        return smoke()
     if args.tagged is not None:
         return bench_tagged(args.jobs, args.tagged)
     if args.verify_all:

@@ -32,7 +32,8 @@ Measures, in one run:
    core loses when all are busy) and the threads' occupancy (CPU over threads x wall: idling, imbalance,
    other processes);
 6. start-up in fresh processes, ours (each compiled backend) and OpenSubdiv Far's: seconds and peak resident
-   memory (VmHWM) after importing, loading the kernel, the setup and one evaluation of 10^6 points.
+   memory (VmHWM) after importing, the setup, loading the kernel (ours: a first evaluation of one point) and one
+   evaluation of 10^6 points.
    Then what ``import ccproof`` (with the evaluator and the mesh reader) and the kernel load add over
    ``python -c 'import numpy'`` (fresh processes in turn, round by round: seconds from start to exit and
    peak memory, per round against the floor of the same round), against the target of 0.3 s and 50 MiB.
@@ -66,10 +67,11 @@ import numpy as np
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 sys.path.insert(0, str(Path(__file__).resolve().parent))  # scripts/_osd.py
+from _bench import missing, ratio_line  # noqa: E402
 
 from ccproof.evaluate import natural_limit_surface as limit_surface  # noqa: E402
 from ccproof.evaluate.local import CORNERS  # noqa: E402
-from ccproof.evaluate.surface import _CORNER, _SPLIT, available_backends  # noqa: E402
+from ccproof.evaluate.surface import available_backends  # noqa: E402
 from ccproof.mesh import limit_normals, limit_positions, read_obj, subdivide  # noqa: E402
 from ccproof.mesh.io import read_mesh  # noqa: E402
 
@@ -278,7 +280,7 @@ def osd_side_by_side(n, rng, quick=False, rounds=7):
 
     why = _osd.why_unavailable()
     if why:
-        print(f"   {why}. Skipped.")
+        missing("OpenSubdiv", why)
         return None
     lib = _osd.load()
     import os
@@ -361,7 +363,7 @@ def osd_side_by_side(n, rng, quick=False, rounds=7):
 
 
 _STARTUP_OURS = """
-import json, sys, time
+import json, os, sys, time
 t = [time.perf_counter()]
 def hwm():
     return int([x for x in open("/proc/self/status") if x.startswith("VmHWM")][0].split()[1]) / 1024
@@ -371,9 +373,11 @@ t.append(time.perf_counter()); m.append(hwm())
 import ccproof.evaluate.surface as surface
 from ccproof.mesh.io import read_mesh
 t.append(time.perf_counter()); m.append(hwm())
-name = surface._compiled_kernel(None)[0]
-t.append(time.perf_counter()); m.append(hwm())
 S = surface.natural_limit_surface(read_mesh(sys.argv[1]))
+t.append(time.perf_counter()); m.append(hwm())
+name = surface.available_backends()[0] if os.environ.get("CCPROOF_BACKEND", "auto") == "auto" else \
+    os.environ["CCPROOF_BACKEND"]
+S.evaluate([0], [0.5], [0.5], 1, threads=1)  # the first call loads the backend's kernel
 t.append(time.perf_counter()); m.append(hwm())
 d = np.load(sys.argv[2])
 f, s, u = d["f"], d["s"], d["t"]
@@ -410,9 +414,10 @@ print(json.dumps({"t": t, "m": m, "backend": "far"}))
 
 def startup_and_memory(path, n, rng, env_backends=("c", "numba")):
     """Fresh processes, ours against OpenSubdiv Far: the steps import numpy, import (ours: the evaluator
-    and the mesh reader; Far: the compiled C API), kernel load (ours: the backend choice), setup (the
-    mesh, read by ours, given as arrays to Far), the points, then one evaluation of ``n`` points (P + Pu +
-    Pv, one thread); seconds and the peak resident memory (VmHWM of /proc/self/status, MiB) after each."""
+    and the mesh reader; Far: the compiled C API), setup (the mesh, read by ours, given as arrays to Far) and
+    kernel load (ours: after the setup, a first evaluation of one point loads the backend's kernel; Far: none),
+    the points, then one evaluation of ``n`` points (P + Pu + Pv, one thread); seconds and the peak resident
+    memory (VmHWM of /proc/self/status, MiB) after each."""
     import json
     import os
     import subprocess
@@ -442,9 +447,11 @@ def startup_and_memory(path, n, rng, env_backends=("c", "numba")):
             r = subprocess.run([sys.executable, "-c", _STARTUP_OSD, arr, pts, str(Path(__file__).resolve().parent)],
                                capture_output=True, text=True, env=env0, check=True)
             runs["OpenSubdiv Far"] = json.loads(r.stdout)
-    steps = ["import numpy", "import", "kernel load", "setup", "points", "evaluate"]
     for name, r in runs.items():
         tt, mm = r["t"], r["m"]
+        # ours sets up before loading its kernel (a first evaluation of one point); Far has no kernel load
+        steps = ["import numpy", "import", "setup", "kernel load", "points", "evaluate"] if "numba" in r else \
+            ["import numpy", "import", "kernel load", "setup", "points", "evaluate"]
         parts = ", ".join(f"{st} {tt[i + 1] - tt[i]:.3f} s -> {mm[i + 1]:.0f} MiB" for i, st in enumerate(steps))
         extra = f" (numba imported: {r['numba']}, scipy: {r['scipy']})" if "numba" in r else ""
         print(f"   {name}: {parts}{extra}")
@@ -452,7 +459,7 @@ def startup_and_memory(path, n, rng, env_backends=("c", "numba")):
     for name, r in runs.items():
         if base is None or r is base:
             continue
-        imp = (r["t"][3] - r["t"][1], r["m"][3] - r["m"][1])
+        imp = (r["t"][2] - r["t"][1] + r["t"][4] - r["t"][3], r["m"][2] - r["m"][1] + r["m"][4] - r["m"][3])
         print(f"   {name}: import + kernel load {imp[0]:.3f} s, +{imp[1]:.0f} MiB above numpy; peak "
               f"{r['m'][-1]:.0f} MiB vs OpenSubdiv's {base['m'][-1]:.0f} MiB (+{r['m'][-1] - base['m'][-1]:.0f} MiB); "
               f"before evaluating {r['m'][-3]:.0f} vs {base['m'][-3]:.0f} MiB")
@@ -460,12 +467,14 @@ def startup_and_memory(path, n, rng, env_backends=("c", "numba")):
 
 
 #: the import targets: a fresh ``python -c`` that imports numpy (the floor), against one that also imports
-#: ccproof, the evaluator and the mesh reader and loads the evaluation kernel (the backend choice); each prints
+#: ccproof, the evaluator and the mesh reader and loads the evaluation kernel (by a first evaluation of one point on
+#: the 16-quad torus of ccproof.mesh.examples: its small setup is counted too); each prints
 #: its peak resident memory (VmHWM, MiB) as it exits
 _HWM = "print(int([x for x in open('/proc/self/status') if x.startswith('VmHWM')][0].split()[1]) / 1024)"
 _IMPORT_FLOOR = "import numpy; " + _HWM
 _IMPORT_OURS = ("import numpy, ccproof, ccproof.evaluate.surface as s; from ccproof.mesh.io import read_mesh; "
-                "s._compiled_kernel(None); " + _HWM)
+                "from ccproof.mesh.examples import torus; "
+                "s.natural_limit_surface(torus()).evaluate([0], [0.5], [0.5], threads=1); " + _HWM)
 #: what the import and the kernel load may add over ``python -c 'import numpy'``: seconds, MiB
 IMPORT_TARGET = (0.3, 50.0)
 
@@ -723,6 +732,10 @@ def timed(fn, repeat=3):
 
 
 # ------------------------------------------------------------------ (a) per-point implementation
+#: the kinds of a template's virtual faces (``PatchTable.kind``, documented there)
+CORNER, SPLIT = 1, 2
+
+
 def _basis(x):
     t = 1.0 - x
     B = (t * t * t / 6, (3 * x**3 - 6 * x * x + 4) / 6, (-3 * x**3 + 3 * x * x + 3 * x + 1) / 6, x**3 / 6)
@@ -731,16 +744,17 @@ def _basis(x):
 
 
 def naive_point(S, f, u, v):
-    """One point at a time, plain Python on the same tables: locate, net, basis, 16-term sums."""
-    T = S._table
+    """One point at a time, plain Python on the same tables (the public ``S.patch_map.table`` of a surface
+    built by :func:`natural_limit_surface`): locate, net, basis, 16-term sums."""
+    T = S.patch_map.table
     job = int(T.top[f, int(u >= 0.5) + 2 * int(v >= 0.5)])
     vf = int(T.job_root[job])
     for _ in range(T.split_depth):
-        if T.kind[vf] != _SPLIT:
+        if T.kind[vf] != SPLIT:
             break
         half = T.h[vf] * 0.5
         vf = int(T.child[vf, int(u >= T.u0[vf] + half) + 2 * int(v >= T.v0[vf] + half)])
-    if T.kind[vf] == _CORNER:
+    if T.kind[vf] == CORNER:
         U0, V0, H = T.u0[vf], T.v0[vf], T.h[vf]
         du = ((U0 + H) - u if T.cu[vf] else u - U0) / H
         dv = ((V0 + H) - v if T.cv[vf] else v - V0) / H
@@ -781,13 +795,34 @@ def naive_point(S, f, u, v):
     return P, Pu, Pv
 
 
+def smoke(n=20_000, rounds=2):
+    """The test suite's run: each backend against numpy on the bunny (interleaved rounds), then OpenSubdiv side by
+    side (or the line saying it is missing)."""
+    mesh = read_mesh(SHAPES[0][1])
+    S = limit_surface(mesh)
+    rng = np.random.default_rng(0)
+    f, u, v = uniform_points(mesh, n, rng)
+    backends = available_backends()
+    for be in backends:
+        S.evaluate(f[:10], u[:10], v[:10], 1, backend=be)  # numba: compile (cached on disk)
+    times, load = interleaved({be: (lambda be=be: S.evaluate(f, u, v, 1, backend=be, threads=1)) for be in backends},
+                              rounds)
+    for be in backends[:-1]:
+        print(ratio_line(f"bunny P + Pu + Pv, {n:,} points, {be}/numpy time:",
+                         np.array(times[be]) / np.array(times["numpy"]), load))
+    osd_side_by_side(n, rng, True, rounds=rounds)
+    return 0
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--points", type=int, default=1_000_000)
     ap.add_argument("--memory-points", type=int, default=10_000_000)
     ap.add_argument("--naive-points", type=int, default=2000)
     ap.add_argument("--pygel-levels", type=int, default=5)
-    ap.add_argument("--quick", action="store_true", help="small sizes (smoke test)")
+    ap.add_argument("--quick", action="store_true", help="small sizes")
+    ap.add_argument("--smoke", action="store_true",
+                    help="the test suite's run: 20,000 points, each backend against numpy and OpenSubdiv, 2 rounds")
     ap.add_argument("--osd-points", type=int, default=1_000_000)
     ap.add_argument("--osd-only", action="store_true", help="only part 5 (OpenSubdiv side by side)")
     ap.add_argument("--rounds", type=int, default=7, help="interleaved rounds of part 5 (at least 7)")
@@ -797,6 +832,8 @@ def main(argv=None):
     ap.add_argument("--startup", action="store_true",
                     help="only part 6: start-up times and peak memory in fresh processes, ours and OpenSubdiv's")
     args = ap.parse_args(argv)
+    if args.smoke:
+        return smoke()
     if args.setup_only:
         fresh_process_setup(args.rounds)
         return 0

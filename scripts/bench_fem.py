@@ -27,10 +27,14 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
 
 import argparse  # noqa: E402
 import json  # noqa: E402
+import sys  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _bench import load, ratio_line  # noqa: E402
 
 
 def _timeit(fn, repeat=3):
@@ -164,13 +168,22 @@ def main(argv=None):
                     help="skip the element-by-element step above this many vertices")
     ap.add_argument("--no-fit", action="store_true")
     ap.add_argument("--json", default=None, help="write the numbers here")
+    ap.add_argument("--smoke", action="store_true", help="the cube subdivided 1 and 2 times, no fit (the test "
+                    "suite's run)")
     args = ap.parse_args(argv)
     if args.one_fit:
         one_fit(*args.one_fit)
         return 0
     print("subdivisions, vertices, nnz(K), layout s, assemble M1 s, assemble K s, implicit step (31) s "
           "(assembled), CG iterations, step s (element by element)")
-    rows = bench_levels(range(2, args.max_level + 1), args.matrix_free_max)
+    load0 = load()
+    rows = bench_levels(range(1, 3) if args.smoke else range(2, args.max_level + 1), args.matrix_free_max)
+    both = [r for r in rows if "matrix_free" in r]
+    if both:  # the element-by-element step is the baseline of the assembled one
+        print(ratio_line("implicit step assembled / element by element, over the meshes:",
+                         [r["assembled"]["step_s"] / r["matrix_free"]["step_s"] for r in both], [load0, load()]))
+    if args.smoke:
+        return 0
     print(f"log-log slopes (>= 1k vertices): assemble K {slope(rows, lambda r: r['assemble_K_s']):.2f}, "
           f"step {slope(rows, lambda r: r['assembled']['step_s']):.2f}")
     out = {"levels": rows}

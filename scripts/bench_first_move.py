@@ -2,15 +2,14 @@
 
 The surface of an icosphere with an infinitely sharp crease loop (tagged, not all quads: the build
 runs the tagged level-1 step) is built, then moved twice; the build, the first and the second move
-are timed, and, on a second surface, the part of a move that needs the step (the level-1 positions
-the rings index, ``LimitSurface._classified_positions``) on its first and second call. Each round
+are timed (the level-1 positions alone, a private method's time, are no longer measured). Each round
 runs one fresh process per tree (``--before``, exported with ``git archive``, the compiled kernel
 copied over, and this working tree), alternating which goes first: interleaved rounds on a shared
 machine. Printed: the medians per tree, and from the first two rounds (tracemalloc, an extra untimed
 build) the bytes the surface holds and the build's peak, per ptex face, with the table's bytes per
-ptex face and, where the build keeps it, the kept step's.
+ptex face; and per level the ratio after/before of each time (min, median, max over the rounds; load).
 
-Usage: ``python scripts/bench_first_move.py [--before main] [--rounds 4] [--levels 4 5]``
+Usage: ``python scripts/bench_first_move.py [--before main] [--rounds 4] [--levels 4 5] [--smoke]``
 (level 4: 5,120 triangles, level 5: 20,480).
 """
 
@@ -26,6 +25,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "scripts"))
+from _bench import load, ratio_line  # noqa: E402
 from _trees import export_revision  # noqa: E402
 
 SNIPPET = r"""
@@ -35,10 +35,6 @@ sys.path.insert(0, "scripts")
 from bench_memory import icosphere
 from ccproof.evaluate import LimitSurface
 from ccproof.mesh.polymesh import PolyMesh
-try:  # the revisions before PolyMesh.with_vertices
-    from ccproof.evaluate.surface import _polymesh_with_vertices
-except ImportError:
-    pass
 
 def mesh(L):
     V, F = icosphere(L)
@@ -57,15 +53,7 @@ for L in LEVELS:
     V = np.asarray(m.vertices)
     t = time.perf_counter(); S.with_vertices(V + 1e-3 * rng.standard_normal(V.shape)); first = time.perf_counter() - t
     t = time.perf_counter(); S.with_vertices(V + 1e-3 * rng.standard_normal(V.shape)); second = time.perf_counter() - t
-    # the level-1 positions alone (the part of a move that needs the step), on a second surface
-    T = LimitSurface(m, progress=False)
-    X = V + 1e-3 * rng.standard_normal(V.shape)
-    m2 = m.with_vertices(X) if hasattr(m, "with_vertices") else _polymesh_with_vertices(m, X)
-    t = time.perf_counter(); T._classified_positions(m2); pos1 = time.perf_counter() - t
-    t = time.perf_counter(); T._classified_positions(m2); pos2 = time.perf_counter() - t
-    del T
-    r = dict(build=build, first=first, second=second, pos1=pos1, pos2=pos2, P=S.n_faces, table=S.table_bytes,
-             step=S._moving["step"].nbytes if "step" in S._moving and hasattr(S._moving["step"], "nbytes") else 0)
+    r = dict(build=build, first=first, second=second, P=S.n_faces, table=S.table_bytes)
     if MEMORY:
         del S
         tracemalloc.start()
@@ -91,13 +79,19 @@ def main(argv=None):
     ap.add_argument("--before", default="main")
     ap.add_argument("--rounds", type=int, default=4)
     ap.add_argument("--levels", type=int, nargs="+", default=[4, 5])
+    ap.add_argument("--smoke", action="store_true",
+                    help="this tree against itself (no export), level 1, 2 rounds (the test suite's run)")
     args = ap.parse_args(argv)
+    if args.smoke:
+        args.rounds, args.levels = 1, [1]
+    loads = []
     with tempfile.TemporaryDirectory() as tmp:
-        old = Path(tmp)
-        rev = export_revision(args.before, old)
+        old = ROOT if args.smoke else Path(tmp)
+        rev = "this tree" if args.smoke else export_revision(args.before, old)
         trees = {f"before ({args.before} = {rev})": old, "after (this tree)": ROOT}
         res: dict = {k: [] for k in trees}
         for i in range(args.rounds):
+            loads.append(load())
             for name in (list(trees) if i % 2 == 0 else list(trees)[::-1]):
                 res[name].append(_run(trees[name], args.levels, i < 2))
     for L in args.levels:
@@ -105,14 +99,15 @@ def main(argv=None):
         for name, rs in res.items():
             r0 = next(r[L] for r in rs if "held" in r[L])
             P = r0["P"]
-            med = {k: statistics.median(r[L][k] for r in rs) * 1e3
-                   for k in ("build", "first", "second", "pos1", "pos2")}
+            med = {k: statistics.median(r[L][k] for r in rs) * 1e3 for k in ("build", "first", "second")}
             print(f"icosphere level {L} creased, {P} ptex faces, {name}: build {med['build']:.0f} ms, "
-                  f"first move {med['first']:.1f} ms, second move {med['second']:.1f} ms, of a move the level-1 "
-                  f"positions {med['pos1']:.1f} ms first, {med['pos2']:.1f} ms then (medians of {len(rs)} "
-                  f"interleaved rounds); table {r0['table'] / P:.0f} B per ptex face, kept step "
-                  f"{r0['step'] / P:.1f} B ({100 * r0['step'] / r0['table']:.2f} % of the table); tracemalloc: "
+                  f"first move {med['first']:.1f} ms, second move {med['second']:.1f} ms (medians of {len(rs)} "
+                  f"interleaved rounds); table {r0['table'] / P:.0f} B per ptex face; tracemalloc: "
                   f"surface held {r0['held'] / P:.0f} B, build peak {r0['peak'] / P:.0f} B per ptex face", flush=True)
+        after, before = (res[k] for k in reversed(list(res)))
+        for k in ("build", "first", "second"):
+            ratios = [a[L][k] / b[L][k] for a, b in zip(after, before)]
+            print(ratio_line(f"icosphere level {L} {k}: after/before", ratios, loads), flush=True)
 
 
 if __name__ == "__main__":

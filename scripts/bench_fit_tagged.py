@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import statistics
 import subprocess
 import sys
@@ -50,21 +51,31 @@ print(json.dumps({"rc": rc, "s": t, "sha": hashlib.sha256(v).hexdigest()}))
 """
 
 
-def main():
+def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--old", required=True)
-    ap.add_argument("--new", required=True)
+    ap.add_argument("--old")
+    ap.add_argument("--new")
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--max-steps", type=int, default=5)
     ap.add_argument("meshes", nargs="*")
-    a = ap.parse_args()
+    ap.add_argument("--smoke", action="store_true",
+                    help="this tree against itself, 1 round, 1 step, one mesh (the test suite's run)")
+    a = ap.parse_args(argv)
+    if a.smoke:
+        a.old = a.new = str(REPO)
+        a.rounds, a.max_steps = 1, 1
+        a.meshes = [str(REPO / "tests/data/osd_features/meshes/catmark_cube_creases0.obj")]
+    if a.old is None or a.new is None:
+        ap.error("--old and --new are required (or --smoke)")
     meshes = a.meshes or [str(REPO / "tests/data/osd_features/meshes" / f"{m}.obj")
                           for m in ("catmark_cube_creases0", "catmark_dart_edgeonly")]
     trees = {"old": str(Path(a.old).resolve()), "new": str(Path(a.new).resolve())}
     times = {(t, m): [] for t in trees for m in meshes}
+    loads = []
     shas = {(t, m): set() for t in trees for m in meshes}
     for r in range(a.rounds):
         order = ["old", "new"] if r % 2 == 0 else ["new", "old"]
+        loads.append(os.getloadavg()[0])
         for m in meshes:
             for t in order:
                 with tempfile.TemporaryDirectory() as cwd:
@@ -83,6 +94,9 @@ def main():
             x = times[(t, m)]
             print(f"{Path(m).stem} {t}: min {min(x):.2f} median {statistics.median(x):.2f} max {max(x):.2f} s "
                   f"({len(x)} rounds)")
+        ratios = [n / o for o, n in zip(times[("old", m)], times[("new", m)])]
+        print(f"{Path(m).stem} new/old: min {min(ratios):.3f}  median {statistics.median(ratios):.3f}  max "
+              f"{max(ratios):.3f}  ({len(ratios)} rounds; load {min(loads):.2f}-{max(loads):.2f})")
         same = len(shas[("old", m)] | shas[("new", m)]) == 1
         print(f"{Path(m).stem}: outputs identical across trees and rounds: {same}")
 

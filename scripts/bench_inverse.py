@@ -22,8 +22,12 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _bench import load, ratio_line  # noqa: E402
 
 
 def interleaved(fns, repeat):
@@ -81,7 +85,10 @@ def main(argv=None):
     ap.add_argument("--all", action="store_true", help="k = 3..50, 100, 1000 (overrides --k)")
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--seed", type=int, default=2024)
+    ap.add_argument("--smoke", action="store_true", help="2,000 points, k = 5, 2 rounds (the test suite's run)")
     args = ap.parse_args(argv)
+    if args.smoke:
+        args.n, args.k, args.repeat = 2000, [5], 2
     if args.all:
         args.k = list(range(3, 51)) + [100, 1000]
 
@@ -96,8 +103,9 @@ def main(argv=None):
             f"{'inv/fwd+J':>14} {'loc/fwd':>14} {'fallback':>9} {'fail':>5} {'roundtrip':>10} "
             f"{'clust.fb':>9} {'fail':>5} {'clust.rt':>9}")
     print(head)
-    worst = 0
+    worst, lines = 0, []
     for k in args.k:
+        load0 = load()
         characteristic_map(k, u[:4], v[:4])
         inverse_characteristic_map(k, u[:4], v[:4])
         fns = [lambda k=k: characteristic_map(k, u, v),
@@ -123,7 +131,9 @@ def main(argv=None):
         print(f"{k:>5} {tf.min():8.4f} {tj.min():8.4f} {ti.min():8.4f} {tl.min():8.4f} {ratio(ti, tf):>14} "
               f"{ratio(ti, tj):>14} {ratio(tl, tf):>14} {res.stats['fallback'] / args.n:9.2e} {fails:>5} "
               f"{err:10.2e} {cres.stats['fallback'] / cx.size:9.2e} {cres.stats['failures']:>5} {cerr:9.2e}")
+        lines.append(ratio_line(f"k = {k:>4} inverse/forward:", ti / tf, [load0, load()]))
         sys.stdout.flush()
+    print("\n".join(lines))
     return 1 if worst else 0
 
 

@@ -1,105 +1,157 @@
-"""A/B of builds of the C evaluation kernel in one process: the same table, the same points, rounds interleaved.
+"""A/B of builds of the C evaluation kernel: the same meshes, the same points, rounds interleaved.
 
-Each library (a build of ``ccproof/evaluate/_clib.c`` with the same ``ccp_abi``) is loaded with ctypes and its
-``ccp_evaluate`` called on one :class:`ccproof.evaluate._ckernel.CTable` of each mesh of
-``scripts/bench_evaluate.py`` (uniform points and points near extraordinary vertices, P + Pu + Pv), in rounds
-whose order rotates, the process pinned to one CPU. Per case it prints the 1-minute load before and after, the
-first library's median time, and for every other library the median (min-max) over the rounds of the per-round
-ratio first / other (above 1: faster than the first) in CPU time of the calling thread (less sensitive to the
-other processes of a shared machine than the wall clock), and whether its results have the first library's
-bits. Load a second copy of the first library (another file) as a control: its ratio is the floor of the
-A/B on that machine at that time.
+Each library (a build of ``ccproof/evaluate/_clib.c``) runs in a worker process of its own, which loads it
+through the environment variable ``CCPROOF_CLIB`` (the file the evaluator loads instead of the installed
+kernel) and evaluates with the public ``LimitSurface.evaluate(..., backend="c", threads=1)``; the workers
+stay alive and the parent asks them in turn, round by round, the order rotating, every worker pinned to the
+same CPU. The cases: each mesh of ``scripts/bench_evaluate.py`` with uniform points and points near
+extraordinary vertices, P + Pu + Pv. Per case it prints the first library's median time and, for every other
+library, the per-round ratio first / other (above 1: faster than the first; min, median, max) in CPU time of
+the evaluating thread (less sensitive to the other processes of a shared machine than the wall clock), the
+1-minute load, and whether its results have the first library's bits. Give the first library twice as a
+control (each worker is a process of its own): its ratio is the floor of the A/B on that machine at that time.
+
+A library built from another version of ``_clib.c`` (another ``ccp_abi``) is not loaded: the evaluator then
+falls back, and the worker stops with an error naming the file.
 
 Build a library with setup.py's flags, e.g.::
 
     gcc -shared -fPIC -std=c99 -O3 -ffp-contract=off -fno-math-errno -Wno-psabi ccproof/evaluate/_clib.c -o /tmp/new.so
-    python scripts/bench_kernel_ab.py /tmp/old.so /tmp/old_copy.so /tmp/new.so --rounds 61 --points 100000
+    python scripts/bench_kernel_ab.py /tmp/old.so /tmp/old.so /tmp/new.so --rounds 61 --points 100000
+    python scripts/bench_kernel_ab.py --smoke      the installed kernel against itself (the test suite's run)
 """
 
 from __future__ import annotations
 
 import argparse
-import ctypes
 import os
+import subprocess
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
 
-REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO))
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
 
-import bench_evaluate as be  # noqa: E402
+from _bench import load, missing, ratio_line  # noqa: E402
+from bench_evaluate import SHAPES, near_ev_points, uniform_points  # noqa: E402
 
-from ccproof.evaluate import _ckernel, natural_limit_surface  # noqa: E402
+from ccproof.evaluate import natural_limit_surface  # noqa: E402
+from ccproof.evaluate.surface import available_backends  # noqa: E402
 from ccproof.mesh.io import read_mesh  # noqa: E402
 
+#: the worker: reads "case path npz" lines, prints "thread-seconds digest" per line
+WORKER = r"""
+import hashlib, os, sys, time
+import numpy as np
+from ccproof.evaluate import natural_limit_surface
+from ccproof.evaluate.surface import available_backends
+from ccproof.mesh.io import read_mesh
+if "c" not in available_backends():
+    sys.exit(f"{os.environ.get('CCPROOF_CLIB')}: not loaded (not a build of this _clib.c?)")
+if hasattr(os, "sched_setaffinity"):
+    os.sched_setaffinity(0, {int(sys.argv[1])})
+surfaces, points = {}, {}
+for line in sys.stdin:
+    path, pts = line.split()
+    if path not in surfaces:
+        surfaces[path] = natural_limit_surface(read_mesh(path), progress=False)
+    if pts not in points:
+        d = np.load(pts)
+        points[pts] = (d["f"], d["u"], d["v"])
+    S, (f, u, v) = surfaces[path], points[pts]
+    t0 = time.thread_time()
+    r = S.evaluate(f, u, v, 1, backend="c", threads=1)
+    dt = time.thread_time() - t0
+    h = hashlib.sha256(b"".join(np.ascontiguousarray(r[k]).tobytes() for k in ("P", "Pu", "Pv"))).hexdigest()
+    print(dt, h, flush=True)
+"""
 
-def _load(path):
-    lib = ctypes.CDLL(os.path.abspath(path))
-    lib.ccp_abi.restype = ctypes.c_int64
-    if lib.ccp_abi() != 1000 * ctypes.sizeof(_ckernel._Table) + _ckernel._ABI:
-        raise SystemExit(f"{path}: built from another version of _clib.c (ccp_abi differs)")
-    lib.ccp_evaluate.restype = ctypes.c_int64
-    lib.ccp_evaluate.argtypes = ([ctypes.POINTER(_ckernel._Table), ctypes.c_int64] + [ctypes.c_void_p] * 3
-                                 + [ctypes.c_int64] + [ctypes.c_void_p] * 7)
-    return lib
+
+def _installed_kernel():
+    """The C kernel this install built (the file the evaluator loads by default), or None."""
+    import ccproof.evaluate as ev
+
+    here = Path(ev.__file__).parent
+    found = sorted(here.glob("_clib*.so")) + sorted(here.glob("_clib*.pyd"))
+    return found[0] if found else None
 
 
-def _call(lib, ct, f, u, v, o, cache):
-    """P, Pu, Pv of the points (f, u, v) into o by ``lib``'s kernel, with its own corner-net cache."""
-    return lib.ccp_evaluate(ct.ref, f.size, f.ctypes.data, u.ctypes.data, v.ctypes.data, 1, o[0].ctypes.data,
-                            o[1].ctypes.data, o[2].ctypes.data, None, None, None, cache.ctypes.data)
+class Worker:
+    """A process evaluating with one library (``CCPROOF_CLIB``), pinned to ``cpu``."""
+
+    def __init__(self, lib, cpu):
+        env = dict(os.environ, CCPROOF_CLIB=str(Path(lib).resolve()))
+        env.pop("CCPROOF_BACKEND", None)
+        self.p = subprocess.Popen([sys.executable, "-c", WORKER, str(cpu)], stdin=subprocess.PIPE,
+                                  stdout=subprocess.PIPE, text=True, env=env)
+
+    def run(self, path, pts):
+        self.p.stdin.write(f"{path} {pts}\n")
+        self.p.stdin.flush()
+        line = self.p.stdout.readline()
+        if not line:
+            raise SystemExit(f"a worker stopped (exit {self.p.wait()})")
+        dt, digest = line.split()
+        return float(dt), digest
+
+    def close(self):
+        self.p.stdin.close()
+        self.p.wait()
 
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("libs", nargs="+", help="shared libraries; the first is the baseline")
+    ap.add_argument("libs", nargs="*", help="shared libraries; the first is the baseline")
     ap.add_argument("--rounds", type=int, default=41)
     ap.add_argument("--points", type=int, default=100_000)
-    ap.add_argument("--shapes", default=",".join(label for label, _ in be.SHAPES))
+    ap.add_argument("--shapes", default=",".join(label for label, _ in SHAPES))
     ap.add_argument("--dists", default="uniform,near")
+    ap.add_argument("--smoke", action="store_true",
+                    help="the installed kernel against itself, 2 rounds, 2,000 points, one mesh")
     a = ap.parse_args(argv)
-    if _ckernel.load() is None:
-        raise SystemExit("the C kernel was not built (python setup.py build_ext --inplace): CTable needs it")
-    libs = [_load(p) for p in a.libs]
+    if a.smoke:
+        a.rounds, a.points, a.shapes, a.dists = 2, 2000, SHAPES[2][0], "uniform,near"
+        lib = _installed_kernel()
+        if lib is None or "c" not in available_backends():
+            missing("the C kernel", "not built: python setup.py build_ext --inplace")
+            S = natural_limit_surface(read_mesh(SHAPES[2][1]), progress=False)
+            print(f"our side (numpy): {S.evaluate([0], [0.5], [0.5])['P'].shape[0]} point evaluated")
+            return 0
+        a.libs = [str(lib), str(lib)]
+    if len(a.libs) < 2:
+        ap.error("give at least two libraries (the first is the baseline), or --smoke")
     names = [os.path.basename(p) for p in a.libs]
-    if hasattr(os, "sched_setaffinity"):
-        os.sched_setaffinity(0, {min(os.sched_getaffinity(0))})
+    cpu = min(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else 0
+    workers = [Worker(p, cpu) for p in a.libs]
     rng = np.random.default_rng(1)
-    n = a.points
-    for label, path in be.SHAPES:
-        if label not in a.shapes.split(","):
-            continue
-        mesh = read_mesh(path)
-        ct = _ckernel.CTable(natural_limit_surface(mesh)._table)
-        for dist in a.dists.split(","):
-            f, u, v = (be.uniform_points(mesh, n, rng) if dist == "uniform" else be.near_ev_points(mesh, n, rng)[:3])
-            f, u, v = (np.ascontiguousarray(x, dtype=t) for x, t in ((f, np.int64), (u, np.float64), (v, np.float64)))
-            outs = [[np.empty((n, 3)) for _ in range(3)] for _ in libs]
-            caches = [np.zeros(_ckernel.load().ccp_cache_words()) for _ in libs]
+    import tempfile
 
-            for i in range(len(libs)):
-                if _call(libs[i], ct, f, u, v, outs[i], caches[i]) != -1:
-                    raise SystemExit(f"{names[i]} refused a point")
-            same = [all(np.array_equal(x.view(np.int64), y.view(np.int64)) for x, y in zip(outs[0], o)) for o in outs]
-            times = [[] for _ in libs]
-            load0 = os.getloadavg()[0]
-            for r in range(a.rounds):
-                for i in [(r + j) % len(libs) for j in range(len(libs))]:
-                    t0 = time.thread_time()
-                    _call(libs[i], ct, f, u, v, outs[i], caches[i])
-                    times[i].append(time.thread_time() - t0)
-            base = np.array(times[0])
-            line = (f"{label:15s} {dist:8s} load {load0:.2f}-{os.getloadavg()[0]:.2f}  {names[0]} "
-                    f"{np.median(base) * 1e3:.1f} ms")
-            for i in range(1, len(libs)):
-                r_ = base / np.array(times[i])
-                line += (f" | {names[i]} {np.median(r_):.3f} ({r_.min():.2f}-{r_.max():.2f})"
-                         f"{'' if same[i] else ' OTHER BITS'}")
-            print(line, flush=True)
+    with tempfile.TemporaryDirectory() as tmp:
+        for label, path in SHAPES:
+            if label not in a.shapes.split(","):
+                continue
+            mesh = read_mesh(path)
+            for dist in a.dists.split(","):
+                pick = uniform_points if dist == "uniform" else (lambda m, n, r: near_ev_points(m, n, r)[:3])
+                f, u, v = pick(mesh, a.points, rng)
+                pts = os.path.join(tmp, f"{label}_{dist}.npz")
+                np.savez(pts, f=np.asarray(f, np.int64), u=np.asarray(u, np.float64), v=np.asarray(v, np.float64))
+                first = [w.run(path, pts) for w in workers]  # warm-up: the surface built, the bits compared
+                same = [d == first[0][1] for _, d in first]
+                times, loads = [[] for _ in workers], []
+                for r in range(a.rounds):
+                    loads.append(load())
+                    for i in [(r + j) % len(workers) for j in range(len(workers))]:
+                        times[i].append(workers[i].run(path, pts)[0])
+                base = np.array(times[0])
+                print(f"{label:15s} {dist:8s} {names[0]} {np.median(base) * 1e3:.1f} ms", flush=True)
+                for i in range(1, len(workers)):
+                    line = ratio_line(f"   {names[0]}/{names[i]}:", base / np.array(times[i]), loads)
+                    print(line + ("" if same[i] else "  OTHER BITS"), flush=True)
+    for w in workers:
+        w.close()
     return 0
 
 

@@ -36,6 +36,9 @@ from pathlib import Path
 
 import numpy as np
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _bench import load, missing, ratio_line  # noqa: E402
+
 REPO = Path(__file__).resolve().parents[1]
 
 
@@ -77,7 +80,6 @@ S = natural_limit_surface(sys.argv[1], progress=False)
 t2 = time.perf_counter()
 print(json.dumps({"import_s": t1 - t0, "setup_s": t2 - t1, "n_ptex": int(S.n_faces),
                   "table_bytes": int(S.table_bytes), "configuration_bytes": int(S.configuration_bytes),
-                  "templates": len(S._groups), "configurations": len(S._schemes),
                   "peak_rss": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024}))
 """
 
@@ -196,10 +198,15 @@ def main(argv=None):
     ap.add_argument("--osd-max-triangles", type=int, default=5120,
                     help="largest mesh given to OpenSubdiv (default 5120: at level 10 Far holds ~75 kB per ptex "
                     "face of these meshes, 1.2 GB at 5,120 triangles)")
+    ap.add_argument("--smoke", action="store_true", help="level 1 and 1,000 samples (the test suite's run)")
     args = ap.parse_args(argv)
+    if args.smoke:
+        args.levels, args.samples = [1], 1000
     print(f"python {sys.version.split()[0]}, load {os.getloadavg()}, {os.cpu_count()} cores")
     exe = None if args.no_osd else build_osd_driver()
-    rows = []
+    if exe is None:
+        missing("OpenSubdiv Far", "--no-osd, or libosd-dev / g++ not installed")
+    rows, loads = [], []
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         for L in args.levels:
@@ -207,6 +214,7 @@ def main(argv=None):
             mesh = tmp / f"icosphere{L}.obj"
             write_obj(mesh, V, F)
             row = {"level": L, "triangles": F.shape[0]}
+            loads.append(load())
             r = subprocess.run([sys.executable, "-c", _TABLE_JOB, str(mesh)], capture_output=True, text=True,
                                env=_env())
             if r.returncode != 0:
@@ -243,6 +251,10 @@ def main(argv=None):
               f"{1000 * row['setup_s'] / row['triangles']:>8.3f} {per:>7.0f} {row['configuration_bytes'] / 1e6:>7.1f} "
               f"{osd_per:>10.0f} {per / osd_per:>8.2f} {row.get('eval_peak_rss', float('nan')) / 1e9:>12.2f} "
               f"{row.get('eval_s', float('nan')):>7.1f}")
+    ratios = [(r["table_bytes"] - r["configuration_bytes"]) / r["n_ptex"] / (r["osd_bytes"] / r["osd_ptex"])
+              for r in rows if r.get("osd_bytes")]
+    if ratios:
+        print(ratio_line("bytes per ptex face ours/Far over the meshes:", ratios, loads + [load()]))
     print(f"load after: {os.getloadavg()}")
     return 0
 
@@ -251,8 +263,8 @@ def _print_row(row):
     print(f"level {row['level']}: {row['triangles']} triangles, {row['n_ptex']} ptex faces; "
           f"setup {row['setup_s']:.2f} s "
           f"(imports {row['import_s']:.2f} s); table {row['table_bytes'] / 1e6:.1f} MB "
-          f"({row['configuration_bytes'] / 1e6:.1f} MB in {row['configurations']} configurations and "
-          f"{row['templates']} templates); peak RSS of the build {row['peak_rss'] / 1e9:.2f} GB"
+          f"(of which {row['configuration_bytes'] / 1e6:.1f} MB held once per configuration); peak RSS of the build "
+          f"{row['peak_rss'] / 1e9:.2f} GB"
           + (f"; ccproof eval: peak RSS {row['eval_peak_rss'] / 1e9:.2f} GB, {row['eval_s']:.1f} s"
              if "eval_peak_rss" in row else "")
           + (f"; Far: {row['osd_bytes'] / 1e6:.1f} MB ({row['osd_patches']} patches), peak RSS "

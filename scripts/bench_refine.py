@@ -16,12 +16,11 @@ each pair's child meshes are compared (vertices bit for bit, faces, tags, holes)
    refines once with ``refine(operator="csr")``), the former refine patched in as "old" (its CSR arrays
    built from the same stencils: the same bits).
 
-Usage: python scripts/bench_refine.py [--rounds 5] [--tri-levels 6] [--setup-levels 5]
+Usage: python scripts/bench_refine.py [--rounds 5] [--tri-levels 6] [--setup-levels 5] [--smoke]
 
 ``--before REV`` (e.g. ``main``) instead compares this tree's ``refine(operator=False)`` against the one of
 the git revision REV (exported with ``git archive``, the compiled kernel copied over): each round runs one
 fresh worker process per tree, alternating which goes first, on the icosphere of ``--tri-levels``,
-the step alone on it (``PolyMesh._step``: the operator, without the child mesh's construction),
 catmark_cubes_infsharp at levels 0 and 2, and ``subdivision_matrix`` of the QuadMesh of the icosphere of
 ``--tri-levels`` - 1 refined once; a worker times ``--reps`` calls of each and keeps the fastest, and in
 the first round measures the tracemalloc peak of one more call. Printed per mesh: the times of both trees
@@ -151,10 +150,6 @@ def child(pm):
     tags = repr((list(m.edge_sharpness.items()), list(m.vertex_sharpness.items()), m.options, m.level))
     return digest(m.vertices, m.indices, m.sizes, m.is_hole, np.frombuffer(tags.encode(), dtype=np.uint8))
 
-def step(pm):
-    st = pm._step(sparse=False)
-    return digest(*st.csr, st.faces, st.edges)
-
 def matrix(qm):
     S = subdivision_matrix(qm)
     return digest(S.indptr, S.indices, S.data)
@@ -163,7 +158,6 @@ cases = []
 V, F = _icosphere(__TRI__)
 sphere = PolyMesh(V, F)
 cases.append((f"refine icosphere ({F.shape[0]:,} triangles)", child, sphere))
-cases.append(("its step alone (PolyMesh._step)", step, sphere))
 for lv in (0, 2):
     pm = read_mesh(__DATA__ + "/catmark_cubes_infsharp.obj").manifold
     for _ in range(lv):
@@ -231,14 +225,17 @@ def before_main(a):
               f"new {res['new'][0][case]['peak'] / 2**20:.1f} MiB", flush=True)
 
 
-def main():
+def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--rounds", type=int, default=5)
     ap.add_argument("--tri-levels", type=int, default=6)
     ap.add_argument("--setup-levels", type=int, default=5)
     ap.add_argument("--before", default=None, help="a git revision: compare against its refine (see above)")
     ap.add_argument("--reps", type=int, default=3, help="with --before: calls per worker and mesh")
-    a = ap.parse_args()
+    ap.add_argument("--smoke", action="store_true", help="one round on the smallest inputs (the test suite's run)")
+    a = ap.parse_args(argv)
+    if a.smoke:
+        a.rounds, a.tri_levels, a.setup_levels, a.reps = 1, 1, 1, 1
     if a.before is not None:
         return before_main(a)
     from ccproof.evaluate.surface import natural_limit_surface

@@ -35,6 +35,9 @@ from pathlib import Path
 
 import numpy as np
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _bench import load, ratio_line  # noqa: E402
+
 DEFAULT_MESH = Path(__file__).resolve().parents[1] / "tests" / "data" / "meshes" / "bunny_quads.obj"
 
 
@@ -118,18 +121,22 @@ def main(argv=None):
     ap.add_argument("--sampling", choices=("uniform", "ev-faces"), default="uniform",
                     help="uniform: random face and (u, v); ev-faces: only faces with an extraordinary corner "
                     "(the worst case for the reparameterizations)")
+    ap.add_argument("--smoke", action="store_true",
+                    help="a 5-regular disk, 3,000 points, 2 rounds, numpy, first call of k = 5 (the test suite's run)")
     args = ap.parse_args(argv)
+    if args.smoke:
+        args.mesh, args.points, args.rounds, args.backend, args.first_calls = "disk:5", 3000, 2, "numpy", "5"
     os.environ["CCPROOF_BACKEND"] = args.backend
     if args.first_calls:
         report_first_calls([int(k) for k in args.first_calls.split(",")])
     if args.points <= 0:
         return
 
-    from ccproof.evaluate._numba_kernel import evaluate_points
+    from ccproof.evaluate.surface import available_backends
     from ccproof.reparam import corner_valence, limit_surface
     from ccproof.reparam.blend import face_map
 
-    if args.backend == "numba" and evaluate_points is None:
+    if args.backend == "numba" and "numba" not in available_backends():
         raise SystemExit("numba is not installed: use --backend numpy")
     t0 = time.perf_counter()
     mesh = load_mesh(args.mesh)
@@ -152,7 +159,9 @@ def main(argv=None):
     cv, alpha = corner_valence(mesh)[f], S.parameterizations["vanishing"].alphas(S)
     act = {p: float(face_map(cv, u, v, p, alpha)["active"].mean()) for p in names[1:]}
     times = {p: [] for p in names}
+    loads = []
     for _ in range(args.rounds):
+        loads.append(load())
         for p in names:
             a = time.perf_counter()
             S.evaluate(f, u, v, args.derivatives, parameterization=p)
@@ -171,7 +180,7 @@ def main(argv=None):
               f"{n / best / 1e6:6.2f} M points/s")
     for p in names[1:]:
         r = [a / b for a, b in zip(times[p], times["natural"])]
-        print(f"  ratio {p}/natural: median {statistics.median(r):.2f} (rounds {min(r):.2f} .. {max(r):.2f})")
+        print("  " + ratio_line(f"ratio {p}/natural:", r, loads))
     rc = statistics.median(a / b for a, b in zip(times["characteristic"], times["natural"]))
     print(f"target characteristic <= 4 x natural: {'met' if rc <= 4 else 'MISSED'} ({rc:.2f})")
 

@@ -8,16 +8,20 @@ every split form, keyed by path prefix), alternating round by round. Prints per 
 seconds of each, min, median and max of their ratio, the peak traced memory of each (measured once,
 apart from the timing) and the load.
 
-    python scripts/bench_replay.py [--depth 6] [--rounds 3] [--prec 128]
+    python scripts/bench_replay.py [--depth 6] [--rounds 3] [--prec 128] [--smoke]
 """
 
 import argparse
 import os
-import statistics
+import sys
 import time
 import tracemalloc
+from pathlib import Path
 
 from flint import ctx
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _bench import load, ratio_line  # noqa: E402
 
 
 def cached_replay(root, boxes):
@@ -63,12 +67,15 @@ def form_bytes(root):
     return size / 2
 
 
-def main():
+def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--depth", type=int, default=6, help="2^DEPTH boxes (default 64)")
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--prec", type=int, default=128)
-    args = ap.parse_args()
+    ap.add_argument("--smoke", action="store_true", help="depth 1, 2 rounds (the test suite's run)")
+    args = ap.parse_args(argv)
+    if args.smoke:
+        args.depth, args.rounds = 1, 2
     from ccproof.certify.verify.maps import corner_det_form
     from ccproof.certify.verify.replay import check_boxes
     from ccproof.certify.verify.statement import c_lam, nets_for_valence
@@ -83,17 +90,21 @@ def main():
         boxes = [{"path": p, "bound": "0.07"} for p in paths]  # the published bound is 0.0755
         print(f"corner form P2, k = 5: {len(root.coeffs)} coefficients, {args.prec} bits; {len(boxes)} boxes "
               f"(depth {args.depth}, {len(boxes) - 1} splits)")
-        rt = []
-        for r in range(args.rounds):
+        rt, loads = [], []
+        for r in range(args.rounds):  # the order alternates round by round
+            loads.append(load())
+            if r % 2:
+                ok_old, t_old = cpu_seconds(lambda: cached_replay(root, boxes))
             ok_new, t_new = cpu_seconds(lambda: check_boxes(root, boxes, "bench")[0])
-            ok_old, t_old = cpu_seconds(lambda: cached_replay(root, boxes))
+            if not r % 2:
+                ok_old, t_old = cpu_seconds(lambda: cached_replay(root, boxes))
             assert ok_new and ok_old
             rt.append(t_old / t_new)
             print(f"round {r}: depth-first {t_new:.2f} s CPU ({1e3 * t_new / (len(boxes) - 1):.0f} ms per split); "
                   f"cached {t_old:.2f} s ({1e3 * t_old / (len(boxes) - 1):.0f} ms per split)")
         m_new = peak_bytes(lambda: check_boxes(root, boxes, "bench"))
         m_old = peak_bytes(lambda: cached_replay(root, boxes))
-    print(f"time cached / depth-first: min {min(rt):.2f} median {statistics.median(rt):.2f} max {max(rt):.2f}")
+    print(ratio_line("time cached / depth-first:", rt, loads))
     print(f"peak traced memory: depth-first {m_new / 2**20:.1f} MiB, cached {m_old / 2**20:.1f} MiB "
           f"(ratio {m_old / m_new:.1f}); one form {form_bytes(root) / 2**20:.2f} MiB")
     print(f"load average: {' '.join(f'{x:.2f}' for x in os.getloadavg())}")

@@ -16,6 +16,7 @@ import argparse
 import contextlib
 import io
 import logging
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -45,15 +46,31 @@ def main(argv=None):
     ap.add_argument("--mesh", default=str(ROOT / "tests" / "data" / "meshes" / "bunny_quads.obj"))
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--skip", nargs="*", default=[], choices=["certify", "verify", "eval"])
+    ap.add_argument("--smoke", action="store_true",
+                    help="one worker, 40,000 points on catmark_smoothtris1, no certify or verify (the suite's run)")
     args = ap.parse_args(argv)
+    if args.smoke:
+        args.workers, args.points, args.chunk, args.skip = 1, 4e4, 20_000, ["certify", "verify"]
+        args.mesh = str(ROOT / "tests" / "data" / "osd_features" / "meshes" / "catmark_smoothtris1.obj")
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from _bench import load, missing, ratio_line
 
-    import distributed
+    try:
+        import distributed
+    except ImportError:
+        missing("a Dask cluster", "the optional extra scale is not installed: pip install 'ccproof[scale]'")
+        from ccproof.scale import run_tasks
+
+        ser = run_tasks(_noop, range(200), "serial", progress=False)
+        print(f"our side, serial: 200 empty tasks in {ser.seconds:.3f} s")
+        return
     import numpy as np
 
     from ccproof.cli import main as ccproof
     from ccproof.scale import read_shards, run_tasks
 
     rows = []
+    load0 = load()
     t0 = time.perf_counter()
     cluster = distributed.LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True,
                                        dashboard_address=None, silence_logs=logging.ERROR)
@@ -112,6 +129,8 @@ def main(argv=None):
             rows.append((f"evaluate {pts} points (serial: all threads)", ts, tc))
     client.close()
     cluster.close()
+    timed = [(s, c) for _, s, c in rows if c is not None]
+    print(ratio_line("serial/cluster time, over the jobs:", [s / c for s, c in timed], [load0, load()]))
     print("\n| job | serial (s) | cluster (s) | speed-up |\n|---|---|---|---|")
     for name, s, c in rows:
         print(f"| {name} | {s:.2f} | {'' if c is None else f'{c:.2f}'} | "

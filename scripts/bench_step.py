@@ -6,21 +6,22 @@ polygon step from face points, the untagged quad operator assembled in floats, t
 tagged step with ``refine_complex`` on the fans of semi-sharp vertices), in one process, taking turns
 round by round (min, median, max of the ratio new / old per round; the 1-minute load before each round):
 
-1. the setup of the evaluator (``natural_limit_surface`` of the file, the disk cache filled by the
-   warm-up) on bunny_quads, catmark_cubes_infsharp and catmark_smoothtris1 and on an icosphere of
-   triangles (``--tri-levels``: scan-like, the mesh the untagged polygon step serves), with the
-   evaluator's polygon step from face points (``catmark_step``, kept) as "old" and the same step as
-   ``catmark_operator(...).S @ X`` as "new" (the measurement behind keeping the former);
-2. the step alone: ``catmark_step`` on that icosphere (the same two), ``subdivision_matrix`` on
-   bunny_quads subdivided once, ``tagged_step`` on catmark_cubes_infsharp and catmark_pyramid_creases1
-   (semi-sharp) subdivided twice (the former code as "old", the operator as "new").
+1. ``subdivision_matrix`` on bunny_quads subdivided once;
+2. ``tagged_step`` on catmark_cubes_infsharp and catmark_pyramid_creases1 (semi-sharp) subdivided twice
+   (the former code as "old", the operator as "new").
 
-Usage: python scripts/bench_step.py [--rounds 7] [--tri-levels 4]
+The baselines' private helpers are copied here verbatim too (``_boundary_neighbours``, ``_decrement``,
+``_pair_keys``, ``_semi``, ``_fan_complex``): the script uses public names of ccproof only. The former A/B of
+the evaluator's polygon step (``catmark_step``, a function of a private module, swapped into the evaluator
+by assignment) against ``catmark_operator(...).S @ X`` is no longer measured: it needed the private module.
+
+Usage: python scripts/bench_step.py [--rounds 7] [--smoke]
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import statistics
 import time
@@ -28,17 +29,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ccproof.apps.control_mesh import (
-    _fan_complex,
-    _pair_keys,
-    _semi,
-    read_control_mesh,
-    subdivide_control,
-    tags_of,
-    vertex_rules,
-)
+from ccproof.apps.control_mesh import read_control_mesh, subdivide_control, tags_of, vertex_rules
 from ccproof.mesh import QuadMesh, subdivide
-from ccproof.mesh.subdivision import _boundary_neighbours
 from ccproof.rule_weights import (
     crease_vertex_weights,
     face_point_weight,
@@ -52,75 +44,71 @@ DATA = REPO / "tests" / "data"
 
 
 # ------------------------------------------------------------------ the baselines (the former code)
-def old_catmark_step(mesh):
-    from ccproof.rule_weights import crease_vertex_weights, smooth_edge_weights, smooth_vertex_weights
+#: ccproof.mesh.rules.INFINITE (the sharpness that means infinitely sharp)
+INFINITE = 10.0
+_F32 = np.float32
+_ONE = _F32(1.0)
 
-    opts = mesh.options
-    if (mesh.edge_sharpness or mesh.vertex_sharpness or np.asarray(mesh.is_hole).any()
-            or opts.triangle_subdivision != "catmark" or opts.boundary == "none"):
-        return None
-    X = np.asarray(mesh.vertices, dtype=np.float64)
-    idx = np.asarray(mesh.indices, dtype=np.int64)
-    sizes = np.asarray(mesh.sizes, dtype=np.int64)
-    off = np.asarray(mesh.offsets, dtype=np.int64)[:sizes.size]
-    n, m, H = X.shape[0], sizes.size, idx.size
-    face = np.repeat(np.arange(m), sizes)
-    pos = np.arange(H) - off[face]
-    nxt = off[face] + (pos + 1) % sizes[face]
-    prv = off[face] + (pos - 1) % sizes[face]
-    org, dst = idx, idx[nxt]
-    if np.unique(org * n + dst).size != H:  # a directed edge twice: non-manifold or misoriented
-        return None
-    lo, hi = np.minimum(org, dst), np.maximum(org, dst)
-    uniq, first, inv = np.unique(lo * n + hi, return_index=True, return_inverse=True)
-    inv = inv.reshape(-1)
-    E = uniq.size
-    order = np.argsort(first, kind="stable")
-    rank = np.empty(E, dtype=np.int64)
-    rank[order] = np.arange(E)
-    he_edge = rank[inv]  # edge id of every half-edge (first-occurrence order)
-    count = np.bincount(he_edge, minlength=E)
-    if (count > 2).any():
-        return None
-    valence = np.bincount(org, minlength=n)  # faces (outgoing half-edges) at every vertex
-    if (valence == 0).any():
-        return None
-    bnd_h = count[he_edge] == 1  # boundary half-edges
-    nb_out = np.bincount(org[bnd_h], minlength=n)
-    nb_in = np.bincount(dst[bnd_h], minlength=n)
-    if (nb_out > 1).any() or (nb_in != nb_out).any():
-        return None
-    if opts.boundary == "edge_and_corner" and ((nb_out > 0) & (valence == 1)).any():
-        return None  # a one-face corner: sharp from level 1 on (a tagged level-1 mesh)
-    one = 1.0
-    fp = np.add.reduceat(X[idx], off, axis=0) / sizes[:, None] if m else np.zeros((0, 3))
-    # edge points
-    h1 = first[order]  # the first half-edge of every edge, in edge order
-    h2 = np.full(E, -1, dtype=np.int64)
-    second = np.flatnonzero(np.arange(H) != first[inv])
-    h2[he_edge[second]] = second
-    a, b = org[h1], dst[h1]
-    vw, fw = smooth_edge_weights(one)
-    ep = 0.5 * (X[a] + X[b])
-    inner = h2 >= 0
-    ep[inner] = vw * (X[a[inner]] + X[b[inner]]) + fw * (fp[face[h1[inner]]] + fp[face[h2[inner]]])
-    # vertex points
-    vp = np.empty((n, 3))
-    sum_e = np.stack([np.bincount(org, weights=X[dst, c], minlength=n) for c in range(3)], axis=1)
-    sum_f = np.stack([np.bincount(org, weights=fp[face, c], minlength=n) for c in range(3)], axis=1)
-    wv, we, wf = smooth_vertex_weights(valence, one)
-    vp[:] = wv[:, None] * X + we[:, None] * sum_e + wf[:, None] * sum_f
-    bv = np.flatnonzero(nb_out > 0)
-    if bv.size:
-        cw, ce = crease_vertex_weights(one)
-        bn = np.zeros((n, 3))
-        np.add.at(bn, org[bnd_h], X[dst[bnd_h]])
-        np.add.at(bn, dst[bnd_h], X[org[bnd_h]])
-        vp[bv] = cw * X[bv] + ce * bn[bv]
-    X1 = np.concatenate([vp, ep, fp])
-    F1 = np.stack([org, n + he_edge, n + E + face, n + he_edge[prv]], axis=1)
-    return X1, F1
 
+def _boundary_neighbours(mesh):
+    """For every boundary vertex its two boundary neighbours (e0 after it, e1 before it)."""
+    F = mesh.faces
+    org = F.reshape(-1)
+    dst = np.roll(F, -1, axis=1).reshape(-1)
+    bh = np.flatnonzero(mesh.twin < 0)
+    n = mesh.n_vertices
+    e0 = np.full(n, -1, dtype=np.int64)
+    e1 = np.full(n, -1, dtype=np.int64)
+    e0[org[bh]] = dst[bh]
+    e1[dst[bh]] = org[bh]
+    return e0, e1
+
+
+def _decrement(s):
+    if s <= 0.0:
+        return 0.0
+    if s >= INFINITE:
+        return math.inf
+    if s > 1.0:
+        return float(_F32(s) - _ONE)
+    return 0.0
+
+
+def _pair_keys(pairs, n):
+    p = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
+    return np.minimum(p[:, 0], p[:, 1]) * n + np.maximum(p[:, 0], p[:, 1])
+
+
+def _semi(x):
+    return (x > 0) & np.isfinite(x)
+
+
+def _fan_complex(mesh: QuadMesh, v, edge_sharpness, vertex_sharpness):
+    """The faces around ``v`` as a :class:`ccproof.mesh.rules.Complex` in local labels (``v`` is label 0),
+    with the sharpness of the edges at ``v`` and of ``v``; and the local -> global vertex map."""
+    from ccproof.mesh.rules import Complex, Options
+
+    c = mesh.fan_corners[mesh.fan_ptr[v]: mesh.fan_ptr[v] + mesh.face_count[v]]
+    F = mesh.faces[(c // 4)[:, None], ((c % 4)[:, None] + np.arange(4)[None, :]) % 4]  # each face from v
+    glob, loc = np.unique(F, return_inverse=True)
+    order = np.argsort(glob != v, kind="stable")  # v -> label 0
+    rank = np.empty_like(order)
+    rank[order] = np.arange(order.size)
+    faces = rank[loc.reshape(F.shape)]
+    gl = glob[order]
+    tags = {}
+    ekey = _pair_keys(np.c_[np.full(F.shape[0] * 2, v), np.r_[F[:, 1], F[:, 3]]], mesh.n_vertices)
+    allkey = _pair_keys(mesh.edges, mesh.n_vertices)
+    srt = np.argsort(allkey)
+    pos = srt[np.searchsorted(allkey[srt], ekey)]
+    for u, e in zip(np.r_[F[:, 1], F[:, 3]].tolist(), pos.tolist()):
+        s = float(edge_sharpness[e])
+        if s > 0 and not mesh.is_boundary_edge[e]:
+            lu = int(rank[np.searchsorted(glob, u)])
+            tags[(0, lu)] = s
+    vs = float(vertex_sharpness[v])
+    cx = Complex(faces.tolist(), tags, {0: vs} if vs > 0 else {}, Options(), level=1, n_vertices=gl.size)
+    return cx, gl
 
 def old_subdivision_matrix(mesh):
     F = mesh.faces
@@ -200,7 +188,6 @@ def _local_step_rows(mesh: QuadMesh, v, edge_sharpness, vertex_sharpness):
 def old_tagged_step(mesh: QuadMesh, edge_sharpness=None, vertex_sharpness=None):
     import scipy.sparse as sp
 
-    from ccproof.mesh.rules import _decrement
 
     if edge_sharpness is None:
         edge_sharpness, vertex_sharpness = tags_of(mesh)
@@ -273,16 +260,6 @@ def _dedup(M):
 
 
 # ------------------------------------------------------------------ the runs
-def operator_catmark_step(mesh):
-    """``catmark_step`` as a wrapper of the one operator: the same cases refused, then ``S @ X``."""
-    from ccproof.mesh.step import catmark_operator
-
-    if old_catmark_step(mesh) is None:
-        return None
-    st = catmark_operator(mesh.n_vertices, mesh.indices, mesh.sizes)
-    return st.S @ np.asarray(mesh.vertices, dtype=np.float64), st.faces
-
-
 def _icosphere(levels):
     """An icosphere: the icosahedron's triangles split ``levels`` times, projected to the sphere."""
     t = (1 + 5 ** 0.5) / 2
@@ -327,46 +304,26 @@ def _ab(name, old, new, rounds):
           f"  (load {min(loads):.1f}-{max(loads):.1f})", flush=True)
 
 
-def main():
+def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--rounds", type=int, default=7)
-    ap.add_argument("--tri-levels", type=int, default=4)
-    a = ap.parse_args()
-    import ccproof.evaluate.tagged as tagged
+    ap.add_argument("--smoke", action="store_true", help="one round on the smallest inputs (the test suite's run)")
+    a = ap.parse_args(argv)
     from ccproof.apps.control_mesh import tagged_step
-    from ccproof.evaluate._table import catmark_step
-    from ccproof.evaluate.surface import natural_limit_surface
-    from ccproof.mesh import PolyMesh, subdivision_matrix
+    from ccproof.mesh import subdivision_matrix
     from ccproof.mesh.io import read_mesh
 
-    V, F = _icosphere(a.tri_levels)
-    sphere = PolyMesh(V, F)
-    print(f"icosphere: {F.shape[0]:,} triangles; {os.cpu_count()} cpus; rounds {a.rounds}", flush=True)
-
-    def setup(path_or_mesh, step):
-        def run():
-            tagged.catmark_step = step
-            try:
-                natural_limit_surface(path_or_mesh, progress=False)
-            finally:
-                tagged.catmark_step = catmark_step
-        return run
-
-    files = [("bunny_quads", DATA / "meshes" / "bunny_quads.obj"),
-             ("cubes_infsharp", DATA / "osd_features" / "meshes" / "catmark_cubes_infsharp.obj"),
-             ("smoothtris1", DATA / "osd_features" / "meshes" / "catmark_smoothtris1.obj")]
-    for name, p in files + [(f"icosphere ({F.shape[0]:,} triangles)", sphere)]:
-        _ab(f"setup {name}", setup(p, catmark_step), setup(p, operator_catmark_step), a.rounds)
-    _ab("catmark_step icosphere", lambda: catmark_step(sphere), lambda: operator_catmark_step(sphere), a.rounds)
+    rounds = 1 if a.smoke else a.rounds
+    print(f"{os.cpu_count()} cpus; rounds {rounds}", flush=True)
     bunny = read_mesh(DATA / "meshes" / "bunny_quads.obj").to_quad_mesh()
-    b1 = subdivide(bunny)
-    _ab(f"subdivision_matrix bunny level 1 ({b1.n_faces:,} quads)", lambda: old_subdivision_matrix(b1),
-        lambda: subdivision_matrix(b1), a.rounds)
+    b1 = bunny if a.smoke else subdivide(bunny)
+    _ab(f"subdivision_matrix bunny level {0 if a.smoke else 1} ({b1.n_faces:,} quads)",
+        lambda: old_subdivision_matrix(b1), lambda: subdivision_matrix(b1), rounds)
     for name in ("catmark_cubes_infsharp", "catmark_pyramid_creases1"):
         m, _ = read_control_mesh(DATA / "osd_features" / "meshes" / f"{name}.obj")
         m = subdivide_control(subdivide_control(m))
         _ab(f"tagged_step {name} level 2 ({m.n_faces:,} quads)", lambda m=m: old_tagged_step(m),
-            lambda m=m: tagged_step(m), a.rounds)
+            lambda m=m: tagged_step(m), rounds)
 
 
 if __name__ == "__main__":

@@ -10,6 +10,8 @@ set, 20 s for the symbolic derivation).
 
 import argparse
 import importlib
+import os
+import sys
 import tempfile
 import time
 
@@ -18,6 +20,8 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--kmax", type=int, default=100)
     ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--smoke", action="store_true",
+                    help="k = 3 specialized exactly and in arb, 2 rounds in turn, no table set (the test suite's run)")
     args = ap.parse_args()
 
     import ccproof.algebra.characteristic_map as cm
@@ -31,6 +35,21 @@ def main():
 
     from ccproof.algebra.specialize import characteristic_map_patches
 
+    if args.smoke:
+        sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+        from _bench import load, ratio_line
+
+        ratios, loads = [], []
+        for r in range(2):
+            loads.append(load())
+            t = {}
+            for arith, prec in (("exact", 128), ("arb", 53)) if r % 2 == 0 else (("arb", 53), ("exact", 128)):
+                t0 = time.perf_counter()
+                characteristic_map_patches(3, "bezier", arith, prec)
+                t[arith] = time.perf_counter() - t0
+            ratios.append(t["exact"] / t["arb"])
+        print(ratio_line("specialize k = 3, exact/arb53:", ratios, loads))
+        return
     for k in (3, 7, 40):
         row = []
         for arith, prec in (("exact", 0), ("arb", 53), ("arb", 256), ("float", 53)):

@@ -8,7 +8,7 @@ and the template disk cache filled), then times ``--reps`` setups of each mesh i
 (``natural_limit_surface``, as ``ccproof eval`` builds a surface; the median is the round's time) and
 measures one more under ``tracemalloc`` (the peak of Python allocations during the setup, numpy's included);
 the same for ``build_tagged`` alone on the polygon meshes (the topology, the first step and the classification:
-the setup less the patch table's float data), and for ``catmark_step`` alone on the untagged icosphere.
+the setup less the patch table's float data).
 
 Meshes: ``catmark_cubes_infsharp`` (tagged quads, infinitely sharp creases) as read and refined twice
 (the tagged level-1 path on a bigger mesh), ``catmark_smoothtris1`` (tagged triangles), an icosphere of
@@ -18,10 +18,11 @@ loop and ``triangle_subdivision="smooth"``, one level coarser (tagged: the tagge
 
 ``--tables``: instead, whether both trees build the same patch tables, bit for bit (a SHA-256 of every array of
 ``PatchTable``), on every mesh of ``tests/data`` (``osd_features``, ``osd_nonmanifold``, ``meshes``) and on five
-feature meshes refined twice, with the compiled ring walk and with the Python walk; and whether the untagged step
-(``catmark_step``) gives the same bits on every polygon mesh of these without its tags.
+feature meshes refined twice. (The Python ring walk, chosen by assigning a private function, and the untagged step
+``catmark_step`` of a private module, alone, are no longer measured: the script uses public names only.)
 
 Usage: python scripts/bench_topology.py --old DIR --new DIR [--rounds 5] [--reps 3] [--tri-levels 4] [--tables]
+       python scripts/bench_topology.py --smoke     this tree against itself, tiny (the test suite's run)
 """
 
 from __future__ import annotations
@@ -29,12 +30,13 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import statistics
 import subprocess
 import sys
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO / "scripts"))
+from _bench import ratio_line  # noqa: E402
 
 WORKER = r"""
 import json, statistics, sys, time, tracemalloc
@@ -109,10 +111,6 @@ for name, m in meshes.items():
     out[name] = measure(lambda: natural_limit_surface(m, progress=False))
     if isinstance(m, PolyMesh):
         out[name + ": build_tagged"] = measure(lambda: build_tagged(m, False))
-    if isinstance(m, PolyMesh) and not m.has_tags and not m.is_all_quads:
-        from ccproof.evaluate._table import catmark_step
-
-        out[name + ": catmark_step"] = measure(lambda: catmark_step(m))
 print(json.dumps(out))
 """
 
@@ -124,13 +122,10 @@ import numpy as np
 sys.path.insert(0, sys.argv[1])
 import ccproof
 assert ccproof.__file__.startswith(sys.argv[1]), ccproof.__file__
-from ccproof.evaluate import _table
 from ccproof.evaluate.surface import LimitSurface
 from ccproof.mesh.io import read_mesh, read_obj_tagged
 
 data = Path(sys.argv[2])
-if sys.argv[3] == "python":
-    _table._ring_walks = lambda n: None
 feat = data / "osd_features" / "meshes"
 meshes = [(p.name, read_obj_tagged(p)) for p in sorted(feat.glob("*.obj"))]
 meshes += [(p.name, read_mesh(p)) for p in sorted((data / "osd_nonmanifold" / "meshes").iterdir())
@@ -142,36 +137,28 @@ for name in ("catmark_pyramid_creases1", "catmark_xord_boundary", "catmark_hole_
     meshes.append((name + " refined twice", m.refine(operator=False)[0].refine(operator=False)[0]))
 out = {}
 for name, m in meshes:
-    T = LimitSurface(m)._table
+    T = LimitSurface(m).patch_map.table  # the PatchTable (a NamedTuple: _fields is its public API)
     h = hashlib.sha256()
     for f in T._fields:
         a = getattr(T, f)
         h.update(f.encode())
         h.update(np.ascontiguousarray(a).tobytes() if isinstance(a, np.ndarray) else repr(a).encode())
     out[name] = h.hexdigest()
-from ccproof.evaluate._table import catmark_step
-from ccproof.mesh import PolyMesh
-
-for name, m in meshes:  # the untagged step on the polygons without their tags
-    if isinstance(m, PolyMesh):
-        r = catmark_step(PolyMesh(m.vertices, [list(q) for q in m.polygons]))
-        h = hashlib.sha256(b"None" if r is None else r[0].tobytes() + r[1].tobytes())
-        out["catmark_step " + name] = h.hexdigest()
 print(json.dumps(out))
 """
 
 
 def _tables(a):
-    for walk in ("compiled", "python"):
+    for walk in ("compiled",):
         res = []
         for tree in (a.old, a.new):
-            r = subprocess.run([sys.executable, "-c", TABLES, str(tree.resolve()), str(REPO / "tests" / "data"), walk],
+            r = subprocess.run([sys.executable, "-c", TABLES, str(tree.resolve()), str(REPO / "tests" / "data")],
                                capture_output=True, text=True, env=dict(os.environ, PYTHONPATH=str(tree)), cwd="/")
             if r.returncode:
                 sys.exit(f"{tree}: {r.stderr}")
             res.append(json.loads(r.stdout.strip().splitlines()[-1]))
         same = [k for k in res[0] if res[0][k] == res[1].get(k)]
-        print(f"{walk} walk: {len(same)} of {len(res[0])} patch tables and untagged steps the same bits"
+        print(f"{walk} walk: {len(same)} of {len(res[0])} patch tables the same bits"
               + ("" if len(same) == len(res[0]) else f"; different: {sorted(set(res[0]) - set(same))}"))
 
 
@@ -184,15 +171,22 @@ def _run(tree, a):
     return json.loads(r.stdout.strip().splitlines()[-1])
 
 
-def main():
+def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--old", required=True, type=Path)
-    ap.add_argument("--new", required=True, type=Path)
+    ap.add_argument("--old", type=Path)
+    ap.add_argument("--new", type=Path)
     ap.add_argument("--rounds", type=int, default=5)
     ap.add_argument("--reps", type=int, default=3)
     ap.add_argument("--tri-levels", type=int, default=4)
     ap.add_argument("--tables", action="store_true")
-    a = ap.parse_args()
+    ap.add_argument("--smoke", action="store_true",
+                    help="this tree against itself, one round, one setup, icosphere level 1 (the test suite's run)")
+    a = ap.parse_args(argv)
+    if a.smoke:
+        a.old = a.new = REPO
+        a.rounds, a.reps, a.tri_levels = 1, 1, 1
+    if a.old is None or a.new is None:
+        ap.error("--old and --new are required (or --smoke)")
     if a.tables:
         return _tables(a)
     res = {"old": [], "new": []}
@@ -204,16 +198,13 @@ def main():
         print(f"round {i + 1}/{a.rounds} done", file=sys.stderr, flush=True)
     print(f"{a.rounds} rounds, {a.reps} setups per process (median), load {min(loads):.1f}-{max(loads):.1f}; "
           f"{os.cpu_count()} cpus")
-    print(f"{'mesh':72s} {'old ms':>9s} {'new ms':>9s} {'new/old min med max':>22s} {'peak old MiB':>13s} "
-          f"{'new MiB':>8s}")
     for name in res["old"][0]:
         to = [r[name][0] for r in res["old"]]
         tn = [r[name][0] for r in res["new"]]
-        ratio = sorted(n / o for o, n in zip(to, tn))
         po = min(r[name][1] for r in res["old"]) / 2**20
         pn = min(r[name][1] for r in res["new"]) / 2**20
-        print(f"{name:72s} {min(to) * 1e3:9.1f} {min(tn) * 1e3:9.1f} "
-              f"{ratio[0]:7.2f}{statistics.median(ratio):7.2f}{ratio[-1]:7.2f} {po:13.2f} {pn:8.2f}")
+        print(f"{name}: old {min(to) * 1e3:.1f} ms, new {min(tn) * 1e3:.1f} ms; tracemalloc peak old {po:.2f} MiB, "
+              f"new {pn:.2f} MiB;  " + ratio_line("new/old", [n / o for o, n in zip(to, tn)], loads))
 
 
 if __name__ == "__main__":

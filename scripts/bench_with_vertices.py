@@ -11,8 +11,8 @@ tests/data/osd_features/meshes/catmark_helmet.obj refined twice with its tags (a
 semi-sharp creases) and tests/data/osd_nonmanifold/meshes/two_cubes_creases.obj refined twice
 (non-manifold, all quads).
 
-Also printed: the table's bytes per ptex face (less those held once per configuration) and, of them,
-the jobs' rings that ``with_vertices`` needs (kept on PolyMesh surfaces for it).
+Also printed: the table's bytes per ptex face (less those held once per configuration), and per mesh the ratio
+with_vertices / fresh build of each round (min, median, max; load).
 
 Usage: ``python scripts/bench_with_vertices.py [--rounds 5]``
 """
@@ -30,6 +30,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "scripts"))
 
+from _bench import load, ratio_line  # noqa: E402
 from bench_memory import icosphere  # noqa: E402
 
 from ccproof.evaluate import LimitSurface  # noqa: E402
@@ -44,9 +45,9 @@ def _rebuild(mesh, X):
                     options=mesh.options)
 
 
-def _meshes():
+def _meshes(smoke=False):
     out = {}
-    for L in (3, 4):
+    for L in (2,) if smoke else (3, 4):
         V, F = icosphere(L)
         out[f"icosphere{L} untagged ({F.shape[0]} tri)"] = PolyMesh(V, F)
         z = V[:, 2]
@@ -66,16 +67,20 @@ def _meshes():
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--rounds", type=int, default=5)
+    ap.add_argument("--smoke", action="store_true", help="2 rounds, icosphere level 2 (the test suite's run)")
     args = ap.parse_args(argv)
+    if args.smoke:
+        args.rounds = 2
     rng = np.random.default_rng(0)
-    for label, mesh in _meshes().items():
+    for label, mesh in _meshes(args.smoke).items():
         V = np.asarray(mesh.vertices)
         S = LimitSurface(mesh, progress=False)
         t = time.perf_counter()
         S.with_vertices(V + 1e-3 * rng.standard_normal(V.shape))
         first = time.perf_counter() - t
-        fresh, moved = [], []
+        fresh, moved, loads = [], [], []
         for _ in range(args.rounds):
+            loads.append(load())
             X = V + 1e-2 * rng.standard_normal(V.shape)
             t = time.perf_counter()
             LimitSurface(_rebuild(mesh, X), progress=False)
@@ -84,12 +89,13 @@ def main(argv=None):
             S.with_vertices(X)
             moved.append(time.perf_counter() - t)
         a, b = statistics.median(fresh), statistics.median(moved)
-        rings = sum(r.nbytes + j.nbytes for _, j, r in S._groups)  # what with_vertices needs kept
         P = S.n_faces
         print(f"{label}: fresh build {a * 1e3:.1f} ms, with_vertices {b * 1e3:.2f} ms (first {first * 1e3:.1f} ms), "
               f"ratio {a / b:.1f}x (medians of {args.rounds} interleaved rounds); table "
-              f"{(S.table_bytes - S.configuration_bytes) / P:.0f} bytes per ptex face beyond the configurations, "
-              f"of which the kept rings {rings / P:.0f}", flush=True)
+              f"{(S.table_bytes - S.configuration_bytes) / P:.0f} bytes per ptex face beyond the configurations",
+              flush=True)
+        print(ratio_line(f"{label}: with_vertices/fresh build", [y / x for x, y in zip(fresh, moved)], loads),
+              flush=True)
 
 
 if __name__ == "__main__":

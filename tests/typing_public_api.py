@@ -14,7 +14,9 @@ from numpy.typing import NDArray
 import ccproof
 from ccproof.apps.arap.core import MethodResult
 from ccproof.apps.dynamics.fit import FitResult
+from ccproof.evaluate import PatchTable
 from ccproof.evaluate.surface import LimitSurface
+from ccproof.reparam.surface import Parameterization
 from ccproof.tables.numeric import CharacteristicTable
 
 F64 = NDArray[np.float64]
@@ -37,3 +39,9 @@ def _public_api_types(quad: ccproof.QuadMesh, poly: ccproof.PolyMesh) -> None:
     assert_type(ccproof.limit_surface(poly), LimitSurface)
     assert_type(ccproof.parameterize(quad, variant="boundary"), MethodResult)
     assert_type(ccproof.fit_points(np.zeros((10, 3)), levels=0), FitResult)
+    assert_type(ccproof.limit_surface(quad), ccproof.LimitSurface)
+    assert_type(ccproof.LimitSurface(poly), LimitSurface)
+    assert_type(ccproof.Parameterization("vanishing", 2.5), Parameterization)
+    assert_type(ccproof.Parameterization("characteristic").kind, str)
+    assert_type(ccproof.PatchTable, type[PatchTable])
+    assert_type(ccproof.evaluate.PatchTable, type[PatchTable])

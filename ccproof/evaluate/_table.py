@@ -117,6 +117,17 @@ class PatchTable(NamedTuple):
         computed like the kernel computes them (the same sums in the same order), kept when they fit
         :data:`HOT_BUDGET`; empty otherwise. A uniformly random point of a corner face is in layer 0
         with probability 3/4.
+
+    Examples
+    --------
+    A surface's table is ``S.patch_map.table`` (:class:`ccproof.evaluate.patch_map.PatchMap`). The 5-regular
+    disk of two rings: 20 ptex faces, 10 stored regular patches (net and origin, 17 rows), 10 corner faces:
+
+    >>> from ccproof.evaluate import natural_limit_surface
+    >>> from ccproof.mesh.examples import k_regular_disk
+    >>> T = natural_limit_surface(k_regular_disk(5, 2)).patch_map.table
+    >>> T.top.shape, T.nets.shape, T.origin.shape
+    ((20, 4), (10, 17, 3), (10, 3))
     """
 
     top: np.ndarray

@@ -295,7 +295,7 @@ def test_a_forged_weight_is_caught(refdir):
 
 @pytest.mark.slow
 def test_bench_step_runs(capsys):
-    """Smoke test of scripts/bench_step.py (one round, a small icosphere): it prints every ratio."""
+    """Smoke test of scripts/bench_step.py (one round, the smallest inputs): it prints every ratio."""
     import importlib.util
     import sys
     from pathlib import Path
@@ -305,13 +305,13 @@ def test_bench_step_runs(capsys):
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)
     argv = sys.argv
-    sys.argv = ["bench_step.py", "--rounds", "1", "--tri-levels", "1"]
+    sys.argv = ["bench_step.py", "--smoke"]
     try:
         mod.main()
     finally:
         sys.argv = argv
     out = capsys.readouterr().out
-    assert out.count("new/old") == 8
+    assert out.count("new/old") == 3
 
 
 @pytest.mark.slow
@@ -351,7 +351,7 @@ def test_bench_refine_before_runs():
     p = subprocess.run([sys.executable, str(root / "scripts" / "bench_refine.py"), "--before", "HEAD", "--rounds", "1",
                         "--reps", "1", "--tri-levels", "2"], cwd=root, capture_output=True, text=True)
     assert p.returncode == 0, p.stderr + p.stdout
-    assert p.stdout.count("new/old") == 5 and p.stdout.count("tracemalloc peak") == 5
+    assert p.stdout.count("new/old") == 4 and p.stdout.count("tracemalloc peak") == 4
 
 
 def test_pack_csr_restores_the_bits():
