@@ -19,8 +19,8 @@ fit a surface to points             :func:`fit_points` (qmv98)
 errors                              :class:`CCProofError` and subclasses; the verifier's own :class:`CertificateError`
 ==================================  ======================================================================
 
-The error types and :class:`Valence` use only the standard library and are imported eagerly; the
-others load on first use (PEP 562), because importing numpy, scipy and numba costs ~0.5 s and
+Every name loads on first use (PEP 562): the verifier's import loads nothing of ccproof outside the
+trusted base (docs/trusted_base.md), and importing numpy, scipy and numba costs ~0.5 s and
 ``ccproof --help`` must start in < 0.3 s (``python -X importtime -c 'import ccproof'``: 2 ms with
 this lazy table, ~1 s if it were eager; see scripts/bench_reparam.py).
 
@@ -36,9 +36,6 @@ the certified tables; ``apps`` and the command line on top.
 from importlib import import_module
 from typing import TYPE_CHECKING
 
-from ccproof.errors import CCProofError, MeshError, TableNotFoundError, ValenceError
-from ccproof.valence import Valence, parse_valence
-
 if TYPE_CHECKING:  # the lazy names of _LAZY below, seen by type checkers (mypy in .ci/run) as what they are
     from ccproof.apps.arap.core import parameterize
     from ccproof.apps.arap.export import write_uv_mesh
@@ -47,6 +44,7 @@ if TYPE_CHECKING:  # the lazy names of _LAZY below, seen by type checkers (mypy 
     from ccproof.certify.verify import verify_file
     from ccproof.certify.verify.errors import CertificateError
     from ccproof.certify.verify.record import VerifyResult
+    from ccproof.errors import CCProofError, MeshError, TableNotFoundError, ValenceError
     from ccproof.evaluate import LimitSurface, PatchTable
     from ccproof.inverse.algorithm import inverse_characteristic_map
     from ccproof.inverse.forward import characteristic_map
@@ -54,11 +52,14 @@ if TYPE_CHECKING:  # the lazy names of _LAZY below, seen by type checkers (mypy 
     from ccproof.reparam.surface import Parameterization, limit_surface
     from ccproof.tables.build import build_table
     from ccproof.tables.numeric import load_table
+    from ccproof.valence import Valence, parse_valence
 
 __version__ = "0.1.0"
 
 #: lazily loaded public names -> defining module
 _LAZY = {
+    **dict.fromkeys(("CCProofError", "MeshError", "TableNotFoundError", "ValenceError"), "ccproof.errors"),
+    **dict.fromkeys(("Valence", "parse_valence"), "ccproof.valence"),
     "load_table": "ccproof.tables.numeric",
     "build_table": "ccproof.tables.build",
     "prove_valence": "ccproof.certify.prover",
@@ -112,8 +113,7 @@ __all__ = [
     "write_uv_mesh",
 ]
 
-_EAGER = {"CCProofError", "MeshError", "TableNotFoundError", "ValenceError", "Valence", "parse_valence"}
-assert set(__all__) == _EAGER | set(_LAZY)
+assert set(__all__) == set(_LAZY)
 
 
 def __getattr__(name: str) -> object:
