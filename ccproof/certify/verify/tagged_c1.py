@@ -37,6 +37,10 @@ a degenerate net: for every net whose lam1-, lam2- and gamma-coefficients a1, a2
 independent the same leading terms give the same contradiction (docs/tagged_c1.md), an open dense set
 of nets.
 
+Two witnesses beyond that generic pair, part G of each in :mod:`.tagged_refute`: a dart's flip (x, y and a
+quadrant; alpha beta < 0, part F: J_xy != 0, the normal changes sign with every level) and a Jordan chain
+(N < 5: y a generalized eigenvector of beta = gamma, part N on J_xe with e = (S - beta) y).
+
 A ``"C1"`` certificate (the generalized Reif criterion for a sector): the spectral part
 (:func:`.tagged.leading_spectrum`: 1 simple, lam1 >= lam2 > |others| real and non-defective), a tangent
 plane that sees the crease (lam1 or lam2 an eigenvalue of the crease block), the eigenvectors x of lam1
