@@ -14,7 +14,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from flint import ctx, fmpq, fmpq_mat
+from flint import ctx, fmpq, fmpq_mat, fmpq_poly
 
 from ccproof.certify.verify import TAGGED_SCHEMA, verify_certificate
 from ccproof.certify.verify.tagged import (
@@ -200,7 +200,7 @@ def witness_candidates(name, prec=DEFAULT_PREC):
     """
     fam, n = parse_configuration(name)
     if fam == "dart":
-        return []
+        return _flip_candidates(n, prec)
     pts = labels(fam, n)
     modes = n >= MIN_N  # the verifier's closed forms: no exact spectrum, no pivot search
     inner = _mode_candidates(fam, n, prec) if modes else _interior_candidates(fam, n, prec)
@@ -229,10 +229,31 @@ def witness_candidates(name, prec=DEFAULT_PREC):
         half = [(g, v) for g, v in creases if g == fmpq(1, 2)]
         if x and len(half) >= 2:
             for (g1, v1), (g2, v2) in ((half[0], half[1]), (half[1], half[0])):
-                for r in sharp_rays(fam, n):
-                    out.append({"x": x, "y": rat(g1, v1), "z": rat(g2, v2), "ray": r})
+                # z: the other ray's tangent; or, where y has no eigenvector (a Jordan chain at 1/2, corner:4),
+                # the combinations of both rays' tangents that lift to one
+                for zv in (v2, [a + b for a, b in zip(v1, v2)], [b - a for a, b in zip(v1, v2)]):
+                    out += [{"x": x, "y": rat(g1, v1), "z": rat(g2, zv), "ray": r} for r in sharp_rays(fam, n)]
     del pts
     return out
+
+
+def _flip_candidates(k, prec):
+    """A dart's witness (x, y): the two eigenvalues below 1 largest in modulus, when real and simple, with
+    intervals and pivots (floats choose; the verifier decides whether their signs differ)."""
+    if k >= MIN_N:
+        return []
+    ev = eigenvalues("dart", k, prec)
+    rest = sorted((i for i, t in enumerate(ev) if t[1] != fmpq_poly([-1, 1])),
+                  key=lambda i: -float(abs(ev[i][0]).mid()))
+    coords = []
+    for i in rest[:2]:
+        z = ev[i][0]
+        pv = _pivot("dart", k, z, prec) if z.imag.is_zero() and ev[i][2] == 1 else None
+        if pv is None:
+            return []
+        coords.append({"eigenvalue": _interval(z, [t[0] for j, t in enumerate(ev) if j != i]), "crease": [],
+                       "pivot": pv})
+    return [{"x": coords[0], "y": coords[1]}]
 
 
 def _decimal_exact(q):
@@ -285,6 +306,8 @@ def prove_tagged(name, prec=DEFAULT_PREC):
         return prove_dart_tail(name, prec)
     if isinstance(n, dict):
         return prove_tagged_limit(name, prec)
+    if fam == "dart" and n >= MIN_N:  # no flip (lam1 > lam2 > 0): the C1 route decides these
+        return None, f"undecided: a dart's witness is checked for K < {MIN_N} only"
     why = []
     for w in witness_candidates(name, prec):
         for q in range(n):
@@ -292,13 +315,12 @@ def prove_tagged(name, prec=DEFAULT_PREC):
                     "witness": dict(w, quadrant=q)}
             res = verify_certificate(cert, log=lambda line: None)
             if res:
-                return cert, f"not C1 (witness: ray {w['ray']}, quadrant {q})"
+                ray = f"ray {w['ray']}, " if "ray" in w else ""
+                return cert, f"not C1 (witness: {ray}quadrant {q})"
             why += [f"{p.name.split(':')[0]}: {p.message}" for p in res.failures()][:1]
-            if not any(p.name.startswith("N ") for p in res.failures()):
+            if not any(p.name.startswith(("N ", "F ")) for p in res.failures()):
                 break  # only the normal depends on the quadrant
     witness = f"; no witness ({why[0]})" if why else "; no witness candidate"
-    if fam == "dart":
-        return None, "undecided: no witness form for darts"
     return None, f"undecided: {leading_spectrum(fam, n, prec)[1]}{witness}"
 
 

@@ -37,6 +37,10 @@ a degenerate net: for every net whose lam1-, lam2- and gamma-coefficients a1, a2
 independent the same leading terms give the same contradiction (docs/tagged_c1.md), an open dense set
 of nets.
 
+Two witnesses beyond that generic pair, part G of each in :mod:`.tagged_refute`: a dart's flip (x, y and a
+quadrant; alpha beta < 0, part F: J_xy != 0, the normal changes sign with every level) and a Jordan chain
+(N < 5: y a generalized eigenvector of beta = gamma, part N on J_xe with e = (S - beta) y).
+
 A ``"C1"`` certificate (the generalized Reif criterion for a sector): the spectral part
 (:func:`.tagged.leading_spectrum`: 1 simple, lam1 >= lam2 > |others| real and non-defective), a tangent
 plane that sees the crease (lam1 or lam2 an eigenvalue of the crease block), the eigenvectors x of lam1
@@ -46,7 +50,7 @@ sector (:func:`.tagged_map.check_map` on the boxes of ``parts``; docs/tagged_c1.
 
 from __future__ import annotations
 
-from flint import arb, arb_mat, ctx, fmpq, fmpq_mat, fmpq_poly
+from flint import arb, arb_mat, ctx, fmpq, fmpq_mat
 
 from .errors import CertificateError
 from .record import exact_keys, field_of
@@ -64,6 +68,7 @@ from .tagged import (
 )
 from .tagged_map import check_map
 from .tagged_modes import MIN_N, even_vector, mode_spectrum, mode_vector
+from .tagged_refute import chain_generic, chain_top, flip_generic, mode_generic, ordering, same_root
 
 TAGGED_SCHEMA = "ccproof.tagged-c1/1"
 STATEMENTS = ("C1", "not C1")
@@ -117,67 +122,42 @@ def verify_tagged(cert, part, log):
     rows = sector_rows(fam, n)
     ok = all(sum(row.values(), fmpq(0)) == 1 for row in rows)
     part("S sector matrix derived from the rules", ok, f"{len(rows)} points, rows sum to 1 (exact)")
-    if statement == "C1" and fam == "dart" and n >= MIN_N:  # the odd half through the modes (tagged_modes)
-        with ctx.workprec(prec):
-            _verify_dart_c1(cert, n, prec, part)
-        return name
-    if statement == "C1":
-        ok, msg, lead = leading_spectrum(fam, n, prec)
-        part("spectral part of the generalized Reif criterion", ok, msg)
-        if ok and fam != "dart":
-            cpoly = crease_block(fam, n).charpoly()
-            ok = any(t[1].gcd(cpoly).degree() > 0 for t in lead[1:3])
-            part("the tangent plane sees the crease: lam1 or lam2 is an eigenvalue of the crease block", ok,
-                 "" if ok else "both eigenvectors vanish on the crease points, so the characteristic map "
-                 "sends the sharp edges to v (not injective)")
-        if part.failed:
-            return name
-        mp, orient = _map_field(cert)
-        with ctx.workprec(prec):
-            vecs, vals = {}, {}
-            for c, t in (("x", lead[1]), ("y", lead[2])):
-                val, vec, msg = eigenvector_of(fam, n, field_of(mp, c, dict, "map"), c, prec)
-                ok = vec is not None and _same(t, val)
-                part(f"{c}: eigenvector of lam{'1' if c == 'x' else '2'}", ok,
-                     msg if vec is not None and ok else msg if vec is None else "not the eigenvalue of lam1 / lam2")
-                if not ok:
-                    return name
-                vals[c], vecs[c] = val, vec
-            check_map(fam, n, vecs["x"], vecs["y"], vals["x"], vals["y"], orient,
-                      field_of(cert, "parts", dict, "certificate"), prec, part)
-        return name
-    if fam == "dart":
-        raise CertificateError("witnesses are defined for crease and corner sectors only")
-    w = field_of(cert, "witness", dict, "certificate")
-    exact_keys(w, ("x", "y", "z", "ray", "quadrant"), "witness")
-    r, q = field_of(w, "ray", int, "witness"), field_of(w, "quadrant", int, "witness")
-    if r not in sharp_rays(fam, n) or not 0 <= q < n:
-        raise CertificateError(f"witness: ray {r} is not sharp or quadrant {q} outside 0..{n - 1}")
-    if n >= MIN_N:  # the spectrum and the eigenvectors through the sine modes (tagged_modes), O(N)
-        with ctx.workprec(prec):
-            _verify_witness_modes(fam, n, w, r, q, part, log)
-        return name
     with ctx.workprec(prec):
-        vecs, vals = {}, {}
-        for c in ("x", "y", "z"):
-            val, vec, msg = eigenvector_of(fam, n, field_of(w, c, dict, "witness"), c, prec, c == "z")
-            part(f"{c}: {'(generalized) ' if c == 'z' else ''}eigenvector of S", vec is not None, msg)
-            if vec is None:
-                return name
-            vals[c], vecs[c] = val, vec
-        ok, msg = _ordering(fam, n, vals["x"], vals["y"], vals["z"], prec, "generalized" in msgs_z(part))
-        part("G generic: alpha = lam1, beta = lam2, gamma = the crease block's largest eigenvalue below 1; "
-             "no Jordan block at |lam| >= beta; gamma < beta for a generalized z", ok, msg)
-        if not ok:
-            return name
-        _check_boundary(fam, n, r, vecs, part)
-        J = _jacobian(fam, n, q, vecs["x"], vecs["y"])
-        ok = J > 0 or J < 0
-        part(f"N normal at vertex (1,1) of quadrant {q}: J_xy != 0", ok, f"J_xy = {J.str(6)}")
-        if not part.failed:
-            log(f"  the limit surface of this net is not C1 at the {fam} vertex: normals along the level-m "
-                f"copies of quadrant {q}'s (1,1) tend to n_z != 0, yet e_z lies in T_v (ray {r})")
+        if statement == "C1" and fam == "dart" and n >= MIN_N:  # the odd half through the modes (tagged_modes)
+            _verify_dart_c1(cert, n, prec, part)
+        elif statement == "C1":
+            _verify_c1(cert, fam, n, prec, part)
+        elif fam == "dart":
+            _verify_flip(field_of(cert, "witness", dict, "certificate"), n, prec, part, log)
+        else:
+            _verify_witness(field_of(cert, "witness", dict, "certificate"), fam, n, prec, part, log)
     return name
+
+
+def _verify_c1(cert, fam, n, prec, part):
+    """A "C1" certificate on the exact spectrum: the spectral part, the crease seen, x and y, the map."""
+    ok, msg, lead = leading_spectrum(fam, n, prec)
+    part("spectral part of the generalized Reif criterion", ok, msg)
+    if ok and fam != "dart":
+        cpoly = crease_block(fam, n).charpoly()
+        ok = any(t[1].gcd(cpoly).degree() > 0 for t in lead[1:3])
+        part("the tangent plane sees the crease: lam1 or lam2 is an eigenvalue of the crease block", ok,
+             "" if ok else "both eigenvectors vanish on the crease points, so the characteristic map "
+             "sends the sharp edges to v (not injective)")
+    if part.failed:
+        return
+    mp, orient = _map_field(cert)
+    vecs, vals = {}, {}
+    for c, t in (("x", lead[1]), ("y", lead[2])):
+        val, vec, msg = eigenvector_of(fam, n, field_of(mp, c, dict, "map"), c, prec)
+        ok = vec is not None and same_root(t, val)
+        part(f"{c}: eigenvector of lam{'1' if c == 'x' else '2'}", ok,
+             msg if vec is None or ok else "not the eigenvalue of lam1 / lam2")
+        if not ok:
+            return
+        vals[c], vecs[c] = val, vec
+    check_map(fam, n, vecs["x"], vecs["y"], vals["x"], vals["y"], orient,
+              field_of(cert, "parts", dict, "certificate"), prec, part)
 
 
 def _map_field(cert):
@@ -193,11 +173,19 @@ def _where(t):
     return f"mode {t[3]}" if t[3] else "even"
 
 
-def _verify_dart_c1(cert, k, prec, part):
-    """A dart's "C1" certificate, K >= MIN_N: the spectral part from :func:`.tagged_modes.mode_spectrum`
-    (every eigenvalue enclosed, S_E's exactly, the odd half's through the modes), lam1 and lam2 each
-    isolated (so simple), x and y in closed form (odd) or from S_E (even), then the map's parts."""
-    ev = mode_spectrum("dart", k)
+def _isolated(ev, lo_hi, c):
+    """The index of the one entry of ``ev`` certainly inside the decimal interval [low, high] with no
+    other entry touching it, else None."""
+    if len(lo_hi) != 2:
+        raise CertificateError(f"{c}: the eigenvalue must be [low, high]")
+    lo, hi = parse_decimal(lo_hi[0]), parse_decimal(lo_hi[1])
+    inside = [j for j, t in enumerate(ev) if t[0].real > lo and t[0].real < hi]
+    near = [j for j, t in enumerate(ev) if t[0].real.overlaps(arb(lo).union(arb(hi)))]
+    return inside[0] if len(inside) == 1 and near == inside else None
+
+
+def _dart_leading(k, ev):
+    """(i1, i2, why): a dart's lam1 and lam2 in the mode list, why None when the spectral part holds."""
     one = [i for i, t in enumerate(ev) if not abs(t[0]) < 1]
     rest = sorted((i for i in range(len(ev)) if i not in one), key=lambda i: -abs(ev[i][0]).mid())
     i1, i2 = rest[0], rest[1]
@@ -207,187 +195,203 @@ def _verify_dart_c1(cert, k, prec, part):
                z.imag.is_zero() and z.real > 0 for z in (l1, l2)) else
            "lam1 > lam2 is not certain" if not l1.real > l2.real else
            "|lam3| is not certainly below lam2" if not all(abs(ev[i][0]) < l2.real for i in rest[2:]) else None)
-    part("spectral part of the generalized Reif criterion", why is None,
-         f"dart:{k}: 1 simple; lam1 = {l1.real.str(5, radius=False)} ({_where(ev[i1])}) > lam2 = "
-         f"{l2.real.str(5, radius=False)} ({_where(ev[i2])}), each simple"
-         f" > |lam3| = {abs(ev[rest[2]][0]).str(5, radius=False)}" if why is None else f"dart:{k}: {why}")
+    msg = (f"dart:{k}: 1 simple; lam1 = {l1.real.str(5, radius=False)} ({_where(ev[i1])}) > lam2 = "
+           f"{l2.real.str(5, radius=False)} ({_where(ev[i2])}), each simple"
+           f" > |lam3| = {abs(ev[rest[2]][0]).str(5, radius=False)}" if why is None else f"dart:{k}: {why}")
+    return i1, i2, why, msg
+
+
+def _dart_vector(k, ev, i, spec, c):
+    """(vector or None, message): the eigenvector of the mode-list entry i, normalized at the pivot."""
+    exact_keys(spec, ("eigenvalue", "crease", "pivot"), c)
+    lo_hi, pivot = field_of(spec, "eigenvalue", list, c), field_of(spec, "pivot", int, c)
+    if field_of(spec, "crease", list, c) or not 0 <= pivot < len(ev):
+        raise CertificateError(f"{c}: a dart's coordinate is an interval, crease [] and a pivot 0..{len(ev) - 1}")
+    lam, which = ev[i][0].real, f"lam{'1' if c == 'x' else '2'}"
+    if _isolated(ev, lo_hi, c) != i:
+        return None, f"[{lo_hi[0]}, {lo_hi[1]}] does not isolate {which}: not the eigenvalue of lam1 / lam2"
+    vec, how = None, "even: the bordered system on S_E proved regular"
+    if ev[i][3] is not None:  # odd: closed form, normalized at the pivot
+        f = mode_vector("dart", k, ev[i][3], lam)
+        if f is not None and abs(f[pivot]) > 0:
+            vec = [v if isinstance(v, fmpq) else (v / f[pivot]).real for v in f]
+        how = f"closed form in mode {ev[i][3]} (odd)"
+    else:
+        try:
+            vec = even_vector(k, lam, pivot)
+        except ZeroDivisionError:
+            pass
+    if vec is None:
+        return None, (f"the eigenvector is not certainly non-zero at the pivot {pivot} (or its system not "
+                      "certainly regular)")
+    return vec, f"eigenvalue {lam.str(10)}, simple; {how}, pivot {labels('dart', k)[pivot]}"
+
+
+def _verify_dart_c1(cert, k, prec, part):
+    """A dart's "C1" certificate, K >= MIN_N: the spectral part from :func:`.tagged_modes.mode_spectrum`
+    (every eigenvalue enclosed, S_E's exactly, the odd half's through the modes), lam1 and lam2 each
+    isolated (so simple), x and y in closed form (odd) or from S_E (even), then the map's parts."""
+    ev = mode_spectrum("dart", k)
+    i1, i2, why, msg = _dart_leading(k, ev)
+    part("spectral part of the generalized Reif criterion", why is None, msg)
     if why is not None:
         return
     mp, orient = _map_field(cert)
     vecs = {}
     for c, i in (("x", i1), ("y", i2)):
-        spec = field_of(mp, c, dict, "map")
-        exact_keys(spec, ("eigenvalue", "crease", "pivot"), c)
-        lo_hi, pivot = field_of(spec, "eigenvalue", list, c), field_of(spec, "pivot", int, c)
-        if field_of(spec, "crease", list, c) or len(lo_hi) != 2 or not 0 <= pivot < len(ev):
-            raise CertificateError(f"{c}: a dart's coordinate is an interval, crease [] and a pivot 0..{len(ev) - 1}")
-        lo, hi = parse_decimal(lo_hi[0]), parse_decimal(lo_hi[1])
-        inside = [j for j, t in enumerate(ev) if t[0].real > lo and t[0].real < hi]
-        near = [j for j, t in enumerate(ev) if t[0].real.overlaps(arb(lo).union(arb(hi)))]
-        lam = ev[i][0].real
-        if inside != [i] or near != [i]:
-            part(f"{c}: eigenvector of lam{'1' if c == 'x' else '2'}", False,
-                 f"[{lo}, {hi}] does not isolate lam{'1' if c == 'x' else '2'}: not the eigenvalue of lam1 / lam2")
+        vecs[c], msg = _dart_vector(k, ev, i, field_of(mp, c, dict, "map"), c)
+        part(f"{c}: eigenvector of lam{'1' if c == 'x' else '2'}", vecs[c] is not None, msg)
+        if vecs[c] is None:
             return
-        if ev[i][3] is not None:  # odd: closed form, normalized at the pivot
-            f = mode_vector("dart", k, ev[i][3], lam)
-            ok = f is not None and abs(f[pivot]) > 0
-            vec = [v if isinstance(v, fmpq) else (v / f[pivot]).real for v in f] if ok else None
-            how = f"closed form in mode {ev[i][3]} (odd)"
-        else:
-            try:
-                vec, how = even_vector(k, lam, pivot), "even: the bordered system on S_E proved regular"
-            except ZeroDivisionError:
-                vec = None
-        part(f"{c}: eigenvector of lam{'1' if c == 'x' else '2'}", vec is not None,
-             f"eigenvalue {lam.str(10)}, simple; {how}, pivot {labels('dart', k)[pivot]}" if vec is not None else
-             f"the eigenvector is not certainly non-zero at the pivot {pivot} (or its system not certainly regular)")
-        if vec is None:
-            return
-        vecs[c] = vec
-    check_map("dart", k, vecs["x"], vecs["y"], l1.real, l2.real, orient, field_of(cert, "parts", dict, "certificate"),
-              prec, part)
+    check_map("dart", k, vecs["x"], vecs["y"], ev[i1][0].real, ev[i2][0].real, orient,
+              field_of(cert, "parts", dict, "certificate"), prec, part)
 
 
-def _verify_witness_modes(fam, n, w, r, q, part, log):
-    """The parts of a "not C1" witness for crease:N, corner:N, N >= MIN_N, from :mod:`.tagged_modes`:
-    x and y eigenvectors of simple mode roots (closed form), z's existence from its crease values, G, B, N."""
+def _verify_flip(w, k, prec, part, log):
+    """A dart's "not C1" witness (x, y, quadrant; :mod:`.tagged_refute`): x, y eigenvectors of simple
+    eigenvalues of opposite signs leading the spectrum, and J_xy != 0: the normal flips at every level."""
+    exact_keys(w, ("x", "y", "quadrant"), "witness")
+    q = field_of(w, "quadrant", int, "witness")
+    if not 0 <= q < k:
+        raise CertificateError(f"witness: quadrant {q} outside 0..{k - 1}")
+    if k >= MIN_N:
+        part("x: eigenvector of S", False, f"a dart's witness is checked on the exact spectrum, K < {MIN_N} only")
+        return
+    vecs, vals = {}, {}
+    for c in ("x", "y"):
+        vals[c], vecs[c], msg = eigenvector_of("dart", k, field_of(w, c, dict, "witness"), c, prec)
+        part(f"{c}: eigenvector of S", vecs[c] is not None, msg)
+        if vecs[c] is None:
+            return
+    ok, msg = flip_generic(k, vals["x"], vals["y"], prec)
+    part("G generic: alpha, beta simple, of opposite signs, each larger in modulus than every other eigenvalue "
+         "but 1 (simple)", ok, msg)
+    if not ok:
+        return
+    J = _jacobian("dart", k, q, vecs["x"], vecs["y"])
+    ok = J > 0 or J < 0
+    part(f"F flip at vertex (1,1) of quadrant {q}: J_xy != 0, so the normal there is (alpha beta)^m J_xy e_z + "
+         "o(|alpha beta|^m)", ok, f"J_xy = {J.str(6)}")
+    if ok:
+        log(f"  the limit surface of this net is not C1 at the dart vertex: the unit normals at the level-m copies "
+            f"of quadrant {q}'s (1,1) tend to (-1)^m sign(J_xy) e_z (no limit; the projection folds)")
+
+
+def _verify_witness(w, fam, n, prec, part, log):
+    """A crease or corner "not C1" witness: x, y, z, G, then B and N (module docstring)."""
+    exact_keys(w, ("x", "y", "z", "ray", "quadrant"), "witness")
+    r, q = field_of(w, "ray", int, "witness"), field_of(w, "quadrant", int, "witness")
+    if r not in sharp_rays(fam, n) or not 0 <= q < n:
+        raise CertificateError(f"witness: ray {r} is not sharp or quadrant {q} outside 0..{n - 1}")
+    if n >= MIN_N:  # the spectrum and the eigenvectors through the sine modes (tagged_modes), O(N)
+        got = _witness_modes(fam, n, w, part)
+    else:
+        got = _witness_exact(fam, n, w, prec, part)
+    if got is None:
+        return
+    vecs, second, label = got
+    _check_boundary(fam, n, r, vecs, part)
+    J = _jacobian(fam, n, q, vecs["x"], second)
+    ok = J > 0 or J < 0
+    part(f"N normal at vertex (1,1) of quadrant {q}: {label} != 0", ok, f"{label} = {J.str(6)}")
+    if not part.failed:
+        log(f"  the limit surface of this net is not C1 at the {fam} vertex: normals along the level-m "
+            f"copies of quadrant {q}'s (1,1) tend to n_z != 0, yet e_z lies in T_v (ray {r})")
+
+
+_G = ("G generic: alpha = lam1, beta = lam2, gamma = the crease block's largest eigenvalue below 1; "
+      "no Jordan block at |lam| >= beta; gamma < beta for a generalized z")
+
+
+def _witness_exact(fam, n, w, prec, part):
+    """Parts x, y, z and G on the exact spectrum (N < MIN_N); (vectors, the vector paired with x in
+    part N, its name) or None. A generalized y (a Jordan chain at beta) pairs x with its top
+    e = (S - beta) y (:func:`.tagged_refute.chain_generic`)."""
+    vecs, vals, tops = {}, {}, {}
+    for c in ("x", "y", "z"):
+        vals[c], vecs[c], msg = eigenvector_of(fam, n, field_of(w, c, dict, "witness"), c, prec, c != "x")
+        tops[c] = None if vecs[c] is None else chain_top(fam, n, vals[c], vecs[c])
+        part(f"{c}: {'(generalized) ' if c == 'z' or tops[c] else ''}eigenvector of S", vecs[c] is not None, msg)
+        if vecs[c] is None:
+            return None
+    if tops["y"] is not None:
+        ok, msg = chain_generic(fam, n, vals, tops, prec)
+        part("G generic (Jordan chain): alpha = lam1 simple > beta = gamma, the crease block's largest eigenvalue "
+             "below 1; Jordan blocks at beta of size <= 2, y's chain tops at e; every other |lam| < beta", ok, msg)
+        return (vecs, tops["y"], "J_xe") if ok else None
+    ok, msg = ordering(fam, n, vals["x"], vals["y"], vals["z"], prec, tops["z"] is not None)
+    part(_G, ok, msg)
+    return (vecs, vecs["y"], "J_xy") if ok else None
+
+
+def _witness_modes(fam, n, w, part):
+    """Parts x, y, z and G for crease:N, corner:N, N >= MIN_N, from :mod:`.tagged_modes`: x and y
+    eigenvectors of simple mode roots (closed form), z's existence from its crease values."""
     ev = mode_spectrum(fam, n)
     vecs, at = {}, {}
     for c in ("x", "y"):
-        spec = field_of(w, c, dict, "witness")
-        exact_keys(spec, ("eigenvalue", "crease", "pivot"), c)
-        crease, lo_hi = field_of(spec, "crease", list, c), field_of(spec, "eigenvalue", list, c)
-        if len(crease) != 5 or len(lo_hi) != 2:
-            raise CertificateError(f"{c}: crease values must be 5 decimals and the eigenvalue [low, high]")
-        if any(parse_decimal(v) != 0 for v in crease):
-            part(f"{c}: eigenvector of S", False,
-                 "an irrational eigenvalue's eigenvector vanishes on the crease points")
-            return
-        lo, hi = parse_decimal(lo_hi[0]), parse_decimal(lo_hi[1])
-        inside = [i for i, t in enumerate(ev) if t[0].real > lo and t[0].real < hi]
-        near = [i for i, t in enumerate(ev) if t[0].real.overlaps(arb(lo).union(arb(hi)))]
-        i = inside[0] if len(inside) == 1 and near == inside else None
-        if i is None or not ev[i][0].imag.is_zero() or ev[i][3] is None:
-            part(f"{c}: eigenvector of S", False, f"[{lo}, {hi}] does not isolate one simple real root of a mode")
-            return
-        pivot = field_of(spec, "pivot", int, c)
-        if not 0 <= pivot < len(ev) or pivot in crease_points(fam, n):
-            raise CertificateError(f"{c}: pivot must index a non-crease point")
-        f = mode_vector(fam, n, ev[i][3], ev[i][0].real)
-        if f is None:
-            part(f"{c}: eigenvector of S", False, "no pivot makes the bordered 6 x 6 system certainly regular")
-            return
-        if not abs(f[pivot]) > 0:
-            part(f"{c}: eigenvector of S", False, f"the eigenvector is not certainly non-zero at the pivot {pivot}")
-            return
-        vecs[c] = [v if isinstance(v, fmpq) else (v / f[pivot]).real for v in f]
-        at[c] = i
-        part(f"{c}: eigenvector of S", True, f"eigenvalue {ev[i][0].real.str(10)} = lam(cos({ev[i][3]} pi/{n})), "
-             f"simple; closed form in mode {ev[i][3]} (the bordered 6 x 6 system proved regular), pivot "
-             f"{labels(fam, n)[pivot]}")
-    spec = field_of(w, "z", dict, "witness")
+        at[c], vecs[c] = _mode_coordinate(fam, n, ev, field_of(w, c, dict, "witness"), c, part)
+        if vecs[c] is None:
+            return None
+    gz = _mode_z(fam, n, ev, field_of(w, "z", dict, "witness"), part)
+    if gz is None:
+        return None
+    g, cval = gz
+    ia, ib = at["x"], at["y"]
+    beta = ev[ib][0].real
+    why = mode_generic(ev, ia, ib, g)
+    part(_G, why is None, f"alpha = {ev[ia][0].real.str(8)} > beta = {beta.str(8)} > |every other| (each simple), "
+         f"1 simple; gamma = {g} < beta" if why is None else why)
+    if why is not None:
+        return None
+    cp = crease_points(fam, n)
+    vecs["z"] = [cval[cp.index(i)] if i in cp else None for i in range(len(ev))]  # B reads the crease points only
+    return vecs, vecs["y"], "J_xy"
+
+
+def _mode_coordinate(fam, n, ev, spec, c, part):
+    """(index in the mode list, closed-form eigenvector) of x or y, or (None, None) with a failed part."""
+    exact_keys(spec, ("eigenvalue", "crease", "pivot"), c)
+    crease, lo_hi = field_of(spec, "crease", list, c), field_of(spec, "eigenvalue", list, c)
+    if len(crease) != 5 or len(lo_hi) != 2:
+        raise CertificateError(f"{c}: crease values must be 5 decimals and the eigenvalue [low, high]")
+    i = _isolated(ev, lo_hi, c)
+    why = ("an irrational eigenvalue's eigenvector vanishes on the crease points"
+           if any(parse_decimal(v) != 0 for v in crease) else
+           f"[{lo_hi[0]}, {lo_hi[1]}] does not isolate one simple real root of a mode" if i is None
+           or ev[i][3] is None or not ev[i][0].imag.is_zero() else None)
+    pivot = field_of(spec, "pivot", int, c)
+    if why is None and (not 0 <= pivot < len(ev) or pivot in crease_points(fam, n)):
+        raise CertificateError(f"{c}: pivot must index a non-crease point")
+    f = None if why is not None else mode_vector(fam, n, ev[i][3], ev[i][0].real)
+    why = why or ("no pivot makes the bordered 6 x 6 system certainly regular" if f is None else
+                  f"the eigenvector is not certainly non-zero at the pivot {pivot}" if not abs(f[pivot]) > 0 else None)
+    if why is not None:
+        part(f"{c}: eigenvector of S", False, why)
+        return None, None
+    part(f"{c}: eigenvector of S", True, f"eigenvalue {ev[i][0].real.str(10)} = lam(cos({ev[i][3]} pi/{n})), "
+         f"simple; closed form in mode {ev[i][3]} (the bordered 6 x 6 system proved regular), pivot "
+         f"{labels(fam, n)[pivot]}")
+    return i, [v if isinstance(v, fmpq) else (v / f[pivot]).real for v in f]
+
+
+def _mode_z(fam, n, ev, spec, part):
+    """(gamma, crease values) once C c = gamma c exactly and gamma is at most a simple eigenvalue of I."""
     exact_keys(spec, ("eigenvalue", "crease"), "z")
     g, cval = field_of(spec, "eigenvalue", str, "z"), field_of(spec, "crease", list, "z")
     if len(cval) != 5:
         raise CertificateError("z: crease values must be 5 decimals")
     g, cval = parse_decimal(g), [parse_decimal(v) for v in cval]
-    C = crease_block(fam, n)
-    Cc = C * fmpq_mat([[v] for v in cval])
+    Cc = crease_block(fam, n) * fmpq_mat([[v] for v in cval])
     at_g = [t for t in ev if t[2] == "I" and (t[1] == g if t[1] is not None else t[0].real.overlaps(arb(g)))]
     why = (f"no eigenvector for {g} with the given crease values (C c = {g} c, c != 0 fails)"
            if all(v == 0 for v in cval) or any(Cc[i, 0] != g * cval[i] for i in range(5)) else
            f"{g} is possibly a multiple eigenvalue of I" if len(at_g) > 1 else None)
-    ok = why is None
-    part("z: (generalized) eigenvector of S", ok,
+    part("z: (generalized) eigenvector of S", why is None,
          f"eigenvalue {g}: C c = {g} c exactly on the crease points, and {g} is at most a simple eigenvalue of I, so "
          f"some z with these crease values has (S - {g})^2 z = 0 and (S - {g}) z = 0 on the crease points"
-         if ok else why)
-    if not ok:
-        return
-    ia, ib = at["x"], at["y"]
-    one = [t for t in ev if not abs(t[0]) < 1]
-    beta = ev[ib][0].real
-    others = [t for i, t in enumerate(ev) if i not in (ia, ib) and t[1] != 1]
-    below = [t[1] for t in ev if t[2] == "C" and t[1] is not None and t[1] < 1]
-    why = ("x and y are the same eigenvector (beta is not an eigenvalue distinct from alpha)" if ia == ib else
-           "eigenvalue 1 is not simple" if len(one) != 1 or one[0][1] != 1 or one[0][2] != "C" else
-           "alpha >= beta is not certain" if not ev[ia][0].real >= beta else
-           "an eigenvalue is not certainly below beta (lam1, lam2 not alpha, beta)"
-           if not all(abs(t[0]) < beta for t in others) else
-           f"gamma is not the crease block's largest eigenvalue below 1 ({max(below) if below else None})"
-           if not below or g != max(below) else "gamma < beta is not certain" if not arb(g) < beta else None)
-    part("G generic: alpha = lam1, beta = lam2, gamma = the crease block's largest eigenvalue below 1; "
-         "no Jordan block at |lam| >= beta; gamma < beta for a generalized z", why is None,
-         f"alpha = {ev[ia][0].real.str(8)} > beta = {beta.str(8)} > |every other| (each simple), 1 simple; "
-         f"gamma = {g} < beta" if why is None else why)
-    if why is not None:
-        return
-    cp = crease_points(fam, n)
-    vecs["z"] = [cval[cp.index(i)] if i in cp else None for i in range(len(ev))]  # B reads the crease points only
-    _check_boundary(fam, n, r, vecs, part)
-    J = _jacobian(fam, n, q, vecs["x"], vecs["y"])
-    ok = J > 0 or J < 0
-    part(f"N normal at vertex (1,1) of quadrant {q}: J_xy != 0", ok, f"J_xy = {J.str(6)}")
-    if not part.failed:
-        log(f"  the limit surface of this net is not C1 at the {fam} vertex: normals along the level-m copies of "
-            f"quadrant {q}'s (1,1) tend to n_z != 0, yet e_z lies in T_v (ray {r})")
-
-
-def _same(t, v):
-    """Is the eigenvalue v (fmpq, or the arb ball of an irrational root) the root t[0] of factor t[1]?"""
-    if isinstance(v, fmpq):
-        return t[1].degree() == 1 and -t[1][0] / t[1][1] == v
-    return t[1].degree() > 1 and t[0].real.overlaps(v) and t[0].imag.is_zero()
-
-
-def _ordering(fam, n, a, b, g, prec, generalized):
-    """(ok, message): a = lam1 >= b = lam2 >= every other |lam| (1 simple, ties only with b itself), g the
-    largest eigenvalue below 1 of the crease block, every eigenvalue of modulus possibly >= b non-defective,
-    and g < b when z is a generalized eigenvector."""
-    ev = eigenvalues(fam, n, prec)  # each root once per unit of algebraic multiplicity
-    one = fmpq_poly([-1, 1])
-    if sum(1 for t in ev if t[1] == one) != 1:
-        return False, "eigenvalue 1 is not simple"
-    rest = [t for t in ev if t[1] != one]
-    ia = next((i for i, t in enumerate(rest) if _same(t, a)), None)
-    if ia is None:
-        return False, "alpha is not an eigenvalue"
-    rest_b = rest[:ia] + rest[ia + 1:]
-    ib = next((i for i, t in enumerate(rest_b) if _same(t, b)), None)
-    if ib is None:
-        return False, "beta is not an eigenvalue (distinct from alpha's copy)"
-    others = rest_b[:ib] + rest_b[ib + 1:]
-    if not (abs(rest[ia][0]) >= abs(rest_b[ib][0]) or rest[ia][1] == rest_b[ib][1]):
-        return False, "alpha >= beta is not certain"
-    bad = [t for t in others if not (_same(t, b) or abs(t[0]) < abs(rest_b[ib][0]))]  # certainly below beta
-    if bad:
-        return False, f"an eigenvalue ({bad[0][0].str(6)}) is not certainly below beta (lam1, lam2 not alpha, beta)"
-    cfac = [p for p, _ in crease_block(fam, n).charpoly().factor()[1]]
-    if any(p.degree() > 1 for p in cfac):
-        return False, "the crease block has irrational eigenvalues"
-    croots = [-p[0] / p[1] for p in cfac]
-    below = [r for r in croots if r < 1]
-    if not isinstance(g, fmpq) or not below or g != max(below):
-        return False, f"gamma is not the crease block's largest eigenvalue below 1 ({max(below) if below else None})"
-    beta = abs(rest_b[ib][0])
-    defective = [t for t in rest if t[3] < t[2] and not abs(t[0]) < beta]  # Jordan blocks that could reach beta
-    if defective:
-        return False, f"a Jordan block at |lam| >= beta: {defective[0][1]} (algebraic multiplicity " \
-                      f"{defective[0][2]}, geometric {defective[0][3]})"
-    if generalized and not arb(g) < beta:
-        return False, "z is a generalized eigenvector but gamma < beta is not certain"
-    return True, (f"alpha = {_str(a)}, beta = {_str(b)}, gamma = {g}{' (Jordan chain)' if generalized else ''}; "
-                  "1 simple; no Jordan block at |lam| >= beta")
-
-
-def _str(v):
-    return str(v) if isinstance(v, fmpq) else v.str(8)
-
-
-def msgs_z(part):
-    """The message of the z part just recorded (it says whether z is a generalized eigenvector)."""
-    return part.result.parts[-1].message
+         if why is None else why)
+    return None if why is not None else (g, cval)
 
 
 def eigenvector_of(fam, n, spec, c, prec, chain=False):
@@ -399,43 +403,50 @@ def eigenvector_of(fam, n, spec, c, prec, chain=False):
     if len(crease) != len(cp):
         raise CertificateError(f"{c}: crease values must be {len(cp)} decimals")
     cval = [parse_decimal(v) for v in crease]
+    if isinstance(spec["eigenvalue"], str):  # rational eigenvalue: exact
+        return _exact_eigenvector(fam, n, spec, c, cp, cval, chain)
+    return _ball_eigenvector(fam, n, spec, c, cp, cval, prec)
+
+
+def _exact_eigenvector(fam, n, spec, c, cp, cval, chain):
     S = sector_matrix(fam, n)
     m = S.nrows()
-    ev = spec["eigenvalue"]
-    if isinstance(ev, str):  # rational eigenvalue: exact
-        lam = parse_decimal(ev)
-        A = S - lam * fmpq_mat([[1 if i == j else 0 for j in range(m)] for i in range(m)])
-        if "pivot" in spec:  # one more fixed coordinate: 1 at the pivot
-            pv = field_of(spec, "pivot", int, c)
-            if not 0 <= pv < m or pv in cp:
-                raise CertificateError(f"{c}: pivot must index a non-crease point")
-            cp, cval = cp + [pv], cval + [fmpq(1)]
-        vec = _solve_exact(A, cp, cval)
-        if vec is not None:
-            return lam, vec, f"eigenvalue {lam}; S v = {lam} v exactly"
-        vec = _solve_exact(A * A, cp, cval) if chain else None
-        if vec is None:
-            return lam, None, f"no eigenvector for {lam} with the given crease values"
-        u = A * fmpq_mat([[v] for v in vec])
-        if any(u[i, 0] != 0 for i in cp):
-            return lam, None, f"(S - {lam}) z is not 0 on the crease points"
-        return lam, vec, f"eigenvalue {lam}; (S - {lam})^2 z = 0 exactly, (S - {lam}) z != 0 vanishes on the crease " \
-                         "(generalized)"
+    lam = parse_decimal(spec["eigenvalue"])
+    A = S - lam * fmpq_mat([[1 if i == j else 0 for j in range(m)] for i in range(m)])
+    if "pivot" in spec:  # one more fixed coordinate: 1 at the pivot
+        pv = field_of(spec, "pivot", int, c)
+        if not 0 <= pv < m or pv in cp:
+            raise CertificateError(f"{c}: pivot must index a non-crease point")
+        cp, cval = cp + [pv], cval + [fmpq(1)]
+    vec = _solve_exact(A, cp, cval)
+    if vec is not None:
+        return lam, vec, f"eigenvalue {lam}; S v = {lam} v exactly"
+    vec = _solve_exact(A * A, cp, cval) if chain else None
+    if vec is None:
+        return lam, None, f"no eigenvector for {lam} with the given crease values"
+    u = A * fmpq_mat([[v] for v in vec])
+    if any(u[i, 0] != 0 for i in cp):
+        return lam, None, f"(S - {lam}) z is not 0 on the crease points"
+    return lam, vec, f"eigenvalue {lam}; (S - {lam})^2 z = 0 exactly, (S - {lam}) z != 0 vanishes on the crease " \
+                     "(generalized)"
+
+
+def _ball_eigenvector(fam, n, spec, c, cp, cval, prec):
     lo_hi = field_of(spec, "eigenvalue", list, c)
     if len(lo_hi) != 2:
         raise CertificateError(f"{c}: eigenvalue must be a decimal or [low, high]")
-    lo, hi = parse_decimal(lo_hi[0]), parse_decimal(lo_hi[1])
-    inside = [t for t in eigenvalues(fam, n, prec) if t[0].real > lo and t[0].real < hi]
-    near = [t for t in eigenvalues(fam, n, prec) if t[0].real.overlaps(arb(lo).union(arb(hi)))]
-    if len(inside) != 1 or len(near) != 1 or not inside[0][0].imag.is_zero() or inside[0][2] != 1:
-        return None, None, f"[{lo}, {hi}] does not isolate one simple real eigenvalue of {fam}:{n}"
-    z, p = inside[0][0], inside[0][1]
+    ev = eigenvalues(fam, n, prec)
+    i = _isolated(ev, lo_hi, c)
+    if i is None or not ev[i][0].imag.is_zero() or ev[i][2] != 1:
+        return None, None, f"[{lo_hi[0]}, {lo_hi[1]}] does not isolate one simple real eigenvalue of {fam}:{n}"
+    z, p = ev[i][0], ev[i][1]
     if any(v != 0 for v in cval):
         return None, None, "an irrational eigenvalue's eigenvector vanishes on the crease points"
     if cp and p.gcd(crease_block(fam, n).charpoly()).degree() > 0:
         return None, None, "the eigenvalue is one of the crease block's"
     pivot = field_of(spec, "pivot", int, c)
-    free = [i for i in range(m) if i not in cp]
+    S = sector_matrix(fam, n)
+    free = [i for i in range(S.nrows()) if i not in cp]
     if pivot not in free:
         raise CertificateError(f"{c}: pivot must index a non-crease point")
     lam = z.real
@@ -443,7 +454,7 @@ def eigenvector_of(fam, n, spec, c, prec, chain=False):
         sol = bordered_solve(S, free, pivot, lam)
     except ZeroDivisionError:
         return None, None, f"the system for the eigenvector of {lam.str(8)} (pivot {pivot}) is not certainly regular"
-    vec = [arb(0)] * m
+    vec = [arb(0)] * S.nrows()
     for k, i in enumerate(free):
         vec[i] = sol[k, 0]
     return lam, vec, f"eigenvalue {lam.str(10)} (simple root of {p}); vector in arb, pivot {labels(fam, n)[pivot]}"
