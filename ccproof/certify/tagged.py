@@ -256,7 +256,8 @@ def _decimal_exact(q):
 
 
 def prove_tagged(name, prec=DEFAULT_PREC):
-    """A verified certificate for the configuration, or None with the reason.
+    """A verified "not C1" certificate (a witness net) for one configuration, or None with the reason (the
+    prover of the registry's route "tagged not C1"; :func:`ccproof.certify.prover.prove_configuration`).
 
     Parameters
     ----------
@@ -279,12 +280,8 @@ def prove_tagged(name, prec=DEFAULT_PREC):
      no witness candidate'
     """
     fam, n = parse_configuration(name)
-    if isinstance(n, dict) and fam == "dart":  # every K >= K0, "C1" (verified by the caller: about a minute)
-        from ccproof.certify.tagged_dart import prove_dart_tail
-
-        return prove_dart_tail(name, prec)
     if isinstance(n, dict):
-        return prove_tagged_limit(name, prec)
+        return None, f"undecided: {name}: the witness route takes one configuration"
     why = []
     for w in witness_candidates(name, prec):
         for q in range(n):
