@@ -185,3 +185,17 @@ def test_the_prover_has_one_route_per_family_of_the_registry():
     assert cert["statement"] == "not C1" and verify_certificate(cert, **QUIET)
     cert, why = P.prove_configuration("crease:4")
     assert cert is None and why.startswith("undecided: ") and "Jordan" in why
+
+
+def test_report_tagged_prints_the_coverage_the_verifier_decides(monkeypatch):
+    import ccproof.certify.verify as V
+    from ccproof.cli.report import tagged_table
+
+    files = [C / "c1" / "crease" / "n005.json", C / "c1" / "corner" / "n003.json", C / "injectivity" / "k003.json"]
+    monkeypatch.setattr(V, "certificate_files", lambda d: files)
+    table = tagged_table()
+    assert "| crease:5 | not C1 | VERIFIED |" in table and "| corner:3 | not C1 | VERIFIED |" in table
+    assert "smooth" not in table
+    assert "* crease: INCOMPLETE: no certificate for 2-3, 6-100, >= 101; C1 for none, not C1 for 5; undecided: " \
+           "1 (lam2 = 1/4 in a Jordan block), 4 (lam2 = 1/2 in a Jordan block)" in table
+    assert "* dart: INCOMPLETE: no certificate for 3-100, >= 101" in table

@@ -20,17 +20,14 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from .c1 import C1_SCHEMA, verify_c1
-from .dart_tail import verify_dart_tail
 from .errors import CertificateError
-from .injectivity import SCHEMA, verify_injectivity
 from .record import field_of, read_valence
-from .tagged import parse_configuration
-from .tagged_c1 import TAGGED_SCHEMA, verify_tagged
-from .tagged_limit import verify_tail
 
+#: the schemas, one per kind of hints (docs/certificates.md)
+SCHEMA = "ccproof.injectivity/3"
+C1_SCHEMA = "ccproof.c1/2"
+TAGGED_SCHEMA = "ccproof.tagged-c1/1"
 TAGGED = ("dart", "crease", "corner")
-
 
 @dataclass(frozen=True)
 class Route:
@@ -63,26 +60,42 @@ class Route:
         return family in self.families and ("every" if isinstance(n, dict) else "one") in self.sizes
 
 
-def _smooth(check):
-    return lambda cert, fam, k, part, log: check(cert, k, part, log)
+# The checkers, each imported when its route is taken (verifying one kind of certificate loads that kind's
+# modules only).
+def _injectivity(cert, fam, k, part, log):
+    from .injectivity import verify_injectivity
+
+    verify_injectivity(cert, k, part, log)
+
+
+def _c1(cert, fam, k, part, log):
+    from .c1 import verify_c1
+
+    verify_c1(cert, k, part, log)
 
 
 def _tagged_one(cert, fam, n, part, log):
+    from .tagged_c1 import verify_tagged
+
     verify_tagged(cert, part, log)
 
 
 def _dart_tail(cert, fam, n, part, log):
+    from .dart_tail import verify_dart_tail
+
     verify_dart_tail(cert, n["min"], part, log)
 
 
 def _tagged_tail(cert, fam, n, part, log):
+    from .tagged_limit import verify_tail
+
     verify_tail(cert, fam, n["min"], part, log)
 
 
 #: every family of certificates the verifier checks, in the order the prover tries them for a configuration
 ROUTES = (
-    Route("smooth injective", SCHEMA, ("smooth",), ("one", "every"), "injective", _smooth(verify_injectivity)),
-    Route("smooth C1", C1_SCHEMA, ("smooth",), ("one", "every"), "C1", _smooth(verify_c1)),
+    Route("smooth injective", SCHEMA, ("smooth",), ("one", "every"), "injective", _injectivity),
+    Route("smooth C1", C1_SCHEMA, ("smooth",), ("one", "every"), "C1", _c1),
     Route("tagged not C1", TAGGED_SCHEMA, TAGGED, ("one",), "not C1", _tagged_one),
     Route("tagged C1", TAGGED_SCHEMA, TAGGED, ("one",), "C1", _tagged_one),
     Route("dart:>=K0 C1", TAGGED_SCHEMA, ("dart",), ("every",), "C1", _dart_tail),
@@ -100,6 +113,8 @@ def configuration_of(name):
     >>> configuration_of("smooth:>=40"), configuration_of("dart:7")
     (('smooth', {'min': 40}), ('dart', 7))
     """
+    from .tagged import parse_configuration
+
     fam, _, size = str(name).partition(":")
     if fam != "smooth":
         return parse_configuration(name)
@@ -144,6 +159,8 @@ def route_of(cert):
     if schema != TAGGED_SCHEMA:
         k = read_valence(cert)
         return next(r for r in ROUTES if r.schema == schema), "smooth", k
+    from .tagged import parse_configuration
+
     fam, n = parse_configuration(field_of(cert, "configuration", str, "certificate"))
     routes = [r for r in ROUTES if r.schema == schema and r.takes(fam, n)]
     statement = field_of(cert, "statement", str, "certificate")
