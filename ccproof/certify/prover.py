@@ -510,10 +510,10 @@ def c1_certificate_path(k, directory=None):
     return Path(directory or certificates_dir() / "c1") / (Valence.parse(k).stem + ".json")
 
 
-def _prove_smooth(prove, name, prec):
+def _prove_smooth(prove, name, prec, statement):
     k = Valence.parse(name.partition(":")[2]).to_json()
     try:
-        return prove(k, prec), "proved"
+        return prove(k, prec), statement
     except ProofFailed as exc:
         return None, f"undecided: {exc}"
 
@@ -521,11 +521,11 @@ def _prove_smooth(prove, name, prec):
 def _prove_injective(name, prec):
     v = Valence.parse(name.partition(":")[2])
     return _prove_smooth(lambda k, p: (prove_interval if v.interval else prove_valence)(k, p, progress=False),
-                         name, prec)
+                         name, prec, "injective")
 
 
 def _prove_c1(name, prec):
-    return _prove_smooth(prove_c1, name, prec)
+    return _prove_smooth(prove_c1, name, prec, "C1")
 
 
 def _tagged_prover(which):
@@ -555,7 +555,8 @@ PROVERS = {
 def prove_configuration(name, prec=DEFAULT_PREC, statement=None):
     """A certificate for a configuration (``"crease:5"``, ``"dart:>=101"``, ``"smooth:5"``) from the first
     route of the verifier's registry that takes it (and proves ``statement``, when given) whose prover finds
-    one; else None with each route's reason. The caller re-checks the written file with the verifier.
+    one; else None with each route's reason (``"undecided: not C1: ...; C1: ..."``). The caller re-checks
+    the written file with the verifier.
 
     Parameters
     ----------
@@ -588,5 +589,5 @@ def prove_configuration(name, prec=DEFAULT_PREC, statement=None):
         cert, why = PROVERS[route.name](name, prec)
         if cert is not None:
             return cert, why
-        whys.append(why.removeprefix("undecided: "))
+        whys.append(f"{route.statement}: {why.removeprefix('undecided: ')}")
     return None, "undecided: " + "; ".join(whys)

@@ -199,3 +199,17 @@ def test_report_tagged_prints_the_coverage_the_verifier_decides(monkeypatch):
     assert "* crease: INCOMPLETE: no certificate for 2-3, 6-100, >= 101; C1 for none, not C1 for 5; undecided: " \
            "1 (lam2 = 1/4 in a Jordan block), 4 (lam2 = 1/2 in a Jordan block)" in table
     assert "* dart: INCOMPLETE: no certificate for 3-100, >= 101" in table
+
+
+def test_each_configuration_statement_pair_has_at_most_one_route():
+    keys = [(r.schema, fam, size, r.statement) for r in ROUTES for fam in r.families for size in r.sizes]
+    assert len(keys) == len(set(keys))
+    # and one schema per statement of a smooth valence, so the schema alone picks a smooth route
+    assert sorted(r.statement for r in ROUTES if r.families == ("smooth",)) == ["C1", "injective"]
+
+
+@pytest.mark.parametrize("name", ["smooth:4", "smooth:>=40"])
+def test_the_smooth_c1_route_proves_what_the_verifier_accepts(name):
+    cert, why = P.prove_configuration(name, statement="C1")
+    res = verify_certificate(cert, **QUIET)
+    assert why == "C1" and res and (res.configuration, res.statement) == (name, "C1")
