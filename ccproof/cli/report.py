@@ -96,13 +96,14 @@ def tagged_table():
     tagged family as the verifier decides it from these verdicts (with the undecided configurations and
     their reasons)."""
     from ccproof.certify.verify import certificate_files, coverage, verify_file
+    from ccproof.certify.verify.registry import TAGGED
     from ccproof.cli.verify import summary
     from ccproof.tables.format import certificates_dir
 
     head = "| configuration | statement | verdict | spectrum (re-derived) | verify s |\n|---|---|---|---|---|\n"
     body, results = "", []
     for path in certificate_files(certificates_dir()):
-        if path.parent.name not in ("dart", "crease", "corner"):
+        if path.parent.name not in TAGGED:
             continue
         res = verify_file(path, log=lambda line: None)
         results.append(res)
@@ -111,7 +112,7 @@ def tagged_table():
         spec = spec.removeprefix(f"{row['configuration']}: ").removeprefix("1 simple; ").split(";")[0]
         body += (f"| {row['configuration']} | {row['statement']} | {row['verdict']} | {spec} | "
                  f"{row['seconds']:.1f} |\n")
-    tagged = [line for line in coverage(results)[1] if line.startswith(("dart:", "crease:", "corner:"))]
+    tagged = [line for line in coverage(results)[1] if line.split(":")[0] in TAGGED]
     return head + body + "\n" + "\n".join(f"* {line}" for line in tagged) + "\n"
 
 

@@ -25,7 +25,7 @@ from pathlib import Path
 
 from .errors import CertificateError
 from .record import Part, Recorder, VerifyResult
-from .registry import C1_SCHEMA, ROUTES, SCHEMA, TAGGED_SCHEMA, check_coverage, coverage, route_of
+from .registry import C1_SCHEMA, ROUTES, SCHEMA, TAGGED, TAGGED_SCHEMA, check_coverage, coverage, route_of
 from .replay import check_size
 
 __all__ = ["SCHEMA", "C1_SCHEMA", "TAGGED_SCHEMA", "CertificateError", "Part", "VerifyResult", "verify_certificate",
@@ -200,6 +200,6 @@ def certificate_files(directory):
     ('c1', 'k003.json', 'injectivity')
     """
     d = Path(directory)
-    tagged = sorted(f for fam in ("dart", "crease", "corner") for f in (d / "c1" / fam).glob("[kn]*.json"))
+    tagged = sorted(f for fam in TAGGED for f in (d / "c1" / fam).glob("[kn]*.json"))
     return sorted((d / "c1").glob("k*.json")) + tagged + sorted((d / "injectivity").glob("k*.json"))
 
