@@ -79,10 +79,9 @@ def _args(files, **kw):
                               no_progress=True, scheduler=None, jobs=None, **kw)
 
 
-def test_a_file_changed_or_replaced_by_a_fifo_after_verification_changes_nothing(tmp_path, monkeypatch, capsys):
-    """Between the verification of a file and the report, the file's statement is swapped ("not C1" ->
-    "C1") and another file is replaced by a FIFO with no writer: the --json lines report what was verified,
-    and nothing waits on the FIFO."""
+def _tamper_after_verification(tmp_path, monkeypatch):
+    """Two published certificates copied to ``tmp_path``; once each is verified, crease:5's statement is
+    swapped ("not C1" -> "C1") and corner:3's file replaced by a FIFO with no writer."""
     swapped, fifo = tmp_path / "n005.json", tmp_path / "n003.json"
     cert5 = json.loads((C / "c1" / "crease" / "n005.json").read_text())
     swapped.write_text(json.dumps(cert5))
@@ -99,8 +98,13 @@ def test_a_file_changed_or_replaced_by_a_fifo_after_verification_changes_nothing
         return out
 
     monkeypatch.setattr(cli_verify, "_check", check_then_tamper)
+    return swapped, fifo
+
+
+def _run_without_hanging(args, fifo):
+    """``ccproof verify`` in a thread; fails (after releasing the reader) if it waits on the FIFO."""
     rc = []
-    worker = threading.Thread(target=lambda: rc.append(cli_verify.run(_args([swapped, fifo]))), daemon=True)
+    worker = threading.Thread(target=lambda: rc.append(cli_verify.run(args)), daemon=True)
     worker.start()
     worker.join(60)
     hung = worker.is_alive()
@@ -108,10 +112,31 @@ def test_a_file_changed_or_replaced_by_a_fifo_after_verification_changes_nothing
         os.close(os.open(fifo, os.O_WRONLY | os.O_NONBLOCK))
         worker.join(60)
     assert not hung, "the report waited on a FIFO that replaced a verified file"
+    return rc[0]
+
+
+def test_a_file_changed_or_replaced_by_a_fifo_after_verification_changes_nothing(tmp_path, monkeypatch, capsys):
+    """--json reports what was verified, and nothing waits on the FIFO."""
+    swapped, fifo = _tamper_after_verification(tmp_path, monkeypatch)
+    assert _run_without_hanging(_args([swapped, fifo]), fifo) == 0
     rows = [json.loads(s) for s in capsys.readouterr().out.splitlines()]
-    assert rc == [0]
     assert [(r["configuration"], r["statement"], r["verdict"]) for r in rows] == [
         ("crease:5", "not C1", "VERIFIED"), ("corner:3", "not C1", "VERIFIED")]
+
+
+def test_the_coverage_of_verify_all_ignores_files_changed_after_verification(tmp_path, monkeypatch, capsys):
+    """--all (here over the two files alone): the coverage lines count crease:5 and corner:3 as verified."""
+    import ccproof.certify.verify as V
+
+    swapped, fifo = _tamper_after_verification(tmp_path, monkeypatch)
+    monkeypatch.setattr(V, "certificate_files", lambda d: [])
+    args = _args([swapped, fifo])
+    args.all, args.json = True, False
+    assert _run_without_hanging(args, fifo) == 1  # incomplete, of course
+    out = capsys.readouterr().out
+    assert "2 of 2 certificates verified" in out
+    assert "crease: INCOMPLETE: no certificate for 2-3, 6-100, >= 101; C1 for none, not C1 for 5;" in out
+    assert "corner: INCOMPLETE: no certificate for 1, 5-100, >= 101; C1 for none, not C1 for 3;" in out
 
 
 def test_coverage_reads_no_file(tmp_path):

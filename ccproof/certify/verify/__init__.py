@@ -91,7 +91,7 @@ def verify_file(path: str | Path, log: Callable[[str], object] = print) -> Verif
     Parameters
     ----------
     path : str or Path
-        A certificate file (JSON, schema ``ccproof.injectivity/3`` or ``ccproof.c1/2``).
+        A certificate file (JSON, one of the schemas of :data:`.registry.ROUTES`).
     log : callable
         Receives each output line (default ``print``).
 
