@@ -29,6 +29,7 @@ C1_SCHEMA = "ccproof.c1/2"
 TAGGED_SCHEMA = "ccproof.tagged-c1/1"
 TAGGED = ("dart", "crease", "corner")
 
+
 @dataclass(frozen=True)
 class Route:
     """One family of certificates.
@@ -120,7 +121,7 @@ def configuration_of(name):
         return parse_configuration(name)
     every = size.startswith(">=")
     digits = size[2:] if every else size
-    if not digits.isdigit() or len(digits) > 7:
+    if not (digits.isascii() and digits.isdigit()) or len(digits) > 7:
         raise CertificateError(f"configuration {str(name)[:40]!r} is not smooth:K or smooth:>=K0")
     k = read_valence({"valence": {"min": int(digits)} if every else int(digits)})
     return fam, k
