@@ -508,3 +508,86 @@ def c1_certificate_path(k, directory=None):
     ('d/k005.json', 'c1')
     """
     return Path(directory or certificates_dir() / "c1") / (Valence.parse(k).stem + ".json")
+
+
+def _prove_smooth(prove, name, prec, statement):
+    k = Valence.parse(name.partition(":")[2]).to_json()
+    try:
+        return prove(k, prec), statement
+    except ProofFailed as exc:
+        return None, f"undecided: {exc}"
+
+
+def _prove_injective(name, prec):
+    v = Valence.parse(name.partition(":")[2])
+    return _prove_smooth(lambda k, p: (prove_interval if v.interval else prove_valence)(k, p, progress=False),
+                         name, prec, "injective")
+
+
+def _prove_c1(name, prec):
+    return _prove_smooth(prove_c1, name, prec, "C1")
+
+
+def _tagged_prover(which):
+    """The prover ``which`` of :mod:`ccproof.certify.tagged` or :mod:`ccproof.certify.tagged_dart`, imported
+    when it runs (the smooth routes need neither)."""
+    def prove(name, prec):
+        from ccproof.certify import tagged, tagged_dart
+
+        fn = {"witness": tagged.prove_tagged, "map": tagged.prove_tagged_c1, "limit": tagged.prove_tagged_limit,
+              "dart tail": tagged_dart.prove_dart_tail}[which]
+        return fn(name, prec)
+    return prove
+
+
+#: one prover per route of the verifier's registry (:data:`ccproof.certify.verify.ROUTES`), by the route's name;
+#: each takes a configuration name and a precision and returns (certificate or None, reason)
+PROVERS = {
+    "smooth injective": _prove_injective,
+    "smooth C1": _prove_c1,
+    "tagged not C1": _tagged_prover("witness"),
+    "tagged C1": _tagged_prover("map"),
+    "dart:>=K0 C1": _tagged_prover("dart tail"),
+    "crease, corner:>=N0 not C1": _tagged_prover("limit"),
+}
+
+
+def prove_configuration(name, prec=DEFAULT_PREC, statement=None):
+    """A certificate for a configuration (``"crease:5"``, ``"dart:>=101"``, ``"smooth:5"``) from the first
+    route of the verifier's registry that takes it (and proves ``statement``, when given) whose prover finds
+    one; else None with each route's reason (``"undecided: not C1: ...; C1: ..."``). The caller re-checks
+    the written file with the verifier.
+
+    Parameters
+    ----------
+    name : str
+    prec : int
+    statement : str, optional
+        ``"injective"``, ``"C1"`` or ``"not C1"``; default: any, in the registry's order.
+
+    Returns
+    -------
+    (dict or None, str)
+
+    Examples
+    --------
+    >>> cert, why = prove_configuration("corner:1")
+    >>> cert["statement"], why
+    ('C1', 'C1')
+    >>> prove_configuration("crease:5", statement="injective")
+    Traceback (most recent call last):
+    ...
+    ccproof.errors.CCProofError: crease:5: no route of the registry certifies 'injective'
+    """
+    from ccproof.certify.verify.registry import routes_for
+
+    routes = [r for r in routes_for(name) if statement in (None, r.statement)]
+    if not routes:
+        raise CCProofError(f"{name}: no route of the registry certifies {statement!r}")
+    whys = []
+    for route in routes:
+        cert, why = PROVERS[route.name](name, prec)
+        if cert is not None:
+            return cert, why
+        whys.append(f"{route.statement}: {why.removeprefix('undecided: ')}")
+    return None, "undecided: " + "; ".join(whys)

@@ -277,7 +277,8 @@ def _decimal_exact(q):
 
 
 def prove_tagged(name, prec=DEFAULT_PREC):
-    """A verified certificate for the configuration, or None with the reason.
+    """A verified "not C1" certificate (a witness net) for one configuration, or None with the reason (the
+    prover of the registry's route "tagged not C1"; :func:`ccproof.certify.prover.prove_configuration`).
 
     Parameters
     ----------
@@ -300,12 +301,8 @@ def prove_tagged(name, prec=DEFAULT_PREC):
      no witness candidate'
     """
     fam, n = parse_configuration(name)
-    if isinstance(n, dict) and fam == "dart":  # every K >= K0, "C1" (verified by the caller: about a minute)
-        from ccproof.certify.tagged_dart import prove_dart_tail
-
-        return prove_dart_tail(name, prec)
     if isinstance(n, dict):
-        return prove_tagged_limit(name, prec)
+        return None, f"undecided: {name}: the witness route takes one configuration"
     if fam == "dart" and n >= MIN_N:  # no flip (lam1 > lam2 > 0): the C1 route decides these
         return None, f"undecided: a dart's witness is checked for K < {MIN_N} only"
     why = []

@@ -184,10 +184,10 @@ def prove_dart_tail(name, prec=128, hints=None, progress=None):
     -------
     (dict or None, str)
     """
+    from ccproof.certify.verify import TAGGED_SCHEMA
     from ccproof.certify.verify.dart_family import TaylorHints
     from ccproof.certify.verify.replay import parse_decimal
     from ccproof.certify.verify.tagged import parse_configuration
-    from ccproof.certify.verify.tagged_c1 import TAGGED_SCHEMA
 
     fam, n = parse_configuration(name)
     if fam != "dart" or not isinstance(n, dict):

@@ -163,15 +163,13 @@ def _print_summary(summary):
 def _run_tagged(args):
     import time
 
-    from ccproof.certify.tagged import configurations, prove_tagged, prove_tagged_c1, write_tagged
+    from ccproof.certify.prover import prove_configuration
+    from ccproof.certify.tagged import configurations, write_tagged
 
     ok_all = True
     for name in configurations(args.valences):
         t0 = time.perf_counter()
-        cert, why = prove_tagged(name, prec=args.prec)
-        if cert is None:
-            cert, why_c1 = prove_tagged_c1(name, prec=args.prec)
-            why = why_c1 if cert is not None else f"{why}; C1 attempt: {why_c1}"
+        cert, why = prove_configuration(name, prec=args.prec)  # the registry's routes: "not C1", then "C1"
         seconds = time.perf_counter() - t0
         if cert is None:
             print(f"{name}: {why} ({seconds:.1f} s); no certificate written")

@@ -5,7 +5,8 @@
   ccproof report --write         also write it as Markdown to docs/certified_valences.md
   ccproof report --plot F.png    plot the margins against k
   ccproof report --tagged        re-verify the tagged certificates (certificates/c1/{dart,crease,corner}/)
-                                 and print configuration, statement, verdict and the spectral reason
+                                 and print configuration, statement, verdict and the spectral reason, then
+                                 each family's coverage as the verifier decides it from those verdicts
 
 Every number comes from the verifier's run (its VerifyResult): the smallest bound it re-checked per
 part (det J_Phi and det J_G in the local coordinates of their boxes, det J_G / h^2 on the corner cell)
@@ -91,23 +92,28 @@ def _kname(k):
 
 def tagged_table():
     """Markdown table of the tagged certificates, each re-verified in this run (the reason column is the
-    verifier's message on the spectrum: lam1, lam2 and, for a witness, gamma)."""
-    from ccproof.certify.verify import certificate_files, verify_file
+    verifier's message on the spectrum: lam1, lam2 and, for a witness, gamma), then the coverage of each
+    tagged family as the verifier decides it from these verdicts (with the undecided configurations and
+    their reasons)."""
+    from ccproof.certify.verify import certificate_files, coverage, verify_file
+    from ccproof.certify.verify.registry import TAGGED
     from ccproof.cli.verify import summary
     from ccproof.tables.format import certificates_dir
 
     head = "| configuration | statement | verdict | spectrum (re-derived) | verify s |\n|---|---|---|---|---|\n"
-    body = ""
+    body, results = "", []
     for path in certificate_files(certificates_dir()):
-        if path.parent.name not in ("dart", "crease", "corner"):
+        if path.parent.name not in TAGGED:
             continue
         res = verify_file(path, log=lambda line: None)
+        results.append(res)
         row = summary(res)
         spec = next((p["message"] for p in row["parts"] if p["name"].startswith(("G ", "spectral"))), "")
         spec = spec.removeprefix(f"{row['configuration']}: ").removeprefix("1 simple; ").split(";")[0]
         body += (f"| {row['configuration']} | {row['statement']} | {row['verdict']} | {spec} | "
                  f"{row['seconds']:.1f} |\n")
-    return head + body
+    tagged = [line for line in coverage(results)[1] if line.split(":")[0] in TAGGED]
+    return head + body + "\n" + "\n".join(f"* {line}" for line in tagged) + "\n"
 
 
 def run(args):

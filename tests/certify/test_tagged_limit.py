@@ -10,14 +10,13 @@ import numpy as np
 import pytest
 from flint import acb, arb, ctx, fmpq
 
-from ccproof.certify.verify import Part, VerifyResult, verify_certificate
 from ccproof.certify.verify import tagged_limit as tl
 from ccproof.certify.verify import tagged_modes as tm
+from ccproof.certify.verify import verify_certificate
 from ccproof.certify.verify.errors import CertificateError
 from ccproof.certify.verify.spectrum import lam_of
 from ccproof.certify.verify.tagged import labels, parse_configuration
 from ccproof.certify.verify.tagged_c1 import _jacobian
-from ccproof.cli.verify import tagged_coverage
 from ccproof.tables.format import certificates_dir
 
 from .test_tagged import library_matrix
@@ -39,7 +38,7 @@ def _fails(cert, why):
 @pytest.mark.parametrize("fam", ["crease", "corner"])
 def test_published_interval_certificates_verify(fam):
     res = verify_certificate(_tail(fam), **QUIET)
-    assert res and res.valence == f"{fam}:>=101"
+    assert res and res.configuration == f"{fam}:>=101"
     assert [p.name.split(":")[0].split(" ")[0] for p in res.parts] == ["S", "range", "z", "G", "B", "N", "x,", "N", "N"]
 
 
@@ -190,27 +189,6 @@ def test_forgery_perturbed_stencil(monkeypatch):
     for f in (tm.check_ring, tl.check_windows, tm.check_structure, tl.reflection_identity):
         f.cache_clear()
     assert verify_certificate(_tail("corner"), **QUIET)
-
-
-def _result(tmp_path, name, statement):
-    path = tmp_path / f"{name.replace(':', '_').replace('>=', 'ge')}.json"
-    path.write_text(json.dumps({"statement": statement}))
-    return VerifyResult(path=str(path), schema="ccproof.tagged-c1/1", valence=name, parts=[Part("S", True)])
-
-
-def test_coverage_counts_the_interval(tmp_path):
-    singles = [_result(tmp_path, f"crease:{n}", "not C1") for n in range(5, 101)]
-    singles += [_result(tmp_path, f"crease:{n}", "C1") for n in (2, 3)]
-    line = lambda rs: next(s for s in tagged_coverage(rs)[1] if s.startswith("crease"))  # noqa: E731
-    assert line(singles).startswith("crease: INCOMPLETE: no certificate for >= 101")
-    tail = _result(tmp_path, "crease:>=101", "not C1")
-    assert line(singles + [tail]).startswith("crease: OK (crease:1-100, every N)")
-    assert "not C1 for 5-100, >= 101" in line(singles + [tail])
-    assert line(singles[1:] + [_result(tmp_path, "crease:>=5", "not C1")]).startswith("crease: OK")  # 5 by the tail
-    assert line(singles[:-2] + [tail]).startswith("crease: INCOMPLETE: no certificate for 2-3")
-    c1 = _result(tmp_path, "crease:40", "C1")
-    clash = line([c1, _result(tmp_path, "crease:>=16", "not C1")])
-    assert clash.startswith("crease: CONTRADICTORY: certified twice: [40]")
 
 
 def test_verify_json_and_certify_on_the_command_line(tmp_path):

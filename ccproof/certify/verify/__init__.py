@@ -23,29 +23,24 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
-from .c1 import C1_SCHEMA, verify_c1
-from .dart_tail import verify_dart_tail
 from .errors import CertificateError
-from .injectivity import SCHEMA, verify_injectivity
-from .record import Part, Recorder, VerifyResult, field_of, read_valence
+from .record import Part, Recorder, VerifyResult
+from .registry import C1_SCHEMA, ROUTES, SCHEMA, TAGGED, TAGGED_SCHEMA, check_coverage, coverage, route_of
 from .replay import check_size
-from .tagged import parse_configuration
-from .tagged_c1 import TAGGED_SCHEMA, verify_tagged
-from .tagged_limit import verify_tail
 
 __all__ = ["SCHEMA", "C1_SCHEMA", "TAGGED_SCHEMA", "CertificateError", "Part", "VerifyResult", "verify_certificate",
-           "verify_file", "check_coverage", "certificate_files", "read_certificate_bytes"]
+           "verify_file", "check_coverage", "coverage", "certificate_files", "read_certificate_bytes", "ROUTES"]
 
 MAX_FILE_BYTES = 4 * 2**20  # the published certificates: at most 64 KB; MAX_BOXES boxes take at most ~1 MB
-_KINDS = {SCHEMA: verify_injectivity, C1_SCHEMA: verify_c1}  # certificates of a valence
-_SCHEMAS = (*_KINDS, TAGGED_SCHEMA)
 #: what a malformed file can raise while it is being read; each ends in FAIL with the reason
 _MALFORMED = (CertificateError, ValueError, TypeError, KeyError, IndexError, AttributeError, RecursionError,
               OverflowError, ZeroDivisionError)
 
 
 def verify_certificate(cert, log=print, path=None):
-    """Check a parsed certificate (a dict). Returns a :class:`VerifyResult`; never raises for bad input.
+    """Check a parsed certificate (a dict) through the one route of the registry that takes its schema,
+    configuration and statement (:func:`.registry.route_of`). Returns a :class:`VerifyResult` with the
+    family, valence and statement it checked; never raises for bad input.
 
     Parameters
     ----------
@@ -76,25 +71,11 @@ def verify_certificate(cert, log=print, path=None):
     t0 = time.perf_counter()
     part = Recorder(res, log)
     try:
-        if not isinstance(cert, dict) or cert.get("schema") not in _SCHEMAS:
-            got = cert.get("schema") if isinstance(cert, dict) else None
-            raise CertificateError(f"unknown certificate schema {str(got)[:60]!r} (expected one of "
-                                   f"{', '.join(map(repr, _SCHEMAS))})")
-        res.schema = cert["schema"]
+        route, res.family, res.valence = route_of(cert)  # the one route of the registry (.registry.ROUTES)
+        res.schema, res.statement = route.schema, route.statement
         check_size(cert)
-        if res.schema == TAGGED_SCHEMA:  # a configuration name instead of a valence (docs/tagged_c1.md)
-            fam, n = parse_configuration(field_of(cert, "configuration", str, "certificate"))
-            if not isinstance(n, dict):
-                res.valence = verify_tagged(cert, part, log)
-            elif fam == "dart":  # every K >= K0 at once, "C1" (dart_tail)
-                res.valence = verify_dart_tail(cert, n["min"], part, log)
-            else:  # every N >= N0 at once, "not C1" (tagged_limit)
-                res.valence = verify_tail(cert, fam, n["min"], part, log)
-            res.seconds = time.perf_counter() - t0
-            return res
-        res.valence = read_valence(cert)
-        res.N = cert.get("N") if isinstance(cert.get("N"), int) else None
-        _KINDS[res.schema](cert, res.valence, part, log)
+        res.N = cert.get("N") if isinstance(cert.get("N"), int) and not isinstance(cert.get("N"), bool) else None
+        route.check(cert, res.family, res.valence, part, log)
     except _MALFORMED as exc:
         res.error = f"{type(exc).__name__}: {exc}" if not isinstance(exc, CertificateError) else str(exc)
     res.seconds = time.perf_counter() - t0
@@ -110,7 +91,7 @@ def verify_file(path: str | Path, log: Callable[[str], object] = print) -> Verif
     Parameters
     ----------
     path : str or Path
-        A certificate file (JSON, schema ``ccproof.injectivity/3`` or ``ccproof.c1/2``).
+        A certificate file (JSON, one of the schemas of :data:`.registry.ROUTES`).
     log : callable
         Receives each output line (default ``print``).
 
@@ -219,45 +200,6 @@ def certificate_files(directory):
     ('c1', 'k003.json', 'injectivity')
     """
     d = Path(directory)
-    tagged = sorted(f for fam in ("dart", "crease", "corner") for f in (d / "c1" / fam).glob("[kn]*.json"))
+    tagged = sorted(f for fam in TAGGED for f in (d / "c1" / fam).glob("[kn]*.json"))
     return sorted((d / "c1").glob("k*.json")) + tagged + sorted((d / "injectivity").glob("k*.json"))
 
-
-def check_coverage(valences):
-    """Do the valences (ints and {'min': k0}) cover every k >= 3? Returns (ok, message).
-
-    Every k >= 3 must be covered at least once: k = 3..k0-1 each by its own certificate, where k0 is the
-    smallest interval certificate {'min': k0}. Interval certificates may overlap each other and single
-    valences (a k >= k0 certificate next to the k >= 40 one, or k = 39 next to k >= 10), since a
-    statement proved twice is still proved; a single valence may appear at most once (a second file
-    for the same k is a publishing mistake).
-
-    Parameters
-    ----------
-    valences : iterable of int or dict ``{"min": k0}``
-
-    Returns
-    -------
-    (bool, str)
-
-    Examples
-    --------
-    >>> check_coverage([3, 4, {"min": 5}])
-    (True, 'every k >= 3 covered (3..4 one by one, k >= 5)')
-    >>> check_coverage([3, {"min": 5}])
-    (False, 'missing valences [4]')
-    """
-    ints = sorted(v for v in valences if isinstance(v, int))
-    tails = sorted({v["min"] for v in valences if isinstance(v, dict)})
-    if len(set(ints)) != len(ints):
-        return False, "a valence is claimed twice"
-    if not tails:
-        return False, "no interval k >= k0"
-    k0 = tails[0]
-    missing = sorted(set(range(3, k0)) - set(ints))
-    if missing:
-        return False, f"missing valences {missing}"
-    over = [k for k in ints if k >= k0]
-    return True, (f"every k >= 3 covered (3..{k0 - 1} one by one, k >= {k0}"
-                  + ("".join(f", k >= {t}" for t in tails[1:]))
-                  + (f"; covered twice: {over[0]}..{over[-1]}" if over else "") + ")")

@@ -24,8 +24,6 @@ from .replay import check_boxes, parse_decimal, read_boxes
 from .spectrum import check_block_polynomials, spectral_ordering
 from .statement import PATCHES, StatementError, c_lam, derivation, nets_for_valence
 
-C1_SCHEMA = "ccproof.c1/2"
-
 
 def verify_c1(cert, k, part, log):
     """Check a C1 certificate (module docstring: Reif's criterion; docs/certificates.md) into ``part``.

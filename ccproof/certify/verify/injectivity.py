@@ -29,10 +29,10 @@ from .maps import (
     square_inside_image,
 )
 from .record import exact_keys, field_of, kname
+from .registry import SCHEMA  # noqa: F401 (named in the examples)
 from .replay import check_boxes, parse_decimal, read_boxes
 from .statement import PATCHES, StatementError, c_lam, derivation, nets_for_valence
 
-SCHEMA = "ccproof.injectivity/3"
 _CELL_KEY = re.compile(r"[0-9]{1,4},[0-9]{1,4},[0-2],[0-2]")
 MAX_LEVEL = 6  # N: every published certificate, every k >= 3, needs at most 5; the required cells grow as 4^N
 

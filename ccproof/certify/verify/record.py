@@ -38,13 +38,19 @@ class VerifyResult:
     """The verdict on one certificate: ``ok`` only when every part passed; ``parts`` in order; ``error``
     names why the file could not be checked at all (malformed, unknown field), else None. True as a bool
     exactly when ``ok``. ``margins`` maps a section (``regularity``, ``cells``, ``corner``, ``star``) to the
-    smallest bound re-checked in this run.
+    smallest bound re-checked in this run. ``family``, ``valence`` and ``statement`` are what the verifier
+    checked (set by :func:`ccproof.certify.verify.verify_certificate` from the bytes it verified, before the
+    checks: a failed result may carry them too); ``configuration`` names the two first.
 
     Attributes
     ----------
     path, schema : str or None
+    family : str or None
+        ``"smooth"``, ``"dart"``, ``"crease"`` or ``"corner"``.
     valence : int or dict or None
-        k, or ``{"min": k0}`` for every k >= k0.
+        k (N, K), or ``{"min": k0}`` for every k >= k0.
+    statement : str or None
+        ``"injective"``, ``"C1"`` or ``"not C1"``.
     N : int or None
     parts : list of Part
     error : str or None
@@ -57,16 +63,24 @@ class VerifyResult:
     >>> r = VerifyResult(parts=[Part("A", True), Part("B", False, "a coefficient is not above the bound")])
     >>> bool(r), [p.name for p in r.failures()]
     (False, ['B'])
+    >>> VerifyResult(family="crease", valence={"min": 101}, statement="not C1").configuration
+    'crease:>=101'
     """
 
     path: str | None = None
     schema: str | None = None
+    family: str | None = None
     valence: object = None
+    statement: str | None = None
     N: int | None = None
     parts: list = field(default_factory=list)
     error: str | None = None
     seconds: float = 0.0
     margins: dict = field(default_factory=dict)
+
+    @property
+    def configuration(self):
+        return None if self.family is None or self.valence is None else f"{self.family}:{kname(self.valence)}"
 
     @property
     def ok(self):

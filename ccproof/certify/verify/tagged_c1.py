@@ -54,6 +54,7 @@ from flint import arb, arb_mat, ctx, fmpq, fmpq_mat
 
 from .errors import CertificateError
 from .record import exact_keys, field_of
+from .registry import TAGGED_SCHEMA
 from .replay import parse_decimal
 from .tagged import (
     crease_block,
@@ -70,7 +71,6 @@ from .tagged_map import check_map
 from .tagged_modes import MIN_N, even_vector, mode_spectrum, mode_vector
 from .tagged_refute import chain_generic, chain_top, flip_generic, mode_generic, ordering, same_root
 
-TAGGED_SCHEMA = "ccproof.tagged-c1/1"
 STATEMENTS = ("C1", "not C1")
 _W = (fmpq(1, 6), fmpq(4, 6), fmpq(1, 6))
 _DW = (fmpq(-1, 2), fmpq(0), fmpq(1, 2))

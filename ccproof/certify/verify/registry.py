@@ -1,0 +1,316 @@
+"""The certificate families: one registry that every entry point dispatches through, and the coverage of
+what the verifier proved, decided from its own verdicts (trusted).
+
+A :class:`Route` is one family of certificates: its schema, the configurations it speaks about (the
+grammar ``smooth:K``, ``smooth:>=K0``, ``dart:K``, ``crease:N``, ``corner:N``, ``dart:>=K0``,
+``crease:>=N0``, ``corner:>=N0``), the statement it proves (``"injective"``, ``"C1"``, ``"not C1"``) and
+its checker. :func:`route_of` reads the schema and the configuration of a parsed certificate and picks
+the one route that checks it; :func:`coverage` decides, from the :class:`~.record.VerifyResult` objects
+the verifier produced (never from a file), which configurations are certified and which are missing.
+The prover reads the same table (``ccproof.certify.prover.PROVERS`` has one prover per route).
+
+>>> [r.name for r in routes_for("crease:5")]
+['tagged not C1', 'tagged C1']
+>>> [r.name for r in routes_for("smooth:>=40")]
+['smooth injective', 'smooth C1']
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from .errors import CertificateError
+from .record import field_of, read_valence
+
+#: the schemas, one per kind of hints (docs/certificates.md)
+SCHEMA = "ccproof.injectivity/3"
+C1_SCHEMA = "ccproof.c1/2"
+TAGGED_SCHEMA = "ccproof.tagged-c1/1"
+TAGGED = ("dart", "crease", "corner")
+
+
+@dataclass(frozen=True)
+class Route:
+    """One family of certificates.
+
+    Attributes
+    ----------
+    name : str
+        How the prover and the reports refer to it.
+    schema : str
+    families : tuple of str
+        ``("smooth",)`` or some of :data:`TAGGED`.
+    sizes : tuple of str
+        ``"one"`` (a single valence or N), ``"every"`` (every K >= K0 at once), or both.
+    statement : str
+        ``"injective"``, ``"C1"`` or ``"not C1"``.
+    check : callable (cert, family, n, part, log) -> None
+        Records its parts into ``part``; raises :class:`CertificateError` on a malformed certificate.
+    """
+
+    name: str
+    schema: str
+    families: tuple
+    sizes: tuple
+    statement: str
+    check: Callable
+
+    def takes(self, family, n):
+        """Does this route speak about ``family`` with size ``n`` (an int or ``{"min": N0}``)?"""
+        return family in self.families and ("every" if isinstance(n, dict) else "one") in self.sizes
+
+
+# The checkers, each imported when its route is taken (verifying one kind of certificate loads that kind's
+# modules only).
+def _injectivity(cert, fam, k, part, log):
+    from .injectivity import verify_injectivity
+
+    verify_injectivity(cert, k, part, log)
+
+
+def _c1(cert, fam, k, part, log):
+    from .c1 import verify_c1
+
+    verify_c1(cert, k, part, log)
+
+
+def _tagged_one(cert, fam, n, part, log):
+    from .tagged_c1 import verify_tagged
+
+    verify_tagged(cert, part, log)
+
+
+def _dart_tail(cert, fam, n, part, log):
+    from .dart_tail import verify_dart_tail
+
+    verify_dart_tail(cert, n["min"], part, log)
+
+
+def _tagged_tail(cert, fam, n, part, log):
+    from .tagged_limit import verify_tail
+
+    verify_tail(cert, fam, n["min"], part, log)
+
+
+#: every family of certificates the verifier checks, in the order the prover tries them for a configuration
+ROUTES = (
+    Route("smooth injective", SCHEMA, ("smooth",), ("one", "every"), "injective", _injectivity),
+    Route("smooth C1", C1_SCHEMA, ("smooth",), ("one", "every"), "C1", _c1),
+    Route("tagged not C1", TAGGED_SCHEMA, TAGGED, ("one",), "not C1", _tagged_one),
+    Route("tagged C1", TAGGED_SCHEMA, TAGGED, ("one",), "C1", _tagged_one),
+    Route("dart:>=K0 C1", TAGGED_SCHEMA, ("dart",), ("every",), "C1", _dart_tail),
+    Route("crease, corner:>=N0 not C1", TAGGED_SCHEMA, ("crease", "corner"), ("every",), "not C1", _tagged_tail),
+)
+SCHEMAS = tuple(dict.fromkeys(r.schema for r in ROUTES))
+
+
+def configuration_of(name):
+    """``(family, n)`` of a configuration name: ``smooth:K``, ``smooth:>=K0`` or a tagged one
+    (:func:`.tagged.parse_configuration`); n is an int or ``{"min": N0}``.
+
+    Examples
+    --------
+    >>> configuration_of("smooth:>=40"), configuration_of("dart:7")
+    (('smooth', {'min': 40}), ('dart', 7))
+    """
+    from .tagged import parse_configuration
+
+    fam, _, size = str(name).partition(":")
+    if fam != "smooth":
+        return parse_configuration(name)
+    every = size.startswith(">=")
+    digits = size[2:] if every else size
+    if not (digits.isascii() and digits.isdigit()) or len(digits) > 7:
+        raise CertificateError(f"configuration {str(name)[:40]!r} is not smooth:K or smooth:>=K0")
+    k = read_valence({"valence": {"min": int(digits)} if every else int(digits)})
+    return fam, k
+
+
+def routes_for(name):
+    """The routes that can certify the configuration ``name``, in :data:`ROUTES` order (the prover's)."""
+    fam, n = configuration_of(name)
+    return [r for r in ROUTES if r.takes(fam, n)]
+
+
+def route_of(cert):
+    """``(route, family, n)`` for a parsed certificate: the schema picks the families, the configuration
+    (``valence`` of a smooth certificate, ``configuration`` of a tagged one) the size, and a tagged
+    certificate's ``statement`` the route among those that take the configuration.
+
+    Raises
+    ------
+    CertificateError
+        An unknown schema, a malformed configuration, or a statement no route proves for it.
+
+    Examples
+    --------
+    >>> route, fam, n = route_of({"schema": TAGGED_SCHEMA, "configuration": "corner:>=101", "statement": "not C1"})
+    >>> route.name, fam, n
+    ('crease, corner:>=N0 not C1', 'corner', {'min': 101})
+    >>> route_of({"schema": TAGGED_SCHEMA, "configuration": "dart:>=101", "statement": "not C1"})
+    Traceback (most recent call last):
+    ...
+    ccproof.certify.verify.errors.CertificateError: dart:>=K0 is certified "C1" only (its statement is fixed ...)
+    """
+    schema = cert.get("schema") if isinstance(cert, dict) else None
+    if schema not in SCHEMAS:
+        raise CertificateError(f"unknown certificate schema {str(schema)[:60]!r} (expected one of "
+                               f"{', '.join(map(repr, SCHEMAS))})")
+    if schema != TAGGED_SCHEMA:
+        k = read_valence(cert)
+        return next(r for r in ROUTES if r.schema == schema), "smooth", k
+    from .tagged import parse_configuration
+
+    fam, n = parse_configuration(field_of(cert, "configuration", str, "certificate"))
+    routes = [r for r in ROUTES if r.schema == schema and r.takes(fam, n)]
+    statement = field_of(cert, "statement", str, "certificate")
+    for r in routes:
+        if r.statement == statement:
+            return r, fam, n
+    if isinstance(n, dict):
+        said = " or ".join(f'"{r.statement}"' for r in routes)
+        raise CertificateError(f"{fam}:>={'K0' if fam == 'dart' else 'N0'} is certified {said} only (its statement "
+                               "is fixed by the configuration)")
+    raise CertificateError(f"statement must be one of {tuple(r.statement for r in routes)}, got {statement[:20]!r}")
+
+
+#: per tagged family, the configurations a complete run accounts for one by one (each certified or undecided);
+#: every N above the range needs a verified ``FAMILY:>=N0`` with N0 at most the range's end + 1
+TAGGED_RANGE = {"dart": (2, 100), "crease": (1, 100), "corner": (1, 100)}
+#: the configurations of the ranges that no certificate decides yet, with the reason (docs/tagged_c1.md); one
+#: that has a verified certificate counts as certified
+UNDECIDED = {
+    "crease:1": "lam2 = 1/4 in a Jordan block",
+    "crease:4": "lam2 = 1/2 in a Jordan block",
+    "corner:2": "lam1 = 1/2 triple with a Jordan block",
+}
+
+
+def coverage(results):
+    """``(ok, lines)``: what the verified results cover, decided from the results alone (their family,
+    size and statement, set by the verifier; nothing is read from a file). Smooth C1 and injectivity:
+    every k >= 3 (:func:`check_coverage`); each tagged family: :func:`family_coverage`.
+
+    Parameters
+    ----------
+    results : iterable of VerifyResult
+        Failed results count for nothing.
+
+    Returns
+    -------
+    (bool, list of str)
+
+    Examples
+    --------
+    >>> from ccproof.certify.verify.record import Part, VerifyResult
+    >>> r = VerifyResult(family="smooth", valence={"min": 3}, statement="C1", parts=[Part("S", True)])
+    >>> ok, lines = coverage([r, VerifyResult(family="smooth", valence={"min": 3}, statement="injective")])
+    >>> ok, lines[0][:29], lines[1]
+    (False, 'C1 (Reif) coverage: OK: every', 'injectivity (Appendix A) coverage: INCOMPLETE: no interval k >= k0')
+    """
+    verified = [r for r in results if r and r.family is not None and r.statement is not None]
+    ok_all, lines = True, []
+    for label, statement in (("C1 (Reif)", "C1"), ("injectivity (Appendix A)", "injective")):
+        ok, msg = check_coverage([r.valence for r in verified if r.family == "smooth" and r.statement == statement])
+        lines.append(f"{label} coverage: {'OK' if ok else 'INCOMPLETE'}: {msg}")
+        ok_all &= ok
+    for fam in TAGGED:
+        ok, line = family_coverage(fam, [(r.valence, r.statement) for r in verified if r.family == fam])
+        lines.append(line)
+        ok_all &= ok
+    return ok_all, lines
+
+
+def family_coverage(fam, certified):
+    """``(ok, line)`` for one tagged family: the N certified C1 and not C1; ok unless a configuration is
+    certified twice (a statement and its negation, or a publishing mistake; a single N inside a
+    ``FAMILY:>=N0`` with the other statement), an N of :data:`TAGGED_RANGE` is neither certified nor in
+    :data:`UNDECIDED`, or no ``FAMILY:>=N0`` reaches past the range.
+
+    Parameters
+    ----------
+    fam : str
+    certified : list of (int or dict, str)
+        ``(n, statement)`` of each verified certificate of the family.
+
+    Examples
+    --------
+    >>> family_coverage("crease", [(5, "not C1"), (5, "not C1")])[1][:49]
+    'crease: CONTRADICTORY: certified twice: [5]; C1 f'
+    >>> family_coverage("crease", [(5, "not C1")])[1][:60]
+    'crease: INCOMPLETE: no certificate for 2-3, 6-100, >= 101; C'
+    >>> ok, line = family_coverage("corner", [(n, "not C1") for n in (1, 3, 4)] + [({"min": 5}, "not C1")])
+    >>> ok, line[:60], line[60:]
+    (True, 'corner: OK (corner:1-100, every N): C1 for none, not C1 for ', '1, 3-4, >= 5; undecided: 2 (lam1 ...)')
+    """
+    rows = [(n, st) for n, st in certified if not isinstance(n, dict)]
+    tails = sorted((n["min"], st) for n, st in certified if isinstance(n, dict))
+    ns = [n for n, _ in rows]
+    twice = sorted({n for n in ns if ns.count(n) > 1}) or sorted(
+        n for n, st in rows for t, st_t in tails if n >= t and st != st_t)
+    lo, hi = TAGGED_RANGE[fam]
+    n0 = min((t for t, _ in tails), default=hi + 2)
+    open_ = [n for n in range(lo, min(hi, n0 - 1) + 1) if n not in ns]
+    undecided = [n for n in open_ if f"{fam}:{n}" in UNDECIDED]
+    missing = [_ranges([n for n in open_ if n not in undecided])] + ([f">= {hi + 1}"] if n0 > hi + 1 else [])
+    missing = ", ".join(filter(None, missing))
+    said = {st: ", ".join(filter(None, [_ranges(sorted(n for n, s in rows if s == st))]
+                                 + [f">= {t}" for t, s in tails if s == st])) or "none" for st in ("C1", "not C1")}
+    status = (f"CONTRADICTORY: certified twice: {twice}; " if twice else f"INCOMPLETE: no certificate for {missing}; "
+              if missing else f"OK ({fam}:{lo}-{hi}, every N): ")
+    why = ", ".join(f"{n} ({UNDECIDED[f'{fam}:{n}']})" for n in undecided) or "none"
+    return not twice and not missing, (f"{fam}: {status}C1 for {said['C1']}, not C1 for {said['not C1']}; "
+                                       f"undecided: {why}")
+
+
+def check_coverage(valences):
+    """Do the valences (ints and {'min': k0}) cover every k >= 3? Returns (ok, message).
+
+    Every k >= 3 must be covered at least once: k = 3..k0-1 each by its own certificate, where k0 is the
+    smallest interval certificate {'min': k0}. Interval certificates may overlap each other and single
+    valences (a k >= k0 certificate next to the k >= 40 one, or k = 39 next to k >= 10), since a
+    statement proved twice is still proved; a single valence may appear at most once (a second file
+    for the same k is a publishing mistake).
+
+    Parameters
+    ----------
+    valences : iterable of int or dict ``{"min": k0}``
+
+    Returns
+    -------
+    (bool, str)
+
+    Examples
+    --------
+    >>> check_coverage([3, 4, {"min": 5}])
+    (True, 'every k >= 3 covered (3..4 one by one, k >= 5)')
+    >>> check_coverage([3, {"min": 5}])
+    (False, 'missing valences [4]')
+    """
+    ints = sorted(v for v in valences if isinstance(v, int))
+    tails = sorted({v["min"] for v in valences if isinstance(v, dict)})
+    if len(set(ints)) != len(ints):
+        return False, "a valence is claimed twice"
+    if not tails:
+        return False, "no interval k >= k0"
+    k0 = tails[0]
+    missing = sorted(set(range(3, k0)) - set(ints))
+    if missing:
+        return False, f"missing valences {missing}"
+    over = [k for k in ints if k >= k0]
+    return True, (f"every k >= 3 covered (3..{k0 - 1} one by one, k >= {k0}"
+                  + ("".join(f", k >= {t}" for t in tails[1:]))
+                  + (f"; covered twice: {over[0]}..{over[-1]}" if over else "") + ")")
+
+
+def _ranges(ns):
+    """``[1, 2, 3, 5]`` -> ``'1-3, 5'``."""
+    out, i = [], 0
+    while i < len(ns):
+        j = i
+        while j + 1 < len(ns) and ns[j + 1] == ns[j] + 1:
+            j += 1
+        out.append(str(ns[i]) if i == j else f"{ns[i]}-{ns[j]}")
+        i = j + 1
+    return ", ".join(out)
