@@ -89,32 +89,29 @@ from pathlib import Path
 
 from flint import acb, arb, ctx, fmpq
 
+from ccproof.certify.verify import dart_curves as _C
+from ccproof.certify.verify import dart_regularity as _R
 from ccproof.certify.verify.dart_curves import (  # noqa: F401 (re-exported for the tests)
-    coord_box,
-    coord_disc,
-    coord_taylor,
     disc_trans,
-    layer_coord,
-    layer_trans_disc,
-    layer_trans_taylor,
     taylor_trans,
     ymid_box,
 )
 from ccproof.certify.verify.dart_family import (  # noqa: F401 (re-exported for the tests)
     CURVES,
     PIECES,
+    XB,
     YB,
     Family,
     _ball,
-    _parts,
+    _hvar,
+    basis_nets,
     bordered,
     layer_nets,
     piece_nets,
+    series_cap,
 )
 from ccproof.certify.verify.dart_regularity import (  # noqa: F401 (re-exported for the tests)
     disc_bounds,
-    kdet_box,
-    layer_box,
     layer_disc,
     layer_taylor,
     middle_box,
@@ -124,6 +121,58 @@ from ccproof.certify.verify.dart_regularity import (  # noqa: F401 (re-exported 
 from ccproof.certify.verify.dart_zeros import (  # noqa: F401 (re-exported for the tests)
     exact_zeros,
 )
+from ccproof.rigorous.analytic import disc_bound
+
+# the verifier's evaluators take analytic models (ccproof.rigorous.analytic); these keep the scripts' calls
+# on (Taylor coefficients, disc bounds, r, n)
+
+def _parts(T):
+    return sorted({key[2] for key in T})
+
+
+def kdet_box(T, M, s_lo, s_hi, h_lo, h_hi, sigma, r, n, prec=128):
+    return _R.kdet_box(_R.bulk_models(T, M, r), s_lo, s_hi, h_lo, h_hi, sigma, prec=prec)
+
+
+def layer_box(T, M, h_lo, h_hi, r, n, order=3, prec=128):
+    return _R.layer_box(_R.column_models(T, M, r), h_lo, h_hi, order=order, prec=prec)
+
+
+def coord_box(T, M, s_lo, s_hi, h_lo, h_hi, sigma, r, n, coord, prec=128):
+    models = _C.curve_models(T, M, r, XB if coord == "x" else YB)
+    return _C.coord_box(models, s_lo, s_hi, h_lo, h_hi, sigma, coord, prec=prec)
+
+
+def coord_taylor(sigma, n, coord, prec=128):
+    return _C.coord_taylor(sigma, n, coord, prec=prec)
+
+
+def coord_disc(sigma, r, coord, grid=12, prec=128):
+    with ctx.workprec(prec):
+        return disc_bound(lambda h: _C.coord_values(basis_nets(Family(h, sigma)), coord), r, grid)
+
+
+def layer_trans_taylor(q, sigma, n, prec=128):
+    with ctx.workprec(prec), series_cap(n):
+        fam = Family(_hvar(n), sigma)
+        return _C.layer_trans_series(fam, layer_nets(fam, q), n)
+
+
+def layer_trans_disc(q, sigma, r, grid=12, prec=128):
+    def values(h):
+        fam = Family(h, sigma)
+        return _C.layer_trans_values(fam, layer_nets(fam, q))
+    with ctx.workprec(prec):
+        return disc_bound(values, r, grid)
+
+
+def layer_coord(q, sigma, n, r, grid=12, prec=128):
+    """(Taylor coefficients {curve: [m: 4 arb]}, disc bounds {curve: M}) of Y on layer quadrant q's outer curves."""
+    with ctx.workprec(prec), series_cap(n):
+        T = _C.layer_y_series(layer_nets(Family(_hvar(n), sigma), q), n)
+        M = disc_bound(lambda h: _C.layer_y_values(layer_nets(Family(h, sigma), q)), r, grid) if grid else {}
+        return T, M
+
 
 # the outer curves of a quadrant's layer 0, as tagged_map/maps.STAR_CURVES: (piece, side, orientation)
 

@@ -1,9 +1,8 @@
 """The covers of a ``dart:>=K0`` record: bisection over the trusted evaluators, written as trees (untrusted).
 
-The verifier (:mod:`ccproof.certify.verify.dart_trees`) replays a tree and never searches; this module is the
-search. :func:`cover` bisects each grid cell of a region's root until the region's evaluator
-(:class:`~ccproof.certify.verify.dart_regularity.RegularityBox`,
-:class:`~ccproof.certify.verify.dart_curves.CurveBox`) proves the claim's sign on every leaf, and records the
+The verifier (:func:`ccproof.certify.verify.replay.replay_tree`) replays a tree and never searches; this module
+is the search. :func:`cover` bisects each grid cell of a region's root until the region's evaluator
+(:class:`~ccproof.certify.verify.dart_models.SigmaBox`) proves the claim's sign on every leaf, and records the
 leaves in the record's grammar (docs/certificates.md, "Every dart K >= K0 in one certificate"): a path of
 halvings per leaf, a bound a little inside the leaf's enclosure (floats choose the bound; the verifier
 decides), and ``outside`` leaves in the middle region where no K >= K0 lies. :func:`map_covers` builds the
@@ -19,10 +18,9 @@ import math
 
 from flint import fmpq
 
-from ccproof.certify.verify.dart_curves import CurveModels
-from ccproof.certify.verify.dart_regularity import RegularityModels
-from ccproof.certify.verify.dart_trees import leaf_box
+from ccproof.certify.verify.dart_models import DartModels
 from ccproof.certify.verify.errors import CertificateError
+from ccproof.certify.verify.replay import leaf_box
 
 
 def _inside(val, sign):
@@ -118,8 +116,7 @@ def map_covers(k0, sig_lo, sig_hi, hints, s0, layer, winding, prec=128, progress
     -------
     dict
     """
-    R = RegularityModels(sig_lo, sig_hi, hints, layer, prec)
-    C = CurveModels(sig_lo, sig_hi, hints, layer, prec)
+    models = DartModels(sig_lo, sig_hi, hints, layer, prec)
     h0, half = fmpq(1, k0), fmpq(1, 2)
     s_a, s_b = winding
     bulk, middle, hroot = [(s0, half), (fmpq(0), h0)], [(fmpq(0), s0), (fmpq(0), fmpq(1, layer))], [(fmpq(0), h0)]
@@ -128,7 +125,7 @@ def map_covers(k0, sig_lo, sig_hi, hints, s0, layer, winding, prec=128, progress
            "winding": {"Y<0 bulk": [], "X>0 bulk": [], "Y>0 bulk": [], "Y<0 middle": [],
                        "Y<0 layer": {str(q): [] for q in range(layer)}}}
     for i in range(hints.sigma_boxes):
-        rb, cb = R.sigma_box(i), C.sigma_box(i)
+        rb = cb = models.sigma_box(i)
         reg, tra, win = out["regularity"], out["transversal"], out["winding"]
         reg["bulk"].append(cover(bulk, rb.bulk, 1, [16, 1]))
         reg["middle"].append(cover(middle, rb.middle, 1, [1, 1], k0=k0, outside=True))

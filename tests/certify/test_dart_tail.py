@@ -24,9 +24,20 @@ def record():
     return json.loads(PUBLISHED.read_text())
 
 
-def _no_map(cert):
+def _tree(n, bound):
+    return {"grid": [1] * n, "leaves": [{"cell": [0] * n, "path": "", "bound": bound}]}
+
+
+def _no_map(cert, sigma_boxes=10, layer=3):
+    """The record with its map cut to one root leaf per tree, each claiming a bound its whole region does not
+    reach: the map step fails at its first leaf, after the models are built."""
     out = copy.deepcopy(cert)
-    out["parts"] = {}
+    pos, neg = ([_tree(n, b)] * sigma_boxes for n, b in ((2, "1e-9"), (2, "-1e-9")))
+    lay = {str(q): [_tree(1, "1e-9")] * sigma_boxes for q in range(layer)}
+    cover = {"bulk": pos, "middle": pos, "layer": lay}
+    out["parts"] = {"regularity": cover, "transversal": cover,
+                    "winding": {"Y<0 bulk": neg, "X>0 bulk": pos, "Y>0 bulk": pos, "Y<0 middle": neg,
+                                "Y<0 layer": {str(q): [_tree(1, "-1e-9")] * sigma_boxes for q in range(layer)}}}
     return out
 
 
@@ -44,7 +55,18 @@ def test_every_step_before_the_map_passes(record):
     res = verify_certificate(_no_map(record), **QUIET)
     names = [p.name[0] for p in res.parts if p.ok]
     assert names == ["S", "Z", "G", "E"], [(p.name, p.message) for p in res.parts]
-    assert res.failures()[0].name.startswith("M") and "parts" in res.failures()[0].message
+    assert res.failures()[0].name.startswith("M") and "R bulk, sigma box 0" in res.failures()[0].message
+
+
+def test_a_map_without_its_trees_fails_before_any_arithmetic(record):
+    cert = copy.deepcopy(record)
+    cert["parts"] = {}
+    res = _fails(cert, "parts")
+    assert not res.parts
+    cert = copy.deepcopy(record)
+    del cert["parts"]["regularity"]["bulk"][3]["leaves"][-1]
+    res = _fails(cert, "R bulk, sigma box 3")
+    assert not res.parts
 
 
 @pytest.mark.parametrize("change, why", [

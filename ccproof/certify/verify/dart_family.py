@@ -24,8 +24,6 @@ from dataclasses import dataclass
 
 from flint import acb, acb_mat, acb_poly, acb_series, arb, ctx, fmpq, fmpq_mat
 
-from ccproof.rigorous import BernsteinForm, bernstein_jacobian_determinant
-
 from .rules import CENTRE, canonical, level1_rule
 from .tagged_modes import _POS, ring_stencil
 
@@ -306,34 +304,6 @@ def piece_nets(level0, centre, lam, zero):
 XB, YB = ("X+", "X-"), ("Y0", "Y+", "Y-")
 
 
-def _real_forms(net, prec):
-    """(Re, Im) Bernstein forms of a 4 x 4 acb net."""
-    return tuple(BernsteinForm((4, 4), [getattr(acb(net[i][j]), part) for i in range(4) for j in range(4)], prec=prec)
-                 for part in ("real", "imag"))
-
-
-def _jac(a, b):
-    return bernstein_jacobian_determinant([a, b]).coeffs
-
-
-def partials(form):
-    """(d/du, d/dv) of a Bernstein form: computed once per form, then shared by every determinant it enters."""
-    return form.diff(0), form.diff(1)
-
-
-def jac_partials(pa, pb):
-    """det d(a, b)/d(u, v) from the partials: a_u b_v - a_v b_u, the operations of
-    :func:`~ccproof.rigorous.bernstein_jacobian_determinant` on two forms, in the same order."""
-    return (pa[0] * pb[1] - pa[1] * pb[0]).coeffs
-
-
-def complex_det_partials(pa, pb):
-    """:func:`complex_det` from the partials of the (Re, Im) forms (:func:`partials` of each)."""
-    rr, ii = jac_partials(pa[0], pb[0]), jac_partials(pa[1], pb[1])
-    ri, ir = jac_partials(pa[0], pb[1]), jac_partials(pa[1], pb[0])
-    return [acb(a - b, c + d) for a, b, c, d in zip(rr, ii, ri, ir)]
-
-
 _SU, _SH = 6, 36  # Kronecker strides: a product of bicubic partials has degree <= 5 in u and in v
 _BIN2, _BIN3, _BIN5 = (1, 2, 1), (1, 3, 3, 1), (1, 5, 10, 10, 5, 1)
 
@@ -356,18 +326,12 @@ def det_series(A, B, n):
     nets ``A[m]``, ``B[m]`` (4 x 4, acb): the Cauchy products of Bernstein forms as one polynomial product each
     (the scaled coefficients of a product are the plain convolution of the scaled factors, as in
     :meth:`~ccproof.rigorous.BernsteinForm.__mul__`; h, u, v packed with the strides above). Returns
-    ``[[36 acb, (i, j) row-major, degree (5, 5)] for m in 0..n]``, the coefficients of :func:`complex_det`."""
+    ``[[36 acb, (i, j) row-major] for m in 0..n]``: D's Bernstein coefficients (degree (5, 5))."""
     P = _packed(A, 0) * _packed(B, 1) - _packed(A, 1) * _packed(B, 0)
     c = P.coeffs()
     c += [acb(0)] * max(0, _SH * (n + 1) - len(c))
     return [[c[m * _SH + i * _SU + j] / (_BIN5[i] * _BIN5[j]) for i in range(6) for j in range(6)]
             for m in range(n + 1)]
-
-
-def complex_det(fa, fb):
-    """Bernstein coefficients (acb) of the bilinear D(A, B) = det d(A, B)/d(u, v) for complex nets given by
-    their (Re, Im) forms."""
-    return complex_det_partials(tuple(map(partials, fa)), tuple(map(partials, fb)))
 
 
 def basis_nets(fam):
@@ -447,9 +411,6 @@ def layer_nets(fam, q):
         out[name] = tuple(_bezier([[V(oa + i, ob + j) for j in range(4)] for i in range(4)], fam.zero)
                           for V in (VX, VY))
     return out
-
-
-_BIN3, _BIN2, _BIN5 = (1, 3, 3, 1), (1, 2, 1), (1, 5, 10, 10, 5, 1)
 
 
 def curve_points(nets, name):

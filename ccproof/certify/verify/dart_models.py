@@ -1,0 +1,279 @@
+"""The models R, T and W of a ``dart:>=K0`` record are replayed on, and the replay of its map trees (trusted).
+
+:class:`DartModels` bounds every quantity of :mod:`.dart_regularity` (R) and :mod:`.dart_curves` (T, W) on
+the complex h-square once, for the whole sigma bracket: one family per acb box, every quantity read off it
+(:func:`~ccproof.rigorous.analytic.disc_bound`). :class:`SigmaBox` holds the Taylor coefficients on one sigma
+box (one series family for the bulk, one for the layer quadrants) as analytic models; each evaluator returns
+one arb containing every value of its region's scaled quantity on a box (a list of (lo, hi) fmpq).
+:func:`read_map` reads the record's trees against the roots their regions fix (:func:`.replay.read_tree`),
+before any arithmetic; :func:`replay_map` replays them sigma box by sigma box (:func:`.replay.replay_tree`).
+"""
+
+from __future__ import annotations
+
+from flint import arb, ctx, fmpq
+
+from ccproof.rigorous.analytic import ball, disc_bound
+
+from . import dart_curves as C
+from . import dart_regularity as R
+from .dart_family import XB, YB, Family, _hvar, _series_curves, basis_nets, layer_nets, series_cap
+from .errors import CertificateError
+from .record import exact_keys
+from .replay import read_tree, replay_tree
+
+
+def _span(low, high):
+    """The arb ball [low, high] (both arb points or balls: their hull)."""
+    return arb(low).union(arb(high))
+
+
+def _split(M, tag):
+    return {key[1:] if len(key) > 2 else key[1]: v for key, v in M.items() if key[0] == tag}
+
+
+class DartModels:
+    """The disc bounds of R, T and W over the whole sigma bracket, and one :class:`SigmaBox` per sigma box.
+
+    Parameters
+    ----------
+    sig_lo, sig_hi : fmpq
+        The bracket of sigma(K) (shown by the spectrum and the eigenvector lemma).
+    hints : TaylorHints
+    layer : int
+        T: the layer quadrants are 0..T-1.
+    prec : int
+
+    Examples
+    --------
+    >>> from flint import fmpq
+    >>> from ccproof.certify.verify.dart_family import TaylorHints
+    >>> hints = TaylorHints(r=fmpq(1, 32), disc_grid=6, sigma_boxes=10, order=12, layer_order=14, exp_order=24)
+    >>> box = DartModels(fmpq(4484, 1000), fmpq(44935, 10000), hints, 0, 128).sigma_box(0)
+    >>> box.bulk([(fmpq(1, 4), fmpq(26, 100)), (fmpq(0), fmpq(1, 101))]) > 0  # K det J_Phi, every K >= 101
+    True
+    """
+
+    def __init__(self, sig_lo, sig_hi, hints, layer, prec):
+        self.hints, self.layer, self.prec = hints, layer, prec
+        self.edges = [fmpq(sig_lo) + (fmpq(sig_hi) - fmpq(sig_lo)) * fmpq(i, hints.sigma_boxes)
+                      for i in range(hints.sigma_boxes + 1)]
+        with ctx.workprec(prec):
+            self.M = disc_bound(self._values(ball(sig_lo, sig_hi)), hints.r, hints.disc_grid)
+        self._boxes = {}
+
+    def _values(self, sigma):
+        def values(h):
+            fam = Family(h, sigma)
+            nets = basis_nets(fam)
+            out = {("R",) + k: v for k, v in R.det_values(nets).items()}
+            out.update({("T",) + k: v for k, v in C.trans_values(fam, nets).items()})
+            out.update({("X",) + k: v for k, v in C.coord_values(nets, "x").items()})
+            out.update({("Y",) + k: v for k, v in C.coord_values(nets, "y").items()})
+            for q in range(self.layer):
+                ln = layer_nets(fam, q)
+                out.update({("RL", q, p): v for p, v in R.layer_det_values(ln).items()})
+                out.update({("TL", q, c): v for c, v in C.layer_trans_values(fam, ln).items()})
+                out.update({("YL", q, c): v for c, v in C.layer_y_values(ln).items()})
+            return out
+        return values
+
+    def bounds(self, tag, q=None):
+        """The disc bounds of one quantity ("R", "T", "X", "Y"; "RL", "TL", "YL" with a layer quadrant q)."""
+        if q is None:
+            return _split(self.M, tag)
+        return {key[2]: v for key, v in self.M.items() if key[:2] == (tag, q)}
+
+    def sigma_box(self, i):
+        """The models on sigma box i of ``hints.sigma_boxes`` equal boxes of the bracket (cached)."""
+        if not 0 <= i < self.hints.sigma_boxes:
+            raise IndexError(f"sigma box {i} of {self.hints.sigma_boxes}")
+        if i not in self._boxes:
+            self._boxes[i] = SigmaBox(self, i)
+        return self._boxes[i]
+
+
+class SigmaBox:
+    """The analytic models of R, T and W on one sigma box, and their evaluators (module docstring)."""
+
+    def __init__(self, models, i):
+        self.m, hn, prec, r = models, models.hints, models.prec, models.hints.r
+        with ctx.workprec(prec):
+            self.sigma = sigma = ball(models.edges[i], models.edges[i + 1])
+            with series_cap(hn.order):
+                fam = Family(_hvar(hn.order), sigma)
+                nets = basis_nets(fam)
+                self.TR, self.TT = R.dets_series(nets, hn.order), C.trans_series(fam, nets, hn.order)
+                coord = {b: _series_curves(nets[b], hn.order) for b in XB + YB}
+            self.TY = {(b, c): pts for b in YB for c, pts in coord[b].items()}
+            self.R = R.bulk_models(self.TR, models.bounds("R"), r)
+            self.T = R.bulk_models(self.TT, models.bounds("T"), r)
+            self.X = C.curve_models({(b, c): p for b in XB for c, p in coord[b].items()}, models.bounds("X"), r, XB)
+            self.Y = C.curve_models(self.TY, models.bounds("Y"), r, YB)
+            self.ER = R.middle_coeffs(self.TR, sigma, L=hn.exp_order)
+            self.ET = R.middle_coeffs(self.TT, sigma, L=hn.exp_order)
+            self._layers(hn.layer_order, r)
+
+    def _layers(self, n, r):
+        with series_cap(n):
+            fam = Family(_hvar(n), self.sigma)
+            self.L = {}
+            for q in range(self.m.layer):
+                ln = layer_nets(fam, q)
+                self.L[q] = (R.column_models(R.layer_dets_series(ln, n), self.m.bounds("RL", q), r),
+                             R.column_models(C.layer_trans_series(fam, ln, n), self.m.bounds("TL", q), r),
+                             R.column_models(C.layer_y_series(ln, n), self.m.bounds("YL", q), r))
+
+    def bulk(self, box):
+        """K det J_Phi on (s, h) in the box (the bulk, s in [s0, 1/2])."""
+        (s_lo, s_hi), (h_lo, h_hi) = box
+        return _span(*R.kdet_box(self.R, s_lo, s_hi, h_lo, h_hi, self.sigma, prec=self.m.prec))
+
+    def _middle(self, T, E, M, box):
+        (s_lo, s_hi), (w_lo, w_hi) = box
+        hn = self.m.hints
+        return _span(*R.middle_box(T, E, M, s_lo, s_hi, w_lo, w_hi, self.sigma, hn.r, hn.order, L=hn.exp_order,
+                                   prec=self.m.prec))
+
+    def middle(self, box):
+        """K^3 det J_Phi/q^2 as a function of (s, w = 1/q) in the box (the middle)."""
+        return self._middle(self.TR, self.ER, self.m.bounds("R"), box)
+
+    def layer(self, q, box):
+        """K^3 det J_Phi of layer quadrant q on h in the box."""
+        ((h_lo, h_hi),) = box
+        return _span(*R.layer_box(self.L[q][0], h_lo, h_hi, prec=self.m.prec))
+
+    def transversal_bulk(self, box):
+        """K (a1 X Y' - a2 Y X') on the four outer curves, (s, h) in the box."""
+        (s_lo, s_hi), (h_lo, h_hi) = box
+        return _span(*R.kdet_box(self.T, s_lo, s_hi, h_lo, h_hi, self.sigma, prec=self.m.prec))
+
+    def transversal_middle(self, box):
+        """K^3 (a1 X Y' - a2 Y X')/q^2 as a function of (s, w = 1/q) in the box."""
+        return self._middle(self.TT, self.ET, self.m.bounds("T"), box)
+
+    def transversal_layer(self, q, box):
+        """K^3 (a1 X Y' - a2 Y X') on layer quadrant q's outer curves, h in the box."""
+        ((h_lo, h_hi),) = box
+        return _span(*R.layer_box(self.L[q][1], h_lo, h_hi, prec=self.m.prec))
+
+    def x_bulk(self, box):
+        """X on every outer-curve Bezier point, (s, h) in the box."""
+        (s_lo, s_hi), (h_lo, h_hi) = box
+        return _span(*C.coord_box(self.X, s_lo, s_hi, h_lo, h_hi, self.sigma, "x", prec=self.m.prec))
+
+    def y_bulk(self, box):
+        """Y on every outer-curve Bezier point, (s, h) in the box."""
+        (s_lo, s_hi), (h_lo, h_hi) = box
+        return _span(*C.coord_box(self.Y, s_lo, s_hi, h_lo, h_hi, self.sigma, "y", prec=self.m.prec))
+
+    def y_middle(self, box):
+        """Y/s on every outer-curve Bezier point, (s, w) in the box."""
+        (s_lo, s_hi), (w_lo, w_hi) = box
+        hn = self.m.hints
+        return _span(*C.ymid_box(self.TY, self.m.bounds("Y"), s_lo, s_hi, w_lo, w_hi, self.sigma, hn.r, hn.order,
+                                 L=hn.exp_order, prec=self.m.prec))
+
+    def y_layer(self, q, box):
+        """K Y on layer quadrant q's outer-curve points (K^2 Y at ray 0's end point of quadrant 0), h in the box."""
+        ((h_lo, h_hi),) = box
+        return _span(*C.layer_y_box(self.L[q][2], q, h_lo, h_hi, prec=self.m.prec))
+
+
+def _lists(parts, k0, s0, layer, winding):
+    """(name, trees, root, evaluator name, sign, outside allowed) of every tree list of the record's parts."""
+    s_a, s_b = winding
+    half, h0 = fmpq(1, 2), fmpq(1, k0)
+    exact_keys(parts, ("regularity", "transversal", "winding"), "parts")
+    reg, tra, win = parts["regularity"], parts["transversal"], parts["winding"]
+    for name, obj in (("regularity", reg), ("transversal", tra)):
+        exact_keys(obj, ("bulk", "middle", "layer"), name)
+    exact_keys(win, ("Y<0 bulk", "X>0 bulk", "Y>0 bulk", "Y<0 middle", "Y<0 layer"), "winding")
+    quads = tuple(str(q) for q in range(layer))
+    for name, obj in (("regularity layer", reg["layer"]), ("transversal layer", tra["layer"]),
+                      ("winding Y<0 layer", win["Y<0 layer"])):
+        exact_keys(obj, quads, name)
+    bulk, middle = [(s0, half), (fmpq(0), h0)], [(fmpq(0), s0), (fmpq(0), fmpq(1, layer))]
+    hroot = [(fmpq(0), h0)]
+    lists = [("R bulk", reg["bulk"], bulk, "bulk", 1, False), ("R middle", reg["middle"], middle, "middle", 1, True),
+             ("T bulk", tra["bulk"], bulk, "transversal_bulk", 1, False),
+             ("T middle", tra["middle"], middle, "transversal_middle", 1, True),
+             ("Y<0 bulk", win["Y<0 bulk"], [(s0, s_a), (fmpq(0), h0)], "y_bulk", -1, False),
+             ("X>0 bulk", win["X>0 bulk"], [(s_a, s_b), (fmpq(0), h0)], "x_bulk", 1, False),
+             ("Y>0 bulk", win["Y>0 bulk"], [(s_b, half), (fmpq(0), h0)], "y_bulk", 1, False),
+             ("Y<0 middle", win["Y<0 middle"], middle, "y_middle", -1, True)]
+    for q in quads:
+        lists += [(f"R layer {q}", reg["layer"][q], hroot, ("layer", int(q)), 1, False),
+                  (f"T layer {q}", tra["layer"][q], hroot, ("transversal_layer", int(q)), 1, False),
+                  (f"Y<0 layer {q}", win["Y<0 layer"][q], hroot, ("y_layer", int(q)), -1, False)]
+    return lists
+
+
+def read_map(parts, k0, hints, s0, layer, winding):
+    """Step 1 for the map: every tree of R, T and W read against the root its region fixes, no arithmetic.
+
+    Parameters
+    ----------
+    parts : object (parsed JSON)
+        ``{"regularity": cover, "transversal": cover, "winding": signs}`` (docs/certificates.md).
+    k0 : int
+    hints : TaylorHints
+    s0 : fmpq
+        The bulk is s in [s0, 1/2]; the middle is (s, w) in [0, s0] x [0, 1/layer].
+    layer : int
+        T >= 3: the layer quadrants 0..T-1.
+    winding : (fmpq, fmpq)
+        (s_a, s_b), s0 < s_a < s_b < 1/2.
+
+    Returns
+    -------
+    list of (name, evaluator name, sign, [leaves per sigma box])
+
+    Raises
+    ------
+    CertificateError
+        Naming the list and the leaf.
+
+    Examples
+    --------
+    >>> from flint import fmpq
+    >>> from ccproof.certify.verify.dart_family import TaylorHints
+    >>> hints = TaylorHints(fmpq(1, 32), 12, 10, 12, 14, 24)
+    >>> read_map({}, 101, hints, fmpq(1, 20), 3, (fmpq(1, 4), fmpq(7, 20)))
+    Traceback (most recent call last):
+    ...
+    ccproof.certify.verify.errors.CertificateError: parts: ...
+    """
+    s_a, s_b = winding
+    if not (0 < s0 < s_a < s_b < fmpq(1, 2) and layer >= 3 and fmpq(1, k0) < hints.r and s0 / layer < hints.r):
+        raise CertificateError("regions: need 0 < s0 < s_a < s_b < 1/2, T >= 3, 1/K0 < r and s0/T < r")
+    out = []
+    for name, trees, root, method, sign, outside in _lists(parts, k0, s0, layer, winding):
+        if not isinstance(trees, list) or len(trees) != hints.sigma_boxes:
+            raise CertificateError(f"{name}: one tree per sigma box ({hints.sigma_boxes}) is needed")
+        out.append((name, method, sign, [read_tree(t, root, f"{name}, sigma box {i}", sign, k0=k0, outside=outside)
+                                         for i, t in enumerate(trees)]))
+    return out
+
+
+def replay_map(lists, sig_lo, sig_hi, hints, layer, prec):
+    """Step 6 of a ``dart:>=K0`` record: the lists of :func:`read_map` replayed on the trusted models, sigma
+    box by sigma box; {list name: (leaves evaluated, least bound)}. Raises CertificateError naming the leaf."""
+    models = DartModels(sig_lo, sig_hi, hints, layer, prec)
+    summary = {}
+    for i in range(hints.sigma_boxes):
+        box = models.sigma_box(i)
+        for name, method, sign, leaves in lists:
+            if isinstance(method, tuple):
+                fn, q = getattr(box, method[0]), method[1]
+
+                def evaluate(b, fn=fn, q=q):
+                    return fn(q, b)
+            else:
+                evaluate = getattr(box, method)
+            count, least = replay_tree(leaves[i], evaluate, sign, f"{name}, sigma box {i}")
+            old = summary.get(name, (0, None))
+            best = least if old[1] is None or (least is not None and abs(least) < abs(old[1])) else old[1]
+            summary[name] = (old[0] + count, best)
+    return summary
