@@ -180,12 +180,10 @@ def layer_y_box(models, q, h_lo, h_hi, prec=128):
     with ctx.workprec(prec):
         low = high = None
         for c, model in models.items():
-            for order in (1, 2):
-                V, rho = model.enclose(h_lo, h_hi, low=order)
-                for p in range(4):
-                    if (order == 2) != (q == 0 and c == "P1s1" and p == 0):
-                        continue
-                    v = V[p, 0].real + arb(0, rho[0].upper())
-                    low = v.lower() if low is None or v.lower() < low else low
-                    high = v.upper() if high is None or v.upper() > high else high
+            enclosures = {order: model.enclose(h_lo, h_hi, low=order) for order in (1, 2)}
+            for p in range(4):
+                V, rho = enclosures[2 if (q == 0 and c == "P1s1" and p == 0) else 1]
+                v = V[p, 0].real + arb(0, rho[0].upper())
+                low = v.lower() if low is None or v.lower() < low else low
+                high = v.upper() if high is None or v.upper() > high else high
         return low, high
