@@ -102,7 +102,6 @@ from ccproof.certify.verify.dart_family import (  # noqa: F401 (re-exported for 
     XB,
     YB,
     Family,
-    _ball,
     _hvar,
     basis_nets,
     bordered,
@@ -121,6 +120,7 @@ from ccproof.certify.verify.dart_regularity import (  # noqa: F401 (re-exported 
 from ccproof.certify.verify.dart_zeros import (  # noqa: F401 (re-exported for the tests)
     exact_zeros,
 )
+from ccproof.rigorous.analytic import ball as _ball  # noqa: F401 (re-exported for the tests)
 from ccproof.rigorous.analytic import disc_bound
 
 # the verifier's evaluators take analytic models (ccproof.rigorous.analytic); these keep the scripts' calls

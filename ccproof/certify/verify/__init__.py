@@ -28,7 +28,7 @@ from .dart_tail import verify_dart_tail
 from .errors import CertificateError
 from .injectivity import SCHEMA, verify_injectivity
 from .record import Part, Recorder, VerifyResult, field_of, read_valence
-from .replay import check_size
+from .replay import check_size, close_budget
 from .tagged import parse_configuration
 from .tagged_c1 import TAGGED_SCHEMA, verify_tagged
 from .tagged_limit import verify_tail
@@ -97,6 +97,8 @@ def verify_certificate(cert, log=print, path=None):
         _KINDS[res.schema](cert, res.valence, part, log)
     except _MALFORMED as exc:
         res.error = f"{type(exc).__name__}: {exc}" if not isinstance(exc, CertificateError) else str(exc)
+    finally:
+        close_budget()  # the replay budget that check_size opened for this certificate
     res.seconds = time.perf_counter() - t0
     return res
 

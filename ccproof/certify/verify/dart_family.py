@@ -339,16 +339,6 @@ def basis_nets(fam):
     return {name: piece_nets(f, c, lam, fam.zero) for name, (f, c, lam) in fam.parts().items()}
 
 
-def _ball(lo, hi):
-    lo, hi = fmpq(lo), fmpq(hi)
-    return arb((lo + hi) / 2, (hi - lo) / 2)
-
-
-def _parts(T):
-    """The pieces (or outer curves) that a Taylor dict keyed (i, j, part) covers."""
-    return sorted({key[2] for key in T})
-
-
 def layer_level0(fam, q):
     """(x(t, p), y(t, p), x_C, y_C) at integer sectors t (any sign) for the layer quadrant q, as analytic
     functions of h (fam.h of any type): x = (v^(p) w^t - v^(p~) w^(-t-eps))/(2i) (one mode, every t),

@@ -28,10 +28,6 @@ def _span(low, high):
     return arb(low).union(arb(high))
 
 
-def _split(M, tag):
-    return {key[1:] if len(key) > 2 else key[1]: v for key, v in M.items() if key[0] == tag}
-
-
 class DartModels:
     """The disc bounds of R, T and W over the whole sigma bracket, and one :class:`SigmaBox` per sigma box.
 
@@ -81,7 +77,7 @@ class DartModels:
     def bounds(self, tag, q=None):
         """The disc bounds of one quantity ("R", "T", "X", "Y"; "RL", "TL", "YL" with a layer quadrant q)."""
         if q is None:
-            return _split(self.M, tag)
+            return {key[1:]: v for key, v in self.M.items() if key[0] == tag}
         return {key[2]: v for key, v in self.M.items() if key[:2] == (tag, q)}
 
     def sigma_box(self, i):
@@ -123,6 +119,13 @@ class SigmaBox:
                 self.L[q] = (R.column_models(R.layer_dets_series(ln, n), self.m.bounds("RL", q), r),
                              R.column_models(C.layer_trans_series(fam, ln, n), self.m.bounds("TL", q), r),
                              R.column_models(C.layer_y_series(ln, n), self.m.bounds("YL", q), r))
+
+    def evaluator(self, method):
+        """The evaluator (box) -> arb that :func:`map_regions` names: a method, or (method, layer quadrant)."""
+        if isinstance(method, tuple):
+            fn, q = getattr(self, method[0]), method[1]
+            return lambda box: fn(q, box)
+        return getattr(self, method)
 
     def bulk(self, box):
         """K det J_Phi on (s, h) in the box (the bulk, s in [s0, 1/2])."""
@@ -181,10 +184,34 @@ class SigmaBox:
         return _span(*C.layer_y_box(self.L[q][2], q, h_lo, h_hi, prec=self.m.prec))
 
 
-def _lists(parts, k0, s0, layer, winding):
-    """(name, trees, root, evaluator name, sign, outside allowed) of every tree list of the record's parts."""
+def map_regions(k0, s0, layer, winding):
+    """Every tree list of a record's ``parts``: (name, keys into ``parts``, root box, evaluator of
+    :class:`SigmaBox`, sign of the claim, ``outside`` leaves allowed); the roots are fixed by K0 and the
+    regions, never by the file. The prover covers the same lists.
+
+    >>> [r[:2] for r in map_regions(101, fmpq(1, 20), 3, (fmpq(1, 4), fmpq(7, 20)))][-1]
+    ('Y<0 layer 2', ('winding', 'Y<0 layer', '2'))
+    """
     s_a, s_b = winding
     half, h0 = fmpq(1, 2), fmpq(1, k0)
+    bulk, middle = [(s0, half), (fmpq(0), h0)], [(fmpq(0), s0), (fmpq(0), fmpq(1, layer))]
+    out = [("R bulk", ("regularity", "bulk"), bulk, "bulk", 1, False),
+           ("R middle", ("regularity", "middle"), middle, "middle", 1, True),
+           ("T bulk", ("transversal", "bulk"), bulk, "transversal_bulk", 1, False),
+           ("T middle", ("transversal", "middle"), middle, "transversal_middle", 1, True),
+           ("Y<0 bulk", ("winding", "Y<0 bulk"), [(s0, s_a), (fmpq(0), h0)], "y_bulk", -1, False),
+           ("X>0 bulk", ("winding", "X>0 bulk"), [(s_a, s_b), (fmpq(0), h0)], "x_bulk", 1, False),
+           ("Y>0 bulk", ("winding", "Y>0 bulk"), [(s_b, half), (fmpq(0), h0)], "y_bulk", 1, False),
+           ("Y<0 middle", ("winding", "Y<0 middle"), middle, "y_middle", -1, True)]
+    for q in range(layer):
+        out += [(f"R layer {q}", ("regularity", "layer", str(q)), [(fmpq(0), h0)], ("layer", q), 1, False),
+                (f"T layer {q}", ("transversal", "layer", str(q)), [(fmpq(0), h0)], ("transversal_layer", q), 1,
+                 False),
+                (f"Y<0 layer {q}", ("winding", "Y<0 layer", str(q)), [(fmpq(0), h0)], ("y_layer", q), -1, False)]
+    return out
+
+
+def _check_keys(parts, layer):
     exact_keys(parts, ("regularity", "transversal", "winding"), "parts")
     reg, tra, win = parts["regularity"], parts["transversal"], parts["winding"]
     for name, obj in (("regularity", reg), ("transversal", tra)):
@@ -194,20 +221,6 @@ def _lists(parts, k0, s0, layer, winding):
     for name, obj in (("regularity layer", reg["layer"]), ("transversal layer", tra["layer"]),
                       ("winding Y<0 layer", win["Y<0 layer"])):
         exact_keys(obj, quads, name)
-    bulk, middle = [(s0, half), (fmpq(0), h0)], [(fmpq(0), s0), (fmpq(0), fmpq(1, layer))]
-    hroot = [(fmpq(0), h0)]
-    lists = [("R bulk", reg["bulk"], bulk, "bulk", 1, False), ("R middle", reg["middle"], middle, "middle", 1, True),
-             ("T bulk", tra["bulk"], bulk, "transversal_bulk", 1, False),
-             ("T middle", tra["middle"], middle, "transversal_middle", 1, True),
-             ("Y<0 bulk", win["Y<0 bulk"], [(s0, s_a), (fmpq(0), h0)], "y_bulk", -1, False),
-             ("X>0 bulk", win["X>0 bulk"], [(s_a, s_b), (fmpq(0), h0)], "x_bulk", 1, False),
-             ("Y>0 bulk", win["Y>0 bulk"], [(s_b, half), (fmpq(0), h0)], "y_bulk", 1, False),
-             ("Y<0 middle", win["Y<0 middle"], middle, "y_middle", -1, True)]
-    for q in quads:
-        lists += [(f"R layer {q}", reg["layer"][q], hroot, ("layer", int(q)), 1, False),
-                  (f"T layer {q}", tra["layer"][q], hroot, ("transversal_layer", int(q)), 1, False),
-                  (f"Y<0 layer {q}", win["Y<0 layer"][q], hroot, ("y_layer", int(q)), -1, False)]
-    return lists
 
 
 def read_map(parts, k0, hints, s0, layer, winding):
@@ -248,8 +261,12 @@ def read_map(parts, k0, hints, s0, layer, winding):
     s_a, s_b = winding
     if not (0 < s0 < s_a < s_b < fmpq(1, 2) and layer >= 3 and fmpq(1, k0) < hints.r and s0 / layer < hints.r):
         raise CertificateError("regions: need 0 < s0 < s_a < s_b < 1/2, T >= 3, 1/K0 < r and s0/T < r")
+    _check_keys(parts, layer)
     out = []
-    for name, trees, root, method, sign, outside in _lists(parts, k0, s0, layer, winding):
+    for name, keys, root, method, sign, outside in map_regions(k0, s0, layer, winding):
+        trees = parts
+        for key in keys:
+            trees = trees[key]
         if not isinstance(trees, list) or len(trees) != hints.sigma_boxes:
             raise CertificateError(f"{name}: one tree per sigma box ({hints.sigma_boxes}) is needed")
         out.append((name, method, sign, [read_tree(t, root, f"{name}, sigma box {i}", sign, k0=k0, outside=outside)
@@ -265,14 +282,7 @@ def replay_map(lists, sig_lo, sig_hi, hints, layer, prec):
     for i in range(hints.sigma_boxes):
         box = models.sigma_box(i)
         for name, method, sign, leaves in lists:
-            if isinstance(method, tuple):
-                fn, q = getattr(box, method[0]), method[1]
-
-                def evaluate(b, fn=fn, q=q):
-                    return fn(q, b)
-            else:
-                evaluate = getattr(box, method)
-            count, least = replay_tree(leaves[i], evaluate, sign, f"{name}, sigma box {i}")
+            count, least = replay_tree(leaves[i], box.evaluator(method), sign, f"{name}, sigma box {i}")
             old = summary.get(name, (0, None))
             best = least if old[1] is None or (least is not None and abs(least) < abs(old[1])) else old[1]
             summary[name] = (old[0] + count, best)

@@ -72,8 +72,14 @@ def check_size(cert):
             stack.extend(v)
     if boxes > MAX_BOXES:
         raise CertificateError(f"certificate: more than {MAX_BOXES} boxes")
-    _SPENT.set([0])  # a new certificate: its box lists share one budget (:func:`replay_work`)
+    _SPENT.set([0])  # a new certificate: its box lists share one budget until close_budget()
     return boxes
+
+
+def close_budget():
+    """End the current certificate's replay budget (opened by :func:`check_size`): a box list checked
+    afterwards, outside a certificate, has the whole budget alone."""
+    _SPENT.set(None)
 
 
 def replay_work(form, nboxes):
