@@ -252,18 +252,6 @@ class Family:
             "Y-": (lambda d, p: vy[_POS[_swap(p)]] * self._e("y", -d - eps(p)) * self.sign / 2, self.zero, self.lam2),
         }
 
-    def values(self, s):
-        """(x, y): level0(delta, pos) at the quadrant K s, and the centre values (real h and s only)."""
-        E, F = acb(0, 2 * arb.pi() * s).exp(), acb(0, self.sigma * (2 * s - 1)).exp()
-        P = self.parts()
-
-        def x(d, p):
-            return (E * P["X+"][0](d, p) + P["X-"][0](d, p) / E).real
-
-        def y(d, p):
-            return (P["Y0"][0](d, p) + F * P["Y+"][0](d, p) + P["Y-"][0](d, p) / F).real
-        return x, y, acb(self.yc).real
-
 
 def local_value(level0, centre, lam, zero):
     """``value(A, B)``: the level-1 value at position (A, B) of a bulk quadrant (no sharp ray within reach):
