@@ -63,38 +63,17 @@ def _kappa():
 
 
 def _adj_kappa_polys():
-    """N(lam) = adj(lam - B(1)) kappa as 6 exact polynomials (coefficient lists, degree <= 5), by
-    interpolation at lam = 1..6 and checked at lam = 7, 8 (B(1)'s eigenvalues are below 1)."""
+    """N(lam) = adj(lam - B(1)) kappa as 6 exact polynomials (coefficient lists, degree <= 5), by the
+    Cayley-Hamilton form of the adjugate: with det(lam - B) = sum_j c_j lam^j (degree 6),
+    adj(lam - B) = sum_(k < 6) lam^k sum_(j > k) c_j B^(j-k-1)."""
     B1 = fmpq_mat([[sum((x for (d, pos), x in ring_stencil()[i].items() if _POS[pos] == k), fmpq(0))
                     for k in range(6)] for i in range(6)])
-    kap = fmpq_mat([[z] for z in _kappa()])
-
-    def n_at(lam):
-        M = fmpq_mat([[(lam if i == k else 0) - B1[i, k] for k in range(6)] for i in range(6)])
-        sol = M.solve(kap)
-        d = M.det()
-        return [d * sol[i, 0] for i in range(6)]
-    xs = [fmpq(i) for i in range(1, 7)]
-    vals = [n_at(x) for x in xs]
-    polys = []
-    for comp in range(6):
-        coeffs = [fmpq(0)] * 6
-        for a, xa in enumerate(xs):  # Lagrange basis, expanded
-            basis, den = [fmpq(1)], fmpq(1)
-            for b, xb in enumerate(xs):
-                if b != a:
-                    basis = [fmpq(0)] + basis
-                    for i in range(len(basis) - 1):
-                        basis[i] -= xb * basis[i + 1]
-                    den *= xa - xb
-            for i, c in enumerate(basis):
-                coeffs[i] += vals[a][comp] * c / den
-        polys.append(coeffs)
-    for x in (fmpq(7), fmpq(8)):
-        got = [sum((c * x ** i for i, c in enumerate(p)), fmpq(0)) for p in polys]
-        if got != n_at(x):
-            raise AssertionError("adj(lam - B(1)) kappa is not a polynomial of degree <= 5")
-    return polys, B1
+    c = B1.charpoly()
+    powers = [fmpq_mat([[z] for z in _kappa()])]  # B^m kappa
+    for _ in range(5):
+        powers.append(B1 * powers[-1])
+    return [[sum((c[j] * powers[j - k - 1][i, 0] for j in range(k + 1, 7)), fmpq(0)) for k in range(6)]
+            for i in range(6)], B1
 
 
 _NPOLY, _B1 = _adj_kappa_polys()
