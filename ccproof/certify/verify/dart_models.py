@@ -211,16 +211,14 @@ def map_regions(k0, s0, layer, winding):
     return out
 
 
-def _check_keys(parts, layer):
-    exact_keys(parts, ("regularity", "transversal", "winding"), "parts")
-    reg, tra, win = parts["regularity"], parts["transversal"], parts["winding"]
-    for name, obj in (("regularity", reg), ("transversal", tra)):
-        exact_keys(obj, ("bulk", "middle", "layer"), name)
-    exact_keys(win, ("Y<0 bulk", "X>0 bulk", "Y>0 bulk", "Y<0 middle", "Y<0 layer"), "winding")
-    quads = tuple(str(q) for q in range(layer))
-    for name, obj in (("regularity layer", reg["layer"]), ("transversal layer", tra["layer"]),
-                      ("winding Y<0 layer", win["Y<0 layer"])):
-        exact_keys(obj, quads, name)
+def _check_keys(obj, regions, where, depth=0):
+    """Exactly the keys that ``regions`` (:func:`map_regions`) name at this depth, recursively."""
+    keys = {r[1][depth] for r in regions}
+    exact_keys(obj, tuple(sorted(keys)), where)
+    for key in keys:
+        inner = [r for r in regions if r[1][depth] == key and len(r[1]) > depth + 1]
+        if inner:
+            _check_keys(obj[key], inner, f"{where} {key}", depth + 1)
 
 
 def read_map(parts, k0, hints, s0, layer, winding):
@@ -261,9 +259,10 @@ def read_map(parts, k0, hints, s0, layer, winding):
     s_a, s_b = winding
     if not (0 < s0 < s_a < s_b < fmpq(1, 2) and layer >= 3 and fmpq(1, k0) < hints.r and s0 / layer < hints.r):
         raise CertificateError("regions: need 0 < s0 < s_a < s_b < 1/2, T >= 3, 1/K0 < r and s0/T < r")
-    _check_keys(parts, layer)
+    regions = map_regions(k0, s0, layer, winding)
+    _check_keys(parts, regions, "parts")
     out = []
-    for name, keys, root, method, sign, outside in map_regions(k0, s0, layer, winding):
+    for name, keys, root, method, sign, outside in regions:
         trees = parts
         for key in keys:
             trees = trees[key]
