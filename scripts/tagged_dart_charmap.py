@@ -94,7 +94,6 @@ from ccproof.certify.verify import dart_regularity as _R
 from ccproof.certify.verify.dart_curves import (  # noqa: F401 (re-exported for the tests)
     disc_trans,
     taylor_trans,
-    ymid_box,
 )
 from ccproof.certify.verify.dart_family import (  # noqa: F401 (re-exported for the tests)
     CURVES,
@@ -113,8 +112,6 @@ from ccproof.certify.verify.dart_regularity import (  # noqa: F401 (re-exported 
     disc_bounds,
     layer_disc,
     layer_taylor,
-    middle_box,
-    middle_coeffs,
     taylor_dets,
 )
 from ccproof.certify.verify.dart_zeros import (  # noqa: F401 (re-exported for the tests)
@@ -144,17 +141,38 @@ def _parts(T):
     return sorted({key[2] for key in T})
 
 
+def _bounds(ball_):
+    return ball_.lower(), ball_.upper()
+
+
 def kdet_box(T, M, s_lo, s_hi, h_lo, h_hi, sigma, r, n, prec=128):
-    return _R.kdet_box(_R.bulk_models(T, M, r), s_lo, s_hi, h_lo, h_hi, sigma, prec=prec)
+    return _bounds(_R.kdet_box(_R.bulk_models(T, M, r), s_lo, s_hi, h_lo, h_hi, sigma, prec=prec))
+
+
+def middle_coeffs(T, sigma, L=24):
+    """{(m, l, piece): coefficient list}: the verifier's e_ml of each piece."""
+    models = _R.bulk_models(T, {key: arb(0) for key in T}, fmpq(1))
+    return {key + (p,): [mat[c, 0] for c in range(mat.nrows())]
+            for p, model in models.items() for key, mat in _R.middle_coeffs(model, sigma, L).items()}
+
+
+def middle_box(T, E, M, s_lo, s_hi, w_lo, w_hi, sigma, r, n, L=24, prec=128):
+    models = _R.bulk_models(T, M, r)
+    coeffs = {p: _R.middle_coeffs(model, sigma, L) for p, model in models.items()}
+    return _bounds(_R.middle_box(models, coeffs, s_lo, s_hi, w_lo, w_hi, sigma, L=L, prec=prec))
+
+
+def ymid_box(T, M, s_lo, s_hi, w_lo, w_hi, sigma, r, n, L=24, prec=128):
+    return _bounds(_C.ymid_box(T, M, s_lo, s_hi, w_lo, w_hi, sigma, r, n, L=L, prec=prec))
 
 
 def layer_box(T, M, h_lo, h_hi, r, n, order=3, prec=128):
-    return _R.layer_box(_R.column_models(T, M, r), h_lo, h_hi, order=order, prec=prec)
+    return _bounds(_R.layer_box(_R.column_models(T, M, r), h_lo, h_hi, order=order, prec=prec))
 
 
 def coord_box(T, M, s_lo, s_hi, h_lo, h_hi, sigma, r, n, coord, prec=128):
     models = _C.curve_models(T, M, r, XB if coord == "x" else YB)
-    return _C.coord_box(models, s_lo, s_hi, h_lo, h_hi, sigma, coord, prec=prec)
+    return _bounds(_C.coord_box(models, s_lo, s_hi, h_lo, h_hi, sigma, coord, prec=prec))
 
 
 def coord_taylor(sigma, n, coord, prec=128):

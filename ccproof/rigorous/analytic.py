@@ -14,7 +14,7 @@ matrices, the Taylor coefficients of every entry) and M per column and encloses 
 
 from __future__ import annotations
 
-from flint import acb, arb, fmpq
+from flint import acb, acb_mat, arb, fmpq
 
 
 def ball(lo, hi):
@@ -127,5 +127,26 @@ class AnalyticModel:
         tail = arb(fmpq(h_hi)) ** (self.order + 1 - low) * cauchy_factor(self.r, self.order, h_hi)
         return acc, [m * tail for m in self.M]
 
+    def real_part(self, weights, h_lo, h_hi, low=0):
+        """Re sum_k weights[k] f_k(h)/h^low for every row (a list of arb), every h in [h_lo, h_hi]: the rows
+        of :meth:`enclose` times the weights (acb), and |Re w e| <= (|Re w| + |Im w|) rho for |e| <= rho."""
+        V, rho = self.enclose(h_lo, h_hi, low)
+        vals = V * acb_mat([[acb(w)] for w in weights])
+        rad = sum(((abs(acb(w).real) + abs(acb(w).imag)) * t for w, t in zip(weights, rho)), arb(0)).upper()
+        return [vals[c, 0].real + arb(0, rad) for c in range(vals.nrows())]
 
-__all__ = ["AnalyticModel", "ball", "cauchy_factor", "disc_bound", "square_boxes"]
+
+def hull(balls):
+    """The arb ball holding every ball of a non-empty iterable.
+
+    >>> hull([arb(1), arb(3), arb(2)]).contains(ball(1, 3))
+    True
+    """
+    it = iter(balls)
+    out = next(it)
+    for b in it:
+        out = out.union(b)
+    return out
+
+
+__all__ = ["AnalyticModel", "ball", "cauchy_factor", "disc_bound", "hull", "square_boxes"]

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from flint import acb, acb_mat, arb, ctx, fmpq
 
-from ccproof.rigorous.analytic import AnalyticModel, ball, cauchy_factor, disc_bound
+from ccproof.rigorous.analytic import AnalyticModel, ball, cauchy_factor, disc_bound, hull
 
 from .dart_family import (
     CURVES,
@@ -125,23 +125,15 @@ def _coord_factors(coord, s, sigma):
 
 
 def coord_box(models, s_lo, s_hi, h_lo, h_hi, sigma, coord, prec=128):
-    """(lower, upper) bounds of X or Y on every outer curve's Bezier points, s in [s_lo, s_hi], h in
-    [h_lo, h_hi] (a bulk quadrant), from the models of :func:`curve_models`."""
+    """An arb holding X or Y on every outer curve's Bezier points, s in [s_lo, s_hi], h in [h_lo, h_hi] (a
+    bulk quadrant), from the models of :func:`curve_models`."""
     with ctx.workprec(prec):
         fac = _coord_factors(coord, ball(s_lo, s_hi), sigma)
-        low = high = None
-        for model in models.values():
-            V, rho = model.enclose(h_lo, h_hi)
-            for p in range(4):
-                v = sum((f * (V[p, k] + acb(arb(0, t.upper()), arb(0, t.upper())))
-                         for k, (f, t) in enumerate(zip(fac, rho))), acb(0)).real
-                low = v.lower() if low is None or v.lower() < low else low
-                high = v.upper() if high is None or v.upper() > high else high
-        return low, high
+        return hull(v for model in models.values() for v in model.real_part(fac, h_lo, h_hi))
 
 
 def ymid_box(T, M, s_lo, s_hi, w_lo, w_hi, sigma, r, n, L=24, prec=128):
-    """(lower, upper) bounds of Y/s on every outer curve point, s in [s_lo, s_hi], w = h/s in [w_lo, w_hi]:
+    """An arb holding Y/s on every outer curve point, s in [s_lo, s_hi], w = h/s in [w_lo, w_hi]:
     the h^0 part sum_j b_j(s) Y_j0 = sum_(l >= 1) (...) s^l (its s^0 coefficient is y at K = infinity and s = 0:
     0 exactly) divided by s termwise, the parts h^m, m >= 1, as b_j(s) Y_jm s^(m-1) w^m, and the tails."""
     with ctx.workprec(prec):
@@ -154,7 +146,7 @@ def ymid_box(T, M, s_lo, s_hi, w_lo, w_hi, sigma, r, n, L=24, prec=128):
             raise ValueError("s too large for the exponential series")
         geo = z ** L / arb.fac_ui(L + 1) / (1 - z / (L + 2)) * 2 * abs(sigma).upper()
         ctail = arb(fmpq(s_hi)) ** n * arb(fmpq(w_hi)) ** (n + 1) * cauchy_factor(r, n, fmpq(s_hi) * fmpq(w_hi))
-        low = high = None
+        vals = []
         for c in CURVES:
             y0max = max((abs(T[(j, c)][0][p]).upper() for j in YB for p in range(4)), key=lambda x: x)
             rad = (3 * y0max * geo + sum((M[(j, c)] * ctail for j in YB), arb(0))).upper()
@@ -166,24 +158,18 @@ def ymid_box(T, M, s_lo, s_hi, w_lo, w_hi, sigma, r, n, L=24, prec=128):
                     g = g * s + coef
                 for m in range(1, n + 1):
                     g += sum((fac[j] * T[(j, c)][m][p] for j in YB), acb(0)) * s ** (m - 1) * w ** m
-                v = g.real + arb(0, rad)
-                low = v.lower() if low is None or v.lower() < low else low
-                high = v.upper() if high is None or v.upper() > high else high
-        return low, high
+                vals.append(g.real + arb(0, rad))
+        return hull(vals)
 
 
 def layer_y_box(models, q, h_lo, h_hi, prec=128):
-    """(lower, upper) bounds of K Y over layer quadrant q's outer-curve points (K^2 Y at ray 0's end point of
-    quadrant 0), h in [h_lo, h_hi], from one-column models (:func:`.dart_regularity.column_models`); the
-    coefficients below h^order are dropped (0 exactly: y = O(h), and O(h^2) at ray 0's end point where x,
-    hence y's first order, vanishes)."""
+    """An arb holding K Y over layer quadrant q's outer-curve points (K^2 Y at ray 0's end point of quadrant 0),
+    h in [h_lo, h_hi], from one-column models (:func:`.dart_regularity.column_models`); the coefficients below
+    h^order are dropped (0 exactly: y = O(h), and O(h^2) at ray 0's end point where x, hence y's first order,
+    vanishes)."""
     with ctx.workprec(prec):
-        low = high = None
+        vals = []
         for c, model in models.items():
-            enclosures = {order: model.enclose(h_lo, h_hi, low=order) for order in (1, 2)}
-            for p in range(4):
-                V, rho = enclosures[2 if (q == 0 and c == "P1s1" and p == 0) else 1]
-                v = V[p, 0].real + arb(0, rho[0].upper())
-                low = v.lower() if low is None or v.lower() < low else low
-                high = v.upper() if high is None or v.upper() > high else high
-        return low, high
+            ky, k2y = (model.real_part([1], h_lo, h_hi, low=order) for order in (1, 2))
+            vals += [k2y[p] if (q == 0 and c == "P1s1" and p == 0) else ky[p] for p in range(4)]
+        return hull(vals)

@@ -11,7 +11,7 @@ before any arithmetic; :func:`replay_map` replays them sigma box by sigma box (:
 
 from __future__ import annotations
 
-from flint import arb, ctx, fmpq
+from flint import ctx, fmpq
 
 from ccproof.rigorous.analytic import ball, disc_bound
 
@@ -21,11 +21,6 @@ from .dart_family import XB, YB, Family, _hvar, _series_curves, basis_nets, laye
 from .errors import CertificateError
 from .record import exact_keys
 from .replay import read_tree, replay_tree
-
-
-def _span(low, high):
-    """The arb ball [low, high] (both arb points or balls: their hull)."""
-    return arb(low).union(arb(high))
 
 
 class DartModels:
@@ -106,8 +101,8 @@ class SigmaBox:
             self.T = R.bulk_models(self.TT, models.bounds("T"), r)
             self.X = C.curve_models({(b, c): p for b in XB for c, p in coord[b].items()}, models.bounds("X"), r, XB)
             self.Y = C.curve_models(self.TY, models.bounds("Y"), r, YB)
-            self.ER = R.middle_coeffs(self.TR, sigma, L=hn.exp_order)
-            self.ET = R.middle_coeffs(self.TT, sigma, L=hn.exp_order)
+            self.ER = {p: R.middle_coeffs(m, sigma, L=hn.exp_order) for p, m in self.R.items()}
+            self.ET = {p: R.middle_coeffs(m, sigma, L=hn.exp_order) for p, m in self.T.items()}
             self._layers(hn.layer_order, r)
 
     def _layers(self, n, r):
@@ -130,58 +125,56 @@ class SigmaBox:
     def bulk(self, box):
         """K det J_Phi on (s, h) in the box (the bulk, s in [s0, 1/2])."""
         (s_lo, s_hi), (h_lo, h_hi) = box
-        return _span(*R.kdet_box(self.R, s_lo, s_hi, h_lo, h_hi, self.sigma, prec=self.m.prec))
+        return R.kdet_box(self.R, s_lo, s_hi, h_lo, h_hi, self.sigma, prec=self.m.prec)
 
-    def _middle(self, T, E, M, box):
+    def _middle(self, models, E, box):
         (s_lo, s_hi), (w_lo, w_hi) = box
-        hn = self.m.hints
-        return _span(*R.middle_box(T, E, M, s_lo, s_hi, w_lo, w_hi, self.sigma, hn.r, hn.order, L=hn.exp_order,
-                                   prec=self.m.prec))
+        return R.middle_box(models, E, s_lo, s_hi, w_lo, w_hi, self.sigma, L=self.m.hints.exp_order, prec=self.m.prec)
 
     def middle(self, box):
         """K^3 det J_Phi/q^2 as a function of (s, w = 1/q) in the box (the middle)."""
-        return self._middle(self.TR, self.ER, self.m.bounds("R"), box)
+        return self._middle(self.R, self.ER, box)
 
     def layer(self, q, box):
         """K^3 det J_Phi of layer quadrant q on h in the box."""
         ((h_lo, h_hi),) = box
-        return _span(*R.layer_box(self.L[q][0], h_lo, h_hi, prec=self.m.prec))
+        return R.layer_box(self.L[q][0], h_lo, h_hi, prec=self.m.prec)
 
     def transversal_bulk(self, box):
         """K (a1 X Y' - a2 Y X') on the four outer curves, (s, h) in the box."""
         (s_lo, s_hi), (h_lo, h_hi) = box
-        return _span(*R.kdet_box(self.T, s_lo, s_hi, h_lo, h_hi, self.sigma, prec=self.m.prec))
+        return R.kdet_box(self.T, s_lo, s_hi, h_lo, h_hi, self.sigma, prec=self.m.prec)
 
     def transversal_middle(self, box):
         """K^3 (a1 X Y' - a2 Y X')/q^2 as a function of (s, w = 1/q) in the box."""
-        return self._middle(self.TT, self.ET, self.m.bounds("T"), box)
+        return self._middle(self.T, self.ET, box)
 
     def transversal_layer(self, q, box):
         """K^3 (a1 X Y' - a2 Y X') on layer quadrant q's outer curves, h in the box."""
         ((h_lo, h_hi),) = box
-        return _span(*R.layer_box(self.L[q][1], h_lo, h_hi, prec=self.m.prec))
+        return R.layer_box(self.L[q][1], h_lo, h_hi, prec=self.m.prec)
 
     def x_bulk(self, box):
         """X on every outer-curve Bezier point, (s, h) in the box."""
         (s_lo, s_hi), (h_lo, h_hi) = box
-        return _span(*C.coord_box(self.X, s_lo, s_hi, h_lo, h_hi, self.sigma, "x", prec=self.m.prec))
+        return C.coord_box(self.X, s_lo, s_hi, h_lo, h_hi, self.sigma, "x", prec=self.m.prec)
 
     def y_bulk(self, box):
         """Y on every outer-curve Bezier point, (s, h) in the box."""
         (s_lo, s_hi), (h_lo, h_hi) = box
-        return _span(*C.coord_box(self.Y, s_lo, s_hi, h_lo, h_hi, self.sigma, "y", prec=self.m.prec))
+        return C.coord_box(self.Y, s_lo, s_hi, h_lo, h_hi, self.sigma, "y", prec=self.m.prec)
 
     def y_middle(self, box):
         """Y/s on every outer-curve Bezier point, (s, w) in the box."""
         (s_lo, s_hi), (w_lo, w_hi) = box
         hn = self.m.hints
-        return _span(*C.ymid_box(self.TY, self.m.bounds("Y"), s_lo, s_hi, w_lo, w_hi, self.sigma, hn.r, hn.order,
-                                 L=hn.exp_order, prec=self.m.prec))
+        return C.ymid_box(self.TY, self.m.bounds("Y"), s_lo, s_hi, w_lo, w_hi, self.sigma, hn.r, hn.order,
+                          L=hn.exp_order, prec=self.m.prec)
 
     def y_layer(self, q, box):
         """K Y on layer quadrant q's outer-curve points (K^2 Y at ray 0's end point of quadrant 0), h in the box."""
         ((h_lo, h_hi),) = box
-        return _span(*C.layer_y_box(self.L[q][2], q, h_lo, h_hi, prec=self.m.prec))
+        return C.layer_y_box(self.L[q][2], q, h_lo, h_hi, prec=self.m.prec)
 
 
 def map_regions(k0, s0, layer, winding):

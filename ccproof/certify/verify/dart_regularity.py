@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from flint import acb, acb_mat, arb, ctx, fmpq
 
-from ccproof.rigorous.analytic import AnalyticModel, ball, cauchy_factor, disc_bound
+from ccproof.rigorous.analytic import AnalyticModel, ball, cauchy_factor, disc_bound, hull
 
 from .dart_family import PIECES, XB, YB, Family, _coeffs, _hvar, basis_nets, det_series, layer_nets, series_cap
 
@@ -61,91 +61,73 @@ def bulk_models(T, M, r):
 
 
 def kdet_box(models, s_lo, s_hi, h_lo, h_hi, sigma, prec=128):
-    """(lower, upper) bounds of K det J_Phi over the pieces' Bernstein coefficients, for s in [s_lo, s_hi] and
-    h in [h_lo, h_hi] (0 <= h_hi < r): sum_ij a_i(s) b_j(s) D_ij(h)/h from the models of :func:`bulk_models`
-    (the h^0 terms 0 exactly); the real part of a_i b_j rho_ij is at most (|Re a_i b_j| + |Im a_i b_j|) rho_ij."""
+    """An arb holding K det J_Phi's Bernstein coefficients (every piece) for s in [s_lo, s_hi] and h in
+    [h_lo, h_hi] (0 <= h_hi < r): Re sum_ij a_i(s) b_j(s) D_ij(h)/h from the models of :func:`bulk_models`
+    (the h^0 terms 0 exactly)."""
     with ctx.workprec(prec):
         s = ball(s_lo, s_hi)
         E, F = acb(0, 2 * arb.pi() * s).exp(), acb(0, sigma * (2 * s - 1)).exp()
         a, b = {"X+": E, "X-": 1 / E}, {"Y0": acb(1), "Y+": F, "Y-": 1 / F}
         ws = [a[i] * b[j] for i, j in IJ]
-        low = high = None
-        for model in models.values():
-            V, rho = model.enclose(h_lo, h_hi, low=1)
-            rad = sum(((abs(w.real) + abs(w.imag)) * t for w, t in zip(ws, rho)), arb(0)).upper()
-            for c in range(V.nrows()):
-                v = sum((V[c, k] * w for k, w in enumerate(ws)), acb(0)).real + arb(0, rad)
-                low = v.lower() if low is None or v.lower() < low else low
-                high = v.upper() if high is None or v.upper() > high else high
-        return low, high
+        return hull(v for model in models.values() for v in model.real_part(ws, h_lo, h_hi, low=1))
 
 
 def _omegas(sigma):
-    """a_i(s) b_j(s) = c_ij e^(i omega_ij s): {(i, j): (c_ij, omega_ij)} (acb, arb)."""
+    """a_i(s) b_j(s) = c_ij e^(i omega_ij s): [(c_ij, omega_ij)] (acb, arb) in the order of IJ."""
     tp, es = 2 * arb.pi(), acb(0, sigma).exp()
     a = {"X+": tp, "X-": -tp}
     b = {"Y0": (acb(1), arb(0)), "Y+": (1 / es, 2 * sigma), "Y-": (es, -2 * sigma)}
-    return {(i, j): (b[j][0], a[i] + b[j][1]) for i, j in IJ}
+    return [(b[j][0], a[i] + b[j][1]) for i, j in IJ]
 
 
-def middle_coeffs(T, sigma, L=24):
-    """e[(m, l, piece)] = sum_ij d_ijm c_ij (i omega_ij)^l/l! (Bernstein coefficient lists, acb): the
-    coefficient of s^l h^(m-1) in K det J_Phi = sum_ij a_i(s) b_j(s) sum_m d_ijm h^(m-1), for m = 1, 2 and
-    l <= L (the terms m >= 3 are evaluated directly)."""
+def middle_coeffs(model, sigma, L=24):
+    """{(m, l): e_ml} = D_m (c_ij (i omega_ij)^l/l!)_ij (acb_mat, a row per Bernstein coefficient): the
+    coefficient of s^l h^(m-1) in K det J_Phi = sum_ij a_i(s) b_j(s) sum_m D_ijm h^(m-1), for m = 1, 2 and
+    l <= L (the terms m >= 3 are evaluated directly); D_m the coefficients of a :func:`bulk_models` model."""
     om = _omegas(sigma)
-    out = {}
-    for m in (1, 2):
-        for l in range(L + 1):
-            for piece in sorted({key[2] for key in T}):
-                acc = None
-                for (i, j), (c, w) in om.items():
-                    f = c * (acb(0, w) ** l) / arb.fac_ui(l)
-                    v = [f * z for z in T[(i, j, piece)][m]]
-                    acc = v if acc is None else [x + y for x, y in zip(acc, v)]
-                out[(m, l, piece)] = acc
-    return out
+    return {(m, l): model.coeffs[m] * acb_mat([[c * acb(0, w) ** l / arb.fac_ui(l)] for c, w in om])
+            for m in (1, 2) for l in range(L + 1)}
 
 
-def middle_box(T, E, M, s_lo, s_hi, w_lo, w_hi, sigma, r, n, L=24, prec=128):
-    """(lower, upper) bounds of G = K det J_Phi/s^2 (= K^3 det J_Phi/q^2 at s = q h) on s in [s_lo, s_hi],
-    w = h/s in [w_lo, w_hi] (s_lo >= 0): the m = 1 part sum_(l >= 2) e_1l s^(l-2), the m = 2 part
-    w sum_(l >= 1) e_2l s^(l-1) (the coefficients e_10, e_11, e_20 being 0 exactly), the m >= 3 parts
-    a_i(s) b_j(s) d_ijm s^(m-3) w^(m-1), the tails of the exponential series (|omega s|^(L+1)/(L+1)!, with
-    the factor 1/(1 - |omega s|/(L + 2))) and the Cauchy remainder M_ij s^(n-2) w^n/(r^(n+1) (1 - h/r))."""
+def _horner(e, m, top, bottom, s):
+    acc = e[(m, top)]
+    for l in range(top - 1, bottom - 1, -1):
+        acc = acc * s + e[(m, l)]
+    return acc
+
+
+def middle_box(models, E, s_lo, s_hi, w_lo, w_hi, sigma, L=24, prec=128):
+    """An arb holding G = K det J_Phi/s^2 (= K^3 det J_Phi/q^2 at s = q h) on s in [s_lo, s_hi], w = h/s in
+    [w_lo, w_hi] (s_lo >= 0), per piece (``E[piece]``: :func:`middle_coeffs`): the m = 1 part
+    sum_(l >= 2) e_1l s^(l-2), the m = 2 part w sum_(l >= 1) e_2l s^(l-1) (the coefficients e_10, e_11, e_20
+    being 0 exactly), the m >= 3 parts a_i(s) b_j(s) D_ijm s^(m-3) w^(m-1), the tails of the exponential
+    series (|omega s|^(L+1)/(L+1)!, with the factor 1/(1 - |omega s|/(L + 2))) and the Cauchy remainder
+    M_ij s^(n-2) w^n/(r^(n+1) (1 - h/r))."""
     with ctx.workprec(prec):
-        s, w = ball(s_lo, s_hi), ball(w_lo, w_hi)
+        s, w = acb(ball(s_lo, s_hi)), acb(ball(w_lo, w_hi))
         om = _omegas(sigma)
-        wmax = max((abs(x[1]).upper() for x in om.values()), key=lambda x: x)
+        wmax = max((abs(x[1]).upper() for x in om), key=lambda x: x)
         z = wmax * arb(fmpq(s_hi))
         if not z < L + 2:
             raise ValueError("s too large for the exponential series")
         # the tails of the exponential series, divided by s^2 (m = 1) and s (m = 2): |c_ij| = 1 and
         # sum_(l > L) |omega s|^l/l! <= |omega s|^(L+1)/(L+1)!/(1 - |omega s|/(L + 2))
         geo = z ** (L - 1) / arb.fac_ui(L + 1) / (1 - z / (L + 2))
-        ctail = arb(fmpq(s_hi)) ** (n - 2) * arb(fmpq(w_hi)) ** n * cauchy_factor(r, n, fmpq(s_hi) * fmpq(w_hi))
-        ab = {k: c * acb(0, w_ * s).exp() for k, (c, w_) in om.items()}
-        low = high = None
-        for piece in sorted({key[2] for key in T}):
-            dmax = {m: max((abs(c).upper() for key in T if key[2] == piece for c in T[key][m]), key=lambda x: x)
-                    for m in (1, 2)}
-            rad1 = 6 * dmax[1] * wmax ** 2 * geo
-            rad2 = 6 * dmax[2] * wmax * geo * z * arb(fmpq(w_hi))
-            rem = sum((M[(i, j, piece)] * ctail for i, j in IJ), arb(0))
-            rad = (rad1 + rad2 + rem).upper()
-            for c in range(len(T[("X+", "Y0", piece)][1])):  # the pieces' (or curves') Bernstein coefficients
-                g1 = acb(0)
-                for l in range(L, 1, -1):
-                    g1 = g1 * s + E[(1, l, piece)][c]
-                g2 = acb(0)
-                for l in range(L, 0, -1):
-                    g2 = g2 * s + E[(2, l, piece)][c]
-                g = g1 + w * g2
-                for m in range(3, n + 1):
-                    g += sum((ab[k] * T[k + (piece,)][m][c] for k in ab), acb(0)) * s ** (m - 3) * w ** (m - 1)
-                v = g.real + arb(0, rad)
-                low = v.lower() if low is None or v.lower() < low else low
-                high = v.upper() if high is None or v.upper() > high else high
-        return low, high
+        ab = acb_mat([[c * (w_ * s * acb(0, 1)).exp()] for c, w_ in om])
+        vals = []
+        for piece, model in models.items():
+            n, D = model.order, model.coeffs
+            ctail = (arb(fmpq(s_hi)) ** (n - 2) * arb(fmpq(w_hi)) ** n
+                     * cauchy_factor(model.r, n, fmpq(s_hi) * fmpq(w_hi)))
+            dmax = [max((abs(D[m][c, k]).upper() for c in range(D[m].nrows()) for k in range(6)), key=lambda x: x)
+                    for m in (1, 2)]
+            rad = (6 * dmax[0] * wmax ** 2 * geo + 6 * dmax[1] * wmax * geo * z * arb(fmpq(w_hi))
+                   + sum(model.M, arb(0)) * ctail).upper()
+            g = _horner(E[piece], 1, L, 2, s) + _horner(E[piece], 2, L, 1, s) * w
+            for m in range(3, n + 1):
+                g = g + (D[m] * ab) * (s ** (m - 3) * w ** (m - 1))
+            vals += [g[c, 0].real + arb(0, rad) for c in range(g.nrows())]
+        return hull(vals)
 
 
 def layer_det_values(lnets):
@@ -183,14 +165,7 @@ def column_models(T, M, r):
 
 
 def layer_box(models, h_lo, h_hi, order=3, prec=128):
-    """(lower, upper) bounds of K^order det J_Phi on h in [h_lo, h_hi] from the models of
-    :func:`column_models` (the coefficients of h^0 .. h^(order-1) being 0 exactly)."""
+    """An arb holding K^order det J_Phi on h in [h_lo, h_hi] from the models of :func:`column_models` (the
+    coefficients of h^0 .. h^(order-1) being 0 exactly)."""
     with ctx.workprec(prec):
-        low = high = None
-        for model in models.values():
-            V, rho = model.enclose(h_lo, h_hi, low=order)
-            for c in range(V.nrows()):
-                v = V[c, 0].real + arb(0, rho[0].upper())
-                low = v.lower() if low is None or v.lower() < low else low
-                high = v.upper() if high is None or v.upper() > high else high
-        return low, high
+        return hull(v for model in models.values() for v in model.real_part([1], h_lo, h_hi, low=order))
