@@ -1,5 +1,6 @@
-"""The trees of a dart:>=K0 record (verify.dart_trees): partition per cell before arithmetic, the outside
-rule, the bound's sign, and the replay on a real evaluator (forgeries FAIL with a reason)."""
+"""The trees of a dart:>=K0 record (verify.replay.read_tree, replay_tree): partition per cell before
+arithmetic, the outside rule, the bound's sign, and the replay on a real evaluator (forgeries FAIL with a
+reason)."""
 
 import pytest
 from flint import arb, fmpq

@@ -60,7 +60,7 @@ The regions (each includes h = 0, K = infinity), on lam = r e^(it), r = lam(cos(
 * F, (t, h) in [v0^2, 355/113] x [0, 1/K0]: 1 - F, T >= Im(phi) K0/2.
 
 Each evaluator returns an arb enclosing Re of its quantity on a box (the multiplier h or v is > 0 for
-every finite K); the record's trees (:mod:`.dart_trees`) bound it below by a positive number.
+every finite K); the record's trees (:func:`.replay.read_tree`) bound it below by a positive number.
 """
 
 from __future__ import annotations
