@@ -152,18 +152,20 @@ def kdet_box(T, M, s_lo, s_hi, h_lo, h_hi, sigma, r, n, prec=128):
 def middle_coeffs(T, sigma, L=24):
     """{(m, l, piece): coefficient list}: the verifier's e_ml of each piece."""
     models = _R.bulk_models(T, {key: arb(0) for key in T}, fmpq(1))
-    return {key + (p,): [mat[c, 0] for c in range(mat.nrows())]
-            for p, model in models.items() for key, mat in _R.middle_coeffs(model, sigma, L).items()}
+    return {key + (p,): [mat[c, 0] for c in range(mat.nrows())] for p, model in models.items()
+            for key, mat in _R.middle_coeffs(model, _R.omegas(sigma), 1, 2, L).items()}
 
 
 def middle_box(T, E, M, s_lo, s_hi, w_lo, w_hi, sigma, r, n, L=24, prec=128):
-    models = _R.bulk_models(T, M, r)
-    coeffs = {p: _R.middle_coeffs(model, sigma, L) for p, model in models.items()}
-    return _bounds(_R.middle_box(models, coeffs, s_lo, s_hi, w_lo, w_hi, sigma, L=L, prec=prec))
+    models, om = _R.bulk_models(T, M, r), _R.omegas(sigma)
+    coeffs = {p: _R.middle_coeffs(model, om, 1, 2, L) for p, model in models.items()}
+    return _bounds(_R.middle_box(models, coeffs, om, s_lo, s_hi, w_lo, w_hi, 1, 2, L=L, prec=prec))
 
 
 def ymid_box(T, M, s_lo, s_hi, w_lo, w_hi, sigma, r, n, L=24, prec=128):
-    return _bounds(_C.ymid_box(T, M, s_lo, s_hi, w_lo, w_hi, sigma, r, n, L=L, prec=prec))
+    models, om = _C.curve_models(T, M, r, YB), _C.y_omegas(sigma)
+    coeffs = {c: _R.middle_coeffs(model, om, 0, 1, L) for c, model in models.items()}
+    return _bounds(_R.middle_box(models, coeffs, om, s_lo, s_hi, w_lo, w_hi, 0, 1, L=L, prec=prec))
 
 
 def layer_box(T, M, h_lo, h_hi, r, n, order=3, prec=128):

@@ -8,9 +8,9 @@ The models and the disc bounds are those of :mod:`ccproof.rigorous.analytic`.
 
 from __future__ import annotations
 
-from flint import acb, acb_mat, arb, ctx, fmpq
+from flint import acb, acb_mat, arb, ctx
 
-from ccproof.rigorous.analytic import AnalyticModel, ball, cauchy_factor, disc_bound, hull
+from ccproof.rigorous.analytic import AnalyticModel, ball, disc_bound, hull
 
 from .dart_family import (
     CURVES,
@@ -132,34 +132,10 @@ def coord_box(models, s_lo, s_hi, h_lo, h_hi, sigma, coord, prec=128):
         return hull(v for model in models.values() for v in model.real_part(fac, h_lo, h_hi))
 
 
-def ymid_box(T, M, s_lo, s_hi, w_lo, w_hi, sigma, r, n, L=24, prec=128):
-    """An arb holding Y/s on every outer curve point, s in [s_lo, s_hi], w = h/s in [w_lo, w_hi]:
-    the h^0 part sum_j b_j(s) Y_j0 = sum_(l >= 1) (...) s^l (its s^0 coefficient is y at K = infinity and s = 0:
-    0 exactly) divided by s termwise, the parts h^m, m >= 1, as b_j(s) Y_jm s^(m-1) w^m, and the tails."""
-    with ctx.workprec(prec):
-        s, w = ball(s_lo, s_hi), ball(w_lo, w_hi)
-        es = acb(0, sigma).exp()
-        om = {"Y0": (acb(1), arb(0)), "Y+": (1 / es, 2 * sigma), "Y-": (es, -2 * sigma)}
-        fac = dict(zip(YB, _coord_factors("y", s, sigma)))
-        z = 2 * abs(sigma).upper() * arb(fmpq(s_hi))
-        if not z < L + 2:
-            raise ValueError("s too large for the exponential series")
-        geo = z ** L / arb.fac_ui(L + 1) / (1 - z / (L + 2)) * 2 * abs(sigma).upper()
-        ctail = arb(fmpq(s_hi)) ** n * arb(fmpq(w_hi)) ** (n + 1) * cauchy_factor(r, n, fmpq(s_hi) * fmpq(w_hi))
-        vals = []
-        for c in CURVES:
-            y0max = max((abs(T[(j, c)][0][p]).upper() for j in YB for p in range(4)), key=lambda x: x)
-            rad = (3 * y0max * geo + sum((M[(j, c)] * ctail for j in YB), arb(0))).upper()
-            for p in range(4):
-                g = acb(0)
-                for l in range(L, 0, -1):
-                    coef = sum((cj * acb(0, wj) ** l / arb.fac_ui(l) * T[(j, c)][0][p] for j, (cj, wj) in om.items()),
-                               acb(0))
-                    g = g * s + coef
-                for m in range(1, n + 1):
-                    g += sum((fac[j] * T[(j, c)][m][p] for j in YB), acb(0)) * s ** (m - 1) * w ** m
-                vals.append(g.real + arb(0, rad))
-        return hull(vals)
+def y_omegas(sigma):
+    """b_j(s) = c_j e^(i omega_j s): [(c_j, omega_j)] in the order of YB (Y0, Y+, Y-)."""
+    es = acb(0, sigma).exp()
+    return [(acb(1), arb(0)), (1 / es, 2 * sigma), (es, -2 * sigma)]
 
 
 def layer_y_box(models, q, h_lo, h_hi, prec=128):

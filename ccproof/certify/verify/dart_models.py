@@ -94,15 +94,16 @@ class SigmaBox:
             with series_cap(hn.order):
                 fam = Family(_hvar(hn.order), sigma)
                 nets = basis_nets(fam)
-                self.TR, self.TT = R.dets_series(nets, hn.order), C.trans_series(fam, nets, hn.order)
+                TR, TT = R.dets_series(nets, hn.order), C.trans_series(fam, nets, hn.order)
                 coord = {b: _series_curves(nets[b], hn.order) for b in XB + YB}
-            self.TY = {(b, c): pts for b in YB for c, pts in coord[b].items()}
-            self.R = R.bulk_models(self.TR, models.bounds("R"), r)
-            self.T = R.bulk_models(self.TT, models.bounds("T"), r)
+            self.R = R.bulk_models(TR, models.bounds("R"), r)
+            self.T = R.bulk_models(TT, models.bounds("T"), r)
             self.X = C.curve_models({(b, c): p for b in XB for c, p in coord[b].items()}, models.bounds("X"), r, XB)
-            self.Y = C.curve_models(self.TY, models.bounds("Y"), r, YB)
-            self.ER = {p: R.middle_coeffs(m, sigma, L=hn.exp_order) for p, m in self.R.items()}
-            self.ET = {p: R.middle_coeffs(m, sigma, L=hn.exp_order) for p, m in self.T.items()}
+            self.Y = C.curve_models({(b, c): p for b in YB for c, p in coord[b].items()}, models.bounds("Y"), r, YB)
+            self.om, self.omy = R.omegas(sigma), C.y_omegas(sigma)
+            self.ER = {p: R.middle_coeffs(m, self.om, 1, 2, L=hn.exp_order) for p, m in self.R.items()}
+            self.ET = {p: R.middle_coeffs(m, self.om, 1, 2, L=hn.exp_order) for p, m in self.T.items()}
+            self.EY = {c: R.middle_coeffs(m, self.omy, 0, 1, L=hn.exp_order) for c, m in self.Y.items()}
             self._layers(hn.layer_order, r)
 
     def _layers(self, n, r):
@@ -127,9 +128,10 @@ class SigmaBox:
         (s_lo, s_hi), (h_lo, h_hi) = box
         return R.kdet_box(self.R, s_lo, s_hi, h_lo, h_hi, self.sigma, prec=self.m.prec)
 
-    def _middle(self, models, E, box):
+    def _middle(self, models, E, box, om=None, m0=1, q=2):
         (s_lo, s_hi), (w_lo, w_hi) = box
-        return R.middle_box(models, E, s_lo, s_hi, w_lo, w_hi, self.sigma, L=self.m.hints.exp_order, prec=self.m.prec)
+        return R.middle_box(models, E, om or self.om, s_lo, s_hi, w_lo, w_hi, m0, q, L=self.m.hints.exp_order,
+                            prec=self.m.prec)
 
     def middle(self, box):
         """K^3 det J_Phi/q^2 as a function of (s, w = 1/q) in the box (the middle)."""
@@ -166,10 +168,7 @@ class SigmaBox:
 
     def y_middle(self, box):
         """Y/s on every outer-curve Bezier point, (s, w) in the box."""
-        (s_lo, s_hi), (w_lo, w_hi) = box
-        hn = self.m.hints
-        return C.ymid_box(self.TY, self.m.bounds("Y"), s_lo, s_hi, w_lo, w_hi, self.sigma, hn.r, hn.order,
-                          L=hn.exp_order, prec=self.m.prec)
+        return self._middle(self.Y, self.EY, box, self.omy, 0, 1)
 
     def y_layer(self, q, box):
         """K Y on layer quadrant q's outer-curve points (K^2 Y at ray 0's end point of quadrant 0), h in the box."""

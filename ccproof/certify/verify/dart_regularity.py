@@ -72,7 +72,7 @@ def kdet_box(models, s_lo, s_hi, h_lo, h_hi, sigma, prec=128):
         return hull(v for model in models.values() for v in model.real_part(ws, h_lo, h_hi, low=1))
 
 
-def _omegas(sigma):
+def omegas(sigma):
     """a_i(s) b_j(s) = c_ij e^(i omega_ij s): [(c_ij, omega_ij)] (acb, arb) in the order of IJ."""
     tp, es = 2 * arb.pi(), acb(0, sigma).exp()
     a = {"X+": tp, "X-": -tp}
@@ -80,53 +80,48 @@ def _omegas(sigma):
     return [(b[j][0], a[i] + b[j][1]) for i, j in IJ]
 
 
-def middle_coeffs(model, sigma, L=24):
-    """{(m, l): e_ml} = D_m (c_ij (i omega_ij)^l/l!)_ij (acb_mat, a row per Bernstein coefficient): the
-    coefficient of s^l h^(m-1) in K det J_Phi = sum_ij a_i(s) b_j(s) sum_m D_ijm h^(m-1), for m = 1, 2 and
-    l <= L (the terms m >= 3 are evaluated directly); D_m the coefficients of a :func:`bulk_models` model."""
-    om = _omegas(sigma)
+def middle_coeffs(model, om, m0, q, L=24):
+    """{(m, l): e_ml = D_m (c_k (i omega_k)^l/l!)_k} (acb_mat, a row per value) for m0 <= m < m0 + q and
+    l <= L: the coefficient of s^l h^m in F = sum_k c_k e^(i omega_k s) sum_m D_km h^m (``om``: the (c_k,
+    omega_k) of the model's columns, |c_k| = 1)."""
     return {(m, l): model.coeffs[m] * acb_mat([[c * acb(0, w) ** l / arb.fac_ui(l)] for c, w in om])
-            for m in (1, 2) for l in range(L + 1)}
+            for m in range(m0, m0 + q) for l in range(L + 1)}
 
 
-def _horner(e, m, top, bottom, s):
-    acc = e[(m, top)]
-    for l in range(top - 1, bottom - 1, -1):
-        acc = acc * s + e[(m, l)]
-    return acc
-
-
-def middle_box(models, E, s_lo, s_hi, w_lo, w_hi, sigma, L=24, prec=128):
-    """An arb holding G = K det J_Phi/s^2 (= K^3 det J_Phi/q^2 at s = q h) on s in [s_lo, s_hi], w = h/s in
-    [w_lo, w_hi] (s_lo >= 0), per piece (``E[piece]``: :func:`middle_coeffs`): the m = 1 part
-    sum_(l >= 2) e_1l s^(l-2), the m = 2 part w sum_(l >= 1) e_2l s^(l-1) (the coefficients e_10, e_11, e_20
-    being 0 exactly), the m >= 3 parts a_i(s) b_j(s) D_ijm s^(m-3) w^(m-1), the tails of the exponential
-    series (|omega s|^(L+1)/(L+1)!, with the factor 1/(1 - |omega s|/(L + 2))) and the Cauchy remainder
-    M_ij s^(n-2) w^n/(r^(n+1) (1 - h/r))."""
+def middle_box(models, E, om, s_lo, s_hi, w_lo, w_hi, m0, q, L=24, prec=128):
+    """An arb holding Re F/(h^m0 s^q) (F of :func:`middle_coeffs`, every model's rows) on s in [s_lo, s_hi],
+    w = h/s in [w_lo, w_hi], s_lo >= 0, where F's coefficients of h^m s^l with l + m - m0 < q are 0 exactly:
+    the orders m < m0 + q expanded in s, sum_l e_ml s^(l + m - m0 - q) w^(m - m0), the tails of those
+    exponential series (|omega s|^l/l! summed past L: at most z^(L+1)/(L+1)!/(1 - z/(L + 2)), z = |omega| s)
+    and the rest direct, (c e^(i omega s) . D_m) s^(m - m0 - q) w^(m - m0), with the Cauchy remainder
+    sum_k M_k s^(n+1-m0-q) w^(n+1-m0)/(r^(n+1) (1 - h/r)). K det J_Phi/s^2 is m0 = 1, q = 2; Y/s is m0 = 0,
+    q = 1."""
     with ctx.workprec(prec):
         s, w = acb(ball(s_lo, s_hi)), acb(ball(w_lo, w_hi))
-        om = _omegas(sigma)
         wmax = max((abs(x[1]).upper() for x in om), key=lambda x: x)
-        z = wmax * arb(fmpq(s_hi))
+        z, sh, wh = wmax * arb(fmpq(s_hi)), arb(fmpq(s_hi)), arb(fmpq(w_hi))
         if not z < L + 2:
             raise ValueError("s too large for the exponential series")
-        # the tails of the exponential series, divided by s^2 (m = 1) and s (m = 2): |c_ij| = 1 and
-        # sum_(l > L) |omega s|^l/l! <= |omega s|^(L+1)/(L+1)!/(1 - |omega s|/(L + 2))
-        geo = z ** (L - 1) / arb.fac_ui(L + 1) / (1 - z / (L + 2))
+        geo = 1 / (arb.fac_ui(L + 1) * (1 - z / (L + 2)))
         ab = acb_mat([[c * (w_ * s * acb(0, 1)).exp()] for c, w_ in om])
         vals = []
-        for piece, model in models.items():
+        for key, model in models.items():
             n, D = model.order, model.coeffs
-            ctail = (arb(fmpq(s_hi)) ** (n - 2) * arb(fmpq(w_hi)) ** n
-                     * cauchy_factor(model.r, n, fmpq(s_hi) * fmpq(w_hi)))
-            dmax = [max((abs(D[m][c, k]).upper() for c in range(D[m].nrows()) for k in range(6)), key=lambda x: x)
-                    for m in (1, 2)]
-            rad = (6 * dmax[0] * wmax ** 2 * geo + 6 * dmax[1] * wmax * geo * z * arb(fmpq(w_hi))
-                   + sum(model.M, arb(0)) * ctail).upper()
-            g = _horner(E[piece], 1, L, 2, s) + _horner(E[piece], 2, L, 1, s) * w
-            for m in range(3, n + 1):
-                g = g + (D[m] * ab) * (s ** (m - 3) * w ** (m - 1))
-            vals += [g[c, 0].real + arb(0, rad) for c in range(g.nrows())]
+            rad = sum(model.M, arb(0)) * sh ** (n + 1 - m0 - q) * wh ** (n + 1 - m0) * cauchy_factor(
+                model.r, n, fmpq(s_hi) * fmpq(w_hi))
+            g = None
+            for j in range(q):
+                e = E[key]
+                dmax = max((abs(D[m0 + j][c, k]).upper() for c in range(D[m0 + j].nrows()) for k in range(len(om))),
+                           key=lambda x: x)
+                rad += len(om) * dmax * wh ** j * wmax ** (q - j) * z ** (L + 1 + j - q) * geo
+                acc = e[(m0 + j, L)]
+                for l in range(L - 1, q - j - 1, -1):
+                    acc = acc * s + e[(m0 + j, l)]
+                g = acc * w ** j if g is None else g + acc * w ** j
+            for m in range(m0 + q, n + 1):
+                g = g + (D[m] * ab) * (s ** (m - m0 - q) * w ** (m - m0))
+            vals += [g[c, 0].real + arb(0, rad.upper()) for c in range(g.nrows())]
         return hull(vals)
 
 
