@@ -91,10 +91,6 @@ from flint import acb, arb, ctx, fmpq
 
 from ccproof.certify.verify import dart_curves as _C
 from ccproof.certify.verify import dart_regularity as _R
-from ccproof.certify.verify.dart_curves import (  # noqa: F401 (re-exported for the tests)
-    disc_trans,
-    taylor_trans,
-)
 from ccproof.certify.verify.dart_family import (  # noqa: F401 (re-exported for the tests)
     CURVES,
     PIECES,
@@ -102,17 +98,12 @@ from ccproof.certify.verify.dart_family import (  # noqa: F401 (re-exported for 
     YB,
     Family,
     _hvar,
+    _series_curves,
     basis_nets,
     bordered,
     layer_nets,
     piece_nets,
     series_cap,
-)
-from ccproof.certify.verify.dart_regularity import (  # noqa: F401 (re-exported for the tests)
-    disc_bounds,
-    layer_disc,
-    layer_taylor,
-    taylor_dets,
 )
 from ccproof.certify.verify.dart_zeros import (  # noqa: F401 (re-exported for the tests)
     exact_zeros,
@@ -139,6 +130,60 @@ def family_values(fam, s):
 
 def _parts(T):
     return sorted({key[2] for key in T})
+
+
+# the Taylor coefficients and disc bounds of one quantity at a time (the verifier builds them all at once)
+
+def taylor_dets(sigma, n, prec=128, **control):
+    """The Taylor coefficients in h of D_ij = D(X_i, Y_j) for the basis parts X_i (X+, X-) and Y_j (Y0, Y+, Y-):
+    {(i, j, piece): [coefficient list (acb) of h^m, m = 0..n]}. D is bilinear, so the coefficient of h^m is
+    sum_(k + l = m) D(X_i,k, Y_j,l) of the nets' own Taylor coefficients (acb_series, rigorous)."""
+    with ctx.workprec(prec), series_cap(n):
+        return _R.dets_series(basis_nets(Family(_hvar(n), sigma, **control)), n)
+
+
+def disc_bounds(sigma, r, grid=4, prec=128, **control):
+    """M with |D_ij(h)| <= M[(i, j, piece)] (every Bernstein coefficient) for every complex h in the square
+    [-r, r]^2 (ccproof.rigorous.analytic.disc_bound; every system on each box proved regular by arb,
+    so D_ij is analytic on the disc |h| <= r)."""
+    with ctx.workprec(prec):
+        return disc_bound(lambda h: _R.det_values(basis_nets(Family(h, sigma, **control))), r, grid)
+
+
+def layer_taylor(q, sigma, n, prec=128):
+    """The verifier's layer_dets_series of layer quadrant q."""
+    with ctx.workprec(prec), series_cap(n):
+        return _R.layer_dets_series(layer_nets(Family(_hvar(n), sigma), q), n)
+
+
+def layer_disc(q, sigma, r, grid=12, prec=128):
+    """{piece: M} with |det J_Phi(h)| <= M (every Bernstein coefficient) for complex h in [-r, r]^2."""
+    with ctx.workprec(prec):
+        return disc_bound(lambda h: _R.layer_det_values(layer_nets(Family(h, sigma), q)), r, grid)
+
+
+def taylor_trans(sigma, n, prec=128, **control):
+    """The verifier's trans_series of the family at sigma."""
+    with ctx.workprec(prec), series_cap(n):
+        fam = Family(_hvar(n), sigma, **control)
+        return _C.trans_series(fam, basis_nets(fam), n)
+
+
+def disc_trans(sigma, r, grid=12, prec=128, **control):
+    """The disc bounds (ccproof.rigorous.analytic.disc_bound) of the verifier's trans_values."""
+    def values(h):
+        fam = Family(h, sigma, **control)
+        return _C.trans_values(fam, basis_nets(fam))
+    with ctx.workprec(prec):
+        return disc_bound(values, r, grid)
+
+
+def coord_taylor(sigma, n, coord, prec=128):
+    """{(basis part, curve): [order m: 4 acb]}: Taylor coefficients in h of the verifier's coord_values."""
+    with ctx.workprec(prec), series_cap(n):
+        nets = basis_nets(Family(_hvar(n), sigma))
+        return {(b, c): pts for b in (XB if coord == "x" else YB) for c, pts in _series_curves(nets[b], n).items()}
+
 
 
 def _bounds(ball_):
@@ -175,10 +220,6 @@ def layer_box(T, M, h_lo, h_hi, r, n, order=3, prec=128):
 def coord_box(T, M, s_lo, s_hi, h_lo, h_hi, sigma, r, n, coord, prec=128):
     models = _C.curve_models(T, M, r, XB if coord == "x" else YB)
     return _bounds(_C.coord_box(models, s_lo, s_hi, h_lo, h_hi, sigma, coord, prec=prec))
-
-
-def coord_taylor(sigma, n, coord, prec=128):
-    return _C.coord_taylor(sigma, n, coord, prec=prec)
 
 
 def coord_disc(sigma, r, coord, grid=12, prec=128):

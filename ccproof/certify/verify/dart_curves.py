@@ -10,22 +10,18 @@ from __future__ import annotations
 
 from flint import acb, acb_mat, arb, ctx
 
-from ccproof.rigorous.analytic import AnalyticModel, ball, disc_bound, hull
+from ccproof.rigorous.analytic import AnalyticModel, ball, hull
 
 from .dart_family import (
     CURVES,
     PIECES,
     XB,
     YB,
-    Family,
     _bprod,
     _coeffs,
-    _hvar,
     _series_curves,
     _trans_series,
-    basis_nets,
     curve_points,
-    series_cap,
 )
 
 
@@ -84,29 +80,6 @@ def layer_y_series(lnets, n):
     """{curve: [m: 4 arb]}: Taylor coefficients of Y's outer-curve points on a layer quadrant."""
     ys = _series_curves({p: lnets[p][1] for p in PIECES}, n)
     return {c: [[z.real for z in pts] for pts in ys[c]] for c in CURVES}
-
-
-def taylor_trans(sigma, n, prec=128, **control):
-    """:func:`trans_series` of the family at sigma."""
-    with ctx.workprec(prec), series_cap(n):
-        fam = Family(_hvar(n), sigma, **control)
-        return trans_series(fam, basis_nets(fam), n)
-
-
-def disc_trans(sigma, r, grid=12, prec=128, **control):
-    """The disc bounds (:func:`~ccproof.rigorous.analytic.disc_bound`) of :func:`trans_values`."""
-    def values(h):
-        fam = Family(h, sigma, **control)
-        return trans_values(fam, basis_nets(fam))
-    with ctx.workprec(prec):
-        return disc_bound(values, r, grid)
-
-
-def coord_taylor(sigma, n, coord, prec=128):
-    """{(basis part, curve): [order m: 4 acb]}: Taylor coefficients in h of :func:`coord_values`."""
-    with ctx.workprec(prec), series_cap(n):
-        nets = basis_nets(Family(_hvar(n), sigma))
-        return {(b, c): pts for b in (XB if coord == "x" else YB) for c, pts in _series_curves(nets[b], n).items()}
 
 
 def curve_models(T, M, r, parts):

@@ -11,9 +11,9 @@ from __future__ import annotations
 
 from flint import acb, acb_mat, arb, ctx, fmpq
 
-from ccproof.rigorous.analytic import AnalyticModel, ball, cauchy_factor, disc_bound, hull
+from ccproof.rigorous.analytic import AnalyticModel, ball, cauchy_factor, hull
 
-from .dart_family import PIECES, XB, YB, Family, _coeffs, _hvar, basis_nets, det_series, layer_nets, series_cap
+from .dart_family import PIECES, XB, YB, _coeffs, det_series
 
 IJ = [(i, j) for i in XB for j in YB]  # the columns of the bulk models
 
@@ -33,22 +33,6 @@ def dets_series(nets, n):
     series = {key: [[[_coeffs(z, n + 1)[m] for z in row] for row in net] for m in range(n + 1)]
               for key, net in _flat(nets).items()}
     return {(i, j, p): det_series(series[(i, p)], series[(j, p)], n) for i, j in IJ for p in PIECES}
-
-
-def taylor_dets(sigma, n, prec=128, **control):
-    """The Taylor coefficients in h of D_ij = D(X_i, Y_j) for the basis parts X_i (X+, X-) and Y_j (Y0, Y+, Y-):
-    {(i, j, piece): [coefficient list (acb) of h^m, m = 0..n]}. D is bilinear, so the coefficient of h^m is
-    sum_(k + l = m) D(X_i,k, Y_j,l) of the nets' own Taylor coefficients (acb_series, rigorous)."""
-    with ctx.workprec(prec), series_cap(n):
-        return dets_series(basis_nets(Family(_hvar(n), sigma, **control)), n)
-
-
-def disc_bounds(sigma, r, grid=4, prec=128, **control):
-    """M with |D_ij(h)| <= M[(i, j, piece)] (every Bernstein coefficient) for every complex h in the square
-    [-r, r]^2 (:func:`~ccproof.rigorous.analytic.disc_bound`; every system on each box proved regular by arb,
-    so D_ij is analytic on the disc |h| <= r)."""
-    with ctx.workprec(prec):
-        return disc_bound(lambda h: det_values(basis_nets(Family(h, sigma, **control))), r, grid)
 
 
 def bulk_models(T, M, r):
@@ -139,18 +123,6 @@ def layer_dets_series(lnets, n):
                    for m in range(n + 1)] for Z in (X, Y))
         out[piece] = [[z.real for z in c] for c in det_series(fx, fy, n)]
     return out
-
-
-def layer_taylor(q, sigma, n, prec=128):
-    """:func:`layer_dets_series` of layer quadrant q."""
-    with ctx.workprec(prec), series_cap(n):
-        return layer_dets_series(layer_nets(Family(_hvar(n), sigma), q), n)
-
-
-def layer_disc(q, sigma, r, grid=12, prec=128):
-    """{piece: M} with |det J_Phi(h)| <= M (every Bernstein coefficient) for complex h in [-r, r]^2."""
-    with ctx.workprec(prec):
-        return disc_bound(lambda h: layer_det_values(layer_nets(Family(h, sigma), q)), r, grid)
 
 
 def column_models(T, M, r):
