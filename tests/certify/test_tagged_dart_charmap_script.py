@@ -380,10 +380,10 @@ def test_the_exact_nets_are_the_acb_familys_nets():
             el = []
             for e in exs:
                 x, y = e.layer_level0(q)
-                el.append({p: mod._bezier([[mod.layer_value(y, e.yc, e.lam2, q, e.zero)(mod._OFFSET[p][0] + i,
+                el.append({p: mod._bezier([[mod.level1_value(y, e.yc, e.lam2, e.zero, q)(mod._OFFSET[p][0] + i,
                                                                                             mod._OFFSET[p][1] + j)
                                              for j in range(4)] for i in range(4)], e.zero) for p in mod.PIECES})
-                x0 = {p: mod._bezier([[mod.layer_value(x, e.zero, e.lam1, q, e.zero)(mod._OFFSET[p][0] + i,
+                x0 = {p: mod._bezier([[mod.level1_value(x, e.zero, e.lam1, e.zero, q)(mod._OFFSET[p][0] + i,
                                                                                      mod._OFFSET[p][1] + j)
                                        for j in range(4)] for i in range(4)], e.zero) for p in mod.PIECES}
             for p in mod.PIECES:

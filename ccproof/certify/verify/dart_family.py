@@ -232,10 +232,13 @@ class Family:
         }
 
 
-def local_value(level0, centre, lam, zero):
-    """``value(A, B)``: the level-1 value at position (A, B) of a bulk quadrant (no sharp ray within reach):
-    lam times the level-0 value on the two-ring (the vector is an eigenvector of every ring row), the
-    level-1 rule of :mod:`.rules` elsewhere; ``level0(delta, pos)`` the level-0 value of sector q + delta."""
+def level1_value(level0, centre, lam, zero, q=None):
+    """``value(A, B)``: the level-1 value at position (A, B) of a quadrant: lam times the level-0 value on the
+    two-ring (the vector is an eigenvector of every ring row), the level-1 rule of :mod:`.rules` elsewhere.
+    ``q`` None: a bulk quadrant (no sharp ray within reach; ``level0(delta, pos)`` the level-0 value of sector
+    q + delta); else the layer quadrant q >= 0 (``level0(t, pos)`` at the sector t; ray 0 sharp, as
+    tagged_map.level1_values: the ghost row 2 P(A, 0) - P(A, 1) across ray 0, the sharp edge's midpoint at
+    ray 0's (3, 0))."""
     def lev0(d, a, b):
         dd, a2, b2 = canonical(a, b)
         return centre if (a2, b2) == CENTRE else level0(d + dd, (a2, b2))
@@ -243,12 +246,17 @@ def local_value(level0, centre, lam, zero):
     def value(A, B):
         if (A, B) == (0, 0):
             return lam * centre
+        if B == -1 and q == 0:
+            return 2 * value(A, 0) - value(A, 1)
         d, A2, B2 = canonical(A, B)
+        t = d if q is None else q + d
         if (A2, B2) in _POS:
-            return lam * level0(d, (A2, B2))
+            return lam * level0(t, (A2, B2))
+        if q is not None and B2 == 0 and t == 0:
+            return (level0(0, (1, 0)) + level0(0, (2, 0))) / 2
         acc = zero
         for (a, b), w in level1_rule(A2, B2).items():
-            acc = acc + lev0(d, a, b) * w
+            acc = acc + lev0(t, a, b) * w
         return acc
     return value
 
@@ -263,7 +271,7 @@ def _bezier(net, zero):
 
 def piece_nets(level0, centre, lam, zero):
     """{piece: 4 x 4 Bezier net} of one coordinate (or one basis part) on a bulk quadrant."""
-    V = local_value(level0, centre, lam, zero)
+    V = level1_value(level0, centre, lam, zero)
     return {name: _bezier([[V(_OFFSET[name][0] + i, _OFFSET[name][1] + j) for j in range(4)] for i in range(4)], zero)
             for name in PIECES}
 
@@ -331,37 +339,11 @@ def layer_level0(fam, q):
     return x, y, fam.zero, fam.yc
 
 
-def layer_value(level0, centre, lam, q, zero):
-    """``value(A, B)``: level-1 values of layer quadrant q >= 0 (ray 0 sharp; as tagged_map.level1_values:
-    lam times the level-0 value on the two-ring, the ghost row 2 P(A, 0) - P(A, 1) across ray 0, the sharp
-    edge's midpoint at ray 0's (3, 0), the level-1 rules elsewhere)."""
-    def lev0(d, a, b):
-        dd, a2, b2 = canonical(a, b)
-        return centre if (a2, b2) == CENTRE else level0(d + dd, (a2, b2))
-
-    def value(A, B):
-        if (A, B) == (0, 0):
-            return lam * centre
-        if B == -1 and q == 0:
-            return 2 * value(A, 0) - value(A, 1)
-        d, A2, B2 = canonical(A, B)
-        t = q + d
-        if (A2, B2) in _POS:
-            return lam * level0(t, (A2, B2))
-        if B2 == 0 and t == 0:
-            return (level0(0, (1, 0)) + level0(0, (2, 0))) / 2
-        acc = zero
-        for (a, b), w in level1_rule(A2, B2).items():
-            acc = acc + lev0(t, a, b) * w
-        return acc
-    return value
-
-
 def layer_nets(fam, q):
     """{piece: (X net, Y net)} (4 x 4 Bezier, values of fam.h's type) of layer quadrant q."""
     x, y, xc, yc = layer_level0(fam, q)
-    VX = layer_value(x, xc, fam.lam1, q, fam.zero)
-    VY = layer_value(y, yc, fam.lam2, q, fam.zero)
+    VX = level1_value(x, xc, fam.lam1, fam.zero, q)
+    VY = level1_value(y, yc, fam.lam2, fam.zero, q)
     out = {}
     for name in PIECES:
         oa, ob = _OFFSET[name]
