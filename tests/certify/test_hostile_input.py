@@ -285,7 +285,7 @@ def test_a_record_beyond_the_work_budget_fails_with_the_reason_in_seconds(kind, 
     k = 5 (every box of the published certificate into 256, the last bound raised past its box) once the box
     lists' splits pass the certificate's budget, about 5 CPU-minutes before the budget."""
     if kind.startswith("dart"):
-        c, reason = _dart_at_the_grammars_limits(), "beyond the budget of 30 s"
+        c, reason = _dart_at_the_grammars_limits(), "beyond the budget of 16 s"
     else:
         c = split_further(load("k005.json"), 8)
         assert count_boxes(c) == 8192
