@@ -91,6 +91,24 @@ def test_record_forgeries_fail_before_any_arithmetic(record, change, why):
     assert not res.parts, [p.name for p in res.parts]  # the record step: no part was run
 
 
+@pytest.mark.parametrize("change", [
+    lambda c: c.__setitem__("prec", 256),
+    lambda c: c["taylor"].__setitem__("disc_grid", 30),
+    lambda c: c["taylor"].__setitem__("order", 20),
+    lambda c: c["spectrum"].__setitem__("sigma_h", 4096),
+])
+def test_each_size_is_priced_and_past_the_budget_fails_before_any_arithmetic(record, change):
+    """The published record is inside the work budget; raising one declared size (precision, disc grid, the
+    bulk's Taylor order, h-balls) within its grammar takes it past, and it FAILs before any part runs."""
+    from ccproof.certify.verify.dart_tail import MAX_WORK, read_record, record_work
+
+    assert record_work(read_record(record, 101)) <= MAX_WORK
+    cert = copy.deepcopy(record)
+    change(cert)
+    res = _fails(cert, "beyond the budget")
+    assert not res.parts
+
+
 def test_a_raised_spectral_bound_fails_the_spectrum(record):
     cert = _no_map(record)
     leaf = cert["spectrum"]["re"]["I"]["leaves"][7]
