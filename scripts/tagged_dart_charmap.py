@@ -89,41 +89,165 @@ from pathlib import Path
 
 from flint import acb, arb, ctx, fmpq
 
-from ccproof.certify.verify.dart_curves import (  # noqa: F401 (re-exported for the tests)
-    coord_box,
-    coord_disc,
-    coord_taylor,
-    disc_trans,
-    layer_coord,
-    layer_trans_disc,
-    layer_trans_taylor,
-    taylor_trans,
-    ymid_box,
-)
+from ccproof.certify.verify import dart_curves as _C
+from ccproof.certify.verify import dart_regularity as _R
 from ccproof.certify.verify.dart_family import (  # noqa: F401 (re-exported for the tests)
     CURVES,
     PIECES,
+    XB,
     YB,
     Family,
-    _ball,
-    _parts,
+    _hvar,
+    _series_curves,
+    basis_nets,
     bordered,
     layer_nets,
     piece_nets,
-)
-from ccproof.certify.verify.dart_regularity import (  # noqa: F401 (re-exported for the tests)
-    disc_bounds,
-    kdet_box,
-    layer_box,
-    layer_disc,
-    layer_taylor,
-    middle_box,
-    middle_coeffs,
-    taylor_dets,
+    series_cap,
 )
 from ccproof.certify.verify.dart_zeros import (  # noqa: F401 (re-exported for the tests)
     exact_zeros,
 )
+from ccproof.rigorous.analytic import ball as _ball  # noqa: F401 (re-exported for the tests)
+from ccproof.rigorous.analytic import disc_bound
+
+# the verifier's evaluators take analytic models (ccproof.rigorous.analytic); these keep the scripts' calls
+# on (Taylor coefficients, disc bounds, r, n)
+
+def family_values(fam, s):
+    """(x, y, y_C): the level-0 values x(delta, pos), y(delta, pos) at the quadrant K s of a dart family (real h
+    and s only), and the centre's y."""
+    E, F = acb(0, 2 * arb.pi() * s).exp(), acb(0, fam.sigma * (2 * s - 1)).exp()
+    P = fam.parts()
+
+    def x(d, p):
+        return (E * P["X+"][0](d, p) + P["X-"][0](d, p) / E).real
+
+    def y(d, p):
+        return (P["Y0"][0](d, p) + F * P["Y+"][0](d, p) + P["Y-"][0](d, p) / F).real
+    return x, y, acb(fam.yc).real
+
+
+def _parts(T):
+    return sorted({key[2] for key in T})
+
+
+# the Taylor coefficients and disc bounds of one quantity at a time (the verifier builds them all at once)
+
+def taylor_dets(sigma, n, prec=128, **control):
+    """The Taylor coefficients in h of D_ij = D(X_i, Y_j) for the basis parts X_i (X+, X-) and Y_j (Y0, Y+, Y-):
+    {(i, j, piece): [coefficient list (acb) of h^m, m = 0..n]}. D is bilinear, so the coefficient of h^m is
+    sum_(k + l = m) D(X_i,k, Y_j,l) of the nets' own Taylor coefficients (acb_series, rigorous)."""
+    with ctx.workprec(prec), series_cap(n):
+        return _R.dets_series(basis_nets(Family(_hvar(n), sigma, **control)), n)
+
+
+def disc_bounds(sigma, r, grid=4, prec=128, **control):
+    """M with |D_ij(h)| <= M[(i, j, piece)] (every Bernstein coefficient) for every complex h in the square
+    [-r, r]^2 (ccproof.rigorous.analytic.disc_bound; every system on each box proved regular by arb,
+    so D_ij is analytic on the disc |h| <= r)."""
+    with ctx.workprec(prec):
+        return disc_bound(lambda h: _R.det_values(basis_nets(Family(h, sigma, **control))), r, grid)
+
+
+def layer_taylor(q, sigma, n, prec=128):
+    """The verifier's layer_dets_series of layer quadrant q."""
+    with ctx.workprec(prec), series_cap(n):
+        return _R.layer_dets_series(layer_nets(Family(_hvar(n), sigma), q), n)
+
+
+def layer_disc(q, sigma, r, grid=12, prec=128):
+    """{piece: M} with |det J_Phi(h)| <= M (every Bernstein coefficient) for complex h in [-r, r]^2."""
+    with ctx.workprec(prec):
+        return disc_bound(lambda h: _R.layer_det_values(layer_nets(Family(h, sigma), q)), r, grid)
+
+
+def taylor_trans(sigma, n, prec=128, **control):
+    """The verifier's trans_series of the family at sigma."""
+    with ctx.workprec(prec), series_cap(n):
+        fam = Family(_hvar(n), sigma, **control)
+        return _C.trans_series(fam, basis_nets(fam), n)
+
+
+def disc_trans(sigma, r, grid=12, prec=128, **control):
+    """The disc bounds (ccproof.rigorous.analytic.disc_bound) of the verifier's trans_values."""
+    def values(h):
+        fam = Family(h, sigma, **control)
+        return _C.trans_values(fam, basis_nets(fam))
+    with ctx.workprec(prec):
+        return disc_bound(values, r, grid)
+
+
+def coord_taylor(sigma, n, coord, prec=128):
+    """{(basis part, curve): [order m: 4 acb]}: Taylor coefficients in h of the verifier's coord_values."""
+    with ctx.workprec(prec), series_cap(n):
+        nets = basis_nets(Family(_hvar(n), sigma))
+        return {(b, c): pts for b in (XB if coord == "x" else YB) for c, pts in _series_curves(nets[b], n).items()}
+
+
+
+def _bounds(ball_):
+    return ball_.lower(), ball_.upper()
+
+
+def kdet_box(T, M, s_lo, s_hi, h_lo, h_hi, sigma, r, n, prec=128):
+    return _bounds(_R.kdet_box(_R.bulk_models(T, M, r), s_lo, s_hi, h_lo, h_hi, sigma, prec=prec))
+
+
+def middle_coeffs(T, sigma, L=24):
+    """{(m, l, piece): coefficient list}: the verifier's e_ml of each piece."""
+    models = _R.bulk_models(T, {key: arb(0) for key in T}, fmpq(1))
+    return {key + (p,): [mat[c, 0] for c in range(mat.nrows())] for p, model in models.items()
+            for key, mat in _R.middle_coeffs(model, _R.omegas(sigma), 1, 2, L).items()}
+
+
+def middle_box(T, E, M, s_lo, s_hi, w_lo, w_hi, sigma, r, n, L=24, prec=128):
+    models, om = _R.bulk_models(T, M, r), _R.omegas(sigma)
+    coeffs = {p: _R.middle_coeffs(model, om, 1, 2, L) for p, model in models.items()}
+    return _bounds(_R.middle_box(models, coeffs, om, s_lo, s_hi, w_lo, w_hi, 1, 2, L=L, prec=prec))
+
+
+def ymid_box(T, M, s_lo, s_hi, w_lo, w_hi, sigma, r, n, L=24, prec=128):
+    models, om = _C.curve_models(T, M, r, YB), _C.y_omegas(sigma)
+    coeffs = {c: _R.middle_coeffs(model, om, 0, 1, L) for c, model in models.items()}
+    return _bounds(_R.middle_box(models, coeffs, om, s_lo, s_hi, w_lo, w_hi, 0, 1, L=L, prec=prec))
+
+
+def layer_box(T, M, h_lo, h_hi, r, n, order=3, prec=128):
+    return _bounds(_R.layer_box(_R.column_models(T, M, r), h_lo, h_hi, order=order, prec=prec))
+
+
+def coord_box(T, M, s_lo, s_hi, h_lo, h_hi, sigma, r, n, coord, prec=128):
+    models = _C.curve_models(T, M, r, XB if coord == "x" else YB)
+    return _bounds(_C.coord_box(models, s_lo, s_hi, h_lo, h_hi, sigma, coord, prec=prec))
+
+
+def coord_disc(sigma, r, coord, grid=12, prec=128):
+    with ctx.workprec(prec):
+        return disc_bound(lambda h: _C.coord_values(basis_nets(Family(h, sigma)), coord), r, grid)
+
+
+def layer_trans_taylor(q, sigma, n, prec=128):
+    with ctx.workprec(prec), series_cap(n):
+        fam = Family(_hvar(n), sigma)
+        return _C.layer_trans_series(fam, layer_nets(fam, q), n)
+
+
+def layer_trans_disc(q, sigma, r, grid=12, prec=128):
+    def values(h):
+        fam = Family(h, sigma)
+        return _C.layer_trans_values(fam, layer_nets(fam, q))
+    with ctx.workprec(prec):
+        return disc_bound(values, r, grid)
+
+
+def layer_coord(q, sigma, n, r, grid=12, prec=128):
+    """(Taylor coefficients {curve: [m: 4 arb]}, disc bounds {curve: M}) of Y on layer quadrant q's outer curves."""
+    with ctx.workprec(prec), series_cap(n):
+        T = _C.layer_y_series(layer_nets(Family(_hvar(n), sigma), q), n)
+        M = disc_bound(lambda h: _C.layer_y_values(layer_nets(Family(h, sigma), q)), r, grid) if grid else {}
+        return T, M
+
 
 # the outer curves of a quadrant's layer 0, as tagged_map/maps.STAR_CURVES: (piece, side, orientation)
 
@@ -292,7 +416,7 @@ def corner_dets(sigma, k, s):
     bulk quadrant at s, for h = 1/k and the family's member ``sigma`` (arb balls)."""
     from ccproof.certify.verify.maps import regularity_form
     fam = Family(acb(arb(fmpq(1, k))), sigma)
-    x, y, yc = fam.values(s)
+    x, y, yc = family_values(fam, s)
     nx = piece_nets(x, arb(0), acb(fam.lam1).real, arb(0))
     ny = piece_nets(y, yc, acb(fam.lam2).real, arb(0))
     out = []
@@ -519,9 +643,9 @@ def exact_check(k):
     ye = even_vector(k, lam2, py)
     f = mode_vector("dart", k, 1, lam1)
     xe = [arb(0)] + [(z / f[px]).real for z in f[1:]]
-    xf, yf = [arb(0)], [fam.values(0)[2]]
+    xf, yf = [arb(0)], [family_values(fam, 0)[2]]
     for p in pts[1:]:
-        x, y, _ = fam.values(fmpq(p[1], k))
+        x, y, _ = family_values(fam, fmpq(p[1], k))
         xf.append(x(0, p[2:]))
         yf.append(y(0, p[2:]))
     err_y = max(float(abs(a - b / yf[py]).upper()) for a, b in zip(ye, yf))
@@ -530,7 +654,7 @@ def exact_check(k):
     err_n, err_layer = 0.0, 0.0
     for q in (3, (k - 1) // 2):
         ref = quadrant_nets("dart", k, xf, yf, q, ctx.prec)
-        x, y, yc = fam.values(fmpq(q, k))
+        x, y, yc = family_values(fam, fmpq(q, k))
         nx = piece_nets(x, arb(0), acb(fam.lam1).real, arb(0))
         ny = piece_nets(y, yc, acb(fam.lam2).real, arb(0))
         err_n = max([err_n] + [float(abs(ref[n][i][j][c] - (nx, ny)[c][n][i][j]).upper())

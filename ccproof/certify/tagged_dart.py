@@ -1,9 +1,8 @@
 """The covers of a ``dart:>=K0`` record: bisection over the trusted evaluators, written as trees (untrusted).
 
-The verifier (:mod:`ccproof.certify.verify.dart_trees`) replays a tree and never searches; this module is the
-search. :func:`cover` bisects each grid cell of a region's root until the region's evaluator
-(:class:`~ccproof.certify.verify.dart_regularity.RegularityBox`,
-:class:`~ccproof.certify.verify.dart_curves.CurveBox`) proves the claim's sign on every leaf, and records the
+The verifier (:func:`ccproof.certify.verify.replay.replay_tree`) replays a tree and never searches; this module
+is the search. :func:`cover` bisects each grid cell of a region's root until the region's evaluator
+(:class:`~ccproof.certify.verify.dart_models.SigmaBox`) proves the claim's sign on every leaf, and records the
 leaves in the record's grammar (docs/certificates.md, "Every dart K >= K0 in one certificate"): a path of
 halvings per leaf, a bound a little inside the leaf's enclosure (floats choose the bound; the verifier
 decides), and ``outside`` leaves in the middle region where no K >= K0 lies. :func:`map_covers` builds the
@@ -13,16 +12,14 @@ F, and :func:`prove_dart_tail` the whole record (``ccproof certify 'dart:>=101' 
 
 from __future__ import annotations
 
-import functools
 import itertools
 import math
 
 from flint import fmpq
 
-from ccproof.certify.verify.dart_curves import CurveModels
-from ccproof.certify.verify.dart_regularity import RegularityModels
-from ccproof.certify.verify.dart_trees import leaf_box
+from ccproof.certify.verify.dart_models import DartModels, map_regions
 from ccproof.certify.verify.errors import CertificateError
+from ccproof.certify.verify.replay import leaf_box
 
 
 def _inside(val, sign):
@@ -118,30 +115,18 @@ def map_covers(k0, sig_lo, sig_hi, hints, s0, layer, winding, prec=128, progress
     -------
     dict
     """
-    R = RegularityModels(sig_lo, sig_hi, hints, layer, prec)
-    C = CurveModels(sig_lo, sig_hi, hints, layer, prec)
-    h0, half = fmpq(1, k0), fmpq(1, 2)
-    s_a, s_b = winding
-    bulk, middle, hroot = [(s0, half), (fmpq(0), h0)], [(fmpq(0), s0), (fmpq(0), fmpq(1, layer))], [(fmpq(0), h0)]
-    out = {"regularity": {"bulk": [], "middle": [], "layer": {str(q): [] for q in range(layer)}},
-           "transversal": {"bulk": [], "middle": [], "layer": {str(q): [] for q in range(layer)}},
-           "winding": {"Y<0 bulk": [], "X>0 bulk": [], "Y>0 bulk": [], "Y<0 middle": [],
-                       "Y<0 layer": {str(q): [] for q in range(layer)}}}
+    models = DartModels(sig_lo, sig_hi, hints, layer, prec)
+    regions = map_regions(k0, s0, layer, winding)
+    out = {}
     for i in range(hints.sigma_boxes):
-        rb, cb = R.sigma_box(i), C.sigma_box(i)
-        reg, tra, win = out["regularity"], out["transversal"], out["winding"]
-        reg["bulk"].append(cover(bulk, rb.bulk, 1, [16, 1]))
-        reg["middle"].append(cover(middle, rb.middle, 1, [1, 1], k0=k0, outside=True))
-        tra["bulk"].append(cover(bulk, cb.transversal_bulk, 1, [16, 1]))
-        tra["middle"].append(cover(middle, cb.transversal_middle, 1, [1, 1], k0=k0, outside=True))
-        win["Y<0 bulk"].append(cover([(s0, s_a), (fmpq(0), h0)], cb.y_bulk, -1, [8, 1]))
-        win["X>0 bulk"].append(cover([(s_a, s_b), (fmpq(0), h0)], cb.x_bulk, 1, [8, 1]))
-        win["Y>0 bulk"].append(cover([(s_b, half), (fmpq(0), h0)], cb.y_bulk, 1, [8, 1]))
-        win["Y<0 middle"].append(cover(middle, cb.y_middle, -1, [1, 1], k0=k0, outside=True))
-        for q in range(layer):
-            reg["layer"][str(q)].append(cover(hroot, functools.partial(rb.layer, q), 1, [1]))
-            tra["layer"][str(q)].append(cover(hroot, functools.partial(cb.transversal_layer, q), 1, [1]))
-            win["Y<0 layer"][str(q)].append(cover(hroot, functools.partial(cb.y_layer, q), -1, [1]))
+        box = models.sigma_box(i)
+        for name, keys, root, method, sign, outside in regions:
+            node = out
+            for key in keys[:-1]:
+                node = node.setdefault(key, {})
+            grid = [1] * len(root) if "layer" in name or "middle" in name else [8 if name[0] in "XY" else 16, 1]
+            node.setdefault(keys[-1], []).append(cover(root, box.evaluator(method), sign, grid, k0=k0,
+                                                       outside=outside))
         if progress is not None:
             progress(f"sigma box {i + 1}/{hints.sigma_boxes}")
     return out

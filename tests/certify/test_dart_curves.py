@@ -3,8 +3,8 @@
 import pytest
 from flint import fmpq
 
-from ccproof.certify.verify.dart_curves import CurveModels
 from ccproof.certify.verify.dart_family import TaylorHints
+from ccproof.certify.verify.dart_models import DartModels
 
 LO, HI = fmpq(4484, 1000), fmpq(44935, 10000)  # the bracket of sigma(K), K >= 101
 H = (fmpq(0), fmpq(1, 101))  # every K >= 101
@@ -13,7 +13,7 @@ H = (fmpq(0), fmpq(1, 101))  # every K >= 101
 @pytest.fixture(scope="module")
 def box0():
     hints = TaylorHints(r=fmpq(1, 32), disc_grid=6, sigma_boxes=10, order=12, layer_order=14, exp_order=24)
-    return CurveModels(LO, HI, hints, 1, 128).sigma_box(0)
+    return DartModels(LO, HI, hints, 1, 128).sigma_box(0)
 
 
 def test_the_signs_of_w_on_bulk_boxes(box0):

@@ -7,7 +7,7 @@ import pytest
 from flint import arb, ctx, fmpq
 
 from ccproof.certify.verify.dart_family import TaylorHints
-from ccproof.certify.verify.dart_regularity import RegularityModels
+from ccproof.certify.verify.dart_models import DartModels
 from ccproof.certify.verify.tagged_map import PIECES
 
 LO, HI = fmpq(4484, 1000), fmpq(44935, 10000)  # the bracket of sigma(K), K >= 101
@@ -20,7 +20,7 @@ def _hints(order=12, grid=6):
 
 @pytest.fixture(scope="module")
 def models():
-    return RegularityModels(LO, HI, _hints(), 0, 128)
+    return DartModels(LO, HI, _hints(), 0, 128)
 
 
 def test_a_bulk_leaf_is_proved_for_every_k(models):
@@ -32,7 +32,7 @@ def test_a_bulk_leaf_is_proved_for_every_k(models):
 
 
 def test_an_order_too_low_for_the_cauchy_tail_proves_nothing(models):
-    low = RegularityModels(LO, HI, _hints(order=4), 0, 128).sigma_box(0)
+    low = DartModels(LO, HI, _hints(order=4), 0, 128).sigma_box(0)
     assert not low.bulk(BOX) > 0
 
 
@@ -55,7 +55,7 @@ def test_the_models_enclose_the_per_k_verifiers_det_at_k_101():
     k, q = 101, 30
     with ctx.workprec(128):
         ref = mod._verifier_kdet(k, q)
-        models = RegularityModels(LO, HI, _hints(grid=12), 0, 128)
+        models = DartModels(LO, HI, _hints(grid=12), 0, 128)
         ball = models.sigma_box(0).bulk([(fmpq(q, k), fmpq(q, k)), (fmpq(1, k), fmpq(1, k))])
         values = [c for p in PIECES for c in ref[p]]
         assert all(ball.overlaps(c) for c in values)

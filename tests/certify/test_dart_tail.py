@@ -24,9 +24,20 @@ def record():
     return json.loads(PUBLISHED.read_text())
 
 
-def _no_map(cert):
+def _tree(n, bound):
+    return {"grid": [1] * n, "leaves": [{"cell": [0] * n, "path": "", "bound": bound}]}
+
+
+def _no_map(cert, sigma_boxes=10, layer=3):
+    """The record with its map cut to one root leaf per tree, each claiming a bound its whole region does not
+    reach: the map step fails at its first leaf, after the models are built."""
     out = copy.deepcopy(cert)
-    out["parts"] = {}
+    pos, neg = ([_tree(n, b)] * sigma_boxes for n, b in ((2, "1e-9"), (2, "-1e-9")))
+    lay = {str(q): [_tree(1, "1e-9")] * sigma_boxes for q in range(layer)}
+    cover = {"bulk": pos, "middle": pos, "layer": lay}
+    out["parts"] = {"regularity": cover, "transversal": cover,
+                    "winding": {"Y<0 bulk": neg, "X>0 bulk": pos, "Y>0 bulk": pos, "Y<0 middle": neg,
+                                "Y<0 layer": {str(q): [_tree(1, "-1e-9")] * sigma_boxes for q in range(layer)}}}
     return out
 
 
@@ -44,7 +55,18 @@ def test_every_step_before_the_map_passes(record):
     res = verify_certificate(_no_map(record), **QUIET)
     names = [p.name[0] for p in res.parts if p.ok]
     assert names == ["S", "Z", "G", "E"], [(p.name, p.message) for p in res.parts]
-    assert res.failures()[0].name.startswith("M") and "parts" in res.failures()[0].message
+    assert res.failures()[0].name.startswith("M") and "R bulk, sigma box 0" in res.failures()[0].message
+
+
+def test_a_map_without_its_trees_fails_before_any_arithmetic(record):
+    cert = copy.deepcopy(record)
+    cert["parts"] = {}
+    res = _fails(cert, "parts")
+    assert not res.parts
+    cert = copy.deepcopy(record)
+    del cert["parts"]["regularity"]["bulk"][3]["leaves"][-1]
+    res = _fails(cert, "R bulk, sigma box 3")
+    assert not res.parts
 
 
 @pytest.mark.parametrize("change, why", [
@@ -67,6 +89,24 @@ def test_record_forgeries_fail_before_any_arithmetic(record, change, why):
     change(cert)
     res = _fails(cert, why)
     assert not res.parts, [p.name for p in res.parts]  # the record step: no part was run
+
+
+@pytest.mark.parametrize("change", [
+    lambda c: c.__setitem__("prec", 256),
+    lambda c: c["taylor"].__setitem__("disc_grid", 30),
+    lambda c: c["taylor"].__setitem__("order", 20),
+    lambda c: c["spectrum"].__setitem__("sigma_h", 4096),
+])
+def test_each_size_is_priced_and_past_the_budget_fails_before_any_arithmetic(record, change):
+    """The published record is inside the work budget; raising one declared size (precision, disc grid, the
+    bulk's Taylor order, h-balls) within its grammar takes it past, and it FAILs before any part runs."""
+    from ccproof.certify.verify.dart_tail import MAX_WORK, read_record, record_work
+
+    assert record_work(read_record(record, 101)) <= MAX_WORK
+    cert = copy.deepcopy(record)
+    change(cert)
+    res = _fails(cert, "beyond the budget")
+    assert not res.parts
 
 
 def test_a_raised_spectral_bound_fails_the_spectrum(record):

@@ -1,13 +1,14 @@
-"""The trees of a dart:>=K0 record (verify.dart_trees): partition per cell before arithmetic, the outside
-rule, the bound's sign, and the replay on a real evaluator (forgeries FAIL with a reason)."""
+"""The trees of a dart:>=K0 record (verify.replay.read_tree, replay_tree): partition per cell before
+arithmetic, the outside rule, the bound's sign, and the replay on a real evaluator (forgeries FAIL with a
+reason)."""
 
 import pytest
 from flint import arb, fmpq
 
-from ccproof.certify.verify.dart_curves import CurveModels
 from ccproof.certify.verify.dart_family import TaylorHints
-from ccproof.certify.verify.dart_trees import read_tree, replay_tree
+from ccproof.certify.verify.dart_models import DartModels
 from ccproof.certify.verify.errors import CertificateError
+from ccproof.certify.verify.replay import read_tree, replay_tree
 
 UNIT = [(fmpq(0), fmpq(1)), (fmpq(0), fmpq(1))]
 
@@ -71,7 +72,7 @@ def test_a_w_sign_tree_on_the_real_models():
     """X > 0 on s in [1/4, 7/20] for every K >= 101, from a two-cell tree on sigma box 0; a forged leaf
     claiming Y > 0 across Y's zero (s near 0.30) FAILs."""
     hints = TaylorHints(r=fmpq(1, 32), disc_grid=6, sigma_boxes=10, order=12, layer_order=14, exp_order=24)
-    box0 = CurveModels(fmpq(4484, 1000), fmpq(44935, 10000), hints, 0, 128).sigma_box(0)
+    box0 = DartModels(fmpq(4484, 1000), fmpq(44935, 10000), hints, 0, 128).sigma_box(0)
     root = [(fmpq(1, 4), fmpq(7, 20)), (fmpq(0), fmpq(1, 101))]
     tree = _tree(*[([i, 0], "", {"bound": "1e-3"}) for i in range(10)], grid=(10, 1))
     count, least = replay_tree(read_tree(tree, root, "X>0 bulk", 1), box0.x_bulk, 1, "X>0 bulk")

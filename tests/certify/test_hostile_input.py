@@ -255,3 +255,46 @@ def test_the_partition_is_checked_before_any_box_is_replayed(monkeypatch):
     c["parts"]["corner"]["P3"].pop()
     res = V.verify_certificate(c, log=lambda s: None)
     assert not res and "parts.corner.P3" in res.error and "(gap)" in res.error
+
+
+def _dart_at_the_grammars_limits():
+    """The published dart:>=101 record with the largest hints its grammar allows (disc grid 64, orders 24, 24,
+    64, 64 layer quadrants, 1,024 bits) and one root leaf per tree: about 45 KB, and on the verifier before its
+    work budget some 26 minutes of CPU before it FAILed."""
+    c = json.loads((certificates_dir() / "c1" / "dart" / "k_ge_101.json").read_text())
+    layer, one = 64, 1
+    c["prec"] = 1024
+    c["taylor"] = {"r": "0.03125", "disc_grid": 64, "sigma_boxes": one, "order": 24, "layer_order": 24,
+                   "exp_order": 64}
+    c["regions"]["layer"] = layer
+
+    def tree(n, bound):
+        return [{"grid": [1] * n, "leaves": [{"cell": [0] * n, "path": "", "bound": bound}]}] * one
+    lay = {str(q): tree(1, "1e-9") for q in range(layer)}
+    cover = {"bulk": tree(2, "1e-9"), "middle": tree(2, "1e-9"), "layer": lay}
+    c["parts"] = {"regularity": cover, "transversal": cover,
+                  "winding": {"Y<0 bulk": tree(2, "-1e-9"), "X>0 bulk": tree(2, "1e-9"), "Y>0 bulk": tree(2, "1e-9"),
+                              "Y<0 middle": tree(2, "-1e-9"), "Y<0 layer": {str(q): tree(1, "-1e-9") for q in lay}}}
+    return c
+
+
+@pytest.mark.parametrize("kind", ["dart:>=101 at the grammar's limits", "8,192 boxes, the last bound false"])
+def test_a_record_beyond_the_work_budget_fails_with_the_reason_in_seconds(kind, tmp_path):
+    """The work a record declares is refused before the arithmetic it would take (docs/certificates.md,
+    "Bounds"): the dart record at its grammar's limits before any model is built, the 8,192-box split of
+    k = 5 (every box of the published certificate into 256, the last bound raised past its box) once the box
+    lists' splits pass the certificate's budget, about 5 CPU-minutes before the budget."""
+    if kind.startswith("dart"):
+        c, reason = _dart_at_the_grammars_limits(), "beyond the budget of 16 s"
+    else:
+        c = split_further(load("k005.json"), 8)
+        assert count_boxes(c) == 8192
+        c["parts"]["corner"]["P3"][-1]["bound"] = "1e6"
+        reason = "coefficient operations in all, beyond the budget"
+    p = tmp_path / "record.json"
+    p.write_text(json.dumps(c))
+    out = verify_in_child(p)
+    assert not out["ok"]
+    assert any(reason in line for line in [out["error"] or "", *out["lines"]]), out["lines"][-3:]
+    assert out["lines"][-1].startswith(f"FAILED {p}"), out["lines"][-3:]
+    assert out["cpu"] < CPU_S, out

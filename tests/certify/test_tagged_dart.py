@@ -5,10 +5,10 @@ import pytest
 from flint import arb, fmpq
 
 from ccproof.certify.tagged_dart import cover, map_covers
-from ccproof.certify.verify.dart_curves import CurveModels
 from ccproof.certify.verify.dart_family import TaylorHints
-from ccproof.certify.verify.dart_trees import read_tree, replay_map, replay_tree
+from ccproof.certify.verify.dart_models import DartModels, read_map, replay_map
 from ccproof.certify.verify.errors import CertificateError
+from ccproof.certify.verify.replay import read_tree, replay_tree
 
 H = (fmpq(0), fmpq(1, 101))
 
@@ -16,7 +16,7 @@ H = (fmpq(0), fmpq(1, 101))
 @pytest.fixture(scope="module")
 def box0():
     hints = TaylorHints(r=fmpq(1, 32), disc_grid=6, sigma_boxes=10, order=12, layer_order=14, exp_order=24)
-    return CurveModels(fmpq(4484, 1000), fmpq(44935, 10000), hints, 1, 128).sigma_box(0)
+    return DartModels(fmpq(4484, 1000), fmpq(44935, 10000), hints, 1, 128).sigma_box(0)
 
 
 def test_a_cover_round_trips_through_the_verifiers_trees(box0):
@@ -52,6 +52,10 @@ def _regions():
                 winding=(fmpq(1, 4), fmpq(7, 20)), prec=128)
 
 
+def _replay(parts, hints, k0, sig_lo, sig_hi, s0, layer, winding, prec):
+    return replay_map(read_map(parts, k0, hints, s0, layer, winding), sig_lo, sig_hi, hints, layer, prec)
+
+
 def test_malformed_map_parts_fail_before_any_model_is_built():
     r = _regions()
     tree = {"grid": [1, 1], "leaves": [{"cell": [0, 0], "path": "", "bound": "1"}]}
@@ -61,15 +65,15 @@ def test_malformed_map_parts_fail_before_any_model_is_built():
              "Y<0 layer": {q: [ltree] * 10 for q in "012"}}
     parts = {"regularity": cov, "transversal": cov, "winding": signs}
     with pytest.raises(CertificateError, match="wrong sign"):  # the Y<0 lists need negative bounds
-        replay_map(parts, hints=_hints(), **r)
+        _replay(parts, hints=_hints(), **r)
     with pytest.raises(CertificateError, match="one tree per sigma box"):
-        replay_map(dict(parts, regularity=dict(cov, bulk=[tree] * 9)), hints=_hints(), **r)
+        _replay(dict(parts, regularity=dict(cov, bulk=[tree] * 9)), hints=_hints(), **r)
     with pytest.raises(CertificateError):
-        replay_map(dict(parts, extra=1), hints=_hints(), **r)
+        _replay(dict(parts, extra=1), hints=_hints(), **r)
     with pytest.raises(CertificateError, match="s0 < s_a"):
-        replay_map(parts, hints=_hints(), **dict(r, winding=(fmpq(1, 30), fmpq(7, 20))))
+        _replay(parts, hints=_hints(), **dict(r, winding=(fmpq(1, 30), fmpq(7, 20))))
     with pytest.raises(CertificateError, match="T >= 3"):
-        replay_map(parts, hints=_hints(), **dict(r, layer=2))
+        _replay(parts, hints=_hints(), **dict(r, layer=2))
 
 
 @pytest.mark.slow
@@ -78,11 +82,11 @@ def test_the_whole_map_part_for_every_k_from_101_round_trips():
     by the trusted trees on fresh models; a bulk tree with its last cell's leaves dropped FAILs."""
     r = _regions()
     parts = map_covers(r["k0"], r["sig_lo"], r["sig_hi"], _hints(), r["s0"], r["layer"], r["winding"])
-    summary = replay_map(parts, hints=_hints(), **r)
+    summary = _replay(parts, hints=_hints(), **r)
     assert summary["R bulk"][0] == 1643 and summary["R bulk"][1] > 0
     assert summary["Y<0 layer 0"][1] < 0
     tree = parts["regularity"]["bulk"][3]
     last = max(leaf["cell"][0] for leaf in tree["leaves"])
     tree["leaves"] = [leaf for leaf in tree["leaves"] if leaf["cell"][0] != last]
     with pytest.raises(CertificateError, match="no leaf"):
-        replay_map(parts, hints=_hints(), **r)
+        _replay(parts, hints=_hints(), **r)

@@ -57,9 +57,9 @@ def test_a_perturbed_family_member_is_not_an_eigenvector_and_folds():
         for sig, small in ((mod._limit_script().sigma_of(arb(fmpq(1, k))), True), (arb(5), False)):
             fam = mod.Family(acb(arb(fmpq(1, k))), sig)
             pts, rows = labels("dart", k), sector_rows("dart", k)
-            y = [fam.values(0)[2]]
+            y = [mod.family_values(fam, 0)[2]]
             for p in pts[1:]:
-                y.append(fam.values(fmpq(p[1], k))[1](0, p[2:]))
+                y.append(mod.family_values(fam, fmpq(p[1], k))[1](0, p[2:]))
             lam = acb(fam.lam2).real
             res = max(float(abs(sum((w * y[j] for j, w in row.items()), arb(0)) - lam * y[i]).upper())
                       for i, row in enumerate(rows))
@@ -76,7 +76,8 @@ def _verifier_kdet(k, q):
     lam1 = max((z[0].real for z in ev if z[3] == 1), key=lambda r: r.mid())
     py, px = pts.index(("r", k // 2, 1, 0)), pts.index(("r", k // 4, 1, 0))
     fam = mod.Family(acb(arb(fmpq(1, k))), mod._limit_script().sigma_of(arb(fmpq(1, k))))
-    sx, sy = fam.values(fmpq(k // 4, k))[0](0, (1, 0)), fam.values(fmpq(k // 2, k))[1](0, (1, 0))
+    vals = mod.family_values
+    sx, sy = vals(fam, fmpq(k // 4, k))[0](0, (1, 0)), vals(fam, fmpq(k // 2, k))[1](0, (1, 0))
     f = mode_vector("dart", k, 1, lam1)
     x = [arb(0)] + [(z / f[px]).real * sx for z in f[1:]]
     y = [v * sy for v in even_vector(k, lam2, py)]
@@ -163,7 +164,8 @@ def test_transversality_models_enclose_the_verifiers_forms():
                    key=lambda r: r.mid())
         lam1 = max((z[0].real for z in ev if z[3] == 1), key=lambda r: r.mid())
         py, px = pts.index(("r", k // 2, 1, 0)), pts.index(("r", k // 4, 1, 0))
-        sx, sy = fam.values(fmpq(k // 4, k))[0](0, (1, 0)), fam.values(fmpq(k // 2, k))[1](0, (1, 0))
+        vals = mod.family_values
+        sx, sy = vals(fam, fmpq(k // 4, k))[0](0, (1, 0)), vals(fam, fmpq(k // 2, k))[1](0, (1, 0))
         f = mode_vector("dart", k, 1, lam1)
         x = [arb(0)] + [(z / f[px]).real * sx for z in f[1:]]
         y = [v * sy for v in even_vector(k, lam2, py)]
@@ -378,10 +380,10 @@ def test_the_exact_nets_are_the_acb_familys_nets():
             el = []
             for e in exs:
                 x, y = e.layer_level0(q)
-                el.append({p: mod._bezier([[mod.layer_value(y, e.yc, e.lam2, q, e.zero)(mod._OFFSET[p][0] + i,
+                el.append({p: mod._bezier([[mod.level1_value(y, e.yc, e.lam2, e.zero, q)(mod._OFFSET[p][0] + i,
                                                                                             mod._OFFSET[p][1] + j)
                                              for j in range(4)] for i in range(4)], e.zero) for p in mod.PIECES})
-                x0 = {p: mod._bezier([[mod.layer_value(x, e.zero, e.lam1, q, e.zero)(mod._OFFSET[p][0] + i,
+                x0 = {p: mod._bezier([[mod.level1_value(x, e.zero, e.lam1, e.zero, q)(mod._OFFSET[p][0] + i,
                                                                                      mod._OFFSET[p][1] + j)
                                        for j in range(4)] for i in range(4)], e.zero) for p in mod.PIECES}
             for p in mod.PIECES:

@@ -26,7 +26,7 @@ from pathlib import Path
 from .errors import CertificateError
 from .record import Part, Recorder, VerifyResult
 from .registry import C1_SCHEMA, ROUTES, SCHEMA, TAGGED, TAGGED_SCHEMA, check_coverage, coverage, route_of
-from .replay import check_size
+from .replay import check_size, close_budget
 
 __all__ = ["SCHEMA", "C1_SCHEMA", "TAGGED_SCHEMA", "CertificateError", "Part", "VerifyResult", "verify_certificate",
            "verify_file", "check_coverage", "coverage", "certificate_files", "read_certificate_bytes", "ROUTES"]
@@ -78,6 +78,8 @@ def verify_certificate(cert, log=print, path=None):
         route.check(cert, res.family, res.valence, part, log)
     except _MALFORMED as exc:
         res.error = f"{type(exc).__name__}: {exc}" if not isinstance(exc, CertificateError) else str(exc)
+    finally:
+        close_budget()  # the replay budget that check_size opened for this certificate
     res.seconds = time.perf_counter() - t0
     return res
 

@@ -83,6 +83,8 @@ from __future__ import annotations
 
 from flint import acb, arb, ctx, fmpq, fmpq_mat, fmpq_poly
 
+from ccproof.rigorous.analytic import ball
+
 from .dart_family import _NPOLY, Family, l0, layer_level0
 from .errors import CertificateError
 from .rules import TWO_RING
@@ -194,11 +196,6 @@ def check_crease_row(points=W_POINTS):
             if P % q != 0:
                 raise CertificateError(f"a1 b2 != a2 b1 at w = {w}: the crease vertex row of ray 0 fails")
     return True
-
-
-def _ball(lo, hi):
-    lo, hi = fmpq(lo), fmpq(hi)
-    return arb((lo + hi) / 2, (hi - lo) / 2)
 
 
 def _nonzero(z, what):
@@ -320,13 +317,13 @@ def check_eigenvector(sig_lo, sig_hi, k0, prec, balls=64, family=Family):
         check_reach()
         check_mode0()
         check_crease_row()
-        box = _ball(sig_lo, sig_hi)
+        box = ball(sig_lo, sig_hi)
         if not box.cos() < 0:
             raise CertificateError("eigenvector lemma: cos(sigma) is not certainly < 0 on the bracket (alpha != 0)")
         tol = arb(2) ** (-(prec // 2))
         signs = set()
         for i in range(balls):
-            h = acb(_ball(fmpq(i, balls * k0), fmpq(i + 1, balls * k0)))
+            h = acb(ball(fmpq(i, balls * k0), fmpq(i + 1, balls * k0)))
             try:
                 _guard(family(acb(fmpq(2 * i + 1, 2 * balls * k0)), arb(sig_lo)), tol)  # at the ball's centre
                 vals = [scaled_centre_residual(family(h, s)) for s in (arb(sig_lo), arb(sig_hi), box)]

@@ -24,8 +24,6 @@ from dataclasses import dataclass
 
 from flint import acb, acb_mat, acb_poly, acb_series, arb, ctx, fmpq, fmpq_mat
 
-from ccproof.rigorous import BernsteinForm, bernstein_jacobian_determinant
-
 from .rules import CENTRE, canonical, level1_rule
 from .tagged_modes import _POS, ring_stencil
 
@@ -65,38 +63,17 @@ def _kappa():
 
 
 def _adj_kappa_polys():
-    """N(lam) = adj(lam - B(1)) kappa as 6 exact polynomials (coefficient lists, degree <= 5), by
-    interpolation at lam = 1..6 and checked at lam = 7, 8 (B(1)'s eigenvalues are below 1)."""
+    """N(lam) = adj(lam - B(1)) kappa as 6 exact polynomials (coefficient lists, degree <= 5), by the
+    Cayley-Hamilton form of the adjugate: with det(lam - B) = sum_j c_j lam^j (degree 6),
+    adj(lam - B) = sum_(k < 6) lam^k sum_(j > k) c_j B^(j-k-1)."""
     B1 = fmpq_mat([[sum((x for (d, pos), x in ring_stencil()[i].items() if _POS[pos] == k), fmpq(0))
                     for k in range(6)] for i in range(6)])
-    kap = fmpq_mat([[z] for z in _kappa()])
-
-    def n_at(lam):
-        M = fmpq_mat([[(lam if i == k else 0) - B1[i, k] for k in range(6)] for i in range(6)])
-        sol = M.solve(kap)
-        d = M.det()
-        return [d * sol[i, 0] for i in range(6)]
-    xs = [fmpq(i) for i in range(1, 7)]
-    vals = [n_at(x) for x in xs]
-    polys = []
-    for comp in range(6):
-        coeffs = [fmpq(0)] * 6
-        for a, xa in enumerate(xs):  # Lagrange basis, expanded
-            basis, den = [fmpq(1)], fmpq(1)
-            for b, xb in enumerate(xs):
-                if b != a:
-                    basis = [fmpq(0)] + basis
-                    for i in range(len(basis) - 1):
-                        basis[i] -= xb * basis[i + 1]
-                    den *= xa - xb
-            for i, c in enumerate(basis):
-                coeffs[i] += vals[a][comp] * c / den
-        polys.append(coeffs)
-    for x in (fmpq(7), fmpq(8)):
-        got = [sum((c * x ** i for i, c in enumerate(p)), fmpq(0)) for p in polys]
-        if got != n_at(x):
-            raise AssertionError("adj(lam - B(1)) kappa is not a polynomial of degree <= 5")
-    return polys, B1
+    c = B1.charpoly()
+    powers = [fmpq_mat([[z] for z in _kappa()])]  # B^m kappa
+    for _ in range(5):
+        powers.append(B1 * powers[-1])
+    return [[sum((c[j] * powers[j - k - 1][i, 0] for j in range(k + 1, 7)), fmpq(0)) for k in range(6)]
+            for i in range(6)], B1
 
 
 _NPOLY, _B1 = _adj_kappa_polys()
@@ -254,23 +231,14 @@ class Family:
             "Y-": (lambda d, p: vy[_POS[_swap(p)]] * self._e("y", -d - eps(p)) * self.sign / 2, self.zero, self.lam2),
         }
 
-    def values(self, s):
-        """(x, y): level0(delta, pos) at the quadrant K s, and the centre values (real h and s only)."""
-        E, F = acb(0, 2 * arb.pi() * s).exp(), acb(0, self.sigma * (2 * s - 1)).exp()
-        P = self.parts()
 
-        def x(d, p):
-            return (E * P["X+"][0](d, p) + P["X-"][0](d, p) / E).real
-
-        def y(d, p):
-            return (P["Y0"][0](d, p) + F * P["Y+"][0](d, p) + P["Y-"][0](d, p) / F).real
-        return x, y, acb(self.yc).real
-
-
-def local_value(level0, centre, lam, zero):
-    """``value(A, B)``: the level-1 value at position (A, B) of a bulk quadrant (no sharp ray within reach):
-    lam times the level-0 value on the two-ring (the vector is an eigenvector of every ring row), the
-    level-1 rule of :mod:`.rules` elsewhere; ``level0(delta, pos)`` the level-0 value of sector q + delta."""
+def level1_value(level0, centre, lam, zero, q=None):
+    """``value(A, B)``: the level-1 value at position (A, B) of a quadrant: lam times the level-0 value on the
+    two-ring (the vector is an eigenvector of every ring row), the level-1 rule of :mod:`.rules` elsewhere.
+    ``q`` None: a bulk quadrant (no sharp ray within reach; ``level0(delta, pos)`` the level-0 value of sector
+    q + delta); else the layer quadrant q >= 0 (``level0(t, pos)`` at the sector t; ray 0 sharp, as
+    tagged_map.level1_values: the ghost row 2 P(A, 0) - P(A, 1) across ray 0, the sharp edge's midpoint at
+    ray 0's (3, 0))."""
     def lev0(d, a, b):
         dd, a2, b2 = canonical(a, b)
         return centre if (a2, b2) == CENTRE else level0(d + dd, (a2, b2))
@@ -278,12 +246,17 @@ def local_value(level0, centre, lam, zero):
     def value(A, B):
         if (A, B) == (0, 0):
             return lam * centre
+        if B == -1 and q == 0:
+            return 2 * value(A, 0) - value(A, 1)
         d, A2, B2 = canonical(A, B)
+        t = d if q is None else q + d
         if (A2, B2) in _POS:
-            return lam * level0(d, (A2, B2))
+            return lam * level0(t, (A2, B2))
+        if q is not None and B2 == 0 and t == 0:
+            return (level0(0, (1, 0)) + level0(0, (2, 0))) / 2
         acc = zero
         for (a, b), w in level1_rule(A2, B2).items():
-            acc = acc + lev0(d, a, b) * w
+            acc = acc + lev0(t, a, b) * w
         return acc
     return value
 
@@ -298,40 +271,12 @@ def _bezier(net, zero):
 
 def piece_nets(level0, centre, lam, zero):
     """{piece: 4 x 4 Bezier net} of one coordinate (or one basis part) on a bulk quadrant."""
-    V = local_value(level0, centre, lam, zero)
+    V = level1_value(level0, centre, lam, zero)
     return {name: _bezier([[V(_OFFSET[name][0] + i, _OFFSET[name][1] + j) for j in range(4)] for i in range(4)], zero)
             for name in PIECES}
 
 
 XB, YB = ("X+", "X-"), ("Y0", "Y+", "Y-")
-
-
-def _real_forms(net, prec):
-    """(Re, Im) Bernstein forms of a 4 x 4 acb net."""
-    return tuple(BernsteinForm((4, 4), [getattr(acb(net[i][j]), part) for i in range(4) for j in range(4)], prec=prec)
-                 for part in ("real", "imag"))
-
-
-def _jac(a, b):
-    return bernstein_jacobian_determinant([a, b]).coeffs
-
-
-def partials(form):
-    """(d/du, d/dv) of a Bernstein form: computed once per form, then shared by every determinant it enters."""
-    return form.diff(0), form.diff(1)
-
-
-def jac_partials(pa, pb):
-    """det d(a, b)/d(u, v) from the partials: a_u b_v - a_v b_u, the operations of
-    :func:`~ccproof.rigorous.bernstein_jacobian_determinant` on two forms, in the same order."""
-    return (pa[0] * pb[1] - pa[1] * pb[0]).coeffs
-
-
-def complex_det_partials(pa, pb):
-    """:func:`complex_det` from the partials of the (Re, Im) forms (:func:`partials` of each)."""
-    rr, ii = jac_partials(pa[0], pb[0]), jac_partials(pa[1], pb[1])
-    ri, ir = jac_partials(pa[0], pb[1]), jac_partials(pa[1], pb[0])
-    return [acb(a - b, c + d) for a, b, c, d in zip(rr, ii, ri, ir)]
 
 
 _SU, _SH = 6, 36  # Kronecker strides: a product of bicubic partials has degree <= 5 in u and in v
@@ -356,7 +301,7 @@ def det_series(A, B, n):
     nets ``A[m]``, ``B[m]`` (4 x 4, acb): the Cauchy products of Bernstein forms as one polynomial product each
     (the scaled coefficients of a product are the plain convolution of the scaled factors, as in
     :meth:`~ccproof.rigorous.BernsteinForm.__mul__`; h, u, v packed with the strides above). Returns
-    ``[[36 acb, (i, j) row-major, degree (5, 5)] for m in 0..n]``, the coefficients of :func:`complex_det`."""
+    ``[[36 acb, (i, j) row-major] for m in 0..n]``: D's Bernstein coefficients (degree (5, 5))."""
     P = _packed(A, 0) * _packed(B, 1) - _packed(A, 1) * _packed(B, 0)
     c = P.coeffs()
     c += [acb(0)] * max(0, _SH * (n + 1) - len(c))
@@ -364,25 +309,9 @@ def det_series(A, B, n):
             for m in range(n + 1)]
 
 
-def complex_det(fa, fb):
-    """Bernstein coefficients (acb) of the bilinear D(A, B) = det d(A, B)/d(u, v) for complex nets given by
-    their (Re, Im) forms."""
-    return complex_det_partials(tuple(map(partials, fa)), tuple(map(partials, fb)))
-
-
 def basis_nets(fam):
     """{basis part: {piece: 4 x 4 net}} of the family's five basis parts."""
     return {name: piece_nets(f, c, lam, fam.zero) for name, (f, c, lam) in fam.parts().items()}
-
-
-def _ball(lo, hi):
-    lo, hi = fmpq(lo), fmpq(hi)
-    return arb((lo + hi) / 2, (hi - lo) / 2)
-
-
-def _parts(T):
-    """The pieces (or outer curves) that a Taylor dict keyed (i, j, part) covers."""
-    return sorted({key[2] for key in T})
 
 
 def layer_level0(fam, q):
@@ -410,46 +339,17 @@ def layer_level0(fam, q):
     return x, y, fam.zero, fam.yc
 
 
-def layer_value(level0, centre, lam, q, zero):
-    """``value(A, B)``: level-1 values of layer quadrant q >= 0 (ray 0 sharp; as tagged_map.level1_values:
-    lam times the level-0 value on the two-ring, the ghost row 2 P(A, 0) - P(A, 1) across ray 0, the sharp
-    edge's midpoint at ray 0's (3, 0), the level-1 rules elsewhere)."""
-    def lev0(d, a, b):
-        dd, a2, b2 = canonical(a, b)
-        return centre if (a2, b2) == CENTRE else level0(d + dd, (a2, b2))
-
-    def value(A, B):
-        if (A, B) == (0, 0):
-            return lam * centre
-        if B == -1 and q == 0:
-            return 2 * value(A, 0) - value(A, 1)
-        d, A2, B2 = canonical(A, B)
-        t = q + d
-        if (A2, B2) in _POS:
-            return lam * level0(t, (A2, B2))
-        if B2 == 0 and t == 0:
-            return (level0(0, (1, 0)) + level0(0, (2, 0))) / 2
-        acc = zero
-        for (a, b), w in level1_rule(A2, B2).items():
-            acc = acc + lev0(t, a, b) * w
-        return acc
-    return value
-
-
 def layer_nets(fam, q):
     """{piece: (X net, Y net)} (4 x 4 Bezier, values of fam.h's type) of layer quadrant q."""
     x, y, xc, yc = layer_level0(fam, q)
-    VX = layer_value(x, xc, fam.lam1, q, fam.zero)
-    VY = layer_value(y, yc, fam.lam2, q, fam.zero)
+    VX = level1_value(x, xc, fam.lam1, fam.zero, q)
+    VY = level1_value(y, yc, fam.lam2, fam.zero, q)
     out = {}
     for name in PIECES:
         oa, ob = _OFFSET[name]
         out[name] = tuple(_bezier([[V(oa + i, ob + j) for j in range(4)] for i in range(4)], fam.zero)
                           for V in (VX, VY))
     return out
-
-
-_BIN3, _BIN2, _BIN5 = (1, 3, 3, 1), (1, 2, 1), (1, 5, 10, 10, 5, 1)
 
 
 def curve_points(nets, name):

@@ -60,7 +60,7 @@ The regions (each includes h = 0, K = infinity), on lam = r e^(it), r = lam(cos(
 * F, (t, h) in [v0^2, 355/113] x [0, 1/K0]: 1 - F, T >= Im(phi) K0/2.
 
 Each evaluator returns an arb enclosing Re of its quantity on a box (the multiplier h or v is > 0 for
-every finite K); the record's trees (:mod:`.dart_trees`) bound it below by a positive number.
+every finite K); the record's trees (:func:`.replay.read_tree`) bound it below by a positive number.
 """
 
 from __future__ import annotations
@@ -69,7 +69,9 @@ from functools import cache
 
 from flint import acb, arb, fmpq, fmpq_mpoly_ctx, fmpq_poly
 
-from .dart_family import _ball, _kappa
+from ccproof.rigorous.analytic import ball
+
+from .dart_family import _kappa
 from .errors import CertificateError
 from .tagged import labels, sector_rows
 from .tagged_modes import _POS, _roots, check_dart, check_ring, ring_stencil
@@ -300,7 +302,7 @@ def check_mode0_roots(sig_r, k0, balls):
     sr = arb(sig_r)
     least = None
     for i in range(balls):
-        h = _ball(fmpq(i, balls * k0), fmpq(i + 1, balls * k0))
+        h = ball(fmpq(i, balls * k0), fmpq(i + 1, balls * k0))
         r = lam_circle(sr, h)
         q_over_h = l0 + l1 * r - r / 4 * sr ** 2 * h * (sr * h).sinc() ** 2  # P(r) = -r sigma_r^2 h^2 sinc^2/4
         b, c = -fmpq(3, 4) + h * l1, fmpq(1, 16) + h * l0
@@ -366,7 +368,7 @@ class SpectralRegions:
         self.sig_r, self.k0 = arb(sig_r), k0
 
     def n(self, box):
-        tau, h = (_ball(*iv) for iv in box)
+        tau, h = (ball(*iv) for iv in box)
         sr = self.sig_r
         r = lam_circle(sr, h)
         e = acb(0, 1) * tau * h * h
@@ -379,7 +381,7 @@ class SpectralRegions:
         return val.real
 
     def i(self, box):
-        v, w = (_ball(*iv) for iv in box)
+        v, w = (ball(*iv) for iv in box)
         sr = self.sig_r
         h = v * w
         r = lam_circle(sr, h)
@@ -405,7 +407,7 @@ class SpectralRegions:
         return val.real
 
     def f(self, box):
-        t, h = (_ball(*iv) for iv in box)
+        t, h = (ball(*iv) for iv in box)
         r = lam_circle(self.sig_r, h)
         lam = r * (acb(0, 1) * t).exp()
         cs = 8 * lam - 5 + 1 / (2 * lam)

@@ -7,16 +7,16 @@ simple; x the odd mode-1 eigenvector, y the even eigenvector of lam2 (y = 1 at r
 det J_Phi > 0 on every piece of every quadrant, the transversality forms > 0 on the outer curves, and the
 outer curve crosses {Y = 0, X > 0} once. The record holds hints only. The steps, each a part:
 
-1. **Record** (:func:`read_record`): exactly the grammar's keys, every number in its range, the three
-   spectral trees read against the roots their regions fix (:func:`.dart_spectrum.region_roots`), before any
-   arithmetic on them.
+1. **Record** (:func:`read_record`): exactly the grammar's keys, every number in its range, every tree read
+   against the root its region fixes (:func:`.dart_spectrum.region_roots`, :func:`.dart_models.read_map`)
+   and the work the sizes declare within the budget (:func:`check_work`), before any arithmetic.
 2. **Construction** (:func:`.dart_spectrum.check_construction`): S for every K >= 7 from one window.
 3. **Exact zeros** (:func:`.dart_zeros.check_zeros`): every coefficient the Taylor models drop is 0.
 4. **Spectrum** (:mod:`.dart_spectrum`): the identities of the secular equation, mode 0's roots below the
    circle, Re(1 - F) > 0 on every leaf of N, I, F: only 1, lam1 and one even eigenvalue outside the circle.
 5. **Eigenvector lemma** (:func:`.dart_eigen.check_eigenvector`): that even eigenvalue is
    lam(cos(2 sigma*/K)), sigma* in the bracket, and the family member there (and x) are the eigenvectors.
-6. **Map** (:func:`.dart_trees.replay_map`): R, T and W on every leaf, sigma box by sigma box.
+6. **Map** (:func:`.dart_models.replay_map`): R, T and W on every leaf, sigma box by sigma box.
 7. **Conclusion**: the reflection in ray 0 (x odd, y even) carries the quadrants q <= (K - 1)/2 to the
    rest; with 2 to 6 the generalized Reif criterion holds for every K >= K0.
 """
@@ -27,6 +27,7 @@ from flint import arb, ctx, fmpq
 
 from .dart_eigen import check_eigenvector
 from .dart_family import TaylorHints
+from .dart_models import read_map, replay_map
 from .dart_spectrum import (
     SpectralRegions,
     check_construction,
@@ -35,13 +36,13 @@ from .dart_spectrum import (
     check_secular,
     region_roots,
 )
-from .dart_trees import MAX_LEAVES, read_tree, replay_map, replay_tree
 from .dart_zeros import check_zeros
 from .errors import CertificateError
 from .record import exact_keys, field_of
-from .replay import parse_decimal
+from .replay import MAX_BOXES, parse_decimal, read_tree, replay_tree
 
 MIN_K0 = 101  # the regions need 1/K0 < r, and the covers are shown from 101 on
+MAX_WORK = 165_000  # units of 0.1 ms of CPU (:func:`record_work`): 16.5 s; the published record declares 10.8 s
 MAX_BALLS = 8192
 _KEYS = ("schema", "configuration", "statement", "prec", "map", "spectrum", "taylor", "regions", "parts")
 _SPECTRUM = ("sigma", "sigma_h", "circle", "mode0_h", "tau1", "v0", "re")
@@ -77,7 +78,7 @@ def read_record(cert, k0):
     -------
     dict
         prec, sig_lo, sig_hi, sig_r, sigma_h, mode0_h, tau1, v0, re (name -> leaves), hints (TaylorHints),
-        s0, layer, winding, parts.
+        s0, layer, winding, map (:func:`.dart_models.read_map`); its work checked (:func:`check_work`).
 
     Raises
     ------
@@ -109,8 +110,6 @@ def read_record(cert, k0):
     exact_keys(re, ("N", "I", "F"), "spectrum re")
     roots = region_roots(k0, out["tau1"], out["v0"])
     out["re"] = {name: read_tree(re[name], roots[name], f"spectrum re {name}", 1) for name in ("N", "I", "F")}
-    if sum(len(v) for v in out["re"].values()) > MAX_LEAVES:
-        raise CertificateError(f"spectrum: more than {MAX_LEAVES} leaves")
     ty = field_of(cert, "taylor", dict, "certificate")
     exact_keys(ty, ("r", *_TAYLOR), "taylor")
     r = parse_decimal(field_of(ty, "r", str, "taylor"))
@@ -125,8 +124,51 @@ def read_record(cert, k0):
     if len(win) != 2:
         raise CertificateError("regions: winding must be [s_a, s_b]")
     out["winding"] = tuple(_fraction(s, "regions winding") for s in win)
-    out["parts"] = field_of(cert, "parts", dict, "certificate")
+    out["map"] = read_map(field_of(cert, "parts", dict, "certificate"), k0, out["hints"], out["s0"], out["layer"],
+                          out["winding"])
+    check_work(out)
     return out
+
+
+def record_work(rec):
+    """The CPU work the record's sizes declare, in units of 0.1 ms (upper estimates measured on the reference
+    machine of docs/certificates.md, "Bounds", at 128 bits): the exact zeros (fixed), the disc bounds
+    (disc_grid^2 acb boxes, the bulk and T layer quadrants on each), the Taylor series of each sigma box
+    (order^2, and layer_order^2 per layer quadrant), each map leaf by its region (bulk: order; middle:
+    exp_order + order; layer: layer_order), each spectral leaf, each h-ball of the eigenvector and mode-0
+    checks; all times ceil(prec/128).
+
+    Examples
+    --------
+    >>> import json
+    >>> from ccproof.tables.format import certificates_dir
+    >>> rec = read_record(json.loads((certificates_dir() / "c1/dart/k_ge_101.json").read_text()), 101)
+    >>> record_work(rec), MAX_WORK
+    (107630, 165000)
+    """
+    hn, layer = rec["hints"], rec["layer"]
+    work = 16000 + hn.disc_grid ** 2 * (70 + 24 * layer)
+    work += hn.sigma_boxes * (14 * hn.order ** 2 + 14 * layer * hn.layer_order ** 2 // 10)
+    per_leaf = {"bulk": hn.order, "middle": 65 * (hn.exp_order + hn.order) // 100 + 1,
+                "layer": 2 * hn.layer_order // 10 + 1}
+    for name, _, _, trees in rec["map"]:
+        kind = "layer" if "layer" in name else "middle" if "middle" in name else "bulk"
+        work += per_leaf[kind] * sum(len(t) for t in trees)
+    work += 2 * sum(len(v) for v in rec["re"].values()) + 15 * rec["sigma_h"] + rec["mode0_h"]
+    return work * ((rec["prec"] + 127) // 128)
+
+
+def check_work(rec):
+    """Refuse, before any arithmetic, a record whose declared work (:func:`record_work`) passes
+    :data:`MAX_WORK`, or which holds more than :data:`.replay.MAX_BOXES` leaves in all."""
+    leaves = sum(len(t) for _, _, _, trees in rec["map"] for t in trees) + sum(len(v) for v in rec["re"].values())
+    if leaves > MAX_BOXES:
+        raise CertificateError(f"more than {MAX_BOXES} leaves in all ({leaves})")
+    work = record_work(rec)
+    if work > MAX_WORK:
+        raise CertificateError(f"the record declares about {work // 10000} s of work ({work:,} units of 0.1 ms: "
+                               f"disc grid, sigma boxes, orders, leaves, prec), beyond the budget of "
+                               f"{MAX_WORK // 10000} s (docs/certificates.md, \"Bounds\")")
 
 
 def verify_dart_tail(cert, k0, part, log):
@@ -181,8 +223,7 @@ def _spectrum(rec, k0):
 
 
 def _map(rec, k0):
-    out = replay_map(rec["parts"], k0, rec["sig_lo"], rec["sig_hi"], rec["hints"], rec["s0"], rec["layer"],
-                     rec["winding"], rec["prec"])
+    out = replay_map(rec["map"], rec["sig_lo"], rec["sig_hi"], rec["hints"], rec["layer"], rec["prec"])
     return "; ".join(f"{n} {c} (>= {_show(b)})" if b is not None else f"{n} {c}" for n, (c, b) in out.items())
 
 
@@ -214,4 +255,4 @@ def _steps(rec, k0, part, log):
          "q <= (K - 1)/2 to the rest (x odd, y even): Phi regular and injective, so dart:K is C1")
 
 
-__all__ = ["MIN_K0", "read_record", "verify_dart_tail"]
+__all__ = ["MAX_WORK", "MIN_K0", "check_work", "read_record", "record_work", "verify_dart_tail"]

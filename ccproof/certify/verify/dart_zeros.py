@@ -35,7 +35,7 @@ vanish exactly when m^k divides the representative: the checks are remainders, t
 off (:meth:`QS.coeffs`) only where one is not 0. Truncations are exact: e^(i k h) = 1 + i k h - k^2 h^2/2,
 sqrt(20 (1 + z)) = 2 sqrt 5 (1 + z/2 - z^2/8), ln(1 + z) = z - z^2/2 for z in (h). The bordered 7 x 7 systems
 are solved by Gauss-Jordan over the ring (unit pivots), U from :mod:`.dart_family`'s exact polynomials, and
-the nets by the family's own assembly (``piece_nets``, ``layer_value``, ``_bezier``). det J_Phi's h^m
+the nets by the family's own assembly (``piece_nets``, ``level1_value``, ``_bezier``). det J_Phi's h^m
 coefficient, of degree <= (5, 5) in the patch parameters (u, v), is checked on the 6 x 6 grid u, v in
 {0, 1/5, ..., 1}; T's and the curve points' as the Bernstein coefficients. Parts depending on fewer of
 (a, b, c, t) (X's nets on a, Y+-'s on b, Y0's on (b, c)) are computed once, counted at each grid point.
@@ -405,7 +405,7 @@ class ExactFamily:
     def layer_nets(self, q, coordinate):
         """{piece: 4 x 4 Bezier net} of x (coordinate 0) or y (1) on layer quadrant q."""
         f = self.layer_level0(q)[coordinate]
-        V = _df.layer_value(f, (self.zero, self.yc)[coordinate], (self.lam1, self.lam2)[coordinate], q, self.zero)
+        V = _df.level1_value(f, (self.zero, self.yc)[coordinate], (self.lam1, self.lam2)[coordinate], self.zero, q)
         off = _df._OFFSET
         return {n: _df._bezier([[V(off[n][0] + i, off[n][1] + j) for j in range(4)] for i in range(4)], self.zero)
                 for n in PIECES}

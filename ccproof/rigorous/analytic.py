@@ -1,0 +1,152 @@
+"""Functions analytic in one complex parameter h on a disc: Taylor coefficients and a Cauchy remainder.
+
+A quantity f(h) (a vector or matrix of them) analytic on the disc |h| <= r is enclosed on a real interval
+[h_lo, h_hi], 0 <= h_lo <= h_hi < r, by its Taylor polynomial of order n and Cauchy's estimate of the rest:
+if |f| <= M on the disc, the coefficients satisfy |f_m| <= M / r^m, so
+
+    |sum_(m > n) f_m h^m| <= M h^(n+1) / (r^(n+1) (1 - h/r)).
+
+:func:`disc_bound` finds M by covering the square [-r, r]^2 (which contains the disc) with acb boxes, the
+quantity evaluated on each box in ball arithmetic; :class:`AnalyticModel` holds the coefficients (acb
+matrices, the Taylor coefficients of every entry) and M per column and encloses f(h)/h^low, the terms below
+``low`` being 0 exactly (the caller shows that). Nothing here is specific to one quantity.
+"""
+
+from __future__ import annotations
+
+from flint import acb, acb_mat, arb, fmpq
+
+
+def ball(lo, hi):
+    """The arb ball [lo, hi] of two exact endpoints.
+
+    >>> ball(0, 1).contains(0), ball(0, 1).contains(1), ball(0, 1).contains(fmpq(11, 10))
+    (True, True, False)
+    """
+    lo, hi = fmpq(lo), fmpq(hi)
+    return arb((lo + hi) / 2, (hi - lo) / 2)
+
+
+def square_boxes(r, grid):
+    """The grid x grid acb boxes covering the square [-r, r]^2 of the complex plane (r > 0 exact).
+
+    >>> len(list(square_boxes(fmpq(1, 2), 3)))
+    9
+    """
+    r = fmpq(r)
+    edges = [-r + 2 * r * fmpq(a, grid) for a in range(grid + 1)]
+    for a in range(grid):
+        for b in range(grid):
+            yield acb(ball(edges[a], edges[a + 1]), ball(edges[b], edges[b + 1]))
+
+
+def disc_bound(values, r, grid):
+    """{key: M} with |z| <= M for every entry z of ``values(h)[key]`` and every complex h in [-r, r]^2.
+
+    Parameters
+    ----------
+    values : callable (acb) -> dict of key -> iterable of acb (or arb)
+        The quantity on an acb box; it raises ZeroDivisionError where it cannot certify its own
+        analyticity on the box (a singular system, a square root near its cut).
+    r : fmpq
+    grid : int
+
+    Returns
+    -------
+    dict of key -> arb
+
+    Raises
+    ------
+    ZeroDivisionError
+        Where a box gives no finite bound.
+
+    Examples
+    --------
+    >>> M = disc_bound(lambda h: {"exp": [h.exp()]}, fmpq(1, 2), 4)
+    >>> bool(M["exp"] > arb(fmpq(1, 2)).exp()), bool(M["exp"] < 2)
+    (True, True)
+    """
+    M = {}
+    for i, h in enumerate(square_boxes(r, grid)):
+        for key, zs in values(h).items():
+            bound = max((abs(acb(z)).upper() for z in zs), key=lambda x: x)
+            if not bound.is_finite():
+                raise ZeroDivisionError(f"disc box {divmod(i, grid)}, {key}: no bound")
+            M[key] = bound if key not in M or bound > M[key] else M[key]
+    return M
+
+
+def cauchy_factor(r, n, h_hi):
+    """1 / (r^(n+1) (1 - h_hi/r)): the Cauchy remainder of order n is at most M h^(n+1) times this for
+    0 <= h <= h_hi < r (ZeroDivisionError unless h_hi < r).
+
+    >>> cauchy_factor(fmpq(1, 2), 0, fmpq(1, 4)).contains(4)
+    True
+    """
+    r, h_hi = fmpq(r), fmpq(h_hi)
+    if not (0 <= h_hi < r):
+        raise ZeroDivisionError(f"h up to {h_hi} is not inside the Cauchy disc of radius {r}")
+    return 1 / (arb(r) ** (n + 1) * (1 - arb(h_hi / r)))
+
+
+class AnalyticModel:
+    """f(h) = sum_(m <= n) C_m h^m + (Cauchy remainder), C_m acb matrices of one shape, |column k| <= M[k]
+    on the disc |h| <= r.
+
+    Parameters
+    ----------
+    coeffs : list of acb_mat
+        C_0 .. C_n.
+    M : list of arb
+        One bound per column (:func:`disc_bound`).
+    r : fmpq
+
+    Examples
+    --------
+    e^h to order 8 on [0, 1/8], with |e^h| <= e^(1/2) on |h| <= 1/2 (the coefficient of h^0 dropped):
+
+    >>> from flint import acb_mat
+    >>> coeffs = [acb_mat([[arb(1) / arb.fac_ui(m)]]) for m in range(9)]
+    >>> model = AnalyticModel(coeffs, [arb(fmpq(1, 2)).exp()], fmpq(1, 2))
+    >>> V, rho = model.enclose(fmpq(1, 8), fmpq(1, 8), low=1)
+    >>> bool((V[0, 0].real + arb(0, rho[0].upper())).contains((arb(fmpq(1, 8)).exp() - 1) * 8))
+    True
+    """
+
+    def __init__(self, coeffs, M, r):
+        self.coeffs, self.M, self.r = coeffs, M, fmpq(r)
+        self.order = len(coeffs) - 1
+
+    def enclose(self, h_lo, h_hi, low=0):
+        """(V, rho): f(h)/h^low lies in V[c, k] plus a complex ball of radius rho[k] for every h in
+        [h_lo, h_hi] (entries below h^low dropped: the caller knows them to be 0)."""
+        h = acb(ball(h_lo, h_hi))
+        acc = self.coeffs[-1]
+        for C in reversed(self.coeffs[low:-1]):
+            acc = acc * h + C
+        tail = arb(fmpq(h_hi)) ** (self.order + 1 - low) * cauchy_factor(self.r, self.order, h_hi)
+        return acc, [m * tail for m in self.M]
+
+    def real_part(self, weights, h_lo, h_hi, low=0):
+        """Re sum_k weights[k] f_k(h)/h^low for every row (a list of arb), every h in [h_lo, h_hi]: the rows
+        of :meth:`enclose` times the weights (acb), and |Re w e| <= (|Re w| + |Im w|) rho for |e| <= rho."""
+        V, rho = self.enclose(h_lo, h_hi, low)
+        vals = V * acb_mat([[acb(w)] for w in weights])
+        rad = sum(((abs(acb(w).real) + abs(acb(w).imag)) * t for w, t in zip(weights, rho)), arb(0)).upper()
+        return [vals[c, 0].real + arb(0, rad) for c in range(vals.nrows())]
+
+
+def hull(balls):
+    """The arb ball holding every ball of a non-empty iterable.
+
+    >>> hull([arb(1), arb(3), arb(2)]).contains(ball(1, 3))
+    True
+    """
+    it = iter(balls)
+    out = next(it)
+    for b in it:
+        out = out.union(b)
+    return out
+
+
+__all__ = ["AnalyticModel", "ball", "cauchy_factor", "disc_bound", "hull", "square_boxes"]
