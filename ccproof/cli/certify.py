@@ -183,14 +183,9 @@ def _run_tagged(args):
 
 
 def run(args):
-    if ":" in str(args.valences):
-        if not args.c1:
-            raise CCProofError(f"{args.valences}: tagged configurations (FAMILY:N) are certified with --c1")
-        if args.out is None:
-            from ccproof.tables.format import output_dir
-
-            args.out = str(output_dir() / "c1")
-        return _run_tagged(args)
+    tagged = ":" in str(args.valences)
+    if tagged and not args.c1:
+        raise CCProofError(f"{args.valences}: tagged configurations (FAMILY:N) are certified with --c1")
     if args.out is None:
         from ccproof.tables.format import output_dir
 
@@ -198,6 +193,8 @@ def run(args):
     from ccproof.cli._output import check_folder
 
     args.out = str(check_folder(args.out))  # before any proof; absolute, whatever folder a worker runs in
+    if tagged:
+        return _run_tagged(args)
     ks = parse_valences(args.valences)
     _check_options(args, ks)
     if args.c1:

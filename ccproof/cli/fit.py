@@ -26,6 +26,10 @@ nearest data point; the area fraction farther than --stray-distance (default 3 d
 two-sided (Hausdorff) error. A warning (stderr) says when more than --stray-fraction of the surface
 strays (a torus' hole spanned, an unseen side filled in) or a level stopped at --max-steps.
 --errors FILE.csv writes x, y, z, distance and distance in % for every data point.
+
+Outputs (--out, --surface-out or its derived name, --errors) are checked before any work: distinct from
+each other and from the inputs (other spellings and links included), writable, within the file system's
+name limits; they are renamed into place together when all are written, so a failure leaves none of them.
 """
 
 from __future__ import annotations
@@ -76,9 +80,7 @@ def add_arguments(p):
 def run(args) -> int:
     from pathlib import Path
 
-    from ccproof.cli._output import atomic, check_outputs
-
-    check_outputs(args, out=(".obj",), surface_out="mesh", errors=(".csv",))  # before any work
+    plan = _output_plan(args)  # before any work
     import numpy as np
 
     from ccproof.apps.control_mesh import merge_labels, read_control_mesh, write_control_obj
@@ -131,22 +133,43 @@ def run(args) -> int:
     comment = (f"ccproof fit {Path(args.points).name}: {n_written} control vertices, max error "
                f"{res.max_error_percent:.3f} %, two-sided {res.two_sided_error_percent:.3f} % of the "
                f"enclosing-sphere diameter")
-    with atomic(args.out) as tmp:  # a non-manifold --init: the copies merged, the file's numbering
-        write_control_obj(tmp, res.mesh, comment=comment)
-    surf_out = args.surface_out
-    if surf_out is None:
-        o = Path(args.out)
-        surf_out = str(o.with_name(o.stem + "_limit" + (o.suffix or ".obj")))
-    with atomic(surf_out) as tmp:
-        _write_surface(tmp, res, comment)
-    print(f"wrote {args.out} (control mesh) and {surf_out} (limit surface at level {res.sample_level})")
+    with plan:  # all outputs or none
+        with plan.write(args.out) as tmp:  # a non-manifold --init: the copies merged, the file's numbering
+            write_control_obj(tmp, res.mesh, comment=comment)
+        with plan.write(args.surface_out) as tmp:
+            _write_surface(tmp, res, comment)
+        if args.errors:
+            d = res.data_distances
+            with plan.write(args.errors) as tmp:
+                np.savetxt(tmp, np.column_stack([X, d, 100 * d / res.diameter]), delimiter=",",
+                           header="x,y,z,distance,distance_percent_of_diameter", comments="", fmt="%.9g")
+    print(f"wrote {args.out} (control mesh) and {args.surface_out} (limit surface at level {res.sample_level})")
     if args.errors:
-        d = res.data_distances
-        with atomic(args.errors) as tmp:
-            np.savetxt(tmp, np.column_stack([X, d, 100 * d / res.diameter]), delimiter=",",
-                       header="x,y,z,distance,distance_percent_of_diameter", comments="", fmt="%.9g")
         print(f"wrote {args.errors} (per-point data -> surface distances)")
     return 0
+
+
+def _output_plan(args):
+    """Every file ``fit`` writes (the derived ``OUT_limit`` name too), checked together before any work."""
+    from pathlib import Path
+
+    from ccproof.cli._output import OutputPlan, meshio_suffixes
+
+    plan = OutputPlan()
+    plan.add_input("POINTS", args.points)
+    if args.init != "cube":
+        plan.add_input("--init", args.init)
+    plan.add("--out", args.out, (".obj",))
+    if args.surface_out is None:
+        o = Path(args.out)
+        args.surface_out = str(o.with_name(o.stem + "_limit" + (o.suffix or ".obj")))
+        plan.add("--surface-out (default: derived from --out)", args.surface_out, (".obj",))
+    else:
+        plan.add("--surface-out", args.surface_out, (".obj", *meshio_suffixes()))
+    if args.errors:
+        plan.add("--errors", args.errors, (".csv",))
+    plan.check()
+    return plan
 
 
 def _write_surface(path, res, comment):
