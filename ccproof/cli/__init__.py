@@ -26,6 +26,30 @@ COMMANDS: dict[str, tuple[str, str]] = {
 }
 
 
+#: the commands that read meshes, point files or chart labels: they take --max-input (ccproof/mesh/_input.py)
+INPUT_COMMANDS = ("eval", "project", "fit", "arap")
+
+
+def _add_input_limit(p):
+    p.add_argument("--max-input", type=float, default=None, metavar="GB",
+                   help="largest input file read, in GB (default 2); inputs are regular files or pipes (read "
+                        "once): a folder, a device such as /dev/zero or a socket is refused by name")
+
+
+def _apply_input_limit(args):
+    """Set the input cap of ``--max-input`` (refused unless a positive number); returns the previous cap."""
+    from ccproof.mesh._input import input_cap, set_input_cap
+
+    gb = getattr(args, "max_input", None)
+    if gb is None:
+        return input_cap()
+    if not (gb > 0 and gb * 1e9 < float("inf")):
+        from ccproof.errors import CCProofError
+
+        raise CCProofError(f"--max-input must be a positive number of GB, got {gb}")
+    return set_input_cap(gb * 1e9)
+
+
 def _available():
     out = {}
     for name, (modname, helptext) in COMMANDS.items():
@@ -61,6 +85,8 @@ def build_parser() -> argparse.ArgumentParser:
             formatter_class=argparse.RawDescriptionHelpFormatter,
         )
         mod.add_arguments(p)
+        if name in INPUT_COMMANDS:
+            _add_input_limit(p)
         p.set_defaults(_run=mod.run)
     return parser
 
@@ -133,9 +159,11 @@ def main(argv=None) -> int:
     def one_line_warning(message, category, filename, lineno, file=None, line=None):
         print(f"ccproof {args.command}: warning: {error_message(message)}", file=sys.stderr)
 
+    cap = None
     try:
         with warnings.catch_warnings():
             warnings.showwarning = one_line_warning
+            cap = _apply_input_limit(args) if args.command in INPUT_COMMANDS else None
             return int(args._run(args) or 0)
     except KeyboardInterrupt as exc:
         terminated = isinstance(exc, _Terminated)
@@ -147,6 +175,10 @@ def main(argv=None) -> int:
     finally:
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
+        if cap is not None:
+            from ccproof.mesh._input import set_input_cap
+
+            set_input_cap(cap)
 
 
 if __name__ == "__main__":  # pragma: no cover
