@@ -97,7 +97,7 @@ def read_face_uv_csv(path):
 
     rows = read_csv_columns(path, ("face", "u", "v"))
     face = rows[:, 0]
-    bad = np.flatnonzero(face != np.round(face))
+    bad = np.flatnonzero(~np.isfinite(face) | (face != np.round(face)))
     if bad.size:
-        raise CCProofError(f"{path}:{int(bad[0]) + 2}: face must be an integer, got {face[bad[0]]!r}")
+        raise CCProofError(f"{path}:{int(bad[0]) + 2}: face must be an integer, got {float(face[bad[0]])!r}")
     return face.astype(np.int64), rows[:, 1].copy(), rows[:, 2].copy()

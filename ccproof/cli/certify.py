@@ -44,7 +44,8 @@ def add_arguments(p):
     p.add_argument("--c1", action="store_true",
                    help="certify Reif's C1 criterion (regular, injective characteristic map) instead")
     p.add_argument("--prec", type=int, default=128, help="arb precision in bits (default 128)")
-    p.add_argument("--jobs", type=int, default=None, help="same as --scheduler local:JOBS (kept for old scripts)")
+    p.add_argument("--jobs", type=int, default=None, help="same as --scheduler local:JOBS (kept for old scripts; >= 1, "
+                   "at most the cores of this machine and the number of tasks)")
     from ccproof.scale.engine import add_scheduler_arguments
 
     add_scheduler_arguments(p)

@@ -115,6 +115,7 @@ def run(args) -> int:
     from ccproof.scale import evaluate_points, open_scheduler, point_chunks, scheduler_from_args, ship
 
     points = None if args.points is None else Path(args.points).resolve()
+    sched = scheduler_from_args(args)  # --scheduler checked before any work
     t0 = time.perf_counter()
     poly = read_mesh(args.mesh)  # OBJ with OpenSubdiv tags, OFF, or any meshio format
     tagged = not poly.is_plain_quads
@@ -148,7 +149,6 @@ def run(args) -> int:
             raise CCProofError(f"--samples must be >= 0, got {args.samples}")
         sources = point_chunks(args.chunk, samples=args.samples, seed=args.seed,
                                n_faces=n_faces if evaluable is None else evaluable)
-    sched = scheduler_from_args(args)
     from ccproof.cli._notice import compile_notice
 
     compile_notice("eval")  # after the input checks: an error stays one line
