@@ -127,6 +127,17 @@ def error_message(exc) -> str:
     return "; ".join(line.strip() for line in text.splitlines() if line.strip())
 
 
+def _stdout_closed():
+    """Whether the process started with its standard output closed (``>&-``: Python's ``sys.stdout`` is None);
+    then the report goes to the null device, so that the command still writes its files."""
+    import os
+
+    if sys.stdout is not None:
+        return False
+    sys.stdout = open(os.devnull, "w")  # noqa: SIM115 - lives as long as the command
+    return True
+
+
 class _Terminated(KeyboardInterrupt):
     """SIGTERM, raised like Ctrl-C so that every ``finally`` runs (temporary output files are removed)."""
 
@@ -159,6 +170,10 @@ def main(argv=None) -> int:
     def one_line_warning(message, category, filename, lineno, file=None, line=None):
         print(f"ccproof {args.command}: warning: {error_message(message)}", file=sys.stderr)
 
+    closed = _stdout_closed()
+    if closed:
+        print(f"ccproof {args.command}: warning: standard output is closed: the printed report is discarded "
+              f"(output files are written)", file=sys.stderr)
     cap = None
     try:
         with warnings.catch_warnings():
@@ -173,6 +188,9 @@ def main(argv=None) -> int:
         print(f"ccproof {args.command}: error: {error_message(exc)}", file=sys.stderr)
         return 2
     finally:
+        if closed:
+            sys.stdout.close()
+            sys.stdout = None  # as it was
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
         if cap is not None:

@@ -1140,7 +1140,8 @@ def job_floats(groups, X, sizes, progress=None):
     bar.close()
     for name, a in (("nets", nets), ("origin", origin), ("ring", ring)):
         if not np.isfinite(a).all():
-            raise MeshError(f"internal error: non-finite {name} in the patch table (a non-finite control point?)")
+            raise MeshError(f"non-finite {name} in the patch table: a control point beyond about 1e150 in magnitude "
+                            "(the differences overflow; scale the mesh) or a non-finite one")
     return nets, origin, ring
 
 

@@ -420,7 +420,28 @@ def read_mesh(path: str | os.PathLike[str]) -> PolyMesh:
     if os.path.isdir(p):
         raise MeshError(f"{p}: is a folder, not a mesh file")
     with checked_input(p, MeshError) as q:  # a regular file or a pipe, at most --max-input bytes
-        return _read_mesh(p, q)
+        mesh = _read_mesh(p, q)
+    _check_magnitudes(mesh, p)
+    return mesh
+
+
+#: largest coordinate of a vertex a face uses (as for the points of ccproof project): beyond it the
+#: differences, derivatives and squared distances of the evaluators overflow
+MAX_COORDINATE = 1e150
+
+
+def _check_magnitudes(mesh: PolyMesh, p: str) -> None:
+    """MeshError naming the file and the first used vertex with a coordinate beyond :data:`MAX_COORDINATE`."""
+    V = np.asarray(mesh.vertices)
+    big = np.flatnonzero((np.abs(V) > MAX_COORDINATE).any(axis=1))
+    if big.size:
+        used = np.zeros(V.shape[0], dtype=bool)
+        used[np.concatenate([np.asarray(f, dtype=np.int64) for f in mesh.polygons])] = True
+        hit = big[used[big]]
+        if hit.size:
+            v = int(hit[0])
+            raise MeshError(f"{p}: vertex {v} (0-based) has coordinates {V[v].tolist()} beyond {MAX_COORDINATE:g} in "
+                            "magnitude: the surface's differences and derivatives would overflow; scale the mesh")
 
 
 def _read_mesh(p: str, q: str) -> PolyMesh:
