@@ -54,3 +54,23 @@ def test_invert_prec_out_of_range_is_one_line(capsys):
         assert main(["invert", "5", "0.3", "0.2", "--rigorous", "--prec", prec]) == 2
         err = capsys.readouterr().err
         assert f"--prec must be 2..4096 bits, got {prec}" in err and len(err.strip().splitlines()) == 1, err
+
+
+@pytest.mark.parametrize("option, value, words", [
+    ("--tol", "nan", "--tol must be a finite number"), ("--stray-fraction", "nan", "--stray-fraction must be in"),
+    ("--stray-distance", "nan", "--stray-distance must be"), ("--max-steps", "-1", "--max-steps must be >= 1"),
+    ("--sample-level", "-1", "--sample-level must be 0..6"), ("--sample-level", "12", "--sample-level must be 0..6"),
+])
+def test_fit_refuses_nan_and_out_of_range_options_before_the_work(tmp_path, monkeypatch, capsys, option, value, words):
+    """NaN compares false, so it used to pass the checks and run (--tol nan: until --max-steps); --sample-level
+    -1 ended in numba's SystemError."""
+    import ccproof.apps.dynamics.fit as fit
+
+    def no_work(*a, **k):
+        raise AssertionError("the work started before the options were checked")
+
+    monkeypatch.setattr(fit, "fit_points", no_work)
+    np.savetxt(tmp_path / "p.xyz", np.random.default_rng(0).normal(size=(50, 3)))
+    assert main(["fit", str(tmp_path / "p.xyz"), "--out", str(tmp_path / "o.obj"), option, value]) == 2
+    err = capsys.readouterr().err
+    assert words in err and len(err.strip().splitlines()) == 1, err

@@ -68,7 +68,8 @@ def add_arguments(p):
                    help="write the fitted limit surface sampled at --sample-level (.obj or any meshio format; "
                         "default OUT with _limit before the extension)")
     p.add_argument("--sample-level", type=int, default=None,
-                   help="subdivision level of the sampled limit surface (default: 1..3, >= 4 samples per point)")
+                   help="subdivision level of the sampled limit surface (default: 1..3, >= 4 samples per point; "
+                        "at most 6)")
     p.add_argument("--stray-distance", type=float, default=None,
                    help="surface samples farther than this (%% of the diameter) from every data point stray "
                         "(default 3 data spacings)")
@@ -80,6 +81,7 @@ def add_arguments(p):
 def run(args) -> int:
     from pathlib import Path
 
+    _check_options(args)
     plan = _output_plan(args)  # before any work
     import numpy as np
 
@@ -147,6 +149,30 @@ def run(args) -> int:
     if args.errors:
         print(f"wrote {args.errors} (per-point data -> surface distances)")
     return 0
+
+
+def _check_options(args):
+    """The options the library checks only later (or never: NaN compares false), before any work."""
+    from math import isfinite
+
+    from ccproof.errors import CCProofError
+
+    if args.max_steps < 1:
+        raise CCProofError(f"--max-steps must be >= 1, got {args.max_steps}")
+    if args.sample_level is not None and not 0 <= args.sample_level <= MAX_SAMPLE_LEVEL:
+        raise CCProofError(f"--sample-level must be 0..{MAX_SAMPLE_LEVEL} (each level has 4 times the samples), "
+                           f"got {args.sample_level}")
+    if not (isfinite(args.tol) and args.tol >= 0):
+        raise CCProofError(f"--tol must be a finite number >= 0, got {args.tol}")
+    if not 0 <= args.stray_fraction <= 1:  # NaN too
+        raise CCProofError(f"--stray-fraction must be in [0, 1], got {args.stray_fraction}")
+    if args.stray_distance is not None and not (isfinite(args.stray_distance) and args.stray_distance > 0):
+        raise CCProofError(f"--stray-distance must be a finite number > 0 (% of the diameter), got "
+                           f"{args.stray_distance}")
+
+
+#: the finest --sample-level (the 386-vertex model at level 6 is 1.6 million samples)
+MAX_SAMPLE_LEVEL = 6
 
 
 def _output_plan(args):
