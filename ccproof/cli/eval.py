@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import sys
 import time
+from pathlib import Path
 
 from ccproof.cli._eval_args import add_arguments as _add_evaluate_arguments
 from ccproof.cli._eval_args import evaluable_ptex_faces, read_face_uv_csv
@@ -94,6 +95,45 @@ def _checked_points(path, n_faces, evaluable=None):
     return face, u, v
 
 
+def check_result_size(n, derivatives, out_path, shards, what=""):
+    """Refuse, before any work, a result that cannot be held: one ``.npz`` file is built in memory (at most
+    the machine's physical memory), shards are streamed to disk (at most the free space of their folder).
+
+    >>> from pathlib import Path
+    >>> check_result_size(10**15, 1, Path("o.npz"), False, "--samples 1000000000000000: ")
+    Traceback (most recent call last):
+    ...
+    ccproof.errors.CCProofError: --samples 1000000000000000: the result takes 96 PB (96 bytes per point), more ...
+    """
+    import os
+    import shutil
+
+    per_point = 8 * (3 + 3 * (1, 3, 6)[derivatives])  # face, u, v and P (Pu, Pv; Puu, Puv, Pvv)
+    need = n * per_point
+    if shards:
+        folder = Path(out_path)
+        while not folder.exists() and folder != folder.parent:
+            folder = folder.parent
+        have, where = shutil.disk_usage(folder).free, f"the free space of {folder}"
+        hint = "free some space or write elsewhere"
+    else:
+        try:
+            have = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+        except (ValueError, OSError, AttributeError):
+            return
+        where, hint = "this machine's memory", "write shards with --out FOLDER/ (one .npz per --chunk points)"
+    if need > have:
+        raise CCProofError(f"{what}the result takes {_size(need)} ({per_point} bytes per point), more than {where} "
+                           f"({_size(have)}); {hint}, or evaluate fewer points")
+
+
+def _size(b):
+    for unit in ("bytes", "kB", "MB", "GB", "TB", "PB"):
+        if b < 1000 or unit == "PB":
+            return f"{b:.0f} {unit}" if unit == "bytes" else f"{b:.3g} {unit}"
+        b /= 1000
+
+
 def run(args) -> int:
     from pathlib import Path
 
@@ -143,10 +183,13 @@ def run(args) -> int:
     if points is not None and points.is_dir():
         sources = point_chunks(args.chunk, shards=points)
     elif points is not None:
-        sources = point_chunks(args.chunk, arrays=_checked_points(args.points, n_faces, evaluable))
+        arrays = _checked_points(args.points, n_faces, evaluable)
+        check_result_size(arrays[0].size, args.derivatives, out_path, shards, f"{args.points}: ")
+        sources = point_chunks(args.chunk, arrays=arrays)
     else:
         if args.samples < 0:
             raise CCProofError(f"--samples must be >= 0, got {args.samples}")
+        check_result_size(args.samples, args.derivatives, out_path, shards, f"--samples {args.samples}: ")
         sources = point_chunks(args.chunk, samples=args.samples, seed=args.seed,
                                n_faces=n_faces if evaluable is None else evaluable)
     from ccproof.cli._notice import compile_notice
