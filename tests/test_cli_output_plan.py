@@ -128,3 +128,13 @@ def test_plan_keeps_temporaries_of_live_writers(tmp_path):
     plan.add("--out", tmp_path / "o.obj", (".obj",))
     plan.check()
     assert live.exists() and other.exists()
+
+
+def test_eval_and_project_refuse_an_output_replacing_an_input(disk, tmp_path, monkeypatch, capsys):
+    import ccproof.mesh.io as io
+
+    monkeypatch.setattr(io, "read_mesh", _no_work)
+    (tmp_path / "pts.npz").write_text("x,y,z\n0,0,1\n")  # the CSV reader does not look at the suffix
+    _refused(["project", str(disk), "pts.npz", "--out", "./pts.npz"], capsys, "POINTS", "replace an input")
+    (tmp_path / "shards").mkdir()
+    _refused(["eval", str(disk), "--points", "shards", "--out", "shards/"], capsys, "--points", "replace an input")

@@ -319,6 +319,12 @@ class OutputPlan:
         self.outputs.append((f"{option} {path}", p))
         return p
 
+    def add_folder(self, option, path) -> Path:
+        """Check the output folder ``path`` of ``option`` (:func:`check_folder`); returns it absolute."""
+        p = check_folder(path, option)
+        self.outputs.append((f"{option} {path}", p))
+        return p
+
     def add_input(self, option, path):
         """Record an input file (``option``: how messages name it) that no output may replace."""
         if path is not None:

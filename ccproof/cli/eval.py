@@ -137,13 +137,19 @@ def _size(b):
 def run(args) -> int:
     from pathlib import Path
 
-    from ccproof.cli._output import PLOT_SUFFIXES, atomic, check_file, check_folder, is_folder_request
+    from ccproof.cli._output import PLOT_SUFFIXES, OutputPlan, atomic, is_folder_request
 
-    # every output checked before any work (even the imports); absolute paths (a Dask worker may run elsewhere)
+    # every output checked before any work (even the imports), distinct from the inputs (--points FOLDER may
+    # not be the --out folder); absolute paths (a Dask worker may run elsewhere)
+    plan = OutputPlan()
+    plan.add_input("MESH", args.mesh)
+    plan.add_input("--points", args.points)
     shards = is_folder_request(args.out)
-    out_path = check_folder(args.out) if shards else check_file(args.out, (".npz",), hint="(or FOLDER/ for shards)")
+    out_path = plan.add_folder("--out", args.out) if shards else \
+        plan.add("--out", args.out, (".npz",), hint="(or FOLDER/ for shards)")
     if args.plot:
-        check_file(args.plot, PLOT_SUFFIXES, "--plot")
+        plan.add("--plot", args.plot, PLOT_SUFFIXES)
+    plan.check()
     if args.alpha is not None and args.parameterization != "vanishing":
         raise CCProofError(f"--alpha is the exponent of --parameterization vanishing, not of {args.parameterization}")
     if args.threads is not None and args.threads < 1:

@@ -73,9 +73,13 @@ def read_xyz_csv(path):
 def run(args):
     import time
 
-    from ccproof.cli._output import atomic, check_file
+    from ccproof.cli._output import OutputPlan, atomic
 
-    out_path = check_file(args.out, (".npz",))  # before any work (even the imports)
+    plan = OutputPlan()  # before any work (even the imports)
+    plan.add_input("MESH", args.mesh)
+    plan.add_input("POINTS", args.points)
+    out_path = plan.add("--out", args.out, (".npz",))
+    plan.check()
     import numpy as np
 
     from ccproof.cli._progress import progress_enabled
