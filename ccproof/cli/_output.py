@@ -196,20 +196,23 @@ def _pid_alive(pid):
 
 
 def remove_stale_temporaries(path) -> int:
-    """Remove the temporary files of ``path`` (:func:`_temporary`) left by a killed writer (its process is
-    gone, or, for an older version's name without a pid, older than :data:`STALE_SECONDS`); returns how
-    many. Temporary files of running writers and every other file are kept."""
+    """Remove the temporary files of ``path`` (:func:`_temporary`; for a folder, those in it) left by a killed
+    writer (its process is gone, or, for an older version's name without a pid, older than
+    :data:`STALE_SECONDS`); returns how many. Temporary files of running writers and every other file are
+    kept."""
     path = Path(path)
+    inside = path.is_dir()  # an output folder (shards): every temporary file of ours in it
+    folder = path if inside else path.parent
     n = 0
     try:
-        names = os.listdir(path.parent)
+        names = os.listdir(folder)
     except OSError:
         return 0
     for name in names:
         m = _TEMPORARY.match(name)
-        if m is None or m.group(2) != path.name:
+        if m is None or not inside and m.group(2) != path.name:
             continue
-        q = path.parent / name
+        q = folder / name
         try:
             stale = not _pid_alive(int(m.group(1))) if m.group(1) else time.time() - q.stat().st_mtime > STALE_SECONDS
             if stale:
@@ -218,6 +221,17 @@ def remove_stale_temporaries(path) -> int:
         except OSError:
             pass
     return n
+
+
+@contextlib.contextmanager
+def _named(path, tmp):
+    """An OSError of a writer (a full disk) that names no file, or the temporary one, names ``path``."""
+    try:
+        yield
+    except OSError as exc:
+        if exc.filename is None or os.fspath(exc.filename) == os.fspath(tmp):
+            raise OSError(exc.errno, exc.strerror or str(exc), str(path)) from None
+        raise
 
 
 @contextlib.contextmanager
@@ -235,7 +249,8 @@ def atomic(path):
     path = Path(path)
     tmp = _temporary(path)
     try:
-        yield str(tmp)
+        with _named(path, tmp):
+            yield str(tmp)
         if not tmp.exists():
             raise CCProofError(f"{path}: the writer produced no file")
         os.replace(tmp, path)
@@ -351,7 +366,8 @@ class OutputPlan:
         path = Path(path)
         tmp = _temporary(path)
         self._pending.append((tmp, path))
-        yield str(tmp)
+        with _named(path, tmp):
+            yield str(tmp)
         if not tmp.exists():
             raise CCProofError(f"{path}: the writer produced no file")
 

@@ -146,9 +146,26 @@ def _chunk_points(source):
     if kind == "arrays":
         return tuple(np.asarray(a) for a in source[1:])
     if kind == "shard":
-        with np.load(source[1]) as z:
-            return z["face"], z["u"], z["v"]
+        return _read_shard_points(source[1])
     raise CCProofError(f"unknown chunk source {kind!r}")
+
+
+def _read_shard_points(path):
+    """(face, u, v) of one shard file, a truncated or foreign file refused naming it."""
+    import zipfile
+
+    import numpy as np
+
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            face, u, v = z["face"], z["u"], z["v"]
+    except (zipfile.BadZipFile, EOFError, ValueError, KeyError, OSError) as exc:
+        why = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise CCProofError(f"{path}: not a readable shard of points face, u, v (truncated or another file?): "
+                           f"{why}") from None
+    if not face.shape == u.shape == v.shape or face.ndim != 1:
+        raise CCProofError(f"{path}: face, u, v of shapes {face.shape}, {u.shape}, {v.shape}: expected (n,) each")
+    return face, u, v
 
 
 def _evaluate_chunk(task, shipped):
@@ -178,7 +195,7 @@ def _replace_when_written(path, write):
     import uuid
 
     path = Path(path)
-    tmp = path.with_name(f".tmp-{uuid.uuid4().hex[:8]}-{path.name}")
+    tmp = path.with_name(f".tmp-{os.getpid()}-{uuid.uuid4().hex[:6]}-{path.name}")  # a dead writer's: removed later
     try:
         write(str(tmp))
         os.replace(tmp, path)
