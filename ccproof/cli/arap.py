@@ -45,10 +45,12 @@ optimizing (b)/(c), which lets (c) reach (d)'s E_area on small charts; --accel (
 Anderson acceleration of the local/global iteration. --preview FILE.png renders checkerboard and
 distortion maps.
 
-Outputs: every file a run writes (--out and FILE.json, --control-out and UV.obj.json, --labels-out,
---preview) is checked before any work: distinct from each other and from the inputs (other spellings and
-links included), writable, within the file system's name limits; they are renamed into place together
-when all are written, so a failure (a full disk) leaves none of them.
+Inputs (the mesh, --charts) at most --max-input GB (default 2; regular files or a pipe). Outputs: every
+file a run writes (--out and FILE.json, --control-out and UV.obj.json, --labels-out, --preview) is checked
+before any work: distinct from each other and from the inputs (other spellings and links included),
+writable, within the file system's name limits; they are renamed into place together when all are
+written, so a failure (a full disk) leaves none of them. --out-level, --control-extra, --levels and the
+other counts must be >= 0, --max-memory and --tol finite.
 
 Example:  ccproof arap bunny_quads.obj --segment normals --baselines --out bunny_uv.obj --preview bunny.png
 """

@@ -15,6 +15,11 @@ random (--samples N, uniform face and (u, v); faces in holes have no surface and
 The output .npz holds the arrays P, Pu, Pv (and Puu, Puv, Pvv with --derivatives 2), each of shape
 (n, 3) in the order of the points, and face, u, v.
 
+Limits (checked before any work): every input file at most --max-input GB (default 2; regular files or a
+pipe, read once); one .npz result must fit this machine's memory (96 bytes per point, 168 with --derivatives
+2), shards (--out FOLDER/) the free disk; --scheduler local:N at most the cores and the chunks; outputs may
+not replace an input.
+
 Examples:
   ccproof eval bunny.obj --samples 1000000 --out bunny.npz --plot ev.png
   ccproof eval mesh.obj --points points.csv --parameterization characteristic --derivatives 1 --out out.npz

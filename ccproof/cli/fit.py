@@ -27,9 +27,11 @@ two-sided (Hausdorff) error. A warning (stderr) says when more than --stray-frac
 strays (a torus' hole spanned, an unseen side filled in) or a level stopped at --max-steps.
 --errors FILE.csv writes x, y, z, distance and distance in % for every data point.
 
-Outputs (--out, --surface-out or its derived name, --errors) are checked before any work: distinct from
-each other and from the inputs (other spellings and links included), writable, within the file system's
-name limits; they are renamed into place together when all are written, so a failure leaves none of them.
+Limits: input files (POINTS, --init) at most --max-input GB (default 2; regular files or a pipe);
+--sample-level at most 6. Outputs (--out, --surface-out or its derived name, --errors) are checked before
+any work: distinct from each other and from the inputs (other spellings and links included), writable,
+within the file system's name limits; they are renamed into place together when all are written, so a
+failure leaves none of them.
 """
 
 from __future__ import annotations

@@ -11,6 +11,10 @@ strings ('certified', 'ambiguous', 'uncertified'), distance_lo, distance_hi (n,)
 enclosure of the distance where certified) and parameter_radius (n,) (the nearest parameter
 lies within this max-norm radius of (u, v) in the same face, where certified).
 
+Limits (checked before any work): input files at most --max-input GB (default 2); the search structure,
+about 320 bytes per sample and (2 --cells + 1)^2 samples per face, at most --max-memory GB (default 2);
+--out may not replace an input.
+
 Example:
   ccproof project bunny.obj points.csv --out nearest.npz
 """
