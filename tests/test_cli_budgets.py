@@ -52,3 +52,28 @@ def test_project_refuses_a_search_structure_above_max_memory(disk, tmp_path, mon
     for bad in ("nan", "0", "-1"):
         assert main(argv + ["--max-memory", bad]) == 2
         assert "--max-memory must be a positive number" in capsys.readouterr().err
+
+
+def test_a_large_polygon_is_refused_up_front_and_the_option_raises_the_limit(tmp_path, capsys):
+    """A 1000-gon used to take 26 minutes and 2.2 GB for 100 points; now refused at once, by face and size."""
+    import time
+
+    import numpy as np
+
+    def ngon(n):
+        a = np.linspace(0, 2 * np.pi, n, endpoint=False)
+        p = tmp_path / f"ngon{n}.obj"
+        p.write_text("".join(f"v {float(np.cos(t))!r} {float(np.sin(t))!r} 0\n" for t in a)
+                     + "f " + " ".join(str(i + 1) for i in range(n)) + "\n")
+        return str(p)
+
+    t0 = time.perf_counter()
+    assert main(["eval", ngon(1000), "--samples", "100", "--out", str(tmp_path / "o.npz")]) == 2
+    err = capsys.readouterr().err
+    assert "ngon1000.obj: face 0 has 1000 vertices, above --max-polygon 256" in err, err
+    assert time.perf_counter() - t0 < 5
+    assert main(["eval", ngon(12), "--samples", "20", "--out", str(tmp_path / "o.npz"), "--max-polygon", "8"]) == 2
+    assert "face 0 has 12 vertices, above --max-polygon 8" in capsys.readouterr().err
+    assert main(["eval", ngon(12), "--samples", "20", "--out", str(tmp_path / "o.npz"), "--max-polygon", "12"]) == 0
+    assert main(["eval", ngon(12), "--samples", "20", "--out", str(tmp_path / "o.npz"), "--max-polygon", "2"]) == 2
+    assert "--max-polygon must be an integer >= 3" in capsys.readouterr().err

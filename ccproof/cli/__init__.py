@@ -31,15 +31,27 @@ INPUT_COMMANDS = ("eval", "project", "fit", "arap")
 
 
 def _add_input_limit(p):
+    from ccproof.mesh._input import MAX_POLYGON
+
     p.add_argument("--max-input", type=float, default=None, metavar="GB",
                    help="largest input file read, in GB (default 2); inputs are regular files or pipes (read "
                         "once): a folder, a device such as /dev/zero or a socket is refused by name")
+    p.add_argument("--max-polygon", type=int, default=MAX_POLYGON, metavar="N",
+                   help=f"largest polygon of a mesh (default {MAX_POLYGON}; the exact data of an n-gon cost about "
+                        "n^1.5 to n^2.3: 21 s at n = 128, 26 min at 1000)")
 
 
 def _apply_input_limit(args):
     """Set the input cap of ``--max-input`` (refused unless a positive number); returns the previous cap."""
-    from ccproof.mesh._input import input_cap, set_input_cap
+    from ccproof.mesh._input import input_cap, set_input_cap, set_polygon_cap
 
+    n = getattr(args, "max_polygon", None)
+    if n is not None:
+        if n < 3:
+            from ccproof.errors import CCProofError
+
+            raise CCProofError(f"--max-polygon must be an integer >= 3, got {n}")
+        set_polygon_cap(n)
     gb = getattr(args, "max_input", None)
     if gb is None:
         return input_cap()
@@ -194,9 +206,10 @@ def main(argv=None) -> int:
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
         if cap is not None:
-            from ccproof.mesh._input import set_input_cap
+            from ccproof.mesh._input import set_input_cap, set_polygon_cap
 
             set_input_cap(cap)
+            set_polygon_cap(None)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ccproof.errors import MeshError
-from ccproof.mesh._input import checked_input
+from ccproof.mesh._input import check_polygon_sizes, checked_input
 from ccproof.mesh.quadmesh import QuadMesh
 
 if TYPE_CHECKING:
@@ -422,6 +422,7 @@ def read_mesh(path: str | os.PathLike[str]) -> PolyMesh:
     with checked_input(p, MeshError) as q:  # a regular file or a pipe, at most --max-input bytes
         mesh = _read_mesh(p, q)
     _check_magnitudes(mesh, p)
+    check_polygon_sizes(mesh.polygons, p, MeshError)
     return mesh
 
 
