@@ -309,6 +309,32 @@ def _sigint_ignored():
         signal.signal(signal.SIGINT, previous)
 
 
+@contextlib.contextmanager
+def _signals_deferred():
+    """While a cluster starts: SIGINT ignored (:func:`_sigint_ignored`: the worker processes inherit that, so
+    a Ctrl-C sent to the whole process group reaches only this process later on), SIGTERM recorded and
+    raised when the block ends (no traceback from inside the cluster's start-up; the caller closes the
+    half-started cluster). A Ctrl-C during the start itself is still lost: ignoring it is what keeps it from
+    the workers, which inherit the disposition (a blocked mask would not reach them, nor stop other threads)."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    got = []
+    previous = signal.signal(signal.SIGTERM, lambda signum, frame: got.append(signum))
+    try:
+        with _sigint_ignored():
+            yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+        if got and callable(previous):
+            previous(signal.SIGTERM, None)  # the command's handler raises (one line, exit 143)
+        elif got and previous == signal.SIG_DFL:
+            os.kill(os.getpid(), signal.SIGTERM)
+
+
 def _ignore_sigint():  # initializer of the worker processes of process_pool
     import signal
 
@@ -403,10 +429,18 @@ def client_for(scheduler):
     if s.kind == "local":
         import logging
 
-        with _sigint_ignored():  # the workers leave Ctrl-C to this process, which stops them on exit
-            cluster = LocalCluster(n_workers=s.workers, threads_per_worker=1, processes=True,
-                                   dashboard_address=None, silence_logs=logging.ERROR)
-        with cluster, Client(cluster) as client:
+        cluster = client = None
+        try:
+            with _signals_deferred():  # the workers leave Ctrl-C to this process; one arriving now is raised after
+                cluster = LocalCluster(n_workers=s.workers, threads_per_worker=1, processes=True,
+                                       dashboard_address=None, silence_logs=logging.ERROR)
+                client = Client(cluster)
+        except BaseException:  # a Ctrl-C or SIGTERM during the start: the cluster stopped, then one line
+            for part in (client, cluster):
+                if part is not None:
+                    part.close()
+            raise
+        with cluster, client:
             yield client
     elif s.kind == "address":
         with Client(s.address, timeout="30s") as client:
