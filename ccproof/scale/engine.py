@@ -335,10 +335,25 @@ def _signals_deferred():
             os.kill(os.getpid(), signal.SIGTERM)
 
 
-def _ignore_sigint():  # initializer of the worker processes of process_pool
+#: seconds between a pool worker's checks that the process that started it is alive
+PARENT_POLL_SECONDS = 0.5
+
+
+def _ignore_sigint(parent=None):  # initializer of the worker processes of process_pool
+    """Ignore Ctrl-C (left to the parent) and end this worker when ``parent`` is gone (killed by SIGKILL: no
+    process of ours outlives its parent, and the resource tracker ends with the last worker)."""
     import signal
+    import threading
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if parent is not None:
+        threading.Thread(target=_exit_with, args=(parent,), daemon=True, name="ccproof-parent-watch").start()
+
+
+def _exit_with(parent):
+    while os.getppid() == parent:
+        time.sleep(PARENT_POLL_SECONDS)
+    os._exit(1)  # reparented: the parent died without stopping us
 
 
 @contextlib.contextmanager
@@ -370,7 +385,7 @@ def process_pool(workers, context="spawn"):
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor
 
-    ex = ProcessPoolExecutor(max_workers=workers, initializer=_ignore_sigint,
+    ex = ProcessPoolExecutor(max_workers=workers, initializer=_ignore_sigint, initargs=(os.getpid(),),
                              mp_context=multiprocessing.get_context(context))
     try:
         yield ex
