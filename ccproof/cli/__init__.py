@@ -26,12 +26,12 @@ COMMANDS: dict[str, tuple[str, str]] = {
 }
 
 
-#: the commands that read meshes, point files or chart labels: they take --max-input (ccproof/mesh/_input.py)
+#: the commands that read meshes, point files or chart labels: they take --max-input (ccproof/mesh/inputs.py)
 INPUT_COMMANDS = ("eval", "project", "fit", "arap")
 
 
 def _add_input_limit(p):
-    from ccproof.mesh._input import MAX_POLYGON
+    from ccproof.mesh.inputs import MAX_POLYGON
 
     p.add_argument("--max-input", type=float, default=None, metavar="GB",
                    help="largest input file read, in GB (default 2); inputs are regular files or pipes (read "
@@ -43,7 +43,7 @@ def _add_input_limit(p):
 
 def _apply_input_limit(args):
     """Set the input cap of ``--max-input`` (refused unless a positive number); returns the previous cap."""
-    from ccproof.mesh._input import input_cap, set_input_cap, set_polygon_cap
+    from ccproof.mesh.inputs import input_cap, set_input_cap, set_polygon_cap
 
     n = getattr(args, "max_polygon", None)
     if n is not None:
@@ -206,7 +206,7 @@ def main(argv=None) -> int:
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
         if cap is not None:
-            from ccproof.mesh._input import set_input_cap, set_polygon_cap
+            from ccproof.mesh.inputs import set_input_cap, set_polygon_cap
 
             set_input_cap(cap)
             set_polygon_cap(None)

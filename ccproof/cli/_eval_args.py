@@ -69,7 +69,7 @@ def read_csv_columns(path, header):
     :class:`CCProofError` naming the file and line."""
     import numpy as np
 
-    from ccproof.mesh._input import read_input_text
+    from ccproof.mesh.inputs import read_input_text
 
     want = ",".join(header)
     # a regular file or a pipe, at most --max-input bytes; a BOM and CRLF (spreadsheets) accepted

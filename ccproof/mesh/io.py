@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ccproof.errors import MeshError
-from ccproof.mesh._input import check_polygon_sizes, checked_input
+from ccproof.mesh.inputs import check_polygon_sizes, checked_input
 from ccproof.mesh.quadmesh import QuadMesh
 
 if TYPE_CHECKING:

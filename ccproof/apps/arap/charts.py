@@ -97,7 +97,7 @@ def read_labels(path, n_faces=None):
     ...
     ccproof.apps.arap.charts.ChartError: ...
     """
-    from ccproof.mesh._input import read_input_text
+    from ccproof.mesh.inputs import read_input_text
 
     vals = []
     text = read_input_text(path, ChartError, "one integer label per face")  # at most --max-input bytes

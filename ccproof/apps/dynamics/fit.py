@@ -188,7 +188,7 @@ def read_points(path):
     >>> read_points(p).tolist()
     [[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]]
     """
-    from ccproof.mesh._input import checked_input
+    from ccproof.mesh.inputs import checked_input
 
     path = Path(path)
     with checked_input(path) as q:  # a regular file or a pipe, at most --max-input bytes
@@ -241,7 +241,7 @@ _PLY_TYPES = {"char": "i1", "uchar": "u1", "short": "i2", "ushort": "u2", "int":
 
 def _text(path, q):
     """The text of a points file (UTF-8, a byte-order mark dropped); a binary file refused by name."""
-    from ccproof.mesh._input import decode_text
+    from ccproof.mesh.inputs import decode_text
 
     return decode_text(q.read_bytes(), path, expect=f"{path.suffix} holds lines of numbers x y z")
 
