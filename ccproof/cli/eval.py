@@ -192,6 +192,9 @@ def run(args) -> int:
         n_faces, kwargs = mesh.n_faces, {"parameterization": args.parameterization}
     # the points before the surface's setup (seconds on large meshes): a bad point is reported at once
     if points is not None and points.is_dir():
+        from ccproof.mesh.inputs import check_regular_file
+
+        check_regular_file(points / "index.json")  # (a link to /dev/zero refused before it is read)
         sources = point_chunks(args.chunk, shards=points)
     elif points is not None:
         arrays = _checked_points(args.points, n_faces, evaluable)

@@ -30,8 +30,8 @@ import tempfile
 
 from ccproof.errors import CCProofError
 
-__all__ = ["checked_input", "read_input_text", "decode_text", "input_cap", "set_input_cap", "MAX_INPUT_BYTES",
-           "polygon_cap", "set_polygon_cap", "check_polygon_sizes"]
+__all__ = ["checked_input", "check_regular_file", "read_input_text", "decode_text", "input_cap", "set_input_cap",
+           "MAX_INPUT_BYTES", "polygon_cap", "set_polygon_cap", "check_polygon_sizes"]
 
 #: default largest input file, bytes (``--max-input`` raises it)
 MAX_INPUT_BYTES = 2 * 10**9
@@ -59,6 +59,27 @@ def _kind(mode):
 def _too_big(path, size, cap, error):
     return error(f"{path}: {size} bytes or more, above the input limit of {cap} bytes ({cap / 1e9:g} GB); "
                  f"--max-input GB raises it")
+
+
+def check_regular_file(path, error=CCProofError):
+    """Refuse, without opening it, a file that is not regular or above :func:`input_cap` (for a file another
+    layer reads, such as a shard folder's index); a missing file is left to that reader.
+
+    >>> check_regular_file("/dev/null")
+    Traceback (most recent call last):
+    ...
+    ccproof.errors.CCProofError: /dev/null: not a regular file (a character device); ccproof reads regular files here
+    """
+    p = os.fspath(path)
+    try:
+        st = os.stat(p)
+    except FileNotFoundError:
+        return
+    if not stat.S_ISREG(st.st_mode):
+        to = f" -> {os.path.realpath(p)}" if os.path.islink(p) else ""
+        raise error(f"{p}{to}: not a regular file ({_kind(st.st_mode)}); ccproof reads regular files here")
+    if st.st_size > input_cap():
+        raise _too_big(p, st.st_size, input_cap(), error)
 
 
 def _read_fifo(fd, path, cap, error):

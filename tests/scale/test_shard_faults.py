@@ -35,3 +35,13 @@ def test_stale_temporaries_in_an_output_folder_are_removed(tmp_path):
     out = str(tmp_path / "sh") + "/"
     assert main(["eval", str(tmp_path / "d.obj"), "--samples", "10", "--serial", "--out", out]) == 0
     assert not stale.exists() and live.exists()
+
+
+def test_a_shard_index_linked_to_dev_zero_is_refused_at_once(tmp_path, capsys):
+    write_obj(tmp_path / "d.obj", k_regular_disk(5, rings=2))
+    (tmp_path / "sh").mkdir()
+    os.symlink("/dev/zero", tmp_path / "sh" / "index.json")
+    assert main(["eval", str(tmp_path / "d.obj"), "--points", str(tmp_path / "sh"), "--out", str(tmp_path / "o.npz"),
+                 "--max-input", "0.001"]) == 2  # (a cap too: on the old code this test ends at 1 MB, not at memory)
+    err = capsys.readouterr().err
+    assert "index.json -> /dev/zero: not a regular file (a character device)" in err, err
