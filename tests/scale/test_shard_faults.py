@@ -42,6 +42,6 @@ def test_a_shard_index_linked_to_dev_zero_is_refused_at_once(tmp_path, capsys):
     (tmp_path / "sh").mkdir()
     os.symlink("/dev/zero", tmp_path / "sh" / "index.json")
     assert main(["eval", str(tmp_path / "d.obj"), "--points", str(tmp_path / "sh"), "--out", str(tmp_path / "o.npz"),
-                 "--max-input", "0.001"]) == 2  # (a cap too: on the old code this test ends at 1 MB, not at memory)
+                 "--max-input", "0.001"]) == 2  # (the old code read it until memory ran out)
     err = capsys.readouterr().err
     assert "index.json -> /dev/zero: not a regular file (a character device)" in err, err
