@@ -173,7 +173,8 @@ def _evaluate_chunk(task, shipped):
 
     ``task`` is ``{"source": ("samples", seed, n_faces, count, index) | ("arrays", face, u, v) |
     ("shard", path), "derivatives": d, "kwargs": {...}, "out": path or None}``; returns the number of
-    points written, or the dict face, u, v, P, ... when ``out`` is None.
+    points written and :func:`degenerate_normals` of the shard, or the dict face, u, v, P, ... when ``out``
+    is None.
     """
     import numpy as np
 
@@ -184,7 +185,47 @@ def _evaluate_chunk(task, shipped):
     if task["out"] is None:
         return arrays
     _replace_when_written(task["out"], lambda tmp: np.savez(tmp, **arrays))
-    return int(f.size)
+    return int(f.size), degenerate_normals(arrays)
+
+
+class DegenerateNormalWarning(UserWarning):
+    """Evaluated points where ``Pu x Pv = 0``: the surface has no normal there (collapsed faces)."""
+
+
+#: ``|Pu x Pv| <= NORMAL_TOLERANCE |Pu| |Pv|`` counts as no normal (0 = 0 too: a vanishing derivative)
+NORMAL_TOLERANCE = 1e-12
+
+
+def degenerate_normals(arrays):
+    """(count, up to 6 faces) of the points of a result whose normal is undefined (``|Pu x Pv|`` at most
+    :data:`NORMAL_TOLERANCE` times ``|Pu| |Pv|``); (0, []) without derivatives.
+
+    >>> import numpy as np
+    >>> degenerate_normals({"face": np.array([3, 4]), "Pu": np.array([[1.0, 0, 0], [1.0, 0, 0]]),
+    ...                     "Pv": np.array([[0, 1.0, 0], [2.0, 0, 0]])})
+    (1, [4])
+    """
+    import numpy as np
+
+    if "Pu" not in arrays:
+        return 0, []
+    Pu, Pv = arrays["Pu"], arrays["Pv"]
+    c = np.linalg.norm(np.cross(Pu, Pv), axis=1)
+    bad = c <= NORMAL_TOLERANCE * np.linalg.norm(Pu, axis=1) * np.linalg.norm(Pv, axis=1)
+    faces = np.unique(np.asarray(arrays["face"])[bad])
+    return int(bad.sum()), [int(x) for x in faces[:6]]
+
+
+def _warn_degenerate(n, counts):
+    """One warning for the points without a normal (count, and the first faces), if any."""
+    import warnings
+
+    k = sum(c for c, _ in counts)
+    if k:
+        faces = sorted({f for _, fs in counts for f in fs})
+        warnings.warn(f"{k} of {n} points have no normal (|Pu x Pv| = 0: a collapsed or degenerate face there), "
+                      f"in faces {', '.join(map(str, faces[:5]))}{', ...' if len(faces) > 5 else ''}",
+                      DegenerateNormalWarning, stacklevel=3)
 
 
 def _replace_when_written(path, write):
@@ -445,7 +486,10 @@ def evaluate_points(shipped, sources, derivatives, kwargs, out, scheduler=None, 
         arrays = {n: np.concatenate([r[n] for r in sweep.results]) for n in ("face", "u", "v", *names)}
         _replace_when_written(out, lambda tmp: np.savez(tmp, **arrays))
         n = int(arrays["face"].size)
+        counts = [degenerate_normals(arrays)]
     else:
-        _write_index(folder, sweep.results, ("face", "u", "v", *names))
-        n = int(sum(sweep.results))
+        _write_index(folder, [r[0] for r in sweep.results], ("face", "u", "v", *names))
+        n = int(sum(r[0] for r in sweep.results))
+        counts = [r[1] for r in sweep.results]
+    _warn_degenerate(n, counts)
     return n, names, sweep
