@@ -232,6 +232,10 @@ def run(args) -> int:
           f"levels {args.start_level}..{args.levels}, refine {refine}, metrics at level {eval_level}, "
           f"baseline engine {engine}")
     print(format_table(results, eval_level))
+    flips = results[ours].metrics.flips
+    if flips:
+        print(f"ccproof arap: warning: {results[ours].name}: {flips} flipped samples at level {eval_level} (the "
+              f"texture folds there; E_stretch {results[ours].metrics.E_stretch:.3g}); {_finer(args)}", file=sys.stderr)
     lv = results[ours].levels
     for k in range(len(lv[0]) if lv and lv[0] else 0):
         its = sum(c[k].iterations for c in lv)
@@ -256,6 +260,14 @@ def run(args) -> int:
         _write_outputs(args, plan, results, ours, labels, out_level, eval_level, comment, table)
     sys.stdout.flush()
     return 0
+
+
+def _finer(args):
+    """What to try against folds: a finer control mesh for the optimization."""
+    if args.refine == "auto":
+        return "give --refine 1 or 2 (a finer control mesh for the optimization)"
+    return (f"--refine {args.refine} was given: raise it, or leave it to the default (auto: >= 1000 control faces "
+            f"per chart)")
 
 
 def _check_options(args):
@@ -341,6 +353,9 @@ def _write_outputs(args, plan, results, ours, labels, out_level, eval_level, com
         print(f"wrote {args.out} (level {surf.level}: {surf.points.shape[0]} vertices, {surf.cells.shape[0]} "
               f"{surf.cell_type}s, {surf.folds()} folded; written triangles E_angle {wm.E_angle:.6f} "
               f"E_area {wm.E_area:.6f} E_stretch {wm.E_stretch:.6f}) and {args.out}.json")
+        if surf.folds():
+            print(f"ccproof arap: warning: --out {args.out}: {surf.folds()} of {surf.cells.shape[0]} {surf.cell_type}s "
+                  f"are folded in UV (E_stretch {wm.E_stretch:.3g}); {_finer(args)}", file=sys.stderr)
     if args.control_out:
         _write_control(args, plan, results[ours], surf, eval_level, comment, table, write_uv_obj)
 
