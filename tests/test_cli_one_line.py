@@ -74,3 +74,10 @@ def test_fit_refuses_nan_and_out_of_range_options_before_the_work(tmp_path, monk
     assert main(["fit", str(tmp_path / "p.xyz"), "--out", str(tmp_path / "o.obj"), option, value]) == 2
     err = capsys.readouterr().err
     assert words in err and len(err.strip().splitlines()) == 1, err
+
+
+def test_eval_negative_seed_is_refused_before_the_work(disk, tmp_path, capsys):
+    """It used to fail in every task after the setup ('FAILED: ValueError: expected non-negative integer')."""
+    assert main(["eval", str(disk), "--samples", "5", "--seed", "-1", "--out", str(tmp_path / "o.npz")]) == 2
+    err = capsys.readouterr().err
+    assert "--seed must be an integer >= 0, got -1" in err and len(err.strip().splitlines()) == 1, err

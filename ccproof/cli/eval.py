@@ -159,6 +159,8 @@ def run(args) -> int:
         raise CCProofError(f"--alpha is the exponent of --parameterization vanishing, not of {args.parameterization}")
     if args.threads is not None and args.threads < 1:
         raise CCProofError(f"--threads must be >= 1, got {args.threads}")
+    if args.seed < 0:  # numpy's generators take non-negative seeds (the tasks failed one by one after the setup)
+        raise CCProofError(f"--seed must be an integer >= 0, got {args.seed}")
 
     import numpy as np
 
