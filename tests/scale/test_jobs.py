@@ -18,7 +18,8 @@ def _no_work(*a, **k):
 
 
 @pytest.mark.parametrize("jobs", ["0", "-1"])
-@pytest.mark.parametrize("argv", [["certify", "5-6"], ["table", "--all", "--kmax", "4", "--dir", "{tmp}"]])
+@pytest.mark.parametrize("argv", [["certify", "5-6"], ["verify", "--all"],
+                                  ["table", "--all", "--kmax", "4", "--dir", "{tmp}"]])
 def test_jobs_below_one_are_refused_by_every_command(argv, jobs, tmp_path, monkeypatch, capsys):
     monkeypatch.setattr(engine, "run_tasks", _no_work)
     monkeypatch.setattr(engine, "process_pool", _no_work)
