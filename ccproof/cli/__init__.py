@@ -26,6 +26,42 @@ COMMANDS: dict[str, tuple[str, str]] = {
 }
 
 
+#: the commands that read meshes, point files or chart labels: they take --max-input (ccproof/mesh/inputs.py)
+INPUT_COMMANDS = ("eval", "project", "fit", "arap")
+
+
+def _add_input_limit(p):
+    from ccproof.mesh.inputs import MAX_POLYGON
+
+    p.add_argument("--max-input", type=float, default=None, metavar="GB",
+                   help="largest input file read, in GB (default 2); inputs are regular files or pipes (read "
+                        "once): a folder, a device such as /dev/zero or a socket is refused by name")
+    p.add_argument("--max-polygon", type=int, default=MAX_POLYGON, metavar="N",
+                   help=f"largest polygon of a mesh (default {MAX_POLYGON}; the exact data of an n-gon cost about "
+                        "n^1.5 to n^2.3: 21 s at n = 128, 26 min at 1000)")
+
+
+def _apply_input_limit(args):
+    """Set the input cap of ``--max-input`` (refused unless a positive number); returns the previous cap."""
+    from ccproof.mesh.inputs import input_cap, set_input_cap, set_polygon_cap
+
+    n = getattr(args, "max_polygon", None)
+    if n is not None:
+        if n < 3:
+            from ccproof.errors import CCProofError
+
+            raise CCProofError(f"--max-polygon must be an integer >= 3, got {n}")
+        set_polygon_cap(n)
+    gb = getattr(args, "max_input", None)
+    if gb is None:
+        return input_cap()
+    if not (gb > 0 and gb * 1e9 < float("inf")):
+        from ccproof.errors import CCProofError
+
+        raise CCProofError(f"--max-input must be a positive number of GB, got {gb}")
+    return set_input_cap(gb * 1e9)
+
+
 def _available():
     out = {}
     for name, (modname, helptext) in COMMANDS.items():
@@ -61,6 +97,8 @@ def build_parser() -> argparse.ArgumentParser:
             formatter_class=argparse.RawDescriptionHelpFormatter,
         )
         mod.add_arguments(p)
+        if name in INPUT_COMMANDS:
+            _add_input_limit(p)
         p.set_defaults(_run=mod.run)
     return parser
 
@@ -101,6 +139,17 @@ def error_message(exc) -> str:
     return "; ".join(line.strip() for line in text.splitlines() if line.strip())
 
 
+def _stdout_closed():
+    """Whether the process started with its standard output closed (``>&-``: Python's ``sys.stdout`` is None);
+    then the report goes to the null device, so that the command still writes its files."""
+    import os
+
+    if sys.stdout is not None:
+        return False
+    sys.stdout = open(os.devnull, "w")  # noqa: SIM115 - lives as long as the command
+    return True
+
+
 class _Terminated(KeyboardInterrupt):
     """SIGTERM, raised like Ctrl-C so that every ``finally`` runs (temporary output files are removed)."""
 
@@ -133,9 +182,15 @@ def main(argv=None) -> int:
     def one_line_warning(message, category, filename, lineno, file=None, line=None):
         print(f"ccproof {args.command}: warning: {error_message(message)}", file=sys.stderr)
 
+    closed = _stdout_closed()
+    if closed:
+        print(f"ccproof {args.command}: warning: standard output is closed: the printed report is discarded "
+              f"(output files are written)", file=sys.stderr)
+    cap = None
     try:
         with warnings.catch_warnings():
             warnings.showwarning = one_line_warning
+            cap = _apply_input_limit(args) if args.command in INPUT_COMMANDS else None
             return int(args._run(args) or 0)
     except KeyboardInterrupt as exc:
         terminated = isinstance(exc, _Terminated)
@@ -145,8 +200,16 @@ def main(argv=None) -> int:
         print(f"ccproof {args.command}: error: {error_message(exc)}", file=sys.stderr)
         return 2
     finally:
+        if closed:
+            sys.stdout.close()
+            sys.stdout = None  # as it was
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
+        if cap is not None:
+            from ccproof.mesh.inputs import set_input_cap, set_polygon_cap
+
+            set_input_cap(cap)
+            set_polygon_cap(None)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -69,22 +69,25 @@ def read_csv_columns(path, header):
     :class:`CCProofError` naming the file and line."""
     import numpy as np
 
+    from ccproof.mesh.inputs import read_input_text
+
     want = ",".join(header)
-    with open(path, encoding="utf-8") as fh:
-        first = fh.readline()
-        if [h.strip().lower() for h in first.strip().split(",")] != list(header):
-            raise CCProofError(f"{path}: the first line must be the header '{want}', got {first.strip()!r}")
-        rows = []
-        for no, line in enumerate(fh, start=2):
-            if not line.strip():
-                continue
-            parts = line.split(",")
-            if len(parts) != len(header):
-                raise CCProofError(f"{path}:{no}: expected {len(header)} comma-separated values, got {line.strip()!r}")
-            try:
-                rows.append([float(x) for x in parts])
-            except ValueError:
-                raise CCProofError(f"{path}:{no}: bad value in {line.strip()!r}") from None
+    # a regular file or a pipe, at most --max-input bytes; a BOM and CRLF (spreadsheets) accepted
+    lines = read_input_text(path, expect=f"a CSV file with the header {want}").splitlines()
+    first = lines[0] if lines else ""
+    if [h.strip().lower() for h in first.strip().split(",")] != list(header):
+        raise CCProofError(f"{path}: the first line must be the header '{want}', got {first.strip()!r}")
+    rows = []
+    for no, line in enumerate(lines[1:], start=2):
+        if not line.strip():
+            continue
+        parts = line.split(",")
+        if len(parts) != len(header):
+            raise CCProofError(f"{path}:{no}: expected {len(header)} comma-separated values, got {line.strip()!r}")
+        try:
+            rows.append([float(x) for x in parts])
+        except ValueError:
+            raise CCProofError(f"{path}:{no}: bad value in {line.strip()!r}") from None
     return np.array(rows, dtype=np.float64).reshape(-1, len(header))
 
 
@@ -94,7 +97,7 @@ def read_face_uv_csv(path):
 
     rows = read_csv_columns(path, ("face", "u", "v"))
     face = rows[:, 0]
-    bad = np.flatnonzero(face != np.round(face))
+    bad = np.flatnonzero(~np.isfinite(face) | (face != np.round(face)))
     if bad.size:
-        raise CCProofError(f"{path}:{int(bad[0]) + 2}: face must be an integer, got {face[bad[0]]!r}")
+        raise CCProofError(f"{path}:{int(bad[0]) + 2}: face must be an integer, got {float(face[bad[0]])!r}")
     return face.astype(np.int64), rows[:, 1].copy(), rows[:, 2].copy()

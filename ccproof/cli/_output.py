@@ -27,13 +27,15 @@ from __future__ import annotations
 
 import contextlib
 import os
+import re
+import time
 import uuid
 from pathlib import Path
 
 from ccproof.errors import CCProofError
 
 __all__ = ["check_file", "check_folder", "check_outputs", "atomic", "write_text", "is_folder_request",
-           "meshio_suffixes", "PLOT_SUFFIXES"]
+           "meshio_suffixes", "PLOT_SUFFIXES", "OutputPlan"]
 
 #: what a plot option can write (matplotlib)
 PLOT_SUFFIXES = (".png", ".pdf", ".svg")
@@ -171,8 +173,65 @@ def is_folder_request(path) -> bool:
 
 def _temporary(path: Path) -> Path:
     """A hidden name in the same folder that keeps the full name at its end (so writers that choose a
-    format by the suffix, numpy, meshio, matplotlib, write the same format)."""
-    return path.with_name(f".tmp-{uuid.uuid4().hex[:8]}-{path.name}")
+    format by the suffix, numpy, meshio, matplotlib, write the same format), with the writer's process id
+    (a later run removes those of dead writers, :func:`remove_stale_temporaries`)."""
+    return path.with_name(f".tmp-{os.getpid()}-{uuid.uuid4().hex[:6]}-{path.name}")
+
+
+#: the longest temporary name beyond the final name (``.tmp-PID-hhhhhh-``; Linux pids have at most 7 digits)
+TEMPORARY_EXTRA = len(".tmp-") + 7 + 1 + 6 + 1
+_TEMPORARY = re.compile(r"^\.tmp-(?:(\d+)-[0-9a-f]{6}|[0-9a-f]{8})-(.+)$")  # ours, and older versions' (no pid)
+#: a temporary file of an older version (no pid in its name) is stale after this many seconds
+STALE_SECONDS = 3600.0
+
+
+def _pid_alive(pid):
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError):
+        return True
+    return True
+
+
+def remove_stale_temporaries(path) -> int:
+    """Remove the temporary files of ``path`` (:func:`_temporary`; for a folder, those in it) left by a killed
+    writer (its process is gone, or, for an older version's name without a pid, older than
+    :data:`STALE_SECONDS`); returns how many. Temporary files of running writers and every other file are
+    kept."""
+    path = Path(path)
+    inside = path.is_dir()  # an output folder (shards): every temporary file of ours in it
+    folder = path if inside else path.parent
+    n = 0
+    try:
+        names = os.listdir(folder)
+    except OSError:
+        return 0
+    for name in names:
+        m = _TEMPORARY.match(name)
+        if m is None or not inside and m.group(2) != path.name:
+            continue
+        q = folder / name
+        try:
+            stale = not _pid_alive(int(m.group(1))) if m.group(1) else time.time() - q.stat().st_mtime > STALE_SECONDS
+            if stale:
+                q.unlink()
+                n += 1
+        except OSError:
+            pass
+    return n
+
+
+@contextlib.contextmanager
+def _named(path, tmp):
+    """An OSError of a writer (a full disk) that names no file, or the temporary one, names ``path``."""
+    try:
+        yield
+    except OSError as exc:
+        if exc.filename is None or os.fspath(exc.filename) == os.fspath(tmp):
+            raise OSError(exc.errno, exc.strerror or str(exc), str(path)) from None
+        raise
 
 
 @contextlib.contextmanager
@@ -190,7 +249,8 @@ def atomic(path):
     path = Path(path)
     tmp = _temporary(path)
     try:
-        yield str(tmp)
+        with _named(path, tmp):
+            yield str(tmp)
         if not tmp.exists():
             raise CCProofError(f"{path}: the writer produced no file")
         os.replace(tmp, path)
@@ -203,3 +263,143 @@ def write_text(path, text, encoding="utf-8"):
     """Write a text file atomically (:func:`atomic`)."""
     with atomic(path) as tmp, open(tmp, "w", encoding=encoding) as fh:
         fh.write(text)
+
+
+def _identity(p: Path):
+    """What a path names: the file's (device, inode) when it exists, else its resolved path (symbolic links
+    and ``..`` followed), so that two spellings of one file, a link to it, or a hard link compare equal."""
+    try:
+        st = os.stat(p)
+        return ("inode", st.st_dev, st.st_ino)
+    except OSError:
+        return ("path", os.path.realpath(p))
+
+
+def _name_limits(p: Path, what: str):
+    """Refuse a name (or its temporary name) beyond the file system's limits, before any work."""
+    folder = p.parent if p.parent.exists() else Path(os.path.abspath(os.sep))
+    try:
+        name_max = os.pathconf(folder, "PC_NAME_MAX")
+        path_max = os.pathconf(folder, "PC_PATH_MAX")
+    except (OSError, ValueError, AttributeError):
+        name_max, path_max = 255, 4096
+    n = len(os.fsencode(p.name))
+    if n + TEMPORARY_EXTRA > name_max:
+        raise CCProofError(f"{what}: the name is {n} bytes long; this file system allows {name_max}, and the "
+                           f"temporary name it is written under first {TEMPORARY_EXTRA} more: use at most "
+                           f"{name_max - TEMPORARY_EXTRA} bytes")
+    if len(os.fsencode(str(p))) + TEMPORARY_EXTRA >= path_max:
+        raise CCProofError(f"{what}: the path is longer than this file system allows ({path_max} bytes)")
+
+
+class OutputPlan:
+    """Every file one run of a command writes, checked together before any work; written all or none.
+
+    :meth:`add` checks each output as :func:`check_file` does, and its name (and the temporary name it is
+    written under) against the file system's limits; :meth:`add_input` records an input; :meth:`check`
+    then refuses two outputs naming one file, or an output naming an input (resolved: another spelling,
+    a symbolic or a hard link), and removes the temporary files of these names left by a killed run.
+    Files are written to temporary names (:meth:`write`, :meth:`adopt`) and renamed onto their names only
+    when the whole run succeeded (:meth:`commit`, at the end of the ``with`` block); on any failure every
+    temporary file is removed, so nothing of the run is left under any of its names.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> a = os.path.join(tmp.name, "a.obj")
+    >>> plan = OutputPlan()
+    >>> _ = plan.add("--out", a, (".obj",)); _ = plan.add("--surface-out", tmp.name + "/./a.obj", (".obj",))
+    >>> plan.check()
+    Traceback (most recent call last):
+    ...
+    ccproof.errors.CCProofError: --surface-out .../a.obj and --out .../a.obj name the same file: one would ...
+    >>> plan = OutputPlan(); out = plan.add("--out", a, (".obj",)); plan.check()
+    >>> with plan:
+    ...     with plan.write(out) as part, open(part, "w") as fh:
+    ...         _ = fh.write("v 0 0 0")
+    >>> os.listdir(tmp.name)
+    ['a.obj']
+    """
+
+    def __init__(self):
+        self.outputs = []  # (option text, absolute path)
+        self.inputs = []
+        self._pending = []  # (temporary, final)
+
+    def add(self, option, path, suffixes=(), *, hint="") -> Path:
+        """Check the output ``path`` of ``option`` (:func:`check_file`, name limits); returns it absolute."""
+        p = check_file(path, suffixes, option, hint=hint)
+        _name_limits(p, f"{option} {path}")
+        self.outputs.append((f"{option} {path}", p))
+        return p
+
+    def add_folder(self, option, path) -> Path:
+        """Check the output folder ``path`` of ``option`` (:func:`check_folder`); returns it absolute."""
+        p = check_folder(path, option)
+        self.outputs.append((f"{option} {path}", p))
+        return p
+
+    def add_input(self, option, path):
+        """Record an input file (``option``: how messages name it) that no output may replace."""
+        if path is not None:
+            self.inputs.append((f"{option} {path}".strip(), Path(os.path.abspath(os.fspath(path)))))
+
+    def check(self):
+        """Refuse outputs naming one file, or an input; remove stale temporary files of the outputs."""
+        seen = {}
+        for what, p in self.inputs:
+            seen.setdefault(_identity(p), (what, True))
+        for what, p in self.outputs:
+            key = _identity(p)
+            if key in seen:
+                other, is_input = seen[key]
+                raise CCProofError(f"{what} and {other} name the same file: " + (
+                    "an output would replace an input" if is_input else "one would replace the other"))
+            seen[key] = (what, False)
+        for _, p in self.outputs:
+            remove_stale_temporaries(p)
+
+    @contextlib.contextmanager
+    def write(self, path):
+        """Yield a temporary path for the output ``path``; it is renamed onto ``path`` at :meth:`commit`."""
+        path = Path(path)
+        tmp = _temporary(path)
+        self._pending.append((tmp, path))
+        with _named(path, tmp):
+            yield str(tmp)
+        if not tmp.exists():
+            raise CCProofError(f"{path}: the writer produced no file")
+
+    def adopt(self, tmp, path):
+        """A file a writer made next to a temporary one (a sidecar), to be renamed onto ``path`` too."""
+        self._pending.append((Path(tmp), Path(path)))
+
+    def write_text(self, path, text, encoding="utf-8"):
+        with self.write(path) as tmp, open(tmp, "w", encoding=encoding) as fh:
+            fh.write(text)
+
+    def commit(self):
+        for tmp, path in self._pending:
+            os.replace(tmp, path)
+        self._pending = []
+
+    def abort(self):
+        for tmp, _ in self._pending:
+            with contextlib.suppress(OSError):
+                tmp.unlink()
+        self._pending = []
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, exc_type, exc, tb):
+        if exc_type is None:
+            try:
+                self.commit()
+            except BaseException:
+                self.abort()
+                raise
+        else:
+            self.abort()
+        return False

@@ -45,13 +45,19 @@ optimizing (b)/(c), which lets (c) reach (d)'s E_area on small charts; --accel (
 Anderson acceleration of the local/global iteration. --preview FILE.png renders checkerboard and
 distortion maps.
 
+Inputs (the mesh, --charts) at most --max-input GB (default 2; regular files or a pipe). Outputs: every
+file a run writes (--out and FILE.json, --control-out and UV.obj.json, --labels-out, --preview) is checked
+before any work: distinct from each other and from the inputs (other spellings and links included),
+writable, within the file system's name limits; they are renamed into place together when all are
+written, so a failure (a full disk) leaves none of them. --out-level, --control-extra, --levels and the
+other counts must be >= 0, --max-memory and --tol finite.
+
 Example:  ccproof arap bunny_quads.obj --segment normals --baselines --out bunny_uv.obj --preview bunny.png
 """
 
 from __future__ import annotations
 
 import json
-import os
 import sys
 
 __all__ = ["add_arguments", "run", "format_table"]
@@ -148,33 +154,14 @@ def default_eval_level(mesh, labels, levels, with_d):
 
 
 def run(args) -> int:
-    from ccproof.cli._output import atomic, check_outputs, write_text
-
-    check_outputs(args, out="mesh", control_out=(".obj",), labels_out=(), preview="plot")  # before any work
-    from ccproof.apps.arap.charts import read_labels, segment_by_normals, write_labels
+    plan = _output_plan(args)  # every file written, and the options among themselves: before any work
+    from ccproof.apps.arap.charts import read_labels, segment_by_normals
     from ccproof.apps.arap.core import VARIANTS, MemoryBudgetError, auto_refine, compare
-    from ccproof.apps.arap.export import sampled_surface, write_surface
-    from ccproof.apps.arap.io import write_uv_obj
     from ccproof.apps.control_mesh import children_labels, read_control_mesh
     from ccproof.cli._progress import progress_enabled
     from ccproof.errors import CCProofError
 
-    # the options among themselves, before any work
-    refine = None
-    if args.refine != "auto":
-        try:
-            refine = int(args.refine)
-        except ValueError:
-            refine = -1
-        if refine < 0:
-            raise CCProofError(f"--refine must be auto or an integer >= 0, got {args.refine!r}")
-    if args.start_level < 0:
-        raise CCProofError(f"--start-level must be >= 0, got {args.start_level}")
-    if args.levels is not None and args.levels < args.start_level:
-        raise CCProofError(f"--levels {args.levels} is below --start-level {args.start_level}")
-    if args.eval_level is not None and refine is not None and args.eval_level < refine:
-        raise CCProofError(f"--eval-level {args.eval_level} is below --refine {refine} (the metrics are sampled "
-                           "on the refined mesh)")
+    refine = _check_options(args)
     mesh, origin = read_control_mesh(args.mesh)
     n_file = mesh.n_faces if origin is None else int(origin.max()) + 1
     if origin is not None:
@@ -189,9 +176,6 @@ def run(args) -> int:
         labels = segment_by_normals(mesh)
     else:
         labels = None
-    if args.labels_out and labels is not None:
-        with atomic(args.labels_out) as tmp:
-            write_labels(tmp, labels)
     ours = VARIANTS[args.variant]
     methods = [ours]
     engine = args.engine
@@ -248,6 +232,10 @@ def run(args) -> int:
           f"levels {args.start_level}..{args.levels}, refine {refine}, metrics at level {eval_level}, "
           f"baseline engine {engine}")
     print(format_table(results, eval_level))
+    flips = results[ours].metrics.flips
+    if flips:
+        print(f"ccproof arap: warning: {results[ours].name}: {flips} flipped samples at level {eval_level} (the "
+              f"texture folds there; E_stretch {results[ours].metrics.E_stretch:.3g}); {_finer(args)}", file=sys.stderr)
     lv = results[ours].levels
     for k in range(len(lv[0]) if lv and lv[0] else 0):
         its = sum(c[k].iterations for c in lv)
@@ -264,6 +252,84 @@ def run(args) -> int:
         for m, r in results.items()
     }
     comment = f"ccproof arap {args.mesh}: {results[ours].name}, levels {args.start_level}..{args.levels}"
+    if labels is None:  # without --charts or --segment the whole mesh is chart 0 (--labels-out)
+        import numpy as np
+
+        labels = np.zeros(mesh.n_faces, dtype=np.int64)
+    with plan:  # all outputs or none
+        _write_outputs(args, plan, results, ours, labels, out_level, eval_level, comment, table)
+    sys.stdout.flush()
+    return 0
+
+
+def _finer(args):
+    """What to try against folds: a finer control mesh for the optimization."""
+    if args.refine == "auto":
+        return "give --refine 1 or 2 (a finer control mesh for the optimization)"
+    return (f"--refine {args.refine} was given: raise it, or leave it to the default (auto: >= 1000 control faces "
+            f"per chart)")
+
+
+def _check_options(args):
+    """The options among themselves, before any work; returns --refine as an int (None: auto)."""
+    from ccproof.errors import CCProofError
+
+    refine = None
+    if args.refine != "auto":
+        try:
+            refine = int(args.refine)
+        except ValueError:
+            refine = -1
+        if refine < 0:
+            raise CCProofError(f"--refine must be auto or an integer >= 0, got {args.refine!r}")
+    for name in ("start_level", "levels", "eval_level", "out_level", "control_extra", "accel", "max_iter"):
+        value = getattr(args, name)
+        if value is not None and value < 0:
+            raise CCProofError(f"--{name.replace('_', '-')} must be >= 0, got {value}")
+    if args.control_max_faces < 1:
+        raise CCProofError(f"--control-max-faces must be >= 1, got {args.control_max_faces}")
+    if not (args.max_memory > 0 and args.max_memory < float("inf")):  # NaN too
+        raise CCProofError(f"--max-memory must be a positive number of GB, got {args.max_memory}")
+    if not (args.tol >= 0 and args.tol < float("inf")):
+        raise CCProofError(f"--tol must be a finite number >= 0, got {args.tol}")
+    if args.levels is not None and args.levels < args.start_level:
+        raise CCProofError(f"--levels {args.levels} is below --start-level {args.start_level}")
+    if args.eval_level is not None and refine is not None and args.eval_level < refine:
+        raise CCProofError(f"--eval-level {args.eval_level} is below --refine {refine} (the metrics are sampled "
+                           "on the refined mesh)")
+    return refine
+
+
+def _output_plan(args):
+    """Every file ``arap`` writes (sidecars ``.json`` too), checked together before any work."""
+    from ccproof.cli._output import PLOT_SUFFIXES, OutputPlan, meshio_suffixes
+
+    plan = OutputPlan()
+    plan.add_input("MESH", args.mesh)
+    plan.add_input("--charts", args.charts)
+    if args.out:
+        plan.add("--out", args.out, (".obj", *meshio_suffixes()))
+        plan.add("--out (its metrics sidecar)", args.out + ".json")
+    if args.control_out:
+        plan.add("--control-out", args.control_out, (".obj",))
+        plan.add("--control-out (its sidecar)", args.control_out + ".json")
+    if args.labels_out:
+        plan.add("--labels-out", args.labels_out)
+    if args.preview:
+        plan.add("--preview", args.preview, PLOT_SUFFIXES)
+    plan.check()
+    return plan
+
+
+def _write_outputs(args, plan, results, ours, labels, out_level, eval_level, comment, table):
+    """Write every requested output through ``plan`` (renamed onto their names only when all are written)."""
+    from ccproof.apps.arap.charts import write_labels
+    from ccproof.apps.arap.export import sampled_surface, write_surface
+    from ccproof.apps.arap.io import write_uv_obj
+
+    if args.labels_out:
+        with plan.write(args.labels_out) as tmp:
+            write_labels(tmp, labels)
     surf = None
     if args.out or args.control_out:
         surf = sampled_surface(results[ours], out_level, args.cells)
@@ -271,11 +337,11 @@ def run(args) -> int:
         from ccproof.apps.arap.preview import render_preview
 
         surfs = {m: sampled_surface(r, r.sample_level) for m, r in results.items()}
-        with atomic(args.preview) as tmp:
+        with plan.write(args.preview) as tmp:
             render_preview(tmp, surfs, {m: r.name for m, r in results.items()}, title=args.mesh)
         print(f"wrote {args.preview}")
     if args.out:
-        with atomic(args.out) as tmp:
+        with plan.write(args.out) as tmp:
             write_surface(tmp, surf, comment)
         wm = surf.metrics()
         info = {"method": ours, "level": surf.level, "cells": surf.cell_type, "uv_scale": surf.scale,
@@ -283,22 +349,22 @@ def run(args) -> int:
                 "written_triangles": {"E_angle": wm.E_angle, "E_area": wm.E_area, "E_stretch": wm.E_stretch,
                                       "note": "E_area at the natural UV scale: divide the file's UVs by uv_scale"},
                 "table": table}
-        write_text(args.out + ".json", json.dumps(info, indent=1))
+        plan.write_text(args.out + ".json", json.dumps(info, indent=1))
         print(f"wrote {args.out} (level {surf.level}: {surf.points.shape[0]} vertices, {surf.cells.shape[0]} "
               f"{surf.cell_type}s, {surf.folds()} folded; written triangles E_angle {wm.E_angle:.6f} "
               f"E_area {wm.E_area:.6f} E_stretch {wm.E_stretch:.6f}) and {args.out}.json")
+        if surf.folds():
+            print(f"ccproof arap: warning: --out {args.out}: {surf.folds()} of {surf.cells.shape[0]} {surf.cell_type}s "
+                  f"are folded in UV (E_stretch {wm.E_stretch:.3g}); {_finer(args)}", file=sys.stderr)
     if args.control_out:
-        _write_control(args, results[ours], surf, eval_level, comment, table, write_uv_obj)
-    sys.stdout.flush()
-    return 0
+        _write_control(args, plan, results[ours], surf, eval_level, comment, table, write_uv_obj)
 
 
-def _write_control(args, r, surf, eval_level, comment, table, write_uv_obj):
+def _write_control(args, plan, r, surf, eval_level, comment, table, write_uv_obj):
     """--control-out: control UVs for the face-varying 'corners only' rule, and what a tool will see."""
     from dataclasses import replace
 
     from ccproof.apps.arap.fvar import FOLD_LEVELS, export_control
-    from ccproof.cli._output import atomic
     from ccproof.cli._progress import progress_enabled
 
     exp = export_control(r, eval_level=eval_level, levels=args.levels, accel=args.accel, max_extra=args.control_extra,
@@ -322,8 +388,8 @@ def _write_control(args, r, surf, eval_level, comment, table, write_uv_obj):
         what["minimax"] = {"chart_weights": [None if w is None else list(w) for w in exp.chart_weights],
                            "arap_polish_alone": {"E_angle": a.E_angle, "E_area": a.E_area, "E_stretch": a.E_stretch}}
     side = args.control_out + ".json"
-    with atomic(args.control_out) as tmp:
-        os.replace(write_uv_obj(tmp, exp.mesh, replace(r, textures=exp.textures), comment=comment + note,
+    with plan.write(args.control_out) as tmp:
+        plan.adopt(write_uv_obj(tmp, exp.mesh, replace(r, textures=exp.textures), comment=comment + note,
                                 table=dict(table, control_out=what), transforms=surf.transforms, scale=surf.scale),
                    side)
     tags = ""

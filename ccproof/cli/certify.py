@@ -44,7 +44,8 @@ def add_arguments(p):
     p.add_argument("--c1", action="store_true",
                    help="certify Reif's C1 criterion (regular, injective characteristic map) instead")
     p.add_argument("--prec", type=int, default=128, help="arb precision in bits (default 128)")
-    p.add_argument("--jobs", type=int, default=None, help="same as --scheduler local:JOBS (kept for old scripts)")
+    p.add_argument("--jobs", type=int, default=None, help="same as --scheduler local:JOBS (kept for old scripts; >= 1, "
+                   "at most the cores of this machine and the number of tasks)")
     from ccproof.scale.engine import add_scheduler_arguments
 
     add_scheduler_arguments(p)
@@ -181,14 +182,9 @@ def _run_tagged(args):
 
 
 def run(args):
-    if ":" in str(args.valences):
-        if not args.c1:
-            raise CCProofError(f"{args.valences}: tagged configurations (FAMILY:N) are certified with --c1")
-        if args.out is None:
-            from ccproof.tables.format import output_dir
-
-            args.out = str(output_dir() / "c1")
-        return _run_tagged(args)
+    tagged = ":" in str(args.valences)
+    if tagged and not args.c1:
+        raise CCProofError(f"{args.valences}: tagged configurations (FAMILY:N) are certified with --c1")
     if args.out is None:
         from ccproof.tables.format import output_dir
 
@@ -196,6 +192,8 @@ def run(args):
     from ccproof.cli._output import check_folder
 
     args.out = str(check_folder(args.out))  # before any proof; absolute, whatever folder a worker runs in
+    if tagged:
+        return _run_tagged(args)
     ks = parse_valences(args.valences)
     _check_options(args, ks)
     if args.c1:

@@ -15,6 +15,11 @@ random (--samples N, uniform face and (u, v); faces in holes have no surface and
 The output .npz holds the arrays P, Pu, Pv (and Puu, Puv, Pvv with --derivatives 2), each of shape
 (n, 3) in the order of the points, and face, u, v.
 
+Limits (checked before any work): every input file at most --max-input GB (default 2; regular files or a
+pipe, read once); one .npz result must fit this machine's memory (96 bytes per point, 168 with --derivatives
+2), shards (--out FOLDER/) the free disk; --scheduler local:N at most the cores and the chunks; outputs may
+not replace an input.
+
 Examples:
   ccproof eval bunny.obj --samples 1000000 --out bunny.npz --plot ev.png
   ccproof eval mesh.obj --points points.csv --parameterization characteristic --derivatives 1 --out out.npz
@@ -25,6 +30,7 @@ from __future__ import annotations
 
 import sys
 import time
+from pathlib import Path
 
 from ccproof.cli._eval_args import add_arguments as _add_evaluate_arguments
 from ccproof.cli._eval_args import evaluable_ptex_faces, read_face_uv_csv
@@ -94,20 +100,67 @@ def _checked_points(path, n_faces, evaluable=None):
     return face, u, v
 
 
+def check_result_size(n, derivatives, out_path, shards, what=""):
+    """Refuse, before any work, a result that cannot be held: one ``.npz`` file is built in memory (at most
+    the machine's physical memory), shards are streamed to disk (at most the free space of their folder).
+
+    >>> from pathlib import Path
+    >>> check_result_size(10**15, 1, Path("o.npz"), False, "--samples 1000000000000000: ")
+    Traceback (most recent call last):
+    ...
+    ccproof.errors.CCProofError: --samples 1000000000000000: the result takes 96 PB (96 bytes per point), more ...
+    """
+    import os
+    import shutil
+
+    per_point = 8 * (3 + 3 * (1, 3, 6)[derivatives])  # face, u, v and P (Pu, Pv; Puu, Puv, Pvv)
+    need = n * per_point
+    if shards:
+        folder = Path(out_path)
+        while not folder.exists() and folder != folder.parent:
+            folder = folder.parent
+        have, where = shutil.disk_usage(folder).free, f"the free space of {folder}"
+        hint = "free some space or write elsewhere"
+    else:
+        try:
+            have = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+        except (ValueError, OSError, AttributeError):
+            return
+        where, hint = "this machine's memory", "write shards with --out FOLDER/ (one .npz per --chunk points)"
+    if need > have:
+        raise CCProofError(f"{what}the result takes {_size(need)} ({per_point} bytes per point), more than {where} "
+                           f"({_size(have)}); {hint}, or evaluate fewer points")
+
+
+def _size(b):
+    for unit in ("bytes", "kB", "MB", "GB", "TB", "PB"):
+        if b < 1000 or unit == "PB":
+            return f"{b:.0f} {unit}" if unit == "bytes" else f"{b:.3g} {unit}"
+        b /= 1000
+
+
 def run(args) -> int:
     from pathlib import Path
 
-    from ccproof.cli._output import PLOT_SUFFIXES, atomic, check_file, check_folder, is_folder_request
+    from ccproof.cli._output import PLOT_SUFFIXES, OutputPlan, atomic, is_folder_request
 
-    # every output checked before any work (even the imports); absolute paths (a Dask worker may run elsewhere)
+    # every output checked before any work (even the imports), distinct from the inputs (--points FOLDER may
+    # not be the --out folder); absolute paths (a Dask worker may run elsewhere)
+    plan = OutputPlan()
+    plan.add_input("MESH", args.mesh)
+    plan.add_input("--points", args.points)
     shards = is_folder_request(args.out)
-    out_path = check_folder(args.out) if shards else check_file(args.out, (".npz",), hint="(or FOLDER/ for shards)")
+    out_path = plan.add_folder("--out", args.out) if shards else \
+        plan.add("--out", args.out, (".npz",), hint="(or FOLDER/ for shards)")
     if args.plot:
-        check_file(args.plot, PLOT_SUFFIXES, "--plot")
+        plan.add("--plot", args.plot, PLOT_SUFFIXES)
+    plan.check()
     if args.alpha is not None and args.parameterization != "vanishing":
         raise CCProofError(f"--alpha is the exponent of --parameterization vanishing, not of {args.parameterization}")
     if args.threads is not None and args.threads < 1:
         raise CCProofError(f"--threads must be >= 1, got {args.threads}")
+    if args.seed < 0:  # numpy's generators take non-negative seeds (the tasks failed one by one after the setup)
+        raise CCProofError(f"--seed must be an integer >= 0, got {args.seed}")
 
     import numpy as np
 
@@ -115,6 +168,7 @@ def run(args) -> int:
     from ccproof.scale import evaluate_points, open_scheduler, point_chunks, scheduler_from_args, ship
 
     points = None if args.points is None else Path(args.points).resolve()
+    sched = scheduler_from_args(args)  # --scheduler checked before any work
     t0 = time.perf_counter()
     poly = read_mesh(args.mesh)  # OBJ with OpenSubdiv tags, OFF, or any meshio format
     tagged = not poly.is_plain_quads
@@ -140,15 +194,20 @@ def run(args) -> int:
         n_faces, kwargs = mesh.n_faces, {"parameterization": args.parameterization}
     # the points before the surface's setup (seconds on large meshes): a bad point is reported at once
     if points is not None and points.is_dir():
+        from ccproof.mesh.inputs import check_regular_file
+
+        check_regular_file(points / "index.json")  # (a link to /dev/zero refused before it is read)
         sources = point_chunks(args.chunk, shards=points)
     elif points is not None:
-        sources = point_chunks(args.chunk, arrays=_checked_points(args.points, n_faces, evaluable))
+        arrays = _checked_points(args.points, n_faces, evaluable)
+        check_result_size(arrays[0].size, args.derivatives, out_path, shards, f"{args.points}: ")
+        sources = point_chunks(args.chunk, arrays=arrays)
     else:
         if args.samples < 0:
             raise CCProofError(f"--samples must be >= 0, got {args.samples}")
+        check_result_size(args.samples, args.derivatives, out_path, shards, f"--samples {args.samples}: ")
         sources = point_chunks(args.chunk, samples=args.samples, seed=args.seed,
                                n_faces=n_faces if evaluable is None else evaluable)
-    sched = scheduler_from_args(args)
     from ccproof.cli._notice import compile_notice
 
     compile_notice("eval")  # after the input checks: an error stays one line

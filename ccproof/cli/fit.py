@@ -26,6 +26,12 @@ nearest data point; the area fraction farther than --stray-distance (default 3 d
 two-sided (Hausdorff) error. A warning (stderr) says when more than --stray-fraction of the surface
 strays (a torus' hole spanned, an unseen side filled in) or a level stopped at --max-steps.
 --errors FILE.csv writes x, y, z, distance and distance in % for every data point.
+
+Limits: input files (POINTS, --init) at most --max-input GB (default 2; regular files or a pipe);
+--sample-level at most 6. Outputs (--out, --surface-out or its derived name, --errors) are checked before
+any work: distinct from each other and from the inputs (other spellings and links included), writable,
+within the file system's name limits; they are renamed into place together when all are written, so a
+failure leaves none of them.
 """
 
 from __future__ import annotations
@@ -64,7 +70,8 @@ def add_arguments(p):
                    help="write the fitted limit surface sampled at --sample-level (.obj or any meshio format; "
                         "default OUT with _limit before the extension)")
     p.add_argument("--sample-level", type=int, default=None,
-                   help="subdivision level of the sampled limit surface (default: 1..3, >= 4 samples per point)")
+                   help="subdivision level of the sampled limit surface (default: 1..3, >= 4 samples per point; "
+                        "at most 6)")
     p.add_argument("--stray-distance", type=float, default=None,
                    help="surface samples farther than this (%% of the diameter) from every data point stray "
                         "(default 3 data spacings)")
@@ -76,9 +83,8 @@ def add_arguments(p):
 def run(args) -> int:
     from pathlib import Path
 
-    from ccproof.cli._output import atomic, check_outputs
-
-    check_outputs(args, out=(".obj",), surface_out="mesh", errors=(".csv",))  # before any work
+    _check_options(args)
+    plan = _output_plan(args)  # before any work
     import numpy as np
 
     from ccproof.apps.control_mesh import merge_labels, read_control_mesh, write_control_obj
@@ -131,22 +137,67 @@ def run(args) -> int:
     comment = (f"ccproof fit {Path(args.points).name}: {n_written} control vertices, max error "
                f"{res.max_error_percent:.3f} %, two-sided {res.two_sided_error_percent:.3f} % of the "
                f"enclosing-sphere diameter")
-    with atomic(args.out) as tmp:  # a non-manifold --init: the copies merged, the file's numbering
-        write_control_obj(tmp, res.mesh, comment=comment)
-    surf_out = args.surface_out
-    if surf_out is None:
-        o = Path(args.out)
-        surf_out = str(o.with_name(o.stem + "_limit" + (o.suffix or ".obj")))
-    with atomic(surf_out) as tmp:
-        _write_surface(tmp, res, comment)
-    print(f"wrote {args.out} (control mesh) and {surf_out} (limit surface at level {res.sample_level})")
+    with plan:  # all outputs or none
+        with plan.write(args.out) as tmp:  # a non-manifold --init: the copies merged, the file's numbering
+            write_control_obj(tmp, res.mesh, comment=comment)
+        with plan.write(args.surface_out) as tmp:
+            _write_surface(tmp, res, comment)
+        if args.errors:
+            d = res.data_distances
+            with plan.write(args.errors) as tmp:
+                np.savetxt(tmp, np.column_stack([X, d, 100 * d / res.diameter]), delimiter=",",
+                           header="x,y,z,distance,distance_percent_of_diameter", comments="", fmt="%.9g")
+    print(f"wrote {args.out} (control mesh) and {args.surface_out} (limit surface at level {res.sample_level})")
     if args.errors:
-        d = res.data_distances
-        with atomic(args.errors) as tmp:
-            np.savetxt(tmp, np.column_stack([X, d, 100 * d / res.diameter]), delimiter=",",
-                       header="x,y,z,distance,distance_percent_of_diameter", comments="", fmt="%.9g")
         print(f"wrote {args.errors} (per-point data -> surface distances)")
     return 0
+
+
+def _check_options(args):
+    """The options the library checks only later (or never: NaN compares false), before any work."""
+    from math import isfinite
+
+    from ccproof.errors import CCProofError
+
+    if args.max_steps < 1:
+        raise CCProofError(f"--max-steps must be >= 1, got {args.max_steps}")
+    if args.sample_level is not None and not 0 <= args.sample_level <= MAX_SAMPLE_LEVEL:
+        raise CCProofError(f"--sample-level must be 0..{MAX_SAMPLE_LEVEL} (each level has 4 times the samples), "
+                           f"got {args.sample_level}")
+    if not (isfinite(args.tol) and args.tol >= 0):
+        raise CCProofError(f"--tol must be a finite number >= 0, got {args.tol}")
+    if not 0 <= args.stray_fraction <= 1:  # NaN too
+        raise CCProofError(f"--stray-fraction must be in [0, 1], got {args.stray_fraction}")
+    if args.stray_distance is not None and not (isfinite(args.stray_distance) and args.stray_distance > 0):
+        raise CCProofError(f"--stray-distance must be a finite number > 0 (% of the diameter), got "
+                           f"{args.stray_distance}")
+
+
+#: the finest --sample-level (the 386-vertex model at level 6 is 1.6 million samples)
+MAX_SAMPLE_LEVEL = 6
+
+
+def _output_plan(args):
+    """Every file ``fit`` writes (the derived ``OUT_limit`` name too), checked together before any work."""
+    from pathlib import Path
+
+    from ccproof.cli._output import OutputPlan, meshio_suffixes
+
+    plan = OutputPlan()
+    plan.add_input("POINTS", args.points)
+    if args.init != "cube":
+        plan.add_input("--init", args.init)
+    plan.add("--out", args.out, (".obj",))
+    if args.surface_out is None:
+        o = Path(args.out)
+        args.surface_out = str(o.with_name(o.stem + "_limit" + (o.suffix or ".obj")))
+        plan.add("--surface-out (default: derived from --out)", args.surface_out, (".obj",))
+    else:
+        plan.add("--surface-out", args.surface_out, (".obj", *meshio_suffixes()))
+    if args.errors:
+        plan.add("--errors", args.errors, (".csv",))
+    plan.check()
+    return plan
 
 
 def _write_surface(path, res, comment):

@@ -13,6 +13,9 @@ Examples:
 
 from __future__ import annotations
 
+#: --prec range: below 2 bits arb has no numbers; above 4096 a certification takes minutes for nothing
+MIN_PREC, MAX_PREC = 2, 4096
+
 
 def add_arguments(parser):
     parser.add_argument("K", help="valence (integer >= 3)")
@@ -21,7 +24,8 @@ def add_arguments(parser):
     parser.add_argument("--domain", choices=("quadrant", "face"), default="quadrant",
                         help="'face': refuse points outside Phi([0,1]^2) (default: quadrant)")
     parser.add_argument("--rigorous", action="store_true", help="certify the preimage with arb")
-    parser.add_argument("--prec", type=int, default=128, help="arb precision in bits (--rigorous)")
+    parser.add_argument("--prec", type=int, default=128,
+                        help=f"arb precision in bits (--rigorous; default 128, {MIN_PREC}..{MAX_PREC})")
 
 
 def _number(text, name):
@@ -34,12 +38,14 @@ def _number(text, name):
 
 
 def run(args) -> int:
-    from ccproof.errors import check_valence
+    from ccproof.errors import CCProofError, check_valence
     from ccproof.inverse import characteristic_map, inverse_characteristic_map
     from ccproof.inverse.algorithm import PATCH_NAMES
 
     k = check_valence(args.K)
     u, v = _number(args.U, "U"), _number(args.V, "V")
+    if args.rigorous and not MIN_PREC <= args.prec <= MAX_PREC:
+        raise CCProofError(f"--prec must be {MIN_PREC}..{MAX_PREC} bits, got {args.prec}")
     res = inverse_characteristic_map(k, u, v, domain=args.domain, full_output=True,
                                      rigorous=args.rigorous, prec=args.prec)
     r, s = float(res.r), float(res.s)

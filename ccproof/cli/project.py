@@ -11,6 +11,10 @@ strings ('certified', 'ambiguous', 'uncertified'), distance_lo, distance_hi (n,)
 enclosure of the distance where certified) and parameter_radius (n,) (the nearest parameter
 lies within this max-norm radius of (u, v) in the same face, where certified).
 
+Limits (checked before any work): input files at most --max-input GB (default 2); the search structure,
+about 320 bytes per sample and (2 --cells + 1)^2 samples per face, at most --max-memory GB (default 2);
+--out may not replace an input.
+
 Example:
   ccproof project bunny.obj points.csv --out nearest.npz
 """
@@ -25,10 +29,38 @@ def add_arguments(parser):
     parser.add_argument("--out", metavar="FILE.npz", required=True, help="output file (numpy .npz)")
     parser.add_argument("--certify", action="store_true",
                         help="add interval-arithmetic verdicts (slow: per point; untagged all-quad meshes only)")
-    parser.add_argument("--cells", type=int, default=None, help="cells per face side of the search structure")
+    parser.add_argument("--cells", type=int, default=None,
+                        help="cells per face side of the search structure (default 8; its memory, about "
+                             f"{SAMPLE_BYTES} bytes per sample, (2 cells + 1)^2 samples per face, must fit "
+                             "--max-memory)")
+    parser.add_argument("--max-memory", type=float, default=2.0, metavar="GB",
+                        help="refuse a search structure whose estimated memory exceeds this (default 2 GB)")
     from ccproof.cli._progress import add_progress_argument
 
     add_progress_argument(parser)
+
+
+#: peak bytes per sample of the search structure (measured on the bunny, 2036 faces: 181 MB at --cells 8,
+#: 971 MB at 24, i.e. 200-310 bytes per sample: positions, derivatives, parameters, trees, cell bounds)
+SAMPLE_BYTES = 320
+
+
+def check_search_memory(n_faces, cells, max_memory_gb):
+    """Refuse, before any work, a search structure above ``--max-memory`` (the figure and the options named).
+
+    >>> check_search_memory(2036, 100000, 2.0)
+    Traceback (most recent call last):
+    ...
+    ccproof.errors.CCProofError: --cells 100000: the search structure of 2036 faces needs about 2.61e+07 GB, ...
+    """
+    from ccproof.errors import CCProofError
+
+    if not (max_memory_gb > 0 and max_memory_gb < float("inf")):
+        raise CCProofError(f"--max-memory must be a positive number of GB, got {max_memory_gb}")
+    need = n_faces * (2 * cells + 1) ** 2 * SAMPLE_BYTES / 1e9
+    if need > max_memory_gb:
+        raise CCProofError(f"--cells {cells}: the search structure of {n_faces} faces needs about {need:.3g} GB, "
+                           f"above --max-memory {max_memory_gb:g} GB; lower --cells or raise --max-memory")
 
 
 #: points per progress step of the float search (the certified mode steps point by point)
@@ -45,9 +77,13 @@ def read_xyz_csv(path):
 def run(args):
     import time
 
-    from ccproof.cli._output import atomic, check_file
+    from ccproof.cli._output import OutputPlan, atomic
 
-    out_path = check_file(args.out, (".npz",))  # before any work (even the imports)
+    plan = OutputPlan()  # before any work (even the imports)
+    plan.add_input("MESH", args.mesh)
+    plan.add_input("POINTS", args.points)
+    out_path = plan.add("--out", args.out, (".npz",))
+    plan.check()
     import numpy as np
 
     from ccproof.cli._progress import progress_enabled
@@ -64,6 +100,8 @@ def run(args):
         raise CCProofError(f"{args.points}: {exc} (point i is on line i + 2)") from None
     if args.cells is not None and args.cells < 1:
         raise CCProofError(f"--cells must be >= 1, got {args.cells}")
+    if not (args.max_memory > 0 and args.max_memory < float("inf")):
+        raise CCProofError(f"--max-memory must be a positive number of GB, got {args.max_memory}")
     from ccproof.cli._eval_args import evaluable_ptex_faces
     from ccproof.mesh.io import read_mesh
 
@@ -74,6 +112,8 @@ def run(args):
     evaluable = evaluable_ptex_faces(poly)  # holes (tagged, or boundary mode none) have no surface
     if evaluable is not None and evaluable.size == 0:
         raise CCProofError(f"{args.mesh}: every face is a hole: there is no limit surface to project onto")
+    n_search = poly.n_ptex if evaluable is None else evaluable.size
+    check_search_memory(n_search, CELLS if args.cells is None else args.cells, args.max_memory)  # before the setup
     S = limit_surface(poly.to_quad_mesh() if poly.is_plain_quads else poly, progress=progress)  # a bar if long
     from ccproof.cli._notice import compile_notice
 

@@ -16,7 +16,8 @@ def add_arguments(p):
     p.add_argument("valence", nargs="?", help="valence K >= 3, or '>=K0' for the interval table")
     p.add_argument("--all", action="store_true", help="regenerate every table (k = 3..100 and k >= 40)")
     p.add_argument("--kmax", type=int, default=100, help="largest valence with --all (default 100)")
-    p.add_argument("--jobs", type=int, default=2, help="worker processes with --all (default 2)")
+    p.add_argument("--jobs", type=int, default=2, help="worker processes with --all (default 2; >= 1, at most "
+                   "the cores of this machine and the number of tables)")
     p.add_argument("--dir", default=None, help="tables folder for --all (default: certificates/tables of the "
                    "checkout, or the user folder of an installed package, never site-packages)")
     p.add_argument("--json", action="store_true", help="print the raw JSON instead of a summary")
@@ -71,21 +72,21 @@ def run(args):
     if args.all:
         if args.kmax < 3:
             raise CCProofError(f"--kmax must be >= 3 (the smallest valence), got {args.kmax}")
-        if args.jobs < 1:
-            raise CCProofError(f"--jobs must be >= 1, got {args.jobs}")
         from tqdm import tqdm
 
         from ccproof.cli._output import check_folder
         from ccproof.cli._progress import progress_enabled
+        from ccproof.scale.engine import check_jobs
         from ccproof.tables.build import DEFAULT_INTERVAL_K0
         from ccproof.tables.format import output_dir
 
         ks = [Valence(k) for k in range(3, args.kmax + 1)] + [Valence(DEFAULT_INTERVAL_K0, interval=True)]
         args.dir = str(check_folder(args.dir or str(output_dir() / "tables"), "--dir"))  # before any work
         work = [(k, args.dir) for k in ks]
+        jobs = check_jobs(args.jobs, tasks=len(work))  # as every command: >= 1, at most the cores and the tasks
         from ccproof.scale.engine import process_pool
 
-        with process_pool(args.jobs) as ex:  # Ctrl-C: one line, the workers stopped
+        with process_pool(jobs) as ex:  # Ctrl-C: one line, the workers stopped
             for _ in tqdm(ex.map(_build_one, work), total=len(work), desc="tables", unit="table",
                           disable=not progress_enabled(args)):
                 pass

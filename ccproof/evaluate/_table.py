@@ -37,6 +37,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ccproof.errors import MeshError
+from ccproof.evaluate import _diskcache
 from ccproof.evaluate.local import (
     _CENTER,
     _SIDES,
@@ -326,43 +327,47 @@ def _template_bytes(t):
     n_cor, len(json)]``, then per virtual face ``kind``, ``dom`` (3), ``child`` (4), ``leaf``,
     ``pts``, ``cfg``, ``corner`` (2), then ``cor_vertex`` (n_cor), ``R`` (17 n_reg, N), ``Q``
     (n_pts, N), ``O`` (n_cor, N) (integers are exact in float64), then the JSON of the corner keys
-    and orientations of its configurations, then the SHA-256 of all that (32 bytes)."""
-    import hashlib
+    and orientations of its configurations (the file seals these bytes, :mod:`._diskcache`)."""
     import json
 
     V, N = len(t.kind), t.n
     js = json.dumps(t.schemes).encode()
     ints = np.array([t.kind, t.leaf, t.pts, t.cfg], dtype=np.float64).reshape(4, V)
-    body = np.concatenate([
+    return np.concatenate([
         [_TPL_MAGIC, N, t.n_pts, V, t.R.shape[0] // 17, t.O.shape[0], len(js)],
         np.array(t.dom, dtype=np.float64).reshape(-1), np.array(t.child, dtype=np.float64).reshape(-1),
         ints.reshape(-1), np.array(t.corner, dtype=np.float64).reshape(-1),
         np.array(t.cor_vertex, dtype=np.float64), t.R.reshape(-1), t.Q.reshape(-1), t.O.reshape(-1),
     ]).astype("<f8").tobytes() + js
-    return body + hashlib.sha256(body).digest()
 
 
 def _tuples(x):
     return tuple(_tuples(y) for y in x) if isinstance(x, list) else x
 
 
-def _read_template(path):
-    """The template stored at ``path`` (:func:`_template_bytes`); ValueError unless the file holds
-    exactly what was written (digest, magic, sizes)."""
-    import hashlib
+def _read_template(path, name):
+    """The template stored at ``path`` for the cache name ``name`` (:func:`_template_bytes`, sealed by
+    :func:`ccproof.evaluate._diskcache.seal`); ValueError unless the file holds exactly what was
+    written for that name (digest of name and content, magic, sizes)."""
+    try:
+        return _parse_template(_diskcache.unseal(path.read_bytes(), name))
+    except ValueError as e:
+        raise ValueError(f"{path}: {e}") from None
+
+
+def _parse_template(body):
     import json
 
-    b = path.read_bytes()
-    body, digest = b[:-32], b[-32:]
-    if len(b) < 32 + 56 or hashlib.sha256(body).digest() != digest:
-        raise ValueError(f"{path}: digest mismatch")
+    body = bytes(body)
+    if len(body) < 56:
+        raise ValueError("too short for a template file")
     head = np.frombuffer(body, dtype="<f8", count=7)
-    if head[0] != _TPL_MAGIC:
-        raise ValueError(f"{path}: not a template file")
+    if head[0] != _TPL_MAGIC or not all(0 <= x < 2**40 and x == int(x) for x in head[1:]):
+        raise ValueError("not a template file")
     N, n_pts, V, n_reg, n_cor, n_js = (int(x) for x in head[1:])
     n = 7 + 13 * V + n_cor + (17 * n_reg + n_pts + n_cor) * N
     if len(body) != 8 * n + n_js:
-        raise ValueError(f"{path}: sizes do not match its header")
+        raise ValueError("sizes do not match its header")
     z = np.frombuffer(body, dtype="<f8", count=n)
     o = 7
 
@@ -391,31 +396,24 @@ def _cached_template(tkey, depth_semi, make):
     :func:`ccproof.evaluate.local.corner_scheme` (same folder, ``CCPROOF_CACHE``).
 
     One file per template, ``SHA-256(key, depth_semi, sources).tpl`` (:func:`_template_bytes`: the
-    virtual faces, the leaf operators ``R``, ``Q``, ``O``, the corner keys of its configurations,
-    and the SHA-256 of all of it, checked on read with the header's sizes); a missing, unreadable or
-    corrupt file is rebuilt (exact local refinement) and rewritten atomically. A cached template is
-    the built one bit for bit; with every file present a setup does no exact local step.
+    virtual faces, the leaf operators ``R``, ``Q``, ``O``, the corner keys of its configurations),
+    sealed by the SHA-256 of its name and content (:mod:`ccproof.evaluate._diskcache`), checked on
+    read with the header's sizes; a missing, unreadable or corrupt file is rebuilt (exact local
+    refinement, from corner schemes that were themselves verified) and rewritten atomically, a
+    corrupt one reported once. A cached template is the built one bit for bit; with every file
+    present a setup does no exact local step.
     """
     import hashlib
-    import os
 
     d = _cache_dir()
     if d is None:
         return _finished(make())
     name = hashlib.sha256(f"template|{_template_version()}|{depth_semi}|{tkey!r}".encode()).hexdigest()
-    path = d / f"{name}.tpl"
-    try:
-        return _read_template(path)
-    except (OSError, ValueError, UnicodeDecodeError):  # missing or corrupt: rebuilt
-        pass
+    t = _diskcache.read_entry(d / f"{name}.tpl", name, _parse_template)
+    if t is not None:
+        return t
     t = _finished(make())
-    try:
-        d.mkdir(parents=True, exist_ok=True)
-        tmp = d / f".{name}.{os.getpid()}.tpl"
-        tmp.write_bytes(_template_bytes(t))
-        os.replace(tmp, path)
-    except OSError:
-        pass
+    _diskcache.store(d, name, ".tpl", _template_bytes(t))
     return t
 
 
@@ -1153,7 +1151,8 @@ def job_floats(groups, X, sizes, progress=None):
     bar.close()
     for name, a in (("nets", nets), ("origin", origin), ("ring", ring)):
         if not np.isfinite(a).all():
-            raise MeshError(f"internal error: non-finite {name} in the patch table (a non-finite control point?)")
+            raise MeshError(f"non-finite {name} in the patch table: a control point beyond about 1e150 in magnitude "
+                            "(the differences overflow; scale the mesh) or a non-finite one")
     return nets, origin, ring
 
 

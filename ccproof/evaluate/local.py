@@ -30,6 +30,7 @@ import math
 import numpy as np
 
 from ccproof.errors import MeshError
+from ccproof.evaluate import _diskcache
 from ccproof.mesh.rules import CORNER, CREASE, SMOOTH, Complex, Options, refine_complex, to_float, vertex_rule
 
 __all__ = [
@@ -685,7 +686,7 @@ def power_layers(M, A, l_row):
     raise MeshError(f"corner configuration of {N} vertices does not converge to its limit point")
 
 
-_SOURCES = ("evaluate/local.py", "mesh/rules.py", "rule_weights.py")  # the code that computes the cached data
+_SOURCES = ("evaluate/local.py", "evaluate/_diskcache.py", "mesh/rules.py", "rule_weights.py")  # what computes the data
 
 
 @functools.lru_cache(maxsize=1)
@@ -701,14 +702,7 @@ def _code_version():
     return h.hexdigest()[:16]
 
 
-def _cache_dir():
-    import os
-    from pathlib import Path
-
-    d = os.environ.get("CCPROOF_CACHE")
-    if d is not None and d.strip().lower() in ("", "0", "off", "none", "no"):
-        return None
-    return Path(d) if d else Path.home() / ".cache" / "ccproof" / "corner_schemes"
+_cache_dir = _diskcache.cache_dir
 
 
 def _cached_scheme(kind, key, compute):
@@ -718,61 +712,73 @@ def _cached_scheme(kind, key, compute):
     ``CCPROOF_CACHE`` = another folder, or ``off``) holds two files per configuration, named by
     the SHA-256 of the configuration key and of the sources that compute it: ``.f64``, one raw
     little-endian float64 vector ``[N, n_layers, n_support, limit mask (N), support, layers]``
-    (read at setup; no header to parse), and
-    ``.A.npz``, the exact matrix ``A`` (integer numerators as decimal strings and one denominator,
-    read only when the tangent masks need it). A cached scheme is the computed one bit for bit.
-    Unreadable or unwritable cache files are ignored (the data are then computed).
+    (read at setup), and ``.A``, the exact matrix ``A`` (its denominator and integer numerators in
+    decimal, read only when the tangent masks need it). Both are sealed
+    (:mod:`ccproof.evaluate._diskcache`: the SHA-256 of the name and the content follows the
+    content, checked before any use): a cached scheme is the computed one bit for bit, and a corrupt
+    file is reported once, recomputed and rewritten. Unreadable or unwritable cache files are
+    ignored (the data are then computed).
     """
     import hashlib
-    import os
 
     d = _cache_dir()
     if d is None:
         return compute()
     name = hashlib.sha256(f"{kind}|{_code_version()}|{key!r}".encode()).hexdigest()
-    path, apath = d / f"{name}.f64", d / f"{name}.A.npz"
-    if path.exists() and apath.exists():
-        try:
-            z = np.fromfile(path, dtype="<f8")
-            N, nl, ns = (int(x) for x in z[:3])
-            if z.size != 3 + N + ns + nl * 48 * N:
-                raise ValueError("truncated cache file")
-            mask = z[3:3 + N]  # views of the freshly read vector
-            sup = [int(i) for i in z[3 + N:3 + N + ns]]
-            layers = z[3 + N + ns:].reshape(nl, 3, 16, N)
-            # the exact A is only needed for the tangent masks: read and converted on first use
-            loader = functools.partial(_cached_exact_matrix, apath, N, compute)
-            return CornerScheme(N, loader, mask, layers, sup or None)
-        except (OSError, ValueError, KeyError):
-            pass
+    path, apath = d / f"{name}.f64", d / f"{name}.A"
+    sch = _diskcache.read_entry(path, name, functools.partial(_parse_scheme, apath=apath, name=name, compute=compute))
+    if sch is not None:
+        return sch
     sch = compute()
     if sch is None:
         return None
-    try:
-        d.mkdir(parents=True, exist_ok=True)
-        num, den = sch.A.numer_denom()
-        tmp = d / f".{name}.{os.getpid()}.A.npz"
-        np.savez(tmp, A_den=np.array(str(den)), A_num=np.array([str(x) for x in num.entries()]))
-        os.replace(tmp, apath)
-        sup = list(sch.support) if sch.support else []
-        head = np.array([sch.size, sch.n_layers, len(sup)] + sup, dtype=np.float64)
-        tmp = d / f".{name}.{os.getpid()}.f64"
-        np.concatenate([head[:3], sch.limit_mask, head[3:], sch.layers.reshape(-1)]).astype("<f8").tofile(tmp)
-        os.replace(tmp, path)
-    except OSError:
-        pass
+    num, den = sch.A.numer_denom()
+    _diskcache.store(d, name, ".A", _matrix_bytes(num, den))
+    sup = list(sch.support) if sch.support else []
+    head = np.array([sch.size, sch.n_layers, len(sup)] + sup, dtype=np.float64)
+    vec = np.concatenate([head[:3], sch.limit_mask, head[3:], sch.layers.reshape(-1)]).astype("<f8")
+    _diskcache.store(d, name, ".f64", vec.tobytes())
     return sch
 
 
-def _cached_exact_matrix(apath, N, compute):
-    """The exact ``A`` of a cached scheme from its ``.A.npz`` (recomputed if that file is gone)."""
+def _parse_scheme(body, apath, name, compute):
+    """The CornerScheme of a verified ``.f64`` body (ValueError if its sizes disagree)."""
+    z = np.frombuffer(bytearray(body), dtype="<f8")
+    if z.size < 3 or not all(0 <= x < 2**31 and x == int(x) for x in z[:3]):
+        raise ValueError("bad header")
+    N, nl, ns = (int(x) for x in z[:3])
+    if z.size != 3 + N + ns + nl * 48 * N:
+        raise ValueError("sizes do not match its header")
+    mask = z[3:3 + N]  # views of the freshly read vector
+    sup = [int(i) for i in z[3 + N:3 + N + ns]]
+    layers = z[3 + N + ns:].reshape(nl, 3, 16, N)
+    # the exact A is only needed for the tangent masks: read and converted on first use
+    loader = functools.partial(_cached_exact_matrix, apath, name, N, compute)
+    return CornerScheme(N, loader, mask, layers, sup or None)
+
+
+def _matrix_bytes(num, den):
+    """An exact matrix ``num / den`` as ASCII: the denominator, then the numerators row by row."""
+    return (str(den) + "\n" + " ".join(str(x) for x in num.entries()) + "\n").encode()
+
+
+def _cached_exact_matrix(apath, name, N, compute):
+    """The exact ``A`` of a cached scheme from its ``.A`` file (recomputed and rewritten if that file
+    is missing or corrupt)."""
     import flint  # imported where exact matrices are built: not on a filled disk cache
-    try:
-        with np.load(apath, allow_pickle=False) as z:
-            den = int(str(z["A_den"]))
-            return flint.fmpq_mat(N, N, [flint.fmpq(int(x), den) for x in z["A_num"].tolist()])
-    except (OSError, ValueError, KeyError):
-        return compute().A
+
+    def parse(body):
+        den, num = bytes(body).decode("ascii").split("\n", 1)
+        q, nums = int(den), num.split()
+        if len(nums) != N * N or q <= 0:
+            raise ValueError("sizes do not match the configuration")
+        return flint.fmpq_mat(N, N, [flint.fmpq(int(x), q) for x in nums])
+
+    A = _diskcache.read_entry(apath, name, parse)
+    if A is None:
+        A = compute().A
+        _diskcache.store(apath.parent, name, ".A", _matrix_bytes(*A.numer_denom()))
+    return A
 
 
 class CornerScheme:

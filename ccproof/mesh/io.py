@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ccproof.errors import MeshError
+from ccproof.mesh.inputs import check_polygon_sizes, checked_input
 from ccproof.mesh.quadmesh import QuadMesh
 
 if TYPE_CHECKING:
@@ -86,7 +87,7 @@ def _read_obj_arrays(path, tags=False):
     """
     from array import array
 
-    with open(os.fspath(path), encoding="utf-8", errors="replace") as fh:
+    with open(os.fspath(path), encoding="utf-8-sig", errors="replace") as fh:
         text = fh.read()
     verts, idx, sizes, lines = array("d"), array("q"), array("q"), array("q")
     nv = 0
@@ -284,7 +285,7 @@ def read_off_polygons(path):
     ((5, 3), [[0, 1, 2, 3], [1, 4, 2]], [9, 10])
     """
     p = os.fspath(path)
-    with open(p, encoding="utf-8", errors="replace") as fh:
+    with open(p, encoding="utf-8-sig", errors="replace") as fh:
         text = fh.read()
     rows = []
     for no, line in enumerate(text.splitlines(), start=1):
@@ -415,25 +416,51 @@ def read_mesh(path: str | os.PathLike[str]) -> PolyMesh:
     ccproof.errors.MeshError: .../cube.xyz: no such file
     >>> import shutil; shutil.rmtree(d)
     """
-    from ccproof.mesh.polymesh import PolyMesh
-
     p = os.fspath(path)
     if os.path.isdir(p):
         raise MeshError(f"{p}: is a folder, not a mesh file")
-    if not os.path.exists(p):
-        raise MeshError(f"{p}: no such file")
+    with checked_input(p, MeshError) as q:  # a regular file or a pipe, at most --max-input bytes
+        mesh = _read_mesh(p, q)
+    _check_magnitudes(mesh, p)
+    check_polygon_sizes(mesh.polygons, p, MeshError)
+    return mesh
+
+
+#: largest coordinate of a vertex a face uses (as for the points of ccproof project): beyond it the
+#: differences, derivatives and squared distances of the evaluators overflow
+MAX_COORDINATE = 1e150
+
+
+def _check_magnitudes(mesh: PolyMesh, p: str) -> None:
+    """MeshError naming the file and the first used vertex with a coordinate beyond :data:`MAX_COORDINATE`."""
+    V = np.asarray(mesh.vertices)
+    big = np.flatnonzero((np.abs(V) > MAX_COORDINATE).any(axis=1))
+    if big.size:
+        used = np.zeros(V.shape[0], dtype=bool)
+        used[np.concatenate([np.asarray(f, dtype=np.int64) for f in mesh.polygons])] = True
+        hit = big[used[big]]
+        if hit.size:
+            v = int(hit[0])
+            raise MeshError(f"{p}: vertex {v} (0-based) has coordinates {V[v].tolist()} beyond {MAX_COORDINATE:g} in "
+                            "magnitude: the surface's differences and derivatives would overflow; scale the mesh")
+
+
+def _read_mesh(p: str, q: str) -> PolyMesh:
+    """:func:`read_mesh` of the file ``p``, read from ``q`` (``p`` itself, or a pipe's copy)."""
+    from ccproof.mesh.polymesh import PolyMesh
+
     ext = os.path.splitext(p)[1].lower()
     if ext == ".obj":
-        return read_obj_tagged(p)
+        return read_obj_tagged(q)
     if ext == ".off":
-        V, polys, _ = read_off_polygons(p)
+        V, polys, _ = read_off_polygons(q)
         try:
             return PolyMesh(V, polys)
         except MeshError as exc:
             raise MeshError(f"{p}: {exc}") from None
     if ext == ".ply":
-        _check_ply_header(p)
-    mesh = _meshio_read(p, ext)
+        _check_ply_header(q)
+    mesh = _meshio_read(q, ext)
     polys = []
     for b, block in enumerate(mesh.cells):
         if block.type in ("triangle", "quad") or block.type.startswith("polygon"):
@@ -524,14 +551,15 @@ def read_obj(path: str | os.PathLike[str]) -> QuadMesh:
     ccproof.errors.MeshError: .../cube.obj: face 6 (line 16) has 3 vertices, not 4: ccproof needs an all-quad mesh
     >>> import shutil; shutil.rmtree(d)
     """
-    V, polys, lines = read_obj_polygons(path)
-    with open(os.fspath(path), encoding="utf-8", errors="replace") as fh:
-        for no, name, *_ in _parse_tags(path, fh.read()):
-            if name not in ("facevaryinginterpolateboundary", "facevaryingpropagatecorners"):
-                raise MeshError(
-                    f"{path}:{no}: OpenSubdiv tag {name!r}: a QuadMesh has no creases, corners, holes or "
-                    "boundary modes; read the file with read_mesh / read_obj_tagged (PolyMesh) instead"
-                )
+    with checked_input(path, MeshError) as q:  # a regular file or a pipe, at most --max-input bytes
+        V, polys, lines = read_obj_polygons(q)
+        with open(q, encoding="utf-8-sig", errors="replace") as fh:
+            for no, name, *_ in _parse_tags(path, fh.read()):
+                if name not in ("facevaryinginterpolateboundary", "facevaryingpropagatecorners"):
+                    raise MeshError(
+                        f"{path}:{no}: OpenSubdiv tag {name!r}: a QuadMesh has no creases, corners, holes or "
+                        "boundary modes; read the file with read_mesh / read_obj_tagged (PolyMesh) instead"
+                    )
     try:
         return QuadMesh.from_polygons(V, polys, lines=lines)
     except MeshError as exc:

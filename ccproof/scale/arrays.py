@@ -146,9 +146,26 @@ def _chunk_points(source):
     if kind == "arrays":
         return tuple(np.asarray(a) for a in source[1:])
     if kind == "shard":
-        with np.load(source[1]) as z:
-            return z["face"], z["u"], z["v"]
+        return _read_shard_points(source[1])
     raise CCProofError(f"unknown chunk source {kind!r}")
+
+
+def _read_shard_points(path):
+    """(face, u, v) of one shard file, a truncated or foreign file refused naming it."""
+    import zipfile
+
+    import numpy as np
+
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            face, u, v = z["face"], z["u"], z["v"]
+    except (zipfile.BadZipFile, EOFError, ValueError, KeyError, OSError) as exc:
+        why = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise CCProofError(f"{path}: not a readable shard of points face, u, v (truncated or another file?): "
+                           f"{why}") from None
+    if not face.shape == u.shape == v.shape or face.ndim != 1:
+        raise CCProofError(f"{path}: face, u, v of shapes {face.shape}, {u.shape}, {v.shape}: expected (n,) each")
+    return face, u, v
 
 
 def _evaluate_chunk(task, shipped):
@@ -156,7 +173,8 @@ def _evaluate_chunk(task, shipped):
 
     ``task`` is ``{"source": ("samples", seed, n_faces, count, index) | ("arrays", face, u, v) |
     ("shard", path), "derivatives": d, "kwargs": {...}, "out": path or None}``; returns the number of
-    points written, or the dict face, u, v, P, ... when ``out`` is None.
+    points written and :func:`degenerate_normals` of the shard, or the dict face, u, v, P, ... when ``out``
+    is None.
     """
     import numpy as np
 
@@ -167,7 +185,47 @@ def _evaluate_chunk(task, shipped):
     if task["out"] is None:
         return arrays
     _replace_when_written(task["out"], lambda tmp: np.savez(tmp, **arrays))
-    return int(f.size)
+    return int(f.size), degenerate_normals(arrays)
+
+
+class DegenerateNormalWarning(UserWarning):
+    """Evaluated points where ``Pu x Pv = 0``: the surface has no normal there (collapsed faces)."""
+
+
+#: ``|Pu x Pv| <= NORMAL_TOLERANCE |Pu| |Pv|`` counts as no normal (0 = 0 too: a vanishing derivative)
+NORMAL_TOLERANCE = 1e-12
+
+
+def degenerate_normals(arrays):
+    """(count, up to 6 faces) of the points of a result whose normal is undefined (``|Pu x Pv|`` at most
+    :data:`NORMAL_TOLERANCE` times ``|Pu| |Pv|``); (0, []) without derivatives.
+
+    >>> import numpy as np
+    >>> degenerate_normals({"face": np.array([3, 4]), "Pu": np.array([[1.0, 0, 0], [1.0, 0, 0]]),
+    ...                     "Pv": np.array([[0, 1.0, 0], [2.0, 0, 0]])})
+    (1, [4])
+    """
+    import numpy as np
+
+    if "Pu" not in arrays:
+        return 0, []
+    Pu, Pv = arrays["Pu"], arrays["Pv"]
+    c = np.linalg.norm(np.cross(Pu, Pv), axis=1)
+    bad = c <= NORMAL_TOLERANCE * np.linalg.norm(Pu, axis=1) * np.linalg.norm(Pv, axis=1)
+    faces = np.unique(np.asarray(arrays["face"])[bad])
+    return int(bad.sum()), [int(x) for x in faces[:6]]
+
+
+def _warn_degenerate(n, counts):
+    """One warning for the points without a normal (count, and the first faces), if any."""
+    import warnings
+
+    k = sum(c for c, _ in counts)
+    if k:
+        faces = sorted({f for _, fs in counts for f in fs})
+        warnings.warn(f"{k} of {n} points have no normal (|Pu x Pv| = 0: a collapsed or degenerate face there), "
+                      f"in faces {', '.join(map(str, faces[:5]))}{', ...' if len(faces) > 5 else ''}",
+                      DegenerateNormalWarning, stacklevel=3)
 
 
 def _replace_when_written(path, write):
@@ -178,7 +236,7 @@ def _replace_when_written(path, write):
     import uuid
 
     path = Path(path)
-    tmp = path.with_name(f".tmp-{uuid.uuid4().hex[:8]}-{path.name}")
+    tmp = path.with_name(f".tmp-{os.getpid()}-{uuid.uuid4().hex[:6]}-{path.name}")  # a dead writer's: removed later
     try:
         write(str(tmp))
         os.replace(tmp, path)
@@ -428,7 +486,10 @@ def evaluate_points(shipped, sources, derivatives, kwargs, out, scheduler=None, 
         arrays = {n: np.concatenate([r[n] for r in sweep.results]) for n in ("face", "u", "v", *names)}
         _replace_when_written(out, lambda tmp: np.savez(tmp, **arrays))
         n = int(arrays["face"].size)
+        counts = [degenerate_normals(arrays)]
     else:
-        _write_index(folder, sweep.results, ("face", "u", "v", *names))
-        n = int(sum(sweep.results))
+        _write_index(folder, [r[0] for r in sweep.results], ("face", "u", "v", *names))
+        n = int(sum(r[0] for r in sweep.results))
+        counts = [r[1] for r in sweep.results]
+    _warn_degenerate(n, counts)
     return n, names, sweep

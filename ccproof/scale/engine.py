@@ -103,6 +103,61 @@ class Scheduler:
         return self.address if self.kind == "address" else "serial"
 
 
+def usable_cores():
+    """The cores this process may run on (its CPU affinity where the system has one).
+
+    >>> usable_cores() >= 1
+    True
+    """
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except (AttributeError, OSError):
+        return max(1, os.cpu_count() or 1)
+
+
+def check_jobs(n, option="--jobs", tasks=None):
+    """The worker processes of ``option N``, validated the same way by every command.
+
+    Parameters
+    ----------
+    n : int
+    option : str
+        How the message names it (``--jobs``, ``--scheduler local:N``).
+    tasks : int, optional
+        The number of tasks, when known: more workers than tasks would idle.
+
+    Returns
+    -------
+    int
+        ``n``, capped at :func:`usable_cores` and at ``tasks`` (a warning says so when it caps).
+
+    Raises
+    ------
+    CCProofError
+        For ``n < 1`` (0 and -1 are not "the default").
+
+    Examples
+    --------
+    >>> check_jobs(1), check_jobs(1, tasks=1)
+    (1, 1)
+    >>> check_jobs(0)
+    Traceback (most recent call last):
+    ...
+    ccproof.errors.CCProofError: --jobs must be an integer >= 1 (1 runs in this process), got 0
+    """
+    import warnings
+
+    if isinstance(n, bool) or not isinstance(n, int) or n < 1:
+        raise CCProofError(f"{option} must be an integer >= 1 (1 runs in this process), got {n}")
+    cores = usable_cores()
+    cap = cores if tasks is None else max(1, min(cores, tasks))
+    if n > cap:
+        why = f"the {cores} cores of this machine" if cap == cores else f"the {tasks} tasks"
+        warnings.warn(f"{option} {n}: {cap} worker process{'es' if cap > 1 else ''} ({why})", stacklevel=2)
+        return cap
+    return n
+
+
 def parse_scheduler(spec=None, *, serial=False):
     """Parse ``"serial" | "local" | "local:N" | ADDRESS`` (None: "local", one worker per core).
 
@@ -149,9 +204,29 @@ def parse_scheduler(spec=None, *, serial=False):
             raise CCProofError(f"--scheduler: local:N needs an integer N >= 1, got {text!r}")
         return Scheduler("serial") if int(n) == 1 else Scheduler("local", workers=int(n))
     if "://" in text or ":" in text:
-        return Scheduler("address", address=text)
+        return Scheduler("address", address=_checked_address(text))
     raise CCProofError(f"--scheduler: expected serial, local, local:N or a scheduler address such as "
                        f"tcp://host:8786, got {text!r}")
+
+
+def _checked_address(text):
+    """A scheduler address ``[PROTOCOL://]HOST:PORT``, refused by name without a port (Dask would fail
+    later with a traceback of its own).
+
+    >>> _checked_address("tcp://h:8786")
+    'tcp://h:8786'
+    >>> _checked_address("tcp://localhost")
+    Traceback (most recent call last):
+    ...
+    ccproof.errors.CCProofError: --scheduler tcp://localhost: a scheduler address needs a port, as in tcp://localhost:8786
+    """
+    proto, sep, rest = text.rpartition("://")
+    host, colon, port = rest.rpartition(":")
+    if not colon or not host or not port.isdigit() or not 0 < int(port) < 65536:
+        base = rest if not colon else host or rest
+        raise CCProofError(f"--scheduler {text}: a scheduler address needs a port, as in "
+                           f"{proto + sep if sep else 'tcp://'}{base.strip(':') or 'host'}:8786")
+    return text
 
 
 def add_scheduler_arguments(p):
@@ -196,14 +271,24 @@ def scheduler_from_args(args):
     Examples
     --------
     >>> import argparse
-    >>> str(scheduler_from_args(argparse.Namespace(jobs=4))), str(scheduler_from_args(argparse.Namespace(serial=True)))
-    ('local:4', 'serial')
+    >>> str(scheduler_from_args(argparse.Namespace(jobs=1))), str(scheduler_from_args(argparse.Namespace(serial=True)))
+    ('serial', 'serial')
+    >>> scheduler_from_args(argparse.Namespace(jobs=-1))
+    Traceback (most recent call last):
+    ...
+    ccproof.errors.CCProofError: --jobs must be an integer >= 1 (1 runs in this process), got -1
     """
     spec = getattr(args, "scheduler", None)
     jobs = getattr(args, "jobs", None)
-    if spec is None and jobs is not None:
-        spec = f"local:{int(jobs)}" if int(jobs) >= 1 else None
-    return parse_scheduler(spec, serial=bool(getattr(args, "serial", False)))
+    s = parse_scheduler(spec, serial=bool(getattr(args, "serial", False)))
+    if spec is not None and s.kind == "local" and not s.implicit:  # local:N: the same check as --jobs
+        n = check_jobs(s.workers, f"--scheduler {spec}")
+        s = Scheduler("local", workers=n) if n > 1 else Scheduler("serial")
+    if jobs is not None:
+        jobs = check_jobs(jobs)
+        if spec is None and not s.kind == "serial":
+            s = parse_scheduler(f"local:{jobs}")
+    return s
 
 
 @contextlib.contextmanager
@@ -224,10 +309,51 @@ def _sigint_ignored():
         signal.signal(signal.SIGINT, previous)
 
 
-def _ignore_sigint():  # initializer of the worker processes of process_pool
+@contextlib.contextmanager
+def _signals_deferred():
+    """While a cluster starts: SIGINT ignored (:func:`_sigint_ignored`: the worker processes inherit that, so
+    a Ctrl-C sent to the whole process group reaches only this process later on), SIGTERM recorded and
+    raised when the block ends (no traceback from inside the cluster's start-up; the caller closes the
+    half-started cluster). A Ctrl-C during the start itself is still lost: ignoring it is what keeps it from
+    the workers, which inherit the disposition (a blocked mask would not reach them, nor stop other threads)."""
     import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    got = []
+    previous = signal.signal(signal.SIGTERM, lambda signum, frame: got.append(signum))
+    try:
+        with _sigint_ignored():
+            yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+        if got and callable(previous):
+            previous(signal.SIGTERM, None)  # the command's handler raises (one line, exit 143)
+        elif got and previous == signal.SIG_DFL:
+            os.kill(os.getpid(), signal.SIGTERM)
+
+
+#: seconds between a pool worker's checks that the process that started it is alive
+PARENT_POLL_SECONDS = 0.5
+
+
+def _ignore_sigint(parent=None):  # initializer of the worker processes of process_pool
+    """Ignore Ctrl-C (left to the parent) and end this worker when ``parent`` is gone (killed by SIGKILL: no
+    process of ours outlives its parent, and the resource tracker ends with the last worker)."""
+    import signal
+    import threading
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if parent is not None:
+        threading.Thread(target=_exit_with, args=(parent,), daemon=True, name="ccproof-parent-watch").start()
+
+
+def _exit_with(parent):
+    while os.getppid() == parent:
+        time.sleep(PARENT_POLL_SECONDS)
+    os._exit(1)  # reparented: the parent died without stopping us
 
 
 @contextlib.contextmanager
@@ -259,7 +385,7 @@ def process_pool(workers, context="spawn"):
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor
 
-    ex = ProcessPoolExecutor(max_workers=workers, initializer=_ignore_sigint,
+    ex = ProcessPoolExecutor(max_workers=workers, initializer=_ignore_sigint, initargs=(os.getpid(),),
                              mp_context=multiprocessing.get_context(context))
     try:
         yield ex
@@ -318,16 +444,31 @@ def client_for(scheduler):
     if s.kind == "local":
         import logging
 
-        with _sigint_ignored():  # the workers leave Ctrl-C to this process, which stops them on exit
-            cluster = LocalCluster(n_workers=s.workers, threads_per_worker=1, processes=True,
-                                   dashboard_address=None, silence_logs=logging.ERROR)
-        with cluster, Client(cluster) as client:
+        cluster = client = None
+        try:
+            with _signals_deferred():  # the workers leave Ctrl-C to this process; one arriving now is raised after
+                cluster = LocalCluster(n_workers=s.workers, threads_per_worker=1, processes=True,
+                                       dashboard_address=None, silence_logs=logging.ERROR)
+                client = Client(cluster)
+        except BaseException:  # a Ctrl-C or SIGTERM during the start: the cluster stopped, then one line
+            for part in (client, cluster):
+                if part is not None:
+                    part.close()
+            raise
+        with cluster, client:
             yield client
     elif s.kind == "address":
         with Client(s.address, timeout="30s") as client:
             yield client
     else:
         raise CCProofError("client_for needs a local or address scheduler, not 'serial'")
+
+
+def _capped(s, n_tasks):
+    """A local scheduler with no more workers than tasks (None: unknown)."""
+    if s.kind == "local" and n_tasks is not None and s.workers is not None and s.workers > max(n_tasks, 1):
+        return Scheduler("local", workers=max(n_tasks, 1), implicit=s.implicit)
+    return s
 
 
 @contextlib.contextmanager
@@ -356,7 +497,7 @@ def open_scheduler(scheduler=None, n_tasks=None):
     if scheduler.__class__.__name__ == "Client":
         yield scheduler
         return
-    s = parse_scheduler(scheduler)
+    s = _capped(parse_scheduler(scheduler), n_tasks)
     if s.kind == "serial" or s.kind == "local" and n_tasks is not None and n_tasks <= 1 or (
             s.implicit and not dask_available()):
         yield Scheduler("serial")
@@ -519,7 +660,7 @@ def run_tasks(fn, tasks, scheduler=None, *, shared=(), retries=2, deterministic=
     [6, 24, 120]
     """
     tasks = list(tasks)
-    s = scheduler if scheduler.__class__.__name__ == "Client" else parse_scheduler(scheduler)
+    s = scheduler if scheduler.__class__.__name__ == "Client" else _capped(parse_scheduler(scheduler), len(tasks))
     if isinstance(s, Scheduler) and (s.kind == "local" and len(tasks) <= 1
                                      or s.implicit and not dask_available()):
         s = Scheduler("serial")

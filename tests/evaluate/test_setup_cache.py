@@ -15,7 +15,7 @@ import sys
 import numpy as np
 import pytest
 
-from ccproof.evaluate import _table, local
+from ccproof.evaluate import _diskcache, _table, local
 from ccproof.evaluate.surface import natural_limit_surface
 from ccproof.mesh.io import read_mesh
 
@@ -115,22 +115,25 @@ def test_corrupt_template_file_is_detected_and_rebuilt(refdir, tmp_path, monkeyp
     b[len(b) // 2] ^= 0x10
     files[0].write_bytes(bytes(b))
     with pytest.raises(ValueError, match="digest"):
-        _table._read_template(files[0])
+        _table._read_template(files[0], files[0].stem)
     # 1b. a file whose digest matches but whose header does not (one value appended): caught by the sizes
     body = files[3].read_bytes()[:-32]
     n_js = int(np.frombuffer(body, dtype="<f8", count=7)[6])
     body = body[:len(body) - n_js] + bytes(8) + body[len(body) - n_js:]
-    files[3].write_bytes(body + hashlib.sha256(body).digest())
+    name = files[3].stem
+    files[3].write_bytes(body + hashlib.sha256(name.encode() + b"\0" + body).digest())
     with pytest.raises(ValueError, match="sizes"):
-        _table._read_template(files[3])
+        _table._read_template(files[3], name)
     # 2. a truncated file; 3. garbage
     files[1].write_bytes(files[1].read_bytes()[:100])
     files[2].write_bytes(b"not a template")
-    T2, n2 = _tables(mesh)
+    monkeypatch.setattr(_diskcache, "_reported", [])  # reported once per process: this test's
+    with pytest.warns(UserWarning, match="corrupt"):
+        T2, n2 = _tables(mesh)
     assert n2 > 0  # rebuilt with the exact steps
     _same(T0, T2)
     for f in files[:4]:  # rewritten, and now read back
-        _table._read_template(f)
+        _table._read_template(f, f.stem)
     T3, n3 = _tables(mesh)
     assert n3 == 0
     _same(T0, T3)

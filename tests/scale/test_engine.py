@@ -61,7 +61,9 @@ def test_local_workers_without_dask_are_processes(monkeypatch, tmp_path):
     assert "t3: FAILED: CCProofError: bad task 3" in lines
 
 
-def test_cli_scheduler_options():
+def test_cli_scheduler_options(monkeypatch):
+    monkeypatch.setattr(engine, "usable_cores", lambda: 8)  # --jobs is capped at the cores (tests/scale/test_jobs.py)
+
     class A:
         scheduler, serial, jobs = None, False, 3
 

@@ -97,14 +97,16 @@ def read_labels(path, n_faces=None):
     ...
     ccproof.apps.arap.charts.ChartError: ...
     """
+    from ccproof.mesh.inputs import read_input_text
+
     vals = []
-    with open(os.fspath(path), encoding="utf-8") as fh:
-        for no, line in enumerate(fh, start=1):
-            for tok in line.split("#", 1)[0].split():
-                try:
-                    vals.append(int(tok))
-                except ValueError:
-                    raise ChartError(f"{path}:{no}: chart label {tok!r} is not an integer") from None
+    text = read_input_text(path, ChartError, "one integer label per face")  # at most --max-input bytes
+    for no, line in enumerate(text.splitlines(), start=1):
+        for tok in line.split("#", 1)[0].split():
+            try:
+                vals.append(int(tok))
+            except ValueError:
+                raise ChartError(f"{path}:{no}: chart label {tok!r} is not an integer") from None
     labels = np.array(vals, dtype=np.int64)
     if n_faces is not None and labels.size != n_faces:
         raise ChartError(f"{path}: {labels.size} chart labels for a mesh of {n_faces} faces (need one per face)")

@@ -188,13 +188,19 @@ def read_points(path):
     >>> read_points(p).tolist()
     [[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]]
     """
+    from ccproof.mesh.inputs import checked_input
+
     path = Path(path)
-    if not path.exists():
-        raise CCProofError(f"{path}: no such file")
+    with checked_input(path) as q:  # a regular file or a pipe, at most --max-input bytes
+        return check_points(_read_points(path, Path(q)), f"point cloud {path.name}")
+
+
+def _read_points(path, q):
+    """The points of the file ``path``, read from ``q`` (``path`` itself, or a pipe's copy)."""
     ext = path.suffix.lower()
     if ext in (".xyz", ".txt", ".pts"):
         rows = []
-        for ln, line in enumerate(path.read_text().splitlines(), 1):
+        for ln, line in enumerate(_text(path, q).splitlines(), 1):
             s = line.split("#", 1)[0].replace(",", " ").split()
             if not s:
                 continue
@@ -207,23 +213,25 @@ def read_points(path):
         X = np.array(rows, dtype=np.float64).reshape(-1, 3)
     elif ext == ".obj":
         rows = []
-        for ln, line in enumerate(path.read_text().splitlines(), 1):
+        for ln, line in enumerate(_text(path, q).splitlines(), 1):
             s = line.split()
             if s and s[0] == "v":
                 try:
+                    if len(s) < 4:
+                        raise ValueError
                     rows.append([float(x) for x in s[1:4]])
                 except ValueError:
-                    raise CCProofError(f"{path}:{ln}: bad vertex line {line!r}") from None
+                    raise CCProofError(f"{path}:{ln}: bad vertex line {line!r} (needs 'v x y z')") from None
         X = np.array(rows, dtype=np.float64).reshape(-1, 3)
     elif ext == ".ply":
-        X = _read_ply(path)
+        X = _read_ply(path, q)
     else:  # any other mesh format: its vertices (the mesh reader of ccproof eval)
         from ccproof.mesh.io import read_mesh
 
-        if path.stat().st_size == 0:
+        if q.stat().st_size == 0:
             raise CCProofError(f"{path}: empty file (no points)")
-        X = np.asarray(read_mesh(path).vertices, dtype=np.float64)
-    return check_points(X, f"point cloud {path.name}")
+        X = np.asarray(read_mesh(q).vertices, dtype=np.float64)
+    return X
 
 
 _PLY_TYPES = {"char": "i1", "uchar": "u1", "short": "i2", "ushort": "u2", "int": "i4", "uint": "u4",
@@ -231,8 +239,15 @@ _PLY_TYPES = {"char": "i1", "uchar": "u1", "short": "i2", "ushort": "u2", "int":
               "int32": "i4", "uint32": "u4", "float32": "f4", "float64": "f8"}
 
 
-def _read_ply(path):
-    data = path.read_bytes()
+def _text(path, q):
+    """The text of a points file (UTF-8, a byte-order mark dropped); a binary file refused by name."""
+    from ccproof.mesh.inputs import decode_text
+
+    return decode_text(q.read_bytes(), path, expect=f"{path.suffix} holds lines of numbers x y z")
+
+
+def _read_ply(path, q):
+    data = q.read_bytes()
     end = data.find(b"end_header")
     if not data.startswith(b"ply") or end < 0:
         raise CCProofError(f"{path}: not a PLY file")

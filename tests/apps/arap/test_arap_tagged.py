@@ -176,8 +176,13 @@ def test_arap_command_on_tagged_meshes(refdir, tmp_path, capsys, name):
     points, uv, cells = read_surface(out)
     assert np.isfinite(points).all() and np.isfinite(uv).all() and cells.size
     assert uv.min() >= -1e-12 and uv.max() <= 1 + 1e-12
-    flat = json.dumps(json.loads((tmp_path / "uv.obj.json").read_text()))
+    info = json.loads((tmp_path / "uv.obj.json").read_text())
+    flat = json.dumps(info)
     assert "NaN" not in flat and "Infinity" not in flat
+    # quality is never silent: at this explicit --refine 0 the creased cube folds; each fold is on stderr
+    flips, folds = info["table"]["c"]["flips_eval"], info["folds"]
+    assert (f"{flips} flipped samples at level 3" in cap.err) == (flips > 0), cap.err
+    assert (f"{folds} of {cells.shape[0]} triangles are folded in UV" in cap.err) == (folds > 0), cap.err
     # the written points are limit points of the file's surface: every corner limit of the file's faces is
     # among them (charts cover every face; level 1 keeps the level-0 corners)
     poly = read_mesh(refdir / name)
