@@ -21,6 +21,9 @@ EXACT_ATTRS = {"nvars", "shape", "box", "MAX_VARS", "ncols"}
 
 #: (file, source text of the node) -> why its meaning on balls is the intended one
 REVIEWED = {
+    ("registry.py", 'fam != "smooth"'): "str (family names)",
+    ("registry.py", "schema != TAGGED_SCHEMA"): "str (schema names)",
+    ("registry.py", "st != st_t"): "str (statements)",
     ("dart_curves.py", "not z < L + 2"): "refuses unless |omega s| < L + 2 certainly: conservative",
     ("dart_regularity.py", "not z < L + 2"): "refuses unless |omega s| < L + 2 certainly: conservative",
     ("dart_eigen.py", "B1.charpoly() != p"): "fmpq_poly (exact)",
