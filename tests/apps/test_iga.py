@@ -167,3 +167,20 @@ def test_errors_name_the_problem(surfaces):
         study_mesh("sphere")
     with pytest.raises(CCProofError, match="order and depth must be >= 1"):
         surface_quadrature(surfaces["cube"], order=0)
+
+
+def test_dynamic_surface_rows_agree_with_limit_surface_basis():
+    """Two implementations of the same rows: the qmv98 model's (its special elements' own eigen
+    decomposition, ccproof.apps.dynamics) and LimitSurface.basis (the patch table's operators)."""
+    from ccproof.apps.dynamics.meshes import paper_initial_model
+    from ccproof.apps.dynamics.model import DynamicSurface
+    from ccproof.evaluate import natural_limit_surface
+
+    m = paper_initial_model()
+    rng = np.random.default_rng(0)
+    n = 2000
+    f, u, v = rng.integers(0, m.n_faces, n), rng.random(n), rng.random(n)
+    u[:100], v[:100] = 10.0 ** -rng.uniform(1, 12, 100), 10.0 ** -rng.uniform(1, 12, 100)
+    A, B = DynamicSurface(m).basis(f, u, v, 1), natural_limit_surface(m).basis(f, u, v, 1)
+    for a, b in (("P", "P"), ("Pu", "Du"), ("Pv", "Dv")):
+        assert abs(A[a] - B[b]).max() <= 1e-15, a

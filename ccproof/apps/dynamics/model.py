@@ -511,7 +511,9 @@ class DynamicSurface:
     def basis(self, faces, u, v, derivatives=0):
         """Rows of ``J`` (and of its derivatives) at points: dict name -> CSR (m, n).
 
-        ``basis(...)["P"] @ P`` is the limit surface at the points (qmv98 eq. 15, scalar form).
+        ``basis(...)["P"] @ P`` is the limit surface at the points (qmv98 eq. 15, scalar form). The model's
+        own rows (its special elements, tagged quad meshes); on an untagged QuadMesh they equal the public
+        operator :meth:`ccproof.evaluate.surface.LimitSurface.basis` (keys ``"Du"``, ... there; tested).
         """
         faces, u, v = _check_points(faces, u, v, self.mesh.n_faces)
         m, n = faces.size, self.n_vertices
