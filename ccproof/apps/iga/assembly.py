@@ -84,22 +84,30 @@ class SurfaceFields:
             G = self.Ginv
             self.kappa = -(G[:, 0, 0] * II[0][0] + 2 * G[:, 0, 1] * II[0][1] + G[:, 1, 1] * II[1][1])
 
-    def _weighted(self, A, c, B):
-        return (A.T @ sp.csr_matrix(B.multiply(c[:, None]))).tocsr()
+    def _scaled(self, terms):
+        """``sum_k diag(c_k) B_k`` for ``terms = [(c_k, B_k)]`` of rows that share one sparsity pattern
+        (the basis rows do: one pattern per point), as one CSR matrix."""
+        B0 = terms[0][1]
+        reps = np.diff(B0.indptr)
+        data = np.zeros(B0.nnz)
+        for c, B in terms:
+            if B.nnz != B0.nnz or not (np.array_equal(B.indptr, B0.indptr) and np.array_equal(B.indices, B0.indices)):
+                raise CCProofError("internal error: basis rows of one point with different patterns")
+            data += np.repeat(c, reps) * B.data
+        return sp.csr_matrix((data, B0.indices.copy(), B0.indptr.copy()), shape=B0.shape)
 
     def mass(self):
         """``W_P^T diag(dA) W_P`` (sparse, symmetric)."""
-        return self._weighted(self.W["P"], self.dA, self.W["P"])
+        P = self.W["P"]
+        return (P.T @ self._scaled([(self.dA, P)])).tocsr()
 
     def stiffness(self):
         """``sum_ab W_a^T diag(dA G^ab) W_b``: the Laplace-Beltrami stiffness (sparse, symmetric)."""
-        D = (self.W["Du"], self.W["Dv"])
-        K = None
-        for a in range(2):
-            for b in range(2):
-                part = self._weighted(D[a], self.dA * self.Ginv[:, a, b], D[b])
-                K = part if K is None else K + part
-        return K.tocsr()
+        Du, Dv = self.W["Du"], self.W["Dv"]
+        G, w = self.Ginv, self.dA
+        E = sp.vstack([self._scaled([(w * G[:, 0, 0], Du), (w * G[:, 0, 1], Dv)]),
+                       self._scaled([(w * G[:, 1, 0], Du), (w * G[:, 1, 1], Dv)])], format="csr")
+        return (sp.vstack([Du, Dv], format="csr").T @ E).tocsr()
 
     def load(self, values):
         """``W_P^T (dA values)`` for the values (n_points,) of f at the points."""
