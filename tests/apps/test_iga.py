@@ -167,6 +167,8 @@ def test_errors_name_the_problem(surfaces):
         study_mesh("sphere")
     with pytest.raises(CCProofError, match="order and depth must be >= 1"):
         surface_quadrature(surfaces["cube"], order=0)
+    with pytest.raises(CCProofError, match="depth must be >= 1"):
+        surface_quadrature(surfaces["cube"], depth=0)
 
 
 def test_dynamic_surface_rows_agree_with_limit_surface_basis():
@@ -184,3 +186,32 @@ def test_dynamic_surface_rows_agree_with_limit_surface_basis():
     A, B = DynamicSurface(m).basis(f, u, v, 1), natural_limit_surface(m).basis(f, u, v, 1)
     for a, b in (("P", "P"), ("Pu", "Du"), ("Pv", "Dv")):
         assert abs(A[a] - B[b]).max() <= 1e-15, a
+
+
+@pytest.mark.parametrize("name", ["cube", "icosahedron"])
+def test_adaptive_cells_lie_in_one_polynomial_patch(surfaces, name):
+    """Every cell of the adaptive rule lies in one patch of the natural parameterization (a regular
+    bicubic patch, or one patch of one layer of a corner face): its four corners, pulled 1e-12 inside,
+    are located in the same patch by the evaluator's own patch map; but the innermost square at each
+    extraordinary corner (side 2^-(depth + 1)), which holds all deeper layers. The plain rule's face cells
+    are not."""
+    from ccproof.apps.iga.quadrature import extraordinary_corners, quadrature_cells
+
+    S = surfaces[name]
+
+    def patches_per_cell(kind):
+        f, u0, v0, hu, hv = quadrature_cells(S, kind, depth=8)
+        ids = []
+        for a, b in ((0, 0), (1, 0), (0, 1), (1, 1)):
+            u = u0 + hu * (1e-12 + a * (1 - 2e-12))
+            v = v0 + hv * (1e-12 + b * (1 - 2e-12))
+            ids.append(S.locate(f, u, v)[0])
+        inner = (hu == 2.0**-9) & ((u0 == 0) | (u0 + hu == 1)) & ((v0 == 0) | (v0 + hv == 1))
+        return np.stack(ids, 1), inner
+
+    ids, inner = patches_per_cell("adaptive")
+    assert (ids[~inner] == ids[~inner, :1]).all()
+    assert inner.sum() == 4 * S.n_faces - (~extraordinary_corners(S.mesh)).sum()  # one per EV corner
+    assert (ids[inner] != ids[inner, :1]).any(axis=1).all()
+    plain, _ = patches_per_cell("plain")
+    assert (plain != plain[:, :1]).any()

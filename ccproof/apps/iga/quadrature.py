@@ -47,7 +47,7 @@ import numpy as np
 
 from ccproof.errors import CCProofError
 
-__all__ = ["QuadratureRule", "surface_quadrature", "extraordinary_corners", "RULE_KINDS"]
+__all__ = ["QuadratureRule", "surface_quadrature", "quadrature_cells", "extraordinary_corners", "RULE_KINDS"]
 
 RULE_KINDS = ("plain", "adaptive", "split")
 
@@ -111,7 +111,6 @@ def _ring_cells(depth):
 
 def _adaptive_cells(ev, depth):
     """Cells of the adaptive rule for faces with the corner flags ``ev`` (m, 4)."""
-    m = ev.shape[0]
     plain = np.flatnonzero(~ev.any(axis=1))
     cells = [(plain, np.zeros(plain.size), np.zeros(plain.size), np.ones(plain.size), np.ones(plain.size))]
     rings = _ring_cells(depth)
@@ -128,7 +127,6 @@ def _adaptive_cells(ev, depth):
             k = rings.shape[0]
             cells.append((np.repeat(has, k), np.tile(u0, has.size), np.tile(v0, has.size), np.tile(h, has.size),
                           np.tile(h, has.size)))
-    del m
     return [np.concatenate(parts) for parts in zip(*cells)]
 
 
@@ -148,8 +146,36 @@ def _split_cells(ev):
     return [np.concatenate(p) for p in zip(*parts)]
 
 
+def quadrature_cells(surface, kind="adaptive", depth=12):
+    """The cells of a rule: ``(face, u0, v0, hu, hv)`` arrays, cell ``[u0, u0 + hu] x [v0, v0 + hv]`` of ``face``.
+
+    >>> from ccproof.mesh.examples import cube
+    >>> from ccproof.evaluate import natural_limit_surface
+    >>> f, u0, v0, hu, hv = quadrature_cells(natural_limit_surface(cube()), "split")
+    >>> f.size, sorted(set(u0[f == 0].tolist()))    # cut at 1/6, 1/3, 1/2 from both corners of each face
+    (216, [0.0, 0.16666666666666666, 0.3333333333333333, 0.5, 0.6666666666666667, 0.8333333333333334])
+    """
+    from ccproof.mesh import QuadMesh
+
+    if kind not in RULE_KINDS:
+        raise CCProofError(f"unknown quadrature kind {kind!r}; use one of {', '.join(RULE_KINDS)}")
+    if int(depth) < 1:
+        raise CCProofError(f"depth must be >= 1, got {depth!r}")
+    if not isinstance(surface.mesh, QuadMesh):
+        raise CCProofError(f"the quadrature needs a surface on a QuadMesh, not a {type(surface.mesh).__name__}")
+    ev = extraordinary_corners(surface.mesh)
+    m = ev.shape[0]
+    if kind == "plain":
+        one = np.ones(m)
+        return np.arange(m), np.zeros(m), np.zeros(m), one, one
+    if kind == "adaptive":
+        return tuple(_adaptive_cells(ev, int(depth)))
+    return tuple(_split_cells(ev))
+
+
 def surface_quadrature(surface, order=4, kind="adaptive", depth=12):
-    """A quadrature rule on the faces of ``surface`` (module docstring).
+    """A quadrature rule on the faces of ``surface`` (module docstring): ``order x order`` Gauss-Legendre
+    points on every cell of :func:`quadrature_cells`, sorted face by face.
 
     Parameters
     ----------
@@ -170,23 +196,8 @@ def surface_quadrature(surface, order=4, kind="adaptive", depth=12):
     CCProofError
         An unknown kind, an order or depth below 1, a surface not on a QuadMesh.
     """
-    from ccproof.mesh import QuadMesh
-
-    if kind not in RULE_KINDS:
-        raise CCProofError(f"unknown quadrature kind {kind!r}; use one of {', '.join(RULE_KINDS)}")
-    if int(order) < 1 or int(depth) < 1:
+    if int(order) < 1:
         raise CCProofError(f"order and depth must be >= 1, got order={order!r}, depth={depth!r}")
-    if not isinstance(surface.mesh, QuadMesh):
-        raise CCProofError(f"surface_quadrature needs a surface on a QuadMesh, not a {type(surface.mesh).__name__}")
-    ev = extraordinary_corners(surface.mesh)
-    m = ev.shape[0]
-    if kind == "plain":
-        one = np.ones(m)
-        cells = (np.arange(m), np.zeros(m), np.zeros(m), one, one)
-    elif kind == "adaptive":
-        cells = _adaptive_cells(ev, int(depth))
-    else:
-        cells = _split_cells(ev)
-    Q = _cells_rule(cells, int(order))
+    Q = _cells_rule(quadrature_cells(surface, kind, depth), int(order))
     order_ = np.lexsort((Q.v, Q.u, Q.face))  # face by face
     return QuadratureRule(*(a[order_] for a in Q))
