@@ -82,7 +82,7 @@ class _Topology:
             ostart = np.zeros(n, dtype=np.int64)
             ostart[1:] = np.cumsum(sizes)[:-1]
             dstart = np.where([d is None for d, _, _ in self._ops], -1, 16 * ostart)
-            cols = np.concatenate([c for _, _, c in self._ops]).astype(np.int64)
+            cols = np.concatenate([np.zeros(0, np.int64)] + [c for _, _, c in self._ops]).astype(np.int64)
             dev = np.concatenate([np.zeros(0)] + [d.reshape(-1) for d, _, _ in self._ops if d is not None])
             org = np.concatenate([np.zeros(0)] + [o for d, o, _ in self._ops if d is not None])
             self.arrays = (cstart, ncols, dstart, cols, dev, org)

@@ -196,3 +196,13 @@ def test_bench_script_smoke(capsys):
     assert mod.main(["--smoke"]) == 0
     out = capsys.readouterr().out
     assert out.count("basis/evaluate min") == 2 and "median" in out and "load" in out
+
+
+def test_no_points_and_derived_surfaces():
+    """An empty batch gives empty matrices; a surface from with_vertices shares the rows' topology."""
+    S = natural_limit_surface(cube())
+    W = S.basis([], [], [], 2)
+    assert sorted(W) == ["Du", "Duu", "Duv", "Dv", "Dvv", "P"] and all(w.shape == (0, 8) for w in W.values())
+    T = S.with_vertices(2.0 * np.asarray(cube().vertices))
+    a, b = S.basis([0], [0.3], [0.2])["P"], T.basis([0], [0.3], [0.2])["P"]
+    assert abs(a - b).max() == 0.0
