@@ -216,3 +216,55 @@ def test_adaptive_cells_lie_in_one_polynomial_patch(surfaces, name):
     assert (ids[inner] != ids[inner, :1]).any(axis=1).all()
     plain, _ = patches_per_cell("plain")
     assert (plain != plain[:, :1]).any()
+
+
+def test_parent_points_map_children_onto_their_parents():
+    """Level j+1 (subdivided mesh) at a child point = level j at its parent point: positions, and the
+    derivatives through d(u, v)/d(s, t) = [d1 d2] / 2 (the map of ccproof.apps.iga.graded)."""
+    from ccproof.apps.iga.graded import parent_points
+    from ccproof.evaluate import natural_limit_surface
+    from ccproof.mesh import subdivide
+
+    M = study_mesh("icosahedron")
+    S0, S1 = natural_limit_surface(M), natural_limit_surface(subdivide(M))
+    rng = np.random.default_rng(2)
+    f, s, t = rng.integers(0, S1.n_faces, 500), rng.random(500), rng.random(500)
+    F, u, v = parent_points(f, s, t)
+    a, b = S1.evaluate(f, s, t, 1), S0.evaluate(F, u, v, 1)
+    assert np.abs(a["P"] - b["P"]).max() <= 1e-14
+    C = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    d1, d2 = (np.roll(C, -1, 0) - C)[f % 4], (np.roll(C, 1, 0) - C)[f % 4]
+    Ps = 0.5 * (d1[:, :1] * b["Pu"] + d1[:, 1:] * b["Pv"])
+    Pt = 0.5 * (d2[:, :1] * b["Pu"] + d2[:, 1:] * b["Pv"])
+    assert np.abs(a["Pu"] - Ps).max() <= 1e-12 and np.abs(a["Pv"] - Pt).max() <= 1e-12
+
+
+def test_graded_space_tiles_the_surface_and_holds_the_geometry():
+    """The leaves' rules tile the level-0 parameter domain; the hierarchical space contains the level-0
+    space, so the L2 projection of the coordinates reproduces the surface (to solver accuracy)."""
+    from ccproof.apps.iga.graded import HierarchicalSpace
+    from ccproof.mesh import subdivide
+
+    H = HierarchicalSpace(subdivide(subdivide(study_mesh("cube"))), extra=2, rings=3)
+    assert H.n_dofs > 98 and all(a.any() for a in H.active)
+    rules = H.quadrature(order=2, depth=6)
+    assert abs(sum(r.weight.sum() / 4**j for j, r in enumerate(rules)) - 96) <= 1e-12
+    Fs = H.fields(curvature=False)
+    M = sum(F.mass() for F in Fs)
+    for c in range(3):
+        coef = solve_spd(M, sum(F.load(F.P[:, c]) for F in Fs))
+        assert max(np.abs(F.W["P"] @ coef - F.P[:, c]).max() for F in Fs) <= 1e-8
+
+
+@pytest.mark.slow
+def test_graded_space_beats_uniform_refinement_at_valence_5():
+    """Icosahedral mesh, level 2 graded 2 more levels toward the EVs (4 rings): fewer dofs than the uniform
+    level 3 and smaller L2 and H1 errors (measured: 2,402 dofs, 2.6e-6 / 1.9e-4 against 3,842 dofs,
+    5.1e-6 / 3.7e-4)."""
+    from ccproof.apps.iga.graded import solve_graded
+    from ccproof.mesh import subdivide
+
+    M = subdivide(subdivide(study_mesh("icosahedron")))
+    g = solve_graded(M, 2, AmbientFunction(), rings=4)
+    u = list(convergence_study("icosahedron", levels=1, start=3))[0]
+    assert g["dofs"] < u["dofs"] and g["L2"] < u["L2"] and g["H1"] < u["H1"]

@@ -85,14 +85,14 @@ class SurfaceFields:
             self.kappa = -(G[:, 0, 0] * II[0][0] + 2 * G[:, 0, 1] * II[0][1] + G[:, 1, 1] * II[1][1])
 
     def _scaled(self, terms):
-        """``sum_k diag(c_k) B_k`` for ``terms = [(c_k, B_k)]`` of rows that share one sparsity pattern
-        (the basis rows do: one pattern per point), as one CSR matrix."""
+        """``sum_k diag(c_k) B_k`` for ``terms = [(c_k, B_k)]`` as one CSR matrix (directly on the data where
+        the rows share one sparsity pattern, as the basis rows of one surface do)."""
         B0 = terms[0][1]
         reps = np.diff(B0.indptr)
         data = np.zeros(B0.nnz)
         for c, B in terms:
             if B.nnz != B0.nnz or not (np.array_equal(B.indptr, B0.indptr) and np.array_equal(B.indices, B0.indices)):
-                raise CCProofError("internal error: basis rows of one point with different patterns")
+                return sum(sp.diags(c) @ B for c, B in terms).tocsr()  # rows of other origins: general sum
             data += np.repeat(c, reps) * B.data
         return sp.csr_matrix((data, B0.indices.copy(), B0.indptr.copy()), shape=B0.shape)
 

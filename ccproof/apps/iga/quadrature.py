@@ -47,7 +47,8 @@ import numpy as np
 
 from ccproof.errors import CCProofError
 
-__all__ = ["QuadratureRule", "surface_quadrature", "quadrature_cells", "extraordinary_corners", "RULE_KINDS"]
+__all__ = ["QuadratureRule", "surface_quadrature", "quadrature_cells", "cells_rule", "extraordinary_corners",
+           "RULE_KINDS"]
 
 RULE_KINDS = ("plain", "adaptive", "split")
 
@@ -81,8 +82,14 @@ def _gauss(order):
     return 0.5 * (x + 1.0), 0.5 * w
 
 
-def _cells_rule(cells, order):
-    """Tensor Gauss rule on cells ``(face, u0, v0, hu, hv)`` (arrays): points and weights."""
+def cells_rule(cells, order):
+    """The ``order x order`` Gauss-Legendre rule on cells ``(face, u0, v0, hu, hv)`` (arrays).
+
+    >>> import numpy as np
+    >>> Q = cells_rule((np.array([3]), np.array([0.5]), np.array([0.0]), np.array([0.5]), np.array([0.25])), 2)
+    >>> Q.face.tolist(), round(float(Q.weight.sum()), 15)
+    ([3, 3, 3, 3], 0.125)
+    """
     f, u0, v0, hu, hv = (np.asarray(a) for a in cells)
     x, w = _gauss(order)
     X, Y = np.meshgrid(x, x, indexing="ij")
@@ -198,6 +205,6 @@ def surface_quadrature(surface, order=4, kind="adaptive", depth=12):
     """
     if int(order) < 1:
         raise CCProofError(f"order and depth must be >= 1, got order={order!r}, depth={depth!r}")
-    Q = _cells_rule(quadrature_cells(surface, kind, depth), int(order))
+    Q = cells_rule(quadrature_cells(surface, kind, depth), int(order))
     order_ = np.lexsort((Q.v, Q.u, Q.face))  # face by face
     return QuadratureRule(*(a[order_] for a in Q))
