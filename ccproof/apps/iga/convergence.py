@@ -66,7 +66,7 @@ def study_mesh(name):
 
 
 def convergence_study(mesh, levels=4, kind="adaptive", parameterization="natural", order=4, depth=12,
-                      exact=None, start=0):
+                      exact=None, start=0, graded=None):
     """Yield per level ``{"level", "faces", "dofs", "L2", "H1"}`` of the Galerkin solution.
 
     Parameters
@@ -80,6 +80,9 @@ def convergence_study(mesh, levels=4, kind="adaptive", parameterization="natural
     parameterization : {"natural", "characteristic"}
     exact : AmbientFunction, optional
         The manufactured solution (default ``AmbientFunction()``).
+    graded : (extra, rings), optional
+        Instead of the uniform space: the hierarchical space graded ``extra`` levels toward the EVs over
+        ``rings`` face rings (:mod:`ccproof.apps.iga.graded`; natural parameterization, adaptive rule).
     """
     from ccproof.mesh import subdivide
     from ccproof.reparam import limit_surface
@@ -91,6 +94,14 @@ def convergence_study(mesh, levels=4, kind="adaptive", parameterization="natural
     for _ in range(start):
         M = subdivide(M)
     for L in range(start, start + levels):
+        if graded is not None:
+            from ccproof.apps.iga.graded import solve_graded
+
+            r = solve_graded(M, int(graded[0]), exact, rings=int(graded[1]))
+            yield {"level": L, "faces": M.n_faces, "dofs": r["dofs"], "L2": r["L2"], "H1": r["H1"]}
+            if L + 1 < start + levels:
+                M = subdivide(M)
+            continue
         S = limit_surface(M)
         rule = surface_quadrature(S, order, kind, depth)
         fine = surface_quadrature(S, 6, "adaptive" if parameterization == "natural" else "split", 14)
@@ -100,7 +111,12 @@ def convergence_study(mesh, levels=4, kind="adaptive", parameterization="natural
             M = subdivide(M)
 
 
-def rates(rows, key):
-    """``log2(e_(L-1) / e_L)`` between consecutive rows (NaN for the first)."""
+def rates(rows, key, per="level"):
+    """Rates between consecutive rows (NaN for the first): ``log2(e_(L-1) / e_L)`` per level, or per
+    sqrt(dofs) (``per="dofs"``: ``2 log(e_(L-1) / e_L) / log(N_L / N_(L-1))``; the same for uniform
+    refinement, where N grows fourfold)."""
     e = [r[key] for r in rows]
-    return [math.nan] + [math.log2(a / b) for a, b in zip(e[:-1], e[1:])]
+    if per == "level":
+        return [math.nan] + [math.log2(a / b) for a, b in zip(e[:-1], e[1:])]
+    n = [r["dofs"] for r in rows]
+    return [math.nan] + [2 * math.log(a / b) / math.log(m / k) for a, b, k, m in zip(e[:-1], e[1:], n[:-1], n[1:])]
