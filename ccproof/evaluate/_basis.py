@@ -23,10 +23,12 @@ import numpy as np
 import scipy.sparse as sp
 
 from ccproof.evaluate._parallel import in_blocks, threads_for
-from ccproof.evaluate._table import _CORNER
 from ccproof.evaluate.bspline import bspline_basis
 
 __all__ = ["BASIS_KEYS", "basis_rows"]
+
+#: ``kind`` of a corner face (one irregular corner) in the patch table (:class:`ccproof.evaluate.patch_map.Location`)
+CORNER_KIND = 1
 
 #: the keys of :meth:`LimitSurface.basis` per derivative order, and the key of ``evaluate`` each one reproduces
 BASIS_KEYS = {0: ("P",), 1: ("P", "Du", "Dv"), 2: ("P", "Du", "Dv", "Duu", "Duv", "Dvv")}
@@ -102,7 +104,7 @@ class _Topology:
         lv = vf - self.root[g]
         if getattr(t, "smooth_grid", None) is not None:  # the net is the ring itself (job_floats)
             return None, None, np.arange(16)
-        if T.kind[vf] == _CORNER:
+        if T.kind[vf] == CORNER_KIND:
             layer, code = divmod(rest - 1, 3)
             c, cfg = int(t.leaf[lv]), int(T.cfg[vf])
             Nc, st, nl = int(T.op_size[cfg]), int(T.op_start[cfg]), int(T.n_layers[cfg])
@@ -199,9 +201,9 @@ def _locate(S, top, f, u, v, kernels, nt):
     n = f.size
     job, key = np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64)
     s, t, scale = np.empty(n), np.empty(n), np.empty(n)
-    args = (T.top, T.job_root, T.kind, T.child, T.u0, T.v0, T.h, T.cfg, T.cu, T.cv, T.n_layers, T.unit, top.stride,
-            job, key, s, t, scale)
-    in_blocks(lambda lo, hi: kernels[0](lo, hi, f, u, v, *args), n, nt, 32768, per_thread=4)
+    table = (T.top, T.job_root, T.kind, T.child, T.u0, T.v0, T.h, T.cfg, T.cu, T.cv, T.n_layers, T.unit)
+    out = (job, key, s, t, scale)
+    in_blocks(lambda lo, hi: kernels[0](lo, hi, f, u, v, table, top.stride, out), n, nt, 32768, per_thread=4)
     return _Located(job, s, t, scale), key
 
 
@@ -231,8 +233,10 @@ def basis_rows(S, f, u, v, derivatives, backend=None, threads=None):
     else:
         rs = top.job_ring[loc.job]
         pad = [data[0]] * (6 - len(names))
-        in_blocks(lambda lo, hi: kernels[1](lo, hi, loc.s, loc.t, loc.scale, op, rs, top.ring, cstart, ncols, dstart,
-                                            cols, dev, org, indptr, indices, len(names), *data, *pad),
+        pts = (loc.s, loc.t, loc.scale, op, rs)
+        ops = (cstart, ncols, dstart, cols, dev, org)
+        data6 = tuple(data) + tuple(pad)
+        in_blocks(lambda lo, hi: kernels[1](lo, hi, pts, ops, top.ring, indptr, indices, len(names), data6),
                   f.size, nt, 32768, per_thread=4)
     out = {}
     for k, name in enumerate(names):
@@ -243,11 +247,12 @@ def basis_rows(S, f, u, v, derivatives, backend=None, threads=None):
     return out
 
 
-def _fill_points(lo, hi, s, t, scale, op, rs, ring, cstart, ncols, dstart, cols, dev, org, indptr, indices, nk,
-                 d0, d1, d2, d3, d4, d5):
-    """The rows of points lo..hi-1 into ``d0 .. d(nk-1)`` (the numba kernel; the sums of :func:`_rows`
-    point by point)."""
-    data = (d0, d1, d2, d3, d4, d5)
+def _fill_points(lo, hi, pts, ops, ring, indptr, indices, nk, data):
+    """The rows of points lo..hi-1 into ``data[0 .. nk-1]`` (the numba kernel; the sums of :func:`_rows`
+    point by point). ``pts = (s, t, scale, op, ring start)`` per point, ``ops`` the flat operators
+    (:meth:`_Topology.flat`)."""
+    s, t, scale, op, rs = pts
+    cstart, ncols, dstart, cols, dev, org = ops
     B = np.empty(16)
     bu = np.empty((3, 4))
     bv = np.empty((3, 4))
@@ -286,9 +291,11 @@ def _fill_points(lo, hi, s, t, scale, op, rs, ring, cstart, ncols, dstart, cols,
             dk[q] = (1.0 if k == 0 else 0.0) - tot
 
 
-def _locate_points(lo, hi, f, u, v, top, job_root, kind, child, u0, v0, h, cfg, cu, cv, n_layers, unit, stride,
-                   job, key, s, t, scale):
-    """:meth:`PatchMap.locate` of points lo..hi-1 (the same exact operations), and their operator keys."""
+def _locate_points(lo, hi, f, u, v, table, stride, out):
+    """:meth:`PatchMap.locate` of points lo..hi-1 (the same exact operations), and their operator keys:
+    ``table`` the patch table's topology arrays, ``out = (job, key, s, t, scale)``."""
+    top, job_root, kind, child, u0, v0, h, cfg, cu, cv, n_layers, unit = table
+    job, key, s, t, scale = out
     for p in range(lo, hi):
         x, y = u[p], v[p]
         jb = top[f[p], (1 if x >= 0.5 else 0) + (2 if y >= 0.5 else 0)]
