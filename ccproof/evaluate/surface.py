@@ -398,6 +398,58 @@ class LimitSurface:
             self._eval_chunk(f[lo:hi], u[lo:hi], v[lo:hi], derivatives, {k: out[k][lo:hi] for k in keys})
         return out
 
+    def basis(self, face_ids, u, v, derivatives=0, *, parameterization="natural", threads=None):
+        """Basis rows: the sparse linear map from the control points to points and derivatives.
+
+        ``W = S.basis(f, u, v, d)`` holds, per point, the weights of the file's control vertices (the
+        limit stencils of OpenSubdiv): ``W["P"] @ X`` equals ``S.evaluate(f, u, v, d)["P"]`` for the
+        surface's control points X (to round-off), ``W["Du"] @ X`` its ``"Pu"``, and so on; the same
+        rows serve any other control points (``S.with_vertices(Y)`` evaluates to ``W["P"] @ Y``) and any
+        array framework that multiplies by a sparse matrix (differentiation through the surface).
+
+        Parameters
+        ----------
+        face_ids, u, v : array_like, shape (n,)
+            Points as :meth:`evaluate` takes them (checked the same way).
+        derivatives : int, 0, 1 or 2
+        parameterization : str or parameterization value
+            ``"natural"`` (default), or a name of :attr:`parameterizations` or a value with a
+            ``basis_on(surface, f, u, v, derivatives)`` method (:class:`ccproof.reparam.Parameterization`).
+        threads : int, optional
+            Threads of the compiled kernels (natural parameterization), as :meth:`evaluate` takes them.
+
+        Returns
+        -------
+        dict of scipy.sparse.csr_matrix, shape (n, n_vertices)
+            ``"P"``; with ``derivatives >= 1`` also ``"Du"``, ``"Dv"``; with 2 also ``"Duu"``, ``"Duv"``,
+            ``"Dvv"`` (derivatives with respect to the face's own (u, v)). Columns: the vertices of
+            :attr:`mesh` (a PolyMesh's own vertices; an unused vertex's column is empty).
+
+        Examples
+        --------
+        The centre of the cube's top face: 68/81 (one step and the limit mask), as a weighted sum of
+        the cube's 8 vertices:
+
+        >>> from ccproof.mesh.examples import cube
+        >>> S = natural_limit_surface(cube())
+        >>> W = S.basis([1], [0.5], [0.5], 1)
+        >>> sorted(W), W["P"].shape, round(float(W["P"].sum()), 12), round(float(abs(W["Du"].sum())), 12)
+        (['Du', 'Dv', 'P'], (1, 8), 1.0, 0.0)
+        >>> round(float((W["P"] @ np.asarray(cube().vertices))[0, 2] * 81), 12)
+        68.0
+        """
+        if derivatives not in (0, 1, 2):
+            raise CCProofError(f"derivatives must be 0, 1 or 2, got {derivatives!r}")
+        f, u, v = self._check(face_ids, u, v)
+        if not (isinstance(parameterization, str) and parameterization == "natural"):
+            p = self._parameterization(parameterization)
+            if not callable(getattr(p, "basis_on", None)):
+                raise CCProofError(f"parameterization {parameterization!r} has no basis_on method")
+            return p.basis_on(self, f, u, v, derivatives)
+        from ccproof.evaluate._basis import basis_rows
+
+        return basis_rows(self, f, u, v, derivatives, threads=threads)
+
     def _parameterization(self, p):
         """The parameterization value of ``evaluate(..., parameterization=p)``: a name looked up in
         :attr:`parameterizations`, or a value with an ``evaluate_on`` method."""

@@ -206,6 +206,59 @@ class Parameterization:
             self._fix_corner_limits(surface, f[idx], idx, q, m, res, R, derivatives)
         return R
 
+    def basis_on(self, surface: LimitSurface, f: np.ndarray, u: np.ndarray, v: np.ndarray,
+                 derivatives: int = 0) -> dict[str, Any]:
+        """The basis rows of f o F_b at checked points: what ``surface.basis(..., parameterization=self)`` returns.
+
+        The natural rows at F_b(t) (:meth:`~ccproof.evaluate.surface.LimitSurface.basis`) and the chain
+        rule on them (the rows are linear in the control points, so the chain rule of
+        :meth:`evaluate_on` applies row by row). Points whose preimage F_b(t) is within 2^-30 of an
+        extraordinary corner (where :meth:`evaluate_on` substitutes limit values) are refused.
+
+        Raises
+        ------
+        CCProofError
+            A point that close to an extraordinary corner (names the point).
+        """
+        if self.kind == "natural":
+            return surface.basis(f, u, v, derivatives)
+        import scipy.sparse as sp
+
+        st = _state(surface)
+        idx, q, s, t, k = active_points(st.corner_valence, f, u, v, self.kind)
+        if idx.size == 0:
+            return surface.basis(f, u, v, derivatives)
+        res = blend_points(q, s, t, k, self.kind, self.alphas(surface), derivatives)
+        near = np.flatnonzero(res["local"].max(axis=1) < _DEEP)
+        if near.size:
+            i = int(idx[near[0]])
+            raise CCProofError(f"point {i}: (face {int(f[i])}, u = {float(u[i])!r}, v = {float(v[i])!r}) maps within "
+                               "2^-30 of an extraordinary corner: no basis rows there (use evaluate)")
+        u2, v2 = u.copy(), v.copy()
+        u2[idx], v2[idx] = res["u"], res["v"]
+        W = surface.basis(f, u2, v2, derivatives)
+        if derivatives == 0:
+            return W
+        n = f.size
+        J = np.zeros((n, 2, 2))
+        J[:, 0, 0] = J[:, 1, 1] = 1.0
+        J[idx] = res["J"]
+
+        def d(x):
+            return sp.diags(x, format="csr")
+
+        out = {"P": W["P"]}
+        if derivatives >= 2:
+            H = np.zeros((n, 2, 2, 2))
+            H[idx] = res["H"]
+            for key, i, j in (("Duu", 0, 0), ("Duv", 0, 1), ("Dvv", 1, 1)):
+                out[key] = (d(J[:, 0, i] * J[:, 0, j]) @ W["Duu"] + d(J[:, 0, i] * J[:, 1, j] + J[:, 1, i] * J[:, 0, j])
+                            @ W["Duv"] + d(J[:, 1, i] * J[:, 1, j]) @ W["Dvv"] + d(H[:, 0, i, j]) @ W["Du"]
+                            + d(H[:, 1, i, j]) @ W["Dv"]).tocsr()
+        out["Du"] = (d(J[:, 0, 0]) @ W["Du"] + d(J[:, 1, 0]) @ W["Dv"]).tocsr()
+        out["Dv"] = (d(J[:, 0, 1]) @ W["Du"] + d(J[:, 1, 1]) @ W["Dv"]).tocsr()
+        return {key: out[key] for key in W}
+
     def _fix_corner_limits(self, surface: LimitSurface, f: np.ndarray, idx: np.ndarray, q: np.ndarray,
                            m: np.ndarray, res: dict[str, Any], R: dict[str, np.ndarray], derivatives: int) -> None:
         """Limit derivatives at the corner and beyond the evaluator's deepest layer (module doc).

@@ -45,6 +45,9 @@ from ccproof.errors import CCProofError
 
 __all__ = ["Material", "DynamicSurface", "LimitEvaluator", "MAX_EVAL_LEVEL"]
 
+#: the key of the basis rows of every evaluated quantity (LimitSurface.basis's keys)
+_ROW_KEY = {"P": "P", "Pu": "Du", "Pv": "Dv", "Puu": "Duu", "Puv": "Duv", "Pvv": "Dvv"}
+
 #: deepest local level used by the evaluation; below 2^-MAX_EVAL_LEVEL the EV limit point is returned
 MAX_EVAL_LEVEL = 60
 
@@ -511,7 +514,11 @@ class DynamicSurface:
     def basis(self, faces, u, v, derivatives=0):
         """Rows of ``J`` (and of its derivatives) at points: dict name -> CSR (m, n).
 
-        ``basis(...)["P"] @ P`` is the limit surface at the points (qmv98 eq. 15, scalar form).
+        ``basis(...)["P"] @ P`` is the limit surface at the points (qmv98 eq. 15, scalar form), ``["Du"] @ P``
+        its ``evaluate(...)["Pu"]``, and so on (``"Dv"``, ``"Duu"``, ``"Duv"``, ``"Dvv"``): the keys of the public
+        operator :meth:`ccproof.evaluate.surface.LimitSurface.basis`. The
+        model's own rows (its special elements, tagged quad meshes); on an untagged QuadMesh they equal the
+        public operator's (tested).
         """
         faces, u, v = _check_points(faces, u, v, self.mesh.n_faces)
         m, n = faces.size, self.n_vertices
@@ -525,7 +532,7 @@ class DynamicSurface:
             r = np.concatenate([p[0] for p in parts])
             c = np.concatenate([p[1] for p in parts])
             d = np.concatenate([p[2] for p in parts])
-            out[k] = sp.csr_matrix((d, (r, c)), shape=(m, n))
+            out[_ROW_KEY[k]] = sp.csr_matrix((d, (r, c)), shape=(m, n))
         return out
 
     def evaluate(self, faces, u, v, derivatives=0, P=None):

@@ -1,0 +1,122 @@
+"""Manufactured-solution convergence study of ``-Laplace_Gamma u + u = f`` on closed limit surfaces.
+
+Meshes (:func:`study_mesh`): ``torus`` (no extraordinary vertex), ``cube`` (valence 3), ``icosahedron``
+(one Catmull-Clark step of the icosahedron: valence 5 and 3) and ``prism6`` (one step of the hexagonal
+prism: valence 6 and 3). Level L is the mesh subdivided L times (uniform refinement, h halves); the
+errors are measured with a finer rule than the one assembled with (adaptive, 6 x 6 points per cell,
+14 rings), so that they are the solution's. The rate between levels is ``log2(e_(L-1) / e_L)``
+(per sqrt(dofs)). docs/iga.md lists the measured tables.
+
+>>> rows = list(convergence_study("torus", levels=2))
+>>> [r["dofs"] for r in rows], rows[-1]["L2"] < rows[0]["L2"]
+([48, 192], True)
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ccproof.apps.iga.assembly import AmbientFunction, solve_screened_poisson
+from ccproof.apps.iga.quadrature import surface_quadrature
+from ccproof.errors import CCProofError
+
+__all__ = ["STUDY_MESHES", "study_mesh", "convergence_study", "rates"]
+
+STUDY_MESHES = ("torus", "cube", "icosahedron", "prism6")
+
+
+def _icosahedron():
+    p = (1 + 5**0.5) / 2
+    V = [[-1, p, 0], [1, p, 0], [-1, -p, 0], [1, -p, 0], [0, -1, p], [0, 1, p], [0, -1, -p], [0, 1, -p],
+         [p, 0, -1], [p, 0, 1], [-p, 0, -1], [-p, 0, 1]]
+    F = [[0, 11, 5], [0, 5, 1], [0, 1, 7], [0, 7, 10], [0, 10, 11], [1, 5, 9], [5, 11, 4], [11, 10, 2], [10, 7, 6],
+         [7, 1, 8], [3, 9, 4], [3, 4, 2], [3, 2, 6], [3, 6, 8], [3, 8, 9], [4, 9, 5], [2, 4, 11], [6, 2, 10],
+         [8, 6, 7], [9, 8, 1]]
+    return np.array(V, dtype=np.float64) / math.sqrt(1 + p * p), F
+
+
+def _prism6():
+    a = np.arange(6) * np.pi / 3
+    ring = np.stack([np.cos(a), np.sin(a), np.zeros(6)], 1)
+    V = np.concatenate([ring - [0, 0, 1], ring + [0, 0, 1]])
+    F = [[5, 4, 3, 2, 1, 0], [6, 7, 8, 9, 10, 11]] + [[i, (i + 1) % 6, (i + 1) % 6 + 6, i + 6] for i in range(6)]
+    return V, F
+
+
+def study_mesh(name):
+    """The level-0 QuadMesh of a study mesh (see the module docstring).
+
+    >>> m = study_mesh("prism6")
+    >>> m.n_faces, sorted(set(m.valence.tolist()))
+    (36, [3, 4, 6])
+    """
+    from ccproof.mesh.examples import cube, torus
+    from ccproof.mesh.polymesh import PolyMesh
+
+    if name == "torus":
+        return torus()
+    if name == "cube":
+        return cube()
+    if name in ("icosahedron", "prism6"):
+        V, F = _icosahedron() if name == "icosahedron" else _prism6()
+        return PolyMesh(V, F).refine(operator=False)[0].to_quad_mesh()
+    raise CCProofError(f"unknown study mesh {name!r}; use one of {', '.join(STUDY_MESHES)}")
+
+
+def convergence_study(mesh, levels=4, kind="adaptive", parameterization="natural", order=4, depth=12,
+                      exact=None, start=0, graded=None):
+    """Yield per level ``{"level", "faces", "dofs", "L2", "H1"}`` of the Galerkin solution.
+
+    Parameters
+    ----------
+    mesh : str or QuadMesh
+        A :data:`STUDY_MESHES` name or a closed QuadMesh (level 0).
+    levels : int
+        Levels ``start .. start + levels - 1``.
+    kind, order, depth
+        The assembly's quadrature (:func:`ccproof.apps.iga.quadrature.surface_quadrature`).
+    parameterization : {"natural", "characteristic"}
+    exact : AmbientFunction, optional
+        The manufactured solution (default ``AmbientFunction()``).
+    graded : (extra, rings), optional
+        Instead of the uniform space: the hierarchical space graded ``extra`` levels toward the EVs over
+        ``rings`` face rings (:mod:`ccproof.apps.iga.graded`; natural parameterization, adaptive rule).
+    """
+    from ccproof.mesh import subdivide
+    from ccproof.reparam import limit_surface
+
+    M = study_mesh(mesh) if isinstance(mesh, str) else mesh
+    if M.is_boundary_vertex.any():
+        raise CCProofError("the convergence study needs a closed mesh (no boundary conditions are imposed)")
+    exact = AmbientFunction() if exact is None else exact
+    for _ in range(start):
+        M = subdivide(M)
+    for L in range(start, start + levels):
+        if graded is not None:
+            from ccproof.apps.iga.graded import solve_graded
+
+            r = solve_graded(M, int(graded[0]), exact, rings=int(graded[1]))
+            yield {"level": L, "faces": M.n_faces, "dofs": r["dofs"], "L2": r["L2"], "H1": r["H1"]}
+            if L + 1 < start + levels:
+                M = subdivide(M)
+            continue
+        S = limit_surface(M)
+        rule = surface_quadrature(S, order, kind, depth)
+        fine = surface_quadrature(S, 6, "adaptive" if parameterization == "natural" else "split", 14)
+        r = solve_screened_poisson(S, rule, exact, parameterization, error_rule=fine)
+        yield {"level": L, "faces": M.n_faces, "dofs": r["dofs"], "L2": r["L2"], "H1": r["H1"]}
+        if L + 1 < start + levels:
+            M = subdivide(M)
+
+
+def rates(rows, key, per="level"):
+    """Rates between consecutive rows (NaN for the first): ``log2(e_(L-1) / e_L)`` per level, or per
+    sqrt(dofs) (``per="dofs"``: ``2 log(e_(L-1) / e_L) / log(N_L / N_(L-1))``; the same for uniform
+    refinement, where N grows fourfold)."""
+    e = [r[key] for r in rows]
+    if per == "level":
+        return [math.nan] + [math.log2(a / b) for a, b in zip(e[:-1], e[1:])]
+    n = [r["dofs"] for r in rows]
+    return [math.nan] + [2 * math.log(a / b) / math.log(m / k) for a, b, k, m in zip(e[:-1], e[1:], n[:-1], n[1:])]

@@ -1,0 +1,82 @@
+#!/usr/bin/env python
+"""Benchmark of LimitSurface.basis against LimitSurface.evaluate on the same points (interleaved rounds).
+
+The cube subdivided ``--levels`` times (1,536 faces at 4: eight valence-3 vertices, corner faces in their
+layers) and ``--points`` uniformly random points (face, u, v), a tenth of them within 10^-1 .. 10^-12 of
+a face corner. Per round and derivative order d = 0, 1: ``evaluate(f, u, v, d)`` (the compiled kernel) and
+``basis(f, u, v, d)`` (the CSR rows of the file's control vertices), in turn; the ratio basis / evaluate
+per round is printed as min, median, max, with the 1-minute load before the rounds. Both on ``--threads``
+threads (default: the evaluator's default, all cores for large batches). Rows hold 16 weights and
+indices per point (regular patch), so the output is about 8x that of ``evaluate`` per derivative.
+
+Usage: python scripts/bench_basis.py [--points 1000000] [--rounds 5] [--threads N] [--smoke]
+(``--smoke``: 10^4 points, 2 rounds: checks that it runs).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import time
+
+import numpy as np
+
+
+def _points(S, n, seed=0):
+    rng = np.random.default_rng(seed)
+    f = rng.integers(0, S.n_faces, n)
+    u, v = rng.random(n), rng.random(n)
+    k = n // 10
+    u[:k], v[:k] = 10.0 ** -rng.uniform(1, 12, k), 10.0 ** -rng.uniform(1, 12, k)
+    return f, u, v
+
+
+def _stats(r):
+    return f"min {min(r):.2f}  median {statistics.median(r):.2f}  max {max(r):.2f}"
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--points", type=int, default=10**6)
+    ap.add_argument("--rounds", type=int, default=5)
+    ap.add_argument("--levels", type=int, default=4)
+    ap.add_argument("--threads", type=int, default=None)
+    ap.add_argument("--smoke", action="store_true")
+    a = ap.parse_args(argv)
+    if a.smoke:
+        a.points, a.rounds, a.levels = 10**4, 2, 2
+    from ccproof.evaluate import natural_limit_surface
+    from ccproof.mesh import subdivide
+    from ccproof.mesh.examples import cube
+
+    mesh = cube()
+    for _ in range(a.levels):
+        mesh = subdivide(mesh)
+    S = natural_limit_surface(mesh, progress=False)
+    f, u, v = _points(S, a.points)
+    print(f"cube subdivided {a.levels} times: {S.n_faces:,} faces; {a.points:,} points; {os.cpu_count()} cpus; "
+          f"threads {a.threads or 'default'}; rounds {a.rounds}", flush=True)
+    for d in (0, 1):
+        S.evaluate(f, u, v, d, threads=a.threads)  # warm-up: kernels loaded, operators built
+        S.basis(f, u, v, d, threads=a.threads)
+        t_ev, t_b, ratios = [], [], []
+        load = os.getloadavg()[0]
+        for i in range(a.rounds):
+            order = [("e", t_ev), ("b", t_b)] if i % 2 == 0 else [("b", t_b), ("e", t_ev)]
+            for what, acc in order:
+                t0 = time.perf_counter()
+                if what == "e":
+                    S.evaluate(f, u, v, d, threads=a.threads)
+                else:
+                    W = S.basis(f, u, v, d, threads=a.threads)
+                acc.append(time.perf_counter() - t0)
+            ratios.append(t_b[-1] / t_ev[-1])
+        nnz = W["P"].nnz / a.points
+        print(f"derivatives {d}: evaluate {min(t_ev) * 1e3:7.1f} ms  basis {min(t_b) * 1e3:7.1f} ms "
+              f"({nnz:.1f} weights per point)  basis/evaluate {_stats(ratios)}  (load {load:.1f})", flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
