@@ -24,6 +24,7 @@ SCRIPTS = Path(__file__).resolve().parents[1] / "scripts"
 
 #: per script, the arguments of its smoke run (a few seconds each)
 SMOKE = {
+    "bench_basis.py": ["--smoke"],
     "bench_arap.py": ["--smoke"],
     "bench_certify.py": ["--smoke"],
     "bench_evaluate.py": ["--smoke"],

@@ -1,8 +1,8 @@
 """The ccproof source the verifier loads: modules and lines imported to verify one published certificate of
 each kind, each in a fresh process, then all of them in one process (the import trace of ``sys.modules``).
 
-  python scripts/bench_verify_imports.py          every kind (about a minute: dart:>=101 and smooth:>=40)
-  python scripts/bench_verify_imports.py --fast   without dart:>=101
+  python scripts/verify_imports.py          every kind (about a minute: dart:>=101 and smooth:>=40)
+  python scripts/verify_imports.py --fast   without dart:>=101
 """
 
 import json
