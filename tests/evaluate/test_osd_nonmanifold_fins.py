@@ -174,3 +174,43 @@ def test_every_command_accepts_a_fin(refdir, tmp_path, command):
         assert main(["arap", path, "--segment", "normals", "--levels", "1", "--eval-level", "2", "--refine", "0",
                      "--out", str(tmp_path / "uv.obj"), "--no-progress"]) == 0
         assert (tmp_path / "uv.obj").stat().st_size > 0
+
+
+def _limit_of_smooth_vertex(R, c):
+    """Catmull-Clark limit position of the smooth interior vertex c of the all-quad mesh R, from its
+    one-ring alone: (n^2 v + 4 sum(edge neighbours) + sum(diagonal ones)) / (n (n + 5))."""
+    quads = [p for p in R.polygons if c in p]
+    n = len(quads)
+    e = sum(R.vertices[q[(q.index(c) + 1) % 4]] for q in quads)  # each edge neighbour once (interior)
+    f = sum(R.vertices[q[(q.index(c) + 2) % 4]] for q in quads)
+    return (n * n * R.vertices[c] + 4 * e + f) / (n * (n + 5))
+
+
+@pytest.mark.parametrize("name", sorted(FINS))
+def test_fins_and_pages_are_the_limit_of_our_refinement(refdir, name):
+    """Brute force, independent of the evaluator: one step of our refinement, then the closed-form limit
+    of each face point (a smooth interior vertex: its one-ring decides it) against the evaluated surface
+    at that parameter, on every face, fins included (the surface there is the corner's)."""
+    mesh = read_mesh(_path(refdir, name))
+    M = mesh.manifold
+    R, _ = mesh.refine(operator=False)
+    S = limit_surface(mesh)
+    first_face_point = M.n_vertices + len(M.edges)
+    for f in range(mesh.n_faces):
+        want = _limit_of_smooth_vertex(R, first_face_point + f)
+        ptex, st = (mesh.ptex_of(f), (0.5, 0.5)) if mesh.sizes[f] == 4 else (mesh.ptex_of(f, 0), (1.0, 1.0))
+        P = S.evaluate([ptex], [st[0]], [st[1]], 0)["P"][0]
+        assert np.abs(P - want).max() <= 1e-14 * mesh.bounding_box_diagonal, f
+
+
+def test_manifold_meshes_never_take_the_split(refdir, monkeypatch):
+    """A manifold mesh is its own evaluated mesh: the split (and its handling of fins) is never called."""
+    def refuse(self, *args):
+        raise AssertionError("the split was called on a manifold mesh")
+
+    monkeypatch.setattr(PolyMesh, "_split_nonmanifold", refuse)
+    monkeypatch.setattr(PolyMesh, "_fans_off_the_crease", refuse)
+    for name in ("unused.obj", "prism.off"):
+        m = read_mesh(_path(refdir, name))
+        assert m.is_manifold and m.manifold is m
+        limit_surface(m).evaluate([0], [0.5], [0.5], 1)
