@@ -138,6 +138,31 @@ def test_a_closed_fan_at_a_crease_vertex_is_a_corner(refdir):
     assert np.abs(R.vertices[pages] - (0.75 * V[1] + 0.125 * (V[0] + V[2]))).max() <= 1e-15
 
 
+def test_a_closed_surface_on_a_spine_edge_is_a_fin(refdir):
+    """A tetrahedron on book4's spine edge (0, 1): at vertex 1 its faces form a fin (from the spine edge
+    back to it); at vertex 0 they form one fan, so the fin's two sides meet again in the split, whose
+    edge there is manifold and infinitely sharp. The fin's copy is a corner, the pages' keep the crease
+    rule; the split is manifold and evaluates (its face points' limits, brute force)."""
+    book = read_mesh(refdir / "osd_nonmanifold" / "meshes" / "book4.obj")
+    V, F = np.array(book.vertices), [list(p) for p in book.polygons]
+    p, q = len(V), len(V) + 1
+    m = PolyMesh(np.vstack([V, [[0.4, 0.3, 0.5], [0.3, 0.6, 0.4]]]),
+                 F + [[0, 1, p], [1, 0, q], [0, p, q], [1, q, p]])
+    M, vmap = m.manifold, m.manifold_vertex_map
+    assert M.is_manifold
+    fin = M.polygons[len(F)][1]
+    assert vmap[fin] == 1 and M.vertex_sharpness[fin] == np.inf
+    assert [M.vertex_sharpness.get(u, 0.0) for u in np.flatnonzero(vmap == 1) if u != fin] == [0.0] * 4
+    e = M.halfedges.edge_index_of([M.polygons[len(F)][0]], [fin])[0]
+    assert M.edge_face_count[e] == 2 and M.edge_sharpness[tuple(M.edges[e].tolist())] == np.inf
+    R, _ = m.refine(operator=False)
+    S = limit_surface(m)
+    for f in range(len(F), len(F) + 4):
+        P = S.evaluate([m.ptex_of(f, 0)], [1.0], [1.0], 0)["P"][0]
+        want = _limit_of_smooth_vertex(R, M.n_vertices + len(M.edges) + f)
+        assert np.abs(P - want).max() <= 1e-14 * m.bounding_box_diagonal
+
+
 @pytest.mark.parametrize("command", ["eval", "project", "fit", "arap"])
 def test_every_command_accepts_a_fin(refdir, tmp_path, command):
     name = "fin_tri.obj"
