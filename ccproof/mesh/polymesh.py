@@ -284,9 +284,11 @@ class PolyMesh:
         sharpened vertices get infinite vertex sharpness. Every rule then acts on the copies as
         OpenSubdiv's acts on the vertex. A crease vertex with other semi-sharp edges is a corner
         until the last of them has decayed: its copies get that edge's sharpness as vertex sharpness
-        (same rule at every level, same fractional weight). Cases where no split reproduces the
-        vertex's rule are refused by name: a crease vertex with a fan not bounded by both
-        non-manifold edges, or whose last semi-sharp features have different values, and Chaikin
+        (same rule at every level, same fractional weight). A crease vertex's fan not bounded by both
+        non-manifold edges (a fin, a closed fan) cannot see both crease neighbours: its copy is made
+        an infinitely sharp corner (:meth:`_fans_off_the_crease`; the one surface here that is not
+        OpenSubdiv's, documented in docs/evaluate.md). Cases where no split comes close are refused
+        by name: a crease vertex whose last semi-sharp features have different values, and Chaikin
         creases with semi-sharp edges in more than one fan of a non-manifold vertex or at a crease
         vertex.
 
@@ -318,6 +320,7 @@ class PolyMesh:
         vsharp = {int(v): s for v, s in self.vertex_sharpness.items()}
         by_vertex = np.argsort(org, kind="stable")  # corners grouped by vertex
         ptr = np.r_[0, np.cumsum(self.face_count)]
+        sharp_fans = set()  # fans of crease vertices not bounded by both non-manifold edges: corners
         # OpenSubdiv's sharpening of the non-manifold vertices
         for v in np.flatnonzero(nm_v).tolist():
             cs = by_vertex[ptr[v] : ptr[v + 1]]
@@ -356,15 +359,7 @@ class PolyMesh:
                         f"non-manifold crease vertex {v}: semi-sharp edges or vertex sharpness {sorted(last)} "
                         "ending at the same level with different values are not supported")
                 vsharp[v] = top
-            for c in set(comp[cs].tolist()):
-                members = cs[comp[cs] == c]
-                lead_c = members[self.twin[members] < 0]  # outgoing half-edge on a singular edge
-                trail_c = members[self.twin[prv[members]] < 0]
-                if lead_c.size != 1 or trail_c.size != 1 or edge_of[lead_c[0]] == edge_of[prv[trail_c[0]]]:
-                    raise MeshError(
-                        f"non-manifold crease vertex {v}: a fan of faces "
-                        f"{sorted(self.face_of_halfedge[members].tolist())} "
-                        "is not bounded by both non-manifold edges (not supported)")
+            sharp_fans.update(self._fans_off_the_crease(cs))
         if self.options.boundary == "edge_and_corner":
             corner = (self.face_count == 1) & self.is_boundary_vertex & ~nm_v
             for v in np.flatnonzero(corner).tolist():
@@ -389,6 +384,8 @@ class PolyMesh:
         for v, x in vsharp.items():
             for u in [v, *copies.get(v, [])]:
                 corners[u] = x
+        for c in sorted(sharp_fans):  # (after the vertex's own value: these copies are corners for ever)
+            corners[int(label[c])] = math.inf
         opts = Options("edge_only", self.options.crease_method, self.options.triangle_subdivision)
         try:
             m = PolyMesh(self.vertices[vmap], np.asarray(new, dtype=np.int64), sizes=self.sizes,
@@ -399,6 +396,30 @@ class PolyMesh:
                             f"{exc}") from None
         m.level = self.level
         return m, vmap
+
+    def _fans_off_the_crease(self, cs):
+        """The fans (ids of ``_fan_of_corner``) of a non-manifold crease vertex, given its corners ``cs``,
+        that are not bounded by both of its non-manifold edges: a fin (a fan that leaves and comes back
+        to the same non-manifold edge) or a closed fan.
+
+        OpenSubdiv gives the vertex the crease rule along its two non-manifold edges (ends a, b:
+        ``3/4 v + 1/8 (a + b)`` at every level); a fan bounded by both edges sees both ends, its split
+        copy's crease rule is that one. A copy of any other fan sees at most one of them: no rule of
+        the copy's own fan reproduces OpenSubdiv's vertex point there (it needs a vertex outside the
+        fan). Such a copy is made an infinitely sharp corner: the sharp vertex of a sharpened
+        non-manifold vertex, the closest exact surface the split can give (exact on every fan bounded
+        by both edges; on the others the vertex stays at its position, where OpenSubdiv's moves along
+        the crease curve of a, v, b: the fin's limit point is v instead of (a + 4 v + b) / 6).
+        """
+        comp, twin, prv, edge_of = self._fan_of_corner, self.twin, self.prev, self.edge_of_halfedge
+        out = []
+        for c in sorted(set(comp[cs].tolist())):
+            members = cs[comp[cs] == c]
+            lead_c = members[twin[members] < 0]  # outgoing half-edge on a singular edge
+            trail_c = members[twin[prv[members]] < 0]
+            if lead_c.size != 1 or trail_c.size != 1 or edge_of[lead_c[0]] == edge_of[prv[trail_c[0]]]:
+                out.append(c)
+        return out
 
     def _creases(self, creases):
         out = {}

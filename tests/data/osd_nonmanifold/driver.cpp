@@ -14,7 +14,9 @@
 // first derivatives (second derivatives are computed, not written). Samples: per ptex face the 3x3
 // grid s,t in {0,1/2,1}, the points (2^-k, 2^-k-1) and their images at each corner for k = 2,4,..,12,
 // and 4 random points (std::mt19937_64 seeded with SEED).
-// Also the level-0 tags OpenSubdiv assigned (non-manifold edges/vertices, sharpness, vertex rule).
+// Also the level-0 tags OpenSubdiv assigned (non-manifold edges/vertices, sharpness, vertex rule), and
+// the points of two uniform steps (PrimvarRefiner): vertex_points[l][v] the vertex point of vertex v
+// after l + 1 steps, edge_points[e] the edge point of level-0 edge e (same order as edges).
 #include <opensubdiv/far/patchMap.h>
 #include <opensubdiv/far/patchTable.h>
 #include <opensubdiv/far/patchTableFactory.h>
@@ -196,6 +198,20 @@ int main(int argc, char **argv) {
     }
     int nEdges0 = L0.GetNumEdges();
 
+    // the vertex points of two uniform steps (PrimvarRefiner): per level-0 vertex its child and grandchild,
+    // per level-0 edge its edge point (level 1)
+    Far::TopologyRefiner *uni = Far::TopologyRefinerFactory<Descriptor>::Create(
+        desc, Far::TopologyRefinerFactory<Descriptor>::Options(Sdc::SCHEME_CATMARK, sdc));
+    uni->RefineUniform(Far::TopologyRefiner::UniformOptions(2));
+    std::vector<Pt> uv(uni->GetNumVerticesTotal());
+    for (int i = 0; i < nv; ++i)
+        for (int j = 0; j < 3; ++j) uv[i].x[j] = V[3 * i + j];
+    Far::PrimvarRefinerReal<double> uprim(*uni);
+    int n1 = uni->GetLevel(1).GetNumVertices();
+    Pt *u0 = &uv[0], *u1 = &uv[nv], *u2 = &uv[nv + n1];
+    uprim.Interpolate(1, u0, u1);
+    uprim.Interpolate(2, u1, u2);
+
     const int level = 10;
     Far::TopologyRefiner::AdaptiveOptions aopts(level);
     aopts.useInfSharpPatch = true;
@@ -268,6 +284,22 @@ int main(int argc, char **argv) {
         printf("%s[%d, %d, %.9g]", e ? ", " : "", edgeVerts[2 * e], edgeVerts[2 * e + 1], eSharp[e]);
     printf("],\n  \"faces\": [");
     for (int f = 0; f < nf; ++f) printf("%s{\"size\": %d, \"ptex\": %d}", f ? ", " : "", sizes[f], ptex.GetFaceId(f));
+    printf("],\n  \"vertex_points\": [[");
+    Far::TopologyLevel const &U0 = uni->GetLevel(0), &U1 = uni->GetLevel(1);
+    double nan3[3] = {NAN, NAN, NAN};
+    for (int v = 0; v < nv; ++v) {
+        int c = U0.GetVertexChildVertex(v);
+        printf(v ? ", " : "");
+        put(c < 0 ? nan3 : uv[nv + c].x);
+    }
+    printf("], [");
+    for (int v = 0; v < nv; ++v) {
+        int c = U0.GetVertexChildVertex(v), g = c < 0 ? -1 : U1.GetVertexChildVertex(c);
+        printf(v ? ", " : "");
+        put(g < 0 ? nan3 : uv[nv + n1 + g].x);
+    }
+    printf("]],\n  \"edge_points\": [");
+    for (int e = 0; e < nEdges0; ++e) { printf(e ? ", " : ""); put(uv[nv + U0.GetEdgeChildVertex(e)].x); }
     printf("],\n  \"samples\": [\n");
     double wP[20], wDs[20], wDt[20], wDss[20], wDst[20], wDtt[20];
     int written = 0;
@@ -309,5 +341,6 @@ int main(int argc, char **argv) {
     printf("\n  ]\n}\n");
     delete table;
     delete refiner;
+    delete uni;
     return 0;
 }

@@ -228,5 +228,69 @@ def main():
               "replaced by 6 in every face, its two triangles kept with a repeated vertex (7 is now unused)")
 
 
+def cone_fan(V, F, v, a, axis, k=3, radius=1.0, flip=False):
+    """A fin: k quads around vertex v that leave the edge (v, a) and come back to it, on a cone with
+    apex V[v] and axis `axis` through the direction of a (faces appended to F, ring vertices to V)."""
+    c = np.asarray(V[v], dtype=float)
+    d = np.asarray(axis, dtype=float) / np.linalg.norm(axis)
+    da = np.asarray(V[a], dtype=float) - c
+    da /= np.linalg.norm(da)
+    u = da - (da @ d) * d
+    u /= np.linalg.norm(u)
+    w = np.cross(d, u)
+    cos_h = da @ d
+    sin_h = math.sqrt(1.0 - cos_h * cos_h)
+    ring = [a]
+    for j in range(1, 2 * k):
+        t = math.pi * j / k
+        r = radius * (1.4 if j % 2 == 0 else 1.0)
+        V.append((c + r * (cos_h * d + sin_h * (math.cos(t) * u + math.sin(t) * w))).tolist())
+        ring.append(len(V) - 1)
+    ring.append(a)
+    for j in range(k):
+        q = [v, ring[2 * j], ring[2 * j + 1], ring[2 * j + 2]]
+        F.append(q[::-1] if flip else q)
+
+
+def spine_with_fins(pages=1, fins0=1, fins1=1):
+    """A spine of two edges (vertices 0, 1, 2 along z), `pages` 2x2 pages on both spine edges, `fins0`
+    fins on the edge (1, 0) and `fins1` on the edge (1, 2) (cone_fan)."""
+    V, F = book(pages)
+    V = np.asarray(V, dtype=float).tolist()
+    for i in range(fins0):
+        cone_fan(V, F, 1, 0, (math.cos(math.pi + 1.2 * i), math.sin(math.pi + 1.2 * i), -1.0), flip=i % 2 == 1)
+    for i in range(fins1):
+        cone_fan(V, F, 1, 2, (math.cos(2.0 + 1.2 * i), math.sin(2.0 + 1.2 * i), 1.0), flip=i % 2 == 1)
+    return jitter(V, 0.03), F
+
+
+def triangulated(V, F):
+    """Each quad cut along a diagonal chosen at random (a decimated scan's triangles)."""
+    out = []
+    for q in F:
+        if rng.uniform() < 0.5:
+            out += [[q[0], q[1], q[2]], [q[0], q[2], q[3]]]
+        else:
+            out += [[q[0], q[1], q[3]], [q[1], q[2], q[3]]]
+    return V, out
+
+
+def fins_main():
+    """The meshes with fans of a non-manifold crease vertex not bounded by both non-manifold edges."""
+    V, F = spine_with_fins(1, 1, 1)
+    write_obj("fin.obj", V, F, "a 2x2 page on a spine of two edges (vertices 0, 1, 2) and a fin of three quads on\n"
+              "each spine edge (a fan at vertex 1 that leaves the edge and comes back to it): both spine edges\n"
+              "non-manifold (3 faces), vertex 1 a non-manifold crease whose fins see one spine edge each")
+    V, F = spine_with_fins(0, 2, 2)
+    write_obj("fins_only.obj", V, F, "a spine of two edges (vertices 0, 1, 2), two fins of three quads on the edge\n"
+              "(1, 0) and two on (1, 2) (the second ones reversed), no page: vertex 1 a non-manifold crease with\n"
+              "no fan bounded by both spine edges")
+    V, F = triangulated(*spine_with_fins(3, 1, 0))
+    write_obj("fin_tri.obj", V, F, "three pages and a fin on the edge (1, 0), every quad cut along a random\n"
+              "diagonal (a decimated scan's triangles): vertex 1 a non-manifold crease with three pages\n"
+              "bounded by both spine edges and a fin")
+
+
 if __name__ == "__main__":
     main()
+    fins_main()
