@@ -29,6 +29,7 @@ from __future__ import annotations
 import functools
 import itertools
 import math
+import warnings
 
 import numpy as np
 
@@ -321,6 +322,7 @@ class PolyMesh:
         by_vertex = np.argsort(org, kind="stable")  # corners grouped by vertex
         ptr = np.r_[0, np.cumsum(self.face_count)]
         sharp_fans = set()  # fans of crease vertices not bounded by both non-manifold edges: corners
+        fin_vertices = []  # the non-manifold crease vertices with such a fan (one warning names them)
         # OpenSubdiv's sharpening of the non-manifold vertices
         for v in np.flatnonzero(nm_v).tolist():
             cs = by_vertex[ptr[v] : ptr[v + 1]]
@@ -359,7 +361,15 @@ class PolyMesh:
                         f"non-manifold crease vertex {v}: semi-sharp edges or vertex sharpness {sorted(last)} "
                         "ending at the same level with different values are not supported")
                 vsharp[v] = top
-            sharp_fans.update(self._fans_off_the_crease(cs))
+            fins = self._fans_off_the_crease(cs)
+            sharp_fans.update(fins)
+            if fins:
+                fin_vertices.append(v)
+        if fin_vertices:
+            warnings.warn(f"non-manifold crease vertices {fin_vertices[:10]}{' ...' if len(fin_vertices) > 10 else ''}"
+                          f" ({len(fin_vertices)}): a fan not bounded by both non-manifold edges (a fin) is made a "
+                          "sharp corner; OpenSubdiv's crease rule there needs a vertex outside the fan, so near "
+                          "these vertices the surface differs from OpenSubdiv's (docs/evaluate.md)", stacklevel=2)
         if self.options.boundary == "edge_and_corner":
             corner = (self.face_count == 1) & self.is_boundary_vertex & ~nm_v
             for v in np.flatnonzero(corner).tolist():

@@ -239,3 +239,12 @@ def test_manifold_meshes_never_take_the_split(refdir, monkeypatch):
         m = read_mesh(_path(refdir, name))
         assert m.is_manifold and m.manifold is m
         limit_surface(m).evaluate([0], [0.5], [0.5], 1)
+
+
+def test_a_fin_made_a_corner_is_said_and_a_mesh_of_pages_says_nothing(refdir, recwarn):
+    """The fin's copy is not OpenSubdiv's surface: the split says so once, naming the vertices; book4 (pages
+    only: every fan bounded by both non-manifold edges) is OpenSubdiv's surface and warns nothing."""
+    limit_surface(read_mesh(refdir / "osd_nonmanifold" / "meshes" / "book4.obj"))
+    assert not [w for w in recwarn if "fin" in str(w.message)]
+    with pytest.warns(UserWarning, match=r"non-manifold crease vertices \[\d+.*a fin\) is made a sharp corner"):
+        limit_surface(read_mesh(_path(refdir, "fin.obj")))
