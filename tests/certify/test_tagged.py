@@ -359,3 +359,44 @@ def test_dart_certificates_and_the_rotated_axis():
     forged = copy.deepcopy(cert5)
     forged["parts"]["winding"]["axis"] = [2, 1]
     _fails(forged, "not allowed")
+
+
+# ----------------------------------------------------------------------- the cost budget of one configuration
+_CPU_CHILD = r"""
+import json, resource, sys
+from ccproof.certify.verify import verify_file
+res = verify_file(sys.argv[1], log=lambda line: None)
+use = resource.getrusage(resource.RUSAGE_SELF)
+print(json.dumps({"ok": bool(res), "error": res.error, "cpu": use.ru_utime + use.ru_stime}))
+"""
+
+
+def test_a_large_configuration_on_the_exact_route_fails_on_its_budget_within_10_s(tmp_path):
+    """crease:3's "C1" file renamed crease:100 (1.6 KB): the exact spectrum of S (603 points) took 9 s of
+    CPU before the spectral part failed; it is refused from N alone."""
+    c = json.loads((certificates_dir() / "c1" / "crease" / "n003.json").read_text())
+    c["configuration"] = "crease:100"
+    p = tmp_path / "n100.json"
+    p.write_text(json.dumps(c))
+    out = subprocess.run([sys.executable, "-c", _CPU_CHILD, str(p)], capture_output=True, text=True, timeout=90)
+    got = json.loads(out.stdout.splitlines()[-1])
+    assert not got["ok"] and "exceeds the budget" in got["error"], got
+    assert got["cpu"] < 10.0, got
+
+
+def test_every_published_configuration_on_the_exact_route_fits_the_budget_with_room():
+    from ccproof.certify.verify.tagged import EXACT_BUDGET, check_exact_budget
+    from ccproof.certify.verify.tagged_modes import MIN_N
+
+    sizes = []
+    for p in sorted((certificates_dir() / "c1").glob("*/*.json")):
+        c = json.loads(p.read_text())
+        fam, _, n = c["configuration"].partition(":")
+        if n.isdigit() and (int(n) < MIN_N or c["statement"] == "C1" and fam != "dart"):
+            check_exact_budget(fam, int(n))
+            sizes.append(len(labels(fam, int(n))))
+    assert sizes and max(sizes) ** 3 * 64 < EXACT_BUDGET  # room: 4x in the points, 64x in the work
+    for fam in ("dart", "crease", "corner"):
+        check_exact_budget(fam, 20)
+        with pytest.raises(Exception, match="exceeds the budget"):
+            check_exact_budget(fam, 22)

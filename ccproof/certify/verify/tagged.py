@@ -27,12 +27,12 @@ from flint import acb, ctx, fmpq, fmpq_mat, fmpq_poly
 from .errors import CertificateError
 from .rules import CENTRE, canonical, level1_rule
 
-FAMILIES = ("dart", "crease", "corner")
 RAY_POS = ((1, 0), (2, 0))
 QUAD_POS = ((1, 1), (2, 1), (1, 2), (2, 2))
 MAX_SIZE = 100  # N, K at most this (exact characteristic polynomials of 6K + 1 rows)
 _NAME = re.compile(r"(dart|crease|corner):(>=)?([0-9]{1,7})")
 MAX_TAIL = 10**6  # FAMILY:>=N0 needs N0 at most this
+EXACT_BUDGET = 128**3  # work m^3 of the exact route for S of m points; the published use at most 27 points
 
 
 def parse_configuration(name):
@@ -76,6 +76,35 @@ def parse_configuration(name):
         raise CertificateError(f"configuration {name!r}: {fam}:{'K' if fam == 'dart' else 'N'} needs "
                                f"{lo} <= {'K' if fam == 'dart' else 'N'} <= {MAX_SIZE}")
     return fam, n
+
+
+def check_exact_budget(fam, n):
+    """Refuse, before any arithmetic, a configuration whose exact route exceeds :data:`EXACT_BUDGET`.
+
+    The exact route (the characteristic polynomial of the whole S over Q, its factors, the ranks of
+    p(S), :func:`exact_spectrum`) costs about m^3 operations on rationals for S of m points (m = 6N + 3,
+    6K + 1 for a dart), 9 s of CPU for crease:100. The budget, 128^3 (N, K <= 20; a few hundredths of a
+    second), admits every published certificate on that route (at most 27 points) with room; larger
+    configurations are decided through the modes of :mod:`.tagged_modes` or not at all.
+
+    Raises
+    ------
+    CertificateError
+        Naming the configuration, its work and the budget.
+
+    Examples
+    --------
+    >>> check_exact_budget("crease", 20)
+    >>> try:
+    ...     check_exact_budget("crease", 100)
+    ... except CertificateError as exc:
+    ...     print(exc)
+    crease:100: the exact route on S of 603 points exceeds the budget (m^3 > 128^3: N, K <= 20)
+    """
+    m = len(labels(fam, n))
+    if m**3 > EXACT_BUDGET:
+        raise CertificateError(f"{fam}:{n}: the exact route on S of {m} points exceeds the budget (m^3 > 128^3: "
+                               "N, K <= 20)")
 
 
 def labels(fam, n):
