@@ -56,6 +56,32 @@ def verify_c1(cert, k, part, log):
     >>> bool(res), res.parts[4].name
     (True, 'det J_Phi > 0 on P1')
     """
+    prec, piece_list, ends = _read_pieces(cert, k)
+    log(f"C1 certificate for valence {kname(k)} ({prec} bits)")
+    if not _check_spectrum(k, ends, prec, part):
+        return
+    exact = derivation().integer_forms("bspline") if ends else None
+    for idx, pc in enumerate(piece_list):
+        tag = f"[piece {idx}] " if ends else ""
+        with ctx.workprec(prec):
+            try:
+                if ends:
+                    La, Lb = ends[idx]
+                    nets, lam = hull_nets(parameter_nets(exact, La, Lb, 0, 3, prec), prec), arb(La).union(arb(Lb))
+                else:
+                    nets, lam = nets_for_valence(k, prec), c_lam(k, prec)[1]
+            except (StatementError, CertificateError) as exc:
+                part(f"{tag}S nets of the characteristic map", False, str(exc))
+                return
+            check_hypotheses(nets, lam, part, tag)
+            _check_parts(nets, pc["parts"], tag, prec, part)
+            if part.failed:
+                return
+
+
+def _read_pieces(cert, k):
+    """``(prec, pieces, ends)``: the record read and every box list checked to partition its domain, before
+    any arithmetic; ``ends`` the exact (low, high) of each lam piece (empty for one valence)."""
     exact_keys(cert, ("schema", "valence", "prec", "pieces" if isinstance(k, dict) else "parts"), "certificate")
     prec = field_of(cert, "prec", int, "certificate")
     if not 64 <= prec <= 1024:
@@ -80,45 +106,33 @@ def verify_c1(cert, k, part, log):
         for label, sec, nv in (("regularity", reg, 2), ("star", star, 1)):
             for name, boxes in sec.items():
                 read_boxes(boxes, nv, f"parts.{label}.{name}")  # the partition, before any arithmetic
-    if ends and (any(not a < b for a, b in ends) or any(ends[i][1] != ends[i + 1][0] for i in range(len(ends) - 1))):
+    if any(not a < b for a, b in ends) or any(ends[i][1] != ends[i + 1][0] for i in range(len(ends) - 1)):
         raise CertificateError("the lam pieces must be increasing and contiguous")  # exact fmpq comparisons
-    log(f"C1 certificate for valence {kname(k)} ({prec} bits)")
+    return prec, piece_list, ends
+
+
+def _check_spectrum(k, ends, prec, part):
+    """The derivation, the Fourier blocks, the spectral ordering and (every k >= k0) the lam interval."""
     if not check_derivation(part):
-        return
+        return False
     ok = check_block_polynomials()
     part("spectrum: Fourier blocks of the rules have the stated characteristic polynomials", ok,
          "exact identities in (x, w) and (x, 1/k)" if ok else "an identity fails")
     if not ok:
-        return
+        return False
     ok, msg = spectral_ordering(k, prec)
     part("spectral ordering 1 > lam = lam > |lam_3|, lam non-defective", ok, msg)
-    if not ok:
-        return
-    if ends:
+    if ok and ends:
         ok = lam_interval_ok(k["min"], ends[0][0], ends[-1][1], prec)
         part(f"lam(k) in [{ends[0][0]}, {ends[-1][1]}] for every k >= {k['min']}", ok)
-        if not ok:
-            return
-    exact = derivation().integer_forms("bspline") if ends else None
-    for idx, pc in enumerate(piece_list):
-        tag = f"[piece {idx}] " if ends else ""
-        with ctx.workprec(prec):
-            try:
-                if ends:
-                    La, Lb = ends[idx]
-                    nets, lam = hull_nets(parameter_nets(exact, La, Lb, 0, 3, prec), prec), arb(La).union(arb(Lb))
-                else:
-                    nets, lam = nets_for_valence(k, prec), c_lam(k, prec)[1]
-            except (StatementError, CertificateError) as exc:
-                part(f"{tag}S nets of the characteristic map", False, str(exc))
-                return
-            check_hypotheses(nets, lam, part, tag)
-            for name in PATCHES:
-                ok, msg, mb = check_boxes(regularity_form(nets, name, prec), pc["parts"]["regularity"][name],
-                                          f"regularity {name}")
-                part(f"{tag}det J_Phi > 0 on {name}", ok, msg or f"min bound {mb} (local s,t)", mb, "regularity")
-            for curve in STAR_CURVES:
-                ok, msg, mb = check_boxes(star_form(nets, curve, prec), pc["parts"]["star"][curve], f"star {curve}")
-                part(f"{tag}outer boundary star-shaped on {curve}", ok, msg or f"min bound {mb}", mb, "star")
-            if part.failed:
-                return
+    return ok
+
+
+def _check_parts(nets, parts, tag, prec, part):
+    """Replay the boxes of ``parts.regularity`` (det J_Phi) and ``parts.star`` (the outer curves)."""
+    for name in PATCHES:
+        ok, msg, mb = check_boxes(regularity_form(nets, name, prec), parts["regularity"][name], f"regularity {name}")
+        part(f"{tag}det J_Phi > 0 on {name}", ok, msg or f"min bound {mb} (local s,t)", mb, "regularity")
+    for curve in STAR_CURVES:
+        ok, msg, mb = check_boxes(star_form(nets, curve, prec), parts["star"][curve], f"star {curve}")
+        part(f"{tag}outer boundary star-shaped on {curve}", ok, msg or f"min bound {mb}", mb, "star")

@@ -293,6 +293,13 @@ def derivation():
     """
     vals = _eigenvector()
     eig_ok = all(e.is_zero() for e in _eigen_equations(vals))
+    vec, bs, bz = _normalized_nets(vals)
+    symmetric, hyp = _hypotheses(bz, eig_ok)
+    return Derivation(vec, bs, bz, symmetric, hyp)
+
+
+def _normalized_nets(vals):
+    """(eigenvector, B-spline nets, Bezier nets), scaled so that Phi(1, 0) = (1, 0)."""
     raw = {n: [[level1(vals, oa + i, ob + j) for j in range(4)] for i in range(4)]
            for n, (oa, ob) in NET_OFFSETS.items()}
     phi10 = bspline_to_bezier(raw["P1"])[3][0]
@@ -301,7 +308,11 @@ def derivation():
     scale = phi10[0].inverse()
     bs = {n: [[tuple(q * scale for q in p) for p in row] for row in net] for n, net in raw.items()}
     vec = {p: tuple(q * scale for q in v) for p, v in vals.items()}
-    bz = {n: bspline_to_bezier(net) for n, net in bs.items()}
+    return vec, bs, {n: bspline_to_bezier(net) for n, net in bs.items()}
+
+
+def _hypotheses(bz, eig_ok):
+    """(symmetric, [(hypothesis, holds)]): docs/appendix_a.md section 0, exact in F."""
     P1, P2, P3 = bz["P1"], bz["P2"], bz["P3"]
     L = QL.lam()
     zero, one = QL(0), QL(1)
@@ -329,7 +340,7 @@ def derivation():
         ("layer boundary: Phi(u, 1/2) = lam Phi(2u, 1)",
          same(inner3[0], scaled(row(P3, 3))) and same(inner3[1], scaled(row(P2, 3)))),
     ]
-    return Derivation(vec, bs, bz, symmetric, hyp)
+    return symmetric, hyp
 
 
 # ------------------------------------------------------------------------ one valence in arb

@@ -260,6 +260,34 @@ def winding(rho, arcs, R, M):
     return turn / (2 * arb.pi()), None
 
 
+def _in_modes(x):  # is x a root of some q_c, c in [-1, 1]? c*(x) = 8 x + 1/(2 x) - 5
+    return x != 0 and -1 <= 8 * x + 1 / (2 * x) - 5 <= 1
+
+
+def _leading_gap(croots, below, blocks, others, b0, n0):
+    """Why 1 is not simple or alpha, beta do not lead (None when they do)."""
+    if croots.count(1) != 1 or len(below) != 4:
+        return "eigenvalue 1 is not simple in the crease block"
+    if _in_modes(fmpq(1)) or any(M.charpoly()(1) == 0 for M in blocks):
+        return "1 is an eigenvalue of the modes"
+    if not lam_of(arb(1)) < 1:
+        return "lam(1) < 1 is not certain"
+    if not all(x < b0 for x in others):
+        return f"an eigenvalue other than alpha, beta is not certainly below lam(cos(2 pi/{n0}))"
+    return None
+
+
+def _gamma_gap(g, cg, below, blocks, b0, n0):
+    """Why gamma = g is not the crease block's largest eigenvalue below 1, simple and below beta (or None)."""
+    if g != max(below):
+        return f"gamma is not the crease block's largest eigenvalue below 1 ({max(below)})"
+    if not arb(g) < b0:
+        return f"gamma < lam(cos(2 pi/{n0})) is not certain"
+    if g in _SMALL or cg is None or (1 + cg) * (9 + cg) == 0 or any(M.charpoly()(g) == 0 for M in blocks):
+        return "gamma is possibly a multiple eigenvalue of I"
+    return None
+
+
 def uniform_spectrum(fam, n0, g, C, blocks):
     """(ok, message): part 2 of the module docstring for every N >= n0 with gamma = g (exact)."""
     fac = C.charpoly().factor()[1]
@@ -270,20 +298,8 @@ def uniform_spectrum(fam, n0, g, C, blocks):
     b0 = lam_of(arb(fmpq(2, n0)).cos_pi())  # <= beta = lam(cos(2 pi/N)) for every N >= n0
     inner = [z for M in blocks for z, _ in _roots(M)]
     others = [arb(abs(r)) for r in below] + [abs(z) for z in inner] + [arb(s) for s in _SMALL] + [arb(fmpq(1, 4))]
-
-    def in_modes(x):  # is x a root of some q_c, c in [-1, 1]? c*(x) = 8 x + 1/(2 x) - 5
-        return x != 0 and -1 <= 8 * x + 1 / (2 * x) - 5 <= 1
-
     cg = 8 * g + 1 / (2 * g) - 5 if g != 0 else None
-    why = ("eigenvalue 1 is not simple in the crease block" if croots.count(1) != 1 or len(below) != 4 else
-           "1 is an eigenvalue of the modes" if in_modes(fmpq(1)) or any(M.charpoly()(1) == 0 for M in blocks) else
-           "lam(1) < 1 is not certain" if not lam_of(arb(1)) < 1 else
-           f"an eigenvalue other than alpha, beta is not certainly below lam(cos(2 pi/{n0}))"
-           if not all(x < b0 for x in others) else
-           f"gamma is not the crease block's largest eigenvalue below 1 ({max(below)})" if g != max(below) else
-           f"gamma < lam(cos(2 pi/{n0})) is not certain" if not arb(g) < b0 else
-           "gamma is possibly a multiple eigenvalue of I" if g in _SMALL or cg is None or (1 + cg) * (9 + cg) == 0
-           or any(M.charpoly()(g) == 0 for M in blocks) else None)
+    why = _leading_gap(croots, below, blocks, others, b0, n0) or _gamma_gap(g, cg, below, blocks, b0, n0)
     if why is not None:
         return False, f"every N >= {n0}: {why}"
     return True, (f"every N >= {n0}: alpha = lam(cos(pi/N)) > beta = lam(cos(2 pi/N)) >= {b0.str(6, radius=False)} > "
@@ -380,8 +396,12 @@ def _check_tail(fam, n0, g, cval, rho, R, side, arcs, outer, part, log):
     ok = reflection_identity()
     part("N reflection: B(1/w) R_w = R_w B(w) (exact), so f is odd and H has a zero of order >= 4 at 0", ok,
          "" if ok else "the ring stencil breaks the reflection identity")
-    if part.failed:
-        return
+    if not part.failed:
+        _check_normal(fam, n0, rho, R, side, arcs, outer, part, log)
+
+
+def _check_normal(fam, n0, rho, R, side, arcs, outer, part, log):
+    """N for every N >= n0: H analytic on the disc |theta| <= R, bounded on its circle, winding 4 times."""
     got = check_disc(R, side)
     ok = isinstance(got, int)
     part(f"x, y and N analytic: the bordered systems of modes 1 and 2 regular on |theta| <= {R}", ok,

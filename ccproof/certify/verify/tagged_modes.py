@@ -339,6 +339,36 @@ def check_dart(k):
         raise CertificateError(f"dart:{k}: the mode structure is used for K >= {MIN_N}")
     check_ring()
     pts, rows = labels("dart", k), sector_rows("dart", k)
+    refl = _check_dart_rows(k, pts, rows)
+    reps = [i for i in range(len(pts)) if i <= refl[i]]
+    rep = [0] * len(pts)
+    for a, i in enumerate(reps):
+        rep[i] = rep[refl[i]] = a
+    SE = fmpq_mat(len(reps), len(reps))
+    for a, i in enumerate(reps):
+        for j, x in rows[i].items():
+            SE[a, rep[j]] += x
+    blocks = [M for M, _ in [_odd_block(1)] + ([_odd_block(-1)] if k % 2 == 0 else []) if M is not None]
+    if 6 * ((k + 1) // 2 - 1) + sum(M.nrows() for M in blocks) != len(pts) - len(reps):
+        raise CertificateError(f"dart:{k}: the modes do not account for every odd vector")
+    inner = [a for a, i in enumerate(reps) if pts[i] == ("C",) or pts[i][2:] in ((1, 0), (1, 1))]
+    fac, outer, bound = _one_ring(k, SE, inner)
+    return SE, tuple(rep), tuple(blocks), fac, (tuple(inner), outer), bound
+
+
+def _one_ring(k, SE, inner):
+    """The one-ring (centre, (1,0), (1,1)) is closed: S_E = [[S_in, 0], [*, S_out]] (checked exactly); the
+    factors of S_in's characteristic polynomial, the outer rows and |S_out|_inf >= rho(S_out)."""
+    outer = tuple(a for a in range(SE.nrows()) if a not in inner)
+    if any(SE[a, b] != 0 for a in inner for b in outer):
+        raise CertificateError(f"dart:{k}: the one-ring is not closed under the rules")
+    bound = max(sum((abs(SE[a, b]) for b in outer), fmpq(0)) for a in outer)
+    return fmpq_mat([[SE[a, b] for b in inner] for a in inner]).charpoly().factor()[1], outer, bound
+
+
+def _check_dart_rows(k, pts, rows):
+    """The reflection in the sharp ray (as a permutation of the points), after checking exactly that the
+    rows commute with it and that every row but the centre's and ray 0's is the ring rule."""
     idx = {p: i for i, p in enumerate(pts)}
     refl = [idx[_dart_reflect(p, k)] for p in pts]
     for i, p in enumerate(pts):
@@ -352,25 +382,7 @@ def check_dart(k):
             ring[j] = ring.get(j, 0) + x
         if {j: x for j, x in ring.items() if x != 0} != {j: x for j, x in rows[i].items() if j != 0}:
             raise CertificateError(f"dart:{k}: the row of {p} is not the ring rule")
-    reps = [i for i in range(len(pts)) if i <= refl[i]]
-    rep = [0] * len(pts)
-    for a, i in enumerate(reps):
-        rep[i] = rep[refl[i]] = a
-    SE = fmpq_mat(len(reps), len(reps))
-    for a, i in enumerate(reps):
-        for j, x in rows[i].items():
-            SE[a, rep[j]] += x
-    blocks = [M for M, _ in [_odd_block(1)] + ([_odd_block(-1)] if k % 2 == 0 else []) if M is not None]
-    if 6 * ((k + 1) // 2 - 1) + sum(M.nrows() for M in blocks) != len(pts) - len(reps):
-        raise CertificateError(f"dart:{k}: the modes do not account for every odd vector")
-    # the one-ring (centre, (1,0), (1,1)) is closed: S_E = [[S_in, 0], [*, S_out]], rho(S_out) <= |S_out|_inf
-    inner = [a for a, i in enumerate(reps) if pts[i] == ("C",) or pts[i][2:] in ((1, 0), (1, 1))]
-    outer = [a for a in range(len(reps)) if a not in inner]
-    if any(SE[a, b] != 0 for a in inner for b in outer):
-        raise CertificateError(f"dart:{k}: the one-ring is not closed under the rules")
-    bound = max(sum((abs(SE[a, b]) for b in outer), fmpq(0)) for a in outer)
-    S_in = fmpq_mat([[SE[a, b] for b in inner] for a in inner])
-    return SE, tuple(rep), tuple(blocks), S_in.charpoly().factor()[1], (tuple(inner), tuple(outer)), bound
+    return refl
 
 
 def even_vector(k, lam, pivot):
