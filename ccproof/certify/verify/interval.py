@@ -23,7 +23,7 @@ from ccproof.rigorous import (
 
 from .errors import CertificateError
 from .maps import ORIGIN, cell_geometry, cell_pieces, dyadic_cells, net_form, weight_piece
-from .statement import B2Z, PATCHES
+from .statement import B2Z, PATCHES, c_lam
 
 ZBOX = ((fmpq(-1), fmpq(1)), (fmpq(0), fmpq(1)), (fmpq(0), fmpq(1)))  # (zeta, s, t) of part D
 
@@ -337,6 +337,4 @@ def lam_interval_ok(k0, La, Lb, prec):
     [True, False, False]
     """
     with ctx.workprec(prec):
-        c = arb(fmpq(2, k0)).cos_pi()
-        lam0 = (5 + c + ((1 + c) * (9 + c)).sqrt()) / 16
-        return bool(lam0 >= La) and bool((3 + arb(5).sqrt()) / 8 <= Lb)
+        return bool(c_lam(k0, prec)[1] >= La) and bool((3 + arb(5).sqrt()) / 8 <= Lb)

@@ -30,6 +30,7 @@ from __future__ import annotations
 from flint import arb, ctx, fmpq, fmpq_mat
 
 from .rules import CENTRE, TWO_RING, apply, centre_rule_mode0, level1_rule
+from .statement import lam_of
 
 
 def _block(w=None, t=None):
@@ -109,25 +110,6 @@ def check_block_polynomials():
             if _charpoly_at(rows, fmpq(x)) != _claimed_mode0(fmpq(x), fmpq(t)):
                 return False
     return True
-
-
-def lam_of(c):
-    """lam = (5 + c + sqrt((1 + c)(9 + c))) / 16, the subdominant eigenvalue at c = cos(2 pi/k) (R2).
-
-    Parameters
-    ----------
-    c : arb
-
-    Returns
-    -------
-    arb
-
-    Examples
-    --------
-    >>> lam_of(arb(0)), lam_of(arb(-1) / 2).overlaps((9 + arb(17).sqrt()) / 32)   # k = 4, k = 3
-    (0.500000000000000, True)
-    """
-    return (5 + c + ((1 + c) * (9 + c)).sqrt()) / 16
 
 
 def spectral_ordering(k, prec):

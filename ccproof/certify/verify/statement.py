@@ -344,6 +344,19 @@ def _hypotheses(bz, eig_ok):
 
 
 # ------------------------------------------------------------------------ one valence in arb
+def lam_of(c):
+    """lam(c) = (5 + c + sqrt((1 + c)(9 + c)))/16: the subdominant eigenvalue, at c = cos(2 pi/k) for the
+    valence k (docs/readings.md R2); the one definition of lam in the trusted base (arb or acb c, the
+    principal square root).
+
+    Examples
+    --------
+    >>> lam_of(arb(0)), lam_of(arb(-1) / 2).overlaps((9 + arb(17).sqrt()) / 32)   # k = 4, k = 3
+    (0.500000000000000, True)
+    """
+    return (5 + c + ((1 + c) * (9 + c)).sqrt()) / 16
+
+
 def c_lam(k, prec):
     """Balls (c, lam) holding cos(2 pi/k) and lam(k) = (5 + c + sqrt((1 + c)(9 + c)))/16.
 
@@ -367,7 +380,7 @@ def c_lam(k, prec):
     """
     with ctx.workprec(prec):
         c = arb(fmpq(2, k)).cos_pi()
-        return c, (5 + c + ((1 + c) * (9 + c)).sqrt()) / 16
+        return c, lam_of(c)
 
 
 def nets_for_valence(k, prec, which="bezier"):

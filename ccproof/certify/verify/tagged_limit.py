@@ -55,7 +55,8 @@ from flint import acb, acb_mat, arb, ctx, fmpq, fmpq_mat
 from .errors import CertificateError
 from .record import exact_keys, field_of
 from .replay import parse_decimal
-from .spectrum import _SMALL, lam_of
+from .spectrum import _SMALL
+from .statement import lam_of
 from .tagged import crease_block, crease_points, labels, sector_rows
 from .tagged_c1 import _DW, _W, _check_boundary
 from .tagged_modes import _POS, _block, _roots, check_ring, check_structure
@@ -156,7 +157,7 @@ def _tangents(theta, j):
     disc = (1 + c) * (9 + c)
     if not disc.real > 0:
         raise ZeroDivisionError("(1 + c)(9 + c) is not certainly in the right half-plane")
-    lam = (5 + c + disc.sqrt()) / 16
+    lam = lam_of(c)
     B = _block(w)
     rows = [[B[i][k] - (lam if i == k else 0) for k in range(6)] + [acb(int(i == _PIVOT))] for i in range(6)]
     rows.append([acb(int(k == _PIVOT)) for k in range(6)] + [acb(0)])

@@ -24,7 +24,7 @@ characteristic polynomial of the 6N + 3 points (docs/tagged_c1.md, "Spectrum in 
 4. **Block polynomials.** det(x - B(w)) = (x - 1/8)(x - 1/16)(x - 1/32)(x - 1/64)(x^2 - (5 + c) x/8 + 1/16),
    c = (w + 1/w)/2, checked here exactly for this stencil on a grid of rational points (as
    :func:`.spectrum.check_block_polynomials`). So mode j has 1/8..1/64, lam(c_j) and 1/(16 lam(c_j)),
-   c_j = cos(pi j/N), lam(c) = (5 + c + sqrt((1 + c)(9 + c)))/16 (:func:`.spectrum.lam_of`).
+   c_j = cos(pi j/N), lam(c) = (5 + c + sqrt((1 + c)(9 + c)))/16 (:func:`.statement.lam_of`).
 
 **Darts** (:func:`check_dart`, K >= MIN_N): S commutes with the reflection R in the sharp ray 0 (checked
 row by row), so the even and the odd vectors are invariant; every row but the centre's and ray 0's is
@@ -49,7 +49,8 @@ from flint import acb, acb_mat, arb, arb_mat, fmpq, fmpq_mat
 
 from .errors import CertificateError
 from .rules import CENTRE, TWO_RING, canonical, level1_rule
-from .spectrum import _SMALL, _charpoly_at, _claimed_mode, lam_of
+from .spectrum import _SMALL, _charpoly_at, _claimed_mode
+from .statement import lam_of
 from .tagged import crease_block, crease_points, labels, sector_rows
 
 MIN_N = 5  # crease:N, corner:N with N >= MIN_N take this path (a "not C1" witness)
