@@ -38,7 +38,6 @@ def verify_c1(cert, k, part, log):
         From :func:`.record.read_valence`.
     part : Recorder
         Receives one :class:`.record.Part` per checked claim.
-    log : callable (str) -> None
 
     Raises
     ------

@@ -140,11 +140,6 @@ class QL:
 def horner(p, x):
     """p(x) for an fmpq_poly p and an arb x (ball arithmetic, Horner's scheme).
 
-    Parameters
-    ----------
-    p : fmpq_poly
-    x : arb
-
     Returns
     -------
     arb

@@ -40,10 +40,6 @@ MAX_LEVEL = 6  # N: every published certificate, every k >= 3, needs at most 5; 
 def check_derivation(part):
     """Part S: the statement's identities (once per process; every valence at once).
 
-    Parameters
-    ----------
-    part : Recorder
-
     Returns
     -------
     bool
@@ -69,9 +65,6 @@ def check_hypotheses(nets, lam, part, tag=""):
 
     Parameters
     ----------
-    nets : dict[str, 4 x 4 of (arb, arb)]
-    lam : arb
-    part : Recorder
     tag : str
         Prefix of the part's name.
 
@@ -97,14 +90,6 @@ def form_patches(symmetric):
     """The pieces whose forms parts B and E check: all three, or P2 and P3 under the mirror symmetry
     (exact, part S), which maps P1's det J_Phi and corner form onto P3's with (s, t) swapped
     (docs/appendix_a.md section 8), as part D keeps only the cells with l <= m.
-
-    Parameters
-    ----------
-    symmetric : bool
-
-    Returns
-    -------
-    tuple of str
 
     Examples
     --------
@@ -132,14 +117,6 @@ def _check_structure(parts, cell_vars):
 def read_n_prec(cert):
     """The level N (1..:data:`MAX_LEVEL`) and the precision in bits (64..1024) of a certificate.
 
-    Parameters
-    ----------
-    cert : dict
-
-    Returns
-    -------
-    (int, int)
-
     Examples
     --------
     >>> read_n_prec({"N": 3, "prec": 128})
@@ -163,9 +140,6 @@ def verify_valence(cert, k, part, log):
     ----------
     cert : dict
         Schema :data:`SCHEMA` with ``N``, ``prec`` and ``parts`` (``regularity``, ``cells``, ``corner``).
-    k : int
-    part : Recorder
-    log : callable (str) -> None
 
     Raises
     ------
@@ -209,12 +183,6 @@ def check_parts(parts, nets, lam, N, prec, cells, part, tag):
     ----------
     parts : dict
         ``regularity``, ``cells``, ``corner`` box lists of the certificate.
-    nets : dict[str, 4 x 4 of (arb, arb)]
-    lam : arb
-    N, prec : int
-    cells : list of (str, callable () -> BernsteinForm)
-    part : Recorder
-    tag : str
 
     Examples
     --------
@@ -288,9 +256,6 @@ def verify_interval(cert, k, part, log):
     ----------
     cert : dict
         Schema :data:`SCHEMA` with ``N``, ``prec``, ``parameter`` and ``pieces``.
-    k : dict ``{"min": k0}``
-    part : Recorder
-    log : callable (str) -> None
 
     Raises
     ------
@@ -356,13 +321,6 @@ def verify_interval(cert, k, part, log):
 
 def verify_injectivity(cert, k, part, log):
     """An injectivity certificate (docs/appendix_a.md): :func:`verify_interval` or :func:`verify_valence`.
-
-    Parameters
-    ----------
-    cert : dict
-    k : int or dict ``{"min": k0}``
-    part : Recorder
-    log : callable (str) -> None
 
     Returns
     -------

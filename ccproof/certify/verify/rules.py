@@ -68,10 +68,6 @@ def _add(acc, comb, w):
 def face_point(a, b):
     """New face point of the level-0 face with lower corner (a, b): {raw position: weight}.
 
-    Parameters
-    ----------
-    a, b : int
-
     Returns
     -------
     dict[(int, int), fmpq]
@@ -170,14 +166,8 @@ def apply(comb, lookup, zero):
 
     Parameters
     ----------
-    comb : dict[(int, int), weight]
     lookup : callable (delta, (a', b')) -> value
         The value at position (a', b') of the sector delta steps on.
-    zero : the zero of the values
-
-    Returns
-    -------
-    value
 
     Examples
     --------
@@ -197,11 +187,6 @@ def apply(comb, lookup, zero):
 def level1_value(A, B, lookup, zero):
     """The level-1 value at any sector-local level-1 position (A, B) != centre, rotated into place:
     canonicalize to (delta, A', B'), apply the rule in sector delta.
-
-    Parameters
-    ----------
-    A, B : int
-    lookup, zero : as in :func:`apply` (relative to sector delta)
 
     Returns
     -------

@@ -118,7 +118,6 @@ def spectral_ordering(k, prec):
 
     Parameters
     ----------
-    k : int or dict ``{"min": k0}``
     prec : int
         Bits of the arb comparisons.
 

@@ -56,15 +56,6 @@ class StatementError(ValueError):
 def rot(delta, p):
     """R^delta p in the normalized frame, R = [[0, -1], [1, 2c]] (delta in -1..2; docs/readings.md R3).
 
-    Parameters
-    ----------
-    delta : int
-    p : (QL, QL)
-
-    Returns
-    -------
-    (QL, QL)
-
     Examples
     --------
     >>> x, y = rot(1, (QL(1), QL(0)))
@@ -116,7 +107,6 @@ def level1(values, A, B):
     ----------
     values : dict[(int, int), (QL, QL)]
         The sector-0 two-ring (:data:`TWO_RING`) in the normalized frame.
-    A, B : int
 
     Returns
     -------
@@ -189,10 +179,6 @@ def _eigenvector():
 
 def bspline_to_bezier(net):
     """Bezier net of the uniform bicubic B-spline segment of a 4x4 net of F-points (exact).
-
-    Parameters
-    ----------
-    net : 4 x 4 nested sequence of (QL, QL)
 
     Returns
     -------
@@ -362,7 +348,6 @@ def c_lam(k, prec):
 
     Parameters
     ----------
-    k : int
     prec : int
         Bits.
 
@@ -386,16 +371,6 @@ def c_lam(k, prec):
 def nets_for_valence(k, prec, which="bezier"):
     """arb nets {piece: 4x4 of (x, y)} of valence k, evaluated from the derived exact forms; raises
     :class:`StatementError` if a denominator may vanish at c = cos(2 pi/k).
-
-    Parameters
-    ----------
-    k : int
-    prec : int
-    which : {"bezier", "bspline"}
-
-    Returns
-    -------
-    dict[str, 4 x 4 of (arb, arb)]
 
     Examples
     --------

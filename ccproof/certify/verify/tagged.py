@@ -45,10 +45,6 @@ def parse_configuration(name):
         ``"dart:K"`` (K >= 2), ``"crease:N"`` or ``"corner:N"`` (N >= 1), at most :data:`MAX_SIZE`;
         ``"FAMILY:>=N0"`` with 2 <= N0 <= :data:`MAX_TAIL`.
 
-    Returns
-    -------
-    (str, int or dict)
-
     Raises
     ------
     CertificateError
@@ -109,11 +105,6 @@ def check_exact_budget(fam, n):
 
 def labels(fam, n):
     """The points of the sector complex, in matrix order: centre, ray points, quadrant points.
-
-    Parameters
-    ----------
-    fam : str
-    n : int
 
     Returns
     -------
@@ -252,11 +243,6 @@ def exact_spectrum(fam, n):
     dim ker p(S) = deg(p) * (geometric multiplicity), so the roots are non-defective iff
     dim ker p(S) = e deg(p).
 
-    Parameters
-    ----------
-    fam : str
-    n : int
-
     Returns
     -------
     list of (fmpq_poly, int, int)
@@ -302,10 +288,6 @@ def crease_points(fam, n):
 def crease_block(fam, n):
     """The block C of S on :func:`crease_points`, after checking exactly that those rows vanish elsewhere.
 
-    Returns
-    -------
-    flint.fmpq_mat, shape (5, 5)
-
     Raises
     ------
     CertificateError
@@ -332,16 +314,6 @@ def eigenvalues(fam, n, prec):
     each root listed once per unit of algebraic multiplicity; isolated by arb (``complex_roots``), real
     roots with an exactly zero imaginary part.
 
-    Parameters
-    ----------
-    fam : str
-    n : int
-    prec : int
-
-    Returns
-    -------
-    list of (acb, fmpq_poly, int, int)
-
     Examples
     --------
     >>> ev = eigenvalues("crease", 3, 64)
@@ -363,12 +335,6 @@ def _key(item):  # ordering for display and for choosing candidates; every decis
 def leading_spectrum(fam, n, prec):
     """The spectral part of the generalized Reif criterion for a sector (docs/tagged_c1.md):
     1 simple, lam1 >= lam2 > |every other| real and positive, lam1 and lam2 non-defective.
-
-    Parameters
-    ----------
-    fam : str
-    n : int
-    prec : int
 
     Returns
     -------

@@ -316,10 +316,6 @@ def verify_tail(cert, fam, n0, part, log):
     cert : dict
         ``schema``, ``configuration``, ``statement`` ("not C1"), ``prec``, ``witness`` ({"z": coord}) and
         ``limit`` ({"rho", "R", "box": decimals, "arcs", "outer_arcs": ints}).
-    fam : str
-    n0 : int
-    part : Recorder
-    log : callable (str) -> None
 
     Returns
     -------
