@@ -109,7 +109,6 @@ REVIEWED = {
     ("tagged_modes.py", "image != mirrored"): "dicts of fmpq weights with int keys (exact)",
     ("tagged_modes.py", "{j: x for j, x in folded.items() if x != 0} != {j: x for j, x in rows[i].items() if j not in "
                         "cp}"): "dicts of fmpq weights (exact)",
-    ("tagged_modes.py", "_charpoly_at(rows, fmpq(x)) != _claimed_mode(fmpq(x), c)"): "fmpq determinants (exact)",
     ("tagged_modes.py", "w != 0"): "fmpq rule weights (exact)",
     ("tagged_modes.py", "R[r, c] != 0"): "fmpq_mat entries (exact)",
     ("tagged_modes.py", "x != 0"): "fmpq folded weights (exact)",

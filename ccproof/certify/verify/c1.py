@@ -16,11 +16,11 @@ from __future__ import annotations
 from flint import arb, ctx
 
 from .errors import CertificateError
-from .injectivity import check_derivation, check_hypotheses
+from .injectivity import check_derivation, check_hypotheses, read_lam_pieces
 from .interval import hull_nets, lam_interval_ok, parameter_nets
 from .maps import STAR_CURVES, regularity_form, star_form
 from .record import exact_keys, field_of, kname
-from .replay import check_boxes, parse_decimal, read_boxes
+from .replay import check_boxes, read_boxes
 from .spectrum import check_block_polynomials, spectral_ordering
 from .statement import PATCHES, StatementError, c_lam, derivation, nets_for_valence
 
@@ -85,29 +85,22 @@ def _read_pieces(cert, k):
     prec = field_of(cert, "prec", int, "certificate")
     if not 64 <= prec <= 1024:
         raise CertificateError("prec must lie in 64..1024")
-    piece_list = field_of(cert, "pieces", list, "certificate") if isinstance(k, dict) else [
-        {"lam": None, "parts": field_of(cert, "parts", dict, "certificate")}]
-    if not 1 <= len(piece_list) <= 64:
-        raise CertificateError("there must be 1..64 lam pieces")
-    ends = []
-    for pc in piece_list:
-        if isinstance(k, dict):
-            exact_keys(pc, ("lam", "parts"), "piece")
-            lo_hi = field_of(pc, "lam", list, "piece")
-            if len(lo_hi) != 2:
-                raise CertificateError("piece lam must be [low, high]")
-            ends.append(tuple(parse_decimal(x) for x in lo_hi))
-        parts = pc["parts"]
-        exact_keys(parts, ("regularity", "star"), "parts")
-        reg, star = field_of(parts, "regularity", dict, "parts"), field_of(parts, "star", dict, "parts")
-        exact_keys(reg, PATCHES, "parts.regularity")
-        exact_keys(star, tuple(STAR_CURVES), "parts.star")
-        for label, sec, nv in (("regularity", reg, 2), ("star", star, 1)):
-            for name, boxes in sec.items():
-                read_boxes(boxes, nv, f"parts.{label}.{name}")  # the partition, before any arithmetic
-    if any(not a < b for a, b in ends) or any(ends[i][1] != ends[i + 1][0] for i in range(len(ends) - 1)):
-        raise CertificateError("the lam pieces must be increasing and contiguous")  # exact fmpq comparisons
-    return prec, piece_list, ends
+    if not isinstance(k, dict):
+        piece_list = [{"lam": None, "parts": field_of(cert, "parts", dict, "certificate")}]
+        _read_parts(piece_list[0]["parts"])
+        return prec, piece_list, []
+    piece_list = field_of(cert, "pieces", list, "certificate")
+    return prec, piece_list, read_lam_pieces(piece_list, _read_parts)
+
+
+def _read_parts(parts):
+    exact_keys(parts, ("regularity", "star"), "parts")
+    reg, star = field_of(parts, "regularity", dict, "parts"), field_of(parts, "star", dict, "parts")
+    exact_keys(reg, PATCHES, "parts.regularity")
+    exact_keys(star, tuple(STAR_CURVES), "parts.star")
+    for label, sec, nv in (("regularity", reg, 2), ("star", star, 1)):
+        for name, boxes in sec.items():
+            read_boxes(boxes, nv, f"parts.{label}.{name}")  # the partition, before any arithmetic
 
 
 def _check_spectrum(k, ends, prec, part):

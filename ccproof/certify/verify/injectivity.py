@@ -249,6 +249,32 @@ def _check_sections(parts, sec, label, build, part, tag):
     part(f"{tag}{label}", True, f"min bound {min(mins)} (w.r.t. the local variables)", min(mins), sec)
 
 
+def read_lam_pieces(pieces, read_parts):
+    """The exact ends (low, high) of 1..64 lam pieces ``{"lam": [low, high], "parts": ...}``, increasing and
+    contiguous; ``read_parts(parts)`` reads each piece's hints (their partitions, before any arithmetic).
+
+    Examples
+    --------
+    >>> read_lam_pieces([{"lam": ["0.5", "0.6"], "parts": {}}, {"lam": ["0.6", "0.7"], "parts": {}}], print)
+    {}
+    {}
+    [(1/2, 3/5), (3/5, 7/10)]
+    """
+    if not 1 <= len(pieces) <= 64:
+        raise CertificateError("there must be 1..64 lam pieces")
+    ends = []
+    for pc in pieces:
+        exact_keys(pc, ("lam", "parts"), "piece")
+        lo_hi = field_of(pc, "lam", list, "piece")
+        if len(lo_hi) != 2:
+            raise CertificateError("piece lam must be [low, high]")
+        ends.append(tuple(parse_decimal(x) for x in lo_hi))
+        read_parts(field_of(pc, "parts", dict, "piece"))
+    if any(not a < b for a, b in ends) or any(ends[i][1] != ends[i + 1][0] for i in range(len(ends) - 1)):
+        raise CertificateError("the lam pieces must be increasing and contiguous")  # exact fmpq comparisons
+    return ends
+
+
 def verify_interval(cert, k, part, log):
     """Every valence k >= k0 (``k = {"min": k0}``): lam pieces with Taylor models (:mod:`.interval`).
 
@@ -279,18 +305,7 @@ def verify_interval(cert, k, part, log):
     if param["variable"] != "lam" or not 1 <= D <= deg <= 8:
         raise CertificateError("parameter must be {'variable': 'lam', 1 <= truncation_degree <= taylor_degree <= 8}")
     pieces = field_of(cert, "pieces", list, "certificate")
-    if not 1 <= len(pieces) <= 64:
-        raise CertificateError("there must be 1..64 lam pieces")
-    ends = []
-    for pc in pieces:
-        exact_keys(pc, ("lam", "parts"), "piece")
-        lo_hi = field_of(pc, "lam", list, "piece")
-        if len(lo_hi) != 2:
-            raise CertificateError("piece lam must be [low, high]")
-        ends.append(tuple(parse_decimal(x) for x in lo_hi))
-        _check_structure(field_of(pc, "parts", dict, "piece"), 3)
-    if any(not a < b for a, b in ends) or any(ends[i][1] != ends[i + 1][0] for i in range(len(ends) - 1)):
-        raise CertificateError("the lam pieces must be increasing and contiguous")  # exact fmpq comparisons
+    ends = read_lam_pieces(pieces, lambda parts: _check_structure(parts, 3))
     if not (ends[0][0] > fmpq(1, 4) and ends[-1][1] < 1):
         raise CertificateError("the lam pieces must lie inside (1/4, 1)")
     log(f"certificate for valences k >= {k['min']} (N = {N}, {prec} bits, {len(pieces)} lam piece(s), "

@@ -55,7 +55,7 @@ from flint import acb, acb_mat, arb, ctx, fmpq, fmpq_mat
 from .errors import CertificateError
 from .record import exact_keys, field_of
 from .replay import parse_decimal
-from .spectrum import _SMALL
+from .spectrum import SMALL_ROOTS
 from .statement import lam_of
 from .tagged import crease_block, crease_points, labels, sector_rows
 from .tagged_c1 import _DW, _W, _check_boundary
@@ -284,7 +284,7 @@ def _gamma_gap(g, cg, below, blocks, b0, n0):
         return f"gamma is not the crease block's largest eigenvalue below 1 ({max(below)})"
     if not arb(g) < b0:
         return f"gamma < lam(cos(2 pi/{n0})) is not certain"
-    if g in _SMALL or cg is None or (1 + cg) * (9 + cg) == 0 or any(M.charpoly()(g) == 0 for M in blocks):
+    if g in SMALL_ROOTS or cg is None or (1 + cg) * (9 + cg) == 0 or any(M.charpoly()(g) == 0 for M in blocks):
         return "gamma is possibly a multiple eigenvalue of I"
     return None
 
@@ -298,7 +298,7 @@ def uniform_spectrum(fam, n0, g, C, blocks):
     below = [r for r in croots if r < 1]
     b0 = lam_of(arb(fmpq(2, n0)).cos_pi())  # <= beta = lam(cos(2 pi/N)) for every N >= n0
     inner = [z for M in blocks for z, _ in _roots(M)]
-    others = [arb(abs(r)) for r in below] + [abs(z) for z in inner] + [arb(s) for s in _SMALL] + [arb(fmpq(1, 4))]
+    others = [arb(abs(r)) for r in below] + [abs(z) for z in inner] + [arb(s) for s in SMALL_ROOTS] + [arb(fmpq(1, 4))]
     cg = 8 * g + 1 / (2 * g) - 5 if g != 0 else None
     why = _leading_gap(croots, below, blocks, others, b0, n0) or _gamma_gap(g, cg, below, blocks, b0, n0)
     if why is not None:

@@ -23,7 +23,7 @@ characteristic polynomial of the 6N + 3 points (docs/tagged_c1.md, "Spectrum in 
    B(w) and to have, with the 6 (N - 1) others, the dimension 6N - 2 of I.
 4. **Block polynomials.** det(x - B(w)) = (x - 1/8)(x - 1/16)(x - 1/32)(x - 1/64)(x^2 - (5 + c) x/8 + 1/16),
    c = (w + 1/w)/2, checked here exactly for this stencil on a grid of rational points (as
-   :func:`.spectrum.check_block_polynomials`). So mode j has 1/8..1/64, lam(c_j) and 1/(16 lam(c_j)),
+   :func:`.spectrum.mode_polynomials_hold`). So mode j has 1/8..1/64, lam(c_j) and 1/(16 lam(c_j)),
    c_j = cos(pi j/N), lam(c) = (5 + c + sqrt((1 + c)(9 + c)))/16 (:func:`.statement.lam_of`).
 
 **Darts** (:func:`check_dart`, K >= MIN_N): S commutes with the reflection R in the sharp ray 0 (checked
@@ -49,7 +49,7 @@ from flint import acb, acb_mat, arb, arb_mat, fmpq, fmpq_mat
 
 from .errors import CertificateError
 from .rules import CENTRE, TWO_RING, canonical, level1_rule
-from .spectrum import _SMALL, _charpoly_at, _claimed_mode
+from .spectrum import SMALL_ROOTS, mode_polynomials_hold
 from .statement import lam_of
 from .tagged import crease_block, crease_points, labels, sector_rows
 
@@ -115,12 +115,8 @@ def check_ring():
         mirrored = {_reflect(d, q): x for (d, q), x in ring_stencil()[i].items()}
         if image != mirrored:
             raise CertificateError(f"the ring stencil does not commute with the reflection at {pos}")
-    for w in range(1, 20):  # w^6 det(x - B(w)) has degree <= 18 in w (|delta| <= 2... checked below)
-        rows = _block(fmpq(w))
-        c = (fmpq(w) + 1 / fmpq(w)) / 2
-        for x in range(7):
-            if _charpoly_at(rows, fmpq(x)) != _claimed_mode(fmpq(x), c):
-                raise CertificateError("a Fourier block of the ring stencil has another characteristic polynomial")
+    if not mode_polynomials_hold(_block):  # w^6 det(x - B(w)) of degree <= 18 in w: |delta| <= 2, checked below
+        raise CertificateError("a Fourier block of the ring stencil has another characteristic polynomial")
     if any(not -1 <= d <= 2 for row in ring_stencil() for d, _ in row):
         raise CertificateError("the ring stencil reaches beyond the neighbouring sectors")
     return True
@@ -253,7 +249,7 @@ def mode_spectrum(fam, n):
     for j in modes:
         lam = lam_of(arb(fmpq(2 * j, ring)).cos_pi())
         out += [(acb(lam), None, tag, j), (acb(1 / (16 * lam)), None, tag, j)]
-        out += [(acb(s), s, tag, None) for s in _SMALL]
+        out += [(acb(s), s, tag, None) for s in SMALL_ROOTS]
     return out
 
 
