@@ -31,11 +31,11 @@ from .maps import STAR_CURVES, regularity_form
 from .record import exact_keys
 from .replay import check_boxes, check_partition, parse_path
 from .rules import CENTRE, canonical, level1_rule
+from .statement import B2Z, bspline_to_bezier
 from .tagged import labels, sector_rows, sharp_rays
 
 PIECES = ("P1", "P2", "P3")
 _OFFSET = {"P1": (0, -1), "P2": (0, 0), "P3": (-1, 0)}  # level-1 position of B-spline net[0][0]
-_B2Z = ((1, 4, 1, 0), (0, 4, 2, 0), (0, 2, 4, 0), (0, 1, 4, 1))  # uniform cubic B-spline -> Bezier, times 6
 
 
 def level1_values(fam, n, v):
@@ -95,12 +95,6 @@ def level1_values(fam, n, v):
     return value
 
 
-def _lin(coeffs, pts):
-    x = sum((p[0] * fmpq(c, 6) for c, p in zip(coeffs, pts) if c), arb(0))
-    y = sum((p[1] * fmpq(c, 6) for c, p in zip(coeffs, pts) if c), arb(0))
-    return (x, y)
-
-
 def quadrant_nets(fam, n, vx, vy, q, prec):
     """Bezier nets {P1, P2, P3: 4 x 4 of (arb, arb)} of Phi = (X, Y) on quadrant q.
 
@@ -120,8 +114,7 @@ def quadrant_nets(fam, n, vx, vy, q, prec):
         for name in PIECES:
             oa, ob = _OFFSET[name]
             net = [[(arb(X(q, oa + i, ob + j)), arb(Y(q, oa + i, ob + j))) for j in range(4)] for i in range(4)]
-            tmp = [[_lin(_B2Z[i], [net[r][j] for r in range(4)]) for j in range(4)] for i in range(4)]
-            out[name] = [[_lin(_B2Z[j], tmp[i]) for j in range(4)] for i in range(4)]
+            out[name] = bspline_to_bezier(net, (arb(0), arb(0)))
     return out
 
 
@@ -237,7 +230,7 @@ def _zero(vals):  # exactly 0 (an arb only when it is the exact 0)
 
 
 def _bez(vals):  # Bezier points of the segment [1, 2] of the B-spline with these values
-    return [sum((arb(z) * fmpq(c, 6) for c, z in zip(row, vals) if c), arb(0)) for row in _B2Z]
+    return [sum((arb(z) * fmpq(c, 6) for c, z in zip(row, vals) if c), arb(0)) for row in B2Z]
 
 
 def check_map(fam, n, vx, vy, lam1, lam2, orient, parts, prec, part):
