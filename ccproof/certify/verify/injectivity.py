@@ -20,10 +20,11 @@ from flint import arb, ctx, fmpq
 from .errors import CertificateError
 from .interval import hull_nets, interval_cells, lam_interval_ok, parameter_nets
 from .maps import (
+    STAR_CURVES,
     cell_det_builder,
     corner_containment,
     corner_det_form,
-    outer_curves,
+    curve_points,
     regularity_form,
     required_cells,
     square_inside_image,
@@ -78,8 +79,9 @@ def check_hypotheses(nets, lam, part, tag=""):
     >>> res.parts[1].ok, res.parts[1].message
     (False, 'lam fails')
     """
-    exact = outer_curves(derivation().bezier)  # a coordinate that is exactly 0 in F is on the axis
-    quadrant = all(q.is_zero() or x >= 0 for cv, ecv in zip(outer_curves(nets), exact) for p, e in zip(cv, ecv)
+    exact = derivation().bezier  # a coordinate that is exactly 0 in F is on the axis
+    quadrant = all(q.is_zero() or x >= 0 for cv in STAR_CURVES
+                   for p, e in zip(curve_points(nets, cv), curve_points(exact, cv))
                    for x, q in zip(p, e))  # arb >= : certainly
     ok = lam > 0 and lam < 1 and 2 * lam**4 < 1
     part(f"{tag}H 0 < lam < 1, 2 lam^4 < 1, outer curve in the first quadrant", ok and quadrant,

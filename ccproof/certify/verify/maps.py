@@ -19,7 +19,7 @@ from ccproof.rigorous import (
     jacobian_determinant,
 )
 
-from .statement import PATCHES
+from .statement import PATCHES, split_half
 
 BREAKS = (fmpq(0), fmpq(1, 6), fmpq(1, 3), fmpq(1, 2))  # w pieces (docs/readings.md R5); piece 3 is w = 0
 
@@ -309,6 +309,21 @@ def regularity_form(nets, name, prec):
 STAR_CURVES = {"P1s1": ("P1", "s", 1), "P2s1": ("P2", "s", 1), "P2t1": ("P2", "t", -1), "P3t1": ("P3", "t", -1)}
 
 
+def curve_points(nets, curve):
+    """The Bezier points of one cubic of the outer boundary (a key of :data:`STAR_CURVES`: the side s = 1 or
+    t = 1 of a piece), in the piece's parameter order.
+
+    Examples
+    --------
+    >>> nets = {"P2": [[(i, j) for j in range(4)] for i in range(4)]}
+    >>> curve_points(nets, "P2s1"), curve_points(nets, "P2t1")
+    ([(3, 0), (3, 1), (3, 2), (3, 3)], [(0, 3), (1, 3), (2, 3), (3, 3)])
+    """
+    name, side, _ = STAR_CURVES[curve]
+    net = nets[name]
+    return [net[3][j] for j in range(4)] if side == "s" else [net[i][3] for i in range(4)]
+
+
 def star_form(nets, curve, prec):
     """Bernstein form (degree 5) of x y' - y x' along one cubic of the outer boundary, oriented from
     (1,0) towards (0,1). Positive on all four curves means the outer boundary is star-shaped.
@@ -324,14 +339,12 @@ def star_form(nets, curve, prec):
     >>> [bool(abs(range_enclosure(star_form(nets, cv, 64))[0] - arb(1) / 2) < 1e-12) for cv in STAR_CURVES]
     [True, True, True, True]
     """
-    name, side, sign = STAR_CURVES[curve]
-    net = nets[name]
-    pts = [net[3][j] for j in range(4)] if side == "s" else [net[i][3] for i in range(4)]
+    pts = curve_points(nets, curve)
     with ctx.workprec(prec):
         X = BernsteinForm((4,), [p[0] for p in pts], prec=prec)
         Y = BernsteinForm((4,), [p[1] for p in pts], prec=prec)
         cross = X * Y.diff(0) - Y * X.diff(0)
-        return cross if sign > 0 else -cross
+        return cross if STAR_CURVES[curve][2] > 0 else -cross
 
 
 def corner_containment(nets, lam, N):
@@ -359,21 +372,7 @@ def square_inside_image(nets):
     >>> square_inside_image(nets)
     True
     """
-    return all(_curve_avoids(cv, 40) for cv in outer_curves(nets))
-
-
-def outer_curves(nets):
-    """The four cubic Bezier curves of the outer boundary (u = 1 on P1, P2; v = 1 on P2, P3).
-
-    Examples
-    --------
-    >>> from ccproof.certify.verify.statement import c_lam, nets_for_valence
-    >>> nets, (c, lam) = nets_for_valence(4, 64), c_lam(4, 64)   # k = 4: Phi is the identity, lam = 1/2
-    >>> [[z.str(6, radius=False) for z in p] for p in outer_curves(nets)[0]]   # u = 1: (1, v) for v = 0..1/2
-    [['1.00000', '0'], ['1.00000', '0.166667'], ['1.00000', '0.333333'], ['1.00000', '0.500000']]
-    """
-    return [[nets["P1"][3][j] for j in range(4)], [nets["P2"][3][j] for j in range(4)],
-            [nets["P2"][i][3] for i in range(4)], [nets["P3"][i][3] for i in range(4)]]
+    return all(_curve_avoids(curve_points(nets, cv), 40) for cv in STAR_CURVES)
 
 
 def _curve_avoids(curve, depth):
@@ -383,12 +382,7 @@ def _curve_avoids(curve, depth):
         return True
     if depth == 0:
         return False
-    b = [list(p) for p in curve]
-    left, right, pts = [b[0]], [b[3]], b
-    for _ in range(3):
-        pts = [[(p[i] + q[i]) * half for i in range(2)] for p, q in zip(pts, pts[1:])]
-        left.append(pts[0])
-        right.append(pts[-1])
-    return _curve_avoids(left, depth - 1) and _curve_avoids(right[::-1], depth - 1)
+    left, right = split_half(curve)
+    return _curve_avoids(left, depth - 1) and _curve_avoids(right, depth - 1)
 
 

@@ -361,9 +361,15 @@ def _eq(p, q):
     return p[0] == q[0] and p[1] == q[1]
 
 
-def _split_half(curve):
-    """De Casteljau halves of a cubic Bezier curve of F-points (exact)."""
-    half = QL(fmpq(1, 2))
+def split_half(curve):
+    """De Casteljau halves (left, right) of a cubic Bezier curve of points of F (exact) or of arb balls.
+
+    Examples
+    --------
+    >>> split_half([(0, 0), (1, 0), (2, 0), (3, 3)])[1]
+    [(3/2, 3/8), (2, 3/4), (5/2, 3/2), (3, 3)]
+    """
+    half = fmpq(1, 2)
     left, right, pts = [curve[0]], [curve[3]], list(curve)
     for _ in range(3):
         pts = [((p[0] + q[0]) * half, (p[1] + q[1]) * half) for p, q in zip(pts, pts[1:])]
@@ -461,7 +467,7 @@ def _hypotheses(bz, eig_ok):
 
     col = lambda net, i: [net[i][j] for j in range(4)]  # side s = i/3 (a curve in t)
     row = lambda net, j: [net[i][j] for i in range(4)]  # side t = j/3 (a curve in s)
-    inner1, inner3 = _split_half(col(P1, 0)), _split_half(row(P3, 0))
+    inner1, inner3 = split_half(col(P1, 0)), split_half(row(P3, 0))
     symmetric = all(_eq(P3[i][j], _swap(P1[j][i])) and _eq(P2[i][j], _swap(P2[j][i]))
                     for i in range(4) for j in range(4))
     hyp = [

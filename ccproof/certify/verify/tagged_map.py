@@ -27,7 +27,7 @@ from flint import arb, ctx, fmpq
 from ccproof.rigorous import BernsteinForm
 
 from .errors import CertificateError
-from .maps import STAR_CURVES, regularity_form
+from .maps import STAR_CURVES, curve_points, regularity_form
 from .record import exact_keys
 from .replay import check_boxes, check_partition, parse_path
 from .rules import CENTRE, canonical, level1_rule
@@ -118,11 +118,9 @@ def quadrant_nets(fam, n, vx, vy, q, prec):
     return out
 
 
-def _curve(nets, curve):
-    name, side, sign = STAR_CURVES[curve]
-    net = nets[name]
-    pts = [net[3][j] for j in range(4)] if side == "s" else [net[i][3] for i in range(4)]
-    return pts if sign > 0 else pts[::-1]  # oriented counterclockwise (from ray q towards ray q + 1)
+def _curve(nets, curve):  # oriented counterclockwise (from ray q towards ray q + 1)
+    pts = curve_points(nets, curve)
+    return pts if STAR_CURVES[curve][2] > 0 else pts[::-1]
 
 
 def transversal_form(nets, curve, a1, a2, prec):
