@@ -103,3 +103,17 @@ def test_every_function_of_the_base_is_short_and_simple():
     new = {k: v for k, v in found.items() if k not in OVER_CAP}
     assert not new, f"over {MAX_FUNCTION_LINES} lines or complexity {MAX_COMPLEXITY} (lines, complexity): {new}"
     assert not OVER_CAP - set(found), f"within the caps now, remove from OVER_CAP: {OVER_CAP - set(found)}"
+
+
+def test_the_page_states_its_own_totals():
+    """The total row and the prose ("Small.") state the sums of the table, the verifier and the kernel apart."""
+    text = DOC.read_text()
+    rows = [(p, int(a), int(b)) for p, a, b in re.findall(r"\| `(ccproof/[\w/]+\.py)` \| (\d+) \| (\d+) \|", text)]
+    verifier = [r for r in rows if "/verify/" in r[0]]
+    kernel = [r for r in rows if "/rigorous/" in r[0]]
+    lines, code = sum(r[1] for r in rows), sum(r[2] for r in rows)
+    want = (f"| **total** | **{lines}** | **{code}** | lines: the verifier proper {sum(r[1] for r in verifier)}, "
+            f"the kernel {sum(r[1] for r in kernel)}; code (no docstrings, comments, blank lines): "
+            f"{sum(r[2] for r in verifier)} and {sum(r[2] for r in kernel)} |")
+    assert want in text, want
+    assert f"**Small.** {code:,} lines of code (the rest of the {lines:,} lines" in text.replace("\n  ", " ")

@@ -79,14 +79,9 @@ def check_exact_budget(fam, n):
 
     The exact route (the characteristic polynomial of the whole S over Q, its factors, the ranks of
     p(S), :func:`exact_spectrum`) costs about m^3 operations on rationals for S of m points (m = 6N + 3,
-    6K + 1 for a dart), 9 s of CPU for crease:100. The budget, 128^3 (N, K <= 20; a few hundredths of a
-    second), admits every published certificate on that route (at most 27 points) with room; larger
-    configurations are decided through the modes of :mod:`.tagged_modes` or not at all.
-
-    Raises
-    ------
-    CertificateError
-        Naming the configuration, its work and the budget.
+    6K + 1 for a dart), 9 s of CPU for crease:100. The budget, 128^3 (N, K <= 20; under 0.1 s), admits
+    every published certificate on that route (at most 27 points) with room; larger configurations are
+    decided through the modes of :mod:`.tagged_modes` or not at all.
 
     Examples
     --------
