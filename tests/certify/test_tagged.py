@@ -400,3 +400,34 @@ def test_every_published_configuration_on_the_exact_route_fits_the_budget_with_r
         check_exact_budget(fam, 20)
         with pytest.raises(Exception, match="exceeds the budget"):
             check_exact_budget(fam, 22)
+
+
+def _verify_in_child(path):
+    out = subprocess.run([sys.executable, "-c", _CPU_CHILD, str(path)], capture_output=True, text=True, timeout=90)
+    return json.loads(out.stdout.splitlines()[-1])
+
+
+def test_an_interval_record_over_its_budget_fails_from_its_declared_sizes_within_10_s(tmp_path):
+    """crease:>=101 with the most arcs and disc boxes the grammar allows at 1024 bits: 24,484 evaluations of H,
+    which verified after 10.6 s of CPU; refused from the declared sizes before any arithmetic."""
+    c = json.loads((certificates_dir() / "c1" / "crease" / "n_ge_101.json").read_text())
+    c["prec"] = 1024
+    c["limit"].update(arcs=8192, outer_arcs=8192, box="0.0068")
+    p = tmp_path / "n_ge_101.json"
+    p.write_text(json.dumps(c))
+    got = _verify_in_child(p)
+    assert not got["ok"] and "exceed the budget" in got["error"], got
+    assert got["cpu"] < 10.0, got
+
+
+def test_the_published_interval_records_fit_the_budget_with_room():
+    import math
+    from fractions import Fraction
+
+    from ccproof.certify.verify.tagged_limit import TAIL_BUDGET
+
+    for fam in ("crease", "corner"):
+        c = json.loads((certificates_dir() / "c1" / fam / "n_ge_101.json").read_text())
+        lim = c["limit"]
+        boxes = (2 * math.ceil(Fraction(lim["R"]) / Fraction(lim["box"]))) ** 2
+        assert (lim["arcs"] + lim["outer_arcs"] + boxes) * Fraction(c["prec"] + 1024, 1024) * 4 < TAIL_BUDGET

@@ -64,6 +64,10 @@ from .tagged_modes import _POS, _block, _roots, check_ring, check_structure
 WINDOW = (7, 8)  # the window classes of every N >= 7 occur in both
 MIN_TAIL = WINDOW[0]
 MAX_ARCS = 8192  # arcs on either circle, and boxes on the disc (bounded work for a hostile file)
+# evaluations of H (arcs on both circles, boxes on the disc) weighted by (prec + 1024)/1024, checked before any
+# arithmetic: the published certificates need 3,042, the prover's widest hints (every N0 >= 7) about 21,000;
+# at the budget a file costs about 5 s of CPU
+TAIL_BUDGET = 3 * 8192
 _LIMIT_KEYS = ("rho", "R", "arcs", "outer_arcs", "box")
 _PIVOT = _POS[(1, 0)]
 
@@ -360,6 +364,10 @@ def verify_tail(cert, fam, n0, part, log):
     if not (1 <= arcs <= MAX_ARCS and 1 <= outer <= MAX_ARCS and 0 < rho < R <= 1 and 0 < side <= R
             and (2 * R / side + 2) ** 2 <= MAX_ARCS):
         raise CertificateError(f"limit: need 0 < rho < R <= 1, 0 < box <= R, at most {MAX_ARCS} arcs and boxes")
+    evals = arcs + outer + (2 * ((R / side).ceil())) ** 2  # at most (2 ceil(R/box))^2 boxes meet the disc
+    if evals * fmpq(prec + 1024, 1024) > TAIL_BUDGET:
+        raise CertificateError(f"limit: {evals} evaluations of H at {prec} bits exceed the budget "
+                               f"({TAIL_BUDGET} weighted by (prec + 1024)/1024)")
     name = f"{fam}:>={n0}"
     log(f"not C1 certificate for {name} ({prec} bits)")
     with ctx.workprec(prec):
