@@ -50,7 +50,7 @@ from __future__ import annotations
 
 from functools import cache
 
-from flint import acb, acb_mat, arb, ctx, fmpq, fmpq_mat
+from flint import acb, arb, ctx, fmpq, fmpq_mat
 
 from .errors import CertificateError
 from .record import exact_keys, field_of
@@ -59,7 +59,7 @@ from .spectrum import SMALL_ROOTS
 from .statement import lam_of
 from .tagged import crease_block, crease_points, labels, sector_rows
 from .tagged_c1 import _DW, _W, _check_boundary
-from .tagged_modes import _POS, _block, _roots, check_ring, check_structure
+from .tagged_modes import _POS, _block, _roots, bordered_solve, check_ring, check_structure
 
 WINDOW = (7, 8)  # the window classes of every N >= 7 occur in both
 MIN_TAIL = WINDOW[0]
@@ -162,11 +162,8 @@ def _tangents(theta, j):
     if not disc.real > 0:
         raise ZeroDivisionError("(1 + c)(9 + c) is not certainly in the right half-plane")
     lam = lam_of(c)
-    B = _block(w)
-    rows = [[B[i][k] - (lam if i == k else 0) for k in range(6)] + [acb(int(i == _PIVOT))] for i in range(6)]
-    rows.append([acb(int(k == _PIVOT)) for k in range(6)] + [acb(0)])
-    sol = acb_mat(rows).solve(acb_mat([[0]] * 6 + [[1]]))
-    vh = {p: sol[i, 0] for p, i in _POS.items()}
+    sol = bordered_solve(_block(w), lam, _PIVOT)
+    vh = {p: sol[i] for p, i in _POS.items()}
     val = {}
     for a in range(3):
         for b in range(3):  # the centre and ray 0: 0; ray 1: v^(b,0)(w - 1/w); quadrant 0: v^(a,b) - v^(b,a)/w

@@ -201,10 +201,11 @@ def check_structure(fam, n):
     return tuple(M for M in (M0, Mn) if M is not None)
 
 
-def _roots(M):
-    """(acb, fmpq or None) per eigenvalue of a rational matrix, repeated by algebraic multiplicity."""
+def _roots(M, fac=None):
+    """(acb, fmpq or None) per eigenvalue of a rational matrix (or of the factors ``fac`` of a characteristic
+    polynomial), repeated by algebraic multiplicity."""
     out = []
-    for p, e in M.charpoly().factor()[1]:
+    for p, e in M.charpoly().factor()[1] if fac is None else fac:
         for z, _ in p.complex_roots():
             out += [(acb(z), -p[0] / p[1] if p.degree() == 1 else None)] * e
     return out
@@ -235,10 +236,7 @@ def mode_spectrum(fam, n):
     """
     if fam == "dart":  # the even part exactly (S_E's factors), the odd part through the modes w = exp(2 pi i j/K)
         _, _, extra, fac, (_, outer), bound = check_dart(n)
-        out, tag, modes = [], "O", range(1, (n + 1) // 2)
-        for p, e in fac:
-            out += [(acb(z), -p[0] / p[1] if p.degree() == 1 else None, "E", None)
-                    for z, _ in p.complex_roots()] * e
+        out, tag, modes = [(z, q, "E", None) for z, q in _roots(None, fac)], "O", range(1, (n + 1) // 2)
         out += [(acb(arb(0, bound), arb(0, bound)), None, "E", None)] * len(outer)  # |z| <= bound, each
     else:
         extra, tag, modes = check_structure(fam, n), "I", range(1, n)
@@ -251,6 +249,23 @@ def mode_spectrum(fam, n):
         out += [(acb(lam), None, tag, j), (acb(1 / (16 * lam)), None, tag, j)]
         out += [(acb(s), s, tag, None) for s in SMALL_ROOTS]
     return out
+
+
+def bordered_solve(B, lam, pivot):
+    """The null vector v of B - lam (6 x 6, acb) with v[pivot] = 1, from the bordered system
+    [[B - lam, e_p], [e_p^T, 0]] (v, s) = (0, 1); raises ZeroDivisionError unless arb proves it regular
+    (then lam is a simple eigenvalue with v[pivot] != 0, and s = 0).
+
+    Examples
+    --------
+    >>> [z.real.mid() for z in bordered_solve([[acb(int(i == k)) * (i + 1) for k in range(6)] for i in range(6)],
+    ...                                       acb(2), 1)]
+    [0, 1.00000000000000, 0, 0, 0, 0]
+    """
+    rows = [[B[i][k] - (lam if i == k else 0) for k in range(6)] + [acb(int(i == pivot))] for i in range(6)]
+    rows.append([acb(int(k == pivot)) for k in range(6)] + [acb(0)])
+    sol = acb_mat(rows).solve(acb_mat([[0]] * 6 + [[1]]))
+    return [sol[i, 0] for i in range(6)]
 
 
 def _unit(num, den):
@@ -282,14 +297,11 @@ def mode_vector(fam, n, j, lam):
     B = _block(_unit(2 * j, ring))
     vh = None
     for pv in range(6):  # the first pivot that arb proves regular (the bordered-system argument of tagged_c1)
-        rows = [[B[i][k] - (lam if i == k else 0) for k in range(6)] + [acb(int(i == pv))] for i in range(6)]
-        rows.append([acb(int(k == pv)) for k in range(6)] + [acb(0)])
         try:
-            sol = acb_mat(rows).solve(acb_mat([[0]] * 6 + [[1]]))
+            vh = bordered_solve(B, lam, pv)
+            break
         except ZeroDivisionError:
             continue
-        vh = [sol[i, 0] for i in range(6)]
-        break
     if vh is None:
         return None
     skip = {0} if fam == "dart" else set(crease_points(fam, n))
