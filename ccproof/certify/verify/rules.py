@@ -160,6 +160,21 @@ def centre_rule_mode0(t):
     return acc
 
 
+class Vec(tuple):
+    """A vector with ``+`` and ``* weight`` entrywise, what :func:`apply` needs of its values (points of F^2,
+    rows of a Fourier block).
+
+    >>> Vec((1, 2)) + Vec((3, 4)) * 2
+    (7, 10)
+    """
+
+    def __add__(self, other):
+        return Vec(a + b for a, b in zip(self, other))
+
+    def __mul__(self, w):
+        return Vec(a * w for a in self)
+
+
 def apply(comb, lookup, zero):
     """Sum of weight * lookup(delta, (a', b')) over a combination of raw positions; the centre is
     ``lookup(0, (0, 0))``.

@@ -29,7 +29,7 @@ from __future__ import annotations
 
 from flint import arb, ctx, fmpq, fmpq_mat
 
-from .rules import CENTRE, TWO_RING, apply, centre_rule_mode0, level1_rule
+from .rules import CENTRE, TWO_RING, Vec, apply, centre_rule_mode0, level1_rule
 from .statement import lam_of
 
 
@@ -44,23 +44,15 @@ def _block(w=None, t=None):
         if p == CENTRE:
             if t is not None:
                 out[idx[CENTRE]] = fmpq(1)
-            return _Vec(out)
+            return Vec(out)
         out[idx[p]] = fmpq(1) if t is not None else fmpq(w) ** delta
-        return _Vec(out)
+        return Vec(out)
 
     rows = []
     for p in pos:
         comb = centre_rule_mode0(t) if p == CENTRE else level1_rule(*p)
-        rows.append(list(apply(comb, column_lookup, _Vec([fmpq(0)] * n))))
+        rows.append(list(apply(comb, column_lookup, Vec([fmpq(0)] * n))))
     return rows
-
-
-class _Vec(list):
-    def __add__(self, other):
-        return _Vec([a + b for a, b in zip(self, other)])
-
-    def __mul__(self, s):
-        return _Vec([a * s for a in self])
 
 
 def _charpoly_at(rows, x):

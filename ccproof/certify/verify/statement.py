@@ -44,7 +44,7 @@ from functools import lru_cache
 
 from flint import arb, ctx, fmpq, fmpq_poly
 
-from .rules import TWO_RING, level1_value
+from .rules import TWO_RING, Vec, level1_value
 
 PATCHES = ("P1", "P2", "P3")
 #: level-1 grid position of B-spline control point [0][0] of each piece (net[i][j] at offset + (i, j))
@@ -224,32 +224,14 @@ def rot(delta, p):
     return (x, y)
 
 
-def _pt_add(p, q):
-    return (p[0] + q[0], p[1] + q[1])
-
-
-def _pt_scale(p, w):
-    return (p[0] * w, p[1] * w)
-
-
-class _Pt(tuple):
-    """A point of F^2 supporting ``+`` and ``* weight`` (what :func:`.rules.apply` needs)."""
-
-    def __add__(self, other):
-        return _Pt(_pt_add(self, other))
-
-    def __mul__(self, w):
-        return _Pt(_pt_scale(self, w))
-
-
-_ZERO = _Pt((QL(0), QL(0)))
+_ZERO = Vec((QL(0), QL(0)))
 
 
 def _lookup(values):
     def look(delta, p):
         if p == (0, 0):
             return _ZERO  # the centre is 0 in Fourier mode 1
-        return _Pt(rot(delta, values[p]))
+        return Vec(rot(delta, values[p]))
     return look
 
 
@@ -277,7 +259,7 @@ def level1(values, A, B):
     if (A, B) == (0, 0):
         return _ZERO
     delta, v = level1_value(A, B, _lookup(values), _ZERO)
-    return _Pt(rot(delta, v))
+    return Vec(rot(delta, v))
 
 
 # ------------------------------------------------------------------------ the derivation
@@ -344,10 +326,10 @@ def bspline_to_bezier(net, zero=None):
     [True, True, True, True]
     """
     def lin(coeffs, pts):
-        acc = _ZERO if zero is None else _Pt(zero)
+        acc = _ZERO if zero is None else Vec(zero)
         for a, p in zip(coeffs, pts):
             if a:
-                acc = acc + _Pt(p) * fmpq(a, 6)
+                acc = acc + Vec(p) * fmpq(a, 6)
         return acc
     tmp = [[lin(B2Z[i], [net[r][j] for r in range(4)]) for j in range(4)] for i in range(4)]
     return [[tuple(lin(B2Z[j], tmp[i])) for j in range(4)] for i in range(4)]
