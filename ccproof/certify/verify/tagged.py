@@ -128,20 +128,29 @@ def sharp_rays(fam, n):
     return (0,) if fam == "dart" else (0, n)
 
 
+def position_key(fam, n, q, a, b):
+    """The label (:func:`labels`) of the raw grid position (a, b) of quadrant q (:func:`.rules.canonical`;
+    rays and quadrants mod K for a dart), whether or not the complex holds it.
+
+    Examples
+    --------
+    >>> position_key("dart", 5, 4, 0, 2), position_key("crease", 2, 0, 1, -1), position_key("crease", 2, 1, 0, 0)
+    (('r', 0, 2, 0), ('q', -1, 1, 1), ('C',))
+    """
+    delta, a2, b2 = canonical(a, b)
+    if (a2, b2) == CENTRE:
+        return ("C",)
+    s = (q + delta) % n if fam == "dart" else q + delta
+    return ("r", s, a2, b2) if b2 == 0 else ("q", s, a2, b2)
+
+
 def _index(fam, n):
     idx = {p: i for i, p in enumerate(labels(fam, n))}
 
     def at(q, comb):  # raw positions of quadrant q -> {index: weight}
         out = {}
         for (a, b), w in comb.items():
-            delta, a2, b2 = canonical(a, b)
-            if (a2, b2) == CENTRE:
-                key = ("C",)
-            else:
-                s = q + delta
-                if fam == "dart":
-                    s %= n
-                key = ("r", s, a2, b2) if b2 == 0 else ("q", s, a2, b2)
+            key = position_key(fam, n, q, a, b)
             if key not in idx:
                 raise CertificateError(f"{fam}:{n}: position {(a, b)} of quadrant {q} outside the complex")
             out[idx[key]] = out.get(idx[key], 0) + w

@@ -30,9 +30,9 @@ from .errors import CertificateError
 from .maps import STAR_CURVES, curve_points, regularity_form
 from .record import exact_keys
 from .replay import check_boxes, check_partition, parse_path
-from .rules import CENTRE, canonical, level1_rule
+from .rules import level1_rule
 from .statement import B2Z, bspline_to_bezier
-from .tagged import labels, sector_rows, sharp_rays
+from .tagged import labels, position_key, sector_rows, sharp_rays
 
 PIECES = ("P1", "P2", "P3")
 _OFFSET = {"P1": (0, -1), "P2": (0, 0), "P3": (-1, 0)}  # level-1 position of B-spline net[0][0]
@@ -67,13 +67,6 @@ def level1_values(fam, n, v):
     def quad(s):
         return s % n if fam == "dart" else s
 
-    def level0(q, a, b):
-        delta, a2, b2 = canonical(a, b)
-        if (a2, b2) == CENTRE:
-            return v[0]
-        s = quad(q + delta)
-        return v[idx[("r", s, a2, 0) if b2 == 0 else ("q", s, a2, b2)]]
-
     def value(q, A, B):
         if (A, B) == (0, 0):
             return one(0)
@@ -81,16 +74,15 @@ def level1_values(fam, n, v):
             return 2 * value(q, A, 0) - value(q, A, 1)
         if A == -1 and quad(q + 1) in sharp:  # across the sharp ray q + 1: the ghost column
             return 2 * value(q, 0, B) - value(q, 1, B)
-        delta, A2, B2 = canonical(A, B)
-        s = quad(q + delta)
-        key = ("r", s, A2, 0) if B2 == 0 else ("q", s, A2, B2)
+        key = position_key(fam, n, q, A, B)
         if key in idx:
             return one(idx[key])
+        _, s, A2, B2 = key
         if B2 == 0 and s in sharp:  # (3, 0) on a sharp ray: the midpoint of level-0 (1,0), (2,0)
             return (v[idx[("r", s, 1, 0)]] + v[idx[("r", s, 2, 0)]]) / 2
         acc = 0 * v[0]
         for (a, b), w in level1_rule(A2, B2).items():
-            acc += level0(s, a, b) * w
+            acc += v[idx[position_key(fam, n, s, a, b)]] * w
         return acc
     return value
 
