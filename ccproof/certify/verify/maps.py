@@ -122,16 +122,12 @@ def cell_pieces(X, Y):
     >>> cell_pieces(net_form(nets["P1"], 0, 64), net_form(nets["P1"], 1, 64))   # x in [1/2, 1], y in [0, 1/2]
     [(2, 0), (2, 1), (2, 2), (2, 3), (3, 0), (3, 1), (3, 2), (3, 3)]
     """
-    out = []
     rng = []
     for F in (X, Y):
         lo = min(c.lower() for c in F.coeffs)
         hi = max(c.upper() for c in F.coeffs)
         rng.append([p for p in range(4) if not (hi < BREAKS[p] or (p < 3 and lo > BREAKS[p + 1]))])
-    for p in rng[0]:
-        for q in rng[1]:
-            out.append((p, q))
-    return out
+    return [(p, q) for p in rng[0] for q in rng[1]]
 
 
 def dyadic_cells(N, symmetric):
