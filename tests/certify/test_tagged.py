@@ -367,7 +367,8 @@ import json, resource, sys
 from ccproof.certify.verify import verify_file
 res = verify_file(sys.argv[1], log=lambda line: None)
 use = resource.getrusage(resource.RUSAGE_SELF)
-print(json.dumps({"ok": bool(res), "error": res.error, "cpu": use.ru_utime + use.ru_stime}))
+why = res.error or "; ".join(p.message for p in res.failures())
+print(json.dumps({"ok": bool(res), "error": why, "cpu": use.ru_utime + use.ru_stime}))
 """
 
 

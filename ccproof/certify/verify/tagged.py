@@ -352,8 +352,14 @@ def leading_spectrum(fam, n, prec):
     (True, 'crease:2: 1 simple; lam1 = lam2 = 1/2 (double, non-defective) > |lam3| = 1/4')
     >>> leading_spectrum("crease", 4, 64)[1]
     'crease:4: lam2 = 1/2 lies in a Jordan block (algebraic multiplicity 2, geometric 1)'
+    >>> leading_spectrum("crease", 100, 64)[:2]   # refused before any arithmetic (check_exact_budget)
+    (False, 'crease:100: the exact route on S of 603 points exceeds the budget (m^3 > 128^3: N, K <= 20)')
     """
     name = f"{fam}:{n}"
+    try:
+        check_exact_budget(fam, n)  # before any arithmetic on the whole S
+    except CertificateError as exc:
+        return False, str(exc), []
     with ctx.workprec(prec):
         ev = sorted(eigenvalues(fam, n, prec), key=_key)
         one = [t for t in ev if t[1] == fmpq_poly([-1, 1])]
@@ -363,12 +369,9 @@ def leading_spectrum(fam, n, prec):
         if any(not abs(t[0]) < 1 for t in rest):  # reviewed (tests/certify/test_arb_comparisons.py)
             return False, f"{name}: an eigenvalue other than 1 is not certainly inside the unit disc", ev[:4]
         l1, l2, l3 = rest[0], rest[1], rest[2]
-        for lab, t in (("lam1", l1), ("lam2", l2)):
-            if not (t[0].imag.is_zero() and t[0].real > 0):
-                return False, f"{name}: {lab} = {_show(t)} is not certainly real and positive", ev[:4]
-            if t[3] < t[2]:
-                return False, (f"{name}: {lab} = {_show(t)} lies in a Jordan block (algebraic multiplicity {t[2]}, "
-                               f"geometric {t[3]})"), ev[:4]
+        why = _not_simple_positive(name, "lam1", l1) or _not_simple_positive(name, "lam2", l2)
+        if why:
+            return False, why, ev[:4]
         same12 = l1[1] == l2[1] and l1[0].overlaps(l2[0])
         if not (same12 or l1[0].real > l2[0].real):
             return False, f"{name}: lam1 and lam2 are not separated", ev[:4]
@@ -379,6 +382,15 @@ def leading_spectrum(fam, n, prec):
         lead = (f"lam1 = lam2 = {_show(l1)} (double, non-defective)" if same12 else
                 f"lam1 = {_show(l1)} > lam2 = {_show(l2)} (simple)")
         return True, f"{name}: 1 simple; {lead} > |lam3| = {_show(l3)}", ev[:4]
+
+
+def _not_simple_positive(name, lab, t):
+    """Why the eigenvalue t is not certainly real, positive and non-defective (None when it is)."""
+    if not (t[0].imag.is_zero() and t[0].real > 0):
+        return f"{name}: {lab} = {_show(t)} is not certainly real and positive"
+    if t[3] < t[2]:
+        return f"{name}: {lab} = {_show(t)} lies in a Jordan block (algebraic multiplicity {t[2]}, geometric {t[3]})"
+    return None
 
 
 def _show(t):
