@@ -12,7 +12,7 @@ from flint import arb, ctx, fmpq, fmpq_poly
 from ccproof.algebra.subdivision import ring_subdivision_matrix, two_ring_vertices
 from ccproof.certify.verify import rules, spectrum
 from ccproof.certify.verify import statement as St
-from ccproof.certify.verify.field import QL
+from ccproof.certify.verify.statement import QL
 from ccproof.tables.format import read_table_json, table_nets_exact, table_path
 
 

@@ -359,3 +359,76 @@ def test_dart_certificates_and_the_rotated_axis():
     forged = copy.deepcopy(cert5)
     forged["parts"]["winding"]["axis"] = [2, 1]
     _fails(forged, "not allowed")
+
+
+# ----------------------------------------------------------------------- the cost budget of one configuration
+_CPU_CHILD = r"""
+import json, resource, sys
+from ccproof.certify.verify import verify_file
+res = verify_file(sys.argv[1], log=lambda line: None)
+use = resource.getrusage(resource.RUSAGE_SELF)
+why = res.error or "; ".join(p.message for p in res.failures())
+print(json.dumps({"ok": bool(res), "error": why, "cpu": use.ru_utime + use.ru_stime}))
+"""
+
+
+def test_a_large_configuration_on_the_exact_route_fails_on_its_budget_within_10_s(tmp_path):
+    """crease:3's "C1" file renamed crease:100 (1.6 KB): the exact spectrum of S (603 points) took 9 s of
+    CPU before the spectral part failed; it is refused from N alone."""
+    c = json.loads((certificates_dir() / "c1" / "crease" / "n003.json").read_text())
+    c["configuration"] = "crease:100"
+    p = tmp_path / "n100.json"
+    p.write_text(json.dumps(c))
+    out = subprocess.run([sys.executable, "-c", _CPU_CHILD, str(p)], capture_output=True, text=True, timeout=90)
+    got = json.loads(out.stdout.splitlines()[-1])
+    assert not got["ok"] and "exceeds the budget" in got["error"], got
+    assert got["cpu"] < 10.0, got
+
+
+def test_every_published_configuration_on_the_exact_route_fits_the_budget_with_room():
+    from ccproof.certify.verify.tagged import EXACT_BUDGET, check_exact_budget
+    from ccproof.certify.verify.tagged_modes import MIN_N
+
+    sizes = []
+    for p in sorted((certificates_dir() / "c1").glob("*/*.json")):
+        c = json.loads(p.read_text())
+        fam, _, n = c["configuration"].partition(":")
+        if n.isdigit() and (int(n) < MIN_N or c["statement"] == "C1" and fam != "dart"):
+            check_exact_budget(fam, int(n))
+            sizes.append(len(labels(fam, int(n))))
+    assert sizes and max(sizes) ** 3 * 64 < EXACT_BUDGET  # room: 4x in the points, 64x in the work
+    for fam in ("dart", "crease", "corner"):
+        check_exact_budget(fam, 20)
+        with pytest.raises(Exception, match="exceeds the budget"):
+            check_exact_budget(fam, 22)
+
+
+def _verify_in_child(path):
+    out = subprocess.run([sys.executable, "-c", _CPU_CHILD, str(path)], capture_output=True, text=True, timeout=90)
+    return json.loads(out.stdout.splitlines()[-1])
+
+
+def test_an_interval_record_over_its_budget_fails_from_its_declared_sizes_within_10_s(tmp_path):
+    """crease:>=101 with the most arcs and disc boxes the grammar allows at 1024 bits: 24,484 evaluations of H,
+    which verified after 10.6 s of CPU; refused from the declared sizes before any arithmetic."""
+    c = json.loads((certificates_dir() / "c1" / "crease" / "n_ge_101.json").read_text())
+    c["prec"] = 1024
+    c["limit"].update(arcs=8192, outer_arcs=8192, box="0.0068")
+    p = tmp_path / "n_ge_101.json"
+    p.write_text(json.dumps(c))
+    got = _verify_in_child(p)
+    assert not got["ok"] and "exceed the budget" in got["error"], got
+    assert got["cpu"] < 10.0, got
+
+
+def test_the_published_interval_records_fit_the_budget_with_room():
+    import math
+    from fractions import Fraction
+
+    from ccproof.certify.verify.tagged_limit import TAIL_BUDGET
+
+    for fam in ("crease", "corner"):
+        c = json.loads((certificates_dir() / "c1" / fam / "n_ge_101.json").read_text())
+        lim = c["limit"]
+        boxes = (2 * math.ceil(Fraction(lim["R"]) / Fraction(lim["box"]))) ** 2
+        assert (lim["arcs"] + lim["outer_arcs"] + boxes) * Fraction(c["prec"] + 1024, 1024) * 4 < TAIL_BUDGET

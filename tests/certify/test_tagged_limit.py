@@ -14,7 +14,7 @@ from ccproof.certify.verify import tagged_limit as tl
 from ccproof.certify.verify import tagged_modes as tm
 from ccproof.certify.verify import verify_certificate
 from ccproof.certify.verify.errors import CertificateError
-from ccproof.certify.verify.spectrum import lam_of
+from ccproof.certify.verify.statement import lam_of
 from ccproof.certify.verify.tagged import labels, parse_configuration
 from ccproof.certify.verify.tagged_c1 import _jacobian
 from ccproof.tables.format import certificates_dir

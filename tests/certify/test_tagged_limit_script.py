@@ -6,7 +6,7 @@ from pathlib import Path
 import pytest
 from flint import acb, arb, ctx, fmpq
 
-from ccproof.certify.verify.spectrum import lam_of
+from ccproof.certify.verify.statement import lam_of
 from ccproof.certify.verify.tagged import labels
 from ccproof.certify.verify.tagged_c1 import _jacobian
 from ccproof.certify.verify.tagged_modes import mode_vector

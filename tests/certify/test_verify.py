@@ -193,6 +193,31 @@ def test_c1_tampering_rejected():
     assert any("FAIL  spectral ordering" in s and "mode-0" in s for s in lines)
 
 
+def cell_det_poly(nets, lam, N, l, m, p, q, prec):
+    """det dG/d(s,t) on cell (l, m) for the w piece (p, q), directly on the cell's own restricted nets (not
+    from one form per piece restricted, as the verifier does); G = w y + (1 - w) Phi (docs/readings.md R6)."""
+    from flint import ctx, fmpq
+
+    from ccproof.rigorous import Poly, jacobian_determinant
+
+    i, name, box = M.cell_geometry(l, m, N)
+    with ctx.workprec(prec):
+        li = lam**i
+        X = M.net_form(nets[name], 0, prec, box).to_poly() * li
+        Y = M.net_form(nets[name], 1, prec, box).to_poly() * li
+        s, t = Poly.variable(0, 2), Poly.variable(1, 2)
+        y1, y2 = (s + l) * fmpq(1, 2**N), (t + m) * fmpq(1, 2**N)
+        w = M.weight_piece(p).compose([X]) * M.weight_piece(q).compose([Y])
+        return jacobian_determinant([X + w * (y1 - X), Y + w * (y2 - Y)])
+
+
+def test_the_direct_cell_determinant_is_4_to_the_minus_N_for_the_identity_map():
+    from flint import arb
+
+    nets, lam = St.nets_for_valence(4, 64), St.c_lam(4, 64)[1]  # k = 4: Phi is the identity, lam = 1/2
+    assert cell_det_poly(nets, lam, 1, 1, 0, 2, 2, 64).coeffs[0].overlaps(arb(1) / 4)
+
+
 # ---------------------------------------------------------------- mirror symmetry (parts B, D, E)
 def test_mirror_symmetry_of_the_exact_nets_and_its_consequence():
     from flint import ctx
@@ -210,8 +235,8 @@ def test_mirror_symmetry_of_the_exact_nets_and_its_consequence():
         assert set(half) == {c for c in full if c[0] <= c[1]}
         assert {(m, l, q, p) for l, m, p, q in full} == set(full)  # the required set itself is symmetric
         for l, m, p, q in [(0, 1, 0, 0), (1, 6, 1, 2), (2, 7, 2, 2)]:
-            a = bernstein_coefficients(M.cell_det_poly(nets, lam, 3, l, m, p, q, 128))
-            b = bernstein_coefficients(M.cell_det_poly(nets, lam, 3, m, l, q, p, 128))
+            a = bernstein_coefficients(cell_det_poly(nets, lam, 3, l, m, p, q, 128))
+            b = bernstein_coefficients(cell_det_poly(nets, lam, 3, m, l, q, p, 128))
             n0, n1 = a.shape
             assert b.shape == (n1, n0)
             for i in range(n0):
@@ -238,7 +263,7 @@ def test_cell_forms_restricted_from_one_piece_form_equal_the_direct_cell_determi
         assert len(picked) == 4  # one cell on each layer 0..3 (h = 1/8 .. 1)
         for l, m, p, q in picked + cells[-3:]:
             a = build(l, m, p, q)
-            b = bernstein_coefficients(M.cell_det_poly(nets, lam, 4, l, m, p, q, 128))
+            b = bernstein_coefficients(cell_det_poly(nets, lam, 4, l, m, p, q, 128))
             assert a.shape == b.shape
             for x, y in zip(a.coeffs, b.coeffs):
                 assert x.overlaps(y) and abs(x.mid() - y.mid()) < 1e-25 and x.rad() < 1e-25, (l, m, p, q)

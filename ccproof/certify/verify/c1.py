@@ -16,11 +16,11 @@ from __future__ import annotations
 from flint import arb, ctx
 
 from .errors import CertificateError
-from .injectivity import check_derivation, check_hypotheses
+from .injectivity import check_derivation, check_hypotheses, read_lam_pieces
 from .interval import hull_nets, lam_interval_ok, parameter_nets
 from .maps import STAR_CURVES, regularity_form, star_form
 from .record import exact_keys, field_of, kname
-from .replay import check_boxes, parse_decimal, read_boxes
+from .replay import check_boxes, read_boxes
 from .spectrum import check_block_polynomials, spectral_ordering
 from .statement import PATCHES, StatementError, c_lam, derivation, nets_for_valence
 
@@ -36,7 +36,6 @@ def verify_c1(cert, k, part, log):
         From :func:`.record.read_valence`.
     part : Recorder
         Receives one :class:`.record.Part` per checked claim.
-    log : callable (str) -> None
 
     Raises
     ------
@@ -54,49 +53,10 @@ def verify_c1(cert, k, part, log):
     >>> bool(res), res.parts[4].name
     (True, 'det J_Phi > 0 on P1')
     """
-    exact_keys(cert, ("schema", "valence", "prec", "pieces" if isinstance(k, dict) else "parts"), "certificate")
-    prec = field_of(cert, "prec", int, "certificate")
-    if not 64 <= prec <= 1024:
-        raise CertificateError("prec must lie in 64..1024")
-    piece_list = field_of(cert, "pieces", list, "certificate") if isinstance(k, dict) else [
-        {"lam": None, "parts": field_of(cert, "parts", dict, "certificate")}]
-    if not 1 <= len(piece_list) <= 64:
-        raise CertificateError("there must be 1..64 lam pieces")
-    ends = []
-    for pc in piece_list:
-        if isinstance(k, dict):
-            exact_keys(pc, ("lam", "parts"), "piece")
-            lo_hi = field_of(pc, "lam", list, "piece")
-            if len(lo_hi) != 2:
-                raise CertificateError("piece lam must be [low, high]")
-            ends.append(tuple(parse_decimal(x) for x in lo_hi))
-        parts = pc["parts"]
-        exact_keys(parts, ("regularity", "star"), "parts")
-        reg, star = field_of(parts, "regularity", dict, "parts"), field_of(parts, "star", dict, "parts")
-        exact_keys(reg, PATCHES, "parts.regularity")
-        exact_keys(star, tuple(STAR_CURVES), "parts.star")
-        for label, sec, nv in (("regularity", reg, 2), ("star", star, 1)):
-            for name, boxes in sec.items():
-                read_boxes(boxes, nv, f"parts.{label}.{name}")  # the partition, before any arithmetic
-    if ends and (any(not a < b for a, b in ends) or any(ends[i][1] != ends[i + 1][0] for i in range(len(ends) - 1))):
-        raise CertificateError("the lam pieces must be increasing and contiguous")  # exact fmpq comparisons
+    prec, piece_list, ends = _read_pieces(cert, k)
     log(f"C1 certificate for valence {kname(k)} ({prec} bits)")
-    if not check_derivation(part):
+    if not _check_spectrum(k, ends, prec, part):
         return
-    ok = check_block_polynomials()
-    part("spectrum: Fourier blocks of the rules have the stated characteristic polynomials", ok,
-         "exact identities in (x, w) and (x, 1/k)" if ok else "an identity fails")
-    if not ok:
-        return
-    ok, msg = spectral_ordering(k, prec)
-    part("spectral ordering 1 > lam = lam > |lam_3|, lam non-defective", ok, msg)
-    if not ok:
-        return
-    if ends:
-        ok = lam_interval_ok(k["min"], ends[0][0], ends[-1][1], prec)
-        part(f"lam(k) in [{ends[0][0]}, {ends[-1][1]}] for every k >= {k['min']}", ok)
-        if not ok:
-            return
     exact = derivation().integer_forms("bspline") if ends else None
     for idx, pc in enumerate(piece_list):
         tag = f"[piece {idx}] " if ends else ""
@@ -111,12 +71,58 @@ def verify_c1(cert, k, part, log):
                 part(f"{tag}S nets of the characteristic map", False, str(exc))
                 return
             check_hypotheses(nets, lam, part, tag)
-            for name in PATCHES:
-                ok, msg, mb = check_boxes(regularity_form(nets, name, prec), pc["parts"]["regularity"][name],
-                                          f"regularity {name}")
-                part(f"{tag}det J_Phi > 0 on {name}", ok, msg or f"min bound {mb} (local s,t)", mb, "regularity")
-            for curve in STAR_CURVES:
-                ok, msg, mb = check_boxes(star_form(nets, curve, prec), pc["parts"]["star"][curve], f"star {curve}")
-                part(f"{tag}outer boundary star-shaped on {curve}", ok, msg or f"min bound {mb}", mb, "star")
+            _check_parts(nets, pc["parts"], tag, prec, part)
             if part.failed:
                 return
+
+
+def _read_pieces(cert, k):
+    """``(prec, pieces, ends)``: the record read and every box list checked to partition its domain, before
+    any arithmetic; ``ends`` the exact (low, high) of each lam piece (empty for one valence)."""
+    exact_keys(cert, ("schema", "valence", "prec", "pieces" if isinstance(k, dict) else "parts"), "certificate")
+    prec = field_of(cert, "prec", int, "certificate")
+    if not 64 <= prec <= 1024:
+        raise CertificateError("prec must lie in 64..1024")
+    if not isinstance(k, dict):
+        piece_list = [{"lam": None, "parts": field_of(cert, "parts", dict, "certificate")}]
+        _read_parts(piece_list[0]["parts"])
+        return prec, piece_list, []
+    piece_list = field_of(cert, "pieces", list, "certificate")
+    return prec, piece_list, read_lam_pieces(piece_list, _read_parts)
+
+
+def _read_parts(parts):
+    exact_keys(parts, ("regularity", "star"), "parts")
+    reg, star = field_of(parts, "regularity", dict, "parts"), field_of(parts, "star", dict, "parts")
+    exact_keys(reg, PATCHES, "parts.regularity")
+    exact_keys(star, tuple(STAR_CURVES), "parts.star")
+    for label, sec, nv in (("regularity", reg, 2), ("star", star, 1)):
+        for name, boxes in sec.items():
+            read_boxes(boxes, nv, f"parts.{label}.{name}")  # the partition, before any arithmetic
+
+
+def _check_spectrum(k, ends, prec, part):
+    """The derivation, the Fourier blocks, the spectral ordering and (every k >= k0) the lam interval."""
+    if not check_derivation(part):
+        return False
+    ok = check_block_polynomials()
+    part("spectrum: Fourier blocks of the rules have the stated characteristic polynomials", ok,
+         "exact identities in (x, w) and (x, 1/k)" if ok else "an identity fails")
+    if not ok:
+        return False
+    ok, msg = spectral_ordering(k, prec)
+    part("spectral ordering 1 > lam = lam > |lam_3|, lam non-defective", ok, msg)
+    if ok and ends:
+        ok = lam_interval_ok(k["min"], ends[0][0], ends[-1][1], prec)
+        part(f"lam(k) in [{ends[0][0]}, {ends[-1][1]}] for every k >= {k['min']}", ok)
+    return ok
+
+
+def _check_parts(nets, parts, tag, prec, part):
+    """Replay the boxes of ``parts.regularity`` (det J_Phi) and ``parts.star`` (the outer curves)."""
+    for name in PATCHES:
+        ok, msg, mb = check_boxes(regularity_form(nets, name, prec), parts["regularity"][name], f"regularity {name}")
+        part(f"{tag}det J_Phi > 0 on {name}", ok, msg or f"min bound {mb} (local s,t)", mb, "regularity")
+    for curve in STAR_CURVES:
+        ok, msg, mb = check_boxes(star_form(nets, curve, prec), parts["star"][curve], f"star {curve}")
+        part(f"{tag}outer boundary star-shaped on {curve}", ok, msg or f"min bound {mb}", mb, "star")

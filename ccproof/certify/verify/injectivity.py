@@ -20,10 +20,11 @@ from flint import arb, ctx, fmpq
 from .errors import CertificateError
 from .interval import hull_nets, interval_cells, lam_interval_ok, parameter_nets
 from .maps import (
+    STAR_CURVES,
     cell_det_builder,
     corner_containment,
     corner_det_form,
-    outer_curves,
+    curve_points,
     regularity_form,
     required_cells,
     square_inside_image,
@@ -39,10 +40,6 @@ MAX_LEVEL = 6  # N: every published certificate, every k >= 3, needs at most 5; 
 
 def check_derivation(part):
     """Part S: the statement's identities (once per process; every valence at once).
-
-    Parameters
-    ----------
-    part : Recorder
 
     Returns
     -------
@@ -69,9 +66,6 @@ def check_hypotheses(nets, lam, part, tag=""):
 
     Parameters
     ----------
-    nets : dict[str, 4 x 4 of (arb, arb)]
-    lam : arb
-    part : Recorder
     tag : str
         Prefix of the part's name.
 
@@ -85,8 +79,9 @@ def check_hypotheses(nets, lam, part, tag=""):
     >>> res.parts[1].ok, res.parts[1].message
     (False, 'lam fails')
     """
-    exact = outer_curves(derivation().bezier)  # a coordinate that is exactly 0 in F is on the axis
-    quadrant = all(q.is_zero() or x >= 0 for cv, ecv in zip(outer_curves(nets), exact) for p, e in zip(cv, ecv)
+    exact = derivation().bezier  # a coordinate that is exactly 0 in F is on the axis
+    quadrant = all(q.is_zero() or x >= 0 for cv in STAR_CURVES
+                   for p, e in zip(curve_points(nets, cv), curve_points(exact, cv))
                    for x, q in zip(p, e))  # arb >= : certainly
     ok = lam > 0 and lam < 1 and 2 * lam**4 < 1
     part(f"{tag}H 0 < lam < 1, 2 lam^4 < 1, outer curve in the first quadrant", ok and quadrant,
@@ -97,14 +92,6 @@ def form_patches(symmetric):
     """The pieces whose forms parts B and E check: all three, or P2 and P3 under the mirror symmetry
     (exact, part S), which maps P1's det J_Phi and corner form onto P3's with (s, t) swapped
     (docs/appendix_a.md section 8), as part D keeps only the cells with l <= m.
-
-    Parameters
-    ----------
-    symmetric : bool
-
-    Returns
-    -------
-    tuple of str
 
     Examples
     --------
@@ -132,14 +119,6 @@ def _check_structure(parts, cell_vars):
 def read_n_prec(cert):
     """The level N (1..:data:`MAX_LEVEL`) and the precision in bits (64..1024) of a certificate.
 
-    Parameters
-    ----------
-    cert : dict
-
-    Returns
-    -------
-    (int, int)
-
     Examples
     --------
     >>> read_n_prec({"N": 3, "prec": 128})
@@ -163,9 +142,6 @@ def verify_valence(cert, k, part, log):
     ----------
     cert : dict
         Schema :data:`SCHEMA` with ``N``, ``prec`` and ``parts`` (``regularity``, ``cells``, ``corner``).
-    k : int
-    part : Recorder
-    log : callable (str) -> None
 
     Raises
     ------
@@ -209,12 +185,6 @@ def check_parts(parts, nets, lam, N, prec, cells, part, tag):
     ----------
     parts : dict
         ``regularity``, ``cells``, ``corner`` box lists of the certificate.
-    nets : dict[str, 4 x 4 of (arb, arb)]
-    lam : arb
-    N, prec : int
-    cells : list of (str, callable () -> BernsteinForm)
-    part : Recorder
-    tag : str
 
     Examples
     --------
@@ -281,6 +251,32 @@ def _check_sections(parts, sec, label, build, part, tag):
     part(f"{tag}{label}", True, f"min bound {min(mins)} (w.r.t. the local variables)", min(mins), sec)
 
 
+def read_lam_pieces(pieces, read_parts):
+    """The exact ends (low, high) of 1..64 lam pieces ``{"lam": [low, high], "parts": ...}``, increasing and
+    contiguous; ``read_parts(parts)`` reads each piece's hints (their partitions, before any arithmetic).
+
+    Examples
+    --------
+    >>> read_lam_pieces([{"lam": ["0.5", "0.6"], "parts": {}}, {"lam": ["0.6", "0.7"], "parts": {}}], print)
+    {}
+    {}
+    [(1/2, 3/5), (3/5, 7/10)]
+    """
+    if not 1 <= len(pieces) <= 64:
+        raise CertificateError("there must be 1..64 lam pieces")
+    ends = []
+    for pc in pieces:
+        exact_keys(pc, ("lam", "parts"), "piece")
+        lo_hi = field_of(pc, "lam", list, "piece")
+        if len(lo_hi) != 2:
+            raise CertificateError("piece lam must be [low, high]")
+        ends.append(tuple(parse_decimal(x) for x in lo_hi))
+        read_parts(field_of(pc, "parts", dict, "piece"))
+    if any(not a < b for a, b in ends) or any(ends[i][1] != ends[i + 1][0] for i in range(len(ends) - 1)):
+        raise CertificateError("the lam pieces must be increasing and contiguous")  # exact fmpq comparisons
+    return ends
+
+
 def verify_interval(cert, k, part, log):
     """Every valence k >= k0 (``k = {"min": k0}``): lam pieces with Taylor models (:mod:`.interval`).
 
@@ -288,9 +284,6 @@ def verify_interval(cert, k, part, log):
     ----------
     cert : dict
         Schema :data:`SCHEMA` with ``N``, ``prec``, ``parameter`` and ``pieces``.
-    k : dict ``{"min": k0}``
-    part : Recorder
-    log : callable (str) -> None
 
     Raises
     ------
@@ -314,18 +307,7 @@ def verify_interval(cert, k, part, log):
     if param["variable"] != "lam" or not 1 <= D <= deg <= 8:
         raise CertificateError("parameter must be {'variable': 'lam', 1 <= truncation_degree <= taylor_degree <= 8}")
     pieces = field_of(cert, "pieces", list, "certificate")
-    if not 1 <= len(pieces) <= 64:
-        raise CertificateError("there must be 1..64 lam pieces")
-    ends = []
-    for pc in pieces:
-        exact_keys(pc, ("lam", "parts"), "piece")
-        lo_hi = field_of(pc, "lam", list, "piece")
-        if len(lo_hi) != 2:
-            raise CertificateError("piece lam must be [low, high]")
-        ends.append(tuple(parse_decimal(x) for x in lo_hi))
-        _check_structure(field_of(pc, "parts", dict, "piece"), 3)
-    if any(not a < b for a, b in ends) or any(ends[i][1] != ends[i + 1][0] for i in range(len(ends) - 1)):
-        raise CertificateError("the lam pieces must be increasing and contiguous")  # exact fmpq comparisons
+    ends = read_lam_pieces(pieces, lambda parts: _check_structure(parts, 3))
     if not (ends[0][0] > fmpq(1, 4) and ends[-1][1] < 1):
         raise CertificateError("the lam pieces must lie inside (1/4, 1)")
     log(f"certificate for valences k >= {k['min']} (N = {N}, {prec} bits, {len(pieces)} lam piece(s), "
@@ -356,13 +338,6 @@ def verify_interval(cert, k, part, log):
 
 def verify_injectivity(cert, k, part, log):
     """An injectivity certificate (docs/appendix_a.md): :func:`verify_interval` or :func:`verify_valence`.
-
-    Parameters
-    ----------
-    cert : dict
-    k : int or dict ``{"min": k0}``
-    part : Recorder
-    log : callable (str) -> None
 
     Returns
     -------

@@ -23,7 +23,7 @@ from ccproof.rigorous import (
 
 from .errors import CertificateError
 from .maps import ORIGIN, cell_geometry, cell_pieces, dyadic_cells, net_form, weight_piece
-from .statement import B2Z, PATCHES
+from .statement import B2Z, PATCHES, c_lam
 
 ZBOX = ((fmpq(-1), fmpq(1)), (fmpq(0), fmpq(1)), (fmpq(0), fmpq(1)))  # (zeta, s, t) of part D
 
@@ -41,10 +41,8 @@ def entry_model(form, L, layer, degree, prec):
 
     Parameters
     ----------
-    form : [A, B, D], integer coefficient lists in c (:meth:`.field.QL.integer_form`)
     L : fmpq_poly
         lam as a polynomial in zeta.
-    layer, degree, prec : int
 
     Returns
     -------
@@ -91,19 +89,12 @@ def parameter_nets(exact, La, Lb, layer, degree, prec):
     ----------
     exact : dict[str, 4 x 4 of ([A, B, D], [A, B, D])]
         :meth:`.statement.Derivation.integer_forms` of the B-spline nets.
-    La, Lb : fmpq
-    layer, degree, prec : int
-
-    Returns
-    -------
-    dict[str, 4 x 4 of (list of arb, list of arb)]
 
     Examples
     --------
     On the one-point interval lam = 1/2 (k = 4) the net is the identity's, (1/2 + i/6, j/6) on P1:
 
     >>> from ccproof.certify.verify.statement import derivation
-    >>> from ccproof.rigorous import range_enclosure
     >>> exact, h = derivation().integer_forms(), fmpq(1, 2)    # the one-point interval lam = 1/2: k = 4
     >>> zn = {i: parameter_nets(exact, h, h, i, 2, 64) for i in (0, 1)}
     >>> [z[0].str(6, radius=False) for z in zn[0]["P1"][1][1]]
@@ -123,19 +114,9 @@ def parameter_nets(exact, La, Lb, layer, degree, prec):
 def hull_nets(znets, prec):
     """arb nets enclosing the zeta-polynomial nets for every zeta in [-1, 1] (Bernstein range).
 
-    Parameters
-    ----------
-    znets : dict[str, 4 x 4 of (list of arb, list of arb)]
-    prec : int
-
-    Returns
-    -------
-    dict[str, 4 x 4 of (arb, arb)]
-
     Examples
     --------
     >>> from ccproof.certify.verify.statement import derivation
-    >>> from ccproof.rigorous import range_enclosure
     >>> exact, h = derivation().integer_forms(), fmpq(1, 2)    # the one-point interval lam = 1/2: k = 4
     >>> zn = {i: parameter_nets(exact, h, h, i, 2, 64) for i in (0, 1)}
     >>> x, y = hull_nets(zn[0], 64)["P1"][1][1]
@@ -155,18 +136,12 @@ def cell_maps_z(znets, N, l, m, D, prec):
     ----------
     znets : dict[int, nets of :func:`parameter_nets`]
         By layer.
-    N, l, m, D, prec : int
-
-    Returns
-    -------
-    (Poly, Poly)
 
     Examples
     --------
     Cell (1, 0) of level 1 is piece P1 of layer 0, where Phi(s, t) = (1/2 + s/2, t/2) at k = 4:
 
     >>> from ccproof.certify.verify.statement import derivation
-    >>> from ccproof.rigorous import range_enclosure
     >>> exact, h = derivation().integer_forms(), fmpq(1, 2)    # the one-point interval lam = 1/2: k = 4
     >>> zn = {i: parameter_nets(exact, h, h, i, 2, 64) for i in (0, 1)}
     >>> X, Y = cell_maps_z(zn, 1, 1, 0, 2, 64)
@@ -188,21 +163,9 @@ def piece_maps_z(znets, i, name, D, prec):
     """(X, Y) = lam^i Phi on piece ``name`` of layer i as TaylorForms in (zeta; sigma, tau): the Bezier
     net entries are the Bernstein coefficients in (sigma, tau), their zeta polynomials the Taylor part.
 
-    Parameters
-    ----------
-    znets : dict[int, nets of :func:`parameter_nets`]
-    i : int
-    name : {"P1", "P2", "P3"}
-    D, prec : int
-
-    Returns
-    -------
-    (TaylorForm, TaylorForm)
-
     Examples
     --------
     >>> from ccproof.certify.verify.statement import derivation
-    >>> from ccproof.rigorous import range_enclosure
     >>> exact, h = derivation().integer_forms(), fmpq(1, 2)    # the one-point interval lam = 1/2: k = 4
     >>> zn = {i: parameter_nets(exact, h, h, i, 2, 64) for i in (0, 1)}
     >>> X, Y = piece_maps_z(zn, 0, "P1", 2, 64)
@@ -230,17 +193,6 @@ def piece_det_form_z(znets, i, name, p, q, D, prec):
     every lam of the interval at once (Taylor model in zeta, truncated to degree D; one form for all the
     cells of that layer, piece and w piece; y = 2^-i (ORIGIN + (sigma, tau)/2) as in :func:`piece_det_form`).
 
-    Parameters
-    ----------
-    znets : dict[int, nets of :func:`parameter_nets`]
-    i : int
-    name : {"P1", "P2", "P3"}
-    p, q, D, prec : int
-
-    Returns
-    -------
-    BernsteinForm
-
     Examples
     --------
     At k = 4, Phi = y, so the blend G is y and det = 4^-(i+1):
@@ -267,12 +219,6 @@ def interval_cells(znets, N, D, prec, symmetric=False):
     """Part D for an interval: every (key, build root) with a w piece met by the Bernstein hull of the
     cell's image over all zeta; the root is det dG/d(s,t) in (zeta, s, t) on ZBOX: the form of its layer,
     piece and w piece (:func:`piece_det_form_z`) restricted to the cell's box, times h^2 (h a power of 2).
-
-    Parameters
-    ----------
-    znets : dict[int, nets of :func:`parameter_nets`]
-    N, D, prec : int
-    symmetric : bool
 
     Returns
     -------
@@ -318,16 +264,6 @@ def lam_interval_ok(k0, La, Lb, prec):
     """[La, Lb] contains lam(k) for every k >= k0: La <= lam(k0) and Lb >= (3 + sqrt 5)/8 = lim lam
     (lam increases with c = cos(2 pi/k), which increases with k).
 
-    Parameters
-    ----------
-    k0 : int
-    La, Lb : fmpq
-    prec : int
-
-    Returns
-    -------
-    bool
-
     Examples
     --------
     lam(5) = 0.5497..., lim lam = 0.6545... (docs/readings.md R2, R10):
@@ -337,6 +273,4 @@ def lam_interval_ok(k0, La, Lb, prec):
     [True, False, False]
     """
     with ctx.workprec(prec):
-        c = arb(fmpq(2, k0)).cos_pi()
-        lam0 = (5 + c + ((1 + c) * (9 + c)).sqrt()) / 16
-        return bool(lam0 >= La) and bool((3 + arb(5).sqrt()) / 8 <= Lb)
+        return bool(c_lam(k0, prec)[1] >= La) and bool((3 + arb(5).sqrt()) / 8 <= Lb)

@@ -2,7 +2,9 @@
 
 Given nets of the characteristic map (arb balls enclosing the exact nets of :mod:`.statement`) and
 lam, these functions build the polynomials whose positivity the certificates claim
-(docs/certificates.md, parts A-E; docs/appendix_a.md derives them).
+(docs/certificates.md, parts A-E; docs/appendix_a.md derives them). Throughout, ``nets`` maps each piece
+P1, P2, P3 to its 4 x 4 Bezier net of points (arb, arb), ``lam`` is an arb, ``prec`` the bits, and a
+form is a :class:`~ccproof.rigorous.BernsteinForm` on the unit box of the local parameters.
 """
 
 from __future__ import annotations
@@ -17,7 +19,7 @@ from ccproof.rigorous import (
     jacobian_determinant,
 )
 
-from .statement import PATCHES
+from .statement import PATCHES, split_half
 
 BREAKS = (fmpq(0), fmpq(1, 6), fmpq(1, 3), fmpq(1, 2))  # w pieces (docs/readings.md R5); piece 3 is w = 0
 
@@ -25,10 +27,6 @@ BREAKS = (fmpq(0), fmpq(1, 6), fmpq(1, 3), fmpq(1, 2))  # w pieces (docs/reading
 def weight_piece(p):
     """b(x) = B(6x+1) + B(6x) + B(6x-1) on [BREAKS[p], BREAKS[p+1]] (R5) as an exact 1-var Poly;
     B is the centred uniform cubic B-spline: (4 - 6z^2 + 3|z|^3)/6 on |z| <= 1, (2 - |z|)^3/6 on 1..2.
-
-    Parameters
-    ----------
-    p : int in 0..2
 
     Returns
     -------
@@ -65,13 +63,6 @@ def net_form(net, coord, prec, box=None):
     """Bernstein form (unit box in the local variables) of one coordinate of a 4x4 Bezier net,
     restricted to ``box`` (dyadic sub-box of [0,1]^2 in the piece's local parameters).
 
-    Parameters
-    ----------
-    net : 4 x 4 of (arb, arb)
-    coord : {0, 1}
-    prec : int
-    box : ((lo, hi), (lo, hi)) of fmpq, optional
-
     Returns
     -------
     BernsteinForm
@@ -80,7 +71,6 @@ def net_form(net, coord, prec, box=None):
     Examples
     --------
     >>> from ccproof.certify.verify.statement import c_lam, nets_for_valence
-    >>> from flint import arb
     >>> from ccproof.rigorous import range_enclosure
     >>> nets, (c, lam) = nets_for_valence(4, 64), c_lam(4, 64)   # k = 4: Phi is the identity, lam = 1/2
     >>> boxes = (None, ((0, 1), (0, "1/2")))
@@ -94,16 +84,8 @@ def net_form(net, coord, prec, box=None):
 
 
 def cell_geometry(l, m, N):
-    """Layer i, piece name and (s, t) sub-box of the dyadic cell (l, m) != (0, 0) of level N.
-
-    Parameters
-    ----------
-    l, m, N : int
-        Cell [l, l+1] x [m, m+1] / 2^N of the face (docs/appendix_a.md, part D).
-
-    Returns
-    -------
-    (int, str, ((fmpq, fmpq), (fmpq, fmpq)))
+    """Layer i, piece name and (s, t) sub-box of the dyadic cell (l, m) != (0, 0) of level N, the cell
+    [l, l+1] x [m, m+1] / 2^N of the face (docs/appendix_a.md, part D).
 
     Examples
     --------
@@ -128,11 +110,6 @@ def cell_geometry(l, m, N):
 def cell_pieces(X, Y):
     """The w pieces (p, q), p, q in 0..3, whose regions the Bezier hull of (X, Y) may meet.
 
-    Parameters
-    ----------
-    X, Y : BernsteinForm
-        The two coordinates of a map (ball coefficients).
-
     Returns
     -------
     list of (int, int)
@@ -141,35 +118,20 @@ def cell_pieces(X, Y):
     Examples
     --------
     >>> from ccproof.certify.verify.statement import c_lam, nets_for_valence
-    >>> from flint import arb
-    >>> from ccproof.rigorous import range_enclosure
     >>> nets, (c, lam) = nets_for_valence(4, 64), c_lam(4, 64)   # k = 4: Phi is the identity, lam = 1/2
     >>> cell_pieces(net_form(nets["P1"], 0, 64), net_form(nets["P1"], 1, 64))   # x in [1/2, 1], y in [0, 1/2]
     [(2, 0), (2, 1), (2, 2), (2, 3), (3, 0), (3, 1), (3, 2), (3, 3)]
     """
-    out = []
     rng = []
     for F in (X, Y):
         lo = min(c.lower() for c in F.coeffs)
         hi = max(c.upper() for c in F.coeffs)
         rng.append([p for p in range(4) if not (hi < BREAKS[p] or (p < 3 and lo > BREAKS[p + 1]))])
-    for p in rng[0]:
-        for q in rng[1]:
-            out.append((p, q))
-    return out
+    return [(p, q) for p in rng[0] for q in rng[1]]
 
 
 def dyadic_cells(N, symmetric):
     """The cells (l, m) != (0, 0) of level N that part D checks (l <= m only when ``symmetric``).
-
-    Parameters
-    ----------
-    N : int
-    symmetric : bool
-
-    Returns
-    -------
-    list of (int, int)
 
     Examples
     --------
@@ -183,22 +145,9 @@ def required_cells(nets, lam, N, prec, symmetric=False):
     """Every (l, m, p, q) of part D: cell (l, m) of :func:`dyadic_cells` and w piece (p, q), p, q < 3, met
     by the Bezier hull of Phi(cell). Pieces with p = 3 or q = 3 have w = 0 (G = Phi, covered by part B).
 
-    Parameters
-    ----------
-    nets : dict[str, 4 x 4 of (arb, arb)]
-    lam : arb
-    N, prec : int
-    symmetric : bool
-
-    Returns
-    -------
-    list of (int, int, int, int)
-
     Examples
     --------
     >>> from ccproof.certify.verify.statement import c_lam, nets_for_valence
-    >>> from flint import arb
-    >>> from ccproof.rigorous import range_enclosure
     >>> nets, (c, lam) = nets_for_valence(4, 64), c_lam(4, 64)   # k = 4: Phi is the identity, lam = 1/2
     >>> required_cells(nets, lam, 1, 64)
     [(0, 1, 0, 2), (0, 1, 1, 2), (0, 1, 2, 2), (1, 0, 2, 0), (1, 0, 2, 1), (1, 0, 2, 2), (1, 1, 2, 2)]
@@ -215,44 +164,6 @@ def required_cells(nets, lam, N, prec, symmetric=False):
     return out
 
 
-def cell_det_poly(nets, lam, N, l, m, p, q, prec):
-    """det dG/d(s,t) on cell (l, m) for the w piece (p, q) (p, q < 3), local coordinates in [0,1]^2.
-
-    Parameters
-    ----------
-    nets : dict[str, 4 x 4 of (arb, arb)]
-    lam : arb
-    N, l, m, p, q, prec : int
-
-    Returns
-    -------
-    Poly
-        Ball coefficients; G = w y + (1 - w) Phi is the blend of docs/readings.md R6 (bmz04 eq. 4).
-
-    Examples
-    --------
-    With Phi = y (k = 4) G is y and det dG/d(s, t) = 4^-N:
-
-    >>> from ccproof.certify.verify.statement import c_lam, nets_for_valence
-    >>> from flint import arb
-    >>> from ccproof.rigorous import range_enclosure
-    >>> nets, (c, lam) = nets_for_valence(4, 64), c_lam(4, 64)   # k = 4: Phi is the identity, lam = 1/2
-    >>> cell_det_poly(nets, lam, 1, 1, 0, 2, 2, 64).coeffs[0].overlaps(arb(1) / 4)
-    True
-    """
-    i, name, box = cell_geometry(l, m, N)
-    with ctx.workprec(prec):
-        li = lam**i
-        X = net_form(nets[name], 0, prec, box).to_poly() * li
-        Y = net_form(nets[name], 1, prec, box).to_poly() * li
-        s, t = Poly.variable(0, 2), Poly.variable(1, 2)
-        y1 = (s + l) * fmpq(1, 2**N)
-        y2 = (t + m) * fmpq(1, 2**N)
-        w = weight_piece(p).compose([X]) * weight_piece(q).compose([Y])
-        # G = w y + (1 - w) Phi, written X + w (y - X): one product per coordinate
-        return jacobian_determinant([X + w * (y1 - X), Y + w * (y2 - Y)])
-
-
 #: layer-0 coordinates (u, v) = ORIGIN + (sigma, tau) / 2 of the local parameters (sigma, tau) of each piece
 ORIGIN = {"P1": (fmpq(1, 2), fmpq(0)), "P2": (fmpq(1, 2), fmpq(1, 2)), "P3": (fmpq(0), fmpq(1, 2))}
 
@@ -261,18 +172,6 @@ def piece_det_form(nets, lam, i, name, p, q, prec):
     """Bernstein form on [0,1]^2 of det dG/d(sigma, tau) on layer i of piece ``name`` for the w piece (p, q)
     (p, q < 3), in the piece's local parameters: one polynomial for every cell of that layer, piece and w piece.
     On layer i, Phi = lam^i Phi_0(sigma, tau) and y = 2^-i (ORIGIN + (sigma, tau)/2).
-
-    Parameters
-    ----------
-    nets : dict[str, 4 x 4 of (arb, arb)]
-    lam : arb
-    i : int
-    name : {"P1", "P2", "P3"}
-    p, q, prec : int
-
-    Returns
-    -------
-    BernsteinForm
 
     Examples
     --------
@@ -301,17 +200,8 @@ def piece_det_form(nets, lam, i, name, p, q, prec):
 def cell_det_form(piece_form, N, l, m, p, q, prec):
     """Bernstein form of det dG/d(s, t) on cell (l, m) for the w piece (p, q) in the cell's local (s, t):
     the piece's form (``piece_form(i, name, p, q)``, :func:`piece_det_form`) restricted to the cell's box
-    (sigma = s0 + h s, tau = t0 + h t) times h^2 (exact: h is a power of 2). Same polynomial as
-    :func:`cell_det_poly` on the cell; restricting one form per piece is the cheap way to get it.
-
-    Parameters
-    ----------
-    piece_form : callable (i, name, p, q) -> BernsteinForm
-    N, l, m, p, q, prec : int
-
-    Returns
-    -------
-    BernsteinForm
+    (sigma = s0 + h s, tau = t0 + h t) times h^2 (exact: h is a power of 2): the determinant on the
+    cell's own nets (tests/certify/test_verify.py checks it), one form per piece restricted.
 
     Examples
     --------
@@ -332,16 +222,6 @@ def cell_det_form(piece_form, N, l, m, p, q, prec):
 
 def cell_det_builder(nets, lam, N, prec):
     """A function (l, m, p, q) -> :func:`cell_det_form`, building each :func:`piece_det_form` once.
-
-    Parameters
-    ----------
-    nets : dict[str, 4 x 4 of (arb, arb)]
-    lam : arb
-    N, prec : int
-
-    Returns
-    -------
-    callable (l, m, p, q) -> BernsteinForm
 
     Examples
     --------
@@ -367,14 +247,6 @@ def corner_det_form(nets, lam, N, name, prec):
     """Bernstein form on [0,1]^4 of det(J_G)/h^2 on layer i >= N of piece ``name`` in (rho, kappa, s, t)
     (R9 form), computed in Bernstein arithmetic (stays tight for the interval nets of k >= k0).
 
-    Parameters
-    ----------
-    nets : dict[str, 4 x 4 of (arb, arb)]
-    lam : arb
-    N : int
-    name : {"P1", "P2", "P3"}
-    prec : int
-
     Returns
     -------
     BernsteinForm
@@ -386,7 +258,6 @@ def corner_det_form(nets, lam, N, name, prec):
 
     >>> from ccproof.certify.verify.statement import c_lam, nets_for_valence
     >>> from flint import arb
-    >>> from ccproof.rigorous import range_enclosure
     >>> nets, (c, lam) = nets_for_valence(4, 64), c_lam(4, 64)   # k = 4: Phi is the identity, lam = 1/2
     >>> f = corner_det_form(nets, lam, 2, "P1", 64)
     >>> f.nvars, f.coeffs[0].overlaps(arb(1) / 4)
@@ -417,22 +288,11 @@ def regularity_form(nets, name, prec):
     """Bernstein form (degree (5,5)) of det J_Phi w.r.t. the local (s, t) of piece ``name`` on layer 0,
     computed in Bernstein arithmetic (stays tight for the interval nets of k >= k0).
 
-    Parameters
-    ----------
-    nets : dict[str, 4 x 4 of (arb, arb)]
-    name : {"P1", "P2", "P3"}
-    prec : int
-
-    Returns
-    -------
-    BernsteinForm
-
     Examples
     --------
     At k = 4, Phi(s, t) on a piece is the identity scaled by 1/2, so det J_Phi = 1/4:
 
     >>> from ccproof.certify.verify.statement import c_lam, nets_for_valence
-    >>> from flint import arb
     >>> from ccproof.rigorous import range_enclosure
     >>> nets, (c, lam) = nets_for_valence(4, 64), c_lam(4, 64)   # k = 4: Phi is the identity, lam = 1/2
     >>> [z.str(6, radius=False) for z in range_enclosure(regularity_form(nets, "P2", 64))]
@@ -445,19 +305,24 @@ def regularity_form(nets, name, prec):
 STAR_CURVES = {"P1s1": ("P1", "s", 1), "P2s1": ("P2", "s", 1), "P2t1": ("P2", "t", -1), "P3t1": ("P3", "t", -1)}
 
 
+def curve_points(nets, curve):
+    """The Bezier points of one cubic of the outer boundary (a key of :data:`STAR_CURVES`: the side s = 1 or
+    t = 1 of a piece), in the piece's parameter order.
+
+    Examples
+    --------
+    >>> nets = {"P2": [[(i, j) for j in range(4)] for i in range(4)]}
+    >>> curve_points(nets, "P2s1"), curve_points(nets, "P2t1")
+    ([(3, 0), (3, 1), (3, 2), (3, 3)], [(0, 3), (1, 3), (2, 3), (3, 3)])
+    """
+    name, side, _ = STAR_CURVES[curve]
+    net = nets[name]
+    return [net[3][j] for j in range(4)] if side == "s" else [net[i][3] for i in range(4)]
+
+
 def star_form(nets, curve, prec):
     """Bernstein form (degree 5) of x y' - y x' along one cubic of the outer boundary, oriented from
     (1,0) towards (0,1). Positive on all four curves means the outer boundary is star-shaped.
-
-    Parameters
-    ----------
-    nets : dict[str, 4 x 4 of (arb, arb)]
-    curve : key of :data:`STAR_CURVES`
-    prec : int
-
-    Returns
-    -------
-    BernsteinForm
 
     Examples
     --------
@@ -470,34 +335,20 @@ def star_form(nets, curve, prec):
     >>> [bool(abs(range_enclosure(star_form(nets, cv, 64))[0] - arb(1) / 2) < 1e-12) for cv in STAR_CURVES]
     [True, True, True, True]
     """
-    name, side, sign = STAR_CURVES[curve]
-    net = nets[name]
-    pts = [net[3][j] for j in range(4)] if side == "s" else [net[i][3] for i in range(4)]
+    pts = curve_points(nets, curve)
     with ctx.workprec(prec):
         X = BernsteinForm((4,), [p[0] for p in pts], prec=prec)
         Y = BernsteinForm((4,), [p[1] for p in pts], prec=prec)
         cross = X * Y.diff(0) - Y * X.diff(0)
-        return cross if sign > 0 else -cross
+        return cross if STAR_CURVES[curve][2] > 0 else -cross
 
 
 def corner_containment(nets, lam, N):
     """Part A: (lam^N * max(all Bezier coordinates) < 1/6 certainly, that ball).
 
-    Parameters
-    ----------
-    nets : dict[str, 4 x 4 of (arb, arb)]
-    lam : arb
-    N : int
-
-    Returns
-    -------
-    (bool, arb)
-
     Examples
     --------
     >>> from ccproof.certify.verify.statement import c_lam, nets_for_valence
-    >>> from flint import arb
-    >>> from ccproof.rigorous import range_enclosure
     >>> nets, (c, lam) = nets_for_valence(4, 64), c_lam(4, 64)   # k = 4: Phi is the identity, lam = 1/2
     >>> corner_containment(nets, lam, 3), corner_containment(nets, lam, 2)[0]   # 1/8 < 1/6 < 1/4
     ((True, 0.125000000000000), False)
@@ -510,48 +361,14 @@ def corner_containment(nets, lam, N):
 def square_inside_image(nets):
     """Part C: the images of the outer sides u = 1, v = 1 avoid [0,1/2]^2 (replayed bisection).
 
-    Parameters
-    ----------
-    nets : dict[str, 4 x 4 of (arb, arb)]
-
-    Returns
-    -------
-    bool
-
     Examples
     --------
     >>> from ccproof.certify.verify.statement import c_lam, nets_for_valence
-    >>> from flint import arb
-    >>> from ccproof.rigorous import range_enclosure
     >>> nets, (c, lam) = nets_for_valence(4, 64), c_lam(4, 64)   # k = 4: Phi is the identity, lam = 1/2
     >>> square_inside_image(nets)
     True
     """
-    return all(_curve_avoids(cv, 40) for cv in outer_curves(nets))
-
-
-def outer_curves(nets):
-    """The four cubic Bezier curves of the outer boundary (u = 1 on P1, P2; v = 1 on P2, P3).
-
-    Parameters
-    ----------
-    nets : dict[str, 4 x 4 of (x, y)]
-
-    Returns
-    -------
-    list of 4 lists of 4 (x, y)
-
-    Examples
-    --------
-    >>> from ccproof.certify.verify.statement import c_lam, nets_for_valence
-    >>> from flint import arb
-    >>> from ccproof.rigorous import range_enclosure
-    >>> nets, (c, lam) = nets_for_valence(4, 64), c_lam(4, 64)   # k = 4: Phi is the identity, lam = 1/2
-    >>> [[z.str(6, radius=False) for z in p] for p in outer_curves(nets)[0]]   # u = 1: (1, v) for v = 0..1/2
-    [['1.00000', '0'], ['1.00000', '0.166667'], ['1.00000', '0.333333'], ['1.00000', '0.500000']]
-    """
-    return [[nets["P1"][3][j] for j in range(4)], [nets["P2"][3][j] for j in range(4)],
-            [nets["P2"][i][3] for i in range(4)], [nets["P3"][i][3] for i in range(4)]]
+    return all(_curve_avoids(curve_points(nets, cv), 40) for cv in STAR_CURVES)
 
 
 def _curve_avoids(curve, depth):
@@ -561,12 +378,7 @@ def _curve_avoids(curve, depth):
         return True
     if depth == 0:
         return False
-    b = [list(p) for p in curve]
-    left, right, pts = [b[0]], [b[3]], b
-    for _ in range(3):
-        pts = [[(p[i] + q[i]) * half for i in range(2)] for p, q in zip(pts, pts[1:])]
-        left.append(pts[0])
-        right.append(pts[-1])
-    return _curve_avoids(left, depth - 1) and _curve_avoids(right[::-1], depth - 1)
+    left, right = split_half(curve)
+    return _curve_avoids(left, depth - 1) and _curve_avoids(right, depth - 1)
 
 

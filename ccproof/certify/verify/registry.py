@@ -246,22 +246,32 @@ def family_coverage(fam, certified):
     """
     rows = [(n, st) for n, st in certified if not isinstance(n, dict)]
     tails = sorted((n["min"], st) for n, st in certified if isinstance(n, dict))
-    ns = [n for n, _ in rows]
-    twice = sorted({n for n in ns if ns.count(n) > 1}) or sorted(
-        n for n, st in rows for t, st_t in tails if n >= t and st != st_t)
+    twice = _twice(rows, tails)
     lo, hi = TAGGED_RANGE[fam]
     n0 = min((t for t, _ in tails), default=hi + 2)
-    open_ = [n for n in range(lo, min(hi, n0 - 1) + 1) if n not in ns]
+    open_ = [n for n in range(lo, min(hi, n0 - 1) + 1) if n not in {n for n, _ in rows}]
     undecided = [n for n in open_ if f"{fam}:{n}" in UNDECIDED]
     missing = [_ranges([n for n in open_ if n not in undecided])] + ([f">= {hi + 1}"] if n0 > hi + 1 else [])
     missing = ", ".join(filter(None, missing))
-    said = {st: ", ".join(filter(None, [_ranges(sorted(n for n, s in rows if s == st))]
-                                 + [f">= {t}" for t, s in tails if s == st])) or "none" for st in ("C1", "not C1")}
+    said = {st: _said(rows, tails, st) for st in ("C1", "not C1")}
     status = (f"CONTRADICTORY: certified twice: {twice}; " if twice else f"INCOMPLETE: no certificate for {missing}; "
               if missing else f"OK ({fam}:{lo}-{hi}, every N): ")
     why = ", ".join(f"{n} ({UNDECIDED[f'{fam}:{n}']})" for n in undecided) or "none"
     return not twice and not missing, (f"{fam}: {status}C1 for {said['C1']}, not C1 for {said['not C1']}; "
                                        f"undecided: {why}")
+
+
+def _twice(rows, tails):
+    """The N certified twice: two single certificates, or a single one against a ``FAMILY:>=N0``'s statement."""
+    ns = [n for n, _ in rows]
+    return sorted({n for n in ns if ns.count(n) > 1}) or sorted(
+        n for n, st in rows for t, st_t in tails if n >= t and st != st_t)
+
+
+def _said(rows, tails, statement):
+    """The N certified with ``statement``, as ranges, then the tails ``>= N0``; ``none`` if there are none."""
+    return ", ".join(filter(None, [_ranges(sorted(n for n, s in rows if s == statement))]
+                            + [f">= {t}" for t, s in tails if s == statement])) or "none"
 
 
 def check_coverage(valences):

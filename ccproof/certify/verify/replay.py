@@ -416,20 +416,25 @@ def _read_grid(tree, n, where):
         raise CertificateError(f"{where}: leaves must be a non-empty list of at most {MAX_BOXES}")
     cells = {}
     for i, leaf in enumerate(leaves):
-        if not isinstance(leaf, dict) or set(leaf) not in ({"cell", "path", "bound"}, {"cell", "path", "outside"}):
-            raise CertificateError(f"{where}: a leaf must be {{'cell', 'path', 'bound'}} or {{'cell', 'path', "
-                                   "'outside'}}")
-        cell = leaf["cell"]
-        if not isinstance(cell, list) or len(cell) != n or not all(type(c) is int and 0 <= c < g
-                                                                    for c, g in zip(cell, grid)):
-            raise CertificateError(f"{where}: cell {str(cell)[:40]} is not a cell of the grid {grid}")
-        cells.setdefault(tuple(cell), []).append(i)
+        cells.setdefault(_leaf_cell(leaf, grid, where), []).append(i)
     total = 1
     for g in grid:
         total *= g
     if len(cells) != total:
         raise CertificateError(f"{where}: {total - len(cells)} of the {total} grid cells have no leaf (gap)")
     return grid, leaves, cells
+
+
+def _leaf_cell(leaf, grid, where):
+    """The grid cell (a tuple) a leaf of a grid tree names, its keys and indices checked."""
+    if not isinstance(leaf, dict) or set(leaf) not in ({"cell", "path", "bound"}, {"cell", "path", "outside"}):
+        raise CertificateError(f"{where}: a leaf must be {{'cell', 'path', 'bound'}} or {{'cell', 'path', "
+                               "'outside'}}")
+    cell = leaf["cell"]
+    if not isinstance(cell, list) or len(cell) != len(grid) or not all(type(c) is int and 0 <= c < g
+                                                                        for c, g in zip(cell, grid)):
+        raise CertificateError(f"{where}: cell {str(cell)[:40]} is not a cell of the grid {grid}")
+    return tuple(cell)
 
 
 def _claim(leaf, box, where, sign, k0, outside):

@@ -68,10 +68,6 @@ def _add(acc, comb, w):
 def face_point(a, b):
     """New face point of the level-0 face with lower corner (a, b): {raw position: weight}.
 
-    Parameters
-    ----------
-    a, b : int
-
     Returns
     -------
     dict[(int, int), fmpq]
@@ -164,20 +160,29 @@ def centre_rule_mode0(t):
     return acc
 
 
+class Vec(tuple):
+    """A vector with ``+`` and ``* weight`` entrywise, what :func:`apply` needs of its values (points of F^2,
+    rows of a Fourier block).
+
+    >>> Vec((1, 2)) + Vec((3, 4)) * 2
+    (7, 10)
+    """
+
+    def __add__(self, other):
+        return Vec(a + b for a, b in zip(self, other))
+
+    def __mul__(self, w):
+        return Vec(a * w for a in self)
+
+
 def apply(comb, lookup, zero):
     """Sum of weight * lookup(delta, (a', b')) over a combination of raw positions; the centre is
     ``lookup(0, (0, 0))``.
 
     Parameters
     ----------
-    comb : dict[(int, int), weight]
     lookup : callable (delta, (a', b')) -> value
         The value at position (a', b') of the sector delta steps on.
-    zero : the zero of the values
-
-    Returns
-    -------
-    value
 
     Examples
     --------
@@ -197,11 +202,6 @@ def apply(comb, lookup, zero):
 def level1_value(A, B, lookup, zero):
     """The level-1 value at any sector-local level-1 position (A, B) != centre, rotated into place:
     canonicalize to (delta, A', B'), apply the rule in sector delta.
-
-    Parameters
-    ----------
-    A, B : int
-    lookup, zero : as in :func:`apply` (relative to sector delta)
 
     Returns
     -------

@@ -29,7 +29,8 @@ from __future__ import annotations
 
 from flint import arb, ctx, fmpq, fmpq_mat
 
-from .rules import CENTRE, TWO_RING, apply, centre_rule_mode0, level1_rule
+from .rules import CENTRE, TWO_RING, Vec, apply, centre_rule_mode0, level1_rule
+from .statement import lam_of
 
 
 def _block(w=None, t=None):
@@ -43,23 +44,15 @@ def _block(w=None, t=None):
         if p == CENTRE:
             if t is not None:
                 out[idx[CENTRE]] = fmpq(1)
-            return _Vec(out)
+            return Vec(out)
         out[idx[p]] = fmpq(1) if t is not None else fmpq(w) ** delta
-        return _Vec(out)
+        return Vec(out)
 
     rows = []
     for p in pos:
         comb = centre_rule_mode0(t) if p == CENTRE else level1_rule(*p)
-        rows.append(list(apply(comb, column_lookup, _Vec([fmpq(0)] * n))))
+        rows.append(list(apply(comb, column_lookup, Vec([fmpq(0)] * n))))
     return rows
-
-
-class _Vec(list):
-    def __add__(self, other):
-        return _Vec([a + b for a, b in zip(self, other)])
-
-    def __mul__(self, s):
-        return _Vec([a * s for a in self])
 
 
 def _charpoly_at(rows, x):
@@ -67,21 +60,40 @@ def _charpoly_at(rows, x):
     return fmpq_mat(n, n, [(x if i == j else 0) - rows[i][j] for i in range(n) for j in range(n)]).det()
 
 
-_SMALL = (fmpq(1, 8), fmpq(1, 16), fmpq(1, 32), fmpq(1, 64))
+SMALL_ROOTS = (fmpq(1, 8), fmpq(1, 16), fmpq(1, 32), fmpq(1, 64))
 
 
 def _claimed_mode(x, c):
     out = x * x - (5 + c) * x / 8 + fmpq(1, 16)
-    for r in _SMALL:
+    for r in SMALL_ROOTS:
         out *= x - r
     return out
 
 
 def _claimed_mode0(x, t):
     out = (x - 1) * (x * x - (12 - 28 * t) * x / 16 + (1 - 3 * t) / 16)
-    for r in _SMALL:
+    for r in SMALL_ROOTS:
         out *= x - r
     return out
+
+
+def mode_polynomials_hold(block):
+    """True iff det(x - B(w)) = (x - 1/8)(x - 1/16)(x - 1/32)(x - 1/64)(x^2 - (5 + c) x/8 + 1/16) for the
+    6 x 6 rows ``block(w)`` (module docstring): w^6 det(x - B(w)) has degree <= 18 in w and 6 in x, so
+    the grid w = 1..19, x = 0..6 of exact determinants decides the identity.
+
+    Examples
+    --------
+    >>> mode_polynomials_hold(lambda w: _block(w=w)), mode_polynomials_hold(lambda w: _block(w=w * w))
+    (True, False)
+    """
+    for w in range(1, 20):
+        rows = block(fmpq(w))
+        c = (fmpq(w) + 1 / fmpq(w)) / 2
+        for x in range(7):
+            if _charpoly_at(rows, fmpq(x)) != _claimed_mode(fmpq(x), c):
+                return False
+    return True
 
 
 def check_block_polynomials():
@@ -97,12 +109,8 @@ def check_block_polynomials():
     >>> check_block_polynomials()
     True
     """
-    for w in range(1, 20):  # degree <= 18 in w after multiplying by w^6
-        rows = _block(w=fmpq(w))
-        c = (fmpq(w) + 1 / fmpq(w)) / 2
-        for x in range(7):  # degree 6 in x
-            if _charpoly_at(rows, fmpq(x)) != _claimed_mode(fmpq(x), c):
-                return False
+    if not mode_polynomials_hold(lambda w: _block(w=w)):
+        return False
     for t in range(1, 9):  # degree <= 7 in t and in x
         rows = _block(t=fmpq(t))
         for x in range(8):
@@ -111,32 +119,12 @@ def check_block_polynomials():
     return True
 
 
-def lam_of(c):
-    """lam = (5 + c + sqrt((1 + c)(9 + c))) / 16, the subdominant eigenvalue at c = cos(2 pi/k) (R2).
-
-    Parameters
-    ----------
-    c : arb
-
-    Returns
-    -------
-    arb
-
-    Examples
-    --------
-    >>> lam_of(arb(0)), lam_of(arb(-1) / 2).overlaps((9 + arb(17).sqrt()) / 32)   # k = 4, k = 3
-    (0.500000000000000, True)
-    """
-    return (5 + c + ((1 + c) * (9 + c)).sqrt()) / 16
-
-
 def spectral_ordering(k, prec):
     """(ok, message): 1 = lam_0 > lam_1 = lam_2 = lam(k) > |lam_3|, lam double and non-defective, for the
     valence k (an int) or every k >= k0 (``{"min": k0}``); assumes :func:`check_block_polynomials`.
 
     Parameters
     ----------
-    k : int or dict ``{"min": k0}``
     prec : int
         Bits of the arb comparisons.
 

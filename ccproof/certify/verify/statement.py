@@ -1,7 +1,7 @@
 """The statement of a certificate, derived from the valence and the Catmull-Clark rules alone (trusted).
 
 Nothing here is read from a file. :func:`derivation` computes once, with c = cos(2 pi/k) an
-indeterminate (so for every valence at once), in the field F of :mod:`.field`:
+indeterminate (so for every valence at once), in the field F below:
 
 1. the mode-1 subdominant eigenvector on the two-ring of sector 0 in the normalized frame
    (docs/readings.md R3): the rotation to the next sector is R = [[0, -1], [1, 2c]]; the vector solves
@@ -19,22 +19,175 @@ lam = (5 + c + sqrt((1 + c)(9 + c)))/16, the larger root of the quadratic, whose
 lam(k); each net entry is evaluated from its exact form, after checking that no denominator vanishes.
 That the eigenvector is *the* subdominant one (lam simple in its Fourier block, the ordering of the
 spectrum) is :mod:`.spectrum`.
+
+The field F = Q(c)[lam] / (16 lam^2 - 2(5 + c) lam + 1) in which the characteristic map lives.
+
+c = cos(2 pi/k) is kept as an indeterminate, so one computation in F covers every valence at once;
+lam is the root of the subdominant quadratic (docs/readings.md R2). The quadratic is irreducible
+over Q(c) (its discriminant 4(1 + c)(9 + c) is not a square in Q(c)), so {1, lam} is a basis of F over
+Q(c): ``a + b lam == 0`` iff ``a == b == 0``, which makes equality exact and decidable.
+
+An element is ``(a + b lam) / d`` with a, b, d in Q[c] (python-flint ``fmpq_poly``), d != 0, kept in
+lowest terms with d monic. Inversion uses the conjugate lam' = (10 + 2c)/16 - lam:
+(a + b lam)(a + b lam') = a^2 + a b (10 + 2c)/16 + b^2/16, a non-zero polynomial when a + b lam != 0.
+
+>>> L, c = QL.lam(), QL.c()
+>>> 16 * L * L - 2 * (5 + c) * L + 1 == QL(0)
+True
+>>> (1 / (4 * L - 1)) * (4 * L - 1) == QL(1)
+True
 """
 
 from __future__ import annotations
 
 from functools import lru_cache
 
-from flint import arb, ctx, fmpq
+from flint import arb, ctx, fmpq, fmpq_poly
 
-from .field import QL
-from .rules import TWO_RING, level1_value
+from .rules import TWO_RING, Vec, level1_value
 
 PATCHES = ("P1", "P2", "P3")
 #: level-1 grid position of B-spline control point [0][0] of each piece (net[i][j] at offset + (i, j))
 NET_OFFSETS = {"P1": (0, -1), "P2": (0, 0), "P3": (-1, 0)}
 #: uniform cubic B-spline segment -> Bezier (per direction), times 6
 B2Z = ((1, 4, 1, 0), (0, 4, 2, 0), (0, 2, 4, 0), (0, 1, 4, 1))
+
+
+# ------------------------------------------------------------------------ the field F
+_C = fmpq_poly([0, 1])
+_S = fmpq_poly([fmpq(10, 16), fmpq(2, 16)])  # lam + lam' = (10 + 2c)/16; lam lam' = 1/16
+
+
+def _poly(x):
+    if isinstance(x, fmpq_poly):
+        return x
+    if isinstance(x, (int, fmpq)) and not isinstance(x, bool):
+        return fmpq_poly([x])
+    raise TypeError(f"not an exact scalar: {x!r}")
+
+
+class QL:
+    """An element (a + b lam) / d of F (see the module docstring; docs/readings.md R2).
+
+    Parameters
+    ----------
+    a, b, d : int, fmpq or fmpq_poly in c
+        Numerators and denominator (d != 0); stored in lowest terms with d monic.
+
+    Examples
+    --------
+    At k = 4 (c = 0) the subdominant eigenvalue is lam = 1/2 (16 lam^2 - 10 lam + 1 = 0):
+
+    >>> x = (1 + QL.lam()) / (QL.c() + 2)
+    >>> x.evaluate(arb(0), arb(1) / 2), x.integer_form()
+    (0.750000000000000, [[1], [1], [2, 1]])
+    """
+
+    __slots__ = ("a", "b", "d")
+
+    def __init__(self, a=0, b=0, d=1):
+        a, b, d = _poly(a), _poly(b), _poly(d)
+        if d == 0:
+            raise ZeroDivisionError("zero denominator")
+        g = a.gcd(b).gcd(d) if (a != 0 or b != 0) else d
+        if g != 0 and g.degree() > 0:
+            a, b, d = a / g, b / g, d / g  # exact: g divides all three
+            a, b, d = _poly(a), _poly(b), _poly(d)
+        lead = d.coeffs()[-1]
+        self.a, self.b, self.d = a / lead, b / lead, d / lead
+
+    @classmethod
+    def lam(cls):
+        return cls(0, 1)
+
+    @classmethod
+    def c(cls):
+        return cls(_C)
+
+    @staticmethod
+    def of(x):
+        return x if isinstance(x, QL) else QL(x)
+
+    def is_zero(self):
+        return self.a == 0 and self.b == 0  # exact polynomials: == is equality
+
+    def __eq__(self, other):
+        return (self - QL.of(other)).is_zero()
+
+    def __hash__(self):
+        raise TypeError("QL is not hashable")
+
+    def __add__(self, other):
+        o = QL.of(other)
+        return QL(self.a * o.d + o.a * self.d, self.b * o.d + o.b * self.d, self.d * o.d)
+
+    __radd__ = __add__
+
+    def __neg__(self):
+        return QL(-self.a, -self.b, self.d)
+
+    def __sub__(self, other):
+        return self + (-QL.of(other))
+
+    def __rsub__(self, other):
+        return QL.of(other) - self
+
+    def __mul__(self, other):
+        o = QL.of(other)
+        bb = self.b * o.b  # lam^2 = ((10 + 2c) lam - 1)/16
+        return QL(self.a * o.a - bb / 16, self.a * o.b + self.b * o.a + bb * _S, self.d * o.d)
+
+    __rmul__ = __mul__
+
+    def inverse(self):
+        if self.is_zero():
+            raise ZeroDivisionError("inverse of 0 in F")
+        norm = self.a * self.a + self.a * self.b * _S + self.b * self.b / 16
+        return QL(self.d * (self.a + self.b * _S), -self.d * self.b, norm)
+
+    def __truediv__(self, other):
+        return self * QL.of(other).inverse()
+
+    def __rtruediv__(self, other):
+        return QL.of(other) * self.inverse()
+
+    def __repr__(self):
+        return f"(({self.a}) + ({self.b})*lam)/({self.d})"
+
+    # -------------------------------------------------------------- specializations
+    def integer_form(self):
+        """``[A, B, D]``: integer coefficient lists (constant first) with self = (A(c) + B(c) lam)/D(c)."""
+        from math import lcm
+
+        den = lcm(*(int(q.q) for p in (self.a, self.b, self.d) for q in (p.coeffs() or [fmpq(0)])))
+        return [[int(q * den) for q in (p.coeffs() or [fmpq(0)])] for p in (self.a, self.b, self.d)]
+
+    def evaluate(self, c, lam):
+        """Ball enclosing self at every (c, lam) in the balls ``c`` and ``lam``; raises ZeroDivisionError when
+        the denominator's ball contains 0 (the caller sets the working precision)."""
+        den = horner(self.d, c)
+        if den.contains(0):  # a ball containing 0 cannot be divided by: the value may not exist
+            raise ZeroDivisionError("the denominator may vanish")
+        return (horner(self.a, c) + horner(self.b, c) * lam) / den
+
+
+def horner(p, x):
+    """p(x) for an fmpq_poly p and an arb x (ball arithmetic, Horner's scheme).
+
+    Returns
+    -------
+    arb
+        A ball containing p(y) for every y in x.
+
+    Examples
+    --------
+    >>> horner(fmpq_poly([1, 2, 3]), arb(2))   # 1 + 2 * 2 + 3 * 4
+    17.0000000000000
+    """
+    acc = arb(0)
+    for q in reversed(p.coeffs()):
+        acc = acc * x + q
+    return acc
 
 
 class StatementError(ValueError):
@@ -56,15 +209,6 @@ class StatementError(ValueError):
 def rot(delta, p):
     """R^delta p in the normalized frame, R = [[0, -1], [1, 2c]] (delta in -1..2; docs/readings.md R3).
 
-    Parameters
-    ----------
-    delta : int
-    p : (QL, QL)
-
-    Returns
-    -------
-    (QL, QL)
-
     Examples
     --------
     >>> x, y = rot(1, (QL(1), QL(0)))
@@ -80,32 +224,14 @@ def rot(delta, p):
     return (x, y)
 
 
-def _pt_add(p, q):
-    return (p[0] + q[0], p[1] + q[1])
-
-
-def _pt_scale(p, w):
-    return (p[0] * w, p[1] * w)
-
-
-class _Pt(tuple):
-    """A point of F^2 supporting ``+`` and ``* weight`` (what :func:`.rules.apply` needs)."""
-
-    def __add__(self, other):
-        return _Pt(_pt_add(self, other))
-
-    def __mul__(self, w):
-        return _Pt(_pt_scale(self, w))
-
-
-_ZERO = _Pt((QL(0), QL(0)))
+_ZERO = Vec((QL(0), QL(0)))
 
 
 def _lookup(values):
     def look(delta, p):
         if p == (0, 0):
             return _ZERO  # the centre is 0 in Fourier mode 1
-        return _Pt(rot(delta, values[p]))
+        return Vec(rot(delta, values[p]))
     return look
 
 
@@ -116,7 +242,6 @@ def level1(values, A, B):
     ----------
     values : dict[(int, int), (QL, QL)]
         The sector-0 two-ring (:data:`TWO_RING`) in the normalized frame.
-    A, B : int
 
     Returns
     -------
@@ -134,7 +259,7 @@ def level1(values, A, B):
     if (A, B) == (0, 0):
         return _ZERO
     delta, v = level1_value(A, B, _lookup(values), _ZERO)
-    return _Pt(rot(delta, v))
+    return Vec(rot(delta, v))
 
 
 # ------------------------------------------------------------------------ the derivation
@@ -187,17 +312,10 @@ def _eigenvector():
     return values_with(dict(zip(unknowns, sol)))
 
 
-def bspline_to_bezier(net):
-    """Bezier net of the uniform bicubic B-spline segment of a 4x4 net of F-points (exact).
-
-    Parameters
-    ----------
-    net : 4 x 4 nested sequence of (QL, QL)
-
-    Returns
-    -------
-    list of 4 lists of 4 (QL, QL)
-        ``B2Z`` (the B-spline to Bezier matrix, / 6) applied in both directions.
+def bspline_to_bezier(net, zero=None):
+    """Bezier net of the uniform bicubic B-spline segment of a 4x4 net of points: ``B2Z`` (the B-spline to
+    Bezier matrix, / 6) applied in both directions; points of F (exact; the default) or with ``zero`` the
+    origin of their kind (``(arb(0), arb(0))``: a tagged sector's nets).
 
     Examples
     --------
@@ -208,10 +326,10 @@ def bspline_to_bezier(net):
     [True, True, True, True]
     """
     def lin(coeffs, pts):
-        acc = _ZERO
+        acc = _ZERO if zero is None else Vec(zero)
         for a, p in zip(coeffs, pts):
             if a:
-                acc = acc + _Pt(p) * fmpq(a, 6)
+                acc = acc + Vec(p) * fmpq(a, 6)
         return acc
     tmp = [[lin(B2Z[i], [net[r][j] for r in range(4)]) for j in range(4)] for i in range(4)]
     return [[tuple(lin(B2Z[j], tmp[i])) for j in range(4)] for i in range(4)]
@@ -225,9 +343,15 @@ def _eq(p, q):
     return p[0] == q[0] and p[1] == q[1]
 
 
-def _split_half(curve):
-    """De Casteljau halves of a cubic Bezier curve of F-points (exact)."""
-    half = QL(fmpq(1, 2))
+def split_half(curve):
+    """De Casteljau halves (left, right) of a cubic Bezier curve of points of F (exact) or of arb balls.
+
+    Examples
+    --------
+    >>> split_half([(0, 0), (1, 0), (2, 0), (3, 3)])[1]
+    [(3/2, 3/8), (2, 3/4), (5/2, 3/2), (3, 3)]
+    """
+    half = fmpq(1, 2)
     left, right, pts = [curve[0]], [curve[3]], list(curve)
     for _ in range(3):
         pts = [((p[0] + q[0]) * half, (p[1] + q[1]) * half) for p, q in zip(pts, pts[1:])]
@@ -293,6 +417,13 @@ def derivation():
     """
     vals = _eigenvector()
     eig_ok = all(e.is_zero() for e in _eigen_equations(vals))
+    vec, bs, bz = _normalized_nets(vals)
+    symmetric, hyp = _hypotheses(bz, eig_ok)
+    return Derivation(vec, bs, bz, symmetric, hyp)
+
+
+def _normalized_nets(vals):
+    """(eigenvector, B-spline nets, Bezier nets), scaled so that Phi(1, 0) = (1, 0)."""
     raw = {n: [[level1(vals, oa + i, ob + j) for j in range(4)] for i in range(4)]
            for n, (oa, ob) in NET_OFFSETS.items()}
     phi10 = bspline_to_bezier(raw["P1"])[3][0]
@@ -301,7 +432,11 @@ def derivation():
     scale = phi10[0].inverse()
     bs = {n: [[tuple(q * scale for q in p) for p in row] for row in net] for n, net in raw.items()}
     vec = {p: tuple(q * scale for q in v) for p, v in vals.items()}
-    bz = {n: bspline_to_bezier(net) for n, net in bs.items()}
+    return vec, bs, {n: bspline_to_bezier(net) for n, net in bs.items()}
+
+
+def _hypotheses(bz, eig_ok):
+    """(symmetric, [(hypothesis, holds)]): docs/appendix_a.md section 0, exact in F."""
     P1, P2, P3 = bz["P1"], bz["P2"], bz["P3"]
     L = QL.lam()
     zero, one = QL(0), QL(1)
@@ -314,7 +449,7 @@ def derivation():
 
     col = lambda net, i: [net[i][j] for j in range(4)]  # side s = i/3 (a curve in t)
     row = lambda net, j: [net[i][j] for i in range(4)]  # side t = j/3 (a curve in s)
-    inner1, inner3 = _split_half(col(P1, 0)), _split_half(row(P3, 0))
+    inner1, inner3 = split_half(col(P1, 0)), split_half(row(P3, 0))
     symmetric = all(_eq(P3[i][j], _swap(P1[j][i])) and _eq(P2[i][j], _swap(P2[j][i]))
                     for i in range(4) for j in range(4))
     hyp = [
@@ -329,16 +464,28 @@ def derivation():
         ("layer boundary: Phi(u, 1/2) = lam Phi(2u, 1)",
          same(inner3[0], scaled(row(P3, 3))) and same(inner3[1], scaled(row(P2, 3)))),
     ]
-    return Derivation(vec, bs, bz, symmetric, hyp)
+    return symmetric, hyp
 
 
 # ------------------------------------------------------------------------ one valence in arb
+def lam_of(c):
+    """lam(c) = (5 + c + sqrt((1 + c)(9 + c)))/16: the subdominant eigenvalue, at c = cos(2 pi/k) for the
+    valence k (docs/readings.md R2); the one definition of lam in the trusted base (arb or acb c, the
+    principal square root).
+
+    Examples
+    --------
+    >>> lam_of(arb(0)), lam_of(arb(-1) / 2).overlaps((9 + arb(17).sqrt()) / 32)   # k = 4, k = 3
+    (0.500000000000000, True)
+    """
+    return (5 + c + ((1 + c) * (9 + c)).sqrt()) / 16
+
+
 def c_lam(k, prec):
     """Balls (c, lam) holding cos(2 pi/k) and lam(k) = (5 + c + sqrt((1 + c)(9 + c)))/16.
 
     Parameters
     ----------
-    k : int
     prec : int
         Bits.
 
@@ -356,22 +503,12 @@ def c_lam(k, prec):
     """
     with ctx.workprec(prec):
         c = arb(fmpq(2, k)).cos_pi()
-        return c, (5 + c + ((1 + c) * (9 + c)).sqrt()) / 16
+        return c, lam_of(c)
 
 
 def nets_for_valence(k, prec, which="bezier"):
     """arb nets {piece: 4x4 of (x, y)} of valence k, evaluated from the derived exact forms; raises
     :class:`StatementError` if a denominator may vanish at c = cos(2 pi/k).
-
-    Parameters
-    ----------
-    k : int
-    prec : int
-    which : {"bezier", "bspline"}
-
-    Returns
-    -------
-    dict[str, 4 x 4 of (arb, arb)]
 
     Examples
     --------

@@ -27,12 +27,12 @@ from flint import acb, ctx, fmpq, fmpq_mat, fmpq_poly
 from .errors import CertificateError
 from .rules import CENTRE, canonical, level1_rule
 
-FAMILIES = ("dart", "crease", "corner")
 RAY_POS = ((1, 0), (2, 0))
 QUAD_POS = ((1, 1), (2, 1), (1, 2), (2, 2))
 MAX_SIZE = 100  # N, K at most this (exact characteristic polynomials of 6K + 1 rows)
 _NAME = re.compile(r"(dart|crease|corner):(>=)?([0-9]{1,7})")
 MAX_TAIL = 10**6  # FAMILY:>=N0 needs N0 at most this
+EXACT_BUDGET = 128**3  # work m^3 of the exact route for S of m points; the published use at most 27 points
 
 
 def parse_configuration(name):
@@ -44,10 +44,6 @@ def parse_configuration(name):
     name : str
         ``"dart:K"`` (K >= 2), ``"crease:N"`` or ``"corner:N"`` (N >= 1), at most :data:`MAX_SIZE`;
         ``"FAMILY:>=N0"`` with 2 <= N0 <= :data:`MAX_TAIL`.
-
-    Returns
-    -------
-    (str, int or dict)
 
     Raises
     ------
@@ -78,13 +74,32 @@ def parse_configuration(name):
     return fam, n
 
 
+def check_exact_budget(fam, n):
+    """Refuse, before any arithmetic, a configuration whose exact route exceeds :data:`EXACT_BUDGET`.
+
+    The exact route (the characteristic polynomial of the whole S over Q, its factors, the ranks of
+    p(S), :func:`exact_spectrum`) costs about m^3 operations on rationals for S of m points (m = 6N + 3,
+    6K + 1 for a dart), 9 s of CPU for crease:100. The budget, 128^3 (N, K <= 20; under 0.1 s), admits
+    every published certificate on that route (at most 27 points) with room; larger configurations are
+    decided through the modes of :mod:`.tagged_modes` or not at all.
+
+    Examples
+    --------
+    >>> check_exact_budget("crease", 20)
+    >>> try:
+    ...     check_exact_budget("crease", 100)
+    ... except CertificateError as exc:
+    ...     print(exc)
+    crease:100: the exact route on S of 603 points exceeds the budget (m^3 > 128^3: N, K <= 20)
+    """
+    m = len(labels(fam, n))
+    if m**3 > EXACT_BUDGET:
+        raise CertificateError(f"{fam}:{n}: the exact route on S of {m} points exceeds the budget (m^3 > 128^3: "
+                               "N, K <= 20)")
+
+
 def labels(fam, n):
     """The points of the sector complex, in matrix order: centre, ray points, quadrant points.
-
-    Parameters
-    ----------
-    fam : str
-    n : int
 
     Returns
     -------
@@ -113,20 +128,29 @@ def sharp_rays(fam, n):
     return (0,) if fam == "dart" else (0, n)
 
 
+def position_key(fam, n, q, a, b):
+    """The label (:func:`labels`) of the raw grid position (a, b) of quadrant q (:func:`.rules.canonical`;
+    rays and quadrants mod K for a dart), whether or not the complex holds it.
+
+    Examples
+    --------
+    >>> position_key("dart", 5, 4, 0, 2), position_key("crease", 2, 0, 1, -1), position_key("crease", 2, 1, 0, 0)
+    (('r', 0, 2, 0), ('q', -1, 1, 1), ('C',))
+    """
+    delta, a2, b2 = canonical(a, b)
+    if (a2, b2) == CENTRE:
+        return ("C",)
+    s = (q + delta) % n if fam == "dart" else q + delta
+    return ("r", s, a2, b2) if b2 == 0 else ("q", s, a2, b2)
+
+
 def _index(fam, n):
     idx = {p: i for i, p in enumerate(labels(fam, n))}
 
     def at(q, comb):  # raw positions of quadrant q -> {index: weight}
         out = {}
         for (a, b), w in comb.items():
-            delta, a2, b2 = canonical(a, b)
-            if (a2, b2) == CENTRE:
-                key = ("C",)
-            else:
-                s = q + delta
-                if fam == "dart":
-                    s %= n
-                key = ("r", s, a2, b2) if b2 == 0 else ("q", s, a2, b2)
+            key = position_key(fam, n, q, a, b)
             if key not in idx:
                 raise CertificateError(f"{fam}:{n}: position {(a, b)} of quadrant {q} outside the complex")
             out[idx[key]] = out.get(idx[key], 0) + w
@@ -223,11 +247,6 @@ def exact_spectrum(fam, n):
     dim ker p(S) = deg(p) * (geometric multiplicity), so the roots are non-defective iff
     dim ker p(S) = e deg(p).
 
-    Parameters
-    ----------
-    fam : str
-    n : int
-
     Returns
     -------
     list of (fmpq_poly, int, int)
@@ -273,10 +292,6 @@ def crease_points(fam, n):
 def crease_block(fam, n):
     """The block C of S on :func:`crease_points`, after checking exactly that those rows vanish elsewhere.
 
-    Returns
-    -------
-    flint.fmpq_mat, shape (5, 5)
-
     Raises
     ------
     CertificateError
@@ -303,16 +318,6 @@ def eigenvalues(fam, n, prec):
     each root listed once per unit of algebraic multiplicity; isolated by arb (``complex_roots``), real
     roots with an exactly zero imaginary part.
 
-    Parameters
-    ----------
-    fam : str
-    n : int
-    prec : int
-
-    Returns
-    -------
-    list of (acb, fmpq_poly, int, int)
-
     Examples
     --------
     >>> ev = eigenvalues("crease", 3, 64)
@@ -335,12 +340,6 @@ def leading_spectrum(fam, n, prec):
     """The spectral part of the generalized Reif criterion for a sector (docs/tagged_c1.md):
     1 simple, lam1 >= lam2 > |every other| real and positive, lam1 and lam2 non-defective.
 
-    Parameters
-    ----------
-    fam : str
-    n : int
-    prec : int
-
     Returns
     -------
     (bool, str, list)
@@ -353,8 +352,14 @@ def leading_spectrum(fam, n, prec):
     (True, 'crease:2: 1 simple; lam1 = lam2 = 1/2 (double, non-defective) > |lam3| = 1/4')
     >>> leading_spectrum("crease", 4, 64)[1]
     'crease:4: lam2 = 1/2 lies in a Jordan block (algebraic multiplicity 2, geometric 1)'
+    >>> leading_spectrum("crease", 100, 64)[:2]   # refused before any arithmetic (check_exact_budget)
+    (False, 'crease:100: the exact route on S of 603 points exceeds the budget (m^3 > 128^3: N, K <= 20)')
     """
     name = f"{fam}:{n}"
+    try:
+        check_exact_budget(fam, n)  # before any arithmetic on the whole S
+    except CertificateError as exc:
+        return False, str(exc), []
     with ctx.workprec(prec):
         ev = sorted(eigenvalues(fam, n, prec), key=_key)
         one = [t for t in ev if t[1] == fmpq_poly([-1, 1])]
@@ -364,12 +369,9 @@ def leading_spectrum(fam, n, prec):
         if any(not abs(t[0]) < 1 for t in rest):  # reviewed (tests/certify/test_arb_comparisons.py)
             return False, f"{name}: an eigenvalue other than 1 is not certainly inside the unit disc", ev[:4]
         l1, l2, l3 = rest[0], rest[1], rest[2]
-        for lab, t in (("lam1", l1), ("lam2", l2)):
-            if not (t[0].imag.is_zero() and t[0].real > 0):
-                return False, f"{name}: {lab} = {_show(t)} is not certainly real and positive", ev[:4]
-            if t[3] < t[2]:
-                return False, (f"{name}: {lab} = {_show(t)} lies in a Jordan block (algebraic multiplicity {t[2]}, "
-                               f"geometric {t[3]})"), ev[:4]
+        why = _not_simple_positive(name, "lam1", l1) or _not_simple_positive(name, "lam2", l2)
+        if why:
+            return False, why, ev[:4]
         same12 = l1[1] == l2[1] and l1[0].overlaps(l2[0])
         if not (same12 or l1[0].real > l2[0].real):
             return False, f"{name}: lam1 and lam2 are not separated", ev[:4]
@@ -380,6 +382,15 @@ def leading_spectrum(fam, n, prec):
         lead = (f"lam1 = lam2 = {_show(l1)} (double, non-defective)" if same12 else
                 f"lam1 = {_show(l1)} > lam2 = {_show(l2)} (simple)")
         return True, f"{name}: 1 simple; {lead} > |lam3| = {_show(l3)}", ev[:4]
+
+
+def _not_simple_positive(name, lab, t):
+    """Why the eigenvalue t is not certainly real, positive and non-defective (None when it is)."""
+    if not (t[0].imag.is_zero() and t[0].real > 0):
+        return f"{name}: {lab} = {_show(t)} is not certainly real and positive"
+    if t[3] < t[2]:
+        return f"{name}: {lab} = {_show(t)} lies in a Jordan block (algebraic multiplicity {t[2]}, geometric {t[3]})"
+    return None
 
 
 def _show(t):

@@ -50,19 +50,24 @@ from __future__ import annotations
 
 from functools import cache
 
-from flint import acb, acb_mat, arb, ctx, fmpq, fmpq_mat
+from flint import acb, arb, ctx, fmpq, fmpq_mat
 
 from .errors import CertificateError
 from .record import exact_keys, field_of
 from .replay import parse_decimal
-from .spectrum import _SMALL, lam_of
+from .spectrum import SMALL_ROOTS
+from .statement import lam_of
 from .tagged import crease_block, crease_points, labels, sector_rows
 from .tagged_c1 import _DW, _W, _check_boundary
-from .tagged_modes import _POS, _block, _roots, check_ring, check_structure
+from .tagged_modes import _POS, _block, _roots, bordered_solve, check_ring, check_structure
 
 WINDOW = (7, 8)  # the window classes of every N >= 7 occur in both
 MIN_TAIL = WINDOW[0]
 MAX_ARCS = 8192  # arcs on either circle, and boxes on the disc (bounded work for a hostile file)
+# evaluations of H (arcs on both circles, boxes on the disc) weighted by (prec + 1024)/1024, checked before any
+# arithmetic: the published certificates need 3,042, the prover's widest hints (every N0 >= 7) about 21,000;
+# at the budget a file costs about 5 s of CPU
+TAIL_BUDGET = 3 * 8192
 _LIMIT_KEYS = ("rho", "R", "arcs", "outer_arcs", "box")
 _PIVOT = _POS[(1, 0)]
 
@@ -156,12 +161,9 @@ def _tangents(theta, j):
     disc = (1 + c) * (9 + c)
     if not disc.real > 0:
         raise ZeroDivisionError("(1 + c)(9 + c) is not certainly in the right half-plane")
-    lam = (5 + c + disc.sqrt()) / 16
-    B = _block(w)
-    rows = [[B[i][k] - (lam if i == k else 0) for k in range(6)] + [acb(int(i == _PIVOT))] for i in range(6)]
-    rows.append([acb(int(k == _PIVOT)) for k in range(6)] + [acb(0)])
-    sol = acb_mat(rows).solve(acb_mat([[0]] * 6 + [[1]]))
-    vh = {p: sol[i, 0] for p, i in _POS.items()}
+    lam = lam_of(c)
+    sol = bordered_solve(_block(w), lam, _PIVOT)
+    vh = {p: sol[i] for p, i in _POS.items()}
     val = {}
     for a in range(3):
         for b in range(3):  # the centre and ray 0: 0; ray 1: v^(b,0)(w - 1/w); quadrant 0: v^(a,b) - v^(b,a)/w
@@ -260,6 +262,34 @@ def winding(rho, arcs, R, M):
     return turn / (2 * arb.pi()), None
 
 
+def _in_modes(x):  # is x a root of some q_c, c in [-1, 1]? c*(x) = 8 x + 1/(2 x) - 5
+    return x != 0 and -1 <= 8 * x + 1 / (2 * x) - 5 <= 1
+
+
+def _leading_gap(croots, below, blocks, others, b0, n0):
+    """Why 1 is not simple or alpha, beta do not lead (None when they do)."""
+    if croots.count(1) != 1 or len(below) != 4:
+        return "eigenvalue 1 is not simple in the crease block"
+    if _in_modes(fmpq(1)) or any(M.charpoly()(1) == 0 for M in blocks):
+        return "1 is an eigenvalue of the modes"
+    if not lam_of(arb(1)) < 1:
+        return "lam(1) < 1 is not certain"
+    if not all(x < b0 for x in others):
+        return f"an eigenvalue other than alpha, beta is not certainly below lam(cos(2 pi/{n0}))"
+    return None
+
+
+def _gamma_gap(g, cg, below, blocks, b0, n0):
+    """Why gamma = g is not the crease block's largest eigenvalue below 1, simple and below beta (or None)."""
+    if g != max(below):
+        return f"gamma is not the crease block's largest eigenvalue below 1 ({max(below)})"
+    if not arb(g) < b0:
+        return f"gamma < lam(cos(2 pi/{n0})) is not certain"
+    if g in SMALL_ROOTS or cg is None or (1 + cg) * (9 + cg) == 0 or any(M.charpoly()(g) == 0 for M in blocks):
+        return "gamma is possibly a multiple eigenvalue of I"
+    return None
+
+
 def uniform_spectrum(fam, n0, g, C, blocks):
     """(ok, message): part 2 of the module docstring for every N >= n0 with gamma = g (exact)."""
     fac = C.charpoly().factor()[1]
@@ -269,21 +299,9 @@ def uniform_spectrum(fam, n0, g, C, blocks):
     below = [r for r in croots if r < 1]
     b0 = lam_of(arb(fmpq(2, n0)).cos_pi())  # <= beta = lam(cos(2 pi/N)) for every N >= n0
     inner = [z for M in blocks for z, _ in _roots(M)]
-    others = [arb(abs(r)) for r in below] + [abs(z) for z in inner] + [arb(s) for s in _SMALL] + [arb(fmpq(1, 4))]
-
-    def in_modes(x):  # is x a root of some q_c, c in [-1, 1]? c*(x) = 8 x + 1/(2 x) - 5
-        return x != 0 and -1 <= 8 * x + 1 / (2 * x) - 5 <= 1
-
+    others = [arb(abs(r)) for r in below] + [abs(z) for z in inner] + [arb(s) for s in SMALL_ROOTS] + [arb(fmpq(1, 4))]
     cg = 8 * g + 1 / (2 * g) - 5 if g != 0 else None
-    why = ("eigenvalue 1 is not simple in the crease block" if croots.count(1) != 1 or len(below) != 4 else
-           "1 is an eigenvalue of the modes" if in_modes(fmpq(1)) or any(M.charpoly()(1) == 0 for M in blocks) else
-           "lam(1) < 1 is not certain" if not lam_of(arb(1)) < 1 else
-           f"an eigenvalue other than alpha, beta is not certainly below lam(cos(2 pi/{n0}))"
-           if not all(x < b0 for x in others) else
-           f"gamma is not the crease block's largest eigenvalue below 1 ({max(below)})" if g != max(below) else
-           f"gamma < lam(cos(2 pi/{n0})) is not certain" if not arb(g) < b0 else
-           "gamma is possibly a multiple eigenvalue of I" if g in _SMALL or cg is None or (1 + cg) * (9 + cg) == 0
-           or any(M.charpoly()(g) == 0 for M in blocks) else None)
+    why = _leading_gap(croots, below, blocks, others, b0, n0) or _gamma_gap(g, cg, below, blocks, b0, n0)
     if why is not None:
         return False, f"every N >= {n0}: {why}"
     return True, (f"every N >= {n0}: alpha = lam(cos(pi/N)) > beta = lam(cos(2 pi/N)) >= {b0.str(6, radius=False)} > "
@@ -299,10 +317,6 @@ def verify_tail(cert, fam, n0, part, log):
     cert : dict
         ``schema``, ``configuration``, ``statement`` ("not C1"), ``prec``, ``witness`` ({"z": coord}) and
         ``limit`` ({"rho", "R", "box": decimals, "arcs", "outer_arcs": ints}).
-    fam : str
-    n0 : int
-    part : Recorder
-    log : callable (str) -> None
 
     Returns
     -------
@@ -347,6 +361,10 @@ def verify_tail(cert, fam, n0, part, log):
     if not (1 <= arcs <= MAX_ARCS and 1 <= outer <= MAX_ARCS and 0 < rho < R <= 1 and 0 < side <= R
             and (2 * R / side + 2) ** 2 <= MAX_ARCS):
         raise CertificateError(f"limit: need 0 < rho < R <= 1, 0 < box <= R, at most {MAX_ARCS} arcs and boxes")
+    evals = arcs + outer + (2 * ((R / side).ceil())) ** 2  # at most (2 ceil(R/box))^2 boxes meet the disc
+    if evals * fmpq(prec + 1024, 1024) > TAIL_BUDGET:
+        raise CertificateError(f"limit: {evals} evaluations of H at {prec} bits exceed the budget "
+                               f"({TAIL_BUDGET} weighted by (prec + 1024)/1024)")
     name = f"{fam}:>={n0}"
     log(f"not C1 certificate for {name} ({prec} bits)")
     with ctx.workprec(prec):
@@ -380,8 +398,12 @@ def _check_tail(fam, n0, g, cval, rho, R, side, arcs, outer, part, log):
     ok = reflection_identity()
     part("N reflection: B(1/w) R_w = R_w B(w) (exact), so f is odd and H has a zero of order >= 4 at 0", ok,
          "" if ok else "the ring stencil breaks the reflection identity")
-    if part.failed:
-        return
+    if not part.failed:
+        _check_normal(fam, n0, rho, R, side, arcs, outer, part, log)
+
+
+def _check_normal(fam, n0, rho, R, side, arcs, outer, part, log):
+    """N for every N >= n0: H analytic on the disc |theta| <= R, bounded on its circle, winding 4 times."""
     got = check_disc(R, side)
     ok = isinstance(got, int)
     part(f"x, y and N analytic: the bordered systems of modes 1 and 2 regular on |theta| <= {R}", ok,

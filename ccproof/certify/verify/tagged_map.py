@@ -27,15 +27,15 @@ from flint import arb, ctx, fmpq
 from ccproof.rigorous import BernsteinForm
 
 from .errors import CertificateError
-from .maps import STAR_CURVES, regularity_form
+from .maps import STAR_CURVES, curve_points, regularity_form
 from .record import exact_keys
 from .replay import check_boxes, check_partition, parse_path
-from .rules import CENTRE, canonical, level1_rule
-from .tagged import labels, sector_rows, sharp_rays
+from .rules import level1_rule
+from .statement import B2Z, bspline_to_bezier
+from .tagged import labels, position_key, sector_rows, sharp_rays
 
 PIECES = ("P1", "P2", "P3")
 _OFFSET = {"P1": (0, -1), "P2": (0, 0), "P3": (-1, 0)}  # level-1 position of B-spline net[0][0]
-_B2Z = ((1, 4, 1, 0), (0, 4, 2, 0), (0, 2, 4, 0), (0, 1, 4, 1))  # uniform cubic B-spline -> Bezier, times 6
 
 
 def level1_values(fam, n, v):
@@ -67,13 +67,6 @@ def level1_values(fam, n, v):
     def quad(s):
         return s % n if fam == "dart" else s
 
-    def level0(q, a, b):
-        delta, a2, b2 = canonical(a, b)
-        if (a2, b2) == CENTRE:
-            return v[0]
-        s = quad(q + delta)
-        return v[idx[("r", s, a2, 0) if b2 == 0 else ("q", s, a2, b2)]]
-
     def value(q, A, B):
         if (A, B) == (0, 0):
             return one(0)
@@ -81,24 +74,17 @@ def level1_values(fam, n, v):
             return 2 * value(q, A, 0) - value(q, A, 1)
         if A == -1 and quad(q + 1) in sharp:  # across the sharp ray q + 1: the ghost column
             return 2 * value(q, 0, B) - value(q, 1, B)
-        delta, A2, B2 = canonical(A, B)
-        s = quad(q + delta)
-        key = ("r", s, A2, 0) if B2 == 0 else ("q", s, A2, B2)
+        key = position_key(fam, n, q, A, B)
         if key in idx:
             return one(idx[key])
+        _, s, A2, B2 = key
         if B2 == 0 and s in sharp:  # (3, 0) on a sharp ray: the midpoint of level-0 (1,0), (2,0)
             return (v[idx[("r", s, 1, 0)]] + v[idx[("r", s, 2, 0)]]) / 2
         acc = 0 * v[0]
         for (a, b), w in level1_rule(A2, B2).items():
-            acc += level0(s, a, b) * w
+            acc += v[idx[position_key(fam, n, s, a, b)]] * w
         return acc
     return value
-
-
-def _lin(coeffs, pts):
-    x = sum((p[0] * fmpq(c, 6) for c, p in zip(coeffs, pts) if c), arb(0))
-    y = sum((p[1] * fmpq(c, 6) for c, p in zip(coeffs, pts) if c), arb(0))
-    return (x, y)
 
 
 def quadrant_nets(fam, n, vx, vy, q, prec):
@@ -120,16 +106,13 @@ def quadrant_nets(fam, n, vx, vy, q, prec):
         for name in PIECES:
             oa, ob = _OFFSET[name]
             net = [[(arb(X(q, oa + i, ob + j)), arb(Y(q, oa + i, ob + j))) for j in range(4)] for i in range(4)]
-            tmp = [[_lin(_B2Z[i], [net[r][j] for r in range(4)]) for j in range(4)] for i in range(4)]
-            out[name] = [[_lin(_B2Z[j], tmp[i]) for j in range(4)] for i in range(4)]
+            out[name] = bspline_to_bezier(net, (arb(0), arb(0)))
     return out
 
 
-def _curve(nets, curve):
-    name, side, sign = STAR_CURVES[curve]
-    net = nets[name]
-    pts = [net[3][j] for j in range(4)] if side == "s" else [net[i][3] for i in range(4)]
-    return pts if sign > 0 else pts[::-1]  # oriented counterclockwise (from ray q towards ray q + 1)
+def _curve(nets, curve):  # oriented counterclockwise (from ray q towards ray q + 1)
+    pts = curve_points(nets, curve)
+    return pts if STAR_CURVES[curve][2] > 0 else pts[::-1]
 
 
 def transversal_form(nets, curve, a1, a2, prec):
@@ -180,16 +163,28 @@ def crossings(nets, curve, paths, direction, prec):
             fa, fp = A, P
             for ax, side in parse_path(path, 1):
                 fa, fp = (f.split(ax)[0 if side == "L" else 1] for f in (fa, fp))
-            if all(c > 0 for c in fp.coeffs) or all(c < 0 for c in fp.coeffs) or all(c < 0 for c in fa.coeffs):
-                continue
-            if not all(c > 0 for c in fa.coeffs):
-                return f"{curve}: box {path!r} decides nothing"
-            s0, s1 = fp.coeffs[0], fp.coeffs[-1]
-            if (s0 < 0 and s1 > 0) or (s0 > 0 and s1 < 0):
-                count += 1
-            elif not ((s0 < 0 and s1 < 0) or (s0 > 0 and s1 > 0)):
-                return f"{curve}: box {path!r}: the sign at an end is not certain"
+            got = _box_crossings(fa.coeffs, fp.coeffs)
+            if isinstance(got, str):
+                return f"{curve}: box {path!r}{got}"
+            count += got
     return count
+
+
+def _sign(values):
+    """+1 or -1 when every value is certainly of that sign, else 0."""
+    return 1 if all(c > 0 for c in values) else -1 if all(c < 0 for c in values) else 0
+
+
+def _box_crossings(fa, fp):
+    """Crossings of H in one box (Bernstein coefficients along and across H), or why it decides nothing."""
+    if _sign(fp) or _sign(fa) < 0:
+        return 0
+    if _sign(fa) <= 0:
+        return " decides nothing"
+    ends = _sign(fp[:1]) * _sign(fp[-1:])
+    if ends == 0:
+        return ": the sign at an end is not certain"
+    return 1 if ends < 0 else 0
 
 
 def rays_on_axes(fam, n, vx, vy):
@@ -209,24 +204,23 @@ def rays_on_axes(fam, n, vx, vy):
     True
     """
     X, Y = level1_values(fam, n, vx), level1_values(fam, n, vy)
-    r0 = [(X(0, a, 0), Y(0, a, 0)) for a in range(4)]
-    rn = [(X(n - 1, 0, b), Y(n - 1, 0, b)) for b in range(4)]
-
-    def zero(vals):
-        return all(isinstance(z, fmpq) and z == 0 or isinstance(z, arb) and z.is_zero() for z in vals)
-
-    def bez(vals):  # Bezier points of the segment [1, 2] of the B-spline with these values
-        return [sum((arb(z) * fmpq(c, 6) for c, z in zip(row, vals) if c), arb(0)) for row in _B2Z]
-
+    x0, y0 = [X(0, a, 0) for a in range(4)], [Y(0, a, 0) for a in range(4)]
+    xn, yn = [X(n - 1, 0, b) for b in range(4)], [Y(n - 1, 0, b) for b in range(4)]
     if fam == "crease":
-        ok = (zero([p[0] for p in r0 + rn]) and all(z < 0 for z in bez([p[1] for p in r0]))
-              and all(z > 0 for z in bez([p[1] for p in rn])))
+        ok = _zero(x0 + xn) and _sign(_bez(y0)) < 0 and _sign(_bez(yn)) > 0
         return ok, "X = 0 on both sharp rays, Y < 0 on ray 0 and Y > 0 on ray N" if ok else \
             "the sharp rays are not mapped onto the negative and positive Y half-axes"
-    ok = (zero([p[1] for p in r0]) and all(z > 0 for z in bez([p[0] for p in r0]))
-          and zero([p[0] for p in rn]) and all(z > 0 for z in bez([p[1] for p in rn])))
+    ok = _zero(y0) and _sign(_bez(x0)) > 0 and _zero(xn) and _sign(_bez(yn)) > 0
     return ok, "ray 0 onto the positive X half-axis, ray N onto the positive Y half-axis" if ok else \
         "the sharp rays are not mapped onto the positive half-axes"
+
+
+def _zero(vals):  # exactly 0 (an arb only when it is the exact 0)
+    return all(isinstance(z, fmpq) and z == 0 or isinstance(z, arb) and z.is_zero() for z in vals)
+
+
+def _bez(vals):  # Bezier points of the segment [1, 2] of the B-spline with these values
+    return [sum((arb(z) * fmpq(c, 6) for c, z in zip(row, vals) if c), arb(0)) for row in B2Z]
 
 
 def check_map(fam, n, vx, vy, lam1, lam2, orient, parts, prec, part):
@@ -237,18 +231,12 @@ def check_map(fam, n, vx, vy, lam1, lam2, orient, parts, prec, part):
     parts : dict
         ``{"regularity": {"q:P": boxes}, "transversal": {"q:curve": boxes}, "winding": {"q:curve": [path]}}``.
     """
+    regs = [f"{q}:{p}" for q in range(n) for p in PIECES]
+    curves = [f"{q}:{c}" for q in range(n) for c in STAR_CURVES]
+    _check_keys(parts, regs, curves)
     with ctx.workprec(prec):
         a1, a2 = -arb(lam1).log(), -arb(lam2).log()
         nets = [quadrant_nets(fam, n, vx, vy, q, prec) for q in range(n)]
-        regs = [f"{q}:{p}" for q in range(n) for p in PIECES]
-        curves = [f"{q}:{c}" for q in range(n) for c in STAR_CURVES]
-        exact_keys(parts, ("regularity", "transversal", "winding"), "parts")
-        exact_keys(parts["winding"], ("axis", "boxes"), "parts.winding")
-        for sec, got, keys in (("regularity", parts["regularity"], regs),
-                               ("transversal", parts["transversal"], curves),
-                               ("winding.boxes", parts["winding"]["boxes"], curves)):
-            if not isinstance(got, dict) or set(got) != set(keys):
-                raise CertificateError(f"parts.{sec} must have exactly the keys {keys[:3]}... ({len(keys)})")
 
         def replay(hint, keys, form, title):
             """Replay the boxes of ``parts[hint]`` on ``form(quadrant, name) * orient`` for every key; the
@@ -273,34 +261,60 @@ def check_map(fam, n, vx, vy, lam1, lam2, orient, parts, prec, part):
         if worst is None:
             return
         part(title, True, f"min bound {worst}", worst, "transversal")
-        win = parts["winding"]
-        axis = win.get("axis")
-        # the D-angle along Gamma is monotone (T); the counts below say it turns by exactly the sector's
-        # angle: from -y to +y through x > 0 (x < 0 when the orientation is -1), from +x to +y through the
-        # first quadrant (the other three when -1), once around for a dart
-        # a dart with lam1 = lam2 (D a multiple of the identity) may name any ray [a, b] (every ray is an orbit)
-        ray = (isinstance(axis, list) and len(axis) == 2 and all(type(c) is int and abs(c) <= 16 for c in axis)
-               and axis != [0, 0] and fam == "dart" and isinstance(lam1, fmpq) and lam1 == lam2)
-        want = 1 if ray else ({("+x", 1): 1, ("-x", 1): 0, ("+x", -1): 0, ("-x", -1): 1} if fam == "crease" else
-                              {("-x", 1): 0, ("-y", 1): 0, ("-x", -1): 1, ("-y", -1): 1} if fam == "corner" else
-                              {(a, o): 1 for a in AXES for o in (1, -1)}).get((axis, orient)) \
-            if isinstance(axis, str) else None
-        if want is None:
-            raise CertificateError(f"parts.winding.axis {str(axis)[:12]!r} is not allowed for {fam}")
-        direction = tuple(axis) if ray else AXES[axis]
-        total = 0
-        for key in curves:
-            q, c = key.split(":")
-            paths = win["boxes"][key]
-            if not isinstance(paths, list) or not paths or not all(isinstance(p, str) for p in paths):
-                raise CertificateError(f"parts.winding.{key} must be a list of paths")
-            got = crossings(nets[int(q)], c, paths, direction, prec)
-            if isinstance(got, str):
-                part(f"W the outer curve crosses the {axis} half-axis {want} time(s)", False, got)
-                return
-            total += got
-        part(f"W the outer curve crosses the {axis} half-axis {want} time(s)", total == want,
-             f"{total} crossing(s)")
+        if not _check_winding(fam, nets, curves, parts["winding"], _lam_ray(fam, lam1, lam2), orient, prec, part):
+            return
         if fam != "dart":
             ok, msg = rays_on_axes(fam, n, vx, vy)
             part("E the sharp rays map onto half-axes", ok, msg)
+
+
+def _check_keys(parts, regs, curves):
+    exact_keys(parts, ("regularity", "transversal", "winding"), "parts")
+    exact_keys(parts["winding"], ("axis", "boxes"), "parts.winding")
+    for sec, got, keys in (("regularity", parts["regularity"], regs), ("transversal", parts["transversal"], curves),
+                           ("winding.boxes", parts["winding"]["boxes"], curves)):
+        if not isinstance(got, dict) or set(got) != set(keys):
+            raise CertificateError(f"parts.{sec} must have exactly the keys {keys[:3]}... ({len(keys)})")
+
+
+def _lam_ray(fam, lam1, lam2):  # a dart with lam1 = lam2 (D a multiple of the identity): every ray is an orbit
+    return fam == "dart" and isinstance(lam1, fmpq) and lam1 == lam2
+
+
+# the half-axes a curve may be counted against, and how often it crosses each: from -y to +y through x > 0
+# (x < 0 when the orientation is -1) for a crease, from +x to +y through the first quadrant (the other three
+# when -1) for a corner, once around for a dart
+_WANT = {"crease": {("+x", 1): 1, ("-x", 1): 0, ("+x", -1): 0, ("-x", -1): 1},
+         "corner": {("-x", 1): 0, ("-y", 1): 0, ("-x", -1): 1, ("-y", -1): 1},
+         "dart": {(a, o): 1 for a in AXES for o in (1, -1)}}
+
+
+def _direction(fam, axis, orient, ray):
+    """``(direction, crossings wanted)`` for the certificate's ``parts.winding.axis``."""
+    if ray and isinstance(axis, list) and len(axis) == 2 and axis != [0, 0] \
+            and all(type(c) is int and abs(c) <= 16 for c in axis):
+        return tuple(axis), 1
+    want = _WANT[fam].get((axis, orient)) if isinstance(axis, str) else None
+    if want is None:
+        raise CertificateError(f"parts.winding.axis {str(axis)[:12]!r} is not allowed for {fam}")
+    return AXES[axis], want
+
+
+def _check_winding(fam, nets, curves, win, ray, orient, prec, part):
+    """W: the D-angle along Gamma is monotone (T); the count of crossings says it turns by exactly the
+    sector's angle. False when a box decides nothing (the count is then not recorded)."""
+    axis = win.get("axis")
+    direction, want = _direction(fam, axis, orient, ray)
+    title, total = f"W the outer curve crosses the {axis} half-axis {want} time(s)", 0
+    for key in curves:
+        q, c = key.split(":")
+        paths = win["boxes"][key]
+        if not isinstance(paths, list) or not paths or not all(isinstance(p, str) for p in paths):
+            raise CertificateError(f"parts.winding.{key} must be a list of paths")
+        got = crossings(nets[int(q)], c, paths, direction, prec)
+        if isinstance(got, str):
+            part(title, False, got)
+            return False
+        total += got
+    part(title, total == want, f"{total} crossing(s)")
+    return True

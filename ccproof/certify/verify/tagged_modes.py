@@ -23,8 +23,8 @@ characteristic polynomial of the 6N + 3 points (docs/tagged_c1.md, "Spectrum in 
    B(w) and to have, with the 6 (N - 1) others, the dimension 6N - 2 of I.
 4. **Block polynomials.** det(x - B(w)) = (x - 1/8)(x - 1/16)(x - 1/32)(x - 1/64)(x^2 - (5 + c) x/8 + 1/16),
    c = (w + 1/w)/2, checked here exactly for this stencil on a grid of rational points (as
-   :func:`.spectrum.check_block_polynomials`). So mode j has 1/8..1/64, lam(c_j) and 1/(16 lam(c_j)),
-   c_j = cos(pi j/N), lam(c) = (5 + c + sqrt((1 + c)(9 + c)))/16 (:func:`.spectrum.lam_of`).
+   :func:`.spectrum.mode_polynomials_hold`). So mode j has 1/8..1/64, lam(c_j) and 1/(16 lam(c_j)),
+   c_j = cos(pi j/N), lam(c) = (5 + c + sqrt((1 + c)(9 + c)))/16 (:func:`.statement.lam_of`).
 
 **Darts** (:func:`check_dart`, K >= MIN_N): S commutes with the reflection R in the sharp ray 0 (checked
 row by row), so the even and the odd vectors are invariant; every row but the centre's and ray 0's is
@@ -49,7 +49,8 @@ from flint import acb, acb_mat, arb, arb_mat, fmpq, fmpq_mat
 
 from .errors import CertificateError
 from .rules import CENTRE, TWO_RING, canonical, level1_rule
-from .spectrum import _SMALL, _charpoly_at, _claimed_mode, lam_of
+from .spectrum import SMALL_ROOTS, mode_polynomials_hold
+from .statement import lam_of
 from .tagged import crease_block, crease_points, labels, sector_rows
 
 MIN_N = 5  # crease:N, corner:N with N >= MIN_N take this path (a "not C1" witness)
@@ -114,12 +115,8 @@ def check_ring():
         mirrored = {_reflect(d, q): x for (d, q), x in ring_stencil()[i].items()}
         if image != mirrored:
             raise CertificateError(f"the ring stencil does not commute with the reflection at {pos}")
-    for w in range(1, 20):  # w^6 det(x - B(w)) has degree <= 18 in w (|delta| <= 2... checked below)
-        rows = _block(fmpq(w))
-        c = (fmpq(w) + 1 / fmpq(w)) / 2
-        for x in range(7):
-            if _charpoly_at(rows, fmpq(x)) != _claimed_mode(fmpq(x), c):
-                raise CertificateError("a Fourier block of the ring stencil has another characteristic polynomial")
+    if not mode_polynomials_hold(_block):  # w^6 det(x - B(w)) of degree <= 18 in w: |delta| <= 2, checked below
+        raise CertificateError("a Fourier block of the ring stencil has another characteristic polynomial")
     if any(not -1 <= d <= 2 for row in ring_stencil() for d, _ in row):
         raise CertificateError("the ring stencil reaches beyond the neighbouring sectors")
     return True
@@ -204,10 +201,11 @@ def check_structure(fam, n):
     return tuple(M for M in (M0, Mn) if M is not None)
 
 
-def _roots(M):
-    """(acb, fmpq or None) per eigenvalue of a rational matrix, repeated by algebraic multiplicity."""
+def _roots(M, fac=None):
+    """(acb, fmpq or None) per eigenvalue of a rational matrix (or of the factors ``fac`` of a characteristic
+    polynomial), repeated by algebraic multiplicity."""
     out = []
-    for p, e in M.charpoly().factor()[1]:
+    for p, e in M.charpoly().factor()[1] if fac is None else fac:
         for z, _ in p.complex_roots():
             out += [(acb(z), -p[0] / p[1] if p.degree() == 1 else None)] * e
     return out
@@ -238,10 +236,7 @@ def mode_spectrum(fam, n):
     """
     if fam == "dart":  # the even part exactly (S_E's factors), the odd part through the modes w = exp(2 pi i j/K)
         _, _, extra, fac, (_, outer), bound = check_dart(n)
-        out, tag, modes = [], "O", range(1, (n + 1) // 2)
-        for p, e in fac:
-            out += [(acb(z), -p[0] / p[1] if p.degree() == 1 else None, "E", None)
-                    for z, _ in p.complex_roots()] * e
+        out, tag, modes = [(z, q, "E", None) for z, q in _roots(None, fac)], "O", range(1, (n + 1) // 2)
         out += [(acb(arb(0, bound), arb(0, bound)), None, "E", None)] * len(outer)  # |z| <= bound, each
     else:
         extra, tag, modes = check_structure(fam, n), "I", range(1, n)
@@ -252,8 +247,25 @@ def mode_spectrum(fam, n):
     for j in modes:
         lam = lam_of(arb(fmpq(2 * j, ring)).cos_pi())
         out += [(acb(lam), None, tag, j), (acb(1 / (16 * lam)), None, tag, j)]
-        out += [(acb(s), s, tag, None) for s in _SMALL]
+        out += [(acb(s), s, tag, None) for s in SMALL_ROOTS]
     return out
+
+
+def bordered_solve(B, lam, pivot):
+    """The null vector v of B - lam (6 x 6, acb) with v[pivot] = 1, from the bordered system
+    [[B - lam, e_p], [e_p^T, 0]] (v, s) = (0, 1); raises ZeroDivisionError unless arb proves it regular
+    (then lam is a simple eigenvalue with v[pivot] != 0, and s = 0).
+
+    Examples
+    --------
+    >>> [z.real.mid() for z in bordered_solve([[acb(int(i == k)) * (i + 1) for k in range(6)] for i in range(6)],
+    ...                                       acb(2), 1)]
+    [0, 1.00000000000000, 0, 0, 0, 0]
+    """
+    rows = [[B[i][k] - (lam if i == k else 0) for k in range(6)] + [acb(int(i == pivot))] for i in range(6)]
+    rows.append([acb(int(k == pivot)) for k in range(6)] + [acb(0)])
+    sol = acb_mat(rows).solve(acb_mat([[0]] * 6 + [[1]]))
+    return [sol[i, 0] for i in range(6)]
 
 
 def _unit(num, den):
@@ -285,14 +297,11 @@ def mode_vector(fam, n, j, lam):
     B = _block(_unit(2 * j, ring))
     vh = None
     for pv in range(6):  # the first pivot that arb proves regular (the bordered-system argument of tagged_c1)
-        rows = [[B[i][k] - (lam if i == k else 0) for k in range(6)] + [acb(int(i == pv))] for i in range(6)]
-        rows.append([acb(int(k == pv)) for k in range(6)] + [acb(0)])
         try:
-            sol = acb_mat(rows).solve(acb_mat([[0]] * 6 + [[1]]))
+            vh = bordered_solve(B, lam, pv)
+            break
         except ZeroDivisionError:
             continue
-        vh = [sol[i, 0] for i in range(6)]
-        break
     if vh is None:
         return None
     skip = {0} if fam == "dart" else set(crease_points(fam, n))
@@ -339,6 +348,36 @@ def check_dart(k):
         raise CertificateError(f"dart:{k}: the mode structure is used for K >= {MIN_N}")
     check_ring()
     pts, rows = labels("dart", k), sector_rows("dart", k)
+    refl = _check_dart_rows(k, pts, rows)
+    reps = [i for i in range(len(pts)) if i <= refl[i]]
+    rep = [0] * len(pts)
+    for a, i in enumerate(reps):
+        rep[i] = rep[refl[i]] = a
+    SE = fmpq_mat(len(reps), len(reps))
+    for a, i in enumerate(reps):
+        for j, x in rows[i].items():
+            SE[a, rep[j]] += x
+    blocks = [M for M, _ in [_odd_block(1)] + ([_odd_block(-1)] if k % 2 == 0 else []) if M is not None]
+    if 6 * ((k + 1) // 2 - 1) + sum(M.nrows() for M in blocks) != len(pts) - len(reps):
+        raise CertificateError(f"dart:{k}: the modes do not account for every odd vector")
+    inner = [a for a, i in enumerate(reps) if pts[i] == ("C",) or pts[i][2:] in ((1, 0), (1, 1))]
+    fac, outer, bound = _one_ring(k, SE, inner)
+    return SE, tuple(rep), tuple(blocks), fac, (tuple(inner), outer), bound
+
+
+def _one_ring(k, SE, inner):
+    """The one-ring (centre, (1,0), (1,1)) is closed: S_E = [[S_in, 0], [*, S_out]] (checked exactly); the
+    factors of S_in's characteristic polynomial, the outer rows and |S_out|_inf >= rho(S_out)."""
+    outer = tuple(a for a in range(SE.nrows()) if a not in inner)
+    if any(SE[a, b] != 0 for a in inner for b in outer):
+        raise CertificateError(f"dart:{k}: the one-ring is not closed under the rules")
+    bound = max(sum((abs(SE[a, b]) for b in outer), fmpq(0)) for a in outer)
+    return fmpq_mat([[SE[a, b] for b in inner] for a in inner]).charpoly().factor()[1], outer, bound
+
+
+def _check_dart_rows(k, pts, rows):
+    """The reflection in the sharp ray (as a permutation of the points), after checking exactly that the
+    rows commute with it and that every row but the centre's and ray 0's is the ring rule."""
     idx = {p: i for i, p in enumerate(pts)}
     refl = [idx[_dart_reflect(p, k)] for p in pts]
     for i, p in enumerate(pts):
@@ -352,25 +391,7 @@ def check_dart(k):
             ring[j] = ring.get(j, 0) + x
         if {j: x for j, x in ring.items() if x != 0} != {j: x for j, x in rows[i].items() if j != 0}:
             raise CertificateError(f"dart:{k}: the row of {p} is not the ring rule")
-    reps = [i for i in range(len(pts)) if i <= refl[i]]
-    rep = [0] * len(pts)
-    for a, i in enumerate(reps):
-        rep[i] = rep[refl[i]] = a
-    SE = fmpq_mat(len(reps), len(reps))
-    for a, i in enumerate(reps):
-        for j, x in rows[i].items():
-            SE[a, rep[j]] += x
-    blocks = [M for M, _ in [_odd_block(1)] + ([_odd_block(-1)] if k % 2 == 0 else []) if M is not None]
-    if 6 * ((k + 1) // 2 - 1) + sum(M.nrows() for M in blocks) != len(pts) - len(reps):
-        raise CertificateError(f"dart:{k}: the modes do not account for every odd vector")
-    # the one-ring (centre, (1,0), (1,1)) is closed: S_E = [[S_in, 0], [*, S_out]], rho(S_out) <= |S_out|_inf
-    inner = [a for a, i in enumerate(reps) if pts[i] == ("C",) or pts[i][2:] in ((1, 0), (1, 1))]
-    outer = [a for a in range(len(reps)) if a not in inner]
-    if any(SE[a, b] != 0 for a in inner for b in outer):
-        raise CertificateError(f"dart:{k}: the one-ring is not closed under the rules")
-    bound = max(sum((abs(SE[a, b]) for b in outer), fmpq(0)) for a in outer)
-    S_in = fmpq_mat([[SE[a, b] for b in inner] for a in inner])
-    return SE, tuple(rep), tuple(blocks), S_in.charpoly().factor()[1], (tuple(inner), tuple(outer)), bound
+    return refl
 
 
 def even_vector(k, lam, pivot):

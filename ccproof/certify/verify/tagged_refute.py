@@ -120,16 +120,21 @@ def chain_generic(fam, n, vals, tops, prec):
     ev = eigenvalues(fam, n, prec)
     ia = _find(ev, a)
     at_b = [i for i, t in enumerate(ev) if same_root(t, b)]
-    why = ("eigenvalue 1 is not simple" if sum(1 for t in ev if t[1] == _ONE) != 1 else
-           "alpha is not a simple eigenvalue" if ia is None or ev[ia][2] != 1 or ia in at_b else
-           "alpha > beta > 0 is not certain" if not (b > 0 and ev[ia][0].real > b) else
-           _blocks_at(fam, n, b, len(at_b)) or _below(ev, [ia, *at_b], b) or _crease_top(fam, n, g) or
-           ("gamma is not beta" if g != b else None))
+    why = _chain_order(ev, ia, at_b, b) or (
+        _blocks_at(fam, n, b, len(at_b)) or _below(ev, [ia, *at_b], b) or _crease_top(fam, n, g) or
+        ("gamma is not beta" if g != b else None))
     if why:
         return False, why
     return True, (f"alpha = {ev[ia][0].real.str(8, radius=False)} > beta = {b} = gamma > |every other|, 1 simple; "
                   f"beta: algebraic multiplicity {len(at_b)}, geometric {ev[at_b[0]][3]}, Jordan blocks of size <= 2 "
                   "(dim ker (S - beta)^2 = algebraic multiplicity); e = (S - beta) y != 0, 0 on the crease points")
+
+
+def _chain_order(ev, ia, at_b, b):
+    """The reason 1 is not simple, alpha (index ``ia``) not simple, or alpha > beta > 0 not certain; or None."""
+    return ("eigenvalue 1 is not simple" if sum(1 for t in ev if t[1] == _ONE) != 1 else
+            "alpha is not a simple eigenvalue" if ia is None or ev[ia][2] != 1 or ia in at_b else
+            "alpha > beta > 0 is not certain" if not (b > 0 and ev[ia][0].real > b) else None)
 
 
 def _blocks_at(fam, n, b, alg):
@@ -161,13 +166,17 @@ def mode_generic(ev, ia, ib, g):
     one = [t for t in ev if not abs(t[0]) < 1]
     beta = ev[ib][0].real
     others = [t for i, t in enumerate(ev) if i not in (ia, ib) and t[1] != 1]
-    below = [t[1] for t in ev if t[2] == "C" and t[1] is not None and t[1] < 1]
     return ("x and y are the same eigenvector (beta is not an eigenvalue distinct from alpha)" if ia == ib else
             "eigenvalue 1 is not simple" if len(one) != 1 or one[0][1] != 1 or one[0][2] != "C" else
             "alpha >= beta is not certain" if not ev[ia][0].real >= beta else
             "an eigenvalue is not certainly below beta (lam1, lam2 not alpha, beta)"
-            if not all(abs(t[0]) < beta for t in others) else
-            f"gamma is not the crease block's largest eigenvalue below 1 ({max(below) if below else None})"
+            if not all(abs(t[0]) < beta for t in others) else _mode_gamma(ev, g, beta))
+
+
+def _mode_gamma(ev, g, beta):
+    """The reason gamma is not the crease block's largest eigenvalue below 1, or not certainly below beta; or None."""
+    below = [t[1] for t in ev if t[2] == "C" and t[1] is not None and t[1] < 1]
+    return (f"gamma is not the crease block's largest eigenvalue below 1 ({max(below) if below else None})"
             if not below or g != max(below) else "gamma < beta is not certain" if not arb(g) < beta else None)
 
 
