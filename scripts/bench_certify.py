@@ -10,6 +10,11 @@ totals (wall clock) with the ratio certify/verify, against the targets (all of 3
                                                        (targets certify <= 5 min, verify <= 1 min)
     python scripts/bench_certify.py --verify-all      `ccproof verify --all` on 2 processes (target
                                                        <= 90 s), and the share of the statement derivation
+    python scripts/bench_certify.py --verify-all --before DIR --rounds 2
+                                                      `ccproof verify --all --jobs JOBS` of this tree against
+                                                      the checkout DIR of an earlier revision (its own
+                                                      certificates), alternating round by round: the ratio
+                                                      (this) / (before) as min, median, max, load
     python scripts/bench_certify.py --tagged 2        what the tagged certificates (certificates/c1/{dart,
                                                        crease,corner}/) add to `verify --all`: the smooth
                                                        ones and the tagged ones verified on JOBS fresh
@@ -75,8 +80,13 @@ def main():
     ap.add_argument("--verify-all", action="store_true", help="time `ccproof verify --all --jobs JOBS`")
     ap.add_argument("--tagged", type=int, default=None, metavar="ROUNDS",
                     help="what the tagged certificates add to verify --all (ROUNDS alternating rounds)")
+    ap.add_argument("--before", default=None, metavar="DIR",
+                    help="with --verify-all: a checkout of an earlier revision to compare against")
+    ap.add_argument("--rounds", type=int, default=2, help="with --before: alternating rounds")
     ap.add_argument("--smoke", action="store_true", help="valence 3, in this process (the test suite's run)")
     args = ap.parse_args()
+    if args.verify_all and args.before:
+        return bench_verify_all_against(args.before, args.jobs, args.rounds)
     if args.smoke:
         return smoke()
     if args.tagged is not None:
@@ -195,6 +205,39 @@ def bench_verify_all(jobs):
     print(f"verify --all with {jobs} processes: {total:.1f} s (target 90 s); statement derivation {deriv:.2f} s "
           f"per worker process ({jobs} x {deriv:.2f} s = {100 * jobs * deriv / (jobs * total):.1f} % of the "
           f"{jobs} x {total:.1f} s of process time); exit status {out.returncode}")
+
+
+def _verify_all_seconds(tree, jobs):
+    """Wall clock of `ccproof verify --all --quiet --jobs JOBS` run from the package under ``tree`` (None: this
+    one), a fresh process; the run must end with exit status 0."""
+    import subprocess
+
+    env = dict(os.environ)
+    if tree is not None:
+        env["PYTHONPATH"] = os.pathsep.join([str(tree), env.get("PYTHONPATH", "")])
+    code = "import sys; from ccproof.cli import main; sys.exit(main(sys.argv[1:]))"
+    t = time.perf_counter()
+    out = subprocess.run([sys.executable, "-c", code, "verify", "--all", "--quiet", "--jobs", str(jobs)],
+                         capture_output=True, text=True, env=env, cwd=tempfile.gettempdir())
+    if out.returncode != 0:
+        raise SystemExit(f"verify --all ({tree or 'this tree'}) failed:\n{out.stdout[-2000:]}{out.stderr[-2000:]}")
+    return time.perf_counter() - t, out.stdout.strip().splitlines()[-1]
+
+
+def bench_verify_all_against(before, jobs, rounds):
+    """(this) / (before) for `verify --all --jobs JOBS`, alternating which runs first round by round."""
+    from _bench import ratio_line
+
+    ratios, loads = [], []
+    for r in range(rounds):
+        order = [None, before] if r % 2 else [before, None]
+        wall = {}
+        for tree in order:
+            loads.append(os.getloadavg()[0])
+            wall[tree], last = _verify_all_seconds(tree, jobs)
+            print(f"round {r}: {'before' if tree else 'this'} {wall[tree]:.1f} s ({last})", flush=True)
+        ratios.append(wall[None] / wall[before])
+    print(ratio_line(f"verify --all --jobs {jobs}, (this) / (before):", ratios, loads))
 
 
 if __name__ == "__main__":

@@ -28,11 +28,12 @@ COMMANDS: dict[str, tuple[str, str]] = {
 
 #: the commands that read meshes, point files or chart labels: they take --max-input (ccproof/mesh/inputs.py)
 INPUT_COMMANDS = ("eval", "project", "fit", "arap")
+#: the command line's default --max-polygon (the library reads any polygon); a constant here, so that
+#: ``ccproof --help`` imports nothing of the mesh package (no numpy)
+MAX_POLYGON = 256
 
 
 def _add_input_limit(p):
-    from ccproof.mesh.inputs import MAX_POLYGON
-
     p.add_argument("--max-input", type=float, default=None, metavar="GB",
                    help="largest input file read, in GB (default 2); inputs are regular files or pipes (read "
                         "once): a folder, a device such as /dev/zero or a socket is refused by name")

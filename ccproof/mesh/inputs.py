@@ -189,8 +189,7 @@ def read_input_text(path, error=CCProofError, expect="lines of text"):
 #: the largest polygon a command evaluates by default (``--max-polygon`` raises it): the exact data of an
 #: n-gon (the corner scheme of its centre, valence n) cost about n^1.5 to n^2.3 (measured, empty cache: 21 s
 #: at n = 128 on a loaded 2-core machine; 37 s at 200 and 26 min, 2.2 GB at 1000 elsewhere)
-MAX_POLYGON = 256
-_polygon_cap = [None]  # the library reads any polygon; the command line sets MAX_POLYGON
+_polygon_cap = [None]  # the library reads any polygon; the command line sets its --max-polygon
 
 
 def polygon_cap():
