@@ -1,6 +1,7 @@
 """Project 3-D points onto the Catmull-Clark limit surface of a mesh (globally nearest limit points).
 
-For every point of POINTS.csv (header ``x,y,z``) the nearest point of the limit surface: its
+For every point of POINTS (``.xyz``, ``.ply``, ``.obj`` vertices, or ``.csv`` with the header ``x,y,z``; the
+same formats as ``ccproof fit``) the nearest point of the limit surface: its
 parameter (face, u, v) (ptex face; corner i of the face at (0,0), (1,0), (1,1), (0,1)), the point
 P, the distance |X - P| and the unit normal there. The search is global (bounding cylinders over
 sampled cells, a bounding-volume hierarchy, best-first projected Newton descents), see
@@ -25,7 +26,8 @@ from __future__ import annotations
 def add_arguments(parser):
     parser.add_argument("mesh", help="mesh file: OBJ (with OpenSubdiv tags), OFF, PLY, STL, VTK, ... (any mesh "
                         "'ccproof eval' reads)")
-    parser.add_argument("points", help="CSV file with the header x,y,z")
+    parser.add_argument("points", help="point cloud: .xyz (x y z per line), .ply (vertex x, y, z), .obj (v lines), "
+                        ".csv (header x,y,z), or the vertices of any mesh file")
     parser.add_argument("--out", metavar="FILE.npz", required=True, help="output file (numpy .npz)")
     parser.add_argument("--certify", action="store_true",
                         help="add interval-arithmetic verdicts (slow: per point; untagged all-quad meshes only)")
@@ -67,13 +69,6 @@ def check_search_memory(n_faces, cells, max_memory_gb):
 BATCH = 1000
 
 
-def read_xyz_csv(path):
-    """Read an ``x,y,z`` CSV file; returns an (n, 3) float array."""
-    from ccproof.cli._eval_args import read_csv_columns
-
-    return read_csv_columns(path, ("x", "y", "z"))
-
-
 def run(args):
     import time
 
@@ -93,11 +88,13 @@ def run(args):
     from ccproof.evaluate.surface import limit_surface
 
     progress = progress_enabled(args)
-    X = read_xyz_csv(args.points)
-    try:  # non-finite or huge coordinates: refused before the search structure is built
+    from ccproof.mesh.io import read_points
+
+    X = read_points(args.points)  # file and line named for a bad or non-finite point
+    try:  # huge coordinates: refused before the search structure is built
         check_points(X)
     except CCProofError as exc:
-        raise CCProofError(f"{args.points}: {exc} (point i is on line i + 2)") from None
+        raise CCProofError(f"{args.points}: {exc} (points counted from 0 in file order)") from None
     if args.cells is not None and args.cells < 1:
         raise CCProofError(f"--cells must be >= 1, got {args.cells}")
     if not (args.max_memory > 0 and args.max_memory < float("inf")):
