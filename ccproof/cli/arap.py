@@ -216,11 +216,12 @@ def run(args) -> int:
     from ccproof.apps.arap.charts import read_labels, segment_by_normals
     from ccproof.apps.arap.core import VARIANTS, MemoryBudgetError, auto_refine, compare
     from ccproof.apps.control_mesh import children_labels, read_control_mesh
-    from ccproof.cli._progress import progress_enabled
+    from ccproof.cli._progress import phase, progress_enabled
     from ccproof.errors import CCProofError
 
     refine = _check_options(args)
-    mesh, origin = read_control_mesh(args.mesh)
+    with phase(f"read {args.mesh}", progress_enabled(args)):
+        mesh, origin = read_control_mesh(args.mesh)
     n_file = mesh.n_faces if origin is None else int(origin.max()) + 1
     if origin is not None:
         steps = getattr(mesh, "global_steps", 1)

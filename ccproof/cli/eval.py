@@ -65,6 +65,16 @@ def add_arguments(parser):
                         "--points FOLDER reads one (docs/scale-out.md)")
 
 
+def _phases(read, setup, worker_setup):
+    """The phases before the evaluation, as printed: read and setup seconds (in this process, in the workers).
+
+    >>> _phases(1.5, 2.0, 0.0), _phases(1.5, 0.0, 3.25)
+    ('read in 1.50 s, setup 2.00 s', 'read in 1.50 s, setup 3.25 s (in each worker, the longest)')
+    """
+    text = f"read in {read:.2f} s, setup {setup + worker_setup:.2f} s"
+    return text + (" (in each worker, the longest)" if worker_setup > setup else "")
+
+
 def build_surface(mesh, tagged, alpha=None, progress=False):
     """The surface ``ccproof eval`` evaluates (module level, so a Dask worker can rebuild it by name):
     the tagged evaluator's natural parameterization for a tagged or non-quad :class:`PolyMesh`, else the
@@ -169,8 +179,13 @@ def run(args) -> int:
 
     points = None if args.points is None else Path(args.points).resolve()
     sched = scheduler_from_args(args)  # --scheduler checked before any work
+    from ccproof.cli._progress import phase
+
+    progress = progress_enabled(args)
     t0 = time.perf_counter()
-    poly = read_mesh(args.mesh)  # OBJ with OpenSubdiv tags, OFF, or any meshio format
+    with phase(f"read {Path(args.mesh).name}", progress):
+        poly = read_mesh(args.mesh)  # OBJ with OpenSubdiv tags, OFF, or any meshio format
+    t_read = time.perf_counter() - t0
     tagged = not poly.is_plain_quads
     if tagged:
         # triangles, n-gons, creases, corners, holes, boundary modes: the natural parameterization
@@ -212,37 +227,39 @@ def run(args) -> int:
 
     compile_notice("eval")  # after the input checks: an error stays one line
     # on a cluster each worker builds the surface itself (once); here only for in-process work or --plot
-    progress = progress_enabled(args)
-    surface = build_surface(mesh, tagged, args.alpha, progress) if sched.kind == "serial" or args.plot else None
     t1 = time.perf_counter()
-    t2 = time.perf_counter()
+    surface = build_surface(mesh, tagged, args.alpha, progress) if sched.kind == "serial" or args.plot else None
+    setup = time.perf_counter() - t1  # the setup in this process (the workers' is measured by them)
+    t_start = time.perf_counter()
     with open_scheduler(sched, len(sources)) as sched:
+        t_start = time.perf_counter() - t_start  # a local cluster's start
         in_process = getattr(sched, "kind", None) == "serial"  # a Client, or local worker processes without Dask
         if surface is None and in_process:  # a single chunk runs here after all
+            t1 = time.perf_counter()
             surface = build_surface(mesh, tagged, args.alpha, progress)
+            setup += time.perf_counter() - t1
         if args.threads is not None:
             kwargs["threads"] = args.threads
         elif not in_process:
             kwargs["threads"] = 1  # one worker per core already: no second level of threads
         # the file (or each shard and the index) is written under a temporary name, then renamed
-        n, names, sweep = evaluate_points(ship(build_surface, mesh, tagged, args.alpha), sources, args.derivatives,
-                                          kwargs, str(out_path), sched, local=surface,
-                                          progress=progress)
-    t3 = time.perf_counter()
+        t_tasks = time.perf_counter()
+        n, names, sweep, worker_setup = evaluate_points(ship(build_surface, mesh, tagged, args.alpha), sources,
+                                                        args.derivatives, kwargs, str(out_path), sched,
+                                                        local=surface, progress=progress)
+        t_write = time.perf_counter() - t_tasks - sweep.seconds  # gathering and writing the output
     for line in sweep.report([f"chunk {i}" for i in range(len(sources))]):  # retried or lost tasks
         print(line)
     out = dict.fromkeys(names)
-    if tagged:
-        print(f"{args.mesh}: {mesh}; prepared in {t1 - t0:.2f} s")
-    else:
-        print(
-            f"{args.mesh}: {mesh.n_vertices} vertices, {mesh.n_faces} faces, "
-            f"{mesh.extraordinary_vertices.size} extraordinary vertices; prepared in {t1 - t0:.2f} s"
-        )
-    rate = n / (t3 - t2) if t3 > t2 and n else float("nan")
+    what = (str(mesh) if tagged else f"{mesh.n_vertices} vertices, {mesh.n_faces} faces, "
+            f"{mesh.extraordinary_vertices.size} extraordinary vertices")
+    print(f"{args.mesh}: {what}; {_phases(t_read, setup, worker_setup)}")
+    evaluation = max(sweep.seconds - worker_setup, 0.0)  # the workers build at the same time, first
+    rate = n / evaluation if evaluation > 0 and n else float("nan")
     print(
         f"evaluated {n} points ({args.parameterization} parameterization, derivatives {args.derivatives}) "
-        f"in {t3 - t2:.3f} s ({rate:,.0f} points/s)"
+        f"in {evaluation:.3f} s ({rate:,.0f} points/s, evaluation alone); "
+        + (f"scheduler start {t_start:.2f} s, " if t_start >= 0.005 else "") + f"gathering and writing {t_write:.2f} s"
     )
     print(f"wrote {args.out}: {', '.join(['face', 'u', 'v', *out])}")
     if args.plot:

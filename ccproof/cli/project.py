@@ -71,6 +71,7 @@ BATCH = 1000
 
 def run(args):
     import time
+    from pathlib import Path
 
     from ccproof.cli._output import OutputPlan, atomic
 
@@ -100,9 +101,13 @@ def run(args):
     if not (args.max_memory > 0 and args.max_memory < float("inf")):
         raise CCProofError(f"--max-memory must be a positive number of GB, got {args.max_memory}")
     from ccproof.cli._eval_args import evaluable_ptex_faces
+    from ccproof.cli._progress import phase
     from ccproof.mesh.io import read_mesh
 
-    poly = read_mesh(args.mesh)
+    t_read = time.perf_counter()
+    with phase(f"read {Path(args.mesh).name}", progress):
+        poly = read_mesh(args.mesh)
+    t_read = time.perf_counter() - t_read
     if args.certify and not poly.is_plain_quads:  # before the search: certify_closest needs a QuadMesh
         raise CCProofError(f"{args.mesh}: --certify needs an untagged manifold all-quad mesh (this one has "
                            "non-quad faces, OpenSubdiv tags or non-manifold edges or vertices); drop --certify")
@@ -111,12 +116,17 @@ def run(args):
         raise CCProofError(f"{args.mesh}: every face is a hole: there is no limit surface to project onto")
     n_search = poly.n_ptex if evaluable is None else evaluable.size
     check_search_memory(n_search, CELLS if args.cells is None else args.cells, args.max_memory)  # before the setup
+    t_setup = time.perf_counter()
     S = limit_surface(poly.to_quad_mesh() if poly.is_plain_quads else poly, progress=progress)  # a bar if long
+    t_setup = time.perf_counter() - t_setup
     from ccproof.cli._notice import compile_notice
 
     compile_notice("project")  # after the input checks: an error stays one line
+    t_build = time.perf_counter()
+    with phase("search structure", progress):
+        finder = ClosestPointFinder(S, cells=CELLS if args.cells is None else args.cells, faces=evaluable)
     t0 = time.perf_counter()
-    finder = ClosestPointFinder(S, cells=CELLS if args.cells is None else args.cells, faces=evaluable)
+    t_build = t0 - t_build
     starts = range(0, X.shape[0], BATCH)
     if progress and len(starts) > 1:
         from tqdm import tqdm
@@ -124,7 +134,8 @@ def run(args):
         starts = tqdm(starts, desc="project", unit="batch")
     parts = [finder.query(X[a:a + BATCH]) for a in starts] or [finder.query(X)]  # (no points: empty arrays)
     out = {k: np.concatenate([getattr(r, k) for r in parts]) for k in ("face", "u", "v", "P", "distance", "normal")}
-    msg = f"{X.shape[0]} points projected in {time.perf_counter() - t0:.2f} s"
+    msg = (f"{args.mesh}: read in {t_read:.2f} s, setup {t_setup:.2f} s, search structure {t_build:.2f} s; "
+           f"{X.shape[0]} points projected in {time.perf_counter() - t0:.2f} s")
     if args.certify:
         from ccproof.evaluate.closest_certified import certify_closest
 
