@@ -18,7 +18,7 @@ from ccproof.mesh import QuadMesh
 from ccproof.mesh.examples import cube
 
 
-def noisy_cap_obj(path, nx=20, ny=14, seed=38):
+def noisy_cap_obj(path, nx=20, ny=14, seed=7):
     """An nx x ny grid of split quads (560 triangles) on a noisy sphere cap and two ear triangles on its boundary
     (562); returns the number of triangles."""
     rng = np.random.default_rng(seed)
