@@ -70,9 +70,9 @@ def test_fit_reads_a_csv_point_cloud(tmp_path, capsys):
 @pytest.mark.parametrize("name,text,words", [
     ("l.csv", "x,y,z\n1,2,3\n1,2\n", "l.csv:3: expected 3 comma-separated values"),
     ("h.csv", "face,u,v\n0,0.5,0.5\n", "header 'x,y,z'"),
-    ("n.csv", "x,y,z\n1,2,3\n\n4,nan,6\n", "n.csv:4: a non-finite coordinate"),
+    ("n.csv", "x,y,z\n1,2,3\n\n4,nan,6\n", "n.csv:4: point 1 has a non-finite coordinate"),
     ("s.xyz", "1 2 3\n# c\n4 5\n", "s.xyz:3: expected 3 numbers"),
-    ("i.xyz", "1 2 3\n1 inf 2\n", "i.xyz:2: a non-finite coordinate"),
+    ("i.xyz", "1 2 3\n1 inf 2\n", "i.xyz:2: point 1 has a non-finite coordinate"),
     ("w.obj", "v 0 0 0\nvt 1 1\nv 1 x 2\n", "w.obj:3: bad vertex line"),
     ("e.xyz", "# nothing\n", "e.xyz: empty file"),
     ("t.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"

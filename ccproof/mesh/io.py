@@ -729,7 +729,8 @@ def read_points(path: str | os.PathLike[str]) -> np.ndarray:
         raise CCProofError(f"{p}: empty file (no points)")
     bad = np.flatnonzero(~np.isfinite(X).all(axis=1))
     if bad.size:
-        raise CCProofError(f"{p}:{where(int(bad[0]))}: a non-finite coordinate {X[bad[0]].tolist()}")
+        i = int(bad[0])
+        raise CCProofError(f"{p}:{where(i)}: point {i} has a non-finite coordinate {X[i].tolist()}")
     return X
 
 
