@@ -91,3 +91,11 @@ def test_both_commands_name_the_bad_line(refdir, tmp_path, capsys, cmd):
     assert main([cmd, *mesh, str(tmp_path / "bad.csv"), "--out", str(tmp_path / "o.npz" if mesh else "o.obj")]) == 2
     err = capsys.readouterr().err
     assert "bad.csv:3:" in err and len(err.strip().splitlines()) == 1, err
+
+
+def test_xyz_lines_of_different_widths_and_separators(tmp_path):
+    text = "".join(" ".join(map(_r, r)) + (" 1" * i) + "\n" for i, r in enumerate(X))  # 3, 4, 5, 6 columns
+    (tmp_path / "w.xyz").write_text(text)
+    (tmp_path / "c.xyz").write_text(text.replace(" ", ", "))  # commas too
+    for name in ("w.xyz", "c.xyz"):
+        assert np.array_equal(read_points(tmp_path / name), X), name

@@ -754,6 +754,28 @@ def _point_lines(path, q, obj):
     from ccproof.mesh.inputs import decode_text
 
     text = decode_text(q.read_bytes(), path, expect="'v x y z' lines" if obj else "lines of numbers x y z")
+    if not obj:  # numpy's parser (twice as fast) when every line has the same columns; else the loop names the line
+        X = _uniform_columns(text)
+        if X is not None:
+            return X, lambda i: _text_points(path, text, obj)[1](i)
+    return _text_points(path, text, obj)
+
+
+def _uniform_columns(text):
+    """x, y, z of a text of whitespace columns (at least 3, the same on every line, ``#`` comments), or None."""
+    import warnings
+
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # an empty text: numpy warns; the caller's empty-file error follows
+            A = np.loadtxt(text.splitlines(), dtype=np.float64, comments="#", ndmin=2)
+    except ValueError:
+        return None
+    return A[:, :3].copy() if A.shape[1] >= 3 else None
+
+
+def _text_points(path, text, obj):
+    """The points of the text of an ``.xyz`` or ``.obj`` file and where(i), the line of point i, line by line."""
     rows, lines = [], []
     for ln, line in enumerate(text.splitlines(), 1):
         if obj:
