@@ -82,16 +82,16 @@ def run(args):
     plan.check()
     import numpy as np
 
-    from ccproof.cli._progress import progress_enabled
+    from ccproof.cli._progress import phase, progress_enabled
     from ccproof.errors import CCProofError
     from ccproof.evaluate.closest import CELLS, ClosestPointFinder
     from ccproof.evaluate.closest import _check_points as check_points
     from ccproof.evaluate.surface import limit_surface
-
-    progress = progress_enabled(args)
     from ccproof.mesh.io import read_points
 
-    X = read_points(args.points)  # file and line named for a bad or non-finite point
+    progress = progress_enabled(args)
+    with phase(f"read {Path(args.points).name}", progress):
+        X = read_points(args.points)  # file and line named for a bad or non-finite point
     try:  # huge coordinates: refused before the search structure is built
         check_points(X)
     except CCProofError as exc:
@@ -101,7 +101,6 @@ def run(args):
     if not (args.max_memory > 0 and args.max_memory < float("inf")):
         raise CCProofError(f"--max-memory must be a positive number of GB, got {args.max_memory}")
     from ccproof.cli._eval_args import evaluable_ptex_faces
-    from ccproof.cli._progress import phase
     from ccproof.mesh.io import read_mesh
 
     t_read = time.perf_counter()
