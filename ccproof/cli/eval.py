@@ -152,7 +152,7 @@ def _size(b):
 def run(args) -> int:
     from pathlib import Path
 
-    from ccproof.cli._output import PLOT_SUFFIXES, OutputPlan, atomic, is_folder_request
+    from ccproof.cli._output import PLOT_SUFFIXES, OutputPlan, is_folder_request
 
     # every output checked before any work (even the imports), distinct from the inputs (--points FOLDER may
     # not be the --out folder); absolute paths (a Dask worker may run elsewhere)
@@ -171,8 +171,6 @@ def run(args) -> int:
         raise CCProofError(f"--threads must be >= 1, got {args.threads}")
     if args.seed < 0:  # numpy's generators take non-negative seeds (the tasks failed one by one after the setup)
         raise CCProofError(f"--seed must be an integer >= 0, got {args.seed}")
-
-    import numpy as np
 
     from ccproof.mesh.io import read_mesh
     from ccproof.scale import evaluate_points, open_scheduler, point_chunks, scheduler_from_args, ship
@@ -255,22 +253,37 @@ def run(args) -> int:
             f"{mesh.extraordinary_vertices.size} extraordinary vertices")
     print(f"{args.mesh}: {what}; {_phases(t_read, setup, worker_setup)}")
     evaluation = max(sweep.seconds - worker_setup, 0.0)  # the workers build at the same time, first
-    rate = n / evaluation if evaluation > 0 and n else float("nan")
-    print(
-        f"evaluated {n} points ({args.parameterization} parameterization, derivatives {args.derivatives}) "
-        f"in {evaluation:.3f} s ({rate:,.0f} points/s, evaluation alone); "
-        + (f"scheduler start {t_start:.2f} s, " if t_start >= 0.005 else "") + f"gathering and writing {t_write:.2f} s"
-    )
+    print(f"evaluated {n} points ({args.parameterization} parameterization, derivatives {args.derivatives}) "
+          f"in {_evaluation_phases(n, evaluation, t_start, t_write)}")
     print(f"wrote {args.out}: {', '.join(['face', 'u', 'v', *out])}")
     if args.plot:
-        from ccproof.reparam.plot import plot_isoparameter_lines
-
-        vtx = args.plot_vertex
-        if vtx is None:
-            ev = mesh.extraordinary_vertices
-            vtx = int(ev[np.argmax(mesh.valence[ev])]) if ev.size else 0
-        with atomic(Path(args.plot).resolve()) as tmp:
-            plot_isoparameter_lines(surface, vtx, tmp, parameterization=args.parameterization)
-        print(f"wrote {args.plot}: isoparameter lines around vertex {vtx} (valence {int(mesh.valence[vtx])})")
+        _plot(args, mesh, surface)
     sys.stdout.flush()
     return 0
+
+
+def _evaluation_phases(n, evaluation, start, write):
+    """The evaluation's seconds and rate (of the evaluation alone), then the scheduler's start and the writing.
+
+    >>> _evaluation_phases(10**6, 0.5, 0.0, 0.25)
+    '0.500 s (2,000,000 points/s, evaluation alone); gathering and writing 0.25 s'
+    """
+    rate = n / evaluation if evaluation > 0 and n else float("nan")
+    return (f"{evaluation:.3f} s ({rate:,.0f} points/s, evaluation alone); "
+            + (f"scheduler start {start:.2f} s, " if start >= 0.005 else "") + f"gathering and writing {write:.2f} s")
+
+
+def _plot(args, mesh, surface):
+    """--plot: the isoparameter lines around --plot-vertex (default: the extraordinary vertex of highest valence)."""
+    import numpy as np
+
+    from ccproof.cli._output import atomic
+    from ccproof.reparam.plot import plot_isoparameter_lines
+
+    vtx = args.plot_vertex
+    if vtx is None:
+        ev = mesh.extraordinary_vertices
+        vtx = int(ev[np.argmax(mesh.valence[ev])]) if ev.size else 0
+    with atomic(Path(args.plot).resolve()) as tmp:
+        plot_isoparameter_lines(surface, vtx, tmp, parameterization=args.parameterization)
+    print(f"wrote {args.plot}: isoparameter lines around vertex {vtx} (valence {int(mesh.valence[vtx])})")

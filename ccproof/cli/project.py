@@ -136,22 +136,30 @@ def run(args):
     msg = (f"{args.mesh}: read in {t_read:.2f} s, setup {t_setup:.2f} s, search structure {t_build:.2f} s; "
            f"{X.shape[0]} points projected in {time.perf_counter() - t0:.2f} s")
     if args.certify:
-        from ccproof.evaluate.closest_certified import certify_closest
-
         t1 = time.perf_counter()
-        points = range(X.shape[0])
-        if progress:
-            from tqdm import tqdm
-
-            points = tqdm(points, desc="certify", unit="point")
-        cert = [certify_closest(S, X[i], out["face"][i], out["u"][i], out["v"][i]) for i in points]
-        out["verdict"] = np.array([c.verdict for c in cert])
-        out["distance_lo"] = np.array([c.distance_lo for c in cert])
-        out["distance_hi"] = np.array([c.distance_hi for c in cert])
-        out["parameter_radius"] = np.array([c.parameter_radius for c in cert])
-        counts = {k: int((out["verdict"] == k).sum()) for k in ("certified", "ambiguous", "uncertified")}
+        counts = _certify(S, X, out, progress)
         msg += f"; certified mode {time.perf_counter() - t1:.2f} s: {counts}"
     with atomic(out_path) as tmp:
         np.savez(tmp, **out)
     print(f"{msg}; wrote {args.out}")
     return 0
+
+
+def _certify(S, X, out, progress):
+    """Add the interval verdicts of --certify to ``out`` (verdict, distance_lo, distance_hi, parameter_radius);
+    returns the count of each verdict."""
+    import numpy as np
+
+    from ccproof.evaluate.closest_certified import certify_closest
+
+    points = range(X.shape[0])
+    if progress:
+        from tqdm import tqdm
+
+        points = tqdm(points, desc="certify", unit="point")
+    cert = [certify_closest(S, X[i], out["face"][i], out["u"][i], out["v"][i]) for i in points]
+    out["verdict"] = np.array([c.verdict for c in cert])
+    out["distance_lo"] = np.array([c.distance_lo for c in cert])
+    out["distance_hi"] = np.array([c.distance_hi for c in cert])
+    out["parameter_radius"] = np.array([c.parameter_radius for c in cert])
+    return {k: int((out["verdict"] == k).sum()) for k in ("certified", "ambiguous", "uncertified")}
