@@ -76,7 +76,11 @@ def test_fit_reads_a_csv_point_cloud(tmp_path, capsys):
     ("w.obj", "v 0 0 0\nvt 1 1\nv 1 x 2\n", "w.obj:3: bad vertex line"),
     ("e.xyz", "# nothing\n", "e.xyz: empty file"),
     ("t.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
-              "end_header\n1 2 3\n", "t.ply: truncated vertex list"),
+              "end_header\n1 2 3\n", "t.ply:9: truncated vertex list"),
+    ("b.ply", "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\n"
+              "end_header\n1 2 3\n4 q 6\n", "b.ply:9: not a number in vertex 1"),
+    ("f.ply", "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\n"
+              "end_header\n1 2 3\n4 nan 6\n", "f.ply:9: point 1 has a non-finite coordinate"),
 ])
 def test_bad_point_files_are_named_with_their_line(tmp_path, name, text, words):
     (tmp_path / name).write_text(text)

@@ -743,7 +743,7 @@ def _read_point_rows(path, q):
     if ext in (".xyz", ".txt", ".pts", ".obj"):
         return _point_lines(path, q, ext == ".obj")
     if ext == ".ply":
-        return _read_ply_vertices(path, q), lambda i: f" vertex {i}"
+        return _read_ply_vertices(path, q)
     if q.stat().st_size == 0:
         raise CCProofError(f"{path}: empty file (no points)")
     return np.asarray(read_mesh(q).vertices, dtype=np.float64).reshape(-1, 3), lambda i: f" vertex {i}"
@@ -878,25 +878,36 @@ def _ply_vertex_header(path, data):
 
 
 def _read_ply_vertices(path, q):
-    """The x, y, z of the vertex element of a PLY file (ASCII or binary)."""
-    fmt, nv, props, body = _ply_vertex_header(path, q.read_bytes())
+    """(x, y, z of the vertex element of a PLY file (ASCII or binary), where(i): the line or vertex of point i)."""
+    data = q.read_bytes()
+    fmt, nv, props, body = _ply_vertex_header(path, data)
     names = [n for n, _ in props]
     if fmt == "ascii":
-        lines = body.decode("ascii", "replace").split("\n")[:nv]
-        rows = [ln.split()[: len(props)] for ln in lines]
-        if len(rows) < nv or any(len(r) < len(props) for r in rows):
-            raise CCProofError(f"{path}: truncated vertex list (the header declares {nv} vertices of "
-                               f"{len(props)} properties)")
+        first = data[: len(data) - len(body)].count(b"\n") + 1  # the line of vertex 0
+        rows = [ln.split()[: len(props)] for ln in body.decode("ascii", "replace").split("\n")[:nv]]
+        short = next((i for i, r in enumerate(rows) if len(r) < len(props)), len(rows))
+        if short < nv:
+            raise CCProofError(f"{path}:{first + short}: truncated vertex list (the header declares {nv} vertices "
+                               f"of {len(props)} properties)")
         try:
             A = np.array(rows, dtype=np.float64)
         except ValueError:
-            raise CCProofError(f"{path}: not a number in the vertex list") from None
-        return A[:, [names.index(k) for k in "xyz"]]
+            bad = next(i for i, r in enumerate(rows) if not _all_numbers(r))
+            raise CCProofError(f"{path}:{first + bad}: not a number in vertex {bad}") from None
+        return A[:, [names.index(k) for k in "xyz"]], lambda i: first + i
     if fmt in ("binary_little_endian", "binary_big_endian"):
         bo = "<" if fmt == "binary_little_endian" else ">"
         dt = np.dtype([(n, bo + t) for n, t in props])
         if len(body) < nv * dt.itemsize:
             raise CCProofError(f"{path}: truncated vertex list (the header declares {nv} vertices)")
         rec = np.frombuffer(body[: nv * dt.itemsize], dtype=dt)
-        return np.stack([rec["x"], rec["y"], rec["z"]], axis=1).astype(np.float64)
+        return np.stack([rec["x"], rec["y"], rec["z"]], axis=1).astype(np.float64), lambda i: f" vertex {i}"
     raise CCProofError(f"{path}: unknown PLY format {fmt!r}")
+
+
+def _all_numbers(words):
+    try:
+        [float(w) for w in words]
+    except ValueError:
+        return False
+    return True
