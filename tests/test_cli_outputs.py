@@ -120,9 +120,9 @@ def test_eval_prints_the_retry_report(tmp_path, monkeypatch, capsys):
     real = arrays.evaluate_points
 
     def lost_once(*a, **kw):
-        n, names, sweep = real(*a, **kw)
+        n, names, sweep, setup = real(*a, **kw)
         sweep.retried[1] = "its worker was lost 1 time(s); re-run on another worker"
-        return n, names, sweep
+        return n, names, sweep, setup
 
     monkeypatch.setattr(arrays, "evaluate_points", lost_once)
     monkeypatch.chdir(tmp_path)

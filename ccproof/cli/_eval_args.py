@@ -63,37 +63,11 @@ def evaluable_ptex_faces(poly):
     return np.repeat(~poly.is_hole, counts).nonzero()[0].astype(np.int64)
 
 
-def read_csv_columns(path, header):
-    """Rows of a CSV file whose first line is exactly ``header`` (e.g. ``("face", "u", "v")``), as floats
-    (n, len(header)); blank lines are skipped; a bad header, row length or value raises
-    :class:`CCProofError` naming the file and line."""
-    import numpy as np
-
-    from ccproof.mesh.inputs import read_input_text
-
-    want = ",".join(header)
-    # a regular file or a pipe, at most --max-input bytes; a BOM and CRLF (spreadsheets) accepted
-    lines = read_input_text(path, expect=f"a CSV file with the header {want}").splitlines()
-    first = lines[0] if lines else ""
-    if [h.strip().lower() for h in first.strip().split(",")] != list(header):
-        raise CCProofError(f"{path}: the first line must be the header '{want}', got {first.strip()!r}")
-    rows = []
-    for no, line in enumerate(lines[1:], start=2):
-        if not line.strip():
-            continue
-        parts = line.split(",")
-        if len(parts) != len(header):
-            raise CCProofError(f"{path}:{no}: expected {len(header)} comma-separated values, got {line.strip()!r}")
-        try:
-            rows.append([float(x) for x in parts])
-        except ValueError:
-            raise CCProofError(f"{path}:{no}: bad value in {line.strip()!r}") from None
-    return np.array(rows, dtype=np.float64).reshape(-1, len(header))
-
-
 def read_face_uv_csv(path):
     """Read a ``face,u,v`` CSV file; returns (face int64 (n,), u (n,), v (n,))."""
     import numpy as np
+
+    from ccproof.mesh.io import read_csv_columns
 
     rows = read_csv_columns(path, ("face", "u", "v"))
     face = rows[:, 0]

@@ -4,7 +4,9 @@ Optimizes the texture control points of every chart so that the subdivided textu
 surface as rigidly as possible (hsh10 Eq. 3), with a multi-resolution schedule over the levels
 start..K, either with extended charts (hsh10 (c), default) or with boundary rules (b). Charts are
 per-face integer labels (--charts FILE, one per face in OBJ order; negative = no chart) or a simple
-segmentation (--segment normals); without either the whole mesh must be a topological disk.
+segmentation (--segment normals: six charts by the dominant axis of the face normal, or with --normal-angle DEG
+charts whose normals lie within DEG degrees of their first face's; then split into disks); without either the
+whole mesh must be a topological disk, and a single chart that folds says so with the fix (segment into charts).
 
 Prints E_angle, E_area, E_stretch (hsh10 section 4, at --eval-level, default 5), flipped texture
 triangles of the control mesh and flipped samples at the evaluation level, seconds and iterations.
@@ -38,8 +40,10 @@ the file's vertices in its numbering) with its creases, corners and holes as Ope
 OBJ tag lines ('t crease 2/1/0 a b s', 't corner 1/1/0 v s', 't hole k/0/0 f ...'; 0-based, infinitely sharp
 as 10): reading it back (ccproof eval, OpenSubdiv) gives the same tags and the same limit surface.
 
-Scale: charts are processed one at a time; the peak memory is estimated first and a run above
---max-memory (default 2 GB) stops with an error naming the options that lower it. --refine R (default:
+Scale: charts are processed one at a time; the peak memory is estimated first. The levels not given
+(--out-level, --eval-level, then --levels) are lowered one at a time until the estimate fits --max-memory
+(default 2 GB), and stderr says which were chosen; a run that still does not fit stops with an error naming
+the options that lower it. --refine R (default:
 the smallest R in 0..2 giving >= 1000 control faces per chart) subdivides the control mesh before
 optimizing (b)/(c), which lets (c) reach (d)'s E_area on small charts; --accel (default 5) is the
 Anderson acceleration of the local/global iteration. --preview FILE.png renders checkerboard and
@@ -68,6 +72,10 @@ def add_arguments(parser):
                                      "too); triangles and n-gons are subdivided once (Catmull-Clark) to quads first")
     parser.add_argument("--charts", metavar="LABELS", help="chart label file: one integer per face of the file")
     parser.add_argument("--segment", choices=["normals"], help="segment into charts (when no --charts)")
+    parser.add_argument("--normal-angle", type=float, default=None, metavar="DEG",
+                        help="with --segment normals: a chart holds faces whose normals are within DEG degrees of "
+                             "its first face's (larger: fewer charts; default: six charts by the dominant axis of "
+                             "the normal, then split into disks)")
     parser.add_argument("--variant", choices=["extended", "boundary"], default="extended",
                         help="chart boundary treatment: extended charts (c) or boundary rules (b)")
     parser.add_argument("--levels", type=int, default=None, metavar="K",
@@ -76,12 +84,13 @@ def add_arguments(parser):
     parser.add_argument("--start-level", type=int, default=1, help="coarsest optimization level (default 1)")
     parser.add_argument("--eval-level", type=int, default=None,
                         help="level of the metric samples (default: 5, lowered for large meshes so that all "
-                             "charts have at most 4M samples, at least 3 with --baselines)")
+                             "charts have at most 4M samples and to fit --max-memory, at least 3 with --baselines)")
     parser.add_argument("--refine", default="auto",
                         help="subdivide the control mesh R times before optimizing (b)/(c): 0, 1, 2 or auto "
                              "(default: the smallest R in 0..2 giving >= 1000 control faces per chart)")
     parser.add_argument("--max-memory", type=float, default=2.0, metavar="GB",
-                        help="refuse runs whose estimated peak memory exceeds this (default 2 GB)")
+                        help="the levels not given are lowered to fit this estimated peak memory; a run that still "
+                             "exceeds it is refused (default 2 GB)")
     from ccproof.cli._progress import add_progress_argument
 
     add_progress_argument(parser)
@@ -153,16 +162,66 @@ def default_eval_level(mesh, labels, levels, with_d):
     return max(k, levels, 3 if with_d else 0)
 
 
+def _default_out_level(mesh, labels):
+    """3, lowered while --out would hold more than MAX_DEFAULT_OUT_TRIANGLES triangles."""
+    n = mesh.n_faces if labels is None else int((labels >= 0).sum())
+    out_level = 3
+    while out_level > 0 and 2 * n * 4**out_level > MAX_DEFAULT_OUT_TRIANGLES:
+        out_level -= 1
+    return out_level
+
+
+def _sample_level(args, out_level):
+    """The level the outputs sample (--out, --control-out, --preview), None when none is written."""
+    return out_level if (args.out or args.control_out or args.preview) else None
+
+
+def _levels_within_budget(args, mesh, labels, hierarchies, methods, refine):
+    """(levels, eval level, out level): the options given, the others at their defaults, lowered one level at a
+    time (the metrics' or the output's sampling level first, then the optimization's) while the estimated peak
+    memory exceeds --max-memory; says on stderr what was lowered. When nothing given can be lowered enough, the
+    run refuses later by name (:class:`~ccproof.apps.arap.core.MemoryBudgetError`)."""
+    from ccproof.apps.arap.core import run_memory
+
+    budget = args.max_memory * 1e9
+    levels = 3 if args.levels is None else args.levels
+    ev = args.eval_level if args.eval_level is not None else default_eval_level(mesh, labels, levels, "d" in methods)
+    out = args.out_level if args.out_level is not None else _default_out_level(mesh, labels)
+    first = (levels, ev, out)
+
+    def need(levels, ev, out):
+        return run_memory(hierarchies, methods, levels, ev, _sample_level(args, out), refine, release=True)[0]
+
+    floor = max(refine, 3 if "d" in methods else 0)
+    while need(levels, ev, out) > budget:
+        samples = _sample_level(args, out)
+        if args.out_level is None and samples is not None and out > 0 and out >= ev:
+            out -= 1
+        elif args.eval_level is None and ev > max(floor, levels):
+            ev -= 1
+        elif args.levels is None and levels > max(args.start_level, 1):
+            levels -= 1
+        else:
+            break
+    if (levels, ev, out) != first:
+        names = ("levels", "metrics level", "output level")
+        what = ", ".join(f"{n} {a} -> {b}" for n, a, b in zip(names, first, (levels, ev, out)) if a != b)
+        print(f"ccproof arap: chosen to fit --max-memory {args.max_memory:g} GB: {what} (estimated peak "
+              f"{need(levels, ev, out) / 1e9:.2f} GB)", file=sys.stderr)
+    return levels, ev, out
+
+
 def run(args) -> int:
     plan = _output_plan(args)  # every file written, and the options among themselves: before any work
     from ccproof.apps.arap.charts import read_labels, segment_by_normals
     from ccproof.apps.arap.core import VARIANTS, MemoryBudgetError, auto_refine, compare
     from ccproof.apps.control_mesh import children_labels, read_control_mesh
-    from ccproof.cli._progress import progress_enabled
+    from ccproof.cli._progress import phase, progress_enabled
     from ccproof.errors import CCProofError
 
     refine = _check_options(args)
-    mesh, origin = read_control_mesh(args.mesh)
+    with phase(f"read {args.mesh}", progress_enabled(args)):
+        mesh, origin = read_control_mesh(args.mesh)
     n_file = mesh.n_faces if origin is None else int(origin.max()) + 1
     if origin is not None:
         steps = getattr(mesh, "global_steps", 1)
@@ -173,7 +232,7 @@ def run(args) -> int:
     if args.charts:
         labels = children_labels(read_labels(args.charts, n_file), origin)
     elif args.segment == "normals":
-        labels = segment_by_normals(mesh)
+        labels = segment_by_normals(mesh, max_angle=args.normal_angle)
     else:
         labels = None
     ours = VARIANTS[args.variant]
@@ -193,29 +252,16 @@ def run(args) -> int:
     elif engine == "auto":
         engine = "numpy"
     refine = auto_refine(mesh, labels) if refine is None else refine
-    from ccproof.apps.arap.core import _charts, estimate_memory
+    from ccproof.apps.arap.core import _charts
     from ccproof.apps.arap.hierarchy import ChartHierarchy
 
     hierarchies = [ChartHierarchy(mesh, fc) for fc in _charts(mesh, labels)]
-    levels = args.levels
-    if levels is None:
-        levels = 3
-        while levels > 1 and estimate_memory(hierarchies, 0, True, levels) > args.max_memory * 1e9:
-            levels -= 1
+    levels, eval_level, out_level = _levels_within_budget(args, mesh, labels, hierarchies, methods, refine)
     args.levels = levels
-    eval_level = args.eval_level
-    if eval_level is None:
-        eval_level = default_eval_level(mesh, labels, args.levels, "d" in methods)
-        if eval_level < refine:
-            raise CCProofError(f"--refine {refine} is above the metrics' level {eval_level} (the default "
-                               "--eval-level); give --eval-level >= --refine")
-    out_level = args.out_level
-    if out_level is None:
-        n = mesh.n_faces if labels is None else int((labels >= 0).sum())
-        out_level = 3
-        while out_level > 0 and 2 * n * 4**out_level > MAX_DEFAULT_OUT_TRIANGLES:
-            out_level -= 1
-    sample_level = out_level if (args.out or args.control_out or args.preview) else None
+    if eval_level < refine:
+        raise CCProofError(f"--refine {refine} is above the metrics' level {eval_level} (the default "
+                           "--eval-level); give --eval-level >= --refine")
+    sample_level = _sample_level(args, out_level)
     try:
         results, _ = compare(mesh, labels, methods, levels=args.levels, start_level=args.start_level,
                              eval_level=eval_level, tol=args.tol, max_iter=args.max_iter, engine=engine,
@@ -235,7 +281,8 @@ def run(args) -> int:
     flips = results[ours].metrics.flips
     if flips:
         print(f"ccproof arap: warning: {results[ours].name}: {flips} flipped samples at level {eval_level} (the "
-              f"texture folds there; E_stretch {results[ours].metrics.E_stretch:.3g}); {_finer(args)}", file=sys.stderr)
+              f"texture folds there; E_stretch {results[ours].metrics.E_stretch:.3g}); {_finer(args, nch)}",
+              file=sys.stderr)
     lv = results[ours].levels
     for k in range(len(lv[0]) if lv and lv[0] else 0):
         its = sum(c[k].iterations for c in lv)
@@ -262,12 +309,14 @@ def run(args) -> int:
     return 0
 
 
-def _finer(args):
-    """What to try against folds: a finer control mesh for the optimization."""
+def _finer(args, n_charts):
+    """What to try against folds: charts when there is a single one, and a finer control mesh for the optimization."""
+    one = ("a single chart, which folds: segment the mesh into charts (--segment normals [--normal-angle DEG], or "
+           "--charts LABELS); or " if n_charts == 1 else "")
     if args.refine == "auto":
-        return "give --refine 1 or 2 (a finer control mesh for the optimization)"
-    return (f"--refine {args.refine} was given: raise it, or leave it to the default (auto: >= 1000 control faces "
-            f"per chart)")
+        return one + "give --refine 1 or 2 (a finer control mesh for the optimization)"
+    return (one + f"--refine {args.refine} was given: raise it, or leave it to the default (auto: >= 1000 control "
+            f"faces per chart)")
 
 
 def _check_options(args):
@@ -292,6 +341,10 @@ def _check_options(args):
         raise CCProofError(f"--max-memory must be a positive number of GB, got {args.max_memory}")
     if not (args.tol >= 0 and args.tol < float("inf")):
         raise CCProofError(f"--tol must be a finite number >= 0, got {args.tol}")
+    if args.normal_angle is not None and (args.segment != "normals" or args.charts):
+        raise CCProofError("--normal-angle is a setting of --segment normals (without --charts)")
+    if args.normal_angle is not None and not 0 < args.normal_angle <= 180:
+        raise CCProofError(f"--normal-angle must be in (0, 180] degrees, got {args.normal_angle}")
     if args.levels is not None and args.levels < args.start_level:
         raise CCProofError(f"--levels {args.levels} is below --start-level {args.start_level}")
     if args.eval_level is not None and refine is not None and args.eval_level < refine:
@@ -354,8 +407,9 @@ def _write_outputs(args, plan, results, ours, labels, out_level, eval_level, com
               f"{surf.cell_type}s, {surf.folds()} folded; written triangles E_angle {wm.E_angle:.6f} "
               f"E_area {wm.E_area:.6f} E_stretch {wm.E_stretch:.6f}) and {args.out}.json")
         if surf.folds():
+            hint = _finer(args, len(results[ours].textures))
             print(f"ccproof arap: warning: --out {args.out}: {surf.folds()} of {surf.cells.shape[0]} {surf.cell_type}s "
-                  f"are folded in UV (E_stretch {wm.E_stretch:.3g}); {_finer(args)}", file=sys.stderr)
+                  f"are folded in UV (E_stretch {wm.E_stretch:.3g}); {hint}", file=sys.stderr)
     if args.control_out:
         _write_control(args, plan, results[ours], surf, eval_level, comment, table, write_uv_obj)
 

@@ -65,6 +65,16 @@ def add_arguments(parser):
                         "--points FOLDER reads one (docs/scale-out.md)")
 
 
+def _phases(read, setup, worker_setup):
+    """The phases before the evaluation, as printed: read and setup seconds (in this process, in the workers).
+
+    >>> _phases(1.5, 2.0, 0.0), _phases(1.5, 0.0, 3.25)
+    ('read in 1.50 s, setup 2.00 s', 'read in 1.50 s, setup 3.25 s (in each worker, the longest)')
+    """
+    text = f"read in {read:.2f} s, setup {setup + worker_setup:.2f} s"
+    return text + (" (in each worker, the longest)" if worker_setup > setup else "")
+
+
 def build_surface(mesh, tagged, alpha=None, progress=False):
     """The surface ``ccproof eval`` evaluates (module level, so a Dask worker can rebuild it by name):
     the tagged evaluator's natural parameterization for a tagged or non-quad :class:`PolyMesh`, else the
@@ -142,7 +152,7 @@ def _size(b):
 def run(args) -> int:
     from pathlib import Path
 
-    from ccproof.cli._output import PLOT_SUFFIXES, OutputPlan, atomic, is_folder_request
+    from ccproof.cli._output import PLOT_SUFFIXES, OutputPlan, is_folder_request
 
     # every output checked before any work (even the imports), distinct from the inputs (--points FOLDER may
     # not be the --out folder); absolute paths (a Dask worker may run elsewhere)
@@ -162,15 +172,18 @@ def run(args) -> int:
     if args.seed < 0:  # numpy's generators take non-negative seeds (the tasks failed one by one after the setup)
         raise CCProofError(f"--seed must be an integer >= 0, got {args.seed}")
 
-    import numpy as np
-
     from ccproof.mesh.io import read_mesh
     from ccproof.scale import evaluate_points, open_scheduler, point_chunks, scheduler_from_args, ship
 
     points = None if args.points is None else Path(args.points).resolve()
     sched = scheduler_from_args(args)  # --scheduler checked before any work
+    from ccproof.cli._progress import phase
+
+    progress = progress_enabled(args)
     t0 = time.perf_counter()
-    poly = read_mesh(args.mesh)  # OBJ with OpenSubdiv tags, OFF, or any meshio format
+    with phase(f"read {Path(args.mesh).name}", progress):
+        poly = read_mesh(args.mesh)  # OBJ with OpenSubdiv tags, OFF, or any meshio format
+    t_read = time.perf_counter() - t0
     tagged = not poly.is_plain_quads
     if tagged:
         # triangles, n-gons, creases, corners, holes, boundary modes: the natural parameterization
@@ -212,48 +225,65 @@ def run(args) -> int:
 
     compile_notice("eval")  # after the input checks: an error stays one line
     # on a cluster each worker builds the surface itself (once); here only for in-process work or --plot
-    progress = progress_enabled(args)
-    surface = build_surface(mesh, tagged, args.alpha, progress) if sched.kind == "serial" or args.plot else None
     t1 = time.perf_counter()
-    t2 = time.perf_counter()
+    surface = build_surface(mesh, tagged, args.alpha, progress) if sched.kind == "serial" or args.plot else None
+    setup = time.perf_counter() - t1  # the setup in this process (the workers' is measured by them)
+    t_start = time.perf_counter()
     with open_scheduler(sched, len(sources)) as sched:
+        t_start = time.perf_counter() - t_start  # a local cluster's start
         in_process = getattr(sched, "kind", None) == "serial"  # a Client, or local worker processes without Dask
         if surface is None and in_process:  # a single chunk runs here after all
+            t1 = time.perf_counter()
             surface = build_surface(mesh, tagged, args.alpha, progress)
+            setup += time.perf_counter() - t1
         if args.threads is not None:
             kwargs["threads"] = args.threads
         elif not in_process:
             kwargs["threads"] = 1  # one worker per core already: no second level of threads
         # the file (or each shard and the index) is written under a temporary name, then renamed
-        n, names, sweep = evaluate_points(ship(build_surface, mesh, tagged, args.alpha), sources, args.derivatives,
-                                          kwargs, str(out_path), sched, local=surface,
-                                          progress=progress)
-    t3 = time.perf_counter()
+        t_tasks = time.perf_counter()
+        n, names, sweep, worker_setup = evaluate_points(ship(build_surface, mesh, tagged, args.alpha), sources,
+                                                        args.derivatives, kwargs, str(out_path), sched,
+                                                        local=surface, progress=progress)
+        t_write = time.perf_counter() - t_tasks - sweep.seconds  # gathering and writing the output
     for line in sweep.report([f"chunk {i}" for i in range(len(sources))]):  # retried or lost tasks
         print(line)
     out = dict.fromkeys(names)
-    if tagged:
-        print(f"{args.mesh}: {mesh}; prepared in {t1 - t0:.2f} s")
-    else:
-        print(
-            f"{args.mesh}: {mesh.n_vertices} vertices, {mesh.n_faces} faces, "
-            f"{mesh.extraordinary_vertices.size} extraordinary vertices; prepared in {t1 - t0:.2f} s"
-        )
-    rate = n / (t3 - t2) if t3 > t2 and n else float("nan")
-    print(
-        f"evaluated {n} points ({args.parameterization} parameterization, derivatives {args.derivatives}) "
-        f"in {t3 - t2:.3f} s ({rate:,.0f} points/s)"
-    )
+    what = (str(mesh) if tagged else f"{mesh.n_vertices} vertices, {mesh.n_faces} faces, "
+            f"{mesh.extraordinary_vertices.size} extraordinary vertices")
+    print(f"{args.mesh}: {what}; {_phases(t_read, setup, worker_setup)}")
+    evaluation = max(sweep.seconds - worker_setup, 0.0)  # the workers build at the same time, first
+    print(f"evaluated {n} points ({args.parameterization} parameterization, derivatives {args.derivatives}) "
+          f"in {_evaluation_phases(n, evaluation, t_start, t_write)}")
     print(f"wrote {args.out}: {', '.join(['face', 'u', 'v', *out])}")
     if args.plot:
-        from ccproof.reparam.plot import plot_isoparameter_lines
-
-        vtx = args.plot_vertex
-        if vtx is None:
-            ev = mesh.extraordinary_vertices
-            vtx = int(ev[np.argmax(mesh.valence[ev])]) if ev.size else 0
-        with atomic(Path(args.plot).resolve()) as tmp:
-            plot_isoparameter_lines(surface, vtx, tmp, parameterization=args.parameterization)
-        print(f"wrote {args.plot}: isoparameter lines around vertex {vtx} (valence {int(mesh.valence[vtx])})")
+        _plot(args, mesh, surface)
     sys.stdout.flush()
     return 0
+
+
+def _evaluation_phases(n, evaluation, start, write):
+    """The evaluation's seconds and rate (of the evaluation alone), then the scheduler's start and the writing.
+
+    >>> _evaluation_phases(10**6, 0.5, 0.0, 0.25)
+    '0.500 s (2,000,000 points/s, evaluation alone); gathering and writing 0.25 s'
+    """
+    rate = n / evaluation if evaluation > 0 and n else float("nan")
+    return (f"{evaluation:.3f} s ({rate:,.0f} points/s, evaluation alone); "
+            + (f"scheduler start {start:.2f} s, " if start >= 0.005 else "") + f"gathering and writing {write:.2f} s")
+
+
+def _plot(args, mesh, surface):
+    """--plot: the isoparameter lines around --plot-vertex (default: the extraordinary vertex of highest valence)."""
+    import numpy as np
+
+    from ccproof.cli._output import atomic
+    from ccproof.reparam.plot import plot_isoparameter_lines
+
+    vtx = args.plot_vertex
+    if vtx is None:
+        ev = mesh.extraordinary_vertices
+        vtx = int(ev[np.argmax(mesh.valence[ev])]) if ev.size else 0
+    with atomic(Path(args.plot).resolve()) as tmp:
+        plot_isoparameter_lines(surface, vtx, tmp, parameterization=args.parameterization)
+    print(f"wrote {args.plot}: isoparameter lines around vertex {vtx} (valence {int(mesh.valence[vtx])})")

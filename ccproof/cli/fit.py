@@ -4,8 +4,9 @@
   ccproof fit scan.ply --levels 2 --out fitted.obj        two global subdivisions after the first fit
   ccproof fit bunny.obj --init start.ply --out fit.obj    start from your own closed control mesh
 
-POINTS: .xyz (x y z per line), .ply (vertex x, y, z; ASCII or binary), .obj or the vertices of any mesh file
-eval reads. --init: any mesh eval reads; triangles and n-gons are subdivided once (Catmull-Clark) to quads
+POINTS: .xyz (x y z per line), .ply (vertex x, y, z; ASCII or binary), .obj, .csv (header x,y,z; the formats
+of `ccproof project`) or the vertices of any mesh file eval reads.
+--init: any mesh eval reads; triangles and n-gons are subdivided once (Catmull-Clark) to quads
 first (the same limit surface); unused vertices are dropped; OpenSubdiv tags (infinitely sharp and semi-sharp
 creases and corners, holes, boundary modes) and non-manifold edges and vertices (infinitely sharp) are kept:
 faces near them are tagged elements whose surface is the one `ccproof eval` evaluates (hole faces carry no
@@ -40,7 +41,7 @@ import sys
 
 
 def add_arguments(p):
-    p.add_argument("points", help="point cloud: .xyz, .ply or .obj")
+    p.add_argument("points", help="point cloud: .xyz, .ply, .obj or .csv (header x,y,z)")
     p.add_argument("--out", required=True, help="write the fitted control mesh (OBJ) here")
     p.add_argument("--init", default="cube",
                    help="'cube' (the paper's 98-vertex model, default) or a mesh (any format eval reads, with "
@@ -88,11 +89,12 @@ def run(args) -> int:
     import numpy as np
 
     from ccproof.apps.control_mesh import merge_labels, read_control_mesh, write_control_obj
-    from ccproof.apps.dynamics.fit import fit_points, read_points
+    from ccproof.apps.dynamics.fit import fit_points
     from ccproof.apps.dynamics.model import Material
     from ccproof.cli._notice import compile_notice
     from ccproof.cli._progress import progress_enabled
     from ccproof.errors import CCProofError
+    from ccproof.mesh.io import read_points
 
     X = read_points(args.points)
     init = args.init

@@ -1,6 +1,7 @@
 """Project 3-D points onto the Catmull-Clark limit surface of a mesh (globally nearest limit points).
 
-For every point of POINTS.csv (header ``x,y,z``) the nearest point of the limit surface: its
+For every point of POINTS (``.xyz``, ``.ply``, ``.obj`` vertices, or ``.csv`` with the header ``x,y,z``; the
+same formats as ``ccproof fit``) the nearest point of the limit surface: its
 parameter (face, u, v) (ptex face; corner i of the face at (0,0), (1,0), (1,1), (0,1)), the point
 P, the distance |X - P| and the unit normal there. The search is global (bounding cylinders over
 sampled cells, a bounding-volume hierarchy, best-first projected Newton descents), see
@@ -25,7 +26,8 @@ from __future__ import annotations
 def add_arguments(parser):
     parser.add_argument("mesh", help="mesh file: OBJ (with OpenSubdiv tags), OFF, PLY, STL, VTK, ... (any mesh "
                         "'ccproof eval' reads)")
-    parser.add_argument("points", help="CSV file with the header x,y,z")
+    parser.add_argument("points", help="point cloud: .xyz (x y z per line), .ply (vertex x, y, z), .obj (v lines), "
+                        ".csv (header x,y,z), or the vertices of any mesh file")
     parser.add_argument("--out", metavar="FILE.npz", required=True, help="output file (numpy .npz)")
     parser.add_argument("--certify", action="store_true",
                         help="add interval-arithmetic verdicts (slow: per point; untagged all-quad meshes only)")
@@ -67,15 +69,9 @@ def check_search_memory(n_faces, cells, max_memory_gb):
 BATCH = 1000
 
 
-def read_xyz_csv(path):
-    """Read an ``x,y,z`` CSV file; returns an (n, 3) float array."""
-    from ccproof.cli._eval_args import read_csv_columns
-
-    return read_csv_columns(path, ("x", "y", "z"))
-
-
 def run(args):
     import time
+    from pathlib import Path
 
     from ccproof.cli._output import OutputPlan, atomic
 
@@ -86,18 +82,20 @@ def run(args):
     plan.check()
     import numpy as np
 
-    from ccproof.cli._progress import progress_enabled
+    from ccproof.cli._progress import phase, progress_enabled
     from ccproof.errors import CCProofError
     from ccproof.evaluate.closest import CELLS, ClosestPointFinder
     from ccproof.evaluate.closest import _check_points as check_points
     from ccproof.evaluate.surface import limit_surface
+    from ccproof.mesh.io import read_points
 
     progress = progress_enabled(args)
-    X = read_xyz_csv(args.points)
-    try:  # non-finite or huge coordinates: refused before the search structure is built
+    with phase(f"read {Path(args.points).name}", progress):
+        X = read_points(args.points)  # file and line named for a bad or non-finite point
+    try:  # huge coordinates: refused before the search structure is built
         check_points(X)
     except CCProofError as exc:
-        raise CCProofError(f"{args.points}: {exc} (point i is on line i + 2)") from None
+        raise CCProofError(f"{args.points}: {exc} (points counted from 0 in file order)") from None
     if args.cells is not None and args.cells < 1:
         raise CCProofError(f"--cells must be >= 1, got {args.cells}")
     if not (args.max_memory > 0 and args.max_memory < float("inf")):
@@ -105,7 +103,10 @@ def run(args):
     from ccproof.cli._eval_args import evaluable_ptex_faces
     from ccproof.mesh.io import read_mesh
 
-    poly = read_mesh(args.mesh)
+    t_read = time.perf_counter()
+    with phase(f"read {Path(args.mesh).name}", progress):
+        poly = read_mesh(args.mesh)
+    t_read = time.perf_counter() - t_read
     if args.certify and not poly.is_plain_quads:  # before the search: certify_closest needs a QuadMesh
         raise CCProofError(f"{args.mesh}: --certify needs an untagged manifold all-quad mesh (this one has "
                            "non-quad faces, OpenSubdiv tags or non-manifold edges or vertices); drop --certify")
@@ -114,12 +115,17 @@ def run(args):
         raise CCProofError(f"{args.mesh}: every face is a hole: there is no limit surface to project onto")
     n_search = poly.n_ptex if evaluable is None else evaluable.size
     check_search_memory(n_search, CELLS if args.cells is None else args.cells, args.max_memory)  # before the setup
+    t_setup = time.perf_counter()
     S = limit_surface(poly.to_quad_mesh() if poly.is_plain_quads else poly, progress=progress)  # a bar if long
+    t_setup = time.perf_counter() - t_setup
     from ccproof.cli._notice import compile_notice
 
     compile_notice("project")  # after the input checks: an error stays one line
+    t_build = time.perf_counter()
+    with phase("search structure", progress):
+        finder = ClosestPointFinder(S, cells=CELLS if args.cells is None else args.cells, faces=evaluable)
     t0 = time.perf_counter()
-    finder = ClosestPointFinder(S, cells=CELLS if args.cells is None else args.cells, faces=evaluable)
+    t_build = t0 - t_build
     starts = range(0, X.shape[0], BATCH)
     if progress and len(starts) > 1:
         from tqdm import tqdm
@@ -127,24 +133,33 @@ def run(args):
         starts = tqdm(starts, desc="project", unit="batch")
     parts = [finder.query(X[a:a + BATCH]) for a in starts] or [finder.query(X)]  # (no points: empty arrays)
     out = {k: np.concatenate([getattr(r, k) for r in parts]) for k in ("face", "u", "v", "P", "distance", "normal")}
-    msg = f"{X.shape[0]} points projected in {time.perf_counter() - t0:.2f} s"
+    msg = (f"{args.mesh}: read in {t_read:.2f} s, setup {t_setup:.2f} s, search structure {t_build:.2f} s; "
+           f"{X.shape[0]} points projected in {time.perf_counter() - t0:.2f} s")
     if args.certify:
-        from ccproof.evaluate.closest_certified import certify_closest
-
         t1 = time.perf_counter()
-        points = range(X.shape[0])
-        if progress:
-            from tqdm import tqdm
-
-            points = tqdm(points, desc="certify", unit="point")
-        cert = [certify_closest(S, X[i], out["face"][i], out["u"][i], out["v"][i]) for i in points]
-        out["verdict"] = np.array([c.verdict for c in cert])
-        out["distance_lo"] = np.array([c.distance_lo for c in cert])
-        out["distance_hi"] = np.array([c.distance_hi for c in cert])
-        out["parameter_radius"] = np.array([c.parameter_radius for c in cert])
-        counts = {k: int((out["verdict"] == k).sum()) for k in ("certified", "ambiguous", "uncertified")}
+        counts = _certify(S, X, out, progress)
         msg += f"; certified mode {time.perf_counter() - t1:.2f} s: {counts}"
     with atomic(out_path) as tmp:
         np.savez(tmp, **out)
     print(f"{msg}; wrote {args.out}")
     return 0
+
+
+def _certify(S, X, out, progress):
+    """Add the interval verdicts of --certify to ``out`` (verdict, distance_lo, distance_hi, parameter_radius);
+    returns the count of each verdict."""
+    import numpy as np
+
+    from ccproof.evaluate.closest_certified import certify_closest
+
+    points = range(X.shape[0])
+    if progress:
+        from tqdm import tqdm
+
+        points = tqdm(points, desc="certify", unit="point")
+    cert = [certify_closest(S, X[i], out["face"][i], out["u"][i], out["v"][i]) for i in points]
+    out["verdict"] = np.array([c.verdict for c in cert])
+    out["distance_lo"] = np.array([c.distance_lo for c in cert])
+    out["distance_hi"] = np.array([c.distance_hi for c in cert])
+    out["parameter_radius"] = np.array([c.parameter_radius for c in cert])
+    return {k: int((out["verdict"] == k).sum()) for k in ("certified", "ambiguous", "uncertified")}

@@ -173,19 +173,25 @@ def _evaluate_chunk(task, shipped):
 
     ``task`` is ``{"source": ("samples", seed, n_faces, count, index) | ("arrays", face, u, v) |
     ("shard", path), "derivatives": d, "kwargs": {...}, "out": path or None}``; returns the number of
-    points written and :func:`degenerate_normals` of the shard, or the dict face, u, v, P, ... when ``out``
-    is None.
+    points written, :func:`degenerate_normals` of the shard and the seconds (setup, evaluation) of the task, or
+    the dict face, u, v, P, ... and seconds when ``out`` is None.
     """
+    import time
+
     import numpy as np
 
     f, u, v = _chunk_points(task["source"])
+    t0 = time.perf_counter()
+    rebuild(shipped)  # the setup: built once per process (this task may be the one that builds it)
+    t1 = time.perf_counter()
     res = _evaluate_block(f, u, v, shipped, task["derivatives"], tuple(sorted(task["kwargs"].items())))
+    seconds = (t1 - t0, time.perf_counter() - t1)  # (setup, evaluation) in this task
     arrays = {"face": f, "u": u, "v": v}
     arrays.update({n: res[:, j, :] for j, n in enumerate(output_names(task["derivatives"]))})
     if task["out"] is None:
-        return arrays
+        return {**arrays, "seconds": seconds}
     _replace_when_written(task["out"], lambda tmp: np.savez(tmp, **arrays))
-    return int(f.size), degenerate_normals(arrays)
+    return int(f.size), degenerate_normals(arrays), seconds
 
 
 class DegenerateNormalWarning(UserWarning):
@@ -452,6 +458,10 @@ def evaluate_points(shipped, sources, derivatives, kwargs, out, scheduler=None, 
     names : tuple of str
         Result names (:func:`output_names`).
     sweep : Sweep
+        Its ``seconds``: the wall-clock time of the tasks (not the gathering and writing of ``out``).
+    setup_seconds : float
+        The longest time a task spent building the surface (each worker process builds it once, the workers at
+        the same time; 0 when ``local`` served every task). ``sweep.seconds - setup_seconds`` is the evaluation's.
 
     Examples
     --------
@@ -464,6 +474,8 @@ def evaluate_points(shipped, sources, derivatives, kwargs, out, scheduler=None, 
     >>> src = point_chunks(1, arrays=(np.array([0, 0]), np.array([0.5, 0.5]), np.array([0.5, 0.5])))
     >>> evaluate_points(ship(limit_surface, cube()), src, 0, {}, out, "serial", progress=False)[:2]
     (2, ('P',))
+    >>> evaluate_points(ship(limit_surface, cube()), src, 0, {}, out, "serial", progress=False)[3] < 1  # built
+    True
     >>> P = np.load(out)["P"]
     >>> bool(np.all(np.abs(np.abs(P[:, 2]) - 68 / 81) < 1e-12))
     True
@@ -487,9 +499,11 @@ def evaluate_points(shipped, sources, derivatives, kwargs, out, scheduler=None, 
         _replace_when_written(out, lambda tmp: np.savez(tmp, **arrays))
         n = int(arrays["face"].size)
         counts = [degenerate_normals(arrays)]
+        seconds = [r["seconds"] for r in sweep.results]
     else:
         _write_index(folder, [r[0] for r in sweep.results], ("face", "u", "v", *names))
         n = int(sum(r[0] for r in sweep.results))
         counts = [r[1] for r in sweep.results]
+        seconds = [r[2] for r in sweep.results]
     _warn_degenerate(n, counts)
-    return n, names, sweep
+    return n, names, sweep, max((s[0] for s in seconds), default=0.0)

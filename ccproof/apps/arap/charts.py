@@ -39,6 +39,7 @@ __all__ = [
     "charts_from_labels",
     "check_disk",
     "segment_by_normals",
+    "grow_by_normal_angle",
     "split_into_disks",
     "merge_small",
     "grow_patch",
@@ -416,8 +417,9 @@ def merge_small(mesh: QuadMesh, labels, min_faces):
     return out
 
 
-def segment_by_normals(mesh: QuadMesh, smooth=3, min_faces=20):
-    """Six-direction segmentation: label = dominant signed axis of the face normal (+x, -x, ...).
+def segment_by_normals(mesh: QuadMesh, smooth=3, min_faces=20, max_angle=None):
+    """Six-direction segmentation: label = dominant signed axis of the face normal (+x, -x, ...); with
+    ``max_angle`` (degrees) region growing instead (:func:`grow_by_normal_angle`).
 
     Then ``smooth`` rounds of majority vote (a face takes the label of more than half of its edge
     neighbours, if there is one),
@@ -431,6 +433,9 @@ def segment_by_normals(mesh: QuadMesh, smooth=3, min_faces=20):
         Rounds of majority vote.
     min_faces : int, optional
         Charts smaller than this are merged (:func:`merge_small`).
+    max_angle : float, optional
+        Degrees in (0, 180]: a chart holds faces whose normals are within this angle of its first face's
+        normal (larger: fewer, larger charts), then split into disks and small charts merged as above.
 
     Returns
     -------
@@ -443,6 +448,9 @@ def segment_by_normals(mesh: QuadMesh, smooth=3, min_faces=20):
     >>> segment_by_normals(cube(), min_faces=1).tolist()
     [0, 1, 2, 3, 4, 5]
     """
+    if max_angle is not None:
+        lab = grow_by_normal_angle(mesh, max_angle)
+        return merge_small(mesh, split_into_disks(mesh, lab), min_faces)
     nrm = _face_normals(mesh)
     ax = np.argmax(np.abs(nrm), axis=1)
     sign = nrm[np.arange(mesh.n_faces), ax] < 0
@@ -457,6 +465,53 @@ def segment_by_normals(mesh: QuadMesh, smooth=3, min_faces=20):
     if hole is not None and hole.any():
         lab = np.where(hole, -1, lab)
     return merge_small(mesh, split_into_disks(mesh, lab), min_faces)
+
+
+def grow_by_normal_angle(mesh: QuadMesh, max_angle):
+    """Charts grown through edges: faces in index order seed a chart, which takes every edge-connected face whose
+    normal is within ``max_angle`` degrees of the seed's; hole faces (a TaggedQuadMesh's) get -1.
+
+    Parameters
+    ----------
+    mesh : QuadMesh
+    max_angle : float
+        Degrees, in (0, 180].
+
+    Returns
+    -------
+    ndarray, shape (n_faces,) int64
+
+    Examples
+    --------
+    The cube's neighbouring faces are 90 degrees apart, its faces 0 and 1 opposite (180):
+
+    >>> from ccproof.mesh.examples import cube
+    >>> [grow_by_normal_angle(cube(), a).tolist() for a in (89, 90, 180)]
+    [[0, 1, 2, 3, 4, 5], [0, 1, 0, 0, 0, 0], [0, 0, 0, 0, 0, 0]]
+    """
+    from collections import deque
+
+    if not (0 < max_angle <= 180):  # NaN too
+        raise CCProofError(f"the normal angle of a chart must be in (0, 180] degrees, got {max_angle}")
+    nrm = _face_normals(mesh)
+    cos = np.cos(np.radians(max_angle)) - 1e-12  # 90 degrees: cos 0 up to rounding
+    adj = face_adjacency(mesh).tocsr()
+    hole = getattr(mesh, "hole", None)
+    lab = np.full(mesh.n_faces, -1, dtype=np.int64)
+    free = np.ones(mesh.n_faces, dtype=bool) if hole is None else ~np.asarray(hole, dtype=bool)
+    n = 0
+    for seed in range(mesh.n_faces):
+        if not free[seed]:
+            continue
+        free[seed], lab[seed], queue = False, n, deque([seed])
+        while queue:
+            f = queue.popleft()
+            for g in adj.indices[adj.indptr[f]:adj.indptr[f + 1]]:
+                if free[g] and nrm[g] @ nrm[seed] >= cos:
+                    free[g], lab[g] = False, n
+                    queue.append(g)
+        n += 1
+    return lab
 
 
 def grow_patch(mesh: QuadMesh, seed_face, rings):

@@ -56,6 +56,7 @@ __all__ = [
     "auto_refine",
     "estimate_memory",
     "MemoryBudgetError",
+    "run_memory",
     "METHODS",
     "VARIANTS",
 ]
@@ -683,6 +684,26 @@ def estimate_memory(hierarchies, deepest_level, release=True, opt_level=None):
     return BASE_BYTES + max(need(deepest_level, BYTES_PER_FACE), need(opt_level, OPT_BYTES_PER_FACE))
 
 
+def run_memory(hierarchies, methods, levels, eval_level, sample_level=None, refine=0, baseline_level=3,
+               release=True):
+    """(bytes, deepest level, optimization level) of :func:`compare` with these options: the estimate it checks
+    against ``max_memory`` before allocating (:func:`estimate_memory`), and the levels it counts.
+
+    >>> from ccproof.mesh.examples import grid
+    >>> from ccproof.apps.arap.hierarchy import ChartHierarchy
+    >>> h = ChartHierarchy(grid(3, 3), range(9))
+    >>> need, deepest, opt = run_memory([h], ("c",), 2, 4, refine=1)
+    >>> (deepest, opt), need == estimate_memory([h], 4, True, 2)
+    ((4, 2), True)
+    """
+    deepest = max([eval_level] + ([sample_level] if sample_level is not None else [])
+                  + ([baseline_level] if "d" in methods else []))
+    opt = None
+    if any(m in ("b", "c") for m in methods):
+        opt = max(levels, int(refine) + 1) if refine else levels
+    return estimate_memory(hierarchies, deepest, release, opt), deepest, opt
+
+
 class MemoryBudgetError(CCProofError):
     """The estimated memory of a run exceeds the budget (raised before allocating).
 
@@ -752,12 +773,8 @@ def compare(mesh, labels=None, methods=METHODS, levels=3, start_level=1, eval_le
         rmesh, rlab = refine_mesh(mesh, labels, refine)
         fine = {"hierarchies": [ChartHierarchy(rmesh, fc) for fc in _charts(rmesh, rlab)],
                 "start": max(start_level, refine + 1) - refine, "levels": max(levels, refine + 1) - refine}
-    deepest = max([eval_level] + ([sample_level] if sample_level is not None else [])
-                  + ([baseline_level] if "d" in methods else []))
-    opt = None
-    if any(m in ("b", "c") for m in methods):
-        opt = fine["levels"] + refine if fine else levels
-    need = estimate_memory(hierarchies, deepest, release, opt)
+    need, deepest, opt = run_memory(hierarchies, methods, levels, eval_level, sample_level, refine,
+                                    baseline_level, release)
     if max_memory is not None and need > max_memory:
         big = int(np.argmax([h.n_faces(0) for h in hierarchies]))
         raise MemoryBudgetError(

@@ -38,7 +38,6 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Literal
 
 import numpy as np
@@ -51,6 +50,7 @@ from ccproof.apps.dynamics.meshes import paper_initial_model
 from ccproof.apps.dynamics.model import DynamicSurface, Material
 from ccproof.errors import CCProofError
 from ccproof.mesh import QuadMesh
+from ccproof.mesh.io import read_points
 
 __all__ = [
     "minimal_enclosing_sphere",
@@ -163,131 +163,7 @@ def minimal_enclosing_sphere(X, seed=0):
 # ---------------------------------------------------------------------------- point files
 
 
-def read_points(path):
-    """Read a point cloud: ``.xyz``, ``.ply``, ``.obj`` or the vertices of any mesh file.
-
-    ``.xyz``: whitespace columns x y z ...; ``.ply``: ASCII or binary vertex element; ``.obj``: the
-    ``v`` lines; any other extension: the vertices of :func:`ccproof.mesh.io.read_mesh` (OFF, STL, VTK,
-    ...). The input of ``ccproof fit`` (docs/qmv98.md).
-
-    Parameters
-    ----------
-    path : str or os.PathLike
-
-    Returns
-    -------
-    ndarray, shape (m, 3) float64
-
-    Examples
-    --------
-    >>> import os, tempfile
-    >>> import numpy as np
-    >>> tmp = tempfile.TemporaryDirectory()          # removed when the example ends
-    >>> p = os.path.join(tmp.name, "cloud.xyz")
-    >>> np.savetxt(p, [[1, 2, 3, 9], [4, 5, 6, 9]])                  # extra columns are ignored
-    >>> read_points(p).tolist()
-    [[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]]
-    """
-    from ccproof.mesh.inputs import checked_input
-
-    path = Path(path)
-    with checked_input(path) as q:  # a regular file or a pipe, at most --max-input bytes
-        return check_points(_read_points(path, Path(q)), f"point cloud {path.name}")
-
-
-def _read_points(path, q):
-    """The points of the file ``path``, read from ``q`` (``path`` itself, or a pipe's copy)."""
-    ext = path.suffix.lower()
-    if ext in (".xyz", ".txt", ".pts"):
-        rows = []
-        for ln, line in enumerate(_text(path, q).splitlines(), 1):
-            s = line.split("#", 1)[0].replace(",", " ").split()
-            if not s:
-                continue
-            if len(s) < 3:
-                raise CCProofError(f"{path}:{ln}: expected at least 3 numbers, got {line!r}")
-            try:
-                rows.append([float(x) for x in s[:3]])
-            except ValueError:
-                raise CCProofError(f"{path}:{ln}: not a number in {line!r}") from None
-        X = np.array(rows, dtype=np.float64).reshape(-1, 3)
-    elif ext == ".obj":
-        rows = []
-        for ln, line in enumerate(_text(path, q).splitlines(), 1):
-            s = line.split()
-            if s and s[0] == "v":
-                try:
-                    if len(s) < 4:
-                        raise ValueError
-                    rows.append([float(x) for x in s[1:4]])
-                except ValueError:
-                    raise CCProofError(f"{path}:{ln}: bad vertex line {line!r} (needs 'v x y z')") from None
-        X = np.array(rows, dtype=np.float64).reshape(-1, 3)
-    elif ext == ".ply":
-        X = _read_ply(path, q)
-    else:  # any other mesh format: its vertices (the mesh reader of ccproof eval)
-        from ccproof.mesh.io import read_mesh
-
-        if q.stat().st_size == 0:
-            raise CCProofError(f"{path}: empty file (no points)")
-        X = np.asarray(read_mesh(q).vertices, dtype=np.float64)
-    return X
-
-
-_PLY_TYPES = {"char": "i1", "uchar": "u1", "short": "i2", "ushort": "u2", "int": "i4", "uint": "u4",
-              "float": "f4", "double": "f8", "int8": "i1", "uint8": "u1", "int16": "i2", "uint16": "u2",
-              "int32": "i4", "uint32": "u4", "float32": "f4", "float64": "f8"}
-
-
-def _text(path, q):
-    """The text of a points file (UTF-8, a byte-order mark dropped); a binary file refused by name."""
-    from ccproof.mesh.inputs import decode_text
-
-    return decode_text(q.read_bytes(), path, expect=f"{path.suffix} holds lines of numbers x y z")
-
-
-def _read_ply(path, q):
-    data = q.read_bytes()
-    end = data.find(b"end_header")
-    if not data.startswith(b"ply") or end < 0:
-        raise CCProofError(f"{path}: not a PLY file")
-    header = data[:end].decode("ascii", "replace").splitlines()
-    body = data[data.index(b"\n", end) + 1 :]
-    fmt = None
-    elements = []
-    for line in header:
-        s = line.split()
-        if not s:
-            continue
-        if s[0] == "format":
-            fmt = s[1]
-        elif s[0] == "element":
-            elements.append([s[1], int(s[2]), []])
-        elif s[0] == "property" and elements:
-            if s[1] == "list":
-                elements[-1][2].append((s[-1], "list", s[2], s[3]))
-            else:
-                elements[-1][2].append((s[2], _PLY_TYPES.get(s[1])))
-    if not elements or elements[0][0] != "vertex":
-        raise CCProofError(f"{path}: the first PLY element must be 'vertex'")
-    _, nv, props = elements[0]
-    names = [p[0] for p in props]
-    if any(len(p) != 2 or p[1] is None for p in props) or not {"x", "y", "z"} <= set(names):
-        raise CCProofError(f"{path}: the vertex element needs scalar properties x, y, z")
-    if fmt == "ascii":
-        lines = body.decode("ascii", "replace").split("\n")[:nv]
-        A = np.array([[float(x) for x in ln.split()[: len(props)]] for ln in lines], dtype=np.float64)
-        if A.shape != (nv, len(props)):
-            raise CCProofError(f"{path}: truncated vertex list")
-        return A[:, [names.index(k) for k in "xyz"]]
-    if fmt in ("binary_little_endian", "binary_big_endian"):
-        bo = "<" if fmt == "binary_little_endian" else ">"
-        dt = np.dtype([(p[0], bo + p[1]) for p in props])
-        if len(body) < nv * dt.itemsize:
-            raise CCProofError(f"{path}: truncated vertex list")
-        rec = np.frombuffer(body[: nv * dt.itemsize], dtype=dt)
-        return np.stack([rec["x"], rec["y"], rec["z"]], axis=1).astype(np.float64)
-    raise CCProofError(f"{path}: unknown PLY format {fmt!r}")
+# read_points: the one point-cloud reader of the package (ccproof.mesh.io), kept under this name here
 
 
 # ---------------------------------------------------------------------------- fitting
