@@ -23,9 +23,14 @@ and the data springs sum to --spring.
 
 The other direction is reported too: the limit surface sampled at --sample-level (written to
 --surface-out, default OUT with "_limit" before the extension) and the distance of every sample to its
-nearest data point; the area fraction farther than --stray-distance (default 3 data spacings) and the
-two-sided (Hausdorff) error. A warning (stderr) says when more than --stray-fraction of the surface
-strays (a torus' hole spanned, an unseen side filled in) or a level stopped at --max-steps.
+nearest data point: max, area-weighted mean and RMS, the area fraction farther than --stray-distance
+(default 3 data spacings) and the two-sided (Hausdorff) error. Springs act both ways: besides the data
+springs, once the first level has reached equilibrium, those of 4 x 4 samples per face that are farther
+than --stray-distance from every data point are pulled toward their nearest data points, to within that
+distance (constants in proportion to area, summing to --surface-spring, default 5; 0 turns them off), so
+surface that no data point is near (a membrane across a concavity) is drawn to the data. A warning (stderr)
+says when more than --stray-fraction of the surface strays (a torus' hole spanned, an unseen side filled in, a
+concavity spanned) or a level stopped at --max-steps.
 --errors FILE.csv writes x, y, z, distance and distance in % for every data point.
 
 Limits: input files (POINTS, --init) at most --max-input GB (default 2; regular files or a pipe);
@@ -78,6 +83,12 @@ def add_arguments(p):
                         "(default 3 data spacings)")
     p.add_argument("--stray-fraction", type=float, default=0.01,
                    help="warn when more than this area fraction of the surface strays (default 0.01)")
+    p.add_argument("--surface-spring", type=float, default=5.0,
+                   help="sum of the surface -> data spring constants (4 x 4 samples per face, in proportion to "
+                        "area): samples farther than --stray-distance from every data point are pulled toward their "
+                        "nearest data point, from the first level's data-spring equilibrium on, so that surface no "
+                        "data point is near (a membrane across a concavity) is pulled to the data; 0: data springs "
+                        "only, as in the paper (default 5)")
     p.add_argument("--errors", default=None, metavar="FILE.csv", help="write the per-point errors here")
 
 
@@ -116,7 +127,8 @@ def run(args) -> int:
     res = fit_points(X, init=init, levels=args.levels, material=material, spring_total=args.spring, dt=args.dt,
                      scheme=args.scheme, max_steps=args.max_steps, tol=args.tol, init_scale=args.init_scale,
                      truncation=args.truncation, progress=progress_enabled(args), sample_level=args.sample_level,
-                     stray_distance_percent=args.stray_distance, stray_fraction=args.stray_fraction)
+                     stray_distance_percent=args.stray_distance, stray_fraction=args.stray_fraction,
+                     surface_spring_total=args.surface_spring)
     print(f"data: {X.shape[0]} points from {args.points}; minimal enclosing sphere diameter {res.diameter:.6g}")
     print("level  vertices  faces  steps  equilibrium  max error %  mean error %  seconds")
     for i, lev in enumerate(res.levels):
@@ -126,11 +138,13 @@ def run(args) -> int:
         print(f"level {i}: {lev.reason}; energy {lev.energy:.6g}")
     print(f"fit error (max distance to the limit surface, % of the enclosing-sphere diameter): "
           f"{res.max_error_percent:.3f} %   mean: {res.mean_error_percent:.4f} %")
+    print(f"data -> surface ({X.shape[0]} points): max {res.max_error_percent:.3f} %, RMS "
+          f"{res.data_rms_percent:.4f} %")
     rep = res.surface_report
     print(f"surface -> data (limit surface at level {res.sample_level}, {res.surface.n_vertices} samples): max "
-          f"{res.surface_max_percent:.3f} %, area-weighted mean {100 * rep['mean'] / res.diameter:.4f} %, "
-          f"{100 * rep['stray_fraction']:.2f} % of the area farther than {res.stray_distance_percent:.3f} % "
-          f"(data spacing {100 * res.spacing / res.diameter:.3f} %)")
+          f"{res.surface_max_percent:.3f} %, area-weighted mean {100 * rep['mean'] / res.diameter:.4f} %, RMS "
+          f"{res.surface_rms_percent:.4f} %, {100 * rep['stray_fraction']:.2f} % of the area farther than "
+          f"{res.stray_distance_percent:.3f} % (data spacing {100 * res.spacing / res.diameter:.3f} %)")
     print(f"two-sided (Hausdorff) error: {res.two_sided_error_percent:.3f} % of the enclosing-sphere diameter")
     for w in res.warnings:
         print(f"ccproof fit: warning: {w}", file=sys.stderr)
@@ -170,6 +184,8 @@ def _check_options(args):
         raise CCProofError(f"--tol must be a finite number >= 0, got {args.tol}")
     if not 0 <= args.stray_fraction <= 1:  # NaN too
         raise CCProofError(f"--stray-fraction must be in [0, 1], got {args.stray_fraction}")
+    if not (isfinite(args.surface_spring) and args.surface_spring >= 0):
+        raise CCProofError(f"--surface-spring must be a finite number >= 0, got {args.surface_spring}")
     if args.stray_distance is not None and not (isfinite(args.stray_distance) and args.stray_distance > 0):
         raise CCProofError(f"--stray-distance must be a finite number > 0 (% of the diameter), got "
                            f"{args.stray_distance}")

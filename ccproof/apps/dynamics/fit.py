@@ -17,6 +17,14 @@ Pipeline (:func:`fit_points`):
    creeps: both must have settled), or ``max_steps`` (default 1000, a safety cap: the bunny scan needs
    about 200 + 100 steps); a level that stops otherwise says why (:attr:`FitLevel.reason`, and a
    warning naming the criterion that failed, the values reached and whether the energy rose);
+   then the springs act both ways: surface -> data springs
+   (:class:`~ccproof.apps.dynamics.forces.SurfaceToDataSprings`, total ``surface_spring_total``) pull
+   the fixed samples of the surface that are farther than the stray distance (step 6) from every data
+   point toward their nearest data points, to within that distance, so that surface no data point is
+   near (a membrane spanning a concavity of the data) is drawn to the data; on the first level they are
+   switched on once the data springs alone have reached equilibrium (from the small start cube they
+   would pull the surface onto the nearest data, inner walls of a concavity included) and the
+   evolution goes on to the equilibrium of both; on the later levels they act from the start;
 4. subdivide globally and rebuild the model (densities rescaled, :meth:`Material.refined`), refit;
    repeat ``levels`` times;
 5. report the paper's fit error: the largest distance of a data point to the limit surface, in % of the
@@ -44,7 +52,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ccproof.apps.control_mesh import TaggedQuadMesh
-from ccproof.apps.dynamics.forces import ModelClosestPoints, Springs, check_points
+from ccproof.apps.dynamics.forces import ModelClosestPoints, Springs, SurfaceToDataSprings, check_points
 from ccproof.apps.dynamics.integrate import ImplicitIntegrator
 from ccproof.apps.dynamics.meshes import paper_initial_model
 from ccproof.apps.dynamics.model import DynamicSurface, Material
@@ -363,8 +371,8 @@ def surface_to_data(surface, X, stray_distance):
     Returns
     -------
     dict
-        ``distances`` (n,), ``areas`` (n,) vertex area weights, ``max``, ``mean`` (area-weighted),
-        ``stray_fraction`` (area fraction farther than ``stray_distance``).
+        ``distances`` (n,), ``areas`` (n,) vertex area weights, ``max``, ``mean`` and ``rms``
+        (area-weighted), ``stray_fraction`` (area fraction farther than ``stray_distance``).
 
     Examples
     --------
@@ -373,8 +381,8 @@ def surface_to_data(surface, X, stray_distance):
     >>> from ccproof.mesh.examples import cube
     >>> S = limit_surface_mesh(cube(), 1)
     >>> r = surface_to_data(S, S.vertices + [0, 0, 0.01], 0.005)
-    >>> round(r["max"], 12), round(r["mean"], 12), r["stray_fraction"]
-    (0.01, 0.01, 1.0)
+    >>> round(r["max"], 12), round(r["mean"], 12), round(r["rms"], 12), r["stray_fraction"]
+    (0.01, 0.01, 0.01, 1.0)
     """
     from scipy.spatial import cKDTree
 
@@ -383,7 +391,7 @@ def surface_to_data(surface, X, stray_distance):
     w = _vertex_areas(surface)
     W = float(w.sum()) or 1.0
     return {"distances": d, "areas": w, "max": float(d.max()), "mean": float(w @ d) / W,
-            "stray_fraction": float(w[d > stray_distance].sum()) / W}
+            "rms": math.sqrt(float(w @ d**2) / W), "stray_fraction": float(w[d > stray_distance].sum()) / W}
 
 
 @dataclass
@@ -493,6 +501,18 @@ class FitResult:
         return 100.0 * max(float(self.data_distances.max()), self.surface_report["max"]) / self.diameter
 
     @property
+    def data_rms_percent(self):
+        """Root mean square of the data -> surface distances, in % of the enclosing-sphere diameter."""
+        if self.data_distances is None:
+            raise CCProofError("no data distances: this FitResult was not filled by fit_points")
+        return 100.0 * float(np.sqrt(np.mean(self.data_distances**2))) / self.diameter
+
+    @property
+    def surface_rms_percent(self):
+        """Area-weighted root mean square of the surface -> data distances, in % of the diameter."""
+        return 100.0 * self.surface_report["rms"] / self.diameter
+
+    @property
     def surface_max_percent(self):
         return 100.0 * self.surface_report["max"] / self.diameter
 
@@ -528,7 +548,7 @@ def fit_points(X: ArrayLike, init: Literal["cube"] | QuadMesh = "cube", levels: 
                init_scale: float = 0.5, truncation: int = 6, progress: bool = False,
                callback: Callable[[int, int, DynamicSurface, NDArray[np.float64]], object] | None = None,
                sample_level: int | None = None, stray_distance_percent: float | None = None,
-               stray_fraction: float = 0.01) -> FitResult:
+               stray_fraction: float = 0.01, surface_spring_total: float = 5.0) -> FitResult:
     """Recover a closed surface from range data (module docstring).
 
     Parameters
@@ -570,6 +590,13 @@ def fit_points(X: ArrayLike, init: Literal["cube"] | QuadMesh = "cube", levels: 
         diameter (default 3 times :func:`data_spacing`).
     stray_fraction : float
         Warn when more than this area fraction of the surface strays.
+    surface_spring_total : float >= 0
+        Sum of the constants of the surface -> data springs
+        (:class:`~ccproof.apps.dynamics.forces.SurfaceToDataSprings`: 4 x 4 samples per patch face, in
+        proportion to area; a sample farther than the stray distance from every data point is pulled
+        toward its nearest data point, to within the stray distance), which pull the parts of the surface
+        that no data point is near (a membrane across a concavity) to the data; 0 turns them off (the
+        paper's one-way data springs only). Default 5 (the data springs sum to ``spring_total``).
 
     Returns
     -------
@@ -597,6 +624,8 @@ def fit_points(X: ArrayLike, init: Literal["cube"] | QuadMesh = "cube", levels: 
         raise CCProofError(f"levels must be an integer >= 0, got {levels!r}")
     if not (spring_total > 0 and math.isfinite(spring_total)):
         raise CCProofError(f"spring_total must be finite and > 0, got {spring_total!r}")
+    if not (surface_spring_total >= 0 and math.isfinite(surface_spring_total)):
+        raise CCProofError(f"surface_spring_total must be finite and >= 0, got {surface_spring_total!r}")
     if not (0 < init_scale <= 1):
         raise CCProofError(f"init_scale must be in (0, 1], got {init_scale!r}")
     if dt is None:
@@ -624,8 +653,11 @@ def fit_points(X: ArrayLike, init: Literal["cube"] | QuadMesh = "cube", levels: 
     result = FitResult(mesh=None, model=None, center=centre, diameter=diameter,
                        parameters={"material": material, "spring_total": spring_total, "dt": dt, "scheme": scheme,
                                    "max_steps": max_steps, "tol": tol, "init_scale": init_scale,
-                                   "truncation": truncation, "levels": levels})
+                                   "truncation": truncation, "levels": levels,
+                                   "surface_spring_total": surface_spring_total})
     spacing_n = max(data_spacing(Xn), 1e-300)
+    # the stray distance (normalized): the surface -> data springs pull the samples farther than it back to it
+    stray_n = 3.0 * spacing_n if stray_distance_percent is None else float(stray_distance_percent) / 100.0
     bar = None
     if progress:
         from tqdm import tqdm
@@ -636,15 +668,21 @@ def fit_points(X: ArrayLike, init: Literal["cube"] | QuadMesh = "cube", levels: 
             t0 = time.perf_counter()
             finder = ModelClosestPoints(model)
             integ = ImplicitIntegrator(model, dt, P=P, scheme=scheme, tol=1e-9, copies=copies)
+            reverse = (SurfaceToDataSprings(model, Xn, surface_spring_total, slack=stray_n)
+                       if surface_spring_total > 0 else None)
             converged = False
             cg = 0
             step = 0
             energies, errors = [], []
             change = err_change = math.inf
+            two_way = reverse is not None and level > 0
+            one_way_steps = 0
             for step in range(1, max_steps + 1):
                 f, u, v, _, dist = finder.query(integ.P, Xn)
                 errors.append(float(np.mean(dist)))  # of the state before this step
                 springs = Springs(model, f, u, v, Xn, k)
+                if two_way and reverse is not None:  # and from the surface to the data (two-way forces)
+                    springs = Springs.stacked(springs, reverse.springs(integ.P)[0])
                 info = integ.step(springs=springs)
                 cg += info.iterations
                 energies.append(model.energy(integ.P) + springs.energy(integ.P))
@@ -659,11 +697,15 @@ def fit_points(X: ArrayLike, init: Literal["cube"] | QuadMesh = "cube", levels: 
                 if callback is not None:
                     callback(level, step, model, integ.P)
                 if change <= tol and err_change <= tol:
+                    if reverse is not None and not two_way:  # the first level's data-spring equilibrium
+                        two_way, energies, errors, one_way_steps = True, [], [], step
+                        continue
                     converged = True
                     break
             rises = sum(b > a for a, b in zip(energies[-11:-1], energies[-10:]))
             if converged:
-                reason = (f"equilibrium after {step} steps: relative energy change {change:.2g} and mean-error "
+                first = f" (data springs alone for the first {one_way_steps})" if one_way_steps else ""
+                reason = (f"equilibrium after {step} steps{first}: relative energy change {change:.2g} and mean-error "
                           f"change {err_change:.2g} over two steps, both <= tol {tol:g}")
             else:
                 failed = [w for w, c in (("energy", change), ("mean data error", err_change)) if not c <= tol]
@@ -709,6 +751,7 @@ def fit_points(X: ArrayLike, init: Literal["cube"] | QuadMesh = "cube", levels: 
         result.warnings.append(
             f"the fitted surface strays from the data: {100 * rep['stray_fraction']:.1f} % of its area is farther "
             f"than {result.stray_distance_percent:.2f} % of the diameter from every data point, "
-            f"up to {result.surface_max_percent:.2f} %; the data may not cover the surface (an unseen side) or the "
-            f"start mesh's topology may not match the data's (e.g. a genus-0 start for a torus: give --init)")
+            f"up to {result.surface_max_percent:.2f} %; the data may not cover the surface (an unseen side), the "
+            f"start mesh's topology may not match the data's (e.g. a genus-0 start for a torus: give --init), or "
+            f"the surface spans a concavity of the data (raise --surface-spring or --levels)")
     return result

@@ -23,7 +23,7 @@ import numpy as np
 
 from ccproof.errors import CCProofError
 
-__all__ = ["Springs", "ModelClosestPoints", "closest_cells", "check_points"]
+__all__ = ["Springs", "SurfaceToDataSprings", "ModelClosestPoints", "closest_cells", "check_points"]
 
 
 def check_points(X, name="point cloud"):
@@ -89,7 +89,7 @@ class Springs:
     (1, [2.0], 6.0)
     """
 
-    def __init__(self, model, faces, u, v, anchors, stiffness):
+    def __init__(self, model, faces, u, v, anchors, stiffness, jacobian=None):
         anchors = check_points(anchors, "spring anchors")
         k = np.broadcast_to(np.asarray(stiffness, dtype=np.float64), (anchors.shape[0],)).copy()
         if not (np.isfinite(k).all() and (k >= 0).all()):
@@ -98,7 +98,8 @@ class Springs:
         self.faces = np.asarray(faces)
         self.u = np.asarray(u, dtype=np.float64)
         self.v = np.asarray(v, dtype=np.float64)
-        self.jacobian = model.basis(self.faces, self.u, self.v)["P"]
+        # the rows J(face, u, v) of fixed attachment points may be given (computed once, e.g. by the caller)
+        self.jacobian = model.basis(self.faces, self.u, self.v)["P"] if jacobian is None else jacobian.tocsr()
         if self.jacobian.shape[0] != anchors.shape[0]:
             raise CCProofError("one anchor point per attachment point is needed")
         self.anchors = anchors
@@ -129,12 +130,124 @@ class Springs:
         return 0.5 * float(np.sum(self.stiffness * self.lengths(P) ** 2))
 
     @classmethod
+    def stacked(cls, first, second):
+        """One set of springs holding the springs of ``first`` and then those of ``second`` (same model).
+
+        >>> import numpy as np
+        >>> from ccproof.apps.dynamics.meshes import paper_initial_model
+        >>> from ccproof.apps.dynamics.model import DynamicSurface
+        >>> m = DynamicSurface(paper_initial_model())
+        >>> a = Springs(m, [0], [0.5], [0.5], [[0, 0, 9.0]], 1.0)
+        >>> b = Springs(m, [1, 2], [0.5, 0.5], [0.5, 0.5], [[0, 0, 9.0], [1, 0, 0.0]], 2.0)
+        >>> ab = Springs.stacked(a, b)
+        >>> ab.count, bool(np.isclose(ab.energy(m.vertices), a.energy(m.vertices) + b.energy(m.vertices)))
+        (3, True)
+        """
+        import scipy.sparse as sp
+
+        if first.model is not second.model:
+            raise CCProofError("springs of two different models cannot be stacked")
+        return cls(first.model, np.concatenate([first.faces, second.faces]), np.concatenate([first.u, second.u]),
+                   np.concatenate([first.v, second.v]), np.concatenate([first.anchors, second.anchors]),
+                   np.concatenate([first.stiffness, second.stiffness]),
+                   jacobian=sp.vstack([first.jacobian, second.jacobian], format="csr"))
+
+    @classmethod
     def to_nearest(cls, model, P, anchors, stiffness, finder=None):
         """Springs attached to the points of the limit surface (state P) nearest to the anchors."""
         anchors = check_points(anchors, "spring anchors")
         finder = ModelClosestPoints(model) if finder is None else finder
         f, u, v, _, _ = finder.query(P, anchors)
         return cls(model, f, u, v, anchors, stiffness)
+
+
+class SurfaceToDataSprings:
+    """Springs from the limit surface to the data: the other direction of the data springs.
+
+    The data springs pull, for every data point, the surface point nearest to it; a part of the surface
+    that is nearest to no data point (a membrane spanning a concavity, a hole) feels no force from them
+    and stays where the tension left it. These springs pull, for every one of ``per_side`` x ``per_side``
+    fixed parameter samples of each patch face (the cell centres of a uniform grid), the surface point
+    there toward the data point nearest to it (a k-d tree of the data, re-queried at every step): the
+    two-way forces of qmv98 section 3.2, where a spring may pull the surface toward the data as well as a
+    data point toward the surface. Sample i gets the constant ``total * a_i / A``: its share ``a_i`` of the
+    current surface area (``|s_u x s_v|`` at the sample), so a region is pulled in proportion to its area.
+    Only samples farther than ``slack`` from every data point are pulled, and only to within ``slack`` of
+    their nearest data point (the anchor lies on the segment to it, ``slack`` short of it; the others get
+    the constant 0): a surface the data covers lies within about one data spacing of the data everywhere,
+    and pulling it onto the discrete points would draw it inward between them (by about spacing^2 / 8R on a
+    convex part of radius R), while a region that no data point is near is pulled to the data.
+
+    Parameters
+    ----------
+    model : DynamicSurface
+    X : ndarray, shape (m, 3) float64
+        The data points.
+    total : float >= 0
+        Sum of the spring constants over all samples (those within ``slack`` get 0).
+    per_side : int, optional
+        Samples per face side (default 4).
+    slack : float >= 0, optional
+        Distance to the data within which a sample is not pulled (default 0; the fit passes its data
+        spacing).
+
+    Examples
+    --------
+    On the 98-vertex cube model with one data point far above it, every sample is pulled to that point;
+    the constants sum to ``total`` and the springs' lengths are the distances of the samples to it less
+    the slack:
+
+    >>> import numpy as np
+    >>> from ccproof.apps.dynamics.meshes import paper_initial_model
+    >>> from ccproof.apps.dynamics.model import DynamicSurface
+    >>> m = DynamicSurface(paper_initial_model())
+    >>> rev = SurfaceToDataSprings(m, np.array([[0, 0, 10.0]]), 2.0, per_side=2, slack=0.5)
+    >>> s, d = rev.springs(m.vertices)
+    >>> s.count, round(float(s.stiffness.sum()), 12), bool(np.allclose(s.lengths(m.vertices), d - 0.5))
+    (384, 2.0, True)
+    """
+
+    def __init__(self, model, X, total, per_side=4, slack=0.0):
+        from scipy.spatial import cKDTree
+
+        if not (math.isfinite(total) and total >= 0):
+            raise CCProofError(f"the surface -> data spring total must be finite and >= 0, got {total!r}")
+        if not (math.isfinite(slack) and slack >= 0):
+            raise CCProofError(f"the slack of the surface -> data springs must be finite and >= 0, got {slack!r}")
+        if int(per_side) != per_side or per_side < 1:
+            raise CCProofError(f"per_side must be an integer >= 1, got {per_side!r}")
+        self.model = model
+        self.data = check_points(X, "data points")
+        self.total = float(total)
+        self.slack = float(slack)
+        faces = np.flatnonzero(model.layout.face_kind > 0)  # the faces that carry a patch
+        g = (np.arange(per_side) + 0.5) / per_side
+        uu, vv = np.meshgrid(g, g, indexing="ij")
+        self.faces = np.repeat(faces, per_side * per_side)
+        self.u = np.tile(uu.ravel(), faces.size)
+        self.v = np.tile(vv.ravel(), faces.size)
+        rows = model.basis(self.faces, self.u, self.v, derivatives=1)
+        self.jacobian, self._du, self._dv = rows["P"], rows["Du"], rows["Dv"]
+        self._tree = cKDTree(self.data)
+
+    def springs(self, P):
+        """The springs for the state ``P`` (n, 3) and the distances of the samples to their nearest data points.
+
+        Returns
+        -------
+        Springs, ndarray (k,)
+        """
+        Y = np.asarray(self.jacobian @ P)
+        area = np.linalg.norm(np.cross(np.asarray(self._du @ P), np.asarray(self._dv @ P)), axis=1)
+        dist, nearest = self._tree.query(Y)
+        D = self.data[nearest]
+        total_area = float(area.sum())
+        k = self.total * area / total_area if total_area > 0 else np.full(area.size, self.total / area.size)
+        pulled = dist > self.slack
+        k[~pulled] = 0.0
+        anchors = Y.copy()  # the samples within the slack: constant 0, anchored where they are
+        anchors[pulled] = D[pulled] + (self.slack / dist[pulled])[:, None] * (Y[pulled] - D[pulled])
+        return Springs(self.model, self.faces, self.u, self.v, anchors, k, jacobian=self.jacobian), dist
 
 
 def closest_cells(n_faces, budget=25_000, most=8):
