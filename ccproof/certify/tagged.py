@@ -155,9 +155,10 @@ def _pivot(fam, n, z, prec):
     """A point where the eigenvector of the simple eigenvalue z is large (numerical choice only; the
     verifier proves the bordered system regular)."""
     import numpy as np
+    from flint import arb, arb_mat
 
     from ccproof.certify.verify.tagged import sector_matrix
-    from ccproof.certify.verify.tagged_c1 import bordered_solve
+    from ccproof.certify.verify.tagged_modes import bordered_solve
 
     S = sector_matrix(fam, n)
     cp = crease_points(fam, n) if fam != "dart" else []
@@ -174,10 +175,10 @@ def _pivot(fam, n, z, prec):
     with ctx.workprec(prec):
         for pv in order[:8]:
             try:
-                sol = bordered_solve(S, free, pv, z.real)
+                sol = bordered_solve([[arb(S[i, j]) for j in free] for i in free], z.real, free.index(pv), arb_mat)
             except ZeroDivisionError:
                 continue
-            size = max(abs(float(sol[k, 0].mid())) for k in range(len(free)))
+            size = max(abs(float(x.mid())) for x in sol)
             if best is None or size < best[0]:
                 best = (size, pv)
             if size <= 1.0:

@@ -68,7 +68,7 @@ from .tagged import (
     sharp_rays,
 )
 from .tagged_map import check_map
-from .tagged_modes import MIN_N, even_vector, mode_spectrum, mode_vector
+from .tagged_modes import MIN_N, bordered_solve, even_vector, mode_spectrum, mode_vector
 from .tagged_refute import chain_generic, chain_top, flip_generic, mode_generic, ordering, same_root
 
 STATEMENTS = ("C1", "not C1")
@@ -451,40 +451,13 @@ def _ball_eigenvector(fam, n, spec, c, cp, cval, prec):
         raise CertificateError(f"{c}: pivot must index a non-crease point")
     lam = z.real
     try:
-        sol = bordered_solve(S, free, pivot, lam)
+        sol = bordered_solve([[arb(S[i, j]) for j in free] for i in free], lam, free.index(pivot), arb_mat)
     except ZeroDivisionError:
         return None, None, f"the system for the eigenvector of {lam.str(8)} (pivot {pivot}) is not certainly regular"
     vec = [arb(0)] * S.nrows()
     for k, i in enumerate(free):
-        vec[i] = sol[k, 0]
+        vec[i] = sol[k]
     return lam, vec, f"eigenvalue {lam.str(10)} (simple root of {p}); vector in arb, pivot {labels(fam, n)[pivot]}"
-
-
-def bordered_solve(S, free, pivot, lam):
-    """Enclosure of the eigenvector v of the simple eigenvalue lam (a ball) on the coordinates ``free``
-    with v[pivot] = 1: the bordered system [[S - lam, e_pivot], [e_pivot^T, 0]] (v, mu) = (0, 1) on the
-    rows and columns ``free``. Raises ZeroDivisionError unless arb proves it regular for every lam of the
-    ball. Regular at the exact lam, it has one solution; the eigenvector v* (geometric multiplicity 1)
-    gives the kernel vector (v*, 0) if v*[pivot] = 0, so v*[pivot] != 0 and (v* / v*[pivot], 0) is it.
-
-    Returns
-    -------
-    arb_mat, shape (len(free) + 1, 1)
-        v on ``free`` (in that order), then mu (an enclosure of 0).
-
-    Examples
-    --------
-    >>> from flint import fmpq_mat
-    >>> sol = bordered_solve(fmpq_mat([[2, 1], [1, 2]]), [0, 1], 0, arb(3))
-    >>> [sol[i, 0].str(3) for i in range(3)]
-    ['1.00', '1.00', '0']
-    """
-    k = len(free)
-    pos = free.index(pivot)
-    rows = [[arb(S[i, j]) - (lam if i == j else 0) for j in free] + [arb(1 if r == pos else 0)]
-            for r, i in enumerate(free)]
-    rows.append([arb(1 if c == pos else 0) for c in range(k)] + [arb(0)])
-    return arb_mat(rows).solve(arb_mat([[0]] * k + [[1]]))
 
 
 def _solve_exact(A, cp, cval):

@@ -251,21 +251,26 @@ def mode_spectrum(fam, n):
     return out
 
 
-def bordered_solve(B, lam, pivot):
-    """The null vector v of B - lam (6 x 6, acb) with v[pivot] = 1, from the bordered system
-    [[B - lam, e_p], [e_p^T, 0]] (v, s) = (0, 1); raises ZeroDivisionError unless arb proves it regular
-    (then lam is a simple eigenvalue with v[pivot] != 0, and s = 0).
+def bordered_solve(B, lam, pivot, mat=acb_mat):
+    """The null vector v of B - lam (B square: a list of rows of balls or exact numbers) with v[pivot] = 1,
+    from the bordered system [[B - lam, e_p], [e_p^T, 0]] (v, s) = (0, 1) solved in ``mat`` (``acb_mat`` or
+    ``arb_mat``); raises ZeroDivisionError unless arb proves it regular for every lam of the ball. Regular at
+    the exact lam, it has one solution: the eigenvector v* (geometric multiplicity 1) gives the kernel vector
+    (v*, 0) if v*[pivot] = 0, so lam is simple with v*[pivot] != 0, v = v* / v*[pivot] and s = 0.
 
     Examples
     --------
     >>> [z.real.mid() for z in bordered_solve([[acb(int(i == k)) * (i + 1) for k in range(6)] for i in range(6)],
     ...                                       acb(2), 1)]
     [0, 1.00000000000000, 0, 0, 0, 0]
+    >>> [x.str(3) for x in bordered_solve([[2, 1], [1, 2]], arb(3), 0, arb_mat)]
+    ['1.00', '1.00']
     """
-    rows = [[B[i][k] - (lam if i == k else 0) for k in range(6)] + [acb(int(i == pivot))] for i in range(6)]
-    rows.append([acb(int(k == pivot)) for k in range(6)] + [acb(0)])
-    sol = acb_mat(rows).solve(acb_mat([[0]] * 6 + [[1]]))
-    return [sol[i, 0] for i in range(6)]
+    k = len(B)
+    rows = [[B[i][j] - (lam if i == j else 0) for j in range(k)] + [int(i == pivot)] for i in range(k)]
+    rows.append([int(j == pivot) for j in range(k)] + [0])
+    sol = mat(rows).solve(mat([[0]] * k + [[1]]))
+    return [sol[i, 0] for i in range(k)]
 
 
 def _unit(num, den):
