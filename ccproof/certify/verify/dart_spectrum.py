@@ -71,10 +71,10 @@ from flint import acb, arb, fmpq, fmpq_mpoly_ctx, fmpq_poly
 
 from ccproof.rigorous.analytic import ball
 
-from .dart_family import _kappa
+from .dart_family import kappa
 from .errors import CertificateError
 from .tagged import labels, sector_rows
-from .tagged_modes import _POS, _roots, check_dart, check_ring, ring_stencil
+from .tagged_modes import _POS, _block, _roots, check_dart, check_ring, ring_stencil
 
 WINDOW = (7, 8)  # the window classes of every K >= 7 occur in both
 _C = ("C",)
@@ -149,7 +149,7 @@ def check_construction():
             raise CertificateError(f"the ring row of {pos} leaves the one-ring")
     sharp = classes[0][("r", 0, 3) + _E]
     smooth = {("r" if q[1] == 0 else "q", dlt) + q: x for (dlt, q), x in ring_stencil()[_POS[_E]].items()}
-    smooth[_C] = _kappa()[_POS[_E]]
+    smooth[_C] = kappa()[_POS[_E]]
     d = {key: sharp.get(key, 0) - smooth.get(key, 0) for key in set(sharp) | set(smooth)}
     d = {key: x for key, x in d.items() if x != 0}
     for key in d:
@@ -162,12 +162,9 @@ def check_construction():
 
 
 def _b1(w):
-    """B1(w): the ring stencil's 2 x 2 block on (1,0), (1,1) (w of any ring type with 1/w)."""
-    out = [[w * 0, w * 0], [w * 0, w * 0]]
-    for i, pos in enumerate((_E, _F)):
-        for (dlt, q), x in ring_stencil()[_POS[pos]].items():
-            out[i][(_E, _F).index(q)] += x * w ** dlt if dlt >= 0 else x / w ** (-dlt)
-    return out
+    """B1(w): the ring stencil's 2 x 2 block on (1,0), (1,1)."""
+    B = _block(w)
+    return [[B[_POS[p]][_POS[q]] for q in (_E, _F)] for p in (_E, _F)]
 
 
 def _d_modes(w):
@@ -187,7 +184,7 @@ def _d_modes(w):
 
 def b0(lam, h):
     """lam - B0(h), the mode-0 block on (C, E, F) (3 x 3 of lam's type)."""
-    kap, B = _kappa(), _b1(fmpq(1))
+    kap, B = kappa(), _b1(fmpq(1))
     rows = [[1 - fmpq(7, 4) * h, fmpq(3, 2) * h, _QUARTER * h], [kap[_POS[_E]], B[0][0], B[0][1]],
             [kap[_POS[_F]], B[1][0], B[1][1]]]
     return [[(lam if i == j else 0) - rows[i][j] for j in range(3)] for i in range(3)]

@@ -248,22 +248,8 @@ class _Mode:
         self.lam = _lam_series(self.k)
         self.v = _bordered(self.k, self.lam, stencil)
         if with_u:
-            lam = self.lam
-            den = (lam - fmpq(1, 8)) * (lam - fmpq(1, 16)) * (lam - fmpq(1, 32)) * (lam - fmpq(1, 64)) * (lam - L0_LOW)
-            self.U = [_horner(p, lam, QS(0)) / den for p in _df._NPOLY]
-
-
-def _horner(p, x, acc):
-    for coef in reversed(p):
-        acc = acc * x + coef
-    return acc
-
-
-def _eps(pos):
-    return 0 if pos[1] == 0 else 1
-
-
-_sw = _df._swap
+            den = _df.u_denominator(self.lam, L0_LOW)
+            self.U = [_df.horner(p, self.lam, QS(0)) / den for p in _df._NPOLY]
 
 
 class QL0:
@@ -337,13 +323,13 @@ def exact_zeros():
     pos = {p: k for p, k in _POS.items()}
     if not all(rho[pos[(a, b)]] == rho[pos[(b, a)]] for (a, b) in pos if b > 0 and (b, a) in pos):
         raise CertificateError("rho is not symmetric in (a, b)")
-    N = [_horner(p, L, QL0(0)) for p in _df._NPOLY]
+    N = [_df.horner(p, L, QL0(0)) for p in _df._NPOLY]
     if not all((N[k] - N[0] * rho[k]).is_zero() for k in range(6)) or N[0].is_zero():
         raise CertificateError("adj(L0 - B(1)) kappa is not a non-zero multiple of rho")
     return rho
 
 
-class ExactFamily:
+class ExactFamily(_df.Modes):
     """The family of :class:`.dart_family.Family` at one grid point (a, b, c, t), exact (:class:`QS` in h).
 
     Parameters
@@ -373,42 +359,16 @@ class ExactFamily:
             self.alpha = -self.alpha
         self.yc = self.alpha * (lam - L0)
         self.em, self.ep = QS(self.c) - I * self.t, QS(self.c) + I * self.t  # e^(-i sigma), e^(i sigma)
+        self.i2, self.sign = I * 2, 1
 
-    def parts(self):
-        """{basis part: (level0(delta, pos), centre, lam)} as :meth:`.dart_family.Family.parts`, exact."""
-        vx, vy, a, b = self.vx, self.vy, self.a, self.b
-        i2 = I * 2
-        return {
-            "X+": (lambda d, p: vx[_POS[p]] * _exp_i(a * d) / i2, self.zero, self.lam1),
-            "X-": (lambda d, p: -(vx[_POS[_sw(p)]] * _exp_i(-a * (d + _eps(p)))) / i2, self.zero, self.lam1),
-            "Y0": (lambda d, p: self.alpha * self.U[_POS[p]], self.yc, self.lam2),
-            "Y+": (lambda d, p: vy[_POS[p]] * _exp_i(b * d) / 2, self.zero, self.lam2),
-            "Y-": (lambda d, p: vy[_POS[_sw(p)]] * _exp_i(-b * (d + _eps(p))) / 2, self.zero, self.lam2),
-        }
-
-    def layer_level0(self, q):
-        """(x(t, pos), y(t, pos)) as :func:`.dart_family.layer_level0` (y reflected in ray 0 for t < 0)."""
-        vx, vy, a, b = self.vx, self.vy, self.a, self.b
-        i2 = I * 2
-
-        def x(t, pos):
-            return (vx[_POS[pos]] * _exp_i(a * t) - vx[_POS[_sw(pos)]] * _exp_i(-a * (t + _eps(pos)))) / i2
-
-        def y(t, pos):
-            if t < 0:
-                t, pos = (-t, pos) if pos[1] == 0 else (-t - 1, _sw(pos))
-            return (self.alpha * self.U[_POS[pos]]
-                    + (vy[_POS[pos]] * _exp_i(b * t) * self.em
-                       + vy[_POS[_sw(pos)]] * _exp_i(-b * (t + _eps(pos))) * self.ep) / 2)
-        return x, y
+    def e(self, c, k):
+        """e^(i k a h) (c = "x") or e^(i k b h) (c = "y"), exact."""
+        return _exp_i((self.a if c == "x" else self.b) * k)
 
     def layer_nets(self, q, coordinate):
         """{piece: 4 x 4 Bezier net} of x (coordinate 0) or y (1) on layer quadrant q."""
-        f = self.layer_level0(q)[coordinate]
-        V = _df.level1_value(f, (self.zero, self.yc)[coordinate], (self.lam1, self.lam2)[coordinate], self.zero, q)
-        off = _df._OFFSET
-        return {n: _df._bezier([[V(off[n][0] + i, off[n][1] + j) for j in range(4)] for i in range(4)], self.zero)
-                for n in PIECES}
+        return _df.piece_nets(self.layer_level0(q)[coordinate], (self.zero, self.yc)[coordinate],
+                              (self.lam1, self.lam2)[coordinate], self.zero, q)
 
 
 # --- det J as a polynomial in the patch parameters (u, v), on the 6 x 6 grid; raw fmpq_poly below -------
