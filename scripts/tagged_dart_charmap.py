@@ -208,7 +208,7 @@ def middle_box(T, E, M, s_lo, s_hi, w_lo, w_hi, sigma, r, n, L=24, prec=128):
 
 
 def ymid_box(T, M, s_lo, s_hi, w_lo, w_hi, sigma, r, n, L=24, prec=128):
-    models, om = _C.curve_models(T, M, r, YB), _C.y_omegas(sigma)
+    models, om = _C.curve_models(T, M, r, YB), _R.y_omegas(sigma)
     coeffs = {c: _R.middle_coeffs(model, om, 0, 1, L) for c, model in models.items()}
     return _bounds(_R.middle_box(models, coeffs, om, s_lo, s_hi, w_lo, w_hi, 0, 1, L=L, prec=prec))
 

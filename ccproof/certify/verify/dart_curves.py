@@ -8,7 +8,7 @@ The models and the disc bounds are those of :mod:`ccproof.rigorous.analytic`.
 
 from __future__ import annotations
 
-from flint import acb, acb_mat, arb, ctx
+from flint import acb, ctx
 
 from ccproof.rigorous.analytic import AnalyticModel, ball, hull
 
@@ -23,6 +23,7 @@ from .dart_family import (
     _trans_series,
     curve_points,
 )
+from .dart_regularity import mode_factors, real_hull
 
 
 def _logs(fam):
@@ -84,31 +85,15 @@ def layer_y_series(lnets, n):
 
 def curve_models(T, M, r, parts):
     """{curve: AnalyticModel}: row p the Bezier point, column the basis part (in the order of ``parts``)."""
-    n = len(T[(parts[0], next(iter(CURVES)))]) - 1
-    return {c: AnalyticModel([acb_mat([[T[(b, c)][m][p] for b in parts] for p in range(4)]) for m in range(n + 1)],
-                             [M[(b, c)] for b in parts], r) for c in CURVES}
-
-
-def _coord_factors(coord, s, sigma):
-    if coord == "x":
-        E = acb(0, 2 * arb.pi() * s).exp()
-        return [E, 1 / E]
-    F = acb(0, sigma * (2 * s - 1)).exp()
-    return [acb(1), F, 1 / F]
+    return {c: AnalyticModel.from_columns([T[(b, c)] for b in parts], [M[(b, c)] for b in parts], r) for c in CURVES}
 
 
 def coord_box(models, s_lo, s_hi, h_lo, h_hi, sigma, coord, prec=128):
     """An arb holding X or Y on every outer curve's Bezier points, s in [s_lo, s_hi], h in [h_lo, h_hi] (a
     bulk quadrant), from the models of :func:`curve_models`."""
     with ctx.workprec(prec):
-        fac = _coord_factors(coord, ball(s_lo, s_hi), sigma)
-        return hull(v for model in models.values() for v in model.real_part(fac, h_lo, h_hi))
-
-
-def y_omegas(sigma):
-    """b_j(s) = c_j e^(i omega_j s): [(c_j, omega_j)] in the order of YB (Y0, Y+, Y-)."""
-    es = acb(0, sigma).exp()
-    return [(acb(1), arb(0)), (1 / es, 2 * sigma), (es, -2 * sigma)]
+        fac = mode_factors(ball(s_lo, s_hi), sigma)[0 if coord == "x" else 1]
+        return real_hull(models, fac, h_lo, h_hi, 0, prec)
 
 
 def layer_y_box(models, q, h_lo, h_hi, prec=128):
