@@ -85,7 +85,7 @@ from flint import acb, arb, ctx, fmpq, fmpq_mat, fmpq_poly
 
 from ccproof.rigorous.analytic import ball
 
-from .dart_family import _NPOLY, Family, kappa, l0, layer_level0, u_denominator
+from .dart_family import _NPOLY, Family, adjugate, kappa, l0, layer_level0, u_denominator
 from .errors import CertificateError
 from .rules import TWO_RING
 from .tagged_modes import _POS, _block, check_ring, ring_stencil
@@ -149,19 +149,6 @@ def check_mode0():
     return True
 
 
-def _adjugate(B):
-    """adj(x - B) as a 6 x 6 list of fmpq_poly (Faddeev-LeVerrier, exact; Cayley-Hamilton checked)."""
-    n = B.nrows()
-    c = B.charpoly().coeffs()
-    eye = fmpq_mat([[int(i == j) for j in range(n)] for i in range(n)])
-    Ms = [eye]
-    for k in range(1, n):
-        Ms.append(B * Ms[-1] + c[n - k] * eye)
-    if B * Ms[-1] + c[0] * eye != fmpq_mat(n, n):
-        raise CertificateError("Cayley-Hamilton fails: the adjugate is wrong")
-    return [[fmpq_poly([Ms[n - 1 - d][i, j] for d in range(n)]) for j in range(n)] for i in range(n)]
-
-
 def check_crease_row(points=W_POINTS):
     """Raise unless a1 b2 = a2 b1 on the curve lam = lam(c) (item 2 of the module docstring): the crease
     vertex row of ray 0 holds wherever the sharp midpoint's does. Exact, at w = 1..points.
@@ -186,7 +173,7 @@ def check_crease_row(points=W_POINTS):
     for w in range(1, points + 1):
         c = (fmpq(w) + fmpq(1, w)) / 2
         q = _X * _X - (5 + c) / 8 * _X + fmpq(1, 16)
-        adj = _adjugate(fmpq_mat(_block(fmpq(w))))
+        adj = adjugate(fmpq_mat(_block(fmpq(w))))
         for j in range(6):
             P = sum((psi[i] * adj[i][j] for i in range(6)), fmpq_poly(0))
             if P % q != 0:

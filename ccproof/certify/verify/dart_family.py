@@ -22,8 +22,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from flint import acb, acb_mat, acb_poly, acb_series, arb, ctx, fmpq, fmpq_mat
+from flint import acb, acb_mat, acb_poly, acb_series, arb, ctx, fmpq, fmpq_mat, fmpq_poly
 
+from .errors import CertificateError
 from .rules import CENTRE, canonical, level1_rule
 from .tagged_modes import _POS, _block, ring_stencil
 
@@ -63,17 +64,24 @@ def kappa():
     return [1 - sum(ring_stencil()[i].values()) for i in range(6)]
 
 
+def adjugate(B):
+    """adj(x - B) as a list of lists of fmpq_poly (Faddeev-LeVerrier, exact; Cayley-Hamilton checked)."""
+    n = B.nrows()
+    c = B.charpoly().coeffs()
+    eye = fmpq_mat([[int(i == j) for j in range(n)] for i in range(n)])
+    Ms = [eye]
+    for k in range(1, n):
+        Ms.append(B * Ms[-1] + c[n - k] * eye)
+    if B * Ms[-1] + c[0] * eye != fmpq_mat(n, n):
+        raise CertificateError("Cayley-Hamilton fails: the adjugate is wrong")
+    return [[fmpq_poly([Ms[n - 1 - d][i, j] for d in range(n)]) for j in range(n)] for i in range(n)]
+
+
 def _adj_kappa_polys():
-    """N(lam) = adj(lam - B(1)) kappa as 6 exact polynomials (coefficient lists, degree <= 5), by the
-    Cayley-Hamilton form of the adjugate: with det(lam - B) = sum_j c_j lam^j (degree 6),
-    adj(lam - B) = sum_(k < 6) lam^k sum_(j > k) c_j B^(j-k-1)."""
+    """N(lam) = adj(lam - B(1)) kappa as 6 exact polynomials (coefficient lists, degree <= 5)."""
     B1 = fmpq_mat(_block(fmpq(1)))
-    c = B1.charpoly()
-    powers = [fmpq_mat([[z] for z in kappa()])]  # B^m kappa
-    for _ in range(5):
-        powers.append(B1 * powers[-1])
-    return [[sum((c[j] * powers[j - k - 1][i, 0] for j in range(k + 1, 7)), fmpq(0)) for k in range(6)]
-            for i in range(6)], B1
+    adj, kap = adjugate(B1), kappa()
+    return [[sum((adj[i][k][d] * kap[k] for k in range(6)), fmpq(0)) for d in range(6)] for i in range(6)], B1
 
 
 _NPOLY, _B1 = _adj_kappa_polys()
@@ -140,15 +148,19 @@ def _coeffs(z, n):
     return [acb(c[i]) if i < len(c) else acb(0) for i in range(n)]
 
 
+def bordered_matrix(B, lam, zero, pivot=0):
+    """The bordered 7 x 7 matrix [[B - lam, e_pivot], [e_pivot^T, 0]] (``zero`` of B's ring)."""
+    A = [[(B[i][k] - lam) if i == k else B[i][k] for k in range(6)] + [zero + int(i == pivot)] for i in range(6)]
+    return A + [[zero + int(k == pivot) for k in range(6)] + [zero]]
+
+
 def bordered(w, lam, pivot=0):
     """v^ (6 values of w's type): B(w) v^ = lam v^, v^[pivot] = 1, from the bordered 7 x 7 system A v = e_7.
 
     For acb balls arb proves A regular on the whole ball (ZeroDivisionError otherwise). For power series
     in h (acb_series) the Taylor coefficients follow from A_0 v_k = -sum_(j >= 1) A_j v_(k-j), A_0 the
     system at h = 0 (proved regular by arb)."""
-    B = _block(w)
-    A = [[(B[i][k] - lam) if i == k else B[i][k] for k in range(6)] + [w * 0 + int(i == pivot)] for i in range(6)]
-    A.append([w * 0 + int(k == pivot) for k in range(6)] + [w * 0])
+    A = bordered_matrix(_block(w), lam, w * 0, pivot)
     if not isinstance(w, acb_series):
         sol = acb_mat(A).solve(acb_mat([[0]] * 6 + [[1]]))
         return [sol[i, 0] for i in range(6)]

@@ -235,9 +235,7 @@ def _bordered(k, lam, stencil):
     for i, row in enumerate(stencil):
         for (d, pos), x in row.items():
             B[i][_POS[pos]] = B[i][_POS[pos]] + _exp_i(fmpq(k) * d) * fmpq(x)
-    A = [[(B[i][j] - lam) if i == j else B[i][j] for j in range(6)] + [QS(int(i == 0))] for i in range(6)]
-    A.append([QS(int(j == 0)) for j in range(6)] + [QS(0)])
-    return _solve(A, [QS(0)] * 6 + [QS(1)])[:6]
+    return _solve(_df.bordered_matrix(B, lam, QS(0)), [QS(0)] * 6 + [QS(1)])[:6]
 
 
 class _Mode:
