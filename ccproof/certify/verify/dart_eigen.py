@@ -85,7 +85,7 @@ from flint import acb, arb, ctx, fmpq, fmpq_mat, fmpq_poly
 
 from ccproof.rigorous.analytic import ball
 
-from .dart_family import _NPOLY, Family, adjugate, kappa, l0, layer_level0, u_denominator
+from .dart_family import _B1, _NPOLY, Family, adjugate, kappa, l0, layer_level0, u_denominator
 from .errors import CertificateError
 from .rules import TWO_RING
 from .tagged_modes import _POS, _block, check_ring, ring_stencil
@@ -117,10 +117,6 @@ def check_reach():
     return True
 
 
-def _b1():
-    return fmpq_mat(_block(fmpq(1)))
-
-
 def _charpoly_claimed():
     out = _X * _X - fmpq(3, 4) * _X + fmpq(1, 16)
     for s in _SMALL:
@@ -137,7 +133,7 @@ def check_mode0():
     >>> check_mode0()
     True
     """
-    B1, p = _b1(), _charpoly_claimed()
+    B1, p = _B1, _charpoly_claimed()
     if B1.charpoly() != p:
         raise CertificateError("det(x - B(1)) is not the claimed product")
     N = [fmpq_poly(c) for c in _NPOLY]

@@ -152,7 +152,7 @@ class QS:
 
     def coeffs(self):
         """[e_0, e_1, e_2]: the coefficients of h^0, h^1, h^2 as polynomials in theta (degree < 4)."""
-        return _coeffs(self.p)
+        return _h_coeffs(self.p)
 
     @property
     def c(self):
@@ -160,7 +160,7 @@ class QS:
         return [QF(e) for e in self.coeffs()]
 
 
-def _coeffs(p):
+def _h_coeffs(p):
     out, r = [], p
     for k in range(3):
         e = r % _MOD[1]
@@ -419,7 +419,7 @@ class _Tally:
             self.rows[row][0] += len(orders)
             if (p % _MOD[max(orders) + 1]).is_zero():
                 continue
-            cs = _coeffs(p % _M3)
+            cs = _h_coeffs(p % _M3)
             bad = [m for m in orders if not cs[m].is_zero()]
             self.rows[row][1] += len(bad)
             if bad and self.stop:
