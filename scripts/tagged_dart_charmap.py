@@ -92,7 +92,6 @@ from flint import acb, arb, ctx, fmpq
 from ccproof.certify.verify import dart_curves as _C
 from ccproof.certify.verify import dart_regularity as _R
 from ccproof.certify.verify.dart_family import (  # noqa: F401 (re-exported for the tests)
-    CURVES,
     PIECES,
     XB,
     YB,
@@ -108,6 +107,7 @@ from ccproof.certify.verify.dart_family import (  # noqa: F401 (re-exported for 
 from ccproof.certify.verify.dart_zeros import (  # noqa: F401 (re-exported for the tests)
     exact_zeros,
 )
+from ccproof.certify.verify.maps import STAR_CURVES  # noqa: F401 (re-exported for the tests)
 from ccproof.rigorous.analytic import ball as _ball  # noqa: F401 (re-exported for the tests)
 from ccproof.rigorous.analytic import disc_bound
 
@@ -208,7 +208,7 @@ def middle_box(T, E, M, s_lo, s_hi, w_lo, w_hi, sigma, r, n, L=24, prec=128):
 
 
 def ymid_box(T, M, s_lo, s_hi, w_lo, w_hi, sigma, r, n, L=24, prec=128):
-    models, om = _C.curve_models(T, M, r, YB), _C.y_omegas(sigma)
+    models, om = _C.curve_models(T, M, r, YB), _R.y_omegas(sigma)
     coeffs = {c: _R.middle_coeffs(model, om, 0, 1, L) for c, model in models.items()}
     return _bounds(_R.middle_box(models, coeffs, om, s_lo, s_hi, w_lo, w_hi, 0, 1, L=L, prec=prec))
 
@@ -531,7 +531,7 @@ def ymid_zero(T, sigma):
     es = acb(0, sigma).exp()
     c = {"Y0": acb(1), "Y+": 1 / es, "Y-": es}
     return max(float(abs(sum((c[j] * T[(j, cv)][0][p] for j in YB), acb(0))).upper())
-               for cv in CURVES for p in range(4))
+               for cv in STAR_CURVES for p in range(4))
 
 
 def layer_y_upper(T, M, q, h_lo, h_hi, r, n, prec=128):
@@ -542,7 +542,7 @@ def layer_y_upper(T, M, q, h_lo, h_hi, r, n, prec=128):
         h = _ball(h_lo, h_hi)
         hr = arb(fmpq(h_hi)) / r
         high, zero = None, 0.0
-        for c in CURVES:
+        for c in STAR_CURVES:
             for p in range(4):
                 order = 2 if (q == 0 and c == "P1s1" and p == 0) else 1
                 zero = max([zero] + [float(abs(T[c][m][p]).upper()) for m in range(order)])

@@ -34,13 +34,25 @@ from ccproof.certify.verify.maps import (
 from ccproof.certify.verify.replay import MAX_BOXES, parse_decimal
 from ccproof.certify.verify.statement import PATCHES, c_lam, derivation, nets_for_valence
 from ccproof.errors import CCProofError, ValenceError, check_valence
-from ccproof.rigorous import certainly_positive, lower_bound
+from ccproof.rigorous import certainly_positive, exact_fmpq, range_enclosure
 from ccproof.tables.format import certificates_dir
 from ccproof.valence import Valence, ValenceLike
 
 DEFAULT_PREC = 128
 MAX_DEPTH = 14
 
+
+
+def lower_bound(form):
+    """The lower end of ``range_enclosure(form)`` as an exact ``fmpq`` (None if it is -inf or NaN): the
+    bound a leaf records (the verifier re-derives its own).
+
+    >>> from flint import arb
+    >>> lower_bound([arb(1) / 3, arb(2)]) < fmpq(1, 3)
+    True
+    """
+    lo = range_enclosure(form)[0]
+    return lo if isinstance(lo, fmpq) else exact_fmpq(lo)
 
 class ProofFailed(CCProofError):
     """The search found no certificate (the claim may be false, or needs deeper subdivision).

@@ -16,10 +16,11 @@ Guarantees
   ``range_enclosure(bernstein_coefficients(p, box))`` brackets ``p`` on the whole box and
   ``certainly_positive`` (every coefficient certainly > 0, finite) proves ``p > 0`` on it.
 
-Main entry points: :class:`Poly`, :func:`jacobian_determinant`, :func:`bernstein_coefficients`,
+Main entry points: :class:`Poly`, :func:`jacobian_determinant` (of power, Bernstein or Taylor forms; also
+named ``bernstein_jacobian_determinant`` and ``taylor_jacobian_determinant``), :func:`bernstein_coefficients`,
 :class:`BernsteinForm` (``split``, ``restrict``, ``elevate``, ``diff``, ``+ - *``),
-:func:`range_enclosure`, :func:`lower_bound`, :func:`certainly_positive`, :func:`ball_contains`,
-:func:`bernstein_jacobian_determinant`, :class:`TaylorForm` (a Taylor model in one parameter with
+:func:`range_enclosure`, :func:`certainly_positive`, :func:`ball_contains`,
+:class:`TaylorForm` (a Taylor model in one parameter with
 Bernstein coefficients in the other variables, ``truncate``, ``bernstein``).  See ``docs/rigorous.md``.
 """
 
@@ -27,14 +28,15 @@ from ._tensor import ball_contains, exact_fmpq
 from .bernstein import (
     BernsteinForm,
     bernstein_coefficients,
-    bernstein_jacobian_determinant,
     certainly_positive,
-    lower_bound,
     range_enclosure,
     unit_box,
 )
 from .poly import Poly, jacobian_determinant
-from .taylor import TaylorForm, taylor_jacobian_determinant
+from .taylor import TaylorForm
+
+# one determinant for every kind of form (the names its callers use)
+bernstein_jacobian_determinant = taylor_jacobian_determinant = jacobian_determinant
 
 __all__ = [
     "BernsteinForm",
@@ -46,7 +48,6 @@ __all__ = [
     "certainly_positive",
     "exact_fmpq",
     "jacobian_determinant",
-    "lower_bound",
     "range_enclosure",
     "taylor_jacobian_determinant",
     "unit_box",

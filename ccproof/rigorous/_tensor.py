@@ -265,3 +265,21 @@ def pad(coeffs, shape, new_shape, prec):
     for c, i in zip(coeffs, idx):
         out[i] = c
     return out
+
+
+def truncate(coeffs, shape, axis, degree, prec):
+    """(coeffs, shape) of degree <= ``degree`` along ``axis``: every dropped coefficient c (of x_axis^j,
+    j > degree) added as [-|c|, |c|] to the coefficient of x_axis^0 with the same other exponents (a Taylor
+    model's remainder for |x_axis| <= 1)."""
+    n, post = shape[axis], size(shape[axis + 1 :])
+    out = []
+    with flint.ctx.workprec(prec):
+        for base in range(0, len(coeffs), n * post):
+            head = coeffs[base : base + post]
+            for j in range(degree + 1, n):
+                for q in range(post):
+                    x = coeffs[base + j * post + q]
+                    if not x.is_zero():  # exact zero only: a ball that merely contains 0 still counts
+                        head[q] = head[q] + arb(0, abs(x).upper())
+            out += head + coeffs[base + post : base + (degree + 1) * post]
+    return out, shape[:axis] + (degree + 1,) + shape[axis + 1 :]

@@ -117,6 +117,17 @@ class AnalyticModel:
         self.coeffs, self.M, self.r = coeffs, M, fmpq(r)
         self.order = len(coeffs) - 1
 
+    @classmethod
+    def from_columns(cls, columns, M, r):
+        """The model whose column k has the Taylor coefficients ``columns[k][m]`` (a list of values, the rows,
+        per order m) and the bound M[k].
+
+        >>> AnalyticModel.from_columns([[[1, 2], [3, 4]]], [arb(5)], fmpq(1, 2)).coeffs[1][1, 0]
+        4.00000000000000
+        """
+        return cls([acb_mat([[acb(col[m][row]) for col in columns] for row in range(len(columns[0][m]))])
+                    for m in range(len(columns[0]))], M, r)
+
     def enclose(self, h_lo, h_hi, low=0):
         """(V, rho): f(h)/h^low lies in V[c, k] plus a complex ball of radius rho[k] for every h in
         [h_lo, h_hi] (entries below h^low dropped: the caller knows them to be 0)."""

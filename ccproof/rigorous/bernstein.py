@@ -28,7 +28,7 @@ import flint
 from flint import arb, fmpq, fmpq_mat, fmpz
 
 from . import _tensor as T
-from .poly import Poly, _det, check_box, taylor_shift_matrix
+from .poly import Poly, check_box, taylor_shift_matrix
 
 _HALF = fmpq(1, 2)
 
@@ -369,28 +369,6 @@ def range_enclosure(form):
     return lo, hi
 
 
-def lower_bound(form):
-    """Lower end of :func:`range_enclosure` as an exact ``fmpq`` (``None`` if it is -inf/NaN).
-
-    Parameters
-    ----------
-    form : BernsteinForm or sequence of fmpq / arb
-
-    Returns
-    -------
-    fmpq or None
-
-    Examples
-    --------
-    >>> lower_bound([arb(1) / 3, arb(2)]) < fmpq(1, 3)
-    True
-    """
-    lo = range_enclosure(form)[0]
-    if isinstance(lo, fmpq):
-        return lo
-    return T.exact_fmpq(lo)
-
-
 def certainly_positive(form):
     """True only when every coefficient is certainly > 0 (so the polynomial is > 0 on the box).
 
@@ -418,36 +396,6 @@ def certainly_positive(form):
         elif not T.exact_scalar(c) > 0:
             return False
     return bool(coeffs)
-
-
-def bernstein_jacobian_determinant(forms, axes=None):
-    """Bernstein form of det(d forms[i] / d x_axes[j]) on the forms' common box, in Bernstein arithmetic.
-
-    Parameters
-    ----------
-    forms : sequence of n BernsteinForm (1 <= n <= 4), on one box
-    axes : tuple of n distinct int, optional: default ``0 .. n-1``
-
-    Returns
-    -------
-    BernsteinForm: det J, whose positivity gives local injectivity (docs/readings.md R7)
-
-    Examples
-    --------
-    For z^2 = (x^2 - y^2, 2 x y) the determinant is 4 x^2 + 4 y^2:
-
-    >>> x, y = Poly.variable(0, 2), Poly.variable(1, 2)
-    >>> J = bernstein_jacobian_determinant([bernstein_coefficients(x**2 - y**2), bernstein_coefficients(2 * x * y)])
-    >>> J.to_poly() == 4 * x**2 + 4 * y**2, J.coeffs[:3]
-    (True, [0, 0, 4])
-    """
-    forms = list(forms)
-    n = len(forms)
-    axes = tuple(range(n)) if axes is None else tuple(axes)
-    if not 1 <= n <= T.MAX_VARS or len(axes) != n or len(set(axes)) != n:
-        raise ValueError(f"{n} components with axes {axes!r}")
-    jac = [[f.diff(a) for a in axes] for f in forms]
-    return _det(jac)
 
 
 def _coefficients(form):

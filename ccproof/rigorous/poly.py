@@ -17,7 +17,7 @@ accepted.
 21/4
 >>> p.diff(1) == 4 * x + 8 * y
 True
->>> p.restrict([(1, 3), (0, 1)])(0, 1) == p(1, 1)
+>>> p.affine(0, 1, 3)(0, 1) == p(1, 1)
 True
 """
 
@@ -126,7 +126,7 @@ class Poly:
 
     @property
     def degrees(self):
-        """Degree bound per variable (the stored shape minus one; see :meth:`trim`)."""
+        """Degree bound per variable (the stored shape minus one)."""
         return tuple(n - 1 for n in self.shape)
 
     @property
@@ -146,19 +146,6 @@ class Poly:
     def terms(self):
         """``{exponents: coefficient}`` for the coefficients that are not exactly zero."""
         return {e: c for e, c in zip(T.multi_indices(self.shape), self.coeffs) if not _is_exact_zero(c)}
-
-    def trim(self):
-        """The same polynomial with trailing exactly-zero slices removed along every axis."""
-        shape = list(self.shape)
-        terms = self.terms()
-        for i in range(self.nvars):
-            shape[i] = max([e[i] for e in terms], default=0) + 1
-        shape = tuple(shape)
-        if shape == self.shape:
-            return self
-        strides = T._strides(self.shape)
-        idx = T.embed_indices(shape, strides)
-        return Poly._raw(shape, [self.coeffs[i] for i in idx], self.prec)
 
     def __repr__(self):
         kind = "exact" if self.prec is None else f"arb {self.prec} bits"
@@ -399,30 +386,8 @@ class Poly:
             return self
         if self.prec is None:
             raise TypeError("truncate() makes balls: convert with .to_arb(prec) first")
-        pre, post = T.size(self.shape[:axis]), T.size(self.shape[axis + 1 :])
-        c = self.coeffs
-        out = []
-        with flint.ctx.workprec(self.prec):
-            for p in range(pre):
-                base = p * n * post
-                head = [c[base + q] for q in range(post)]
-                for j in range(degree + 1, n):
-                    for q in range(post):
-                        x = c[base + j * post + q]
-                        if not x.is_zero():  # exact zero only: a ball that merely contains 0 still counts
-                            head[q] = head[q] + arb(0, abs(x).upper())
-                out += head + c[base + post : base + (degree + 1) * post]
-        shape = self.shape[:axis] + (degree + 1,) + self.shape[axis + 1 :]
-        return Poly._raw(shape, out, self.prec)
-
-    def restrict(self, box):
-        """``p`` reparameterized so that [0,1]^n maps affinely onto ``box`` = [(lo, hi), ...]."""
-        box = check_box(box, self.nvars)
-        p = self
-        for axis, (lo, hi) in enumerate(box):
-            if (lo, hi) != (0, 1):
-                p = p.affine(axis, lo, hi)
-        return p
+        c, shape = T.truncate(self.coeffs, self.shape, axis, degree, self.prec)
+        return Poly._raw(shape, c, self.prec)
 
     def _axis(self, axis):
         if isinstance(axis, bool) or not isinstance(axis, int) or not 0 <= axis < self.nvars:
@@ -523,18 +488,19 @@ def taylor_shift_matrix(n, a, h):
 
 
 def jacobian_determinant(components, variables=None):
-    """det of ``(d components[i] / d x_{variables[j]})`` for 1 to 4 components (Laplace expansion).
+    """det of ``(d components[i] / d x_{variables[j]})`` for 1 to 4 components (Laplace expansion), in the
+    components' own arithmetic: power form, Bernstein form on their common box, or Taylor model (z kept).
 
     ``variables`` defaults to ``0 .. len(components)-1``; extra variables act as parameters.
 
     Parameters
     ----------
-    components : sequence of n Poly (1 <= n <= 4)
-    variables : tuple of n distinct int, optional
+    components : sequence of n Poly, BernsteinForm or TaylorForm (1 <= n <= 4), anything with ``diff``
+    variables : tuple of n distinct int, optional (for a TaylorForm, x axes >= 1)
 
     Returns
     -------
-    Poly
+    Poly, BernsteinForm or TaylorForm
         det J, whose sign decides local injectivity (docs/readings.md R7; e.g. det J_Phi of the
         characteristic map).
 

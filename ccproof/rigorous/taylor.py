@@ -15,7 +15,7 @@ which cancel heavily at high degree).
 
 >>> from flint import arb
 >>> x = TaylorForm.variable(1, 1, prec=64)               # x_1 on [0,1]
->>> z = TaylorForm.parameter(1, prec=64)                 # z on [-1, 1]
+>>> z = TaylorForm.from_poly(Poly.variable(0, 2), 64)   # z on [-1, 1]
 >>> f = (x * z + 1) * (x * z - 1)                        # x^2 z^2 - 1
 >>> f.shape, f.truncate(1).shape
 ((3, 3), (2, 3))
@@ -119,11 +119,6 @@ class TaylorForm:
         shape = (1,) + tuple(2 if i == axis else 1 for i in range(1, d + 1))
         return cls._raw(shape, [arb(0), arb(1)], prec)
 
-    @classmethod
-    def parameter(cls, nx, prec):
-        """The parameter ``z`` itself, as a form in ``nx`` variables x."""
-        return cls._raw((2,) + (1,) * nx, [arb(0), arb(1)], prec)
-
     # ------------------------------------------------------------------ arithmetic
 
     def _aligned(self, other):
@@ -207,19 +202,10 @@ class TaylorForm:
         [-|c|, |c|] to the coefficient of z^0 B_k (|z| <= 1 and B_k >= 0)."""
         if isinstance(degree, bool) or not isinstance(degree, int) or degree < 0:
             raise ValueError(f"degree must be a non-negative int, got {degree!r}")
-        m = self.shape[0]
-        if m <= degree + 1:
+        if self.shape[0] <= degree + 1:
             return self
-        block = prod(self.shape[1:])
-        c = self.coeffs
-        with flint.ctx.workprec(self.prec):
-            head = list(c[:block])
-            for e in range(degree + 1, m):
-                for q in range(block):
-                    x = c[e * block + q]
-                    if not x.is_zero():  # exact zero only: a ball that merely contains 0 still counts
-                        head[q] = head[q] + arb(0, abs(x).upper())
-        return TaylorForm._raw((degree + 1,) + self.shape[1:], head + c[block:(degree + 1) * block], self.prec)
+        c, shape = T.truncate(self.coeffs, self.shape, 0, degree, self.prec)
+        return TaylorForm._raw(shape, c, self.prec)
 
     def bernstein(self):
         """The :class:`BernsteinForm` of the same polynomial on [-1, 1] x [0, 1]^d (z converted)."""
@@ -227,31 +213,3 @@ class TaylorForm:
         c, shape = T.apply_along_axis(self.coeffs, self.shape, 0, _conversion_matrix(n, n, *ZBOX), self.prec)
         box = (ZBOX,) + ((T.exact_scalar(0), T.exact_scalar(1)),) * (len(shape) - 1)
         return BernsteinForm._raw(shape, c, box, self.prec)
-
-
-def taylor_jacobian_determinant(components, axes):
-    """det of (d components[i] / d x_{axes[j]}) for two components (2 x 2, the parameter z kept).
-
-    Parameters
-    ----------
-    components : (TaylorForm, TaylorForm)
-    axes : (int, int)
-        Axes of the x variables (1..d; axis 0 is z).
-
-    Returns
-    -------
-    TaylorForm
-        det J for all k >= k0 at once (docs/readings.md R7, R10).
-
-    Examples
-    --------
-    For (x^2 + z y, y + z x) the determinant is 2 x - z^2: z^0 block (0, 0, 1, 1, 2, 2), z^2 block -1:
-
-    >>> z, x, y = (Poly.variable(i, 3) for i in range(3))
-    >>> f, g = TaylorForm.from_poly(x * x + z * y, 53), TaylorForm.from_poly(y + z * x, 53)
-    >>> J = taylor_jacobian_determinant([f, g], (1, 2))
-    >>> J.shape, [c.str(3, radius=False) for c in J.coeffs[:6]], [c.str(3, radius=False) for c in J.coeffs[12:]]
-    ((3, 3, 2), ['0', '0', '1.00', '1.00', '2.00', '2.00'], ['-1.00', '-1.00', '-1.00', '-1.00', '-1.00', '-1.00'])
-    """
-    (f, g), (a, b) = components, axes
-    return f.diff(a) * g.diff(b) - f.diff(b) * g.diff(a)

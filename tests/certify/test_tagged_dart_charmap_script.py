@@ -175,14 +175,14 @@ def test_transversality_models_enclose_the_verifiers_forms():
         h = fmpq(1, k)
         for q in (30, 50):
             nets = quadrant_nets("dart", k, x, y, q, 128)
-            want = min(min(c.lower() for c in transversal_form(nets, cv, a1, a2, 128).coeffs) for cv in mod.CURVES)
+            want = min(min(c.lower() for c in transversal_form(nets, cv, a1, a2, 128).coeffs) for cv in mod.STAR_CURVES)
             lo, hi = mod.kdet_box(T, M, fmpq(q, k), fmpq(q, k), h, h, sig, r, n)
             assert lo <= want * k <= hi and lo > 0, (q, lo, want * k, hi)
         TL = mod.layer_trans_taylor(0, sig, 14)
         ML = mod.layer_trans_disc(0, mod._ball(mod.SIGMA_LO, mod.SIGMA_HI), r)
         assert all(abs(z) < 1e-25 for c in TL for m in range(3) for z in TL[c][m])
         nets = quadrant_nets("dart", k, x, y, 0, 128)
-        want = min(min(c.lower() for c in transversal_form(nets, cv, a1, a2, 128).coeffs) for cv in mod.CURVES)
+        want = min(min(c.lower() for c in transversal_form(nets, cv, a1, a2, 128).coeffs) for cv in mod.STAR_CURVES)
         lo, hi = mod.layer_box(TL, ML, h, h, r, 14)
         assert lo <= want * k ** 3 <= hi and lo > 0, (lo, want * k ** 3, hi)
 
@@ -198,7 +198,7 @@ def test_winding_signs_and_their_controls():
         assert all(c > 0 and not f for c, f in res.values()), res
         sig = mod._limit_script().sigma_of(arb(fmpq(1, k)))
         T, _ = mod.layer_coord(0, sig, 14, mod.R_CAUCHY, grid=0)
-        assert all(abs(T[c][0][p]) < 1e-25 for c in mod.CURVES for p in range(4))
+        assert all(abs(T[c][0][p]) < 1e-25 for c in mod.STAR_CURVES for p in range(4))
         assert abs(T["P1s1"][1][0]) < 1e-25  # ray 0's end point: y = O(h^2)
         TY = mod.coord_taylor(sig, 12, "y")
         assert mod.ymid_zero(TY, sig) < 1e-25
@@ -380,10 +380,10 @@ def test_the_exact_nets_are_the_acb_familys_nets():
             el = []
             for e in exs:
                 x, y = e.layer_level0(q)
-                el.append({p: mod._bezier([[mod.level1_value(y, e.yc, e.lam2, e.zero, q)(mod._OFFSET[p][0] + i,
+                el.append({p: mod._bezier([[mod.quadrant_level1(y, e.yc, e.lam2, e.zero, q)(mod._OFFSET[p][0] + i,
                                                                                             mod._OFFSET[p][1] + j)
                                              for j in range(4)] for i in range(4)], e.zero) for p in mod.PIECES})
-                x0 = {p: mod._bezier([[mod.level1_value(x, e.zero, e.lam1, e.zero, q)(mod._OFFSET[p][0] + i,
+                x0 = {p: mod._bezier([[mod.quadrant_level1(x, e.zero, e.lam1, e.zero, q)(mod._OFFSET[p][0] + i,
                                                                                      mod._OFFSET[p][1] + j)
                                        for j in range(4)] for i in range(4)], e.zero) for p in mod.PIECES}
             for p in mod.PIECES:

@@ -79,20 +79,19 @@ def test_compose_matches_sympy():
     assert w.to_arb(100).compose([q.to_arb(100) for q in phi]).contains(got)
 
 
-def test_affine_and_restrict_match_sympy():
+def test_affine_matches_sympy_on_each_axis():
     r = H.rng(3)
     p = H.random_poly(r, (3, 2))
     a, b = fmpq(-1, 3), fmpq(5, 4)
     got = p.affine(0, a, b)
     expect = H.to_sympy(p).subs(X[0], H.q2s(a) + (H.q2s(b) - H.q2s(a)) * X[0])
     assert sp.expand(H.to_sympy(got) - expect) == 0
-    box = [(fmpq(1, 4), fmpq(1, 2)), ("-2", 3)]
-    got = p.restrict(box)
+    got = p.affine(0, fmpq(1, 4), fmpq(1, 2)).affine(1, -2, 3)
     expect = H.to_sympy(p).subs(
         {X[0]: sp.Rational(1, 4) + sp.Rational(1, 4) * X[0], X[1]: -2 + 5 * X[1]}, simultaneous=True
     )
     assert sp.expand(H.to_sympy(got) - expect) == 0
-    assert p.to_arb(90).restrict(box).contains(got)
+    assert p.to_arb(90).affine(0, fmpq(1, 4), fmpq(1, 2)).affine(1, -2, 3).contains(got)
 
 
 def test_jacobian_determinant_matches_sympy():
@@ -124,7 +123,7 @@ def test_trim_terms_and_equality():
     x, y = Poly.variable(0, 2), Poly.variable(1, 2)
     p = (x + y) ** 2 - x * x - 2 * x * y
     assert p.degrees == (2, 2)
-    assert p.trim().degrees == (0, 2)
+    assert Poly(p.terms(), 2).degrees == (0, 2)
     assert p == y**2
     assert p.terms() == {(0, 2): fmpq(1)}
     assert Poly.constant(3, 2) == 3
@@ -156,8 +155,6 @@ def test_input_validation():
         Poly({(0, 1): arb(1)})  # arb in an exact polynomial
     with pytest.raises(TypeError):
         Poly.variable(0, 2) * arb(2)
-    with pytest.raises(ValueError):
-        Poly.variable(0, 2).restrict([(1, 1), (0, 1)])
     with pytest.raises(ValueError):
         Poly.variable(0, 2).evaluate([arb(1), 1])  # exact poly at a ball needs prec
     with pytest.raises(ValueError):

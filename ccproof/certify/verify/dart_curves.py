@@ -8,12 +8,11 @@ The models and the disc bounds are those of :mod:`ccproof.rigorous.analytic`.
 
 from __future__ import annotations
 
-from flint import acb, acb_mat, arb, ctx
+from flint import acb, ctx
 
 from ccproof.rigorous.analytic import AnalyticModel, ball, hull
 
 from .dart_family import (
-    CURVES,
     PIECES,
     XB,
     YB,
@@ -21,8 +20,9 @@ from .dart_family import (
     _coeffs,
     _series_curves,
     _trans_series,
-    curve_points,
 )
+from .dart_regularity import mode_factors, real_hull
+from .maps import STAR_CURVES, curve_points
 
 
 def _logs(fam):
@@ -39,25 +39,28 @@ def _trans(X, Y, a1, a2):
 def trans_values(fam, nets):
     """{(i, j, curve): the 6 Bernstein coefficients of a1 X_i Y_j' - a2 Y_j X_i'} at one acb h."""
     a1, a2 = _logs(fam)
-    return {(i, j, c): _trans(curve_points(nets[i], c), curve_points(nets[j], c), a1, a2)
-            for i in XB for j in YB for c in CURVES}
+    return {(i, j, c): _trans(curve_points(nets[i], c, oriented=True), curve_points(nets[j], c, oriented=True),
+                              a1, a2)
+            for i in XB for j in YB for c in STAR_CURVES}
 
 
 def layer_trans_values(fam, lnets):
     """{curve: the 6 Bernstein coefficients of a1 X Y' - a2 Y X'} of one layer quadrant at one acb h."""
     a1, a2 = _logs(fam)
     xs, ys = ({p: lnets[p][k] for p in PIECES} for k in (0, 1))
-    return {c: _trans(curve_points(xs, c), curve_points(ys, c), a1, a2) for c in CURVES}
+    return {c: _trans(curve_points(xs, c, oriented=True), curve_points(ys, c, oriented=True), a1, a2)
+            for c in STAR_CURVES}
 
 
 def coord_values(nets, coord):
     """{(basis part, curve): its 4 Bezier points} of x (coord "x") or y ("y") at one acb h."""
-    return {(part, c): curve_points(nets[part], c) for part in (XB if coord == "x" else YB) for c in CURVES}
+    return {(part, c): curve_points(nets[part], c, oriented=True)
+            for part in (XB if coord == "x" else YB) for c in STAR_CURVES}
 
 
 def layer_y_values(lnets):
     """{curve: 4 Bezier points of Y} of one layer quadrant at one acb h."""
-    return {c: curve_points({p: lnets[p][1] for p in PIECES}, c) for c in CURVES}
+    return {c: curve_points({p: lnets[p][1] for p in PIECES}, c, oriented=True) for c in STAR_CURVES}
 
 
 def trans_series(fam, nets, n):
@@ -65,50 +68,37 @@ def trans_series(fam, nets, n):
     T_ij(0) = 0 exactly (a1 = a2, both parts multiples of one real curve at h = 0)."""
     A1, A2 = (_coeffs(-lam.log(), n + 1) for lam in (fam.lam1, fam.lam2))
     curves = {b: _series_curves(nets[b], n) for b in nets}
-    return {(i, j, c): _trans_series(curves[i][c], curves[j][c], A1, A2, n) for i in XB for j in YB for c in CURVES}
+    return {(i, j, c): _trans_series(curves[i][c], curves[j][c], A1, A2, n)
+            for i in XB for j in YB for c in STAR_CURVES}
 
 
 def layer_trans_series(fam, lnets, n):
     """{curve: [coefficients (arb) of h^m]} of a1 X Y' - a2 Y X' on a layer quadrant (h^0..h^2: 0 exactly)."""
     A1, A2 = ([z.real for z in _coeffs(-lam.log(), n + 1)] for lam in (fam.lam1, fam.lam2))
     xs, ys = (_series_curves({p: lnets[p][k] for p in PIECES}, n) for k in (0, 1))
-    real = {c: ([[z.real for z in pts] for pts in xs[c]], [[z.real for z in pts] for pts in ys[c]]) for c in CURVES}
-    return {c: [[z.real for z in row] for row in _trans_series(real[c][0], real[c][1], A1, A2, n)] for c in CURVES}
+    real = {c: ([[z.real for z in pts] for pts in xs[c]], [[z.real for z in pts] for pts in ys[c]])
+            for c in STAR_CURVES}
+    return {c: [[z.real for z in row] for row in _trans_series(real[c][0], real[c][1], A1, A2, n)] for c in STAR_CURVES}
 
 
 def layer_y_series(lnets, n):
     """{curve: [m: 4 arb]}: Taylor coefficients of Y's outer-curve points on a layer quadrant."""
     ys = _series_curves({p: lnets[p][1] for p in PIECES}, n)
-    return {c: [[z.real for z in pts] for pts in ys[c]] for c in CURVES}
+    return {c: [[z.real for z in pts] for pts in ys[c]] for c in STAR_CURVES}
 
 
 def curve_models(T, M, r, parts):
     """{curve: AnalyticModel}: row p the Bezier point, column the basis part (in the order of ``parts``)."""
-    n = len(T[(parts[0], next(iter(CURVES)))]) - 1
-    return {c: AnalyticModel([acb_mat([[T[(b, c)][m][p] for b in parts] for p in range(4)]) for m in range(n + 1)],
-                             [M[(b, c)] for b in parts], r) for c in CURVES}
-
-
-def _coord_factors(coord, s, sigma):
-    if coord == "x":
-        E = acb(0, 2 * arb.pi() * s).exp()
-        return [E, 1 / E]
-    F = acb(0, sigma * (2 * s - 1)).exp()
-    return [acb(1), F, 1 / F]
+    return {c: AnalyticModel.from_columns([T[(b, c)] for b in parts], [M[(b, c)] for b in parts], r)
+            for c in STAR_CURVES}
 
 
 def coord_box(models, s_lo, s_hi, h_lo, h_hi, sigma, coord, prec=128):
     """An arb holding X or Y on every outer curve's Bezier points, s in [s_lo, s_hi], h in [h_lo, h_hi] (a
     bulk quadrant), from the models of :func:`curve_models`."""
     with ctx.workprec(prec):
-        fac = _coord_factors(coord, ball(s_lo, s_hi), sigma)
-        return hull(v for model in models.values() for v in model.real_part(fac, h_lo, h_hi))
-
-
-def y_omegas(sigma):
-    """b_j(s) = c_j e^(i omega_j s): [(c_j, omega_j)] in the order of YB (Y0, Y+, Y-)."""
-    es = acb(0, sigma).exp()
-    return [(acb(1), arb(0)), (1 / es, 2 * sigma), (es, -2 * sigma)]
+        fac = mode_factors(ball(s_lo, s_hi), sigma)[0 if coord == "x" else 1]
+        return real_hull(models, fac, h_lo, h_hi, 0, prec)
 
 
 def layer_y_box(models, q, h_lo, h_hi, prec=128):

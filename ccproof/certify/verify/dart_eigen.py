@@ -85,7 +85,7 @@ from flint import acb, arb, ctx, fmpq, fmpq_mat, fmpq_poly
 
 from ccproof.rigorous.analytic import ball
 
-from .dart_family import _NPOLY, Family, l0, layer_level0
+from .dart_family import _B1, _NPOLY, Family, adjugate, kappa, l0, layer_level0, u_denominator
 from .errors import CertificateError
 from .rules import TWO_RING
 from .tagged_modes import _POS, _block, check_ring, ring_stencil
@@ -117,14 +117,6 @@ def check_reach():
     return True
 
 
-def _b1():
-    return fmpq_mat(_block(fmpq(1)))
-
-
-def _kappa():
-    return [1 - sum(ring_stencil()[i].values()) for i in range(6)]
-
-
 def _charpoly_claimed():
     out = _X * _X - fmpq(3, 4) * _X + fmpq(1, 16)
     for s in _SMALL:
@@ -141,29 +133,16 @@ def check_mode0():
     >>> check_mode0()
     True
     """
-    B1, p = _b1(), _charpoly_claimed()
+    B1, p = _B1, _charpoly_claimed()
     if B1.charpoly() != p:
         raise CertificateError("det(x - B(1)) is not the claimed product")
     N = [fmpq_poly(c) for c in _NPOLY]
-    kap = _kappa()
+    kap = kappa()
     for i in range(6):
         lhs = _X * N[i] - sum((B1[i, k] * N[k] for k in range(6)), fmpq_poly(0))
         if lhs != p * kap[i]:
             raise CertificateError("U's numerator is not adj(x - B(1)) kappa: the mode-0 part misses its rows")
     return True
-
-
-def _adjugate(B):
-    """adj(x - B) as a 6 x 6 list of fmpq_poly (Faddeev-LeVerrier, exact; Cayley-Hamilton checked)."""
-    n = B.nrows()
-    c = B.charpoly().coeffs()
-    eye = fmpq_mat([[int(i == j) for j in range(n)] for i in range(n)])
-    Ms = [eye]
-    for k in range(1, n):
-        Ms.append(B * Ms[-1] + c[n - k] * eye)
-    if B * Ms[-1] + c[0] * eye != fmpq_mat(n, n):
-        raise CertificateError("Cayley-Hamilton fails: the adjugate is wrong")
-    return [[fmpq_poly([Ms[n - 1 - d][i, j] for d in range(n)]) for j in range(n)] for i in range(n)]
 
 
 def check_crease_row(points=W_POINTS):
@@ -190,7 +169,7 @@ def check_crease_row(points=W_POINTS):
     for w in range(1, points + 1):
         c = (fmpq(w) + fmpq(1, w)) / 2
         q = _X * _X - (5 + c) / 8 * _X + fmpq(1, 16)
-        adj = _adjugate(fmpq_mat(_block(fmpq(w))))
+        adj = adjugate(fmpq_mat(_block(fmpq(w))))
         for j in range(6):
             P = sum((psi[i] * adj[i][j] for i in range(6)), fmpq_poly(0))
             if P % q != 0:
@@ -239,10 +218,7 @@ def _denominators(fam):
     """ZeroDivisionError unless U's denominator, alpha's a1 and lam - 1/2 (alpha != 0) are certainly non-zero
     and U, v^ finite (then the family is analytic on the ball: items 1b, 2, 3)."""
     lam, L0, L1 = fam.lam2, *l0()
-    den = lam - L1
-    for s in _SMALL:
-        den *= lam - s
-    _nonzero(den, "U's denominator")
+    _nonzero(u_denominator(lam, L1), "U's denominator")
     _nonzero((lam - fmpq(1, 2)) * fam.U[_E10] - (lam - L0) / 2, "alpha's denominator a1")
     _nonzero(lam - fmpq(1, 2), "lam - 1/2")
     if not all(z.is_finite() for z in list(fam.U) + list(fam.vy) + list(fam.vx)):
@@ -255,7 +231,7 @@ def _guard(fam, tol):
     radii below tol; they are identities, items 1 and 2)."""
     lam, L0 = fam.lam2, l0()[0]
     _, y, _, yc = layer_level0(fam, 0)
-    kap = _kappa()
+    kap = kappa()
     res = [fam.vy[_E10] - 1, yc - fam.alpha * (lam - L0),
            (lam - fmpq(1, 2)) * y(0, (1, 0)) - yc / 2,
            (lam - fmpq(1, 8)) * y(0, (2, 0)) - fmpq(3, 4) * y(0, (1, 0)) - yc / 8]

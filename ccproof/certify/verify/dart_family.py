@@ -22,10 +22,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from flint import acb, acb_mat, acb_poly, acb_series, arb, ctx, fmpq, fmpq_mat
+from flint import acb, acb_mat, acb_poly, acb_series, arb, ctx, fmpq, fmpq_mat, fmpq_poly
 
+from .errors import CertificateError
+from .maps import STAR_CURVES, curve_points
 from .rules import CENTRE, canonical, level1_rule
-from .tagged_modes import _POS, ring_stencil
+from .statement import horner
+from .tagged_modes import _POS, _block, ring_stencil
 
 
 @dataclass(frozen=True)
@@ -55,25 +58,31 @@ _OFFSET = {"P1": (0, -1), "P2": (0, 0), "P3": (-1, 0)}  # as tagged_map: level-1
 PIECES = ("P1", "P2", "P3")
 
 
-CURVES = {"P1s1": ("P1", "s", 1), "P2s1": ("P2", "s", 1), "P2t1": ("P2", "t", -1), "P3t1": ("P3", "t", -1)}
 
 
-def _kappa():
+def kappa():
+    """The centre's weights in the six ring rows (exact)."""
     return [1 - sum(ring_stencil()[i].values()) for i in range(6)]
 
 
+def adjugate(B):
+    """adj(x - B) as a list of lists of fmpq_poly (Faddeev-LeVerrier, exact; Cayley-Hamilton checked)."""
+    n = B.nrows()
+    c = B.charpoly().coeffs()
+    eye = fmpq_mat([[int(i == j) for j in range(n)] for i in range(n)])
+    Ms = [eye]
+    for k in range(1, n):
+        Ms.append(B * Ms[-1] + c[n - k] * eye)
+    if B * Ms[-1] + c[0] * eye != fmpq_mat(n, n):
+        raise CertificateError("Cayley-Hamilton fails: the adjugate is wrong")
+    return [[fmpq_poly([Ms[n - 1 - d][i, j] for d in range(n)]) for j in range(n)] for i in range(n)]
+
+
 def _adj_kappa_polys():
-    """N(lam) = adj(lam - B(1)) kappa as 6 exact polynomials (coefficient lists, degree <= 5), by the
-    Cayley-Hamilton form of the adjugate: with det(lam - B) = sum_j c_j lam^j (degree 6),
-    adj(lam - B) = sum_(k < 6) lam^k sum_(j > k) c_j B^(j-k-1)."""
-    B1 = fmpq_mat([[sum((x for (d, pos), x in ring_stencil()[i].items() if _POS[pos] == k), fmpq(0))
-                    for k in range(6)] for i in range(6)])
-    c = B1.charpoly()
-    powers = [fmpq_mat([[z] for z in _kappa()])]  # B^m kappa
-    for _ in range(5):
-        powers.append(B1 * powers[-1])
-    return [[sum((c[j] * powers[j - k - 1][i, 0] for j in range(k + 1, 7)), fmpq(0)) for k in range(6)]
-            for i in range(6)], B1
+    """N(lam) = adj(lam - B(1)) kappa as 6 exact polynomials (coefficient lists, degree <= 5)."""
+    B1 = fmpq_mat(_block(fmpq(1)))
+    adj, kap = adjugate(B1), kappa()
+    return [[sum((adj[i][k][d] * kap[k] for k in range(6)), fmpq(0)) for d in range(6)] for i in range(6)], B1
 
 
 _NPOLY, _B1 = _adj_kappa_polys()
@@ -85,17 +94,15 @@ def l0():
     return (6 + r) / 16, (6 - r) / 16
 
 
+def u_denominator(lam, low):
+    """(lam - 1/8)(lam - 1/16)(lam - 1/32)(lam - 1/64)(lam - low), low = 1/(16 L0) (of lam's type)."""
+    return (lam - fmpq(1, 8)) * (lam - fmpq(1, 16)) * (lam - fmpq(1, 32)) * (lam - fmpq(1, 64)) * (lam - low)
+
+
 def big_u(lam):
-    """U(lam) (6 values of lam's type) = adj(lam - B(1)) kappa divided by
-    (lam - 1/8)(lam - 1/16)(lam - 1/32)(lam - 1/64)(lam - 1/(16 L0))."""
-    den = (lam - fmpq(1, 8)) * (lam - fmpq(1, 16)) * (lam - fmpq(1, 32)) * (lam - fmpq(1, 64)) * (lam - l0()[1])
-    out = []
-    for p in _NPOLY:
-        acc = lam * 0
-        for c in reversed(p):
-            acc = acc * lam + c
-        out.append(acc / den)
-    return out
+    """U(lam) (6 values of lam's type) = adj(lam - B(1)) kappa / :func:`u_denominator`."""
+    den = u_denominator(lam, l0()[1])
+    return [horner(p, lam, lam * 0) / den for p in _NPOLY]
 
 
 def _lam_principal(c):
@@ -106,16 +113,6 @@ def _lam_principal(c):
     if isinstance(arg, acb) and not arg.real > 0:
         raise ZeroDivisionError("sqrt((1 + c)(9 + c)): the argument is not certainly off the branch cut")
     return (5 + c + arg.sqrt()) / 16
-
-
-def _block(w):
-    """B(w) (6 x 6 of w's type): entries sum x w^delta, delta in -1..2."""
-    powers = {-1: 1 / w, 0: w * 0 + 1, 1: w, 2: w * w}
-    rows = [[w * 0 for _ in range(6)] for _ in range(6)]
-    for i, row in enumerate(ring_stencil()):
-        for (d, pos), x in row.items():
-            rows[i][_POS[pos]] = rows[i][_POS[pos]] + powers[d] * x
-    return rows
 
 
 def _hvar(n):
@@ -145,15 +142,19 @@ def _coeffs(z, n):
     return [acb(c[i]) if i < len(c) else acb(0) for i in range(n)]
 
 
+def bordered_matrix(B, lam, zero, pivot=0):
+    """The bordered 7 x 7 matrix [[B - lam, e_pivot], [e_pivot^T, 0]] (``zero`` of B's ring)."""
+    A = [[(B[i][k] - lam) if i == k else B[i][k] for k in range(6)] + [zero + int(i == pivot)] for i in range(6)]
+    return A + [[zero + int(k == pivot) for k in range(6)] + [zero]]
+
+
 def bordered(w, lam, pivot=0):
     """v^ (6 values of w's type): B(w) v^ = lam v^, v^[pivot] = 1, from the bordered 7 x 7 system A v = e_7.
 
     For acb balls arb proves A regular on the whole ball (ZeroDivisionError otherwise). For power series
     in h (acb_series) the Taylor coefficients follow from A_0 v_k = -sum_(j >= 1) A_j v_(k-j), A_0 the
     system at h = 0 (proved regular by arb)."""
-    B = _block(w)
-    A = [[(B[i][k] - lam) if i == k else B[i][k] for k in range(6)] + [w * 0 + int(i == pivot)] for i in range(6)]
-    A.append([w * 0 + int(k == pivot) for k in range(6)] + [w * 0])
+    A = bordered_matrix(_block(w), lam, w * 0, pivot)
     if not isinstance(w, acb_series):
         sol = acb_mat(A).solve(acb_mat([[0]] * 6 + [[1]]))
         return [sol[i, 0] for i in range(6)]
@@ -173,15 +174,50 @@ def _swap(pos):
     return pos if pos[1] == 0 else (pos[1], pos[0])
 
 
-class Family:
-    """x and y of dart:K at one h (an acb ball, or the series variable: acb_series [0, 1]) and one sigma,
-    split by their dependence on s:
+def _eps(pos):
+    return 0 if pos[1] == 0 else 1
 
-        x = E X+ + E^-1 X-,  y = Y0 + F Y+ + F^-1 Y-,  E = e^(2 pi i s), F = e^(i sigma (2 s - 1)),
 
-    each basis part a function ``part(delta, pos)`` of the offset delta and the two-ring position (the level-0
-    value at sector K s + delta), with its centre value; analytic in h (no Re or Im: the conjugate of a mode
-    is written as the mode of 1/w with the positions (a, b) swapped).
+class Modes:
+    """x and y from their modes, split by their dependence on s: x = E X+ + E^-1 X-, y = Y0 + F Y+ + F^-1 Y-,
+    E = e^(2 pi i s), F = e^(i sigma (2 s - 1)); one assembly for :class:`Family` (acb) and the exact family of
+    :mod:`.dart_zeros`. Needs vx, vy, U, alpha, yc (y's centre), lam1, lam2, zero, i2 = 2i, sign, em, ep =
+    e^(-+ i sigma) and ``e(c, k)``: e^(i k a h) for c = "x", e^(i k b h) for "y" (a = 2 pi, b = 2 sigma). No
+    Re or Im: the conjugate of a mode is the mode of 1/w with the positions (a, b) swapped."""
+
+    def parts(self):
+        """{name: (level0(delta, pos), centre, lam)} for X+, X-, Y0, Y+, Y-: level0 the level-0 value at sector
+        K s + delta and two-ring position pos."""
+        vx, vy, e, i2, z = self.vx, self.vy, self.e, self.i2, self.zero
+        return {
+            "X+": (lambda d, p: vx[_POS[p]] * e("x", d) / i2, z, self.lam1),
+            "X-": (lambda d, p: -(vx[_POS[_swap(p)]] * e("x", -d - _eps(p))) / i2, z, self.lam1),
+            "Y0": (lambda d, p: self.alpha * self.U[_POS[p]], self.yc, self.lam2),
+            "Y+": (lambda d, p: vy[_POS[p]] * e("y", d) * self.sign / 2, z, self.lam2),
+            "Y-": (lambda d, p: vy[_POS[_swap(p)]] * e("y", -d - _eps(p)) * self.sign / 2, z, self.lam2),
+        }
+
+    def layer_level0(self, q=0):
+        """(x(t, p), y(t, p)) at integer sectors t (any sign; the same for every layer quadrant q):
+        x = (v^(p) w^t - v^(p~) w^(-t-eps))/(2i) (one mode, every t), y = alpha U(p) + (v^_y(p)
+        e^(i sigma (2 h t - 1)) + v^_y(p~) e^(-i sigma (2 h (t + eps) - 1)))/2 for t >= 0 and y's reflection
+        in ray 0 for t < 0 (ray t -> ray -t, quadrant t (a, b) -> quadrant -t-1 (b, a))."""
+        vx, vy, e = self.vx, self.vy, self.e
+
+        def x(t, pos):
+            return (vx[_POS[pos]] * e("x", t) - vx[_POS[_swap(pos)]] * e("x", -t - _eps(pos))) / self.i2
+
+        def y(t, pos):
+            if t < 0:
+                t, pos = (-t, pos) if pos[1] == 0 else (-t - 1, _swap(pos))
+            return (self.alpha * self.U[_POS[pos]] + (vy[_POS[pos]] * e("y", t) * self.em
+                                                      + vy[_POS[_swap(pos)]] * e("y", -t - _eps(pos)) * self.ep) / 2)
+        return x, y
+
+
+class Family(Modes):
+    """x and y of dart:K (:class:`Modes`) at one h (an acb ball, or the series variable: acb_series [0, 1])
+    and one sigma.
 
     Parameters
     ----------
@@ -194,8 +230,9 @@ class Family:
     def __init__(self, h, sigma, flip_mode0=False, smooth=False):
         self.h, self.sigma = h, sigma
         one, pi = h * 0 + 1, arb.pi()
-        self.zero = h * 0
+        self.zero, self.i2 = h * 0, acb(0, 2)
         self.ix, self.iy = acb(0, 2) * pi, acb(0, 2) * sigma   # w_x = e^(ix h), w_y = e^(iy h)
+        self.em, self.ep = (acb(0, -1) * sigma).exp(), (acb(0, 1) * sigma).exp()
         self.lam1 = _lam_principal((h * (2 * pi)).cos())
         self.vx = bordered((h * self.ix).exp(), self.lam1)
         self.lam2 = _lam_principal((h * (2 * sigma)).cos())
@@ -211,28 +248,14 @@ class Family:
         self.yc = self.alpha * (lam - L0)
         self._exp = {}
 
-    def _e(self, c, k):  # e^(c k h), memoized
+    def e(self, c, k):
+        """e^(i k a h) (c = "x") or e^(i k b h) (c = "y"), memoized."""
         if (c, k) not in self._exp:
             self._exp[(c, k)] = (self.h * ((self.ix if c == "x" else self.iy) * k)).exp()
         return self._exp[(c, k)]
 
-    def parts(self):
-        """{name: (level0(delta, pos), centre, lam)} for X+, X-, Y0, Y+, Y-."""
-        i2 = acb(0, 2)
-        vx, vy = self.vx, self.vy
 
-        def eps(pos):
-            return 0 if pos[1] == 0 else 1
-        return {
-            "X+": (lambda d, p: vx[_POS[p]] * self._e("x", d) / i2, self.zero, self.lam1),
-            "X-": (lambda d, p: -vx[_POS[_swap(p)]] * self._e("x", -d - eps(p)) / i2, self.zero, self.lam1),
-            "Y0": (lambda d, p: self.alpha * self.U[_POS[p]], self.yc, self.lam2),
-            "Y+": (lambda d, p: vy[_POS[p]] * self._e("y", d) * self.sign / 2, self.zero, self.lam2),
-            "Y-": (lambda d, p: vy[_POS[_swap(p)]] * self._e("y", -d - eps(p)) * self.sign / 2, self.zero, self.lam2),
-        }
-
-
-def level1_value(level0, centre, lam, zero, q=None):
+def quadrant_level1(level0, centre, lam, zero, q=None):
     """``value(A, B)``: the level-1 value at position (A, B) of a quadrant: lam times the level-0 value on the
     two-ring (the vector is an eigenvector of every ring row), the level-1 rule of :mod:`.rules` elsewhere.
     ``q`` None: a bulk quadrant (no sharp ray within reach; ``level0(delta, pos)`` the level-0 value of sector
@@ -269,9 +292,10 @@ def _bezier(net, zero):
             for i in range(4)]
 
 
-def piece_nets(level0, centre, lam, zero):
-    """{piece: 4 x 4 Bezier net} of one coordinate (or one basis part) on a bulk quadrant."""
-    V = level1_value(level0, centre, lam, zero)
+def piece_nets(level0, centre, lam, zero, q=None):
+    """{piece: 4 x 4 Bezier net} of one coordinate (or one basis part) on a bulk quadrant (``q`` None) or on
+    the layer quadrant q (:func:`quadrant_level1`)."""
+    V = quadrant_level1(level0, centre, lam, zero, q)
     return {name: _bezier([[V(_OFFSET[name][0] + i, _OFFSET[name][1] + j) for j in range(4)] for i in range(4)], zero)
             for name in PIECES}
 
@@ -315,49 +339,16 @@ def basis_nets(fam):
 
 
 def layer_level0(fam, q):
-    """(x(t, p), y(t, p), x_C, y_C) at integer sectors t (any sign) for the layer quadrant q, as analytic
-    functions of h (fam.h of any type): x = (v^(p) w^t - v^(p~) w^(-t-eps))/(2i) (one mode, every t),
-    y = alpha U(p) + (v^_y(p) e^(i sigma (2 h t - 1)) + v^_y(p~) e^(-i sigma (2 h (t + eps) - 1)))/2 for t >= 0
-    and y's reflection in ray 0 for t < 0 (ray t -> ray -t, quadrant t (a, b) -> quadrant -t-1 (b, a))."""
-    h, sig = fam.h, fam.sigma
-    i2 = acb(0, 2)
-    eis = acb(0, 1) * sig
-
-    def eps(pos):
-        return 0 if pos[1] == 0 else 1
-
-    def x(t, pos):
-        return (fam.vx[_POS[pos]] * (h * (fam.ix * t)).exp()
-                - fam.vx[_POS[_swap(pos)]] * (h * (fam.ix * (-t - eps(pos)))).exp()) / i2
-
-    def y(t, pos):
-        if t < 0:
-            t, pos = (-t, pos) if pos[1] == 0 else (-t - 1, _swap(pos))
-        return (fam.alpha * fam.U[_POS[pos]]
-                + (fam.vy[_POS[pos]] * (h * (2 * eis * t) - eis).exp()
-                   + fam.vy[_POS[_swap(pos)]] * (eis - h * (2 * eis * (t + eps(pos)))).exp()) / 2)
+    """(x, y, x's centre, y's centre) of the layer quadrant q (:meth:`Modes.layer_level0`)."""
+    x, y = fam.layer_level0(q)
     return x, y, fam.zero, fam.yc
 
 
 def layer_nets(fam, q):
     """{piece: (X net, Y net)} (4 x 4 Bezier, values of fam.h's type) of layer quadrant q."""
-    x, y, xc, yc = layer_level0(fam, q)
-    VX = level1_value(x, xc, fam.lam1, fam.zero, q)
-    VY = level1_value(y, yc, fam.lam2, fam.zero, q)
-    out = {}
-    for name in PIECES:
-        oa, ob = _OFFSET[name]
-        out[name] = tuple(_bezier([[V(oa + i, ob + j) for j in range(4)] for i in range(4)], fam.zero)
-                          for V in (VX, VY))
-    return out
-
-
-def curve_points(nets, name):
-    """The 4 Bezier points of one outer curve (CURVES) of a quadrant's nets {piece: 4 x 4}, counterclockwise."""
-    piece, side, sign = CURVES[name]
-    net = nets[piece]
-    pts = [net[3][j] for j in range(4)] if side == "s" else [net[i][3] for i in range(4)]
-    return pts if sign > 0 else pts[::-1]
+    x, y = fam.layer_level0(q)
+    X, Y = piece_nets(x, fam.zero, fam.lam1, fam.zero, q), piece_nets(y, fam.yc, fam.lam2, fam.zero, q)
+    return {name: (X[name], Y[name]) for name in PIECES}
 
 
 def _bprod(f, g):
@@ -375,8 +366,8 @@ def _bprod(f, g):
 def _series_curves(nets, n):
     """{curve: [order m: 4 acb]} of one coordinate's nets {piece: 4 x 4 acb_series}."""
     out = {}
-    for name in CURVES:
-        pts = [_coeffs(z, n + 1) for z in curve_points(nets, name)]
+    for name in STAR_CURVES:
+        pts = [_coeffs(z, n + 1) for z in curve_points(nets, name, oriented=True)]
         out[name] = [[pts[p][m] for p in range(4)] for m in range(n + 1)]
     return out
 

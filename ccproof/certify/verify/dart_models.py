@@ -100,7 +100,7 @@ class SigmaBox:
             self.T = R.bulk_models(TT, models.bounds("T"), r)
             self.X = C.curve_models({(b, c): p for b in XB for c, p in coord[b].items()}, models.bounds("X"), r, XB)
             self.Y = C.curve_models({(b, c): p for b in YB for c, p in coord[b].items()}, models.bounds("Y"), r, YB)
-            self.om, self.omy = R.omegas(sigma), C.y_omegas(sigma)
+            self.om, self.omy = R.omegas(sigma), R.y_omegas(sigma)
             self.ER = {p: R.middle_coeffs(m, self.om, 1, 2, L=hn.exp_order) for p, m in self.R.items()}
             self.ET = {p: R.middle_coeffs(m, self.om, 1, 2, L=hn.exp_order) for p, m in self.T.items()}
             self.EY = {c: R.middle_coeffs(m, self.omy, 0, 1, L=hn.exp_order) for c, m in self.Y.items()}

@@ -37,11 +37,21 @@ def dets_series(nets, n):
 
 def bulk_models(T, M, r):
     """{piece: AnalyticModel} of the D_ij: row c the Bernstein coefficient, column ij (in the order of IJ)."""
-    pieces = sorted({key[2] for key in T})
-    n = len(T[IJ[0] + (pieces[0],)]) - 1
-    return {p: AnalyticModel([acb_mat([[T[ij + (p,)][m][c] for ij in IJ] for c in range(len(T[IJ[0] + (p,)][m]))])
-                              for m in range(n + 1)], [M[ij + (p,)] for ij in IJ], r)
-            for p in pieces}
+    return {p: AnalyticModel.from_columns([T[ij + (p,)] for ij in IJ], [M[ij + (p,)] for ij in IJ], r)
+            for p in sorted({key[2] for key in T})}
+
+
+def mode_factors(s, sigma):
+    """([a_i(s)] in the order of XB, [b_j(s)] in the order of YB): E = e^(2 pi i s), 1/E; 1, F, 1/F,
+    F = e^(i sigma (2 s - 1))."""
+    E, F = acb(0, 2 * arb.pi() * s).exp(), acb(0, sigma * (2 * s - 1)).exp()
+    return [E, 1 / E], [acb(1), F, 1 / F]
+
+
+def real_hull(models, weights, h_lo, h_hi, low, prec):
+    """An arb holding Re sum_k weights[k] f_k(h)/h^low, every row of every model, h in [h_lo, h_hi]."""
+    with ctx.workprec(prec):
+        return hull(v for model in models.values() for v in model.real_part(weights, h_lo, h_hi, low=low))
 
 
 def kdet_box(models, s_lo, s_hi, h_lo, h_hi, sigma, prec=128):
@@ -49,19 +59,20 @@ def kdet_box(models, s_lo, s_hi, h_lo, h_hi, sigma, prec=128):
     [h_lo, h_hi] (0 <= h_hi < r): Re sum_ij a_i(s) b_j(s) D_ij(h)/h from the models of :func:`bulk_models`
     (the h^0 terms 0 exactly)."""
     with ctx.workprec(prec):
-        s = ball(s_lo, s_hi)
-        E, F = acb(0, 2 * arb.pi() * s).exp(), acb(0, sigma * (2 * s - 1)).exp()
-        a, b = {"X+": E, "X-": 1 / E}, {"Y0": acb(1), "Y+": F, "Y-": 1 / F}
-        ws = [a[i] * b[j] for i, j in IJ]
-        return hull(v for model in models.values() for v in model.real_part(ws, h_lo, h_hi, low=1))
+        a, b = mode_factors(ball(s_lo, s_hi), sigma)
+        return real_hull(models, [x * y for x in a for y in b], h_lo, h_hi, 1, prec)
+
+
+def y_omegas(sigma):
+    """b_j(s) = c_j e^(i omega_j s): [(c_j, omega_j)] in the order of YB (Y0, Y+, Y-)."""
+    es = acb(0, sigma).exp()
+    return [(acb(1), arb(0)), (1 / es, 2 * sigma), (es, -2 * sigma)]
 
 
 def omegas(sigma):
     """a_i(s) b_j(s) = c_ij e^(i omega_ij s): [(c_ij, omega_ij)] (acb, arb) in the order of IJ."""
-    tp, es = 2 * arb.pi(), acb(0, sigma).exp()
-    a = {"X+": tp, "X-": -tp}
-    b = {"Y0": (acb(1), arb(0)), "Y+": (1 / es, 2 * sigma), "Y-": (es, -2 * sigma)}
-    return [(b[j][0], a[i] + b[j][1]) for i, j in IJ]
+    tp = 2 * arb.pi()
+    return [(c, a + w) for a in (tp, -tp) for c, w in y_omegas(sigma)]
 
 
 def middle_coeffs(model, om, m0, q, L=24):
@@ -127,12 +138,10 @@ def layer_dets_series(lnets, n):
 
 def column_models(T, M, r):
     """{key: AnalyticModel} with one column: the coefficient lists T[key][m] (rows) and the bound M[key]."""
-    return {key: AnalyticModel([acb_mat([[acb(z)] for z in c]) for c in coeffs], [M[key]], r)
-            for key, coeffs in T.items()}
+    return {key: AnalyticModel.from_columns([coeffs], [M[key]], r) for key, coeffs in T.items()}
 
 
 def layer_box(models, h_lo, h_hi, order=3, prec=128):
     """An arb holding K^order det J_Phi on h in [h_lo, h_hi] from the models of :func:`column_models` (the
     coefficients of h^0 .. h^(order-1) being 0 exactly)."""
-    with ctx.workprec(prec):
-        return hull(v for model in models.values() for v in model.real_part([1], h_lo, h_hi, low=order))
+    return real_hull(models, [1], h_lo, h_hi, order, prec)

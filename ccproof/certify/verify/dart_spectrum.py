@@ -71,7 +71,7 @@ from flint import acb, arb, fmpq, fmpq_mpoly_ctx, fmpq_poly
 
 from ccproof.rigorous.analytic import ball
 
-from .dart_family import _kappa
+from .dart_family import kappa
 from .errors import CertificateError
 from .tagged import labels, sector_rows
 from .tagged_modes import _POS, _roots, check_dart, check_ring, ring_stencil
@@ -149,7 +149,7 @@ def check_construction():
             raise CertificateError(f"the ring row of {pos} leaves the one-ring")
     sharp = classes[0][("r", 0, 3) + _E]
     smooth = {("r" if q[1] == 0 else "q", dlt) + q: x for (dlt, q), x in ring_stencil()[_POS[_E]].items()}
-    smooth[_C] = _kappa()[_POS[_E]]
+    smooth[_C] = kappa()[_POS[_E]]
     d = {key: sharp.get(key, 0) - smooth.get(key, 0) for key in set(sharp) | set(smooth)}
     d = {key: x for key, x in d.items() if x != 0}
     for key in d:
@@ -161,33 +161,31 @@ def check_construction():
     return d, bound
 
 
-def _b1(w):
-    """B1(w): the ring stencil's 2 x 2 block on (1,0), (1,1) (w of any ring type with 1/w)."""
-    out = [[w * 0, w * 0], [w * 0, w * 0]]
+def _b1w(w, zero):
+    """w B1(w), B1 the ring stencil's 2 x 2 block on (1,0), (1,1) (no negative power of w: w an fmpq or a
+    polynomial generator; ``zero`` of its ring)."""
+    out = [[zero, zero], [zero, zero]]
     for i, pos in enumerate((_E, _F)):
         for (dlt, q), x in ring_stencil()[_POS[pos]].items():
-            out[i][(_E, _F).index(q)] += x * w ** dlt if dlt >= 0 else x / w ** (-dlt)
+            out[i][(_E, _F).index(q)] = out[i][(_E, _F).index(q)] + x * w ** (dlt + 1)
     return out
 
 
-def _d_modes(w):
-    """(d_C, d_e(w), d_f(w)): d in the mode w (d_e = sum over rays delta of d w^delta, d_f over quadrants)."""
+def _dw(w, zero):
+    """(d_C, w d_e(w), w d_f(w)): d in the mode w (d_e = sum over rays delta of d w^delta, d_f over quadrants;
+    w and ``zero`` as :func:`_b1w`)."""
     d, _ = check_construction()
-    de, df = w * 0, w * 0
+    de, df = zero, zero
     for key, x in d.items():
-        if key == _C:
-            continue
-        term = x * w ** key[1] if key[1] >= 0 else x / w ** (-key[1])
-        if key[2:] == _E:
-            de += term
-        else:
-            df += term
+        if key != _C:
+            t = x * w ** (key[1] + 1)
+            de, df = (de + t, df) if key[2:] == _E else (de, df + t)
     return d.get(_C, fmpq(0)), de, df
 
 
 def b0(lam, h):
     """lam - B0(h), the mode-0 block on (C, E, F) (3 x 3 of lam's type)."""
-    kap, B = _kappa(), _b1(fmpq(1))
+    kap, B = kappa(), _b1w(fmpq(1), fmpq(0))  # B1(1)
     rows = [[1 - fmpq(7, 4) * h, fmpq(3, 2) * h, _QUARTER * h], [kap[_POS[_E]], B[0][0], B[0][1]],
             [kap[_POS[_F]], B[1][0], B[1][1]]]
     return [[(lam if i == j else 0) - rows[i][j] for j in range(3)] for i in range(3)]
@@ -203,7 +201,7 @@ def mode0_parts(lam, h):
     numerators of (lam - B0)^-1 (0, 1, 0) weighed by d's mode-0 part; det R = the h-coefficient of
     det(lam - B0) (only B0's first row depends on h, affinely)."""
     M = b0(lam, h)
-    dc, de, df = _d_modes(fmpq(1))
+    dc, de, df = _dw(fmpq(1), fmpq(0))
     num = 0 * lam
     for c, wt in enumerate((dc, de, df)):
         num += wt * _det3([[(int(i == 1) if j == c else M[i][j]) for j in range(3)] for i in range(3)])
@@ -225,12 +223,12 @@ def check_secular():
     ctx = fmpq_mpoly_ctx.get(("l", "w", "h"), "lex")
     lam, w, h = ctx.gens()
     # clear w's negative powers: everything below is multiplied by w^2 (B1 reaches w^-1, d reaches w^-1)
-    B = _b1_poly(w, ctx)
+    B = _b1w(w, ctx.from_dict({}))
     c2 = (w * w + 1) * w / 2  # w^2 c
     det2 = (lam * w - B[0][0]) * (lam * w - B[1][1]) - B[0][1] * B[1][0]  # w^2 det(lam - B1)
     if det2 != w * w * lam * lam - (5 * w * w + c2) * lam / 8 + w * w / 16:
         raise CertificateError("the 2 x 2 one-ring block has another characteristic polynomial")
-    dc, de, df = _d_poly(w, ctx)  # w d_e(w), w d_f(w)
+    dc, de, df = _dw(w, ctx.from_dict({}))  # w d_e(w), w d_f(w)
     g_num = (lam * w - B[1][1]) * de + B[1][0] * df  # w^2 det(lam - B1) g
     # c* = 8 lam - 5 + 1/(2 lam); 2 lam n* = 4 (2 lam - 2 lam c*)(lam - 1/4) - (2 lam + 2 lam c*)
     lc = 16 * lam * lam - 10 * lam + 1  # 2 lam c*
@@ -252,27 +250,6 @@ def check_secular():
     if rem != 0 or ell.degree() > 1:
         raise CertificateError("det R is not (lam - 1) times a linear polynomial")
     return True
-
-
-def _b1_poly(w, ctx):
-    """w B1(w) with polynomial entries."""
-    out = [[ctx.from_dict({}) for _ in range(2)] for _ in range(2)]
-    for i, pos in enumerate((_E, _F)):
-        for (dlt, q), x in ring_stencil()[_POS[pos]].items():
-            out[i][(_E, _F).index(q)] += x * w ** (dlt + 1)
-    return out
-
-
-def _d_poly(w, ctx):
-    d, _ = check_construction()
-    de, df = ctx.from_dict({}), ctx.from_dict({})
-    for key, x in d.items():
-        if key != _C:
-            if key[2:] == _E:
-                de += x * w ** (key[1] + 1)
-            else:
-                df += x * w ** (key[1] + 1)
-    return d.get(_C, fmpq(0)), de, df
 
 
 def _ell():

@@ -35,7 +35,7 @@ vanish exactly when m^k divides the representative: the checks are remainders, t
 off (:meth:`QS.coeffs`) only where one is not 0. Truncations are exact: e^(i k h) = 1 + i k h - k^2 h^2/2,
 sqrt(20 (1 + z)) = 2 sqrt 5 (1 + z/2 - z^2/8), ln(1 + z) = z - z^2/2 for z in (h). The bordered 7 x 7 systems
 are solved by Gauss-Jordan over the ring (unit pivots), U from :mod:`.dart_family`'s exact polynomials, and
-the nets by the family's own assembly (``piece_nets``, ``level1_value``, ``_bezier``). det J_Phi's h^m
+the nets by the family's own assembly (``piece_nets``, ``quadrant_level1``, ``_bezier``). det J_Phi's h^m
 coefficient, of degree <= (5, 5) in the patch parameters (u, v), is checked on the 6 x 6 grid u, v in
 {0, 1/5, ..., 1}; T's and the curve points' as the Bernstein coefficients. Parts depending on fewer of
 (a, b, c, t) (X's nets on a, Y+-'s on b, Y0's on (b, c)) are computed once, counted at each grid point.
@@ -48,8 +48,10 @@ import itertools
 from flint import fmpq, fmpq_poly
 
 from . import dart_family as _df
-from .dart_family import CURVES, PIECES, XB, YB, curve_points
+from .dart_family import PIECES, XB, YB
 from .errors import CertificateError
+from .maps import STAR_CURVES, curve_points
+from .statement import horner
 from .tagged_modes import _POS, ring_stencil
 
 GRID_AB = (1, 2, 3)  # degree <= 2 in a and in b
@@ -152,7 +154,7 @@ class QS:
 
     def coeffs(self):
         """[e_0, e_1, e_2]: the coefficients of h^0, h^1, h^2 as polynomials in theta (degree < 4)."""
-        return _coeffs(self.p)
+        return _h_coeffs(self.p)
 
     @property
     def c(self):
@@ -160,7 +162,7 @@ class QS:
         return [QF(e) for e in self.coeffs()]
 
 
-def _coeffs(p):
+def _h_coeffs(p):
     out, r = [], p
     for k in range(3):
         e = r % _MOD[1]
@@ -235,9 +237,7 @@ def _bordered(k, lam, stencil):
     for i, row in enumerate(stencil):
         for (d, pos), x in row.items():
             B[i][_POS[pos]] = B[i][_POS[pos]] + _exp_i(fmpq(k) * d) * fmpq(x)
-    A = [[(B[i][j] - lam) if i == j else B[i][j] for j in range(6)] + [QS(int(i == 0))] for i in range(6)]
-    A.append([QS(int(j == 0)) for j in range(6)] + [QS(0)])
-    return _solve(A, [QS(0)] * 6 + [QS(1)])[:6]
+    return _solve(_df.bordered_matrix(B, lam, QS(0)), [QS(0)] * 6 + [QS(1)])[:6]
 
 
 class _Mode:
@@ -248,22 +248,8 @@ class _Mode:
         self.lam = _lam_series(self.k)
         self.v = _bordered(self.k, self.lam, stencil)
         if with_u:
-            lam = self.lam
-            den = (lam - fmpq(1, 8)) * (lam - fmpq(1, 16)) * (lam - fmpq(1, 32)) * (lam - fmpq(1, 64)) * (lam - L0_LOW)
-            self.U = [_horner(p, lam, QS(0)) / den for p in _df._NPOLY]
-
-
-def _horner(p, x, acc):
-    for coef in reversed(p):
-        acc = acc * x + coef
-    return acc
-
-
-def _eps(pos):
-    return 0 if pos[1] == 0 else 1
-
-
-_sw = _df._swap
+            den = _df.u_denominator(self.lam, L0_LOW)
+            self.U = [horner(p, self.lam, QS(0)) / den for p in _df._NPOLY]
 
 
 class QL0:
@@ -337,13 +323,13 @@ def exact_zeros():
     pos = {p: k for p, k in _POS.items()}
     if not all(rho[pos[(a, b)]] == rho[pos[(b, a)]] for (a, b) in pos if b > 0 and (b, a) in pos):
         raise CertificateError("rho is not symmetric in (a, b)")
-    N = [_horner(p, L, QL0(0)) for p in _df._NPOLY]
+    N = [horner(p, L, QL0(0)) for p in _df._NPOLY]
     if not all((N[k] - N[0] * rho[k]).is_zero() for k in range(6)) or N[0].is_zero():
         raise CertificateError("adj(L0 - B(1)) kappa is not a non-zero multiple of rho")
     return rho
 
 
-class ExactFamily:
+class ExactFamily(_df.Modes):
     """The family of :class:`.dart_family.Family` at one grid point (a, b, c, t), exact (:class:`QS` in h).
 
     Parameters
@@ -373,42 +359,16 @@ class ExactFamily:
             self.alpha = -self.alpha
         self.yc = self.alpha * (lam - L0)
         self.em, self.ep = QS(self.c) - I * self.t, QS(self.c) + I * self.t  # e^(-i sigma), e^(i sigma)
+        self.i2, self.sign = I * 2, 1
 
-    def parts(self):
-        """{basis part: (level0(delta, pos), centre, lam)} as :meth:`.dart_family.Family.parts`, exact."""
-        vx, vy, a, b = self.vx, self.vy, self.a, self.b
-        i2 = I * 2
-        return {
-            "X+": (lambda d, p: vx[_POS[p]] * _exp_i(a * d) / i2, self.zero, self.lam1),
-            "X-": (lambda d, p: -(vx[_POS[_sw(p)]] * _exp_i(-a * (d + _eps(p)))) / i2, self.zero, self.lam1),
-            "Y0": (lambda d, p: self.alpha * self.U[_POS[p]], self.yc, self.lam2),
-            "Y+": (lambda d, p: vy[_POS[p]] * _exp_i(b * d) / 2, self.zero, self.lam2),
-            "Y-": (lambda d, p: vy[_POS[_sw(p)]] * _exp_i(-b * (d + _eps(p))) / 2, self.zero, self.lam2),
-        }
-
-    def layer_level0(self, q):
-        """(x(t, pos), y(t, pos)) as :func:`.dart_family.layer_level0` (y reflected in ray 0 for t < 0)."""
-        vx, vy, a, b = self.vx, self.vy, self.a, self.b
-        i2 = I * 2
-
-        def x(t, pos):
-            return (vx[_POS[pos]] * _exp_i(a * t) - vx[_POS[_sw(pos)]] * _exp_i(-a * (t + _eps(pos)))) / i2
-
-        def y(t, pos):
-            if t < 0:
-                t, pos = (-t, pos) if pos[1] == 0 else (-t - 1, _sw(pos))
-            return (self.alpha * self.U[_POS[pos]]
-                    + (vy[_POS[pos]] * _exp_i(b * t) * self.em
-                       + vy[_POS[_sw(pos)]] * _exp_i(-b * (t + _eps(pos))) * self.ep) / 2)
-        return x, y
+    def e(self, c, k):
+        """e^(i k a h) (c = "x") or e^(i k b h) (c = "y"), exact."""
+        return _exp_i((self.a if c == "x" else self.b) * k)
 
     def layer_nets(self, q, coordinate):
         """{piece: 4 x 4 Bezier net} of x (coordinate 0) or y (1) on layer quadrant q."""
-        f = self.layer_level0(q)[coordinate]
-        V = _df.level1_value(f, (self.zero, self.yc)[coordinate], (self.lam1, self.lam2)[coordinate], self.zero, q)
-        off = _df._OFFSET
-        return {n: _df._bezier([[V(off[n][0] + i, off[n][1] + j) for j in range(4)] for i in range(4)], self.zero)
-                for n in PIECES}
+        return _df.piece_nets(self.layer_level0(q)[coordinate], (self.zero, self.yc)[coordinate],
+                              (self.lam1, self.lam2)[coordinate], self.zero, q)
 
 
 # --- det J as a polynomial in the patch parameters (u, v), on the 6 x 6 grid; raw fmpq_poly below -------
@@ -461,7 +421,7 @@ class _Tally:
             self.rows[row][0] += len(orders)
             if (p % _MOD[max(orders) + 1]).is_zero():
                 continue
-            cs = _coeffs(p % _M3)
+            cs = _h_coeffs(p % _M3)
             bad = [m for m in orders if not cs[m].is_zero()]
             self.rows[row][1] += len(bad)
             if bad and self.stop:
@@ -520,8 +480,8 @@ def _check_point(fam, ells, tally, cache):
         for (i, j), vals in G.items():
             tally.add(ROWS[0], [(v, (0,)) for v in vals], f"{pt}, {piece}, D({i}, {j})", "uv")
         tally.add(ROWS[1], _middle(G, fam), f"{pt}, {piece}", "mid")
-    for curve in CURVES:
-        pts = {n: curve_points(nets[n], curve) for n in nets}
+    for curve in STAR_CURVES:
+        pts = {n: curve_points(nets[n], curve, oriented=True) for n in nets}
         for i, j in itertools.product(XB, YB):  # X Y', Y X' depend on (a, b) or (a, b, c) only
             if (keys[i], keys[j], curve) not in cache:
                 cache[(keys[i], keys[j], curve)] = _xy(pts[i], pts[j])
@@ -536,8 +496,8 @@ def _check_point(fam, ells, tally, cache):
         yn, yp = _nets(cache, ("LY", b, c, t, q), lambda q=q: fam.layer_nets(q, 1))  # y's depend on (b, c, t)
         for piece in PIECES:
             tally.add(ROWS[5], [(v, (0, 1, 2)) for v in _det(xp[piece], yp[piece])], f"{pt}, q = {q}, {piece}", "uv")
-        for curve in CURVES:
-            xs, ys = curve_points(xn, curve), curve_points(yn, curve)
+        for curve in STAR_CURVES:
+            xs, ys = curve_points(xn, curve, oriented=True), curve_points(yn, curve, oriented=True)
             tally.add(ROWS[6], [(v, (0, 1, 2)) for v in _trans(_xy(xs, ys), A)],
                       f"{pt}, q = {q}, {curve}", "coef")
             end = q == 0 and curve == "P1s1"  # ray 0's end point: h^1 too

@@ -305,19 +305,22 @@ def regularity_form(nets, name, prec):
 STAR_CURVES = {"P1s1": ("P1", "s", 1), "P2s1": ("P2", "s", 1), "P2t1": ("P2", "t", -1), "P3t1": ("P3", "t", -1)}
 
 
-def curve_points(nets, curve):
+def curve_points(nets, curve, oriented=False):
     """The Bezier points of one cubic of the outer boundary (a key of :data:`STAR_CURVES`: the side s = 1 or
-    t = 1 of a piece), in the piece's parameter order.
+    t = 1 of a piece), in the piece's parameter order, or counterclockwise around the star (``oriented``).
 
     Examples
     --------
     >>> nets = {"P2": [[(i, j) for j in range(4)] for i in range(4)]}
     >>> curve_points(nets, "P2s1"), curve_points(nets, "P2t1")
     ([(3, 0), (3, 1), (3, 2), (3, 3)], [(0, 3), (1, 3), (2, 3), (3, 3)])
+    >>> curve_points(nets, "P2t1", oriented=True)
+    [(3, 3), (2, 3), (1, 3), (0, 3)]
     """
-    name, side, _ = STAR_CURVES[curve]
+    name, side, sign = STAR_CURVES[curve]
     net = nets[name]
-    return [net[3][j] for j in range(4)] if side == "s" else [net[i][3] for i in range(4)]
+    pts = [net[3][j] for j in range(4)] if side == "s" else [net[i][3] for i in range(4)]
+    return pts[::-1] if oriented and sign < 0 else pts
 
 
 def star_form(nets, curve, prec):

@@ -171,21 +171,19 @@ class QL:
         return (horner(self.a, c) + horner(self.b, c) * lam) / den
 
 
-def horner(p, x):
-    """p(x) for an fmpq_poly p and an arb x (ball arithmetic, Horner's scheme).
-
-    Returns
-    -------
-    arb
-        A ball containing p(y) for every y in x.
+def horner(p, x, acc=None):
+    """p(x) by Horner's scheme, for an fmpq_poly p or a list of coefficients (constant term first), accumulated
+    onto ``acc`` (the zero of x's ring; default arb(0)). On a ball x, a ball containing p(y) for every y in x.
 
     Examples
     --------
     >>> horner(fmpq_poly([1, 2, 3]), arb(2))   # 1 + 2 * 2 + 3 * 4
     17.0000000000000
+    >>> horner([fmpq(1), 2, 3], fmpq(1, 2), fmpq(0))
+    11/4
     """
-    acc = arb(0)
-    for q in reversed(p.coeffs()):
+    acc = arb(0) if acc is None else acc
+    for q in reversed(p.coeffs() if isinstance(p, fmpq_poly) else p):
         acc = acc * x + q
     return acc
 
