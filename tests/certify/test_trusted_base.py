@@ -51,9 +51,6 @@ def test_the_prover_imports_no_private_name_of_the_verifier():
 
 
 MAX_FUNCTION_LINES, MAX_COMPLEXITY = 80, 20
-# Functions of the base still over a cap, owned by work in progress elsewhere (each must shrink off this
-# list; an entry that no longer exceeds its cap must be removed, so the list stays current).
-OVER_CAP = {"dart_spectrum.py:check_construction", "dart_zeros.py:_check_point"}
 
 
 def complexity(fn):
@@ -95,9 +92,7 @@ def test_the_complexity_count_sees_branches():
 
 def test_every_function_of_the_base_is_short_and_simple():
     found = over_cap()
-    new = {k: v for k, v in found.items() if k not in OVER_CAP}
-    assert not new, f"over {MAX_FUNCTION_LINES} lines or complexity {MAX_COMPLEXITY} (lines, complexity): {new}"
-    assert not OVER_CAP - set(found), f"within the caps now, remove from OVER_CAP: {OVER_CAP - set(found)}"
+    assert not found, f"over {MAX_FUNCTION_LINES} lines or complexity {MAX_COMPLEXITY} (lines, complexity): {found}"
 
 
 def test_the_page_states_its_own_totals():

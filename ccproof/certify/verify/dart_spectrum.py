@@ -127,6 +127,15 @@ def check_construction():
     >>> d[("C",)], d[("r", 0, 1, 0)], d[("q", -1, 1, 1)], bound
     (1/8, 1/8, -1/16, 15/64)
     """
+    sharp = _check_rows()
+    bound = _outer_bound()
+    _check_one_ring_closed()
+    return _check_d(_construction_d(sharp)), bound
+
+
+def _check_rows():
+    """Raise unless the window classes agree, the centre row is the rule's and no weight is negative; returns
+    the sharp midpoint row of ray 0."""
     check_ring()
     classes = [_window_rows(k)[0] for k in WINDOW]
     if classes[0] != classes[1]:
@@ -135,6 +144,12 @@ def check_construction():
         raise CertificateError("dart: the centre row is not (1 - 7h/4, 3h^2/2 per ray, h^2/4 per quadrant)")
     if any(x < 0 for k in WINDOW for row in sector_rows("dart", k) for x in row.values()):
         raise CertificateError("dart: a negative weight (the outer bound assumes none)")
+    return classes[0][("r", 0, 3) + _E]
+
+
+def _outer_bound():
+    """The bound on the outer even rows over the window (raise if over 15/64, or if an odd block of the modes
+    +-1 has an eigenvalue >= 1/2)."""
     bound = fmpq(0)
     for k in WINDOW:
         _, _, blocks, _, _, b = check_dart(k)
@@ -144,21 +159,32 @@ def check_construction():
                 raise CertificateError(f"dart:{k}: an odd block of the modes +-1 has an eigenvalue >= 1/2")
     if bound > fmpq(15, 64):
         raise CertificateError(f"dart: the outer even rows bound {bound} > 15/64")
+    return bound
+
+
+def _check_one_ring_closed():
     for pos in (_E, _F):  # the one-ring is closed in the ring stencil
         if any(q not in (_E, _F) for _, q in ring_stencil()[_POS[pos]]):
             raise CertificateError(f"the ring row of {pos} leaves the one-ring")
-    sharp = classes[0][("r", 0, 3) + _E]
+
+
+def _construction_d(sharp):
+    """The sharp midpoint row minus the smooth edge row, zero weights dropped."""
     smooth = {("r" if q[1] == 0 else "q", dlt) + q: x for (dlt, q), x in ring_stencil()[_POS[_E]].items()}
     smooth[_C] = kappa()[_POS[_E]]
     d = {key: sharp.get(key, 0) - smooth.get(key, 0) for key in set(sharp) | set(smooth)}
-    d = {key: x for key, x in d.items() if x != 0}
+    return {key: x for key, x in d.items() if x != 0}
+
+
+def _check_d(d):
+    """Raise unless d reads only the one-ring window and is invariant under the reflection in ray 0."""
     for key in d:
         if key != _C and (key[2:] not in (_E, _F) or not -1 <= key[1] <= 1):
             raise CertificateError(f"dart: d reads {key} outside the one-ring window")
         mirror = key if key == _C else (key[0], -key[1] if key[2:] == _E else -key[1] - 1) + key[2:]
         if d.get(mirror, 0) != d[key]:
             raise CertificateError("dart: d is not invariant under the reflection in ray 0")
-    return d, bound
+    return d
 
 
 def _b1w(w, zero):
