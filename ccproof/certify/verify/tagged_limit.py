@@ -221,6 +221,8 @@ def _on_circle(radius, k, arcs):
 
 def circle_bound(R, arcs):
     """An upper bound M of |H| on |theta| = R (acb balls covering the arcs), or None if one is not proved.
+    Not :func:`~ccproof.rigorous.analytic.disc_bound`: its square [-R, R]^2 reaches outside the disc that
+    :func:`check_disc` proves analytic; with boxes of side 1/20 it bounds |H| by 47.3 where the arcs give 0.0261.
 
     Examples
     --------
