@@ -74,7 +74,7 @@ from ccproof.rigorous.analytic import ball
 from .dart_family import kappa
 from .errors import CertificateError
 from .tagged import labels, sector_rows
-from .tagged_modes import _POS, _roots, check_dart, check_ring, ring_stencil
+from .tagged_modes import RING_INDEX, charpoly_roots, check_dart, check_ring, ring_stencil
 
 WINDOW = (7, 8)  # the window classes of every K >= 7 occur in both
 _C = ("C",)
@@ -155,7 +155,7 @@ def _outer_bound():
         _, _, blocks, _, _, b = check_dart(k)
         bound = max(bound, b)
         for M in blocks:
-            if not all(abs(z) < _HALF for z, _ in _roots(M)):
+            if not all(abs(z) < _HALF for z, _ in charpoly_roots(M)):
                 raise CertificateError(f"dart:{k}: an odd block of the modes +-1 has an eigenvalue >= 1/2")
     if bound > fmpq(15, 64):
         raise CertificateError(f"dart: the outer even rows bound {bound} > 15/64")
@@ -164,14 +164,14 @@ def _outer_bound():
 
 def _check_one_ring_closed():
     for pos in (_E, _F):  # the one-ring is closed in the ring stencil
-        if any(q not in (_E, _F) for _, q in ring_stencil()[_POS[pos]]):
+        if any(q not in (_E, _F) for _, q in ring_stencil()[RING_INDEX[pos]]):
             raise CertificateError(f"the ring row of {pos} leaves the one-ring")
 
 
 def _construction_d(sharp):
     """The sharp midpoint row minus the smooth edge row, zero weights dropped."""
-    smooth = {("r" if q[1] == 0 else "q", dlt) + q: x for (dlt, q), x in ring_stencil()[_POS[_E]].items()}
-    smooth[_C] = kappa()[_POS[_E]]
+    smooth = {("r" if q[1] == 0 else "q", dlt) + q: x for (dlt, q), x in ring_stencil()[RING_INDEX[_E]].items()}
+    smooth[_C] = kappa()[RING_INDEX[_E]]
     d = {key: sharp.get(key, 0) - smooth.get(key, 0) for key in set(sharp) | set(smooth)}
     return {key: x for key, x in d.items() if x != 0}
 
@@ -192,7 +192,7 @@ def _b1w(w, zero):
     polynomial generator; ``zero`` of its ring)."""
     out = [[zero, zero], [zero, zero]]
     for i, pos in enumerate((_E, _F)):
-        for (dlt, q), x in ring_stencil()[_POS[pos]].items():
+        for (dlt, q), x in ring_stencil()[RING_INDEX[pos]].items():
             out[i][(_E, _F).index(q)] = out[i][(_E, _F).index(q)] + x * w ** (dlt + 1)
     return out
 
@@ -212,8 +212,8 @@ def _dw(w, zero):
 def b0(lam, h):
     """lam - B0(h), the mode-0 block on (C, E, F) (3 x 3 of lam's type)."""
     kap, B = kappa(), _b1w(fmpq(1), fmpq(0))  # B1(1)
-    rows = [[1 - fmpq(7, 4) * h, fmpq(3, 2) * h, _QUARTER * h], [kap[_POS[_E]], B[0][0], B[0][1]],
-            [kap[_POS[_F]], B[1][0], B[1][1]]]
+    rows = [[1 - fmpq(7, 4) * h, fmpq(3, 2) * h, _QUARTER * h], [kap[RING_INDEX[_E]], B[0][0], B[0][1]],
+            [kap[RING_INDEX[_F]], B[1][0], B[1][1]]]
     return [[(lam if i == j else 0) - rows[i][j] for j in range(3)] for i in range(3)]
 
 

@@ -52,7 +52,7 @@ from .dart_family import PIECES, XB, YB
 from .errors import CertificateError
 from .maps import STAR_CURVES, curve_points
 from .statement import horner
-from .tagged_modes import _POS, ring_stencil
+from .tagged_modes import RING_INDEX, ring_stencil
 
 GRID_AB = (1, 2, 3)  # degree <= 2 in a and in b
 GRID_CT = (1, 2)  # degree <= 1 in c, t, l
@@ -236,7 +236,7 @@ def _bordered(k, lam, stencil):
     B = [[QS(0) for _ in range(6)] for _ in range(6)]
     for i, row in enumerate(stencil):
         for (d, pos), x in row.items():
-            B[i][_POS[pos]] = B[i][_POS[pos]] + _exp_i(fmpq(k) * d) * fmpq(x)
+            B[i][RING_INDEX[pos]] = B[i][RING_INDEX[pos]] + _exp_i(fmpq(k) * d) * fmpq(x)
     return _solve(_df.bordered_matrix(B, lam, QS(0)), [QS(0)] * 6 + [QS(1)])[:6]
 
 
@@ -249,7 +249,7 @@ class _Mode:
         self.v = _bordered(self.k, self.lam, stencil)
         if with_u:
             den = _df.u_denominator(self.lam, L0_LOW)
-            self.U = [horner(p, self.lam, QS(0)) / den for p in _df._NPOLY]
+            self.U = [horner(p, self.lam, QS(0)) / den for p in _df.N_POLYS]
 
 
 class QL0:
@@ -311,7 +311,7 @@ def exact_zeros():
     (True, True, True)
     """
     L = QL0(0, 1)
-    A = [[(L if i == k else QL0(0)) - _df._B1[i, k] for k in range(6)] for i in range(6)]
+    A = [[(L if i == k else QL0(0)) - _df.B_AT_1[i, k] for k in range(6)] for i in range(6)]
     # rho: solve A rho = 0 with rho(1,0) = 1: drop row 0 (rank 5 since L0 is simple: checked by the solve)
     try:
         rho = [QL0(1)] + _solve([[A[i][k] for k in range(1, 6)] for i in range(1, 6)], [-A[i][0] for i in range(1, 6)],
@@ -320,10 +320,10 @@ def exact_zeros():
         raise CertificateError("L0 is not a simple eigenvalue of B(1)") from None
     if not all(sum((A[i][k] * rho[k] for k in range(6)), QL0(0)).is_zero() for i in range(6)):
         raise CertificateError("rho is no eigenvector of B(1) for L0")
-    pos = {p: k for p, k in _POS.items()}
+    pos = {p: k for p, k in RING_INDEX.items()}
     if not all(rho[pos[(a, b)]] == rho[pos[(b, a)]] for (a, b) in pos if b > 0 and (b, a) in pos):
         raise CertificateError("rho is not symmetric in (a, b)")
-    N = [horner(p, L, QL0(0)) for p in _df._NPOLY]
+    N = [horner(p, L, QL0(0)) for p in _df.N_POLYS]
     if not all((N[k] - N[0] * rho[k]).is_zero() for k in range(6)) or N[0].is_zero():
         raise CertificateError("adj(L0 - B(1)) kappa is not a non-zero multiple of rho")
     return rho
@@ -432,7 +432,7 @@ class _Tally:
 def _xy(xs, ys):
     """(X Y', Y X'): the degree-5 Bernstein coefficients (raw, reduced) from the curves' cubic Bezier points."""
     xs, ys = [z.p for z in xs], [z.p for z in ys]
-    return [z % _M3 for z in _df._bprod(xs, ys)], [z % _M3 for z in _df._bprod(ys, xs)]
+    return [z % _M3 for z in _df.bezier_product(xs, ys)], [z % _M3 for z in _df.bezier_product(ys, xs)]
 
 
 def _trans(PQ, A):
