@@ -29,21 +29,21 @@ import math
 
 from flint import acb, acb_mat, arb, ctx, fmpq
 
-from ccproof.certify.verify.tagged_modes import _POS, _block
+from ccproof.certify.verify.tagged_modes import RING_INDEX, ring_block
 
 _W = (fmpq(1, 6), fmpq(4, 6), fmpq(1, 6))
 _DW = (fmpq(-1, 2), fmpq(0), fmpq(1, 2))
-_PIVOT = _POS[(1, 0)]
+_PIVOT = RING_INDEX[(1, 0)]
 
 
 def _reflection(w):
     """R_w as a 6 x 6 list (rows: hat positions of the mode 1/w vector v o R)."""
     rows = [[0 * w] * 6 for _ in range(6)]
-    for p, i in _POS.items():
+    for p, i in RING_INDEX.items():
         if p[1] == 0:
             rows[i][i] += 1
         else:
-            rows[i][_POS[(p[1], p[0])]] += 1 / w
+            rows[i][RING_INDEX[(p[1], p[0])]] += 1 / w
     return rows
 
 
@@ -55,7 +55,7 @@ def reflection_identity(points=range(2, 14)):
     """True iff B(1/w) R_w == R_w B(w) exactly at the rational points w (Laurent degree <= 3 each side)."""
     for a in points:
         for w in (fmpq(a), fmpq(-a), fmpq(1, a), fmpq(-1, a)):
-            if _mul(_block(1 / w), _reflection(w)) != _mul(_reflection(w), _block(w)):
+            if _mul(ring_block(1 / w), _reflection(w)) != _mul(_reflection(w), ring_block(w)):
                 return False
     return True
 
@@ -68,11 +68,11 @@ def _local(theta, j):
     if not disc.real > 0:  # the principal square root is analytic on the right half-plane
         raise ZeroDivisionError("(1 + c)(9 + c) not certainly in the right half-plane")
     lam = (5 + c + disc.sqrt()) / 16
-    B = _block(w)
+    B = ring_block(w)
     rows = [[B[i][k] - (lam if i == k else 0) for k in range(6)] + [acb(int(i == _PIVOT))] for i in range(6)]
     rows.append([acb(int(k == _PIVOT)) for k in range(6)] + [acb(0)])
     sol = acb_mat(rows).solve(acb_mat([[0]] * 6 + [[1]]))
-    vh = {p: sol[i, 0] for p, i in _POS.items()}
+    vh = {p: sol[i, 0] for p, i in RING_INDEX.items()}
     val = {}
     for a in range(3):
         for b in range(3):

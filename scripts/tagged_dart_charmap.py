@@ -96,13 +96,13 @@ from ccproof.certify.verify.dart_family import (  # noqa: F401 (re-exported for 
     XB,
     YB,
     Family,
-    _hvar,
-    _series_curves,
     basis_nets,
     bordered,
     layer_nets,
     piece_nets,
     series_cap,
+    series_curves,
+    series_variable,
 )
 from ccproof.certify.verify.dart_zeros import (  # noqa: F401 (re-exported for the tests)
     exact_zeros,
@@ -139,7 +139,7 @@ def taylor_dets(sigma, n, prec=128, **control):
     {(i, j, piece): [coefficient list (acb) of h^m, m = 0..n]}. D is bilinear, so the coefficient of h^m is
     sum_(k + l = m) D(X_i,k, Y_j,l) of the nets' own Taylor coefficients (acb_series, rigorous)."""
     with ctx.workprec(prec), series_cap(n):
-        return _R.dets_series(basis_nets(Family(_hvar(n), sigma, **control)), n)
+        return _R.dets_series(basis_nets(Family(series_variable(n), sigma, **control)), n)
 
 
 def disc_bounds(sigma, r, grid=4, prec=128, **control):
@@ -153,7 +153,7 @@ def disc_bounds(sigma, r, grid=4, prec=128, **control):
 def layer_taylor(q, sigma, n, prec=128):
     """The verifier's layer_dets_series of layer quadrant q."""
     with ctx.workprec(prec), series_cap(n):
-        return _R.layer_dets_series(layer_nets(Family(_hvar(n), sigma), q), n)
+        return _R.layer_dets_series(layer_nets(Family(series_variable(n), sigma), q), n)
 
 
 def layer_disc(q, sigma, r, grid=12, prec=128):
@@ -165,7 +165,7 @@ def layer_disc(q, sigma, r, grid=12, prec=128):
 def taylor_trans(sigma, n, prec=128, **control):
     """The verifier's trans_series of the family at sigma."""
     with ctx.workprec(prec), series_cap(n):
-        fam = Family(_hvar(n), sigma, **control)
+        fam = Family(series_variable(n), sigma, **control)
         return _C.trans_series(fam, basis_nets(fam), n)
 
 
@@ -181,8 +181,8 @@ def disc_trans(sigma, r, grid=12, prec=128, **control):
 def coord_taylor(sigma, n, coord, prec=128):
     """{(basis part, curve): [order m: 4 acb]}: Taylor coefficients in h of the verifier's coord_values."""
     with ctx.workprec(prec), series_cap(n):
-        nets = basis_nets(Family(_hvar(n), sigma))
-        return {(b, c): pts for b in (XB if coord == "x" else YB) for c, pts in _series_curves(nets[b], n).items()}
+        nets = basis_nets(Family(series_variable(n), sigma))
+        return {(b, c): pts for b in (XB if coord == "x" else YB) for c, pts in series_curves(nets[b], n).items()}
 
 
 
@@ -229,7 +229,7 @@ def coord_disc(sigma, r, coord, grid=12, prec=128):
 
 def layer_trans_taylor(q, sigma, n, prec=128):
     with ctx.workprec(prec), series_cap(n):
-        fam = Family(_hvar(n), sigma)
+        fam = Family(series_variable(n), sigma)
         return _C.layer_trans_series(fam, layer_nets(fam, q), n)
 
 
@@ -244,7 +244,7 @@ def layer_trans_disc(q, sigma, r, grid=12, prec=128):
 def layer_coord(q, sigma, n, r, grid=12, prec=128):
     """(Taylor coefficients {curve: [m: 4 arb]}, disc bounds {curve: M}) of Y on layer quadrant q's outer curves."""
     with ctx.workprec(prec), series_cap(n):
-        T = _C.layer_y_series(layer_nets(Family(_hvar(n), sigma), q), n)
+        T = _C.layer_y_series(layer_nets(Family(series_variable(n), sigma), q), n)
         M = disc_bound(lambda h: _C.layer_y_values(layer_nets(Family(h, sigma), q)), r, grid) if grid else {}
         return T, M
 

@@ -541,7 +541,7 @@ def closed_form_vectors(k):
     import scipy.sparse as sp
 
     from ccproof.certify.verify.tagged import labels, sector_rows
-    from ccproof.certify.verify.tagged_modes import _POS, _block, mode_vector, ring_stencil
+    from ccproof.certify.verify.tagged_modes import RING_INDEX, mode_vector, ring_block, ring_stencil
 
     def cv(z):
         return complex(float(z.real.mid()), float(z.imag.mid())) if isinstance(z, acb) else complex(float(z))
@@ -553,8 +553,8 @@ def closed_form_vectors(k):
     pts, rows = labels("dart", k), sector_rows("dart", k)
     m = len(pts)
     kappa = np.array([1 - sum(float(w) for w in ring_stencil()[i].values()) for i in range(6)])
-    u = np.linalg.solve(lam * np.eye(6) - np.array([[cv(z).real for z in r] for r in _block(fmpq(1))]), kappa)
-    Bw = np.array([[cv(z) for z in r] for r in _block(acb(math.cos(phi), math.sin(phi)))])
+    u = np.linalg.solve(lam * np.eye(6) - np.array([[cv(z).real for z in r] for r in ring_block(fmpq(1))]), kappa)
+    Bw = np.array([[cv(z) for z in r] for r in ring_block(acb(math.cos(phi), math.sin(phi)))])
     ev, V = np.linalg.eig(Bw)
     vh = V[:, int(np.argmin(abs(ev - lam)))]
     cols = np.zeros((m, 3))
@@ -562,8 +562,9 @@ def closed_form_vectors(k):
     for i, p in enumerate(pts[1:], 1):
         t, pos = p[1], p[2:]
         tm, pm = (k - t if t else k, pos) if pos[1] == 0 else (k - 1 - t, (pos[1], pos[0]))
-        a = vh[_POS[pos]] * cmath.exp(1j * phi * (t - k / 2)) + vh[_POS[pm]] * cmath.exp(1j * phi * (tm - k / 2))
-        cols[i] = (u[_POS[pos]], a.real, a.imag)
+        a = (vh[RING_INDEX[pos]] * cmath.exp(1j * phi * (t - k / 2))
+             + vh[RING_INDEX[pm]] * cmath.exp(1j * phi * (tm - k / 2)))
+        cols[i] = (u[RING_INDEX[pos]], a.real, a.imag)
     ij = ([i for i, row in enumerate(rows) for _ in row], [j for row in rows for j in row])
     S = sp.csr_matrix(([float(w) for row in rows for w in row.values()], ij), shape=(m, m))
     R = S @ cols - lam * cols

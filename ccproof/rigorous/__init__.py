@@ -16,9 +16,8 @@ Guarantees
   ``range_enclosure(bernstein_coefficients(p, box))`` brackets ``p`` on the whole box and
   ``certainly_positive`` (every coefficient certainly > 0, finite) proves ``p > 0`` on it.
 
-Main entry points: :class:`Poly`, :func:`jacobian_determinant` (of power, Bernstein or Taylor forms; also
-named ``bernstein_jacobian_determinant`` and ``taylor_jacobian_determinant``), :func:`bernstein_coefficients`,
-:class:`BernsteinForm` (``split``, ``restrict``, ``elevate``, ``diff``, ``+ - *``),
+Main entry points: :class:`Poly`, :func:`jacobian_determinant` (of power, Bernstein or Taylor forms),
+:func:`bernstein_coefficients`, :class:`BernsteinForm` (``split``, ``restrict``, ``elevate``, ``diff``, ``+ - *``),
 :func:`range_enclosure`, :func:`certainly_positive`, :func:`ball_contains`,
 :class:`TaylorForm` (a Taylor model in one parameter with
 Bernstein coefficients in the other variables, ``truncate``, ``bernstein``).  See ``docs/rigorous.md``.
@@ -35,20 +34,15 @@ from .bernstein import (
 from .poly import Poly, jacobian_determinant
 from .taylor import TaylorForm
 
-# one determinant for every kind of form (the names its callers use)
-bernstein_jacobian_determinant = taylor_jacobian_determinant = jacobian_determinant
-
 __all__ = [
     "BernsteinForm",
     "Poly",
     "TaylorForm",
     "ball_contains",
     "bernstein_coefficients",
-    "bernstein_jacobian_determinant",
     "certainly_positive",
     "exact_fmpq",
     "jacobian_determinant",
     "range_enclosure",
-    "taylor_jacobian_determinant",
     "unit_box",
 ]

@@ -198,7 +198,7 @@ def multiply(a, a_shape, b, b_shape, prec):
     so the univariate product's coefficients are exactly the product tensor's coefficients.
     """
     shape = tuple(p + q - 1 for p, q in zip(a_shape, b_shape))
-    strides = _strides(shape)
+    strides = row_major_strides(shape)
     total = size(shape)
     pa = _embed(a, a_shape, strides, prec)
     pb = _embed(b, b_shape, strides, prec)
@@ -215,7 +215,8 @@ def multiply(a, a_shape, b, b_shape, prec):
     return list(c), shape
 
 
-def _strides(shape):
+def row_major_strides(shape):
+    """The row-major strides of a dense array of ``shape``."""
     s = [1] * len(shape)
     for i in range(len(shape) - 2, -1, -1):
         s[i] = s[i + 1] * shape[i + 1]
@@ -261,7 +262,7 @@ def pad(coeffs, shape, new_shape, prec):
         return list(coeffs)
     z = zero(prec)
     out = [z] * size(new_shape)
-    idx = embed_indices(shape, _strides(new_shape))
+    idx = embed_indices(shape, row_major_strides(new_shape))
     for c, i in zip(coeffs, idx):
         out[i] = c
     return out

@@ -75,7 +75,8 @@ class BernsteinForm:
         self.prec = prec
 
     @classmethod
-    def _raw(cls, shape, coeffs, box, prec):
+    def from_raw(cls, shape, coeffs, box, prec):
+        """From coefficients already of the form's kind and precision (no conversion, no checks)."""
         f = object.__new__(cls)
         f.shape, f.coeffs, f.box, f.prec = tuple(shape), coeffs, box, prec
         return f
@@ -101,7 +102,7 @@ class BernsteinForm:
         """Ball version at ``prec`` bits."""
         if T.check_prec(prec) is None:
             raise ValueError("to_arb needs a precision in bits")
-        return BernsteinForm._raw(self.shape, T.convert(self.coeffs, prec), self.box, prec)
+        return BernsteinForm.from_raw(self.shape, T.convert(self.coeffs, prec), self.box, prec)
 
     # ------------------------------------------------------------------ subdivision
 
@@ -157,7 +158,7 @@ class BernsteinForm:
         """The polynomial in the original (box) variables, in the power basis."""
         mats = [bernstein_to_power_matrix(n - 1) for n in self.shape]
         c, shape = T.apply_all_axes(self.coeffs, self.shape, mats, self.prec)
-        p = Poly._raw(shape, c, self.prec)
+        p = Poly.from_raw(shape, c, self.prec)
         for axis, (lo, hi) in enumerate(self.box):
             if (lo, hi) != (0, 1):
                 h = hi - lo
@@ -167,7 +168,7 @@ class BernsteinForm:
     def _along(self, axis, mat, interval):
         c, shape = T.apply_along_axis(self.coeffs, self.shape, axis, mat, self.prec)
         box = self.box[:axis] + (interval,) + self.box[axis + 1 :]
-        return BernsteinForm._raw(shape, c, box, self.prec)
+        return BernsteinForm.from_raw(shape, c, box, self.prec)
 
     def _axis(self, axis):
         if isinstance(axis, bool) or not isinstance(axis, int) or not 0 <= axis < self.nvars:
@@ -191,7 +192,7 @@ class BernsteinForm:
             return self._shift(T.scalar(other), 1)
         a, b, shape, prec = self._common(other)
         with flint.ctx.workprec(prec or flint.ctx.prec):
-            return BernsteinForm._raw(shape, [x + y for x, y in zip(a, b)], self.box, prec)
+            return BernsteinForm.from_raw(shape, [x + y for x, y in zip(a, b)], self.box, prec)
 
     __radd__ = __add__
 
@@ -200,20 +201,20 @@ class BernsteinForm:
             return self._shift(T.scalar(other), -1)
         a, b, shape, prec = self._common(other)
         with flint.ctx.workprec(prec or flint.ctx.prec):
-            return BernsteinForm._raw(shape, [x - y for x, y in zip(a, b)], self.box, prec)
+            return BernsteinForm.from_raw(shape, [x - y for x, y in zip(a, b)], self.box, prec)
 
     def __rsub__(self, other):
         return (-self)._shift(T.scalar(other), 1)
 
     def __neg__(self):
-        return BernsteinForm._raw(self.shape, [-c for c in self.coeffs], self.box, self.prec)
+        return BernsteinForm.from_raw(self.shape, [-c for c in self.coeffs], self.box, self.prec)
 
     def _shift(self, c, sign):
         # adding a constant adds it to every coefficient (partition of unity)
         self._check_scalar_kind(c)
         with flint.ctx.workprec(self.prec or flint.ctx.prec):
             out = [x + c for x in self.coeffs] if sign > 0 else [x - c for x in self.coeffs]
-        return BernsteinForm._raw(self.shape, out, self.box, self.prec)
+        return BernsteinForm.from_raw(self.shape, out, self.box, self.prec)
 
     def _check_scalar_kind(self, c):
         if isinstance(c, arb) and self.prec is None:
@@ -229,20 +230,20 @@ class BernsteinForm:
             c = T.scalar(other)
             self._check_scalar_kind(c)
             with flint.ctx.workprec(self.prec or flint.ctx.prec):
-                return BernsteinForm._raw(self.shape, [x * c for x in self.coeffs], self.box, self.prec)
+                return BernsteinForm.from_raw(self.shape, [x * c for x in self.coeffs], self.box, self.prec)
         if other.box != self.box:
             raise ValueError(f"Bernstein forms on different boxes: {self.box} and {other.box}")
         prec = T.join_prec(self.prec, other.prec)
-        wa = T.weights(self.shape, [_binomials(n - 1) for n in self.shape])
-        wb = T.weights(other.shape, [_binomials(n - 1) for n in other.shape])
+        wa = T.weights(self.shape, [binomials(n - 1) for n in self.shape])
+        wb = T.weights(other.shape, [binomials(n - 1) for n in other.shape])
         with flint.ctx.workprec(prec or flint.ctx.prec):
             a = [c * w for c, w in zip(T.convert(self.coeffs, prec), wa)]
             b = [c * w for c, w in zip(T.convert(other.coeffs, prec), wb)]
         c, shape = T.multiply(a, self.shape, b, other.shape, prec)
-        wc = T.weights(shape, [_binomials(n - 1) for n in shape])
+        wc = T.weights(shape, [binomials(n - 1) for n in shape])
         with flint.ctx.workprec(prec or flint.ctx.prec):
             c = [x / w for x, w in zip(c, wc)]
-        return BernsteinForm._raw(shape, c, self.box, prec)
+        return BernsteinForm.from_raw(shape, c, self.box, prec)
 
     __rmul__ = __mul__
 
@@ -255,7 +256,7 @@ class BernsteinForm:
                 raise ZeroDivisionError("Bernstein form divided by zero")
             return self * (1 / c)
         with flint.ctx.workprec(self.prec):
-            return BernsteinForm._raw(self.shape, [x / c for x in self.coeffs], self.box, self.prec)
+            return BernsteinForm.from_raw(self.shape, [x / c for x in self.coeffs], self.box, self.prec)
 
 
 # ---------------------------------------------------------------------------- conversion
@@ -315,9 +316,9 @@ def bernstein_coefficients(poly, box=None, degrees=None):
         isinstance(d, bool) or not isinstance(d, int) or d < n for d, n in zip(degrees, poly.degrees)
     ):
         raise ValueError(f"Bernstein degrees {degrees} below the polynomial's degrees {poly.degrees}")
-    mats = [_conversion_matrix(n - 1, d, lo, hi) for n, d, (lo, hi) in zip(poly.shape, degrees, box)]
+    mats = [conversion_matrix(n - 1, d, lo, hi) for n, d, (lo, hi) in zip(poly.shape, degrees, box)]
     c, shape = T.apply_all_axes(poly.coeffs, poly.shape, mats, poly.prec)
-    return BernsteinForm._raw(shape, c, box, poly.prec)
+    return BernsteinForm.from_raw(shape, c, box, poly.prec)
 
 
 def range_enclosure(form):
@@ -430,7 +431,8 @@ def _C(n, k):
     return comb(n, k) if 0 <= k <= n else 0
 
 
-def _binomials(n):
+def binomials(n):
+    """[C(n, 0), ..., C(n, n)] (fmpz): the scaling of degree-n Bernstein coefficients."""
     return [fmpz(comb(n, i)) for i in range(n + 1)]
 
 
@@ -536,7 +538,8 @@ def derivative_matrix(n, h):
     )
 
 
-def _conversion_matrix(n, d, lo, hi):
+def conversion_matrix(n, d, lo, hi):
+    """Power coefficients of degree n on [lo, hi] -> Bernstein ones of degree d >= n (cached)."""
     if (lo, hi) == (0, 1):
         return power_to_bernstein_matrix(n, d)
     return _cached(

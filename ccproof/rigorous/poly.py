@@ -72,7 +72,7 @@ class Poly:
             if len(e) != nvars or any(isinstance(k, bool) or not isinstance(k, int) or k < 0 for k in e):
                 raise ValueError(f"exponent {e!r} is not a tuple of {nvars} non-negative ints")
         shape = tuple(max([e[i] for e in terms], default=0) + 1 for i in range(nvars))
-        strides = T._strides(shape)
+        strides = T.row_major_strides(shape)
         coeffs = [T.zero(prec)] * T.size(shape)
         with flint.ctx.workprec(prec or flint.ctx.prec):
             for e, c in terms.items():
@@ -85,7 +85,8 @@ class Poly:
     # ------------------------------------------------------------------ construction
 
     @classmethod
-    def _raw(cls, shape, coeffs, prec):
+    def from_raw(cls, shape, coeffs, prec):
+        """From coefficients already of the form's kind and precision (no conversion, no checks)."""
         p = object.__new__(cls)
         p.shape, p.coeffs, p.prec = tuple(shape), coeffs, prec
         return p
@@ -104,7 +105,7 @@ class Poly:
         coeffs = [T.scalar(c) for c in coeffs]
         if prec is None and any(isinstance(c, arb) for c in coeffs):
             raise TypeError("arb coefficient in an exact polynomial: pass prec=... for balls")
-        return cls._raw(shape, T.convert(coeffs, prec), prec)
+        return cls.from_raw(shape, T.convert(coeffs, prec), prec)
 
     @classmethod
     def constant(cls, c, nvars, prec=None):
@@ -140,7 +141,7 @@ class Poly:
             raise ValueError(f"exponent {exps!r} for {self.nvars} variables")
         if any(k < 0 or k >= n for k, n in zip(exps, self.shape)):
             return T.zero(self.prec)
-        strides = T._strides(self.shape)
+        strides = T.row_major_strides(self.shape)
         return self.coeffs[sum(k * s for k, s in zip(exps, strides))]
 
     def terms(self):
@@ -159,13 +160,13 @@ class Poly:
         prec = T.check_prec(prec)
         if prec is None:
             raise ValueError("to_arb needs a precision in bits")
-        return Poly._raw(self.shape, T.convert(self.coeffs, prec), prec)
+        return Poly.from_raw(self.shape, T.convert(self.coeffs, prec), prec)
 
     def midpoint(self):
         """Exact polynomial of the balls' midpoints (a representative, *not* an enclosure)."""
         if self.prec is None:
             return self
-        return Poly._raw(self.shape, [T.exact_fmpq(c.mid()) for c in self.coeffs], None)
+        return Poly.from_raw(self.shape, [T.exact_fmpq(c.mid()) for c in self.coeffs], None)
 
     def contains(self, other):
         """True when every coefficient ball contains the matching coefficient of ``other``."""
@@ -208,7 +209,7 @@ class Poly:
         b = T.pad(T.convert(other.coeffs, prec), other.shape, shape, prec)
         with flint.ctx.workprec(prec or flint.ctx.prec):
             c = [x + y for x, y in zip(a, b)] if sign > 0 else [x - y for x, y in zip(a, b)]
-        return Poly._raw(shape, c, prec)
+        return Poly.from_raw(shape, c, prec)
 
     def __add__(self, other):
         return self._binary_add(other, 1)
@@ -222,7 +223,7 @@ class Poly:
         return self._coerce(other)._binary_add(self, -1)
 
     def __neg__(self):
-        return Poly._raw(self.shape, [-c for c in self.coeffs], self.prec)
+        return Poly.from_raw(self.shape, [-c for c in self.coeffs], self.prec)
 
     def __pos__(self):
         return self
@@ -235,13 +236,13 @@ class Poly:
                     "arb scalar with an exact polynomial: convert it with .to_arb(prec) first"
                 )
             with flint.ctx.workprec(self.prec or flint.ctx.prec):
-                return Poly._raw(self.shape, [x * c for x in self.coeffs], self.prec)
+                return Poly.from_raw(self.shape, [x * c for x in self.coeffs], self.prec)
         other = self._coerce(other)
         prec = T.join_prec(self.prec, other.prec)
         c, shape = T.multiply(
             T.convert(self.coeffs, prec), self.shape, T.convert(other.coeffs, prec), other.shape, prec
         )
-        return Poly._raw(shape, c, prec)
+        return Poly.from_raw(shape, c, prec)
 
     __rmul__ = __mul__
 
@@ -254,7 +255,7 @@ class Poly:
                     "arb scalar with an exact polynomial: convert it with .to_arb(prec) first"
                 )
             with flint.ctx.workprec(self.prec):
-                return Poly._raw(self.shape, [x / c for x in self.coeffs], self.prec)
+                return Poly.from_raw(self.shape, [x / c for x in self.coeffs], self.prec)
         if c == 0:
             raise ZeroDivisionError("polynomial divided by zero")
         return self * (1 / c)
@@ -279,7 +280,7 @@ class Poly:
         axis = self._axis(axis)
         n = self.shape[axis]
         if n == 1:
-            return Poly._raw(self.shape, [T.zero(self.prec)] * T.size(self.shape), self.prec)
+            return Poly.from_raw(self.shape, [T.zero(self.prec)] * T.size(self.shape), self.prec)
         pre = T.size(self.shape[:axis])
         post = T.size(self.shape[axis + 1 :])
         c = self.coeffs
@@ -291,7 +292,7 @@ class Poly:
                 for q in range(post)
             ]
         shape = self.shape[:axis] + (n - 1,) + self.shape[axis + 1 :]
-        return Poly._raw(shape, out, self.prec)
+        return Poly.from_raw(shape, out, self.prec)
 
     def evaluate(self, point, prec=None):
         """Value at ``point`` (ints, fmpq, ``"p/q"`` strings or arb balls), by nested Horner.
@@ -358,7 +359,7 @@ class Poly:
         a, b = T.exact_scalar(a), T.exact_scalar(b)
         mat = taylor_shift_matrix(self.shape[axis] - 1, a, b - a)
         c, shape = T.apply_along_axis(self.coeffs, self.shape, axis, mat, self.prec)
-        return Poly._raw(shape, c, self.prec)
+        return Poly.from_raw(shape, c, self.prec)
 
     def truncate(self, degree, axis=0):
         """Ball polynomial of degree <= ``degree`` in ``x_axis`` that encloses ``self`` for
@@ -387,7 +388,7 @@ class Poly:
         if self.prec is None:
             raise TypeError("truncate() makes balls: convert with .to_arb(prec) first")
         c, shape = T.truncate(self.coeffs, self.shape, axis, degree, self.prec)
-        return Poly._raw(shape, c, self.prec)
+        return Poly.from_raw(shape, c, self.prec)
 
     def _axis(self, axis):
         if isinstance(axis, bool) or not isinstance(axis, int) or not 0 <= axis < self.nvars:

@@ -34,8 +34,8 @@ from flint import arb
 from . import _tensor as T
 from .bernstein import (
     BernsteinForm,
-    _binomials,
-    _conversion_matrix,
+    binomials,
+    conversion_matrix,
     derivative_matrix,
     elevation_matrix,
     power_to_bernstein_matrix,
@@ -88,7 +88,8 @@ class TaylorForm:
         self.shape, self.coeffs, self.prec = shape, T.convert(coeffs, prec), prec
 
     @classmethod
-    def _raw(cls, shape, coeffs, prec):
+    def from_raw(cls, shape, coeffs, prec):
+        """From coefficients already of the form's kind and precision (no conversion, no checks)."""
         f = object.__new__(cls)
         f.shape, f.coeffs, f.prec = tuple(shape), coeffs, prec
         return f
@@ -102,13 +103,13 @@ class TaylorForm:
         for axis in range(1, len(shape)):
             coeffs, shape = T.apply_along_axis(coeffs, shape, axis,
                                                power_to_bernstein_matrix(shape[axis] - 1, shape[axis] - 1), prec)
-        return cls._raw(shape, coeffs, prec)
+        return cls.from_raw(shape, coeffs, prec)
 
     @classmethod
     def constant(cls, c, nx, prec):
         """The constant ``c`` as a form in ``nx`` variables x (degree 0)."""
         with flint.ctx.workprec(prec):
-            return cls._raw((1,) * (nx + 1), [T.to_kind(T.scalar(c), prec)], prec)
+            return cls.from_raw((1,) * (nx + 1), [T.to_kind(T.scalar(c), prec)], prec)
 
     @classmethod
     def variable(cls, axis, nx, prec):
@@ -117,7 +118,7 @@ class TaylorForm:
         if isinstance(axis, bool) or not isinstance(axis, int) or not 1 <= axis <= d:
             raise ValueError(f"axis {axis!r} out of range 1..{d}")
         shape = (1,) + tuple(2 if i == axis else 1 for i in range(1, d + 1))
-        return cls._raw(shape, [arb(0), arb(1)], prec)
+        return cls.from_raw(shape, [arb(0), arb(1)], prec)
 
     # ------------------------------------------------------------------ arithmetic
 
@@ -142,26 +143,26 @@ class TaylorForm:
         block = prod(self.shape[1:])
         with flint.ctx.workprec(self.prec):
             head = [x + c for x in self.coeffs[:block]] if sign > 0 else [x - c for x in self.coeffs[:block]]
-        return TaylorForm._raw(self.shape, head + self.coeffs[block:], self.prec)
+        return TaylorForm.from_raw(self.shape, head + self.coeffs[block:], self.prec)
 
     def __add__(self, other):
         if not isinstance(other, TaylorForm):
             return self._shift(other, 1)
         a, b, shape = self._aligned(other)
         with flint.ctx.workprec(self.prec):
-            return TaylorForm._raw(shape, [x + y for x, y in zip(a, b)], self.prec)
+            return TaylorForm.from_raw(shape, [x + y for x, y in zip(a, b)], self.prec)
 
     __radd__ = __add__
 
     def __neg__(self):
-        return TaylorForm._raw(self.shape, [-c for c in self.coeffs], self.prec)
+        return TaylorForm.from_raw(self.shape, [-c for c in self.coeffs], self.prec)
 
     def __sub__(self, other):
         if not isinstance(other, TaylorForm):
             return self._shift(other, -1)
         a, b, shape = self._aligned(other)
         with flint.ctx.workprec(self.prec):
-            return TaylorForm._raw(shape, [x - y for x, y in zip(a, b)], self.prec)
+            return TaylorForm.from_raw(shape, [x - y for x, y in zip(a, b)], self.prec)
 
     def __rsub__(self, other):
         return (-self)._shift(other, 1)
@@ -171,19 +172,19 @@ class TaylorForm:
         if not isinstance(other, TaylorForm):
             c = T.scalar(other)
             with flint.ctx.workprec(self.prec):
-                return TaylorForm._raw(self.shape, [x * c for x in self.coeffs], self.prec)
+                return TaylorForm.from_raw(self.shape, [x * c for x in self.coeffs], self.prec)
         if other.prec != self.prec or len(other.shape) != len(self.shape):
             raise ValueError("TaylorForms of different precision or number of variables")
 
         def weights(shape):
-            return T.weights(shape, [[1] * shape[0]] + [_binomials(n - 1) for n in shape[1:]])
+            return T.weights(shape, [[1] * shape[0]] + [binomials(n - 1) for n in shape[1:]])
 
         with flint.ctx.workprec(self.prec):
             a = [c * w for c, w in zip(self.coeffs, weights(self.shape))]
             b = [c * w for c, w in zip(other.coeffs, weights(other.shape))]
             c, shape = T.multiply(a, self.shape, b, other.shape, self.prec)
             c = [x / w for x, w in zip(c, weights(shape))]
-        return TaylorForm._raw(shape, c, self.prec)
+        return TaylorForm.from_raw(shape, c, self.prec)
 
     __rmul__ = __mul__
 
@@ -195,7 +196,7 @@ class TaylorForm:
             raise ValueError(f"axis {axis!r} is not an x axis")
         c, shape = T.apply_along_axis(self.coeffs, self.shape, axis,
                                       derivative_matrix(self.shape[axis] - 1, T.exact_scalar(1)), self.prec)
-        return TaylorForm._raw(shape, c, self.prec)
+        return TaylorForm.from_raw(shape, c, self.prec)
 
     def truncate(self, degree):
         """Keep z^0 .. z^degree; each dropped coefficient c of z^e B_k (e > degree) is added as
@@ -205,11 +206,11 @@ class TaylorForm:
         if self.shape[0] <= degree + 1:
             return self
         c, shape = T.truncate(self.coeffs, self.shape, 0, degree, self.prec)
-        return TaylorForm._raw(shape, c, self.prec)
+        return TaylorForm.from_raw(shape, c, self.prec)
 
     def bernstein(self):
         """The :class:`BernsteinForm` of the same polynomial on [-1, 1] x [0, 1]^d (z converted)."""
         n = self.shape[0] - 1
-        c, shape = T.apply_along_axis(self.coeffs, self.shape, 0, _conversion_matrix(n, n, *ZBOX), self.prec)
+        c, shape = T.apply_along_axis(self.coeffs, self.shape, 0, conversion_matrix(n, n, *ZBOX), self.prec)
         box = (ZBOX,) + ((T.exact_scalar(0), T.exact_scalar(1)),) * (len(shape) - 1)
-        return BernsteinForm._raw(shape, c, box, self.prec)
+        return BernsteinForm.from_raw(shape, c, box, self.prec)

@@ -48,7 +48,7 @@ def _derived(nets_bez, lam, prec):
     """Certified derived quantities from the arb Bezier nets (see module docstring)."""
     from flint import arb, ctx, fmpq
 
-    from ccproof.rigorous import BernsteinForm, bernstein_jacobian_determinant, range_enclosure
+    from ccproof.rigorous import BernsteinForm, jacobian_determinant, range_enclosure
 
     with ctx.workprec(prec):
         det_lo: Any = None  # arb balls, once the first patch is done
@@ -59,7 +59,7 @@ def _derived(nets_bez, lam, prec):
             net = nets_bez[name]
             X = BernsteinForm((4, 4), [net[i][j][0] for i in range(4) for j in range(4)], prec=prec)
             Y = BernsteinForm((4, 4), [net[i][j][1] for i in range(4) for j in range(4)], prec=prec)
-            det = bernstein_jacobian_determinant([X, Y]) * arb(4)  # d(s,t)/d(u,v) = 2 * 2
+            det = jacobian_determinant([X, Y]) * arb(4)  # d(s,t)/d(u,v) = 2 * 2
             lo, hi = _refine_min(det, depth=6)
             det_lo = lo if det_lo is None else min(det_lo, lo, key=_key)
             det_hi = hi if det_hi is None else min(det_hi, hi, key=_key)

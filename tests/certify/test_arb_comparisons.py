@@ -137,7 +137,7 @@ REVIEWED = {
     ("tagged_limit.py", "out.setdefault(key, rel) != rel"): "dicts of fmpq weights (exact)",
     ("tagged_limit.py", "C != crease_block(fam, WINDOW[1])"): "fmpq_mat (exact)",
     ("tagged_limit.py", "blocks[0] != blocks[1]"): "tuples of fmpq_mat (exact)",
-    ("tagged_limit.py", "_mul(_block(1 / w), _reflection(w)) != _mul(_reflection(w), _block(w))"):
+    ("tagged_limit.py", "_mul(ring_block(1 / w), _reflection(w)) != _mul(_reflection(w), ring_block(w))"):
         "lists of fmpq (w is an exact rational)",
     ("tagged_limit.py", "not slope * length < abs(h0)"): "fails unless the arc's image certainly misses 0: "
                                                          "conservative",

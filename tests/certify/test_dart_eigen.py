@@ -49,21 +49,21 @@ def test_fails_with_a_flipped_alpha_or_too_small_k0_or_too_few_balls():
 
 
 def test_exact_identities_fail_when_perturbed(monkeypatch):
-    N = [list(c) for c in E._NPOLY]
+    N = [list(c) for c in E.N_POLYS]
     N[0][2] += fmpq(1, 1000)
-    monkeypatch.setattr(E, "_NPOLY", N)
+    monkeypatch.setattr(E, "N_POLYS", N)
     with pytest.raises(CertificateError, match="mode-0"):
         E.check_mode0()
     with pytest.raises(CertificateError, match="crease vertex"):
         E.check_crease_row()
     monkeypatch.undo()
-    real = E._block
+    real = E.ring_block
 
     def bent(w):  # the (2,0) row reads a little more of its own (2,0) point: no longer the crease identity
         rows = real(w)
         rows[1][1] += fmpq(1, 64)
         return rows
-    monkeypatch.setattr(E, "_block", bent)
+    monkeypatch.setattr(E, "ring_block", bent)
     with pytest.raises(CertificateError, match="crease vertex"):
         E.check_crease_row()
     with pytest.raises(CertificateError, match="degree"):

@@ -86,12 +86,12 @@ def test_the_exact_series_and_nets_are_the_acb_familys():
     with ctx.workprec(128), df.series_cap(3):
         half = arb(fmpq(1, 2))
         co, si, tp = half.cos(), half.sin(), 2 * arb.pi()
-        fam = df.Family(df._hvar(2), half)
+        fam = df.Family(df.series_variable(2), half)
         worst = 0.0
 
         def cmp(got, zs, scale_x):
             nonlocal worst
-            g = df._coeffs(got, 3)
+            g = df.series_coeffs(got, 3)
             for m in range(3):
                 want = (tp ** m * _acb(zs[0].c[m]) if scale_x
                         else co * _acb(zs[0].c[m]) + si * _acb(zs[1].c[m]) if len(zs) == 2 else _acb(zs[0].c[m]))

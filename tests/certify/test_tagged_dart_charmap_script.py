@@ -251,10 +251,10 @@ def test_series_are_not_truncated_silently():
         try:
             ctx.cap = 10
             with pytest.raises(ValueError):
-                mod._hvar(12)
+                mod.series_variable(12)
             with mod.series_cap(12):
-                fam = mod.Family(mod._hvar(12), arb("4.49"))
-                c = mod._coeffs(fam.vx[2], 13)
+                fam = mod.Family(mod.series_variable(12), arb("4.49"))
+                c = mod.series_coeffs(fam.vx[2], 13)
             assert ctx.cap == 10
             assert abs(c[11]) > 1e-6 and abs(c[12]) > 1e-6
         finally:
@@ -293,17 +293,17 @@ def test_the_exact_series_are_the_acb_familys():
     zmod, mod = _load_zeros(), _load()
     ex = zmod.ExactFamily(mod, 1, 1, 1, 1)
     with ctx.workprec(128), mod.series_cap(3):
-        fam = mod.Family(mod._hvar(2), arb(fmpq(1, 2)))
+        fam = mod.Family(mod.series_variable(2), arb(fmpq(1, 2)))
         tp = 2 * arb.pi()
         for k in range(6):
-            cy, cx = mod._coeffs(fam.vy[k], 3), mod._coeffs(fam.vx[k], 3)
+            cy, cx = mod.series_coeffs(fam.vy[k], 3), mod.series_coeffs(fam.vx[k], 3)
             for m in range(3):
                 assert abs(cy[m] - _qf(ex.vy[k].c[m])) < 1e-30
                 assert abs(cx[m] - tp ** m * _qf(ex.vx[k].c[m])) < 1e-30
-        ca = mod._coeffs(fam.alpha, 3)
+        ca = mod.series_coeffs(fam.alpha, 3)
         for m in range(3):
             assert abs(ca[m] - arb(fmpq(1, 2)).cos() * _qf(ex.alpha.c[m])) < 1e-30
-        assert abs(mod._coeffs(fam.lam2, 3)[2] - _qf(ex.lam2.c[2])) < 1e-30
+        assert abs(mod.series_coeffs(fam.lam2, 3)[2] - _qf(ex.lam2.c[2])) < 1e-30
         assert abs(_qf(ex.lam2.c[2])) > 0.01  # lam's h^2 term is there
 
 
@@ -358,7 +358,7 @@ def test_the_exact_nets_are_the_acb_familys_nets():
     with ctx.workprec(128), mod.series_cap(3):
         half = arb(fmpq(1, 2))
         co, si, tp = half.cos(), half.sin(), 2 * arb.pi()
-        fam = mod.Family(mod._hvar(2), half)
+        fam = mod.Family(mod.series_variable(2), half)
         mine = mod.basis_nets(fam)
         ex = [{n: mod.piece_nets(f, c, lam, e.zero) for n, (f, c, lam) in e.parts().items()} for e in exs]
         worst = 0.0
@@ -366,7 +366,7 @@ def test_the_exact_nets_are_the_acb_familys_nets():
             for p in mod.PIECES:
                 for i in range(4):
                     for j in range(4):
-                        got = mod._coeffs(mine[name][p][i][j], 3)
+                        got = mod.series_coeffs(mine[name][p][i][j], 3)
                         for m in range(3):
                             if name.startswith("X"):
                                 want = tp ** m * _qf(ex[0][name][p][i][j].c[m])
@@ -389,7 +389,7 @@ def test_the_exact_nets_are_the_acb_familys_nets():
             for p in mod.PIECES:
                 for i in range(4):
                     for j in range(4):
-                        gx, gy = mod._coeffs(ln[p][0][i][j], 3), mod._coeffs(ln[p][1][i][j], 3)
+                        gx, gy = mod.series_coeffs(ln[p][0][i][j], 3), mod.series_coeffs(ln[p][1][i][j], 3)
                         for m in range(3):
                             worst = max(worst, float(abs(gx[m] - tp ** m * _qf(x0[p][i][j].c[m])).upper()),
                                         float(abs(gy[m] - exact_y([el[0][p][i][j], el[1][p][i][j]], m)).upper()))

@@ -166,14 +166,14 @@ def test_forgery_gamma():
 def test_forgery_perturbed_stencil(monkeypatch):
     """A stencil that breaks the reflection identity: refused by the identity check itself, and (a perturbed
     ring rule) already by the ring check."""
-    block = tl._block
+    block = tl.ring_block
 
     def perturbed(w):
         rows = block(w)
         rows[0][1] += w / 100  # not symmetric under w -> 1/w with the swap
         return rows
 
-    monkeypatch.setattr(tl, "_block", perturbed)
+    monkeypatch.setattr(tl, "ring_block", perturbed)
     tl.reflection_identity.cache_clear()
     _fails(_tail("crease"), "breaks the reflection identity")
     monkeypatch.undo()

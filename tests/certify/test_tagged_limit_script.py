@@ -44,12 +44,12 @@ def test_h_is_the_verifiers_jacobian_times_the_ray_values(fam, n):
 def test_reflection_identity_fails_for_a_perturbed_stencil(monkeypatch):
     mod = _load()
     assert mod.reflection_identity()
-    block = mod._block
+    block = mod.ring_block
 
     def perturbed(w):
         rows = block(w)
         rows[0][1] += w / 100  # not symmetric under w -> 1/w with the swap
         return rows
 
-    monkeypatch.setattr(mod, "_block", perturbed)
+    monkeypatch.setattr(mod, "ring_block", perturbed)
     assert not mod.reflection_identity()

@@ -17,7 +17,6 @@ from ccproof.rigorous import (
     Poly,
     ball_contains,
     bernstein_coefficients,
-    bernstein_jacobian_determinant,
     certainly_positive,
     exact_fmpq,
     jacobian_determinant,
@@ -323,7 +322,7 @@ def test_det_jacobian_bernstein_reproduces_sympy():
     sym = sp.Matrix([H.to_sympy(g1), H.to_sympy(g2)]).jacobian(X[:2]).det()
     assert sp.expand(H.bernstein_to_sympy(f) - sym) == 0
     # the same coefficients from Bernstein arithmetic (derivatives and products on the box)
-    fg = bernstein_jacobian_determinant(
+    fg = jacobian_determinant(
         [bernstein_coefficients(g1, box), bernstein_coefficients(g2, box)]
     )
     assert fg.coeffs == bernstein_coefficients(det, box, fg.degrees).coeffs
@@ -395,11 +394,11 @@ def test_bezier_net_to_poly_and_det_j_of_a_bicubic_patch():
     for f, p in zip(patch, polys):
         assert _sympy_equal(f, p)
         assert bernstein_coefficients(p, box).coeffs == f.coeffs
-    det_b = bernstein_jacobian_determinant(patch)
+    det_b = jacobian_determinant(patch)
     det_p = jacobian_determinant(polys)
     assert det_b.coeffs == bernstein_coefficients(det_p, box, det_b.degrees).coeffs
     # ball nets (as read from a table) enclose the exact determinant's coefficients
-    balls = bernstein_jacobian_determinant([f.to_arb(100) for f in patch])
+    balls = jacobian_determinant([f.to_arb(100) for f in patch])
     assert all(ball_contains(b, e) for b, e in zip(balls.coeffs, det_b.coeffs))
     mid = Poly.from_dense(polys[0].shape, polys[0].coeffs).to_arb(64).midpoint()
     assert mid.is_exact

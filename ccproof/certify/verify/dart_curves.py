@@ -16,10 +16,10 @@ from .dart_family import (
     PIECES,
     XB,
     YB,
-    _bprod,
-    _coeffs,
-    _series_curves,
-    _trans_series,
+    bezier_product,
+    curve_trans_series,
+    series_coeffs,
+    series_curves,
 )
 from .dart_regularity import mode_factors, real_hull
 from .maps import STAR_CURVES, curve_points
@@ -33,7 +33,7 @@ def _logs(fam):
 
 
 def _trans(X, Y, a1, a2):
-    return [a1 * p - a2 * q for p, q in zip(_bprod(X, Y), _bprod(Y, X))]
+    return [a1 * p - a2 * q for p, q in zip(bezier_product(X, Y), bezier_product(Y, X))]
 
 
 def trans_values(fam, nets):
@@ -66,24 +66,25 @@ def layer_y_values(lnets):
 def trans_series(fam, nets, n):
     """As :func:`trans_values` for the series family: {(i, j, curve): [coefficient list of h^m]};
     T_ij(0) = 0 exactly (a1 = a2, both parts multiples of one real curve at h = 0)."""
-    A1, A2 = (_coeffs(-lam.log(), n + 1) for lam in (fam.lam1, fam.lam2))
-    curves = {b: _series_curves(nets[b], n) for b in nets}
-    return {(i, j, c): _trans_series(curves[i][c], curves[j][c], A1, A2, n)
+    A1, A2 = (series_coeffs(-lam.log(), n + 1) for lam in (fam.lam1, fam.lam2))
+    curves = {b: series_curves(nets[b], n) for b in nets}
+    return {(i, j, c): curve_trans_series(curves[i][c], curves[j][c], A1, A2, n)
             for i in XB for j in YB for c in STAR_CURVES}
 
 
 def layer_trans_series(fam, lnets, n):
     """{curve: [coefficients (arb) of h^m]} of a1 X Y' - a2 Y X' on a layer quadrant (h^0..h^2: 0 exactly)."""
-    A1, A2 = ([z.real for z in _coeffs(-lam.log(), n + 1)] for lam in (fam.lam1, fam.lam2))
-    xs, ys = (_series_curves({p: lnets[p][k] for p in PIECES}, n) for k in (0, 1))
+    A1, A2 = ([z.real for z in series_coeffs(-lam.log(), n + 1)] for lam in (fam.lam1, fam.lam2))
+    xs, ys = (series_curves({p: lnets[p][k] for p in PIECES}, n) for k in (0, 1))
     real = {c: ([[z.real for z in pts] for pts in xs[c]], [[z.real for z in pts] for pts in ys[c]])
             for c in STAR_CURVES}
-    return {c: [[z.real for z in row] for row in _trans_series(real[c][0], real[c][1], A1, A2, n)] for c in STAR_CURVES}
+    return {c: [[z.real for z in row] for row in curve_trans_series(real[c][0], real[c][1], A1, A2, n)]
+            for c in STAR_CURVES}
 
 
 def layer_y_series(lnets, n):
     """{curve: [m: 4 arb]}: Taylor coefficients of Y's outer-curve points on a layer quadrant."""
-    ys = _series_curves({p: lnets[p][1] for p in PIECES}, n)
+    ys = series_curves({p: lnets[p][1] for p in PIECES}, n)
     return {c: [[z.real for z in pts] for pts in ys[c]] for c in STAR_CURVES}
 
 

@@ -85,14 +85,14 @@ from flint import acb, arb, ctx, fmpq, fmpq_mat, fmpq_poly
 
 from ccproof.rigorous.analytic import ball
 
-from .dart_family import _B1, _NPOLY, Family, adjugate, kappa, l0, layer_level0, u_denominator
+from .dart_family import B_AT_1, N_POLYS, Family, adjugate, kappa, l0, layer_level0, u_denominator
 from .errors import CertificateError
 from .rules import TWO_RING
-from .tagged_modes import _POS, _block, check_ring, ring_stencil
+from .tagged_modes import RING_INDEX, check_ring, ring_block, ring_stencil
 
 _SMALL = (fmpq(1, 8), fmpq(1, 16), fmpq(1, 32), fmpq(1, 64))
 _X = fmpq_poly([0, 1])
-_E10, _E20, _E11 = _POS[(1, 0)], _POS[(2, 0)], _POS[(1, 1)]
+_E10, _E20, _E11 = RING_INDEX[(1, 0)], RING_INDEX[(2, 0)], RING_INDEX[(1, 1)]
 W_POINTS = 33  # the remainders of check_crease_row: w^-16 times polynomials of degree <= 32 in w
 
 
@@ -133,10 +133,10 @@ def check_mode0():
     >>> check_mode0()
     True
     """
-    B1, p = _B1, _charpoly_claimed()
+    B1, p = B_AT_1, _charpoly_claimed()
     if B1.charpoly() != p:
         raise CertificateError("det(x - B(1)) is not the claimed product")
-    N = [fmpq_poly(c) for c in _NPOLY]
+    N = [fmpq_poly(c) for c in N_POLYS]
     kap = kappa()
     for i in range(6):
         lhs = _X * N[i] - sum((B1[i, k] * N[k] for k in range(6)), fmpq_poly(0))
@@ -157,7 +157,7 @@ def check_crease_row(points=W_POINTS):
     if points < W_POINTS:
         raise CertificateError(f"{points} values of w cannot show an identity of degree {W_POINTS - 1}")
     p = _charpoly_claimed()
-    N = [fmpq_poly(c) for c in _NPOLY]
+    N = [fmpq_poly(c) for c in N_POLYS]
     if any(n.degree() > 5 for n in N):
         raise CertificateError("U's numerator has degree > 5: the degree bound of the identity fails")
     h = fmpq(1, 2)
@@ -169,7 +169,7 @@ def check_crease_row(points=W_POINTS):
     for w in range(1, points + 1):
         c = (fmpq(w) + fmpq(1, w)) / 2
         q = _X * _X - (5 + c) / 8 * _X + fmpq(1, 16)
-        adj = adjugate(fmpq_mat(_block(fmpq(w))))
+        adj = adjugate(fmpq_mat(ring_block(fmpq(w))))
         for j in range(6):
             P = sum((psi[i] * adj[i][j] for i in range(6)), fmpq_poly(0))
             if P % q != 0:

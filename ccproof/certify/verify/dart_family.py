@@ -28,7 +28,7 @@ from .errors import CertificateError
 from .maps import STAR_CURVES, curve_points
 from .rules import CENTRE, canonical, level1_rule
 from .statement import horner
-from .tagged_modes import _POS, _block, ring_stencil
+from .tagged_modes import RING_INDEX, ring_block, ring_stencil
 
 
 @dataclass(frozen=True)
@@ -80,12 +80,12 @@ def adjugate(B):
 
 def _adj_kappa_polys():
     """N(lam) = adj(lam - B(1)) kappa as 6 exact polynomials (coefficient lists, degree <= 5)."""
-    B1 = fmpq_mat(_block(fmpq(1)))
+    B1 = fmpq_mat(ring_block(fmpq(1)))
     adj, kap = adjugate(B1), kappa()
     return [[sum((adj[i][k][d] * kap[k] for k in range(6)), fmpq(0)) for d in range(6)] for i in range(6)], B1
 
 
-_NPOLY, _B1 = _adj_kappa_polys()
+N_POLYS, B_AT_1 = _adj_kappa_polys()  # N(lam) = adj(lam - B(1)) kappa (coefficient lists); B(1) (fmpq_mat)
 
 
 def l0():
@@ -102,7 +102,7 @@ def u_denominator(lam, low):
 def big_u(lam):
     """U(lam) (6 values of lam's type) = adj(lam - B(1)) kappa / :func:`u_denominator`."""
     den = u_denominator(lam, l0()[1])
-    return [horner(p, lam, lam * 0) / den for p in _NPOLY]
+    return [horner(p, lam, lam * 0) / den for p in N_POLYS]
 
 
 def _lam_principal(c):
@@ -115,7 +115,7 @@ def _lam_principal(c):
     return (5 + c + arg.sqrt()) / 16
 
 
-def _hvar(n):
+def series_variable(n):
     """The series variable h to order n. python-flint truncates every series to ``ctx.cap`` terms (10 by
     default) whatever its ``prec``: the callers run under :func:`series_cap` so that no order is lost."""
     if ctx.cap < n + 1:
@@ -137,7 +137,8 @@ class series_cap:
         ctx.cap = self.old
 
 
-def _coeffs(z, n):
+def series_coeffs(z, n):
+    """The first n Taylor coefficients of the series z (acb; zeros past its length)."""
     c = z.coeffs()
     return [acb(c[i]) if i < len(c) else acb(0) for i in range(n)]
 
@@ -154,12 +155,12 @@ def bordered(w, lam, pivot=0):
     For acb balls arb proves A regular on the whole ball (ZeroDivisionError otherwise). For power series
     in h (acb_series) the Taylor coefficients follow from A_0 v_k = -sum_(j >= 1) A_j v_(k-j), A_0 the
     system at h = 0 (proved regular by arb)."""
-    A = bordered_matrix(_block(w), lam, w * 0, pivot)
+    A = bordered_matrix(ring_block(w), lam, w * 0, pivot)
     if not isinstance(w, acb_series):
         sol = acb_mat(A).solve(acb_mat([[0]] * 6 + [[1]]))
         return [sol[i, 0] for i in range(6)]
     n = w.prec
-    Ak = [acb_mat([[_coeffs(A[i][k], n)[m] for k in range(7)] for i in range(7)]) for m in range(n)]
+    Ak = [acb_mat([[series_coeffs(A[i][k], n)[m] for k in range(7)] for i in range(7)]) for m in range(n)]
     inv0 = Ak[0].inv()
     vs = [inv0 * acb_mat([[0]] * 6 + [[1]])]
     for m in range(1, n):
@@ -190,11 +191,11 @@ class Modes:
         K s + delta and two-ring position pos."""
         vx, vy, e, i2, z = self.vx, self.vy, self.e, self.i2, self.zero
         return {
-            "X+": (lambda d, p: vx[_POS[p]] * e("x", d) / i2, z, self.lam1),
-            "X-": (lambda d, p: -(vx[_POS[_swap(p)]] * e("x", -d - _eps(p))) / i2, z, self.lam1),
-            "Y0": (lambda d, p: self.alpha * self.U[_POS[p]], self.yc, self.lam2),
-            "Y+": (lambda d, p: vy[_POS[p]] * e("y", d) * self.sign / 2, z, self.lam2),
-            "Y-": (lambda d, p: vy[_POS[_swap(p)]] * e("y", -d - _eps(p)) * self.sign / 2, z, self.lam2),
+            "X+": (lambda d, p: vx[RING_INDEX[p]] * e("x", d) / i2, z, self.lam1),
+            "X-": (lambda d, p: -(vx[RING_INDEX[_swap(p)]] * e("x", -d - _eps(p))) / i2, z, self.lam1),
+            "Y0": (lambda d, p: self.alpha * self.U[RING_INDEX[p]], self.yc, self.lam2),
+            "Y+": (lambda d, p: vy[RING_INDEX[p]] * e("y", d) * self.sign / 2, z, self.lam2),
+            "Y-": (lambda d, p: vy[RING_INDEX[_swap(p)]] * e("y", -d - _eps(p)) * self.sign / 2, z, self.lam2),
         }
 
     def layer_level0(self, q=0):
@@ -205,13 +206,13 @@ class Modes:
         vx, vy, e = self.vx, self.vy, self.e
 
         def x(t, pos):
-            return (vx[_POS[pos]] * e("x", t) - vx[_POS[_swap(pos)]] * e("x", -t - _eps(pos))) / self.i2
+            return (vx[RING_INDEX[pos]] * e("x", t) - vx[RING_INDEX[_swap(pos)]] * e("x", -t - _eps(pos))) / self.i2
 
         def y(t, pos):
             if t < 0:
                 t, pos = (-t, pos) if pos[1] == 0 else (-t - 1, _swap(pos))
-            return (self.alpha * self.U[_POS[pos]] + (vy[_POS[pos]] * e("y", t) * self.em
-                                                      + vy[_POS[_swap(pos)]] * e("y", -t - _eps(pos)) * self.ep) / 2)
+            return (self.alpha * self.U[RING_INDEX[pos]] + (vy[RING_INDEX[pos]] * e("y", t) * self.em
+                    + vy[RING_INDEX[_swap(pos)]] * e("y", -t - _eps(pos)) * self.ep) / 2)
         return x, y
 
 
@@ -273,7 +274,7 @@ def quadrant_level1(level0, centre, lam, zero, q=None):
             return 2 * value(A, 0) - value(A, 1)
         d, A2, B2 = canonical(A, B)
         t = d if q is None else q + d
-        if (A2, B2) in _POS:
+        if (A2, B2) in RING_INDEX:
             return lam * level0(t, (A2, B2))
         if q is not None and B2 == 0 and t == 0:
             return (level0(0, (1, 0)) + level0(0, (2, 0))) / 2
@@ -351,7 +352,7 @@ def layer_nets(fam, q):
     return {name: (X[name], Y[name]) for name in PIECES}
 
 
-def _bprod(f, g):
+def bezier_product(f, g):
     """Bernstein coefficients (degree 5) of f g' for cubic Bezier values f, g (any ring)."""
     gd = [3 * (g[i + 1] - g[i]) for i in range(3)]
     out = []
@@ -363,11 +364,11 @@ def _bprod(f, g):
     return out
 
 
-def _series_curves(nets, n):
+def series_curves(nets, n):
     """{curve: [order m: 4 acb]} of one coordinate's nets {piece: 4 x 4 acb_series}."""
     out = {}
     for name in STAR_CURVES:
-        pts = [_coeffs(z, n + 1) for z in curve_points(nets, name, oriented=True)]
+        pts = [series_coeffs(z, n + 1) for z in curve_points(nets, name, oriented=True)]
         out[name] = [[pts[p][m] for p in range(4)] for m in range(n + 1)]
     return out
 
@@ -382,7 +383,7 @@ def _curve_packed(c, deriv):
     return acb_poly(out)
 
 
-def _trans_series(xc, yc, A1, A2, n):
+def curve_trans_series(xc, yc, A1, A2, n):
     """Taylor coefficients of a1 X Y' - a2 Y X' from the coordinates' (xc, yc: [m: 4 values]) and a_i's: the
     Cauchy products in h of the degree-5 Bernstein products f g' (scaled coefficients convolve, then divide by
     C(5, k)) as acb_poly products, h packed with stride 6."""

@@ -17,7 +17,7 @@ from ccproof.rigorous.analytic import ball, disc_bound
 
 from . import dart_curves as C
 from . import dart_regularity as R
-from .dart_family import XB, YB, Family, _hvar, _series_curves, basis_nets, layer_nets, series_cap
+from .dart_family import XB, YB, Family, basis_nets, layer_nets, series_cap, series_curves, series_variable
 from .errors import CertificateError
 from .record import exact_keys
 from .replay import read_tree, replay_tree
@@ -92,10 +92,10 @@ class SigmaBox:
         with ctx.workprec(prec):
             self.sigma = sigma = ball(models.edges[i], models.edges[i + 1])
             with series_cap(hn.order):
-                fam = Family(_hvar(hn.order), sigma)
+                fam = Family(series_variable(hn.order), sigma)
                 nets = basis_nets(fam)
                 TR, TT = R.dets_series(nets, hn.order), C.trans_series(fam, nets, hn.order)
-                coord = {b: _series_curves(nets[b], hn.order) for b in XB + YB}
+                coord = {b: series_curves(nets[b], hn.order) for b in XB + YB}
             self.R = R.bulk_models(TR, models.bounds("R"), r)
             self.T = R.bulk_models(TT, models.bounds("T"), r)
             self.X = C.curve_models({(b, c): p for b in XB for c, p in coord[b].items()}, models.bounds("X"), r, XB)
@@ -108,7 +108,7 @@ class SigmaBox:
 
     def _layers(self, n, r):
         with series_cap(n):
-            fam = Family(_hvar(n), self.sigma)
+            fam = Family(series_variable(n), self.sigma)
             self.L = {}
             for q in range(self.m.layer):
                 ln = layer_nets(fam, q)

@@ -13,7 +13,7 @@ from flint import acb, acb_mat, arb, ctx, fmpq
 
 from ccproof.rigorous.analytic import AnalyticModel, ball, cauchy_factor, hull
 
-from .dart_family import PIECES, XB, YB, _coeffs, det_series
+from .dart_family import PIECES, XB, YB, det_series, series_coeffs
 
 IJ = [(i, j) for i in XB for j in YB]  # the columns of the bulk models
 
@@ -30,7 +30,7 @@ def _flat(nets):
 
 def dets_series(nets, n):
     """As :func:`det_values` for nets of acb_series: [coefficient list (acb) of h^m, m = 0..n]."""
-    series = {key: [[[_coeffs(z, n + 1)[m] for z in row] for row in net] for m in range(n + 1)]
+    series = {key: [[[series_coeffs(z, n + 1)[m] for z in row] for row in net] for m in range(n + 1)]
               for key, net in _flat(nets).items()}
     return {(i, j, p): det_series(series[(i, p)], series[(j, p)], n) for i, j in IJ for p in PIECES}
 
@@ -130,7 +130,7 @@ def layer_dets_series(lnets, n):
     """{piece: [Bernstein coefficients of det J_Phi's h^m (real parts: real for real h), m = 0..n]}."""
     out = {}
     for piece, (X, Y) in lnets.items():
-        fx, fy = ([[[acb(_coeffs(Z[i][j], n + 1)[m].real) for j in range(4)] for i in range(4)]
+        fx, fy = ([[[acb(series_coeffs(Z[i][j], n + 1)[m].real) for j in range(4)] for i in range(4)]
                    for m in range(n + 1)] for Z in (X, Y))
         out[piece] = [[z.real for z in c] for c in det_series(fx, fy, n)]
     return out

@@ -74,7 +74,7 @@ from ccproof.rigorous.analytic import ball
 from .dart_family import kappa
 from .errors import CertificateError
 from .tagged import labels, sector_rows
-from .tagged_modes import _POS, _roots, check_dart, check_ring, ring_stencil
+from .tagged_modes import RING_INDEX, charpoly_roots, check_dart, check_ring, ring_stencil
 
 WINDOW = (7, 8)  # the window classes of every K >= 7 occur in both
 _C = ("C",)
@@ -127,6 +127,15 @@ def check_construction():
     >>> d[("C",)], d[("r", 0, 1, 0)], d[("q", -1, 1, 1)], bound
     (1/8, 1/8, -1/16, 15/64)
     """
+    sharp = _check_rows()
+    bound = _outer_bound()
+    _check_one_ring_closed()
+    return _check_d(_construction_d(sharp)), bound
+
+
+def _check_rows():
+    """Raise unless the window classes agree, the centre row is the rule's and no weight is negative; returns
+    the sharp midpoint row of ray 0."""
     check_ring()
     classes = [_window_rows(k)[0] for k in WINDOW]
     if classes[0] != classes[1]:
@@ -135,30 +144,47 @@ def check_construction():
         raise CertificateError("dart: the centre row is not (1 - 7h/4, 3h^2/2 per ray, h^2/4 per quadrant)")
     if any(x < 0 for k in WINDOW for row in sector_rows("dart", k) for x in row.values()):
         raise CertificateError("dart: a negative weight (the outer bound assumes none)")
+    return classes[0][("r", 0, 3) + _E]
+
+
+def _outer_bound():
+    """The bound on the outer even rows over the window (raise if over 15/64, or if an odd block of the modes
+    +-1 has an eigenvalue >= 1/2)."""
     bound = fmpq(0)
     for k in WINDOW:
         _, _, blocks, _, _, b = check_dart(k)
         bound = max(bound, b)
         for M in blocks:
-            if not all(abs(z) < _HALF for z, _ in _roots(M)):
+            if not all(abs(z) < _HALF for z, _ in charpoly_roots(M)):
                 raise CertificateError(f"dart:{k}: an odd block of the modes +-1 has an eigenvalue >= 1/2")
     if bound > fmpq(15, 64):
         raise CertificateError(f"dart: the outer even rows bound {bound} > 15/64")
+    return bound
+
+
+def _check_one_ring_closed():
     for pos in (_E, _F):  # the one-ring is closed in the ring stencil
-        if any(q not in (_E, _F) for _, q in ring_stencil()[_POS[pos]]):
+        if any(q not in (_E, _F) for _, q in ring_stencil()[RING_INDEX[pos]]):
             raise CertificateError(f"the ring row of {pos} leaves the one-ring")
-    sharp = classes[0][("r", 0, 3) + _E]
-    smooth = {("r" if q[1] == 0 else "q", dlt) + q: x for (dlt, q), x in ring_stencil()[_POS[_E]].items()}
-    smooth[_C] = kappa()[_POS[_E]]
+
+
+def _construction_d(sharp):
+    """The sharp midpoint row minus the smooth edge row, zero weights dropped."""
+    smooth = {("r" if q[1] == 0 else "q", dlt) + q: x for (dlt, q), x in ring_stencil()[RING_INDEX[_E]].items()}
+    smooth[_C] = kappa()[RING_INDEX[_E]]
     d = {key: sharp.get(key, 0) - smooth.get(key, 0) for key in set(sharp) | set(smooth)}
-    d = {key: x for key, x in d.items() if x != 0}
+    return {key: x for key, x in d.items() if x != 0}
+
+
+def _check_d(d):
+    """Raise unless d reads only the one-ring window and is invariant under the reflection in ray 0."""
     for key in d:
         if key != _C and (key[2:] not in (_E, _F) or not -1 <= key[1] <= 1):
             raise CertificateError(f"dart: d reads {key} outside the one-ring window")
         mirror = key if key == _C else (key[0], -key[1] if key[2:] == _E else -key[1] - 1) + key[2:]
         if d.get(mirror, 0) != d[key]:
             raise CertificateError("dart: d is not invariant under the reflection in ray 0")
-    return d, bound
+    return d
 
 
 def _b1w(w, zero):
@@ -166,7 +192,7 @@ def _b1w(w, zero):
     polynomial generator; ``zero`` of its ring)."""
     out = [[zero, zero], [zero, zero]]
     for i, pos in enumerate((_E, _F)):
-        for (dlt, q), x in ring_stencil()[_POS[pos]].items():
+        for (dlt, q), x in ring_stencil()[RING_INDEX[pos]].items():
             out[i][(_E, _F).index(q)] = out[i][(_E, _F).index(q)] + x * w ** (dlt + 1)
     return out
 
@@ -186,8 +212,8 @@ def _dw(w, zero):
 def b0(lam, h):
     """lam - B0(h), the mode-0 block on (C, E, F) (3 x 3 of lam's type)."""
     kap, B = kappa(), _b1w(fmpq(1), fmpq(0))  # B1(1)
-    rows = [[1 - fmpq(7, 4) * h, fmpq(3, 2) * h, _QUARTER * h], [kap[_POS[_E]], B[0][0], B[0][1]],
-            [kap[_POS[_F]], B[1][0], B[1][1]]]
+    rows = [[1 - fmpq(7, 4) * h, fmpq(3, 2) * h, _QUARTER * h], [kap[RING_INDEX[_E]], B[0][0], B[0][1]],
+            [kap[RING_INDEX[_F]], B[1][0], B[1][1]]]
     return [[(lam if i == j else 0) - rows[i][j] for j in range(3)] for i in range(3)]
 
 

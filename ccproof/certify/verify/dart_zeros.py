@@ -52,7 +52,7 @@ from .dart_family import PIECES, XB, YB
 from .errors import CertificateError
 from .maps import STAR_CURVES, curve_points
 from .statement import horner
-from .tagged_modes import _POS, ring_stencil
+from .tagged_modes import RING_INDEX, ring_stencil
 
 GRID_AB = (1, 2, 3)  # degree <= 2 in a and in b
 GRID_CT = (1, 2)  # degree <= 1 in c, t, l
@@ -236,7 +236,7 @@ def _bordered(k, lam, stencil):
     B = [[QS(0) for _ in range(6)] for _ in range(6)]
     for i, row in enumerate(stencil):
         for (d, pos), x in row.items():
-            B[i][_POS[pos]] = B[i][_POS[pos]] + _exp_i(fmpq(k) * d) * fmpq(x)
+            B[i][RING_INDEX[pos]] = B[i][RING_INDEX[pos]] + _exp_i(fmpq(k) * d) * fmpq(x)
     return _solve(_df.bordered_matrix(B, lam, QS(0)), [QS(0)] * 6 + [QS(1)])[:6]
 
 
@@ -249,7 +249,7 @@ class _Mode:
         self.v = _bordered(self.k, self.lam, stencil)
         if with_u:
             den = _df.u_denominator(self.lam, L0_LOW)
-            self.U = [horner(p, self.lam, QS(0)) / den for p in _df._NPOLY]
+            self.U = [horner(p, self.lam, QS(0)) / den for p in _df.N_POLYS]
 
 
 class QL0:
@@ -311,7 +311,7 @@ def exact_zeros():
     (True, True, True)
     """
     L = QL0(0, 1)
-    A = [[(L if i == k else QL0(0)) - _df._B1[i, k] for k in range(6)] for i in range(6)]
+    A = [[(L if i == k else QL0(0)) - _df.B_AT_1[i, k] for k in range(6)] for i in range(6)]
     # rho: solve A rho = 0 with rho(1,0) = 1: drop row 0 (rank 5 since L0 is simple: checked by the solve)
     try:
         rho = [QL0(1)] + _solve([[A[i][k] for k in range(1, 6)] for i in range(1, 6)], [-A[i][0] for i in range(1, 6)],
@@ -320,10 +320,10 @@ def exact_zeros():
         raise CertificateError("L0 is not a simple eigenvalue of B(1)") from None
     if not all(sum((A[i][k] * rho[k] for k in range(6)), QL0(0)).is_zero() for i in range(6)):
         raise CertificateError("rho is no eigenvector of B(1) for L0")
-    pos = {p: k for p, k in _POS.items()}
+    pos = {p: k for p, k in RING_INDEX.items()}
     if not all(rho[pos[(a, b)]] == rho[pos[(b, a)]] for (a, b) in pos if b > 0 and (b, a) in pos):
         raise CertificateError("rho is not symmetric in (a, b)")
-    N = [horner(p, L, QL0(0)) for p in _df._NPOLY]
+    N = [horner(p, L, QL0(0)) for p in _df.N_POLYS]
     if not all((N[k] - N[0] * rho[k]).is_zero() for k in range(6)) or N[0].is_zero():
         raise CertificateError("adj(L0 - B(1)) kappa is not a non-zero multiple of rho")
     return rho
@@ -432,7 +432,7 @@ class _Tally:
 def _xy(xs, ys):
     """(X Y', Y X'): the degree-5 Bernstein coefficients (raw, reduced) from the curves' cubic Bezier points."""
     xs, ys = [z.p for z in xs], [z.p for z in ys]
-    return [z % _M3 for z in _df._bprod(xs, ys)], [z % _M3 for z in _df._bprod(ys, xs)]
+    return [z % _M3 for z in _df.bezier_product(xs, ys)], [z % _M3 for z in _df.bezier_product(ys, xs)]
 
 
 def _trans(PQ, A):
@@ -468,6 +468,7 @@ def _nets(cache, key, make):
 
 
 def _check_point(fam, ells, tally, cache):
+    """Add every dropped coefficient at the grid point of ``fam`` (and l in ``ells``) to ``tally``."""
     a, b, c, t = fam.a, fam.b, fam.c, fam.t
     pt = f"(a, b, c, t) = ({a}, {b}, {c}, {t})"
     keys = {"X+": ("X+", a), "X-": ("X-", a), "Y0": ("Y0", b, c), "Y+": ("Y+", b), "Y-": ("Y-", b)}
@@ -475,11 +476,23 @@ def _check_point(fam, ells, tally, cache):
     for name, key in keys.items():  # X's nets depend on a only, Y+-'s on b, Y0's on (b, c)
         nets[name], part[name] = _nets(cache, key, lambda name=name: _df.piece_nets(*fam.parts()[name], fam.zero))
     A = [((-_log_ratio(fam.lam1) - ell).p, (-_log_ratio(fam.lam2) - ell).p) for ell in ells]  # -l - ln(lam_i/L0)
+    _check_pieces(fam, part, tally, pt)
+    _check_curves(fam, nets, keys, A, tally, cache, pt)
+    _check_layers(fam, A, tally, cache, pt)
+    return tally
+
+
+def _check_pieces(fam, part, tally, pt):
+    """The bulk's D_ij at h^0 and the middle's e_10, e_11, e_20 of K det J_Phi, per piece."""
     for piece in PIECES:
         G = {(i, j): _det(part[i][piece], part[j][piece]) for i in XB for j in YB}
         for (i, j), vals in G.items():
             tally.add(ROWS[0], [(v, (0,)) for v in vals], f"{pt}, {piece}, D({i}, {j})", "uv")
         tally.add(ROWS[1], _middle(G, fam), f"{pt}, {piece}", "mid")
+
+
+def _check_curves(fam, nets, keys, A, tally, cache, pt):
+    """The bulk's T_ij at h^0, the middle's of K (a1 X Y' - a2 Y X') and Y at s = h = 0, per outer curve."""
     for curve in STAR_CURVES:
         pts = {n: curve_points(nets[n], curve, oriented=True) for n in nets}
         for i, j in itertools.product(XB, YB):  # X Y', Y X' depend on (a, b) or (a, b, c) only
@@ -491,9 +504,13 @@ def _check_point(fam, ells, tally, cache):
         tally.add(ROWS[3], _middle(G, fam), f"{pt}, {curve}", "midT")
         tally.add(ROWS[4], [((pts["Y0"][p] + pts["Y+"][p] * fam.em + pts["Y-"][p] * fam.ep).p, (0,)) for p in range(4)],
                   f"{pt}, {curve}", "point")
+
+
+def _check_layers(fam, A, tally, cache, pt):
+    """On the layer quadrants q = 0, 1, 2: det J_Phi, the transversality and Y's curve points (h^0 .. h^2)."""
     for q in range(3):
-        xn, xp = _nets(cache, ("LX", a, q), lambda q=q: fam.layer_nets(q, 0))
-        yn, yp = _nets(cache, ("LY", b, c, t, q), lambda q=q: fam.layer_nets(q, 1))  # y's depend on (b, c, t)
+        xn, xp = _nets(cache, ("LX", fam.a, q), lambda q=q: fam.layer_nets(q, 0))
+        yn, yp = _nets(cache, ("LY", fam.b, fam.c, fam.t, q), lambda q=q: fam.layer_nets(q, 1))  # y: (b, c, t)
         for piece in PIECES:
             tally.add(ROWS[5], [(v, (0, 1, 2)) for v in _det(xp[piece], yp[piece])], f"{pt}, q = {q}, {piece}", "uv")
         for curve in STAR_CURVES:
@@ -503,7 +520,6 @@ def _check_point(fam, ells, tally, cache):
             end = q == 0 and curve == "P1s1"  # ray 0's end point: h^1 too
             tally.add(ROWS[7], [(y.p, (0, 1) if end and k == 0 else (0,)) for k, y in enumerate(ys)],
                       f"{pt}, q = {q}, {curve}", "point")
-    return tally
 
 
 def _run(points, ells, stencil, flip_alpha, stop):

@@ -17,8 +17,8 @@ from ccproof.rigorous import (
     TaylorForm,
     bernstein_coefficients,
     exact_fmpq,
+    jacobian_determinant,
     range_enclosure,
-    taylor_jacobian_determinant,
 )
 
 from .errors import CertificateError
@@ -212,7 +212,7 @@ def piece_det_form_z(znets, i, name, p, q, D, prec):
         y2 = (TaylorForm.variable(2, 2, prec) + 2 * v0) * scale
         w = (_weight_z(p, X, D) * _weight_z(q, Y, D)).truncate(D)
         G = [(F + w * (y - F)).truncate(D) for y, F in ((y1, X), (y2, Y))]
-        return taylor_jacobian_determinant(G, (1, 2)).truncate(D).bernstein()
+        return jacobian_determinant(G, (1, 2)).truncate(D).bernstein()
 
 
 def interval_cells(znets, N, D, prec, symmetric=False):

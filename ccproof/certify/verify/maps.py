@@ -15,7 +15,6 @@ from ccproof.rigorous import (
     BernsteinForm,
     Poly,
     bernstein_coefficients,
-    bernstein_jacobian_determinant,
     jacobian_determinant,
 )
 
@@ -299,7 +298,7 @@ def regularity_form(nets, name, prec):
     ['0.250000', '0.250000']
     """
     with ctx.workprec(prec):
-        return bernstein_jacobian_determinant([net_form(nets[name], 0, prec), net_form(nets[name], 1, prec)])
+        return jacobian_determinant([net_form(nets[name], 0, prec), net_form(nets[name], 1, prec)])
 
 
 STAR_CURVES = {"P1s1": ("P1", "s", 1), "P2s1": ("P2", "s", 1), "P2t1": ("P2", "t", -1), "P3t1": ("P3", "t", -1)}

@@ -72,8 +72,8 @@ from .tagged_modes import MIN_N, bordered_solve, even_vector, mode_spectrum, mod
 from .tagged_refute import chain_generic, chain_top, flip_generic, mode_generic, ordering, same_root
 
 STATEMENTS = ("C1", "not C1")
-_W = (fmpq(1, 6), fmpq(4, 6), fmpq(1, 6))
-_DW = (fmpq(-1, 2), fmpq(0), fmpq(1, 2))
+LIMIT_MASK = (fmpq(1, 6), fmpq(4, 6), fmpq(1, 6))  # a cubic B-spline's limit weights on three control points
+TANGENT_MASK = (fmpq(-1, 2), fmpq(0), fmpq(1, 2))  # and its tangent's
 
 
 def verify_tagged(cert, part, log):
@@ -290,7 +290,7 @@ def _verify_witness(w, fam, n, prec, part, log):
     if got is None:
         return
     vecs, second, label = got
-    _check_boundary(fam, n, r, vecs, part)
+    check_boundary(fam, n, r, vecs, part)
     J = _jacobian(fam, n, q, vecs["x"], second)
     ok = J > 0 or J < 0
     part(f"N normal at vertex (1,1) of quadrant {q}: {label} != 0", ok, f"{label} = {J.str(6)}")
@@ -482,7 +482,9 @@ def _solve_exact(A, cp, cval):
     return vec if all(Av[i, 0] == 0 for i in range(m)) else None
 
 
-def _check_boundary(fam, n, r, vecs, part):
+def check_boundary(fam, n, r, vecs, part):
+    """Part B into ``part``: ray r's limit curve lies on the z-axis (x = y = 0 exactly on the crease points of
+    ``fam:n``) and z's limit leaves v (0 at v, not 0 at ray r's first point); ``vecs`` {"x", "y", "z": values}."""
     pts = labels(fam, n)
     rays = sharp_rays(fam, n) if fam == "crease" else (r,)
     on_curve = [0] + [pts.index(("r", s, a, 0)) for s in rays for a in (1, 2)]
@@ -522,9 +524,9 @@ def _jacobian(fam, n, q, x, y):
                 acc += arb(da[a] * db[b]) * v[index(a, b)]
         return acc
 
-    xa, xb = tangent(x, _DW, _W), tangent(x, _W, _DW)
-    ya, yb = tangent(y, _DW, _W), tangent(y, _W, _DW)
+    xa, xb = tangent(x, TANGENT_MASK, LIMIT_MASK), tangent(x, LIMIT_MASK, TANGENT_MASK)
+    ya, yb = tangent(y, TANGENT_MASK, LIMIT_MASK), tangent(y, LIMIT_MASK, TANGENT_MASK)
     return xa * yb - xb * ya
 
 
-__all__ = ["TAGGED_SCHEMA", "verify_tagged"]
+__all__ = ["LIMIT_MASK", "TAGGED_SCHEMA", "TANGENT_MASK", "check_boundary", "verify_tagged"]

@@ -54,7 +54,7 @@ from .statement import lam_of
 from .tagged import crease_block, crease_points, labels, sector_rows
 
 MIN_N = 5  # crease:N, corner:N with N >= MIN_N take this path (a "not C1" witness)
-_POS = {p: i for i, p in enumerate(TWO_RING)}
+RING_INDEX = {p: i for i, p in enumerate(TWO_RING)}  # ring position -> its index in a mode vector v^ (and B(w))
 
 
 @cache
@@ -91,12 +91,12 @@ def _reflect(t, pos):
     return (-t, pos) if b == 0 else (-t - 1, (b, a))
 
 
-def _block(w):
+def ring_block(w):
     """B(w): (B v^)(p) = sum of the stencil weights times w^delta (w a number, fmpq or acb)."""
     rows = [[0 * w] * 6 for _ in range(6)]
     for i, row in enumerate(ring_stencil()):
         for (d, pos), x in row.items():
-            rows[i][_POS[pos]] += x * w ** d
+            rows[i][RING_INDEX[pos]] += x * w ** d
     return rows
 
 
@@ -111,11 +111,11 @@ def check_ring():
     """
     for i, pos in enumerate(TWO_RING):
         t, p = _reflect(0, pos)
-        image = {(d + t, q): x for (d, q), x in ring_stencil()[_POS[p]].items()}
+        image = {(d + t, q): x for (d, q), x in ring_stencil()[RING_INDEX[p]].items()}
         mirrored = {_reflect(d, q): x for (d, q), x in ring_stencil()[i].items()}
         if image != mirrored:
             raise CertificateError(f"the ring stencil does not commute with the reflection at {pos}")
-    if not mode_polynomials_hold(_block):  # w^6 det(x - B(w)) of degree <= 18 in w: |delta| <= 2, checked below
+    if not mode_polynomials_hold(ring_block):  # w^6 det(x - B(w)) of degree <= 18 in w: |delta| <= 2, checked below
         raise CertificateError("a Fourier block of the ring stencil has another characteristic polynomial")
     if any(not -1 <= d <= 2 for row in ring_stencil() for d, _ in row):
         raise CertificateError("the ring stencil reaches beyond the neighbouring sectors")
@@ -151,11 +151,11 @@ def _odd_block(w):
     """B(w) on the odd vectors of the mode w = +-1: (its matrix M, the dimension), checked invariant."""
     Rh = fmpq_mat(6, 6)
     for p in TWO_RING:  # (v o R)(t, p) = w^t (R^ v^)(p): rays p, quadrants w^-1 v^(b, a)
-        Rh[_POS[p], _POS[p if p[1] == 0 else (p[1], p[0])]] = 1 if p[1] == 0 else w
+        Rh[RING_INDEX[p], RING_INDEX[p if p[1] == 0 else (p[1], p[0])]] = 1 if p[1] == 0 else w
     K = _kernel(Rh + fmpq_mat([[int(i == j) for j in range(6)] for i in range(6)]))
     if K is None:
         return None, 0
-    B = fmpq_mat(_block(fmpq(w)))
+    B = fmpq_mat(ring_block(fmpq(w)))
     Kt = K.transpose()
     M = (Kt * K).inv() * Kt * B * K
     if B * K != K * M:
@@ -189,7 +189,7 @@ def check_structure(fam, n):
             continue
         t, pos = p[1], p[2:]
         folded = {}
-        for (d, q), x in ring_stencil()[_POS[pos]].items():
+        for (d, q), x in ring_stencil()[RING_INDEX[pos]].items():
             f = _fold(t + d, q, n)
             if f is not None:
                 folded[idx[f[1]]] = folded.get(idx[f[1]], 0) + f[0] * x
@@ -201,7 +201,7 @@ def check_structure(fam, n):
     return tuple(M for M in (M0, Mn) if M is not None)
 
 
-def _roots(M, fac=None):
+def charpoly_roots(M, fac=None):
     """(acb, fmpq or None) per eigenvalue of a rational matrix (or of the factors ``fac`` of a characteristic
     polynomial), repeated by algebraic multiplicity."""
     out = []
@@ -236,13 +236,13 @@ def mode_spectrum(fam, n):
     """
     if fam == "dart":  # the even part exactly (S_E's factors), the odd part through the modes w = exp(2 pi i j/K)
         _, _, extra, fac, (_, outer), bound = check_dart(n)
-        out, tag, modes = [(z, q, "E", None) for z, q in _roots(None, fac)], "O", range(1, (n + 1) // 2)
+        out, tag, modes = [(z, q, "E", None) for z, q in charpoly_roots(None, fac)], "O", range(1, (n + 1) // 2)
         out += [(acb(arb(0, bound), arb(0, bound)), None, "E", None)] * len(outer)  # |z| <= bound, each
     else:
         extra, tag, modes = check_structure(fam, n), "I", range(1, n)
-        out = [(z, q, "C", None) for z, q in _roots(crease_block(fam, n))]
+        out = [(z, q, "C", None) for z, q in charpoly_roots(crease_block(fam, n))]
     for M in extra:
-        out += [(z, q, tag, None) for z, q in _roots(M)]
+        out += [(z, q, tag, None) for z, q in charpoly_roots(M)]
     ring = n if fam == "dart" else 2 * n
     for j in modes:
         lam = lam_of(arb(fmpq(2 * j, ring)).cos_pi())
@@ -299,7 +299,7 @@ def mode_vector(fam, n, j, lam):
     (33, 0)
     """
     ring = n if fam == "dart" else 2 * n
-    B = _block(_unit(2 * j, ring))
+    B = ring_block(_unit(2 * j, ring))
     vh = None
     for pv in range(6):  # the first pivot that arb proves regular (the bordered-system argument of tagged_c1)
         try:
@@ -317,10 +317,10 @@ def mode_vector(fam, n, j, lam):
             continue
         t, pos = p[1], p[2:]
         if pos[1] == 0:
-            out.append(vh[_POS[pos]] * (_unit(2 * j * t, ring) - _unit(-2 * j * t, ring)))
+            out.append(vh[RING_INDEX[pos]] * (_unit(2 * j * t, ring) - _unit(-2 * j * t, ring)))
         else:
-            out.append(vh[_POS[pos]] * _unit(2 * j * t, ring)
-                       - vh[_POS[(pos[1], pos[0])]] * _unit(-2 * j * (t + 1), ring))
+            out.append(vh[RING_INDEX[pos]] * _unit(2 * j * t, ring)
+                       - vh[RING_INDEX[(pos[1], pos[0])]] * _unit(-2 * j * (t + 1), ring))
     return out
 
 
@@ -391,7 +391,7 @@ def _check_dart_rows(k, pts, rows):
         if p == ("C",) or p[:2] == ("r", 0):
             continue  # R-invariant rows: 0 on odd vectors, as L's
         ring = {}
-        for (d, q), x in ring_stencil()[_POS[p[2:]]].items():
+        for (d, q), x in ring_stencil()[RING_INDEX[p[2:]]].items():
             j = idx[("r" if q[1] == 0 else "q", (p[1] + d) % k) + q]
             ring[j] = ring.get(j, 0) + x
         if {j: x for j, x in ring.items() if x != 0} != {j: x for j, x in rows[i].items() if j != 0}:
@@ -429,5 +429,5 @@ def even_vector(k, lam, pivot):
     return [y[rep[i]] for i in range(len(rep))]
 
 
-__all__ = ["MIN_N", "check_dart", "check_ring", "check_structure", "even_vector", "mode_spectrum", "mode_vector",
-           "ring_stencil"]
+__all__ = ["MIN_N", "RING_INDEX", "charpoly_roots", "check_dart", "check_ring", "check_structure", "even_vector",
+           "mode_spectrum", "mode_vector", "ring_block", "ring_stencil"]
