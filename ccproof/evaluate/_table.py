@@ -55,7 +55,7 @@ from ccproof.evaluate.local import (
 )
 from ccproof.mesh.halfedges import HalfEdges
 
-#: kinds of a virtual face: a regular bicubic patch, a corner (eigen-basis) patch, split into four children
+#: kinds of a virtual face: a regular bicubic patch, a corner face of a corner scheme, split into four children
 KIND_REGULAR, KIND_CORNER, KIND_SPLIT = 0, 1, 2
 
 #: how many times a face may be subdivided before it must be regular or self-similar
