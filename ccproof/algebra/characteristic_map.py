@@ -27,7 +27,7 @@ from fractions import Fraction
 from functools import lru_cache
 
 from ccproof.algebra.field import C, QcLam
-from ccproof.algebra.subdivision import TWO_RING_POSITIONS, _regular_stencil, canonical
+from ccproof.algebra.subdivision import TWO_RING_POSITIONS, canonical, regular_stencil
 
 #: names of the three layer-0 pieces and their domains in the face parameter (u, v) (R4)
 PATCH_DOMAINS = {
@@ -146,12 +146,12 @@ def mode1_eigenvector():
     inner[(1, 1)] = (f, f)
     outer = [(2, 0), (2, 1), (1, 2), (2, 2)]
     # S x = lam x on the outer positions: the level-1 vertex at grid position p (computed from
-    # level-0 values by _regular_stencil(p)) equals lam times the level-0 value at position p.
+    # level-0 values by regular_stencil(p)) equals lam times the level-0 value at position p.
     unknown_index = {p: i for i, p in enumerate(outer)}
     nun = 2 * len(outer)
     rows, rhs = [], []
     for p in outer:
-        st = _regular_stencil(*p)
+        st = regular_stencil(*p)
         # linear form: sum_w w R^d x_q ; split into known (inner) and unknown (outer) parts
         coeff = [[_zero() for _ in range(nun)] for _ in range(2)]
         known = (_zero(), _zero())
@@ -189,7 +189,7 @@ def _level1_value(values, A, B):
     d, A2, B2 = canonical(A, B)
     if (A2, B2) == (0, 0):
         return (_zero(), _zero())
-    return _rot(d, _apply_stencil(_regular_stencil(A2, B2), values))
+    return _rot(d, _apply_stencil(regular_stencil(A2, B2), values))
 
 
 @lru_cache(maxsize=1)

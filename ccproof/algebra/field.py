@@ -217,7 +217,7 @@ def integer_form_string(form):
     return f"(({poly_str(A)}) + ({poly_str(B)})*lam)/({poly_str(D)})"
 
 
-def _subdominant_lam_sympy(c):
+def subdominant_lam_sympy(c):
     """Exact lam(c) = (5 + c + sqrt((1 + c)(9 + c)))/16 as a sympy expression (R2;
     :func:`ccproof.valence.lam_from_c` in sympy arithmetic)."""
     return lam_from_c(sympify(c), sqrt)

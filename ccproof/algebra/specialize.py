@@ -13,7 +13,7 @@ symbolic; here c (and lam, R2) get values:
 
 from __future__ import annotations
 
-from ccproof.algebra.field import _subdominant_lam_sympy, eval_integer_form
+from ccproof.algebra.field import eval_integer_form, subdominant_lam_sympy
 from ccproof.errors import CCProofError, check_valence
 from ccproof.valence import Valence, lam_from_c
 
@@ -109,7 +109,7 @@ def subdominant_eigenvalue(k, arithmetic="arb", prec=128):
     if arithmetic == "exact":
         from sympy import expand, radsimp
 
-        return expand(radsimp(_subdominant_lam_sympy(cos_2pi_over_k(k, "exact"))))
+        return expand(radsimp(subdominant_lam_sympy(cos_2pi_over_k(k, "exact"))))
     _check_prec(prec)
     from flint import ctx
 
@@ -220,7 +220,7 @@ def _field_values(v, arithmetic, prec):
     k = v.k
     if arithmetic == "exact":
         c = cos_2pi_over_k(k, "exact")
-        return c, _subdominant_lam_sympy(c)
+        return c, subdominant_lam_sympy(c)
     return cos_2pi_over_k(k, "arb", prec + 20), subdominant_eigenvalue(k, "arb", prec + 20)
 
 

@@ -71,7 +71,7 @@ def canonical(a, b):
     raise ValueError(f"grid position ({a}, {b}) is more than one sector away")
 
 
-def _regular_stencil(A, B):
+def regular_stencil(A, B):
     """Level-0 stencil of the level-1 vertex at position (A, B) of a sector, (A, B) != (0, 0).
 
     Returns a list of ``(weight, (a, b))`` with Fraction weights and raw (not canonical) level-0
@@ -184,7 +184,7 @@ def level1_stencil(k, vertex):
         return st
     j, A, B = vertex
     out = {}
-    for w, (a, b) in _regular_stencil(A, B):
+    for w, (a, b) in regular_stencil(A, B):
         d, a2, b2 = canonical(a, b)
         key = CENTER if (a2, b2) == (0, 0) else ((j + d) % k, a2, b2)
         out[key] = out.get(key, 0) + w

@@ -84,9 +84,9 @@ def c_kernel_evaluates():
     """
     if os.environ.get("CCPROOF_BACKEND", "auto") not in ("auto", "c"):
         return False
-    from ccproof.evaluate._ckernel import load
+    from ccproof.evaluate.surface import available_backends
 
-    return load() is not None
+    return "c" in available_backends()
 
 
 def compile_notice(command, stream=None):

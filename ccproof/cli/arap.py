@@ -148,11 +148,11 @@ def default_eval_level(mesh, labels, levels, with_d):
     below the optimization level, nor below 3 when (d) is measured (its texture lives at level 3)."""
     import numpy as np
 
-    from ccproof.apps.arap.core import _charts
+    from ccproof.apps.arap.core import mesh_charts
 
     F = mesh.faces
     n = 0
-    for fc in _charts(mesh, labels):  # faces of E_0: the chart and its ring
+    for fc in mesh_charts(mesh, labels):  # faces of E_0: the chart and its ring
         isc = np.zeros(mesh.n_vertices, dtype=bool)
         isc[F[fc]] = True
         n += int(isc[F].any(axis=1).sum())
@@ -252,10 +252,10 @@ def run(args) -> int:
     elif engine == "auto":
         engine = "numpy"
     refine = auto_refine(mesh, labels) if refine is None else refine
-    from ccproof.apps.arap.core import _charts
+    from ccproof.apps.arap.core import mesh_charts
     from ccproof.apps.arap.hierarchy import ChartHierarchy
 
-    hierarchies = [ChartHierarchy(mesh, fc) for fc in _charts(mesh, labels)]
+    hierarchies = [ChartHierarchy(mesh, fc) for fc in mesh_charts(mesh, labels)]
     levels, eval_level, out_level = _levels_within_budget(args, mesh, labels, hierarchies, methods, refine)
     args.levels = levels
     if eval_level < refine:

@@ -225,9 +225,9 @@ def run(args):
             print(f"  certificate written to {path}")
             written.append(path)
         if not args.no_verify and written:
-            from ccproof.cli.verify import _check
+            from ccproof.cli.verify import verify_task
 
-            check = run_tasks(_check, [(str(p), True) for p in written], sched, desc="verify", unit="file",
+            check = run_tasks(verify_task, [(str(p), True) for p in written], sched, desc="verify", unit="file",
                               names=[str(p) for p in written], raise_errors=False, progress=progress)
             for line in check.report([str(p) for p in written]):
                 print(line)

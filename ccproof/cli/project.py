@@ -85,7 +85,7 @@ def run(args):
     from ccproof.cli._progress import phase, progress_enabled
     from ccproof.errors import CCProofError
     from ccproof.evaluate.closest import CELLS, ClosestPointFinder
-    from ccproof.evaluate.closest import _check_points as check_points
+    from ccproof.evaluate.closest import check_query_points as check_points
     from ccproof.evaluate.surface import limit_surface
     from ccproof.mesh.io import read_points
 

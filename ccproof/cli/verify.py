@@ -62,7 +62,7 @@ def summary(res):
             "parts": [{"name": p.name, "ok": p.ok, "message": p.message} for p in res.parts]}
 
 
-def _check(args):
+def verify_task(args):
     """One task: verify a file; ``args`` is ``(path, quiet)`` or ``(absolute path, quiet, name shown)``."""
     path, quiet, *shown = args
     from ccproof.certify.verify import verify_file
@@ -97,7 +97,7 @@ def run(args):
     work = [(str(f.absolute()), args.quiet, str(f)) for f in files]
     # longest first (the k >= k0 certificates), so that the workers finish together
     size = [f.stat().st_size if f.is_file() else 0 for f in files]
-    sweep = run_tasks(_check, work, scheduler_from_args(args), desc="verify", unit="file", priority=size,
+    sweep = run_tasks(verify_task, work, scheduler_from_args(args), desc="verify", unit="file", priority=size,
                       names=[str(f) for f in files], raise_errors=False, progress=progress_enabled(args))
     results = []
     for f, out in zip(files, sweep.results):

@@ -15,7 +15,8 @@ try:
 except ImportError:  # pragma: no cover - optional dependency
     numba = None
 
-_REGULAR, _CORNER, _SPLIT = 0, 1, 2
+from ccproof.evaluate._table import KIND_CORNER, KIND_SPLIT
+
 #: corner nets (layers beyond the precomputed ones) kept per kernel call: slots (a power of 2, 408 bytes each)
 _CACHE_SLOTS = 16384
 #: calls on fewer points compute every corner net (no cache to allocate)
@@ -136,7 +137,7 @@ def _evaluate_points(f, u, v, d, T, P, Pu, Pv, Puu, Puv, Pvv):
         vf = T.job_root[job]
         kind = T.kind[vf]
         for _ in range(T.split_depth):
-            if kind != _SPLIT:
+            if kind != KIND_SPLIT:
                 break
             half = T.h[vf] * 0.5
             q = 0
@@ -146,7 +147,7 @@ def _evaluate_points(f, u, v, d, T, P, Pu, Pv, Puu, Puv, Pvv):
                 q += 2
             vf = T.child[vf, q]
             kind = T.kind[vf]
-        if kind == _CORNER:
+        if kind == KIND_CORNER:
             U0 = T.u0[vf]
             V0 = T.v0[vf]
             H = T.h[vf]

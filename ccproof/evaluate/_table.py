@@ -39,24 +39,24 @@ import numpy as np
 from ccproof.errors import MeshError
 from ccproof.evaluate import _diskcache
 from ccproof.evaluate.local import (
-    _CENTER,
-    _SIDES,
+    CENTER,
     CORNERS,
-    _cache_dir,
-    _child_ring,
-    _code_version,
-    _has_semi_sharp,
-    _key_complex,
-    _regular_net_matrix,
+    SIDES,
     canonical_ring,
+    child_ring,
+    code_version,
     corner_scheme,
+    has_semi_sharp,
     irregular_corners,
+    key_complex,
     refine_key,
+    regular_net_matrix,
     ring_key,
 )
 from ccproof.mesh.halfedges import HalfEdges
 
-_REGULAR, _CORNER, _SPLIT = 0, 1, 2
+#: kinds of a virtual face: a regular bicubic patch, a corner face of a corner scheme, split into four children
+KIND_REGULAR, KIND_CORNER, KIND_SPLIT = 0, 1, 2
 
 #: how many times a face may be subdivided before it must be regular or self-similar
 MAX_DEPTH = 4
@@ -167,7 +167,8 @@ class PatchTable(NamedTuple):
 _C = tuple((float(x), float(y)) for x, y in CORNERS)
 
 
-def _compose(frame, sub):
+def compose(frame, sub):
+    """Frame ``sub`` (given in the coordinates of ``frame``) in the coordinates ``frame`` is given in."""
     (ox, oy), (ax, ay), (bx, by) = frame
     (p, q), (sa0, sa1), (sb0, sb1) = sub
     return ((ox + ax * p + bx * q, oy + ay * p + by * q), (ax * sa0 + bx * sa1, ay * sa0 + by * sa1),
@@ -180,7 +181,8 @@ def _corner_frame(i, scale=1.0):
     return (c, ((c1[0] - c[0]) * scale, (c1[1] - c[1]) * scale), ((c3[0] - c[0]) * scale, (c3[1] - c[1]) * scale))
 
 
-def _child_frame(i):
+def child_frame(i):
+    """Frame of the half-size child square at corner ``i`` of [0,1]^2 (corner ``i`` its origin)."""
     return _corner_frame(i, 0.5)
 
 
@@ -191,7 +193,8 @@ def _layer_frame(n, j):
     return ((o[0] * 2.0 * h, o[1] * 2.0 * h), a, b)
 
 
-def _domain(frame):
+def domain(frame):
+    """``(u0, v0, size)``: the axis-aligned square a frame covers, its lower-left corner and side."""
     (ox, oy), (ax, ay), (bx, by) = frame
     return ox + min(ax, 0.0) + min(bx, 0.0), oy + min(ay, 0.0) + min(by, 0.0), max(abs(ax), abs(ay))
 
@@ -233,9 +236,9 @@ def _corner_orientation(orient):
     rows = np.empty(48, dtype=np.int64)
     unit = np.empty((3, 3))
     for j in (1, 2, 3):
-        f0 = _compose(unit_rot, _layer_frame(0, j))
+        f0 = compose(unit_rot, _layer_frame(0, j))
         rows[16 * codes[j]:16 * codes[j] + 16] = 16 * (j - 1) + _net_permutation(f0)
-        unit[codes[j]] = _domain(f0)
+        unit[codes[j]] = domain(f0)
     rows.setflags(write=False)
     unit.setflags(write=False)
     return rows, unit
@@ -285,7 +288,7 @@ class _Template:
 
     def new_vface(self, kind, frame):
         self.kind.append(kind)
-        self.dom.append(_domain(frame))
+        self.dom.append(domain(frame))
         self.child.append([-1, -1, -1, -1])
         self.leaf.append(-1)
         self.pts.append(0)
@@ -312,11 +315,11 @@ def _finished(t):
 
 @functools.lru_cache(maxsize=1)
 def _template_version():
-    """Hash of the sources that define a template (:func:`_code_version` and this module)."""
+    """Hash of the sources that define a template (:func:`code_version` and this module)."""
     import hashlib
     from pathlib import Path
 
-    return hashlib.sha256((_code_version() + "|").encode() + Path(__file__).read_bytes()).hexdigest()[:16]
+    return hashlib.sha256((code_version() + "|").encode() + Path(__file__).read_bytes()).hexdigest()[:16]
 
 
 _TPL_MAGIC = 20261202.0  # first value of a template file (the format below)
@@ -405,7 +408,7 @@ def _cached_template(tkey, depth_semi, make):
     """
     import hashlib
 
-    d = _cache_dir()
+    d = _diskcache.cache_dir()
     if d is None:
         return _finished(make())
     name = hashlib.sha256(f"template|{_template_version()}|{depth_semi}|{tkey!r}".encode()).hexdigest()
@@ -460,7 +463,7 @@ class _NoBar:
         pass
 
 
-class _Jobs:
+class Jobs:
     """The quads to classify: ``g`` (J,) quads of the complex, ``fid`` (J,) index of each one's frame
     in ``frames``, ``base`` (J,) the ptex face errors name. ``jobs[i]`` is ``(g, frame, base)``."""
 
@@ -641,7 +644,7 @@ def _row_hash(a):
         return z.sum(axis=1, dtype=np.uint64).view(np.int64)
 
 
-class _Builder:
+class Builder:
     """Classifies the jobs of a mesh into templates; :meth:`table` assembles the patch table."""
 
     def __init__(self, depth_semi=1, what="face", progress=None):
@@ -682,7 +685,7 @@ class _Builder:
             t.rings.extend(rings)
 
     def classify(self, he, X, jobs, vmap=None):
-        """Classify the quads ``jobs`` (``[(g, frame, base), ...]`` or :class:`_Jobs`) of the mesh with
+        """Classify the quads ``jobs`` (``[(g, frame, base), ...]`` or :class:`Jobs`) of the mesh with
         half-edges ``he`` (:class:`~ccproof.mesh.halfedges.HalfEdges`; a :class:`TaggedHalfEdges` for
         the tagged walk: its tags enter the rings' keys) with positions ``X``; job ids are assigned in
         order. ``vmap``: the mesh vertex of every vertex of ``he`` (records where the corner faces'
@@ -694,7 +697,7 @@ class _Builder:
         The rings of an all-quad mesh are walked by the compiled kernel where it is there
         (:meth:`_walk_all`), else face by face on the mesh read as a complex (:class:`_ComplexView`).
         """
-        jobs = _Jobs.of(jobs)
+        jobs = Jobs.of(jobs)
         self.X = X
         self.vmap = vmap
         j0 = self.n_jobs
@@ -801,7 +804,7 @@ class _Builder:
                 key = ring_key(view, rings[rep, :n].tolist(), ftup, 4)
             else:
                 key = (ftup, (), (), opts)
-            if tagged and self.depth_semi != 1 and _has_semi_sharp(key) and not at_corner[rep]:
+            if tagged and self.depth_semi != 1 and has_semi_sharp(key) and not at_corner[rep]:
                 fallback.append(idx[mem])  # the Chaikin phase reads the two-ring: the Python walk
                 continue
             frame = jobs.frames[jobs.fid[idx[rep]]]
@@ -829,7 +832,7 @@ class _Builder:
         """
         if not jobs:
             return np.zeros(0, dtype=bool)
-        jobs = _Jobs.of(jobs)
+        jobs = Jobs.of(jobs)
         org, nxt, prv, twin = cx.org, cx.nxt, cx.prv, cx.twin
         ok = _smooth_regular_vertices(cx)
         g = jobs.g
@@ -844,7 +847,7 @@ class _Builder:
         for s_ in range(4):
             h = H[:, s_]
             t = twin[h]
-            cell = [p[0] + 4 * p[1] for p in (_CENTER[s_],) + _SIDES[s_][:3]]
+            cell = [p[0] + 4 * p[1] for p in (CENTER[s_],) + SIDES[s_][:3]]
             grid[:, cell[0]] = org[h]
             grid[:, cell[1]] = org[nxt[nxt[t]]]
             grid[:, cell[2]] = org[prv[t]]
@@ -878,7 +881,7 @@ class _Builder:
         (:meth:`_face_template`)."""
         ring, faces, nr = canonical_ring(cx, g, 0, 1)
         key = ring_key(cx, ring, faces, nr)
-        if self.depth_semi != 1 and _has_semi_sharp(key):
+        if self.depth_semi != 1 and has_semi_sharp(key):
             ring, faces, nr = canonical_ring(cx, g, 0, self.depth_semi)
             key = ring_key(cx, ring, faces, nr)
         self._register(("face", key, frame), functools.partial(self._face_template, key, frame, base), (job,), ring)
@@ -886,14 +889,14 @@ class _Builder:
     @staticmethod
     def _corner_ok(key_r):
         """Whether a ring read from a face's corner makes the face a corner face at that corner."""
-        if _has_semi_sharp(key_r) or irregular_corners(key_r) != (0,):
+        if has_semi_sharp(key_r) or irregular_corners(key_r) != (0,):
             return False
         return corner_scheme(key_r) is not None
 
     def _corner_template(self, key_r, r, frame, base):
-        N = _key_complex(key_r).n_vertices
+        N = key_complex(key_r).n_vertices
         t = _Template(N)
-        root = t.new_vface(_REGULAR, frame)
+        root = t.new_vface(KIND_REGULAR, frame)
         self.scheme_face(t, key_r, np.eye(N), list(range(N)), r, frame, base, root, np.arange(N))
         return t
 
@@ -901,14 +904,14 @@ class _Builder:
         """The template of a face whose ring (read from corner 0) has the tagged key ``key``: the
         classification run on the key's own complex (the ring in canonical labels: the same walks
         read the same rings) with the identity as control points."""
-        kc = _key_complex(key)
+        kc = key_complex(key)
         N = kc.n_vertices
         depth = 1 if self.depth_semi == 1 or len(key[0]) == len(canonical_ring(kc, 0, 0, 1)[1]) else self.depth_semi
         ring, faces, _ = canonical_ring(kc, 0, 0, depth)
         if faces != key[0] or ring != list(range(N)):  # pragma: no cover - the premise of the key caches
             raise MeshError(f"internal error: the ring of {self.what} {base} is not read back from its key")
         t = _Template(N)
-        root = t.new_vface(_REGULAR, frame)
+        root = t.new_vface(KIND_REGULAR, frame)
         self._face(t, kc, np.eye(N), 0, frame, 0, 0, base, root, vmap=np.arange(N))
         return t
 
@@ -923,12 +926,12 @@ class _Builder:
 
         def ring_of(r, depth_):
             if src is not None:
-                return _child_ring(src[0], src[1], g, r, depth_)
+                return child_ring(src[0], src[1], g, r, depth_)
             ring_, faces_, nr_ = canonical_ring(cx, g, r, depth_)
             return ring_, ring_key(cx, ring_, faces_, nr_), nr_
 
         ring, key, nr = ring_of(0, 1)
-        if _has_semi_sharp(key):
+        if has_semi_sharp(key):
             if semi_depth >= MAX_SEMI_DEPTH:
                 raise MeshError(f"{self.what} {base}: semi-sharp creases did not decay in {MAX_SEMI_DEPTH} levels")
             D = self.depth_semi
@@ -937,13 +940,13 @@ class _Builder:
             return self.split_face(t, key, nr, X[ring], frame, depth, semi_depth + 1, base, vid, vmap[ring])
         irr = irregular_corners(key)
         if not irr:
-            M = _regular_net_matrix(key)
+            M = regular_net_matrix(key)
             Xl = X[ring]
             origin = Xl.mean(axis=0)
             op = np.empty((17, Xl.shape[1]))
             op[:16] = (M @ (Xl - origin))[_net_permutation(frame)]
             op[16] = origin
-            t.kind[vid] = _REGULAR
+            t.kind[vid] = KIND_REGULAR
             t.leaf[vid] = len(t.reg)
             t.reg.append(op)
             return vid
@@ -965,13 +968,13 @@ class _Builder:
         (listed from that corner)."""
         scheme = corner_scheme(key_r)
         C = X[ring_r]
-        rot = _compose(frame, _corner_frame(r))
+        rot = compose(frame, _corner_frame(r))
         orient = (_sign(rot[1]), _sign(rot[2]))
         src = (key_r, orient)
         cfg = t.schemes.index(src) if src in t.schemes else len(t.schemes)
         if cfg == len(t.schemes):
             t.schemes.append(src)
-        t.kind[vid] = _CORNER
+        t.kind[vid] = KIND_CORNER
         U0, V0, H = t.dom[vid]
         corner = rot[0]
         t.corner[vid] = (int(corner[0] > U0), int(corner[1] > V0))
@@ -1000,13 +1003,13 @@ class _Builder:
         X1 = S @ Xr
         vmap1 = np.full(S.shape[0], -1, dtype=np.int64)
         vmap1[: len(vmap)] = vmap
-        t.kind[vid] = _SPLIT
+        t.kind[vid] = KIND_SPLIT
         U0, V0, _ = t.dom[vid]
         for i in range(4):
-            cf = _compose(frame, _child_frame(i))
-            cu, cv, _ = _domain(cf)
+            cf = compose(frame, child_frame(i))
+            cu, cv, _ = domain(cf)
             q = int(cu > U0) + 2 * int(cv > V0)
-            c = t.new_vface(_REGULAR, cf)
+            c = t.new_vface(KIND_REGULAR, cf)
             t.child[vid][q] = c
             self._face(t, child, X1, i, cf, depth, semi_depth, base, c, src=(key, nr), vmap=vmap1)
         return vid
@@ -1048,7 +1051,7 @@ class _Builder:
             corner += t.corner
             dv = np.zeros(len(t.kind), dtype=np.int64)
             for v, ch in enumerate(t.child):  # children are created after their parents
-                if t.kind[v] == _SPLIT:
+                if t.kind[v] == KIND_SPLIT:
                     dv[ch] = dv[v] + 1
             depth = max(depth, int(dv.max()))
             n_tv += len(t.kind)
@@ -1091,7 +1094,7 @@ class _Builder:
 def _smooth_template(frame):
     """The template of a smooth regular quad: its ring is its 4 x 4 grid in the base orientation."""
     t = _Template(16)
-    t.new_vface(_REGULAR, frame)
+    t.new_vface(KIND_REGULAR, frame)
     op = np.empty((17, 16))
     op[:16] = np.eye(16) - 1.0 / 16
     op[16] = 1.0 / 16
@@ -1254,7 +1257,7 @@ def layer0_nets(T, groups):
         nc, npt = t.O.shape[0], t.Q.shape[0]
         k = jobs.size
         for vf, kind in enumerate(t.kind):
-            if kind != _CORNER:
+            if kind != KIND_CORNER:
                 continue
             cfg = t.cfg[vf]
             Nc, st = int(T.op_size[cfg]), int(T.op_start[cfg])

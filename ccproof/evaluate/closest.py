@@ -432,7 +432,7 @@ class ClosestPointFinder:
     # ------------------------------------------------------------------ query
     def query(self, X, *, chunk=CHUNK):
         """Nearest limit points of ``X`` (n, 3); returns :class:`ClosestPoints`."""
-        X = _check_points(X)
+        X = check_query_points(X)
         n = X.shape[0]
         out = ClosestPoints(
             np.empty(n, dtype=np.int64), np.empty(n), np.empty(n), np.empty((n, 3)), np.empty(n),
@@ -549,10 +549,10 @@ class ClosestPointFinder:
 MAX_COORDINATE = 1e150
 
 
-def _check_points(X):
+def check_query_points(X):
     """``X`` as a float (n, 3) array; refuses non-finite and too large coordinates, naming the point.
 
-    >>> _check_points([[0.0, 1e200, 0.0]])  # doctest: +ELLIPSIS
+    >>> check_query_points([[0.0, 1e200, 0.0]])  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
     ccproof.errors.CCProofError: point 0: coordinates [0.0, 1e+200, 0.0] exceed 1e+150 in magnitude ...

@@ -253,13 +253,14 @@ def ring_key(cx, ring, faces, n_rule):
 
 
 @functools.lru_cache(maxsize=8192)
-def _key_complex(key):
+def key_complex(key):
     """The complex of a ring key (shared by the functions cached per key; not to be modified)."""
     faces, tags, vs, opts = key
     return Complex(faces, dict(tags), dict(vs), Options(*opts), level=1)
 
 
-def _has_semi_sharp(key):
+def has_semi_sharp(key):
+    """Whether the ring ``key`` has a semi-sharp (finite, positive sharpness) edge or vertex tag."""
     return any(0.0 < s < math.inf for _, s in key[1]) or any(0.0 < s < math.inf for _, s in key[2])
 
 
@@ -299,7 +300,7 @@ def refine_key(key, n_rule):
     >>> S.shape, stencils[0][0], np.nansum(S, axis=1)[:4].tolist()
     ((55, 18), 13/20, [1.0, 1.0, 1.0, 1.0])
     """
-    cx = _key_complex(key)
+    cx = key_complex(key)
     rule = range(n_rule)
     edges = [e for e, h in enumerate(cx.edges) if cx.org[h] < n_rule or cx.dst(h) < n_rule]
     stencils, children, ces, cvs = refine_complex(cx, vertices=rule, edges=edges)
@@ -311,7 +312,7 @@ def refine_key(key, n_rule):
 
 
 @functools.lru_cache(maxsize=1 << 16)
-def _child_ring(key, n_rule, g, r, depth):
+def child_ring(key, n_rule, g, r, depth):
     """Ring (ring positions as an index array, tagged key, rule count) of face ``g`` of the child
     complex of :func:`refine_key` ``(key, n_rule)``, from corner ``r``."""
     _, _, child = refine_key(key, n_rule)
@@ -389,13 +390,16 @@ def corner_is_regular(cx, c):
     return False
 
 
-_SIDES = (
+#: per side s of a face, in its 4 x 4 net's (i, j) positions: the two net points across side s, the diagonal point
+#: beyond corner s, and the unit step from that side towards the face (the ghost points' direction)
+SIDES = (
     ((1, 0), (2, 0), (0, 0), (0, 1)),
     ((3, 1), (3, 2), (3, 0), (-1, 0)),
     ((2, 3), (1, 3), (3, 3), (0, -1)),
     ((0, 2), (0, 1), (0, 3), (1, 0)),
 )
-_CENTER = ((1, 1), (2, 1), (2, 2), (1, 2))
+#: the (i, j) net position of each corner of the face
+CENTER = ((1, 1), (2, 1), (2, 2), (1, 2))
 
 
 def regular_net(cx, g):
@@ -437,13 +441,13 @@ def regular_net(cx, g):
     fv = [cx.org[s0 + s] for s in range(4)]
     grid = {}
     for s in range(4):
-        grid[_CENTER[s]] = {fv[s]: 1}
+        grid[CENTER[s]] = {fv[s]: 1}
     bnd = [cx.sharpness(cx.he_edge[s0 + s]) > 0.0 for s in range(4)]
     for s in range(4):
         if not bnd[s]:
             t = cx.twin[s0 + s]
-            grid[_SIDES[s][0]] = {cx.dst(cx.nxt[t]): 1}
-            grid[_SIDES[s][1]] = {cx.org[cx.prv[t]]: 1}
+            grid[SIDES[s][0]] = {cx.dst(cx.nxt[t]): 1}
+            grid[SIDES[s][1]] = {cx.org[cx.prv[t]]: 1}
 
     def ghost(p, nrm):
         q = (p[0] + nrm[0], p[1] + nrm[1])
@@ -452,11 +456,11 @@ def regular_net(cx, g):
 
     for s in range(4):
         if bnd[s]:
-            for p in _SIDES[s][:2]:
-                grid[p] = ghost(p, _SIDES[s][3])
+            for p in SIDES[s][:2]:
+                grid[p] = ghost(p, SIDES[s][3])
     for s in range(4):
         sp, sm = s, (s + 3) % 4
-        p = _SIDES[s][2]
+        p = SIDES[s][2]
         if not bnd[sp] and not bnd[sm]:
             t = cx.twin[s0 + s]
             t2 = cx.twin[cx.nxt[t]]
@@ -464,14 +468,14 @@ def regular_net(cx, g):
                 return None
             grid[p] = {cx.org[cx.prv[t2]]: 1}
         else:
-            grid[p] = ghost(p, _SIDES[sp if bnd[sp] else sm][3])
+            grid[p] = ghost(p, SIDES[sp if bnd[sp] else sm][3])
     return [grid[(i, j)] for j in range(4) for i in range(4)]
 
 
 @functools.lru_cache(maxsize=8192)
-def _regular_net_matrix(key):
+def regular_net_matrix(key):
     """Float (16, N) matrix of the regular net of face 0 of the ring ``key``, or None."""
-    cx = _key_complex(key)
+    cx = key_complex(key)
     net = regular_net(cx, 0)
     if net is None:
         return None
@@ -500,7 +504,7 @@ def irregular_corners(key):
     >>> irregular_corners(quad_ring(cube().faces, 0, 0)[1])   # eight vertices of valence 3
     (0, 1, 2, 3)
     """
-    cx = _key_complex(key)
+    cx = key_complex(key)
     return tuple(i for i in range(4) if not corner_is_regular(cx, i))
 
 
@@ -566,7 +570,7 @@ def _corner_scheme(key):
     """
     import flint  # imported where exact matrices are built: not on a filled disk cache
     _, stencils, child = refine_key(key, 4)
-    N = _key_complex(key).n_vertices
+    N = key_complex(key).n_vertices
     ring1, faces1, nr = canonical_ring(child, 0, 0, 1)
     key1 = ring_key(child, ring1, faces1, nr)
     if key1 != key:
@@ -690,7 +694,7 @@ _SOURCES = ("evaluate/local.py", "evaluate/_diskcache.py", "mesh/rules.py", "rul
 
 
 @functools.lru_cache(maxsize=1)
-def _code_version():
+def code_version():
     """Hash of the sources that define the exact data (a change invalidates the disk cache)."""
     import hashlib
     from pathlib import Path
@@ -701,8 +705,6 @@ def _code_version():
         h.update((root / rel).read_bytes())
     return h.hexdigest()[:16]
 
-
-_cache_dir = _diskcache.cache_dir
 
 
 def _cached_scheme(kind, key, compute):
@@ -721,10 +723,10 @@ def _cached_scheme(kind, key, compute):
     """
     import hashlib
 
-    d = _cache_dir()
+    d = _diskcache.cache_dir()
     if d is None:
         return compute()
-    name = hashlib.sha256(f"{kind}|{_code_version()}|{key!r}".encode()).hexdigest()
+    name = hashlib.sha256(f"{kind}|{code_version()}|{key!r}".encode()).hexdigest()
     path, apath = d / f"{name}.f64", d / f"{name}.A"
     sch = _diskcache.read_entry(path, name, functools.partial(_parse_scheme, apath=apath, name=name, compute=compute))
     if sch is not None:

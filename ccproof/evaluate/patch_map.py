@@ -46,7 +46,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ccproof.evaluate._table import _CORNER, _SPLIT
+from ccproof.evaluate._table import KIND_CORNER, KIND_SPLIT
 
 __all__ = ["PatchMap", "Location"]
 
@@ -130,7 +130,7 @@ class PatchMap:
         vf = T.job_root[job]
         kind = T.kind[vf]
         for _ in range(T.split_depth):
-            idx = np.flatnonzero(kind == _SPLIT)
+            idx = np.flatnonzero(kind == KIND_SPLIT)
             if idx.size == 0:
                 break
             w = vf[idx]
@@ -185,7 +185,7 @@ class PatchMap:
         job, vf, kind = self.faces(f, u, v)
         patch = T.job_net[job] + T.leaf[vf]
         pu0, pv0, h = T.u0[vf], T.v0[vf], T.h[vf]
-        idx = np.flatnonzero(kind == _CORNER)
+        idx = np.flatnonzero(kind == KIND_CORNER)
         n = code = ci = np.zeros(0, dtype=np.int64)
         if idx.size:
             w = vf[idx]

@@ -35,10 +35,10 @@ import numpy as np
 from ccproof.errors import CCProofError
 from ccproof.evaluate._parallel import in_blocks, threads_for
 from ccproof.evaluate._table import (
-    _CORNER,
-    _REGULAR,
-    _Builder,
-    _Jobs,
+    KIND_CORNER,
+    KIND_REGULAR,
+    Builder,
+    Jobs,
     catmark_step,
     job_floats,
     layer0_nets,
@@ -127,16 +127,16 @@ class LimitSurface:
         if not isinstance(mesh, QuadMesh):
             raise CCProofError(f"LimitSurface takes a QuadMesh or a PolyMesh, not {type(mesh).__name__}")
         self._hole_ptex = self._ptex_face = None
-        b = _Builder(progress=progress)
+        b = Builder(progress=progress)
         cx = mesh.halfedges  # the mesh's own topology (untagged, default options)
         base = ((0.0, 0.0), (1.0, 0.0), (0.0, 1.0))
         m = mesh.n_faces
-        b.classify(cx, mesh.vertices, _Jobs(np.arange(m), np.zeros(m, np.int64), np.arange(m), [base]),
+        b.classify(cx, mesh.vertices, Jobs(np.arange(m), np.zeros(m, np.int64), np.arange(m), [base]),
                    vmap=np.arange(mesh.n_vertices))
         self._finish(b, np.repeat(np.arange(m, dtype=np.int64)[:, None], 4, axis=1), np.zeros(m, dtype=np.bool_))
 
     def _finish(self, b, top, refused, keep_job_base=True):
-        """The patch table from a :class:`_Builder` that has classified every job; ``top`` (P, 4) the
+        """The patch table from a :class:`Builder` that has classified every job; ``top`` (P, 4) the
         job of each quadrant of every ptex face, ``refused`` (P,) the ptex faces evaluation refuses.
         The jobs' rings are kept (:meth:`with_vertices` recomputes the float data from them);
         ``keep_job_base``: keep the base face of every job (the quad-mesh :meth:`vertex_normals`)."""
@@ -262,7 +262,7 @@ class LimitSurface:
         N = None
         if nets:
             N = np.empty((f.size, 17, 3))
-            reg = np.flatnonzero(loc.kind == _REGULAR)
+            reg = np.flatnonzero(loc.kind == KIND_REGULAR)
             N[reg] = T.nets[loc.patch[reg]]
             idx = loc.corner
             if idx.size:
@@ -555,7 +555,7 @@ class LimitSurface:
         r = self.evaluate(f, u, v, 1)
         N = np.cross(r["Pu"], r["Pv"])
         job, vf, kind = self.patch_map.faces(f, u, v)
-        idx = np.flatnonzero(kind == _CORNER)
+        idx = np.flatnonzero(kind == KIND_CORNER)
         if idx.size:
             T = self._table
             w = vf[idx]
@@ -614,7 +614,8 @@ class LimitSurface:
             for c, pos in enumerate(t.cor_vertex):
                 if pos < 0:
                     continue
-                vf = int(T.job_root[jobs[0]]) + next(i for i, k in enumerate(t.kind) if k == _CORNER and t.leaf[i] == c)
+                corner = next(i for i, k in enumerate(t.kind) if k == KIND_CORNER and t.leaf[i] == c)
+                vf = int(T.job_root[jobs[0]]) + corner
                 for job, vert in zip(jobs.tolist(), self._vmap[rings[:, pos]].tolist()):
                     out.setdefault(int(vert), (job, vf))
         return out

@@ -1,7 +1,7 @@
 """Exact limit evaluation on tagged polygon meshes (creases, corners, holes, boundary modes, n-gons).
 
 The patch table of a :class:`~ccproof.mesh.polymesh.PolyMesh` is built by the builder of the all-quad
-meshes (:class:`ccproof.evaluate._table._Builder`: same classification, arrays, locator and
+meshes (:class:`ccproof.evaluate._table.Builder`: same classification, arrays, locator and
 kernels), from the tagged rules of :mod:`ccproof.mesh.rules`; :func:`build_tagged` classifies, the one
 evaluator :class:`ccproof.evaluate.surface.LimitSurface` holds the table and evaluates:
 
@@ -33,7 +33,7 @@ import math
 
 import numpy as np
 
-from ccproof.evaluate._table import TaggedHalfEdges, _Builder, _child_frame, _compose, _domain, _Jobs, catmark_step
+from ccproof.evaluate._table import Builder, Jobs, TaggedHalfEdges, catmark_step, child_frame, compose, domain
 from ccproof.mesh.halfedges import HalfEdges
 from ccproof.mesh.polymesh import PolyMesh
 from ccproof.mesh.step import pack_csr
@@ -59,7 +59,7 @@ def build_tagged(mesh: PolyMesh, progress=None, keep=None):
 
     Returns
     -------
-    builder : _Builder
+    builder : Builder
         Every job classified (the patch table is ``builder.table(top, hole)``).
     top : ndarray of int, shape (n_ptex, 4)
         The job of each quadrant of every ptex face.
@@ -77,7 +77,7 @@ def build_tagged(mesh: PolyMesh, progress=None, keep=None):
     ((6, 4), [False, False, False, False, False, True], [0, 1, 2, 3, 4, 5])
     """
     mesh = mesh.manifold
-    b = _Builder(2 if mesh.options.crease_method == "chaikin" else 1, what="ptex face", progress=progress)
+    b = Builder(2 if mesh.options.crease_method == "chaikin" else 1, what="ptex face", progress=progress)
     ident = ((0.0, 0.0), (1.0, 0.0), (0.0, 1.0))
     P = mesh.n_ptex
     ptex_face = np.empty(P, dtype=np.int64)
@@ -93,7 +93,7 @@ def build_tagged(mesh: PolyMesh, progress=None, keep=None):
                 he = TaggedHalfEdges.of(he.with_tags(mesh.edge_sharpness, vertex_values=vv))
         ptex_face[:] = np.arange(mesh.n_faces)
         m = mesh.n_faces
-        b.classify(he, np.asarray(mesh.vertices), _Jobs(np.arange(m), np.zeros(m, np.int64), np.arange(m), [ident]))
+        b.classify(he, np.asarray(mesh.vertices), Jobs(np.arange(m), np.zeros(m, np.int64), np.arange(m), [ident]))
         top = np.repeat(np.arange(P, dtype=np.int64)[:, None], 4, axis=1)
         return b, top, mesh.is_hole[ptex_face], ptex_face
     step = catmark_step(mesh)  # untagged: vectorized, and the level-1 mesh as half-edge arrays
@@ -112,8 +112,8 @@ def build_tagged(mesh: PolyMesh, progress=None, keep=None):
     frames = [ident]
     quarter_q = []
     for i in range(4):
-        cf = _compose(ident, _child_frame(i))
-        cu, cv, _ = _domain(cf)
+        cf = compose(ident, child_frame(i))
+        cu, cv, _ = domain(cf)
         frames.append(cf)
         quarter_q.append(int(cu > 0) + 2 * int(cv > 0))
     sizes = np.asarray(mesh.sizes, dtype=np.int64)
@@ -132,7 +132,7 @@ def build_tagged(mesh: PolyMesh, progress=None, keep=None):
     top[ptex[nq]] = jid[nq, None]
     qd = np.flatnonzero(is_quad)
     top[ptex[qd], np.asarray(quarter_q)[corner[qd]]] = jid[qd]
-    b.classify(he, X, _Jobs(g, fid, ptex, frames))
+    b.classify(he, X, Jobs(g, fid, ptex, frames))
     del he, step, g, fid, ptex, face, corner, is_quad, jid  # before the table's float data
     return b, top, mesh.is_hole[ptex_face], ptex_face
 

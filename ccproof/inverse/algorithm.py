@@ -48,9 +48,9 @@ from ccproof.inverse.data import (
     NMAX,
     SAFE_HI,
     SAFE_LO,
-    _approx_log,
-    _as_points,
-    _patch_eval_jac,
+    approx_log,
+    as_points,
+    patch_eval_jac,
     polynomial_rows,
     valence_data,
 )
@@ -155,7 +155,7 @@ def inverse_characteristic_map(k: int, u: ArrayLike, v: ArrayLike, *, domain: Li
     k = check_valence(k)
     if domain not in ("quadrant", "face"):
         raise CCProofError(f"unknown domain {domain!r}; use 'quadrant' or 'face'")
-    x, y, shape = _as_points(u, v, "image")
+    x, y, shape = as_points(u, v, "image")
     D = valence_data(k)
     npts = x.shape[0]
     R = np.empty(npts)
@@ -204,7 +204,7 @@ def _check_face(x, y, R, S):
 
 def _first_layer(D, a, fast=False):
     """Step 1: n0 = floor(log_lam(a / A)) (an approximate log is enough: the band has room)."""
-    n0 = np.floor((_approx_log(a) - D.log_a) * D.inv_log_lam)
+    n0 = np.floor((approx_log(a) - D.log_a) * D.inv_log_lam)
     if not fast:
         np.clip(n0, -NMAX + 4, NMAX - 4, out=n0)
     return n0.astype(np.int64)
@@ -367,7 +367,7 @@ def newton(Cp, s, t, X, Y):
 
 
 def _newton_step(Cp, s, t, X, Y, want_step=True):
-    x, y, xs, xt, ys, yt = _patch_eval_jac(Cp, s, t)
+    x, y, xs, xt, ys, yt = patch_eval_jac(Cp, s, t)
     x -= X
     y -= Y
     with np.errstate(all="ignore"):
@@ -389,14 +389,14 @@ def _newton_step(Cp, s, t, X, Y, want_step=True):
 
 
 def _run_fallback(D, x, y, idx, R, S, layer, patch, ver):
-    from ccproof.inverse.fallback import _subdivision_inverse
+    from ccproof.inverse.fallback import subdivision_inverse
 
     xs, ys = x[idx], y[idx]
     sw = ys > xs
     a = np.where(sw, ys, xs)
     b = np.where(sw, xs, ys)
     n0 = _first_layer(D, a)
-    n, p, s_loc, t_loc, verified = _subdivision_inverse(D, a, b, n0)
+    n, p, s_loc, t_loc, verified = subdivision_inverse(D, a, b, n0)
     t_loc[(b == 0) & (p == 0)] = 0.0
     r = np.maximum(np.ldexp((s_loc + 1.0) * 0.5, -n), 0.0)
     s = np.maximum(np.ldexp((t_loc + p) * 0.5, -n), 0.0)

@@ -542,18 +542,18 @@ SAFE_LO = 2.0**-900
 SAFE_HI = 2.0**900
 
 _LN2 = float(np.log(2.0))
-#: quadratic approximation of log(m) on [1/2, 1) (error < 1e-2), used by :func:`_approx_log`
+#: quadratic approximation of log(m) on [1/2, 1) (error < 1e-2), used by :func:`approx_log`
 _LOG_Q = np.polyfit(np.linspace(0.5, 1.0, 200), np.log(np.linspace(0.5, 1.0, 200)), 2)
 
 
-def _approx_log(a):
+def approx_log(a):
     """log(a) to within 1e-2 (a > 0): frexp plus a quadratic; 3x cheaper than np.log."""
     m, e = np.frexp(a)
     c2, c1, c0 = _LOG_Q
     return (c2 * m + c1) * m + (c0 + _LN2 * e)
 
 
-def _patch_eval(Wp, s, t, jacobian=False):
+def patch_eval(Wp, s, t, jacobian=False):
     """P(s, t) of one piece (``Wp`` = ``ValenceData.W[p]``) at arrays s, t (local coordinates).
 
     Returns (x, y) or (x, y, x_s, x_t, y_s, y_t). The t-polynomials q_i(t) of both components
@@ -578,7 +578,7 @@ def _horner_rows(W, t):
     return Q
 
 
-def _patch_eval_jac(Cp, s, t):
+def patch_eval_jac(Cp, s, t):
     """(x, y, x_s, x_t, y_s, y_t) of one piece (``Cp`` = ``ValenceData.C6[p]``), shape (6, n).
 
     The t-polynomials of x, y (cubics) and of x_t, y_t (quadratics) for each power of s by Horner's
@@ -657,7 +657,7 @@ def chunks(n, size=CHUNK):
         yield slice(i, min(i + size, n))
 
 
-def _as_points(u, v, what="point"):
+def as_points(u, v, what="point"):
     """Broadcast two coordinate arrays to flat float64 arrays; reject NaN, inf and negatives.
 
     Returns (u, v, shape). Raises :class:`~ccproof.errors.CCProofError`.

@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ccproof.inverse.data import NMAX, _patch_eval
+from ccproof.inverse.data import NMAX, patch_eval
 
 #: first level at which Newton is tried from the surviving box centres
 NEWTON_LEVEL = 8
@@ -54,7 +54,7 @@ def _split_t(nets):
     return left.transpose(0, 2, 1, 3), right.transpose(0, 2, 1, 3)
 
 
-def _subdivision_inverse(D, a, b, n0):
+def subdivision_inverse(D, a, b, n0):
     """Preimages of the points (a, b) (a >= b >= 0, not both 0) with first-guess layer ``n0``.
 
     Returns ``(n, p, s, t, verified)``: layer, piece (0: P1, 1: P2), local coordinates of the
@@ -138,7 +138,7 @@ def _residual(D, pc, s, t, tx, ty):
     for p in (0, 1):
         sel = pc == p
         if sel.any():
-            x[sel], y[sel] = _patch_eval(D.W[p], s[sel], t[sel])
+            x[sel], y[sel] = patch_eval(D.W[p], s[sel], t[sel])
     return np.maximum(np.abs(x - tx), np.abs(y - ty))
 
 
@@ -152,7 +152,7 @@ def _newton_polish(D, pc, s, t, tx, ty, scale, iterations=12):
             sel = np.flatnonzero(pc == p)
             if sel.size == 0:
                 continue
-            x, y, xs, xt, ys, yt = _patch_eval(D.W[p], s[sel], t[sel], True)
+            x, y, xs, xt, ys, yt = patch_eval(D.W[p], s[sel], t[sel], True)
             fx = x - tx[sel]
             fy = y - ty[sel]
             with np.errstate(all="ignore"):

@@ -24,10 +24,10 @@ from ccproof.inverse.data import (
     NMAX,
     SAFE_HI,
     SAFE_LO,
-    _as_points,
-    _patch_eval,
-    _patch_eval_jac,
+    as_points,
     chunks,
+    patch_eval,
+    patch_eval_jac,
     valence_data,
 )
 
@@ -64,7 +64,7 @@ def characteristic_map(k: int, r: ArrayLike, s: ArrayLike, jacobian: bool = Fals
     ([1.0, 0.549988354518, 0.0], [0.0, 0.0, 0.0])
     """
     k = check_valence(k)
-    ra, sa, shape = _as_points(r, s, "parameter")
+    ra, sa, shape = as_points(r, s, "parameter")
     D = valence_data(k)
     n = ra.shape[0]
     X = np.empty(n)
@@ -96,9 +96,9 @@ def _forward_chunk(D, r, s, X, Y, J):
         if sel.size == 0:
             continue
         if J is None:
-            out = _patch_eval(D.W[p], sl[sel], tl[sel])
+            out = patch_eval(D.W[p], sl[sel], tl[sel])
         else:
-            out = _patch_eval_jac(D.C6[p], sl[sel], tl[sel])
+            out = patch_eval_jac(D.C6[p], sl[sel], tl[sel])
         px[sel] = out[0]
         py[sel] = out[1]
         if J is not None:

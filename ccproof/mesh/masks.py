@@ -28,7 +28,7 @@ from fractions import Fraction
 import numpy as np
 
 from ccproof.mesh.quadmesh import QuadMesh
-from ccproof.mesh.subdivision import _boundary_neighbours
+from ccproof.mesh.subdivision import boundary_neighbours
 from ccproof.rule_weights import crease_limit_weights, smooth_limit_weights
 from ccproof.valence import lam_from_c
 
@@ -78,7 +78,7 @@ def limit_positions(mesh: QuadMesh, vertices=None):
     L[unused] = np.nan
     bv = mesh.is_boundary_vertex
     if bv.any():
-        e0, e1 = _boundary_neighbours(mesh)
+        e0, e1 = boundary_neighbours(mesh)
         cV, ce, cden = _integer_weights(crease_limit_weights(Fraction(1)))
         L[bv] = (cV * V[bv] + ce * (V[e0[bv]] + V[e1[bv]])) / cden
     return L

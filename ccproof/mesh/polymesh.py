@@ -35,7 +35,7 @@ import numpy as np
 
 from ccproof.errors import MeshError
 from ccproof.mesh.halfedges import HalfEdges
-from ccproof.mesh.quadmesh import _check_used_finite
+from ccproof.mesh.quadmesh import check_used_finite
 from ccproof.mesh.rules import INFINITE, Complex, Options, refine_complex
 
 __all__ = ["PolyMesh"]
@@ -138,7 +138,7 @@ class PolyMesh:
                 if len(set(p)) != len(p):
                     r = next(v for v in p if p.count(v) > 1)
                     raise MeshError(f"face {f} repeats vertex {r} within one fan: {p}")
-        _check_used_finite(V, idx)
+        check_used_finite(V, idx)
         self.vertices = V
         self.vertices.setflags(write=False)
         self.sizes = sz
@@ -617,7 +617,7 @@ class PolyMesh:
         V = np.array(vertices, dtype=np.float64)
         if V.shape != self.vertices.shape:
             raise MeshError(f"vertices must have shape {self.vertices.shape}, got {V.shape}")
-        _check_used_finite(V, self.indices)
+        check_used_finite(V, self.indices)
         V.setflags(write=False)
         new = self._replace_vertices(V)
         if self.manifold is self:
@@ -682,7 +682,7 @@ class PolyMesh:
                 return self.manifold.refine(operator)
             m, _ = self.manifold.refine(operator=False)
             return m, (self.subdivision_operator() if operator else None)
-        from ccproof.mesh.step import _decrement, apply_csr
+        from ccproof.mesh.step import apply_csr, decrement_sharpness
 
         st = self._step(sparse=False)
         n = self.n_vertices
@@ -694,7 +694,7 @@ class PolyMesh:
         cvs[st.child_corners[0]] = st.child_corners[1]
         if unused.size and self.vertex_sharpness:
             vs = np.array([self.vertex_sharpness.get(v, 0.0) for v in unused.tolist()])
-            cvs[unused] = _decrement(vs)
+            cvs[unused] = decrement_sharpness(vs)
         sharp_v = np.flatnonzero(cvs > 0)
         pairs, ces = st.child_creases
         he = self.halfedges

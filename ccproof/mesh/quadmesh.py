@@ -73,7 +73,7 @@ def _check_pairing(he):
         )
 
 
-def _check_used_finite(V, used):
+def check_used_finite(V, used):
     """MeshError naming the first vertex used by a face whose coordinates are not finite (NaN, inf).
 
     Unused vertices (common in scans) may hold anything: they do not enter the surface.
@@ -188,7 +188,7 @@ class QuadMesh:
         if out.size:
             f = int(out[0])
             raise MeshError(f"face {f} has a vertex index out of range [0, {n}): {F[f].tolist()}")
-        _check_used_finite(V, F.reshape(-1))
+        check_used_finite(V, F.reshape(-1))
         s = np.sort(F, axis=1)
         rep = np.flatnonzero((s[:, 1:] == s[:, :-1]).any(axis=1))
         if rep.size:
@@ -263,7 +263,7 @@ class QuadMesh:
         V = np.array(vertices, dtype=np.float64)
         if V.shape != self.vertices.shape:
             raise MeshError(f"vertices must have shape {self.vertices.shape}, got {V.shape}")
-        _check_used_finite(V, self.faces.reshape(-1))
+        check_used_finite(V, self.faces.reshape(-1))
         V.setflags(write=False)
         new.vertices = V
         return new

@@ -93,7 +93,7 @@ class Step(NamedTuple):
     csr: tuple
 
 
-def _decrement(s):
+def decrement_sharpness(s):
     """Sdc's uniform decay of float32 sharpness values (0 at or below 1, infinite stays)."""
     s = np.asarray(s, dtype=np.float64)
     out = np.where(s > 1.0, (s.astype(_F32) - _F32(1.0)).astype(np.float64), 0.0)
@@ -510,7 +510,7 @@ def catmark_operator(n, indices, sizes, *, halfedges=None, edge_of_halfedge=None
     inc_v, inc_e, inc_u = inc_v[o], inc_e[o], inc_u[o]
     pe = es[inc_e]
     # child sharpness of every edge at every vertex (Sdc SubdivideEdgeSharpnessesAroundVertex)
-    ce = _decrement(pe)
+    ce = decrement_sharpness(pe)
     if chaikin:
         semi = (pe > 0) & np.isfinite(pe)
         total, nsemi = _f32_sums(inc_v[semi], pe[semi], n)
@@ -525,7 +525,7 @@ def catmark_operator(n, indices, sizes, *, halfedges=None, edge_of_halfedge=None
     pv = vs.copy()
     if opts.boundary == "edge_and_corner" and level == 0:
         pv[is_bv & (k == 1)] = np.inf
-    cv = _decrement(pv)
+    cv = decrement_sharpness(pv)
     np_ = np.bincount(inc_v[pe > 0], minlength=n)
     nc_ = np.bincount(inc_v[ce > 0], minlength=n)
     SMOOTH, CREASE, CORNER = 0, 2, 3
@@ -652,7 +652,7 @@ def catmark_operator(n, indices, sizes, *, halfedges=None, edge_of_halfedge=None
         ce_end[inc_e[~first_end], 1] = ce[~first_end]
         both = (ce_end > 0).all(axis=1)
     else:
-        both = _decrement(es) > 0
+        both = decrement_sharpness(es) > 0
     mid = (es > 0) & (bnd_e | both)
     pw = np.where(mid, 1.0, np.where(es > 0, es.astype(_F32).astype(np.float64), 0.0))  # weight of the midpoint
     tri_e = np.zeros(E, dtype=bool)  # TRI_SUB_SMOOTH's edges (level 0, a triangle on a side), not both sharp

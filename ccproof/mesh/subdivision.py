@@ -70,7 +70,7 @@ def child_faces(mesh):
     return out.reshape(4 * m, 4)
 
 
-def _boundary_neighbours(mesh):
+def boundary_neighbours(mesh):
     """For every boundary vertex its two boundary neighbours (e0 after it, e1 before it)."""
     F = mesh.faces
     org = F.reshape(-1)

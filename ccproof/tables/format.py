@@ -186,7 +186,7 @@ def _check_integer_form(form, where):
     return form
 
 
-def _eval_form_arb(form, c, lam):
+def eval_form_arb(form, c, lam):
     """(A(c) + B(c) lam)/D(c) in ball arithmetic (Horner); encloses the value for all c, lam in
     the balls (the caller sets the working precision)."""
 

@@ -19,10 +19,10 @@ import numpy as np
 from ccproof.errors import TableNotFoundError, check_valence
 from ccproof.tables.format import (
     PATCHES,
-    _eval_form_arb,
     arb_from_json,
     available_tables,
     describe_available,
+    eval_form_arb,
     read_table_json,
     table_nets_arb,
     table_nets_exact,
@@ -206,7 +206,7 @@ def characteristic_arb(k, prec=128):
         lam = lam_from_c(c, arb.sqrt)
         nets = {}
         for name in PATCHES:
-            bs = [[tuple(_eval_form_arb(q, c, lam) for q in p) for p in row] for row in exact[name]]
+            bs = [[tuple(eval_form_arb(q, c, lam) for q in p) for p in row] for row in exact[name]]
             rows = [[tuple(sum((M[a] * bs[a][j][comp] for a in range(4)), arb(0)) / 6 for comp in range(2))
                      for j in range(4)] for M in BSPLINE_TO_BEZIER_6]
             nets[name] = [[tuple(sum((M[b] * rows[i][b][comp] for b in range(4)), arb(0)) / 6 for comp in range(2))

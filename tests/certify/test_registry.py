@@ -90,7 +90,7 @@ def _tamper_after_verification(tmp_path, monkeypatch):
     cert5 = json.loads((C / "c1" / "crease" / "n005.json").read_text())
     swapped.write_text(json.dumps(cert5))
     fifo.write_text((C / "c1" / "corner" / "n003.json").read_text())
-    real = cli_verify._check
+    real = cli_verify.verify_task
 
     def check_then_tamper(args):
         out = real(args)
@@ -101,7 +101,7 @@ def _tamper_after_verification(tmp_path, monkeypatch):
             os.mkfifo(fifo)
         return out
 
-    monkeypatch.setattr(cli_verify, "_check", check_then_tamper)
+    monkeypatch.setattr(cli_verify, "verify_task", check_then_tamper)
     return swapped, fifo
 
 

@@ -129,7 +129,7 @@ def test_tagged_evaluator_on_the_quad_references(refdir, name):
 
 def test_disk_cache_gives_the_computed_scheme(tmp_path, monkeypatch):
     """A corner scheme read back from the disk cache is the computed one, bit for bit."""
-    from ccproof.evaluate import local
+    from ccproof.evaluate import _diskcache, local
 
     monkeypatch.setenv("CCPROOF_CACHE", str(tmp_path))
     V = [[np.cos(a), np.sin(a), 0.1 * np.cos(3 * a)] for a in np.linspace(0, 2 * np.pi, 5, endpoint=False)]
@@ -148,4 +148,4 @@ def test_disk_cache_gives_the_computed_scheme(tmp_path, monkeypatch):
     assert key is not computed and key.A == computed.A  # the exact matrix, read on first use
     assert np.array_equal(key.tangent_masks, computed.tangent_masks)
     monkeypatch.setenv("CCPROOF_CACHE", "off")
-    assert local._cache_dir() is None and key.A.nrows() == key.size
+    assert _diskcache.cache_dir() is None and key.A.nrows() == key.size

@@ -9,7 +9,7 @@ subdivision (test_tagged_bruteforce.py); here the shortcuts are switched off to 
 import numpy as np
 
 from ccproof.evaluate import _table
-from ccproof.evaluate._table import _Builder
+from ccproof.evaluate._table import Builder
 from ccproof.evaluate.surface import LimitSurface
 from ccproof.mesh.io import read_mesh
 
@@ -22,7 +22,7 @@ def _points(S, n=4000, seed=0):
 
 def _compare(mesh, monkeypatch):
     handled, at_corner = [], []
-    shortcut, corner_at = _Builder.smooth_regular_patches, _Builder.corner_at
+    shortcut, corner_at = Builder.smooth_regular_patches, Builder.corner_at
 
     def counting(self, cx, X, jobs):
         done = shortcut(self, cx, X, jobs)
@@ -39,14 +39,14 @@ def _compare(mesh, monkeypatch):
         compiled = LimitSurface(mesh)  # untagged rings walked by the compiled kernel (with numba)
     with monkeypatch.context() as m:
         m.setattr(_table, "_ring_walks", lambda n: None)  # the Python walk, face by face
-        m.setattr(_Builder, "smooth_regular_patches", counting)
-        m.setattr(_Builder, "corner_at", counting_corner)
+        m.setattr(Builder, "smooth_regular_patches", counting)
+        m.setattr(Builder, "corner_at", counting_corner)
         fast = LimitSurface(mesh)
     assert sum(handled) > 0  # the shortcut is exercised
     with monkeypatch.context() as m:
         m.setattr(_table, "_ring_walks", lambda n: None)
-        m.setattr(_Builder, "smooth_regular_patches", lambda self, cx, X, jobs: np.zeros(len(jobs), bool))
-        m.setattr(_Builder, "corner_at", lambda self, *args, **kwargs: False)
+        m.setattr(Builder, "smooth_regular_patches", lambda self, cx, X, jobs: np.zeros(len(jobs), bool))
+        m.setattr(Builder, "corner_at", lambda self, *args, **kwargs: False)
         slow = LimitSurface(mesh)
     assert fast.n_patches == slow.n_patches
     f, u, v = _points(fast)

@@ -22,12 +22,12 @@ from ccproof.mesh.polymesh import PolyMesh
 from ccproof.mesh.rules import CORNER, CREASE, SMOOTH, vertex_rule
 
 
-def _child_frame(i):
+def child_frame(i):
     c = np.array(CORNERS, dtype=float)
     return c[i], (c[(i + 1) % 4] - c[i]) / 2, (c[(i + 3) % 4] - c[i]) / 2
 
 
-def _compose(fr, sub):
+def compose(fr, sub):
     o, a, b = fr
     so, sa, sb = sub
     return o + a * so[0] + b * so[1], a * sa[0] + b * sa[1], a * sb[0] + b * sb[1]
@@ -42,12 +42,12 @@ def refine_with_frames(mesh, levels):
         k = int(mesh.sizes[f])
         for i in range(k):
             if k == 4:
-                frames.append((int(mesh.ptex_start[f]), _child_frame(i)))
+                frames.append((int(mesh.ptex_start[f]), child_frame(i)))
             else:
                 frames.append((int(mesh.ptex_start[f]) + i, ident))
     for _ in range(levels - 1):
         m, _ = m.refine()
-        frames = [(p, _compose(fr, _child_frame(i))) for p, fr in frames for i in range(4)]
+        frames = [(p, compose(fr, child_frame(i))) for p, fr in frames for i in range(4)]
     return m, frames
 
 

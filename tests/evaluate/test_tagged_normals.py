@@ -94,10 +94,10 @@ def test_normals_near_feature_vertices_converge(refdir, name, kind):
 def _subdominant(S, p, c):
     """Largest eigenvalue below 1 of the corner's subdivision matrix on the points the face uses."""
     from ccproof.evaluate.local import _fmpq_mat_to_float
-    from ccproof.evaluate.surface import _CORNER
+    from ccproof.evaluate.surface import KIND_CORNER
 
     job, vf, kind = S.patch_map.faces(np.array([p]), np.array([c[0]]), np.array([c[1]]))
-    assert kind[0] == _CORNER
+    assert kind[0] == KIND_CORNER
     scheme, _ = S._corner_leaf(int(job[0]), int(vf[0]))
     A = _fmpq_mat_to_float(scheme.A)
     sup = list(scheme.support) if scheme.support else list(range(A.shape[0]))

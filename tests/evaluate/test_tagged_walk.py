@@ -15,7 +15,7 @@ import pytest
 
 from ccproof.evaluate import _table
 from ccproof.evaluate._ckernel import load
-from ccproof.evaluate._table import TaggedHalfEdges, _Builder
+from ccproof.evaluate._table import Builder, TaggedHalfEdges
 from ccproof.evaluate.tagged import build_tagged
 from ccproof.mesh.examples import k_regular_disk
 from ccproof.mesh.halfedges import HalfEdges
@@ -40,7 +40,7 @@ def _classification(b):
 
 def _both(mesh, monkeypatch):
     walked = []
-    walk_all, face = _Builder._walk_all, _Builder.face
+    walk_all, face = Builder._walk_all, Builder.face
 
     def counting(self, he, *args):
         walked.append(type(he).__name__)
@@ -52,8 +52,8 @@ def _both(mesh, monkeypatch):
 
     with monkeypatch.context() as m:
         m.setattr(_table, "COMPILED_WALK_MIN", 0)
-        m.setattr(_Builder, "_walk_all", counting)
-        m.setattr(_Builder, "face", python_face)
+        m.setattr(Builder, "_walk_all", counting)
+        m.setattr(Builder, "face", python_face)
         compiled = build_tagged(mesh)
     with monkeypatch.context() as m:
         m.setattr(_table, "_ring_walks", lambda n: None)  # the Python walk, face by face

@@ -70,13 +70,13 @@ def _forged(tmp_path):
 
 
 def test_verify_verdicts_equal_on_the_cluster(cluster, tmp_path, capsys):
-    from ccproof.cli.verify import _check
+    from ccproof.cli.verify import verify_task
 
     files = [ROOT / "certificates" / "c1" / "k003.json", ROOT / "certificates" / "c1" / "k004.json",
              _forged(tmp_path), ROOT / "certificates" / "c1" / "k005.json"]
     work = [(str(f), True) for f in files]
-    serial = run_tasks(_check, work, "serial", progress=False)
-    dist = run_tasks(_check, work, cluster[1], progress=False)
+    serial = run_tasks(verify_task, work, "serial", progress=False)
+    dist = run_tasks(verify_task, work, cluster[1], progress=False)
     verdicts = [bool(r) for r, _ in serial.results]
     assert verdicts == [True, True, False, True]
     assert [bool(r) for r, _ in dist.results] == verdicts

@@ -488,7 +488,8 @@ def run_method(h: ChartHierarchy, method, levels=3, start_level=1, tol=1e-6, max
 
 
 # --------------------------------------------------------------------------- measuring
-def _metric_samples(h: ChartHierarchy, level, rules):
+def metric_samples(h: ChartHierarchy, level, rules):
+    """The metric samples of level ``level`` of ``h`` for ``rules`` (built once, kept on ``h``)."""
     cache = h.__dict__.setdefault("_metric_samples", {})
     key = (level, rules)
     if key not in cache:
@@ -525,7 +526,7 @@ def texture_metrics(tex: ChartTexture, eval_level=5, per_sample=False):
     if eval_level < tex.level:
         raise CCProofError(f"evaluation level {eval_level} is below the texture's level {tex.level}")
     X = tex.hierarchy.subdivide_values(tex.values, tex.rules, tex.level, eval_level)
-    S = _metric_samples(tex.hierarchy, eval_level, tex.rules)
+    S = metric_samples(tex.hierarchy, eval_level, tex.rules)
     return sample_metrics(S, X, per_sample=per_sample)
 
 
@@ -557,7 +558,8 @@ def control_flips(tex: ChartTexture):
 
 
 # --------------------------------------------------------------------------- whole meshes
-def _charts(mesh, labels):
+def mesh_charts(mesh, labels):
+    """Face index arrays of the charts (per-face ``labels``, None: one chart), hole faces left out."""
     hole = getattr(mesh, "hole", None)
     if hole is not None and hole.any():  # hole faces are not part of the surface: in no chart
         if labels is None:
@@ -640,7 +642,7 @@ def auto_refine(mesh, labels, faces_per_chart=1000):
     >>> auto_refine(grid(3, 3), None, 10), auto_refine(grid(3, 3), None, 100), auto_refine(grid(3, 3), None, 10**6)
     (1, 2, 2)
     """
-    n_charts = len(_charts(mesh, labels))
+    n_charts = len(mesh_charts(mesh, labels))
     per = mesh.n_faces / max(n_charts, 1) if labels is None else (np.asarray(labels) >= 0).sum() / max(n_charts, 1)
     r = 0
     while r < 2 and per * 4**r < faces_per_chart:
@@ -762,7 +764,7 @@ def compare(mesh, labels=None, methods=METHODS, levels=3, start_level=1, eval_le
     >>> [[round(x, 9) for x in res[m].metrics.as_tuple()] for m in "bc"], len(hierarchies)
     ([[2.0, 2.0, 1.0], [2.0, 2.0, 1.0]], 1)
     """
-    charts = _charts(mesh, labels)
+    charts = mesh_charts(mesh, labels)
     if hierarchies is None:
         hierarchies = [ChartHierarchy(mesh, fc) for fc in charts]
     refine = int(refine)
@@ -771,7 +773,7 @@ def compare(mesh, labels=None, methods=METHODS, levels=3, start_level=1, eval_le
     fine = {}
     if refine and any(m in ("b", "c") for m in methods):
         rmesh, rlab = refine_mesh(mesh, labels, refine)
-        fine = {"hierarchies": [ChartHierarchy(rmesh, fc) for fc in _charts(rmesh, rlab)],
+        fine = {"hierarchies": [ChartHierarchy(rmesh, fc) for fc in mesh_charts(rmesh, rlab)],
                 "start": max(start_level, refine + 1) - refine, "levels": max(levels, refine + 1) - refine}
     need, deepest, opt = run_memory(hierarchies, methods, levels, eval_level, sample_level, refine,
                                     baseline_level, release)

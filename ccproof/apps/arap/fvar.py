@@ -179,10 +179,10 @@ def _metric_system(hierarchy: ChartHierarchy, level):
     metric samples (the samples of :func:`~ccproof.apps.arap.core.texture_metrics`), and their weights."""
     import scipy.sparse as sp
 
-    from ccproof.apps.arap.core import _metric_samples
+    from ccproof.apps.arap.core import metric_samples
     from ccproof.apps.arap.samples import isometric_frames
 
-    S = _metric_samples(hierarchy, level, "boundary")
+    S = metric_samples(hierarchy, level, "boundary")
     ok = S.weight > 1e-14 * S.weight.max()
     A = hierarchy.operator(level, "boundary")
     G1 = (S.O1 @ A).tocsr()[ok]

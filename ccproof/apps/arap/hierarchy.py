@@ -52,6 +52,7 @@ from ccproof.apps.control_mesh import edge_values, tagged_step, tags_of, vertex_
 from ccproof.errors import CCProofError, MeshError
 from ccproof.mesh import QuadMesh, child_faces
 from ccproof.mesh.quadmesh import shared_halfedges
+from ccproof.mesh.subdivision import boundary_neighbours
 from ccproof.rule_weights import crease_vertex_weights, sharp_edge_weight
 
 __all__ = ["ChartHierarchy", "Level", "HierarchyError", "split_nonmanifold", "RULES"]
@@ -152,17 +153,6 @@ def split_nonmanifold(F, n):
     return newid[inv].reshape(m, 4), orig
 
 
-def _boundary_neighbours(mesh):
-    F = mesh.faces
-    org = F.ravel()
-    dst = np.roll(F, -1, axis=1).ravel()
-    bh = np.flatnonzero(mesh.twin < 0)
-    nb = np.full((mesh.n_vertices, 2), -1, dtype=np.int64)
-    nb[org[bh], 0] = dst[bh]
-    nb[dst[bh], 1] = org[bh]
-    return nb
-
-
 class Level:
     """One level ``E_k`` of a chart hierarchy and its chart bookkeeping.
 
@@ -241,7 +231,7 @@ class Level:
         self.corner = self.chart_boundary & (cfc == 1)
         if not surface_corners:
             self.corner &= ~(mesh.is_boundary_vertex & (mesh.face_count == 1))
-        self.surface_boundary_nbrs = _boundary_neighbours(mesh)
+        self.surface_boundary_nbrs = np.column_stack(boundary_neighbours(mesh))
 
     @property
     def n_vertices(self):
@@ -327,7 +317,7 @@ class ChartHierarchy:
     # ------------------------------------------------------------------ construction
     def n_unknowns(self, rules):
         """Number of texture unknowns for ``rules`` ("extended" or "boundary")."""
-        return self.unknown_vertices.size if _rules(rules) == "extended" else self.n_chart_vertices
+        return self.unknown_vertices.size if check_rules(rules) == "extended" else self.n_chart_vertices
 
     def level(self, k) -> Level:
         """Level ``k`` (built on demand)."""
@@ -433,7 +423,7 @@ class ChartHierarchy:
     # ------------------------------------------------------------------ operators
     def operator(self, k, rules):
         """Sparse ``A_k``: texture unknowns -> level-k values on ``E_k`` (shape (n_k, n_unknowns))."""
-        r = _rules(rules)
+        r = check_rules(rules)
         self.level(k)
         A = self._A[r]
         while len(A) <= k:
@@ -442,7 +432,7 @@ class ChartHierarchy:
 
     def subdivide_values(self, X, rules, from_level, to_level):
         """Push values given on ``E_{from_level}`` to ``E_{to_level}`` with the rules ``rules``."""
-        r = _rules(rules)
+        r = check_rules(rules)
         self.level(to_level)
         X = np.asarray(X, dtype=np.float64)
         for k in range(from_level, to_level):
@@ -451,10 +441,11 @@ class ChartHierarchy:
 
     def lift_unknowns(self, X, rules):
         """Level-0 values on ``E_0`` of the unknowns ``X`` (n_unknowns, d)."""
-        return self.A0[_rules(rules)] @ np.asarray(X, dtype=np.float64)
+        return self.A0[check_rules(rules)] @ np.asarray(X, dtype=np.float64)
 
 
-def _rules(rules):
+def check_rules(rules):
+    """``rules`` if it names texture rules (one of ``RULES``), else a CCProofError naming it."""
     if rules not in RULES:
         raise CCProofError(f"unknown texture rules {rules!r}; expected one of {RULES}")
     return rules

@@ -44,7 +44,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from ccproof.apps.arap.hierarchy import HierarchyError, Level, _rules
+from ccproof.apps.arap.hierarchy import HierarchyError, Level, check_rules
 from ccproof.apps.control_mesh import moving_limit_rows
 from ccproof.rule_weights import crease_limit_weights, smooth_limit_weights
 
@@ -258,7 +258,7 @@ def limit_operator(level: Level, rules):
     >>> A.shape, bool(np.all((np.abs(r - 1) < 1e-12) | (r == 0))), bool((r != 0).any())
     ((49, 49), True, True)
     """
-    r = _rules(rules)
+    r = check_rules(rules)
     mesh = level.mesh
     F = mesh.faces
     n = mesh.n_vertices
@@ -416,7 +416,7 @@ def build_samples(level: Level, rules, purpose="optimize") -> SampleSet:
     >>> float(abs(S.p1[:, 2]).max()), float(abs(S.p2[:, 2]).max())
     (0.0, 0.0)
     """
-    r = _rules(rules)
+    r = check_rules(rules)
     mesh = level.mesh
     F = mesh.faces
     P = mesh.vertices

@@ -239,7 +239,7 @@ class ElementLayout:
         return int((self.face_kind > 0).sum())
 
 
-def _normal_nets(mesh, faces):
+def normal_nets(mesh, faces):
     """4 x 4 nets of normal faces by half-edge walks (each corner of valence 4, interior)."""
     Ff = mesh.faces.reshape(-1)
     tw = mesh.twin
@@ -281,7 +281,7 @@ def _two_ring(mesh, ev):
     return np.r_[ev, ring], f, c
 
 
-def _special_elements(mesh, evs, kind, elem, sector, corner):
+def special_elements(mesh, evs, kind, elem, sector, corner):
     """The special elements of the extraordinary vertices ``evs``, marked in the face arrays (in place).
 
     Face f of EV ``evs[e]``'s fan gets ``kind[f] = 2``, ``elem[f] = e``, its sector and the corner of the EV.
@@ -351,7 +351,7 @@ def element_layout(mesh):
     normal = np.flatnonzero(all_interior & (n_ev == 0))
     kind[normal] = 1
     elem[normal] = np.arange(normal.size)
-    nets = _normal_nets(mesh, normal)
+    nets = normal_nets(mesh, normal)
 
     evs, skipped = [], []
     for ev in np.flatnonzero(is_ev):
@@ -360,7 +360,7 @@ def element_layout(mesh):
     lay = ElementLayout(
         normal_faces=normal,
         normal_nets=nets,
-        **_special_elements(mesh, evs, kind, elem, sector, corner),
+        **special_elements(mesh, evs, kind, elem, sector, corner),
         face_kind=kind,
         face_element=elem,
         face_sector=sector,

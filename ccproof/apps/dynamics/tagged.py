@@ -493,7 +493,7 @@ def tagged_layout(mesh):
     ([0, 1, 2, 3, 4, 5], [3, 3, 3, 3, 3, 3])
     """
     from ccproof.apps.control_mesh import tags_of, vertex_rules
-    from ccproof.apps.dynamics.elements import ElementLayout, _normal_nets, _special_elements
+    from ccproof.apps.dynamics.elements import ElementLayout, normal_nets, special_elements
 
     es, vs = tags_of(mesh)
     ns = vertex_rules(mesh, es, vs)[0]
@@ -516,10 +516,10 @@ def tagged_layout(mesh):
         others = F[fan][F[fan] != ev]
         if not hole[fan].any() and regular[others].all():
             evs.append(int(ev))
-    specials = _special_elements(mesh, evs, kind, elem, sector, corner)
+    specials = special_elements(mesh, evs, kind, elem, sector, corner)
     tagged = np.flatnonzero(kind == 3)
     elem[tagged] = np.arange(tagged.size)
-    lay = ElementLayout(normal_faces=normal, normal_nets=_normal_nets(mesh, normal), **specials,
+    lay = ElementLayout(normal_faces=normal, normal_nets=normal_nets(mesh, normal), **specials,
                         face_kind=kind, face_element=elem, face_sector=sector, face_corner=corner,
                         skipped_ev=np.zeros(0, dtype=np.int64))
     return lay, tagged
