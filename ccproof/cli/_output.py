@@ -33,6 +33,7 @@ import uuid
 from pathlib import Path
 
 from ccproof.errors import CCProofError
+from ccproof.scale.engine import pid_alive
 
 __all__ = ["check_file", "check_folder", "check_outputs", "atomic", "write_text", "is_folder_request",
            "meshio_suffixes", "PLOT_SUFFIXES", "OutputPlan"]
@@ -185,16 +186,6 @@ _TEMPORARY = re.compile(r"^\.tmp-(?:(\d+)-[0-9a-f]{6}|[0-9a-f]{8})-(.+)$")  # ou
 STALE_SECONDS = 3600.0
 
 
-def _pid_alive(pid):
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except (PermissionError, OverflowError):
-        return True
-    return True
-
-
 def remove_stale_temporaries(path) -> int:
     """Remove the temporary files of ``path`` (:func:`_temporary`; for a folder, those in it) left by a killed
     writer (its process is gone, or, for an older version's name without a pid, older than
@@ -214,7 +205,7 @@ def remove_stale_temporaries(path) -> int:
             continue
         q = folder / name
         try:
-            stale = not _pid_alive(int(m.group(1))) if m.group(1) else time.time() - q.stat().st_mtime > STALE_SECONDS
+            stale = not pid_alive(int(m.group(1))) if m.group(1) else time.time() - q.stat().st_mtime > STALE_SECONDS
             if stale:
                 q.unlink()
                 n += 1

@@ -29,6 +29,8 @@ import time
 import warnings
 from pathlib import Path
 
+from ccproof.scale.engine import pid_alive
+
 __all__ = ["cache_dir", "seal", "unseal", "read_entry", "store", "report_bad", "CorruptCacheWarning"]
 
 #: bytes of the trailing digest of a cache file
@@ -115,7 +117,7 @@ def _sweep(d):
         return
     for n in names:
         m = _TMP.match(n)
-        if m is None or int(m.group(2)) == os.getpid() or _alive(int(m.group(2))):
+        if m is None or int(m.group(2)) == os.getpid() or pid_alive(int(m.group(2))):
             continue
         try:
             p = d / n
@@ -123,16 +125,6 @@ def _sweep(d):
                 p.unlink()
         except OSError:
             pass
-
-
-def _alive(pid):
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except (PermissionError, OverflowError):
-        return True
-    return True
 
 
 def store(d, name, suffix, body):

@@ -70,6 +70,21 @@ def dask_available():
     return True
 
 
+
+def pid_alive(pid) -> bool:
+    """Is process ``pid`` alive (or not ours to signal)? The writers of temporary files are judged by it.
+
+    >>> pid_alive(os.getpid())
+    True
+    """
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError):
+        return True
+    return True
+
 @dataclass(frozen=True)
 class Scheduler:
     """A parsed scheduler spec (:func:`parse_scheduler`).
