@@ -18,7 +18,11 @@ triangle (or --cells quad) mesh whose per-vertex UVs are the parameterization ev
 the limit points; charts packed into [0, 1]^2 without overlap (shelf packing, one common scale);
 seams as duplicated vertices (one UV per chart). FILE.obj is written directly (v, vt, f i/i), any
 other extension through meshio (point data "uv"; PLY: "s", "t"); FILE.json holds the metrics, the
-packing scale and the written triangles' own distortion. --control-out FILE.obj writes a control mesh
+packing scale and the written triangles' own distortion. The written triangles are judged first: where
+their UVs fold (signed area <= 0) the default --refine/--out-level refine the control mesh further (up to 4,
+within --max-memory) until none folds, saying which; an explicit --refine/--out-level that folds is refused
+(exit 1, the count and the fix, nothing written) unless --allow-folds (written, with a warning).
+--control-out FILE.obj writes a control mesh
 with texture control points for the rule every subdivision tool has, OpenSubdiv's face-varying "corners
 only" (FVAR_LINEAR_CORNERS_ONLY; its header says so): fitted to the exact texture and polished by the
 same optimization under that rule, on the texture's control mesh subdivided 0..--control-extra more times
