@@ -18,7 +18,11 @@ triangle (or --cells quad) mesh whose per-vertex UVs are the parameterization ev
 the limit points; charts packed into [0, 1]^2 without overlap (shelf packing, one common scale);
 seams as duplicated vertices (one UV per chart). FILE.obj is written directly (v, vt, f i/i), any
 other extension through meshio (point data "uv"; PLY: "s", "t"); FILE.json holds the metrics, the
-packing scale and the written triangles' own distortion. --control-out FILE.obj writes a control mesh
+packing scale and the written triangles' own distortion. The written triangles are judged first: where
+their UVs fold (signed area <= 0) the default --refine/--out-level refine the control mesh further (up to 4,
+within --max-memory) until none folds, saying which; an explicit --refine/--out-level that folds is refused
+(exit 1, the count and the fix, nothing written) unless --allow-folds (written, with a warning).
+--control-out FILE.obj writes a control mesh
 with texture control points for the rule every subdivision tool has, OpenSubdiv's face-varying "corners
 only" (FVAR_LINEAR_CORNERS_ONLY; its header says so): fitted to the exact texture and polished by the
 same optimization under that rule, on the texture's control mesh subdivided 0..--control-extra more times
@@ -117,6 +121,9 @@ def add_arguments(parser):
                              "not beyond --control-max-faces")
     parser.add_argument("--control-max-faces", type=int, default=150_000, metavar="F",
                         help="largest control mesh --control-out writes (default 150000 faces)")
+    parser.add_argument("--allow-folds", action="store_true",
+                        help="write --out even where its UV triangles fold (with a warning); without it such an "
+                             "output is refined away at the default --refine/--out-level, else refused (exit 1)")
     parser.add_argument("--labels-out", metavar="FILE", help="write the chart labels used")
     parser.add_argument("--preview", metavar="FILE.png",
                         help="render a checkerboard through the UVs and the per-triangle distortion (matplotlib), "
@@ -214,7 +221,7 @@ def _levels_within_budget(args, mesh, labels, hierarchies, methods, refine):
 def run(args) -> int:
     plan = _output_plan(args)  # every file written, and the options among themselves: before any work
     from ccproof.apps.arap.charts import read_labels, segment_by_normals
-    from ccproof.apps.arap.core import VARIANTS, MemoryBudgetError, auto_refine, compare
+    from ccproof.apps.arap.core import VARIANTS, auto_refine
     from ccproof.apps.control_mesh import children_labels, read_control_mesh
     from ccproof.cli._progress import phase, progress_enabled
     from ccproof.errors import CCProofError
@@ -262,17 +269,16 @@ def run(args) -> int:
         raise CCProofError(f"--refine {refine} is above the metrics' level {eval_level} (the default "
                            "--eval-level); give --eval-level >= --refine")
     sample_level = _sample_level(args, out_level)
-    try:
-        results, _ = compare(mesh, labels, methods, levels=args.levels, start_level=args.start_level,
-                             eval_level=eval_level, tol=args.tol, max_iter=args.max_iter, engine=engine,
-                             refine=refine, sample_level=sample_level, release=True, hierarchies=hierarchies,
-                             max_memory=args.max_memory * 1e9, progress=progress_enabled(args), accel=args.accel)
-    except MemoryBudgetError:
-        raise
-    except MemoryError as exc:
-        raise CCProofError(f"out of memory ({exc}); lower --eval-level, --levels or --out-level (each level "
-                           f"less needs 4x less memory) or lower --max-memory so that the estimate refuses "
-                           f"earlier") from None
+
+    def optimize(refine):
+        return _optimize(args, mesh, labels, methods, engine, refine, eval_level, sample_level, hierarchies)
+
+    results = optimize(refine)
+    judged = _judge_folds(args, results, ours, out_level, refine, optimize,
+                          lambda r: _fits(args, hierarchies, methods, eval_level, sample_level, r))
+    if judged is None:
+        return 1  # a negative verdict: folded UV triangles, nothing written
+    results, refine = judged
     nch = len(results[ours].textures)
     print(f"{args.mesh}: {mesh.n_vertices} vertices, {mesh.n_faces} faces, {nch} chart(s); "
           f"levels {args.start_level}..{args.levels}, refine {refine}, metrics at level {eval_level}, "
@@ -307,6 +313,83 @@ def run(args) -> int:
         _write_outputs(args, plan, results, ours, labels, out_level, eval_level, comment, table)
     sys.stdout.flush()
     return 0
+
+
+#: the finest --refine the default tries against folded --out triangles
+MAX_FOLD_REFINE = 4
+
+
+def _optimize(args, mesh, labels, methods, engine, refine, eval_level, sample_level, hierarchies):
+    """The methods' results at ``refine`` (compare, with the memory errors named)."""
+    from ccproof.apps.arap.core import MemoryBudgetError, compare
+    from ccproof.cli._progress import progress_enabled
+    from ccproof.errors import CCProofError
+
+    try:
+        results, _ = compare(mesh, labels, methods, levels=args.levels, start_level=args.start_level,
+                             eval_level=eval_level, tol=args.tol, max_iter=args.max_iter, engine=engine,
+                             refine=refine, sample_level=sample_level, release=True, hierarchies=hierarchies,
+                             max_memory=args.max_memory * 1e9, progress=progress_enabled(args), accel=args.accel)
+    except MemoryBudgetError:
+        raise
+    except MemoryError as exc:
+        raise CCProofError(f"out of memory ({exc}); lower --eval-level, --levels or --out-level (each level "
+                           f"less needs 4x less memory) or lower --max-memory so that the estimate refuses "
+                           f"earlier") from None
+    return results
+
+
+def _fits(args, hierarchies, methods, eval_level, sample_level, refine):
+    """Whether ``refine`` keeps the estimated peak memory within --max-memory (and the metrics level above it)."""
+    from ccproof.apps.arap.core import run_memory
+
+    if refine > eval_level:
+        return False
+    need = run_memory(hierarchies, methods, args.levels, eval_level, sample_level, refine, release=True)[0]
+    return need <= args.max_memory * 1e9
+
+
+def _out_folds(args, result, out_level):
+    """(folded, total) triangles of the --out surface to be written; (0, 0) without --out."""
+    from ccproof.apps.arap.export import sampled_surface
+
+    if not args.out:
+        return 0, 0
+    surf = sampled_surface(result, out_level, args.cells)
+    return surf.folds(), surf.triangles().shape[0]
+
+
+def _judge_folds(args, results, ours, out_level, refine, optimize, fits):
+    """Judge the --out UVs before writing: (results, refine) to write, or None after a one-line refusal.
+
+    With the default --refine and --out-level a folding output is optimized again on a finer control mesh
+    (refine + 1, ... up to MAX_FOLD_REFINE, within --max-memory) until no written triangle folds, and stderr says
+    what was chosen; with an explicit --refine or --out-level, or when no refinement within the budget unfolds it,
+    the run refuses (exit 1) naming the count and the options, unless --allow-folds (then a warning at the write).
+    """
+    folded, total = _out_folds(args, results[ours], out_level)
+    if not folded or args.allow_folds:
+        return results, refine
+    first, first_refine = folded, refine
+    if args.refine == "auto" and args.out_level is None:
+        while folded and refine < MAX_FOLD_REFINE and fits(refine + 1):
+            refine += 1
+            results = optimize(refine)
+            folded, total = _out_folds(args, results[ours], out_level)
+            if not folded:
+                print(f"ccproof arap: --out {args.out}: {first} of {total} triangles folded in UV at refine "
+                      f"{first_refine}; chosen refine {refine} (none folds)", file=sys.stderr)
+                return results, refine
+    if args.refine != "auto" or args.out_level is not None:
+        given = f"--refine {args.refine}" if args.refine != "auto" else f"--out-level {args.out_level}"
+        fix = "a higher --refine (or the defaults, which refine until none folds)"
+    else:
+        given = f"refine {refine} (the finest within --max-memory, --eval-level and {MAX_FOLD_REFINE})"
+        fix = "more charts (--segment normals --normal-angle DEG, --charts), more --max-memory"
+    print(f"ccproof arap: refused: --out {args.out}: {folded} of {total} triangles are folded in UV at {given}, "
+          f"output level {out_level}; nothing written; give {fix}, or --allow-folds to write them anyway",
+          file=sys.stderr)
+    return None
 
 
 def _finer(args, n_charts):
@@ -409,7 +492,8 @@ def _write_outputs(args, plan, results, ours, labels, out_level, eval_level, com
         if surf.folds():
             hint = _finer(args, len(results[ours].textures))
             print(f"ccproof arap: warning: --out {args.out}: {surf.folds()} of {surf.cells.shape[0]} {surf.cell_type}s "
-                  f"are folded in UV (E_stretch {wm.E_stretch:.3g}); {hint}", file=sys.stderr)
+                  f"are folded in UV (E_stretch {wm.E_stretch:.3g}), written as --allow-folds asks; {hint}",
+                  file=sys.stderr)
     if args.control_out:
         _write_control(args, plan, results[ours], surf, eval_level, comment, table, write_uv_obj)
 
