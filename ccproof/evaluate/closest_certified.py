@@ -290,16 +290,7 @@ def certify_closest(surface, x, face, u, v, *, radius=None, separation=None, amb
         for _ in range(up_level):
             pc = _corner_piece(pc, u, v, arb)
         d_up = _bounds(pc, *geo[:3], arb)[1]
-        # float prefilter of the base faces (box of the one-ring; the margin covers the rounding)
-        ring_lo, ring_hi = _ring_boxes(F, Vx, vf)
-        gap = np.maximum(np.maximum(ring_lo - x, x - ring_hi), 0.0)
-        lbf = np.sqrt((gap * gap).sum(axis=1)) * (1 - 1e-12)
-        active = []
-        for g in np.flatnonzero(lbf <= float(d_up) * (1 + 1e-12)).tolist():
-            p = _base_piece(F, Vx, vf, g, arb)
-            p.lb, p.ub = _bounds(p, *geo[:3], arb)
-            if p.lb <= d_up:
-                active.append(p)
+        active = _candidates(F, Vx, vf, x, geo, arb, d_up)
         active, n_pieces = _subdivide(active, geo, arb, d_up, radius, (max_level, max_pieces),
                                       F.shape[0] + up_level)
         return _verdict(active, geo, arb, d_up, (face, u, v), n_pieces,
@@ -323,6 +314,23 @@ def _target(surface, x, face, u, v, arb):
     an = sum((t * t for t in a), arb(0)).sqrt()
     Pa = [arb(float(t)) for t in P]
     return X, a, an, Pa
+
+
+def _candidates(F, Vx, vf, x, geo, arb, d_up):
+    """The base pieces whose lower bound of the distance to ``x`` is at most ``d_up``, after a float prefilter of
+    the base faces (box of the one-ring; the margin covers the rounding)."""
+    import numpy as np
+
+    ring_lo, ring_hi = _ring_boxes(F, Vx, vf)
+    gap = np.maximum(np.maximum(ring_lo - x, x - ring_hi), 0.0)
+    lbf = np.sqrt((gap * gap).sum(axis=1)) * (1 - 1e-12)
+    active = []
+    for g in np.flatnonzero(lbf <= float(d_up) * (1 + 1e-12)).tolist():
+        p = _base_piece(F, Vx, vf, g, arb)
+        p.lb, p.ub = _bounds(p, *geo[:3], arb)
+        if p.lb <= d_up:
+            active.append(p)
+    return active
 
 
 def _base_piece(F, Vx, vf, g, arb):
