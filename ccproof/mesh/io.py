@@ -216,21 +216,9 @@ def read_obj_tagged(path):
                 corners[v] = max(s, 0.0)
         elif name == "hole":
             holes.extend(ints)
-        elif name == "interpolateboundary":
-            modes = {0: "none", 1: "edge_and_corner", 2: "edge_only"}
-            if len(ints) != 1 or ints[0] not in modes:
-                raise MeshError(f"{where}: expected one of 0, 1, 2, got {ints}")
-            opts["boundary"] = modes[ints[0]]
-        elif name == "creasemethod":
-            m = {"normal": "uniform", "chaikin": "chaikin"}
-            if len(strings) != 1 or strings[0] not in m:
-                raise MeshError(f"{where}: expected 'normal' or 'chaikin', got {strings}")
-            opts["crease_method"] = m[strings[0]]
-        elif name == "smoothtriangles":
-            m = {"catmark": "catmark", "smooth": "smooth"}
-            if len(strings) != 1 or strings[0] not in m:
-                raise MeshError(f"{where}: expected 'catmark' or 'smooth', got {strings}")
-            opts["triangle_subdivision"] = m[strings[0]]
+        elif name in ("interpolateboundary", "creasemethod", "smoothtriangles"):
+            key, value = _option_tag(where, name, ints, strings)
+            opts[key] = value
         elif name in ("facevaryinginterpolateboundary", "facevaryingpropagatecorners"):
             continue  # face-varying data only
         else:
@@ -240,6 +228,25 @@ def read_obj_tagged(path):
                         holes=holes or None, options=Options(**opts))
     except MeshError as exc:
         raise MeshError(f"{path}: {exc}") from None
+
+
+def _option_tag(where, name, ints, strings):
+    """(Options field, value) of the OBJ option tag ``name`` (interpolateboundary, creasemethod,
+    smoothtriangles); ``where`` names the file, line and tag in the error."""
+    if name == "interpolateboundary":
+        modes = {0: "none", 1: "edge_and_corner", 2: "edge_only"}
+        if len(ints) != 1 or ints[0] not in modes:
+            raise MeshError(f"{where}: expected one of 0, 1, 2, got {ints}")
+        return "boundary", modes[ints[0]]
+    if name == "creasemethod":
+        m = {"normal": "uniform", "chaikin": "chaikin"}
+        if len(strings) != 1 or strings[0] not in m:
+            raise MeshError(f"{where}: expected 'normal' or 'chaikin', got {strings}")
+        return "crease_method", m[strings[0]]
+    m = {"catmark": "catmark", "smooth": "smooth"}
+    if len(strings) != 1 or strings[0] not in m:
+        raise MeshError(f"{where}: expected 'catmark' or 'smooth', got {strings}")
+    return "triangle_subdivision", m[strings[0]]
 
 
 _OFF_KEYWORDS = ("OFF", "COFF", "NOFF", "CNOFF", "STOFF", "STCOFF", "STNOFF", "STCNOFF")
