@@ -558,19 +558,26 @@ def read_control_mesh(path: str | os.PathLike[str]) -> tuple[QuadMesh, np.ndarra
     if poly.has_tags or not poly.is_manifold:
         return _tagged_control_mesh(poly, os.fspath(path))
     sizes = np.asarray(poly.sizes, dtype=np.int64)
-    idx = np.asarray(poly.indices, dtype=np.int64)
-    used = np.unique(idx)
-    if used.size < poly.n_vertices:  # unused vertices (a subdivision step cannot even place them): dropped
-        from ccproof.mesh.polymesh import PolyMesh
-
-        new = np.full(poly.n_vertices, -1, dtype=np.int64)
-        new[used] = np.arange(used.size)
-        poly = PolyMesh(np.asarray(poly.vertices)[used], new[idx], sizes=sizes)
+    poly = _drop_unused_vertices(poly, sizes)
     # the PolyMesh's half-edges are the QuadMesh's (QuadMesh.from_polymesh): each topology built once
     if poly.is_all_quads:
         return QuadMesh.from_polymesh(poly), None
     fine, _ = poly.refine(operator=False)
     return QuadMesh.from_polymesh(fine), np.repeat(np.arange(sizes.size, dtype=np.int64), sizes)
+
+
+def _drop_unused_vertices(poly, sizes):
+    """``poly`` without the vertices no face uses (a subdivision step cannot even place them), renumbered in
+    order; ``poly`` itself when every vertex is used."""
+    idx = np.asarray(poly.indices, dtype=np.int64)
+    used = np.unique(idx)
+    if used.size < poly.n_vertices:
+        from ccproof.mesh.polymesh import PolyMesh
+
+        new = np.full(poly.n_vertices, -1, dtype=np.int64)
+        new[used] = np.arange(used.size)
+        poly = PolyMesh(np.asarray(poly.vertices)[used], new[idx], sizes=sizes)
+    return poly
 
 
 def _tagged_control_mesh(poly, name):

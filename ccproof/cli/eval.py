@@ -152,10 +152,50 @@ def _size(b):
 def run(args) -> int:
     from pathlib import Path
 
+    out_path, shards = _check_outputs_and_options(args)
+    from ccproof.mesh.io import read_mesh
+    from ccproof.scale import scheduler_from_args
+
+    points = None if args.points is None else Path(args.points).resolve()
+    sched = scheduler_from_args(args)  # --scheduler checked before any work
+    from ccproof.cli._progress import phase
+
+    progress = progress_enabled(args)
+    t0 = time.perf_counter()
+    with phase(f"read {Path(args.mesh).name}", progress):
+        poly = read_mesh(args.mesh)  # OBJ with OpenSubdiv tags, OFF, or any meshio format
+    t_read = time.perf_counter() - t0
+    mesh, tagged, n_faces, kwargs, evaluable = _mesh_to_evaluate(args, poly)
+    # the points before the surface's setup (seconds on large meshes): a bad point is reported at once
+    sources = _point_sources(args, points, n_faces, evaluable, out_path, shards)
+    from ccproof.cli._notice import compile_notice
+
+    compile_notice("eval")  # after the input checks: an error stays one line
+    n, names, sweep, surface, times = _evaluate_sources(args, mesh, tagged, kwargs, sources, out_path, sched,
+                                                        progress)
+    setup, worker_setup, t_start, t_write = times
+    for line in sweep.report([f"chunk {i}" for i in range(len(sources))]):  # retried or lost tasks
+        print(line)
+    out = dict.fromkeys(names)
+    what = (str(mesh) if tagged else f"{mesh.n_vertices} vertices, {mesh.n_faces} faces, "
+            f"{mesh.extraordinary_vertices.size} extraordinary vertices")
+    print(f"{args.mesh}: {what}; {_phases(t_read, setup, worker_setup)}")
+    evaluation = max(sweep.seconds - worker_setup, 0.0)  # the workers build at the same time, first
+    print(f"evaluated {n} points ({args.parameterization} parameterization, derivatives {args.derivatives}) "
+          f"in {_evaluation_phases(n, evaluation, t_start, t_write)}")
+    print(f"wrote {args.out}: {', '.join(['face', 'u', 'v', *out])}")
+    if args.plot:
+        _plot(args, mesh, surface)
+    sys.stdout.flush()
+    return 0
+
+
+def _check_outputs_and_options(args):
+    """Every output checked before any work (even the imports), then the options; returns (out path, shards)."""
     from ccproof.cli._output import PLOT_SUFFIXES, OutputPlan, is_folder_request
 
-    # every output checked before any work (even the imports), distinct from the inputs (--points FOLDER may
-    # not be the --out folder); absolute paths (a Dask worker may run elsewhere)
+    # distinct from the inputs (--points FOLDER may not be the --out folder); absolute paths (a Dask worker may
+    # run elsewhere)
     plan = OutputPlan()
     plan.add_input("MESH", args.mesh)
     plan.add_input("--points", args.points)
@@ -171,19 +211,11 @@ def run(args) -> int:
         raise CCProofError(f"--threads must be >= 1, got {args.threads}")
     if args.seed < 0:  # numpy's generators take non-negative seeds (the tasks failed one by one after the setup)
         raise CCProofError(f"--seed must be an integer >= 0, got {args.seed}")
+    return out_path, shards
 
-    from ccproof.mesh.io import read_mesh
-    from ccproof.scale import evaluate_points, open_scheduler, point_chunks, scheduler_from_args, ship
 
-    points = None if args.points is None else Path(args.points).resolve()
-    sched = scheduler_from_args(args)  # --scheduler checked before any work
-    from ccproof.cli._progress import phase
-
-    progress = progress_enabled(args)
-    t0 = time.perf_counter()
-    with phase(f"read {Path(args.mesh).name}", progress):
-        poly = read_mesh(args.mesh)  # OBJ with OpenSubdiv tags, OFF, or any meshio format
-    t_read = time.perf_counter() - t0
+def _mesh_to_evaluate(args, poly):
+    """(mesh, tagged, number of faces, evaluate's keywords, evaluable ptex faces or None) of the mesh read."""
     tagged = not poly.is_plain_quads
     if tagged:
         # triangles, n-gons, creases, corners, holes, boundary modes: the natural parameterization
@@ -196,34 +228,41 @@ def run(args) -> int:
             )
         if args.plot:
             raise CCProofError(f"{args.mesh}: --plot needs an untagged all-quad mesh")
-        mesh, n_faces, kwargs = poly, poly.n_ptex, {}
         evaluable = evaluable_ptex_faces(poly)  # holes (tagged, or boundary mode none) have no surface
         if evaluable is not None and evaluable.size == 0:
             raise CCProofError(f"{args.mesh}: every face is a hole: there is no limit surface to evaluate")
-    else:
-        mesh, evaluable = poly.to_quad_mesh(), None
-        if args.plot and args.plot_vertex is not None and not 0 <= args.plot_vertex < mesh.n_vertices:
-            raise CCProofError(f"--plot-vertex {args.plot_vertex} out of range [0, {mesh.n_vertices})")
-        n_faces, kwargs = mesh.n_faces, {"parameterization": args.parameterization}
-    # the points before the surface's setup (seconds on large meshes): a bad point is reported at once
+        return poly, tagged, poly.n_ptex, {}, evaluable
+    mesh = poly.to_quad_mesh()
+    if args.plot and args.plot_vertex is not None and not 0 <= args.plot_vertex < mesh.n_vertices:
+        raise CCProofError(f"--plot-vertex {args.plot_vertex} out of range [0, {mesh.n_vertices})")
+    return mesh, tagged, mesh.n_faces, {"parameterization": args.parameterization}, None
+
+
+def _point_sources(args, points, n_faces, evaluable, out_path, shards):
+    """The chunks of points to evaluate (--points FILE or FOLDER, or --samples), checked before the setup."""
+    from ccproof.scale import point_chunks
+
     if points is not None and points.is_dir():
         from ccproof.mesh.inputs import check_regular_file
 
         check_regular_file(points / "index.json")  # (a link to /dev/zero refused before it is read)
-        sources = point_chunks(args.chunk, shards=points)
-    elif points is not None:
+        return point_chunks(args.chunk, shards=points)
+    if points is not None:
         arrays = _checked_points(args.points, n_faces, evaluable)
         check_result_size(arrays[0].size, args.derivatives, out_path, shards, f"{args.points}: ")
-        sources = point_chunks(args.chunk, arrays=arrays)
-    else:
-        if args.samples < 0:
-            raise CCProofError(f"--samples must be >= 0, got {args.samples}")
-        check_result_size(args.samples, args.derivatives, out_path, shards, f"--samples {args.samples}: ")
-        sources = point_chunks(args.chunk, samples=args.samples, seed=args.seed,
-                               n_faces=n_faces if evaluable is None else evaluable)
-    from ccproof.cli._notice import compile_notice
+        return point_chunks(args.chunk, arrays=arrays)
+    if args.samples < 0:
+        raise CCProofError(f"--samples must be >= 0, got {args.samples}")
+    check_result_size(args.samples, args.derivatives, out_path, shards, f"--samples {args.samples}: ")
+    return point_chunks(args.chunk, samples=args.samples, seed=args.seed,
+                        n_faces=n_faces if evaluable is None else evaluable)
 
-    compile_notice("eval")  # after the input checks: an error stays one line
+
+def _evaluate_sources(args, mesh, tagged, kwargs, sources, out_path, sched, progress):
+    """Evaluate the chunks on the scheduler and write --out; returns (points, names, sweep, surface, times)
+    with times = (setup here, the workers' setup, the scheduler's start, gathering and writing)."""
+    from ccproof.scale import evaluate_points, open_scheduler, ship
+
     # on a cluster each worker builds the surface itself (once); here only for in-process work or --plot
     t1 = time.perf_counter()
     surface = build_surface(mesh, tagged, args.alpha, progress) if sched.kind == "serial" or args.plot else None
@@ -246,20 +285,7 @@ def run(args) -> int:
                                                         args.derivatives, kwargs, str(out_path), sched,
                                                         local=surface, progress=progress)
         t_write = time.perf_counter() - t_tasks - sweep.seconds  # gathering and writing the output
-    for line in sweep.report([f"chunk {i}" for i in range(len(sources))]):  # retried or lost tasks
-        print(line)
-    out = dict.fromkeys(names)
-    what = (str(mesh) if tagged else f"{mesh.n_vertices} vertices, {mesh.n_faces} faces, "
-            f"{mesh.extraordinary_vertices.size} extraordinary vertices")
-    print(f"{args.mesh}: {what}; {_phases(t_read, setup, worker_setup)}")
-    evaluation = max(sweep.seconds - worker_setup, 0.0)  # the workers build at the same time, first
-    print(f"evaluated {n} points ({args.parameterization} parameterization, derivatives {args.derivatives}) "
-          f"in {_evaluation_phases(n, evaluation, t_start, t_write)}")
-    print(f"wrote {args.out}: {', '.join(['face', 'u', 'v', *out])}")
-    if args.plot:
-        _plot(args, mesh, surface)
-    sys.stdout.flush()
-    return 0
+    return n, names, sweep, surface, (setup, worker_setup, t_start, t_write)
 
 
 def _evaluation_phases(n, evaluation, start, write):

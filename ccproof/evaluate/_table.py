@@ -1186,7 +1186,7 @@ def catmark_step(mesh):
         boundary vertex under "edge_and_corner"), one with unused vertices, a non-manifold edge or a
         vertex with more than one boundary edge pair.
     """
-    from ccproof.rule_weights import crease_vertex_weights, smooth_edge_weights, smooth_vertex_weights
+    from ccproof.rule_weights import smooth_edge_weights
 
     opts = mesh.options
     if (mesh.edge_sharpness or mesh.vertex_sharpness or np.asarray(mesh.is_hole).any()
@@ -1227,7 +1227,20 @@ def catmark_step(mesh):
     ep = 0.5 * (X[a] + X[b])
     inner = h2 >= 0
     ep[inner] = vw * (X[a[inner]] + X[b[inner]]) + fw * (fp[face[h1[inner]]] + fp[face[h2[inner]]])
-    # vertex points
+    vp = _step_vertex_points(X, (org, dst, face), fp, valence, bnd_h, nb_out)
+    X1 = np.concatenate([vp, ep, fp])
+    F1 = np.stack([org, n + he_edge, n + E + face, n + he_edge[prv]], axis=1)
+    return X1, F1
+
+
+def _step_vertex_points(X, corners, fp, valence, bnd_h, nb_out):
+    """The vertex points of :func:`catmark_step`: the smooth rule, the crease rule at the boundary vertices.
+    ``corners`` = (origin, destination, face) of every half-edge, ``fp`` the face points, ``bnd_h`` the
+    boundary half-edges, ``nb_out`` the boundary half-edges leaving every vertex."""
+    from ccproof.rule_weights import crease_vertex_weights, smooth_vertex_weights
+
+    org, dst, face = corners
+    n, one = X.shape[0], 1.0
     vp = np.empty((n, 3))
     sum_e = np.stack([np.bincount(org, weights=X[dst, c], minlength=n) for c in range(3)], axis=1)
     sum_f = np.stack([np.bincount(org, weights=fp[face, c], minlength=n) for c in range(3)], axis=1)
@@ -1240,9 +1253,7 @@ def catmark_step(mesh):
         np.add.at(bn, org[bnd_h], X[dst[bnd_h]])
         np.add.at(bn, dst[bnd_h], X[org[bnd_h]])
         vp[bv] = cw * X[bv] + ce * bn[bv]
-    X1 = np.concatenate([vp, ep, fp])
-    F1 = np.stack([org, n + he_edge, n + E + face, n + he_edge[prv]], axis=1)
-    return X1, F1
+    return vp
 
 
 def layer0_nets(T, groups):

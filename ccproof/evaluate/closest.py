@@ -244,68 +244,10 @@ def newton(surface, X, face, u, v, max_iter=MAX_ITER, *, backend=None, threads=N
         if active.size == 0:
             break
         a = active
-        Ra = R[a]
-        Pu, Pv = cur["Pu"][a], cur["Pv"][a]
-        gu, gv = _dot(Pu, Ra), _dot(Pv, Ra)
-        guu, guv, gvv = _dot(Pu, Pu), _dot(Pu, Pv), _dot(Pv, Pv)
-        huu = guu + _dot(cur["Puu"][a], Ra)
-        huv = guv + _dot(cur["Puv"][a], Ra)
-        hvv = gvv + _dot(cur["Pvv"][a], Ra)
         ua, va = u[a], v[a]
-        fu = ~(((ua <= 0.0) & (gu > 0)) | ((ua >= 1.0) & (gu < 0)))
-        fv = ~(((va <= 0.0) & (gv > 0)) | ((va >= 1.0) & (gv < 0)))
-        # Newton where the (free part of the) Hessian is positive definite, else Gauss-Newton + LM
-        tr = np.abs(guu) + np.abs(gvv) + 1e-300
-        pd = (huu > 0) & (hvv > 0) & (huu * hvv - huv * huv > 1e-14 * tr * tr)
-        pd1u, pd1v = huu > 1e-14 * tr, hvv > 1e-14 * tr
-        lm = 1e-6 * tr
-        Auu = np.where(pd | (fu & ~fv & pd1u), huu, guu + lm)
-        Avv = np.where(pd | (fv & ~fu & pd1v), hvv, gvv + lm)
-        Auv = np.where(pd, huv, guv)
-        both = fu & fv
-        det = Auu * Avv - Auv * Auv
-        with np.errstate(invalid="ignore", divide="ignore"):
-            du = np.where(both, -(Avv * gu - Auv * gv) / det, np.where(fu, -gu / Auu, 0.0))
-            dv = np.where(both, -(Auu * gv - Auv * gu) / det, np.where(fv, -gv / Avv, 0.0))
-        bad = ~(np.isfinite(du) & np.isfinite(dv))
-        du[bad], dv[bad] = -gu[bad] / tr[bad], -gv[bad] / tr[bad]
-        pg = np.hypot(np.where(fu, gu, 0.0), np.where(fv, gv, 0.0))
+        gu, gv, guu, gvv, du, dv, pg = _descent_direction(cur, a, R[a], ua, va)
         al = alpha[a]
-        done = np.zeros(a.size, dtype=bool)
-        # backtracking: accept the first step with an Armijo decrease; give up below 2^-MAX_HALVINGS
-        for _ls in range(MAX_HALVINGS + 1):
-            idx = np.flatnonzero(~done)
-            if idx.size == 0:
-                break
-            ai = a[idx]
-            nu = np.clip(ua[idx] + al[idx] * du[idx], 0.0, 1.0)
-            nv = np.clip(va[idx] + al[idx] * dv[idx], 0.0, 1.0)
-            moved = (nu != ua[idx]) | (nv != va[idx])
-            rt = surface.evaluate(face[ai], nu, nv, 2)
-            Rt = rt["P"] - X[ai]
-            Et = 0.5 * _dot(Rt, Rt)
-            pred = gu[idx] * (nu - ua[idx]) + gv[idx] * (nv - va[idx])
-            # Armijo decrease; or, where E is flat to round-off (next to the minimum), a smaller
-            # projected gradient at no larger E beyond its round-off (slack, fixed at the start)
-            gtu, gtv = _dot(rt["Pu"], Rt), _dot(rt["Pv"], Rt)
-            ftu = ~(((nu <= 0.0) & (gtu > 0)) | ((nu >= 1.0) & (gtu < 0)))
-            ftv = ~(((nv <= 0.0) & (gtv > 0)) | ((nv >= 1.0) & (gtv < 0)))
-            pg_t = np.hypot(np.where(ftu, gtu, 0.0), np.where(ftv, gtv, 0.0))
-            ok = moved & (
-                (Et <= E[ai] + 1e-4 * np.minimum(pred, 0.0))
-                | ((Et <= E[ai] + slack[ai]) & (pg_t < 0.5 * pg[idx]))
-            )
-            acc = idx[ok]
-            aa = a[acc]
-            u[aa], v[aa] = nu[ok], nv[ok]
-            E[aa], R[aa] = Et[ok], Rt[ok]
-            for k in cur:
-                cur[k][aa] = rt[k][ok]
-            done[acc] = True
-            still = idx[~ok]
-            stop = ~moved[~ok] | (al[still] <= 2.0**-MAX_HALVINGS)
-            done[still[stop]] = True
-            al[still[~stop]] *= 0.5
+        _line_search(surface, X, face, a, (ua, va, gu, gv, pg), (du, dv, al), (u, v, E, R, cur), slack)
         step = np.maximum(np.abs(u[a] - ua), np.abs(v[a] - va))
         # converged: no move, or a full step smaller than round-off of the parameter
         # or a step below 1e-12 of the distance to the nearest face corner (converged to round-off:
@@ -317,6 +259,79 @@ def newton(surface, X, face, u, v, max_iter=MAX_ITER, *, backend=None, threads=N
         alpha[a] = np.minimum(1.0, al * 2.0)
         active = a[keep]
     return u, v, E
+
+
+def _descent_direction(cur, a, Ra, ua, va):
+    """:func:`newton`'s step at the active points ``a`` (residuals ``Ra``, parameters ``ua``, ``va``):
+    (gu, gv, guu, gvv, du, dv, projected gradient norm)."""
+    Pu, Pv = cur["Pu"][a], cur["Pv"][a]
+    gu, gv = _dot(Pu, Ra), _dot(Pv, Ra)
+    guu, guv, gvv = _dot(Pu, Pu), _dot(Pu, Pv), _dot(Pv, Pv)
+    huu = guu + _dot(cur["Puu"][a], Ra)
+    huv = guv + _dot(cur["Puv"][a], Ra)
+    hvv = gvv + _dot(cur["Pvv"][a], Ra)
+    fu = ~(((ua <= 0.0) & (gu > 0)) | ((ua >= 1.0) & (gu < 0)))
+    fv = ~(((va <= 0.0) & (gv > 0)) | ((va >= 1.0) & (gv < 0)))
+    # Newton where the (free part of the) Hessian is positive definite, else Gauss-Newton + LM
+    tr = np.abs(guu) + np.abs(gvv) + 1e-300
+    pd = (huu > 0) & (hvv > 0) & (huu * hvv - huv * huv > 1e-14 * tr * tr)
+    pd1u, pd1v = huu > 1e-14 * tr, hvv > 1e-14 * tr
+    lm = 1e-6 * tr
+    Auu = np.where(pd | (fu & ~fv & pd1u), huu, guu + lm)
+    Avv = np.where(pd | (fv & ~fu & pd1v), hvv, gvv + lm)
+    Auv = np.where(pd, huv, guv)
+    both = fu & fv
+    det = Auu * Avv - Auv * Auv
+    with np.errstate(invalid="ignore", divide="ignore"):
+        du = np.where(both, -(Avv * gu - Auv * gv) / det, np.where(fu, -gu / Auu, 0.0))
+        dv = np.where(both, -(Auu * gv - Auv * gu) / det, np.where(fv, -gv / Avv, 0.0))
+    bad = ~(np.isfinite(du) & np.isfinite(dv))
+    du[bad], dv[bad] = -gu[bad] / tr[bad], -gv[bad] / tr[bad]
+    pg = np.hypot(np.where(fu, gu, 0.0), np.where(fv, gv, 0.0))
+    return gu, gv, guu, gvv, du, dv, pg
+
+
+def _line_search(surface, X, face, a, start, step, state, slack):
+    """:func:`newton`'s backtracking at the active points ``a``: accept the first step with an Armijo decrease;
+    give up below 2^-MAX_HALVINGS. ``start`` = (ua, va, gu, gv, pg) at the start, ``step`` = (du, dv, al)
+    (``al`` halved in place), ``state`` = (u, v, E, R, cur) updated in place where a step is accepted."""
+    ua, va, gu, gv, pg = start
+    du, dv, al = step
+    u, v, E, R, cur = state
+    done = np.zeros(a.size, dtype=bool)
+    for _ls in range(MAX_HALVINGS + 1):
+        idx = np.flatnonzero(~done)
+        if idx.size == 0:
+            break
+        ai = a[idx]
+        nu = np.clip(ua[idx] + al[idx] * du[idx], 0.0, 1.0)
+        nv = np.clip(va[idx] + al[idx] * dv[idx], 0.0, 1.0)
+        moved = (nu != ua[idx]) | (nv != va[idx])
+        rt = surface.evaluate(face[ai], nu, nv, 2)
+        Rt = rt["P"] - X[ai]
+        Et = 0.5 * _dot(Rt, Rt)
+        pred = gu[idx] * (nu - ua[idx]) + gv[idx] * (nv - va[idx])
+        # Armijo decrease; or, where E is flat to round-off (next to the minimum), a smaller
+        # projected gradient at no larger E beyond its round-off (slack, fixed at the start)
+        gtu, gtv = _dot(rt["Pu"], Rt), _dot(rt["Pv"], Rt)
+        ftu = ~(((nu <= 0.0) & (gtu > 0)) | ((nu >= 1.0) & (gtu < 0)))
+        ftv = ~(((nv <= 0.0) & (gtv > 0)) | ((nv >= 1.0) & (gtv < 0)))
+        pg_t = np.hypot(np.where(ftu, gtu, 0.0), np.where(ftv, gtv, 0.0))
+        ok = moved & (
+            (Et <= E[ai] + 1e-4 * np.minimum(pred, 0.0))
+            | ((Et <= E[ai] + slack[ai]) & (pg_t < 0.5 * pg[idx]))
+        )
+        acc = idx[ok]
+        aa = a[acc]
+        u[aa], v[aa] = nu[ok], nv[ok]
+        E[aa], R[aa] = Et[ok], Rt[ok]
+        for k in cur:
+            cur[k][aa] = rt[k][ok]
+        done[acc] = True
+        still = idx[~ok]
+        stop = ~moved[~ok] | (al[still] <= 2.0**-MAX_HALVINGS)
+        done[still[stop]] = True
+        al[still[~stop]] *= 0.5
 
 
 def _newton_compiled(surface, kernel, X, face, u, v, max_iter, threads):

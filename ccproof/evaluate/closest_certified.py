@@ -279,90 +279,133 @@ def certify_closest(surface, x, face, u, v, *, radius=None, separation=None, amb
     flint.ctx.prec = PREC
     try:
         arb = flint.arb
-        X = [arb(float(t)) for t in x]
-        P = surface.evaluate([face], [u], [v], 0)["P"][0]
-        a_f = x - P
-        if not np.any(a_f):
-            a_f = np.asarray(surface.evaluate([face], [u], [v], 1)["Pu"][0], dtype=np.float64)
-            a_f = np.cross(a_f, surface.evaluate([face], [u], [v], 1)["Pv"][0])
-        a = [arb(float(t)) for t in a_f]
-        an = sum((t * t for t in a), arb(0)).sqrt()
-        Pa = [arb(float(t)) for t in P]
+        geo = _target(surface, x, face, u, v, arb)
         # vertex -> faces
         vf = {}
         for g, row in enumerate(F.tolist()):
             for w in row:
                 vf.setdefault(w, set()).add(g)
-
-        def base_piece(g):
-            ring = sorted(set().union(*(vf[w] for w in F[g].tolist())))
-            verts = sorted({w for h in ring for w in F[h].tolist()})
-            loc = {w: i for i, w in enumerate(verts)}
-            faces = [tuple(loc[w] for w in F[h].tolist()) for h in ring]
-            pts = [[arb(float(t)) for t in Vx[w]] for w in verts]
-            return _Piece(faces, pts, ring.index(g), g, 0.0, 0.0, 1.0, 0)
-
-        def far_from_P(piece):
-            # the hull is farther than `radius` from P somewhere: max_j |P - c_j| > radius
-            return spread(piece) > radius
-
-        def spread(piece):
-            return max(_sqrt_up(sum((_sq(Pa[k] - p[k]) for k in range(3)), arb(0))) for p in piece.pts)
-
         # upper bound: the piece at level up_level containing (u, v)
-        pc = base_piece(face)
+        pc = _base_piece(F, Vx, vf, face, arb)
         for _ in range(up_level):
             pc = _corner_piece(pc, u, v, arb)
-        d_up = _bounds(pc, X, a, an, arb)[1]
-        # float prefilter of the base faces (box of the one-ring; the margin covers the rounding)
-        ring_lo, ring_hi = _ring_boxes(F, Vx, vf)
-        gap = np.maximum(np.maximum(ring_lo - x, x - ring_hi), 0.0)
-        lbf = np.sqrt((gap * gap).sum(axis=1)) * (1 - 1e-12)
-        active = []
-        for g in np.flatnonzero(lbf <= float(d_up) * (1 + 1e-12)).tolist():
-            p = base_piece(g)
-            p.lb, p.ub = _bounds(p, X, a, an, arb)
-            if p.lb <= d_up:
-                active.append(p)
-        n_pieces = F.shape[0] + up_level
-        while True:
-            split = [p for p in active if p.level < max_level and far_from_P(p)]
-            if not split:
-                break
-            if n_pieces + 4 * len(split) > max_pieces:
-                break
-            keep = [p for p in active if not (p.level < max_level and far_from_P(p))]
-            for p in split:
-                for q in range(4):
-                    ch = _refine(p, q, arb)
-                    ch.lb, ch.ub = _bounds(ch, X, a, an, arb)
-                    n_pieces += 1
-                    if ch.lb <= d_up:
-                        keep.append(ch)
-            active = keep
-        lo = min((p.lb for p in active), default=d_up)
-        boxes = [(p.face, (p.u0, p.u0 + p.h), (p.v0, p.v0 + p.h)) for p in active]
-        if not (np.isfinite(float(d_up)) and np.isfinite(float(lo))):
-            return CertifiedClosest("uncertified", float("nan"), float("nan"), float("nan"), [], n_pieces,
-                                    "the enclosures are not finite")
-        sp = [float(spread(p)) for p in active]
-        sep = [p for p, r_ in zip(active, sp) if r_ > separation]
-        if not sep:
-            same = [b for b in boxes if b[0] == face]
-            rad = max((max(abs(b[1][0] - u), abs(b[1][1] - u), abs(b[2][0] - v), abs(b[2][1] - v)) for b in same),
-                      default=0.0)
-            if len(same) < len(boxes):
-                rad = float("inf")
-            return CertifiedClosest("certified", float(lo), float(d_up), float(rad), boxes, n_pieces,
-                                    f"every surface point within {float(d_up):.17g} of x lies within "
-                                    f"{max(sp, default=0.0):.3g} of P")
-        near_min = [p for p in sep if p.ub <= d_up + ambiguity]
-        if near_min:
-            return CertifiedClosest("ambiguous", float(lo), float(d_up), float("nan"), boxes, n_pieces,
-                                    f"{len(near_min)} pieces farther than {separation:.3g} from P are within "
-                                    f"{ambiguity:.3g} of the distance")
-        return CertifiedClosest("uncertified", float(lo), float(d_up), float("nan"), boxes, n_pieces,
-                                f"{len(sep)} pieces farther than {separation:.3g} from P could not be excluded "
-                                f"(levels <= {max_level}, pieces <= {max_pieces})")
+        d_up = _bounds(pc, *geo[:3], arb)[1]
+        active = _candidates(F, Vx, vf, x, geo, arb, d_up)
+        active, n_pieces = _subdivide(active, geo, arb, d_up, radius, (max_level, max_pieces),
+                                      F.shape[0] + up_level)
+        return _verdict(active, geo, arb, d_up, (face, u, v), n_pieces,
+                        (separation, ambiguity, max_level, max_pieces))
     finally:
         flint.ctx.prec = old
+
+
+def _target(surface, x, face, u, v, arb):
+    """(X, a, |a|, P) as arb balls: the point ``x``, the direction of the distance from the limit point P at
+    (face, u, v) (the normal there when x = P), its length, P."""
+    import numpy as np
+
+    X = [arb(float(t)) for t in x]
+    P = surface.evaluate([face], [u], [v], 0)["P"][0]
+    a_f = x - P
+    if not np.any(a_f):
+        a_f = np.asarray(surface.evaluate([face], [u], [v], 1)["Pu"][0], dtype=np.float64)
+        a_f = np.cross(a_f, surface.evaluate([face], [u], [v], 1)["Pv"][0])
+    a = [arb(float(t)) for t in a_f]
+    an = sum((t * t for t in a), arb(0)).sqrt()
+    Pa = [arb(float(t)) for t in P]
+    return X, a, an, Pa
+
+
+def _candidates(F, Vx, vf, x, geo, arb, d_up):
+    """The base pieces whose lower bound of the distance to ``x`` is at most ``d_up``, after a float prefilter of
+    the base faces (box of the one-ring; the margin covers the rounding)."""
+    import numpy as np
+
+    ring_lo, ring_hi = _ring_boxes(F, Vx, vf)
+    gap = np.maximum(np.maximum(ring_lo - x, x - ring_hi), 0.0)
+    lbf = np.sqrt((gap * gap).sum(axis=1)) * (1 - 1e-12)
+    active = []
+    for g in np.flatnonzero(lbf <= float(d_up) * (1 + 1e-12)).tolist():
+        p = _base_piece(F, Vx, vf, g, arb)
+        p.lb, p.ub = _bounds(p, *geo[:3], arb)
+        if p.lb <= d_up:
+            active.append(p)
+    return active
+
+
+def _base_piece(F, Vx, vf, g, arb):
+    """The level-0 piece of base face ``g`` (its one-ring, exact points); ``vf``: vertex -> faces."""
+    ring = sorted(set().union(*(vf[w] for w in F[g].tolist())))
+    verts = sorted({w for h in ring for w in F[h].tolist()})
+    loc = {w: i for i, w in enumerate(verts)}
+    faces = [tuple(loc[w] for w in F[h].tolist()) for h in ring]
+    pts = [[arb(float(t)) for t in Vx[w]] for w in verts]
+    return _Piece(faces, pts, ring.index(g), g, 0.0, 0.0, 1.0, 0)
+
+
+def _spread(piece, Pa, arb):
+    """An upper bound of max_j |P - c_j| over the control points c_j of ``piece`` (P = ``Pa``)."""
+    return max(_sqrt_up(sum((_sq(Pa[k] - p[k]) for k in range(3)), arb(0))) for p in piece.pts)
+
+
+def _subdivide(active, geo, arb, d_up, radius, limits, n_pieces):
+    """Split the pieces whose hull is farther than ``radius`` from P somewhere, keeping the children whose
+    lower bound is at most ``d_up``, until none is left or ``limits`` = (max_level, max_pieces) is met;
+    returns (active, n_pieces)."""
+    X, a, an, Pa = geo
+    max_level, max_pieces = limits
+
+    def far_from_P(piece):
+        # the hull is farther than `radius` from P somewhere: max_j |P - c_j| > radius
+        return _spread(piece, Pa, arb) > radius
+
+    while True:
+        split = [p for p in active if p.level < max_level and far_from_P(p)]
+        if not split:
+            break
+        if n_pieces + 4 * len(split) > max_pieces:
+            break
+        keep = [p for p in active if not (p.level < max_level and far_from_P(p))]
+        for p in split:
+            for q in range(4):
+                ch = _refine(p, q, arb)
+                ch.lb, ch.ub = _bounds(ch, X, a, an, arb)
+                n_pieces += 1
+                if ch.lb <= d_up:
+                    keep.append(ch)
+        active = keep
+    return active, n_pieces
+
+
+def _verdict(active, geo, arb, d_up, point, n_pieces, limits):
+    """The :class:`CertifiedClosest` of the pieces left; ``point`` = (face, u, v), ``limits`` = (separation,
+    ambiguity, max_level, max_pieces)."""
+    import numpy as np
+
+    face, u, v = point
+    separation, ambiguity, max_level, max_pieces = limits
+    Pa = geo[3]
+    lo = min((p.lb for p in active), default=d_up)
+    boxes = [(p.face, (p.u0, p.u0 + p.h), (p.v0, p.v0 + p.h)) for p in active]
+    if not (np.isfinite(float(d_up)) and np.isfinite(float(lo))):
+        return CertifiedClosest("uncertified", float("nan"), float("nan"), float("nan"), [], n_pieces,
+                                "the enclosures are not finite")
+    sp = [float(_spread(p, Pa, arb)) for p in active]
+    sep = [p for p, r_ in zip(active, sp) if r_ > separation]
+    if not sep:
+        same = [b for b in boxes if b[0] == face]
+        rad = max((max(abs(b[1][0] - u), abs(b[1][1] - u), abs(b[2][0] - v), abs(b[2][1] - v)) for b in same),
+                  default=0.0)
+        if len(same) < len(boxes):
+            rad = float("inf")
+        return CertifiedClosest("certified", float(lo), float(d_up), float(rad), boxes, n_pieces,
+                                f"every surface point within {float(d_up):.17g} of x lies within "
+                                f"{max(sp, default=0.0):.3g} of P")
+    near_min = [p for p in sep if p.ub <= d_up + ambiguity]
+    if near_min:
+        return CertifiedClosest("ambiguous", float(lo), float(d_up), float("nan"), boxes, n_pieces,
+                                f"{len(near_min)} pieces farther than {separation:.3g} from P are within "
+                                f"{ambiguity:.3g} of the distance")
+    return CertifiedClosest("uncertified", float(lo), float(d_up), float("nan"), boxes, n_pieces,
+                            f"{len(sep)} pieces farther than {separation:.3g} from P could not be excluded "
+                            f"(levels <= {max_level}, pieces <= {max_pieces})")

@@ -358,45 +358,60 @@ class LimitSurface:
         if out is None:
             out = {k: np.empty((n, 3)) for k in keys}
         if kernel is not None:
-            back = []  # (key, temporary): outputs the C kernel cannot write in place
-            if name == "c":
-                from ccproof.evaluate._ckernel import evaluate_block
-
-                f, u, v = (np.ascontiguousarray(a) for a in (f, u, v))
-                arrs = []
-                for k in _KEYS[2]:
-                    a = out.get(k) if k in keys else None
-                    if a is not None and not (isinstance(a, np.ndarray) and a.dtype == np.float64
-                                              and a.shape == (n, 3) and a.flags.c_contiguous):
-                        back.append((k, np.empty((n, 3))))
-                        a = back[-1][1]
-                    arrs.append(a)
-                table = self._c_table()
-
-                def block(lo, hi):
-                    return evaluate_block(kernel, table, f[lo:hi], u[lo:hi], v[lo:hi], derivatives,
-                                          [None if a is None else a[lo:hi] for a in arrs])
-            else:
-                dummy = np.empty((0, 3))
-                arrs = [out.get(k, dummy) for k in _KEYS[2]]
-                table = self._kernel_table()
-
-                def block(lo, hi):
-                    return kernel(f[lo:hi], u[lo:hi], v[lo:hi], derivatives, table,
-                                  *[a[lo:hi] if a.shape[0] else a for a in arrs])
-
-            # few blocks: each kernel call computes the corner nets it meets once (a cache per call)
-            bad = in_blocks(block, n, threads_for(threads, n), 32768, per_thread=4)
-            if max(bad) >= 0:
-                self._check_values(f, u, v)  # raises, naming the first bad point
-                raise CCProofError("internal error: the compiled kernel refused a point the checks accept")
-            for k, a in back:
-                out[k][...] = a
-            return out
+            return self._evaluate_compiled(name, kernel, f, u, v, derivatives, out, threads)
         for lo in range(0, n, chunk):
             hi = min(n, lo + chunk)
             self._eval_chunk(f[lo:hi], u[lo:hi], v[lo:hi], derivatives, {k: out[k][lo:hi] for k in keys})
         return out
+
+    def _evaluate_compiled(self, name, kernel, f, u, v, derivatives, out, threads):
+        """:meth:`evaluate` by the compiled kernel ``name`` (``"c"`` or ``"numba"``) into ``out``, in blocks."""
+        n = f.size
+        if name == "c":
+            f, u, v = (np.ascontiguousarray(a) for a in (f, u, v))
+            block, back = self._c_block(kernel, f, u, v, derivatives, out)
+        else:
+            block, back = self._numba_block(kernel, f, u, v, derivatives, out), []
+        # few blocks: each kernel call computes the corner nets it meets once (a cache per call)
+        bad = in_blocks(block, n, threads_for(threads, n), 32768, per_thread=4)
+        if max(bad) >= 0:
+            self._check_values(f, u, v)  # raises, naming the first bad point
+            raise CCProofError("internal error: the compiled kernel refused a point the checks accept")
+        for k, a in back:
+            out[k][...] = a
+        return out
+
+    def _c_block(self, kernel, f, u, v, derivatives, out):
+        """(block(lo, hi) calling the C kernel, [(key, temporary)]: outputs it cannot write in place)."""
+        from ccproof.evaluate._ckernel import evaluate_block
+
+        n, keys = f.size, _KEYS[derivatives]
+        back = []
+        arrs = []
+        for k in _KEYS[2]:
+            a = out.get(k) if k in keys else None
+            if a is not None and not (isinstance(a, np.ndarray) and a.dtype == np.float64
+                                      and a.shape == (n, 3) and a.flags.c_contiguous):
+                back.append((k, np.empty((n, 3))))
+                a = back[-1][1]
+            arrs.append(a)
+        table = self._c_table()
+
+        def block(lo, hi):
+            return evaluate_block(kernel, table, f[lo:hi], u[lo:hi], v[lo:hi], derivatives,
+                                  [None if a is None else a[lo:hi] for a in arrs])
+        return block, back
+
+    def _numba_block(self, kernel, f, u, v, derivatives, out):
+        """block(lo, hi) calling the numba kernel on ``out``'s rows lo:hi."""
+        dummy = np.empty((0, 3))
+        arrs = [out.get(k, dummy) for k in _KEYS[2]]
+        table = self._kernel_table()
+
+        def block(lo, hi):
+            return kernel(f[lo:hi], u[lo:hi], v[lo:hi], derivatives, table,
+                          *[a[lo:hi] if a.shape[0] else a for a in arrs])
+        return block
 
     def basis(self, face_ids, u, v, derivatives=0, *, parameterization="natural", threads=None):
         """Basis rows: the sparse linear map from the control points to points and derivatives.

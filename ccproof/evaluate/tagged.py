@@ -78,23 +78,8 @@ def build_tagged(mesh: PolyMesh, progress=None, keep=None):
     """
     mesh = mesh.manifold
     b = Builder(2 if mesh.options.crease_method == "chaikin" else 1, what="ptex face", progress=progress)
-    ident = ((0.0, 0.0), (1.0, 0.0), (0.0, 1.0))
-    P = mesh.n_ptex
-    ptex_face = np.empty(P, dtype=np.int64)
     if mesh.is_all_quads:
-        # no global step needed: start on the base mesh, with the one level-0-only rule that
-        # can act on quads (EDGE_AND_CORNER sharpens one-face boundary vertices) made explicit
-        he = mesh.halfedges
-        if mesh.edge_sharpness or mesh.vertex_sharpness or mesh.options.boundary == "edge_and_corner":
-            vv = he.vertex_tags().copy()
-            if mesh.options.boundary == "edge_and_corner":
-                vv[(he.face_count == 1) & he.is_boundary_vertex] = math.inf
-            if mesh.edge_sharpness or vv.any():  # tagged: the tags enter the rings' keys
-                he = TaggedHalfEdges.of(he.with_tags(mesh.edge_sharpness, vertex_values=vv))
-        ptex_face[:] = np.arange(mesh.n_faces)
-        m = mesh.n_faces
-        b.classify(he, np.asarray(mesh.vertices), Jobs(np.arange(m), np.zeros(m, np.int64), np.arange(m), [ident]))
-        top = np.repeat(np.arange(P, dtype=np.int64)[:, None], 4, axis=1)
+        top, ptex_face = _classify_base_quads(mesh, b)
         return b, top, mesh.is_hole[ptex_face], ptex_face
     step = catmark_step(mesh)  # untagged: vectorized, and the level-1 mesh as half-edge arrays
     if step is not None:
@@ -107,12 +92,42 @@ def build_tagged(mesh: PolyMesh, progress=None, keep=None):
         del csr
         he = TaggedHalfEdges.of(m1.halfedges)
         X = np.asarray(m1.vertices)
-    # jobs: sub-face i of an n-gon is level-1 child i (same (s, t)), its own ptex face; a quad is
-    # one ptex face whose four level-1 children are its quadrants (frames: the child frames)
-    frames = [ident]
+    top, ptex_face, jobs = _level1_jobs(mesh)
+    b.classify(he, X, jobs)
+    del he, step, jobs  # before the table's float data
+    return b, top, mesh.is_hole[ptex_face], ptex_face
+
+
+_IDENT = ((0.0, 0.0), (1.0, 0.0), (0.0, 1.0))
+
+
+def _classify_base_quads(mesh, b):
+    """Classify the all-quad manifold ``mesh`` on ``b`` from the base mesh itself; returns (top, ptex_face)."""
+    # no global step needed: start on the base mesh, with the one level-0-only rule that
+    # can act on quads (EDGE_AND_CORNER sharpens one-face boundary vertices) made explicit
+    he = mesh.halfedges
+    if mesh.edge_sharpness or mesh.vertex_sharpness or mesh.options.boundary == "edge_and_corner":
+        vv = he.vertex_tags().copy()
+        if mesh.options.boundary == "edge_and_corner":
+            vv[(he.face_count == 1) & he.is_boundary_vertex] = math.inf
+        if mesh.edge_sharpness or vv.any():  # tagged: the tags enter the rings' keys
+            he = TaggedHalfEdges.of(he.with_tags(mesh.edge_sharpness, vertex_values=vv))
+    ptex_face = np.empty(mesh.n_ptex, dtype=np.int64)
+    ptex_face[:] = np.arange(mesh.n_faces)
+    m = mesh.n_faces
+    b.classify(he, np.asarray(mesh.vertices), Jobs(np.arange(m), np.zeros(m, np.int64), np.arange(m), [_IDENT]))
+    top = np.repeat(np.arange(mesh.n_ptex, dtype=np.int64)[:, None], 4, axis=1)
+    return top, ptex_face
+
+
+def _level1_jobs(mesh):
+    """(top, ptex_face, Jobs) of the level-1 children of the manifold ``mesh``: sub-face i of an n-gon is
+    level-1 child i (same (s, t)), its own ptex face; a quad is one ptex face whose four level-1 children
+    are its quadrants (frames: the child frames)."""
+    frames = [_IDENT]
     quarter_q = []
     for i in range(4):
-        cf = compose(ident, child_frame(i))
+        cf = compose(_IDENT, child_frame(i))
         cu, cv, _ = domain(cf)
         frames.append(cf)
         quarter_q.append(int(cu > 0) + 2 * int(cv > 0))
@@ -125,16 +140,15 @@ def build_tagged(mesh: PolyMesh, progress=None, keep=None):
     ptex = np.where(is_quad, ptex_start[face], ptex_start[face] + corner)
     g = np.asarray(mesh.offsets, dtype=np.int64)[:nf][face] + corner
     fid = np.where(is_quad, 1 + corner, 0)
+    ptex_face = np.empty(mesh.n_ptex, dtype=np.int64)
     ptex_face[ptex] = face
-    top = np.empty((P, 4), dtype=np.int32 if len(mesh.indices) < 2**31 else np.int64)
+    top = np.empty((mesh.n_ptex, 4), dtype=np.int32 if len(mesh.indices) < 2**31 else np.int64)
     jid = np.arange(face.size)
     nq = np.flatnonzero(~is_quad)
     top[ptex[nq]] = jid[nq, None]
     qd = np.flatnonzero(is_quad)
     top[ptex[qd], np.asarray(quarter_q)[corner[qd]]] = jid[qd]
-    b.classify(he, X, Jobs(g, fid, ptex, frames))
-    del he, step, g, fid, ptex, face, corner, is_quad, jid  # before the table's float data
-    return b, top, mesh.is_hole[ptex_face], ptex_face
+    return top, ptex_face, Jobs(g, fid, ptex, frames)
 
 
 def vertex_corners(mesh: PolyMesh):

@@ -416,26 +416,7 @@ def valence_data(k):
     k = check_valence(k)
     lam, bez = _float_nets(k)
     power = np.einsum("im,jn,pijc->pcmn", BEZ2POW, BEZ2POW, bez[:2])
-    W = np.zeros((2, 22, 4))
-    for p in range(2):
-        for c in range(2):
-            for i in range(4):
-                for j in range(4):
-                    W[p, 4 * c + i, j] = power[p, c, i, j]
-                    if j >= 1:
-                        W[p, 8 + 4 * c + i, j - 1] = j * power[p, c, i, j]
-                    if i >= 1:
-                        W[p, 16 + 3 * c + i - 1, j] = i * power[p, c, i, j]
-    C6 = np.zeros((2, 6, 16))
-    for p in range(2):
-        for i in range(4):
-            for j in range(4):
-                for c in range(2):
-                    C6[p, c, 4 * i + j] = power[p, c, i, j]
-                    if i < 3:
-                        C6[p, 2 + 2 * c, 4 * i + j] = (i + 1) * power[p, c, i + 1, j]
-                    if j < 3:
-                        C6[p, 3 + 2 * c, 4 * i + j] = (j + 1) * power[p, c, i, j + 1]
+    W, C6 = _derivative_tables(power)
     lam_arb = characteristic_arb(k).lam
     mant, expo = _arb_pow_table(lam_arb)
 
@@ -483,6 +464,33 @@ def valence_data(k):
     return ValenceData(k, lam, bez, power, W, C6, mant, expo, pow_lam, pow_2lam, pow2, 1.0 / np.log(lam),
                        float(log_a), G, fit, inside_sign(k, "P1:s=0", gam_arb),
                        inside_sign(k, "P1:t=1", sep_arb))
+
+
+def _derivative_tables(power):
+    """(W, C6) of :func:`valence_data` from the power-basis coefficients ``power`` (p, c, i, j) of the two
+    patches: W (2, 22, 4) the values and first derivatives by rows, C6 (2, 6, 16) the values and first
+    derivatives as flattened bicubic coefficient rows."""
+    W = np.zeros((2, 22, 4))
+    for p in range(2):
+        for c in range(2):
+            for i in range(4):
+                for j in range(4):
+                    W[p, 4 * c + i, j] = power[p, c, i, j]
+                    if j >= 1:
+                        W[p, 8 + 4 * c + i, j - 1] = j * power[p, c, i, j]
+                    if i >= 1:
+                        W[p, 16 + 3 * c + i - 1, j] = i * power[p, c, i, j]
+    C6 = np.zeros((2, 6, 16))
+    for p in range(2):
+        for i in range(4):
+            for j in range(4):
+                for c in range(2):
+                    C6[p, c, 4 * i + j] = power[p, c, i, j]
+                    if i < 3:
+                        C6[p, 2 + 2 * c, 4 * i + j] = (i + 1) * power[p, c, i + 1, j]
+                    if j < 3:
+                        C6[p, 3 + 2 * c, 4 * i + j] = (j + 1) * power[p, c, i, j + 1]
+    return W, C6
 
 
 #: points per block in the vectorized kernels (keeps the temporaries in cache)

@@ -254,65 +254,16 @@ class HalfEdges:
         if not parent.edge_manifold or (parent.n_fans > 1).any():
             raise ValueError("HalfEdges.refined: the parent is not manifold")
         n, H, m = parent.n_vertices, parent.org.size, parent.sizes.size
-        org, nxt, prv, twin = parent.org, parent.nxt, parent.prv, parent.twin
-        first, cnt = parent.edge_halfedge, parent.edge_face_count
-        E = first.size
-        h = np.arange(H, dtype=np.int64)
-        # the edges numbered by first occurrence (catmark_operator's numbering): k = rank of the smallest half-edge
-        is_first = np.zeros(H, dtype=bool)
-        is_first[first] = True
-        renum = (np.cumsum(is_first) - 1)[first]
-        se = renum[parent.edge_of]  # (H,): the step's edge of every half-edge
-        h1 = np.empty(E, dtype=np.int64)
-        h1[renum] = first
-        cnt_k = np.empty(E, dtype=np.int64)
-        cnt_k[renum] = cnt
+        se, is_first, h1, cnt_k = _step_edges(parent)
+        E = h1.size
         N = n + E + m
+        h = np.arange(H, dtype=np.int64)
         face = h // parent.uniform if parent.uniform else parent.face_of
-        corg = np.stack([org, n + se, n + E + face, n + se[prv]], axis=1)
-        # twins: across the parent's edges (the halves at org h) and inside the parent's face
-        t, tp = twin, twin[prv]
-        ctwin = np.stack([np.where(t >= 0, 4 * nxt[np.maximum(t, 0)] + 3, -1), 4 * nxt + 2, 4 * prv + 1,
-                          np.where(tp >= 0, 4 * tp, -1)], axis=1)
-        del t, tp
-        # edges of the first kind: (v, n + k), v an end of parent edge k; sorted by (v, k)
-        ends = np.stack([org[h1], org[nxt[h1]]], axis=1).reshape(-1)  # item 2 k + s: end s of edge k
-        order = np.argsort(ends, kind="stable")  # by vertex, then (stable) by edge
-        rank1 = np.empty(2 * E, dtype=np.int64)
-        rank1[order] = np.arange(2 * E, dtype=np.int64)
-        a_end, b_end = rank1[0::2], rank1[1::2]  # the child edge (a_k, n + k), and (b_k, n + k)
-        # edges of the second kind: (n + k, n + E + f), by k then f (the faces' order is their half-edges')
-        start2 = 2 * E + np.r_[0, np.cumsum(cnt_k)[:-1]].astype(np.int64)
-        ex2 = start2[se] + ~is_first  # the second kind of edge through the edge point of h, in h's face
-        p = prv
-        cedge = np.stack([np.where(is_first, a_end[se], b_end[se]), ex2, ex2[p],
-                          np.where(is_first[p], b_end[se[p]], a_end[se[p]])], axis=1)
-        E1 = 2 * E + H
-        edges = np.empty((E1, 2), dtype=np.int64)
-        edges[:2 * E, 0] = ends[order]
-        edges[:2 * E, 1] = n + order // 2
-        edges[cedge[:, 1], 0] = n + se
-        edges[cedge[:, 1], 1] = n + E + face
-        efc = np.full(E1, 2, dtype=np.int64)
-        efc[:2 * E] = cnt_k[order // 2]
-        eh = np.full(E1, 4 * H, dtype=np.int64)
-        for j in range(4):  # (an edge has at most one half-edge of each column j: distinct indices)
-            col = cedge[:, j]
-            eh[col] = np.minimum(eh[col], 4 * h + j)
-        # fans: one per child vertex (a manifold parent's child is manifold), numbered by smallest corner
-        mc = np.full(N, 4 * H, dtype=np.int64)
-        pmin = np.full(n, H, dtype=np.int64)
-        np.minimum.at(pmin, org, h)
-        used = pmin < H
-        mc[:n][used] = 4 * pmin[used]
-        ek = np.minimum(4 * h1 + 1, 4 * nxt[h1] + 3)
-        two = cnt_k == 2
-        h2 = np.where(two, twin[h1], 0)
-        mc[n:n + E] = np.where(two, np.minimum(ek, np.minimum(4 * h2 + 1, 4 * nxt[h2] + 3)), ek)
-        mc[n + E:] = 4 * parent.start + 2
-        first_c = np.zeros(4 * H, dtype=bool)
-        first_c[mc[mc < 4 * H]] = True
-        label = np.cumsum(first_c) - 1
+        corg = np.stack([parent.org, n + se, n + E + face, n + se[parent.prv]], axis=1)
+        ctwin = _child_twins(parent)
+        cedge, edges, efc, eh = _child_edges(parent, se, is_first, h1, cnt_k, face)
+        E1 = edges.shape[0]
+        label, mc = _child_fans(parent, h1, cnt_k, N)
         corg = corg.reshape(-1)
         new = object.__new__(cls)
         new.n_vertices = N
@@ -484,3 +435,85 @@ class HalfEdges:
             return np.unique(self.face_of[corners[ptr[v[0]]:ptr[v[0] + 1]]])
         cs = np.concatenate([corners[ptr[x]:ptr[x + 1]] for x in v.tolist()])
         return np.unique(self.face_of[cs])
+
+
+def _step_edges(parent):
+    """(se, is_first, h1, cnt_k) of :meth:`HalfEdges.refined`: the parent's edges numbered by first occurrence
+    (``catmark_operator``'s numbering: k = rank of the smallest half-edge); ``se`` the step's edge of every
+    half-edge, ``is_first`` whether a half-edge is its edge's smallest, ``h1`` and ``cnt_k`` the smallest
+    half-edge and the face count of step edge k."""
+    first, cnt = parent.edge_halfedge, parent.edge_face_count
+    E, H = first.size, parent.org.size
+    is_first = np.zeros(H, dtype=bool)
+    is_first[first] = True
+    renum = (np.cumsum(is_first) - 1)[first]
+    se = renum[parent.edge_of]  # (H,): the step's edge of every half-edge
+    h1 = np.empty(E, dtype=np.int64)
+    h1[renum] = first
+    cnt_k = np.empty(E, dtype=np.int64)
+    cnt_k[renum] = cnt
+    return se, is_first, h1, cnt_k
+
+
+def _child_twins(parent):
+    """(H, 4) twins of the child's half-edges ``4 h + j``: across the parent's edges (the halves at org h)
+    and inside the parent's face."""
+    nxt, prv, twin = parent.nxt, parent.prv, parent.twin
+    t, tp = twin, twin[prv]
+    return np.stack([np.where(t >= 0, 4 * nxt[np.maximum(t, 0)] + 3, -1), 4 * nxt + 2, 4 * prv + 1,
+                     np.where(tp >= 0, 4 * tp, -1)], axis=1)
+
+
+def _child_edges(parent, se, is_first, h1, cnt_k, face):
+    """(edge of each child half-edge (H, 4), the child's edges (E1, 2), their face counts, their smallest
+    half-edges) of :meth:`HalfEdges.refined`."""
+    n, H, E = parent.n_vertices, parent.org.size, h1.size
+    org, nxt, prv = parent.org, parent.nxt, parent.prv
+    h = np.arange(H, dtype=np.int64)
+    # edges of the first kind: (v, n + k), v an end of parent edge k; sorted by (v, k)
+    ends = np.stack([org[h1], org[nxt[h1]]], axis=1).reshape(-1)  # item 2 k + s: end s of edge k
+    order = np.argsort(ends, kind="stable")  # by vertex, then (stable) by edge
+    rank1 = np.empty(2 * E, dtype=np.int64)
+    rank1[order] = np.arange(2 * E, dtype=np.int64)
+    a_end, b_end = rank1[0::2], rank1[1::2]  # the child edge (a_k, n + k), and (b_k, n + k)
+    # edges of the second kind: (n + k, n + E + f), by k then f (the faces' order is their half-edges')
+    start2 = 2 * E + np.r_[0, np.cumsum(cnt_k)[:-1]].astype(np.int64)
+    ex2 = start2[se] + ~is_first  # the second kind of edge through the edge point of h, in h's face
+    p = prv
+    cedge = np.stack([np.where(is_first, a_end[se], b_end[se]), ex2, ex2[p],
+                      np.where(is_first[p], b_end[se[p]], a_end[se[p]])], axis=1)
+    E1 = 2 * E + H
+    edges = np.empty((E1, 2), dtype=np.int64)
+    edges[:2 * E, 0] = ends[order]
+    edges[:2 * E, 1] = n + order // 2
+    edges[cedge[:, 1], 0] = n + se
+    edges[cedge[:, 1], 1] = n + E + face
+    efc = np.full(E1, 2, dtype=np.int64)
+    efc[:2 * E] = cnt_k[order // 2]
+    eh = np.full(E1, 4 * H, dtype=np.int64)
+    for j in range(4):  # (an edge has at most one half-edge of each column j: distinct indices)
+        col = cedge[:, j]
+        eh[col] = np.minimum(eh[col], 4 * h + j)
+    return cedge, edges, efc, eh
+
+
+def _child_fans(parent, h1, cnt_k, N):
+    """(fan label of each child corner by smallest corner, smallest corner of each of the N child vertices):
+    one fan per child vertex (a manifold parent's child is manifold)."""
+    n, H, E = parent.n_vertices, parent.org.size, h1.size
+    org, nxt, twin = parent.org, parent.nxt, parent.twin
+    h = np.arange(H, dtype=np.int64)
+    mc = np.full(N, 4 * H, dtype=np.int64)
+    pmin = np.full(n, H, dtype=np.int64)
+    np.minimum.at(pmin, org, h)
+    used = pmin < H
+    mc[:n][used] = 4 * pmin[used]
+    ek = np.minimum(4 * h1 + 1, 4 * nxt[h1] + 3)
+    two = cnt_k == 2
+    h2 = np.where(two, twin[h1], 0)
+    mc[n:n + E] = np.where(two, np.minimum(ek, np.minimum(4 * h2 + 1, 4 * nxt[h2] + 3)), ek)
+    mc[n + E:] = 4 * parent.start + 2
+    first_c = np.zeros(4 * H, dtype=bool)
+    first_c[mc[mc < 4 * H]] = True
+    label = np.cumsum(first_c) - 1
+    return label, mc

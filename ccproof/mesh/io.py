@@ -216,21 +216,9 @@ def read_obj_tagged(path):
                 corners[v] = max(s, 0.0)
         elif name == "hole":
             holes.extend(ints)
-        elif name == "interpolateboundary":
-            modes = {0: "none", 1: "edge_and_corner", 2: "edge_only"}
-            if len(ints) != 1 or ints[0] not in modes:
-                raise MeshError(f"{where}: expected one of 0, 1, 2, got {ints}")
-            opts["boundary"] = modes[ints[0]]
-        elif name == "creasemethod":
-            m = {"normal": "uniform", "chaikin": "chaikin"}
-            if len(strings) != 1 or strings[0] not in m:
-                raise MeshError(f"{where}: expected 'normal' or 'chaikin', got {strings}")
-            opts["crease_method"] = m[strings[0]]
-        elif name == "smoothtriangles":
-            m = {"catmark": "catmark", "smooth": "smooth"}
-            if len(strings) != 1 or strings[0] not in m:
-                raise MeshError(f"{where}: expected 'catmark' or 'smooth', got {strings}")
-            opts["triangle_subdivision"] = m[strings[0]]
+        elif name in ("interpolateboundary", "creasemethod", "smoothtriangles"):
+            key, value = _option_tag(where, name, ints, strings)
+            opts[key] = value
         elif name in ("facevaryinginterpolateboundary", "facevaryingpropagatecorners"):
             continue  # face-varying data only
         else:
@@ -240,6 +228,25 @@ def read_obj_tagged(path):
                         holes=holes or None, options=Options(**opts))
     except MeshError as exc:
         raise MeshError(f"{path}: {exc}") from None
+
+
+def _option_tag(where, name, ints, strings):
+    """(Options field, value) of the OBJ option tag ``name`` (interpolateboundary, creasemethod,
+    smoothtriangles); ``where`` names the file, line and tag in the error."""
+    if name == "interpolateboundary":
+        modes = {0: "none", 1: "edge_and_corner", 2: "edge_only"}
+        if len(ints) != 1 or ints[0] not in modes:
+            raise MeshError(f"{where}: expected one of 0, 1, 2, got {ints}")
+        return "boundary", modes[ints[0]]
+    if name == "creasemethod":
+        m = {"normal": "uniform", "chaikin": "chaikin"}
+        if len(strings) != 1 or strings[0] not in m:
+            raise MeshError(f"{where}: expected 'normal' or 'chaikin', got {strings}")
+        return "crease_method", m[strings[0]]
+    m = {"catmark": "catmark", "smooth": "smooth"}
+    if len(strings) != 1 or strings[0] not in m:
+        raise MeshError(f"{where}: expected 'catmark' or 'smooth', got {strings}")
+    return "triangle_subdivision", m[strings[0]]
 
 
 _OFF_KEYWORDS = ("OFF", "COFF", "NOFF", "CNOFF", "STOFF", "STCOFF", "STNOFF", "STCNOFF")
@@ -294,6 +301,17 @@ def read_off_polygons(path):
             rows.append((no, tok))
     if not rows:
         raise MeshError(f"{p}: empty OFF file")
+    k, nv, nf = _off_counts(p, rows)
+    body = rows[k + 1 :]
+    if len(body) < nv + nf:
+        raise MeshError(f"{p}: the header announces {nv} vertices and {nf} faces, the file has {len(body)} data lines")
+    verts = _off_vertices(p, body[:nv])
+    polys, lines = _off_faces(p, body[nv : nv + nf], nv)
+    return np.array(verts, dtype=np.float64).reshape(-1, 3), polys, lines
+
+
+def _off_counts(p, rows):
+    """(index of the counts' row, vertices, faces) of the OFF file ``p`` split into (line, tokens) ``rows``."""
     k = 0
     no, tok = rows[0]
     head = tok[0].upper()
@@ -315,19 +333,26 @@ def read_off_polygons(path):
         raise MeshError(f"{p}:{no}: expected the counts 'vertices faces edges', got {' '.join(tok)!r}") from None
     if nv < 0 or nf < 0:
         raise MeshError(f"{p}:{no}: negative counts {nv} {nf}")
-    body = rows[k + 1 :]
-    if len(body) < nv + nf:
-        raise MeshError(f"{p}: the header announces {nv} vertices and {nf} faces, the file has {len(body)} data lines")
+    return k, nv, nf
+
+
+def _off_vertices(p, rows):
+    """The x y z of each vertex row (line, tokens) of the OFF file ``p``."""
     verts = []
-    for no, tok in body[:nv]:
+    for no, tok in rows:
         try:
             verts.append([float(x) for x in tok[:3]])
         except ValueError:
             raise MeshError(f"{p}:{no}: bad vertex coordinate in {' '.join(tok)!r}") from None
         if len(tok) < 3:
             raise MeshError(f"{p}:{no}: vertex line needs 3 coordinates: {' '.join(tok)!r}")
+    return verts
+
+
+def _off_faces(p, rows, nv):
+    """(polygons, source lines) of the face rows (line, tokens) of the OFF file ``p`` with ``nv`` vertices."""
     polys, lines = [], []
-    for f, (no, tok) in enumerate(body[nv : nv + nf]):
+    for f, (no, tok) in enumerate(rows):
         try:
             size = int(tok[0])
             idx = [int(x) for x in tok[1 : 1 + size]]
@@ -340,7 +365,7 @@ def read_off_polygons(path):
                 raise MeshError(f"{p}:{no}: face {f} refers to vertex {i} of {nv} (0-based)")
         polys.append(idx)
         lines.append(no)
-    return np.array(verts, dtype=np.float64).reshape(-1, 3), polys, lines
+    return polys, lines
 
 
 def _check_ply_header(p):

@@ -302,8 +302,38 @@ class PolyMesh:
         vmap : ndarray of int, shape (n',)
             Vertex of this mesh of every vertex of the split mesh (``vmap[:n] = arange(n)``).
         """
+        n = self.n_vertices
+        label, vmap, new = self._fan_copies()
+        vsharp = {int(v): s for v, s in self.vertex_sharpness.items()}
+        sharp_fans, fin_vertices = self._sharpen_nonmanifold(vsharp)
+        if fin_vertices:
+            warnings.warn(f"non-manifold crease vertices {fin_vertices[:10]}{' ...' if len(fin_vertices) > 10 else ''}"
+                          f" ({len(fin_vertices)}): a fan not bounded by both non-manifold edges (a fin) is made a "
+                          "sharp corner; OpenSubdiv's crease rule there needs a vertex outside the fan, so near "
+                          "these vertices the surface differs from OpenSubdiv's (docs/evaluate.md)", stacklevel=2)
+        if self.options.boundary == "edge_and_corner":
+            corner = (self.face_count == 1) & self.is_boundary_vertex & ~self.is_nonmanifold_vertex
+            for v in np.flatnonzero(corner).tolist():
+                vsharp[v] = math.inf
+        creases = self._split_creases(new)
+        corners = _split_corners(vsharp, vmap, n, sharp_fans, label)
+        opts = Options("edge_only", self.options.crease_method, self.options.triangle_subdivision)
+        try:
+            m = PolyMesh(self.vertices[vmap], np.asarray(new, dtype=np.int64), sizes=self.sizes,
+                         creases=creases or None, corners=corners or None,
+                         holes=np.flatnonzero(self.is_hole), options=opts, _split=False)
+        except MeshError as exc:
+            raise MeshError(f"non-manifold mesh not supported after splitting its non-manifold vertices: "
+                            f"{exc}") from None
+        m.level = self.level
+        return m, vmap
+
+    def _fan_copies(self):
+        """(label, vmap, new) of :meth:`_split_nonmanifold`: the split vertex of every fan (the first fan of a
+        vertex keeps its index, the others get n, n+1, ...), the vertex of every split vertex, the split
+        vertex of every corner."""
         n, H = self.n_vertices, self.indices.size
-        org, nxt, prv, comp = self.indices, self.next, self.prev, self._fan_of_corner
+        org, comp = self.indices, self._fan_of_corner
         ncomp = int(comp.max()) + 1
         first_corner = np.full(ncomp, H, dtype=np.int64)
         np.minimum.at(first_corner, comp, np.arange(H))
@@ -316,14 +346,18 @@ class PolyMesh:
         label[extra] = n + np.arange(extra.size)
         vmap = np.r_[np.arange(n), cv[extra]].astype(np.int64)
         new = label[comp]
+        return label, vmap, new
+
+    def _sharpen_nonmanifold(self, vsharp):
+        """OpenSubdiv's sharpening of the non-manifold vertices into ``vsharp`` (see :meth:`_split_nonmanifold`);
+        returns (the fans made corners, the non-manifold crease vertices with such a fan)."""
+        org, prv, comp = self.indices, self.prev, self._fan_of_corner
         edge_of, nm_e, nm_v = self.edge_of_halfedge, self.is_nonmanifold_edge, self.is_nonmanifold_vertex
         chaikin = self.options.crease_method == "chaikin"
-        vsharp = {int(v): s for v, s in self.vertex_sharpness.items()}
         by_vertex = np.argsort(org, kind="stable")  # corners grouped by vertex
         ptr = np.r_[0, np.cumsum(self.face_count)]
         sharp_fans = set()  # fans of crease vertices not bounded by both non-manifold edges: corners
         fin_vertices = []  # the non-manifold crease vertices with such a fan (one warning names them)
-        # OpenSubdiv's sharpening of the non-manifold vertices
         for v in np.flatnonzero(nm_v).tolist():
             cs = by_vertex[ptr[v] : ptr[v + 1]]
             es = np.unique(np.r_[edge_of[cs], edge_of[prv[cs]]])
@@ -365,15 +399,13 @@ class PolyMesh:
             sharp_fans.update(fins)
             if fins:
                 fin_vertices.append(v)
-        if fin_vertices:
-            warnings.warn(f"non-manifold crease vertices {fin_vertices[:10]}{' ...' if len(fin_vertices) > 10 else ''}"
-                          f" ({len(fin_vertices)}): a fan not bounded by both non-manifold edges (a fin) is made a "
-                          "sharp corner; OpenSubdiv's crease rule there needs a vertex outside the fan, so near "
-                          "these vertices the surface differs from OpenSubdiv's (docs/evaluate.md)", stacklevel=2)
-        if self.options.boundary == "edge_and_corner":
-            corner = (self.face_count == 1) & self.is_boundary_vertex & ~nm_v
-            for v in np.flatnonzero(corner).tolist():
-                vsharp[v] = math.inf
+        return sharp_fans, fin_vertices
+
+    def _split_creases(self, new):
+        """The crease tags ``{(a, b): s}`` of the split mesh whose corner vertices are ``new``: the non-manifold
+        edges infinitely sharp, the other tagged edges as tagged."""
+        H, nxt = self.indices.size, self.next
+        edge_of, nm_e = self.edge_of_halfedge, self.is_nonmanifold_edge
         creases = {}
         hs = np.arange(H)
         for h in hs[nm_e[edge_of]].tolist():
@@ -387,25 +419,7 @@ class PolyMesh:
             h = int(self._edge_halfedge[e])
             p, q = int(new[h]), int(new[nxt[h]])
             creases[(min(p, q), max(p, q))] = x
-        copies = {}
-        for u in range(n, len(vmap)):
-            copies.setdefault(int(vmap[u]), []).append(u)
-        corners = {}
-        for v, x in vsharp.items():
-            for u in [v, *copies.get(v, [])]:
-                corners[u] = x
-        for c in sorted(sharp_fans):  # (after the vertex's own value: these copies are corners for ever)
-            corners[int(label[c])] = math.inf
-        opts = Options("edge_only", self.options.crease_method, self.options.triangle_subdivision)
-        try:
-            m = PolyMesh(self.vertices[vmap], np.asarray(new, dtype=np.int64), sizes=self.sizes,
-                         creases=creases or None, corners=corners or None,
-                         holes=np.flatnonzero(self.is_hole), options=opts, _split=False)
-        except MeshError as exc:
-            raise MeshError(f"non-manifold mesh not supported after splitting its non-manifold vertices: "
-                            f"{exc}") from None
-        m.level = self.level
-        return m, vmap
+        return creases
 
     def _fans_off_the_crease(self, cs):
         """The fans (ids of ``_fan_of_corner``) of a non-manifold crease vertex, given its corners ``cs``,
@@ -776,3 +790,18 @@ def _with_unused_rows(csr, unused, ncols):
         data = np.r_[data, np.full(unused.size, np.nan)][o]
         indptr = np.r_[0, np.cumsum(np.bincount(rows, minlength=N))]
     return sp.csr_matrix((data, indices, indptr), shape=(N, ncols))
+
+
+def _split_corners(vsharp, vmap, n, sharp_fans, label):
+    """The vertex sharpness ``{u: s}`` of the split mesh: each vertex's value on all its copies, then the fans
+    made corners (``label``: the split vertex of every fan)."""
+    copies = {}
+    for u in range(n, len(vmap)):
+        copies.setdefault(int(vmap[u]), []).append(u)
+    corners = {}
+    for v, x in vsharp.items():
+        for u in [v, *copies.get(v, [])]:
+            corners[u] = x
+    for c in sorted(sharp_fans):  # (after the vertex's own value: these copies are corners for ever)
+        corners[int(label[c])] = math.inf
+    return corners

@@ -552,12 +552,30 @@ def refine_complex(cx, vertices=None, edges=None):
     opts = cx.options
     uniform = opts.crease_method == "uniform"
     one = exact_one()
-    half = sharp_edge_weight(one)
     fpts = []
     for f in cx.faces:
         w = face_point_weight(len(f), one)
         fpts.append({v: w for v in f})
     want_v = range(n) if vertices is None else sorted(set(vertices))
+    vpts, csharp = _vertex_stencils(cx, want_v, fpts, uniform)
+    edge_list = range(E) if edges is None else sorted(set(edges))
+    epts = _edge_stencils(cx, edge_list, fpts, csharp, uniform)
+    stencils = vpts + epts + fpts
+    children = []
+    for g, f in enumerate(cx.faces):
+        fp = n + E + g
+        s0, k = cx.start[g], len(f)
+        for i in range(k):
+            h = s0 + i
+            children.append((f[i], n + cx.he_edge[h], fp, n + cx.he_edge[s0 + (i - 1) % k]))
+    ces, cvs = _child_tags(cx, want_v, csharp)
+    return stencils, children, ces, cvs
+
+
+def _vertex_stencils(cx, want_v, fpts, uniform):
+    """(vertex-point stencils of :func:`refine_complex`, None where not wanted or not computable; the child
+    sharpness ``{v: {edge: s}}`` of the edges' halves at the wanted vertices)."""
+    n, opts = cx.n_vertices, cx.options
     csharp = {}  # v -> {edge: child sharpness of its half at v}
     vpts = [None] * n
     for v in want_v:
@@ -584,7 +602,14 @@ def refine_complex(cx, vertices=None, edges=None):
             _add(out, 1 - w, mc)
             m = out
         vpts[v] = {u: x for u, x in m.items() if x != 0}
-    edge_list = range(E) if edges is None else sorted(set(edges))
+    return vpts, csharp
+
+
+def _edge_stencils(cx, edge_list, fpts, csharp, uniform):
+    """The edge-point stencils of :func:`refine_complex` (None where not wanted or not computable)."""
+    E, opts = len(cx.edges), cx.options
+    one = exact_one()
+    half = sharp_edge_weight(one)
     epts = [None] * E
     tri_smooth = opts.triangle_subdivision == "smooth" and cx.level == 0
     for e in edge_list:
@@ -629,14 +654,12 @@ def refine_complex(cx, vertices=None, edges=None):
         _add(out, 1 - pw, smooth)
         _add(out, pw, {a: half, b: half})
         epts[e] = {u: x for u, x in out.items() if x != 0}
-    stencils = vpts + epts + fpts
-    children = []
-    for g, f in enumerate(cx.faces):
-        fp = n + E + g
-        s0, k = cx.start[g], len(f)
-        for i in range(k):
-            h = s0 + i
-            children.append((f[i], n + cx.he_edge[h], fp, n + cx.he_edge[s0 + (i - 1) % k]))
+    return epts
+
+
+def _child_tags(cx, want_v, csharp):
+    """(child edge sharpness ``{(v, n + e): s}``, child vertex sharpness ``{v: s}``) of :func:`refine_complex`."""
+    n, opts = cx.n_vertices, cx.options
     ces = {}
     for v, d in csharp.items():
         for e, s in d.items():
@@ -652,4 +675,4 @@ def refine_complex(cx, vertices=None, edges=None):
         d = _decrement(s)
         if d > 0.0:
             cvs[v] = d
-    return stencils, children, ces, cvs
+    return ces, cvs

@@ -480,8 +480,6 @@ def evaluate_points(shipped, sources, derivatives, kwargs, out, scheduler=None, 
     >>> bool(np.all(np.abs(np.abs(P[:, 2]) - 68 / 81) < 1e-12))
     True
     """
-    import numpy as np
-
     from .engine import run_tasks
 
     if local is not None:
@@ -494,16 +492,20 @@ def evaluate_points(shipped, sources, derivatives, kwargs, out, scheduler=None, 
               "out": None if folder is None else str(folder / _shard_name(i))} for i, s in enumerate(sources)]
     sweep = run_tasks(_evaluate_chunk, tasks, scheduler, shared=[shipped], desc="evaluate", unit="chunk",
                       progress=progress, names=[f"chunk {i}" for i in range(len(tasks))])
-    if folder is None:
-        arrays = {n: np.concatenate([r[n] for r in sweep.results]) for n in ("face", "u", "v", *names)}
-        _replace_when_written(out, lambda tmp: np.savez(tmp, **arrays))
-        n = int(arrays["face"].size)
-        counts = [degenerate_normals(arrays)]
-        seconds = [r["seconds"] for r in sweep.results]
-    else:
-        _write_index(folder, [r[0] for r in sweep.results], ("face", "u", "v", *names))
-        n = int(sum(r[0] for r in sweep.results))
-        counts = [r[1] for r in sweep.results]
-        seconds = [r[2] for r in sweep.results]
+    n, counts, seconds = _gather(sweep.results, names, out, folder)
     _warn_degenerate(n, counts)
     return n, names, sweep, max((s[0] for s in seconds), default=0.0)
+
+
+def _gather(results, names, out, folder):
+    """(points, degenerate-normal counts, seconds per chunk) of the chunks' ``results``: written to the file
+    ``out`` (one .npz) when ``folder`` is None, else the shards' index written in ``folder``."""
+    import numpy as np
+
+    if folder is None:
+        arrays = {n: np.concatenate([r[n] for r in results]) for n in ("face", "u", "v", *names)}
+        _replace_when_written(out, lambda tmp: np.savez(tmp, **arrays))
+        counts = [degenerate_normals(arrays)]
+        return int(arrays["face"].size), counts, [r["seconds"] for r in results]
+    _write_index(folder, [r[0] for r in results], ("face", "u", "v", *names))
+    return int(sum(r[0] for r in results)), [r[1] for r in results], [r[2] for r in results]

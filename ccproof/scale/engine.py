@@ -687,66 +687,9 @@ def run_tasks(fn, tasks, scheduler=None, *, shared=(), retries=2, deterministic=
         _run_pool(call, tasks, shared, s.workers, retries, priority, sweep, outcomes,
                   progress and len(tasks) > 1, desc, unit)
     elif isinstance(s, Scheduler) and s.kind == "serial":
-        it = range(len(tasks))
-        if progress and len(tasks) > 1:
-            from tqdm import tqdm
-
-            it = tqdm(it, desc=desc, unit=unit)
-        for i in it:
-            for attempt in range(retries + 1):
-                try:
-                    outcomes[i] = call(tasks[i], *shared)
-                    break
-                except Exception as exc:  # an unexpected error: retried like on a cluster
-                    if attempt == retries:
-                        outcomes[i] = (False, exc)
-                    else:
-                        sweep.retried[i] = f"raised {type(exc).__name__}: {exc}; retried"
+        _run_serial(call, tasks, shared, retries, sweep, outcomes, (desc, unit, progress and len(tasks) > 1))
     else:
-        with client_for(s) as client:
-            from distributed import as_completed
-
-            run = uuid.uuid4().hex[:8]
-            shared_f = [client.submit(_identity, obj, key=f"shared-{getattr(obj, 'digest', uuid.uuid4().hex)[:16]}",
-                                      pure=False) for obj in shared]
-            order = range(len(tasks)) if priority is None else sorted(range(len(tasks)), key=lambda i: -priority[i])
-            futs, index = {}, {}
-            for i in order:
-                key = f"{desc.replace(' ', '_')}-{i}-{run}"
-                index[key] = i
-                futs[key] = client.submit(call, tasks[i], *shared_f, key=key, retries=retries, pure=False,
-                                          priority=0 if priority is None else int(priority[i]))
-            done = as_completed(list(futs.values()))
-            bar = None
-            if progress:
-                from tqdm import tqdm
-
-                bar = tqdm(total=len(futs), desc=desc, unit=unit)
-            for batch in done.batches():
-                for fut in batch:
-                    i = index[fut.key]
-                    try:
-                        outcomes[i] = fut.result()
-                    except Exception as exc:  # retries exhausted, or KilledWorker: reported, not dropped
-                        outcomes[i] = (False, exc)
-                # how each finished task got there, asked before it is released (a released result is not
-                # recomputed when a worker that held it dies later)
-                info = client.run_on_scheduler(_retry_info, [f.key for f in batch], retries)
-                for key, (used, lost) in info.items():
-                    what = []
-                    if lost:
-                        what.append(f"its worker was lost {lost} time(s); re-run on another worker")
-                    if used > 0:
-                        what.append(f"raised an exception {used} time(s); retried")
-                    if what:
-                        sweep.retried[index[key]] = "; ".join(what)
-                for fut in batch:
-                    futs.pop(fut.key).release()
-                if bar is not None:
-                    bar.update(len(batch))
-            if bar is not None:
-                bar.close()
-            del futs, shared_f
+        _run_dask(call, tasks, shared, s, retries, priority, sweep, outcomes, (desc, unit, progress))
     for i, (ok, value) in outcomes.items():
         if ok:
             sweep.results[i] = value
@@ -757,3 +700,76 @@ def run_tasks(fn, tasks, scheduler=None, *, shared=(), retries=2, deterministic=
         lines = [ln for ln in sweep.report(names) if "FAILED" in ln]
         raise TaskFailed(f"{len(sweep.errors)} of {len(tasks)} task(s) failed: " + "; ".join(lines))
     return sweep
+
+
+def _run_serial(call, tasks, shared, retries, sweep, outcomes, label):
+    """:func:`run_tasks` in this process, one task after the other; ``label`` = (desc, unit, show a bar)."""
+    desc, unit, show = label
+    it = range(len(tasks))
+    if show:
+        from tqdm import tqdm
+
+        it = tqdm(it, desc=desc, unit=unit)
+    for i in it:
+        for attempt in range(retries + 1):
+            try:
+                outcomes[i] = call(tasks[i], *shared)
+                break
+            except Exception as exc:  # an unexpected error: retried like on a cluster
+                if attempt == retries:
+                    outcomes[i] = (False, exc)
+                else:
+                    sweep.retried[i] = f"raised {type(exc).__name__}: {exc}; retried"
+
+
+def _run_dask(call, tasks, shared, s, retries, priority, sweep, outcomes, label):
+    """:func:`run_tasks` on a Dask client or cluster ``s``; ``label`` = (desc, unit, show a bar)."""
+    desc, unit, show = label
+    with client_for(s) as client:
+        from distributed import as_completed
+
+        run = uuid.uuid4().hex[:8]
+        shared_f = [client.submit(_identity, obj, key=f"shared-{getattr(obj, 'digest', uuid.uuid4().hex)[:16]}",
+                                  pure=False) for obj in shared]
+        order = range(len(tasks)) if priority is None else sorted(range(len(tasks)), key=lambda i: -priority[i])
+        futs, index = {}, {}
+        for i in order:
+            key = f"{desc.replace(' ', '_')}-{i}-{run}"
+            index[key] = i
+            futs[key] = client.submit(call, tasks[i], *shared_f, key=key, retries=retries, pure=False,
+                                      priority=0 if priority is None else int(priority[i]))
+        done = as_completed(list(futs.values()))
+        bar = None
+        if show:
+            from tqdm import tqdm
+
+            bar = tqdm(total=len(futs), desc=desc, unit=unit)
+        for batch in done.batches():
+            for fut in batch:
+                i = index[fut.key]
+                try:
+                    outcomes[i] = fut.result()
+                except Exception as exc:  # retries exhausted, or KilledWorker: reported, not dropped
+                    outcomes[i] = (False, exc)
+            _note_retries(client, batch, index, retries, sweep)
+            for fut in batch:
+                futs.pop(fut.key).release()
+            if bar is not None:
+                bar.update(len(batch))
+        if bar is not None:
+            bar.close()
+        del futs, shared_f
+
+
+def _note_retries(client, batch, index, retries, sweep):
+    """Record in ``sweep.retried`` how each finished task of ``batch`` got there, asked of the scheduler before
+    the task is released (a released result is not recomputed when a worker that held it dies later)."""
+    info = client.run_on_scheduler(_retry_info, [f.key for f in batch], retries)
+    for key, (used, lost) in info.items():
+        what = []
+        if lost:
+            what.append(f"its worker was lost {lost} time(s); re-run on another worker")
+        if used > 0:
+            what.append(f"raised an exception {used} time(s); retried")
+        if what:
+            sweep.retried[index[key]] = "; ".join(what)

@@ -620,14 +620,7 @@ def fit_points(X: ArrayLike, init: Literal["cube"] | QuadMesh = "cube", levels: 
     (98, True, True, [])
     """
     pts = check_cloud(X)  # (m, 3) float64
-    if int(levels) != levels or levels < 0:
-        raise CCProofError(f"levels must be an integer >= 0, got {levels!r}")
-    if not (spring_total > 0 and math.isfinite(spring_total)):
-        raise CCProofError(f"spring_total must be finite and > 0, got {spring_total!r}")
-    if not (surface_spring_total >= 0 and math.isfinite(surface_spring_total)):
-        raise CCProofError(f"surface_spring_total must be finite and >= 0, got {surface_spring_total!r}")
-    if not (0 < init_scale <= 1):
-        raise CCProofError(f"init_scale must be in (0, 1], got {init_scale!r}")
+    _check_fit_numbers(levels, spring_total, surface_spring_total, init_scale)
     if dt is None:
         dt = 1000.0 if scheme == "massless" else 10.0
     material = DEFAULT_FIT_MATERIAL if material is None else material
@@ -636,15 +629,7 @@ def fit_points(X: ArrayLike, init: Literal["cube"] | QuadMesh = "cube", levels: 
     if not diameter > 0:
         raise CCProofError("the data points all coincide")
     Xn = (pts - centre) / diameter
-    if isinstance(init, str):
-        mesh0 = _initial_mesh(init, Xn, init_scale)
-    else:
-        mesh0 = _initial_mesh(init, Xn, init_scale)
-        mesh0 = mesh0.with_vertices((np.asarray(mesh0.vertices) - centre) / diameter)
-    from ccproof.apps.dynamics.elements import isolate_extraordinary
-
-    if not isinstance(mesh0, TaggedQuadMesh):  # tagged elements take any face (docs/qmv98.md)
-        mesh0, _ = isolate_extraordinary(mesh0)
+    mesh0 = _start_mesh(init, Xn, init_scale, centre, diameter)
     model = DynamicSurface(mesh0, material, levels=truncation)
     P = np.array(mesh0.vertices)
     # a non-manifold file's split mesh: the copies of one file vertex are one free point (docs/qmv98.md)
@@ -670,49 +655,9 @@ def fit_points(X: ArrayLike, init: Literal["cube"] | QuadMesh = "cube", levels: 
             integ = ImplicitIntegrator(model, dt, P=P, scheme=scheme, tol=1e-9, copies=copies)
             reverse = (SurfaceToDataSprings(model, Xn, surface_spring_total, slack=stray_n)
                        if surface_spring_total > 0 else None)
-            converged = False
-            cg = 0
-            step = 0
-            energies, errors = [], []
-            change = err_change = math.inf
-            two_way = reverse is not None and level > 0
-            one_way_steps = 0
-            for step in range(1, max_steps + 1):
-                f, u, v, _, dist = finder.query(integ.P, Xn)
-                errors.append(float(np.mean(dist)))  # of the state before this step
-                springs = Springs(model, f, u, v, Xn, k)
-                if two_way and reverse is not None:  # and from the surface to the data (two-way forces)
-                    springs = Springs.stacked(springs, reverse.springs(integ.P)[0])
-                info = integ.step(springs=springs)
-                cg += info.iterations
-                energies.append(model.energy(integ.P) + springs.energy(integ.P))
-                change = abs(energies[-1] - energies[-3]) / abs(energies[-1]) if len(energies) >= 3 else math.inf
-                # relative to the mean error, or to the data spacing once the error is below it (changes
-                # finer than the data's resolution are not progress)
-                err_change = (abs(errors[-1] - errors[-3]) / max(abs(errors[-1]), spacing_n)
-                              if len(errors) >= 3 else math.inf)
-                if bar is not None:
-                    bar.update(1)
-                    bar.set_postfix(level=level, dE=f"{change:.1e}", dErr=f"{err_change:.1e}")
-                if callback is not None:
-                    callback(level, step, model, integ.P)
-                if change <= tol and err_change <= tol:
-                    if reverse is not None and not two_way:  # the first level's data-spring equilibrium
-                        two_way, energies, errors, one_way_steps = True, [], [], step
-                        continue
-                    converged = True
-                    break
-            rises = sum(b > a for a, b in zip(energies[-11:-1], energies[-10:]))
-            if converged:
-                first = f" (data springs alone for the first {one_way_steps})" if one_way_steps else ""
-                reason = (f"equilibrium after {step} steps{first}: relative energy change {change:.2g} and mean-error "
-                          f"change {err_change:.2g} over two steps, both <= tol {tol:g}")
-            else:
-                failed = [w for w, c in (("energy", change), ("mean data error", err_change)) if not c <= tol]
-                reason = (f"stopped at the step cap ({max_steps} steps, --max-steps) before equilibrium: relative "
-                          f"{' and '.join(failed)} change over two steps {change:.2g} / {err_change:.2g} > tol {tol:g}"
-                          + (f"; the energy rose at {rises} of the last 10 steps (lower --dt)" if rises else
-                             "; the energy was still falling (raise --max-steps)"))
+            run = _relax_level(model, finder, integ, (Xn, k, reverse), level, result.parameters, spacing_n,
+                               (bar, callback))
+            step, converged, cg, energies, change, err_change, reason = run
             if bar is not None and step < max_steps:
                 bar.update(max_steps - step)
             P = integ.P
@@ -737,6 +682,102 @@ def fit_points(X: ArrayLike, init: Literal["cube"] | QuadMesh = "cube", levels: 
     for i, lev in enumerate(result.levels):
         if not lev.converged:
             result.warnings.append(f"level {i} {lev.reason}")
+    _report_surface(result, pts, sample_level, stray_distance_percent, stray_fraction)
+    return result
+
+
+def _check_fit_numbers(levels, spring_total, surface_spring_total, init_scale):
+    """Refuse, naming the option, a bad number of levels, spring totals or initial scale of :func:`fit_points`."""
+    if int(levels) != levels or levels < 0:
+        raise CCProofError(f"levels must be an integer >= 0, got {levels!r}")
+    if not (spring_total > 0 and math.isfinite(spring_total)):
+        raise CCProofError(f"spring_total must be finite and > 0, got {spring_total!r}")
+    if not (surface_spring_total >= 0 and math.isfinite(surface_spring_total)):
+        raise CCProofError(f"surface_spring_total must be finite and >= 0, got {surface_spring_total!r}")
+    if not (0 < init_scale <= 1):
+        raise CCProofError(f"init_scale must be in (0, 1], got {init_scale!r}")
+
+
+def _start_mesh(init, Xn, init_scale, centre, diameter):
+    """The start mesh of :func:`fit_points` in the normalized frame (extraordinary vertices isolated where the
+    elements need it)."""
+    if isinstance(init, str):
+        mesh0 = _initial_mesh(init, Xn, init_scale)
+    else:
+        mesh0 = _initial_mesh(init, Xn, init_scale)
+        mesh0 = mesh0.with_vertices((np.asarray(mesh0.vertices) - centre) / diameter)
+    from ccproof.apps.dynamics.elements import isolate_extraordinary
+
+    if not isinstance(mesh0, TaggedQuadMesh):  # tagged elements take any face (docs/qmv98.md)
+        mesh0, _ = isolate_extraordinary(mesh0)
+    return mesh0
+
+
+def _relax_level(model, finder, integ, data, level, params, spacing_n, hooks):
+    """Integrate one level of :func:`fit_points` with ``integ`` to equilibrium or to the step cap.
+    ``data`` = (Xn, k, reverse springs or None), ``params`` the fit's parameters, ``hooks`` = (bar, callback).
+    Returns (steps, converged, CG iterations, energies, change, error change, reason)."""
+    Xn, k, reverse = data
+    bar, callback = hooks
+    max_steps, tol = params["max_steps"], params["tol"]
+    converged = False
+    cg = 0
+    step = 0
+    energies, errors = [], []
+    change = err_change = math.inf
+    two_way = reverse is not None and level > 0
+    one_way_steps = 0
+    for step in range(1, max_steps + 1):
+        f, u, v, _, dist = finder.query(integ.P, Xn)
+        errors.append(float(np.mean(dist)))  # of the state before this step
+        springs = Springs(model, f, u, v, Xn, k)
+        if two_way and reverse is not None:  # and from the surface to the data (two-way forces)
+            springs = Springs.stacked(springs, reverse.springs(integ.P)[0])
+        info = integ.step(springs=springs)
+        cg += info.iterations
+        energies.append(model.energy(integ.P) + springs.energy(integ.P))
+        change = abs(energies[-1] - energies[-3]) / abs(energies[-1]) if len(energies) >= 3 else math.inf
+        # relative to the mean error, or to the data spacing once the error is below it (changes
+        # finer than the data's resolution are not progress)
+        err_change = (abs(errors[-1] - errors[-3]) / max(abs(errors[-1]), spacing_n)
+                      if len(errors) >= 3 else math.inf)
+        if bar is not None:
+            bar.update(1)
+            bar.set_postfix(level=level, dE=f"{change:.1e}", dErr=f"{err_change:.1e}")
+        if callback is not None:
+            callback(level, step, model, integ.P)
+        if change <= tol and err_change <= tol:
+            if reverse is not None and not two_way:  # the first level's data-spring equilibrium
+                two_way, energies, errors, one_way_steps = True, [], [], step
+                continue
+            converged = True
+            break
+    reason = _level_reason(converged, step, one_way_steps, (change, err_change), energies, (max_steps, tol))
+    return step, converged, cg, energies, change, err_change, reason
+
+
+def _level_reason(converged, step, one_way_steps, changes, energies, caps):
+    """Why a level of :func:`fit_points` stopped (equilibrium, or the step cap and what had not settled)."""
+    change, err_change = changes
+    max_steps, tol = caps
+    rises = sum(b > a for a, b in zip(energies[-11:-1], energies[-10:]))
+    if converged:
+        first = f" (data springs alone for the first {one_way_steps})" if one_way_steps else ""
+        reason = (f"equilibrium after {step} steps{first}: relative energy change {change:.2g} and mean-error "
+                  f"change {err_change:.2g} over two steps, both <= tol {tol:g}")
+    else:
+        failed = [w for w, c in (("energy", change), ("mean data error", err_change)) if not c <= tol]
+        reason = (f"stopped at the step cap ({max_steps} steps, --max-steps) before equilibrium: relative "
+                  f"{' and '.join(failed)} change over two steps {change:.2g} / {err_change:.2g} > tol {tol:g}"
+                  + (f"; the energy rose at {rises} of the last 10 steps (lower --dt)" if rises else
+                     "; the energy was still falling (raise --max-steps)"))
+    return reason
+
+
+def _report_surface(result, pts, sample_level, stray_distance_percent, stray_fraction):
+    """The fitted limit surface of ``result``, its sampling level, the data spacing, and how far it strays from
+    the data (a warning beyond ``stray_fraction``)."""
+    mesh, diameter = result.mesh, result.diameter
     if sample_level is None:
         nf = mesh.n_faces
         sample_level = next((k for k in (1, 2, 3) if nf * 4**k >= 4 * pts.shape[0]), 3)
@@ -754,4 +795,3 @@ def fit_points(X: ArrayLike, init: Literal["cube"] | QuadMesh = "cube", levels: 
             f"up to {result.surface_max_percent:.2f} %; the data may not cover the surface (an unseen side), the "
             f"start mesh's topology may not match the data's (e.g. a genus-0 start for a torus: give --init), or "
             f"the surface spans a concavity of the data (raise --surface-spring or --levels)")
-    return result
