@@ -4,7 +4,6 @@ chain). Cross-checks against the library's own Sdc stencils (exact integer subdi
 forgeries, and the configurations that stay undecided."""
 
 import copy
-import json
 import math
 from fractions import Fraction
 
@@ -14,18 +13,11 @@ import pytest
 from ccproof.certify.tagged import prove_tagged
 from ccproof.certify.verify import TAGGED_SCHEMA, verify_certificate
 from ccproof.certify.verify.tagged import eigenvalues, labels
-from ccproof.tables.format import certificates_dir
 
-from .test_tagged import library_matrix
+from .test_tagged import _cert, library_matrix
 
 QUIET = {"log": lambda line: None}
 W, DW = (Fraction(1, 6), Fraction(4, 6), Fraction(1, 6)), (Fraction(-1, 2), Fraction(0), Fraction(1, 2))
-
-
-def _cert(name):
-    fam, n = name.split(":")
-    stem = f"{'k' if fam == 'dart' else 'n'}{int(n):03d}.json"
-    return json.loads((certificates_dir() / "c1" / fam / stem).read_text())
 
 
 def _fails(cert, why):
