@@ -8,7 +8,7 @@ import pytest
 
 from ccproof.cli import main
 from ccproof.errors import CCProofError
-from ccproof.mesh.io import read_points
+from ccproof.mesh.points import read_points
 
 X = np.array([[0.1, 0.2, 0.5], [-0.3, 0.1, -0.2], [0.0, 0.0, 0.0], [1 / 3, -2 / 7, 0.125]])
 

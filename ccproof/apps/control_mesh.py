@@ -694,7 +694,7 @@ def merged_copies(mesh, file_vertex):
         The first copy's position for every label.
     faces : ndarray of int64, shape (m, 4)
     tag_lines : list of str
-        OpenSubdiv's OBJ tag lines (:func:`ccproof.mesh.io.obj_tag_lines`) in the merged numbering: a sharp
+        OpenSubdiv's OBJ tag lines (:func:`ccproof.mesh.write.obj_tag_lines`) in the merged numbering: a sharp
         edge's largest sharpness over its copies, likewise for vertices; the holes.
 
     Examples

@@ -67,7 +67,7 @@ def read_face_uv_csv(path):
     """Read a ``face,u,v`` CSV file; returns (face int64 (n,), u (n,), v (n,))."""
     import numpy as np
 
-    from ccproof.mesh.io import read_csv_columns
+    from ccproof.mesh.points import read_csv_columns
 
     rows = read_csv_columns(path, ("face", "u", "v"))
     face = rows[:, 0]

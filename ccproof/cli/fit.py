@@ -105,7 +105,7 @@ def run(args) -> int:
     from ccproof.cli._notice import compile_notice
     from ccproof.cli._progress import progress_enabled
     from ccproof.errors import CCProofError
-    from ccproof.mesh.io import read_points
+    from ccproof.mesh.points import read_points
 
     X = read_points(args.points)
     init = args.init

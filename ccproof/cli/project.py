@@ -87,7 +87,7 @@ def run(args):
     from ccproof.evaluate.closest import CELLS, ClosestPointFinder
     from ccproof.evaluate.closest import check_query_points as check_points
     from ccproof.evaluate.surface import limit_surface
-    from ccproof.mesh.io import read_points
+    from ccproof.mesh.points import read_points
 
     progress = progress_enabled(args)
     with phase(f"read {Path(args.points).name}", progress):

@@ -9,12 +9,13 @@ Layer ``mesh`` of docs/architecture.md: imports nothing from ccproof but :mod:`c
 True
 """
 
-from ccproof.mesh.io import read_mesh, read_obj, read_obj_polygons, read_obj_tagged, write_obj
+from ccproof.mesh.io import read_mesh, read_obj, read_obj_polygons, read_obj_tagged
 from ccproof.mesh.masks import limit_normals, limit_positions, limit_tangents
 from ccproof.mesh.polymesh import PolyMesh
 from ccproof.mesh.quadmesh import QuadMesh
 from ccproof.mesh.rules import Options
 from ccproof.mesh.subdivision import child_faces, subdivide, subdivision_matrix
+from ccproof.mesh.write import write_obj
 
 __all__ = [
     "QuadMesh",

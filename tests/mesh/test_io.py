@@ -81,9 +81,10 @@ def test_tagged_writers_are_atomic(tmp_path, monkeypatch):
     import os
 
     from ccproof.apps.control_mesh import TaggedQuadMesh
-    from ccproof.mesh import io
+    from ccproof.mesh import write
     from ccproof.mesh.examples import cube
-    from ccproof.mesh.io import read_obj_tagged, write_obj
+    from ccproof.mesh.io import read_obj_tagged
+    from ccproof.mesh.write import write_obj
 
     c = cube()
     t = TaggedQuadMesh(c.vertices, c.faces, creases=([c.faces[0][:2]], [2.5]), corners=([3], [np.inf]), holes=[5])
@@ -95,7 +96,7 @@ def test_tagged_writers_are_atomic(tmp_path, monkeypatch):
     def boom(mesh):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(io, "obj_tag_lines", boom)
+    monkeypatch.setattr(write, "obj_tag_lines", boom)
     with pytest.raises(KeyboardInterrupt):
         write_obj(p, t)
     assert p.read_text() == "old\n" and sorted(os.listdir(tmp_path)) == ["m.obj", "ref.txt"]
@@ -115,7 +116,7 @@ def test_tagged_writers_are_atomic(tmp_path, monkeypatch):
     res, _ = compare(grid(3, 3), methods=("c",), levels=1, eval_level=3)
     q = tmp_path / "uv.obj"
     q.write_text("old uv\n")
-    monkeypatch.setattr(io, "obj_tag_lines", boom)
+    monkeypatch.setattr(write, "obj_tag_lines", boom)
     with pytest.raises(KeyboardInterrupt):
         arap_io.write_uv_obj(q, grid(3, 3), res["c"])
     assert q.read_text() == "old uv\n" and sorted(os.listdir(tmp_path)) == ["m.obj", "ref.txt", "uv.obj"]

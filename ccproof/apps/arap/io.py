@@ -8,7 +8,7 @@ The OBJ holds the control mesh (``v``), the texture control points of every char
 with the transforms of :func:`~ccproof.apps.arap.export.pack_charts` when given, else laid side by
 side at their natural ARAP scale), the chart faces as ``f v/vt`` and, for a tagged control mesh
 (:class:`~ccproof.apps.control_mesh.TaggedQuadMesh`), its creases, corners and holes as OpenSubdiv's
-``t`` lines (:func:`ccproof.mesh.io.obj_tag_lines`: read back by :func:`ccproof.mesh.io.read_obj_tagged`,
+``t`` lines (:func:`ccproof.mesh.write.obj_tag_lines`: read back by :func:`ccproof.mesh.io.read_obj_tagged`,
 the same tags and surface).
 Faces in no chart are written without texture. For extended charts the texture of a chart also
 has control points on the ring of faces around it (hsh10 section 3.2): they are written as extra
@@ -148,7 +148,7 @@ def write_uv_obj(path, mesh, result, comment=None, table=None, transforms=None, 
         )
         base += uv.shape[0]
     from ccproof.apps.control_mesh import merge_labels, merged_copies
-    from ccproof.mesh.io import atomic_path, obj_tag_lines
+    from ccproof.mesh.write import atomic_path, obj_tag_lines
 
     tag_lines = obj_tag_lines(mesh)
     lab = merge_labels(mesh)

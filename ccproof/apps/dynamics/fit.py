@@ -58,7 +58,7 @@ from ccproof.apps.dynamics.meshes import paper_initial_model
 from ccproof.apps.dynamics.model import DynamicSurface, Material
 from ccproof.errors import CCProofError
 from ccproof.mesh import QuadMesh
-from ccproof.mesh.io import read_points
+from ccproof.mesh.points import read_points
 
 __all__ = [
     "minimal_enclosing_sphere",

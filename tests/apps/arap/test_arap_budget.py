@@ -66,7 +66,7 @@ def test_a_tighter_budget_lowers_the_optimization_levels_too_and_a_hopeless_one_
 def _ball_with_a_hole(path, times=2):
     """A sphere (the cube subdivided ``times``, projected) less one face: a disk that folds as one chart."""
     from ccproof.apps.control_mesh import subdivide_control
-    from ccproof.mesh.io import write_obj
+    from ccproof.mesh.write import write_obj
 
     m = cube()
     for _ in range(times):
