@@ -60,161 +60,8 @@ from functools import cache, lru_cache
 
 from ccproof.errors import CCProofError, check_valence
 from ccproof.inverse.data import bezier_to_power
-
-#: the patch each net row/column belongs to, which local coordinate is fixed and its value
-_EDGE_SPECS = {
-    # name: (patch, axis (0: s fixed, 1: t fixed), value, face segment, the other side)
-    "P1:s=0": ("P1", 0, 0, "u = 1/2, 0 <= v <= 1/2", "layer 1 (pieces P1, P2 of layer 1)"),
-    "P1:s=1": ("P1", 0, 1, "u = 1, 0 <= v <= 1/2", "layer -1 (outside the face)"),
-    "P1:t=1": ("P1", 1, 1, "v = 1/2, 1/2 <= u <= 1", "P2"),
-    "P2:s=0": ("P2", 0, 0, "u = 1/2, 1/2 <= v <= 1", "P3"),
-    "P2:s=1": ("P2", 0, 1, "u = 1, 1/2 <= v <= 1", "layer -1 (outside the face)"),
-    "P2:t=0": ("P2", 1, 0, "v = 1/2, 1/2 <= u <= 1", "P1"),
-    "P2:t=1": ("P2", 1, 1, "v = 1, 1/2 <= u <= 1", "layer -1 (outside the face)"),
-    "P3:s=1": ("P3", 0, 1, "u = 1/2, 1/2 <= v <= 1", "P2"),
-    "P3:t=0": ("P3", 1, 0, "v = 1/2, 0 <= u <= 1/2", "layer 1 (pieces P2, P3 of layer 1)"),
-    "P3:t=1": ("P3", 1, 1, "v = 1, 0 <= u <= 1/2", "layer -1 (outside the face)"),
-}
-
-
-@dataclass(frozen=True)
-class Edge:
-    """A boundary edge of a layer-0 piece (bmz04 Definition 5; docs/inverse.md).
-
-    Parameters
-    ----------
-    name : str
-        ``"<patch>:<s|t>=<0|1>"``, the key of :data:`EDGES`.
-    patch : str
-        ``"P1"``, ``"P2"`` or ``"P3"``.
-    axis : int
-        The local coordinate held fixed (0: s, 1: t).
-    value : int
-        Its value (0 or 1).
-    segment : str
-        The face segment the edge is the image of.
-    other : str
-        The piece or layer across it.
-
-    Examples
-    --------
-    >>> e = EDGES["P1:s=1"]
-    >>> e.patch, e.axis, e.value, e.segment
-    ('P1', 0, 1, 'u = 1, 0 <= v <= 1/2')
-    """
-
-    name: str
-    patch: str
-    axis: int
-    value: int
-    segment: str
-    other: str
-
-    def control_points(self, net):
-        """The four Bezier control points of the edge, in the order of the free coordinate w."""
-        a = 3 * self.value
-        if self.axis == 0:
-            return [net[a][j] for j in range(4)]
-        return [net[i][a] for i in range(4)]
-
-    def parameter(self, w, n=0):
-        """Local (s, t) of the point at edge parameter w moved by n towards the piece's inside."""
-        fixed = self.value - n if self.value == 1 else self.value + n
-        return (fixed, w) if self.axis == 0 else (w, fixed)
-
-
-#: every boundary edge, by name (``"P1:s=1"`` is the edge s = 1 of piece P1, ...)
-EDGES = {name: Edge(name, *spec) for name, spec in _EDGE_SPECS.items()}
-
-
-def _get_edge(edge):
-    if isinstance(edge, Edge):
-        return edge
-    try:
-        return EDGES[edge]
-    except KeyError:
-        raise CCProofError(f"unknown boundary edge {edge!r}; choose one of {', '.join(EDGES)}") from None
-
-
-# ---------------------------------------------------------------------------------------------
-# Sylvester matrix and determinant (Definition 5), generic over a commutative ring
-# ---------------------------------------------------------------------------------------------
-
-
-def sylvester_matrix(q, r, zero):
-    """The (m+n) x (m+n) Sylvester matrix of Definition 5 (bmz04) of q = q0 + ... + qm x^m and
-    r = r0 + ... + rn x^n given as coefficient lists (constant term first): n rows of q's
-    coefficients ``q0 .. qm`` shifted right one column per row, then m rows of r's.
-
-    Parameters
-    ----------
-    q, r : sequence
-        Coefficient lists, constant term first, of degrees m and n (any commutative ring).
-    zero : scalar
-        The zero of that ring.
-
-    Returns
-    -------
-    list of lists, shape (m + n, m + n)
-
-    Examples
-    --------
-    >>> sylvester_matrix([1, 2], [3, 4, 5], 0)
-    [[1, 2, 0], [0, 1, 2], [3, 4, 5]]
-    """
-    m, n = len(q) - 1, len(r) - 1
-    size = m + n
-    S = [[zero for _ in range(size)] for _ in range(size)]
-    for i in range(n):
-        for j, a in enumerate(q):
-            S[i][i + j] = a
-    for i in range(m):
-        for j, a in enumerate(r):
-            S[n + i][i + j] = a
-    return S
-
-
-def determinant(M, zero, one):
-    """Exact determinant of a square matrix over a commutative ring (no division): Laplace
-    expansion along the rows with the minors memoized by their set of columns (2^n of them).
-
-    Parameters
-    ----------
-    M : sequence of sequences, shape (n, n)
-        Entries in a commutative ring (ints, Fractions, flint polynomials, ...).
-    zero, one : scalar
-        The ring's 0 and 1.
-
-    Returns
-    -------
-    scalar
-
-    Examples
-    --------
-    >>> determinant([[1, 2], [3, 4]], 0, 1)
-    -2
-    """
-    n = len(M)
-    memo = {}
-
-    def minor(row, cols):
-        if row == n:
-            return one
-        key = cols
-        if key in memo:
-            return memo[key]
-        acc = zero
-        for idx, col in enumerate(cols):
-            a = M[row][col]
-            if a == 0:
-                continue
-            term = a * minor(row + 1, cols[:idx] + cols[idx + 1:])
-            acc = acc + term if idx % 2 == 0 else acc - term
-        memo[key] = acc
-        return acc
-
-    return minor(0, tuple(range(n)))
-
+from ccproof.inverse.edges import Edge, get_edge
+from ccproof.inverse.sylvester import determinant, rational_implicit, rational_nets, sylvester_matrix
 
 # ---------------------------------------------------------------------------------------------
 # symbolic implicitization over Q(c, lam)
@@ -328,7 +175,7 @@ def symbolic_implicit(edge):
     """
     from ccproof.algebra.characteristic_map import symbolic_bezier_nets
 
-    e = _get_edge(edge)
+    e = get_edge(edge)
     R = _zring()
     _, _, u, v = R.gens()
     pts = e.control_points(symbolic_bezier_nets()[e.patch])
@@ -398,7 +245,7 @@ def implicit_polynomial(k, edge, arithmetic="arb", prec=128):
     (3, 0)
     """
     k = check_valence(k)
-    e = _get_edge(edge)
+    e = get_edge(edge)
     if k == 4:
         g = rational_implicit(e, Fraction(0), Fraction(1, 2))
         if arithmetic == "exact":
@@ -464,112 +311,6 @@ def _arb_coefficients(k, edge_name, prec):
     return tuple(out)
 
 
-# ---------------------------------------------------------------------------------------------
-# rational (c, lam): actual-degree Sylvester determinant over Q
-# ---------------------------------------------------------------------------------------------
-
-
-def rational_nets(c, lam):
-    """Bezier nets of P1, P2, P3 with c and lam rational (``Fraction``): exact, ``Fraction``s.
-
-    Valid for any rational pair with 16 lam^2 - 2 (5 + c) lam + 1 = 0: k = 4 (c = 0, lam = 1/2)
-    and the *rational pseudo-valences* of :data:`RATIONAL_PAIRS` used to test the algebra exactly
-    (bmz04 section 4.3; docs/readings.md R3).
-
-    Parameters
-    ----------
-    c, lam : Fraction or int
-
-    Returns
-    -------
-    dict
-        ``{"P1": net, "P2": net, "P3": net}``, ``net[i][j] = (x, y)`` Fractions, i, j = 0..3.
-
-    Raises
-    ------
-    CCProofError
-        If lam is not a root for c.
-
-    Examples
-    --------
-    >>> rational_nets(0, Fraction(1, 2))["P2"][3][3]            # k = 4: the identity map
-    (Fraction(1, 1), Fraction(1, 1))
-    """
-    c, lam = Fraction(c), Fraction(lam)
-    if 16 * lam * lam - 2 * (5 + c) * lam + 1 != 0:
-        raise CCProofError(f"lam = {lam} is not a root of 16 L^2 - 2 (5 + c) L + 1 for c = {c}")
-    return _rational_nets(c, lam)
-
-
-@lru_cache(maxsize=32)
-def _rational_nets(c, lam):
-    from ccproof.algebra.characteristic_map import symbolic_bezier_nets
-    from ccproof.algebra.field import eval_integer_form
-
-    return {name: [[tuple(eval_integer_form(x.integer_form(), c, lam) for x in p) for p in row]
-                   for row in net]
-            for name, net in symbolic_bezier_nets().items()}
-
-
-def _rational_pair(m):
-    a = Fraction(8) / (m * m - 1)
-    c = a - 1
-    return c, (5 + c + a * m) / 16
-
-
-#: rational (c, lam) pairs with 16 lam^2 - 2(5+c) lam + 1 = 0 and c in (-1, 1): (1+c)(9+c) is a
-#: square for 1 + c = 8/(m^2 - 1). m = 3 is k = 4; the others are "pseudo-valences" near k = 3
-#: (c = -7/15), 6 (c = 11/21) and 8 (c = 81/119) on which every identity can be tested over Q.
-RATIONAL_PAIRS = tuple(_rational_pair(Fraction(m)) for m in (4, 3, Fraction(5, 2), Fraction(12, 5)))
-
-
-def _trim(coeffs):
-    coeffs = list(coeffs)
-    while len(coeffs) > 1 and coeffs[-1] == 0:
-        coeffs.pop()
-    return coeffs
-
-
-def rational_implicit(edge, c, lam):
-    """g(u, v) for rational (c, lam) as ``{(a, b): Fraction}``: the Sylvester determinant of
-    Definition 5 over Q with the actual degrees of x(w) - u and y(w) - v (no formal leading
-    zeros; for k = 4, whose boundaries are straight lines, this is what gives a non-zero g).
-
-    Parameters
-    ----------
-    edge : str or Edge
-        A boundary edge (:data:`EDGES`).
-    c, lam : Fraction or int
-        A rational pair with 16 lam^2 - 2 (5 + c) lam + 1 = 0 (:func:`rational_nets`).
-
-    Returns
-    -------
-    dict of tuple -> Fraction
-        ``{(a, b): g_ab}``.
-
-    Examples
-    --------
-    >>> rational_implicit("P1:t=1", 0, Fraction(1, 2))   # k = 4: the line v = 1/2, as 1/2 - v
-    {(0, 0): Fraction(1, 2), (0, 1): Fraction(-1, 1)}
-    """
-    from flint import fmpq, fmpq_mpoly_ctx
-
-    e = _get_edge(edge)
-    pts = e.control_points(rational_nets(c, lam)[e.patch])
-    Q = fmpq_mpoly_ctx.get(("u", "v"), "lex")
-    u, v = Q.gens()
-
-    def conv(x):
-        return Q.constant(fmpq(x.numerator, x.denominator))
-
-    q = [conv(a) for a in _trim(bezier_to_power([p[0] for p in pts]))]
-    r = [conv(a) for a in _trim(bezier_to_power([p[1] for p in pts]))]
-    q[0] = q[0] - u
-    r[0] = r[0] - v
-    g = determinant(sylvester_matrix(q, r, Q.constant(0)), Q.constant(0), Q.constant(1))
-    return {tuple(int(x) for x in ab): Fraction(int(x.p), int(x.q)) for ab, x in sorted(g.to_dict().items())}
-
-
 def _exact_value_rational_c(edge, c, u, v):
     """g(u, v) exactly for rational c (valences 3, 4, 6, or a rational pseudo-valence) and
     rational u, v, as ``(alpha, beta, d)`` meaning alpha + beta sqrt(d) with d = (1+c)(9+c)
@@ -582,7 +323,7 @@ def _exact_value_rational_c(edge, c, u, v):
     from flint import fmpq
 
     c, u, v = Fraction(c), Fraction(u), Fraction(v)
-    sym = symbolic_implicit(_get_edge(edge))
+    sym = symbolic_implicit(get_edge(edge))
     f = lambda x: fmpq(x.numerator, x.denominator)
     # numerator = N0 + N1 lam at (c, u, v) (exact substitution in flint); lam = (5 + c + sqrt d)/16
     rest = sym.numerator.subs({"c": f(c), "u": f(u), "v": f(v)})
@@ -659,7 +400,7 @@ def exact_sign(k, edge, u, v, prec=256):
     from flint import arb, ctx, fmpq
 
     while prec <= 4096:
-        coeffs = _arb_coefficients(k, _get_edge(edge).name, prec)
+        coeffs = _arb_coefficients(k, get_edge(edge).name, prec)
         with ctx.workprec(prec):
             U, V = arb(fmpq(u.numerator, u.denominator)), arb(fmpq(v.numerator, v.denominator))
             val = sum((x * U**a * V**b for (a, b), x in coeffs), arb(0))
@@ -731,7 +472,7 @@ def inside_sign(k, edge, prec=128):
     True
     """
     k = check_valence(k)
-    e = _get_edge(edge)
+    e = get_edge(edge)
     if k == 4:
         net = rational_nets(0, Fraction(1, 2))[e.patch]
         g = rational_implicit(e, 0, Fraction(1, 2))
@@ -811,7 +552,7 @@ class FloatImplicit:
         import numpy as np
 
         k = check_valence(k)
-        e = _get_edge(edge)
+        e = get_edge(edge)
         g = implicit_polynomial(k, e, "float")
         c = np.zeros((4, 4))
         for (a, b), x in g.items():

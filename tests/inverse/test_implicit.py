@@ -17,20 +17,10 @@ from hypothesis import strategies as st
 
 from ccproof.algebra.specialize import characteristic_map_patches, subdominant_eigenvalue
 from ccproof.errors import CCProofError
-from ccproof.inverse.implicit import (
-    EDGES,
-    RATIONAL_PAIRS,
-    FloatImplicit,
-    bezier_to_power,
-    determinant,
-    exact_sign,
-    implicit_polynomial,
-    inside_sign,
-    rational_implicit,
-    rational_nets,
-    sylvester_matrix,
-    symbolic_implicit,
-)
+from ccproof.inverse.data import bezier_to_power
+from ccproof.inverse.edges import EDGES
+from ccproof.inverse.implicit import FloatImplicit, exact_sign, implicit_polynomial, inside_sign, symbolic_implicit
+from ccproof.inverse.sylvester import RATIONAL_PAIRS, determinant, rational_implicit, rational_nets, sylvester_matrix
 
 EDGE_NAMES = sorted(EDGES)
 
