@@ -37,8 +37,8 @@ from importlib import import_module
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:  # the lazy names of _LAZY below, seen by type checkers (mypy in .ci/run) as what they are
-    from ccproof.apps.arap.core import parameterize
     from ccproof.apps.arap.export import write_uv_mesh
+    from ccproof.apps.arap.meshes import parameterize
     from ccproof.apps.dynamics.fit import fit_points
     from ccproof.certify.prover import prove_c1, prove_interval, prove_valence
     from ccproof.certify.verify import verify_file
@@ -78,7 +78,7 @@ _LAZY = {
     "PatchTable": "ccproof.evaluate",
     "characteristic_map": "ccproof.inverse.forward",
     "inverse_characteristic_map": "ccproof.inverse.algorithm",
-    "parameterize": "ccproof.apps.arap.core",
+    "parameterize": "ccproof.apps.arap.meshes",
     "write_uv_mesh": "ccproof.apps.arap.export",
     "fit_points": "ccproof.apps.dynamics.fit",
 }

@@ -100,10 +100,11 @@ def osd_folds(exe, path, levels=(1, 2, 3)):
 
 def arap(eval_level, out_dir, use_osd, refines=("0", "auto"), metric="auto"):
     from ccproof.apps.arap.charts import segment_by_normals
-    from ccproof.apps.arap.core import ChartTexture, auto_refine, compare, texture_metrics
+    from ccproof.apps.arap.core import ChartTexture, texture_metrics
     from ccproof.apps.arap.fvar import FOLD_LEVELS, export_control, subdivided_folds
     from ccproof.apps.arap.hierarchy import ChartHierarchy
     from ccproof.apps.arap.io import write_uv_obj
+    from ccproof.apps.arap.meshes import auto_refine, compare
     from ccproof.apps.arap.metrics import Metrics
     from ccproof.mesh import read_obj
 
@@ -172,8 +173,9 @@ def band(eval_level, chart, weights):
     from scipy.spatial import cKDTree
 
     from ccproof.apps.arap.charts import segment_by_normals
-    from ccproof.apps.arap.core import ChartTexture, auto_refine, compare, optimize_chart, refine_mesh, texture_metrics
+    from ccproof.apps.arap.core import ChartTexture, optimize_chart, texture_metrics
     from ccproof.apps.arap.fvar import corners_only_texture, metric_polish
+    from ccproof.apps.arap.meshes import auto_refine, compare, refine_mesh
     from ccproof.mesh import read_obj
 
     mesh = read_obj(BUNNY)

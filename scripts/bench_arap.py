@@ -42,13 +42,7 @@ from pathlib import Path
 import numpy as np
 
 from ccproof.apps.arap.charts import charts_from_labels, grow_patch, segment_by_normals
-from ccproof.apps.arap.core import (
-    ChartTexture,
-    initial_texture,
-    optimize_chart,
-    run_method,
-    texture_metrics,
-)
+from ccproof.apps.arap.core import ChartTexture, initial_texture, optimize_chart, run_method, texture_metrics
 from ccproof.apps.arap.hierarchy import ChartHierarchy
 from ccproof.apps.arap.metrics import Metrics
 from ccproof.apps.arap.samples import build_samples
@@ -180,7 +174,7 @@ def one_run(args):
     """Child process of --scale: one method on one mesh, printed as one JSON line."""
     import resource
 
-    from ccproof.apps.arap.core import auto_refine, compare, refine_mesh
+    from ccproof.apps.arap.meshes import auto_refine, compare, refine_mesh
 
     mesh = read_obj(args.mesh)
     if args.subdivide:

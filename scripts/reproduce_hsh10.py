@@ -33,15 +33,9 @@ from pathlib import Path
 import numpy as np
 
 from ccproof.apps.arap.charts import grow_patch, segment_by_normals
-from ccproof.apps.arap.core import (
-    METHOD_NAMES,
-    ChartTexture,
-    compare,
-    initial_texture,
-    optimize_chart,
-    texture_metrics,
-)
+from ccproof.apps.arap.core import METHOD_NAMES, ChartTexture, initial_texture, optimize_chart, texture_metrics
 from ccproof.apps.arap.hierarchy import ChartHierarchy
+from ccproof.apps.arap.meshes import compare
 from ccproof.apps.arap.metrics import sample_metrics
 from ccproof.apps.arap.samples import build_samples, limit_operator
 from ccproof.mesh import QuadMesh, read_obj

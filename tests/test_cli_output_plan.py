@@ -80,9 +80,9 @@ def test_fit_refuses_a_derived_name_beyond_the_name_limit(cloud, capsys):
 
 
 def test_arap_refuses_colliding_outputs_and_negative_levels_before_the_work(disk, monkeypatch, capsys):
-    import ccproof.apps.arap.core as core
+    import ccproof.apps.arap.meshes as meshes
 
-    monkeypatch.setattr(core, "compare", _no_work)
+    monkeypatch.setattr(meshes, "compare", _no_work)
     _refused(["arap", str(disk), "--out", "x.obj", "--control-out", "x.obj"], capsys, "--control-out", "same file")
     _refused(["arap", str(disk), "--out", "x.obj", "--labels-out", "x.obj.json"], capsys, "sidecar", "same file")
     _refused(["arap", str(disk), "--out", "x.obj", "--labels-out", str(disk)], capsys, "MESH", "replace an input")

@@ -155,7 +155,7 @@ def default_eval_level(mesh, labels, levels, with_d):
     below the optimization level, nor below 3 when (d) is measured (its texture lives at level 3)."""
     import numpy as np
 
-    from ccproof.apps.arap.core import mesh_charts
+    from ccproof.apps.arap.meshes import mesh_charts
 
     F = mesh.faces
     n = 0
@@ -187,8 +187,8 @@ def _levels_within_budget(args, mesh, labels, hierarchies, methods, refine):
     """(levels, eval level, out level): the options given, the others at their defaults, lowered one level at a
     time (the metrics' or the output's sampling level first, then the optimization's) while the estimated peak
     memory exceeds --max-memory; says on stderr what was lowered. When nothing given can be lowered enough, the
-    run refuses later by name (:class:`~ccproof.apps.arap.core.MemoryBudgetError`)."""
-    from ccproof.apps.arap.core import run_memory
+    run refuses later by name (:class:`~ccproof.apps.arap.meshes.MemoryBudgetError`)."""
+    from ccproof.apps.arap.meshes import run_memory
 
     budget = args.max_memory * 1e9
     levels = 3 if args.levels is None else args.levels
@@ -221,7 +221,8 @@ def _levels_within_budget(args, mesh, labels, hierarchies, methods, refine):
 def run(args) -> int:
     plan = _output_plan(args)  # every file written, and the options among themselves: before any work
     from ccproof.apps.arap.charts import read_labels, segment_by_normals
-    from ccproof.apps.arap.core import VARIANTS, auto_refine
+    from ccproof.apps.arap.core import VARIANTS
+    from ccproof.apps.arap.meshes import auto_refine
     from ccproof.apps.control_mesh import children_labels, read_control_mesh
     from ccproof.cli._progress import phase, progress_enabled
     from ccproof.errors import CCProofError
@@ -259,8 +260,8 @@ def run(args) -> int:
     elif engine == "auto":
         engine = "numpy"
     refine = auto_refine(mesh, labels) if refine is None else refine
-    from ccproof.apps.arap.core import mesh_charts
     from ccproof.apps.arap.hierarchy import ChartHierarchy
+    from ccproof.apps.arap.meshes import mesh_charts
 
     hierarchies = [ChartHierarchy(mesh, fc) for fc in mesh_charts(mesh, labels)]
     levels, eval_level, out_level = _levels_within_budget(args, mesh, labels, hierarchies, methods, refine)
@@ -321,7 +322,7 @@ MAX_FOLD_REFINE = 4
 
 def _optimize(args, mesh, labels, methods, engine, refine, eval_level, sample_level, hierarchies):
     """The methods' results at ``refine`` (compare, with the memory errors named)."""
-    from ccproof.apps.arap.core import MemoryBudgetError, compare
+    from ccproof.apps.arap.meshes import MemoryBudgetError, compare
     from ccproof.cli._progress import progress_enabled
     from ccproof.errors import CCProofError
 
@@ -341,7 +342,7 @@ def _optimize(args, mesh, labels, methods, engine, refine, eval_level, sample_le
 
 def _fits(args, hierarchies, methods, eval_level, sample_level, refine):
     """Whether ``refine`` keeps the estimated peak memory within --max-memory (and the metrics level above it)."""
-    from ccproof.apps.arap.core import run_memory
+    from ccproof.apps.arap.meshes import run_memory
 
     if refine > eval_level:
         return False

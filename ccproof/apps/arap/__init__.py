@@ -35,8 +35,8 @@ __all__ = [
 ]
 
 _WHERE = {
-    "compare": "core",
-    "parameterize": "core",
+    "compare": "meshes",
+    "parameterize": "meshes",
     "texture_metrics": "core",
     "charts_from_labels": "charts",
     "read_labels": "charts",

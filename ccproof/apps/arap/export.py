@@ -69,7 +69,7 @@ class SampledSurface:
     Examples
     --------
     >>> from ccproof.mesh.examples import grid
-    >>> from ccproof.apps.arap.core import compare
+    >>> from ccproof.apps.arap.meshes import compare
     >>> res, _ = compare(grid(3, 3), methods=("c",), levels=1, eval_level=3)
     >>> S = sampled_surface(res["c"], level=1)
     >>> S.points.shape, S.cells.shape, S.cell_type, bool(0 <= S.uv.min() and S.uv.max() <= 1)
@@ -120,7 +120,7 @@ def sample_chart(tex, level):
     Level 1 of a 3 x 3 grid has 6 x 6 quads on 7 x 7 vertices:
 
     >>> from ccproof.mesh.examples import grid
-    >>> from ccproof.apps.arap.core import compare
+    >>> from ccproof.apps.arap.meshes import compare
     >>> res, _ = compare(grid(3, 3), methods=("c",), levels=1, eval_level=3)
     >>> P, UV, Q = sample_chart(res["c"].textures[0], 1)
     >>> P.shape, UV.shape, Q.shape
@@ -237,7 +237,7 @@ def sampled_surface(result, level=3, cells="triangle", gap=0.02):
     Examples
     --------
     >>> from ccproof.mesh.examples import grid
-    >>> from ccproof.apps.arap.core import compare
+    >>> from ccproof.apps.arap.meshes import compare
     >>> res, _ = compare(grid(3, 3), methods=("c",), levels=1, eval_level=3)
     >>> sampled_surface(res["c"], level=1, cells="quad").cells.shape
     (36, 4)
@@ -300,7 +300,7 @@ def write_surface(path: str | os.PathLike[str], surf: SampledSurface, comment: s
     >>> import os, tempfile
     >>> import numpy as np
     >>> from ccproof.mesh.examples import grid
-    >>> from ccproof.apps.arap.core import compare
+    >>> from ccproof.apps.arap.meshes import compare
     >>> res, _ = compare(grid(3, 3), methods=("c",), levels=1, eval_level=3)
     >>> S = sampled_surface(res["c"], level=1)
     >>> tmp = tempfile.TemporaryDirectory()          # removed when the example ends
@@ -367,7 +367,7 @@ def read_surface(path):
     >>> import os, tempfile
     >>> import numpy as np
     >>> from ccproof.mesh.examples import grid
-    >>> from ccproof.apps.arap.core import compare
+    >>> from ccproof.apps.arap.meshes import compare
     >>> res, _ = compare(grid(3, 3), methods=("c",), levels=1, eval_level=3)
     >>> S = sampled_surface(res["c"], level=1, cells="quad")
     >>> tmp = tempfile.TemporaryDirectory()          # removed when the example ends
@@ -405,7 +405,7 @@ def write_uv_mesh(path: str | os.PathLike[str], result: MethodResult, level: int
     ----------
     path : str or os.PathLike
     result : MethodResult
-        Of :func:`~ccproof.apps.arap.core.parameterize` (or one method of ``compare``).
+        Of :func:`~ccproof.apps.arap.meshes.parameterize` (or one method of ``compare``).
     level : int
         Subdivision level of the samples (4^level triangles pairs per control face).
     cells : {"triangle", "quad"}

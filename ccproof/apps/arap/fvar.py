@@ -35,7 +35,7 @@ corners-only one (on a uniform flat grid every rule reproduces affine functions 
 
 >>> import numpy as np
 >>> from ccproof.mesh.examples import grid
->>> from ccproof.apps.arap.core import compare
+>>> from ccproof.apps.arap.meshes import compare
 >>> labels = -np.ones(25, dtype=int)
 >>> labels[[6, 7, 8, 11, 12, 13, 16, 17, 18]] = 0
 >>> res, _ = compare(grid(5, 5), labels, methods=("c",), levels=1, eval_level=3)
@@ -74,7 +74,7 @@ METRIC_WEIGHTS = ((1.3, 1.0), (1.6, 1.0), (2.0, 2.0))
 
 def _refined_chart(h: ChartHierarchy, times, mesh=None):
     """The chart of ``h`` on its control mesh subdivided ``times`` times (children 4^t f .. 4^t f + 4^t - 1)."""
-    from ccproof.apps.arap.core import refine_mesh
+    from ccproof.apps.arap.meshes import refine_mesh
 
     if mesh is None:
         mesh, _ = refine_mesh(h.surface, None, times)
@@ -468,7 +468,8 @@ def export_control(result, eval_level=5, max_extra=2, max_excess_ratio=1.05, fit
     ControlExport
         The accepted refinement, or the best one tried (fewest folds, then smallest largest excess ratio).
     """
-    from ccproof.apps.arap.core import ChartTexture, optimize_chart, refine_mesh, texture_metrics
+    from ccproof.apps.arap.core import ChartTexture, optimize_chart, texture_metrics
+    from ccproof.apps.arap.meshes import refine_mesh
 
     if metric not in ("auto", True, False):
         raise CCProofError(f"metric must be 'auto', True or False, got {metric!r}")

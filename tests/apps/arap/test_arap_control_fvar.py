@@ -182,9 +182,9 @@ def test_default_refine_control_out_meets_the_target(tmp_path, capsys):
 
 def test_library_rule_is_the_independent_rule(tmp_path):
     """The boundary rules with surface_corners=True subdivide the written UVs exactly as the rule above."""
-    from ccproof.apps.arap.core import compare
     from ccproof.apps.arap.fvar import export_control
     from ccproof.apps.arap.io import write_uv_obj
+    from ccproof.apps.arap.meshes import compare
 
     m, chart = M.curved_ev_mesh()
     labels = np.array([0 if f in set(chart) else -1 for f in range(m.n_faces)])
@@ -284,9 +284,10 @@ def _osd_subdivide(exe, path, level):
 def test_opensubdiv_subdivides_the_control_uvs_as_the_rule_and_they_do_not_fold(tmp_path, osd_driver):
     from scipy.spatial import cKDTree
 
-    from ccproof.apps.arap.core import MethodResult, compare
+    from ccproof.apps.arap.core import MethodResult
     from ccproof.apps.arap.fvar import export_control
     from ccproof.apps.arap.io import write_uv_obj
+    from ccproof.apps.arap.meshes import compare
 
     m, chart = M.curved_ev_mesh()
     labels = np.array([0 if f in set(chart) else -1 for f in range(m.n_faces)])
@@ -400,9 +401,10 @@ def test_export_control_minimax_keeps_no_fold_and_does_not_raise_the_largest_rat
     """metric=True on a chart whose ARAP polish misses the target: the largest excess ratio does not rise, the
     written UVs have no folded triangle at levels 1-3 under the independent rule, and the ARAP-only metrics are
     those of metric=False."""
-    from ccproof.apps.arap.core import MethodResult, compare
+    from ccproof.apps.arap.core import MethodResult
     from ccproof.apps.arap.fvar import METRIC_WEIGHTS, export_control
     from ccproof.apps.arap.io import write_uv_obj
+    from ccproof.apps.arap.meshes import compare
 
     m, chart = M.curved_ev_mesh()
     labels = np.array([0 if f in set(chart) else -1 for f in range(m.n_faces)])

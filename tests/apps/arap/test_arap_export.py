@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 from scipy.spatial import cKDTree
 
-from ccproof.apps.arap.core import compare
 from ccproof.apps.arap.export import pack_charts, read_surface, sampled_surface, write_surface
+from ccproof.apps.arap.meshes import compare
 from ccproof.cli import main
 from ccproof.mesh import QuadMesh, limit_positions, subdivide, write_obj
 
@@ -178,13 +178,13 @@ def test_cli_writes_surface_and_control_mesh(tmp_path, capsys):
 
 
 def test_memory_budget_is_checked_before_allocating(ev_case):
-    from ccproof.apps.arap.core import MemoryBudgetError, estimate_memory
     from ccproof.apps.arap.hierarchy import ChartHierarchy
+    from ccproof.apps.arap.meshes import MemoryBudgetError, estimate_memory
 
     m, lab, _ = ev_case
     chart = np.flatnonzero(lab >= 0)
     h = ChartHierarchy(m, chart)
-    from ccproof.apps.arap.core import BASE_BYTES
+    from ccproof.apps.arap.meshes import BASE_BYTES
 
     e4, e5 = estimate_memory([h], 4), estimate_memory([h], 5)
     assert e5 - BASE_BYTES == pytest.approx(4 * (e4 - BASE_BYTES))  # linear in the faces of the deepest level
@@ -210,8 +210,9 @@ def test_cli_memory_error_names_the_option(tmp_path, capsys):
 def test_release_and_refine_keep_the_texture(ev_case):
     """Charts processed one at a time give the same numbers; the texture lifted to the refined mesh is
     the same map (same metric samples: the refined mesh's level k - r is the input's level k)."""
-    from ccproof.apps.arap.core import lift_to_refined, refine_mesh, texture_metrics
+    from ccproof.apps.arap.core import lift_to_refined, texture_metrics
     from ccproof.apps.arap.hierarchy import ChartHierarchy
+    from ccproof.apps.arap.meshes import refine_mesh
 
     m, lab, res = ev_case
     r2, _ = compare(m, lab, ("c",), levels=2, eval_level=2, release=True)

@@ -64,9 +64,9 @@ def test_default_refinement_writes_no_fold(refdir, tmp_path, capsys):
 
 def test_default_refine_that_folds_is_refined_until_none_fold(refdir, tmp_path, capsys, monkeypatch):
     """The default --refine (here made to pick 0, which folds) is raised until the written UVs do not fold."""
-    import ccproof.apps.arap.core as core
+    import ccproof.apps.arap.meshes as meshes
 
-    monkeypatch.setattr(core, "auto_refine", lambda mesh, labels: 0)
+    monkeypatch.setattr(meshes, "auto_refine", lambda mesh, labels: 0)
     out = tmp_path / "uv.obj"
     assert main(_base(refdir, out)) == 0
     err = capsys.readouterr().err

@@ -11,8 +11,9 @@ import numpy as np
 import pytest
 
 from ccproof.apps.arap.charts import grow_patch
-from ccproof.apps.arap.core import ChartTexture, compare, initial_texture, optimize_chart, texture_metrics
+from ccproof.apps.arap.core import ChartTexture, initial_texture, optimize_chart, texture_metrics
 from ccproof.apps.arap.hierarchy import ChartHierarchy
+from ccproof.apps.arap.meshes import compare
 from ccproof.mesh import read_obj
 from ccproof.mesh.examples import k_regular_disk
 

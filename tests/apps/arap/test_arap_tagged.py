@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 from ccproof.apps.arap.charts import segment_by_normals
-from ccproof.apps.arap.core import compare
 from ccproof.apps.arap.export import sample_chart
+from ccproof.apps.arap.meshes import compare
 from ccproof.apps.control_mesh import TaggedQuadMesh, read_control_mesh, subdivide_control, tagged_step
 from ccproof.evaluate import LimitSurface
 from ccproof.mesh.io import read_mesh
