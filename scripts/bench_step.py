@@ -29,7 +29,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ccproof.apps.control_mesh import read_control_mesh, subdivide_control, tags_of, vertex_rules
+from ccproof.apps.control_file import read_control_mesh
+from ccproof.apps.control_mesh import subdivide_control, tags_of, vertex_rules
 from ccproof.mesh import QuadMesh, subdivide
 from ccproof.rule_weights import (
     crease_vertex_weights,

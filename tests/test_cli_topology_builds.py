@@ -106,7 +106,7 @@ def test_eval_and_project_build_the_topology_once(builds, meshes, tmp_path, caps
 @pytest.mark.parametrize("command", ["arap", "fit"])
 @pytest.mark.parametrize("kind", ["quad", "tagged", "tri"])
 def test_arap_and_fit_build_the_control_topology_once(builds, meshes, tmp_path, capsys, command, kind):
-    from ccproof.apps.control_mesh import read_control_mesh
+    from ccproof.apps.control_file import read_control_mesh
 
     control, _ = read_control_mesh(meshes[kind])  # (before the counting)
     control_key = _key(control.n_vertices, control.faces, 4 * np.arange(control.n_faces + 1))

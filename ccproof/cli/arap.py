@@ -223,7 +223,7 @@ def run(args) -> int:
     from ccproof.apps.arap.charts import read_labels, segment_by_normals
     from ccproof.apps.arap.core import VARIANTS
     from ccproof.apps.arap.meshes import auto_refine
-    from ccproof.apps.control_mesh import children_labels, read_control_mesh
+    from ccproof.apps.control_file import children_labels, read_control_mesh
     from ccproof.cli._progress import phase, progress_enabled
     from ccproof.errors import CCProofError
 

@@ -99,7 +99,7 @@ def run(args) -> int:
     plan = _output_plan(args)  # before any work
     import numpy as np
 
-    from ccproof.apps.control_mesh import merge_labels, read_control_mesh, write_control_obj
+    from ccproof.apps.control_file import merge_labels, read_control_mesh, write_control_obj
     from ccproof.apps.dynamics.fit import fit_points
     from ccproof.apps.dynamics.model import Material
     from ccproof.cli._notice import compile_notice

@@ -8,7 +8,7 @@ culprit.
 import numpy as np
 import pytest
 
-from ccproof.apps.control_mesh import read_control_mesh
+from ccproof.apps.control_file import read_control_mesh
 from ccproof.errors import MeshError
 from ccproof.evaluate import natural_limit_surface
 from ccproof.mesh.io import read_mesh

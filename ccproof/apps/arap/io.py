@@ -81,7 +81,7 @@ def write_uv_obj(path, mesh, result, comment=None, table=None, transforms=None, 
     ``transforms`` (list of (R, t) per chart) and ``scale``: the packing of
     :func:`~ccproof.apps.arap.export.pack_charts` (texture point ``scale * (uv @ R.T + t)``).
     The OBJ of ``ccproof arap`` (docs/hsh10.md); a tagged mesh's tags as ``t`` lines; a non-manifold file's
-    split copies of a vertex as one vertex (:func:`~ccproof.apps.control_mesh.merge_labels`; the sidecar's chart
+    split copies of a vertex as one vertex (:func:`~ccproof.apps.control_file.merge_labels`; the sidecar's chart
     ``vertices`` in that numbering). Both files are written atomically (a temporary file in the same folder,
     then ``os.replace``).
 
@@ -147,7 +147,7 @@ def write_uv_obj(path, mesh, result, comment=None, table=None, transforms=None, 
             }
         )
         base += uv.shape[0]
-    from ccproof.apps.control_mesh import merge_labels, merged_copies
+    from ccproof.apps.control_file import merge_labels, merged_copies
     from ccproof.mesh.write import atomic_path, obj_tag_lines
 
     tag_lines = obj_tag_lines(mesh)

@@ -445,7 +445,7 @@ class FitResult:
     mesh : QuadMesh or None
         The fitted control mesh (data units). From a non-manifold start mesh: the split mesh, its
         ``file_vertex`` labelling the copies of one vertex (which the fit keeps at one point;
-        :func:`ccproof.apps.control_mesh.write_control_obj` writes it merged, in the file's numbering).
+        :func:`ccproof.apps.control_file.write_control_obj` writes it merged, in the file's numbering).
     model : DynamicSurface or None
     levels : list of FitLevel
     center : ndarray, shape (3,), optional

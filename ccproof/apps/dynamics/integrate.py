@@ -243,7 +243,7 @@ class ImplicitIntegrator:
         Element-by-element products instead of the assembled matrix.
     copies : array_like of int, shape (n,), optional
         Rows of the state that are one point (the copies of one vertex of a non-manifold file,
-        :func:`ccproof.apps.control_mesh.read_control_mesh`): ``copies[i]`` is the label of row i, the
+        :func:`ccproof.apps.control_file.read_control_mesh`): ``copies[i]`` is the label of row i, the
         labels ``0 .. r-1``. The state is then ``P = E Y`` (``E`` the 0/1 (n, r) matrix of the labels) and
         each step solves ``E^T A E Y = E^T b`` for the r free points (forces, stiffness and mass pulled
         back by ``E^T``), so the copies move together. None (default): every row is free.

@@ -5,7 +5,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ccproof.apps.control_mesh import read_control_mesh
+from ccproof.apps.control_file import read_control_mesh
 from ccproof.mesh.io import read_obj_polygons
 
 MESHES = Path(__file__).resolve().parents[2] / "data" / "osd_nonmanifold" / "meshes"

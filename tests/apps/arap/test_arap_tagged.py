@@ -13,7 +13,8 @@ import pytest
 from ccproof.apps.arap.charts import segment_by_normals
 from ccproof.apps.arap.export import sample_chart
 from ccproof.apps.arap.meshes import compare
-from ccproof.apps.control_mesh import TaggedQuadMesh, read_control_mesh, subdivide_control, tagged_step
+from ccproof.apps.control_file import read_control_mesh
+from ccproof.apps.control_mesh import TaggedQuadMesh, subdivide_control, tagged_step
 from ccproof.evaluate import LimitSurface
 from ccproof.mesh.io import read_mesh
 

@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ccproof.apps.control_mesh import read_control_mesh, write_control_obj
+from ccproof.apps.control_file import read_control_mesh, write_control_obj
 from ccproof.apps.dynamics.fit import fit_points, limit_surface_mesh
 from ccproof.apps.dynamics.integrate import ImplicitIntegrator, MatrixSystem
 from ccproof.mesh.io import read_obj_polygons
@@ -106,7 +106,7 @@ def test_cli_fit_nonmanifold(tmp_path):
 def test_written_control_mesh_reads_back(tmp_path, name):
     """``write_control_obj`` of the split control mesh: the copies merged (the file's vertex count), except for
     collapsed (degenerate faces: written split); read back, the same split mesh size and limit surface."""
-    from ccproof.apps.control_mesh import merge_labels
+    from ccproof.apps.control_file import merge_labels
 
     path = MESHES / f"{name}.obj"
     V, _, _ = read_obj_polygons(path)

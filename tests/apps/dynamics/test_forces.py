@@ -148,7 +148,7 @@ def test_tagged_model_moves_its_evaluator_without_a_rebuild(refdir, monkeypatch)
     state (``LimitSurface.with_vertices``: no build per query); the answers are those of a finder on a surface
     built from scratch on the moved mesh, bit for bit, and the attachment points are the FEM model's own
     limit points (its tagged elements, not ccproof.evaluate)."""
-    from ccproof.apps.control_mesh import read_control_mesh
+    from ccproof.apps.control_file import read_control_mesh
     from ccproof.apps.dynamics.forces import _evaluated_mesh
     from ccproof.evaluate import LimitSurface
     from ccproof.evaluate.closest import ClosestPointFinder

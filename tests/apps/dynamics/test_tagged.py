@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from ccproof.apps.control_mesh import TaggedQuadMesh, read_control_mesh, subdivide_control, tagged_step, tags_of
+from ccproof.apps.control_file import read_control_mesh
+from ccproof.apps.control_mesh import TaggedQuadMesh, subdivide_control, tagged_step, tags_of
 from ccproof.apps.dynamics.meshes import paper_initial_model
 from ccproof.apps.dynamics.model import DynamicSurface, Material
 from ccproof.apps.dynamics.tagged import TaggedElement
