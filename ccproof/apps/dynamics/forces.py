@@ -309,7 +309,7 @@ class ModelClosestPoints:
 
     >>> from ccproof.apps.dynamics.meshes import paper_initial_model
     >>> from ccproof.apps.dynamics.model import DynamicSurface
-    >>> from ccproof.apps.dynamics.fit import limit_surface_mesh
+    >>> from ccproof.apps.dynamics.cloud import limit_surface_mesh
     >>> m = DynamicSurface(paper_initial_model())
     >>> X = limit_surface_mesh(m.mesh, 1).vertices                                     # doctest: +SKIP
     >>> res = ModelClosestPoints(m).query(m.vertices, X)                                 # doctest: +SKIP

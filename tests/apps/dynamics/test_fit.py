@@ -5,7 +5,8 @@ import itertools
 import numpy as np
 import pytest
 
-from ccproof.apps.dynamics.fit import fit_points, minimal_enclosing_sphere, read_points
+from ccproof.apps.dynamics.cloud import minimal_enclosing_sphere
+from ccproof.apps.dynamics.fit import fit_points, read_points
 from ccproof.apps.dynamics.meshes import (
     flat_sheet,
     genus2_surface,
@@ -146,7 +147,7 @@ def test_q9_fit_ellipsoid_98_then_386():
     assert l1.mean_error_percent < l0.mean_error_percent
     # the returned mesh is in the data's coordinates: its limit surface is close to the data
     model = DynamicSurface(res.mesh)
-    from ccproof.apps.dynamics.fit import fit_error
+    from ccproof.apps.dynamics.cloud import fit_error
 
     err = fit_error(model, np.asarray(res.mesh.vertices), X)
     assert err["max_percent"] == pytest.approx(l1.max_error_percent, rel=0.05)

@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from ccproof.apps.control_file import read_control_mesh, write_control_obj
-from ccproof.apps.dynamics.fit import fit_points, limit_surface_mesh
+from ccproof.apps.dynamics.cloud import limit_surface_mesh
+from ccproof.apps.dynamics.fit import fit_points
 from ccproof.apps.dynamics.integrate import ImplicitIntegrator, MatrixSystem
 from ccproof.mesh.io import read_obj_polygons
 

@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 from scipy.spatial import cKDTree
 
-from ccproof.apps.dynamics.fit import fit_points, limit_surface_mesh
+from ccproof.apps.dynamics.cloud import limit_surface_mesh
+from ccproof.apps.dynamics.fit import fit_points
 from ccproof.apps.dynamics.forces import Springs, SurfaceToDataSprings
 from ccproof.apps.dynamics.meshes import paper_initial_model
 from ccproof.apps.dynamics.model import DynamicSurface
