@@ -63,7 +63,8 @@ def clustered(k, rng, n, eps=1e-12):
 
 def location_only(k, u, v):
     from ccproof.inverse.algorithm import locate
-    from ccproof.inverse.data import CHUNK, valence_data
+    from ccproof.inverse.data import valence_data
+    from ccproof.inverse.kernels import CHUNK
 
     D = valence_data(k)
     n = u.shape[0]

@@ -42,18 +42,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ccproof.errors import CCProofError, check_valence
-from ccproof.inverse.data import (
-    CHUNK,
-    FIT_DEGREE,
-    NMAX,
-    SAFE_HI,
-    SAFE_LO,
-    approx_log,
-    as_points,
-    patch_eval_jac,
-    polynomial_rows,
-    valence_data,
-)
+from ccproof.inverse.data import FIT_DEGREE, NMAX, valence_data
+from ccproof.inverse.kernels import CHUNK, SAFE_HI, SAFE_LO, approx_log, as_points, patch_eval_jac, polynomial_rows
 
 #: Newton steps done for every point before the first convergence check
 NEWTON_STEPS = 2

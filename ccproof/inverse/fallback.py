@@ -28,7 +28,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ccproof.inverse.data import NMAX, patch_eval
+from ccproof.inverse.data import NMAX
+from ccproof.inverse.kernels import patch_eval
 
 #: first level at which Newton is tried from the surviving box centres
 NEWTON_LEVEL = 8

@@ -20,16 +20,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ccproof.errors import check_valence
-from ccproof.inverse.data import (
-    NMAX,
-    SAFE_HI,
-    SAFE_LO,
-    as_points,
-    chunks,
-    patch_eval,
-    patch_eval_jac,
-    valence_data,
-)
+from ccproof.inverse.data import NMAX, valence_data
+from ccproof.inverse.kernels import SAFE_HI, SAFE_LO, as_points, chunks, patch_eval, patch_eval_jac
 
 
 @overload
