@@ -23,8 +23,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _bench import load, ratio_line  # noqa: E402
 
 from ccproof.evaluate import limit_surface  # noqa: E402
-from ccproof.evaluate.closest import ClosestPointFinder, newton  # noqa: E402
+from ccproof.evaluate.closest import ClosestPointFinder
 from ccproof.evaluate.closest_certified import certify_closest  # noqa: E402
+from ccproof.evaluate.newton import newton  # noqa: E402
 from ccproof.mesh.examples import torus  # noqa: E402
 
 BUNNY = Path(__file__).resolve().parents[1] / "tests" / "data" / "meshes" / "bunny_quads.obj"

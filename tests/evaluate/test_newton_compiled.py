@@ -6,7 +6,8 @@ import pytest
 from ccproof import limit_surface
 from ccproof.errors import CCProofError
 from ccproof.evaluate import natural_limit_surface
-from ccproof.evaluate.closest import closest_points, newton
+from ccproof.evaluate.closest import closest_points
+from ccproof.evaluate.newton import newton
 from ccproof.mesh.examples import torus
 from ccproof.mesh.io import read_mesh
 
