@@ -699,7 +699,7 @@ class LimitSurface:
         of :attr:`PolyMesh.manifold <ccproof.mesh.polymesh.PolyMesh.manifold>` (``X[manifold_vertex_map]``)
         on an all-quad mesh, else its level-1 vertices, recomputed as the build computes them (the
         vectorized untagged step :func:`ccproof.evaluate._table.catmark_step`, or the tagged step that
-        the build ran, kept by it as CSR arrays (:class:`ccproof.mesh.step.PackedCSR`, 24 bytes per ptex
+        the build ran, kept by it as CSR arrays (:class:`ccproof.mesh.csr.PackedCSR`, 24 bytes per ptex
         face on a tagged triangle mesh, docs/evaluate.md; shared by the derived surfaces) and applied as
         :meth:`PolyMesh.refine` applies it: no move repeats the step).
 

@@ -34,9 +34,9 @@ import math
 import numpy as np
 
 from ccproof.evaluate._table import Builder, Jobs, TaggedHalfEdges, catmark_step, child_frame, compose, domain
+from ccproof.mesh.csr import pack_csr
 from ccproof.mesh.halfedges import HalfEdges
 from ccproof.mesh.polymesh import PolyMesh
-from ccproof.mesh.step import pack_csr
 
 __all__ = ["build_tagged", "vertex_corners"]
 
@@ -53,7 +53,7 @@ def build_tagged(mesh: PolyMesh, progress=None, keep=None):
         As in :class:`ccproof.evaluate.surface.LimitSurface`.
     keep : dict, optional
         Receives, where the build runs the tagged level-1 step (a tagged mesh that is not all quads),
-        that step under ``"step"`` (:class:`~ccproof.mesh.step.PackedCSR`, the columns the vertices of
+        that step under ``"step"`` (:class:`~ccproof.mesh.csr.PackedCSR`, the columns the vertices of
         :attr:`PolyMesh.manifold`): what :meth:`LimitSurface.with_vertices
         <ccproof.evaluate.surface.LimitSurface.with_vertices>` re-applies to moved vertices.
 

@@ -688,7 +688,7 @@ class PolyMesh:
             ``S @ self.vertices`` equals up to rounding (the copies' weights merged, other column order).
             With ``operator="csr"``: ``(indptr, indices, data)`` (:attr:`ccproof.mesh.step.Step.csr`) of the
             step of :attr:`manifold`, its columns that mesh's vertices, an unused vertex's row empty:
-            ``refined.vertices == apply_csr(csr, manifold.vertices)`` (:func:`ccproof.mesh.step.apply_csr`)
+            ``refined.vertices == apply_csr(csr, manifold.vertices)`` (:func:`ccproof.mesh.csr.apply_csr`)
             but on the unused vertices' rows (NaN there).
         """
         if self.manifold is not self:
@@ -696,7 +696,8 @@ class PolyMesh:
                 return self.manifold.refine(operator)
             m, _ = self.manifold.refine(operator=False)
             return m, (self.subdivision_operator() if operator else None)
-        from ccproof.mesh.step import apply_csr, decrement_sharpness
+        from ccproof.mesh.csr import apply_csr
+        from ccproof.mesh.step import decrement_sharpness
 
         st = self._step(sparse=False)
         n = self.n_vertices

@@ -105,7 +105,7 @@ def test_tagged_with_vertices_paths(refdir, monkeypatch):
     step (nothing kept), the tagged step (kept by the build, shared when chained, never recomputed)."""
     feats = refdir / "osd_features" / "meshes"
     from ccproof.evaluate._table import catmark_step
-    from ccproof.mesh.step import PackedCSR
+    from ccproof.mesh.csr import PackedCSR
 
     assert catmark_step(_read(refdir, "", "pyramid")) is not None  # the vectorized path is tested above
     quads = LimitSurface(read_mesh(refdir / "osd_nonmanifold" / "meshes" / "book4.obj"), progress=False)

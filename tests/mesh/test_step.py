@@ -17,10 +17,11 @@ import math
 import numpy as np
 import pytest
 
+from ccproof.mesh.csr import apply_csr
 from ccproof.mesh.io import read_mesh
 from ccproof.mesh.polymesh import PolyMesh
 from ccproof.mesh.rules import refine_complex, to_float
-from ccproof.mesh.step import apply_csr, catmark_operator
+from ccproof.mesh.step import catmark_operator
 
 FEATURES = ["catmark_chaikin1.obj", "catmark_cube_corner2.obj", "catmark_cube_corner4.obj",
             "catmark_cube_creases0.obj", "catmark_cubes_infsharp.obj", "catmark_dart_edgeonly.obj",
@@ -254,7 +255,7 @@ def test_halfedges_of_another_mesh_are_refused():
 def test_pack_csr_widens_the_indices_past_int32():
     """Indices that do not fit 32 bits (a column index 2**31, or 2**31 stored entries in indptr) stay int64;
     one below the limit is packed to int32. Small arrays stand for the huge mesh (only the values matter)."""
-    from ccproof.mesh.step import pack_csr
+    from ccproof.mesh.csr import pack_csr
 
     data = np.array([0.25, 0.5, 0.25])
     for top, want in ((2**31 - 2, np.int32), (2**31 - 1, np.int64), (2**31, np.int64)):
@@ -360,7 +361,7 @@ def test_pack_csr_restores_the_bits():
     unpacked int64 arrays."""
     import scipy.sparse as sp
 
-    from ccproof.mesh.step import apply_csr, pack_csr
+    from ccproof.mesh.csr import apply_csr, pack_csr
 
     rng = np.random.default_rng(5)
     for k in (3, 300):
