@@ -9,7 +9,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-__all__ = ["apply_csr", "PackedCSR", "pack_csr"]
+__all__ = ["apply_csr", "PackedCSR", "pack_csr", "csr_matrix_with_empty_rows"]
 
 
 def apply_csr(csr, X, out=None):
@@ -131,3 +131,19 @@ def pack_csr(csr):
     itype = np.int32 if small else np.int64
     return PackedCSR(np.asarray(indptr, dtype=itype), np.asarray(indices, dtype=itype),
                      codes.reshape(-1).astype(ctype), bits.view(np.float64))
+
+
+def csr_matrix_with_empty_rows(csr, unused, ncols):
+    """The scipy CSR matrix of the CSR arrays ``csr`` with NaN at column 0 of the (empty) rows ``unused``
+    (an unused vertex has no vertex point)."""
+    import scipy.sparse as sp
+
+    indptr, indices, data = csr
+    N = indptr.size - 1
+    if unused.size:  # empty rows: the NaN entries go after the entries of the rows before them
+        rows = np.r_[np.repeat(np.arange(N), np.diff(indptr)), unused]
+        o = np.argsort(rows, kind="stable")
+        indices = np.r_[indices, np.zeros(unused.size, dtype=np.int64)][o]
+        data = np.r_[data, np.full(unused.size, np.nan)][o]
+        indptr = np.r_[0, np.cumsum(np.bincount(rows, minlength=N))]
+    return sp.csr_matrix((data, indices, indptr), shape=(N, ncols))

@@ -21,7 +21,7 @@ more than two faces or two faces in the same direction, e.g. a face given twice,
 ``Far::TopologyRefinerFactory``: such edges infinitely sharp, such vertices infinitely sharp
 corners but on an interior non-manifold crease). :attr:`PolyMesh.manifold` is the mesh the surface
 is evaluated on: the fans of every non-manifold vertex split apart (see
-:meth:`PolyMesh._split_nonmanifold`), the same faces.
+:func:`ccproof.mesh.nonmanifold.split_nonmanifold`), the same faces.
 """
 
 from __future__ import annotations
@@ -29,30 +29,17 @@ from __future__ import annotations
 import functools
 import itertools
 import math
-import warnings
 
 import numpy as np
 
 from ccproof.errors import MeshError
+from ccproof.mesh.csr import csr_matrix_with_empty_rows
 from ccproof.mesh.halfedges import HalfEdges
 from ccproof.mesh.quadmesh import check_used_finite
-from ccproof.mesh.rules import INFINITE, Complex, Options, refine_complex
+from ccproof.mesh.rules import Complex, Options, refine_complex
+from ccproof.mesh.tags import corner_tags, crease_tags
 
 __all__ = ["PolyMesh"]
-
-
-def _sharp_value(x, what):
-    try:
-        s = float(x)
-    except (TypeError, ValueError):
-        raise MeshError(f"{what}: sharpness {x!r} is not a number") from None
-    if math.isnan(s):
-        raise MeshError(f"{what}: sharpness is NaN")
-    if s < 0:
-        raise MeshError(f"{what}: negative sharpness {s!r}")
-    if s >= INFINITE:
-        return math.inf
-    return float(np.float32(s))  # OpenSubdiv stores sharpness as float32
 
 
 class PolyMesh:
@@ -150,8 +137,8 @@ class PolyMesh:
             options = Options(**options)
         self.options = options
         self._build_topology(_halfedges)
-        self.edge_sharpness = self._creases(creases)
-        self.vertex_sharpness = self._corners(corners)
+        self.edge_sharpness = crease_tags(self.halfedges, creases)
+        self.vertex_sharpness = corner_tags(self.vertices.shape[0], corners)
         if self.edge_sharpness or self.vertex_sharpness:  # the tags as arrays on the one topology
             self.halfedges = self.halfedges.with_tags(self.edge_sharpness, self.vertex_sharpness)
         m = int(sz.size)
@@ -246,9 +233,6 @@ class PolyMesh:
         # gives each such occurrence an edge of its own with one face (a boundary edge), so that both
         # ends are sharpened (corners)
         self._repeat_edge = he.repeat_edge
-        self._sharpened_by_degenerate = np.zeros(n, dtype=bool)
-        self._sharpened_by_degenerate[he.edges[he.repeat_edge].reshape(-1)] = True
-        self._edge_halfedge = he.edge_halfedge  # one half-edge of every edge
         self.edges = he.edges
         self.edge_face_count = he.edge_face_count
         self.is_boundary_edge = he.edge_face_count == 1
@@ -257,7 +241,6 @@ class PolyMesh:
         self.edge_of_halfedge = he.edge_of
         self.face_count = he.face_count
         self.is_nonmanifold_vertex = he.is_nonmanifold_vertex
-        self._fan_of_corner = he.fan_of_corner
         self.is_boundary_vertex = he.is_boundary_vertex
         self.is_unused_vertex = self.face_count == 0
 
@@ -272,237 +255,11 @@ class PolyMesh:
         return self.edges[self.is_nonmanifold_edge]
 
     def _split_nonmanifold(self):
-        """The manifold mesh on which the limit surface is evaluated, and its vertex map.
+        """The manifold mesh on which the limit surface is evaluated, and its vertex map:
+        :func:`ccproof.mesh.nonmanifold.split_nonmanifold`."""
+        from ccproof.mesh.nonmanifold import split_nonmanifold
 
-        OpenSubdiv (``Far::TopologyRefinerFactory::prepareComponentTagsAndSharpness``) makes every
-        non-manifold edge infinitely sharp and every non-manifold vertex an infinitely sharp corner,
-        except on an interior non-manifold crease (two non-manifold edges, no boundary edge, more
-        faces than edges), whose vertex follows the crease rule along the two non-manifold edges.
-        Its patches (``Far::PatchBuilder``) see, at a non-manifold vertex, only the fan of faces
-        between two singular edges. Both say that each fan of a non-manifold vertex may be a
-        vertex of its own: the fans are split apart into copies (the first fan keeps the vertex
-        index, the others get indices n, n+1, ...), the non-manifold edges become boundary edges,
-        sharpened vertices get infinite vertex sharpness. Every rule then acts on the copies as
-        OpenSubdiv's acts on the vertex. A crease vertex with other semi-sharp edges is a corner
-        until the last of them has decayed: its copies get that edge's sharpness as vertex sharpness
-        (same rule at every level, same fractional weight). A crease vertex's fan not bounded by both
-        non-manifold edges (a fin, a closed fan) cannot see both crease neighbours: its copy is made
-        an infinitely sharp corner (:meth:`_fans_off_the_crease`; the one surface here that is not
-        OpenSubdiv's, documented in docs/evaluate.md). Cases where no split comes close are refused
-        by name: a crease vertex whose last semi-sharp features have different values, and Chaikin
-        creases with semi-sharp edges in more than one fan of a non-manifold vertex or at a crease
-        vertex.
-
-        Returns
-        -------
-        PolyMesh
-            Same faces, in order (same ptex faces), vertices ``vertices[vmap]``, all-infinite tags
-            on the split edges, the tags of the mesh and boundary mode ``edge_only`` (the mesh's
-            mode applied: ``edge_and_corner`` corners as vertex sharpness, ``none`` holes as holes).
-        vmap : ndarray of int, shape (n',)
-            Vertex of this mesh of every vertex of the split mesh (``vmap[:n] = arange(n)``).
-        """
-        n = self.n_vertices
-        label, vmap, new = self._fan_copies()
-        vsharp = {int(v): s for v, s in self.vertex_sharpness.items()}
-        sharp_fans, fin_vertices = self._sharpen_nonmanifold(vsharp)
-        if fin_vertices:
-            warnings.warn(f"non-manifold crease vertices {fin_vertices[:10]}{' ...' if len(fin_vertices) > 10 else ''}"
-                          f" ({len(fin_vertices)}): a fan not bounded by both non-manifold edges (a fin) is made a "
-                          "sharp corner; OpenSubdiv's crease rule there needs a vertex outside the fan, so near "
-                          "these vertices the surface differs from OpenSubdiv's (docs/evaluate.md)", stacklevel=2)
-        if self.options.boundary == "edge_and_corner":
-            corner = (self.face_count == 1) & self.is_boundary_vertex & ~self.is_nonmanifold_vertex
-            for v in np.flatnonzero(corner).tolist():
-                vsharp[v] = math.inf
-        creases = self._split_creases(new)
-        corners = _split_corners(vsharp, vmap, n, sharp_fans, label)
-        opts = Options("edge_only", self.options.crease_method, self.options.triangle_subdivision)
-        try:
-            m = PolyMesh(self.vertices[vmap], np.asarray(new, dtype=np.int64), sizes=self.sizes,
-                         creases=creases or None, corners=corners or None,
-                         holes=np.flatnonzero(self.is_hole), options=opts, _split=False)
-        except MeshError as exc:
-            raise MeshError(f"non-manifold mesh not supported after splitting its non-manifold vertices: "
-                            f"{exc}") from None
-        m.level = self.level
-        return m, vmap
-
-    def _fan_copies(self):
-        """(label, vmap, new) of :meth:`_split_nonmanifold`: the split vertex of every fan (the first fan of a
-        vertex keeps its index, the others get n, n+1, ...), the vertex of every split vertex, the split
-        vertex of every corner."""
-        n, H = self.n_vertices, self.indices.size
-        org, comp = self.indices, self._fan_of_corner
-        ncomp = int(comp.max()) + 1
-        first_corner = np.full(ncomp, H, dtype=np.int64)
-        np.minimum.at(first_corner, comp, np.arange(H))
-        cv = org[first_corner]
-        o = np.lexsort((first_corner, cv))
-        lead = np.r_[True, cv[o][1:] != cv[o][:-1]]
-        label = np.empty(ncomp, dtype=np.int64)
-        label[o[lead]] = cv[o[lead]]
-        extra = o[~lead]
-        label[extra] = n + np.arange(extra.size)
-        vmap = np.r_[np.arange(n), cv[extra]].astype(np.int64)
-        new = label[comp]
-        return label, vmap, new
-
-    def _sharpen_nonmanifold(self, vsharp):
-        """OpenSubdiv's sharpening of the non-manifold vertices into ``vsharp`` (see :meth:`_split_nonmanifold`);
-        returns (the fans made corners, the non-manifold crease vertices with such a fan)."""
-        org, prv, comp = self.indices, self.prev, self._fan_of_corner
-        edge_of, nm_e, nm_v = self.edge_of_halfedge, self.is_nonmanifold_edge, self.is_nonmanifold_vertex
-        chaikin = self.options.crease_method == "chaikin"
-        by_vertex = np.argsort(org, kind="stable")  # corners grouped by vertex
-        ptr = np.r_[0, np.cumsum(self.face_count)]
-        sharp_fans = set()  # fans of crease vertices not bounded by both non-manifold edges: corners
-        fin_vertices = []  # the non-manifold crease vertices with such a fan (one warning names them)
-        for v in np.flatnonzero(nm_v).tolist():
-            cs = by_vertex[ptr[v] : ptr[v + 1]]
-            es = np.unique(np.r_[edge_of[cs], edge_of[prv[cs]]])
-            nm_count = int(nm_e[es].sum())
-            bnd = int(self.is_boundary_edge[es].sum())
-            other = [self.edge_sharpness.get(tuple(self.edges[e].tolist()), 0.0) for e in es if not nm_e[e]]
-            sharpened = not (nm_count == 2 and bnd == 0 and cs.size > es.size) or self._sharpened_by_degenerate[v]
-            if chaikin and any(0.0 < x < math.inf for x in other):
-                # Chaikin: the child sharpness at v depends on all semi-sharp edges at v; a copy sees those
-                # of its own fan only, so they must all be in one fan (and v a corner for ever)
-                semi_e = {e for e in es if not nm_e[e]
-                          and 0.0 < self.edge_sharpness.get(tuple(self.edges[e].tolist()), 0.0) < math.inf}
-                fans = {int(comp[c]) for c in cs if edge_of[c] in semi_e or edge_of[prv[c]] in semi_e}
-                if not sharpened or len(fans) > 1:
-                    raise MeshError(f"non-manifold vertex {v}: Chaikin creases with semi-sharp edges at a "
-                                    "non-manifold vertex are supported only in one of its fans, at a corner")
-            if sharpened:
-                vsharp[v] = math.inf
-                continue
-            # an interior non-manifold crease: the crease rule along its two non-manifold edges
-            if any(x == math.inf for x in other):
-                vsharp[v] = math.inf  # three or more infinitely sharp edges: a corner for ever
-                continue
-            semi = [x for x in other if x > 0.0]
-            if semi:
-                # a corner while any of these is sharp (three sharp edges), then the crease rule, blended
-                # with the mean of the features that end at that step: the vertex sharpness T = the
-                # largest of them on every copy gives each copy that schedule and that weight (uniform
-                # decay), provided the features ending last all have T
-                feats = semi + ([vsharp[v]] if vsharp.get(v, 0.0) > 0.0 else [])
-                top = max(feats)
-                last = {x for x in feats if math.ceil(x) == math.ceil(top)}
-                if len(last) > 1:
-                    raise MeshError(
-                        f"non-manifold crease vertex {v}: semi-sharp edges or vertex sharpness {sorted(last)} "
-                        "ending at the same level with different values are not supported")
-                vsharp[v] = top
-            fins = self._fans_off_the_crease(cs)
-            sharp_fans.update(fins)
-            if fins:
-                fin_vertices.append(v)
-        return sharp_fans, fin_vertices
-
-    def _split_creases(self, new):
-        """The crease tags ``{(a, b): s}`` of the split mesh whose corner vertices are ``new``: the non-manifold
-        edges infinitely sharp, the other tagged edges as tagged."""
-        H, nxt = self.indices.size, self.next
-        edge_of, nm_e = self.edge_of_halfedge, self.is_nonmanifold_edge
-        creases = {}
-        hs = np.arange(H)
-        for h in hs[nm_e[edge_of]].tolist():
-            a, b = int(new[h]), int(new[nxt[h]])
-            creases[(min(a, b), max(a, b))] = math.inf
-        tagged = list(self.edge_sharpness.items())
-        eids = self.halfedges.edge_index_of([a for (a, _), _ in tagged], [b for (_, b), _ in tagged]).tolist()
-        for (_, x), e in zip(tagged, eids):
-            if nm_e[e]:
-                continue
-            h = int(self._edge_halfedge[e])
-            p, q = int(new[h]), int(new[nxt[h]])
-            creases[(min(p, q), max(p, q))] = x
-        return creases
-
-    def _fans_off_the_crease(self, cs):
-        """The fans (ids of ``_fan_of_corner``) of a non-manifold crease vertex, given its corners ``cs``,
-        that are not bounded by both of its non-manifold edges: a fin (a fan that leaves and comes back
-        to the same non-manifold edge) or a closed fan.
-
-        OpenSubdiv gives the vertex the crease rule along its two non-manifold edges (ends a, b:
-        ``3/4 v + 1/8 (a + b)`` at every level); a fan bounded by both edges sees both ends, its split
-        copy's crease rule is that one. A copy of any other fan sees at most one of them: no rule of
-        the copy's own fan reproduces OpenSubdiv's vertex point there (it needs a vertex outside the
-        fan). Such a copy is made an infinitely sharp corner: the sharp vertex of a sharpened
-        non-manifold vertex, the closest exact surface the split can give (exact on every fan bounded
-        by both edges; on the others the vertex stays at its position, where OpenSubdiv's moves along
-        the crease curve of a, v, b: the fin's limit point is v instead of (a + 4 v + b) / 6).
-        """
-        comp, twin, prv, edge_of = self._fan_of_corner, self.twin, self.prev, self.edge_of_halfedge
-        out = []
-        for c in sorted(set(comp[cs].tolist())):
-            members = cs[comp[cs] == c]
-            lead_c = members[twin[members] < 0]  # outgoing half-edge on a singular edge
-            trail_c = members[twin[prv[members]] < 0]
-            if lead_c.size != 1 or trail_c.size != 1 or edge_of[lead_c[0]] == edge_of[prv[trail_c[0]]]:
-                out.append(c)
-        return out
-
-    def _creases(self, creases):
-        out = {}
-        if creases is None:
-            return out
-        if isinstance(creases, dict):
-            items = list(creases.items())
-        else:
-            E, S = creases
-            E = np.asarray(E).reshape(-1, 2)
-            S = np.broadcast_to(np.asarray(S, dtype=object), (E.shape[0],))
-            items = [((a, b), s) for (a, b), s in zip(E.tolist(), S.tolist())]
-        # the values checked item by item, the edges looked up at once (no dict of all the mesh's edges);
-        # the first bad item, in order, named
-        ab, sv, err = [], [], None
-        try:
-            for (a, b), s in items:
-                a, b = int(a), int(b)
-                x = _sharp_value(s, f"crease on edge ({a}, {b})")
-                ab.append((a, b))
-                sv.append(x)
-        except (MeshError, TypeError, ValueError) as exc:  # raised after any missing edge before it
-            err = exc
-        n = self.n_vertices  # (a vertex id out of range, even beyond int64, is no edge: -1)
-        A = np.array([(a if 0 <= a < n else -1, b if 0 <= b < n else -1) for a, b in ab], dtype=np.int64).reshape(-1, 2)
-        missing = np.flatnonzero(self.halfedges.edge_index_of(A[:, 0], A[:, 1]) < 0)
-        if missing.size:
-            a, b = ab[int(missing[0])]
-            raise MeshError(f"crease on edge ({a}, {b}): no such edge in the mesh")
-        if err is not None:
-            raise err
-        for (a, b), x in zip(ab, sv):
-            k = (min(a, b), max(a, b))
-            if x > 0:
-                out[k] = x
-            else:
-                out.pop(k, None)
-        return out
-
-    def _corners(self, corners):
-        out = {}
-        if corners is None:
-            return out
-        if isinstance(corners, dict):
-            items = list(corners.items())
-        else:
-            Vs, S = corners
-            Vs = np.asarray(Vs).reshape(-1)
-            S = np.broadcast_to(np.asarray(S, dtype=object), (Vs.shape[0],))
-            items = list(zip(Vs.tolist(), S.tolist()))
-        n = self.vertices.shape[0]
-        for v, s in items:
-            vi = int(v)
-            if vi != v or not 0 <= vi < n:
-                raise MeshError(f"corner on vertex {v!r}: out of range [0, {n})")
-            sv = _sharp_value(s, f"corner on vertex {vi}")
-            if sv > 0:
-                out[vi] = sv
-        return out
+        return split_nonmanifold(self)
 
     def _implicit_holes(self):
         """``VTX_BOUNDARY_NONE``: faces at a boundary vertex with a boundary edge not tagged infinite."""
@@ -722,7 +479,7 @@ class PolyMesh:
         m.level = self.level + 1
         if operator == "csr":
             return m, st.csr
-        S = _with_unused_rows(st.csr, unused, n) if operator else None
+        S = csr_matrix_with_empty_rows(st.csr, unused, n) if operator else None
         return m, S
 
     def _step(self, **kwargs):
@@ -749,7 +506,7 @@ class PolyMesh:
         if not exact:
             M = self.manifold
             st = M._step(columns=self.manifold_vertex_map, n_columns=self.n_vertices, sparse=False)
-            return _with_unused_rows(st.csr, np.flatnonzero(M.is_unused_vertex), self.n_vertices)
+            return csr_matrix_with_empty_rows(st.csr, np.flatnonzero(M.is_unused_vertex), self.n_vertices)
         stencils, _, _, _ = refine_complex(self.complex())
         if self.manifold is not self:
             vmap = self.manifold_vertex_map.tolist()
@@ -775,34 +532,3 @@ class PolyMesh:
         return (f"PolyMesh({self.n_vertices} vertices, {self.n_faces} faces, {self.n_ptex} ptex faces, "
                 f"{len(self.edge_sharpness)} creases, {len(self.vertex_sharpness)} corners, "
                 f"{int(self.is_hole.sum())} holes, {extra}{self.options})")
-
-
-def _with_unused_rows(csr, unused, ncols):
-    """The scipy CSR matrix of the CSR arrays ``csr`` with NaN at column 0 of the (empty) rows ``unused``
-    (an unused vertex has no vertex point)."""
-    import scipy.sparse as sp
-
-    indptr, indices, data = csr
-    N = indptr.size - 1
-    if unused.size:  # empty rows: the NaN entries go after the entries of the rows before them
-        rows = np.r_[np.repeat(np.arange(N), np.diff(indptr)), unused]
-        o = np.argsort(rows, kind="stable")
-        indices = np.r_[indices, np.zeros(unused.size, dtype=np.int64)][o]
-        data = np.r_[data, np.full(unused.size, np.nan)][o]
-        indptr = np.r_[0, np.cumsum(np.bincount(rows, minlength=N))]
-    return sp.csr_matrix((data, indices, indptr), shape=(N, ncols))
-
-
-def _split_corners(vsharp, vmap, n, sharp_fans, label):
-    """The vertex sharpness ``{u: s}`` of the split mesh: each vertex's value on all its copies, then the fans
-    made corners (``label``: the split vertex of every fan)."""
-    copies = {}
-    for u in range(n, len(vmap)):
-        copies.setdefault(int(vmap[u]), []).append(u)
-    corners = {}
-    for v, x in vsharp.items():
-        for u in [v, *copies.get(v, [])]:
-            corners[u] = x
-    for c in sorted(sharp_fans):  # (after the vertex's own value: these copies are corners for ever)
-        corners[int(label[c])] = math.inf
-    return corners
