@@ -11,6 +11,7 @@ Usage:
   python scripts/iga_convergence.py --mesh cube|icosahedron|prism6|torus [--levels 5] [--start 0]
          [--rule adaptive|plain|split] [--parameterization natural|characteristic] [--order 4] [--depth 12]
          [--graded EXTRA [--rings 4]]
+  python scripts/iga_convergence.py --mesh grid|annulus|ogrid [--bc dirichlet|neumann] [--ghost] ...
 
 The default rule is "adaptive" (dyadic rings toward the extraordinary vertices) with the natural
 parameterization and "split" (cells cut at the blend's breakpoints) with the characteristic one.
@@ -26,12 +27,12 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from ccproof.apps.iga.convergence import STUDY_MESHES, convergence_study, rates  # noqa: E402
+from ccproof.apps.iga.convergence import OPEN_MESHES, STUDY_MESHES, convergence_study, fit_rate, rates  # noqa: E402
 
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--mesh", choices=STUDY_MESHES, default="cube")
+    ap.add_argument("--mesh", choices=STUDY_MESHES + OPEN_MESHES, default="cube")
     ap.add_argument("--levels", type=int, default=5)
     ap.add_argument("--start", type=int, default=0, help="first level")
     ap.add_argument("--rule", choices=("adaptive", "plain", "split"), default=None)
@@ -41,10 +42,16 @@ def main(argv=None):
     ap.add_argument("--graded", type=int, default=None, metavar="EXTRA",
                     help="the hierarchical space graded EXTRA levels toward the EVs (rates per sqrt(dofs))")
     ap.add_argument("--rings", type=int, default=4, help="face rings refined around every EV (--graded)")
+    ap.add_argument("--bc", choices=("dirichlet", "neumann"), default="dirichlet", help="open meshes")
+    ap.add_argument("--ghost", action="store_true",
+                    help="open meshes: a ring of ghost control vertices (free) outside the boundary")
     a = ap.parse_args(argv)
     rule = a.rule or ("adaptive" if a.parameterization == "natural" else "split")
     graded = None if a.graded is None else (a.graded, a.rings)
     space = "uniform" if graded is None else f"graded {a.graded} levels over {a.rings} rings toward the EVs"
+    if a.mesh in OPEN_MESHES:
+        space += f", {a.bc} boundary, " + ("ghost ring (Nitsche if Dirichlet)" if a.ghost else
+                                            "OpenSubdiv EDGE_ONLY space (strong if Dirichlet)")
     print(f"mesh {a.mesh}, {space}, {a.parameterization} parameterization, {rule} rule (order {a.order}, "
           f"depth {a.depth})", flush=True)
     print(f"{'level':>5} {'faces':>8} {'dofs':>8} {'L2 error':>12} {'rate':>6} {'H1 error':>12} {'rate':>6}"
@@ -53,13 +60,15 @@ def main(argv=None):
     t0 = time.perf_counter()
     per = "level" if graded is None else "dofs"
     for r in convergence_study(a.mesh, a.levels, rule, a.parameterization, a.order, a.depth, start=a.start,
-                               graded=graded):
+                               graded=graded, bc=a.bc, ghost=a.ghost):
         rows.append(r)
         r2, r1 = rates(rows, "L2", per)[-1], rates(rows, "H1", per)[-1]
         print(f"{r['level']:5d} {r['faces']:8d} {r['dofs']:8d} {r['L2']:12.4e} {r2:6.2f} {r['H1']:12.4e} {r1:6.2f} "
               f"{time.perf_counter() - t0:6.1f}s", flush=True)
     r2, r1 = rates(rows, "L2", per)[-1], rates(rows, "H1", per)[-1]
     print(f"rates: L2 {r2:.2f} H1 {r1:.2f}" if not math.isnan(r2) else "rates: L2 nan H1 nan")
+    if len(rows) >= 3:
+        print(f"fitted rates (all levels): L2 {fit_rate(rows, 'L2'):.2f} H1 {fit_rate(rows, 'H1'):.2f}")
     return 0
 
 
