@@ -172,13 +172,16 @@ class AmbientFunction:
         H[:, 1, 2] = H[:, 2, 1] = -b * c * sx * sy * ez
         return H
 
-    def screened_poisson_rhs(self, fields):
-        """``f = -Laplace_Gamma u + u`` at the points of ``fields`` (made with ``curvature=True``)."""
+    def laplace_beltrami(self, fields):
+        """``Laplace_Gamma u`` at the points of ``fields`` (made with ``curvature=True``)."""
         X, n = fields.P, fields.normal
         H = self.hessian(X)
-        lap = np.trace(H, axis1=1, axis2=2) - np.einsum("ni,nij,nj->n", n, H, n) \
+        return np.trace(H, axis1=1, axis2=2) - np.einsum("ni,nij,nj->n", n, H, n) \
             - fields.kappa * np.einsum("ij,ij->i", self.gradient(X), n)
-        return -lap + self.value(X)
+
+    def screened_poisson_rhs(self, fields):
+        """``f = -Laplace_Gamma u + u`` at the points of ``fields`` (made with ``curvature=True``)."""
+        return -self.laplace_beltrami(fields) + self.value(fields.P)
 
 
 def solve_spd(A, b, rtol=1e-13):

@@ -22,7 +22,8 @@ from ccproof.apps.iga.assembly import AmbientFunction, solve_screened_poisson
 from ccproof.apps.iga.quadrature import surface_quadrature
 from ccproof.errors import CCProofError
 
-__all__ = ["STUDY_MESHES", "OPEN_MESHES", "study_mesh", "open_study_mesh", "convergence_study", "rates", "fit_rate"]
+__all__ = ["STUDY_MESHES", "OPEN_MESHES", "PROBLEMS", "study_mesh", "open_study_mesh", "convergence_study", "rates",
+           "fit_rate"]
 
 STUDY_MESHES = ("torus", "cube", "icosahedron", "prism6")
 
@@ -30,6 +31,8 @@ STUDY_MESHES = ("torus", "cube", "icosahedron", "prism6")
 #: face), ``annulus`` (12 x 2 quads between radii 0.5 and 1.5; every vertex regular), ``ogrid`` (a square in
 #: a ring of four trapezoids: four interior vertices of valence 3, a regular boundary)
 OPEN_MESHES = ("grid", "annulus", "ogrid")
+
+PROBLEMS = ("screened", "biharmonic")
 
 
 def _icosahedron():
@@ -121,8 +124,9 @@ def study_mesh(name):
 
 
 def convergence_study(mesh, levels=4, kind="adaptive", parameterization="natural", order=4, depth=12,
-                      exact=None, start=0, graded=None, bc="dirichlet", ghost=False):
-    """Yield per level ``{"level", "faces", "dofs", "L2", "H1"}`` of the Galerkin solution.
+                      exact=None, start=0, graded=None, bc="dirichlet", ghost=False, problem="screened"):
+    """Yield per level ``{"level", "faces", "dofs", "L2", "H1"}`` (and ``"H2"`` for the biharmonic problem) of
+    the Galerkin solution.
 
     Parameters
     ----------
@@ -143,8 +147,15 @@ def convergence_study(mesh, levels=4, kind="adaptive", parameterization="natural
         On the open meshes (:func:`ccproof.apps.iga.boundary.solve_open_screened_poisson`).
     ghost : bool
         On the open meshes: the space with a ring of ghost vertices (:func:`open_study_mesh`).
+    problem : {"screened", "biharmonic"}
+        ``-Laplace_Gamma u + u = f``, or ``Laplace_Gamma^2 u + u = f`` on a closed mesh
+        (:mod:`ccproof.apps.iga.biharmonic`; uniform space).
     """
+    if problem not in PROBLEMS:
+        raise CCProofError(f"unknown problem {problem!r}; use one of {', '.join(PROBLEMS)}")
     if isinstance(mesh, str) and mesh in OPEN_MESHES:
+        if problem != "screened" or graded is not None:
+            raise CCProofError(f"the open mesh {mesh!r} takes the screened Poisson problem on a uniform space")
         yield from _open_study(mesh, levels, kind, order, depth, exact, start, bc, ghost)
         return
     from ccproof.mesh import subdivide
@@ -169,8 +180,13 @@ def convergence_study(mesh, levels=4, kind="adaptive", parameterization="natural
         S = limit_surface(M)
         rule = surface_quadrature(S, order, kind, depth)
         fine = surface_quadrature(S, 6, "adaptive" if parameterization == "natural" else "split", 14)
-        r = solve_screened_poisson(S, rule, exact, parameterization, error_rule=fine)
-        yield {"level": L, "faces": M.n_faces, "dofs": r["dofs"], "L2": r["L2"], "H1": r["H1"]}
+        if problem == "biharmonic":
+            from ccproof.apps.iga.biharmonic import solve_biharmonic
+
+            r = solve_biharmonic(S, rule, exact, parameterization, error_rule=fine)
+        else:
+            r = solve_screened_poisson(S, rule, exact, parameterization, error_rule=fine)
+        yield {"level": L, "faces": M.n_faces, **{k: r[k] for k in ("dofs", "L2", "H1", "H2") if k in r}}
         if L + 1 < start + levels:
             M = subdivide(M)
 
