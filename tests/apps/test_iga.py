@@ -300,7 +300,7 @@ def _loop_rows(mesh):
     return f, s, np.stack([[prv[i] for i in a], a, b, [nxt[j] for j in b]], 1)
 
 
-@pytest.mark.parametrize("name", ["grid", "annulus", "ogrid"])
+@pytest.mark.parametrize("name", ["grid", "annulus", "ogrid", "disk5"])
 def test_boundary_trace_is_the_cubic_bspline_of_the_boundary_loop(name):
     """EDGE_ONLY: on every boundary side (corners with one face included) the rows are exactly the
     uniform cubic B-spline weights of the loop's control vertices, so the boundary vertices' functions
@@ -339,13 +339,15 @@ def test_boundary_conormal_by_the_divergence_theorem(name, ghost):
     assert np.abs(B.ds @ B.conormal).max() <= 1e-12
 
 
-@pytest.mark.parametrize("name,ghost,bc", [("grid", False, "dirichlet"), ("grid", False, "neumann"),
-                                           ("ogrid", False, "dirichlet"), ("annulus", True, "dirichlet"),
-                                           ("ogrid", True, "neumann"), ("grid", True, "dirichlet")])
-def test_affine_solution_is_reproduced(name, ghost, bc):
+@pytest.mark.parametrize("name,ghost,bc,tol", [
+    ("grid", False, "dirichlet", 1e-10), ("grid", False, "neumann", 1e-10), ("ogrid", False, "dirichlet", 1e-10),
+    ("annulus", True, "dirichlet", 1e-10), ("ogrid", True, "neumann", 1e-10), ("grid", True, "dirichlet", 1e-10),
+    ("disk5", False, "neumann", 1e-9), ("disk5", True, "dirichlet", 1e-9)])
+def test_affine_solution_is_reproduced(name, ghost, bc, tol):
     """Patch test: u = 0.3 + x - 2 y (+ 0.5 z = 0) lies in the space, so the Galerkin solution is exact
     with strong Dirichlet data, Nitsche's terms or Neumann data (a wrong conormal, a missing consistency
-    term or a lift off the trace space breaks it)."""
+    term or a lift off the trace space breaks it). disk5: measured 2.7e-10 and 4.0e-10 in L2, the round-off
+    of the rows near its valence-5 vertex and one-face corners (docs/iga.md, basis accuracy)."""
     from ccproof.apps.iga.boundary import solve_open_screened_poisson
     from ccproof.apps.iga.convergence import open_study_mesh
 
@@ -353,7 +355,7 @@ def test_affine_solution_is_reproduced(name, ghost, bc):
     S = ccproof.limit_surface(M)
     r = solve_open_screened_poisson(S, surface_quadrature(S, 4, "adaptive", 10), _Affine(), bc,
                                     region=region if ghost else None)
-    assert r["L2"] <= 1e-10 and r["H1"] <= 1e-9
+    assert r["L2"] <= tol and r["H1"] <= 10 * tol
 
 
 def test_edge_only_space_has_zero_second_derivative_across_the_boundary():
@@ -464,3 +466,12 @@ def test_ghost_ring_keeps_the_surface_and_frees_the_space():
     c = np.zeros(M.shape[0])
     c[act] = solve_spd(M[act][:, act].tocsr(), F1.load(g)[act])
     assert np.abs(F1.W["P"] @ c - g).max() <= 1e-8
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("bc", ["dirichlet", "neumann"])
+def test_open_ghost_rates_with_valence_3_slow(bc):
+    """`python scripts/iga_convergence.py --mesh ogrid --ghost --levels 6 [--bc neumann]`: four interior EVs
+    of valence 3, levels 3-5 fitted (measured 4.23 / 3.08 both)."""
+    rows = list(convergence_study("ogrid", levels=3, start=3, bc=bc, ghost=True))
+    assert fit_rate(rows, "L2") >= 3.9 and fit_rate(rows, "H1") >= 2.9

@@ -29,8 +29,10 @@ STUDY_MESHES = ("torus", "cube", "icosahedron", "prism6")
 
 #: flat open meshes (plane z = 0): ``grid`` (4 x 4 unit-square grid scaled to side 1; four corners with one
 #: face), ``annulus`` (12 x 2 quads between radii 0.5 and 1.5; every vertex regular), ``ogrid`` (a square in
-#: a ring of four trapezoids: four interior vertices of valence 3, a regular boundary)
-OPEN_MESHES = ("grid", "annulus", "ogrid")
+#: a ring of four trapezoids: four interior vertices of valence 3, a regular boundary), ``disk5`` (the planar
+#: 5-regular complex of 5 sectors of 2 x 2 quads scaled by 1/2: one interior vertex of valence 5, five
+#: boundary corners with one face)
+OPEN_MESHES = ("grid", "annulus", "ogrid", "disk5")
 
 PROBLEMS = ("screened", "biharmonic")
 
@@ -83,7 +85,7 @@ def open_study_mesh(name, ghost=False):
     (49, 16, -0.25, 1.25)
     """
     from ccproof.mesh import QuadMesh
-    from ccproof.mesh.examples import grid
+    from ccproof.mesh.examples import grid, k_regular_disk
 
     if name not in OPEN_MESHES:
         raise CCProofError(f"unknown open study mesh {name!r}; use one of {', '.join(OPEN_MESHES)}")
@@ -99,6 +101,10 @@ def open_study_mesh(name, ghost=False):
         region = np.zeros(len(F), dtype=bool)
         region[12 * g:12 * (2 + g)] = True
         return QuadMesh(V, F), region
+    if name == "disk5":  # sector j, face (j R + a) R + b; the sectors extend linearly (2 B - I)
+        m, R = k_regular_disk(5, rings=2 + g), 2 + g
+        a, b = np.divmod(np.arange(m.n_faces) % (R * R), R)
+        return QuadMesh(m.vertices / 2, m.faces), (a < 2) & (b < 2)
     V, F = _ogrid([0.4, 1.0, 1.6][:2 + g])
     return QuadMesh(V, F), np.arange(len(F)) < 5
 
