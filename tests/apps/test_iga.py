@@ -6,7 +6,9 @@ grid with its own formulas, fine Gauss); Gauss-Bonnet (the total Gaussian curvat
 surface of genus 0 is 4 pi, of the torus 0), whose integrand is singular at the extraordinary vertices;
 the Dirichlet energy of the coordinate functions, ``int |grad_Gamma x|^2 = int (1 - n_x^2)``; rates of a
 manufactured solution, asserted as scikit-fem asserts them (a lower bound on small levels; the longer
-runs marked slow).
+runs marked slow). Open surfaces: the boundary rows against the boundary loop's own cubic B-spline, the
+conormal by the divergence theorem, affine solutions reproduced (patch test). The biharmonic: the
+second-derivative rows against the first-derivative stiffness (Green's identity).
 """
 
 import math
