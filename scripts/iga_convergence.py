@@ -13,6 +13,7 @@ Usage:
          [--graded EXTRA [--rings 4]]
   python scripts/iga_convergence.py --mesh grid|annulus|ogrid [--bc dirichlet|neumann] [--ghost] ...
   python scripts/iga_convergence.py --mesh torus|cube|... --problem biharmonic ...
+  python scripts/iga_convergence.py --mesh grid --problem plate [--levels 5]
 
 The default rule is "adaptive" (dyadic rings toward the extraordinary vertices) with the natural
 parameterization and "split" (cells cut at the blend's breakpoints) with the characteristic one.
@@ -54,7 +55,8 @@ def main(argv=None):
     ap.add_argument("--ghost", action="store_true",
                     help="open meshes: a ring of ghost control vertices (free) outside the boundary")
     ap.add_argument("--problem", choices=PROBLEMS, default="screened",
-                    help="-Laplace u + u = f, or Laplace^2 u + u = f (closed meshes; also prints the H2 error)")
+                    help="-Laplace u + u = f, Laplace^2 u + u = f (closed meshes), or the clamped plate "
+                         "Delta^2 w = f (--mesh grid: the unit square); the last two also print the H2 error")
     a = ap.parse_args(argv)
     rule = a.rule or ("adaptive" if a.parameterization == "natural" else "split")
     graded = None if a.graded is None else (a.graded, a.rings)
@@ -62,9 +64,13 @@ def main(argv=None):
     if a.mesh in OPEN_MESHES:
         space += f", {a.bc} boundary, " + ("ghost ring (Nitsche if Dirichlet)" if a.ghost else
                                             "OpenSubdiv EDGE_ONLY space (strong if Dirichlet)")
-    print(f"{a.problem} problem, mesh {a.mesh}, {space}, {a.parameterization} parameterization, {rule} rule "
-          f"(order {a.order}, depth {a.depth})", flush=True)
-    h2 = a.problem == "biharmonic"
+    if a.problem == "plate":
+        print("plate problem (clamped, w = sin^2(pi x) sin^2(pi y)), the unit square with a ghost ring, level L at "
+              "mesh size 1/(4 2^L), plain rule (order 4)", flush=True)
+    else:
+        print(f"{a.problem} problem, mesh {a.mesh}, {space}, {a.parameterization} parameterization, {rule} rule "
+              f"(order {a.order}, depth {a.depth})", flush=True)
+    h2 = a.problem in ("biharmonic", "plate")
     print(f"{'level':>5} {'faces':>8} {'dofs':>8} {'L2 error':>12} {'rate':>6} {'H1 error':>12} {'rate':>6}"
           + (f" {'H2 error':>12} {'rate':>6}" if h2 else "") + f" {'time':>7}")
     rows = []

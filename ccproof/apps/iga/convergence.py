@@ -34,7 +34,7 @@ STUDY_MESHES = ("torus", "cube", "icosahedron", "prism6")
 #: boundary corners with one face)
 OPEN_MESHES = ("grid", "annulus", "ogrid", "disk5")
 
-PROBLEMS = ("screened", "biharmonic")
+PROBLEMS = ("screened", "biharmonic", "plate")
 
 
 def _icosahedron():
@@ -153,12 +153,22 @@ def convergence_study(mesh, levels=4, kind="adaptive", parameterization="natural
         On the open meshes (:func:`ccproof.apps.iga.boundary.solve_open_screened_poisson`).
     ghost : bool
         On the open meshes: the space with a ring of ghost vertices (:func:`open_study_mesh`).
-    problem : {"screened", "biharmonic"}
+    problem : {"screened", "biharmonic", "plate"}
         ``-Laplace_Gamma u + u = f``, or ``Laplace_Gamma^2 u + u = f`` on a closed mesh
-        (:mod:`ccproof.apps.iga.biharmonic`; uniform space).
+        (:mod:`ccproof.apps.iga.biharmonic`; uniform space), or the clamped plate on ``grid`` (the unit
+        square, level L at mesh size ``1 / (4 2^L)``, :mod:`ccproof.apps.iga.plate`).
     """
     if problem not in PROBLEMS:
         raise CCProofError(f"unknown problem {problem!r}; use one of {', '.join(PROBLEMS)}")
+    if problem == "plate":
+        if mesh != "grid":
+            raise CCProofError(f"the plate problem is posed on the mesh 'grid' (the unit square), not {mesh!r}")
+        from ccproof.apps.iga.plate import solve_clamped_plate
+
+        for L in range(start, start + levels):
+            r = solve_clamped_plate(4 * 2**L)
+            yield {"level": L, "faces": 16 * 4**L, **{k: r[k] for k in ("dofs", "L2", "H1", "H2")}}
+        return
     if isinstance(mesh, str) and mesh in OPEN_MESHES:
         if problem != "screened" or graded is not None:
             raise CCProofError(f"the open mesh {mesh!r} takes the screened Poisson problem on a uniform space")
