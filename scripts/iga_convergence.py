@@ -13,7 +13,7 @@ Usage:
          [--graded EXTRA [--rings 4]]
   python scripts/iga_convergence.py --mesh grid|annulus|ogrid [--bc dirichlet|neumann] [--ghost] ...
   python scripts/iga_convergence.py --mesh torus|cube|... --problem biharmonic ...
-  python scripts/iga_convergence.py --mesh grid --problem plate [--levels 5]
+  python scripts/iga_convergence.py --mesh grid --problem plate [--support clamped|simple] [--levels 5]
 
 The default rule is "adaptive" (dyadic rings toward the extraordinary vertices) with the natural
 parameterization and "split" (cells cut at the blend's breakpoints) with the characteristic one.
@@ -57,6 +57,7 @@ def main(argv=None):
     ap.add_argument("--problem", choices=PROBLEMS, default="screened",
                     help="-Laplace u + u = f, Laplace^2 u + u = f (closed meshes), or the clamped plate "
                          "Delta^2 w = f (--mesh grid: the unit square); the last two also print the H2 error")
+    ap.add_argument("--support", choices=("clamped", "simple"), default="clamped", help="--problem plate")
     a = ap.parse_args(argv)
     rule = a.rule or ("adaptive" if a.parameterization == "natural" else "split")
     graded = None if a.graded is None else (a.graded, a.rings)
@@ -65,7 +66,8 @@ def main(argv=None):
         space += f", {a.bc} boundary, " + ("ghost ring (Nitsche if Dirichlet)" if a.ghost else
                                             "OpenSubdiv EDGE_ONLY space (strong if Dirichlet)")
     if a.problem == "plate":
-        print("plate problem (clamped, w = sin^2(pi x) sin^2(pi y)), the unit square with a ghost ring, level L at "
+        sol = "sin^2(pi x) sin^2(pi y)" if a.support == "clamped" else "sin(pi x) sin(pi y)"
+        print(f"plate problem ({a.support}, w = {sol}), the unit square with a ghost ring, level L at "
               "mesh size 1/(4 2^L), plain rule (order 4)", flush=True)
     else:
         print(f"{a.problem} problem, mesh {a.mesh}, {space}, {a.parameterization} parameterization, {rule} rule "
@@ -77,7 +79,8 @@ def main(argv=None):
     t0 = time.perf_counter()
     per = "level" if graded is None else "dofs"
     for r in convergence_study(a.mesh, a.levels, rule, a.parameterization, a.order, a.depth, start=a.start,
-                               graded=graded, bc=a.bc, ghost=a.ghost, problem=a.problem):
+                               graded=graded, bc=a.bc, ghost=a.ghost, problem=a.problem,
+                               support=a.support):
         rows.append(r)
         r2, r1 = rates(rows, "L2", per)[-1], rates(rows, "H1", per)[-1]
         extra = f" {r['H2']:12.4e} {rates(rows, 'H2', per)[-1]:6.2f}" if h2 else ""

@@ -52,7 +52,7 @@ def laplace_beltrami_rows(surface, fields, rule, parameterization="natural"):
     t = [sum(coef[k] * np.einsum("ij,ij->i", H[k], Pd) for k in H) for Pd in (Pu, Pv)]
     cu = G[:, 0, 0] * t[0] + G[:, 0, 1] * t[1]
     cv = G[:, 1, 0] * t[0] + G[:, 1, 1] * t[1]
-    return fields._scaled([(coef["uu"], W["Duu"]), (coef["uv"], W["Duv"]), (coef["vv"], W["Dvv"]),
+    return fields.combine([(coef["uu"], W["Duu"]), (coef["uv"], W["Duv"]), (coef["vv"], W["Dvv"]),
                            (-cu, W["Du"]), (-cv, W["Dv"])])
 
 

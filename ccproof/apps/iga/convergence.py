@@ -130,7 +130,8 @@ def study_mesh(name):
 
 
 def convergence_study(mesh, levels=4, kind="adaptive", parameterization="natural", order=4, depth=12,
-                      exact=None, start=0, graded=None, bc="dirichlet", ghost=False, problem="screened"):
+                      exact=None, start=0, graded=None, bc="dirichlet", ghost=False, problem="screened",
+                      support="clamped"):
     """Yield per level ``{"level", "faces", "dofs", "L2", "H1"}`` (and ``"H2"`` for the biharmonic problem) of
     the Galerkin solution.
 
@@ -155,18 +156,20 @@ def convergence_study(mesh, levels=4, kind="adaptive", parameterization="natural
         On the open meshes: the space with a ring of ghost vertices (:func:`open_study_mesh`).
     problem : {"screened", "biharmonic", "plate"}
         ``-Laplace_Gamma u + u = f``, or ``Laplace_Gamma^2 u + u = f`` on a closed mesh
-        (:mod:`ccproof.apps.iga.biharmonic`; uniform space), or the clamped plate on ``grid`` (the unit
-        square, level L at mesh size ``1 / (4 2^L)``, :mod:`ccproof.apps.iga.plate`).
+        (:mod:`ccproof.apps.iga.biharmonic`; uniform space), or the plate on ``grid`` (the unit square,
+        level L at mesh size ``1 / (4 2^L)``, :mod:`ccproof.apps.iga.plate`).
+    support : {"clamped", "simple"}
+        The plate's edges.
     """
     if problem not in PROBLEMS:
         raise CCProofError(f"unknown problem {problem!r}; use one of {', '.join(PROBLEMS)}")
     if problem == "plate":
         if mesh != "grid":
             raise CCProofError(f"the plate problem is posed on the mesh 'grid' (the unit square), not {mesh!r}")
-        from ccproof.apps.iga.plate import solve_clamped_plate
+        from ccproof.apps.iga.plate import solve_plate
 
         for L in range(start, start + levels):
-            r = solve_clamped_plate(4 * 2**L)
+            r = solve_plate(4 * 2**L, support)
             yield {"level": L, "faces": 16 * 4**L, **{k: r[k] for k in ("dofs", "L2", "H1", "H2")}}
         return
     if isinstance(mesh, str) and mesh in OPEN_MESHES:

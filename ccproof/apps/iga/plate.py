@@ -1,22 +1,25 @@
-"""Kirchhoff plate bending on the flat open mesh, clamped: ``Delta^2 w = f`` on the unit square, ``w = 0``
-and ``grad w . m = 0`` on its boundary.
+"""Kirchhoff plate bending on the flat open mesh: ``Delta^2 w = f`` on the unit square, clamped (``w = 0``
+and ``grad w . m = 0`` on its boundary) or simply supported (``w = 0`` and no bending moment, ``Delta w = 0``).
 
 The space is the ghost-ring space of :func:`ccproof.apps.iga.convergence.open_study_mesh` built directly at
 mesh size ``1 / n``: the ``(n + 2) x (n + 2)`` grid shifted by one ghost row on every side, the region its
 ``n x n`` inner faces. Every region face is a regular bicubic patch of the uniform lattice, so the region's
-limit is exactly the unit square and its functions are the tensor-product cubic B-splines on it. Clamping
-is imposed strongly: per direction, the conditions ``s(0) = s'(0) = 0`` on the B-spline coefficients
-``c_-1, c_0, c_1`` of the three functions at the edge are ``c_-1 = c_1``, ``c_0 = -c_1 / 2`` (and the mirror
-image at 1), so the clamped space is the tensor product of the two 1D spaces (:func:`clamped_square`).
+limit is exactly the unit square and its functions are the tensor-product cubic B-splines on it. The
+essential conditions are imposed strongly, per direction on the B-spline coefficients ``c_-1, c_0, c_1`` of
+the three functions at an edge (and the mirror image at 1), so the constrained space is the tensor product
+of two 1D spaces (:func:`plate_square`): clamped, ``s(0) = s'(0) = 0`` is ``c_-1 = c_1``, ``c_0 = -c_1 / 2``;
+simply supported, ``s(0) = 0`` is ``c_-1 = -4 c_0 - c_1``.
 
-The bending energy is ``int nabla^2 w : nabla^2 v`` (Poisson ratio 0; for clamped plates every ratio gives
-the same solution), the covariant Hessian ``nabla^2 phi_ab = phi_ab - Gamma^c_ab phi_c`` from the basis's
+The bending energy: clamped, ``int nabla^2 w : nabla^2 v`` (Poisson ratio 0; for a clamped plate every ratio
+gives the same solution); simply supported, ``int Delta w Delta v`` (ratio 1), whose natural condition is
+``Delta w = 0``. The covariant Hessian ``nabla^2 phi_ab = phi_ab - Gamma^c_ab phi_c`` comes from the basis's
 second-derivative rows and the metric (:func:`hessian_rows`), contracted with the inverse metric
 (``|H|^2 = tr(G H G H)``, written as the Frobenius norm of ``L^T H L`` for ``G = L L^T``).
 
-Manufactured solution ``w = sin^2(pi x) sin^2(pi y)`` (clamped on the square), ``f = Delta^2 w`` in closed form.
+Manufactured solutions, ``f = Delta^2 w`` in closed form (:class:`PlateSolution`):
+``w = sin^2(pi x) sin^2(pi y)`` (clamped) and ``w = sin(pi x) sin(pi y)`` (simply supported).
 
->>> r = solve_clamped_plate(4)
+>>> r = solve_plate(4)
 >>> r["dofs"], r["L2"] < 1e-2
 (9, True)
 """
@@ -28,21 +31,31 @@ import scipy.sparse as sp
 
 from ccproof.errors import CCProofError
 
-__all__ = ["clamped_square", "hessian_rows", "solve_clamped_plate", "SIN2"]
+__all__ = ["plate_square", "hessian_rows", "solve_plate", "PlateSolution", "SUPPORTS"]
+
+SUPPORTS = ("clamped", "simple")
 
 
-def _clamped_1d(n):
-    """(n + 3, n - 1): coefficients ``c_-1 .. c_(n+1)`` from the free ones ``c_1 .. c_(n-1)``."""
-    T = sp.lil_matrix((n + 3, n - 1))
-    for k in range(1, n):
-        T[k + 1, k - 1] = 1.0
-    T[0, 0], T[1, 0] = 1.0, -0.5  # c_-1 = c_1, c_0 = -c_1 / 2
-    T[n + 2, n - 2], T[n + 1, n - 2] = 1.0, -0.5  # c_(n+1) = c_(n-1), c_n = -c_(n-1) / 2
+def _constrained_1d(n, support):
+    """Coefficients ``c_-1 .. c_(n+1)`` from the free ones: ``c_1 .. c_(n-1)`` (clamped, (n + 3, n - 1)) or
+    ``c_0 .. c_n`` (simply supported, (n + 3, n + 1))."""
+    if support == "clamped":
+        T = sp.lil_matrix((n + 3, n - 1))
+        for k in range(1, n):
+            T[k + 1, k - 1] = 1.0
+        T[0, 0], T[1, 0] = 1.0, -0.5  # c_-1 = c_1, c_0 = -c_1 / 2
+        T[n + 2, n - 2], T[n + 1, n - 2] = 1.0, -0.5  # c_(n+1) = c_(n-1), c_n = -c_(n-1) / 2
+        return T.tocsr()
+    T = sp.lil_matrix((n + 3, n + 1))
+    for k in range(n + 1):
+        T[k + 1, k] = 1.0
+    T[0, 0], T[0, 1] = -4.0, -1.0  # c_-1 = -4 c_0 - c_1
+    T[n + 2, n], T[n + 2, n - 1] = -4.0, -1.0  # c_(n+1) = -4 c_n - c_(n-1)
     return T.tocsr()
 
 
-def clamped_square(n):
-    """The ghost grid of the unit square at mesh size 1/n, its region and the clamped space.
+def plate_square(n, support="clamped"):
+    """The ghost grid of the unit square at mesh size 1/n, its region and the constrained space.
 
     Returns
     -------
@@ -51,18 +64,20 @@ def clamped_square(n):
         ``((i - 1)/n, (j - 1)/n)``).
     region : bool (n_faces,)
         The ``n x n`` faces over the unit square.
-    T : CSR (n_vertices, (n - 1)^2)
-        Coefficients of the clamped functions (columns) in the vertices' functions.
+    T : CSR (n_vertices, (n - 1)^2 or (n + 1)^2)
+        Coefficients of the clamped or simply supported functions (columns) in the vertices' functions.
 
-    >>> M, region, T = clamped_square(4)
-    >>> M.n_vertices, int(region.sum()), T.shape
-    (49, 16, (49, 9))
+    >>> M, region, T = plate_square(4)
+    >>> M.n_vertices, int(region.sum()), T.shape, plate_square(4, "simple")[2].shape
+    (49, 16, (49, 9), (49, 25))
     """
     from ccproof.mesh import QuadMesh
     from ccproof.mesh.examples import grid
 
+    if support not in SUPPORTS:
+        raise CCProofError(f"unknown plate support {support!r}; use one of {', '.join(SUPPORTS)}")
     if int(n) < 2:
-        raise CCProofError(f"the clamped square needs n >= 2 faces per side, got n={n!r}")
+        raise CCProofError(f"the plate square needs n >= 2 faces per side, got n={n!r}")
     n = int(n)
     g = grid(n + 2, n + 2)
     V = (np.asarray(g.vertices) - [1.0, 1.0, 0.0]) / n
@@ -70,7 +85,7 @@ def clamped_square(n):
     i = np.arange(n + 2)
     inner = (i >= 1) & (i <= n)
     region = (inner[None, :] & inner[:, None]).ravel()  # face i + (n + 2) j
-    T1 = _clamped_1d(n)
+    T1 = _constrained_1d(n, support)
     return QuadMesh(V, g.faces), region, sp.kron(T1, T1, format="csr")  # vertex i + (n + 3) j: j slow
 
 
@@ -97,17 +112,24 @@ def hessian_rows(surface, fields, rule):
         for (a, b), parts in H.items():
             w = L[:, a, p] * L[:, b, q] + (L[:, b, p] * L[:, a, q] if a != b else 0.0)
             terms += [(w * c, B) for c, B in parts]
-        out.append(fields._scaled(terms))
+        out.append(fields.combine(terms))
     return tuple(out)
 
 
-class SIN2:
-    """``w = sin^2(pi x) sin^2(pi y)``: value, gradient, Hessian (n, 2, 2) and ``Delta^2 w`` at points (n, 3)."""
+class PlateSolution:
+    """``w = s(x) s(y)`` with ``s = sin^2(pi x)`` (``"clamped"``) or ``sin(pi x)`` (``"simple"``): value,
+    gradient, Hessian (n, 2, 2) and ``Delta^2 w`` at points (n, 3)."""
 
-    @staticmethod
-    def _s(x):
+    def __init__(self, support="clamped"):
+        self.support = support
+
+    def _s(self, x):
+        """s and its derivatives of orders 1, 2, 4."""
+        if self.support == "simple":
+            c, s = np.cos(np.pi * x), np.sin(np.pi * x)
+            return s, np.pi * c, -np.pi**2 * s, np.pi**4 * s
         c, s = np.cos(2 * np.pi * x), np.sin(2 * np.pi * x)
-        return (1 - c) / 2, np.pi * s, 2 * np.pi**2 * c, -8 * np.pi**4 * c  # s, s', s'', s''''
+        return (1 - c) / 2, np.pi * s, 2 * np.pi**2 * c, -8 * np.pi**4 * c
 
     def value(self, X):
         return self._s(X[:, 0])[0] * self._s(X[:, 1])[0]
@@ -128,23 +150,23 @@ class SIN2:
         return sx[3] * sy[0] + 2 * sx[2] * sy[2] + sx[0] * sy[3]
 
 
-def solve_clamped_plate(n, order=4, error_order=6):
-    """Galerkin solution of the clamped plate ``Delta^2 w = f`` on the unit square at mesh size 1/n for
-    ``w = sin^2(pi x) sin^2(pi y)`` (module docstring).
+def solve_plate(n, support="clamped", order=4, error_order=6):
+    """Galerkin solution of the plate ``Delta^2 w = f`` on the unit square at mesh size 1/n for the
+    manufactured :class:`PlateSolution` of ``support`` (module docstring).
 
     Returns
     -------
     dict
         ``c`` (n_vertices,), errors ``L2``, ``H1`` (seminorm), ``H2`` (``||nabla^2 (w_h - w)||``), ``dofs``
-        (the clamped space's dimension).
+        (the constrained space's dimension).
     """
     from ccproof.apps.iga.assembly import SurfaceFields, solve_spd
     from ccproof.apps.iga.quadrature import surface_quadrature
     from ccproof.evaluate import natural_limit_surface
 
-    M, region, T = clamped_square(n)
+    M, region, T = plate_square(n, support)
     S = natural_limit_surface(M)
-    w = SIN2()
+    w = PlateSolution(support)
 
     def fields(k):
         Q = surface_quadrature(S, k, "plain")
@@ -154,23 +176,18 @@ def solve_clamped_plate(n, order=4, error_order=6):
 
     F, R = fields(order)
     D = sp.diags(F.dA)
-    K = R[0].T @ D @ R[0] + 2 * (R[1].T @ D @ R[1]) + R[2].T @ D @ R[2]
+    if support == "clamped":
+        K = R[0].T @ D @ R[0] + 2 * (R[1].T @ D @ R[1]) + R[2].T @ D @ R[2]
+    else:
+        Lap = (R[0] + R[2]).tocsr()
+        K = Lap.T @ D @ Lap
     b = F.load(w.bilaplacian(F.P))
     c = T @ solve_spd((T.T @ K @ T).tocsr(), T.T @ b)
     F, R = fields(error_order)
-    L2, H1 = F.errors(c, _Ambient(w))
+    L2, H1 = F.errors(c, w)
     # the exact Hessian in the same orthonormal frame: the Cartesian one (the plane z = 0, frame L^T)
-    Hx = w.hessian(F.P)
     J = np.stack([F.Pu[:, :2], F.Pv[:, :2]], 2)  # columns P_u, P_v in the plane
-    L = np.linalg.cholesky(F.Ginv)
-    E = np.einsum("nia,nap->nip", J, L)  # the orthonormal frame's vectors in x, y
-    He = np.einsum("nip,nij,njq->npq", E, Hx, E)
+    E = np.einsum("nia,nap->nip", J, np.linalg.cholesky(F.Ginv))  # the orthonormal frame in x, y
+    He = np.einsum("nip,nij,njq->npq", E, w.hessian(F.P), E)
     e2 = sum(k * (R[i] @ c - He[:, p, q]) ** 2 for i, (p, q, k) in enumerate(((0, 0, 1), (0, 1, 2), (1, 1, 1))))
     return {"c": c, "L2": L2, "H1": H1, "H2": float(np.sqrt(F.dA @ e2)), "dofs": int(T.shape[1])}
-
-
-class _Ambient:
-    """:class:`~ccproof.apps.iga.assembly.SurfaceFields.errors` takes value and gradient only."""
-
-    def __init__(self, w):
-        self.value, self.gradient = w.value, w.gradient
