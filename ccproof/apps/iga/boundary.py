@@ -1,4 +1,4 @@
-"""Open surfaces: the boundary curve, its quadrature, Dirichlet (strong) and Neumann (natural) conditions.
+"""Open surfaces: the boundary curve, its quadrature, Dirichlet (strong or Nitsche) and Neumann (natural) data.
 
 Under OpenSubdiv's ``VTX_BOUNDARY_EDGE_ONLY`` rules (the rules of :class:`~ccproof.mesh.QuadMesh`), a boundary
 vertex and a boundary edge point depend on boundary vertices only (crease rule ``(3/4) V + (1/8)(e0 + e1)``
@@ -8,12 +8,18 @@ boundary is spanned exactly by the boundary vertices' limit functions: the perio
 loop, in the face parameter of the boundary edges (one knot span per boundary edge). The interior vertices'
 functions vanish on the boundary.
 
-Dirichlet data ``u = g`` are therefore imposed **strongly**: the boundary coefficients are the L2 projection
-of g onto the trace space (:func:`dirichlet_lift`, a banded system on the loop, h^4 in L2 along the curve),
-and the interior coefficients solve the Galerkin system with those fixed. No penalty parameter is needed
-(Nitsche's method would need one scaled by an inverse estimate, which the singular metric at the corners of
-the limit makes hard to bound), and the discrete problem stays symmetric positive definite. Neumann data
-``grad u . m = g`` (m the outward conormal) are natural: the load gets ``int_boundary g phi_i ds``.
+Dirichlet data ``u = g`` are therefore imposed **strongly** on this space: the boundary coefficients are the
+L2 projection of g onto the trace space (:func:`dirichlet_lift`, a banded system on the loop), and the
+interior coefficients solve the Galerkin system with those fixed. No penalty parameter is needed and the
+discrete problem stays symmetric positive definite. Neumann data ``grad u . m = g`` (m the outward conormal)
+are natural: the load gets ``int_boundary g phi_i ds``.
+
+Every function of this space has a zero second derivative across a regular boundary (the net's ghost row
+``2 B - I``), which limits the rates to h^2.5 (L2) and h^1.5 (H1) for a solution with ``u_nn != 0`` there.
+Solving on a *region* of a larger mesh (one ring of ghost faces outside,
+:func:`ccproof.apps.iga.convergence.open_study_mesh`) frees that derivative; the trace is then no longer
+spanned by a subset of the vertices, and Dirichlet data are imposed by **Nitsche's** method
+(:meth:`BoundaryFields.nitsche`).
 
 Faces and their boundary sides: side i of a face runs from its corner i to corner i + 1 (corners at
 (0,0), (1,0), (1,1), (0,1)), counter-clockwise around the face seen from its normal ``P_u x P_v``, so the
@@ -226,8 +232,9 @@ def solve_open_screened_poisson(surface, rule, exact, bc="dirichlet", boundary_o
     error_rule : QuadratureRule, optional
         For the errors (default: ``rule``; restricted to ``region`` too).
     region : bool array (n_faces,), optional
-        Solve on these faces only, with every limit function nonzero there (:func:`ghost_space_meshes`:
-        a ring of ghost vertices outside the region frees the normal second derivative at its boundary).
+        Solve on these faces only, with every limit function nonzero there
+        (:func:`ccproof.apps.iga.convergence.open_study_mesh`: a ring of ghost vertices outside the region
+        frees the normal second derivative at its boundary).
         Dirichlet data are then imposed by Nitsche's method (the trace is no longer spanned by a subset
         of the vertices); without a region, strongly (:func:`dirichlet_lift`).
     penalty : float
