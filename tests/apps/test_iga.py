@@ -191,16 +191,17 @@ def test_dynamic_surface_rows_agree_with_limit_surface_basis():
         assert abs(A[key] - B[key]).max() <= 1e-15, key
 
 
-@pytest.mark.parametrize("name", ["cube", "icosahedron"])
+@pytest.mark.parametrize("name", ["cube", "icosahedron", "grid"])
 def test_adaptive_cells_lie_in_one_polynomial_patch(surfaces, name):
     """Every cell of the adaptive rule lies in one patch of the natural parameterization (a regular
     bicubic patch, or one patch of one layer of a corner face): its four corners, pulled 1e-12 inside,
     are located in the same patch by the evaluator's own patch map; but the innermost square at each
     extraordinary corner (side 2^-(depth + 1)), which holds all deeper layers. The plain rule's face cells
-    are not."""
-    from ccproof.apps.iga.quadrature import extraordinary_corners, quadrature_cells
+    are not. On the open grid the one-face corners are irregular too: they get the rings."""
+    from ccproof.apps.iga.convergence import open_study_mesh
+    from ccproof.apps.iga.quadrature import irregular_corners, quadrature_cells
 
-    S = surfaces[name]
+    S = ccproof.limit_surface(open_study_mesh("grid")[0]) if name == "grid" else surfaces[name]
 
     def patches_per_cell(kind):
         f, u0, v0, hu, hv = quadrature_cells(S, kind, depth=8)
@@ -214,7 +215,8 @@ def test_adaptive_cells_lie_in_one_polynomial_patch(surfaces, name):
 
     ids, inner = patches_per_cell("adaptive")
     assert (ids[~inner] == ids[~inner, :1]).all()
-    assert inner.sum() == 4 * S.n_faces - (~extraordinary_corners(S.mesh)).sum()  # one per EV corner
+    assert inner.sum() == irregular_corners(S.mesh).sum()  # one per irregular corner
+    assert name != "grid" or inner.sum() == 4
     assert (ids[inner] != ids[inner, :1]).any(axis=1).all()
     plain, _ = patches_per_cell("plain")
     assert (plain != plain[:, :1]).any()
