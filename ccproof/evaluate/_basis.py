@@ -231,9 +231,8 @@ def basis_rows(S, f, u, v, derivatives, backend=None, threads=None):
     if kernels is None:
         _fill_numpy(top, loc, op, indptr, names, derivatives, indices, data)
     else:
-        rs = top.job_ring[loc.job]
         pad = [data[0]] * (6 - len(names))
-        pts = (loc.s, loc.t, loc.scale, op, rs)
+        pts = (loc.s, loc.t, loc.scale, op, loc.job, top.job_ring)
         ops = (cstart, ncols, dstart, cols, dev, org)
         data6 = tuple(data) + tuple(pad)
         in_blocks(lambda lo, hi: kernels[1](lo, hi, pts, ops, top.ring, indptr, indices, len(names), data6),
@@ -249,9 +248,10 @@ def basis_rows(S, f, u, v, derivatives, backend=None, threads=None):
 
 def _fill_points(lo, hi, pts, ops, ring, indptr, indices, nk, data):
     """The rows of points lo..hi-1 into ``data[0 .. nk-1]`` (the numba kernel; the sums of :func:`_rows`
-    point by point). ``pts = (s, t, scale, op, ring start)`` per point, ``ops`` the flat operators
-    (:meth:`_Topology.flat`)."""
-    s, t, scale, op, rs = pts
+    point by point). ``pts = (s, t, scale, op, job)`` per point and every job's ring start, ``ops`` the
+    flat operators (:meth:`_Topology.flat`). A smooth regular quad's row is written in one pass (its
+    net is its ring: no operator, no cancellation)."""
+    s, t, scale, op, job, job_ring = pts
     cstart, ncols, dstart, cols, dev, org = ops
     B = np.empty(16)
     bu = np.empty((3, 4))
@@ -261,12 +261,24 @@ def _fill_points(lo, hi, pts, ops, ring, indptr, indices, nk, data):
         nc = ncols[o]
         c0 = cstart[o]
         q = indptr[p]
-        for c in range(nc):
-            indices[q + c] = ring[rs[p] + cols[c0 + c]]
+        ds = dstart[o]
         _bspline(s[p], bu)
         _bspline(t[p], bv)
         g = scale[p]
-        ds = dstart[o]
+        r0 = job_ring[job[p]]
+        if ds < 0:  # a smooth regular quad: its net is its ring (cols 0..15), the weights are B itself
+            for c in range(16):
+                indices[q + c] = ring[r0 + c]
+            for k in range(nk):
+                dk = data[k]
+                a, b = _ORD_A[k], _ORD_B[k]
+                f = 1.0 if a + b == 0 else (g if a + b == 1 else g * g)
+                for j in range(4):
+                    for i in range(4):
+                        dk[q + 4 * j + i] = bv[b, j] * bu[a, i] * f
+            continue
+        for c in range(nc):
+            indices[q + c] = ring[r0 + cols[c0 + c]]
         for k in range(nk):
             dk = data[k]
             a, b = _ORD_A[k], _ORD_B[k]
@@ -274,10 +286,6 @@ def _fill_points(lo, hi, pts, ops, ring, indptr, indices, nk, data):
             for j in range(4):
                 for i in range(4):
                     B[4 * j + i] = bv[b, j] * bu[a, i] * f
-            if ds < 0:
-                for c in range(16):
-                    dk[q + c] = B[c]
-                continue
             m = nc - 1
             tot = 0.0
             for c in range(m):

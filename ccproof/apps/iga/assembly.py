@@ -84,7 +84,7 @@ class SurfaceFields:
             G = self.Ginv
             self.kappa = -(G[:, 0, 0] * II[0][0] + 2 * G[:, 0, 1] * II[0][1] + G[:, 1, 1] * II[1][1])
 
-    def _scaled(self, terms):
+    def combine(self, terms):
         """``sum_k diag(c_k) B_k`` for ``terms = [(c_k, B_k)]`` as one CSR matrix (directly on the data where
         the rows share one sparsity pattern, as the basis rows of one surface do)."""
         B0 = terms[0][1]
@@ -99,14 +99,14 @@ class SurfaceFields:
     def mass(self):
         """``W_P^T diag(dA) W_P`` (sparse, symmetric)."""
         P = self.W["P"]
-        return (P.T @ self._scaled([(self.dA, P)])).tocsr()
+        return (P.T @ self.combine([(self.dA, P)])).tocsr()
 
     def stiffness(self):
         """``sum_ab W_a^T diag(dA G^ab) W_b``: the Laplace-Beltrami stiffness (sparse, symmetric)."""
         Du, Dv = self.W["Du"], self.W["Dv"]
         G, w = self.Ginv, self.dA
-        E = sp.vstack([self._scaled([(w * G[:, 0, 0], Du), (w * G[:, 0, 1], Dv)]),
-                       self._scaled([(w * G[:, 1, 0], Du), (w * G[:, 1, 1], Dv)])], format="csr")
+        E = sp.vstack([self.combine([(w * G[:, 0, 0], Du), (w * G[:, 0, 1], Dv)]),
+                       self.combine([(w * G[:, 1, 0], Du), (w * G[:, 1, 1], Dv)])], format="csr")
         return (sp.vstack([Du, Dv], format="csr").T @ E).tocsr()
 
     def load(self, values):
@@ -172,13 +172,16 @@ class AmbientFunction:
         H[:, 1, 2] = H[:, 2, 1] = -b * c * sx * sy * ez
         return H
 
-    def screened_poisson_rhs(self, fields):
-        """``f = -Laplace_Gamma u + u`` at the points of ``fields`` (made with ``curvature=True``)."""
+    def laplace_beltrami(self, fields):
+        """``Laplace_Gamma u`` at the points of ``fields`` (made with ``curvature=True``)."""
         X, n = fields.P, fields.normal
         H = self.hessian(X)
-        lap = np.trace(H, axis1=1, axis2=2) - np.einsum("ni,nij,nj->n", n, H, n) \
+        return np.trace(H, axis1=1, axis2=2) - np.einsum("ni,nij,nj->n", n, H, n) \
             - fields.kappa * np.einsum("ij,ij->i", self.gradient(X), n)
-        return -lap + self.value(X)
+
+    def screened_poisson_rhs(self, fields):
+        """``f = -Laplace_Gamma u + u`` at the points of ``fields`` (made with ``curvature=True``)."""
+        return -self.laplace_beltrami(fields) + self.value(fields.P)
 
 
 def solve_spd(A, b, rtol=1e-13):

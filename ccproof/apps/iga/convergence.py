@@ -22,9 +22,19 @@ from ccproof.apps.iga.assembly import AmbientFunction, solve_screened_poisson
 from ccproof.apps.iga.quadrature import surface_quadrature
 from ccproof.errors import CCProofError
 
-__all__ = ["STUDY_MESHES", "study_mesh", "convergence_study", "rates"]
+__all__ = ["STUDY_MESHES", "OPEN_MESHES", "PROBLEMS", "study_mesh", "open_study_mesh", "convergence_study", "rates",
+           "fit_rate"]
 
 STUDY_MESHES = ("torus", "cube", "icosahedron", "prism6")
+
+#: flat open meshes (plane z = 0): ``grid`` (4 x 4 unit-square grid scaled to side 1; four corners with one
+#: face), ``annulus`` (12 x 2 quads between radii 0.5 and 1.5; every vertex regular), ``ogrid`` (a square in
+#: a ring of four trapezoids: four interior vertices of valence 3, a regular boundary), ``disk5`` (the planar
+#: 5-regular complex of 5 sectors of 2 x 2 quads scaled by 1/2: one interior vertex of valence 5, five
+#: boundary corners with one face)
+OPEN_MESHES = ("grid", "annulus", "ogrid", "disk5")
+
+PROBLEMS = ("screened", "biharmonic", "plate")
 
 
 def _icosahedron():
@@ -43,6 +53,60 @@ def _prism6():
     V = np.concatenate([ring - [0, 0, 1], ring + [0, 0, 1]])
     F = [[5, 4, 3, 2, 1, 0], [6, 7, 8, 9, 10, 11]] + [[i, (i + 1) % 6, (i + 1) % 6 + 6, i + 6] for i in range(6)]
     return V, F
+
+
+def _annulus(n, radii):
+    a = 2 * np.pi * np.arange(n) / n
+    r = np.asarray(radii, dtype=np.float64)
+    V = np.stack([np.outer(r, np.cos(a)).ravel(), np.outer(r, np.sin(a)).ravel(), np.zeros(r.size * n)], 1)
+    F = [[i * n + j, (i + 1) * n + j, (i + 1) * n + (j + 1) % n, i * n + (j + 1) % n]
+         for i in range(r.size - 1) for j in range(n)]
+    return V, F
+
+
+def _ogrid(sizes):
+    """Nested squares of half-sides ``sizes`` joined by rings of four trapezoids, the first one a face."""
+    sq = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]], dtype=np.float64)
+    V = np.concatenate([np.c_[s * sq, np.zeros(4)] for s in sizes])
+    F = [[0, 1, 2, 3]] + [[4 * (i + 1) + c, 4 * (i + 1) + (c + 1) % 4, 4 * i + (c + 1) % 4, 4 * i + c]
+                          for i in range(len(sizes) - 1) for c in range(4)]
+    return V, F
+
+
+def open_study_mesh(name, ghost=False):
+    """The level-0 QuadMesh of a flat open study mesh (:data:`OPEN_MESHES`) and its region (bool per face).
+
+    With ``ghost``, one more ring of faces outside, its vertices at ``2 B - I`` (B a boundary vertex, I its
+    neighbour inside): the region (the original faces) is then surrounded by free ghost vertices, and its
+    limit is a regular bicubic surface up to its boundary (on ``grid``: exactly the unit square).
+
+    >>> m, region = open_study_mesh("grid", ghost=True)
+    >>> m.n_vertices, int(region.sum()), float(m.vertices[:, :2].min()), float(m.vertices[:, :2].max())
+    (49, 16, -0.25, 1.25)
+    """
+    from ccproof.mesh import QuadMesh
+    from ccproof.mesh.examples import grid, k_regular_disk
+
+    if name not in OPEN_MESHES:
+        raise CCProofError(f"unknown open study mesh {name!r}; use one of {', '.join(OPEN_MESHES)}")
+    g = int(bool(ghost))
+    if name == "grid":
+        m = grid(4 + 2 * g, 4 + 2 * g)
+        V = (m.vertices - [g, g, 0.0]) / 4
+        i = np.arange(4 + 2 * g)
+        region = ((i[None, :] >= g) & (i[None, :] < 4 + g) & (i[:, None] >= g) & (i[:, None] < 4 + g)).ravel()
+        return QuadMesh(V, m.faces), region
+    if name == "annulus":
+        V, F = _annulus(12, np.linspace(0.5 - 0.5 * g, 1.5 + 0.5 * g, 3 + 2 * g))
+        region = np.zeros(len(F), dtype=bool)
+        region[12 * g:12 * (2 + g)] = True
+        return QuadMesh(V, F), region
+    if name == "disk5":  # sector j, face (j R + a) R + b; the sectors extend linearly (2 B - I)
+        m, R = k_regular_disk(5, rings=2 + g), 2 + g
+        a, b = np.divmod(np.arange(m.n_faces) % (R * R), R)
+        return QuadMesh(m.vertices / 2, m.faces), (a < 2) & (b < 2)
+    V, F = _ogrid([0.4, 1.0, 1.6][:2 + g])
+    return QuadMesh(V, F), np.arange(len(F)) < 5
 
 
 def study_mesh(name):
@@ -66,30 +130,60 @@ def study_mesh(name):
 
 
 def convergence_study(mesh, levels=4, kind="adaptive", parameterization="natural", order=4, depth=12,
-                      exact=None, start=0, graded=None):
-    """Yield per level ``{"level", "faces", "dofs", "L2", "H1"}`` of the Galerkin solution.
+                      exact=None, start=0, graded=None, bc="dirichlet", ghost=False, problem="screened",
+                      support="clamped"):
+    """Yield per level ``{"level", "faces", "dofs", "L2", "H1"}`` (and ``"H2"`` for the biharmonic problem) of
+    the Galerkin solution.
 
     Parameters
     ----------
     mesh : str or QuadMesh
-        A :data:`STUDY_MESHES` name or a closed QuadMesh (level 0).
+        A :data:`STUDY_MESHES` or :data:`OPEN_MESHES` name, or a closed QuadMesh (level 0).
     levels : int
         Levels ``start .. start + levels - 1``.
     kind, order, depth
         The assembly's quadrature (:func:`ccproof.apps.iga.quadrature.surface_quadrature`).
     parameterization : {"natural", "characteristic"}
     exact : AmbientFunction, optional
-        The manufactured solution (default ``AmbientFunction()``).
+        The manufactured solution (default ``AmbientFunction()``; on the open meshes
+        ``sin(pi x) cos(pi y)``).
     graded : (extra, rings), optional
         Instead of the uniform space: the hierarchical space graded ``extra`` levels toward the EVs over
         ``rings`` face rings (:mod:`ccproof.apps.iga.graded`; natural parameterization, adaptive rule).
+    bc : {"dirichlet", "neumann"}
+        On the open meshes (:func:`ccproof.apps.iga.boundary.solve_open_screened_poisson`).
+    ghost : bool
+        On the open meshes: the space with a ring of ghost vertices (:func:`open_study_mesh`).
+    problem : {"screened", "biharmonic", "plate"}
+        ``-Laplace_Gamma u + u = f``, or ``Laplace_Gamma^2 u + u = f`` on a closed mesh
+        (:mod:`ccproof.apps.iga.biharmonic`; uniform space), or the plate on ``grid`` (the unit square,
+        level L at mesh size ``1 / (4 2^L)``, :mod:`ccproof.apps.iga.plate`).
+    support : {"clamped", "simple"}
+        The plate's edges.
     """
+    if problem not in PROBLEMS:
+        raise CCProofError(f"unknown problem {problem!r}; use one of {', '.join(PROBLEMS)}")
+    if problem == "plate":
+        if mesh != "grid":
+            raise CCProofError(f"the plate problem is posed on the mesh 'grid' (the unit square), not {mesh!r}")
+        from ccproof.apps.iga.plate import solve_plate
+
+        for L in range(start, start + levels):
+            r = solve_plate(4 * 2**L, support)
+            yield {"level": L, "faces": 16 * 4**L, **{k: r[k] for k in ("dofs", "L2", "H1", "H2")}}
+        return
+    if isinstance(mesh, str) and mesh in OPEN_MESHES:
+        if problem != "screened" or graded is not None:
+            raise CCProofError(f"the open mesh {mesh!r} takes the screened Poisson problem on a uniform space")
+        yield from _open_study(mesh, levels, kind, order, depth, exact, start, bc, ghost)
+        return
     from ccproof.mesh import subdivide
     from ccproof.reparam import limit_surface
 
     M = study_mesh(mesh) if isinstance(mesh, str) else mesh
     if M.is_boundary_vertex.any():
-        raise CCProofError("the convergence study needs a closed mesh (no boundary conditions are imposed)")
+        raise CCProofError("the convergence study needs a closed mesh or an open study mesh name "
+                           f"({', '.join(OPEN_MESHES)})")
     exact = AmbientFunction() if exact is None else exact
     for _ in range(start):
         M = subdivide(M)
@@ -105,10 +199,44 @@ def convergence_study(mesh, levels=4, kind="adaptive", parameterization="natural
         S = limit_surface(M)
         rule = surface_quadrature(S, order, kind, depth)
         fine = surface_quadrature(S, 6, "adaptive" if parameterization == "natural" else "split", 14)
-        r = solve_screened_poisson(S, rule, exact, parameterization, error_rule=fine)
-        yield {"level": L, "faces": M.n_faces, "dofs": r["dofs"], "L2": r["L2"], "H1": r["H1"]}
+        if problem == "biharmonic":
+            from ccproof.apps.iga.biharmonic import solve_biharmonic
+
+            r = solve_biharmonic(S, rule, exact, parameterization, error_rule=fine)
+        else:
+            r = solve_screened_poisson(S, rule, exact, parameterization, error_rule=fine)
+        yield {"level": L, "faces": M.n_faces, **{k: r[k] for k in ("dofs", "L2", "H1", "H2") if k in r}}
         if L + 1 < start + levels:
             M = subdivide(M)
+
+
+def _open_study(name, levels, kind, order, depth, exact, start, bc, ghost):
+    """:func:`convergence_study` on an open study mesh (natural parameterization)."""
+    from ccproof.apps.iga.boundary import solve_open_screened_poisson
+    from ccproof.evaluate import natural_limit_surface
+    from ccproof.mesh import subdivide
+
+    M, region = open_study_mesh(name, ghost)
+    exact = AmbientFunction(math.pi, math.pi, 0.0) if exact is None else exact
+    for L in range(start + levels):
+        if L >= start:
+            S = natural_limit_surface(M)
+            r = solve_open_screened_poisson(S, surface_quadrature(S, order, kind, depth), exact, bc,
+                                            error_rule=surface_quadrature(S, 6, "adaptive", 14),
+                                            region=region if ghost else None)
+            yield {"level": L, "faces": int(region.sum()), "dofs": r["dofs"], "L2": r["L2"], "H1": r["H1"]}
+        if L + 1 < start + levels:
+            M, region = subdivide(M), np.repeat(region, 4)
+
+
+def fit_rate(rows, key):
+    """Least-squares slope of ``-log2 e`` against the level (h halves per level), scikit-fem style.
+
+    >>> fit_rate([{"L2": 1.0}, {"L2": 1 / 16}, {"L2": 1 / 256}], "L2")
+    4.0
+    """
+    e = np.log2([r[key] for r in rows])
+    return float(round(-np.polyfit(np.arange(e.size), e, 1)[0], 12))
 
 
 def rates(rows, key, per="level"):

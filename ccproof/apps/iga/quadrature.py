@@ -8,12 +8,13 @@ area element ``|Pu x Pv|`` of the parameterization the points are evaluated in
 ``"plain"``
     ``order x order`` Gauss-Legendre points on every face.
 ``"adaptive"`` (natural parameterization)
-    The same on faces without an extraordinary corner; a face with an extraordinary vertex (interior,
-    valence != 4) at corner c gets, in its quadrant at c, the dyadic rings of the natural
-    parameterization (layer n: the three squares of side ``2^-(n+1)`` where ``max(du, dv)`` lies in
-    ``[2^-(n+1), 2^-n)``, du, dv the distances to the corner), ``depth`` of them, and a Gauss rule on the
-    innermost square; its other quadrants a Gauss rule each. Every square of a ring is one bicubic
-    polynomial patch of the surface (bmz04 Fig. 3), so the basis functions are polynomials on every cell.
+    The same on faces without an irregular corner; a face with an irregular vertex (interior valence
+    != 4, or a boundary vertex with other than two faces: :func:`irregular_corners`) at corner c gets,
+    in its quadrant at c, the dyadic rings of the natural parameterization (layer n: the three squares
+    of side ``2^-(n+1)`` where ``max(du, dv)`` lies in ``[2^-(n+1), 2^-n)``, du, dv the distances to the
+    corner), ``depth`` of them, and a Gauss rule on the innermost square; its other quadrants a Gauss
+    rule each. Every square of a ring is one bicubic polynomial patch of the surface (bmz04 Fig. 3), so
+    the basis functions are polynomials on every cell.
 ``"split"`` (characteristic parameterization)
     Cells cut at the blend's breakpoints 1/6, 1/3, 1/2 (distance to every extraordinary corner of the
     face, along u and v), a Gauss rule per cell: the blend ``b(s) b(t)`` is C2 but not C3 there.
@@ -48,7 +49,7 @@ import numpy as np
 from ccproof.errors import CCProofError
 
 __all__ = ["QuadratureRule", "surface_quadrature", "quadrature_cells", "cells_rule", "extraordinary_corners",
-           "RULE_KINDS"]
+           "irregular_corners", "RULE_KINDS"]
 
 RULE_KINDS = ("plain", "adaptive", "split")
 
@@ -75,6 +76,21 @@ def extraordinary_corners(mesh):
     val = np.asarray(mesh.valence)
     ev = (val != 4) & ~np.asarray(mesh.is_boundary_vertex)
     return ev[np.asarray(mesh.faces)]
+
+
+def irregular_corners(mesh):
+    """Per face and corner, whether the corner is irregular: an extraordinary vertex, or a boundary vertex
+    with a number of faces other than 2 (a corner of an open mesh; the limit is piecewise polynomial on
+    dyadic rings there too, and its metric degenerates at the vertex), shape (m, 4) bool.
+
+    >>> from ccproof.mesh.examples import grid
+    >>> irregular_corners(grid(2, 1)).astype(int).tolist()
+    [[1, 0, 0, 1], [0, 1, 1, 0]]
+    """
+    val = np.asarray(mesh.valence)
+    bnd = np.asarray(mesh.is_boundary_vertex)
+    irr = np.where(bnd, np.asarray(mesh.face_count) != 2, val != 4)
+    return irr[np.asarray(mesh.faces)]
 
 
 def _gauss(order):
@@ -170,7 +186,7 @@ def quadrature_cells(surface, kind="adaptive", depth=12):
         raise CCProofError(f"depth must be >= 1, got {depth!r}")
     if not isinstance(surface.mesh, QuadMesh):
         raise CCProofError(f"the quadrature needs a surface on a QuadMesh, not a {type(surface.mesh).__name__}")
-    ev = extraordinary_corners(surface.mesh)
+    ev = irregular_corners(surface.mesh)
     m = ev.shape[0]
     if kind == "plain":
         one = np.ones(m)
