@@ -23,6 +23,9 @@ mesh with numpy, the rules that :func:`ccproof.mesh.rules.refine_complex` states
   vertex sharpness ``s - 1``; ``VTX_BOUNDARY_EDGE_AND_CORNER`` makes a one-face boundary vertex an
   infinitely sharp corner at level 0; holes pass to the children.
 
+The rules are bmz04 Fig. 1 (docs/readings.md R1) with OpenSubdiv's Sdc crease, corner and boundary rules
+(``sdc/catmarkScheme.h``, ``sdc/crease.cpp``; docs/evaluate.md "Tagged polygon meshes").
+
 Layout (that of :mod:`ccproof.mesh.rules` and :mod:`ccproof.mesh.subdivision`): new vertex ``v < n``
 is the vertex point of ``v``, ``n + e`` the edge point of edge ``e``, ``n + E + f`` the face point
 of face ``f``; child ``offsets[f] + k`` of face ``f`` is ``(v_k', e_{k,k+1}', f', e_{k-1,k}')``.
@@ -46,7 +49,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ccproof.errors import MeshError
+from ccproof.mesh.step_topology import step_topology, vertex_fans
 from ccproof.rule_weights import (
     crease_vertex_weights,
     face_point_weight,
@@ -131,7 +134,7 @@ def _csr(rows, cols, vals, R, ncols):
     return indptr, (key[start] % max(ncols, 1))[keep].astype(np.int64), data
 
 
-def _tri_smooth_rows(te, n, a, b, h1, h2, pw, face, sz, off, pos, idx, columns):
+def _tri_smooth_rows(te, t, pw, columns):
     """The rows of the ``TRI_SUB_SMOOTH`` edge points ``te`` as final, correctly rounded weights.
 
     Their face weight ``(w0 + w1) / 2`` (``w = 0.47`` at a triangle, a float64 weight: 2^-54 granular)
@@ -146,6 +149,7 @@ def _tri_smooth_rows(te, n, a, b, h1, h2, pw, face, sz, off, pos, idx, columns):
     rows, cols : ndarray of int64, shape (k,)
     vals : ndarray of float64, shape (k,)
     """
+    n, a, b, h1, h2, face, sz, off, pos, idx = t.n, t.a, t.b, t.h1, t.h2, t.face, t.sz, t.off, t.pos, t.idx
     one = Fraction(1)
     half = sharp_edge_weight(one)
     vw0, fw0 = smooth_edge_weights(one)
@@ -216,11 +220,8 @@ def catmark_operator(n, indices, sizes, *, halfedges=None, edge_of_halfedge=None
     sizes : array_like of int, shape (m,)
         Face sizes (>= 3).
     halfedges : ccproof.mesh.halfedges.HalfEdges, optional
-        The half-edges of this mesh (built from ``indices``, ``sizes``, ``n``: the caller's
-        ``mesh.halfedges``; ValueError when its vertices, face sizes or corners, in order, are not these):
-        its ``nxt``, ``prv``, ``twin`` and edges are read instead of pairing the half-edges again (the
-        numbering of the edge points stays ``edge_of_halfedge``'s or the default).
-        Not read when it has a non-manifold edge (the half-edges are then paired here).
+        The caller's ``mesh.halfedges`` of these faces (ValueError otherwise), read instead of pairing the
+        half-edges again (edge points numbered as ``edge_of_halfedge`` says); paired here when non-manifold.
     edge_of_halfedge : array_like of int, shape (H,), optional
         The edge of every half-edge (the edge points' numbering, 0..E-1); default: numbered by first
         occurrence along the faces (:class:`ccproof.mesh.rules.Complex`'s numbering). With
@@ -247,11 +248,6 @@ def catmark_operator(n, indices, sizes, *, halfedges=None, edge_of_halfedge=None
     Step
         ``S`` (n + E + m, n_columns) and its arrays, the child faces, the edges, the child tags and holes.
 
-    Notes
-    -----
-    bmz04 Fig. 1 (docs/readings.md R1) with OpenSubdiv's Sdc crease, corner and boundary rules
-    (``sdc/catmarkScheme.h``, ``sdc/crease.cpp``; docs/evaluate.md "Tagged polygon meshes").
-
     Examples
     --------
     One quad: corners take the crease rule along the boundary, edges their midpoints:
@@ -272,69 +268,44 @@ def catmark_operator(n, indices, sizes, *, halfedges=None, edge_of_halfedge=None
 
     opts = Options() if options is None else options
     chaikin = opts.crease_method == "chaikin"
-    idx = np.asarray(indices, dtype=np.int64).reshape(-1)
-    sz = np.asarray(sizes, dtype=np.int64).reshape(-1)
-    m, H = sz.size, idx.size
-    off = np.r_[0, np.cumsum(sz)].astype(np.int64)
-    he = halfedges
-    if he is not None and (he.org.size != H or he.sizes.size != m or he.n_vertices != n
-                           or not np.array_equal(he.sizes, sz) or not np.array_equal(he.org, idx)):
-        raise ValueError("halfedges: not the half-edges of this mesh")  # (its twins would be other half-edges')
-    face = None if he is None else he.__dict__.get("face_of")  # (built by HalfEdges on mixed face sizes)
-    if face is None:
-        face = np.repeat(np.arange(m), sz)
-    pos = np.arange(H) - off[face]
-    if he is None:
-        nxt = off[face] + (pos + 1) % sz[face]
-        prv = off[face] + (pos - 1) % sz[face]
-    else:
-        nxt, prv = he.nxt, he.prv
-    org, dst = idx, idx[nxt]
-    if he is not None and he.edge_manifold:
-        # the mesh's pairing: twins across its manifold edges, each edge's smallest half-edge ``first``
-        twin, first = he.twin, he.edge_halfedge
-        if edge_of_halfedge is None:  # numbered by first occurrence: the order of the edges' first half-edges
-            is_first = np.zeros(H, dtype=bool)
-            is_first[first] = True
-            renum = (np.cumsum(is_first) - 1)[first]
-            he_edge = renum[he.edge_of]
-        else:
-            he_edge = np.asarray(edge_of_halfedge, dtype=np.int64).reshape(-1)
-            renum = he_edge[first]
-        E = first.size
-        h1 = np.empty(E, dtype=np.int64)
-        h1[renum] = first  # the smallest half-edge of every edge
-        count = np.empty(E, dtype=np.int64)
-        count[renum] = he.edge_face_count
-        h2 = np.where(count == 2, twin[h1], -1)
-        two = h2 >= 0
-    else:
-        lo, hi = np.minimum(org, dst), np.maximum(org, dst)
-        if edge_of_halfedge is None:
-            _, first, inv = np.unique(lo * n + hi, return_index=True, return_inverse=True)
-            order = np.argsort(first, kind="stable")
-            rank = np.empty(first.size, dtype=np.int64)
-            rank[order] = np.arange(first.size)
-            he_edge = rank[inv.reshape(-1)]
-        else:
-            he_edge = np.asarray(edge_of_halfedge, dtype=np.int64).reshape(-1)
-        E = int(he_edge.max()) + 1 if H else 0
-        count = np.bincount(he_edge, minlength=E)
-        if (count > 2).any():
-            e = int(np.flatnonzero(count > 2)[0])
-            h = int(np.flatnonzero(he_edge == e)[0])
-            raise MeshError(f"edge ({int(lo[h])}, {int(hi[h])}) has {int(count[e])} faces: the step needs a "
-                            "manifold mesh (take PolyMesh.manifold)")
-        by_edge = np.argsort(he_edge, kind="stable")
-        estart = np.r_[0, np.cumsum(count)][:-1]
-        h1 = by_edge[estart]
-        h2 = np.where(count == 2, by_edge[np.minimum(estart + 1, H - 1)], -1)
-        twin = np.full(H, -1, dtype=np.int64)
-        two = h2 >= 0
-        twin[h1[two]], twin[h2[two]] = h2[two], h1[two]
-    a, b = org[h1], dst[h1]
-    bnd_e = ~two
-    # tags
+    t = step_topology(n, indices, sizes, halfedges, edge_of_halfedge)
+    es = _edge_tags(t, edge_sharpness)
+    vs = _vertex_tags(n, vertex_sharpness)
+    fans = vertex_fans(t)
+    pe = es[fans.inc_e]
+    ce = _child_edge_sharpness(pe, fans.inc_v, n, chaikin)
+    coef, cv = _vertex_coefficients(t, fans, vs, pe, ce, chaikin, opts.boundary == "edge_and_corner" and level == 0)
+    ncols = (n if columns is None else int(np.max(columns, initial=-1)) + 1) if n_columns is None else int(n_columns)
+    rows = _Rows(t, fans)
+    rows.face_points()
+    rows.vertex_points(coef, pe, ce)
+    tri_e = rows.edge_points(es, ce, chaikin, opts.triangle_subdivision == "smooth" and level == 0)
+    csr = rows.csr(ncols, columns, tri_e)
+    S = _scipy_csr(csr, (n + t.E + t.m, ncols)) if sparse else None
+    faces = np.stack([t.org, n + t.he_edge, n + t.E + t.face, n + t.he_edge[t.prv]], axis=1)
+    return Step(S, faces, np.stack([t.a, t.b], axis=1), *_child_tags(t, fans, ce, cv, holes), csr)
+
+
+def _scipy_csr(csr, shape):
+    import scipy.sparse as sp
+
+    return sp.csr_matrix((csr[2], csr[1], csr[0]), shape=shape)
+
+
+def _child_tags(t, fans, ce, cv, holes):
+    """(child creases, child corners, child holes) of :class:`Step`."""
+    keep = ce > 0
+    child_creases = (np.stack([fans.inc_v[keep], t.n + fans.inc_e[keep]], axis=1).reshape(-1, 2), ce[keep])
+    cvs = np.where(fans.k > 0, cv, 0.0)
+    sharp_v = np.flatnonzero(cvs > 0)
+    child_holes = np.zeros(t.H, dtype=bool) if holes is None else np.repeat(np.asarray(holes, dtype=bool), t.sz)
+    return child_creases, (sharp_v, cvs[sharp_v]), child_holes
+
+
+def _edge_tags(t, edge_sharpness):
+    """Sharpness per edge (E,): the tags (an array in the edge numbering, or a dict by vertex pair), ``>= 10``
+    infinite, boundary edges infinite."""
+    n, E, a, b = t.n, t.E, t.a, t.b
     if isinstance(edge_sharpness, dict):
         es = np.zeros(E)
         if edge_sharpness:
@@ -350,7 +321,12 @@ def catmark_operator(n, indices, sizes, *, halfedges=None, edge_of_halfedge=None
     else:
         es = np.array(edge_sharpness, dtype=np.float64).reshape(E)
     es = np.where(es >= INFINITE, np.inf, np.maximum(es, 0.0))
-    es[bnd_e] = np.inf
+    es[~t.two] = np.inf
+    return es
+
+
+def _vertex_tags(n, vertex_sharpness):
+    """Sharpness per vertex (n,): the tags (an array or a dict), ``>= 10`` infinite."""
     if isinstance(vertex_sharpness, dict):
         vs = np.zeros(n)
         if vertex_sharpness:
@@ -359,38 +335,11 @@ def catmark_operator(n, indices, sizes, *, halfedges=None, edge_of_halfedge=None
         vs = np.zeros(n)
     else:
         vs = np.array(vertex_sharpness, dtype=np.float64).reshape(n)
-    vs = np.where(vs >= INFINITE, np.inf, np.maximum(vs, 0.0))
-    # fans: corners around each vertex counter-clockwise, from the clockwise-most (boundary) or the
-    # smallest corner (interior): the order of refine_complex's sums
-    k = np.bincount(org, minlength=n)  # faces at each vertex
-    rot = twin[prv]
-    start = np.full(n, H, dtype=np.int64)
-    np.minimum.at(start, org, np.arange(H))
-    bh = np.flatnonzero(twin < 0)
-    start[org[bh]] = bh
-    is_bv = np.zeros(n, dtype=bool)
-    is_bv[org[bh]] = True
-    ptr = np.r_[0, np.cumsum(k)]
-    fan = np.empty(H, dtype=np.int64)
-    cur = start.copy()
-    for j in range(int(k.max()) if n else 0):
-        sel = np.flatnonzero(k > j)
-        if (cur[sel] < 0).any():
-            v = int(sel[cur[sel] < 0][0])
-            raise MeshError(f"vertex {v}: its faces form more than one fan (take PolyMesh.manifold)")
-        fan[ptr[sel] + j] = cur[sel]
-        cur[sel] = rot[cur[sel]]
-    # incidences (vertex, edge) in fan order: the outgoing edge of every corner, then for a boundary
-    # vertex the incoming boundary edge
-    fv = org[fan]
-    inc_v = np.r_[fv, dst[bh]]
-    inc_e = np.r_[he_edge[fan], he_edge[bh]]
-    inc_u = np.r_[dst[fan], org[bh]]
-    inc_o = np.r_[np.arange(H), H + np.arange(bh.size)]
-    o = np.lexsort((inc_o, inc_v))
-    inc_v, inc_e, inc_u = inc_v[o], inc_e[o], inc_u[o]
-    pe = es[inc_e]
-    # child sharpness of every edge at every vertex (Sdc SubdivideEdgeSharpnessesAroundVertex)
+    return np.where(vs >= INFINITE, np.inf, np.maximum(vs, 0.0))
+
+
+def _child_edge_sharpness(pe, inc_v, n, chaikin):
+    """Child sharpness of every edge at every vertex (Sdc SubdivideEdgeSharpnessesAroundVertex), per incidence."""
     ce = decrement_sharpness(pe)
     if chaikin:
         semi = (pe > 0) & np.isfinite(pe)
@@ -402,26 +351,22 @@ def catmark_operator(n, indices, sizes, *, halfedges=None, edge_of_halfedge=None
             avg = ((total[inc_v[many]] - s32) / (nsemi[inc_v[many]] - 1).astype(_F32)).astype(_F32)
             c = (_F32(0.75) * s32 + _F32(0.25) * avg).astype(_F32) - _F32(1.0)
             ce[many] = np.where(c > 0, c.astype(np.float64), 0.0)
-    # vertex rules
+    return ce
+
+
+def _vertex_coefficients(t, fans, vs, pe, ce, chaikin, corners_at_level0):
+    """((a_smooth, a_crease_p, a_crease_c, a_corner), child vertex sharpness): per vertex the coefficient of
+    each mask in its vertex point (Sdc's rule of the parent and of the child, blended by the fractional
+    weight ``w``, Sdc ComputeFractionalWeightAtVertex in float32 in fan order)."""
+    n, k, inc_v = t.n, fans.k, fans.inc_v
     pv = vs.copy()
-    if opts.boundary == "edge_and_corner" and level == 0:
-        pv[is_bv & (k == 1)] = np.inf
+    if corners_at_level0:  # EDGE_AND_CORNER: a one-face boundary vertex is a corner
+        pv[fans.is_bv & (k == 1)] = np.inf
     cv = decrement_sharpness(pv)
-    np_ = np.bincount(inc_v[pe > 0], minlength=n)
-    nc_ = np.bincount(inc_v[ce > 0], minlength=n)
-    SMOOTH, CREASE, CORNER = 0, 2, 3
-
-    def rule(sv, ns):
-        r = np.where(ns >= 3, CORNER, np.where(ns == 2, CREASE, SMOOTH))
-        return np.where(sv > 0, CORNER, r)
-
-    prule, crule = rule(pv, np_), rule(cv, nc_)
-    blend = (prule != SMOOTH) & (crule != prule)
-    # Sdc ComputeFractionalWeightAtVertex (float32, in fan order)
-    if chaikin:
-        hit = (pe > 0) & (ce <= 0)
-    else:
-        hit = (pe > 0) & (pe <= 1)
+    prule = _rule(pv, np.bincount(inc_v[pe > 0], minlength=n))
+    crule = _rule(cv, np.bincount(inc_v[ce > 0], minlength=n))
+    blend = (prule != _SMOOTH) & (crule != prule)
+    hit = ((pe > 0) & (ce <= 0)) if chaikin else ((pe > 0) & (pe <= 1))
     hit &= blend[inc_v]
     vhit = blend & (pv > 0) & (cv <= 0)
     seg = np.r_[np.flatnonzero(vhit), inc_v[hit]]
@@ -434,145 +379,176 @@ def catmark_operator(n, indices, sizes, *, halfedges=None, edge_of_halfedge=None
     w[has] = np.minimum(w32.astype(np.float64), 1.0)
     cp = np.where(blend, w, 1.0)  # weight of the parent's mask
     cc = np.where(blend, 1.0 - w, 0.0)  # of the child's
-    a_smooth = np.where(prule == SMOOTH, 1.0, 0.0) + np.where(blend & (crule == SMOOTH), cc, 0.0)
-    a_crease_p = np.where(prule == CREASE, cp, 0.0)
-    a_crease_c = np.where(blend & (crule == CREASE), cc, 0.0)
-    a_corner = np.where(prule == CORNER, cp, 0.0) + np.where(blend & (crule == CORNER), cc, 0.0)
+    a_smooth = np.where(prule == _SMOOTH, 1.0, 0.0) + np.where(blend & (crule == _SMOOTH), cc, 0.0)
+    a_crease_p = np.where(prule == _CREASE, cp, 0.0)
+    a_crease_c = np.where(blend & (crule == _CREASE), cc, 0.0)
+    a_corner = np.where(prule == _CORNER, cp, 0.0) + np.where(blend & (crule == _CORNER), cc, 0.0)
     for x in (a_smooth, a_crease_p, a_crease_c, a_corner):
         x[k == 0] = 0.0  # unused vertices: no row
+    return (a_smooth, a_crease_p, a_crease_c, a_corner), cv
 
-    # every weight is a sum of terms coef * t / d (coef a dyadic float: 1, a fractional weight, a sharpness;
-    # t / d a rule's rational weight): summed exactly as integers over the row's common denominator, then
-    # divided once (the correctly rounded weight, as refine_complex's to_float of its exact stencil)
-    rows, cols, vals = [], [], []
 
-    def scaled(r, coef, t, d):
-        """``coef * t / d`` times the common denominator ``R[r]`` of row ``r``: exact (a dyadic times an integer)."""
-        q, bad = np.divmod(R[r], d)
+_SMOOTH, _CREASE, _CORNER = 0, 2, 3
+
+
+def _rule(sv, ns):
+    """Sdc's vertex rule from the vertex sharpness ``sv`` and the number ``ns`` of sharp edges at the vertex."""
+    r = np.where(ns >= 3, _CORNER, np.where(ns == 2, _CREASE, _SMOOTH))
+    return np.where(sv > 0, _CORNER, r)
+
+
+class _Rows:
+    """The terms of the step's rows, appended in order (face, vertex, edge points: the order fixes the sums).
+
+    Every weight is a sum of terms coef * t / d (coef a dyadic float: 1, a fractional weight, a sharpness;
+    t / d a rule's rational weight): summed exactly as integers over the row's common denominator ``R``,
+    then divided once (the correctly rounded weight, as refine_complex's to_float of its exact stencil).
+    """
+
+    def __init__(self, t, fans):
+        self.t, self.fans = t, fans
+        self.rows, self.cols, self.vals = [], [], []
+        one = Fraction(1)  # the rule functions in exact rationals, one value per distinct size or valence
+        self.face_t, self.face_d = _ratios(lambda x: face_point_weight(x, one), t.sz)  # (m,)
+        kk = np.maximum(fans.k, 1)
+        self.wv, self.we, self.wf = (_ratios(lambda x, i=i: smooth_vertex_weights(x, one)[i], kk) for i in range(3))
+        self.wcv, self.wcn = crease_vertex_weights(one)
+        self.half = sharp_edge_weight(one)
+        self.vw0, self.fw0 = smooth_edge_weights(one)
+        self.R = self._denominators()
+
+    def _denominators(self):
+        """The common denominator of every row: a face's; at a vertex, of its smooth, crease and corner
+        weights; at an edge, of the midpoint's and the smooth rule's."""
+        t, fans, face_d = self.t, self.fans, self.face_d
+        lf = np.ones(t.n, dtype=np.int64)
+        if t.H:
+            used = np.flatnonzero(fans.k > 0)
+            lf[used] = np.lcm.reduceat(face_d[t.face[fans.fan]], fans.ptr[used])
+        n, E, two, h1, h2 = t.n, t.E, t.two, t.h1, t.h2
+        return np.concatenate([
+            np.lcm.reduce([self.wv[1], self.we[1], self.wf[1] * lf, np.full(n, self.wcv.denominator),
+                           np.full(n, self.wcn.denominator)]),
+            np.lcm.reduce([np.full(E, self.half.denominator), np.full(E, self.vw0.denominator),
+                           self.fw0.denominator * face_d[t.face[h1]],
+                           self.fw0.denominator * np.where(two, face_d[t.face[h2]], 1)]),
+            face_d]).astype(np.int64)
+
+    def scaled(self, r, coef, tn, d):
+        """``coef * tn / d`` times the common denominator ``R[r]`` of row ``r``: exact (a dyadic times an integer)."""
+        q, bad = np.divmod(self.R[r], d)
         if bad.any():
             raise AssertionError("internal: a rule weight's denominator does not divide its row's")
-        return coef * (t * q).astype(np.float64)
+        return coef * (tn * q).astype(np.float64)
 
-    def add(r, c, coef, t, d):
+    def put(self, r, c, x):
+        self.rows.append(r)
+        self.cols.append(c)
+        self.vals.append(x)
+
+    def add(self, r, c, coef, tn, d):
         r = np.asarray(r, dtype=np.int64)
-        rows.append(r)
-        cols.append(np.broadcast_to(np.asarray(c, dtype=np.int64), r.shape))
-        vals.append(np.broadcast_to(scaled(r, coef, t, d), r.shape))
+        self.put(r, np.broadcast_to(np.asarray(c, dtype=np.int64), r.shape),
+                 np.broadcast_to(self.scaled(r, coef, tn, d), r.shape))
 
-    def add_face_rest(r, h, x):
+    def add_face_rest(self, r, h, x):
         """Row ``r`` gets ``x`` on every vertex of the face of half-edge ``h`` but ``org(h)``, ``dst(h)``
         (the rest of a face point spelled out; the caller merges those two into its own terms)."""
-        f = face[h]
-        for j in range(2, int(sz[f].max()) if f.size else 0):
-            sel = sz[f] > j
-            hj = off[f] + (pos[h] + j) % sz[f]
+        t = self.t
+        f = t.face[h]
+        for j in range(2, int(t.sz[f].max()) if f.size else 0):
+            sel = t.sz[f] > j
+            hj = t.off[f] + (t.pos[h] + j) % t.sz[f]
             if sel.all():
-                rows.append(r)
-                cols.append(idx[hj])
-                vals.append(x)
+                self.put(r, t.idx[hj], x)
             else:
-                rows.append(r[sel])
-                cols.append(idx[hj[sel]])
-                vals.append(x[sel])
+                self.put(r[sel], t.idx[hj[sel]], x[sel])
 
-    one = Fraction(1)  # the rule functions in exact rationals, one value per distinct size or valence
-    face_t, face_d = _ratios(lambda x: face_point_weight(x, one), sz)  # (m,)
-    kk = np.maximum(k, 1)
-    (wv_t, wv_d), (we_t, we_d), (wf_t, wf_d) = (
-        _ratios(lambda x, i=i: smooth_vertex_weights(x, one)[i], kk) for i in range(3))
-    wcv, wcn = crease_vertex_weights(one)
-    half = sharp_edge_weight(one)
-    vw0, fw0 = smooth_edge_weights(one)
-    ncols = (n if columns is None else int(np.max(columns, initial=-1)) + 1) if n_columns is None else int(n_columns)
-    # the common denominator of every row: a face's; at a vertex, of its smooth, crease and corner
-    # weights; at an edge, of the midpoint's and the smooth rule's
-    lf = np.ones(n, dtype=np.int64)
-    if H:
-        used = np.flatnonzero(k > 0)
-        lf[used] = np.lcm.reduceat(face_d[face[fan]], ptr[used])
-    R = np.concatenate([
-        np.lcm.reduce([wv_d, we_d, wf_d * lf, np.full(n, wcv.denominator), np.full(n, wcn.denominator)]),
-        np.lcm.reduce([np.full(E, half.denominator), np.full(E, vw0.denominator),
-                       fw0.denominator * face_d[face[h1]], fw0.denominator * np.where(two, face_d[face[h2]], 1)]),
-        face_d]).astype(np.int64)
-    # face points
-    rows.append(n + E + face)  # (R = the face's denominator: the weight's numerator)
-    cols.append(idx)
-    vals.append(face_t[face].astype(np.float64))
-    # vertex points: smooth masks
-    sm = np.flatnonzero(a_smooth != 0)
-    if sm.size:
-        c = np.flatnonzero(a_smooth[org] != 0)  # corners at those vertices: one edge and one face each
-        v = org[c]
-        f = face[c]
-        xf = scaled(v, a_smooth[v], wf_t[v] * face_t[f], wf_d[v] * face_d[f])  # each vertex of the face
-        diag = np.bincount(v, weights=xf, minlength=n)  # v is in each of its faces
-        diag[sm] += scaled(sm, a_smooth[sm], wv_t[sm], wv_d[sm])
-        rows.append(sm)
-        cols.append(sm)
-        vals.append(diag[sm])
-        rows.append(v)  # the edge neighbour of the corner, which is also the next vertex of its face
-        cols.append(dst[c])
-        vals.append(scaled(v, a_smooth[v], we_t[v], we_d[v]) + xf)
-        add_face_rest(v, c, xf)
-    for coef, sh in ((a_crease_p, pe), (a_crease_c, ce)):
-        cr = np.flatnonzero(coef != 0)
-        if not cr.size:
-            continue
-        add(cr, cr, coef[cr], wcv.numerator, wcv.denominator)
-        sel = (coef[inc_v] != 0) & (sh > 0)
-        add(inc_v[sel], inc_u[sel], coef[inc_v[sel]], wcn.numerator, wcn.denominator)
-    co = np.flatnonzero(a_corner != 0)
-    add(co, co, a_corner[co], 1, 1)
-    # edge points
-    er = n + np.arange(E)
-    if chaikin:  # the child sharpness of the edge's half at each end
-        ce_end = np.zeros((E, 2))
-        first_end = inc_v == a[inc_e]
-        ce_end[inc_e[first_end], 0] = ce[first_end]
-        ce_end[inc_e[~first_end], 1] = ce[~first_end]
-        both = (ce_end > 0).all(axis=1)
-    else:
-        both = decrement_sharpness(es) > 0
-    mid = (es > 0) & (bnd_e | both)
-    pw = np.where(mid, 1.0, np.where(es > 0, es.astype(_F32).astype(np.float64), 0.0))  # weight of the midpoint
-    tri_e = np.zeros(E, dtype=bool)  # TRI_SUB_SMOOTH's edges (level 0, a triangle on a side), not both sharp
-    if opts.triangle_subdivision == "smooth" and level == 0 and two.any():
-        tri_e[two] = ((sz[face[h1[two]]] == 3) | (sz[face[h2[two]]] == 3)) & (pw[two] != 1.0)
-    ms = np.flatnonzero((pw != 0) & ~tri_e)
-    for end in (a, b):
-        add(er[ms], end[ms], pw[ms], half.numerator, half.denominator)
-    smooth_e = np.flatnonzero((pw != 1.0) & two & ~tri_e)
-    if smooth_e.size:
-        f1, f2 = face[h1[smooth_e]], face[h2[smooth_e]]
-        q = 1.0 - pw[smooth_e]  # exact: pw is a float32 value in [0, 1]
-        r = er[smooth_e]
-        x1 = scaled(r, q, fw0.numerator * face_t[f1], fw0.denominator * face_d[f1])  # each vertex of the faces
-        x2 = scaled(r, q, fw0.numerator * face_t[f2], fw0.denominator * face_d[f2])
-        xend = scaled(r, q, vw0.numerator, vw0.denominator) + x1 + x2  # the ends are in both faces
+    def face_points(self):
+        """The centroids (R = the face's denominator: the weight's numerator)."""
+        t = self.t
+        self.put(t.n + t.E + t.face, t.idx, self.face_t[t.face].astype(np.float64))
+
+    def vertex_points(self, coef, pe, ce):
+        """The smooth, crease (parent's and child's) and corner masks with their coefficients."""
+        a_smooth, a_crease_p, a_crease_c, a_corner = coef
+        self._smooth_vertices(a_smooth)
+        inc_v, inc_u = self.fans.inc_v, self.fans.inc_u
+        for c, sh in ((a_crease_p, pe), (a_crease_c, ce)):
+            cr = np.flatnonzero(c != 0)
+            if not cr.size:
+                continue
+            self.add(cr, cr, c[cr], self.wcv.numerator, self.wcv.denominator)
+            sel = (c[inc_v] != 0) & (sh > 0)
+            self.add(inc_v[sel], inc_u[sel], c[inc_v[sel]], self.wcn.numerator, self.wcn.denominator)
+        co = np.flatnonzero(a_corner != 0)
+        self.add(co, co, a_corner[co], 1, 1)
+
+    def _smooth_vertices(self, a_smooth):
+        t = self.t
+        sm = np.flatnonzero(a_smooth != 0)
+        if not sm.size:
+            return
+        (wv_t, wv_d), (we_t, we_d), (wf_t, wf_d) = self.wv, self.we, self.wf
+        c = np.flatnonzero(a_smooth[t.org] != 0)  # corners at those vertices: one edge and one face each
+        v = t.org[c]
+        f = t.face[c]
+        xf = self.scaled(v, a_smooth[v], wf_t[v] * self.face_t[f], wf_d[v] * self.face_d[f])  # each face vertex
+        diag = np.bincount(v, weights=xf, minlength=t.n)  # v is in each of its faces
+        diag[sm] += self.scaled(sm, a_smooth[sm], wv_t[sm], wv_d[sm])
+        self.put(sm, sm, diag[sm])
+        # the edge neighbour of the corner, which is also the next vertex of its face
+        self.put(v, t.dst[c], self.scaled(v, a_smooth[v], we_t[v], we_d[v]) + xf)
+        self.add_face_rest(v, c, xf)
+
+    def edge_points(self, es, ce, chaikin, tri_smooth):
+        """Midpoints blended with the smooth rule by the midpoint weight ``pw``; returns the ``TRI_SUB_SMOOTH``
+        edges (level 0, a triangle on a side, not both halves sharp), whose rows :meth:`csr` adds."""
+        t, fans = self.t, self.fans
+        a, b, two, h1, h2 = t.a, t.b, t.two, t.h1, t.h2
+        er = t.n + np.arange(t.E)
+        if chaikin:  # the child sharpness of the edge's half at each end
+            ce_end = np.zeros((t.E, 2))
+            first_end = fans.inc_v == a[fans.inc_e]
+            ce_end[fans.inc_e[first_end], 0] = ce[first_end]
+            ce_end[fans.inc_e[~first_end], 1] = ce[~first_end]
+            both = (ce_end > 0).all(axis=1)
+        else:
+            both = decrement_sharpness(es) > 0
+        mid = (es > 0) & (~two | both)
+        pw = np.where(mid, 1.0, np.where(es > 0, es.astype(_F32).astype(np.float64), 0.0))  # midpoint's weight
+        tri_e = np.zeros(t.E, dtype=bool)
+        if tri_smooth and two.any():
+            tri_e[two] = ((t.sz[t.face[h1[two]]] == 3) | (t.sz[t.face[h2[two]]] == 3)) & (pw[two] != 1.0)
+        ms = np.flatnonzero((pw != 0) & ~tri_e)
         for end in (a, b):
-            rows.append(r)
-            cols.append(end[smooth_e])
-            vals.append(xend)
-        add_face_rest(r, h1[smooth_e], x1)
-        add_face_rest(r, h2[smooth_e], x2)
-    rows, cols, vals = (np.concatenate(x) for x in (rows, cols, vals))
-    if columns is not None:
-        cols = np.asarray(columns, dtype=np.int64)[cols]
-    if tri_e.any():  # final weights: these rows are not divided
-        tr, tc, tv = _tri_smooth_rows(np.flatnonzero(tri_e), n, a, b, h1, h2, pw, face, sz, off, pos, idx, columns)
-        rows, cols, vals = np.r_[rows, tr], np.r_[cols, tc], np.r_[vals, tv]
-        R[n + np.flatnonzero(tri_e)] = 1
-    csr = _csr(rows, cols, vals, R, ncols)
-    S = None
-    if sparse:
-        import scipy.sparse as sp
+            self.add(er[ms], end[ms], pw[ms], self.half.numerator, self.half.denominator)
+        smooth_e = np.flatnonzero((pw != 1.0) & two & ~tri_e)
+        if smooth_e.size:
+            self._smooth_edges(er[smooth_e], smooth_e, 1.0 - pw[smooth_e])  # exact: pw is a float32 in [0, 1]
+        self.pw = pw
+        return tri_e
 
-        S = sp.csr_matrix((csr[2], csr[1], csr[0]), shape=(n + E + m, ncols))
-    faces = np.stack([org, n + he_edge, n + E + face, n + he_edge[prv]], axis=1)
-    keep = ce > 0
-    child_creases = (np.stack([inc_v[keep], n + inc_e[keep]], axis=1).reshape(-1, 2), ce[keep])
-    cvs = np.where(k > 0, cv, 0.0)
-    sharp_v = np.flatnonzero(cvs > 0)
-    child_holes = np.zeros(H, dtype=bool) if holes is None else np.repeat(np.asarray(holes, dtype=bool), sz)
-    return Step(S, faces, np.stack([a, b], axis=1), child_creases, (sharp_v, cvs[sharp_v]), child_holes, csr)
+    def _smooth_edges(self, r, e, q):
+        t, fw0, vw0 = self.t, self.fw0, self.vw0
+        f1, f2 = t.face[t.h1[e]], t.face[t.h2[e]]
+        x1 = self.scaled(r, q, fw0.numerator * self.face_t[f1], fw0.denominator * self.face_d[f1])  # face vertices
+        x2 = self.scaled(r, q, fw0.numerator * self.face_t[f2], fw0.denominator * self.face_d[f2])
+        xend = self.scaled(r, q, vw0.numerator, vw0.denominator) + x1 + x2  # the ends are in both faces
+        for end in (t.a, t.b):
+            self.put(r, end[e], xend)
+        self.add_face_rest(r, t.h1[e], x1)
+        self.add_face_rest(r, t.h2[e], x2)
+
+    def csr(self, ncols, columns, tri_e):
+        """The CSR arrays of the rows (vertex copies merged by ``columns``), with the ``TRI_SUB_SMOOTH`` rows."""
+        t = self.t
+        rows, cols, vals = (np.concatenate(x) for x in (self.rows, self.cols, self.vals))
+        if columns is not None:
+            cols = np.asarray(columns, dtype=np.int64)[cols]
+        R = self.R
+        if tri_e.any():  # final weights: these rows are not divided
+            tr, tc, tv = _tri_smooth_rows(np.flatnonzero(tri_e), t, self.pw, columns)
+            rows, cols, vals = np.r_[rows, tr], np.r_[cols, tc], np.r_[vals, tv]
+            R[t.n + np.flatnonzero(tri_e)] = 1
+        return _csr(rows, cols, vals, R, ncols)
