@@ -143,6 +143,9 @@ def canonical_ring(cx, g, r, depth=1):
                     walk.append(c)
                     t = twin[c]
                     c = -1 if t < 0 else nxt[t]
+            if len(walk) > _BIG_FAN and isinstance(org, memoryview):  # (the centre of an n-gon)
+                _read_fan(cx, walk, seen, pos, ring, first_corner, faces)
+                continue
             for c in walk:
                 h = face_of[c]
                 if h in seen:
@@ -163,6 +166,46 @@ def canonical_ring(cx, g, r, depth=1):
                 faces.append(tuple(vs))
         done = upto
     return ring, tuple(faces), done
+
+
+#: fans longer than this are read with array operations (:func:`_read_fan`)
+_BIG_FAN = 48
+
+
+def _read_fan(cx, walk, seen, pos, ring, first_corner, faces):
+    """The face-reading step of :func:`canonical_ring` for one long fan ``walk`` (corners), on arrays: the
+    same faces, labels and first corners as the loop there (each new face read from its corner in the walk,
+    new vertices numbered by first appearance), at a cost linear in the fan with a small constant."""
+    org = np.asarray(cx.org)
+    start = np.asarray(cx.start)
+    W = np.array(walk, dtype=np.int64)
+    H = np.asarray(cx.face_of)[W]
+    keep = [i for i, h in enumerate(H.tolist()) if not (h in seen or seen.add(h))]
+    W, H = W[keep], H[keep]
+    sh = start[H]
+    nxt_start = np.where(H + 1 < start.size, start[np.minimum(H + 1, start.size - 1)], org.size)
+    k = nxt_start - sh
+    ends = np.cumsum(k)
+    rep = np.repeat(np.arange(k.size), k)
+    hc = sh[rep] + (W[rep] - sh[rep] + np.arange(ends[-1] if k.size else 0) - (ends - k)[rep]) % k[rep]
+    U = org[hc]
+    uniq, first, inv = np.unique(U, return_index=True, return_inverse=True)
+    order = np.argsort(first, kind="stable")  # the vertices by first appearance
+    us = uniq[order].tolist()
+    known = [pos.get(u, -1) for u in us]
+    new = [i for i, q in enumerate(known) if q < 0]
+    labels = dict(zip((us[i] for i in new), range(len(ring), len(ring) + len(new))))
+    pos.update(labels)
+    ring.extend(labels)
+    first_corner.update(zip(labels, hc[first[order[new]]].tolist()))
+    lab = np.empty(uniq.size, dtype=np.int64)
+    lab[order] = [q if q >= 0 else labels[u] for u, q in zip(us, known)]
+    L = lab[inv.reshape(-1)]
+    if k.size and (k == k[0]).all():  # (all quads: one reshape)
+        faces.extend(map(tuple, L.reshape(-1, int(k[0])).tolist()))
+        return
+    L, b = L.tolist(), [0] + ends.tolist()
+    faces.extend(tuple(L[b[i]:b[i + 1]]) for i in range(k.size))
 
 
 def quad_ring(faces, f, r):
@@ -281,8 +324,9 @@ def refine_key(key, n_rule):
 
     Returns
     -------
-    S : ndarray, shape (n_points, N)
-        Float stencils (dense: local complexes are small), rows of uncomputable points NaN.
+    S : ndarray or scipy.sparse.csr_matrix, shape (n_points, N)
+        Float stencils (dense: local complexes are small, but for rings of ``SPARSE_RING`` points or more,
+        the centre of a large n-gon), rows of uncomputable points NaN.
         Row v < N is the vertex point of ring vertex v (docs/evaluate.md "Conventions").
     stencils : tuple of dict or None (exact)
     child : Complex
@@ -309,10 +353,34 @@ def refine_key(key, n_rule):
     edges = [e for e, h in enumerate(cx.edges) if cx.org[h] < n_rule or cx.dst(h) < n_rule]
     stencils, children, ces, cvs = refine_complex(cx, vertices=rule, edges=edges)
     child = Complex(children, ces, cvs, cx.options, level=2, n_vertices=len(stencils))
+    if cx.n_vertices >= SPARSE_RING:
+        return _sparse_stencils(stencils, cx.n_vertices), tuple(stencils), child
     S = _stencil_matrix([{} if st is None else st for st in stencils], cx.n_vertices)
     S[[i for i, st in enumerate(stencils) if st is None]] = np.nan
     S.setflags(write=False)
     return S, tuple(stencils), child
+
+
+#: rings of at least this many points (the centre of an n-gon, n >= 124) keep their float stencils sparse
+SPARSE_RING = 256
+
+
+def _sparse_stencils(stencils, ncols):
+    """The float stencils as a sparse matrix (``scipy.sparse.csr_matrix``), a row of an uncomputable point
+    one NaN (so that ``S @ X`` is NaN in that row, as with the dense NaN row)."""
+    import scipy.sparse
+
+    rows, cols, vals = [], [], []
+    for r, st in enumerate(stencils):
+        if st is None:
+            rows.append(r)
+            cols.append(0)
+            vals.append(math.nan)
+            continue
+        rows.extend([r] * len(st))
+        cols.extend(st)
+        vals.extend(to_float(w) for w in st.values())
+    return scipy.sparse.csr_matrix((vals, (rows, cols)), shape=(len(stencils), ncols))
 
 
 @functools.lru_cache(maxsize=1 << 16)
