@@ -898,7 +898,9 @@ class CornerScheme:
         if self.support is not None:
             idx = self.support
             A = flint.fmpq_mat(len(idx), len(idx), [A[i, j] for i in idx for j in idx])
-        T = _tangent_masks_float(A)
+        T = _tangent_masks_sparse(A) if A.nrows() >= SPARSE_RING else None
+        if T is None:
+            T = _tangent_masks_float(A)
         if T is None:
             T = _tangent_masks(A)
         if T is None or self.support is None:
@@ -906,6 +908,51 @@ class CornerScheme:
         out = np.zeros((2, self.size))
         out[:, list(self.support)] = T
         return out
+
+
+def _tangent_masks_sparse(A, k=8):
+    """:meth:`CornerScheme.tangent_masks` of a large ring (an n-gon centre), or None (then the dense paths).
+
+    The ``k`` eigenvalues of largest modulus of the rounded ``A`` by Arnoldi iteration on the sparse
+    ``A^T`` (ARPACK: cost about linear in the ring, not cubic), grouped within 1e-6; the real span of a
+    group's eigenvectors (SVD of their real and imaginary parts). Accepted only when unambiguous, as in
+    :func:`_tangent_masks_float`: real groups, one eigenvalue 1, two directions in all, residuals
+    ``|x (A - mu)| <= 1e-12 |x|``; a simple eigenvalue with a defective partner (a Jordan chain) is left
+    to the dense paths.
+    """
+    import scipy.sparse
+    import scipy.sparse.linalg
+
+    Af = scipy.sparse.csr_matrix(_fmpq_mat_to_float(A))
+    try:
+        vals, vecs = scipy.sparse.linalg.eigs(Af.T.tocsr(), k=k, which="LM", tol=0)
+    except (scipy.sparse.linalg.ArpackError, ValueError):
+        return None
+    order = np.argsort(-np.abs(vals), kind="stable")
+    vals, vecs = vals[order], vecs[:, order]
+    masks, i = [], 0
+    for g in _group_eigenvalues(list(vals), 1e-6):
+        idx = list(range(i, i + len(g)))
+        i += len(g)
+        mu = sum(g) / len(g)
+        if abs(mu - 1) < 1e-9:
+            if len(g) != 1:
+                return None
+            continue
+        if abs(mu.imag) > 1e-9 or i == len(vals):  # complex, or possibly a group cut off by k
+            return None
+        V = np.vstack([vecs[:, idx].real.T, vecs[:, idx].imag.T])
+        _, S, Wt = np.linalg.svd(V, full_matrices=False)
+        span = [Wt[j] for j in range(len(S)) if S[j] > 1e-8 * S[0]]
+        if len(span) != len(g) or (masks and len(span) > 1):
+            return None
+        for x in span[: 2 - len(masks)]:
+            if np.linalg.norm(Af.T @ x - mu.real * x) > 1e-12 * np.linalg.norm(x):
+                return None
+            masks.append(x)
+        if len(masks) == 2:
+            return np.array(masks)
+    return None
 
 
 def _tangent_masks_float(A):

@@ -191,3 +191,18 @@ def test_ngon_centre_is_its_closed_form_limit():
     f = np.arange(n)  # the first n-gon's ptex faces
     got = S.evaluate(f, np.ones(n), np.ones(n), 0)["P"]
     assert np.abs(got - want).max() <= 1e-13 * mesh.bounding_box_diagonal
+
+
+@pytest.mark.parametrize("n", [60, 130])
+def test_sparse_tangent_masks_span_the_dense_tangent_plane(n):
+    """The tangent masks at a large n-gon centre by Arnoldi iteration on the sparse matrix (linear cost) span
+    the plane of the dense eigen-decomposition (numpy eig + SVD, cubic), and are left eigenvectors."""
+    from ccproof.evaluate.local import _tangent_masks_float, _tangent_masks_sparse, _to_fmpq_mat
+
+    rows, _, N = _stationary(_centre_key(_drum(n), n))
+    A = _to_fmpq_mat(rows, N)
+    Ts, Td = _tangent_masks_sparse(A), _tangent_masks_float(A)
+    assert Ts is not None and Td is not None and Ts.shape == (2, N)
+    Q, _ = np.linalg.qr(Td.T)
+    assert np.linalg.norm(Ts.T - Q @ (Q.T @ Ts.T)) <= 1e-10 * np.linalg.norm(Ts)
+    assert np.linalg.matrix_rank(Ts, tol=1e-6) == 2
