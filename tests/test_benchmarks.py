@@ -34,6 +34,7 @@ SMOKE = {
     "bench_inverse.py": ["--smoke"],
     "bench_kernel_ab.py": ["--smoke"],
     "bench_memory.py": ["--smoke"],
+    "bench_ngon.py": ["--smoke"],
     "bench_project.py": ["--smoke"],
     "bench_refine.py": ["--smoke"],
     "bench_reparam.py": ["--smoke"],

@@ -30,7 +30,7 @@ import math
 import numpy as np
 
 from ccproof.errors import MeshError
-from ccproof.evaluate import _diskcache
+from ccproof.evaluate import _diskcache, _powers
 from ccproof.mesh.rules import CORNER, CREASE, SMOOTH, Complex, Options, refine_complex, to_float, vertex_rule
 
 __all__ = [
@@ -143,6 +143,9 @@ def canonical_ring(cx, g, r, depth=1):
                     walk.append(c)
                     t = twin[c]
                     c = -1 if t < 0 else nxt[t]
+            if len(walk) > _BIG_FAN and isinstance(org, memoryview):  # (the centre of an n-gon)
+                _read_fan(cx, walk, seen, pos, ring, first_corner, faces)
+                continue
             for c in walk:
                 h = face_of[c]
                 if h in seen:
@@ -163,6 +166,46 @@ def canonical_ring(cx, g, r, depth=1):
                 faces.append(tuple(vs))
         done = upto
     return ring, tuple(faces), done
+
+
+#: fans longer than this are read with array operations (:func:`_read_fan`)
+_BIG_FAN = 48
+
+
+def _read_fan(cx, walk, seen, pos, ring, first_corner, faces):
+    """The face-reading step of :func:`canonical_ring` for one long fan ``walk`` (corners), on arrays: the
+    same faces, labels and first corners as the loop there (each new face read from its corner in the walk,
+    new vertices numbered by first appearance), at a cost linear in the fan with a small constant."""
+    org = np.asarray(cx.org)
+    start = np.asarray(cx.start)
+    W = np.array(walk, dtype=np.int64)
+    H = np.asarray(cx.face_of)[W]
+    keep = [i for i, h in enumerate(H.tolist()) if not (h in seen or seen.add(h))]
+    W, H = W[keep], H[keep]
+    sh = start[H]
+    nxt_start = np.where(H + 1 < start.size, start[np.minimum(H + 1, start.size - 1)], org.size)
+    k = nxt_start - sh
+    ends = np.cumsum(k)
+    rep = np.repeat(np.arange(k.size), k)
+    hc = sh[rep] + (W[rep] - sh[rep] + np.arange(ends[-1] if k.size else 0) - (ends - k)[rep]) % k[rep]
+    U = org[hc]
+    uniq, first, inv = np.unique(U, return_index=True, return_inverse=True)
+    order = np.argsort(first, kind="stable")  # the vertices by first appearance
+    us = uniq[order].tolist()
+    known = [pos.get(u, -1) for u in us]
+    new = [i for i, q in enumerate(known) if q < 0]
+    labels = dict(zip((us[i] for i in new), range(len(ring), len(ring) + len(new))))
+    pos.update(labels)
+    ring.extend(labels)
+    first_corner.update(zip(labels, hc[first[order[new]]].tolist()))
+    lab = np.empty(uniq.size, dtype=np.int64)
+    lab[order] = [q if q >= 0 else labels[u] for u, q in zip(us, known)]
+    L = lab[inv.reshape(-1)]
+    if k.size and (k == k[0]).all():  # (all quads: one reshape)
+        faces.extend(map(tuple, L.reshape(-1, int(k[0])).tolist()))
+        return
+    L, b = L.tolist(), [0] + ends.tolist()
+    faces.extend(tuple(L[b[i]:b[i + 1]]) for i in range(k.size))
 
 
 def quad_ring(faces, f, r):
@@ -227,6 +270,18 @@ def ring_key(cx, ring, faces, n_rule):
     ((((0, 1), 2.0),), ())
     """
     tags = []
+    if len(cx.edge_sharpness):  # (no edge tags, as around an n-gon of an untagged mesh: nothing to look up)
+        _edge_tags(cx, ring, faces, n_rule, tags)
+    vs = []
+    for i in range(n_rule):
+        s = cx.vertex_sharpness.get(ring[i], 0.0)
+        if s > 0.0:
+            vs.append((i, math.inf if s >= 10.0 else s))
+    return (faces, tuple(sorted(tags)), tuple(vs), cx.options.key())
+
+
+def _edge_tags(cx, ring, faces, n_rule, tags):
+    """Append ``(local edge, sharpness)`` of the tagged interior edges at the ``n_rule`` rule vertices."""
     rule = set(range(n_rule))
     seen = set()
     for f in faces:
@@ -239,17 +294,9 @@ def ring_key(cx, ring, faces, n_rule):
             seen.add(e)
             ga, gb = ring[a], ring[b]
             gk = (ga, gb) if ga < gb else (gb, ga)
-            if cx.twin[cx.edges[cx.edge_index[gk]]] < 0:
-                continue  # boundary edge: infinitely sharp by the topology
             s = cx.edge_sharpness.get(gk, 0.0)
-            if s > 0.0:
+            if s > 0.0 and cx.twin[cx.edges[cx.edge_index[gk]]] >= 0:  # boundary edges: sharp by the topology
                 tags.append((e, math.inf if s >= 10.0 else s))
-    vs = []
-    for i in range(n_rule):
-        s = cx.vertex_sharpness.get(ring[i], 0.0)
-        if s > 0.0:
-            vs.append((i, math.inf if s >= 10.0 else s))
-    return (faces, tuple(sorted(tags)), tuple(vs), cx.options.key())
 
 
 @functools.lru_cache(maxsize=8192)
@@ -277,8 +324,9 @@ def refine_key(key, n_rule):
 
     Returns
     -------
-    S : ndarray, shape (n_points, N)
-        Float stencils (dense: local complexes are small), rows of uncomputable points NaN.
+    S : ndarray or scipy.sparse.csr_matrix, shape (n_points, N)
+        Float stencils (dense: local complexes are small, but for rings of ``SPARSE_RING`` points or more,
+        the centre of a large n-gon), rows of uncomputable points NaN.
         Row v < N is the vertex point of ring vertex v (docs/evaluate.md "Conventions").
     stencils : tuple of dict or None (exact)
     child : Complex
@@ -305,10 +353,34 @@ def refine_key(key, n_rule):
     edges = [e for e, h in enumerate(cx.edges) if cx.org[h] < n_rule or cx.dst(h) < n_rule]
     stencils, children, ces, cvs = refine_complex(cx, vertices=rule, edges=edges)
     child = Complex(children, ces, cvs, cx.options, level=2, n_vertices=len(stencils))
+    if cx.n_vertices >= SPARSE_RING:
+        return _sparse_stencils(stencils, cx.n_vertices), tuple(stencils), child
     S = _stencil_matrix([{} if st is None else st for st in stencils], cx.n_vertices)
     S[[i for i, st in enumerate(stencils) if st is None]] = np.nan
     S.setflags(write=False)
     return S, tuple(stencils), child
+
+
+#: rings of at least this many points (the centre of an n-gon, n >= 124) keep their float stencils sparse
+SPARSE_RING = 256
+
+
+def _sparse_stencils(stencils, ncols):
+    """The float stencils as a sparse matrix (``scipy.sparse.csr_matrix``), a row of an uncomputable point
+    one NaN (so that ``S @ X`` is NaN in that row, as with the dense NaN row)."""
+    import scipy.sparse
+
+    rows, cols, vals = [], [], []
+    for r, st in enumerate(stencils):
+        if st is None:
+            rows.append(r)
+            cols.append(0)
+            vals.append(math.nan)
+            continue
+        rows.extend([r] * len(st))
+        cols.extend(st)
+        vals.extend(to_float(w) for w in st.values())
+    return scipy.sparse.csr_matrix((vals, (rows, cols)), shape=(len(stencils), ncols))
 
 
 @functools.lru_cache(maxsize=1 << 16)
@@ -568,7 +640,6 @@ def _corner_scheme(key):
     relative precision at every layer, so the derivatives (which grow like (2 lam)^n, bmz04 eq. 3)
     are as accurate deep down as near the face centre. The limit mask is exact.
     """
-    import flint  # imported where exact matrices are built: not on a filled disk cache
     _, stencils, child = refine_key(key, 4)
     N = key_complex(key).n_vertices
     ring1, faces1, nr = canonical_ring(child, 0, 0, 1)
@@ -578,7 +649,29 @@ def _corner_scheme(key):
     rows = [stencils[v] for v in ring1]
     if any(r is None for r in rows):
         return None
-    A = _to_fmpq_mat(rows, N)
+    nets = _child_nets(child, stencils)
+    if nets is None:
+        return None
+    support = set()
+    for row in nets:
+        support.update(row)
+    support = _powers.closure(rows, support)  # the rows of A at the support use only the support
+    lmask = _limit_mask(rows, N)
+    layers = _powers.class_layers(nets, rows, lmask, N, LAYER_TOLERANCE, MAX_LAYERS)
+    if layers is None:
+        raise MeshError(f"corner configuration of {N} vertices does not converge to its limit point")
+    mask = np.array([int(w.p) / int(w.q) for w in map(_fmpq, lmask)], dtype=np.float64)
+    A = functools.partial(_to_fmpq_mat, rows, N)  # exact A: built on first use (tangent masks)
+    return CornerScheme(N, A, mask, layers.reshape(-1, 3, 16, N), support)
+
+
+def _fmpq(w):
+    import flint  # imported where exact matrices are built: not on a filled disk cache
+    return flint.fmpq(w)
+
+
+def _child_nets(child, stencils):
+    """The 48 exact stencils (in the parent ring) of the nets of children 1, 2, 3, or None if irregular."""
     nets = []
     for j in (1, 2, 3):
         net = regular_net(child, j)
@@ -593,17 +686,22 @@ def _corner_scheme(key):
                 for u, x in sv.items():
                     row[u] = row.get(u, 0) + w * x
             nets.append(row)
-    M = _to_fmpq_mat(nets, N)
-    support = set()
-    for row in nets:
-        support.update(row)
-    todo = list(support)
-    while todo:  # close under A: the rows of A at the support use only the support
-        i = todo.pop()
-        for j in rows[i]:
-            if j not in support:
-                support.add(j)
-                todo.append(j)
+    return nets
+
+
+#: rings up to this size solve for the limit mask densely (exact, and it detects a multiple eigenvalue 1);
+#: larger ones (the centre of an n-gon, n > 28) on the quotient of an equitable partition (3 x 3 there)
+DENSE_RING = 64
+
+
+def _limit_mask(rows, N):
+    """The exact limit mask (list of fmpq) of ring vertex 0 of the subdivision matrix with rows ``rows``."""
+    import flint  # imported where exact matrices are built: not on a filled disk cache
+    if N > DENSE_RING:
+        lm = _powers.limit_mask(rows, N)
+        if lm is not None:
+            return lm
+    A = _to_fmpq_mat(rows, N)
     Bt = (A - flint.fmpq_mat(N, N, [int(i == j) for i in range(N) for j in range(N)])).transpose()
     for j in range(N):
         Bt[N - 1, j] = 1
@@ -612,9 +710,7 @@ def _corner_scheme(key):
         lvec = Bt.solve(rhs)
     except ZeroDivisionError:
         raise MeshError("corner configuration whose subdivision matrix has a multiple eigenvalue 1") from None
-    l_row = flint.fmpq_mat(1, N, [lvec[i, 0] for i in range(N)])
-    layers = power_layers(M, A, l_row)
-    return CornerScheme(N, A, _fmpq_mat_to_float(l_row)[0], layers, sorted(support))
+    return [lvec[i, 0] for i in range(N)]
 
 
 def _to_fmpq_mat(rows, ncols):
@@ -634,63 +730,8 @@ def _fmpq_mat_to_float(M):
     return out.reshape(M.nrows(), M.ncols())
 
 
-def power_layers(M, A, l_row):
-    """Rounded deviations ``M A^n - 1 l^T`` for n = 0, 1, ... until below ``LAYER_TOLERANCE``.
-
-    Parameters
-    ----------
-    M : flint.fmpq_mat, shape (48, N)
-    A : flint.fmpq_mat, shape (N, N)
-    l_row : flint.fmpq_mat, shape (1, N)
-
-    Returns
-    -------
-    ndarray, shape (n_layers, 3, 16, N)
-
-    Notes
-    -----
-    Layer n of docs/readings.md R4 (docs/evaluate.md "Method", item 2). Exact throughout: with
-    ``A = Ai / a``, ``M = Mi / m`` and ``l = li / c`` (integer matrices and
-    common denominators) the n-th deviation is ``(c Mi Ai^n - m a^n 1 li^T) / (c m a^n)``; the powers
-    are integer matrix products (flint ``fmpz_mat``), and only the final quotients are rounded.
-
-    Examples
-    --------
-    Point 1 moves halfway to point 0 at each step (limit mask ``l = (1, 0)``); every net point is
-    point 1, so the deviation of layer n is ``(-2^-n, 2^-n)``, below ``2^-60`` from n = 61 on:
-
-    >>> import flint
-    >>> A = flint.fmpq_mat(2, 2, [1, 0, flint.fmpq(1, 2), flint.fmpq(1, 2)])
-    >>> M = flint.fmpq_mat(48, 2, [0, 1] * 48)
-    >>> D = power_layers(M, A, flint.fmpq_mat(1, 2, [1, 0]))
-    >>> D.shape, D[3, 0, 0].tolist()
-    ((62, 3, 16, 2), [-0.125, 0.125])
-    """
-    import flint  # imported where exact matrices are built: not on a filled disk cache
-    N = A.nrows()
-    Ai, a = A.numer_denom()
-    Mi, m = M.numer_denom()
-    li, c = l_row.numer_denom()
-    a, m, c = int(a), int(m), int(c)
-    Lrow = [int(x) for x in li.entries()]
-    ones = flint.fmpz_mat(48, 1, [1] * 48)
-    L1 = ones * flint.fmpz_mat(1, N, Lrow)
-    R = Mi
-    den = m
-    layers = []
-    for _ in range(MAX_LAYERS):
-        num = R * c - L1 * den
-        q = c * den
-        D = np.array([int(p) / q for p in num.entries()], dtype=np.float64).reshape(48, N)
-        layers.append(D.reshape(3, 16, N))
-        if np.abs(D).max() < LAYER_TOLERANCE:
-            return np.array(layers)
-        R = R * Ai
-        den *= a
-    raise MeshError(f"corner configuration of {N} vertices does not converge to its limit point")
-
-
-_SOURCES = ("evaluate/local.py", "evaluate/_diskcache.py", "mesh/rules.py", "rule_weights.py")  # what computes the data
+#: what computes the data
+_SOURCES = ("evaluate/local.py", "evaluate/_powers.py", "evaluate/_diskcache.py", "mesh/rules.py", "rule_weights.py")
 
 
 @functools.lru_cache(maxsize=1)
@@ -715,7 +756,8 @@ def _cached_scheme(kind, key, compute):
     the SHA-256 of the configuration key and of the sources that compute it: ``.f64``, one raw
     little-endian float64 vector ``[N, n_layers, n_support, limit mask (N), support, layers]``
     (read at setup), and ``.A``, the exact matrix ``A`` (its denominator and integer numerators in
-    decimal, read only when the tangent masks need it). Both are sealed
+    decimal, read only when the tangent masks need it; written at once only for rings of at most
+    ``DENSE_RING`` points, larger ones when first needed). Both are sealed
     (:mod:`ccproof.evaluate._diskcache`: the SHA-256 of the name and the content follows the
     content, checked before any use): a cached scheme is the computed one bit for bit, and a corrupt
     file is reported once, recomputed and rewritten. Unreadable or unwritable cache files are
@@ -734,8 +776,9 @@ def _cached_scheme(kind, key, compute):
     sch = compute()
     if sch is None:
         return None
-    num, den = sch.A.numer_denom()
-    _diskcache.store(d, name, ".A", _matrix_bytes(num, den))
+    if sch.size <= DENSE_RING:  # a larger exact A (N^2 entries) is rebuilt if the tangent masks need it
+        num, den = sch.A.numer_denom()
+        _diskcache.store(d, name, ".A", _matrix_bytes(num, den))
     sup = list(sch.support) if sch.support else []
     head = np.array([sch.size, sch.n_layers, len(sup)] + sup, dtype=np.float64)
     vec = np.concatenate([head[:3], sch.limit_mask, head[3:], sch.layers.reshape(-1)]).astype("<f8")
@@ -855,7 +898,9 @@ class CornerScheme:
         if self.support is not None:
             idx = self.support
             A = flint.fmpq_mat(len(idx), len(idx), [A[i, j] for i in idx for j in idx])
-        T = _tangent_masks_float(A)
+        T = _tangent_masks_sparse(A) if A.nrows() >= SPARSE_RING else None
+        if T is None:
+            T = _tangent_masks_float(A)
         if T is None:
             T = _tangent_masks(A)
         if T is None or self.support is None:
@@ -863,6 +908,51 @@ class CornerScheme:
         out = np.zeros((2, self.size))
         out[:, list(self.support)] = T
         return out
+
+
+def _tangent_masks_sparse(A, k=8):
+    """:meth:`CornerScheme.tangent_masks` of a large ring (an n-gon centre), or None (then the dense paths).
+
+    The ``k`` eigenvalues of largest modulus of the rounded ``A`` by Arnoldi iteration on the sparse
+    ``A^T`` (ARPACK: cost about linear in the ring, not cubic), grouped within 1e-6; the real span of a
+    group's eigenvectors (SVD of their real and imaginary parts). Accepted only when unambiguous, as in
+    :func:`_tangent_masks_float`: real groups, one eigenvalue 1, two directions in all, residuals
+    ``|x (A - mu)| <= 1e-12 |x|``; a simple eigenvalue with a defective partner (a Jordan chain) is left
+    to the dense paths.
+    """
+    import scipy.sparse
+    import scipy.sparse.linalg
+
+    Af = scipy.sparse.csr_matrix(_fmpq_mat_to_float(A))
+    try:
+        vals, vecs = scipy.sparse.linalg.eigs(Af.T.tocsr(), k=k, which="LM", tol=0)
+    except (scipy.sparse.linalg.ArpackError, ValueError):
+        return None
+    order = np.argsort(-np.abs(vals), kind="stable")
+    vals, vecs = vals[order], vecs[:, order]
+    masks, i = [], 0
+    for g in _group_eigenvalues(list(vals), 1e-6):
+        idx = list(range(i, i + len(g)))
+        i += len(g)
+        mu = sum(g) / len(g)
+        if abs(mu - 1) < 1e-9:
+            if len(g) != 1:
+                return None
+            continue
+        if abs(mu.imag) > 1e-9 or i == len(vals):  # complex, or possibly a group cut off by k
+            return None
+        V = np.vstack([vecs[:, idx].real.T, vecs[:, idx].imag.T])
+        _, S, Wt = np.linalg.svd(V, full_matrices=False)
+        span = [Wt[j] for j in range(len(S)) if S[j] > 1e-8 * S[0]]
+        if len(span) != len(g) or (masks and len(span) > 1):
+            return None
+        for x in span[: 2 - len(masks)]:
+            if np.linalg.norm(Af.T @ x - mu.real * x) > 1e-12 * np.linalg.norm(x):
+                return None
+            masks.append(x)
+        if len(masks) == 2:
+            return np.array(masks)
+    return None
 
 
 def _tangent_masks_float(A):

@@ -325,29 +325,75 @@ def _sigint_ignored():
 
 
 @contextlib.contextmanager
+def _children_ignore_sigint():
+    """Processes that multiprocessing spawns meanwhile (from any thread: a cluster's workers and their
+    helpers) start with SIGINT ignored, as they would if it were ignored here: their command runs through
+    ``/bin/sh -c 'trap "" INT; exec ...'`` (an ignored signal stays ignored across exec, and Python keeps an
+    ignored SIGINT ignored). A Ctrl-C sent by a terminal to the whole process group then reaches only this
+    process. Returns False (does nothing) where there is no such spawn (not POSIX, no /bin/sh)."""
+    import multiprocessing.util as mpu
+
+    original = getattr(mpu, "spawnv_passfds", None)
+    if original is None or not os.path.exists("/bin/sh"):
+        yield False
+        return
+
+    def spawn(path, args, passfds):
+        sh = os.fsencode("/bin/sh") if isinstance(path, bytes) else "/bin/sh"
+        return original(sh, [sh, "-c", 'trap "" INT; exec "$@"', "sh", path, *args[1:]], passfds)
+
+    mpu.spawnv_passfds = spawn
+    try:
+        yield True
+    finally:
+        mpu.spawnv_passfds = original
+
+
+#: the signals a cluster's start defers (recorded, then honoured once the start is over)
+DEFERRED_SIGNALS = ("SIGINT", "SIGTERM")
+
+
+@contextlib.contextmanager
 def _signals_deferred():
-    """While a cluster starts: SIGINT ignored (:func:`_sigint_ignored`: the worker processes inherit that, so
-    a Ctrl-C sent to the whole process group reaches only this process later on), SIGTERM recorded and
-    raised when the block ends (no traceback from inside the cluster's start-up; the caller closes the
-    half-started cluster). A Ctrl-C during the start itself is still lost: ignoring it is what keeps it from
-    the workers, which inherit the disposition (a blocked mask would not reach them, nor stop other threads)."""
+    """While a cluster starts: SIGINT and SIGTERM recorded, not acted on, and honoured when the block ends
+    (raised by this process's own handlers: one line of the command, exit 130 or 143; no traceback from
+    inside the cluster's start-up; the caller closes the half-started cluster). The worker processes started
+    meanwhile ignore SIGINT (:func:`_children_ignore_sigint`): a Ctrl-C to the process group is this
+    process's alone. Where children cannot be made to ignore it (no POSIX spawn), SIGINT is ignored here
+    during the start instead (inherited by the workers; a Ctrl-C in that window is then lost)."""
     import signal
     import threading
 
     if threading.current_thread() is not threading.main_thread():
         yield
         return
-    got = []
-    previous = signal.signal(signal.SIGTERM, lambda signum, frame: got.append(signum))
-    try:
-        with _sigint_ignored():
-            yield
-    finally:
-        signal.signal(signal.SIGTERM, previous)
-        if got and callable(previous):
-            previous(signal.SIGTERM, None)  # the command's handler raises (one line, exit 143)
-        elif got and previous == signal.SIG_DFL:
-            os.kill(os.getpid(), signal.SIGTERM)
+    with _children_ignore_sigint() as children_ignore:
+        names = DEFERRED_SIGNALS if children_ignore else ("SIGTERM",)
+        got = []
+        previous = {}
+        for name in names:
+            sig = getattr(signal, name)
+            previous[sig] = signal.signal(sig, lambda signum, frame: got.append(signum))
+        try:
+            with contextlib.nullcontext() if children_ignore else _sigint_ignored():
+                yield
+        finally:
+            for sig, handler in previous.items():
+                signal.signal(sig, handler)
+            if got:
+                _honour(got[0], previous[got[0]])
+
+
+def _honour(signum, handler):
+    """Act on a deferred signal as its handler ``handler`` would have."""
+    import signal
+
+    if callable(handler):
+        handler(signum, None)  # the command's handlers raise (KeyboardInterrupt: one line, exit 130 or 143)
+    elif handler == signal.SIG_DFL:
+        if signum == signal.SIGINT:
+            raise KeyboardInterrupt
+        os.kill(os.getpid(), signum)
 
 
 #: seconds between a pool worker's checks that the process that started it is alive

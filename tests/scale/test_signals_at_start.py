@@ -59,3 +59,103 @@ def test_sigterm_during_the_cluster_start_is_raised_after_it(fake_cluster, monke
         assert signal.getsignal(signal.SIGTERM) is stop
     finally:
         signal.signal(signal.SIGTERM, previous)
+
+
+def test_sigint_during_the_cluster_start_is_raised_after_it(fake_cluster):
+    """A Ctrl-C in the window is no longer discarded: KeyboardInterrupt once the start is over."""
+    fake_cluster.append(signal.SIGINT)
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        with pytest.raises(KeyboardInterrupt), engine.client_for("local:2"):
+            pytest.fail("the run went on after SIGINT")
+        assert fake_cluster[1] == "started" and "closed" in fake_cluster
+        assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+# ---------------------------------------------------------------- a real cluster, a real command
+#: sitecustomize of the command and of its workers: the first process spawned by the command (inside the
+#: cluster's start) leaves a mark and waits a second, so that the test signals inside the window
+_SITE = '''
+import os
+if os.environ.get("CCPROOF_TEST_SPAWN_MARK") and not os.environ.get("CCPROOF_TEST_SPAWNED"):
+    import multiprocessing.util as mpu, pathlib, time
+    original = mpu.spawnv_passfds
+    def spawn(path, args, passfds):
+        os.environ["CCPROOF_TEST_SPAWNED"] = "1"  # once, and not in the children (they inherit it)
+        mpu.spawnv_passfds = original
+        pathlib.Path(os.environ["CCPROOF_TEST_SPAWN_MARK"]).touch()
+        time.sleep(1.0)
+        return original(path, args, passfds)
+    mpu.spawnv_passfds = spawn
+'''
+
+CUBE = "\n".join(
+    ["v -1 -1 -1", "v 1 -1 -1", "v 1 1 -1", "v -1 1 -1", "v -1 -1 1", "v 1 -1 1", "v 1 1 1", "v -1 1 1",
+     "f 1 4 3 2", "f 5 6 7 8", "f 1 2 6 5", "f 2 3 7 6", "f 3 4 8 7", "f 4 1 5 8"]) + "\n"
+
+
+def _session_processes(sid):
+    out = []
+    for d in os.listdir("/proc"):
+        if d.isdigit():
+            try:
+                stat = open(f"/proc/{d}/stat").read()
+            except OSError:
+                continue
+            fields = stat[stat.rindex(")") + 2:].split()
+            if int(fields[3]) == sid:  # (state, ppid, pgrp, session, ...)
+                out.append(int(d))
+    return out
+
+
+@pytest.mark.skipif(not os.path.exists("/proc"), reason="reads the processes of a session from /proc")
+@pytest.mark.parametrize("how", ["SIGINT to the group", "SIGTERM"])
+def test_a_signal_while_the_cluster_starts_stops_the_command(tmp_path, how):
+    """``eval`` on a local cluster, signalled while the cluster starts (a terminal's Ctrl-C reaches the
+    whole process group, the first workers too): one line, exit 130 or 143, nothing written, no process of
+    the command left. Before, the Ctrl-C was discarded and the run wrote its output."""
+    pytest.importorskip("distributed")
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    site = tmp_path / "site"
+    site.mkdir()
+    (site / "sitecustomize.py").write_text(_SITE)
+    (tmp_path / "cube.obj").write_text(CUBE)
+    mark = tmp_path / "spawning"
+    repo = Path(__file__).resolve().parents[2]
+    env = dict(os.environ, CCPROOF_TEST_SPAWN_MARK=str(mark), PYTHONPATH=f"{site}{os.pathsep}{repo}")
+    env.pop("CCPROOF_TEST_SPAWNED", None)
+    code = "import signal, sys; signal.signal(signal.SIGINT, signal.default_int_handler)\n" \
+           "from ccproof.cli import main; sys.exit(main(sys.argv[1:]))"
+    proc = subprocess.Popen([sys.executable, "-c", code, "eval", "cube.obj", "--samples", "4", "--chunk", "2",
+                             "--scheduler", "local:2", "--out", "o.npz"], cwd=tmp_path, env=env, text=True,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True)
+    try:
+        for _ in range(2400):  # at most 2 min until the cluster spawns its first process
+            if mark.exists() or proc.poll() is not None:
+                break
+            time.sleep(0.05)
+        assert mark.exists() and proc.poll() is None, proc.stderr.read() if proc.poll() is not None else ""
+        if how == "SIGTERM":
+            proc.send_signal(signal.SIGTERM)
+        else:
+            os.killpg(proc.pid, signal.SIGINT)
+        _, err = proc.communicate(timeout=120)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+    word, status = ("terminated", 143) if how == "SIGTERM" else ("interrupted", 130)
+    lines = err.strip().splitlines()
+    assert proc.returncode == status, err
+    assert lines[-1] == f"ccproof eval: {word}" and "Traceback" not in err, err
+    assert all(ln.startswith("ccproof eval: warning: ") for ln in lines[:-1]), err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["cube.obj", "site", "spawning"]
+    for _ in range(100):  # the workers and the resource tracker end with the command (within seconds)
+        if not _session_processes(proc.pid):
+            break
+        time.sleep(0.1)
+    assert _session_processes(proc.pid) == []
