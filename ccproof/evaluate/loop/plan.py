@@ -1,0 +1,207 @@
+"""What to do with one tagged ring configuration, computed once per configuration (exact, then rounded).
+
+:func:`plan` maps the key of a triangle's one-ring (:func:`~ccproof.evaluate.loop.complex.canonical_ring`)
+to one of
+
+* :class:`Regular`: the three corners are regular: the box-spline patch on 12 ring points;
+* :class:`Corner`: corner 0 alone is irregular and the ring is self-similar (the ring of the child
+  at corner 0 has the same key): Stam's layers. With ``A`` the exact subdivision matrix from the
+  ring to the ring of the corner child, layer n (the corner child of level n minus its own corner
+  child) consists of the three regular children of level n + 1 whose nets are ``M_j A^n C``; stored
+  as the deviations ``M_j A^n - 1 l^T`` from the limit point (l: the exact limit mask), until they
+  fall below 2^-60 (as :func:`ccproof.evaluate.local.power_layers` does for Catmull-Clark);
+* :class:`Split`: anything else: one exact local Loop step; four child rings (stencil matrices from
+  this ring), each planned in turn.
+
+The weights of Loop's rules lie in Q(cos(2 pi / k)); they are computed as balls (``flint.arb``) of
+:data:`PRECISION` bits, and every stored float is the ball's midpoint, the radius checked below
+2^-200 (the rounding to float64 is the only error that matters).
+"""
+
+from __future__ import annotations
+
+import contextlib
+from dataclasses import dataclass
+
+import numpy as np
+
+from ccproof.errors import MeshError
+from ccproof.evaluate.loop.complex import canonical_ring, key_complex, limit_stencil, loop_step, regular_net
+
+__all__ = ["Regular", "Corner", "Split", "plan", "oriented_ring", "PRECISION", "MAX_DEPTH", "LAYER_TOLERANCE"]
+
+#: bits of the balls in which the exact data are computed
+PRECISION = 320
+#: smallest deviation kept in a layer table (beyond it the layer equals the limit point in float64)
+LAYER_TOLERANCE = 2.0**-60
+#: most local subdivisions of one configuration before its children are regular or self-similar
+MAX_DEPTH = 6
+_MAX_LAYERS = 400
+
+
+@dataclass(frozen=True)
+class Regular:
+    """Box-spline patch: ``net`` = ring indices of the 12 control points (box_spline.NET order)."""
+    net: tuple
+
+
+@dataclass(frozen=True, eq=False)
+class Corner:
+    """Self-similar layers at irregular corner 0: ``limit_mask`` (N,), ``layers`` (n_layers, 3, 12, N)."""
+    size: int
+    limit_mask: np.ndarray
+    layers: np.ndarray
+
+
+@dataclass(frozen=True, eq=False)
+class Split:
+    """One local step: per child (rotation r, rows (N_child, N), child key) in loop_step's child order."""
+    children: tuple
+
+
+@contextlib.contextmanager
+def _precision():
+    import flint
+
+    old = flint.ctx.prec
+    flint.ctx.prec = PRECISION
+    try:
+        yield flint.arb(1)
+    finally:
+        flint.ctx.prec = old
+
+
+def _to_float(x):
+    if float(x.rad()) > 2.0**-200 * max(1.0, abs(float(x.mid()))):
+        raise MeshError(f"internal: a weight lost its precision ({x})")  # pragma: no cover
+    return float(x.mid())
+
+
+def _dense(rows, ncols):
+    """Float matrix of stencils (dict column -> ball)."""
+    M = np.zeros((len(rows), ncols))
+    for i, s in enumerate(rows):
+        for j, w in s.items():
+            M[i, j] = _to_float(w)
+    return M
+
+
+def irregular_corners(cx, tri):
+    return [i for i in range(3) if not cx.is_regular(tri[i])]
+
+
+def oriented_ring(cx, tri):
+    """(rotation r, ring labels, key) of a triangle: read from its irregular corner when it has one alone.
+
+    Rotation r lists the triangle from its corner r (the parameter turns accordingly,
+    :data:`ccproof.evaluate.loop.surface.ROTATIONS`).
+    """
+    irr = irregular_corners(cx, tri)
+    r = irr[0] if len(irr) == 1 else 0
+    ring, key = canonical_ring(cx, tri[r:] + tri[:r])
+    return r, ring, key
+
+
+_PLANS: dict = {}
+
+
+def plan(key, depth=0):
+    """The :class:`Regular`, :class:`Corner` or :class:`Split` of a ring key (cached per key)."""
+    if key in _PLANS:
+        return _PLANS[key]
+    if depth > MAX_DEPTH:
+        raise MeshError(f"a triangle configuration is neither regular nor self-similar after {MAX_DEPTH} "
+                        "local Loop steps")
+    cx = key_complex(key)
+    irr = irregular_corners(cx, (0, 1, 2))
+    out = Regular(tuple(regular_net(cx, (0, 1, 2)))) if not irr else None
+    if out is None and irr == [0]:
+        out = _corner(cx, key)
+    if out is None:
+        out = _split(cx, key, depth)
+    _PLANS[key] = out
+    return out
+
+
+def _children(cx, key, one):
+    """(child complex, stencils, the four children of triangle (0, 1, 2))."""
+    child, st = loop_step(cx, one)
+    i = key[0].index((0, 1, 2))
+    return child, st, child.triangles[4 * i:4 * i + 4]
+
+
+def _split(cx, key, depth):
+    with _precision() as one:
+        child, st, kids = _children(cx, key, one)
+        out = []
+        for t in kids:
+            r, ring, ckey = oriented_ring(child, t)
+            rows = [st[x] for x in ring]
+            if any(s is None for s in rows):
+                raise MeshError("internal: a child ring needs triangles outside its parent's ring")
+            out.append((r, _dense(rows, cx.n_vertices), ckey))
+    return Split(tuple((r, rows, ckey, plan(ckey, depth + 1)) for r, rows, ckey in out))
+
+
+def _corner(cx, key):
+    import flint
+
+    with _precision() as one:
+        child, st, kids = _children(cx, key, one)
+        ring0, key0 = canonical_ring(child, kids[0])
+        if key0 != key or any(irregular_corners(child, t) for t in kids[1:]):
+            return None
+        rows = [st[x] for x in ring0]
+        nets = [st[x] for t in kids[1:] for x in regular_net(child, t)]
+        if any(s is None for s in rows + nets):
+            return None
+        N = cx.n_vertices
+        A, M = _arb_mat(rows, N), _arb_mat(nets, N)
+        lmask = limit_stencil(cx, 0, one)
+        l_row = flint.arb_mat(1, N, [lmask.get(j, 0) for j in range(N)])
+        layers = power_layers(M, A, l_row)
+        return Corner(N, np.array([_to_float(l_row[0, j]) for j in range(N)]), layers)
+
+
+def _arb_mat(rows, ncols):
+    import flint
+
+    M = flint.arb_mat(len(rows), ncols)
+    for i, s in enumerate(rows):
+        for j, w in s.items():
+            M[i, j] = w
+    return M
+
+
+def power_layers(M, A, l_row):
+    """Rounded deviations ``M A^n - 1 l^T`` (balls), n = 0, 1, ... until below ``LAYER_TOLERANCE``.
+
+    Returns ndarray (n_layers, 3, 12, N).
+
+    Examples
+    --------
+    Point 1 moves halfway to point 0 at each step: the deviation of layer n is ``(-2^-n, 2^-n)``:
+
+    >>> import flint
+    >>> A = flint.arb_mat(2, 2, [1, 0, 0.5, 0.5])
+    >>> D = power_layers(flint.arb_mat(36, 2, [0, 1] * 36), A, flint.arb_mat(1, 2, [1, 0]))
+    >>> D.shape, D[3, 0, 0].tolist()
+    ((62, 3, 12, 2), [-0.125, 0.125])
+    """
+    with _precision():
+        return _power_layers(M, A, l_row)
+
+
+def _power_layers(M, A, l_row):
+    import flint
+
+    rows, N = M.nrows(), A.nrows()
+    L = flint.arb_mat(rows, N, [l_row[0, j] for _ in range(rows) for j in range(N)])
+    R, layers = M, []
+    for _ in range(_MAX_LAYERS):
+        D = np.array([_to_float(x) for x in (R - L).entries()]).reshape(3, 12, N)
+        layers.append(D)
+        if np.abs(D).max() < LAYER_TOLERANCE:
+            return np.array(layers)
+        R = R * A
+    raise MeshError(f"corner configuration of {N} vertices does not converge to its limit point")

@@ -1,0 +1,168 @@
+"""Brute-force Loop subdivision for the tests (independent of ccproof.evaluate.loop and ccproof.mesh.scheme).
+
+Global subdivision of the whole mesh L levels with Loop's rules as OpenSubdiv's Sdc states them (smooth
+vertex ``(1 - k beta) V + beta sum``, ``beta = (5/8 - (3/8 + cos(2 pi / k) / 4)^2) / k``; smooth edge
+3/8 3/8 1/8 1/8; crease and boundary vertex 3/4 1/8 1/8; sharp edge midpoint; corners fixed), the
+limit position of a level-L vertex by the limit mask, and at a vertex whose neighbourhood is regular
+the exact derivatives of the quartic box spline from its one-ring: ``D_x = (1/3) sum_j <x, e_j> p_j``
+with the unit vectors e_j of the equilateral lattice (the cos / sin tangent masks, scaled so that
+linear functions are reproduced), and the second derivatives as second differences (the box spline's
+second derivatives at a lattice point are supported on the one-ring and even; the three-direction
+quartic box spline reproduces quadratics up to a constant, which fixes them).
+"""
+
+from __future__ import annotations
+
+import math
+from fractions import Fraction
+
+import numpy as np
+
+DIRS = ((1, 0), (0, 1), (-1, 1), (-1, 0), (0, -1), (1, -1))
+
+
+def _beta(k):
+    c = 3 / 8 + math.cos(2 * math.pi / k) / 4
+    return (5 / 8 - c * c) / k
+
+
+class Level:
+    """One level of the global subdivision: vertices, triangles, tags."""
+
+    def __init__(self, V, F, sharp=(), corners=(), boundary="edge_only"):
+        self.V = np.asarray(V, dtype=float)
+        self.F = [tuple(int(x) for x in f) for f in F]
+        self.sharp = {(min(a, b), max(a, b)) for a, b in sharp}
+        self.corners = set(corners)
+        self.boundary = boundary
+        self.opp = {}
+        for a, b, c in self.F:
+            self.opp[(a, b)], self.opp[(b, c)], self.opp[(c, a)] = c, a, b
+        self.nbrs = {}
+        for a, b in self.opp:
+            self.nbrs.setdefault(a, set()).add(b)
+            self.nbrs.setdefault(b, set()).add(a)
+
+    def is_sharp(self, a, b):
+        return (min(a, b), max(a, b)) in self.sharp or (a, b) not in self.opp or (b, a) not in self.opp
+
+    def kind(self, v):
+        ns = [w for w in self.nbrs[v] if self.is_sharp(v, w)]
+        boundary = any((v, w) not in self.opp or (w, v) not in self.opp for w in self.nbrs[v])
+        if v in self.corners or len(ns) > 2 or (boundary and len(self.nbrs[v]) == 2
+                                                 and self.boundary == "edge_and_corner"):
+            return "corner", ns
+        return ("crease" if len(ns) == 2 else "smooth"), ns
+
+    def subdivide(self):
+        V, n = self.V, len(self.V)
+        newV = np.empty_like(V)
+        for v in range(n):
+            kind, ns = self.kind(v)
+            if kind == "corner":
+                newV[v] = V[v]
+            elif kind == "crease":
+                newV[v] = 0.75 * V[v] + 0.125 * (V[ns[0]] + V[ns[1]])
+            else:
+                k = len(self.nbrs[v])
+                b = _beta(k)
+                newV[v] = (1 - k * b) * V[v] + b * sum(V[w] for w in self.nbrs[v])
+        emap, pts = {}, []
+        for a, b, c in self.F:
+            for x, y in ((a, b), (b, c), (c, a)):
+                e = (min(x, y), max(x, y))
+                if e not in emap:
+                    emap[e] = n + len(pts)
+                    if self.is_sharp(x, y):
+                        pts.append(0.5 * (V[x] + V[y]))
+                    else:
+                        pts.append(0.375 * (V[x] + V[y]) + 0.125 * (V[self.opp[(x, y)]] + V[self.opp[(y, x)]]))
+        F = []
+        for a, b, c in self.F:
+            ab, bc, ca = emap[(min(a, b), max(a, b))], emap[(min(b, c), max(b, c))], emap[(min(c, a), max(c, a))]
+            F += [(a, ab, ca), (ab, b, bc), (ca, bc, c), (bc, ca, ab)]
+        sharp = []
+        for a, b in self.sharp:
+            e = emap[(a, b)]
+            sharp += [(a, e), (e, b)]
+        return Level(np.vstack([newV, pts]), F, sharp, self.corners, self.boundary)
+
+    def fan(self, v, start):
+        out, w = [start], start
+        while True:
+            w = self.opp.get((v, w))
+            if w is None or w == start:
+                return out
+            out.append(w)
+
+    def limit(self, v):
+        kind, ns = self.kind(v)
+        if kind == "corner":
+            return self.V[v]
+        if kind == "crease":
+            return (4 * self.V[v] + self.V[ns[0]] + self.V[ns[1]]) / 6
+        k = len(self.nbrs[v])
+        eps = 1 / (k + 3 / (8 * _beta(k)))
+        return (1 - k * eps) * self.V[v] + eps * sum(self.V[w] for w in self.nbrs[v])
+
+    def regular_around(self, v):
+        """v and its neighbours: smooth interior valence 6, no sharp edge (the surface there is a box spline)."""
+        for x in [v] + sorted(self.nbrs[v]):
+            if self.kind(x)[0] != "smooth" or len(self.nbrs[x]) != 6:
+                return False
+            if any(self.is_sharp(x, w) for w in self.nbrs[x]):
+                return False
+        return True
+
+
+def levels(V, F, L, **tags):
+    out = [Level(V, F, **tags)]
+    for _ in range(L):
+        out.append(out[-1].subdivide())
+    return out
+
+
+def locate(u, v, L):
+    """(child path, final corner, sign) of the dyadic point (u, v) (Fractions, denominator 2^L)."""
+    path, sign = [], 1
+    for _ in range(L):
+        if u >= Fraction(1, 2):
+            c, u, v = 1, 2 * u - 1, 2 * v
+        elif v >= Fraction(1, 2):
+            c, u, v = 2, 2 * u, 2 * v - 1
+        elif u + v <= Fraction(1, 2):
+            c, u, v = 0, 2 * u, 2 * v
+        else:
+            c, u, v, sign = 3, 1 - 2 * u, 1 - 2 * v, -sign
+        path.append(c)
+    corner = {(0, 0): 0, (1, 0): 1, (0, 1): 2}[(u, v)]
+    return path, corner, sign
+
+
+def brute(lv, face, u, v):
+    """Exact values at dyadic (u, v) of a level-0 face: dict P (and Pu, Pv, Puu, Puv, Pvv at regular vertices)."""
+    L = len(lv) - 1
+    path, corner, sign = locate(Fraction(u), Fraction(v), L)
+    f = face
+    for c in path:
+        f = 4 * f + c
+    top = lv[L]
+    tri = top.F[f]
+    x = tri[corner]
+    out = {"P": top.limit(x)}
+    if not top.regular_around(x):
+        return out
+    fan = top.fan(x, tri[(corner + 1) % 3])
+    d = [DIRS[(2 * corner + j) % 6] for j in range(6)]
+    p = {di: top.V[w] for di, w in zip(d, fan)}
+    p0 = top.V[x]
+    # equilateral lattice: e_j at angles 60 j; d/du = <(1, 0), .>, d/dv = <(1/2, sqrt 3 / 2), .>
+    ang = {DIRS[j]: math.pi * j / 3 for j in range(6)}
+    h = 2.0**L * sign
+    out["Pu"] = h * sum(math.cos(ang[q]) * p[q] for q in DIRS) / 3
+    out["Pv"] = h * sum(math.cos(ang[q] - math.pi / 3) * p[q] for q in DIRS) / 3
+    h2 = 4.0**L
+    out["Puu"] = h2 * (p[(1, 0)] + p[(-1, 0)] - 2 * p0)
+    out["Pvv"] = h2 * (p[(0, 1)] + p[(0, -1)] - 2 * p0)
+    out["Puv"] = h2 * (0.5 * (p[(1, 0)] + p[(-1, 0)] + p[(0, 1)] + p[(0, -1)] - p[(-1, 1)] - p[(1, -1)]) - p0)
+    return out
