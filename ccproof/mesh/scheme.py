@@ -53,8 +53,8 @@ __all__ = ["Scheme", "CATMARK", "LOOP", "SCHEMES", "scheme_named", "loop_beta", 
            "cos_2pi"]
 
 #: the fractions q of a turn whose cos(2 pi q) is rational (exact arithmetic works there)
-_RATIONAL_COS = {Fraction(0): 1, Fraction(1, 6): Fraction(1, 2), Fraction(1, 4): 0, Fraction(1, 3): Fraction(-1, 2),
-                 Fraction(1, 2): -1, Fraction(2, 3): Fraction(-1, 2), Fraction(3, 4): 0, Fraction(5, 6): Fraction(1, 2)}
+_RATIONAL_COS = {Fraction(0): (1, 1), Fraction(1, 6): (1, 2), Fraction(1, 4): (0, 1), Fraction(1, 3): (-1, 2),
+                 Fraction(1, 2): (-1, 1), Fraction(2, 3): (-1, 2), Fraction(3, 4): (0, 1), Fraction(5, 6): (1, 2)}
 
 
 def cos_2pi(j, k, one):
@@ -80,7 +80,8 @@ def cos_2pi(j, k, one):
         return one * math.cos(2 * math.pi * j / k)
     q = Fraction(j % k, k) if isinstance(k, int) and isinstance(j, int) else None
     if q in _RATIONAL_COS:
-        return one * _RATIONAL_COS[q]
+        num, den = _RATIONAL_COS[q]
+        return one * num / den
     raise ValueError(f"cos(2 pi * {j}/{k}) is irrational: exact weights exist for valences 3, 4 and 6 only "
                      "(use flint.arb)")
 
