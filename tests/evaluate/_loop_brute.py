@@ -101,9 +101,29 @@ class Level:
             return self.V[v]
         if kind == "crease":
             return (4 * self.V[v] + self.V[ns[0]] + self.V[ns[1]]) / 6
+        if ns:  # a dart: the left eigenvector of its one-ring's subdivision matrix (one edge point a midpoint)
+            return self._dart_limit(v)
         k = len(self.nbrs[v])
         eps = 1 / (k + 3 / (8 * _beta(k)))
         return (1 - k * eps) * self.V[v] + eps * sum(self.V[w] for w in self.nbrs[v])
+
+    def _dart_limit(self, v):
+        fan = self.fan(v, sorted(self.nbrs[v])[0])
+        k = len(fan)
+        S = np.zeros((k + 1, k + 1))
+        b = _beta(k)
+        S[0, 0], S[0, 1:] = 1 - k * b, b
+        for j, w in enumerate(fan):
+            if self.is_sharp(v, w):
+                S[1 + j, 0] = S[1 + j, 1 + j] = 0.5
+            else:
+                S[1 + j, 0] = S[1 + j, 1 + j] = 0.375
+                S[1 + j, 1 + (j + 1) % k] += 0.125
+                S[1 + j, 1 + (j - 1) % k] += 0.125
+        vals, vecs = np.linalg.eig(S.T)
+        x = np.real(vecs[:, np.argmin(abs(vals - 1))])
+        x /= x.sum()
+        return x[0] * self.V[v] + sum(x[1 + j] * self.V[w] for j, w in enumerate(fan))
 
     def regular_around(self, v):
         """v and its neighbours: smooth interior valence 6, no sharp edge (the surface there is a box spline)."""

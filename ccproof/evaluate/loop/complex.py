@@ -96,10 +96,31 @@ class TriComplex:
             return CORNER, fan
         return (CREASE if n_sharp == 2 else SMOOTH), fan
 
-    def is_regular(self, v):
-        """A complete smooth vertex of valence 6 with no sharp edge: the box spline's."""
+    def sector(self, v, start):
+        """Neighbours of ``v`` counter-clockwise in the sector of edge (v, start) (bounded by sharp edges and
+        the boundary; the whole fan at a smooth vertex without sharp edges): (list, index of start)."""
+        out, w = [start], start
+        while not (self.is_sharp(v, w) and w != start):
+            w = self.opp.get((v, w))
+            if w is None or w == start:
+                break
+            out.append(w)
+        i, w = 0, start
+        while not self.is_sharp(v, w):
+            w = self.opp.get((w, v))
+            if w is None or w in out:
+                break
+            out.insert(0, w)
+            i += 1
+        return out, i
+
+    def is_regular(self, v, start):
+        """Corner v of a triangle with next vertex ``start`` is regular: smooth of valence 6 without sharp
+        edges, or a crease (boundary) vertex with three triangles in the triangle's sector."""
         rule, fan = self.rule(v)
-        return rule == SMOOTH and len(fan) == 6 and not any(self.is_sharp(v, w) for w in fan)
+        if rule == SMOOTH:
+            return len(fan) == 6 and not any(self.is_sharp(v, w) for w in fan)
+        return rule == CREASE and len(self.sector(v, start)[0]) == 4
 
 
 def vertex_stencil(cx, v, one):
@@ -240,15 +261,42 @@ def key_complex(key):
 
 
 def regular_net(cx, tri):
-    """Labels of the 12 control points (box_spline.NET order) of a triangle whose corners are regular."""
-    pos = {(0, 0): tri[0], (1, 0): tri[1], (0, 1): tri[2]}
+    """The 12 control points (box_spline.NET order) of a triangle whose corners are regular, as stencils
+    (dict label -> weight), or None.
+
+    Lattice points across a sharp line (boundary or crease) are ghosts ``a + b - m``: a, b the two
+    points of the line next to it, m its mirror image ``a + b - x`` (they reproduce the crease rules:
+    the Loop edge point of (a, b) with the ghost is the midpoint, the vertex point 3/4, 1/8, 1/8).
+    """
+    pos = {}
     for i, (base, start) in enumerate((((0, 0), tri[1]), ((1, 0), tri[2]), ((0, 1), tri[0]))):
-        fan, closed = cx.fan(tri[i], start)
-        if not closed or len(fan) != 6:
-            raise MeshError(f"internal: corner {i} of triangle {tri} is not regular")
+        pos.setdefault(base, tri[i])
+        fan, k = cx.sector(tri[i], start)
         for j, w in enumerate(fan):
-            d = DIRS[(2 * i + j) % 6]
+            d = DIRS[(2 * i + j - k) % 6]
             p = (base[0] + d[0], base[1] + d[1])
             if pos.setdefault(p, w) != w:
-                raise MeshError(f"internal: lattice point {p} of triangle {tri} has two vertices")
-    return [pos[p] for p in NET]
+                return None
+    rows = []
+    for x in NET:
+        if x in pos:
+            rows.append({pos[x]: 1})
+            continue
+        g = _ghost(cx, pos, x)
+        if g is None:
+            return None
+        rows.append(g)
+    return rows
+
+
+def _ghost(cx, pos, x):
+    for j in range(6):
+        a = (x[0] + DIRS[j][0], x[1] + DIRS[j][1])
+        b = (x[0] + DIRS[(j + 1) % 6][0], x[1] + DIRS[(j + 1) % 6][1])
+        m = (a[0] + b[0] - x[0], a[1] + b[1] - x[1])
+        if a in pos and b in pos and m in pos and cx.is_sharp(pos[a], pos[b]):
+            s = {pos[a]: 1}
+            s[pos[b]] = s.get(pos[b], 0) + 1
+            s[pos[m]] = s.get(pos[m], 0) - 1
+            return s
+    return None

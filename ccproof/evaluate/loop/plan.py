@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ccproof.errors import MeshError
-from ccproof.evaluate.loop.complex import canonical_ring, key_complex, limit_stencil, loop_step, regular_net
+from ccproof.evaluate.loop.complex import SMOOTH, canonical_ring, key_complex, limit_stencil, loop_step, regular_net
 
 __all__ = ["Regular", "Corner", "Split", "plan", "oriented_ring", "PRECISION", "MAX_DEPTH", "LAYER_TOLERANCE"]
 
@@ -39,10 +39,10 @@ MAX_DEPTH = 6
 _MAX_LAYERS = 400
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Regular:
-    """Box-spline patch: ``net`` = ring indices of the 12 control points (box_spline.NET order)."""
-    net: tuple
+    """Box-spline patch: ``net`` (12, N): its control points (box_spline.NET order) from the ring."""
+    net: np.ndarray
 
 
 @dataclass(frozen=True, eq=False)
@@ -72,6 +72,8 @@ def _precision():
 
 
 def _to_float(x):
+    if isinstance(x, (int, float)):
+        return float(x)
     if float(x.rad()) > 2.0**-200 * max(1.0, abs(float(x.mid()))):
         raise MeshError(f"internal: a weight lost its precision ({x})")  # pragma: no cover
     return float(x.mid())
@@ -87,7 +89,7 @@ def _dense(rows, ncols):
 
 
 def irregular_corners(cx, tri):
-    return [i for i in range(3) if not cx.is_regular(tri[i])]
+    return [i for i in range(3) if not cx.is_regular(tri[i], tri[(i + 1) % 3])]
 
 
 def oriented_ring(cx, tri):
@@ -114,7 +116,8 @@ def plan(key, depth=0):
                         "local Loop steps")
     cx = key_complex(key)
     irr = irregular_corners(cx, (0, 1, 2))
-    out = Regular(tuple(regular_net(cx, (0, 1, 2)))) if not irr else None
+    net = regular_net(cx, (0, 1, 2)) if not irr else None
+    out = Regular(_dense(net, cx.n_vertices)) if net is not None else None
     if out is None and irr == [0]:
         out = _corner(cx, key)
     if out is None:
@@ -144,7 +147,6 @@ def _split(cx, key, depth):
 
 
 def _corner(cx, key):
-    import flint
 
     with _precision() as one:
         child, st, kids = _children(cx, key, one)
@@ -152,15 +154,44 @@ def _corner(cx, key):
         if key0 != key or any(irregular_corners(child, t) for t in kids[1:]):
             return None
         rows = [st[x] for x in ring0]
-        nets = [st[x] for t in kids[1:] for x in regular_net(child, t)]
-        if any(s is None for s in rows + nets):
+        nets = [regular_net(child, t) for t in kids[1:]]
+        if any(n is None for n in nets) or any(s is None for s in rows):
+            return None
+        nets = [_compose(r, st) for n in nets for r in n]
+        if any(s is None for s in nets):
             return None
         N = cx.n_vertices
         A, M = _arb_mat(rows, N), _arb_mat(nets, N)
-        lmask = limit_stencil(cx, 0, one)
-        l_row = flint.arb_mat(1, N, [lmask.get(j, 0) for j in range(N)])
+        l_row = _limit_row(cx, A, N, one)
         layers = power_layers(M, A, l_row)
         return Corner(N, np.array([_to_float(l_row[0, j]) for j in range(N)]), layers)
+
+
+def _limit_row(cx, A, N, one):
+    """The limit mask of corner 0 as a (1, N) ball matrix: Sdc's closed forms, and at a dart (smooth rule,
+    one sharp edge, whose edge point is a midpoint) the left eigenvector of ``A`` for 1, solved exactly."""
+    import flint
+
+    rule, fan = cx.rule(0)
+    if rule != SMOOTH or not any(cx.is_sharp(0, w) for w in fan):
+        lmask = limit_stencil(cx, 0, one)
+        return flint.arb_mat(1, N, [lmask.get(j, 0) for j in range(N)])
+    B = (A - flint.arb_mat(N, N, [int(i == j) for i in range(N) for j in range(N)])).transpose()
+    for j in range(N):
+        B[N - 1, j] = 1
+    x = B.solve(flint.arb_mat(N, 1, [0] * (N - 1) + [1]))
+    return flint.arb_mat(1, N, [x[i, 0] for i in range(N)])
+
+
+def _compose(row, stencils):
+    """A stencil of child labels composed with the children's stencils (None where one is missing)."""
+    out = {}
+    for v, w in row.items():
+        if stencils[v] is None:
+            return None
+        for x, y in stencils[v].items():
+            out[x] = out.get(x, 0) + w * y
+    return out
 
 
 def _arb_mat(rows, ncols):

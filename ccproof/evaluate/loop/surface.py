@@ -126,7 +126,7 @@ class LoopSurface:
         self.split_depth = max(self.split_depth, depth)
         if isinstance(p, Regular):
             self._kind[node], self._ref[node] = _REGULAR, len(self._nets)
-            self._nets.append(C[list(p.net)])
+            self._nets.append(p.net @ C)
         elif isinstance(p, Corner):
             g = self._groups.setdefault(id(p), (len(self._groups), p, []))
             self._kind[node], self._ref[node], self._gid[node] = _CORNER, len(g[2]), g[0]
