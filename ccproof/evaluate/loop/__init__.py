@@ -5,6 +5,6 @@ complexes and one exact Loop step), :mod:`.plan` (per-configuration exact data: 
 self-similar layers, local splits), :mod:`.surface` (setup and batched evaluation).
 """
 
-from ccproof.evaluate.loop.surface import LoopSurface
+from ccproof.evaluate.loop.surface import LoopSurface, loop_limit_surface
 
-__all__ = ["LoopSurface"]
+__all__ = ["LoopSurface", "loop_limit_surface"]

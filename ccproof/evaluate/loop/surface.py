@@ -32,7 +32,7 @@ from ccproof.evaluate.loop.box_spline import basis
 from ccproof.evaluate.loop.complex import TriComplex
 from ccproof.evaluate.loop.plan import MAX_DEPTH, Corner, Regular, oriented_ring, plan
 
-__all__ = ["LoopSurface", "ROTATIONS"]
+__all__ = ["LoopSurface", "ROTATIONS", "loop_limit_surface"]
 
 #: (Jacobian, offset) of the parameter of a triangle listed from its corner r: (u', v') = J (u, v) + o
 ROTATIONS = (
@@ -64,6 +64,35 @@ def _triangles(mesh):
     if semi:
         raise CCProofError(f"the Loop evaluator does not take semi-sharp tags yet (at {semi[0]})")
     return mesh.polygons
+
+
+def loop_limit_surface(mesh, *, scheme="loop", alpha=None):
+    """``ccproof.limit_surface(mesh, scheme=...)`` for a scheme other than Catmull-Clark: the
+    :class:`LoopSurface` of a PolyMesh, a QuadMesh (refused: quads) or a mesh file.
+
+    >>> loop_limit_surface("m.obj", alpha=2.0)
+    Traceback (most recent call last):
+    ...
+    ccproof.errors.CCProofError: alpha applies to the Catmull-Clark parameterizations (bmz04), not to scheme='loop'
+    >>> loop_limit_surface("m.obj", scheme="butterfly")
+    Traceback (most recent call last):
+    ...
+    ccproof.errors.CCProofError: scheme must be 'catmark' or 'loop', got 'butterfly'
+    """
+    from ccproof.mesh import QuadMesh
+    from ccproof.mesh.polymesh import PolyMesh
+
+    if scheme != "loop":
+        raise CCProofError(f"scheme must be 'catmark' or 'loop', got {scheme!r}")
+    if alpha is not None:
+        raise CCProofError("alpha applies to the Catmull-Clark parameterizations (bmz04), not to scheme='loop'")
+    if isinstance(mesh, QuadMesh):
+        mesh = PolyMesh(mesh.vertices, mesh.faces.tolist())
+    elif not isinstance(mesh, PolyMesh):
+        from ccproof.mesh.io import read_mesh
+
+        mesh = read_mesh(mesh)
+    return LoopSurface(mesh)
 
 
 class LoopSurface:
@@ -151,12 +180,18 @@ class LoopSurface:
         self.n_corner = sum(len(c) for _, c in self._corner_data)
 
     # ------------------------------------------------------------------ evaluation
-    def evaluate(self, face, u, v, derivatives=0):
+    def evaluate(self, face, u, v, derivatives=0, *, parameterization="natural", threads=None):
         """Position and derivatives at points (face, u, v): dict of (n, 3) arrays ``P`` (and ``Pu``,
         ``Pv``; ``Puu``, ``Puv``, ``Pvv``) with respect to the triangle's (u, v).
 
-        Raises CCProofError for a face out of range or a point outside its triangle (naming it).
+        ``parameterization``: ``"natural"`` only (bmz04's reparameterizations are Catmull-Clark's);
+        ``threads``: accepted for the interface of :class:`~ccproof.evaluate.surface.LimitSurface`
+        (this evaluator runs on the calling thread). Raises CCProofError for a face out of range or a
+        point outside its triangle (naming it).
         """
+        if parameterization != "natural":
+            raise CCProofError(f"the {parameterization!r} parameterization is Catmull-Clark's (bmz04); "
+                               "the Loop surface has the natural one only")
         face, u, v = self._checked(face, u, v, derivatives)
         n = face.size
         node = self._root[face]
@@ -215,8 +250,8 @@ class LoopSurface:
         bad = np.flatnonzero((face < 0) | (face >= m) | ~(u >= 0) | ~(v >= 0) | ~(u + v <= 1 + 4e-16))
         if bad.size:
             i = int(bad[0])
-            raise CCProofError(f"point {i}: face {int(face[i])}, (u, v) = ({u[i]!r}, {v[i]!r}) is not in a triangle "
-                               f"of this mesh ({m} faces; u, v >= 0, u + v <= 1)")
+            raise CCProofError(f"point {i}: face {int(face[i])}, (u, v) = ({float(u[i])!r}, {float(v[i])!r}) is not in "
+                               f"a triangle of this mesh ({m} faces; u, v >= 0, u + v <= 1)")
         return face, u, v
 
 
