@@ -102,6 +102,9 @@ class LoopSurface:
     ----------
     mesh : PolyMesh
         Triangles only (another face size is refused, naming the face), manifold, no holes.
+    backend : {"numba", "numpy"}
+        The compiled point loop (:mod:`ccproof.evaluate.loop.kernel`, default) or the vectorized numpy
+        path (the same tables and arithmetic).
 
     Attributes
     ----------
@@ -128,7 +131,10 @@ class LoopSurface:
     (1, True)
     """
 
-    def __init__(self, mesh):
+    def __init__(self, mesh, *, backend="numba"):
+        if backend not in ("numba", "numpy"):
+            raise CCProofError(f"backend must be 'numba' or 'numpy', got {backend!r}")
+        self.backend = backend
         tris = _triangles(mesh)
         self.mesh = mesh
         sharp = [e for e, s in mesh.edge_sharpness.items() if s == math.inf]
@@ -178,6 +184,33 @@ class LoopSurface:
         self._groups = None
         self.n_regular = len(self._nets)
         self.n_corner = sum(len(c) for _, c in self._corner_data)
+        self._kernel_tables()
+
+    def _kernel_tables(self):
+        """The flat tables of :func:`ccproof.evaluate.loop.kernel.evaluate_points`."""
+        from ccproof.evaluate.loop.box_spline import basis_coefficients
+
+        K = np.array([[int(x.p) / int(x.q) for x in row] for row in basis_coefficients()])
+        start = np.cumsum([0] + [len(c) for _, c in self._corner_data])
+        cref = self._ref.copy()
+        corner = self._kind == _CORNER
+        cref[corner] += start[self._gid[corner]]
+        sizes = [p.size for p, _ in self._corner_data]
+        flat = [c.reshape(-1) for _, c in self._corner_data]
+        piece = np.repeat(np.array(sizes, dtype=np.int64) * 3, [len(c) for _, c in self._corner_data])
+        self._k = dict(
+            root=self._root, kind=self._kind.astype(np.int64), rot=self._rot.astype(np.int64), ref=cref,
+            children=self._children, gid=self._gid,
+            reg_coef=np.ascontiguousarray(np.einsum("mk,pkc->pmc", K, self._nets)),
+            piece_off=np.r_[0, np.cumsum(piece)][:-1].astype(np.int64),
+            gN=np.array(sizes, dtype=np.int64), gnl=np.array([p.layers.shape[0] for p, _ in self._corner_data],
+                                                              dtype=np.int64),
+            glay=np.cumsum([0] + [p.layers.size // 12 * 15 for p, _ in self._corner_data])[:-1].astype(np.int64),
+            gmask=np.cumsum([0] + sizes)[:-1].astype(np.int64),
+            layers=np.concatenate([np.einsum("mk,njkN->njmN", K, p.layers).reshape(-1) for p, _ in self._corner_data]
+                                  + [np.zeros(0)]),
+            masks=np.concatenate([p.limit_mask for p, _ in self._corner_data] + [np.zeros(0)]),
+            coords=np.concatenate(flat + [np.zeros(0)]))
 
     # ------------------------------------------------------------------ evaluation
     def evaluate(self, face, u, v, derivatives=0, *, parameterization="natural", threads=None):
@@ -193,6 +226,8 @@ class LoopSurface:
             raise CCProofError(f"the {parameterization!r} parameterization is Catmull-Clark's (bmz04); "
                                "the Loop surface has the natural one only")
         face, u, v = self._checked(face, u, v, derivatives)
+        if self.backend == "numba":
+            return self._evaluate_compiled(face, u, v, derivatives)
         n = face.size
         node = self._root[face]
         T = np.broadcast_to(np.eye(2), (n, 2, 2)).copy()
@@ -219,6 +254,17 @@ class LoopSurface:
                 _put(local, idx, _layers(p, coords[self._ref[node[idx]]], u[idx], v[idx], derivatives))
         _chain(out, local, T, derivatives)
         return out
+
+    def _evaluate_compiled(self, face, u, v, derivatives):
+        from ccproof.evaluate.loop.kernel import evaluate_points
+
+        nrows = (1, 3, 6)[derivatives]
+        out = np.empty((nrows, face.size, 3))
+        k = self._k
+        evaluate_points(face, u, v, nrows, k["root"], k["kind"], k["rot"], k["ref"], k["children"], k["gid"],
+                        k["reg_coef"], k["piece_off"], k["gN"], k["gnl"], k["glay"], k["gmask"], k["layers"],
+                        k["masks"], k["coords"], out)
+        return {key: out[r] for r, key in enumerate(_KEYS[derivatives])}
 
     def _turn(self, node, u, v, T):
         self._turn_some(node, u, v, T, np.arange(node.size))
