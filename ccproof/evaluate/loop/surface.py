@@ -31,6 +31,7 @@ from ccproof.errors import CCProofError
 from ccproof.evaluate.loop.box_spline import basis
 from ccproof.evaluate.loop.complex import TriComplex
 from ccproof.evaluate.loop.plan import MAX_DEPTH, Corner, Regular, oriented_ring, plan
+from ccproof.evaluate.loop.regular import regular_triangles
 
 __all__ = ["LoopSurface", "ROTATIONS", "loop_limit_surface"]
 
@@ -144,7 +145,19 @@ class LoopSurface:
         self._kind, self._rot, self._ref, self._children, self._gid = [], [], [], [], []
         self._nets, self._groups = [], {}
         self.split_depth = 0
-        self._root = np.array([self._add_face(X, t) for t in tris], dtype=np.int64)
+        tagged = {v for e in mesh.edge_sharpness for v in e} | set(mesh.vertex_sharpness)
+        reg, labels = regular_triangles(np.array(tris, dtype=np.int64).reshape(-1, 3), len(X), tagged)
+        self._root = np.empty(len(tris), dtype=np.int64)
+        self._root[reg] = np.arange(labels.shape[0])  # the regular triangles first: nodes 0 .. R-1
+        nr = labels.shape[0]
+        self._kind += [_REGULAR] * nr
+        self._rot += [0] * nr
+        self._ref += list(range(nr))
+        self._children += [(-1, -1, -1, -1)] * nr
+        self._gid += [-1] * nr
+        self._net_block = X[labels]
+        for f in np.flatnonzero(~reg).tolist():
+            self._root[f] = self._add_face(X, tris[f])
         self._finish()
 
     def _add_face(self, X, tri):
@@ -160,7 +173,7 @@ class LoopSurface:
         self._gid.append(-1)
         self.split_depth = max(self.split_depth, depth)
         if isinstance(p, Regular):
-            self._kind[node], self._ref[node] = _REGULAR, len(self._nets)
+            self._kind[node], self._ref[node] = _REGULAR, len(self._net_block) + len(self._nets)
             self._nets.append(p.net @ C)
         elif isinstance(p, Corner):
             g = self._groups.setdefault(id(p), (len(self._groups), p, []))
@@ -175,7 +188,8 @@ class LoopSurface:
         self._rot = np.array(self._rot, dtype=np.int8)
         self._ref = np.array(self._ref, dtype=np.int64)
         self._children = np.array(self._children, dtype=np.int64).reshape(-1, 4)
-        self._nets = np.array(self._nets, dtype=np.float64).reshape(-1, 12, 3)
+        self._nets = np.concatenate([self._net_block, np.array(self._nets, dtype=np.float64).reshape(-1, 12, 3)])
+        self._net_block = None
         self._gid = np.array(self._gid, dtype=np.int64)
         self._corner_data = []
         groups = sorted(self._groups.values(), key=lambda g: g[0])
