@@ -30,10 +30,13 @@ class Level:
     """One level of the global subdivision: vertices, triangles, tags."""
 
     def __init__(self, V, F, sharp=(), corners=(), boundary="edge_only"):
+        """``sharp``, ``corners``: dicts of sharpness, or iterables (infinitely sharp)."""
         self.V = np.asarray(V, dtype=float)
         self.F = [tuple(int(x) for x in f) for f in F]
-        self.sharp = {(min(a, b), max(a, b)) for a, b in sharp}
-        self.corners = set(corners)
+        sharp = sharp if isinstance(sharp, dict) else dict.fromkeys(sharp, math.inf)
+        self.sharp = {(min(a, b), max(a, b)): x for (a, b), x in sharp.items() if x > 0}
+        corners = corners if isinstance(corners, dict) else dict.fromkeys(corners, math.inf)
+        self.corners = {v: x for v, x in corners.items() if x > 0}
         self.boundary = boundary
         self.opp = {}
         for a, b, c in self.F:
@@ -43,49 +46,76 @@ class Level:
             self.nbrs.setdefault(a, set()).add(b)
             self.nbrs.setdefault(b, set()).add(a)
 
-    def is_sharp(self, a, b):
-        return (min(a, b), max(a, b)) in self.sharp or (a, b) not in self.opp or (b, a) not in self.opp
+    def s(self, a, b):
+        if (a, b) not in self.opp or (b, a) not in self.opp:
+            return math.inf
+        return self.sharp.get((min(a, b), max(a, b)), 0.0)
 
-    def kind(self, v):
-        ns = [w for w in self.nbrs[v] if self.is_sharp(v, w)]
+    def is_sharp(self, a, b):
+        return self.s(a, b) > 0
+
+    def kind(self, v, down=0):
+        """Sdc rule of v with every sharpness lowered by ``down`` (1: the child's), and its sharp neighbours."""
+        def dec(x):
+            return x if x == math.inf else x - down
+        ns = [w for w in self.nbrs[v] if dec(self.s(v, w)) > 0]
         boundary = any((v, w) not in self.opp or (w, v) not in self.opp for w in self.nbrs[v])
-        if v in self.corners or len(ns) > 2 or (boundary and len(self.nbrs[v]) == 2
-                                                 and self.boundary == "edge_and_corner"):
+        if dec(self.corners.get(v, 0.0)) > 0 or len(ns) > 2 or (boundary and len(self.nbrs[v]) == 2
+                                                                and self.boundary == "edge_and_corner"):
             return "corner", ns
         return ("crease" if len(ns) == 2 else "smooth"), ns
 
+    def _mask_point(self, v, kind, ns):
+        V = self.V
+        if kind == "corner":
+            return V[v]
+        if kind == "crease":
+            return 0.75 * V[v] + 0.125 * (V[ns[0]] + V[ns[1]])
+        k = len(self.nbrs[v])
+        b = _beta(k)
+        return (1 - k * b) * V[v] + b * sum(V[w] for w in self.nbrs[v])
+
+    def vertex_point(self, v):
+        """Sdc's vertex point with semi-sharp transitions: parent rule, child rule, blended by the mean
+        parent sharpness of the tags that become smooth."""
+        kind, ns = self.kind(v)
+        if kind == "smooth":
+            return self._mask_point(v, kind, ns)
+        ckind, cns = self.kind(v, 1)
+        if ckind == kind:
+            return self._mask_point(v, kind, ns)
+        tags = [self.corners.get(v, 0.0)] + [self.s(v, w) for w in self.nbrs[v]]
+        gone = [x for x in tags if 0 < x <= 1]
+        w = min(sum(gone) / len(gone), 1.0) if gone else 0.0
+        return w * self._mask_point(v, kind, ns) + (1 - w) * self._mask_point(v, ckind, cns)
+
     def subdivide(self):
         V, n = self.V, len(self.V)
-        newV = np.empty_like(V)
-        for v in range(n):
-            kind, ns = self.kind(v)
-            if kind == "corner":
-                newV[v] = V[v]
-            elif kind == "crease":
-                newV[v] = 0.75 * V[v] + 0.125 * (V[ns[0]] + V[ns[1]])
-            else:
-                k = len(self.nbrs[v])
-                b = _beta(k)
-                newV[v] = (1 - k * b) * V[v] + b * sum(V[w] for w in self.nbrs[v])
+        newV = np.array([self.vertex_point(v) for v in range(n)])
         emap, pts = {}, []
         for a, b, c in self.F:
             for x, y in ((a, b), (b, c), (c, a)):
                 e = (min(x, y), max(x, y))
                 if e not in emap:
                     emap[e] = n + len(pts)
-                    if self.is_sharp(x, y):
-                        pts.append(0.5 * (V[x] + V[y]))
-                    else:
-                        pts.append(0.375 * (V[x] + V[y]) + 0.125 * (V[self.opp[(x, y)]] + V[self.opp[(y, x)]]))
+                    mid = 0.5 * (V[x] + V[y])
+                    sh = self.s(x, y)
+                    if sh > 1:
+                        pts.append(mid)
+                        continue
+                    smooth = 0.375 * (V[x] + V[y]) + 0.125 * (V[self.opp[(x, y)]] + V[self.opp[(y, x)]])
+                    pts.append(sh * mid + (1 - sh) * smooth)
         F = []
         for a, b, c in self.F:
             ab, bc, ca = emap[(min(a, b), max(a, b))], emap[(min(b, c), max(b, c))], emap[(min(c, a), max(c, a))]
             F += [(a, ab, ca), (ab, b, bc), (ca, bc, c), (bc, ca, ab)]
-        sharp = []
-        for a, b in self.sharp:
+        sharp = {}
+        for (a, b), x in self.sharp.items():
             e = emap[(a, b)]
-            sharp += [(a, e), (e, b)]
-        return Level(np.vstack([newV, pts]), F, sharp, self.corners, self.boundary)
+            if x - 1 > 0:
+                sharp[(a, e)] = sharp[(e, b)] = x - 1
+        corners = {v: x - 1 for v, x in self.corners.items() if x - 1 > 0}
+        return Level(np.vstack([newV, pts]), F, sharp, corners, self.boundary)
 
     def fan(self, v, start):
         out, w = [start], start

@@ -78,11 +78,14 @@ def flip_edges(T, count, seed, max_valence=8):
 
 def compare(V, T, L, faces, derivatives=2, **tags):
     """Largest error per key (relative to max(1, |value|)) over the level-L vertices of ``faces``."""
-    creases = {e: math.inf for e in tags.get("sharp", ())}
-    corners = {v: math.inf for v in tags.get("corners", ())}
-    S = LoopSurface(PolyMesh(V, T, creases=creases, corners=corners,
-                             options={"boundary": tags.get("boundary", "edge_only")}))
-    lv = levels(V, T, L, **tags)
+    sharp, corner_tags = tags.get("sharp", ()), tags.get("corners", ())
+    creases = dict(sharp) if isinstance(sharp, dict) else dict.fromkeys(sharp, math.inf)
+    corners = dict(corner_tags) if isinstance(corner_tags, dict) else dict.fromkeys(corner_tags, math.inf)
+    mesh = PolyMesh(V, T, creases=creases, corners=corners, options={"boundary": tags.get("boundary", "edge_only")})
+    S = LoopSurface(mesh)
+    # the tags as the mesh holds them (OpenSubdiv's float32 sharpness)
+    lv = levels(V, T, L, sharp=dict(mesh.edge_sharpness), corners=dict(mesh.vertex_sharpness),
+                boundary=mesh.options.boundary)
     pts = [(f, i / 2**L, j / 2**L) for f in faces for i in range(2**L + 1) for j in range(2**L + 1 - i)]
     R = S.evaluate([p[0] for p in pts], [p[1] for p in pts], [p[2] for p in pts], derivatives)
     err, count = {}, {}
@@ -142,6 +145,20 @@ def test_creases_corners_and_darts():
     _check(err, count)
 
 
+@pytest.mark.parametrize("s", [0.5, 1.0, 1.7])
+def test_semi_sharp_creases_and_corners(s):
+    """Semi-sharp tags (Sdc's uniform creasing: decay by 1 per level, fractional edge and vertex rules):
+    a closed crease loop of sharpness s, an open chain of mixed sharpness ending in the interior, a
+    semi-sharp corner."""
+    V, T = icosahedron()
+    loop = [0, 1, 9, 3, 2, 11, 0]
+    sharp = {(min(a, b), max(a, b)): s for a, b in zip(loop, loop[1:])}
+    sharp.update({(4, 5): 2.5, (4, 11): s / 2})
+    err, count, S = compare(V, T, 3, range(20), sharp=sharp, corners={7: 1.3})
+    _check(err, count)
+    assert S.split_depth >= 2
+
+
 def test_points_near_and_at_an_extraordinary_vertex():
     """Deep layers: the distance to the limit point decays like lam^n (lam = 3/8 + cos(2 pi / 5) / 4 at
     valence 5); below the last layer and at the vertex itself the limit point of the limit mask."""
@@ -164,8 +181,8 @@ def test_refusals():
     quad = PolyMesh([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [2, 0, 0]], [[0, 1, 4], [0, 4, 2, 3]])
     with pytest.raises(CCProofError, match=r"triangles only: face 1 has 4 vertices"):
         LoopSurface(quad)
-    with pytest.raises(CCProofError, match=r"semi-sharp"):
-        LoopSurface(PolyMesh(V, T, creases={(0, 2): 2.0}))
+    with pytest.raises(CCProofError, match=r"semi-sharp tags with uniform creasing only, not 'chaikin'"):
+        LoopSurface(PolyMesh(V, T, creases={(0, 2): 2.0}, options={"crease_method": "chaikin"}))
     S = LoopSurface(PolyMesh(V, T))
     with pytest.raises(CCProofError, match=r"point 1: face 2, \(u, v\) = \(0.75, 0.5\) is not in a triangle"):
         S.evaluate([0, 2], [0.1, 0.75], [0.1, 0.5])
@@ -232,7 +249,7 @@ def _osd():
         pytest.skip(str(e))
 
 
-@pytest.mark.parametrize("case", ["icosahedron", "creased_open_grid"])
+@pytest.mark.parametrize("case", ["icosahedron", "creased_open_grid", "semi_sharp"])
 def test_against_opensubdiv_loop_patches(case):
     """Far's Loop PatchTable (isolation level 6): at every point on a regular Loop patch (no end cap) the
     same P, Pu, Pv to 1e-12 (relative to max(1, |value|))."""
@@ -240,6 +257,9 @@ def test_against_opensubdiv_loop_patches(case):
     if case == "icosahedron":
         V, T = icosahedron()
         mesh = PolyMesh(V, T)
+    elif case == "semi_sharp":
+        V, T = icosahedron()
+        mesh = PolyMesh(V, T, creases={(0, 1): 1.5, (1, 9): 0.7, (3, 9): 3.2, (2, 4): 2.5}, corners={7: 1.3})
     else:
         V, T = grid(5)
         T = flip_edges(T, 8, seed=4)

@@ -11,6 +11,8 @@ triangle sharing a vertex with it) in a deterministic order whose key identifies
 
 from __future__ import annotations
 
+import math
+
 from ccproof.errors import MeshError
 from ccproof.evaluate.loop.box_spline import DIRS, NET
 from ccproof.mesh.scheme import LOOP
@@ -20,16 +22,29 @@ __all__ = ["TriComplex", "loop_step", "canonical_ring", "regular_net", "SMOOTH",
 SMOOTH, CREASE, CORNER = "smooth", "crease", "corner"
 
 
+def classify(vertex_sharpness, edge_sharpness, boundary_corner=False):
+    """Sdc's vertex rule: corner (tagged, more than two sharp edges, or a boundary vertex of one triangle
+    with ``edge_and_corner``), crease (two sharp edges) or smooth (none or one: a dart).
+
+    >>> classify(0.0, [0.0, 2.5, 0.0, math.inf]), classify(0.5, []), classify(0.0, [1.0, 0.0])
+    ('crease', 'corner', 'smooth')
+    """
+    n_sharp = sum(x > 0 for x in edge_sharpness)
+    if vertex_sharpness > 0 or n_sharp > 2 or boundary_corner:
+        return CORNER
+    return CREASE if n_sharp == 2 else SMOOTH
+
+
 class TriComplex:
     """Counter-clockwise triangles with tags (see the module docstring).
 
     Parameters
     ----------
     triangles : sequence of (a, b, c)
-    sharp : iterable of (a, b)
-        Infinitely sharp edges (either orientation).
-    corners : iterable of int
-        Infinitely sharp vertices.
+    sharp : dict (a, b) -> sharpness, or iterable of (a, b) (infinitely sharp)
+        Tagged edges (either orientation; sharpness > 0, ``math.inf`` for infinitely sharp).
+    corners : dict v -> sharpness, or iterable of int (infinitely sharp)
+        Tagged vertices.
     complete : iterable of int or None
         Vertices whose fan is complete (None: every vertex).
     boundary : {"edge_only", "edge_and_corner"}
@@ -58,8 +73,10 @@ class TriComplex:
         for a, b in self.opp:
             self.first.setdefault(a, b)
         self.n_vertices = 1 + max((max(t) for t in self.triangles), default=-1)
-        self.sharp = frozenset((min(a, b), max(a, b)) for a, b in sharp)
-        self.corners = frozenset(int(v) for v in corners)
+        pairs = sharp.items() if isinstance(sharp, dict) else ((e, math.inf) for e in sharp)
+        self.sharp = {(min(a, b), max(a, b)): float(x) for (a, b), x in pairs if x > 0}
+        items = corners.items() if isinstance(corners, dict) else ((v, math.inf) for v in corners)
+        self.corners = {int(v): float(x) for v, x in items if x > 0}
         self.complete = None if complete is None else frozenset(complete)
         self.boundary = boundary
 
@@ -84,17 +101,21 @@ class TriComplex:
                 return out, False
             out.insert(0, w)
 
+    def sharpness(self, a, b):
+        """The edge's sharpness: its tag, infinite on a boundary edge (one triangle), else 0."""
+        if (a, b) not in self.opp or (b, a) not in self.opp:
+            return math.inf
+        return self.sharp.get((min(a, b), max(a, b)), 0.0)
+
     def is_sharp(self, a, b):
-        """Infinitely sharp: tagged, or a boundary edge (one triangle)."""
-        return (min(a, b), max(a, b)) in self.sharp or (a, b) not in self.opp or (b, a) not in self.opp
+        """Sharp (Sdc's ``IsSharp``): sharpness > 0."""
+        return self.sharpness(a, b) > 0
 
     def rule(self, v):
         """(rule, fan) of a complete vertex: its Sdc rule and its neighbours (counter-clockwise)."""
         fan, closed = self.fan(v, self.first[v])
-        n_sharp = sum(self.is_sharp(v, w) for w in fan)
-        if v in self.corners or n_sharp > 2 or (not closed and len(fan) == 2 and self.boundary == "edge_and_corner"):
-            return CORNER, fan
-        return (CREASE if n_sharp == 2 else SMOOTH), fan
+        return classify(self.corners.get(v, 0.0), [self.sharpness(v, w) for w in fan],
+                        not closed and len(fan) == 2 and self.boundary == "edge_and_corner"), fan
 
     def sector(self, v, start):
         """Neighbours of ``v`` counter-clockwise in the sector of edge (v, start) (bounded by sharp edges and
@@ -120,20 +141,53 @@ class TriComplex:
         rule, fan = self.rule(v)
         if rule == SMOOTH:
             return len(fan) == 6 and not any(self.is_sharp(v, w) for w in fan)
-        return rule == CREASE and len(self.sector(v, start)[0]) == 4
+        return rule == CREASE and len(self.sector(v, start)[0]) == 4 and \
+            all(self.sharpness(v, w) in (0, math.inf) for w in fan)
 
 
 def vertex_stencil(cx, v, one):
-    """The Sdc Loop vertex point of complete vertex ``v``: dict label -> weight."""
+    """The Sdc Loop vertex point of complete vertex ``v``: dict label -> weight.
+
+    Semi-sharp tags (Sdc, uniform creasing): the rule of the parent (its sharp edges and its corner tag) and
+    of the child (sharpness less 1); where they differ, ``w P + (1 - w) C`` with ``w`` the mean parent
+    sharpness of the tags that become smooth (at most 1).
+    """
     rule, fan = cx.rule(v)
+    if rule == SMOOTH:
+        return _rule_mask(cx, v, SMOOTH, fan, (), one)
+    vs = cx.corners.get(v, 0.0)
+    es = [cx.sharpness(v, w) for w in fan]
+    cvs = _decay(vs)
+    ces = [_decay(x) for x in es]
+    bcorner = rule == CORNER and classify(vs, es) != CORNER  # edge_and_corner's boundary corner: it stays
+    crule = classify(cvs, ces, bcorner)
+    sharp_now = [w for w, x in zip(fan, es) if x > 0]
+    pmask = _rule_mask(cx, v, rule, fan, sharp_now, one)
+    if crule == rule:
+        return pmask
+    trans = ([vs] if vs > 0 and cvs <= 0 else []) + [x for x, c in zip(es, ces) if x > 0 and c <= 0]
+    w = min(sum(trans) / len(trans), 1.0) if trans else 0.0
+    cmask = _rule_mask(cx, v, crule, fan, [u for u, x in zip(fan, ces) if x > 0], one)
+    out = {}
+    for m, f in ((pmask, one * w), (cmask, one * (1 - w))):
+        for x, y in m.items():
+            out[x] = out.get(x, 0) + f * y
+    return out
+
+
+def _decay(x):
+    """Sdc's uniform creasing: sharpness one level down (infinite stays infinite)."""
+    return x if x == math.inf else max(x - 1.0, 0.0)
+
+
+def _rule_mask(cx, v, rule, fan, sharp, one):
     if rule == CORNER:
         return {v: one}
     if rule == CREASE:
         wV, we = LOOP.crease_vertex(one)
         s = {v: wV}
-        for w in fan:
-            if cx.is_sharp(v, w):
-                s[w] = we
+        for w in sharp:
+            s[w] = s.get(w, 0) + we
         return s
     wV, we = LOOP.vertex_point(len(fan), one)
     s = {v: wV}
@@ -162,13 +216,20 @@ def limit_stencil(cx, v, one):
 
 
 def _edge_stencil(cx, a, b, one):
-    if cx.is_sharp(a, b):
-        w = LOOP.sharp_edge(one)
+    """Sdc Loop edge point: sharpness > 1 the midpoint, 0 smooth, between the blend with weight s."""
+    x = cx.sharpness(a, b)
+    w = LOOP.sharp_edge(one)
+    if x > 1:
         return {a: w, b: w}
     we, wo = LOOP.edge_point(one)
     s = {a: we, b: we}
-    for x in (cx.opp[(a, b)], cx.opp[(b, a)]):
-        s[x] = s.get(x, 0) + wo
+    for y in (cx.opp[(a, b)], cx.opp[(b, a)]):
+        s[y] = s.get(y, 0) + wo
+    if x > 0:
+        f = one * x
+        s = {k: (1 - f) * y for k, y in s.items()}
+        s[a] += f * w
+        s[b] += f * w
     return s
 
 
@@ -195,7 +256,7 @@ def loop_step(cx, one):
     for v in range(n):
         if cx.is_complete(v) and v in cx.first:
             stencils[v] = vertex_stencil(cx, v, one)
-    tris, sharp = [], []
+    tris, sharp = [], {}
     for a, b, c in cx.triangles:
         ab, bc, ca = (_label(edge_label, n, x, y) for x, y in ((a, b), (b, c), (c, a)))
         tris += [(a, ab, ca), (ab, b, bc), (ca, bc, c), (bc, ca, ab)]
@@ -204,11 +265,13 @@ def loop_step(cx, one):
         full = (a, b) in cx.opp and (b, a) in cx.opp
         if full or cx.is_complete(a) or cx.is_complete(b):
             stencils[e] = _edge_stencil(cx, a, b, one)
-        if (a, b) in cx.sharp:
-            sharp += [(a, e), (e, b)]
+        x = _decay(cx.sharp.get((a, b), 0.0))
+        if x > 0:
+            sharp[(a, e)] = sharp[(e, b)] = x
     complete = None if cx.complete is None else \
         {v for v in cx.complete} | {e for (a, b), e in edge_label.items() if stencils[e] is not None}
-    child = TriComplex(tris, sharp, cx.corners, complete, cx.boundary)
+    corners = {v: _decay(x) for v, x in cx.corners.items()}
+    child = TriComplex(tris, sharp, corners, complete, cx.boundary)
     return child, stencils
 
 
@@ -249,15 +312,16 @@ def canonical_ring(cx, tri):
             t = (pos[x], pos[p], pos[q])
             i = t.index(min(t))
             T.add(t[i:] + t[:i])
-    sharp = sorted(tuple(sorted((pos[p], pos[q]))) for p, q in cx.sharp if p in pos and q in pos)
-    corners = sorted(pos[v] for v in cx.corners if v in pos)
+    sharp = sorted((min(pos[p], pos[q]), max(pos[p], pos[q]), x) for (p, q), x in cx.sharp.items()
+                   if p in pos and q in pos)
+    corners = sorted((pos[v], x) for v, x in cx.corners.items() if v in pos)
     return ring, (tuple(sorted(T)), tuple(sharp), tuple(corners), cx.boundary)
 
 
 def key_complex(key):
     """The complex of a ring key (its three first vertices complete)."""
     tris, sharp, corners, boundary = key
-    return TriComplex(tris, sharp, corners, (0, 1, 2), boundary)
+    return TriComplex(tris, {(a, b): x for a, b, x in sharp}, dict(corners), (0, 1, 2), boundary)
 
 
 def regular_net(cx, tri):
@@ -294,7 +358,7 @@ def _ghost(cx, pos, x):
         a = (x[0] + DIRS[j][0], x[1] + DIRS[j][1])
         b = (x[0] + DIRS[(j + 1) % 6][0], x[1] + DIRS[(j + 1) % 6][1])
         m = (a[0] + b[0] - x[0], a[1] + b[1] - x[1])
-        if a in pos and b in pos and m in pos and cx.is_sharp(pos[a], pos[b]):
+        if a in pos and b in pos and m in pos and cx.sharpness(pos[a], pos[b]) == math.inf:
             s = {pos[a]: 1}
             s[pos[b]] = s.get(pos[b], 0) + 1
             s[pos[m]] = s.get(pos[m], 0) - 1

@@ -35,7 +35,7 @@ PRECISION = 320
 #: smallest deviation kept in a layer table (beyond it the layer equals the limit point in float64)
 LAYER_TOLERANCE = 2.0**-60
 #: most local subdivisions of one configuration before its children are regular or self-similar
-MAX_DEPTH = 6
+MAX_DEPTH = 12
 _MAX_LAYERS = 400
 
 

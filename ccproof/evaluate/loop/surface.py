@@ -62,8 +62,9 @@ def _triangles(mesh):
         raise CCProofError(f"the Loop evaluator does not take holes (face {int(np.flatnonzero(mesh.is_hole)[0])})")
     semi = [e for e, s in mesh.edge_sharpness.items() if 0 < s < math.inf] + \
         [v for v, s in mesh.vertex_sharpness.items() if 0 < s < math.inf]
-    if semi:
-        raise CCProofError(f"the Loop evaluator does not take semi-sharp tags yet (at {semi[0]})")
+    if semi and mesh.options.crease_method != "uniform":
+        raise CCProofError(f"the Loop evaluator takes semi-sharp tags with uniform creasing only, not "
+                           f"{mesh.options.crease_method!r} (semi-sharp tag at {semi[0]})")
     return mesh.polygons
 
 
@@ -138,9 +139,8 @@ class LoopSurface:
         self.backend = backend
         tris = _triangles(mesh)
         self.mesh = mesh
-        sharp = [e for e, s in mesh.edge_sharpness.items() if s == math.inf]
-        corners = [v for v, s in mesh.vertex_sharpness.items() if s == math.inf]
-        self._cx = TriComplex(tris, sharp, corners, None, mesh.options.boundary)
+        self._cx = TriComplex(tris, dict(mesh.edge_sharpness), dict(mesh.vertex_sharpness), None,
+                              mesh.options.boundary)
         X = np.asarray(mesh.vertices, dtype=np.float64)
         self._kind, self._rot, self._ref, self._children, self._gid = [], [], [], [], []
         self._nets, self._groups = [], {}
