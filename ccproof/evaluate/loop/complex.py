@@ -290,31 +290,32 @@ def canonical_ring(cx, tri):
     is equal for isomorphic tagged rings: the cache key of everything computed per configuration.
     """
     a, b, c = tri
-    pos, ring = {}, []
-
-    def add(x):
-        if x not in pos:
-            pos[x] = len(ring)
-            ring.append(x)
-
-    for x in tri:
-        add(x)
+    pos, ring = {a: 0, b: 1, c: 2}, [a, b, c]
     fans = []
     for x, start in ((a, b), (b, c), (c, a)):
         fan, closed = cx.fan(x, start)
-        fans.append((x, fan, closed))
         for w in fan:
-            add(w)
+            if w not in pos:
+                pos[w] = len(ring)
+                ring.append(w)
+        idx = [pos[w] for w in fan]
+        if closed:
+            idx.append(idx[0])
+        fans.append((pos[x], idx))
     T = set()
-    for x, fan, closed in fans:
-        pairs = list(zip(fan, fan[1:])) + ([(fan[-1], fan[0])] if closed else [])
-        for p, q in pairs:
-            t = (pos[x], pos[p], pos[q])
-            i = t.index(min(t))
-            T.add(t[i:] + t[:i])
-    sharp = sorted((min(pos[p], pos[q]), max(pos[p], pos[q]), x) for (p, q), x in cx.sharp.items()
-                   if p in pos and q in pos)
-    corners = sorted((pos[v], x) for v, x in cx.corners.items() if v in pos)
+    for px, idx in fans:
+        for p, q in zip(idx, idx[1:]):  # triangle (px, p, q), listed from its lowest label
+            T.add((px, p, q) if px < p and px < q else (p, q, px) if p < q else (q, px, p))
+    sharp, corners = [], []
+    if cx.sharp:  # the tagged edges of the ring's triangles (each edge once: from its lower label)
+        for t in T:
+            for i, j in ((t[0], t[1]), (t[1], t[2]), (t[2], t[0])):
+                x = cx.sharp.get((min(ring[i], ring[j]), max(ring[i], ring[j])))
+                if x is not None and (i < j or (ring[j], ring[i]) not in cx.opp):
+                    sharp.append((min(i, j), max(i, j), x))
+        sharp = sorted(set(sharp))
+    if cx.corners:
+        corners = sorted((i, cx.corners[v]) for i, v in enumerate(ring) if v in cx.corners)
     return ring, (tuple(sorted(T)), tuple(sharp), tuple(corners), cx.boundary)
 
 

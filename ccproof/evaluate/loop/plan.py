@@ -92,13 +92,14 @@ def irregular_corners(cx, tri):
     return [i for i in range(3) if not cx.is_regular(tri[i], tri[(i + 1) % 3])]
 
 
-def oriented_ring(cx, tri):
+def oriented_ring(cx, tri, irr=None):
     """(rotation r, ring labels, key) of a triangle: read from its irregular corner when it has one alone.
 
     Rotation r lists the triangle from its corner r (the parameter turns accordingly,
-    :data:`ccproof.evaluate.loop.surface.ROTATIONS`).
+    :data:`ccproof.evaluate.loop.surface.ROTATIONS`). ``irr``: the irregular corners when known.
     """
-    irr = irregular_corners(cx, tri)
+    if irr is None:
+        irr = irregular_corners(cx, tri)
     r = irr[0] if len(irr) == 1 else 0
     ring, key = canonical_ring(cx, tri[r:] + tri[:r])
     return r, ring, key

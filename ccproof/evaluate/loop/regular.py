@@ -33,7 +33,8 @@ def _net_sources():
 
 
 def regular_triangles(F, n_vertices, tagged_vertices=()):
-    """(mask (m,) of the regular triangles, their control points' vertex labels (R, 12) in NET order).
+    """(mask (m,) of the regular triangles, their control points' vertex labels (R, 12) in NET order, and
+    per vertex whether it is simple: interior, valence 6, untagged).
 
     Parameters
     ----------
@@ -73,4 +74,4 @@ def regular_triangles(F, n_vertices, tagged_vertices=()):
     labels = np.empty((faces.size, 12), dtype=np.int64)
     for k, (i, j) in enumerate(_net_sources()):
         labels[:, k] = F[faces, i] if j < 0 else fans[:, i, j]
-    return reg, labels
+    return reg, labels, simple

@@ -146,7 +146,12 @@ class LoopSurface:
         self._nets, self._groups = [], {}
         self.split_depth = 0
         tagged = {v for e in mesh.edge_sharpness for v in e} | set(mesh.vertex_sharpness)
-        reg, labels = regular_triangles(np.array(tris, dtype=np.int64).reshape(-1, 3), len(X), tagged)
+        reg, labels, simple = regular_triangles(np.array(tris, dtype=np.int64).reshape(-1, 3), len(X), tagged)
+        # corners decided without the complex: simple ones regular, untagged interior others irregular
+        ask = np.zeros(len(X), dtype=bool)
+        ask[list(tagged)] = True
+        ask |= self._cx_boundary_vertices(len(X))
+        self._simple, self._ask = simple.tolist(), ask.tolist()
         self._root = np.empty(len(tris), dtype=np.int64)
         self._root[reg] = np.arange(labels.shape[0])  # the regular triangles first: nodes 0 .. R-1
         nr = labels.shape[0]
@@ -160,8 +165,18 @@ class LoopSurface:
             self._root[f] = self._add_face(X, tris[f])
         self._finish()
 
+    def _cx_boundary_vertices(self, n):
+        out = np.zeros(n, dtype=bool)
+        for a, b in self._cx.opp:
+            if (b, a) not in self._cx.opp:
+                out[a] = out[b] = True
+        return out
+
     def _add_face(self, X, tri):
-        r, ring, key = oriented_ring(self._cx, tri)
+        cx, simple, ask = self._cx, self._simple, self._ask
+        irr = [i for i in range(3) if not simple[tri[i]]
+               and (not ask[tri[i]] or not cx.is_regular(tri[i], tri[(i + 1) % 3]))]
+        r, ring, key = oriented_ring(cx, tri, irr)
         return self._add(plan(key), r, X[ring], 0)
 
     def _add(self, p, r, C, depth):
