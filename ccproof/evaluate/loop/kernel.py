@@ -5,8 +5,8 @@ same tables; results equal to rounding, checked by tests/evaluate/test_loop.py).
 Tables (built by :meth:`ccproof.evaluate.loop.surface.LoopSurface`): the node arrays (kind, rotation,
 reference, children), per regular patch its polynomial coefficients (15 monomials x 3), per corner piece
 its ring's offset in one flat array of control points and its configuration, per configuration its layers
-as polynomial coefficients (``K D[n, j]``: 15 monomials x N ring points, K the box spline's coefficient
-matrix) and its limit mask, in flat arrays.
+as polynomial coefficients (``(K D[n, j])^T``: N ring points x 15 monomials, K the box spline's
+coefficient matrix; regular patches' coefficients likewise 3 x 15) and its limit mask, in flat arrays.
 """
 
 from __future__ import annotations
@@ -22,12 +22,16 @@ __all__ = ["evaluate_points"]
 
 _MP = np.array([p for p, _ in MONOMIALS], dtype=np.int64)
 _MQ = np.array([q for _, q in MONOMIALS], dtype=np.int64)
+#: corner patches' coefficients kept per kernel call (a power of 2; 384 bytes each), on calls of at least
+#: _CACHE_MIN points
+_CACHE_SLOTS = 16384
+_CACHE_MIN = 256
 #: (Jacobian, offset) per rotation (surface.ROTATIONS), flattened: j00 j01 j10 j11 o0 o1
 _ROT = np.array([[1.0, 0.0, 0.0, 1.0, 0.0, 0.0], [0.0, 1.0, -1.0, -1.0, 0.0, 1.0],
                  [-1.0, -1.0, 1.0, 0.0, 1.0, 0.0]])
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _monomials(a, b, mono, mp, mq, pa, pb, nrows):
     """mono[0..5, m]: u^p v^q and its d/du, d/dv, d2/du2, d2/dudv, d2/dv2 at (a, b), the first nrows rows
     (pa, pb: work (5,))."""
@@ -48,23 +52,25 @@ def _monomials(a, b, mono, mp, mq, pa, pb, nrows):
             mono[5, m] = q * (q - 1) * pa[p] * pb[q - 2] if q >= 2 else 0.0
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _apply(mono, coef, nrows, out):
-    """out[r, c] = sum_m mono[r, m] coef[m, c] for the first nrows derivative rows."""
+    """out[r, c] = sum_m mono[r, m] coef[c, m] for the first nrows derivative rows."""
     for r in range(nrows):
         x0 = x1 = x2 = 0.0
         for m in range(15):
             w = mono[r, m]
-            x0 += w * coef[m, 0]
-            x1 += w * coef[m, 1]
-            x2 += w * coef[m, 2]
+            x0 += w * coef[0, m]
+            x1 += w * coef[1, m]
+            x2 += w * coef[2, m]
         out[r, 0], out[r, 1], out[r, 2] = x0, x1, x2
 
 
-@numba.njit(cache=True)
-def _corner_local(g, piece_off, a, b, gN, gnl, glay, gmask, layers, masks, coords, out, mono, mp, mq, nrows,
-                  work):
-    """Local value and derivatives at corner-configuration g (Stam's layers) into out (6, 3); returns scale."""
+@numba.njit(cache=True, inline="always")
+def _corner_local(g, p, piece_off, a, b, gN, gnl, glay, gmask, layers, masks, coords, out, mono, mp, mq, nrows,
+                  work, ckey, clim, ccoef):
+    """Local value and derivatives at corner piece p of configuration g (Stam's layers) into out (6, 3);
+    returns the derivatives' scale. The coefficients of (piece, layer, child) are kept in a hashed cache
+    (``ckey`` of size 1: none) for the other points of the call on the same patch."""
     N, nl = gN[g], gnl[g]
     s = a + b
     if s > 0.0:
@@ -84,8 +90,20 @@ def _corner_local(g, piece_off, a, b, gN, gnl, glay, gmask, layers, masks, coord
         j, x, y, sg = 1, 2 * U, 2 * V - 1, 1.0
     else:
         j, x, y, sg = 2, 1 - 2 * U, 1 - 2 * V, -1.0
-    base = glay[g] + (n * 3 + j) * 15 * N
     lim, coef, pa, pb = work
+    slot = 0
+    if ckey.size > 1:
+        key = p * 4096 + n * 4 + j
+        slot = ((key * 2654435761) >> 16) & (ckey.size - 1)  # the middle bits: p enters them
+        lim, coef = clim[slot], ccoef[slot]
+        if ckey[slot] == key:
+            _monomials(x, y, mono, mp, mq, pa, pb, nrows)
+            _apply(mono, coef, nrows, out)
+            for c in range(3):
+                out[0, c] = lim[c] if deep else out[0, c] + lim[c]
+            return sg * math.ldexp(1.0, n + 1)
+        ckey[slot] = key
+    base = glay[g] + (n * 3 + j) * N * 15
     x0 = x1 = x2 = 0.0
     mo = gmask[g]
     for k in range(N):
@@ -95,16 +113,16 @@ def _corner_local(g, piece_off, a, b, gN, gnl, glay, gmask, layers, masks, coord
         x1 += w * coords[o + 1]
         x2 += w * coords[o + 2]
     lim[0], lim[1], lim[2] = x0, x1, x2
-    for m in range(15):
-        x0 = x1 = x2 = 0.0
-        lo = base + m * N
-        for k in range(N):
-            w = layers[lo + k]
-            o = piece_off + 3 * k
-            x0 += w * coords[o]
-            x1 += w * coords[o + 1]
-            x2 += w * coords[o + 2]
-        coef[m, 0], coef[m, 1], coef[m, 2] = x0, x1, x2
+    coef[:] = 0.0
+    for k in range(N):  # coef[c, m] += KD[n, j, k, m] C[k, c]: 45 independent sums, m contiguous
+        o = piece_off + 3 * k
+        c0, c1, c2 = coords[o], coords[o + 1], coords[o + 2]
+        lo = base + k * 15
+        for m in range(15):
+            w = layers[lo + m]
+            coef[0, m] += w * c0
+            coef[1, m] += w * c1
+            coef[2, m] += w * c2
     _monomials(x, y, mono, mp, mq, pa, pb, nrows)
     _apply(mono, coef, nrows, out)
     for c in range(3):
@@ -119,7 +137,11 @@ def evaluate_points(face, u, v, nrows, root, kind, rot, ref, children, gid, reg_
     mp, mq, R = _MP, _MQ, _ROT
     mono = np.empty((6, 15))
     loc = np.empty((6, 3))
-    work = (np.zeros(3), np.zeros((15, 3)), np.empty(5), np.empty(5))
+    work = (np.zeros(3), np.zeros((3, 15)), np.empty(5), np.empty(5))
+    slots = _CACHE_SLOTS if face.size >= _CACHE_MIN else 1
+    ckey = np.full(slots, -1, dtype=np.int64)
+    clim = np.empty((slots, 3))
+    ccoef = np.empty((slots, 3, 15))
     for i in range(face.size):
         node = root[face[i]]
         a, b = u[i], v[i]
@@ -149,8 +171,8 @@ def evaluate_points(face, u, v, nrows, root, kind, rot, ref, children, gid, reg_
             _apply(mono, reg_coef[ref[node]], nrows, loc)
         else:
             p = ref[node]
-            scale = _corner_local(gid[node], piece_off[p], a, b, gN, gnl, glay, gmask, layers, masks, coords,
-                                  loc, mono, mp, mq, nrows, work)
+            scale = _corner_local(gid[node], p, piece_off[p], a, b, gN, gnl, glay, gmask, layers, masks, coords,
+                                  loc, mono, mp, mq, nrows, work, ckey, clim, ccoef)
         for c in range(3):
             out[0, i, c] = loc[0, c]
             if nrows > 1:

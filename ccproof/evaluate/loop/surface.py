@@ -230,13 +230,13 @@ class LoopSurface:
         self._k = dict(
             root=self._root, kind=self._kind.astype(np.int64), rot=self._rot.astype(np.int64), ref=cref,
             children=self._children, gid=self._gid,
-            reg_coef=np.ascontiguousarray(np.einsum("mk,pkc->pmc", K, self._nets)),
+            reg_coef=np.ascontiguousarray(np.einsum("mk,pkc->pcm", K, self._nets)),
             piece_off=np.r_[0, np.cumsum(piece)][:-1].astype(np.int64),
             gN=np.array(sizes, dtype=np.int64), gnl=np.array([p.layers.shape[0] for p, _ in self._corner_data],
                                                               dtype=np.int64),
             glay=np.cumsum([0] + [p.layers.size // 12 * 15 for p, _ in self._corner_data])[:-1].astype(np.int64),
             gmask=np.cumsum([0] + sizes)[:-1].astype(np.int64),
-            layers=np.concatenate([np.einsum("mk,njkN->njmN", K, p.layers).reshape(-1) for p, _ in self._corner_data]
+            layers=np.concatenate([np.einsum("mk,njkN->njNm", K, p.layers).reshape(-1) for p, _ in self._corner_data]
                                   + [np.zeros(0)]),
             masks=np.concatenate([p.limit_mask for p, _ in self._corner_data] + [np.zeros(0)]),
             coords=np.concatenate(flat + [np.zeros(0)]))
