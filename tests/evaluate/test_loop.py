@@ -307,7 +307,7 @@ def test_vectorized_regular_nets_equal_the_per_configuration_path():
     V, T = icosahedron(seed=7)
     one = Level(V, T).subdivide().subdivide()
     F = np.array(flip_edges(one.F, 8, seed=5))
-    reg, labels, _ = regular_triangles(F, len(one.V))
+    reg, labels, _, _ = regular_triangles(F, len(one.V))
     assert 0.2 * len(F) < reg.sum() < len(F)
     cx = TriComplex([tuple(f) for f in F.tolist()])
     for k, f in enumerate(np.flatnonzero(reg)):

@@ -33,8 +33,8 @@ def _net_sources():
 
 
 def regular_triangles(F, n_vertices, tagged_vertices=()):
-    """(mask (m,) of the regular triangles, their control points' vertex labels (R, 12) in NET order, and
-    per vertex whether it is simple: interior, valence 6, untagged).
+    """(mask (m,) of the regular triangles, their control points' vertex labels (R, 12) in NET order, per
+    vertex whether it is simple (interior, valence 6, untagged), per vertex whether it is on the boundary).
 
     Parameters
     ----------
@@ -58,9 +58,10 @@ def regular_triangles(F, n_vertices, tagged_vertices=()):
     pos = np.minimum(np.searchsorted(key, rev, sorter=order), key.size - 1)
     twin = np.where(key[order[pos]] == rev, order[pos], -1)
     valence = np.bincount(src, minlength=n_vertices)
-    simple = valence == 6
-    simple[src[twin < 0]] = False
-    simple[dst[twin < 0]] = False
+    boundary = np.zeros(n_vertices, dtype=bool)
+    boundary[src[twin < 0]] = True
+    boundary[dst[twin < 0]] = True
+    simple = (valence == 6) & ~boundary
     simple[np.asarray(list(tagged_vertices), dtype=np.int64)] = False
     reg = simple[F].all(axis=1)
     faces = np.flatnonzero(reg)
@@ -74,4 +75,4 @@ def regular_triangles(F, n_vertices, tagged_vertices=()):
     labels = np.empty((faces.size, 12), dtype=np.int64)
     for k, (i, j) in enumerate(_net_sources()):
         labels[:, k] = F[faces, i] if j < 0 else fans[:, i, j]
-    return reg, labels, simple
+    return reg, labels, simple, boundary

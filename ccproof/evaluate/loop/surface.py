@@ -139,38 +139,30 @@ class LoopSurface:
         self.backend = backend
         tris = _triangles(mesh)
         self.mesh = mesh
-        self._cx = TriComplex(tris, dict(mesh.edge_sharpness), dict(mesh.vertex_sharpness), None,
-                              mesh.options.boundary)
         X = np.asarray(mesh.vertices, dtype=np.float64)
         self._kind, self._rot, self._ref, self._children, self._gid = [], [], [], [], []
         self._nets, self._groups = [], {}
         self.split_depth = 0
         tagged = {v for e in mesh.edge_sharpness for v in e} | set(mesh.vertex_sharpness)
-        reg, labels, simple = regular_triangles(np.array(tris, dtype=np.int64).reshape(-1, 3), len(X), tagged)
+        F = np.array(tris, dtype=np.int64).reshape(-1, 3)
+        reg, labels, simple, boundary = regular_triangles(F, len(X), tagged)
+        # the complex of the other triangles' corners' fans (the rings walked below)
+        near = np.zeros(len(X), dtype=bool)
+        near[F[~reg].reshape(-1)] = True
+        self._cx = TriComplex([tris[f] for f in np.flatnonzero(near[F].any(axis=1)).tolist()],
+                              dict(mesh.edge_sharpness), dict(mesh.vertex_sharpness), None, mesh.options.boundary)
         # corners decided without the complex: simple ones regular, untagged interior others irregular
-        ask = np.zeros(len(X), dtype=bool)
+        ask = boundary.copy()
         ask[list(tagged)] = True
-        ask |= self._cx_boundary_vertices(len(X))
         self._simple, self._ask = simple.tolist(), ask.tolist()
         self._root = np.empty(len(tris), dtype=np.int64)
         self._root[reg] = np.arange(labels.shape[0])  # the regular triangles first: nodes 0 .. R-1
         nr = labels.shape[0]
-        self._kind += [_REGULAR] * nr
-        self._rot += [0] * nr
-        self._ref += list(range(nr))
-        self._children += [(-1, -1, -1, -1)] * nr
-        self._gid += [-1] * nr
+        self._nreg = nr  # nodes 0 .. nr - 1; the lists hold the nodes from nr on
         self._net_block = X[labels]
         for f in np.flatnonzero(~reg).tolist():
             self._root[f] = self._add_face(X, tris[f])
         self._finish()
-
-    def _cx_boundary_vertices(self, n):
-        out = np.zeros(n, dtype=bool)
-        for a, b in self._cx.opp:
-            if (b, a) not in self._cx.opp:
-                out[a] = out[b] = True
-        return out
 
     def _add_face(self, X, tri):
         cx, simple, ask = self._cx, self._simple, self._ask
@@ -180,7 +172,7 @@ class LoopSurface:
         return self._add(plan(key), r, X[ring], 0)
 
     def _add(self, p, r, C, depth):
-        node = len(self._kind)
+        node = self._nreg + len(self._kind)
         self._kind.append(_SPLIT)
         self._rot.append(r)
         self._ref.append(-1)
@@ -188,24 +180,29 @@ class LoopSurface:
         self._gid.append(-1)
         self.split_depth = max(self.split_depth, depth)
         if isinstance(p, Regular):
-            self._kind[node], self._ref[node] = _REGULAR, len(self._net_block) + len(self._nets)
+            i = node - self._nreg
+            self._kind[i], self._ref[i] = _REGULAR, len(self._net_block) + len(self._nets)
             self._nets.append(p.net @ C)
         elif isinstance(p, Corner):
             g = self._groups.setdefault(id(p), (len(self._groups), p, []))
-            self._kind[node], self._ref[node], self._gid[node] = _CORNER, len(g[2]), g[0]
+            i = node - self._nreg
+            self._kind[i], self._ref[i], self._gid[i] = _CORNER, len(g[2]), g[0]
             g[2].append(C)
         else:
-            self._children[node] = tuple(self._add(cp, cr, rows @ C, depth + 1) for cr, rows, _, cp in p.children)
+            kids = tuple(self._add(cp, cr, rows @ C, depth + 1) for cr, rows, _, cp in p.children)
+            self._children[node - self._nreg] = kids
         return node
 
     def _finish(self):
-        self._kind = np.array(self._kind, dtype=np.int8)
-        self._rot = np.array(self._rot, dtype=np.int8)
-        self._ref = np.array(self._ref, dtype=np.int64)
-        self._children = np.array(self._children, dtype=np.int64).reshape(-1, 4)
+        nr = self._nreg
+        self._kind = np.r_[np.full(nr, _REGULAR, dtype=np.int8), np.array(self._kind, dtype=np.int8)]
+        self._rot = np.r_[np.zeros(nr, dtype=np.int8), np.array(self._rot, dtype=np.int8)]
+        self._ref = np.r_[np.arange(nr, dtype=np.int64), np.array(self._ref, dtype=np.int64)]
+        self._children = np.concatenate([np.full((nr, 4), -1, dtype=np.int64),
+                                         np.array(self._children, dtype=np.int64).reshape(-1, 4)])
         self._nets = np.concatenate([self._net_block, np.array(self._nets, dtype=np.float64).reshape(-1, 12, 3)])
         self._net_block = None
-        self._gid = np.array(self._gid, dtype=np.int64)
+        self._gid = np.r_[np.full(nr, -1, dtype=np.int64), np.array(self._gid, dtype=np.int64)]
         self._corner_data = []
         groups = sorted(self._groups.values(), key=lambda g: g[0])
         for _, p, coords in groups:
@@ -230,7 +227,7 @@ class LoopSurface:
         self._k = dict(
             root=self._root, kind=self._kind.astype(np.int64), rot=self._rot.astype(np.int64), ref=cref,
             children=self._children, gid=self._gid,
-            reg_coef=np.ascontiguousarray(np.einsum("mk,pkc->pcm", K, self._nets)),
+            reg_coef=np.matmul(self._nets.transpose(0, 2, 1), K.T),
             piece_off=np.r_[0, np.cumsum(piece)][:-1].astype(np.int64),
             gN=np.array(sizes, dtype=np.int64), gnl=np.array([p.layers.shape[0] for p, _ in self._corner_data],
                                                               dtype=np.int64),
