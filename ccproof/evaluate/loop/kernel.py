@@ -31,7 +31,7 @@ _ROT = np.array([[1.0, 0.0, 0.0, 1.0, 0.0, 0.0], [0.0, 1.0, -1.0, -1.0, 0.0, 1.0
                  [-1.0, -1.0, 1.0, 0.0, 1.0, 0.0]])
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True)
 def _monomials(a, b, mono, mp, mq, pa, pb, nrows):
     """mono[0..5, m]: u^p v^q and its d/du, d/dv, d2/du2, d2/dudv, d2/dv2 at (a, b), the first nrows rows
     (pa, pb: work (5,))."""
@@ -52,7 +52,7 @@ def _monomials(a, b, mono, mp, mq, pa, pb, nrows):
             mono[5, m] = q * (q - 1) * pa[p] * pb[q - 2] if q >= 2 else 0.0
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True)
 def _apply(mono, coef, nrows, out):
     """out[r, c] = sum_m mono[r, m] coef[c, m] for the first nrows derivative rows."""
     for r in range(nrows):
@@ -65,12 +65,17 @@ def _apply(mono, coef, nrows, out):
         out[r, 0], out[r, 1], out[r, 2] = x0, x1, x2
 
 
-@numba.njit(cache=True, inline="always")
-def _corner_local(g, p, piece_off, a, b, gN, gnl, glay, gmask, layers, masks, coords, out, mono, mp, mq, nrows,
-                  work, ckey, clim, ccoef):
+@numba.njit(cache=True)
+def _corner_local(g, p, a, b, nrows, corner, scratch, out):
     """Local value and derivatives at corner piece p of configuration g (Stam's layers) into out (6, 3);
-    returns the derivatives' scale. The coefficients of (piece, layer, child) are kept in a hashed cache
-    (``ckey`` of size 1: none) for the other points of the call on the same patch."""
+    returns the derivatives' scale. ``corner``: the tables (piece offsets, per configuration N, layer count,
+    layer and mask offsets, layers, masks, control points); ``scratch``: work arrays and the hashed cache
+    of the coefficients of (piece, layer, child) for the other points of the call on the same patch
+    (``ckey`` of size 1: none)."""
+    piece_offs, gN, gnl, glay, gmask, layers, masks, coords = corner
+    mono, work, ckey, clim, ccoef = scratch
+    mp, mq = _MP, _MQ
+    piece_off = piece_offs[p]
     N, nl = gN[g], gnl[g]
     s = a + b
     if s > 0.0:
@@ -131,9 +136,14 @@ def _corner_local(g, p, piece_off, a, b, gN, gnl, glay, gmask, layers, masks, co
 
 
 @numba.njit(cache=True)
-def evaluate_points(face, u, v, nrows, root, kind, rot, ref, children, gid, reg_coef, piece_off, gN, gnl, glay,
-                    gmask, layers, masks, coords, out):
-    """out[r, i, c] for points i: rows 0 (P), 1-2 (Pu, Pv), 3-5 (Puu, Puv, Pvv), the first nrows rows."""
+def evaluate_points(face, u, v, nrows, tables, out):
+    """out[r, i, c] for points i: rows 0 (P), 1-2 (Pu, Pv), 3-5 (Puu, Puv, Pvv), the first nrows rows.
+
+    ``tables``: (root, kind, rot, ref, children, gid, reg_coef) and the corner tables (piece offsets, gN, gnl,
+    glay, gmask, layers, masks, coords), as :meth:`ccproof.evaluate.loop.surface.LoopSurface` builds them.
+    """
+    root, kind, rot, ref, children, gid, reg_coef = tables[:7]
+    corner = tables[7:]
     mp, mq, R = _MP, _MQ, _ROT
     mono = np.empty((6, 15))
     loc = np.empty((6, 3))
@@ -142,6 +152,7 @@ def evaluate_points(face, u, v, nrows, root, kind, rot, ref, children, gid, reg_
     ckey = np.full(slots, -1, dtype=np.int64)
     clim = np.empty((slots, 3))
     ccoef = np.empty((slots, 3, 15))
+    scratch = (mono, work, ckey, clim, ccoef)
     for i in range(face.size):
         node = root[face[i]]
         a, b = u[i], v[i]
@@ -171,8 +182,7 @@ def evaluate_points(face, u, v, nrows, root, kind, rot, ref, children, gid, reg_
             _apply(mono, reg_coef[ref[node]], nrows, loc)
         else:
             p = ref[node]
-            scale = _corner_local(gid[node], p, piece_off[p], a, b, gN, gnl, glay, gmask, layers, masks, coords,
-                                  loc, mono, mp, mq, nrows, work, ckey, clim, ccoef)
+            scale = _corner_local(gid[node], p, a, b, nrows, corner, scratch, loc)
         for c in range(3):
             out[0, i, c] = loc[0, c]
             if nrows > 1:

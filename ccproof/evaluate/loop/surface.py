@@ -287,9 +287,9 @@ class LoopSurface:
         nrows = (1, 3, 6)[derivatives]
         out = np.empty((nrows, face.size, 3))
         k = self._k
-        evaluate_points(face, u, v, nrows, k["root"], k["kind"], k["rot"], k["ref"], k["children"], k["gid"],
-                        k["reg_coef"], k["piece_off"], k["gN"], k["gnl"], k["glay"], k["gmask"], k["layers"],
-                        k["masks"], k["coords"], out)
+        tables = tuple(k[name] for name in ("root", "kind", "rot", "ref", "children", "gid", "reg_coef", "piece_off",
+                                            "gN", "gnl", "glay", "gmask", "layers", "masks", "coords"))
+        evaluate_points(face, u, v, nrows, tables, out)
         return {key: out[r] for r, key in enumerate(_KEYS[derivatives])}
 
     def _turn(self, node, u, v, T):
