@@ -315,3 +315,48 @@ def test_vectorized_regular_nets_equal_the_per_configuration_path():
         p = plan(key)
         assert r == 0 and isinstance(p, Regular)
         assert np.array_equal(p.net @ one.V[ring], one.V[labels[k]])
+
+
+@pytest.mark.parametrize("k", range(3, 13))
+def test_scheme_masks_are_left_eigenvectors(k):
+    """The limit and tangent masks of ccproof.mesh.scheme on the one-ring subdivision matrices written here:
+    Loop (vertex and its k neighbours) and Catmull-Clark (vertex, k edge and k diagonal neighbours)."""
+    from ccproof.mesh.scheme import CATMARK, LOOP
+
+    wV, we = LOOP.vertex_point(k, 1.0)
+    ev, eo = LOOP.edge_point(1.0)
+    S = np.zeros((k + 1, k + 1))
+    S[0, 0], S[0, 1:] = wV, we
+    for j in range(k):
+        S[1 + j, 0] = S[1 + j, 1 + j] = ev
+        S[1 + j, 1 + (j + 1) % k] += eo
+        S[1 + j, 1 + (j - 1) % k] += eo
+    lV, le = LOOP.limit(k, 1.0)
+    lmask = np.r_[lV, [le] * k]
+    assert np.abs(lmask @ S - lmask).max() < 1e-15
+    lam = 3 / 8 + math.cos(2 * math.pi / k) / 4
+    for t in LOOP.tangent_masks(k, 1.0):
+        x = np.r_[0.0, t]
+        assert np.abs(x @ S - lam * x).max() < 1e-14
+    # Catmull-Clark: points V, e_0..e_{k-1}, d_0..d_{k-1} (d_j between e_j and e_{j+1})
+    n = 2 * k + 1
+    face = np.zeros((k, n))
+    for j in range(k):
+        face[j, [0, 1 + j, 1 + k + j, 1 + (j + 1) % k]] = 0.25
+    C = np.zeros((n, n))
+    cV, ce, cf = CATMARK.vertex_point(k, 1.0)
+    C[0, 0] = cV
+    C[0, 1:1 + k] = ce
+    C[0] += cf * face.sum(axis=0)
+    for j in range(k):
+        C[1 + j, 0] = C[1 + j, 1 + j] = 0.25
+        C[1 + j] += 0.25 * (face[j - 1] + face[j])
+        C[1 + k + j] = face[j]
+    wV, we_, wd = CATMARK.limit(k, 1.0)
+    lmask = np.r_[wV, [we_] * k, [wd] * k]
+    assert np.abs(lmask @ C - lmask).max() < 1e-15
+    c = math.cos(2 * math.pi / k)
+    lam_cc = (5 + c + math.cos(math.pi / k) * math.sqrt(18 + 2 * c)) / 16
+    for e, d in CATMARK.tangent_masks(k, 1.0):
+        x = np.r_[0.0, e, d]
+        assert np.abs(x @ C - lam_cc * x).max() < 1e-13 * np.abs(x).max()
