@@ -264,7 +264,10 @@ def _loop_mesh(args, poly):
         f = int(bad[0])
         raise CCProofError(f"{args.mesh}: --scheme loop takes triangles only: face {f} has {int(poly.sizes[f])} "
                            "vertices")
-    return poly, True, poly.n_faces, {}, None
+    evaluable = np.flatnonzero(~poly.is_hole).astype(np.int64) if poly.is_hole.any() else None
+    if evaluable is not None and evaluable.size == 0:
+        raise CCProofError(f"{args.mesh}: every face is a hole: there is no limit surface to evaluate")
+    return poly, True, poly.n_faces, {}, evaluable
 
 
 def _check_in_triangles(path, face, u, v):
@@ -278,14 +281,15 @@ def _check_in_triangles(path, face, u, v):
                            f"{int(face[k])} (--scheme loop: u, v >= 0, u + v <= 1)")
 
 
-def _loop_samples(args, n_faces):
-    """--samples for --scheme loop: uniform triangle, uniform (u, v) in it (u + v <= 1)."""
+def _loop_samples(args, n_faces, evaluable):
+    """--samples for --scheme loop: uniform triangle (outside holes), uniform (u, v) in it (u + v <= 1)."""
     import numpy as np
 
     from ccproof.scale import point_chunks
 
     rng = np.random.default_rng(args.seed)
-    face = rng.integers(0, n_faces, args.samples)
+    face = rng.integers(0, n_faces, args.samples) if evaluable is None else \
+        evaluable[rng.integers(0, evaluable.size, args.samples)]
     u, v = rng.random(args.samples), rng.random(args.samples)
     flip = u + v > 1
     u[flip], v[flip] = 1 - u[flip], 1 - v[flip]
@@ -311,7 +315,7 @@ def _point_sources(args, points, n_faces, evaluable, out_path, shards):
         raise CCProofError(f"--samples must be >= 0, got {args.samples}")
     check_result_size(args.samples, args.derivatives, out_path, shards, f"--samples {args.samples}: ")
     if args.scheme == "loop":
-        return _loop_samples(args, n_faces)
+        return _loop_samples(args, n_faces, evaluable)
     return point_chunks(args.chunk, samples=args.samples, seed=args.seed,
                         n_faces=n_faces if evaluable is None else evaluable)
 

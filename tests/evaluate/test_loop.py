@@ -360,3 +360,29 @@ def test_scheme_masks_are_left_eigenvectors(k):
     for e, d in CATMARK.tangent_masks(k, 1.0):
         x = np.r_[0.0, e, d]
         assert np.abs(x @ C - lam_cc * x).max() < 1e-13 * np.abs(x).max()
+
+
+def test_holes_take_part_in_the_rules_and_have_no_surface():
+    """A tagged hole and boundary interpolation "none": the other faces agree with Far (which builds no
+    patch on holes), points on a hole are refused by name."""
+    _osd_mod, lib = _osd()
+    V, T = icosahedron()
+    G, TG = grid(5)
+    for mesh in (PolyMesh(V, T, holes=[3, 4]), PolyMesh(G, flip_edges(TG, 8, seed=4), options={"boundary": "none"})):
+        S = LoopSurface(mesh)
+        ok = np.flatnonzero(~mesh.is_hole)
+        rng = np.random.default_rng(1)
+        f = ok[rng.integers(0, ok.size, 3000)]
+        u, v = rng.random(f.size), rng.random(f.size)
+        flip = u + v > 1
+        u[flip], v[flip] = 1 - u[flip], 1 - v[flip]
+        far = _osd_mod.Evaluator(lib, "far", mesh, level=6, scheme="loop")
+        exact = far.patch_types(f, u, v) == 5
+        assert exact.sum() > 0.9 * f.size
+        P, Ps, Pt = far.evaluate(f[exact], u[exact], v[exact])
+        R = S.evaluate(f[exact], u[exact], v[exact], 1)
+        for ours, theirs in ((R["P"], P), (R["Pu"], Ps), (R["Pv"], Pt)):
+            assert np.max(np.abs(ours - theirs) / np.maximum(1, np.abs(theirs))) < TOL
+        h = int(np.flatnonzero(mesh.is_hole)[0])
+        with pytest.raises(CCProofError, match=rf"point 1: face {h} is a hole"):
+            S.evaluate([int(ok[0]), h], [0.1, 0.1], [0.1, 0.1])

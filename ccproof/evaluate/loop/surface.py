@@ -46,7 +46,7 @@ _REGULAR, _CORNER, _SPLIT = 0, 1, 2
 
 
 def _triangles(mesh):
-    """The faces of a PolyMesh, checked: triangles, manifold, no holes, tags the evaluator handles."""
+    """The faces of a PolyMesh, checked: triangles, manifold, tags the evaluator handles."""
     from ccproof.mesh.polymesh import PolyMesh
 
     if not isinstance(mesh, PolyMesh):
@@ -58,8 +58,6 @@ def _triangles(mesh):
     if not mesh.is_manifold:
         raise CCProofError("the Loop evaluator takes manifold meshes only (this one has non-manifold edges or "
                            "vertices)")
-    if mesh.is_hole.any():
-        raise CCProofError(f"the Loop evaluator does not take holes (face {int(np.flatnonzero(mesh.is_hole)[0])})")
     semi = [e for e, s in mesh.edge_sharpness.items() if 0 < s < math.inf] + \
         [v for v, s in mesh.vertex_sharpness.items() if 0 < s < math.inf]
     if semi and mesh.options.crease_method != "uniform":
@@ -103,7 +101,9 @@ class LoopSurface:
     Parameters
     ----------
     mesh : PolyMesh
-        Triangles only (another face size is refused, naming the face), manifold, no holes.
+        Triangles only (another face size is refused, naming the face), manifold. Hole faces (tagged, or
+        at the boundary with boundary interpolation "none") take part in the rules but have no surface:
+        points on them are refused.
     backend : {"numba", "numpy"}
         The compiled point loop (:mod:`ccproof.evaluate.loop.kernel`, default) or the vectorized numpy
         path (the same tables and arithmetic).
@@ -138,6 +138,7 @@ class LoopSurface:
             raise CCProofError(f"backend must be 'numba' or 'numpy', got {backend!r}")
         self.backend = backend
         tris = _triangles(mesh)
+        self._holes = np.asarray(mesh.is_hole, dtype=bool) if mesh.is_hole.any() else None
         self.mesh = mesh
         X = np.asarray(mesh.vertices, dtype=np.float64)
         self._kind, self._rot, self._ref, self._children, self._gid = [], [], [], [], []
@@ -320,6 +321,12 @@ class LoopSurface:
         face = face.astype(np.int64)
         m = len(self._root)
         bad = np.flatnonzero((face < 0) | (face >= m) | ~(u >= 0) | ~(v >= 0) | ~(u + v <= 1 + 4e-16))
+        if not bad.size and self._holes is not None:
+            hole = np.flatnonzero(self._holes[face])
+            if hole.size:
+                i = int(hole[0])
+                raise CCProofError(f"point {i}: face {int(face[i])} is a hole (tagged, or at the boundary with "
+                                   "boundary interpolation 'none'): it has no limit surface")
         if bad.size:
             i = int(bad[0])
             raise CCProofError(f"point {i}: face {int(face[i])}, (u, v) = ({float(u[i])!r}, {float(v[i])!r}) is not in "
