@@ -386,3 +386,28 @@ def test_holes_take_part_in_the_rules_and_have_no_surface():
         h = int(np.flatnonzero(mesh.is_hole)[0])
         with pytest.raises(CCProofError, match=rf"point 1: face {h} is a hole"):
             S.evaluate([int(ok[0]), h], [0.1, 0.1], [0.1, 0.1])
+
+
+def test_non_manifold_vertex_and_edge_against_opensubdiv():
+    """Two icosahedra sharing a vertex, and a flap on an interior edge of a grid (three triangles on one edge):
+    OpenSubdiv's values on its regular Loop patches."""
+    _osd_mod, lib = _osd()
+    V, T = icosahedron()
+    twin = [[0 if x == 0 else x + 11 for x in t] for t in T]
+    G, TG = grid(4)
+    meshes = [PolyMesh(np.vstack([V, V[1:] + [3.0, 0, 0]]), T + twin),
+              PolyMesh(np.vstack([G, [[2.5, 2.0, 1.0]]]), [list(t) for t in TG] + [[12, 13, len(G)]])]
+    for mesh in meshes:
+        assert not mesh.is_manifold
+        rng = np.random.default_rng(2)
+        f = rng.integers(0, mesh.n_faces, 3000)
+        u, v = rng.random(f.size), rng.random(f.size)
+        flip = u + v > 1
+        u[flip], v[flip] = 1 - u[flip], 1 - v[flip]
+        far = _osd_mod.Evaluator(lib, "far", mesh, level=6, scheme="loop")
+        exact = far.patch_types(f, u, v) == 5
+        assert exact.sum() > 0.9 * f.size
+        P, Ps, Pt = far.evaluate(f[exact], u[exact], v[exact])
+        R = LoopSurface(mesh).evaluate(f[exact], u[exact], v[exact], 1)
+        for ours, theirs in ((R["P"], P), (R["Pu"], Ps), (R["Pv"], Pt)):
+            assert np.max(np.abs(ours - theirs) / np.maximum(1, np.abs(theirs))) < TOL

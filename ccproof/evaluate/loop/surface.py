@@ -46,7 +46,7 @@ _REGULAR, _CORNER, _SPLIT = 0, 1, 2
 
 
 def _triangles(mesh):
-    """The faces of a PolyMesh, checked: triangles, manifold, tags the evaluator handles."""
+    """The faces of a PolyMesh, checked: triangles, tags the evaluator handles."""
     from ccproof.mesh.polymesh import PolyMesh
 
     if not isinstance(mesh, PolyMesh):
@@ -55,9 +55,6 @@ def _triangles(mesh):
     if bad.size:
         f = int(bad[0])
         raise CCProofError(f"the Loop scheme takes triangles only: face {f} has {int(mesh.sizes[f])} vertices")
-    if not mesh.is_manifold:
-        raise CCProofError("the Loop evaluator takes manifold meshes only (this one has non-manifold edges or "
-                           "vertices)")
     semi = [e for e, s in mesh.edge_sharpness.items() if 0 < s < math.inf] + \
         [v for v, s in mesh.vertex_sharpness.items() if 0 < s < math.inf]
     if semi and mesh.options.crease_method != "uniform":
@@ -101,7 +98,8 @@ class LoopSurface:
     Parameters
     ----------
     mesh : PolyMesh
-        Triangles only (another face size is refused, naming the face), manifold. Hole faces (tagged, or
+        Triangles only (another face size is refused, naming the face); non-manifold edges and vertices
+        as OpenSubdiv takes them (:attr:`PolyMesh.manifold`). Hole faces (tagged, or
         at the boundary with boundary interpolation "none") take part in the rules but have no surface:
         points on them are refused.
     backend : {"numba", "numpy"}
@@ -137,9 +135,13 @@ class LoopSurface:
         if backend not in ("numba", "numpy"):
             raise CCProofError(f"backend must be 'numba' or 'numpy', got {backend!r}")
         self.backend = backend
-        tris = _triangles(mesh)
-        self._holes = np.asarray(mesh.is_hole, dtype=bool) if mesh.is_hole.any() else None
+        _triangles(mesh)
         self.mesh = mesh
+        # non-manifold edges and vertices as OpenSubdiv takes them: PolyMesh's split (the same faces, the
+        # non-manifold vertices copied per fan and tagged infinitely sharp)
+        mesh = mesh.manifold
+        tris = mesh.polygons
+        self._holes = np.asarray(mesh.is_hole, dtype=bool) if mesh.is_hole.any() else None
         X = np.asarray(mesh.vertices, dtype=np.float64)
         self._kind, self._rot, self._ref, self._children, self._gid = [], [], [], [], []
         self._nets, self._groups = [], {}
