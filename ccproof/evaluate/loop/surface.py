@@ -257,6 +257,10 @@ class LoopSurface:
         face, u, v = self._checked(face, u, v, derivatives)
         if self.backend == "numba":
             return self._evaluate_compiled(face, u, v, derivatives)
+        return self._evaluate_numpy(face, u, v, derivatives)
+
+    def _evaluate_numpy(self, face, u, v, derivatives):
+        """The vectorized path: descent through the splits, then one product per patch kind."""
         n = face.size
         node = self._root[face]
         T = np.broadcast_to(np.eye(2), (n, 2, 2)).copy()
