@@ -86,8 +86,12 @@ class Level:
             return self._mask_point(v, kind, ns)
         tags = [self.corners.get(v, 0.0)] + [self.s(v, w) for w in self.nbrs[v]]
         gone = [x for x in tags if 0 < x <= 1]
-        w = min(sum(gone) / len(gone), 1.0) if gone else 0.0
-        return w * self._mask_point(v, kind, ns) + (1 - w) * self._mask_point(v, ckind, cns)
+        # OpenSubdiv computes this weight and 1 - w in float32
+        total = np.float32(0)
+        for x in sorted(gone):
+            total = np.float32(total + np.float32(x))
+        w = min(float(np.float32(total / np.float32(len(gone)))), 1.0) if gone else 0.0
+        return w * self._mask_point(v, kind, ns) + float(np.float32(1 - w)) * self._mask_point(v, ckind, cns)
 
     def subdivide(self):
         V, n = self.V, len(self.V)
@@ -104,7 +108,7 @@ class Level:
                         pts.append(mid)
                         continue
                     smooth = 0.375 * (V[x] + V[y]) + 0.125 * (V[self.opp[(x, y)]] + V[self.opp[(y, x)]])
-                    pts.append(sh * mid + (1 - sh) * smooth)
+                    pts.append(sh * mid + float(np.float32(1 - sh)) * smooth)
         F = []
         for a, b, c in self.F:
             ab, bc, ca = emap[(min(a, b), max(a, b))], emap[(min(b, c), max(b, c))], emap[(min(c, a), max(c, a))]

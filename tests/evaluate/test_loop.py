@@ -411,3 +411,49 @@ def test_non_manifold_vertex_and_edge_against_opensubdiv():
         R = LoopSurface(mesh).evaluate(f[exact], u[exact], v[exact], 1)
         for ours, theirs in ((R["P"], P), (R["Pu"], Ps), (R["Pv"], Pt)):
             assert np.max(np.abs(ours - theirs) / np.maximum(1, np.abs(theirs))) < TOL
+
+
+def test_random_tags_against_opensubdiv():
+    """Random semi-sharp and infinitely sharp creases, corners and holes on a flipped icosphere: OpenSubdiv's
+    values (whose fractional weights are float32: so are ours) on its regular Loop patches. The sharpness
+    values have few bits, so that OpenSubdiv's float32 sums of three or more tags changing rule at one
+    vertex do not depend on its order of the edges (which ours does not follow: docs/evaluate.md)."""
+    _osd_mod, lib = _osd()
+    V, T = icosahedron(seed=3)
+    one = Level(V, T).subdivide()
+    F = flip_edges(one.F, 25, seed=1)
+    rng = np.random.default_rng(1)
+    E = sorted({(min(a, b), max(a, b)) for f in F for a, b in zip(f, f[1:] + f[:1])})
+    creases = {E[i]: float(rng.choice([0.25, 1.0, 1.5, 2.75, math.inf])) for i in rng.choice(len(E), 25, replace=False)}
+    corners = {int(x): float(rng.choice([0.625, 2.25, math.inf])) for x in rng.choice(len(one.V), 3, replace=False)}
+    mesh = PolyMesh(one.V, F, creases=creases, corners=corners, holes=[5, 17])
+    ok = np.flatnonzero(~mesh.is_hole)
+    f = ok[rng.integers(0, ok.size, 4000)]
+    u, v = rng.random(f.size), rng.random(f.size)
+    flip = u + v > 1
+    u[flip], v[flip] = 1 - u[flip], 1 - v[flip]
+    _agree_with_far(_osd_mod, lib, mesh, f, u, v)
+
+
+def test_float32_fractional_weights_as_opensubdiv():
+    """Two tags of sharpness 0.3 and 1.0 becoming smooth at one vertex (weight (0.3 + 1) / 2 and 1 - 0.3 in
+    float32, as OpenSubdiv): its values to 1e-12 (in double the difference is about 1e-9)."""
+    _osd_mod, lib = _osd()
+    V, T = icosahedron()
+    mesh = PolyMesh(V, T, creases={(0, 1): 0.3, (0, 5): 1.0, (1, 9): 0.3})
+    rng = np.random.default_rng(4)
+    f = rng.integers(0, 20, 4000)
+    u, v = rng.random(f.size), rng.random(f.size)
+    flip = u + v > 1
+    u[flip], v[flip] = 1 - u[flip], 1 - v[flip]
+    _agree_with_far(_osd_mod, lib, mesh, f, u, v)
+
+
+def _agree_with_far(osd_module, lib, mesh, f, u, v):
+    far = osd_module.Evaluator(lib, "far", mesh, level=8, scheme="loop")
+    exact = far.patch_types(f, u, v) == 5
+    assert exact.sum() > 0.9 * f.size
+    P, Ps, Pt = far.evaluate(f[exact], u[exact], v[exact])
+    R = LoopSurface(mesh).evaluate(f[exact], u[exact], v[exact], 1)
+    for ours, theirs in ((R["P"], P), (R["Pu"], Ps), (R["Pv"], Pt)):
+        assert np.max(np.abs(ours - theirs) / np.maximum(1, np.abs(theirs))) < TOL

@@ -12,6 +12,7 @@ triangle sharing a vertex with it) in a deterministic order whose key identifies
 from __future__ import annotations
 
 import math
+import struct
 
 from ccproof.errors import MeshError
 from ccproof.evaluate.loop.box_spline import DIRS, NET
@@ -150,7 +151,8 @@ def vertex_stencil(cx, v, one):
 
     Semi-sharp tags (Sdc, uniform creasing): the rule of the parent (its sharp edges and its corner tag) and
     of the child (sharpness less 1); where they differ, ``w P + (1 - w) C`` with ``w`` the mean parent
-    sharpness of the tags that become smooth (at most 1).
+    sharpness of the tags that become smooth (at most 1), ``w`` and ``1 - w`` rounded to float32 as Sdc
+    computes them.
     """
     rule, fan = cx.rule(v)
     if rule == SMOOTH:
@@ -166,13 +168,21 @@ def vertex_stencil(cx, v, one):
     if crule == rule:
         return pmask
     trans = ([vs] if vs > 0 and cvs <= 0 else []) + [x for x, c in zip(es, ces) if x > 0 and c <= 0]
-    w = min(sum(trans) / len(trans), 1.0) if trans else 0.0
+    w = 0.0
+    for x in sorted(trans):  # in float32, as Sdc's Crease::ComputeFractionalWeightAtVertex (its order: its edges')
+        w = _f32(w + x)
+    w = min(_f32(w / len(trans)), 1.0) if trans else 0.0
     cmask = _rule_mask(cx, v, crule, fan, [u for u, x in zip(fan, ces) if x > 0], one)
     out = {}
-    for m, f in ((pmask, one * w), (cmask, one * (1 - w))):
+    for m, f in ((pmask, one * w), (cmask, one * _f32(1 - w))):
         for x, y in m.items():
             out[x] = out.get(x, 0) + f * y
     return out
+
+
+def _f32(x):
+    """``x`` rounded to float32 (OpenSubdiv computes the fractional weights of semi-sharp rules in float)."""
+    return struct.unpack("f", struct.pack("f", x))[0]
 
 
 def _decay(x):
@@ -225,9 +235,9 @@ def _edge_stencil(cx, a, b, one):
     s = {a: we, b: we}
     for y in (cx.opp[(a, b)], cx.opp[(b, a)]):
         s[y] = s.get(y, 0) + wo
-    if x > 0:
-        f = one * x
-        s = {k: (1 - f) * y for k, y in s.items()}
+    if x > 0:  # weights x and 1 - x, the latter in float32 as Sdc
+        f, g = one * x, one * _f32(1 - x)
+        s = {k: g * y for k, y in s.items()}
         s[a] += f * w
         s[b] += f * w
     return s
