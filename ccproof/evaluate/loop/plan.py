@@ -14,8 +14,9 @@ to one of
   this ring), each planned in turn.
 
 The weights of Loop's rules lie in Q(cos(2 pi / k)); they are computed as balls (``flint.arb``) of
-:data:`PRECISION` bits, and every stored float is the ball's midpoint, the radius checked below
-2^-200 (the rounding to float64 is the only error that matters).
+:data:`PRECISION` bits, and every stored float is the ball's midpoint (correctly rounded), the radius
+checked below 2^-120 times max(1, |value|): the deviations kept reach down to 2^-60, so each keeps a
+relative accuracy of 2^-60 before its rounding to float64, the only error that matters.
 """
 
 from __future__ import annotations
@@ -31,7 +32,7 @@ from ccproof.evaluate.loop.complex import SMOOTH, canonical_ring, key_complex, l
 __all__ = ["Regular", "Corner", "Split", "plan", "oriented_ring", "PRECISION", "MAX_DEPTH", "LAYER_TOLERANCE"]
 
 #: bits of the balls in which the exact data are computed
-PRECISION = 320
+PRECISION = 192
 #: smallest deviation kept in a layer table (beyond it the layer equals the limit point in float64)
 LAYER_TOLERANCE = 2.0**-60
 #: most local subdivisions of one configuration before its children are regular or self-similar
@@ -74,7 +75,7 @@ def _precision():
 def _to_float(x):
     if isinstance(x, (int, float)):
         return float(x)
-    if float(x.rad()) > 2.0**-200 * max(1.0, abs(float(x.mid()))):
+    if float(x.rad()) > 2.0**-120 * max(1.0, abs(float(x.mid()))):
         raise MeshError(f"internal: a weight lost its precision ({x})")  # pragma: no cover
     return float(x.mid())
 
@@ -231,9 +232,12 @@ def _power_layers(M, A, l_row):
     L = flint.arb_mat(rows, N, [l_row[0, j] for _ in range(rows) for j in range(N)])
     R, layers = M, []
     for _ in range(_MAX_LAYERS):
-        D = np.array([_to_float(x) for x in (R - L).entries()]).reshape(3, 12, N)
+        E = (R - L).entries()
+        D = np.array([float(x) for x in E]).reshape(3, 12, N)  # the midpoints, correctly rounded
         layers.append(D)
         if np.abs(D).max() < LAYER_TOLERANCE:
+            for x in E:  # the radii grow with n: checked on the last layer
+                _to_float(x)
             return np.array(layers)
         R = R * A
     raise MeshError(f"corner configuration of {N} vertices does not converge to its limit point")
