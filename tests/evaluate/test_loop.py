@@ -457,3 +457,23 @@ def _agree_with_far(osd_module, lib, mesh, f, u, v):
     R = LoopSurface(mesh).evaluate(f[exact], u[exact], v[exact], 1)
     for ours, theirs in ((R["P"], P), (R["Pu"], Ps), (R["Pv"], Pt)):
         assert np.max(np.abs(ours - theirs) / np.maximum(1, np.abs(theirs))) < TOL
+
+
+@pytest.mark.parametrize("case", ["triangle", "triangle_corners", "tetrahedron", "tetrahedron_crease"])
+def test_tiny_meshes_against_opensubdiv(case):
+    """Rings that overlap themselves (every vertex of a tetrahedron is in every triangle's ring) and a lone
+    triangle (three boundary vertices of one triangle: creases, or corners with edge_and_corner)."""
+    _osd_mod, lib = _osd()
+    T4 = np.array([[1, 1, 1], [1, -1, -1], [-1, 1, -1], [-1, -1, 1]], float)
+    F4 = [[0, 1, 2], [0, 2, 3], [0, 3, 1], [1, 3, 2]]
+    one = [[0, 0, 0], [1, 0, 0], [0, 1, 0.3]]
+    mesh = {"triangle": lambda: PolyMesh(one, [[0, 1, 2]]),
+            "triangle_corners": lambda: PolyMesh(one, [[0, 1, 2]], options={"boundary": "edge_and_corner"}),
+            "tetrahedron": lambda: PolyMesh(T4, F4),
+            "tetrahedron_crease": lambda: PolyMesh(T4, F4, creases={(0, 1): math.inf, (1, 2): 1.5})}[case]()
+    rng = np.random.default_rng(6)
+    f = rng.integers(0, mesh.n_faces, 3000)
+    u, v = rng.random(f.size), rng.random(f.size)
+    flip = u + v > 1
+    u[flip], v[flip] = 1 - u[flip], 1 - v[flip]
+    _agree_with_far(_osd_mod, lib, mesh, f, u, v)
