@@ -247,10 +247,11 @@ class Scheme:
         return _blend(smooth, sharp, s)
 
     def child_sharpness(self, s):
-        """Sharpness of the children of an edge or vertex of sharpness ``s`` (Sdc's uniform decay).
+        """Sharpness of the children of an edge or vertex of sharpness ``s`` (Sdc's uniform decay; infinite
+        stays infinite).
 
-        >>> LOOP.child_sharpness(2.5), LOOP.child_sharpness(0.5)
-        (1.5, 0)
+        >>> LOOP.child_sharpness(2.5), LOOP.child_sharpness(0.5), LOOP.child_sharpness(float("inf"))
+        (1.5, 0, inf)
         """
         return _uniform_decay(s)
 

@@ -159,8 +159,8 @@ def vertex_stencil(cx, v, one):
         return _rule_mask(cx, v, SMOOTH, fan, (), one)
     vs = cx.corners.get(v, 0.0)
     es = [cx.sharpness(v, w) for w in fan]
-    cvs = _decay(vs)
-    ces = [_decay(x) for x in es]
+    cvs = LOOP.child_sharpness(vs)
+    ces = [LOOP.child_sharpness(x) for x in es]
     bcorner = rule == CORNER and classify(vs, es) != CORNER  # edge_and_corner's boundary corner: it stays
     crule = classify(cvs, ces, bcorner)
     sharp_now = [w for w, x in zip(fan, es) if x > 0]
@@ -183,11 +183,6 @@ def vertex_stencil(cx, v, one):
 def _f32(x):
     """``x`` rounded to float32 (OpenSubdiv computes the fractional weights of semi-sharp rules in float)."""
     return struct.unpack("f", struct.pack("f", x))[0]
-
-
-def _decay(x):
-    """Sdc's uniform creasing: sharpness one level down (infinite stays infinite)."""
-    return x if x == math.inf else max(x - 1.0, 0.0)
 
 
 def _rule_mask(cx, v, rule, fan, sharp, one):
@@ -275,12 +270,12 @@ def loop_step(cx, one):
         full = (a, b) in cx.opp and (b, a) in cx.opp
         if full or cx.is_complete(a) or cx.is_complete(b):
             stencils[e] = _edge_stencil(cx, a, b, one)
-        x = _decay(cx.sharp.get((a, b), 0.0))
+        x = LOOP.child_sharpness(cx.sharp.get((a, b), 0.0))
         if x > 0:
             sharp[(a, e)] = sharp[(e, b)] = x
     complete = None if cx.complete is None else \
         {v for v in cx.complete} | {e for (a, b), e in edge_label.items() if stencils[e] is not None}
-    corners = {v: _decay(x) for v, x in cx.corners.items()}
+    corners = {v: LOOP.child_sharpness(x) for v, x in cx.corners.items()}
     child = TriComplex(tris, sharp, corners, complete, cx.boundary)
     return child, stencils
 
