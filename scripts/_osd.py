@@ -63,6 +63,8 @@ def load():
     for name in ("far_eval", "bfr_eval"):
         getattr(lib, name).argtypes = _EVAL_ARGS
         getattr(lib, name).restype = ctypes.c_int64
+    lib.far_patch_types.argtypes = _EVAL_ARGS[:5] + [ctypes.POINTER(ctypes.c_int32)]
+    lib.far_patch_types.restype = None
     for name in ("far_free", "bfr_free"):
         getattr(lib, name).argtypes = [ctypes.c_void_p]
         getattr(lib, name).restype = None
@@ -97,9 +99,13 @@ def _ptr(a, typ):
     return a.ctypes.data_as(ctypes.POINTER(typ))
 
 
-def mesh_arrays(mesh):
-    """The C API's mesh arguments of a :class:`ccproof.mesh.PolyMesh` (kept alive by the caller)."""
-    flags = int(mesh.options.crease_method == "chaikin") | 2 * int(mesh.options.triangle_subdivision == "smooth")
+def mesh_arrays(mesh, scheme="catmark"):
+    """The C API's mesh arguments of a :class:`ccproof.mesh.PolyMesh` (kept alive by the caller); ``scheme``:
+    "catmark" or "loop" (OpenSubdiv's Sdc::SCHEME_LOOP; triangles)."""
+    if scheme not in ("catmark", "loop"):
+        raise ValueError(f"scheme must be 'catmark' or 'loop', got {scheme!r}")
+    flags = int(mesh.options.crease_method == "chaikin") | 2 * int(mesh.options.triangle_subdivision == "smooth") \
+        | 4 * int(scheme == "loop")
     bmode = {"none": 0, "edge_only": 1, "edge_and_corner": 2}[mesh.options.boundary]
     cre = list(mesh.edge_sharpness.items())
     cor = list(mesh.vertex_sharpness.items())
@@ -121,9 +127,10 @@ class Evaluator:
     EvaluateBasis; "bfr": Bfr::RefinerSurfaceFactory, one prepared Surface per face, approximation levels
     ``approx`` (0: Bfr's defaults, smooth 2 and sharp 6)) of one mesh."""
 
-    def __init__(self, lib, kind, mesh, level=10, approx=0):
+    def __init__(self, lib, kind, mesh, level=10, approx=0, scheme="catmark"):
         self.lib, self.kind = lib, kind
-        a = self._arrays = mesh if isinstance(mesh, dict) else mesh_arrays(mesh)  # a dict: mesh_arrays' result
+        a = self._arrays = mesh if isinstance(mesh, dict) else mesh_arrays(mesh, scheme)  # a dict: mesh_arrays'
+
         args = [a["nv"], _ptr(a["X"], ctypes.c_double), a["nf"], _ptr(a["sizes"], ctypes.c_int),
                 _ptr(a["idx"], ctypes.c_int), a["cw"].size, _ptr(a["cre"], ctypes.c_int),
                 _ptr(a["cw"], ctypes.c_float), a["cor"].size, _ptr(a["cor"], ctypes.c_int),
@@ -150,6 +157,19 @@ class Evaluator:
             out = tuple(np.empty((n, 3)) for _ in range(3))
         self.missing = self._eval(self.h, n, _ptr(f, ctypes.c_int32), _ptr(s, ctypes.c_double),
                                   _ptr(t, ctypes.c_double), *(_ptr(o, ctypes.c_double) for o in out))
+        return out
+
+    def patch_types(self, f, s, t):
+        """Far's ``PatchDescriptor::Type`` of the patch holding each point (int32 (n,), -1: none): 5 LOOP and
+        6 REGULAR are exact, 9 GREGORY_BASIS and 10 GREGORY_TRIANGLE end caps ("far" only)."""
+        if self.kind != "far":
+            raise ValueError("patch types are Far's")
+        f = np.ascontiguousarray(f, dtype=np.int32)
+        s = np.ascontiguousarray(s, dtype=np.float64)
+        t = np.ascontiguousarray(t, dtype=np.float64)
+        out = np.empty(f.size, dtype=np.int32)
+        self.lib.far_patch_types(self.h, f.size, _ptr(f, ctypes.c_int32), _ptr(s, ctypes.c_double),
+                                 _ptr(t, ctypes.c_double), _ptr(out, ctypes.c_int32))
         return out
 
     def close(self):

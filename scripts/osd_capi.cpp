@@ -5,14 +5,17 @@
 // Mesh input (every array owned by the caller, read during create only):
 //   nv, X (nv x 3 doubles), nf, sizes (nf), idx (sum of sizes), creases (nc pairs, float weights),
 //   corners (nk vertices, float weights), holes (nh faces), boundary (Sdc VtxBoundaryInterpolation),
-//   flags (1: Chaikin creasing, 2: smooth triangle subdivision).
-// Points: ptex face, (s, t) in [0, 1]^2 (Far::PtexIndices order, as ccproof's `face`).
+//   flags (1: Chaikin creasing, 2: smooth triangle subdivision, 4: Loop scheme instead of Catmull-Clark).
+// Points: ptex face, (s, t) in [0, 1]^2 (Far::PtexIndices order, as ccproof's `face`); Loop: the triangle,
+//   (s, t) with s + t <= 1.
 // Output: P, Ps, Pt (n x 3 doubles each), derivatives with respect to the ptex face's (s, t).
 //
 //   far_create(...)  adaptive refinement to `level`, PatchTable with Gregory end caps (double), PatchMap
 //   bfr_create(..., approx)  Bfr::RefinerSurfaceFactory (approx > 0: approximation levels smooth = sharp =
 //                    approx; else Bfr's defaults); one prepared Surface per base face (built at create)
 //   *_eval(h, n, face, s, t, P, Ps, Pt)   one thread, in order; returns the number of points not found
+//   far_patch_types(h, n, face, s, t, types)  Far::PatchDescriptor::Type of the patch holding each point
+//                    (-1: none): 5 LOOP and 6 REGULAR are exact, 9 GREGORY_BASIS and 10 GREGORY_TRIANGLE end caps
 //   *_free(h)
 #include <opensubdiv/bfr/refinerSurfaceFactory.h>
 #include <opensubdiv/bfr/surface.h>
@@ -60,7 +63,7 @@ Far::TopologyRefiner *make_refiner(int nv, int nf, const int *sizes, const int *
     d.numHoles = nh;
     d.holeIndices = holes;
     typedef Far::TopologyRefinerFactory<Far::TopologyDescriptor> Factory;
-    return Factory::Create(d, Factory::Options(Sdc::SCHEME_CATMARK, so));
+    return Factory::Create(d, Factory::Options(flags & 4 ? Sdc::SCHEME_LOOP : Sdc::SCHEME_CATMARK, so));
 }
 
 struct FarHandle {
@@ -150,6 +153,14 @@ int64_t far_eval(void *hv, int64_t n, const int32_t *pf, const double *ps, const
         }
     }
     return missing;
+}
+
+void far_patch_types(void *hv, int64_t n, const int32_t *pf, const double *ps, const double *pt, int32_t *types) {
+    FarHandle *h = (FarHandle *)hv;
+    for (int64_t i = 0; i < n; ++i) {
+        Far::PatchTable::PatchHandle const *ph = h->pmap->FindPatch(pf[i], ps[i], pt[i]);
+        types[i] = ph ? (int32_t)h->tab->GetPatchDescriptor(*ph).GetType() : -1;
+    }
 }
 
 void far_free(void *h) { delete (FarHandle *)h; }

@@ -32,6 +32,7 @@ SMOKE = {
     "bench_first_move.py": ["--smoke"],
     "bench_fit_tagged.py": ["--smoke"],
     "bench_inverse.py": ["--smoke"],
+    "bench_loop.py": ["--smoke"],
     "bench_kernel_ab.py": ["--smoke"],
     "bench_memory.py": ["--smoke"],
     "bench_ngon.py": ["--smoke"],

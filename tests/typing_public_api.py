@@ -15,6 +15,7 @@ import ccproof
 from ccproof.apps.arap.core import MethodResult
 from ccproof.apps.dynamics.fit import FitResult
 from ccproof.evaluate import PatchTable
+from ccproof.evaluate.loop import LoopSurface
 from ccproof.evaluate.surface import LimitSurface
 from ccproof.reparam.surface import Parameterization
 from ccproof.tables.numeric import CharacteristicTable
@@ -37,6 +38,7 @@ def _public_api_types(quad: ccproof.QuadMesh, poly: ccproof.PolyMesh) -> None:
     assert_type(ccproof.limit_surface(quad), LimitSurface)
     assert_type(ccproof.limit_surface("mesh.obj", alpha=2.5), LimitSurface)
     assert_type(ccproof.limit_surface(poly), LimitSurface)
+    assert_type(ccproof.limit_surface(poly, scheme="loop"), LoopSurface)
     assert_type(ccproof.parameterize(quad, variant="boundary"), MethodResult)
     assert_type(ccproof.fit_points(np.zeros((10, 3)), levels=0), FitResult)
     assert_type(ccproof.limit_surface(quad), ccproof.LimitSurface)

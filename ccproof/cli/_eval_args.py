@@ -34,6 +34,10 @@ def add_arguments(parser):
     parser.add_argument("--out", metavar="FILE.npz", required=True,
                         help="output file (numpy .npz), or FOLDER/ for one .npz shard per --chunk points")
     parser.add_argument("--seed", type=int, default=0, help="random seed for --samples (default 0)")
+    parser.add_argument("--scheme", choices=("catmark", "loop"), default="catmark",
+                        help="subdivision scheme: catmark (Catmull-Clark, default) or loop (Loop's scheme with "
+                        "OpenSubdiv's Sdc rules, exact; triangle meshes only, face = triangle index, corner 0 at "
+                        "(u, v) = (0, 0), 1 at (1, 0), 2 at (0, 1), u + v <= 1; natural parameterization only)")
     parser.add_argument(
         "--plot", metavar="FILE.png", help="draw isoparameter lines of the faces around an extraordinary vertex"
     )

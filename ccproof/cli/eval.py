@@ -1,5 +1,5 @@
-"""Evaluate the Catmull-Clark limit surface of a mesh (OBJ with OpenSubdiv tags, OFF, PLY, STL,
-VTK or any other format meshio reads; non-manifold edges and vertices and unused vertices as
+"""Evaluate the Catmull-Clark (or, with --scheme loop, the Loop) limit surface of a mesh (OBJ with OpenSubdiv
+tags, OFF, PLY, STL, VTK or any other format meshio reads; non-manifold edges and vertices and unused vertices as
 OpenSubdiv takes them) in one of the parameterizations of bmz04 (triangles, n-gons, tagged and
 non-manifold meshes: natural only, ``face`` being the ptex face index): natural (Stam, section 2),
 vanishing (F^alpha blend, section 4.2: derivatives tend to 0 at extraordinary vertices) or
@@ -20,10 +20,15 @@ pipe, read once); one .npz result must fit this machine's memory (96 bytes per p
 2), shards (--out FOLDER/) the free disk; --scheduler local:N at most the cores and the chunks; outputs may
 not replace an input.
 
+With --scheme loop: the exact Loop limit surface of a triangle mesh (OpenSubdiv's Sdc Loop rules: boundaries,
+infinitely sharp creases and corners), ``face`` the triangle index, corner 0 of the triangle at (u, v) = (0, 0),
+1 at (1, 0), 2 at (0, 1), u + v <= 1 (--samples draws uniformly in the triangles).
+
 Examples:
   ccproof eval bunny.obj --samples 1000000 --out bunny.npz --plot ev.png
   ccproof eval mesh.obj --points points.csv --parameterization characteristic --derivatives 1 --out out.npz
   ccproof eval mesh.obj --samples 1000 --parameterization vanishing --alpha 2.5 --out out.npz
+  ccproof eval triangles.obj --scheme loop --samples 100000 --derivatives 2 --out loop.npz
 """
 
 from __future__ import annotations
@@ -75,11 +80,15 @@ def _phases(read, setup, worker_setup):
     return text + (" (in each worker, the longest)" if worker_setup > setup else "")
 
 
-def build_surface(mesh, tagged, alpha=None, progress=False):
+def build_surface(mesh, tagged, alpha=None, progress=False, scheme="catmark"):
     """The surface ``ccproof eval`` evaluates (module level, so a Dask worker can rebuild it by name):
     the tagged evaluator's natural parameterization for a tagged or non-quad :class:`PolyMesh`, else the
-    reparameterizable surface of an all-quad :class:`QuadMesh`. ``progress``: a bar for the setup, where the
-    constructor draws one (never on a worker)."""
+    reparameterizable surface of an all-quad :class:`QuadMesh`; with ``scheme="loop"`` the Loop surface of a
+    triangle mesh. ``progress``: a bar for the setup, where the constructor draws one (never on a worker)."""
+    if scheme != "catmark":
+        from ccproof.reparam.surface import limit_surface
+
+        return limit_surface(mesh, scheme=scheme)
     if tagged:
         from ccproof.evaluate import limit_surface as natural_surface
 
@@ -181,7 +190,8 @@ def run(args) -> int:
             f"{mesh.extraordinary_vertices.size} extraordinary vertices")
     print(f"{args.mesh}: {what}; {_phases(t_read, setup, worker_setup)}")
     evaluation = max(sweep.seconds - worker_setup, 0.0)  # the workers build at the same time, first
-    print(f"evaluated {n} points ({args.parameterization} parameterization, derivatives {args.derivatives}) "
+    scheme = "" if args.scheme == "catmark" else f"{args.scheme} scheme, "
+    print(f"evaluated {n} points ({scheme}{args.parameterization} parameterization, derivatives {args.derivatives}) "
           f"in {_evaluation_phases(n, evaluation, t_start, t_write)}")
     print(f"wrote {args.out}: {', '.join(['face', 'u', 'v', *out])}")
     if args.plot:
@@ -216,6 +226,8 @@ def _check_outputs_and_options(args):
 
 def _mesh_to_evaluate(args, poly):
     """(mesh, tagged, number of faces, evaluate's keywords, evaluable ptex faces or None) of the mesh read."""
+    if args.scheme == "loop":
+        return _loop_mesh(args, poly)
     tagged = not poly.is_plain_quads
     if tagged:
         # triangles, n-gons, creases, corners, holes, boundary modes: the natural parameterization
@@ -238,6 +250,52 @@ def _mesh_to_evaluate(args, poly):
     return mesh, tagged, mesh.n_faces, {"parameterization": args.parameterization}, None
 
 
+def _loop_mesh(args, poly):
+    """--scheme loop: the triangle mesh (checked before any work), its faces, no keywords."""
+    import numpy as np
+
+    if args.parameterization != "natural":
+        raise CCProofError(f"--parameterization {args.parameterization} is Catmull-Clark's (bmz04); --scheme loop "
+                           "has the natural parameterization only")
+    if args.plot:
+        raise CCProofError("--plot draws Catmull-Clark isoparameter lines; it does not apply to --scheme loop")
+    bad = np.flatnonzero(poly.sizes != 3)
+    if bad.size:
+        f = int(bad[0])
+        raise CCProofError(f"{args.mesh}: --scheme loop takes triangles only: face {f} has {int(poly.sizes[f])} "
+                           "vertices")
+    evaluable = np.flatnonzero(~poly.is_hole).astype(np.int64) if poly.is_hole.any() else None
+    if evaluable is not None and evaluable.size == 0:
+        raise CCProofError(f"{args.mesh}: every face is a hole: there is no limit surface to evaluate")
+    return poly, True, poly.n_faces, {}, evaluable
+
+
+def _check_in_triangles(path, face, u, v):
+    """--scheme loop: every point of a CSV file in its triangle (u + v <= 1), else the line named."""
+    import numpy as np
+
+    i = np.flatnonzero(~(u + v <= 1))
+    if i.size:
+        k = int(i[0])
+        raise CCProofError(f"{path}:{k + 2}: point {k}: u + v = {float(u[k] + v[k])!r} > 1 is outside triangle "
+                           f"{int(face[k])} (--scheme loop: u, v >= 0, u + v <= 1)")
+
+
+def _loop_samples(args, n_faces, evaluable):
+    """--samples for --scheme loop: uniform triangle (outside holes), uniform (u, v) in it (u + v <= 1)."""
+    import numpy as np
+
+    from ccproof.scale import point_chunks
+
+    rng = np.random.default_rng(args.seed)
+    face = rng.integers(0, n_faces, args.samples) if evaluable is None else \
+        evaluable[rng.integers(0, evaluable.size, args.samples)]
+    u, v = rng.random(args.samples), rng.random(args.samples)
+    flip = u + v > 1
+    u[flip], v[flip] = 1 - u[flip], 1 - v[flip]
+    return point_chunks(args.chunk, arrays=(face, u, v))
+
+
 def _point_sources(args, points, n_faces, evaluable, out_path, shards):
     """The chunks of points to evaluate (--points FILE or FOLDER, or --samples), checked before the setup."""
     from ccproof.scale import point_chunks
@@ -249,11 +307,15 @@ def _point_sources(args, points, n_faces, evaluable, out_path, shards):
         return point_chunks(args.chunk, shards=points)
     if points is not None:
         arrays = _checked_points(args.points, n_faces, evaluable)
+        if args.scheme == "loop":
+            _check_in_triangles(args.points, *arrays)
         check_result_size(arrays[0].size, args.derivatives, out_path, shards, f"{args.points}: ")
         return point_chunks(args.chunk, arrays=arrays)
     if args.samples < 0:
         raise CCProofError(f"--samples must be >= 0, got {args.samples}")
     check_result_size(args.samples, args.derivatives, out_path, shards, f"--samples {args.samples}: ")
+    if args.scheme == "loop":
+        return _loop_samples(args, n_faces, evaluable)
     return point_chunks(args.chunk, samples=args.samples, seed=args.seed,
                         n_faces=n_faces if evaluable is None else evaluable)
 
@@ -265,7 +327,8 @@ def _evaluate_sources(args, mesh, tagged, kwargs, sources, out_path, sched, prog
 
     # on a cluster each worker builds the surface itself (once); here only for in-process work or --plot
     t1 = time.perf_counter()
-    surface = build_surface(mesh, tagged, args.alpha, progress) if sched.kind == "serial" or args.plot else None
+    surface = build_surface(mesh, tagged, args.alpha, progress, args.scheme) \
+        if sched.kind == "serial" or args.plot else None
     setup = time.perf_counter() - t1  # the setup in this process (the workers' is measured by them)
     t_start = time.perf_counter()
     with open_scheduler(sched, len(sources)) as sched:
@@ -273,7 +336,7 @@ def _evaluate_sources(args, mesh, tagged, kwargs, sources, out_path, sched, prog
         in_process = getattr(sched, "kind", None) == "serial"  # a Client, or local worker processes without Dask
         if surface is None and in_process:  # a single chunk runs here after all
             t1 = time.perf_counter()
-            surface = build_surface(mesh, tagged, args.alpha, progress)
+            surface = build_surface(mesh, tagged, args.alpha, progress, args.scheme)
             setup += time.perf_counter() - t1
         if args.threads is not None:
             kwargs["threads"] = args.threads
@@ -281,7 +344,8 @@ def _evaluate_sources(args, mesh, tagged, kwargs, sources, out_path, sched, prog
             kwargs["threads"] = 1  # one worker per core already: no second level of threads
         # the file (or each shard and the index) is written under a temporary name, then renamed
         t_tasks = time.perf_counter()
-        n, names, sweep, worker_setup = evaluate_points(ship(build_surface, mesh, tagged, args.alpha), sources,
+        shipped = ship(build_surface, mesh, tagged, args.alpha, False, args.scheme)
+        n, names, sweep, worker_setup = evaluate_points(shipped, sources,
                                                         args.derivatives, kwargs, str(out_path), sched,
                                                         local=surface, progress=progress)
         t_write = time.perf_counter() - t_tasks - sweep.seconds  # gathering and writing the output

@@ -41,7 +41,7 @@ import threading
 import weakref
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Literal, overload
 
 import numpy as np
 
@@ -52,6 +52,7 @@ from ccproof.reparam.blend import CORNER_FRAMES, PARAMETERIZATIONS, active_point
 from ccproof.reparam.quadrant import check_alpha, default_alpha
 
 if TYPE_CHECKING:
+    from ccproof.evaluate.loop import LoopSurface
     from ccproof.mesh.polymesh import PolyMesh
 
 __all__ = ["Parameterization", "corner_valence", "limit_surface", "named_parameterizations"]
@@ -399,8 +400,18 @@ def named_parameterizations(alpha: float | Mapping[int, float] | None = None) ->
     return {"vanishing": Parameterization("vanishing", alpha), "characteristic": Parameterization("characteristic")}
 
 
+@overload
 def limit_surface(mesh: QuadMesh | PolyMesh | str | os.PathLike[str], alpha: float | Mapping[int, float] | None = None,
-                  *, progress: bool | None = None) -> LimitSurface:
+                  *, progress: bool | None = None, scheme: Literal["catmark"] = "catmark") -> LimitSurface: ...
+
+
+@overload
+def limit_surface(mesh: QuadMesh | PolyMesh | str | os.PathLike[str], alpha: float | Mapping[int, float] | None = None,
+                  *, progress: bool | None = None, scheme: Literal["loop"]) -> LoopSurface: ...
+
+
+def limit_surface(mesh: QuadMesh | PolyMesh | str | os.PathLike[str], alpha: float | Mapping[int, float] | None = None,
+                  *, progress: bool | None = None, scheme: str = "catmark") -> LimitSurface | LoopSurface:
     """The limit surface of a mesh: exact evaluation, normals and the parameterizations of bmz04.
 
     The one entry point for limit surfaces (``ccproof.limit_surface``): the exact evaluator of
@@ -424,10 +435,14 @@ def limit_surface(mesh: QuadMesh | PolyMesh | str | os.PathLike[str], alpha: flo
     progress : bool, optional
         Show a progress bar (tqdm, on stderr) when building the patch table takes more than 2 s;
         default: when stderr is a terminal.
+    scheme : {"catmark", "loop"}
+        The subdivision scheme (:mod:`ccproof.mesh.scheme`). ``"loop"``: the exact Loop evaluator
+        :class:`~ccproof.evaluate.loop.LoopSurface` of a triangle mesh (natural parameterization only;
+        ``alpha`` is refused).
 
     Returns
     -------
-    LimitSurface
+    LimitSurface or LoopSurface
 
     Raises
     ------
@@ -446,6 +461,10 @@ def limit_surface(mesh: QuadMesh | PolyMesh | str | os.PathLike[str], alpha: flo
     from ccproof.evaluate.surface import natural_limit_surface
     from ccproof.mesh.polymesh import PolyMesh
 
+    if scheme != "catmark":
+        from ccproof.evaluate.loop import loop_limit_surface
+
+        return loop_limit_surface(mesh, scheme=scheme, alpha=alpha)
     if not isinstance(mesh, (QuadMesh, PolyMesh)):
         from ccproof.mesh.io import read_mesh
 
