@@ -27,7 +27,7 @@ from flint import acb, acb_mat, acb_poly, acb_series, arb, ctx, fmpq, fmpq_mat, 
 from .errors import CertificateError
 from .maps import STAR_CURVES, curve_points
 from .rules import CENTRE, canonical, level1_rule
-from .statement import horner
+from .statement import B2Z, horner
 from .tagged_modes import RING_INDEX, ring_block, ring_stencil
 
 
@@ -47,9 +47,6 @@ class TaylorHints:
     order: int
     layer_order: int
     exp_order: int
-
-
-_B2Z = ((1, 4, 1, 0), (0, 4, 2, 0), (0, 2, 4, 0), (0, 1, 4, 1))  # uniform cubic B-spline -> Bezier, times 6
 
 
 _OFFSET = {"P1": (0, -1), "P2": (0, 0), "P3": (-1, 0)}  # as tagged_map: level-1 position of net[0][0]
@@ -160,7 +157,8 @@ def bordered(w, lam, pivot=0):
         sol = acb_mat(A).solve(acb_mat([[0]] * 6 + [[1]]))
         return [sol[i, 0] for i in range(6)]
     n = w.prec
-    Ak = [acb_mat([[series_coeffs(A[i][k], n)[m] for k in range(7)] for i in range(7)]) for m in range(n)]
+    cs = [[series_coeffs(A[i][k], n) for k in range(7)] for i in range(7)]
+    Ak = [acb_mat([[cs[i][k][m] for k in range(7)] for i in range(7)]) for m in range(n)]
     inv0 = Ak[0].inv()
     vs = [inv0 * acb_mat([[0]] * 6 + [[1]])]
     for m in range(1, n):
@@ -286,17 +284,22 @@ def quadrant_level1(level0, centre, lam, zero, q=None):
 
 
 def _bezier(net, zero):
-    """4 x 4 B-spline control values -> Bezier (one coordinate, any ring)."""
-    tmp = [[sum((net[r][j] * fmpq(c, 6) for c, r in zip(_B2Z[i], range(4)) if c), zero) for j in range(4)]
-           for i in range(4)]
-    return [[sum((tmp[i][r] * fmpq(c, 6) for c, r in zip(_B2Z[j], range(4)) if c), zero) for j in range(4)]
+    """4 x 4 B-spline control values -> Bezier (one coordinate, any ring): ``B2Z`` in both directions, integer
+    weights, one division by 36."""
+    tmp = [[sum((net[r][j] * c for r, c in enumerate(B2Z[i]) if c), zero) for j in range(4)] for i in range(4)]
+    return [[sum((tmp[i][r] * c for r, c in enumerate(B2Z[j]) if c), zero) / 36 for j in range(4)]
             for i in range(4)]
 
 
 def piece_nets(level0, centre, lam, zero, q=None):
     """{piece: 4 x 4 Bezier net} of one coordinate (or one basis part) on a bulk quadrant (``q`` None) or on
     the layer quadrant q (:func:`quadrant_level1`)."""
-    V = quadrant_level1(level0, centre, lam, zero, q)
+    value, memo = quadrant_level1(level0, centre, lam, zero, q), {}
+
+    def V(A, B):  # the three pieces share most of their level-1 points
+        if (A, B) not in memo:
+            memo[(A, B)] = value(A, B)
+        return memo[(A, B)]
     return {name: _bezier([[V(_OFFSET[name][0] + i, _OFFSET[name][1] + j) for j in range(4)] for i in range(4)], zero)
             for name in PIECES}
 
@@ -321,14 +324,21 @@ def _packed(nets, axis):
     return acb_poly(coeffs)
 
 
+def packed_partials(nets):
+    """(u-partial, v-partial) of a net given by its h^m coefficient nets (:func:`_packed`), for
+    :func:`det_series`: pack each factor once when it enters several determinants."""
+    return _packed(nets, 0), _packed(nets, 1)
+
+
 def det_series(A, B, n):
     """The h^m coefficients, m = 0..n, of D(A, B) = A_u B_v - A_v B_u for nets given by their h^m coefficient
-    nets ``A[m]``, ``B[m]`` (4 x 4, acb): the Cauchy products of Bernstein forms as one polynomial product each
-    (the scaled coefficients of a product are the plain convolution of the scaled factors, as in
-    :meth:`~ccproof.rigorous.BernsteinForm.__mul__`; h, u, v packed with the strides above). Returns
-    ``[[36 acb, (i, j) row-major] for m in 0..n]``: D's Bernstein coefficients (degree (5, 5))."""
-    P = _packed(A, 0) * _packed(B, 1) - _packed(A, 1) * _packed(B, 0)
-    c = P.coeffs()
+    nets ``A[m]``, ``B[m]`` (4 x 4, acb) or by their :func:`packed_partials`: the Cauchy products of
+    Bernstein forms as one polynomial product each (the scaled coefficients of a product are the plain
+    convolution of the scaled factors, as in :meth:`~ccproof.rigorous.BernsteinForm.__mul__`; h, u, v packed
+    with the strides above). Returns ``[[36 acb, (i, j) row-major] for m in 0..n]``: D's Bernstein
+    coefficients (degree (5, 5))."""
+    (Au, Av), (Bu, Bv) = (X if isinstance(X, tuple) else packed_partials(X) for X in (A, B))
+    c = (Au * Bv - Av * Bu).coeffs()
     c += [acb(0)] * max(0, _SH * (n + 1) - len(c))
     return [[c[m * _SH + i * _SU + j] / (_BIN5[i] * _BIN5[j]) for i in range(6) for j in range(6)]
             for m in range(n + 1)]

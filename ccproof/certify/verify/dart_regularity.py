@@ -13,14 +13,14 @@ from flint import acb, acb_mat, arb, ctx, fmpq
 
 from ccproof.rigorous.analytic import AnalyticModel, ball, cauchy_factor, hull
 
-from .dart_family import PIECES, XB, YB, det_series, series_coeffs
+from .dart_family import PIECES, XB, YB, det_series, packed_partials, series_coeffs
 
 IJ = [(i, j) for i in XB for j in YB]  # the columns of the bulk models
 
 
 def det_values(nets):
     """{(i, j, piece): 36 Bernstein coefficients of D(X_i, Y_j)} for nets of acb values (one h)."""
-    forms = {key: [[[acb(z) for z in row] for row in net]] for key, net in _flat(nets).items()}
+    forms = {key: packed_partials([[[acb(z) for z in row] for row in net]]) for key, net in _flat(nets).items()}
     return {(i, j, p): det_series(forms[(i, p)], forms[(j, p)], 0)[0] for i, j in IJ for p in PIECES}
 
 
@@ -30,8 +30,10 @@ def _flat(nets):
 
 def dets_series(nets, n):
     """As :func:`det_values` for nets of acb_series: [coefficient list (acb) of h^m, m = 0..n]."""
-    series = {key: [[[series_coeffs(z, n + 1)[m] for z in row] for row in net] for m in range(n + 1)]
-              for key, net in _flat(nets).items()}
+    series = {}
+    for key, net in _flat(nets).items():
+        cs = [[series_coeffs(z, n + 1) for z in row] for row in net]
+        series[key] = packed_partials([[[c[m] for c in row] for row in cs] for m in range(n + 1)])
     return {(i, j, p): det_series(series[(i, p)], series[(j, p)], n) for i, j in IJ for p in PIECES}
 
 
@@ -130,8 +132,9 @@ def layer_dets_series(lnets, n):
     """{piece: [Bernstein coefficients of det J_Phi's h^m (real parts: real for real h), m = 0..n]}."""
     out = {}
     for piece, (X, Y) in lnets.items():
-        fx, fy = ([[[acb(series_coeffs(Z[i][j], n + 1)[m].real) for j in range(4)] for i in range(4)]
-                   for m in range(n + 1)] for Z in (X, Y))
+        cx, cy = ([[series_coeffs(z, n + 1) for z in row] for row in Z] for Z in (X, Y))
+        fx, fy = ([[[acb(c[i][j][m].real) for j in range(4)] for i in range(4)] for m in range(n + 1)]
+                  for c in (cx, cy))
         out[piece] = [[z.real for z in c] for c in det_series(fx, fy, n)]
     return out
 
