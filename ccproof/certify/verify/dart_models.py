@@ -41,7 +41,7 @@ class DartModels:
     >>> from ccproof.certify.verify.dart_family import TaylorHints
     >>> hints = TaylorHints(r=fmpq(1, 32), disc_grid=6, sigma_boxes=10, order=12, layer_order=14, exp_order=24)
     >>> box = DartModels(fmpq(4484, 1000), fmpq(44935, 10000), hints, 0, 128).sigma_box(0)
-    >>> box.bulk([(fmpq(1, 4), fmpq(26, 100)), (fmpq(0), fmpq(1, 101))]) > 0  # K det J_Phi, every K >= 101
+    >>> box.evaluate("R", "bulk", [(fmpq(1, 4), fmpq(26, 100)), (fmpq(0), fmpq(1, 101))]) > 0  # K det J_Phi, K >= 101
     True
     """
 
@@ -117,69 +117,42 @@ class SigmaBox:
                              R.column_models(C.layer_y_series(ln, n), self.m.bounds("YL", q), r))
 
     def evaluator(self, method):
-        """The evaluator (box) -> arb that :func:`map_regions` names: a method, or (method, layer quadrant)."""
-        if isinstance(method, tuple):
-            fn, q = getattr(self, method[0]), method[1]
-            return lambda box: fn(q, box)
-        return getattr(self, method)
+        """The evaluator (box) -> arb that :func:`map_regions` names: method = (quantity, region, layer
+        quadrant or None); see :meth:`evaluate`."""
+        return lambda box: self.evaluate(*method[:2], box, method[2])
 
-    def bulk(self, box):
-        """K det J_Phi on (s, h) in the box (the bulk, s in [s0, 1/2])."""
-        (s_lo, s_hi), (h_lo, h_hi) = box
-        return R.kdet_box(self.R, s_lo, s_hi, h_lo, h_hi, self.sigma, prec=self.m.prec)
+    def evaluate(self, quantity, region, box, q=None):
+        """One arb holding the quantity's scaled values on a box (a list of (lo, hi) fmpq) of its region:
 
-    def _middle(self, models, E, box, om=None, m0=1, q=2):
-        (s_lo, s_hi), (w_lo, w_hi) = box
-        return R.middle_box(models, E, om or self.om, s_lo, s_hi, w_lo, w_hi, m0, q, L=self.m.hints.exp_order,
-                            prec=self.m.prec)
-
-    def middle(self, box):
-        """K^3 det J_Phi/q^2 as a function of (s, w = 1/q) in the box (the middle)."""
-        return self._middle(self.R, self.ER, box)
-
-    def layer(self, q, box):
-        """K^3 det J_Phi of layer quadrant q on h in the box."""
-        ((h_lo, h_hi),) = box
-        return R.layer_box(self.L[q][0], h_lo, h_hi, prec=self.m.prec)
-
-    def transversal_bulk(self, box):
-        """K (a1 X Y' - a2 Y X') on the four outer curves, (s, h) in the box."""
-        (s_lo, s_hi), (h_lo, h_hi) = box
-        return R.kdet_box(self.T, s_lo, s_hi, h_lo, h_hi, self.sigma, prec=self.m.prec)
-
-    def transversal_middle(self, box):
-        """K^3 (a1 X Y' - a2 Y X')/q^2 as a function of (s, w = 1/q) in the box."""
-        return self._middle(self.T, self.ET, box)
-
-    def transversal_layer(self, q, box):
-        """K^3 (a1 X Y' - a2 Y X') on layer quadrant q's outer curves, h in the box."""
-        ((h_lo, h_hi),) = box
-        return R.layer_box(self.L[q][1], h_lo, h_hi, prec=self.m.prec)
-
-    def x_bulk(self, box):
-        """X on every outer-curve Bezier point, (s, h) in the box."""
-        (s_lo, s_hi), (h_lo, h_hi) = box
-        return C.coord_box(self.X, s_lo, s_hi, h_lo, h_hi, self.sigma, "x", prec=self.m.prec)
-
-    def y_bulk(self, box):
-        """Y on every outer-curve Bezier point, (s, h) in the box."""
-        (s_lo, s_hi), (h_lo, h_hi) = box
-        return C.coord_box(self.Y, s_lo, s_hi, h_lo, h_hi, self.sigma, "y", prec=self.m.prec)
-
-    def y_middle(self, box):
-        """Y/s on every outer-curve Bezier point, (s, w) in the box."""
-        return self._middle(self.Y, self.EY, box, self.omy, 0, 1)
-
-    def y_layer(self, q, box):
-        """K Y on layer quadrant q's outer-curve points (K^2 Y at ray 0's end point of quadrant 0), h in the box."""
-        ((h_lo, h_hi),) = box
-        return C.layer_y_box(self.L[q][2], q, h_lo, h_hi, prec=self.m.prec)
+        ========  ===========================  ===================================  ================================
+        quantity  bulk (s, h)                  middle (s, w = 1/q)                  layer quadrant q (h)
+        ========  ===========================  ===================================  ================================
+        R         K det J_Phi                  K^3 det J_Phi/q^2                    K^3 det J_Phi
+        T         K (a1 X Y' - a2 Y X')        K^3 (a1 X Y' - a2 Y X')/q^2          K^3 (a1 X Y' - a2 Y X')
+        X, Y      X, Y on the Bezier points    Y/s on the Bezier points             K Y (K^2 Y at ray 0's end)
+        ========  ===========================  ===================================  ================================
+        """
+        prec = self.m.prec
+        if region == "layer":
+            ((h_lo, h_hi),) = box
+            models = self.L[q]["RTY".index(quantity)]
+            if quantity == "Y":
+                return C.layer_y_box(models, q, h_lo, h_hi, prec=prec)
+            return R.layer_box(models, h_lo, h_hi, prec=prec)
+        (s_lo, s_hi), (t_lo, t_hi) = box
+        if region == "middle":
+            models, E, om, m0, order = {"R": (self.R, self.ER, self.om, 1, 2), "T": (self.T, self.ET, self.om, 1, 2),
+                                        "Y": (self.Y, self.EY, self.omy, 0, 1)}[quantity]
+            return R.middle_box(models, E, om, s_lo, s_hi, t_lo, t_hi, m0, order, L=self.m.hints.exp_order, prec=prec)
+        if quantity in "RT":
+            return R.kdet_box(getattr(self, quantity), s_lo, s_hi, t_lo, t_hi, self.sigma, prec=prec)
+        return C.coord_box(getattr(self, quantity), s_lo, s_hi, t_lo, t_hi, self.sigma, quantity.lower(), prec=prec)
 
 
 def map_regions(k0, s0, layer, winding):
-    """Every tree list of a record's ``parts``: (name, keys into ``parts``, root box, evaluator of
-    :class:`SigmaBox`, sign of the claim, ``outside`` leaves allowed); the roots are fixed by K0 and the
-    regions, never by the file. The prover covers the same lists.
+    """Every tree list of a record's ``parts``: (name, keys into ``parts``, root box, (quantity, region, layer
+    quadrant) of :meth:`SigmaBox.evaluate`, sign of the claim, ``outside`` leaves allowed); the roots are fixed by
+    K0 and the regions, never by the file. The prover covers the same lists.
 
     >>> [r[:2] for r in map_regions(101, fmpq(1, 20), 3, (fmpq(1, 4), fmpq(7, 20)))][-1]
     ('Y<0 layer 2', ('winding', 'Y<0 layer', '2'))
@@ -187,19 +160,18 @@ def map_regions(k0, s0, layer, winding):
     s_a, s_b = winding
     half, h0 = fmpq(1, 2), fmpq(1, k0)
     bulk, middle = [(s0, half), (fmpq(0), h0)], [(fmpq(0), s0), (fmpq(0), fmpq(1, layer))]
-    out = [("R bulk", ("regularity", "bulk"), bulk, "bulk", 1, False),
-           ("R middle", ("regularity", "middle"), middle, "middle", 1, True),
-           ("T bulk", ("transversal", "bulk"), bulk, "transversal_bulk", 1, False),
-           ("T middle", ("transversal", "middle"), middle, "transversal_middle", 1, True),
-           ("Y<0 bulk", ("winding", "Y<0 bulk"), [(s0, s_a), (fmpq(0), h0)], "y_bulk", -1, False),
-           ("X>0 bulk", ("winding", "X>0 bulk"), [(s_a, s_b), (fmpq(0), h0)], "x_bulk", 1, False),
-           ("Y>0 bulk", ("winding", "Y>0 bulk"), [(s_b, half), (fmpq(0), h0)], "y_bulk", 1, False),
-           ("Y<0 middle", ("winding", "Y<0 middle"), middle, "y_middle", -1, True)]
+    out = [("R bulk", ("regularity", "bulk"), bulk, ("R", "bulk", None), 1, False),
+           ("R middle", ("regularity", "middle"), middle, ("R", "middle", None), 1, True),
+           ("T bulk", ("transversal", "bulk"), bulk, ("T", "bulk", None), 1, False),
+           ("T middle", ("transversal", "middle"), middle, ("T", "middle", None), 1, True),
+           ("Y<0 bulk", ("winding", "Y<0 bulk"), [(s0, s_a), (fmpq(0), h0)], ("Y", "bulk", None), -1, False),
+           ("X>0 bulk", ("winding", "X>0 bulk"), [(s_a, s_b), (fmpq(0), h0)], ("X", "bulk", None), 1, False),
+           ("Y>0 bulk", ("winding", "Y>0 bulk"), [(s_b, half), (fmpq(0), h0)], ("Y", "bulk", None), 1, False),
+           ("Y<0 middle", ("winding", "Y<0 middle"), middle, ("Y", "middle", None), -1, True)]
     for q in range(layer):
-        out += [(f"R layer {q}", ("regularity", "layer", str(q)), [(fmpq(0), h0)], ("layer", q), 1, False),
-                (f"T layer {q}", ("transversal", "layer", str(q)), [(fmpq(0), h0)], ("transversal_layer", q), 1,
-                 False),
-                (f"Y<0 layer {q}", ("winding", "Y<0 layer", str(q)), [(fmpq(0), h0)], ("y_layer", q), -1, False)]
+        out += [(f"R layer {q}", ("regularity", "layer", str(q)), [(fmpq(0), h0)], ("R", "layer", q), 1, False),
+                (f"T layer {q}", ("transversal", "layer", str(q)), [(fmpq(0), h0)], ("T", "layer", q), 1, False),
+                (f"Y<0 layer {q}", ("winding", "Y<0 layer", str(q)), [(fmpq(0), h0)], ("Y", "layer", q), -1, False)]
     return out
 
 
