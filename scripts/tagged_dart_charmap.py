@@ -717,7 +717,7 @@ def main(argv=None):
     rho = exact_zeros()
     print("Z  exact in Q(sqrt 5): rho = v^(0) is the eigenvector of B(1) for L0 = (6 + sqrt 20)/16 with "
           "rho(a, b) = rho(b, a), and adj(L0 - B(1)) kappa is a non-zero multiple of rho (the facts the dropped "
-          "coefficients rest on); rho = (" + ", ".join(f"{float(z.a) + float(z.b) * 0.6545084971874737:.6f}"
+          "coefficients rest on); rho = (" + ", ".join(f"{float(z.c[0].p) + float(z.c[0].q) * 5 ** 0.5:.6f}"
                                                       for z in rho) + ")")
     t = time.time()
     zmod = _zeros_script()
