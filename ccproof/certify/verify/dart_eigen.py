@@ -85,7 +85,7 @@ from flint import acb, arb, ctx, fmpq, fmpq_mat, fmpq_poly
 
 from ccproof.rigorous.analytic import ball
 
-from .dart_family import B_AT_1, N_POLYS, Family, adjugate, kappa, l0, layer_level0, u_denominator
+from .dart_family import B_AT_1, N_POLYS, Family, adjugate, kappa, l0, u_denominator
 from .errors import CertificateError
 from .rules import TWO_RING
 from .tagged_modes import RING_INDEX, check_ring, ring_block, ring_stencil
@@ -230,7 +230,7 @@ def _guard(fam, tol):
     alpha (lam - L0), ray 0's two sharp rows and the ring rows of sector 1 satisfied (balls containing 0,
     radii below tol; they are identities, items 1 and 2)."""
     lam, L0 = fam.lam2, l0()[0]
-    _, y, _, yc = layer_level0(fam, 0)
+    y, yc = fam.layer_level0(0)[1], fam.yc
     kap = kappa()
     res = [fam.vy[_E10] - 1, yc - fam.alpha * (lam - L0),
            (lam - fmpq(1, 2)) * y(0, (1, 0)) - yc / 2,

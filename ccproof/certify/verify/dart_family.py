@@ -27,7 +27,7 @@ from flint import acb, acb_mat, acb_poly, acb_series, arb, ctx, fmpq, fmpq_mat, 
 from .errors import CertificateError
 from .maps import STAR_CURVES, curve_points
 from .rules import CENTRE, canonical, level1_rule
-from .statement import B2Z, horner
+from .statement import B2Z, horner, lam_of
 from .tagged_modes import RING_INDEX, ring_block, ring_stencil
 
 
@@ -103,13 +103,12 @@ def big_u(lam):
 
 
 def _lam_principal(c):
-    """lam(c) = (5 + c + sqrt((1 + c)(9 + c)))/16 (acb, arb or acb_series). On an acb ball the square root's
+    """lam(c) (:func:`.statement.lam_of`; acb, arb or acb_series). On an acb ball the square root's
     argument must lie in the right half-plane (off the principal branch's cut, so the value is analytic
     there: the Cauchy bounds need that); ZeroDivisionError otherwise."""
-    arg = (1 + c) * (9 + c)
-    if isinstance(arg, acb) and not arg.real > 0:
+    if isinstance(c, acb) and not ((1 + c) * (9 + c)).real > 0:
         raise ZeroDivisionError("sqrt((1 + c)(9 + c)): the argument is not certainly off the branch cut")
-    return (5 + c + arg.sqrt()) / 16
+    return lam_of(c)
 
 
 def series_variable(n):
@@ -347,12 +346,6 @@ def det_series(A, B, n):
 def basis_nets(fam):
     """{basis part: {piece: 4 x 4 net}} of the family's five basis parts."""
     return {name: piece_nets(f, c, lam, fam.zero) for name, (f, c, lam) in fam.parts().items()}
-
-
-def layer_level0(fam, q):
-    """(x, y, x's centre, y's centre) of the layer quadrant q (:meth:`Modes.layer_level0`)."""
-    x, y = fam.layer_level0(q)
-    return x, y, fam.zero, fam.yc
 
 
 def layer_nets(fam, q):

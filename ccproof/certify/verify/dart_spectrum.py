@@ -73,6 +73,7 @@ from ccproof.rigorous.analytic import ball
 
 from .dart_family import kappa
 from .errors import CertificateError
+from .statement import lam_of
 from .tagged import labels, sector_rows
 from .tagged_modes import RING_INDEX, charpoly_roots, check_dart, check_ring, ring_stencil
 
@@ -286,8 +287,7 @@ def _ell():
 
 def lam_circle(sig_r, h):
     """r = lam(cos(2 sigma_r h)) (arb; 2 sigma_r h < pi/2 keeps (1 + c)(9 + c) > 0)."""
-    c = (2 * sig_r * h).cos()
-    return (5 + c + ((1 + c) * (9 + c)).sqrt()) / 16
+    return lam_of((2 * sig_r * h).cos())
 
 
 def check_mode0_roots(sig_r, k0, balls):
