@@ -283,9 +283,7 @@ def check_eigenvector(sig_lo, sig_hi, k0, prec, balls=64, family=Family):
     sig_lo, sig_hi = fmpq(sig_lo), fmpq(sig_hi)
     if k0 < 7 or balls < 1:
         raise CertificateError(f"eigenvector lemma: K0 = {k0} < 7 or no h-balls")
-    old = ctx.prec
-    ctx.prec = prec
-    try:
+    with ctx.workprec(prec):
         pi = arb.pi()
         if not (arb(sig_lo) > pi and arb(sig_hi) < 2 * pi and sig_lo < sig_hi):
             raise CertificateError("eigenvector lemma: the bracket is not inside (pi, 2 pi)")
@@ -316,8 +314,6 @@ def check_eigenvector(sig_lo, sig_hi, k0, prec, balls=64, family=Family):
         return (f"eigenvector lemma for every K >= {k0}: ring rows and ray 0's rows identically (exact: reach, "
                 f"mode 0, crease row at {W_POINTS} w), centre residual changes sign on ({sig_lo}, {sig_hi}) on "
                 f"{balls} h-balls, the family (x's and y's bordered systems, U, alpha) regular on the whole bracket")
-    finally:
-        ctx.prec = old
 
 
 __all__ = ["W_POINTS", "check_crease_row", "check_eigenvector", "check_mode0", "check_reach",
