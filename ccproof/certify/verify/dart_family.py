@@ -133,10 +133,12 @@ class series_cap:
         ctx.cap = self.old
 
 
-def series_coeffs(z, n):
-    """The first n Taylor coefficients of the series z (acb; zeros past its length)."""
-    c = z.coeffs()
-    return [acb(c[i]) if i < len(c) else acb(0) for i in range(n)]
+def series_coeffs(z, n, real=False):
+    """The first n Taylor coefficients of the series z (acb; zeros past its length; with ``real`` their real
+    parts, for a quantity real for real h); a value (acb, arb: the quantity at one h) is its own coefficient of
+    h^0, so every function below serves both."""
+    c = z.coeffs() if isinstance(z, acb_series) else [z]
+    return [acb(c[i].real if real else c[i]) if i < len(c) else acb(0) for i in range(n)]
 
 
 def bordered_matrix(B, lam, zero, pivot=0):
@@ -367,11 +369,12 @@ def bezier_product(f, g):
     return out
 
 
-def series_curves(nets, n):
-    """{curve: [order m: 4 acb]} of one coordinate's nets {piece: 4 x 4 acb_series}."""
+def series_curves(nets, n, real=False):
+    """{curve: [order m: 4 acb]} of one coordinate's nets {piece: 4 x 4 acb_series} (``real``: as
+    :func:`series_coeffs`)."""
     out = {}
     for name in STAR_CURVES:
-        pts = [series_coeffs(z, n + 1) for z in curve_points(nets, name, oriented=True)]
+        pts = [series_coeffs(z, n + 1, real) for z in curve_points(nets, name, oriented=True)]
         out[name] = [[pts[p][m] for p in range(4)] for m in range(n + 1)]
     return out
 

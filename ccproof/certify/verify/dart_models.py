@@ -11,7 +11,7 @@ before any arithmetic; :func:`replay_map` replays them sigma box by sigma box (:
 
 from __future__ import annotations
 
-from flint import ctx, fmpq
+from flint import acb_series, ctx, fmpq
 
 from ccproof.rigorous.analytic import ball, disc_bound
 
@@ -21,6 +21,35 @@ from .dart_family import XB, YB, Family, basis_nets, layer_nets, series_cap, ser
 from .errors import CertificateError
 from .record import exact_keys
 from .replay import read_tree, replay_tree
+
+
+def quantities(fam, n, layers=(), bulk=True):
+    """{key: [coefficient list of h^m, m = 0..n]} of every quantity the models bound, from one family (of the
+    series variable; at an acb h with n = 0, the values there): ("R", i, j, piece) and ("T", i, j, curve) of
+    :mod:`.dart_regularity` and :mod:`.dart_curves`, ("X", part, curve), ("Y", part, curve) the outer curves'
+    points; ("RL", q, piece), ("TL", q, curve), ("YL", q, curve) on the layer quadrants q in ``layers``."""
+    out = {}
+    if bulk:
+        nets = basis_nets(fam)
+        out.update({("R",) + k: v for k, v in R.dets_series(nets, n).items()})
+        out.update({("T",) + k: v for k, v in C.trans_series(fam, nets, n).items()})
+        for tag, parts in (("X", XB), ("Y", YB)):
+            out.update({(tag, b, c): pts for b in parts for c, pts in series_curves(nets[b], n).items()})
+    real = isinstance(fam.h, acb_series)  # the layer's series: real coefficients (real nets for real h)
+    for q in layers:
+        ln = layer_nets(fam, q)
+        out.update({("RL", q, p): v for p, v in R.layer_dets_series(ln, n, real).items()})
+        out.update({("TL", q, c): v for c, v in C.layer_trans_series(fam, ln, n, real).items()})
+        out.update({("YL", q, c): v for c, v in C.layer_y_series(ln, n, real).items()})
+    return out
+
+
+def select(table, tag, q=None):
+    """The entries of one quantity of a :func:`quantities` table (or of its disc bounds), keyed without the
+    tag ("R", "T", "X", "Y"), or without (tag, q) for "RL", "TL", "YL" on layer quadrant q."""
+    if q is None:
+        return {key[1:]: v for key, v in table.items() if key[0] == tag}
+    return {key[2]: v for key, v in table.items() if key[:2] == (tag, q)}
 
 
 class DartModels:
@@ -55,25 +84,12 @@ class DartModels:
 
     def _values(self, sigma):
         def values(h):
-            fam = Family(h, sigma)
-            nets = basis_nets(fam)
-            out = {("R",) + k: v for k, v in R.det_values(nets).items()}
-            out.update({("T",) + k: v for k, v in C.trans_values(fam, nets).items()})
-            out.update({("X",) + k: v for k, v in C.coord_values(nets, "x").items()})
-            out.update({("Y",) + k: v for k, v in C.coord_values(nets, "y").items()})
-            for q in range(self.layer):
-                ln = layer_nets(fam, q)
-                out.update({("RL", q, p): v for p, v in R.layer_det_values(ln).items()})
-                out.update({("TL", q, c): v for c, v in C.layer_trans_values(fam, ln).items()})
-                out.update({("YL", q, c): v for c, v in C.layer_y_values(ln).items()})
-            return out
+            return {key: v[0] for key, v in quantities(Family(h, sigma), 0, range(self.layer)).items()}
         return values
 
     def bounds(self, tag, q=None):
-        """The disc bounds of one quantity ("R", "T", "X", "Y"; "RL", "TL", "YL" with a layer quadrant q)."""
-        if q is None:
-            return {key[1:]: v for key, v in self.M.items() if key[0] == tag}
-        return {key[2]: v for key, v in self.M.items() if key[:2] == (tag, q)}
+        """The disc bounds of one quantity (:func:`select`)."""
+        return select(self.M, tag, q)
 
     def sigma_box(self, i):
         """The models on sigma box i of ``hints.sigma_boxes`` equal boxes of the bracket (cached)."""
@@ -92,14 +108,10 @@ class SigmaBox:
         with ctx.workprec(prec):
             self.sigma = sigma = ball(models.edges[i], models.edges[i + 1])
             with series_cap(hn.order):
-                fam = Family(series_variable(hn.order), sigma)
-                nets = basis_nets(fam)
-                TR, TT = R.dets_series(nets, hn.order), C.trans_series(fam, nets, hn.order)
-                coord = {b: series_curves(nets[b], hn.order) for b in XB + YB}
-            self.R = R.bulk_models(TR, models.bounds("R"), r)
-            self.T = R.bulk_models(TT, models.bounds("T"), r)
-            self.X = C.curve_models({(b, c): p for b in XB for c, p in coord[b].items()}, models.bounds("X"), r, XB)
-            self.Y = C.curve_models({(b, c): p for b in YB for c, p in coord[b].items()}, models.bounds("Y"), r, YB)
+                Q = quantities(Family(series_variable(hn.order), sigma), hn.order)
+            self.R, self.T = (R.bulk_models(select(Q, t), models.bounds(t), r) for t in ("R", "T"))
+            self.X, self.Y = (C.curve_models(select(Q, t), models.bounds(t), r, parts) for t, parts in (("X", XB),
+                                                                                                          ("Y", YB)))
             self.om, self.omy = R.omegas(sigma), R.y_omegas(sigma)
             self.ER = {p: R.middle_coeffs(m, self.om, 1, 2, L=hn.exp_order) for p, m in self.R.items()}
             self.ET = {p: R.middle_coeffs(m, self.om, 1, 2, L=hn.exp_order) for p, m in self.T.items()}
@@ -108,13 +120,9 @@ class SigmaBox:
 
     def _layers(self, n, r):
         with series_cap(n):
-            fam = Family(series_variable(n), self.sigma)
-            self.L = {}
-            for q in range(self.m.layer):
-                ln = layer_nets(fam, q)
-                self.L[q] = (R.column_models(R.layer_dets_series(ln, n), self.m.bounds("RL", q), r),
-                             R.column_models(C.layer_trans_series(fam, ln, n), self.m.bounds("TL", q), r),
-                             R.column_models(C.layer_y_series(ln, n), self.m.bounds("YL", q), r))
+            Q = quantities(Family(series_variable(n), self.sigma), n, range(self.m.layer), bulk=False)
+        self.L = {q: tuple(R.column_models(select(Q, t, q), self.m.bounds(t, q), r) for t in ("RL", "TL", "YL"))
+                  for q in range(self.m.layer)}
 
     def evaluator(self, method):
         """The evaluator (box) -> arb that :func:`map_regions` names: method = (quantity, region, layer
