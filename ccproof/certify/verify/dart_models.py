@@ -79,17 +79,10 @@ class DartModels:
         self.edges = [fmpq(sig_lo) + (fmpq(sig_hi) - fmpq(sig_lo)) * fmpq(i, hints.sigma_boxes)
                       for i in range(hints.sigma_boxes + 1)]
         with ctx.workprec(prec):
-            self.M = disc_bound(self._values(ball(sig_lo, sig_hi)), hints.r, hints.disc_grid)
+            sigma = ball(sig_lo, sig_hi)  # one family per acb box h, the values: the h^0 coefficients
+            self.M = disc_bound(lambda h: {k: v[0] for k, v in quantities(Family(h, sigma), 0, range(layer)).items()},
+                                hints.r, hints.disc_grid)
         self._boxes = {}
-
-    def _values(self, sigma):
-        def values(h):
-            return {key: v[0] for key, v in quantities(Family(h, sigma), 0, range(self.layer)).items()}
-        return values
-
-    def bounds(self, tag, q=None):
-        """The disc bounds of one quantity (:func:`select`)."""
-        return select(self.M, tag, q)
 
     def sigma_box(self, i):
         """The models on sigma box i of ``hints.sigma_boxes`` equal boxes of the bracket (cached)."""
@@ -109,9 +102,9 @@ class SigmaBox:
             self.sigma = sigma = ball(models.edges[i], models.edges[i + 1])
             with series_cap(hn.order):
                 Q = quantities(Family(series_variable(hn.order), sigma), hn.order)
-            self.R, self.T = (R.bulk_models(select(Q, t), models.bounds(t), r) for t in ("R", "T"))
-            self.X, self.Y = (C.curve_models(select(Q, t), models.bounds(t), r, parts) for t, parts in (("X", XB),
-                                                                                                          ("Y", YB)))
+            M = models.M
+            self.R, self.T = (R.bulk_models(select(Q, t), select(M, t), r) for t in ("R", "T"))
+            self.X, self.Y = (C.curve_models(select(Q, t), select(M, t), r, ps) for t, ps in (("X", XB), ("Y", YB)))
             self.om, self.omy = R.omegas(sigma), R.y_omegas(sigma)
             self.ER = {p: R.middle_coeffs(m, self.om, 1, 2, L=hn.exp_order) for p, m in self.R.items()}
             self.ET = {p: R.middle_coeffs(m, self.om, 1, 2, L=hn.exp_order) for p, m in self.T.items()}
@@ -121,7 +114,7 @@ class SigmaBox:
     def _layers(self, n, r):
         with series_cap(n):
             Q = quantities(Family(series_variable(n), self.sigma), n, range(self.m.layer), bulk=False)
-        self.L = {q: tuple(R.column_models(select(Q, t, q), self.m.bounds(t, q), r) for t in ("RL", "TL", "YL"))
+        self.L = {q: tuple(R.column_models(select(Q, t, q), select(self.m.M, t, q), r) for t in ("RL", "TL", "YL"))
                   for q in range(self.m.layer)}
 
     def evaluator(self, method):
