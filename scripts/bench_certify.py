@@ -20,6 +20,11 @@ totals (wall clock) with the ratio certify/verify, against the targets (all of 3
                                                        ones and the tagged ones verified on JOBS fresh
                                                        processes, alternating, ROUNDS rounds: the ratio
                                                        (all) / (smooth) (target <= 2), per family seconds
+    python scripts/bench_certify.py --dart-budget     the published dart:>=101 record and the costliest ones the
+                                                       work budget admits (one declared size raised to the
+                                                       largest value within it, the last map leaf false), each
+                                                       verified in a fresh process: declared work, verdict,
+                                                       CPU seconds (target: every one under 10 s)
 
 Certificates go to a temporary folder; the published ones are not touched.
 """
@@ -84,7 +89,10 @@ def main():
                     help="with --verify-all: a checkout of an earlier revision to compare against")
     ap.add_argument("--rounds", type=int, default=2, help="with --before: alternating rounds")
     ap.add_argument("--smoke", action="store_true", help="valence 3, in this process (the test suite's run)")
+    ap.add_argument("--dart-budget", action="store_true", help="the costliest dart:>=101 records within the budget")
     args = ap.parse_args()
+    if args.dart_budget:
+        return bench_dart_budget()
     if args.verify_all and args.before:
         return bench_verify_all_against(args.before, args.jobs, args.rounds)
     if args.smoke:
@@ -238,6 +246,77 @@ def bench_verify_all_against(before, jobs, rounds):
             print(f"round {r}: {'before' if tree else 'this'} {wall[tree]:.1f} s ({last})", flush=True)
         ratios.append(wall[None] / wall[before])
     print(ratio_line(f"verify --all --jobs {jobs}, (this) / (before):", ratios, loads))
+
+
+DART_SIZES = (("taylor", "disc_grid"), ("spectrum", "sigma_h"), ("spectrum", "mode0_h"), ("taylor", "order"),
+              ("taylor", "layer_order"), ("taylor", "exp_order"))
+_CPU_CHILD = r"""
+import json, resource, sys
+from ccproof.certify.verify import verify_file
+lines = []
+res = verify_file(sys.argv[1], log=lines.append)
+use = resource.getrusage(resource.RUSAGE_SELF)
+print(json.dumps({"ok": bool(res), "fail": [s for s in lines if "FAIL " in s][:1], "cpu": use.ru_utime + use.ru_stime}))
+"""
+
+
+def _declared(cert):
+    """The declared work of a dart:>=101 record, or None where it is refused (past the budget)."""
+    from ccproof.certify.verify import CertificateError
+    from ccproof.certify.verify.dart_tail import read_record, record_work
+
+    try:
+        return record_work(read_record(cert, 101))
+    except CertificateError:
+        return None
+
+
+def _largest_within(cert, section, key):
+    """Raise cert[section][key] to the largest value whose declared work is within the budget (in place)."""
+    lo, hi = cert[section][key], None
+    step = 1
+    while hi is None:
+        cert[section][key] = lo + step
+        if _declared(cert) is None:
+            hi = lo + step
+        else:
+            lo, step = lo + step, 2 * step
+    while hi - lo > 1:
+        cert[section][key] = (lo + hi) // 2
+        lo, hi = (cert[section][key], hi) if _declared(cert) is not None else (lo, cert[section][key])
+    cert[section][key] = lo
+    return lo
+
+
+def bench_dart_budget():
+    """The published dart:>=101 record and, per declared size, the costliest record within the budget with its
+    last map leaf false, each verified in a fresh process (CPU seconds, getrusage)."""
+    import copy
+    import json
+    import subprocess
+
+    from ccproof.certify.verify.dart_tail import MAX_WORK
+    from ccproof.tables.format import certificates_dir
+
+    published = json.loads((certificates_dir() / "c1" / "dart" / "k_ge_101.json").read_text())
+    cases = [("published", published)]
+    for section, key in DART_SIZES:
+        c = copy.deepcopy(published)
+        v = _largest_within(c, section, key)
+        c["parts"]["winding"]["Y<0 layer"]["2"][-1]["leaves"][-1]["bound"] = "-1e3"
+        cases.append((f"{key} = {v}, last leaf false", c))
+    with tempfile.TemporaryDirectory() as d:
+        for name, cert in cases:
+            path = os.path.join(d, "record.json")
+            with open(path, "w") as f:
+                json.dump(cert, f)
+            load = os.getloadavg()[0]
+            out = subprocess.run([sys.executable, "-c", _CPU_CHILD, path], capture_output=True, text=True,
+                                 cwd=tempfile.gettempdir())
+            res = json.loads(out.stdout.strip().splitlines()[-1])
+            verdict = "VERIFIED" if res["ok"] else "FAILED ..." + (res["fail"] or ["?"])[0].strip()[-70:]
+            print(f"{name}: declared {_declared(cert):,} of {MAX_WORK:,} units, {res['cpu']:.1f} s CPU (load "
+                  f"{load:.1f}): {verdict}", flush=True)
 
 
 if __name__ == "__main__":

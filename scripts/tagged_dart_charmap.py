@@ -128,6 +128,21 @@ def family_values(fam, s):
     return x, y, acb(fam.yc).real
 
 
+def _values(series):
+    """The values at one h of the verifier's series tables (n = 0: the coefficient of h^0)."""
+    return {key: v[0] for key, v in series.items()}
+
+
+def _real(series):
+    """The verifier's real layer series (acb with imaginary part 0) as arb, as the script's callers read them."""
+    return {key: [[z.real for z in c] for c in v] for key, v in series.items()}
+
+
+def _coord_values(nets, coord):
+    """{(basis part, curve): its 4 Bezier points} of x or y at one acb h."""
+    return {(b, c): pts[0] for b in (XB if coord == "x" else YB) for c, pts in series_curves(nets[b], 0).items()}
+
+
 def _parts(T):
     return sorted({key[2] for key in T})
 
@@ -147,19 +162,19 @@ def disc_bounds(sigma, r, grid=4, prec=128, **control):
     [-r, r]^2 (ccproof.rigorous.analytic.disc_bound; every system on each box proved regular by arb,
     so D_ij is analytic on the disc |h| <= r)."""
     with ctx.workprec(prec):
-        return disc_bound(lambda h: _R.det_values(basis_nets(Family(h, sigma, **control))), r, grid)
+        return disc_bound(lambda h: _values(_R.dets_series(basis_nets(Family(h, sigma, **control)), 0)), r, grid)
 
 
 def layer_taylor(q, sigma, n, prec=128):
     """The verifier's layer_dets_series of layer quadrant q."""
     with ctx.workprec(prec), series_cap(n):
-        return _R.layer_dets_series(layer_nets(Family(series_variable(n), sigma), q), n)
+        return _real(_R.layer_dets_series(layer_nets(Family(series_variable(n), sigma), q), n, real=True))
 
 
 def layer_disc(q, sigma, r, grid=12, prec=128):
     """{piece: M} with |det J_Phi(h)| <= M (every Bernstein coefficient) for complex h in [-r, r]^2."""
     with ctx.workprec(prec):
-        return disc_bound(lambda h: _R.layer_det_values(layer_nets(Family(h, sigma), q)), r, grid)
+        return disc_bound(lambda h: _values(_R.layer_dets_series(layer_nets(Family(h, sigma), q), 0)), r, grid)
 
 
 def taylor_trans(sigma, n, prec=128, **control):
@@ -170,16 +185,16 @@ def taylor_trans(sigma, n, prec=128, **control):
 
 
 def disc_trans(sigma, r, grid=12, prec=128, **control):
-    """The disc bounds (ccproof.rigorous.analytic.disc_bound) of the verifier's trans_values."""
+    """The disc bounds (ccproof.rigorous.analytic.disc_bound) of the verifier's trans_series at one h."""
     def values(h):
         fam = Family(h, sigma, **control)
-        return _C.trans_values(fam, basis_nets(fam))
+        return _values(_C.trans_series(fam, basis_nets(fam), 0))
     with ctx.workprec(prec):
         return disc_bound(values, r, grid)
 
 
 def coord_taylor(sigma, n, coord, prec=128):
-    """{(basis part, curve): [order m: 4 acb]}: Taylor coefficients in h of the verifier's coord_values."""
+    """{(basis part, curve): [order m: 4 acb]}: Taylor coefficients in h of the outer curves' points."""
     with ctx.workprec(prec), series_cap(n):
         nets = basis_nets(Family(series_variable(n), sigma))
         return {(b, c): pts for b in (XB if coord == "x" else YB) for c, pts in series_curves(nets[b], n).items()}
@@ -224,19 +239,19 @@ def coord_box(T, M, s_lo, s_hi, h_lo, h_hi, sigma, r, n, coord, prec=128):
 
 def coord_disc(sigma, r, coord, grid=12, prec=128):
     with ctx.workprec(prec):
-        return disc_bound(lambda h: _C.coord_values(basis_nets(Family(h, sigma)), coord), r, grid)
+        return disc_bound(lambda h: _coord_values(basis_nets(Family(h, sigma)), coord), r, grid)
 
 
 def layer_trans_taylor(q, sigma, n, prec=128):
     with ctx.workprec(prec), series_cap(n):
         fam = Family(series_variable(n), sigma)
-        return _C.layer_trans_series(fam, layer_nets(fam, q), n)
+        return _real(_C.layer_trans_series(fam, layer_nets(fam, q), n, real=True))
 
 
 def layer_trans_disc(q, sigma, r, grid=12, prec=128):
     def values(h):
         fam = Family(h, sigma)
-        return _C.layer_trans_values(fam, layer_nets(fam, q))
+        return _values(_C.layer_trans_series(fam, layer_nets(fam, q), 0))
     with ctx.workprec(prec):
         return disc_bound(values, r, grid)
 
@@ -244,8 +259,10 @@ def layer_trans_disc(q, sigma, r, grid=12, prec=128):
 def layer_coord(q, sigma, n, r, grid=12, prec=128):
     """(Taylor coefficients {curve: [m: 4 arb]}, disc bounds {curve: M}) of Y on layer quadrant q's outer curves."""
     with ctx.workprec(prec), series_cap(n):
-        T = _C.layer_y_series(layer_nets(Family(series_variable(n), sigma), q), n)
-        M = disc_bound(lambda h: _C.layer_y_values(layer_nets(Family(h, sigma), q)), r, grid) if grid else {}
+        T = _real(_C.layer_y_series(layer_nets(Family(series_variable(n), sigma), q), n, real=True))
+        M = {}
+        if grid:
+            M = disc_bound(lambda h: _values(_C.layer_y_series(layer_nets(Family(h, sigma), q), 0)), r, grid)
         return T, M
 
 
@@ -717,7 +734,7 @@ def main(argv=None):
     rho = exact_zeros()
     print("Z  exact in Q(sqrt 5): rho = v^(0) is the eigenvector of B(1) for L0 = (6 + sqrt 20)/16 with "
           "rho(a, b) = rho(b, a), and adj(L0 - B(1)) kappa is a non-zero multiple of rho (the facts the dropped "
-          "coefficients rest on); rho = (" + ", ".join(f"{float(z.a) + float(z.b) * 0.6545084971874737:.6f}"
+          "coefficients rest on); rho = (" + ", ".join(f"{float(z.c[0].p) + float(z.c[0].q) * 5 ** 0.5:.6f}"
                                                       for z in rho) + ")")
     t = time.time()
     zmod = _zeros_script()

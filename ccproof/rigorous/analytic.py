@@ -6,8 +6,8 @@ if |f| <= M on the disc, the coefficients satisfy |f_m| <= M / r^m, so
 
     |sum_(m > n) f_m h^m| <= M h^(n+1) / (r^(n+1) (1 - h/r)).
 
-:func:`disc_bound` finds M by covering the square [-r, r]^2 (which contains the disc) with acb boxes, the
-quantity evaluated on each box in ball arithmetic; :class:`AnalyticModel` holds the coefficients (acb
+:func:`disc_bound` finds M by covering the disc with the acb boxes of a grid on the square [-r, r]^2 that
+meet it, the quantity evaluated on each box in ball arithmetic; :class:`AnalyticModel` holds the coefficients (acb
 matrices, the Taylor coefficients of every entry) and M per column and encloses f(h)/h^low, the terms below
 ``low`` being 0 exactly (the caller shows that). Nothing here is specific to one quantity.
 """
@@ -27,21 +27,31 @@ def ball(lo, hi):
     return arb((lo + hi) / 2, (hi - lo) / 2)
 
 
-def square_boxes(r, grid):
-    """The grid x grid acb boxes covering the square [-r, r]^2 of the complex plane (r > 0 exact).
+def _near(a, grid):
+    """The distance from 0 of the nearest point of the a-th of ``grid`` equal intervals of [-1, 1], times
+    grid/2 (an integer: the edges are -1 + 2a/grid)."""
+    lo, hi = 2 * a - grid, 2 * a + 2 - grid
+    return 0 if lo <= 0 <= hi else min(abs(lo), abs(hi))
 
-    >>> len(list(square_boxes(fmpq(1, 2), 3)))
-    9
+
+def disc_boxes(r, grid):
+    """The acb boxes of the grid x grid grid on the square [-r, r]^2 of the complex plane (r > 0 exact) that
+    meet the closed disc |h| <= r (an exact integer test; the corners of the square are left out).
+
+    >>> len(list(disc_boxes(fmpq(1, 2), 3))), len(list(disc_boxes(fmpq(1, 2), 4))), len(list(disc_boxes(1, 12)))
+    (9, 16, 132)
     """
     r = fmpq(r)
     edges = [-r + 2 * r * fmpq(a, grid) for a in range(grid + 1)]
     for a in range(grid):
         for b in range(grid):
-            yield acb(ball(edges[a], edges[a + 1]), ball(edges[b], edges[b + 1]))
+            if _near(a, grid) ** 2 + _near(b, grid) ** 2 <= grid ** 2:
+                yield acb(ball(edges[a], edges[a + 1]), ball(edges[b], edges[b + 1]))
 
 
 def disc_bound(values, r, grid):
-    """{key: M} with |z| <= M for every entry z of ``values(h)[key]`` and every complex h in [-r, r]^2.
+    """{key: M} with |z| <= M for every entry z of ``values(h)[key]`` and every complex h of the disc |h| <= r
+    (on the boxes of :func:`disc_boxes`; finite values on a box prove the quantity analytic there).
 
     Parameters
     ----------
@@ -67,11 +77,11 @@ def disc_bound(values, r, grid):
     (True, True)
     """
     M = {}
-    for i, h in enumerate(square_boxes(r, grid)):
+    for i, h in enumerate(disc_boxes(r, grid)):
         for key, zs in values(h).items():
             bound = max((abs(acb(z)).upper() for z in zs), key=lambda x: x)
             if not bound.is_finite():
-                raise ZeroDivisionError(f"disc box {divmod(i, grid)}, {key}: no bound")
+                raise ZeroDivisionError(f"disc box {i} ({h}), {key}: no bound")
             M[key] = bound if key not in M or bound > M[key] else M[key]
     return M
 
@@ -142,8 +152,9 @@ class AnalyticModel:
         """Re sum_k weights[k] f_k(h)/h^low for every row (a list of arb), every h in [h_lo, h_hi]: the rows
         of :meth:`enclose` times the weights (acb), and |Re w e| <= (|Re w| + |Im w|) rho for |e| <= rho."""
         V, rho = self.enclose(h_lo, h_hi, low)
-        vals = V * acb_mat([[acb(w)] for w in weights])
-        rad = sum(((abs(acb(w).real) + abs(acb(w).imag)) * t for w, t in zip(weights, rho)), arb(0)).upper()
+        ws = [acb(w) for w in weights]
+        vals = V * acb_mat([[w] for w in ws])
+        rad = sum(((abs(w.real) + abs(w.imag)) * t for w, t in zip(ws, rho)), arb(0)).upper()
         return [vals[c, 0].real + arb(0, rad) for c in range(vals.nrows())]
 
 
@@ -160,4 +171,4 @@ def hull(balls):
     return out
 
 
-__all__ = ["AnalyticModel", "ball", "cauchy_factor", "disc_bound", "hull", "square_boxes"]
+__all__ = ["AnalyticModel", "ball", "cauchy_factor", "disc_bound", "disc_boxes", "hull"]

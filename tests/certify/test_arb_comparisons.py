@@ -59,7 +59,7 @@ REVIEWED = {
     ("dart_tail.py", 'field_of(m, "orientation", int, "map") != 1'): "ints",
     ("dart_tail.py", 's.count("/") != 1'): "ints",
     ("dart_family.py", "got != n_at(x)"): "lists of fmpq (exact)",
-    ("dart_family.py", "not arg.real > 0"): "refuses unless certainly off the cut: conservative",
+    ("dart_family.py", "not ((1 + c) * (9 + c)).real > 0"): "refuses unless certainly off the cut: conservative",
     ("dart_zeros.py", "(s * p) % _M3 != 1"): "fmpq_poly (exact)",
     ("dart_zeros.py", "w != 0"): "fmpq Bernstein weights (exact)",
     ("statement.py", "g != 0"): "fmpq_poly (exact)",

@@ -17,20 +17,20 @@ def box0():
 
 
 def test_the_signs_of_w_on_bulk_boxes(box0):
-    assert box0.x_bulk([(fmpq(1, 4), fmpq(26, 100)), H]) > 0
-    assert box0.y_bulk([(fmpq(1, 10), fmpq(11, 100)), H]) < 0
-    assert box0.y_bulk([(fmpq(45, 100), fmpq(46, 100)), H]) > 0
+    assert box0.evaluate("X", "bulk", [(fmpq(1, 4), fmpq(26, 100)), H]) > 0
+    assert box0.evaluate("Y", "bulk", [(fmpq(1, 10), fmpq(11, 100)), H]) < 0
+    assert box0.evaluate("Y", "bulk", [(fmpq(45, 100), fmpq(46, 100)), H]) > 0
     # Y changes sign near s = 0.30 (rays 25 to 35 at K = 101): a box across its zero proves neither sign
-    across = box0.y_bulk([(fmpq(25, 100), fmpq(35, 100)), H])
+    across = box0.evaluate("Y", "bulk", [(fmpq(25, 100), fmpq(35, 100)), H])
     assert not across > 0 and not across < 0
 
 
 def test_transversality_on_a_bulk_box_and_the_layer_sign(box0):
-    assert box0.transversal_bulk([(fmpq(1, 4), fmpq(26, 100)), H]) > 0
+    assert box0.evaluate("T", "bulk", [(fmpq(1, 4), fmpq(26, 100)), H]) > 0
     # K Y < 0 on layer quadrant 0 for small h; the whole range [0, 1/101] at once is too coarse for the model
-    assert box0.y_layer(0, [(fmpq(0), fmpq(1, 1010))]) < 0
+    assert box0.evaluate("Y", "layer", [(fmpq(0), fmpq(1, 1010))], 0) < 0
 
 
 def test_boxes_outside_the_disc_are_refused(box0):
     with pytest.raises(ZeroDivisionError):
-        box0.x_bulk([(fmpq(1, 4), fmpq(26, 100)), (fmpq(0), fmpq(1, 16))])
+        box0.evaluate("X", "bulk", [(fmpq(1, 4), fmpq(26, 100)), (fmpq(0), fmpq(1, 16))])

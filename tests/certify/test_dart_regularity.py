@@ -25,7 +25,7 @@ def models():
 
 def test_a_bulk_leaf_is_proved_for_every_k(models):
     b = models.sigma_box(0)
-    val = b.bulk(BOX)
+    val = b.evaluate("R", "bulk", BOX)
     assert val > 0
     # the union over the three pieces' coefficients is informative, not a huge ball that happens to be > 0
     assert val.rad() < 1
@@ -33,12 +33,12 @@ def test_a_bulk_leaf_is_proved_for_every_k(models):
 
 def test_an_order_too_low_for_the_cauchy_tail_proves_nothing(models):
     low = DartModels(LO, HI, _hints(order=4), 0, 128).sigma_box(0)
-    assert not low.bulk(BOX) > 0
+    assert not low.evaluate("R", "bulk", BOX) > 0
 
 
 def test_boxes_outside_the_disc_and_unknown_sigma_boxes_are_refused(models):
     with pytest.raises(ZeroDivisionError):
-        models.sigma_box(0).bulk([(fmpq(1, 4), fmpq(26, 100)), (fmpq(0), fmpq(1, 16))])
+        models.sigma_box(0).evaluate("R", "bulk", [(fmpq(1, 4), fmpq(26, 100)), (fmpq(0), fmpq(1, 16))])
     with pytest.raises(IndexError):
         models.sigma_box(10)
 
@@ -56,7 +56,7 @@ def test_the_models_enclose_the_per_k_verifiers_det_at_k_101():
     with ctx.workprec(128):
         ref = mod._verifier_kdet(k, q)
         models = DartModels(LO, HI, _hints(grid=12), 0, 128)
-        ball = models.sigma_box(0).bulk([(fmpq(q, k), fmpq(q, k)), (fmpq(1, k), fmpq(1, k))])
+        ball = models.sigma_box(0).evaluate("R", "bulk", [(fmpq(q, k), fmpq(q, k)), (fmpq(1, k), fmpq(1, k))])
         values = [c for p in PIECES for c in ref[p]]
         assert all(ball.overlaps(c) for c in values)
         lo = min((c.lower() for c in values), key=lambda x: x)

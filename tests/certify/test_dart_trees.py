@@ -75,7 +75,7 @@ def test_a_w_sign_tree_on_the_real_models():
     box0 = DartModels(fmpq(4484, 1000), fmpq(44935, 10000), hints, 0, 128).sigma_box(0)
     root = [(fmpq(1, 4), fmpq(7, 20)), (fmpq(0), fmpq(1, 101))]
     tree = _tree(*[([i, 0], "", {"bound": "1e-3"}) for i in range(10)], grid=(10, 1))
-    count, least = replay_tree(read_tree(tree, root, "X>0 bulk", 1), box0.x_bulk, 1, "X>0 bulk")
+    count, least = replay_tree(read_tree(tree, root, "X>0 bulk", 1), box0.evaluator(("X", "bulk", None)), 1, "X>0 bulk")
     assert count == 10 and least == fmpq(1, 1000)
     with pytest.raises(CertificateError, match="claims"):
-        replay_tree(read_tree(tree, root, "Y>0 bulk", 1), box0.y_bulk, 1, "Y>0 bulk")
+        replay_tree(read_tree(tree, root, "Y>0 bulk", 1), box0.evaluator(("Y", "bulk", None)), 1, "Y>0 bulk")

@@ -21,21 +21,22 @@ def box0():
 
 def test_a_cover_round_trips_through_the_verifiers_trees(box0):
     root = [(fmpq(1, 4), fmpq(7, 20)), H]
-    tree = cover(root, box0.x_bulk, 1, [4, 1])
-    count, least = replay_tree(read_tree(tree, root, "X>0 bulk", 1), box0.x_bulk, 1, "X>0 bulk")
+    tree = cover(root, box0.evaluator(("X", "bulk", None)), 1, [4, 1])
+    count, least = replay_tree(read_tree(tree, root, "X>0 bulk", 1), box0.evaluator(("X", "bulk", None)), 1, "X>0 bulk")
     assert count == len(tree["leaves"]) and least > 0
     # a bound raised past what the model encloses FAILs in the verifier
     forged = {"grid": tree["grid"], "leaves": [dict(leaf) for leaf in tree["leaves"]]}
     forged["leaves"][0]["bound"] = str(float(forged["leaves"][0]["bound"]) * 10)
     with pytest.raises(CertificateError, match="claims"):
-        replay_tree(read_tree(forged, root, "X>0 bulk", 1), box0.x_bulk, 1, "X>0 bulk")
+        replay_tree(read_tree(forged, root, "X>0 bulk", 1), box0.evaluator(("X", "bulk", None)), 1, "X>0 bulk")
 
 
 def test_negative_claims_and_the_layer(box0):
     root = [(fmpq(0), fmpq(1, 1010))]
-    tree = cover(root, lambda b: box0.y_layer(0, b), -1, [1])
+    tree = cover(root, lambda b: box0.evaluate("Y", "layer", b, 0), -1, [1])
     assert all(leaf["bound"].startswith("-") for leaf in tree["leaves"])
-    assert replay_tree(read_tree(tree, root, "Y<0 layer", -1), lambda b: box0.y_layer(0, b), -1, "l")[0] >= 1
+    layer0 = box0.evaluator(("Y", "layer", 0))
+    assert replay_tree(read_tree(tree, root, "Y<0 layer", -1), layer0, -1, "l")[0] >= 1
 
 
 def test_a_false_claim_stays_undecided():

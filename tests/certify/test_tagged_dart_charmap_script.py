@@ -266,12 +266,13 @@ def test_the_exact_facts_behind_the_dropped_coefficients():
     mod = _load()
     with ctx.workprec(128):
         rho = mod.exact_zeros()
-        L0 = (6 + arb(20).sqrt()) / 16
         fam = mod.Family(acb(0), arb("4.49"))
         for z, vx, vy in zip(rho, fam.vx, fam.vy):
-            want = arb(z.a) + arb(z.b) * L0
+            e = z.c[0]  # p + q sqrt 5 + i (r + u sqrt 5), constant in h
+            assert e.r == 0 and e.u == 0 and all(x.p == x.q == x.r == x.u == 0 for x in z.c[1:])
+            want = arb(e.p) + arb(e.q) * arb(5).sqrt()
             assert abs(acb(vx) - want) < 1e-30 and abs(acb(vy) - want) < 1e-30
-        assert rho[2] == mod.QL0(-4, 8)  # rho(1,1) = sqrt 5 - 1 = -4 + 8 L0
+        assert (rho[2].c[0].p, rho[2].c[0].q) == (-1, 1)  # rho(1,1) = sqrt 5 - 1
 
 
 def _load_zeros():

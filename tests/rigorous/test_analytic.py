@@ -1,13 +1,13 @@
 """ccproof.rigorous.analytic: the disc bound and the Cauchy remainder against functions known in closed form.
 
-f(h) = 1/(1 - h) has Taylor coefficients 1 (exact) and |f| <= 1/(1 - sqrt 2 r) on the square [-r, r]^2, whose
-corners lie at distance sqrt 2 r from 0; its values at sample points are computed independently in fmpq.
+f(h) = 1/(1 - h) has Taylor coefficients 1 (exact) and |f| <= 1/(1 - r) on the disc |h| <= r (the grid's boxes
+that meet the disc reach at most sqrt 2 r from 0); its values at sample points are computed independently in fmpq.
 """
 
 import pytest
 from flint import acb, acb_mat, arb, ctx, fmpq
 
-from ccproof.rigorous.analytic import AnalyticModel, ball, cauchy_factor, disc_bound, hull, square_boxes
+from ccproof.rigorous.analytic import AnalyticModel, ball, cauchy_factor, disc_bound, disc_boxes, hull
 
 R = fmpq(1, 2)
 
@@ -16,19 +16,29 @@ def geometric(order, M):
     return AnalyticModel([acb_mat([[acb(1)], [acb(2)]]) for _ in range(order + 1)], [M, M], R)
 
 
-def test_the_boxes_cover_the_square_and_nothing_far_outside():
-    boxes = list(square_boxes(R, 4))
-    assert len(boxes) == 16
-    for z in (acb(fmpq(1, 2), fmpq(1, 2)), acb(fmpq(-1, 2), fmpq(-1, 2)), acb(fmpq(1, 7), fmpq(-2, 9))):
+def test_the_boxes_cover_the_disc_and_leave_out_the_far_corners():
+    boxes = list(disc_boxes(R, 4))
+    assert len(boxes) == 16  # at grid 4 every box meets the disc (the corner boxes at distance R/sqrt 2)
+    for z in (acb(fmpq(1, 2), fmpq(0)), acb(fmpq(-1, 3), fmpq(-1, 3)), acb(fmpq(1, 7), fmpq(-2, 9))):
         assert any(b.real.contains(z.real) and b.imag.contains(z.imag) for b in boxes)
     assert not any(b.real.contains(fmpq(3, 4)) for b in boxes)
+    # grid 12: a box is kept iff its point nearest 0 lies in the closed disc (checked here on a fine sample
+    # of points of the disc: each lies in a kept box), and the 3 boxes at each corner are left out
+    fine = list(disc_boxes(R, 12))
+    assert len(fine) == 144 - 12
+    for i in range(-12, 13):
+        for j in range(-12, 13):
+            z = acb(R * fmpq(i, 12), R * fmpq(j, 12))
+            if fmpq(i * i + j * j, 144) <= 1:
+                assert any(b.real.contains(z.real) and b.imag.contains(z.imag) for b in fine), (i, j)
+    assert not any(b.real.contains(R * fmpq(23, 24)) and b.imag.contains(R * fmpq(23, 24)) for b in fine)
 
 
 def test_the_disc_bound_holds_the_maximum_and_fails_where_the_function_has_a_pole():
     with ctx.workprec(128):
         M = disc_bound(lambda h: {"f": [1 / (1 - h)]}, fmpq(1, 4), 8)["f"]
-        # the maximum of |1/(1 - h)| on the square is at the corner 1/4 + i/4: 1/|3/4 - i/4| = 4/sqrt(10)
-        assert M >= 4 / arb(10).sqrt()
+        # the maximum of |1/(1 - h)| on the disc |h| <= 1/4 is at h = 1/4: 4/3
+        assert M >= arb(4) / 3
         assert M < 2  # and the grid keeps it informative
         with pytest.raises(ZeroDivisionError):  # the pole h = 1 lies in [-1, 1]^2: no finite bound
             disc_bound(lambda h: {"f": [1 / (1 - h)]}, fmpq(1), 4)

@@ -16,76 +16,42 @@ from .dart_family import (
     PIECES,
     XB,
     YB,
-    bezier_product,
     curve_trans_series,
     series_coeffs,
     series_curves,
 )
 from .dart_regularity import mode_factors, real_hull
-from .maps import STAR_CURVES, curve_points
+from .maps import STAR_CURVES
 
 
-def _logs(fam):
-    """(a1, a2) = (-ln lam1, -ln lam2) at an acb h (ZeroDivisionError unless certainly off the cut)."""
-    if not (acb(fam.lam1).real > 0 and acb(fam.lam2).real > 0):
+def _log_coeffs(fam, n, real=False):
+    """The Taylor coefficients of (a1, a2) = (-ln lam1, -ln lam2) (at an acb h, the values: ZeroDivisionError
+    unless certainly off the branch cut)."""
+    if isinstance(fam.lam1, acb) and not (acb(fam.lam1).real > 0 and acb(fam.lam2).real > 0):
         raise ZeroDivisionError("log lam: not certainly off the branch cut")
-    return -acb(fam.lam1).log(), -acb(fam.lam2).log()
-
-
-def _trans(X, Y, a1, a2):
-    return [a1 * p - a2 * q for p, q in zip(bezier_product(X, Y), bezier_product(Y, X))]
-
-
-def trans_values(fam, nets):
-    """{(i, j, curve): the 6 Bernstein coefficients of a1 X_i Y_j' - a2 Y_j X_i'} at one acb h."""
-    a1, a2 = _logs(fam)
-    return {(i, j, c): _trans(curve_points(nets[i], c, oriented=True), curve_points(nets[j], c, oriented=True),
-                              a1, a2)
-            for i in XB for j in YB for c in STAR_CURVES}
-
-
-def layer_trans_values(fam, lnets):
-    """{curve: the 6 Bernstein coefficients of a1 X Y' - a2 Y X'} of one layer quadrant at one acb h."""
-    a1, a2 = _logs(fam)
-    xs, ys = ({p: lnets[p][k] for p in PIECES} for k in (0, 1))
-    return {c: _trans(curve_points(xs, c, oriented=True), curve_points(ys, c, oriented=True), a1, a2)
-            for c in STAR_CURVES}
-
-
-def coord_values(nets, coord):
-    """{(basis part, curve): its 4 Bezier points} of x (coord "x") or y ("y") at one acb h."""
-    return {(part, c): curve_points(nets[part], c, oriented=True)
-            for part in (XB if coord == "x" else YB) for c in STAR_CURVES}
-
-
-def layer_y_values(lnets):
-    """{curve: 4 Bezier points of Y} of one layer quadrant at one acb h."""
-    return {c: curve_points({p: lnets[p][1] for p in PIECES}, c, oriented=True) for c in STAR_CURVES}
+    return [series_coeffs(-lam.log(), n + 1, real) for lam in (fam.lam1, fam.lam2)]
 
 
 def trans_series(fam, nets, n):
-    """As :func:`trans_values` for the series family: {(i, j, curve): [coefficient list of h^m]};
-    T_ij(0) = 0 exactly (a1 = a2, both parts multiples of one real curve at h = 0)."""
-    A1, A2 = (series_coeffs(-lam.log(), n + 1) for lam in (fam.lam1, fam.lam2))
+    """{(i, j, curve): [the 6 Bernstein coefficients of a1 X_i Y_j' - a2 Y_j X_i' of h^m, m = 0..n]} (series;
+    values with n = 0); T_ij(0) = 0 exactly (a1 = a2, both parts multiples of one real curve at h = 0)."""
+    A1, A2 = _log_coeffs(fam, n)
     curves = {b: series_curves(nets[b], n) for b in nets}
     return {(i, j, c): curve_trans_series(curves[i][c], curves[j][c], A1, A2, n)
             for i in XB for j in YB for c in STAR_CURVES}
 
 
-def layer_trans_series(fam, lnets, n):
-    """{curve: [coefficients (arb) of h^m]} of a1 X Y' - a2 Y X' on a layer quadrant (h^0..h^2: 0 exactly)."""
-    A1, A2 = ([z.real for z in series_coeffs(-lam.log(), n + 1)] for lam in (fam.lam1, fam.lam2))
-    xs, ys = (series_curves({p: lnets[p][k] for p in PIECES}, n) for k in (0, 1))
-    real = {c: ([[z.real for z in pts] for pts in xs[c]], [[z.real for z in pts] for pts in ys[c]])
-            for c in STAR_CURVES}
-    return {c: [[z.real for z in row] for row in curve_trans_series(real[c][0], real[c][1], A1, A2, n)]
-            for c in STAR_CURVES}
+def layer_trans_series(fam, lnets, n, real=False):
+    """{curve: [coefficients of h^m]} of a1 X Y' - a2 Y X' on a layer quadrant (h^0..h^2: 0 exactly; ``real``:
+    of the real parts)."""
+    A1, A2 = _log_coeffs(fam, n, real)
+    xs, ys = (series_curves({p: lnets[p][k] for p in PIECES}, n, real) for k in (0, 1))
+    return {c: curve_trans_series(xs[c], ys[c], A1, A2, n) for c in STAR_CURVES}
 
 
-def layer_y_series(lnets, n):
-    """{curve: [m: 4 arb]}: Taylor coefficients of Y's outer-curve points on a layer quadrant."""
-    ys = series_curves({p: lnets[p][1] for p in PIECES}, n)
-    return {c: [[z.real for z in pts] for pts in ys[c]] for c in STAR_CURVES}
+def layer_y_series(lnets, n, real=False):
+    """{curve: [m: 4 acb]}: Taylor coefficients of Y's outer-curve points on a layer quadrant."""
+    return series_curves({p: lnets[p][1] for p in PIECES}, n, real)
 
 
 def curve_models(T, M, r, parts):

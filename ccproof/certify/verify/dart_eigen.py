@@ -85,7 +85,7 @@ from flint import acb, arb, ctx, fmpq, fmpq_mat, fmpq_poly
 
 from ccproof.rigorous.analytic import ball
 
-from .dart_family import B_AT_1, N_POLYS, Family, adjugate, kappa, l0, layer_level0, u_denominator
+from .dart_family import B_AT_1, N_POLYS, Family, adjugate, kappa, l0, u_denominator
 from .errors import CertificateError
 from .rules import TWO_RING
 from .tagged_modes import RING_INDEX, check_ring, ring_block, ring_stencil
@@ -230,7 +230,7 @@ def _guard(fam, tol):
     alpha (lam - L0), ray 0's two sharp rows and the ring rows of sector 1 satisfied (balls containing 0,
     radii below tol; they are identities, items 1 and 2)."""
     lam, L0 = fam.lam2, l0()[0]
-    _, y, _, yc = layer_level0(fam, 0)
+    y, yc = fam.layer_level0(0)[1], fam.yc
     kap = kappa()
     res = [fam.vy[_E10] - 1, yc - fam.alpha * (lam - L0),
            (lam - fmpq(1, 2)) * y(0, (1, 0)) - yc / 2,
@@ -283,9 +283,7 @@ def check_eigenvector(sig_lo, sig_hi, k0, prec, balls=64, family=Family):
     sig_lo, sig_hi = fmpq(sig_lo), fmpq(sig_hi)
     if k0 < 7 or balls < 1:
         raise CertificateError(f"eigenvector lemma: K0 = {k0} < 7 or no h-balls")
-    old = ctx.prec
-    ctx.prec = prec
-    try:
+    with ctx.workprec(prec):
         pi = arb.pi()
         if not (arb(sig_lo) > pi and arb(sig_hi) < 2 * pi and sig_lo < sig_hi):
             raise CertificateError("eigenvector lemma: the bracket is not inside (pi, 2 pi)")
@@ -316,8 +314,6 @@ def check_eigenvector(sig_lo, sig_hi, k0, prec, balls=64, family=Family):
         return (f"eigenvector lemma for every K >= {k0}: ring rows and ray 0's rows identically (exact: reach, "
                 f"mode 0, crease row at {W_POINTS} w), centre residual changes sign on ({sig_lo}, {sig_hi}) on "
                 f"{balls} h-balls, the family (x's and y's bordered systems, U, alpha) regular on the whole bracket")
-    finally:
-        ctx.prec = old
 
 
 __all__ = ["W_POINTS", "check_crease_row", "check_eigenvector", "check_mode0", "check_reach",

@@ -27,7 +27,7 @@ from flint import acb, acb_mat, acb_poly, acb_series, arb, ctx, fmpq, fmpq_mat, 
 from .errors import CertificateError
 from .maps import STAR_CURVES, curve_points
 from .rules import CENTRE, canonical, level1_rule
-from .statement import horner
+from .statement import B2Z, horner, lam_of
 from .tagged_modes import RING_INDEX, ring_block, ring_stencil
 
 
@@ -47,9 +47,6 @@ class TaylorHints:
     order: int
     layer_order: int
     exp_order: int
-
-
-_B2Z = ((1, 4, 1, 0), (0, 4, 2, 0), (0, 2, 4, 0), (0, 1, 4, 1))  # uniform cubic B-spline -> Bezier, times 6
 
 
 _OFFSET = {"P1": (0, -1), "P2": (0, 0), "P3": (-1, 0)}  # as tagged_map: level-1 position of net[0][0]
@@ -106,13 +103,12 @@ def big_u(lam):
 
 
 def _lam_principal(c):
-    """lam(c) = (5 + c + sqrt((1 + c)(9 + c)))/16 (acb, arb or acb_series). On an acb ball the square root's
+    """lam(c) (:func:`.statement.lam_of`; acb, arb or acb_series). On an acb ball the square root's
     argument must lie in the right half-plane (off the principal branch's cut, so the value is analytic
     there: the Cauchy bounds need that); ZeroDivisionError otherwise."""
-    arg = (1 + c) * (9 + c)
-    if isinstance(arg, acb) and not arg.real > 0:
+    if isinstance(c, acb) and not ((1 + c) * (9 + c)).real > 0:
         raise ZeroDivisionError("sqrt((1 + c)(9 + c)): the argument is not certainly off the branch cut")
-    return (5 + c + arg.sqrt()) / 16
+    return lam_of(c)
 
 
 def series_variable(n):
@@ -137,10 +133,12 @@ class series_cap:
         ctx.cap = self.old
 
 
-def series_coeffs(z, n):
-    """The first n Taylor coefficients of the series z (acb; zeros past its length)."""
-    c = z.coeffs()
-    return [acb(c[i]) if i < len(c) else acb(0) for i in range(n)]
+def series_coeffs(z, n, real=False):
+    """The first n Taylor coefficients of the series z (acb; zeros past its length; with ``real`` their real
+    parts, for a quantity real for real h); a value (acb, arb: the quantity at one h) is its own coefficient of
+    h^0, so every function below serves both."""
+    c = z.coeffs() if isinstance(z, acb_series) else [z]
+    return [acb(c[i].real if real else c[i]) if i < len(c) else acb(0) for i in range(n)]
 
 
 def bordered_matrix(B, lam, zero, pivot=0):
@@ -160,7 +158,8 @@ def bordered(w, lam, pivot=0):
         sol = acb_mat(A).solve(acb_mat([[0]] * 6 + [[1]]))
         return [sol[i, 0] for i in range(6)]
     n = w.prec
-    Ak = [acb_mat([[series_coeffs(A[i][k], n)[m] for k in range(7)] for i in range(7)]) for m in range(n)]
+    cs = [[series_coeffs(A[i][k], n) for k in range(7)] for i in range(7)]
+    Ak = [acb_mat([[cs[i][k][m] for k in range(7)] for i in range(7)]) for m in range(n)]
     inv0 = Ak[0].inv()
     vs = [inv0 * acb_mat([[0]] * 6 + [[1]])]
     for m in range(1, n):
@@ -286,17 +285,22 @@ def quadrant_level1(level0, centre, lam, zero, q=None):
 
 
 def _bezier(net, zero):
-    """4 x 4 B-spline control values -> Bezier (one coordinate, any ring)."""
-    tmp = [[sum((net[r][j] * fmpq(c, 6) for c, r in zip(_B2Z[i], range(4)) if c), zero) for j in range(4)]
-           for i in range(4)]
-    return [[sum((tmp[i][r] * fmpq(c, 6) for c, r in zip(_B2Z[j], range(4)) if c), zero) for j in range(4)]
+    """4 x 4 B-spline control values -> Bezier (one coordinate, any ring): ``B2Z`` in both directions, integer
+    weights, one division by 36."""
+    tmp = [[sum((net[r][j] * c for r, c in enumerate(B2Z[i]) if c), zero) for j in range(4)] for i in range(4)]
+    return [[sum((tmp[i][r] * c for r, c in enumerate(B2Z[j]) if c), zero) / 36 for j in range(4)]
             for i in range(4)]
 
 
 def piece_nets(level0, centre, lam, zero, q=None):
     """{piece: 4 x 4 Bezier net} of one coordinate (or one basis part) on a bulk quadrant (``q`` None) or on
     the layer quadrant q (:func:`quadrant_level1`)."""
-    V = quadrant_level1(level0, centre, lam, zero, q)
+    value, memo = quadrant_level1(level0, centre, lam, zero, q), {}
+
+    def V(A, B):  # the three pieces share most of their level-1 points
+        if (A, B) not in memo:
+            memo[(A, B)] = value(A, B)
+        return memo[(A, B)]
     return {name: _bezier([[V(_OFFSET[name][0] + i, _OFFSET[name][1] + j) for j in range(4)] for i in range(4)], zero)
             for name in PIECES}
 
@@ -321,14 +325,21 @@ def _packed(nets, axis):
     return acb_poly(coeffs)
 
 
+def packed_partials(nets):
+    """(u-partial, v-partial) of a net given by its h^m coefficient nets (:func:`_packed`), for
+    :func:`det_series`: pack each factor once when it enters several determinants."""
+    return _packed(nets, 0), _packed(nets, 1)
+
+
 def det_series(A, B, n):
     """The h^m coefficients, m = 0..n, of D(A, B) = A_u B_v - A_v B_u for nets given by their h^m coefficient
-    nets ``A[m]``, ``B[m]`` (4 x 4, acb): the Cauchy products of Bernstein forms as one polynomial product each
-    (the scaled coefficients of a product are the plain convolution of the scaled factors, as in
-    :meth:`~ccproof.rigorous.BernsteinForm.__mul__`; h, u, v packed with the strides above). Returns
-    ``[[36 acb, (i, j) row-major] for m in 0..n]``: D's Bernstein coefficients (degree (5, 5))."""
-    P = _packed(A, 0) * _packed(B, 1) - _packed(A, 1) * _packed(B, 0)
-    c = P.coeffs()
+    nets ``A[m]``, ``B[m]`` (4 x 4, acb) or by their :func:`packed_partials`: the Cauchy products of
+    Bernstein forms as one polynomial product each (the scaled coefficients of a product are the plain
+    convolution of the scaled factors, as in :meth:`~ccproof.rigorous.BernsteinForm.__mul__`; h, u, v packed
+    with the strides above). Returns ``[[36 acb, (i, j) row-major] for m in 0..n]``: D's Bernstein
+    coefficients (degree (5, 5))."""
+    (Au, Av), (Bu, Bv) = (X if isinstance(X, tuple) else packed_partials(X) for X in (A, B))
+    c = (Au * Bv - Av * Bu).coeffs()
     c += [acb(0)] * max(0, _SH * (n + 1) - len(c))
     return [[c[m * _SH + i * _SU + j] / (_BIN5[i] * _BIN5[j]) for i in range(6) for j in range(6)]
             for m in range(n + 1)]
@@ -337,12 +348,6 @@ def det_series(A, B, n):
 def basis_nets(fam):
     """{basis part: {piece: 4 x 4 net}} of the family's five basis parts."""
     return {name: piece_nets(f, c, lam, fam.zero) for name, (f, c, lam) in fam.parts().items()}
-
-
-def layer_level0(fam, q):
-    """(x, y, x's centre, y's centre) of the layer quadrant q (:meth:`Modes.layer_level0`)."""
-    x, y = fam.layer_level0(q)
-    return x, y, fam.zero, fam.yc
 
 
 def layer_nets(fam, q):
@@ -364,11 +369,12 @@ def bezier_product(f, g):
     return out
 
 
-def series_curves(nets, n):
-    """{curve: [order m: 4 acb]} of one coordinate's nets {piece: 4 x 4 acb_series}."""
+def series_curves(nets, n, real=False):
+    """{curve: [order m: 4 acb]} of one coordinate's nets {piece: 4 x 4 acb_series} (``real``: as
+    :func:`series_coeffs`)."""
     out = {}
     for name in STAR_CURVES:
-        pts = [series_coeffs(z, n + 1) for z in curve_points(nets, name, oriented=True)]
+        pts = [series_coeffs(z, n + 1, real) for z in curve_points(nets, name, oriented=True)]
         out[name] = [[pts[p][m] for p in range(4)] for m in range(n + 1)]
     return out
 

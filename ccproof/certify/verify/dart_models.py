@@ -11,7 +11,7 @@ before any arithmetic; :func:`replay_map` replays them sigma box by sigma box (:
 
 from __future__ import annotations
 
-from flint import ctx, fmpq
+from flint import acb_series, ctx, fmpq
 
 from ccproof.rigorous.analytic import ball, disc_bound
 
@@ -21,6 +21,35 @@ from .dart_family import XB, YB, Family, basis_nets, layer_nets, series_cap, ser
 from .errors import CertificateError
 from .record import exact_keys
 from .replay import read_tree, replay_tree
+
+
+def quantities(fam, n, layers=(), bulk=True):
+    """{key: [coefficient list of h^m, m = 0..n]} of every quantity the models bound, from one family (of the
+    series variable; at an acb h with n = 0, the values there): ("R", i, j, piece) and ("T", i, j, curve) of
+    :mod:`.dart_regularity` and :mod:`.dart_curves`, ("X", part, curve), ("Y", part, curve) the outer curves'
+    points; ("RL", q, piece), ("TL", q, curve), ("YL", q, curve) on the layer quadrants q in ``layers``."""
+    out = {}
+    if bulk:
+        nets = basis_nets(fam)
+        out.update({("R",) + k: v for k, v in R.dets_series(nets, n).items()})
+        out.update({("T",) + k: v for k, v in C.trans_series(fam, nets, n).items()})
+        for tag, parts in (("X", XB), ("Y", YB)):
+            out.update({(tag, b, c): pts for b in parts for c, pts in series_curves(nets[b], n).items()})
+    real = isinstance(fam.h, acb_series)  # the layer's series: real coefficients (real nets for real h)
+    for q in layers:
+        ln = layer_nets(fam, q)
+        out.update({("RL", q, p): v for p, v in R.layer_dets_series(ln, n, real).items()})
+        out.update({("TL", q, c): v for c, v in C.layer_trans_series(fam, ln, n, real).items()})
+        out.update({("YL", q, c): v for c, v in C.layer_y_series(ln, n, real).items()})
+    return out
+
+
+def select(table, tag, q=None):
+    """The entries of one quantity of a :func:`quantities` table (or of its disc bounds), keyed without the
+    tag ("R", "T", "X", "Y"), or without (tag, q) for "RL", "TL", "YL" on layer quadrant q."""
+    if q is None:
+        return {key[1:]: v for key, v in table.items() if key[0] == tag}
+    return {key[2]: v for key, v in table.items() if key[:2] == (tag, q)}
 
 
 class DartModels:
@@ -41,7 +70,7 @@ class DartModels:
     >>> from ccproof.certify.verify.dart_family import TaylorHints
     >>> hints = TaylorHints(r=fmpq(1, 32), disc_grid=6, sigma_boxes=10, order=12, layer_order=14, exp_order=24)
     >>> box = DartModels(fmpq(4484, 1000), fmpq(44935, 10000), hints, 0, 128).sigma_box(0)
-    >>> box.bulk([(fmpq(1, 4), fmpq(26, 100)), (fmpq(0), fmpq(1, 101))]) > 0  # K det J_Phi, every K >= 101
+    >>> box.evaluate("R", "bulk", [(fmpq(1, 4), fmpq(26, 100)), (fmpq(0), fmpq(1, 101))]) > 0  # K det J_Phi, K >= 101
     True
     """
 
@@ -50,30 +79,10 @@ class DartModels:
         self.edges = [fmpq(sig_lo) + (fmpq(sig_hi) - fmpq(sig_lo)) * fmpq(i, hints.sigma_boxes)
                       for i in range(hints.sigma_boxes + 1)]
         with ctx.workprec(prec):
-            self.M = disc_bound(self._values(ball(sig_lo, sig_hi)), hints.r, hints.disc_grid)
+            sigma = ball(sig_lo, sig_hi)  # one family per acb box h, the values: the h^0 coefficients
+            self.M = disc_bound(lambda h: {k: v[0] for k, v in quantities(Family(h, sigma), 0, range(layer)).items()},
+                                hints.r, hints.disc_grid)
         self._boxes = {}
-
-    def _values(self, sigma):
-        def values(h):
-            fam = Family(h, sigma)
-            nets = basis_nets(fam)
-            out = {("R",) + k: v for k, v in R.det_values(nets).items()}
-            out.update({("T",) + k: v for k, v in C.trans_values(fam, nets).items()})
-            out.update({("X",) + k: v for k, v in C.coord_values(nets, "x").items()})
-            out.update({("Y",) + k: v for k, v in C.coord_values(nets, "y").items()})
-            for q in range(self.layer):
-                ln = layer_nets(fam, q)
-                out.update({("RL", q, p): v for p, v in R.layer_det_values(ln).items()})
-                out.update({("TL", q, c): v for c, v in C.layer_trans_values(fam, ln).items()})
-                out.update({("YL", q, c): v for c, v in C.layer_y_values(ln).items()})
-            return out
-        return values
-
-    def bounds(self, tag, q=None):
-        """The disc bounds of one quantity ("R", "T", "X", "Y"; "RL", "TL", "YL" with a layer quadrant q)."""
-        if q is None:
-            return {key[1:]: v for key, v in self.M.items() if key[0] == tag}
-        return {key[2]: v for key, v in self.M.items() if key[:2] == (tag, q)}
 
     def sigma_box(self, i):
         """The models on sigma box i of ``hints.sigma_boxes`` equal boxes of the bracket (cached)."""
@@ -92,14 +101,10 @@ class SigmaBox:
         with ctx.workprec(prec):
             self.sigma = sigma = ball(models.edges[i], models.edges[i + 1])
             with series_cap(hn.order):
-                fam = Family(series_variable(hn.order), sigma)
-                nets = basis_nets(fam)
-                TR, TT = R.dets_series(nets, hn.order), C.trans_series(fam, nets, hn.order)
-                coord = {b: series_curves(nets[b], hn.order) for b in XB + YB}
-            self.R = R.bulk_models(TR, models.bounds("R"), r)
-            self.T = R.bulk_models(TT, models.bounds("T"), r)
-            self.X = C.curve_models({(b, c): p for b in XB for c, p in coord[b].items()}, models.bounds("X"), r, XB)
-            self.Y = C.curve_models({(b, c): p for b in YB for c, p in coord[b].items()}, models.bounds("Y"), r, YB)
+                Q = quantities(Family(series_variable(hn.order), sigma), hn.order)
+            M = models.M
+            self.R, self.T = (R.bulk_models(select(Q, t), select(M, t), r) for t in ("R", "T"))
+            self.X, self.Y = (C.curve_models(select(Q, t), select(M, t), r, ps) for t, ps in (("X", XB), ("Y", YB)))
             self.om, self.omy = R.omegas(sigma), R.y_omegas(sigma)
             self.ER = {p: R.middle_coeffs(m, self.om, 1, 2, L=hn.exp_order) for p, m in self.R.items()}
             self.ET = {p: R.middle_coeffs(m, self.om, 1, 2, L=hn.exp_order) for p, m in self.T.items()}
@@ -108,78 +113,47 @@ class SigmaBox:
 
     def _layers(self, n, r):
         with series_cap(n):
-            fam = Family(series_variable(n), self.sigma)
-            self.L = {}
-            for q in range(self.m.layer):
-                ln = layer_nets(fam, q)
-                self.L[q] = (R.column_models(R.layer_dets_series(ln, n), self.m.bounds("RL", q), r),
-                             R.column_models(C.layer_trans_series(fam, ln, n), self.m.bounds("TL", q), r),
-                             R.column_models(C.layer_y_series(ln, n), self.m.bounds("YL", q), r))
+            Q = quantities(Family(series_variable(n), self.sigma), n, range(self.m.layer), bulk=False)
+        self.L = {q: tuple(R.column_models(select(Q, t, q), select(self.m.M, t, q), r) for t in ("RL", "TL", "YL"))
+                  for q in range(self.m.layer)}
 
     def evaluator(self, method):
-        """The evaluator (box) -> arb that :func:`map_regions` names: a method, or (method, layer quadrant)."""
-        if isinstance(method, tuple):
-            fn, q = getattr(self, method[0]), method[1]
-            return lambda box: fn(q, box)
-        return getattr(self, method)
+        """The evaluator (box) -> arb that :func:`map_regions` names: method = (quantity, region, layer
+        quadrant or None); see :meth:`evaluate`."""
+        return lambda box: self.evaluate(*method[:2], box, method[2])
 
-    def bulk(self, box):
-        """K det J_Phi on (s, h) in the box (the bulk, s in [s0, 1/2])."""
-        (s_lo, s_hi), (h_lo, h_hi) = box
-        return R.kdet_box(self.R, s_lo, s_hi, h_lo, h_hi, self.sigma, prec=self.m.prec)
+    def evaluate(self, quantity, region, box, q=None):
+        """One arb holding the quantity's scaled values on a box (a list of (lo, hi) fmpq) of its region:
 
-    def _middle(self, models, E, box, om=None, m0=1, q=2):
-        (s_lo, s_hi), (w_lo, w_hi) = box
-        return R.middle_box(models, E, om or self.om, s_lo, s_hi, w_lo, w_hi, m0, q, L=self.m.hints.exp_order,
-                            prec=self.m.prec)
-
-    def middle(self, box):
-        """K^3 det J_Phi/q^2 as a function of (s, w = 1/q) in the box (the middle)."""
-        return self._middle(self.R, self.ER, box)
-
-    def layer(self, q, box):
-        """K^3 det J_Phi of layer quadrant q on h in the box."""
-        ((h_lo, h_hi),) = box
-        return R.layer_box(self.L[q][0], h_lo, h_hi, prec=self.m.prec)
-
-    def transversal_bulk(self, box):
-        """K (a1 X Y' - a2 Y X') on the four outer curves, (s, h) in the box."""
-        (s_lo, s_hi), (h_lo, h_hi) = box
-        return R.kdet_box(self.T, s_lo, s_hi, h_lo, h_hi, self.sigma, prec=self.m.prec)
-
-    def transversal_middle(self, box):
-        """K^3 (a1 X Y' - a2 Y X')/q^2 as a function of (s, w = 1/q) in the box."""
-        return self._middle(self.T, self.ET, box)
-
-    def transversal_layer(self, q, box):
-        """K^3 (a1 X Y' - a2 Y X') on layer quadrant q's outer curves, h in the box."""
-        ((h_lo, h_hi),) = box
-        return R.layer_box(self.L[q][1], h_lo, h_hi, prec=self.m.prec)
-
-    def x_bulk(self, box):
-        """X on every outer-curve Bezier point, (s, h) in the box."""
-        (s_lo, s_hi), (h_lo, h_hi) = box
-        return C.coord_box(self.X, s_lo, s_hi, h_lo, h_hi, self.sigma, "x", prec=self.m.prec)
-
-    def y_bulk(self, box):
-        """Y on every outer-curve Bezier point, (s, h) in the box."""
-        (s_lo, s_hi), (h_lo, h_hi) = box
-        return C.coord_box(self.Y, s_lo, s_hi, h_lo, h_hi, self.sigma, "y", prec=self.m.prec)
-
-    def y_middle(self, box):
-        """Y/s on every outer-curve Bezier point, (s, w) in the box."""
-        return self._middle(self.Y, self.EY, box, self.omy, 0, 1)
-
-    def y_layer(self, q, box):
-        """K Y on layer quadrant q's outer-curve points (K^2 Y at ray 0's end point of quadrant 0), h in the box."""
-        ((h_lo, h_hi),) = box
-        return C.layer_y_box(self.L[q][2], q, h_lo, h_hi, prec=self.m.prec)
+        ========  ===========================  ===================================  ================================
+        quantity  bulk (s, h)                  middle (s, w = 1/q)                  layer quadrant q (h)
+        ========  ===========================  ===================================  ================================
+        R         K det J_Phi                  K^3 det J_Phi/q^2                    K^3 det J_Phi
+        T         K (a1 X Y' - a2 Y X')        K^3 (a1 X Y' - a2 Y X')/q^2          K^3 (a1 X Y' - a2 Y X')
+        X, Y      X, Y on the Bezier points    Y/s on the Bezier points             K Y (K^2 Y at ray 0's end)
+        ========  ===========================  ===================================  ================================
+        """
+        prec = self.m.prec
+        if region == "layer":
+            ((h_lo, h_hi),) = box
+            models = self.L[q]["RTY".index(quantity)]
+            if quantity == "Y":
+                return C.layer_y_box(models, q, h_lo, h_hi, prec=prec)
+            return R.layer_box(models, h_lo, h_hi, prec=prec)
+        (s_lo, s_hi), (t_lo, t_hi) = box
+        if region == "middle":
+            models, E, om, m0, order = {"R": (self.R, self.ER, self.om, 1, 2), "T": (self.T, self.ET, self.om, 1, 2),
+                                        "Y": (self.Y, self.EY, self.omy, 0, 1)}[quantity]
+            return R.middle_box(models, E, om, s_lo, s_hi, t_lo, t_hi, m0, order, L=self.m.hints.exp_order, prec=prec)
+        if quantity in "RT":
+            return R.kdet_box(getattr(self, quantity), s_lo, s_hi, t_lo, t_hi, self.sigma, prec=prec)
+        return C.coord_box(getattr(self, quantity), s_lo, s_hi, t_lo, t_hi, self.sigma, quantity.lower(), prec=prec)
 
 
 def map_regions(k0, s0, layer, winding):
-    """Every tree list of a record's ``parts``: (name, keys into ``parts``, root box, evaluator of
-    :class:`SigmaBox`, sign of the claim, ``outside`` leaves allowed); the roots are fixed by K0 and the
-    regions, never by the file. The prover covers the same lists.
+    """Every tree list of a record's ``parts``: (name, keys into ``parts``, root box, (quantity, region, layer
+    quadrant) of :meth:`SigmaBox.evaluate`, sign of the claim, ``outside`` leaves allowed); the roots are fixed by
+    K0 and the regions, never by the file. The prover covers the same lists.
 
     >>> [r[:2] for r in map_regions(101, fmpq(1, 20), 3, (fmpq(1, 4), fmpq(7, 20)))][-1]
     ('Y<0 layer 2', ('winding', 'Y<0 layer', '2'))
@@ -187,19 +161,18 @@ def map_regions(k0, s0, layer, winding):
     s_a, s_b = winding
     half, h0 = fmpq(1, 2), fmpq(1, k0)
     bulk, middle = [(s0, half), (fmpq(0), h0)], [(fmpq(0), s0), (fmpq(0), fmpq(1, layer))]
-    out = [("R bulk", ("regularity", "bulk"), bulk, "bulk", 1, False),
-           ("R middle", ("regularity", "middle"), middle, "middle", 1, True),
-           ("T bulk", ("transversal", "bulk"), bulk, "transversal_bulk", 1, False),
-           ("T middle", ("transversal", "middle"), middle, "transversal_middle", 1, True),
-           ("Y<0 bulk", ("winding", "Y<0 bulk"), [(s0, s_a), (fmpq(0), h0)], "y_bulk", -1, False),
-           ("X>0 bulk", ("winding", "X>0 bulk"), [(s_a, s_b), (fmpq(0), h0)], "x_bulk", 1, False),
-           ("Y>0 bulk", ("winding", "Y>0 bulk"), [(s_b, half), (fmpq(0), h0)], "y_bulk", 1, False),
-           ("Y<0 middle", ("winding", "Y<0 middle"), middle, "y_middle", -1, True)]
+    out = [("R bulk", ("regularity", "bulk"), bulk, ("R", "bulk", None), 1, False),
+           ("R middle", ("regularity", "middle"), middle, ("R", "middle", None), 1, True),
+           ("T bulk", ("transversal", "bulk"), bulk, ("T", "bulk", None), 1, False),
+           ("T middle", ("transversal", "middle"), middle, ("T", "middle", None), 1, True),
+           ("Y<0 bulk", ("winding", "Y<0 bulk"), [(s0, s_a), (fmpq(0), h0)], ("Y", "bulk", None), -1, False),
+           ("X>0 bulk", ("winding", "X>0 bulk"), [(s_a, s_b), (fmpq(0), h0)], ("X", "bulk", None), 1, False),
+           ("Y>0 bulk", ("winding", "Y>0 bulk"), [(s_b, half), (fmpq(0), h0)], ("Y", "bulk", None), 1, False),
+           ("Y<0 middle", ("winding", "Y<0 middle"), middle, ("Y", "middle", None), -1, True)]
     for q in range(layer):
-        out += [(f"R layer {q}", ("regularity", "layer", str(q)), [(fmpq(0), h0)], ("layer", q), 1, False),
-                (f"T layer {q}", ("transversal", "layer", str(q)), [(fmpq(0), h0)], ("transversal_layer", q), 1,
-                 False),
-                (f"Y<0 layer {q}", ("winding", "Y<0 layer", str(q)), [(fmpq(0), h0)], ("y_layer", q), -1, False)]
+        out += [(f"R layer {q}", ("regularity", "layer", str(q)), [(fmpq(0), h0)], ("R", "layer", q), 1, False),
+                (f"T layer {q}", ("transversal", "layer", str(q)), [(fmpq(0), h0)], ("T", "layer", q), 1, False),
+                (f"Y<0 layer {q}", ("winding", "Y<0 layer", str(q)), [(fmpq(0), h0)], ("Y", "layer", q), -1, False)]
     return out
 
 

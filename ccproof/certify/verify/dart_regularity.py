@@ -13,25 +13,26 @@ from flint import acb, acb_mat, arb, ctx, fmpq
 
 from ccproof.rigorous.analytic import AnalyticModel, ball, cauchy_factor, hull
 
-from .dart_family import PIECES, XB, YB, det_series, series_coeffs
+from .dart_family import PIECES, XB, YB, det_series, packed_partials, series_coeffs
 
 IJ = [(i, j) for i in XB for j in YB]  # the columns of the bulk models
-
-
-def det_values(nets):
-    """{(i, j, piece): 36 Bernstein coefficients of D(X_i, Y_j)} for nets of acb values (one h)."""
-    forms = {key: [[[acb(z) for z in row] for row in net]] for key, net in _flat(nets).items()}
-    return {(i, j, p): det_series(forms[(i, p)], forms[(j, p)], 0)[0] for i, j in IJ for p in PIECES}
 
 
 def _flat(nets):
     return {(name, piece): net for name, pn in nets.items() for piece, net in pn.items()}
 
 
+def coefficient_nets(net, n, real=False):
+    """[the 4 x 4 net of the h^m Taylor coefficients (acb), m = 0..n] of a net of series or of values
+    (``real``: as :func:`.dart_family.series_coeffs`)."""
+    cs = [[series_coeffs(z, n + 1, real) for z in row] for row in net]
+    return [[[c[m] for c in row] for row in cs] for m in range(n + 1)]
+
+
 def dets_series(nets, n):
-    """As :func:`det_values` for nets of acb_series: [coefficient list (acb) of h^m, m = 0..n]."""
-    series = {key: [[[series_coeffs(z, n + 1)[m] for z in row] for row in net] for m in range(n + 1)]
-              for key, net in _flat(nets).items()}
+    """{(i, j, piece): [the 36 Bernstein coefficients of D(X_i, Y_j)'s h^m, m = 0..n]} of the basis nets (of
+    acb_series; of acb values with n = 0: the values at one h)."""
+    series = {key: packed_partials(coefficient_nets(net, n)) for key, net in _flat(nets).items()}
     return {(i, j, p): det_series(series[(i, p)], series[(j, p)], n) for i, j in IJ for p in PIECES}
 
 
@@ -120,20 +121,10 @@ def middle_box(models, E, om, s_lo, s_hi, w_lo, w_hi, m0, q, L=24, prec=128):
         return hull(vals)
 
 
-def layer_det_values(lnets):
-    """{piece: 36 Bernstein coefficients of det J_Phi} of one layer quadrant's nets at one h (acb)."""
-    return {p: det_series([[[acb(z) for z in row] for row in X]], [[[acb(z) for z in row] for row in Y]], 0)[0]
-            for p, (X, Y) in lnets.items()}
-
-
-def layer_dets_series(lnets, n):
-    """{piece: [Bernstein coefficients of det J_Phi's h^m (real parts: real for real h), m = 0..n]}."""
-    out = {}
-    for piece, (X, Y) in lnets.items():
-        fx, fy = ([[[acb(series_coeffs(Z[i][j], n + 1)[m].real) for j in range(4)] for i in range(4)]
-                   for m in range(n + 1)] for Z in (X, Y))
-        out[piece] = [[z.real for z in c] for c in det_series(fx, fy, n)]
-    return out
+def layer_dets_series(lnets, n, real=False):
+    """{piece: [Bernstein coefficients of det J_Phi's h^m, m = 0..n]} of one layer quadrant's nets (series, or
+    values with n = 0; ``real``: of the real parts, the nets being real for real h)."""
+    return {p: det_series(coefficient_nets(X, n, real), coefficient_nets(Y, n, real), n) for p, (X, Y) in lnets.items()}
 
 
 def column_models(T, M, r):

@@ -66,6 +66,7 @@ every finite K); the record's trees (:func:`.replay.read_tree`) bound it below b
 from __future__ import annotations
 
 from functools import cache
+from math import isqrt
 
 from flint import acb, arb, fmpq, fmpq_mpoly_ctx, fmpq_poly
 
@@ -73,6 +74,7 @@ from ccproof.rigorous.analytic import ball
 
 from .dart_family import kappa
 from .errors import CertificateError
+from .statement import lam_of
 from .tagged import labels, sector_rows
 from .tagged_modes import RING_INDEX, charpoly_roots, check_dart, check_ring, ring_stencil
 
@@ -286,8 +288,7 @@ def _ell():
 
 def lam_circle(sig_r, h):
     """r = lam(cos(2 sigma_r h)) (arb; 2 sigma_r h < pi/2 keeps (1 + c)(9 + c) > 0)."""
-    c = (2 * sig_r * h).cos()
-    return (5 + c + ((1 + c) * (9 + c)).sqrt()) / 16
+    return lam_of((2 * sig_r * h).cos())
 
 
 def check_mode0_roots(sig_r, k0, balls):
@@ -431,7 +432,8 @@ class SpectralRegions:
 
 
 def w1_of(tau1):
-    """w1 = m/W_DEN with m the least integer such that w1^2 tau1 >= 1 (exact).
+    """w1 = m/W_DEN with m the least integer such that w1^2 tau1 >= 1 (exact: m^2 >= c, c the least integer
+    >= W_DEN^2/tau1).
 
     >>> from flint import fmpq
     >>> w1_of(fmpq(50))
@@ -439,17 +441,9 @@ def w1_of(tau1):
     """
     if not tau1 > 0:
         raise CertificateError("spectrum: tau1 must be > 0")
-    hi = 1
-    while fmpq(hi * hi) * tau1 < W_DEN * W_DEN:  # doubling: no cap, so w1^2 tau1 >= 1 whatever tau1 is
-        hi *= 2
-    lo = 0
-    while lo < hi:  # the least m with m^2 tau1 >= W_DEN^2
-        m = (lo + hi) // 2
-        if fmpq(m * m) * tau1 >= W_DEN * W_DEN:
-            hi = m
-        else:
-            lo = m + 1
-    return fmpq(lo, W_DEN)
+    tau1 = fmpq(tau1)
+    c = -(-(W_DEN * W_DEN * int(tau1.q)) // int(tau1.p))
+    return fmpq(isqrt(c - 1) + 1, W_DEN)
 
 
 def region_roots(k0, tau1, v0):

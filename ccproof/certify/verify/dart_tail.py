@@ -25,6 +25,8 @@ from __future__ import annotations
 
 from flint import arb, ctx, fmpq
 
+from ccproof.rigorous.analytic import disc_boxes
+
 from .dart_eigen import check_eigenvector
 from .dart_family import TaylorHints
 from .dart_models import read_map, replay_map
@@ -42,7 +44,7 @@ from .record import exact_keys, field_of
 from .replay import MAX_BOXES, parse_decimal, read_tree, replay_tree
 
 MIN_K0 = 101  # the regions need 1/K0 < r, and the covers are shown from 101 on
-MAX_WORK = 165_000  # units of 0.1 ms of CPU (:func:`record_work`): 16.5 s; the published record declares 10.8 s
+MAX_WORK = 100_000  # units of 0.1 ms of CPU (:func:`record_work`): 10 s; the published record declares 8.4 s
 MAX_BALLS = 8192
 _KEYS = ("schema", "configuration", "statement", "prec", "map", "spectrum", "taylor", "regions", "parts")
 _SPECTRUM = ("sigma", "sigma_h", "circle", "mode0_h", "tau1", "v0", "re")
@@ -132,11 +134,12 @@ def read_record(cert, k0):
 
 def record_work(rec):
     """The CPU work the record's sizes declare, in units of 0.1 ms (upper estimates measured on the reference
-    machine of docs/certificates.md, "Bounds", at 128 bits): the exact zeros (fixed), the disc bounds
-    (disc_grid^2 acb boxes, the bulk and T layer quadrants on each), the Taylor series of each sigma box
-    (order^2, and layer_order^2 per layer quadrant), each map leaf by its region (bulk: order; middle:
-    exp_order + order; layer: layer_order), each spectral leaf, each h-ball of the eigenvector and mode-0
-    checks; all times ceil(prec/128).
+    machine of docs/certificates.md, "Bounds", at 128 bits): the exact zeros (fixed), the disc bounds (one
+    family per acb box of the grid that meets the disc, with the T layer quadrants), the Taylor series of each
+    sigma box (order^2, and layer_order^2 per layer quadrant), each map leaf by its quantity and region (R in
+    the bulk: order; T, X, Y in the bulk: order/3; the middle: exp_order + order, times 0.45 for R and 0.2
+    otherwise; the layer: layer_order/3), each spectral leaf, each h-ball of the eigenvector and mode-0 checks;
+    all times ceil(prec/128).
 
     Examples
     --------
@@ -144,16 +147,16 @@ def record_work(rec):
     >>> from ccproof.tables.format import certificates_dir
     >>> rec = read_record(json.loads((certificates_dir() / "c1/dart/k_ge_101.json").read_text()), 101)
     >>> record_work(rec), MAX_WORK
-    (107630, 165000)
+    (86238, 100000)
     """
     hn, layer = rec["hints"], rec["layer"]
-    work = 16000 + hn.disc_grid ** 2 * (70 + 24 * layer)
-    work += hn.sigma_boxes * (14 * hn.order ** 2 + 14 * layer * hn.layer_order ** 2 // 10)
-    per_leaf = {"bulk": hn.order, "middle": 65 * (hn.exp_order + hn.order) // 100 + 1,
-                "layer": 2 * hn.layer_order // 10 + 1}
-    for name, _, _, trees in rec["map"]:
-        kind = "layer" if "layer" in name else "middle" if "middle" in name else "bulk"
-        work += per_leaf[kind] * sum(len(t) for t in trees)
+    work = 16000 + len(list(disc_boxes(hn.r, hn.disc_grid))) * (60 + 18 * layer)
+    work += hn.sigma_boxes * (11 * hn.order ** 2 + 13 * layer * hn.layer_order ** 2 // 10)
+    mid = hn.exp_order + hn.order
+    per_leaf = {("R", "bulk"): hn.order, ("R", "middle"): 45 * mid // 100 + 1, ("R", "layer"): hn.layer_order // 3 + 1,
+                ("", "bulk"): hn.order // 3 + 1, ("", "middle"): mid // 5 + 1, ("", "layer"): hn.layer_order // 3 + 1}
+    for _, (quantity, region, _), _, trees in rec["map"]:
+        work += per_leaf[("R" if quantity == "R" else "", region)] * sum(len(t) for t in trees)
     work += 2 * sum(len(v) for v in rec["re"].values()) + 15 * rec["sigma_h"] + rec["mode0_h"]
     return work * ((rec["prec"] + 127) // 128)
 

@@ -212,13 +212,13 @@ def _log_ratio(lam):
     return z - z * z / 2
 
 
-def _solve(A, b, unit=lambda z: not z.vanishes(1)):
-    """Gauss-Jordan with pivots that are units (over Q(sqrt 5, i)[h]/(h^3): A(h = 0) regular; or over Q(L0)
-    with ``unit`` = non-zero); ZeroDivisionError if there is none."""
+def _solve(A, b):
+    """Gauss-Jordan over Q(sqrt 5, i)[h]/(h^3) with pivots that are units (A(h = 0) regular); ZeroDivisionError
+    if there is none."""
     n = len(A)
     M = [list(A[i]) + [b[i]] for i in range(n)]
     for c in range(n):
-        piv = next((r for r in range(c, n) if unit(M[r][c])), None)
+        piv = next((r for r in range(c, n) if not M[r][c].vanishes(1)), None)
         if piv is None:
             raise ZeroDivisionError("singular system")
         M[c], M[piv] = M[piv], M[c]
@@ -252,78 +252,30 @@ class _Mode:
             self.U = [horner(p, self.lam, QS(0)) / den for p in _df.N_POLYS]
 
 
-class QL0:
-    """a + b L0 in Q(L0) = Q(sqrt 5), L0 = lam(1) = (6 + sqrt 20)/16 the root of 16 x^2 - 12 x + 1 = 0 (exact)."""
-
-    __slots__ = ("a", "b")
-
-    def __init__(self, a, b=0):
-        self.a, self.b = fmpq(a), fmpq(b)
-
-    @staticmethod
-    def lift(z):
-        return z if isinstance(z, QL0) else QL0(z)
-
-    def __add__(self, o):
-        o = QL0.lift(o)
-        return QL0(self.a + o.a, self.b + o.b)
-
-    __radd__ = __add__
-
-    def __neg__(self):
-        return QL0(-self.a, -self.b)
-
-    def __sub__(self, o):
-        return self + (-QL0.lift(o))
-
-    def __mul__(self, o):
-        o = QL0.lift(o)
-        bb = self.b * o.b  # L0^2 = (12 L0 - 1)/16
-        return QL0(self.a * o.a - bb / 16, self.a * o.b + self.b * o.a + bb * fmpq(12, 16))
-
-    __rmul__ = __mul__
-
-    def inv(self):
-        # (a + b L0)(a + b L0') = a^2 + a b (L0 + L0') + b^2 L0 L0' = a^2 + 3 a b/4 + b^2/16, L0' = 3/4 - L0
-        n = self.a * self.a + self.a * self.b * fmpq(3, 4) + self.b * self.b / 16
-        return QL0((self.a + self.b * fmpq(3, 4)) / n, -self.b / n)
-
-    def __truediv__(self, o):
-        return self * QL0.lift(o).inv()
-
-    def __eq__(self, o):
-        o = QL0.lift(o)
-        return self.a == o.a and self.b == o.b
-
-    def is_zero(self):
-        return self.a == 0 and self.b == 0
-
-
 def exact_zeros():
-    """Check exactly (in Q(L0)) the facts the dropped coefficients rest on: L0 is an eigenvalue of B(1) with
-    eigenvector rho (rho(1,0) = 1) and rho(a, b) = rho(b, a); adj(L0 - B(1)) kappa = N(L0) is a multiple of rho
-    (so U(L0) = U(1,0) rho and alpha(0) U(L0) = -cos(sigma) rho). Returns rho (6 QL0), CertificateError if not.
+    """Check exactly (in Q(sqrt 5), the constants of :class:`QS`) the facts the dropped coefficients rest on:
+    L0 is an eigenvalue of B(1) with eigenvector rho (rho(1,0) = 1) and rho(a, b) = rho(b, a); adj(L0 - B(1))
+    kappa = N(L0) is a multiple of rho (so U(L0) = U(1,0) rho and alpha(0) U(L0) = -cos(sigma) rho). Returns
+    rho (6 QS), CertificateError if not.
 
     Examples
     --------
     >>> rho = exact_zeros()
-    >>> rho[0] == 1, rho[2] == QL0(-4, 8), rho[2] * rho[2] + rho[2] * 2 == 4  # rho(1,1) = sqrt 5 - 1
-    (True, True, True)
+    >>> (rho[0] - 1).is_zero(), (rho[2] - (SQRT20 / 2 - 1)).is_zero()  # rho(1,1) = sqrt 5 - 1
+    (True, True)
     """
-    L = QL0(0, 1)
-    A = [[(L if i == k else QL0(0)) - _df.B_AT_1[i, k] for k in range(6)] for i in range(6)]
+    A = [[(L0 if i == k else QS(0)) - _df.B_AT_1[i, k] for k in range(6)] for i in range(6)]
     # rho: solve A rho = 0 with rho(1,0) = 1: drop row 0 (rank 5 since L0 is simple: checked by the solve)
     try:
-        rho = [QL0(1)] + _solve([[A[i][k] for k in range(1, 6)] for i in range(1, 6)], [-A[i][0] for i in range(1, 6)],
-                                unit=lambda z: not z.is_zero())
+        rho = [ONE] + _solve([[A[i][k] for k in range(1, 6)] for i in range(1, 6)], [-A[i][0] for i in range(1, 6)])
     except ZeroDivisionError:
         raise CertificateError("L0 is not a simple eigenvalue of B(1)") from None
-    if not all(sum((A[i][k] * rho[k] for k in range(6)), QL0(0)).is_zero() for i in range(6)):
+    if not all(sum((A[i][k] * rho[k] for k in range(6)), QS(0)).is_zero() for i in range(6)):
         raise CertificateError("rho is no eigenvector of B(1) for L0")
     pos = {p: k for p, k in RING_INDEX.items()}
-    if not all(rho[pos[(a, b)]] == rho[pos[(b, a)]] for (a, b) in pos if b > 0 and (b, a) in pos):
+    if not all((rho[pos[(a, b)]] - rho[pos[(b, a)]]).is_zero() for (a, b) in pos if b > 0 and (b, a) in pos):
         raise CertificateError("rho is not symmetric in (a, b)")
-    N = [horner(p, L, QL0(0)) for p in _df.N_POLYS]
+    N = [horner(p, L0, QS(0)) for p in _df.N_POLYS]
     if not all((N[k] - N[0] * rho[k]).is_zero() for k in range(6)) or N[0].is_zero():
         raise CertificateError("adj(L0 - B(1)) kappa is not a non-zero multiple of rho")
     return rho
