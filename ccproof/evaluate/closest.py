@@ -254,8 +254,11 @@ class ClosestPointFinder:
         U, V = np.meshgrid(t, t, indexing="ij")  # [i along u, j along v]
         self._U, self._V = U.ravel(), V.ravel()
         self._eps = 0.0  # the face bounds enclose the cells' bounds without it; added below
+        self._cache = _CellCache(self, max(1, min(CACHE_CELLS // self._mm, self.faces.size)))
         fc, fn, fr, fh, scale = self._face_bounds()
-        self._eps = 1e-13 * scale  # the margin of today's cells: round-off of the samples
+        self._eps = 1e-13 * scale  # added to every cell's radius and half-height: round-off of the samples
+        self._cache.r += self._eps
+        self._cache.h += self._eps
         self._tiny = 1e-12 * scale
         fr += 2.0 * self._eps
         fh += 2.0 * self._eps
@@ -263,7 +266,6 @@ class ClosestPointFinder:
         self._bvh = _bvh.build(fc, np.hypot(fr, fh))
         # face centres, for the first descent (unbalanced, non-compact nodes: faster for far points)
         self._ftree = cKDTree(fc, balanced_tree=False, compact_nodes=False)
-        self._cache = _CellCache(self, max(1, min(CACHE_CELLS // self._mm, self.faces.size)))
 
     def nbytes(self):
         """Bytes the structure keeps (face cylinders, hierarchy, k-d tree estimate, cell cache now)."""
@@ -278,8 +280,8 @@ class ClosestPointFinder:
         r = self.surface.evaluate(np.repeat(self.faces[pos], g2), np.tile(self._U, k), np.tile(self._V, k), 1)
         grid = (k, g, g, 3)
         P = r["P"].reshape(grid)
-        cells = _bvh.cell_bounds(P, r["Pu"].reshape(grid), r["Pv"].reshape(grid), self.m, SAFETY, self._eps)
-        return P, cells
+        c, n, rr, h = _bvh.cell_bounds(P, r["Pu"].reshape(grid), r["Pv"].reshape(grid), self.m, SAFETY, 0.0)
+        return P, (c, n, rr + self._eps, h + self._eps)  # (the same bits whether built or refined later)
 
     def _blocks(self, n):
         """Ranges of at most ``BATCH_SAMPLES`` samples' faces covering ``0 .. n - 1``."""
@@ -296,6 +298,8 @@ class ClosestPointFinder:
             P, (c, n, r, h) = self._refine(pos)
             scale = max(scale, float(np.abs(P).max()))
             fc[pos], fn[pos], fr[pos], fh[pos] = enclosing_cylinders(P[:, m, m], c, n, r, h, self._mm)
+            if self._cache.capacity == nf:  # every face fits the cache: its cells are kept (eps added after)
+                self._cache.store(pos, c, n, r, h)
         return fc, fn, fr, fh, (scale if nf else 1.0)
 
     def lower_bounds(self, X, faces):
@@ -357,10 +361,11 @@ class ClosestPointFinder:
             np.empty(n, dtype=np.int64), np.empty(n), np.empty(n), np.empty((n, 3)), np.empty(n),
             np.empty((n, 3)), np.empty(n, dtype=np.int32),
         )
+        order = morton_order(X)  # nearby points in the same chunk: fewer faces refined, more found in the cache
         for lo in range(0, n, chunk):
-            hi = min(n, lo + chunk)
-            f, u, v, nd = self._query_chunk(X[lo:hi])
-            out.face[lo:hi], out.u[lo:hi], out.v[lo:hi], out.descents[lo:hi] = f, u, v, nd
+            idx = order[lo:lo + chunk]
+            f, u, v, nd = self._query_chunk(X[idx])
+            out.face[idx], out.u[idx], out.v[idx], out.descents[idx] = f, u, v, nd
         r = self.surface.evaluate(out.face, out.u, out.v, 1)
         out.P[:] = r["P"]
         out.distance[:] = np.linalg.norm(X - r["P"], axis=1)
@@ -525,6 +530,30 @@ def enclosing_cylinders(centre, c, n, r, h, mm):
     return centre, axis, np.where(bad, np.inf, fr), np.where(bad, np.inf, fh)
 
 
+def morton_order(X, bits=10):
+    """Order of the points ``X`` (n, 3) along a Z-order (Morton) curve of their bounding box (``bits`` per axis).
+
+    >>> morton_order(np.array([[1.0, 1, 1], [0, 0, 0], [1, 0, 0], [0, 0.1, 0]])).tolist()
+    [1, 3, 2, 0]
+    """
+    if X.shape[0] == 0:
+        return np.zeros(0, dtype=np.int64)
+    lo, ext = X.min(axis=0), np.ptp(X, axis=0)
+    q = ((X - lo) / np.where(ext > 0, ext, 1.0) * ((1 << bits) - 1)).astype(np.int64)
+    code = np.zeros(X.shape[0], dtype=np.int64)
+    for b in range(bits):
+        for a in range(3):
+            code |= ((q[:, a] >> b) & 1) << (3 * b + a)
+    return np.argsort(code, kind="stable")
+
+
+def _grown(a, n):
+    """``a`` in a new array of ``n`` rows (its rows first; np.resize would keep a larger base alive)."""
+    out = np.empty((n,) + a.shape[1:], dtype=a.dtype)
+    out[: a.shape[0]] = a
+    return out
+
+
 class _CellCache:
     """Cell cylinders of recently refined faces, ``capacity`` faces at most (emptied when full; the arrays
     grow as faces are added)."""
@@ -548,9 +577,8 @@ class _CellCache:
             return
         cap = min(self.capacity, max(faces, 2 * self.pos.size))
         rows = cap * self.finder._mm
-        self.pos = np.resize(self.pos, cap)
-        self.c, self.n = np.resize(self.c, (rows, 3)), np.resize(self.n, (rows, 3))
-        self.r, self.h = np.resize(self.r, rows), np.resize(self.h, rows)
+        self.pos, self.c, self.n, self.r, self.h = (_grown(a, n) for a, n in zip(
+            (self.pos, self.c, self.n, self.r, self.h), (cap, rows, rows, rows, rows)))
 
     def ensure(self, pos):
         """Slots of the faces at ``pos`` (at most ``capacity`` distinct), refining those not cached."""
@@ -559,16 +587,19 @@ class _CellCache:
             self.slot[self.pos[: self.size]] = -1
             self.size = 0
             new = np.unique(pos)
-        self._reserve(self.size + new.size)
-        mm = self.finder._mm
         for blk in self.finder._blocks(new.size):
-            _, (c, n, r, h) = self.finder._refine(new[blk])
-            a, b = self.size * mm, (self.size + blk.size) * mm
-            self.c[a:b], self.n[a:b], self.r[a:b], self.h[a:b] = c, n, r, h
-            self.pos[self.size: self.size + blk.size] = new[blk]
-            self.slot[new[blk]] = np.arange(self.size, self.size + blk.size)
-            self.size += blk.size
+            self.store(new[blk], *self.finder._refine(new[blk])[1])
         return self.slot[pos].astype(np.int64)
+
+    def store(self, pos, c, n, r, h):
+        """Add the cells (c, n, r, h) of the faces at ``pos`` (not cached, room left)."""
+        mm = self.finder._mm
+        self._reserve(self.size + pos.size)
+        a, b = self.size * mm, (self.size + pos.size) * mm
+        self.c[a:b], self.n[a:b], self.r[a:b], self.h[a:b] = c, n, r, h
+        self.pos[self.size: self.size + pos.size] = pos
+        self.slot[pos] = np.arange(self.size, self.size + pos.size)
+        self.size += pos.size
 
 
 #: largest coordinate magnitude of a query point: the squared distances of the search must stay finite
