@@ -22,16 +22,21 @@ Method (global search, then local refinement):
    ``sqrt(max(rho - r, 0)^2 + max(z - delta, 0)^2)`` with ``z = |<X - c, n>|`` and ``rho`` the lateral
    offset. These bounds are sampled estimates (the rigorous counterpart, from convex hulls of control
    nets in interval arithmetic, is :mod:`ccproof.evaluate.closest_certified`).
-2. **First descent.** A k-d tree (scipy ``cKDTree``) over the cell centres gives the nearest one;
-   the projected Newton iteration below from it gives an upper bound ``d*`` of the distance.
-3. **Pruning.** The cells whose lower bound is below ``d*`` are the candidates, listed by a
-   bounding-volume hierarchy over the cells (:mod:`ccproof.evaluate._bvh`). A candidate is
+   **One bound per face.** The structure keeps, per face, a cylinder holding all its cells' cylinders
+   (:func:`enclosing_cylinders`: its lower bound never exceeds theirs), a bounding-volume hierarchy over
+   them (:mod:`ccproof.evaluate._bvh`) and a k-d tree of face centres: about ``FACE_BYTES`` per face. The
+   samples are dropped after the build; a face's cells are computed again (the same bits) when a query
+   reaches it, and cached (``CACHE_CELLS`` at most). :func:`search_memory` estimates the peak.
+2. **First descent.** From the cell centre nearest to X in the face of the nearest face centre; the
+   projected Newton iteration below gives an upper bound ``d*`` of the distance.
+3. **Pruning.** The faces whose bound is below ``d*``, then their cells whose bound is below ``d*``, are
+   the candidates (the same cells as a search over all cells). A candidate is
    *covered* once a descent in its face started in it or ended within ``cover`` cells of it
    (default 3); uncovered candidates start new descents, best first (per round one descent per
    point, from its open candidate of lowest bound), until every candidate is covered or its bound
    exceeds the best distance found. A descent whose result is a new best on an edge of its face is
    *handed off* to the face on the other side: a new descent starts from the sample of another face
-   nearest to the end point (a k-d tree over the samples, queried with surface points), so minima
+   nearest to the end point (the faces whose bound is near the end point are sampled), so minima
    next to face edges and corners are reached from both sides without any adjacency information.
    The answer is the best of all descents.
 4. **Projected Newton** (:mod:`ccproof.evaluate.newton`) on ``E(u, v) = |P(u, v) - X|^2 / 2`` in ``[0, 1]^2``: gradient
@@ -336,16 +341,36 @@ class ClosestPointFinder:
         return tuple(np.concatenate(x) for x in zip(*parts))
 
     def _starts(self, X):
-        """First descents: in the face of the nearest face centre, from its cell centre nearest to X."""
+        """First descents: from the cell centre nearest to X among all faces' cells (the faces whose bound is
+        closer than the nearest cell centre of the face of the nearest face centre)."""
+        n = X.shape[0]
         _, j = self._ftree.query(X, k=1)
-        j = np.asarray(j, dtype=np.int64)
-        k = np.empty(j.size, dtype=np.int64)
-        order = np.argsort(j, kind="stable")
-        for blk in np.array_split(order, -(-order.size // self._cache.capacity) if order.size else 1):
-            slot = self._cache.ensure(j[blk])
-            C = self._cache.c.reshape(-1, self._mm, 3)[slot]
-            k[blk] = np.argmin(((C - X[blk, None, :]) ** 2).sum(axis=2), axis=1)
-        return j * self._mm + k
+        best, cid = np.full(n, np.inf), np.zeros(n, dtype=np.int64)
+        self._nearest_cells(X, np.arange(n), np.asarray(j, dtype=np.int64), best, cid)
+        pid, pos = self._face_candidates(X, np.sqrt(best))
+        self._nearest_cells(X, pid, pos, best, cid)
+        return cid
+
+    def _nearest_cells(self, X, pid, pos, best, cid):
+        """Update ``best`` (squared distance) and ``cid`` (cell) of the points ``pid`` with the cell centres of
+        the faces at ``pos`` (pairs aligned), in blocks of faces that fit the cache."""
+        order = np.argsort(pos, kind="stable")
+        pid, pos = pid[order], pos[order]
+        ufaces = np.unique(pos)
+        mm = self._mm
+        for blk in np.array_split(ufaces, -(-ufaces.size // self._cache.capacity) if ufaces.size else 1):
+            if blk.size == 0:
+                continue
+            a, b = np.searchsorted(pos, [blk[0], blk[-1] + 1])
+            p, slot = pid[a:b], self._cache.ensure(pos[a:b])
+            d = ((self._cache.c.reshape(-1, mm, 3)[slot] - X[p, None, :]) ** 2).sum(axis=2)
+            k = np.argmin(d, axis=1)
+            dk = d[np.arange(k.size), k]
+            o = np.lexsort((pos[a:b] * mm + k, dk, p))  # per point its nearest pair first (ties: lowest cell)
+            first = o[np.r_[True, p[o[1:]] != p[o[:-1]]]]
+            upd = first[dk[first] < best[p[first]]]
+            best[p[upd]] = dk[upd]
+            cid[p[upd]] = pos[a + upd] * mm + k[upd]
 
     def _cell(self, cid):
         """Face, ci, cj of cell ids."""
