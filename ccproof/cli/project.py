@@ -127,8 +127,8 @@ def run(args):
 
     compile_notice("project")  # after the input checks: an error stays one line
     t_build = time.perf_counter()
-    with phase("search structure", progress):
-        finder = ClosestPointFinder(S, cells=CELLS if args.cells is None else args.cells, faces=evaluable)
+    finder = ClosestPointFinder(S, cells=CELLS if args.cells is None else args.cells, faces=evaluable,
+                                progress=progress)  # a bar over the faces
     t0 = time.perf_counter()
     t_build = t0 - t_build
     starts = range(0, X.shape[0], BATCH)

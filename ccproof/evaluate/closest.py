@@ -216,6 +216,8 @@ class ClosestPointFinder:
     faces : array_like of int, optional
         Search only these parameter faces (default: all); e.g. the faces that carry a patch of a
         finite-element model (ccproof.apps.dynamics). The answers lie on these faces only.
+    progress : bool, optional
+        A progress bar (tqdm, on stderr) over the faces while the bounds are built.
 
     Notes
     -----
@@ -236,7 +238,7 @@ class ClosestPointFinder:
     ([5, 30], [0.25, 0.5], [0.75, 0.125], True)
     """
 
-    def __init__(self, surface, cells=CELLS, cover=None, faces=None):
+    def __init__(self, surface, cells=CELLS, cover=None, faces=None, progress=False):
         from scipy.spatial import cKDTree
 
         if int(cells) != cells or cells < 1:
@@ -260,7 +262,7 @@ class ClosestPointFinder:
         self._U, self._V = U.ravel(), V.ravel()
         self._eps = 0.0  # the face bounds enclose the cells' bounds without it; added below
         self._cache = _CellCache(self, max(1, min(CACHE_CELLS // self._mm, self.faces.size)))
-        fc, fn, fr, fh, scale = self._face_bounds()
+        fc, fn, fr, fh, scale = self._face_bounds(progress)
         self._eps = 1e-13 * scale  # added to every cell's radius and half-height: round-off of the samples
         self._cache.r += self._eps
         self._cache.h += self._eps
@@ -293,10 +295,18 @@ class ClosestPointFinder:
         step = max(1, BATCH_SAMPLES // self._U.size)
         return [np.arange(lo, min(n, lo + step)) for lo in range(0, n, step)]
 
-    def _face_bounds(self):
-        """One cylinder per face enclosing its cells' cylinders (samples computed in blocks and dropped);
-        returns centres, axes, radii, half-heights and the largest sample coordinate."""
+    def _face_bounds(self, progress):
+        """One cylinder per face enclosing its cells' cylinders (samples computed in blocks and dropped; a
+        bar on stderr if ``progress``); returns centres, axes, radii, half-heights and the largest sample
+        coordinate."""
         nf, m = self.faces.size, self.m
+        bar = None
+        if progress:
+            import sys
+
+            from tqdm import tqdm
+
+            bar = tqdm(total=nf, desc="search structure", unit="face", file=sys.stderr)
         fc, fn, fr, fh = np.empty((nf, 3)), np.empty((nf, 3)), np.empty(nf), np.empty(nf)
         scale = 0.0
         for pos in self._blocks(nf):
@@ -305,6 +315,10 @@ class ClosestPointFinder:
             fc[pos], fn[pos], fr[pos], fh[pos] = enclosing_cylinders(P[:, m, m], c, n, r, h, self._mm)
             if self._cache.capacity == nf:  # every face fits the cache: its cells are kept (eps added after)
                 self._cache.store(pos, c, n, r, h)
+            if bar is not None:
+                bar.update(pos.size)
+        if bar is not None:
+            bar.close()
         return fc, fn, fr, fh, (scale if nf else 1.0)
 
     def lower_bounds(self, X, faces):
