@@ -39,8 +39,10 @@ def build(centres, radii):
     """
     centres = np.ascontiguousarray(centres, dtype=np.float64).reshape(-1, 3)
     radii = np.ascontiguousarray(radii, dtype=np.float64).reshape(-1)
-    order, lo, hi, child, start, count, nn = _build(centres, radii, LEAF)
-    return order, lo[:nn], hi[:nn], child[:nn], start[:nn], count[:nn]  # (views: no second copy at the peak)
+    order, *nodes, nn = _build(centres, radii, LEAF)
+    for i in range(len(nodes)):  # trimmed to the nodes used (about 2 n / 3 of n + 2), one array at a time
+        nodes[i] = nodes[i][:nn].copy()
+    return (order, *nodes)
 
 
 def _build(centres, radii, leaf):
