@@ -216,6 +216,39 @@ def expand_cells(X, dstar, pid, pos, slot, cells, mm):
     return out_p[:k].copy(), out_c[:k].copy(), out_lb[:k].copy()
 
 
+def _nearest(X, pid, slot, c, mm, out_k, out_d):
+    for i in range(pid.size):
+        p = pid[i]
+        best, kb = math.inf, 0
+        for k in range(mm):
+            j = slot[i] * mm + k
+            d = (X[p, 0] - c[j, 0]) ** 2 + (X[p, 1] - c[j, 1]) ** 2 + (X[p, 2] - c[j, 2]) ** 2
+            if d < best:
+                best, kb = d, k
+        out_k[i] = kb
+        out_d[i] = best
+
+
+if numba is not None:  # pragma: no branch
+    _nearest = numba.njit(cache=True, nogil=True)(_nearest)
+
+
+def nearest_centres(X, pid, slot, c, mm):
+    """For pairs (point ``pid[i]``, face whose ``mm`` cells are rows ``slot[i] * mm ...`` of the centres
+    ``c``): the face's cell whose centre is nearest to the point (the first of equals) and the squared
+    distance (``inf`` where none is finite).
+
+    >>> c = np.array([[0.0, 0, 0], [1.0, 0, 0], [5.0, 0, 0], [2.0, 0, 0]])
+    >>> k, d = nearest_centres(np.array([[1.8, 0, 0]]), np.array([0, 0]), np.array([0, 1]), c, 2)
+    >>> k.tolist(), d.round(12).tolist()
+    ([1, 1], [0.64, 0.04])
+    """
+    k, d = np.empty(pid.size, dtype=np.int64), np.empty(pid.size)
+    _nearest(np.ascontiguousarray(X, dtype=np.float64), np.asarray(pid, dtype=np.int64),
+             np.asarray(slot, dtype=np.int64), c, int(mm), k, d)
+    return k, d
+
+
 def candidates(X, dstar, tree, c, nrm, r, h):
     """Pairs (point, cell) whose cylinder lower bound is below ``dstar[point]``.
 

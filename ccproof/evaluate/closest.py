@@ -377,9 +377,7 @@ class ClosestPointFinder:
                 continue
             a, b = np.searchsorted(pos, [blk[0], blk[-1] + 1])
             p, slot = pid[a:b], self._cache.ensure(pos[a:b])
-            d = ((self._cache.c.reshape(-1, mm, 3)[slot] - X[p, None, :]) ** 2).sum(axis=2)
-            k = np.argmin(d, axis=1)
-            dk = d[np.arange(k.size), k]
+            k, dk = _bvh.nearest_centres(X, p, slot, self._cache.c, mm)
             o = np.lexsort((pos[a:b] * mm + k, dk, p))  # per point its nearest pair first (ties: lowest cell)
             first = o[np.r_[True, p[o[1:]] != p[o[:-1]]]]
             upd = first[dk[first] < best[p[first]]]
