@@ -47,7 +47,8 @@ def test_project_refuses_a_search_structure_above_max_memory(disk, tmp_path, mon
     argv = ["project", str(disk), str(tmp_path / "p.csv"), "--out", str(tmp_path / "o.npz")]
     assert main(argv + ["--cells", "100000"]) == 2
     err = capsys.readouterr().err
-    assert "--cells 100000: the search structure of 45 faces needs about 5.76e+05 GB" in err, err
+    # one face's 200001^2 samples at 400 bytes (1.6e4 GB) + a full cell cache (2^20 cells of 64 bytes) + 45 faces
+    assert "--cells 100000: the search structure of 45 faces needs about 1.66e+04 GB" in err, err
     assert "above --max-memory 2 GB; lower --cells or raise --max-memory" in err
     for bad in ("nan", "0", "-1"):
         assert main(argv + ["--max-memory", bad]) == 2

@@ -13,8 +13,9 @@ enclosure of the distance where certified) and parameter_radius (n,) (the neares
 lies within this max-norm radius of (u, v) in the same face, where certified).
 
 Limits (checked before any work): input files at most --max-input GB (default 2); the search structure,
-about 320 bytes per sample and (2 --cells + 1)^2 samples per face, at most --max-memory GB (default 2);
---out may not replace an input.
+about 250 bytes per ptex face plus a cell cache of at most 67 MB and 52 MB of samples evaluated at once
+(more only if one face's (2 --cells + 1)^2 samples exceed that), at most --max-memory GB (default 2; the
+evaluator's table is not counted); --out may not replace an input.
 
 Example:
   ccproof project bunny.obj points.csv --out nearest.npz
@@ -32,19 +33,15 @@ def add_arguments(parser):
     parser.add_argument("--certify", action="store_true",
                         help="add interval-arithmetic verdicts (slow: per point; untagged all-quad meshes only)")
     parser.add_argument("--cells", type=int, default=None,
-                        help="cells per face side of the search structure (default 8; its memory, about "
-                             f"{SAMPLE_BYTES} bytes per sample, (2 cells + 1)^2 samples per face, must fit "
-                             "--max-memory)")
+                        help="cells per face side of the search structure (default 8): the cells of a face "
+                             "are computed when a query reaches it, from (2 cells + 1)^2 samples; the structure "
+                             "keeps one bound per face")
     parser.add_argument("--max-memory", type=float, default=2.0, metavar="GB",
-                        help="refuse a search structure whose estimated memory exceeds this (default 2 GB)")
+                        help="refuse a search structure whose estimated memory exceeds this (default 2 GB; "
+                             "about 250 bytes per ptex face plus 0.12 GB)")
     from ccproof.cli._progress import add_progress_argument
 
     add_progress_argument(parser)
-
-
-#: peak bytes per sample of the search structure (measured on the bunny, 2036 faces: 181 MB at --cells 8,
-#: 971 MB at 24, i.e. 200-310 bytes per sample: positions, derivatives, parameters, trees, cell bounds)
-SAMPLE_BYTES = 320
 
 
 def check_search_memory(n_faces, cells, max_memory_gb):
@@ -53,16 +50,24 @@ def check_search_memory(n_faces, cells, max_memory_gb):
     >>> check_search_memory(2036, 100000, 2.0)
     Traceback (most recent call last):
     ...
-    ccproof.errors.CCProofError: --cells 100000: the search structure of 2036 faces needs about 2.61e+07 GB, ...
+    ccproof.errors.CCProofError: --cells 100000: the search structure of 2036 faces needs about 1.66e+04 GB, ...
+    >>> check_search_memory(2_600_000, 8, 0.5)  # a 871k-triangle scan
+    Traceback (most recent call last):
+    ...
+    ccproof.errors.CCProofError: --cells 8: the search structure of 2600000 faces needs about 0.77 GB, ...
     """
     from ccproof.errors import CCProofError
+    from ccproof.evaluate.closest import BATCH_SAMPLES, CACHE_CELLS, search_memory
 
     if not (max_memory_gb > 0 and max_memory_gb < float("inf")):
         raise CCProofError(f"--max-memory must be a positive number of GB, got {max_memory_gb}")
-    need = n_faces * (2 * cells + 1) ** 2 * SAMPLE_BYTES / 1e9
+    need = search_memory(n_faces, cells) / 1e9
+    # --cells counts only where one face's samples or cells exceed what is evaluated or cached at once
+    big = (2 * cells + 1) ** 2 > BATCH_SAMPLES or cells * cells > CACHE_CELLS
+    fix = "lower --cells or raise --max-memory" if big else "raise --max-memory"
     if need > max_memory_gb:
         raise CCProofError(f"--cells {cells}: the search structure of {n_faces} faces needs about {need:.3g} GB, "
-                           f"above --max-memory {max_memory_gb:g} GB; lower --cells or raise --max-memory")
+                           f"above --max-memory {max_memory_gb:g} GB; {fix}")
 
 
 #: points per progress step of the float search (the certified mode steps point by point)
@@ -122,8 +127,8 @@ def run(args):
 
     compile_notice("project")  # after the input checks: an error stays one line
     t_build = time.perf_counter()
-    with phase("search structure", progress):
-        finder = ClosestPointFinder(S, cells=CELLS if args.cells is None else args.cells, faces=evaluable)
+    finder = ClosestPointFinder(S, cells=CELLS if args.cells is None else args.cells, faces=evaluable,
+                                progress=progress)  # a bar over the faces
     t0 = time.perf_counter()
     t_build = t0 - t_build
     starts = range(0, X.shape[0], BATCH)
@@ -131,8 +136,14 @@ def run(args):
         from tqdm import tqdm
 
         starts = tqdm(starts, desc="project", unit="batch")
-    parts = [finder.query(X[a:a + BATCH]) for a in starts] or [finder.query(X)]  # (no points: empty arrays)
-    out = {k: np.concatenate([getattr(r, k) for r in parts]) for k in ("face", "u", "v", "P", "distance", "normal")}
+    from ccproof.evaluate.closest import morton_order
+
+    order = morton_order(X)  # nearby points in the same batch: the finder refines fewer faces
+    parts = [finder.query(X[order[a:a + BATCH]]) for a in starts] or [finder.query(X)]  # (no points: empty arrays)
+    out = {}
+    for k in ("face", "u", "v", "P", "distance", "normal"):
+        out[k] = np.empty_like(np.concatenate([getattr(r, k) for r in parts]))
+        out[k][order] = np.concatenate([getattr(r, k) for r in parts])
     msg = (f"{args.mesh}: read in {t_read:.2f} s, setup {t_setup:.2f} s, search structure {t_build:.2f} s; "
            f"{X.shape[0]} points projected in {time.perf_counter() - t0:.2f} s")
     if args.certify:

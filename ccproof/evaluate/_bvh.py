@@ -1,10 +1,11 @@
-"""Bounding-volume hierarchy over the cells of :mod:`ccproof.evaluate.closest` (axis-aligned boxes).
+"""Bounding-volume hierarchy over the faces of :mod:`ccproof.evaluate.closest` (axis-aligned boxes).
 
-:func:`build` sorts the cells by recursive median splits of their centres (leaves of at most ``LEAF``
-cells) and stores for every node the box of its cells' bounding spheres. :func:`candidates` lists,
-for every query point, the cells whose cylinder lower bound is below the point's current upper bound
-``d*``, visiting only the nodes whose box is closer than ``d*``. Compiled with numba when it is
-installed (the same code runs as plain Python otherwise, slowly).
+:func:`build` sorts bounding cylinders (one per face in the search structure) by recursive median splits of
+their centres (leaves of at most ``LEAF``) and stores for every node the box of their bounding spheres.
+:func:`candidates` lists, for every query point, the cylinders whose lower bound is below the point's
+current upper bound ``d*``, visiting only the nodes whose box is closer than ``d*``; :func:`expand_cells`
+turns candidate faces into candidate cells (the cylinders of :func:`cell_bounds`). Compiled with numba
+when it is installed (the same code runs as plain Python otherwise, slowly).
 """
 
 from __future__ import annotations
@@ -38,19 +39,21 @@ def build(centres, radii):
     """
     centres = np.ascontiguousarray(centres, dtype=np.float64).reshape(-1, 3)
     radii = np.ascontiguousarray(radii, dtype=np.float64).reshape(-1)
-    smin = centres - radii[:, None]
-    smax = centres + radii[:, None]
-    order, lo, hi, child, start, count, nn = _build(centres, smin, smax, LEAF)
-    return order, lo[:nn].copy(), hi[:nn].copy(), child[:nn].copy(), start[:nn].copy(), count[:nn].copy()
+    order, *nodes, nn = _build(centres, radii, LEAF)
+    for i in range(len(nodes)):  # trimmed to the nodes used (about 2 n / 3 of n + 2), one array at a time
+        nodes[i] = nodes[i][:nn].copy()
+    return (order, *nodes)
 
 
-def _build(centres, smin, smax, leaf):
+def _build(centres, radii, leaf):
     """Depth-first construction (pre-order node numbering, left child first) with an explicit stack:
     a node's box holds its cells' spheres; a node of more than ``leaf`` cells is split at the median of
     its centres along their widest axis."""
     n = centres.shape[0]
     order = np.arange(n)
-    cap = 2 * n + 2
+    # a node of more than ``leaf >= 2`` items is split into halves of at least 2 items: at most n / 2
+    # leaves, hence at most n nodes (n + 2 for n <= leaf)
+    cap = n + 2
     lo = np.empty((cap, 3))
     hi = np.empty((cap, 3))
     child = np.full((cap, 2), -1, dtype=np.int64)
@@ -79,8 +82,8 @@ def _build(centres, smin, smax, leaf):
         for q in range(s, e):
             j = order[q]
             for a in range(3):
-                lo[i, a] = min(lo[i, a], smin[j, a])
-                hi[i, a] = max(hi[i, a], smax[j, a])
+                lo[i, a] = min(lo[i, a], centres[j, a] - radii[j])
+                hi[i, a] = max(hi[i, a], centres[j, a] + radii[j])
                 cmin[a] = min(cmin[a], centres[j, a])
                 cmax[a] = max(cmax[a], centres[j, a])
         if e - s > leaf:
@@ -153,6 +156,97 @@ def _traverse(X, dstar, order, lo, hi, child, start, count, c, nrm, r, h, out_p,
 
 if numba is not None:  # pragma: no branch
     _traverse = numba.njit(cache=True, nogil=True)(_traverse)
+
+
+def _expand(X, dstar, pid, pos, slot, c, nrm, r, h, mm, out_p, out_c, out_lb):
+    """Write the pairs (point, cell, lower bound) with lower bound < d* of candidate pairs (point, face):
+    face ``pos[i]`` has its ``mm`` cells at rows ``slot[i] * mm ...`` of (c, nrm, r, h); cell ids are
+    ``pos * mm + k``. Returns their number (``out_*`` hold ``pid.size * mm`` rows)."""
+    total = 0
+    for i in range(pid.size):
+        p = pid[i]
+        x0, x1, x2 = X[p, 0], X[p, 1], X[p, 2]
+        ds = dstar[p]
+        for k in range(mm):
+            j = slot[i] * mm + k
+            w0, w1, w2 = x0 - c[j, 0], x1 - c[j, 1], x2 - c[j, 2]
+            z = abs(w0 * nrm[j, 0] + w1 * nrm[j, 1] + w2 * nrm[j, 2])
+            rho = math.sqrt(max(w0 * w0 + w1 * w1 + w2 * w2 - z * z, 0.0))
+            a1 = max(rho - r[j], 0.0)
+            a2 = max(z - h[j], 0.0)
+            lb = math.sqrt(a1 * a1 + a2 * a2)
+            if lb < ds:
+                out_p[total] = p
+                out_c[total] = pos[i] * mm + k
+                out_lb[total] = lb
+                total += 1
+    return total
+
+
+if numba is not None:  # pragma: no branch
+    _expand = numba.njit(cache=True, nogil=True)(_expand)
+
+
+def expand_cells(X, dstar, pid, pos, slot, cells, mm):
+    """Candidate cells of candidate faces: the pairs (point, cell) whose cylinder lower bound (the formula of
+    :func:`candidates`) is below ``dstar[point]``.
+
+    Parameters
+    ----------
+    X : ndarray, shape (n, 3)
+    dstar : ndarray, shape (n,)
+    pid, pos, slot : ndarray of int, shape (k,)
+        Candidate pairs: point, face position (cell ids ``pos * mm + 0 .. mm - 1``), rows of the face's
+        cells in ``cells`` (``slot * mm + 0 .. mm - 1``).
+    cells : tuple of ndarray
+        ``(c, nrm, r, h)`` as returned by :func:`cell_bounds`.
+    mm : int
+        Cells per face.
+
+    Returns
+    -------
+    pid, cid : ndarray of int64
+    lb : ndarray
+    """
+    m = pid.size * mm
+    out_p, out_c, out_lb = np.empty(m, dtype=np.int64), np.empty(m, dtype=np.int64), np.empty(m)
+    k = _expand(np.ascontiguousarray(X, dtype=np.float64), np.ascontiguousarray(dstar, dtype=np.float64),
+                np.asarray(pid, dtype=np.int64), np.asarray(pos, dtype=np.int64), np.asarray(slot, dtype=np.int64),
+                *cells, int(mm), out_p, out_c, out_lb)
+    return out_p[:k].copy(), out_c[:k].copy(), out_lb[:k].copy()
+
+
+def _nearest(X, pid, slot, c, mm, out_k, out_d):
+    for i in range(pid.size):
+        p = pid[i]
+        best, kb = math.inf, 0
+        for k in range(mm):
+            j = slot[i] * mm + k
+            d = (X[p, 0] - c[j, 0]) ** 2 + (X[p, 1] - c[j, 1]) ** 2 + (X[p, 2] - c[j, 2]) ** 2
+            if d < best:
+                best, kb = d, k
+        out_k[i] = kb
+        out_d[i] = best
+
+
+if numba is not None:  # pragma: no branch
+    _nearest = numba.njit(cache=True, nogil=True)(_nearest)
+
+
+def nearest_centres(X, pid, slot, c, mm):
+    """For pairs (point ``pid[i]``, face whose ``mm`` cells are rows ``slot[i] * mm ...`` of the centres
+    ``c``): the face's cell whose centre is nearest to the point (the first of equals) and the squared
+    distance (``inf`` where none is finite).
+
+    >>> c = np.array([[0.0, 0, 0], [1.0, 0, 0], [5.0, 0, 0], [2.0, 0, 0]])
+    >>> k, d = nearest_centres(np.array([[1.8, 0, 0]]), np.array([0, 0]), np.array([0, 1]), c, 2)
+    >>> k.tolist(), d.round(12).tolist()
+    ([1, 1], [0.64, 0.04])
+    """
+    k, d = np.empty(pid.size, dtype=np.int64), np.empty(pid.size)
+    _nearest(np.ascontiguousarray(X, dtype=np.float64), np.asarray(pid, dtype=np.int64),
+             np.asarray(slot, dtype=np.int64), c, int(mm), k, d)
+    return k, d
 
 
 def candidates(X, dstar, tree, c, nrm, r, h):

@@ -22,16 +22,21 @@ Method (global search, then local refinement):
    ``sqrt(max(rho - r, 0)^2 + max(z - delta, 0)^2)`` with ``z = |<X - c, n>|`` and ``rho`` the lateral
    offset. These bounds are sampled estimates (the rigorous counterpart, from convex hulls of control
    nets in interval arithmetic, is :mod:`ccproof.evaluate.closest_certified`).
-2. **First descent.** A k-d tree (scipy ``cKDTree``) over the cell centres gives the nearest one;
-   the projected Newton iteration below from it gives an upper bound ``d*`` of the distance.
-3. **Pruning.** The cells whose lower bound is below ``d*`` are the candidates, listed by a
-   bounding-volume hierarchy over the cells (:mod:`ccproof.evaluate._bvh`). A candidate is
+   **One bound per face.** The structure keeps, per face, a cylinder holding all its cells' cylinders
+   (:func:`enclosing_cylinders`: its lower bound never exceeds theirs), a bounding-volume hierarchy over
+   them (:mod:`ccproof.evaluate._bvh`) and a k-d tree of face centres: about ``FACE_BYTES`` per face. The
+   samples are dropped after the build; a face's cells are computed again (the same bits) when a query
+   reaches it, and cached (``CACHE_CELLS`` at most). :func:`search_memory` estimates the peak.
+2. **First descent.** From the cell centre nearest to X in the face of the nearest face centre; the
+   projected Newton iteration below gives an upper bound ``d*`` of the distance.
+3. **Pruning.** The faces whose bound is below ``d*``, then their cells whose bound is below ``d*``, are
+   the candidates (the same cells as a search over all cells). A candidate is
    *covered* once a descent in its face started in it or ended within ``cover`` cells of it
    (default 3); uncovered candidates start new descents, best first (per round one descent per
    point, from its open candidate of lowest bound), until every candidate is covered or its bound
    exceeds the best distance found. A descent whose result is a new best on an edge of its face is
    *handed off* to the face on the other side: a new descent starts from the sample of another face
-   nearest to the end point (a k-d tree over the samples, queried with surface points), so minima
+   nearest to the end point (the faces whose bound is near the end point are sampled), so minima
    next to face edges and corners are reached from both sides without any adjacency information.
    The answer is the best of all descents.
 4. **Projected Newton** (:mod:`ccproof.evaluate.newton`) on ``E(u, v) = |P(u, v) - X|^2 / 2`` in ``[0, 1]^2``: gradient
@@ -61,7 +66,7 @@ from ccproof.errors import CCProofError
 from ccproof.evaluate import _bvh
 from ccproof.evaluate.newton import newton, row_dot, unit_normal
 
-__all__ = ["ClosestPoints", "ClosestPointFinder", "closest_points", "parameter_faces"]
+__all__ = ["ClosestPoints", "ClosestPointFinder", "closest_points", "parameter_faces", "search_memory"]
 
 #: cells per face side
 CELLS = 8
@@ -74,7 +79,20 @@ MAX_ROUNDS = 64
 #: hand-offs across face edges at most per point
 MAX_HANDOFFS = 4
 #: points per chunk
-CHUNK = 1 << 16
+CHUNK = 1 << 13
+#: samples per evaluation while the face bounds are built or faces refined (bounds the transient memory)
+BATCH_SAMPLES = 1 << 17
+#: cells of refined faces kept for later queries at most (64 bytes each; emptied when full)
+CACHE_CELLS = 1 << 20
+#: bytes per searched face the structure holds at its peak (face cylinders, hierarchy, k-d tree of face centres, the
+#: cache's slot): 222 measured at 245,760 faces (``python scripts/bench_project.py --memory --levels 6``)
+FACE_BYTES = 250
+#: bytes per cell in the cache (centre, axis, radius, half-height)
+CELL_BYTES = 64
+#: transient bytes per sample evaluated at once (positions, derivatives, parameters, the evaluator's work arrays)
+SAMPLE_BYTES = 400
+#: relative enlargement of d* against the face bounds (a face bound may exceed its cells' by round-off)
+FACE_SLACK = 1e-10
 
 
 def parameter_faces(surface):
@@ -114,6 +132,23 @@ def parameter_faces(surface):
         if n is not None:
             return int(n)
     raise CCProofError("the surface does not say how many parameter faces it has")
+
+
+def search_memory(n_faces, cells=CELLS):
+    """Estimated peak bytes of a :class:`ClosestPointFinder` over ``n_faces`` faces (before any work).
+
+    ``FACE_BYTES`` per face, the cell cache (at most ``CACHE_CELLS`` cells, or one face's ``cells^2``, of
+    ``CELL_BYTES``) and the samples evaluated at once (``BATCH_SAMPLES``, or one face's ``(2 cells + 1)^2``,
+    of ``SAMPLE_BYTES``); the surface's own table is not counted.
+
+    >>> round(search_memory(245760) / 1e6)  # a 81,920-triangle scan (3 ptex faces per triangle)
+    181
+    >>> round(search_memory(2036, cells=100000) / 1e9)  # one face's 200001^2 samples at once
+    16640
+    """
+    mm = cells * cells
+    cache = min(n_faces * mm, max(CACHE_CELLS, mm)) * CELL_BYTES
+    return n_faces * FACE_BYTES + cache + max(BATCH_SAMPLES, (2 * cells + 1) ** 2) * SAMPLE_BYTES
 
 
 @dataclass
@@ -172,7 +207,8 @@ class ClosestPointFinder:
     ----------
     surface : LimitSurface
     cells : int
-        Cells per face side (``cells^2`` bounding cylinders per face, ``(2 cells + 1)^2`` samples).
+        Cells per face side (``cells^2`` bounding cylinders per face from ``(2 cells + 1)^2`` samples,
+        computed when a query needs them; the structure keeps one cylinder per face).
     cover : int, optional
         A descent in a face covers its start cell and the candidate cells of that face within
         ``cover`` cells of its end cell (default ``COVER``; ``cover >= cells``: the whole face, i.e.
@@ -180,11 +216,15 @@ class ClosestPointFinder:
     faces : array_like of int, optional
         Search only these parameter faces (default: all); e.g. the faces that carry a patch of a
         finite-element model (ccproof.apps.dynamics). The answers lie on these faces only.
+    progress : bool, optional
+        A progress bar (tqdm, on stderr) over the faces while the bounds are built.
 
     Notes
     -----
-    Bounding cylinders per cell and a k-d tree of samples, docs/closest.md "Float path: method";
-    :meth:`query` answers like :func:`closest_points`.
+    One bounding cylinder per face (enclosing its cells' cylinders), a hierarchy over them and a k-d
+    tree of face centres; the cells of a face are computed again when a query reaches it (a cache of
+    ``CACHE_CELLS`` cells). docs/closest.md "Float path: method"; :meth:`query` answers like
+    :func:`closest_points`; :meth:`nbytes` is the memory the structure keeps.
 
     Examples
     --------
@@ -198,13 +238,14 @@ class ClosestPointFinder:
     ([5, 30], [0.25, 0.5], [0.75, 0.125], True)
     """
 
-    def __init__(self, surface, cells=CELLS, cover=None, faces=None):
+    def __init__(self, surface, cells=CELLS, cover=None, faces=None, progress=False):
         from scipy.spatial import cKDTree
 
         if int(cells) != cells or cells < 1:
             raise CCProofError(f"cells must be a positive integer, got {cells!r}")
         self.surface = surface
         self.m = m = int(cells)
+        self._mm = m * m
         self.cover = min(COVER, m) if cover is None else int(cover)
         nall = parameter_faces(surface)
         if faces is None:
@@ -215,48 +256,138 @@ class ClosestPointFinder:
                 raise CCProofError(f"faces must be a non-empty list of parameter faces in [0, {nall})")
             sel = sel.astype(np.int64)
         self.faces = sel
-        nf = sel.size
         self.n_faces = nall
-        g = 2 * m + 1
-        t = np.arange(g) / (2 * m)
+        t = np.arange(2 * m + 1) / (2 * m)
         U, V = np.meshgrid(t, t, indexing="ij")  # [i along u, j along v]
-        fu = np.repeat(sel, g * g)
-        r = surface.evaluate(fu, np.tile(U.ravel(), nf), np.tile(V.ravel(), nf), 1)
-        self._samples = r["P"]
-        self._sample_face = fu
-        self._sample_u = np.tile(U.ravel(), nf)
-        self._sample_v = np.tile(V.ravel(), nf)
-        # samples, for hand-offs across face edges (queried with surface points only: fast; the
-        # unbalanced, non-compact tree builds 2.6x faster and answers as fast)
-        self._stree = cKDTree(self._samples, balanced_tree=False, compact_nodes=False)
-        # cells [face, ci, cj]: cylinders around the centre samples (compiled; numpy reference
-        # _bvh.cell_bounds_numpy)
-        scale = np.abs(self._samples).max() if self._samples.size else 1.0
-        grid = (nf, g, g, 3)
-        self._c, self._n, self._r, self._h = _bvh.cell_bounds(
-            r["P"].reshape(grid), r["Pu"].reshape(grid), r["Pv"].reshape(grid), m, SAFETY, 1e-13 * scale
-        )
-        self._R = np.hypot(self._r, self._h)
-        self._Rmax = float(self._R.max()) if self._R.size else 0.0
-        self._bvh = _bvh.build(self._c, self._R)
-        # (unbalanced, non-compact nodes: several times faster queries for points far from the surface)
-        self._ctree = cKDTree(self._c, balanced_tree=False, compact_nodes=False)
-        cid = np.arange(nf * m * m)
-        self._cface = sel[cid // (m * m)]
-        self._ci = (cid // m) % m
-        self._cj = cid % m
+        self._U, self._V = U.ravel(), V.ravel()
+        self._eps = 0.0  # the face bounds enclose the cells' bounds without it; added below
+        self._cache = _CellCache(self, max(1, min(CACHE_CELLS // self._mm, self.faces.size)))
+        fc, fn, fr, fh, scale = self._face_bounds(progress)
+        self._eps = 1e-13 * scale  # added to every cell's radius and half-height: round-off of the samples
+        self._cache.r += self._eps
+        self._cache.h += self._eps
+        self._tiny = 1e-12 * scale
+        fr += 2.0 * self._eps
+        fh += 2.0 * self._eps
+        self._fc, self._fn, self._fr, self._fh = fc, fn, fr, fh
+        self._bvh = _bvh.build(fc, np.hypot(fr, fh))
+        # face centres, for the first descent (unbalanced, non-compact nodes: faster for far points)
+        self._ftree = cKDTree(fc, balanced_tree=False, compact_nodes=False)
+
+    def nbytes(self):
+        """Bytes the structure keeps (face cylinders, hierarchy, k-d tree estimate, cell cache now)."""
+        arrays = [self.faces, self._fc, self._fn, self._fr, self._fh, *self._bvh]  # (the cache: up to 64 CACHE_CELLS)
+        kd = self._fc.nbytes + 8 * self.faces.size + 64 * (self.faces.size // 8 + 1)  # data, indices, nodes
+        return int(sum(a.nbytes for a in arrays) + kd + self._cache.nbytes())
 
     # ------------------------------------------------------------------ bounds
-    def lower_bounds(self, X, cells):
-        """Lower bounds of the distance from points ``X`` (n, 3) to cells ``cells`` (n,) (sampled cylinders)."""
-        w = X - self._c[cells]
-        z = np.abs(row_dot(w, self._n[cells]))
+    def _refine(self, pos):
+        """Samples (k, 2m + 1, 2m + 1, 3) and cell cylinders ``(c, n, r, h)`` of the faces ``faces[pos]``."""
+        g2, k, g = self._U.size, pos.size, 2 * self.m + 1
+        r = self.surface.evaluate(np.repeat(self.faces[pos], g2), np.tile(self._U, k), np.tile(self._V, k), 1)
+        grid = (k, g, g, 3)
+        P = r["P"].reshape(grid)
+        c, n, rr, h = _bvh.cell_bounds(P, r["Pu"].reshape(grid), r["Pv"].reshape(grid), self.m, SAFETY, 0.0)
+        return P, (c, n, rr + self._eps, h + self._eps)  # (the same bits whether built or refined later)
+
+    def _blocks(self, n):
+        """Ranges of at most ``BATCH_SAMPLES`` samples' faces covering ``0 .. n - 1``."""
+        step = max(1, BATCH_SAMPLES // self._U.size)
+        return [np.arange(lo, min(n, lo + step)) for lo in range(0, n, step)]
+
+    def _face_bounds(self, progress):
+        """One cylinder per face enclosing its cells' cylinders (samples computed in blocks and dropped; a
+        bar on stderr if ``progress``); returns centres, axes, radii, half-heights and the largest sample
+        coordinate."""
+        nf, m = self.faces.size, self.m
+        bar = None
+        if progress:
+            import sys
+
+            from tqdm import tqdm
+
+            bar = tqdm(total=nf, desc="search structure", unit="face", file=sys.stderr)
+        fc, fn, fr, fh = np.empty((nf, 3)), np.empty((nf, 3)), np.empty(nf), np.empty(nf)
+        scale = 0.0
+        for pos in self._blocks(nf):
+            P, (c, n, r, h) = self._refine(pos)
+            scale = max(scale, float(np.abs(P).max()))
+            fc[pos], fn[pos], fr[pos], fh[pos] = enclosing_cylinders(P[:, m, m], c, n, r, h, self._mm)
+            if self._cache.capacity == nf:  # every face fits the cache: its cells are kept (eps added after)
+                self._cache.store(pos, c, n, r, h)
+            if bar is not None:
+                bar.update(pos.size)
+        if bar is not None:
+            bar.close()
+        return fc, fn, fr, fh, (scale if nf else 1.0)
+
+    def lower_bounds(self, X, faces):
+        """Lower bounds of the distance from points ``X`` (n, 3) to the faces at positions ``faces`` (n,)
+        of :attr:`faces` (their enclosing cylinders)."""
+        w = X - self._fc[faces]
+        z = np.abs(row_dot(w, self._fn[faces]))
         rho = np.sqrt(np.maximum(row_dot(w, w) - z * z, 0.0))
-        return np.hypot(np.maximum(rho - self._r[cells], 0.0), np.maximum(z - self._h[cells], 0.0))
+        return np.hypot(np.maximum(rho - self._fr[faces], 0.0), np.maximum(z - self._fh[faces], 0.0))
+
+    def _face_candidates(self, X, dstar):
+        """Pairs (point, face position) whose face bound is below d* (enlarged by its round-off)."""
+        pid, pos, _ = _bvh.candidates(X, dstar * (1.0 + FACE_SLACK) + self._tiny, self._bvh, self._fc, self._fn,
+                                      self._fr, self._fh)
+        return pid, pos
 
     def _candidates(self, X, dstar):
-        """Pairs (point, cell) with lower bound < d*: arrays pid, cid, lb."""
-        return _bvh.candidates(X, dstar, self._bvh, self._c, self._n, self._r, self._h)
+        """Pairs (point, cell) with cell lower bound < d*: arrays pid, cid, lb (cell ``cid`` is cell
+        ``cid % cells^2`` of the face at position ``cid // cells^2``)."""
+        pid, pos = self._face_candidates(X, dstar)
+        order = np.argsort(pos, kind="stable")
+        pid, pos = pid[order], pos[order]
+        parts = []
+        ufaces = np.unique(pos)
+        for blk in np.array_split(ufaces, -(-ufaces.size // self._cache.capacity) if ufaces.size else 1):
+            if blk.size == 0:
+                continue
+            a, b = np.searchsorted(pos, [blk[0], blk[-1] + 1])
+            slot = self._cache.ensure(pos[a:b])
+            parts.append(_bvh.expand_cells(X, dstar, pid[a:b], pos[a:b], slot, self._cache.cells(), self._mm))
+        if not parts:
+            e = np.empty(0, dtype=np.int64)
+            return e, e.copy(), np.empty(0)
+        return tuple(np.concatenate(x) for x in zip(*parts))
+
+    def _starts(self, X):
+        """First descents: from the cell centre nearest to X among all faces' cells (the faces whose bound is
+        closer than the nearest cell centre of the face of the nearest face centre)."""
+        n = X.shape[0]
+        _, j = self._ftree.query(X, k=1)
+        best, cid = np.full(n, np.inf), np.zeros(n, dtype=np.int64)
+        self._nearest_cells(X, np.arange(n), np.asarray(j, dtype=np.int64), best, cid)
+        pid, pos = self._face_candidates(X, np.sqrt(best))
+        self._nearest_cells(X, pid, pos, best, cid)
+        return cid
+
+    def _nearest_cells(self, X, pid, pos, best, cid):
+        """Update ``best`` (squared distance) and ``cid`` (cell) of the points ``pid`` with the cell centres of
+        the faces at ``pos`` (pairs aligned), in blocks of faces that fit the cache."""
+        order = np.argsort(pos, kind="stable")
+        pid, pos = pid[order], pos[order]
+        ufaces = np.unique(pos)
+        mm = self._mm
+        for blk in np.array_split(ufaces, -(-ufaces.size // self._cache.capacity) if ufaces.size else 1):
+            if blk.size == 0:
+                continue
+            a, b = np.searchsorted(pos, [blk[0], blk[-1] + 1])
+            p, slot = pid[a:b], self._cache.ensure(pos[a:b])
+            k, dk = _bvh.nearest_centres(X, p, slot, self._cache.c, mm)
+            o = np.lexsort((pos[a:b] * mm + k, dk, p))  # per point its nearest pair first (ties: lowest cell)
+            first = o[np.r_[True, p[o[1:]] != p[o[:-1]]]]
+            upd = first[dk[first] < best[p[first]]]
+            best[p[upd]] = dk[upd]
+            cid[p[upd]] = pos[a + upd] * mm + k[upd]
+
+    def _cell(self, cid):
+        """Face, ci, cj of cell ids."""
+        f = cid // self._mm
+        return self.faces[f], (cid // self.m) % self.m, cid % self.m
 
     # ------------------------------------------------------------------ query
     def query(self, X, *, chunk=CHUNK):
@@ -267,10 +398,11 @@ class ClosestPointFinder:
             np.empty(n, dtype=np.int64), np.empty(n), np.empty(n), np.empty((n, 3)), np.empty(n),
             np.empty((n, 3)), np.empty(n, dtype=np.int32),
         )
+        order = morton_order(X)  # nearby points in the same chunk: fewer faces refined, more found in the cache
         for lo in range(0, n, chunk):
-            hi = min(n, lo + chunk)
-            f, u, v, nd = self._query_chunk(X[lo:hi])
-            out.face[lo:hi], out.u[lo:hi], out.v[lo:hi], out.descents[lo:hi] = f, u, v, nd
+            idx = order[lo:lo + chunk]
+            f, u, v, nd = self._query_chunk(X[idx])
+            out.face[idx], out.u[idx], out.v[idx], out.descents[idx] = f, u, v, nd
         r = self.surface.evaluate(out.face, out.u, out.v, 1)
         out.P[:] = r["P"]
         out.distance[:] = np.linalg.norm(X - r["P"], axis=1)
@@ -283,10 +415,10 @@ class ClosestPointFinder:
     def _query_chunk(self, X):
         n = X.shape[0]
         m = self.m
-        _, j = self._ctree.query(X, k=1)
         # starts of the current round: point, face, (u, v)
-        sp, sf = np.arange(n), self._cface[j]
-        su, sv = (self._ci[j] + 0.5) / m, (self._cj[j] + 0.5) / m
+        sp = np.arange(n)
+        sf, ci, cj = self._cell(self._starts(X))
+        su, sv = (ci + 0.5) / m, (cj + 0.5) / m
         bf = np.zeros(n, dtype=np.int64)
         bu, bv, bE = np.zeros(n), np.zeros(n), np.full(n, np.inf)
         ndesc = np.zeros(n, dtype=np.int32)
@@ -303,7 +435,7 @@ class ClosestPointFinder:
             bf[q], bu[q], bv[q], bE[q] = sf[better], nu[better], nv[better], nE[better]
             if pid is None:
                 pid, cid, lb = self._candidates(X, np.sqrt(2.0 * bE))
-                order = np.lexsort((lb, pid))  # sorted by point, then bound (kept by every compression)
+                order = np.lexsort((cid, lb, pid))  # sorted by point, then bound (kept by every compression)
                 pid, cid, lb = pid[order], cid[order], lb[order]
                 covered = np.zeros(pid.size, dtype=bool)
             # coverage: every descent covers its start cell and the cells near its end, in its face
@@ -327,11 +459,11 @@ class ClosestPointFinder:
                 break
             # best first: one descent per point from its open candidate of lowest bound
             first = np.flatnonzero(np.r_[True, pid[1:] != pid[:-1]]) if pid.size else np.zeros(0, dtype=np.int64)
-            cp, cc = pid[first], cid[first]
+            cp, (cf, ci, cj) = pid[first], self._cell(cid[first])
             sp = np.concatenate([cp, hp])
-            sf = np.concatenate([self._cface[cc], hf])
-            su = np.concatenate([(self._ci[cc] + 0.5) / m, hu])
-            sv = np.concatenate([(self._cj[cc] + 0.5) / m, hv])
+            sf = np.concatenate([cf, hf])
+            su = np.concatenate([(ci + 0.5) / m, hu])
+            sv = np.concatenate([(cj + 0.5) / m, hv])
         return bf, bu, bv, ndesc
 
     @staticmethod
@@ -346,18 +478,47 @@ class ClosestPointFinder:
         return [order[rank == r] for r in range(int(rank.max()) + 1)]
 
     def _across(self, p, f, u, v):
-        """For end points (f, u, v) on a face edge: the nearest sample of another face (points p)."""
+        """For end points (f, u, v) on a face edge: the nearest sample of another face (points p).
+
+        The faces whose bound holds the end point P (its neighbours across the edge among them) give a
+        sample of another face at distance delta; then every face whose bound is within delta of P is
+        sampled, and the nearest sample of a face other than f wins."""
+        e = np.empty(0, dtype=np.int64)
         if p.size == 0:
-            e = np.empty(0, dtype=np.int64)
             return e, np.empty(0), np.empty(0), e
         P = self.surface.evaluate(f, u, v, 0)["P"]
-        k = 8
-        _, J = self._stree.query(P, k=k)
-        other = self._sample_face[J] != f[:, None]
-        has = other.any(axis=1)
-        col = np.argmax(other, axis=1)
-        jj = J[np.arange(p.size), col][has]
-        return self._sample_face[jj], self._sample_u[jj], self._sample_v[jj], p[has]
+        best = np.full(p.size, np.inf)
+        arg = np.full((p.size, 2), -1, dtype=np.int64)  # (face position, sample)
+        for ds in (np.zeros(p.size), None):
+            ds = best if ds is None else ds
+            live = np.isfinite(ds) if ds is best else np.ones(p.size, dtype=bool)
+            q, pos = self._face_candidates(P[live], ds[live])
+            q = np.flatnonzero(live)[q]
+            other = self.faces[pos] != f[q]
+            self._nearest_samples(P, q[other], pos[other], best, arg)
+        has = arg[:, 0] >= 0
+        pos, k = arg[has, 0], arg[has, 1]
+        return self.faces[pos], self._U[k], self._V[k], p[has]
+
+    def _nearest_samples(self, P, q, pos, best, arg):
+        """Update ``best`` (distance) and ``arg`` (face position, sample) of points ``P[q]`` with the samples
+        of the faces at ``pos`` (pairs aligned)."""
+        order = np.argsort(pos, kind="stable")
+        q, pos = q[order], pos[order]
+        ufaces = np.unique(pos)
+        for blk in self._blocks(ufaces.size):
+            a, b = np.searchsorted(pos, [ufaces[blk[0]], ufaces[blk[-1]] + 1])
+            S, _ = self._refine(ufaces[blk])
+            loc = np.searchsorted(ufaces[blk], pos[a:b])
+            d = np.linalg.norm(S.reshape(blk.size, -1, 3)[loc] - P[q[a:b], None, :], axis=2)
+            k = np.argmin(d, axis=1)
+            dk = d[np.arange(k.size), k]
+            qq = q[a:b]
+            o = np.lexsort((dk, qq))  # per point, its nearest pair first
+            first = o[np.r_[True, qq[o[1:]] != qq[o[:-1]]]]
+            upd = first[dk[first] < best[qq[first]]]
+            best[qq[upd]] = dk[upd]
+            arg[qq[upd], 0], arg[qq[upd], 1] = pos[a + upd], k[upd]
 
     def _cell_of(self, t):
         return np.minimum((np.asarray(t) * self.m).astype(np.int64), self.m - 1)
@@ -365,12 +526,117 @@ class ClosestPointFinder:
     def _covered_by(self, pid, cid, rf, si, sj, ei, ej):
         """Candidates (pid, cid) in the face ``rf`` of a descent of the same point, within one cell of
         its start cell (si, sj) or its end cell (ei, ej) (all arrays aligned with pid)."""
-        same = self._cface[cid] == rf
+        cf, ci, cj = self._cell(cid)
+        same = cf == rf
         if self.cover >= self.m:
             return same
-        ci, cj, c = self._ci[cid], self._cj[cid], self.cover
+        c = self.cover
         near = ((ci == si) & (cj == sj)) | ((np.abs(ci - ei) <= c) & (np.abs(cj - ej) <= c))
         return same & near
+
+
+def enclosing_cylinders(centre, c, n, r, h, mm):
+    """Per face, a cylinder around ``centre`` (k, 3) holding the cylinders (c, n, r, h) of its ``mm`` cells.
+
+    The axis ``a`` is the mean of the cells' axes ``n`` (``(0, 0, 1)`` where it vanishes). A cell's cylinder
+    reaches ``h |<n, a>| + r sin`` along ``a`` and ``r + h sin`` across it (``sin`` the sine of the angle
+    between n and a), so the face's half-height and radius are the largest of ``|z| + h |<n, a>| + r sin``
+    and ``rho + r + h sin`` (z, rho: axial and lateral offsets of the cell centres). Bounds that are not
+    finite become infinite (the face is then always a candidate).
+
+    >>> c = np.array([[1.0, 0, 0], [-1.0, 0, 0]]); n = np.array([[0, 0, 1.0], [0, 0, 1.0]])
+    >>> bounds = enclosing_cylinders(np.zeros((1, 3)), c, n, np.array([0.5, 0.25]), np.array([0.1, 0.2]), 2)
+    >>> [a.tolist() for a in bounds]
+    [[[0.0, 0.0, 0.0]], [[0.0, 0.0, 1.0]], [1.5], [0.2]]
+    """
+    k = centre.shape[0]
+    C, N, r, h = c.reshape(k, mm, 3), n.reshape(k, mm, 3), r.reshape(k, mm), h.reshape(k, mm)
+    axis = N.sum(axis=1)
+    nn = np.linalg.norm(axis, axis=1, keepdims=True)
+    good = np.isfinite(nn) & (nn > 0)
+    axis = np.where(good, axis / np.where(good, nn, 1.0), np.array([0.0, 0.0, 1.0]))
+    W = C - centre[:, None, :]
+    z = np.einsum("kmc,kc->km", W, axis)
+    rho = np.sqrt(np.maximum(np.einsum("kmc,kmc->km", W, W) - z * z, 0.0))
+    cos = np.minimum(np.abs(np.einsum("kmc,kc->km", N, axis)), 1.0)
+    sin = np.sqrt(np.maximum(1.0 - cos * cos, 0.0))
+    with np.errstate(invalid="ignore"):
+        fr = (rho + r + h * sin).max(axis=1)
+        fh = (np.abs(z) + h * cos + r * sin).max(axis=1)
+    bad = ~(np.isfinite(fr) & np.isfinite(fh))
+    return centre, axis, np.where(bad, np.inf, fr), np.where(bad, np.inf, fh)
+
+
+def morton_order(X, bits=10):
+    """Order of the points ``X`` (n, 3) along a Z-order (Morton) curve of their bounding box (``bits`` per axis).
+
+    >>> morton_order(np.array([[1.0, 1, 1], [0, 0, 0], [1, 0, 0], [0, 0.1, 0]])).tolist()
+    [1, 3, 2, 0]
+    """
+    if X.shape[0] == 0:
+        return np.zeros(0, dtype=np.int64)
+    lo, ext = X.min(axis=0), np.ptp(X, axis=0)
+    q = ((X - lo) / np.where(ext > 0, ext, 1.0) * ((1 << bits) - 1)).astype(np.int64)
+    code = np.zeros(X.shape[0], dtype=np.int64)
+    for b in range(bits):
+        for a in range(3):
+            code |= ((q[:, a] >> b) & 1) << (3 * b + a)
+    return np.argsort(code, kind="stable")
+
+
+def _grown(a, n):
+    """``a`` in a new array of ``n`` rows (its rows first; np.resize would keep a larger base alive)."""
+    out = np.empty((n,) + a.shape[1:], dtype=a.dtype)
+    out[: a.shape[0]] = a
+    return out
+
+
+class _CellCache:
+    """Cell cylinders of recently refined faces, ``capacity`` faces at most (emptied when full; the arrays
+    grow as faces are added)."""
+
+    def __init__(self, finder, capacity):
+        self.finder, self.capacity = finder, capacity
+        self.slot = np.full(finder.faces.size, -1, dtype=np.int32)
+        self.pos = np.empty(0, dtype=np.int64)
+        self.c, self.n, self.r, self.h = np.empty((0, 3)), np.empty((0, 3)), np.empty(0), np.empty(0)
+        self.size = 0
+
+    def nbytes(self):
+        return sum(a.nbytes for a in (self.slot, self.pos, self.c, self.n, self.r, self.h))
+
+    def cells(self):
+        return self.c, self.n, self.r, self.h
+
+    def _reserve(self, faces):
+        """Room for ``faces`` faces (at most ``capacity``; doubling)."""
+        if faces <= self.pos.size:
+            return
+        cap = min(self.capacity, max(faces, 2 * self.pos.size))
+        rows = cap * self.finder._mm
+        self.pos, self.c, self.n, self.r, self.h = (_grown(a, n) for a, n in zip(
+            (self.pos, self.c, self.n, self.r, self.h), (cap, rows, rows, rows, rows)))
+
+    def ensure(self, pos):
+        """Slots of the faces at ``pos`` (at most ``capacity`` distinct), refining those not cached."""
+        new = np.unique(pos[self.slot[pos] < 0])
+        if self.size + new.size > self.capacity:
+            self.slot[self.pos[: self.size]] = -1
+            self.size = 0
+            new = np.unique(pos)
+        for blk in self.finder._blocks(new.size):
+            self.store(new[blk], *self.finder._refine(new[blk])[1])
+        return self.slot[pos].astype(np.int64)
+
+    def store(self, pos, c, n, r, h):
+        """Add the cells (c, n, r, h) of the faces at ``pos`` (not cached, room left)."""
+        mm = self.finder._mm
+        self._reserve(self.size + pos.size)
+        a, b = self.size * mm, (self.size + pos.size) * mm
+        self.c[a:b], self.n[a:b], self.r[a:b], self.h[a:b] = c, n, r, h
+        self.pos[self.size: self.size + pos.size] = pos
+        self.slot[pos] = np.arange(self.size, self.size + pos.size)
+        self.size += pos.size
 
 
 #: largest coordinate magnitude of a query point: the squared distances of the search must stay finite

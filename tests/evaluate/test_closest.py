@@ -320,3 +320,81 @@ def test_compiled_cell_bounds_equal_the_numpy_reference(surfaces, name):
         W = P[f, 2 * ci : 2 * ci + 3, 2 * cj : 2 * cj + 3].reshape(-1, 3) - c[k]
         z = W @ n[k]
         assert np.abs(z).max() < hh[k] and np.sqrt(np.maximum((W * W).sum(1) - z * z, 0)).max() < rr[k]
+
+
+def _face_grid(S, faces, g):
+    """Samples P, Pu, Pv (k, g, g, 3) of ``faces`` on the g x g grid (index i along u)."""
+    t = np.arange(g) / (g - 1)
+    U, V = np.meshgrid(t, t, indexing="ij")
+    k = faces.size
+    r = S.evaluate(np.repeat(faces, g * g), np.tile(U.ravel(), k), np.tile(V.ravel(), k), 1)
+    return [r[key].reshape(k, g, g, 3) for key in ("P", "Pu", "Pv")]
+
+
+@pytest.mark.parametrize("name", ["sector_k5", "torus_8x6"])
+def test_face_bounds_hold_the_surface_and_stay_below_their_cells(surfaces, name):
+    """The structure keeps one cylinder per face: every limit point of the face (a 41 x 41 sampling, finer
+    than the 17 x 17 the bounds come from) lies in it, and its lower bound never exceeds the bound of any of
+    its cells (the cylinders of cell_bounds at 8 x 8 cells, computed here from the evaluator's samples), so
+    the faces it prunes hold no cell the search by cells would have kept."""
+    from ccproof.evaluate import _bvh
+
+    S = surfaces[name]
+    F = ClosestPointFinder(S)
+    faces = np.arange(S.mesh.n_faces)
+    P = _face_grid(S, faces, 41)[0]
+    for f in faces:
+        lb = F.lower_bounds(P[f].reshape(-1, 3), np.full(41 * 41, f))
+        assert lb.max() == 0.0, (f, lb.max())
+    c, n, r, h = _bvh.cell_bounds(*_face_grid(S, faces, 17), 8, 2.0, 0.0)
+    rng = np.random.default_rng(4)
+    lo, hi = P.reshape(-1, 3).min(0), P.reshape(-1, 3).max(0)
+    X = lo - 0.5 * (hi - lo) + 2.0 * (hi - lo) * rng.random((200, 3))
+    for f in rng.choice(faces, 12, replace=False):
+        W = X[:, None, :] - c[None, 64 * f:64 * f + 64]
+        z = np.abs((W * n[None, 64 * f:64 * f + 64]).sum(-1))
+        rho = np.sqrt(np.maximum((W * W).sum(-1) - z * z, 0.0))
+        cell_lb = np.hypot(np.maximum(rho - r[64 * f:64 * f + 64], 0), np.maximum(z - h[64 * f:64 * f + 64], 0))
+        assert (F.lower_bounds(X, np.full(X.shape[0], f)) <= cell_lb.min(1) * (1 + 1e-12)).all()
+
+
+def test_small_cell_cache_gives_the_same_answers(surfaces, monkeypatch):
+    """Cells computed again after the cache is emptied (room for 2 faces) give the same answers, bit for bit."""
+    import ccproof.evaluate.closest as closest
+
+    S = surfaces["torus_8x6"]
+    X = _points(S, 60, seed=21)
+    a = closest_points(S, X)
+    monkeypatch.setattr(closest, "CACHE_CELLS", 2 * 64)
+    F = ClosestPointFinder(S)
+    assert F._cache.capacity == 2
+    b = F.query(X, chunk=7)
+    for key in ("face", "u", "v", "distance"):
+        np.testing.assert_array_equal(getattr(b, key), getattr(a, key))
+    assert F._cache.size <= 2
+
+
+def test_search_structure_memory_is_linear_in_faces(bunny_path):
+    """On the bunny (2,036 faces) the structure keeps less than 400 bytes per face after its build besides
+    its cell cache (the search by cells kept 37 kB per face: samples, cells, two k-d trees), the cache at
+    most CACHE_CELLS cells of 64 bytes, and the peak of its build and of queries stays within the estimate
+    `ccproof project` checks before any work (numpy arrays, traced)."""
+    import tracemalloc
+
+    from ccproof.evaluate.closest import CACHE_CELLS, search_memory
+
+    S = limit_surface(bunny_path)
+    ClosestPointFinder(S, cells=2).query(np.zeros((3, 3)))  # compiled kernels and the table's lazy parts
+    tracemalloc.start()
+    try:
+        F = ClosestPointFinder(S)
+        kept, peak = tracemalloc.get_traced_memory()
+        F.query(_points(S, 300, seed=2))
+        peak = max(peak, tracemalloc.get_traced_memory()[1])
+    finally:
+        tracemalloc.stop()
+    nf = S.mesh.n_faces
+    cache = sum(a.nbytes for a in (F._cache.c, F._cache.n, F._cache.r, F._cache.h))
+    assert cache <= 64 * min(CACHE_CELLS, 64 * nf)
+    assert kept - cache < 400 * nf, (kept - cache) / nf
+    assert peak < search_memory(nf), (peak, search_memory(nf))
