@@ -36,7 +36,7 @@ from _bench import load, ratio_line  # noqa: E402
 from ccproof.evaluate import limit_surface  # noqa: E402
 from ccproof.evaluate.closest import ClosestPointFinder, morton_order  # noqa: E402
 from ccproof.evaluate.closest_certified import certify_closest  # noqa: E402
-from ccproof.evaluate.newton import newton  # noqa: E402
+from ccproof.evaluate.newton import newton_descent  # noqa: E402
 from ccproof.mesh.examples import torus  # noqa: E402
 
 BUNNY = Path(__file__).resolve().parents[1] / "tests" / "data" / "meshes" / "bunny_quads.obj"
@@ -122,7 +122,7 @@ def main(argv=None):
                 ours.append((time.perf_counter() - t0) / a.n)
             else:
                 _, j = T.query(X[:nb], k=1)
-                bu, bv, bE = newton(S, X[:nb], fu[j], uu[j], vv[j])
+                bu, bv, bE = newton_descent(S, X[:nb], fu[j], uu[j], vv[j])
                 base.append((time.perf_counter() - t0) / nb)
     t_ours, t_base = min(ours) * a.n, min(base) * a.n  # for all n points at the measured rate
     print(f"ours: preparation {t_prep:.2f} s, {a.n} points in {t_ours:.2f} s: {a.n / t_ours:,.0f} points/s "

@@ -1,5 +1,5 @@
 """Compiled evaluation kernel (numba), the same arithmetic as the numpy path point by point, and the
-compiled Newton descent of the closest points (:func:`ccproof.evaluate.newton.newton`, point by point).
+compiled Newton descent of the closest points (:func:`ccproof.evaluate.newton.newton_descent`, point by point).
 
 Imported only when numba is installed; :mod:`ccproof.evaluate.surface` falls back to numpy otherwise.
 """
@@ -217,7 +217,7 @@ def _free(w, g):
 
 
 def _newton_points(X, face, u, v, max_iter, max_halvings, T, E):
-    """The descent of :func:`ccproof.evaluate.newton.newton`, point by point: the same formulas in
+    """The descent of :func:`ccproof.evaluate.newton.newton_descent`, point by point: the same formulas in
     the same order (u, v updated in place, E filled). The points must be valid (checked by the
     caller); each evaluation is the batch kernel's on one point."""
     n = X.shape[0]

@@ -64,7 +64,7 @@ import numpy as np
 
 from ccproof.errors import CCProofError
 from ccproof.evaluate import _bvh
-from ccproof.evaluate.newton import newton, row_dot, unit_normal
+from ccproof.evaluate.newton import newton_descent, row_dot, unit_normal
 
 __all__ = ["ClosestPoints", "ClosestPointFinder", "closest_points", "parameter_faces", "search_memory"]
 
@@ -425,7 +425,7 @@ class ClosestPointFinder:
         handoffs = np.zeros(n, dtype=np.int32)
         pid = None
         for _round in range(MAX_ROUNDS + 1):
-            nu, nv, nE = newton(self.surface, X[sp], sf, su, sv)
+            nu, nv, nE = newton_descent(self.surface, X[sp], sf, su, sv)
             np.add.at(ndesc, sp, 1)
             # best per point among this round's descents, then against the best so far
             order = np.lexsort((nE, sp))

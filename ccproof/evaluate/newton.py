@@ -15,7 +15,7 @@ import numpy as np
 from ccproof.errors import CCProofError
 from ccproof.evaluate._parallel import in_blocks, threads_for
 
-__all__ = ["newton", "row_dot", "unit_normal", "MAX_ITER", "MAX_HALVINGS"]
+__all__ = ["newton_descent", "row_dot", "unit_normal", "MAX_ITER", "MAX_HALVINGS"]
 
 #: Newton steps at most per descent
 MAX_ITER = 60
@@ -36,7 +36,7 @@ def unit_normal(Pu, Pv):
     return N
 
 
-def newton(surface, X, face, u, v, max_iter=MAX_ITER, *, backend=None, threads=None):
+def newton_descent(surface, X, face, u, v, max_iter=MAX_ITER, *, backend=None, threads=None):
     """Projected, backtracked Newton descent of ``|P(face, u, v) - X|^2 / 2`` in ``[0, 1]^2``.
 
     Parameters
@@ -73,7 +73,7 @@ def newton(surface, X, face, u, v, max_iter=MAX_ITER, *, backend=None, threads=N
 
     >>> from ccproof.evaluate import limit_surface
     >>> from ccproof.mesh.examples import cube
-    >>> u, v, E = newton(limit_surface(cube()), [[0.0, 0.0, 2.0]], [1], [0.3], [0.3])
+    >>> u, v, E = newton_descent(limit_surface(cube()), [[0.0, 0.0, 2.0]], [1], [0.3], [0.3])
     >>> u.round(12).tolist(), v.round(12).tolist(), round(float(2 * E[0] * 81**2), 9)
     ([0.5], [0.5], 8836.0)
     """
@@ -116,7 +116,7 @@ def newton(surface, X, face, u, v, max_iter=MAX_ITER, *, backend=None, threads=N
 
 
 def _descent_direction(cur, a, Ra, ua, va):
-    """:func:`newton`'s step at the active points ``a`` (residuals ``Ra``, parameters ``ua``, ``va``):
+    """:func:`newton_descent`'s step at the active points ``a`` (residuals ``Ra``, parameters ``ua``, ``va``):
     (gu, gv, guu, gvv, du, dv, projected gradient norm)."""
     Pu, Pv = cur["Pu"][a], cur["Pv"][a]
     gu, gv = row_dot(Pu, Ra), row_dot(Pv, Ra)
@@ -146,7 +146,7 @@ def _descent_direction(cur, a, Ra, ua, va):
 
 
 def _line_search(surface, X, face, a, start, step, state, slack):
-    """:func:`newton`'s backtracking at the active points ``a``: accept the first step with an Armijo decrease;
+    """:func:`newton_descent`'s backtracking at the active points ``a``: accept the first step with an Armijo decrease;
     give up below 2^-MAX_HALVINGS. ``start`` = (ua, va, gu, gv, pg) at the start, ``step`` = (du, dv, al)
     (``al`` halved in place), ``state`` = (u, v, E, R, cur) updated in place where a step is accepted."""
     ua, va, gu, gv, pg = start
@@ -189,7 +189,7 @@ def _line_search(surface, X, face, a, start, step, state, slack):
 
 
 def _newton_compiled(surface, kernel, X, face, u, v, max_iter, threads):
-    """:func:`newton` by the compiled descent (points checked first: the kernel trusts its input)."""
+    """:func:`newton_descent` by the compiled descent (points checked first: the kernel trusts its input)."""
     face, u, v = surface._check(face, u, v)
     X = np.ascontiguousarray(X.reshape(-1, 3) if X.size else np.zeros((0, 3)))
     if X.shape[0] != u.size:

@@ -1,5 +1,5 @@
 """Non-manifold meshes as OpenSubdiv takes them: the fans of every non-manifold vertex split apart into copies
-(:func:`split_nonmanifold`), the non-manifold edges infinitely sharp, the sharpened vertices infinitely sharp
+(:func:`split_nonmanifold_vertices`), the non-manifold edges infinitely sharp, the sharpened vertices infinitely sharp
 corners, an interior non-manifold crease following the crease rule. :attr:`ccproof.mesh.PolyMesh.manifold` is the
 result; every rule then acts on the copies as OpenSubdiv's acts on the vertex.
 """
@@ -14,10 +14,10 @@ import numpy as np
 from ccproof.errors import MeshError
 from ccproof.mesh.rules import Options
 
-__all__ = ["split_nonmanifold", "fans_off_the_crease"]
+__all__ = ["split_nonmanifold_vertices", "fans_off_the_crease"]
 
 
-def split_nonmanifold(mesh):
+def split_nonmanifold_vertices(mesh):
     """The manifold mesh on which the limit surface is evaluated, and its vertex map.
 
     OpenSubdiv (``Far::TopologyRefinerFactory::prepareComponentTagsAndSharpness``) makes every
@@ -76,7 +76,7 @@ def split_nonmanifold(mesh):
 
 
 def _fan_copies(mesh):
-    """(label, vmap, new) of :func:`split_nonmanifold`: the split vertex of every fan (the first fan of a
+    """(label, vmap, new) of :func:`split_nonmanifold_vertices`: the split vertex of every fan (the first fan of a
     vertex keeps its index, the others get n, n+1, ...), the vertex of every split vertex, the split
     vertex of every corner."""
     n, H = mesh.n_vertices, mesh.indices.size
@@ -97,7 +97,7 @@ def _fan_copies(mesh):
 
 
 def _sharpen_nonmanifold(mesh, vsharp):
-    """OpenSubdiv's sharpening of the non-manifold vertices into ``vsharp`` (see :func:`split_nonmanifold`);
+    """OpenSubdiv's sharpening of the non-manifold vertices into ``vsharp`` (see :func:`split_nonmanifold_vertices`);
     returns (the fans made corners, the non-manifold crease vertices with such a fan)."""
     org, prv, comp = mesh.indices, mesh.prev, mesh.halfedges.fan_of_corner
     he = mesh.halfedges

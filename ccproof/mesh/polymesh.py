@@ -21,7 +21,7 @@ more than two faces or two faces in the same direction, e.g. a face given twice,
 ``Far::TopologyRefinerFactory``: such edges infinitely sharp, such vertices infinitely sharp
 corners but on an interior non-manifold crease). :attr:`PolyMesh.manifold` is the mesh the surface
 is evaluated on: the fans of every non-manifold vertex split apart (see
-:func:`ccproof.mesh.nonmanifold.split_nonmanifold`), the same faces.
+:func:`ccproof.mesh.nonmanifold.split_nonmanifold_vertices`), the same faces.
 """
 
 from __future__ import annotations
@@ -256,10 +256,10 @@ class PolyMesh:
 
     def _split_nonmanifold(self):
         """The manifold mesh on which the limit surface is evaluated, and its vertex map:
-        :func:`ccproof.mesh.nonmanifold.split_nonmanifold`."""
-        from ccproof.mesh.nonmanifold import split_nonmanifold
+        :func:`ccproof.mesh.nonmanifold.split_nonmanifold_vertices`."""
+        from ccproof.mesh.nonmanifold import split_nonmanifold_vertices
 
-        return split_nonmanifold(self)
+        return split_nonmanifold_vertices(self)
 
     def _implicit_holes(self):
         """``VTX_BOUNDARY_NONE``: faces at a boundary vertex with a boundary edge not tagged infinite."""

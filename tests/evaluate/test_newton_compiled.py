@@ -7,7 +7,7 @@ from ccproof import limit_surface
 from ccproof.errors import CCProofError
 from ccproof.evaluate import natural_limit_surface
 from ccproof.evaluate.closest import closest_points
-from ccproof.evaluate.newton import newton
+from ccproof.evaluate.newton import newton_descent
 from ccproof.mesh.examples import torus
 from ccproof.mesh.io import read_mesh
 
@@ -46,9 +46,9 @@ def test_compiled_descent_equals_numpy_descent(refdir, mesh):
     else:
         S = natural_limit_surface(read_mesh(refdir / "osd_features" / "meshes" / f"{mesh}.obj"))
     X, f, u0, v0 = _starts(S, 3000, seed=len(mesh))
-    a = newton(S, X, f, u0, v0, backend="numpy")
-    b = newton(S, X, f, u0, v0, backend="numba", threads=1)
-    c = newton(S, X, f, u0, v0, backend="numba", threads=3)
+    a = newton_descent(S, X, f, u0, v0, backend="numpy")
+    b = newton_descent(S, X, f, u0, v0, backend="numba", threads=1)
+    c = newton_descent(S, X, f, u0, v0, backend="numba", threads=3)
     for x, y, z in zip(a, b, c):
         assert np.array_equal(x, y) and np.array_equal(y, z)
     # the descent did something: most points moved, none got farther
@@ -60,11 +60,11 @@ def test_compiled_descent_checks_its_points():
     S = natural_limit_surface(torus())
     X = np.zeros((2, 3))
     with pytest.raises(CCProofError, match=r"point 1: face id \d+ out of range"):
-        newton(S, X, [0, S.n_faces], [0.5, 0.5], [0.5, 0.5])
+        newton_descent(S, X, [0, S.n_faces], [0.5, 0.5], [0.5, 0.5])
     with pytest.raises(CCProofError, match="point 0: u = nan"):
-        newton(S, X, [0, 1], [np.nan, 0.5], [0.5, 0.5])
+        newton_descent(S, X, [0, 1], [np.nan, 0.5], [0.5, 0.5])
     with pytest.raises(CCProofError, match="one row per point"):
-        newton(S, np.zeros((3, 3)), [0, 1], [0.5, 0.5], [0.5, 0.5])
+        newton_descent(S, np.zeros((3, 3)), [0, 1], [0.5, 0.5], [0.5, 0.5])
 
 
 def test_reparameterizable_surfaces_take_the_compiled_descent():

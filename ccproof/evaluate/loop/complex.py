@@ -5,7 +5,7 @@ A :class:`TriComplex` is a set of counter-clockwise triangles in local vertex la
 that the rules read: infinitely sharp edges, corner vertices, the boundary interpolation, and the
 vertices whose fan is *complete* (all their mesh triangles present: only there the vertex rules apply
 and a missing triangle means a boundary). :func:`loop_step` subdivides a complex once, exactly, and
-returns the children's stencils; :func:`canonical_ring` lists the one-ring of a triangle (every
+returns the children's stencils; :func:`canonical_triangle_ring` lists the one-ring of a triangle (every
 triangle sharing a vertex with it) in a deterministic order whose key identifies isomorphic rings.
 """
 
@@ -18,7 +18,7 @@ from ccproof.errors import MeshError
 from ccproof.evaluate.loop.box_spline import DIRS, NET
 from ccproof.mesh.scheme import LOOP
 
-__all__ = ["TriComplex", "loop_step", "canonical_ring", "regular_net", "SMOOTH", "CREASE", "CORNER"]
+__all__ = ["TriComplex", "loop_step", "canonical_triangle_ring", "regular_triangle_net", "SMOOTH", "CREASE", "CORNER"]
 
 SMOOTH, CREASE, CORNER = "smooth", "crease", "corner"
 
@@ -287,7 +287,7 @@ def _label(edge_label, n, a, b):
     return edge_label[key]
 
 
-def canonical_ring(cx, tri):
+def canonical_triangle_ring(cx, tri):
     """The one-ring of triangle ``tri = (a, b, c)`` (its corners complete): (labels, key).
 
     Labels: a, b, c, then the fans of a (from b), b (from c) and c (from a), each new vertex at its
@@ -330,7 +330,7 @@ def key_complex(key):
     return TriComplex(tris, {(a, b): x for a, b, x in sharp}, dict(corners), (0, 1, 2), boundary)
 
 
-def regular_net(cx, tri):
+def regular_triangle_net(cx, tri):
     """The 12 control points (box_spline.NET order) of a triangle whose corners are regular, as stencils
     (dict label -> weight), or None.
 

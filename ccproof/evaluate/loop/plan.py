@@ -1,6 +1,6 @@
 """What to do with one tagged ring configuration, computed once per configuration (exact, then rounded).
 
-:func:`plan` maps the key of a triangle's one-ring (:func:`~ccproof.evaluate.loop.complex.canonical_ring`)
+:func:`plan` maps the key of a triangle's one-ring (:func:`~ccproof.evaluate.loop.complex.canonical_triangle_ring`)
 to one of
 
 * :class:`Regular`: the three corners are regular: the box-spline patch on 12 ring points;
@@ -27,7 +27,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from ccproof.errors import MeshError
-from ccproof.evaluate.loop.complex import SMOOTH, canonical_ring, key_complex, limit_stencil, loop_step, regular_net
+from ccproof.evaluate.loop.complex import (
+    SMOOTH,
+    canonical_triangle_ring,
+    key_complex,
+    limit_stencil,
+    loop_step,
+    regular_triangle_net,
+)
 
 __all__ = ["Regular", "Corner", "Split", "plan", "oriented_ring", "PRECISION", "MAX_DEPTH", "LAYER_TOLERANCE"]
 
@@ -102,7 +109,7 @@ def oriented_ring(cx, tri, irr=None):
     if irr is None:
         irr = irregular_corners(cx, tri)
     r = irr[0] if len(irr) == 1 else 0
-    ring, key = canonical_ring(cx, tri[r:] + tri[:r])
+    ring, key = canonical_triangle_ring(cx, tri[r:] + tri[:r])
     return r, ring, key
 
 
@@ -118,7 +125,7 @@ def plan(key, depth=0):
                         "local Loop steps")
     cx = key_complex(key)
     irr = irregular_corners(cx, (0, 1, 2))
-    net = regular_net(cx, (0, 1, 2)) if not irr else None
+    net = regular_triangle_net(cx, (0, 1, 2)) if not irr else None
     out = Regular(_dense(net, cx.n_vertices)) if net is not None else None
     if out is None and irr == [0]:
         out = _corner(cx, key)
@@ -152,11 +159,11 @@ def _corner(cx, key):
 
     with _precision() as one:
         child, st, kids = _children(cx, key, one)
-        ring0, key0 = canonical_ring(child, kids[0])
+        ring0, key0 = canonical_triangle_ring(child, kids[0])
         if key0 != key or any(irregular_corners(child, t) for t in kids[1:]):
             return None
         rows = [st[x] for x in ring0]
-        nets = [regular_net(child, t) for t in kids[1:]]
+        nets = [regular_triangle_net(child, t) for t in kids[1:]]
         if any(n is None for n in nets) or any(s is None for s in rows):
             return None
         nets = [_compose(r, st) for n in nets for r in n]
