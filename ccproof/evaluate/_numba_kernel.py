@@ -75,21 +75,65 @@ def _bicubic(net, p, s, t, g, d, k, P, Pu, Pv, Puu, Puv, Pvv):
                 Pvv[k, c] = _sum4(s0, s1, s2, s3, x2, y2, z2, q2) * g2
 
 
+def _regular_net(T, job, vf, W, s):
+    """Net ``W[s]`` (17 x 3) of the regular leaf ``vf`` of ``job``: row i ``sum_j op[j, i] (X[ring[j]] -
+    X[ring[0]])`` over the ring points j = 1, 2, ... in order from 0.0, row 16 that sum plus ``X[ring[0]]``."""
+    N = T.vn[vf]
+    o = T.vop_start[vf]
+    r0_ = T.job_ring[job]
+    i0 = T.rings[r0_]
+    for i in range(17):
+        W[s, i, 0] = 0.0
+        W[s, i, 1] = 0.0
+        W[s, i, 2] = 0.0
+    for j in range(1, N):
+        ij = T.rings[r0_ + j]
+        r0 = T.points[ij, 0] - T.points[i0, 0]
+        r1 = T.points[ij, 1] - T.points[i0, 1]
+        r2 = T.points[ij, 2] - T.points[i0, 2]
+        r = o + 17 * j
+        for i in range(17):
+            w = T.vop[r + i]
+            W[s, i, 0] += w * r0
+            W[s, i, 1] += w * r1
+            W[s, i, 2] += w * r2
+    for c in range(3):
+        W[s, 16, c] = W[s, 16, c] + T.points[i0, c]
+    return W
+
+
 def _corner_net(T, job, vf, cfg, lay, code, ci, W, s):
     """Net ``W[s]`` (17 x 3, row 16 the limit point) of patch ``code`` of layer ``lay`` of corner face
-    ``vf`` of ``job``: ``L[lay, code] @ ring`` summed over the ring points j = 1, 2, ... in order
+    ``vf`` of ``job``: its ring relative to the corner vertex (``Q @ (X[ring] - X[ring[0]])``, summed over
+    j = 1, 2, ... in order), then ``L[lay, code] @ ring`` summed over the ring points j = 1, 2, ... in order
     (row 0 of the relative ring is 0), the 16 entries side by side."""
     Nc = T.op_size[cfg]
+    m = Nc - 1
+    N = T.vn[vf]
+    q = T.vop_start[vf]
+    r0_ = T.job_ring[job]
+    i0 = T.rings[r0_]
+    rc = np.zeros((max(m, 1), 3))
+    for j in range(1, N):
+        ij = T.rings[r0_ + j]
+        r0 = T.points[ij, 0] - T.points[i0, 0]
+        r1 = T.points[ij, 1] - T.points[i0, 1]
+        r2 = T.points[ij, 2] - T.points[i0, 2]
+        b = q + m * j
+        for r in range(m):
+            w = T.vop[b + r]
+            rc[r, 0] += w * r0
+            rc[r, 1] += w * r1
+            rc[r, 2] += w * r2
     o = T.op_start[cfg] + (3 * lay + code) * 16 * Nc
-    q0 = T.job_pts[job] + T.pts[vf] - 1  # ring row j >= 1 (row 0, the vertex, is 0)
     for i in range(16):
         W[s, i, 0] = 0.0
         W[s, i, 1] = 0.0
         W[s, i, 2] = 0.0
     for j in range(1, Nc):
-        r0 = T.ring[q0 + j, 0]
-        r1 = T.ring[q0 + j, 1]
-        r2 = T.ring[q0 + j, 2]
+        r0 = rc[j - 1, 0]
+        r1 = rc[j - 1, 1]
+        r2 = rc[j - 1, 2]
         r = o + 16 * j
         for i in range(16):
             w = T.ops[r + i]
@@ -194,8 +238,19 @@ def _evaluate_points(f, u, v, d, T, P, Pu, Pv, Puu, Puv, Pvv):
                 net = _corner_net(T, job, vf, cfg, lay, code, ci, W, 0)
                 p = 0
         else:
-            net = T.nets
             p = T.job_net[job] + T.leaf[vf]
+            if T.nets.shape[0] > 0:
+                net = T.nets
+            elif ns > 0:
+                key = 3 * lm * T.origin.shape[0] + p
+                p = (key * _HASH) & (ns - 1)
+                if tags[p] != key:
+                    _regular_net(T, job, vf, cache, p)
+                    tags[p] = key
+                net = cache
+            else:
+                net = _regular_net(T, job, vf, W, 0)
+                p = 0
             pu0 = T.u0[vf]
             pv0 = T.v0[vf]
             h = T.h[vf]
@@ -415,6 +470,7 @@ def _ring_walks(org, nxt, prv, twin, pos, seen, g, r, rings, nring, faces, nface
 
 
 if numba is not None:
+    _regular_net = numba.njit(cache=True, nogil=True)(_regular_net)
     _corner_net = numba.njit(cache=True, nogil=True)(_corner_net)
     _basis = numba.njit(cache=True, nogil=True, inline="always")(_basis)
     _sum4 = numba.njit(cache=True, nogil=True, inline="always")(_sum4)

@@ -18,12 +18,19 @@ shared by every face with that key:
 * per *configuration* (a corner scheme and the orientation of the corner in the ptex face): the
   exact-then-rounded layer operators ``L`` (n_layers, 3, 16, Nc) of
   :func:`ccproof.evaluate.local.corner_scheme`, shared by every corner face of that configuration;
-* per job: the id of its template and its ring (vertex indices); the float data derived from them
-  (the 17 x 3 nets of its regular patches, the Nc x 3 relative ring and the limit point of its corner
-  faces), so that a regular point costs one gather and a corner point one ``16 x Nc`` product.
+* per job: the id of its template and its ring (int32 indices into the positions the rings index,
+  one (V, 3) array shared by every job); the limit point of each of its corner faces.
 
-Memory: O(control points + ptex faces + configurations): nothing is stored per layer per face; a
-point in layer n of a corner face gets its net as ``L[n, code] @ ring`` at evaluation time.
+A point's net is computed when it is evaluated, from the positions of its job's ring: the net of a
+regular patch is its template operator (17 x N) applied to ``rel = X[ring] - X[ring[0]]``, the net of
+layer n of a corner face is ``L[n, code] @ (Q @ rel)`` (Q the corner face's ring operator), every sum
+taken in one fixed order (ring point j = 1, 2, ... from 0.0) by every backend, so that all give the
+same bits. Small tables keep the nets precomputed by the same sums (:data:`NETS_BUDGET`,
+:data:`HOT_BUDGET`).
+
+Memory: O(control points + ptex faces + configurations): per ptex face of a triangle scan about 150
+bytes (the ring's indices, the corner limit points, the offsets); nothing is stored per layer or per
+net of a face.
 """
 
 from __future__ import annotations
@@ -68,6 +75,9 @@ _BLOCK = 1 << 13
 #: largest size of the layer-0 nets of the corner faces kept precomputed (``PatchTable.hot``, 1,224
 #: bytes per corner face); beyond it every corner net is computed at evaluation time
 HOT_BUDGET = 32 << 20
+#: largest size of the regular nets kept precomputed (``PatchTable.nets``, 408 bytes per regular patch);
+#: beyond it every regular net is computed at evaluation time from the ring
+NETS_BUDGET = 32 << 20
 
 
 class PatchTable(NamedTuple):
@@ -80,9 +90,9 @@ class PatchTable(NamedTuple):
         unless the ptex face is a quad split into its four level-1 children).
     refused : bool (P,)
         Ptex faces evaluation refuses (holes).
-    job_root, job_net, job_corner, job_pts : int32 (J,) (int64 where the offsets need it)
-        Per job: the root virtual face of its template, and the offsets of its regular nets in
-        ``nets``, of its corner faces in ``origin``, of its corner rings in ``ring``.
+    job_root, job_net, job_corner, job_ring : int32 (J,) (int64 where the offsets need it)
+        Per job: the root virtual face of its template, and the index of its first regular patch, of its
+        first corner face (in ``origin``) and of its ring in ``rings``.
     kind : int8 (T,)
         Per template virtual face: 0 regular patch, 1 corner face, 2 split into four children.
     child : int64 (T, 4)
@@ -91,20 +101,29 @@ class PatchTable(NamedTuple):
         Domain of a virtual face in its ptex face (lower-left corner, side: a power of 2).
     leaf : int64 (T,)
         Index of a leaf among its template's regular patches or corner faces.
-    pts : int64 (T,)
-        Offset of a corner face's ring among its template's corner rings.
     cfg : int64 (T,)
         Configuration of a corner face.
     cu, cv : bool (T,)
         Whether a corner face's irregular corner is at ``u0 + h`` (``v0 + h``).
+    vop_start, vn : int64 (T,)
+        Per leaf its operator's offset in ``vop`` and its template's ring size N.
+    vop : float64
+        Per regular leaf its operator (N, 17): row j the weights of ring point j in the 16 net rows
+        (relative to row 16) and in row 16 (less the ring's point 0); per corner face (N, Nc - 1): row j
+        the weights of ring point j in the rows 1 .. Nc - 1 of the corner ring relative to its vertex.
     split_depth : int
         Deepest split in any template.
-    nets : float64 (n_regular, 17, 3)
-        Regular patch nets, base orientation, relative to row 16 (the origin).
+    n_regular : int
+        Regular patches (leaves) of all jobs together.
+    points : float64 (V, 3)
+        The positions the rings index (the mesh's vertices, or the level-1 points of a polygon mesh).
+    rings : int32 (sum of the jobs' ring sizes,)
+        The rings of the jobs, one after the other.
+    nets : float64 (n_regular, 17, 3) or (0, 17, 3)
+        The nets of the regular patches (base orientation, row 16 the origin) computed by the kernels'
+        sums, kept when they fit :data:`NETS_BUDGET`; empty otherwise (computed when evaluated).
     origin : float64 (n_corner, 3)
         Limit point of each corner face's irregular corner.
-    ring : float64 (n_points, 3)
-        Corner rings relative to their corner vertex, rows 1 .. Nc - 1 (row 0, the vertex, is 0).
     ops : float64 (sum of n_layers * 48 * Nc,)
         Per configuration its layer operators ``L`` laid out (n_layers, 3, Nc, 16): ``[n, code, j, i]``
         the weight of ring point j in entry i of the net of layer n, patch ``code`` (0 along u, 1
@@ -122,13 +141,13 @@ class PatchTable(NamedTuple):
     Examples
     --------
     A surface's table is ``S.patch_map.table`` (:class:`ccproof.evaluate.patch_map.PatchMap`). The 5-regular
-    disk of two rings: 20 ptex faces, 10 stored regular patches (net and origin, 17 rows), 10 corner faces:
+    disk of two rings: 20 ptex faces, 10 regular patches (their nets kept: a small table), 10 corner faces:
 
     >>> from ccproof.evaluate import natural_limit_surface
     >>> from ccproof.mesh.examples import k_regular_disk
     >>> T = natural_limit_surface(k_regular_disk(5, 2)).patch_map.table
-    >>> T.top.shape, T.nets.shape, T.origin.shape
-    ((20, 4), (10, 17, 3), (10, 3))
+    >>> T.top.shape, T.n_regular, T.nets.shape, T.origin.shape
+    ((20, 4), 10, (10, 17, 3), (10, 3))
     """
 
     top: np.ndarray
@@ -136,21 +155,25 @@ class PatchTable(NamedTuple):
     job_root: np.ndarray
     job_net: np.ndarray
     job_corner: np.ndarray
-    job_pts: np.ndarray
+    job_ring: np.ndarray
     kind: np.ndarray
     child: np.ndarray
     u0: np.ndarray
     v0: np.ndarray
     h: np.ndarray
     leaf: np.ndarray
-    pts: np.ndarray
     cfg: np.ndarray
     cu: np.ndarray
     cv: np.ndarray
+    vop_start: np.ndarray
+    vn: np.ndarray
+    vop: np.ndarray
     split_depth: int
+    n_regular: int
+    points: np.ndarray
+    rings: np.ndarray
     nets: np.ndarray
     origin: np.ndarray
-    ring: np.ndarray
     ops: np.ndarray
     op_start: np.ndarray
     op_size: np.ndarray
@@ -1017,38 +1040,48 @@ class Builder:
     # ------------------------------------------------------------------ assembly
     def table(self, top, refused):
         """The :class:`PatchTable` (floats from the positions given to :meth:`classify`), and the
-        template groups ``[(template, jobs, rings)]`` that :func:`job_floats` recomputes from."""
+        template groups ``[(template, jobs, rings)]`` that :func:`job_floats` recomputes from (``rings``
+        views of the table's ``rings``)."""
         temps = list(self.templates.values())
         J = self.n_jobs
         job_root = np.full(J, -1, dtype=np.int64)
         job_net = np.zeros(J, dtype=np.int64)
         job_corner = np.zeros(J, dtype=np.int64)
-        job_pts = np.zeros(J, dtype=np.int64)
-        kind, child, dom, leaf, pts, cfg, corner = [], [], [], [], [], [], []
-        n_tv = n_reg = n_cor = n_pts = 0
+        job_ring = np.zeros(J, dtype=np.int64)
+        kind, child, dom, leaf, cfg, corner, vop_start, vn, vop = [], [], [], [], [], [], [], [], []
+        n_tv = n_reg = n_cor = n_ring = n_vop = 0
         groups = []
         depth = 0
+        rings_flat = np.empty(sum(len(t.rings) for t in temps), dtype=np.int32)
         for t in temps:
-            jobs = np.frombuffer(t.jobs, dtype=np.int64) if len(t.jobs) else np.zeros(0, np.int64)
-            rings = np.frombuffer(t.rings, dtype=np.int32).reshape(-1, t.n) if len(t.rings) else \
-                np.zeros((0, t.n), np.int32)
+            jobs = np.frombuffer(t.jobs, dtype=np.int64).astype(np.int32 if J < 2**31 else np.int64) \
+                if len(t.jobs) else np.zeros(0, np.int64)
             k = jobs.size
+            rings = rings_flat[n_ring:n_ring + k * t.n].reshape(k, t.n)
+            if k:
+                rings[...] = np.frombuffer(t.rings, dtype=np.int32).reshape(k, t.n)
+            t.rings = None  # (the table's copy is the one kept)
             job_root[jobs] = n_tv
             nr, nc = t.R.shape[0] // 17, t.O.shape[0]
             job_net[jobs] = n_reg + nr * np.arange(k)
             job_corner[jobs] = n_cor + nc * np.arange(k)
-            job_pts[jobs] = n_pts + t.n_pts * np.arange(k)
-            t.offsets = (n_reg, n_cor, n_pts)
+            job_ring[jobs] = n_ring + t.n * np.arange(k)
+            t.offsets = (n_reg, n_cor, n_ring)
             n_reg += nr * k
             n_cor += nc * k
-            n_pts += t.n_pts * k
+            n_ring += t.n * k
             kind += t.kind
             child += [[c + n_tv if c >= 0 else -1 for c in ch] for ch in t.child]
             dom += t.dom
             leaf += t.leaf
-            pts += t.pts
             cfg += t.cfg
             corner += t.corner
+            for ops_ in _leaf_operators(t):
+                vop_start.append(n_vop if ops_ is not None else -1)
+                vn.append(t.n)
+                if ops_ is not None:
+                    vop.append(ops_.reshape(-1))
+                    n_vop += ops_.size
             dv = np.zeros(len(t.kind), dtype=np.int64)
             for v, ch in enumerate(t.child):  # children are created after their parents
                 if t.kind[v] == KIND_SPLIT:
@@ -1071,24 +1104,54 @@ class Builder:
             off += L.size
         d = np.array(dom, dtype=np.float64).reshape(-1, 3)
         c = np.array(corner, dtype=bool).reshape(-1, 2)
-        nets, origin, ring = job_floats(groups, self.X, (n_reg, n_cor, n_pts), self.progress)
+        X = np.ascontiguousarray(self.X, dtype=np.float64)
+        origin = job_floats(groups, X, n_cor, self.progress)
+
         def small(a, bound):  # int32 where it fits (the per-face arrays are the big ones)
             return np.ascontiguousarray(a, dtype=np.int32 if bound < 2**31 else np.int64)
 
         T = PatchTable(
             top=small(top, J), refused=np.ascontiguousarray(refused, dtype=np.bool_),
             job_root=small(job_root, n_tv), job_net=small(job_net, n_reg), job_corner=small(job_corner, n_cor),
-            job_pts=small(job_pts, n_pts),
+            job_ring=small(job_ring, n_ring),
             kind=np.array(kind, dtype=np.int8), child=np.array(child, dtype=np.int64).reshape(-1, 4),
             u0=d[:, 0].copy(), v0=d[:, 1].copy(), h=d[:, 2].copy(), leaf=np.array(leaf, dtype=np.int64),
-            pts=np.array(pts, dtype=np.int64), cfg=np.array(cfg, dtype=np.int64),
-            cu=c[:, 0].copy(), cv=c[:, 1].copy(), split_depth=depth, nets=nets, origin=origin, ring=ring,
+            cfg=np.array(cfg, dtype=np.int64), cu=c[:, 0].copy(), cv=c[:, 1].copy(),
+            vop_start=np.array(vop_start, dtype=np.int64), vn=np.array(vn, dtype=np.int64),
+            vop=np.concatenate(vop) if vop else np.zeros(0), split_depth=depth, n_regular=n_reg,
+            points=X, rings=rings_flat, nets=np.zeros((0, 17, 3)), origin=origin,
             ops=np.concatenate(ops) if ops else np.zeros(0), op_start=np.array(op_start, dtype=np.int64),
             op_size=np.array(op_size, dtype=np.int64), n_layers=np.array(n_layers, dtype=np.int64),
             unit=np.array(unit, dtype=np.float64).reshape(-1, 3, 3), hot=np.zeros((0, 17, 3)))
-        if 0 < n_cor and n_cor * 3 * 17 * 3 * 8 <= HOT_BUDGET:
-            T = T._replace(hot=layer0_nets(T, groups))
-        return T, groups
+        return with_nets(T, groups), groups
+
+
+def _leaf_operators(t):
+    """Per virtual face of the finished template ``t`` its operator as :attr:`PatchTable.vop` stores it
+    (regular (N, 17), corner (N, Nc - 1)), or None (a split face)."""
+    out = []
+    starts = sorted(t.pts[v] for v, k in enumerate(t.kind) if k == KIND_CORNER) + [t.Q.shape[0]]
+    for v, k in enumerate(t.kind):
+        if k == KIND_REGULAR:
+            r = 17 * t.leaf[v]
+            out.append(np.ascontiguousarray(t.R[r:r + 17].T))
+        elif k == KIND_CORNER:
+            p = t.pts[v]
+            out.append(np.ascontiguousarray(t.Q[p:starts[starts.index(p) + 1]].T))
+        else:
+            out.append(None)
+    return out
+
+
+def with_nets(T, groups):
+    """``T`` with the precomputed nets that fit their budgets: the regular nets (:data:`NETS_BUDGET`) and
+    the layer-0 corner nets (:data:`HOT_BUDGET`), both by the kernels' sums (none where they do not fit)."""
+    n_cor = T.origin.shape[0]
+    if 0 < T.n_regular and T.n_regular * 17 * 3 * 8 <= NETS_BUDGET:
+        T = T._replace(nets=regular_nets(T, groups))
+    if 0 < n_cor and n_cor * 3 * 17 * 3 * 8 <= HOT_BUDGET:
+        T = T._replace(hot=layer0_nets(T, groups))
+    return T
 
 
 def _smooth_template(frame):
@@ -1104,59 +1167,85 @@ def _smooth_template(frame):
     return t
 
 
-def job_floats(groups, X, sizes, progress=None):
-    """The float data of every job from the positions ``X`` of the complex its rings index.
-
-    Per template group, in blocks of jobs: ``rel = X[ring] - X[ring[0]]`` (J, N, 3), then the
-    template's operators applied to it (one stacked matrix product per block); the affine rows (patch
-    origins, corner limit points) add ``X[ring[0]]`` back.
+def job_floats(groups, X, n_cor, progress=None):
+    """The limit points of the corner faces of every job from the positions ``X`` of the complex its
+    rings index: per template group, in blocks of jobs, ``O @ (X[ring] - X[ring[0]]) + X[ring[0]]``.
 
     Returns
     -------
-    nets : ndarray (n_regular, 17, 3)
     origin : ndarray (n_corner, 3)
-    ring : ndarray (n_points, 3)
     """
     X = np.asarray(X, dtype=np.float64)
-    n_reg, n_cor, n_pts = sizes
-    nets = np.empty((n_reg, 17, 3))
     origin = np.empty((n_cor, 3))
-    ring = np.empty((n_pts, 3))
+    bad = False
     bar = _progress(progress, sum(g[1].size for g in groups), "patch data")
     for t, jobs, rings in groups:
-        o_reg, o_cor, o_pts = t.offsets
-        nr, nc, npt = t.R.shape[0] // 17, t.O.shape[0], t.Q.shape[0]
-        grid = getattr(t, "smooth_grid", None)
+        o_cor = t.offsets[1]
+        nc = t.O.shape[0]
         for lo in range(0, jobs.size, _BLOCK):
             R = rings[lo:lo + _BLOCK]
             k = R.shape[0]
-            if grid is not None:  # a smooth regular quad: its grid less the grid's mean, directly
-                origin_ = X[R[:, grid]].mean(axis=1)
-                a = np.empty((k, 17, 3))
-                a[:, :16] = X[R] - origin_[:, None, :]
-                a[:, 16] = origin_
-                nets[o_reg + lo:o_reg + lo + k] = a
-                bar.update(k)
-                continue
             X0 = X[R[:, 0]]
-            rel = X[R] - X0[:, None, :]  # (k, N, 3); the operators applied job by job (stacked products
-            # write the (job, row, xyz) layout of the table directly: no transposed copies)
-            if nr:
-                a = np.matmul(t.R, rel).reshape(k, nr, 17, 3)
-                a[:, :, 16] += X0[:, None, :]
-                nets[o_reg + nr * lo:o_reg + nr * (lo + k)] = a.reshape(-1, 17, 3)
+            rel = X[R] - X0[:, None, :]
+            if not (np.abs(rel) <= 1e300).all():  # the nets computed from rel would not be finite
+                bad = True
             if nc:
-                np.matmul(t.Q, rel, out=ring[o_pts + npt * lo:o_pts + npt * (lo + k)].reshape(k, npt, 3))
                 b = np.matmul(t.O, rel)
                 b += X0[:, None, :]
                 origin[o_cor + nc * lo:o_cor + nc * (lo + k)] = b.reshape(-1, 3)
             bar.update(k)
     bar.close()
-    for name, a in (("nets", nets), ("origin", origin), ("ring", ring)):
-        if not np.isfinite(a).all():
-            raise MeshError(f"non-finite {name} in the patch table: a control point beyond about 1e150 in magnitude "
-                            "(the differences overflow; scale the mesh) or a non-finite one")
-    return nets, origin, ring
+    if bad or not np.isfinite(origin).all():
+        raise MeshError("non-finite limit point in the patch table: a control point beyond about 1e150 in magnitude "
+                        "(the differences overflow; scale the mesh) or a non-finite one")
+    return origin
+
+
+def ring_products(op, X, rings):
+    """``op`` (N, r) applied to the rings (k, N) of positions ``X``, the kernels' sums: per ring
+    ``sum_j op[j] * (X[ring[j]] - X[ring[0]])`` over j = 1, 2, ... in order from 0.0. Shape (k, r, 3).
+
+    >>> X = np.array([[0.0, 0, 0], [1, 0, 0], [0, 2, 0]])
+    >>> ring_products(np.array([[9.0], [1.0], [0.5]]), X, np.array([[0, 1, 2]]))[0].tolist()
+    [[1.0, 1.0, 0.0]]
+    """
+    X0 = X[rings[:, 0]]
+    acc = np.zeros((rings.shape[0], op.shape[1], 3))
+    for j in range(1, op.shape[0]):
+        acc += op[j][None, :, None] * (X[rings[:, j]] - X0)[:, None, :]
+    return acc
+
+
+def regular_nets(T, groups):
+    """The nets of every regular patch of table ``T`` (:attr:`PatchTable.nets`), computed as the kernels
+    compute them (:func:`ring_products` of the leaf's operator, row 16 plus the ring's point 0)."""
+    nets = np.empty((T.n_regular, 17, 3))
+    X = T.points
+    for t, jobs, rings in groups:
+        if not jobs.size:
+            continue
+        root = int(T.job_root[jobs[0]])
+        for vf, kind in enumerate(t.kind):
+            if kind != KIND_REGULAR:
+                continue
+            g = root + vf
+            st, N = int(T.vop_start[g]), int(T.vn[g])
+            for lo in range(0, jobs.size, _BLOCK):
+                R = rings[lo:lo + _BLOCK]
+                a = ring_products(T.vop[st:st + 17 * N].reshape(N, 17), X, R)
+                a[:, 16] += X[R[:, 0]]
+                nets[T.job_net[jobs[lo:lo + _BLOCK]] + t.leaf[vf]] = a
+    return nets
+
+
+def corner_rings(T, jobs, vf):
+    """The rings (k, Nc, 3) relative to their corner vertex (row 0 zero) of the corner face ``vf`` (a
+    virtual face of the table ``T``) of ``jobs`` (k,), computed as the kernels compute them."""
+    N, st, Nc = int(T.vn[vf]), int(T.vop_start[vf]), int(T.op_size[T.cfg[vf]])
+    R = T.rings[T.job_ring[jobs][:, None] + np.arange(N)]
+    out = np.zeros((R.shape[0], Nc, 3))
+    out[:, 1:] = ring_products(T.vop[st:st + N * (Nc - 1)].reshape(N, Nc - 1), T.points, R)
+    return out
 
 
 def catmark_step(mesh):
@@ -1259,26 +1348,28 @@ def _step_vertex_points(X, corners, fp, valence, bnd_h, nb_out):
 def layer0_nets(T, groups):
     """The nets of layer 0 of every corner face of table ``T`` (see :attr:`PatchTable.hot`): per
     corner face c and patch code, ``sum_j L[0, code, j] ring[j]`` summed over j = 1, 2, ... in order
-    (the compiled kernel's sums), row 16 the limit point. Shape (3 n_corner, 17, 3)."""
+    (the compiled kernel's sums; the ring by :func:`corner_rings`), row 16 the limit point. Shape
+    (3 n_corner, 17, 3)."""
     hot = np.empty((3 * T.origin.shape[0], 17, 3))
     for t, jobs, _ in groups:
         if jobs is None or not jobs.size or not t.O.shape[0]:
             continue
-        o_reg, o_cor, o_pts = t.offsets
-        nc, npt = t.O.shape[0], t.Q.shape[0]
-        k = jobs.size
+        root = int(T.job_root[jobs[0]])
         for vf, kind in enumerate(t.kind):
             if kind != KIND_CORNER:
                 continue
-            cfg = t.cfg[vf]
+            g = root + vf
+            cfg = int(T.cfg[g])
             Nc, st = int(T.op_size[cfg]), int(T.op_start[cfg])
-            ci = o_cor + nc * np.arange(k) + t.leaf[vf]
-            q0 = o_pts + npt * np.arange(k) + t.pts[vf] - 1
             L0 = T.ops[st:st + 48 * Nc].reshape(3, Nc, 16)
-            for code in range(3):
-                acc = np.zeros((k, 16, 3))
-                for j in range(1, Nc):
-                    acc += L0[code, j][None, :, None] * T.ring[q0 + j][:, None, :]
-                hot[3 * ci + code, :16] = acc
-                hot[3 * ci + code, 16] = T.origin[ci]
+            for lo in range(0, jobs.size, _BLOCK):
+                jb = jobs[lo:lo + _BLOCK]
+                ring = corner_rings(T, jb, g)
+                ci = T.job_corner[jb] + t.leaf[vf]
+                for code in range(3):
+                    acc = np.zeros((jb.size, 16, 3))
+                    for j in range(1, Nc):
+                        acc += L0[code, j][None, :, None] * ring[:, j][:, None, :]
+                    hot[3 * ci + code, :16] = acc
+                    hot[3 * ci + code, 16] = T.origin[ci]
     return hot

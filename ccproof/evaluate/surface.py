@@ -40,8 +40,10 @@ from ccproof.evaluate._table import (
     Builder,
     Jobs,
     catmark_step,
+    corner_rings,
     job_floats,
-    layer0_nets,
+    ring_products,
+    with_nets,
 )
 from ccproof.evaluate.bspline import bspline_basis
 from ccproof.evaluate.patch_map import PatchMap
@@ -156,11 +158,15 @@ class LimitSurface:
 
     @property
     def table_bytes(self):
-        """Bytes held by the patch table: the kernel's arrays, the jobs' rings and the configurations'
-        operators (the mesh itself not included); :attr:`configuration_bytes` of them are per
-        configuration, the rest grows with the faces."""
-        n = sum(a.nbytes for a in self._table if isinstance(a, np.ndarray))
-        n += sum(rings.nbytes + jobs.nbytes for _, jobs, rings in self._groups if rings is not None)
+        """Bytes held by the patch table: the kernel's arrays (the jobs' rings, the positions they index
+        unless they are the mesh's vertices), the jobs of every template, the operators;
+        :attr:`configuration_bytes` of them are per configuration or template, the rest grows with the faces."""
+        T = self._table
+        n = sum(a.nbytes for a in T if isinstance(a, np.ndarray) and a is not T.points)
+        vertices = getattr(self.mesh, "vertices", None)
+        if not (isinstance(vertices, np.ndarray) and np.shares_memory(vertices, T.points)):
+            n += T.points.nbytes  # (the mesh's own vertices are not counted)
+        n += sum(jobs.nbytes for _, jobs, _ in self._groups)
         return n + self._job_base.nbytes + sum(t.R.nbytes + t.Q.nbytes + t.O.nbytes for t, _, _ in self._groups)
 
     @property
@@ -169,7 +175,7 @@ class LimitSurface:
         operators), shared by all faces of that configuration."""
         T = self._table
         n = sum(a.nbytes for a in (T.ops, T.op_start, T.op_size, T.n_layers, T.unit, T.kind, T.child, T.u0,
-                                   T.v0, T.h, T.leaf, T.pts, T.cfg, T.cu, T.cv))
+                                   T.v0, T.h, T.leaf, T.cfg, T.cu, T.cv, T.vop, T.vop_start, T.vn))
         return n + sum(t.R.nbytes + t.Q.nbytes + t.O.nbytes for t, _, _ in self._groups)
 
     @property
@@ -263,31 +269,45 @@ class LimitSurface:
         if nets:
             N = np.empty((f.size, 17, 3))
             reg = np.flatnonzero(loc.kind == KIND_REGULAR)
-            N[reg] = T.nets[loc.patch[reg]]
+            if T.nets.shape[0]:  # kept (the same sums)
+                N[reg] = T.nets[loc.patch[reg]]
+            else:
+                for w in np.unique(loc.vface[reg]).tolist():
+                    sel = reg[loc.vface[reg] == w]
+                    n_, st = int(T.vn[w]), int(T.vop_start[w])
+                    R = T.rings[T.job_ring[loc.job[sel]][:, None] + np.arange(n_)]
+                    a = ring_products(T.vop[st:st + 17 * n_].reshape(n_, 17), T.points, R)
+                    a[:, 16] += T.points[R[:, 0]]
+                    N[sel] = a
             idx = loc.corner
             if idx.size:
-                w = loc.vface[idx]
-                n, code, ci = loc.layer, loc.code, loc.corner_face
-                q0 = T.job_pts[loc.job[idx]] + T.pts[w]
-                cfg = T.cfg[w]
-                todo = np.ones(idx.size, dtype=bool)
-                if T.hot.shape[0]:  # layer 0 precomputed (the same sums)
-                    h0 = np.flatnonzero(n == 0)
-                    N[idx[h0]] = T.hot[3 * ci[h0] + code[h0]]
-                    todo[h0] = False
-                for c in np.unique(cfg[todo]).tolist():
-                    sel = np.flatnonzero((cfg == c) & todo)
-                    Nc, nl, st = int(T.op_size[c]), int(T.n_layers[c]), int(T.op_start[c])
-                    Lc = T.ops[st:st + nl * 48 * Nc].reshape(nl * 3, Nc, 16)
-                    Q = T.ring[q0[sel][:, None] + np.arange(Nc - 1)]  # rows 1.. (row 0 is 0)
-                    rows = idx[sel]
-                    Ls = Lc[3 * n[sel] + code[sel]]  # (k, Nc, 16)
-                    acc = np.zeros((sel.size, 16, 3))
-                    for j in range(1, Nc):  # summed in the compiled kernel's order: the same bits
-                        acc += Ls[:, j, :, None] * Q[:, None, j - 1, :]
-                    N[rows, :16] = acc
-                    N[rows, 16] = T.origin[ci[sel]]
+                self._corner_point_nets(loc, N)
         return loc.patch, loc.s, loc.t, loc.scale, N
+
+    def _corner_point_nets(self, loc, N):
+        """The nets of the points of ``loc`` (a :class:`~ccproof.evaluate.patch_map.Location`) in corner
+        faces into ``N``: layer 0 kept (``hot``) or ``L[n, code] @ ring`` summed in the kernels' order."""
+        T = self._table
+        idx = loc.corner
+        w = loc.vface[idx]
+        n, code, ci = loc.layer, loc.code, loc.corner_face
+        todo = np.ones(idx.size, dtype=bool)
+        if T.hot.shape[0]:  # layer 0 precomputed (the same sums)
+            h0 = np.flatnonzero(n == 0)
+            N[idx[h0]] = T.hot[3 * ci[h0] + code[h0]]
+            todo[h0] = False
+        for vf in np.unique(w[todo]).tolist():
+            sel = np.flatnonzero((w == vf) & todo)
+            c = int(T.cfg[vf])
+            Nc, nl, st = int(T.op_size[c]), int(T.n_layers[c]), int(T.op_start[c])
+            Lc = T.ops[st:st + nl * 48 * Nc].reshape(nl * 3, Nc, 16)
+            Q = corner_rings(T, loc.job[idx[sel]], vf)
+            Ls = Lc[3 * n[sel] + code[sel]]  # (k, Nc, 16)
+            acc = np.zeros((sel.size, 16, 3))
+            for j in range(1, Nc):  # summed in the compiled kernel's order: the same bits
+                acc += Ls[:, j, :, None] * Q[:, None, j, :]
+            N[idx[sel], :16] = acc
+            N[idx[sel], 16] = T.origin[ci[sel]]
 
     def evaluate(self, face_ids, u, v, derivatives=1, *, parameterization="natural", chunk=CHUNK, out=None,
                  backend=None, threads=None):
@@ -528,9 +548,7 @@ class LimitSurface:
         """``(CornerScheme, C - C[0])`` of the corner face ``vf`` of ``job``: its configuration's
         scheme and its ring (Nc, 3) relative to the corner vertex."""
         T = self._table
-        cfg = int(T.cfg[vf])
-        q = int(T.job_pts[job] + T.pts[vf])
-        return self._schemes[cfg], np.vstack([np.zeros((1, 3)), T.ring[q:q + int(T.op_size[cfg]) - 1]])
+        return self._schemes[int(T.cfg[vf])], corner_rings(T, np.array([job]), vf)[0]
 
     def _eigen_normal(self, job, vf):
         """Unit normal at the irregular corner of corner face ``vf`` of ``job`` from the exact tangent masks."""
@@ -737,11 +755,10 @@ class LimitSurface:
         new.mesh = mesh
         new.parameterizations = dict(self.parameterizations)
         T = self._table
-        nets, origin, ring = job_floats(self._groups, V, (T.nets.shape[0], T.origin.shape[0],
-                                                                      T.ring.shape[0]), progress=False)
-        new._table = T._replace(nets=nets, origin=origin, ring=ring)
-        if T.hot.shape[0]:
-            new._table = new._table._replace(hot=layer0_nets(new._table, self._groups))
+        V = np.ascontiguousarray(V, dtype=np.float64)
+        origin = job_floats(self._groups, V, T.origin.shape[0], progress=False)
+        new._table = with_nets(T._replace(points=V, origin=origin, nets=T.nets[:0], hot=T.hot[:0]), self._groups)
+        new._ctable = None
         new._corner_normal = {}
         return new
 

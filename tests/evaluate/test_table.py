@@ -54,6 +54,7 @@ def test_bytes_per_ptex_face_flat_under_refinement_and_depth(refdir, monkeypatch
     from ccproof.evaluate import _table
 
     monkeypatch.setattr(_table, "HOT_BUDGET", 0)  # no precomputed layer 0 (it is kept on small meshes only)
+    monkeypatch.setattr(_table, "NETS_BUDGET", 0)  # nor regular nets
     mesh = read_obj_tagged(refdir / "osd_features" / "meshes" / "catmark_smoothtris1.obj")
     per_face = []
     m = mesh
@@ -64,7 +65,9 @@ def test_bytes_per_ptex_face_flat_under_refinement_and_depth(refdir, monkeypatch
         per_face.append((cur - S.configuration_bytes) / m.n_ptex)
     print("bytes per ptex face after 1, 2, 3 refinements:", [round(b) for b in per_face])
     assert max(per_face) <= 5 * min(per_face), per_face
-    assert max(per_face) < 4096, per_face  # a stored layer table alone is ~90 layers x 1.2 kB
+    # the rings' indices, the corner limit points and the offsets: no float net is kept per face (a stored
+    # layer table alone would be ~90 layers x 1.2 kB; stored nets and rings ~1.7 kB on the first refinement)
+    assert max(per_face) < 400, per_face
     # deep points at every ptex corner: the retained memory does not change
     P = m.n_ptex
     f = np.repeat(np.arange(P), 4)
@@ -85,15 +88,18 @@ def test_bytes_per_ptex_face_flat_under_refinement_and_depth(refdir, monkeypatch
 
 
 def test_precomputed_layer_zero_gives_the_same_bits(refdir, monkeypatch):
-    """The layer-0 nets kept precomputed on small meshes are the sums the kernels compute otherwise:
-    the same numbers, bit for bit, on every backend (points in every layer of every corner)."""
+    """The layer-0 nets and the regular nets kept precomputed on small meshes are the sums the kernels
+    compute otherwise from the rings: the same numbers, bit for bit, on every backend (points in every
+    layer of every corner)."""
     from ccproof.evaluate import _table
 
     mesh = read_obj_tagged(refdir / "osd_features" / "meshes" / "catmark_smoothtris1.obj")
     hot = LimitSurface(mesh, progress=False)
     monkeypatch.setattr(_table, "HOT_BUDGET", 0)
+    monkeypatch.setattr(_table, "NETS_BUDGET", 0)
     cold = LimitSurface(mesh, progress=False)
     assert hot._table.hot.shape[0] == 3 * hot._table.origin.shape[0] > 0 and cold._table.hot.shape[0] == 0
+    assert hot._table.nets.shape[0] == hot._table.n_regular > 0 and cold._table.nets.shape[0] == 0
     rng = np.random.default_rng(5)
     n = 20000
     f = rng.integers(0, mesh.n_ptex, n)
