@@ -104,7 +104,7 @@ class Worker:
         elif opt:
             raise SystemExit(f"{spec}: unknown option {opt!r} (computed)")
         self.p = subprocess.Popen([sys.executable, "-c", WORKER, str(cpu)], stdin=subprocess.PIPE,
-                                  stdout=subprocess.PIPE, text=True, env=env)
+                                  stdout=subprocess.PIPE, text=True, env=env, cwd=tree or None)  # ("" first)
 
     def run(self, path, pts):
         self.p.stdin.write(f"{path} {pts}\n")

@@ -55,6 +55,10 @@ __all__ = ["natural_limit_surface", "LimitSurface", "available_backends"]
 
 #: points evaluated per chunk (bounds the temporary memory: about 1 kB per point)
 CHUNK = 1 << 15
+#: calls on at least this many points (faces not in order) evaluate them batched by face
+SORT_MIN = 1 << 12
+#: points per kernel call of the batched evaluation (bounds its temporaries: 8 bytes per point and output)
+SORT_CHUNK = 1 << 16
 
 _KEYS = {0: ("P",), 1: ("P", "Pu", "Pv"), 2: ("P", "Pu", "Pv", "Puu", "Puv", "Pvv")}
 
@@ -385,8 +389,12 @@ class LimitSurface:
         return out
 
     def _evaluate_compiled(self, name, kernel, f, u, v, derivatives, out, threads):
-        """:meth:`evaluate` by the compiled kernel ``name`` (``"c"`` or ``"numba"``) into ``out``, in blocks."""
+        """:meth:`evaluate` by the compiled kernel ``name`` (``"c"`` or ``"numba"``) into ``out``, in blocks;
+        from :data:`SORT_MIN` points on, unless the faces are in order already, batched by face
+        (:meth:`_evaluate_by_face`)."""
         n = f.size
+        if n >= SORT_MIN and (f[1:] < f[:-1]).any():
+            return self._evaluate_by_face(name, kernel, f, u, v, derivatives, out, threads)
         if name == "c":
             f, u, v = (np.ascontiguousarray(a) for a in (f, u, v))
             block, back = self._c_block(kernel, f, u, v, derivatives, out)
@@ -399,6 +407,35 @@ class LimitSurface:
             raise CCProofError("internal error: the compiled kernel refused a point the checks accept")
         for k, a in back:
             out[k][...] = a
+        return out
+
+    def _evaluate_by_face(self, name, kernel, f, u, v, derivatives, out, threads):
+        """:meth:`_evaluate_compiled` on the points taken in the order of their faces (the table's rows and
+        the positions the nets are computed from are read in order, and points of one patch find its net
+        in the kernel's cache), in chunks of :data:`SORT_CHUNK` points written back to ``out`` in the
+        caller's order. Every point gets the same bits as in any other order (its net is the same sums)."""
+        order = np.argsort(f)
+        keys = _KEYS[derivatives]
+
+        def block(lo, hi):
+            for a in range(lo, hi, SORT_CHUNK):
+                sel = order[a:min(hi, a + SORT_CHUNK)]
+                fb, ub, vb = f[sel], u[sel], v[sel]
+                tmp = {k: np.empty((sel.size, 3)) for k in keys}
+                if name == "c":
+                    bad = self._c_block(kernel, fb, ub, vb, derivatives, tmp)[0](0, sel.size)
+                else:
+                    bad = self._numba_block(kernel, fb, ub, vb, derivatives, tmp)(0, sel.size)
+                if bad >= 0:
+                    return bad
+                for k in keys:
+                    out[k][sel] = tmp[k]
+            return -1
+
+        bad = in_blocks(block, f.size, threads_for(threads, f.size), 32768, per_thread=4)
+        if max(bad) >= 0:
+            self._check_values(f, u, v)  # raises, naming the first bad point
+            raise CCProofError("internal error: the compiled kernel refused a point the checks accept")
         return out
 
     def _c_block(self, kernel, f, u, v, derivatives, out):
