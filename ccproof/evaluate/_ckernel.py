@@ -18,6 +18,7 @@ import threading
 import numpy as np
 
 from ccproof.errors import CCProofError
+from ccproof.evaluate._table import COMPOSED_LAYERS
 
 __all__ = ["load", "CTable", "evaluate_block", "ring_walks"]
 
@@ -25,6 +26,8 @@ _P = ctypes.c_void_p
 _I = ctypes.c_int64
 #: most layers of corner nets precomputed (CCP_LAYER_NETS in _clib.c)
 _LAYER_NETS = 4
+#: layers of a corner face with composed operators (CCP_COMPOSED in _clib.c)
+_COMPOSED = 2
 #: the bytes the precomputed corner nets of layers 1, 2, ... may take together (layer 0 is the table's own
 #: ``hot``): a point in layer n of a corner face reads its net there instead of the kernel's corner-net cache
 LAYER_NETS_BUDGET = 4 << 20
@@ -181,6 +184,8 @@ class CTable:
         s.n_hot = int(T.hot.shape[0])
         s.n_nets = int(T.nets.shape[0])
         s.n_corner = int(T.origin.shape[0])
+        if COMPOSED_LAYERS != _COMPOSED:
+            raise CCProofError(f"the C kernel composes {_COMPOSED} layers, the table {COMPOSED_LAYERS}")
         self._keep = keep
         self.struct = s
         self.ref = ctypes.byref(s)

@@ -38,6 +38,7 @@
 #define CCP_HASH 2654435761u
 #define CCP_NET 51 /* 17 x 3 doubles: 16 net rows relative to row 16, the origin */
 #define CCP_LAYER_NETS 4 /* most layers of corner nets kept precomputed */
+#define CCP_COMPOSED 2   /* layers of a corner face with composed operators (_table.COMPOSED_LAYERS) */
 #define CCP_VF_BITS 24 /* bits of the virtual face in a grid cell */
 
 #if defined(__GNUC__)
@@ -277,7 +278,9 @@ static void regular_net(const ccp_table *T, int64_t job, int64_t vf, double *W) 
 }
 
 /* Net W (17 x 3, row 16 the limit point) of patch ``code`` of layer ``lay`` of the corner face ``vf`` of
- * ``job``: its ring relative to the corner vertex first (rows 1 .. Nc - 1: Q @ (X[ring] - X[ring[0]]), the
+ * ``job``. Layers below CCP_COMPOSED: the composed operator M (N x 16) of the layer and code, the sums over the
+ * ring points j = 1, 2, ... in order from 0.0 of M[j, i] (X[ring[j]] - X[ring[0]]). Deeper: its ring relative
+ * to the corner vertex first (rows 1 .. Nc - 1: Q @ (X[ring] - X[ring[0]]), the
  * sums over the ring points j = 1, 2, ... in order from 0.0; Q: vop, N x (Nc - 1)), then L[lay, code] @ that
  * ring summed over its points j = 1, 2, ... in order, from 0.0. */
 static void corner_net(const ccp_table *T, int64_t job, int64_t vf, int64_t cfg, int64_t lay, int64_t code,
@@ -287,6 +290,28 @@ static void corner_net(const ccp_table *T, int64_t job, int64_t vf, int64_t cfg,
     const double *q = T->vop + T->vop_start[vf];
     const int32_t *rg = ring_of(T, job);
     const double *x0 = T->points + 3 * (int64_t)rg[0];
+    if (lay < CCP_COMPOSED) { /* one product: the composed operator (N x 16) of this layer and code */
+        const double *M = q + N * m + (3 * lay + code) * N * 16;
+        double b0[16], b1[16], b2[16];
+        for (int i = 0; i < 16; i++) b0[i] = b1[i] = b2[i] = 0.0;
+        for (int64_t j = 1; j < N; j++) {
+            const double *x = T->points + 3 * (int64_t)rg[j];
+            double r0 = x[0] - x0[0], r1 = x[1] - x0[1], r2 = x[2] - x0[2];
+            const double *w = M + 16 * j;
+            for (int i = 0; i < 16; i++) {
+                b0[i] += w[i] * r0;
+                b1[i] += w[i] * r1;
+                b2[i] += w[i] * r2;
+            }
+        }
+        for (int i = 0; i < 16; i++) {
+            W[3 * i] = b0[i];
+            W[3 * i + 1] = b1[i];
+            W[3 * i + 2] = b2[i];
+        }
+        for (int c = 0; c < 3; c++) W[48 + c] = T->origin[3 * ci + c];
+        return;
+    }
     double rc[3 * (m > 0 ? m : 1)];
     for (int64_t r = 0; r < 3 * m; r++) rc[r] = 0.0;
     for (int64_t j = 1; j < N; j++) {

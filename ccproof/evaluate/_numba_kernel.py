@@ -15,7 +15,7 @@ try:
 except ImportError:  # pragma: no cover - optional dependency
     numba = None
 
-from ccproof.evaluate._table import KIND_CORNER, KIND_SPLIT
+from ccproof.evaluate._table import COMPOSED_LAYERS, KIND_CORNER, KIND_SPLIT
 
 #: corner nets (layers beyond the precomputed ones) kept per kernel call: slots (a power of 2, 408 bytes each)
 _CACHE_SLOTS = 16384
@@ -104,7 +104,8 @@ def _regular_net(T, job, vf, W, s):
 
 def _corner_net(T, job, vf, cfg, lay, code, ci, W, s):
     """Net ``W[s]`` (17 x 3, row 16 the limit point) of patch ``code`` of layer ``lay`` of corner face
-    ``vf`` of ``job``: its ring relative to the corner vertex (``Q @ (X[ring] - X[ring[0]])``, summed over
+    ``vf`` of ``job``: below :data:`COMPOSED_LAYERS` the composed operator's sums over the ring points; deeper,
+    its ring relative to the corner vertex (``Q @ (X[ring] - X[ring[0]])``, summed over
     j = 1, 2, ... in order), then ``L[lay, code] @ ring`` summed over the ring points j = 1, 2, ... in order
     (row 0 of the relative ring is 0), the 16 entries side by side."""
     Nc = T.op_size[cfg]
@@ -113,6 +114,26 @@ def _corner_net(T, job, vf, cfg, lay, code, ci, W, s):
     q = T.vop_start[vf]
     r0_ = T.job_ring[job]
     i0 = T.rings[r0_]
+    if lay < COMPOSED_LAYERS:  # one product: the composed operator (N x 16) of this layer and code
+        b = q + N * m + (3 * lay + code) * N * 16
+        for i in range(16):
+            W[s, i, 0] = 0.0
+            W[s, i, 1] = 0.0
+            W[s, i, 2] = 0.0
+        for j in range(1, N):
+            ij = T.rings[r0_ + j]
+            r0 = T.points[ij, 0] - T.points[i0, 0]
+            r1 = T.points[ij, 1] - T.points[i0, 1]
+            r2 = T.points[ij, 2] - T.points[i0, 2]
+            r = b + 16 * j
+            for i in range(16):
+                w = T.vop[r + i]
+                W[s, i, 0] += w * r0
+                W[s, i, 1] += w * r1
+                W[s, i, 2] += w * r2
+        for c in range(3):
+            W[s, 16, c] = T.origin[ci, c]
+        return W
     rc = np.zeros((max(m, 1), 3))
     for j in range(1, N):
         ij = T.rings[r0_ + j]

@@ -75,6 +75,11 @@ _BLOCK = 1 << 13
 #: largest size of the layer-0 nets of the corner faces kept precomputed (``PatchTable.hot``, 1,224
 #: bytes per corner face); beyond it every corner net is computed at evaluation time
 HOT_BUDGET = 32 << 20
+#: layers of a corner face whose nets are one product with the ring: the layer operator composed with the
+#: corner ring's (``Q L[n, code]``, (N, 16) per layer and code, per corner face of a template); the deeper
+#: layers take the ring first (``L[n, code] @ (Q @ rel)``). A uniformly random point of a corner face is in
+#: layer 0 or 1 with probability 15/16.
+COMPOSED_LAYERS = 2
 #: largest size of the regular nets kept precomputed (``PatchTable.nets``, 408 bytes per regular patch);
 #: beyond it every regular net is computed at evaluation time from the ring
 NETS_BUDGET = 32 << 20
@@ -110,7 +115,9 @@ class PatchTable(NamedTuple):
     vop : float64
         Per regular leaf its operator (N, 17): row j the weights of ring point j in the 16 net rows
         (relative to row 16) and in row 16 (less the ring's point 0); per corner face (N, Nc - 1): row j
-        the weights of ring point j in the rows 1 .. Nc - 1 of the corner ring relative to its vertex.
+        the weights of ring point j in the rows 1 .. Nc - 1 of the corner ring relative to its vertex,
+        followed by the composed operators (N, 16) of its first layers (:data:`COMPOSED_LAYERS`), layer by
+        layer, code by code: row j the weights of ring point j in the 16 rows of that net.
     split_depth : int
         Deepest split in any template.
     n_regular : int
@@ -1052,6 +1059,17 @@ class Builder:
         n_tv = n_reg = n_cor = n_ring = n_vop = 0
         groups = []
         depth = 0
+        ops, op_start, op_size, n_layers, unit = [], [], [], [], []
+        off = 0
+        for scheme, orient in self.schemes:
+            L, u = _oriented_layers(scheme, orient)
+            nl_, nc_ = scheme.n_layers, L.shape[1]
+            ops.append(L.reshape(nl_ * 3, 16, nc_).transpose(0, 2, 1).reshape(-1))  # (layer, code, j, i)
+            op_start.append(off)
+            op_size.append(L.shape[1])
+            n_layers.append(scheme.n_layers)
+            unit.append(u)
+            off += L.size
         rings_flat = np.empty(sum(len(t.rings) for t in temps), dtype=np.int32)
         for t in temps:
             jobs = np.frombuffer(t.jobs, dtype=np.int64).astype(np.int32 if J < 2**31 else np.int64) \
@@ -1076,7 +1094,7 @@ class Builder:
             leaf += t.leaf
             cfg += t.cfg
             corner += t.corner
-            for ops_ in _leaf_operators(t):
+            for ops_ in _leaf_operators(t, ops):
                 vop_start.append(n_vop if ops_ is not None else -1)
                 vn.append(t.n)
                 if ops_ is not None:
@@ -1091,17 +1109,6 @@ class Builder:
             groups.append((t, jobs, rings))
         if (job_root < 0).any():  # pragma: no cover - would be a bug in the classification
             raise MeshError(f"internal error: job {int(np.flatnonzero(job_root < 0)[0])} was not classified")
-        ops, op_start, op_size, n_layers, unit = [], [], [], [], []
-        off = 0
-        for scheme, orient in self.schemes:
-            L, u = _oriented_layers(scheme, orient)
-            nl_, nc_ = scheme.n_layers, L.shape[1]
-            ops.append(L.reshape(nl_ * 3, 16, nc_).transpose(0, 2, 1).reshape(-1))  # (layer, code, j, i)
-            op_start.append(off)
-            op_size.append(L.shape[1])
-            n_layers.append(scheme.n_layers)
-            unit.append(u)
-            off += L.size
         d = np.array(dom, dtype=np.float64).reshape(-1, 3)
         c = np.array(corner, dtype=bool).reshape(-1, 2)
         X = np.ascontiguousarray(self.X, dtype=np.float64)
@@ -1126,9 +1133,11 @@ class Builder:
         return with_nets(T, groups), groups
 
 
-def _leaf_operators(t):
-    """Per virtual face of the finished template ``t`` its operator as :attr:`PatchTable.vop` stores it
-    (regular (N, 17), corner (N, Nc - 1)), or None (a split face)."""
+def _leaf_operators(t, ops):
+    """Per virtual face of the finished template ``t`` (its ``cfg`` the table's) its operators as
+    :attr:`PatchTable.vop` stores them, or None (a split face): regular (N, 17); corner (N, Nc - 1), then
+    per layer n < min(:data:`COMPOSED_LAYERS`, layers) and code the composed (N, 16) ``Q L[n, code]``
+    (``ops``: the flat layer operators of each configuration, (n_layers, 3, Nc, 16))."""
     out = []
     starts = sorted(t.pts[v] for v, k in enumerate(t.kind) if k == KIND_CORNER) + [t.Q.shape[0]]
     for v, k in enumerate(t.kind):
@@ -1137,7 +1146,10 @@ def _leaf_operators(t):
             out.append(np.ascontiguousarray(t.R[r:r + 17].T))
         elif k == KIND_CORNER:
             p = t.pts[v]
-            out.append(np.ascontiguousarray(t.Q[p:starts[starts.index(p) + 1]].T))
+            Q = t.Q[p:starts[starts.index(p) + 1]].T  # (N, Nc - 1)
+            L = ops[t.cfg[v]].reshape(-1, 3, Q.shape[1] + 1, 16)  # (layer, code, j, i)
+            comp = [Q @ L[n, c, 1:] for n in range(min(COMPOSED_LAYERS, L.shape[0])) for c in range(3)]
+            out.append(np.concatenate([Q.reshape(-1)] + [m.reshape(-1) for m in comp]))
         else:
             out.append(None)
     return out
@@ -1236,6 +1248,18 @@ def regular_nets(T, groups):
                 a[:, 16] += X[R[:, 0]]
                 nets[T.job_net[jobs[lo:lo + _BLOCK]] + t.leaf[vf]] = a
     return nets
+
+
+def composed_nets(T, jobs, vf, lay, code):
+    """The nets (k, 17, 3) of patch ``code`` of layer ``lay`` < :data:`COMPOSED_LAYERS` of the corner face
+    ``vf`` of ``jobs`` (k,): :func:`ring_products` of the composed operator, row 16 the limit point."""
+    N, st, Nc = int(T.vn[vf]), int(T.vop_start[vf]), int(T.op_size[T.cfg[vf]])
+    st += N * (Nc - 1) + (3 * lay + code) * N * 16
+    R = T.rings[T.job_ring[jobs][:, None] + np.arange(N)]
+    out = np.empty((R.shape[0], 17, 3))
+    out[:, :16] = ring_products(T.vop[st:st + N * 16].reshape(N, 16), T.points, R)
+    out[:, 16] = T.origin[T.job_corner[jobs] + T.leaf[vf]]
+    return out
 
 
 def corner_rings(T, jobs, vf):
@@ -1347,9 +1371,8 @@ def _step_vertex_points(X, corners, fp, valence, bnd_h, nb_out):
 
 def layer0_nets(T, groups):
     """The nets of layer 0 of every corner face of table ``T`` (see :attr:`PatchTable.hot`): per
-    corner face c and patch code, ``sum_j L[0, code, j] ring[j]`` summed over j = 1, 2, ... in order
-    (the compiled kernel's sums; the ring by :func:`corner_rings`), row 16 the limit point. Shape
-    (3 n_corner, 17, 3)."""
+    corner face c and patch code the composed operator's sums (:func:`composed_nets`, the compiled
+    kernel's), row 16 the limit point. Shape (3 n_corner, 17, 3)."""
     hot = np.empty((3 * T.origin.shape[0], 17, 3))
     for t, jobs, _ in groups:
         if jobs is None or not jobs.size or not t.O.shape[0]:
@@ -1358,18 +1381,9 @@ def layer0_nets(T, groups):
         for vf, kind in enumerate(t.kind):
             if kind != KIND_CORNER:
                 continue
-            g = root + vf
-            cfg = int(T.cfg[g])
-            Nc, st = int(T.op_size[cfg]), int(T.op_start[cfg])
-            L0 = T.ops[st:st + 48 * Nc].reshape(3, Nc, 16)
             for lo in range(0, jobs.size, _BLOCK):
                 jb = jobs[lo:lo + _BLOCK]
-                ring = corner_rings(T, jb, g)
                 ci = T.job_corner[jb] + t.leaf[vf]
                 for code in range(3):
-                    acc = np.zeros((jb.size, 16, 3))
-                    for j in range(1, Nc):
-                        acc += L0[code, j][None, :, None] * ring[:, j][:, None, :]
-                    hot[3 * ci + code, :16] = acc
-                    hot[3 * ci + code, 16] = T.origin[ci]
+                    hot[3 * ci + code] = composed_nets(T, jb, root + vf, 0, code)
     return hot

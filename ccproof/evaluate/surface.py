@@ -35,11 +35,13 @@ import numpy as np
 from ccproof.errors import CCProofError
 from ccproof.evaluate._parallel import in_blocks, threads_for
 from ccproof.evaluate._table import (
+    COMPOSED_LAYERS,
     KIND_CORNER,
     KIND_REGULAR,
     Builder,
     Jobs,
     catmark_step,
+    composed_nets,
     corner_rings,
     job_floats,
     ring_products,
@@ -290,7 +292,8 @@ class LimitSurface:
 
     def _corner_point_nets(self, loc, N):
         """The nets of the points of ``loc`` (a :class:`~ccproof.evaluate.patch_map.Location`) in corner
-        faces into ``N``: layer 0 kept (``hot``) or ``L[n, code] @ ring`` summed in the kernels' order."""
+        faces into ``N``: layer 0 kept (``hot``), the first layers by their composed operators, the others
+        ``L[n, code] @ ring``, summed in the kernels' order."""
         T = self._table
         idx = loc.corner
         w = loc.vface[idx]
@@ -301,7 +304,15 @@ class LimitSurface:
             N[idx[h0]] = T.hot[3 * ci[h0] + code[h0]]
             todo[h0] = False
         for vf in np.unique(w[todo]).tolist():
-            sel = np.flatnonzero((w == vf) & todo)
+            at = (w == vf) & todo
+            for lay in range(COMPOSED_LAYERS):  # one product with the ring
+                for code_ in range(3):
+                    sel = np.flatnonzero(at & (n == lay) & (code == code_))
+                    if sel.size:
+                        N[idx[sel]] = composed_nets(T, loc.job[idx[sel]], vf, lay, code_)
+            sel = np.flatnonzero(at & (n >= COMPOSED_LAYERS))
+            if not sel.size:
+                continue
             c = int(T.cfg[vf])
             Nc, nl, st = int(T.op_size[c]), int(T.n_layers[c]), int(T.op_start[c])
             Lc = T.ops[st:st + nl * 48 * Nc].reshape(nl * 3, Nc, 16)
