@@ -401,10 +401,10 @@ class LimitSurface:
 
     def _evaluate_compiled(self, name, kernel, f, u, v, derivatives, out, threads):
         """:meth:`evaluate` by the compiled kernel ``name`` (``"c"`` or ``"numba"``) into ``out``, in blocks;
-        from :data:`SORT_MIN` points on, unless the faces are in order already, batched by face
-        (:meth:`_evaluate_by_face`)."""
+        from :data:`SORT_MIN` points on, on a table whose nets are computed at evaluation time (a large one),
+        unless the faces are in order already, batched by face (:meth:`_evaluate_by_face`)."""
         n = f.size
-        if n >= SORT_MIN and (f[1:] < f[:-1]).any():
+        if n >= SORT_MIN and self._table.nets.shape[0] == 0 and (f[1:] < f[:-1]).any():
             return self._evaluate_by_face(name, kernel, f, u, v, derivatives, out, threads)
         if name == "c":
             f, u, v = (np.ascontiguousarray(a) for a in (f, u, v))
@@ -421,11 +421,13 @@ class LimitSurface:
         return out
 
     def _evaluate_by_face(self, name, kernel, f, u, v, derivatives, out, threads):
-        """:meth:`_evaluate_compiled` on the points taken in the order of their faces (the table's rows and
+        """:meth:`_evaluate_compiled` on the points taken in the order of their faces (in runs of at most
+        ``n_faces / 2^15`` faces, in the caller's order within a run; the table's rows and
         the positions the nets are computed from are read in order, and points of one patch find its net
         in the kernel's cache), in chunks of :data:`SORT_CHUNK` points written back to ``out`` in the
         caller's order. Every point gets the same bits as in any other order (its net is the same sums)."""
-        order = np.argsort(f)
+        shift = max(0, int(self.n_faces - 1).bit_length() - 16)  # (runs of 2^shift faces: a radix sort)
+        order = np.argsort((f >> shift).astype(np.uint16), kind="stable")
         keys = _KEYS[derivatives]
 
         def block(lo, hi):

@@ -1,6 +1,7 @@
-"""Points in any order: the compiled kernels take large calls batched by face (``surface.SORT_MIN``) and
-write the results back in the caller's order; every point gets the bits it gets alone, on every backend,
-with the nets kept precomputed or computed from the rings at evaluation time."""
+"""Points in any order: the compiled kernels take large calls on tables whose nets are computed at
+evaluation time batched by face (``surface.SORT_MIN``) and write the results back in the caller's order;
+every point gets the bits it gets alone, on every backend, with the nets kept precomputed (no batching) or
+computed from the rings."""
 
 import numpy as np
 import pytest
