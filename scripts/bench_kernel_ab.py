@@ -21,9 +21,11 @@ Build a library with setup.py's flags, e.g.::
     python scripts/bench_kernel_ab.py --smoke      the installed kernel against itself (the test suite's run)
 
 A library may name the source tree its worker imports ccproof from and options of its table: ``LIB@TREE`` (the
-tree put first on the worker's PYTHONPATH: compares two versions of the package, each with its own kernel) and
-``LIB@TREE@computed`` (no precomputed nets: ``NETS_BUDGET`` and ``HOT_BUDGET`` set to 0, every net computed from
-the rings at evaluation time), e.g. the table of the main branch against this one on the icospheres of
+tree put first on the worker's PYTHONPATH: compares two versions of the package, each with its own kernel),
+``LIB@TREE@computed`` (no precomputed nets: the environment variables ``CCPROOF_NETS_BUDGET`` and
+``CCPROOF_HOT_BUDGET`` set to 0, every net computed from the rings at evaluation time), ``LIB@TREE@unsorted``
+(points never batched by face: ``SORT_MIN`` out of reach) or both (``@computed,unsorted``), e.g. the table
+of the main branch against this one on the icospheres of
 ``scripts/bench_memory.py`` (``--mesh`` adds meshes; ``--shapes none`` leaves out the default ones)::
 
     python scripts/bench_kernel_ab.py /tmp/old.so@/tmp/oldtree /tmp/new.so /tmp/new.so@.@computed \
@@ -54,9 +56,9 @@ from ccproof.mesh.io import read_mesh  # noqa: E402
 WORKER = r"""
 import hashlib, os, sys, time
 import numpy as np
-if os.environ.get("CCPROOF_AB_COMPUTED"):
-    from ccproof.evaluate import _table
-    _table.NETS_BUDGET = _table.HOT_BUDGET = 0
+if os.environ.get("CCPROOF_AB_UNSORTED"):
+    from ccproof.evaluate import surface
+    surface.SORT_MIN = 1 << 62
 from ccproof.evaluate import natural_limit_surface
 from ccproof.evaluate.surface import available_backends
 from ccproof.mesh.io import read_mesh
@@ -99,10 +101,13 @@ class Worker:
         env.pop("CCPROOF_BACKEND", None)
         if tree:
             env["PYTHONPATH"] = str(Path(tree).resolve()) + os.pathsep + env.get("PYTHONPATH", "")
-        if opt == "computed":
-            env["CCPROOF_AB_COMPUTED"] = "1"
-        elif opt:
-            raise SystemExit(f"{spec}: unknown option {opt!r} (computed)")
+        for o in filter(None, opt.split(",")):
+            if o not in ("computed", "unsorted"):
+                raise SystemExit(f"{spec}: unknown option {o!r} (computed, unsorted)")
+            if o == "computed":
+                env["CCPROOF_NETS_BUDGET"] = env["CCPROOF_HOT_BUDGET"] = "0"
+            else:
+                env["CCPROOF_AB_UNSORTED"] = "1"
         self.p = subprocess.Popen([sys.executable, "-c", WORKER, str(cpu)], stdin=subprocess.PIPE,
                                   stdout=subprocess.PIPE, text=True, env=env, cwd=tree or None)  # ("" first)
 

@@ -102,6 +102,23 @@ def _regular_net(T, job, vf, W, s):
     return W
 
 
+def _regular_lookup(T, job, vf, lm, cache, tags, W):
+    """``(array, row)`` holding the net of the regular leaf ``vf`` of ``job``: the kept nets, the call's
+    cache (computed into it when missing; keys after the corner nets'), or ``W`` (no cache)."""
+    p = T.job_net[job] + T.leaf[vf]
+    if T.nets.shape[0] > 0:
+        return T.nets, p
+    ns = cache.shape[0]
+    if ns == 0:
+        return _regular_net(T, job, vf, W, 0), 0
+    key = 3 * lm * T.origin.shape[0] + p
+    s = (key * _HASH) & (ns - 1)
+    if tags[s] != key:
+        _regular_net(T, job, vf, cache, s)
+        tags[s] = key
+    return cache, s
+
+
 def _corner_net(T, job, vf, cfg, lay, code, ci, W, s):
     """Net ``W[s]`` (17 x 3, row 16 the limit point) of patch ``code`` of layer ``lay`` of corner face
     ``vf`` of ``job``: below :data:`COMPOSED_LAYERS` the composed operator's sums over the ring points; deeper,
@@ -259,19 +276,7 @@ def _evaluate_points(f, u, v, d, T, P, Pu, Pv, Puu, Puv, Pvv):
                 net = _corner_net(T, job, vf, cfg, lay, code, ci, W, 0)
                 p = 0
         else:
-            p = T.job_net[job] + T.leaf[vf]
-            if T.nets.shape[0] > 0:
-                net = T.nets
-            elif ns > 0:
-                key = 3 * lm * T.origin.shape[0] + p
-                p = (key * _HASH) & (ns - 1)
-                if tags[p] != key:
-                    _regular_net(T, job, vf, cache, p)
-                    tags[p] = key
-                net = cache
-            else:
-                net = _regular_net(T, job, vf, W, 0)
-                p = 0
+            net, p = _regular_lookup(T, job, vf, lm, cache, tags, W)
             pu0 = T.u0[vf]
             pv0 = T.v0[vf]
             h = T.h[vf]
@@ -492,6 +497,7 @@ def _ring_walks(org, nxt, prv, twin, pos, seen, g, r, rings, nring, faces, nface
 
 if numba is not None:
     _regular_net = numba.njit(cache=True, nogil=True)(_regular_net)
+    _regular_lookup = numba.njit(cache=True, nogil=True)(_regular_lookup)
     _corner_net = numba.njit(cache=True, nogil=True)(_corner_net)
     _basis = numba.njit(cache=True, nogil=True, inline="always")(_basis)
     _sum4 = numba.njit(cache=True, nogil=True, inline="always")(_sum4)

@@ -1045,6 +1045,22 @@ class Builder:
         return vid
 
     # ------------------------------------------------------------------ assembly
+    def _configuration_ops(self):
+        """Per configuration its layer operators, flat (layer, code, j, i), their offsets in the
+        concatenation, its ring size Nc, its number of layers, its layer-0 domains ``unit``."""
+        ops, op_start, op_size, n_layers, unit = [], [], [], [], []
+        off = 0
+        for scheme, orient in self.schemes:
+            L, u = _oriented_layers(scheme, orient)
+            nl_, nc_ = scheme.n_layers, L.shape[1]
+            ops.append(L.reshape(nl_ * 3, 16, nc_).transpose(0, 2, 1).reshape(-1))  # (layer, code, j, i)
+            op_start.append(off)
+            op_size.append(L.shape[1])
+            n_layers.append(scheme.n_layers)
+            unit.append(u)
+            off += L.size
+        return ops, op_start, op_size, n_layers, unit
+
     def table(self, top, refused):
         """The :class:`PatchTable` (floats from the positions given to :meth:`classify`), and the
         template groups ``[(template, jobs, rings)]`` that :func:`job_floats` recomputes from (``rings``
@@ -1059,17 +1075,7 @@ class Builder:
         n_tv = n_reg = n_cor = n_ring = n_vop = 0
         groups = []
         depth = 0
-        ops, op_start, op_size, n_layers, unit = [], [], [], [], []
-        off = 0
-        for scheme, orient in self.schemes:
-            L, u = _oriented_layers(scheme, orient)
-            nl_, nc_ = scheme.n_layers, L.shape[1]
-            ops.append(L.reshape(nl_ * 3, 16, nc_).transpose(0, 2, 1).reshape(-1))  # (layer, code, j, i)
-            op_start.append(off)
-            op_size.append(L.shape[1])
-            n_layers.append(scheme.n_layers)
-            unit.append(u)
-            off += L.size
+        ops, op_start, op_size, n_layers, unit = self._configuration_ops()
         rings_flat = np.empty(sum(len(t.rings) for t in temps), dtype=np.int32)
         for t in temps:
             jobs = np.frombuffer(t.jobs, dtype=np.int64).astype(np.int32 if J < 2**31 else np.int64) \
@@ -1156,14 +1162,35 @@ def _leaf_operators(t, ops):
 
 
 def with_nets(T, groups):
-    """``T`` with the precomputed nets that fit their budgets: the regular nets (:data:`NETS_BUDGET`) and
-    the layer-0 corner nets (:data:`HOT_BUDGET`), both by the kernels' sums (none where they do not fit)."""
+    """``T`` with the precomputed nets that fit their budgets: the regular nets (:data:`NETS_BUDGET`, or the
+    environment variable ``CCPROOF_NETS_BUDGET`` in bytes) and the layer-0 corner nets (:data:`HOT_BUDGET`,
+    ``CCPROOF_HOT_BUDGET``), both by the kernels' sums (none where they do not fit: the same bits)."""
     n_cor = T.origin.shape[0]
-    if 0 < T.n_regular and T.n_regular * 17 * 3 * 8 <= NETS_BUDGET:
+    if 0 < T.n_regular and T.n_regular * 17 * 3 * 8 <= _budget("CCPROOF_NETS_BUDGET", NETS_BUDGET):
         T = T._replace(nets=regular_nets(T, groups))
-    if 0 < n_cor and n_cor * 3 * 17 * 3 * 8 <= HOT_BUDGET:
+    if 0 < n_cor and n_cor * 3 * 17 * 3 * 8 <= _budget("CCPROOF_HOT_BUDGET", HOT_BUDGET):
         T = T._replace(hot=layer0_nets(T, groups))
     return T
+
+
+def _budget(name, default):
+    """The byte budget in the environment variable ``name`` (a non-negative integer), else ``default``.
+
+    >>> _budget("CCPROOF_NO_SUCH_BUDGET", 7)
+    7
+    """
+    import os
+
+    v = os.environ.get(name)
+    if v is None or v == "":
+        return default
+    try:
+        b = int(v)
+    except ValueError:
+        b = -1
+    if b < 0:
+        raise MeshError(f"{name}={v!r}: a budget in bytes, a non-negative integer")
+    return b
 
 
 def _smooth_template(frame):

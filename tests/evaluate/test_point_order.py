@@ -6,7 +6,7 @@ computed from the rings."""
 import numpy as np
 import pytest
 
-from ccproof.evaluate import _table, surface
+from ccproof.evaluate import surface
 from ccproof.evaluate.surface import LimitSurface, available_backends
 from ccproof.mesh.io import read_obj_tagged
 
@@ -17,8 +17,8 @@ def surf(request, refdir):
     if request.param == "kept":
         return LimitSurface(mesh, progress=False)
     mp = pytest.MonkeyPatch()
-    mp.setattr(_table, "NETS_BUDGET", 0)
-    mp.setattr(_table, "HOT_BUDGET", 0)
+    mp.setenv("CCPROOF_NETS_BUDGET", "0")  # the environment's budgets (bytes) over _table's defaults
+    mp.setenv("CCPROOF_HOT_BUDGET", "0")
     try:
         S = LimitSurface(mesh, progress=False)
     finally:
@@ -82,3 +82,10 @@ def test_a_bad_point_is_named_after_batching(surf):
     u[777] = 1.5
     with pytest.raises(Exception, match="point 777: u = 1.5"):
         S.evaluate(f, u, v, 1)
+
+
+def test_a_bad_budget_is_named(refdir, monkeypatch):
+    monkeypatch.setenv("CCPROOF_NETS_BUDGET", "lots")
+    mesh = read_obj_tagged(refdir / "osd_features" / "meshes" / "catmark_smoothtris1.obj")
+    with pytest.raises(Exception, match="CCPROOF_NETS_BUDGET='lots': a budget in bytes"):
+        LimitSurface(mesh, progress=False)
