@@ -70,7 +70,7 @@ MAX_DEPTH = 4
 #: local subdivisions allowed in the semi-sharp phase of a tagged mesh (sharpness < 10 decays in
 #: 10 uniform levels)
 MAX_SEMI_DEPTH = 40
-#: jobs per block when the float data are computed (bounds the temporaries)
+#: jobs per block when the limit points or precomputed nets are computed (bounds the temporaries)
 _BLOCK = 1 << 13
 #: largest size of the layer-0 nets of the corner faces kept precomputed (``PatchTable.hot``, 1,224
 #: bytes per corner face); beyond it every corner net is computed at evaluation time
@@ -1063,7 +1063,7 @@ class Builder:
 
     def table(self, top, refused):
         """The :class:`PatchTable` (floats from the positions given to :meth:`classify`), and the
-        template groups ``[(template, jobs, rings)]`` that :func:`job_floats` recomputes from (``rings``
+        template groups ``[(template, jobs, rings)]`` (:func:`job_floats`, :func:`with_nets`; ``rings``
         views of the table's ``rings``)."""
         temps = list(self.templates.values())
         J = self.n_jobs

@@ -146,7 +146,7 @@ class LimitSurface:
     def _finish(self, b, top, refused, keep_job_base=True):
         """The patch table from a :class:`Builder` that has classified every job; ``top`` (P, 4) the
         job of each quadrant of every ptex face, ``refused`` (P,) the ptex faces evaluation refuses.
-        The jobs' rings are kept (:meth:`with_vertices` recomputes the float data from them);
+        The jobs' rings are the table's (:meth:`with_vertices` shares them);
         ``keep_job_base``: keep the base face of every job (the quad-mesh :meth:`vertex_normals`)."""
         self._table, self._groups = b.table(top, refused)
         self._schemes = [s for s, _ in b.schemes]
@@ -756,11 +756,11 @@ class LimitSurface:
         """The limit surface of the same mesh with the control points ``X`` (n_vertices, 3).
 
         Everything that depends only on the connectivity (classification, templates, configurations,
-        the jobs' rings) is shared with ``self``; only the float data of the jobs (regular nets,
-        corner rings and limit points: the templates' linear operators applied to the rings) are
-        recomputed. The result evaluates like a fresh build on the mesh with the new control points
-        (the same operations on the same data; on PolyMesh surfaces tested bit for bit), at a fraction
-        of its cost (for the moving surfaces of ccproof.apps.dynamics).
+        the jobs' rings) is shared with ``self``; only the positions the rings index, the limit points of
+        the corner faces and, on small tables, the precomputed nets are new. The result evaluates like a
+        fresh build on the mesh with the new control points (the same operations on the same data; on
+        PolyMesh surfaces tested bit for bit), at a fraction of its cost (for the moving surfaces of
+        ccproof.apps.dynamics).
 
         A :class:`~ccproof.mesh.polymesh.PolyMesh` surface (tags, n-gons, holes, non-manifold): ``X``
         are the PolyMesh's own vertices. The rings index the vertices the builder classified: those
