@@ -771,7 +771,9 @@ def naive_point(S, f, u, v):
         ring = [[0.0] * 3] + [[ring[r][c] for c in range(3)] for r in range(Nc - 1)]  # row 0: the vertex
         ops = T.ops[o:o + 16 * Nc].tolist()
         net = [[sum(ops[16 * k + i] * ring[k][c] for k in range(Nc)) for c in range(3)] for i in range(16)]
-        origin = T.origin[int(T.job_corner[job] + T.leaf[vf])].tolist()
+        lim = _ring_rows(T, job, vf, 1, int(T.vn[vf]) * (Nc - 1))[0]  # the limit point less X[ring[0]]
+        x0 = T.points[int(T.rings[int(T.job_ring[job])])].tolist()
+        origin = [lim[c] + x0[c] for c in range(3)]
         sc = math.ldexp(H, -n)
         pu0 = T.unit[cfg, code, 0] * sc + (U0 + H if T.cu[vf] else U0)
         pv0 = T.unit[cfg, code, 1] * sc + (V0 + H if T.cv[vf] else V0)
@@ -796,10 +798,10 @@ def naive_point(S, f, u, v):
     return P, Pu, Pv
 
 
-def _ring_rows(T, job, vf, m):
-    """The m rows ``sum_j op[j] (X[ring[j]] - X[ring[0]])`` of leaf ``vf`` of ``job`` (op: its (N, m) operator in
-    ``vop``), in plain Python."""
-    N, st, r0 = int(T.vn[vf]), int(T.vop_start[vf]), int(T.job_ring[job])
+def _ring_rows(T, job, vf, m, skip=0):
+    """The m rows ``sum_j op[j] (X[ring[j]] - X[ring[0]])`` of leaf ``vf`` of ``job`` (op: the (N, m) operator
+    ``skip`` entries into its block of ``vop``), in plain Python."""
+    N, st, r0 = int(T.vn[vf]), int(T.vop_start[vf]) + skip, int(T.job_ring[job])
     X = [T.points[int(T.rings[r0 + j])].tolist() for j in range(N)]
     op = T.vop[st:st + N * m].tolist()
     return [[sum(op[m * j + r] * (X[j][c] - X[0][c]) for j in range(1, N)) for c in range(3)] for r in range(m)]

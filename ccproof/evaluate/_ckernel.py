@@ -42,7 +42,7 @@ class _Table(ctypes.Structure):
                 ("wide", _I * 5), ("refused", _P), ("kind", _P), ("child", _P), ("u0", _P), ("v0", _P),
                 ("h", _P), ("leaf", _P), ("cfg", _P), ("cu", _P), ("cv", _P), ("vop_start", _P), ("vn", _P),
                 ("vop", _P), ("points", _P), ("rings", _P), ("split_depth", _I), ("n_ptex", _I),
-                ("max_layers", _I), ("n_corner", _I), ("n_nets", _I), ("nets", _P), ("origin", _P), ("ops", _P),
+                ("max_layers", _I), ("n_corner", _I), ("n_nets", _I), ("nets", _P), ("ops", _P),
                 ("op_start", _P), ("op_size", _P), ("n_layers", _P), ("unit", _P), ("hot", _P), ("n_hot", _I),
                 ("layer_nets", _P * _LAYER_NETS), ("n_layer_nets", _I), ("grid", _P), ("inv_h", _P),
                 ("inv_unit", _P)]
@@ -51,7 +51,7 @@ class _Table(ctypes.Structure):
 _LIB = None
 _TRIED = False
 #: the version of the kernel's interface (``ccp_abi`` in _clib.c)
-_ABI = 4
+_ABI = 5
 #: calls on fewer points use no corner-net cache (CCP_CACHE_MIN in _clib.c)
 _CACHE_MIN = 256
 
@@ -173,7 +173,7 @@ class CTable:
         s.kind = arr("kind", np.int8)
         for name in ("child", "leaf", "cfg", "op_start", "op_size", "n_layers", "vop_start", "vn"):
             setattr(s, name, arr(name, np.int64))
-        for name in ("u0", "v0", "h", "nets", "origin", "ops", "unit", "hot", "vop", "points"):
+        for name in ("u0", "v0", "h", "nets", "ops", "unit", "hot", "vop", "points"):
             setattr(s, name, arr(name, np.float64))
         s.rings = arr("rings", np.int32)
         s.cu = arr("cu", np.bool_)  # one byte each, 0 or 1
@@ -183,7 +183,7 @@ class CTable:
         s.max_layers = max(1, int(T.n_layers.max()) if T.n_layers.size else 1)
         s.n_hot = int(T.hot.shape[0])
         s.n_nets = int(T.nets.shape[0])
-        s.n_corner = int(T.origin.shape[0])
+        s.n_corner = int(T.n_corner)
         if COMPOSED_LAYERS != _COMPOSED:
             raise CCProofError(f"the C kernel composes {_COMPOSED} layers, the table {COMPOSED_LAYERS}")
         self._keep = keep

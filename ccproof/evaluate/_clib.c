@@ -77,7 +77,7 @@ typedef struct {
     int64_t max_layers; /* max(1, max n_layers): the cache key's stride */
     int64_t n_corner;   /* corner faces of all jobs (the regular nets' cache keys follow theirs) */
     int64_t n_nets;     /* rows of ``nets`` (0: the regular nets are computed from the rings) */
-    const double *nets, *origin, *ops;
+    const double *nets, *ops;
     const int64_t *op_start, *op_size, *n_layers;
     const double *unit;
     const double *hot;
@@ -277,7 +277,8 @@ static void regular_net(const ccp_table *T, int64_t job, int64_t vf, double *W) 
     W[50] = a2[16] + x0[2];
 }
 
-/* Net W (17 x 3, row 16 the limit point) of patch ``code`` of layer ``lay`` of the corner face ``vf`` of
+/* Net W (17 x 3, row 16 the limit point: the sum over j = 1, 2, ... of o[j] (X[ring[j]] - X[ring[0]]) from 0.0,
+ * plus X[ring[0]]; o the operator row after Q) of patch ``code`` of layer ``lay`` of the corner face ``vf`` of
  * ``job``. Layers below CCP_COMPOSED: the composed operator M (N x 16) of the layer and code, the sums over the
  * ring points j = 1, 2, ... in order from 0.0 of M[j, i] (X[ring[j]] - X[ring[0]]). Deeper: its ring relative
  * to the corner vertex first (rows 1 .. Nc - 1: Q @ (X[ring] - X[ring[0]]), the
@@ -290,8 +291,11 @@ static void corner_net(const ccp_table *T, int64_t job, int64_t vf, int64_t cfg,
     const double *q = T->vop + T->vop_start[vf];
     const int32_t *rg = ring_of(T, job);
     const double *x0 = T->points + 3 * (int64_t)rg[0];
+    const double *o = q + N * m; /* the limit point's weights */
+    double e0 = 0.0, e1 = 0.0, e2 = 0.0;
+    (void)ci;
     if (lay < CCP_COMPOSED) { /* one product: the composed operator (N x 16) of this layer and code */
-        const double *M = q + N * m + (3 * lay + code) * N * 16;
+        const double *M = o + N + (3 * lay + code) * N * 16;
         double b0[16], b1[16], b2[16];
         for (int i = 0; i < 16; i++) b0[i] = b1[i] = b2[i] = 0.0;
         for (int64_t j = 1; j < N; j++) {
@@ -303,13 +307,18 @@ static void corner_net(const ccp_table *T, int64_t job, int64_t vf, int64_t cfg,
                 b1[i] += w[i] * r1;
                 b2[i] += w[i] * r2;
             }
+            e0 += o[j] * r0;
+            e1 += o[j] * r1;
+            e2 += o[j] * r2;
         }
         for (int i = 0; i < 16; i++) {
             W[3 * i] = b0[i];
             W[3 * i + 1] = b1[i];
             W[3 * i + 2] = b2[i];
         }
-        for (int c = 0; c < 3; c++) W[48 + c] = T->origin[3 * ci + c];
+        W[48] = e0 + x0[0];
+        W[49] = e1 + x0[1];
+        W[50] = e2 + x0[2];
         return;
     }
     double rc[3 * (m > 0 ? m : 1)];
@@ -323,6 +332,9 @@ static void corner_net(const ccp_table *T, int64_t job, int64_t vf, int64_t cfg,
             rc[3 * r + 1] += w[r] * r1;
             rc[3 * r + 2] += w[r] * r2;
         }
+        e0 += o[j] * r0;
+        e1 += o[j] * r1;
+        e2 += o[j] * r2;
     }
     double a0[16], a1[16], a2[16];
     for (int i = 0; i < 16; i++) a0[i] = a1[i] = a2[i] = 0.0;
@@ -340,7 +352,9 @@ static void corner_net(const ccp_table *T, int64_t job, int64_t vf, int64_t cfg,
         W[3 * i + 1] = a1[i];
         W[3 * i + 2] = a2[i];
     }
-    for (int c = 0; c < 3; c++) W[48 + c] = T->origin[3 * ci + c];
+    W[48] = e0 + x0[0];
+    W[49] = e1 + x0[1];
+    W[50] = e2 + x0[2];
 }
 
 /* The corner-net cache (the caller's buffer of CCP_CACHE_WORDS doubles, zero when new, kept between calls
@@ -730,7 +744,7 @@ int64_t ccp_grid(const ccp_table *T, int64_t *grid) {
 }
 
 /* The layout this file was compiled with: the binding refuses a library whose structure differs. */
-int64_t ccp_abi(void) { return 1000 * (int64_t)sizeof(ccp_table) + 4; }
+int64_t ccp_abi(void) { return 1000 * (int64_t)sizeof(ccp_table) + 5; }
 
 /* ------------------------------------------------------------------------------------------------------------
  * The ring walk of the table's setup (the numba kernel's _ring_walks, ccproof/evaluate/_numba_kernel.py, step

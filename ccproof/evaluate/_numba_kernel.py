@@ -111,7 +111,7 @@ def _regular_lookup(T, job, vf, lm, cache, tags, W):
     ns = cache.shape[0]
     if ns == 0:
         return _regular_net(T, job, vf, W, 0), 0
-    key = 3 * lm * T.origin.shape[0] + p
+    key = 3 * lm * T.n_corner + p
     s = (key * _HASH) & (ns - 1)
     if tags[s] != key:
         _regular_net(T, job, vf, cache, s)
@@ -119,7 +119,7 @@ def _regular_lookup(T, job, vf, lm, cache, tags, W):
     return cache, s
 
 
-def _corner_net(T, job, vf, cfg, lay, code, ci, W, s):
+def _corner_net(T, job, vf, cfg, lay, code, ci, W, s, rc):
     """Net ``W[s]`` (17 x 3, row 16 the limit point) of patch ``code`` of layer ``lay`` of corner face
     ``vf`` of ``job``: below :data:`COMPOSED_LAYERS` the composed operator's sums over the ring points; deeper,
     its ring relative to the corner vertex (``Q @ (X[ring] - X[ring[0]])``, summed over
@@ -131,8 +131,12 @@ def _corner_net(T, job, vf, cfg, lay, code, ci, W, s):
     q = T.vop_start[vf]
     r0_ = T.job_ring[job]
     i0 = T.rings[r0_]
+    o = q + N * m  # the limit point's weights
+    e0 = 0.0
+    e1 = 0.0
+    e2 = 0.0
     if lay < COMPOSED_LAYERS:  # one product: the composed operator (N x 16) of this layer and code
-        b = q + N * m + (3 * lay + code) * N * 16
+        b = o + N + (3 * lay + code) * N * 16
         for i in range(16):
             W[s, i, 0] = 0.0
             W[s, i, 1] = 0.0
@@ -148,10 +152,17 @@ def _corner_net(T, job, vf, cfg, lay, code, ci, W, s):
                 W[s, i, 0] += w * r0
                 W[s, i, 1] += w * r1
                 W[s, i, 2] += w * r2
-        for c in range(3):
-            W[s, 16, c] = T.origin[ci, c]
+            e0 += T.vop[o + j] * r0
+            e1 += T.vop[o + j] * r1
+            e2 += T.vop[o + j] * r2
+        W[s, 16, 0] = e0 + T.points[i0, 0]
+        W[s, 16, 1] = e1 + T.points[i0, 1]
+        W[s, 16, 2] = e2 + T.points[i0, 2]
         return W
-    rc = np.zeros((max(m, 1), 3))
+    for r in range(m):  # rc: the caller's scratch, (at least m, 3)
+        rc[r, 0] = 0.0
+        rc[r, 1] = 0.0
+        rc[r, 2] = 0.0
     for j in range(1, N):
         ij = T.rings[r0_ + j]
         r0 = T.points[ij, 0] - T.points[i0, 0]
@@ -163,6 +174,9 @@ def _corner_net(T, job, vf, cfg, lay, code, ci, W, s):
             rc[r, 0] += w * r0
             rc[r, 1] += w * r1
             rc[r, 2] += w * r2
+        e0 += T.vop[o + j] * r0
+        e1 += T.vop[o + j] * r1
+        e2 += T.vop[o + j] * r2
     o = T.op_start[cfg] + (3 * lay + code) * 16 * Nc
     for i in range(16):
         W[s, i, 0] = 0.0
@@ -178,8 +192,9 @@ def _corner_net(T, job, vf, cfg, lay, code, ci, W, s):
             W[s, i, 0] += w * r0
             W[s, i, 1] += w * r1
             W[s, i, 2] += w * r2
-    for c in range(3):
-        W[s, 16, c] = T.origin[ci, c]
+    W[s, 16, 0] = e0 + T.points[i0, 0]
+    W[s, 16, 1] = e1 + T.points[i0, 1]
+    W[s, 16, 2] = e2 + T.points[i0, 2]
     return W
 
 
@@ -202,8 +217,11 @@ def _evaluate_points(f, u, v, d, T, P, Pu, Pv, Puu, Puv, Pvv):
     cache = np.empty((ns, 17, 3))
     tags = np.full(ns, -1, dtype=np.int64)
     lm = 1
+    mc = 1
     for c in range(T.n_layers.shape[0]):
         lm = max(lm, T.n_layers[c])
+        mc = max(mc, T.op_size[c])
+    rc = np.empty((mc, 3))  # a corner ring of the deeper layers (_corner_net)
     for k in range(n):
         pf = f[k]
         uu = u[k]
@@ -269,11 +287,11 @@ def _evaluate_points(f, u, v, d, T, P, Pu, Pv, Puu, Puv, Pvv):
                 key = 3 * (lm * ci + lay) + code
                 p = (key * _HASH) & (ns - 1)
                 if tags[p] != key:
-                    _corner_net(T, job, vf, cfg, lay, code, ci, cache, p)
+                    _corner_net(T, job, vf, cfg, lay, code, ci, cache, p, rc)
                     tags[p] = key
                 net = cache
             else:
-                net = _corner_net(T, job, vf, cfg, lay, code, ci, W, 0)
+                net = _corner_net(T, job, vf, cfg, lay, code, ci, W, 0, rc)
                 p = 0
         else:
             net, p = _regular_lookup(T, job, vf, lm, cache, tags, W)

@@ -19,7 +19,7 @@ shared by every face with that key:
   exact-then-rounded layer operators ``L`` (n_layers, 3, 16, Nc) of
   :func:`ccproof.evaluate.local.corner_scheme`, shared by every corner face of that configuration;
 * per job: the id of its template and its ring (int32 indices into the positions the rings index,
-  one (V, 3) array shared by every job); the limit point of each of its corner faces.
+  one (V, 3) array shared by every job).
 
 A point's net is computed when it is evaluated, from the positions of its job's ring: the net of a
 regular patch is its template operator (17 x N) applied to ``rel = X[ring] - X[ring[0]]``, the net of
@@ -28,9 +28,9 @@ taken in one fixed order (ring point j = 1, 2, ... from 0.0) by every backend, s
 same bits. Small tables keep the nets precomputed by the same sums (:data:`NETS_BUDGET`,
 :data:`HOT_BUDGET`).
 
-Memory: O(control points + ptex faces + configurations): per ptex face of a triangle scan about 150
-bytes (the ring's indices, the corner limit points, the offsets); nothing is stored per layer or per
-net of a face.
+Memory: O(control points + ptex faces + configurations): per ptex face of a triangle scan 133 bytes
+(the ring's indices, the offsets, the level-1 points); nothing is stored per layer or per net of a face,
+nor any limit point.
 """
 
 from __future__ import annotations
@@ -97,7 +97,7 @@ class PatchTable(NamedTuple):
         Ptex faces evaluation refuses (holes).
     job_root, job_net, job_corner, job_ring : int32 (J,) (int64 where the offsets need it)
         Per job: the root virtual face of its template, and the index of its first regular patch, of its
-        first corner face (in ``origin``) and of its ring in ``rings``.
+        first corner face and of its ring in ``rings``.
     kind : int8 (T,)
         Per template virtual face: 0 regular patch, 1 corner face, 2 split into four children.
     child : int64 (T, 4)
@@ -116,12 +116,13 @@ class PatchTable(NamedTuple):
         Per regular leaf its operator (N, 17): row j the weights of ring point j in the 16 net rows
         (relative to row 16) and in row 16 (less the ring's point 0); per corner face (N, Nc - 1): row j
         the weights of ring point j in the rows 1 .. Nc - 1 of the corner ring relative to its vertex,
-        followed by the composed operators (N, 16) of its first layers (:data:`COMPOSED_LAYERS`), layer by
-        layer, code by code: row j the weights of ring point j in the 16 rows of that net.
+        then (N,) the weights in its limit point (less the ring's point 0), then the composed operators
+        (N, 16) of its first layers (:data:`COMPOSED_LAYERS`), layer by layer, code by code: row j the
+        weights of ring point j in the 16 rows of that net.
     split_depth : int
         Deepest split in any template.
-    n_regular : int
-        Regular patches (leaves) of all jobs together.
+    n_regular, n_corner : int
+        Regular patches and corner faces (leaves) of all jobs together.
     points : float64 (V, 3)
         The positions the rings index (the mesh's vertices, or the level-1 points of a polygon mesh).
     rings : int32 (sum of the jobs' ring sizes,)
@@ -129,8 +130,6 @@ class PatchTable(NamedTuple):
     nets : float64 (n_regular, 17, 3) or (0, 17, 3)
         The nets of the regular patches (base orientation, row 16 the origin) computed by the kernels'
         sums, kept when they fit :data:`NETS_BUDGET`; empty otherwise (computed when evaluated).
-    origin : float64 (n_corner, 3)
-        Limit point of each corner face's irregular corner.
     ops : float64 (sum of n_layers * 48 * Nc,)
         Per configuration its layer operators ``L`` laid out (n_layers, 3, Nc, 16): ``[n, code, j, i]``
         the weight of ring point j in entry i of the net of layer n, patch ``code`` (0 along u, 1
@@ -153,8 +152,8 @@ class PatchTable(NamedTuple):
     >>> from ccproof.evaluate import natural_limit_surface
     >>> from ccproof.mesh.examples import k_regular_disk
     >>> T = natural_limit_surface(k_regular_disk(5, 2)).patch_map.table
-    >>> T.top.shape, T.n_regular, T.nets.shape, T.origin.shape
-    ((20, 4), 10, (10, 17, 3), (10, 3))
+    >>> T.top.shape, T.n_regular, T.nets.shape, T.n_corner
+    ((20, 4), 10, (10, 17, 3), 10)
     """
 
     top: np.ndarray
@@ -177,10 +176,10 @@ class PatchTable(NamedTuple):
     vop: np.ndarray
     split_depth: int
     n_regular: int
+    n_corner: int
     points: np.ndarray
     rings: np.ndarray
     nets: np.ndarray
-    origin: np.ndarray
     ops: np.ndarray
     op_start: np.ndarray
     op_size: np.ndarray
@@ -1063,7 +1062,7 @@ class Builder:
 
     def table(self, top, refused):
         """The :class:`PatchTable` (floats from the positions given to :meth:`classify`), and the
-        template groups ``[(template, jobs, rings)]`` (:func:`job_floats`, :func:`with_nets`; ``rings``
+        template groups ``[(template, jobs, rings)]`` (:func:`with_nets`; ``rings``
         views of the table's ``rings``)."""
         temps = list(self.templates.values())
         J = self.n_jobs
@@ -1118,7 +1117,7 @@ class Builder:
         d = np.array(dom, dtype=np.float64).reshape(-1, 3)
         c = np.array(corner, dtype=bool).reshape(-1, 2)
         X = np.ascontiguousarray(self.X, dtype=np.float64)
-        origin = job_floats(groups, X, n_cor, self.progress)
+        check_positions(X, rings_flat)
 
         def small(a, bound):  # int32 where it fits (the per-face arrays are the big ones)
             return np.ascontiguousarray(a, dtype=np.int32 if bound < 2**31 else np.int64)
@@ -1131,8 +1130,8 @@ class Builder:
             u0=d[:, 0].copy(), v0=d[:, 1].copy(), h=d[:, 2].copy(), leaf=np.array(leaf, dtype=np.int64),
             cfg=np.array(cfg, dtype=np.int64), cu=c[:, 0].copy(), cv=c[:, 1].copy(),
             vop_start=np.array(vop_start, dtype=np.int64), vn=np.array(vn, dtype=np.int64),
-            vop=np.concatenate(vop) if vop else np.zeros(0), split_depth=depth, n_regular=n_reg,
-            points=X, rings=rings_flat, nets=np.zeros((0, 17, 3)), origin=origin,
+            vop=np.concatenate(vop) if vop else np.zeros(0), split_depth=depth, n_regular=n_reg, n_corner=n_cor,
+            points=X, rings=rings_flat, nets=np.zeros((0, 17, 3)),
             ops=np.concatenate(ops) if ops else np.zeros(0), op_start=np.array(op_start, dtype=np.int64),
             op_size=np.array(op_size, dtype=np.int64), n_layers=np.array(n_layers, dtype=np.int64),
             unit=np.array(unit, dtype=np.float64).reshape(-1, 3, 3), hot=np.zeros((0, 17, 3)))
@@ -1141,8 +1140,9 @@ class Builder:
 
 def _leaf_operators(t, ops):
     """Per virtual face of the finished template ``t`` (its ``cfg`` the table's) its operators as
-    :attr:`PatchTable.vop` stores them, or None (a split face): regular (N, 17); corner (N, Nc - 1), then
-    per layer n < min(:data:`COMPOSED_LAYERS`, layers) and code the composed (N, 16) ``Q L[n, code]``
+    :attr:`PatchTable.vop` stores them, or None (a split face): regular (N, 17); corner (N, Nc - 1), its
+    limit point's (N,), then per layer n < min(:data:`COMPOSED_LAYERS`, layers) and code the composed (N,
+    16) ``Q L[n, code]``
     (``ops``: the flat layer operators of each configuration, (n_layers, 3, Nc, 16))."""
     out = []
     starts = sorted(t.pts[v] for v, k in enumerate(t.kind) if k == KIND_CORNER) + [t.Q.shape[0]]
@@ -1155,7 +1155,7 @@ def _leaf_operators(t, ops):
             Q = t.Q[p:starts[starts.index(p) + 1]].T  # (N, Nc - 1)
             L = ops[t.cfg[v]].reshape(-1, 3, Q.shape[1] + 1, 16)  # (layer, code, j, i)
             comp = [Q @ L[n, c, 1:] for n in range(min(COMPOSED_LAYERS, L.shape[0])) for c in range(3)]
-            out.append(np.concatenate([Q.reshape(-1)] + [m.reshape(-1) for m in comp]))
+            out.append(np.concatenate([Q.reshape(-1), t.O[t.leaf[v]]] + [m.reshape(-1) for m in comp]))
         else:
             out.append(None)
     return out
@@ -1165,7 +1165,7 @@ def with_nets(T, groups):
     """``T`` with the precomputed nets that fit their budgets: the regular nets (:data:`NETS_BUDGET`, or the
     environment variable ``CCPROOF_NETS_BUDGET`` in bytes) and the layer-0 corner nets (:data:`HOT_BUDGET`,
     ``CCPROOF_HOT_BUDGET``), both by the kernels' sums (none where they do not fit: the same bits)."""
-    n_cor = T.origin.shape[0]
+    n_cor = T.n_corner
     if 0 < T.n_regular and T.n_regular * 17 * 3 * 8 <= _budget("CCPROOF_NETS_BUDGET", NETS_BUDGET):
         T = T._replace(nets=regular_nets(T, groups))
     if 0 < n_cor and n_cor * 3 * 17 * 3 * 8 <= _budget("CCPROOF_HOT_BUDGET", HOT_BUDGET):
@@ -1206,38 +1206,21 @@ def _smooth_template(frame):
     return t
 
 
-def job_floats(groups, X, n_cor, progress=None):
-    """The limit points of the corner faces of every job from the positions ``X`` of the complex its
-    rings index: per template group, in blocks of jobs, ``O @ (X[ring] - X[ring[0]]) + X[ring[0]]``.
+def check_positions(X, rings):
+    """MeshError unless every position the ``rings`` index is finite and below 1e300 in magnitude (the
+    nets computed from their differences are then finite).
 
-    Returns
-    -------
-    origin : ndarray (n_corner, 3)
+    >>> check_positions(np.array([[0.0, 1, 2], [np.nan, 0, 0]]), np.array([0], np.int32))
+    >>> check_positions(np.array([[0.0, 1, 2], [np.nan, 0, 0]]), np.array([0, 1], np.int32))
+    Traceback (most recent call last):
+    ...
+    ccproof.errors.MeshError: control point 1 of the patch table is not finite or beyond 1e300 in magnitude
     """
-    X = np.asarray(X, dtype=np.float64)
-    origin = np.empty((n_cor, 3))
-    bad = False
-    bar = _progress(progress, sum(g[1].size for g in groups), "patch data")
-    for t, jobs, rings in groups:
-        o_cor = t.offsets[1]
-        nc = t.O.shape[0]
-        for lo in range(0, jobs.size, _BLOCK):
-            R = rings[lo:lo + _BLOCK]
-            k = R.shape[0]
-            X0 = X[R[:, 0]]
-            rel = X[R] - X0[:, None, :]
-            if not (np.abs(rel) <= 1e300).all():  # the nets computed from rel would not be finite
-                bad = True
-            if nc:
-                b = np.matmul(t.O, rel)
-                b += X0[:, None, :]
-                origin[o_cor + nc * lo:o_cor + nc * (lo + k)] = b.reshape(-1, 3)
-            bar.update(k)
-    bar.close()
-    if bad or not np.isfinite(origin).all():
-        raise MeshError("non-finite limit point in the patch table: a control point beyond about 1e150 in magnitude "
-                        "(the differences overflow; scale the mesh) or a non-finite one")
-    return origin
+    used = np.zeros(X.shape[0], dtype=bool)
+    used[rings] = True
+    bad = np.flatnonzero(used & ~(np.abs(X) <= 1e300).all(axis=1))
+    if bad.size:
+        raise MeshError(f"control point {int(bad[0])} of the patch table is not finite or beyond 1e300 in magnitude")
 
 
 def ring_products(op, X, rings):
@@ -1281,12 +1264,21 @@ def composed_nets(T, jobs, vf, lay, code):
     """The nets (k, 17, 3) of patch ``code`` of layer ``lay`` < :data:`COMPOSED_LAYERS` of the corner face
     ``vf`` of ``jobs`` (k,): :func:`ring_products` of the composed operator, row 16 the limit point."""
     N, st, Nc = int(T.vn[vf]), int(T.vop_start[vf]), int(T.op_size[T.cfg[vf]])
-    st += N * (Nc - 1) + (3 * lay + code) * N * 16
+    st += N * (Nc - 1) + N + (3 * lay + code) * N * 16
     R = T.rings[T.job_ring[jobs][:, None] + np.arange(N)]
     out = np.empty((R.shape[0], 17, 3))
     out[:, :16] = ring_products(T.vop[st:st + N * 16].reshape(N, 16), T.points, R)
-    out[:, 16] = T.origin[T.job_corner[jobs] + T.leaf[vf]]
+    out[:, 16] = corner_limits(T, jobs, vf)
     return out
+
+
+def corner_limits(T, jobs, vf):
+    """The limit points (k, 3) at the irregular corner of the corner face ``vf`` of ``jobs`` (k,), computed
+    as the kernels compute them (:func:`ring_products` of its operator row, plus the ring's point 0)."""
+    N, st, Nc = int(T.vn[vf]), int(T.vop_start[vf]), int(T.op_size[T.cfg[vf]])
+    st += N * (Nc - 1)
+    R = T.rings[T.job_ring[jobs][:, None] + np.arange(N)]
+    return ring_products(T.vop[st:st + N].reshape(N, 1), T.points, R)[:, 0] + T.points[R[:, 0]]
 
 
 def corner_rings(T, jobs, vf):
@@ -1400,7 +1392,7 @@ def layer0_nets(T, groups):
     """The nets of layer 0 of every corner face of table ``T`` (see :attr:`PatchTable.hot`): per
     corner face c and patch code the composed operator's sums (:func:`composed_nets`, the compiled
     kernel's), row 16 the limit point. Shape (3 n_corner, 17, 3)."""
-    hot = np.empty((3 * T.origin.shape[0], 17, 3))
+    hot = np.empty((3 * T.n_corner, 17, 3))
     for t, jobs, _ in groups:
         if jobs is None or not jobs.size or not t.O.shape[0]:
             continue

@@ -41,9 +41,10 @@ from ccproof.evaluate._table import (
     Builder,
     Jobs,
     catmark_step,
+    check_positions,
     composed_nets,
+    corner_limits,
     corner_rings,
-    job_floats,
     ring_products,
     with_nets,
 )
@@ -322,7 +323,7 @@ class LimitSurface:
             for j in range(1, Nc):  # summed in the compiled kernel's order: the same bits
                 acc += Ls[:, j, :, None] * Q[:, None, j, :]
             N[idx[sel], :16] = acc
-            N[idx[sel], 16] = T.origin[ci[sel]]
+            N[idx[sel], 16] = corner_limits(T, loc.job[idx[sel]], vf)
 
     def evaluate(self, face_ids, u, v, derivatives=1, *, parameterization="natural", chunk=CHUNK, out=None,
                  backend=None, threads=None):
@@ -806,8 +807,8 @@ class LimitSurface:
         new.parameterizations = dict(self.parameterizations)
         T = self._table
         V = np.ascontiguousarray(V, dtype=np.float64)
-        origin = job_floats(self._groups, V, T.origin.shape[0], progress=False)
-        new._table = with_nets(T._replace(points=V, origin=origin, nets=T.nets[:0], hot=T.hot[:0]), self._groups)
+        check_positions(V, T.rings)
+        new._table = with_nets(T._replace(points=V, nets=T.nets[:0], hot=T.hot[:0]), self._groups)
         new._ctable = None
         new._corner_normal = {}
         return new

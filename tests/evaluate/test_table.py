@@ -98,7 +98,7 @@ def test_precomputed_layer_zero_gives_the_same_bits(refdir, monkeypatch):
     monkeypatch.setattr(_table, "HOT_BUDGET", 0)
     monkeypatch.setattr(_table, "NETS_BUDGET", 0)
     cold = LimitSurface(mesh, progress=False)
-    assert hot._table.hot.shape[0] == 3 * hot._table.origin.shape[0] > 0 and cold._table.hot.shape[0] == 0
+    assert hot._table.hot.shape[0] == 3 * hot._table.n_corner > 0 and cold._table.hot.shape[0] == 0
     assert hot._table.nets.shape[0] == hot._table.n_regular > 0 and cold._table.nets.shape[0] == 0
     rng = np.random.default_rng(5)
     n = 20000
