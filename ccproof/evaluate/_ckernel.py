@@ -44,6 +44,7 @@ class _Table(ctypes.Structure):
                 ("vop", _P), ("points", _P), ("rings", _P), ("split_depth", _I), ("n_ptex", _I),
                 ("max_layers", _I), ("n_corner", _I), ("n_nets", _I), ("nets", _P), ("ops", _P),
                 ("op_start", _P), ("op_size", _P), ("n_layers", _P), ("unit", _P), ("hot", _P), ("n_hot", _I),
+                ("cor_ring", _P), ("ring", _P),
                 ("layer_nets", _P * _LAYER_NETS), ("n_layer_nets", _I), ("grid", _P), ("inv_h", _P),
                 ("inv_unit", _P)]
 
@@ -51,7 +52,7 @@ class _Table(ctypes.Structure):
 _LIB = None
 _TRIED = False
 #: the version of the kernel's interface (``ccp_abi`` in _clib.c)
-_ABI = 5
+_ABI = 6
 #: calls on fewer points use no corner-net cache (CCP_CACHE_MIN in _clib.c)
 _CACHE_MIN = 256
 
@@ -182,6 +183,9 @@ class CTable:
         s.n_ptex = int(T.refused.shape[0])
         s.max_layers = max(1, int(T.n_layers.max()) if T.n_layers.size else 1)
         s.n_hot = int(T.hot.shape[0])
+        if T.cor_ring.size:  # (NULL otherwise: no kept ring)
+            s.cor_ring = arr("cor_ring", np.int64)
+            s.ring = arr("ring", np.float64)
         s.n_nets = int(T.nets.shape[0])
         s.n_corner = int(T.n_corner)
         if COMPOSED_LAYERS != _COMPOSED:

@@ -82,6 +82,8 @@ typedef struct {
     const double *unit;
     const double *hot;
     int64_t n_hot; /* rows of ``hot`` (0: none) */
+    const int64_t *cor_ring; /* NULL, or per corner face the row of its kept ring in ``ring`` (-1: none) */
+    const double *ring;
     /* the nets of layers 0 .. n_layer_nets - 1 of every corner face, per layer 3 n_corner x 17 x 3 (layer 0:
      * ``hot``; the others filled by ccp_corner_nets when the binding makes the table) */
     const double *layer_nets[CCP_LAYER_NETS];
@@ -293,7 +295,6 @@ static void corner_net(const ccp_table *T, int64_t job, int64_t vf, int64_t cfg,
     const double *x0 = T->points + 3 * (int64_t)rg[0];
     const double *o = q + N * m; /* the limit point's weights */
     double e0 = 0.0, e1 = 0.0, e2 = 0.0;
-    (void)ci;
     if (lay < CCP_COMPOSED) { /* one product: the composed operator (N x 16) of this layer and code */
         const double *M = o + N + (3 * lay + code) * N * 16;
         double b0[16], b1[16], b2[16];
@@ -321,9 +322,19 @@ static void corner_net(const ccp_table *T, int64_t job, int64_t vf, int64_t cfg,
         W[50] = e2 + x0[2];
         return;
     }
-    double rc[3 * (m > 0 ? m : 1)];
-    for (int64_t r = 0; r < 3 * m; r++) rc[r] = 0.0;
-    for (int64_t j = 1; j < N; j++) {
+    double rc_[3 * (m > 0 ? m : 1)], *rc = rc_;
+    int64_t kept = T->cor_ring != NULL ? T->cor_ring[ci] : -1;
+    if (kept >= 0) { /* the kept ring (the same sums); the limit point's sum alone */
+        rc = (double *)(T->ring + 3 * kept);
+        for (int64_t j = 1; j < N; j++) {
+            const double *x = T->points + 3 * (int64_t)rg[j];
+            e0 += o[j] * (x[0] - x0[0]);
+            e1 += o[j] * (x[1] - x0[1]);
+            e2 += o[j] * (x[2] - x0[2]);
+        }
+    }
+    if (kept < 0) for (int64_t r = 0; r < 3 * m; r++) rc[r] = 0.0;
+    for (int64_t j = 1; j < N && kept < 0; j++) {
         const double *x = T->points + 3 * (int64_t)rg[j];
         double r0 = x[0] - x0[0], r1 = x[1] - x0[1], r2 = x[2] - x0[2];
         const double *w = q + m * j;
@@ -744,7 +755,7 @@ int64_t ccp_grid(const ccp_table *T, int64_t *grid) {
 }
 
 /* The layout this file was compiled with: the binding refuses a library whose structure differs. */
-int64_t ccp_abi(void) { return 1000 * (int64_t)sizeof(ccp_table) + 5; }
+int64_t ccp_abi(void) { return 1000 * (int64_t)sizeof(ccp_table) + 6; }
 
 /* ------------------------------------------------------------------------------------------------------------
  * The ring walk of the table's setup (the numba kernel's _ring_walks, ccproof/evaluate/_numba_kernel.py, step

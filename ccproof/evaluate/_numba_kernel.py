@@ -159,11 +159,23 @@ def _corner_net(T, job, vf, cfg, lay, code, ci, W, s, rc):
         W[s, 16, 1] = e1 + T.points[i0, 1]
         W[s, 16, 2] = e2 + T.points[i0, 2]
         return W
-    for r in range(m):  # rc: the caller's scratch, (at least m, 3)
-        rc[r, 0] = 0.0
-        rc[r, 1] = 0.0
-        rc[r, 2] = 0.0
-    for j in range(1, N):
+    kept = T.cor_ring[ci] if T.cor_ring.shape[0] > 0 else -1
+    if kept >= 0:  # the kept ring (the same sums); the limit point's sum alone
+        for r in range(m):
+            rc[r, 0] = T.ring[kept + r, 0]
+            rc[r, 1] = T.ring[kept + r, 1]
+            rc[r, 2] = T.ring[kept + r, 2]
+        for j in range(1, N):
+            ij = T.rings[r0_ + j]
+            e0 += T.vop[o + j] * (T.points[ij, 0] - T.points[i0, 0])
+            e1 += T.vop[o + j] * (T.points[ij, 1] - T.points[i0, 1])
+            e2 += T.vop[o + j] * (T.points[ij, 2] - T.points[i0, 2])
+    else:
+        for r in range(m):  # rc: the caller's scratch, (at least m, 3)
+            rc[r, 0] = 0.0
+            rc[r, 1] = 0.0
+            rc[r, 2] = 0.0
+    for j in range(1, N if kept < 0 else 1):
         ij = T.rings[r0_ + j]
         r0 = T.points[ij, 0] - T.points[i0, 0]
         r1 = T.points[ij, 1] - T.points[i0, 1]

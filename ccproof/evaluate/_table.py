@@ -80,6 +80,8 @@ HOT_BUDGET = 32 << 20
 #: layers take the ring first (``L[n, code] @ (Q @ rel)``). A uniformly random point of a corner face is in
 #: layer 0 or 1 with probability 15/16.
 COMPOSED_LAYERS = 2
+#: corner rings of at least this many points are kept per corner face (``PatchTable.ring``)
+KEEP_RING_NC = 40
 #: largest size of the regular nets kept precomputed (``PatchTable.nets``, 408 bytes per regular patch);
 #: beyond it every regular net is computed at evaluation time from the ring
 NETS_BUDGET = 32 << 20
@@ -143,6 +145,14 @@ class PatchTable(NamedTuple):
         computed like the kernel computes them (the same sums in the same order), kept when they fit
         :data:`HOT_BUDGET`; empty otherwise. A uniformly random point of a corner face is in layer 0
         with probability 3/4.
+    cor_ring : int64 (n_corner,) or (0,)
+        Per corner face the row in ``ring`` of its kept ring, or -1 (computed when needed); empty where no
+        ring is kept.
+    ring : float64 (rows, 3)
+        The kept rings (rows 1 .. Nc - 1 of each, relative to the corner vertex, computed by the kernels'
+        sums) of the corner faces of configurations with Nc >= :data:`KEEP_RING_NC` (the centres of large
+        n-gons, vertices of high valence: a deep net computed from the job's ring costs N (Nc - 1) x 3
+        products there), for the layers from :data:`COMPOSED_LAYERS` on.
 
     Examples
     --------
@@ -186,6 +196,8 @@ class PatchTable(NamedTuple):
     n_layers: np.ndarray
     unit: np.ndarray
     hot: np.ndarray
+    cor_ring: np.ndarray
+    ring: np.ndarray
 
 
 # ---------------------------------------------------------------------------------- frames
@@ -1134,7 +1146,8 @@ class Builder:
             points=X, rings=rings_flat, nets=np.zeros((0, 17, 3)),
             ops=np.concatenate(ops) if ops else np.zeros(0), op_start=np.array(op_start, dtype=np.int64),
             op_size=np.array(op_size, dtype=np.int64), n_layers=np.array(n_layers, dtype=np.int64),
-            unit=np.array(unit, dtype=np.float64).reshape(-1, 3, 3), hot=np.zeros((0, 17, 3)))
+            unit=np.array(unit, dtype=np.float64).reshape(-1, 3, 3), hot=np.zeros((0, 17, 3)),
+            cor_ring=np.zeros(0, np.int64), ring=np.zeros((0, 3)))
         return with_nets(T, groups), groups
 
 
@@ -1170,7 +1183,33 @@ def with_nets(T, groups):
         T = T._replace(nets=regular_nets(T, groups))
     if 0 < n_cor and n_cor * 3 * 17 * 3 * 8 <= _budget("CCPROOF_HOT_BUDGET", HOT_BUDGET):
         T = T._replace(hot=layer0_nets(T, groups))
-    return T
+    return kept_rings(T, groups)
+
+
+def kept_rings(T, groups):
+    """``T`` with the rings of its corner faces with at least :data:`KEEP_RING_NC` points kept
+    (:attr:`PatchTable.ring`, by :func:`corner_rings`: the kernels' sums), or ``T`` where there are none."""
+    parts, off = [], 0
+    cor_ring = None
+    for t, jobs, _ in groups:
+        if not jobs.size:
+            continue
+        root = int(T.job_root[jobs[0]])
+        for vf, kind in enumerate(t.kind):
+            g = root + vf
+            if kind != KIND_CORNER or T.op_size[T.cfg[g]] < KEEP_RING_NC:
+                continue
+            if cor_ring is None:
+                cor_ring = np.full(T.n_corner, -1, dtype=np.int64)
+            m = int(T.op_size[T.cfg[g]]) - 1
+            for lo in range(0, jobs.size, _BLOCK):
+                jb = jobs[lo:lo + _BLOCK]
+                parts.append(corner_rings(T, jb, g)[:, 1:].reshape(-1, 3))
+                cor_ring[T.job_corner[jb] + t.leaf[vf]] = off + m * np.arange(jb.size)
+                off += m * jb.size
+    if cor_ring is None:
+        return T
+    return T._replace(cor_ring=cor_ring, ring=np.concatenate(parts))
 
 
 def _budget(name, default):

@@ -808,7 +808,8 @@ class LimitSurface:
         T = self._table
         V = np.ascontiguousarray(V, dtype=np.float64)
         check_positions(V, T.rings)
-        new._table = with_nets(T._replace(points=V, nets=T.nets[:0], hot=T.hot[:0]), self._groups)
+        new._table = with_nets(T._replace(points=V, nets=T.nets[:0], hot=T.hot[:0], cor_ring=T.cor_ring[:0],
+                                          ring=T.ring[:0]), self._groups)
         new._ctable = None
         new._corner_normal = {}
         return new
