@@ -119,6 +119,38 @@ def _regular_lookup(T, job, vf, lm, cache, tags, W):
     return cache, s
 
 
+def _composed_net(T, r0_, N, o, b, W, s):
+    """Net ``W[s]`` of a corner face in a composed layer: ``sum_j M[j] (X[ring[j]] - X[ring[0]])`` (M the
+    (N, 16) operator at ``vop[b:]``), row 16 the limit point (its weights at ``vop[o:]``), the sums over j =
+    1, 2, ... in order from 0.0; ``r0_`` the job's ring in ``rings``."""
+    i0 = T.rings[r0_]
+    e0 = 0.0
+    e1 = 0.0
+    e2 = 0.0
+    for i in range(16):
+        W[s, i, 0] = 0.0
+        W[s, i, 1] = 0.0
+        W[s, i, 2] = 0.0
+    for j in range(1, N):
+        ij = T.rings[r0_ + j]
+        r0 = T.points[ij, 0] - T.points[i0, 0]
+        r1 = T.points[ij, 1] - T.points[i0, 1]
+        r2 = T.points[ij, 2] - T.points[i0, 2]
+        r = b + 16 * j
+        for i in range(16):
+            w = T.vop[r + i]
+            W[s, i, 0] += w * r0
+            W[s, i, 1] += w * r1
+            W[s, i, 2] += w * r2
+        e0 += T.vop[o + j] * r0
+        e1 += T.vop[o + j] * r1
+        e2 += T.vop[o + j] * r2
+    W[s, 16, 0] = e0 + T.points[i0, 0]
+    W[s, 16, 1] = e1 + T.points[i0, 1]
+    W[s, 16, 2] = e2 + T.points[i0, 2]
+    return W
+
+
 def _corner_net(T, job, vf, cfg, lay, code, ci, W, s, rc):
     """Net ``W[s]`` (17 x 3, row 16 the limit point) of patch ``code`` of layer ``lay`` of corner face
     ``vf`` of ``job``: below :data:`COMPOSED_LAYERS` the composed operator's sums over the ring points; deeper,
@@ -136,29 +168,7 @@ def _corner_net(T, job, vf, cfg, lay, code, ci, W, s, rc):
     e1 = 0.0
     e2 = 0.0
     if lay < COMPOSED_LAYERS:  # one product: the composed operator (N x 16) of this layer and code
-        b = o + N + (3 * lay + code) * N * 16
-        for i in range(16):
-            W[s, i, 0] = 0.0
-            W[s, i, 1] = 0.0
-            W[s, i, 2] = 0.0
-        for j in range(1, N):
-            ij = T.rings[r0_ + j]
-            r0 = T.points[ij, 0] - T.points[i0, 0]
-            r1 = T.points[ij, 1] - T.points[i0, 1]
-            r2 = T.points[ij, 2] - T.points[i0, 2]
-            r = b + 16 * j
-            for i in range(16):
-                w = T.vop[r + i]
-                W[s, i, 0] += w * r0
-                W[s, i, 1] += w * r1
-                W[s, i, 2] += w * r2
-            e0 += T.vop[o + j] * r0
-            e1 += T.vop[o + j] * r1
-            e2 += T.vop[o + j] * r2
-        W[s, 16, 0] = e0 + T.points[i0, 0]
-        W[s, 16, 1] = e1 + T.points[i0, 1]
-        W[s, 16, 2] = e2 + T.points[i0, 2]
-        return W
+        return _composed_net(T, r0_, N, o, o + N + (3 * lay + code) * N * 16, W, s)
     kept = T.cor_ring[ci] if T.cor_ring.shape[0] > 0 else -1
     if kept >= 0:  # the kept ring (the same sums); the limit point's sum alone
         for r in range(m):
@@ -527,6 +537,7 @@ def _ring_walks(org, nxt, prv, twin, pos, seen, g, r, rings, nring, faces, nface
 
 if numba is not None:
     _regular_net = numba.njit(cache=True, nogil=True)(_regular_net)
+    _composed_net = numba.njit(cache=True, nogil=True)(_composed_net)
     _regular_lookup = numba.njit(cache=True, nogil=True)(_regular_lookup)
     _corner_net = numba.njit(cache=True, nogil=True)(_corner_net)
     _basis = numba.njit(cache=True, nogil=True, inline="always")(_basis)
