@@ -767,18 +767,21 @@ def naive_point(S, f, u, v):
         code = 0 if (a and not b) else 1 if (a and b) else 2 if b else 1
         Nc = int(T.op_size[cfg])
         o = int(T.op_start[cfg]) + (3 * n + code) * 16 * Nc
-        q0 = int(T.job_pts[job] + T.pts[vf])
-        ring = [[0.0] * 3] + T.ring[q0:q0 + Nc - 1].tolist()  # row 0 (the vertex) is not stored
+        ring = _ring_rows(T, job, vf, Nc - 1)
+        ring = [[0.0] * 3] + [[ring[r][c] for c in range(3)] for r in range(Nc - 1)]  # row 0: the vertex
         ops = T.ops[o:o + 16 * Nc].tolist()
         net = [[sum(ops[16 * k + i] * ring[k][c] for k in range(Nc)) for c in range(3)] for i in range(16)]
-        origin = T.origin[int(T.job_corner[job] + T.leaf[vf])].tolist()
+        lim = _ring_rows(T, job, vf, 1, int(T.vn[vf]) * (Nc - 1))[0]  # the limit point less X[ring[0]]
+        x0 = T.points[int(T.rings[int(T.job_ring[job])])].tolist()
+        origin = [lim[c] + x0[c] for c in range(3)]
         sc = math.ldexp(H, -n)
         pu0 = T.unit[cfg, code, 0] * sc + (U0 + H if T.cu[vf] else U0)
         pv0 = T.unit[cfg, code, 1] * sc + (V0 + H if T.cv[vf] else V0)
         h = T.unit[cfg, code, 2] * sc
     else:
-        p = int(T.job_net[job] + T.leaf[vf])
-        net, origin = T.nets[p, :16].tolist(), T.nets[p, 16].tolist()
+        rows = _ring_rows(T, job, vf, 17)
+        x0 = T.points[int(T.rings[int(T.job_ring[job])])].tolist()
+        net, origin = rows[:16], [rows[16][c] + x0[c] for c in range(3)]
         pu0, pv0, h = T.u0[vf], T.v0[vf], T.h[vf]
     s = min(max((u - pu0) / h, 0.0), 1.0)
     t = min(max((v - pv0) / h, 0.0), 1.0)
@@ -793,6 +796,15 @@ def naive_point(S, f, u, v):
                 Pu[c] += Ds[i] * Bt[j] * w[c] / h
                 Pv[c] += Bs[i] * Dt[j] * w[c] / h
     return P, Pu, Pv
+
+
+def _ring_rows(T, job, vf, m, skip=0):
+    """The m rows ``sum_j op[j] (X[ring[j]] - X[ring[0]])`` of leaf ``vf`` of ``job`` (op: the (N, m) operator
+    ``skip`` entries into its block of ``vop``), in plain Python."""
+    N, st, r0 = int(T.vn[vf]), int(T.vop_start[vf]) + skip, int(T.job_ring[job])
+    X = [T.points[int(T.rings[r0 + j])].tolist() for j in range(N)]
+    op = T.vop[st:st + N * m].tolist()
+    return [[sum(op[m * j + r] * (X[j][c] - X[0][c]) for j in range(1, N)) for c in range(3)] for r in range(m)]
 
 
 def smoke(n=20_000, rounds=2):

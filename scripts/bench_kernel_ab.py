@@ -19,6 +19,17 @@ Build a library with setup.py's flags, e.g.::
     gcc -shared -fPIC -std=c99 -O3 -ffp-contract=off -fno-math-errno -Wno-psabi ccproof/evaluate/_clib.c -o /tmp/new.so
     python scripts/bench_kernel_ab.py /tmp/old.so /tmp/old.so /tmp/new.so --rounds 61 --points 100000
     python scripts/bench_kernel_ab.py --smoke      the installed kernel against itself (the test suite's run)
+
+A library may name the source tree its worker imports ccproof from and options of its table: ``LIB@TREE`` (the
+tree put first on the worker's PYTHONPATH: compares two versions of the package, each with its own kernel),
+``LIB@TREE@computed`` (no precomputed nets: the environment variables ``CCPROOF_NETS_BUDGET`` and
+``CCPROOF_HOT_BUDGET`` set to 0, every net computed from the rings at evaluation time), ``LIB@TREE@unsorted``
+(points never batched by face: ``SORT_MIN`` out of reach) or both (``@computed,unsorted``), e.g. the table
+of the main branch against this one on the icospheres of
+``scripts/bench_memory.py`` (``--mesh`` adds meshes; ``--shapes none`` leaves out the default ones)::
+
+    python scripts/bench_kernel_ab.py /tmp/old.so@/tmp/oldtree /tmp/new.so /tmp/new.so@.@computed \
+        --shapes none --mesh /tmp/icosphere5.obj --dists uniform --rounds 11 --points 200000
 """
 
 from __future__ import annotations
@@ -45,6 +56,9 @@ from ccproof.mesh.io import read_mesh  # noqa: E402
 WORKER = r"""
 import hashlib, os, sys, time
 import numpy as np
+if os.environ.get("CCPROOF_AB_UNSORTED"):
+    from ccproof.evaluate import surface
+    surface.SORT_MIN = 1 << 62
 from ccproof.evaluate import natural_limit_surface
 from ccproof.evaluate.surface import available_backends
 from ccproof.mesh.io import read_mesh
@@ -81,11 +95,21 @@ def _installed_kernel():
 class Worker:
     """A process evaluating with one library (``CCPROOF_CLIB``), pinned to ``cpu``."""
 
-    def __init__(self, lib, cpu):
+    def __init__(self, spec, cpu):
+        lib, tree, opt = (spec.split("@") + ["", ""])[:3]
         env = dict(os.environ, CCPROOF_CLIB=str(Path(lib).resolve()))
         env.pop("CCPROOF_BACKEND", None)
+        if tree:
+            env["PYTHONPATH"] = str(Path(tree).resolve()) + os.pathsep + env.get("PYTHONPATH", "")
+        for o in filter(None, opt.split(",")):
+            if o not in ("computed", "unsorted"):
+                raise SystemExit(f"{spec}: unknown option {o!r} (computed, unsorted)")
+            if o == "computed":
+                env["CCPROOF_NETS_BUDGET"] = env["CCPROOF_HOT_BUDGET"] = "0"
+            else:
+                env["CCPROOF_AB_UNSORTED"] = "1"
         self.p = subprocess.Popen([sys.executable, "-c", WORKER, str(cpu)], stdin=subprocess.PIPE,
-                                  stdout=subprocess.PIPE, text=True, env=env)
+                                  stdout=subprocess.PIPE, text=True, env=env, cwd=tree or None)  # ("" first)
 
     def run(self, path, pts):
         self.p.stdin.write(f"{path} {pts}\n")
@@ -108,6 +132,7 @@ def main(argv=None):
     ap.add_argument("--points", type=int, default=100_000)
     ap.add_argument("--shapes", default=",".join(label for label, _ in SHAPES))
     ap.add_argument("--dists", default="uniform,near")
+    ap.add_argument("--mesh", action="append", default=[], help="another mesh file (label: its name)")
     ap.add_argument("--smoke", action="store_true",
                     help="the installed kernel against itself, 2 rounds, 2,000 points, one mesh")
     a = ap.parse_args(argv)
@@ -122,15 +147,15 @@ def main(argv=None):
         a.libs = [str(lib), str(lib)]
     if len(a.libs) < 2:
         ap.error("give at least two libraries (the first is the baseline), or --smoke")
-    names = [os.path.basename(p) for p in a.libs]
+    names = ["@".join(os.path.basename(x) for x in p.split("@")) for p in a.libs]
     cpu = min(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else 0
     workers = [Worker(p, cpu) for p in a.libs]
     rng = np.random.default_rng(1)
     import tempfile
 
     with tempfile.TemporaryDirectory() as tmp:
-        for label, path in SHAPES:
-            if label not in a.shapes.split(","):
+        for label, path in SHAPES + [(Path(m).stem, Path(m)) for m in a.mesh]:
+            if label not in a.shapes.split(",") and str(path) not in a.mesh:
                 continue
             mesh = read_mesh(path)
             for dist in a.dists.split(","):

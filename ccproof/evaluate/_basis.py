@@ -102,7 +102,7 @@ class _Topology:
         g = int(self.vf_group[vf])
         t = S._groups[g][0]
         lv = vf - self.root[g]
-        if getattr(t, "smooth_grid", None) is not None:  # the net is the ring itself (job_floats)
+        if getattr(t, "smooth_grid", None) is not None:  # the net is the ring's grid (its template)
             return None, None, np.arange(16)
         if T.kind[vf] == CORNER_KIND:
             layer, code = divmod(rest - 1, 3)

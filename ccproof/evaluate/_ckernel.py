@@ -18,6 +18,7 @@ import threading
 import numpy as np
 
 from ccproof.errors import CCProofError
+from ccproof.evaluate._table import COMPOSED_LAYERS
 
 __all__ = ["load", "CTable", "evaluate_block", "ring_walks"]
 
@@ -25,6 +26,8 @@ _P = ctypes.c_void_p
 _I = ctypes.c_int64
 #: most layers of corner nets precomputed (CCP_LAYER_NETS in _clib.c)
 _LAYER_NETS = 4
+#: layers of a corner face with composed operators (CCP_COMPOSED in _clib.c)
+_COMPOSED = 2
 #: the bytes the precomputed corner nets of layers 1, 2, ... may take together (layer 0 is the table's own
 #: ``hot``): a point in layer n of a corner face reads its net there instead of the kernel's corner-net cache
 LAYER_NETS_BUDGET = 4 << 20
@@ -35,19 +38,21 @@ GRID_BUDGET = 32 << 20
 class _Table(ctypes.Structure):
     """``ccp_table`` of ``_clib.c`` (the same fields in the same order)."""
 
-    _fields_ = [("top", _P), ("job_root", _P), ("job_net", _P), ("job_corner", _P), ("job_pts", _P),
+    _fields_ = [("top", _P), ("job_root", _P), ("job_net", _P), ("job_corner", _P), ("job_ring", _P),
                 ("wide", _I * 5), ("refused", _P), ("kind", _P), ("child", _P), ("u0", _P), ("v0", _P),
-                ("h", _P), ("leaf", _P), ("pts", _P), ("cfg", _P), ("cu", _P), ("cv", _P),
-                ("split_depth", _I), ("n_ptex", _I), ("max_layers", _I), ("nets", _P), ("origin", _P),
-                ("ring", _P), ("ops", _P), ("op_start", _P), ("op_size", _P), ("n_layers", _P), ("unit", _P),
-                ("hot", _P), ("n_hot", _I), ("layer_nets", _P * _LAYER_NETS), ("n_layer_nets", _I),
-                ("grid", _P), ("inv_h", _P), ("inv_unit", _P)]
+                ("h", _P), ("leaf", _P), ("cfg", _P), ("cu", _P), ("cv", _P), ("vop_start", _P), ("vn", _P),
+                ("vop", _P), ("points", _P), ("rings", _P), ("split_depth", _I), ("n_ptex", _I),
+                ("max_layers", _I), ("n_corner", _I), ("n_nets", _I), ("nets", _P), ("ops", _P),
+                ("op_start", _P), ("op_size", _P), ("n_layers", _P), ("unit", _P), ("hot", _P), ("n_hot", _I),
+                ("cor_ring", _P), ("ring", _P),
+                ("layer_nets", _P * _LAYER_NETS), ("n_layer_nets", _I), ("grid", _P), ("inv_h", _P),
+                ("inv_unit", _P)]
 
 
 _LIB = None
 _TRIED = False
 #: the version of the kernel's interface (``ccp_abi`` in _clib.c)
-_ABI = 3
+_ABI = 6
 #: calls on fewer points use no corner-net cache (CCP_CACHE_MIN in _clib.c)
 _CACHE_MIN = 256
 
@@ -160,23 +165,31 @@ class CTable:
 
         s = _Table()
         wide = []
-        for name in ("top", "job_root", "job_net", "job_corner", "job_pts"):
+        for name in ("top", "job_root", "job_net", "job_corner", "job_ring"):
             p, w = offsets(name)
             setattr(s, name, p)
             wide.append(w)
         s.wide = (_I * 5)(*wide)
         s.refused = arr("refused", np.bool_)
         s.kind = arr("kind", np.int8)
-        for name in ("child", "leaf", "pts", "cfg", "op_start", "op_size", "n_layers"):
+        for name in ("child", "leaf", "cfg", "op_start", "op_size", "n_layers", "vop_start", "vn"):
             setattr(s, name, arr(name, np.int64))
-        for name in ("u0", "v0", "h", "nets", "origin", "ring", "ops", "unit", "hot"):
+        for name in ("u0", "v0", "h", "nets", "ops", "unit", "hot", "vop", "points"):
             setattr(s, name, arr(name, np.float64))
+        s.rings = arr("rings", np.int32)
         s.cu = arr("cu", np.bool_)  # one byte each, 0 or 1
         s.cv = arr("cv", np.bool_)
         s.split_depth = int(T.split_depth)
         s.n_ptex = int(T.refused.shape[0])
         s.max_layers = max(1, int(T.n_layers.max()) if T.n_layers.size else 1)
         s.n_hot = int(T.hot.shape[0])
+        if T.cor_ring.size:  # (NULL otherwise: no kept ring)
+            s.cor_ring = arr("cor_ring", np.int64)
+            s.ring = arr("ring", np.float64)
+        s.n_nets = int(T.nets.shape[0])
+        s.n_corner = int(T.n_corner)
+        if COMPOSED_LAYERS != _COMPOSED:
+            raise CCProofError(f"the C kernel composes {_COMPOSED} layers, the table {COMPOSED_LAYERS}")
         self._keep = keep
         self.struct = s
         self.ref = ctypes.byref(s)

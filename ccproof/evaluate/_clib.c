@@ -38,6 +38,7 @@
 #define CCP_HASH 2654435761u
 #define CCP_NET 51 /* 17 x 3 doubles: 16 net rows relative to row 16, the origin */
 #define CCP_LAYER_NETS 4 /* most layers of corner nets kept precomputed */
+#define CCP_COMPOSED 2   /* layers of a corner face with composed operators (_table.COMPOSED_LAYERS) */
 #define CCP_VF_BITS 24 /* bits of the virtual face in a grid cell */
 
 #if defined(__GNUC__)
@@ -56,25 +57,33 @@
 #endif
 
 /* The patch table (ccproof.evaluate._table.PatchTable), as pointers into its numpy arrays. The five
- * per-face offset arrays are int32 or int64 (``wide``); every other integer array is int64, except
- * ``kind`` (int8) and the bools (one byte). Field order and types: _ckernel.py, _Table. */
+ * per-face offset arrays are int32 or int64 (``wide``); the rings are int32; every other integer array is
+ * int64, except ``kind`` (int8) and the bools (one byte). Field order and types: _ckernel.py, _Table. */
 typedef struct {
-    const void *top, *job_root, *job_net, *job_corner, *job_pts;
+    const void *top, *job_root, *job_net, *job_corner, *job_ring;
     int64_t wide[5];
     const uint8_t *refused;
     const int8_t *kind;
     const int64_t *child;
     const double *u0, *v0, *h;
-    const int64_t *leaf, *pts, *cfg;
+    const int64_t *leaf, *cfg;
     const uint8_t *cu, *cv;
+    const int64_t *vop_start, *vn; /* per leaf: its operator in vop, its template's ring size N */
+    const double *vop;
+    const double *points; /* the positions the rings index (V x 3) */
+    const int32_t *rings;
     int64_t split_depth;
     int64_t n_ptex;
     int64_t max_layers; /* max(1, max n_layers): the cache key's stride */
-    const double *nets, *origin, *ring, *ops;
+    int64_t n_corner;   /* corner faces of all jobs (the regular nets' cache keys follow theirs) */
+    int64_t n_nets;     /* rows of ``nets`` (0: the regular nets are computed from the rings) */
+    const double *nets, *ops;
     const int64_t *op_start, *op_size, *n_layers;
     const double *unit;
     const double *hot;
     int64_t n_hot; /* rows of ``hot`` (0: none) */
+    const int64_t *cor_ring; /* NULL, or per corner face the row of its kept ring in ``ring`` (-1: none) */
+    const double *ring;
     /* the nets of layers 0 .. n_layer_nets - 1 of every corner face, per layer 3 n_corner x 17 x 3 (layer 0:
      * ``hot``; the others filled by ccp_corner_nets when the binding makes the table) */
     const double *layer_nets[CCP_LAYER_NETS];
@@ -236,17 +245,112 @@ CCP_INLINE void bicubic(const double *net, const double *bs, const double *bt, d
 }
 #endif
 
-/* Net W (17 x 3, row 16 the limit point) of patch ``code`` of layer ``lay`` of the corner face ``vf`` of
- * ``job``: L[lay, code] @ ring summed over the ring points j = 1, 2, ... in order, from 0.0. */
+/* The ring of ``job``: N indices into points */
+CCP_INLINE const int32_t *ring_of(const ccp_table *T, int64_t job) {
+    return T->rings + ld(T->job_ring, T->wide[4], job);
+}
+
+/* Net W (17 x 3) of the regular leaf vf of ``job``: row i the sum over the ring points j = 1, 2, ... in order,
+ * from 0.0, of op[j, i] (X[ring[j]] - X[ring[0]]), row 16 that sum plus X[ring[0]] (op: vop, N x 17). */
+static void regular_net(const ccp_table *T, int64_t job, int64_t vf, double *W) {
+    int64_t N = T->vn[vf];
+    const double *op = T->vop + T->vop_start[vf];
+    const int32_t *rg = ring_of(T, job);
+    const double *x0 = T->points + 3 * (int64_t)rg[0];
+    double a0[17], a1[17], a2[17];
+    for (int i = 0; i < 17; i++) a0[i] = a1[i] = a2[i] = 0.0;
+    for (int64_t j = 1; j < N; j++) {
+        const double *x = T->points + 3 * (int64_t)rg[j];
+        double r0 = x[0] - x0[0], r1 = x[1] - x0[1], r2 = x[2] - x0[2];
+        const double *w = op + 17 * j;
+        for (int i = 0; i < 17; i++) {
+            a0[i] += w[i] * r0;
+            a1[i] += w[i] * r1;
+            a2[i] += w[i] * r2;
+        }
+    }
+    for (int i = 0; i < 16; i++) {
+        W[3 * i] = a0[i];
+        W[3 * i + 1] = a1[i];
+        W[3 * i + 2] = a2[i];
+    }
+    W[48] = a0[16] + x0[0];
+    W[49] = a1[16] + x0[1];
+    W[50] = a2[16] + x0[2];
+}
+
+/* Net W (17 x 3, row 16 the limit point: the sum over j = 1, 2, ... of o[j] (X[ring[j]] - X[ring[0]]) from 0.0,
+ * plus X[ring[0]]; o the operator row after Q) of patch ``code`` of layer ``lay`` of the corner face ``vf`` of
+ * ``job``. Layers below CCP_COMPOSED: the composed operator M (N x 16) of the layer and code, the sums over the
+ * ring points j = 1, 2, ... in order from 0.0 of M[j, i] (X[ring[j]] - X[ring[0]]). Deeper: its ring relative
+ * to the corner vertex first (rows 1 .. Nc - 1: Q @ (X[ring] - X[ring[0]]), the
+ * sums over the ring points j = 1, 2, ... in order from 0.0; Q: vop, N x (Nc - 1)), then L[lay, code] @ that
+ * ring summed over its points j = 1, 2, ... in order, from 0.0. */
 static void corner_net(const ccp_table *T, int64_t job, int64_t vf, int64_t cfg, int64_t lay, int64_t code,
                        int64_t ci, double *W) {
-    int64_t Nc = T->op_size[cfg];
+    int64_t Nc = T->op_size[cfg], N = T->vn[vf], m = Nc - 1;
     const double *op = T->ops + T->op_start[cfg] + (3 * lay + code) * 16 * Nc;
-    const double *rg = T->ring + 3 * (ld(T->job_pts, T->wide[4], job) + T->pts[vf] - 1);
+    const double *q = T->vop + T->vop_start[vf];
+    const int32_t *rg = ring_of(T, job);
+    const double *x0 = T->points + 3 * (int64_t)rg[0];
+    const double *o = q + N * m; /* the limit point's weights */
+    double e0 = 0.0, e1 = 0.0, e2 = 0.0;
+    if (lay < CCP_COMPOSED) { /* one product: the composed operator (N x 16) of this layer and code */
+        const double *M = o + N + (3 * lay + code) * N * 16;
+        double b0[16], b1[16], b2[16];
+        for (int i = 0; i < 16; i++) b0[i] = b1[i] = b2[i] = 0.0;
+        for (int64_t j = 1; j < N; j++) {
+            const double *x = T->points + 3 * (int64_t)rg[j];
+            double r0 = x[0] - x0[0], r1 = x[1] - x0[1], r2 = x[2] - x0[2];
+            const double *w = M + 16 * j;
+            for (int i = 0; i < 16; i++) {
+                b0[i] += w[i] * r0;
+                b1[i] += w[i] * r1;
+                b2[i] += w[i] * r2;
+            }
+            e0 += o[j] * r0;
+            e1 += o[j] * r1;
+            e2 += o[j] * r2;
+        }
+        for (int i = 0; i < 16; i++) {
+            W[3 * i] = b0[i];
+            W[3 * i + 1] = b1[i];
+            W[3 * i + 2] = b2[i];
+        }
+        W[48] = e0 + x0[0];
+        W[49] = e1 + x0[1];
+        W[50] = e2 + x0[2];
+        return;
+    }
+    double rc_[3 * (m > 0 ? m : 1)], *rc = rc_;
+    int64_t kept = T->cor_ring != NULL ? T->cor_ring[ci] : -1;
+    if (kept >= 0) { /* the kept ring (the same sums); the limit point's sum alone */
+        rc = (double *)(T->ring + 3 * kept);
+        for (int64_t j = 1; j < N; j++) {
+            const double *x = T->points + 3 * (int64_t)rg[j];
+            e0 += o[j] * (x[0] - x0[0]);
+            e1 += o[j] * (x[1] - x0[1]);
+            e2 += o[j] * (x[2] - x0[2]);
+        }
+    }
+    if (kept < 0) for (int64_t r = 0; r < 3 * m; r++) rc[r] = 0.0;
+    for (int64_t j = 1; j < N && kept < 0; j++) {
+        const double *x = T->points + 3 * (int64_t)rg[j];
+        double r0 = x[0] - x0[0], r1 = x[1] - x0[1], r2 = x[2] - x0[2];
+        const double *w = q + m * j;
+        for (int64_t r = 0; r < m; r++) {
+            rc[3 * r] += w[r] * r0;
+            rc[3 * r + 1] += w[r] * r1;
+            rc[3 * r + 2] += w[r] * r2;
+        }
+        e0 += o[j] * r0;
+        e1 += o[j] * r1;
+        e2 += o[j] * r2;
+    }
     double a0[16], a1[16], a2[16];
     for (int i = 0; i < 16; i++) a0[i] = a1[i] = a2[i] = 0.0;
     for (int64_t j = 1; j < Nc; j++) {
-        double r0 = rg[3 * j], r1 = rg[3 * j + 1], r2 = rg[3 * j + 2];
+        double r0 = rc[3 * (j - 1)], r1 = rc[3 * (j - 1) + 1], r2 = rc[3 * (j - 1) + 2];
         const double *w = op + 16 * j;
         for (int i = 0; i < 16; i++) {
             a0[i] += w[i] * r0;
@@ -259,7 +363,9 @@ static void corner_net(const ccp_table *T, int64_t job, int64_t vf, int64_t cfg,
         W[3 * i + 1] = a1[i];
         W[3 * i + 2] = a2[i];
     }
-    for (int c = 0; c < 3; c++) W[48 + c] = T->origin[3 * ci + c];
+    W[48] = e0 + x0[0];
+    W[49] = e1 + x0[1];
+    W[50] = e2 + x0[2];
 }
 
 /* The corner-net cache (the caller's buffer of CCP_CACHE_WORDS doubles, zero when new, kept between calls
@@ -297,6 +403,14 @@ CCP_INLINE int64_t expo(double x) {
 typedef struct {
     int64_t job, vf, cfg, lay, code, ci;
 } ccp_deep;
+
+/* The net of a point that locate did not find stored: a regular net (cfg < 0) or a corner net. */
+static void deep_net(const ccp_table *T, const ccp_deep *d, double *W) {
+    if (d->cfg < 0)
+        regular_net(T, d->job, d->vf, W);
+    else
+        corner_net(T, d->job, d->vf, d->cfg, d->lay, d->code, d->ci, W);
+}
 
 /* The net of point (pf, uu, ww), its parameter (s, t) in the patch and the scale g = 1 / h. Returns NULL
  * for a point evaluation refuses, and CCP_DEEP for a corner net of a layer beyond the precomputed one,
@@ -417,7 +531,18 @@ CCP_INLINE const double *locate(const ccp_table *T, int64_t job, int64_t vf, int
             net = CCP_DEEP;
         }
     } else {
-        net = T->nets + CCP_NET * (ld(T->job_net, T->wide[2], job) + T->leaf[vf]);
+        int64_t p = ld(T->job_net, T->wide[2], job) + T->leaf[vf];
+        if (T->n_nets > 0) {
+            net = T->nets + CCP_NET * p;
+        } else { /* computed from the ring (cfg -1: a regular net) */
+            dp->job = job;
+            dp->vf = vf;
+            dp->cfg = -1;
+            dp->lay = 0;
+            dp->code = 0;
+            dp->ci = p;
+            net = CCP_DEEP;
+        }
         pu0 = T->u0[vf];
         pv0 = T->v0[vf];
         h = T->h[vf];
@@ -492,8 +617,11 @@ CCP_INLINE int64_t run(const ccp_table *T, int64_t n, const int64_t *f, const do
             DL[nd] = i;
             nd += net == CCP_DEEP;
             if (net == CCP_DEEP) {
+                const int32_t *rg = ring_of(T, dp[i].job); /* the ring's positions, read in pass 2 */
+                for (int64_t j = 0; j < T->vn[dp[i].vf]; j++) CCP_PREFETCH(T->points + 3 * (int64_t)rg[j]);
                 if (base == NULL) continue;
-                key[i] = 3 * (T->max_layers * dp[i].ci + dp[i].lay) + dp[i].code;
+                key[i] = dp[i].cfg < 0 ? 3 * T->max_layers * T->n_corner + dp[i].ci
+                                       : 3 * (T->max_layers * dp[i].ci + dp[i].lay) + dp[i].code;
                 slot[i] = base + 8 + CCP_SLOT * (int64_t)(((uint64_t)key[i] * CCP_HASH) & (CCP_CACHE_SLOTS - 1));
                 net = (const double *)slot[i];
             }
@@ -509,7 +637,7 @@ CCP_INLINE int64_t run(const ccp_table *T, int64_t n, const int64_t *f, const do
             int i = DL[jd];
             const ccp_deep *d = dp + i;
             if (base == NULL) {
-                corner_net(T, d->job, d->vf, d->cfg, d->lay, d->code, d->ci, W[i]);
+                deep_net(T, d, W[i]);
                 N[i] = W[i];
                 continue;
             }
@@ -519,7 +647,7 @@ CCP_INLINE int64_t run(const ccp_table *T, int64_t n, const int64_t *f, const do
                     for (; i0 < i; i0++) bicubic(N[i0], BS[i0], BT[i0], G[i0], D, k0 + i0, k0 + i0 + 1 < n, P, Pu, Pv, Puu, Puv, Pvv);
                     block++;
                 }
-                corner_net(T, d->job, d->vf, d->cfg, d->lay, d->code, d->ci, (double *)(sl + 5));
+                deep_net(T, d, (double *)(sl + 5));
                 sl[0] = key[i] + 1;
             }
             sl[1] = block;
@@ -627,7 +755,7 @@ int64_t ccp_grid(const ccp_table *T, int64_t *grid) {
 }
 
 /* The layout this file was compiled with: the binding refuses a library whose structure differs. */
-int64_t ccp_abi(void) { return 1000 * (int64_t)sizeof(ccp_table) + 3; }
+int64_t ccp_abi(void) { return 1000 * (int64_t)sizeof(ccp_table) + 6; }
 
 /* ------------------------------------------------------------------------------------------------------------
  * The ring walk of the table's setup (the numba kernel's _ring_walks, ccproof/evaluate/_numba_kernel.py, step

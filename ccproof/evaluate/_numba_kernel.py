@@ -15,7 +15,7 @@ try:
 except ImportError:  # pragma: no cover - optional dependency
     numba = None
 
-from ccproof.evaluate._table import KIND_CORNER, KIND_SPLIT
+from ccproof.evaluate._table import COMPOSED_LAYERS, KIND_CORNER, KIND_SPLIT
 
 #: corner nets (layers beyond the precomputed ones) kept per kernel call: slots (a power of 2, 408 bytes each)
 _CACHE_SLOTS = 16384
@@ -75,29 +75,148 @@ def _bicubic(net, p, s, t, g, d, k, P, Pu, Pv, Puu, Puv, Pvv):
                 Pvv[k, c] = _sum4(s0, s1, s2, s3, x2, y2, z2, q2) * g2
 
 
-def _corner_net(T, job, vf, cfg, lay, code, ci, W, s):
+def _regular_net(T, job, vf, W, s):
+    """Net ``W[s]`` (17 x 3) of the regular leaf ``vf`` of ``job``: row i ``sum_j op[j, i] (X[ring[j]] -
+    X[ring[0]])`` over the ring points j = 1, 2, ... in order from 0.0, row 16 that sum plus ``X[ring[0]]``."""
+    N = T.vn[vf]
+    o = T.vop_start[vf]
+    r0_ = T.job_ring[job]
+    i0 = T.rings[r0_]
+    for i in range(17):
+        W[s, i, 0] = 0.0
+        W[s, i, 1] = 0.0
+        W[s, i, 2] = 0.0
+    for j in range(1, N):
+        ij = T.rings[r0_ + j]
+        r0 = T.points[ij, 0] - T.points[i0, 0]
+        r1 = T.points[ij, 1] - T.points[i0, 1]
+        r2 = T.points[ij, 2] - T.points[i0, 2]
+        r = o + 17 * j
+        for i in range(17):
+            w = T.vop[r + i]
+            W[s, i, 0] += w * r0
+            W[s, i, 1] += w * r1
+            W[s, i, 2] += w * r2
+    for c in range(3):
+        W[s, 16, c] = W[s, 16, c] + T.points[i0, c]
+    return W
+
+
+def _regular_lookup(T, job, vf, lm, cache, tags, W):
+    """``(array, row)`` holding the net of the regular leaf ``vf`` of ``job``: the kept nets, the call's
+    cache (computed into it when missing; keys after the corner nets'), or ``W`` (no cache)."""
+    p = T.job_net[job] + T.leaf[vf]
+    if T.nets.shape[0] > 0:
+        return T.nets, p
+    ns = cache.shape[0]
+    if ns == 0:
+        return _regular_net(T, job, vf, W, 0), 0
+    key = 3 * lm * T.n_corner + p
+    s = (key * _HASH) & (ns - 1)
+    if tags[s] != key:
+        _regular_net(T, job, vf, cache, s)
+        tags[s] = key
+    return cache, s
+
+
+def _composed_net(T, r0_, N, o, b, W, s):
+    """Net ``W[s]`` of a corner face in a composed layer: ``sum_j M[j] (X[ring[j]] - X[ring[0]])`` (M the
+    (N, 16) operator at ``vop[b:]``), row 16 the limit point (its weights at ``vop[o:]``), the sums over j =
+    1, 2, ... in order from 0.0; ``r0_`` the job's ring in ``rings``."""
+    i0 = T.rings[r0_]
+    e0 = 0.0
+    e1 = 0.0
+    e2 = 0.0
+    for i in range(16):
+        W[s, i, 0] = 0.0
+        W[s, i, 1] = 0.0
+        W[s, i, 2] = 0.0
+    for j in range(1, N):
+        ij = T.rings[r0_ + j]
+        r0 = T.points[ij, 0] - T.points[i0, 0]
+        r1 = T.points[ij, 1] - T.points[i0, 1]
+        r2 = T.points[ij, 2] - T.points[i0, 2]
+        r = b + 16 * j
+        for i in range(16):
+            w = T.vop[r + i]
+            W[s, i, 0] += w * r0
+            W[s, i, 1] += w * r1
+            W[s, i, 2] += w * r2
+        e0 += T.vop[o + j] * r0
+        e1 += T.vop[o + j] * r1
+        e2 += T.vop[o + j] * r2
+    W[s, 16, 0] = e0 + T.points[i0, 0]
+    W[s, 16, 1] = e1 + T.points[i0, 1]
+    W[s, 16, 2] = e2 + T.points[i0, 2]
+    return W
+
+
+def _corner_net(T, job, vf, cfg, lay, code, ci, W, s, rc):
     """Net ``W[s]`` (17 x 3, row 16 the limit point) of patch ``code`` of layer ``lay`` of corner face
-    ``vf`` of ``job``: ``L[lay, code] @ ring`` summed over the ring points j = 1, 2, ... in order
+    ``vf`` of ``job``: below :data:`COMPOSED_LAYERS` the composed operator's sums over the ring points; deeper,
+    its ring relative to the corner vertex (``Q @ (X[ring] - X[ring[0]])``, summed over
+    j = 1, 2, ... in order), then ``L[lay, code] @ ring`` summed over the ring points j = 1, 2, ... in order
     (row 0 of the relative ring is 0), the 16 entries side by side."""
     Nc = T.op_size[cfg]
+    m = Nc - 1
+    N = T.vn[vf]
+    q = T.vop_start[vf]
+    r0_ = T.job_ring[job]
+    i0 = T.rings[r0_]
+    o = q + N * m  # the limit point's weights
+    e0 = 0.0
+    e1 = 0.0
+    e2 = 0.0
+    if lay < COMPOSED_LAYERS:  # one product: the composed operator (N x 16) of this layer and code
+        return _composed_net(T, r0_, N, o, o + N + (3 * lay + code) * N * 16, W, s)
+    kept = T.cor_ring[ci] if T.cor_ring.shape[0] > 0 else -1
+    if kept >= 0:  # the kept ring (the same sums); the limit point's sum alone
+        for r in range(m):
+            rc[r, 0] = T.ring[kept + r, 0]
+            rc[r, 1] = T.ring[kept + r, 1]
+            rc[r, 2] = T.ring[kept + r, 2]
+        for j in range(1, N):
+            ij = T.rings[r0_ + j]
+            e0 += T.vop[o + j] * (T.points[ij, 0] - T.points[i0, 0])
+            e1 += T.vop[o + j] * (T.points[ij, 1] - T.points[i0, 1])
+            e2 += T.vop[o + j] * (T.points[ij, 2] - T.points[i0, 2])
+    else:
+        for r in range(m):  # rc: the caller's scratch, (at least m, 3)
+            rc[r, 0] = 0.0
+            rc[r, 1] = 0.0
+            rc[r, 2] = 0.0
+    for j in range(1, N if kept < 0 else 1):
+        ij = T.rings[r0_ + j]
+        r0 = T.points[ij, 0] - T.points[i0, 0]
+        r1 = T.points[ij, 1] - T.points[i0, 1]
+        r2 = T.points[ij, 2] - T.points[i0, 2]
+        b = q + m * j
+        for r in range(m):
+            w = T.vop[b + r]
+            rc[r, 0] += w * r0
+            rc[r, 1] += w * r1
+            rc[r, 2] += w * r2
+        e0 += T.vop[o + j] * r0
+        e1 += T.vop[o + j] * r1
+        e2 += T.vop[o + j] * r2
     o = T.op_start[cfg] + (3 * lay + code) * 16 * Nc
-    q0 = T.job_pts[job] + T.pts[vf] - 1  # ring row j >= 1 (row 0, the vertex, is 0)
     for i in range(16):
         W[s, i, 0] = 0.0
         W[s, i, 1] = 0.0
         W[s, i, 2] = 0.0
     for j in range(1, Nc):
-        r0 = T.ring[q0 + j, 0]
-        r1 = T.ring[q0 + j, 1]
-        r2 = T.ring[q0 + j, 2]
+        r0 = rc[j - 1, 0]
+        r1 = rc[j - 1, 1]
+        r2 = rc[j - 1, 2]
         r = o + 16 * j
         for i in range(16):
             w = T.ops[r + i]
             W[s, i, 0] += w * r0
             W[s, i, 1] += w * r1
             W[s, i, 2] += w * r2
-    for c in range(3):
-        W[s, 16, c] = T.origin[ci, c]
+    W[s, 16, 0] = e0 + T.points[i0, 0]
+    W[s, 16, 1] = e1 + T.points[i0, 1]
+    W[s, 16, 2] = e2 + T.points[i0, 2]
     return W
 
 
@@ -120,8 +239,11 @@ def _evaluate_points(f, u, v, d, T, P, Pu, Pv, Puu, Puv, Pvv):
     cache = np.empty((ns, 17, 3))
     tags = np.full(ns, -1, dtype=np.int64)
     lm = 1
+    mc = 1
     for c in range(T.n_layers.shape[0]):
         lm = max(lm, T.n_layers[c])
+        mc = max(mc, T.op_size[c])
+    rc = np.empty((mc, 3))  # a corner ring of the deeper layers (_corner_net)
     for k in range(n):
         pf = f[k]
         uu = u[k]
@@ -187,15 +309,14 @@ def _evaluate_points(f, u, v, d, T, P, Pu, Pv, Puu, Puv, Pvv):
                 key = 3 * (lm * ci + lay) + code
                 p = (key * _HASH) & (ns - 1)
                 if tags[p] != key:
-                    _corner_net(T, job, vf, cfg, lay, code, ci, cache, p)
+                    _corner_net(T, job, vf, cfg, lay, code, ci, cache, p, rc)
                     tags[p] = key
                 net = cache
             else:
-                net = _corner_net(T, job, vf, cfg, lay, code, ci, W, 0)
+                net = _corner_net(T, job, vf, cfg, lay, code, ci, W, 0, rc)
                 p = 0
         else:
-            net = T.nets
-            p = T.job_net[job] + T.leaf[vf]
+            net, p = _regular_lookup(T, job, vf, lm, cache, tags, W)
             pu0 = T.u0[vf]
             pv0 = T.v0[vf]
             h = T.h[vf]
@@ -415,6 +536,9 @@ def _ring_walks(org, nxt, prv, twin, pos, seen, g, r, rings, nring, faces, nface
 
 
 if numba is not None:
+    _regular_net = numba.njit(cache=True, nogil=True)(_regular_net)
+    _composed_net = numba.njit(cache=True, nogil=True)(_composed_net)
+    _regular_lookup = numba.njit(cache=True, nogil=True)(_regular_lookup)
     _corner_net = numba.njit(cache=True, nogil=True)(_corner_net)
     _basis = numba.njit(cache=True, nogil=True, inline="always")(_basis)
     _sum4 = numba.njit(cache=True, nogil=True, inline="always")(_sum4)

@@ -18,12 +18,19 @@ shared by every face with that key:
 * per *configuration* (a corner scheme and the orientation of the corner in the ptex face): the
   exact-then-rounded layer operators ``L`` (n_layers, 3, 16, Nc) of
   :func:`ccproof.evaluate.local.corner_scheme`, shared by every corner face of that configuration;
-* per job: the id of its template and its ring (vertex indices); the float data derived from them
-  (the 17 x 3 nets of its regular patches, the Nc x 3 relative ring and the limit point of its corner
-  faces), so that a regular point costs one gather and a corner point one ``16 x Nc`` product.
+* per job: the id of its template and its ring (int32 indices into the positions the rings index,
+  one (V, 3) array shared by every job).
 
-Memory: O(control points + ptex faces + configurations): nothing is stored per layer per face; a
-point in layer n of a corner face gets its net as ``L[n, code] @ ring`` at evaluation time.
+A point's net is computed when it is evaluated, from the positions of its job's ring: the net of a
+regular patch is its template operator (17 x N) applied to ``rel = X[ring] - X[ring[0]]``, the net of
+layer n of a corner face is ``L[n, code] @ (Q @ rel)`` (Q the corner face's ring operator), every sum
+taken in one fixed order (ring point j = 1, 2, ... from 0.0) by every backend, so that all give the
+same bits. Small tables keep the nets precomputed by the same sums (:data:`NETS_BUDGET`,
+:data:`HOT_BUDGET`).
+
+Memory: O(control points + ptex faces + configurations): per ptex face of a triangle scan 133 bytes
+(the ring's indices, the offsets, the level-1 points); nothing is stored per layer or per net of a face,
+nor any limit point.
 """
 
 from __future__ import annotations
@@ -63,11 +70,21 @@ MAX_DEPTH = 4
 #: local subdivisions allowed in the semi-sharp phase of a tagged mesh (sharpness < 10 decays in
 #: 10 uniform levels)
 MAX_SEMI_DEPTH = 40
-#: jobs per block when the float data are computed (bounds the temporaries)
+#: jobs per block when the limit points or precomputed nets are computed (bounds the temporaries)
 _BLOCK = 1 << 13
 #: largest size of the layer-0 nets of the corner faces kept precomputed (``PatchTable.hot``, 1,224
 #: bytes per corner face); beyond it every corner net is computed at evaluation time
 HOT_BUDGET = 32 << 20
+#: layers of a corner face whose nets are one product with the ring: the layer operator composed with the
+#: corner ring's (``Q L[n, code]``, (N, 16) per layer and code, per corner face of a template); the deeper
+#: layers take the ring first (``L[n, code] @ (Q @ rel)``). A uniformly random point of a corner face is in
+#: layer 0 or 1 with probability 15/16.
+COMPOSED_LAYERS = 2
+#: corner rings of at least this many points are kept per corner face (``PatchTable.ring``)
+KEEP_RING_NC = 40
+#: largest size of the regular nets kept precomputed (``PatchTable.nets``, 408 bytes per regular patch);
+#: beyond it every regular net is computed at evaluation time from the ring
+NETS_BUDGET = 32 << 20
 
 
 class PatchTable(NamedTuple):
@@ -80,9 +97,9 @@ class PatchTable(NamedTuple):
         unless the ptex face is a quad split into its four level-1 children).
     refused : bool (P,)
         Ptex faces evaluation refuses (holes).
-    job_root, job_net, job_corner, job_pts : int32 (J,) (int64 where the offsets need it)
-        Per job: the root virtual face of its template, and the offsets of its regular nets in
-        ``nets``, of its corner faces in ``origin``, of its corner rings in ``ring``.
+    job_root, job_net, job_corner, job_ring : int32 (J,) (int64 where the offsets need it)
+        Per job: the root virtual face of its template, and the index of its first regular patch, of its
+        first corner face and of its ring in ``rings``.
     kind : int8 (T,)
         Per template virtual face: 0 regular patch, 1 corner face, 2 split into four children.
     child : int64 (T, 4)
@@ -91,20 +108,30 @@ class PatchTable(NamedTuple):
         Domain of a virtual face in its ptex face (lower-left corner, side: a power of 2).
     leaf : int64 (T,)
         Index of a leaf among its template's regular patches or corner faces.
-    pts : int64 (T,)
-        Offset of a corner face's ring among its template's corner rings.
     cfg : int64 (T,)
         Configuration of a corner face.
     cu, cv : bool (T,)
         Whether a corner face's irregular corner is at ``u0 + h`` (``v0 + h``).
+    vop_start, vn : int64 (T,)
+        Per leaf its operator's offset in ``vop`` and its template's ring size N.
+    vop : float64
+        Per regular leaf its operator (N, 17): row j the weights of ring point j in the 16 net rows
+        (relative to row 16) and in row 16 (less the ring's point 0); per corner face (N, Nc - 1): row j
+        the weights of ring point j in the rows 1 .. Nc - 1 of the corner ring relative to its vertex,
+        then (N,) the weights in its limit point (less the ring's point 0), then the composed operators
+        (N, 16) of its first layers (:data:`COMPOSED_LAYERS`), layer by layer, code by code: row j the
+        weights of ring point j in the 16 rows of that net.
     split_depth : int
         Deepest split in any template.
-    nets : float64 (n_regular, 17, 3)
-        Regular patch nets, base orientation, relative to row 16 (the origin).
-    origin : float64 (n_corner, 3)
-        Limit point of each corner face's irregular corner.
-    ring : float64 (n_points, 3)
-        Corner rings relative to their corner vertex, rows 1 .. Nc - 1 (row 0, the vertex, is 0).
+    n_regular, n_corner : int
+        Regular patches and corner faces (leaves) of all jobs together.
+    points : float64 (V, 3)
+        The positions the rings index (the mesh's vertices, or the level-1 points of a polygon mesh).
+    rings : int32 (sum of the jobs' ring sizes,)
+        The rings of the jobs, one after the other.
+    nets : float64 (n_regular, 17, 3) or (0, 17, 3)
+        The nets of the regular patches (base orientation, row 16 the origin) computed by the kernels'
+        sums, kept when they fit :data:`NETS_BUDGET`; empty otherwise (computed when evaluated).
     ops : float64 (sum of n_layers * 48 * Nc,)
         Per configuration its layer operators ``L`` laid out (n_layers, 3, Nc, 16): ``[n, code, j, i]``
         the weight of ring point j in entry i of the net of layer n, patch ``code`` (0 along u, 1
@@ -118,17 +145,25 @@ class PatchTable(NamedTuple):
         computed like the kernel computes them (the same sums in the same order), kept when they fit
         :data:`HOT_BUDGET`; empty otherwise. A uniformly random point of a corner face is in layer 0
         with probability 3/4.
+    cor_ring : int64 (n_corner,) or (0,)
+        Per corner face the row in ``ring`` of its kept ring, or -1 (computed when needed); empty where no
+        ring is kept.
+    ring : float64 (rows, 3)
+        The kept rings (rows 1 .. Nc - 1 of each, relative to the corner vertex, computed by the kernels'
+        sums) of the corner faces of configurations with Nc >= :data:`KEEP_RING_NC` (the centres of large
+        n-gons, vertices of high valence: a deep net computed from the job's ring costs N (Nc - 1) x 3
+        products there), for the layers from :data:`COMPOSED_LAYERS` on.
 
     Examples
     --------
     A surface's table is ``S.patch_map.table`` (:class:`ccproof.evaluate.patch_map.PatchMap`). The 5-regular
-    disk of two rings: 20 ptex faces, 10 stored regular patches (net and origin, 17 rows), 10 corner faces:
+    disk of two rings: 20 ptex faces, 10 regular patches (their nets kept: a small table), 10 corner faces:
 
     >>> from ccproof.evaluate import natural_limit_surface
     >>> from ccproof.mesh.examples import k_regular_disk
     >>> T = natural_limit_surface(k_regular_disk(5, 2)).patch_map.table
-    >>> T.top.shape, T.nets.shape, T.origin.shape
-    ((20, 4), (10, 17, 3), (10, 3))
+    >>> T.top.shape, T.n_regular, T.nets.shape, T.n_corner
+    ((20, 4), 10, (10, 17, 3), 10)
     """
 
     top: np.ndarray
@@ -136,27 +171,33 @@ class PatchTable(NamedTuple):
     job_root: np.ndarray
     job_net: np.ndarray
     job_corner: np.ndarray
-    job_pts: np.ndarray
+    job_ring: np.ndarray
     kind: np.ndarray
     child: np.ndarray
     u0: np.ndarray
     v0: np.ndarray
     h: np.ndarray
     leaf: np.ndarray
-    pts: np.ndarray
     cfg: np.ndarray
     cu: np.ndarray
     cv: np.ndarray
+    vop_start: np.ndarray
+    vn: np.ndarray
+    vop: np.ndarray
     split_depth: int
+    n_regular: int
+    n_corner: int
+    points: np.ndarray
+    rings: np.ndarray
     nets: np.ndarray
-    origin: np.ndarray
-    ring: np.ndarray
     ops: np.ndarray
     op_start: np.ndarray
     op_size: np.ndarray
     n_layers: np.ndarray
     unit: np.ndarray
     hot: np.ndarray
+    cor_ring: np.ndarray
+    ring: np.ndarray
 
 
 # ---------------------------------------------------------------------------------- frames
@@ -1018,49 +1059,9 @@ class Builder:
         return vid
 
     # ------------------------------------------------------------------ assembly
-    def table(self, top, refused):
-        """The :class:`PatchTable` (floats from the positions given to :meth:`classify`), and the
-        template groups ``[(template, jobs, rings)]`` that :func:`job_floats` recomputes from."""
-        temps = list(self.templates.values())
-        J = self.n_jobs
-        job_root = np.full(J, -1, dtype=np.int64)
-        job_net = np.zeros(J, dtype=np.int64)
-        job_corner = np.zeros(J, dtype=np.int64)
-        job_pts = np.zeros(J, dtype=np.int64)
-        kind, child, dom, leaf, pts, cfg, corner = [], [], [], [], [], [], []
-        n_tv = n_reg = n_cor = n_pts = 0
-        groups = []
-        depth = 0
-        for t in temps:
-            jobs = np.frombuffer(t.jobs, dtype=np.int64) if len(t.jobs) else np.zeros(0, np.int64)
-            rings = np.frombuffer(t.rings, dtype=np.int32).reshape(-1, t.n) if len(t.rings) else \
-                np.zeros((0, t.n), np.int32)
-            k = jobs.size
-            job_root[jobs] = n_tv
-            nr, nc = t.R.shape[0] // 17, t.O.shape[0]
-            job_net[jobs] = n_reg + nr * np.arange(k)
-            job_corner[jobs] = n_cor + nc * np.arange(k)
-            job_pts[jobs] = n_pts + t.n_pts * np.arange(k)
-            t.offsets = (n_reg, n_cor, n_pts)
-            n_reg += nr * k
-            n_cor += nc * k
-            n_pts += t.n_pts * k
-            kind += t.kind
-            child += [[c + n_tv if c >= 0 else -1 for c in ch] for ch in t.child]
-            dom += t.dom
-            leaf += t.leaf
-            pts += t.pts
-            cfg += t.cfg
-            corner += t.corner
-            dv = np.zeros(len(t.kind), dtype=np.int64)
-            for v, ch in enumerate(t.child):  # children are created after their parents
-                if t.kind[v] == KIND_SPLIT:
-                    dv[ch] = dv[v] + 1
-            depth = max(depth, int(dv.max()))
-            n_tv += len(t.kind)
-            groups.append((t, jobs, rings))
-        if (job_root < 0).any():  # pragma: no cover - would be a bug in the classification
-            raise MeshError(f"internal error: job {int(np.flatnonzero(job_root < 0)[0])} was not classified")
+    def _configuration_ops(self):
+        """Per configuration its layer operators, flat (layer, code, j, i), their offsets in the
+        concatenation, its ring size Nc, its number of layers, its layer-0 domains ``unit``."""
         ops, op_start, op_size, n_layers, unit = [], [], [], [], []
         off = 0
         for scheme, orient in self.schemes:
@@ -1072,26 +1073,166 @@ class Builder:
             n_layers.append(scheme.n_layers)
             unit.append(u)
             off += L.size
+        return ops, op_start, op_size, n_layers, unit
+
+    def table(self, top, refused):
+        """The :class:`PatchTable` (floats from the positions given to :meth:`classify`), and the
+        template groups ``[(template, jobs, rings)]`` (:func:`with_nets`; ``rings``
+        views of the table's ``rings``)."""
+        temps = list(self.templates.values())
+        J = self.n_jobs
+        job_root = np.full(J, -1, dtype=np.int64)
+        job_net = np.zeros(J, dtype=np.int64)
+        job_corner = np.zeros(J, dtype=np.int64)
+        job_ring = np.zeros(J, dtype=np.int64)
+        kind, child, dom, leaf, cfg, corner, vop_start, vn, vop = [], [], [], [], [], [], [], [], []
+        n_tv = n_reg = n_cor = n_ring = n_vop = 0
+        groups = []
+        depth = 0
+        ops, op_start, op_size, n_layers, unit = self._configuration_ops()
+        rings_flat = np.empty(sum(len(t.rings) for t in temps), dtype=np.int32)
+        for t in temps:
+            jobs = np.frombuffer(t.jobs, dtype=np.int64).astype(np.int32 if J < 2**31 else np.int64) \
+                if len(t.jobs) else np.zeros(0, np.int64)
+            k = jobs.size
+            rings = rings_flat[n_ring:n_ring + k * t.n].reshape(k, t.n)
+            if k:
+                rings[...] = np.frombuffer(t.rings, dtype=np.int32).reshape(k, t.n)
+            t.rings = None  # (the table's copy is the one kept)
+            job_root[jobs] = n_tv
+            nr, nc = t.R.shape[0] // 17, t.O.shape[0]
+            job_net[jobs] = n_reg + nr * np.arange(k)
+            job_corner[jobs] = n_cor + nc * np.arange(k)
+            job_ring[jobs] = n_ring + t.n * np.arange(k)
+            t.offsets = (n_reg, n_cor, n_ring)
+            n_reg += nr * k
+            n_cor += nc * k
+            n_ring += t.n * k
+            kind += t.kind
+            child += [[c + n_tv if c >= 0 else -1 for c in ch] for ch in t.child]
+            dom += t.dom
+            leaf += t.leaf
+            cfg += t.cfg
+            corner += t.corner
+            for ops_ in _leaf_operators(t, ops):
+                vop_start.append(n_vop if ops_ is not None else -1)
+                vn.append(t.n)
+                if ops_ is not None:
+                    vop.append(ops_.reshape(-1))
+                    n_vop += ops_.size
+            dv = np.zeros(len(t.kind), dtype=np.int64)
+            for v, ch in enumerate(t.child):  # children are created after their parents
+                if t.kind[v] == KIND_SPLIT:
+                    dv[ch] = dv[v] + 1
+            depth = max(depth, int(dv.max()))
+            n_tv += len(t.kind)
+            groups.append((t, jobs, rings))
+        if (job_root < 0).any():  # pragma: no cover - would be a bug in the classification
+            raise MeshError(f"internal error: job {int(np.flatnonzero(job_root < 0)[0])} was not classified")
         d = np.array(dom, dtype=np.float64).reshape(-1, 3)
         c = np.array(corner, dtype=bool).reshape(-1, 2)
-        nets, origin, ring = job_floats(groups, self.X, (n_reg, n_cor, n_pts), self.progress)
+        X = np.ascontiguousarray(self.X, dtype=np.float64)
+        check_positions(X, rings_flat)
+
         def small(a, bound):  # int32 where it fits (the per-face arrays are the big ones)
             return np.ascontiguousarray(a, dtype=np.int32 if bound < 2**31 else np.int64)
 
         T = PatchTable(
             top=small(top, J), refused=np.ascontiguousarray(refused, dtype=np.bool_),
             job_root=small(job_root, n_tv), job_net=small(job_net, n_reg), job_corner=small(job_corner, n_cor),
-            job_pts=small(job_pts, n_pts),
+            job_ring=small(job_ring, n_ring),
             kind=np.array(kind, dtype=np.int8), child=np.array(child, dtype=np.int64).reshape(-1, 4),
             u0=d[:, 0].copy(), v0=d[:, 1].copy(), h=d[:, 2].copy(), leaf=np.array(leaf, dtype=np.int64),
-            pts=np.array(pts, dtype=np.int64), cfg=np.array(cfg, dtype=np.int64),
-            cu=c[:, 0].copy(), cv=c[:, 1].copy(), split_depth=depth, nets=nets, origin=origin, ring=ring,
+            cfg=np.array(cfg, dtype=np.int64), cu=c[:, 0].copy(), cv=c[:, 1].copy(),
+            vop_start=np.array(vop_start, dtype=np.int64), vn=np.array(vn, dtype=np.int64),
+            vop=np.concatenate(vop) if vop else np.zeros(0), split_depth=depth, n_regular=n_reg, n_corner=n_cor,
+            points=X, rings=rings_flat, nets=np.zeros((0, 17, 3)),
             ops=np.concatenate(ops) if ops else np.zeros(0), op_start=np.array(op_start, dtype=np.int64),
             op_size=np.array(op_size, dtype=np.int64), n_layers=np.array(n_layers, dtype=np.int64),
-            unit=np.array(unit, dtype=np.float64).reshape(-1, 3, 3), hot=np.zeros((0, 17, 3)))
-        if 0 < n_cor and n_cor * 3 * 17 * 3 * 8 <= HOT_BUDGET:
-            T = T._replace(hot=layer0_nets(T, groups))
-        return T, groups
+            unit=np.array(unit, dtype=np.float64).reshape(-1, 3, 3), hot=np.zeros((0, 17, 3)),
+            cor_ring=np.zeros(0, np.int64), ring=np.zeros((0, 3)))
+        return with_nets(T, groups), groups
+
+
+def _leaf_operators(t, ops):
+    """Per virtual face of the finished template ``t`` (its ``cfg`` the table's) its operators as
+    :attr:`PatchTable.vop` stores them, or None (a split face): regular (N, 17); corner (N, Nc - 1), its
+    limit point's (N,), then per layer n < min(:data:`COMPOSED_LAYERS`, layers) and code the composed (N,
+    16) ``Q L[n, code]``
+    (``ops``: the flat layer operators of each configuration, (n_layers, 3, Nc, 16))."""
+    out = []
+    starts = sorted(t.pts[v] for v, k in enumerate(t.kind) if k == KIND_CORNER) + [t.Q.shape[0]]
+    for v, k in enumerate(t.kind):
+        if k == KIND_REGULAR:
+            r = 17 * t.leaf[v]
+            out.append(np.ascontiguousarray(t.R[r:r + 17].T))
+        elif k == KIND_CORNER:
+            p = t.pts[v]
+            Q = t.Q[p:starts[starts.index(p) + 1]].T  # (N, Nc - 1)
+            L = ops[t.cfg[v]].reshape(-1, 3, Q.shape[1] + 1, 16)  # (layer, code, j, i)
+            comp = [Q @ L[n, c, 1:] for n in range(min(COMPOSED_LAYERS, L.shape[0])) for c in range(3)]
+            out.append(np.concatenate([Q.reshape(-1), t.O[t.leaf[v]]] + [m.reshape(-1) for m in comp]))
+        else:
+            out.append(None)
+    return out
+
+
+def with_nets(T, groups):
+    """``T`` with the precomputed nets that fit their budgets: the regular nets (:data:`NETS_BUDGET`, or the
+    environment variable ``CCPROOF_NETS_BUDGET`` in bytes) and the layer-0 corner nets (:data:`HOT_BUDGET`,
+    ``CCPROOF_HOT_BUDGET``), both by the kernels' sums (none where they do not fit: the same bits)."""
+    n_cor = T.n_corner
+    if 0 < T.n_regular and T.n_regular * 17 * 3 * 8 <= _budget("CCPROOF_NETS_BUDGET", NETS_BUDGET):
+        T = T._replace(nets=regular_nets(T, groups))
+    if 0 < n_cor and n_cor * 3 * 17 * 3 * 8 <= _budget("CCPROOF_HOT_BUDGET", HOT_BUDGET):
+        T = T._replace(hot=layer0_nets(T, groups))
+    return kept_rings(T, groups)
+
+
+def kept_rings(T, groups):
+    """``T`` with the rings of its corner faces with at least :data:`KEEP_RING_NC` points kept
+    (:attr:`PatchTable.ring`, by :func:`corner_rings`: the kernels' sums), or ``T`` where there are none."""
+    parts, off = [], 0
+    cor_ring = None
+    for t, jobs, _ in groups:
+        if not jobs.size:
+            continue
+        root = int(T.job_root[jobs[0]])
+        for vf, kind in enumerate(t.kind):
+            g = root + vf
+            if kind != KIND_CORNER or T.op_size[T.cfg[g]] < KEEP_RING_NC:
+                continue
+            if cor_ring is None:
+                cor_ring = np.full(T.n_corner, -1, dtype=np.int64)
+            m = int(T.op_size[T.cfg[g]]) - 1
+            for lo in range(0, jobs.size, _BLOCK):
+                jb = jobs[lo:lo + _BLOCK]
+                parts.append(corner_rings(T, jb, g)[:, 1:].reshape(-1, 3))
+                cor_ring[T.job_corner[jb] + t.leaf[vf]] = off + m * np.arange(jb.size)
+                off += m * jb.size
+    if cor_ring is None:
+        return T
+    return T._replace(cor_ring=cor_ring, ring=np.concatenate(parts))
+
+
+def _budget(name, default):
+    """The byte budget in the environment variable ``name`` (a non-negative integer), else ``default``.
+
+    >>> _budget("CCPROOF_NO_SUCH_BUDGET", 7)
+    7
+    """
+    import os
+
+    v = os.environ.get(name)
+    if v is None or v == "":
+        return default
+    try:
+        b = int(v)
+    except ValueError:
+        b = -1
+    if b < 0:
+        raise MeshError(f"{name}={v!r}: a budget in bytes, a non-negative integer")
+    return b
 
 
 def _smooth_template(frame):
@@ -1107,85 +1248,106 @@ def _smooth_template(frame):
     return t
 
 
-def job_floats(groups, X, sizes, progress=None):
-    """The float data of every job from the positions ``X`` of the complex its rings index.
+def check_positions(X, rings):
+    """MeshError unless every position the ``rings`` index is finite and below 1e300 in magnitude (the
+    nets computed from their differences are then finite).
 
-    Per template group, in blocks of jobs: ``rel = X[ring] - X[ring[0]]`` (J, N, 3), then the
-    template's operators applied to it (one stacked matrix product per block); the affine rows (patch
-    origins, corner limit points) add ``X[ring[0]]`` back.
-
-    Returns
-    -------
-    nets : ndarray (n_regular, 17, 3)
-    origin : ndarray (n_corner, 3)
-    ring : ndarray (n_points, 3)
+    >>> check_positions(np.array([[0.0, 1, 2], [np.nan, 0, 0]]), np.array([0], np.int32))
+    >>> check_positions(np.array([[0.0, 1, 2], [np.nan, 0, 0]]), np.array([0, 1], np.int32))
+    Traceback (most recent call last):
+    ...
+    ccproof.errors.MeshError: control point 1 of the patch table is not finite or beyond 1e300 in magnitude
     """
-    X = np.asarray(X, dtype=np.float64)
-    n_reg, n_cor, n_pts = sizes
-    nets = np.empty((n_reg, 17, 3))
-    origin = np.empty((n_cor, 3))
-    ring = np.empty((n_pts, 3))
-    bar = _progress(progress, sum(g[1].size for g in groups), "patch data")
+    used = np.zeros(X.shape[0], dtype=bool)
+    used[rings] = True
+    bad = np.flatnonzero(used & ~(np.abs(X) <= 1e300).all(axis=1))
+    if bad.size:
+        raise MeshError(f"control point {int(bad[0])} of the patch table is not finite or beyond 1e300 in magnitude")
+
+
+def ring_products(op, X, rings):
+    """``op`` (N, r) applied to the rings (k, N) of positions ``X``, the kernels' sums: per ring
+    ``sum_j op[j] * (X[ring[j]] - X[ring[0]])`` over j = 1, 2, ... in order from 0.0. Shape (k, r, 3).
+
+    >>> X = np.array([[0.0, 0, 0], [1, 0, 0], [0, 2, 0]])
+    >>> ring_products(np.array([[9.0], [1.0], [0.5]]), X, np.array([[0, 1, 2]]))[0].tolist()
+    [[1.0, 1.0, 0.0]]
+    """
+    X0 = X[rings[:, 0]]
+    acc = np.zeros((rings.shape[0], op.shape[1], 3))
+    for j in range(1, op.shape[0]):
+        acc += op[j][None, :, None] * (X[rings[:, j]] - X0)[:, None, :]
+    return acc
+
+
+def regular_nets(T, groups):
+    """The nets of every regular patch of table ``T`` (:attr:`PatchTable.nets`), computed as the kernels
+    compute them (:func:`ring_products` of the leaf's operator, row 16 plus the ring's point 0)."""
+    nets = np.empty((T.n_regular, 17, 3))
+    X = T.points
     for t, jobs, rings in groups:
-        o_reg, o_cor, o_pts = t.offsets
-        nr, nc, npt = t.R.shape[0] // 17, t.O.shape[0], t.Q.shape[0]
-        grid = getattr(t, "smooth_grid", None)
-        for lo in range(0, jobs.size, _BLOCK):
-            R = rings[lo:lo + _BLOCK]
-            k = R.shape[0]
-            if grid is not None:  # a smooth regular quad: its grid less the grid's mean, directly
-                origin_ = X[R[:, grid]].mean(axis=1)
-                a = np.empty((k, 17, 3))
-                a[:, :16] = X[R] - origin_[:, None, :]
-                a[:, 16] = origin_
-                nets[o_reg + lo:o_reg + lo + k] = a
-                bar.update(k)
+        if not jobs.size:
+            continue
+        root = int(T.job_root[jobs[0]])
+        for vf, kind in enumerate(t.kind):
+            if kind != KIND_REGULAR:
                 continue
-            X0 = X[R[:, 0]]
-            rel = X[R] - X0[:, None, :]  # (k, N, 3); the operators applied job by job (stacked products
-            # write the (job, row, xyz) layout of the table directly: no transposed copies)
-            if nr:
-                a = np.matmul(t.R, rel).reshape(k, nr, 17, 3)
-                a[:, :, 16] += X0[:, None, :]
-                nets[o_reg + nr * lo:o_reg + nr * (lo + k)] = a.reshape(-1, 17, 3)
-            if nc:
-                _ring_product(t, rel, ring[o_pts + npt * lo:o_pts + npt * (lo + k)].reshape(k, npt, 3))
-                b = np.matmul(t.O, rel)
-                b += X0[:, None, :]
-                origin[o_cor + nc * lo:o_cor + nc * (lo + k)] = b.reshape(-1, 3)
-            bar.update(k)
-    bar.close()
-    for name, a in (("nets", nets), ("origin", origin), ("ring", ring)):
-        if not np.isfinite(a).all():
-            raise MeshError(f"non-finite {name} in the patch table: a control point beyond about 1e150 in magnitude "
-                            "(the differences overflow; scale the mesh) or a non-finite one")
-    return nets, origin, ring
+            g = root + vf
+            st, N = int(T.vop_start[g]), int(T.vn[g])
+            for lo in range(0, jobs.size, _BLOCK):
+                R = rings[lo:lo + _BLOCK]
+                a = ring_products(T.vop[st:st + 17 * N].reshape(N, 17), X, R)
+                a[:, 16] += X[R[:, 0]]
+                nets[T.job_net[jobs[lo:lo + _BLOCK]] + t.leaf[vf]] = a
+    return nets
 
 
-def _ring_product(t, rel, out):
-    """``out[j] = t.Q @ rel[j]``, linear in n per job where ``Q`` is large and sparse but for one row
-    subtracted from all (the ring of the centre of an n-gon relative to the centre: about 12 entries a
-    row plus the centre's row): ``Q = S + 1 m`` with ``m`` the column medians, ``S`` sparse."""
-    parts = getattr(t, "_ring_parts", False)
-    if parts is False:
-        parts = t._ring_parts = _sparse_parts(t.Q)
+def composed_nets(T, jobs, vf, lay, code):
+    """The nets (k, 17, 3) of patch ``code`` of layer ``lay`` < :data:`COMPOSED_LAYERS` of the corner face
+    ``vf`` of ``jobs`` (k,): :func:`ring_products` of the composed operator, row 16 the limit point."""
+    N, st, Nc = int(T.vn[vf]), int(T.vop_start[vf]), int(T.op_size[T.cfg[vf]])
+    st += N * (Nc - 1) + N + (3 * lay + code) * N * 16
+    R = T.rings[T.job_ring[jobs][:, None] + np.arange(N)]
+    out = np.empty((R.shape[0], 17, 3))
+    out[:, :16] = ring_products(T.vop[st:st + N * 16].reshape(N, 16), T.points, R)
+    out[:, 16] = corner_limits(T, jobs, vf)
+    return out
+
+
+def corner_limits(T, jobs, vf):
+    """The limit points (k, 3) at the irregular corner of the corner face ``vf`` of ``jobs`` (k,), computed
+    as the kernels compute them (:func:`ring_products` of its operator row, plus the ring's point 0)."""
+    N, st, Nc = int(T.vn[vf]), int(T.vop_start[vf]), int(T.op_size[T.cfg[vf]])
+    st += N * (Nc - 1)
+    R = T.rings[T.job_ring[jobs][:, None] + np.arange(N)]
+    return ring_products(T.vop[st:st + N].reshape(N, 1), T.points, R)[:, 0] + T.points[R[:, 0]]
+
+
+def corner_rings(T, jobs, vf):
+    """The rings (k, Nc, 3) relative to their corner vertex (row 0 zero) of the corner face ``vf`` (a
+    virtual face of the table ``T``) of ``jobs`` (k,), computed as the kernels compute them."""
+    N, st, Nc = int(T.vn[vf]), int(T.vop_start[vf]), int(T.op_size[T.cfg[vf]])
+    R = T.rings[T.job_ring[jobs][:, None] + np.arange(N)]
+    out = np.zeros((R.shape[0], Nc, 3))
+    op = T.vop[st:st + N * (Nc - 1)].reshape(N, Nc - 1)
+    parts = _sparse_parts(op) if N >= 256 and Nc >= 256 else None
     if parts is None:
-        np.matmul(t.Q, rel, out=out)
-        return
-    S, m = parts
-    k, N, _ = rel.shape
-    out[:] = (S @ rel.transpose(1, 0, 2).reshape(N, 3 * k)).reshape(-1, k, 3).transpose(1, 0, 2)
-    out += np.matmul(m, rel)[:, None, :]
+        out[:, 1:] = ring_products(op, T.points, R)
+    else:  # an n-gon centre's ring: linear in n, the same sums but in another order (rounding ~1e-16)
+        S, m = parts
+        D = T.points[R] - T.points[R[:, :1]]  # (k, N, 3)
+        for c in range(3):
+            out[:, 1:, c] = (S.T @ D[:, :, c].T).T + (D[:, :, c] @ m)[:, None]
+    return out
 
 
-def _sparse_parts(Q):
-    """``(S, m)`` with ``Q = S + 1 m``, ``S`` a sparse matrix of at most 10 % entries, or None."""
-    if Q.shape[0] < 256 or Q.shape[1] < 256:
-        return None
+def _sparse_parts(op):
+    """``(S, m)`` with ``op = S + m 1^T`` (``m`` the row medians: the part every output shares, as the centre
+    of an n-gon's ring is in every point relative to the corner), ``S`` sparse (at most 10 % entries), or None."""
     import scipy.sparse
 
-    m = np.median(Q, axis=0)
-    S = Q - m
+    m = np.median(op, axis=1)
+    S = op - m[:, None]
     if np.count_nonzero(S) > 0.1 * S.size:
         return None
     return scipy.sparse.csr_matrix(S), m
@@ -1290,27 +1452,19 @@ def _step_vertex_points(X, corners, fp, valence, bnd_h, nb_out):
 
 def layer0_nets(T, groups):
     """The nets of layer 0 of every corner face of table ``T`` (see :attr:`PatchTable.hot`): per
-    corner face c and patch code, ``sum_j L[0, code, j] ring[j]`` summed over j = 1, 2, ... in order
-    (the compiled kernel's sums), row 16 the limit point. Shape (3 n_corner, 17, 3)."""
-    hot = np.empty((3 * T.origin.shape[0], 17, 3))
+    corner face c and patch code the composed operator's sums (:func:`composed_nets`, the compiled
+    kernel's), row 16 the limit point. Shape (3 n_corner, 17, 3)."""
+    hot = np.empty((3 * T.n_corner, 17, 3))
     for t, jobs, _ in groups:
         if jobs is None or not jobs.size or not t.O.shape[0]:
             continue
-        o_reg, o_cor, o_pts = t.offsets
-        nc, npt = t.O.shape[0], t.Q.shape[0]
-        k = jobs.size
+        root = int(T.job_root[jobs[0]])
         for vf, kind in enumerate(t.kind):
             if kind != KIND_CORNER:
                 continue
-            cfg = t.cfg[vf]
-            Nc, st = int(T.op_size[cfg]), int(T.op_start[cfg])
-            ci = o_cor + nc * np.arange(k) + t.leaf[vf]
-            q0 = o_pts + npt * np.arange(k) + t.pts[vf] - 1
-            L0 = T.ops[st:st + 48 * Nc].reshape(3, Nc, 16)
-            for code in range(3):
-                acc = np.zeros((k, 16, 3))
-                for j in range(1, Nc):
-                    acc += L0[code, j][None, :, None] * T.ring[q0 + j][:, None, :]
-                hot[3 * ci + code, :16] = acc
-                hot[3 * ci + code, 16] = T.origin[ci]
+            for lo in range(0, jobs.size, _BLOCK):
+                jb = jobs[lo:lo + _BLOCK]
+                ci = T.job_corner[jb] + t.leaf[vf]
+                for code in range(3):
+                    hot[3 * ci + code] = composed_nets(T, jb, root + vf, 0, code)
     return hot

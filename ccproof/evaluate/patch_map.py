@@ -100,14 +100,14 @@ class PatchMap:
     Attributes
     ----------
     n_patches : int
-        Stored regular patches.
+        Regular patches (their ids: ``job_net[job] + leaf``).
     max_layers : int
         The most layers of any configuration (the stride of corner patch ids).
     """
 
     def __init__(self, table):
         self.table = table
-        self.n_patches = int(table.nets.shape[0])
+        self.n_patches = int(table.n_regular)
         self.max_layers = int(table.n_layers.max()) if table.n_layers.size else 0
 
     def faces(self, f, u, v):

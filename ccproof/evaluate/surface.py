@@ -35,13 +35,18 @@ import numpy as np
 from ccproof.errors import CCProofError
 from ccproof.evaluate._parallel import in_blocks, threads_for
 from ccproof.evaluate._table import (
+    COMPOSED_LAYERS,
     KIND_CORNER,
     KIND_REGULAR,
     Builder,
     Jobs,
     catmark_step,
-    job_floats,
-    layer0_nets,
+    check_positions,
+    composed_nets,
+    corner_limits,
+    corner_rings,
+    ring_products,
+    with_nets,
 )
 from ccproof.evaluate.bspline import bspline_basis
 from ccproof.evaluate.patch_map import PatchMap
@@ -53,6 +58,10 @@ __all__ = ["natural_limit_surface", "LimitSurface", "available_backends"]
 
 #: points evaluated per chunk (bounds the temporary memory: about 1 kB per point)
 CHUNK = 1 << 15
+#: calls on at least this many points (faces not in order) evaluate them batched by face
+SORT_MIN = 1 << 12
+#: points per kernel call of the batched evaluation (bounds its temporaries: 8 bytes per point and output)
+SORT_CHUNK = 1 << 16
 
 _KEYS = {0: ("P",), 1: ("P", "Pu", "Pv"), 2: ("P", "Pu", "Pv", "Puu", "Puv", "Pvv")}
 
@@ -138,7 +147,7 @@ class LimitSurface:
     def _finish(self, b, top, refused, keep_job_base=True):
         """The patch table from a :class:`Builder` that has classified every job; ``top`` (P, 4) the
         job of each quadrant of every ptex face, ``refused`` (P,) the ptex faces evaluation refuses.
-        The jobs' rings are kept (:meth:`with_vertices` recomputes the float data from them);
+        The jobs' rings are the table's (:meth:`with_vertices` shares them);
         ``keep_job_base``: keep the base face of every job (the quad-mesh :meth:`vertex_normals`)."""
         self._table, self._groups = b.table(top, refused)
         self._schemes = [s for s, _ in b.schemes]
@@ -156,11 +165,15 @@ class LimitSurface:
 
     @property
     def table_bytes(self):
-        """Bytes held by the patch table: the kernel's arrays, the jobs' rings and the configurations'
-        operators (the mesh itself not included); :attr:`configuration_bytes` of them are per
-        configuration, the rest grows with the faces."""
-        n = sum(a.nbytes for a in self._table if isinstance(a, np.ndarray))
-        n += sum(rings.nbytes + jobs.nbytes for _, jobs, rings in self._groups if rings is not None)
+        """Bytes held by the patch table: the kernel's arrays (the jobs' rings, the positions they index
+        unless they are the mesh's vertices), the jobs of every template, the operators;
+        :attr:`configuration_bytes` of them are per configuration or template, the rest grows with the faces."""
+        T = self._table
+        n = sum(a.nbytes for a in T if isinstance(a, np.ndarray) and a is not T.points)
+        vertices = getattr(self.mesh, "vertices", None)
+        if not (isinstance(vertices, np.ndarray) and np.shares_memory(vertices, T.points)):
+            n += T.points.nbytes  # (the mesh's own vertices are not counted)
+        n += sum(jobs.nbytes for _, jobs, _ in self._groups)
         return n + self._job_base.nbytes + sum(t.R.nbytes + t.Q.nbytes + t.O.nbytes for t, _, _ in self._groups)
 
     @property
@@ -169,7 +182,7 @@ class LimitSurface:
         operators), shared by all faces of that configuration."""
         T = self._table
         n = sum(a.nbytes for a in (T.ops, T.op_start, T.op_size, T.n_layers, T.unit, T.kind, T.child, T.u0,
-                                   T.v0, T.h, T.leaf, T.pts, T.cfg, T.cu, T.cv))
+                                   T.v0, T.h, T.leaf, T.cfg, T.cu, T.cv, T.vop, T.vop_start, T.vn))
         return n + sum(t.R.nbytes + t.Q.nbytes + t.O.nbytes for t, _, _ in self._groups)
 
     @property
@@ -263,31 +276,54 @@ class LimitSurface:
         if nets:
             N = np.empty((f.size, 17, 3))
             reg = np.flatnonzero(loc.kind == KIND_REGULAR)
-            N[reg] = T.nets[loc.patch[reg]]
+            if T.nets.shape[0]:  # kept (the same sums)
+                N[reg] = T.nets[loc.patch[reg]]
+            else:
+                for w in np.unique(loc.vface[reg]).tolist():
+                    sel = reg[loc.vface[reg] == w]
+                    n_, st = int(T.vn[w]), int(T.vop_start[w])
+                    R = T.rings[T.job_ring[loc.job[sel]][:, None] + np.arange(n_)]
+                    a = ring_products(T.vop[st:st + 17 * n_].reshape(n_, 17), T.points, R)
+                    a[:, 16] += T.points[R[:, 0]]
+                    N[sel] = a
             idx = loc.corner
             if idx.size:
-                w = loc.vface[idx]
-                n, code, ci = loc.layer, loc.code, loc.corner_face
-                q0 = T.job_pts[loc.job[idx]] + T.pts[w]
-                cfg = T.cfg[w]
-                todo = np.ones(idx.size, dtype=bool)
-                if T.hot.shape[0]:  # layer 0 precomputed (the same sums)
-                    h0 = np.flatnonzero(n == 0)
-                    N[idx[h0]] = T.hot[3 * ci[h0] + code[h0]]
-                    todo[h0] = False
-                for c in np.unique(cfg[todo]).tolist():
-                    sel = np.flatnonzero((cfg == c) & todo)
-                    Nc, nl, st = int(T.op_size[c]), int(T.n_layers[c]), int(T.op_start[c])
-                    Lc = T.ops[st:st + nl * 48 * Nc].reshape(nl * 3, Nc, 16)
-                    Q = T.ring[q0[sel][:, None] + np.arange(Nc - 1)]  # rows 1.. (row 0 is 0)
-                    rows = idx[sel]
-                    Ls = Lc[3 * n[sel] + code[sel]]  # (k, Nc, 16)
-                    acc = np.zeros((sel.size, 16, 3))
-                    for j in range(1, Nc):  # summed in the compiled kernel's order: the same bits
-                        acc += Ls[:, j, :, None] * Q[:, None, j - 1, :]
-                    N[rows, :16] = acc
-                    N[rows, 16] = T.origin[ci[sel]]
+                self._corner_point_nets(loc, N)
         return loc.patch, loc.s, loc.t, loc.scale, N
+
+    def _corner_point_nets(self, loc, N):
+        """The nets of the points of ``loc`` (a :class:`~ccproof.evaluate.patch_map.Location`) in corner
+        faces into ``N``: layer 0 kept (``hot``), the first layers by their composed operators, the others
+        ``L[n, code] @ ring``, summed in the kernels' order."""
+        T = self._table
+        idx = loc.corner
+        w = loc.vface[idx]
+        n, code, ci = loc.layer, loc.code, loc.corner_face
+        todo = np.ones(idx.size, dtype=bool)
+        if T.hot.shape[0]:  # layer 0 precomputed (the same sums)
+            h0 = np.flatnonzero(n == 0)
+            N[idx[h0]] = T.hot[3 * ci[h0] + code[h0]]
+            todo[h0] = False
+        for vf in np.unique(w[todo]).tolist():
+            at = (w == vf) & todo
+            for lay in range(COMPOSED_LAYERS):  # one product with the ring
+                for code_ in range(3):
+                    sel = np.flatnonzero(at & (n == lay) & (code == code_))
+                    if sel.size:
+                        N[idx[sel]] = composed_nets(T, loc.job[idx[sel]], vf, lay, code_)
+            sel = np.flatnonzero(at & (n >= COMPOSED_LAYERS))
+            if not sel.size:
+                continue
+            c = int(T.cfg[vf])
+            Nc, nl, st = int(T.op_size[c]), int(T.n_layers[c]), int(T.op_start[c])
+            Lc = T.ops[st:st + nl * 48 * Nc].reshape(nl * 3, Nc, 16)
+            Q = corner_rings(T, loc.job[idx[sel]], vf)
+            Ls = Lc[3 * n[sel] + code[sel]]  # (k, Nc, 16)
+            acc = np.zeros((sel.size, 16, 3))
+            for j in range(1, Nc):  # summed in the compiled kernel's order: the same bits
+                acc += Ls[:, j, :, None] * Q[:, None, j, :]
+            N[idx[sel], :16] = acc
+            N[idx[sel], 16] = corner_limits(T, loc.job[idx[sel]], vf)
 
     def evaluate(self, face_ids, u, v, derivatives=1, *, parameterization="natural", chunk=CHUNK, out=None,
                  backend=None, threads=None):
@@ -365,8 +401,12 @@ class LimitSurface:
         return out
 
     def _evaluate_compiled(self, name, kernel, f, u, v, derivatives, out, threads):
-        """:meth:`evaluate` by the compiled kernel ``name`` (``"c"`` or ``"numba"``) into ``out``, in blocks."""
+        """:meth:`evaluate` by the compiled kernel ``name`` (``"c"`` or ``"numba"``) into ``out``, in blocks;
+        from :data:`SORT_MIN` points on, on a table whose nets are computed at evaluation time (a large one),
+        unless the faces are in order already, batched by face (:meth:`_evaluate_by_face`)."""
         n = f.size
+        if n >= SORT_MIN and self._table.nets.shape[0] == 0 and (f[1:] < f[:-1]).any():
+            return self._evaluate_by_face(name, kernel, f, u, v, derivatives, out, threads)
         if name == "c":
             f, u, v = (np.ascontiguousarray(a) for a in (f, u, v))
             block, back = self._c_block(kernel, f, u, v, derivatives, out)
@@ -379,6 +419,37 @@ class LimitSurface:
             raise CCProofError("internal error: the compiled kernel refused a point the checks accept")
         for k, a in back:
             out[k][...] = a
+        return out
+
+    def _evaluate_by_face(self, name, kernel, f, u, v, derivatives, out, threads):
+        """:meth:`_evaluate_compiled` on the points taken in the order of their faces (in runs of at most
+        ``n_faces / 2^15`` faces, in the caller's order within a run; the table's rows and
+        the positions the nets are computed from are read in order, and points of one patch find its net
+        in the kernel's cache), in chunks of :data:`SORT_CHUNK` points written back to ``out`` in the
+        caller's order. Every point gets the same bits as in any other order (its net is the same sums)."""
+        shift = max(0, int(self.n_faces - 1).bit_length() - 16)  # (runs of 2^shift faces: a radix sort)
+        order = np.argsort((f >> shift).astype(np.uint16), kind="stable")
+        keys = _KEYS[derivatives]
+
+        def block(lo, hi):
+            for a in range(lo, hi, SORT_CHUNK):
+                sel = order[a:min(hi, a + SORT_CHUNK)]
+                fb, ub, vb = f[sel], u[sel], v[sel]
+                tmp = {k: np.empty((sel.size, 3)) for k in keys}
+                if name == "c":
+                    bad = self._c_block(kernel, fb, ub, vb, derivatives, tmp)[0](0, sel.size)
+                else:
+                    bad = self._numba_block(kernel, fb, ub, vb, derivatives, tmp)(0, sel.size)
+                if bad >= 0:
+                    return bad
+                for k in keys:
+                    out[k][sel] = tmp[k]
+            return -1
+
+        bad = in_blocks(block, f.size, threads_for(threads, f.size), 32768, per_thread=4)
+        if max(bad) >= 0:
+            self._check_values(f, u, v)  # raises, naming the first bad point
+            raise CCProofError("internal error: the compiled kernel refused a point the checks accept")
         return out
 
     def _c_block(self, kernel, f, u, v, derivatives, out):
@@ -528,9 +599,7 @@ class LimitSurface:
         """``(CornerScheme, C - C[0])`` of the corner face ``vf`` of ``job``: its configuration's
         scheme and its ring (Nc, 3) relative to the corner vertex."""
         T = self._table
-        cfg = int(T.cfg[vf])
-        q = int(T.job_pts[job] + T.pts[vf])
-        return self._schemes[cfg], np.vstack([np.zeros((1, 3)), T.ring[q:q + int(T.op_size[cfg]) - 1]])
+        return self._schemes[int(T.cfg[vf])], corner_rings(T, np.array([job]), vf)[0]
 
     def _eigen_normal(self, job, vf):
         """Unit normal at the irregular corner of corner face ``vf`` of ``job`` from the exact tangent masks."""
@@ -688,11 +757,11 @@ class LimitSurface:
         """The limit surface of the same mesh with the control points ``X`` (n_vertices, 3).
 
         Everything that depends only on the connectivity (classification, templates, configurations,
-        the jobs' rings) is shared with ``self``; only the float data of the jobs (regular nets,
-        corner rings and limit points: the templates' linear operators applied to the rings) are
-        recomputed. The result evaluates like a fresh build on the mesh with the new control points
-        (the same operations on the same data; on PolyMesh surfaces tested bit for bit), at a fraction
-        of its cost (for the moving surfaces of ccproof.apps.dynamics).
+        the jobs' rings) is shared with ``self``; only the positions the rings index, the limit points of
+        the corner faces and, on small tables, the precomputed nets are new. The result evaluates like a
+        fresh build on the mesh with the new control points (the same operations on the same data; on
+        PolyMesh surfaces tested bit for bit), at a fraction of its cost (for the moving surfaces of
+        ccproof.apps.dynamics).
 
         A :class:`~ccproof.mesh.polymesh.PolyMesh` surface (tags, n-gons, holes, non-manifold): ``X``
         are the PolyMesh's own vertices. The rings index the vertices the builder classified: those
@@ -737,11 +806,11 @@ class LimitSurface:
         new.mesh = mesh
         new.parameterizations = dict(self.parameterizations)
         T = self._table
-        nets, origin, ring = job_floats(self._groups, V, (T.nets.shape[0], T.origin.shape[0],
-                                                                      T.ring.shape[0]), progress=False)
-        new._table = T._replace(nets=nets, origin=origin, ring=ring)
-        if T.hot.shape[0]:
-            new._table = new._table._replace(hot=layer0_nets(new._table, self._groups))
+        V = np.ascontiguousarray(V, dtype=np.float64)
+        check_positions(V, T.rings)
+        new._table = with_nets(T._replace(points=V, nets=T.nets[:0], hot=T.hot[:0], cor_ring=T.cor_ring[:0],
+                                          ring=T.ring[:0]), self._groups)
+        new._ctable = None
         new._corner_normal = {}
         return new
 

@@ -54,6 +54,7 @@ def test_bytes_per_ptex_face_flat_under_refinement_and_depth(refdir, monkeypatch
     from ccproof.evaluate import _table
 
     monkeypatch.setattr(_table, "HOT_BUDGET", 0)  # no precomputed layer 0 (it is kept on small meshes only)
+    monkeypatch.setattr(_table, "NETS_BUDGET", 0)  # nor regular nets
     mesh = read_obj_tagged(refdir / "osd_features" / "meshes" / "catmark_smoothtris1.obj")
     per_face = []
     m = mesh
@@ -64,7 +65,9 @@ def test_bytes_per_ptex_face_flat_under_refinement_and_depth(refdir, monkeypatch
         per_face.append((cur - S.configuration_bytes) / m.n_ptex)
     print("bytes per ptex face after 1, 2, 3 refinements:", [round(b) for b in per_face])
     assert max(per_face) <= 5 * min(per_face), per_face
-    assert max(per_face) < 4096, per_face  # a stored layer table alone is ~90 layers x 1.2 kB
+    # the rings' indices and the offsets, and the rings of the few corners of valence >= 16: no float net is
+    # kept per face (a stored layer table alone would be ~90 layers x 1.2 kB; stored nets and rings: 1.9 kB)
+    assert max(per_face) < 600, per_face
     # deep points at every ptex corner: the retained memory does not change
     P = m.n_ptex
     f = np.repeat(np.arange(P), 4)
@@ -85,15 +88,18 @@ def test_bytes_per_ptex_face_flat_under_refinement_and_depth(refdir, monkeypatch
 
 
 def test_precomputed_layer_zero_gives_the_same_bits(refdir, monkeypatch):
-    """The layer-0 nets kept precomputed on small meshes are the sums the kernels compute otherwise:
-    the same numbers, bit for bit, on every backend (points in every layer of every corner)."""
+    """The layer-0 nets and the regular nets kept precomputed on small meshes are the sums the kernels
+    compute otherwise from the rings: the same numbers, bit for bit, on every backend (points in every
+    layer of every corner)."""
     from ccproof.evaluate import _table
 
     mesh = read_obj_tagged(refdir / "osd_features" / "meshes" / "catmark_smoothtris1.obj")
     hot = LimitSurface(mesh, progress=False)
     monkeypatch.setattr(_table, "HOT_BUDGET", 0)
+    monkeypatch.setattr(_table, "NETS_BUDGET", 0)
     cold = LimitSurface(mesh, progress=False)
-    assert hot._table.hot.shape[0] == 3 * hot._table.origin.shape[0] > 0 and cold._table.hot.shape[0] == 0
+    assert hot._table.hot.shape[0] == 3 * hot._table.n_corner > 0 and cold._table.hot.shape[0] == 0
+    assert hot._table.nets.shape[0] == hot._table.n_regular > 0 and cold._table.nets.shape[0] == 0
     rng = np.random.default_rng(5)
     n = 20000
     f = rng.integers(0, mesh.n_ptex, n)
@@ -291,3 +297,33 @@ def test_vectorized_step_equals_the_tagged_rules(refdir, name):
     boundary_corner = catmark_step(tagged_opts)
     if boundary_corner is not None:  # no one-face boundary vertex: the same step
         assert np.array_equal(boundary_corner[1], F1)
+
+
+def test_kept_rings_of_large_corners_give_the_same_bits(monkeypatch):
+    """The rings kept per corner face where they are large (the centre of a 60-gon: Nc - 1 = 127 points) are
+    the sums the kernels compute otherwise from the job's ring: deep points there, the same bits on every
+    backend with the rings kept and with none kept; a vertex of valence <= 15 keeps none."""
+    from ccproof.evaluate import _table
+
+    n = 60
+    t = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    V = np.stack([np.cos(t), np.sin(t), 0.1 * np.sin(3 * t)], 1)
+    F = [list(range(n))] + [[(i + 1) % n, n + (i + 1) % n, n + i, i] for i in range(n)]
+    mesh = PolyMesh(np.vstack([V, 2 * V]), F)
+    kept = LimitSurface(mesh, progress=False)
+    assert kept._table.ring.shape == (n * (2 * n + 7), 3) and (kept._table.cor_ring >= 0).sum() == n
+    monkeypatch.setattr(_table, "KEEP_RING_NC", 10**9)
+    none = LimitSurface(mesh, progress=False)
+    assert none._table.ring.shape[0] == 0 and none._table.cor_ring.shape[0] == 0
+    rng = np.random.default_rng(0)
+    k = 4000
+    f = rng.integers(0, n, k)  # the n-gon's ptex faces: their corner (1, 1) is its centre
+    u = np.ldexp(rng.random(k), -rng.integers(0, 20, k))
+    v = rng.random(k) * u
+    ref = none.evaluate(f, 1 - u, 1 - v, 2, backend="numpy")
+    for backend in available_backends():
+        for S in (kept, none):
+            r = S.evaluate(f, 1 - u, 1 - v, 2, backend=backend)
+            for key in r:
+                assert np.array_equal(r[key], ref[key]), (backend, key)
+    assert LimitSurface(k_regular_disk(15, 2), progress=False)._table.ring.shape[0] == 0
