@@ -34,7 +34,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _bench import load, ratio_line  # noqa: E402
 
 from ccproof.evaluate import limit_surface  # noqa: E402
-from ccproof.evaluate.closest import ClosestPointFinder, morton_order  # noqa: E402
+from ccproof.evaluate.closest import ClosestPointFinder  # noqa: E402
+from ccproof.evaluate.closest_cells import morton_order  # noqa: E402
 from ccproof.evaluate.closest_certified import certify_closest  # noqa: E402
 from ccproof.evaluate.newton import newton_descent  # noqa: E402
 from ccproof.mesh.examples import torus  # noqa: E402

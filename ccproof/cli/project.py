@@ -136,7 +136,7 @@ def run(args):
         from tqdm import tqdm
 
         starts = tqdm(starts, desc="project", unit="batch")
-    from ccproof.evaluate.closest import morton_order
+    from ccproof.evaluate.closest_cells import morton_order
 
     order = morton_order(X)  # nearby points in the same batch: the finder refines fewer faces
     parts = [finder.query(X[order[a:a + BATCH]]) for a in starts] or [finder.query(X)]  # (no points: empty arrays)

@@ -23,10 +23,10 @@ Method (global search, then local refinement):
    offset. These bounds are sampled estimates (the rigorous counterpart, from convex hulls of control
    nets in interval arithmetic, is :mod:`ccproof.evaluate.closest_certified`).
    **One bound per face.** The structure keeps, per face, a cylinder holding all its cells' cylinders
-   (:func:`enclosing_cylinders`: its lower bound never exceeds theirs), a bounding-volume hierarchy over
-   them (:mod:`ccproof.evaluate._bvh`) and a k-d tree of face centres: about ``FACE_BYTES`` per face. The
-   samples are dropped after the build; a face's cells are computed again (the same bits) when a query
-   reaches it, and cached (``CACHE_CELLS`` at most). :func:`search_memory` estimates the peak.
+   (:func:`~ccproof.evaluate.closest_cells.enclosing_cylinders`: its lower bound never exceeds theirs), a
+   bounding-volume hierarchy over them (:mod:`ccproof.evaluate._bvh`) and a k-d tree of face centres: about
+   ``FACE_BYTES`` per face. The samples are dropped after the build; a face's cells are computed again (the
+   same bits) when a query reaches it, and cached (``CACHE_CELLS`` at most). :func:`search_memory` estimates the peak.
 2. **First descent.** From the cell centre nearest to X in the face of the nearest face centre; the
    projected Newton iteration below gives an upper bound ``d*`` of the distance.
 3. **Pruning.** The faces whose bound is below ``d*``, then their cells whose bound is below ``d*``, are
@@ -39,16 +39,8 @@ Method (global search, then local refinement):
    nearest to the end point (the faces whose bound is near the end point are sampled), so minima
    next to face edges and corners are reached from both sides without any adjacency information.
    The answer is the best of all descents.
-4. **Projected Newton** (:mod:`ccproof.evaluate.newton`) on ``E(u, v) = |P(u, v) - X|^2 / 2`` in ``[0, 1]^2``: gradient
-   ``(<P_u, R>, <P_v, R>)``, Hessian ``J^T J + <P_ww, R>`` (``R = P - X``); variables at a bound with
-   the gradient pushing outwards are frozen (minima on face edges and corners, boundaries); an
-   indefinite Hessian is replaced by ``J^T J`` plus a Levenberg term; every step is backtracked
-   (Armijo) so ``E`` never increases, and the iteration stops after ``MAX_ITER`` steps at the latest.
-   Near an extraordinary vertex the natural parameterization is singular at the corner (derivatives
-   tend to 0 for valence 3 and to infinity for valence >= 5); there the clipping at the face's
-   corner and the backtracking still give a monotone descent, and the evaluator's self-similar
-   layers keep the derivatives exact down to ``2^-60`` of the corner, so Newton converges (linearly
-   in the last layers at worst) to the corner or to the nearby minimum.
+4. **Projected Newton** (:func:`ccproof.evaluate.newton.newton_descent`) on ``E(u, v) = |P(u, v) - X|^2 / 2``
+   in ``[0, 1]^2``, backtracked so that ``E`` never increases, also next to extraordinary vertices.
 
 The normal is ``P_u x P_v / |P_u x P_v|`` at the answer (at a face corner that is an
 extraordinary vertex this is the normal of the innermost stored layer, which converges to the
@@ -64,6 +56,7 @@ import numpy as np
 
 from ccproof.errors import CCProofError
 from ccproof.evaluate import _bvh
+from ccproof.evaluate.closest_cells import CellCache, enclosing_cylinders, morton_order
 from ccproof.evaluate.newton import newton_descent, row_dot, unit_normal
 
 __all__ = ["ClosestPoints", "ClosestPointFinder", "closest_points", "parameter_faces", "search_memory"]
@@ -98,25 +91,10 @@ FACE_SLACK = 1e-10
 def parameter_faces(surface):
     """Number of parameter faces (ptex faces) of ``surface``: face ids are ``0 .. parameter_faces - 1``.
 
-    Parameters
-    ----------
-    surface : LimitSurface
-        Anything with ``n_ptex_faces`` / ``n_param_faces``, or a ``mesh`` with ``n_ptex_faces``,
-        ``n_ptex`` or ``n_faces``.
+    ``surface``: anything with ``n_ptex_faces`` / ``n_param_faces``, or a ``mesh`` with ``n_ptex_faces``,
+    ``n_ptex`` or ``n_faces`` (a quad one parameter face, an n-gon n: OpenSubdiv's ptex convention,
+    docs/evaluate.md "Conventions"); :class:`CCProofError` if it says none of these.
 
-    Returns
-    -------
-    int
-        A quad mesh has one parameter face per face; a polygon of n != 4 sides has n (OpenSubdiv's
-        ptex convention, docs/evaluate.md "Conventions").
-
-    Raises
-    ------
-    CCProofError
-        If ``surface`` says none of these.
-
-    Examples
-    --------
     >>> from ccproof.evaluate import limit_surface
     >>> from ccproof.mesh.examples import cube
     >>> parameter_faces(limit_surface(cube()))
@@ -261,7 +239,8 @@ class ClosestPointFinder:
         U, V = np.meshgrid(t, t, indexing="ij")  # [i along u, j along v]
         self._U, self._V = U.ravel(), V.ravel()
         self._eps = 0.0  # the face bounds enclose the cells' bounds without it; added below
-        self._cache = _CellCache(self, max(1, min(CACHE_CELLS // self._mm, self.faces.size)))
+        self._cache = CellCache(self.faces.size, self._mm, max(1, min(CACHE_CELLS // self._mm, self.faces.size)),
+                                self._refined_blocks)
         fc, fn, fr, fh, scale = self._face_bounds(progress)
         self._eps = 1e-13 * scale  # added to every cell's radius and half-height: round-off of the samples
         self._cache.r += self._eps
@@ -294,6 +273,11 @@ class ClosestPointFinder:
         """Ranges of at most ``BATCH_SAMPLES`` samples' faces covering ``0 .. n - 1``."""
         step = max(1, BATCH_SAMPLES // self._U.size)
         return [np.arange(lo, min(n, lo + step)) for lo in range(0, n, step)]
+
+    def _refined_blocks(self, pos):
+        """The faces ``pos`` in blocks with their cells: ``(block, (c, n, r, h))``."""
+        for blk in self._blocks(pos.size):
+            yield pos[blk], self._refine(pos[blk])[1]
 
     def _face_bounds(self, progress):
         """One cylinder per face enclosing its cells' cylinders (samples computed in blocks and dropped; a
@@ -533,110 +517,6 @@ class ClosestPointFinder:
         c = self.cover
         near = ((ci == si) & (cj == sj)) | ((np.abs(ci - ei) <= c) & (np.abs(cj - ej) <= c))
         return same & near
-
-
-def enclosing_cylinders(centre, c, n, r, h, mm):
-    """Per face, a cylinder around ``centre`` (k, 3) holding the cylinders (c, n, r, h) of its ``mm`` cells.
-
-    The axis ``a`` is the mean of the cells' axes ``n`` (``(0, 0, 1)`` where it vanishes). A cell's cylinder
-    reaches ``h |<n, a>| + r sin`` along ``a`` and ``r + h sin`` across it (``sin`` the sine of the angle
-    between n and a), so the face's half-height and radius are the largest of ``|z| + h |<n, a>| + r sin``
-    and ``rho + r + h sin`` (z, rho: axial and lateral offsets of the cell centres). Bounds that are not
-    finite become infinite (the face is then always a candidate).
-
-    >>> c = np.array([[1.0, 0, 0], [-1.0, 0, 0]]); n = np.array([[0, 0, 1.0], [0, 0, 1.0]])
-    >>> bounds = enclosing_cylinders(np.zeros((1, 3)), c, n, np.array([0.5, 0.25]), np.array([0.1, 0.2]), 2)
-    >>> [a.tolist() for a in bounds]
-    [[[0.0, 0.0, 0.0]], [[0.0, 0.0, 1.0]], [1.5], [0.2]]
-    """
-    k = centre.shape[0]
-    C, N, r, h = c.reshape(k, mm, 3), n.reshape(k, mm, 3), r.reshape(k, mm), h.reshape(k, mm)
-    axis = N.sum(axis=1)
-    nn = np.linalg.norm(axis, axis=1, keepdims=True)
-    good = np.isfinite(nn) & (nn > 0)
-    axis = np.where(good, axis / np.where(good, nn, 1.0), np.array([0.0, 0.0, 1.0]))
-    W = C - centre[:, None, :]
-    z = np.einsum("kmc,kc->km", W, axis)
-    rho = np.sqrt(np.maximum(np.einsum("kmc,kmc->km", W, W) - z * z, 0.0))
-    cos = np.minimum(np.abs(np.einsum("kmc,kc->km", N, axis)), 1.0)
-    sin = np.sqrt(np.maximum(1.0 - cos * cos, 0.0))
-    with np.errstate(invalid="ignore"):
-        fr = (rho + r + h * sin).max(axis=1)
-        fh = (np.abs(z) + h * cos + r * sin).max(axis=1)
-    bad = ~(np.isfinite(fr) & np.isfinite(fh))
-    return centre, axis, np.where(bad, np.inf, fr), np.where(bad, np.inf, fh)
-
-
-def morton_order(X, bits=10):
-    """Order of the points ``X`` (n, 3) along a Z-order (Morton) curve of their bounding box (``bits`` per axis).
-
-    >>> morton_order(np.array([[1.0, 1, 1], [0, 0, 0], [1, 0, 0], [0, 0.1, 0]])).tolist()
-    [1, 3, 2, 0]
-    """
-    if X.shape[0] == 0:
-        return np.zeros(0, dtype=np.int64)
-    lo, ext = X.min(axis=0), np.ptp(X, axis=0)
-    q = ((X - lo) / np.where(ext > 0, ext, 1.0) * ((1 << bits) - 1)).astype(np.int64)
-    code = np.zeros(X.shape[0], dtype=np.int64)
-    for b in range(bits):
-        for a in range(3):
-            code |= ((q[:, a] >> b) & 1) << (3 * b + a)
-    return np.argsort(code, kind="stable")
-
-
-def _grown(a, n):
-    """``a`` in a new array of ``n`` rows (its rows first; np.resize would keep a larger base alive)."""
-    out = np.empty((n,) + a.shape[1:], dtype=a.dtype)
-    out[: a.shape[0]] = a
-    return out
-
-
-class _CellCache:
-    """Cell cylinders of recently refined faces, ``capacity`` faces at most (emptied when full; the arrays
-    grow as faces are added)."""
-
-    def __init__(self, finder, capacity):
-        self.finder, self.capacity = finder, capacity
-        self.slot = np.full(finder.faces.size, -1, dtype=np.int32)
-        self.pos = np.empty(0, dtype=np.int64)
-        self.c, self.n, self.r, self.h = np.empty((0, 3)), np.empty((0, 3)), np.empty(0), np.empty(0)
-        self.size = 0
-
-    def nbytes(self):
-        return sum(a.nbytes for a in (self.slot, self.pos, self.c, self.n, self.r, self.h))
-
-    def cells(self):
-        return self.c, self.n, self.r, self.h
-
-    def _reserve(self, faces):
-        """Room for ``faces`` faces (at most ``capacity``; doubling)."""
-        if faces <= self.pos.size:
-            return
-        cap = min(self.capacity, max(faces, 2 * self.pos.size))
-        rows = cap * self.finder._mm
-        self.pos, self.c, self.n, self.r, self.h = (_grown(a, n) for a, n in zip(
-            (self.pos, self.c, self.n, self.r, self.h), (cap, rows, rows, rows, rows)))
-
-    def ensure(self, pos):
-        """Slots of the faces at ``pos`` (at most ``capacity`` distinct), refining those not cached."""
-        new = np.unique(pos[self.slot[pos] < 0])
-        if self.size + new.size > self.capacity:
-            self.slot[self.pos[: self.size]] = -1
-            self.size = 0
-            new = np.unique(pos)
-        for blk in self.finder._blocks(new.size):
-            self.store(new[blk], *self.finder._refine(new[blk])[1])
-        return self.slot[pos].astype(np.int64)
-
-    def store(self, pos, c, n, r, h):
-        """Add the cells (c, n, r, h) of the faces at ``pos`` (not cached, room left)."""
-        mm = self.finder._mm
-        self._reserve(self.size + pos.size)
-        a, b = self.size * mm, (self.size + pos.size) * mm
-        self.c[a:b], self.n[a:b], self.r[a:b], self.h[a:b] = c, n, r, h
-        self.pos[self.size: self.size + pos.size] = pos
-        self.slot[pos] = np.arange(self.size, self.size + pos.size)
-        self.size += pos.size
 
 
 #: largest coordinate magnitude of a query point: the squared distances of the search must stay finite

@@ -6,6 +6,12 @@ with the gradient pushing outwards are frozen; an indefinite Hessian is replaced
 Levenberg term; every step is backtracked (Armijo) so ``E`` never increases; at most :data:`MAX_ITER`
 steps of at most :data:`MAX_HALVINGS` halvings. On the evaluator's own surfaces the descent runs
 compiled with the same formulas in the same order (bit-identical, tests/evaluate/test_newton_compiled.py).
+
+Near an extraordinary vertex the natural parameterization is singular at the corner (derivatives tend to 0
+for valence 3 and to infinity for valence >= 5); there the clipping at the face's corner and the backtracking
+still give a monotone descent, and the evaluator's self-similar layers keep the derivatives exact down to
+``2^-60`` of the corner, so the descent converges (linearly in the last layers at worst) to the corner or to
+the nearby minimum.
 """
 
 from __future__ import annotations
