@@ -33,7 +33,15 @@ says when more than --stray-fraction of the surface strays (a torus' hole spanne
 concavity spanned) or a level stopped at --max-steps.
 --errors FILE.csv writes x, y, z, distance and distance in % for every data point.
 
-Limits: input files (POINTS, --init) at most --max-input GB (default 2; regular files or a pipe);
+Limits: every time step re-projects every data point onto the limit surface (global closest points), so the time
+grows with points x steps: on the bunny's limit surface (scripts/fit_dense.py) 10^4 points take minutes (about
+400 + 80 steps at --levels 1), 10^5 points about 7 s per step of the first level on a loaded 2-core machine (an
+hour or more): give a random subset of about 10^4 points of a dense cloud for minutes (measured on 10^4 uniform
+points: the figures below). The surface -> data springs are what keep a dense fit from spanning a concavity
+(from 6.9 % of the area more than 2 % of the diameter off the true surface with --surface-spring 0 to 0.05 % at
+the default, 10^4 points); the stray warning's figures are distances to the data, which on a dense cloud are
+within about one spacing of the distances to the true surface.
+Input files (POINTS, --init) at most --max-input GB (default 2; regular files or a pipe);
 --sample-level at most 6. Outputs (--out, --surface-out or its derived name, --errors) are checked before
 any work: distinct from each other and from the inputs (other spellings and links included), writable,
 within the file system's name limits; they are renamed into place together when all are written, so a

@@ -479,6 +479,27 @@ def _report_surface(result, pts, sample_level, stray_distance_percent, stray_fra
         result.warnings.append(
             f"the fitted surface strays from the data: {100 * rep['stray_fraction']:.1f} % of its area is farther "
             f"than {result.stray_distance_percent:.2f} % of the diameter from every data point, "
-            f"up to {result.surface_max_percent:.2f} %; the data may not cover the surface (an unseen side), the "
-            f"start mesh's topology may not match the data's (e.g. a genus-0 start for a torus: give --init), or "
-            f"the surface spans a concavity of the data (raise --surface-spring or --levels)")
+            f"up to {result.surface_max_percent:.2f} %{_where_stray(result)}; the surface spans a concavity of the "
+            f"data (a web; raise --surface-spring or --levels), the data may not cover the surface (an unseen "
+            f"side), or the start mesh's topology may not match the data's (e.g. a genus-0 start for a torus: "
+            f"give --init)")
+
+
+def _where_stray(result, most=12):
+    """Where the stray part of ``result.surface`` lies: the fitted control faces whose sampled faces have stray corners
+    (the ``most`` with the most of them, in that order), and the centroid of the stray samples (data units); '' for
+    a tagged mesh (its sampled faces leave the holes out, so they are not numbered by their control face)."""
+    rep, surface, mesh = result.surface_report, result.surface, result.mesh
+    stray = rep["distances"] > result.stray_distance
+    if isinstance(mesh, TaggedQuadMesh) or surface.n_faces != mesh.n_faces * 4**result.sample_level:
+        return ""
+    # child 4 f + i of face f at every subdivision: sampled face q lies in control face q // 4^level; the faces
+    # with the most stray sample corners first
+    weight = np.bincount(np.arange(surface.n_faces) // 4**result.sample_level,
+                         weights=stray[surface.faces].sum(axis=1), minlength=mesh.n_faces)
+    faces = np.flatnonzero(weight > 0)
+    faces = faces[np.argsort(-weight[faces], kind="stable")]
+    c = np.asarray(surface.vertices)[stray].mean(axis=0)
+    listed = ", ".join(str(f) for f in faces[:most]) + (", ..." if faces.size > most else "")
+    return (f", on {faces.size} of the {mesh.n_faces} fitted control faces (most: {listed}) around "
+            f"({c[0]:.4g}, {c[1]:.4g}, {c[2]:.4g})")

@@ -1,0 +1,85 @@
+"""Dense clouds off the bunny's limit surface (scripts/fit_dense.py): the sampler draws exact limit points uniformly
+by area, and the fit is judged against the TRUE surface, both ways.
+
+The sampler is checked independently: its points lie on the limit surface (global closest points of
+:mod:`ccproof.evaluate.closest`, distance 0) and the share of the points per group of faces matches the share of
+the area of those faces, measured on the exact limit points of the mesh subdivided three times (two triangles
+per quad), not on the sampler's own densities.
+"""
+
+import importlib.util
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+SCRIPT = Path(__file__).resolve().parents[3] / "scripts" / "fit_dense.py"
+
+
+@pytest.fixture(scope="module")
+def fit_dense():
+    spec = importlib.util.spec_from_file_location("fit_dense", SCRIPT)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+@pytest.fixture(scope="module")
+def bunny(fit_dense):
+    return fit_dense.true_surface()  # (control mesh, limit surface, closest-point search on it)
+
+
+def _face_areas_level3(mesh):
+    from ccproof.apps.dynamics.cloud import limit_surface_mesh
+
+    S = limit_surface_mesh(mesh, 3)  # child 4 f + i of face f: the 64 quads of face f are 64 f .. 64 f + 63
+    V, F = np.asarray(S.vertices), S.faces
+    a = 0.5 * (np.linalg.norm(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]), axis=1)
+               + np.linalg.norm(np.cross(V[F[:, 2]] - V[F[:, 0]], V[F[:, 3]] - V[F[:, 0]]), axis=1))
+    return a.reshape(mesh.n_faces, 64).sum(axis=1)
+
+
+def test_dense_samples_are_limit_points_spread_by_area(fit_dense, bunny):
+    mesh, S, finder = bunny
+    n = 20_000
+    X = fit_dense.sample_by_area(S, mesh.n_faces, n, seed=3)
+    r = finder.query(X)
+    assert X.shape == (n, 3) and float(r.distance.max()) < 1e-9  # on the true surface
+    area = _face_areas_level3(mesh)
+    groups = np.arange(mesh.n_faces) * 20 // mesh.n_faces  # 20 groups of about 100 faces
+    share = np.bincount(groups, weights=area) / area.sum()
+    got = np.bincount(groups[r.face], minlength=20) / n
+    # binomial standard deviation of a 5 % share over 20,000 points: 0.15 %; allow 4 of them
+    assert np.abs(got - share).max() < 0.006, (got - share).round(4).tolist()
+    # a sampler by parameter instead of area (every face the same share) is far off: the check can fail
+    assert np.abs(np.bincount(groups) / mesh.n_faces - share).max() > 0.006
+
+
+def _fit_and_judge(fit_dense, bunny, n, **kw):
+    from ccproof.apps.dynamics.fit import fit_points
+
+    mesh, S, finder = bunny
+    X = fit_dense.sample_by_area(S, mesh.n_faces, n, seed=0)
+    res = fit_points(X, levels=1, **kw)
+    return res, fit_dense.judge(res, finder)  # the fitted limit surface against the true one (closest points)
+
+
+# about 7 minutes on the loaded 2-core machine (400 + 80 steps); also: python scripts/fit_dense.py --n 10000
+@pytest.mark.slow
+def test_dense_bunny_fit_stays_on_the_true_surface_both_ways(fit_dense, bunny):
+    """10^4 exact points off the bunny: the default (two-way) fit spans no concavity: measured 0.05 % of its area
+    more than 2 % of the diameter off the true surface, max 2.58 %, data -> surface 1.35 %, no warning."""
+    res, q = _fit_and_judge(fit_dense, bunny, 10_000)
+    assert q["over2"] < 0.005 and q["max"] < 4.0 and q["rms"] < 0.3  # fitted surface -> true surface
+    assert res.max_error_percent < 2.0  # data (on the true surface) -> fitted surface
+    assert res.warnings == []
+
+
+@pytest.mark.slow  # about 7 minutes on the loaded 2-core machine
+def test_dense_bunny_one_way_fit_webs_across_the_ear_concavity(fit_dense, bunny):
+    """The paper's data springs alone (the fit before the surface -> data springs, 229 + 73 steps): a web across a
+    concavity that the data -> surface error does not show; the fit's own stray report sees it (8.0 % of the area)."""
+    res, q = _fit_and_judge(fit_dense, bunny, 10_000, surface_spring_total=0.0)
+    assert q["over2"] > 0.04 and q["max"] > 6.0  # measured 6.89 % of the area, max 9.87 %: the judge above fails
+    assert res.max_error_percent < 2.0  # measured 1.34 %: the headline error does not show it
+    assert any("spans a concavity" in w for w in res.warnings)
