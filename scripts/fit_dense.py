@@ -135,6 +135,8 @@ def main(argv=None):
     ap.add_argument("--noise", type=float, nargs="*", default=[0.0, 0.2], help="in %% of the diameter")
     ap.add_argument("--levels", type=int, nargs="*", default=[1, 2])
     ap.add_argument("--surface-spring", type=float, default=None, help="fit_points' surface_spring_total")
+    ap.add_argument("--stray-distance", type=float, default=None,
+                    help="fit_points' stray_distance_percent (%% of the diameter; default 3 data spacings)")
     ap.add_argument("--max-steps", type=int, default=None, help="fit_points' max_steps (default: its own)")
     ap.add_argument("--smoke", action="store_true", help="one tiny run (1,000 points, level 0, 5 steps)")
     ap.add_argument("--where", action="store_true", help="print the true faces nearest to the far part")
@@ -143,6 +145,8 @@ def main(argv=None):
     kw = {} if args.surface_spring is None else {"surface_spring_total": args.surface_spring}
     if args.smoke:
         args.n, args.noise, args.levels, args.max_steps = [1000], [0.0], [0], 5
+    if args.stray_distance is not None:
+        kw["stray_distance_percent"] = args.stray_distance
     if args.max_steps is not None:
         kw["max_steps"] = args.max_steps
     print("(timings on a machine shared with other jobs)")

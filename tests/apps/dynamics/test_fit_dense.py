@@ -8,6 +8,7 @@ per quad), not on the sampler's own densities.
 """
 
 import importlib.util
+import re
 from pathlib import Path
 
 import numpy as np
@@ -53,6 +54,17 @@ def test_dense_samples_are_limit_points_spread_by_area(fit_dense, bunny):
     assert np.abs(got - share).max() < 0.006, (got - share).round(4).tolist()
     # a sampler by parameter instead of area (every face the same share) is far off: the check can fail
     assert np.abs(np.bincount(groups) / mesh.n_faces - share).max() > 0.006
+
+
+def test_fit_dense_smoke_run_prints_the_true_surface_figures(fit_dense, capsys):
+    """The script's tiny run (1,000 points, 5 steps: a fit far from equilibrium, which the figures must show)."""
+    fit_dense.main(["--smoke"])
+    out = capsys.readouterr().out
+    m = re.search(r"n=\s*1000 .*>1%\s+([\d.]+) % of area, >2%\s+([\d.]+) %, max\s+([\d.]+) %", out)
+    assert m, out
+    over1, over2, worst = (float(t) for t in m.groups())
+    assert 100 >= over1 >= over2 > 1.0 and worst > 2.0  # 5 steps from the small cube: far off the bunny
+    assert "stopped at the step cap" in out
 
 
 def _fit_and_judge(fit_dense, bunny, n, **kw):
