@@ -235,7 +235,8 @@ def fit_points(X: ArrayLike, init: Literal["cube"] | QuadMesh = "cube", levels: 
                init_scale: float = 0.5, truncation: int = 6, progress: bool = False,
                callback: Callable[[int, int, DynamicSurface, NDArray[np.float64]], object] | None = None,
                sample_level: int | None = None, stray_distance_percent: float | None = None,
-               stray_fraction: float = 0.01, surface_spring_total: float = 5.0) -> FitResult:
+               stray_fraction: float = 0.01, surface_spring_total: float = 5.0,
+               spring_points: int | None = 10_000) -> FitResult:
     """Recover a closed surface from range data (module docstring).
 
     Parameters
@@ -284,6 +285,11 @@ def fit_points(X: ArrayLike, init: Literal["cube"] | QuadMesh = "cube", levels: 
         toward its nearest data point, to within the stray distance), which pull the parts of the surface
         that no data point is near (a membrane across a concavity) to the data; 0 turns them off (the
         paper's one-way data springs only). Default 5 (the data springs sum to ``spring_total``).
+    spring_points : int >= 4 or None
+        At most this many data points carry data springs (a fixed random subset, seed 0, when the cloud is
+        larger; each spring ``spring_total / count``): every step re-projects them all, so the time grows with
+        their number, while a few points per spacing of the final surface pin it as well (docs/qmv98.md, dense
+        clouds). The errors, the stray report and the surface -> data springs use every point. None: all.
 
     Returns
     -------
@@ -321,12 +327,13 @@ def fit_points(X: ArrayLike, init: Literal["cube"] | QuadMesh = "cube", levels: 
     P = np.array(mesh0.vertices)
     # a non-manifold file's split mesh: the copies of one file vertex are one free point (docs/qmv98.md)
     copies = getattr(mesh0, "file_vertex", None)
-    k = np.full(pts.shape[0], spring_total / pts.shape[0])
+    Xs = _spring_subset(Xn, spring_points)
+    k = np.full(Xs.shape[0], spring_total / Xs.shape[0])
     result = FitResult(mesh=None, model=None, center=centre, diameter=diameter,
                        parameters={"material": material, "spring_total": spring_total, "dt": dt, "scheme": scheme,
                                    "max_steps": max_steps, "tol": tol, "init_scale": init_scale,
                                    "truncation": truncation, "levels": levels,
-                                   "surface_spring_total": surface_spring_total})
+                                   "surface_spring_total": surface_spring_total, "spring_points": Xs.shape[0]})
     spacing_n = max(data_spacing(Xn), 1e-300)
     # the stray distance (normalized): the surface -> data springs pull the samples farther than it back to it
     stray_n = 3.0 * spacing_n if stray_distance_percent is None else float(stray_distance_percent) / 100.0
@@ -342,7 +349,7 @@ def fit_points(X: ArrayLike, init: Literal["cube"] | QuadMesh = "cube", levels: 
             integ = ImplicitIntegrator(model, dt, P=P, scheme=scheme, tol=1e-9, copies=copies)
             reverse = (SurfaceToDataSprings(model, Xn, surface_spring_total, slack=stray_n)
                        if surface_spring_total > 0 else None)
-            run = _relax_level(model, finder, integ, (Xn, k, reverse), level, result.parameters, spacing_n,
+            run = _relax_level(model, finder, integ, (Xs, k, reverse), level, result.parameters, spacing_n,
                                (bar, callback))
             step, converged, cg, energies, change, err_change, reason = run
             if bar is not None and step < max_steps:
@@ -371,6 +378,16 @@ def fit_points(X: ArrayLike, init: Literal["cube"] | QuadMesh = "cube", levels: 
             result.warnings.append(f"level {i} {lev.reason}")
     _report_surface(result, pts, sample_level, stray_distance_percent, stray_fraction)
     return result
+
+
+def _spring_subset(Xn, spring_points):
+    """The data points that carry data springs: all, or a fixed random subset (seed 0) of ``spring_points``."""
+    if spring_points is not None and (int(spring_points) != spring_points or spring_points < 4):
+        raise CCProofError(f"spring_points must be an integer >= 4 or None, got {spring_points!r}")
+    if spring_points is None or Xn.shape[0] <= spring_points:
+        return Xn
+    keep = np.sort(np.random.default_rng(0).choice(Xn.shape[0], size=int(spring_points), replace=False))
+    return Xn[keep]
 
 
 def _check_fit_numbers(levels, spring_total, surface_spring_total, init_scale):
