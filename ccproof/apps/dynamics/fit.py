@@ -9,7 +9,8 @@ Pipeline (:func:`fit_points`):
    or a user mesh;
 3. evolve with the massless scheme (32) (default) or (31) under data springs: every data point pulls
    its nearest limit-surface point (the global closest point, :mod:`ccproof.evaluate.closest`;
-   re-projected every step), until equilibrium: the total energy (elastic + springs) changes by less
+   re-projected every step; at most ``spring_points`` of them, a fixed random subset of a denser
+   cloud), until equilibrium: the total energy (elastic + springs) changes by less
    than ``tol`` (relative) between steps t - dt and t + dt (the paper's criterion, section 3.4; two
    steps because (32) advances two interleaved sequences) *and* so does the mean data -> surface
    distance (relative to itself, or to the data spacing of :func:`data_spacing` once it is smaller; the
