@@ -36,11 +36,12 @@ concavity spanned) or a level stopped at --max-steps.
 Limits: every time step re-projects every data point that carries a spring onto the limit surface (global
 closest points), so the time grows with those points x steps: at most --spring-points of them (default 10^4, a
 fixed random subset of a larger cloud; 0: all). On the bunny's limit surface (scripts/fit_dense.py) 10^4 points
-take minutes (about 400 + 80 steps at --levels 1, a loaded 2-core machine); all of 10^5 points about 7 s per
-step of the first level (an hour or more). The surface -> data springs are what keep a dense fit from spanning a
-concavity (10^4 points: 6.9 % of the area more than 2 % of the diameter off the true surface with --surface-
-spring 0, 0.05 % at the default); the stray warning's figures are distances to the data, within about one
-spacing of the distances to the true surface on a dense cloud, and it names the faces where the surface strays.
+take minutes (about 400 + 80 steps at --levels 1, a loaded 2-core machine); 10^5 points in about 6 minutes on
+the default subset, while with all of them pulling (--spring-points 0) a step of the first level takes about 7 s
+(an hour or more per fit). The surface -> data springs are what keep a dense fit from spanning a concavity (10^4
+points: 6.9 % of the area more than 2 % of the diameter off the true surface with --surface- spring 0, 0.05 % at
+the default); the stray warning's figures are distances to the data, within about one spacing of the distances
+to the true surface on a dense cloud, and it names the faces where the surface strays.
 Input files (POINTS, --init) at most --max-input GB (default 2; regular files or a pipe);
 --sample-level at most 6. Outputs (--out, --surface-out or its derived name, --errors) are checked before
 any work: distinct from each other and from the inputs (other spellings and links included), writable,
