@@ -76,7 +76,7 @@ def _fit_and_judge(fit_dense, bunny, n, **kw):
     return res, fit_dense.judge(res, finder)  # the fitted limit surface against the true one (closest points)
 
 
-# about 7 minutes on the loaded 2-core machine (400 + 80 steps); also: python scripts/fit_dense.py --n 10000
+# 64 s on a quiet machine, about 7 minutes under load (400 + 80 steps); also: python scripts/fit_dense.py --n 10000
 @pytest.mark.slow
 def test_dense_bunny_fit_stays_on_the_true_surface_both_ways(fit_dense, bunny):
     """10^4 exact points off the bunny: the default (two-way) fit spans no concavity: measured 0.05 % of its area
@@ -87,7 +87,7 @@ def test_dense_bunny_fit_stays_on_the_true_surface_both_ways(fit_dense, bunny):
     assert res.warnings == []
 
 
-@pytest.mark.slow  # about 7 minutes on the loaded 2-core machine
+@pytest.mark.slow  # 40 s on a quiet machine, about 3 minutes under load
 def test_dense_bunny_one_way_fit_webs_across_the_ear_concavity(fit_dense, bunny):
     """The paper's data springs alone (the fit before the surface -> data springs, 229 + 73 steps): a web across a
     concavity that the data -> surface error does not show; the fit's own stray report sees it (8.0 % of the area)."""
@@ -125,7 +125,7 @@ def test_spring_points_cap_which_points_pull_not_which_are_judged(capsys, tmp_pa
     assert "--spring-points must be 0 (all) or at least 4, got 2" in capsys.readouterr().err
 
 
-# about 6 minutes on the loaded 2-core machine (423 + 109 steps); also: python scripts/fit_dense.py --n 100000
+# 78 s on a quiet machine, about 6 minutes under load (423 + 109 steps); also: python scripts/fit_dense.py --n 100000
 @pytest.mark.slow
 def test_dense_bunny_fit_of_100k_points_on_a_spring_subset(fit_dense, bunny):
     """10^5 exact points: the data springs on the default 10^4 of them (every point re-projected at every step
