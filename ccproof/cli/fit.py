@@ -33,7 +33,16 @@ says when more than --stray-fraction of the surface strays (a torus' hole spanne
 concavity spanned) or a level stopped at --max-steps.
 --errors FILE.csv writes x, y, z, distance and distance in % for every data point.
 
-Limits: input files (POINTS, --init) at most --max-input GB (default 2; regular files or a pipe);
+Limits: every time step re-projects every data point that carries a spring onto the limit surface (global
+closest points), so the time grows with those points x steps: at most --spring-points of them (default 10^4, a
+fixed random subset of a larger cloud; 0: all). On the bunny's limit surface (scripts/fit_dense.py) 10^4 points
+take minutes (about 400 + 80 steps at --levels 1, a loaded 2-core machine); 10^5 points in about 6 minutes on
+the default subset, while with all of them pulling (--spring-points 0) a step of the first level takes about 7 s
+(an hour or more per fit). The surface -> data springs are what keep a dense fit from spanning a concavity (10^4
+points: 6.9 % of the area more than 2 % of the diameter off the true surface with --surface- spring 0, 0.05 % at
+the default); the stray warning's figures are distances to the data, within about one spacing of the distances
+to the true surface on a dense cloud, and it names the faces where the surface strays.
+Input files (POINTS, --init) at most --max-input GB (default 2; regular files or a pipe);
 --sample-level at most 6. Outputs (--out, --surface-out or its derived name, --errors) are checked before
 any work: distinct from each other and from the inputs (other spellings and links included), writable,
 within the file system's name limits; they are renamed into place together when all are written, so a
@@ -89,6 +98,9 @@ def add_arguments(p):
                         "nearest data point, from the first level's data-spring equilibrium on, so that surface no "
                         "data point is near (a membrane across a concavity) is pulled to the data; 0: data springs "
                         "only, as in the paper (default 5)")
+    p.add_argument("--spring-points", type=int, default=10_000,
+                   help="at most this many data points carry data springs (a fixed random subset of a larger cloud; "
+                        "errors, stray report and surface -> data springs use every point); 0: all (default 10000)")
     p.add_argument("--errors", default=None, metavar="FILE.csv", help="write the per-point errors here")
 
 
@@ -128,7 +140,7 @@ def run(args) -> int:
                      scheme=args.scheme, max_steps=args.max_steps, tol=args.tol, init_scale=args.init_scale,
                      truncation=args.truncation, progress=progress_enabled(args), sample_level=args.sample_level,
                      stray_distance_percent=args.stray_distance, stray_fraction=args.stray_fraction,
-                     surface_spring_total=args.surface_spring)
+                     surface_spring_total=args.surface_spring, spring_points=args.spring_points or None)
     print(f"data: {X.shape[0]} points from {args.points}; minimal enclosing sphere diameter {res.diameter:.6g}")
     print("level  vertices  faces  steps  equilibrium  max error %  mean error %  seconds")
     for i, lev in enumerate(res.levels):
@@ -186,6 +198,8 @@ def _check_options(args):
         raise CCProofError(f"--stray-fraction must be in [0, 1], got {args.stray_fraction}")
     if not (isfinite(args.surface_spring) and args.surface_spring >= 0):
         raise CCProofError(f"--surface-spring must be a finite number >= 0, got {args.surface_spring}")
+    if args.spring_points != 0 and args.spring_points < 4:
+        raise CCProofError(f"--spring-points must be 0 (all) or at least 4, got {args.spring_points}")
     if args.stray_distance is not None and not (isfinite(args.stray_distance) and args.stray_distance > 0):
         raise CCProofError(f"--stray-distance must be a finite number > 0 (% of the diameter), got "
                            f"{args.stray_distance}")

@@ -9,7 +9,8 @@ Pipeline (:func:`fit_points`):
    or a user mesh;
 3. evolve with the massless scheme (32) (default) or (31) under data springs: every data point pulls
    its nearest limit-surface point (the global closest point, :mod:`ccproof.evaluate.closest`;
-   re-projected every step), until equilibrium: the total energy (elastic + springs) changes by less
+   re-projected every step; at most ``spring_points`` of them, a fixed random subset of a denser
+   cloud), until equilibrium: the total energy (elastic + springs) changes by less
    than ``tol`` (relative) between steps t - dt and t + dt (the paper's criterion, section 3.4; two
    steps because (32) advances two interleaved sequences) *and* so does the mean data -> surface
    distance (relative to itself, or to the data spacing of :func:`data_spacing` once it is smaller; the
@@ -235,7 +236,8 @@ def fit_points(X: ArrayLike, init: Literal["cube"] | QuadMesh = "cube", levels: 
                init_scale: float = 0.5, truncation: int = 6, progress: bool = False,
                callback: Callable[[int, int, DynamicSurface, NDArray[np.float64]], object] | None = None,
                sample_level: int | None = None, stray_distance_percent: float | None = None,
-               stray_fraction: float = 0.01, surface_spring_total: float = 5.0) -> FitResult:
+               stray_fraction: float = 0.01, surface_spring_total: float = 5.0,
+               spring_points: int | None = 10_000) -> FitResult:
     """Recover a closed surface from range data (module docstring).
 
     Parameters
@@ -284,6 +286,11 @@ def fit_points(X: ArrayLike, init: Literal["cube"] | QuadMesh = "cube", levels: 
         toward its nearest data point, to within the stray distance), which pull the parts of the surface
         that no data point is near (a membrane across a concavity) to the data; 0 turns them off (the
         paper's one-way data springs only). Default 5 (the data springs sum to ``spring_total``).
+    spring_points : int >= 4 or None
+        At most this many data points carry data springs (a fixed random subset, seed 0, when the cloud is
+        larger; each spring ``spring_total / count``): every step re-projects them all, so the time grows with
+        their number, while a few points per spacing of the final surface pin it as well (docs/qmv98.md, dense
+        clouds). The errors, the stray report and the surface -> data springs use every point. None: all.
 
     Returns
     -------
@@ -321,12 +328,13 @@ def fit_points(X: ArrayLike, init: Literal["cube"] | QuadMesh = "cube", levels: 
     P = np.array(mesh0.vertices)
     # a non-manifold file's split mesh: the copies of one file vertex are one free point (docs/qmv98.md)
     copies = getattr(mesh0, "file_vertex", None)
-    k = np.full(pts.shape[0], spring_total / pts.shape[0])
+    Xs = _spring_subset(Xn, spring_points)
+    k = np.full(Xs.shape[0], spring_total / Xs.shape[0])
     result = FitResult(mesh=None, model=None, center=centre, diameter=diameter,
                        parameters={"material": material, "spring_total": spring_total, "dt": dt, "scheme": scheme,
                                    "max_steps": max_steps, "tol": tol, "init_scale": init_scale,
                                    "truncation": truncation, "levels": levels,
-                                   "surface_spring_total": surface_spring_total})
+                                   "surface_spring_total": surface_spring_total, "spring_points": Xs.shape[0]})
     spacing_n = max(data_spacing(Xn), 1e-300)
     # the stray distance (normalized): the surface -> data springs pull the samples farther than it back to it
     stray_n = 3.0 * spacing_n if stray_distance_percent is None else float(stray_distance_percent) / 100.0
@@ -342,7 +350,7 @@ def fit_points(X: ArrayLike, init: Literal["cube"] | QuadMesh = "cube", levels: 
             integ = ImplicitIntegrator(model, dt, P=P, scheme=scheme, tol=1e-9, copies=copies)
             reverse = (SurfaceToDataSprings(model, Xn, surface_spring_total, slack=stray_n)
                        if surface_spring_total > 0 else None)
-            run = _relax_level(model, finder, integ, (Xn, k, reverse), level, result.parameters, spacing_n,
+            run = _relax_level(model, finder, integ, (Xs, k, reverse), level, result.parameters, spacing_n,
                                (bar, callback))
             step, converged, cg, energies, change, err_change, reason = run
             if bar is not None and step < max_steps:
@@ -371,6 +379,16 @@ def fit_points(X: ArrayLike, init: Literal["cube"] | QuadMesh = "cube", levels: 
             result.warnings.append(f"level {i} {lev.reason}")
     _report_surface(result, pts, sample_level, stray_distance_percent, stray_fraction)
     return result
+
+
+def _spring_subset(Xn, spring_points):
+    """The data points that carry data springs: all, or a fixed random subset (seed 0) of ``spring_points``."""
+    if spring_points is not None and (int(spring_points) != spring_points or spring_points < 4):
+        raise CCProofError(f"spring_points must be an integer >= 4 or None, got {spring_points!r}")
+    if spring_points is None or Xn.shape[0] <= spring_points:
+        return Xn
+    keep = np.sort(np.random.default_rng(0).choice(Xn.shape[0], size=int(spring_points), replace=False))
+    return Xn[keep]
 
 
 def _check_fit_numbers(levels, spring_total, surface_spring_total, init_scale):
@@ -479,6 +497,27 @@ def _report_surface(result, pts, sample_level, stray_distance_percent, stray_fra
         result.warnings.append(
             f"the fitted surface strays from the data: {100 * rep['stray_fraction']:.1f} % of its area is farther "
             f"than {result.stray_distance_percent:.2f} % of the diameter from every data point, "
-            f"up to {result.surface_max_percent:.2f} %; the data may not cover the surface (an unseen side), the "
-            f"start mesh's topology may not match the data's (e.g. a genus-0 start for a torus: give --init), or "
-            f"the surface spans a concavity of the data (raise --surface-spring or --levels)")
+            f"up to {result.surface_max_percent:.2f} %{_where_stray(result)}; the surface spans a concavity of the "
+            f"data (a web; raise --surface-spring or --levels), the data may not cover the surface (an unseen "
+            f"side), or the start mesh's topology may not match the data's (e.g. a genus-0 start for a torus: "
+            f"give --init)")
+
+
+def _where_stray(result, most=12):
+    """Where the stray part of ``result.surface`` lies: the fitted control faces whose sampled faces have stray corners
+    (the ``most`` with the most of them, in that order), and the centroid of the stray samples (data units); '' for
+    a tagged mesh (its sampled faces leave the holes out, so they are not numbered by their control face)."""
+    rep, surface, mesh = result.surface_report, result.surface, result.mesh
+    stray = rep["distances"] > result.stray_distance
+    if isinstance(mesh, TaggedQuadMesh) or surface.n_faces != mesh.n_faces * 4**result.sample_level:
+        return ""
+    # child 4 f + i of face f at every subdivision: sampled face q lies in control face q // 4^level; the faces
+    # with the most stray sample corners first
+    weight = np.bincount(np.arange(surface.n_faces) // 4**result.sample_level,
+                         weights=stray[surface.faces].sum(axis=1), minlength=mesh.n_faces)
+    faces = np.flatnonzero(weight > 0)
+    faces = faces[np.argsort(-weight[faces], kind="stable")]
+    c = np.asarray(surface.vertices)[stray].mean(axis=0)
+    listed = ", ".join(str(f) for f in faces[:most]) + (", ..." if faces.size > most else "")
+    return (f", on {faces.size} of the {mesh.n_faces} fitted control faces (most: {listed}) around "
+            f"({c[0]:.4g}, {c[1]:.4g}, {c[2]:.4g})")

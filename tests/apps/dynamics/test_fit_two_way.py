@@ -6,6 +6,8 @@ revolution); the fitted limit surface is compared with a dense sampling of it, i
 reports.
 """
 
+import re
+
 import numpy as np
 import pytest
 from scipy.spatial import cKDTree
@@ -75,6 +77,17 @@ def test_one_way_fit_webs_across_the_pit_with_a_small_data_error(truth):
     assert far > 0.045 and worst > 14.0  # measured 6.37 % of the area, up to 17.9 %: a web across the pit
     assert res.surface_max_percent > 14.0 and res.surface_report["stray_fraction"] > 0.02  # and the report sees it
     assert any("strays from the data" in w for w in res.warnings)
+    # the warning says where: the control faces it names are among those whose limit surface lies more than 2 %
+    # of the diameter off the true surface (level-3 quads, child 4 f + i: quad q lies in control face q // 64)
+    warn = next(w for w in res.warnings if "strays from the data" in w)
+    where = re.search(r"on (\d+) of the (\d+) fitted control faces \(most: ([\d, .]+)\) around \(([^)]*)\)", warn)
+    assert where and "spans a concavity" in warn, warn
+    named = {int(t) for t in where.group(3).replace("...", "").split(",") if t.strip()}
+    S = limit_surface_mesh(res.mesh, 3)
+    d, _ = truth.query(np.asarray(S.vertices)[S.faces].mean(axis=1))
+    off = set((np.flatnonzero(d > 0.02 * DIAMETER) // 64).tolist())
+    assert len(named & off) >= 0.75 * len(named), (sorted(named), sorted(off))
+    assert 0 < int(where.group(1)) < int(where.group(2)) == res.mesh.n_faces
 
 
 @pytest.mark.slow  # about 20 s (288 + 32 steps)
