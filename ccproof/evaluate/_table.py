@@ -1465,6 +1465,20 @@ def layer0_nets(T, groups):
             for lo in range(0, jobs.size, _BLOCK):
                 jb = jobs[lo:lo + _BLOCK]
                 ci = T.job_corner[jb] + t.leaf[vf]
+                nets = _layer0_block(T, jb, root + vf)
                 for code in range(3):
-                    hot[3 * ci + code] = composed_nets(T, jb, root + vf, 0, code)
+                    hot[3 * ci + code] = nets[:, code]
     return hot
+
+
+def _layer0_block(T, jobs, vf):
+    """:func:`composed_nets` of layer 0 for the three patch codes at once, shape (k, 3, 17, 3): the three
+    operators side by side in one :func:`ring_products` (each entry's sum the same, in the same order)."""
+    N, st, Nc = int(T.vn[vf]), int(T.vop_start[vf]), int(T.op_size[T.cfg[vf]])
+    st += N * (Nc - 1) + N
+    op = T.vop[st:st + 3 * N * 16].reshape(3, N, 16).transpose(1, 0, 2).reshape(N, 48)
+    R = T.rings[T.job_ring[jobs][:, None] + np.arange(N)]
+    out = np.empty((R.shape[0], 3, 17, 3))
+    out[:, :, :16] = ring_products(op, T.points, R).reshape(-1, 3, 16, 3)
+    out[:, :, 16] = corner_limits(T, jobs, vf)[:, None, :]
+    return out
