@@ -42,9 +42,9 @@ Method (global search, then local refinement):
 4. **Projected Newton** (:func:`ccproof.evaluate.newton.newton_descent`) on ``E(u, v) = |P(u, v) - X|^2 / 2``
    in ``[0, 1]^2``, backtracked so that ``E`` never increases, also next to extraordinary vertices.
 
-The normal is ``P_u x P_v / |P_u x P_v|`` at the answer (at a face corner that is an
-extraordinary vertex this is the normal of the innermost stored layer, which converges to the
-limit normal).
+The normal is the surface's own (:meth:`~ccproof.evaluate.LimitSurface.normals`: ``P_u x P_v / |P_u x P_v|``,
+and at an extraordinary corner the exact tangent plane of its subdivision matrix), or ``P_u x P_v`` normalized
+for a surface that has only ``evaluate``.
 """
 
 from __future__ import annotations
@@ -144,7 +144,8 @@ class ClosestPoints:
     distance : ndarray, shape (n,)
         ``|X - P|``.
     normal : ndarray, shape (n, 3)
-        Unit normal ``P_u x P_v / |P_u x P_v|`` at (face, u, v).
+        Unit normal at (face, u, v): the surface's ``normals`` (exact at extraordinary corners), else
+        ``P_u x P_v / |P_u x P_v|``.
     descents : ndarray of int32, shape (n,)
         Number of Newton descents run for the point (1 when the first one was provably best
         among the candidate cells).
@@ -390,7 +391,8 @@ class ClosestPointFinder:
         r = self.surface.evaluate(out.face, out.u, out.v, 1)
         out.P[:] = r["P"]
         out.distance[:] = np.linalg.norm(X - r["P"], axis=1)
-        out.normal[:] = unit_normal(r["Pu"], r["Pv"])
+        normals = getattr(self.surface, "normals", None)  # exact at an irregular corner (its tangent masks)
+        out.normal[:] = unit_normal(r["Pu"], r["Pv"]) if normals is None else normals(out.face, out.u, out.v)
         _warn_undefined_normals(out)
         return out
 

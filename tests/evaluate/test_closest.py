@@ -398,3 +398,20 @@ def test_search_structure_memory_is_linear_in_faces(bunny_path):
     assert cache <= 64 * min(CACHE_CELLS, 64 * nf)
     assert kept - cache < 400 * nf, (kept - cache) / nf
     assert peak < search_memory(nf), (peak, search_memory(nf))
+
+
+def test_the_normal_at_an_ngon_centre_is_the_exact_tangent_plane():
+    """A drum (two 100-gons joined by a band of quads, symmetric about the z axis): the nearest point to a point on
+    the axis is the centre of a 100-gon, where the normal is (0, 0, +-1) by symmetry. Pu x Pv at the innermost layer
+    was tilted there by 0.03 rad; the surface's exact tangent plane is not."""
+    from ccproof.evaluate import natural_limit_surface
+    from ccproof.mesh.polymesh import PolyMesh
+
+    n = 100
+    t = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    V = np.r_[np.c_[np.cos(t), np.sin(t), np.ones(n)], np.c_[np.cos(t), np.sin(t), -np.ones(n)]]
+    F = [list(range(n))[::-1], list(range(n, 2 * n))] + [[i, (i + 1) % n, n + (i + 1) % n, n + i] for i in range(n)]
+    S = natural_limit_surface(PolyMesh(V, F))
+    res = closest_points(S, np.array([[0.0, 0.0, 3.0], [0.0, 0.0, -3.0]]))
+    assert np.allclose(np.abs(res.P[:, 2]), np.abs(res.P[:, 2]).max()) and np.abs(res.P[:, :2]).max() < 1e-12
+    assert np.abs(res.normal[:, :2]).max() < 1e-12 and np.allclose(np.abs(res.normal[:, 2]), 1.0, atol=1e-12)
