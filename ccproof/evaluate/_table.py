@@ -1302,16 +1302,20 @@ def regular_nets(T, groups):
     return nets
 
 
-def composed_nets(T, jobs, vf, lay, code):
+def composed_nets(T, jobs, vf, lay, code=None):
     """The nets (k, 17, 3) of patch ``code`` of layer ``lay`` < :data:`COMPOSED_LAYERS` of the corner face
-    ``vf`` of ``jobs`` (k,): :func:`ring_products` of the composed operator, row 16 the limit point."""
+    ``vf`` of ``jobs`` (k,): :func:`ring_products` of the composed operator, row 16 the limit point. ``code``
+    None: the three patch codes at once, shape (k, 3, 17, 3), their operators side by side in one product (each
+    entry's sum the same, in the same order)."""
     N, st, Nc = int(T.vn[vf]), int(T.vop_start[vf]), int(T.op_size[T.cfg[vf]])
-    st += N * (Nc - 1) + N + (3 * lay + code) * N * 16
+    codes = 3 if code is None else 1
+    st += N * (Nc - 1) + N + (3 * lay + (0 if code is None else code)) * N * 16
+    op = T.vop[st:st + codes * N * 16].reshape(codes, N, 16).transpose(1, 0, 2).reshape(N, codes * 16)
     R = T.rings[T.job_ring[jobs][:, None] + np.arange(N)]
-    out = np.empty((R.shape[0], 17, 3))
-    out[:, :16] = ring_products(T.vop[st:st + N * 16].reshape(N, 16), T.points, R)
-    out[:, 16] = corner_limits(T, jobs, vf)
-    return out
+    out = np.empty((R.shape[0], codes, 17, 3))
+    out[:, :, :16] = ring_products(op, T.points, R).reshape(-1, codes, 16, 3)
+    out[:, :, 16] = corner_limits(T, jobs, vf)[:, None, :]
+    return out if code is None else out[:, 0]
 
 
 def corner_limits(T, jobs, vf):
@@ -1465,20 +1469,8 @@ def layer0_nets(T, groups):
             for lo in range(0, jobs.size, _BLOCK):
                 jb = jobs[lo:lo + _BLOCK]
                 ci = T.job_corner[jb] + t.leaf[vf]
-                nets = _layer0_block(T, jb, root + vf)
+                nets = composed_nets(T, jb, root + vf, 0)
                 for code in range(3):
                     hot[3 * ci + code] = nets[:, code]
     return hot
 
-
-def _layer0_block(T, jobs, vf):
-    """:func:`composed_nets` of layer 0 for the three patch codes at once, shape (k, 3, 17, 3): the three
-    operators side by side in one :func:`ring_products` (each entry's sum the same, in the same order)."""
-    N, st, Nc = int(T.vn[vf]), int(T.vop_start[vf]), int(T.op_size[T.cfg[vf]])
-    st += N * (Nc - 1) + N
-    op = T.vop[st:st + 3 * N * 16].reshape(3, N, 16).transpose(1, 0, 2).reshape(N, 48)
-    R = T.rings[T.job_ring[jobs][:, None] + np.arange(N)]
-    out = np.empty((R.shape[0], 3, 17, 3))
-    out[:, :, :16] = ring_products(op, T.points, R).reshape(-1, 3, 16, 3)
-    out[:, :, 16] = corner_limits(T, jobs, vf)[:, None, :]
-    return out
