@@ -41,6 +41,7 @@ SMOKE = {
     "bench_reparam.py": ["--smoke"],
     "bench_replay.py": ["--smoke"],
     "bench_scale.py": ["--smoke"],
+    "bench_scans.py": ["--smoke"],
     "bench_step.py": ["--smoke"],
     "bench_tables.py": ["--smoke"],
     "bench_topology.py": ["--smoke"],
