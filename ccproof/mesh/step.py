@@ -305,17 +305,14 @@ def _child_tags(t, fans, ce, cv, holes):
 def _edge_tags(t, edge_sharpness):
     """Sharpness per edge (E,): the tags (an array in the edge numbering, or a dict by vertex pair), ``>= 10``
     infinite, boundary edges infinite."""
-    n, E, a, b = t.n, t.E, t.a, t.b
+    E = t.E
     if isinstance(edge_sharpness, dict):
         es = np.zeros(E)
-        if edge_sharpness:
+        if edge_sharpness:  # the pairs looked up among the mesh's edges (sorted there once)
             keys = np.array(list(edge_sharpness.keys()), dtype=np.int64).reshape(-1, 2)
-            kk = np.minimum(keys[:, 0], keys[:, 1]) * n + np.maximum(keys[:, 0], keys[:, 1])
-            ek = np.minimum(a, b) * n + np.maximum(a, b)
-            srt = np.argsort(ek)
-            p = np.minimum(np.searchsorted(ek[srt], kk), E - 1)
-            ok = ek[srt][p] == kk
-            es[srt[p[ok]]] = np.asarray(list(edge_sharpness.values()), dtype=np.float64)[ok]
+            e = t.halfedges.edge_index_of(keys[:, 0], keys[:, 1])
+            ok = e >= 0
+            es[t.renum[e[ok]]] = np.asarray(list(edge_sharpness.values()), dtype=np.float64)[ok]
     elif edge_sharpness is None:
         es = np.zeros(E)
     else:

@@ -213,36 +213,43 @@ def _same_step(x, y):
 
 
 @pytest.mark.parametrize("folder,name", CASES)
-def test_the_mesh_halfedges_give_the_step_of_its_own_pairing(refdir, folder, name):
-    """catmark_operator reading the mesh's HalfEdges (what PolyMesh.refine and the QuadMesh steps pass)
-    against it pairing the half-edges itself (its own code, not HalfEdges'), at levels 0 and 1: the same
-    arrays bit for bit in the first-occurrence numbering and in HalfEdges' sorted one (the QuadMesh
-    numbering), and the edges of each numbering where that numbering puts them."""
+def test_the_step_reads_the_pairing_of_halfedges(refdir, folder, name):
+    """The step pairs no half-edges: its topology is read from HalfEdges (the mesh's, or built once when none
+    is passed), at levels 0 and 1 (the child's HalfEdges derived by HalfEdges.refined). Against the pairing of
+    rules.Complex (its own code: a dict of directed edges, or its numpy sort): the same twins, the edges
+    numbered by first occurrence, each as its first half-edge; in HalfEdges' sorted numbering (the QuadMesh
+    numbering) the edges where that numbering puts them; the step the same bits whichever HalfEdges it reads."""
+    from ccproof.mesh.step_topology import step_topology
+
     pm = read_mesh(refdir / folder / "meshes" / name).manifold
     for _ in range(2):
         he = pm.halfedges
         assert he.edge_manifold
         kw = dict(edge_sharpness=dict(pm.edge_sharpness), vertex_sharpness=dict(pm.vertex_sharpness),
                   options=pm.options, level=pm.level, holes=pm.is_hole, sparse=False)
-        paired = catmark_operator(pm.n_vertices, pm.indices, pm.sizes, **kw)
-        _same_step(catmark_operator(pm.n_vertices, pm.indices, pm.sizes, halfedges=he, **kw), paired)
-        cx = pm.complex()  # edges numbered by first occurrence, each as its first half-edge
-        assert [[cx.org[h], cx.org[cx.nxt[h]]] for h in cx.edges] == paired.edges.tolist()
-        sorted_paired = catmark_operator(pm.n_vertices, pm.indices, pm.sizes, edge_of_halfedge=he.edge_of, **kw)
+        built = catmark_operator(pm.n_vertices, pm.indices, pm.sizes, **kw)
+        _same_step(catmark_operator(pm.n_vertices, pm.indices, pm.sizes, halfedges=he, **kw), built)
+        cx = pm.complex()
+        t = step_topology(pm.n_vertices, pm.indices, pm.sizes, he, None)
+        assert t.twin.tolist() == cx.twin and t.he_edge.tolist() == cx.he_edge and t.h1.tolist() == cx.edges
+        assert [[cx.org[h], cx.org[cx.nxt[h]]] for h in cx.edges] == built.edges.tolist()
         got = catmark_operator(pm.n_vertices, pm.indices, pm.sizes, halfedges=he, edge_of_halfedge=he.edge_of, **kw)
-        _same_step(got, sorted_paired)
         assert np.array_equal(np.sort(got.edges, axis=1), he.edges)
         pm, _ = pm.refine(operator=False)
 
 
-def test_halfedges_with_a_non_manifold_edge_are_not_read():
-    """Three faces on the edge (0, 1): the step pairs the half-edges itself and refuses the mesh."""
+def test_a_non_manifold_edge_is_refused_by_name():
+    """Three faces on the edge (0, 1), or two faces running along (1, 2) the same way: the step refuses the
+    mesh naming the edge, whether it reads the mesh's HalfEdges or builds them."""
     from ccproof.errors import MeshError
 
     pm = PolyMesh(np.zeros((5, 3)), [[0, 1, 2], [1, 0, 3], [0, 1, 4]])
     assert not pm.halfedges.edge_manifold
-    with pytest.raises(MeshError, match=r"edge \(0, 1\) has 3 faces"):
-        catmark_operator(pm.n_vertices, pm.indices, pm.sizes, halfedges=pm.halfedges)
+    for he in (pm.halfedges, None):
+        with pytest.raises(MeshError, match=r"edge \(0, 1\) has 3 faces"):
+            catmark_operator(pm.n_vertices, pm.indices, pm.sizes, halfedges=he)
+    with pytest.raises(MeshError, match=r"edge \(1, 2\) has 2 faces that do not pair"):
+        catmark_operator(5, [0, 1, 2, 4, 1, 2, 3], [3, 4])
 
 
 def test_halfedges_of_another_mesh_are_refused():
