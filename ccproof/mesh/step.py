@@ -52,6 +52,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ccproof.mesh.crease import INFINITE
+from ccproof.mesh.rules import Options
 from ccproof.mesh.scheme import CATMARK
 from ccproof.mesh.step_topology import step_topology, vertex_fans
 
@@ -89,6 +90,16 @@ class StepOptions(NamedTuple):
     columns: object = None
     n_columns: object = None
     sparse: bool = True
+
+    def column_count(self, n):
+        """The operator's number of columns on a mesh of ``n`` vertices.
+
+        >>> StepOptions().column_count(5), StepOptions(columns=[0, 1, 1]).column_count(3)
+        (5, 2)
+        """
+        if self.n_columns is not None:
+            return int(self.n_columns)
+        return n if self.columns is None else int(np.max(self.columns, initial=-1)) + 1
 
 
 class Step(NamedTuple):
@@ -249,9 +260,8 @@ def catmark_operator(n, indices, sizes, *, halfedges=None, edge_of_halfedge=None
         The caller's ``mesh.halfedges`` of these faces (ValueError otherwise): the step's topology (no pairing
         of half-edges here); built from the faces when None. A non-manifold edge is refused (MeshError).
     edge_of_halfedge : array_like of int, shape (H,), optional
-        The edge of every half-edge (the edge points' numbering, 0..E-1); default: numbered by first
-        occurrence along the faces (:class:`ccproof.mesh.rules.Complex`'s numbering). With
-        ``halfedges``, a renumbering of its edges (``halfedges.edge_of`` itself: the QuadMesh numbering).
+        The edge points' numbering (0..E-1); default: by first occurrence along the faces (:class:`Complex
+        <ccproof.mesh.complex.Complex>`'s); ``halfedges.edge_of``: the QuadMesh numbering.
     edge_sharpness : ndarray, shape (E,), or dict[(int, int), float], optional
         Sharpness per edge of that numbering, or a dict keyed by ``(min, max)`` vertex pairs; ``>= 10``
         infinite. Boundary edges are infinitely sharp whatever the tag.
@@ -292,8 +302,6 @@ def catmark_operator(n, indices, sizes, *, halfedges=None, edge_of_halfedge=None
     ...
     ValueError: catmark_operator: scheme 'loop' splits faces into triangles, not quads
     """
-    from ccproof.mesh.rules import Options
-
     o = StepOptions() if options is None else options
     if scheme.split != "quad":
         raise ValueError(f"catmark_operator: scheme {scheme.name!r} splits faces into {scheme.split}s, not quads")
@@ -306,15 +314,12 @@ def catmark_operator(n, indices, sizes, *, halfedges=None, edge_of_halfedge=None
     pe = es[fans.inc_e]
     ce = _child_edge_sharpness(pe, fans.inc_v, n, chaikin)
     coef, cv = _vertex_coefficients(t, fans, vs, pe, ce, chaikin, sdc.boundary == "edge_and_corner" and o.level == 0)
-    columns, ncols = o.columns, o.n_columns
-    if ncols is None:
-        ncols = n if columns is None else int(np.max(columns, initial=-1)) + 1
-    ncols = int(ncols)
+    ncols = o.column_count(n)
     rows = _Rows(t, fans, scheme)
     rows.face_points()
     rows.vertex_points(coef, pe, ce)
     tri_e = rows.edge_points(es, ce, chaikin, sdc.triangle_subdivision == "smooth" and o.level == 0)
-    csr = rows.csr(ncols, columns, tri_e)
+    csr = rows.csr(ncols, o.columns, tri_e)
     S = _scipy_csr(csr, (n + t.E + t.m, ncols)) if o.sparse else None
     faces = np.stack([t.org, n + t.he_edge, n + t.E + t.face, n + t.he_edge[t.prv]], axis=1)
     return Step(S, faces, np.stack([t.a, t.b], axis=1), *_child_tags(t, fans, ce, cv, holes), csr)
