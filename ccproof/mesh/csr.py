@@ -114,8 +114,8 @@ def pack_csr(csr):
 
     Examples
     --------
-    >>> from ccproof.mesh.step import catmark_operator
-    >>> st = catmark_operator(4, [0, 1, 2, 3], [4], sparse=False)
+    >>> from ccproof.mesh.step import StepOptions, catmark_operator
+    >>> st = catmark_operator(4, [0, 1, 2, 3], [4], options=StepOptions(sparse=False))
     >>> p = pack_csr(st.csr)
     >>> p.weights.tolist(), p.codes.dtype.name, p.indices.dtype.name, p.nbytes < sum(a.nbytes for a in st.csr)
     ([0.125, 0.25, 0.5, 0.75], 'uint8', 'int32', True)

@@ -217,14 +217,15 @@ class HalfEdges:
         return cls(F.reshape(-1), 4 * np.arange(F.shape[0] + 1, dtype=np.int64), n_vertices, options, edges)
 
     @classmethod
-    def refined(cls, parent, options=None):
+    def refined(cls, parent, options=None, edge_of_halfedge=None):
         """The half-edges of the all-quad child of one Catmull-Clark step of ``parent``, derived from its
         arrays (OpenSubdiv's ``Vtr::QuadRefinement``), equal to those paired from the child's faces.
 
         The child is the one of :meth:`ccproof.mesh.polymesh.PolyMesh.refine`
         (:func:`ccproof.mesh.step.catmark_operator`'s layout): vertex ``v < n`` the vertex point of v,
         ``n + k`` the edge point of edge k numbered by first occurrence (the order of the edges'
-        smallest half-edges), ``n + E + f`` the face point of face f; child face ``h`` (a parent
+        smallest half-edges) or as ``edge_of_halfedge`` says, ``n + E + f`` the face point of face f; child
+        face ``h`` (a parent
         half-edge) is ``(org h, n + k(h), n + E + f(h), n + k(prv h))``, its half-edges ``4 h + j``.
         Twins follow from the parent's (``4 h`` and ``4 nxt(twin h) + 3``, ``4 h + 1`` and
         ``4 nxt(h) + 2``); the child's edges are the halves ``(v, n + k)`` of the parent's, sorted by
@@ -237,6 +238,9 @@ class HalfEdges:
             every vertex (ValueError otherwise: pair the child's faces instead).
         options : ccproof.mesh.rules.Options, optional
             The child's options (``parent.options`` when None).
+        edge_of_halfedge : ndarray of int64, shape (H,), optional
+            The edge points' numbering (``parent.edge_of``: the sorted one of
+            :func:`ccproof.mesh.subdivision.child_faces`); default: by first occurrence.
 
         Returns
         -------
@@ -254,7 +258,7 @@ class HalfEdges:
         if not parent.edge_manifold or (parent.n_fans > 1).any():
             raise ValueError("HalfEdges.refined: the parent is not manifold")
         n, H, m = parent.n_vertices, parent.org.size, parent.sizes.size
-        se, is_first, h1, cnt_k = _step_edges(parent)
+        se, is_first, h1, cnt_k = _step_edges(parent, edge_of_halfedge)
         E = h1.size
         N = n + E + m
         h = np.arange(H, dtype=np.int64)
@@ -437,17 +441,21 @@ class HalfEdges:
         return np.unique(self.face_of[cs])
 
 
-def _step_edges(parent):
+def _step_edges(parent, edge_of_halfedge=None):
     """(se, is_first, h1, cnt_k) of :meth:`HalfEdges.refined`: the parent's edges numbered by first occurrence
-    (``catmark_operator``'s numbering: k = rank of the smallest half-edge); ``se`` the step's edge of every
-    half-edge, ``is_first`` whether a half-edge is its edge's smallest, ``h1`` and ``cnt_k`` the smallest
-    half-edge and the face count of step edge k."""
+    (``catmark_operator``'s numbering: k = rank of the smallest half-edge) or by ``edge_of_halfedge``; ``se``
+    the step's edge of every half-edge, ``is_first`` whether a half-edge is its edge's smallest, ``h1`` and
+    ``cnt_k`` the smallest half-edge and the face count of step edge k."""
     first, cnt = parent.edge_halfedge, parent.edge_face_count
     E, H = first.size, parent.org.size
     is_first = np.zeros(H, dtype=bool)
     is_first[first] = True
-    renum = (np.cumsum(is_first) - 1)[first]
-    se = renum[parent.edge_of]  # (H,): the step's edge of every half-edge
+    if edge_of_halfedge is None:
+        renum = (np.cumsum(is_first) - 1)[first]
+        se = renum[parent.edge_of]  # (H,): the step's edge of every half-edge
+    else:
+        se = np.asarray(edge_of_halfedge, dtype=np.int64).reshape(-1)
+        renum = se[first]
     h1 = np.empty(E, dtype=np.int64)
     h1[renum] = first
     cnt_k = np.empty(E, dtype=np.int64)

@@ -1,4 +1,5 @@
-"""Limit-position and limit-tangent masks of Catmull-Clark at the vertices of a mesh.
+"""Limit-position and limit-tangent masks of Catmull-Clark at the vertices of a mesh (the limit weights read
+through the scheme, :data:`ccproof.mesh.scheme.CATMARK`).
 
 Interior vertex of valence k with edge neighbours e_j and face-diagonal neighbours d_j (counter-
 clockwise, :meth:`QuadMesh.one_ring`):
@@ -28,8 +29,8 @@ from fractions import Fraction
 import numpy as np
 
 from ccproof.mesh.quadmesh import QuadMesh
+from ccproof.mesh.scheme import CATMARK
 from ccproof.mesh.subdivision import boundary_neighbours
-from ccproof.rule_weights import crease_limit_weights, smooth_limit_weights
 from ccproof.valence import lam_from_c
 
 __all__ = ["limit_positions", "limit_tangents", "limit_normals"]
@@ -71,7 +72,7 @@ def limit_positions(mesh: QuadMesh, vertices=None):
     unused = getattr(mesh, "is_unused_vertex", np.zeros(n, dtype=bool))
     val = np.where(unused, 4, mesh.valence)  # unused vertices (valence 0): NaN below
     ks = np.unique(val)
-    table = np.array([_integer_weights(smooth_limit_weights(int(k), Fraction(1))) for k in ks], dtype=np.float64)
+    table = np.array([_integer_weights(CATMARK.limit(int(k), Fraction(1))) for k in ks], dtype=np.float64)
     nV, ne, nd, den = table[np.searchsorted(ks, val)].T[:, :, None]
     with np.errstate(invalid="ignore"):
         L = (nV * V + ne * esum + nd * dsum) / den
@@ -79,7 +80,7 @@ def limit_positions(mesh: QuadMesh, vertices=None):
     bv = mesh.is_boundary_vertex
     if bv.any():
         e0, e1 = boundary_neighbours(mesh)
-        cV, ce, cden = _integer_weights(crease_limit_weights(Fraction(1)))
+        cV, ce, cden = _integer_weights(CATMARK.crease_limit(Fraction(1)))
         L[bv] = (cV * V[bv] + ce * (V[e0[bv]] + V[e1[bv]])) / cden
     return L
 

@@ -486,12 +486,11 @@ class PolyMesh:
         """:func:`ccproof.mesh.step.catmark_operator` of this manifold mesh with its tags (keyword
         arguments passed on), edges numbered as :class:`~ccproof.mesh.rules.Complex` numbers them; the step
         reads :attr:`halfedges` (no second pairing)."""
-        from ccproof.mesh.step import catmark_operator
+        from ccproof.mesh.step import StepOptions, catmark_operator
 
         return catmark_operator(self.n_vertices, self.indices, self.sizes, halfedges=self.halfedges,
-                                edge_sharpness=self.edge_sharpness,
-                                vertex_sharpness=self.vertex_sharpness, options=self.options, level=self.level,
-                                holes=self.is_hole, **kwargs)
+                                edge_sharpness=self.edge_sharpness, vertex_sharpness=self.vertex_sharpness,
+                                holes=self.is_hole, options=StepOptions(self.options, self.level, **kwargs))
 
     def subdivision_operator(self, exact=False):
         """The linear operator S of one step: ``refine()[0].vertices == S @ vertices`` (bit for bit on a

@@ -27,6 +27,7 @@ import numpy as np
 from ccproof.errors import MeshError
 from ccproof.mesh.halfedges import HalfEdges, connected_components
 from ccproof.mesh.rules import Options
+from ccproof.mesh.scheme import CATMARK
 
 __all__ = ["QuadMesh", "connected_components"]
 
@@ -353,13 +354,16 @@ class QuadMesh:
 
     @property
     def is_regular_vertex(self):
-        """bool (n,): interior of valence 4, or boundary with exactly two faces."""
-        return np.where(self.is_boundary_vertex, self.face_count == 2, self.valence == 4)
+        """bool (n,): interior of valence 4, or boundary with exactly two faces (valence 3): the scheme's regular
+        valences (:data:`~ccproof.mesh.scheme.CATMARK`)."""
+        v = self.valence
+        return np.where(self.is_boundary_vertex, v == CATMARK.regular_boundary_valence, v == CATMARK.regular_valence)
 
     @property
     def extraordinary_vertices(self):
         """int (e,): interior vertices of valence != 4 (bmz04: extraordinary vertices); unused vertices are not."""
-        return np.flatnonzero(~self.is_boundary_vertex & ~self.is_unused_vertex & (self.valence != 4))
+        irregular = self.valence != CATMARK.regular_valence
+        return np.flatnonzero(~self.is_boundary_vertex & ~self.is_unused_vertex & irregular)
 
     @property
     def boundary_edges(self):

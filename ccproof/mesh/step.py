@@ -7,8 +7,10 @@ untagged quad step of :func:`ccproof.mesh.subdivision_matrix` and the applicatio
 :class:`~ccproof.mesh.halfedges.HalfEdges` (``halfedges=``), which the step reads instead of pairing the
 half-edges again. It assembles, over the whole
 mesh with numpy, the rules that :func:`ccproof.mesh.rules.refine_complex` states as exact stencils
-(the independent reference of the tests; the weights come from the same rule functions of
-:mod:`ccproof.rule_weights`, evaluated in floats):
+(the independent reference of the tests; the weights are read through the scheme,
+:data:`ccproof.mesh.scheme.CATMARK`, the same rule functions of :mod:`ccproof.rule_weights`, evaluated in
+rationals and rounded once per row; the step only splits faces, so another quad-splitting scheme is
+another :class:`~ccproof.mesh.scheme.Scheme` value):
 
 * face point: the centroid;
 * edge point: boundary edges are infinitely sharp (the midpoint); an interior edge of sharpness
@@ -49,20 +51,55 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ccproof.mesh.crease import INFINITE
+from ccproof.mesh.rules import Options
+from ccproof.mesh.scheme import CATMARK
 from ccproof.mesh.step_topology import step_topology, vertex_fans
-from ccproof.rule_weights import (
-    crease_vertex_weights,
-    face_point_weight,
-    sharp_edge_weight,
-    smooth_edge_weights,
-    smooth_vertex_weights,
-)
 
-__all__ = ["catmark_operator", "Step"]
+__all__ = ["catmark_operator", "Step", "StepOptions"]
 
-#: OpenSubdiv's Sdc::Crease::SHARPNESS_INFINITE
-INFINITE = 10.0
 _F32 = np.float32
+
+
+class StepOptions(NamedTuple):
+    """How :func:`catmark_operator` takes the step and what it returns.
+
+    Attributes
+    ----------
+    sdc : ccproof.mesh.rules.Options, optional
+        The Sdc options (default ``Options()``).
+    level : int
+        The level of the mesh (``TRI_SUB_SMOOTH`` and ``EDGE_AND_CORNER`` act at level 0).
+    columns : array_like of int, shape (n,), optional
+        The column of every vertex (default: its index): vertices sharing a column have their terms
+        summed exactly, before the one division (the copies of a split non-manifold vertex:
+        :meth:`ccproof.mesh.polymesh.PolyMesh.subdivision_operator`).
+    n_columns : int, optional
+        Number of columns (default: ``max(columns) + 1``, or n).
+    sparse : bool
+        Build ``S`` (scipy); False: ``S`` is None and scipy is not imported (``csr`` holds the operator).
+
+    Examples
+    --------
+    >>> StepOptions(level=1, sparse=False)
+    StepOptions(sdc=None, level=1, columns=None, n_columns=None, sparse=False)
+    """
+
+    sdc: object = None
+    level: int = 0
+    columns: object = None
+    n_columns: object = None
+    sparse: bool = True
+
+    def column_count(self, n):
+        """The operator's number of columns on a mesh of ``n`` vertices.
+
+        >>> StepOptions().column_count(5), StepOptions(columns=[0, 1, 1]).column_count(3)
+        (5, 2)
+        """
+        if self.n_columns is not None:
+            return int(self.n_columns)
+        return n if self.columns is None else int(np.max(self.columns, initial=-1)) + 1
 
 
 class Step(NamedTuple):
@@ -134,7 +171,7 @@ def _csr(rows, cols, vals, R, ncols):
     return indptr, (key[start] % max(ncols, 1))[keep].astype(np.int64), data
 
 
-def _tri_smooth_rows(te, t, pw, columns):
+def _tri_smooth_rows(te, t, pw, columns, scheme):
     """The rows of the ``TRI_SUB_SMOOTH`` edge points ``te`` as final, correctly rounded weights.
 
     Their face weight ``(w0 + w1) / 2`` (``w = 0.47`` at a triangle, a float64 weight: 2^-54 granular)
@@ -151,8 +188,8 @@ def _tri_smooth_rows(te, t, pw, columns):
     """
     n, a, b, h1, h2, face, sz, off, pos, idx = t.n, t.a, t.b, t.h1, t.h2, t.face, t.sz, t.off, t.pos, t.idx
     one = Fraction(1)
-    half = sharp_edge_weight(one)
-    vw0, fw0 = smooth_edge_weights(one)
+    half = scheme.sharp_edge(one)
+    vw0, fw0 = scheme.edge_point(one)
     s1, s2 = sz[face[h1[te]]], sz[face[h2[te]]]
     pws, pinv = np.unique(pw[te], return_inverse=True)
     B = int(max(s1.max(), s2.max())) + 1
@@ -189,8 +226,8 @@ def _tri_smooth_rows(te, t, pw, columns):
         P = Fraction(p)
         fw = ((tri_w if z1 == 3 else fw0) + (tri_w if z2 == 3 else fw0)) / 2
         vw = (1 - 2 * fw) / 2
-        rest1 = (1 - P) * fw * face_point_weight(z1, one)
-        rest2 = (1 - P) * fw * face_point_weight(z2, one)
+        rest1 = (1 - P) * fw * scheme.face_point(z1, one)
+        rest2 = (1 - P) * fw * scheme.face_point(z2, one)
         end = P * half + (1 - P) * vw + rest1 + rest2
         w.append(float(c0 * end + c1 * rest1 + c2 * rest2))
     return n + te[ge], ukey % ncol, np.asarray(w, dtype=np.float64)[sinv.reshape(-1)]
@@ -207,9 +244,9 @@ def _ratios(rule, x):
 
 
 def catmark_operator(n, indices, sizes, *, halfedges=None, edge_of_halfedge=None, edge_sharpness=None,
-                     vertex_sharpness=None, options=None, level=0, holes=None, columns=None, n_columns=None,
-                     sparse=True):
-    """One Catmull-Clark step of a tagged manifold polygon mesh, as a sparse operator (module docstring).
+                     vertex_sharpness=None, holes=None, options=None, scheme=CATMARK):
+    """One step of a quad-splitting scheme (Catmull-Clark) on a tagged manifold polygon mesh, as a sparse
+    operator (module docstring).
 
     Parameters
     ----------
@@ -220,28 +257,21 @@ def catmark_operator(n, indices, sizes, *, halfedges=None, edge_of_halfedge=None
     sizes : array_like of int, shape (m,)
         Face sizes (>= 3).
     halfedges : ccproof.mesh.halfedges.HalfEdges, optional
-        The caller's ``mesh.halfedges`` of these faces (ValueError otherwise), read instead of pairing the
-        half-edges again (edge points numbered as ``edge_of_halfedge`` says); paired here when non-manifold.
+        The caller's ``mesh.halfedges`` of these faces (ValueError otherwise): the step's topology (no pairing
+        of half-edges here); built from the faces when None. A non-manifold edge is refused (MeshError).
     edge_of_halfedge : array_like of int, shape (H,), optional
-        The edge of every half-edge (the edge points' numbering, 0..E-1); default: numbered by first
-        occurrence along the faces (:class:`ccproof.mesh.rules.Complex`'s numbering). With
-        ``halfedges``, a renumbering of its edges (``halfedges.edge_of`` itself: the QuadMesh numbering).
+        The edge points' numbering (0..E-1); default: by first occurrence along the faces (:class:`Complex
+        <ccproof.mesh.complex.Complex>`'s); ``halfedges.edge_of``: the QuadMesh numbering.
     edge_sharpness : ndarray, shape (E,), or dict[(int, int), float], optional
         Sharpness per edge of that numbering, or a dict keyed by ``(min, max)`` vertex pairs; ``>= 10``
         infinite. Boundary edges are infinitely sharp whatever the tag.
     vertex_sharpness : ndarray, shape (n,), or dict[int, float], optional
-    options : ccproof.mesh.rules.Options, optional
-    level : int
-        The level of the mesh (``TRI_SUB_SMOOTH`` and ``EDGE_AND_CORNER`` act at level 0).
     holes : array_like of bool, shape (m,), optional
-    columns : array_like of int, shape (n,), optional
-        The column of every vertex (default: its index): vertices sharing a column have their terms
-        summed exactly, before the one division (the copies of a split non-manifold vertex:
-        :meth:`ccproof.mesh.polymesh.PolyMesh.subdivision_operator`).
-    n_columns : int, optional
-        Number of columns (default: ``max(columns) + 1``, or n).
-    sparse : bool
-        Build ``S`` (scipy); False: ``S`` is None and scipy is not imported (``csr`` holds the operator).
+    options : StepOptions, optional
+        The Sdc options, the mesh's level, the output's columns and whether to build ``S``.
+    scheme : ccproof.mesh.scheme.Scheme
+        The rules' weights (:data:`~ccproof.mesh.scheme.CATMARK`); a scheme that splits faces into quads
+        (ValueError otherwise, naming it).
 
     Returns
     -------
@@ -263,25 +293,34 @@ def catmark_operator(n, indices, sizes, *, halfedges=None, edge_of_halfedge=None
     >>> e = int(np.flatnonzero((st.edges == [1, 4]).all(axis=1))[0])
     >>> st.S[6 + e].toarray()[0].tolist(), len(st.child_creases[1]), 2 * (len(st.edges) - 1)
     ([0.03125, 0.4375, 0.03125, 0.03125, 0.4375, 0.03125], 12, 12)
-    """
-    from ccproof.mesh.rules import Options
 
-    opts = Options() if options is None else options
-    chaikin = opts.crease_method == "chaikin"
+    The rules are the scheme's: Loop's split faces into triangles, not this step's quads:
+
+    >>> from ccproof.mesh.scheme import LOOP
+    >>> catmark_operator(3, [0, 1, 2], [3], scheme=LOOP)
+    Traceback (most recent call last):
+    ...
+    ValueError: catmark_operator: scheme 'loop' splits faces into triangles, not quads
+    """
+    o = StepOptions() if options is None else options
+    if scheme.split != "quad":
+        raise ValueError(f"catmark_operator: scheme {scheme.name!r} splits faces into {scheme.split}s, not quads")
+    sdc = Options() if o.sdc is None else o.sdc
+    chaikin = sdc.crease_method == "chaikin"
     t = step_topology(n, indices, sizes, halfedges, edge_of_halfedge)
     es = _edge_tags(t, edge_sharpness)
     vs = _vertex_tags(n, vertex_sharpness)
     fans = vertex_fans(t)
     pe = es[fans.inc_e]
     ce = _child_edge_sharpness(pe, fans.inc_v, n, chaikin)
-    coef, cv = _vertex_coefficients(t, fans, vs, pe, ce, chaikin, opts.boundary == "edge_and_corner" and level == 0)
-    ncols = (n if columns is None else int(np.max(columns, initial=-1)) + 1) if n_columns is None else int(n_columns)
-    rows = _Rows(t, fans)
+    coef, cv = _vertex_coefficients(t, fans, vs, pe, ce, chaikin, sdc.boundary == "edge_and_corner" and o.level == 0)
+    ncols = o.column_count(n)
+    rows = _Rows(t, fans, scheme)
     rows.face_points()
     rows.vertex_points(coef, pe, ce)
-    tri_e = rows.edge_points(es, ce, chaikin, opts.triangle_subdivision == "smooth" and level == 0)
-    csr = rows.csr(ncols, columns, tri_e)
-    S = _scipy_csr(csr, (n + t.E + t.m, ncols)) if sparse else None
+    tri_e = rows.edge_points(es, ce, chaikin, sdc.triangle_subdivision == "smooth" and o.level == 0)
+    csr = rows.csr(ncols, o.columns, tri_e)
+    S = _scipy_csr(csr, (n + t.E + t.m, ncols)) if o.sparse else None
     faces = np.stack([t.org, n + t.he_edge, n + t.E + t.face, n + t.he_edge[t.prv]], axis=1)
     return Step(S, faces, np.stack([t.a, t.b], axis=1), *_child_tags(t, fans, ce, cv, holes), csr)
 
@@ -305,17 +344,14 @@ def _child_tags(t, fans, ce, cv, holes):
 def _edge_tags(t, edge_sharpness):
     """Sharpness per edge (E,): the tags (an array in the edge numbering, or a dict by vertex pair), ``>= 10``
     infinite, boundary edges infinite."""
-    n, E, a, b = t.n, t.E, t.a, t.b
+    E = t.E
     if isinstance(edge_sharpness, dict):
         es = np.zeros(E)
-        if edge_sharpness:
+        if edge_sharpness:  # the pairs looked up among the mesh's edges (sorted there once)
             keys = np.array(list(edge_sharpness.keys()), dtype=np.int64).reshape(-1, 2)
-            kk = np.minimum(keys[:, 0], keys[:, 1]) * n + np.maximum(keys[:, 0], keys[:, 1])
-            ek = np.minimum(a, b) * n + np.maximum(a, b)
-            srt = np.argsort(ek)
-            p = np.minimum(np.searchsorted(ek[srt], kk), E - 1)
-            ok = ek[srt][p] == kk
-            es[srt[p[ok]]] = np.asarray(list(edge_sharpness.values()), dtype=np.float64)[ok]
+            e = t.halfedges.edge_index_of(keys[:, 0], keys[:, 1])
+            ok = e >= 0
+            es[t.renum[e[ok]]] = np.asarray(list(edge_sharpness.values()), dtype=np.float64)[ok]
     elif edge_sharpness is None:
         es = np.zeros(E)
     else:
@@ -405,16 +441,17 @@ class _Rows:
     then divided once (the correctly rounded weight, as refine_complex's to_float of its exact stencil).
     """
 
-    def __init__(self, t, fans):
-        self.t, self.fans = t, fans
+    def __init__(self, t, fans, scheme):
+        self.t, self.fans, self.scheme = t, fans, scheme
         self.rows, self.cols, self.vals = [], [], []
-        one = Fraction(1)  # the rule functions in exact rationals, one value per distinct size or valence
-        self.face_t, self.face_d = _ratios(lambda x: face_point_weight(x, one), t.sz)  # (m,)
+        one = Fraction(1)  # the scheme's rules in exact rationals, one value per distinct size or valence
+        self.face_t, self.face_d = _ratios(lambda x: scheme.face_point(x, one), t.sz)  # (m,)
         kk = np.maximum(fans.k, 1)
-        self.wv, self.we, self.wf = (_ratios(lambda x, i=i: smooth_vertex_weights(x, one)[i], kk) for i in range(3))
-        self.wcv, self.wcn = crease_vertex_weights(one)
-        self.half = sharp_edge_weight(one)
-        self.vw0, self.fw0 = smooth_edge_weights(one)
+        self.wv, self.we, self.wf = (_ratios(lambda x, i=i: scheme.vertex_point(x, one)[i], kk) for i in range(3))
+        self.wcv, self.wcn = scheme.crease_vertex(one)
+        (self.wco,) = scheme.corner_vertex(one)
+        self.half = scheme.sharp_edge(one)
+        self.vw0, self.fw0 = scheme.edge_point(one)
         self.R = self._denominators()
 
     def _denominators(self):
@@ -428,7 +465,7 @@ class _Rows:
         n, E, two, h1, h2 = t.n, t.E, t.two, t.h1, t.h2
         return np.concatenate([
             np.lcm.reduce([self.wv[1], self.we[1], self.wf[1] * lf, np.full(n, self.wcv.denominator),
-                           np.full(n, self.wcn.denominator)]),
+                           np.full(n, self.wcn.denominator), np.full(n, self.wco.denominator)]),
             np.lcm.reduce([np.full(E, self.half.denominator), np.full(E, self.vw0.denominator),
                            self.fw0.denominator * face_d[t.face[h1]],
                            self.fw0.denominator * np.where(two, face_d[t.face[h2]], 1)]),
@@ -482,7 +519,7 @@ class _Rows:
             sel = (c[inc_v] != 0) & (sh > 0)
             self.add(inc_v[sel], inc_u[sel], c[inc_v[sel]], self.wcn.numerator, self.wcn.denominator)
         co = np.flatnonzero(a_corner != 0)
-        self.add(co, co, a_corner[co], 1, 1)
+        self.add(co, co, a_corner[co], self.wco.numerator, self.wco.denominator)
 
     def _smooth_vertices(self, a_smooth):
         t = self.t
@@ -548,7 +585,7 @@ class _Rows:
             cols = np.asarray(columns, dtype=np.int64)[cols]
         R = self.R
         if tri_e.any():  # final weights: these rows are not divided
-            tr, tc, tv = _tri_smooth_rows(np.flatnonzero(tri_e), t, self.pw, columns)
+            tr, tc, tv = _tri_smooth_rows(np.flatnonzero(tri_e), t, self.pw, columns, self.scheme)
             rows, cols, vals = np.r_[rows, tr], np.r_[cols, tc], np.r_[vals, tv]
             R[t.n + np.flatnonzero(tri_e)] = 1
         return _csr(rows, cols, vals, R, ncols)

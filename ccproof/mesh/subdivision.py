@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ccproof.mesh.halfedges import HalfEdges
 from ccproof.mesh.quadmesh import QuadMesh
 
 __all__ = ["subdivide", "subdivision_matrix", "child_faces"]
@@ -107,7 +108,8 @@ def subdivide(mesh):
     >>> m1.vertices[0].tolist(), m1.vertices[8].tolist()   # corner: (e0 + 6 V + e1)/8; face point
     ([0.125, 0.125, 0.0], [0.5, 0.5, 0.0])
     """
-    return QuadMesh(subdivision_matrix(mesh) @ mesh.vertices, child_faces(mesh))
+    he = HalfEdges.refined(mesh.halfedges, edge_of_halfedge=mesh.edge_of_halfedge)  # derived, not paired again
+    return QuadMesh(subdivision_matrix(mesh) @ mesh.vertices, child_faces(mesh), _halfedges=he)
 
 
 def subdivision_matrix(mesh):

@@ -104,3 +104,47 @@ def test_refined_rejects_a_nonmanifold_parent():
     with pytest.raises(ValueError, match="not manifold"):
         HalfEdges.refined(bow.halfedges)
     assert HalfEdges.refined(bow.manifold.halfedges).n_vertices == 6 + 6 + 2
+
+
+QUAD_MESHES = ["catmark_cube_corner2.obj", "catmark_xord_boundary.obj", "catmark_nonquads.obj",
+               "catmark_smoothtris1.obj"]
+
+
+@pytest.mark.parametrize("name", QUAD_MESHES)
+def test_subdivide_derives_the_quad_childs_halfedges_in_its_sorted_numbering(name, monkeypatch):
+    """``subdivide`` of a QuadMesh (edge points in the sorted numbering of ``mesh.edges``) takes the child's
+    half-edges from HalfEdges.refined with that numbering: array by array those the constructor pairs from the
+    child's faces, and the child QuadMesh the one built from its faces alone, at levels 1 and 2."""
+    from ccproof.mesh import QuadMesh, subdivide
+
+    pm = read_mesh(DATA / "osd_features" / "meshes" / name).manifold
+    if not (pm.sizes == 4).all():
+        pm, _ = pm.refine(operator=False)
+    q = QuadMesh(pm.vertices, pm.indices.reshape(-1, 4))
+    pairings = []
+    real = HalfEdges._pair
+    for _ in range(2):
+        with monkeypatch.context() as mp:
+            mp.setattr(HalfEdges, "_pair", lambda self: pairings.append(1) or real(self))
+            child = subdivide(q)
+        assert not pairings  # no half-edge paired: the child's derived
+        alone = QuadMesh(child.vertices, child.faces)  # paired from the faces by the constructor
+        _same_halfedges(child.halfedges, alone.halfedges)
+        for k, x in alone.__dict__.items():
+            y = child.__dict__[k]
+            if isinstance(x, np.ndarray):
+                assert x.dtype == y.dtype and np.array_equal(x, y), k
+        q = child
+
+
+def test_refined_in_the_sorted_numbering_differs_from_first_occurrence():
+    """The numbering matters (the test above can fail): on a 2 x 2 grid the sorted and first-occurrence
+    numberings of the edges differ, and so do the child's half-edges derived under each."""
+    from ccproof.mesh.examples import grid
+
+    g = grid(2, 2)
+    first = HalfEdges.refined(g.halfedges)
+    srt = HalfEdges.refined(g.halfedges, edge_of_halfedge=g.edge_of_halfedge)
+    assert not np.array_equal(first.org, srt.org)
+    q = HalfEdges.from_quads(srt.org.reshape(-1, 4), srt.n_vertices)
+    assert np.array_equal(q.twin, srt.twin) and np.array_equal(q.edges, srt.edges)

@@ -235,7 +235,7 @@ def test_complex_topology_numpy_equals_the_loop(refdir, monkeypatch):
     """The numpy construction of a large Complex's half-edge lists gives the loop's lists exactly (twins,
     edge numbering by first occurrence, corners), on the OpenSubdiv shapes, their refinements and
     non-manifold meshes (a directed edge repeated: the last one is the twin, as the loop's dict keeps)."""
-    from ccproof.mesh import rules
+    from ccproof.mesh import complex as complex_module
     from ccproof.mesh.io import read_mesh
 
     names = ["osd_features/meshes/catmark_nonquads.obj", "osd_features/meshes/catmark_smoothtris1.obj",
@@ -248,10 +248,10 @@ def test_complex_topology_numpy_equals_the_loop(refdir, monkeypatch):
         faces = [list(p) for p in m.polygons]
         cases = [faces, [list(f) for f in m.manifold.refine(operator=False)[0].polygons]]
         for F in cases:
-            monkeypatch.setattr(rules, "_VECTORIZED_FACES", 1 << 30)
-            a = rules.Complex(F, {}, {}, m.options, n_vertices=None)
-            monkeypatch.setattr(rules, "_VECTORIZED_FACES", 1)
-            b = rules.Complex(F, {}, {}, m.options, n_vertices=None)
+            monkeypatch.setattr(complex_module, "_VECTORIZED_FACES", 1 << 30)
+            a = complex_module.Complex(F, {}, {}, m.options, n_vertices=None)
+            monkeypatch.setattr(complex_module, "_VECTORIZED_FACES", 1)
+            b = complex_module.Complex(F, {}, {}, m.options, n_vertices=None)
             for k in attrs:
                 assert getattr(a, k) == getattr(b, k), (name, k)
             n += 1

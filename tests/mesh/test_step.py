@@ -13,6 +13,7 @@ refine_complex; unused vertices NaN), the same vertices bit for bit, faces, tags
 """
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -21,7 +22,7 @@ from ccproof.mesh.csr import apply_csr
 from ccproof.mesh.io import read_mesh
 from ccproof.mesh.polymesh import PolyMesh
 from ccproof.mesh.rules import refine_complex, to_float
-from ccproof.mesh.step import catmark_operator
+from ccproof.mesh.step import StepOptions, catmark_operator
 
 FEATURES = ["catmark_chaikin1.obj", "catmark_cube_corner2.obj", "catmark_cube_corner4.obj",
             "catmark_cube_creases0.obj", "catmark_cubes_infsharp.obj", "catmark_dart_edgeonly.obj",
@@ -36,8 +37,8 @@ CASES = [("osd_features", m) for m in FEATURES] + [("osd_nonmanifold", m) for m 
 
 def _operator(pm):
     return catmark_operator(pm.n_vertices, pm.indices, pm.sizes, edge_sharpness=dict(pm.edge_sharpness),
-                            vertex_sharpness=dict(pm.vertex_sharpness), options=pm.options, level=pm.level,
-                            holes=pm.is_hole)
+                            vertex_sharpness=dict(pm.vertex_sharpness), holes=pm.is_hole,
+                            options=StepOptions(pm.options, pm.level))
 
 
 def _check_level(pm):
@@ -213,36 +214,43 @@ def _same_step(x, y):
 
 
 @pytest.mark.parametrize("folder,name", CASES)
-def test_the_mesh_halfedges_give_the_step_of_its_own_pairing(refdir, folder, name):
-    """catmark_operator reading the mesh's HalfEdges (what PolyMesh.refine and the QuadMesh steps pass)
-    against it pairing the half-edges itself (its own code, not HalfEdges'), at levels 0 and 1: the same
-    arrays bit for bit in the first-occurrence numbering and in HalfEdges' sorted one (the QuadMesh
-    numbering), and the edges of each numbering where that numbering puts them."""
+def test_the_step_reads_the_pairing_of_halfedges(refdir, folder, name):
+    """The step pairs no half-edges: its topology is read from HalfEdges (the mesh's, or built once when none
+    is passed), at levels 0 and 1 (the child's HalfEdges derived by HalfEdges.refined). Against the pairing of
+    rules.Complex (its own code: a dict of directed edges, or its numpy sort): the same twins, the edges
+    numbered by first occurrence, each as its first half-edge; in HalfEdges' sorted numbering (the QuadMesh
+    numbering) the edges where that numbering puts them; the step the same bits whichever HalfEdges it reads."""
+    from ccproof.mesh.step_topology import step_topology
+
     pm = read_mesh(refdir / folder / "meshes" / name).manifold
     for _ in range(2):
         he = pm.halfedges
         assert he.edge_manifold
         kw = dict(edge_sharpness=dict(pm.edge_sharpness), vertex_sharpness=dict(pm.vertex_sharpness),
-                  options=pm.options, level=pm.level, holes=pm.is_hole, sparse=False)
-        paired = catmark_operator(pm.n_vertices, pm.indices, pm.sizes, **kw)
-        _same_step(catmark_operator(pm.n_vertices, pm.indices, pm.sizes, halfedges=he, **kw), paired)
-        cx = pm.complex()  # edges numbered by first occurrence, each as its first half-edge
-        assert [[cx.org[h], cx.org[cx.nxt[h]]] for h in cx.edges] == paired.edges.tolist()
-        sorted_paired = catmark_operator(pm.n_vertices, pm.indices, pm.sizes, edge_of_halfedge=he.edge_of, **kw)
+                  holes=pm.is_hole, options=StepOptions(pm.options, pm.level, sparse=False))
+        built = catmark_operator(pm.n_vertices, pm.indices, pm.sizes, **kw)
+        _same_step(catmark_operator(pm.n_vertices, pm.indices, pm.sizes, halfedges=he, **kw), built)
+        cx = pm.complex()
+        t = step_topology(pm.n_vertices, pm.indices, pm.sizes, he, None)
+        assert t.twin.tolist() == cx.twin and t.he_edge.tolist() == cx.he_edge and t.h1.tolist() == cx.edges
+        assert [[cx.org[h], cx.org[cx.nxt[h]]] for h in cx.edges] == built.edges.tolist()
         got = catmark_operator(pm.n_vertices, pm.indices, pm.sizes, halfedges=he, edge_of_halfedge=he.edge_of, **kw)
-        _same_step(got, sorted_paired)
         assert np.array_equal(np.sort(got.edges, axis=1), he.edges)
         pm, _ = pm.refine(operator=False)
 
 
-def test_halfedges_with_a_non_manifold_edge_are_not_read():
-    """Three faces on the edge (0, 1): the step pairs the half-edges itself and refuses the mesh."""
+def test_a_non_manifold_edge_is_refused_by_name():
+    """Three faces on the edge (0, 1), or two faces running along (1, 2) the same way: the step refuses the
+    mesh naming the edge, whether it reads the mesh's HalfEdges or builds them."""
     from ccproof.errors import MeshError
 
     pm = PolyMesh(np.zeros((5, 3)), [[0, 1, 2], [1, 0, 3], [0, 1, 4]])
     assert not pm.halfedges.edge_manifold
-    with pytest.raises(MeshError, match=r"edge \(0, 1\) has 3 faces"):
-        catmark_operator(pm.n_vertices, pm.indices, pm.sizes, halfedges=pm.halfedges)
+    for he in (pm.halfedges, None):
+        with pytest.raises(MeshError, match=r"edge \(0, 1\) has 3 faces"):
+            catmark_operator(pm.n_vertices, pm.indices, pm.sizes, halfedges=he)
+    with pytest.raises(MeshError, match=r"edge \(1, 2\) has 2 faces that do not pair"):
+        catmark_operator(5, [0, 1, 2, 4, 1, 2, 3], [3, 4])
 
 
 def test_halfedges_of_another_mesh_are_refused():
@@ -380,3 +388,33 @@ def test_pack_csr_restores_the_bits():
         Y = p.apply(X)
         assert np.array_equal(Y, apply_csr(csr, X))
         assert np.array_equal(Y, sp.csr_matrix((data, csr[1], csr[0]), shape=(40, 30)) @ X)
+
+
+def test_a_third_quad_scheme_is_a_scheme_value():
+    """The step reads its weights through the scheme: OpenSubdiv's bilinear rules written as a Scheme value
+    (vertex points stay, edge points are midpoints, face points centroids), no change to the step, give the
+    bilinear operator, checked row by row against the faces; CATMARK's differs (the seam is read)."""
+    import dataclasses
+
+    from ccproof.mesh.scheme import CATMARK
+
+    bilinear = dataclasses.replace(CATMARK, name="bilinear", edge_point=lambda one: (one / 2, 0 * one),
+                                   vertex_point=lambda k, one: (one, 0 * one, 0 * one),
+                                   crease_vertex=lambda one: (one, 0 * one))
+    pm = read_mesh(Path(__file__).resolve().parents[1] / "data" / "osd_features" / "meshes"
+                   / "catmark_nonquads.obj").manifold
+    n = pm.n_vertices
+    st = catmark_operator(n, pm.indices, pm.sizes, halfedges=pm.halfedges, scheme=bilinear)
+    S = st.S.toarray()
+    E = st.edges.shape[0]
+    want = np.zeros_like(S)
+    used = np.bincount(pm.indices, minlength=n) > 0
+    want[np.flatnonzero(used), np.flatnonzero(used)] = 1.0
+    for e, (a, b) in enumerate(st.edges.tolist()):
+        want[n + e, a] += 0.5
+        want[n + e, b] += 0.5
+    off = np.r_[0, np.cumsum(pm.sizes)]
+    for f in range(pm.sizes.size):
+        want[n + E + f, pm.indices[off[f]:off[f + 1]]] += 1.0 / pm.sizes[f]
+    assert np.array_equal(S, want)
+    assert not np.array_equal(catmark_operator(n, pm.indices, pm.sizes).S.toarray(), want)

@@ -1,0 +1,106 @@
+"""OpenSubdiv's Sdc crease rules, one vertex at a time (``sdc/crease.cpp``): what every scheme shares.
+
+Sharpness ``s`` is an IEEE float32 as in OpenSubdiv, ``s >= INFINITE`` (10) is infinite; the rule of a
+vertex (:func:`vertex_rule`) follows from its sharpness and the number of sharp edges at it; sharpness decays
+by one per level (:func:`decrement`), or by Chaikin's average around a vertex
+(:func:`child_sharpness_at_vertex`). :func:`ccproof.mesh.rules.refine_complex` reads them; the vectorized
+step (:mod:`ccproof.mesh.step`) writes the same rules over the whole mesh (checked equal bit for bit by
+tests/mesh/test_step.py).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+__all__ = ["INFINITE", "SMOOTH", "DART", "CREASE", "CORNER", "decrement", "child_sharpness_at_vertex",
+           "vertex_rule"]
+
+#: OpenSubdiv's Sdc::Crease::SHARPNESS_INFINITE: sharpness at or above it is infinite
+INFINITE = 10.0
+
+#: the vertex rules (Sdc ``Crease::Rule``)
+SMOOTH, DART, CREASE, CORNER = "smooth", "dart", "crease", "corner"
+
+_F32 = np.float32
+_ONE = _F32(1.0)
+
+
+def _is_semi_sharp(s):
+    return 0.0 < s < INFINITE
+
+
+def decrement(s):
+    """Sdc's uniform decay of one float32 sharpness: ``s - 1`` in float32 above 1, 0 at or below, infinite stays.
+
+    >>> decrement(2.5), decrement(0.5), decrement(10.0)
+    (1.5, 0.0, inf)
+    """
+    if s <= 0.0:
+        return 0.0
+    if s >= INFINITE:
+        return math.inf
+    if s > 1.0:
+        return float(_F32(s) - _ONE)
+    return 0.0
+
+
+def child_sharpness_at_vertex(edge_sharpness, chaikin):
+    """Sdc ``SubdivideEdgeSharpnessesAroundVertex``: child sharpness of every edge at one vertex.
+
+    ``CREASE_UNIFORM`` (``chaikin`` False): each decays by one; ``CREASE_CHAIKIN``: with two or more
+    semi-sharp edges, ``0.75 s + 0.25 mean(other semi-sharp) - 1`` in float32.
+
+    >>> child_sharpness_at_vertex([2.0, 1.0, 0.0], False), child_sharpness_at_vertex([2.0, 1.0, 0.0], True)
+    ([1.0, 0.0, 0.0], [0.75, 0.25, 0.0])
+    """
+    if not chaikin or len(edge_sharpness) < 2:
+        return [decrement(s) for s in edge_sharpness]
+    semi = [s for s in edge_sharpness if _is_semi_sharp(s)]
+    if not semi:
+        return list(edge_sharpness)
+    total = _F32(0.0)
+    for s in semi:
+        total = _F32(total + _F32(s))
+    out = []
+    for s in edge_sharpness:
+        if s <= 0.0:
+            out.append(0.0)
+        elif s >= INFINITE:
+            out.append(math.inf)
+        elif len(semi) == 1:
+            out.append(decrement(s))
+        else:
+            avg = _F32((total - _F32(s)) / _F32(len(semi) - 1))
+            c = _F32(_F32(_F32(0.75) * _F32(s)) + _F32(_F32(0.25) * avg)) - _ONE
+            out.append(float(c) if c > 0 else 0.0)
+    return out
+
+
+def vertex_rule(vertex_sharpness, edge_sharpness):
+    """Sdc ``DetermineVertexVertexRule``: 'corner', 'crease', 'dart' or 'smooth'.
+
+    Parameters
+    ----------
+    vertex_sharpness : float
+    edge_sharpness : sequence of float
+        Sharpness of the edges at the vertex.
+
+    Returns
+    -------
+    str
+        A sharp vertex or three or more sharp edges: corner; two: crease; one: dart; none: smooth.
+
+    Examples
+    --------
+    >>> import math
+    >>> [vertex_rule(0.0, e) for e in ([0, 0, 0, 0], [math.inf, 0, 0, 0], [2, 0, 2, 0], [1, 1, 1, 0])]
+    ['smooth', 'dart', 'crease', 'corner']
+    >>> vertex_rule(1.0, [0, 0, 0, 0])
+    'corner'
+    """
+    if vertex_sharpness > 0.0:
+        return CORNER
+    n = sum(1 for s in edge_sharpness if s > 0.0)
+    return (SMOOTH, DART, CREASE)[n] if n <= 2 else CORNER
