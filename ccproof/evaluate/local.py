@@ -731,7 +731,8 @@ def _fmpq_mat_to_float(M):
 
 
 #: what computes the data
-_SOURCES = ("evaluate/local.py", "evaluate/_powers.py", "evaluate/_diskcache.py", "mesh/rules.py", "rule_weights.py")
+_SOURCES = ("evaluate/local.py", "evaluate/_powers.py", "evaluate/_diskcache.py", "mesh/rules.py", "mesh/complex.py",
+            "mesh/crease.py", "mesh/scheme.py", "rule_weights.py")
 
 
 @functools.lru_cache(maxsize=1)
