@@ -18,9 +18,9 @@ import threading
 import numpy as np
 
 from ccproof.errors import CCProofError
-from ccproof.evaluate._table import COMPOSED_LAYERS
+from ccproof.evaluate.patch_table import COMPOSED_LAYERS
 
-__all__ = ["load", "CTable", "evaluate_block", "ring_walks"]
+__all__ = ["load", "CTable", "evaluate_block", "point_blocks", "ring_walks"]
 
 _P = ctypes.c_void_p
 _I = ctypes.c_int64
@@ -113,7 +113,7 @@ def _powers_of_two(a):
 
 
 class CTable:
-    """The patch table (:class:`ccproof.evaluate._table.PatchTable`) as the C kernel reads it.
+    """The patch table (:class:`ccproof.evaluate.patch_table.PatchTable`) as the C kernel reads it.
 
     Holds the arrays in the dtypes the kernel reads (the table's own arrays where they already are), the
     ``ccp_table`` structure pointing into them, and the corner-net caches of the calls (7.3 MB each, one
@@ -253,6 +253,27 @@ def evaluate_block(lib, ct, f, u, v, d, outs):
         return int(lib.ccp_evaluate(ct.ref, f.size, _addr(f), _addr(u), _addr(v), d, *ptrs, _addr(cache)))
     finally:
         ct.give_cache(cache)
+
+
+def point_blocks(lib, ct, f, u, v, d, outs):
+    """``(block, back)`` for :func:`ccproof.evaluate.backend.evaluation_blocks`: ``block(lo, hi)`` calls
+    :func:`evaluate_block` on the points lo:hi (``f, u, v`` contiguous) of the table ``ct`` (a :class:`CTable`);
+    ``outs`` the six outputs (None where absent), those beyond derivative order ``d`` not written; ``back``:
+    ``[(index, temporary)]`` for the outputs it cannot write in place (not contiguous float64 (n, 3))."""
+    f, u, v = (np.ascontiguousarray(a) for a in (f, u, v))
+    n = f.size
+    back, arrs = [], []
+    for i, a in enumerate(outs):
+        a = a if i < (1, 3, 6)[d] else None
+        if a is not None and not (isinstance(a, np.ndarray) and a.dtype == np.float64
+                                  and a.shape == (n, 3) and a.flags.c_contiguous):
+            back.append((i, np.empty((n, 3))))
+            a = back[-1][1]
+        arrs.append(a)
+
+    def block(lo, hi):
+        return evaluate_block(lib, ct, f[lo:hi], u[lo:hi], v[lo:hi], d, [None if a is None else a[lo:hi] for a in arrs])
+    return block, back
 
 
 def _arg(a, dtype, name):

@@ -1,7 +1,7 @@
 """Compiled evaluation kernel (numba), the same arithmetic as the numpy path point by point, and the
 compiled Newton descent of the closest points (:func:`ccproof.evaluate.newton.newton_descent`, point by point).
 
-Imported only when numba is installed; :mod:`ccproof.evaluate.surface` falls back to numpy otherwise.
+The numba backend (chosen by :mod:`ccproof.evaluate.backend`; without numba its kernels are None).
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ try:
 except ImportError:  # pragma: no cover - optional dependency
     numba = None
 
-from ccproof.evaluate._table import COMPOSED_LAYERS, KIND_CORNER, KIND_SPLIT
+from ccproof.evaluate.patch_table import COMPOSED_LAYERS, KIND_CORNER, KIND_SPLIT
 
 #: corner nets (layers beyond the precomputed ones) kept per kernel call: slots (a power of 2, 408 bytes each)
 _CACHE_SLOTS = 16384
@@ -23,6 +23,18 @@ _CACHE_SLOTS = 16384
 _CACHE_MIN = 256
 #: multiplier spreading the patch keys over the slots (Knuth's multiplicative hash)
 _HASH = 2654435761
+
+
+def point_blocks(kernel, table, f, u, v, d, outs):
+    """``(block, [])`` for :func:`ccproof.evaluate.backend.evaluation_blocks`: ``block(lo, hi)`` calls ``kernel``
+    (:func:`evaluate_points`) on the points lo:hi of ``table`` (a :class:`~ccproof.evaluate.patch_table.PatchTable`)
+    and the six outputs ``outs`` (None where absent)."""
+    dummy = np.empty((0, 3))
+    arrs = [dummy if a is None else a for a in outs]
+
+    def block(lo, hi):
+        return kernel(f[lo:hi], u[lo:hi], v[lo:hi], d, table, *[a[lo:hi] if a.shape[0] else a for a in arrs])
+    return block, []
 
 
 def _basis(x):
@@ -222,7 +234,7 @@ def _corner_net(T, job, vf, cfg, lay, code, ci, W, s, rc):
 
 def _evaluate_points(f, u, v, d, T, P, Pu, Pv, Puu, Puv, Pvv):
     """Fill P (n, 3) and, for d >= 1, Pu, Pv, for d >= 2, Puu, Puv, Pvv (each (n, 3)) from the patch
-    table ``T`` (:class:`ccproof.evaluate._table.PatchTable`).
+    table ``T`` (:class:`ccproof.evaluate.patch_table.PatchTable`).
 
     Returns -1, or the index of the first point whose face is out of range or refused (a hole)
     or whose (u, v) is outside [0, 1]^2 or NaN; the caller then names it (the outputs from that
