@@ -283,9 +283,10 @@ def _arg(a, dtype, name):
     return _addr(a)
 
 
-def ring_walks(org, nxt, prv, twin, pos, seen, g, r, rings, nring, faces, nfaces, hashes):
+def ring_walks(halfedges, scratch, g, r, out):
     """The ring walk of :func:`ccproof.evaluate._numba_kernel.ring_walks` (the same arguments and results)
     in C: ``ccp_ring_walks`` of ``_clib.c``. Requires :func:`load` to have found the library."""
+    (org, nxt, prv, twin), (pos, seen), (rings, nring, faces, nfaces, hashes) = halfedges, scratch, out
     lib = load()
     k, maxn = rings.shape
     maxf = faces.shape[1]

@@ -16,6 +16,7 @@ from __future__ import annotations
 import functools
 import sys
 from array import array
+from typing import NamedTuple
 
 import numpy as np
 
@@ -45,6 +46,39 @@ MAX_DEPTH = 4
 #: local subdivisions allowed in the semi-sharp phase of a tagged mesh (sharpness < 10 decays in
 #: 10 uniform levels)
 MAX_SEMI_DEPTH = 40
+
+
+class Depth(NamedTuple):
+    """How many local subdivisions lie above a virtual face: ``local`` ones (at most :data:`MAX_DEPTH`), and
+    ``semi`` in the semi-sharp phase (at most :data:`MAX_SEMI_DEPTH`).
+
+    >>> Depth(0, 0).split().semi_split()
+    Depth(local=1, semi=1)
+    """
+
+    local: int
+    semi: int
+
+    def split(self):
+        return Depth(self.local + 1, self.semi)
+
+    def semi_split(self):
+        return Depth(self.local, self.semi + 1)
+
+
+class _BlockWalk(NamedTuple):
+    """What every block of :meth:`Builder._walk_all` shares: the half-edges ``he``, the compiled ring walk
+    ``walks`` and its scratch arrays ``pos`` and ``seen``, the :class:`Jobs` and the id ``j0`` of the first,
+    the options' key ``opts``, and the view ``view`` that computes the keys of tagged rings (or None)."""
+
+    he: object
+    walks: object
+    pos: np.ndarray
+    seen: np.ndarray
+    jobs: object
+    j0: int
+    opts: tuple
+    view: object
 
 
 def _smooth_regular_vertices(he):
@@ -224,37 +258,40 @@ class Builder:
         (:func:`ccproof.evaluate.local.ring_key` on the mesh read as a complex, :class:`ComplexView`;
         untagged: the faces and the options). Rings the walk cannot classify
         (beyond its arrays; a semi-sharp ring that needs the Chaikin two-ring) take the Python walk."""
-        walks = backend.compiled_ring_walk(todo.size)
-        opts = he.options.key()
-        view = ComplexView(he) if isinstance(he, TaggedHalfEdges) else None  # (keys of tagged rings)
-        pos = np.full(he.n_vertices, -1, dtype=np.int64)
-        seen = np.zeros(he.n_faces, dtype=np.bool_)
+        w = _BlockWalk(he, backend.compiled_ring_walk(todo.size), np.full(he.n_vertices, -1, dtype=np.int64),
+                       np.zeros(he.n_faces, dtype=np.bool_), jobs, j0, he.options.key(),
+                       ComplexView(he) if isinstance(he, TaggedHalfEdges) else None)  # (view: keys of tagged rings)
         bar = _progress(self.progress, todo.size, "patch table")
         step = 1 << 15
         fallback = []
         for lo in range(0, todo.size, step):
             idx = todo[lo:lo + step]
             r0 = single[lo:lo + step]
-            retry, fb = self._walk_block(he, walks, pos, seen, jobs, j0, idx, np.maximum(r0, 0), r0 >= 0, opts, view)
+            retry, fb = self._walk_block(w, idx, np.maximum(r0, 0), r0 >= 0)
             fallback.append(fb)
             if retry.size:  # corner candidates that are not corner faces: from corner 0
-                fallback.append(self._walk_block(he, walks, pos, seen, jobs, j0, retry, np.zeros(retry.size, np.int64),
-                                                 np.zeros(retry.size, bool), opts, view)[1])
+                zero = np.zeros(retry.size, np.int64)
+                fallback.append(self._walk_block(w, retry, zero, zero.astype(bool))[1])
             bar.update(idx.size)
         bar.close()
         fallback = np.concatenate(fallback) if fallback else np.zeros(0, dtype=np.int64)
         if fallback.size:
             where = {int(i): n for n, i in enumerate(todo.tolist())}
-            self._python_walk(he, jobs, j0, fallback, single[[where[i] for i in fallback.tolist()]], view)
+            self._python_walk(he, jobs, j0, fallback, single[[where[i] for i in fallback.tolist()]], w.view)
 
-    def _walk_block(self, he, walks, pos, seen, jobs, j0, idx, r, at_corner, opts, view=None, maxn=64, maxf=48):
+    def _walk_block(self, w, idx, r, at_corner, maxn=64, maxf=48):
+        """Walk the rings of the jobs ``idx`` of ``w`` (a :class:`_BlockWalk`) from their corners ``r`` (corner
+        candidates where ``at_corner``) and register them by groups of equal rings (:meth:`_walk_all`). Returns
+        the corner candidates that are not corner faces and the jobs left to the Python walk."""
+        he, jobs, j0, view = w.he, w.jobs, w.j0, w.view
         k = idx.size
         rings = np.full((k, maxn), -1, dtype=np.int32)
         faces = np.zeros((k, maxf, 4), dtype=np.int64)
         nring = np.empty(k, dtype=np.int64)
         nfaces = np.empty(k, dtype=np.int64)
         hashes = np.empty(k, dtype=np.uint64)
-        walks(he.org, he.nxt, he.prv, he.twin, pos, seen, jobs.g[idx], r, rings, nring, faces, nfaces, hashes)
+        w.walks((he.org, he.nxt, he.prv, he.twin), (w.pos, w.seen), jobs.g[idx], r,
+                (rings, nring, faces, nfaces, hashes))
         fallback = [idx[nring < 0]]  # a ring beyond the arrays (a valence above ~25): the Python walk
         tagged = isinstance(he, TaggedHalfEdges)
         cols = [hashes.view(np.int64), r + 4 * at_corner + 8 * jobs.fid[idx]]
@@ -284,7 +321,7 @@ class Builder:
             if tagged:
                 key = ring_key(view, rings[rep, :n].tolist(), ftup, 4)
             else:
-                key = (ftup, (), (), opts)
+                key = (ftup, (), (), w.opts)
             if tagged and self.depth_semi != 1 and has_semi_sharp(key) and not at_corner[rep]:
                 fallback.append(idx[mem])  # the Chaikin phase reads the two-ring: the Python walk
                 continue
@@ -393,15 +430,16 @@ class Builder:
             raise MeshError(f"internal error: the ring of {self.what} {base} is not read back from its key")
         t = Template(N)
         root = t.new_vface(KIND_REGULAR, frame)
-        self._face(t, kc, np.eye(N), 0, frame, 0, 0, base, root, vmap=np.arange(N))
+        self._face(t, kc, np.eye(N), 0, frame, Depth(0, 0), base, root, vmap=np.arange(N))
         return t
 
     # ------------------------------------------------------------------ template building
-    def _face(self, t, cx, X, g, frame, depth, semi_depth, base, vid, src=None, vmap=None):
+    def _face(self, t, cx, X, g, frame, depth, base, vid, src=None, vmap=None):
         """Classify quad ``g`` of complex ``cx`` with positions ``X`` (NaN where not exact) into
         virtual face ``vid`` of template ``t``.
 
-        ``src = (key, n_rule)``: ``cx`` is the child complex of that ring (its rings are cached).
+        ``depth``: the local subdivisions above it (a :class:`Depth`). ``src = (key, n_rule)``: ``cx`` is the
+        child complex of that ring (its rings are cached).
         ``vmap``: ring position of every vertex of ``cx`` (-1 for new points).
         """
 
@@ -413,12 +451,12 @@ class Builder:
 
         ring, key, nr = ring_of(0, 1)
         if has_semi_sharp(key):
-            if semi_depth >= MAX_SEMI_DEPTH:
+            if depth.semi >= MAX_SEMI_DEPTH:
                 raise MeshError(f"{self.what} {base}: semi-sharp creases did not decay in {MAX_SEMI_DEPTH} levels")
             D = self.depth_semi
             if D != 1:
                 ring, key, nr = ring_of(0, D)
-            return self.split_face(t, key, nr, X[ring], frame, depth, semi_depth + 1, base, vid, vmap[ring])
+            return self.split_face(t, key, nr, X[ring], frame, depth.semi_split(), base, vid, vmap[ring])
         irr = irregular_corners(key)
         if not irr:
             M = regular_net_matrix(key)
@@ -436,12 +474,12 @@ class Builder:
             ring_r, key_r, _ = ring_of(r, 1)
             if corner_scheme(key_r) is not None:
                 return self.scheme_face(t, key_r, X, ring_r, r, frame, base, vid, vmap)
-        if depth >= MAX_DEPTH:
+        if depth.local >= MAX_DEPTH:
             raise MeshError(
                 f"{self.what} {base}: the configuration around it is not supported "
                 f"(still irregular after {MAX_DEPTH} local subdivisions)"
             )
-        return self.split_face(t, key, nr, X[ring], frame, depth + 1, semi_depth, base, vid, vmap[ring])
+        return self.split_face(t, key, nr, X[ring], frame, depth.split(), base, vid, vmap[ring])
 
     def scheme_face(self, t, key_r, X, ring_r, r, frame, base, vid, vmap):
         """Virtual face ``vid`` of ``t`` is a corner face of the scheme of ``key_r``
@@ -471,7 +509,7 @@ class Builder:
         t.cor_vertex.append(int(vmap[ring_r[0]]))
         return vid
 
-    def split_face(self, t, key, nr, Xr, frame, depth, semi_depth, base, vid, vmap):
+    def split_face(self, t, key, nr, Xr, frame, depth, base, vid, vmap):
         """Subdivide the ring ``key`` (positions ``Xr``) once, exactly and locally; classify the
         four children of its face 0 into new virtual faces of ``t``.
 
@@ -492,7 +530,7 @@ class Builder:
             q = int(cu > U0) + 2 * int(cv > V0)
             c = t.new_vface(KIND_REGULAR, cf)
             t.child[vid][q] = c
-            self._face(t, child, X1, i, cf, depth, semi_depth, base, c, src=(key, nr), vmap=vmap1)
+            self._face(t, child, X1, i, cf, depth, base, c, src=(key, nr), vmap=vmap1)
         return vid
 
     # ------------------------------------------------------------------ assembly

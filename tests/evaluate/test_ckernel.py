@@ -220,7 +220,7 @@ def test_ring_walks_equal_the_numba_walk(maxn, maxf):
             pos, seen = np.full(m.n_vertices, -1, np.int64), np.zeros(m.n_faces, bool)
             out = (np.full((g.size, maxn), -1, np.int32), np.empty(g.size, np.int64),
                    np.zeros((g.size, maxf, 4), np.int64), np.empty(g.size, np.int64), np.empty(g.size, np.uint64))
-            walk(he.org, he.nxt, he.prv, he.twin, pos, seen, g, r, *out)
+            walk((he.org, he.nxt, he.prv, he.twin), (pos, seen), g, r, tuple(out))
             assert (pos == -1).all() and not seen.any()  # the scratch arrays restored
             res.append(out)
         for a, b in zip(*res):

@@ -121,8 +121,8 @@ def test_ring_tags_separate_the_keys():
         pos = np.full(he.n_vertices, -1, dtype=np.int64)
         seen = np.zeros(he.faces.shape[0], dtype=np.bool_)
         walk = backend.compiled_ring_walk(k)
-        walk(he.org, he.nxt, he.prv, he.twin, pos, seen, np.zeros(1, np.int64), np.zeros(1, np.int64),
-             rings, nring, fc, nfaces, hashes)
+        walk((he.org, he.nxt, he.prv, he.twin), (pos, seen), np.zeros(1, np.int64), np.zeros(1, np.int64),
+             (rings, nring, fc, nfaces, hashes))
         rows.append(he.ring_tags(rings, nring, fc, nfaces)[0])
     nz = [sorted(set(r[r != 0].tolist())) for r in rows]
     assert nz == [[2.0], [math.inf], []]
