@@ -199,6 +199,7 @@ def _configuration_ops(schemes):
         off += L.size
     return ops, op_start, op_size, n_layers, unit
 
+
 def assemble(temps, schemes, n_jobs, X, top, refused):
     """The :class:`PatchTable` of the finished templates ``temps`` (their ``cfg`` indices into ``schemes``, the
     configurations ``[(CornerScheme, orientation)]``) of ``n_jobs`` jobs with positions ``X``, without
