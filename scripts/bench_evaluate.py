@@ -70,8 +70,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))  # scripts/_osd.py
 from _bench import missing, ratio_line  # noqa: E402
 
 from ccproof.evaluate import natural_limit_surface as limit_surface  # noqa: E402
+from ccproof.evaluate.backend import available_backends  # noqa: E402
 from ccproof.evaluate.local import CORNERS  # noqa: E402
-from ccproof.evaluate.surface import available_backends  # noqa: E402
 from ccproof.mesh import limit_normals, limit_positions, read_obj, subdivide  # noqa: E402
 from ccproof.mesh.io import read_mesh  # noqa: E402
 
@@ -371,11 +371,12 @@ m = [hwm()]
 import numpy as np
 t.append(time.perf_counter()); m.append(hwm())
 import ccproof.evaluate.surface as surface
+from ccproof.evaluate import available_backends
 from ccproof.mesh.io import read_mesh
 t.append(time.perf_counter()); m.append(hwm())
 S = surface.natural_limit_surface(read_mesh(sys.argv[1]))
 t.append(time.perf_counter()); m.append(hwm())
-name = surface.available_backends()[0] if os.environ.get("CCPROOF_BACKEND", "auto") == "auto" else \
+name = available_backends()[0] if os.environ.get("CCPROOF_BACKEND", "auto") == "auto" else \
     os.environ["CCPROOF_BACKEND"]
 S.evaluate([0], [0.5], [0.5], 1, threads=1)  # the first call loads the backend's kernel
 t.append(time.perf_counter()); m.append(hwm())

@@ -49,7 +49,7 @@ from _bench import load, missing, ratio_line  # noqa: E402
 from bench_evaluate import SHAPES, near_ev_points, uniform_points  # noqa: E402
 
 from ccproof.evaluate import natural_limit_surface  # noqa: E402
-from ccproof.evaluate.surface import available_backends  # noqa: E402
+from ccproof.evaluate.backend import available_backends  # noqa: E402
 from ccproof.mesh.io import read_mesh  # noqa: E402
 
 #: the worker: reads "case path npz" lines, prints "thread-seconds digest" per line
@@ -60,7 +60,7 @@ if os.environ.get("CCPROOF_AB_UNSORTED"):
     from ccproof.evaluate import surface
     surface.SORT_MIN = 1 << 62
 from ccproof.evaluate import natural_limit_surface
-from ccproof.evaluate.surface import available_backends
+from ccproof.evaluate.backend import available_backends
 from ccproof.mesh.io import read_mesh
 if "c" not in available_backends():
     sys.exit(f"{os.environ.get('CCPROOF_CLIB')}: not loaded (not a build of this _clib.c?)")

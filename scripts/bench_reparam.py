@@ -132,7 +132,7 @@ def main(argv=None):
     if args.points <= 0:
         return
 
-    from ccproof.evaluate.surface import available_backends
+    from ccproof.evaluate.backend import available_backends
     from ccproof.reparam import corner_valence, limit_surface
     from ccproof.reparam.blend import face_map
 

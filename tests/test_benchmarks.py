@@ -109,7 +109,7 @@ def test_benchmark_uses_public_names_only(name):
 def test_the_private_name_check_can_fail():
     """The check above flags what it must: a forger's private import, a private attribute, the same in code
     a script runs in another process."""
-    assert _private_uses("from ccproof.evaluate._table import catmark_step") != []
+    assert _private_uses("from ccproof.evaluate._basis import basis_rows") != []
     assert _private_uses("from ccproof.evaluate.surface import _CORNER") != []
     assert _private_uses("S = f()\nT = S._table") != []
     assert _private_uses('CODE = """\nimport ccproof\nfrom ccproof.evaluate import _ckernel\n"""') != []

@@ -47,7 +47,7 @@ def test_a_function_entry_needs_that_functions_index(tmp_path, monkeypatch):
 def test_no_evaluation_kernel_to_compile_on_the_c_kernel(tmp_path, monkeypatch):
     """With the C kernel built and the automatic backend, ``eval`` compiles nothing (no notice with an empty
     numba cache) and ``project`` waits only for its other kernels (Newton descent, search structure)."""
-    from ccproof.evaluate.surface import available_backends
+    from ccproof.evaluate.backend import available_backends
 
     if "c" not in available_backends():
         pytest.skip("the C kernel was not built")

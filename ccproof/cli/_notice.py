@@ -84,7 +84,7 @@ def c_kernel_evaluates():
     """
     if os.environ.get("CCPROOF_BACKEND", "auto") not in ("auto", "c"):
         return False
-    from ccproof.evaluate.surface import available_backends
+    from ccproof.evaluate.backend import available_backends
 
     return "c" in available_backends()
 

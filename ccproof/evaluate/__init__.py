@@ -18,15 +18,16 @@ package-wide ``limit_surface`` is :func:`ccproof.limit_surface`.
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:  # the lazy names below, as type checkers see them
-    from ccproof.evaluate._table import PatchTable
-    from ccproof.evaluate.surface import LimitSurface, available_backends, natural_limit_surface
+    from ccproof.evaluate.backend import available_backends
+    from ccproof.evaluate.patch_table import PatchTable
+    from ccproof.evaluate.surface import LimitSurface, natural_limit_surface
     from ccproof.evaluate.surface import limit_surface as limit_surface  # the former name
 
 #: lazily loaded public names -> defining module
 _WHERE = {
     "LimitSurface": "ccproof.evaluate.surface",
-    "PatchTable": "ccproof.evaluate._table",
-    "available_backends": "ccproof.evaluate.surface",
+    "PatchTable": "ccproof.evaluate.patch_table",
+    "available_backends": "ccproof.evaluate.backend",
     "natural_limit_surface": "ccproof.evaluate.surface",
     "limit_surface": "ccproof.evaluate.surface",  # former name of natural_limit_surface
 }

@@ -1,6 +1,6 @@
 """Basis rows of a limit surface: the sparse linear map from the file's control points to points and derivatives.
 
-The patch table (:mod:`ccproof.evaluate._table`) computes every float it holds as a linear function of the
+The patch table (:mod:`ccproof.evaluate.patch_table`) computes every float it holds as a linear function of the
 control points: per job, ``rel = X[ring] - X[ring[0]]`` and a template operator (``R`` for regular nets,
 ``Q`` for corner rings, ``O`` for limit points); a corner layer's net is its configuration's layer
 operator ``L[n, code]`` applied to the corner ring. Composing these per *key* (a regular virtual face, or

@@ -109,8 +109,12 @@ if numba is not None:  # pragma: no branch
     _build = numba.njit(cache=True, nogil=True)(_build)
 
 
-def _traverse(X, dstar, order, lo, hi, child, start, count, c, nrm, r, h, out_p, out_c, out_lb, cap):
-    """Write the pairs (point, cell, lower bound) with lower bound < d* (the first ``cap``); their number."""
+def _traverse(X, dstar, tree, cells, out, cap):
+    """Write the pairs (point, cell, lower bound) with lower bound < d* (the first ``cap``) into ``out`` =
+    (points, cells, lower bounds); their number. ``tree``: :func:`build`'s; ``cells``: (c, nrm, r, h)."""
+    order, lo, hi, child, start, count = tree
+    c, nrm, r, h = cells
+    out_p, out_c, out_lb = out
     npts = X.shape[0]
     total = 0
     stack = np.empty(128, dtype=np.int64)
@@ -158,10 +162,13 @@ if numba is not None:  # pragma: no branch
     _traverse = numba.njit(cache=True, nogil=True)(_traverse)
 
 
-def _expand(X, dstar, pid, pos, slot, c, nrm, r, h, mm, out_p, out_c, out_lb):
-    """Write the pairs (point, cell, lower bound) with lower bound < d* of candidate pairs (point, face):
-    face ``pos[i]`` has its ``mm`` cells at rows ``slot[i] * mm ...`` of (c, nrm, r, h); cell ids are
-    ``pos * mm + k``. Returns their number (``out_*`` hold ``pid.size * mm`` rows)."""
+def _expand(X, dstar, pid, pos, slot, cells, mm, out):
+    """Write the pairs (point, cell, lower bound) with lower bound < d* of candidate pairs (point, face) into
+    ``out`` = (points, cells, lower bounds): face ``pos[i]`` has its ``mm`` cells at rows ``slot[i] * mm ...`` of
+    ``cells`` = (c, nrm, r, h); cell ids are ``pos * mm + k``. Returns their number (``out`` holds
+    ``pid.size * mm`` rows)."""
+    c, nrm, r, h = cells
+    out_p, out_c, out_lb = out
     total = 0
     for i in range(pid.size):
         p = pid[i]
@@ -212,7 +219,7 @@ def expand_cells(X, dstar, pid, pos, slot, cells, mm):
     out_p, out_c, out_lb = np.empty(m, dtype=np.int64), np.empty(m, dtype=np.int64), np.empty(m)
     k = _expand(np.ascontiguousarray(X, dtype=np.float64), np.ascontiguousarray(dstar, dtype=np.float64),
                 np.asarray(pid, dtype=np.int64), np.asarray(pos, dtype=np.int64), np.asarray(slot, dtype=np.int64),
-                *cells, int(mm), out_p, out_c, out_lb)
+                tuple(cells), int(mm), (out_p, out_c, out_lb))
     return out_p[:k].copy(), out_c[:k].copy(), out_lb[:k].copy()
 
 
@@ -275,7 +282,7 @@ def candidates(X, dstar, tree, c, nrm, r, h):
         pid = np.empty(cap, dtype=np.int64)
         cid = np.empty(cap, dtype=np.int64)
         lb = np.empty(cap)
-        k = _traverse(X, dstar, *tree, c, nrm, r, h, pid, cid, lb, cap)
+        k = _traverse(X, dstar, tuple(tree), (c, nrm, r, h), (pid, cid, lb), cap)
         if k <= cap:
             return pid[:k], cid[:k], lb[:k]
         cap = k

@@ -18,9 +18,9 @@ import threading
 import numpy as np
 
 from ccproof.errors import CCProofError
-from ccproof.evaluate._table import COMPOSED_LAYERS
+from ccproof.evaluate.patch_table import COMPOSED_LAYERS
 
-__all__ = ["load", "CTable", "evaluate_block", "ring_walks"]
+__all__ = ["load", "CTable", "evaluate_block", "point_blocks", "ring_walks"]
 
 _P = ctypes.c_void_p
 _I = ctypes.c_int64
@@ -113,7 +113,7 @@ def _powers_of_two(a):
 
 
 class CTable:
-    """The patch table (:class:`ccproof.evaluate._table.PatchTable`) as the C kernel reads it.
+    """The patch table (:class:`ccproof.evaluate.patch_table.PatchTable`) as the C kernel reads it.
 
     Holds the arrays in the dtypes the kernel reads (the table's own arrays where they already are), the
     ``ccp_table`` structure pointing into them, and the corner-net caches of the calls (7.3 MB each, one
@@ -255,6 +255,27 @@ def evaluate_block(lib, ct, f, u, v, d, outs):
         ct.give_cache(cache)
 
 
+def point_blocks(lib, ct, f, u, v, d, outs):
+    """``(block, back)`` for :func:`ccproof.evaluate.backend.evaluation_blocks`: ``block(lo, hi)`` calls
+    :func:`evaluate_block` on the points lo:hi (``f, u, v`` contiguous) of the table ``ct`` (a :class:`CTable`);
+    ``outs`` the six outputs (None where absent), those beyond derivative order ``d`` not written; ``back``:
+    ``[(index, temporary)]`` for the outputs it cannot write in place (not contiguous float64 (n, 3))."""
+    f, u, v = (np.ascontiguousarray(a) for a in (f, u, v))
+    n = f.size
+    back, arrs = [], []
+    for i, a in enumerate(outs):
+        a = a if i < (1, 3, 6)[d] else None
+        if a is not None and not (isinstance(a, np.ndarray) and a.dtype == np.float64
+                                  and a.shape == (n, 3) and a.flags.c_contiguous):
+            back.append((i, np.empty((n, 3))))
+            a = back[-1][1]
+        arrs.append(a)
+
+    def block(lo, hi):
+        return evaluate_block(lib, ct, f[lo:hi], u[lo:hi], v[lo:hi], d, [None if a is None else a[lo:hi] for a in arrs])
+    return block, back
+
+
 def _arg(a, dtype, name):
     """The address of ``a``, which the kernel reads or writes in place: it must be C-contiguous ``dtype``."""
     if not (isinstance(a, np.ndarray) and a.dtype == dtype and a.flags.c_contiguous):
@@ -262,9 +283,10 @@ def _arg(a, dtype, name):
     return _addr(a)
 
 
-def ring_walks(org, nxt, prv, twin, pos, seen, g, r, rings, nring, faces, nfaces, hashes):
+def ring_walks(halfedges, scratch, g, r, out):
     """The ring walk of :func:`ccproof.evaluate._numba_kernel.ring_walks` (the same arguments and results)
     in C: ``ccp_ring_walks`` of ``_clib.c``. Requires :func:`load` to have found the library."""
+    (org, nxt, prv, twin), (pos, seen), (rings, nring, faces, nfaces, hashes) = halfedges, scratch, out
     lib = load()
     k, maxn = rings.shape
     maxf = faces.shape[1]

@@ -56,7 +56,7 @@
 #define CCP_CLONES
 #endif
 
-/* The patch table (ccproof.evaluate._table.PatchTable), as pointers into its numpy arrays. The five
+/* The patch table (ccproof.evaluate.patch_table.PatchTable), as pointers into its numpy arrays. The five
  * per-face offset arrays are int32 or int64 (``wide``); the rings are int32; every other integer array is
  * int64, except ``kind`` (int8) and the bools (one byte). Field order and types: _ckernel.py, _Table. */
 typedef struct {

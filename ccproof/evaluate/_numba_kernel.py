@@ -1,7 +1,7 @@
 """Compiled evaluation kernel (numba), the same arithmetic as the numpy path point by point, and the
 compiled Newton descent of the closest points (:func:`ccproof.evaluate.newton.newton_descent`, point by point).
 
-Imported only when numba is installed; :mod:`ccproof.evaluate.surface` falls back to numpy otherwise.
+The numba backend (chosen by :mod:`ccproof.evaluate.backend`; without numba its kernels are None).
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ try:
 except ImportError:  # pragma: no cover - optional dependency
     numba = None
 
-from ccproof.evaluate._table import COMPOSED_LAYERS, KIND_CORNER, KIND_SPLIT
+from ccproof.evaluate.patch_table import COMPOSED_LAYERS, KIND_CORNER, KIND_SPLIT
 
 #: corner nets (layers beyond the precomputed ones) kept per kernel call: slots (a power of 2, 408 bytes each)
 _CACHE_SLOTS = 16384
@@ -23,6 +23,18 @@ _CACHE_SLOTS = 16384
 _CACHE_MIN = 256
 #: multiplier spreading the patch keys over the slots (Knuth's multiplicative hash)
 _HASH = 2654435761
+
+
+def point_blocks(kernel, table, f, u, v, d, outs):
+    """``(block, [])`` for :func:`ccproof.evaluate.backend.evaluation_blocks`: ``block(lo, hi)`` calls ``kernel``
+    (:func:`evaluate_points`) on the points lo:hi of ``table`` (a :class:`~ccproof.evaluate.patch_table.PatchTable`)
+    and the six outputs ``outs`` (None where absent)."""
+    dummy = np.empty((0, 3))
+    arrs = [dummy if a is None else a for a in outs]
+
+    def block(lo, hi):
+        return kernel(f[lo:hi], u[lo:hi], v[lo:hi], d, table, tuple(a[lo:hi] if a.shape[0] else a for a in arrs))
+    return block, []
 
 
 def _basis(x):
@@ -41,10 +53,12 @@ def _sum4(a0, a1, a2, a3, w0, w1, w2, w3):
     return (((0.0 + a0 * w0) + a1 * w1) + a2 * w2) + a3 * w3
 
 
-def _bicubic(net, p, s, t, g, d, k, P, Pu, Pv, Puu, Puv, Pvv):
-    """Row k of P (and of the derivatives up to order d) from the bicubic net ``net[p]`` (17 x 3, row
-    16 the origin) at (s, t), derivatives scaled by g per order; in registers: the columns
-    ``T_r[i] = sum_j B_r(t)_j net[i + 4 j]`` then ``sum_i B(s)_i T_r[i]``, each sum from 0.0 left to right."""
+def _bicubic(net, p, s, t, g, d, k, out):
+    """Row k of P (and of the derivatives up to order d; ``out`` = (P, Pu, Pv, Puu, Puv, Pvv)) from the bicubic
+    net ``net[p]`` (17 x 3, row 16 the origin) at (s, t), derivatives scaled by g per order; in registers: the
+    columns ``T_r[i] = sum_j B_r(t)_j net[i + 4 j]`` then ``sum_i B(s)_i T_r[i]``, each sum from 0.0 left to
+    right."""
+    P, Pu, Pv, Puu, Puv, Pvv = out
     s0, s1, s2, s3, s4, s5, s6, s7, s8, s9, s10, s11 = _basis(s)
     t0, t1, t2, t3, t4, t5, t6, t7, t8, t9, t10, t11 = _basis(t)
     g2 = g * g
@@ -220,9 +234,9 @@ def _corner_net(T, job, vf, cfg, lay, code, ci, W, s, rc):
     return W
 
 
-def _evaluate_points(f, u, v, d, T, P, Pu, Pv, Puu, Puv, Pvv):
-    """Fill P (n, 3) and, for d >= 1, Pu, Pv, for d >= 2, Puu, Puv, Pvv (each (n, 3)) from the patch
-    table ``T`` (:class:`ccproof.evaluate._table.PatchTable`).
+def _evaluate_points(f, u, v, d, T, out):
+    """Fill ``out`` = (P, Pu, Pv, Puu, Puv, Pvv): P (n, 3) and, for d >= 1, Pu, Pv, for d >= 2, Puu, Puv, Pvv
+    (each (n, 3)) from the patch table ``T`` (:class:`ccproof.evaluate.patch_table.PatchTable`).
 
     Returns -1, or the index of the first point whose face is out of range or refused (a hole)
     or whose (u, v) is outside [0, 1]^2 or NaN; the caller then names it (the outputs from that
@@ -323,7 +337,7 @@ def _evaluate_points(f, u, v, d, T, P, Pu, Pv, Puu, Puv, Pvv):
         s = min(max((uu - pu0) / h, 0.0), 1.0)
         t = min(max((ww - pv0) / h, 0.0), 1.0)
         g = 1.0 / h
-        _bicubic(net, p, s, t, g, d, k, P, Pu, Pv, Puu, Puv, Pvv)
+        _bicubic(net, p, s, t, g, d, k, out)
     return -1
 
 
@@ -359,7 +373,7 @@ def _newton_points(X, face, u, v, max_iter, max_halvings, T, E):
         uk = min(max(u[k], 0.0), 1.0)
         vk = min(max(v[k], 0.0), 1.0)
         fk[0], uw[0], vw[0] = f, uk, vk
-        evaluate_points(fk, uw, vw, 2, T, c0, c1, c2, c3, c4, c5)
+        evaluate_points(fk, uw, vw, 2, T, (c0, c1, c2, c3, c4, c5))
         for c in range(3):
             R[0, c] = C[0, c] - X[k, c]
         Ek = 0.5 * _dot3(R, 0, R, 0)
@@ -399,7 +413,7 @@ def _newton_points(X, face, u, v, max_iter, max_halvings, T, E):
                 nv = min(max(v0 + al * dv, 0.0), 1.0)
                 moved = (nu != u0) or (nv != v0)
                 uw[0], vw[0] = nu, nv
-                evaluate_points(fk, uw, vw, 2, T, n0, n1, n2, n3, n4, n5)
+                evaluate_points(fk, uw, vw, 2, T, (n0, n1, n2, n3, n4, n5))
                 for c in range(3):
                     Rt[0, c] = Cn[0, c] - X[k, c]
                 Et = 0.5 * _dot3(Rt, 0, Rt, 0)
@@ -458,16 +472,20 @@ def _take_face(c, org, pos, seen, ring, faces, fc, fl, n, nf):
     return n, nf + 1
 
 
-def _ring_walks(org, nxt, prv, twin, pos, seen, g, r, rings, nring, faces, nfaces, hashes):
+def _ring_walks(halfedges, scratch, g, r, out):
     """:func:`ccproof.evaluate.local.canonical_ring` (depth 1) of quad ``g[k]`` from corner ``r[k]`` of
-    an all-quad complex (half-edge ``4 f + i`` is corner i of face f), for every k: the same walk.
+    an all-quad complex (``halfedges`` = (org, nxt, prv, twin); half-edge ``4 f + i`` is corner i of face f), for
+    every k: the same walk.
 
-    Writes the ring (vertex labels, ``rings[k, :nring[k]]``), the faces in ring labels
-    (``faces[k, :nfaces[k]]``, rows of 4) and a 64-bit FNV-1a hash of (nring, faces). ``pos``
-    (n_vertices,) and ``seen`` (n_faces,) are scratch arrays, -1 / False on entry and on return.
+    Writes into ``out`` = (rings, nring, faces, nfaces, hashes) the ring (vertex labels, ``rings[k, :nring[k]]``),
+    the faces in ring labels (``faces[k, :nfaces[k]]``, rows of 4) and a 64-bit FNV-1a hash of (nring, faces).
+    ``scratch`` = (pos, seen): ``pos`` (n_vertices,) and ``seen`` (n_faces,), -1 / False on entry and on return.
     ``nring[k] = -1`` if the ring does not fit the arrays or the walk does not close (the caller
     then takes the Python walk).
     """
+    org, nxt, prv, twin = halfedges
+    pos, seen = scratch
+    rings, nring, faces, nfaces, hashes = out
     maxn = rings.shape[1]
     maxf = faces.shape[1]
     fc = np.empty(maxn, dtype=np.int64)

@@ -36,13 +36,14 @@ Supported meshes: quad meshes of :class:`~ccproof.mesh.QuadMesh` (boundary rule
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 from ccproof.errors import CCProofError
 from ccproof.evaluate.local import canonical_ring, refine_key, ring_key
 from ccproof.mesh.rules import Complex, Options
 from ccproof.rule_weights import crease_limit_weights, smooth_limit_weights
 
-__all__ = ["CertifiedClosest", "certify_closest"]
+__all__ = ["CertifiedClosest", "CertifyLimits", "certify_closest"]
 
 #: level of the piece giving the upper bound d_up
 UP_LEVEL = 24
@@ -221,8 +222,38 @@ def _ring_boxes(F, Vx, vf):
     return lo, hi
 
 
-def certify_closest(surface, x, face, u, v, *, radius=None, separation=None, ambiguity=None, up_level=UP_LEVEL,
-                    max_level=MAX_LEVEL, max_pieces=MAX_PIECES):
+class CertifyLimits(NamedTuple):
+    """The tolerances and budgets of :func:`certify_closest`.
+
+    Attributes
+    ----------
+    radius : float, optional
+        Pieces are split until they lie within this 3-D radius of the float answer P (or reach
+        ``max_level``); default (None) 1e-6 of the bounding box diagonal.
+    separation : float, optional
+        Certified if every remaining piece lies within this distance of P (default 1e-3 of the
+        diagonal; the enclosure actually reached is reported); remaining pieces farther away make
+        the point ambiguous or uncertified.
+    ambiguity : float, optional
+        Tolerance of the ambiguity verdict (default 1e-9 of the diagonal).
+    up_level : int
+        Level of the piece giving the upper bound d_up (:data:`UP_LEVEL`).
+    max_level, max_pieces : int
+        Deepest level of the branch and bound (:data:`MAX_LEVEL`), pieces examined at most (:data:`MAX_PIECES`).
+
+    >>> CertifyLimits(max_level=4).max_pieces == MAX_PIECES
+    True
+    """
+
+    radius: float | None = None
+    separation: float | None = None
+    ambiguity: float | None = None
+    up_level: int = UP_LEVEL
+    max_level: int = MAX_LEVEL
+    max_pieces: int = MAX_PIECES
+
+
+def certify_closest(surface, x, face, u, v, limits=None):
     """Certify that the limit point at (face, u, v) is (within enclosures) the nearest one to ``x``.
 
     Parameters
@@ -231,15 +262,8 @@ def certify_closest(surface, x, face, u, v, *, radius=None, separation=None, amb
         Of a quad mesh (its ``mesh`` must have ``faces`` (m, 4) and ``vertices`` (n, 3)).
     x : array_like, shape (3,)
     face, u, v : the float answer (e.g. from :func:`~ccproof.evaluate.closest.closest_points`).
-    radius : float, optional
-        Pieces are split until they lie within this 3-D radius of the float answer P (or reach
-        ``max_level``); default 1e-6 of the bounding box diagonal.
-    separation : float, optional
-        Certified if every remaining piece lies within this distance of P (default 1e-3 of the
-        diagonal; the enclosure actually reached is reported); remaining pieces farther away make
-        the point ambiguous or uncertified.
-    ambiguity : float, optional
-        Tolerance of the ambiguity verdict (default 1e-9 of the diagonal).
+    limits : CertifyLimits, optional
+        Tolerances and budgets (None: the defaults of :class:`CertifyLimits`).
 
     Returns
     -------
@@ -272,9 +296,11 @@ def certify_closest(surface, x, face, u, v, *, radius=None, separation=None, amb
     x = np.asarray(x, dtype=np.float64).reshape(3)
     face, u, v = int(face), float(u), float(v)
     diag = float(np.linalg.norm(Vx.max(0) - Vx.min(0)))
-    radius = 1e-6 * diag if radius is None else float(radius)
-    ambiguity = 1e-9 * diag if ambiguity is None else float(ambiguity)
-    separation = 1e-3 * diag if separation is None else float(separation)
+    limits = CertifyLimits() if limits is None else limits
+    radius = 1e-6 * diag if limits.radius is None else float(limits.radius)
+    ambiguity = 1e-9 * diag if limits.ambiguity is None else float(limits.ambiguity)
+    separation = 1e-3 * diag if limits.separation is None else float(limits.separation)
+    up_level, max_level, max_pieces = limits.up_level, limits.max_level, limits.max_pieces
     old = flint.ctx.prec
     flint.ctx.prec = PREC
     try:

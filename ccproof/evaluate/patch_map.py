@@ -1,6 +1,6 @@
 """Locating points of ptex faces in a patch table (OpenSubdiv ``Far::PatchMap``; bmz04 section 3, Fig. 3).
 
-The patch table (:class:`ccproof.evaluate._table.PatchTable`) stores per ptex face the job of each of its
+The patch table (:class:`ccproof.evaluate.patch_table.PatchTable`) stores per ptex face the job of each of its
 four quadrants and, per job, a template of virtual faces; :class:`PatchMap` finds, for points (f, u, v),
 the virtual face holding each point and, in a corner face (one irregular corner), the layer and the
 patch of that layer (the evaluation then applies the configuration's layer operator to the face's ring):
@@ -46,7 +46,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ccproof.evaluate._table import KIND_CORNER, KIND_SPLIT
+from ccproof.evaluate.patch_table import KIND_CORNER, KIND_SPLIT
 
 __all__ = ["PatchMap", "Location"]
 
@@ -87,7 +87,7 @@ class Location(NamedTuple):
 
 
 class PatchMap:
-    """Locates points (ptex face, u, v) in a :class:`~ccproof.evaluate._table.PatchTable` (module docstring).
+    """Locates points (ptex face, u, v) in a :class:`~ccproof.evaluate.patch_table.PatchTable` (module docstring).
 
     Parameters
     ----------

@@ -22,7 +22,7 @@ Method (everything below is exact up to floating-point round-off):
   extraordinary vertex next to the boundary) is subdivided once, exactly and locally; its four
   children are classified again (at most ``MAX_DEPTH`` times; beyond that a MeshError).
 
-The patch table (:mod:`ccproof.evaluate._table`) holds per configuration the exact operators and per
+The patch table (:mod:`ccproof.evaluate.patch_table`) holds per configuration the exact operators and per
 face its control points: at evaluation time a point is a gather of a stored 4 x 4 net (regular
 patches), or one ``16 x N`` product of its layer's operator with its corner face's ring, plus one
 bicubic evaluation: no Python loop over points, memory bounded by evaluating in chunks.
@@ -33,27 +33,18 @@ from __future__ import annotations
 import numpy as np
 
 from ccproof.errors import CCProofError
+from ccproof.evaluate._numpy_kernel import evaluate_chunk
 from ccproof.evaluate._parallel import in_blocks, threads_for
-from ccproof.evaluate._table import (
-    COMPOSED_LAYERS,
-    KIND_CORNER,
-    KIND_REGULAR,
-    Builder,
-    Jobs,
-    catmark_step,
-    check_positions,
-    composed_nets,
-    corner_limits,
-    corner_rings,
-    ring_products,
-    with_nets,
-)
-from ccproof.evaluate.bspline import bspline_basis
+from ccproof.evaluate.backend import evaluation_blocks, evaluation_kernel, newton_kernel
+from ccproof.evaluate.factory import Builder, Jobs
+from ccproof.evaluate.nets import corner_rings, with_nets
 from ccproof.evaluate.patch_map import PatchMap
+from ccproof.evaluate.patch_table import KIND_CORNER, check_positions
+from ccproof.evaluate.step import catmark_step
 from ccproof.mesh import QuadMesh, limit_normals, limit_positions
 from ccproof.mesh.polymesh import PolyMesh
 
-__all__ = ["natural_limit_surface", "LimitSurface", "available_backends"]
+__all__ = ["natural_limit_surface", "LimitSurface"]
 
 
 #: points evaluated per chunk (bounds the temporary memory: about 1 kB per point)
@@ -267,64 +258,6 @@ class LimitSurface:
         loc = self.patch_map.locate(f, u, v)
         return loc.patch, loc.s, loc.t, loc.scale
 
-    def _point_nets(self, f, u, v, nets=True):
-        """Patch ids, parameters (s, t), scales ``1 / h`` and (``nets``) the nets (n, 17, 3) of the
-        points: a gather for regular patches, ``L[n, code] @ ring`` for the layers of corner faces."""
-        T = self._table
-        loc = self.patch_map.locate(f, u, v)
-        N = None
-        if nets:
-            N = np.empty((f.size, 17, 3))
-            reg = np.flatnonzero(loc.kind == KIND_REGULAR)
-            if T.nets.shape[0]:  # kept (the same sums)
-                N[reg] = T.nets[loc.patch[reg]]
-            else:
-                for w in np.unique(loc.vface[reg]).tolist():
-                    sel = reg[loc.vface[reg] == w]
-                    n_, st = int(T.vn[w]), int(T.vop_start[w])
-                    R = T.rings[T.job_ring[loc.job[sel]][:, None] + np.arange(n_)]
-                    a = ring_products(T.vop[st:st + 17 * n_].reshape(n_, 17), T.points, R)
-                    a[:, 16] += T.points[R[:, 0]]
-                    N[sel] = a
-            idx = loc.corner
-            if idx.size:
-                self._corner_point_nets(loc, N)
-        return loc.patch, loc.s, loc.t, loc.scale, N
-
-    def _corner_point_nets(self, loc, N):
-        """The nets of the points of ``loc`` (a :class:`~ccproof.evaluate.patch_map.Location`) in corner
-        faces into ``N``: layer 0 kept (``hot``), the first layers by their composed operators, the others
-        ``L[n, code] @ ring``, summed in the kernels' order."""
-        T = self._table
-        idx = loc.corner
-        w = loc.vface[idx]
-        n, code, ci = loc.layer, loc.code, loc.corner_face
-        todo = np.ones(idx.size, dtype=bool)
-        if T.hot.shape[0]:  # layer 0 precomputed (the same sums)
-            h0 = np.flatnonzero(n == 0)
-            N[idx[h0]] = T.hot[3 * ci[h0] + code[h0]]
-            todo[h0] = False
-        for vf in np.unique(w[todo]).tolist():
-            at = (w == vf) & todo
-            for lay in range(COMPOSED_LAYERS):  # one product with the ring
-                for code_ in range(3):
-                    sel = np.flatnonzero(at & (n == lay) & (code == code_))
-                    if sel.size:
-                        N[idx[sel]] = composed_nets(T, loc.job[idx[sel]], vf, lay, code_)
-            sel = np.flatnonzero(at & (n >= COMPOSED_LAYERS))
-            if not sel.size:
-                continue
-            c = int(T.cfg[vf])
-            Nc, nl, st = int(T.op_size[c]), int(T.n_layers[c]), int(T.op_start[c])
-            Lc = T.ops[st:st + nl * 48 * Nc].reshape(nl * 3, Nc, 16)
-            Q = corner_rings(T, loc.job[idx[sel]], vf)
-            Ls = Lc[3 * n[sel] + code[sel]]  # (k, Nc, 16)
-            acc = np.zeros((sel.size, 16, 3))
-            for j in range(1, Nc):  # summed in the compiled kernel's order: the same bits
-                acc += Ls[:, j, :, None] * Q[:, None, j, :]
-            N[idx[sel], :16] = acc
-            N[idx[sel], 16] = corner_limits(T, loc.job[idx[sel]], vf)
-
     def evaluate(self, face_ids, u, v, derivatives=1, *, parameterization="natural", chunk=CHUNK, out=None,
                  backend=None, threads=None):
         """Positions and derivatives of the limit surface at points (face, u, v), in a parameterization.
@@ -384,7 +317,7 @@ class LimitSurface:
             p = self._parameterization(parameterization)
             f, u, v = self._check(face_ids, u, v)
             return p.evaluate_on(self, f, u, v, derivatives, chunk=chunk, out=out, backend=backend, threads=threads)
-        name, kernel = _compiled_kernel(backend)
+        name, kernel = evaluation_kernel(backend)
         if kernel is None:
             f, u, v = self._check(face_ids, u, v)
         else:  # the compiled kernel checks the values itself, in the threads
@@ -407,11 +340,7 @@ class LimitSurface:
         n = f.size
         if n >= SORT_MIN and self._table.nets.shape[0] == 0 and (f[1:] < f[:-1]).any():
             return self._evaluate_by_face(name, kernel, f, u, v, derivatives, out, threads)
-        if name == "c":
-            f, u, v = (np.ascontiguousarray(a) for a in (f, u, v))
-            block, back = self._c_block(kernel, f, u, v, derivatives, out)
-        else:
-            block, back = self._numba_block(kernel, f, u, v, derivatives, out), []
+        block, back = evaluation_blocks(name, kernel, self._kernel_tables, f, u, v, derivatives, out)
         # few blocks: each kernel call computes the corner nets it meets once (a cache per call)
         bad = in_blocks(block, n, threads_for(threads, n), 32768, per_thread=4)
         if max(bad) >= 0:
@@ -436,10 +365,7 @@ class LimitSurface:
                 sel = order[a:min(hi, a + SORT_CHUNK)]
                 fb, ub, vb = f[sel], u[sel], v[sel]
                 tmp = {k: np.empty((sel.size, 3)) for k in keys}
-                if name == "c":
-                    bad = self._c_block(kernel, fb, ub, vb, derivatives, tmp)[0](0, sel.size)
-                else:
-                    bad = self._numba_block(kernel, fb, ub, vb, derivatives, tmp)(0, sel.size)
+                bad = evaluation_blocks(name, kernel, self._kernel_tables, fb, ub, vb, derivatives, tmp)[0](0, sel.size)
                 if bad >= 0:
                     return bad
                 for k in keys:
@@ -451,38 +377,6 @@ class LimitSurface:
             self._check_values(f, u, v)  # raises, naming the first bad point
             raise CCProofError("internal error: the compiled kernel refused a point the checks accept")
         return out
-
-    def _c_block(self, kernel, f, u, v, derivatives, out):
-        """(block(lo, hi) calling the C kernel, [(key, temporary)]: outputs it cannot write in place)."""
-        from ccproof.evaluate._ckernel import evaluate_block
-
-        n, keys = f.size, _KEYS[derivatives]
-        back = []
-        arrs = []
-        for k in _KEYS[2]:
-            a = out.get(k) if k in keys else None
-            if a is not None and not (isinstance(a, np.ndarray) and a.dtype == np.float64
-                                      and a.shape == (n, 3) and a.flags.c_contiguous):
-                back.append((k, np.empty((n, 3))))
-                a = back[-1][1]
-            arrs.append(a)
-        table = self._c_table()
-
-        def block(lo, hi):
-            return evaluate_block(kernel, table, f[lo:hi], u[lo:hi], v[lo:hi], derivatives,
-                                  [None if a is None else a[lo:hi] for a in arrs])
-        return block, back
-
-    def _numba_block(self, kernel, f, u, v, derivatives, out):
-        """block(lo, hi) calling the numba kernel on ``out``'s rows lo:hi."""
-        dummy = np.empty((0, 3))
-        arrs = [out.get(k, dummy) for k in _KEYS[2]]
-        table = self._kernel_table()
-
-        def block(lo, hi):
-            return kernel(f[lo:hi], u[lo:hi], v[lo:hi], derivatives, table,
-                          *[a[lo:hi] if a.shape[0] else a for a in arrs])
-        return block
 
     def basis(self, face_ids, u, v, derivatives=0, *, parameterization="natural", threads=None):
         """Basis rows: the sparse linear map from the control points to points and derivatives.
@@ -555,6 +449,10 @@ class LimitSurface:
         """The patch table as the compiled kernels take it (one :class:`PatchTable` argument)."""
         return self._table
 
+    def _kernel_tables(self, name):
+        """The patch table as the backend ``name`` reads it (:func:`ccproof.evaluate.backend.evaluation_blocks`)."""
+        return self._c_table() if name == "c" else self._table
+
     def _c_table(self):
         """The patch table as the C kernel reads it (:class:`ccproof.evaluate._ckernel.CTable`, made
         once per table and kept)."""
@@ -568,31 +466,10 @@ class LimitSurface:
     def _newton_kernel(self, backend=None):
         """The compiled Newton descent of the closest points on this surface (natural parameterization),
         or None: numpy backend."""
-        if _numba_kernel(backend) is None:
-            return None
-        from ccproof.evaluate._numba_kernel import newton_points
-
-        return newton_points
+        return newton_kernel(backend)
 
     def _eval_chunk(self, f, u, v, d, out):
-        _, s, t, g, G = self._point_nets(f, u, v)
-        bs = bspline_basis(s, d)
-        bt = bspline_basis(t, d)
-        G = G.reshape(-1, 51)
-        N = G[:, :48].reshape(-1, 4, 4, 3)  # [n, j, i, c]
-        T0 = np.einsum("nj,njic->nic", bt[0], N)
-        np.add(G[:, 48:], np.einsum("ni,nic->nc", bs[0], T0), out=out["P"])
-        if d >= 1:
-            T1 = np.einsum("nj,njic->nic", bt[1], N)
-            gg = g[:, None]
-            np.multiply(np.einsum("ni,nic->nc", bs[1], T0), gg, out=out["Pu"])
-            np.multiply(np.einsum("ni,nic->nc", bs[0], T1), gg, out=out["Pv"])
-        if d >= 2:
-            T2 = np.einsum("nj,njic->nic", bt[2], N)
-            g2 = (g * g)[:, None]
-            np.multiply(np.einsum("ni,nic->nc", bs[2], T0), g2, out=out["Puu"])
-            np.multiply(np.einsum("ni,nic->nc", bs[1], T1), g2, out=out["Puv"])
-            np.multiply(np.einsum("ni,nic->nc", bs[0], T2), g2, out=out["Pvv"])
+        evaluate_chunk(self._table, self.patch_map, f, u, v, d, out)
 
     # ------------------------------------------------------------------ corner faces
     def _corner_leaf(self, job, vf):
@@ -767,7 +644,7 @@ class LimitSurface:
         are the PolyMesh's own vertices. The rings index the vertices the builder classified: those
         of :attr:`PolyMesh.manifold <ccproof.mesh.polymesh.PolyMesh.manifold>` (``X[manifold_vertex_map]``)
         on an all-quad mesh, else its level-1 vertices, recomputed as the build computes them (the
-        vectorized untagged step :func:`ccproof.evaluate._table.catmark_step`, or the tagged step that
+        vectorized untagged step :func:`ccproof.evaluate.step.catmark_step`, or the tagged step that
         the build ran, kept by it as CSR arrays (:class:`ccproof.mesh.csr.PackedCSR`, 24 bytes per ptex
         face on a tagged triangle mesh, docs/evaluate.md; shared by the derived surfaces) and applied as
         :meth:`PolyMesh.refine` applies it: no move repeats the step).
@@ -827,77 +704,6 @@ class LimitSurface:
         V1 = self._moving["step"].apply(man.vertices)  # the build's step, kept (build_tagged)
         V1[np.flatnonzero(man.is_unused_vertex)] = np.nan  # as PolyMesh.refine: an unused vertex has no vertex point
         return V1
-
-
-_BACKENDS = ("auto", "c", "numba", "numpy")
-
-
-def available_backends():
-    """The evaluation backends this install can run, in the order the automatic choice takes them.
-
-    ``"c"`` where the install built the C kernel (``ccproof/evaluate/_clib.c``), ``"numba"`` where numba
-    is installed (not imported here), and always ``"numpy"`` (the reference the tests compare with).
-
-    Returns
-    -------
-    list of str
-
-    Examples
-    --------
-    >>> available_backends()[-1]
-    'numpy'
-    """
-    import importlib.util
-
-    from ccproof.evaluate._ckernel import load
-
-    return (["c"] if load() is not None else []) + \
-        (["numba"] if importlib.util.find_spec("numba") is not None else []) + ["numpy"]
-
-
-def _backend_name(backend):
-    """``backend`` (None: ``CCPROOF_BACKEND``, else automatic) checked."""
-    import os
-
-    if backend is None:
-        backend = os.environ.get("CCPROOF_BACKEND", "auto")
-    if backend not in _BACKENDS:
-        raise CCProofError(f"unknown backend {backend!r} (use 'c', 'numba' or 'numpy')")
-    return backend
-
-
-def _compiled_kernel(backend):
-    """``(name, kernel)`` for ``backend`` (None: automatic): ``("c", library)`` (the C kernel, where it was
-    built: :mod:`ccproof.evaluate._ckernel`), ``("numba", evaluate_points)``, or ``("numpy", None)``.
-    The automatic choice takes them in that order; imports numba only when the C kernel is missing."""
-    backend = _backend_name(backend)
-    if backend == "numpy":
-        return "numpy", None
-    if backend in ("auto", "c"):
-        from ccproof.evaluate._ckernel import load
-
-        lib = load()
-        if lib is not None:
-            return "c", lib
-        if backend == "c":
-            raise CCProofError("backend 'c' requested but the C kernel was not built (reinstall with a C compiler, "
-                               "or run `python setup.py build_ext --inplace` in a checkout)")
-    kernel = _numba_kernel("numba" if backend == "numba" else "auto")
-    return ("numba", kernel) if kernel is not None else ("numpy", None)
-
-
-def _numba_kernel(backend):
-    """The numba kernel for ``backend`` (None: automatic), or None for the numpy path (also when numba
-    is not installed and the backend is automatic). The closest points' Newton descent uses it with
-    any backend but numpy."""
-    backend = _backend_name(backend)
-    if backend == "numpy":
-        return None
-    from ccproof.evaluate._numba_kernel import evaluate_points
-
-    if evaluate_points is None and backend == "numba":
-        raise CCProofError("backend 'numba' requested but numba is not installed")
-    return evaluate_points
 
 
 def natural_limit_surface(mesh, *, progress=None):

@@ -1,13 +1,13 @@
 """Exact limit evaluation on tagged polygon meshes (creases, corners, holes, boundary modes, n-gons).
 
 The patch table of a :class:`~ccproof.mesh.polymesh.PolyMesh` is built by the builder of the all-quad
-meshes (:class:`ccproof.evaluate._table.Builder`: same classification, arrays, locator and
+meshes (:class:`ccproof.evaluate.factory.Builder`: same classification, arrays, locator and
 kernels), from the tagged rules of :mod:`ccproof.mesh.rules`; :func:`build_tagged` classifies, the one
 evaluator :class:`ccproof.evaluate.surface.LimitSurface` holds the table and evaluates:
 
 1. One global Catmull-Clark step (n-gons become quads; ``TRI_SUB_SMOOTH`` and the
    ``EDGE_AND_CORNER`` corners act here); on an untagged mesh vectorized
-   (:func:`ccproof.evaluate._table.catmark_step`). A quad's ptex face is split into its four level-1
+   (:func:`ccproof.evaluate.step.catmark_step`). A quad's ptex face is split into its four level-1
    children; sub-face k of an n-gon *is* level-1 child k (same (s, t)).
 2. Semi-sharp phase: while an edge at a vertex of the face or the vertex itself has a semi-sharp
    sharpness (0 < s < 10), the face's neighbourhood is refined exactly and locally
@@ -33,7 +33,10 @@ import math
 
 import numpy as np
 
-from ccproof.evaluate._table import Builder, Jobs, TaggedHalfEdges, catmark_step, child_frame, compose, domain
+from ccproof.evaluate.factory import Builder, Jobs
+from ccproof.evaluate.frames import child_frame, compose, domain
+from ccproof.evaluate.halfedge_views import TaggedHalfEdges
+from ccproof.evaluate.step import catmark_step
 from ccproof.mesh.csr import pack_csr
 from ccproof.mesh.halfedges import HalfEdges
 from ccproof.mesh.polymesh import PolyMesh

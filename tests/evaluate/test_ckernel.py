@@ -16,7 +16,7 @@ import pytest
 
 from ccproof.errors import CCProofError
 from ccproof.evaluate import natural_limit_surface
-from ccproof.evaluate.surface import available_backends
+from ccproof.evaluate.backend import available_backends
 from ccproof.mesh import read_obj
 from ccproof.mesh.io import read_mesh
 
@@ -189,8 +189,8 @@ def test_moved_control_points_use_their_own_table():
 
 def test_the_c_backend_loads_without_numba():
     """Importing the package and choosing the C kernel does not import numba (a fresh process)."""
-    code = ("import sys; import ccproof, ccproof.evaluate.surface as s; print(s._compiled_kernel(None)[0], "
-            "'numba' in sys.modules, 'llvmlite' in sys.modules)")
+    code = ("import sys; import ccproof, ccproof.evaluate.surface, ccproof.evaluate.backend as b; "
+            "print(b.evaluation_kernel(None)[0], 'numba' in sys.modules, 'llvmlite' in sys.modules)")
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
                        cwd=Path(__file__).resolve().parents[2])
     assert r.stdout.split() == ["c", "False", "False"], r.stdout + r.stderr
@@ -220,7 +220,7 @@ def test_ring_walks_equal_the_numba_walk(maxn, maxf):
             pos, seen = np.full(m.n_vertices, -1, np.int64), np.zeros(m.n_faces, bool)
             out = (np.full((g.size, maxn), -1, np.int32), np.empty(g.size, np.int64),
                    np.zeros((g.size, maxf, 4), np.int64), np.empty(g.size, np.int64), np.empty(g.size, np.uint64))
-            walk(he.org, he.nxt, he.prv, he.twin, pos, seen, g, r, *out)
+            walk((he.org, he.nxt, he.prv, he.twin), (pos, seen), g, r, tuple(out))
             assert (pos == -1).all() and not seen.any()  # the scratch arrays restored
             res.append(out)
         for a, b in zip(*res):

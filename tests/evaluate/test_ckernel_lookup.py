@@ -15,7 +15,7 @@ import pytest
 
 from ccproof.errors import CCProofError
 from ccproof.evaluate import natural_limit_surface
-from ccproof.evaluate.surface import available_backends
+from ccproof.evaluate.backend import available_backends
 from ccproof.mesh import read_obj
 from ccproof.mesh.io import read_mesh
 

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from ccproof.evaluate import natural_limit_surface
-from ccproof.evaluate.surface import available_backends
+from ccproof.evaluate.backend import available_backends
 from ccproof.mesh.io import read_mesh
 
 MESHES = Path(__file__).resolve().parents[1] / "data" / "osd_features" / "meshes"

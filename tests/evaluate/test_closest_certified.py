@@ -7,7 +7,7 @@ import pytest
 from ccproof.errors import CCProofError
 from ccproof.evaluate import limit_surface
 from ccproof.evaluate.closest import closest_points
-from ccproof.evaluate.closest_certified import certify_closest
+from ccproof.evaluate.closest_certified import CertifyLimits, certify_closest
 
 from .test_closest import brute_force
 
@@ -33,7 +33,7 @@ def test_certified_enclosure_contains_brute_force(cube):
 
 def test_centre_of_the_cube_is_ambiguous(cube):
     res = closest_points(cube, np.zeros((1, 3)))
-    c = certify_closest(cube, np.zeros(3), res.face[0], res.u[0], res.v[0], max_level=4)
+    c = certify_closest(cube, np.zeros(3), res.face[0], res.u[0], res.v[0], CertifyLimits(max_level=4))
     assert c.verdict == "ambiguous", c.message
     assert c.distance_lo <= 68 / 81 <= c.distance_hi
 
@@ -42,7 +42,7 @@ def test_wrong_answer_is_not_certified(cube):
     x = np.array([0.3, -0.2, 0.9])
     res = closest_points(cube, x[None])
     wrong = (res.face[0] + 1) % 6  # a face on another side of the cube
-    c = certify_closest(cube, x, wrong, 0.5, 0.5, max_level=5, max_pieces=3000)
+    c = certify_closest(cube, x, wrong, 0.5, 0.5, CertifyLimits(max_level=5, max_pieces=3000))
     assert c.verdict != "certified"
     # the upper bound is still rigorous: a surface point at most that far
     assert c.distance_hi >= res.distance[0]

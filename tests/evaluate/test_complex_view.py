@@ -1,4 +1,4 @@
-"""The setup reads rings and keys on the mesh's half-edges (``_table._ComplexView``) instead of a Python
+"""The setup reads rings and keys on the mesh's half-edges (``halfedge_views.ComplexView``) instead of a Python
 complex of the whole mesh: on tagged level-1 meshes, every face, corner and depth gives the ring, faces,
 rule count and ``ring_key`` that the whole mesh's :class:`ccproof.mesh.rules.Complex` (``PolyMesh.complex``,
 the reference) gives."""
@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ccproof.evaluate._table import TaggedHalfEdges, _ComplexView
+from ccproof.evaluate.halfedge_views import ComplexView, TaggedHalfEdges
 from ccproof.evaluate.local import canonical_ring, ring_key
 from ccproof.mesh.io import read_mesh, read_obj_tagged
 
@@ -28,7 +28,7 @@ def test_the_view_gives_the_whole_mesh_rings_and_keys(path):
     m1 = mesh.manifold.refine(operator=False)[0]
     assert m1.is_all_quads and m1.has_tags
     cx = m1.complex()  # the reference: the whole level-1 mesh
-    view = _ComplexView(TaggedHalfEdges.of(m1.halfedges))
+    view = ComplexView(TaggedHalfEdges.of(m1.halfedges))
     rng = np.random.default_rng(0)
     faces = range(m1.n_faces) if m1.n_faces <= 200 else rng.choice(m1.n_faces, 200, replace=False).tolist()
     tagged = 0

@@ -7,8 +7,8 @@ import pytest
 
 from ccproof.errors import CCProofError, MeshError
 from ccproof.evaluate import limit_surface
+from ccproof.evaluate.backend import available_backends
 from ccproof.evaluate.local import corner_scheme, quad_ring
-from ccproof.evaluate.surface import available_backends
 from ccproof.mesh import QuadMesh, limit_normals, read_obj
 from ccproof.mesh.examples import cube, k_regular_disk, l_shape
 

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from ccproof.evaluate import limit_surface
-from ccproof.evaluate.surface import available_backends
+from ccproof.evaluate.backend import available_backends
 from ccproof.mesh import read_obj
 
 MESHES = ["cube", "sector_k3", "sector_k5", "sector_k6", "torus_8x6"]

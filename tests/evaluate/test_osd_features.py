@@ -16,7 +16,8 @@ import pytest
 
 from ccproof.errors import CCProofError
 from ccproof.evaluate import limit_surface
-from ccproof.evaluate.surface import LimitSurface, available_backends
+from ccproof.evaluate.backend import available_backends
+from ccproof.evaluate.surface import LimitSurface
 from ccproof.mesh.io import read_obj_tagged
 from ccproof.mesh.polymesh import PolyMesh
 

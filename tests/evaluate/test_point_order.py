@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from ccproof.evaluate import surface
-from ccproof.evaluate.surface import LimitSurface, available_backends
+from ccproof.evaluate.backend import available_backends
+from ccproof.evaluate.surface import LimitSurface
 from ccproof.mesh.io import read_obj_tagged
 
 

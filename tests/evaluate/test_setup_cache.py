@@ -15,7 +15,7 @@ import sys
 import numpy as np
 import pytest
 
-from ccproof.evaluate import _diskcache, _table, local
+from ccproof.evaluate import _diskcache, factory, local, template_cache
 from ccproof.evaluate.surface import natural_limit_surface
 from ccproof.mesh.io import read_mesh
 
@@ -25,12 +25,12 @@ NAMES = ("cubes_infsharp", "smoothtris1", "chaikin1", "edgecorner")  # all-quad 
 _CHILD = """
 import sys, json
 import numpy as np
-from ccproof.evaluate import _table
+from ccproof.evaluate import factory
 from ccproof.evaluate.surface import natural_limit_surface
 from ccproof.mesh.io import read_mesh
 calls = []
-refine = _table.refine_key
-_table.refine_key = lambda *a: calls.append(1) or refine(*a)
+refine = factory.refine_key
+factory.refine_key = lambda *a: calls.append(1) or refine(*a)
 out, paths = sys.argv[1], sys.argv[2:]
 arrays, flint = {}, []
 for k, p in enumerate(paths):
@@ -78,17 +78,17 @@ def test_second_setup_in_a_fresh_process_does_no_exact_arithmetic(refdir, tmp_pa
 def _tables(mesh):
     local.corner_scheme.cache_clear()
     calls = []
-    refine = _table.refine_key
+    refine = factory.refine_key
 
     def counting(*a):
         calls.append(1)
         return refine(*a)
 
-    _table.refine_key = counting
+    factory.refine_key = counting
     try:
         S = natural_limit_surface(mesh, progress=False)
     finally:
-        _table.refine_key = refine
+        factory.refine_key = refine
     return S._table, len(calls)
 
 
@@ -115,7 +115,7 @@ def test_corrupt_template_file_is_detected_and_rebuilt(refdir, tmp_path, monkeyp
     b[len(b) // 2] ^= 0x10
     files[0].write_bytes(bytes(b))
     with pytest.raises(ValueError, match="digest"):
-        _table._read_template(files[0], files[0].stem)
+        template_cache.read_template(files[0], files[0].stem)
     # 1b. a file whose digest matches but whose header does not (one value appended): caught by the sizes
     body = files[3].read_bytes()[:-32]
     n_js = int(np.frombuffer(body, dtype="<f8", count=7)[6])
@@ -123,7 +123,7 @@ def test_corrupt_template_file_is_detected_and_rebuilt(refdir, tmp_path, monkeyp
     name = files[3].stem
     files[3].write_bytes(body + hashlib.sha256(name.encode() + b"\0" + body).digest())
     with pytest.raises(ValueError, match="sizes"):
-        _table._read_template(files[3], name)
+        template_cache.read_template(files[3], name)
     # 2. a truncated file; 3. garbage
     files[1].write_bytes(files[1].read_bytes()[:100])
     files[2].write_bytes(b"not a template")
@@ -133,7 +133,7 @@ def test_corrupt_template_file_is_detected_and_rebuilt(refdir, tmp_path, monkeyp
     assert n2 > 0  # rebuilt with the exact steps
     _same(T0, T2)
     for f in files[:4]:  # rewritten, and now read back
-        _table._read_template(f, f.stem)
+        template_cache.read_template(f, f.stem)
     T3, n3 = _tables(mesh)
     assert n3 == 0
     _same(T0, T3)

@@ -8,8 +8,8 @@ subdivision (test_tagged_bruteforce.py); here the shortcuts are switched off to 
 
 import numpy as np
 
-from ccproof.evaluate import _table
-from ccproof.evaluate._table import Builder
+from ccproof.evaluate import backend
+from ccproof.evaluate.factory import Builder
 from ccproof.evaluate.surface import LimitSurface
 from ccproof.mesh.io import read_mesh
 
@@ -35,16 +35,16 @@ def _compare(mesh, monkeypatch):
         return hit
 
     with monkeypatch.context() as m:
-        m.setattr(_table, "COMPILED_WALK_MIN", 0)
+        m.setattr(backend, "COMPILED_WALK_MIN", 0)
         compiled = LimitSurface(mesh)  # untagged rings walked by the compiled kernel (with numba)
     with monkeypatch.context() as m:
-        m.setattr(_table, "_ring_walks", lambda n: None)  # the Python walk, face by face
+        m.setattr(backend, "compiled_ring_walk", lambda n: None)  # the Python walk, face by face
         m.setattr(Builder, "smooth_regular_patches", counting)
         m.setattr(Builder, "corner_at", counting_corner)
         fast = LimitSurface(mesh)
     assert sum(handled) > 0  # the shortcut is exercised
     with monkeypatch.context() as m:
-        m.setattr(_table, "_ring_walks", lambda n: None)
+        m.setattr(backend, "compiled_ring_walk", lambda n: None)
         m.setattr(Builder, "smooth_regular_patches", lambda self, cx, X, jobs: np.zeros(len(jobs), bool))
         m.setattr(Builder, "corner_at", lambda self, *args, **kwargs: False)
         slow = LimitSurface(mesh)

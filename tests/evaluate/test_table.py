@@ -18,8 +18,9 @@ import numpy as np
 import pytest
 
 from ccproof.evaluate import limit_surface
+from ccproof.evaluate.backend import available_backends
 from ccproof.evaluate.local import CORNERS
-from ccproof.evaluate.surface import LimitSurface, available_backends
+from ccproof.evaluate.surface import LimitSurface
 from ccproof.mesh.examples import k_regular_disk
 from ccproof.mesh.io import read_obj_tagged
 from ccproof.mesh.polymesh import PolyMesh
@@ -51,10 +52,10 @@ def test_bytes_per_ptex_face_flat_under_refinement_and_depth(refdir, monkeypatch
     regular patches, about four times a regular face; after more refinements most faces are
     regular); a table of stored layers would cost some 90 layers x 1.2 kB per corner face.
     """
-    from ccproof.evaluate import _table
+    from ccproof.evaluate import nets
 
-    monkeypatch.setattr(_table, "HOT_BUDGET", 0)  # no precomputed layer 0 (it is kept on small meshes only)
-    monkeypatch.setattr(_table, "NETS_BUDGET", 0)  # nor regular nets
+    monkeypatch.setattr(nets, "HOT_BUDGET", 0)  # no precomputed layer 0 (it is kept on small meshes only)
+    monkeypatch.setattr(nets, "NETS_BUDGET", 0)  # nor regular nets
     mesh = read_obj_tagged(refdir / "osd_features" / "meshes" / "catmark_smoothtris1.obj")
     per_face = []
     m = mesh
@@ -91,12 +92,12 @@ def test_precomputed_layer_zero_gives_the_same_bits(refdir, monkeypatch):
     """The layer-0 nets and the regular nets kept precomputed on small meshes are the sums the kernels
     compute otherwise from the rings: the same numbers, bit for bit, on every backend (points in every
     layer of every corner)."""
-    from ccproof.evaluate import _table
+    from ccproof.evaluate import nets
 
     mesh = read_obj_tagged(refdir / "osd_features" / "meshes" / "catmark_smoothtris1.obj")
     hot = LimitSurface(mesh, progress=False)
-    monkeypatch.setattr(_table, "HOT_BUDGET", 0)
-    monkeypatch.setattr(_table, "NETS_BUDGET", 0)
+    monkeypatch.setattr(nets, "HOT_BUDGET", 0)
+    monkeypatch.setattr(nets, "NETS_BUDGET", 0)
     cold = LimitSurface(mesh, progress=False)
     assert hot._table.hot.shape[0] == 3 * hot._table.n_corner > 0 and cold._table.hot.shape[0] == 0
     assert hot._table.nets.shape[0] == hot._table.n_regular > 0 and cold._table.nets.shape[0] == 0
@@ -283,7 +284,7 @@ def test_vectorized_step_equals_the_tagged_rules(refdir, name):
     """The untagged Catmull-Clark step of the evaluator (numpy) against PolyMesh.refine (exact
     stencils of the tagged rules): the same faces, the same points to round-off; and the surfaces
     built on either agree."""
-    from ccproof.evaluate._table import catmark_step
+    from ccproof.evaluate.step import catmark_step
 
     t = read_obj_tagged(refdir / "osd_features" / "meshes" / f"catmark_{name}.obj")
     m = PolyMesh(t.vertices, [list(p) for p in t.polygons])  # the same polygons, untagged
@@ -303,7 +304,7 @@ def test_kept_rings_of_large_corners_give_the_same_bits(monkeypatch):
     """The rings kept per corner face where they are large (the centre of a 60-gon: Nc - 1 = 127 points) are
     the sums the kernels compute otherwise from the job's ring: deep points there, the same bits on every
     backend with the rings kept and with none kept; a vertex of valence <= 15 keeps none."""
-    from ccproof.evaluate import _table
+    from ccproof.evaluate import nets
 
     n = 60
     t = np.linspace(0, 2 * np.pi, n, endpoint=False)
@@ -312,7 +313,7 @@ def test_kept_rings_of_large_corners_give_the_same_bits(monkeypatch):
     mesh = PolyMesh(np.vstack([V, 2 * V]), F)
     kept = LimitSurface(mesh, progress=False)
     assert kept._table.ring.shape == (n * (2 * n + 7), 3) and (kept._table.cor_ring >= 0).sum() == n
-    monkeypatch.setattr(_table, "KEEP_RING_NC", 10**9)
+    monkeypatch.setattr(nets, "KEEP_RING_NC", 10**9)
     none = LimitSurface(mesh, progress=False)
     assert none._table.ring.shape[0] == 0 and none._table.cor_ring.shape[0] == 0
     rng = np.random.default_rng(0)

@@ -13,9 +13,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ccproof.evaluate import _table
+from ccproof.evaluate import backend, factory
 from ccproof.evaluate._ckernel import load
-from ccproof.evaluate._table import Builder, TaggedHalfEdges
+from ccproof.evaluate.factory import Builder
+from ccproof.evaluate.halfedge_views import TaggedHalfEdges
 from ccproof.evaluate.tagged import build_tagged
 from ccproof.mesh.examples import k_regular_disk
 from ccproof.mesh.halfedges import HalfEdges
@@ -51,18 +52,18 @@ def _both(mesh, monkeypatch):
         return face(self, *args, **kwargs)
 
     with monkeypatch.context() as m:
-        m.setattr(_table, "COMPILED_WALK_MIN", 0)
+        m.setattr(backend, "COMPILED_WALK_MIN", 0)
         m.setattr(Builder, "_walk_all", counting)
         m.setattr(Builder, "face", python_face)
         compiled = build_tagged(mesh)
     with monkeypatch.context() as m:
-        m.setattr(_table, "_ring_walks", lambda n: None)  # the Python walk, face by face
+        m.setattr(backend, "compiled_ring_walk", lambda n: None)  # the Python walk, face by face
         python = build_tagged(mesh)
     return compiled, python, walked
 
 
 def _needs_walk():
-    if _table._ring_walks(1 << 20) is None:
+    if backend.compiled_ring_walk(1 << 20) is None:
         pytest.skip("no compiled ring walk (neither the C kernel nor numba)")
 
 
@@ -119,8 +120,9 @@ def test_ring_tags_separate_the_keys():
         nring, nfaces, hashes = np.empty(k, np.int64), np.empty(k, np.int64), np.empty(k, np.uint64)
         pos = np.full(he.n_vertices, -1, dtype=np.int64)
         seen = np.zeros(he.faces.shape[0], dtype=np.bool_)
-        _table._ring_walks(k)(he.org, he.nxt, he.prv, he.twin, pos, seen, np.zeros(1, np.int64), np.zeros(1, np.int64),
-                              rings, nring, fc, nfaces, hashes)
+        walk = backend.compiled_ring_walk(k)
+        walk((he.org, he.nxt, he.prv, he.twin), (pos, seen), np.zeros(1, np.int64), np.zeros(1, np.int64),
+             (rings, nring, fc, nfaces, hashes))
         rows.append(he.ring_tags(rings, nring, fc, nfaces)[0])
     nz = [sorted(set(r[r != 0].tolist())) for r in rows]
     assert nz == [[2.0], [math.inf], []]
@@ -132,7 +134,7 @@ def test_row_hash_separates_permuted_tags():
     rows[0, 1], rows[0, 5] = 2.0, math.inf
     rows[1, 5], rows[1, 1] = 2.0, math.inf
     rows[2, 1] = 1.0
-    h = _table._row_hash(rows)
+    h = factory._row_hash(rows)
     assert len(set(h.tolist())) == 3
 
 

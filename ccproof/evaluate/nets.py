@@ -1,0 +1,201 @@
+"""The nets and rings the kernels compute, computed with numpy by the same sums in the same order.
+
+Every net of a point is a linear function of its job's ring: ``sum_j op[j] * (X[ring[j]] - X[ring[0]])``
+over j = 1, 2, ... in order from 0.0 (:func:`ring_products`), the order every backend keeps, so that all
+give the same bits. Here: the nets a small table keeps precomputed (:func:`with_nets`, within
+:data:`NETS_BUDGET` and :data:`HOT_BUDGET`), the kept rings of large corner faces (:func:`kept_rings`), and
+the nets the numpy backend computes at evaluation time (:func:`composed_nets`, :func:`corner_limits`,
+:func:`corner_rings`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ccproof.errors import MeshError
+from ccproof.evaluate.patch_table import KIND_CORNER, KIND_REGULAR
+
+#: jobs per block when the limit points or precomputed nets are computed (bounds the temporaries)
+_BLOCK = 1 << 13
+
+#: largest size of the layer-0 nets of the corner faces kept precomputed (``PatchTable.hot``, 1,224
+#: bytes per corner face); beyond it every corner net is computed at evaluation time
+HOT_BUDGET = 32 << 20
+
+#: corner rings of at least this many points are kept per corner face (``PatchTable.ring``)
+KEEP_RING_NC = 40
+
+#: largest size of the regular nets kept precomputed (``PatchTable.nets``, 408 bytes per regular patch);
+#: beyond it every regular net is computed at evaluation time from the ring
+NETS_BUDGET = 32 << 20
+
+
+def with_nets(T, groups):
+    """``T`` with the precomputed nets that fit their budgets: the regular nets (:data:`NETS_BUDGET`, or the
+    environment variable ``CCPROOF_NETS_BUDGET`` in bytes) and the layer-0 corner nets (:data:`HOT_BUDGET`,
+    ``CCPROOF_HOT_BUDGET``), both by the kernels' sums (none where they do not fit: the same bits)."""
+    n_cor = T.n_corner
+    if 0 < T.n_regular and T.n_regular * 17 * 3 * 8 <= _budget("CCPROOF_NETS_BUDGET", NETS_BUDGET):
+        T = T._replace(nets=regular_nets(T, groups))
+    if 0 < n_cor and n_cor * 3 * 17 * 3 * 8 <= _budget("CCPROOF_HOT_BUDGET", HOT_BUDGET):
+        T = T._replace(hot=layer0_nets(T, groups))
+    return kept_rings(T, groups)
+
+
+def kept_rings(T, groups):
+    """``T`` with the rings of its corner faces with at least :data:`KEEP_RING_NC` points kept
+    (:attr:`PatchTable.ring`, by :func:`corner_rings`: the kernels' sums), or ``T`` where there are none."""
+    parts, off = [], 0
+    cor_ring = None
+    for t, jobs, _ in groups:
+        if not jobs.size:
+            continue
+        root = int(T.job_root[jobs[0]])
+        for vf, kind in enumerate(t.kind):
+            g = root + vf
+            if kind != KIND_CORNER or T.op_size[T.cfg[g]] < KEEP_RING_NC:
+                continue
+            if cor_ring is None:
+                cor_ring = np.full(T.n_corner, -1, dtype=np.int64)
+            m = int(T.op_size[T.cfg[g]]) - 1
+            for lo in range(0, jobs.size, _BLOCK):
+                jb = jobs[lo:lo + _BLOCK]
+                parts.append(corner_rings(T, jb, g)[:, 1:].reshape(-1, 3))
+                cor_ring[T.job_corner[jb] + t.leaf[vf]] = off + m * np.arange(jb.size)
+                off += m * jb.size
+    if cor_ring is None:
+        return T
+    return T._replace(cor_ring=cor_ring, ring=np.concatenate(parts))
+
+
+def _budget(name, default):
+    """The byte budget in the environment variable ``name`` (a non-negative integer), else ``default``.
+
+    >>> _budget("CCPROOF_NO_SUCH_BUDGET", 7)
+    7
+    """
+    import os
+
+    v = os.environ.get(name)
+    if v is None or v == "":
+        return default
+    try:
+        b = int(v)
+    except ValueError:
+        b = -1
+    if b < 0:
+        raise MeshError(f"{name}={v!r}: a budget in bytes, a non-negative integer")
+    return b
+
+
+def ring_products(op, X, rings):
+    """``op`` (N, r) applied to the rings (k, N) of positions ``X``, the kernels' sums: per ring
+    ``sum_j op[j] * (X[ring[j]] - X[ring[0]])`` over j = 1, 2, ... in order from 0.0. Shape (k, r, 3).
+
+    >>> X = np.array([[0.0, 0, 0], [1, 0, 0], [0, 2, 0]])
+    >>> ring_products(np.array([[9.0], [1.0], [0.5]]), X, np.array([[0, 1, 2]]))[0].tolist()
+    [[1.0, 1.0, 0.0]]
+    """
+    X0 = X[rings[:, 0]]
+    acc = np.zeros((rings.shape[0], op.shape[1], 3))
+    for j in range(1, op.shape[0]):
+        acc += op[j][None, :, None] * (X[rings[:, j]] - X0)[:, None, :]
+    return acc
+
+
+def regular_nets(T, groups):
+    """The nets of every regular patch of table ``T`` (:attr:`PatchTable.nets`), computed as the kernels
+    compute them (:func:`ring_products` of the leaf's operator, row 16 plus the ring's point 0)."""
+    nets = np.empty((T.n_regular, 17, 3))
+    X = T.points
+    for t, jobs, rings in groups:
+        if not jobs.size:
+            continue
+        root = int(T.job_root[jobs[0]])
+        for vf, kind in enumerate(t.kind):
+            if kind != KIND_REGULAR:
+                continue
+            g = root + vf
+            st, N = int(T.vop_start[g]), int(T.vn[g])
+            for lo in range(0, jobs.size, _BLOCK):
+                R = rings[lo:lo + _BLOCK]
+                a = ring_products(T.vop[st:st + 17 * N].reshape(N, 17), X, R)
+                a[:, 16] += X[R[:, 0]]
+                nets[T.job_net[jobs[lo:lo + _BLOCK]] + t.leaf[vf]] = a
+    return nets
+
+
+def composed_nets(T, jobs, vf, lay, code=None):
+    """The nets (k, 17, 3) of patch ``code`` of layer ``lay`` < :data:`~ccproof.evaluate.patch_table.COMPOSED_LAYERS`
+    of the corner face ``vf`` of ``jobs`` (k,): :func:`ring_products` of the composed operator, row 16 the limit
+    point. ``code`` None: the three patch codes at once, shape (k, 3, 17, 3), their operators side by side in one
+    product (each entry's sum the same, in the same order)."""
+    N, st, Nc = int(T.vn[vf]), int(T.vop_start[vf]), int(T.op_size[T.cfg[vf]])
+    codes = 3 if code is None else 1
+    st += N * (Nc - 1) + N + (3 * lay + (0 if code is None else code)) * N * 16
+    op = T.vop[st:st + codes * N * 16].reshape(codes, N, 16).transpose(1, 0, 2).reshape(N, codes * 16)
+    R = T.rings[T.job_ring[jobs][:, None] + np.arange(N)]
+    out = np.empty((R.shape[0], codes, 17, 3))
+    out[:, :, :16] = ring_products(op, T.points, R).reshape(-1, codes, 16, 3)
+    out[:, :, 16] = corner_limits(T, jobs, vf)[:, None, :]
+    return out if code is None else out[:, 0]
+
+
+def corner_limits(T, jobs, vf):
+    """The limit points (k, 3) at the irregular corner of the corner face ``vf`` of ``jobs`` (k,), computed
+    as the kernels compute them (:func:`ring_products` of its operator row, plus the ring's point 0)."""
+    N, st, Nc = int(T.vn[vf]), int(T.vop_start[vf]), int(T.op_size[T.cfg[vf]])
+    st += N * (Nc - 1)
+    R = T.rings[T.job_ring[jobs][:, None] + np.arange(N)]
+    return ring_products(T.vop[st:st + N].reshape(N, 1), T.points, R)[:, 0] + T.points[R[:, 0]]
+
+
+def corner_rings(T, jobs, vf):
+    """The rings (k, Nc, 3) relative to their corner vertex (row 0 zero) of the corner face ``vf`` (a
+    virtual face of the table ``T``) of ``jobs`` (k,), computed as the kernels compute them."""
+    N, st, Nc = int(T.vn[vf]), int(T.vop_start[vf]), int(T.op_size[T.cfg[vf]])
+    R = T.rings[T.job_ring[jobs][:, None] + np.arange(N)]
+    out = np.zeros((R.shape[0], Nc, 3))
+    op = T.vop[st:st + N * (Nc - 1)].reshape(N, Nc - 1)
+    parts = _sparse_parts(op) if N >= 256 and Nc >= 256 else None
+    if parts is None:
+        out[:, 1:] = ring_products(op, T.points, R)
+    else:  # an n-gon centre's ring: linear in n, the same sums but in another order (rounding ~1e-16)
+        S, m = parts
+        D = T.points[R] - T.points[R[:, :1]]  # (k, N, 3)
+        for c in range(3):
+            out[:, 1:, c] = (S.T @ D[:, :, c].T).T + (D[:, :, c] @ m)[:, None]
+    return out
+
+
+def _sparse_parts(op):
+    """``(S, m)`` with ``op = S + m 1^T`` (``m`` the row medians: the part every output shares, as the centre
+    of an n-gon's ring is in every point relative to the corner), ``S`` sparse (at most 10 % entries), or None."""
+    import scipy.sparse
+
+    m = np.median(op, axis=1)
+    S = op - m[:, None]
+    if np.count_nonzero(S) > 0.1 * S.size:
+        return None
+    return scipy.sparse.csr_matrix(S), m
+
+
+def layer0_nets(T, groups):
+    """The nets of layer 0 of every corner face of table ``T`` (see :attr:`PatchTable.hot`): per
+    corner face c and patch code the composed operator's sums (:func:`composed_nets`, the compiled
+    kernel's), row 16 the limit point. Shape (3 n_corner, 17, 3)."""
+    hot = np.empty((3 * T.n_corner, 17, 3))
+    for t, jobs, _ in groups:
+        if jobs is None or not jobs.size or not t.O.shape[0]:
+            continue
+        root = int(T.job_root[jobs[0]])
+        for vf, kind in enumerate(t.kind):
+            if kind != KIND_CORNER:
+                continue
+            for lo in range(0, jobs.size, _BLOCK):
+                jb = jobs[lo:lo + _BLOCK]
+                ci = T.job_corner[jb] + t.leaf[vf]
+                nets = composed_nets(T, jb, root + vf, 0)
+                for code in range(3):
+                    hot[3 * ci + code] = nets[:, code]
+    return hot
