@@ -45,8 +45,8 @@ from _bench import missing, ratio_line  # noqa: E402
 from bench_evaluate import _ideal_lib, _Pinned, hardware_bounds, interleaved, uniform_points  # noqa: E402
 from bench_memory import icosphere, write_obj  # noqa: E402
 
+from ccproof.evaluate import available_backends  # noqa: E402
 from ccproof.evaluate import natural_limit_surface as limit_surface  # noqa: E402
-from ccproof.evaluate.surface import available_backends  # noqa: E402
 from ccproof.mesh import read_mesh  # noqa: E402
 
 
