@@ -91,6 +91,8 @@ from flint import acb, arb, ctx, fmpq
 
 from ccproof.certify.verify import dart_models as _M
 from ccproof.certify.verify.dart_family import (  # noqa: F401 (re-exported for the tests)
+    B_AT_1,
+    N_POLYS,
     PIECES,
     XB,
     YB,
@@ -103,10 +105,11 @@ from ccproof.certify.verify.dart_family import (  # noqa: F401 (re-exported for 
     series_curves,
     series_variable,
 )
-from ccproof.certify.verify.dart_zeros import (  # noqa: F401 (re-exported for the tests)
-    exact_zeros,
-)
+from ccproof.certify.verify.dart_zeros import L0, ONE, QS, solve
+from ccproof.certify.verify.errors import CertificateError
 from ccproof.certify.verify.maps import STAR_CURVES  # noqa: F401 (re-exported for the tests)
+from ccproof.certify.verify.statement import horner
+from ccproof.certify.verify.tagged_modes import RING_INDEX
 from ccproof.rigorous.analytic import ball as _ball  # noqa: F401 (re-exported for the tests)
 from ccproof.rigorous.analytic import disc_bound
 
@@ -125,6 +128,36 @@ def family_values(fam, s):
     def y(d, p):
         return (P["Y0"][0](d, p) + F * P["Y+"][0](d, p) + P["Y-"][0](d, p) / F).real
     return x, y, acb(fam.yc).real
+
+
+def exact_zeros():
+    """Check exactly (in Q(sqrt 5), the constants of dart_zeros.QS) why the dropped coefficients vanish (the
+    verifier checks the coefficients themselves; these facts follow from its check_ring and check_mode0):
+    L0 is an eigenvalue of B(1) with eigenvector rho (rho(1,0) = 1) and rho(a, b) = rho(b, a); adj(L0 - B(1))
+    kappa = N(L0) is a multiple of rho (so U(L0) = U(1,0) rho and alpha(0) U(L0) = -cos(sigma) rho). Returns
+    rho (6 QS), CertificateError if not.
+
+    Examples
+    --------
+    >>> rho = exact_zeros()
+    >>> (rho[0] - 1).is_zero()
+    True
+    """
+    A = [[(L0 if i == k else QS(0)) - B_AT_1[i, k] for k in range(6)] for i in range(6)]
+    # rho: solve A rho = 0 with rho(1,0) = 1: drop row 0 (rank 5 since L0 is simple: checked by the solve)
+    try:
+        rho = [ONE] + solve([[A[i][k] for k in range(1, 6)] for i in range(1, 6)], [-A[i][0] for i in range(1, 6)])
+    except ZeroDivisionError:
+        raise CertificateError("L0 is not a simple eigenvalue of B(1)") from None
+    if not all(sum((A[i][k] * rho[k] for k in range(6)), QS(0)).is_zero() for i in range(6)):
+        raise CertificateError("rho is no eigenvector of B(1) for L0")
+    pos = {p: k for p, k in RING_INDEX.items()}
+    if not all((rho[pos[(a, b)]] - rho[pos[(b, a)]]).is_zero() for (a, b) in pos if b > 0 and (b, a) in pos):
+        raise CertificateError("rho is not symmetric in (a, b)")
+    N = [horner(p, L0, QS(0)) for p in N_POLYS]
+    if not all((N[k] - N[0] * rho[k]).is_zero() for k in range(6)) or N[0].is_zero():
+        raise CertificateError("adj(L0 - B(1)) kappa is not a non-zero multiple of rho")
+    return rho
 
 
 def _values(series):

@@ -2,7 +2,7 @@
 
 The Taylor models of det J_Phi (R), transversality (T) and winding (W) of ``dart:K``, every K >= K0, drop their
 lowest coefficients as 0 (docs/tagged_c1.md, "A plan for every dart K >= 101", item 6, part Z).
-:func:`check_zeros` computes each exactly and checks it is 0, after :func:`exact_zeros`. The rows (:data:`ROWS`;
+:func:`check_zeros` computes each exactly and checks it is 0. The rows (:data:`ROWS`;
 every piece, outer curve, basis part X+-, Y0, Y+-): D_ij = det d(X_i, Y_j)/d(u, v) and T_ij at h^0; the
 middle's e_10, e_11, e_20 (s^0 h^0, s^1 h^0, s^0 h^1) of K det J_Phi and of K (a1 X Y' - a2 Y X'); Y at
 s = h = 0; on the layer quadrants q = 0, 1, 2 the h^0, h^1, h^2 of det J_Phi and of a1 X Y' - a2 Y X', and
@@ -212,7 +212,7 @@ def _log_ratio(lam):
     return z - z * z / 2
 
 
-def _solve(A, b):
+def solve(A, b):
     """Gauss-Jordan over Q(sqrt 5, i)[h]/(h^3) with pivots that are units (A(h = 0) regular); ZeroDivisionError
     if there is none."""
     n = len(A)
@@ -237,7 +237,7 @@ def _bordered(k, lam, stencil):
     for i, row in enumerate(stencil):
         for (d, pos), x in row.items():
             B[i][RING_INDEX[pos]] = B[i][RING_INDEX[pos]] + _exp_i(fmpq(k) * d) * fmpq(x)
-    return _solve(_df.bordered_matrix(B, lam, QS(0)), [QS(0)] * 6 + [QS(1)])[:6]
+    return solve(_df.bordered_matrix(B, lam, QS(0)), [QS(0)] * 6 + [QS(1)])[:6]
 
 
 class _Mode:
@@ -250,35 +250,6 @@ class _Mode:
         if with_u:
             den = _df.u_denominator(self.lam, L0_LOW)
             self.U = [horner(p, self.lam, QS(0)) / den for p in _df.N_POLYS]
-
-
-def exact_zeros():
-    """Check exactly (in Q(sqrt 5), the constants of :class:`QS`) the facts the dropped coefficients rest on:
-    L0 is an eigenvalue of B(1) with eigenvector rho (rho(1,0) = 1) and rho(a, b) = rho(b, a); adj(L0 - B(1))
-    kappa = N(L0) is a multiple of rho (so U(L0) = U(1,0) rho and alpha(0) U(L0) = -cos(sigma) rho). Returns
-    rho (6 QS), CertificateError if not.
-
-    Examples
-    --------
-    >>> rho = exact_zeros()
-    >>> (rho[0] - 1).is_zero(), (rho[2] - (SQRT20 / 2 - 1)).is_zero()  # rho(1,1) = sqrt 5 - 1
-    (True, True)
-    """
-    A = [[(L0 if i == k else QS(0)) - _df.B_AT_1[i, k] for k in range(6)] for i in range(6)]
-    # rho: solve A rho = 0 with rho(1,0) = 1: drop row 0 (rank 5 since L0 is simple: checked by the solve)
-    try:
-        rho = [ONE] + _solve([[A[i][k] for k in range(1, 6)] for i in range(1, 6)], [-A[i][0] for i in range(1, 6)])
-    except ZeroDivisionError:
-        raise CertificateError("L0 is not a simple eigenvalue of B(1)") from None
-    if not all(sum((A[i][k] * rho[k] for k in range(6)), QS(0)).is_zero() for i in range(6)):
-        raise CertificateError("rho is no eigenvector of B(1) for L0")
-    pos = {p: k for p, k in RING_INDEX.items()}
-    if not all((rho[pos[(a, b)]] - rho[pos[(b, a)]]).is_zero() for (a, b) in pos if b > 0 and (b, a) in pos):
-        raise CertificateError("rho is not symmetric in (a, b)")
-    N = [horner(p, L0, QS(0)) for p in _df.N_POLYS]
-    if not all((N[k] - N[0] * rho[k]).is_zero() for k in range(6)) or N[0].is_zero():
-        raise CertificateError("adj(L0 - B(1)) kappa is not a non-zero multiple of rho")
-    return rho
 
 
 class ExactFamily(_df.Modes):
@@ -505,20 +476,17 @@ def count_zeros(points=GRID, ells=GRID_CT, stencil=None, flip_alpha=False):
 
 def check_zeros(*, _stencil=None, _flip_alpha=False) -> str:
     """Check exactly that every dropped Taylor coefficient of the dart family is 0 on the grid of the degree
-    argument (module docstring), after :func:`exact_zeros`: a one-line summary with the counts per row, or
-    CertificateError naming the row, grid point and place of the first non-zero one (``_stencil``,
+    argument (module docstring): a one-line summary with the counts per row, or CertificateError naming the row, grid point and place of the first non-zero one (``_stencil``,
     ``_flip_alpha``: perturbations for the tests).
 
     Examples
     --------
     >>> print(check_zeros())
-    dropped coefficients exactly 0 on the grid a, b in (1, 2, 3), c, t, l in (1, 2): ... 103428 in all ...
+    dropped coefficients exactly 0 on the grid a, b in (1, 2, 3), c, t, l in (1, 2): ... 103428 in all
     """
-    exact_zeros()
     rows = _run(GRID, GRID_CT, _stencil, _flip_alpha, stop=True).rows
     if not all(n > 0 for n, _ in rows.values()):
         raise CertificateError("a row of dropped coefficients checked nothing")
     return (f"dropped coefficients exactly 0 on the grid a, b in {GRID_AB}, c, t, l in {GRID_CT}: "
             + "; ".join(f"{row} {n}" for row, (n, _) in rows.items())
-            + f"; {sum(n for n, _ in rows.values())} in all (and rho = v^(0) is B(1)'s symmetric eigenvector for "
-            "L0 = (6 + sqrt 20)/16, adj(L0 - B(1)) kappa a non-zero multiple of it)")
+            + f"; {sum(n for n, _ in rows.values())} in all")
