@@ -29,23 +29,24 @@ bracket is used (nor c^2 + t^2 = 1: the identities are polynomial).
 **The exact arithmetic.** Q(theta) = Q(sqrt 5, i), theta = sqrt 5 + i, m(theta) = 0, m(x) = x^4 - 8 x^2 + 36.
 Series in h truncated after h^2 over Q(theta), the ring Q(theta)[h]/(h^3), are held as Q[x]/(m^3) (fmpq_poly
 modulo m^3: the arithmetic in C): theta -> theta~, the root of m lifting x (Newton; m(theta~) = 0 mod m^3
-checked at import), h -> m(x). This is an isomorphism (e(theta~) is a unit for e != 0 in Q(theta), so
-sum e_k(theta~) m^k = 0 mod m^3 forces e_0 = e_1 = e_2 = 0; both have dimension 12), and h^0 .. h^(k-1) all
-vanish exactly when m^k divides the representative: the checks are remainders, the coefficients are read
-off (:meth:`QS.coeffs`) only where one is not 0. Truncations are exact: e^(i k h) = 1 + i k h - k^2 h^2/2,
-sqrt(20 (1 + z)) = 2 sqrt 5 (1 + z/2 - z^2/8), ln(1 + z) = z - z^2/2 for z in (h). The bordered 7 x 7 systems
-are solved by Gauss-Jordan over the ring (unit pivots), U from :mod:`.dart_family`'s exact polynomials, and
-the nets by the family's own assembly (``piece_nets``, ``quadrant_level1``, ``_bezier``). det J_Phi's h^m
-coefficient, of degree <= (5, 5) in the patch parameters (u, v), is checked on the 6 x 6 grid u, v in
-{0, 1/5, ..., 1}; T's and the curve points' as the Bernstein coefficients. Parts depending on fewer of
-(a, b, c, t) (X's nets on a, Y+-'s on b, Y0's on (b, c)) are computed once, counted at each grid point.
+checked at import), h -> m(x). This is an isomorphism (e(theta~) is a unit for e != 0 in Q(theta), so sum
+e_k(theta~) m^k = 0 mod m^3 forces e_0 = e_1 = e_2 = 0; both have dimension 12), and h^0 .. h^(k-1) all vanish
+exactly when m^k divides the representative: the checks are remainders, the coefficients are read off
+(:meth:`QS.coeffs`) only where one is not 0. Truncations are exact: e^(i k h) = 1 + i k h - k^2 h^2/2, sqrt(20
+(1 + z)) = 2 sqrt 5 (1 + z/2 - z^2/8), ln(1 + z) = z - z^2/2 for z in (h). The bordered 7 x 7 systems are
+solved as rational 84 x 84 ones (the ring is 12-dimensional over Q: :func:`solve`), U from
+:mod:`.dart_family`'s exact polynomials, and the nets by the family's own assembly (``piece_nets``,
+``quadrant_level1``, ``_bezier``). det J_Phi's h^m coefficient, of degree <= (5, 5) in the patch parameters (u,
+v), is checked on the 6 x 6 grid u, v in {0, 1/5, ..., 1}; T's and the curve points' as the Bernstein
+coefficients. Parts depending on fewer of (a, b, c, t) (X's nets on a, Y+-'s on b, Y0's on (b, c)) are computed
+once, counted at each grid point.
 """
 
 from __future__ import annotations
 
 import itertools
 
-from flint import fmpq, fmpq_poly
+from flint import fmpq, fmpq_mat, fmpq_poly
 
 from . import dart_family as _df
 from .dart_family import PIECES, XB, YB
@@ -213,22 +214,14 @@ def _log_ratio(lam):
 
 
 def solve(A, b):
-    """Gauss-Jordan over Q(sqrt 5, i)[h]/(h^3) with pivots that are units (A(h = 0) regular); ZeroDivisionError
-    if there is none."""
+    """The solution of A v = b over Q(sqrt 5, i)[h]/(h^3) = Q[x]/(m^3), a 12-dimensional Q-algebra: A as the
+    rational 12 n x 12 n matrix of its multiplications (column k of the block of z: z x^k mod m^3), solved by
+    fmpq_mat (exact; ZeroDivisionError unless A is invertible over the ring, i.e. A(h = 0) regular)."""
     n = len(A)
-    M = [list(A[i]) + [b[i]] for i in range(n)]
-    for c in range(n):
-        piv = next((r for r in range(c, n) if not M[r][c].vanishes(1)), None)
-        if piv is None:
-            raise ZeroDivisionError("singular system")
-        M[c], M[piv] = M[piv], M[c]
-        inv = M[c][c].inv()
-        M[c] = [z * inv for z in M[c]]
-        for r in range(n):
-            if r != c and not M[r][c].is_zero():
-                f = M[r][c]
-                M[r] = [z - f * w for z, w in zip(M[r], M[c])]
-    return [M[r][n] for r in range(n)]
+    cols = [[[(z.p * _X ** k) % _M3 for k in range(12)] for z in row] for row in A]
+    M = fmpq_mat([[cols[i][j][k][r] for j in range(n) for k in range(12)] for i in range(n) for r in range(12)])
+    v = M.solve(fmpq_mat([[(z.p % _M3)[r]] for z in b for r in range(12)]))
+    return [QS(fmpq_poly([v[12 * i + r, 0] for r in range(12)])) for i in range(n)]
 
 
 def _bordered(k, lam, stencil):
@@ -300,7 +293,9 @@ _GRID = [fmpq(k, 5) for k in range(6)]
 _BERN = [[(1 - u) ** 3, 3 * u * (1 - u) ** 2, 3 * u * u * (1 - u), u ** 3] for u in _GRID]
 _DBERN = [[-3 * (1 - u) ** 2, 3 * (1 - u) ** 2 - 6 * u * (1 - u), 6 * u * (1 - u) - 3 * u * u, 3 * u * u]
           for u in _GRID]
-_UV = [f"({i}/5, {j}/5)" for i in range(6) for j in range(6)]
+_UV = "(u, v) in {0, 1/5, .., 1}^2 (row-major)"
+_MID = "(S: e_10, e_20; S': e_11) alternating per " + _UV
+_COEF = "the 6 Bernstein coefficients per l"
 
 
 def _lin(ps, ws):
@@ -328,18 +323,13 @@ def _det(px, py):
 class _Tally:
     """{row: [checked, non-zero]}; with ``stop`` the first non-zero coefficient raises CertificateError."""
 
-    def __init__(self, stop, ells):
+    def __init__(self, stop):
         self.rows = {row: [0, 0] for row in ROWS}
-        self.stop, self.ells = stop, ells
-
-    def _at(self, kind, k):
-        e = "e_10, e_20" if k % 2 == 0 else "e_11"  # the middle's items alternate S, S'
-        return {"uv": lambda: f"(u, v) = {_UV[k]}", "mid": lambda: f"{e} at (u, v) = {_UV[k // 2]}",
-                "midT": lambda: f"{e} at l = {self.ells[k // 12]}, coefficient {k // 2 % 6}",
-                "coef": lambda: f"l = {self.ells[k // 6]}, coefficient {k % 6}", "point": lambda: f"point {k}"}[kind]()
+        self.stop = stop
 
     def add(self, row, items, where, kind):
-        """items: [(raw element, the h-orders that must be 0)]; where, kind: the items' place, for the reason."""
+        """items: [(raw element, the h-orders that must be 0)]; where, kind: the items' place and how they are
+        numbered (item k of ``kind``), for the reason."""
         for k, (p, orders) in enumerate(items):
             self.rows[row][0] += len(orders)
             if (p % _MOD[max(orders) + 1]).is_zero():
@@ -349,7 +339,7 @@ class _Tally:
             self.rows[row][1] += len(bad)
             if bad and self.stop:
                 raise CertificateError(f"dropped coefficient not 0: row '{row}', h^{bad[0]} coefficient "
-                                       f"at {where}, {self._at(kind, k)}")
+                                       f"at {where}, item {k} of {kind}")
 
 
 def _xy(xs, ys):
@@ -410,8 +400,8 @@ def _check_pieces(fam, part, tally, pt):
     for piece in PIECES:
         G = {(i, j): _det(part[i][piece], part[j][piece]) for i in XB for j in YB}
         for (i, j), vals in G.items():
-            tally.add(ROWS[0], [(v, (0,)) for v in vals], f"{pt}, {piece}, D({i}, {j})", "uv")
-        tally.add(ROWS[1], _middle(G, fam), f"{pt}, {piece}", "mid")
+            tally.add(ROWS[0], [(v, (0,)) for v in vals], f"{pt}, {piece}, D({i}, {j})", _UV)
+        tally.add(ROWS[1], _middle(G, fam), f"{pt}, {piece}", _MID)
 
 
 def _check_curves(fam, nets, keys, A, tally, cache, pt):
@@ -423,10 +413,10 @@ def _check_curves(fam, nets, keys, A, tally, cache, pt):
                 cache[(keys[i], keys[j], curve)] = _xy(pts[i], pts[j])
         G = {(i, j): _trans(cache[(keys[i], keys[j], curve)], A) for i in XB for j in YB}
         for (i, j), vals in G.items():
-            tally.add(ROWS[2], [(v, (0,)) for v in vals], f"{pt}, {curve}, T({i}, {j})", "coef")
-        tally.add(ROWS[3], _middle(G, fam), f"{pt}, {curve}", "midT")
+            tally.add(ROWS[2], [(v, (0,)) for v in vals], f"{pt}, {curve}, T({i}, {j})", _COEF)
+        tally.add(ROWS[3], _middle(G, fam), f"{pt}, {curve}", "(S, S') alternating per " + _COEF)
         tally.add(ROWS[4], [((pts["Y0"][p] + pts["Y+"][p] * fam.em + pts["Y-"][p] * fam.ep).p, (0,)) for p in range(4)],
-                  f"{pt}, {curve}", "point")
+                  f"{pt}, {curve}", "the 4 Bezier points")
 
 
 def _check_layers(fam, A, tally, cache, pt):
@@ -435,19 +425,19 @@ def _check_layers(fam, A, tally, cache, pt):
         xn, xp = _nets(cache, ("LX", fam.a, q), lambda q=q: fam.layer_nets(q, 0))
         yn, yp = _nets(cache, ("LY", fam.b, fam.c, fam.t, q), lambda q=q: fam.layer_nets(q, 1))  # y: (b, c, t)
         for piece in PIECES:
-            tally.add(ROWS[5], [(v, (0, 1, 2)) for v in _det(xp[piece], yp[piece])], f"{pt}, q = {q}, {piece}", "uv")
+            tally.add(ROWS[5], [(v, (0, 1, 2)) for v in _det(xp[piece], yp[piece])], f"{pt}, q = {q}, {piece}", _UV)
         for curve in STAR_CURVES:
             xs, ys = curve_points(xn, curve, oriented=True), curve_points(yn, curve, oriented=True)
             tally.add(ROWS[6], [(v, (0, 1, 2)) for v in _trans(_xy(xs, ys), A)],
-                      f"{pt}, q = {q}, {curve}", "coef")
+                      f"{pt}, q = {q}, {curve}", _COEF)
             end = q == 0 and curve == "P1s1"  # ray 0's end point: h^1 too
             tally.add(ROWS[7], [(y.p, (0, 1) if end and k == 0 else (0,)) for k, y in enumerate(ys)],
-                      f"{pt}, q = {q}, {curve}", "point")
+                      f"{pt}, q = {q}, {curve}", "the 4 Bezier points")
 
 
 def _run(points, ells, stencil, flip_alpha, stop):
     stencil = ring_stencil() if stencil is None else stencil
-    tally, modes, cache = _Tally(stop, ells), {}, {}
+    tally, modes, cache = _Tally(stop), {}, {}
     for a, b, c, t in points:
         if ("x", a) not in modes:
             modes[("x", a)] = _Mode(a, stencil)
@@ -476,8 +466,9 @@ def count_zeros(points=GRID, ells=GRID_CT, stencil=None, flip_alpha=False):
 
 def check_zeros(*, _stencil=None, _flip_alpha=False) -> str:
     """Check exactly that every dropped Taylor coefficient of the dart family is 0 on the grid of the degree
-    argument (module docstring): a one-line summary with the counts per row, or CertificateError naming the row, grid point and place of the first non-zero one (``_stencil``,
-    ``_flip_alpha``: perturbations for the tests).
+    argument (module docstring): a one-line summary with the counts per row, or CertificateError naming the
+    row, grid point and place of the first non-zero one (``_stencil``, ``_flip_alpha``: perturbations for the
+    tests).
 
     Examples
     --------
