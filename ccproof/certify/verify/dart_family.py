@@ -309,20 +309,32 @@ XB, YB = ("X+", "X-"), ("Y0", "Y+", "Y-")
 
 
 _SU, _SH = 6, 36  # Kronecker strides: a product of bicubic partials has degree <= 5 in u and in v
-_BIN2, _BIN3, _BIN5 = (1, 2, 1), (1, 3, 3, 1), (1, 5, 10, 10, 5, 1)
+_BIN = ((1,), (1, 1), (1, 2, 1), (1, 3, 3, 1), (1, 4, 6, 4, 1), (1, 5, 10, 10, 5, 1))  # C(d, i)
+_BIN2, _BIN3, _BIN5 = _BIN[2], _BIN[3], _BIN[5]
 
 
-def _packed(nets, axis):
-    """One acb_poly holding, for every h^m coefficient net (4 x 4), the partial along ``axis`` (0: u, 1: v) in
-    Bernstein form times its binomial weights, at x^(m _SH + i _SU + j)."""
-    coeffs = [acb(0)] * (_SH * len(nets))
+def _packed(nets, axis, stride=_SH):
+    """One acb_poly holding, for every h^m coefficient net (4 x 4; 1 x 4 a curve, 1 x 1 a scalar), its partial
+    along ``axis`` (0: u, 1: v; None: the net itself) in Bernstein form times its binomial weights, at
+    x^(m stride + i _SU + j)."""
+    coeffs = [acb(0)] * (stride * len(nets))
     for m, net in enumerate(nets):
-        for i in range(4 - (axis == 0)):
-            for j in range(4 - (axis == 1)):
-                d = net[i + 1][j] - net[i][j] if axis == 0 else net[i][j + 1] - net[i][j]
-                w = (_BIN2[i] * _BIN3[j]) if axis == 0 else (_BIN3[i] * _BIN2[j])
-                coeffs[m * _SH + i * _SU + j] = 3 * w * acb(d)
+        rows, cols = len(net) - (axis == 0), len(net[0]) - (axis == 1)
+        for i in range(rows):
+            for j in range(cols):
+                d = net[i + 1][j] - net[i][j] if axis == 0 else net[i][j + 1] - net[i][j] if axis == 1 else net[i][j]
+                w = (1 if axis is None else 3) * _BIN[rows - 1][i] * _BIN[cols - 1][j]
+                coeffs[m * stride + i * _SU + j] = w * acb(d)
     return acb_poly(coeffs)
+
+
+def _unpacked(P, n, stride, rows):
+    """The h^m coefficients, m = 0..n, of a packed product of degree 5 (in u and v, ``rows`` = 6; or in the curve
+    parameter, ``rows`` = 1): the scaled Bernstein coefficients divided by their binomial weights."""
+    c = P.coeffs()
+    c += [acb(0)] * max(0, stride * (n + 1) - len(c))
+    return [[c[m * stride + i * _SU + j] / (_BIN5[i] * _BIN5[j]) for i in range(rows) for j in range(6)]
+            for m in range(n + 1)]
 
 
 def packed_partials(nets):
@@ -339,10 +351,7 @@ def det_series(A, B, n):
     with the strides above). Returns ``[[36 acb, (i, j) row-major] for m in 0..n]``: D's Bernstein
     coefficients (degree (5, 5))."""
     (Au, Av), (Bu, Bv) = (X if isinstance(X, tuple) else packed_partials(X) for X in (A, B))
-    c = (Au * Bv - Av * Bu).coeffs()
-    c += [acb(0)] * max(0, _SH * (n + 1) - len(c))
-    return [[c[m * _SH + i * _SU + j] / (_BIN5[i] * _BIN5[j]) for i in range(6) for j in range(6)]
-            for m in range(n + 1)]
+    return _unpacked(Au * Bv - Av * Bu, n, _SH, 6)
 
 
 def basis_nets(fam):
@@ -379,24 +388,11 @@ def series_curves(nets, n, real=False):
     return out
 
 
-def _curve_packed(c, deriv):
-    """acb_poly with the h^m coefficient curve (4 Bezier values) at x^(6 m + i), scaled by C(3, i); or its
-    derivative (3 (c_(i+1) - c_i), scaled by C(2, i))."""
-    out = [acb(0)] * (6 * len(c))
-    for m, pts in enumerate(c):
-        for i in range(3 if deriv else 4):
-            out[6 * m + i] = 3 * _BIN2[i] * (acb(pts[i + 1]) - acb(pts[i])) if deriv else _BIN3[i] * acb(pts[i])
-    return acb_poly(out)
-
-
 def curve_trans_series(xc, yc, A1, A2, n):
     """Taylor coefficients of a1 X Y' - a2 Y X' from the coordinates' (xc, yc: [m: 4 values]) and a_i's: the
     Cauchy products in h of the degree-5 Bernstein products f g' (scaled coefficients convolve, then divide by
-    C(5, k)) as acb_poly products, h packed with stride 6."""
-    a1 = acb_poly([acb(A1[m]) if k == 0 else acb(0) for m in range(n + 1) for k in range(6)])
-    a2 = acb_poly([acb(A2[m]) if k == 0 else acb(0) for m in range(n + 1) for k in range(6)])
-    P = a1 * (_curve_packed(xc, False) * _curve_packed(yc, True)) - a2 * (_curve_packed(yc, False)
-                                                                         * _curve_packed(xc, True))
-    c = P.coeffs()
-    c += [acb(0)] * max(0, 6 * (n + 1) - len(c))
-    return [[c[6 * m + k] / _BIN5[k] for k in range(6)] for m in range(n + 1)]
+    C(5, k)) as acb_poly products, h packed with stride 6 (:func:`_packed` of 1 x 4 and 1 x 1 nets)."""
+    a1, a2 = (_packed([[[z]] for z in A[:n + 1]], None, 6) for A in (A1, A2))
+    X, Y = ([[pts] for pts in c] for c in (xc, yc))
+    P = a1 * (_packed(X, None, 6) * _packed(Y, 1, 6)) - a2 * (_packed(Y, None, 6) * _packed(X, 1, 6))
+    return _unpacked(P, n, 6, 1)
