@@ -40,7 +40,7 @@ REVIEWED = {
     ("dart_spectrum.py", "not abs(y) < fmpq(9, 10)"): "refuses unless |y| < 9/10 certainly: conservative",
     ("dart_spectrum.py", "not T > 0"): "refuses unless T > 0 certainly: conservative",
     ("dart_spectrum.py", "not 4 * arb(sig_r) < pi * k0"): "refuses unless certainly: conservative",
-    ("dart_spectrum.py", "full != (x - 1) * (x * x - 3 * x / 4 + fmpq(1, 16)) + hv * detR"): "fmpq_poly (exact)",
+    ("dart_spectrum.py", "_det3(b0(lam, h)) != (lam - 1) * P + h * detR"): "fmpq_mpoly (exact)",
     ("dart_spectrum.py", "rem != 0"): "fmpq_poly (exact)",
     ("dart_spectrum.py", "key != _C"): "tuples",
     # the sign of a square root is a choice (the expressions are even in it); _cot_far then refuses unless

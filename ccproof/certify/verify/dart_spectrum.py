@@ -267,23 +267,20 @@ def check_secular():
     P = lam * lam - 3 * lam / 4 + fmpq(1, 16)
     if 8 * P * 2 != -(2 * lam - lc):  # 8 P = -lam (1 - c*), times 2
         raise CertificateError("P is not -lam (1 - c*)/8")
-    x = fmpq_poly([0, 1])
-    for hv in (fmpq(0), fmpq(1, 7), fmpq(2, 5)):  # det(x - B0(h)) is affine in h: three values decide
-        full = _det3(b0(x, hv))
-        _, detR = mode0_parts(x, hv)
-        if full != (x - 1) * (x * x - 3 * x / 4 + fmpq(1, 16)) + hv * detR:
-            raise CertificateError("det(lam - B0) is not (lam - 1) P + h det R")
-    _, detR = mode0_parts(x, 0)
-    ell, rem = divmod(detR, x - 1)
-    if rem != 0 or ell.degree() > 1:
-        raise CertificateError("det R is not (lam - 1) times a linear polynomial")
+    _, detR = mode0_parts(lam, h)
+    if _det3(b0(lam, h)) != (lam - 1) * P + h * detR:
+        raise CertificateError("det(lam - B0) is not (lam - 1) P + h det R")
+    _ell()
     return True
 
 
 def _ell():
+    """l = det R/(lam - 1), raising unless det R (in Q[lam]) is (lam - 1) times a polynomial of degree <= 1."""
     x = fmpq_poly([0, 1])
-    _, detR = mode0_parts(x, 0)
-    return divmod(detR, x - 1)[0]
+    ell, rem = divmod(mode0_parts(x, 0)[1], x - 1)
+    if rem != 0 or ell.degree() > 1:
+        raise CertificateError("det R is not (lam - 1) times a linear polynomial")
+    return ell
 
 
 def lam_circle(sig_r, h):
