@@ -28,7 +28,7 @@ from .errors import CertificateError
 from .maps import STAR_CURVES, curve_points
 from .rules import CENTRE, canonical, level1_rule
 from .statement import B2Z, horner, lam_of
-from .tagged_modes import RING_INDEX, ring_block, ring_stencil
+from .tagged_modes import RING_INDEX, bordered_solve, ring_block, ring_stencil
 
 
 @dataclass(frozen=True)
@@ -150,13 +150,12 @@ def bordered_matrix(B, lam, zero, pivot=0):
 def bordered(w, lam, pivot=0):
     """v^ (6 values of w's type): B(w) v^ = lam v^, v^[pivot] = 1, from the bordered 7 x 7 system A v = e_7.
 
-    For acb balls arb proves A regular on the whole ball (ZeroDivisionError otherwise). For power series
-    in h (acb_series) the Taylor coefficients follow from A_0 v_k = -sum_(j >= 1) A_j v_(k-j), A_0 the
-    system at h = 0 (proved regular by arb)."""
-    A = bordered_matrix(ring_block(w), lam, w * 0, pivot)
+    For acb balls :func:`.tagged_modes.bordered_solve` (arb proves A regular on the whole ball; ZeroDivisionError
+    otherwise). For power series in h (acb_series) the Taylor coefficients follow from A_0 v_k = -sum_(j >= 1)
+    A_j v_(k-j), A_0 the system at h = 0 (proved regular by arb)."""
     if not isinstance(w, acb_series):
-        sol = acb_mat(A).solve(acb_mat([[0]] * 6 + [[1]]))
-        return [sol[i, 0] for i in range(6)]
+        return bordered_solve(ring_block(w), lam, pivot)
+    A = bordered_matrix(ring_block(w), lam, w * 0, pivot)
     n = w.prec
     cs = [[series_coeffs(A[i][k], n) for k in range(7)] for i in range(7)]
     Ak = [acb_mat([[cs[i][k][m] for k in range(7)] for i in range(7)]) for m in range(n)]
