@@ -101,7 +101,6 @@ from ccproof.certify.verify.dart_family import (  # noqa: F401 (re-exported for 
     bordered,
     layer_nets,
     piece_nets,
-    series_cap,
     series_curves,
     series_variable,
 )
@@ -196,13 +195,13 @@ def _models(tag, T, M, r, q=None):
 
 
 def _bulk(sigma, n, tag, **control):
-    with series_cap(n):
-        return _select(_M.quantities(Family(series_variable(n), sigma, **control), n), tag)
+    with series_variable(n) as h:
+        return _select(_M.quantities(Family(h, sigma, **control), n), tag)
 
 
 def _layer(q, sigma, n, tag):
-    with series_cap(n):
-        return _real(_select(_M.quantities(Family(series_variable(n), sigma), n, [q], bulk=False), tag, q))
+    with series_variable(n) as h:
+        return _real(_select(_M.quantities(Family(h, sigma), n, [q], bulk=False), tag, q))
 
 
 def _disc(sigma, r, grid, tag, q=None, **control):
@@ -255,8 +254,8 @@ def disc_trans(sigma, r, grid=12, prec=128, **control):
 
 def coord_taylor(sigma, n, coord, prec=128):
     """{(basis part, curve): [order m: 4 acb]}: Taylor coefficients in h of the outer curves' points."""
-    with ctx.workprec(prec), series_cap(n):
-        nets = basis_nets(Family(series_variable(n), sigma))
+    with ctx.workprec(prec), series_variable(n) as h:
+        nets = basis_nets(Family(h, sigma))
         return {(b, c): pts for b in (XB if coord == "x" else YB) for c, pts in series_curves(nets[b], n).items()}
 
 

@@ -20,6 +20,7 @@ quadrants next to the sharp ray (:func:`layer_nets`: ghost rows, the sharp midpo
 
 from __future__ import annotations
 
+from contextlib import contextmanager
 from dataclasses import dataclass
 
 from flint import acb, acb_mat, acb_poly, acb_series, arb, ctx, fmpq, fmpq_mat, fmpq_poly
@@ -111,26 +112,17 @@ def _lam_principal(c):
     return lam_of(c)
 
 
+@contextmanager
 def series_variable(n):
-    """The series variable h to order n. python-flint truncates every series to ``ctx.cap`` terms (10 by
-    default) whatever its ``prec``: the callers run under :func:`series_cap` so that no order is lost."""
-    if ctx.cap < n + 1:
-        raise ValueError(f"ctx.cap = {ctx.cap} < {n + 1}: series would be truncated silently")
-    return acb_series([0, 1], prec=n + 1)
-
-
-class series_cap:
-    """Context manager: ctx.cap >= n + 1 inside (restored after)."""
-
-    def __init__(self, n):
-        self.n = n
-
-    def __enter__(self):
-        self.old = ctx.cap
-        ctx.cap = max(self.old, self.n + 1)
-
-    def __exit__(self, *exc):
-        ctx.cap = self.old
+    """Context: the series variable h to order n (acb_series [0, 1]) with ``ctx.cap`` >= n + 1 inside (restored
+    after): python-flint truncates every series to ``ctx.cap`` terms (10 by default) whatever its ``prec``, so
+    that no order is lost."""
+    old = ctx.cap
+    ctx.cap = max(old, n + 1)
+    try:
+        yield acb_series([0, 1], prec=n + 1)
+    finally:
+        ctx.cap = old
 
 
 def series_coeffs(z, n, real=False):

@@ -34,7 +34,6 @@ from .dart_family import (
     det_series,
     layer_nets,
     packed_partials,
-    series_cap,
     series_coeffs,
     series_curves,
     series_variable,
@@ -239,11 +238,10 @@ class SigmaBox:
         self.m, hn, r = models, models.hints, models.hints.r
         with ctx.workprec(models.prec):
             self.sigma = sigma = ball(models.edges[i], models.edges[i + 1])
-            with series_cap(hn.order):
-                Q = quantities(Family(series_variable(hn.order), sigma), hn.order)
-            with series_cap(hn.layer_order):
-                Q.update(quantities(Family(series_variable(hn.layer_order), sigma), hn.layer_order,
-                                    range(models.layer), bulk=False))
+            with series_variable(hn.order) as h:
+                Q = quantities(Family(h, sigma), hn.order)
+            with series_variable(hn.layer_order) as h:
+                Q.update(quantities(Family(h, sigma), hn.layer_order, range(models.layer), bulk=False))
             self.om = {t: omegas(t, sigma) for t in QUANTITIES}
             self.models = {(t, None): group_models(Q, models.M, r, t) for t in QUANTITIES}
             self.models.update({(t, q): group_models(Q, models.M, r, t, q) for t in "RTY" for q in range(models.layer)})
