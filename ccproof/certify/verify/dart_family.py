@@ -172,9 +172,16 @@ def _eps(pos):
 class Modes:
     """x and y from their modes, split by their dependence on s: x = E X+ + E^-1 X-, y = Y0 + F Y+ + F^-1 Y-,
     E = e^(2 pi i s), F = e^(i sigma (2 s - 1)); one assembly for :class:`Family` (acb) and the exact family of
-    :mod:`.dart_zeros`. Needs vx, vy, U, alpha, yc (y's centre), lam1, lam2, zero, i2 = 2i, sign, em, ep =
+    :mod:`.dart_zeros`. Needs vx, vy, U, alpha and yc (:meth:`mode0`), lam1, lam2, zero, i2 = 2i, sign, em, ep =
     e^(-+ i sigma) and ``e(c, k)``: e^(i k a h) for c = "x", e^(i k b h) for "y" (a = 2 pi, b = 2 sigma). No
     Re or Im: the conjugate of a mode is the mode of 1/w with the positions (a, b) swapped."""
+
+    def mode0(self, cos_sigma, L0, flip=False):
+        """alpha = -(lam2 - 1/2) cos(sigma)/((lam2 - 1/2) U(1,0) - (lam2 - L0)/2) (the sharp midpoint's row;
+        -alpha with ``flip``, a control) and y's centre yc = alpha (lam2 - L0)."""
+        lam, half = self.lam2, self.lam2 - fmpq(1, 2)
+        self.alpha = -(half * cos_sigma) / (half * self.U[0] - (lam - L0) / 2) * (-1 if flip else 1)
+        self.yc = self.alpha * (lam - L0)
 
     def parts(self):
         """{name: (level0(delta, pos), centre, lam)} for X+, X-, Y0, Y+, Y-: level0 the level-0 value at sector
@@ -220,7 +227,7 @@ class Family(Modes):
 
     def __init__(self, h, sigma, flip_mode0=False, smooth=False):
         self.h, self.sigma = h, sigma
-        one, pi = h * 0 + 1, arb.pi()
+        pi = arb.pi()
         self.zero, self.i2 = h * 0, acb(0, 2)
         self.ix, self.iy = acb(0, 2) * pi, acb(0, 2) * sigma   # w_x = e^(ix h), w_y = e^(iy h)
         self.em, self.ep = (acb(0, -1) * sigma).exp(), (acb(0, 1) * sigma).exp()
@@ -229,14 +236,10 @@ class Family(Modes):
         self.lam2 = _lam_principal((h * (2 * sigma)).cos())
         self.vy = bordered((h * self.iy).exp(), self.lam2)
         self.U = big_u(self.lam2)
-        lam, L0 = self.lam2, l0()[0]
-        self.alpha = -(lam - fmpq(1, 2)) * sigma.cos() * one / ((lam - fmpq(1, 2)) * self.U[0] - (lam - L0) / 2)
-        if flip_mode0:
-            self.alpha = -self.alpha
+        self.mode0(sigma.cos(), l0()[0], flip_mode0)
         self.sign = 1
         if smooth:  # with sigma = pi: y = Re(v^ e^(2 pi i s)), the smooth valence's mode-1 cosine
-            self.alpha, self.sign = self.zero, -1
-        self.yc = self.alpha * (lam - L0)
+            self.alpha, self.yc, self.sign = self.zero, self.zero, -1
         self._exp = {}
 
     def e(self, c, k):

@@ -268,12 +268,7 @@ class ExactFamily(_df.Modes):
         mx, my = _modes or (_Mode(a, stencil), _Mode(b, stencil, with_u=True))
         self.zero = QS(0)
         self.lam1, self.lam2, self.vx, self.vy, self.U = mx.lam, my.lam, mx.v, my.v, my.U
-        lam = self.lam2
-        half = lam - fmpq(1, 2)
-        self.alpha = -(half * self.c) / (half * self.U[0] - (lam - L0) / 2)
-        if flip_alpha:
-            self.alpha = -self.alpha
-        self.yc = self.alpha * (lam - L0)
+        self.mode0(self.c, L0, flip_alpha)
         self.em, self.ep = QS(self.c) - I * self.t, QS(self.c) + I * self.t  # e^(-i sigma), e^(i sigma)
         self.i2, self.sign = I * 2, 1
 
