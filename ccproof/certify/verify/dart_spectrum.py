@@ -283,11 +283,6 @@ def _ell():
     return ell
 
 
-def lam_circle(sig_r, h):
-    """r = lam(cos(2 sigma_r h)) (arb; 2 sigma_r h < pi/2 keeps (1 + c)(9 + c) > 0)."""
-    return lam_of((2 * sig_r * h).cos())
-
-
 def check_mode0_roots(sig_r, k0, balls):
     """Raise unless on ``balls`` h-balls covering [0, 1/k0]: disc(Q) > 0, Q(0) > 0 and Q'(0) < 0 (both roots
     real and positive), Q(r)/h > 0, Q'(r) > 0 (both below r) and Q(1) > 0 (1 simple). Returns the least Q(r)/h.
@@ -304,7 +299,7 @@ def check_mode0_roots(sig_r, k0, balls):
     least = None
     for i in range(balls):
         h = ball(fmpq(i, balls * k0), fmpq(i + 1, balls * k0))
-        r = lam_circle(sr, h)
+        r = lam_of((2 * sr * h).cos())  # the circle's radius (2 sigma_r h < pi/2: check_ranges)
         q_over_h = l0 + l1 * r - r / 4 * sr ** 2 * h * (sr * h).sinc() ** 2  # P(r) = -r sigma_r^2 h^2 sinc^2/4
         b, c = -fmpq(3, 4) + h * l1, fmpq(1, 16) + h * l0
         ok = (b * b - 4 * c > 0 and c > 0 and b < 0 and q_over_h > 0 and 2 * r + b > 0 and 1 + b + c > 0)
@@ -371,7 +366,7 @@ class SpectralRegions:
     def n(self, box):
         tau, h = (ball(*iv) for iv in box)
         sr = self.sig_r
-        r = lam_circle(sr, h)
+        r = lam_of((2 * sr * h).cos())
         e = acb(0, 1) * tau * h * h
         lam = r * e.exp()
         D = 2 * sr ** 2 * (sr * h).sinc() ** 2 - 8 * r * acb(0, 1) * tau * _e1(e) + acb(0, 1) * tau * _e1(-e) / (2 * r)
@@ -385,7 +380,7 @@ class SpectralRegions:
         v, w = (ball(*iv) for iv in box)
         sr = self.sig_r
         h = v * w
-        r = lam_circle(sr, h)
+        r = lam_of((2 * sr * h).cos())
         e = acb(0, 1) * v * v
         lam = r * e.exp()
         D = 2 * sr ** 2 * w * w * (sr * h).sinc() ** 2 - 8 * r * acb(0, 1) * _e1(e) + acb(0, 1) * _e1(-e) / (2 * r)
@@ -409,7 +404,7 @@ class SpectralRegions:
 
     def f(self, box):
         t, h = (ball(*iv) for iv in box)
-        r = lam_circle(self.sig_r, h)
+        r = lam_of((2 * self.sig_r * h).cos())
         lam = r * (acb(0, 1) * t).exp()
         cs = 8 * lam - 5 + 1 / (2 * lam)
         # any root of cos phi = c* will do (the expression is even and 2 pi-periodic in phi for integer K)
@@ -467,4 +462,4 @@ def check_ranges(k0, sig_lo, sig_hi, sig_r, tau1, v0):
 
 
 __all__ = ["SpectralRegions", "T_PI", "WINDOW", "b0", "check_construction", "check_mode0_roots", "check_ranges",
-           "check_secular", "lam_circle", "mode0_parts", "region_roots", "w1_of"]
+           "check_secular", "mode0_parts", "region_roots", "w1_of"]
