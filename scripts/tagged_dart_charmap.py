@@ -86,6 +86,7 @@ import importlib.util
 import sys
 import time
 from pathlib import Path
+from types import SimpleNamespace
 
 from flint import acb, arb, ctx, fmpq
 
@@ -157,6 +158,16 @@ def exact_zeros():
     if not all((N[k] - N[0] * rho[k]).is_zero() for k in range(6)) or N[0].is_zero():
         raise CertificateError("adj(L0 - B(1)) kappa is not a non-zero multiple of rho")
     return rho
+
+
+def _c(z):
+    """The coefficients of h^0, h^1, h^2 of a dart_zeros.QS as p + q sqrt 5 + i (r + u sqrt 5) (theta = sqrt 5 + i:
+    theta^2 = 4 + 2 i sqrt 5, theta^3 = 2 sqrt 5 + 14 i), read independently of the verifier."""
+    out = []
+    for e in z.coeffs():
+        c = [e[k] for k in range(4)]
+        out.append(SimpleNamespace(p=c[0] + 4 * c[2], q=c[1] + 2 * c[3], r=c[1] + 14 * c[3], u=2 * c[2]))
+    return out
 
 
 def _values(series):
@@ -790,7 +801,7 @@ def main(argv=None):
     rho = exact_zeros()
     print("Z  exact in Q(sqrt 5): rho = v^(0) is the eigenvector of B(1) for L0 = (6 + sqrt 20)/16 with "
           "rho(a, b) = rho(b, a), and adj(L0 - B(1)) kappa is a non-zero multiple of rho (the facts the dropped "
-          "coefficients rest on); rho = (" + ", ".join(f"{float(z.c[0].p) + float(z.c[0].q) * 5 ** 0.5:.6f}"
+          "coefficients rest on); rho = (" + ", ".join(f"{float(_c(z)[0].p) + float(_c(z)[0].q) * 5 ** 0.5:.6f}"
                                                       for z in rho) + ")")
     t = time.time()
     zmod = _zeros_script()

@@ -93,25 +93,15 @@ def _raw(z):
     return z.p if isinstance(z, QS) else fmpq_poly([fmpq(z)])
 
 
-class QF:
-    """p + q sqrt 5 + i (r + u sqrt 5) (fmpq components): one coefficient of a :class:`QS`, for reading."""
-
-    __slots__ = ("p", "q", "r", "u")
-
-    def __init__(self, e):  # e: a polynomial in theta, degree < 4; theta^2 = 4 + 2 i sqrt 5, theta^3 = 2 sqrt 5 + 14 i
-        c = [e[k] for k in range(4)]
-        self.p, self.q, self.r, self.u = c[0] + 4 * c[2], c[1] + 2 * c[3], c[1] + 14 * c[3], 2 * c[2]
-
-
 class QS:
     """A power series in h truncated after h^2 with coefficients in Q(sqrt 5, i), exact: the class of the
     fmpq_poly ``p`` (degree < 12) in Q[x]/(m^3) (module docstring).
 
     Examples
     --------
-    >>> e = QS(1) + I * 3 * H - H * H * fmpq(9, 2)  # e^(3 i h)
-    >>> [(z.p, z.r) for z in e.c], (e * (QS(1) - I * 3 * H - H * H * fmpq(9, 2))).c[2].p
-    ([(1, 0), (0, 3), (-9/2, 0)], 0)
+    >>> e = QS(1) + I * 3 * H - H * H * fmpq(9, 2)  # e^(3 i h) to order 2
+    >>> (e * (QS(1) - I * 3 * H - H * H * fmpq(9, 2)) - 1).is_zero(), (e - 1).vanishes(1), (e - 1).vanishes(2)
+    (True, True, False)
     """
 
     __slots__ = ("p",)
@@ -156,11 +146,6 @@ class QS:
     def coeffs(self):
         """[e_0, e_1, e_2]: the coefficients of h^0, h^1, h^2 as polynomials in theta (degree < 4)."""
         return _h_coeffs(self.p)
-
-    @property
-    def c(self):
-        """[QF of h^0, h^1, h^2]."""
-        return [QF(e) for e in self.coeffs()]
 
 
 def _h_coeffs(p):
@@ -258,8 +243,8 @@ class ExactFamily(_df.Modes):
     Examples
     --------
     >>> fam = ExactFamily(1, 2, 1, 2)
-    >>> fam.vx[0].c[0].p, fam.lam1.c[1].p, (fam.yc.c[0].p, fam.yc.c[1].p)
-    (1, 0, (0, 0))
+    >>> (fam.vx[0] - 1).is_zero(), (fam.lam1 - L0).vanishes(2), fam.yc.vanishes(2)  # the pivot, no h^1 terms
+    (True, True, True)
     """
 
     def __init__(self, a, b, c, t, stencil=None, flip_alpha=False, _modes=None):
