@@ -287,7 +287,6 @@ def check_eigenvector(sig_lo, sig_hi, k0, prec, balls=64, family=Family):
         if not box.cos() < 0:
             raise CertificateError("eigenvector lemma: cos(sigma) is not certainly < 0 on the bracket (alpha != 0)")
         tol = arb(2) ** (-(prec // 2))
-        signs = set()
         for i in range(balls):
             h = acb(ball(fmpq(i, balls * k0), fmpq(i + 1, balls * k0)))
             try:
@@ -296,11 +295,7 @@ def check_eigenvector(sig_lo, sig_hi, k0, prec, balls=64, family=Family):
             except ZeroDivisionError as exc:
                 raise CertificateError(f"eigenvector lemma: h-ball {i}: {exc}") from None
             lo, hi = vals[0].real, vals[1].real
-            if lo > 0 and hi < 0:
-                signs.add(-1)
-            elif lo < 0 and hi > 0:
-                signs.add(1)
-            else:
+            if not (lo > 0 > hi or lo < 0 < hi):
                 raise CertificateError(f"eigenvector lemma: h-ball {i}: the centre residual r/h has no certain sign "
                                        f"change over the bracket (at sig_lo {lo.str(3)}, at sig_hi {hi.str(3)})")
         return (f"eigenvector lemma for every K >= {k0}: ring rows and ray 0's rows identically (exact: reach, "
