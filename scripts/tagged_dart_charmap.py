@@ -86,12 +86,14 @@ import importlib.util
 import sys
 import time
 from pathlib import Path
+from types import SimpleNamespace
 
 from flint import acb, arb, ctx, fmpq
 
-from ccproof.certify.verify import dart_curves as _C
-from ccproof.certify.verify import dart_regularity as _R
+from ccproof.certify.verify import dart_models as _M
 from ccproof.certify.verify.dart_family import (  # noqa: F401 (re-exported for the tests)
+    B_AT_1,
+    N_POLYS,
     PIECES,
     XB,
     YB,
@@ -100,14 +102,14 @@ from ccproof.certify.verify.dart_family import (  # noqa: F401 (re-exported for 
     bordered,
     layer_nets,
     piece_nets,
-    series_cap,
     series_curves,
     series_variable,
 )
-from ccproof.certify.verify.dart_zeros import (  # noqa: F401 (re-exported for the tests)
-    exact_zeros,
-)
+from ccproof.certify.verify.dart_zeros import L0, ONE, QS, solve
+from ccproof.certify.verify.errors import CertificateError
 from ccproof.certify.verify.maps import STAR_CURVES  # noqa: F401 (re-exported for the tests)
+from ccproof.certify.verify.statement import horner
+from ccproof.certify.verify.tagged_modes import RING_INDEX
 from ccproof.rigorous.analytic import ball as _ball  # noqa: F401 (re-exported for the tests)
 from ccproof.rigorous.analytic import disc_bound
 
@@ -126,6 +128,46 @@ def family_values(fam, s):
     def y(d, p):
         return (P["Y0"][0](d, p) + F * P["Y+"][0](d, p) + P["Y-"][0](d, p) / F).real
     return x, y, acb(fam.yc).real
+
+
+def exact_zeros():
+    """Check exactly (in Q(sqrt 5), the constants of dart_zeros.QS) why the dropped coefficients vanish (the
+    verifier checks the coefficients themselves; these facts follow from its check_ring and check_mode0):
+    L0 is an eigenvalue of B(1) with eigenvector rho (rho(1,0) = 1) and rho(a, b) = rho(b, a); adj(L0 - B(1))
+    kappa = N(L0) is a multiple of rho (so U(L0) = U(1,0) rho and alpha(0) U(L0) = -cos(sigma) rho). Returns
+    rho (6 QS), CertificateError if not.
+
+    Examples
+    --------
+    >>> rho = exact_zeros()
+    >>> (rho[0] - 1).is_zero()
+    True
+    """
+    A = [[(L0 if i == k else QS(0)) - B_AT_1[i, k] for k in range(6)] for i in range(6)]
+    # rho: solve A rho = 0 with rho(1,0) = 1: drop row 0 (rank 5 since L0 is simple: checked by the solve)
+    try:
+        rho = [ONE] + solve([[A[i][k] for k in range(1, 6)] for i in range(1, 6)], [-A[i][0] for i in range(1, 6)])
+    except ZeroDivisionError:
+        raise CertificateError("L0 is not a simple eigenvalue of B(1)") from None
+    if not all(sum((A[i][k] * rho[k] for k in range(6)), QS(0)).is_zero() for i in range(6)):
+        raise CertificateError("rho is no eigenvector of B(1) for L0")
+    pos = {p: k for p, k in RING_INDEX.items()}
+    if not all((rho[pos[(a, b)]] - rho[pos[(b, a)]]).is_zero() for (a, b) in pos if b > 0 and (b, a) in pos):
+        raise CertificateError("rho is not symmetric in (a, b)")
+    N = [horner(p, L0, QS(0)) for p in N_POLYS]
+    if not all((N[k] - N[0] * rho[k]).is_zero() for k in range(6)) or N[0].is_zero():
+        raise CertificateError("adj(L0 - B(1)) kappa is not a non-zero multiple of rho")
+    return rho
+
+
+def _c(z):
+    """The coefficients of h^0, h^1, h^2 of a dart_zeros.QS as p + q sqrt 5 + i (r + u sqrt 5) (theta = sqrt 5 + i:
+    theta^2 = 4 + 2 i sqrt 5, theta^3 = 2 sqrt 5 + 14 i), read independently of the verifier."""
+    out = []
+    for e in z.coeffs():
+        c = [e[k] for k in range(4)]
+        out.append(SimpleNamespace(p=c[0] + 4 * c[2], q=c[1] + 2 * c[3], r=c[1] + 14 * c[3], u=2 * c[2]))
+    return out
 
 
 def _values(series):
@@ -147,14 +189,46 @@ def _parts(T):
     return sorted({key[2] for key in T})
 
 
+def _select(table, tag, q=None):
+    """One quantity of the verifier's table (:func:`~ccproof.certify.verify.dart_models.quantities`), keyed
+    without the tag: (i, j, piece or curve) or (basis part, curve) in the bulk; piece or curve on layer q."""
+    if q is None:
+        return {k[1:]: v for k, v in table.items() if k[0] == tag and isinstance(k[1], str)}
+    return {k[2]: v for k, v in table.items() if k[:2] == (tag, q)}
+
+
+def _models(tag, T, M, r, q=None):
+    """The verifier's analytic models (:func:`~ccproof.certify.verify.dart_models.group_models`) of a script
+    table T (keyed as :func:`_select` gives them) with the disc bounds M."""
+    def key(k):
+        return (tag,) + k if q is None else (tag, q, k)
+    return _M.group_models({key(k): v for k, v in T.items()}, {key(k): M[k] for k in T}, r, tag, q)
+
+
+def _bulk(sigma, n, tag, **control):
+    with series_variable(n) as h:
+        return _select(_M.quantities(Family(h, sigma, **control), n), tag)
+
+
+def _layer(q, sigma, n, tag):
+    with series_variable(n) as h:
+        return _real(_select(_M.quantities(Family(h, sigma), n, [q], bulk=False), tag, q))
+
+
+def _disc(sigma, r, grid, tag, q=None, **control):
+    layers, bulk = ([], True) if q is None else ([q], False)
+    return disc_bound(lambda h: _values(_select(_M.quantities(Family(h, sigma, **control), 0, layers, bulk), tag, q)),
+                      r, grid)
+
+
 # the Taylor coefficients and disc bounds of one quantity at a time (the verifier builds them all at once)
 
 def taylor_dets(sigma, n, prec=128, **control):
     """The Taylor coefficients in h of D_ij = D(X_i, Y_j) for the basis parts X_i (X+, X-) and Y_j (Y0, Y+, Y-):
     {(i, j, piece): [coefficient list (acb) of h^m, m = 0..n]}. D is bilinear, so the coefficient of h^m is
     sum_(k + l = m) D(X_i,k, Y_j,l) of the nets' own Taylor coefficients (acb_series, rigorous)."""
-    with ctx.workprec(prec), series_cap(n):
-        return _R.dets_series(basis_nets(Family(series_variable(n), sigma, **control)), n)
+    with ctx.workprec(prec):
+        return _bulk(sigma, n, "R", **control)
 
 
 def disc_bounds(sigma, r, grid=4, prec=128, **control):
@@ -162,43 +236,38 @@ def disc_bounds(sigma, r, grid=4, prec=128, **control):
     [-r, r]^2 (ccproof.rigorous.analytic.disc_bound; every system on each box proved regular by arb,
     so D_ij is analytic on the disc |h| <= r)."""
     with ctx.workprec(prec):
-        return disc_bound(lambda h: _values(_R.dets_series(basis_nets(Family(h, sigma, **control)), 0)), r, grid)
+        return _disc(sigma, r, grid, "R", **control)
 
 
 def layer_taylor(q, sigma, n, prec=128):
-    """The verifier's layer_dets_series of layer quadrant q."""
-    with ctx.workprec(prec), series_cap(n):
-        return _real(_R.layer_dets_series(layer_nets(Family(series_variable(n), sigma), q), n, real=True))
+    """The verifier's layer det series of layer quadrant q."""
+    with ctx.workprec(prec):
+        return _layer(q, sigma, n, "R")
 
 
 def layer_disc(q, sigma, r, grid=12, prec=128):
     """{piece: M} with |det J_Phi(h)| <= M (every Bernstein coefficient) for complex h in [-r, r]^2."""
     with ctx.workprec(prec):
-        return disc_bound(lambda h: _values(_R.layer_dets_series(layer_nets(Family(h, sigma), q), 0)), r, grid)
+        return _disc(sigma, r, grid, "R", q)
 
 
 def taylor_trans(sigma, n, prec=128, **control):
-    """The verifier's trans_series of the family at sigma."""
-    with ctx.workprec(prec), series_cap(n):
-        fam = Family(series_variable(n), sigma, **control)
-        return _C.trans_series(fam, basis_nets(fam), n)
+    """The verifier's transversality series of the family at sigma."""
+    with ctx.workprec(prec):
+        return _bulk(sigma, n, "T", **control)
 
 
 def disc_trans(sigma, r, grid=12, prec=128, **control):
-    """The disc bounds (ccproof.rigorous.analytic.disc_bound) of the verifier's trans_series at one h."""
-    def values(h):
-        fam = Family(h, sigma, **control)
-        return _values(_C.trans_series(fam, basis_nets(fam), 0))
+    """The disc bounds (ccproof.rigorous.analytic.disc_bound) of the verifier's transversality series at one h."""
     with ctx.workprec(prec):
-        return disc_bound(values, r, grid)
+        return _disc(sigma, r, grid, "T", **control)
 
 
 def coord_taylor(sigma, n, coord, prec=128):
     """{(basis part, curve): [order m: 4 acb]}: Taylor coefficients in h of the outer curves' points."""
-    with ctx.workprec(prec), series_cap(n):
-        nets = basis_nets(Family(series_variable(n), sigma))
+    with ctx.workprec(prec), series_variable(n) as h:
+        nets = basis_nets(Family(h, sigma))
         return {(b, c): pts for b in (XB if coord == "x" else YB) for c, pts in series_curves(nets[b], n).items()}
-
 
 
 def _bounds(ball_):
@@ -206,35 +275,41 @@ def _bounds(ball_):
 
 
 def kdet_box(T, M, s_lo, s_hi, h_lo, h_hi, sigma, r, n, prec=128):
-    return _bounds(_R.kdet_box(_R.bulk_models(T, M, r), s_lo, s_hi, h_lo, h_hi, sigma, prec=prec))
+    with ctx.workprec(prec):
+        return _bounds(_M.bulk_box(_models("R", T, M, r), "R", s_lo, s_hi, h_lo, h_hi, sigma))
 
 
 def middle_coeffs(T, sigma, L=24):
     """{(m, l, piece): coefficient list}: the verifier's e_ml of each piece."""
-    models = _R.bulk_models(T, {key: arb(0) for key in T}, fmpq(1))
+    models = _models("R", T, {key: arb(0) for key in T}, fmpq(1))
     return {key + (p,): [mat[c, 0] for c in range(mat.nrows())] for p, model in models.items()
-            for key, mat in _R.middle_coeffs(model, _R.omegas(sigma), 1, 2, L).items()}
+            for key, mat in _M.middle_coeffs(model, _M.omegas("R", sigma), 1, 2, L).items()}
+
+
+def _middle(tag, T, M, s_lo, s_hi, w_lo, w_hi, sigma, r, L, prec):
+    with ctx.workprec(prec):
+        models, om, mid = _models(tag, T, M, r), _M.omegas(tag, sigma), _M.QUANTITIES[tag][1]
+        coeffs = {p: _M.middle_coeffs(model, om, *mid, L) for p, model in models.items()}
+        return _bounds(_M.middle_box(models, coeffs, om, s_lo, s_hi, w_lo, w_hi, *mid, L=L))
 
 
 def middle_box(T, E, M, s_lo, s_hi, w_lo, w_hi, sigma, r, n, L=24, prec=128):
-    models, om = _R.bulk_models(T, M, r), _R.omegas(sigma)
-    coeffs = {p: _R.middle_coeffs(model, om, 1, 2, L) for p, model in models.items()}
-    return _bounds(_R.middle_box(models, coeffs, om, s_lo, s_hi, w_lo, w_hi, 1, 2, L=L, prec=prec))
+    return _middle("R", T, M, s_lo, s_hi, w_lo, w_hi, sigma, r, L, prec)
 
 
 def ymid_box(T, M, s_lo, s_hi, w_lo, w_hi, sigma, r, n, L=24, prec=128):
-    models, om = _C.curve_models(T, M, r, YB), _R.y_omegas(sigma)
-    coeffs = {c: _R.middle_coeffs(model, om, 0, 1, L) for c, model in models.items()}
-    return _bounds(_R.middle_box(models, coeffs, om, s_lo, s_hi, w_lo, w_hi, 0, 1, L=L, prec=prec))
+    return _middle("Y", T, M, s_lo, s_hi, w_lo, w_hi, sigma, r, L, prec)
 
 
-def layer_box(T, M, h_lo, h_hi, r, n, order=3, prec=128):
-    return _bounds(_R.layer_box(_R.column_models(T, M, r), h_lo, h_hi, order=order, prec=prec))
+def layer_box(T, M, h_lo, h_hi, r, n, prec=128):
+    with ctx.workprec(prec):
+        return _bounds(_M.layer_box(_models("R", T, M, r, 0), "R", 0, h_lo, h_hi))
 
 
 def coord_box(T, M, s_lo, s_hi, h_lo, h_hi, sigma, r, n, coord, prec=128):
-    models = _C.curve_models(T, M, r, XB if coord == "x" else YB)
-    return _bounds(_C.coord_box(models, s_lo, s_hi, h_lo, h_hi, sigma, coord, prec=prec))
+    with ctx.workprec(prec):
+        tag = coord.upper()
+        return _bounds(_M.bulk_box(_models(tag, T, M, r), tag, s_lo, s_hi, h_lo, h_hi, sigma))
 
 
 def coord_disc(sigma, r, coord, grid=12, prec=128):
@@ -243,27 +318,19 @@ def coord_disc(sigma, r, coord, grid=12, prec=128):
 
 
 def layer_trans_taylor(q, sigma, n, prec=128):
-    with ctx.workprec(prec), series_cap(n):
-        fam = Family(series_variable(n), sigma)
-        return _real(_C.layer_trans_series(fam, layer_nets(fam, q), n, real=True))
+    with ctx.workprec(prec):
+        return _layer(q, sigma, n, "T")
 
 
 def layer_trans_disc(q, sigma, r, grid=12, prec=128):
-    def values(h):
-        fam = Family(h, sigma)
-        return _values(_C.layer_trans_series(fam, layer_nets(fam, q), 0))
     with ctx.workprec(prec):
-        return disc_bound(values, r, grid)
+        return _disc(sigma, r, grid, "T", q)
 
 
 def layer_coord(q, sigma, n, r, grid=12, prec=128):
     """(Taylor coefficients {curve: [m: 4 arb]}, disc bounds {curve: M}) of Y on layer quadrant q's outer curves."""
-    with ctx.workprec(prec), series_cap(n):
-        T = _real(_C.layer_y_series(layer_nets(Family(series_variable(n), sigma), q), n, real=True))
-        M = {}
-        if grid:
-            M = disc_bound(lambda h: _values(_C.layer_y_series(layer_nets(Family(h, sigma), q), 0)), r, grid)
-        return T, M
+    with ctx.workprec(prec):
+        return _layer(q, sigma, n, "Y"), (_disc(sigma, r, grid, "Y", q) if grid else {})
 
 
 # the outer curves of a quadrant's layer 0, as tagged_map/maps.STAR_CURVES: (piece, side, orientation)
@@ -272,8 +339,8 @@ def layer_coord(q, sigma, n, r, grid=12, prec=128):
 def __getattr__(name):
     """The family, R, T and W functions now live in the trusted base (ccproof.certify.verify.dart_*); the
     tests and tagged_dart_zeros.py that load this script reach them through it."""
-    from ccproof.certify.verify import dart_curves, dart_family, dart_regularity, dart_zeros
-    for mod in (dart_family, dart_regularity, dart_curves, dart_zeros):
+    from ccproof.certify.verify import dart_family, dart_models, dart_zeros
+    for mod in (dart_family, dart_models, dart_zeros):
         if hasattr(mod, name):
             return getattr(mod, name)
     raise AttributeError(name)
@@ -734,7 +801,7 @@ def main(argv=None):
     rho = exact_zeros()
     print("Z  exact in Q(sqrt 5): rho = v^(0) is the eigenvector of B(1) for L0 = (6 + sqrt 20)/16 with "
           "rho(a, b) = rho(b, a), and adj(L0 - B(1)) kappa is a non-zero multiple of rho (the facts the dropped "
-          "coefficients rest on); rho = (" + ", ".join(f"{float(z.c[0].p) + float(z.c[0].q) * 5 ** 0.5:.6f}"
+          "coefficients rest on); rho = (" + ", ".join(f"{float(_c(z)[0].p) + float(_c(z)[0].q) * 5 ** 0.5:.6f}"
                                                       for z in rho) + ")")
     t = time.time()
     zmod = _zeros_script()

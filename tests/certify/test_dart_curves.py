@@ -1,4 +1,4 @@
-"""T and W for every dart K >= K0 (verify.dart_curves): the evaluators a record's leaves are replayed on."""
+"""T and W for every dart K >= K0 (verify.dart_models): the evaluators a record's leaves are replayed on."""
 
 import pytest
 from flint import fmpq

@@ -1,4 +1,4 @@
-"""R for every dart K >= K0 (verify.dart_regularity): the evaluators a record's leaves are replayed on."""
+"""R for every dart K >= K0 (verify.dart_models): the evaluators a record's leaves are replayed on."""
 
 import importlib.util
 from pathlib import Path

@@ -21,11 +21,11 @@ from ccproof.certify.verify.dart_spectrum import (
     check_mode0_roots,
     check_ranges,
     check_secular,
-    lam_circle,
     region_roots,
     w1_of,
 )
 from ccproof.certify.verify.errors import CertificateError
+from ccproof.certify.verify.statement import lam_of
 
 SIG_R = fmpq(27, 5)
 
@@ -77,7 +77,7 @@ def test_construction_derives_d_as_stated():
 def test_regions_equal_the_exact_determinant_ratio(k):
     """Each region's closed form at a point equals det(lam - S)/det(lam - S0) of the one-ring (numpy)."""
     reg, h = SpectralRegions(SIG_R, 101), fmpq(1, k)
-    r = float(lam_circle(arb(SIG_R), arb(h)).mid())
+    r = float(lam_of((2 * arb(SIG_R) * arb(h)).cos()).mid())
     for t in (1e-4, 2e-3):  # N: tau = t/h^2
         ref = one_minus_f(r * cmath.exp(1j * t), k).real
         tau = _q(t) / (h * h)
@@ -108,7 +108,7 @@ def test_control_circle_inside_lam2_is_not_covered():
     reg = SpectralRegions(fmpq(4), 101)
     h = fmpq(1, 202)
     assert reg.n([(fmpq(0), fmpq(0)), (h, h)]) < 0
-    r = float(lam_circle(arb(4), arb(h)).mid())
+    r = float(lam_of((2 * arb(4) * arb(h)).cos()).mid())
     assert one_minus_f(r, 202).real < 0  # the numpy reference agrees
     with pytest.raises(ValueError, match="undecided"):
         cover(region_roots(101, fmpq(50), fmpq(2, 5))["N"], reg.n, 1, [40, 4], max_depth=4)
@@ -118,7 +118,7 @@ def test_control_circle_inside_lam2_is_not_covered():
 def test_count_outside_the_circle_numpy(k):
     """The one-ring of dart:K has exactly three eigenvalues outside |lam| = r: 1, lam1 and lam2, and mode 0's
     other two lie below r (the claims of the spectral step)."""
-    r = float(lam_circle(arb(SIG_R), arb(fmpq(1, k))).mid())
+    r = float(lam_of((2 * arb(SIG_R) * arb(fmpq(1, k))).cos()).mid())
     ev = np.linalg.eigvals(one_ring(k, True))
     out = sorted(ev[abs(ev) > r].real, reverse=True)
     c = math.cos(2 * math.pi / k)

@@ -4,6 +4,7 @@ bordered solves, the verifier's own net construction), and its regions' proofs a
 
 import importlib.util
 from pathlib import Path
+from types import SimpleNamespace
 
 import pytest
 from flint import acb, arb, ctx, fmpq
@@ -15,6 +16,16 @@ from ccproof.certify.verify.tagged_modes import even_vector, mode_spectrum, mode
 
 SCRIPTS = Path(__file__).resolve().parents[2] / "scripts"
 
+
+
+def _c(z):
+    """The coefficients of h^0, h^1, h^2 of a dart_zeros.QS as p + q sqrt 5 + i (r + u sqrt 5) (theta = sqrt 5 + i:
+    theta^2 = 4 + 2 i sqrt 5, theta^3 = 2 sqrt 5 + 14 i), read independently of the verifier."""
+    out = []
+    for e in z.coeffs():
+        c = [e[k] for k in range(4)]
+        out.append(SimpleNamespace(p=c[0] + 4 * c[2], q=c[1] + 2 * c[3], r=c[1] + 14 * c[3], u=2 * c[2]))
+    return out
 
 def _load():
     spec = importlib.util.spec_from_file_location("tagged_dart_charmap", SCRIPTS / "tagged_dart_charmap.py")
@@ -243,18 +254,20 @@ def test_the_dropped_coefficients_vanish_at_a_point_sigma():
 
 
 def test_series_are_not_truncated_silently():
-    # python-flint cuts every series to ctx.cap terms whatever its length: the script must refuse that, and
-    # under series_cap its order-12 coefficients must be there (the x-mode's v^(1,1) has a nonzero h^11 term)
+    # python-flint cuts every series to ctx.cap terms whatever its length: with the series variable of order 12
+    # (ctx.cap raised inside, restored after) its order-12 coefficients must be there (the x-mode's v^(1,1) has a
+    # nonzero h^11 term), and past ctx.cap = 10 they are not
     mod = _load()
     with ctx.workprec(128):
         old = ctx.cap
         try:
             ctx.cap = 10
-            with pytest.raises(ValueError):
-                mod.series_variable(12)
-            with mod.series_cap(12):
-                fam = mod.Family(mod.series_variable(12), arb("4.49"))
+            with mod.series_variable(12) as h:
+                fam = mod.Family(h, arb("4.49"))
                 c = mod.series_coeffs(fam.vx[2], 13)
+            assert ctx.cap == 10
+            cut = mod.series_coeffs(mod.Family(h, arb("4.49")).vx[2], 13)  # the same h under ctx.cap = 10
+            assert abs(cut[11]) == 0 and abs(cut[12]) == 0
             assert ctx.cap == 10
             assert abs(c[11]) > 1e-6 and abs(c[12]) > 1e-6
         finally:
@@ -268,11 +281,11 @@ def test_the_exact_facts_behind_the_dropped_coefficients():
         rho = mod.exact_zeros()
         fam = mod.Family(acb(0), arb("4.49"))
         for z, vx, vy in zip(rho, fam.vx, fam.vy):
-            e = z.c[0]  # p + q sqrt 5 + i (r + u sqrt 5), constant in h
-            assert e.r == 0 and e.u == 0 and all(x.p == x.q == x.r == x.u == 0 for x in z.c[1:])
+            e = _c(z)[0]  # p + q sqrt 5 + i (r + u sqrt 5), constant in h
+            assert e.r == 0 and e.u == 0 and all(x.p == x.q == x.r == x.u == 0 for x in _c(z)[1:])
             want = arb(e.p) + arb(e.q) * arb(5).sqrt()
             assert abs(acb(vx) - want) < 1e-30 and abs(acb(vy) - want) < 1e-30
-        assert (rho[2].c[0].p, rho[2].c[0].q) == (-1, 1)  # rho(1,1) = sqrt 5 - 1
+        assert (_c(rho[2])[0].p, _c(rho[2])[0].q) == (-1, 1)  # rho(1,1) = sqrt 5 - 1
 
 
 def _load_zeros():
@@ -293,19 +306,19 @@ def test_the_exact_series_are_the_acb_familys():
     # alpha by cos(1/2) (alpha is c times a function of b h); an independent route: flint's acb_series solve
     zmod, mod = _load_zeros(), _load()
     ex = zmod.ExactFamily(mod, 1, 1, 1, 1)
-    with ctx.workprec(128), mod.series_cap(3):
-        fam = mod.Family(mod.series_variable(2), arb(fmpq(1, 2)))
+    with ctx.workprec(128), mod.series_variable(2) as h:
+        fam = mod.Family(h, arb(fmpq(1, 2)))
         tp = 2 * arb.pi()
         for k in range(6):
             cy, cx = mod.series_coeffs(fam.vy[k], 3), mod.series_coeffs(fam.vx[k], 3)
             for m in range(3):
-                assert abs(cy[m] - _qf(ex.vy[k].c[m])) < 1e-30
-                assert abs(cx[m] - tp ** m * _qf(ex.vx[k].c[m])) < 1e-30
+                assert abs(cy[m] - _qf(_c(ex.vy[k])[m])) < 1e-30
+                assert abs(cx[m] - tp ** m * _qf(_c(ex.vx[k])[m])) < 1e-30
         ca = mod.series_coeffs(fam.alpha, 3)
         for m in range(3):
-            assert abs(ca[m] - arb(fmpq(1, 2)).cos() * _qf(ex.alpha.c[m])) < 1e-30
-        assert abs(mod.series_coeffs(fam.lam2, 3)[2] - _qf(ex.lam2.c[2])) < 1e-30
-        assert abs(_qf(ex.lam2.c[2])) > 0.01  # lam's h^2 term is there
+            assert abs(ca[m] - arb(fmpq(1, 2)).cos() * _qf(_c(ex.alpha)[m])) < 1e-30
+        assert abs(mod.series_coeffs(fam.lam2, 3)[2] - _qf(_c(ex.lam2)[2])) < 1e-30
+        assert abs(_qf(_c(ex.lam2)[2])) > 0.01  # lam's h^2 term is there
 
 
 def test_the_dropped_coefficients_are_exactly_zero_at_one_grid_point():
@@ -355,11 +368,11 @@ def test_the_exact_nets_are_the_acb_familys_nets():
     exs = [zmod.ExactFamily(mod, 1, 1, c, t) for c, t in ((1, 0), (0, 1))]
 
     def exact_y(zs, m):  # zs: the two exact Series (c, t) = (1, 0), (0, 1)
-        return co * _qf(zs[0].c[m]) + si * _qf(zs[1].c[m])
-    with ctx.workprec(128), mod.series_cap(3):
+        return co * _qf(_c(zs[0])[m]) + si * _qf(_c(zs[1])[m])
+    with ctx.workprec(128), mod.series_variable(2) as h:
         half = arb(fmpq(1, 2))
         co, si, tp = half.cos(), half.sin(), 2 * arb.pi()
-        fam = mod.Family(mod.series_variable(2), half)
+        fam = mod.Family(h, half)
         mine = mod.basis_nets(fam)
         ex = [{n: mod.piece_nets(f, c, lam, e.zero) for n, (f, c, lam) in e.parts().items()} for e in exs]
         worst = 0.0
@@ -370,9 +383,9 @@ def test_the_exact_nets_are_the_acb_familys_nets():
                         got = mod.series_coeffs(mine[name][p][i][j], 3)
                         for m in range(3):
                             if name.startswith("X"):
-                                want = tp ** m * _qf(ex[0][name][p][i][j].c[m])
+                                want = tp ** m * _qf(_c(ex[0][name][p][i][j])[m])
                             elif name != "Y0":
-                                want = _qf(ex[0][name][p][i][j].c[m])
+                                want = _qf(_c(ex[0][name][p][i][j])[m])
                             else:
                                 want = exact_y([ex[0][name][p][i][j], ex[1][name][p][i][j]], m)
                             worst = max(worst, float(abs(got[m] - want).upper()))
@@ -392,6 +405,6 @@ def test_the_exact_nets_are_the_acb_familys_nets():
                     for j in range(4):
                         gx, gy = mod.series_coeffs(ln[p][0][i][j], 3), mod.series_coeffs(ln[p][1][i][j], 3)
                         for m in range(3):
-                            worst = max(worst, float(abs(gx[m] - tp ** m * _qf(x0[p][i][j].c[m])).upper()),
+                            worst = max(worst, float(abs(gx[m] - tp ** m * _qf(_c(x0[p][i][j])[m])).upper()),
                                         float(abs(gy[m] - exact_y([el[0][p][i][j], el[1][p][i][j]], m)).upper()))
         assert worst < 1e-30, worst

@@ -20,6 +20,7 @@ quadrants next to the sharp ray (:func:`layer_nets`: ghost rows, the sharp midpo
 
 from __future__ import annotations
 
+from contextlib import contextmanager
 from dataclasses import dataclass
 
 from flint import acb, acb_mat, acb_poly, acb_series, arb, ctx, fmpq, fmpq_mat, fmpq_poly
@@ -28,7 +29,7 @@ from .errors import CertificateError
 from .maps import STAR_CURVES, curve_points
 from .rules import CENTRE, canonical, level1_rule
 from .statement import B2Z, horner, lam_of
-from .tagged_modes import RING_INDEX, ring_block, ring_stencil
+from .tagged_modes import RING_INDEX, bordered_solve, ring_block, ring_stencil
 
 
 @dataclass(frozen=True)
@@ -111,26 +112,17 @@ def _lam_principal(c):
     return lam_of(c)
 
 
+@contextmanager
 def series_variable(n):
-    """The series variable h to order n. python-flint truncates every series to ``ctx.cap`` terms (10 by
-    default) whatever its ``prec``: the callers run under :func:`series_cap` so that no order is lost."""
-    if ctx.cap < n + 1:
-        raise ValueError(f"ctx.cap = {ctx.cap} < {n + 1}: series would be truncated silently")
-    return acb_series([0, 1], prec=n + 1)
-
-
-class series_cap:
-    """Context manager: ctx.cap >= n + 1 inside (restored after)."""
-
-    def __init__(self, n):
-        self.n = n
-
-    def __enter__(self):
-        self.old = ctx.cap
-        ctx.cap = max(self.old, self.n + 1)
-
-    def __exit__(self, *exc):
-        ctx.cap = self.old
+    """Context: the series variable h to order n (acb_series [0, 1]) with ``ctx.cap`` >= n + 1 inside (restored
+    after): python-flint truncates every series to ``ctx.cap`` terms (10 by default) whatever its ``prec``, so
+    that no order is lost."""
+    old = ctx.cap
+    ctx.cap = max(old, n + 1)
+    try:
+        yield acb_series([0, 1], prec=n + 1)
+    finally:
+        ctx.cap = old
 
 
 def series_coeffs(z, n, real=False):
@@ -150,13 +142,12 @@ def bordered_matrix(B, lam, zero, pivot=0):
 def bordered(w, lam, pivot=0):
     """v^ (6 values of w's type): B(w) v^ = lam v^, v^[pivot] = 1, from the bordered 7 x 7 system A v = e_7.
 
-    For acb balls arb proves A regular on the whole ball (ZeroDivisionError otherwise). For power series
-    in h (acb_series) the Taylor coefficients follow from A_0 v_k = -sum_(j >= 1) A_j v_(k-j), A_0 the
-    system at h = 0 (proved regular by arb)."""
-    A = bordered_matrix(ring_block(w), lam, w * 0, pivot)
+    For acb balls :func:`.tagged_modes.bordered_solve` (arb proves A regular on the whole ball; ZeroDivisionError
+    otherwise). For power series in h (acb_series) the Taylor coefficients follow from A_0 v_k = -sum_(j >= 1)
+    A_j v_(k-j), A_0 the system at h = 0 (proved regular by arb)."""
     if not isinstance(w, acb_series):
-        sol = acb_mat(A).solve(acb_mat([[0]] * 6 + [[1]]))
-        return [sol[i, 0] for i in range(6)]
+        return bordered_solve(ring_block(w), lam, pivot)
+    A = bordered_matrix(ring_block(w), lam, w * 0, pivot)
     n = w.prec
     cs = [[series_coeffs(A[i][k], n) for k in range(7)] for i in range(7)]
     Ak = [acb_mat([[cs[i][k][m] for k in range(7)] for i in range(7)]) for m in range(n)]
@@ -181,9 +172,16 @@ def _eps(pos):
 class Modes:
     """x and y from their modes, split by their dependence on s: x = E X+ + E^-1 X-, y = Y0 + F Y+ + F^-1 Y-,
     E = e^(2 pi i s), F = e^(i sigma (2 s - 1)); one assembly for :class:`Family` (acb) and the exact family of
-    :mod:`.dart_zeros`. Needs vx, vy, U, alpha, yc (y's centre), lam1, lam2, zero, i2 = 2i, sign, em, ep =
+    :mod:`.dart_zeros`. Needs vx, vy, U, alpha and yc (:meth:`mode0`), lam1, lam2, zero, i2 = 2i, sign, em, ep =
     e^(-+ i sigma) and ``e(c, k)``: e^(i k a h) for c = "x", e^(i k b h) for "y" (a = 2 pi, b = 2 sigma). No
     Re or Im: the conjugate of a mode is the mode of 1/w with the positions (a, b) swapped."""
+
+    def mode0(self, cos_sigma, L0, flip=False):
+        """alpha = -(lam2 - 1/2) cos(sigma)/((lam2 - 1/2) U(1,0) - (lam2 - L0)/2) (the sharp midpoint's row;
+        -alpha with ``flip``, a control) and y's centre yc = alpha (lam2 - L0)."""
+        lam, half = self.lam2, self.lam2 - fmpq(1, 2)
+        self.alpha = -(half * cos_sigma) / (half * self.U[0] - (lam - L0) / 2) * (-1 if flip else 1)
+        self.yc = self.alpha * (lam - L0)
 
     def parts(self):
         """{name: (level0(delta, pos), centre, lam)} for X+, X-, Y0, Y+, Y-: level0 the level-0 value at sector
@@ -229,7 +227,7 @@ class Family(Modes):
 
     def __init__(self, h, sigma, flip_mode0=False, smooth=False):
         self.h, self.sigma = h, sigma
-        one, pi = h * 0 + 1, arb.pi()
+        pi = arb.pi()
         self.zero, self.i2 = h * 0, acb(0, 2)
         self.ix, self.iy = acb(0, 2) * pi, acb(0, 2) * sigma   # w_x = e^(ix h), w_y = e^(iy h)
         self.em, self.ep = (acb(0, -1) * sigma).exp(), (acb(0, 1) * sigma).exp()
@@ -238,14 +236,10 @@ class Family(Modes):
         self.lam2 = _lam_principal((h * (2 * sigma)).cos())
         self.vy = bordered((h * self.iy).exp(), self.lam2)
         self.U = big_u(self.lam2)
-        lam, L0 = self.lam2, l0()[0]
-        self.alpha = -(lam - fmpq(1, 2)) * sigma.cos() * one / ((lam - fmpq(1, 2)) * self.U[0] - (lam - L0) / 2)
-        if flip_mode0:
-            self.alpha = -self.alpha
+        self.mode0(sigma.cos(), l0()[0], flip_mode0)
         self.sign = 1
         if smooth:  # with sigma = pi: y = Re(v^ e^(2 pi i s)), the smooth valence's mode-1 cosine
-            self.alpha, self.sign = self.zero, -1
-        self.yc = self.alpha * (lam - L0)
+            self.alpha, self.yc, self.sign = self.zero, self.zero, -1
         self._exp = {}
 
     def e(self, c, k):
@@ -309,20 +303,32 @@ XB, YB = ("X+", "X-"), ("Y0", "Y+", "Y-")
 
 
 _SU, _SH = 6, 36  # Kronecker strides: a product of bicubic partials has degree <= 5 in u and in v
-_BIN2, _BIN3, _BIN5 = (1, 2, 1), (1, 3, 3, 1), (1, 5, 10, 10, 5, 1)
+_BIN = ((1,), (1, 1), (1, 2, 1), (1, 3, 3, 1), (1, 4, 6, 4, 1), (1, 5, 10, 10, 5, 1))  # C(d, i)
+_BIN2, _BIN3, _BIN5 = _BIN[2], _BIN[3], _BIN[5]
 
 
-def _packed(nets, axis):
-    """One acb_poly holding, for every h^m coefficient net (4 x 4), the partial along ``axis`` (0: u, 1: v) in
-    Bernstein form times its binomial weights, at x^(m _SH + i _SU + j)."""
-    coeffs = [acb(0)] * (_SH * len(nets))
+def _packed(nets, axis, stride=_SH):
+    """One acb_poly holding, for every h^m coefficient net (4 x 4; 1 x 4 a curve, 1 x 1 a scalar), its partial
+    along ``axis`` (0: u, 1: v; None: the net itself) in Bernstein form times its binomial weights, at
+    x^(m stride + i _SU + j)."""
+    coeffs = [acb(0)] * (stride * len(nets))
     for m, net in enumerate(nets):
-        for i in range(4 - (axis == 0)):
-            for j in range(4 - (axis == 1)):
-                d = net[i + 1][j] - net[i][j] if axis == 0 else net[i][j + 1] - net[i][j]
-                w = (_BIN2[i] * _BIN3[j]) if axis == 0 else (_BIN3[i] * _BIN2[j])
-                coeffs[m * _SH + i * _SU + j] = 3 * w * acb(d)
+        rows, cols = len(net) - (axis == 0), len(net[0]) - (axis == 1)
+        for i in range(rows):
+            for j in range(cols):
+                d = net[i + 1][j] - net[i][j] if axis == 0 else net[i][j + 1] - net[i][j] if axis == 1 else net[i][j]
+                w = (1 if axis is None else 3) * _BIN[rows - 1][i] * _BIN[cols - 1][j]
+                coeffs[m * stride + i * _SU + j] = w * acb(d)
     return acb_poly(coeffs)
+
+
+def _unpacked(P, n, stride, rows):
+    """The h^m coefficients, m = 0..n, of a packed product of degree 5 (in u and v, ``rows`` = 6; or in the curve
+    parameter, ``rows`` = 1): the scaled Bernstein coefficients divided by their binomial weights."""
+    c = P.coeffs()
+    c += [acb(0)] * max(0, stride * (n + 1) - len(c))
+    return [[c[m * stride + i * _SU + j] / (_BIN5[i] * _BIN5[j]) for i in range(rows) for j in range(6)]
+            for m in range(n + 1)]
 
 
 def packed_partials(nets):
@@ -339,10 +345,7 @@ def det_series(A, B, n):
     with the strides above). Returns ``[[36 acb, (i, j) row-major] for m in 0..n]``: D's Bernstein
     coefficients (degree (5, 5))."""
     (Au, Av), (Bu, Bv) = (X if isinstance(X, tuple) else packed_partials(X) for X in (A, B))
-    c = (Au * Bv - Av * Bu).coeffs()
-    c += [acb(0)] * max(0, _SH * (n + 1) - len(c))
-    return [[c[m * _SH + i * _SU + j] / (_BIN5[i] * _BIN5[j]) for i in range(6) for j in range(6)]
-            for m in range(n + 1)]
+    return _unpacked(Au * Bv - Av * Bu, n, _SH, 6)
 
 
 def basis_nets(fam):
@@ -379,24 +382,11 @@ def series_curves(nets, n, real=False):
     return out
 
 
-def _curve_packed(c, deriv):
-    """acb_poly with the h^m coefficient curve (4 Bezier values) at x^(6 m + i), scaled by C(3, i); or its
-    derivative (3 (c_(i+1) - c_i), scaled by C(2, i))."""
-    out = [acb(0)] * (6 * len(c))
-    for m, pts in enumerate(c):
-        for i in range(3 if deriv else 4):
-            out[6 * m + i] = 3 * _BIN2[i] * (acb(pts[i + 1]) - acb(pts[i])) if deriv else _BIN3[i] * acb(pts[i])
-    return acb_poly(out)
-
-
 def curve_trans_series(xc, yc, A1, A2, n):
     """Taylor coefficients of a1 X Y' - a2 Y X' from the coordinates' (xc, yc: [m: 4 values]) and a_i's: the
     Cauchy products in h of the degree-5 Bernstein products f g' (scaled coefficients convolve, then divide by
-    C(5, k)) as acb_poly products, h packed with stride 6."""
-    a1 = acb_poly([acb(A1[m]) if k == 0 else acb(0) for m in range(n + 1) for k in range(6)])
-    a2 = acb_poly([acb(A2[m]) if k == 0 else acb(0) for m in range(n + 1) for k in range(6)])
-    P = a1 * (_curve_packed(xc, False) * _curve_packed(yc, True)) - a2 * (_curve_packed(yc, False)
-                                                                         * _curve_packed(xc, True))
-    c = P.coeffs()
-    c += [acb(0)] * max(0, 6 * (n + 1) - len(c))
-    return [[c[6 * m + k] / _BIN5[k] for k in range(6)] for m in range(n + 1)]
+    C(5, k)) as acb_poly products, h packed with stride 6 (:func:`_packed` of 1 x 4 and 1 x 1 nets)."""
+    a1, a2 = (_packed([[[z]] for z in A[:n + 1]], None, 6) for A in (A1, A2))
+    X, Y = ([[pts] for pts in c] for c in (xc, yc))
+    P = a1 * (_packed(X, None, 6) * _packed(Y, 1, 6)) - a2 * (_packed(Y, None, 6) * _packed(X, 1, 6))
+    return _unpacked(P, n, 6, 1)

@@ -267,28 +267,20 @@ def check_secular():
     P = lam * lam - 3 * lam / 4 + fmpq(1, 16)
     if 8 * P * 2 != -(2 * lam - lc):  # 8 P = -lam (1 - c*), times 2
         raise CertificateError("P is not -lam (1 - c*)/8")
-    x = fmpq_poly([0, 1])
-    for hv in (fmpq(0), fmpq(1, 7), fmpq(2, 5)):  # det(x - B0(h)) is affine in h: three values decide
-        full = _det3(b0(x, hv))
-        _, detR = mode0_parts(x, hv)
-        if full != (x - 1) * (x * x - 3 * x / 4 + fmpq(1, 16)) + hv * detR:
-            raise CertificateError("det(lam - B0) is not (lam - 1) P + h det R")
-    _, detR = mode0_parts(x, 0)
-    ell, rem = divmod(detR, x - 1)
-    if rem != 0 or ell.degree() > 1:
-        raise CertificateError("det R is not (lam - 1) times a linear polynomial")
+    _, detR = mode0_parts(lam, h)
+    if _det3(b0(lam, h)) != (lam - 1) * P + h * detR:
+        raise CertificateError("det(lam - B0) is not (lam - 1) P + h det R")
+    _ell()
     return True
 
 
 def _ell():
+    """l = det R/(lam - 1), raising unless det R (in Q[lam]) is (lam - 1) times a polynomial of degree <= 1."""
     x = fmpq_poly([0, 1])
-    _, detR = mode0_parts(x, 0)
-    return divmod(detR, x - 1)[0]
-
-
-def lam_circle(sig_r, h):
-    """r = lam(cos(2 sigma_r h)) (arb; 2 sigma_r h < pi/2 keeps (1 + c)(9 + c) > 0)."""
-    return lam_of((2 * sig_r * h).cos())
+    ell, rem = divmod(mode0_parts(x, 0)[1], x - 1)
+    if rem != 0 or ell.degree() > 1:
+        raise CertificateError("det R is not (lam - 1) times a linear polynomial")
+    return ell
 
 
 def check_mode0_roots(sig_r, k0, balls):
@@ -307,7 +299,7 @@ def check_mode0_roots(sig_r, k0, balls):
     least = None
     for i in range(balls):
         h = ball(fmpq(i, balls * k0), fmpq(i + 1, balls * k0))
-        r = lam_circle(sr, h)
+        r = lam_of((2 * sr * h).cos())  # the circle's radius (2 sigma_r h < pi/2: check_ranges)
         q_over_h = l0 + l1 * r - r / 4 * sr ** 2 * h * (sr * h).sinc() ** 2  # P(r) = -r sigma_r^2 h^2 sinc^2/4
         b, c = -fmpq(3, 4) + h * l1, fmpq(1, 16) + h * l0
         ok = (b * b - 4 * c > 0 and c > 0 and b < 0 and q_over_h > 0 and 2 * r + b > 0 and 1 + b + c > 0)
@@ -374,7 +366,7 @@ class SpectralRegions:
     def n(self, box):
         tau, h = (ball(*iv) for iv in box)
         sr = self.sig_r
-        r = lam_circle(sr, h)
+        r = lam_of((2 * sr * h).cos())
         e = acb(0, 1) * tau * h * h
         lam = r * e.exp()
         D = 2 * sr ** 2 * (sr * h).sinc() ** 2 - 8 * r * acb(0, 1) * tau * _e1(e) + acb(0, 1) * tau * _e1(-e) / (2 * r)
@@ -388,7 +380,7 @@ class SpectralRegions:
         v, w = (ball(*iv) for iv in box)
         sr = self.sig_r
         h = v * w
-        r = lam_circle(sr, h)
+        r = lam_of((2 * sr * h).cos())
         e = acb(0, 1) * v * v
         lam = r * e.exp()
         D = 2 * sr ** 2 * w * w * (sr * h).sinc() ** 2 - 8 * r * acb(0, 1) * _e1(e) + acb(0, 1) * _e1(-e) / (2 * r)
@@ -412,7 +404,7 @@ class SpectralRegions:
 
     def f(self, box):
         t, h = (ball(*iv) for iv in box)
-        r = lam_circle(self.sig_r, h)
+        r = lam_of((2 * self.sig_r * h).cos())
         lam = r * (acb(0, 1) * t).exp()
         cs = 8 * lam - 5 + 1 / (2 * lam)
         # any root of cos phi = c* will do (the expression is even and 2 pi-periodic in phi for integer K)
@@ -470,4 +462,4 @@ def check_ranges(k0, sig_lo, sig_hi, sig_r, tau1, v0):
 
 
 __all__ = ["SpectralRegions", "T_PI", "WINDOW", "b0", "check_construction", "check_mode0_roots", "check_ranges",
-           "check_secular", "lam_circle", "mode0_parts", "region_roots", "w1_of"]
+           "check_secular", "mode0_parts", "region_roots", "w1_of"]

@@ -46,26 +46,54 @@ from .replay import MAX_BOXES, parse_decimal, read_tree, replay_tree
 MIN_K0 = 101  # the regions need 1/K0 < r, and the covers are shown from 101 on
 MAX_WORK = 100_000  # units of 0.1 ms of CPU (:func:`record_work`): 10 s; the published record declares 8.4 s
 MAX_BALLS = 8192
-_KEYS = ("schema", "configuration", "statement", "prec", "map", "spectrum", "taylor", "regions", "parts")
-_SPECTRUM = ("sigma", "sigma_h", "circle", "mode0_h", "tau1", "v0", "re")
-_TAYLOR = {"disc_grid": (1, 64), "sigma_boxes": (1, 256), "order": (3, 24), "layer_order": (3, 24),
-           "exp_order": (2, 64)}
+_DEC, _FRAC = "decimal", "fraction"
+#: the record's fields (:func:`read_fields`): a dict of fields (exactly those keys), a list (that many items),
+#: (lo, hi) an int in lo..hi, a decimal string, a fraction 'INT/INT', or a type (read by the step that needs it)
+GRAMMAR = {
+    "schema": str, "configuration": str, "statement": str, "prec": (64, 1024), "map": {"orientation": int},
+    "spectrum": {"sigma": [_DEC, _DEC], "sigma_h": (1, MAX_BALLS), "circle": _DEC, "mode0_h": (1, MAX_BALLS),
+                 "tau1": _DEC, "v0": _DEC, "re": {"N": dict, "I": dict, "F": dict}},
+    "taylor": {"r": _DEC, "disc_grid": (1, 64), "sigma_boxes": (1, 256), "order": (3, 24), "layer_order": (3, 24),
+               "exp_order": (2, 64)},
+    "regions": {"s0": _FRAC, "layer": (3, 64), "winding": [_FRAC, _FRAC]},
+    "parts": dict,
+}
 
 
-def _fraction(s, where):
-    if not isinstance(s, str) or len(s) > 40 or s.count("/") != 1:
-        raise CertificateError(f"{where}: a fraction 'INT/INT' is needed")
-    a, b = s.split("/")
-    if not (a.isdigit() and b.isdigit() and int(b) > 0):
-        raise CertificateError(f"{where}: a fraction 'INT/INT' is needed")
-    return fmpq(int(a), int(b))
+def read_fields(obj, spec, where):
+    """``obj`` read by ``spec`` (:data:`GRAMMAR`): a dict of specs gives a dict of the values (exactly its keys,
+    :func:`.record.exact_keys`), a list of specs a list of that length, (lo, hi) an int in lo..hi, "decimal" an
+    fmpq (:func:`.replay.parse_decimal`), "fraction" the fmpq of 'INT/INT', a type a value of that type.
 
-
-def _int(obj, key, lo, hi, where):
-    v = field_of(obj, key, int, where)
-    if not lo <= v <= hi:
-        raise CertificateError(f"{where}: {key} must lie in {lo}..{hi}")
-    return v
+    Examples
+    --------
+    >>> read_fields({"a": [1, "3/4"]}, {"a": [(0, 9), _FRAC]}, "demo")
+    {'a': [1, 3/4]}
+    >>> read_fields({"a": 10}, {"a": (0, 9)}, "demo")
+    Traceback (most recent call last):
+    ...
+    ccproof.certify.verify.errors.CertificateError: demo a must lie in 0..9
+    """
+    if isinstance(spec, dict):
+        exact_keys(obj, tuple(spec), where)
+        return {k: read_fields(obj[k], s, f"{where} {k}") for k, s in spec.items()}
+    if isinstance(spec, list):
+        if not isinstance(obj, list) or len(obj) != len(spec):
+            raise CertificateError(f"{where}: a list of {len(spec)} is needed")
+        return [read_fields(x, s, where) for x, s in zip(obj, spec)]
+    if spec == _DEC:
+        return parse_decimal(obj)
+    kind = int if isinstance(spec, tuple) else str if spec == _FRAC else spec
+    if not isinstance(obj, kind) or isinstance(obj, bool):
+        raise CertificateError(f"{where} has the wrong type")
+    if isinstance(spec, tuple) and not spec[0] <= obj <= spec[1]:
+        raise CertificateError(f"{where} must lie in {spec[0]}..{spec[1]}")
+    if spec == _FRAC:
+        a, _, b = obj.partition("/")
+        if len(obj) > 40 or not (a.isdigit() and b.isdigit() and int(b) > 0):
+            raise CertificateError(f"{where}: a fraction 'INT/INT' is needed")
+        return fmpq(int(a), int(b))
+    return obj
 
 
 def read_record(cert, k0):
@@ -91,43 +119,19 @@ def read_record(cert, k0):
         raise CertificateError(f"dart:>={k0}: the interval certificate needs {MIN_K0} <= K0 <= 10^6")
     if field_of(cert, "statement", str, "certificate") != "C1":
         raise CertificateError("dart:>=K0 is certified \"C1\" only (its statement is fixed by the configuration)")
-    exact_keys(cert, _KEYS, "certificate")
-    out = {"prec": _int(cert, "prec", 64, 1024, "certificate")}
-    m = field_of(cert, "map", dict, "certificate")
-    exact_keys(m, ("orientation",), "map")
-    if field_of(m, "orientation", int, "map") != 1:
+    g = read_fields(cert, GRAMMAR, "certificate")
+    sp, rg, hints = g["spectrum"], g["regions"], TaylorHints(**g["taylor"])
+    if g["map"]["orientation"] != 1:
         raise CertificateError("map: the statement fixes orientation +1 (x sine-like, y = 1 at ray K/2)")
-    sp = field_of(cert, "spectrum", dict, "certificate")
-    exact_keys(sp, _SPECTRUM, "spectrum")
-    sig = field_of(sp, "sigma", list, "spectrum")
-    if len(sig) != 2:
-        raise CertificateError("spectrum: sigma must be [lo, hi]")
-    out["sig_lo"], out["sig_hi"] = (parse_decimal(s) for s in sig)
-    out["sig_r"], out["tau1"], out["v0"] = (parse_decimal(field_of(sp, k, str, "spectrum"))
-                                            for k in ("circle", "tau1", "v0"))
-    out["sigma_h"] = _int(sp, "sigma_h", 1, MAX_BALLS, "spectrum")
-    out["mode0_h"] = _int(sp, "mode0_h", 1, MAX_BALLS, "spectrum")
-    check_ranges(k0, out["sig_lo"], out["sig_hi"], out["sig_r"], out["tau1"], out["v0"])
-    re = field_of(sp, "re", dict, "spectrum")
-    exact_keys(re, ("N", "I", "F"), "spectrum re")
-    roots = region_roots(k0, out["tau1"], out["v0"])
-    out["re"] = {name: read_tree(re[name], roots[name], f"spectrum re {name}", 1) for name in ("N", "I", "F")}
-    ty = field_of(cert, "taylor", dict, "certificate")
-    exact_keys(ty, ("r", *_TAYLOR), "taylor")
-    r = parse_decimal(field_of(ty, "r", str, "taylor"))
-    if not fmpq(1, k0) < r <= fmpq(1, 8):
+    check_ranges(k0, *sp["sigma"], sp["circle"], sp["tau1"], sp["v0"])
+    if not fmpq(1, k0) < hints.r <= fmpq(1, 8):
         raise CertificateError("taylor: need 1/K0 < r <= 1/8")
-    out["hints"] = TaylorHints(r, *(_int(ty, k, lo, hi, "taylor") for k, (lo, hi) in _TAYLOR.items()))
-    rg = field_of(cert, "regions", dict, "certificate")
-    exact_keys(rg, ("s0", "layer", "winding"), "regions")
-    out["s0"] = _fraction(rg["s0"], "regions s0")
-    out["layer"] = _int(rg, "layer", 3, 64, "regions")
-    win = field_of(rg, "winding", list, "regions")
-    if len(win) != 2:
-        raise CertificateError("regions: winding must be [s_a, s_b]")
-    out["winding"] = tuple(_fraction(s, "regions winding") for s in win)
-    out["map"] = read_map(field_of(cert, "parts", dict, "certificate"), k0, out["hints"], out["s0"], out["layer"],
-                          out["winding"])
+    roots = region_roots(k0, sp["tau1"], sp["v0"])
+    out = {"prec": g["prec"], "sig_lo": sp["sigma"][0], "sig_hi": sp["sigma"][1], "sig_r": sp["circle"],
+           "sigma_h": sp["sigma_h"], "mode0_h": sp["mode0_h"], "tau1": sp["tau1"], "v0": sp["v0"], "hints": hints,
+           "re": {n: read_tree(sp["re"][n], roots[n], f"spectrum re {n}", 1) for n in ("N", "I", "F")},
+           "s0": rg["s0"], "layer": rg["layer"], "winding": tuple(rg["winding"])}
+    out["map"] = read_map(g["parts"], k0, hints, out["s0"], out["layer"], out["winding"])
     check_work(out)
     return out
 

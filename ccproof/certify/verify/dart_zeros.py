@@ -2,7 +2,7 @@
 
 The Taylor models of det J_Phi (R), transversality (T) and winding (W) of ``dart:K``, every K >= K0, drop their
 lowest coefficients as 0 (docs/tagged_c1.md, "A plan for every dart K >= 101", item 6, part Z).
-:func:`check_zeros` computes each exactly and checks it is 0, after :func:`exact_zeros`. The rows (:data:`ROWS`;
+:func:`check_zeros` computes each exactly and checks it is 0. The rows (:data:`ROWS`;
 every piece, outer curve, basis part X+-, Y0, Y+-): D_ij = det d(X_i, Y_j)/d(u, v) and T_ij at h^0; the
 middle's e_10, e_11, e_20 (s^0 h^0, s^1 h^0, s^0 h^1) of K det J_Phi and of K (a1 X Y' - a2 Y X'); Y at
 s = h = 0; on the layer quadrants q = 0, 1, 2 the h^0, h^1, h^2 of det J_Phi and of a1 X Y' - a2 Y X', and
@@ -29,23 +29,24 @@ bracket is used (nor c^2 + t^2 = 1: the identities are polynomial).
 **The exact arithmetic.** Q(theta) = Q(sqrt 5, i), theta = sqrt 5 + i, m(theta) = 0, m(x) = x^4 - 8 x^2 + 36.
 Series in h truncated after h^2 over Q(theta), the ring Q(theta)[h]/(h^3), are held as Q[x]/(m^3) (fmpq_poly
 modulo m^3: the arithmetic in C): theta -> theta~, the root of m lifting x (Newton; m(theta~) = 0 mod m^3
-checked at import), h -> m(x). This is an isomorphism (e(theta~) is a unit for e != 0 in Q(theta), so
-sum e_k(theta~) m^k = 0 mod m^3 forces e_0 = e_1 = e_2 = 0; both have dimension 12), and h^0 .. h^(k-1) all
-vanish exactly when m^k divides the representative: the checks are remainders, the coefficients are read
-off (:meth:`QS.coeffs`) only where one is not 0. Truncations are exact: e^(i k h) = 1 + i k h - k^2 h^2/2,
-sqrt(20 (1 + z)) = 2 sqrt 5 (1 + z/2 - z^2/8), ln(1 + z) = z - z^2/2 for z in (h). The bordered 7 x 7 systems
-are solved by Gauss-Jordan over the ring (unit pivots), U from :mod:`.dart_family`'s exact polynomials, and
-the nets by the family's own assembly (``piece_nets``, ``quadrant_level1``, ``_bezier``). det J_Phi's h^m
-coefficient, of degree <= (5, 5) in the patch parameters (u, v), is checked on the 6 x 6 grid u, v in
-{0, 1/5, ..., 1}; T's and the curve points' as the Bernstein coefficients. Parts depending on fewer of
-(a, b, c, t) (X's nets on a, Y+-'s on b, Y0's on (b, c)) are computed once, counted at each grid point.
+checked at import), h -> m(x). This is an isomorphism (e(theta~) is a unit for e != 0 in Q(theta), so sum
+e_k(theta~) m^k = 0 mod m^3 forces e_0 = e_1 = e_2 = 0; both have dimension 12), and h^0 .. h^(k-1) all vanish
+exactly when m^k divides the representative: the checks are remainders, the coefficients are read off
+(:meth:`QS.coeffs`) only where one is not 0. Truncations are exact: e^(i k h) = 1 + i k h - k^2 h^2/2, sqrt(20
+(1 + z)) = 2 sqrt 5 (1 + z/2 - z^2/8), ln(1 + z) = z - z^2/2 for z in (h). The bordered 7 x 7 systems are
+solved as rational 84 x 84 ones (the ring is 12-dimensional over Q: :func:`solve`), U from
+:mod:`.dart_family`'s exact polynomials, and the nets by the family's own assembly (``piece_nets``,
+``quadrant_level1``, ``_bezier``). det J_Phi's h^m coefficient, of degree <= (5, 5) in the patch parameters (u,
+v), is checked on the 6 x 6 grid u, v in {0, 1/5, ..., 1}; T's and the curve points' as the Bernstein
+coefficients. Parts depending on fewer of (a, b, c, t) (X's nets on a, Y+-'s on b, Y0's on (b, c)) are computed
+once, counted at each grid point.
 """
 
 from __future__ import annotations
 
 import itertools
 
-from flint import fmpq, fmpq_poly
+from flint import fmpq, fmpq_mat, fmpq_poly
 
 from . import dart_family as _df
 from .dart_family import PIECES, XB, YB
@@ -92,25 +93,15 @@ def _raw(z):
     return z.p if isinstance(z, QS) else fmpq_poly([fmpq(z)])
 
 
-class QF:
-    """p + q sqrt 5 + i (r + u sqrt 5) (fmpq components): one coefficient of a :class:`QS`, for reading."""
-
-    __slots__ = ("p", "q", "r", "u")
-
-    def __init__(self, e):  # e: a polynomial in theta, degree < 4; theta^2 = 4 + 2 i sqrt 5, theta^3 = 2 sqrt 5 + 14 i
-        c = [e[k] for k in range(4)]
-        self.p, self.q, self.r, self.u = c[0] + 4 * c[2], c[1] + 2 * c[3], c[1] + 14 * c[3], 2 * c[2]
-
-
 class QS:
     """A power series in h truncated after h^2 with coefficients in Q(sqrt 5, i), exact: the class of the
     fmpq_poly ``p`` (degree < 12) in Q[x]/(m^3) (module docstring).
 
     Examples
     --------
-    >>> e = QS(1) + I * 3 * H - H * H * fmpq(9, 2)  # e^(3 i h)
-    >>> [(z.p, z.r) for z in e.c], (e * (QS(1) - I * 3 * H - H * H * fmpq(9, 2))).c[2].p
-    ([(1, 0), (0, 3), (-9/2, 0)], 0)
+    >>> e = QS(1) + I * 3 * H - H * H * fmpq(9, 2)  # e^(3 i h) to order 2
+    >>> (e * (QS(1) - I * 3 * H - H * H * fmpq(9, 2)) - 1).is_zero(), (e - 1).vanishes(1), (e - 1).vanishes(2)
+    (True, True, False)
     """
 
     __slots__ = ("p",)
@@ -155,11 +146,6 @@ class QS:
     def coeffs(self):
         """[e_0, e_1, e_2]: the coefficients of h^0, h^1, h^2 as polynomials in theta (degree < 4)."""
         return _h_coeffs(self.p)
-
-    @property
-    def c(self):
-        """[QF of h^0, h^1, h^2]."""
-        return [QF(e) for e in self.coeffs()]
 
 
 def _h_coeffs(p):
@@ -212,23 +198,15 @@ def _log_ratio(lam):
     return z - z * z / 2
 
 
-def _solve(A, b):
-    """Gauss-Jordan over Q(sqrt 5, i)[h]/(h^3) with pivots that are units (A(h = 0) regular); ZeroDivisionError
-    if there is none."""
+def solve(A, b):
+    """The solution of A v = b over Q(sqrt 5, i)[h]/(h^3) = Q[x]/(m^3), a 12-dimensional Q-algebra: A as the
+    rational 12 n x 12 n matrix of its multiplications (column k of the block of z: z x^k mod m^3), solved by
+    fmpq_mat (exact; ZeroDivisionError unless A is invertible over the ring, i.e. A(h = 0) regular)."""
     n = len(A)
-    M = [list(A[i]) + [b[i]] for i in range(n)]
-    for c in range(n):
-        piv = next((r for r in range(c, n) if not M[r][c].vanishes(1)), None)
-        if piv is None:
-            raise ZeroDivisionError("singular system")
-        M[c], M[piv] = M[piv], M[c]
-        inv = M[c][c].inv()
-        M[c] = [z * inv for z in M[c]]
-        for r in range(n):
-            if r != c and not M[r][c].is_zero():
-                f = M[r][c]
-                M[r] = [z - f * w for z, w in zip(M[r], M[c])]
-    return [M[r][n] for r in range(n)]
+    cols = [[[(z.p * _X ** k) % _M3 for k in range(12)] for z in row] for row in A]
+    M = fmpq_mat([[cols[i][j][k][r] for j in range(n) for k in range(12)] for i in range(n) for r in range(12)])
+    v = M.solve(fmpq_mat([[(z.p % _M3)[r]] for z in b for r in range(12)]))
+    return [QS(fmpq_poly([v[12 * i + r, 0] for r in range(12)])) for i in range(n)]
 
 
 def _bordered(k, lam, stencil):
@@ -237,7 +215,7 @@ def _bordered(k, lam, stencil):
     for i, row in enumerate(stencil):
         for (d, pos), x in row.items():
             B[i][RING_INDEX[pos]] = B[i][RING_INDEX[pos]] + _exp_i(fmpq(k) * d) * fmpq(x)
-    return _solve(_df.bordered_matrix(B, lam, QS(0)), [QS(0)] * 6 + [QS(1)])[:6]
+    return solve(_df.bordered_matrix(B, lam, QS(0)), [QS(0)] * 6 + [QS(1)])[:6]
 
 
 class _Mode:
@@ -250,35 +228,6 @@ class _Mode:
         if with_u:
             den = _df.u_denominator(self.lam, L0_LOW)
             self.U = [horner(p, self.lam, QS(0)) / den for p in _df.N_POLYS]
-
-
-def exact_zeros():
-    """Check exactly (in Q(sqrt 5), the constants of :class:`QS`) the facts the dropped coefficients rest on:
-    L0 is an eigenvalue of B(1) with eigenvector rho (rho(1,0) = 1) and rho(a, b) = rho(b, a); adj(L0 - B(1))
-    kappa = N(L0) is a multiple of rho (so U(L0) = U(1,0) rho and alpha(0) U(L0) = -cos(sigma) rho). Returns
-    rho (6 QS), CertificateError if not.
-
-    Examples
-    --------
-    >>> rho = exact_zeros()
-    >>> (rho[0] - 1).is_zero(), (rho[2] - (SQRT20 / 2 - 1)).is_zero()  # rho(1,1) = sqrt 5 - 1
-    (True, True)
-    """
-    A = [[(L0 if i == k else QS(0)) - _df.B_AT_1[i, k] for k in range(6)] for i in range(6)]
-    # rho: solve A rho = 0 with rho(1,0) = 1: drop row 0 (rank 5 since L0 is simple: checked by the solve)
-    try:
-        rho = [ONE] + _solve([[A[i][k] for k in range(1, 6)] for i in range(1, 6)], [-A[i][0] for i in range(1, 6)])
-    except ZeroDivisionError:
-        raise CertificateError("L0 is not a simple eigenvalue of B(1)") from None
-    if not all(sum((A[i][k] * rho[k] for k in range(6)), QS(0)).is_zero() for i in range(6)):
-        raise CertificateError("rho is no eigenvector of B(1) for L0")
-    pos = {p: k for p, k in RING_INDEX.items()}
-    if not all((rho[pos[(a, b)]] - rho[pos[(b, a)]]).is_zero() for (a, b) in pos if b > 0 and (b, a) in pos):
-        raise CertificateError("rho is not symmetric in (a, b)")
-    N = [horner(p, L0, QS(0)) for p in _df.N_POLYS]
-    if not all((N[k] - N[0] * rho[k]).is_zero() for k in range(6)) or N[0].is_zero():
-        raise CertificateError("adj(L0 - B(1)) kappa is not a non-zero multiple of rho")
-    return rho
 
 
 class ExactFamily(_df.Modes):
@@ -294,8 +243,8 @@ class ExactFamily(_df.Modes):
     Examples
     --------
     >>> fam = ExactFamily(1, 2, 1, 2)
-    >>> fam.vx[0].c[0].p, fam.lam1.c[1].p, (fam.yc.c[0].p, fam.yc.c[1].p)
-    (1, 0, (0, 0))
+    >>> (fam.vx[0] - 1).is_zero(), (fam.lam1 - L0).vanishes(2), fam.yc.vanishes(2)  # the pivot, no h^1 terms
+    (True, True, True)
     """
 
     def __init__(self, a, b, c, t, stencil=None, flip_alpha=False, _modes=None):
@@ -304,12 +253,7 @@ class ExactFamily(_df.Modes):
         mx, my = _modes or (_Mode(a, stencil), _Mode(b, stencil, with_u=True))
         self.zero = QS(0)
         self.lam1, self.lam2, self.vx, self.vy, self.U = mx.lam, my.lam, mx.v, my.v, my.U
-        lam = self.lam2
-        half = lam - fmpq(1, 2)
-        self.alpha = -(half * self.c) / (half * self.U[0] - (lam - L0) / 2)
-        if flip_alpha:
-            self.alpha = -self.alpha
-        self.yc = self.alpha * (lam - L0)
+        self.mode0(self.c, L0, flip_alpha)
         self.em, self.ep = QS(self.c) - I * self.t, QS(self.c) + I * self.t  # e^(-i sigma), e^(i sigma)
         self.i2, self.sign = I * 2, 1
 
@@ -329,7 +273,9 @@ _GRID = [fmpq(k, 5) for k in range(6)]
 _BERN = [[(1 - u) ** 3, 3 * u * (1 - u) ** 2, 3 * u * u * (1 - u), u ** 3] for u in _GRID]
 _DBERN = [[-3 * (1 - u) ** 2, 3 * (1 - u) ** 2 - 6 * u * (1 - u), 6 * u * (1 - u) - 3 * u * u, 3 * u * u]
           for u in _GRID]
-_UV = [f"({i}/5, {j}/5)" for i in range(6) for j in range(6)]
+_UV = "(u, v) in {0, 1/5, .., 1}^2 (row-major)"
+_MID = "(S: e_10, e_20; S': e_11) alternating per " + _UV
+_COEF = "the 6 Bernstein coefficients per l"
 
 
 def _lin(ps, ws):
@@ -357,18 +303,13 @@ def _det(px, py):
 class _Tally:
     """{row: [checked, non-zero]}; with ``stop`` the first non-zero coefficient raises CertificateError."""
 
-    def __init__(self, stop, ells):
+    def __init__(self, stop):
         self.rows = {row: [0, 0] for row in ROWS}
-        self.stop, self.ells = stop, ells
-
-    def _at(self, kind, k):
-        e = "e_10, e_20" if k % 2 == 0 else "e_11"  # the middle's items alternate S, S'
-        return {"uv": lambda: f"(u, v) = {_UV[k]}", "mid": lambda: f"{e} at (u, v) = {_UV[k // 2]}",
-                "midT": lambda: f"{e} at l = {self.ells[k // 12]}, coefficient {k // 2 % 6}",
-                "coef": lambda: f"l = {self.ells[k // 6]}, coefficient {k % 6}", "point": lambda: f"point {k}"}[kind]()
+        self.stop = stop
 
     def add(self, row, items, where, kind):
-        """items: [(raw element, the h-orders that must be 0)]; where, kind: the items' place, for the reason."""
+        """items: [(raw element, the h-orders that must be 0)]; where, kind: the items' place and how they are
+        numbered (item k of ``kind``), for the reason."""
         for k, (p, orders) in enumerate(items):
             self.rows[row][0] += len(orders)
             if (p % _MOD[max(orders) + 1]).is_zero():
@@ -378,7 +319,7 @@ class _Tally:
             self.rows[row][1] += len(bad)
             if bad and self.stop:
                 raise CertificateError(f"dropped coefficient not 0: row '{row}', h^{bad[0]} coefficient "
-                                       f"at {where}, {self._at(kind, k)}")
+                                       f"at {where}, item {k} of {kind}")
 
 
 def _xy(xs, ys):
@@ -439,8 +380,8 @@ def _check_pieces(fam, part, tally, pt):
     for piece in PIECES:
         G = {(i, j): _det(part[i][piece], part[j][piece]) for i in XB for j in YB}
         for (i, j), vals in G.items():
-            tally.add(ROWS[0], [(v, (0,)) for v in vals], f"{pt}, {piece}, D({i}, {j})", "uv")
-        tally.add(ROWS[1], _middle(G, fam), f"{pt}, {piece}", "mid")
+            tally.add(ROWS[0], [(v, (0,)) for v in vals], f"{pt}, {piece}, D({i}, {j})", _UV)
+        tally.add(ROWS[1], _middle(G, fam), f"{pt}, {piece}", _MID)
 
 
 def _check_curves(fam, nets, keys, A, tally, cache, pt):
@@ -452,10 +393,10 @@ def _check_curves(fam, nets, keys, A, tally, cache, pt):
                 cache[(keys[i], keys[j], curve)] = _xy(pts[i], pts[j])
         G = {(i, j): _trans(cache[(keys[i], keys[j], curve)], A) for i in XB for j in YB}
         for (i, j), vals in G.items():
-            tally.add(ROWS[2], [(v, (0,)) for v in vals], f"{pt}, {curve}, T({i}, {j})", "coef")
-        tally.add(ROWS[3], _middle(G, fam), f"{pt}, {curve}", "midT")
+            tally.add(ROWS[2], [(v, (0,)) for v in vals], f"{pt}, {curve}, T({i}, {j})", _COEF)
+        tally.add(ROWS[3], _middle(G, fam), f"{pt}, {curve}", "(S, S') alternating per " + _COEF)
         tally.add(ROWS[4], [((pts["Y0"][p] + pts["Y+"][p] * fam.em + pts["Y-"][p] * fam.ep).p, (0,)) for p in range(4)],
-                  f"{pt}, {curve}", "point")
+                  f"{pt}, {curve}", "the 4 Bezier points")
 
 
 def _check_layers(fam, A, tally, cache, pt):
@@ -464,19 +405,19 @@ def _check_layers(fam, A, tally, cache, pt):
         xn, xp = _nets(cache, ("LX", fam.a, q), lambda q=q: fam.layer_nets(q, 0))
         yn, yp = _nets(cache, ("LY", fam.b, fam.c, fam.t, q), lambda q=q: fam.layer_nets(q, 1))  # y: (b, c, t)
         for piece in PIECES:
-            tally.add(ROWS[5], [(v, (0, 1, 2)) for v in _det(xp[piece], yp[piece])], f"{pt}, q = {q}, {piece}", "uv")
+            tally.add(ROWS[5], [(v, (0, 1, 2)) for v in _det(xp[piece], yp[piece])], f"{pt}, q = {q}, {piece}", _UV)
         for curve in STAR_CURVES:
             xs, ys = curve_points(xn, curve, oriented=True), curve_points(yn, curve, oriented=True)
             tally.add(ROWS[6], [(v, (0, 1, 2)) for v in _trans(_xy(xs, ys), A)],
-                      f"{pt}, q = {q}, {curve}", "coef")
+                      f"{pt}, q = {q}, {curve}", _COEF)
             end = q == 0 and curve == "P1s1"  # ray 0's end point: h^1 too
             tally.add(ROWS[7], [(y.p, (0, 1) if end and k == 0 else (0,)) for k, y in enumerate(ys)],
-                      f"{pt}, q = {q}, {curve}", "point")
+                      f"{pt}, q = {q}, {curve}", "the 4 Bezier points")
 
 
 def _run(points, ells, stencil, flip_alpha, stop):
     stencil = ring_stencil() if stencil is None else stencil
-    tally, modes, cache = _Tally(stop, ells), {}, {}
+    tally, modes, cache = _Tally(stop), {}, {}
     for a, b, c, t in points:
         if ("x", a) not in modes:
             modes[("x", a)] = _Mode(a, stencil)
@@ -505,20 +446,18 @@ def count_zeros(points=GRID, ells=GRID_CT, stencil=None, flip_alpha=False):
 
 def check_zeros(*, _stencil=None, _flip_alpha=False) -> str:
     """Check exactly that every dropped Taylor coefficient of the dart family is 0 on the grid of the degree
-    argument (module docstring), after :func:`exact_zeros`: a one-line summary with the counts per row, or
-    CertificateError naming the row, grid point and place of the first non-zero one (``_stencil``,
-    ``_flip_alpha``: perturbations for the tests).
+    argument (module docstring): a one-line summary with the counts per row, or CertificateError naming the
+    row, grid point and place of the first non-zero one (``_stencil``, ``_flip_alpha``: perturbations for the
+    tests).
 
     Examples
     --------
     >>> print(check_zeros())
-    dropped coefficients exactly 0 on the grid a, b in (1, 2, 3), c, t, l in (1, 2): ... 103428 in all ...
+    dropped coefficients exactly 0 on the grid a, b in (1, 2, 3), c, t, l in (1, 2): ... 103428 in all
     """
-    exact_zeros()
     rows = _run(GRID, GRID_CT, _stencil, _flip_alpha, stop=True).rows
     if not all(n > 0 for n, _ in rows.values()):
         raise CertificateError("a row of dropped coefficients checked nothing")
     return (f"dropped coefficients exactly 0 on the grid a, b in {GRID_AB}, c, t, l in {GRID_CT}: "
             + "; ".join(f"{row} {n}" for row, (n, _) in rows.items())
-            + f"; {sum(n for n, _ in rows.values())} in all (and rho = v^(0) is B(1)'s symmetric eigenvector for "
-            "L0 = (6 + sqrt 20)/16, adj(L0 - B(1)) kappa a non-zero multiple of it)")
+            + f"; {sum(n for n, _ in rows.values())} in all")
