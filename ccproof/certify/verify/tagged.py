@@ -260,20 +260,24 @@ def exact_spectrum(fam, n):
     >>> sorted((str(p), a, g) for p, a, g in exact_spectrum("crease", 1))[:3]
     [('16*x + (-1)', 2, 2), ('2*x + (-1)', 1, 1), ('4*x + (-1)', 2, 1)]
     """
+    _, fac = sector_matrix(fam, n).charpoly().factor()
+    return [(p, e, 1 if e == 1 else kernel_dim(fam, n, p) // p.degree()) for p, e in fac]
+
+
+def kernel_dim(fam, n, p):
+    """dim ker p(S) (exact; p(S) by Horner) for a polynomial p over Q.
+
+    Examples
+    --------
+    >>> kernel_dim("crease", 1, fmpq_poly([-1, 4])), kernel_dim("crease", 1, fmpq_poly([-1, 4]) ** 2)
+    (1, 2)
+    """
     S = sector_matrix(fam, n)
     m = S.nrows()
-    _, fac = S.charpoly().factor()
-    eye = fmpq_mat([[1 if i == j else 0 for j in range(m)] for i in range(m)])
-    out = []
-    for p, e in fac:
-        if e == 1:
-            out.append((p, 1, 1))
-            continue
-        P = fmpq_mat(m, m)  # p(S) by Horner
-        for c in reversed(p.coeffs()):
-            P = P * S + eye * c
-        out.append((p, e, (m - P.rank()) // p.degree()))
-    return out
+    eye, P = fmpq_mat([[int(i == j) for j in range(m)] for i in range(m)]), fmpq_mat(m, m)
+    for c in reversed(p.coeffs()):
+        P = P * S + eye * c
+    return m - P.rank()
 
 
 def crease_points(fam, n):
