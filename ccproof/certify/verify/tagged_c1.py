@@ -69,7 +69,7 @@ from .tagged import (
 )
 from .tagged_map import all_zero, check_map
 from .tagged_modes import MIN_N, bordered_solve, kernel_basis, mode_spectrum, normalized_vector
-from .tagged_refute import chain_generic, chain_top, flip_generic, mode_generic, ordering, same_root
+from .tagged_refute import chain_generic, chain_top, flip_generic, mode_generic, mode_lead_why, ordering, same_root
 
 LIMIT_MASK = (fmpq(1, 6), fmpq(4, 6), fmpq(1, 6))  # a cubic B-spline's limit weights on three control points
 TANGENT_MASK = (fmpq(-1, 2), fmpq(0), fmpq(1, 2))  # and its tangent's
@@ -190,16 +190,13 @@ def _isolated(ev, lo_hi, c):
 
 
 def _dart_leading(k, ev):
-    """(i1, i2, why): a dart's lam1 and lam2 in the mode list, why None when the spectral part holds."""
-    one = [i for i, t in enumerate(ev) if not abs(t[0]) < 1]
-    rest = sorted((i for i in range(len(ev)) if i not in one), key=lambda i: -abs(ev[i][0]).mid())
+    """(i1, i2, why, message): a dart's lam1 and lam2 in the mode list, why None when the spectral part holds."""
+    rest = sorted((i for i, t in enumerate(ev) if abs(t[0]) < 1), key=lambda i: -abs(ev[i][0]).mid())
     i1, i2 = rest[0], rest[1]
     l1, l2 = ev[i1][0], ev[i2][0]
-    why = ("eigenvalue 1 is not simple" if len(one) != 1 or ev[one[0]][1] != 1 else
-           "lam1 or lam2 is not certainly real and positive" if not all(
-               z.imag.is_zero() and z.real > 0 for z in (l1, l2)) else
-           "lam1 > lam2 is not certain" if not l1.real > l2.real else
-           "|lam3| is not certainly below lam2" if not all(abs(ev[i][0]) < l2.real for i in rest[2:]) else None)
+    why = mode_lead_why(ev, i1, i2) or (
+        "lam1 or lam2 is not certainly real and positive" if not all(z.imag.is_zero() and z.real > 0 for z in (l1, l2))
+        else "lam1 > lam2 is not certain" if not l1.real > l2.real else None)
     msg = (f"dart:{k}: 1 simple; lam1 = {l1.real.str(5, radius=False)} ({_where(ev[i1])}) > lam2 = "
            f"{l2.real.str(5, radius=False)} ({_where(ev[i2])}), each simple"
            f" > |lam3| = {abs(ev[rest[2]][0]).str(5, radius=False)}" if why is None else f"dart:{k}: {why}")
@@ -237,7 +234,7 @@ def _verify_witness(w, fam, n, prec, part, log):
             f"copies of quadrant {q}'s (1,1) tend to n_z != 0, yet e_z lies in T_v (ray {r})")
 
 
-_G = ("G generic: alpha = lam1, beta = lam2, gamma = the crease block's largest eigenvalue below 1; "
+G_GENERIC = ("G generic: alpha = lam1, beta = lam2, gamma = the crease block's largest eigenvalue below 1; "
       "no Jordan block at |lam| >= beta; gamma < beta for a generalized z")
 
 
@@ -264,7 +261,7 @@ def _witness_exact(fam, n, w, prec, part):
              "below 1; Jordan blocks at beta of size <= 2, y's chain tops at e; every other |lam| < beta", ok, msg)
         return (vecs, tops["y"], "J_xe") if ok else None
     ok, msg = ordering(fam, n, vals["x"], vals["y"], vals["z"], prec, tops["z"] is not None)
-    part(_G, ok, msg)
+    part(G_GENERIC, ok, msg)
     return (vecs, vecs["y"], "J_xy") if ok else None
 
 
@@ -285,8 +282,8 @@ def _witness_modes(fam, n, w, part):
     ia, ib = at["x"], at["y"]
     beta = ev[ib][0].real
     why = mode_generic(ev, ia, ib, g, crease_block(fam, n))
-    part(_G, why is None, f"alpha = {ev[ia][0].real.str(8)} > beta = {beta.str(8)} > |every other| (each simple), "
-         f"1 simple; gamma = {g} < beta" if why is None else why)
+    part(G_GENERIC, why is None, f"alpha = {ev[ia][0].real.str(8)} > beta = {beta.str(8)} > |every other| (each "
+         f"simple), 1 simple; gamma = {g} < beta" if why is None else why)
     if why is not None:
         return None
     cp = crease_points(fam, n)
@@ -484,5 +481,5 @@ def vertex_tangents(val):
                  for da, db in ((TANGENT_MASK, LIMIT_MASK), (LIMIT_MASK, TANGENT_MASK)))
 
 
-__all__ = ["LIMIT_MASK", "TAGGED_SCHEMA", "TANGENT_MASK", "check_boundary", "crease_eigen_why", "read_z",
+__all__ = ["G_GENERIC", "LIMIT_MASK", "TAGGED_SCHEMA", "TANGENT_MASK", "check_boundary", "crease_eigen_why", "read_z",
            "verify_tagged", "vertex_tangents"]

@@ -55,19 +55,11 @@ from flint import acb, arb, ctx, fmpq, fmpq_mat
 from .errors import CertificateError
 from .record import exact_keys, field_of
 from .replay import parse_decimal
-from .spectrum import SMALL_ROOTS
+from .spectrum import RING_INDEX, SMALL_ROOTS, ring_block
 from .statement import lam_of
 from .tagged import crease_block, crease_points, labels, sector_rows
-from .tagged_c1 import check_boundary, crease_eigen_why, read_z, vertex_tangents
-from .tagged_modes import (
-    RING_INDEX,
-    bordered_solve,
-    charpoly_roots,
-    check_ring,
-    check_structure,
-    mode_reflection,
-    ring_block,
-)
+from .tagged_c1 import G_GENERIC, check_boundary, crease_eigen_why, read_z, vertex_tangents
+from .tagged_modes import bordered_solve, charpoly_roots, check_ring, check_structure, mode_reflection
 
 WINDOW = (7, 8)  # the window classes of every N >= 7 occur in both
 MIN_TAIL = WINDOW[0]
@@ -378,8 +370,7 @@ def _check_tail(fam, n0, g, cval, rho, R, side, arcs, outer, part, log):
     if part.failed:
         return
     ok, msg = uniform_spectrum(fam, n0, g, C, blocks)
-    part("G generic: alpha = lam1, beta = lam2, gamma = the crease block's largest eigenvalue below 1; "
-         "no Jordan block at |lam| >= beta; gamma < beta for a generalized z", ok, msg)
+    part(G_GENERIC, ok, msg)
     if not ok:
         return
     cp = crease_points(fam, WINDOW[0])

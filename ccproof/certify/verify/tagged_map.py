@@ -110,12 +110,6 @@ def quadrant_nets(fam, n, vx, vy, q, prec):
     return out
 
 
-def oriented_curve(nets, curve):
-    """The Bezier points (X, Y) of one outer cubic, oriented counterclockwise (from ray q towards ray q + 1)."""
-    pts = curve_points(nets, curve)
-    return pts if STAR_CURVES[curve][2] > 0 else pts[::-1]
-
-
 def transversal_form(nets, curve, a1, a2, prec):
     """Bernstein form (degree 5) of a1 X Y' - a2 Y X' along one outer cubic, oriented counterclockwise.
 
@@ -131,7 +125,7 @@ def transversal_form(nets, curve, a1, a2, prec):
     >>> f.coeffs[0].str(5, radius=False)
     '0.50000'
     """
-    pts = oriented_curve(nets, curve)
+    pts = curve_points(nets, curve, oriented=True)
     with ctx.workprec(prec):
         X = BernsteinForm((4,), [p[0] for p in pts], prec=prec)
         Y = BernsteinForm((4,), [p[1] for p in pts], prec=prec)
@@ -183,7 +177,7 @@ def axis_forms(nets, curve, direction, prec):
     ('0.500', '-1.00')
     """
     a, b = direction
-    pts = oriented_curve(nets, curve)
+    pts = curve_points(nets, curve, oriented=True)
     return (BernsteinForm((4,), [p[0] * a + p[1] * b for p in pts], prec=prec),
             BernsteinForm((4,), [p[1] * a - p[0] * b for p in pts], prec=prec))
 

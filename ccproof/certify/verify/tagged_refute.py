@@ -165,17 +165,24 @@ def crease_top_why(C, g):
     return None
 
 
-def mode_generic(ev, ia, ib, g, C):
-    """The reason part G fails on the mode list (C the crease block), or None."""
+def mode_lead_why(ev, ia, ib):
+    """The reason 1 (from the crease block, or a dart's even part) is not simple or the entries ia, ib of the
+    mode list (:func:`.tagged_modes.mode_spectrum`) do not lead (alpha >= beta > |every other|), or None."""
     one = [t for t in ev if not abs(t[0]) < 1]
     beta = ev[ib][0].real
     others = [t for i, t in enumerate(ev) if i not in (ia, ib) and t[1] != 1]
     return ("x and y are the same eigenvector (beta is not an eigenvalue distinct from alpha)" if ia == ib else
-            "eigenvalue 1 is not simple" if len(one) != 1 or one[0][1] != 1 or one[0][2] != "C" else
+            "eigenvalue 1 is not simple" if len(one) != 1 or one[0][1] != 1 or one[0][2] not in ("C", "E") else
             "alpha >= beta is not certain" if not ev[ia][0].real >= beta else
             "an eigenvalue is not certainly below beta (lam1, lam2 not alpha, beta)"
-            if not all(abs(t[0]) < beta for t in others) else crease_top_why(C, g) or (
-                "gamma < beta is not certain" if not arb(g) < beta else None))
+            if not all(abs(t[0]) < beta for t in others) else None)
+
+
+def mode_generic(ev, ia, ib, g, C):
+    """The reason part G fails on the mode list (C the crease block), or None."""
+    beta = ev[ib][0].real
+    return mode_lead_why(ev, ia, ib) or crease_top_why(C, g) or (
+        "gamma < beta is not certain" if not arb(g) < beta else None)
 
 
 def ordering(fam, n, a, b, g, prec, generalized):
@@ -227,4 +234,5 @@ def _str(v):
     return str(v) if isinstance(v, fmpq) else v.str(8)
 
 
-__all__ = ["chain_generic", "chain_top", "crease_top_why", "flip_generic", "mode_generic", "ordering", "same_root"]
+__all__ = ["chain_generic", "chain_top", "crease_top_why", "flip_generic", "mode_generic", "mode_lead_why",
+           "ordering", "same_root"]
