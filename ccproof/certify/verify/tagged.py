@@ -144,7 +144,17 @@ def position_key(fam, n, q, a, b):
     return ("r", s, a2, b2) if b2 == 0 else ("q", s, a2, b2)
 
 
-def _index(fam, n):
+def point_index(fam, n):
+    """``(idx, at)``: the index of each label (:func:`labels`), and ``at(q, comb)``, a combination of raw grid
+    positions of quadrant q (:func:`position_key`) as ``{index: weight}``; raises for a position outside the
+    complex.
+
+    Examples
+    --------
+    >>> idx, at = point_index("crease", 2)
+    >>> idx[("r", 2, 1, 0)], at(1, {(0, 1): fmpq(1, 2), (1, 0): fmpq(1, 2)})
+    (5, {5: 1/2, 3: 1/2})
+    """
     idx = {p: i for i, p in enumerate(labels(fam, n))}
 
     def at(q, comb):  # raw positions of quadrant q -> {index: weight}
@@ -182,7 +192,7 @@ def sector_rows(fam, n):
     {0: 3/4, 1: 1/8, 5: 1/8}
     """
     pts = labels(fam, n)
-    idx, at = _index(fam, n)
+    idx, at = point_index(fam, n)
     rows = []
     sharp = sharp_rays(fam, n)
     half, eighth = fmpq(1, 2), fmpq(1, 8)

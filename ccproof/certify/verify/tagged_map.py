@@ -32,7 +32,7 @@ from .record import exact_keys
 from .replay import check_boxes, check_partition, parse_path
 from .rules import level1_rule
 from .statement import B2Z, bspline_to_bezier
-from .tagged import labels, position_key, sector_rows, sharp_rays
+from .tagged import point_index, position_key, sector_rows, sharp_rays
 
 PIECES = ("P1", "P2", "P3")
 _OFFSET = {"P1": (0, -1), "P2": (0, 0), "P3": (-1, 0)}  # level-1 position of B-spline net[0][0]
@@ -47,6 +47,7 @@ def level1_values(fam, n, v):
     The regular boundary with the linear vector x = a (on quadrant 0, a along ray 0): level 1 halves it,
     and the ghost row across ray 0 continues it linearly:
 
+    >>> from ccproof.certify.verify.tagged import labels
     >>> pts = labels("crease", 2)
     >>> v = [fmpq(p[2]) if p[0] == "r" and p[1] == 0 else fmpq(-p[2]) if p[0] == "r" and p[1] == 2 else
     ...      fmpq(p[2]) if p[0] == "q" and p[1] == 0 else fmpq(-p[3]) if p[0] == "q" else fmpq(0) for p in pts]
@@ -54,8 +55,7 @@ def level1_values(fam, n, v):
     >>> [val(0, a, b) for a, b in ((3, 0), (2, 2), (1, -1))]
     [3/2, 1, 1/2]
     """
-    pts = labels(fam, n)
-    idx = {p: i for i, p in enumerate(pts)}
+    idx, at = point_index(fam, n)
     sharp = sharp_rays(fam, n)
     rows, memo = sector_rows(fam, n), {}
 
@@ -80,10 +80,7 @@ def level1_values(fam, n, v):
         _, s, A2, B2 = key
         if B2 == 0 and s in sharp:  # (3, 0) on a sharp ray: the midpoint of level-0 (1,0), (2,0)
             return (v[idx[("r", s, 1, 0)]] + v[idx[("r", s, 2, 0)]]) / 2
-        acc = 0 * v[0]
-        for (a, b), w in level1_rule(A2, B2).items():
-            acc += v[idx[position_key(fam, n, s, a, b)]] * w
-        return acc
+        return sum((v[j] * w for j, w in at(s, level1_rule(A2, B2)).items()), 0 * v[0])
     return value
 
 
@@ -93,6 +90,7 @@ def quadrant_nets(fam, n, vx, vy, q, prec):
     Examples
     --------
     >>> from flint import fmpq
+    >>> from ccproof.certify.verify.tagged import labels
     >>> pts = labels("corner", 1)
     >>> vx = [fmpq(p[2]) if p[0] == "r" and p[1] == 0 or p[0] == "q" else fmpq(0) for p in pts]
     >>> vy = [fmpq(p[2]) if p[0] == "r" and p[1] == 1 else fmpq(p[3]) if p[0] == "q" else fmpq(0) for p in pts]
@@ -118,6 +116,7 @@ def transversal_form(nets, curve, a1, a2, prec):
     For the identity map and a1 = a2 = 1 this is the star form x y' - y x' (1/2 on u = 1 of P1 here):
 
     >>> from flint import fmpq
+    >>> from ccproof.certify.verify.tagged import labels
     >>> pts = labels("corner", 1)
     >>> vx = [fmpq(p[2]) if p[0] == "r" and p[1] == 0 or p[0] == "q" else fmpq(0) for p in pts]
     >>> vy = [fmpq(p[2]) if p[0] == "r" and p[1] == 1 else fmpq(p[3]) if p[0] == "q" else fmpq(0) for p in pts]
@@ -169,6 +168,7 @@ def axis_forms(nets, curve, direction, prec):
     Examples
     --------
     >>> from flint import fmpq
+    >>> from ccproof.certify.verify.tagged import labels
     >>> pts = labels("corner", 1)
     >>> vx = [fmpq(p[2]) if p[0] == "r" and p[1] == 0 or p[0] == "q" else fmpq(0) for p in pts]
     >>> vy = [fmpq(p[2]) if p[0] == "r" and p[1] == 1 else fmpq(p[3]) if p[0] == "q" else fmpq(0) for p in pts]
@@ -209,6 +209,7 @@ def rays_on_axes(fam, n, vx, vy):
     Examples
     --------
     >>> from flint import fmpq
+    >>> from ccproof.certify.verify.tagged import labels
     >>> pts = labels("corner", 1)
     >>> vx = [fmpq(p[2]) if p[0] == "r" and p[1] == 0 or p[0] == "q" else fmpq(0) for p in pts]
     >>> vy = [fmpq(p[2]) if p[0] == "r" and p[1] == 1 else fmpq(p[3]) if p[0] == "q" else fmpq(0) for p in pts]
