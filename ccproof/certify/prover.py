@@ -91,7 +91,7 @@ def _round_down(q, digits=6):
     return f"{m}e{e}"
 
 
-def _prove_positive(root, axes, what, max_depth=MAX_DEPTH):
+def prove_positive(root, axes, what, max_depth=MAX_DEPTH):
     """Adaptive subdivision of a Bernstein form until every leaf is certainly positive.
 
     Returns the list of ``{"path", "bound"}`` leaves. ``axes`` is the cyclic order of split axes.
@@ -167,7 +167,7 @@ def prove_valence(k: int, prec: int = DEFAULT_PREC, progress: bool = True) -> di
         lam = c_lam(k, prec)[1]
         nets = nets_for_valence(k, prec)
         N = _smallest_level(nets, lam)
-        regularity = {n: _prove_positive(regularity_form(nets, n, prec), (0, 1), f"det J_Phi on {n}")
+        regularity = {n: prove_positive(regularity_form(nets, n, prec), (0, 1), f"det J_Phi on {n}")
                       for n in form_patches(derivation().symmetric)}
         cells = {}
         todo = required_cells(nets, lam, N, prec, derivation().symmetric)
@@ -179,8 +179,8 @@ def prove_valence(k: int, prec: int = DEFAULT_PREC, progress: bool = True) -> di
         build = cell_det_builder(nets, lam, N, prec)
         for l, m, p, q in it:
             root = build(l, m, p, q)
-            cells[f"{l},{m},{p},{q}"] = _prove_positive(root, (0, 1), f"cell ({l},{m}) piece ({p},{q})")
-        corner = {n: _prove_positive(corner_det_form(nets, lam, N, n, prec), (2, 3, 0, 1),
+            cells[f"{l},{m},{p},{q}"] = prove_positive(root, (0, 1), f"cell ({l},{m}) piece ({p},{q})")
+        corner = {n: prove_positive(corner_det_form(nets, lam, N, n, prec), (2, 3, 0, 1),
                                     f"corner {n}") for n in form_patches(derivation().symmetric)}
     boxes = sum(len(b) for part in (regularity, cells, corner) for b in part.values())
     if boxes > MAX_BOXES:
@@ -222,9 +222,9 @@ def _prove_piece(exact, La, Lb, N, degree, trunc, prec, progress, label):
             raise ProofFailed(f"{label}: the corner cell [0, 2^-{N}]^2 is not certainly mapped into [0,1/6)^2")
         if not square_inside_image(nets):
             raise ProofFailed(f"{label}: [0,1/2]^2 not certainly inside Phi([0,1]^2)")
-        regularity = {n: _prove_positive(regularity_form(nets, n, prec), (0, 1), f"{label} det J_Phi on {n}")
+        regularity = {n: prove_positive(regularity_form(nets, n, prec), (0, 1), f"{label} det J_Phi on {n}")
                       for n in form_patches(derivation().symmetric)}
-        corner = {n: _prove_positive(corner_det_form(nets, lam, N, n, prec), (2, 3, 0, 1),
+        corner = {n: prove_positive(corner_det_form(nets, lam, N, n, prec), (2, 3, 0, 1),
                                     f"{label} corner {n}") for n in form_patches(derivation().symmetric)}
         todo = interval_cells(zn, N, trunc, prec, derivation().symmetric)
         it = todo
@@ -232,7 +232,7 @@ def _prove_piece(exact, La, Lb, N, degree, trunc, prec, progress, label):
             from tqdm import tqdm
 
             it = tqdm(todo, desc=f"{label} cells", unit="cell", leave=False)
-        cells = {key: _prove_positive(build(), (1, 2, 0), f"{label} cell {key}") for key, build in it}
+        cells = {key: prove_positive(build(), (1, 2, 0), f"{label} cell {key}") for key, build in it}
     return {"regularity": regularity, "cells": cells, "corner": corner}
 
 
@@ -492,8 +492,8 @@ def prove_c1(k: ValenceLike, prec: int = DEFAULT_PREC) -> dict[str, Any]:
             nets = hull_nets(parameter_nets(derivation().integer_forms("bspline"), La, Lb, 0, 3, prec), prec)
         else:
             nets = nets_for_valence(v.k, prec)
-        reg = {n: _prove_positive(regularity_form(nets, n, prec), (0, 1), f"det J_Phi on {n}") for n in PATCHES}
-        star = {c: _prove_positive(star_form(nets, c, prec), (0,), f"star {c}") for c in STAR_CURVES}
+        reg = {n: prove_positive(regularity_form(nets, n, prec), (0, 1), f"det J_Phi on {n}") for n in PATCHES}
+        star = {c: prove_positive(star_form(nets, c, prec), (0,), f"star {c}") for c in STAR_CURVES}
     parts = {"regularity": reg, "star": star}
     if v.interval:
         return {"schema": C1_SCHEMA, "valence": k, "prec": prec, "pieces": [{"lam": ends, "parts": parts}]}

@@ -26,7 +26,7 @@ from ccproof.certify.verify.tagged import (
     parse_configuration,
     sharp_rays,
 )
-from ccproof.certify.verify.tagged_modes import MIN_N, even_vector, mode_spectrum, mode_vector
+from ccproof.certify.verify.tagged_modes import MIN_N, mode_spectrum, mode_vector, normalized_vector
 from ccproof.errors import CCProofError
 
 DEFAULT_PREC = 128
@@ -465,20 +465,6 @@ def prove_tagged_c1(name, prec=DEFAULT_PREC):
     return None, f"undecided: {last}"
 
 
-def _dart_vector(k, i, ev, pivot):
-    """The eigenvector of entry i of the dart's mode spectrum as the verifier derives it, or None."""
-    lam = ev[i][0].real
-    if ev[i][3] is not None:
-        f = mode_vector("dart", k, ev[i][3], lam)
-        if f is None or not abs(f[pivot]) > 0:
-            return None
-        return [v if isinstance(v, fmpq) else (v / f[pivot]).real for v in f]
-    try:
-        return even_vector(k, lam, pivot)
-    except ZeroDivisionError:
-        return None
-
-
 def _dart_specs(k, prec):
     """Map coordinates (x for lam1, y for lam2) of dart:k, K >= MIN_N: isolating intervals and pivots where
     the vector is large (floats choose; the verifier decides)."""
@@ -489,13 +475,13 @@ def _dart_specs(k, prec):
         out = []
         for i in rest[:2]:
             trial = [pts.index(("q", q, 1, 1)) for q in range(k)] + [pts.index(("r", r, 1, 0)) for r in range(1, k)]
-            vec = next((v for v in (_dart_vector(k, i, ev, p) for p in trial) if v is not None), None)
+            vec = next((v for v in (normalized_vector("dart", k, ev, i, p) for p in trial) if v is not None), None)
             if vec is None:
                 return None, None
             # the largest coordinate among the one-ring points (the left eigenvector vanishes on the outer
             # ring, where the bordered system is singular)
             order = sorted(trial, key=lambda j: -float(abs(vec[j]).mid()))[:24]
-            pivot = next((j for j in order if _dart_vector(k, i, ev, j) is not None), None)
+            pivot = next((j for j in order if normalized_vector("dart", k, ev, i, j) is not None), None)
             if pivot is None:
                 return None, None
             others = [t[0] for j, t in enumerate(ev) if j != i]
@@ -518,7 +504,7 @@ def _prove_map(name, fam, n, specs, prec, entries=None):
         if entries is not None:  # a dart's mode spectrum entries of lam1, lam2
             ev = mode_spectrum("dart", n)
             lx, ly = (ev[i][0].real for i in entries)
-            vx, vy = (_dart_vector(n, i, ev, s["pivot"]) for i, s in zip(entries, specs))
+            vx, vy = (normalized_vector("dart", n, ev, i, s["pivot"]) for i, s in zip(entries, specs))
             if vx is None or vy is None:
                 return None, "no eigenvector at the chosen pivot"
         else:
@@ -547,10 +533,9 @@ def _prove_map(name, fam, n, specs, prec, entries=None):
 
 
 def _c1_parts(name, nets, n, orient, a1, a2, axis, prec):
-    from ccproof.certify.prover import ProofFailed, _prove_positive
+    from ccproof.certify.prover import ProofFailed, prove_positive
     from ccproof.certify.verify.maps import STAR_CURVES, regularity_form
-    from ccproof.certify.verify.tagged_map import AXES, PIECES, _curve, transversal_form
-    from ccproof.rigorous import BernsteinForm
+    from ccproof.certify.verify.tagged_map import AXES, PIECES, axis_forms, transversal_form
 
     parts = {"regularity": {}, "transversal": {}, "winding": {"axis": axis, "boxes": {}}}
     a, b = AXES[axis] if isinstance(axis, str) else axis
@@ -558,15 +543,12 @@ def _c1_parts(name, nets, n, orient, a1, a2, axis, prec):
         try:
             for q in range(n):
                 for p in PIECES:
-                    parts["regularity"][f"{q}:{p}"] = _prove_positive(
+                    parts["regularity"][f"{q}:{p}"] = prove_positive(
                         regularity_form(nets[q], p, prec) * orient, (0, 1), f"{name} det J on {q}:{p}")
                 for c in STAR_CURVES:
-                    parts["transversal"][f"{q}:{c}"] = _prove_positive(
+                    parts["transversal"][f"{q}:{c}"] = prove_positive(
                         transversal_form(nets[q], c, a1, a2, prec) * orient, (0,), f"{name} transversality {q}:{c}")
-                    pts = _curve(nets[q], c)
-                    A = BernsteinForm((4,), [pt[0] * a + pt[1] * b for pt in pts], prec=prec)
-                    P = BernsteinForm((4,), [pt[1] * a - pt[0] * b for pt in pts], prec=prec)
-                    parts["winding"]["boxes"][f"{q}:{c}"] = _winding_paths(A, P)
+                    parts["winding"]["boxes"][f"{q}:{c}"] = _winding_paths(*axis_forms(nets[q], c, (a, b), prec))
         except (ProofFailed, CCProofError) as exc:
             return None, str(exc)
     return parts, None

@@ -99,29 +99,23 @@ REVIEWED = {
     ("tagged_refute.py", "ev[ib][2] != 1"): "ints (multiplicities)",
     ("tagged_refute.py", 'tops["y"][i] != 0'): "fmpq (exact: (S - beta) y in Q)",
     ("tagged_refute.py", "v != 0"): "fmpq (exact: (S - lam) v in Q)",
-    ("tagged_c1.py", "not abs(t[0]) < 1"): "collects every eigenvalue possibly on or outside the unit circle; exactly "
-                                           "one (the crease block's exact 1) is allowed: conservative",
     ("tagged_refute.py", "not abs(t[0]) < 1"): "collects every eigenvalue possibly on or outside the unit circle; "
-                                               "exactly one (the crease block's exact 1) is allowed: conservative",
+                                               "one (the exact 1 of the crease block or S_E) is allowed: conservative",
     ("tagged_c1.py", "u[i, 0] != 0"): "fmpq_mat entries (exact)",
-    ("tagged_c1.py", "R[r, c] != 0"): "fmpq_mat entries (exact)",
     ("tagged_c1.py", "not 0 <= pv < m"): "ints",
     ("tagged_map.py", 'fam != "dart"'): "strings",
     ("tagged.py", "w != 0"): "fmpq rule weights (exact)",
-    ("tagged_c1.py", "not abs(f[pivot]) > 0"): "fails unless the pivot coordinate is certainly non-zero: conservative",
+    ("tagged_modes.py", "not abs(f[pivot]) > 0"): "fails unless the pivot value is certainly non-zero: conservative",
+    ("spectrum.py", "w != 0"): "fmpq rule weights (exact)",
     ("tagged_c1.py", "parse_decimal(v) != 0"): "fmpq (exact decimals)",
     ("tagged_refute.py", "one[0][1] != 1"): "fmpq or None (the exact value of a rational eigenvalue)",
-    ("tagged_refute.py", 'one[0][2] != "C"'): "strings",
     ("tagged_refute.py", "not ev[ia][0].real >= beta"): "fails unless alpha >= beta certainly: conservative",
-    ("tagged_c1.py", "Cc[i, 0] != g * cval[i]"): "fmpq_mat entries and fmpq (exact)",
     ("tagged_modes.py", "B * K != K * M"): "fmpq_mat (exact)",
     ("tagged_modes.py", "image != mirrored"): "dicts of fmpq weights with int keys (exact)",
     ("tagged_modes.py", "{j: x for j, x in folded.items() if x != 0} != {j: x for j, x in rows[i].items() if j not in "
                         "cp}"): "dicts of fmpq weights (exact)",
-    ("tagged_modes.py", "w != 0"): "fmpq rule weights (exact)",
     ("tagged_modes.py", "R[r, c] != 0"): "fmpq_mat entries (exact)",
     ("tagged_modes.py", "x != 0"): "fmpq folded weights (exact)",
-    ("tagged_c1.py", "ev[one[0]][1] != 1"): "fmpq or None (the exact value of a rational eigenvalue)",
     ("tagged_c1.py", "not l1.real > l2.real"): "fails unless lam1 > lam2 certainly: conservative",
     ("tagged_modes.py", "rows[refl[i]] != {refl[j]: x for j, x in rows[i].items()}"): "dicts of fmpq weights (exact)",
     ("tagged_modes.py", "{j: x for j, x in ring.items() if x != 0} != {j: x for j, x in rows[i].items() if j != 0}"):
@@ -131,12 +125,10 @@ REVIEWED = {
     ("maps.py", "not (hi < BREAKS[p] or (p < 3 and lo > BREAKS[p + 1]))"): (
         "keeps a piece unless the hull is certainly outside it: conservative"),
     ("tagged_limit.py", "not disc.real > 0"): "refuses the box unless Re (1 + c)(9 + c) > 0 certainly: conservative",
-    ("tagged_limit.py", 'field_of(cert, "statement", str, "certificate") != "not C1"'): "strings",
     ("tagged_limit.py", "out.setdefault(key, rel) != rel"): "dicts of fmpq weights (exact)",
     ("tagged_limit.py", "C != crease_block(fam, WINDOW[1])"): "fmpq_mat (exact)",
     ("tagged_limit.py", "blocks[0] != blocks[1]"): "tuples of fmpq_mat (exact)",
-    ("tagged_limit.py", "_mul(ring_block(1 / w), _reflection(w)) != _mul(_reflection(w), ring_block(w))"):
-        "lists of fmpq (w is an exact rational)",
+    ("tagged_limit.py", "Bi * R != R * B"): "fmpq_mat (w is an exact rational)",
     ("tagged_limit.py", "not slope * length < abs(h0)"): "fails unless the arc's image certainly misses 0: "
                                                          "conservative",
     ("tagged_limit.py", "g != 0"): "fmpq (exact decimal)",
@@ -144,7 +136,6 @@ REVIEWED = {
     ("tagged_limit.py", "x != 0"): "fmpq (exact)",
     ("tagged_limit.py", "croots.count(1) != 1"): "ints (fmpq roots compared exactly)",
     ("tagged_limit.py", "not lam_of(arb(1)) < 1"): "fails unless lam(1) < 1 certainly: conservative",
-    ("tagged_limit.py", "v != 0"): "fmpq (exact decimals)",
     ("tagged_limit.py", "g != max(below)"): "fmpq (exact roots of the crease block)",
     ("tagged_limit.py", "not arb(g) < b0"): "fails unless gamma < beta certainly: conservative",
 }

@@ -12,7 +12,10 @@ here from :mod:`.rules`, and their characteristic polynomials are checked exactl
 
 Each is an identity of polynomials (after multiplying by w^6, entries of w B(w) have degree <= 3 in w;
 B0 is affine in t), so it holds as soon as both sides agree on a grid of (deg_x + 1) x (deg_w + 1)
-rational points, which :func:`check_block_polynomials` evaluates with exact determinants.
+rational points, which :func:`check_block_polynomials` evaluates with exact determinants. B(w) is
+:func:`ring_block`, built from one stencil (:func:`ring_stencil`: the rule of each two-ring point on the
+two-ring of its own and the neighbouring sectors); the tagged sectors' modes (:mod:`.tagged_modes`) and
+the dart family use the same block.
 
 Consequences (every k >= 3; :func:`spectral_ordering` checks the numbers in arb): mode m != 0 has the
 eigenvalues 1/8..1/64 and the roots of 16 x^2 - 2(5 + c_m) x + 1, c_m = cos(2 pi m/k); the larger root
@@ -27,32 +30,70 @@ vertex (12k - 28)/(32k)).
 
 from __future__ import annotations
 
+from functools import cache
+
 from flint import arb, ctx, fmpq, fmpq_mat
 
-from .rules import CENTRE, TWO_RING, Vec, apply, centre_rule_mode0, level1_rule
+from .rules import CENTRE, TWO_RING, Vec, apply, canonical, centre_rule_mode0, level1_rule
 from .statement import lam_of
 
+RING_INDEX = {p: i for i, p in enumerate(TWO_RING)}  # ring position -> its index in a mode vector v^ (and B(w))
 
-def _block(w=None, t=None):
-    """B(w) (6 x 6, centre dropped) or, with ``t``, B0(t) (7 x 7, centre first) as fmpq rows."""
-    pos = list(TWO_RING) if t is None else [CENTRE] + list(TWO_RING)
-    idx = {p: i for i, p in enumerate(pos)}
-    n = len(pos)
 
-    def column_lookup(delta, p):  # the row vector of the value at (delta, p) in the unknowns
-        out = [fmpq(0)] * n
-        if p == CENTRE:
-            if t is not None:
-                out[idx[CENTRE]] = fmpq(1)
-            return Vec(out)
-        out[idx[p]] = fmpq(1) if t is not None else fmpq(w) ** delta
-        return Vec(out)
+@cache
+def ring_stencil():
+    """The rule of each ring point (sector 0) on the ring points, the centre dropped.
 
-    rows = []
-    for p in pos:
-        comb = centre_rule_mode0(t) if p == CENTRE else level1_rule(*p)
-        rows.append(list(apply(comb, column_lookup, Vec([fmpq(0)] * n))))
+    Returns
+    -------
+    tuple of dict[(int, (int, int)), fmpq]
+        For each position of :data:`.rules.TWO_RING`: ``{(delta, position): weight}``.
+
+    Examples
+    --------
+    The edge point of a ray (level-1 (1, 0)): 3/8 on its end (1, 0), 1/16 on the far corners of the two
+    faces beside it; the centre's 3/8 is dropped:
+
+    >>> row = ring_stencil()[0]
+    >>> row[(0, (1, 0))], row[(-1, (1, 0))], row[(-1, (1, 1))], sum(row.values())
+    (3/8, 1/16, 1/16, 5/8)
+    """
+    out = []
+    for pos in TWO_RING:
+        row = {}
+        for raw, w in level1_rule(*pos).items():
+            d, a, b = canonical(*raw)
+            if (a, b) != CENTRE:
+                row[(d, (a, b))] = row.get((d, (a, b)), 0) + w
+        out.append({k: w for k, w in row.items() if w != 0})
+    return tuple(out)
+
+
+def ring_block(w):
+    """B(w) (module docstring): (B v^)(p) = sum of the stencil weights times w^delta (w a number, fmpq or acb).
+
+    Examples
+    --------
+    Mode 0 (every sector alike): the ray's edge point is 3/8 + 2/16 on (1, 0), 2/16 on (1, 1):
+
+    >>> ring_block(fmpq(1))[0]
+    [1/2, 0, 1/8, 0, 0, 0]
+    """
+    rows = [[0 * w] * 6 for _ in range(6)]
+    for i, row in enumerate(ring_stencil()):
+        for (d, pos), x in row.items():
+            rows[i][RING_INDEX[pos]] += x * w ** d
     return rows
+
+
+def _block0(t):
+    """B0(t) (7 x 7, centre first) as fmpq rows: every sector alike, the centre's rule for t = 1/k."""
+    pos = (CENTRE,) + TWO_RING
+
+    def lookup(delta, p):  # the row vector of the value at (delta, p) in the unknowns
+        return Vec(fmpq(int(p == q)) for q in pos)
+    return [list(apply(centre_rule_mode0(t) if p == CENTRE else level1_rule(*p), lookup, Vec([fmpq(0)] * 7)))
+            for p in pos]
 
 
 def _charpoly_at(rows, x):
@@ -84,7 +125,7 @@ def mode_polynomials_hold(block):
 
     Examples
     --------
-    >>> mode_polynomials_hold(lambda w: _block(w=w)), mode_polynomials_hold(lambda w: _block(w=w * w))
+    >>> mode_polynomials_hold(ring_block), mode_polynomials_hold(lambda w: ring_block(w * w))
     (True, False)
     """
     for w in range(1, 20):
@@ -109,10 +150,10 @@ def check_block_polynomials():
     >>> check_block_polynomials()
     True
     """
-    if not mode_polynomials_hold(lambda w: _block(w=w)):
+    if not mode_polynomials_hold(ring_block):
         return False
     for t in range(1, 9):  # degree <= 7 in t and in x
-        rows = _block(t=fmpq(t))
+        rows = _block0(fmpq(t))
         for x in range(8):
             if _charpoly_at(rows, fmpq(x)) != _claimed_mode0(fmpq(x), fmpq(t)):
                 return False

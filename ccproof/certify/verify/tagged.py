@@ -144,7 +144,17 @@ def position_key(fam, n, q, a, b):
     return ("r", s, a2, b2) if b2 == 0 else ("q", s, a2, b2)
 
 
-def _index(fam, n):
+def point_index(fam, n):
+    """``(idx, at)``: the index of each label (:func:`labels`), and ``at(q, comb)``, a combination of raw grid
+    positions of quadrant q (:func:`position_key`) as ``{index: weight}``; raises for a position outside the
+    complex.
+
+    Examples
+    --------
+    >>> idx, at = point_index("crease", 2)
+    >>> idx[("r", 2, 1, 0)], at(1, {(0, 1): fmpq(1, 2), (1, 0): fmpq(1, 2)})
+    (5, {5: 1/2, 3: 1/2})
+    """
     idx = {p: i for i, p in enumerate(labels(fam, n))}
 
     def at(q, comb):  # raw positions of quadrant q -> {index: weight}
@@ -182,7 +192,7 @@ def sector_rows(fam, n):
     {0: 3/4, 1: 1/8, 5: 1/8}
     """
     pts = labels(fam, n)
-    idx, at = _index(fam, n)
+    idx, at = point_index(fam, n)
     rows = []
     sharp = sharp_rays(fam, n)
     half, eighth = fmpq(1, 2), fmpq(1, 8)
@@ -260,20 +270,24 @@ def exact_spectrum(fam, n):
     >>> sorted((str(p), a, g) for p, a, g in exact_spectrum("crease", 1))[:3]
     [('16*x + (-1)', 2, 2), ('2*x + (-1)', 1, 1), ('4*x + (-1)', 2, 1)]
     """
+    _, fac = sector_matrix(fam, n).charpoly().factor()
+    return [(p, e, 1 if e == 1 else kernel_dim(fam, n, p) // p.degree()) for p, e in fac]
+
+
+def kernel_dim(fam, n, p):
+    """dim ker p(S) (exact; p(S) by Horner) for a polynomial p over Q.
+
+    Examples
+    --------
+    >>> kernel_dim("crease", 1, fmpq_poly([-1, 4])), kernel_dim("crease", 1, fmpq_poly([-1, 4]) ** 2)
+    (1, 2)
+    """
     S = sector_matrix(fam, n)
     m = S.nrows()
-    _, fac = S.charpoly().factor()
-    eye = fmpq_mat([[1 if i == j else 0 for j in range(m)] for i in range(m)])
-    out = []
-    for p, e in fac:
-        if e == 1:
-            out.append((p, 1, 1))
-            continue
-        P = fmpq_mat(m, m)  # p(S) by Horner
-        for c in reversed(p.coeffs()):
-            P = P * S + eye * c
-        out.append((p, e, (m - P.rank()) // p.degree()))
-    return out
+    eye, P = fmpq_mat([[int(i == j) for j in range(m)] for i in range(m)]), fmpq_mat(m, m)
+    for c in reversed(p.coeffs()):
+        P = P * S + eye * c
+    return m - P.rank()
 
 
 def crease_points(fam, n):

@@ -67,11 +67,10 @@ from .tagged import (
     sector_rows,
     sharp_rays,
 )
-from .tagged_map import check_map
-from .tagged_modes import MIN_N, bordered_solve, even_vector, mode_spectrum, mode_vector
-from .tagged_refute import chain_generic, chain_top, flip_generic, mode_generic, ordering, same_root
+from .tagged_map import all_zero, check_map
+from .tagged_modes import MIN_N, bordered_solve, kernel_basis, mode_spectrum, normalized_vector
+from .tagged_refute import chain_generic, chain_top, flip_generic, mode_generic, mode_lead_why, ordering, same_root
 
-STATEMENTS = ("C1", "not C1")
 LIMIT_MASK = (fmpq(1, 6), fmpq(4, 6), fmpq(1, 6))  # a cubic B-spline's limit weights on three control points
 TANGENT_MASK = (fmpq(-1, 2), fmpq(0), fmpq(1, 2))  # and its tangent's
 
@@ -107,9 +106,7 @@ def verify_tagged(cert, part, log):
     >>> verify_tagged(cert, Recorder(res, lambda line: None), lambda line: None), bool(res)
     ('crease:5', True)
     """
-    statement = field_of(cert, "statement", str, "certificate")
-    if statement not in STATEMENTS:
-        raise CertificateError(f"statement must be one of {STATEMENTS}, got {statement[:20]!r}")
+    statement = field_of(cert, "statement", str, "certificate")  # "C1" or "not C1": the registry's route took it
     keys = ("schema", "configuration", "statement", "prec") + (("witness",) if statement == "not C1" else
                                                                 ("map", "parts"))
     exact_keys(cert, keys, "certificate")
@@ -123,20 +120,25 @@ def verify_tagged(cert, part, log):
     ok = all(sum(row.values(), fmpq(0)) == 1 for row in rows)
     part("S sector matrix derived from the rules", ok, f"{len(rows)} points, rows sum to 1 (exact)")
     with ctx.workprec(prec):
-        if statement == "C1" and fam == "dart" and n >= MIN_N:  # the odd half through the modes (tagged_modes)
-            _verify_dart_c1(cert, n, prec, part)
-        elif statement == "C1":
+        if statement == "C1":
             _verify_c1(cert, fam, n, prec, part)
-        elif fam == "dart":
-            _verify_flip(field_of(cert, "witness", dict, "certificate"), n, prec, part, log)
         else:
             _verify_witness(field_of(cert, "witness", dict, "certificate"), fam, n, prec, part, log)
     return name
 
 
 def _verify_c1(cert, fam, n, prec, part):
-    """A "C1" certificate on the exact spectrum: the spectral part, the crease seen, x and y, the map."""
-    ok, msg, lead = leading_spectrum(fam, n, prec)
+    """A "C1" certificate: the spectral part, the crease seen, x and y, the map. A dart with K >= MIN_N takes
+    :func:`.tagged_modes.mode_spectrum` (every eigenvalue enclosed, S_E's exactly, the odd half's through the
+    modes; lam1 and lam2 each isolated, so simple; x and y in closed form (odd) or from S_E (even)); every
+    other configuration its exact spectrum (:func:`.tagged.leading_spectrum`, :func:`eigenvector_of`)."""
+    modes = fam == "dart" and n >= MIN_N
+    if modes:
+        ev = mode_spectrum("dart", n)
+        i1, i2, why, msg = _dart_leading(n, ev)
+        ok, lead = why is None, (None, i1, i2)
+    else:
+        ok, msg, lead = leading_spectrum(fam, n, prec)
     part("spectral part of the generalized Reif criterion", ok, msg)
     if ok and fam != "dart":
         cpoly = crease_block(fam, n).charpoly()
@@ -149,8 +151,11 @@ def _verify_c1(cert, fam, n, prec, part):
     mp, orient = _map_field(cert)
     vecs, vals = {}, {}
     for c, t in (("x", lead[1]), ("y", lead[2])):
-        val, vec, msg = eigenvector_of(fam, n, field_of(mp, c, dict, "map"), c, prec)
-        ok = vec is not None and same_root(t, val)
+        if modes:
+            val, (_, vec, msg) = ev[t][0].real, _mode_coordinate(fam, n, ev, field_of(mp, c, dict, "map"), c, t)
+        else:
+            val, vec, msg = eigenvector_of(fam, n, field_of(mp, c, dict, "map"), c, prec)
+        ok = vec is not None and (modes or same_root(t, val))
         part(f"{c}: eigenvector of lam{'1' if c == 'x' else '2'}", ok,
              msg if vec is None or ok else "not the eigenvalue of lam1 / lam2")
         if not ok:
@@ -185,142 +190,78 @@ def _isolated(ev, lo_hi, c):
 
 
 def _dart_leading(k, ev):
-    """(i1, i2, why): a dart's lam1 and lam2 in the mode list, why None when the spectral part holds."""
-    one = [i for i, t in enumerate(ev) if not abs(t[0]) < 1]
-    rest = sorted((i for i in range(len(ev)) if i not in one), key=lambda i: -abs(ev[i][0]).mid())
+    """(i1, i2, why, message): a dart's lam1 and lam2 in the mode list, why None when the spectral part holds."""
+    rest = sorted((i for i, t in enumerate(ev) if abs(t[0]) < 1), key=lambda i: -abs(ev[i][0]).mid())
     i1, i2 = rest[0], rest[1]
     l1, l2 = ev[i1][0], ev[i2][0]
-    why = ("eigenvalue 1 is not simple" if len(one) != 1 or ev[one[0]][1] != 1 else
-           "lam1 or lam2 is not certainly real and positive" if not all(
-               z.imag.is_zero() and z.real > 0 for z in (l1, l2)) else
-           "lam1 > lam2 is not certain" if not l1.real > l2.real else
-           "|lam3| is not certainly below lam2" if not all(abs(ev[i][0]) < l2.real for i in rest[2:]) else None)
+    why = mode_lead_why(ev, i1, i2) or (
+        "lam1 or lam2 is not certainly real and positive" if not all(z.imag.is_zero() and z.real > 0 for z in (l1, l2))
+        else "lam1 > lam2 is not certain" if not l1.real > l2.real else None)
     msg = (f"dart:{k}: 1 simple; lam1 = {l1.real.str(5, radius=False)} ({_where(ev[i1])}) > lam2 = "
            f"{l2.real.str(5, radius=False)} ({_where(ev[i2])}), each simple"
            f" > |lam3| = {abs(ev[rest[2]][0]).str(5, radius=False)}" if why is None else f"dart:{k}: {why}")
     return i1, i2, why, msg
 
 
-def _dart_vector(k, ev, i, spec, c):
-    """(vector or None, message): the eigenvector of the mode-list entry i, normalized at the pivot."""
-    exact_keys(spec, ("eigenvalue", "crease", "pivot"), c)
-    lo_hi, pivot = field_of(spec, "eigenvalue", list, c), field_of(spec, "pivot", int, c)
-    if field_of(spec, "crease", list, c) or not 0 <= pivot < len(ev):
-        raise CertificateError(f"{c}: a dart's coordinate is an interval, crease [] and a pivot 0..{len(ev) - 1}")
-    lam, which = ev[i][0].real, f"lam{'1' if c == 'x' else '2'}"
-    if _isolated(ev, lo_hi, c) != i:
-        return None, f"[{lo_hi[0]}, {lo_hi[1]}] does not isolate {which}: not the eigenvalue of lam1 / lam2"
-    vec, how = None, "even: the bordered system on S_E proved regular"
-    if ev[i][3] is not None:  # odd: closed form, normalized at the pivot
-        f = mode_vector("dart", k, ev[i][3], lam)
-        if f is not None and abs(f[pivot]) > 0:
-            vec = [v if isinstance(v, fmpq) else (v / f[pivot]).real for v in f]
-        how = f"closed form in mode {ev[i][3]} (odd)"
-    else:
-        try:
-            vec = even_vector(k, lam, pivot)
-        except ZeroDivisionError:
-            pass
-    if vec is None:
-        return None, (f"the eigenvector is not certainly non-zero at the pivot {pivot} (or its system not "
-                      "certainly regular)")
-    return vec, f"eigenvalue {lam.str(10)}, simple; {how}, pivot {labels('dart', k)[pivot]}"
-
-
-def _verify_dart_c1(cert, k, prec, part):
-    """A dart's "C1" certificate, K >= MIN_N: the spectral part from :func:`.tagged_modes.mode_spectrum`
-    (every eigenvalue enclosed, S_E's exactly, the odd half's through the modes), lam1 and lam2 each
-    isolated (so simple), x and y in closed form (odd) or from S_E (even), then the map's parts."""
-    ev = mode_spectrum("dart", k)
-    i1, i2, why, msg = _dart_leading(k, ev)
-    part("spectral part of the generalized Reif criterion", why is None, msg)
-    if why is not None:
-        return
-    mp, orient = _map_field(cert)
-    vecs = {}
-    for c, i in (("x", i1), ("y", i2)):
-        vecs[c], msg = _dart_vector(k, ev, i, field_of(mp, c, dict, "map"), c)
-        part(f"{c}: eigenvector of lam{'1' if c == 'x' else '2'}", vecs[c] is not None, msg)
-        if vecs[c] is None:
-            return
-    check_map("dart", k, vecs["x"], vecs["y"], ev[i1][0].real, ev[i2][0].real, orient,
-              field_of(cert, "parts", dict, "certificate"), prec, part)
-
-
-def _verify_flip(w, k, prec, part, log):
-    """A dart's "not C1" witness (x, y, quadrant; :mod:`.tagged_refute`): x, y eigenvectors of simple
-    eigenvalues of opposite signs leading the spectrum, and J_xy != 0: the normal flips at every level."""
-    exact_keys(w, ("x", "y", "quadrant"), "witness")
-    q = field_of(w, "quadrant", int, "witness")
-    if not 0 <= q < k:
-        raise CertificateError(f"witness: quadrant {q} outside 0..{k - 1}")
-    if k >= MIN_N:
+def _verify_witness(w, fam, n, prec, part, log):
+    """A "not C1" witness: a crease's or corner's x, y, z, G, then B and N (module docstring); a dart's flip
+    (x, y, quadrant; :mod:`.tagged_refute`): x, y eigenvectors of simple eigenvalues of opposite signs leading
+    the spectrum, and J_xy != 0 (part F): the normal flips at every level."""
+    dart = fam == "dart"
+    exact_keys(w, ("x", "y", "quadrant") if dart else ("x", "y", "z", "ray", "quadrant"), "witness")
+    r, q = 0 if dart else field_of(w, "ray", int, "witness"), field_of(w, "quadrant", int, "witness")
+    if r not in sharp_rays(fam, n) or not 0 <= q < n:
+        raise CertificateError(f"witness: quadrant {q} outside 0..{n - 1}" if r == 0 or r == n else
+                               f"witness: ray {r} is not sharp")
+    if dart and n >= MIN_N:
         part("x: eigenvector of S", False, f"a dart's witness is checked on the exact spectrum, K < {MIN_N} only")
         return
-    vecs, vals = {}, {}
-    for c in ("x", "y"):
-        vals[c], vecs[c], msg = eigenvector_of("dart", k, field_of(w, c, dict, "witness"), c, prec)
-        part(f"{c}: eigenvector of S", vecs[c] is not None, msg)
-        if vecs[c] is None:
-            return
-    ok, msg = flip_generic(k, vals["x"], vals["y"], prec)
-    part("G generic: alpha, beta simple, of opposite signs, each larger in modulus than every other eigenvalue "
-         "but 1 (simple)", ok, msg)
-    if not ok:
-        return
-    J = _jacobian("dart", k, q, vecs["x"], vecs["y"])
-    ok = J > 0 or J < 0
-    part(f"F flip at vertex (1,1) of quadrant {q}: J_xy != 0, so the normal there is (alpha beta)^m J_xy e_z + "
-         "o(|alpha beta|^m)", ok, f"J_xy = {J.str(6)}")
-    if ok:
-        log(f"  the limit surface of this net is not C1 at the dart vertex: the unit normals at the level-m copies "
-            f"of quadrant {q}'s (1,1) tend to (-1)^m sign(J_xy) e_z (no limit; the projection folds)")
-
-
-def _verify_witness(w, fam, n, prec, part, log):
-    """A crease or corner "not C1" witness: x, y, z, G, then B and N (module docstring)."""
-    exact_keys(w, ("x", "y", "z", "ray", "quadrant"), "witness")
-    r, q = field_of(w, "ray", int, "witness"), field_of(w, "quadrant", int, "witness")
-    if r not in sharp_rays(fam, n) or not 0 <= q < n:
-        raise CertificateError(f"witness: ray {r} is not sharp or quadrant {q} outside 0..{n - 1}")
-    if n >= MIN_N:  # the spectrum and the eigenvectors through the sine modes (tagged_modes), O(N)
-        got = _witness_modes(fam, n, w, part)
-    else:
-        got = _witness_exact(fam, n, w, prec, part)
+    got = _witness_modes(fam, n, w, part) if n >= MIN_N else _witness_exact(fam, n, w, prec, part)
     if got is None:
         return
     vecs, second, label = got
-    check_boundary(fam, n, r, vecs, part)
+    if not dart:
+        check_boundary(fam, n, r, vecs, part)
     J = _jacobian(fam, n, q, vecs["x"], second)
     ok = J > 0 or J < 0
-    part(f"N normal at vertex (1,1) of quadrant {q}: {label} != 0", ok, f"{label} = {J.str(6)}")
+    part(f"F flip at vertex (1,1) of quadrant {q}: J_xy != 0, so the normal there is (alpha beta)^m J_xy e_z + "
+         "o(|alpha beta|^m)" if dart else f"N normal at vertex (1,1) of quadrant {q}: {label} != 0", ok,
+         f"{label} = {J.str(6)}")
     if not part.failed:
-        log(f"  the limit surface of this net is not C1 at the {fam} vertex: normals along the level-m "
+        log(f"  the limit surface of this net is not C1 at the dart vertex: the unit normals at the level-m copies "
+            f"of quadrant {q}'s (1,1) tend to (-1)^m sign(J_xy) e_z (no limit; the projection folds)" if dart else
+            f"  the limit surface of this net is not C1 at the {fam} vertex: normals along the level-m "
             f"copies of quadrant {q}'s (1,1) tend to n_z != 0, yet e_z lies in T_v (ray {r})")
 
 
-_G = ("G generic: alpha = lam1, beta = lam2, gamma = the crease block's largest eigenvalue below 1; "
+G_GENERIC = ("G generic: alpha = lam1, beta = lam2, gamma = the crease block's largest eigenvalue below 1; "
       "no Jordan block at |lam| >= beta; gamma < beta for a generalized z")
 
 
 def _witness_exact(fam, n, w, prec, part):
-    """Parts x, y, z and G on the exact spectrum (N < MIN_N); (vectors, the vector paired with x in
-    part N, its name) or None. A generalized y (a Jordan chain at beta) pairs x with its top
+    """Parts x, y, z (a dart: x, y) and G on the exact spectrum (N < MIN_N); (vectors, the vector paired with x
+    in part N or F, its name) or None. A generalized y (a Jordan chain at beta) pairs x with its top
     e = (S - beta) y (:func:`.tagged_refute.chain_generic`)."""
     vecs, vals, tops = {}, {}, {}
-    for c in ("x", "y", "z"):
-        vals[c], vecs[c], msg = eigenvector_of(fam, n, field_of(w, c, dict, "witness"), c, prec, c != "x")
+    for c in ("x", "y") if fam == "dart" else ("x", "y", "z"):
+        vals[c], vecs[c], msg = eigenvector_of(fam, n, field_of(w, c, dict, "witness"), c, prec,
+                                               c != "x" and fam != "dart")
         tops[c] = None if vecs[c] is None else chain_top(fam, n, vals[c], vecs[c])
         part(f"{c}: {'(generalized) ' if c == 'z' or tops[c] else ''}eigenvector of S", vecs[c] is not None, msg)
         if vecs[c] is None:
             return None
+    if fam == "dart":
+        ok, msg = flip_generic(n, vals["x"], vals["y"], prec)
+        part("G generic: alpha, beta simple, of opposite signs, each larger in modulus than every other eigenvalue "
+             "but 1 (simple)", ok, msg)
+        return (vecs, vecs["y"], "J_xy") if ok else None
     if tops["y"] is not None:
         ok, msg = chain_generic(fam, n, vals, tops, prec)
         part("G generic (Jordan chain): alpha = lam1 simple > beta = gamma, the crease block's largest eigenvalue "
              "below 1; Jordan blocks at beta of size <= 2, y's chain tops at e; every other |lam| < beta", ok, msg)
         return (vecs, tops["y"], "J_xe") if ok else None
     ok, msg = ordering(fam, n, vals["x"], vals["y"], vals["z"], prec, tops["z"] is not None)
-    part(_G, ok, msg)
+    part(G_GENERIC, ok, msg)
     return (vecs, vecs["y"], "J_xy") if ok else None
 
 
@@ -330,7 +271,8 @@ def _witness_modes(fam, n, w, part):
     ev = mode_spectrum(fam, n)
     vecs, at = {}, {}
     for c in ("x", "y"):
-        at[c], vecs[c] = _mode_coordinate(fam, n, ev, field_of(w, c, dict, "witness"), c, part)
+        at[c], vecs[c], msg = _mode_coordinate(fam, n, ev, field_of(w, c, dict, "witness"), c)
+        part(f"{c}: eigenvector of S", vecs[c] is not None, msg)
         if vecs[c] is None:
             return None
     gz = _mode_z(fam, n, ev, field_of(w, "z", dict, "witness"), part)
@@ -339,9 +281,9 @@ def _witness_modes(fam, n, w, part):
     g, cval = gz
     ia, ib = at["x"], at["y"]
     beta = ev[ib][0].real
-    why = mode_generic(ev, ia, ib, g)
-    part(_G, why is None, f"alpha = {ev[ia][0].real.str(8)} > beta = {beta.str(8)} > |every other| (each simple), "
-         f"1 simple; gamma = {g} < beta" if why is None else why)
+    why = mode_generic(ev, ia, ib, g, crease_block(fam, n))
+    part(G_GENERIC, why is None, f"alpha = {ev[ia][0].real.str(8)} > beta = {beta.str(8)} > |every other| (each "
+         f"simple), 1 simple; gamma = {g} < beta" if why is None else why)
     if why is not None:
         return None
     cp = crease_points(fam, n)
@@ -349,44 +291,58 @@ def _witness_modes(fam, n, w, part):
     return vecs, vecs["y"], "J_xy"
 
 
-def _mode_coordinate(fam, n, ev, spec, c, part):
-    """(index in the mode list, closed-form eigenvector) of x or y, or (None, None) with a failed part."""
+def _mode_coordinate(fam, n, ev, spec, c, want=None):
+    """(index in ``ev`` = :func:`.tagged_modes.mode_spectrum`, eigenvector with 1 at the pivot, message) of x or y,
+    or (None, None, the reason): [low, high] isolates one real root of a mode (or a dart's even part; the
+    entry ``want``, a dart's lam1 or lam2, when given), whose eigenvector vanishes on the crease points."""
     exact_keys(spec, ("eigenvalue", "crease", "pivot"), c)
     crease, lo_hi = field_of(spec, "crease", list, c), field_of(spec, "eigenvalue", list, c)
-    if len(crease) != 5 or len(lo_hi) != 2:
-        raise CertificateError(f"{c}: crease values must be 5 decimals and the eigenvalue [low, high]")
+    cp = [] if fam == "dart" else crease_points(fam, n)
+    if len(crease) != len(cp) or len(lo_hi) != 2:
+        raise CertificateError(f"{c}: crease values must be {len(cp)} decimals (a dart's crease []) and the "
+                               "eigenvalue [low, high]")
     i = _isolated(ev, lo_hi, c)
-    why = ("an irrational eigenvalue's eigenvector vanishes on the crease points"
-           if any(parse_decimal(v) != 0 for v in crease) else
-           f"[{lo_hi[0]}, {lo_hi[1]}] does not isolate one simple real root of a mode" if i is None
-           or ev[i][3] is None or not ev[i][0].imag.is_zero() else None)
+    if any(parse_decimal(v) != 0 for v in crease):
+        return None, None, "an irrational eigenvalue's eigenvector vanishes on the crease points"
+    if i is None or want not in (None, i) or not ev[i][0].imag.is_zero() or ev[i][3] is None and fam != "dart":
+        what = ("one simple real root of a mode" if want is None else
+                f"lam{'1' if c == 'x' else '2'}: not the eigenvalue of lam1 / lam2")
+        return None, None, f"[{lo_hi[0]}, {lo_hi[1]}] does not isolate {what}"
     pivot = field_of(spec, "pivot", int, c)
-    if why is None and (not 0 <= pivot < len(ev) or pivot in crease_points(fam, n)):
+    if not 0 <= pivot < len(ev) or pivot in cp:
         raise CertificateError(f"{c}: pivot must index a non-crease point")
-    f = None if why is not None else mode_vector(fam, n, ev[i][3], ev[i][0].real)
-    why = why or ("no pivot makes the bordered 6 x 6 system certainly regular" if f is None else
-                  f"the eigenvector is not certainly non-zero at the pivot {pivot}" if not abs(f[pivot]) > 0 else None)
-    if why is not None:
-        part(f"{c}: eigenvector of S", False, why)
-        return None, None
-    part(f"{c}: eigenvector of S", True, f"eigenvalue {ev[i][0].real.str(10)} = lam(cos({ev[i][3]} pi/{n})), "
-         f"simple; closed form in mode {ev[i][3]} (the bordered 6 x 6 system proved regular), pivot "
-         f"{labels(fam, n)[pivot]}")
-    return i, [v if isinstance(v, fmpq) else (v / f[pivot]).real for v in f]
+    vec, j = normalized_vector(fam, n, ev, i, pivot), ev[i][3]
+    if vec is None:
+        return None, None, (f"the eigenvector is not certainly non-zero at the pivot {pivot} (or its system not "
+                            "certainly regular)")
+    how = (", simple; even: the bordered system on S_E" if j is None else
+           f" = lam(cos({2 * j if fam == 'dart' else j} pi/{n})), simple; closed form in mode {j}: its 6x6 system")
+    return i, vec, f"eigenvalue {ev[i][0].real.str(10)}{how} proved regular, pivot {labels(fam, n)[pivot]}"
 
 
-def _mode_z(fam, n, ev, spec, part):
-    """(gamma, crease values) once C c = gamma c exactly and gamma is at most a simple eigenvalue of I."""
+
+def read_z(spec):
+    """(gamma, crease values) of a witness's z: ``{"eigenvalue": decimal, "crease": 5 decimals}``, read exactly."""
     exact_keys(spec, ("eigenvalue", "crease"), "z")
     g, cval = field_of(spec, "eigenvalue", str, "z"), field_of(spec, "crease", list, "z")
     if len(cval) != 5:
         raise CertificateError("z: crease values must be 5 decimals")
-    g, cval = parse_decimal(g), [parse_decimal(v) for v in cval]
-    Cc = crease_block(fam, n) * fmpq_mat([[v] for v in cval])
+    return parse_decimal(g), [parse_decimal(v) for v in cval]
+
+
+def crease_eigen_why(C, g, cval):
+    """None when C c = g c exactly with c != 0 (c the crease values), else the reason."""
+    Cc = C * fmpq_mat([[v] for v in cval])
+    ok = any(v != 0 for v in cval) and all(Cc[i, 0] == g * v for i, v in enumerate(cval))
+    return None if ok else f"no eigenvector for {g} with the given crease values (C c = {g} c, c != 0 fails)"
+
+
+def _mode_z(fam, n, ev, spec, part):
+    """(gamma, crease values) once C c = gamma c exactly and gamma is at most a simple eigenvalue of I."""
+    g, cval = read_z(spec)
     at_g = [t for t in ev if t[2] == "I" and (t[1] == g if t[1] is not None else t[0].real.overlaps(arb(g)))]
-    why = (f"no eigenvector for {g} with the given crease values (C c = {g} c, c != 0 fails)"
-           if all(v == 0 for v in cval) or any(Cc[i, 0] != g * cval[i] for i in range(5)) else
-           f"{g} is possibly a multiple eigenvalue of I" if len(at_g) > 1 else None)
+    why = crease_eigen_why(crease_block(fam, n), g, cval) or (
+        f"{g} is possibly a multiple eigenvalue of I" if len(at_g) > 1 else None)
     part("z: (generalized) eigenvector of S", why is None,
          f"eigenvalue {g}: C c = {g} c exactly on the crease points, and {g} is at most a simple eigenvalue of I, so "
          f"some z with these crease values has (S - {g})^2 z = 0 and (S - {g}) z = 0 on the crease points"
@@ -464,22 +420,16 @@ def _solve_exact(A, cp, cval):
     """A vector v with A v = 0 exactly and v = cval on the points cp (free unknowns 0), or None."""
     m = A.nrows()
     free = [i for i in range(m) if i not in cp]
-    rows = [[A[i, j] for j in free] + [-sum((A[i, j] * cval[k] for k, j in enumerate(cp)), fmpq(0))]
-            for i in range(m)]
-    R, rank = fmpq_mat(rows).rref()
-    nf = len(free)
+    sol = kernel_basis(fmpq_mat([[A[i, j] for j in free] + [sum((A[i, j] * cval[k] for k, j in enumerate(cp)), fmpq(0))]
+                                 for i in range(m)])).get(len(free))  # consistent iff the last column is free
+    if sol is None:
+        return None
     vec = [fmpq(0)] * m
     for k, j in enumerate(cp):
         vec[j] = cval[k]
-    for r in range(rank):
-        lead = next(c for c in range(nf + 1) if R[r, c] != 0)
-        if lead == nf:
-            return None  # inconsistent
-        vec[free[lead]] = R[r, nf] / R[r, lead]  # free variables (non-pivot columns) stay 0
-    if all(v == 0 for v in vec):
-        return None
-    Av = A * fmpq_mat([[v] for v in vec])
-    return vec if all(Av[i, 0] == 0 for i in range(m)) else None
+    for k, j in enumerate(free):
+        vec[j] = sol[k]
+    return vec if any(v != 0 for v in vec) else None
 
 
 def check_boundary(fam, n, r, vecs, part):
@@ -488,7 +438,7 @@ def check_boundary(fam, n, r, vecs, part):
     pts = labels(fam, n)
     rays = sharp_rays(fam, n) if fam == "crease" else (r,)
     on_curve = [0] + [pts.index(("r", s, a, 0)) for s in rays for a in (1, 2)]
-    zero_xy = all(_exact_zero(vecs[c][i]) for c in ("x", "y") for i in on_curve)
+    zero_xy = all_zero(vecs[c][i] for c in ("x", "y") for i in on_curve)
     z = vecs["z"]
     r1, r2 = pts.index(("r", r, 1, 0)), pts.index(("r", r, 2, 0))
     exact = all(isinstance(z[i], fmpq) for i in on_curve)
@@ -499,10 +449,6 @@ def check_boundary(fam, n, r, vecs, part):
     part(f"B boundary segment: ray {r}'s limit curve lies on the z-axis and leaves v", ok,
          f"x = y = 0 on its crease points, limit z at v = 0, limit z of ray {r}'s first point = {leave}" if ok
          else "x or y not exactly 0 on the curve, or z's limit curve does not start at v = 0 and leave it")
-
-
-def _exact_zero(v):
-    return isinstance(v, fmpq) and v == 0 or isinstance(v, arb) and v.is_zero()
 
 
 def _jacobian(fam, n, q, x, y):
@@ -517,16 +463,23 @@ def _jacobian(fam, n, q, x, y):
             return pts.index(("r", (q + 1) % n if fam == "dart" else q + 1, b, 0))
         return pts.index(("q", q, a, b))
 
-    def tangent(v, da, db):
-        acc = arb(0)
-        for a in range(3):
-            for b in range(3):
-                acc += arb(da[a] * db[b]) * v[index(a, b)]
-        return acc
-
-    xa, xb = tangent(x, TANGENT_MASK, LIMIT_MASK), tangent(x, LIMIT_MASK, TANGENT_MASK)
-    ya, yb = tangent(y, TANGENT_MASK, LIMIT_MASK), tangent(y, LIMIT_MASK, TANGENT_MASK)
+    (xa, xb), (ya, yb) = (vertex_tangents({(a, b): v[index(a, b)] for a in range(3) for b in range(3)}) for v in (x, y))
     return xa * yb - xb * ya
 
 
-__all__ = ["LIMIT_MASK", "TAGGED_SCHEMA", "TANGENT_MASK", "check_boundary", "verify_tagged"]
+def vertex_tangents(val):
+    """(T_a, T_b), the limit tangents at a regular vertex from the values ``val[a, b]`` (a, b = 0, 1, 2) of its
+    1-ring: the B-spline masks sum w'(a) w(b) val and sum w(a) w'(b) val (an arb, or an acb from acb values).
+
+    Examples
+    --------
+    >>> ta, tb = vertex_tangents({(a, b): fmpq(a + 2 * b) for a in range(3) for b in range(3)})
+    >>> ta.contains(1), tb.contains(2)
+    (True, True)
+    """
+    return tuple(sum((da[a] * db[b] * val[a, b] for a in range(3) for b in range(3)), arb(0))
+                 for da, db in ((TANGENT_MASK, LIMIT_MASK), (LIMIT_MASK, TANGENT_MASK)))
+
+
+__all__ = ["G_GENERIC", "LIMIT_MASK", "TAGGED_SCHEMA", "TANGENT_MASK", "check_boundary", "crease_eigen_why", "read_z",
+           "verify_tagged", "vertex_tangents"]

@@ -55,11 +55,11 @@ from flint import acb, arb, ctx, fmpq, fmpq_mat
 from .errors import CertificateError
 from .record import exact_keys, field_of
 from .replay import parse_decimal
-from .spectrum import SMALL_ROOTS
+from .spectrum import RING_INDEX, SMALL_ROOTS, ring_block
 from .statement import lam_of
 from .tagged import crease_block, crease_points, labels, sector_rows
-from .tagged_c1 import LIMIT_MASK, TANGENT_MASK, check_boundary
-from .tagged_modes import RING_INDEX, bordered_solve, charpoly_roots, check_ring, check_structure, ring_block
+from .tagged_c1 import G_GENERIC, check_boundary, crease_eigen_why, read_z, vertex_tangents
+from .tagged_modes import bordered_solve, charpoly_roots, check_ring, check_structure, mode_reflection
 
 WINDOW = (7, 8)  # the window classes of every N >= 7 occur in both
 MIN_TAIL = WINDOW[0]
@@ -123,17 +123,6 @@ def check_windows(fam):
     return (C,) + tuple(blocks[0])
 
 
-def _reflection(w):
-    rows = [[0 * w] * 6 for _ in range(6)]
-    for p, i in RING_INDEX.items():
-        rows[i][i if p[1] == 0 else RING_INDEX[(p[1], p[0])]] += 1 if p[1] == 0 else 1 / w
-    return rows
-
-
-def _mul(A, B):
-    return [[sum((A[i][k] * B[k][j] for k in range(6)), 0 * A[0][0]) for j in range(6)] for i in range(6)]
-
-
 @cache
 def reflection_identity():
     """Is B(1/w) R_w = R_w B(w) an identity of Laurent polynomials in w (exact)?
@@ -147,10 +136,11 @@ def reflection_identity():
     True
     """
     check_ring()
-    for w in (fmpq(a, b) for a in (1, 2, 3, -1, -2, -3) for b in (1, 5) if (a, b) != (1, 1)):
-        if _mul(ring_block(1 / w), _reflection(w)) != _mul(_reflection(w), ring_block(w)):
+    for w in (fmpq(a, b) for a in (1, 2, 3, -1, -2, -3) for b in (1, 5)):
+        B, Bi, R = (fmpq_mat(m) for m in (ring_block(w), ring_block(1 / w), mode_reflection(w)))
+        if Bi * R != R * B:
             return False
-    return _mul(ring_block(fmpq(1)), _reflection(fmpq(1))) == _mul(_reflection(fmpq(1)), ring_block(fmpq(1)))
+    return True
 
 
 def _tangents(theta, j):
@@ -168,9 +158,7 @@ def _tangents(theta, j):
     for a in range(3):
         for b in range(3):  # the centre and ray 0: 0; ray 1: v^(b,0)(w - 1/w); quadrant 0: v^(a,b) - v^(b,a)/w
             val[a, b] = (acb(0) if b == 0 else vh[(b, 0)] * (w - 1 / w) if a == 0 else vh[(a, b)] - vh[(b, a)] / w)
-    ta = sum((TANGENT_MASK[a] * LIMIT_MASK[b] * val[a, b] for a in range(3) for b in range(3)), acb(0))
-    tb = sum((LIMIT_MASK[a] * TANGENT_MASK[b] * val[a, b] for a in range(3) for b in range(3)), acb(0))
-    return ta, tb
+    return vertex_tangents(val)
 
 
 def limit_h(theta):
@@ -317,7 +305,8 @@ def verify_tail(cert, fam, n0, part, log):
     Parameters
     ----------
     cert : dict
-        ``schema``, ``configuration``, ``statement`` ("not C1"), ``prec``, ``witness`` ({"z": coord}) and
+        ``schema``, ``configuration``, ``statement`` ("not C1": the only statement the registry routes here),
+        ``prec``, ``witness`` ({"z": coord}) and
         ``limit`` ({"rho", "R", "box": decimals, "arcs", "outer_arcs": ints}).
 
     Returns
@@ -342,20 +331,13 @@ def verify_tail(cert, fam, n0, part, log):
     """
     if not MIN_TAIL <= n0 <= 10**6:
         raise CertificateError(f"{fam}:>={n0}: the window argument needs N0 >= {MIN_TAIL}")
-    if field_of(cert, "statement", str, "certificate") != "not C1":
-        raise CertificateError("an interval of configurations is certified \"not C1\" only")
     exact_keys(cert, ("schema", "configuration", "statement", "prec", "witness", "limit"), "certificate")
     prec = field_of(cert, "prec", int, "certificate")
     if not 64 <= prec <= 1024:
         raise CertificateError("prec must lie in 64..1024")
     w = field_of(cert, "witness", dict, "certificate")
     exact_keys(w, ("z",), "witness")
-    z = field_of(w, "z", dict, "witness")
-    exact_keys(z, ("eigenvalue", "crease"), "z")
-    g, cval = parse_decimal(field_of(z, "eigenvalue", str, "z")), field_of(z, "crease", list, "z")
-    if len(cval) != 5:
-        raise CertificateError("z: crease values must be 5 decimals")
-    cval = [parse_decimal(v) for v in cval]
+    g, cval = read_z(field_of(w, "z", dict, "witness"))
     lim = field_of(cert, "limit", dict, "certificate")
     exact_keys(lim, _LIMIT_KEYS, "limit")
     rho, R, side = (parse_decimal(field_of(lim, k, str, "limit")) for k in ("rho", "R", "box"))
@@ -382,15 +364,13 @@ def _check_tail(fam, n0, g, cval, rho, R, side, arcs, outer, part, log):
     ok = rho > arb.pi() / n0
     part(f"range: pi/N < rho for every N >= {n0}", ok, f"rho = {rho} > pi/{n0}" if ok else
          f"rho = {rho} is not certainly above pi/{n0} = {(arb.pi() / n0).str(6)}")
-    Cc = C * fmpq_mat([[v] for v in cval])
-    ok = any(v != 0 for v in cval) and all(Cc[i, 0] == g * cval[i] for i in range(5))
-    part("z: (generalized) eigenvector of S", ok, f"C c = {g} c exactly on the crease points (the same C for "
-         "every N)" if ok else f"no eigenvector for {g} with the given crease values (C c = {g} c, c != 0 fails)")
+    why = crease_eigen_why(C, g, cval)
+    part("z: (generalized) eigenvector of S", why is None,
+         why or f"C c = {g} c exactly on the crease points (the same C for every N)")
     if part.failed:
         return
     ok, msg = uniform_spectrum(fam, n0, g, C, blocks)
-    part("G generic: alpha = lam1, beta = lam2, gamma = the crease block's largest eigenvalue below 1; "
-         "no Jordan block at |lam| >= beta; gamma < beta for a generalized z", ok, msg)
+    part(G_GENERIC, ok, msg)
     if not ok:
         return
     cp = crease_points(fam, WINDOW[0])

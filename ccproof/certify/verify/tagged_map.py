@@ -32,7 +32,7 @@ from .record import exact_keys
 from .replay import check_boxes, check_partition, parse_path
 from .rules import level1_rule
 from .statement import B2Z, bspline_to_bezier
-from .tagged import labels, position_key, sector_rows, sharp_rays
+from .tagged import point_index, position_key, sector_rows, sharp_rays
 
 PIECES = ("P1", "P2", "P3")
 _OFFSET = {"P1": (0, -1), "P2": (0, 0), "P3": (-1, 0)}  # level-1 position of B-spline net[0][0]
@@ -47,6 +47,7 @@ def level1_values(fam, n, v):
     The regular boundary with the linear vector x = a (on quadrant 0, a along ray 0): level 1 halves it,
     and the ghost row across ray 0 continues it linearly:
 
+    >>> from ccproof.certify.verify.tagged import labels
     >>> pts = labels("crease", 2)
     >>> v = [fmpq(p[2]) if p[0] == "r" and p[1] == 0 else fmpq(-p[2]) if p[0] == "r" and p[1] == 2 else
     ...      fmpq(p[2]) if p[0] == "q" and p[1] == 0 else fmpq(-p[3]) if p[0] == "q" else fmpq(0) for p in pts]
@@ -54,8 +55,7 @@ def level1_values(fam, n, v):
     >>> [val(0, a, b) for a, b in ((3, 0), (2, 2), (1, -1))]
     [3/2, 1, 1/2]
     """
-    pts = labels(fam, n)
-    idx = {p: i for i, p in enumerate(pts)}
+    idx, at = point_index(fam, n)
     sharp = sharp_rays(fam, n)
     rows, memo = sector_rows(fam, n), {}
 
@@ -80,10 +80,7 @@ def level1_values(fam, n, v):
         _, s, A2, B2 = key
         if B2 == 0 and s in sharp:  # (3, 0) on a sharp ray: the midpoint of level-0 (1,0), (2,0)
             return (v[idx[("r", s, 1, 0)]] + v[idx[("r", s, 2, 0)]]) / 2
-        acc = 0 * v[0]
-        for (a, b), w in level1_rule(A2, B2).items():
-            acc += v[idx[position_key(fam, n, s, a, b)]] * w
-        return acc
+        return sum((v[j] * w for j, w in at(s, level1_rule(A2, B2)).items()), 0 * v[0])
     return value
 
 
@@ -93,6 +90,7 @@ def quadrant_nets(fam, n, vx, vy, q, prec):
     Examples
     --------
     >>> from flint import fmpq
+    >>> from ccproof.certify.verify.tagged import labels
     >>> pts = labels("corner", 1)
     >>> vx = [fmpq(p[2]) if p[0] == "r" and p[1] == 0 or p[0] == "q" else fmpq(0) for p in pts]
     >>> vy = [fmpq(p[2]) if p[0] == "r" and p[1] == 1 else fmpq(p[3]) if p[0] == "q" else fmpq(0) for p in pts]
@@ -110,11 +108,6 @@ def quadrant_nets(fam, n, vx, vy, q, prec):
     return out
 
 
-def _curve(nets, curve):  # oriented counterclockwise (from ray q towards ray q + 1)
-    pts = curve_points(nets, curve)
-    return pts if STAR_CURVES[curve][2] > 0 else pts[::-1]
-
-
 def transversal_form(nets, curve, a1, a2, prec):
     """Bernstein form (degree 5) of a1 X Y' - a2 Y X' along one outer cubic, oriented counterclockwise.
 
@@ -123,6 +116,7 @@ def transversal_form(nets, curve, a1, a2, prec):
     For the identity map and a1 = a2 = 1 this is the star form x y' - y x' (1/2 on u = 1 of P1 here):
 
     >>> from flint import fmpq
+    >>> from ccproof.certify.verify.tagged import labels
     >>> pts = labels("corner", 1)
     >>> vx = [fmpq(p[2]) if p[0] == "r" and p[1] == 0 or p[0] == "q" else fmpq(0) for p in pts]
     >>> vy = [fmpq(p[2]) if p[0] == "r" and p[1] == 1 else fmpq(p[3]) if p[0] == "q" else fmpq(0) for p in pts]
@@ -130,7 +124,7 @@ def transversal_form(nets, curve, a1, a2, prec):
     >>> f.coeffs[0].str(5, radius=False)
     '0.50000'
     """
-    pts = _curve(nets, curve)
+    pts = curve_points(nets, curve, oriented=True)
     with ctx.workprec(prec):
         X = BernsteinForm((4,), [p[0] for p in pts], prec=prec)
         Y = BernsteinForm((4,), [p[1] for p in pts], prec=prec)
@@ -151,14 +145,11 @@ def crossings(nets, curve, paths, direction, prec):
     int or str
         The count, or the reason why a box decides nothing.
     """
-    pts = _curve(nets, curve)
-    a, b = direction
     if not check_partition(paths, 1):
         return f"{curve}: the boxes do not partition [0, 1]"
     count = 0
     with ctx.workprec(prec):
-        A = BernsteinForm((4,), [p[0] * a + p[1] * b for p in pts], prec=prec)
-        P = BernsteinForm((4,), [p[1] * a - p[0] * b for p in pts], prec=prec)
+        A, P = axis_forms(nets, curve, direction, prec)
         for path in paths:
             fa, fp = A, P
             for ax, side in parse_path(path, 1):
@@ -168,6 +159,27 @@ def crossings(nets, curve, paths, direction, prec):
                 return f"{curve}: box {path!r}{got}"
             count += got
     return count
+
+
+def axis_forms(nets, curve, direction, prec):
+    """The Bernstein forms (degree 3) of a X + b Y (along H) and -b X + a Y (across H) on one outer cubic,
+    oriented counterclockwise, for ``direction`` (a, b) of the half-line H (:func:`crossings`).
+
+    Examples
+    --------
+    >>> from flint import fmpq
+    >>> from ccproof.certify.verify.tagged import labels
+    >>> pts = labels("corner", 1)
+    >>> vx = [fmpq(p[2]) if p[0] == "r" and p[1] == 0 or p[0] == "q" else fmpq(0) for p in pts]
+    >>> vy = [fmpq(p[2]) if p[0] == "r" and p[1] == 1 else fmpq(p[3]) if p[0] == "q" else fmpq(0) for p in pts]
+    >>> A, P = axis_forms(quadrant_nets("corner", 1, vx, vy, 0, 64), "P1s1", (0, 1), 64)
+    >>> A.coeffs[3].str(3, radius=False), P.coeffs[0].str(3, radius=False)   # Y at the end, -X at the start
+    ('0.500', '-1.00')
+    """
+    a, b = direction
+    pts = curve_points(nets, curve, oriented=True)
+    return (BernsteinForm((4,), [p[0] * a + p[1] * b for p in pts], prec=prec),
+            BernsteinForm((4,), [p[1] * a - p[0] * b for p in pts], prec=prec))
 
 
 def _sign(values):
@@ -197,6 +209,7 @@ def rays_on_axes(fam, n, vx, vy):
     Examples
     --------
     >>> from flint import fmpq
+    >>> from ccproof.certify.verify.tagged import labels
     >>> pts = labels("corner", 1)
     >>> vx = [fmpq(p[2]) if p[0] == "r" and p[1] == 0 or p[0] == "q" else fmpq(0) for p in pts]
     >>> vy = [fmpq(p[2]) if p[0] == "r" and p[1] == 1 else fmpq(p[3]) if p[0] == "q" else fmpq(0) for p in pts]
@@ -207,15 +220,16 @@ def rays_on_axes(fam, n, vx, vy):
     x0, y0 = [X(0, a, 0) for a in range(4)], [Y(0, a, 0) for a in range(4)]
     xn, yn = [X(n - 1, 0, b) for b in range(4)], [Y(n - 1, 0, b) for b in range(4)]
     if fam == "crease":
-        ok = _zero(x0 + xn) and _sign(_bez(y0)) < 0 and _sign(_bez(yn)) > 0
+        ok = all_zero(x0 + xn) and _sign(_bez(y0)) < 0 and _sign(_bez(yn)) > 0
         return ok, "X = 0 on both sharp rays, Y < 0 on ray 0 and Y > 0 on ray N" if ok else \
             "the sharp rays are not mapped onto the negative and positive Y half-axes"
-    ok = _zero(y0) and _sign(_bez(x0)) > 0 and _zero(xn) and _sign(_bez(yn)) > 0
+    ok = all_zero(y0) and _sign(_bez(x0)) > 0 and all_zero(xn) and _sign(_bez(yn)) > 0
     return ok, "ray 0 onto the positive X half-axis, ray N onto the positive Y half-axis" if ok else \
         "the sharp rays are not mapped onto the positive half-axes"
 
 
-def _zero(vals):  # exactly 0 (an arb only when it is the exact 0)
+def all_zero(vals):
+    """Is every value exactly 0 (an fmpq 0, or an arb that is the exact 0)?"""
     return all(isinstance(z, fmpq) and z == 0 or isinstance(z, arb) and z.is_zero() for z in vals)
 
 

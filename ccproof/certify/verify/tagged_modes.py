@@ -22,9 +22,10 @@ characteristic polynomial of the 6N + 3 points (docs/tagged_c1.md, "Spectrum in 
    of R^_w + 1 (R^_w the 6 x 6 matrix of v -> v o R on the mode), checked exactly to be invariant under
    B(w) and to have, with the 6 (N - 1) others, the dimension 6N - 2 of I.
 4. **Block polynomials.** det(x - B(w)) = (x - 1/8)(x - 1/16)(x - 1/32)(x - 1/64)(x^2 - (5 + c) x/8 + 1/16),
-   c = (w + 1/w)/2, checked here exactly for this stencil on a grid of rational points (as
-   :func:`.spectrum.mode_polynomials_hold`). So mode j has 1/8..1/64, lam(c_j) and 1/(16 lam(c_j)),
-   c_j = cos(pi j/N), lam(c) = (5 + c + sqrt((1 + c)(9 + c)))/16 (:func:`.statement.lam_of`).
+   c = (w + 1/w)/2: B(w) is the Fourier block :func:`.spectrum.ring_block` of the smooth rules, whose
+   polynomials :func:`.spectrum.mode_polynomials_hold` checks exactly on a grid of rational points. So
+   mode j has 1/8..1/64, lam(c_j) and 1/(16 lam(c_j)), c_j = cos(pi j/N),
+   lam(c) = (5 + c + sqrt((1 + c)(9 + c)))/16 (:func:`.statement.lam_of`).
 
 **Darts** (:func:`check_dart`, K >= MIN_N): S commutes with the reflection R in the sharp ray 0 (checked
 row by row), so the even and the odd vectors are invariant; every row but the centre's and ray 0's is
@@ -48,56 +49,17 @@ from functools import cache
 from flint import acb, acb_mat, arb, arb_mat, fmpq, fmpq_mat
 
 from .errors import CertificateError
-from .rules import CENTRE, TWO_RING, canonical, level1_rule
-from .spectrum import SMALL_ROOTS, mode_polynomials_hold
+from .rules import TWO_RING
+from .spectrum import RING_INDEX, SMALL_ROOTS, mode_polynomials_hold, ring_block, ring_stencil
 from .statement import lam_of
 from .tagged import crease_block, crease_points, labels, sector_rows
 
 MIN_N = 5  # crease:N, corner:N with N >= MIN_N take this path (a "not C1" witness)
-RING_INDEX = {p: i for i, p in enumerate(TWO_RING)}  # ring position -> its index in a mode vector v^ (and B(w))
-
-
-@cache
-def ring_stencil():
-    """The smooth rule of each ring point (sector 0) on the ring points, the centre dropped.
-
-    Returns
-    -------
-    tuple of dict[(int, (int, int)), fmpq]
-        For each position of :data:`.rules.TWO_RING`: ``{(delta, position): weight}``.
-
-    Examples
-    --------
-    The edge point of a ray (level-1 (1, 0)): 3/8 on its end (1, 0), 1/16 on the far corners of the two
-    faces beside it; the centre's 3/8 is dropped:
-
-    >>> row = ring_stencil()[0]
-    >>> row[(0, (1, 0))], row[(-1, (1, 0))], row[(-1, (1, 1))], sum(row.values())
-    (3/8, 1/16, 1/16, 5/8)
-    """
-    out = []
-    for pos in TWO_RING:
-        row = {}
-        for raw, w in level1_rule(*pos).items():
-            d, a, b = canonical(*raw)
-            if (a, b) != CENTRE:
-                row[(d, (a, b))] = row.get((d, (a, b)), 0) + w
-        out.append({k: w for k, w in row.items() if w != 0})
-    return tuple(out)
 
 
 def _reflect(t, pos):
     a, b = pos
     return (-t, pos) if b == 0 else (-t - 1, (b, a))
-
-
-def ring_block(w):
-    """B(w): (B v^)(p) = sum of the stencil weights times w^delta (w a number, fmpq or acb)."""
-    rows = [[0 * w] * 6 for _ in range(6)]
-    for i, row in enumerate(ring_stencil()):
-        for (d, pos), x in row.items():
-            rows[i][RING_INDEX[pos]] += x * w ** d
-    return rows
 
 
 @cache
@@ -132,29 +94,49 @@ def _fold(t, pos, n):
     return (1, ("q", t) + pos) if t < n else (-1, ("q", 2 * n - 1 - t, pos[1], pos[0]))
 
 
-def _kernel(M):
-    """A basis (columns) of the kernel of an fmpq_mat."""
+def kernel_basis(M):
+    """The kernel of an fmpq_mat M from its reduced row echelon form: {f: the kernel vector with 1 at the free
+    column f and 0 at the other free columns}. With M = [A | b], the vector of the last column f (if free) is
+    the solution of A v = -b with every free unknown 0 (its other entries).
+
+    Examples
+    --------
+    >>> kernel_basis(fmpq_mat([[1, 2, 3], [2, 4, 6]]))
+    {1: [-2, 1, 0], 2: [-3, 0, 1]}
+    """
     R, rank = M.rref()
     m = M.ncols()
     leads = [next(c for c in range(m) if R[r, c] != 0) for r in range(rank)]
-    cols = []
+    out = {}
     for f in (c for c in range(m) if c not in leads):
-        v = [fmpq(0)] * m
-        v[f] = fmpq(1)
+        out[f] = [fmpq(int(c == f)) for c in range(m)]
         for r, c in enumerate(leads):
-            v[c] = -R[r, f] / R[r, c]
-        cols.append(v)
-    return fmpq_mat([[v[i] for v in cols] for i in range(m)]) if cols else None
+            out[f][c] = -R[r, f] / R[r, c]
+    return out
+
+
+def mode_reflection(w):
+    """R_w, the reflection R on the mode w: (v o R)(t, p) = w^-t (R_w v^)(p), rays p -> v^(p), quadrants
+    (a, b) -> v^(b, a)/w (rows of numbers like w).
+
+    Examples
+    --------
+    >>> mode_reflection(fmpq(2))[RING_INDEX[(2, 1)]]
+    [0, 0, 0, 0, 1/2, 0]
+    """
+    rows = [[0 * w] * 6 for _ in range(6)]
+    for p, i in RING_INDEX.items():
+        rows[i][RING_INDEX[p if p[1] == 0 else (p[1], p[0])]] += 1 if p[1] == 0 else 1 / w
+    return rows
 
 
 def _odd_block(w):
     """B(w) on the odd vectors of the mode w = +-1: (its matrix M, the dimension), checked invariant."""
-    Rh = fmpq_mat(6, 6)
-    for p in TWO_RING:  # (v o R)(t, p) = w^t (R^ v^)(p): rays p, quadrants w^-1 v^(b, a)
-        Rh[RING_INDEX[p], RING_INDEX[p if p[1] == 0 else (p[1], p[0])]] = 1 if p[1] == 0 else w
-    K = _kernel(Rh + fmpq_mat([[int(i == j) for j in range(6)] for i in range(6)]))
-    if K is None:
+    cols = list(kernel_basis(fmpq_mat(mode_reflection(fmpq(w))) + fmpq_mat([[int(i == j) for j in range(6)]
+                                                                          for i in range(6)])).values())
+    if not cols:
         return None, 0
+    K = fmpq_mat([[v[i] for v in cols] for i in range(6)])
     B = fmpq_mat(ring_block(fmpq(w)))
     Kt = K.transpose()
     M = (Kt * K).inv() * Kt * B * K
@@ -324,6 +306,31 @@ def mode_vector(fam, n, j, lam):
     return out
 
 
+def normalized_vector(fam, n, ev, i, pivot):
+    """The real eigenvector, 1 at ``pivot``, of the entry i of ``ev`` = :func:`mode_spectrum` (fam, n): in closed
+    form for a root of mode j (:func:`mode_vector`), from S_E for a dart's even entry (:func:`even_vector`);
+    None unless arb proves the system regular and the value at the pivot non-zero.
+
+    Examples
+    --------
+    >>> ev = mode_spectrum("crease", 5)
+    >>> i = max((i for i, t in enumerate(ev) if t[3] == 1), key=lambda i: ev[i][0].real.mid())
+    >>> v = normalized_vector("crease", 5, ev, i, 21)
+    >>> v[21].contains(1), v[0]
+    (True, 0)
+    """
+    lam, j = ev[i][0].real, ev[i][3]
+    if j is None:
+        try:
+            return even_vector(n, lam, pivot) if fam == "dart" else None
+        except ZeroDivisionError:
+            return None
+    f = mode_vector(fam, n, j, lam)
+    if f is None or not abs(f[pivot]) > 0:
+        return None
+    return [v if isinstance(v, fmpq) else (v / f[pivot]).real for v in f]
+
+
 def _dart_reflect(p, k):
     if p == ("C",):
         return p
@@ -401,7 +408,7 @@ def _check_dart_rows(k, pts, rows):
 
 def even_vector(k, lam, pivot):
     """The eigenvector (arb, 1 at ``pivot``) of dart:k for a simple eigenvalue lam of S_E: the bordered
-    system (as :func:`.tagged_c1.bordered_solve`) on the one-ring rows of S_E when the pivot lies there,
+    system (:func:`bordered_solve`) on the one-ring rows of S_E when the pivot lies there,
     then the rest from (lam - S_out) y_out = X y_in (S_E is block triangular), spread over each R-orbit.
     Raises ZeroDivisionError unless arb proves the systems regular.
 
@@ -416,11 +423,8 @@ def even_vector(k, lam, pivot):
     SE, rep, _, _, (inner, outer), _ = check_dart(k)
     if rep[pivot] not in inner:  # the whole of S_E
         inner, outer = tuple(range(SE.nrows())), ()
-    m, pv = len(inner), inner.index(rep[pivot])
-    rows = [[arb(SE[a, b]) - (lam if a == b else 0) for b in inner] + [arb(int(i == pv))] for i, a in enumerate(inner)]
-    rows.append([arb(int(c == pv)) for c in range(m)] + [arb(0)])
-    sol = arb_mat(rows).solve(arb_mat([[0]] * m + [[1]]))
-    y = {a: sol[i, 0] for i, a in enumerate(inner)}
+    sol = bordered_solve([[arb(SE[a, b]) for b in inner] for a in inner], lam, inner.index(rep[pivot]), arb_mat)
+    y = {a: sol[i] for i, a in enumerate(inner)}
     if outer:  # (lam - S_out) y_out = X y_in: regular since rho(S_out) <= bound < lam (the caller checks lam)
         A = arb_mat([[(lam if a == b else 0) - arb(SE[a, b]) for b in outer] for a in outer])
         rhs = arb_mat([[sum((arb(SE[a, b]) * y[b] for b in inner if SE[a, b] != 0), arb(0))] for a in outer])
@@ -430,4 +434,5 @@ def even_vector(k, lam, pivot):
 
 
 __all__ = ["MIN_N", "RING_INDEX", "charpoly_roots", "check_dart", "check_ring", "check_structure", "even_vector",
-           "mode_spectrum", "mode_vector", "ring_block", "ring_stencil"]
+           "kernel_basis", "mode_reflection", "mode_spectrum", "mode_vector", "normalized_vector", "ring_block",
+           "ring_stencil"]

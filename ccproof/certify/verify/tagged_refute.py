@@ -28,7 +28,7 @@ from __future__ import annotations
 
 from flint import arb, fmpq, fmpq_mat, fmpq_poly
 
-from .tagged import crease_block, crease_points, eigenvalues, sector_matrix
+from .tagged import crease_block, crease_points, eigenvalues, kernel_dim, sector_matrix
 
 _ONE = fmpq_poly([-1, 1])
 
@@ -121,7 +121,7 @@ def chain_generic(fam, n, vals, tops, prec):
     ia = _find(ev, a)
     at_b = [i for i, t in enumerate(ev) if same_root(t, b)]
     why = _chain_order(ev, ia, at_b, b) or (
-        _blocks_at(fam, n, b, len(at_b)) or _below(ev, [ia, *at_b], b) or _crease_top(fam, n, g) or
+        _blocks_at(fam, n, b, len(at_b)) or _below(ev, [ia, *at_b], b) or crease_top_why(crease_block(fam, n), g) or
         ("gamma is not beta" if g != b else None))
     if why:
         return False, why
@@ -139,10 +139,7 @@ def _chain_order(ev, ia, at_b, b):
 
 def _blocks_at(fam, n, b, alg):
     """None if beta's Jordan blocks have size <= 2 (dim ker (S - beta)^2 = alg, exact), else the reason."""
-    S = sector_matrix(fam, n)
-    m = S.nrows()
-    M = S - b * fmpq_mat([[1 if i == j else 0 for j in range(m)] for i in range(m)])
-    return None if m - (M * M).rank() == alg else f"a Jordan block of size > 2 at beta = {b}"
+    return None if kernel_dim(fam, n, fmpq_poly([-b, 1]) ** 2) == alg else f"a Jordan block of size > 2 at beta = {b}"
 
 
 def _below(ev, skip, b):
@@ -150,9 +147,16 @@ def _below(ev, skip, b):
     return f"an eigenvalue ({bad[0][0].str(6)}) is not certainly below beta in modulus" if bad else None
 
 
-def _crease_top(fam, n, g):
-    """None if g is the crease block's largest eigenvalue below 1 (its factors all linear), else the reason."""
-    fac = [p for p, _ in crease_block(fam, n).charpoly().factor()[1]]
+def crease_top_why(C, g):
+    """None if g is the largest eigenvalue below 1 of the crease block C (its factors all linear), else the reason.
+
+    Examples
+    --------
+    >>> from ccproof.certify.verify.tagged import crease_block
+    >>> crease_top_why(crease_block("crease", 3), fmpq(1, 2)), crease_top_why(crease_block("crease", 3), fmpq(1, 4))
+    (None, "gamma is not the crease block's largest eigenvalue below 1 (1/2)")
+    """
+    fac = [p for p, _ in C.charpoly().factor()[1]]
     if any(p.degree() > 1 for p in fac):
         return "the crease block has irrational eigenvalues"
     below = [-p[0] / p[1] for p in fac if -p[0] / p[1] < 1]
@@ -161,23 +165,24 @@ def _crease_top(fam, n, g):
     return None
 
 
-def mode_generic(ev, ia, ib, g):
-    """The reason part G fails on the mode list, or None."""
+def mode_lead_why(ev, ia, ib):
+    """The reason 1 (from the crease block, or a dart's even part) is not simple or the entries ia, ib of the
+    mode list (:func:`.tagged_modes.mode_spectrum`) do not lead (alpha >= beta > |every other|), or None."""
     one = [t for t in ev if not abs(t[0]) < 1]
     beta = ev[ib][0].real
     others = [t for i, t in enumerate(ev) if i not in (ia, ib) and t[1] != 1]
     return ("x and y are the same eigenvector (beta is not an eigenvalue distinct from alpha)" if ia == ib else
-            "eigenvalue 1 is not simple" if len(one) != 1 or one[0][1] != 1 or one[0][2] != "C" else
+            "eigenvalue 1 is not simple" if len(one) != 1 or one[0][1] != 1 or one[0][2] not in ("C", "E") else
             "alpha >= beta is not certain" if not ev[ia][0].real >= beta else
             "an eigenvalue is not certainly below beta (lam1, lam2 not alpha, beta)"
-            if not all(abs(t[0]) < beta for t in others) else _mode_gamma(ev, g, beta))
+            if not all(abs(t[0]) < beta for t in others) else None)
 
 
-def _mode_gamma(ev, g, beta):
-    """The reason gamma is not the crease block's largest eigenvalue below 1, or not certainly below beta; or None."""
-    below = [t[1] for t in ev if t[2] == "C" and t[1] is not None and t[1] < 1]
-    return (f"gamma is not the crease block's largest eigenvalue below 1 ({max(below) if below else None})"
-            if not below or g != max(below) else "gamma < beta is not certain" if not arb(g) < beta else None)
+def mode_generic(ev, ia, ib, g, C):
+    """The reason part G fails on the mode list (C the crease block), or None."""
+    beta = ev[ib][0].real
+    return mode_lead_why(ev, ia, ib) or crease_top_why(C, g) or (
+        "gamma < beta is not certain" if not arb(g) < beta else None)
 
 
 def ordering(fam, n, a, b, g, prec, generalized):
@@ -190,7 +195,7 @@ def ordering(fam, n, a, b, g, prec, generalized):
     rest = [t for t in ev if t[1] != _ONE]
     ib, why = _alpha_beta(rest, a, b)
     beta = None if why else abs(rest[ib][0])
-    why = why or _crease_top(fam, n, g) or _jordan_at(rest, beta) or (
+    why = why or crease_top_why(crease_block(fam, n), g) or _jordan_at(rest, beta) or (
         "z is a generalized eigenvector but gamma < beta is not certain" if generalized and not arb(g) < beta else None)
     if why:
         return False, why
@@ -229,4 +234,5 @@ def _str(v):
     return str(v) if isinstance(v, fmpq) else v.str(8)
 
 
-__all__ = ["chain_generic", "chain_top", "flip_generic", "mode_generic", "ordering", "same_root"]
+__all__ = ["chain_generic", "chain_top", "crease_top_why", "flip_generic", "mode_generic", "mode_lead_why",
+           "ordering", "same_root"]
