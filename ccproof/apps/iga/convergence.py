@@ -5,7 +5,9 @@ Meshes (:func:`study_mesh`): ``torus`` (no extraordinary vertex), ``cube`` (vale
 prism: valence 6 and 3). Level L is the mesh subdivided L times (uniform refinement, h halves); the
 errors are measured with a finer rule than the one assembled with (adaptive, 6 x 6 points per cell,
 14 rings), so that they are the solution's. The rate between levels is ``log2(e_(L-1) / e_L)``
-(per sqrt(dofs)). docs/iga.md lists the measured tables.
+(per sqrt(dofs)); with ``graded``, the space of :mod:`ccproof.apps.iga.graded` refined toward the
+extraordinary vertices at each level, whose rates are per sqrt(dofs) (:func:`rates`). docs/iga.md lists
+the measured tables.
 
 >>> rows = list(convergence_study("torus", levels=2))
 >>> [r["dofs"] for r in rows], rows[-1]["L2"] < rows[0]["L2"]

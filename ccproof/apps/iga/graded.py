@@ -123,6 +123,19 @@ def _local_child(mesh, keep):
     return subdivide(QuadMesh(np.asarray(mesh.vertices)[used], vmap[F])), ids, vmap
 
 
+def _cut_out(mesh, vertices, rings, tries=4):
+    """:func:`_local_child` of the faces within ``rings`` rings of ``vertices``; where the regions around
+    two vertices touch at a single vertex (a non-manifold cut), one ring more (up to ``tries`` times)."""
+    from ccproof.errors import MeshError
+
+    for k in range(tries - 1):
+        try:
+            return _local_child(mesh, _face_rings(mesh, vertices, rings + k))
+        except MeshError:
+            continue
+    return _local_child(mesh, _face_rings(mesh, vertices, rings + tries - 1))
+
+
 def _ev_levels(mesh, extra):
     """Interior vertices of valence != 4 and their extra levels (``extra``: int, or dict valence -> int)."""
     val = np.asarray(mesh.valence)
@@ -189,7 +202,7 @@ class HierarchicalSpace:
         for j in range(1, int(s.max(initial=0)) + 1):
             ev, s, R = ev[s >= j], s[s >= j], R[s >= j]
             margin = (int(R[:, j - 1].max()) + 5) // 2  # level-(j-1) rings cut out: 2 margin >= rings + 4
-            child, ids, vmap = _local_child(self.meshes[-1], _face_rings(self.meshes[-1], ev, margin))
+            child, ids, vmap = _cut_out(self.meshes[-1], ev, margin)
             ev = vmap[ev]
             parent = ids[np.arange(child.n_faces) // 4]
             near = np.zeros(child.n_faces, dtype=bool)
