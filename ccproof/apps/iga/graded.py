@@ -6,15 +6,18 @@ subdominant eigenvalue, :func:`ccproof.reparam.quadrant.subdominant_lambda`) whi
 ``2^-L``. The L2 and H1 errors there are ``lam^(3L)`` and ``lam^(2L)``, slower than the regular
 ``2^(-4L)``, ``2^(-3L)`` at every valence but 4 (rates 3 log2(1/lam), 2 log2(1/lam): 3.86 / 2.57 at
 valence 3, 2.59 / 1.72 at 5, 2.36 / 1.57 at 6). Refining ``s`` more levels around the EV shrinks its ring
-to ``lam^(L+s)``; the regular rates are kept when ``(L + s) log2(1/lam)`` is at least ``4L / 3`` (L2) and
-``3L / 2`` (H1): :func:`graded_levels`.
+to ``lam^(L+s)``; its own errors fall at the regular rates when ``(L + s) log2(1/lam)`` is at least
+``4L / 3`` (L2) and ``3L / 2`` (H1): :func:`graded_levels`. The regular faces a fixed number of rings
+around it keep the EV's rates too, so the refined region must also be wide on the first extra levels
+(a fixed fraction of a level-0 face, narrowing level by level): :func:`graded_rings`.
 
 Levels ``j = 0 .. max s`` are the mesh subdivided ``j`` more times, level ``j > 0`` only *locally*: the
 faces within a few rings of the EVs graded that deep are cut out of level ``j - 1`` and subdivided
 (QuadMesh child ``4 k + i`` covers the quarter of kept face k at corner i,
 :mod:`ccproof.mesh.subdivision`), with a margin so that every face used is exactly a face of the uniform
 level-j mesh (same patch, same control points). The domain ``Omega_j`` of level j is the set of its faces
-within ``rings`` face rings of those EVs (children of ``Omega_(j-1)``). The space is Kraft's hierarchical
+within ``rings`` face rings of those EVs (a number per EV and level, :func:`graded_rings`; children of
+``Omega_(j-1)``). The space is Kraft's hierarchical
 basis: the level-j limit functions whose support lies in ``Omega_j`` but not in the faces whose children
 all lie in ``Omega_(j+1)``. Every function is an exact limit function of its level's control vertex (rows
 of :meth:`LimitSurface.basis <ccproof.evaluate.surface.LimitSurface.basis>` of that level's surface, the
