@@ -387,8 +387,8 @@ def test_edge_only_space_has_zero_second_derivative_across_the_boundary():
 def test_open_rates_edge_only_and_ghost(bc):
     """Flat grid, sin(pi x) cos(pi y), levels 1-3 fitted (scikit-fem style). The EDGE_ONLY space: L2 2.5,
     H1 1.5 (the end condition above); one ring of free ghost vertices: L2 4, H1 3 (the square exactly)."""
-    edge = list(convergence_study("grid", levels=3, start=1, bc=bc))
-    ghost = list(convergence_study("grid", levels=3, start=1, bc=bc, ghost=True))
+    edge = list(convergence_study("grid", levels=3, start=1, options={"bc": bc}))
+    ghost = list(convergence_study("grid", levels=3, start=1, options={"bc": bc, "ghost": True}))
     assert 2.3 <= fit_rate(edge, "L2") <= 2.8 and 1.3 <= fit_rate(edge, "H1") <= 1.8
     assert fit_rate(ghost, "L2") >= 3.9 and fit_rate(ghost, "H1") >= 2.9
 
@@ -477,7 +477,7 @@ def test_ghost_ring_keeps_the_surface_and_frees_the_space():
 def test_open_ghost_rates_with_valence_3_slow(bc):
     """`python scripts/iga_convergence.py --mesh ogrid --ghost --levels 6 [--bc neumann]`: four interior EVs
     of valence 3, levels 3-5 fitted (measured 4.23 / 3.08 both)."""
-    rows = list(convergence_study("ogrid", levels=3, start=3, bc=bc, ghost=True))
+    rows = list(convergence_study("ogrid", levels=3, start=3, options={"bc": bc, "ghost": True}))
     assert fit_rate(rows, "L2") >= 3.9 and fit_rate(rows, "H1") >= 2.9
 
 
@@ -527,9 +527,9 @@ def test_plate_rates(support):
     """``python scripts/iga_convergence.py --mesh grid --problem plate --support S``: levels 1-3 (h = 1/8 ..
     1/32) fitted L2 >= 3.9, H1 >= 2.9, Hessian >= 1.9 (measured clamped 4.13 / 3.11 / 2.05, simply supported
     4.05 / 3.03 / 2.01)."""
-    rows = list(convergence_study("grid", levels=3, start=1, problem="plate", support=support))
+    rows = list(convergence_study("grid", levels=3, start=1, problem="plate", options={"support": support}))
     assert fit_rate(rows, "L2") >= 3.9 and fit_rate(rows, "H1") >= 2.9 and fit_rate(rows, "H2") >= 1.9
     with pytest.raises(CCProofError, match="posed on the mesh 'grid'"):
         next(convergence_study("cube", problem="plate"))
     with pytest.raises(CCProofError, match="unknown plate support 'free'"):
-        next(convergence_study("grid", problem="plate", support="free"))
+        next(convergence_study("grid", problem="plate", options={"support": "free"}))

@@ -5,7 +5,9 @@ Meshes (:func:`study_mesh`): ``torus`` (no extraordinary vertex), ``cube`` (vale
 prism: valence 6 and 3). Level L is the mesh subdivided L times (uniform refinement, h halves); the
 errors are measured with a finer rule than the one assembled with (adaptive, 6 x 6 points per cell,
 14 rings), so that they are the solution's. The rate between levels is ``log2(e_(L-1) / e_L)``
-(per sqrt(dofs)). docs/iga.md lists the measured tables.
+(per sqrt(dofs)); with ``graded``, the space of :mod:`ccproof.apps.iga.graded` refined toward the
+extraordinary vertices at each level, whose rates are per sqrt(dofs) (:func:`rates`). docs/iga.md lists
+the measured tables.
 
 >>> rows = list(convergence_study("torus", levels=2))
 >>> [r["dofs"] for r in rows], rows[-1]["L2"] < rows[0]["L2"]
@@ -129,11 +131,10 @@ def study_mesh(name):
     raise CCProofError(f"unknown study mesh {name!r}; use one of {', '.join(STUDY_MESHES)}")
 
 
-def convergence_study(mesh, levels=4, kind="adaptive", parameterization="natural", order=4, depth=12,
-                      exact=None, start=0, graded=None, bc="dirichlet", ghost=False, problem="screened",
-                      support="clamped"):
-    """Yield per level ``{"level", "faces", "dofs", "L2", "H1"}`` (and ``"H2"`` for the biharmonic problem) of
-    the Galerkin solution.
+def convergence_study(mesh, levels=4, kind="adaptive", parameterization="natural", exact=None, start=0,
+                      graded=None, problem="screened", options=None):
+    """Yield per level ``{"level", "faces", "dofs", "L2", "H1"}`` (and ``"H2"`` for the biharmonic problem, the
+    errors per level of the refinement ``"leaves"`` for a graded space) of the Galerkin solution.
 
     Parameters
     ----------
@@ -141,26 +142,36 @@ def convergence_study(mesh, levels=4, kind="adaptive", parameterization="natural
         A :data:`STUDY_MESHES` or :data:`OPEN_MESHES` name, or a closed QuadMesh (level 0).
     levels : int
         Levels ``start .. start + levels - 1``.
-    kind, order, depth
+    kind : str
         The assembly's quadrature (:func:`ccproof.apps.iga.quadrature.surface_quadrature`).
     parameterization : {"natural", "characteristic"}
     exact : AmbientFunction, optional
         The manufactured solution (default ``AmbientFunction()``; on the open meshes
         ``sin(pi x) cos(pi y)``).
-    graded : (extra, rings), optional
-        Instead of the uniform space: the hierarchical space graded ``extra`` levels toward the EVs over
-        ``rings`` face rings (:mod:`ccproof.apps.iga.graded`; natural parameterization, adaptive rule).
-    bc : {"dirichlet", "neumann"}
-        On the open meshes (:func:`ccproof.apps.iga.boundary.solve_open_screened_poisson`).
-    ghost : bool
-        On the open meshes: the space with a ring of ghost vertices (:func:`open_study_mesh`).
+    start : int
+        The first level.
+    graded : (extra, rings) or (extra, rings, width), optional
+        Instead of the uniform space: the hierarchical space graded toward the EVs
+        (:mod:`ccproof.apps.iga.graded`; natural parameterization, adaptive rule), ``extra`` levels deep at
+        every level (an int), or at level L ``graded_levels(valence, L, margin)`` levels around each EV
+        (``extra = "auto"``, margin 1, or ``"auto:M"``), over ``rings`` face rings per level, or with a
+        ``width`` > 0 over ``graded_rings(valence, L, j, rings, width)`` rings at level ``L + j``: the
+        grading that keeps the regular rates.
     problem : {"screened", "biharmonic", "plate"}
         ``-Laplace_Gamma u + u = f``, or ``Laplace_Gamma^2 u + u = f`` on a closed mesh
         (:mod:`ccproof.apps.iga.biharmonic`; uniform space), or the plate on ``grid`` (the unit square,
         level L at mesh size ``1 / (4 2^L)``, :mod:`ccproof.apps.iga.plate`).
-    support : {"clamped", "simple"}
-        The plate's edges.
+    options : dict, optional
+        ``order`` (4) and ``depth`` (12) of the assembly's rule; on the open meshes ``bc``
+        (``"dirichlet"`` or ``"neumann"``, :func:`ccproof.apps.iga.boundary.solve_open_screened_poisson`)
+        and ``ghost`` (False: the space with a ring of ghost vertices, :func:`open_study_mesh`); for the
+        plate ``support`` (``"clamped"`` or ``"simple"``).
     """
+    opt = {"order": 4, "depth": 12, "bc": "dirichlet", "ghost": False, "support": "clamped", **(options or {})}
+    unknown = sorted(set(opt) - {"order", "depth", "bc", "ghost", "support"})
+    if unknown:
+        raise CCProofError(f"unknown convergence_study options {unknown}; use order, depth, bc, ghost, support")
+    order, depth = int(opt["order"]), int(opt["depth"])
     if problem not in PROBLEMS:
         raise CCProofError(f"unknown problem {problem!r}; use one of {', '.join(PROBLEMS)}")
     if problem == "plate":
@@ -169,16 +180,15 @@ def convergence_study(mesh, levels=4, kind="adaptive", parameterization="natural
         from ccproof.apps.iga.plate import solve_plate
 
         for L in range(start, start + levels):
-            r = solve_plate(4 * 2**L, support)
+            r = solve_plate(4 * 2**L, opt["support"])
             yield {"level": L, "faces": 16 * 4**L, **{k: r[k] for k in ("dofs", "L2", "H1", "H2")}}
         return
     if isinstance(mesh, str) and mesh in OPEN_MESHES:
         if problem != "screened" or graded is not None:
             raise CCProofError(f"the open mesh {mesh!r} takes the screened Poisson problem on a uniform space")
-        yield from _open_study(mesh, levels, kind, order, depth, exact, start, bc, ghost)
+        yield from _open_study(mesh, levels, (kind, order, depth), exact, start, opt["bc"], opt["ghost"])
         return
     from ccproof.mesh import subdivide
-    from ccproof.reparam import limit_surface
 
     M = study_mesh(mesh) if isinstance(mesh, str) else mesh
     if M.is_boundary_vertex.any():
@@ -191,27 +201,54 @@ def convergence_study(mesh, levels=4, kind="adaptive", parameterization="natural
         if graded is not None:
             from ccproof.apps.iga.graded import solve_graded
 
-            r = solve_graded(M, int(graded[0]), exact, rings=int(graded[1]))
-            yield {"level": L, "faces": M.n_faces, "dofs": r["dofs"], "L2": r["L2"], "H1": r["H1"]}
-            if L + 1 < start + levels:
-                M = subdivide(M)
-            continue
-        S = limit_surface(M)
-        rule = surface_quadrature(S, order, kind, depth)
-        fine = surface_quadrature(S, 6, "adaptive" if parameterization == "natural" else "split", 14)
-        if problem == "biharmonic":
-            from ccproof.apps.iga.biharmonic import solve_biharmonic
-
-            r = solve_biharmonic(S, rule, exact, parameterization, error_rule=fine)
+            extra, rings = _graded_space(M, graded, L)
+            r = solve_graded(M, extra, exact, rings=rings)
         else:
-            r = solve_screened_poisson(S, rule, exact, parameterization, error_rule=fine)
-        yield {"level": L, "faces": M.n_faces, **{k: r[k] for k in ("dofs", "L2", "H1", "H2") if k in r}}
+            r = _solve_uniform(M, (kind, order, depth), parameterization, exact, problem)
+        yield {"level": L, "faces": M.n_faces, **{k: r[k] for k in ("dofs", "L2", "H1", "H2", "leaves") if k in r}}
         if L + 1 < start + levels:
             M = subdivide(M)
 
 
-def _open_study(name, levels, kind, order, depth, exact, start, bc, ghost):
-    """:func:`convergence_study` on an open study mesh (natural parameterization)."""
+def _solve_uniform(mesh, rule, parameterization, exact, problem):
+    """One level of :func:`convergence_study` on a closed mesh, uniform space (``rule`` = kind, order, depth
+    of the assembly's quadrature; errors with the finer rule of the module docstring)."""
+    from ccproof.reparam import limit_surface
+
+    S = limit_surface(mesh)
+    kind, order, depth = rule
+    rule = surface_quadrature(S, order, kind, depth)
+    fine = surface_quadrature(S, 6, "adaptive" if parameterization == "natural" else "split", 14)
+    if problem == "biharmonic":
+        from ccproof.apps.iga.biharmonic import solve_biharmonic
+
+        return solve_biharmonic(S, rule, exact, parameterization, error_rule=fine)
+    return solve_screened_poisson(S, rule, exact, parameterization, error_rule=fine)
+
+
+def _graded_space(mesh, graded, level):
+    """``(extra, rings)`` of :class:`ccproof.apps.iga.graded.HierarchicalSpace` at ``level`` from ``graded``
+    of :func:`convergence_study`: an int as it is, ``"auto[:margin]"`` per valence of the mesh's EVs; the
+    rings as they are, or with a width (third entry > 0) per valence and level (``graded_rings``)."""
+    from ccproof.apps.iga.graded import graded_levels, graded_rings
+
+    extra, rings = graded[0], int(graded[1])
+    width = float(graded[2]) if len(graded) > 2 else 0.0
+    val = np.unique(np.asarray(mesh.valence)[~np.asarray(mesh.is_boundary_vertex)]).tolist()
+    if isinstance(extra, str):
+        name, _, margin = extra.partition(":")
+        if name != "auto":
+            raise CCProofError(f"graded extra levels must be an int or 'auto[:margin]', got {extra!r}")
+        extra = {n: graded_levels(n, level, int(margin or 1)) for n in val}
+    if width <= 0:
+        return extra, rings
+    depth = extra if isinstance(extra, dict) else dict.fromkeys(val, int(extra))
+    return extra, {n: [graded_rings(n, level, j, rings, width) for j in range(1, depth[n] + 1)] for n in val}
+
+
+def _open_study(name, levels, rule, exact, start, bc, ghost):
+    """:func:`convergence_study` on an open study mesh (natural parameterization; ``rule`` = kind, order,
+    depth of the assembly's quadrature)."""
     from ccproof.apps.iga.boundary import solve_open_screened_poisson
     from ccproof.evaluate import natural_limit_surface
     from ccproof.mesh import subdivide
@@ -221,7 +258,7 @@ def _open_study(name, levels, kind, order, depth, exact, start, bc, ghost):
     for L in range(start + levels):
         if L >= start:
             S = natural_limit_surface(M)
-            r = solve_open_screened_poisson(S, surface_quadrature(S, order, kind, depth), exact, bc,
+            r = solve_open_screened_poisson(S, surface_quadrature(S, rule[1], rule[0], rule[2]), exact, bc,
                                             error_rule=surface_quadrature(S, 6, "adaptive", 14),
                                             region=region if ghost else None)
             yield {"level": L, "faces": int(region.sum()), "dofs": r["dofs"], "L2": r["L2"], "H1": r["H1"]}
@@ -229,14 +266,18 @@ def _open_study(name, levels, kind, order, depth, exact, start, bc, ghost):
             M, region = subdivide(M), np.repeat(region, 4)
 
 
-def fit_rate(rows, key):
-    """Least-squares slope of ``-log2 e`` against the level (h halves per level), scikit-fem style.
+def fit_rate(rows, key, per="level"):
+    """Least-squares slope of ``-log2 e`` against the level (h halves per level), scikit-fem style, or
+    (``per="dofs"``) of ``-log e`` against ``log sqrt(dofs)``.
 
     >>> fit_rate([{"L2": 1.0}, {"L2": 1 / 16}, {"L2": 1 / 256}], "L2")
     4.0
+    >>> fit_rate([{"L2": 1.0, "dofs": 10}, {"L2": 1 / 16, "dofs": 40}], "L2", per="dofs")
+    4.0
     """
     e = np.log2([r[key] for r in rows])
-    return float(round(-np.polyfit(np.arange(e.size), e, 1)[0], 12))
+    x = np.arange(e.size) if per == "level" else 0.5 * np.log2([r["dofs"] for r in rows])
+    return float(round(-np.polyfit(x, e, 1)[0], 12))
 
 
 def rates(rows, key, per="level"):
