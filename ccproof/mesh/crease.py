@@ -14,14 +14,17 @@ import math
 
 import numpy as np
 
-__all__ = ["INFINITE", "SMOOTH", "DART", "CREASE", "CORNER", "decrement", "child_sharpness_at_vertex",
-           "vertex_rule"]
+__all__ = ["INFINITE", "SMOOTH", "DART", "CREASE", "CORNER", "RULES", "decrement", "child_sharpness_at_vertex",
+           "vertex_rule", "rule_code", "mask_kind", "rule_blend"]
 
 #: OpenSubdiv's Sdc::Crease::SHARPNESS_INFINITE: sharpness at or above it is infinite
 INFINITE = 10.0
 
 #: the vertex rules (Sdc ``Crease::Rule``)
 SMOOTH, DART, CREASE, CORNER = "smooth", "dart", "crease", "corner"
+
+#: the vertex rules by code (:func:`rule_code`): ``RULES[code]`` is its name
+RULES = (SMOOTH, DART, CREASE, CORNER)
 
 _F32 = np.float32
 _ONE = _F32(1.0)
@@ -78,8 +81,65 @@ def child_sharpness_at_vertex(edge_sharpness, chaikin):
     return out
 
 
+def rule_code(vertex_sharpness, n_sharp):
+    """Sdc ``DetermineVertexVertexRule`` as a code (the index into :data:`RULES`), on numbers or numpy arrays.
+
+    The rule table of the step, exact and float: a sharp vertex or three or more sharp edges: corner (3);
+    two: crease (2); one: dart (1); none: smooth (0).
+
+    Parameters
+    ----------
+    vertex_sharpness : float or ndarray
+    n_sharp : int or ndarray of int
+        The number of sharp edges at the vertex.
+
+    Returns
+    -------
+    ndarray of int64
+        The codes (0-d for numbers).
+
+    Examples
+    --------
+    >>> rule_code([0.0, 0.0, 0.0, 0.0, 2.0], [0, 1, 2, 5, 0]).tolist(), int(rule_code(0.0, 2))
+    ([0, 1, 2, 3, 3], 2)
+    """
+    return np.where(np.asarray(vertex_sharpness) > 0.0, 3, np.minimum(n_sharp, 3)).astype(np.int64)
+
+
+def mask_kind(code):
+    """The mask a rule code uses: a dart uses the smooth mask (0 smooth, 2 crease, 3 corner).
+
+    >>> mask_kind(np.arange(4)).tolist()
+    [0, 0, 2, 3]
+    """
+    return code - (code == 1)
+
+
+def rule_blend(parent, child, w, one):
+    """Sdc's vertex point as ``cp * parent mask + cc * child mask``: the coefficients ``(cp, cc)``.
+
+    Where the parent's mask is not smooth and the child's mask differs (:func:`mask_kind` of the rule codes
+    ``parent``, ``child``), ``cp = w`` and ``cc = 1 - w`` with Sdc's fractional weight ``w``; elsewhere
+    ``cp = 1``, ``cc = 0``. Generic over the number type of ``one`` and ``w``: exact rationals (one vertex of
+    :func:`ccproof.mesh.rules.refine_complex`) or numpy float arrays (every vertex of
+    :func:`ccproof.mesh.step.catmark_operator`; exact there too: ``w`` is a float32 in [0, 1]).
+
+    Examples
+    --------
+    >>> from fractions import Fraction
+    >>> rule_blend(3, 2, Fraction(1, 4), Fraction(1)), rule_blend(1, 0, Fraction(1, 4), Fraction(1))
+    ((Fraction(1, 4), Fraction(3, 4)), (Fraction(1, 1), Fraction(0, 1)))
+    >>> cp, cc = rule_blend(np.array([2, 2, 0]), np.array([0, 2, 0]), np.array([0.5, 0.5, 0.5]), 1.0)
+    >>> cp.tolist(), cc.tolist()
+    ([0.5, 1.0, 1.0], [0.5, 0.0, 0.0])
+    """
+    p, c = mask_kind(parent), mask_kind(child)
+    b = ((p != 0) & (c != p)) * 1  # 0 or 1 (an int, or an int array)
+    return one + b * (w - one), b * (one - w)
+
+
 def vertex_rule(vertex_sharpness, edge_sharpness):
-    """Sdc ``DetermineVertexVertexRule``: 'corner', 'crease', 'dart' or 'smooth'.
+    """Sdc ``DetermineVertexVertexRule``: 'corner', 'crease', 'dart' or 'smooth' (:func:`rule_code`, by name).
 
     Parameters
     ----------
@@ -100,7 +160,4 @@ def vertex_rule(vertex_sharpness, edge_sharpness):
     >>> vertex_rule(1.0, [0, 0, 0, 0])
     'corner'
     """
-    if vertex_sharpness > 0.0:
-        return CORNER
-    n = sum(1 for s in edge_sharpness if s > 0.0)
-    return (SMOOTH, DART, CREASE)[n] if n <= 2 else CORNER
+    return RULES[int(rule_code(vertex_sharpness, sum(1 for s in edge_sharpness if s > 0.0)))]

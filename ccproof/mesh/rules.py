@@ -55,6 +55,9 @@ from ccproof.mesh.crease import (
     SMOOTH,
     child_sharpness_at_vertex,
     decrement,
+    mask_kind,
+    rule_blend,
+    rule_code,
     vertex_rule,
 )
 from ccproof.mesh.scheme import CATMARK
@@ -212,10 +215,11 @@ def _add(out, c, s):
         out[v] = out.get(v, 0) + c * w
 
 
-def _vertex_mask(cx, v, fan, nb, fpts, rule, sh):
-    """Sdc vertex-point mask of ``v`` for one rule (smooth/dart, crease along the sharp edges, corner)."""
+def _vertex_mask(cx, v, fan, nb, fpts, kind, sh):
+    """Sdc vertex-point mask of ``v`` for one :func:`~ccproof.mesh.crease.mask_kind` (0 smooth or dart, 2 crease
+    along the sharp edges, 3 corner)."""
     one = exact_one()
-    if rule in (SMOOTH, DART):
+    if kind == 0:
         wv, we, wf = CATMARK.vertex_point(len(fan), one)
         m = {v: wv}
         for c in fan:
@@ -223,7 +227,7 @@ def _vertex_mask(cx, v, fan, nb, fpts, rule, sh):
             u = cx.dst(c)
             m[u] = m.get(u, 0) + we
         return m
-    if rule == CREASE:
+    if kind == 2:
         wv, we = CATMARK.crease_vertex(one)
         m = {v: wv}
         for u, s in zip(nb, sh):
@@ -318,17 +322,13 @@ def _vertex_stencils(cx, want_v, fpts, uniform):
         if opts.boundary == "edge_and_corner" and not closed and len(fan) == 1 and cx.level == 0:
             pv = math.inf
         cv = decrement(pv)
-        prule = vertex_rule(pv, pe)
-        crule = vertex_rule(cv, ce)
-
-        m = _vertex_mask(cx, v, fan, nb, fpts, prule, pe)
-        if prule not in (SMOOTH, DART) and crule != prule:
-            w = _fractional_weight(pv, cv, pe, ce, uniform)
-            mc = _vertex_mask(cx, v, fan, nb, fpts, crule, ce)
-            out = {}
-            _add(out, w, m)
-            _add(out, 1 - w, mc)
-            m = out
+        prule = int(rule_code(pv, sum(1 for s in pe if s > 0.0)))  # the rule table the float step reads too
+        crule = int(rule_code(cv, sum(1 for s in ce if s > 0.0)))
+        cp, cc = rule_blend(prule, crule, _fractional_weight(pv, cv, pe, ce, uniform), exact_one())
+        m = {}
+        _add(m, cp, _vertex_mask(cx, v, fan, nb, fpts, mask_kind(prule), pe))
+        if cc != 0:
+            _add(m, cc, _vertex_mask(cx, v, fan, nb, fpts, mask_kind(crule), ce))
         vpts[v] = {u: x for u, x in m.items() if x != 0}
     return vpts, csharp
 

@@ -51,7 +51,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ccproof.mesh.crease import INFINITE
+from ccproof.mesh.crease import INFINITE, mask_kind, rule_blend, rule_code
 from ccproof.mesh.rules import Options
 from ccproof.mesh.scheme import CATMARK
 from ccproof.mesh.step_topology import step_topology, vertex_fans
@@ -399,9 +399,10 @@ def _vertex_coefficients(t, fans, vs, pe, ce, chaikin, corners_at_level0):
     if corners_at_level0:  # EDGE_AND_CORNER: a one-face boundary vertex is a corner
         pv[fans.is_bv & (k == 1)] = np.inf
     cv = decrement_sharpness(pv)
-    prule = _rule(pv, np.bincount(inc_v[pe > 0], minlength=n))
-    crule = _rule(cv, np.bincount(inc_v[ce > 0], minlength=n))
-    blend = (prule != _SMOOTH) & (crule != prule)
+    prule = rule_code(pv, np.bincount(inc_v[pe > 0], minlength=n))  # the rule table refine_complex reads too
+    crule = rule_code(cv, np.bincount(inc_v[ce > 0], minlength=n))
+    p, c = mask_kind(prule), mask_kind(crule)
+    blend = (p != 0) & (c != p)
     hit = ((pe > 0) & (ce <= 0)) if chaikin else ((pe > 0) & (pe <= 1))
     hit &= blend[inc_v]
     vhit = blend & (pv > 0) & (cv <= 0)
@@ -413,24 +414,14 @@ def _vertex_coefficients(t, fans, vs, pe, ce, chaikin, corners_at_level0):
     has = cnt > 0
     w32 = (total[has] / cnt[has].astype(_F32)).astype(_F32)
     w[has] = np.minimum(w32.astype(np.float64), 1.0)
-    cp = np.where(blend, w, 1.0)  # weight of the parent's mask
-    cc = np.where(blend, 1.0 - w, 0.0)  # of the child's
-    a_smooth = np.where(prule == _SMOOTH, 1.0, 0.0) + np.where(blend & (crule == _SMOOTH), cc, 0.0)
-    a_crease_p = np.where(prule == _CREASE, cp, 0.0)
-    a_crease_c = np.where(blend & (crule == _CREASE), cc, 0.0)
-    a_corner = np.where(prule == _CORNER, cp, 0.0) + np.where(blend & (crule == _CORNER), cc, 0.0)
+    cp, cc = rule_blend(prule, crule, w, 1.0)  # the weights of the parent's and the child's masks
+    a_smooth = (p == 0) * cp + (c == 0) * cc
+    a_crease_p = (p == 2) * cp
+    a_crease_c = (c == 2) * cc
+    a_corner = (p == 3) * cp + (c == 3) * cc
     for x in (a_smooth, a_crease_p, a_crease_c, a_corner):
         x[k == 0] = 0.0  # unused vertices: no row
     return (a_smooth, a_crease_p, a_crease_c, a_corner), cv
-
-
-_SMOOTH, _CREASE, _CORNER = 0, 2, 3
-
-
-def _rule(sv, ns):
-    """Sdc's vertex rule from the vertex sharpness ``sv`` and the number ``ns`` of sharp edges at the vertex."""
-    r = np.where(ns >= 3, _CORNER, np.where(ns == 2, _CREASE, _SMOOTH))
-    return np.where(sv > 0, _CORNER, r)
 
 
 class _Rows:
