@@ -95,14 +95,16 @@ def rule_code(vertex_sharpness, n_sharp):
 
     Returns
     -------
-    ndarray of int64
-        The codes (0-d for numbers).
+    int or ndarray of int64
+        The code (an int for a number and an int, the exact stencils' one vertex at a time), the codes.
 
     Examples
     --------
-    >>> rule_code([0.0, 0.0, 0.0, 0.0, 2.0], [0, 1, 2, 5, 0]).tolist(), int(rule_code(0.0, 2))
-    ([0, 1, 2, 3, 3], 2)
+    >>> rule_code([0.0, 0.0, 0.0, 0.0, 2.0], [0, 1, 2, 5, 0]).tolist(), rule_code(0.0, 2), rule_code(0.5, 2)
+    ([0, 1, 2, 3, 3], 2, 3)
     """
+    if isinstance(n_sharp, int) and isinstance(vertex_sharpness, (int, float)):  # the same rule, without numpy
+        return 3 if vertex_sharpness > 0.0 else min(n_sharp, 3)
     return np.where(np.asarray(vertex_sharpness) > 0.0, 3, np.minimum(n_sharp, 3)).astype(np.int64)
 
 
@@ -160,4 +162,4 @@ def vertex_rule(vertex_sharpness, edge_sharpness):
     >>> vertex_rule(1.0, [0, 0, 0, 0])
     'corner'
     """
-    return RULES[int(rule_code(vertex_sharpness, sum(1 for s in edge_sharpness if s > 0.0)))]
+    return RULES[rule_code(vertex_sharpness, sum(1 for s in edge_sharpness if s > 0.0))]

@@ -322,13 +322,15 @@ def _vertex_stencils(cx, want_v, fpts, uniform):
         if opts.boundary == "edge_and_corner" and not closed and len(fan) == 1 and cx.level == 0:
             pv = math.inf
         cv = decrement(pv)
-        prule = int(rule_code(pv, sum(1 for s in pe if s > 0.0)))  # the rule table the float step reads too
-        crule = int(rule_code(cv, sum(1 for s in ce if s > 0.0)))
+        prule = rule_code(pv, sum(1 for s in pe if s > 0.0))  # the rule table the float step reads too
+        crule = rule_code(cv, sum(1 for s in ce if s > 0.0))
         cp, cc = rule_blend(prule, crule, _fractional_weight(pv, cv, pe, ce, uniform), exact_one())
-        m = {}
-        _add(m, cp, _vertex_mask(cx, v, fan, nb, fpts, mask_kind(prule), pe))
-        if cc != 0:
-            _add(m, cc, _vertex_mask(cx, v, fan, nb, fpts, mask_kind(crule), ce))
+        m = _vertex_mask(cx, v, fan, nb, fpts, mask_kind(prule), pe)
+        if cc != 0:  # else cp = 1
+            out = {}
+            _add(out, cp, m)
+            _add(out, cc, _vertex_mask(cx, v, fan, nb, fpts, mask_kind(crule), ce))
+            m = out
         vpts[v] = {u: x for u, x in m.items() if x != 0}
     return vpts, csharp
 
