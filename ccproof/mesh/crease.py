@@ -15,7 +15,7 @@ import math
 import numpy as np
 
 __all__ = ["INFINITE", "SMOOTH", "DART", "CREASE", "CORNER", "RULES", "decrement", "child_sharpness_at_vertex",
-           "vertex_rule", "rule_code", "mask_kind", "rule_blend"]
+           "vertex_rule", "rule_code", "mask_kind", "rule_blend", "midpoint_weight"]
 
 #: OpenSubdiv's Sdc::Crease::SHARPNESS_INFINITE: sharpness at or above it is infinite
 INFINITE = 10.0
@@ -138,6 +138,36 @@ def rule_blend(parent, child, w, one):
     p, c = mask_kind(parent), mask_kind(child)
     b = ((p != 0) & (c != p)) * 1  # 0 or 1 (an int, or an int array)
     return one + b * (w - one), b * (one - w)
+
+
+def midpoint_weight(s, halves_sharp):
+    """Sdc's edge rule as the weight ``pw`` of the midpoint in ``pw * midpoint + (1 - pw) * smooth``, on numbers
+    or numpy arrays (the rule table of the edge points, exact and float).
+
+    Parameters
+    ----------
+    s : float or ndarray
+        The edge's sharpness (a boundary edge: infinite).
+    halves_sharp : bool or ndarray of bool
+        Whether both child halves of the edge stay sharp (or it is a boundary edge).
+
+    Returns
+    -------
+    float or ndarray of float64
+        1 where ``s > 0`` and the halves stay sharp, ``s`` as a float32 where ``s > 0`` and they do not
+        (semi-sharp), 0 where ``s <= 0`` (smooth).
+
+    Examples
+    --------
+    >>> midpoint_weight(0.3, False), midpoint_weight(2.0, True), midpoint_weight(0.0, True)
+    (0.30000001192092896, 1.0, 0.0)
+    >>> midpoint_weight(np.array([0.3, 2.0, 0.0]), np.array([False, True, True])).tolist()
+    [0.30000001192092896, 1.0, 0.0]
+    """
+    if isinstance(s, (int, float)):  # the same rule, without arrays (one edge of the exact stencils)
+        return (1.0 if halves_sharp else float(_F32(s))) if s > 0.0 else 0.0
+    s = np.asarray(s, dtype=np.float64)
+    return np.where(s > 0, np.where(halves_sharp, 1.0, s.astype(_F32).astype(np.float64)), 0.0)
 
 
 def vertex_rule(vertex_sharpness, edge_sharpness):

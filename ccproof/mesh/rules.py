@@ -56,6 +56,7 @@ from ccproof.mesh.crease import (
     child_sharpness_at_vertex,
     decrement,
     mask_kind,
+    midpoint_weight,
     rule_blend,
     rule_code,
     vertex_rule,
@@ -347,7 +348,7 @@ def _edge_stencils(cx, edge_list, fpts, csharp, uniform):
         a, b = cx.org[h], cx.dst(h)
         t = cx.twin[h]
         s = cx.sharpness(e)
-        if s > 0.0 and t < 0:
+        if t < 0 and midpoint_weight(s, True) == 1.0:  # a boundary edge (infinitely sharp)
             epts[e] = {a: half, b: half}
             continue
         faces = [cx.face_of[h], cx.face_of[t]]
@@ -376,10 +377,11 @@ def _edge_stencils(cx, edge_list, fpts, csharp, uniform):
             if len(ends) < 2:
                 continue  # an end vertex without a single fan in the complex: not computable
             ca, cb = ends
-        if ca > 0.0 and cb > 0.0:
+        pw = midpoint_weight(s, ca > 0.0 and cb > 0.0)  # the edge rule table the float step reads too
+        if pw == 1.0:
             epts[e] = {a: half, b: half}
             continue
-        pw = _exact(_F32(s))
+        pw = _exact(pw)
         out = {}
         _add(out, 1 - pw, smooth)
         _add(out, pw, {a: half, b: half})

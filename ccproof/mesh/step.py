@@ -51,7 +51,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ccproof.mesh.crease import INFINITE, mask_kind, rule_blend, rule_code
+from ccproof.mesh.crease import INFINITE, mask_kind, midpoint_weight, rule_blend, rule_code
 from ccproof.mesh.rules import Options
 from ccproof.mesh.scheme import CATMARK
 from ccproof.mesh.step_topology import step_topology, vertex_fans
@@ -543,8 +543,7 @@ class _Rows:
             both = (ce_end > 0).all(axis=1)
         else:
             both = decrement_sharpness(es) > 0
-        mid = (es > 0) & (~two | both)
-        pw = np.where(mid, 1.0, np.where(es > 0, es.astype(_F32).astype(np.float64), 0.0))  # midpoint's weight
+        pw = midpoint_weight(es, ~two | both)  # the edge rule table refine_complex reads too
         tri_e = np.zeros(t.E, dtype=bool)
         if tri_smooth and two.any():
             tri_e[two] = ((t.sz[t.face[h1[two]]] == 3) | (t.sz[t.face[h2[two]]] == 3)) & (pw[two] != 1.0)

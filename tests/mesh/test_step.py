@@ -463,13 +463,14 @@ def test_the_fast_step_declines_tagged_meshes(refdir):
 
 
 def test_the_rule_table_is_the_one_of_both_steps():
-    """The step and the exact stencils read one rule table (ccproof.mesh.crease.rule_code, rule_blend):
+    """The step and the exact stencils read one rule table (ccproof.mesh.crease.rule_code, rule_blend,
+    midpoint_weight):
     against Sdc's rules written out by hand here, per (vertex sharpness, sharp edges) and per (parent, child)
     rule: corner above two sharp edges or a sharp vertex, and the blend only from a non-smooth parent to
     another mask (a dart uses the smooth mask)."""
     from fractions import Fraction
 
-    from ccproof.mesh.crease import RULES, rule_blend, rule_code
+    from ccproof.mesh.crease import RULES, midpoint_weight, rule_blend, rule_code
 
     want = {(0.0, 0): "smooth", (0.0, 1): "dart", (0.0, 2): "crease", (0.0, 3): "corner", (0.0, 7): "corner",
             (0.5, 0): "corner", (math.inf, 2): "corner"}
@@ -479,6 +480,14 @@ def test_the_rule_table_is_the_one_of_both_steps():
     blended = {(p, c) for p in range(4) for c in range(4) if rule_blend(p, c, w, one) == (w, one - w)}
     assert blended == {(2, 0), (2, 1), (2, 3), (3, 0), (3, 1), (3, 2)}
     assert all(rule_blend(p, c, w, one) == (one, 0) for p in range(4) for c in range(4) if (p, c) not in blended)
+    # the edge rule: the midpoint where sharp and both halves stay sharp, the float32 sharpness as the blend
+    # where a half becomes smooth, the smooth rule (0) where not sharp; a number and an array alike
+    edges = [(0.0, True, 0.0), (-1.0, False, 0.0), (math.inf, True, 1.0), (2.5, True, 1.0), (0.1, False, 0.1),
+             (1.5, False, 1.5)]
+    for s, halves, pw in edges:
+        assert midpoint_weight(s, halves) == float(np.float32(pw)), (s, halves)
+    assert midpoint_weight(np.array([e[0] for e in edges]), np.array([e[1] for e in edges])).tolist() == [
+        float(np.float32(e[2])) for e in edges]
     cp, cc = rule_blend(np.arange(4).repeat(4), np.tile(np.arange(4), 4), np.full(16, 0.375), 1.0)
     assert [(float(a), float(b)) for a, b in zip(cp, cc)] == [
         (float(x), float(y)) for x, y in (rule_blend(p, c, w, one) for p in range(4) for c in range(4))]
