@@ -1,11 +1,20 @@
-"""OpenSubdiv's Sdc crease rules, one vertex at a time (``sdc/crease.cpp``): what every scheme shares.
+"""OpenSubdiv's Sdc crease rules (``sdc/crease.cpp``): what every scheme shares, and the rule table of the step.
 
 Sharpness ``s`` is an IEEE float32 as in OpenSubdiv, ``s >= INFINITE`` (10) is infinite; the rule of a
-vertex (:func:`vertex_rule`) follows from its sharpness and the number of sharp edges at it; sharpness decays
-by one per level (:func:`decrement`), or by Chaikin's average around a vertex
-(:func:`child_sharpness_at_vertex`). :func:`ccproof.mesh.rules.refine_complex` reads them; the vectorized
-step (:mod:`ccproof.mesh.step`) writes the same rules over the whole mesh (checked equal bit for bit by
-tests/mesh/test_step.py).
+vertex (:func:`rule_code`, :func:`vertex_rule` by name) follows from its sharpness and the number of sharp
+edges at it; sharpness decays by one per level (:func:`decrement`), or by Chaikin's average around a vertex
+(:func:`child_sharpness_at_vertex`).
+
+The rule table, which rule applies where, is written once, on numbers and on numpy arrays alike, and read
+by both the exact stencils (:func:`ccproof.mesh.rules.refine_complex`, one vertex at a time, rationals) and
+the float operator (:func:`ccproof.mesh.step.catmark_operator`, every vertex at once): the vertex rule
+(:func:`rule_code`), the mask it uses (:func:`mask_kind`), the blend of the parent's and the child's masks
+(:func:`rule_blend`, generic over the number type) and the edge rule (:func:`midpoint_weight`). The weights
+are the scheme's (:data:`ccproof.mesh.scheme.CATMARK`). What stays written twice is the assembly of the rows
+(dicts of rationals per point there, integer-scaled numpy terms over the whole mesh here: a shared per-point
+assembly is the former, about 12x slower: ``python scripts/bench_refine.py``) and the float32 sums of
+Sdc's fractional weight and Chaikin's rule (in fan order, one vertex at a time or segmented); tests/mesh/test_step.py
+checks those bit for bit, the OpenSubdiv comparisons check the shared table.
 """
 
 from __future__ import annotations

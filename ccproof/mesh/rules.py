@@ -13,8 +13,9 @@ against these stencils bit for bit). Both read the weights through the scheme
 :func:`smooth_vertex_weights`, :func:`crease_vertex_weights`, re-exported here; :mod:`ccproof.mesh.step`
 evaluates them exactly and rounds each row once): one rule implementation, exact or float by the number
 ``one`` it is given. The proof branch's ring matrices (:mod:`ccproof.algebra.subdivision`) read them too.
-The topology is :class:`~ccproof.mesh.complex.Complex`'s, the crease rules those of :mod:`ccproof.mesh.crease`
-(both re-exported here).
+The topology is :class:`~ccproof.mesh.complex.Complex`'s, the crease rules and the rule table (which vertex and
+edge rule applies where, and how a parent's and a child's masks blend: the one the float step reads) those of
+:mod:`ccproof.mesh.crease` (re-exported here).
 
 Rules (Sdc ``SCHEME_CATMARK``, OpenSubdiv 3.6 ``sdc/scheme.h``, ``sdc/catmarkScheme.h``,
 ``sdc/crease.cpp``; sharpness ``s`` is IEEE float32 as in OpenSubdiv, ``s >= 10`` is infinite,

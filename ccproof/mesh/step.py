@@ -7,7 +7,10 @@ untagged quad step of :func:`ccproof.mesh.subdivision_matrix` and the applicatio
 :class:`~ccproof.mesh.halfedges.HalfEdges` (``halfedges=``), which the step reads instead of pairing the
 half-edges again. It assembles, over the whole
 mesh with numpy, the rules that :func:`ccproof.mesh.rules.refine_complex` states as exact stencils
-(the independent reference of the tests; the weights are read through the scheme,
+(the reference of the tests for the assembly; both read one rule table, :func:`~ccproof.mesh.crease.rule_code`,
+:func:`~ccproof.mesh.crease.rule_blend` and :func:`~ccproof.mesh.crease.midpoint_weight`, which the
+OpenSubdiv comparisons check; its fast path for untagged meshes is :func:`ccproof.mesh.step_fast.catmark_step`;
+the weights are read through the scheme,
 :data:`ccproof.mesh.scheme.CATMARK`, the same rule functions of :mod:`ccproof.rule_weights`, evaluated in
 rationals and rounded once per row; the step only splits faces, so another quad-splitting scheme is
 another :class:`~ccproof.mesh.scheme.Scheme` value):
