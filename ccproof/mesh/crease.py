@@ -44,18 +44,24 @@ def _is_semi_sharp(s):
 
 
 def decrement(s):
-    """Sdc's uniform decay of one float32 sharpness: ``s - 1`` in float32 above 1, 0 at or below, infinite stays.
+    """Sdc's uniform decay of float32 sharpness, on a number or a numpy array: ``s - 1`` in float32 above 1, 0 at
+    or below, infinite (``>= INFINITE``) stays infinite.
 
     >>> decrement(2.5), decrement(0.5), decrement(10.0)
     (1.5, 0.0, inf)
+    >>> decrement(np.array([2.5, 0.5, 12.0, -1.0, np.inf])).tolist()
+    [1.5, 0.0, inf, 0.0, inf]
     """
-    if s <= 0.0:
-        return 0.0
-    if s >= INFINITE:
-        return math.inf
-    if s > 1.0:
-        return float(_F32(s) - _ONE)
-    return 0.0
+    if not isinstance(s, np.ndarray):  # the same rule, without arrays (one vertex of the exact stencils)
+        s = float(s)
+        if s <= 0.0:
+            return 0.0
+        if s >= INFINITE:
+            return math.inf
+        return float(_F32(s) - _ONE) if s > 1.0 else 0.0
+    s = np.asarray(s, dtype=np.float64)
+    out = np.where(s > 1.0, (s.astype(_F32) - _ONE).astype(np.float64), 0.0)
+    return np.where(s >= INFINITE, np.inf, out)
 
 
 def child_sharpness_at_vertex(edge_sharpness, chaikin):
@@ -109,11 +115,13 @@ def rule_code(vertex_sharpness, n_sharp):
 
     Examples
     --------
-    >>> rule_code([0.0, 0.0, 0.0, 0.0, 2.0], [0, 1, 2, 5, 0]).tolist(), rule_code(0.0, 2), rule_code(0.5, 2)
-    ([0, 1, 2, 3, 3], 2, 3)
+    >>> rule_code(np.array([0.0, 0.0, 0.0, 0.0, 2.0]), np.array([0, 1, 2, 5, 0])).tolist()
+    [0, 1, 2, 3, 3]
+    >>> rule_code(0.0, 2), rule_code(0.5, 2)
+    (2, 3)
     """
-    if isinstance(n_sharp, int) and isinstance(vertex_sharpness, (int, float)):  # the same rule, without numpy
-        return 3 if vertex_sharpness > 0.0 else min(n_sharp, 3)
+    if not isinstance(n_sharp, np.ndarray) and not isinstance(vertex_sharpness, np.ndarray):  # the same rule
+        return 3 if vertex_sharpness > 0.0 else min(int(n_sharp), 3)
     return np.where(np.asarray(vertex_sharpness) > 0.0, 3, np.minimum(n_sharp, 3)).astype(np.int64)
 
 
@@ -173,7 +181,8 @@ def midpoint_weight(s, halves_sharp):
     >>> midpoint_weight(np.array([0.3, 2.0, 0.0]), np.array([False, True, True])).tolist()
     [0.30000001192092896, 1.0, 0.0]
     """
-    if isinstance(s, (int, float)):  # the same rule, without arrays (one edge of the exact stencils)
+    if not isinstance(s, np.ndarray):  # the same rule, without arrays (one edge of the exact stencils)
+        s = float(s)
         return (1.0 if halves_sharp else float(_F32(s))) if s > 0.0 else 0.0
     s = np.asarray(s, dtype=np.float64)
     return np.where(s > 0, np.where(halves_sharp, 1.0, s.astype(_F32).astype(np.float64)), 0.0)

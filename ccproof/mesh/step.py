@@ -54,7 +54,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ccproof.mesh.crease import INFINITE, mask_kind, midpoint_weight, rule_blend, rule_code
+from ccproof.mesh.crease import INFINITE, decrement, mask_kind, midpoint_weight, rule_blend, rule_code
 from ccproof.mesh.rules import Options
 from ccproof.mesh.scheme import CATMARK
 from ccproof.mesh.step_topology import step_topology, vertex_fans
@@ -134,13 +134,6 @@ class Step(NamedTuple):
     child_corners: tuple
     child_holes: np.ndarray
     csr: tuple
-
-
-def decrement_sharpness(s):
-    """Sdc's uniform decay of float32 sharpness values (0 at or below 1, infinite stays)."""
-    s = np.asarray(s, dtype=np.float64)
-    out = np.where(s > 1.0, (s.astype(_F32) - _F32(1.0)).astype(np.float64), 0.0)
-    return np.where(np.isinf(s), np.inf, out)
 
 
 def _f32_sums(seg, val, n):
@@ -379,7 +372,7 @@ def _vertex_tags(n, vertex_sharpness):
 
 def _child_edge_sharpness(pe, inc_v, n, chaikin):
     """Child sharpness of every edge at every vertex (Sdc SubdivideEdgeSharpnessesAroundVertex), per incidence."""
-    ce = decrement_sharpness(pe)
+    ce = decrement(pe)
     if chaikin:
         semi = (pe > 0) & np.isfinite(pe)
         total, nsemi = _f32_sums(inc_v[semi], pe[semi], n)
@@ -401,7 +394,7 @@ def _vertex_coefficients(t, fans, vs, pe, ce, chaikin, corners_at_level0):
     pv = vs.copy()
     if corners_at_level0:  # EDGE_AND_CORNER: a one-face boundary vertex is a corner
         pv[fans.is_bv & (k == 1)] = np.inf
-    cv = decrement_sharpness(pv)
+    cv = decrement(pv)
     prule = rule_code(pv, np.bincount(inc_v[pe > 0], minlength=n))  # the rule table refine_complex reads too
     crule = rule_code(cv, np.bincount(inc_v[ce > 0], minlength=n))
     p, c = mask_kind(prule), mask_kind(crule)
@@ -545,7 +538,7 @@ class _Rows:
             ce_end[fans.inc_e[~first_end], 1] = ce[~first_end]
             both = (ce_end > 0).all(axis=1)
         else:
-            both = decrement_sharpness(es) > 0
+            both = decrement(es) > 0
         pw = midpoint_weight(es, ~two | both)  # the edge rule table refine_complex reads too
         tri_e = np.zeros(t.E, dtype=bool)
         if tri_smooth and two.any():
