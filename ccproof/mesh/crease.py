@@ -9,12 +9,14 @@ The rule table, which rule applies where, is written once, on numbers and on num
 by both the exact stencils (:func:`ccproof.mesh.rules.refine_complex`, one vertex at a time, rationals) and
 the float operator (:func:`ccproof.mesh.step.catmark_operator`, every vertex at once): the vertex rule
 (:func:`rule_code`), the mask it uses (:func:`mask_kind`), the blend of the parent's and the child's masks
-(:func:`rule_blend`, generic over the number type) and the edge rule (:func:`midpoint_weight`). The weights
+(:func:`rule_blend`, generic over the number type), the edge rule (:func:`midpoint_weight`), the sharpness decay
+(:func:`decrement`, :func:`chaikin_sharpness`) and which features count in Sdc's fractional weight
+(:func:`becomes_smooth`). The weights
 are the scheme's (:data:`ccproof.mesh.scheme.CATMARK`). What stays written twice is the assembly of the rows
 (dicts of rationals per point there, integer-scaled numpy terms over the whole mesh here: a shared per-point
 assembly is the former, about 12x slower: ``python scripts/bench_refine.py``) and the float32 sums of
-Sdc's fractional weight and Chaikin's rule (in fan order, one vertex at a time or segmented); tests/mesh/test_step.py
-checks those bit for bit, the OpenSubdiv comparisons check the shared table.
+Sdc's fractional weight and Chaikin's rule (in fan order, one vertex at a time or segmented);
+tests/mesh/test_step.py checks those bit for bit, the OpenSubdiv comparisons check the shared table.
 """
 
 from __future__ import annotations
@@ -24,7 +26,8 @@ import math
 import numpy as np
 
 __all__ = ["INFINITE", "SMOOTH", "DART", "CREASE", "CORNER", "RULES", "decrement", "child_sharpness_at_vertex",
-           "vertex_rule", "rule_code", "mask_kind", "rule_blend", "midpoint_weight"]
+           "vertex_rule", "rule_code", "mask_kind", "rule_blend", "midpoint_weight", "chaikin_sharpness",
+           "becomes_smooth"]
 
 #: OpenSubdiv's Sdc::Crease::SHARPNESS_INFINITE: sharpness at or above it is infinite
 INFINITE = 10.0
@@ -90,10 +93,34 @@ def child_sharpness_at_vertex(edge_sharpness, chaikin):
         elif len(semi) == 1:
             out.append(decrement(s))
         else:
-            avg = _F32((total - _F32(s)) / _F32(len(semi) - 1))
-            c = _F32(_F32(_F32(0.75) * _F32(s)) + _F32(_F32(0.25) * avg)) - _ONE
-            out.append(float(c) if c > 0 else 0.0)
+            out.append(chaikin_sharpness(s, total, len(semi)))
     return out
+
+
+def chaikin_sharpness(s, total, n_semi):
+    """Sdc's ``CREASE_CHAIKIN`` child sharpness of a semi-sharp edge ``s`` at a vertex with ``n_semi >= 2``
+    semi-sharp edges whose float32 sharpness sums to ``total``: ``0.75 s + 0.25 mean(the others) - 1`` in float32,
+    0 below; on numbers or numpy arrays (one vertex of the exact stencils, every incidence of the float step).
+
+    >>> chaikin_sharpness(2.0, np.float32(3.0), 2), chaikin_sharpness(np.array([2.0, 1.0]), np.float32(3.0), 2).tolist()
+    (0.75, [0.75, 0.25])
+    """
+    s32 = np.asarray(s).astype(_F32)
+    avg = ((total - s32) / np.asarray(n_semi - 1).astype(_F32)).astype(_F32)
+    c = (_F32(0.75) * s32 + _F32(0.25) * avg).astype(_F32) - _ONE
+    out = np.where(c > 0, c.astype(np.float64), 0.0)
+    return float(out) if out.ndim == 0 else out
+
+
+def becomes_smooth(p, c, uniform):
+    """Whether a feature of sharpness ``p`` (child sharpness ``c``) counts in Sdc's fractional weight
+    (``ComputeFractionalWeightAtVertex``): ``0 < p <= 1`` under ``CREASE_UNIFORM`` edges, ``p > 0`` and ``c <= 0``
+    otherwise (Chaikin edges, and the vertex's own sharpness under either); numbers or numpy arrays.
+
+    >>> becomes_smooth(0.5, 0.0, True), becomes_smooth(1.5, 0.0, False), becomes_smooth(np.array([1.5]), 0.5, True)
+    (True, True, array([False]))
+    """
+    return (p > 0.0) & ((p <= 1.0) if uniform else (c <= 0.0))
 
 
 def rule_code(vertex_sharpness, n_sharp):

@@ -54,6 +54,7 @@ from ccproof.mesh.crease import (
     DART,
     INFINITE,
     SMOOTH,
+    becomes_smooth,
     child_sharpness_at_vertex,
     decrement,
     mask_kind,
@@ -196,14 +197,10 @@ class Options:
 def _fractional_weight(pv, cv, pe, ce, uniform):
     """Sdc ``ComputeFractionalWeightAtVertex`` in float32."""
     count, total = 0, _F32(0.0)
-    if pv > 0.0 and cv <= 0.0:
+    if becomes_smooth(pv, cv, False):
         count, total = 1, _F32(pv)
     for p, c in zip(pe, ce):
-        if uniform:
-            hit = p > 0.0 and p <= 1.0
-        else:
-            hit = p > 0.0 and c <= 0.0
-        if hit:
+        if becomes_smooth(p, c, uniform):
             total = _F32(total + _F32(p))
             count += 1
     if count == 0:

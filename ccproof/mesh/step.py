@@ -54,7 +54,16 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ccproof.mesh.crease import INFINITE, decrement, mask_kind, midpoint_weight, rule_blend, rule_code
+from ccproof.mesh.crease import (
+    INFINITE,
+    becomes_smooth,
+    chaikin_sharpness,
+    decrement,
+    mask_kind,
+    midpoint_weight,
+    rule_blend,
+    rule_code,
+)
 from ccproof.mesh.rules import Options
 from ccproof.mesh.scheme import CATMARK
 from ccproof.mesh.step_topology import step_topology, vertex_fans
@@ -379,10 +388,7 @@ def _child_edge_sharpness(pe, inc_v, n, chaikin):
         nedge = np.bincount(inc_v, minlength=n)
         many = semi & (nsemi[inc_v] >= 2) & (nedge[inc_v] >= 2)
         if many.any():
-            s32 = pe[many].astype(_F32)
-            avg = ((total[inc_v[many]] - s32) / (nsemi[inc_v[many]] - 1).astype(_F32)).astype(_F32)
-            c = (_F32(0.75) * s32 + _F32(0.25) * avg).astype(_F32) - _F32(1.0)
-            ce[many] = np.where(c > 0, c.astype(np.float64), 0.0)
+            ce[many] = chaikin_sharpness(pe[many], total[inc_v[many]], nsemi[inc_v[many]])
     return ce
 
 
@@ -399,9 +405,8 @@ def _vertex_coefficients(t, fans, vs, pe, ce, chaikin, corners_at_level0):
     crule = rule_code(cv, np.bincount(inc_v[ce > 0], minlength=n))
     p, c = mask_kind(prule), mask_kind(crule)
     blend = (p != 0) & (c != p)
-    hit = ((pe > 0) & (ce <= 0)) if chaikin else ((pe > 0) & (pe <= 1))
-    hit &= blend[inc_v]
-    vhit = blend & (pv > 0) & (cv <= 0)
+    hit = becomes_smooth(pe, ce, not chaikin) & blend[inc_v]
+    vhit = blend & becomes_smooth(pv, cv, False)
     seg = np.r_[np.flatnonzero(vhit), inc_v[hit]]
     val = np.r_[pv[vhit], pe[hit]]
     oo = np.argsort(seg, kind="stable")  # the vertex's own sharpness first, then its edges in fan order
