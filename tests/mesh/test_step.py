@@ -464,13 +464,13 @@ def test_the_fast_step_declines_tagged_meshes(refdir):
 
 def test_the_rule_table_is_the_one_of_both_steps():
     """The step and the exact stencils read one rule table (ccproof.mesh.crease.rule_code, rule_blend,
-    midpoint_weight):
+    midpoint_weight, chaikin_sharpness, becomes_smooth):
     against Sdc's rules written out by hand here, per (vertex sharpness, sharp edges) and per (parent, child)
     rule: corner above two sharp edges or a sharp vertex, and the blend only from a non-smooth parent to
     another mask (a dart uses the smooth mask)."""
     from fractions import Fraction
 
-    from ccproof.mesh.crease import RULES, midpoint_weight, rule_blend, rule_code
+    from ccproof.mesh.crease import RULES, becomes_smooth, chaikin_sharpness, midpoint_weight, rule_blend, rule_code
 
     want = {(0.0, 0): "smooth", (0.0, 1): "dart", (0.0, 2): "crease", (0.0, 3): "corner", (0.0, 7): "corner",
             (0.5, 0): "corner", (math.inf, 2): "corner"}
@@ -488,6 +488,14 @@ def test_the_rule_table_is_the_one_of_both_steps():
         assert midpoint_weight(s, halves) == float(np.float32(pw)), (s, halves)
     assert midpoint_weight(np.array([e[0] for e in edges]), np.array([e[1] for e in edges])).tolist() == [
         float(np.float32(e[2])) for e in edges]
+    # Chaikin: 0.75 s + 0.25 mean(other semi-sharp) - 1, 0 below (edges 2, 1, 0.5 at a vertex: the sum 3.5)
+    want = [0.75 * 2 + 0.25 * 0.75 - 1, 0.75 * 1 + 0.25 * 1.25 - 1, 0.0]
+    got = chaikin_sharpness(np.array([2.0, 1.0, 0.5]), np.float32(3.5), 3)
+    assert got.tolist() == want and [chaikin_sharpness(x, np.float32(3.5), 3) for x in (2.0, 1.0, 0.5)] == want
+    # the fractional weight counts 0 < p <= 1 under uniform creasing, else p > 0 with a smooth child
+    feats = [(0.5, 0.0, True, True), (1.0, 0.0, True, True), (1.5, 0.5, True, False), (0.0, 0.0, True, False),
+             (1.5, 0.0, False, True), (1.5, 0.25, False, False), (-1.0, 0.0, False, False)]
+    assert [bool(becomes_smooth(p, c, u)) for p, c, u, _ in feats] == [x[3] for x in feats]
     cp, cc = rule_blend(np.arange(4).repeat(4), np.tile(np.arange(4), 4), np.full(16, 0.375), 1.0)
     assert [(float(a), float(b)) for a, b in zip(cp, cc)] == [
         (float(x), float(y)) for x, y in (rule_blend(p, c, w, one) for p in range(4) for c in range(4))]
