@@ -8,12 +8,15 @@ round by round (min, median, max of the ratio new / old per round; the 1-minute 
 
 1. ``subdivision_matrix`` on bunny_quads subdivided once;
 2. ``tagged_step`` on catmark_cubes_infsharp and catmark_pyramid_creases1 (semi-sharp) subdivided twice
-   (the former code as "old", the operator as "new").
+   (the former code as "old", the operator as "new");
+3. the step's fast path (:func:`ccproof.mesh.step_fast.catmark_step`, the points from the face points) as "new"
+   against the operator (``catmark_operator`` without scipy, then ``apply_csr``) as "old", on an icosphere of
+   triangles (``--tri-levels``, default 5: 20,480 triangles; the setup of a scan takes this step).
 
 The baselines' private helpers are copied here verbatim too (``_boundary_neighbours``, ``_decrement``,
 ``_pair_keys``, ``_semi``, ``_fan_complex``): the script uses public names of ccproof only. The former A/B of
-the evaluator's polygon step (``catmark_step``, a function of a private module, swapped into the evaluator
-by assignment) against ``catmark_operator(...).S @ X`` is no longer measured: it needed the private module.
+the evaluator's polygon step swapped into the evaluator by assignment is no longer measured (it needed a private
+module); case 3 times the fast path itself.
 
 Usage: python scripts/bench_step.py [--rounds 7] [--smoke]
 """
@@ -308,6 +311,7 @@ def _ab(name, old, new, rounds):
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--rounds", type=int, default=7)
+    ap.add_argument("--tri-levels", type=int, default=5, help="icosphere of case 3: 20 * 4^L triangles")
     ap.add_argument("--smoke", action="store_true", help="one round on the smallest inputs (the test suite's run)")
     a = ap.parse_args(argv)
     from ccproof.apps.control_mesh import tagged_step
@@ -325,6 +329,29 @@ def main(argv=None):
         m = subdivide_control(subdivide_control(m))
         _ab(f"tagged_step {name} level 2 ({m.n_faces:,} quads)", lambda m=m: old_tagged_step(m),
             lambda m=m: tagged_step(m), rounds)
+    _fast_path(1 if a.smoke else a.tri_levels, rounds)
+
+
+def _fast_path(levels, rounds):
+    """Case 3: catmark_step against the operator's step on an icosphere (points compared to round-off first)."""
+    from ccproof.mesh import PolyMesh
+    from ccproof.mesh.csr import apply_csr
+    from ccproof.mesh.step import StepOptions, catmark_operator
+    from ccproof.mesh.step_fast import catmark_step
+
+    V, F = _icosphere(levels)
+    pm = PolyMesh(V, F.tolist())
+    he = pm.halfedges
+
+    def operator():
+        st = catmark_operator(pm.n_vertices, he.org, he.sizes, halfedges=he,
+                              options=StepOptions(pm.options, pm.level, sparse=False))
+        return apply_csr(st.csr, pm.vertices), st.faces
+
+    (X0, F0), (X1, F1) = operator(), catmark_step(pm)
+    if not np.array_equal(F0, F1) or np.abs(X0 - X1).max() > 1e-15:
+        raise SystemExit("the fast path and the operator differ")
+    _ab(f"catmark_step / operator icosphere ({len(F):,} triangles)", operator, lambda: catmark_step(pm), rounds)
 
 
 if __name__ == "__main__":

@@ -40,9 +40,9 @@ from ccproof.evaluate.factory import Builder, Jobs
 from ccproof.evaluate.nets import corner_rings, with_nets
 from ccproof.evaluate.patch_map import PatchMap
 from ccproof.evaluate.patch_table import KIND_CORNER, check_positions
-from ccproof.evaluate.step import catmark_step
 from ccproof.mesh import QuadMesh, limit_normals, limit_positions
 from ccproof.mesh.polymesh import PolyMesh
+from ccproof.mesh.step_fast import catmark_step
 
 __all__ = ["natural_limit_surface", "LimitSurface"]
 
@@ -644,7 +644,7 @@ class LimitSurface:
         are the PolyMesh's own vertices. The rings index the vertices the builder classified: those
         of :attr:`PolyMesh.manifold <ccproof.mesh.polymesh.PolyMesh.manifold>` (``X[manifold_vertex_map]``)
         on an all-quad mesh, else its level-1 vertices, recomputed as the build computes them (the
-        vectorized untagged step :func:`ccproof.evaluate.step.catmark_step`, or the tagged step that
+        vectorized untagged step :func:`ccproof.mesh.step_fast.catmark_step`, or the tagged step that
         the build ran, kept by it as CSR arrays (:class:`ccproof.mesh.csr.PackedCSR`, 24 bytes per ptex
         face on a tagged triangle mesh, docs/evaluate.md; shared by the derived surfaces) and applied as
         :meth:`PolyMesh.refine` applies it: no move repeats the step).

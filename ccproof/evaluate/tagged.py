@@ -7,7 +7,7 @@ evaluator :class:`ccproof.evaluate.surface.LimitSurface` holds the table and eva
 
 1. One global Catmull-Clark step (n-gons become quads; ``TRI_SUB_SMOOTH`` and the
    ``EDGE_AND_CORNER`` corners act here); on an untagged mesh vectorized
-   (:func:`ccproof.evaluate.step.catmark_step`). A quad's ptex face is split into its four level-1
+   (:func:`ccproof.mesh.step_fast.catmark_step`). A quad's ptex face is split into its four level-1
    children; sub-face k of an n-gon *is* level-1 child k (same (s, t)).
 2. Semi-sharp phase: while an edge at a vertex of the face or the vertex itself has a semi-sharp
    sharpness (0 < s < 10), the face's neighbourhood is refined exactly and locally
@@ -36,10 +36,10 @@ import numpy as np
 from ccproof.evaluate.factory import Builder, Jobs
 from ccproof.evaluate.frames import child_frame, compose, domain
 from ccproof.evaluate.halfedge_views import TaggedHalfEdges
-from ccproof.evaluate.step import catmark_step
 from ccproof.mesh.csr import pack_csr
 from ccproof.mesh.halfedges import HalfEdges
 from ccproof.mesh.polymesh import PolyMesh
+from ccproof.mesh.step_fast import catmark_step
 
 __all__ = ["build_tagged", "vertex_corners"]
 

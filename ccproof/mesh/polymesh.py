@@ -453,8 +453,8 @@ class PolyMesh:
                 return self.manifold.refine(operator)
             m, _ = self.manifold.refine(operator=False)
             return m, (self.subdivision_operator() if operator else None)
+        from ccproof.mesh.crease import decrement
         from ccproof.mesh.csr import apply_csr
-        from ccproof.mesh.step import decrement_sharpness
 
         st = self._step(sparse=False)
         n = self.n_vertices
@@ -466,7 +466,7 @@ class PolyMesh:
         cvs[st.child_corners[0]] = st.child_corners[1]
         if unused.size and self.vertex_sharpness:
             vs = np.array([self.vertex_sharpness.get(v, 0.0) for v in unused.tolist()])
-            cvs[unused] = decrement_sharpness(vs)
+            cvs[unused] = decrement(vs)
         sharp_v = np.flatnonzero(cvs > 0)
         pairs, ces = st.child_creases
         he = self.halfedges

@@ -13,8 +13,9 @@ against these stencils bit for bit). Both read the weights through the scheme
 :func:`smooth_vertex_weights`, :func:`crease_vertex_weights`, re-exported here; :mod:`ccproof.mesh.step`
 evaluates them exactly and rounds each row once): one rule implementation, exact or float by the number
 ``one`` it is given. The proof branch's ring matrices (:mod:`ccproof.algebra.subdivision`) read them too.
-The topology is :class:`~ccproof.mesh.complex.Complex`'s, the crease rules those of :mod:`ccproof.mesh.crease`
-(both re-exported here).
+The topology is :class:`~ccproof.mesh.complex.Complex`'s, the crease rules and the rule table (which vertex and
+edge rule applies where, and how a parent's and a child's masks blend: the one the float step reads) those of
+:mod:`ccproof.mesh.crease` (re-exported here).
 
 Rules (Sdc ``SCHEME_CATMARK``, OpenSubdiv 3.6 ``sdc/scheme.h``, ``sdc/catmarkScheme.h``,
 ``sdc/crease.cpp``; sharpness ``s`` is IEEE float32 as in OpenSubdiv, ``s >= 10`` is infinite,
@@ -53,8 +54,13 @@ from ccproof.mesh.crease import (
     DART,
     INFINITE,
     SMOOTH,
+    becomes_smooth,
     child_sharpness_at_vertex,
     decrement,
+    mask_kind,
+    midpoint_weight,
+    rule_blend,
+    rule_code,
     vertex_rule,
 )
 from ccproof.mesh.scheme import CATMARK
@@ -191,14 +197,10 @@ class Options:
 def _fractional_weight(pv, cv, pe, ce, uniform):
     """Sdc ``ComputeFractionalWeightAtVertex`` in float32."""
     count, total = 0, _F32(0.0)
-    if pv > 0.0 and cv <= 0.0:
+    if becomes_smooth(pv, cv, False):
         count, total = 1, _F32(pv)
     for p, c in zip(pe, ce):
-        if uniform:
-            hit = p > 0.0 and p <= 1.0
-        else:
-            hit = p > 0.0 and c <= 0.0
-        if hit:
+        if becomes_smooth(p, c, uniform):
             total = _F32(total + _F32(p))
             count += 1
     if count == 0:
@@ -212,10 +214,11 @@ def _add(out, c, s):
         out[v] = out.get(v, 0) + c * w
 
 
-def _vertex_mask(cx, v, fan, nb, fpts, rule, sh):
-    """Sdc vertex-point mask of ``v`` for one rule (smooth/dart, crease along the sharp edges, corner)."""
+def _vertex_mask(cx, v, fan, nb, fpts, kind, sh):
+    """Sdc vertex-point mask of ``v`` for one :func:`~ccproof.mesh.crease.mask_kind` (0 smooth or dart, 2 crease
+    along the sharp edges, 3 corner)."""
     one = exact_one()
-    if rule in (SMOOTH, DART):
+    if kind == 0:
         wv, we, wf = CATMARK.vertex_point(len(fan), one)
         m = {v: wv}
         for c in fan:
@@ -223,7 +226,7 @@ def _vertex_mask(cx, v, fan, nb, fpts, rule, sh):
             u = cx.dst(c)
             m[u] = m.get(u, 0) + we
         return m
-    if rule == CREASE:
+    if kind == 2:
         wv, we = CATMARK.crease_vertex(one)
         m = {v: wv}
         for u, s in zip(nb, sh):
@@ -318,16 +321,14 @@ def _vertex_stencils(cx, want_v, fpts, uniform):
         if opts.boundary == "edge_and_corner" and not closed and len(fan) == 1 and cx.level == 0:
             pv = math.inf
         cv = decrement(pv)
-        prule = vertex_rule(pv, pe)
-        crule = vertex_rule(cv, ce)
-
-        m = _vertex_mask(cx, v, fan, nb, fpts, prule, pe)
-        if prule not in (SMOOTH, DART) and crule != prule:
-            w = _fractional_weight(pv, cv, pe, ce, uniform)
-            mc = _vertex_mask(cx, v, fan, nb, fpts, crule, ce)
+        prule = rule_code(pv, sum(1 for s in pe if s > 0.0))  # the rule table the float step reads too
+        crule = rule_code(cv, sum(1 for s in ce if s > 0.0))
+        cp, cc = rule_blend(prule, crule, _fractional_weight(pv, cv, pe, ce, uniform), exact_one())
+        m = _vertex_mask(cx, v, fan, nb, fpts, mask_kind(prule), pe)
+        if cc != 0:  # else cp = 1
             out = {}
-            _add(out, w, m)
-            _add(out, 1 - w, mc)
+            _add(out, cp, m)
+            _add(out, cc, _vertex_mask(cx, v, fan, nb, fpts, mask_kind(crule), ce))
             m = out
         vpts[v] = {u: x for u, x in m.items() if x != 0}
     return vpts, csharp
@@ -345,7 +346,7 @@ def _edge_stencils(cx, edge_list, fpts, csharp, uniform):
         a, b = cx.org[h], cx.dst(h)
         t = cx.twin[h]
         s = cx.sharpness(e)
-        if s > 0.0 and t < 0:
+        if t < 0 and midpoint_weight(s, True) == 1.0:  # a boundary edge (infinitely sharp)
             epts[e] = {a: half, b: half}
             continue
         faces = [cx.face_of[h], cx.face_of[t]]
@@ -374,10 +375,11 @@ def _edge_stencils(cx, edge_list, fpts, csharp, uniform):
             if len(ends) < 2:
                 continue  # an end vertex without a single fan in the complex: not computable
             ca, cb = ends
-        if ca > 0.0 and cb > 0.0:
+        pw = midpoint_weight(s, ca > 0.0 and cb > 0.0)  # the edge rule table the float step reads too
+        if pw == 1.0:
             epts[e] = {a: half, b: half}
             continue
-        pw = _exact(_F32(s))
+        pw = _exact(pw)
         out = {}
         _add(out, 1 - pw, smooth)
         _add(out, pw, {a: half, b: half})

@@ -7,7 +7,10 @@ untagged quad step of :func:`ccproof.mesh.subdivision_matrix` and the applicatio
 :class:`~ccproof.mesh.halfedges.HalfEdges` (``halfedges=``), which the step reads instead of pairing the
 half-edges again. It assembles, over the whole
 mesh with numpy, the rules that :func:`ccproof.mesh.rules.refine_complex` states as exact stencils
-(the independent reference of the tests; the weights are read through the scheme,
+(the reference of the tests for the assembly; both read one rule table, :func:`~ccproof.mesh.crease.rule_code`,
+:func:`~ccproof.mesh.crease.rule_blend` and :func:`~ccproof.mesh.crease.midpoint_weight`, which the
+OpenSubdiv comparisons check; its fast path for untagged meshes is :func:`ccproof.mesh.step_fast.catmark_step`;
+the weights are read through the scheme,
 :data:`ccproof.mesh.scheme.CATMARK`, the same rule functions of :mod:`ccproof.rule_weights`, evaluated in
 rationals and rounded once per row; the step only splits faces, so another quad-splitting scheme is
 another :class:`~ccproof.mesh.scheme.Scheme` value):
@@ -51,7 +54,16 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ccproof.mesh.crease import INFINITE
+from ccproof.mesh.crease import (
+    INFINITE,
+    becomes_smooth,
+    chaikin_sharpness,
+    decrement,
+    mask_kind,
+    midpoint_weight,
+    rule_blend,
+    rule_code,
+)
 from ccproof.mesh.rules import Options
 from ccproof.mesh.scheme import CATMARK
 from ccproof.mesh.step_topology import step_topology, vertex_fans
@@ -131,13 +143,6 @@ class Step(NamedTuple):
     child_corners: tuple
     child_holes: np.ndarray
     csr: tuple
-
-
-def decrement_sharpness(s):
-    """Sdc's uniform decay of float32 sharpness values (0 at or below 1, infinite stays)."""
-    s = np.asarray(s, dtype=np.float64)
-    out = np.where(s > 1.0, (s.astype(_F32) - _F32(1.0)).astype(np.float64), 0.0)
-    return np.where(np.isinf(s), np.inf, out)
 
 
 def _f32_sums(seg, val, n):
@@ -376,17 +381,14 @@ def _vertex_tags(n, vertex_sharpness):
 
 def _child_edge_sharpness(pe, inc_v, n, chaikin):
     """Child sharpness of every edge at every vertex (Sdc SubdivideEdgeSharpnessesAroundVertex), per incidence."""
-    ce = decrement_sharpness(pe)
+    ce = decrement(pe)
     if chaikin:
         semi = (pe > 0) & np.isfinite(pe)
         total, nsemi = _f32_sums(inc_v[semi], pe[semi], n)
         nedge = np.bincount(inc_v, minlength=n)
         many = semi & (nsemi[inc_v] >= 2) & (nedge[inc_v] >= 2)
         if many.any():
-            s32 = pe[many].astype(_F32)
-            avg = ((total[inc_v[many]] - s32) / (nsemi[inc_v[many]] - 1).astype(_F32)).astype(_F32)
-            c = (_F32(0.75) * s32 + _F32(0.25) * avg).astype(_F32) - _F32(1.0)
-            ce[many] = np.where(c > 0, c.astype(np.float64), 0.0)
+            ce[many] = chaikin_sharpness(pe[many], total[inc_v[many]], nsemi[inc_v[many]])
     return ce
 
 
@@ -398,13 +400,13 @@ def _vertex_coefficients(t, fans, vs, pe, ce, chaikin, corners_at_level0):
     pv = vs.copy()
     if corners_at_level0:  # EDGE_AND_CORNER: a one-face boundary vertex is a corner
         pv[fans.is_bv & (k == 1)] = np.inf
-    cv = decrement_sharpness(pv)
-    prule = _rule(pv, np.bincount(inc_v[pe > 0], minlength=n))
-    crule = _rule(cv, np.bincount(inc_v[ce > 0], minlength=n))
-    blend = (prule != _SMOOTH) & (crule != prule)
-    hit = ((pe > 0) & (ce <= 0)) if chaikin else ((pe > 0) & (pe <= 1))
-    hit &= blend[inc_v]
-    vhit = blend & (pv > 0) & (cv <= 0)
+    cv = decrement(pv)
+    prule = rule_code(pv, np.bincount(inc_v[pe > 0], minlength=n))  # the rule table refine_complex reads too
+    crule = rule_code(cv, np.bincount(inc_v[ce > 0], minlength=n))
+    p, c = mask_kind(prule), mask_kind(crule)
+    blend = (p != 0) & (c != p)
+    hit = becomes_smooth(pe, ce, not chaikin) & blend[inc_v]
+    vhit = blend & becomes_smooth(pv, cv, False)
     seg = np.r_[np.flatnonzero(vhit), inc_v[hit]]
     val = np.r_[pv[vhit], pe[hit]]
     oo = np.argsort(seg, kind="stable")  # the vertex's own sharpness first, then its edges in fan order
@@ -413,24 +415,14 @@ def _vertex_coefficients(t, fans, vs, pe, ce, chaikin, corners_at_level0):
     has = cnt > 0
     w32 = (total[has] / cnt[has].astype(_F32)).astype(_F32)
     w[has] = np.minimum(w32.astype(np.float64), 1.0)
-    cp = np.where(blend, w, 1.0)  # weight of the parent's mask
-    cc = np.where(blend, 1.0 - w, 0.0)  # of the child's
-    a_smooth = np.where(prule == _SMOOTH, 1.0, 0.0) + np.where(blend & (crule == _SMOOTH), cc, 0.0)
-    a_crease_p = np.where(prule == _CREASE, cp, 0.0)
-    a_crease_c = np.where(blend & (crule == _CREASE), cc, 0.0)
-    a_corner = np.where(prule == _CORNER, cp, 0.0) + np.where(blend & (crule == _CORNER), cc, 0.0)
+    cp, cc = rule_blend(prule, crule, w, 1.0)  # the weights of the parent's and the child's masks
+    a_smooth = (p == 0) * cp + (c == 0) * cc
+    a_crease_p = (p == 2) * cp
+    a_crease_c = (c == 2) * cc
+    a_corner = (p == 3) * cp + (c == 3) * cc
     for x in (a_smooth, a_crease_p, a_crease_c, a_corner):
         x[k == 0] = 0.0  # unused vertices: no row
     return (a_smooth, a_crease_p, a_crease_c, a_corner), cv
-
-
-_SMOOTH, _CREASE, _CORNER = 0, 2, 3
-
-
-def _rule(sv, ns):
-    """Sdc's vertex rule from the vertex sharpness ``sv`` and the number ``ns`` of sharp edges at the vertex."""
-    r = np.where(ns >= 3, _CORNER, np.where(ns == 2, _CREASE, _SMOOTH))
-    return np.where(sv > 0, _CORNER, r)
 
 
 class _Rows:
@@ -551,9 +543,8 @@ class _Rows:
             ce_end[fans.inc_e[~first_end], 1] = ce[~first_end]
             both = (ce_end > 0).all(axis=1)
         else:
-            both = decrement_sharpness(es) > 0
-        mid = (es > 0) & (~two | both)
-        pw = np.where(mid, 1.0, np.where(es > 0, es.astype(_F32).astype(np.float64), 0.0))  # midpoint's weight
+            both = decrement(es) > 0
+        pw = midpoint_weight(es, ~two | both)  # the edge rule table refine_complex reads too
         tri_e = np.zeros(t.E, dtype=bool)
         if tri_smooth and two.any():
             tri_e[two] = ((t.sz[t.face[h1[two]]] == 3) | (t.sz[t.face[h2[two]]] == 3)) & (pw[two] != 1.0)

@@ -284,7 +284,7 @@ def test_vectorized_step_equals_the_tagged_rules(refdir, name):
     """The untagged Catmull-Clark step of the evaluator (numpy) against PolyMesh.refine (exact
     stencils of the tagged rules): the same faces, the same points to round-off; and the surfaces
     built on either agree."""
-    from ccproof.evaluate.step import catmark_step
+    from ccproof.mesh.step_fast import catmark_step
 
     t = read_obj_tagged(refdir / "osd_features" / "meshes" / f"catmark_{name}.obj")
     m = PolyMesh(t.vertices, [list(p) for p in t.polygons])  # the same polygons, untagged

@@ -104,8 +104,8 @@ def test_tagged_with_vertices_paths(refdir, monkeypatch):
     """Which positions the rings index: the split base vertices (all quads), the vectorized untagged
     step (nothing kept), the tagged step (kept by the build, shared when chained, never recomputed)."""
     feats = refdir / "osd_features" / "meshes"
-    from ccproof.evaluate.step import catmark_step
     from ccproof.mesh.csr import PackedCSR
+    from ccproof.mesh.step_fast import catmark_step
 
     assert catmark_step(_read(refdir, "", "pyramid")) is not None  # the vectorized path is tested above
     quads = LimitSurface(read_mesh(refdir / "osd_nonmanifold" / "meshes" / "book4.obj"), progress=False)

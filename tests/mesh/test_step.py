@@ -320,7 +320,7 @@ def test_bench_step_runs(capsys):
     finally:
         sys.argv = argv
     out = capsys.readouterr().out
-    assert out.count("new/old") == 3
+    assert out.count("new/old") == 4
 
 
 @pytest.mark.slow
@@ -418,3 +418,84 @@ def test_a_third_quad_scheme_is_a_scheme_value():
         want[n + E + f, pm.indices[off[f]:off[f + 1]]] += 1.0 / pm.sizes[f]
     assert np.array_equal(S, want)
     assert not np.array_equal(catmark_operator(n, pm.indices, pm.sizes).S.toarray(), want)
+
+
+def _fast_and_operator(pm):
+    """(catmark_step's points and faces, the operator's points, faces and |S| @ |X| with its row lengths)."""
+    from ccproof.mesh.step_fast import catmark_step
+
+    X = np.asarray(pm.vertices, dtype=np.float64)
+    st = catmark_operator(pm.n_vertices, pm.indices, pm.sizes, halfedges=pm.halfedges,
+                          options=StepOptions(pm.options, pm.level, sparse=False))
+    indptr, indices, data = st.csr
+    return catmark_step(pm), (apply_csr(st.csr, X), st.faces,
+                              apply_csr((indptr, indices, np.abs(data)), np.abs(X)), np.diff(indptr))
+
+
+@pytest.mark.parametrize("name", FEATURES)
+def test_the_fast_step_is_the_operator_to_round_off(refdir, name):
+    """catmark_step (mesh/step_fast.py: the points from the face points) against catmark_operator applied
+    (the correctly rounded exact weights summed by column) on the untagged polygons of every OpenSubdiv
+    feature mesh: the same child faces bit for bit, and every coordinate within Higham's bound of two
+    evaluations of the same row, ``2 (terms + 4) eps (|S| |X|)`` (a weight off by one part in 10^13 breaks
+    it: the forgery below). Not bit for bit: the fast path sums face points, the operator old vertices."""
+    t = read_mesh(refdir / "osd_features" / "meshes" / name)
+    pm = PolyMesh(t.vertices, [list(p) for p in t.polygons])  # the same polygons, untagged
+    fast, (X1, F1, scale, terms) = _fast_and_operator(pm)
+    assert fast is not None
+    assert np.array_equal(fast[1], F1)
+    bound = 2 * (terms[:, None] + 4) * np.finfo(float).eps * scale
+    assert (np.abs(fast[0] - X1) <= bound).all()
+    forged = X1.copy()
+    forged[0] += 1e-13 * max(abs(forged[0, 0]), 1.0)
+    assert not (np.abs(fast[0] - forged) <= bound).all()
+
+
+def test_the_fast_step_declines_tagged_meshes(refdir):
+    """Creases, corners, holes and smooth triangle subdivision are the operator's: the fast path returns None."""
+    from ccproof.mesh.step_fast import catmark_step
+
+    for name in ("catmark_cubes_infsharp.obj", "catmark_hole_test2.obj", "catmark_cube_corner4.obj"):
+        assert catmark_step(read_mesh(refdir / "osd_features" / "meshes" / name).manifold) is None, name
+    t = read_mesh(refdir / "osd_features" / "meshes" / "catmark_smoothtris1.obj")
+    assert catmark_step(PolyMesh(t.vertices, [list(p) for p in t.polygons],
+                                 options={"triangle_subdivision": "smooth"})) is None
+
+
+def test_the_rule_table_is_the_one_of_both_steps():
+    """The step and the exact stencils read one rule table (ccproof.mesh.crease.rule_code, rule_blend,
+    midpoint_weight, chaikin_sharpness, becomes_smooth):
+    against Sdc's rules written out by hand here, per (vertex sharpness, sharp edges) and per (parent, child)
+    rule: corner above two sharp edges or a sharp vertex, and the blend only from a non-smooth parent to
+    another mask (a dart uses the smooth mask)."""
+    from fractions import Fraction
+
+    from ccproof.mesh.crease import RULES, becomes_smooth, chaikin_sharpness, midpoint_weight, rule_blend, rule_code
+
+    want = {(0.0, 0): "smooth", (0.0, 1): "dart", (0.0, 2): "crease", (0.0, 3): "corner", (0.0, 7): "corner",
+            (0.5, 0): "corner", (math.inf, 2): "corner"}
+    got = rule_code(np.array([k[0] for k in want]), np.array([k[1] for k in want]))
+    assert [RULES[c] for c in got.tolist()] == list(want.values())
+    w, one = Fraction(3, 8), Fraction(1)
+    blended = {(p, c) for p in range(4) for c in range(4) if rule_blend(p, c, w, one) == (w, one - w)}
+    assert blended == {(2, 0), (2, 1), (2, 3), (3, 0), (3, 1), (3, 2)}
+    assert all(rule_blend(p, c, w, one) == (one, 0) for p in range(4) for c in range(4) if (p, c) not in blended)
+    # the edge rule: the midpoint where sharp and both halves stay sharp, the float32 sharpness as the blend
+    # where a half becomes smooth, the smooth rule (0) where not sharp; a number and an array alike
+    edges = [(0.0, True, 0.0), (-1.0, False, 0.0), (math.inf, True, 1.0), (2.5, True, 1.0), (0.1, False, 0.1),
+             (1.5, False, 1.5)]
+    for s, halves, pw in edges:
+        assert midpoint_weight(s, halves) == float(np.float32(pw)), (s, halves)
+    assert midpoint_weight(np.array([e[0] for e in edges]), np.array([e[1] for e in edges])).tolist() == [
+        float(np.float32(e[2])) for e in edges]
+    # Chaikin: 0.75 s + 0.25 mean(other semi-sharp) - 1, 0 below (edges 2, 1, 0.5 at a vertex: the sum 3.5)
+    want = [0.75 * 2 + 0.25 * 0.75 - 1, 0.75 * 1 + 0.25 * 1.25 - 1, 0.0]
+    got = chaikin_sharpness(np.array([2.0, 1.0, 0.5]), np.float32(3.5), 3)
+    assert got.tolist() == want and [chaikin_sharpness(x, np.float32(3.5), 3) for x in (2.0, 1.0, 0.5)] == want
+    # the fractional weight counts 0 < p <= 1 under uniform creasing, else p > 0 with a smooth child
+    feats = [(0.5, 0.0, True, True), (1.0, 0.0, True, True), (1.5, 0.5, True, False), (0.0, 0.0, True, False),
+             (1.5, 0.0, False, True), (1.5, 0.25, False, False), (-1.0, 0.0, False, False)]
+    assert [bool(becomes_smooth(p, c, u)) for p, c, u, _ in feats] == [x[3] for x in feats]
+    cp, cc = rule_blend(np.arange(4).repeat(4), np.tile(np.arange(4), 4), np.full(16, 0.375), 1.0)
+    assert [(float(a), float(b)) for a, b in zip(cp, cc)] == [
+        (float(x), float(y)) for x, y in (rule_blend(p, c, w, one) for p in range(4) for c in range(4))]

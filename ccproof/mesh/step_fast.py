@@ -1,13 +1,21 @@
-"""One Catmull-Clark step of an untagged manifold polygon mesh, vectorized (the fast path of the step).
+"""The fast path of the Catmull-Clark step: one step of an untagged manifold polygon mesh, from its face points.
 
-:func:`catmark_step` gives the level-1 points and quads of :meth:`ccproof.mesh.polymesh.PolyMesh.refine`
-for the meshes it takes (None for the others): the tagged setup (:mod:`ccproof.evaluate.tagged`) and
-:meth:`ccproof.evaluate.surface.LimitSurface.with_vertices` start from them.
+:func:`catmark_step` is the step of :func:`ccproof.mesh.step.catmark_operator` (``apply_csr(csr, X)``) for the
+meshes it takes (None for the others): the same child faces and vertex numbering, the same rules read through
+the scheme (:data:`ccproof.mesh.scheme.CATMARK`), the points evaluated from the face points (no operator
+assembled): equal to the operator's to round-off, not bit for bit (tests/mesh/test_step.py bounds the
+difference on the OpenSubdiv feature meshes). The evaluator's setup of untagged polygon meshes
+(:mod:`ccproof.evaluate.tagged`) and :meth:`ccproof.evaluate.surface.LimitSurface.with_vertices` start from it:
+``python scripts/bench_step.py`` measures it against the operator (assembly and product).
 """
 
 from __future__ import annotations
 
 import numpy as np
+
+from ccproof.mesh.scheme import CATMARK
+
+__all__ = ["catmark_step"]
 
 
 def catmark_step(mesh):
@@ -19,11 +27,10 @@ def catmark_step(mesh):
     :meth:`ccproof.mesh.polymesh.PolyMesh.refine`: vertex points (n), edge points (E, edges numbered
     by first occurrence along the faces' corners), face points (m); child ``offsets[f] + i`` of face
     f is ``(v_i, edge point (v_i, v_i+1), face point, edge point (v_i-1, v_i))``. Evaluated from the
-    face points (float weights of :mod:`ccproof.rule_weights`), not as stencils of the old vertices:
-    the same values to round-off. This is the one step not built on
-    :func:`ccproof.mesh.step.catmark_operator` (``S @ X``): assembling the operator costs the setup
-    of a triangle mesh 2 to 27 % more (median 8 %; ``scripts/bench_step.py``); the same child faces and vertex
-    numbering. The topology is the mesh's own (``mesh.halfedges``), not paired again.
+    face points (the float weights of :data:`~ccproof.mesh.scheme.CATMARK`), not as stencils of the old
+    vertices: the values of :func:`ccproof.mesh.step.catmark_operator` to round-off (the module docstring), the
+    same child faces and vertex numbering. The topology is the mesh's own (``mesh.halfedges``), not paired
+    again.
 
     Parameters
     ----------
@@ -37,8 +44,6 @@ def catmark_step(mesh):
         boundary vertex under "edge_and_corner"), one with unused vertices, a non-manifold edge or a
         vertex with more than one boundary edge pair.
     """
-    from ccproof.rule_weights import smooth_edge_weights
-
     opts = mesh.options
     if (mesh.edge_sharpness or mesh.vertex_sharpness or np.asarray(mesh.is_hole).any()
             or opts.triangle_subdivision != "catmark" or opts.boundary == "none"):
@@ -74,7 +79,7 @@ def catmark_step(mesh):
     h1 = first[order]  # the first half-edge of every edge, in edge order
     h2 = he.twin[h1]  # the other one (-1 on the boundary)
     a, b = org[h1], dst[h1]
-    vw, fw = smooth_edge_weights(one)
+    vw, fw = CATMARK.edge_point(one)
     ep = 0.5 * (X[a] + X[b])
     inner = h2 >= 0
     ep[inner] = vw * (X[a[inner]] + X[b[inner]]) + fw * (fp[face[h1[inner]]] + fp[face[h2[inner]]])
@@ -88,18 +93,16 @@ def _step_vertex_points(X, corners, fp, valence, bnd_h, nb_out):
     """The vertex points of :func:`catmark_step`: the smooth rule, the crease rule at the boundary vertices.
     ``corners`` = (origin, destination, face) of every half-edge, ``fp`` the face points, ``bnd_h`` the
     boundary half-edges, ``nb_out`` the boundary half-edges leaving every vertex."""
-    from ccproof.rule_weights import crease_vertex_weights, smooth_vertex_weights
-
     org, dst, face = corners
     n, one = X.shape[0], 1.0
     vp = np.empty((n, 3))
     sum_e = np.stack([np.bincount(org, weights=X[dst, c], minlength=n) for c in range(3)], axis=1)
     sum_f = np.stack([np.bincount(org, weights=fp[face, c], minlength=n) for c in range(3)], axis=1)
-    wv, we, wf = smooth_vertex_weights(valence, one)
+    wv, we, wf = CATMARK.vertex_point(valence, one)
     vp[:] = wv[:, None] * X + we[:, None] * sum_e + wf[:, None] * sum_f
     bv = np.flatnonzero(nb_out > 0)
     if bv.size:
-        cw, ce = crease_vertex_weights(one)
+        cw, ce = CATMARK.crease_vertex(one)
         bn = np.zeros((n, 3))
         np.add.at(bn, org[bnd_h], X[dst[bnd_h]])
         np.add.at(bn, dst[bnd_h], X[org[bnd_h]])
