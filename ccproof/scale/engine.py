@@ -396,34 +396,67 @@ def _honour(signum, handler):
         os.kill(os.getpid(), signum)
 
 
-#: seconds between a pool worker's checks that the process that started it is alive
+#: seconds between a pool worker's checks that the process that started it is alive (where the system
+#: cannot tell the worker of its parent's death: not Linux, or a pool started from another thread)
 PARENT_POLL_SECONDS = 0.5
 
 
-def _ignore_sigint(parent=None):  # initializer of the worker processes of process_pool
-    """Ignore Ctrl-C (left to the parent) and end this worker when ``parent`` is gone (killed by SIGKILL: no
-    process of ours outlives its parent, and the resource tracker ends with the last worker)."""
+def _pool_worker_init(parent=None, kill_with_parent=False):  # initializer of the workers of process_pool
+    """Ignore Ctrl-C (left to the parent) and end this worker when ``parent`` is gone (SIGKILL included: no
+    process of ours outlives its parent, and the resource tracker ends with the last worker).
+
+    ``kill_with_parent``: the pool was started by the parent's main thread, so the kernel may end the worker
+    with it (Linux ``PR_SET_PDEATHSIG``: at once, even in a long call that holds the interpreter lock, where
+    a watching thread would wait for the call to end); the watching thread is kept everywhere."""
     import signal
     import threading
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    if parent is not None:
-        threading.Thread(target=_exit_with, args=(parent,), daemon=True, name="ccproof-parent-watch").start()
+    if parent is None:
+        return
+    if kill_with_parent:
+        _die_with_parent()
+    threading.Thread(target=_exit_with, args=(parent,), daemon=True, name="ccproof-parent-watch").start()
+
+
+def _die_with_parent():
+    """Ask Linux to SIGKILL this process when the thread that started it ends; False where it cannot."""
+    import ctypes
+    import signal
+    import sys
+
+    if not sys.platform.startswith("linux"):
+        return False
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        return libc.prctl(1, int(signal.SIGKILL), 0, 0, 0) == 0  # 1: PR_SET_PDEATHSIG
+    except (OSError, AttributeError):
+        return False
 
 
 def _exit_with(parent):
-    while os.getppid() == parent:
+    while os.getppid() == parent:  # also closes the race of a parent dead before _die_with_parent
         time.sleep(PARENT_POLL_SECONDS)
     os._exit(1)  # reparented: the parent died without stopping us
+
+
+def _launch_workers(ex):
+    """Start every worker of a fresh executor now (they start on demand otherwise, at any later moment)."""
+    launch = getattr(ex, "_launch_processes", None)
+    if launch is not None and not getattr(ex, "_executor_manager_thread", None):
+        launch()
 
 
 @contextlib.contextmanager
 def process_pool(workers, context="spawn"):
     """A :class:`concurrent.futures.ProcessPoolExecutor` whose workers leave Ctrl-C to this process.
 
-    The workers ignore SIGINT (a terminal sends it to the whole process group: no traceback from each
-    worker); when the block ends with an exception (Ctrl-C, SIGTERM raised as one, an error) the workers
-    are terminated at once instead of finishing their tasks, and the pending tasks are cancelled.
+    Every worker is started on entry, in a window where SIGINT and SIGTERM are deferred
+    (:func:`_signals_deferred`: honoured once the workers are up) and the workers are born ignoring
+    SIGINT, so a Ctrl-C to the process group at any moment is this process's alone (no traceback of a
+    worker still starting). When the block ends with an exception (Ctrl-C, SIGTERM raised as one, an
+    error) the workers are terminated at once instead of finishing their tasks, and the pending tasks are
+    cancelled. No worker outlives this process, SIGKILL included (:func:`_pool_worker_init`).
 
     Parameters
     ----------
@@ -444,24 +477,37 @@ def process_pool(workers, context="spawn"):
     [6, 24]
     """
     import multiprocessing
+    import threading
     from concurrent.futures import ProcessPoolExecutor
 
-    ex = ProcessPoolExecutor(max_workers=workers, initializer=_ignore_sigint, initargs=(os.getpid(),),
-                             mp_context=multiprocessing.get_context(context))
+    ex = None
     try:
+        with _signals_deferred():
+            main = threading.current_thread() is threading.main_thread()
+            ex = ProcessPoolExecutor(max_workers=workers, initializer=_pool_worker_init,
+                                     initargs=(os.getpid(), main), mp_context=multiprocessing.get_context(context))
+            _launch_workers(ex)
         yield ex
     except BaseException:
-        manager = getattr(ex, "_executor_manager_thread", None)
-        for proc in list((getattr(ex, "_processes", None) or {}).values()):
-            proc.terminate()
-        ex.shutdown(wait=False, cancel_futures=True)
-        # The pool's manager thread sees the terminated workers, marks the pool broken and closes its
-        # wake-up pipe. Wait for it here (a few ms): Python 3.11's exit hook would otherwise race it and
-        # write to the closing pipe ("Exception ignored ... Bad file descriptor" after our one line).
-        if manager is not None:
-            manager.join(timeout=30)
+        if ex is not None:
+            _stop_pool(ex)
         raise
     ex.shutdown(wait=True)
+
+
+def _stop_pool(ex):
+    """Terminate the workers of ``ex`` now and cancel its pending tasks."""
+    manager = getattr(ex, "_executor_manager_thread", None)
+    for proc in list((getattr(ex, "_processes", None) or {}).values()):
+        proc.terminate()
+    ex.shutdown(wait=False, cancel_futures=True)
+    # The pool's manager thread sees the terminated workers, marks the pool broken and closes its
+    # wake-up pipe. Wait for it here (a few ms): Python 3.11's exit hook would otherwise race it and
+    # write to the closing pipe ("Exception ignored ... Bad file descriptor" after our one line).
+    if manager is not None:
+        manager.join(timeout=30)
+    for proc in list((getattr(ex, "_processes", None) or {}).values()):
+        proc.join(timeout=5)  # a manager never started (stopped before the first task) joins none
 
 
 @contextlib.contextmanager
@@ -508,8 +554,13 @@ def client_for(scheduler):
         cluster = client = None
         try:
             with _signals_deferred():  # the workers leave Ctrl-C to this process; one arriving now is raised after
+                # no dashboard; the scheduler's small HTTP server on a free port (its default 8787 may be
+                # taken: a warning line); the workers' own logs silenced below CRITICAL (a run stopped by
+                # Ctrl-C closes the scheduler under their heartbeats: 30 lines of tracebacks), the tasks'
+                # errors come back through their results
                 cluster = LocalCluster(n_workers=s.workers, threads_per_worker=1, processes=True,
-                                       dashboard_address=None, silence_logs=logging.ERROR)
+                                       dashboard_address=None, scheduler_kwargs={"dashboard_address": ":0"},
+                                       silence_logs=logging.CRITICAL)
                 client = Client(cluster)
         except BaseException:  # a Ctrl-C or SIGTERM during the start: the cluster stopped, then one line
             for part in (client, cluster):
