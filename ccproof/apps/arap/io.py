@@ -106,8 +106,8 @@ def write_uv_obj(path, mesh, result, comment=None, table=None, transforms=None, 
     --------
     >>> import os, tempfile
     >>> from ccproof.mesh.examples import grid
-    >>> from ccproof.apps.arap.meshes import compare
-    >>> res, _ = compare(grid(3, 3), methods=("c",), levels=1, eval_level=3)
+    >>> from ccproof.apps.arap.meshes import LevelPlan, compare
+    >>> res, _ = compare(grid(3, 3), methods=("c",), plan=LevelPlan(levels=1, eval_level=3))
     >>> tmp = tempfile.TemporaryDirectory()          # removed when the example ends
     >>> d = tmp.name
     >>> sidecar = write_uv_obj(os.path.join(d, "grid.obj"), grid(3, 3), res["c"])
