@@ -122,12 +122,12 @@ def one_fit(points, levels, max_steps):
     """Child process of --fit-large: one fit, printed as one JSON line."""
     import resource
 
-    from ccproof.apps.dynamics.fit import fit_points
+    from ccproof.apps.dynamics.fit import Evolution, fit_points
     from ccproof.apps.dynamics.shapes import synthetic_range_data
 
     X = synthetic_range_data("ellipsoid", points)
     t0 = time.perf_counter()
-    res = fit_points(X, levels=levels, max_steps=max_steps)
+    res = fit_points(X, levels=levels, evolution=Evolution(max_steps=max_steps))
     total = time.perf_counter() - t0
     print(json.dumps({
         "points": points, "levels": [lev.__dict__ for lev in res.levels], "total_s": total,
