@@ -685,19 +685,20 @@ def _retry_info(keys, retries, dask_scheduler=None):
     return out
 
 
-def _run_pool(call, tasks, shared, workers, retries, priority, sweep, outcomes, progress, desc, unit):
+def _run_pool(call, tasks, shared, workers, retries, priority, sweep, outcomes, label):
     """A local scheduler without Dask: ``workers`` processes of :mod:`concurrent.futures` (spawned, so no
     thread state of this process is copied), with the same retries and report as on a Dask cluster. A
     task whose worker died (``BrokenProcessPool``: every task still running in that pool) is re-run in
-    a fresh pool, at most ``retries`` times."""
+    a fresh pool, at most ``retries`` times; ``label`` = (desc, unit, show a bar)."""
     from concurrent.futures import as_completed
     from concurrent.futures.process import BrokenProcessPool
 
     order = list(range(len(tasks))) if priority is None else sorted(range(len(tasks)), key=lambda i: -priority[i])
     used = dict.fromkeys(order, 0)
     lost = dict.fromkeys(order, 0)
+    desc, unit, show = label
     bar = None
-    if progress:
+    if show:
         from tqdm import tqdm
 
         bar = tqdm(total=len(tasks), desc=desc, unit=unit)
@@ -782,7 +783,7 @@ def run_tasks(fn, tasks, scheduler=None, *, shared=(), retries=2, deterministic=
     outcomes = {}
     if isinstance(s, Scheduler) and s.kind == "local" and not dask_available():
         _run_pool(call, tasks, shared, s.workers, retries, priority, sweep, outcomes,
-                  progress and len(tasks) > 1, desc, unit)
+                  (desc, unit, progress and len(tasks) > 1))
     elif isinstance(s, Scheduler) and s.kind == "serial":
         _run_serial(call, tasks, shared, retries, sweep, outcomes, (desc, unit, progress and len(tasks) > 1))
     else:
