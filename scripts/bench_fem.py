@@ -184,8 +184,9 @@ def main(argv=None):
                          [r["assembled"]["step_s"] / r["matrix_free"]["step_s"] for r in both], [load0, load()]))
     if args.smoke:
         return 0
-    print(f"log-log slopes (>= 1k vertices): assemble K {slope(rows, lambda r: r['assemble_K_s']):.2f}, "
-          f"step {slope(rows, lambda r: r['assembled']['step_s']):.2f}")
+    if len(rows) >= 2:  # --max-level 1 measures no mesh (the --fit-large run alone)
+        print(f"log-log slopes (>= 1k vertices): assemble K {slope(rows, lambda r: r['assemble_K_s']):.2f}, "
+              f"step {slope(rows, lambda r: r['assembled']['step_s']):.2f}")
     out = {"levels": rows}
     if not args.no_fit:
         out["fit"] = bench_fit()
