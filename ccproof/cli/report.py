@@ -68,7 +68,7 @@ def collect(jobs=1, progress=True):
     and ``jobs`` is 1)."""
     paths = injectivity_files()
     if jobs > 1:
-        from ccproof.scale.engine import process_pool
+        from ccproof.scale.processes import process_pool
 
         with process_pool(jobs) as ex:  # Ctrl-C: one line, the workers stopped
             rows = list(ex.map(_row, paths))
@@ -127,7 +127,7 @@ def run(args):
 
     from ccproof.cli._output import PLOT_SUFFIXES, atomic, check_file, write_text
     from ccproof.errors import CCProofError
-    from ccproof.scale.engine import check_jobs
+    from ccproof.scale.processes import check_jobs
 
     # as every command: >= 1, at most the cores and the certificates (one line on stderr when it caps)
     jobs = check_jobs(args.jobs, tasks=None if args.tagged else len(injectivity_files()))

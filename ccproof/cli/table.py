@@ -72,7 +72,7 @@ def _remove_dead_temporaries(folder):
     import os
     import re
 
-    from ccproof.scale.engine import pid_alive
+    from ccproof.scale.processes import pid_alive
 
     n = 0
     for name in os.listdir(folder):
@@ -100,7 +100,7 @@ def run(args):
 
         from ccproof.cli._output import check_folder
         from ccproof.cli._progress import progress_enabled
-        from ccproof.scale.engine import check_jobs
+        from ccproof.scale.processes import check_jobs
         from ccproof.tables.build import DEFAULT_INTERVAL_K0
         from ccproof.tables.format import output_dir
 
@@ -108,7 +108,7 @@ def run(args):
         args.dir = str(check_folder(args.dir or str(output_dir() / "tables"), "--dir"))  # before any work
         work = [(k, args.dir) for k in ks]
         jobs = check_jobs(args.jobs, tasks=len(work))  # as every command: >= 1, at most the cores and the tasks
-        from ccproof.scale.engine import process_pool
+        from ccproof.scale.processes import process_pool
 
         _remove_dead_temporaries(args.dir)  # of a run killed before
         try:

@@ -15,7 +15,7 @@ from pathlib import Path
 import pytest
 
 from ccproof.cli import main
-from ccproof.scale import engine
+from ccproof.scale import processes
 
 ROOT = Path(__file__).resolve().parents[2]
 pytestmark = pytest.mark.skipif(not os.path.exists("/proc"), reason="reads processes from /proc")
@@ -104,7 +104,7 @@ _PARENT = '''
 import sys
 sys.path.insert(0, sys.argv[1])
 import greedy
-from ccproof.scale.engine import process_pool
+from ccproof.scale.processes import process_pool
 with process_pool(2) as ex:
     list(ex.map(greedy.task, [sys.argv[2]] * 2))
 '''
@@ -149,7 +149,7 @@ def test_report_jobs_is_checked_and_capped_like_every_command(monkeypatch, capsy
         def __exit__(self, *exc):
             return False
 
-    monkeypatch.setattr(engine, "process_pool", Pool)
+    monkeypatch.setattr(processes, "process_pool", Pool)
     for jobs in ("0", "-1"):
         assert main(["report", "--jobs", jobs]) == 2
         assert f"--jobs must be an integer >= 1 (1 runs in this process), got {jobs}" in capsys.readouterr().err
@@ -157,7 +157,7 @@ def test_report_jobs_is_checked_and_capped_like_every_command(monkeypatch, capsy
         warnings.simplefilter("always")
         assert main(["report", "--jobs", "1000", "--no-progress"]) == 130
     err = capsys.readouterr().err
-    assert started and started[0] <= engine.usable_cores(), started
+    assert started and started[0] <= processes.usable_cores(), started
     assert "--jobs 1000:" in err and "worker process" in err, err
     n = len(report.injectivity_files())
     assert started[0] <= n
@@ -185,7 +185,7 @@ def test_table_removes_the_temporaries_of_its_stopped_workers(tmp_path, monkeypa
         def __exit__(self, *exc):
             return False
 
-    monkeypatch.setattr(engine, "process_pool", Pool)
+    monkeypatch.setattr(processes, "process_pool", Pool)
     assert main(["table", "--all", "--kmax", "6", "--jobs", "1", "--dir", str(tmp_path), "--no-progress"]) == 130
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted([live.name, mine.name])
 
