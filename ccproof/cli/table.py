@@ -74,8 +74,12 @@ def _remove_dead_temporaries(folder):
 
     from ccproof.scale.processes import pid_alive
 
+    try:
+        names = os.listdir(folder)
+    except OSError:  # not there yet: the first table creates it
+        return 0
     n = 0
-    for name in os.listdir(folder):
+    for name in names:
         m = re.match(_TEMPORARY_TABLE, name)
         if m and not pid_alive(int(m.group(1))):
             try:

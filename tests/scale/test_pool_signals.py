@@ -188,6 +188,10 @@ def test_table_removes_the_temporaries_of_its_stopped_workers(tmp_path, monkeypa
     monkeypatch.setattr(processes, "process_pool", Pool)
     assert main(["table", "--all", "--kmax", "6", "--jobs", "1", "--dir", str(tmp_path), "--no-progress"]) == 130
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted([live.name, mine.name])
+    new = tmp_path / "new"  # a folder the first table creates
+    assert main(["table", "--all", "--kmax", "6", "--jobs", "1", "--dir", str(new), "--no-progress"]) == 130, \
+        capsys.readouterr().err
+    assert not new.exists()
 
 
 @pytest.mark.slow  # about 10 s: a real cluster
