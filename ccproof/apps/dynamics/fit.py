@@ -437,7 +437,8 @@ def _relax_level(model, finder, integ, data, level, params, spacing_n, hooks):
         errors.append(float(np.mean(dist)))  # of the state before this step
         springs = Springs(model, f, u, v, Xn, k)
         if two_way and reverse is not None:  # and from the surface to the data (two-way forces)
-            springs = Springs.stacked(springs, reverse.springs(integ.P)[0].pulling())
+            pull = reverse.springs(integ.P)[0].pulling()
+            springs = springs if pull is None else Springs.stacked(springs, pull)
         info = integ.step(springs=springs)
         cg += info.iterations
         energies.append(model.energy(integ.P) + springs.energy(integ.P))

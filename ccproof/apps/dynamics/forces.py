@@ -130,9 +130,9 @@ class Springs:
         return 0.5 * float(np.sum(self.stiffness * self.lengths(P) ** 2))
 
     def pulling(self):
-        """The springs with a constant > 0: the same force, matrix and energy (the others add exact zeros), on
-        fewer rows (a fit's surface -> data springs leave most samples at 0: their rows were most of a step's
-        memory).
+        """The springs with a constant > 0 (None if there is none): the same force, matrix and energy (the others
+        add exact zeros), on fewer rows (a fit's surface -> data springs leave most samples at 0: their rows were
+        most of a step's memory).
 
         >>> import numpy as np
         >>> from ccproof.apps.dynamics.meshes import paper_initial_model
@@ -142,10 +142,14 @@ class Springs:
         >>> p = s.pulling()
         >>> p.count, bool(np.allclose(p.force(m.vertices), s.force(m.vertices)))
         (1, True)
+        >>> Springs(m, [0], [0.5], [0.5], [[0, 0, 9.0]], 0.0).pulling() is None
+        True
         """
         keep = np.flatnonzero(self.stiffness > 0)
         if keep.size == self.count:
             return self
+        if keep.size == 0:
+            return None
         return Springs(self.model, self.faces[keep], self.u[keep], self.v[keep], self.anchors[keep],
                        self.stiffness[keep], jacobian=self.jacobian[keep])
 
