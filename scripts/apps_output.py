@@ -3,7 +3,7 @@ docs/qmv98.md section 4 ("Equilibrium"), printed, not estimated.
 
   python scripts/apps_output.py --arap [--osd]  # bunny, 16 charts: control UVs under the corners-only rule
                                                 # (--osd: folds counted by OpenSubdiv itself too)
-  python scripts/apps_output.py --arap --metric off   # without the minimax (export_control(metric=False))
+  python scripts/apps_output.py --arap --metric off   # without the minimax (ControlOptions(metric=False))
   python scripts/apps_output.py --fit      # bunny scan: fit steps, energy, criterion, two-sided error
   python scripts/apps_output.py --fit-table  # docs/qmv98.md section 4's tables: synthetic data and the bunny,
                                              # defaults and the regularization a = 1e-4, 1e-5, 1e-6 (b = a / 10)
@@ -100,11 +100,11 @@ def osd_folds(exe, path, levels=(1, 2, 3)):
 
 def arap(eval_level, out_dir, use_osd, refines=("0", "auto"), metric="auto"):
     from ccproof.apps.arap.charts import segment_by_normals
-    from ccproof.apps.arap.core import ChartTexture, texture_metrics
-    from ccproof.apps.arap.fvar import FOLD_LEVELS, export_control, subdivided_folds
+    from ccproof.apps.arap.core import ChartTexture, Solver, texture_metrics
+    from ccproof.apps.arap.fvar import FOLD_LEVELS, ControlOptions, export_control, subdivided_folds
     from ccproof.apps.arap.hierarchy import ChartHierarchy
     from ccproof.apps.arap.io import write_uv_obj
-    from ccproof.apps.arap.meshes import auto_refine, compare
+    from ccproof.apps.arap.meshes import LevelPlan, auto_refine, compare
     from ccproof.apps.arap.metrics import Metrics
     from ccproof.mesh import read_obj
 
@@ -117,8 +117,8 @@ def arap(eval_level, out_dir, use_osd, refines=("0", "auto"), metric="auto"):
           f"(E_angle, E_area minimum 2, E_stretch minimum 1); folds at levels {FOLD_LEVELS}")
     for refine in [auto_refine(mesh, labels) if r == "auto" else int(r) for r in refines]:
         t0 = time.perf_counter()
-        res, _ = compare(mesh, labels, methods=("c",), levels=3, eval_level=eval_level, refine=refine,
-                         release=True, accel=5)
+        res, _ = compare(mesh, labels, ("c",), LevelPlan(levels=3, eval_level=eval_level, refine=refine),
+                         Solver(accel=5), release=True)
         r = res["c"]
         t1 = time.perf_counter()
         print(f"\n--refine {refine}: exact texture (c)            {_fmt(r.metrics)}   ({t1 - t0:.1f} s)")
@@ -139,7 +139,7 @@ def arap(eval_level, out_dir, use_osd, refines=("0", "auto"), metric="auto"):
             print(f"    OpenSubdiv's folds of that file: {osd_folds(exe, old)}")
         t2 = time.perf_counter()
         # the CLI's defaults (--metric on / off: the minimax on every refinement that misses the target / never)
-        exp = export_control(r, eval_level=eval_level, levels=3, max_faces=150_000, metric=metric)
+        exp = export_control(r, eval_level, 3, ControlOptions(max_faces=150_000, metric=metric))
         t3 = time.perf_counter()
         ex = np.subtract(r.metrics.as_tuple(), (2.0, 2.0, 1.0))
         for extra, f, m in exp.tried:
@@ -173,15 +173,16 @@ def band(eval_level, chart, weights):
     from scipy.spatial import cKDTree
 
     from ccproof.apps.arap.charts import segment_by_normals
-    from ccproof.apps.arap.core import ChartTexture, optimize_chart, texture_metrics
+    from ccproof.apps.arap.core import ChartTexture, Solver, optimize_chart, texture_metrics
     from ccproof.apps.arap.fvar import corners_only_texture, metric_polish
-    from ccproof.apps.arap.meshes import auto_refine, compare, refine_mesh
+    from ccproof.apps.arap.meshes import LevelPlan, auto_refine, compare, refine_mesh
     from ccproof.mesh import read_obj
 
     mesh = read_obj(BUNNY)
     labels = segment_by_normals(mesh)
     ref = auto_refine(mesh, labels)
-    res, _ = compare(mesh, labels, methods=("c",), levels=3, eval_level=eval_level, refine=ref, release=True, accel=5)
+    res, _ = compare(mesh, labels, ("c",), LevelPlan(levels=3, eval_level=eval_level, refine=ref), Solver(accel=5),
+                     release=True)
     tex = res["c"].textures[chart]
     h = tex.hierarchy
     ev, evx = eval_level - ref, eval_level - ref - 1
@@ -300,9 +301,9 @@ def main(argv=None):
     ap.add_argument("--osd", action="store_true", help="--arap: also count folds with OpenSubdiv itself")
     ap.add_argument("--refines", default="0,auto", help="--arap: the --refine values (default 0,auto)")
     ap.add_argument("--metric", choices=("auto", "on", "off"), default="auto",
-                    help="--arap: export_control(metric=...): the minimax over metric-energy candidates on the last "
-                         "refinement allowed where the ARAP polish misses the target (auto, default), on every "
-                         "refinement that misses it (on), never (off)")
+                    help="--arap: ControlOptions(metric=...) of export_control: the minimax over metric-energy "
+                         "candidates on the last refinement allowed where the ARAP polish misses the target (auto, "
+                         "default), on every refinement that misses it (on), never (off)")
     ap.add_argument("--out-dir", type=Path, default=Path("out/apps_output"), help="control meshes of --arap")
     a = ap.parse_args(argv)
     if not (a.arap or a.fit or a.fit_table or a.band is not None):

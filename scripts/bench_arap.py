@@ -42,7 +42,7 @@ from pathlib import Path
 import numpy as np
 
 from ccproof.apps.arap.charts import charts_from_labels, grow_patch, segment_by_normals
-from ccproof.apps.arap.core import ChartTexture, initial_texture, optimize_chart, run_method, texture_metrics
+from ccproof.apps.arap.core import ChartTexture, Solver, initial_texture, optimize_chart, run_method, texture_metrics
 from ccproof.apps.arap.hierarchy import ChartHierarchy
 from ccproof.apps.arap.metrics import Metrics
 from ccproof.apps.arap.samples import build_samples
@@ -118,7 +118,7 @@ def run_case(name, mesh, charts, engine, tol, repeat):
     t0 = time.perf_counter()
     tex_d, it_d = [], 0
     for h in hs:
-        tex, s, it, _ = run_method(h, "d", tol=tol, engine=engine, baseline_max_iter=20000)
+        tex, s, it, _ = run_method(h, "d", solver=Solver(tol=tol, engine=engine, baseline_max_iter=20000))
         tex_d.append(tex)
         it_d += it
     t_d = time.perf_counter() - t0
@@ -174,7 +174,7 @@ def one_run(args):
     """Child process of --scale: one method on one mesh, printed as one JSON line."""
     import resource
 
-    from ccproof.apps.arap.meshes import auto_refine, compare, refine_mesh
+    from ccproof.apps.arap.meshes import LevelPlan, auto_refine, compare, refine_mesh
 
     mesh = read_obj(args.mesh)
     if args.subdivide:
@@ -184,9 +184,8 @@ def one_run(args):
     t_seg = time.perf_counter() - t0
     refine = auto_refine(mesh, labels) if args.refine == "auto" else int(args.refine)
     t0 = time.perf_counter()
-    res, hs = compare(mesh, labels, (args.one,), eval_level=args.eval_level, engine=args.engine_one,
-                      refine=refine, release=True, baseline_max_iter=args.baseline_max_iter, progress=False,
-                      accel=5)
+    res, hs = compare(mesh, labels, (args.one,), LevelPlan(eval_level=args.eval_level, refine=refine),
+                      Solver(engine=args.engine_one, baseline_max_iter=args.baseline_max_iter, accel=5), release=True)
     total = time.perf_counter() - t0
     r = res[args.one]
     conv = None

@@ -130,25 +130,27 @@ def line(n, noise, levels, res, q, secs, peak):
 
 
 def main(argv=None):
+    from ccproof.apps.dynamics.fit import Evolution, FitSprings, SurfaceCheck
+
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--n", type=int, nargs="*", default=[10_000, 30_000, 100_000])
     ap.add_argument("--noise", type=float, nargs="*", default=[0.0, 0.2], help="in %% of the diameter")
     ap.add_argument("--levels", type=int, nargs="*", default=[1, 2])
-    ap.add_argument("--surface-spring", type=float, default=None, help="fit_points' surface_spring_total")
+    ap.add_argument("--surface-spring", type=float, default=None, help="FitSprings.surface_total of fit_points")
     ap.add_argument("--stray-distance", type=float, default=None,
-                    help="fit_points' stray_distance_percent (%% of the diameter; default 3 data spacings)")
-    ap.add_argument("--max-steps", type=int, default=None, help="fit_points' max_steps (default: its own)")
+                    help="SurfaceCheck.stray_distance_percent of fit_points (%% of the diameter; default 3 spacings)")
+    ap.add_argument("--max-steps", type=int, default=None, help="Evolution.max_steps of fit_points (default: its own)")
     ap.add_argument("--smoke", action="store_true", help="one tiny run (1,000 points, level 0, 5 steps)")
     ap.add_argument("--where", action="store_true", help="print the true faces nearest to the far part")
     args = ap.parse_args(argv)
     mesh, S, finder = true_surface()
-    kw = {} if args.surface_spring is None else {"surface_spring_total": args.surface_spring}
+    kw = {} if args.surface_spring is None else {"springs": FitSprings(surface_total=args.surface_spring)}
     if args.smoke:
         args.n, args.noise, args.levels, args.max_steps = [1000], [0.0], [0], 5
     if args.stray_distance is not None:
-        kw["stray_distance_percent"] = args.stray_distance
+        kw["check"] = SurfaceCheck(stray_distance_percent=args.stray_distance)
     if args.max_steps is not None:
-        kw["max_steps"] = args.max_steps
+        kw["evolution"] = Evolution(max_steps=args.max_steps)
     print("(timings on a machine shared with other jobs)")
     for n in args.n:
         for noise in args.noise:

@@ -33,7 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from ccproof.apps.arap.charts import grow_patch, segment_by_normals
-from ccproof.apps.arap.core import METHOD_NAMES, ChartTexture, initial_texture, optimize_chart, texture_metrics
+from ccproof.apps.arap.core import METHOD_NAMES, ChartTexture, Solver, initial_texture, optimize_chart, texture_metrics
 from ccproof.apps.arap.hierarchy import ChartHierarchy
 from ccproof.apps.arap.meshes import compare
 from ccproof.apps.arap.metrics import sample_metrics
@@ -337,7 +337,7 @@ def main(argv=None):
     for name in args.cases.split(","):
         t0 = time.perf_counter()
         mesh, labels, view, level, desc = case(name)
-        results, hs = compare(mesh, labels, engine=engine)
+        results, hs = compare(mesh, labels, solver=Solver(engine=engine))
         entry = {"description": desc, "charts": len(hs), "faces": int((labels >= 0).sum()), "methods": {}}
         for m, r in results.items():
             met = r.metrics

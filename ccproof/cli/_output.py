@@ -33,7 +33,7 @@ import uuid
 from pathlib import Path
 
 from ccproof.errors import CCProofError
-from ccproof.scale.engine import pid_alive
+from ccproof.scale.processes import pid_alive
 
 __all__ = ["check_file", "check_folder", "check_outputs", "atomic", "write_text", "is_folder_request",
            "meshio_suffixes", "PLOT_SUFFIXES", "OutputPlan"]

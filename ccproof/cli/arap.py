@@ -220,49 +220,14 @@ def _levels_within_budget(args, mesh, labels, hierarchies, methods, refine):
 
 def run(args) -> int:
     plan = _output_plan(args)  # every file written, and the options among themselves: before any work
-    from ccproof.apps.arap.charts import read_labels, segment_by_normals
-    from ccproof.apps.arap.core import VARIANTS
-    from ccproof.apps.arap.meshes import auto_refine
-    from ccproof.apps.control_file import children_labels, read_control_mesh
-    from ccproof.cli._progress import phase, progress_enabled
+    from ccproof.apps.arap.hierarchy import ChartHierarchy
+    from ccproof.apps.arap.meshes import auto_refine, mesh_charts
     from ccproof.errors import CCProofError
 
     refine = _check_options(args)
-    with phase(f"read {args.mesh}", progress_enabled(args)):
-        mesh, origin = read_control_mesh(args.mesh)
-    n_file = mesh.n_faces if origin is None else int(origin.max()) + 1
-    if origin is not None:
-        steps = getattr(mesh, "global_steps", 1)
-        what = ("not all quads: subdivided once" if steps == 1 else
-                f"semi-sharp Chaikin tags: subdivided {steps} times")
-        print(f"{args.mesh}: {n_file} faces, {what} (Catmull-Clark) to {mesh.n_faces} quads, the same limit "
-              f"surface", file=sys.stderr)
-    if args.charts:
-        labels = children_labels(read_labels(args.charts, n_file), origin)
-    elif args.segment == "normals":
-        labels = segment_by_normals(mesh, max_angle=args.normal_angle)
-    else:
-        labels = None
-    ours = VARIANTS[args.variant]
-    methods = [ours]
-    engine = args.engine
-    if args.baselines:
-        other = "b" if ours == "c" else "c"
-        methods = ["a", other, ours, "d"]
-        methods = sorted(set(methods), key="abcd".index)
-        if engine == "auto":
-            try:
-                import igl  # noqa: F401
-
-                engine = "igl"
-            except ImportError:
-                engine = "numpy"
-    elif engine == "auto":
-        engine = "numpy"
+    mesh, labels = _read_input(args)
+    ours, methods, engine = _methods(args)
     refine = auto_refine(mesh, labels) if refine is None else refine
-    from ccproof.apps.arap.hierarchy import ChartHierarchy
-    from ccproof.apps.arap.meshes import mesh_charts
-
     hierarchies = [ChartHierarchy(mesh, fc) for fc in mesh_charts(mesh, labels)]
     levels, eval_level, out_level = _levels_within_budget(args, mesh, labels, hierarchies, methods, refine)
     args.levels = levels
@@ -280,25 +245,10 @@ def run(args) -> int:
     if judged is None:
         return 1  # a negative verdict: folded UV triangles, nothing written
     results, refine = judged
-    nch = len(results[ours].textures)
-    print(f"{args.mesh}: {mesh.n_vertices} vertices, {mesh.n_faces} faces, {nch} chart(s); "
+    print(f"{args.mesh}: {mesh.n_vertices} vertices, {mesh.n_faces} faces, {len(results[ours].textures)} chart(s); "
           f"levels {args.start_level}..{args.levels}, refine {refine}, metrics at level {eval_level}, "
           f"baseline engine {engine}")
-    print(format_table(results, eval_level))
-    flips = results[ours].metrics.flips
-    if flips:
-        print(f"ccproof arap: warning: {results[ours].name}: {flips} flipped samples at level {eval_level} (the "
-              f"texture folds there; E_stretch {results[ours].metrics.E_stretch:.3g}); {_finer(args, nch)}",
-              file=sys.stderr)
-    lv = results[ours].levels
-    for k in range(len(lv[0]) if lv and lv[0] else 0):
-        its = sum(c[k].iterations for c in lv)
-        spi = sum(c[k].seconds for c in lv) / max(its, 1)
-        e0 = sum(c[k].energy_start for c in lv)
-        e1 = sum(c[k].energy_end for c in lv)
-        print(f"  {results[ours].name}: level {lv[0][k].level}: {its} iterations, "
-              f"{1e3 * spi:.2f} ms per chart iteration, energy {e0:.6g} -> {e1:.6g}, "
-              f"converged: {all(c[k].converged for c in lv)}")
+    _print_results(args, results, ours, eval_level)
     table = {
         m: {"E_angle": r.metrics.E_angle, "E_area": r.metrics.E_area, "E_stretch": r.metrics.E_stretch,
             "flips_control": r.flips_control, "flips_eval": r.metrics.flips, "seconds": r.seconds,
@@ -316,21 +266,85 @@ def run(args) -> int:
     return 0
 
 
+def _read_input(args):
+    """The control mesh (all quads: a mesh with other faces or semi-sharp tags subdivided, said on stderr) and
+    its chart labels (--charts, --segment; None: one chart)."""
+    from ccproof.apps.arap.charts import read_labels, segment_by_normals
+    from ccproof.apps.control_file import children_labels, read_control_mesh
+    from ccproof.cli._progress import phase, progress_enabled
+
+    with phase(f"read {args.mesh}", progress_enabled(args)):
+        mesh, origin = read_control_mesh(args.mesh)
+    n_file = mesh.n_faces if origin is None else int(origin.max()) + 1
+    if origin is not None:
+        steps = getattr(mesh, "global_steps", 1)
+        what = ("not all quads: subdivided once" if steps == 1 else
+                f"semi-sharp Chaikin tags: subdivided {steps} times")
+        print(f"{args.mesh}: {n_file} faces, {what} (Catmull-Clark) to {mesh.n_faces} quads, the same limit "
+              f"surface", file=sys.stderr)
+    if args.charts:
+        return mesh, children_labels(read_labels(args.charts, n_file), origin)
+    if args.segment == "normals":
+        return mesh, segment_by_normals(mesh, max_angle=args.normal_angle)
+    return mesh, None
+
+
+def _methods(args):
+    """(our method, the methods run, the baselines' ARAP engine) of --variant, --baselines and --engine."""
+    from ccproof.apps.arap.core import VARIANTS
+
+    ours = VARIANTS[args.variant]
+    if not args.baselines:
+        return ours, [ours], "numpy" if args.engine == "auto" else args.engine
+    other = "b" if ours == "c" else "c"
+    methods = sorted({"a", other, ours, "d"}, key="abcd".index)
+    engine = args.engine
+    if engine == "auto":
+        try:
+            import igl  # noqa: F401
+
+            engine = "igl"
+        except ImportError:
+            engine = "numpy"
+    return ours, methods, engine
+
+
+def _print_results(args, results, ours, eval_level):
+    """The table of the methods, a warning for flipped samples, and our method's levels."""
+    nch = len(results[ours].textures)
+    print(format_table(results, eval_level))
+    flips = results[ours].metrics.flips
+    if flips:
+        print(f"ccproof arap: warning: {results[ours].name}: {flips} flipped samples at level {eval_level} (the "
+              f"texture folds there; E_stretch {results[ours].metrics.E_stretch:.3g}); {_finer(args, nch)}",
+              file=sys.stderr)
+    lv = results[ours].levels
+    for k in range(len(lv[0]) if lv and lv[0] else 0):
+        its = sum(c[k].iterations for c in lv)
+        spi = sum(c[k].seconds for c in lv) / max(its, 1)
+        e0 = sum(c[k].energy_start for c in lv)
+        e1 = sum(c[k].energy_end for c in lv)
+        print(f"  {results[ours].name}: level {lv[0][k].level}: {its} iterations, "
+              f"{1e3 * spi:.2f} ms per chart iteration, energy {e0:.6g} -> {e1:.6g}, "
+              f"converged: {all(c[k].converged for c in lv)}")
+
+
 #: the finest --refine the default tries against folded --out triangles
 MAX_FOLD_REFINE = 4
 
 
 def _optimize(args, mesh, labels, methods, engine, refine, eval_level, sample_level, hierarchies):
     """The methods' results at ``refine`` (compare, with the memory errors named)."""
-    from ccproof.apps.arap.meshes import MemoryBudgetError, compare
+    from ccproof.apps.arap.core import Solver
+    from ccproof.apps.arap.meshes import LevelPlan, MemoryBudgetError, compare
     from ccproof.cli._progress import progress_enabled
     from ccproof.errors import CCProofError
 
     try:
-        results, _ = compare(mesh, labels, methods, levels=args.levels, start_level=args.start_level,
-                             eval_level=eval_level, tol=args.tol, max_iter=args.max_iter, engine=engine,
-                             refine=refine, sample_level=sample_level, release=True, hierarchies=hierarchies,
-                             max_memory=args.max_memory * 1e9, progress=progress_enabled(args), accel=args.accel)
+        plan = LevelPlan(args.levels, args.start_level, eval_level, refine, sample_level)
+        solver = Solver(tol=args.tol, max_iter=args.max_iter, accel=args.accel, engine=engine)
+        results, _ = compare(mesh, labels, methods, plan, solver, release=True, hierarchies=hierarchies,
+                             max_memory=args.max_memory * 1e9, progress=progress_enabled(args))
     except MemoryBudgetError:
         raise
     except MemoryError as exc:
@@ -503,11 +517,11 @@ def _write_control(args, plan, r, surf, eval_level, comment, table, write_uv_obj
     """--control-out: control UVs for the face-varying 'corners only' rule, and what a tool will see."""
     from dataclasses import replace
 
-    from ccproof.apps.arap.fvar import FOLD_LEVELS, export_control
+    from ccproof.apps.arap.fvar import FOLD_LEVELS, ControlOptions, export_control
     from ccproof.cli._progress import progress_enabled
 
-    exp = export_control(r, eval_level=eval_level, levels=args.levels, accel=args.accel, max_extra=args.control_extra,
-                         max_faces=args.control_max_faces, progress=progress_enabled(args))
+    options = ControlOptions(max_extra=args.control_extra, max_faces=args.control_max_faces, accel=args.accel)
+    exp = export_control(r, eval_level, args.levels, options, progress=progress_enabled(args))
     times = r.refine + exp.extra
     note = f"\ncontrol mesh: the input subdivided {times} times (Catmull-Clark)" if times else ""
     note += ("\ncontrol UVs: least-squares fit of the exact texture's limit UVs under the rule below, polished by "

@@ -112,7 +112,7 @@ def run(args) -> int:
     import numpy as np
 
     from ccproof.apps.control_file import merge_labels, read_control_mesh, write_control_obj
-    from ccproof.apps.dynamics.fit import fit_points
+    from ccproof.apps.dynamics.fit import Evolution, FitSprings, SurfaceCheck, fit_points
     from ccproof.apps.dynamics.model import Material
     from ccproof.cli._notice import compile_notice
     from ccproof.cli._progress import progress_enabled
@@ -136,11 +136,13 @@ def run(args) -> int:
     mu = args.mass if args.scheme == "massless" or args.mass > 0 else 1.0
     material = Material(mu=mu, gamma=args.damping, a11=args.tension, a22=args.tension, b11=args.rigidity,
                         b12=2 * args.rigidity, b22=args.rigidity)
-    res = fit_points(X, init=init, levels=args.levels, material=material, spring_total=args.spring, dt=args.dt,
-                     scheme=args.scheme, max_steps=args.max_steps, tol=args.tol, init_scale=args.init_scale,
-                     truncation=args.truncation, progress=progress_enabled(args), sample_level=args.sample_level,
-                     stray_distance_percent=args.stray_distance, stray_fraction=args.stray_fraction,
-                     surface_spring_total=args.surface_spring, spring_points=args.spring_points or None)
+    springs = FitSprings(total=args.spring, surface_total=args.surface_spring, points=args.spring_points or None)
+    evolution = Evolution(scheme=args.scheme, dt=args.dt, max_steps=args.max_steps, tol=args.tol,
+                          truncation=args.truncation)
+    check = SurfaceCheck(sample_level=args.sample_level, stray_distance_percent=args.stray_distance,
+                         stray_fraction=args.stray_fraction)
+    res = fit_points(X, init=init, levels=args.levels, material=material, springs=springs, evolution=evolution,
+                     check=check, init_scale=args.init_scale, progress=progress_enabled(args))
     print(f"data: {X.shape[0]} points from {args.points}; minimal enclosing sphere diameter {res.diameter:.6g}")
     print("level  vertices  faces  steps  equilibrium  max error %  mean error %  seconds")
     for i, lev in enumerate(res.levels):

@@ -19,7 +19,8 @@ from __future__ import annotations
 
 def add_arguments(p):
     p.add_argument("--write", action="store_true", help="write docs/certified_valences.md")
-    p.add_argument("--jobs", type=int, default=1, help="worker processes (default 1)")
+    p.add_argument("--jobs", type=int, default=1, help="worker processes (default 1; >= 1, at most the cores of "
+                   "this machine and the number of certificates)")
     p.add_argument("--plot", default=None, help="write a PNG plot of the margins against k")
     from ccproof.cli._progress import add_progress_argument
 
@@ -54,15 +55,20 @@ def _row(path):
     return row
 
 
-def collect(jobs=1, progress=True):
-    """One row per injectivity certificate, each from a fresh verifier run (a progress bar when ``progress``
-    and ``jobs`` is 1)."""
+def injectivity_files():
+    """The injectivity certificates of the checkout (or of the installed package)."""
     from ccproof.certify.verify import certificate_files
     from ccproof.tables.format import certificates_dir
 
-    paths = [p for p in certificate_files(certificates_dir()) if p.parent.name == "injectivity"]
+    return [p for p in certificate_files(certificates_dir()) if p.parent.name == "injectivity"]
+
+
+def collect(jobs=1, progress=True):
+    """One row per injectivity certificate, each from a fresh verifier run (a progress bar when ``progress``
+    and ``jobs`` is 1)."""
+    paths = injectivity_files()
     if jobs > 1:
-        from ccproof.scale.engine import process_pool
+        from ccproof.scale.processes import process_pool
 
         with process_pool(jobs) as ex:  # Ctrl-C: one line, the workers stopped
             rows = list(ex.map(_row, paths))
@@ -121,9 +127,10 @@ def run(args):
 
     from ccproof.cli._output import PLOT_SUFFIXES, atomic, check_file, write_text
     from ccproof.errors import CCProofError
+    from ccproof.scale.processes import check_jobs
 
-    if args.jobs < 1:
-        raise CCProofError(f"--jobs must be >= 1, got {args.jobs}")
+    # as every command: >= 1, at most the cores and the certificates (one line on stderr when it caps)
+    jobs = check_jobs(args.jobs, tasks=None if args.tagged else len(injectivity_files()))
     if args.tagged and (args.write or args.plot):
         raise CCProofError(f"{'--write' if args.write else '--plot'} applies to the table of the valences, not to "
                            "--tagged")
@@ -137,7 +144,7 @@ def run(args):
     if args.tagged:
         print(tagged_table())
         return 0
-    rows = collect(args.jobs, progress_enabled(args))
+    rows = collect(jobs, progress_enabled(args))
     md = markdown(rows)
     print(md)
     if args.write:

@@ -62,6 +62,34 @@ def _build_one(args):
     return str(write_table(k, directory))
 
 
+#: the temporary name of a table being written by process PID (ccproof.tables.build.write_table)
+_TEMPORARY_TABLE = r"^\.tmp-(\d+)-k(?:_ge_)?[0-9]+\.json$"
+
+
+def _remove_dead_temporaries(folder):
+    """Remove the temporary tables in ``folder`` whose writer is gone (a worker stopped in the middle of a
+    write, or killed with its parent); returns how many."""
+    import os
+    import re
+
+    from ccproof.scale.processes import pid_alive
+
+    try:
+        names = os.listdir(folder)
+    except OSError:  # not there yet: the first table creates it
+        return 0
+    n = 0
+    for name in names:
+        m = re.match(_TEMPORARY_TABLE, name)
+        if m and not pid_alive(int(m.group(1))):
+            try:
+                os.unlink(os.path.join(folder, name))
+                n += 1
+            except OSError:
+                pass
+    return n
+
+
 def run(args):
     import json
 
@@ -76,7 +104,7 @@ def run(args):
 
         from ccproof.cli._output import check_folder
         from ccproof.cli._progress import progress_enabled
-        from ccproof.scale.engine import check_jobs
+        from ccproof.scale.processes import check_jobs
         from ccproof.tables.build import DEFAULT_INTERVAL_K0
         from ccproof.tables.format import output_dir
 
@@ -84,12 +112,16 @@ def run(args):
         args.dir = str(check_folder(args.dir or str(output_dir() / "tables"), "--dir"))  # before any work
         work = [(k, args.dir) for k in ks]
         jobs = check_jobs(args.jobs, tasks=len(work))  # as every command: >= 1, at most the cores and the tasks
-        from ccproof.scale.engine import process_pool
+        from ccproof.scale.processes import process_pool
 
-        with process_pool(jobs) as ex:  # Ctrl-C: one line, the workers stopped
-            for _ in tqdm(ex.map(_build_one, work), total=len(work), desc="tables", unit="table",
-                          disable=not progress_enabled(args)):
-                pass
+        _remove_dead_temporaries(args.dir)  # of a run killed before
+        try:
+            with process_pool(jobs) as ex:  # Ctrl-C: one line, the workers stopped
+                for _ in tqdm(ex.map(_build_one, work), total=len(work), desc="tables", unit="table",
+                              disable=not progress_enabled(args)):
+                    pass
+        finally:  # a worker stopped while it wrote leaves its temporary table: nothing half-written stays
+            _remove_dead_temporaries(args.dir)
         print(f"wrote {len(work)} tables; {describe_available(args.dir)}")
         return 0
     if args.valence is None:

@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 from functools import partial
 
 from ccproof.errors import CCProofError
+from ccproof.scale.processes import check_jobs, pid_alive, process_pool, signals_deferred  # noqa: F401 (re-export)
 
 MISSING_EXTRA = ("a Dask scheduler needs the optional extra 'scale': pip install 'ccproof[scale]' "
                  "(or run with --serial / --scheduler local:1)")
@@ -70,21 +71,6 @@ def dask_available():
     return True
 
 
-
-def pid_alive(pid) -> bool:
-    """Is process ``pid`` alive (or not ours to signal)? The writers of temporary files are judged by it.
-
-    >>> pid_alive(os.getpid())
-    True
-    """
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except (PermissionError, OverflowError):
-        return True
-    return True
-
 @dataclass(frozen=True)
 class Scheduler:
     """A parsed scheduler spec (:func:`parse_scheduler`).
@@ -116,61 +102,6 @@ class Scheduler:
         if self.kind == "local":
             return f"local:{self.workers}"
         return self.address if self.kind == "address" else "serial"
-
-
-def usable_cores():
-    """The cores this process may run on (its CPU affinity where the system has one).
-
-    >>> usable_cores() >= 1
-    True
-    """
-    try:
-        return max(1, len(os.sched_getaffinity(0)))
-    except (AttributeError, OSError):
-        return max(1, os.cpu_count() or 1)
-
-
-def check_jobs(n, option="--jobs", tasks=None):
-    """The worker processes of ``option N``, validated the same way by every command.
-
-    Parameters
-    ----------
-    n : int
-    option : str
-        How the message names it (``--jobs``, ``--scheduler local:N``).
-    tasks : int, optional
-        The number of tasks, when known: more workers than tasks would idle.
-
-    Returns
-    -------
-    int
-        ``n``, capped at :func:`usable_cores` and at ``tasks`` (a warning says so when it caps).
-
-    Raises
-    ------
-    CCProofError
-        For ``n < 1`` (0 and -1 are not "the default").
-
-    Examples
-    --------
-    >>> check_jobs(1), check_jobs(1, tasks=1)
-    (1, 1)
-    >>> check_jobs(0)
-    Traceback (most recent call last):
-    ...
-    ccproof.errors.CCProofError: --jobs must be an integer >= 1 (1 runs in this process), got 0
-    """
-    import warnings
-
-    if isinstance(n, bool) or not isinstance(n, int) or n < 1:
-        raise CCProofError(f"{option} must be an integer >= 1 (1 runs in this process), got {n}")
-    cores = usable_cores()
-    cap = cores if tasks is None else max(1, min(cores, tasks))
-    if n > cap:
-        why = f"the {cores} cores of this machine" if cap == cores else f"the {tasks} tasks"
-        warnings.warn(f"{option} {n}: {cap} worker process{'es' if cap > 1 else ''} ({why})", stacklevel=2)
-        return cap
-    return n
 
 
 def parse_scheduler(spec=None, *, serial=False):
@@ -307,164 +238,6 @@ def scheduler_from_args(args):
 
 
 @contextlib.contextmanager
-def _sigint_ignored():
-    """Ignore SIGINT while worker processes are started: they inherit the disposition, so a Ctrl-C (sent
-    to the whole process group by a terminal) reaches only this process, which stops them cleanly,
-    instead of a traceback from every worker. Does nothing outside the main thread."""
-    import signal
-    import threading
-
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGINT, previous)
-
-
-@contextlib.contextmanager
-def _children_ignore_sigint():
-    """Processes that multiprocessing spawns meanwhile (from any thread: a cluster's workers and their
-    helpers) start with SIGINT ignored, as they would if it were ignored here: their command runs through
-    ``/bin/sh -c 'trap "" INT; exec ...'`` (an ignored signal stays ignored across exec, and Python keeps an
-    ignored SIGINT ignored). A Ctrl-C sent by a terminal to the whole process group then reaches only this
-    process. Returns False (does nothing) where there is no such spawn (not POSIX, no /bin/sh)."""
-    import multiprocessing.util as mpu
-
-    original = getattr(mpu, "spawnv_passfds", None)
-    if original is None or not os.path.exists("/bin/sh"):
-        yield False
-        return
-
-    def spawn(path, args, passfds):
-        sh = os.fsencode("/bin/sh") if isinstance(path, bytes) else "/bin/sh"
-        return original(sh, [sh, "-c", 'trap "" INT; exec "$@"', "sh", path, *args[1:]], passfds)
-
-    mpu.spawnv_passfds = spawn
-    try:
-        yield True
-    finally:
-        mpu.spawnv_passfds = original
-
-
-#: the signals a cluster's start defers (recorded, then honoured once the start is over)
-DEFERRED_SIGNALS = ("SIGINT", "SIGTERM")
-
-
-@contextlib.contextmanager
-def _signals_deferred():
-    """While a cluster starts: SIGINT and SIGTERM recorded, not acted on, and honoured when the block ends
-    (raised by this process's own handlers: one line of the command, exit 130 or 143; no traceback from
-    inside the cluster's start-up; the caller closes the half-started cluster). The worker processes started
-    meanwhile ignore SIGINT (:func:`_children_ignore_sigint`): a Ctrl-C to the process group is this
-    process's alone. Where children cannot be made to ignore it (no POSIX spawn), SIGINT is ignored here
-    during the start instead (inherited by the workers; a Ctrl-C in that window is then lost)."""
-    import signal
-    import threading
-
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    with _children_ignore_sigint() as children_ignore:
-        names = DEFERRED_SIGNALS if children_ignore else ("SIGTERM",)
-        got = []
-        previous = {}
-        for name in names:
-            sig = getattr(signal, name)
-            previous[sig] = signal.signal(sig, lambda signum, frame: got.append(signum))
-        try:
-            with contextlib.nullcontext() if children_ignore else _sigint_ignored():
-                yield
-        finally:
-            for sig, handler in previous.items():
-                signal.signal(sig, handler)
-            if got:
-                _honour(got[0], previous[got[0]])
-
-
-def _honour(signum, handler):
-    """Act on a deferred signal as its handler ``handler`` would have."""
-    import signal
-
-    if callable(handler):
-        handler(signum, None)  # the command's handlers raise (KeyboardInterrupt: one line, exit 130 or 143)
-    elif handler == signal.SIG_DFL:
-        if signum == signal.SIGINT:
-            raise KeyboardInterrupt
-        os.kill(os.getpid(), signum)
-
-
-#: seconds between a pool worker's checks that the process that started it is alive
-PARENT_POLL_SECONDS = 0.5
-
-
-def _ignore_sigint(parent=None):  # initializer of the worker processes of process_pool
-    """Ignore Ctrl-C (left to the parent) and end this worker when ``parent`` is gone (killed by SIGKILL: no
-    process of ours outlives its parent, and the resource tracker ends with the last worker)."""
-    import signal
-    import threading
-
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    if parent is not None:
-        threading.Thread(target=_exit_with, args=(parent,), daemon=True, name="ccproof-parent-watch").start()
-
-
-def _exit_with(parent):
-    while os.getppid() == parent:
-        time.sleep(PARENT_POLL_SECONDS)
-    os._exit(1)  # reparented: the parent died without stopping us
-
-
-@contextlib.contextmanager
-def process_pool(workers, context="spawn"):
-    """A :class:`concurrent.futures.ProcessPoolExecutor` whose workers leave Ctrl-C to this process.
-
-    The workers ignore SIGINT (a terminal sends it to the whole process group: no traceback from each
-    worker); when the block ends with an exception (Ctrl-C, SIGTERM raised as one, an error) the workers
-    are terminated at once instead of finishing their tasks, and the pending tasks are cancelled.
-
-    Parameters
-    ----------
-    workers : int
-        Worker processes (>= 1).
-    context : str, optional
-        The multiprocessing start method (default "spawn": no thread state of this process is copied).
-
-    Yields
-    ------
-    concurrent.futures.ProcessPoolExecutor
-
-    Examples
-    --------
-    >>> import math
-    >>> with process_pool(2) as ex:
-    ...     list(ex.map(math.factorial, [3, 4]))
-    [6, 24]
-    """
-    import multiprocessing
-    from concurrent.futures import ProcessPoolExecutor
-
-    ex = ProcessPoolExecutor(max_workers=workers, initializer=_ignore_sigint, initargs=(os.getpid(),),
-                             mp_context=multiprocessing.get_context(context))
-    try:
-        yield ex
-    except BaseException:
-        manager = getattr(ex, "_executor_manager_thread", None)
-        for proc in list((getattr(ex, "_processes", None) or {}).values()):
-            proc.terminate()
-        ex.shutdown(wait=False, cancel_futures=True)
-        # The pool's manager thread sees the terminated workers, marks the pool broken and closes its
-        # wake-up pipe. Wait for it here (a few ms): Python 3.11's exit hook would otherwise race it and
-        # write to the closing pipe ("Exception ignored ... Bad file descriptor" after our one line).
-        if manager is not None:
-            manager.join(timeout=30)
-        raise
-    ex.shutdown(wait=True)
-
-
-@contextlib.contextmanager
 def client_for(scheduler):
     """A connected :class:`distributed.Client` for a local or address scheduler (closed on exit).
 
@@ -507,9 +280,14 @@ def client_for(scheduler):
 
         cluster = client = None
         try:
-            with _signals_deferred():  # the workers leave Ctrl-C to this process; one arriving now is raised after
+            with signals_deferred():  # the workers leave Ctrl-C to this process; one arriving now is raised after
+                # no dashboard; the scheduler's small HTTP server on a free port (its default 8787 may be
+                # taken: a warning line); the workers' own logs silenced below CRITICAL (a run stopped by
+                # Ctrl-C closes the scheduler under their heartbeats: 30 lines of tracebacks), the tasks'
+                # errors come back through their results
                 cluster = LocalCluster(n_workers=s.workers, threads_per_worker=1, processes=True,
-                                       dashboard_address=None, silence_logs=logging.ERROR)
+                                       dashboard_address=None, scheduler_kwargs={"dashboard_address": ":0"},
+                                       silence_logs=logging.CRITICAL)
                 client = Client(cluster)
         except BaseException:  # a Ctrl-C or SIGTERM during the start: the cluster stopped, then one line
             for part in (client, cluster):
@@ -634,19 +412,20 @@ def _retry_info(keys, retries, dask_scheduler=None):
     return out
 
 
-def _run_pool(call, tasks, shared, workers, retries, priority, sweep, outcomes, progress, desc, unit):
+def _run_pool(call, tasks, shared, workers, retries, priority, sweep, outcomes, label):
     """A local scheduler without Dask: ``workers`` processes of :mod:`concurrent.futures` (spawned, so no
     thread state of this process is copied), with the same retries and report as on a Dask cluster. A
     task whose worker died (``BrokenProcessPool``: every task still running in that pool) is re-run in
-    a fresh pool, at most ``retries`` times."""
+    a fresh pool, at most ``retries`` times; ``label`` = (desc, unit, show a bar)."""
     from concurrent.futures import as_completed
     from concurrent.futures.process import BrokenProcessPool
 
     order = list(range(len(tasks))) if priority is None else sorted(range(len(tasks)), key=lambda i: -priority[i])
     used = dict.fromkeys(order, 0)
     lost = dict.fromkeys(order, 0)
+    desc, unit, show = label
     bar = None
-    if progress:
+    if show:
         from tqdm import tqdm
 
         bar = tqdm(total=len(tasks), desc=desc, unit=unit)
@@ -731,7 +510,7 @@ def run_tasks(fn, tasks, scheduler=None, *, shared=(), retries=2, deterministic=
     outcomes = {}
     if isinstance(s, Scheduler) and s.kind == "local" and not dask_available():
         _run_pool(call, tasks, shared, s.workers, retries, priority, sweep, outcomes,
-                  progress and len(tasks) > 1, desc, unit)
+                  (desc, unit, progress and len(tasks) > 1))
     elif isinstance(s, Scheduler) and s.kind == "serial":
         _run_serial(call, tasks, shared, retries, sweep, outcomes, (desc, unit, progress and len(tasks) > 1))
     else:

@@ -110,10 +110,10 @@ def test_tagged_writers_are_atomic(tmp_path, monkeypatch):
     assert back.is_hole_tagged.tolist() == [False] * 5 + [True]
 
     from ccproof.apps.arap import io as arap_io
-    from ccproof.apps.arap.meshes import compare
+    from ccproof.apps.arap.meshes import LevelPlan, compare
     from ccproof.mesh.examples import grid
 
-    res, _ = compare(grid(3, 3), methods=("c",), levels=1, eval_level=3)
+    res, _ = compare(grid(3, 3), methods=("c",), plan=LevelPlan(levels=1, eval_level=3))
     q = tmp_path / "uv.obj"
     q.write_text("old uv\n")
     monkeypatch.setattr(write, "obj_tag_lines", boom)

@@ -4,7 +4,7 @@ names the extra when a cluster is asked for, and the serial retries."""
 import pytest
 
 from ccproof.errors import CCProofError
-from ccproof.scale import engine
+from ccproof.scale import engine, processes
 
 
 def test_default_without_dask_runs_in_process(monkeypatch):
@@ -62,7 +62,7 @@ def test_local_workers_without_dask_are_processes(monkeypatch, tmp_path):
 
 
 def test_cli_scheduler_options(monkeypatch):
-    monkeypatch.setattr(engine, "usable_cores", lambda: 8)  # --jobs is capped at the cores (tests/scale/test_jobs.py)
+    monkeypatch.setattr(processes, "usable_cores", lambda: 8)  # --jobs is capped at the cores (test_jobs.py)
 
     class A:
         scheduler, serial, jobs = None, False, 3

@@ -10,7 +10,7 @@ from ccproof.cli import main
 from ccproof.errors import CCProofError
 from ccproof.mesh import write_obj
 from ccproof.mesh.examples import k_regular_disk
-from ccproof.scale import engine
+from ccproof.scale import engine, processes
 
 
 def _no_work(*a, **k):
@@ -22,7 +22,7 @@ def _no_work(*a, **k):
                                   ["table", "--all", "--kmax", "4", "--dir", "{tmp}"]])
 def test_jobs_below_one_are_refused_by_every_command(argv, jobs, tmp_path, monkeypatch, capsys):
     monkeypatch.setattr(engine, "run_tasks", _no_work)
-    monkeypatch.setattr(engine, "process_pool", _no_work)
+    monkeypatch.setattr(processes, "process_pool", _no_work)
     monkeypatch.setattr(engine, "open_scheduler", _no_work)
     assert main([a.format(tmp=tmp_path) for a in argv] + ["--jobs", jobs]) == 2
     err = capsys.readouterr().err
@@ -32,8 +32,8 @@ def test_jobs_below_one_are_refused_by_every_command(argv, jobs, tmp_path, monke
 def test_workers_are_capped_by_the_tasks_and_the_cores(monkeypatch):
     with warnings.catch_warnings(record=True) as w:
         warnings.simplefilter("always")
-        assert engine.check_jobs(1000, tasks=2) == min(2, engine.usable_cores())
-        assert engine.check_jobs(1000) == engine.usable_cores()
+        assert processes.check_jobs(1000, tasks=2) == min(2, processes.usable_cores())
+        assert processes.check_jobs(1000) == processes.usable_cores()
     assert len(w) == 2 and "1000" in str(w[0].message) and "worker process" in str(w[0].message)
     started = []
 
@@ -59,8 +59,8 @@ def test_scheduler_local_n_is_checked_like_jobs():
         engine.scheduler_from_args(argparse.Namespace(scheduler="local:0"))
     with warnings.catch_warnings(record=True) as w:
         warnings.simplefilter("always")
-        s = engine.scheduler_from_args(argparse.Namespace(scheduler=f"local:{engine.usable_cores() + 5}"))
-    assert (s.kind, s.workers) in (("local", engine.usable_cores()), ("serial", None)) and len(w) == 1
+        s = engine.scheduler_from_args(argparse.Namespace(scheduler=f"local:{processes.usable_cores() + 5}"))
+    assert (s.kind, s.workers) in (("local", processes.usable_cores()), ("serial", None)) and len(w) == 1
 
 
 def test_a_scheduler_address_without_a_port_is_one_line(tmp_path, monkeypatch, capsys):

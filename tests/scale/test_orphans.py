@@ -21,7 +21,7 @@ _PARENT = '''
 import sys
 sys.path.insert(0, sys.argv[1])
 import stall
-from ccproof.scale.engine import process_pool
+from ccproof.scale.processes import process_pool
 with process_pool(2) as ex:
     list(ex.map(stall.task, [sys.argv[2]] * 2))
 '''

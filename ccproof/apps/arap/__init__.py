@@ -16,15 +16,17 @@
 
 The names below are loaded lazily (``ccproof --help`` does not import numpy).
 
->>> from ccproof.apps.arap import compare
+>>> from ccproof.apps.arap import LevelPlan, compare
 >>> from ccproof.mesh.examples import grid
->>> res, _ = compare(grid(3, 3), methods=("c",), levels=1, eval_level=3)
+>>> res, _ = compare(grid(3, 3), methods=("c",), plan=LevelPlan(levels=1, eval_level=3))
 >>> [round(x, 9) for x in res["c"].metrics.as_tuple()]
 [2.0, 2.0, 1.0]
 """
 
 __all__ = [
     "compare",
+    "LevelPlan",
+    "Solver",
     "parameterize",
     "charts_from_labels",
     "read_labels",
@@ -36,6 +38,8 @@ __all__ = [
 
 _WHERE = {
     "compare": "meshes",
+    "LevelPlan": "meshes",
+    "Solver": "core",
     "parameterize": "meshes",
     "texture_metrics": "core",
     "charts_from_labels": "charts",

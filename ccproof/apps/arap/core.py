@@ -40,6 +40,7 @@ if TYPE_CHECKING:
     pass
 
 __all__ = [
+    "Solver",
     "LevelStats",
     "ChartTexture",
     "MethodResult",
@@ -156,8 +157,8 @@ class MethodResult:
     Examples
     --------
     >>> from ccproof.mesh.examples import grid
-    >>> from ccproof.apps.arap.meshes import compare
-    >>> res, _ = compare(grid(3, 3), methods=("c",), levels=1, eval_level=3)
+    >>> from ccproof.apps.arap.meshes import LevelPlan, compare
+    >>> res, _ = compare(grid(3, 3), methods=("c",), plan=LevelPlan(levels=1, eval_level=3))
     >>> r = res["c"]
     >>> r.method, len(r.textures), r.metrics.flips
     ('c', 1, 0)
@@ -231,6 +232,43 @@ def initial_texture(h: ChartHierarchy, rules):
 
 
 # --------------------------------------------------------------------------- optimization
+@dataclass(frozen=True)
+class Solver:
+    """How the methods iterate (:func:`run_method`, :func:`~ccproof.apps.arap.meshes.compare`).
+
+    Parameters
+    ----------
+    tol : float
+        Stop a level when the relative energy decrease per iteration is below it.
+    max_iter : int
+        Iterations per level at most.
+    accel : int
+        Anderson acceleration history of (b) and (c) (0: the plain local/global iteration; the CLI uses 5);
+        (a) and (d) are never accelerated (they are the baselines as published).
+    engine : {"numpy", "igl"}
+        ARAP engine of the polygon baselines (a) and (d).
+    baseline_level : int
+        Level of the control points that (d) parameterizes.
+    baseline_max_iter : int
+        Iterations of the polygon baselines at most.
+    trace : bool
+        Record the energy of every iteration (:class:`LevelStats`).
+
+    Examples
+    --------
+    >>> Solver(tol=1e-8).max_iter
+    1000
+    """
+
+    tol: float = 1e-6
+    max_iter: int = 1000
+    accel: int = 0
+    engine: str = "numpy"
+    baseline_level: int = 3
+    baseline_max_iter: int = 2000
+    trace: bool = False
+
+
 def optimize_chart(h: ChartHierarchy, rules, X0, levels=3, start_level=1, tol=1e-6, max_iter=1000, trace=False,
                    accel=0):
     """Multi-resolution local/global optimization of one chart (hsh10 sections 3.1-3.3).
@@ -412,28 +450,19 @@ def lift_to_refined(h: ChartHierarchy, X, rules, fine: ChartHierarchy, times):
     return vals[idx]
 
 
-def run_method(h: ChartHierarchy, method, levels=3, start_level=1, tol=1e-6, max_iter=1000, engine="numpy",
-               baseline_level=3, baseline_max_iter=2000, trace=False, X0=None, accel=0):
-    """Run one method of hsh10 section 4 on one chart.
-
-    ``X0``: initial texture unknowns of (b) / (c) (default: :func:`initial_texture`); ``accel``:
-    Anderson acceleration of (b) / (c) (:func:`~ccproof.apps.arap.solver.iterate`). docs/hsh10.md.
+def run_method(h: ChartHierarchy, method, levels=3, start_level=1, solver=Solver(), X0=None):
+    """Run one method of hsh10 section 4 on one chart (docs/hsh10.md).
 
     Parameters
     ----------
     h : ChartHierarchy
     method : {"a", "b", "c", "d"}
     levels, start_level : int, optional
-        The multi-resolution schedule.
-    tol : float, optional
-    max_iter : int, optional
-    engine : {"numpy", "igl"}, optional
-        ARAP engine of method (a).
-    baseline_level, baseline_max_iter : int, optional
-        Level and iterations of the polygon baselines (a), (d).
-    trace : bool, optional
+        The multi-resolution schedule of (b) and (c).
+    solver : Solver, optional
+        Tolerance, iterations, acceleration and the baselines' engine and level.
     X0 : ndarray, shape (n_unknowns, 2), optional
-    accel : int, optional
+        Initial texture unknowns of (b) / (c) (default: :func:`initial_texture`).
 
     Returns
     -------
@@ -454,31 +483,35 @@ def run_method(h: ChartHierarchy, method, levels=3, start_level=1, tol=1e-6, max
     if method in ("b", "c"):
         rules = "boundary" if method == "b" else "extended"
         X0 = initial_texture(h, rules) if X0 is None else X0
-        X, stats, _ = optimize_chart(h, rules, X0, levels, start_level, tol, max_iter, trace, accel)
+        X, stats, _ = optimize_chart(h, rules, X0, levels, start_level, solver.tol, solver.max_iter, solver.trace,
+                                     solver.accel)
         tex = ChartTexture(h, rules, 0, h.lift_unknowns(X, rules), X)
         return tex, time.perf_counter() - t0, sum(s.iterations for s in stats), stats
     if method == "a":
         V, T = _chart_triangles(h)
-        nc = h.n_chart_vertices
-        V = V[:nc]
-        UV0 = fit_area(lscm(V, T), V, T)
-        X, it, _ = polygon_arap(V, T, UV0, engine, tol, baseline_max_iter)
+        V = V[:h.n_chart_vertices]
+        X, it = _baseline_arap(V, T, solver)
         tex = ChartTexture(h, "boundary", 0, h.lift_unknowns(X, "boundary"), X)
         return tex, time.perf_counter() - t0, it, []
     if method == "d":
-        k = int(baseline_level)
+        k = int(solver.baseline_level)
         L = h.level(k)
         cv = np.flatnonzero(L.chart_vertex)
         loc = np.full(L.n_vertices, -1, dtype=np.int64)
         loc[cv] = np.arange(cv.size)
         V = L.mesh.vertices[cv]
-        T = triangulate_quads(V, loc[L.chart_faces()])
-        UV0 = fit_area(lscm(V, T), V, T)
-        X, it, _ = polygon_arap(V, T, UV0, engine, tol, baseline_max_iter)
+        X, it = _baseline_arap(V, triangulate_quads(V, loc[L.chart_faces()]), solver)
         vals = np.zeros((L.n_vertices, 2))
         vals[cv] = X
         return ChartTexture(h, "boundary", k, vals, X), time.perf_counter() - t0, it, []
     raise CCProofError(f"unknown method {method!r}; expected one of {METHODS}")
+
+
+def _baseline_arap(V, T, solver):
+    """The polygon baselines: LSCM scaled to the area, then ARAP of the triangles; (UVs, iterations)."""
+    UV0 = fit_area(lscm(V, T), V, T)
+    X, it, _ = polygon_arap(V, T, UV0, solver.engine, solver.tol, solver.baseline_max_iter)
+    return X, it
 
 
 # --------------------------------------------------------------------------- measuring

@@ -69,8 +69,8 @@ class SampledSurface:
     Examples
     --------
     >>> from ccproof.mesh.examples import grid
-    >>> from ccproof.apps.arap.meshes import compare
-    >>> res, _ = compare(grid(3, 3), methods=("c",), levels=1, eval_level=3)
+    >>> from ccproof.apps.arap.meshes import LevelPlan, compare
+    >>> res, _ = compare(grid(3, 3), methods=("c",), plan=LevelPlan(levels=1, eval_level=3))
     >>> S = sampled_surface(res["c"], level=1)
     >>> S.points.shape, S.cells.shape, S.cell_type, bool(0 <= S.uv.min() and S.uv.max() <= 1)
     ((49, 3), (72, 3), 'triangle', True)
@@ -120,8 +120,8 @@ def sample_chart(tex, level):
     Level 1 of a 3 x 3 grid has 6 x 6 quads on 7 x 7 vertices:
 
     >>> from ccproof.mesh.examples import grid
-    >>> from ccproof.apps.arap.meshes import compare
-    >>> res, _ = compare(grid(3, 3), methods=("c",), levels=1, eval_level=3)
+    >>> from ccproof.apps.arap.meshes import LevelPlan, compare
+    >>> res, _ = compare(grid(3, 3), methods=("c",), plan=LevelPlan(levels=1, eval_level=3))
     >>> P, UV, Q = sample_chart(res["c"].textures[0], 1)
     >>> P.shape, UV.shape, Q.shape
     ((49, 3), (49, 2), (36, 4))
@@ -237,8 +237,8 @@ def sampled_surface(result, level=3, cells="triangle", gap=0.02):
     Examples
     --------
     >>> from ccproof.mesh.examples import grid
-    >>> from ccproof.apps.arap.meshes import compare
-    >>> res, _ = compare(grid(3, 3), methods=("c",), levels=1, eval_level=3)
+    >>> from ccproof.apps.arap.meshes import LevelPlan, compare
+    >>> res, _ = compare(grid(3, 3), methods=("c",), plan=LevelPlan(levels=1, eval_level=3))
     >>> sampled_surface(res["c"], level=1, cells="quad").cells.shape
     (36, 4)
     """
@@ -300,8 +300,8 @@ def write_surface(path: str | os.PathLike[str], surf: SampledSurface, comment: s
     >>> import os, tempfile
     >>> import numpy as np
     >>> from ccproof.mesh.examples import grid
-    >>> from ccproof.apps.arap.meshes import compare
-    >>> res, _ = compare(grid(3, 3), methods=("c",), levels=1, eval_level=3)
+    >>> from ccproof.apps.arap.meshes import LevelPlan, compare
+    >>> res, _ = compare(grid(3, 3), methods=("c",), plan=LevelPlan(levels=1, eval_level=3))
     >>> S = sampled_surface(res["c"], level=1)
     >>> tmp = tempfile.TemporaryDirectory()          # removed when the example ends
     >>> path = os.path.join(tmp.name, "surface.obj")
@@ -367,8 +367,8 @@ def read_surface(path):
     >>> import os, tempfile
     >>> import numpy as np
     >>> from ccproof.mesh.examples import grid
-    >>> from ccproof.apps.arap.meshes import compare
-    >>> res, _ = compare(grid(3, 3), methods=("c",), levels=1, eval_level=3)
+    >>> from ccproof.apps.arap.meshes import LevelPlan, compare
+    >>> res, _ = compare(grid(3, 3), methods=("c",), plan=LevelPlan(levels=1, eval_level=3))
     >>> S = sampled_surface(res["c"], level=1, cells="quad")
     >>> tmp = tempfile.TemporaryDirectory()          # removed when the example ends
     >>> path = os.path.join(tmp.name, "surface.ply")

@@ -35,10 +35,10 @@ corners-only one (on a uniform flat grid every rule reproduces affine functions 
 
 >>> import numpy as np
 >>> from ccproof.mesh.examples import grid
->>> from ccproof.apps.arap.meshes import compare
+>>> from ccproof.apps.arap.meshes import LevelPlan, compare
 >>> labels = -np.ones(25, dtype=int)
 >>> labels[[6, 7, 8, 11, 12, 13, 16, 17, 18]] = 0
->>> res, _ = compare(grid(5, 5), labels, methods=("c",), levels=1, eval_level=3)
+>>> res, _ = compare(grid(5, 5), labels, methods=("c",), plan=LevelPlan(levels=1, eval_level=3))
 >>> exp = export_control(res["c"], eval_level=3)
 >>> exp.extra, exp.folds, [round(x, 9) for x in exp.metrics.as_tuple()]
 (0, [0, 0, 0], [2.0, 2.0, 1.0])
@@ -53,11 +53,13 @@ import scipy.sparse.linalg as spla
 
 from ccproof.apps.arap.hierarchy import ChartHierarchy
 from ccproof.apps.arap.lscm import signed_areas
-from ccproof.apps.arap.metrics import Metrics
+from ccproof.apps.arap.metrics import Metrics, excess_ratios, minimax_choice
 from ccproof.apps.arap.samples import limit_operator
+from ccproof.apps.arap.solver import lbfgs
 from ccproof.errors import CCProofError
 
-__all__ = ["corners_only_texture", "subdivided_folds", "metric_polish", "ControlExport", "export_control",
+__all__ = ["corners_only_texture", "subdivided_folds", "metric_polish", "ControlExport", "ControlOptions",
+           "export_control",
            "FOLD_LEVELS", "EXCESS_FLOOR", "METRIC_WEIGHTS"]
 
 #: distortion excesses below this are not told apart (an isometric exact texture)
@@ -227,52 +229,6 @@ def _metric_energy(B1, B2, w, weights):
     return f
 
 
-def _lbfgs(f, y, max_iter=300, m=10, rtol=1e-9):
-    """Minimize ``f`` (value, gradient; +inf outside its domain) from a point of its domain: L-BFGS with
-    backtracking (Armijo) line search, which backs off from +inf (the fold barrier)."""
-    fy, g = f(y)
-    S, Yk = [], []
-    for _ in range(max_iter):
-        q = g.copy()
-        al = []
-        for s, t in zip(reversed(S), reversed(Yk)):
-            a = (s @ q) / (t @ s)
-            al.append(a)
-            q -= a * t
-        if S:
-            q *= (S[-1] @ Yk[-1]) / (Yk[-1] @ Yk[-1])
-        else:
-            q *= 1e-3 / max(np.abs(q).max(), 1e-300) * max(np.abs(y).max(), 1.0)
-        for (s, t), a in zip(zip(S, Yk), reversed(al)):
-            b = (t @ q) / (t @ s)
-            q += s * (a - b)
-        d = -q
-        slope = g @ d
-        if slope >= 0:
-            d, slope, S, Yk = -g, -(g @ g), [], []
-        step = 1.0
-        for _ in range(40):
-            yn = y + step * d
-            fn, gn = f(yn)
-            if fn <= fy + 1e-4 * step * slope:
-                break
-            step *= 0.5
-        else:
-            break
-        s, t = yn - y, gn - g
-        if s @ t > 1e-300:
-            S.append(s)
-            Yk.append(t)
-            if len(S) > m:
-                S.pop(0)
-                Yk.pop(0)
-        done = fy - fn <= rtol * max(abs(fy), 1.0)
-        y, fy, g = yn, fn, gn
-        if done:
-            break
-    return y, fy
-
-
 def metric_polish(hierarchy: ChartHierarchy, Y, level, weights=(1.0, 1.0, 1.0), max_iter=300):
     """Control UVs that minimize the distortion excess of their corners-only texture at ``level``.
 
@@ -317,54 +273,8 @@ def metric_polish(hierarchy: ChartHierarchy, Y, level, weights=(1.0, 1.0, 1.0), 
     y0 = np.asarray(Y, dtype=np.float64).ravel()
     if not np.isfinite(f(y0)[0]):
         return np.asarray(Y, dtype=np.float64)
-    y, _ = _lbfgs(f, y0, max_iter=max_iter)
+    y, _ = lbfgs(f, y0, max_iter=max_iter)
     return y.reshape(-1, 2)
-
-
-def _excess_ratios(metrics: Metrics, exact: Metrics):
-    """(E_angle, E_area, E_stretch) excess of ``metrics`` over ``exact``'s (1 where both are 0)."""
-    m, e = metrics.as_tuple(), exact.as_tuple()
-    return tuple((a - z) / (b - z) if b - z > 0 else (1.0 if a - z <= 0 else float("inf"))
-                 for a, b, z in zip(m, e, (2.0, 2.0, 1.0)))
-
-
-def _minimax_choice(exact: Metrics, candidates):
-    """Per chart, the candidate that makes the largest global excess ratio smallest.
-
-    ``candidates[c]`` is chart c's list of Metrics (index 0: the default). Coordinate descent (one chart's choice
-    at a time, while the largest ratio falls) from every uniform start (all charts on candidate j, or on 0 where
-    they have fewer), the best end kept: never worse than the all-default choice or any uniform one, and no single
-    chart's change lowers the result.
-
-    Returns
-    -------
-    list of int
-        The chosen index per chart.
-    """
-    def worst(choice):
-        tot = Metrics()
-        for c, j in zip(candidates, choice):
-            tot = tot + c[j]
-        return max(_excess_ratios(tot, exact))
-
-    best = None
-    for start in range(max(len(c) for c in candidates)):
-        choice = [start if start < len(c) else 0 for c in candidates]
-        cur = worst(choice)
-        improved = True
-        while improved:
-            improved = False
-            for i, c in enumerate(candidates):
-                for j in range(len(c)):
-                    if j == choice[i]:
-                        continue
-                    trial = choice[:i] + [j] + choice[i + 1:]
-                    v = worst(trial)
-                    if v < cur:
-                        cur, choice, improved = v, trial, True
-        if best is None or cur < best[0]:
-            best = (cur, choice)
-    return best[1]
 
 
 @dataclass
@@ -412,19 +322,62 @@ class ControlExport:
 
     def excess_ratio(self):
         """(E_angle, E_area, E_stretch) excess of the corners-only texture over the exact texture's."""
-        return _excess_ratios(self.metrics, self.exact)
+        return excess_ratios(self.metrics, self.exact)
 
 
-def export_control(result, eval_level=5, max_extra=2, max_excess_ratio=1.05, fit_level=2, levels=3, polish=True,
-                   accel=5, max_faces=None, progress=False, metric="auto", metric_iter=300):
+@dataclass(frozen=True)
+class ControlOptions:
+    """How :func:`export_control` fits, polishes and judges the control UVs of each refinement it tries.
+
+    Parameters
+    ----------
+    max_extra : int
+        Subdivide the texture's control mesh at most this many more times.
+    max_faces : int, optional
+        Do not subdivide the control mesh beyond this many faces.
+    max_excess_ratio : float
+        Accept the first refinement with no fold at :data:`FOLD_LEVELS` and every distortion excess
+        (E_angle - 2, E_area - 2, E_stretch - 1) at most this times the exact texture's (or at most
+        :data:`EXCESS_FLOOR` where the exact texture's excess is below it).
+    fit_level : int
+        Level of the fit's samples (:func:`corners_only_texture`).
+    polish : bool
+        Polish the fit with hsh10's optimization under the corners-only rules.
+    accel : int
+        Anderson acceleration of the polish.
+    metric : "auto", True or False
+        The minimax over :func:`metric_polish` candidates: "auto" on the last refinement allowed (by
+        ``max_extra`` and ``max_faces``) when the ARAP polish misses the criterion there; True on every
+        refinement whose ARAP polish misses it; False never. It costs ``len(METRIC_WEIGHTS)`` L-BFGS runs per
+        chart (the bunny at its default refinement: 1,249 s against 198-514 s without it, on a loaded machine).
+    metric_iter : int
+        L-BFGS iterations of each candidate per chart.
+
+    Examples
+    --------
+    >>> ControlOptions(max_extra=0).metric
+    'auto'
+    """
+
+    max_extra: int = 2
+    max_faces: int | None = None
+    max_excess_ratio: float = 1.05
+    fit_level: int = 2
+    polish: bool = True
+    accel: int = 5
+    metric: str | bool = "auto"
+    metric_iter: int = 300
+
+
+def export_control(result, eval_level=5, levels=3, options=None, progress=False):
     """Corners-only control UVs for every chart of ``result`` (module docstring).
 
-    Per chart: the least-squares fit of :func:`corners_only_texture`, then (``polish``) hsh10's
+    Per chart: the least-squares fit of :func:`corners_only_texture`, then (``options.polish``) hsh10's
     local/global optimization with the corners-only rules (method (b) on the subdivided control mesh,
     :func:`~ccproof.apps.arap.core.optimize_chart`) started from it; the polished UVs are kept when their
     subdivision has no fold at :data:`FOLD_LEVELS`, else the first blend ``Y2 + t (Y_fit - Y2)``, t = 0.25,
     0.5, 0.75, that has none, else the fit's (or whichever folds least). Where that misses
-    ``max_excess_ratio`` (see ``metric``): per chart the :func:`metric_polish` candidates of
+    ``options.max_excess_ratio`` (see ``options.metric``): per chart the :func:`metric_polish` candidates of
     :data:`METRIC_WEIGHTS` (from the ARAP polish, or from the kept UVs where the polish folds at the samples),
     those without a fold at :data:`FOLD_LEVELS` kept, and per chart the candidate (ARAP included) that
     minimizes the largest of the three global excess ratios (coordinate descent over the charts' choices from
@@ -437,154 +390,48 @@ def export_control(result, eval_level=5, max_extra=2, max_excess_ratio=1.05, fit
     eval_level : int
         Metric level on the input mesh (the texture's control mesh is the input refined
         ``result.refine`` times); raised to level 1 of the subdivided control mesh where it is below.
-    max_extra : int
-        Subdivide the texture's control mesh at most this many more times.
-    max_excess_ratio : float
-        Accept the first refinement with no fold at :data:`FOLD_LEVELS` and every distortion excess
-        (E_angle - 2, E_area - 2, E_stretch - 1) at most this times the exact texture's (or at most
-        :data:`EXCESS_FLOOR` where the exact texture's excess is below it).
-    fit_level : int
-        Level of the fit's samples (:func:`corners_only_texture`).
     levels : int
         Finest optimization level of the polish, counted on the input mesh (at least level 1 of the
         subdivided control mesh).
-    polish : bool
-    accel : int
-        Anderson acceleration of the polish.
-    max_faces : int, optional
-        Do not subdivide the control mesh beyond this many faces.
+    options : ControlOptions, optional
+        Refinements allowed, acceptance, fit, polish and minimax (default ``ControlOptions()``).
     progress : bool
         A tqdm progress bar over the charts of each refinement tried.
-    metric : "auto", True or False
-        The minimax over :func:`metric_polish` candidates: "auto" on the last refinement allowed (by
-        ``max_extra`` and ``max_faces``) when the ARAP polish misses the criterion there; True on every
-        refinement whose ARAP polish misses it; False never. It costs ``len(METRIC_WEIGHTS)`` L-BFGS runs per
-        chart (the bunny at its default refinement: 1,249 s against 198-514 s without it, on a loaded machine).
-    metric_iter : int
-        L-BFGS iterations of each candidate per chart.
 
     Returns
     -------
     ControlExport
         The accepted refinement, or the best one tried (fewest folds, then smallest largest excess ratio).
     """
-    from ccproof.apps.arap.core import ChartTexture, optimize_chart, texture_metrics
     from ccproof.apps.arap.meshes import refine_mesh
 
-    if metric not in ("auto", True, False):
-        raise CCProofError(f"metric must be 'auto', True or False, got {metric!r}")
+    opts = ControlOptions() if options is None else options
+    if opts.metric not in ("auto", True, False):
+        raise CCProofError(f"metric must be 'auto', True or False, got {opts.metric!r}")
     texs = result.textures
     if not texs or any(t.level != 0 for t in texs):
         raise CCProofError("control UVs need level-0 textures (methods b and c)")
-    if int(max_extra) < 0:
-        raise CCProofError(f"max_extra must be >= 0, got {max_extra}")
-    base = texs[0].hierarchy.surface
+    if int(opts.max_extra) < 0:
+        raise CCProofError(f"max_extra must be >= 0, got {opts.max_extra}")
     ref = int(getattr(result, "refine", 0))
-    tried = []
-    best = None
-    exacts: dict[int, Metrics] = {}
-    mesh = base
-    ok = False
-
-    def measure(hc, Y, ev_x):
-        ct = ChartTexture(hc, "boundary", 0, hc.lift_unknowns(Y, "boundary"), Y)
-        return ct, texture_metrics(ct, ev_x)
-
-    def accept(met, folds):
-        ex_m = np.subtract(met.as_tuple(), (2.0, 2.0, 1.0))
-        return sum(folds) == 0 and bool(np.all(ex_m <= np.maximum(max_excess_ratio * ex_e, EXCESS_FLOOR)))
-
-    for extra in range(int(max_extra) + 1):
+    tried, best, exacts, mesh, ok = [], None, {}, texs[0].hierarchy.surface, False
+    for extra in range(int(opts.max_extra) + 1):
         if extra:
-            if max_faces is not None and 4 * mesh.n_faces > max_faces:
+            if opts.max_faces is not None and 4 * mesh.n_faces > opts.max_faces:
                 break
             mesh, _ = refine_mesh(mesh, None, 1)
-        last = extra == int(max_extra) or (max_faces is not None and 4 * mesh.n_faces > max_faces)
+        last = extra == int(opts.max_extra) or (opts.max_faces is not None and 4 * mesh.n_faces > opts.max_faces)
         # metric level on the input mesh: eval_level, at least level 1 of the subdivided control mesh
         e_in = max(int(eval_level), ref + extra + 1)
-        ev, ev_x = e_in - ref, e_in - ref - extra
         if e_in not in exacts:
-            exact = Metrics()
-            for tex in texs:
-                exact = exact + texture_metrics(tex, ev)
-                tex.hierarchy.release()
-            exacts[e_in] = exact
-        exact = exacts[e_in]
-        ex_e = np.subtract(exact.as_tuple(), (2.0, 2.0, 1.0))
-        folds = np.zeros(len(FOLD_LEVELS), dtype=np.int64)
-        met, out, charts = Metrics(), [], []
-        bar = None
-        if progress:
-            from tqdm import tqdm
-
-            bar = tqdm(total=len(texs), desc=f"control UVs, {extra} extra", unit="chart")
-        for tex in texs:
-            hc, Y = corners_only_texture(tex, extra, fit_level, mesh)
-            fo = subdivided_folds(hc, Y)
-            Y2 = Y
-            if polish:
-                top = max(1, int(levels) - ref - extra)
-                Y2, _, _ = optimize_chart(hc, "boundary", Y, levels=top, start_level=1, accel=accel)
-                # the polished UVs, or the nearest blend towards the fit that does not fold
-                for t in (0.0, 0.25, 0.5, 0.75):
-                    Yt = Y2 + t * (Y - Y2)
-                    fot = subdivided_folds(hc, Yt)
-                    if sum(fot) == 0 or sum(fot) < sum(fo):
-                        Y, fo = Yt, fot
-                        if sum(fot) == 0:
-                            break
-            folds += fo
-            ct, m = measure(hc, Y, ev_x)
-            met = met + m
-            hc.release()
-            tex.hierarchy.release()
-            out.append(ct)
-            charts.append((hc, Y, Y2, fo, m))
-            if bar is not None:
-                bar.update(1)
-        if bar is not None:
-            bar.close()
-        ok = accept(met, folds)
-        weights_used = [None] * len(texs)
-        arap_met = None
-        if not ok and (metric is True or (metric == "auto" and last)):
-            # the minimax over metric-energy candidates (fold-free at FOLD_LEVELS), ARAP polish included
-            w0 = 1.0 / np.maximum(ex_e, EXCESS_FLOOR)
-            cands, uvs = [], []
-            bar = tqdm(total=len(texs), desc=f"minimax, {extra} extra", unit="chart") if progress else None
-            for hc, Y, Y2, fo, m in charts:
-                cm, cu = [m], [(Y, fo, None)]
-                if sum(fo) == 0:
-                    # from the ARAP polish where the fold barrier admits it (its folds may lie between samples)
-                    f1 = _metric_energy(*_metric_system(hc, ev_x), (1.0, 1.0, 1.0))
-                    start = Y2 if np.isfinite(f1(np.asarray(Y2, dtype=np.float64).ravel())[0]) else Y
-                    for wa, ws in METRIC_WEIGHTS:
-                        Z = metric_polish(hc, start, ev_x, (wa * w0[0], w0[1], ws * w0[2]), max_iter=metric_iter)
-                        fz = subdivided_folds(hc, Z)
-                        if sum(fz) == 0:
-                            cm.append(measure(hc, Z, ev_x)[1])
-                            cu.append((Z, fz, (wa, ws)))
-                hc.release()
-                cands.append(cm)
-                uvs.append(cu)
-                if bar is not None:
-                    bar.update(1)
-            if bar is not None:
-                bar.close()
-            choice = _minimax_choice(exact, cands)
-            if any(choice):
-                arap_met = met
-                met, out, folds = Metrics(), [], np.zeros(len(FOLD_LEVELS), dtype=np.int64)
-                for (hc, *_), cm, cu, j in zip(charts, cands, uvs, choice):
-                    Z, fz, wts = cu[j]
-                    out.append(ChartTexture(hc, "boundary", 0, hc.lift_unknowns(Z, "boundary"), Z))
-                    met = met + cm[j]
-                    folds += fz
-                    weights_used[len(out) - 1] = wts
-                ok = accept(met, folds)
-        exp = ControlExport(mesh, out, extra, folds.tolist(), met, exact, e_in, chart_weights=weights_used,
-                            arap_metrics=arap_met)
-        tried.append((extra, exp.folds, met))
+            exacts[e_in] = _exact_metrics(texs, e_in - ref)
+        step = _Refinement(mesh, extra, e_in - ref - extra, exacts[e_in], opts)
+        step.polish(texs, max(1, int(levels) - ref - extra), progress)
+        if not step.accepted() and (opts.metric is True or (opts.metric == "auto" and last)):
+            step.minimax(progress)
+        ok = step.accepted()
+        exp = step.export(e_in)
+        tried.append((extra, exp.folds, exp.metrics))
         key = (sum(exp.folds), max(exp.excess_ratio()))
         if best is None or key < best[0] or ok:
             best = (key, exp)
@@ -594,3 +441,125 @@ def export_control(result, eval_level=5, max_extra=2, max_excess_ratio=1.05, fit
     exp.tried = tried
     exp.accepted = bool(ok)
     return exp
+
+
+def _exact_metrics(texs, ev):
+    """The metrics of the exact textures at level ``ev`` of their control mesh (fine levels released)."""
+    from ccproof.apps.arap.core import texture_metrics
+
+    exact = Metrics()
+    for tex in texs:
+        exact = exact + texture_metrics(tex, ev)
+        tex.hierarchy.release()
+    return exact
+
+
+def _bar(progress, total, desc):
+    if not progress:
+        return None
+    from tqdm import tqdm
+
+    return tqdm(total=total, desc=desc, unit="chart")
+
+
+class _Refinement:
+    """One refinement tried by :func:`export_control`: its charts' UVs, folds and metrics at level ``ev_x`` of
+    the subdivided control mesh ``mesh``, judged against the exact textures' metrics ``exact``."""
+
+    def __init__(self, mesh, extra, ev_x, exact, opts):
+        self.mesh, self.extra, self.ev_x, self.exact, self.opts = mesh, extra, ev_x, exact, opts
+        self.ex_e = np.subtract(exact.as_tuple(), (2.0, 2.0, 1.0))
+        self.folds = np.zeros(len(FOLD_LEVELS), dtype=np.int64)
+        self.met, self.out, self.charts = Metrics(), [], []
+        self.weights, self.arap_met = [], None
+
+    def measure(self, hc, Y):
+        from ccproof.apps.arap.core import ChartTexture, texture_metrics
+
+        ct = ChartTexture(hc, "boundary", 0, hc.lift_unknowns(Y, "boundary"), Y)
+        return ct, texture_metrics(ct, self.ev_x)
+
+    def accepted(self):
+        ex_m = np.subtract(self.met.as_tuple(), (2.0, 2.0, 1.0))
+        return sum(self.folds) == 0 and bool(np.all(
+            ex_m <= np.maximum(self.opts.max_excess_ratio * self.ex_e, EXCESS_FLOOR)))
+
+    def polish(self, texs, top, progress):
+        """Per chart: the corners-only fit, polished (the polish or the nearest blend towards the fit that
+        does not fold)."""
+        from ccproof.apps.arap.core import optimize_chart
+
+        bar = _bar(progress, len(texs), f"control UVs, {self.extra} extra")
+        for tex in texs:
+            hc, Y = corners_only_texture(tex, self.extra, self.opts.fit_level, self.mesh)
+            fo = subdivided_folds(hc, Y)
+            Y2 = Y
+            if self.opts.polish:
+                Y2, _, _ = optimize_chart(hc, "boundary", Y, levels=top, start_level=1, accel=self.opts.accel)
+                for t in (0.0, 0.25, 0.5, 0.75):
+                    Yt = Y2 + t * (Y - Y2)
+                    fot = subdivided_folds(hc, Yt)
+                    if sum(fot) == 0 or sum(fot) < sum(fo):
+                        Y, fo = Yt, fot
+                        if sum(fot) == 0:
+                            break
+            self.folds += fo
+            ct, m = self.measure(hc, Y)
+            self.met = self.met + m
+            hc.release()
+            tex.hierarchy.release()
+            self.out.append(ct)
+            self.charts.append((hc, Y, Y2, fo, m))
+            if bar is not None:
+                bar.update(1)
+        if bar is not None:
+            bar.close()
+        self.weights = [None] * len(texs)
+
+    def minimax(self, progress):
+        """The minimax over metric-energy candidates (fold-free at FOLD_LEVELS), ARAP polish included."""
+        cands, uvs = [], []
+        bar = _bar(progress, len(self.charts), f"minimax, {self.extra} extra")
+        for hc, Y, Y2, fo, m in self.charts:
+            cm, cu = self._candidates(hc, Y, Y2, fo, m)
+            hc.release()
+            cands.append(cm)
+            uvs.append(cu)
+            if bar is not None:
+                bar.update(1)
+        if bar is not None:
+            bar.close()
+        choice = minimax_choice(self.exact, cands)
+        if not any(choice):
+            return
+        from ccproof.apps.arap.core import ChartTexture
+
+        self.arap_met = self.met
+        self.met, self.out, self.folds = Metrics(), [], np.zeros(len(FOLD_LEVELS), dtype=np.int64)
+        for i, ((hc, *_), cm, cu, j) in enumerate(zip(self.charts, cands, uvs, choice)):
+            Z, fz, wts = cu[j]
+            self.out.append(ChartTexture(hc, "boundary", 0, hc.lift_unknowns(Z, "boundary"), Z))
+            self.met = self.met + cm[j]
+            self.folds += fz
+            self.weights[i] = wts
+
+    def _candidates(self, hc, Y, Y2, fo, m):
+        """One chart's candidates: (metrics list, (UVs, folds, weights) list), the kept UVs first."""
+        cm, cu = [m], [(Y, fo, None)]
+        if sum(fo):
+            return cm, cu
+        w0 = 1.0 / np.maximum(self.ex_e, EXCESS_FLOOR)
+        # from the ARAP polish where the fold barrier admits it (its folds may lie between samples)
+        f1 = _metric_energy(*_metric_system(hc, self.ev_x), (1.0, 1.0, 1.0))
+        start = Y2 if np.isfinite(f1(np.asarray(Y2, dtype=np.float64).ravel())[0]) else Y
+        for wa, ws in METRIC_WEIGHTS:
+            Z = metric_polish(hc, start, self.ev_x, (wa * w0[0], w0[1], ws * w0[2]), max_iter=self.opts.metric_iter)
+            fz = subdivided_folds(hc, Z)
+            if sum(fz) == 0:
+                cm.append(self.measure(hc, Z)[1])
+                cu.append((Z, fz, (wa, ws)))
+        return cm, cu
+
+    def export(self, e_in):
+        return ControlExport(self.mesh, self.out, self.extra, self.folds.tolist(), self.met, self.exact, e_in,
+                             chart_weights=self.weights, arap_metrics=self.arap_met)

@@ -75,6 +75,32 @@ def layout_offsets(uvs, gap=0.05):
     return offs
 
 
+def _texture_points(mesh, texs, transforms, scale):
+    """The texture points of the charts (packed by ``transforms`` and ``scale``, or side by side without them),
+    the texture point of every corner of every face (-1 outside the charts) and the sidecar's chart entries."""
+    uvs = [np.asarray(t.unknowns, dtype=np.float64) for t in texs]
+    if transforms is None:
+        transforms, scale = [(np.eye(2), o) for o in layout_offsets(uvs)], 1.0
+    F = mesh.faces
+    face_vt = np.full((mesh.n_faces, 4), -1, dtype=np.int64)
+    charts_json, lines_vt, base = [], [], 0
+    for tex, uv, (R, off) in zip(texs, uvs, transforms):
+        h = tex.hierarchy
+        if tex.level != 0:
+            raise ValueError("only level-0 textures can be written (method d is evaluation only)")
+        uvo = scale * (uv @ np.asarray(R).T + off)
+        lines_vt.extend(uvo.tolist())
+        loc = np.full(mesh.n_vertices, -1, dtype=np.int64)
+        nc = h.n_chart_vertices
+        loc[h.unknown_vertices[:nc]] = np.arange(nc)
+        face_vt[h.chart_faces] = base + loc[F[h.chart_faces]]
+        charts_json.append({"faces": h.chart_faces.tolist(), "rules": tex.rules,
+                            "vertices": h.unknown_vertices[: uv.shape[0]].tolist(), "n_chart_vertices": int(nc),
+                            "vt_first": int(base), "uv": uvo.tolist()})
+        base += uv.shape[0]
+    return face_vt, lines_vt, charts_json
+
+
 def write_uv_obj(path, mesh, result, comment=None, table=None, transforms=None, scale=1.0):
     """Write ``result`` (a :class:`~ccproof.apps.arap.core.MethodResult`) for ``mesh``.
 
@@ -106,8 +132,8 @@ def write_uv_obj(path, mesh, result, comment=None, table=None, transforms=None, 
     --------
     >>> import os, tempfile
     >>> from ccproof.mesh.examples import grid
-    >>> from ccproof.apps.arap.meshes import compare
-    >>> res, _ = compare(grid(3, 3), methods=("c",), levels=1, eval_level=3)
+    >>> from ccproof.apps.arap.meshes import LevelPlan, compare
+    >>> res, _ = compare(grid(3, 3), methods=("c",), plan=LevelPlan(levels=1, eval_level=3))
     >>> tmp = tempfile.TemporaryDirectory()          # removed when the example ends
     >>> d = tmp.name
     >>> sidecar = write_uv_obj(os.path.join(d, "grid.obj"), grid(3, 3), res["c"])
@@ -116,41 +142,13 @@ def write_uv_obj(path, mesh, result, comment=None, table=None, transforms=None, 
     """
     path = os.fspath(path)
     texs = result.textures
-    uvs = [np.asarray(t.unknowns, dtype=np.float64) for t in texs]
+    face_vt, lines_vt, charts_json = _texture_points(mesh, texs, transforms, scale)
     if transforms is None:
-        offs = layout_offsets(uvs)
-        transforms = [(np.eye(2), o) for o in offs]
         scale = 1.0
-    V, F = mesh.vertices, mesh.faces
-    face_vt = np.full((mesh.n_faces, 4), -1, dtype=np.int64)
-    charts_json = []
-    base = 0
-    lines_vt = []
-    for tex, uv, (R, off) in zip(texs, uvs, transforms):
-        h = tex.hierarchy
-        if tex.level != 0:
-            raise ValueError("only level-0 textures can be written (method d is evaluation only)")
-        uvo = scale * (uv @ np.asarray(R).T + off)
-        lines_vt.extend(uvo.tolist())
-        loc = np.full(mesh.n_vertices, -1, dtype=np.int64)
-        nc = h.n_chart_vertices
-        loc[h.unknown_vertices[:nc]] = np.arange(nc)
-        face_vt[h.chart_faces] = base + loc[F[h.chart_faces]]
-        charts_json.append(
-            {
-                "faces": h.chart_faces.tolist(),
-                "rules": tex.rules,
-                "vertices": h.unknown_vertices[: uv.shape[0]].tolist(),
-                "n_chart_vertices": int(nc),
-                "vt_first": int(base),
-                "uv": uvo.tolist(),
-            }
-        )
-        base += uv.shape[0]
     from ccproof.apps.control_file import merge_labels, merged_copies
     from ccproof.mesh.write import atomic_path, obj_tag_lines
 
-    tag_lines = obj_tag_lines(mesh)
+    V, F, tag_lines = mesh.vertices, mesh.faces, obj_tag_lines(mesh)
     lab = merge_labels(mesh)
     if lab is not None:  # a non-manifold file's split mesh: its copies written as one vertex (the file's numbering)
         V, F, tag_lines = merged_copies(mesh, lab)
@@ -161,7 +159,7 @@ def write_uv_obj(path, mesh, result, comment=None, table=None, transforms=None, 
             fh.write(f"# {c}\n")
         for r in sorted({t.rules for t in texs}):
             fh.write(f"# {RULE_TEXT[r]}\n")
-        fh.write(f"# {V.shape[0]} vertices, {F.shape[0]} faces, {len(texs)} charts, {base} texture points\n")
+        fh.write(f"# {V.shape[0]} vertices, {F.shape[0]} faces, {len(texs)} charts, {len(lines_vt)} texture points\n")
         fh.writelines(f"v {x:.17g} {y:.17g} {z:.17g}\n" for x, y, z in V.tolist())
         fh.writelines(f"vt {u:.17g} {v:.17g}\n" for u, v in lines_vt)
         for f in range(F.shape[0]):

@@ -6,8 +6,8 @@ work (:class:`MemoryBudgetError`), the comparison of the methods (:func:`compare
 from __future__ import annotations
 
 import time
-from dataclasses import replace
-from typing import TYPE_CHECKING, Any, Literal
+from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -17,6 +17,7 @@ from ccproof.apps.arap.core import (
     METHODS,
     VARIANTS,
     MethodResult,
+    Solver,
     control_flips,
     lift_to_refined,
     run_method,
@@ -29,8 +30,8 @@ from ccproof.errors import CCProofError
 if TYPE_CHECKING:
     from ccproof.mesh import QuadMesh
 
-__all__ = ["mesh_charts", "refine_mesh", "auto_refine", "estimate_memory", "MemoryBudgetError", "run_memory", "compare",
-           "parameterize"]
+__all__ = ["mesh_charts", "refine_mesh", "auto_refine", "estimate_memory", "MemoryBudgetError", "run_memory",
+           "LevelPlan", "compare", "parameterize"]
 
 
 def mesh_charts(mesh, labels):
@@ -196,15 +197,16 @@ class MemoryBudgetError(CCProofError):
     """
 
 
-def compare(mesh, labels=None, methods=METHODS, levels=3, start_level=1, eval_level=5, tol=1e-6, max_iter=1000,
-            engine="numpy", baseline_level=3, baseline_max_iter=2000, hierarchies=None, trace=False,
-            refine=0, sample_level=None, release=False, max_memory=None, progress=False, accel=0):
-    """Run ``methods`` on every chart and measure them the same way.
+@dataclass(frozen=True)
+class LevelPlan:
+    """The subdivision levels of :func:`compare`, counted on the input mesh.
 
     Parameters
     ----------
-    levels, start_level, eval_level : int
-        Optimization and metric levels, counted on the input mesh.
+    levels, start_level : int
+        Last and first optimization level.
+    eval_level : int
+        Level of the metric samples (the same for every method).
     refine : int >= 0
         Subdivide the control mesh ``refine`` times before optimizing (b) and (c) (more texture unknowns,
         the same surface and the same metric samples); their optimization levels are then
@@ -214,17 +216,41 @@ def compare(mesh, labels=None, methods=METHODS, levels=3, start_level=1, eval_le
         on the refined unknowns). (a) and (d) use the input mesh.
     sample_level : int, optional
         Also keep every chart's limit samples at this level (:func:`~ccproof.apps.arap.export.sample_chart`)
-        in ``MethodResult.samples`` (computed before ``release``).
+        in ``MethodResult.samples``.
+
+    Examples
+    --------
+    >>> LevelPlan(levels=1, eval_level=3)
+    LevelPlan(levels=1, start_level=1, eval_level=3, refine=0, sample_level=None)
+    """
+
+    levels: int = 3
+    start_level: int = 1
+    eval_level: int = 5
+    refine: int = 0
+    sample_level: int | None = None
+
+
+def compare(mesh, labels=None, methods=METHODS, plan=LevelPlan(), solver=None, hierarchies=None, release=False,
+            max_memory=None, progress=False):
+    """Run ``methods`` on every chart and measure them the same way.
+
+    Parameters
+    ----------
+    plan : LevelPlan
+        Optimization, metric, refinement and sample levels.
+    solver : Solver, optional
+        Tolerance, iterations, acceleration (the CLI uses 5) and the baselines' engine and level (default
+        ``Solver()``).
+    hierarchies : list of ChartHierarchy, optional
+        Those of the input mesh, when already built (returned for reuse).
     release : bool
         Process the charts one at a time and drop their fine levels afterwards (peak memory of the
-        largest chart instead of the sum).
+        largest chart instead of the sum); the samples of ``plan.sample_level`` are taken before.
     max_memory : float, optional
         Bytes; raise :class:`MemoryBudgetError` before allocating when :func:`estimate_memory` exceeds it.
     progress : bool
         A tqdm progress bar over (chart, method).
-    accel : int
-        Anderson acceleration history for (b) and (c) (0: the plain local/global iteration; the CLI
-        uses 5). (a) and (d) are never accelerated (they are the baselines as published).
 
     Returns
     -------
@@ -235,79 +261,31 @@ def compare(mesh, labels=None, methods=METHODS, levels=3, start_level=1, eval_le
     A flat grid has an isometric texture, E_angle = E_area = 2, E_stretch = 1 (their minima):
 
     >>> from ccproof.mesh.examples import grid
-    >>> res, hierarchies = compare(grid(3, 3), methods=("b", "c"), levels=1, eval_level=3)
+    >>> res, hierarchies = compare(grid(3, 3), methods=("b", "c"), plan=LevelPlan(levels=1, eval_level=3))
     >>> [[round(x, 9) for x in res[m].metrics.as_tuple()] for m in "bc"], len(hierarchies)
     ([[2.0, 2.0, 1.0], [2.0, 2.0, 1.0]], 1)
     """
-    charts = mesh_charts(mesh, labels)
     if hierarchies is None:
-        hierarchies = [ChartHierarchy(mesh, fc) for fc in charts]
-    refine = int(refine)
-    if refine < 0:
-        raise CCProofError(f"refine must be >= 0, got {refine}")
-    fine = {}
-    if refine and any(m in ("b", "c") for m in methods):
-        rmesh, rlab = refine_mesh(mesh, labels, refine)
-        fine = {"hierarchies": [ChartHierarchy(rmesh, fc) for fc in mesh_charts(rmesh, rlab)],
-                "start": max(start_level, refine + 1) - refine, "levels": max(levels, refine + 1) - refine}
-    need, deepest, opt = run_memory(hierarchies, methods, levels, eval_level, sample_level, refine,
-                                    baseline_level, release)
-    if max_memory is not None and need > max_memory:
-        big = int(np.argmax([h.n_faces(0) for h in hierarchies]))
-        raise MemoryBudgetError(
-            f"estimated peak memory {need / 1e9:.2f} GB exceeds the budget {max_memory / 1e9:.2f} GB "
-            f"(--max-memory): chart {big} has {hierarchies[big].n_faces(max(deepest, opt or 0)):,} faces at level "
-            f"{max(deepest, opt or 0)}; lower --eval-level / --levels / --out-level (each level less divides it "
-            f"by 4), or use smaller charts")
+        hierarchies = [ChartHierarchy(mesh, fc) for fc in mesh_charts(mesh, labels)]
+    solver = Solver() if solver is None else solver
+    plan = replace(plan, refine=int(plan.refine))
+    if plan.refine < 0:
+        raise CCProofError(f"refine must be >= 0, got {plan.refine}")
+    fine = _refined_charts(mesh, labels, methods, plan)
+    _check_budget(hierarchies, methods, plan, solver, release, max_memory)
     bar = None
     if progress:
         from tqdm import tqdm
 
         bar = tqdm(total=len(hierarchies) * len(methods), desc="arap", unit="chart")
-    acc: dict[str, dict[str, Any]] = {
-        m: {"texs": [], "secs": 0.0, "its": 0, "lv": [], "met": Metrics(), "fl": 0, "tot": 0, "samples": []}
-        for m in methods}
+    acc = {m: _Tally() for m in methods}
     try:
         for i, h in enumerate(hierarchies):
             for m in methods:
                 if bar is not None:
                     bar.set_postfix(method=m, chart=i)
-                X0, sec0, it0, st0 = None, 0.0, 0, []
-                if fine and m in ("b", "c"):
-                    hm, st, lv, ev = fine["hierarchies"][i], fine["start"], fine["levels"], eval_level - refine
-                    if start_level <= refine:  # multi-resolution: the input mesh's levels below the refined ones
-                        t0 = time.perf_counter()
-                        texc, _, it0, st0 = run_method(h, m, refine, start_level, tol, max_iter, engine,
-                                                       accel=accel)
-                        X0 = lift_to_refined(h, texc.unknowns, texc.rules, hm, refine)
-                        sec0 = time.perf_counter() - t0
-                else:
-                    hm, st, lv, ev = h, start_level, levels, eval_level
-                if ev < 0:
-                    raise CCProofError(f"eval_level {eval_level} is below refine {refine}")
-                tex, sec, it, stt = run_method(hm, m, lv, st, tol, max_iter, engine, baseline_level,
-                                               baseline_max_iter, trace, X0=X0, accel=accel)
-                if hm is not h:  # level numbers on the input mesh
-                    stt = [replace(x, level=x.level + refine) for x in stt]
-                sec, it, stt = sec + sec0, it + it0, st0 + stt
-                a = acc[m]
-                a["texs"].append(tex)
-                a["secs"] += sec
-                a["its"] += it
-                a["lv"].append(stt)
-                a["met"] = a["met"] + texture_metrics(tex, ev)
-                f, t = control_flips(tex)
-                a["fl"] += f
-                a["tot"] += t
-                if sample_level is not None:
-                    from ccproof.apps.arap.export import sample_chart
-
-                    off = refine if hm is not h else 0
-                    sl = max(sample_level - off, tex.level)  # (d) lives at level 3
-                    a["samples"].append(sample_chart(tex, sl))
-                    a["sample_level"] = sl + off
-                if release and hm is not h:
-                    hm.release()
+                hm = fine["hierarchies"][i] if fine and m in ("b", "c") else h
+                acc[m].add(_chart_method(h, hm, m, plan, solver), plan, release)
                 if bar is not None:
                     bar.update(1)
             if release:
@@ -315,16 +293,87 @@ def compare(mesh, labels=None, methods=METHODS, levels=3, start_level=1, eval_le
     finally:
         if bar is not None:
             bar.close()
-    out = {}
-    for m in methods:
-        a = acc[m]
-        r = MethodResult(m, a["texs"], a["secs"], a["its"], levels=a["lv"])
-        r.metrics, r.flips_control, r.triangles_control = a["met"], a["fl"], a["tot"]
-        r.refine = refine if (fine and m in ("b", "c")) else 0
-        r.samples = a["samples"] if sample_level is not None else None
-        r.sample_level = a.get("sample_level", sample_level)
-        out[m] = r
-    return out, hierarchies
+    return {m: acc[m].result(m, plan.refine if fine and m in ("b", "c") else 0, plan) for m in methods}, hierarchies
+
+
+def _refined_charts(mesh, labels, methods, plan):
+    """The charts of the mesh refined ``plan.refine`` times, when (b) or (c) optimize on it ({} otherwise)."""
+    if not (plan.refine and any(m in ("b", "c") for m in methods)):
+        return {}
+    rmesh, rlab = refine_mesh(mesh, labels, plan.refine)
+    return {"hierarchies": [ChartHierarchy(rmesh, fc) for fc in mesh_charts(rmesh, rlab)]}
+
+
+def _check_budget(hierarchies, methods, plan, solver, release, max_memory):
+    """Raise :class:`MemoryBudgetError` when the estimated peak exceeds ``max_memory`` (bytes; None: no budget)."""
+    need, deepest, opt = run_memory(hierarchies, methods, plan.levels, plan.eval_level, plan.sample_level,
+                                    plan.refine, solver.baseline_level, release)
+    if max_memory is not None and need > max_memory:
+        big = int(np.argmax([h.n_faces(0) for h in hierarchies]))
+        raise MemoryBudgetError(
+            f"estimated peak memory {need / 1e9:.2f} GB exceeds the budget {max_memory / 1e9:.2f} GB "
+            f"(--max-memory): chart {big} has {hierarchies[big].n_faces(max(deepest, opt or 0)):,} faces at level "
+            f"{max(deepest, opt or 0)}; lower --eval-level / --levels / --out-level (each level less divides it "
+            f"by 4), or use smaller charts")
+
+
+def _chart_method(h, hm, m, plan, solver):
+    """Method ``m`` on chart ``h`` (on ``hm``, its refined chart, when that is not ``h``): (texture, seconds,
+    iterations, level stats with levels on the input mesh, metric level on hm, hm)."""
+    refine, X0, sec0, it0, st0 = plan.refine, None, 0.0, 0, []
+    if hm is not h:
+        st = max(plan.start_level, refine + 1) - refine
+        lv, ev = max(plan.levels, refine + 1) - refine, plan.eval_level - refine
+        if plan.start_level <= refine:  # multi-resolution: the input mesh's levels below the refined ones
+            t0 = time.perf_counter()
+            texc, _, it0, st0 = run_method(h, m, refine, plan.start_level, replace(solver, trace=False))
+            X0 = lift_to_refined(h, texc.unknowns, texc.rules, hm, refine)
+            sec0 = time.perf_counter() - t0
+    else:
+        st, lv, ev = plan.start_level, plan.levels, plan.eval_level
+    if ev < 0:
+        raise CCProofError(f"eval_level {plan.eval_level} is below refine {refine}")
+    tex, sec, it, stt = run_method(hm, m, lv, st, solver, X0=X0)
+    if hm is not h:  # level numbers on the input mesh
+        stt = [replace(x, level=x.level + refine) for x in stt]
+    return tex, sec + sec0, it + it0, st0 + stt, ev, hm, h
+
+
+class _Tally:
+    """What :func:`compare` gathers of one method over the charts."""
+
+    def __init__(self):
+        self.texs, self.secs, self.its, self.lv, self.met = [], 0.0, 0, [], Metrics()
+        self.flips, self.total, self.samples, self.sample_level = 0, 0, [], None
+
+    def add(self, run, plan, release):
+        """Add one chart's ``run`` (:func:`_chart_method`)."""
+        tex, sec, it, stats, ev, hm, h = run
+        self.texs.append(tex)
+        self.secs += sec
+        self.its += it
+        self.lv.append(stats)
+        self.met = self.met + texture_metrics(tex, ev)
+        f, t = control_flips(tex)
+        self.flips += f
+        self.total += t
+        if plan.sample_level is not None:
+            from ccproof.apps.arap.export import sample_chart
+
+            off = plan.refine if hm is not h else 0
+            sl = max(plan.sample_level - off, tex.level)  # (d) lives at level 3
+            self.samples.append(sample_chart(tex, sl))
+            self.sample_level = sl + off
+        if release and hm is not h:
+            hm.release()
+
+    def result(self, m, refine, plan):
+        r = MethodResult(m, self.texs, self.secs, self.its, levels=self.lv)
+        r.metrics, r.flips_control, r.triangles_control = self.met, self.flips, self.total
+        r.refine = refine
+        r.samples = self.samples if plan.sample_level is not None else None
+        r.sample_level = self.sample_level if self.sample_level is not None else plan.sample_level
+        return r
 
 
 def parameterize(mesh: QuadMesh, labels: ArrayLike | None = None, variant: Literal["extended", "boundary"] = "extended",
@@ -370,5 +419,6 @@ def parameterize(mesh: QuadMesh, labels: ArrayLike | None = None, variant: Liter
     """
     if variant not in VARIANTS:
         raise CCProofError(f"unknown variant {variant!r}; expected one of {tuple(VARIANTS)}")
-    res, hs = compare(mesh, labels, (VARIANTS[variant],), levels, start_level, eval_level, tol, max_iter)
+    res, hs = compare(mesh, labels, (VARIANTS[variant],), LevelPlan(levels, start_level, eval_level),
+                      Solver(tol=tol, max_iter=max_iter))
     return res[VARIANTS[variant]]

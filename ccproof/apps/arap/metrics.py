@@ -26,7 +26,8 @@ import numpy as np
 
 from ccproof.apps.arap.samples import SampleSet, isometric_frames
 
-__all__ = ["singular_values", "jacobians", "Metrics", "sample_metrics", "triangle_metrics"]
+__all__ = ["singular_values", "jacobians", "Metrics", "sample_metrics", "triangle_metrics", "excess_ratios",
+           "minimax_choice"]
 
 
 def singular_values(J):
@@ -283,3 +284,56 @@ def triangle_metrics(P, UV, T, per_triangle=False):
 
     return m, {"s1": full(s1), "s2": full(s2), "det": full(det), "weight": w, "area_distortion": full(are),
                "stretch": full(np.sqrt(st))}
+
+
+def excess_ratios(metrics: Metrics, exact: Metrics):
+    """(E_angle, E_area, E_stretch) excess of ``metrics`` over ``exact``'s (1 where both are 0).
+
+    >>> import numpy as np
+    >>> V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0.0]])
+    >>> m2, m3 = (triangle_metrics(V, s * V[:, :2], np.array([[0, 1, 2]])) for s in (2, 3))
+    >>> [round(x, 6) for x in excess_ratios(m3, m2)]  # E_area: (9 + 1/9 - 2) / (4 + 1/4 - 2); no angle or stretch
+    [1.0, 3.160494, 1.0]
+    """
+    m, e = metrics.as_tuple(), exact.as_tuple()
+    return tuple((a - z) / (b - z) if b - z > 0 else (1.0 if a - z <= 0 else float("inf"))
+                 for a, b, z in zip(m, e, (2.0, 2.0, 1.0)))
+
+
+def minimax_choice(exact: Metrics, candidates):
+    """Per chart, the candidate that makes the largest global excess ratio smallest.
+
+    ``candidates[c]`` is chart c's list of Metrics (index 0: the default). Coordinate descent (one chart's choice
+    at a time, while the largest ratio falls) from every uniform start (all charts on candidate j, or on 0 where
+    they have fewer), the best end kept: never worse than the all-default choice or any uniform one, and no single
+    chart's change lowers the result.
+
+    Returns
+    -------
+    list of int
+        The chosen index per chart.
+    """
+    def worst(choice):
+        tot = Metrics()
+        for c, j in zip(candidates, choice):
+            tot = tot + c[j]
+        return max(excess_ratios(tot, exact))
+
+    best = None
+    for start in range(max(len(c) for c in candidates)):
+        choice = [start if start < len(c) else 0 for c in candidates]
+        cur = worst(choice)
+        improved = True
+        while improved:
+            improved = False
+            for i, c in enumerate(candidates):
+                for j in range(len(c)):
+                    if j == choice[i]:
+                        continue
+                    trial = choice[:i] + [j] + choice[i + 1:]
+                    v = worst(trial)
+                    if v < cur:
+                        cur, choice, improved = v, trial, True
+        if best is None or cur < best[0]:
+            best = (cur, choice)
+    return best[1]

@@ -96,9 +96,9 @@ def render_preview(path, surfaces, names=None, title=None, checks=None, view=Non
     Rendering takes seconds (matplotlib), so this example is not run:
 
     >>> from ccproof.mesh.examples import grid
-    >>> from ccproof.apps.arap.meshes import compare
+    >>> from ccproof.apps.arap.meshes import LevelPlan, compare
     >>> from ccproof.apps.arap.export import sampled_surface
-    >>> res, _ = compare(grid(3, 3), methods=("c",), levels=1, eval_level=3)
+    >>> res, _ = compare(grid(3, 3), methods=("c",), plan=LevelPlan(levels=1, eval_level=3))
     >>> render_preview("preview.png", {"c": sampled_surface(res["c"], level=2)})   # doctest: +SKIP
     """
     import matplotlib

@@ -227,6 +227,38 @@ def _dart_rows(mesh, verts, sharp_nbrs):
                          shape=(verts.size, mesh.n_vertices))
 
 
+def _limit_rule_sets(level: Level, r):
+    """The chart vertices of ``level`` by limit rule for the rules ``r``: (smooth, crease, corner, dart, moving)
+    masks and the two crease neighbours of every vertex (moving: semi-sharp tags, not yet stationary)."""
+    n = level.mesh.n_vertices
+    dart = np.zeros(n, dtype=bool)
+    moving = np.zeros(n, dtype=bool)
+    if r == "extended":
+        inner = level.chart_vertex & ~level.mesh.is_boundary_vertex
+        crease = level.chart_vertex & level.mesh.is_boundary_vertex
+        nbrs = level.surface_boundary_nbrs
+        corner = np.zeros(n, dtype=bool)
+        if level.has_tags:  # the surface's stationary rules (on an untagged surface the same sets)
+            cvx = level.chart_vertex & level.stationary
+            moving = level.chart_vertex & ~level.stationary
+            inner, crease, corner = cvx & level.smooth, cvx & level.crease_rule, cvx & level.corner_rule
+            dart, nbrs = cvx & level.dart_rule, level.crease_nbrs
+        return inner, crease, corner, dart, moving, nbrs
+    inner = level.chart_interior
+    corner = level.corner
+    crease = level.chart_boundary & ~corner
+    nbrs = level.chart_boundary_nbrs
+    if level.has_tags:  # chart-interior vertices follow the surface's rules
+        ci = level.chart_interior & level.stationary
+        moving = level.chart_interior & ~level.stationary
+        inner = ci & level.smooth
+        corner = corner | (ci & level.corner_rule)
+        dart = ci & level.dart_rule
+        nbrs = np.where((ci & level.crease_rule)[:, None], level.crease_nbrs, nbrs)
+        crease = crease | (ci & level.crease_rule)
+    return inner, crease, corner, dart, moving, nbrs
+
+
 def limit_operator(level: Level, rules):
     """Sparse (n, n) limit-position operator on ``E_k`` for ``rules``; rows of chart vertices only.
 
@@ -258,35 +290,10 @@ def limit_operator(level: Level, rules):
     >>> A.shape, bool(np.all((np.abs(r - 1) < 1e-12) | (r == 0))), bool((r != 0).any())
     ((49, 49), True, True)
     """
-    r = check_rules(rules)
     mesh = level.mesh
     F = mesh.faces
     n = mesh.n_vertices
-    dart = np.zeros(n, dtype=bool)
-    moving = np.zeros(n, dtype=bool)  # semi-sharp tags: not stationary
-    if r == "extended":
-        inner = level.chart_vertex & ~mesh.is_boundary_vertex
-        crease = level.chart_vertex & mesh.is_boundary_vertex
-        nbrs = level.surface_boundary_nbrs
-        corner = np.zeros(n, dtype=bool)
-        if level.has_tags:  # the surface's stationary rules (on an untagged surface the same sets)
-            cvx = level.chart_vertex & level.stationary
-            moving = level.chart_vertex & ~level.stationary
-            inner, crease, corner = cvx & level.smooth, cvx & level.crease_rule, cvx & level.corner_rule
-            dart, nbrs = cvx & level.dart_rule, level.crease_nbrs
-    else:
-        inner = level.chart_interior
-        corner = level.corner
-        crease = level.chart_boundary & ~corner
-        nbrs = level.chart_boundary_nbrs
-        if level.has_tags:  # chart-interior vertices follow the surface's rules
-            ci = level.chart_interior & level.stationary
-            moving = level.chart_interior & ~level.stationary
-            inner = ci & level.smooth
-            corner = corner | (ci & level.corner_rule)
-            dart = ci & level.dart_rule
-            nbrs = np.where((ci & level.crease_rule)[:, None], level.crease_nbrs, nbrs)
-            crease = crease | (ci & level.crease_rule)
+    inner, crease, corner, dart, moving, nbrs = _limit_rule_sets(level, check_rules(rules))
     org = F.ravel()
     h = np.flatnonzero(inner[org])
     v = org[h]

@@ -37,7 +37,7 @@ import scipy.sparse.linalg as spla
 
 from ccproof.apps.arap.samples import SampleSet, isometric_frames
 
-__all__ = ["closest_rotations", "LocalGlobal", "IterationResult", "iterate", "triangle_samples"]
+__all__ = ["closest_rotations", "LocalGlobal", "IterationResult", "iterate", "triangle_samples", "lbfgs"]
 
 
 def closest_rotations(J, previous=None):
@@ -412,3 +412,54 @@ def system_from_samples(samples: SampleSet, A, pin=0):
     (True, True)
     """
     return LocalGlobal(samples.p1, samples.p2, samples.O1 @ A, samples.O2 @ A, samples.weight, pin=pin)
+
+
+def lbfgs(f, y, max_iter=300, m=10, rtol=1e-9):
+    """Minimize ``f`` (value, gradient; +inf outside its domain) from a point of its domain: L-BFGS with
+    backtracking (Armijo) line search, which backs off from +inf (a barrier such as a fold); (y, f(y)).
+
+    >>> y, fy = lbfgs(lambda y: (float((y - 3.0) @ (y - 3.0)), 2 * (y - 3.0)), np.zeros(2))
+    >>> np.round(y, 6).tolist(), fy < 1e-12
+    ([3.0, 3.0], True)
+    """
+    fy, g = f(y)
+    S, Yk = [], []
+    for _ in range(max_iter):
+        q = g.copy()
+        al = []
+        for s, t in zip(reversed(S), reversed(Yk)):
+            a = (s @ q) / (t @ s)
+            al.append(a)
+            q -= a * t
+        if S:
+            q *= (S[-1] @ Yk[-1]) / (Yk[-1] @ Yk[-1])
+        else:
+            q *= 1e-3 / max(np.abs(q).max(), 1e-300) * max(np.abs(y).max(), 1.0)
+        for (s, t), a in zip(zip(S, Yk), reversed(al)):
+            b = (t @ q) / (t @ s)
+            q += s * (a - b)
+        d = -q
+        slope = g @ d
+        if slope >= 0:
+            d, slope, S, Yk = -g, -(g @ g), [], []
+        step = 1.0
+        for _ in range(40):
+            yn = y + step * d
+            fn, gn = f(yn)
+            if fn <= fy + 1e-4 * step * slope:
+                break
+            step *= 0.5
+        else:
+            break
+        s, t = yn - y, gn - g
+        if s @ t > 1e-300:
+            S.append(s)
+            Yk.append(t)
+            if len(S) > m:
+                S.pop(0)
+                Yk.pop(0)
+        done = fy - fn <= rtol * max(abs(fy), 1.0)
+        y, fy, g = yn, fn, gn
+        if done:
+            break
+    return y, fy

@@ -61,6 +61,7 @@ from ccproof.apps.dynamics.cloud import (
     minimal_enclosing_sphere,
     surface_to_data,
 )
+from ccproof.apps.dynamics.fit_options import Evolution, FitSprings, SurfaceCheck
 from ccproof.apps.dynamics.forces import ModelClosestPoints, Springs, SurfaceToDataSprings
 from ccproof.apps.dynamics.integrate import ImplicitIntegrator
 from ccproof.apps.dynamics.meshes import paper_initial_model
@@ -71,6 +72,9 @@ from ccproof.mesh.points import read_points
 
 __all__ = [
     "read_points",
+    "FitSprings",
+    "Evolution",
+    "SurfaceCheck",
     "FitLevel",
     "FitResult",
     "fit_points",
@@ -231,13 +235,10 @@ def _initial_mesh(init, Xn, init_scale):
 
 
 def fit_points(X: ArrayLike, init: Literal["cube"] | QuadMesh = "cube", levels: int = 1,
-               material: Material | None = None, spring_total: float = 1.0, dt: float | None = None,
-               scheme: Literal["massless", "inertial"] = "massless", max_steps: int = 1000, tol: float = 1e-3,
-               init_scale: float = 0.5, truncation: int = 6, progress: bool = False,
-               callback: Callable[[int, int, DynamicSurface, NDArray[np.float64]], object] | None = None,
-               sample_level: int | None = None, stray_distance_percent: float | None = None,
-               stray_fraction: float = 0.01, surface_spring_total: float = 5.0,
-               spring_points: int | None = 10_000) -> FitResult:
+               material: Material | None = None, springs: FitSprings | None = None,
+               evolution: Evolution | None = None, check: SurfaceCheck | None = None, init_scale: float = 0.5,
+               progress: bool = False, callback: Callable[[int, int, DynamicSurface, NDArray[np.float64]], object]
+               | None = None) -> FitResult:
     """Recover a closed surface from range data (module docstring).
 
     Parameters
@@ -251,54 +252,22 @@ def fit_points(X: ArrayLike, init: Literal["cube"] | QuadMesh = "cube", levels: 
     material : Material, optional
         Densities in normalized units (default :data:`DEFAULT_FIT_MATERIAL`), for the initial level;
         rescaled at each subdivision (:meth:`Material.refined`).
-    spring_total : float > 0
-        Sum of the data-spring constants (each point gets ``spring_total / m``).
-    dt : float > 0, optional
-        Time step (normalized units); default 1000 (massless: nearly quasi-static steps) or 10
-        (inertial).
-    scheme : "massless" (eq. 32) or "inertial" (eq. 31)
-    max_steps : int
-        Time steps per level at most (a safety cap, not the usual stop).
-    tol : float
-        Equilibrium: relative changes of the total energy and of the mean data -> surface distance (the
-        latter relative to max(mean distance, data spacing)) between steps t - dt and t + dt both at
-        most ``tol``.
+    springs, evolution, check : FitSprings, Evolution, SurfaceCheck, optional
+        The data and surface -> data springs, the evolution of each level (scheme, time step, step cap,
+        tolerance), the surface -> data report (sampling level, stray criterion); default: their defaults.
     init_scale : float in (0, 1]
         Size of the initial control cube relative to the data's bounding box.
-    truncation : int
-        Truncation level L of the special-element stiffness.
     progress : bool
         Show a tqdm progress bar over the time steps.
     callback : callable, optional
         ``callback(level, step, model, P_normalized)`` after every step.
-    sample_level : int, optional
-        Level of the sampled limit surface (default: the smallest level in 1..3 with at least 4 samples
-        per data point).
-    stray_distance_percent : float, optional
-        Surface -> data distance above which a surface sample strays, in % of the enclosing-sphere
-        diameter (default 3 times :func:`data_spacing`).
-    stray_fraction : float
-        Warn when more than this area fraction of the surface strays.
-    surface_spring_total : float >= 0
-        Sum of the constants of the surface -> data springs
-        (:class:`~ccproof.apps.dynamics.forces.SurfaceToDataSprings`: 4 x 4 samples per patch face, in
-        proportion to area; a sample farther than the stray distance from every data point is pulled
-        toward its nearest data point, to within the stray distance), which pull the parts of the surface
-        that no data point is near (a membrane across a concavity) to the data; 0 turns them off (the
-        paper's one-way data springs only). Default 5 (the data springs sum to ``spring_total``).
-    spring_points : int >= 4 or None
-        At most this many data points carry data springs (a fixed random subset, seed 0, when the cloud is
-        larger; each spring ``spring_total / count``): every step re-projects them all, so the time grows with
-        their number, while a few points per spacing of the final surface pin it as well (docs/qmv98.md, dense
-        clouds). The errors, the stray report and the surface -> data springs use every point. None: all.
 
     Returns
     -------
     FitResult
-        ``mesh``: the fitted control mesh (QuadMesh, data coordinates; 98 vertices from the cube, x4 faces
-        per level), ``max_error_percent`` / ``mean_error_percent``: the paper's fit error (data -> limit
-        surface, % of the enclosing-sphere diameter), ``surface``: the limit surface sampled at
-        ``sample_level`` (vertices of shape (n, 3)), ``surface_report`` and ``warnings`` (surface -> data).
+        ``mesh``: the fitted control mesh (data coordinates; 98 vertices from the cube, x4 faces per level),
+        ``max_error_percent`` / ``mean_error_percent``: the paper's fit error (data -> limit surface, % of the
+        enclosing-sphere diameter), ``surface``, ``surface_report`` and ``warnings`` (surface -> data).
 
     Examples
     --------
@@ -313,72 +282,103 @@ def fit_points(X: ArrayLike, init: Literal["cube"] | QuadMesh = "cube", levels: 
     >>> fit.mesh.n_vertices, fit.max_error_percent < 0.5, bool(0.98 < r.min() and r.max() < 1.01), fit.warnings
     (98, True, True, [])
     """
+    springs = FitSprings() if springs is None else springs
+    evolution = Evolution() if evolution is None else evolution
+    check = SurfaceCheck() if check is None else check
     pts = check_cloud(X)  # (m, 3) float64
-    _check_fit_numbers(levels, spring_total, surface_spring_total, init_scale)
-    if dt is None:
-        dt = 1000.0 if scheme == "massless" else 10.0
+    _check_fit_numbers(levels, springs.total, springs.surface_total, init_scale)
     material = DEFAULT_FIT_MATERIAL if material is None else material
     centre, radius = minimal_enclosing_sphere(pts)
-    diameter = 2.0 * radius
-    if not diameter > 0:
+    if not (diameter := 2.0 * radius) > 0:
         raise CCProofError("the data points all coincide")
     Xn = (pts - centre) / diameter
     mesh0 = _start_mesh(init, Xn, init_scale, centre, diameter)
-    model = DynamicSurface(mesh0, material, levels=truncation)
-    P = np.array(mesh0.vertices)
-    # a non-manifold file's split mesh: the copies of one file vertex are one free point (docs/qmv98.md)
-    copies = getattr(mesh0, "file_vertex", None)
-    Xs = _spring_subset(Xn, spring_points)
-    k = np.full(Xs.shape[0], spring_total / Xs.shape[0])
+    Xs = _spring_subset(Xn, springs.points)
     result = FitResult(mesh=None, model=None, center=centre, diameter=diameter,
-                       parameters={"material": material, "spring_total": spring_total, "dt": dt, "scheme": scheme,
-                                   "max_steps": max_steps, "tol": tol, "init_scale": init_scale,
-                                   "truncation": truncation, "levels": levels,
-                                   "surface_spring_total": surface_spring_total, "spring_points": Xs.shape[0]})
+                       parameters=_parameters(material, springs, evolution, init_scale, levels, Xs.shape[0]))
     spacing_n = max(data_spacing(Xn), 1e-300)
     # the stray distance (normalized): the surface -> data springs pull the samples farther than it back to it
-    stray_n = 3.0 * spacing_n if stray_distance_percent is None else float(stray_distance_percent) / 100.0
-    bar = None
-    if progress:
-        from tqdm import tqdm
-
-        bar = tqdm(total=(levels + 1) * max_steps, desc="fit", unit="step")
+    stray_n = 3.0 * spacing_n if check.stray_distance_percent is None else float(check.stray_distance_percent) / 100
+    fit = _FitState(DynamicSurface(mesh0, material, levels=evolution.truncation), mesh0, result, spacing_n)
+    bar = _progress_bar((levels + 1) * evolution.max_steps) if progress else None
     try:
         for level in range(levels + 1):
-            t0 = time.perf_counter()
-            finder = ModelClosestPoints(model)
-            integ = ImplicitIntegrator(model, dt, P=P, scheme=scheme, tol=1e-9, copies=copies)
-            reverse = (SurfaceToDataSprings(model, Xn, surface_spring_total, slack=stray_n)
-                       if surface_spring_total > 0 else None)
-            run = _relax_level(model, finder, integ, (Xs, k, reverse), level, result.parameters, spacing_n,
-                               (bar, callback))
-            step, converged, cg, energies, change, err_change, reason = run
-            if bar is not None and step < max_steps:
-                bar.update(max_steps - step)
-            P = integ.P
-            err = fit_error(model, P, Xn, finder=finder, diameter=1.0)
-            result.levels.append(FitLevel(model.n_vertices, model.mesh.n_faces, step, converged,
-                                          err["max_percent"], err["mean_percent"], time.perf_counter() - t0, cg,
-                                          energies[-1] if energies else math.nan, change, err_change, reason))
+            fit.relax(level, (Xn, Xs, springs, stray_n), evolution, (bar, callback))
             if level < levels:
-                model, A = model.refine(P)
-                P = np.asarray(A @ P)
-                if copies is not None:  # the children of the copies that are one point of the refined file
-                    copies = model.mesh.file_vertex  # (subdivide_control: copy_labels)
+                fit.refine()
     finally:
         if bar is not None:
             bar.close()
-    result.model = model
-    result.mesh = mesh = model.mesh.with_vertices(P * diameter + centre)
-    if copies is not None:
-        mesh.file_vertex = copies
-    result.normalized_state = P
-    result.data_distances = err["distances"] * diameter
-    for i, lev in enumerate(result.levels):
-        if not lev.converged:
-            result.warnings.append(f"level {i} {lev.reason}")
-    _report_surface(result, pts, sample_level, stray_distance_percent, stray_fraction)
+    fit.finish(pts, check)
     return result
+
+
+def _parameters(material, springs, evolution, init_scale, levels, spring_points):
+    """The parameters a :class:`FitResult` records (dt resolved, the count of points carrying springs)."""
+    return {"material": material, "spring_total": springs.total, "dt": evolution.time_step(),
+            "scheme": evolution.scheme, "max_steps": evolution.max_steps, "tol": evolution.tol,
+            "init_scale": init_scale, "truncation": evolution.truncation, "levels": levels,
+            "surface_spring_total": springs.surface_total, "spring_points": spring_points}
+
+
+def _progress_bar(total):
+    from tqdm import tqdm
+
+    return tqdm(total=total, desc="fit", unit="step")
+
+
+class _FitState:
+    """The state of :func:`fit_points` from level to level: the model, its control points ``P`` (normalized),
+    the copies of one file vertex (a non-manifold start: one free point, docs/qmv98.md)."""
+
+    def __init__(self, model, mesh0, result, spacing_n):
+        self.model, self.result, self.spacing_n = model, result, spacing_n
+        self.P = np.array(mesh0.vertices)
+        self.copies = getattr(mesh0, "file_vertex", None)
+        self.err: dict = {}
+
+    def relax(self, level, data, evolution, hooks):
+        """Integrate ``level`` to equilibrium (or the step cap) and record its :class:`FitLevel`."""
+        Xn, Xs, springs, stray_n = data
+        t0 = time.perf_counter()
+        model, result = self.model, self.result
+        finder = ModelClosestPoints(model)
+        integ = ImplicitIntegrator(model, result.parameters["dt"], P=self.P, scheme=evolution.scheme, tol=1e-9,
+                                   copies=self.copies)
+        reverse = (SurfaceToDataSprings(model, Xn, springs.surface_total, slack=stray_n)
+                   if springs.surface_total > 0 else None)
+        k = np.full(Xs.shape[0], springs.total / Xs.shape[0])
+        run = _relax_level(model, finder, integ, (Xs, k, reverse), level, result.parameters, self.spacing_n, hooks)
+        step, converged, cg, energies, change, err_change, reason = run
+        bar = hooks[0]
+        if bar is not None and step < evolution.max_steps:
+            bar.update(evolution.max_steps - step)
+        self.P = integ.P
+        self.err = err = fit_error(model, self.P, Xn, finder=finder, diameter=1.0)
+        result.levels.append(FitLevel(model.n_vertices, model.mesh.n_faces, step, converged, err["max_percent"],
+                                      err["mean_percent"], time.perf_counter() - t0, cg,
+                                      energies[-1] if energies else math.nan, change, err_change, reason))
+
+    def refine(self):
+        """Subdivide the model globally (densities rescaled) and carry the control points over."""
+        self.model, A = self.model.refine(self.P)
+        self.P = np.asarray(A @ self.P)
+        if self.copies is not None:  # the children of the copies that are one point of the refined file
+            self.copies = self.model.mesh.file_vertex  # (subdivide_control: copy_labels)
+
+    def finish(self, pts, check):
+        """The fitted mesh in data units, the data distances, the warnings and the surface -> data report."""
+        result, diameter = self.result, self.result.diameter
+        result.model = self.model
+        result.mesh = mesh = self.model.mesh.with_vertices(self.P * diameter + result.center)
+        if self.copies is not None:
+            mesh.file_vertex = self.copies
+        result.normalized_state = self.P
+        result.data_distances = self.err["distances"] * diameter
+        for i, lev in enumerate(result.levels):
+            if not lev.converged:
+                result.warnings.append(f"level {i} {lev.reason}")
+        _report_surface(result, pts, check.sample_level, check.stray_distance_percent, check.stray_fraction)
 
 
 def _spring_subset(Xn, spring_points):
@@ -437,7 +437,8 @@ def _relax_level(model, finder, integ, data, level, params, spacing_n, hooks):
         errors.append(float(np.mean(dist)))  # of the state before this step
         springs = Springs(model, f, u, v, Xn, k)
         if two_way and reverse is not None:  # and from the surface to the data (two-way forces)
-            springs = Springs.stacked(springs, reverse.springs(integ.P)[0])
+            pull = reverse.springs(integ.P)[0].pulling()
+            springs = springs if pull is None else Springs.stacked(springs, pull)
         info = integ.step(springs=springs)
         cg += info.iterations
         energies.append(model.energy(integ.P) + springs.energy(integ.P))

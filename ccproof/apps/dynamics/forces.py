@@ -129,6 +129,30 @@ class Springs:
     def energy(self, P):
         return 0.5 * float(np.sum(self.stiffness * self.lengths(P) ** 2))
 
+    def pulling(self):
+        """The springs with a constant > 0 (None if there is none): the same force, matrix and energy (the others
+        add exact zeros), on fewer rows (a fit's surface -> data springs leave most samples at 0: their rows were
+        most of a step's memory).
+
+        >>> import numpy as np
+        >>> from ccproof.apps.dynamics.meshes import paper_initial_model
+        >>> from ccproof.apps.dynamics.model import DynamicSurface
+        >>> m = DynamicSurface(paper_initial_model())
+        >>> s = Springs(m, [0, 1], [0.5, 0.5], [0.5, 0.5], [[0, 0, 9.0], [1, 0, 0.0]], [0.0, 2.0])
+        >>> p = s.pulling()
+        >>> p.count, bool(np.allclose(p.force(m.vertices), s.force(m.vertices)))
+        (1, True)
+        >>> Springs(m, [0], [0.5], [0.5], [[0, 0, 9.0]], 0.0).pulling() is None
+        True
+        """
+        keep = np.flatnonzero(self.stiffness > 0)
+        if keep.size == self.count:
+            return self
+        if keep.size == 0:
+            return None
+        return Springs(self.model, self.faces[keep], self.u[keep], self.v[keep], self.anchors[keep],
+                       self.stiffness[keep], jacobian=self.jacobian[keep])
+
     @classmethod
     def stacked(cls, first, second):
         """One set of springs holding the springs of ``first`` and then those of ``second`` (same model).

@@ -182,14 +182,14 @@ def test_default_refine_control_out_meets_the_target(tmp_path, capsys):
 
 def test_library_rule_is_the_independent_rule(tmp_path):
     """The boundary rules with surface_corners=True subdivide the written UVs exactly as the rule above."""
-    from ccproof.apps.arap.fvar import export_control
+    from ccproof.apps.arap.fvar import ControlOptions, export_control
     from ccproof.apps.arap.io import write_uv_obj
-    from ccproof.apps.arap.meshes import compare
+    from ccproof.apps.arap.meshes import LevelPlan, compare
 
     m, chart = M.curved_ev_mesh()
     labels = np.array([0 if f in set(chart) else -1 for f in range(m.n_faces)])
-    res, _ = compare(m, labels, methods=("c",), levels=2, eval_level=4)
-    exp = export_control(res["c"], eval_level=4, max_extra=0)
+    res, _ = compare(m, labels, methods=("c",), plan=LevelPlan(levels=2, eval_level=4))
+    exp = export_control(res["c"], eval_level=4, options=ControlOptions(max_extra=0))
     tex = exp.textures[0]
     path = tmp_path / "c.obj"
     write_uv_obj(path, exp.mesh, res["c"].__class__("c", exp.textures, 0.0, 0))
@@ -285,14 +285,14 @@ def test_opensubdiv_subdivides_the_control_uvs_as_the_rule_and_they_do_not_fold(
     from scipy.spatial import cKDTree
 
     from ccproof.apps.arap.core import MethodResult
-    from ccproof.apps.arap.fvar import export_control
+    from ccproof.apps.arap.fvar import ControlOptions, export_control
     from ccproof.apps.arap.io import write_uv_obj
-    from ccproof.apps.arap.meshes import compare
+    from ccproof.apps.arap.meshes import LevelPlan, compare
 
     m, chart = M.curved_ev_mesh()
     labels = np.array([0 if f in set(chart) else -1 for f in range(m.n_faces)])
-    res, _ = compare(m, labels, methods=("c",), levels=2, eval_level=4)
-    exp = export_control(res["c"], eval_level=4, max_extra=0)
+    res, _ = compare(m, labels, methods=("c",), plan=LevelPlan(levels=2, eval_level=4))
+    exp = export_control(res["c"], eval_level=4, options=ControlOptions(max_extra=0))
     path = tmp_path / "c.obj"
     write_uv_obj(path, exp.mesh, MethodResult("c", exp.textures, 0.0, 0))
     for level in (1, 2, 3):
@@ -364,11 +364,11 @@ def test_minimax_choice_mixes_charts_to_the_brute_force_optimum():
     meets 1.05, one chart on each does (brute force over the 4 choices, computed here from the raw sums)."""
     import itertools
 
-    from ccproof.apps.arap.fvar import _minimax_choice
+    from ccproof.apps.arap.metrics import minimax_choice
 
     exact = _metrics(2.0, 2.01, 2.01, 1.01)
     cands = [[_metrics(1.0, 2.0110, 2.0098, 1.0104), _metrics(1.0, 2.0098, 2.0110, 1.0104)] for _ in range(2)]
-    ch = _minimax_choice(exact, cands)
+    ch = minimax_choice(exact, cands)
     got = _global_ratios([c[j] for c, j in zip(cands, ch)], exact).max()
     brute = min(_global_ratios([c[j] for c, j in zip(cands, js)], exact).max()
                 for js in itertools.product(range(2), repeat=2))
@@ -377,7 +377,7 @@ def test_minimax_choice_mixes_charts_to_the_brute_force_optimum():
 
 
 def test_minimax_choice_is_no_worse_than_any_uniform_choice_and_locally_optimal():
-    from ccproof.apps.arap.fvar import _minimax_choice
+    from ccproof.apps.arap.metrics import minimax_choice
 
     rng = np.random.default_rng(7)
     exact = _metrics(10.0, 2.01, 2.01, 1.01)
@@ -385,7 +385,7 @@ def test_minimax_choice_is_no_worse_than_any_uniform_choice_and_locally_optimal(
         cands = [[_metrics(a, 2 + 0.01 * rng.uniform(0.8, 1.3), 2 + 0.01 * rng.uniform(0.8, 1.3),
                            1 + 0.01 * rng.uniform(0.8, 1.3)) for _ in range(int(rng.integers(1, 4)))]
                  for a in rng.uniform(0.5, 2, size=6)]
-        ch = _minimax_choice(exact, cands)
+        ch = minimax_choice(exact, cands)
         worst = _global_ratios([c[j] for c, j in zip(cands, ch)], exact).max()
         for j in range(3):
             uni = [c[j] if j < len(c) else c[0] for c in cands]
@@ -402,15 +402,16 @@ def test_export_control_minimax_keeps_no_fold_and_does_not_raise_the_largest_rat
     written UVs have no folded triangle at levels 1-3 under the independent rule, and the ARAP-only metrics are
     those of metric=False."""
     from ccproof.apps.arap.core import MethodResult
-    from ccproof.apps.arap.fvar import METRIC_WEIGHTS, export_control
+    from ccproof.apps.arap.fvar import METRIC_WEIGHTS, ControlOptions, export_control
     from ccproof.apps.arap.io import write_uv_obj
-    from ccproof.apps.arap.meshes import compare
+    from ccproof.apps.arap.meshes import LevelPlan, compare
 
     m, chart = M.curved_ev_mesh()
     labels = np.array([0 if f in set(chart) else -1 for f in range(m.n_faces)])
-    res, _ = compare(m, labels, methods=("c",), levels=2, eval_level=4)
-    plain = export_control(res["c"], eval_level=4, max_extra=0, metric=False)
-    auto = export_control(res["c"], eval_level=4, max_extra=0)  # the last refinement allowed misses: it runs
+    res, _ = compare(m, labels, methods=("c",), plan=LevelPlan(levels=2, eval_level=4))
+    plain = export_control(res["c"], eval_level=4, options=ControlOptions(max_extra=0, metric=False))
+    # the last refinement allowed misses: the minimax runs
+    auto = export_control(res["c"], eval_level=4, options=ControlOptions(max_extra=0))
     assert not plain.accepted and plain.arap_metrics is None and plain.chart_weights == [None]
     assert auto.arap_metrics is not None and auto.arap_metrics.as_tuple() == plain.metrics.as_tuple()
     assert auto.chart_weights[0] in METRIC_WEIGHTS

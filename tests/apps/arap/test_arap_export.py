@@ -14,8 +14,9 @@ import numpy as np
 import pytest
 from scipy.spatial import cKDTree
 
+from ccproof.apps.arap.core import Solver
 from ccproof.apps.arap.export import pack_charts, read_surface, sampled_surface, write_surface
-from ccproof.apps.arap.meshes import compare
+from ccproof.apps.arap.meshes import LevelPlan, compare
 from ccproof.cli import main
 from ccproof.mesh import QuadMesh, limit_positions, subdivide, write_obj
 
@@ -29,7 +30,7 @@ def tube_case():
     """Open cylinder cut into two half-tube charts (a seam along two lines), (b) and (c) optimized."""
     m = M.tube(12, 6)
     lab = np.array([0 if (f // 6) < 6 else 1 for f in range(m.n_faces)])
-    res, hs = compare(m, lab, ("b", "c"), levels=2, eval_level=2)
+    res, hs = compare(m, lab, ("b", "c"), LevelPlan(levels=2, eval_level=2))
     return m, lab, res
 
 
@@ -38,7 +39,7 @@ def ev_case():
     m, chart = M.curved_ev_mesh()
     lab = -np.ones(m.n_faces, dtype=int)
     lab[chart] = 0
-    res, hs = compare(m, lab, ("b", "c"), levels=2, eval_level=2)
+    res, hs = compare(m, lab, ("b", "c"), LevelPlan(levels=2, eval_level=2))
     return m, lab, res
 
 
@@ -190,7 +191,7 @@ def test_memory_budget_is_checked_before_allocating(ev_case):
     assert e5 - BASE_BYTES == pytest.approx(4 * (e4 - BASE_BYTES))  # linear in the faces of the deepest level
     assert h.n_faces(5) == 4 * h.n_faces(4) == 4**5 * h.levels[0].mesh.n_faces
     with pytest.raises(MemoryBudgetError, match=r"--max-memory.*lower --eval-level / --levels / --out-level"):
-        compare(m, lab, ("c",), eval_level=9, max_memory=2e9, hierarchies=[h])
+        compare(m, lab, ("c",), LevelPlan(eval_level=9), max_memory=2e9, hierarchies=[h])
     assert len(h.levels) == 1  # refused before building anything
 
 
@@ -215,7 +216,7 @@ def test_release_and_refine_keep_the_texture(ev_case):
     from ccproof.apps.arap.meshes import refine_mesh
 
     m, lab, res = ev_case
-    r2, _ = compare(m, lab, ("c",), levels=2, eval_level=2, release=True)
+    r2, _ = compare(m, lab, ("c",), LevelPlan(levels=2, eval_level=2), release=True)
     assert r2["c"].metrics.as_tuple() == pytest.approx(res["c"].metrics.as_tuple(), abs=1e-12)
     tex = res["c"].textures[0]
     rm, rl = refine_mesh(m, lab, 1)
@@ -236,9 +237,9 @@ def test_refining_the_control_mesh_makes_c_beat_d_on_a_bunny_patch(bunny_path):
     b = read_obj(bunny_path)
     lab = -np.ones(b.n_faces, dtype=int)
     lab[grow_patch(b, 1000, 4)] = 0
-    d = compare(b, lab, ("d",), eval_level=4, engine="numpy")[0]["d"].metrics
-    c0 = compare(b, lab, ("c",), eval_level=4, refine=0)[0]["c"].metrics
-    c2 = compare(b, lab, ("c",), eval_level=4, refine=2)[0]["c"].metrics
+    d = compare(b, lab, ("d",), LevelPlan(eval_level=4), Solver(engine="numpy"))[0]["d"].metrics
+    c0 = compare(b, lab, ("c",), LevelPlan(eval_level=4, refine=0))[0]["c"].metrics
+    c2 = compare(b, lab, ("c",), LevelPlan(eval_level=4, refine=2))[0]["c"].metrics
     assert c0.E_area > d.E_area  # without refinement (c) is behind (d) here
     assert c2.E_area <= d.E_area and c2.E_stretch <= d.E_stretch
     assert c2.samples == d.samples

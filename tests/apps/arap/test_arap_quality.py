@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from ccproof.apps.arap.charts import grow_patch
-from ccproof.apps.arap.core import ChartTexture, initial_texture, optimize_chart, texture_metrics
+from ccproof.apps.arap.core import ChartTexture, Solver, initial_texture, optimize_chart, texture_metrics
 from ccproof.apps.arap.hierarchy import ChartHierarchy
 from ccproof.apps.arap.meshes import compare
 from ccproof.mesh import read_obj
@@ -81,7 +81,7 @@ def curved_comparison():
     m, chart = M.curved_ev_mesh()
     lab = -np.ones(m.n_faces, dtype=int)
     lab[chart] = 0
-    res, _ = compare(m, lab, engine="numpy")
+    res, _ = compare(m, lab, solver=Solver(engine="numpy"))
     return {k: np.array(r.metrics.as_tuple()) for k, r in res.items()}, res
 
 
@@ -123,7 +123,7 @@ def test_bunny_patch_ordering(bunny_path):
     patch = grow_patch(m, 1000, 8)
     lab = -np.ones(m.n_faces, dtype=int)
     lab[patch] = 0
-    res, _ = compare(m, lab, engine="numpy")
+    res, _ = compare(m, lab, solver=Solver(engine="numpy"))
     v = {k: np.array(r.metrics.as_tuple()) for k, r in res.items()}
     assert (v["a"] > v["b"]).all() and (v["b"] > v["c"]).all()
     assert (np.abs(v["c"] - v["d"]) < 0.25 * (v["a"] - v["d"])).all()

@@ -12,7 +12,7 @@ import pytest
 
 from ccproof.apps.arap.charts import segment_by_normals
 from ccproof.apps.arap.export import sample_chart
-from ccproof.apps.arap.meshes import compare
+from ccproof.apps.arap.meshes import LevelPlan, compare
 from ccproof.apps.control_file import read_control_mesh
 from ccproof.apps.control_mesh import TaggedQuadMesh, subdivide_control, tagged_step
 from ccproof.evaluate import LimitSurface
@@ -65,7 +65,7 @@ def _check_samples(path, level=2, methods=("c", "b"), text=None, tmp_path=None):
     mesh, origin = read_control_mesh(path)
     assert isinstance(mesh, TaggedQuadMesh)
     labels = segment_by_normals(mesh)
-    res, hs = compare(mesh, labels, methods, levels=1, eval_level=level, sample_level=level)
+    res, hs = compare(mesh, labels, methods, LevelPlan(levels=1, eval_level=level, sample_level=level))
     frames = _control_frames(poly, mesh.n_faces, origin)
     S = LimitSurface(poly)
     worst = 0.0

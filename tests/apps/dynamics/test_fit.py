@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from ccproof.apps.dynamics.cloud import minimal_enclosing_sphere
-from ccproof.apps.dynamics.fit import fit_points, read_points
+from ccproof.apps.dynamics.fit import Evolution, fit_points, read_points
 from ccproof.apps.dynamics.meshes import (
     flat_sheet,
     genus2_surface,
@@ -134,7 +134,7 @@ def test_bad_point_clouds(tmp_path):
     with pytest.raises(CCProofError, match="no such file"):
         read_points(tmp_path / "missing.xyz")
     with pytest.raises(CCProofError, match="dt"):
-        fit_points(synthetic_range_data("bulb", 50), dt=-1.0)
+        fit_points(synthetic_range_data("bulb", 50), evolution=Evolution(dt=-1.0))
 
 
 def test_q9_fit_ellipsoid_98_then_386():
@@ -213,7 +213,7 @@ def _torus_distance(P, R=1.0, r=0.4):
 
 def test_fit_torus_from_the_cube_reports_the_spanned_hole_and_warns():
     X = synthetic_range_data("torus", 600)
-    res = fit_points(X, levels=0, max_steps=25)
+    res = fit_points(X, levels=0, evolution=Evolution(max_steps=25))
     # data -> surface alone looks good (the paper's error) ...
     assert res.max_error_percent < 5.0
     # ... but the surface spans the hole: far from the true torus (closed-form distance, not the code's)
@@ -291,7 +291,7 @@ def test_fit_stops_at_equilibrium_of_energy_and_error_and_says_why():
     assert lev.energy_change <= tol and lev.error_change <= tol
     assert lev.reason.startswith(f"equilibrium after {lev.steps} steps")
     assert not [w for w in res.warnings if "step cap" in w]
-    capped = fit_points(synthetic_range_data("ellipsoid", 300), levels=0, max_steps=4)
+    capped = fit_points(synthetic_range_data("ellipsoid", 300), levels=0, evolution=Evolution(max_steps=4))
     lev = capped.levels[0]
     assert not lev.converged and lev.steps == 4
     assert max(lev.energy_change, lev.error_change) > tol

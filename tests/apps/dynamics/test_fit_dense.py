@@ -91,7 +91,9 @@ def test_dense_bunny_fit_stays_on_the_true_surface_both_ways(fit_dense, bunny):
 def test_dense_bunny_one_way_fit_webs_across_the_ear_concavity(fit_dense, bunny):
     """The paper's data springs alone (the fit before the surface -> data springs, 229 + 73 steps): a web across a
     concavity that the data -> surface error does not show; the fit's own stray report sees it (8.0 % of the area)."""
-    res, q = _fit_and_judge(fit_dense, bunny, 10_000, surface_spring_total=0.0)
+    from ccproof.apps.dynamics.fit import FitSprings
+
+    res, q = _fit_and_judge(fit_dense, bunny, 10_000, springs=FitSprings(surface_total=0.0))
     assert q["over2"] > 0.04 and q["max"] > 6.0  # measured 6.89 % of the area, max 9.87 %: the judge above fails
     assert res.max_error_percent < 2.0  # measured 1.34 %: the headline error does not show it
     assert any("spans a concavity" in w for w in res.warnings)
@@ -100,17 +102,18 @@ def test_dense_bunny_one_way_fit_webs_across_the_ear_concavity(fit_dense, bunny)
 def test_spring_points_cap_which_points_pull_not_which_are_judged(capsys, tmp_path):
     """A cloud larger than ``spring_points``: a fixed random subset carries the data springs (the same on every
     run), while the errors and the stray report cover every point. With all points the fit differs."""
-    from ccproof.apps.dynamics.fit import fit_points
+    from ccproof.apps.dynamics.fit import Evolution, FitSprings, fit_points
     from ccproof.apps.dynamics.shapes import synthetic_range_data
     from ccproof.cli import main
     from ccproof.errors import CCProofError
 
     X = synthetic_range_data("ellipsoid", 600)
     m = X.shape[0]
-    seen = []
-    res = fit_points(X, levels=0, max_steps=4, spring_points=100, callback=lambda *a: seen.append(a[3].copy()))
-    again = fit_points(X, levels=0, max_steps=4, spring_points=100)
-    full = fit_points(X, levels=0, max_steps=4, spring_points=None)
+    seen, four = [], Evolution(max_steps=4)
+    res = fit_points(X, levels=0, springs=FitSprings(points=100), evolution=four,
+                     callback=lambda *a: seen.append(a[3].copy()))
+    again = fit_points(X, levels=0, springs=FitSprings(points=100), evolution=four)
+    full = fit_points(X, levels=0, springs=FitSprings(points=None), evolution=four)
     assert res.parameters["spring_points"] == 100 and full.parameters["spring_points"] == m
     assert res.data_distances.shape == (m,) and full.data_distances.shape == (m,)  # all points judged
     assert np.array_equal(res.normalized_state, again.normalized_state)  # a fixed subset
@@ -118,7 +121,7 @@ def test_spring_points_cap_which_points_pull_not_which_are_judged(capsys, tmp_pa
     assert not np.allclose(res.normalized_state, full.normalized_state)  # the subset is what pulls
     for bad in (3, 2.5, -1):
         with pytest.raises(CCProofError, match="spring_points must be an integer >= 4 or None"):
-            fit_points(X, levels=0, max_steps=1, spring_points=bad)
+            fit_points(X, levels=0, springs=FitSprings(points=bad), evolution=Evolution(max_steps=1))
     pts = tmp_path / "e.xyz"
     np.savetxt(pts, X)
     assert main(["fit", str(pts), "--out", str(tmp_path / "o.obj"), "--spring-points", "2", "--no-progress"]) == 2

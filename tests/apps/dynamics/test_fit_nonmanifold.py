@@ -8,7 +8,7 @@ import pytest
 
 from ccproof.apps.control_file import read_control_mesh, write_control_obj
 from ccproof.apps.dynamics.cloud import limit_surface_mesh
-from ccproof.apps.dynamics.fit import fit_points
+from ccproof.apps.dynamics.fit import Evolution, fit_points
 from ccproof.apps.dynamics.integrate import ImplicitIntegrator, MatrixSystem
 from ccproof.mesh.io import read_obj_polygons
 
@@ -46,7 +46,7 @@ def test_fit_copies_stay_together(name):
     fv = mesh.file_vertex
     # every control vertex sits where its file vertex is, and every file vertex has a copy
     assert np.array_equal(np.asarray(mesh.vertices), V[fv]) and sorted(set(fv.tolist())) == list(range(len(V)))
-    res = fit_points(_cloud(V), init=mesh, levels=0, max_steps=5)
+    res = fit_points(_cloud(V), init=mesh, levels=0, evolution=Evolution(max_steps=5))
     P = np.asarray(res.mesh.vertices)
     assert np.abs(P - V[fv]).max() > 0.1  # the fit moved the control points
     for k in range(len(V)):  # the copies of one file vertex end at one point, bit for bit
@@ -59,7 +59,7 @@ def test_fit_copies_refined_level():
     path = MESHES / "bowtie.obj"
     V, polygons, _ = read_obj_polygons(path)
     mesh, _ = read_control_mesh(path)
-    res = fit_points(_cloud(V), init=mesh, levels=1, max_steps=3)
+    res = fit_points(_cloud(V), init=mesh, levels=1, evolution=Evolution(max_steps=3))
     fv = res.mesh.file_vertex
     n_file = len(V) + len(_file_edges(polygons)) + len(polygons)
     assert n_file == 49 and res.mesh.n_vertices == 50 and int(fv.max()) + 1 == n_file
@@ -72,7 +72,7 @@ def test_fit_written_in_file_numbering(tmp_path):
     path = MESHES / "book4.obj"
     V, polygons, _ = read_obj_polygons(path)
     mesh, _ = read_control_mesh(path)
-    res = fit_points(_cloud(V), init=mesh, levels=0, max_steps=3)
+    res = fit_points(_cloud(V), init=mesh, levels=0, evolution=Evolution(max_steps=3))
     out = tmp_path / "fit.obj"
     write_control_obj(out, res.mesh)
     W, wpolys, _ = read_obj_polygons(out)
