@@ -9,6 +9,12 @@ per round is printed as min, median, max, with the 1-minute load before the roun
 threads (default: the evaluator's default, all cores for large batches). Rows hold 16 weights and
 indices per point (regular patch), so the output is about 8x that of ``evaluate`` per derivative.
 
+The floor: in the same rounds, writing arrays of the size of W's (its data and indices, per key; numpy
+``fill``) without computing anything, ``write W's arrays / evaluate``. Arrays this large are fresh pages
+from the system in every call (glibc maps allocations over 32 MB anew), whose first touch costs what
+the machine's memory does: in a virtual machine that hands freed memory back to its host, this is most
+of the time of ``basis``, and the noise of the ratio.
+
 Usage: python scripts/bench_basis.py [--points 1000000] [--rounds 5] [--threads N] [--smoke]
 (``--smoke``: 10^4 points, 2 rounds: checks that it runs).
 """
@@ -30,6 +36,14 @@ def _points(S, n, seed=0):
     k = n // 10
     u[:k], v[:k] = 10.0 ** -rng.uniform(1, 12, k), 10.0 ** -rng.uniform(1, 12, k)
     return f, u, v
+
+
+def _write_arrays(nnz, keys):
+    """Arrays of the size of W's, written once (the cost of their memory alone)."""
+    out = [np.empty(nnz) for _ in range(keys)] + [np.empty(nnz, dtype=np.int32) for _ in range(keys)]
+    for x in out:
+        x.fill(1)
+    return out
 
 
 def _stats(r):
@@ -59,22 +73,28 @@ def main(argv=None):
           f"threads {a.threads or 'default'}; rounds {a.rounds}", flush=True)
     for d in (0, 1):
         S.evaluate(f, u, v, d, threads=a.threads)  # warm-up: kernels loaded, operators built
-        S.basis(f, u, v, d, threads=a.threads)
-        t_ev, t_b, ratios = [], [], []
+        W = S.basis(f, u, v, d, threads=a.threads)
+        nnz, keys = W["P"].nnz, len(W)
+        t_ev, t_b, ratios, floor = [], [], [], []
         load = os.getloadavg()[0]
         for i in range(a.rounds):
-            order = [("e", t_ev), ("b", t_b)] if i % 2 == 0 else [("b", t_b), ("e", t_ev)]
-            for what, acc in order:
+            t_w = []
+            order = [("e", t_ev), ("b", t_b), ("w", t_w)]
+            for what, acc in (order if i % 2 == 0 else order[::-1]):
                 t0 = time.perf_counter()
                 if what == "e":
                     S.evaluate(f, u, v, d, threads=a.threads)
-                else:
+                elif what == "b":
                     W = S.basis(f, u, v, d, threads=a.threads)
+                else:
+                    _write_arrays(nnz, keys)
                 acc.append(time.perf_counter() - t0)
             ratios.append(t_b[-1] / t_ev[-1])
-        nnz = W["P"].nnz / a.points
+            floor.append(t_w[-1] / t_ev[-1])
         print(f"derivatives {d}: evaluate {min(t_ev) * 1e3:7.1f} ms  basis {min(t_b) * 1e3:7.1f} ms "
-              f"({nnz:.1f} weights per point)  basis/evaluate {_stats(ratios)}  (load {load:.1f})", flush=True)
+              f"({nnz / a.points:.1f} weights per point)  basis/evaluate {_stats(ratios)}  (load {load:.1f})",
+              flush=True)
+        print(f"    write W's arrays / evaluate (the floor) {_stats(floor)}", flush=True)
     return 0
 
 
