@@ -13,9 +13,12 @@ The floor: in the same rounds, writing arrays of the size of W's (its data and i
 ``fill``) without computing anything, ``write W's arrays / evaluate``. Arrays this large are fresh pages
 from the system in every call (glibc maps allocations over 32 MB anew), whose first touch costs what
 the machine's memory does: in a virtual machine that hands freed memory back to its host, this is most
-of the time of ``basis``, and the noise of the ratio.
+of the time of ``basis``, and the noise of the ratio. ``evaluate``'s outputs (under 32 MB each at 10^6
+points) are served again from the process's heap. ``--keep-memory`` puts both on the same footing: glibc
+keeps every freed allocation in the heap (``mallopt`` M_MMAP_THRESHOLD 1 GiB, M_TRIM_THRESHOLD 2 GiB, as
+``MALLOC_MMAP_THRESHOLD_`` would; a setting of this benchmark's process, not of the package).
 
-Usage: python scripts/bench_basis.py [--points 1000000] [--rounds 5] [--threads N] [--smoke]
+Usage: python scripts/bench_basis.py [--points 1000000] [--rounds 5] [--threads N] [--keep-memory] [--smoke]
 (``--smoke``: 10^4 points, 2 rounds: checks that it runs).
 """
 
@@ -38,6 +41,16 @@ def _points(S, n, seed=0):
     return f, u, v
 
 
+def _keep_freed_memory():
+    """glibc's ``mallopt``: allocations up to 1 GiB from the heap, the heap never trimmed below 2 GiB."""
+    import ctypes
+
+    libc = ctypes.CDLL("libc.so.6")
+    m_trim_threshold, m_mmap_threshold = -1, -3
+    if not (libc.mallopt(m_mmap_threshold, 1 << 30) and libc.mallopt(m_trim_threshold, (1 << 31) - 1)):
+        raise SystemExit("--keep-memory: glibc's mallopt refused the thresholds")
+
+
 def _write_arrays(nnz, keys):
     """Arrays of the size of W's, written once (the cost of their memory alone)."""
     out = [np.empty(nnz) for _ in range(keys)] + [np.empty(nnz, dtype=np.int32) for _ in range(keys)]
@@ -57,7 +70,10 @@ def main(argv=None):
     ap.add_argument("--levels", type=int, default=4)
     ap.add_argument("--threads", type=int, default=None)
     ap.add_argument("--smoke", action="store_true")
+    ap.add_argument("--keep-memory", action="store_true", help="glibc keeps freed memory in the heap")
     a = ap.parse_args(argv)
+    if a.keep_memory:
+        _keep_freed_memory()
     if a.smoke:
         a.points, a.rounds, a.levels = 10**4, 2, 2
     from ccproof.evaluate import natural_limit_surface
@@ -70,7 +86,8 @@ def main(argv=None):
     S = natural_limit_surface(mesh, progress=False)
     f, u, v = _points(S, a.points)
     print(f"cube subdivided {a.levels} times: {S.n_faces:,} faces; {a.points:,} points; {os.cpu_count()} cpus; "
-          f"threads {a.threads or 'default'}; rounds {a.rounds}", flush=True)
+          f"threads {a.threads or 'default'}; rounds {a.rounds}{'; freed memory kept' if a.keep_memory else ''}",
+          flush=True)
     for d in (0, 1):
         S.evaluate(f, u, v, d, threads=a.threads)  # warm-up: kernels loaded, operators built
         W = S.basis(f, u, v, d, threads=a.threads)
