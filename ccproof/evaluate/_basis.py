@@ -180,17 +180,6 @@ def _fill_numpy(top, loc, op, indptr, names, derivatives, indices, data):
             data[k][where] = _rows(name, bs, bt, h, dev, org).reshape(-1)
 
 
-#: points per kernel call within a block (their indices, 16 or more per point, stay in cache for the copies)
-_CHUNK = 8192
-
-
-def _copy_indices(indices, indptr, lo, hi):
-    """The indices of points lo..hi-1 of the first matrix into the other matrices' arrays."""
-    a, b = indptr[lo], indptr[hi]
-    for ind in indices[1:]:
-        ind[a:b] = indices[0][a:b]
-
-
 class _Located(NamedTuple):
     """What the fill needs of :meth:`PatchMap.locate` (see :class:`ccproof.evaluate.patch_map.Location`)."""
 
@@ -201,30 +190,21 @@ class _Located(NamedTuple):
 
 
 def _locate(S, top, f, u, v, kernels, nt):
-    """The points' jobs, parameters and scales in their patches, their operator ids (building the missing
-    operators), their rows' lengths and the sum of these."""
+    """The points' jobs, parameters and scales in their patches, and their operator keys."""
     if kernels is None:
         loc = S.patch_map.locate(f, u, v)
         key = loc.vface.astype(np.int64) * top.stride
         if loc.corner.size:
             key[loc.corner] += 1 + 3 * loc.layer + loc.code
-        op = top.operator_ids(S, key)
-        counts = top.flat()[1][op]
-        return _Located(loc.job, loc.s, loc.t, loc.scale), op, counts, int(counts.sum())
+        return _Located(loc.job, loc.s, loc.t, loc.scale), key
     T = S._table
     n = f.size
-    job, key, op, counts = (np.empty(n, dtype=np.int64) for _ in range(4))
+    job, key = np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64)
     s, t, scale = np.empty(n), np.empty(n), np.empty(n)
     table = (T.top, T.job_root, T.kind, T.child, T.u0, T.v0, T.h, T.cfg, T.cu, T.cv, T.n_layers, T.unit)
-    ops = (top.op_of_key, top.flat()[1])
-    out = (job, key, op, counts, s, t, scale)
-    blocks = in_blocks(lambda lo, hi: kernels[0](lo, hi, f, u, v, table, top.stride, ops, out), n, nt, 32768,
-                       per_thread=4)
-    if any(m for m, _ in blocks):  # operators first needed here: build them, then the rows' lengths
-        op = top.operator_ids(S, key)
-        counts = top.flat()[1][op]
-        return _Located(job, s, t, scale), op, counts, int(counts.sum())
-    return _Located(job, s, t, scale), op, counts, sum(c for _, c in blocks)
+    out = (job, key, s, t, scale)
+    in_blocks(lambda lo, hi: kernels[0](lo, hi, f, u, v, table, top.stride, out), n, nt, 32768, per_thread=4)
+    return _Located(job, s, t, scale), key
 
 
 def basis_rows(S, f, u, v, derivatives, backend=None, threads=None):
@@ -235,37 +215,33 @@ def basis_rows(S, f, u, v, derivatives, backend=None, threads=None):
     top = _topology(S)
     kernels = _kernel() if backend != "numpy" and f.size else None
     nt = threads_for(threads, f.size)
-    loc, op, counts, nnz = _locate(S, top, f, u, v, kernels, nt)
+    loc, key = _locate(S, top, f, u, v, kernels, nt)
+    op = top.operator_ids(S, key)
     cstart, ncols, dstart, cols, dev, org = top.flat()
+    counts = ncols[op]
+    nnz = int(counts.sum())
     M = _vertex_map(S, top)
     n_cols = S.mesh.n_vertices if M is None else M.shape[0]
     ix = np.int32 if max(nnz, n_cols) < 2**31 else np.int64  # scipy's own choice: no copies
-    indptr = np.empty(f.size + 1, dtype=ix)
-    indptr[0] = 0
+    indptr = np.zeros(f.size + 1, dtype=ix)
     np.cumsum(counts, out=indptr[1:])
     names = BASIS_KEYS[derivatives]
-    # each matrix its own arrays (scipy sorts a matrix's indices in place when it needs them sorted, and
-    # copies a view of a larger array): the others' indices are copies of the first's, block by block
-    indices = [np.empty(nnz, dtype=ix) for _ in names]
-    data = [np.empty(nnz) for _ in names]
+    indices = np.empty(nnz, dtype=ix)
+    data = [np.empty(nnz) for _ in names]  # separate arrays: scipy copies a view of a larger one
     if kernels is None:
-        _fill_numpy(top, loc, op, indptr, names, derivatives, indices[0], data)
-        _copy_indices(indices, indptr, 0, f.size)
+        _fill_numpy(top, loc, op, indptr, names, derivatives, indices, data)
     else:
-        data6 = tuple(data) + (data[0],) * (6 - len(names))
+        pad = [data[0]] * (6 - len(names))
         pts = (loc.s, loc.t, loc.scale, op, loc.job, top.job_ring)
         ops = (cstart, ncols, dstart, cols, dev, org)
-
-        def fill(lo, hi):
-            for a in range(lo, hi, _CHUNK):  # chunks: the copies read what the kernel just wrote (in cache)
-                b = min(a + _CHUNK, hi)
-                kernels[1](a, b, pts, ops, top.ring, indptr, indices[0], len(names), data6)
-                _copy_indices(indices, indptr, a, b)
-
-        in_blocks(fill, f.size, nt, 32768, per_thread=4)
+        data6 = tuple(data) + tuple(pad)
+        in_blocks(lambda lo, hi: kernels[1](lo, hi, pts, ops, top.ring, indptr, indices, len(names), data6),
+                  f.size, nt, 32768, per_thread=4)
     out = {}
     for k, name in enumerate(names):
-        W = sp.csr_matrix((data[k], indices[k], indptr if k == 0 else indptr.copy()), shape=(f.size, n_cols))
+        # each matrix its own index arrays: scipy sorts a matrix's indices in place when it needs them sorted
+        ind, ptr = (indices, indptr) if k == 0 else (indices.copy(), indptr.copy())
+        W = sp.csr_matrix((data[k], ind, ptr), shape=(f.size, n_cols))
         out[name] = W if M is None else (W @ M).tocsr()
     return out
 
@@ -323,15 +299,11 @@ def _fill_points(lo, hi, pts, ops, ring, indptr, indices, nk, data):
             dk[q] = (1.0 if k == 0 else 0.0) - tot
 
 
-def _locate_points(lo, hi, f, u, v, table, stride, ops, out):
-    """:meth:`PatchMap.locate` of points lo..hi-1 (the same exact operations), their operator keys, ids
-    and rows' lengths: ``table`` the patch table's topology arrays, ``ops = (op_of_key, ncols)``,
-    ``out = (job, key, op, counts, s, t, scale)``. Returns the number of points whose operator is not
-    built yet (id -1, length 0) and the sum of the lengths."""
+def _locate_points(lo, hi, f, u, v, table, stride, out):
+    """:meth:`PatchMap.locate` of points lo..hi-1 (the same exact operations), and their operator keys:
+    ``table`` the patch table's topology arrays, ``out = (job, key, s, t, scale)``."""
     top, job_root, kind, child, u0, v0, h, cfg, cu, cv, n_layers, unit = table
-    op_of_key, ncols = ops
-    job, key, op, counts, s, t, scale = out
-    missing, total = 0, 0
+    job, key, s, t, scale = out
     for p in range(lo, hi):
         x, y = u[p], v[p]
         jb = top[f[p], (1 if x >= 0.5 else 0) + (2 if y >= 0.5 else 0)]
@@ -359,18 +331,9 @@ def _locate_points(lo, hi, f, u, v, table, stride, ops, out):
             hh = unit[c, code, 2] * sc
             k += 1 + 3 * n + code
         job[p], key[p] = jb, k
-        o = op_of_key[k]
-        op[p] = o
-        if o < 0:
-            missing += 1
-            counts[p] = 0
-        else:
-            counts[p] = ncols[o]
-            total += ncols[o]
         s[p] = min(max((x - pu0) / hh, 0.0), 1.0)
         t[p] = min(max((y - pv0) / hh, 0.0), 1.0)
         scale[p] = 1.0 / hh
-    return missing, total
 
 
 def _bspline(x, out):
