@@ -9,7 +9,16 @@ per round is printed as min, median, max, with the 1-minute load before the roun
 threads (default: the evaluator's default, all cores for large batches). Rows hold 16 weights and
 indices per point (regular patch), so the output is about 8x that of ``evaluate`` per derivative.
 
-Usage: python scripts/bench_basis.py [--points 1000000] [--rounds 5] [--threads N] [--smoke]
+The floor: in the same rounds, writing arrays of the size of W's (its data and indices, per key; numpy
+``fill``) without computing anything, ``write W's arrays / evaluate``. Arrays this large are fresh pages
+from the system in every call (glibc maps allocations over 32 MB anew), whose first touch costs what
+the machine's memory does: in a virtual machine that hands freed memory back to its host, this is most
+of the time of ``basis``, and the noise of the ratio. ``evaluate``'s outputs (under 32 MB each at 10^6
+points) are served again from the process's heap. ``--keep-memory`` puts both on the same footing: glibc
+keeps every freed allocation in the heap (``mallopt`` M_MMAP_THRESHOLD 1 GiB, M_TRIM_THRESHOLD 2 GiB, as
+``MALLOC_MMAP_THRESHOLD_`` would; a setting of this benchmark's process, not of the package).
+
+Usage: python scripts/bench_basis.py [--points 1000000] [--rounds 5] [--threads N] [--keep-memory] [--smoke]
 (``--smoke``: 10^4 points, 2 rounds: checks that it runs).
 """
 
@@ -32,6 +41,24 @@ def _points(S, n, seed=0):
     return f, u, v
 
 
+def _keep_freed_memory():
+    """glibc's ``mallopt``: allocations up to 1 GiB from the heap, the heap never trimmed below 2 GiB."""
+    import ctypes
+
+    libc = ctypes.CDLL("libc.so.6")
+    m_trim_threshold, m_mmap_threshold = -1, -3
+    if not (libc.mallopt(m_mmap_threshold, 1 << 30) and libc.mallopt(m_trim_threshold, (1 << 31) - 1)):
+        raise SystemExit("--keep-memory: glibc's mallopt refused the thresholds")
+
+
+def _write_arrays(nnz, keys):
+    """Arrays of the size of W's, written once (the cost of their memory alone)."""
+    out = [np.empty(nnz) for _ in range(keys)] + [np.empty(nnz, dtype=np.int32) for _ in range(keys)]
+    for x in out:
+        x.fill(1)
+    return out
+
+
 def _stats(r):
     return f"min {min(r):.2f}  median {statistics.median(r):.2f}  max {max(r):.2f}"
 
@@ -43,7 +70,10 @@ def main(argv=None):
     ap.add_argument("--levels", type=int, default=4)
     ap.add_argument("--threads", type=int, default=None)
     ap.add_argument("--smoke", action="store_true")
+    ap.add_argument("--keep-memory", action="store_true", help="glibc keeps freed memory in the heap")
     a = ap.parse_args(argv)
+    if a.keep_memory:
+        _keep_freed_memory()
     if a.smoke:
         a.points, a.rounds, a.levels = 10**4, 2, 2
     from ccproof.evaluate import natural_limit_surface
@@ -56,25 +86,32 @@ def main(argv=None):
     S = natural_limit_surface(mesh, progress=False)
     f, u, v = _points(S, a.points)
     print(f"cube subdivided {a.levels} times: {S.n_faces:,} faces; {a.points:,} points; {os.cpu_count()} cpus; "
-          f"threads {a.threads or 'default'}; rounds {a.rounds}", flush=True)
+          f"threads {a.threads or 'default'}; rounds {a.rounds}{'; freed memory kept' if a.keep_memory else ''}",
+          flush=True)
     for d in (0, 1):
         S.evaluate(f, u, v, d, threads=a.threads)  # warm-up: kernels loaded, operators built
-        S.basis(f, u, v, d, threads=a.threads)
-        t_ev, t_b, ratios = [], [], []
+        W = S.basis(f, u, v, d, threads=a.threads)
+        nnz, keys = W["P"].nnz, len(W)
+        t_ev, t_b, ratios, floor = [], [], [], []
         load = os.getloadavg()[0]
         for i in range(a.rounds):
-            order = [("e", t_ev), ("b", t_b)] if i % 2 == 0 else [("b", t_b), ("e", t_ev)]
-            for what, acc in order:
+            t_w = []
+            order = [("e", t_ev), ("b", t_b), ("w", t_w)]
+            for what, acc in (order if i % 2 == 0 else order[::-1]):
                 t0 = time.perf_counter()
                 if what == "e":
                     S.evaluate(f, u, v, d, threads=a.threads)
-                else:
+                elif what == "b":
                     W = S.basis(f, u, v, d, threads=a.threads)
+                else:
+                    _write_arrays(nnz, keys)
                 acc.append(time.perf_counter() - t0)
             ratios.append(t_b[-1] / t_ev[-1])
-        nnz = W["P"].nnz / a.points
+            floor.append(t_w[-1] / t_ev[-1])
         print(f"derivatives {d}: evaluate {min(t_ev) * 1e3:7.1f} ms  basis {min(t_b) * 1e3:7.1f} ms "
-              f"({nnz:.1f} weights per point)  basis/evaluate {_stats(ratios)}  (load {load:.1f})", flush=True)
+              f"({nnz / a.points:.1f} weights per point)  basis/evaluate {_stats(ratios)}  (load {load:.1f})",
+              flush=True)
+        print(f"    write W's arrays / evaluate (the floor) {_stats(floor)}", flush=True)
     return 0
 
 

@@ -207,3 +207,56 @@ def test_no_points_and_derived_surfaces():
     T = S.with_vertices(2.0 * np.asarray(cube().vertices))
     a, b = S.basis([0], [0.3], [0.2])["P"], T.basis([0], [0.3], [0.2])["P"]
     assert abs(a - b).max() == 0.0
+
+
+def test_rows_of_many_points_on_threads_equal_the_numpy_path():
+    """Over 8192 points (several kernel calls per block, each copying its indices to the other matrices)
+    on one and two threads: the same matrices bit for bit, whose indices are those of the numpy path."""
+    S = natural_limit_surface(cube())
+    f, u, v = _points(S, 20000, seed=6)
+    fc, uc, vc = S._check(f, u, v)
+    one, two = basis_rows(S, fc, uc, vc, 2, threads=1), basis_rows(S, fc, uc, vc, 2, threads=2)
+    ref = basis_rows(S, fc, uc, vc, 2, backend="numpy")
+    for key, W in one.items():
+        for a in ("indptr", "indices", "data"):
+            assert np.array_equal(getattr(W, a), getattr(two[key], a)), (key, a)
+        assert np.array_equal(W.indptr, ref[key].indptr) and np.array_equal(W.indices, ref[key].indices), key
+        D = abs(W - ref[key]).max(axis=1).toarray().ravel()  # as test_compiled_and_numpy_paths_agree
+        assert (D <= 1e-10 * np.maximum(1.0, abs(ref[key]).max(axis=1).toarray().ravel())).all(), key
+
+
+def test_each_matrix_owns_its_arrays():
+    """Sorting or pruning one matrix in place (scipy does when it needs to) leaves the others as they were."""
+    S = natural_limit_surface(cube())
+    f, u, v = _points(S, 3000, seed=7)
+    W = S.basis(f, u, v, 1)
+    for key in W:
+        for other in W:
+            if other != key:
+                assert not np.shares_memory(W[key].indices, W[other].indices), (key, other)
+                assert not np.shares_memory(W[key].indptr, W[other].indptr), (key, other)
+    dv = [getattr(W["Dv"], a).copy() for a in ("indptr", "indices", "data")]
+    assert not W["P"].has_sorted_indices  # the rows list the ring's vertices in its order
+    W["P"].sort_indices()
+    W["Du"].eliminate_zeros()
+    assert all(np.array_equal(getattr(W["Dv"], a), b) for a, b in zip(("indptr", "indices", "data"), dv))
+    X = np.asarray(cube().vertices, dtype=float)
+    r = S.evaluate(f, u, v, 1)
+    for key, ref in (("P", "P"), ("Du", "Pu"), ("Dv", "Pv")):
+        assert np.abs(W[key] @ X - r[ref]).max() <= 1e-13, key
+
+
+def test_operators_first_needed_in_a_later_batch():
+    """A batch whose points need operators no earlier batch built (deep corner layers after regular
+    points): the rows equal those of a fresh surface's numpy path."""
+    S = natural_limit_surface(cube())
+    f, u, v = _points(S, 4000, seed=8)
+    fc, uc, vc = S._check(f, u, v)
+    mid = np.abs(uc - 0.5) + np.abs(vc - 0.5) < 0.1
+    basis_rows(S, fc[mid], uc[mid], vc[mid], 1)  # operators of the middles of the faces only
+    A = basis_rows(S, fc, uc, vc, 1)
+    B = basis_rows(natural_limit_surface(cube()), fc, uc, vc, 1, backend="numpy")
+    for key in A:
+        assert np.array_equal(A[key].indptr, B[key].indptr) and np.array_equal(A[key].indices, B[key].indices)
+        D = abs(A[key] - B[key]).max(axis=1).toarray().ravel()
+        assert (D <= 1e-10 * np.maximum(1.0, abs(B[key]).max(axis=1).toarray().ravel())).all(), key
