@@ -175,13 +175,17 @@ def run(args) -> int:
         poly = read_mesh(args.mesh)  # OBJ with OpenSubdiv tags, OFF, or any meshio format
     t_read = time.perf_counter() - t0
     mesh, tagged, n_faces, kwargs, evaluable = _mesh_to_evaluate(args, poly)
+    del poly  # (``mesh`` is the same object, or its QuadMesh)
     # the points before the surface's setup (seconds on large meshes): a bad point is reported at once
     sources = _point_sources(args, points, n_faces, evaluable, out_path, shards)
     from ccproof.cli._notice import compile_notice
 
     compile_notice("eval")  # after the input checks: an error stays one line
-    n, names, sweep, surface, times = _evaluate_sources(args, mesh, tagged, kwargs, sources, out_path, sched,
+    held = [mesh]  # handed over: once shared, the surface's copy is the only one
+    del mesh
+    n, names, sweep, surface, times = _evaluate_sources(args, held, tagged, kwargs, sources, out_path, sched,
                                                         progress)
+    mesh = surface.mesh
     setup, worker_setup, t_start, t_write = times
     for line in sweep.report([f"chunk {i}" for i in range(len(sources))]):  # retried or lost tasks
         print(line)
@@ -320,35 +324,44 @@ def _point_sources(args, points, n_faces, evaluable, out_path, shards):
                         n_faces=n_faces if evaluable is None else evaluable)
 
 
-def _evaluate_sources(args, mesh, tagged, kwargs, sources, out_path, sched, progress):
+def _evaluate_sources(args, held, tagged, kwargs, sources, out_path, sched, progress):
     """Evaluate the chunks on the scheduler and write --out; returns (points, names, sweep, surface, times)
-    with times = (setup here, the workers' setup, the scheduler's start, gathering and writing)."""
-    from ccproof.scale import evaluate_points, open_scheduler, ship
+    with times = (setup here, the workers' setup, the scheduler's start, gathering and writing).
 
-    # on a cluster each worker builds the surface itself (once); here only for in-process work or --plot
+    The surface is built once, here, before any worker starts, from the mesh in the list ``held`` (emptied:
+    the surface keeps the mesh); the workers of this machine map its arrays from shared memory, those of a
+    remote cluster receive it by value, once per worker (never rebuilt)."""
+    from ccproof.scale import open_scheduler, release_freed_memory, runs_in_process, share
+
     t1 = time.perf_counter()
-    surface = build_surface(mesh, tagged, args.alpha, progress, args.scheme) \
-        if sched.kind == "serial" or args.plot else None
-    setup = time.perf_counter() - t1  # the setup in this process (the workers' is measured by them)
+    surface = build_surface(held.pop(), tagged, args.alpha, progress, args.scheme)
+    setup = time.perf_counter() - t1
+    in_process = runs_in_process(sched, len(sources))
+    where = "here" if in_process else "anywhere" if sched.kind == "address" else "machine"
     t_start = time.perf_counter()
-    with open_scheduler(sched, len(sources)) as sched:
-        t_start = time.perf_counter() - t_start  # a local cluster's start
-        in_process = getattr(sched, "kind", None) == "serial"  # a Client, or local worker processes without Dask
-        if surface is None and in_process:  # a single chunk runs here after all
-            t1 = time.perf_counter()
-            surface = build_surface(mesh, tagged, args.alpha, progress, args.scheme)
-            setup += time.perf_counter() - t1
-        if args.threads is not None:
-            kwargs["threads"] = args.threads
-        elif not in_process:
-            kwargs["threads"] = 1  # one worker per core already: no second level of threads
-        # the file (or each shard and the index) is written under a temporary name, then renamed
-        t_tasks = time.perf_counter()
-        shipped = ship(build_surface, mesh, tagged, args.alpha, False, args.scheme)
-        n, names, sweep, worker_setup = evaluate_points(shipped, sources,
-                                                        args.derivatives, kwargs, str(out_path), sched,
-                                                        local=surface, progress=progress)
-        t_write = time.perf_counter() - t_tasks - sweep.seconds  # gathering and writing the output
+    with share(surface, where) as (shipped, surface):
+        if where == "machine":
+            release_freed_memory()  # the surface as built (its shared copy replaces it here)
+        with open_scheduler(sched, len(sources)) as sched:
+            return _run_chunks(args, kwargs, sources, out_path, sched, progress, shipped, surface, in_process,
+                               (setup, t_start))
+
+
+def _run_chunks(args, kwargs, sources, out_path, sched, progress, shipped, surface, in_process, times):
+    """:func:`_evaluate_sources` once the surface is shared and the scheduler open."""
+    from ccproof.scale import evaluate_points
+
+    setup, t_start = times
+    t_start = time.perf_counter() - t_start  # writing the shared table and a local cluster's start
+    if args.threads is not None:
+        kwargs["threads"] = args.threads
+    elif not in_process:
+        kwargs["threads"] = 1  # one worker per core already: no second level of threads
+    # the file (or each shard and the index) is written under a temporary name, then renamed
+    t_tasks = time.perf_counter()
+    n, names, sweep, worker_setup = evaluate_points(shipped, sources, args.derivatives, kwargs, str(out_path),
+                                                    sched, local=surface, progress=progress)
+    t_write = time.perf_counter() - t_tasks - sweep.seconds  # gathering and writing the output
     return n, names, sweep, surface, (setup, worker_setup, t_start, t_write)
 
 

@@ -1099,6 +1099,7 @@ class Builder:
             if k:
                 rings[...] = np.frombuffer(t.rings, dtype=np.int32).reshape(k, t.n)
             t.rings = None  # (the table's copy is the one kept)
+            t.jobs = array("q")  # (the group's copy is the one kept)
             job_root[jobs] = n_tv
             nr, nc = t.R.shape[0] // 17, t.O.shape[0]
             job_net[jobs] = n_reg + nr * np.arange(k)

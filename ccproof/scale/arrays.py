@@ -184,10 +184,11 @@ def _evaluate_chunk(task, shipped):
     t0 = time.perf_counter()
     rebuild(shipped)  # the setup: built once per process (this task may be the one that builds it)
     t1 = time.perf_counter()
-    res = _evaluate_block(f, u, v, shipped, task["derivatives"], tuple(sorted(task["kwargs"].items())))
+    res = rebuild(shipped).evaluate(f, u, v, derivatives=task["derivatives"], **task["kwargs"])
     seconds = (t1 - t0, time.perf_counter() - t1)  # (setup, evaluation) in this task
     arrays = {"face": f, "u": u, "v": v}
-    arrays.update({n: res[:, j, :] for j, n in enumerate(output_names(task["derivatives"]))})
+    # the evaluator's own (n, 3) arrays, not stacked: no copy of the chunk's results
+    arrays.update({n: np.asarray(res[n], dtype=np.float64) for n in output_names(task["derivatives"])})
     if task["out"] is None:
         return {**arrays, "seconds": seconds}
     _replace_when_written(task["out"], lambda tmp: np.savez(tmp, **arrays))
