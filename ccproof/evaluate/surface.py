@@ -64,6 +64,8 @@ SORT_MIN = 1 << 12
 SORT_CHUNK = 1 << 16
 
 _KEYS = {0: ("P",), 1: ("P", "Pu", "Pv"), 2: ("P", "Pu", "Pv", "Puu", "Puv", "Pvv")}
+#: corner faces whose rings are computed at once by :meth:`LimitSurface.vertex_normals` (temporaries in cache)
+_RING_BLOCK = 1024
 
 
 class LimitSurface:
@@ -636,12 +638,13 @@ class LimitSurface:
             M = self._schemes[int(T.cfg[vf])].tangent_masks
             if M is None:
                 continue
-            rel = corner_rings(T, jobs[sel], vf)  # (k, Nc, 3)
-            t = np.matmul(M, rel)  # (k, 2, 3)
-            c = np.cross(t[:, 0], t[:, 1])
-            n = np.sqrt(np.vecdot(c, c))  # the dot product of np.linalg.norm(c) row by row: the same bits
-            ok = n > 0
-            out[sel[ok]] = c[ok] / n[ok, None]
+            for lo in range(0, sel.size, _RING_BLOCK):  # blocks: the products' temporaries stay in cache
+                part = sel[lo:lo + _RING_BLOCK]
+                t = np.matmul(M, corner_rings(T, jobs[part], vf))  # (k, 2, 3): each ring's own product
+                c = np.cross(t[:, 0], t[:, 1])
+                n = np.sqrt(np.vecdot(c, c))  # the dot product of np.linalg.norm(c) row by row: the same bits
+                ok = n > 0
+                out[part[ok]] = c[ok] / n[ok, None]
         return out
 
     def closest_points(self, X, **options):
