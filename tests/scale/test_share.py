@@ -52,6 +52,16 @@ def test_a_pickled_surface_evaluates_to_the_same_bits(name):
         assert np.array_equal(T.vertex_limits(), S.vertex_limits(), equal_nan=True)
 
 
+def test_the_bmz04_parameterizations_pickle_with_the_surface():
+    from ccproof.reparam.surface import limit_surface as reparam_surface
+
+    S = reparam_surface(cube())
+    f, u, v = _points(S, 2000)
+    T = pickle.loads(pickle.dumps(S, protocol=5))
+    for p in ("vanishing", "characteristic"):
+        assert _same_bits(T.evaluate(f, u, v, 1, parameterization=p), S.evaluate(f, u, v, 1, parameterization=p))
+
+
 def test_a_scheme_whose_exact_matrix_was_built_pickles_with_it():
     from ccproof.evaluate.local import corner_scheme, quad_ring
     from ccproof.mesh.examples import k_regular_disk
