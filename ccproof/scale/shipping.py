@@ -232,19 +232,29 @@ def share(obj, where="machine"):
     if where not in ("here", "machine", "anywhere"):
         raise CCProofError(f"share: where must be 'here', 'machine' or 'anywhere', got {where!r}")
     if where == "here":
-        shipped = Shipped(pickle.dumps((_not_here, (os.getpid(), secrets.token_hex(8)), {})))
-        rebuild(shipped, local=obj)
-        try:
-            yield shipped, obj
-        finally:
-            _CACHE.pop(shipped.digest, None)
-        return
-    if where == "anywhere" or not shared_memory_available():
-        yield Shipped(pickle.dumps((_identity, (obj,), {}), protocol=5)), obj
-        return
-    import mmap
+        shipped, local = Shipped(pickle.dumps((_not_here, (os.getpid(), secrets.token_hex(8)), {}))), obj
+    elif where == "anywhere" or not shared_memory_available():
+        shipped, local = Shipped(pickle.dumps((_identity, (obj,), {}), protocol=5)), obj
+    else:
+        fd, ref, local = _write_shared(obj)
+        del obj  # (the caller drops its copy for ``local``: its memory is freed)
+        shipped = Shipped(pickle.dumps((attach, (ref,), {}), protocol=5))
+    rebuild(shipped, local=local)  # (this process never builds it)
+    try:
+        yield shipped, local
+    finally:
+        _CACHE.pop(shipped.digest, None)
+        if where == "machine" and shared_memory_available():
+            os.close(fd)  # the mappings (here and the workers') keep the pages while they last
 
-    buffers = raw_views = []
+
+def _write_shared(obj):
+    """(fd, :class:`SharedRef`, the object read back from the mapping) of ``obj`` pickled with its large buffers
+    written once to a new anonymous shared file ``fd``."""
+    import mmap
+    import secrets
+
+    buffers = []
 
     def keep(buf):
         try:
@@ -257,26 +267,24 @@ def share(obj, where="machine"):
         return False
 
     inband = pickle.dumps(obj, protocol=5, buffer_callback=keep)
-    del obj  # (the caller drops its copy for ``local``: its memory is freed)
     spans, at = [], _ALIGN
-    for b in buffers:
-        spans.append((at, b.nbytes))
-        at = _aligned(at + b.nbytes)
+    for buf in buffers:
+        spans.append((at, buf.nbytes))
+        at = _aligned(at + buf.nbytes)
     token = secrets.token_bytes(16)
     fd = os.memfd_create("ccproof-shared", os.MFD_CLOEXEC)
     try:
         os.ftruncate(fd, at)
         mm = mmap.mmap(fd, at)  # shared, read-write here; every page written once (counted in this process)
         mm[:16] = token
-        for (a, n), b in zip(spans, buffers):
-            mm[a:a + n] = b.cast("B")
-        buffers.clear()
-        del b, raw_views  # (no view of the caller's arrays is kept: they are freed when the caller drops them)
+        while buffers:  # (no view of the caller's arrays is kept: they are freed when the caller drops them)
+            a, n = spans[len(spans) - len(buffers)]
+            mm[a:a + n] = buffers.pop(0).cast("B")
         ref = SharedRef(os.getpid(), fd, token, at, inband, tuple(spans))
-        local = _unpickle_from(ref, memoryview(mm).toreadonly())
-        yield Shipped(pickle.dumps((attach, (ref,), {}), protocol=5)), local
-    finally:
-        os.close(fd)  # the mapping (and the workers') keep the pages while they last
+        return fd, ref, _unpickle_from(ref, memoryview(mm).toreadonly())
+    except BaseException:
+        os.close(fd)
+        raise
 
 
 def release_freed_memory():
