@@ -117,7 +117,8 @@ class CTable:
 
     Holds the arrays in the dtypes the kernel reads (the table's own arrays where they already are), the
     ``ccp_table`` structure pointing into them, and the corner-net caches of the calls (7.3 MB each, one
-    per concurrent call, kept for the next calls); pickles as the table it was made from.
+    per concurrent call, kept for the next calls); pickles as the table it was made from and the arrays it
+    computed (the corner nets, the grid), which it points into again when unpickled.
 
     Parameters
     ----------
