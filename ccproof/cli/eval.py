@@ -352,6 +352,8 @@ def _evaluate_sources(args, held, tagged, kwargs, sources, out_path, sched, prog
     t_start = time.perf_counter()
     with contextlib.ExitStack() as stack:
         with phase("share the surface with the workers and start them", progress and not in_process):
+            if where == "machine":
+                release_freed_memory()  # the build's temporaries, before the shared copy is written
             shipped, surface = stack.enter_context(share(surface, where))
             if where == "machine":
                 release_freed_memory()  # the surface as built (its shared copy replaces it here)
