@@ -700,7 +700,8 @@ class LimitSurface:
 
         Quad meshes: the masks of :func:`ccproof.mesh.limit_positions`. Tagged meshes: evaluated at
         the ptex corner (0, 0) of a sub-face at the vertex, or at the quad corner (hole faces
-        included: holes do not change the surface of the other faces); NaN at unused vertices.
+        included: holes do not change the surface of the other faces), one corner per vertex, all in
+        one batch as :meth:`evaluate` takes random points; NaN at unused vertices.
         """
         if self._ptex_face is None:
             return limit_positions(self.mesh)
@@ -747,7 +748,8 @@ class LimitSurface:
         (:attr:`ccproof.evaluate.local.CornerScheme.tangent_masks`), oriented like ``Pu x Pv``.
         NaN where the tangent plane is not determined by the dominant eigenvectors. Tagged meshes:
         each vertex takes the normal (:meth:`normals`) of its first face corner that is not on a
-        hole; NaN where the tangent plane is not determined or the vertex has only hole faces.
+        hole (all in one batch; the tangent masks of a corner face applied to the rings of all its jobs at
+        once); NaN where the tangent plane is not determined or the vertex has only hole faces.
         """
         if self._ptex_face is not None:
             from ccproof.evaluate.tagged import vertex_corners
