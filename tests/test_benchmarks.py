@@ -28,6 +28,7 @@ SMOKE = {
     "bench_arap.py": ["--smoke"],
     "bench_certify.py": ["--smoke"],
     "bench_evaluate.py": ["--smoke"],
+    "bench_eval_scheduler.py": ["--smoke"],
     "bench_fem.py": ["--smoke"],
     "bench_first_move.py": ["--smoke"],
     "bench_fit_tagged.py": ["--smoke"],

@@ -70,14 +70,19 @@ def add_arguments(parser):
                         "--points FOLDER reads one (docs/scale-out.md)")
 
 
-def _phases(read, setup, worker_setup):
-    """The phases before the evaluation, as printed: read and setup seconds (in this process, in the workers).
+def _phases(read, setup, worker_setup, start=0.0):
+    """The phases before the evaluation, as printed: read and setup seconds, then (workers) sharing the surface
+    and starting them, and the longest a worker took to map or receive the surface.
 
-    >>> _phases(1.5, 2.0, 0.0), _phases(1.5, 0.0, 3.25)
-    ('read in 1.50 s, setup 2.00 s', 'read in 1.50 s, setup 3.25 s (in each worker, the longest)')
+    >>> _phases(1.5, 2.0, 0.0)
+    'read in 1.50 s, setup 2.00 s'
+    >>> _phases(1.5, 2.0, 0.25, 3.0)
+    'read in 1.50 s, setup 2.00 s, workers ready in 3.00 s (surface taken in 0.25 s)'
     """
-    text = f"read in {read:.2f} s, setup {setup + worker_setup:.2f} s"
-    return text + (" (in each worker, the longest)" if worker_setup > setup else "")
+    text = f"read in {read:.2f} s, setup {setup:.2f} s"
+    if start >= 0.005 or worker_setup >= 0.005:
+        text += f", workers ready in {start:.2f} s (surface taken in {worker_setup:.2f} s)"
+    return text
 
 
 def build_surface(mesh, tagged, alpha=None, progress=False, scheme="catmark"):
@@ -175,24 +180,28 @@ def run(args) -> int:
         poly = read_mesh(args.mesh)  # OBJ with OpenSubdiv tags, OFF, or any meshio format
     t_read = time.perf_counter() - t0
     mesh, tagged, n_faces, kwargs, evaluable = _mesh_to_evaluate(args, poly)
+    del poly  # (``mesh`` is the same object, or its QuadMesh)
     # the points before the surface's setup (seconds on large meshes): a bad point is reported at once
     sources = _point_sources(args, points, n_faces, evaluable, out_path, shards)
     from ccproof.cli._notice import compile_notice
 
     compile_notice("eval")  # after the input checks: an error stays one line
-    n, names, sweep, surface, times = _evaluate_sources(args, mesh, tagged, kwargs, sources, out_path, sched,
+    held = [mesh]  # handed over: once shared, the surface's copy is the only one
+    del mesh
+    n, names, sweep, surface, times = _evaluate_sources(args, held, tagged, kwargs, sources, out_path, sched,
                                                         progress)
+    mesh = surface.mesh
     setup, worker_setup, t_start, t_write = times
     for line in sweep.report([f"chunk {i}" for i in range(len(sources))]):  # retried or lost tasks
         print(line)
     out = dict.fromkeys(names)
     what = (str(mesh) if tagged else f"{mesh.n_vertices} vertices, {mesh.n_faces} faces, "
             f"{mesh.extraordinary_vertices.size} extraordinary vertices")
-    print(f"{args.mesh}: {what}; {_phases(t_read, setup, worker_setup)}")
-    evaluation = max(sweep.seconds - worker_setup, 0.0)  # the workers build at the same time, first
+    print(f"{args.mesh}: {what}; {_phases(t_read, setup, worker_setup, t_start)}")
+    evaluation = max(sweep.seconds - worker_setup, 0.0)  # the workers take the surface at the same time, first
     scheme = "" if args.scheme == "catmark" else f"{args.scheme} scheme, "
     print(f"evaluated {n} points ({scheme}{args.parameterization} parameterization, derivatives {args.derivatives}) "
-          f"in {_evaluation_phases(n, evaluation, t_start, t_write)}")
+          f"in {_evaluation_phases(n, evaluation, t_write)}")
     print(f"wrote {args.out}: {', '.join(['face', 'u', 'v', *out])}")
     if args.plot:
         _plot(args, mesh, surface)
@@ -320,47 +329,70 @@ def _point_sources(args, points, n_faces, evaluable, out_path, shards):
                         n_faces=n_faces if evaluable is None else evaluable)
 
 
-def _evaluate_sources(args, mesh, tagged, kwargs, sources, out_path, sched, progress):
+def _evaluate_sources(args, held, tagged, kwargs, sources, out_path, sched, progress):
     """Evaluate the chunks on the scheduler and write --out; returns (points, names, sweep, surface, times)
-    with times = (setup here, the workers' setup, the scheduler's start, gathering and writing)."""
-    from ccproof.scale import evaluate_points, open_scheduler, ship
+    with times = (setup here, the workers' setup, sharing the surface and starting the workers, gathering and
+    writing).
 
-    # on a cluster each worker builds the surface itself (once); here only for in-process work or --plot
+    The surface is built once, here, before any worker starts, from the mesh in the list ``held`` (emptied:
+    the surface keeps the mesh); the workers of this machine map its arrays from shared memory, those of a
+    remote cluster receive it by value, once per worker (never rebuilt). ``progress``: a bar for every phase
+    (the setup, the sharing and the workers' start, the evaluation, the writing)."""
+    import contextlib
+
+    from ccproof.cli._progress import phase
+    from ccproof.scale import open_scheduler, release_freed_memory, runs_in_process, share
+
     t1 = time.perf_counter()
-    surface = build_surface(mesh, tagged, args.alpha, progress, args.scheme) \
-        if sched.kind == "serial" or args.plot else None
-    setup = time.perf_counter() - t1  # the setup in this process (the workers' is measured by them)
+    with phase("setup", progress):  # (the patch table's own bar below it, where the build is long)
+        surface = build_surface(held.pop(), tagged, args.alpha, progress, args.scheme)
+    setup = time.perf_counter() - t1
+    in_process = runs_in_process(sched, len(sources))
+    where = "here" if in_process else "anywhere" if sched.kind == "address" else "machine"
     t_start = time.perf_counter()
-    with open_scheduler(sched, len(sources)) as sched:
-        t_start = time.perf_counter() - t_start  # a local cluster's start
-        in_process = getattr(sched, "kind", None) == "serial"  # a Client, or local worker processes without Dask
-        if surface is None and in_process:  # a single chunk runs here after all
-            t1 = time.perf_counter()
-            surface = build_surface(mesh, tagged, args.alpha, progress, args.scheme)
-            setup += time.perf_counter() - t1
+    with contextlib.ExitStack() as stack:
+        with phase("share the surface with the workers and start them", progress and not in_process):
+            if where == "machine":
+                release_freed_memory()  # the build's temporaries, before the shared copy is written
+            shipped, surface = stack.enter_context(share(surface, where))
+            if where == "machine":
+                release_freed_memory()  # the surface as built (its shared copy replaces it here)
+            sched = stack.enter_context(open_scheduler(sched, len(sources)))
+        t_start = 0.0 if in_process else time.perf_counter() - t_start
         if args.threads is not None:
             kwargs["threads"] = args.threads
         elif not in_process:
             kwargs["threads"] = 1  # one worker per core already: no second level of threads
         # the file (or each shard and the index) is written under a temporary name, then renamed
         t_tasks = time.perf_counter()
-        shipped = ship(build_surface, mesh, tagged, args.alpha, False, args.scheme)
-        n, names, sweep, worker_setup = evaluate_points(shipped, sources,
-                                                        args.derivatives, kwargs, str(out_path), sched,
-                                                        local=surface, progress=progress)
+        with phase(f"evaluate {sum(_count(s) for s in sources)} points", progress and len(sources) == 1):
+            n, names, sweep, worker_setup = evaluate_points_of(shipped, sources, args, kwargs, out_path, sched,
+                                                               surface, progress)
         t_write = time.perf_counter() - t_tasks - sweep.seconds  # gathering and writing the output
     return n, names, sweep, surface, (setup, worker_setup, t_start, t_write)
 
 
-def _evaluation_phases(n, evaluation, start, write):
-    """The evaluation's seconds and rate (of the evaluation alone), then the scheduler's start and the writing.
+def _count(source):
+    """Points of a chunk source (of :func:`ccproof.scale.point_chunks`; a shard: unknown here, 0)."""
+    return int(source[3]) if source[0] == "samples" else len(source[1]) if source[0] == "arrays" else 0
 
-    >>> _evaluation_phases(10**6, 0.5, 0.0, 0.25)
+
+def evaluate_points_of(shipped, sources, args, kwargs, out_path, sched, surface, progress):
+    """:func:`ccproof.scale.evaluate_points` with the options of ``args``."""
+    from ccproof.scale import evaluate_points
+
+    return evaluate_points(shipped, sources, args.derivatives, kwargs, str(out_path), sched, local=surface,
+                           progress=progress)
+
+
+def _evaluation_phases(n, evaluation, write):
+    """The evaluation's seconds and rate (of the evaluation alone), then the gathering and writing.
+
+    >>> _evaluation_phases(10**6, 0.5, 0.25)
     '0.500 s (2,000,000 points/s, evaluation alone); gathering and writing 0.25 s'
     """
     rate = n / evaluation if evaluation > 0 and n else float("nan")
-    return (f"{evaluation:.3f} s ({rate:,.0f} points/s, evaluation alone); "
-            + (f"scheduler start {start:.2f} s, " if start >= 0.005 else "") + f"gathering and writing {write:.2f} s")
+    return f"{evaluation:.3f} s ({rate:,.0f} points/s, evaluation alone); gathering and writing {write:.2f} s"
 
 
 def _plot(args, mesh, surface):

@@ -117,7 +117,8 @@ class CTable:
 
     Holds the arrays in the dtypes the kernel reads (the table's own arrays where they already are), the
     ``ccp_table`` structure pointing into them, and the corner-net caches of the calls (7.3 MB each, one
-    per concurrent call, kept for the next calls); pickles as the table it was made from.
+    per concurrent call, kept for the next calls); pickles as the table it was made from and the arrays it
+    computed (the corner nets, the grid), which it points into again when unpickled.
 
     Parameters
     ----------
@@ -143,10 +144,11 @@ class CTable:
         ``layers`` outside 1 to 4; ``reciprocals=True`` on a table with a side that is not a power of two.
     """
 
-    def __init__(self, table, layers=None, grid=None, reciprocals=None):
+    def __init__(self, table, layers=None, grid=None, reciprocals=None, derived=None):
         self.table = T = table
         self.layers, self.grid, self.reciprocals = layers, grid, reciprocals
         keep = {}
+        derived = derived or {}  # (a pickled CTable) the arrays computed below, as computed then
 
         def arr(name, dtype):
             a = np.ascontiguousarray(getattr(T, name), dtype=dtype)
@@ -199,17 +201,22 @@ class CTable:
                 raise CCProofError(f"layers must be 1 to {_LAYER_NETS}, got {n}")
             nets = [keep["hot"]]
             lib = load()
-            for lay in range(1, n):
+            for lay in range(1, n) if "layer_nets" not in derived else ():
                 w = np.empty_like(keep["hot"])
                 if lib.ccp_corner_nets(self.ref, T.job_root.shape[0], lay, _addr(w)) != 0:
                     break  # a tree of virtual faces deeper than the walk's stack: the cache serves these layers
                 nets.append(w)
+            nets = derived.get("layer_nets", nets)
             n = len(nets)
             keep["layer_nets"] = nets
             s.layer_nets = (_P * _LAYER_NETS)(*[_addr(a) for a in nets])
             s.n_layer_nets = n
         n_ptex = T.refused.shape[0]
-        if grid if grid is not None else (0 < n_ptex and 128 * n_ptex <= GRID_BUDGET):
+        if "grid" in derived:
+            keep["grid"] = derived["grid"]
+            s.grid = _addr(derived["grid"])
+        elif ("grid_none" not in derived
+              and (grid if grid is not None else (0 < n_ptex and 128 * n_ptex <= GRID_BUDGET))):
             g = np.empty(16 * n_ptex, dtype=np.int64)
             if load().ccp_grid(self.ref, _addr(g)) == 0:
                 keep["grid"] = g
@@ -235,7 +242,12 @@ class CTable:
             self._caches.append(cache)
 
     def __reduce__(self):
-        return CTable, (self.table, self.layers, self.grid, self.reciprocals)
+        """Pickled with the arrays it computed (corner nets, grid): unpickled, it points into them again (a
+        worker of a cluster maps them from shared memory instead of computing its own)."""
+        derived = {k: self._keep[k] for k in ("layer_nets", "grid") if k in self._keep}
+        if "grid" not in derived:
+            derived["grid_none"] = True
+        return CTable, (self.table, self.layers, self.grid, self.reciprocals, derived)
 
 
 def evaluate_block(lib, ct, f, u, v, d, outs):

@@ -610,7 +610,9 @@ def corner_scheme(key):
     >>> sch.size, sch.limit_mask[:3].round(15).tolist(), sch.n_layers
     (18, [0.5, 0.08, 0.02], 70)
     """
-    return _cached_scheme("tagged", key, lambda: _corner_scheme(key))
+    # a module-level function bound by partial (not a lambda): a scheme read from the disk cache keeps it to
+    # rebuild its exact A, and pickles with it (a surface sent to the workers of a cluster)
+    return _cached_scheme("tagged", key, functools.partial(_corner_scheme, key))
 
 
 def _corner_scheme(key):
@@ -808,19 +810,27 @@ def _matrix_bytes(num, den):
     return (str(den) + "\n" + " ".join(str(x) for x in num.entries()) + "\n").encode()
 
 
+def _matrix_from_bytes(N, body):
+    """The exact N x N matrix of :func:`_matrix_bytes` (ValueError if the sizes disagree).
+
+    >>> import flint
+    >>> M = flint.fmpq_mat(2, 2, [flint.fmpq(1, 3), 0, 2, flint.fmpq(-5, 6)])
+    >>> _matrix_from_bytes(2, _matrix_bytes(*M.numer_denom())) == M
+    True
+    """
+    import flint  # imported where exact matrices are built: not on a filled disk cache
+
+    den, num = bytes(body).decode("ascii").split("\n", 1)
+    q, nums = int(den), num.split()
+    if len(nums) != N * N or q <= 0:
+        raise ValueError("sizes do not match the configuration")
+    return flint.fmpq_mat(N, N, [flint.fmpq(int(x), q) for x in nums])
+
+
 def _cached_exact_matrix(apath, name, N, compute):
     """The exact ``A`` of a cached scheme from its ``.A`` file (recomputed and rewritten if that file
     is missing or corrupt)."""
-    import flint  # imported where exact matrices are built: not on a filled disk cache
-
-    def parse(body):
-        den, num = bytes(body).decode("ascii").split("\n", 1)
-        q, nums = int(den), num.split()
-        if len(nums) != N * N or q <= 0:
-            raise ValueError("sizes do not match the configuration")
-        return flint.fmpq_mat(N, N, [flint.fmpq(int(x), q) for x in nums])
-
-    A = _diskcache.read_entry(apath, name, parse)
+    A = _diskcache.read_entry(apath, name, functools.partial(_matrix_from_bytes, N))
     if A is None:
         A = compute().A
         _diskcache.store(apath.parent, name, ".A", _matrix_bytes(*A.numer_denom()))
@@ -877,6 +887,14 @@ class CornerScheme:
         if callable(self._A):
             self._A = self._A()
         return self._A
+
+    def __getstate__(self):
+        """Pickled by value (a surface sent to the workers of a cluster): the exact ``A`` as its loader when it
+        was not built yet, else as its exact entries (a flint matrix does not pickle)."""
+        state = dict(self.__dict__)
+        if not callable(state["_A"]):
+            state["_A"] = functools.partial(_matrix_from_bytes, self.size, _matrix_bytes(*state["_A"].numer_denom()))
+        return state
 
     @property
     def n_layers(self):

@@ -36,6 +36,7 @@ nor any limit point.
 
 from __future__ import annotations
 
+from array import array
 from typing import NamedTuple
 
 import numpy as np
@@ -225,6 +226,7 @@ def assemble(temps, schemes, n_jobs, X, top, refused):
         if k:
             rings[...] = np.frombuffer(t.rings, dtype=np.int32).reshape(k, t.n)
         t.rings = None  # (the table's copy is the one kept)
+        t.jobs = array("q")  # (the group's copy is the one kept)
         job_root[jobs] = n_tv
         nr, nc = t.R.shape[0] // 17, t.O.shape[0]
         job_net[jobs] = n_reg + nr * np.arange(k)

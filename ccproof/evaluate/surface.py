@@ -55,6 +55,8 @@ SORT_MIN = 1 << 12
 SORT_CHUNK = 1 << 16
 
 _KEYS = {0: ("P",), 1: ("P", "Pu", "Pv"), 2: ("P", "Pu", "Pv", "Puu", "Puv", "Pvv")}
+#: corner faces whose rings are computed at once by :meth:`LimitSurface.vertex_normals` (temporaries in cache)
+_RING_BLOCK = 1024
 
 
 class LimitSurface:
@@ -153,6 +155,16 @@ class LimitSurface:
         self.patch_map = PatchMap(T)
         self.n_patches = self.patch_map.n_patches
         self.max_layers = self.patch_map.max_layers
+
+    def __getstate__(self):
+        """Pickled by value, with the C kernel's view of the table (:meth:`_c_table`: its corner nets and grid,
+        computed once here) where that kernel is built: a worker of a cluster receives the table (or maps it
+        from shared memory, :func:`ccproof.scale.share`) instead of building it and its view again."""
+        from ccproof.evaluate._ckernel import load
+
+        if load() is not None:
+            self._c_table()
+        return dict(self.__dict__)
 
     @property
     def table_bytes(self):
@@ -493,6 +505,25 @@ class LimitSurface:
             self._corner_normal[key] = nrm
         return self._corner_normal[key]
 
+    def _eigen_normals(self, jobs, vfs):
+        """:meth:`_eigen_normal` of many corner faces at once, (k, 3), NaN where undetermined: one product of
+        the tangent masks with the rings of all the jobs of each corner face ``vf`` (not cached)."""
+        T = self._table
+        out = np.full((jobs.size, 3), np.nan)
+        for vf in np.unique(vfs).tolist():
+            sel = np.flatnonzero(vfs == vf)
+            M = self._schemes[int(T.cfg[vf])].tangent_masks
+            if M is None:
+                continue
+            for lo in range(0, sel.size, _RING_BLOCK):  # blocks: the products' temporaries stay in cache
+                part = sel[lo:lo + _RING_BLOCK]
+                t = np.matmul(M, corner_rings(T, jobs[part], vf))  # (k, 2, 3): each ring's own product
+                c = np.cross(t[:, 0], t[:, 1])
+                n = np.sqrt(np.vecdot(c, c))  # the dot product of np.linalg.norm(c) row by row: the same bits
+                ok = n > 0
+                out[part[ok]] = c[ok] / n[ok, None]
+        return out
+
     def closest_points(self, X, **options):
         """Globally nearest limit points to the rows of ``X`` (n, 3): face, u, v, P, distance, normal
         (see :func:`ccproof.evaluate.closest.closest_points`)."""
@@ -534,13 +565,9 @@ class LimitSurface:
                 vr = np.where(T.cv[wi], V0[inner] + H[inner] - d, V0[inner] + d)
                 rr = self.evaluate(f[idx[inner]], ur, vr, 1)
                 ref = np.cross(rr["Pu"], rr["Pv"])
-                for k, j in enumerate(inner.tolist()):
-                    e = self._eigen_normal(job[idx[j]], w[j])
-                    i = idx[j]
-                    if e is None:
-                        N[i] = np.nan
-                    else:
-                        N[i] = e if np.dot(e, ref[k]) >= 0 else -e
+                e = self._eigen_normals(job[idx[inner]], wi)  # NaN where undetermined
+                flip = np.einsum("ij,ij->i", e, ref) < 0
+                N[idx[inner]] = np.where(flip[:, None], -e, e)
         with np.errstate(invalid="ignore", divide="ignore"):
             return N / np.linalg.norm(N, axis=1)[:, None]
 
@@ -550,7 +577,8 @@ class LimitSurface:
 
         Quad meshes: the masks of :func:`ccproof.mesh.limit_positions`. Tagged meshes: evaluated at
         the ptex corner (0, 0) of a sub-face at the vertex, or at the quad corner (hole faces
-        included: holes do not change the surface of the other faces); NaN at unused vertices.
+        included: holes do not change the surface of the other faces), one corner per vertex, all in
+        one batch as :meth:`evaluate` takes random points; NaN at unused vertices.
         """
         if self._ptex_face is None:
             return limit_positions(self.mesh)
@@ -558,9 +586,17 @@ class LimitSurface:
 
         out = np.full((self.mesh.n_vertices, 3), np.nan)
         f, u, v, verts = vertex_corners(self.mesh)
-        r = {"P": np.empty((f.size, 3))}
-        self._eval_chunk(f, u, v, 0, r)
-        out[verts] = r["P"]
+        # one corner per vertex, its last in the mesh's order; evaluated as any batch of points (the compiled
+        # kernels: the same sums as the numpy path, the same bits)
+        keep = _one_per_vertex(verts, last=True)
+        hole = self._hole_ptex[f[keep]]  # (evaluate refuses a hole: its corners by the numpy path, as before)
+        for sel, batched in ((keep[~hole], True), (keep[hole], False)):
+            if batched:
+                out[verts[sel]] = self.evaluate(f[sel], u[sel], v[sel], 0)["P"]
+            elif sel.size:
+                r = {"P": np.empty((sel.size, 3))}
+                self._eval_chunk(f[sel], u[sel], v[sel], 0, r)
+                out[verts[sel]] = r["P"]
         return out
 
     def _corner_of_vertex(self):
@@ -589,16 +625,17 @@ class LimitSurface:
         (:attr:`ccproof.evaluate.local.CornerScheme.tangent_masks`), oriented like ``Pu x Pv``.
         NaN where the tangent plane is not determined by the dominant eigenvectors. Tagged meshes:
         each vertex takes the normal (:meth:`normals`) of its first face corner that is not on a
-        hole; NaN where the tangent plane is not determined or the vertex has only hole faces.
+        hole (all in one batch; the tangent masks of a corner face applied to the rings of all its jobs at
+        once); NaN where the tangent plane is not determined or the vertex has only hole faces.
         """
         if self._ptex_face is not None:
             from ccproof.evaluate.tagged import vertex_corners
 
             out = np.full((self.mesh.n_vertices, 3), np.nan)
             f, u, v, verts = vertex_corners(self.mesh)
-            keep = ~self._hole_ptex[f]
-            f, u, v, verts = f[keep][::-1], u[keep][::-1], v[keep][::-1], verts[keep][::-1]
-            out[verts] = self.normals(f, u, v)  # reversed: the first corner of a vertex is written last
+            keep = np.flatnonzero(~self._hole_ptex[f])
+            keep = keep[_one_per_vertex(verts[keep], last=False)]  # the first corner of a vertex not on a hole
+            out[verts[keep]] = self.normals(f[keep], u[keep], v[keep])
             return out
         Nn = limit_normals(self.mesh)
         bad = np.flatnonzero(np.isnan(Nn).any(axis=1))
@@ -704,6 +741,19 @@ class LimitSurface:
         V1 = self._moving["step"].apply(man.vertices)  # the build's step, kept (build_tagged)
         V1[np.flatnonzero(man.is_unused_vertex)] = np.nan  # as PolyMesh.refine: an unused vertex has no vertex point
         return V1
+
+
+def _one_per_vertex(verts, last):
+    """Indices into ``verts`` of one entry per distinct vertex: its first or its last occurrence.
+
+    >>> v = np.array([3, 1, 3, 2, 1])
+    >>> _one_per_vertex(v, last=False).tolist(), _one_per_vertex(v, last=True).tolist()
+    ([1, 3, 0], [4, 3, 2])
+    """
+    if not last:
+        return np.unique(verts, return_index=True)[1]
+    first_of_reversed = np.unique(verts[::-1], return_index=True)[1]
+    return verts.size - 1 - first_of_reversed
 
 
 def natural_limit_surface(mesh, *, progress=None):

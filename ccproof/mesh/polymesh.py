@@ -162,6 +162,11 @@ class PolyMesh:
         else:
             self.manifold, self.manifold_vertex_map = self._split_nonmanifold()
 
+    def __getstate__(self):
+        """Pickled without the Python lists and dicts built on first use (:attr:`polygons`, :attr:`edge_index`:
+        tens of bytes per face each, rebuilt from the arrays where needed), e.g. for the workers of a cluster."""
+        return {k: v for k, v in self.__dict__.items() if k not in ("polygons", "edge_index")}
+
     # ------------------------------------------------------------------ construction helpers
     @functools.cached_property
     def polygons(self):

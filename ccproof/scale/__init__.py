@@ -6,7 +6,9 @@ remote one (``dask.distributed``), with results identical to the serial run (doc
   scheduler address; it shows a progress bar of finished tasks, retries a failed or lost task and
   reports every retry; a task is never dropped.
 * :func:`ship` / :func:`rebuild` send a mesh (or any object built from picklable arguments) to the
-  workers once, keyed by the SHA-256 of its pickled content, and build it once per worker process.
+  workers once, keyed by the SHA-256 of its pickled content, and build it once per worker process;
+  :func:`share` sends an object built here (its arrays in shared memory for the workers of this machine,
+  by value to a remote cluster), so that no worker builds it again.
 * :func:`evaluate_dask` evaluates dask arrays of (face, u, v) chunk-wise (``map_blocks``);
   :func:`write_shards` / :func:`read_shards` keep point sets and results that do not fit in memory as
   a folder of ``.npz`` shards.
@@ -25,7 +27,8 @@ _NAMES = {
     "ship": "shipping", "rebuild": "shipping", "Shipped": "shipping", "build_counts": "shipping",
     "evaluate_dask": "arrays", "evaluate_chunks": "arrays", "write_shards": "arrays", "read_shards": "arrays",
     "output_names": "arrays", "point_chunks": "arrays", "evaluate_points": "arrays", "open_scheduler": "engine",
-    "process_pool": "engine",
+    "process_pool": "engine", "runs_in_process": "engine", "share": "shipping", "attach": "shipping",
+    "shared_memory_available": "shipping", "release_freed_memory": "shipping",
 }
 __all__ = sorted(_NAMES)
 

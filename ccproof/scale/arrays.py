@@ -184,10 +184,11 @@ def _evaluate_chunk(task, shipped):
     t0 = time.perf_counter()
     rebuild(shipped)  # the setup: built once per process (this task may be the one that builds it)
     t1 = time.perf_counter()
-    res = _evaluate_block(f, u, v, shipped, task["derivatives"], tuple(sorted(task["kwargs"].items())))
+    res = rebuild(shipped).evaluate(f, u, v, derivatives=task["derivatives"], **task["kwargs"])
     seconds = (t1 - t0, time.perf_counter() - t1)  # (setup, evaluation) in this task
     arrays = {"face": f, "u": u, "v": v}
-    arrays.update({n: res[:, j, :] for j, n in enumerate(output_names(task["derivatives"]))})
+    # the evaluator's own (n, 3) arrays, not stacked: no copy of the chunk's results
+    arrays.update({n: np.asarray(res[n], dtype=np.float64) for n in output_names(task["derivatives"])})
     if task["out"] is None:
         return {**arrays, "seconds": seconds}
     _replace_when_written(task["out"], lambda tmp: np.savez(tmp, **arrays))
@@ -492,19 +493,36 @@ def evaluate_points(shipped, sources, derivatives, kwargs, out, scheduler=None, 
               "out": None if folder is None else str(folder / _shard_name(i))} for i, s in enumerate(sources)]
     sweep = run_tasks(_evaluate_chunk, tasks, scheduler, shared=[shipped], desc="evaluate", unit="chunk",
                       progress=progress, names=[f"chunk {i}" for i in range(len(tasks))])
-    n, counts, seconds = _gather(sweep.results, names, out, folder)
+    n, counts, seconds = _gather(sweep.results, names, out, folder, progress)
     _warn_degenerate(n, counts)
     return n, names, sweep, max((s[0] for s in seconds), default=0.0)
 
 
-def _gather(results, names, out, folder):
+def _gather(results, names, out, folder, progress=False):
     """(points, degenerate-normal counts, seconds per chunk) of the chunks' ``results``: written to the file
-    ``out`` (one .npz) when ``folder`` is None, else the shards' index written in ``folder``."""
+    ``out`` (one .npz) when ``folder`` is None, else the shards' index written in ``folder``. The chunks'
+    arrays are taken out of ``results`` one name at a time (each freed once joined; a single chunk's arrays
+    are not copied); ``progress``: a bar of the arrays joined and the file written."""
     import numpy as np
 
     if folder is None:
-        arrays = {n: np.concatenate([r[n] for r in results]) for n in ("face", "u", "v", *names)}
+        keys = ("face", "u", "v", *names)
+        bar = None
+        if progress:
+            from tqdm import tqdm
+
+            bar = tqdm(total=len(keys) + 1, desc=f"write {Path(out).name}", unit="array")
+        arrays = {}
+        for n in keys:
+            parts = [r.pop(n) for r in results]
+            arrays[n] = parts[0] if len(parts) == 1 else np.concatenate(parts)
+            del parts
+            if bar is not None:
+                bar.update(1)
         _replace_when_written(out, lambda tmp: np.savez(tmp, **arrays))
+        if bar is not None:
+            bar.update(1)
+            bar.close()
         counts = [degenerate_normals(arrays)]
         return int(arrays["face"].size), counts, [r["seconds"] for r in results]
     _write_index(folder, [r[0] for r in results], ("face", "u", "v", *names))

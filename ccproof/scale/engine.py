@@ -310,6 +310,20 @@ def _capped(s, n_tasks):
     return s
 
 
+def runs_in_process(scheduler, n_tasks=None):
+    """Whether :func:`open_scheduler` runs the tasks in this process: the serial scheduler, a single local
+    task, or the default without Dask (a Client or a scheduler address: never).
+
+    >>> runs_in_process("local:4", 1), runs_in_process("local:4", 2), runs_in_process("serial")
+    (True, False, True)
+    """
+    if scheduler.__class__.__name__ == "Client":
+        return False
+    s = parse_scheduler(scheduler)
+    return s.kind == "serial" or s.kind == "local" and n_tasks is not None and n_tasks <= 1 or (
+        s.implicit and not dask_available())
+
+
 @contextlib.contextmanager
 def open_scheduler(scheduler=None, n_tasks=None):
     """A scheduler kept open for several sweeps: yields a connected Client, or the serial :class:`Scheduler`.
@@ -337,8 +351,7 @@ def open_scheduler(scheduler=None, n_tasks=None):
         yield scheduler
         return
     s = _capped(parse_scheduler(scheduler), n_tasks)
-    if s.kind == "serial" or s.kind == "local" and n_tasks is not None and n_tasks <= 1 or (
-            s.implicit and not dask_available()):
+    if runs_in_process(s, n_tasks):
         yield Scheduler("serial")
         return
     if s.kind == "local" and not dask_available():  # worker processes without Dask (run_tasks)

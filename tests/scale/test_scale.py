@@ -6,6 +6,7 @@ is shared by the module (its start-up costs seconds on a loaded machine).
 
 import json
 import os
+import re
 import signal
 import sys
 import time
@@ -185,6 +186,9 @@ def test_eval_command_shards_on_the_cluster_equal_serial(cluster, refdir, tmp_pa
         assert np.array_equal(f, rng.integers(0, read_obj(obj).n_faces, 1500))
         ref = limit_surface(read_obj(obj)).evaluate(f, u, v, derivatives=0)
         assert np.array_equal(ref["P"], z["P"][:1500])
+    # a scheduler address receives the surface by value: unpickled once per worker, never built there
+    counts = cluster[1].run(build_counts)
+    assert all(c <= 1 for per_worker in counts.values() for c in per_worker.values())
     # the shard folder is a point set for the next evaluation (out of core, chunk by chunk)
     assert main(["eval", obj, "--points", str(tmp_path / "shards"), "--derivatives", "0", "--serial",
                  "--out", str(tmp_path / "again.npz")]) == 0
@@ -237,3 +241,17 @@ def test_a_killed_worker_loses_no_task(cluster, tmp_path, capsys):
     assert all("worker was lost 1 time(s)" in what for what in sweep.retried.values())
     assert "task(s) retried; every result is in" in sweep.report()[0]
     assert time.perf_counter() - t0 < 60
+
+
+def test_eval_on_its_own_local_workers_maps_one_shared_surface_and_equals_serial(refdir, tmp_path, capsys):
+    """The default scheduler's path: a local cluster started by the command, the surface built once here and
+    mapped by the workers from shared memory (tests/scale/test_share.py checks the mapping itself)."""
+    obj = str(refdir / "meshes" / "sector_k5.obj")
+    argv = ["eval", obj, "--samples", "3000", "--chunk", "1000", "--derivatives", "2", "--no-progress"]
+    assert main(argv + ["--scheduler", "local:2", "--out", str(tmp_path / "a.npz")]) == 0
+    line = capsys.readouterr().out
+    assert re.search(r"setup [\d.]+ s, workers ready in [\d.]+ s \(surface taken in [\d.]+ s\)", line), line
+    assert main(argv + ["--serial", "--out", str(tmp_path / "b.npz")]) == 0
+    with np.load(tmp_path / "a.npz") as a, np.load(tmp_path / "b.npz") as b:
+        for name in ("face", "u", "v", "P", "Pu", "Pv", "Puu", "Puv", "Pvv"):
+            assert a[name].tobytes() == b[name].tobytes(), name
