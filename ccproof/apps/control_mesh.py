@@ -457,12 +457,14 @@ def subdivide_control(mesh: QuadMesh) -> QuadMesh:
     (16, [0.5, 0.5, 0.5, 0.5], 4)
     """
     from ccproof.mesh import child_faces, subdivide
+    from ccproof.mesh.halfedges import HalfEdges
 
     if not isinstance(mesh, TaggedQuadMesh):
         return subdivide(mesh)
     S, creases, corners = tagged_step(mesh)
+    he = HalfEdges.refined(mesh.halfedges, edge_of_halfedge=mesh.edge_of_halfedge)  # derived, not paired again
     child = TaggedQuadMesh(S @ mesh.vertices, child_faces(mesh), creases=creases, corners=corners,
-                           holes=np.flatnonzero(np.repeat(mesh.hole, 4)))
+                           holes=np.flatnonzero(np.repeat(mesh.hole, 4)), _halfedges=he)
     lab = getattr(mesh, "file_vertex", None)
     if lab is not None:  # the children of the copies that are one vertex of the refined file
         import scipy.sparse as sp
