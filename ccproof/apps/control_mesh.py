@@ -275,11 +275,9 @@ def _fan_complex(mesh: QuadMesh, v, edge_sharpness, vertex_sharpness):
     faces = rank[loc.reshape(F.shape)]
     gl = glob[order]
     tags = {}
-    ekey = _pair_keys(np.c_[np.full(F.shape[0] * 2, v), np.r_[F[:, 1], F[:, 3]]], mesh.n_vertices)
-    allkey = _pair_keys(mesh.edges, mesh.n_vertices)
-    srt = np.argsort(allkey)
-    pos = srt[np.searchsorted(allkey[srt], ekey)]
-    for u, e in zip(np.r_[F[:, 1], F[:, 3]].tolist(), pos.tolist()):
+    nbrs = np.r_[F[:, 1], F[:, 3]]
+    pos = mesh.halfedges.edge_index_of(np.full(nbrs.size, v), nbrs)  # the edges (v, u): mesh.edges' numbering
+    for u, e in zip(nbrs.tolist(), pos.tolist()):
         s = float(edge_sharpness[e])
         if s > 0 and not mesh.is_boundary_edge[e]:
             lu = int(rank[np.searchsorted(glob, u)])
