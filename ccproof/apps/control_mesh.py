@@ -275,11 +275,9 @@ def _fan_complex(mesh: QuadMesh, v, edge_sharpness, vertex_sharpness):
     faces = rank[loc.reshape(F.shape)]
     gl = glob[order]
     tags = {}
-    ekey = _pair_keys(np.c_[np.full(F.shape[0] * 2, v), np.r_[F[:, 1], F[:, 3]]], mesh.n_vertices)
-    allkey = _pair_keys(mesh.edges, mesh.n_vertices)
-    srt = np.argsort(allkey)
-    pos = srt[np.searchsorted(allkey[srt], ekey)]
-    for u, e in zip(np.r_[F[:, 1], F[:, 3]].tolist(), pos.tolist()):
+    nbrs = np.r_[F[:, 1], F[:, 3]]
+    pos = mesh.halfedges.edge_index_of(np.full(nbrs.size, v), nbrs)  # the edges (v, u): mesh.edges' numbering
+    for u, e in zip(nbrs.tolist(), pos.tolist()):
         s = float(edge_sharpness[e])
         if s > 0 and not mesh.is_boundary_edge[e]:
             lu = int(rank[np.searchsorted(glob, u)])
@@ -457,12 +455,14 @@ def subdivide_control(mesh: QuadMesh) -> QuadMesh:
     (16, [0.5, 0.5, 0.5, 0.5], 4)
     """
     from ccproof.mesh import child_faces, subdivide
+    from ccproof.mesh.halfedges import HalfEdges
 
     if not isinstance(mesh, TaggedQuadMesh):
         return subdivide(mesh)
     S, creases, corners = tagged_step(mesh)
+    he = HalfEdges.refined(mesh.halfedges, edge_of_halfedge=mesh.edge_of_halfedge)  # derived, not paired again
     child = TaggedQuadMesh(S @ mesh.vertices, child_faces(mesh), creases=creases, corners=corners,
-                           holes=np.flatnonzero(np.repeat(mesh.hole, 4)))
+                           holes=np.flatnonzero(np.repeat(mesh.hole, 4)), _halfedges=he)
     lab = getattr(mesh, "file_vertex", None)
     if lab is not None:  # the children of the copies that are one vertex of the refined file
         import scipy.sparse as sp

@@ -110,3 +110,38 @@ def test_control_mesh_shares_the_files_topology(refdir, monkeypatch, name):
 
 def _square():
     return [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], [[0, 1, 2, 3]]
+
+
+@pytest.mark.parametrize("name", ["k5", "osd_features/meshes/catmark_hole_test2.obj",
+                                  "osd_nonmanifold/meshes/book4_infpage.obj"])
+def test_subdivide_control_derives_the_childs_topology(refdir, monkeypatch, name):
+    """subdivide_control derives the child's half-edges from the parent's (no pairing of the child's faces): no
+    HalfEdges is built from faces during the step, and every topology array and tag of the child equals the one a
+    TaggedQuadMesh pairs anew from the child's faces, tags and holes (the independent construction)."""
+    from ccproof.apps.control_mesh import TaggedQuadMesh, subdivide_control
+    from ccproof.mesh.examples import k_regular_disk
+    from ccproof.mesh.halfedges import HalfEdges
+
+    if name == "k5":  # an extraordinary interior vertex, a boundary, a semi-sharp crease, a corner and a hole
+        d = k_regular_disk(5, rings=2)
+        mesh = TaggedQuadMesh(d.vertices, d.faces, creases=(d.faces[0][:2].reshape(1, 2), 2.5),
+                              corners=([d.faces[7][2]], [np.inf]), holes=[11])
+    else:
+        mesh, _ = read_control_mesh(refdir / name)
+    assert isinstance(mesh, TaggedQuadMesh) and mesh.has_tags
+    built = []
+    init = HalfEdges.__init__
+    monkeypatch.setattr(HalfEdges, "__init__", lambda self, *a, **k: built.append(init(self, *a, **k)))
+    child = subdivide_control(mesh)
+    monkeypatch.undo()
+    assert built == []  # derived from the parent's arrays, not paired again
+    e, v = np.flatnonzero(child.edge_sharpness > 0), np.flatnonzero(child.vertex_sharpness > 0)
+    fresh = TaggedQuadMesh(np.array(child.vertices), np.array(child.faces),
+                           creases=(child.edges[e], child.edge_sharpness[e]),
+                           corners=(v, child.vertex_sharpness[v]), holes=np.flatnonzero(child.hole))
+    for k in ("twin", "edges", "edge_of_halfedge", "edge_faces", "fan_corners", "valence", "is_boundary_vertex",
+              "edge_sharpness", "vertex_sharpness", "hole"):
+        assert np.array_equal(getattr(child, k), getattr(fresh, k)), k
+    for k in ("twin", "edge_of", "edges", "edge_face_count", "edge_halfedge", "fan_of_corner"):
+        assert np.array_equal(getattr(child.halfedges, k), getattr(fresh.halfedges, k)), k
+    assert (child.edge_sharpness > 0).any() and (child.hole.any() or name != "k5")  # (the tags were carried)

@@ -46,11 +46,11 @@ from __future__ import annotations
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components
 
 from ccproof.apps.control_mesh import edge_values, tagged_step, tags_of, vertex_rules
 from ccproof.errors import CCProofError, MeshError
-from ccproof.mesh import QuadMesh, child_faces
+from ccproof.mesh import Options, QuadMesh, child_faces
+from ccproof.mesh.halfedges import HalfEdges
 from ccproof.mesh.quadmesh import shared_halfedges
 from ccproof.mesh.subdivision import boundary_neighbours
 from ccproof.rule_weights import crease_vertex_weights, sharp_edge_weight
@@ -102,20 +102,25 @@ def _refuse_zero_area(mesh, faces):
                         "ARAP needs faces of positive area")
 
 
-def split_nonmanifold(F, n):
+def split_nonmanifold(F, n, halfedges=None):
     """Duplicate every vertex whose faces form several fans (edge-manifold, oriented input).
+
+    The fans are those of the faces' :class:`~ccproof.mesh.halfedges.HalfEdges`
+    (:attr:`~ccproof.mesh.halfedges.HalfEdges.fan_of_corner`).
 
     Parameters
     ----------
     F : int array (m, 4), indices in ``[0, n)``, every vertex used
     n : int
+    halfedges : HalfEdges, optional
+        The half-edges of ``F`` (built here when None).
 
     Returns
     -------
     F_new : int array (m, 4)
     orig : int array (n_new,)
-        ``orig[v]`` is the input vertex of output vertex ``v``; the first fan of a vertex keeps its
-        index, extra fans get ``n, n + 1, ...``.
+        ``orig[v]`` is the input vertex of output vertex ``v``; the first fan of a vertex (the one of its
+        smallest corner) keeps its index, extra fans get ``n, n + 1, ...`` (by vertex, then smallest corner).
 
     >>> F = [[0, 1, 2, 3], [0, 4, 5, 6]]          # two quads touching at vertex 0
     >>> Fn, orig = split_nonmanifold(F, 7)
@@ -124,24 +129,12 @@ def split_nonmanifold(F, n):
     """
     F = np.asarray(F, dtype=np.int64)
     m = F.shape[0]
-    H = 4 * m
-    org = F.ravel()
-    dst = np.roll(F, -1, axis=1).ravel()
-    key = org * n + dst
-    order = np.argsort(key, kind="stable")
-    skey = key[order]
-    rkey = dst * n + org
-    pos = np.minimum(np.searchsorted(skey, rkey), H - 1)
-    twin = np.where(skey[pos] == rkey, order[pos], -1)
-    ar = np.arange(H)
-    prev = (ar // 4) * 4 + (ar + 3) % 4
-    rot = twin[prev]
-    ok = rot >= 0
-    g = sp.coo_matrix((np.ones(int(ok.sum())), (ar[ok], rot[ok])), shape=(H, H))
-    ncomp, lab = connected_components(g, directed=False)
-    pair = org * ncomp + lab
+    he = HalfEdges.from_quads(F, n, Options()) if halfedges is None else halfedges
+    lab = he.fan_of_corner  # fans numbered in the order of their smallest corner
+    ncomp = int(lab.max()) + 1 if lab.size else 0
+    pair = F.ravel() * ncomp + lab
     uniq, inv = np.unique(pair, return_inverse=True)
-    uorg = uniq // ncomp
+    uorg = uniq // ncomp if ncomp else uniq
     if uniq.size == n:
         return F.copy(), np.arange(n)
     first = np.r_[True, uorg[1:] != uorg[:-1]]
@@ -290,13 +283,16 @@ class ChartHierarchy:
         gid = np.r_[cv, rv]
         loc = np.full(mesh.n_vertices, -1, dtype=np.int64)
         loc[gid] = np.arange(gid.size)
-        F0, orig = split_nonmanifold(loc[Fg[faces0]], gid.size)
+        F = loc[Fg[faces0]]
+        he = shared_halfedges(mesh, F, gid.size)  # (the whole mesh: its own)
+        he = HalfEdges.from_quads(F, gid.size, Options()) if he is None else he
+        F0, orig = split_nonmanifold(F, gid.size, he)
         #: global control-vertex index of every texture unknown (chart vertices first)
         self.unknown_vertices = gid
         self.n_chart_vertices = cv.size
         #: unknown of every vertex of E_0 (duplicated outer vertices share one)
         self.orig0 = orig
-        E0 = QuadMesh(mesh.vertices[gid[orig]], F0, _halfedges=shared_halfedges(mesh, F0, orig.size))
+        E0 = QuadMesh(mesh.vertices[gid[orig]], F0, _halfedges=he if orig.size == gid.size else None)  # (split: new)
         es, vs = tags_of(mesh)
         g0 = gid[orig]  # the control vertex of every vertex of E_0
         sharp = es > 0
@@ -349,11 +345,12 @@ class ChartHierarchy:
             raise HierarchyError("a kept edge point belongs to an edge without a chart vertex")
         Fk = inv.reshape(-1, 4)
         P = S[used] @ E.vertices
-        try:  # usually manifold: avoid the fan analysis
-            new = QuadMesh(P, Fk)
+        he = HalfEdges.from_quads(Fk, used.size, Options())  # the kept faces' topology (QuadMesh's), built once
+        try:  # usually manifold: no split
+            new = QuadMesh(P, Fk, _halfedges=he)
             rows = used
         except MeshError:
-            Fs, orig = split_nonmanifold(Fk, used.size)
+            Fs, orig = split_nonmanifold(Fk, used.size, he)
             rows = used[orig]
             new = QuadMesh(P[orig], Fs)
         SE = S[rows]

@@ -163,17 +163,6 @@ def term_scale(term, level):
     return 4.0 ** (-level) * 4.0 ** (level * order)
 
 
-# ---------------------------------------------------------------------------- topology
-
-
-def _nxt(h):
-    return h - h % 4 + (h + 1) % 4
-
-
-def _prv(h):
-    return h - h % 4 + (h + 3) % 4
-
-
 @dataclass(frozen=True)
 class ElementLayout:
     """Which face carries which element (see the module docstring).
@@ -242,7 +231,7 @@ class ElementLayout:
 def normal_nets(mesh, faces):
     """4 x 4 nets of normal faces by half-edge walks (each corner of valence 4, interior)."""
     Ff = mesh.faces.reshape(-1)
-    tw = mesh.twin
+    tw, nxt, prv = mesh.twin, mesh.halfedges.nxt, mesh.halfedges.prv
     nets = np.empty((faces.size, 16), dtype=np.int64)
     pos = ((1, 1), (2, 1), (2, 2), (1, 2))
     fwd = ((1, 0), (0, 1), (-1, 0), (0, -1))
@@ -250,10 +239,10 @@ def normal_nets(mesh, faces):
     for c in range(4):
         h = 4 * faces + c
         t = tw[h]
-        x1 = Ff[_nxt(_nxt(t))]
-        t2 = tw[_nxt(t)]
-        x3 = Ff[_nxt(_nxt(t2))]
-        x4 = Ff[_prv(t2)]
+        x1 = Ff[nxt[nxt[t]]]
+        t2 = tw[nxt[t]]
+        x3 = Ff[nxt[nxt[t2]]]
+        x4 = Ff[prv[t2]]
         (pi, pj), (fi, fj), (li, lj) = pos[c], fwd[c], left[c]
         nets[:, 4 * pi + pj] = Ff[h]
         nets[:, 4 * (pi - li) + (pj - lj)] = x1
@@ -266,17 +255,17 @@ def _two_ring(mesh, ev):
     """Two-ring of an interior EV whose fan faces are all interior (module docstring order)."""
     F = mesh.faces
     Ff = F.reshape(-1)
-    tw = mesh.twin
+    tw, nxt, prv = mesh.twin, mesh.halfedges.nxt, mesh.halfedges.prv
     corners = mesh.fan_corners[mesh.fan_ptr[ev] : mesh.fan_ptr[ev + 1]]
     f, c = corners // 4, corners % 4
-    p10 = Ff[_nxt(corners)]
+    p10 = Ff[nxt[corners]]
     p11 = F[f, (c + 2) % 4]
-    t = tw[_nxt(corners)]
-    p20 = Ff[_nxt(_nxt(t))]
-    p21 = Ff[_prv(t)]
-    t2 = tw[_prv(t)]
-    p22 = Ff[_nxt(_nxt(t2))]
-    p12 = Ff[_prv(t2)]
+    t = tw[nxt[corners]]
+    p20 = Ff[nxt[nxt[t]]]
+    p21 = Ff[prv[t]]
+    t2 = tw[prv[t]]
+    p22 = Ff[nxt[nxt[t2]]]
+    p12 = Ff[prv[t2]]
     ring = np.stack([p10, p20, p11, p21, p12, p22], axis=1).reshape(-1)
     return np.r_[ev, ring], f, c
 

@@ -50,16 +50,12 @@ _LEFT = ((0, 1), (-1, 0), (0, -1), (1, 0))
 _CORNERS = np.array([(0, 0), (1, 0), (1, 1), (0, 1)], dtype=float)
 
 
-def _nxt(h):
-    return h - h % 4 + (h + 1) % 4
-
-
-def _prv(h):
-    return h - h % 4 + (h + 3) % 4
-
-
 class _Local:
-    """A small quad mesh with its tags (local labels): faces (m, 4), edge/vertex sharpness."""
+    """A small quad mesh with its tags (local labels): faces (m, 4), edge/vertex sharpness.
+
+    Its topology is the QuadMesh's :class:`~ccproof.mesh.halfedges.HalfEdges` (``mesh.halfedges``); what is
+    held here is the tags over its edges and vertices (``es``, ``vs``, ``sharp``, ``n_sharp``, ``semi_v``) and
+    the cached children of the tagged step."""
 
     def __init__(self, faces, creases, corners, like=None):
         from ccproof.mesh import QuadMesh
@@ -78,9 +74,6 @@ class _Local:
         if len(cv):
             self.vs[np.asarray(cv, dtype=np.int64)] = cs
         m = self.mesh
-        key = np.minimum(m.edges[:, 0], m.edges[:, 1]) * n + np.maximum(m.edges[:, 0], m.edges[:, 1])
-        self._edge = dict(zip(key.tolist(), range(key.size)))
-        self._n = n
         self._children = {}
         sharp = m.is_boundary_edge | (self.es > 0)
         self.sharp = sharp
@@ -89,9 +82,6 @@ class _Local:
         self.semi_v = np.zeros(n, dtype=bool)
         self.semi_v[m.edges[semi].reshape(-1)] = True
         self.semi_v |= (self.vs > 0) & np.isfinite(self.vs)
-
-    def edge(self, a, b):
-        return self._edge[min(a, b) * self._n + max(a, b)]
 
     def children(self, g):
         """The tagged step of this mesh (sparse (n', n)) and the four children of face ``g``: each
@@ -110,9 +100,6 @@ class _Local:
             self._children[g] = (S, kids)
         return self._children[g]
 
-    def is_sharp(self, a, b):
-        return bool(self.sharp[self.edge(a, b)])
-
 
 def regular_corners(loc, g):
     """Which corners of face ``g`` of a local mesh are regular (module docstring), and its sharp sides.
@@ -120,10 +107,10 @@ def regular_corners(loc, g):
     Returns ``(regular (4,) bool, sharp_side (4,) bool)``; side ``k`` runs from corner k to corner k + 1.
     """
     m = loc.mesh
+    nxt, prv, twin, edge_of = m.halfedges.nxt, m.halfedges.prv, m.twin, m.edge_of_halfedge
     F = loc.faces[g]
-    side = np.array([loc.is_sharp(int(F[k]), int(F[(k + 1) % 4])) for k in range(4)])
+    side = loc.sharp[edge_of[4 * g + np.arange(4)]]  # side k: the half-edge 4 g + k
     reg = np.zeros(4, dtype=bool)
-    Ff = loc.faces.reshape(-1)
     for c in range(4):
         v = int(F[c])
         if loc.vs[v] > 0 or loc.semi_v[v]:
@@ -137,12 +124,11 @@ def regular_corners(loc, g):
         if ns == 0:
             reg[c] = True
         elif ns == 2 and side[c] != side[c - 1]:
-            h = 4 * g + c
-            if side[c]:  # the edge opposite side c: from v to the point outward of side c - 1
-                x = Ff[_prv(m.twin[4 * g + (c - 1) % 4])]
-            else:  # opposite side c - 1: to the point outward of side c
-                x = Ff[_nxt(_nxt(m.twin[h]))]
-            reg[c] = loc.is_sharp(v, int(x))
+            if side[c]:  # the edge opposite side c: into v, in the face across side c - 1 (interior: twins exist)
+                e = edge_of[prv[twin[4 * g + (c - 1) % 4]]]
+            else:  # opposite side c - 1: out of v, in the face across side c
+                e = edge_of[nxt[twin[4 * g + c]]]
+            reg[c] = loc.sharp[e]
     return reg, side
 
 
@@ -150,7 +136,7 @@ def _net(loc, g, side):
     """(16, n_local) rows of the B-spline net of a regular face ``g`` (ghost points across sharp sides)."""
     m = loc.mesh
     Ff = loc.faces.reshape(-1)
-    tw = m.twin
+    tw, nxt, prv = m.twin, m.halfedges.nxt, m.halfedges.prv
     F = loc.faces[g]
     net = [None] * 16
     idx = {}
@@ -174,18 +160,18 @@ def _net(loc, g, side):
         if side[c]:
             v[p1] = {int(F[c]): 2.0, int(F[(c + 3) % 4]): -1.0}
         else:
-            v[p1] = {int(Ff[_nxt(_nxt(tw[4 * g + c]))]): 1.0}
+            v[p1] = {int(Ff[nxt[nxt[tw[4 * g + c]]]]): 1.0}
         if side[c - 1]:
             v[p3] = {int(F[c]): 2.0, int(F[(c + 1) % 4]): -1.0}
         else:
-            v[p3] = {int(Ff[_prv(tw[4 * g + (c - 1) % 4])]): 1.0}
+            v[p3] = {int(Ff[prv[tw[4 * g + (c - 1) % 4]]]): 1.0}
         if side[c]:
             ghosts.append((p4, p3, add(p3, left)))  # 2 (pos - fwd) - (pos - fwd + left)
         elif side[c - 1]:
             ghosts.append((p4, p1, add(p1, fwd)))
         else:
-            t2 = tw[_nxt(tw[4 * g + c])]
-            v[p4] = {int(Ff[_prv(t2)]): 1.0}
+            t2 = tw[nxt[tw[4 * g + c]]]
+            v[p4] = {int(Ff[prv[t2]]): 1.0}
         for p, w in v.items():
             net[at(p)] = w
     for p4, a, b in ghosts:

@@ -106,3 +106,57 @@ def test_boundary_rules_equal_the_chart_as_its_own_mesh(case):
         assert d.max() < 1e-13 and np.unique(idx).size == cv.size == Dg.shape[0]
         assert np.abs(X[:, 3:] - Dg[idx, 3:]).max() < 1e-13
         assert abs(A[np.flatnonzero(~L.chart_vertex)]).max() == 0  # boundary-rule textures live on the chart
+
+
+def _fans_by_walk(F, n):
+    """Independent fans: corners (f, i) at one vertex joined when their faces share an edge through it (plain
+    Python union-find over the edges written out corner by corner)."""
+    parent = list(range(4 * len(F)))
+
+    def root(c):
+        while parent[c] != c:
+            parent[c] = parent[parent[c]]
+            c = parent[c]
+        return c
+
+    at_edge = {}
+    for f, face in enumerate(F):
+        for i in range(4):
+            v, w, u = face[i], face[(i + 1) % 4], face[(i - 1) % 4]
+            for other in (w, u):  # the two edges of the face through corner (f, i)
+                key = (v, other)
+                if key in at_edge:
+                    parent[root(4 * f + i)] = root(at_edge[key])
+                else:
+                    at_edge[key] = 4 * f + i
+    fans = {}
+    for c in range(4 * len(F)):
+        fans.setdefault(root(c), []).append(c)
+    return sorted(fans.values())  # each fan's corners increasing; fans by their smallest corner
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_split_nonmanifold_matches_a_fan_walk(seed):
+    """Random face subsets of a torus and a valence-5 disk (fans touching at vertices): every fan of a vertex
+    becomes a vertex of its own, the fan with the vertex's smallest corner keeps the index, the others get
+    n, n + 1, ... by vertex then smallest corner (the documented numbering), faces otherwise unchanged."""
+    from ccproof.apps.arap.hierarchy import split_nonmanifold
+
+    rng = np.random.default_rng(seed)
+    mesh = torus(8, 6) if seed % 2 else k_regular_disk(5, 3)
+    keep = np.flatnonzero(rng.random(mesh.n_faces) < 0.55)
+    used, inv = np.unique(mesh.faces[keep], return_inverse=True)
+    F, n = inv.reshape(-1, 4), used.size
+    fans = _fans_by_walk(F.tolist(), n)
+    by_vertex = {}
+    for fan in fans:
+        by_vertex.setdefault(int(F.ravel()[fan[0]]), []).append(fan)
+    expect = F.ravel().copy()
+    orig = list(range(n))
+    for v in sorted(by_vertex):
+        for fan in by_vertex[v][1:]:
+            expect[fan] = len(orig)
+            orig.append(v)
+    Fn, got_orig = split_nonmanifold(F, n)
+    assert len(orig) > n  # the subset has vertices with several fans
+    assert Fn.tolist() == expect.reshape(-1, 4).tolist() and got_orig.tolist() == orig

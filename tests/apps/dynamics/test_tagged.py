@@ -199,3 +199,25 @@ def test_model_on_a_tagged_mesh_with_triangles(refdir):
         pv.append(w[1])
     ref = LimitSurface(poly).evaluate(pt, pu, pv, 0)["P"]
     assert np.abs(model.evaluate(f, u, v)["P"] - ref).max() <= 1e-12 * poly.bounding_box_diagonal
+
+
+@pytest.mark.parametrize("crease, regular", [
+    ([[10, 11], [11, 12], [12, 13], [13, 14]], [True, True, True, True]),  # a straight crease through corners 2, 3
+    ([[11, 12], [12, 17]], [True, True, False, False]),  # bent at corner 2 (12); corner 3 (11) the end of a dart
+    ([[1, 6], [6, 11], [11, 16], [16, 21]], [True, True, True, True]),  # straight, along the face's side 3
+    ([[1, 6], [6, 11], [11, 12], [12, 13], [13, 14]], [True, True, True, False]),  # bent at corner 3 (11)
+    ([[6, 11], [11, 16]], [False, True, True, True]),  # corner 0 (6) the end of a crease (a dart)
+])
+def test_regular_corners_by_hand(crease, regular):
+    """Face 5 = (6, 7, 12, 11) of a 4 x 4 grid (vertex x + 5 y) with an infinitely sharp crease: a corner on a
+    straight crease is regular, on a bent one or at a dart's end not (the module docstring's rule, by hand)."""
+    from ccproof.apps.dynamics.tagged import _Local, regular_corners
+    from ccproof.mesh.examples import grid
+
+    g = grid(4, 4)
+    assert g.faces[5].tolist() == [6, 7, 12, 11]
+    loc = _Local(g.faces, (np.array(crease), np.full(len(crease), np.inf)), ([], []))
+    reg, side = regular_corners(loc, 5)
+    sides = [{6, 7}, {7, 12}, {12, 11}, {11, 6}]
+    assert reg.tolist() == regular
+    assert side.tolist() == [any(set(e) == s for e in crease) for s in sides]
