@@ -55,6 +55,8 @@ class BernsteinForm:
     """
 
     __slots__ = ("shape", "coeffs", "box", "prec")
+    #: leading axes in the power basis (a :class:`~ccproof.rigorous.TaylorForm`'s parameter z: 1), the others Bernstein
+    POWER_AXES = 0
 
     def __init__(self, shape, coeffs, box=None, prec=None):
         shape = tuple(shape)
@@ -102,7 +104,7 @@ class BernsteinForm:
         """Ball version at ``prec`` bits."""
         if T.check_prec(prec) is None:
             raise ValueError("to_arb needs a precision in bits")
-        return BernsteinForm.from_raw(self.shape, T.convert(self.coeffs, prec), self.box, prec)
+        return self.from_raw(self.shape, T.convert(self.coeffs, prec), self.box, prec)
 
     # ------------------------------------------------------------------ subdivision
 
@@ -112,7 +114,7 @@ class BernsteinForm:
         With the default ``t = 1/2`` the sub-boxes of a dyadic box are dyadic and the matrices are
         dyadic (exact in ``arb``); the result is exact for exact input.
         """
-        axis = self._axis(axis)
+        axis = self._axis(axis, bernstein=True)
         t = T.exact_scalar(t)
         if not 0 < t < 1:
             raise ValueError(f"split fraction must lie in (0, 1), got {t}")
@@ -130,7 +132,7 @@ class BernsteinForm:
         for axis, ((lo, hi), (a, b)) in enumerate(zip(self.box, box)):
             if (a, b) == (lo, hi):
                 continue
-            if a < lo or b > hi:
+            if a < lo or b > hi or axis < self.POWER_AXES:
                 raise ValueError(f"[{a}, {b}] is not inside [{lo}, {hi}] (axis {axis})")
             h = hi - lo
             f = f._along(axis, restrict_matrix(f.shape[axis] - 1, (a - lo) / h, (b - lo) / h), (a, b))
@@ -142,44 +144,57 @@ class BernsteinForm:
         if len(degrees) != self.nvars or any(d < n - 1 for d, n in zip(degrees, self.shape)):
             raise ValueError(f"cannot elevate degrees {self.degrees} to {degrees}")
         f = self
-        for axis, d in enumerate(degrees):
+        for axis, d in enumerate(degrees[self.POWER_AXES:], self.POWER_AXES):
             if d != f.shape[axis] - 1:
                 f = f._along(axis, elevation_matrix(f.shape[axis] - 1, d), self.box[axis])
-        return f
+        shape = tuple(d + 1 for d in degrees[:self.POWER_AXES]) + f.shape[self.POWER_AXES:]  # power axes: zeros
+        return f if shape == f.shape else f.from_raw(shape, T.pad(f.coeffs, f.shape, shape, f.prec), f.box, f.prec)
 
     def diff(self, axis):
         """Bernstein form (degree one less along ``axis``) of the partial derivative on the box."""
-        axis = self._axis(axis)
+        axis = self._axis(axis, bernstein=True)
         n = self.shape[axis] - 1
         lo, hi = self.box[axis]
         return self._along(axis, derivative_matrix(n, hi - lo), self.box[axis])
 
     def to_poly(self):
         """The polynomial in the original (box) variables, in the power basis."""
-        mats = [bernstein_to_power_matrix(n - 1) for n in self.shape]
-        c, shape = T.apply_all_axes(self.coeffs, self.shape, mats, self.prec)
+        f = self.bernstein()
+        mats = [bernstein_to_power_matrix(n - 1) for n in f.shape]
+        c, shape = T.apply_all_axes(f.coeffs, f.shape, mats, f.prec)
         p = Poly.from_raw(shape, c, self.prec)
-        for axis, (lo, hi) in enumerate(self.box):
+        for axis, (lo, hi) in enumerate(f.box):
             if (lo, hi) != (0, 1):
                 h = hi - lo
                 p = p.affine(axis, -lo / h, (1 - lo) / h)  # t = (x - lo) / h
         return p
 
+    def bernstein(self):
+        """The form with every axis in the Bernstein basis on its box (the power axes converted; else itself)."""
+        f = self
+        for axis in range(self.POWER_AXES):
+            n = f.shape[axis] - 1
+            c, shape = T.apply_along_axis(f.coeffs, f.shape, axis, conversion_matrix(n, n, *f.box[axis]), f.prec)
+            f = BernsteinForm.from_raw(shape, c, f.box, f.prec)
+        return f
+
     def _along(self, axis, mat, interval):
         c, shape = T.apply_along_axis(self.coeffs, self.shape, axis, mat, self.prec)
         box = self.box[:axis] + (interval,) + self.box[axis + 1 :]
-        return BernsteinForm.from_raw(shape, c, box, self.prec)
+        return self.from_raw(shape, c, box, self.prec)
 
-    def _axis(self, axis):
+    def _axis(self, axis, bernstein=False):
         if isinstance(axis, bool) or not isinstance(axis, int) or not 0 <= axis < self.nvars:
             raise ValueError(f"axis {axis!r} out of range for {self.nvars} variables")
+        if bernstein and axis < self.POWER_AXES:
+            raise ValueError(f"axis {axis!r} is in the power basis (not an x axis)")
         return axis
 
     # ------------------------------------------------------------------ arithmetic (same box)
 
     def _common(self, other):
-        if not isinstance(other, BernsteinForm):
-            raise TypeError(f"expected a BernsteinForm, got {type(other).__name__}")
+        if type(other) is not type(self):
+            raise TypeError(f"expected a {type(self).__name__}, got {type(other).__name__}")
         if other.box != self.box:
             raise ValueError(f"Bernstein forms on different boxes: {self.box} and {other.box}")
         prec = T.join_prec(self.prec, other.prec)
@@ -192,7 +207,7 @@ class BernsteinForm:
             return self._shift(T.scalar(other), 1)
         a, b, shape, prec = self._common(other)
         with flint.ctx.workprec(prec or flint.ctx.prec):
-            return BernsteinForm.from_raw(shape, [x + y for x, y in zip(a, b)], self.box, prec)
+            return self.from_raw(shape, [x + y for x, y in zip(a, b)], self.box, prec)
 
     __radd__ = __add__
 
@@ -201,20 +216,21 @@ class BernsteinForm:
             return self._shift(T.scalar(other), -1)
         a, b, shape, prec = self._common(other)
         with flint.ctx.workprec(prec or flint.ctx.prec):
-            return BernsteinForm.from_raw(shape, [x - y for x, y in zip(a, b)], self.box, prec)
+            return self.from_raw(shape, [x - y for x, y in zip(a, b)], self.box, prec)
 
     def __rsub__(self, other):
         return (-self)._shift(T.scalar(other), 1)
 
     def __neg__(self):
-        return BernsteinForm.from_raw(self.shape, [-c for c in self.coeffs], self.box, self.prec)
+        return self.from_raw(self.shape, [-c for c in self.coeffs], self.box, self.prec)
 
     def _shift(self, c, sign):
-        # adding a constant adds it to every coefficient (partition of unity)
+        # a constant is added to every coefficient (partition of unity) of the power axes' degree 0
         self._check_scalar_kind(c)
+        n = T.size(self.shape[self.POWER_AXES:])
         with flint.ctx.workprec(self.prec or flint.ctx.prec):
-            out = [x + c for x in self.coeffs] if sign > 0 else [x - c for x in self.coeffs]
-        return BernsteinForm.from_raw(self.shape, out, self.box, self.prec)
+            out = [x + c for x in self.coeffs[:n]] if sign > 0 else [x - c for x in self.coeffs[:n]]
+        return self.from_raw(self.shape, out + self.coeffs[n:], self.box, self.prec)
 
     def _check_scalar_kind(self, c):
         if isinstance(c, arb) and self.prec is None:
@@ -224,28 +240,31 @@ class BernsteinForm:
         """Product on the same box, of degree ``m + n``, computed in Bernstein form.
 
         With ``a~_i = C(m, i) a_i`` (coefficients in the basis t^i (1-t)^(m-i)), the product's
-        scaled coefficients are the plain convolution of ``a~`` and ``b~``; divide by C(m+n, k).
+        scaled coefficients are the plain convolution of ``a~`` and ``b~``; divide by C(m+n, k). Along a power
+        axis the weights are 1 (a plain convolution).
         """
         if not isinstance(other, BernsteinForm):
             c = T.scalar(other)
             self._check_scalar_kind(c)
             with flint.ctx.workprec(self.prec or flint.ctx.prec):
-                return BernsteinForm.from_raw(self.shape, [x * c for x in self.coeffs], self.box, self.prec)
-        if other.box != self.box:
-            raise ValueError(f"Bernstein forms on different boxes: {self.box} and {other.box}")
+                return self.from_raw(self.shape, [x * c for x in self.coeffs], self.box, self.prec)
+        if type(other) is not type(self) or other.box != self.box:
+            raise ValueError(f"forms on different boxes or bases: {self.box} and {other.box}")
         prec = T.join_prec(self.prec, other.prec)
-        wa = T.weights(self.shape, [binomials(n - 1) for n in self.shape])
-        wb = T.weights(other.shape, [binomials(n - 1) for n in other.shape])
+        wa, wb = self._weights(self.shape), self._weights(other.shape)
         with flint.ctx.workprec(prec or flint.ctx.prec):
             a = [c * w for c, w in zip(T.convert(self.coeffs, prec), wa)]
             b = [c * w for c, w in zip(T.convert(other.coeffs, prec), wb)]
         c, shape = T.multiply(a, self.shape, b, other.shape, prec)
-        wc = T.weights(shape, [binomials(n - 1) for n in shape])
+        wc = self._weights(shape)
         with flint.ctx.workprec(prec or flint.ctx.prec):
             c = [x / w for x, w in zip(c, wc)]
-        return BernsteinForm.from_raw(shape, c, self.box, prec)
+        return self.from_raw(shape, c, self.box, prec)
 
     __rmul__ = __mul__
+
+    def _weights(self, shape):
+        return T.weights(shape, [[1] * n if a < self.POWER_AXES else binomials(n - 1) for a, n in enumerate(shape)])
 
     def __truediv__(self, c):
         """Division by a non-zero scalar."""
@@ -256,7 +275,7 @@ class BernsteinForm:
                 raise ZeroDivisionError("Bernstein form divided by zero")
             return self * (1 / c)
         with flint.ctx.workprec(self.prec):
-            return BernsteinForm.from_raw(self.shape, [x / c for x in self.coeffs], self.box, self.prec)
+            return self.from_raw(self.shape, [x / c for x in self.coeffs], self.box, self.prec)
 
 
 # ---------------------------------------------------------------------------- conversion
@@ -401,7 +420,7 @@ def certainly_positive(form):
 
 def _coefficients(form):
     if isinstance(form, BernsteinForm):
-        return form.coeffs
+        return form.bernstein().coeffs
     if isinstance(form, (arb, fmpq, fmpz, int)) and not isinstance(form, bool):
         return [form]
     return list(form)
