@@ -10,7 +10,7 @@ Since the basis functions are non-negative and sum to one on ``B``, ``min b <= f
 all ``arb``; in the ball case every returned coefficient encloses the exact coefficient for every
 choice of real inputs in the input balls.
 
->>> from ccproof.rigorous.poly import Poly
+>>> from ccproof.rigorous import Poly, bernstein_coefficients
 >>> x, y = Poly.variable(0, 2), Poly.variable(1, 2)
 >>> f = bernstein_coefficients(x * y - x / 4 + 1, box=[(0, 1), (0, 1)])
 >>> f.coeffs
@@ -22,13 +22,20 @@ choice of real inputs in the input balls.
 ((3/4, 7/4), True)
 """
 
-from math import comb
 
 import flint
-from flint import arb, fmpq, fmpq_mat, fmpz
+from flint import arb, fmpq, fmpz
 
 from . import _tensor as T
-from .poly import Poly, check_box, taylor_shift_matrix
+from .matrices import (
+    bernstein_to_power_matrix,
+    binomials,
+    conversion_matrix,
+    derivative_matrix,
+    elevation_matrix,
+    restrict_matrix,
+    split_matrix,
+)
 
 _HALF = fmpq(1, 2)
 
@@ -49,6 +56,7 @@ class BernsteinForm:
 
     Examples
     --------
+    >>> from ccproof.rigorous import Poly
     >>> b = BernsteinForm((3,), [0, 0, 1])
     >>> b.to_poly() == Poly.variable(0, 1) ** 2, b.degrees, b.box
     (True, (2,), ((0, 1),))
@@ -158,7 +166,9 @@ class BernsteinForm:
         return self._along(axis, derivative_matrix(n, hi - lo), self.box[axis])
 
     def to_poly(self):
-        """The polynomial in the original (box) variables, in the power basis."""
+        """The polynomial in the original (box) variables, in the power basis (a :class:`~.poly.Poly`)."""
+        from .poly import Poly
+
         f = self.bernstein()
         mats = [bernstein_to_power_matrix(n - 1) for n in f.shape]
         c, shape = T.apply_all_axes(f.coeffs, f.shape, mats, f.prec)
@@ -300,44 +310,43 @@ def unit_box(nvars):
     return ((fmpq(0), fmpq(1)),) * nvars
 
 
-def bernstein_coefficients(poly, box=None, degrees=None):
-    """Bernstein form of ``poly`` on ``box`` (default [0,1]^n) of ``degrees`` (default ``poly.degrees``).
-
-    Per variable, one exact matrix (Taylor shift to the box, then power -> Bernstein basis with
-    degree elevation) is applied along the axis; exact input gives exact ``fmpq`` coefficients,
-    ball input gives balls at ``poly.prec``.  For tight balls on small sub-boxes prefer converting
-    once on a large box and then using :meth:`BernsteinForm.split` / :meth:`BernsteinForm.restrict`
-    (both numerically stable) over re-expanding the power form on each sub-box.
+def check_box(box, nvars):
+    """``box`` as a tuple of ``nvars`` pairs ``(lo, hi)`` of fmpq with ``lo < hi``.
 
     Parameters
     ----------
-    poly : Poly
-    box : sequence of nvars pairs (lo, hi), optional
-    degrees : tuple of int, optional: at least ``poly.degrees`` (higher ones elevate the degree)
+    box : sequence of nvars pairs of exact numbers (int, fmpq, "p/q")
+    nvars : int
 
     Returns
     -------
-    BernsteinForm of shape ``degrees + 1``
+    tuple of nvars (fmpq, fmpq)
+
+    Raises
+    ------
+    ValueError
+        On a wrong number of intervals or an empty or degenerate one.
 
     Examples
     --------
-    x^2 on [1, 3] is (1 + 2t)^2 = (1 - t)^2 + 3 * 2t(1 - t) + 9 t^2:
-
-    >>> x = Poly.variable(0, 1)
-    >>> bernstein_coefficients(x**2, box=[(1, 3)]).coeffs, bernstein_coefficients(x, degrees=(2,)).coeffs
-    ([1, 3, 9], [0, 1/2, 1])
+    >>> check_box([(0, 1), ("1/2", 1)], 2)
+    ((0, 1), (1/2, 1))
+    >>> check_box([(1, 1)], 1)
+    Traceback (most recent call last):
+    ...
+    ValueError: empty or degenerate interval [1, 1]
     """
-    if not isinstance(poly, Poly):
-        raise TypeError(f"expected a Poly, got {type(poly).__name__}")
-    box = unit_box(poly.nvars) if box is None else check_box(box, poly.nvars)
-    degrees = poly.degrees if degrees is None else tuple(degrees)
-    if len(degrees) != poly.nvars or any(
-        isinstance(d, bool) or not isinstance(d, int) or d < n for d, n in zip(degrees, poly.degrees)
-    ):
-        raise ValueError(f"Bernstein degrees {degrees} below the polynomial's degrees {poly.degrees}")
-    mats = [conversion_matrix(n - 1, d, lo, hi) for n, d, (lo, hi) in zip(poly.shape, degrees, box)]
-    c, shape = T.apply_all_axes(poly.coeffs, poly.shape, mats, poly.prec)
-    return BernsteinForm.from_raw(shape, c, box, poly.prec)
+    box = tuple(box)
+    if len(box) != nvars:
+        raise ValueError(f"box with {len(box)} intervals for {nvars} variables")
+    out = []
+    for iv in box:
+        lo, hi = iv
+        lo, hi = T.exact_scalar(lo), T.exact_scalar(hi)
+        if not lo < hi:
+            raise ValueError(f"empty or degenerate interval [{lo}, {hi}]")
+        out.append((lo, hi))
+    return tuple(out)
 
 
 def range_enclosure(form):
@@ -359,6 +368,7 @@ def range_enclosure(form):
     --------
     x (1 - x) has range [0, 1/4] on [0, 1]; its coefficients (0, 1/2, 0) enclose it:
 
+    >>> from ccproof.rigorous import Poly, bernstein_coefficients
     >>> x = Poly.variable(0, 1)
     >>> range_enclosure(bernstein_coefficients(x * (1 - x)))
     (0, 1/2)
@@ -426,142 +436,52 @@ def _coefficients(form):
     return list(form)
 
 
-# ---------------------------------------------------------------------------- exact matrices
+def jacobian_determinant(components, variables=None):
+    """det of ``(d components[i] / d x_{variables[j]})`` for 1 to 4 components (Laplace expansion), in the
+    components' own arithmetic: power form, Bernstein form on their common box, or Taylor model (z kept).
 
-_CACHE = {}
+    ``variables`` defaults to ``0 .. len(components)-1``; extra variables act as parameters.
 
+    Parameters
+    ----------
+    components : sequence of n Poly, BernsteinForm or TaylorForm (1 <= n <= 4), anything with ``diff``
+    variables : tuple of n distinct int, optional (for a TaylorForm, x axes >= 1)
 
-def _cached(key, build):
-    mat = _CACHE.get(key)
-    if mat is None:
-        mat = build()
-        if len(_CACHE) > 8192:
-            _CACHE.clear()
-        _CACHE[key] = mat
-    return mat
-
-
-def _matrix(rows, cols, entry):
-    return fmpq_mat(rows, cols, [fmpq(entry(i, j)) for i in range(rows) for j in range(cols)])
-
-
-def _C(n, k):
-    """Binomial coefficient, zero outside 0 <= k <= n."""
-    return comb(n, k) if 0 <= k <= n else 0
-
-
-def binomials(n):
-    """[C(n, 0), ..., C(n, n)] (fmpz): the scaling of degree-n Bernstein coefficients."""
-    return [fmpz(comb(n, i)) for i in range(n + 1)]
-
-
-def power_to_bernstein_matrix(n, d):
-    """(d+1) x (n+1) ``fmpq_mat``: power coefficients of degree n -> Bernstein ones of degree d >= n on [0,1].
-
-    b_k = sum_i C(k, i) / C(d, i) a_i.
+    Returns
+    -------
+    Poly, BernsteinForm or TaylorForm
+        det J, whose sign decides local injectivity (docs/readings.md R7; e.g. det J_Phi of the
+        characteristic map).
 
     Examples
     --------
-    >>> (power_to_bernstein_matrix(1, 2) * fmpq_mat(2, 1, [0, 1])).entries()   # x in degree 2
-    [0, 1/2, 1]
+    For z^2 = (x^2 - y^2, 2 x y) (Cauchy-Riemann: det J = |2 z|^2):
+
+    >>> from ccproof.rigorous import Poly
+    >>> x, y = Poly.variable(0, 2), Poly.variable(1, 2)
+    >>> jacobian_determinant([x**2 - y**2, 2 * x * y]) == 4 * x**2 + 4 * y**2
+    True
     """
-    return _cached(("p2b", n, d), lambda: _matrix(d + 1, n + 1, lambda k, i: fmpq(_C(k, i), comb(d, i))))
+    components = list(components)
+    n = len(components)
+    if not 1 <= n <= T.MAX_VARS:
+        raise ValueError(f"Jacobian of {n} components")
+    variables = tuple(range(n)) if variables is None else tuple(variables)
+    if len(variables) != n or len(set(variables)) != n:
+        raise ValueError(f"need {n} distinct variables, got {variables!r}")
+    jac = [[g.diff(v) for v in variables] for g in components]
+    return _det(jac)
 
 
-def bernstein_to_power_matrix(n):
-    """(n+1) x (n+1) ``fmpq_mat``: Bernstein coefficients of degree n on [0,1] -> power coefficients.
-
-    a_i = sum_k (-1)^(i-k) C(n, i) C(i, k) b_k (the inverse of :func:`power_to_bernstein_matrix` ``(n, n)``).
-
-    Examples
-    --------
-    >>> (bernstein_to_power_matrix(2) * fmpq_mat(3, 1, [0, 1, 0])).entries()   # 2 x (1 - x)
-    [0, 2, -2]
-    """
-
-    def entry(i, k):
-        return (-1) ** ((i - k) % 2) * _C(n, i) * _C(i, k)
-
-    return _cached(("b2p", n), lambda: _matrix(n + 1, n + 1, entry))
-
-
-def elevation_matrix(n, d):
-    """(d+1) x (n+1) ``fmpq_mat``: Bernstein degree elevation n -> d: b'_k = sum_i C(n,i) C(d-n,k-i) / C(d,k) b_i.
-
-    Examples
-    --------
-    >>> (elevation_matrix(1, 3) * fmpq_mat(2, 1, [0, 1])).entries()   # x in degree 3
-    [0, 1/3, 2/3, 1]
-    """
-
-    def entry(k, i):
-        return fmpq(_C(n, i) * _C(d - n, k - i), comb(d, k))
-
-    return _cached(("elev", n, d), lambda: _matrix(d + 1, n + 1, entry))
-
-
-def split_matrix(n, t, side):
-    """De Casteljau at ``t``: side 0 gives the coefficients on [0, t], side 1 on [t, 1].
-
-    side 0: b'_i = sum_{j <= i} C(i, j) t^j (1-t)^(i-j) b_j;
-    side 1: b'_i = sum_{j >= i} C(n-i, j-i) t^(j-i) (1-t)^(n-j) b_j.  Exact (n+1) x (n+1) ``fmpq_mat``.
-
-    Examples
-    --------
-    >>> (split_matrix(2, fmpq(1, 2), 0) * fmpq_mat(3, 1, [0, 0, 1])).entries()   # x^2 on [0, 1/2]
-    [0, 0, 1/4]
-    """
-    s = 1 - t
-
-    def left(i, j):
-        return _C(i, j) * t**j * s ** (i - j) if j <= i else 0
-
-    def right(i, j):
-        return _C(n - i, j - i) * t ** (j - i) * s ** (n - j) if j >= i else 0
-
-    return _cached(("split", n, t, side), lambda: _matrix(n + 1, n + 1, right if side else left))
-
-
-def restrict_matrix(n, a, b):
-    """(n+1) x (n+1) ``fmpq_mat``: Bernstein coefficients of degree n on [0,1] -> on [a, b] (0 <= a < b <= 1).
-
-    Examples
-    --------
-    >>> (restrict_matrix(1, fmpq(1, 4), fmpq(1, 2)) * fmpq_mat(2, 1, [0, 1])).entries()   # x
-    [1/4, 1/2]
-    """
-
-    def build():
-        mat = split_matrix(n, b, 0) if b < 1 else None
-        if a > 0:
-            right = split_matrix(n, a / b, 1)
-            mat = right if mat is None else right * mat
-        return mat if mat is not None else _matrix(n + 1, n + 1, lambda i, j: int(i == j))
-
-    return _cached(("restrict", n, a, b), build)
-
-
-def derivative_matrix(n, h):
-    """n x (n+1) ``fmpq_mat`` (1 x 1 zero when n = 0): Bernstein coefficients of f' for an interval of width h.
-
-    Examples
-    --------
-    >>> (derivative_matrix(2, fmpq(1, 2)) * fmpq_mat(3, 1, [0, 0, 1])).entries()   # 4 x^2 on [0, 1/2]
-    [0, 4]
-    """
-    if n == 0:
-        return _cached(("diff", 0), lambda: fmpq_mat(1, 1, [0]))
-    return _cached(
-        ("diff", n, h),
-        lambda: _matrix(n, n + 1, lambda i, j: n / h if j == i + 1 else -n / h if j == i else 0),
-    )
-
-
-def conversion_matrix(n, d, lo, hi):
-    """Power coefficients of degree n on [lo, hi] -> Bernstein ones of degree d >= n (cached)."""
-    if (lo, hi) == (0, 1):
-        return power_to_bernstein_matrix(n, d)
-    return _cached(
-        ("conv", n, d, lo, hi),
-        lambda: power_to_bernstein_matrix(n, d) * taylor_shift_matrix(n, lo, hi - lo),
-    )
+def _det(m):
+    n = len(m)
+    if n == 1:
+        return m[0][0]
+    if n == 2:
+        return m[0][0] * m[1][1] - m[0][1] * m[1][0]
+    total = None
+    for j in range(n):
+        minor = [row[:j] + row[j + 1 :] for row in m[1:]]
+        term = m[0][j] * _det(minor)
+        total = term if total is None else (total + term if j % 2 == 0 else total - term)
+    return total

@@ -14,6 +14,7 @@ of the size of the values (a power basis in ``x`` would add the absolute values 
 which cancel heavily at high degree).
 
 >>> from flint import arb
+>>> from ccproof.rigorous import Poly
 >>> x = TaylorForm.variable(1, 1, prec=64)               # x_1 on [0,1]
 >>> z = TaylorForm.from_poly(Poly.variable(0, 2), 64)   # z on [-1, 1]
 >>> f = (x * z + 1) * (x * z - 1)                        # x^2 z^2 - 1
@@ -30,8 +31,8 @@ import flint
 from flint import arb
 
 from . import _tensor as T
-from .bernstein import BernsteinForm, power_to_bernstein_matrix, unit_box
-from .poly import Poly
+from .bernstein import BernsteinForm, unit_box
+from .matrices import power_to_bernstein_matrix
 
 ZBOX = (T.exact_scalar(-1), T.exact_scalar(1))
 
@@ -60,6 +61,7 @@ class TaylorForm(BernsteinForm):
     --------
     x^2 + z y: z-degree 1, Bernstein coefficients in (x, y) of x^2 (0, 0, 1) and of y (0, 1):
 
+    >>> from ccproof.rigorous import Poly
     >>> z, x, y = (Poly.variable(i, 3) for i in range(3))
     >>> f = TaylorForm.from_poly(x * x + z * y, 53)
     >>> f.shape, [c.str(3, radius=False) for c in f.coeffs]
@@ -78,6 +80,8 @@ class TaylorForm(BernsteinForm):
     @classmethod
     def from_poly(cls, poly, prec):
         """The power-basis :class:`Poly` ``poly`` in (z, x_1, ..., x_d), x in the Bernstein basis on [0,1]^d."""
+        from .poly import Poly
+
         if not isinstance(poly, Poly) or poly.nvars < 2:
             raise TypeError("expected a Poly in (z, x_1, ...), at least 2 variables")
         coeffs, shape = T.convert(poly.coeffs, prec), poly.shape

@@ -137,8 +137,9 @@ def test_weight_is_the_bspline_sum_R5():
         f, g = b[p], b[p + 1]
         for _ in range(3):
             assert f(x) == g(x)
-            f, g = f.diff(0), g.diff(0)
-    assert b[2](fmpq(1, 2)) == 0 and b[2].diff(0)(fmpq(1, 2)) == 0 and b[2].diff(0).diff(0)(fmpq(1, 2)) == 0
+            f, g = f.derivative(), g.derivative()
+    d = b[2].derivative()
+    assert b[2](fmpq(1, 2)) == 0 and d(fmpq(1, 2)) == 0 and d.derivative()(fmpq(1, 2)) == 0
 
 
 def test_every_valence_3_to_39_has_a_certificate():
@@ -193,6 +194,17 @@ def test_c1_tampering_rejected():
     assert any("FAIL  spectral ordering" in s and "mode-0" in s for s in lines)
 
 
+def _compose(b, X):
+    """b(X) for an fmpq_poly b and a Poly X (Horner)."""
+    from ccproof.rigorous import Poly
+
+    c = b.coeffs()
+    acc = Poly.constant(c[-1], X.nvars, X.prec)
+    for a in c[-2::-1]:
+        acc = acc * X + a
+    return acc
+
+
 def cell_det_poly(nets, lam, N, l, m, p, q, prec):
     """det dG/d(s,t) on cell (l, m) for the w piece (p, q), directly on the cell's own restricted nets (not
     from one form per piece restricted, as the verifier does); G = w y + (1 - w) Phi (docs/readings.md R6)."""
@@ -207,7 +219,7 @@ def cell_det_poly(nets, lam, N, l, m, p, q, prec):
         Y = M.net_form(nets[name], 1, prec, box).to_poly() * li
         s, t = Poly.variable(0, 2), Poly.variable(1, 2)
         y1, y2 = (s + l) * fmpq(1, 2**N), (t + m) * fmpq(1, 2**N)
-        w = M.weight_piece(p).compose([X]) * M.weight_piece(q).compose([Y])
+        w = _compose(M.weight_piece(p), X) * _compose(M.weight_piece(q), Y)
         return jacobian_determinant([X + w * (y1 - X), Y + w * (y2 - Y)])
 
 
