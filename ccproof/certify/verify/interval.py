@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from flint import arb, arb_mat, ctx, fmpq, fmpq_mat, fmpq_poly
 
-from ccproof.rigorous import TaylorForm, conversion_matrix, range_enclosure
+from ccproof.rigorous import BernsteinForm, TaylorForm, conversion_matrix, range_enclosure
 
 from .errors import CertificateError
 from .maps import cell_geometry, cell_pieces, det_form, dyadic_cells, net_form
@@ -208,7 +208,7 @@ def interval_cells(znets, N, D, prec, symmetric=False):
 
     Examples
     --------
-    The same cells as :func:`.maps.required_cells` for k = 4 at N = 1:
+    For k = 4 at N = 1 (the cells :func:`valence_cells` gives at lam = 1/2):
 
     >>> from ccproof.certify.verify.statement import derivation
     >>> from ccproof.rigorous import range_enclosure
@@ -253,3 +253,31 @@ def lam_interval_ok(k0, La, Lb, prec):
     """
     with ctx.workprec(prec):
         return bool(c_lam(k0, prec)[1] >= La) and bool((3 + arb(5).sqrt()) / 8 <= Lb)
+
+
+def valence_cells(nets, lam, N, prec, symmetric=False):
+    """Part D for one valence: :func:`interval_cells` of the arb nets as Taylor models of degree 0 in zeta
+    (``lam^i`` times the nets on layer i), the zeta axis dropped from each root (the boxes of one valence split
+    (s, t) only).
+
+    Returns
+    -------
+    list of (str, callable () -> BernsteinForm)
+        Keys ``"l,m,p,q"``; the roots on [0, 1]^2.
+
+    Examples
+    --------
+    >>> from ccproof.certify.verify.statement import nets_for_valence
+    >>> cells = valence_cells(nets_for_valence(4, 64), c_lam(4, 64)[1], 1, 64)   # k = 4: Phi is the identity
+    >>> [key for key, _ in cells][:3], cells[-1][1]().box, cells[-1][1]().coeffs[0].str(6, radius=False)
+    (['0,1,0,2', '0,1,1,2', '0,1,2,2'], ((0, 1), (0, 1)), '0.250000')
+    """
+    with ctx.workprec(prec):
+        zn = {i: {n: [[tuple([x * lam**i] for x in pt) for pt in row] for row in net] for n, net in nets.items()}
+              for i in range(N)}
+
+    def flat(build):
+        f = build()
+        return BernsteinForm.from_raw(f.shape[1:], f.coeffs, f.box[1:], f.prec)
+
+    return [(key, lambda b=build: flat(b)) for key, build in interval_cells(zn, N, 0, prec, symmetric)]
