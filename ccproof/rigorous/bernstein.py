@@ -28,7 +28,6 @@ from flint import arb, fmpq, fmpz
 
 from . import _tensor as T
 from .matrices import (
-    bernstein_to_power_matrix,
     binomials,
     conversion_matrix,
     derivative_matrix,
@@ -166,18 +165,10 @@ class BernsteinForm:
         return self._along(axis, derivative_matrix(n, hi - lo), self.box[axis])
 
     def to_poly(self):
-        """The polynomial in the original (box) variables, in the power basis (a :class:`~.poly.Poly`)."""
-        from .poly import Poly
+        """The polynomial in the original (box) variables, in the power basis (:func:`.poly.to_poly`)."""
+        from .poly import to_poly
 
-        f = self.bernstein()
-        mats = [bernstein_to_power_matrix(n - 1) for n in f.shape]
-        c, shape = T.apply_all_axes(f.coeffs, f.shape, mats, f.prec)
-        p = Poly.from_raw(shape, c, self.prec)
-        for axis, (lo, hi) in enumerate(f.box):
-            if (lo, hi) != (0, 1):
-                h = hi - lo
-                p = p.affine(axis, -lo / h, (1 - lo) / h)  # t = (x - lo) / h
-        return p
+        return to_poly(self)
 
     def bernstein(self):
         """The form with every axis in the Bernstein basis on its box (the power axes converted; else itself)."""

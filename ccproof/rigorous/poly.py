@@ -27,7 +27,7 @@ from flint import arb, fmpq
 from . import _tensor as T
 from ._tensor import MAX_VARS
 from .bernstein import BernsteinForm, check_box, unit_box
-from .matrices import conversion_matrix, taylor_shift_matrix
+from .matrices import bernstein_to_power_matrix, conversion_matrix, taylor_shift_matrix
 
 
 class Poly:
@@ -146,7 +146,7 @@ class Poly:
 
     def terms(self):
         """``{exponents: coefficient}`` for the coefficients that are not exactly zero."""
-        return {e: c for e, c in zip(T.multi_indices(self.shape), self.coeffs) if not _is_exact_zero(c)}
+        return {e: c for e, c in zip(multi_indices(self.shape), self.coeffs) if not _is_exact_zero(c)}
 
     def __repr__(self):
         kind = "exact" if self.prec is None else f"arb {self.prec} bits"
@@ -444,5 +444,46 @@ def bernstein_coefficients(poly, box=None, degrees=None):
     ):
         raise ValueError(f"Bernstein degrees {degrees} below the polynomial's degrees {poly.degrees}")
     mats = [conversion_matrix(n - 1, d, lo, hi) for n, d, (lo, hi) in zip(poly.shape, degrees, box)]
-    c, shape = T.apply_all_axes(poly.coeffs, poly.shape, mats, poly.prec)
+    c, shape = apply_all_axes(poly.coeffs, poly.shape, mats, poly.prec)
     return BernsteinForm.from_raw(shape, c, box, poly.prec)
+
+
+def to_poly(form):
+    """The polynomial of a :class:`~.bernstein.BernsteinForm` in the original (box) variables, in the power basis."""
+    f = form.bernstein()
+    mats = [bernstein_to_power_matrix(n - 1) for n in f.shape]
+    c, shape = apply_all_axes(f.coeffs, f.shape, mats, f.prec)
+    p = Poly.from_raw(shape, c, f.prec)
+    for axis, (lo, hi) in enumerate(f.box):
+        if (lo, hi) != (0, 1):
+            h = hi - lo
+            p = p.affine(axis, -lo / h, (1 - lo) / h)  # t = (x - lo) / h
+    return p
+
+
+def apply_all_axes(coeffs, shape, mats, prec):
+    """Apply ``mats[k]`` along every axis ``k`` (a tensor-product basis change).
+
+    Each step multiplies along the leading axis and transposes, which rotates the axes by one;
+    after one step per axis the original order is back, with no permutation done in Python.
+    """
+    if len(mats) != len(shape):
+        raise ValueError(f"{len(mats)} matrices for {len(shape)} axes")
+    with flint.ctx.workprec(prec or flint.ctx.prec):
+        for mat in mats:
+            n = shape[0]
+            if mat.ncols() != n:
+                raise ValueError(f"matrix with {mat.ncols()} columns applied to an axis of length {n}")
+            rest = T.size(shape[1:])
+            y = T.to_matrix(mat, prec) * T.new_matrix(n, rest, coeffs, prec)
+            coeffs = y.transpose().entries()
+            shape = shape[1:] + (mat.nrows(),)
+    return coeffs, shape
+
+
+def multi_indices(shape):
+    """All exponent tuples of ``shape`` in row-major order."""
+    out = [()]
+    for n in shape:
+        out = [e + (k,) for e in out for k in range(n)]
+    return out
