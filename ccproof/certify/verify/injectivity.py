@@ -165,46 +165,44 @@ def check_parts(parts, nets, lam, N, prec, cells, part, tag):
     part(f"{tag}A corner cell maps into [0,1/6)^2", okA, "" if okA else f"lam^N * max = {value.str(6)}")
     if part.failed:
         return
-    _check_sections(parts, "regularity", "B det J_Phi > 0 on layer 0", lambda n: regularity_form(nets, n, prec),
-                    part, tag)
+    patches = form_patches(derivation().symmetric)
+    _replay([(n, lambda n=n: regularity_form(nets, n, prec)) for n in patches], parts["regularity"],
+            "B det J_Phi > 0 on layer 0", "regularity", part, tag)
     if part.failed:
         return
     part(f"{tag}C [0,1/2]^2 inside Phi([0,1]^2)", square_inside_image(nets))
     if part.failed:
         return
-    required = {key for key, _ in cells}
-    extra = sorted(set(parts["cells"]) - required)
+    extra = sorted(set(parts["cells"]) - {key for key, _ in cells})
     if extra:
         part(f"{tag}D cells", False, f"cell(s) {', '.join(extra[:5])} are not required by the statement "
              "(a certificate holds nothing unchecked)")
         return
-    minD, nboxes = None, 0
-    for key, build in cells:
-        boxes = parts["cells"].get(key)
-        if boxes is None:
-            part(f"{tag}D cell {key}", False, "required (l, m, p, q) not in the certificate")
-            return
-        ok, msg, mb = check_boxes(build(), boxes, f"cell {key}")
-        nboxes += len(boxes)
-        if not ok:
-            part(f"{tag}D cell {key}", False, msg)
-            return
-        minD = mb if minD is None or mb < minD else minD
-    part(f"{tag}D det J_G > 0 on every cell != (0,0)", True, f"{len(cells)} cells, {nboxes} boxes, min bound {minD}",
-         minD, "cells")
-    _check_sections(parts, "corner", "E det J_G / h^2 > 0 on the corner cell (all layers >= N)",
-                    lambda n: corner_det_form(nets, lam, N, n, prec), part, tag)
+    _replay(cells, parts["cells"], "D det J_G > 0 on every cell != (0,0)", "cells", part, tag, "cell")
+    if part.failed:
+        return
+    _replay([(n, lambda n=n: corner_det_form(nets, lam, N, n, prec)) for n in patches], parts["corner"],
+            "E det J_G / h^2 > 0 on the corner cell (all layers >= N)", "corner", part, tag)
 
 
-def _check_sections(parts, sec, label, build, part, tag):
-    mins = []
-    for name in form_patches(derivation().symmetric):
-        ok, msg, mb = check_boxes(build(name), parts[sec][name], f"{sec} {name}")
-        if not ok:
-            part(f"{tag}{label[0]} {sec} {name}", False, msg)
+def _replay(roots, boxes, label, sec, part, tag, what=None):
+    """Replay the boxes ``boxes[key]`` on every (key, build root) of ``roots``: one failed part naming the first
+    key (as ``what`` key: default the section ``sec``) whose boxes fail or are missing, else one passed part
+    ``label`` with the least bound (the margin of ``sec``, in the local variables)."""
+    what = what or sec
+    least, count = None, 0
+    for key, build in roots:
+        if key not in boxes:
+            part(f"{tag}{label[0]} {what} {key}", False, "required by the statement, not in the certificate")
             return
-        mins.append(mb)
-    part(f"{tag}{label}", True, f"min bound {min(mins)} (w.r.t. the local variables)", min(mins), sec)
+        ok, msg, mb = check_boxes(build(), boxes[key], f"{what} {key}")
+        count += len(boxes[key])
+        if not ok:
+            part(f"{tag}{label[0]} {what} {key}", False, msg)
+            return
+        least = mb if least is None or mb < least else least
+    part(f"{tag}{label}", True, f"{len(roots)} forms, {count} boxes, min bound {least} (w.r.t. the local variables)",
+         least, sec)
 
 
 def read_lam_pieces(pieces, read_parts):
