@@ -20,14 +20,12 @@ from flint import arb, ctx, fmpq
 
 from ccproof.certify.verify import C1_SCHEMA, SCHEMA
 from ccproof.certify.verify.injectivity import MAX_LEVEL, form_patches
-from ccproof.certify.verify.interval import hull_nets, interval_cells, lam_interval_ok, parameter_nets
+from ccproof.certify.verify.interval import hull_nets, interval_cells, lam_interval_ok, parameter_nets, valence_cells
 from ccproof.certify.verify.maps import (
     STAR_CURVES,
-    cell_det_builder,
     corner_containment,
     corner_det_form,
     regularity_form,
-    required_cells,
     square_inside_image,
     star_form,
 )
@@ -169,17 +167,13 @@ def prove_valence(k: int, prec: int = DEFAULT_PREC, progress: bool = True) -> di
         N = _smallest_level(nets, lam)
         regularity = {n: prove_positive(regularity_form(nets, n, prec), (0, 1), f"det J_Phi on {n}")
                       for n in form_patches(derivation().symmetric)}
-        cells = {}
-        todo = required_cells(nets, lam, N, prec, derivation().symmetric)
+        todo = valence_cells(nets, lam, N, prec, derivation().symmetric)
         it = todo
         if progress:
             from tqdm import tqdm
 
             it = tqdm(todo, desc=f"k={k} cells", unit="cell", leave=False)
-        build = cell_det_builder(nets, lam, N, prec)
-        for l, m, p, q in it:
-            root = build(l, m, p, q)
-            cells[f"{l},{m},{p},{q}"] = prove_positive(root, (0, 1), f"cell ({l},{m}) piece ({p},{q})")
+        cells = {key: prove_positive(build(), (0, 1), f"cell {key}") for key, build in it}
         corner = {n: prove_positive(corner_det_form(nets, lam, N, n, prec), (2, 3, 0, 1),
                                     f"corner {n}") for n in form_patches(derivation().symmetric)}
     boxes = sum(len(b) for part in (regularity, cells, corner) for b in part.values())

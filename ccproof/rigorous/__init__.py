@@ -16,23 +16,35 @@ Guarantees
   ``range_enclosure(bernstein_coefficients(p, box))`` brackets ``p`` on the whole box and
   ``certainly_positive`` (every coefficient certainly > 0, finite) proves ``p > 0`` on it.
 
-Main entry points: :class:`Poly`, :func:`jacobian_determinant` (of power, Bernstein or Taylor forms),
-:func:`bernstein_coefficients`, :class:`BernsteinForm` (``split``, ``restrict``, ``elevate``, ``diff``, ``+ - *``),
+Main entry points: :class:`BernsteinForm` (``split``, ``restrict``, ``elevate``, ``diff``, ``+ - *``),
 :func:`range_enclosure`, :func:`certainly_positive`, :func:`ball_contains`,
 :class:`TaylorForm` (a Taylor model in one parameter with
-Bernstein coefficients in the other variables, ``truncate``, ``bernstein``).  See ``docs/rigorous.md``.
+Bernstein coefficients in the other variables, ``truncate``, ``bernstein``), :func:`jacobian_determinant` (of
+Bernstein or Taylor forms, or of polynomials).  :class:`Poly` (polynomials in the power basis) and
+:func:`bernstein_coefficients` (their Bernstein forms) are the exact reference of the tests; the
+verifier uses neither, so they are loaded only when named.  See ``docs/rigorous.md``.
 """
 
 from ._tensor import ball_contains, exact_fmpq
 from .bernstein import (
     BernsteinForm,
-    bernstein_coefficients,
     certainly_positive,
+    jacobian_determinant,
     range_enclosure,
     unit_box,
 )
-from .poly import Poly, jacobian_determinant
+from .matrices import conversion_matrix
 from .taylor import TaylorForm
+
+
+def __getattr__(name):
+    """:class:`Poly` and :func:`bernstein_coefficients` (module :mod:`.poly`), imported when first named."""
+    if name in ("Poly", "bernstein_coefficients"):
+        from . import poly
+
+        return getattr(poly, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 __all__ = [
     "BernsteinForm",
@@ -41,6 +53,7 @@ __all__ = [
     "ball_contains",
     "bernstein_coefficients",
     "certainly_positive",
+    "conversion_matrix",
     "exact_fmpq",
     "jacobian_determinant",
     "range_enclosure",

@@ -140,7 +140,7 @@ def _arb_matrix(mat, prec):
     return out
 
 
-def _new_matrix(rows, cols, entries, prec):
+def new_matrix(rows, cols, entries, prec):
     return fmpq_mat(rows, cols, entries) if prec is None else arb_mat(rows, cols, entries)
 
 
@@ -159,35 +159,15 @@ def apply_along_axis(coeffs, shape, axis, mat, prec):
     with flint.ctx.workprec(prec or flint.ctx.prec):
         M = to_matrix(mat, prec)
         if pre == 1:  # leading axis: the tensor is an n x post matrix
-            return (M * _new_matrix(n, post, coeffs, prec)).entries(), new_shape
+            return (M * new_matrix(n, post, coeffs, prec)).entries(), new_shape
         if post == 1:  # trailing axis: a pre x n matrix, multiplied by M^T on the right
-            return (_new_matrix(pre, n, coeffs, prec) * M.transpose()).entries(), new_shape
+            return (new_matrix(pre, n, coeffs, prec) * M.transpose()).entries(), new_shape
         rest = pre * post
         # X[i, p*post + q] = c[(p*n + i)*post + q]
         x = [coeffs[(p * n + i) * post + q] for i in range(n) for p in range(pre) for q in range(post)]
-        y = (M * _new_matrix(n, rest, x, prec)).entries()
+        y = (M * new_matrix(n, rest, x, prec)).entries()
     out = [y[j * rest + p * post + q] for p in range(pre) for j in range(m) for q in range(post)]
     return out, new_shape
-
-
-def apply_all_axes(coeffs, shape, mats, prec):
-    """Apply ``mats[k]`` along every axis ``k`` (a tensor-product basis change).
-
-    Each step multiplies along the leading axis and transposes, which rotates the axes by one;
-    after one step per axis the original order is back, with no permutation done in Python.
-    """
-    if len(mats) != len(shape):
-        raise ValueError(f"{len(mats)} matrices for {len(shape)} axes")
-    with flint.ctx.workprec(prec or flint.ctx.prec):
-        for mat in mats:
-            n = shape[0]
-            if mat.ncols() != n:
-                raise ValueError(f"matrix with {mat.ncols()} columns applied to an axis of length {n}")
-            rest = size(shape[1:])
-            y = to_matrix(mat, prec) * _new_matrix(n, rest, coeffs, prec)
-            coeffs = y.transpose().entries()
-            shape = shape[1:] + (mat.nrows(),)
-    return coeffs, shape
 
 
 def multiply(a, a_shape, b, b_shape, prec):
@@ -238,14 +218,6 @@ def embed_indices(shape, strides):
     for n, s in zip(shape, strides):
         idx = [i + k * s for i in idx for k in range(n)]
     return tuple(idx)
-
-
-def multi_indices(shape):
-    """All exponent tuples of ``shape`` in row-major order."""
-    out = [()]
-    for n in shape:
-        out = [e + (k,) for e in out for k in range(n)]
-    return out
 
 
 def weights(shape, per_axis):

@@ -10,7 +10,7 @@ Since the basis functions are non-negative and sum to one on ``B``, ``min b <= f
 all ``arb``; in the ball case every returned coefficient encloses the exact coefficient for every
 choice of real inputs in the input balls.
 
->>> from ccproof.rigorous.poly import Poly
+>>> from ccproof.rigorous import Poly, bernstein_coefficients
 >>> x, y = Poly.variable(0, 2), Poly.variable(1, 2)
 >>> f = bernstein_coefficients(x * y - x / 4 + 1, box=[(0, 1), (0, 1)])
 >>> f.coeffs
@@ -22,13 +22,19 @@ choice of real inputs in the input balls.
 ((3/4, 7/4), True)
 """
 
-from math import comb
 
 import flint
-from flint import arb, fmpq, fmpq_mat, fmpz
+from flint import arb, fmpq, fmpz
 
 from . import _tensor as T
-from .poly import Poly, check_box, taylor_shift_matrix
+from .matrices import (
+    binomials,
+    conversion_matrix,
+    derivative_matrix,
+    elevation_matrix,
+    restrict_matrix,
+    split_matrix,
+)
 
 _HALF = fmpq(1, 2)
 
@@ -49,12 +55,15 @@ class BernsteinForm:
 
     Examples
     --------
+    >>> from ccproof.rigorous import Poly
     >>> b = BernsteinForm((3,), [0, 0, 1])
     >>> b.to_poly() == Poly.variable(0, 1) ** 2, b.degrees, b.box
     (True, (2,), ((0, 1),))
     """
 
     __slots__ = ("shape", "coeffs", "box", "prec")
+    #: leading axes in the power basis (a :class:`~ccproof.rigorous.TaylorForm`'s parameter z: 1), the others Bernstein
+    POWER_AXES = 0
 
     def __init__(self, shape, coeffs, box=None, prec=None):
         shape = tuple(shape)
@@ -102,7 +111,7 @@ class BernsteinForm:
         """Ball version at ``prec`` bits."""
         if T.check_prec(prec) is None:
             raise ValueError("to_arb needs a precision in bits")
-        return BernsteinForm.from_raw(self.shape, T.convert(self.coeffs, prec), self.box, prec)
+        return self.from_raw(self.shape, T.convert(self.coeffs, prec), self.box, prec)
 
     # ------------------------------------------------------------------ subdivision
 
@@ -112,7 +121,7 @@ class BernsteinForm:
         With the default ``t = 1/2`` the sub-boxes of a dyadic box are dyadic and the matrices are
         dyadic (exact in ``arb``); the result is exact for exact input.
         """
-        axis = self._axis(axis)
+        axis = self._axis(axis, bernstein=True)
         t = T.exact_scalar(t)
         if not 0 < t < 1:
             raise ValueError(f"split fraction must lie in (0, 1), got {t}")
@@ -130,7 +139,7 @@ class BernsteinForm:
         for axis, ((lo, hi), (a, b)) in enumerate(zip(self.box, box)):
             if (a, b) == (lo, hi):
                 continue
-            if a < lo or b > hi:
+            if a < lo or b > hi or axis < self.POWER_AXES:
                 raise ValueError(f"[{a}, {b}] is not inside [{lo}, {hi}] (axis {axis})")
             h = hi - lo
             f = f._along(axis, restrict_matrix(f.shape[axis] - 1, (a - lo) / h, (b - lo) / h), (a, b))
@@ -142,44 +151,51 @@ class BernsteinForm:
         if len(degrees) != self.nvars or any(d < n - 1 for d, n in zip(degrees, self.shape)):
             raise ValueError(f"cannot elevate degrees {self.degrees} to {degrees}")
         f = self
-        for axis, d in enumerate(degrees):
+        for axis, d in enumerate(degrees[self.POWER_AXES:], self.POWER_AXES):
             if d != f.shape[axis] - 1:
                 f = f._along(axis, elevation_matrix(f.shape[axis] - 1, d), self.box[axis])
-        return f
+        shape = tuple(d + 1 for d in degrees[:self.POWER_AXES]) + f.shape[self.POWER_AXES:]  # power axes: zeros
+        return f if shape == f.shape else f.from_raw(shape, T.pad(f.coeffs, f.shape, shape, f.prec), f.box, f.prec)
 
     def diff(self, axis):
         """Bernstein form (degree one less along ``axis``) of the partial derivative on the box."""
-        axis = self._axis(axis)
+        axis = self._axis(axis, bernstein=True)
         n = self.shape[axis] - 1
         lo, hi = self.box[axis]
         return self._along(axis, derivative_matrix(n, hi - lo), self.box[axis])
 
     def to_poly(self):
-        """The polynomial in the original (box) variables, in the power basis."""
-        mats = [bernstein_to_power_matrix(n - 1) for n in self.shape]
-        c, shape = T.apply_all_axes(self.coeffs, self.shape, mats, self.prec)
-        p = Poly.from_raw(shape, c, self.prec)
-        for axis, (lo, hi) in enumerate(self.box):
-            if (lo, hi) != (0, 1):
-                h = hi - lo
-                p = p.affine(axis, -lo / h, (1 - lo) / h)  # t = (x - lo) / h
-        return p
+        """The polynomial in the original (box) variables, in the power basis (:func:`.poly.to_poly`)."""
+        from .poly import to_poly
+
+        return to_poly(self)
+
+    def bernstein(self):
+        """The form with every axis in the Bernstein basis on its box (the power axes converted; else itself)."""
+        f = self
+        for axis in range(self.POWER_AXES):
+            n = f.shape[axis] - 1
+            c, shape = T.apply_along_axis(f.coeffs, f.shape, axis, conversion_matrix(n, n, *f.box[axis]), f.prec)
+            f = BernsteinForm.from_raw(shape, c, f.box, f.prec)
+        return f
 
     def _along(self, axis, mat, interval):
         c, shape = T.apply_along_axis(self.coeffs, self.shape, axis, mat, self.prec)
         box = self.box[:axis] + (interval,) + self.box[axis + 1 :]
-        return BernsteinForm.from_raw(shape, c, box, self.prec)
+        return self.from_raw(shape, c, box, self.prec)
 
-    def _axis(self, axis):
+    def _axis(self, axis, bernstein=False):
         if isinstance(axis, bool) or not isinstance(axis, int) or not 0 <= axis < self.nvars:
             raise ValueError(f"axis {axis!r} out of range for {self.nvars} variables")
+        if bernstein and axis < self.POWER_AXES:
+            raise ValueError(f"axis {axis!r} is in the power basis (not an x axis)")
         return axis
 
     # ------------------------------------------------------------------ arithmetic (same box)
 
     def _common(self, other):
-        if not isinstance(other, BernsteinForm):
-            raise TypeError(f"expected a BernsteinForm, got {type(other).__name__}")
+        if type(other) is not type(self):
+            raise TypeError(f"expected a {type(self).__name__}, got {type(other).__name__}")
         if other.box != self.box:
             raise ValueError(f"Bernstein forms on different boxes: {self.box} and {other.box}")
         prec = T.join_prec(self.prec, other.prec)
@@ -192,7 +208,7 @@ class BernsteinForm:
             return self._shift(T.scalar(other), 1)
         a, b, shape, prec = self._common(other)
         with flint.ctx.workprec(prec or flint.ctx.prec):
-            return BernsteinForm.from_raw(shape, [x + y for x, y in zip(a, b)], self.box, prec)
+            return self.from_raw(shape, [x + y for x, y in zip(a, b)], self.box, prec)
 
     __radd__ = __add__
 
@@ -201,20 +217,21 @@ class BernsteinForm:
             return self._shift(T.scalar(other), -1)
         a, b, shape, prec = self._common(other)
         with flint.ctx.workprec(prec or flint.ctx.prec):
-            return BernsteinForm.from_raw(shape, [x - y for x, y in zip(a, b)], self.box, prec)
+            return self.from_raw(shape, [x - y for x, y in zip(a, b)], self.box, prec)
 
     def __rsub__(self, other):
         return (-self)._shift(T.scalar(other), 1)
 
     def __neg__(self):
-        return BernsteinForm.from_raw(self.shape, [-c for c in self.coeffs], self.box, self.prec)
+        return self.from_raw(self.shape, [-c for c in self.coeffs], self.box, self.prec)
 
     def _shift(self, c, sign):
-        # adding a constant adds it to every coefficient (partition of unity)
+        # a constant is added to every coefficient (partition of unity) of the power axes' degree 0
         self._check_scalar_kind(c)
+        n = T.size(self.shape[self.POWER_AXES:])
         with flint.ctx.workprec(self.prec or flint.ctx.prec):
-            out = [x + c for x in self.coeffs] if sign > 0 else [x - c for x in self.coeffs]
-        return BernsteinForm.from_raw(self.shape, out, self.box, self.prec)
+            out = [x + c for x in self.coeffs[:n]] if sign > 0 else [x - c for x in self.coeffs[:n]]
+        return self.from_raw(self.shape, out + self.coeffs[n:], self.box, self.prec)
 
     def _check_scalar_kind(self, c):
         if isinstance(c, arb) and self.prec is None:
@@ -224,28 +241,31 @@ class BernsteinForm:
         """Product on the same box, of degree ``m + n``, computed in Bernstein form.
 
         With ``a~_i = C(m, i) a_i`` (coefficients in the basis t^i (1-t)^(m-i)), the product's
-        scaled coefficients are the plain convolution of ``a~`` and ``b~``; divide by C(m+n, k).
+        scaled coefficients are the plain convolution of ``a~`` and ``b~``; divide by C(m+n, k). Along a power
+        axis the weights are 1 (a plain convolution).
         """
         if not isinstance(other, BernsteinForm):
             c = T.scalar(other)
             self._check_scalar_kind(c)
             with flint.ctx.workprec(self.prec or flint.ctx.prec):
-                return BernsteinForm.from_raw(self.shape, [x * c for x in self.coeffs], self.box, self.prec)
-        if other.box != self.box:
-            raise ValueError(f"Bernstein forms on different boxes: {self.box} and {other.box}")
+                return self.from_raw(self.shape, [x * c for x in self.coeffs], self.box, self.prec)
+        if type(other) is not type(self) or other.box != self.box:
+            raise ValueError(f"forms on different boxes or bases: {self.box} and {other.box}")
         prec = T.join_prec(self.prec, other.prec)
-        wa = T.weights(self.shape, [binomials(n - 1) for n in self.shape])
-        wb = T.weights(other.shape, [binomials(n - 1) for n in other.shape])
+        wa, wb = self._weights(self.shape), self._weights(other.shape)
         with flint.ctx.workprec(prec or flint.ctx.prec):
             a = [c * w for c, w in zip(T.convert(self.coeffs, prec), wa)]
             b = [c * w for c, w in zip(T.convert(other.coeffs, prec), wb)]
         c, shape = T.multiply(a, self.shape, b, other.shape, prec)
-        wc = T.weights(shape, [binomials(n - 1) for n in shape])
+        wc = self._weights(shape)
         with flint.ctx.workprec(prec or flint.ctx.prec):
             c = [x / w for x, w in zip(c, wc)]
-        return BernsteinForm.from_raw(shape, c, self.box, prec)
+        return self.from_raw(shape, c, self.box, prec)
 
     __rmul__ = __mul__
+
+    def _weights(self, shape):
+        return T.weights(shape, [[1] * n if a < self.POWER_AXES else binomials(n - 1) for a, n in enumerate(shape)])
 
     def __truediv__(self, c):
         """Division by a non-zero scalar."""
@@ -256,7 +276,7 @@ class BernsteinForm:
                 raise ZeroDivisionError("Bernstein form divided by zero")
             return self * (1 / c)
         with flint.ctx.workprec(self.prec):
-            return BernsteinForm.from_raw(self.shape, [x / c for x in self.coeffs], self.box, self.prec)
+            return self.from_raw(self.shape, [x / c for x in self.coeffs], self.box, self.prec)
 
 
 # ---------------------------------------------------------------------------- conversion
@@ -281,44 +301,43 @@ def unit_box(nvars):
     return ((fmpq(0), fmpq(1)),) * nvars
 
 
-def bernstein_coefficients(poly, box=None, degrees=None):
-    """Bernstein form of ``poly`` on ``box`` (default [0,1]^n) of ``degrees`` (default ``poly.degrees``).
-
-    Per variable, one exact matrix (Taylor shift to the box, then power -> Bernstein basis with
-    degree elevation) is applied along the axis; exact input gives exact ``fmpq`` coefficients,
-    ball input gives balls at ``poly.prec``.  For tight balls on small sub-boxes prefer converting
-    once on a large box and then using :meth:`BernsteinForm.split` / :meth:`BernsteinForm.restrict`
-    (both numerically stable) over re-expanding the power form on each sub-box.
+def check_box(box, nvars):
+    """``box`` as a tuple of ``nvars`` pairs ``(lo, hi)`` of fmpq with ``lo < hi``.
 
     Parameters
     ----------
-    poly : Poly
-    box : sequence of nvars pairs (lo, hi), optional
-    degrees : tuple of int, optional: at least ``poly.degrees`` (higher ones elevate the degree)
+    box : sequence of nvars pairs of exact numbers (int, fmpq, "p/q")
+    nvars : int
 
     Returns
     -------
-    BernsteinForm of shape ``degrees + 1``
+    tuple of nvars (fmpq, fmpq)
+
+    Raises
+    ------
+    ValueError
+        On a wrong number of intervals or an empty or degenerate one.
 
     Examples
     --------
-    x^2 on [1, 3] is (1 + 2t)^2 = (1 - t)^2 + 3 * 2t(1 - t) + 9 t^2:
-
-    >>> x = Poly.variable(0, 1)
-    >>> bernstein_coefficients(x**2, box=[(1, 3)]).coeffs, bernstein_coefficients(x, degrees=(2,)).coeffs
-    ([1, 3, 9], [0, 1/2, 1])
+    >>> check_box([(0, 1), ("1/2", 1)], 2)
+    ((0, 1), (1/2, 1))
+    >>> check_box([(1, 1)], 1)
+    Traceback (most recent call last):
+    ...
+    ValueError: empty or degenerate interval [1, 1]
     """
-    if not isinstance(poly, Poly):
-        raise TypeError(f"expected a Poly, got {type(poly).__name__}")
-    box = unit_box(poly.nvars) if box is None else check_box(box, poly.nvars)
-    degrees = poly.degrees if degrees is None else tuple(degrees)
-    if len(degrees) != poly.nvars or any(
-        isinstance(d, bool) or not isinstance(d, int) or d < n for d, n in zip(degrees, poly.degrees)
-    ):
-        raise ValueError(f"Bernstein degrees {degrees} below the polynomial's degrees {poly.degrees}")
-    mats = [conversion_matrix(n - 1, d, lo, hi) for n, d, (lo, hi) in zip(poly.shape, degrees, box)]
-    c, shape = T.apply_all_axes(poly.coeffs, poly.shape, mats, poly.prec)
-    return BernsteinForm.from_raw(shape, c, box, poly.prec)
+    box = tuple(box)
+    if len(box) != nvars:
+        raise ValueError(f"box with {len(box)} intervals for {nvars} variables")
+    out = []
+    for iv in box:
+        lo, hi = iv
+        lo, hi = T.exact_scalar(lo), T.exact_scalar(hi)
+        if not lo < hi:
+            raise ValueError(f"empty or degenerate interval [{lo}, {hi}]")
+        out.append((lo, hi))
+    return tuple(out)
 
 
 def range_enclosure(form):
@@ -340,6 +359,7 @@ def range_enclosure(form):
     --------
     x (1 - x) has range [0, 1/4] on [0, 1]; its coefficients (0, 1/2, 0) enclose it:
 
+    >>> from ccproof.rigorous import Poly, bernstein_coefficients
     >>> x = Poly.variable(0, 1)
     >>> range_enclosure(bernstein_coefficients(x * (1 - x)))
     (0, 1/2)
@@ -401,148 +421,58 @@ def certainly_positive(form):
 
 def _coefficients(form):
     if isinstance(form, BernsteinForm):
-        return form.coeffs
+        return form.bernstein().coeffs
     if isinstance(form, (arb, fmpq, fmpz, int)) and not isinstance(form, bool):
         return [form]
     return list(form)
 
 
-# ---------------------------------------------------------------------------- exact matrices
+def jacobian_determinant(components, variables=None):
+    """det of ``(d components[i] / d x_{variables[j]})`` for 1 to 4 components (Laplace expansion), in the
+    components' own arithmetic: power form, Bernstein form on their common box, or Taylor model (z kept).
 
-_CACHE = {}
+    ``variables`` defaults to ``0 .. len(components)-1``; extra variables act as parameters.
 
+    Parameters
+    ----------
+    components : sequence of n Poly, BernsteinForm or TaylorForm (1 <= n <= 4), anything with ``diff``
+    variables : tuple of n distinct int, optional (for a TaylorForm, x axes >= 1)
 
-def _cached(key, build):
-    mat = _CACHE.get(key)
-    if mat is None:
-        mat = build()
-        if len(_CACHE) > 8192:
-            _CACHE.clear()
-        _CACHE[key] = mat
-    return mat
-
-
-def _matrix(rows, cols, entry):
-    return fmpq_mat(rows, cols, [fmpq(entry(i, j)) for i in range(rows) for j in range(cols)])
-
-
-def _C(n, k):
-    """Binomial coefficient, zero outside 0 <= k <= n."""
-    return comb(n, k) if 0 <= k <= n else 0
-
-
-def binomials(n):
-    """[C(n, 0), ..., C(n, n)] (fmpz): the scaling of degree-n Bernstein coefficients."""
-    return [fmpz(comb(n, i)) for i in range(n + 1)]
-
-
-def power_to_bernstein_matrix(n, d):
-    """(d+1) x (n+1) ``fmpq_mat``: power coefficients of degree n -> Bernstein ones of degree d >= n on [0,1].
-
-    b_k = sum_i C(k, i) / C(d, i) a_i.
+    Returns
+    -------
+    Poly, BernsteinForm or TaylorForm
+        det J, whose sign decides local injectivity (docs/readings.md R7; e.g. det J_Phi of the
+        characteristic map).
 
     Examples
     --------
-    >>> (power_to_bernstein_matrix(1, 2) * fmpq_mat(2, 1, [0, 1])).entries()   # x in degree 2
-    [0, 1/2, 1]
+    For z^2 = (x^2 - y^2, 2 x y) (Cauchy-Riemann: det J = |2 z|^2):
+
+    >>> from ccproof.rigorous import Poly
+    >>> x, y = Poly.variable(0, 2), Poly.variable(1, 2)
+    >>> jacobian_determinant([x**2 - y**2, 2 * x * y]) == 4 * x**2 + 4 * y**2
+    True
     """
-    return _cached(("p2b", n, d), lambda: _matrix(d + 1, n + 1, lambda k, i: fmpq(_C(k, i), comb(d, i))))
+    components = list(components)
+    n = len(components)
+    if not 1 <= n <= T.MAX_VARS:
+        raise ValueError(f"Jacobian of {n} components")
+    variables = tuple(range(n)) if variables is None else tuple(variables)
+    if len(variables) != n or len(set(variables)) != n:
+        raise ValueError(f"need {n} distinct variables, got {variables!r}")
+    jac = [[g.diff(v) for v in variables] for g in components]
+    return _det(jac)
 
 
-def bernstein_to_power_matrix(n):
-    """(n+1) x (n+1) ``fmpq_mat``: Bernstein coefficients of degree n on [0,1] -> power coefficients.
-
-    a_i = sum_k (-1)^(i-k) C(n, i) C(i, k) b_k (the inverse of :func:`power_to_bernstein_matrix` ``(n, n)``).
-
-    Examples
-    --------
-    >>> (bernstein_to_power_matrix(2) * fmpq_mat(3, 1, [0, 1, 0])).entries()   # 2 x (1 - x)
-    [0, 2, -2]
-    """
-
-    def entry(i, k):
-        return (-1) ** ((i - k) % 2) * _C(n, i) * _C(i, k)
-
-    return _cached(("b2p", n), lambda: _matrix(n + 1, n + 1, entry))
-
-
-def elevation_matrix(n, d):
-    """(d+1) x (n+1) ``fmpq_mat``: Bernstein degree elevation n -> d: b'_k = sum_i C(n,i) C(d-n,k-i) / C(d,k) b_i.
-
-    Examples
-    --------
-    >>> (elevation_matrix(1, 3) * fmpq_mat(2, 1, [0, 1])).entries()   # x in degree 3
-    [0, 1/3, 2/3, 1]
-    """
-
-    def entry(k, i):
-        return fmpq(_C(n, i) * _C(d - n, k - i), comb(d, k))
-
-    return _cached(("elev", n, d), lambda: _matrix(d + 1, n + 1, entry))
-
-
-def split_matrix(n, t, side):
-    """De Casteljau at ``t``: side 0 gives the coefficients on [0, t], side 1 on [t, 1].
-
-    side 0: b'_i = sum_{j <= i} C(i, j) t^j (1-t)^(i-j) b_j;
-    side 1: b'_i = sum_{j >= i} C(n-i, j-i) t^(j-i) (1-t)^(n-j) b_j.  Exact (n+1) x (n+1) ``fmpq_mat``.
-
-    Examples
-    --------
-    >>> (split_matrix(2, fmpq(1, 2), 0) * fmpq_mat(3, 1, [0, 0, 1])).entries()   # x^2 on [0, 1/2]
-    [0, 0, 1/4]
-    """
-    s = 1 - t
-
-    def left(i, j):
-        return _C(i, j) * t**j * s ** (i - j) if j <= i else 0
-
-    def right(i, j):
-        return _C(n - i, j - i) * t ** (j - i) * s ** (n - j) if j >= i else 0
-
-    return _cached(("split", n, t, side), lambda: _matrix(n + 1, n + 1, right if side else left))
-
-
-def restrict_matrix(n, a, b):
-    """(n+1) x (n+1) ``fmpq_mat``: Bernstein coefficients of degree n on [0,1] -> on [a, b] (0 <= a < b <= 1).
-
-    Examples
-    --------
-    >>> (restrict_matrix(1, fmpq(1, 4), fmpq(1, 2)) * fmpq_mat(2, 1, [0, 1])).entries()   # x
-    [1/4, 1/2]
-    """
-
-    def build():
-        mat = split_matrix(n, b, 0) if b < 1 else None
-        if a > 0:
-            right = split_matrix(n, a / b, 1)
-            mat = right if mat is None else right * mat
-        return mat if mat is not None else _matrix(n + 1, n + 1, lambda i, j: int(i == j))
-
-    return _cached(("restrict", n, a, b), build)
-
-
-def derivative_matrix(n, h):
-    """n x (n+1) ``fmpq_mat`` (1 x 1 zero when n = 0): Bernstein coefficients of f' for an interval of width h.
-
-    Examples
-    --------
-    >>> (derivative_matrix(2, fmpq(1, 2)) * fmpq_mat(3, 1, [0, 0, 1])).entries()   # 4 x^2 on [0, 1/2]
-    [0, 4]
-    """
-    if n == 0:
-        return _cached(("diff", 0), lambda: fmpq_mat(1, 1, [0]))
-    return _cached(
-        ("diff", n, h),
-        lambda: _matrix(n, n + 1, lambda i, j: n / h if j == i + 1 else -n / h if j == i else 0),
-    )
-
-
-def conversion_matrix(n, d, lo, hi):
-    """Power coefficients of degree n on [lo, hi] -> Bernstein ones of degree d >= n (cached)."""
-    if (lo, hi) == (0, 1):
-        return power_to_bernstein_matrix(n, d)
-    return _cached(
-        ("conv", n, d, lo, hi),
-        lambda: power_to_bernstein_matrix(n, d) * taylor_shift_matrix(n, lo, hi - lo),
-    )
+def _det(m):
+    n = len(m)
+    if n == 1:
+        return m[0][0]
+    if n == 2:
+        return m[0][0] * m[1][1] - m[0][1] * m[1][0]
+    total = None
+    for j in range(n):
+        minor = [row[:j] + row[j + 1 :] for row in m[1:]]
+        term = m[0][j] * _det(minor)
+        total = term if total is None else (total + term if j % 2 == 0 else total - term)
+    return total

@@ -21,13 +21,13 @@ True
 True
 """
 
-from math import comb
-
 import flint
-from flint import arb, fmpq, fmpq_mat
+from flint import arb, fmpq
 
 from . import _tensor as T
 from ._tensor import MAX_VARS
+from .bernstein import BernsteinForm, check_box, unit_box
+from .matrices import bernstein_to_power_matrix, conversion_matrix, taylor_shift_matrix
 
 
 class Poly:
@@ -146,7 +146,7 @@ class Poly:
 
     def terms(self):
         """``{exponents: coefficient}`` for the coefficients that are not exactly zero."""
-        return {e: c for e, c in zip(T.multi_indices(self.shape), self.coeffs) if not _is_exact_zero(c)}
+        return {e: c for e, c in zip(multi_indices(self.shape), self.coeffs) if not _is_exact_zero(c)}
 
     def __repr__(self):
         kind = "exact" if self.prec is None else f"arb {self.prec} bits"
@@ -399,45 +399,6 @@ class Poly:
 # ---------------------------------------------------------------------------- helpers
 
 
-def check_box(box, nvars):
-    """``box`` as a tuple of ``nvars`` pairs ``(lo, hi)`` of fmpq with ``lo < hi``.
-
-    Parameters
-    ----------
-    box : sequence of nvars pairs of exact numbers (int, fmpq, "p/q")
-    nvars : int
-
-    Returns
-    -------
-    tuple of nvars (fmpq, fmpq)
-
-    Raises
-    ------
-    ValueError
-        On a wrong number of intervals or an empty or degenerate one.
-
-    Examples
-    --------
-    >>> check_box([(0, 1), ("1/2", 1)], 2)
-    ((0, 1), (1/2, 1))
-    >>> check_box([(1, 1)], 1)
-    Traceback (most recent call last):
-    ...
-    ValueError: empty or degenerate interval [1, 1]
-    """
-    box = tuple(box)
-    if len(box) != nvars:
-        raise ValueError(f"box with {len(box)} intervals for {nvars} variables")
-    out = []
-    for iv in box:
-        lo, hi = iv
-        lo, hi = T.exact_scalar(lo), T.exact_scalar(hi)
-        if not lo < hi:
-            raise ValueError(f"empty or degenerate interval [{lo}, {hi}]")
-        out.append((lo, hi))
-    return tuple(out)
-
-
 def _check_nvars(nvars):
     if isinstance(nvars, bool) or not isinstance(nvars, int) or not 1 <= nvars <= MAX_VARS:
         raise ValueError(f"number of variables must be 1..{MAX_VARS}, got {nvars!r}")
@@ -447,92 +408,82 @@ def _is_exact_zero(c):
     return c == 0 if isinstance(c, fmpq) else c.is_zero()
 
 
-_SHIFT = {}
+def bernstein_coefficients(poly, box=None, degrees=None):
+    """Bernstein form of ``poly`` on ``box`` (default [0,1]^n) of ``degrees`` (default ``poly.degrees``).
 
-
-def taylor_shift_matrix(n, a, h):
-    """Exact matrix sending the coefficients of p(x) (degree n) to those of p(a + h x).
-
-    Parameters
-    ----------
-    n : int
-    a, h : fmpq
-
-    Returns
-    -------
-    fmpq_mat, shape (n + 1, n + 1)
-        Entry (j, i) is ``C(i, j) a^(i-j) h^j``; the Taylor shift to a box before the Bernstein
-        conversion (docs/rigorous.md "API").
-
-    Examples
-    --------
-    x^2 becomes (1 + 2 x)^2 = 1 + 4 x + 4 x^2:
-
-    >>> taylor_shift_matrix(2, fmpq(1), fmpq(2)) * fmpq_mat(3, 1, [0, 0, 1])
-    [1]
-    [4]
-    [4]
-    """
-    key = (n, a, h)
-    mat = _SHIFT.get(key)
-    if mat is None:
-        entries = [
-            fmpq(comb(i, j)) * a ** (i - j) * h**j if i >= j else fmpq(0)
-            for j in range(n + 1)
-            for i in range(n + 1)
-        ]
-        mat = fmpq_mat(n + 1, n + 1, entries)
-        if len(_SHIFT) > 4096:
-            _SHIFT.clear()
-        _SHIFT[key] = mat
-    return mat
-
-
-def jacobian_determinant(components, variables=None):
-    """det of ``(d components[i] / d x_{variables[j]})`` for 1 to 4 components (Laplace expansion), in the
-    components' own arithmetic: power form, Bernstein form on their common box, or Taylor model (z kept).
-
-    ``variables`` defaults to ``0 .. len(components)-1``; extra variables act as parameters.
+    Per variable, one exact matrix (Taylor shift to the box, then power -> Bernstein basis with
+    degree elevation) is applied along the axis; exact input gives exact ``fmpq`` coefficients,
+    ball input gives balls at ``poly.prec``.  For tight balls on small sub-boxes prefer converting
+    once on a large box and then using :meth:`BernsteinForm.split` / :meth:`BernsteinForm.restrict`
+    (both numerically stable) over re-expanding the power form on each sub-box.
 
     Parameters
     ----------
-    components : sequence of n Poly, BernsteinForm or TaylorForm (1 <= n <= 4), anything with ``diff``
-    variables : tuple of n distinct int, optional (for a TaylorForm, x axes >= 1)
+    poly : Poly
+    box : sequence of nvars pairs (lo, hi), optional
+    degrees : tuple of int, optional: at least ``poly.degrees`` (higher ones elevate the degree)
 
     Returns
     -------
-    Poly, BernsteinForm or TaylorForm
-        det J, whose sign decides local injectivity (docs/readings.md R7; e.g. det J_Phi of the
-        characteristic map).
+    BernsteinForm of shape ``degrees + 1``
 
     Examples
     --------
-    For z^2 = (x^2 - y^2, 2 x y) (Cauchy-Riemann: det J = |2 z|^2):
+    x^2 on [1, 3] is (1 + 2t)^2 = (1 - t)^2 + 3 * 2t(1 - t) + 9 t^2:
 
-    >>> x, y = Poly.variable(0, 2), Poly.variable(1, 2)
-    >>> jacobian_determinant([x**2 - y**2, 2 * x * y]) == 4 * x**2 + 4 * y**2
-    True
+    >>> x = Poly.variable(0, 1)
+    >>> bernstein_coefficients(x**2, box=[(1, 3)]).coeffs, bernstein_coefficients(x, degrees=(2,)).coeffs
+    ([1, 3, 9], [0, 1/2, 1])
     """
-    components = list(components)
-    n = len(components)
-    if not 1 <= n <= MAX_VARS:
-        raise ValueError(f"Jacobian of {n} components")
-    variables = tuple(range(n)) if variables is None else tuple(variables)
-    if len(variables) != n or len(set(variables)) != n:
-        raise ValueError(f"need {n} distinct variables, got {variables!r}")
-    jac = [[g.diff(v) for v in variables] for g in components]
-    return _det(jac)
+    if not isinstance(poly, Poly):
+        raise TypeError(f"expected a Poly, got {type(poly).__name__}")
+    box = unit_box(poly.nvars) if box is None else check_box(box, poly.nvars)
+    degrees = poly.degrees if degrees is None else tuple(degrees)
+    if len(degrees) != poly.nvars or any(
+        isinstance(d, bool) or not isinstance(d, int) or d < n for d, n in zip(degrees, poly.degrees)
+    ):
+        raise ValueError(f"Bernstein degrees {degrees} below the polynomial's degrees {poly.degrees}")
+    mats = [conversion_matrix(n - 1, d, lo, hi) for n, d, (lo, hi) in zip(poly.shape, degrees, box)]
+    c, shape = apply_all_axes(poly.coeffs, poly.shape, mats, poly.prec)
+    return BernsteinForm.from_raw(shape, c, box, poly.prec)
 
 
-def _det(m):
-    n = len(m)
-    if n == 1:
-        return m[0][0]
-    if n == 2:
-        return m[0][0] * m[1][1] - m[0][1] * m[1][0]
-    total = None
-    for j in range(n):
-        minor = [row[:j] + row[j + 1 :] for row in m[1:]]
-        term = m[0][j] * _det(minor)
-        total = term if total is None else (total + term if j % 2 == 0 else total - term)
-    return total
+def to_poly(form):
+    """The polynomial of a :class:`~.bernstein.BernsteinForm` in the original (box) variables, in the power basis."""
+    f = form.bernstein()
+    mats = [bernstein_to_power_matrix(n - 1) for n in f.shape]
+    c, shape = apply_all_axes(f.coeffs, f.shape, mats, f.prec)
+    p = Poly.from_raw(shape, c, f.prec)
+    for axis, (lo, hi) in enumerate(f.box):
+        if (lo, hi) != (0, 1):
+            h = hi - lo
+            p = p.affine(axis, -lo / h, (1 - lo) / h)  # t = (x - lo) / h
+    return p
+
+
+def apply_all_axes(coeffs, shape, mats, prec):
+    """Apply ``mats[k]`` along every axis ``k`` (a tensor-product basis change).
+
+    Each step multiplies along the leading axis and transposes, which rotates the axes by one;
+    after one step per axis the original order is back, with no permutation done in Python.
+    """
+    if len(mats) != len(shape):
+        raise ValueError(f"{len(mats)} matrices for {len(shape)} axes")
+    with flint.ctx.workprec(prec or flint.ctx.prec):
+        for mat in mats:
+            n = shape[0]
+            if mat.ncols() != n:
+                raise ValueError(f"matrix with {mat.ncols()} columns applied to an axis of length {n}")
+            rest = T.size(shape[1:])
+            y = T.to_matrix(mat, prec) * T.new_matrix(n, rest, coeffs, prec)
+            coeffs = y.transpose().entries()
+            shape = shape[1:] + (mat.nrows(),)
+    return coeffs, shape
+
+
+def multi_indices(shape):
+    """All exponent tuples of ``shape`` in row-major order."""
+    out = [()]
+    for n in shape:
+        out = [e + (k,) for e in out for k in range(n)]
+    return out

@@ -64,7 +64,7 @@ REVIEWED = {
     ("statement.py", "a != 0"): "fmpq_poly (exact)",
     ("injectivity.py", 'param["variable"] != "lam"'): "strings",
     ("replay.py", '_TOKEN.sub("", path) != ""'): "strings",
-    ("poly.py", "not lo < hi"): "box endpoints are exact fmpq (check_box converts them)",
+    ("bernstein.py", "not lo < hi"): "box endpoints are exact fmpq (check_box converts them)",
     ("poly.py", "not 1 <= nvars <= MAX_VARS"): "ints",
     ("statement.py", "den.contains(0)"): "refuses to divide when the denominator may vanish (possibly 0 is intended)",
     ("_tensor.py", "ball.contains(value)"): "ball_contains: enclosure test, the intended meaning",

@@ -6,6 +6,7 @@ import json
 import pytest
 
 from ccproof.certify import verify as V
+from ccproof.certify.verify import interval as I
 from ccproof.certify.verify import maps as M
 from ccproof.certify.verify import replay as R
 from ccproof.certify.verify import statement as St
@@ -137,8 +138,9 @@ def test_weight_is_the_bspline_sum_R5():
         f, g = b[p], b[p + 1]
         for _ in range(3):
             assert f(x) == g(x)
-            f, g = f.diff(0), g.diff(0)
-    assert b[2](fmpq(1, 2)) == 0 and b[2].diff(0)(fmpq(1, 2)) == 0 and b[2].diff(0).diff(0)(fmpq(1, 2)) == 0
+            f, g = f.derivative(), g.derivative()
+    d = b[2].derivative()
+    assert b[2](fmpq(1, 2)) == 0 and d(fmpq(1, 2)) == 0 and d.derivative()(fmpq(1, 2)) == 0
 
 
 def test_every_valence_3_to_39_has_a_certificate():
@@ -193,6 +195,17 @@ def test_c1_tampering_rejected():
     assert any("FAIL  spectral ordering" in s and "mode-0" in s for s in lines)
 
 
+def _compose(b, X):
+    """b(X) for an fmpq_poly b and a Poly X (Horner)."""
+    from ccproof.rigorous import Poly
+
+    c = b.coeffs()
+    acc = Poly.constant(c[-1], X.nvars, X.prec)
+    for a in c[-2::-1]:
+        acc = acc * X + a
+    return acc
+
+
 def cell_det_poly(nets, lam, N, l, m, p, q, prec):
     """det dG/d(s,t) on cell (l, m) for the w piece (p, q), directly on the cell's own restricted nets (not
     from one form per piece restricted, as the verifier does); G = w y + (1 - w) Phi (docs/readings.md R6)."""
@@ -207,7 +220,7 @@ def cell_det_poly(nets, lam, N, l, m, p, q, prec):
         Y = M.net_form(nets[name], 1, prec, box).to_poly() * li
         s, t = Poly.variable(0, 2), Poly.variable(1, 2)
         y1, y2 = (s + l) * fmpq(1, 2**N), (t + m) * fmpq(1, 2**N)
-        w = M.weight_piece(p).compose([X]) * M.weight_piece(q).compose([Y])
+        w = _compose(M.weight_piece(p), X) * _compose(M.weight_piece(q), Y)
         return jacobian_determinant([X + w * (y1 - X), Y + w * (y2 - Y)])
 
 
@@ -230,8 +243,8 @@ def test_mirror_symmetry_of_the_exact_nets_and_its_consequence():
     with ctx.workprec(128):
         nets = St.nets_for_valence(5, 128)
         lam = St.c_lam(5, 128)[1]
-        full = M.required_cells(nets, lam, 3, 128)
-        half = M.required_cells(nets, lam, 3, 128, symmetric=True)
+        full = _cells(nets, lam, 3)
+        half = _cells(nets, lam, 3, symmetric=True)
         assert set(half) == {c for c in full if c[0] <= c[1]}
         assert {(m, l, q, p) for l, m, p, q in full} == set(full)  # the required set itself is symmetric
         for l, m, p, q in [(0, 1, 0, 0), (1, 6, 1, 2), (2, 7, 2, 2)]:
@@ -245,6 +258,11 @@ def test_mirror_symmetry_of_the_exact_nets_and_its_consequence():
                     assert x.overlaps(y) and abs(x.mid() - y.mid()) < 1e-30
 
 
+def _cells(nets, lam, N, symmetric=False):
+    """The (l, m, p, q) of part D for one valence, as the verifier lists them."""
+    return [tuple(map(int, key.split(","))) for key, _ in I.valence_cells(nets, lam, N, 128, symmetric)]
+
+
 def test_cell_forms_restricted_from_one_piece_form_equal_the_direct_cell_determinants():
     """The verifier builds det J_G once per (layer, piece, w piece) and restricts it to each cell (times
     h^2); the direct computation on the cell's own restricted nets must give the same Bernstein
@@ -256,13 +274,13 @@ def test_cell_forms_restricted_from_one_piece_form_equal_the_direct_cell_determi
     with ctx.workprec(128):
         nets = St.nets_for_valence(7, 128)
         lam = St.c_lam(7, 128)[1]
-        build = M.cell_det_builder(nets, lam, 4, 128)
-        cells = M.required_cells(nets, lam, 4, 128, symmetric=True)
+        builds = dict(I.valence_cells(nets, lam, 4, 128, symmetric=True))
+        cells = _cells(nets, lam, 4, symmetric=True)
         layers = {M.cell_geometry(l, m, 4)[0] for l, m, _, _ in cells}
         picked = [next(c for c in cells if M.cell_geometry(c[0], c[1], 4)[0] == i) for i in sorted(layers)]
         assert len(picked) == 4  # one cell on each layer 0..3 (h = 1/8 .. 1)
         for l, m, p, q in picked + cells[-3:]:
-            a = build(l, m, p, q)
+            a = builds[f"{l},{m},{p},{q}"]()
             b = bernstein_coefficients(cell_det_poly(nets, lam, 4, l, m, p, q, 128))
             assert a.shape == b.shape
             for x, y in zip(a.coeffs, b.coeffs):

@@ -18,15 +18,13 @@ import re
 from flint import arb, ctx, fmpq
 
 from .errors import CertificateError
-from .interval import hull_nets, interval_cells, lam_interval_ok, parameter_nets
+from .interval import hull_nets, interval_cells, lam_interval_ok, parameter_nets, valence_cells
 from .maps import (
     STAR_CURVES,
-    cell_det_builder,
     corner_containment,
     corner_det_form,
     curve_points,
     regularity_form,
-    required_cells,
     square_inside_image,
 )
 from .record import exact_keys, field_of, kname
@@ -135,48 +133,6 @@ def read_n_prec(cert):
     return N, prec
 
 
-def verify_valence(cert, k, part, log):
-    """One valence k (an int): parts S, H, A-E of an injectivity certificate (docs/certificates.md).
-
-    Parameters
-    ----------
-    cert : dict
-        Schema :data:`SCHEMA` with ``N``, ``prec`` and ``parts`` (``regularity``, ``cells``, ``corner``).
-
-    Raises
-    ------
-    CertificateError
-        On a malformed certificate.
-
-    Examples
-    --------
-    >>> verify_valence({"schema": SCHEMA, "valence": 5, "N": 3, "prec": 128}, 5, None, None)
-    Traceback (most recent call last):
-    ...
-    ccproof.certify.verify.errors.CertificateError: certificate: missing field(s) 'parts'
-    """
-    exact_keys(cert, ("schema", "valence", "N", "prec", "parts"), "certificate")
-    N, prec = read_n_prec(cert)
-    parts = field_of(cert, "parts", dict, "certificate")
-    _check_structure(parts, 2)
-    log(f"certificate for valence {k} (N = {N}, {prec} bits)")
-    if not check_derivation(part):
-        return
-    sym = derivation().symmetric
-    try:
-        nets = nets_for_valence(k, prec)
-    except StatementError as exc:
-        part("S nets of valence k in arb", False, str(exc))
-        return
-    with ctx.workprec(prec):
-        lam = c_lam(k, prec)[1]
-        check_hypotheses(nets, lam, part)
-        build = cell_det_builder(nets, lam, N, prec)
-        cells = [(f"{l},{m},{p},{q}", lambda c=(l, m, p, q): build(*c))
-                 for l, m, p, q in required_cells(nets, lam, N, prec, sym)]
-        check_parts(parts, nets, lam, N, prec, cells, part, "")
-
-
 def check_parts(parts, nets, lam, N, prec, cells, part, tag):
     """Parts A-E for the arb ``nets`` and ``lam``; ``cells`` lists (key, build root) of every required cell.
     Stops at the first failed part (it is named; the rest is moot).
@@ -209,46 +165,44 @@ def check_parts(parts, nets, lam, N, prec, cells, part, tag):
     part(f"{tag}A corner cell maps into [0,1/6)^2", okA, "" if okA else f"lam^N * max = {value.str(6)}")
     if part.failed:
         return
-    _check_sections(parts, "regularity", "B det J_Phi > 0 on layer 0", lambda n: regularity_form(nets, n, prec),
-                    part, tag)
+    patches = form_patches(derivation().symmetric)
+    _replay([(n, lambda n=n: regularity_form(nets, n, prec)) for n in patches], parts["regularity"],
+            "B det J_Phi > 0 on layer 0", "regularity", part, tag)
     if part.failed:
         return
     part(f"{tag}C [0,1/2]^2 inside Phi([0,1]^2)", square_inside_image(nets))
     if part.failed:
         return
-    required = {key for key, _ in cells}
-    extra = sorted(set(parts["cells"]) - required)
+    extra = sorted(set(parts["cells"]) - {key for key, _ in cells})
     if extra:
         part(f"{tag}D cells", False, f"cell(s) {', '.join(extra[:5])} are not required by the statement "
              "(a certificate holds nothing unchecked)")
         return
-    minD, nboxes = None, 0
-    for key, build in cells:
-        boxes = parts["cells"].get(key)
-        if boxes is None:
-            part(f"{tag}D cell {key}", False, "required (l, m, p, q) not in the certificate")
-            return
-        ok, msg, mb = check_boxes(build(), boxes, f"cell {key}")
-        nboxes += len(boxes)
-        if not ok:
-            part(f"{tag}D cell {key}", False, msg)
-            return
-        minD = mb if minD is None or mb < minD else minD
-    part(f"{tag}D det J_G > 0 on every cell != (0,0)", True, f"{len(cells)} cells, {nboxes} boxes, min bound {minD}",
-         minD, "cells")
-    _check_sections(parts, "corner", "E det J_G / h^2 > 0 on the corner cell (all layers >= N)",
-                    lambda n: corner_det_form(nets, lam, N, n, prec), part, tag)
+    _replay(cells, parts["cells"], "D det J_G > 0 on every cell != (0,0)", "cells", part, tag, "cell")
+    if part.failed:
+        return
+    _replay([(n, lambda n=n: corner_det_form(nets, lam, N, n, prec)) for n in patches], parts["corner"],
+            "E det J_G / h^2 > 0 on the corner cell (all layers >= N)", "corner", part, tag)
 
 
-def _check_sections(parts, sec, label, build, part, tag):
-    mins = []
-    for name in form_patches(derivation().symmetric):
-        ok, msg, mb = check_boxes(build(name), parts[sec][name], f"{sec} {name}")
-        if not ok:
-            part(f"{tag}{label[0]} {sec} {name}", False, msg)
+def _replay(roots, boxes, label, sec, part, tag, what=None):
+    """Replay the boxes ``boxes[key]`` on every (key, build root) of ``roots``: one failed part naming the first
+    key (as ``what`` key: default the section ``sec``) whose boxes fail or are missing, else one passed part
+    ``label`` with the least bound (the margin of ``sec``, in the local variables)."""
+    what = what or sec
+    least, count = None, 0
+    for key, build in roots:
+        if key not in boxes:
+            part(f"{tag}{label[0]} {what} {key}", False, "required by the statement, not in the certificate")
             return
-        mins.append(mb)
-    part(f"{tag}{label}", True, f"min bound {min(mins)} (w.r.t. the local variables)", min(mins), sec)
+        ok, msg, mb = check_boxes(build(), boxes[key], f"{what} {key}")
+        count += len(boxes[key])
+        if not ok:
+            part(f"{tag}{label[0]} {what} {key}", False, msg)
+            return
+        least = mb if least is None or mb < least else least
+    part(f"{tag}{label}", True, f"{len(roots)} forms, {count} boxes, min bound {least} (w.r.t. the local variables)",
+         least, sec)
 
 
 def read_lam_pieces(pieces, read_parts):
@@ -277,13 +231,21 @@ def read_lam_pieces(pieces, read_parts):
     return ends
 
 
-def verify_interval(cert, k, part, log):
-    """Every valence k >= k0 (``k = {"min": k0}``): lam pieces with Taylor models (:mod:`.interval`).
+def verify_injectivity(cert, k, part, log):
+    """An injectivity certificate (docs/appendix_a.md, docs/certificates.md): parts S, H, A-E for one valence
+    k (an int), or for every k >= k0 (``k = {"min": k0}``) on each lam piece with Taylor models
+    (:mod:`.interval`); one valence is one piece whose nets are those of lam(k) (:func:`_piece`).
 
     Parameters
     ----------
     cert : dict
-        Schema :data:`SCHEMA` with ``N``, ``prec``, ``parameter`` and ``pieces``.
+        Schema :data:`SCHEMA` with ``N``, ``prec`` and ``parts`` (``regularity``, ``cells``, ``corner``), or
+        for k >= k0 ``parameter`` and ``pieces`` in place of ``parts``.
+
+    Returns
+    -------
+    str
+        :func:`.record.kname` of k.
 
     Raises
     ------
@@ -292,15 +254,57 @@ def verify_interval(cert, k, part, log):
 
     Examples
     --------
+    >>> verify_injectivity({"schema": SCHEMA, "valence": 5, "N": 9, "prec": 128, "parts": {}}, 5, None, None)
+    Traceback (most recent call last):
+    ...
+    ccproof.certify.verify.errors.CertificateError: prec must lie in 64..1024 and N in 1..6
+    >>> verify_injectivity({"schema": SCHEMA, "valence": 5, "N": 3, "prec": 128}, 5, None, None)
+    Traceback (most recent call last):
+    ...
+    ccproof.certify.verify.errors.CertificateError: certificate: missing field(s) 'parts'
     >>> cert = {"schema": SCHEMA, "valence": {"min": 9}, "N": 3, "prec": 128, "pieces": [],
     ...         "parameter": {"variable": "c", "taylor_degree": 4, "truncation_degree": 2}}
-    >>> verify_interval(cert, cert["valence"], None, None)
+    >>> verify_injectivity(cert, cert["valence"], None, None)
     Traceback (most recent call last):
     ...
     ccproof.certify.verify.errors.CertificateError: parameter must be {'variable': 'lam', ...}
     """
-    exact_keys(cert, ("schema", "valence", "N", "prec", "parameter", "pieces"), "certificate")
+    N, prec, degrees, pieces, ends = _read(cert, k)
+    log(f"certificate for valence {k} (N = {N}, {prec} bits)" if not ends else
+        f"certificate for valences k >= {k['min']} (N = {N}, {prec} bits, {len(pieces)} lam piece(s), "
+        f"Taylor degree {degrees[0]}, truncation {degrees[1]})")
+    if not check_derivation(part):
+        return kname(k)
+    if ends:
+        part(f"lam(k) in [{ends[0][0]}, {ends[-1][1]}] for every k >= {k['min']}",
+             lam_interval_ok(k["min"], ends[0][0], ends[-1][1], prec))
+    for idx, pc in enumerate(pieces):
+        tag = f"[piece {idx}] " if ends else ""
+        if part.failed:
+            break
+        with ctx.workprec(prec):
+            try:
+                nets, lam, cells = _piece(k, ends[idx] if ends else None, N, prec, degrees)
+            except (StatementError, CertificateError) as exc:
+                part(f"{tag}S nets of the characteristic map", False, str(exc))
+                break
+            check_hypotheses(nets, lam, part, tag)
+            if not part.failed:
+                check_parts(pc["parts"], nets, lam, N, prec, cells, part, tag)
+    return kname(k)
+
+
+def _read(cert, k):
+    """(N, prec, (Taylor degree, truncation degree), pieces, exact ends of the lam pieces): one piece and no
+    ends for one valence; every box list read (its partition checked) before any arithmetic."""
+    every = isinstance(k, dict)
+    exact_keys(cert, ("schema", "valence", "N", "prec") + (("parameter", "pieces") if every else ("parts",)),
+               "certificate")
     N, prec = read_n_prec(cert)
+    if not every:
+        parts = field_of(cert, "parts", dict, "certificate")
+        _check_structure(parts, 2)
+        return N, prec, (0, 0), [{"parts": parts}], []
     param = field_of(cert, "parameter", dict, "certificate")
     exact_keys(param, ("variable", "taylor_degree", "truncation_degree"), "parameter")
     deg, D = field_of(param, "taylor_degree", int, "parameter"), field_of(param, "truncation_degree", int, "parameter")
@@ -310,49 +314,16 @@ def verify_interval(cert, k, part, log):
     ends = read_lam_pieces(pieces, lambda parts: _check_structure(parts, 3))
     if not (ends[0][0] > fmpq(1, 4) and ends[-1][1] < 1):
         raise CertificateError("the lam pieces must lie inside (1/4, 1)")
-    log(f"certificate for valences k >= {k['min']} (N = {N}, {prec} bits, {len(pieces)} lam piece(s), "
-        f"Taylor degree {deg}, truncation {D})")
-    if not check_derivation(part):
-        return
-    exact = derivation().integer_forms("bspline")
+    return N, prec, (deg, D), pieces, ends
+
+
+def _piece(k, ends, N, prec, degrees):
+    """(nets, lam, cells of part D) of one valence k (``ends`` None: the arb nets at lam(k)) or of the lam piece
+    ``ends`` = (La, Lb) (the hulls of the Taylor models in lam, lam in [La, Lb])."""
     sym = derivation().symmetric
-    ok = lam_interval_ok(k["min"], ends[0][0], ends[-1][1], prec)
-    part(f"lam(k) in [{ends[0][0]}, {ends[-1][1]}] for every k >= {k['min']}", ok)
-    for idx, ((La, Lb), pc) in enumerate(zip(ends, pieces)):
-        if part.failed:
-            return
-        with ctx.workprec(prec):
-            try:
-                zn = [parameter_nets(exact, La, Lb, i, deg, prec) for i in range(N)]
-            except CertificateError as exc:
-                part(f"[piece {idx}] S nets as Taylor models", False, str(exc))
-                return
-            nets = hull_nets(zn[0], prec)
-            lam = arb(La).union(arb(Lb))
-            check_hypotheses(nets, lam, part, f"[piece {idx}] ")
-            if part.failed:
-                return
-            check_parts(pc["parts"], nets, lam, N, prec, interval_cells(zn, N, D, prec, sym), part,
-                        f"[piece {idx}] ")
-
-
-def verify_injectivity(cert, k, part, log):
-    """An injectivity certificate (docs/appendix_a.md): :func:`verify_interval` or :func:`verify_valence`.
-
-    Returns
-    -------
-    str
-        :func:`.record.kname` of k.
-
-    Examples
-    --------
-    >>> verify_injectivity({"schema": SCHEMA, "valence": 5, "N": 9, "prec": 128, "parts": {}}, 5, None, None)
-    Traceback (most recent call last):
-    ...
-    ccproof.certify.verify.errors.CertificateError: prec must lie in 64..1024 and N in 1..6
-    """
-    if isinstance(k, dict):
-        verify_interval(cert, k, part, log)
-    else:
-        verify_valence(cert, k, part, log)
-    return kname(k)
+    if ends is None:
+        nets, lam = nets_for_valence(k, prec), c_lam(k, prec)[1]
+        return nets, lam, valence_cells(nets, lam, N, prec, sym)
+    exact = derivation().integer_forms("bspline")
+    zn = [parameter_nets(exact, *ends, i, degrees[0], prec) for i in range(N)]
+    return hull_nets(zn[0], prec), arb(ends[0]).union(arb(ends[1])), interval_cells(zn, N, degrees[1], prec, sym)

@@ -10,19 +10,12 @@ variable (axis 0). docs/appendix_a.md section 6 has the mathematics.
 
 from __future__ import annotations
 
-from flint import arb, ctx, fmpq, fmpq_poly
+from flint import arb, arb_mat, ctx, fmpq, fmpq_mat, fmpq_poly
 
-from ccproof.rigorous import (
-    Poly,
-    TaylorForm,
-    bernstein_coefficients,
-    exact_fmpq,
-    jacobian_determinant,
-    range_enclosure,
-)
+from ccproof.rigorous import BernsteinForm, TaylorForm, conversion_matrix, range_enclosure
 
 from .errors import CertificateError
-from .maps import ORIGIN, cell_geometry, cell_pieces, dyadic_cells, net_form, weight_piece
+from .maps import cell_geometry, cell_pieces, det_form, dyadic_cells, net_form
 from .statement import B2Z, PATCHES, c_lam
 
 ZBOX = ((fmpq(-1), fmpq(1)), (fmpq(0), fmpq(1)), (fmpq(0), fmpq(1)))  # (zeta, s, t) of part D
@@ -31,7 +24,11 @@ ZBOX = ((fmpq(-1), fmpq(1)), (fmpq(0), fmpq(1)), (fmpq(0), fmpq(1)))  # (zeta, s
 def _bern1(p, prec=None):
     """Bernstein coefficients on zeta in [-1, 1] of an fmpq_poly (or a list of arb coefficients)."""
     c = [p[i] for i in range(max(1, p.degree() + 1))] if isinstance(p, fmpq_poly) else p
-    return bernstein_coefficients(Poly.from_dense((len(c),), c, prec), box=ZBOX[:1]).coeffs
+    M = conversion_matrix(len(c) - 1, len(c) - 1, *ZBOX[0])
+    if prec is None:
+        return (M * fmpq_mat(len(c), 1, c)).entries()
+    with ctx.workprec(prec):
+        return (arb_mat(M) * arb_mat(len(c), 1, c)).entries()
 
 
 def entry_model(form, L, layer, degree, prec):
@@ -130,7 +127,8 @@ def hull_nets(znets, prec):
 
 
 def cell_maps_z(znets, N, l, m, D, prec):
-    """(X, Y) = lam^i Phi on cell (l, m) as ball Polys in (zeta, s, t), truncated to degree D in zeta.
+    """(X, Y) = lam^i Phi on cell (l, m) as Bernstein forms on ZBOX in (zeta, s, t): the Taylor models in zeta
+    (truncated to degree D) of the nets restricted to the cell, converted.
 
     Parameters
     ----------
@@ -144,18 +142,18 @@ def cell_maps_z(znets, N, l, m, D, prec):
     >>> from ccproof.certify.verify.statement import derivation
     >>> exact, h = derivation().integer_forms(), fmpq(1, 2)    # the one-point interval lam = 1/2: k = 4
     >>> zn = {i: parameter_nets(exact, h, h, i, 2, 64) for i in (0, 1)}
-    >>> X, Y = cell_maps_z(zn, 1, 1, 0, 2, 64)
-    >>> X(0, 1, 0).mid().str(6), Y(0, 0, 1).mid().str(6)
-    ('1.00000', '0.500000')
+    >>> [[z.str(6, radius=False) for z in range_enclosure(F)] for F in cell_maps_z(zn, 1, 1, 0, 2, 64)]
+    [['0.500000', '1.00000'], ['0', '0.500000']]
     """
     i, name, box = cell_geometry(l, m, N)
+    net = znets[i][name]
+    n = len(net[0][0][0])
     out = []
     for d in range(2):
-        co = []  # zeta^e blocks of the (s, t) power forms
-        for e in range(len(znets[i][name][0][0][d])):
-            net = [[(pt[0][e], pt[1][e]) for pt in row] for row in znets[i][name]]
-            co += net_form(net, d, prec, box).to_poly().coeffs
-        out.append(Poly.from_dense((len(co) // 16, 4, 4), co, prec).truncate(D))
+        co = []  # zeta^e blocks of the (s, t) Bernstein forms on the cell
+        for e in range(n):
+            co += net_form([[(pt[0][e], pt[1][e]) for pt in row] for row in net], d, prec, box).coeffs
+        out.append(TaylorForm((n, 4, 4), co, prec).truncate(D).bernstein())
     return out
 
 
@@ -178,20 +176,10 @@ def piece_maps_z(znets, i, name, D, prec):
                        prec).truncate(D) for d in range(2)]
 
 
-def _weight_z(p, X, D):
-    """b(X) on piece p, Horner around the exact midpoint x0 of X's first coefficient (tighter balls)."""
-    x0 = exact_fmpq(X.coeffs[0].mid())
-    b = weight_piece(p).affine(0, x0, x0 + 1)
-    acc = TaylorForm.constant(b.coeffs[-1], 2, X.prec)
-    for c in b.coeffs[-2::-1]:
-        acc = (acc * (X - x0)).truncate(D) + c
-    return acc
-
-
 def piece_det_form_z(znets, i, name, p, q, D, prec):
     """Bernstein form on ZBOX of det dG/d(sigma, tau) on layer i of piece ``name`` for the w piece (p, q),
     every lam of the interval at once (Taylor model in zeta, truncated to degree D; one form for all the
-    cells of that layer, piece and w piece; y = 2^-i (ORIGIN + (sigma, tau)/2) as in :func:`piece_det_form`).
+    cells of that layer, piece and w piece: :func:`.maps.det_form` of :func:`piece_maps_z`).
 
     Examples
     --------
@@ -205,14 +193,7 @@ def piece_det_form_z(znets, i, name, p, q, D, prec):
     ['0.250000', '0.250000']
     """
     with ctx.workprec(prec):
-        X, Y = piece_maps_z(znets, i, name, D, prec)
-        u0, v0 = ORIGIN[name]
-        scale = fmpq(1, 2 ** (i + 1))
-        y1 = (TaylorForm.variable(1, 2, prec) + 2 * u0) * scale
-        y2 = (TaylorForm.variable(2, 2, prec) + 2 * v0) * scale
-        w = (_weight_z(p, X, D) * _weight_z(q, Y, D)).truncate(D)
-        G = [(F + w * (y - F)).truncate(D) for y, F in ((y1, X), (y2, Y))]
-        return jacobian_determinant(G, (1, 2)).truncate(D).bernstein()
+        return det_form(*piece_maps_z(znets, i, name, D, prec), i, name, p, q, D)
 
 
 def interval_cells(znets, N, D, prec, symmetric=False):
@@ -227,7 +208,7 @@ def interval_cells(znets, N, D, prec, symmetric=False):
 
     Examples
     --------
-    The same cells as :func:`.maps.required_cells` for k = 4 at N = 1:
+    For k = 4 at N = 1 (the cells :func:`valence_cells` gives at lam = 1/2):
 
     >>> from ccproof.certify.verify.statement import derivation
     >>> from ccproof.rigorous import range_enclosure
@@ -252,9 +233,7 @@ def interval_cells(znets, N, D, prec, symmetric=False):
 
     with ctx.workprec(prec):
         for l, m in dyadic_cells(N, symmetric):
-            X, Y = cell_maps_z(znets, N, l, m, D, prec)
-            XY = [bernstein_coefficients(F, box=ZBOX) for F in (X, Y)]
-            for p, q in cell_pieces(*XY):
+            for p, q in cell_pieces(*cell_maps_z(znets, N, l, m, D, prec)):
                 if p < 3 and q < 3:
                     out.append((f"{l},{m},{p},{q}", lambda c=(l, m, p, q): build(*c)))
     return out
@@ -274,3 +253,31 @@ def lam_interval_ok(k0, La, Lb, prec):
     """
     with ctx.workprec(prec):
         return bool(c_lam(k0, prec)[1] >= La) and bool((3 + arb(5).sqrt()) / 8 <= Lb)
+
+
+def valence_cells(nets, lam, N, prec, symmetric=False):
+    """Part D for one valence: :func:`interval_cells` of the arb nets as Taylor models of degree 0 in zeta
+    (``lam^i`` times the nets on layer i), the zeta axis dropped from each root (the boxes of one valence split
+    (s, t) only).
+
+    Returns
+    -------
+    list of (str, callable () -> BernsteinForm)
+        Keys ``"l,m,p,q"``; the roots on [0, 1]^2.
+
+    Examples
+    --------
+    >>> from ccproof.certify.verify.statement import nets_for_valence
+    >>> cells = valence_cells(nets_for_valence(4, 64), c_lam(4, 64)[1], 1, 64)   # k = 4: Phi is the identity
+    >>> [key for key, _ in cells][:3], cells[-1][1]().box, cells[-1][1]().coeffs[0].str(6, radius=False)
+    (['0,1,0,2', '0,1,1,2', '0,1,2,2'], ((0, 1), (0, 1)), '0.250000')
+    """
+    with ctx.workprec(prec):
+        zn = {i: {n: [[tuple([x * lam**i] for x in pt) for pt in row] for row in net] for n, net in nets.items()}
+              for i in range(N)}
+
+    def flat(build):
+        f = build()
+        return BernsteinForm.from_raw(f.shape[1:], f.coeffs, f.box[1:], f.prec)
+
+    return [(key, lambda b=build: flat(b)) for key, build in interval_cells(zn, N, 0, prec, symmetric)]

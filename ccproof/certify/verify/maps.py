@@ -11,12 +11,7 @@ from __future__ import annotations
 
 from flint import ctx, fmpq, fmpq_poly
 
-from ccproof.rigorous import (
-    BernsteinForm,
-    Poly,
-    bernstein_coefficients,
-    jacobian_determinant,
-)
+from ccproof.rigorous import BernsteinForm, TaylorForm, exact_fmpq, jacobian_determinant
 
 from .statement import PATCHES, split_half
 
@@ -24,12 +19,12 @@ BREAKS = (fmpq(0), fmpq(1, 6), fmpq(1, 3), fmpq(1, 2))  # w pieces (docs/reading
 
 
 def weight_piece(p):
-    """b(x) = B(6x+1) + B(6x) + B(6x-1) on [BREAKS[p], BREAKS[p+1]] (R5) as an exact 1-var Poly;
+    """b(x) = B(6x+1) + B(6x) + B(6x-1) on [BREAKS[p], BREAKS[p+1]] (R5) as an exact polynomial;
     B is the centred uniform cubic B-spline: (4 - 6z^2 + 3|z|^3)/6 on |z| <= 1, (2 - |z|)^3/6 on 1..2.
 
     Returns
     -------
-    Poly
+    fmpq_poly
         Degree 3 in x; the weight w is 1 at 0 and 0 from 1/2 on (docs/readings.md R5).
 
     Examples
@@ -54,8 +49,7 @@ def weight_piece(p):
         1: B(1, "zero") + B(0, "outer+") + B(-1, "inner+"),
         2: B(0, "zero") + B(-1, "outer+"),
     }
-    poly = pieces[p]
-    return Poly({(i,): poly[i] for i in range(poly.degree() + 1)}, 1)
+    return pieces[p]
 
 
 def net_form(net, coord, prec, box=None):
@@ -140,106 +134,45 @@ def dyadic_cells(N, symmetric):
     return [(l, m) for l in range(2**N) for m in range(2**N) if (l, m) != (0, 0) and not (symmetric and l > m)]
 
 
-def required_cells(nets, lam, N, prec, symmetric=False):
-    """Every (l, m, p, q) of part D: cell (l, m) of :func:`dyadic_cells` and w piece (p, q), p, q < 3, met
-    by the Bezier hull of Phi(cell). Pieces with p = 3 or q = 3 have w = 0 (G = Phi, covered by part B).
-
-    Examples
-    --------
-    >>> from ccproof.certify.verify.statement import c_lam, nets_for_valence
-    >>> nets, (c, lam) = nets_for_valence(4, 64), c_lam(4, 64)   # k = 4: Phi is the identity, lam = 1/2
-    >>> required_cells(nets, lam, 1, 64)
-    [(0, 1, 0, 2), (0, 1, 1, 2), (0, 1, 2, 2), (1, 0, 2, 0), (1, 0, 2, 1), (1, 0, 2, 2), (1, 1, 2, 2)]
-    """
-    out = []
-    with ctx.workprec(prec):
-        for l, m in dyadic_cells(N, symmetric):
-            i, name, box = cell_geometry(l, m, N)
-            li = lam**i
-            X, Y = (net_form(nets[name], d, prec, box) for d in (0, 1))
-            X = BernsteinForm(X.shape, [c * li for c in X.coeffs], prec=prec)
-            Y = BernsteinForm(Y.shape, [c * li for c in Y.coeffs], prec=prec)
-            out += [(l, m, p, q) for p, q in cell_pieces(X, Y) if p < 3 and q < 3]
-    return out
-
-
 #: layer-0 coordinates (u, v) = ORIGIN + (sigma, tau) / 2 of the local parameters (sigma, tau) of each piece
 ORIGIN = {"P1": (fmpq(1, 2), fmpq(0)), "P2": (fmpq(1, 2), fmpq(1, 2)), "P3": (fmpq(0), fmpq(1, 2))}
 
 
-def piece_det_form(nets, lam, i, name, p, q, prec):
-    """Bernstein form on [0,1]^2 of det dG/d(sigma, tau) on layer i of piece ``name`` for the w piece (p, q)
-    (p, q < 3), in the piece's local parameters: one polynomial for every cell of that layer, piece and w piece.
-    On layer i, Phi = lam^i Phi_0(sigma, tau) and y = 2^-i (ORIGIN + (sigma, tau)/2).
+def det_form(X, Y, i, name, p, q, D):
+    """Bernstein form on [-1, 1] x [0, 1]^2 of det dG/d(sigma, tau) on layer i of piece ``name`` for the w piece
+    (p, q), G = Phi + w(Phi) (y - Phi), from the Taylor models X, Y of lam^i Phi in (zeta; sigma, tau) (truncated
+    to degree D in zeta; zeta-degree 0 for one valence); y = 2^-i (ORIGIN + (sigma, tau)/2): one form for all the
+    cells of that layer, piece and w piece (:func:`.interval.interval_cells` restricts it to each).
 
     Examples
     --------
-    With Phi = y (k = 4) the determinant is 4^-(i+1):
+    At k = 4 (Phi = y on P1, lam = 1/2) the blend G is y and det = 1/4 on layer 0:
 
-    >>> from ccproof.certify.verify.statement import c_lam, nets_for_valence
     >>> from flint import arb
     >>> from ccproof.rigorous import range_enclosure
-    >>> nets, (c, lam) = nets_for_valence(4, 64), c_lam(4, 64)   # k = 4: Phi is the identity, lam = 1/2
-    >>> lo, hi = range_enclosure(piece_det_form(nets, lam, 0, "P1", 2, 2, 64))
-    >>> bool(abs(lo - arb(1) / 4) < 1e-12 and abs(hi - arb(1) / 4) < 1e-12)
-    True
+    >>> X, Y = (TaylorForm((1, 2, 1), [arb(1) / 2, arb(1)], 64), TaylorForm((1, 1, 2), [0, arb(1) / 2], 64))
+    >>> [z.str(6, radius=False) for z in range_enclosure(det_form(X, Y, 0, "P1", 2, 2, 0))]
+    ['0.250000', '0.250000']
     """
+    prec = X.prec
     with ctx.workprec(prec):
-        li = lam**i
-        X = net_form(nets[name], 0, prec).to_poly() * li
-        Y = net_form(nets[name], 1, prec).to_poly() * li
-        s, t = Poly.variable(0, 2), Poly.variable(1, 2)
         u0, v0 = ORIGIN[name]
-        y1 = (s + 2 * u0) * fmpq(1, 2 ** (i + 1))
-        y2 = (t + 2 * v0) * fmpq(1, 2 ** (i + 1))
-        w = weight_piece(p).compose([X]) * weight_piece(q).compose([Y])
-        return bernstein_coefficients(jacobian_determinant([X + w * (y1 - X), Y + w * (y2 - Y)]))
+        scale = fmpq(1, 2 ** (i + 1))
+        y1 = (TaylorForm.variable(1, 2, prec) + 2 * u0) * scale
+        y2 = (TaylorForm.variable(2, 2, prec) + 2 * v0) * scale
+        w = (_weight(p, X, D) * _weight(q, Y, D)).truncate(D)
+        G = [(F + w * (y - F)).truncate(D) for y, F in ((y1, X), (y2, Y))]
+        return jacobian_determinant(G, (1, 2)).truncate(D).bernstein()
 
 
-def cell_det_form(piece_form, N, l, m, p, q, prec):
-    """Bernstein form of det dG/d(s, t) on cell (l, m) for the w piece (p, q) in the cell's local (s, t):
-    the piece's form (``piece_form(i, name, p, q)``, :func:`piece_det_form`) restricted to the cell's box
-    (sigma = s0 + h s, tau = t0 + h t) times h^2 (exact: h is a power of 2): the determinant on the
-    cell's own nets (tests/certify/test_verify.py checks it), one form per piece restricted.
-
-    Examples
-    --------
-    >>> from ccproof.certify.verify.statement import c_lam, nets_for_valence
-    >>> from flint import arb
-    >>> from ccproof.rigorous import range_enclosure
-    >>> nets, (c, lam) = nets_for_valence(4, 64), c_lam(4, 64)   # k = 4: Phi is the identity, lam = 1/2
-    >>> f = piece_det_form(nets, lam, 0, "P1", 2, 2, 64)
-    >>> lo, hi = range_enclosure(cell_det_form(lambda *key: f, 1, 1, 0, 2, 2, 64))   # cell = piece P1
-    >>> bool(abs(lo - arb(1) / 4) < 1e-12 and abs(hi - arb(1) / 4) < 1e-12)
-    True
-    """
-    i, name, box = cell_geometry(l, m, N)
-    h = box[0][1] - box[0][0]
-    with ctx.workprec(prec):
-        return piece_form(i, name, p, q).restrict(box) * (h * h)
-
-
-def cell_det_builder(nets, lam, N, prec):
-    """A function (l, m, p, q) -> :func:`cell_det_form`, building each :func:`piece_det_form` once.
-
-    Examples
-    --------
-    >>> from ccproof.certify.verify.statement import c_lam, nets_for_valence
-    >>> from flint import arb
-    >>> from ccproof.rigorous import range_enclosure
-    >>> nets, (c, lam) = nets_for_valence(4, 64), c_lam(4, 64)   # k = 4: Phi is the identity, lam = 1/2
-    >>> lo, hi = range_enclosure(cell_det_builder(nets, lam, 1, 64)(1, 0, 2, 2))
-    >>> bool(abs(lo - arb(1) / 4) < 1e-12 and abs(hi - arb(1) / 4) < 1e-12)
-    True
-    """
-    forms = {}
-
-    def piece_form(*key):
-        if key not in forms:
-            forms[key] = piece_det_form(nets, lam, *key, prec)
-        return forms[key]
-
-    return lambda l, m, p, q: cell_det_form(piece_form, N, l, m, p, q, prec)
+def _weight(p, X, D):
+    """b(X) on piece p, Horner around the exact midpoint x0 of X's first coefficient (tighter balls)."""
+    x0 = exact_fmpq(X.coeffs[0].mid())
+    b = weight_piece(p)(fmpq_poly([x0, 1])).coeffs() or [fmpq(0)]  # b(x0 + x)
+    acc = TaylorForm.constant(b[-1], 2, X.prec)
+    for c in b[-2::-1]:
+        acc = (acc * (X - x0)).truncate(D) + c
+    return acc
 
 
 def corner_det_form(nets, lam, N, name, prec):
