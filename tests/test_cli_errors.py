@@ -236,14 +236,16 @@ def _stalled(tmp_path, module, name, argv, before="pass"):
     script = _STALL.format(module=module, name=name, before=before)
     proc = subprocess.Popen([sys.executable, "-c", script, *argv], cwd=tmp_path, env=_env(), text=True,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE)
-    line = proc.stdout.readline()
-    assert line.strip() == "ready", (line, proc.stderr.read() if proc.poll() is not None else "")
+    lines = [proc.stdout.readline() for _ in range(1)]
+    while lines[-1] and lines[-1].strip() != "ready" and len(lines) < 20:  # (the command's own lines come first)
+        lines.append(proc.stdout.readline())
+    assert lines[-1].strip() == "ready", (lines, proc.stderr.read() if proc.poll() is not None else "")
     return proc
 
 
 def test_ctrl_c_during_an_evaluation(tmp_path):
     """SIGINT while the points are evaluated: one line, exit 130, no output file."""
-    proc = _stalled(tmp_path, "ccproof.scale.arrays", "_evaluate_block",
+    proc = _stalled(tmp_path, "ccproof.scale.arrays", "_evaluate_chunk",
                     ["eval", "cube.obj", "--samples", "100", "--serial", "--out", "o.npz"])
     proc.send_signal(signal.SIGINT)
     out, err = proc.communicate(timeout=120)
@@ -321,7 +323,7 @@ if os.environ.get("CCPROOF_TEST_STALL"):
     def stall(*args, **kwargs):  # in every worker process too: they all start through this file
         pathlib.Path(os.environ["CCPROOF_TEST_STALL"], str(os.getpid())).touch()
         time.sleep(120)
-    arrays._evaluate_block = stall
+    arrays._evaluate_chunk = stall
 if os.environ.get("CCPROOF_TEST_NO_DASK"):
     import sys
     sys.modules["distributed"] = None
