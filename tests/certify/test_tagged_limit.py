@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 from flint import acb, arb, ctx, fmpq
 
+from ccproof.certify.verify import tagged as tg
 from ccproof.certify.verify import tagged_limit as tl
 from ccproof.certify.verify import tagged_modes as tm
 from ccproof.certify.verify import verify_certificate
@@ -103,7 +104,7 @@ def test_h_vanishes_to_order_four():
 
 def test_window_check_refuses_a_row_that_depends_on_n(monkeypatch):
     """A middle row of crease:8 changed (not crease:7's): the two windows differ."""
-    real = tm.sector_rows
+    real = tg.sector_rows
 
     def rows(fam, n):
         out = list(real(fam, n))
@@ -115,7 +116,7 @@ def test_window_check_refuses_a_row_that_depends_on_n(monkeypatch):
             out[i] = row
         return tuple(out)
 
-    monkeypatch.setattr(tl, "sector_rows", rows)
+    monkeypatch.setattr(tg, "sector_rows", rows)
     tl.check_windows.cache_clear()
     with pytest.raises(CertificateError, match="window class"):
         tl.check_windows("crease")
@@ -123,6 +124,15 @@ def test_window_check_refuses_a_row_that_depends_on_n(monkeypatch):
     tl.check_windows.cache_clear()
     assert tl.check_windows("crease")
 
+
+
+@pytest.mark.parametrize("prec", [63, 1025, "128"])
+def test_forgery_precision_out_of_range(prec):
+    """prec outside 64..1024 (or not an integer) FAILs the tail and a single tagged certificate alike."""
+    one = json.loads((certificates_dir() / "c1" / "crease" / "n005.json").read_text())
+    why = "prec must lie in 64..1024" if isinstance(prec, int) else "field 'prec' has the wrong type"
+    for cert in (_tail("corner"), one):
+        _fails(dict(cert, prec=prec), why)
 
 def test_forgery_statement_and_family():
     cert = _tail("crease")

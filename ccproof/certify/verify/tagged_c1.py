@@ -52,6 +52,7 @@ from __future__ import annotations
 
 from flint import arb, arb_mat, ctx, fmpq, fmpq_mat
 
+from .c1 import read_prec
 from .errors import CertificateError
 from .record import exact_keys, field_of
 from .registry import TAGGED_SCHEMA
@@ -112,9 +113,7 @@ def verify_tagged(cert, part, log):
     exact_keys(cert, keys, "certificate")
     name = field_of(cert, "configuration", str, "certificate")
     fam, n = parse_configuration(name)
-    prec = field_of(cert, "prec", int, "certificate")
-    if not 64 <= prec <= 1024:
-        raise CertificateError("prec must lie in 64..1024")
+    prec = read_prec(cert)
     log(f"{statement} certificate for {name} ({prec} bits)")
     rows = sector_rows(fam, n)
     ok = all(sum(row.values(), fmpq(0)) == 1 for row in rows)
