@@ -297,10 +297,9 @@ def _mode_coordinate(fam, n, ev, spec, c, want=None):
     exact_keys(spec, ("eigenvalue", "crease", "pivot"), c)
     crease, lo_hi = field_of(spec, "crease", list, c), field_of(spec, "eigenvalue", list, c)
     cp = [] if fam == "dart" else crease_points(fam, n)
-    if len(crease) != len(cp) or len(lo_hi) != 2:
-        raise CertificateError(f"{c}: crease values must be {len(cp)} decimals (a dart's crease []) and the "
-                               "eigenvalue [low, high]")
-    i = _isolated(ev, lo_hi, c)
+    if len(crease) != len(cp):
+        raise CertificateError(f"{c}: crease values must be {len(cp)} decimals (a dart's crease [])")
+    i = _isolated(ev, lo_hi, c)  # checks the [low, high] form
     if any(parse_decimal(v) != 0 for v in crease):
         return None, None, "an irrational eigenvalue's eigenvector vanishes on the crease points"
     if i is None or want not in (None, i) or not ev[i][0].imag.is_zero() or ev[i][3] is None and fam != "dart":
@@ -387,11 +386,8 @@ def _exact_eigenvector(fam, n, spec, c, cp, cval, chain):
 
 
 def _ball_eigenvector(fam, n, spec, c, cp, cval, prec):
-    lo_hi = field_of(spec, "eigenvalue", list, c)
-    if len(lo_hi) != 2:
-        raise CertificateError(f"{c}: eigenvalue must be a decimal or [low, high]")
-    ev = eigenvalues(fam, n, prec)
-    i = _isolated(ev, lo_hi, c)
+    ev, lo_hi = eigenvalues(fam, n, prec), field_of(spec, "eigenvalue", list, c)
+    i = _isolated(ev, lo_hi, c)  # checks the [low, high] form
     if i is None or not ev[i][0].imag.is_zero() or ev[i][2] != 1:
         return None, None, f"[{lo_hi[0]}, {lo_hi[1]}] does not isolate one simple real eigenvalue of {fam}:{n}"
     z, p = ev[i][0], ev[i][1]

@@ -330,15 +330,16 @@ def verify_tail(cert, fam, n0, part, log):
     name = f"{fam}:>={n0}"
     log(f"not C1 certificate for {name} ({prec} bits)")
     with ctx.workprec(prec):
-        _check_tail(fam, n0, g, cval, rho, R, side, arcs, outer, part, log)
+        _check_tail(fam, n0, g, cval, (rho, R, side, arcs, outer), part, log)
     return name
 
 
-def _check_tail(fam, n0, g, cval, rho, R, side, arcs, outer, part, log):
+def _check_tail(fam, n0, g, cval, limit, part, log):
     C, *blocks = check_windows(fam)
     part("S sector matrices of every N >= 7 from one window", True,
          f"{fam}:7 and {fam}:8: one row per window class (min(t, 3), min(N - t, 3)), the same in both, rows sum "
          "to 1; crease block and odd blocks of the modes +-1 equal; non-crease rows the folded ring rule (exact)")
+    rho = limit[0]
     ok = rho > arb.pi() / n0
     part(f"range: pi/N < rho for every N >= {n0}", ok, f"rho = {rho} > pi/{n0}" if ok else
          f"rho = {rho} is not certainly above pi/{n0} = {(arb.pi() / n0).str(6)}")
@@ -359,11 +360,13 @@ def _check_tail(fam, n0, g, cval, rho, R, side, arcs, outer, part, log):
     part("N reflection: B(1/w) R_w = R_w B(w) (exact), so f is odd and H has a zero of order >= 4 at 0", ok,
          "" if ok else "the ring stencil breaks the reflection identity")
     if not part.failed:
-        _check_normal(fam, n0, rho, R, side, arcs, outer, part, log)
+        _check_normal(fam, n0, limit, part, log)
 
 
-def _check_normal(fam, n0, rho, R, side, arcs, outer, part, log):
-    """N for every N >= n0: H analytic on the disc |theta| <= R, bounded on its circle, winding 4 times."""
+def _check_normal(fam, n0, limit, part, log):
+    """N for every N >= n0: H analytic on the disc |theta| <= R, bounded on its circle, winding 4 times
+    (``limit`` the record's (rho, R, box, arcs, outer_arcs))."""
+    rho, R, side, arcs, outer = limit
     got = check_disc(R, side)
     ok = isinstance(got, int)
     part(f"x, y and N analytic: the bordered systems of modes 1 and 2 regular on |theta| <= {R}", ok,
