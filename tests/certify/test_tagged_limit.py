@@ -14,6 +14,7 @@ from ccproof.certify.verify import tagged as tg
 from ccproof.certify.verify import tagged_limit as tl
 from ccproof.certify.verify import tagged_modes as tm
 from ccproof.certify.verify import verify_certificate
+from ccproof.certify.verify.dart_spectrum import check_construction
 from ccproof.certify.verify.errors import CertificateError
 from ccproof.certify.verify.statement import lam_of
 from ccproof.certify.verify.tagged import labels, parse_configuration
@@ -102,9 +103,12 @@ def test_h_vanishes_to_order_four():
         assert (tl.limit_h(th) - tl.limit_h(-th)).contains(0)
 
 
-def test_window_check_refuses_a_row_that_depends_on_n(monkeypatch):
-    """A middle row of crease:8 changed (not crease:7's): the two windows differ."""
+@pytest.mark.parametrize("fam", ["crease", "dart"])
+def test_window_check_refuses_a_row_that_depends_on_n(monkeypatch, fam):
+    """A middle quadrant row of fam:8 changed (not fam:7's): its window class has two rows (the crease and
+    corner tails' check_windows, the dart tail's check_construction)."""
     real = tg.sector_rows
+    check = check_construction if fam == "dart" else tl.check_windows
 
     def rows(fam, n):
         out = list(real(fam, n))
@@ -116,14 +120,14 @@ def test_window_check_refuses_a_row_that_depends_on_n(monkeypatch):
             out[i] = row
         return tuple(out)
 
+    args = () if fam == "dart" else (fam,)
     monkeypatch.setattr(tg, "sector_rows", rows)
-    tl.check_windows.cache_clear()
+    check.cache_clear()
     with pytest.raises(CertificateError, match="window class"):
-        tl.check_windows("crease")
+        check(*args)
     monkeypatch.undo()
-    tl.check_windows.cache_clear()
-    assert tl.check_windows("crease")
-
+    check.cache_clear()
+    assert check(*args)
 
 
 @pytest.mark.parametrize("prec", [63, 1025, "128"])
