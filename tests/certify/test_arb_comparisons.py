@@ -47,7 +47,6 @@ REVIEWED = {
     # the imaginary part is certainly positive
     ("dart_spectrum.py", "not psi.imag > 0"): "a choice of root, re-checked by _cot_far: conservative",
     ("dart_spectrum.py", "not phi.imag > 0"): "a choice of root, re-checked by _cot_far: conservative",
-    ("dart_spectrum.py", "out.setdefault(key, rel) != rel"): "dicts of fmpq rows (exact)",
     ("dart_spectrum.py", "x != 0"): "fmpq weights (exact)",
     ("dart_spectrum.py", "not tau1 > 0"): "fmpq (exact)",
     ("dart_spectrum.py", "not m > 0"): "refuses unless m > 0 certainly: conservative",
@@ -83,6 +82,7 @@ REVIEWED = {
     ("c1.py", "not a < b"): "fmpq (exact decimals)",
     ("interval.py", "not (all(c > 0 for c in db) or all(c < 0 for c in db))"): "fmpq Bernstein coefficients",
     ("tagged.py", "S[i, j] != 0"): "fmpq_mat entries (exact)",
+    ("tagged.py", "out.setdefault(key, rel) != rel"): "dicts of fmpq rows (exact)",
     ("tagged.py", "not abs(t[0]) < 1"): "fails unless every eigenvalue is certainly inside the unit disc: conservative",
     ("tagged_refute.py", "sum(1 for t in ev if t[1] == one) != 1"): "ints (fmpq_poly equality is exact)",
     ("tagged_refute.py", "g != max(below)"): "fmpq (exact roots of the crease block)",
@@ -125,7 +125,6 @@ REVIEWED = {
     ("maps.py", "not (hi < BREAKS[p] or (p < 3 and lo > BREAKS[p + 1]))"): (
         "keeps a piece unless the hull is certainly outside it: conservative"),
     ("tagged_limit.py", "not disc.real > 0"): "refuses the box unless Re (1 + c)(9 + c) > 0 certainly: conservative",
-    ("tagged_limit.py", "out.setdefault(key, rel) != rel"): "dicts of fmpq weights (exact)",
     ("tagged_limit.py", "C != crease_block(fam, WINDOW[1])"): "fmpq_mat (exact)",
     ("tagged_limit.py", "blocks[0] != blocks[1]"): "tuples of fmpq_mat (exact)",
     ("tagged_limit.py", "Bi * R != R * B"): "fmpq_mat (w is an exact rational)",

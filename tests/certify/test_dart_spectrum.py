@@ -73,6 +73,7 @@ def test_construction_derives_d_as_stated():
     assert check_secular()
 
 
+
 @pytest.mark.parametrize("k", [101, 400])
 def test_regions_equal_the_exact_determinant_ratio(k):
     """Each region's closed form at a point equals det(lam - S)/det(lam - S0) of the one-ring (numpy)."""

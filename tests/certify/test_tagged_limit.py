@@ -10,9 +10,11 @@ import numpy as np
 import pytest
 from flint import acb, arb, ctx, fmpq
 
+from ccproof.certify.verify import tagged as tg
 from ccproof.certify.verify import tagged_limit as tl
 from ccproof.certify.verify import tagged_modes as tm
 from ccproof.certify.verify import verify_certificate
+from ccproof.certify.verify.dart_spectrum import check_construction
 from ccproof.certify.verify.errors import CertificateError
 from ccproof.certify.verify.statement import lam_of
 from ccproof.certify.verify.tagged import labels, parse_configuration
@@ -101,9 +103,12 @@ def test_h_vanishes_to_order_four():
         assert (tl.limit_h(th) - tl.limit_h(-th)).contains(0)
 
 
-def test_window_check_refuses_a_row_that_depends_on_n(monkeypatch):
-    """A middle row of crease:8 changed (not crease:7's): the two windows differ."""
-    real = tm.sector_rows
+@pytest.mark.parametrize("fam", ["crease", "dart"])
+def test_window_check_refuses_a_row_that_depends_on_n(monkeypatch, fam):
+    """A middle quadrant row of fam:8 changed (not fam:7's): its window class has two rows (the crease and
+    corner tails' check_windows, the dart tail's check_construction)."""
+    real = tg.sector_rows
+    check = check_construction if fam == "dart" else tl.check_windows
 
     def rows(fam, n):
         out = list(real(fam, n))
@@ -115,14 +120,23 @@ def test_window_check_refuses_a_row_that_depends_on_n(monkeypatch):
             out[i] = row
         return tuple(out)
 
-    monkeypatch.setattr(tl, "sector_rows", rows)
-    tl.check_windows.cache_clear()
+    args = () if fam == "dart" else (fam,)
+    monkeypatch.setattr(tg, "sector_rows", rows)
+    check.cache_clear()
     with pytest.raises(CertificateError, match="window class"):
-        tl.check_windows("crease")
+        check(*args)
     monkeypatch.undo()
-    tl.check_windows.cache_clear()
-    assert tl.check_windows("crease")
+    check.cache_clear()
+    assert check(*args)
 
+
+@pytest.mark.parametrize("prec", [63, 1025, "128"])
+def test_forgery_precision_out_of_range(prec):
+    """prec outside 64..1024 (or not an integer) FAILs the tail and a single tagged certificate alike."""
+    one = json.loads((certificates_dir() / "c1" / "crease" / "n005.json").read_text())
+    why = "prec must lie in 64..1024" if isinstance(prec, int) else "field 'prec' has the wrong type"
+    for cert in (_tail("corner"), one):
+        _fails(dict(cert, prec=prec), why)
 
 def test_forgery_statement_and_family():
     cert = _tail("crease")

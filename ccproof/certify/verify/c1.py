@@ -80,9 +80,7 @@ def _read_pieces(cert, k):
     """``(prec, pieces, ends)``: the record read and every box list checked to partition its domain, before
     any arithmetic; ``ends`` the exact (low, high) of each lam piece (empty for one valence)."""
     exact_keys(cert, ("schema", "valence", "prec", "pieces" if isinstance(k, dict) else "parts"), "certificate")
-    prec = field_of(cert, "prec", int, "certificate")
-    if not 64 <= prec <= 1024:
-        raise CertificateError("prec must lie in 64..1024")
+    prec = read_prec(cert)
     if not isinstance(k, dict):
         piece_list = [{"lam": None, "parts": field_of(cert, "parts", dict, "certificate")}]
         _read_parts(piece_list[0]["parts"])
@@ -90,6 +88,24 @@ def _read_pieces(cert, k):
     piece_list = field_of(cert, "pieces", list, "certificate")
     return prec, piece_list, read_lam_pieces(piece_list, _read_parts)
 
+
+
+def read_prec(cert):
+    """The working precision in bits of a C1 or tagged certificate (``prec``, 64..1024).
+
+    Examples
+    --------
+    >>> read_prec({"prec": 128})
+    128
+    >>> read_prec({"prec": 32})
+    Traceback (most recent call last):
+    ...
+    ccproof.certify.verify.errors.CertificateError: prec must lie in 64..1024
+    """
+    prec = field_of(cert, "prec", int, "certificate")
+    if not 64 <= prec <= 1024:
+        raise CertificateError("prec must lie in 64..1024")
+    return prec
 
 def _read_parts(parts):
     exact_keys(parts, ("regularity", "star"), "parts")

@@ -29,7 +29,7 @@ from .errors import CertificateError
 from .maps import STAR_CURVES, curve_points
 from .rules import CENTRE, canonical, level1_rule
 from .statement import B2Z, horner, lam_of
-from .tagged_modes import RING_INDEX, bordered_solve, ring_block, ring_stencil
+from .tagged_modes import RING_INDEX, bordered_matrix, bordered_solve, ring_block, ring_stencil
 
 
 @dataclass(frozen=True)
@@ -131,12 +131,6 @@ def series_coeffs(z, n, real=False):
     h^0, so every function below serves both."""
     c = z.coeffs() if isinstance(z, acb_series) else [z]
     return [acb(c[i].real if real else c[i]) if i < len(c) else acb(0) for i in range(n)]
-
-
-def bordered_matrix(B, lam, zero, pivot=0):
-    """The bordered 7 x 7 matrix [[B - lam, e_pivot], [e_pivot^T, 0]] (``zero`` of B's ring)."""
-    A = [[(B[i][k] - lam) if i == k else B[i][k] for k in range(6)] + [zero + int(i == pivot)] for i in range(6)]
-    return A + [[zero + int(k == pivot) for k in range(6)] + [zero]]
 
 
 def bordered(w, lam, pivot=0):

@@ -75,7 +75,7 @@ from ccproof.rigorous.analytic import ball
 from .dart_family import kappa
 from .errors import CertificateError
 from .statement import lam_of
-from .tagged import labels, sector_rows
+from .tagged import labels, sector_rows, window_rows
 from .tagged_modes import RING_INDEX, charpoly_roots, check_dart, check_ring, ring_stencil
 
 WINDOW = (7, 8)  # the window classes of every K >= 7 occur in both
@@ -84,26 +84,6 @@ _E, _F = (1, 0), (1, 1)  # the one-ring positions
 _HALF, _QUARTER, _EIGHTH = fmpq(1, 2), fmpq(1, 4), fmpq(1, 8)
 T_PI = fmpq(355, 113)  # > pi: region F's end (boxes beyond pi are harmless: the circle continues)
 W_DEN = 1024  # w1 = m/W_DEN, the least m with m^2 tau1 >= W_DEN^2
-
-
-def _rel(p, q, k):
-    if q == _C:
-        return q
-    d = (q[1] - p[1]) % k
-    return (q[0], d - k if d > k // 2 else d) + q[2:]
-
-
-def _window_rows(k):
-    pts, rows = labels("dart", k), sector_rows("dart", k)
-    out = {}
-    for p, row in zip(pts, rows):
-        if p == _C:
-            continue
-        rel = {_rel(p, pts[j], k): x for j, x in row.items()}
-        key = (p[0], min(p[1], 3), min(k - p[1], 3)) + p[2:]
-        if len(rel) != len(row) or out.setdefault(key, rel) != rel:
-            raise CertificateError(f"dart:{k}: two points of window class {key} have different rows")
-    return out, pts, rows
 
 
 def _centre_ok(k):
@@ -139,7 +119,7 @@ def _check_rows():
     """Raise unless the window classes agree, the centre row is the rule's and no weight is negative; returns
     the sharp midpoint row of ray 0."""
     check_ring()
-    classes = [_window_rows(k)[0] for k in WINDOW]
+    classes = [window_rows("dart", k) for k in WINDOW]
     if classes[0] != classes[1]:
         raise CertificateError(f"dart: the window classes of dart:{WINDOW[0]} and dart:{WINDOW[1]} differ")
     if not all(_centre_ok(k) for k in range(7, 13)):

@@ -53,7 +53,7 @@ from .dart_family import PIECES, XB, YB
 from .errors import CertificateError
 from .maps import STAR_CURVES, curve_points
 from .statement import horner
-from .tagged_modes import RING_INDEX, ring_stencil
+from .tagged_modes import RING_INDEX, bordered_matrix, ring_stencil
 
 GRID_AB = (1, 2, 3)  # degree <= 2 in a and in b
 GRID_CT = (1, 2)  # degree <= 1 in c, t, l
@@ -215,7 +215,7 @@ def _bordered(k, lam, stencil):
     for i, row in enumerate(stencil):
         for (d, pos), x in row.items():
             B[i][RING_INDEX[pos]] = B[i][RING_INDEX[pos]] + _exp_i(fmpq(k) * d) * fmpq(x)
-    return solve(_df.bordered_matrix(B, lam, QS(0)), [QS(0)] * 6 + [QS(1)])[:6]
+    return solve(bordered_matrix(B, lam, QS(0), 0), [QS(0)] * 6 + [QS(1)])[:6]
 
 
 class _Mode:

@@ -208,6 +208,43 @@ def sector_rows(fam, n):
     return tuple(rows)
 
 
+def window_rows(fam, n):
+    """{window class: the row relative to its point} for fam:n; raises if one class has two rows.
+
+    A point's class is its kind, its ray or quadrant clipped to 3 from either end, and its position; a
+    column is the point's kind, its offset from the row's ray (mod K for a dart, taken in -K/2 .. K/2) and
+    its position. The centre row of a crease or corner reads rays 0 and N (``"N"``, N - ray); a dart's
+    centre row depends on K and is left out (:mod:`.dart_spectrum` checks it apart).
+
+    Examples
+    --------
+    The crease centre (e0 + 6 V + e1)/8 on rays 0 and N, and a dart's sharp midpoint (C + e1)/2:
+
+    >>> window_rows("crease", 7)[("C",)]
+    {('C',): 3/4, ('r', 0, 1, 0): 1/8, ('r', 'N', 0, 1, 0): 1/8}
+    >>> window_rows("dart", 7)[("r", 0, 3, 1, 0)]
+    {('C',): 1/2, ('r', 0, 1, 0): 1/2}
+    """
+    pts, out = labels(fam, n), {}
+    for p, row in zip(pts, sector_rows(fam, n)):
+        if p == ("C",) and fam == "dart":
+            continue
+        key = p if p == ("C",) else (p[0], min(p[1], 3), min(n - p[1], 3)) + p[2:]
+        rel = {_window_column(p, pts[j], n, fam == "dart"): x for j, x in row.items()}
+        if len(rel) != len(row) or out.setdefault(key, rel) != rel:
+            raise CertificateError(f"{fam}:{n}: two points of window class {key} have different rows")
+    return out
+
+
+def _window_column(p, q, n, ring):  # the column of point q in the row of point p (window_rows)
+    if q == ("C",):
+        return q
+    if p == ("C",):
+        return q if q[1] <= 3 else (q[0], "N", n - q[1]) + q[2:]
+    d = (q[1] - p[1]) % n if ring else q[1] - p[1]
+    return (q[0], d - n if ring and d > n // 2 else d) + q[2:]
+
+
 @cache
 def sector_matrix(fam, n):
     """The exact subdivision matrix S of the configuration: level-1 point i = sum_j S[i, j] level-0 point j.

@@ -52,6 +52,7 @@ from __future__ import annotations
 
 from flint import arb, arb_mat, ctx, fmpq, fmpq_mat
 
+from .c1 import read_prec
 from .errors import CertificateError
 from .record import exact_keys, field_of
 from .registry import TAGGED_SCHEMA
@@ -112,9 +113,7 @@ def verify_tagged(cert, part, log):
     exact_keys(cert, keys, "certificate")
     name = field_of(cert, "configuration", str, "certificate")
     fam, n = parse_configuration(name)
-    prec = field_of(cert, "prec", int, "certificate")
-    if not 64 <= prec <= 1024:
-        raise CertificateError("prec must lie in 64..1024")
+    prec = read_prec(cert)
     log(f"{statement} certificate for {name} ({prec} bits)")
     rows = sector_rows(fam, n)
     ok = all(sum(row.values(), fmpq(0)) == 1 for row in rows)
@@ -298,10 +297,9 @@ def _mode_coordinate(fam, n, ev, spec, c, want=None):
     exact_keys(spec, ("eigenvalue", "crease", "pivot"), c)
     crease, lo_hi = field_of(spec, "crease", list, c), field_of(spec, "eigenvalue", list, c)
     cp = [] if fam == "dart" else crease_points(fam, n)
-    if len(crease) != len(cp) or len(lo_hi) != 2:
-        raise CertificateError(f"{c}: crease values must be {len(cp)} decimals (a dart's crease []) and the "
-                               "eigenvalue [low, high]")
-    i = _isolated(ev, lo_hi, c)
+    if len(crease) != len(cp):
+        raise CertificateError(f"{c}: crease values must be {len(cp)} decimals (a dart's crease [])")
+    i = _isolated(ev, lo_hi, c)  # checks the [low, high] form
     if any(parse_decimal(v) != 0 for v in crease):
         return None, None, "an irrational eigenvalue's eigenvector vanishes on the crease points"
     if i is None or want not in (None, i) or not ev[i][0].imag.is_zero() or ev[i][3] is None and fam != "dart":
@@ -388,11 +386,8 @@ def _exact_eigenvector(fam, n, spec, c, cp, cval, chain):
 
 
 def _ball_eigenvector(fam, n, spec, c, cp, cval, prec):
-    lo_hi = field_of(spec, "eigenvalue", list, c)
-    if len(lo_hi) != 2:
-        raise CertificateError(f"{c}: eigenvalue must be a decimal or [low, high]")
-    ev = eigenvalues(fam, n, prec)
-    i = _isolated(ev, lo_hi, c)
+    ev, lo_hi = eigenvalues(fam, n, prec), field_of(spec, "eigenvalue", list, c)
+    i = _isolated(ev, lo_hi, c)  # checks the [low, high] form
     if i is None or not ev[i][0].imag.is_zero() or ev[i][2] != 1:
         return None, None, f"[{lo_hi[0]}, {lo_hi[1]}] does not isolate one simple real eigenvalue of {fam}:{n}"
     z, p = ev[i][0], ev[i][1]

@@ -52,12 +52,13 @@ from functools import cache
 
 from flint import acb, arb, ctx, fmpq, fmpq_mat
 
+from .c1 import read_prec
 from .errors import CertificateError
 from .record import exact_keys, field_of
 from .replay import parse_decimal
 from .spectrum import RING_INDEX, SMALL_ROOTS, ring_block
 from .statement import lam_of
-from .tagged import crease_block, crease_points, labels, sector_rows
+from .tagged import crease_block, crease_points, labels, window_rows
 from .tagged_c1 import G_GENERIC, check_boundary, crease_eigen_why, read_z, vertex_tangents
 from .tagged_modes import bordered_solve, charpoly_roots, check_ring, check_structure, mode_reflection
 
@@ -70,27 +71,6 @@ MAX_ARCS = 8192  # arcs on either circle, and boxes on the disc (bounded work fo
 TAIL_BUDGET = 3 * 8192
 _LIMIT_KEYS = ("rho", "R", "arcs", "outer_arcs", "box")
 _PIVOT = RING_INDEX[(1, 0)]
-
-
-def _window_rows(fam, n):
-    """{window class: the row relative to its point} for fam:n; raises if one class has two rows."""
-    pts, rows = labels(fam, n), sector_rows(fam, n)
-    out = {}
-    for p, row in zip(pts, rows):
-        key = ("C",) if p == ("C",) else (p[0], min(p[1], 3), min(n - p[1], 3)) + p[2:]
-        rel = {}
-        for j, x in row.items():
-            q = pts[j]
-            if q == ("C",):
-                col = q
-            elif p == ("C",):  # the centre reads rays 0 and N
-                col = (q[0], q[1]) + q[2:] if q[1] <= 3 else (q[0], "N", n - q[1]) + q[2:]
-            else:
-                col = (q[0], q[1] - p[1]) + q[2:]
-            rel[col] = x
-        if out.setdefault(key, rel) != rel:
-            raise CertificateError(f"{fam}:{n}: two points of window class {key} have different rows")
-    return out
 
 
 @cache
@@ -111,7 +91,7 @@ def check_windows(fam):
     """
     if fam not in ("crease", "corner"):
         raise CertificateError(f"{fam}: the interval certificate is defined for crease and corner sectors")
-    a, b = (_window_rows(fam, n) for n in WINDOW)
+    a, b = (window_rows(fam, n) for n in WINDOW)
     if a != b:
         raise CertificateError(f"{fam}: the window classes of {fam}:{WINDOW[0]} and {fam}:{WINDOW[1]} differ")
     if any(sum(row.values(), fmpq(0)) != 1 for row in a.values()):
@@ -332,9 +312,7 @@ def verify_tail(cert, fam, n0, part, log):
     if not MIN_TAIL <= n0 <= 10**6:
         raise CertificateError(f"{fam}:>={n0}: the window argument needs N0 >= {MIN_TAIL}")
     exact_keys(cert, ("schema", "configuration", "statement", "prec", "witness", "limit"), "certificate")
-    prec = field_of(cert, "prec", int, "certificate")
-    if not 64 <= prec <= 1024:
-        raise CertificateError("prec must lie in 64..1024")
+    prec = read_prec(cert)
     w = field_of(cert, "witness", dict, "certificate")
     exact_keys(w, ("z",), "witness")
     g, cval = read_z(field_of(w, "z", dict, "witness"))
@@ -352,15 +330,16 @@ def verify_tail(cert, fam, n0, part, log):
     name = f"{fam}:>={n0}"
     log(f"not C1 certificate for {name} ({prec} bits)")
     with ctx.workprec(prec):
-        _check_tail(fam, n0, g, cval, rho, R, side, arcs, outer, part, log)
+        _check_tail(fam, n0, g, cval, (rho, R, side, arcs, outer), part, log)
     return name
 
 
-def _check_tail(fam, n0, g, cval, rho, R, side, arcs, outer, part, log):
+def _check_tail(fam, n0, g, cval, limit, part, log):
     C, *blocks = check_windows(fam)
     part("S sector matrices of every N >= 7 from one window", True,
          f"{fam}:7 and {fam}:8: one row per window class (min(t, 3), min(N - t, 3)), the same in both, rows sum "
          "to 1; crease block and odd blocks of the modes +-1 equal; non-crease rows the folded ring rule (exact)")
+    rho = limit[0]
     ok = rho > arb.pi() / n0
     part(f"range: pi/N < rho for every N >= {n0}", ok, f"rho = {rho} > pi/{n0}" if ok else
          f"rho = {rho} is not certainly above pi/{n0} = {(arb.pi() / n0).str(6)}")
@@ -381,11 +360,13 @@ def _check_tail(fam, n0, g, cval, rho, R, side, arcs, outer, part, log):
     part("N reflection: B(1/w) R_w = R_w B(w) (exact), so f is odd and H has a zero of order >= 4 at 0", ok,
          "" if ok else "the ring stencil breaks the reflection identity")
     if not part.failed:
-        _check_normal(fam, n0, rho, R, side, arcs, outer, part, log)
+        _check_normal(fam, n0, limit, part, log)
 
 
-def _check_normal(fam, n0, rho, R, side, arcs, outer, part, log):
-    """N for every N >= n0: H analytic on the disc |theta| <= R, bounded on its circle, winding 4 times."""
+def _check_normal(fam, n0, limit, part, log):
+    """N for every N >= n0: H analytic on the disc |theta| <= R, bounded on its circle, winding 4 times
+    (``limit`` the record's (rho, R, box, arcs, outer_arcs))."""
+    rho, R, side, arcs, outer = limit
     got = check_disc(R, side)
     ok = isinstance(got, int)
     part(f"x, y and N analytic: the bordered systems of modes 1 and 2 regular on |theta| <= {R}", ok,

@@ -249,10 +249,22 @@ def bordered_solve(B, lam, pivot, mat=acb_mat):
     ['1.00', '1.00']
     """
     k = len(B)
-    rows = [[B[i][j] - (lam if i == j else 0) for j in range(k)] + [int(i == pivot)] for i in range(k)]
-    rows.append([int(j == pivot) for j in range(k)] + [0])
-    sol = mat(rows).solve(mat([[0]] * k + [[1]]))
+    sol = mat(bordered_matrix(B, lam, 0, pivot)).solve(mat([[0]] * k + [[1]]))
     return [sol[i, 0] for i in range(k)]
+
+
+def bordered_matrix(B, lam, zero, pivot):
+    """The bordered matrix [[B - lam, e_pivot], [e_pivot^T, 0]] as a list of rows (``zero`` of B's ring:
+    0, an exact or a series zero), one size larger than B.
+
+    Examples
+    --------
+    >>> bordered_matrix([[2, 1], [1, 2]], 3, 0, 1)
+    [[-1, 1, 0], [1, -1, 1], [0, 1, 0]]
+    """
+    k = len(B)
+    A = [[(B[i][j] - lam) if i == j else B[i][j] for j in range(k)] + [zero + int(i == pivot)] for i in range(k)]
+    return A + [[zero + int(j == pivot) for j in range(k)] + [zero]]
 
 
 def _unit(num, den):
