@@ -144,3 +144,18 @@ def test_the_page_states_its_own_totals():
             f"{sum(r[2] for r in verifier)} and {sum(r[2] for r in kernel)} |")
     assert want in text, want
     assert f"**Small.** {code:,} lines of code (the rest of the {lines:,} lines" in text.replace("\n  ", " ")
+
+
+def test_no_route_of_the_verifier_loads_the_power_basis_polynomials():
+    """``rigorous/poly.py`` (``Poly``: the prover's and the tests' power basis) is in the table because it sits in
+    the kernel package, but verifying a certificate never imports it: one of each fast kind in a fresh process."""
+    import subprocess
+    import sys
+
+    certs = ROOT.parent / "certificates"
+    files = [certs / f for f in ("injectivity/k005.json", "c1/k005.json", "c1/crease/n005.json", "c1/dart/k005.json")]
+    child = ("import sys\nfrom ccproof.certify.verify import verify_file\n"
+             "ok = all(verify_file(f, log=lambda s: None) for f in sys.argv[1:])\n"
+             "print(ok, 'ccproof.rigorous.poly' in sys.modules, 'ccproof.rigorous.bernstein' in sys.modules)")
+    run = subprocess.run([sys.executable, "-c", child, *map(str, files)], capture_output=True, text=True, timeout=300)
+    assert run.stdout.split() == ["True", "False", "True"], run.stdout + run.stderr
