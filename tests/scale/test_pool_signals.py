@@ -31,21 +31,6 @@ if "--multiprocessing-fork" in sys.argv and os.environ.get("CCPROOF_TEST_WORKER_
 '''
 
 
-def _session(sid):
-    """The live processes of session ``sid``."""
-    out = []
-    for d in os.listdir("/proc"):
-        if d.isdigit():
-            try:
-                stat = open(f"/proc/{d}/stat").read()
-            except OSError:
-                continue
-            fields = stat[stat.rindex(")") + 2:].split()
-            if int(fields[3]) == sid and fields[0] != "Z":
-                out.append(int(d))
-    return out
-
-
 def _alive(pid):
     try:
         with open(f"/proc/{pid}/stat") as fh:
@@ -62,7 +47,7 @@ def _wait_for(cond, seconds):
     return cond()
 
 
-def test_ctrl_c_while_the_table_workers_start(tmp_path):
+def test_ctrl_c_while_the_table_workers_start(tmp_path, session_processes):
     """``table --all --jobs 2``, Ctrl-C while its workers are starting: exit 130, the one line, no traceback,
     no table, no process left. A terminal sends SIGINT to the whole group at once; here the workers get it
     first and the command 0.3 s later, so that the workers' part of the race is deterministic (the command
@@ -84,9 +69,10 @@ def test_ctrl_c_while_the_table_workers_start(tmp_path):
         time.sleep(0.3)
         os.kill(proc.pid, signal.SIGINT)
         _, err = proc.communicate(timeout=60)
-        assert _wait_for(lambda: not _session(proc.pid), 10), "processes of the command outlived it"
+        outlived = "processes of the command outlived it"
+        assert _wait_for(lambda: not session_processes(proc.pid, zombies=False), 10), outlived
     finally:
-        if _session(proc.pid):
+        if session_processes(proc.pid, zombies=False):
             os.killpg(proc.pid, signal.SIGKILL)
     assert proc.returncode == 130, err
     assert err.strip().splitlines() == ["ccproof table: interrupted"], err

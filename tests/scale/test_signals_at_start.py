@@ -96,23 +96,9 @@ CUBE = "\n".join(
      "f 1 4 3 2", "f 5 6 7 8", "f 1 2 6 5", "f 2 3 7 6", "f 3 4 8 7", "f 4 1 5 8"]) + "\n"
 
 
-def _session_processes(sid):
-    out = []
-    for d in os.listdir("/proc"):
-        if d.isdigit():
-            try:
-                stat = open(f"/proc/{d}/stat").read()
-            except OSError:
-                continue
-            fields = stat[stat.rindex(")") + 2:].split()
-            if int(fields[3]) == sid:  # (state, ppid, pgrp, session, ...)
-                out.append(int(d))
-    return out
-
-
 @pytest.mark.skipif(not os.path.exists("/proc"), reason="reads the processes of a session from /proc")
 @pytest.mark.parametrize("how", ["SIGINT to the group", "SIGTERM"])
-def test_a_signal_while_the_cluster_starts_stops_the_command(tmp_path, how):
+def test_a_signal_while_the_cluster_starts_stops_the_command(tmp_path, how, session_processes):
     """``eval`` on a local cluster, signalled while the cluster starts (a terminal's Ctrl-C reaches the
     whole process group, the first workers too): one line, exit 130 or 143, nothing written, no process of
     the command left. Before, the Ctrl-C was discarded and the run wrote its output."""
@@ -155,7 +141,7 @@ def test_a_signal_while_the_cluster_starts_stops_the_command(tmp_path, how):
     assert all(ln.startswith("ccproof eval: warning: ") for ln in lines[:-1]), err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["cube.obj", "site", "spawning"]
     for _ in range(100):  # the workers and the resource tracker end with the command (within seconds)
-        if not _session_processes(proc.pid):
+        if not session_processes(proc.pid):
             break
         time.sleep(0.1)
-    assert _session_processes(proc.pid) == []
+    assert session_processes(proc.pid) == []
