@@ -25,8 +25,12 @@ __all__ = ["evaluate_points", "PRECOMPUTED_LAYERS"]
 
 #: layers whose blocks are stored per corner piece (3 blocks of 360 bytes each per layer)
 PRECOMPUTED_LAYERS = 2
-#: points located (and their blocks prefetched) before they are evaluated
+#: corner points located (and their blocks prefetched) before they are evaluated
 _BLOCK = 16
+#: corner points listed by the patches' loop before they are evaluated
+_SLOW = 1024
+#: the patches' loop prefetches the block of the point this many points ahead
+_AHEAD = 12
 #: (Jacobian, offset) per rotation (surface.ROTATIONS), flattened: j00 j01 j10 j11 o0 o1
 _ROT = np.array([[1.0, 0.0, 0.0, 1.0, 0.0, 0.0], [0.0, 1.0, -1.0, -1.0, 0.0, 1.0],
                  [-1.0, -1.0, 1.0, 0.0, 1.0, 0.0]])
@@ -75,9 +79,9 @@ def _quartic(c, i, a, b, nrows, loc):
 
 
 @numba.njit(cache=True, inline="always")
-def _deep_block(n, j, N, base, o0, layers, coords, lim, tmp):
+def _deep_block(n, j, N, base, o0, layers, coords, plim, p, tmp):
     """tmp[0] (3, 15): the block of layer n, child j of a corner piece (ring of N points at coords[o0:], layer
-    table at layers[base:]), its limit point ``lim`` (3,) included."""
+    table at layers[base:]), its limit point ``plim[p]`` included."""
     base += (n * 3 + j) * N * 15
     for k in range(3):
         for m in range(15):
@@ -92,7 +96,7 @@ def _deep_block(n, j, N, base, o0, layers, coords, lim, tmp):
             tmp[0, 1, m] += w * c1
             tmp[0, 2, m] += w * c2
     for k in range(3):
-        tmp[0, k, 0] += lim[k]
+        tmp[0, k, 0] += plim[p, k]
 
 
 @numba.njit(cache=True, inline="always")
@@ -143,10 +147,9 @@ def evaluate_points(face, u, v, nrows, tables, out):
 
 
 @numba.njit(cache=True, inline="always")
-def _locate(face, u, v, i, finfo, cinfo, pblock, pgid, gnl, R):
-    """(block, piece, layer n, child j, a, b, scale, t00, t01, t10, t11, deep) of point i: the descent through
-    the splits (the parameter turned and scaled, T its Jacobian), then the block of a patch or of a corner
-    piece's stored layer; block -1: a deeper layer. A node is one word: reference * 16 + rotation * 4 + kind."""
+def _descend(face, u, v, i, finfo, cinfo, R):
+    """(word, a, b, t00, t01, t10, t11) of point i: the descent through the splits to its patch or corner piece
+    (the parameter turned and scaled, T its Jacobian). A node is one word: reference * 16 + rotation * 4 + kind."""
     x = finfo[face[i]]
     a, b = u[i], v[i]
     t00, t01, t10, t11 = 1.0, 0.0, 0.0, 1.0
@@ -169,29 +172,67 @@ def _locate(face, u, v, i, finfo, cinfo, pblock, pgid, gnl, R):
             c, a, b, f = 3, 1 - 2 * a, 1 - 2 * b, -2.0
         t00, t01, t10, t11 = f * t00, f * t01, f * t10, f * t11
         x = cinfo[x >> 4, c]
-    ref = x >> 4
-    if x & 3 == 0:
-        return ref, 0, 0, 0, a, b, 1.0, t00, t01, t10, t11, False
-    n, j, a, b, scale, deep = _layer(a, b, gnl[pgid[ref]])
-    blk = pblock[ref] + 3 * n + j if n < PRECOMPUTED_LAYERS else -1
-    return blk, ref, n, j, a, b, scale, t00, t01, t10, t11, deep
+    return x, a, b, t00, t01, t10, t11
 
 
 @numba.njit(cache=True)
 def _points(face, u, v, nrows, finfo, cinfo, coef, pblock, pgid, pcoord, plim, gN, gnl, glay, layers, coords, out):
-    """Blocks of _BLOCK points: first located (their quartic blocks prefetched), then evaluated."""
+    """The points in box-spline patches by :func:`_patch_points`, the others listed and then evaluated by
+    :func:`_corner_points`, _SLOW at a time (the patches' loop is kept free of the corners' tables)."""
+    slow = np.empty(min(face.size, _SLOW), dtype=np.int64)
+    i = 0
+    while i < face.size:
+        i, ns = _patch_points(face, u, v, i, nrows, finfo, cinfo, coef, out, slow)
+        if ns:
+            _corner_points(slow, ns, face, u, v, nrows, finfo, cinfo, coef, pblock, pgid, pcoord, plim, gN, gnl,
+                           glay, layers, coords, out)
+
+
+@numba.njit(cache=True)
+def _patch_points(face, u, v, i, nrows, finfo, cinfo, coef, out, slow):
+    """Points i, i + 1, ... in box-spline patches evaluated (the blocks of faces _AHEAD points on prefetched), the
+    others listed in ``slow`` until it is full; returns (the next point, the count listed)."""
+    R = _ROT
+    loc = np.empty((6, 3))
+    flat = coef.reshape(-1)
+    n, ns = face.size, 0
+    while i < n and ns < slow.size:
+        if i + _AHEAD < n:
+            x = finfo[face[i + _AHEAD]]
+            if x & 3 == 0:
+                for q in range(0, 45, 8):
+                    _prefetch(flat, 45 * (x >> 4) + q)
+                _prefetch(flat, 45 * (x >> 4) + 44)
+        x, a, b, t00, t01, t10, t11 = _descend(face, u, v, i, finfo, cinfo, R)
+        if x & 3 != 0:
+            slow[ns] = i
+            ns += 1
+        else:
+            _quartic(coef, x >> 4, a, b, nrows, loc)
+            _store(out, i, nrows, loc, 1.0, t00, t01, t10, t11)
+        i += 1
+    return i, ns
+
+
+@numba.njit(cache=True)
+def _corner_points(idx, ns, face, u, v, nrows, finfo, cinfo, coef, pblock, pgid, pcoord, plim, gN, gnl, glay, layers,
+                   coords, out):
+    """Points idx[:ns] in corner pieces, _BLOCK at a time: first their layers located (the stored layers' blocks
+    prefetched), then evaluated (deeper layers' blocks formed from the ring)."""
     R = _ROT
     loc = np.empty((6, 3))
     tmp = np.empty((1, 3, 15))
     flat = coef.reshape(-1)
     iw = np.empty((_BLOCK, 4), dtype=np.int64)  # block, piece, n, j
     fw = np.empty((_BLOCK, 8))  # a, b, scale, t00, t01, t10, t11, deep
-    for i0 in range(0, face.size, _BLOCK):
-        i1 = min(i0 + _BLOCK, face.size)
-        for i in range(i0, i1):
-            blk, p, n, j, a, b, scale, t00, t01, t10, t11, deep = _locate(
-                face, u, v, i, finfo, cinfo, pblock, pgid, gnl, R)
-            w = i - i0
+    for k0 in range(0, ns, _BLOCK):
+        k1 = min(k0 + _BLOCK, ns)
+        for k in range(k0, k1):
+            x, a, b, t00, t01, t10, t11 = _descend(face, u, v, idx[k], finfo, cinfo, R)
+            p = x >> 4
+            n, j, a, b, scale, deep = _layer(a, b, gnl[pgid[p]])
+            blk = pblock[p] + 3 * n + j if n < PRECOMPUTED_LAYERS else -1
+            w = k - k0
             iw[w, 0], iw[w, 1], iw[w, 2], iw[w, 3] = blk, p, n, j
             fw[w, 0], fw[w, 1], fw[w, 2], fw[w, 3], fw[w, 4], fw[w, 5], fw[w, 6] = a, b, scale, t00, t01, t10, t11
             fw[w, 7] = 1.0 if deep else 0.0
@@ -199,18 +240,16 @@ def _points(face, u, v, nrows, finfo, cinfo, coef, pblock, pgid, pcoord, plim, g
                 for q in range(0, 45, 8):
                     _prefetch(flat, 45 * blk + q)
                 _prefetch(flat, 45 * blk + 44)
-        for i in range(i0, i1):
-            w = i - i0
-            blk = iw[w, 0]
+        for k in range(k0, k1):
+            w = k - k0
+            blk, p = iw[w, 0], iw[w, 1]
             if blk >= 0:
                 _quartic(coef, blk, fw[w, 0], fw[w, 1], nrows, loc)
             else:
-                p = iw[w, 1]
                 g = pgid[p]
-                _deep_block(iw[w, 2], iw[w, 3], gN[g], glay[g], pcoord[p], layers, coords, plim[p], tmp)
+                _deep_block(iw[w, 2], iw[w, 3], gN[g], glay[g], pcoord[p], layers, coords, plim, p, tmp)
                 _quartic(tmp, 0, fw[w, 0], fw[w, 1], nrows, loc)
             if fw[w, 7] != 0.0:
-                p = iw[w, 1]
-                for k in range(3):
-                    loc[0, k] = plim[p, k]
-            _store(out, i, nrows, loc, fw[w, 2], fw[w, 3], fw[w, 4], fw[w, 5], fw[w, 6])
+                for c in range(3):
+                    loc[0, c] = plim[p, c]
+            _store(out, idx[k], nrows, loc, fw[w, 2], fw[w, 3], fw[w, 4], fw[w, 5], fw[w, 6])
