@@ -79,24 +79,40 @@ def _quartic(c, i, a, b, nrows, loc):
 
 
 @numba.njit(cache=True, inline="always")
+def _ring_sums(layers, lo, N, coords, o, k):
+    """``sum_q layers[lo + 15 q + m] coords[o + 3 q + k]`` for m = 0 .. 14: 15 sums kept in registers."""
+    s0 = s1 = s2 = s3 = s4 = s5 = s6 = s7 = s8 = s9 = s10 = s11 = s12 = s13 = s14 = 0.0
+    for q in range(N):
+        c = coords[o + 3 * q + k]
+        w = lo + 15 * q
+        s0 += layers[w] * c
+        s1 += layers[w + 1] * c
+        s2 += layers[w + 2] * c
+        s3 += layers[w + 3] * c
+        s4 += layers[w + 4] * c
+        s5 += layers[w + 5] * c
+        s6 += layers[w + 6] * c
+        s7 += layers[w + 7] * c
+        s8 += layers[w + 8] * c
+        s9 += layers[w + 9] * c
+        s10 += layers[w + 10] * c
+        s11 += layers[w + 11] * c
+        s12 += layers[w + 12] * c
+        s13 += layers[w + 13] * c
+        s14 += layers[w + 14] * c
+    return s0, s1, s2, s3, s4, s5, s6, s7, s8, s9, s10, s11, s12, s13, s14
+
+
+@numba.njit(cache=True, inline="always")
 def _deep_block(n, j, N, base, o0, layers, coords, plim, p, tmp):
     """tmp[0] (3, 15): the block of layer n, child j of a corner piece (ring of N points at coords[o0:], layer
-    table at layers[base:]), its limit point ``plim[p]`` included."""
-    base += (n * 3 + j) * N * 15
+    table at layers[base:]: ``KD[n, j]``, N x 15), its limit point ``plim[p]`` included."""
+    lo = base + (n * 3 + j) * N * 15
     for k in range(3):
-        for m in range(15):
-            tmp[0, k, m] = 0.0
-    for q in range(N):  # tmp[k, m] += KD[n, j, q, m] C[q, k]: 45 independent sums
-        o = o0 + 3 * q
-        c0, c1, c2 = coords[o], coords[o + 1], coords[o + 2]
-        lo = base + q * 15
-        for m in range(15):
-            w = layers[lo + m]
-            tmp[0, 0, m] += w * c0
-            tmp[0, 1, m] += w * c1
-            tmp[0, 2, m] += w * c2
-    for k in range(3):
-        tmp[0, k, 0] += plim[p, k]
+        s0, s1, s2, s3, s4, s5, s6, s7, s8, s9, s10, s11, s12, s13, s14 = _ring_sums(layers, lo, N, coords, o0, k)
+        t = tmp[0, k]
+        t[0], t[1], t[2], t[3], t[4], t[5], t[6], t[7] = s0 + plim[p, k], s1, s2, s3, s4, s5, s6, s7
+        t[8], t[9], t[10], t[11], t[12], t[13], t[14] = s8, s9, s10, s11, s12, s13, s14
 
 
 @numba.njit(cache=True, inline="always")
@@ -178,14 +194,17 @@ def _descend(face, u, v, i, finfo, cinfo, R):
 @numba.njit(cache=True)
 def _points(face, u, v, nrows, finfo, cinfo, coef, pblock, pgid, pcoord, plim, gN, gnl, glay, layers, coords, out):
     """The points in box-spline patches by :func:`_patch_points`, the others listed and then evaluated by
-    :func:`_corner_points`, _SLOW at a time (the patches' loop is kept free of the corners' tables)."""
+    :func:`_corner_points` (the stored layers) and :func:`_deep_points` (deeper), _SLOW at a time: each loop
+    reads only the tables it needs (a loop that might touch more tables runs slower)."""
     slow = np.empty(min(face.size, _SLOW), dtype=np.int64)
+    deep = np.empty(min(face.size, _SLOW), dtype=np.int64)
     i = 0
     while i < face.size:
         i, ns = _patch_points(face, u, v, i, nrows, finfo, cinfo, coef, out, slow)
-        if ns:
-            _corner_points(slow, ns, face, u, v, nrows, finfo, cinfo, coef, pblock, pgid, pcoord, plim, gN, gnl,
-                           glay, layers, coords, out)
+        nd = _corner_points(slow, ns, face, u, v, nrows, finfo, cinfo, coef, pblock, pgid, gnl, out, deep) if ns else 0
+        if nd:
+            _deep_points(deep, nd, face, u, v, nrows, finfo, cinfo, pgid, pcoord, plim, gN, gnl, glay, layers, coords,
+                         out)
 
 
 @numba.njit(cache=True)
@@ -215,41 +234,56 @@ def _patch_points(face, u, v, i, nrows, finfo, cinfo, coef, out, slow):
 
 
 @numba.njit(cache=True)
-def _corner_points(idx, ns, face, u, v, nrows, finfo, cinfo, coef, pblock, pgid, pcoord, plim, gN, gnl, glay, layers,
-                   coords, out):
+def _corner_points(idx, ns, face, u, v, nrows, finfo, cinfo, coef, pblock, pgid, gnl, out, deep):
     """Points idx[:ns] in corner pieces, _BLOCK at a time: first their layers located (the stored layers' blocks
-    prefetched), then evaluated (deeper layers' blocks formed from the ring)."""
+    prefetched), then evaluated; those in deeper layers listed in ``deep`` (returns their count)."""
     R = _ROT
     loc = np.empty((6, 3))
-    tmp = np.empty((1, 3, 15))
     flat = coef.reshape(-1)
-    iw = np.empty((_BLOCK, 4), dtype=np.int64)  # block, piece, n, j
-    fw = np.empty((_BLOCK, 8))  # a, b, scale, t00, t01, t10, t11, deep
+    iw = np.empty(_BLOCK, dtype=np.int64)  # block, -1: deeper
+    fw = np.empty((_BLOCK, 7))  # a, b, scale, t00, t01, t10, t11
+    nd = 0
     for k0 in range(0, ns, _BLOCK):
         k1 = min(k0 + _BLOCK, ns)
         for k in range(k0, k1):
             x, a, b, t00, t01, t10, t11 = _descend(face, u, v, idx[k], finfo, cinfo, R)
             p = x >> 4
-            n, j, a, b, scale, deep = _layer(a, b, gnl[pgid[p]])
-            blk = pblock[p] + 3 * n + j if n < PRECOMPUTED_LAYERS else -1
+            n, j, a, b, scale, beyond = _layer(a, b, gnl[pgid[p]])
+            blk = pblock[p] + 3 * n + j if n < PRECOMPUTED_LAYERS and not beyond else -1
             w = k - k0
-            iw[w, 0], iw[w, 1], iw[w, 2], iw[w, 3] = blk, p, n, j
+            iw[w] = blk
             fw[w, 0], fw[w, 1], fw[w, 2], fw[w, 3], fw[w, 4], fw[w, 5], fw[w, 6] = a, b, scale, t00, t01, t10, t11
-            fw[w, 7] = 1.0 if deep else 0.0
             if blk >= 0:
                 for q in range(0, 45, 8):
                     _prefetch(flat, 45 * blk + q)
                 _prefetch(flat, 45 * blk + 44)
+            else:
+                deep[nd] = idx[k]
+                nd += 1
         for k in range(k0, k1):
             w = k - k0
-            blk, p = iw[w, 0], iw[w, 1]
-            if blk >= 0:
-                _quartic(coef, blk, fw[w, 0], fw[w, 1], nrows, loc)
-            else:
-                g = pgid[p]
-                _deep_block(iw[w, 2], iw[w, 3], gN[g], glay[g], pcoord[p], layers, coords, plim, p, tmp)
-                _quartic(tmp, 0, fw[w, 0], fw[w, 1], nrows, loc)
-            if fw[w, 7] != 0.0:
-                for c in range(3):
-                    loc[0, c] = plim[p, c]
-            _store(out, idx[k], nrows, loc, fw[w, 2], fw[w, 3], fw[w, 4], fw[w, 5], fw[w, 6])
+            if iw[w] >= 0:
+                _quartic(coef, iw[w], fw[w, 0], fw[w, 1], nrows, loc)
+                _store(out, idx[k], nrows, loc, fw[w, 2], fw[w, 3], fw[w, 4], fw[w, 5], fw[w, 6])
+    return nd
+
+
+@numba.njit(cache=True)
+def _deep_points(idx, nd, face, u, v, nrows, finfo, cinfo, pgid, pcoord, plim, gN, gnl, glay, layers, coords, out):
+    """Points idx[:nd] in the deeper layers of corner pieces (or beyond the last): their blocks formed from the
+    configuration's layer table and the ring."""
+    R = _ROT
+    loc = np.empty((6, 3))
+    tmp = np.empty((1, 3, 15))
+    for k in range(nd):
+        i = idx[k]
+        x, a, b, t00, t01, t10, t11 = _descend(face, u, v, i, finfo, cinfo, R)
+        p = x >> 4
+        g = pgid[p]
+        n, j, a, b, scale, beyond = _layer(a, b, gnl[g])
+        _deep_block(n, j, gN[g], glay[g], pcoord[p], layers, coords, plim, p, tmp)
+        _quartic(tmp, 0, a, b, nrows, loc)
+        if beyond:
+            for c in range(3):
+                loc[0, c] = plim[p, c]
+        _store(out, i, nrows, loc, scale, t00, t01, t10, t11)
