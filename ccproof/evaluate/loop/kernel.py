@@ -196,26 +196,27 @@ def _points(face, u, v, nrows, finfo, cinfo, coef, pblock, pgid, pcoord, plim, g
     """The points in box-spline patches by :func:`_patch_points`, the others listed and then evaluated by
     :func:`_corner_points` (the stored layers) and :func:`_deep_points` (deeper), _SLOW at a time: each loop
     reads only the tables it needs (a loop that might touch more tables runs slower)."""
-    slow = np.empty(min(face.size, _SLOW), dtype=np.int64)
+    slow = np.empty((min(face.size, _SLOW), 2), dtype=np.int64)  # point, word
+    state = np.empty((min(face.size, _SLOW), 6))  # a, b, t00, t01, t10, t11
     deep = np.empty(min(face.size, _SLOW), dtype=np.int64)
     i = 0
     while i < face.size:
-        i, ns = _patch_points(face, u, v, i, nrows, finfo, cinfo, coef, out, slow)
-        nd = _corner_points(slow, ns, face, u, v, nrows, finfo, cinfo, coef, pblock, pgid, gnl, out, deep) if ns else 0
+        i, ns = _patch_points(face, u, v, i, nrows, finfo, cinfo, coef, out, slow, state)
+        nd = _corner_points(slow, state, ns, nrows, coef, pblock, pgid, gnl, out, deep) if ns else 0
         if nd:
             _deep_points(deep, nd, face, u, v, nrows, finfo, cinfo, pgid, pcoord, plim, gN, gnl, glay, layers, coords,
                          out)
 
 
 @numba.njit(cache=True)
-def _patch_points(face, u, v, i, nrows, finfo, cinfo, coef, out, slow):
+def _patch_points(face, u, v, i, nrows, finfo, cinfo, coef, out, slow, state):
     """Points i, i + 1, ... in box-spline patches evaluated (the blocks of faces _AHEAD points on prefetched), the
     others listed in ``slow`` until it is full; returns (the next point, the count listed)."""
     R = _ROT
     loc = np.empty((6, 3))
     flat = coef.reshape(-1)
     n, ns = face.size, 0
-    while i < n and ns < slow.size:
+    while i < n and ns < slow.shape[0]:
         if i + _AHEAD < n:
             x = finfo[face[i + _AHEAD]]
             if x & 3 == 0:
@@ -224,7 +225,9 @@ def _patch_points(face, u, v, i, nrows, finfo, cinfo, coef, out, slow):
                 _prefetch(flat, 45 * (x >> 4) + 44)
         x, a, b, t00, t01, t10, t11 = _descend(face, u, v, i, finfo, cinfo, R)
         if x & 3 != 0:
-            slow[ns] = i
+            slow[ns, 0], slow[ns, 1] = i, x
+            st = state[ns]
+            st[0], st[1], st[2], st[3], st[4], st[5] = a, b, t00, t01, t10, t11
             ns += 1
         else:
             _quartic(coef, x >> 4, a, b, nrows, loc)
@@ -234,10 +237,9 @@ def _patch_points(face, u, v, i, nrows, finfo, cinfo, coef, out, slow):
 
 
 @numba.njit(cache=True)
-def _corner_points(idx, ns, face, u, v, nrows, finfo, cinfo, coef, pblock, pgid, gnl, out, deep):
+def _corner_points(idx, state, ns, nrows, coef, pblock, pgid, gnl, out, deep):
     """Points idx[:ns] in corner pieces, _BLOCK at a time: first their layers located (the stored layers' blocks
     prefetched), then evaluated; those in deeper layers listed in ``deep`` (returns their count)."""
-    R = _ROT
     loc = np.empty((6, 3))
     flat = coef.reshape(-1)
     iw = np.empty(_BLOCK, dtype=np.int64)  # block, -1: deeper
@@ -246,9 +248,9 @@ def _corner_points(idx, ns, face, u, v, nrows, finfo, cinfo, coef, pblock, pgid,
     for k0 in range(0, ns, _BLOCK):
         k1 = min(k0 + _BLOCK, ns)
         for k in range(k0, k1):
-            x, a, b, t00, t01, t10, t11 = _descend(face, u, v, idx[k], finfo, cinfo, R)
-            p = x >> 4
-            n, j, a, b, scale, beyond = _layer(a, b, gnl[pgid[p]])
+            p = idx[k, 1] >> 4
+            t00, t01, t10, t11 = state[k, 2], state[k, 3], state[k, 4], state[k, 5]
+            n, j, a, b, scale, beyond = _layer(state[k, 0], state[k, 1], gnl[pgid[p]])
             blk = pblock[p] + 3 * n + j if n < PRECOMPUTED_LAYERS and not beyond else -1
             w = k - k0
             iw[w] = blk
@@ -258,13 +260,13 @@ def _corner_points(idx, ns, face, u, v, nrows, finfo, cinfo, coef, pblock, pgid,
                     _prefetch(flat, 45 * blk + q)
                 _prefetch(flat, 45 * blk + 44)
             else:
-                deep[nd] = idx[k]
+                deep[nd] = idx[k, 0]
                 nd += 1
         for k in range(k0, k1):
             w = k - k0
             if iw[w] >= 0:
                 _quartic(coef, iw[w], fw[w, 0], fw[w, 1], nrows, loc)
-                _store(out, idx[k], nrows, loc, fw[w, 2], fw[w, 3], fw[w, 4], fw[w, 5], fw[w, 6])
+                _store(out, idx[k, 0], nrows, loc, fw[w, 2], fw[w, 3], fw[w, 4], fw[w, 5], fw[w, 6])
     return nd
 
 
