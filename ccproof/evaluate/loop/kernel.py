@@ -23,8 +23,9 @@ from numba.extending import intrinsic
 
 __all__ = ["evaluate_points", "PRECOMPUTED_LAYERS"]
 
-#: layers whose blocks are stored per corner piece (3 blocks of 360 bytes each per layer)
-PRECOMPUTED_LAYERS = 2
+#: layers whose blocks are stored per corner piece (3 blocks of 360 bytes each per layer; a uniformly random point
+#: of a corner piece is deeper with probability 1/64)
+PRECOMPUTED_LAYERS = 3
 #: corner points located (and their blocks prefetched) before they are evaluated
 _BLOCK = 16
 #: corner points listed by the patches' loop before they are evaluated
