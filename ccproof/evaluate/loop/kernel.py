@@ -9,8 +9,10 @@ from the exponent of u + v (O(1)); in the first layers it reads its block like a
 4^-PRECOMPUTED_LAYERS of the piece's area) it forms the block from the configuration's layer table (``KD[n, j]``:
 N ring points x 15 monomials) and the ring's N control points.
 
-Every point's arithmetic is the same whatever the order and the batch (tests/evaluate/test_loop.py checks
-bit-identical outputs on permuted points and in small calls).
+Three loops (:func:`_points`): the points of box-spline patches (blocks prefetched a few points ahead), then
+the points handed over in corner pieces' stored layers, then the deeper ones; each loop reads only the
+tables it needs. Every point's arithmetic is the same whatever the order and the batch
+(tests/evaluate/test_loop.py checks bit-identical outputs on permuted points and in small calls).
 """
 
 from __future__ import annotations

@@ -17,8 +17,10 @@ regular (smooth, valence 6) is a box-spline patch (:mod:`ccproof.evaluate.loop.b
 with one irregular corner is evaluated by Stam's self-similar layers (exact matrix powers, once per
 configuration); any other triangle is subdivided locally and exactly until its children are one of
 these (on a closed mesh once). Every configuration's data are computed once (cached by its ring key);
-per triangle only its control points are stored (memory O(faces)). Points are evaluated in batches:
-a vectorized descent through the local subdivisions, then one gather and product per patch kind.
+per triangle its control points are stored (memory O(faces)), and for the compiled backend each patch's
+polynomial coefficients (per corner piece those of its first layers, :mod:`ccproof.evaluate.loop.kernel`).
+The numpy backend evaluates in batches: a vectorized descent through the local subdivisions, then one
+gather and product per patch kind.
 """
 
 from __future__ import annotations
@@ -213,7 +215,8 @@ class LoopSurface:
         self._groups = None
         self.n_regular = len(self._nets)
         self.n_corner = sum(len(c) for _, c in self._corner_data)
-        self._kernel_tables()
+        if self.backend == "numba":
+            self._kernel_tables()
 
     def _kernel_tables(self):
         """The flat tables of :func:`ccproof.evaluate.loop.kernel.evaluate_points`: the quartic blocks (box-spline
@@ -232,7 +235,7 @@ class LoopSurface:
         pblock, plim, kd = [], [], []
         nb = len(self._nets)
         for p, coords in self._corner_data:
-            KD = np.einsum("mk,njkN->njNm", K, p.layers)  # (layers, 3, N, 15)
+            KD = p.poly_layers  # (layers, 3, N, 15)
             kd.append(KD.reshape(-1))
             nl = min(PRECOMPUTED_LAYERS, KD.shape[0])
             lim = np.einsum("N,mNk->mk", p.limit_mask, coords)  # (m, 3)
