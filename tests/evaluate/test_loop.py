@@ -280,7 +280,8 @@ def test_against_opensubdiv_loop_patches(case):
 
 
 def test_numpy_backend_equals_compiled():
-    """The vectorized numpy path and the compiled kernel read the same tables: equal to rounding."""
+    """The vectorized numpy path (nets and layer tables times the box-spline basis) and the compiled kernel
+    (precomputed polynomial blocks, deeper layers from the ring): equal to rounding."""
     V, T = icosahedron(seed=7)
     one = Level(V, T).subdivide()
     F = flip_edges(one.F, 40, seed=11)

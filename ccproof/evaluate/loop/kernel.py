@@ -23,7 +23,7 @@ from llvmlite import ir
 from numba.core import cgutils, types
 from numba.extending import intrinsic
 
-__all__ = ["evaluate_points", "PRECOMPUTED_LAYERS"]
+__all__ = ["evaluate_loop_points", "PRECOMPUTED_LAYERS"]
 
 #: layers whose blocks are stored per corner piece (3 blocks of 360 bytes each per layer; a uniformly random point
 #: of a corner piece is deeper with probability 1/64)
@@ -153,7 +153,7 @@ def _store(out, i, nrows, loc, scale, t00, t01, t10, t11):
             out[5, i, c] = t01 * t01 * huu + 2 * t01 * t11 * huv + t11 * t11 * hvv
 
 
-def evaluate_points(face, u, v, nrows, tables, out):
+def evaluate_loop_points(face, u, v, nrows, tables, out):
     """out[r, i, c] for points i: rows 0 (P), 1-2 (Pu, Pv), 3-5 (Puu, Puv, Pvv), the first nrows rows.
 
     ``tables``: ``(finfo, cinfo, coef, corner)`` as :meth:`ccproof.evaluate.loop.surface.LoopSurface` builds

@@ -106,7 +106,7 @@ class LoopSurface:
         points on them are refused.
     backend : {"numba", "numpy"}
         The compiled point loop (:mod:`ccproof.evaluate.loop.kernel`, default) or the vectorized numpy
-        path (the same tables and arithmetic).
+        path (the nets and layer tables times the box-spline basis: the tests' second implementation).
 
     Attributes
     ----------
@@ -219,7 +219,7 @@ class LoopSurface:
             self._kernel_tables()
 
     def _kernel_tables(self):
-        """The flat tables of :func:`ccproof.evaluate.loop.kernel.evaluate_points`: the quartic blocks (box-spline
+        """The flat tables of :func:`ccproof.evaluate.loop.kernel.evaluate_loop_points`: the quartic blocks (box-spline
         patches, then per corner piece its first layers, limit point included), per piece its first block, ring
         offset and limit point, per configuration its ring size, layer count and layer offset."""
         from ccproof.evaluate.loop.box_spline import basis_coefficients
@@ -311,11 +311,11 @@ class LoopSurface:
         return out
 
     def _evaluate_compiled(self, face, u, v, derivatives):
-        from ccproof.evaluate.loop.kernel import evaluate_points
+        from ccproof.evaluate.loop.kernel import evaluate_loop_points
 
         nrows = (1, 3, 6)[derivatives]
         out = np.empty((nrows, face.size, 3))
-        evaluate_points(face, u, v, nrows, self._k, out)
+        evaluate_loop_points(face, u, v, nrows, self._k, out)
         return {key: out[r] for r, key in enumerate(_KEYS[derivatives])}
 
     def _turn(self, node, u, v, T):
