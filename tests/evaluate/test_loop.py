@@ -280,7 +280,8 @@ def test_against_opensubdiv_loop_patches(case):
 
 
 def test_numpy_backend_equals_compiled():
-    """The vectorized numpy path and the compiled kernel read the same tables: equal to rounding."""
+    """The vectorized numpy path (nets and layer tables times the box-spline basis) and the compiled kernel
+    (precomputed polynomial blocks, deeper layers from the ring): equal to rounding."""
     V, T = icosahedron(seed=7)
     one = Level(V, T).subdivide()
     F = flip_edges(one.F, 40, seed=11)
@@ -296,6 +297,30 @@ def test_numpy_backend_equals_compiled():
     B = LoopSurface(mesh, backend="numpy").evaluate(f, u, v, 2)
     for k in KEYS:
         assert np.max(np.abs(A[k] - B[k]) / np.maximum(1, np.abs(B[k]))) < TOL, k
+
+
+def test_outputs_do_not_depend_on_the_order_or_the_batch():
+    """Each point's outputs are bit-identical whether it comes in a large call, permuted, or in small calls,
+    on regular, split and corner patches, in the stored layers and deeper ones."""
+    V, T = icosahedron(seed=3)
+    F = flip_edges(Level(V, T).subdivide().F, 20, seed=4)
+    S = LoopSurface(PolyMesh(Level(V, T).subdivide().V, F))
+    rng = np.random.default_rng(8)
+    n = 8192
+    f = rng.integers(0, len(F), n)
+    u, v = rng.random(n), rng.random(n)
+    flip = u + v > 1
+    u[flip], v[flip] = 1 - u[flip], 1 - v[flip]
+    s = 2.0 ** -rng.integers(0, 80, n // 4)  # layers 0 .. 79 at every corner
+    u[: n // 4], v[: n // 4] = s * rng.random(n // 4), 0.0
+    v[: n // 8] = s[: n // 8] * (1 - u[: n // 8] / s[: n // 8]) * rng.random(n // 8)
+    A = S.evaluate(f, u, v, 2)
+    p = rng.permutation(n)
+    B = S.evaluate(f[p], u[p], v[p], 2)
+    C = [S.evaluate(f[i:i + 100], u[i:i + 100], v[i:i + 100], 2) for i in range(0, n, 100)]
+    for k in KEYS:
+        assert np.array_equal(A[k][p], B[k]), k
+        assert np.array_equal(A[k], np.concatenate([c[k] for c in C])), k
 
 
 def test_vectorized_regular_nets_equal_the_per_configuration_path():

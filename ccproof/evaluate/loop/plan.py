@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ccproof.errors import MeshError
+from ccproof.evaluate.loop.box_spline import basis_coefficients
 from ccproof.evaluate.loop.complex import (
     SMOOTH,
     canonical_triangle_ring,
@@ -55,10 +56,13 @@ class Regular:
 
 @dataclass(frozen=True, eq=False)
 class Corner:
-    """Self-similar layers at irregular corner 0: ``limit_mask`` (N,), ``layers`` (n_layers, 3, 12, N)."""
+    """Self-similar layers at irregular corner 0: ``limit_mask`` (N,), ``layers`` (n_layers, 3, 12, N), and
+    ``poly_layers`` (n_layers, 3, N, 15): the same in monomial form (the box spline's coefficients times each
+    layer's nets: ring point q's weight in the coefficient of monomial m of child j of layer n)."""
     size: int
     limit_mask: np.ndarray
     layers: np.ndarray
+    poly_layers: np.ndarray
 
 
 @dataclass(frozen=True, eq=False)
@@ -173,7 +177,13 @@ def _corner(cx, key):
         A, M = _arb_mat(rows, N), _arb_mat(nets, N)
         l_row = _limit_row(cx, A, N, one)
         layers = power_layers(M, A, l_row)
-        return Corner(N, np.array([_to_float(l_row[0, j]) for j in range(N)]), layers)
+        return Corner(N, np.array([_to_float(l_row[0, j]) for j in range(N)]), layers, _monomial_form(layers))
+
+
+def _monomial_form(layers):
+    """(n_layers, 3, N, 15): the layers' nets (n_layers, 3, 12, N) times the box spline's coefficient matrix."""
+    K = np.array([[int(x.p) / int(x.q) for x in row] for row in basis_coefficients()])  # (15, 12)
+    return np.ascontiguousarray(np.matmul(K, layers).transpose(0, 1, 3, 2))
 
 
 def _limit_row(cx, A, N, one):

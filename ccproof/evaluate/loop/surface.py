@@ -17,8 +17,10 @@ regular (smooth, valence 6) is a box-spline patch (:mod:`ccproof.evaluate.loop.b
 with one irregular corner is evaluated by Stam's self-similar layers (exact matrix powers, once per
 configuration); any other triangle is subdivided locally and exactly until its children are one of
 these (on a closed mesh once). Every configuration's data are computed once (cached by its ring key);
-per triangle only its control points are stored (memory O(faces)). Points are evaluated in batches:
-a vectorized descent through the local subdivisions, then one gather and product per patch kind.
+per triangle its control points are stored (memory O(faces)), and for the compiled backend each patch's
+polynomial coefficients (per corner piece those of its first layers, :mod:`ccproof.evaluate.loop.kernel`).
+The numpy backend evaluates in batches: a vectorized descent through the local subdivisions, then one
+gather and product per patch kind.
 """
 
 from __future__ import annotations
@@ -104,7 +106,7 @@ class LoopSurface:
         points on them are refused.
     backend : {"numba", "numpy"}
         The compiled point loop (:mod:`ccproof.evaluate.loop.kernel`, default) or the vectorized numpy
-        path (the same tables and arithmetic).
+        path (the nets and layer tables times the box-spline basis: the tests' second implementation).
 
     Attributes
     ----------
@@ -213,33 +215,53 @@ class LoopSurface:
         self._groups = None
         self.n_regular = len(self._nets)
         self.n_corner = sum(len(c) for _, c in self._corner_data)
-        self._kernel_tables()
+        if self.backend == "numba":
+            self._kernel_tables()
 
     def _kernel_tables(self):
-        """The flat tables of :func:`ccproof.evaluate.loop.kernel.evaluate_points`."""
+        """The flat tables of :func:`ccproof.evaluate.loop.kernel.evaluate_loop_points`: the quartic blocks (box-spline
+        patches, then per corner piece its first layers, limit point included), per piece its first block, ring
+        offset and limit point, per configuration its ring size, layer count and layer offset."""
         from ccproof.evaluate.loop.box_spline import basis_coefficients
+        from ccproof.evaluate.loop.kernel import PRECOMPUTED_LAYERS
 
         K = np.array([[int(x.p) / int(x.q) for x in row] for row in basis_coefficients()])
-        start = np.cumsum([0] + [len(c) for _, c in self._corner_data])
+        counts = [len(c) for _, c in self._corner_data]
+        start = np.cumsum([0] + counts)
         cref = self._ref.copy()
         corner = self._kind == _CORNER
         cref[corner] += start[self._gid[corner]]
-        sizes = [p.size for p, _ in self._corner_data]
-        flat = [c.reshape(-1) for _, c in self._corner_data]
-        piece = np.repeat(np.array(sizes, dtype=np.int64) * 3, [len(c) for _, c in self._corner_data])
-        self._k = dict(
-            root=self._root, kind=self._kind.astype(np.int64), rot=self._rot.astype(np.int64), ref=cref,
-            children=self._children, gid=self._gid,
-            reg_coef=np.matmul(self._nets.transpose(0, 2, 1), K.T),
-            piece_off=np.r_[0, np.cumsum(piece)][:-1].astype(np.int64),
-            gN=np.array(sizes, dtype=np.int64), gnl=np.array([p.layers.shape[0] for p, _ in self._corner_data],
-                                                              dtype=np.int64),
-            glay=np.cumsum([0] + [p.layers.size // 12 * 15 for p, _ in self._corner_data])[:-1].astype(np.int64),
-            gmask=np.cumsum([0] + sizes)[:-1].astype(np.int64),
-            layers=np.concatenate([np.einsum("mk,njkN->njNm", K, p.layers).reshape(-1) for p, _ in self._corner_data]
-                                  + [np.zeros(0)]),
-            masks=np.concatenate([p.limit_mask for p, _ in self._corner_data] + [np.zeros(0)]),
-            coords=np.concatenate(flat + [np.zeros(0)]))
+        blocks = [np.matmul(self._nets.transpose(0, 2, 1), K.T)]
+        pblock, plim, kd = [], [], []
+        nb = len(self._nets)
+        for p, coords in self._corner_data:
+            KD = p.poly_layers  # (layers, 3, N, 15)
+            kd.append(KD.reshape(-1))
+            nl = min(PRECOMPUTED_LAYERS, KD.shape[0])
+            lim = np.einsum("N,mNk->mk", p.limit_mask, coords)  # (m, 3)
+            m = len(coords)
+            W = KD[:nl].transpose(0, 1, 3, 2).reshape(nl * 45, p.size)
+            B = (W @ coords.transpose(1, 0, 2).reshape(p.size, 3 * m)).reshape(nl, 3, 15, m, 3)
+            B = np.ascontiguousarray(B.transpose(3, 0, 1, 4, 2))  # (m, layer, child, coordinate, monomial)
+            B[..., 0] += lim[:, None, None, :]
+            blocks.append(B.reshape(-1, 3, 15))
+            pblock.append(nb + 3 * nl * np.arange(m, dtype=np.int64))
+            nb += 3 * nl * m
+            plim.append(lim)
+        sizes = np.array([p.size for p, _ in self._corner_data], dtype=np.int64)
+        pieces = (np.concatenate(pblock + [np.zeros(0, dtype=np.int64)]), np.repeat(np.arange(len(counts)), counts),
+                  np.r_[0, np.cumsum(np.repeat(sizes * 3, counts))][:-1].astype(np.int64),
+                  np.concatenate(plim + [np.zeros((0, 3))]))
+        groups = (sizes, np.array([p.layers.shape[0] for p, _ in self._corner_data], dtype=np.int64),
+                  np.cumsum([0] + [x.size for x in kd])[:-1].astype(np.int64))
+        flat = np.concatenate([c.reshape(-1) for _, c in self._corner_data] + [np.zeros(0)])
+        # per node one word: its reference (block; piece; for a split its row of cinfo), rotation and kind
+        split = self._kind == _SPLIT
+        cref[split] = np.arange(int(split.sum()))
+        info = cref * 16 + self._rot.astype(np.int64) * 4 + self._kind.astype(np.int64)
+        cinfo = info[self._children[split]]
+        self._k = (info[self._root], cinfo.reshape(-1, 4), np.concatenate(blocks),
+                   (pieces, groups, np.concatenate(kd + [np.zeros(0)]), flat))
 
     # ------------------------------------------------------------------ evaluation
     def evaluate(self, face, u, v, derivatives=0, *, parameterization="natural", threads=None):
@@ -289,14 +311,11 @@ class LoopSurface:
         return out
 
     def _evaluate_compiled(self, face, u, v, derivatives):
-        from ccproof.evaluate.loop.kernel import evaluate_points
+        from ccproof.evaluate.loop.kernel import evaluate_loop_points
 
         nrows = (1, 3, 6)[derivatives]
         out = np.empty((nrows, face.size, 3))
-        k = self._k
-        tables = tuple(k[name] for name in ("root", "kind", "rot", "ref", "children", "gid", "reg_coef", "piece_off",
-                                            "gN", "gnl", "glay", "gmask", "layers", "masks", "coords"))
-        evaluate_points(face, u, v, nrows, tables, out)
+        evaluate_loop_points(face, u, v, nrows, self._k, out)
         return {key: out[r] for r, key in enumerate(_KEYS[derivatives])}
 
     def _turn(self, node, u, v, T):
