@@ -331,10 +331,11 @@ if os.environ.get("CCPROOF_TEST_NO_DASK"):
 
 
 @pytest.mark.parametrize("workers", ["processes", "dask"])
-def test_ctrl_c_to_the_process_group_with_workers(tmp_path, workers):
+def test_ctrl_c_to_the_process_group_with_workers(tmp_path, workers, session_processes):
     """A terminal sends Ctrl-C to every process of the foreground group, the workers too: still one line
     from the command, exit 130, no traceback from any worker, and no index.json (the folder is unfinished);
-    the command does not wait for the workers' tasks."""
+    the command does not wait for the workers' tasks: it ends within 3 s (Dask's graceful close waited 4 s
+    for a busy worker before killing it) and leaves no process behind."""
     if workers == "dask":
         pytest.importorskip("distributed")
     site = tmp_path / "site"
@@ -358,11 +359,19 @@ def test_ctrl_c_to_the_process_group_with_workers(tmp_path, workers):
             time.sleep(0.05)
         assert os.listdir(marks) and proc.poll() is None, "no worker started a task"
         os.killpg(proc.pid, signal.SIGINT)
+        start = time.monotonic()
         _, err = proc.communicate(timeout=100)  # < the workers' 120 s stall: they were stopped
+        took = time.monotonic() - start
     finally:
         if proc.poll() is None:
             os.killpg(proc.pid, signal.SIGKILL)
     assert proc.returncode == 130, err
+    assert took < 3.0, f"{took:.1f} s from Ctrl-C to the end of the command"
+    for _ in range(50):  # the workers (killed) and the resource tracker end with the command
+        if not session_processes(proc.pid, zombies=False):
+            break
+        time.sleep(0.1)
+    assert not session_processes(proc.pid, zombies=False), "processes of the command outlived it"
     # (Dask may warn first, e.g. that its dashboard port is taken: a one-line warning of the command)
     lines = err.strip().splitlines()
     assert lines[-1] == "ccproof eval: interrupted" and "Traceback" not in err, err
