@@ -213,6 +213,27 @@ def test_a_bug_keeps_its_traceback(tmp_path):
     assert run.returncode == 1 and "Traceback" in run.stderr and "ZeroDivisionError: a bug" in run.stderr
 
 
+def test_a_library_error_while_a_sigterm_unwinds_is_still_one_line(tmp_path):
+    """A SIGTERM during a numba compilation ended in numba's own RuntimeError ("no compiled object yet", raised
+    while the interrupt unwound it) and its traceback; it is the interrupt that ends the command: one line, 143."""
+    script = textwrap.dedent("""
+        import os, signal, sys, time
+        import ccproof.cli.table as table
+        def run(args):
+            try:
+                os.kill(os.getpid(), signal.SIGTERM)
+                time.sleep(30)
+            finally:
+                raise RuntimeError("no compiled object yet")  # what numba raises when stopped mid-compile
+        table.run = run
+        from ccproof.cli import main
+        sys.exit(main(["table", "5"]))
+    """)
+    run = subprocess.run([sys.executable, "-c", script], cwd=tmp_path, env=_env(), capture_output=True, text=True,
+                         timeout=120)
+    assert run.returncode == 143 and run.stderr.strip().splitlines() == ["ccproof table: terminated"], run.stderr
+
+
 #: a subprocess that runs ``ccproof eval`` with one library function replaced by a stand-in that says
 #: "ready" on stdout and then waits; the test signals it at that moment (no sleeps, no races)
 _STALL = textwrap.dedent("""
