@@ -213,6 +213,27 @@ def test_a_bug_keeps_its_traceback(tmp_path):
     assert run.returncode == 1 and "Traceback" in run.stderr and "ZeroDivisionError: a bug" in run.stderr
 
 
+def test_a_library_error_while_a_sigterm_unwinds_is_still_one_line(tmp_path):
+    """A SIGTERM during a numba compilation ended in numba's own RuntimeError ("no compiled object yet", raised
+    while the interrupt unwound it) and its traceback; it is the interrupt that ends the command: one line, 143."""
+    script = textwrap.dedent("""
+        import os, signal, sys, time
+        import ccproof.cli.table as table
+        def run(args):
+            try:
+                os.kill(os.getpid(), signal.SIGTERM)
+                time.sleep(30)
+            finally:
+                raise RuntimeError("no compiled object yet")  # what numba raises when stopped mid-compile
+        table.run = run
+        from ccproof.cli import main
+        sys.exit(main(["table", "5"]))
+    """)
+    run = subprocess.run([sys.executable, "-c", script], cwd=tmp_path, env=_env(), capture_output=True, text=True,
+                         timeout=120)
+    assert run.returncode == 143 and run.stderr.strip().splitlines() == ["ccproof table: terminated"], run.stderr
+
+
 #: a subprocess that runs ``ccproof eval`` with one library function replaced by a stand-in that says
 #: "ready" on stdout and then waits; the test signals it at that moment (no sleeps, no races)
 _STALL = textwrap.dedent("""
@@ -331,10 +352,11 @@ if os.environ.get("CCPROOF_TEST_NO_DASK"):
 
 
 @pytest.mark.parametrize("workers", ["processes", "dask"])
-def test_ctrl_c_to_the_process_group_with_workers(tmp_path, workers):
+def test_ctrl_c_to_the_process_group_with_workers(tmp_path, workers, session_processes):
     """A terminal sends Ctrl-C to every process of the foreground group, the workers too: still one line
     from the command, exit 130, no traceback from any worker, and no index.json (the folder is unfinished);
-    the command does not wait for the workers' tasks."""
+    the command does not wait for the workers' tasks: it ends within 3 s (Dask's graceful close waited 4 s
+    for a busy worker before killing it) and leaves no process behind."""
     if workers == "dask":
         pytest.importorskip("distributed")
     site = tmp_path / "site"
@@ -358,11 +380,19 @@ def test_ctrl_c_to_the_process_group_with_workers(tmp_path, workers):
             time.sleep(0.05)
         assert os.listdir(marks) and proc.poll() is None, "no worker started a task"
         os.killpg(proc.pid, signal.SIGINT)
+        start = time.monotonic()
         _, err = proc.communicate(timeout=100)  # < the workers' 120 s stall: they were stopped
+        took = time.monotonic() - start
     finally:
         if proc.poll() is None:
             os.killpg(proc.pid, signal.SIGKILL)
     assert proc.returncode == 130, err
+    assert took < 3.0, f"{took:.1f} s from Ctrl-C to the end of the command"
+    for _ in range(50):  # the workers (killed) and the resource tracker end with the command
+        if not session_processes(proc.pid, zombies=False):
+            break
+        time.sleep(0.1)
+    assert not session_processes(proc.pid, zombies=False), "processes of the command outlived it"
     # (Dask may warn first, e.g. that its dashboard port is taken: a one-line warning of the command)
     lines = err.strip().splitlines()
     assert lines[-1] == "ccproof eval: interrupted" and "Traceback" not in err, err

@@ -60,6 +60,11 @@ def test_invert_prec_out_of_range_is_one_line(capsys):
     ("--tol", "nan", "--tol must be a finite number"), ("--stray-fraction", "nan", "--stray-fraction must be in"),
     ("--stray-distance", "nan", "--stray-distance must be"), ("--max-steps", "-1", "--max-steps must be >= 1"),
     ("--sample-level", "-1", "--sample-level must be 0..6"), ("--sample-level", "12", "--sample-level must be 0..6"),
+    ("--tension", "nan", "--tension must be a finite number >= 0"), ("--rigidity", "-1", "--rigidity must be"),
+    ("--damping", "inf", "--damping must be"), ("--mass", "-1", "--mass must be"),
+    ("--spring", "inf", "--spring must be a finite number > 0"), ("--dt", "nan", "--dt must be a finite number > 0"),
+    ("--init-scale", "nan", "--init-scale must be in (0, 1]"), ("--levels", "-1", "--levels must be >= 0"),
+    ("--truncation", "-1", "--truncation must be >= 1"),
 ])
 def test_fit_refuses_nan_and_out_of_range_options_before_the_work(tmp_path, monkeypatch, capsys, option, value, words):
     """NaN compares false, so it used to pass the checks and run (--tol nan: until --max-steps); --sample-level

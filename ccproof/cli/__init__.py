@@ -159,6 +159,36 @@ def _terminate(signum, frame):  # pragma: no cover - exercised through a subproc
     raise _Terminated
 
 
+def _stopped(command, exc) -> int:
+    """The one line and exit status of an interrupt (130) or a SIGTERM (143)."""
+    terminated = isinstance(exc, _Terminated)
+    print(f"ccproof {command}: {'terminated' if terminated else 'interrupted'}", file=sys.stderr)
+    return 143 if terminated else 130
+
+
+def _interrupt_behind(exc):
+    """The KeyboardInterrupt (Ctrl-C or our SIGTERM) in the context chain of ``exc``, or None: a library that
+    raised its own error while the interrupt unwound it (numba's "no compiled object yet" when stopped during a
+    compilation) ends the command as the interrupt would, without a traceback.
+
+    >>> try:
+    ...     try:
+    ...         raise KeyboardInterrupt
+    ...     except KeyboardInterrupt:
+    ...         raise RuntimeError("cleanup failed")
+    ... except RuntimeError as e:
+    ...     type(_interrupt_behind(e)).__name__, _interrupt_behind(RuntimeError("a bug"))
+    ('KeyboardInterrupt', None)
+    """
+    seen = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, KeyboardInterrupt):
+            return exc
+        seen.add(id(exc))
+        exc = exc.__context__
+    return None
+
+
 def main(argv=None) -> int:
     """Run one ``ccproof`` command; returns the exit status.
 
@@ -194,10 +224,13 @@ def main(argv=None) -> int:
             cap = _apply_input_limit(args) if args.command in INPUT_COMMANDS else None
             return int(args._run(args) or 0)
     except KeyboardInterrupt as exc:
-        terminated = isinstance(exc, _Terminated)
-        print(f"ccproof {args.command}: {'terminated' if terminated else 'interrupted'}", file=sys.stderr)
-        return 143 if terminated else 130
-    except _expected_errors() as exc:
+        return _stopped(args.command, exc)
+    except Exception as exc:
+        stop = _interrupt_behind(exc)
+        if stop is not None:  # a library failed while our Ctrl-C/SIGTERM unwound it (numba mid-compile)
+            return _stopped(args.command, stop)
+        if not isinstance(exc, _expected_errors()):
+            raise
         print(f"ccproof {args.command}: error: {error_message(exc)}", file=sys.stderr)
         return 2
     finally:

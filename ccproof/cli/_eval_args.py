@@ -78,4 +78,13 @@ def read_face_uv_csv(path):
     bad = np.flatnonzero(~np.isfinite(face) | (face != np.round(face)))
     if bad.size:
         raise CCProofError(f"{path}:{int(bad[0]) + 2}: face must be an integer, got {float(face[bad[0]])!r}")
+    # beyond 2^53 a float is no exact integer, beyond 2^63 the int64 cast is undefined (-9223372036854775808)
+    huge = np.flatnonzero(np.abs(face) >= FACE_LIMIT)
+    if huge.size:
+        raise CCProofError(f"{path}:{int(huge[0]) + 2}: face id {float(face[huge[0]]):g} is out of range "
+                           "(beyond 2^53, no mesh has so many faces)")
     return face.astype(np.int64), rows[:, 1].copy(), rows[:, 2].copy()
+
+
+#: face ids of a points file at least this large are refused before the int64 cast (2^53: floats stay exact)
+FACE_LIMIT = 2.0**53

@@ -205,6 +205,28 @@ def _check_options(args):
     if args.stray_distance is not None and not (isfinite(args.stray_distance) and args.stray_distance > 0):
         raise CCProofError(f"--stray-distance must be a finite number > 0 (% of the diameter), got "
                            f"{args.stray_distance}")
+    _check_model_options(args)
+
+
+def _check_model_options(args):
+    """The model's numbers by their option names (the library named its parameters: a11, gamma, spring_total)."""
+    from math import isfinite
+
+    from ccproof.errors import CCProofError
+
+    for option, value in (("--tension", args.tension), ("--rigidity", args.rigidity), ("--damping", args.damping),
+                          ("--mass", args.mass)):
+        if not (isfinite(value) and value >= 0):
+            raise CCProofError(f"{option} must be a finite number >= 0, got {value}")
+    for option, value in (("--spring", args.spring), ("--dt", args.dt)):
+        if value is not None and not (isfinite(value) and value > 0):
+            raise CCProofError(f"{option} must be a finite number > 0, got {value}")
+    if not 0 < args.init_scale <= 1:  # NaN too
+        raise CCProofError(f"--init-scale must be in (0, 1], got {args.init_scale}")
+    if args.levels < 0:
+        raise CCProofError(f"--levels must be >= 0, got {args.levels}")
+    if args.truncation < 1:
+        raise CCProofError(f"--truncation must be >= 1, got {args.truncation}")
 
 
 #: the finest --sample-level (the 386-vertex model at level 6 is 1.6 million samples)

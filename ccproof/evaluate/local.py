@@ -25,6 +25,7 @@ float tables that :mod:`ccproof.evaluate.surface` (quad meshes) and :mod:`ccproo
 from __future__ import annotations
 
 import functools
+import itertools
 import math
 
 import numpy as np
@@ -180,7 +181,9 @@ def _read_fan(cx, walk, seen, pos, ring, first_corner, faces):
     start = np.asarray(cx.start)
     W = np.array(walk, dtype=np.int64)
     H = np.asarray(cx.face_of)[W]
-    keep = [i for i, h in enumerate(H.tolist()) if not (h in seen or seen.add(h))]
+    faces_h, first_h = np.unique(H, return_index=True)  # each face once, from its first corner in the walk
+    keep = np.sort(first_h[~np.isin(faces_h, np.fromiter(seen, dtype=np.int64, count=len(seen)))])
+    seen.update(faces_h.tolist())
     W, H = W[keep], H[keep]
     sh = start[H]
     nxt_start = np.where(H + 1 < start.size, start[np.minimum(H + 1, start.size - 1)], org.size)
@@ -192,14 +195,15 @@ def _read_fan(cx, walk, seen, pos, ring, first_corner, faces):
     uniq, first, inv = np.unique(U, return_index=True, return_inverse=True)
     order = np.argsort(first, kind="stable")  # the vertices by first appearance
     us = uniq[order].tolist()
-    known = [pos.get(u, -1) for u in us]
-    new = [i for i, q in enumerate(known) if q < 0]
-    labels = dict(zip((us[i] for i in new), range(len(ring), len(ring) + len(new))))
-    pos.update(labels)
-    ring.extend(labels)
-    first_corner.update(zip(labels, hc[first[order[new]]].tolist()))
+    known = np.fromiter(map(pos.get, us, itertools.repeat(-1)), dtype=np.int64, count=len(us))
+    new = np.flatnonzero(known < 0)  # labelled in order of first appearance after the ring so far
+    known[new] = np.arange(len(ring), len(ring) + new.size)
+    fresh = uniq[order[new]].tolist()
+    pos.update(zip(fresh, known[new].tolist()))
+    ring.extend(fresh)
+    first_corner.update(zip(fresh, hc[first[order[new]]].tolist()))
     lab = np.empty(uniq.size, dtype=np.int64)
-    lab[order] = [q if q >= 0 else labels[u] for u, q in zip(us, known)]
+    lab[order] = known
     L = lab[inv.reshape(-1)]
     if k.size and (k == k[0]).all():  # (all quads: one reshape)
         faces.extend(map(tuple, L.reshape(-1, int(k[0])).tolist()))

@@ -30,10 +30,20 @@ KEEP_RING_NC = 40
 NETS_BUDGET = 32 << 20
 
 
+#: precomputing the nets costs a product with every point of every job's ring: none are precomputed where
+#: the rings average more points than this (an n-gon's n corner faces share its centre's 2n + 8 points, n^2
+#: products in all: a lone 1000-gon's 3.4 s of CPU); they are then computed per point (the same bits)
+RING_MEAN_PRECOMPUTED = 64
+
+
 def with_nets(T, groups):
     """``T`` with the precomputed nets that fit their budgets: the regular nets (:data:`NETS_BUDGET`, or the
     environment variable ``CCPROOF_NETS_BUDGET`` in bytes) and the layer-0 corner nets (:data:`HOT_BUDGET`,
-    ``CCPROOF_HOT_BUDGET``), both by the kernels' sums (none where they do not fit: the same bits)."""
+    ``CCPROOF_HOT_BUDGET``), both by the kernels' sums (none where they do not fit: the same bits), and none
+    where the rings average more than :data:`RING_MEAN_PRECOMPUTED` points."""
+    sizes = [(jobs.size, rings.size) for _, jobs, rings in groups if jobs is not None and jobs.size]
+    if sum(r for _, r in sizes) > RING_MEAN_PRECOMPUTED * sum(k for k, _ in sizes):
+        return kept_rings(T, groups)
     n_cor = T.n_corner
     if 0 < T.n_regular and T.n_regular * 17 * 3 * 8 <= _budget("CCPROOF_NETS_BUDGET", NETS_BUDGET):
         T = T._replace(nets=regular_nets(T, groups))

@@ -238,7 +238,7 @@ def _warn_degenerate(n, counts):
 def _replace_when_written(path, write):
     """``write(tmp)`` to a hidden name in the folder of ``path``, then rename it onto ``path``: a shard or
     index interrupted while being written never lies under its final name (the temporary name ends with
-    the final one, so numpy's ``.npz`` is kept)."""
+    the final one, so numpy's ``.npz`` is kept). An ``OSError`` of the writer (a full disk) names ``path``."""
     import os
     import uuid
 
@@ -247,6 +247,10 @@ def _replace_when_written(path, write):
     try:
         write(str(tmp))
         os.replace(tmp, path)
+    except OSError as exc:  # a full disk: numpy's writer names no file (or our hidden one); the error names ours
+        if exc.filename is None or str(exc.filename) == str(tmp):
+            raise OSError(exc.errno, exc.strerror or str(exc), str(path)) from None
+        raise
     finally:
         if tmp.exists():
             tmp.unlink()

@@ -27,7 +27,13 @@ from dataclasses import dataclass, field
 from functools import partial
 
 from ccproof.errors import CCProofError
-from ccproof.scale.processes import check_jobs, pid_alive, process_pool, signals_deferred  # noqa: F401 (re-export)
+from ccproof.scale.processes import (  # noqa: F401 (re-export)
+    check_jobs,
+    pid_alive,
+    process_pool,
+    signals_deferred,
+    stop_cluster_now,
+)
 
 MISSING_EXTRA = ("a Dask scheduler needs the optional extra 'scale': pip install 'ccproof[scale]' "
                  "(or run with --serial / --scheduler local:1)")
@@ -54,12 +60,6 @@ class TaskFailed(CCProofError):
 def dask_available():
     """True when ``dask.distributed`` can be imported (the optional extra ``scale``).
 
-    Returns
-    -------
-    bool
-
-    Examples
-    --------
     >>> import importlib.util
     >>> dask_available() == (importlib.util.find_spec("distributed") is not None)
     True
@@ -239,27 +239,11 @@ def scheduler_from_args(args):
 
 @contextlib.contextmanager
 def client_for(scheduler):
-    """A connected :class:`distributed.Client` for a local or address scheduler (closed on exit).
-
-    A context manager; a local scheduler starts a ``LocalCluster`` of worker processes (one thread each).
-
-    Parameters
-    ----------
-    scheduler : str or Scheduler or distributed.Client
-        A local or address scheduler (:func:`parse_scheduler`); a Client is yielded unchanged.
-
-    Yields
-    ------
-    distributed.Client
-
-    Raises
-    ------
-    CCProofError
-        For the serial scheduler, or when the extra ``scale`` is not installed.
-
-    Examples
-    --------
-    Starting a cluster takes seconds, so the example shows the refusal only:
+    """A connected :class:`distributed.Client` for a local or address scheduler ``scheduler`` (str,
+    :class:`Scheduler`, or a Client, yielded unchanged); a context manager. A local scheduler starts a
+    ``LocalCluster`` of worker processes (one thread each), closed gracefully when the block ends, at once
+    (:func:`~ccproof.scale.processes.stop_cluster_now`) when it raises (Ctrl-C). :class:`CCProofError` for the
+    serial scheduler or without the extra ``scale``. Starting a cluster takes seconds; the example is the refusal:
 
     >>> with client_for("serial"):
     ...     pass
@@ -290,12 +274,15 @@ def client_for(scheduler):
                                        silence_logs=logging.CRITICAL)
                 client = Client(cluster)
         except BaseException:  # a Ctrl-C or SIGTERM during the start: the cluster stopped, then one line
-            for part in (client, cluster):
-                if part is not None:
-                    part.close()
+            stop_cluster_now(client, cluster)
             raise
-        with cluster, client:
+        try:
             yield client
+        except BaseException:  # an interrupt (or a failure) while tasks run: the busy workers are not waited for
+            stop_cluster_now(client, cluster)
+            raise
+        with cluster, client:  # the work is done: a graceful close
+            pass
     elif s.kind == "address":
         with Client(s.address, timeout="30s") as client:
             yield client

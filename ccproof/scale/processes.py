@@ -5,6 +5,7 @@
   process), stopped at once on an interrupt, and ended with this process (SIGKILL included);
 * :func:`signals_deferred`: SIGINT and SIGTERM recorded while worker processes start (a pool's, a Dask
   cluster's) and honoured once they are up;
+* :func:`stop_cluster_now`: a local Dask cluster stopped at once on an interrupt (its busy workers killed);
 * :func:`pid_alive`: whether the writer of a temporary file is still running.
 
 Used by :mod:`ccproof.scale.engine` and the commands (``table --all``, ``report --jobs``).
@@ -19,7 +20,7 @@ import time
 from ccproof.errors import CCProofError
 
 __all__ = ["pid_alive", "usable_cores", "check_jobs", "signals_deferred", "DEFERRED_SIGNALS", "process_pool",
-           "PARENT_POLL_SECONDS"]
+           "PARENT_POLL_SECONDS", "stop_cluster_now", "STOP_SECONDS"]
 
 
 def pid_alive(pid) -> bool:
@@ -294,3 +295,24 @@ def _stop_pool(ex):
         manager.join(timeout=30)
     for proc in list((getattr(ex, "_processes", None) or {}).values()):
         proc.join(timeout=5)  # a manager never started (stopped before the first task) joins none
+
+
+#: seconds a local worker is given to stop when the run is interrupted (then killed by its nanny); Dask's own
+#: default waits 4 s for a worker busy with a task (a Ctrl-C took 4 s to end the command)
+STOP_SECONDS = 0.5
+
+
+def stop_cluster_now(client, cluster):
+    """Close a local cluster at once: every nanny stops its worker within :data:`STOP_SECONDS` (a task still
+    running is killed with its process), then the client and the cluster close (the scheduler, in process)."""
+    import asyncio
+
+    async def stop(nannies):
+        await asyncio.gather(*(n.close(timeout=STOP_SECONDS) for n in nannies), return_exceptions=True)
+
+    if cluster is not None:
+        with contextlib.suppress(Exception):
+            cluster.sync(stop, list(cluster.workers.values()))
+    for part in (client, cluster):
+        if part is not None:
+            part.close()

@@ -82,3 +82,13 @@ def test_a_face_id_inf_is_named(tmp_path, capsys):
                  "--out", str(tmp_path / "o.npz")]) == 2
     err = capsys.readouterr().err
     assert "p.csv:3: face must be an integer, got inf" in err and "-9223372036854775808" not in err, err
+
+
+def test_a_face_id_beyond_int64_is_named(tmp_path, capsys):
+    write_obj(tmp_path / "d.obj", k_regular_disk(5, rings=2))
+    (tmp_path / "p.csv").write_text("face,u,v\n0,0.5,0.5\n1e30,0.5,0.5\n")
+    assert main(["eval", str(tmp_path / "d.obj"), "--points", str(tmp_path / "p.csv"),
+                 "--out", str(tmp_path / "o.npz")]) == 2
+    err = capsys.readouterr().err
+    assert "p.csv:3: face id 1e+30 is out of range" in err and len(err.strip().splitlines()) == 1, err
+    assert "-9223372036854775808" not in err and not (tmp_path / "o.npz").exists()

@@ -45,3 +45,24 @@ def test_a_shard_index_linked_to_dev_zero_is_refused_at_once(tmp_path, capsys):
                  "--max-input", "0.001"]) == 2  # (the old code read it until memory ran out)
     err = capsys.readouterr().err
     assert "index.json -> /dev/zero: not a regular file (a character device)" in err, err
+
+
+def _full_disk(*args, **kwargs):
+    import errno
+
+    raise OSError(errno.ENOSPC, "No space left on device")  # as numpy's zip writer raises it: no file name
+
+
+def test_a_full_disk_names_the_result_file(tmp_path, capsys, monkeypatch):
+    import numpy as np
+
+    write_obj(tmp_path / "d.obj", k_regular_disk(5, rings=2))
+    monkeypatch.setattr(np, "savez", _full_disk)
+    for out in (tmp_path / "o.npz", tmp_path / "sh"):
+        spec = str(out) + ("/" if out.suffix != ".npz" else "")
+        assert main(["eval", str(tmp_path / "d.obj"), "--samples", "30", "--chunk", "10", "--serial",
+                     "--out", spec]) == 2
+        err = capsys.readouterr().err
+        named = str(out / "part-00000.npz") if out.suffix != ".npz" else str(out)
+        assert named in err and "no space left on device" in err.lower() and len(err.strip().splitlines()) == 1, err
+        assert not out.exists() or not [p for p in out.iterdir() if p.name.startswith(".tmp-")]

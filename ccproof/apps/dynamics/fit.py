@@ -495,13 +495,16 @@ def _report_surface(result, pts, sample_level, stray_distance_percent, stray_fra
     rep = surface_to_data(result.surface, pts, result.stray_distance)
     result.surface_report = rep
     if rep["stray_fraction"] > stray_fraction:
+        # both directions: a web across a concavity leaves the data -> surface error (the headline) small
+        data_max = 100.0 * float(result.data_distances.max()) / diameter
         result.warnings.append(
-            f"the fitted surface strays from the data: {100 * rep['stray_fraction']:.1f} % of its area is farther "
-            f"than {result.stray_distance_percent:.2f} % of the diameter from every data point, "
-            f"up to {result.surface_max_percent:.2f} %{_where_stray(result)}; the surface spans a concavity of the "
-            f"data (a web; raise --surface-spring or --levels), the data may not cover the surface (an unseen "
-            f"side), or the start mesh's topology may not match the data's (e.g. a genus-0 start for a torus: "
-            f"give --init)")
+            f"the fitted surface strays from the data: surface -> data, {100 * rep['stray_fraction']:.1f} % of its "
+            f"area is farther than {result.stray_distance_percent:.2f} % of the diameter from every data point, "
+            f"up to {result.surface_max_percent:.2f} %{_where_stray(result)}, while data -> surface every point "
+            f"is within {data_max:.2f} % (RMS {result.data_rms_percent:.3f} %): the fit error does not show it; "
+            f"the surface spans a concavity of the data (a web; raise --surface-spring or --levels), the data may "
+            f"not cover the surface (an unseen side), or the start mesh's topology may not match the data's (e.g. "
+            f"a genus-0 start for a torus: give --init)")
 
 
 def _where_stray(result, most=12):

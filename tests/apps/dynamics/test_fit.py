@@ -1,6 +1,7 @@
 """Q8 (the paper's meshes), Q9 (shape recovery), the enclosing sphere, point files, the CLI, bad input."""
 
 import itertools
+import re
 
 import numpy as np
 import pytest
@@ -222,6 +223,17 @@ def test_fit_torus_from_the_cube_reports_the_spanned_hole_and_warns():
     assert res.two_sided_error_percent > res.stray_distance_percent
     assert res.surface_report["stray_fraction"] > 0.03
     assert any("strays from the data" in w for w in res.warnings)
+    # the warning states both directions: the surface's stray area and the data's small error beside it
+    warn = next(w for w in res.warnings if "strays from the data" in w)
+    both = re.search(r"surface -> data, ([\d.]+) % of its area is farther than ([\d.]+) % .* up to ([\d.]+) %.*"
+                     r"while data -> surface every point is within ([\d.]+) % \(RMS ([\d.]+) %\): the fit error "
+                     r"does not show it", warn)
+    assert both, warn
+    frac, _, worst, data_max, _ = map(float, both.groups())
+    brute = np.sqrt(((X[:, None, :] - S[None]) ** 2).sum(-1)).min(1)  # data -> nearest surface sample
+    assert data_max <= 100 * brute.max() / res.diameter + 0.01 and data_max < 5.0 < worst
+    assert worst >= 100 * _torus_distance(S).max() / res.diameter - 0.01  # the data lie on the true torus
+    assert frac == pytest.approx(100 * res.surface_report["stray_fraction"], abs=0.05)
     # the surface -> data distances agree with a brute-force nearest data point
     i = np.argsort(res.surface_report["distances"])[-5:]
     brute = np.sqrt(((S[i, None, :] - X[None]) ** 2).sum(-1)).min(1)
