@@ -1,8 +1,8 @@
 """The exact basis-change matrices of Bernstein forms and Taylor shifts (``fmpq_mat``, cached; internal).
 
 Each maps the coefficient vector of a polynomial along one axis: power basis to Bernstein basis on [0, 1]
-(with degree elevation), back, elevation, de Casteljau split and restriction, derivative, and the Taylor shift
-p(x) -> p(a + h x). :mod:`._tensor` applies them along an axis, exactly or enclosed in ``arb_mat``.
+(with degree elevation), elevation, de Casteljau split and restriction, derivative, and the Taylor shift
+p(x) -> p(a + h x). :mod:`.tensor` applies them along an axis, exactly or enclosed in ``arb_mat``.
 """
 
 from math import comb
@@ -47,23 +47,6 @@ def power_to_bernstein_matrix(n, d):
     [0, 1/2, 1]
     """
     return _cached(("p2b", n, d), lambda: _matrix(d + 1, n + 1, lambda k, i: fmpq(_C(k, i), comb(d, i))))
-
-
-def bernstein_to_power_matrix(n):
-    """(n+1) x (n+1) ``fmpq_mat``: Bernstein coefficients of degree n on [0,1] -> power coefficients.
-
-    a_i = sum_k (-1)^(i-k) C(n, i) C(i, k) b_k (the inverse of :func:`power_to_bernstein_matrix` ``(n, n)``).
-
-    Examples
-    --------
-    >>> (bernstein_to_power_matrix(2) * fmpq_mat(3, 1, [0, 1, 0])).entries()   # 2 x (1 - x)
-    [0, 2, -2]
-    """
-
-    def entry(i, k):
-        return (-1) ** ((i - k) % 2) * _C(n, i) * _C(i, k)
-
-    return _cached(("b2p", n), lambda: _matrix(n + 1, n + 1, entry))
 
 
 def elevation_matrix(n, d):

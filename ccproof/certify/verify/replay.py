@@ -331,8 +331,8 @@ def check_boxes(root, boxes, what):
     --------
     1 + x on [0, 1]: the halves have Bernstein coefficients (1, 3/2) and (3/2, 2):
 
-    >>> from ccproof.rigorous import Poly, bernstein_coefficients
-    >>> f = bernstein_coefficients(1 + Poly.variable(0, 1)).to_arb(53)
+    >>> from ccproof.rigorous import BernsteinForm
+    >>> f = BernsteinForm((2,), [1, 2], prec=53)
     >>> check_boxes(f, [{"path": "0L", "bound": "0.9"}, {"path": "0H", "bound": "1.4"}], "test")
     (True, '', 9/10)
     >>> check_boxes(f, [{"path": "0L", "bound": "1.1"}, {"path": "0H", "bound": "1.4"}], "test")[0]
