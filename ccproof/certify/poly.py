@@ -180,7 +180,7 @@ class Poly:
         shape = tuple(max(p, q) for p, q in zip(self.shape, other.shape))
         a = T.pad(self.coeffs, self.shape, shape, self.prec)
         b = T.pad(other.coeffs, other.shape, shape, other.prec)
-        return all(T.ball_contains(x, y) for x, y in zip(a, b))
+        return all(ball_contains(x, y) for x, y in zip(a, b))
 
     def __eq__(self, other):
         """Exact equality of exact polynomials (ball polynomials refuse ``==``)."""
@@ -529,3 +529,35 @@ def taylor_form(poly, prec):
         coeffs, shape = T.apply_along_axis(coeffs, shape, axis,
                                            power_to_bernstein_matrix(shape[axis] - 1, shape[axis] - 1), prec)
     return TaylorForm.from_raw(shape, coeffs, TaylorForm.variable(1, len(shape) - 1, prec).box, prec)
+
+
+def ball_contains(ball, value):
+    """Does the ball certainly contain ``value`` (an exact number, compared with the exact endpoints, or a ball)?
+
+    >>> ball_contains(arb(1, fmpq(1, 2)), fmpq(3, 2)), ball_contains(arb(1), 2)
+    (True, False)
+    """
+    if isinstance(value, arb):
+        return bool(ball.contains(value))
+    value = T.exact_scalar(value)
+    if not ball.is_finite():
+        return bool(ball.contains(arb(value)))  # nan: False; infinite radius: True
+    mid, rad = T.exact_fmpq(ball.mid()), T.exact_fmpq(ball.rad())
+    return mid - rad <= value <= mid + rad
+
+
+def certainly_positive(form):
+    """True only when every coefficient is certainly > 0 and finite (so the polynomial is > 0 on the box).
+
+    >>> certainly_positive([arb(1), arb("0 +/- 0.1")]), certainly_positive(arb("nan"))
+    (False, False)
+    """
+    coeffs = form.bernstein().coeffs if isinstance(form, BernsteinForm) else [form] if isinstance(
+        form, (arb, fmpq, flint.fmpz, int)) and not isinstance(form, bool) else list(form)
+    for c in coeffs:
+        if isinstance(c, arb):
+            if not (c.is_finite() and c > 0):
+                return False
+        elif not T.exact_scalar(c) > 0:
+            return False
+    return bool(coeffs)

@@ -1,23 +1,15 @@
-"""Tensor-product Bernstein forms on boxes, de Casteljau subdivision and range enclosure.
+"""Tensor-product Bernstein forms on boxes: de Casteljau subdivision, range enclosure, det J (docs/rigorous.md).
 
-A :class:`BernsteinForm` of degrees ``(n_0, ..., n_{d-1})`` on the box ``B = prod [lo_i, hi_i]``
-(exact rational endpoints) stands for
-
-    f(x) = sum_k b[k] prod_i C(n_i, k_i) t_i^k_i (1 - t_i)^(n_i - k_i),   t_i = (x_i - lo_i) / (hi_i - lo_i).
-
-Since the basis functions are non-negative and sum to one on ``B``, ``min b <= f <= max b`` there
-(:func:`range_enclosure`, :func:`certainly_positive`).  Coefficients are all ``fmpq`` (exact) or
-all ``arb``; in the ball case every returned coefficient encloses the exact coefficient for every
-choice of real inputs in the input balls.
+A form of degrees n on the box [lo, hi] stands for sum_k b[k] prod_i C(n_i, k_i) t_i^k_i (1 - t_i)^(n_i - k_i),
+t_i = (x_i - lo_i) / (hi_i - lo_i); the basis is non-negative and sums to one, so min b <= f <= max b on the box.
 
 >>> f = BernsteinForm((2, 2), [1, 1, fmpq(3, 4), fmpq(7, 4)])   # x y - x/4 + 1 on [0, 1]^2
 >>> left, right = f.split(0)
 >>> left.box[0], left.coeffs
 ((0, 1/2), [1, 1, 7/8, 11/8])
->>> range_enclosure(f), certainly_positive(f)
-((3/4, 7/4), True)
+>>> range_enclosure(f)
+(3/4, 7/4)
 """
-
 
 import flint
 from flint import arb, fmpq, fmpz
@@ -36,21 +28,9 @@ _HALF = fmpq(1, 2)
 
 
 class BernsteinForm:
-    """Bernstein coefficients ``coeffs`` (row-major, shape ``degrees + 1``) of a polynomial on ``box``.
+    """Bernstein coefficients ``coeffs`` (row-major, ``shape`` = degrees + 1, 1 to 4 axes) of a polynomial on the
+    exact ``box`` (default [0, 1]^d), exact (``prec`` None) or arb balls at ``prec`` bits; no basis conversion.
 
-    Build one with :func:`bernstein_coefficients`, or directly from Bezier control values (for
-    example the 4 x 4 net of a bicubic patch, row-major, ``shape=(4, 4)``) with this constructor,
-    which does no basis conversion.
-
-    Parameters
-    ----------
-    shape : tuple of d int (1 <= d <= 4): ``degrees + 1`` per variable (Farin's tensor Bernstein basis)
-    coeffs : sequence of fmpq-convertible or arb, length ``prod(shape)``
-    box : sequence of d exact pairs (lo, hi), optional: default [0, 1]^d
-    prec : int, optional: bits of the arb balls; None (default) for exact coefficients
-
-    Examples
-    --------
     >>> b = BernsteinForm((3,), [0, 0, 1])   # x^2
     >>> b.degrees, b.box
     ((2,), ((0, 1),))
@@ -111,11 +91,7 @@ class BernsteinForm:
     # ------------------------------------------------------------------ subdivision
 
     def split(self, axis, t=_HALF):
-        """De Casteljau split of ``box`` along ``axis`` at fraction ``t`` (default 1/2): ``(low, high)``.
-
-        With the default ``t = 1/2`` the sub-boxes of a dyadic box are dyadic and the matrices are
-        dyadic (exact in ``arb``); the result is exact for exact input.
-        """
+        """De Casteljau: the forms ``(low, high)`` on the two parts of the box cut along ``axis`` at fraction ``t``."""
         axis = self._axis(axis, bernstein=True)
         t = T.exact_scalar(t)
         if not 0 < t < 1:
@@ -227,12 +203,8 @@ class BernsteinForm:
             raise TypeError("arb scalar with an exact Bernstein form: convert it with .to_arb(prec)")
 
     def __mul__(self, other):
-        """Product on the same box, of degree ``m + n``, computed in Bernstein form.
-
-        With ``a~_i = C(m, i) a_i`` (coefficients in the basis t^i (1-t)^(m-i)), the product's
-        scaled coefficients are the plain convolution of ``a~`` and ``b~``; divide by C(m+n, k). Along a power
-        axis the weights are 1 (a plain convolution).
-        """
+        """Product on the same box (degree m + n): the convolution of the coefficients scaled by C(m, i) and C(n, j),
+        divided by C(m + n, k); along a power axis a plain convolution."""
         if not isinstance(other, BernsteinForm):
             c = T.scalar(other)
             self._check_scalar_kind(c)
@@ -268,22 +240,12 @@ class BernsteinForm:
             return self.from_raw(self.shape, [x / c for x in self.coeffs], self.box, self.prec)
 
 
-# ---------------------------------------------------------------------------- conversion
+# ---------------------------------------------------------------------------- boxes, enclosures, det J
 
 
 def unit_box(nvars):
-    """The box [0, 1]^nvars with exact endpoints.
+    """The box [0, 1]^nvars (exact endpoints).
 
-    Parameters
-    ----------
-    nvars : int
-
-    Returns
-    -------
-    tuple of nvars (fmpq, fmpq)
-
-    Examples
-    --------
     >>> unit_box(2)
     ((0, 1), (0, 1))
     """
@@ -291,62 +253,24 @@ def unit_box(nvars):
 
 
 def check_box(box, nvars):
-    """``box`` as a tuple of ``nvars`` pairs ``(lo, hi)`` of fmpq with ``lo < hi``.
+    """``box`` as ``nvars`` exact pairs ``(lo, hi)`` with lo < hi, else ``ValueError``.
 
-    Parameters
-    ----------
-    box : sequence of nvars pairs of exact numbers (int, fmpq, "p/q")
-    nvars : int
-
-    Returns
-    -------
-    tuple of nvars (fmpq, fmpq)
-
-    Raises
-    ------
-    ValueError
-        On a wrong number of intervals or an empty or degenerate one.
-
-    Examples
-    --------
     >>> check_box([(0, 1), ("1/2", 1)], 2)
     ((0, 1), (1/2, 1))
-    >>> check_box([(1, 1)], 1)
-    Traceback (most recent call last):
-    ...
-    ValueError: empty or degenerate interval [1, 1]
     """
     box = tuple(box)
     if len(box) != nvars:
         raise ValueError(f"box with {len(box)} intervals for {nvars} variables")
-    out = []
-    for iv in box:
-        lo, hi = iv
-        lo, hi = T.exact_scalar(lo), T.exact_scalar(hi)
+    out = tuple((T.exact_scalar(lo), T.exact_scalar(hi)) for lo, hi in box)
+    for lo, hi in out:
         if not lo < hi:
             raise ValueError(f"empty or degenerate interval [{lo}, {hi}]")
-        out.append((lo, hi))
-    return tuple(out)
+    return out
 
 
 def range_enclosure(form):
-    """``(lo, hi)`` with ``lo <= f <= hi`` on the box: min and max of the coefficients.
-
-    Exact forms give ``fmpq``; ball forms give zero-radius ``arb`` endpoints rounded outward
-    (``lo`` = min of the balls' lower endpoints, ``hi`` = max of upper endpoints); a NaN
-    coefficient gives ``(-inf, +inf)``.  Also accepts a plain list of coefficients.
-
-    Parameters
-    ----------
-    form : BernsteinForm or sequence of fmpq / arb
-
-    Returns
-    -------
-    (lo, hi) : fmpq or arb, the range enclosure of the module docstring (docs/rigorous.md "Guarantees")
-
-    Examples
-    --------
-    x (1 - x) has range [0, 1/4] on [0, 1]; its coefficients (0, 1/2, 0) enclose it:
+    """``(lo, hi)`` with lo <= f <= hi on the box: the least and greatest coefficient (exact forms: fmpq; balls:
+    zero-radius arb endpoints rounded outward, ``(-inf, +inf)`` for a NaN). Also takes a list of coefficients.
 
     >>> range_enclosure(BernsteinForm((3,), [0, fmpq(1, 2), 0]))
     (0, 1/2)
@@ -356,54 +280,14 @@ def range_enclosure(form):
         raise ValueError("no coefficients")
     if all(isinstance(c, fmpq) for c in coeffs):
         return min(coeffs), max(coeffs)
-    balls = [c if isinstance(c, arb) else None for c in coeffs]
-    if any(b is None for b in balls):
+    if not all(isinstance(c, arb) for c in coeffs):
         raise TypeError("mixed exact and ball coefficients")
-    if any(b.is_nan() for b in balls):
+    if any(b.is_nan() for b in coeffs):
         return arb.neg_inf(), arb.pos_inf()
     prec = max(form.prec if isinstance(form, BernsteinForm) and form.prec else 0, flint.ctx.prec)
     with flint.ctx.workprec(prec):  # endpoints rounded outward at (at least) the form's precision
-        lows = [b.lower() for b in balls]
-        highs = [b.upper() for b in balls]
-    # endpoints are exact (radius 0), so ``<`` is a total order on them (including +-inf)
-    lo = lows[0]
-    for x in lows[1:]:
-        if x < lo:
-            lo = x
-    hi = highs[0]
-    for x in highs[1:]:
-        if x > hi:
-            hi = x
-    return lo, hi
-
-
-def certainly_positive(form):
-    """True only when every coefficient is certainly > 0 (so the polynomial is > 0 on the box).
-
-    Exact ``fmpq`` coefficients are compared exactly; ``arb`` balls with arb's ``>`` (True only when
-    the whole ball is > 0) and must be finite.
-
-    Parameters
-    ----------
-    form : BernsteinForm, sequence of fmpq / arb, or one number
-
-    Returns
-    -------
-    bool
-
-    Examples
-    --------
-    >>> certainly_positive([arb(1), arb("0 +/- 0.1")]), certainly_positive(arb("nan"))
-    (False, False)
-    """
-    coeffs = _coefficients(form)
-    for c in coeffs:
-        if isinstance(c, arb):
-            if not (c.is_finite() and c > 0):
-                return False
-        elif not T.exact_scalar(c) > 0:
-            return False
-    return bool(coeffs)
+        lows, highs = [b.lower() for b in coeffs], [b.upper() for b in coeffs]
+    return min(lows), max(highs)  # exact endpoints (radius 0): < and > are a total order on them, +-inf included
 
 
 def _coefficients(form):
@@ -415,25 +299,8 @@ def _coefficients(form):
 
 
 def jacobian_determinant(components, variables=None):
-    """det of ``(d components[i] / d x_{variables[j]})`` for 1 to 4 components (Laplace expansion), in the
-    components' own arithmetic: power form, Bernstein form on their common box, or Taylor model (z kept).
-
-    ``variables`` defaults to ``0 .. len(components)-1``; extra variables act as parameters.
-
-    Parameters
-    ----------
-    components : sequence of n Poly, BernsteinForm or TaylorForm (1 <= n <= 4), anything with ``diff``
-    variables : tuple of n distinct int, optional (for a TaylorForm, x axes >= 1)
-
-    Returns
-    -------
-    Poly, BernsteinForm or TaylorForm
-        det J, whose sign decides local injectivity (docs/readings.md R7; e.g. det J_Phi of the
-        characteristic map).
-
-    Examples
-    --------
-    For z^2 = (x^2 - y^2, 2 x y) (Cauchy-Riemann: det J = |2 z|^2):
+    """det (d components[i] / d x_variables[j]) of 1 to 4 components (default variables 0..n-1, the others
+    parameters) in their own arithmetic (Bernstein forms on one box, Taylor models with z kept).
 
     >>> x, y = BernsteinForm((2, 1), [0, 1]), BernsteinForm((1, 2), [0, 1])
     >>> jacobian_determinant([x * x - y * y, 2 * x * y]).coeffs == (4 * x * x + 4 * y * y).coeffs
@@ -446,19 +313,14 @@ def jacobian_determinant(components, variables=None):
     variables = tuple(range(n)) if variables is None else tuple(variables)
     if len(variables) != n or len(set(variables)) != n:
         raise ValueError(f"need {n} distinct variables, got {variables!r}")
-    jac = [[g.diff(v) for v in variables] for g in components]
-    return _det(jac)
+    return _det([[g.diff(v) for v in variables] for g in components])
 
 
 def _det(m):
-    n = len(m)
-    if n == 1:
+    if len(m) == 1:
         return m[0][0]
-    if n == 2:
-        return m[0][0] * m[1][1] - m[0][1] * m[1][0]
     total = None
-    for j in range(n):
-        minor = [row[:j] + row[j + 1 :] for row in m[1:]]
-        term = m[0][j] * _det(minor)
+    for j in range(len(m)):
+        term = m[0][j] * _det([row[:j] + row[j + 1:] for row in m[1:]])
         total = term if total is None else (total + term if j % 2 == 0 else total - term)
     return total

@@ -1,13 +1,6 @@
-"""Dense coefficient tensors shared by :mod:`.poly` and :mod:`.bernstein` (internal).
-
-A tensor is a flat Python list in row-major order together with its ``shape`` (a tuple of
-positive ints, one per variable).  Every entry is an ``fmpq`` (exact kind, ``prec is None``) or an
-``arb`` (ball kind, ``prec`` an int).  Arithmetic on balls always runs inside
-``flint.ctx.workprec(prec)``; the global precision is never changed.
-
-Exact rational matrices (basis changes) are built once as ``fmpq_mat`` and cached; for the ball
-kind they are converted to ``arb_mat`` at the working precision (which encloses each rational
-entry) and the product is flint's rigorous ``arb_mat`` product.
+"""Dense coefficient tensors: a row-major list of ``fmpq`` (``prec`` None) or ``arb`` (``prec`` bits, computed inside
+``flint.ctx.workprec``) with its ``shape``; exact basis changes along an axis (``fmpq_mat``, or the ``arb_mat`` that
+encloses it), Kronecker products. Shared by :mod:`.bernstein` and ``ccproof.certify.poly``.
 """
 
 from functools import lru_cache
@@ -88,30 +81,12 @@ def exact_fmpq(x):
     return fmpq(man) * fmpq(2) ** int(exp)
 
 
-def ball_contains(ball, value):
-    """True when the ball certainly contains ``value`` (an exact number or another ball).
-
-    Exact values are compared with the ball's endpoints in exact rational arithmetic (converting
-    them to a ball first would round them and could wrongly report a miss).
-    """
-    if isinstance(value, arb):
-        return bool(ball.contains(value))
-    value = exact_scalar(value)
-    if not ball.is_finite():
-        return bool(ball.contains(arb(value)))  # nan: False; infinite radius: True
-    mid, rad = exact_fmpq(ball.mid()), exact_fmpq(ball.rad())
-    return mid - rad <= value <= mid + rad
-
-
 def zero(prec):
     return _ZERO if prec is None else arb(0)
 
 
 def size(shape):
     return prod(shape)
-
-
-# ---------------------------------------------------------------------------- matrices
 
 
 def to_matrix(mat, prec):
@@ -125,9 +100,7 @@ _ARB_MATS = {}
 
 
 def _arb_matrix(mat, prec):
-    # fmpq_mat is unhashable: key on identity, keeping ``mat`` alive in the entry so that its id
-    # cannot be reused while the entry exists.  The exact matrices come from lru_caches, so the
-    # same object recurs for the same basis change.
+    # keyed on the identity of the cached exact matrix, kept alive in the entry (so its id is not reused)
     key = (id(mat), prec)
     hit = _ARB_MATS.get(key)
     if hit is not None and hit[0] is mat:
@@ -145,10 +118,7 @@ def new_matrix(rows, cols, entries, prec):
 
 
 def apply_along_axis(coeffs, shape, axis, mat, prec):
-    """Multiply the tensor by the exact matrix ``mat`` (m x shape[axis]) along ``axis``.
-
-    Returns ``(coeffs, shape)`` with ``shape[axis]`` replaced by ``m``.
-    """
+    """``(coeffs, shape)`` of the tensor multiplied along ``axis`` by the exact m x shape[axis] matrix ``mat``."""
     n = shape[axis]
     m = mat.nrows()
     if mat.ncols() != n:
@@ -171,12 +141,8 @@ def apply_along_axis(coeffs, shape, axis, mat, prec):
 
 
 def multiply(a, a_shape, b, b_shape, prec):
-    """Product of two dense polynomial tensors (Kronecker substitution, one flint product).
-
-    The exponent tuple ``e`` of either factor is sent to ``sum e_i * S_i`` with ``S`` the
-    row-major strides of the product's shape; exponents of the product never exceed that shape,
-    so the univariate product's coefficients are exactly the product tensor's coefficients.
-    """
+    """Product of two polynomial tensors: one flint product of the univariate polynomials that send exponents e to
+    sum e_i S_i (S the row-major strides of the product's shape, which no exponent of the product exceeds)."""
     shape = tuple(p + q - 1 for p, q in zip(a_shape, b_shape))
     strides = row_major_strides(shape)
     total = size(shape)
@@ -187,12 +153,7 @@ def multiply(a, a_shape, b, b_shape, prec):
     else:
         with flint.ctx.workprec(prec):
             c = (arb_poly(pa) * arb_poly(pb)).coeffs()
-    z = zero(prec)
-    if len(c) < total:
-        c = list(c) + [z] * (total - len(c))
-    elif len(c) > total:  # cannot happen; guard the invariant
-        raise AssertionError("Kronecker product longer than its shape")
-    return list(c), shape
+    return list(c) + [zero(prec)] * (total - len(c)), shape
 
 
 def row_major_strides(shape):
@@ -241,9 +202,8 @@ def pad(coeffs, shape, new_shape, prec):
 
 
 def truncate(coeffs, shape, axis, degree, prec):
-    """(coeffs, shape) of degree <= ``degree`` along ``axis``: every dropped coefficient c (of x_axis^j,
-    j > degree) added as [-|c|, |c|] to the coefficient of x_axis^0 with the same other exponents (a Taylor
-    model's remainder for |x_axis| <= 1)."""
+    """(coeffs, shape) of degree <= ``degree`` along ``axis``, each dropped coefficient c added as [-|c|, |c|] to the
+    one of x_axis^0 with the same other exponents (a Taylor model's remainder for |x_axis| <= 1)."""
     n, post = shape[axis], size(shape[axis + 1 :])
     out = []
     with flint.ctx.workprec(prec):

@@ -11,12 +11,10 @@ from flint import arb, fmpq
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from ccproof.certify.poly import Poly, bernstein_coefficients, to_poly
+from ccproof.certify.poly import Poly, ball_contains, bernstein_coefficients, certainly_positive, to_poly
 from ccproof.certify.prover import lower_bound
 from ccproof.rigorous import (
     BernsteinForm,
-    ball_contains,
-    certainly_positive,
     exact_fmpq,
     jacobian_determinant,
     range_enclosure,

@@ -13,8 +13,8 @@ from math import comb
 import pytest
 from flint import arb, ctx, fmpq
 
-from ccproof.certify.poly import Poly, bernstein_coefficients, taylor_form
-from ccproof.rigorous import TaylorForm, ball_contains, jacobian_determinant
+from ccproof.certify.poly import Poly, ball_contains, bernstein_coefficients, taylor_form
+from ccproof.rigorous import TaylorForm, jacobian_determinant
 
 PREC = 128
 
