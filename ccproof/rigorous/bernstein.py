@@ -73,15 +73,6 @@ class BernsteinForm:
     def degrees(self):
         return tuple(n - 1 for n in self.shape)
 
-    @property
-    def is_exact(self):
-        return self.prec is None
-
-    def __repr__(self):
-        kind = "exact" if self.prec is None else f"arb {self.prec} bits"
-        box = " x ".join(f"[{lo}, {hi}]" for lo, hi in self.box)
-        return f"BernsteinForm({kind}, degrees={self.degrees}, box={box})"
-
     def to_arb(self, prec):
         """Ball version at ``prec`` bits."""
         if T.check_prec(prec) is None:
@@ -169,34 +160,29 @@ class BernsteinForm:
         return T.convert(a.coeffs, prec), T.convert(b.coeffs, prec), a.shape, prec
 
     def __add__(self, other):
-        if not isinstance(other, BernsteinForm):
-            return self._shift(T.scalar(other), 1)
-        a, b, shape, prec = self._common(other)
-        with flint.ctx.workprec(prec or flint.ctx.prec):
-            return self.from_raw(shape, [x + y for x, y in zip(a, b)], self.box, prec)
+        return self._add(other, 1)
 
     __radd__ = __add__
 
     def __sub__(self, other):
-        if not isinstance(other, BernsteinForm):
-            return self._shift(T.scalar(other), -1)
-        a, b, shape, prec = self._common(other)
-        with flint.ctx.workprec(prec or flint.ctx.prec):
-            return self.from_raw(shape, [x - y for x, y in zip(a, b)], self.box, prec)
+        return self._add(other, -1)
 
     def __rsub__(self, other):
-        return (-self)._shift(T.scalar(other), 1)
+        return (-self)._add(other, 1)
 
     def __neg__(self):
         return self.from_raw(self.shape, [-c for c in self.coeffs], self.box, self.prec)
 
-    def _shift(self, c, sign):
-        # a constant is added to every coefficient (partition of unity) of the power axes' degree 0
-        self._check_scalar_kind(c)
-        n = T.size(self.shape[self.POWER_AXES:])
-        with flint.ctx.workprec(self.prec or flint.ctx.prec):
-            out = [x + c for x in self.coeffs[:n]] if sign > 0 else [x - c for x in self.coeffs[:n]]
-        return self.from_raw(self.shape, out + self.coeffs[n:], self.box, self.prec)
+    def _add(self, other, sign):
+        if isinstance(other, BernsteinForm):
+            a, b, shape, prec = self._common(other)
+        else:  # a constant: added to every coefficient (partition of unity) of the power axes' degree 0
+            b, n = T.scalar(other), T.size(self.shape[self.POWER_AXES:])
+            self._check_scalar_kind(b)
+            a, b, shape, prec = self.coeffs[:n], [b] * n, self.shape, self.prec
+        with flint.ctx.workprec(prec or flint.ctx.prec):
+            out = [x + y for x, y in zip(a, b)] if sign > 0 else [x - y for x, y in zip(a, b)]
+        return self.from_raw(shape, out + self.coeffs[len(out):], self.box, prec)  # the rest: a constant's
 
     def _check_scalar_kind(self, c):
         if isinstance(c, arb) and self.prec is None:

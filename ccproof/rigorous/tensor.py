@@ -15,54 +15,43 @@ _ZERO = fmpq(0)
 
 
 def check_prec(prec):
-    """Return ``prec`` (``None`` or an int >= 2), else raise ``ValueError``."""
-    if prec is None:
-        return None
-    if isinstance(prec, bool) or not isinstance(prec, int) or prec < 2:
+    """``prec`` if None or an int >= 2 (bits), else ``ValueError``."""
+    if prec is not None and (isinstance(prec, bool) or not isinstance(prec, int) or prec < 2):
         raise ValueError(f"precision must be an int >= 2 (bits) or None, got {prec!r}")
     return prec
 
 
 def join_prec(p, q):
     """Precision of a result combining kinds ``p`` and ``q`` (``None`` = exact)."""
-    if p is None:
-        return q
-    if q is None:
-        return p
-    return max(p, q)
+    return q if p is None else p if q is None else max(p, q)
 
 
 def exact_scalar(x):
-    """Coerce int/fmpz/fmpq/str (e.g. ``"1/3"``) to ``fmpq``; reject floats and the rest."""
+    """int, fmpz, fmpq or a string ``"p/q"`` as an ``fmpq``; floats and the rest refused."""
     if isinstance(x, fmpq):
         return x
     if isinstance(x, (int, fmpz)) and not isinstance(x, bool):
         return fmpq(x)
-    if isinstance(x, str):
-        try:
-            return fmpq(x)
-        except (ValueError, TypeError):
-            pass
-        raise ValueError(f"not a rational number: {x!r}")
-    raise TypeError(
-        f"expected an exact number (int, fmpz, fmpq or 'p/q' string), got {type(x).__name__}"
-    )
+    if not isinstance(x, str):
+        raise TypeError(f"expected an exact number (int, fmpz, fmpq or 'p/q' string), got {type(x).__name__}")
+    try:
+        return fmpq(x)
+    except (ValueError, TypeError):
+        raise ValueError(f"not a rational number: {x!r}") from None
 
 
 def scalar(x):
-    """Coerce a scalar to ``fmpq`` (exact) or keep an ``arb``; reject floats."""
-    if isinstance(x, arb):
-        return x
-    return exact_scalar(x)
+    """An ``arb`` kept, anything else through :func:`exact_scalar`."""
+    return x if isinstance(x, arb) else exact_scalar(x)
 
 
 def to_kind(x, prec):
     """``x`` (fmpq or arb) as an element of the kind ``prec`` (caller holds the workprec)."""
-    if prec is None:
-        if isinstance(x, arb):
-            raise TypeError("cannot convert an arb ball to an exact fmpq coefficient")
-        return x
-    return x if isinstance(x, arb) else arb(x)
+    if prec is not None:
+        return x if isinstance(x, arb) else arb(x)
+    if isinstance(x, arb):
+        raise TypeError("cannot convert an arb ball to an exact fmpq coefficient")
+    return x
 
 
 def convert(coeffs, prec):
@@ -91,9 +80,7 @@ def size(shape):
 
 def to_matrix(mat, prec):
     """The exact ``fmpq_mat`` ``mat`` for kind ``prec``: itself, or an enclosing ``arb_mat``."""
-    if prec is None:
-        return mat
-    return _arb_matrix(mat, prec)
+    return mat if prec is None else _arb_matrix(mat, prec)
 
 
 _ARB_MATS = {}
