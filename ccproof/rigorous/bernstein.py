@@ -41,22 +41,16 @@ class BernsteinForm:
     POWER_AXES = 0
 
     def __init__(self, shape, coeffs, box=None, prec=None):
-        shape = tuple(shape)
-        if not 1 <= len(shape) <= T.MAX_VARS or any(
-            isinstance(n, bool) or not isinstance(n, int) or n < 1 for n in shape
-        ):
+        shape, coeffs, prec = tuple(shape), [T.scalar(c) for c in coeffs], T.check_prec(prec)
+        if not 1 <= len(shape) <= T.MAX_VARS or any(isinstance(n, bool) or not isinstance(n, int) or n < 1
+                                                    for n in shape):
             raise ValueError(f"bad shape {shape!r}")
-        coeffs = list(coeffs)
         if len(coeffs) != T.size(shape):
             raise ValueError(f"{len(coeffs)} coefficients for shape {shape}")
-        prec = T.check_prec(prec)
-        coeffs = [T.scalar(c) for c in coeffs]
         if prec is None and any(isinstance(c, arb) for c in coeffs):
             raise TypeError("arb coefficient in an exact Bernstein form: pass prec=...")
-        self.shape = shape
-        self.coeffs = T.convert(coeffs, prec)
+        self.shape, self.coeffs, self.prec = shape, T.convert(coeffs, prec), prec
         self.box = unit_box(len(shape)) if box is None else check_box(box, len(shape))
-        self.prec = prec
 
     @classmethod
     def from_raw(cls, shape, coeffs, box, prec):
@@ -72,12 +66,6 @@ class BernsteinForm:
     @property
     def degrees(self):
         return tuple(n - 1 for n in self.shape)
-
-    def to_arb(self, prec):
-        """Ball version at ``prec`` bits."""
-        if T.check_prec(prec) is None:
-            raise ValueError("to_arb needs a precision in bits")
-        return self.from_raw(self.shape, T.convert(self.coeffs, prec), self.box, prec)
 
     # ------------------------------------------------------------------ subdivision
 
@@ -213,17 +201,6 @@ class BernsteinForm:
 
     def _weights(self, shape):
         return T.weights(shape, [[1] * n if a < self.POWER_AXES else binomials(n - 1) for a, n in enumerate(shape)])
-
-    def __truediv__(self, c):
-        """Division by a non-zero scalar."""
-        c = T.scalar(c)
-        self._check_scalar_kind(c)
-        if isinstance(c, fmpq):
-            if c == 0:
-                raise ZeroDivisionError("Bernstein form divided by zero")
-            return self * (1 / c)
-        with flint.ctx.workprec(self.prec):
-            return self.from_raw(self.shape, [x / c for x in self.coeffs], self.box, self.prec)
 
 
 # ---------------------------------------------------------------------------- boxes, enclosures, det J

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import re
 from contextvars import ContextVar
+from decimal import Decimal
 from math import prod
 
 from flint import arb, fmpq
@@ -101,13 +102,9 @@ def parse_decimal(s):
     m = _DECIMAL.fullmatch(s)
     if m is None:
         raise CertificateError(f"{s!r} is not a decimal string")
-    sign, intpart, frac, exp = m.group(1), m.group(2), m.group(3) or "", m.group(4)
-    e = int(exp) if exp else 0
-    if abs(e) > MAX_EXPONENT:
+    if abs(int(m.group(4) or 0)) > MAX_EXPONENT:
         raise CertificateError(f"decimal {s!r}: exponent beyond +-{MAX_EXPONENT}")
-    q = fmpq(int(intpart + frac), 10 ** len(frac))
-    q = q * fmpq(10) ** e if e >= 0 else q / fmpq(10) ** (-e)
-    return -q if sign else q
+    return fmpq(*Decimal(s).as_integer_ratio())
 
 
 def parse_path(path, nvars):
