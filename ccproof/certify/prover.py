@@ -18,6 +18,7 @@ from typing import Any
 
 from flint import arb, ctx, fmpq
 
+from ccproof.certify.poly import certainly_positive
 from ccproof.certify.verify import C1_SCHEMA, SCHEMA
 from ccproof.certify.verify.injectivity import MAX_LEVEL, form_patches
 from ccproof.certify.verify.interval import hull_nets, interval_cells, lam_interval_ok, parameter_nets, valence_cells
@@ -32,7 +33,7 @@ from ccproof.certify.verify.maps import (
 from ccproof.certify.verify.replay import MAX_BOXES, parse_decimal
 from ccproof.certify.verify.statement import PATCHES, c_lam, derivation, nets_for_valence
 from ccproof.errors import CCProofError, ValenceError, check_valence
-from ccproof.rigorous import certainly_positive, exact_fmpq, range_enclosure
+from ccproof.rigorous import exact_fmpq, range_enclosure
 from ccproof.tables.format import certificates_dir
 from ccproof.valence import Valence, ValenceLike
 

@@ -1,16 +1,5 @@
-"""Functions analytic in one complex parameter h on a disc: Taylor coefficients and a Cauchy remainder.
-
-A quantity f(h) (a vector or matrix of them) analytic on the disc |h| <= r is enclosed on a real interval
-[h_lo, h_hi], 0 <= h_lo <= h_hi < r, by its Taylor polynomial of order n and Cauchy's estimate of the rest:
-if |f| <= M on the disc, the coefficients satisfy |f_m| <= M / r^m, so
-
-    |sum_(m > n) f_m h^m| <= M h^(n+1) / (r^(n+1) (1 - h/r)).
-
-:func:`disc_bound` finds M by covering the disc with the acb boxes of a grid on the square [-r, r]^2 that
-meet it, the quantity evaluated on each box in ball arithmetic; :class:`AnalyticModel` holds the coefficients (acb
-matrices, the Taylor coefficients of every entry) and M per column and encloses f(h)/h^low, the terms below
-``low`` being 0 exactly (the caller shows that). Nothing here is specific to one quantity.
-"""
+"""Functions analytic in one complex parameter h on a disc: Taylor coefficients and a Cauchy remainder (the bound:
+docs/rigorous.md, "Analytic models"); nothing here is specific to one quantity."""
 
 from __future__ import annotations
 
@@ -28,15 +17,13 @@ def ball(lo, hi):
 
 
 def _near(a, grid):
-    """The distance from 0 of the nearest point of the a-th of ``grid`` equal intervals of [-1, 1], times
-    grid/2 (an integer: the edges are -1 + 2a/grid)."""
+    """grid/2 times the distance from 0 of the a-th of ``grid`` equal intervals of [-1, 1] (an integer)."""
     lo, hi = 2 * a - grid, 2 * a + 2 - grid
     return 0 if lo <= 0 <= hi else min(abs(lo), abs(hi))
 
 
 def disc_boxes(r, grid):
-    """The acb boxes of the grid x grid grid on the square [-r, r]^2 of the complex plane (r > 0 exact) that
-    meet the closed disc |h| <= r (an exact integer test; the corners of the square are left out).
+    """The acb boxes of the grid x grid grid on [-r, r]^2 that meet the closed disc |h| <= r (exact test).
 
     >>> len(list(disc_boxes(fmpq(1, 2), 3))), len(list(disc_boxes(fmpq(1, 2), 4))), len(list(disc_boxes(1, 12)))
     (9, 16, 132)
@@ -50,28 +37,9 @@ def disc_boxes(r, grid):
 
 
 def disc_bound(values, r, grid):
-    """{key: M} with |z| <= M for every entry z of ``values(h)[key]`` and every complex h of the disc |h| <= r
-    (on the boxes of :func:`disc_boxes`; finite values on a box prove the quantity analytic there).
+    """{key: M}, |z| <= M for every entry z of ``values(h)[key]`` (acb) and every h of the disc |h| <= r, over the
+    boxes of :func:`disc_boxes`; ZeroDivisionError where a box gives no finite bound (or ``values`` raises it).
 
-    Parameters
-    ----------
-    values : callable (acb) -> dict of key -> iterable of acb (or arb)
-        The quantity on an acb box; it raises ZeroDivisionError where it cannot certify its own
-        analyticity on the box (a singular system, a square root near its cut).
-    r : fmpq
-    grid : int
-
-    Returns
-    -------
-    dict of key -> arb
-
-    Raises
-    ------
-    ZeroDivisionError
-        Where a box gives no finite bound.
-
-    Examples
-    --------
     >>> M = disc_bound(lambda h: {"exp": [h.exp()]}, fmpq(1, 2), 4)
     >>> bool(M["exp"] > arb(fmpq(1, 2)).exp()), bool(M["exp"] < 2)
     (True, True)
@@ -87,8 +55,7 @@ def disc_bound(values, r, grid):
 
 
 def cauchy_factor(r, n, h_hi):
-    """1 / (r^(n+1) (1 - h_hi/r)): the Cauchy remainder of order n is at most M h^(n+1) times this for
-    0 <= h <= h_hi < r (ZeroDivisionError unless h_hi < r).
+    """1 / (r^(n+1) (1 - h_hi/r)): the remainder of order n is at most M h^(n+1) times this for 0 <= h <= h_hi < r.
 
     >>> cauchy_factor(fmpq(1, 2), 0, fmpq(1, 4)).contains(4)
     True
@@ -100,22 +67,11 @@ def cauchy_factor(r, n, h_hi):
 
 
 class AnalyticModel:
-    """f(h) = sum_(m <= n) C_m h^m + (Cauchy remainder), C_m acb matrices of one shape, |column k| <= M[k]
-    on the disc |h| <= r.
+    """f(h) = sum_(m <= n) C_m h^m + the Cauchy remainder: C_m acb matrices of one shape, |column k| <= M[k] on the
+    disc |h| <= r.
 
-    Parameters
-    ----------
-    coeffs : list of acb_mat
-        C_0 .. C_n.
-    M : list of arb
-        One bound per column (:func:`disc_bound`).
-    r : fmpq
+    e^h to order 8 on [0, 1/8], |e^h| <= e^(1/2) on |h| <= 1/2 (the coefficient of h^0 dropped):
 
-    Examples
-    --------
-    e^h to order 8 on [0, 1/8], with |e^h| <= e^(1/2) on |h| <= 1/2 (the coefficient of h^0 dropped):
-
-    >>> from flint import acb_mat
     >>> coeffs = [acb_mat([[arb(1) / arb.fac_ui(m)]]) for m in range(9)]
     >>> model = AnalyticModel(coeffs, [arb(fmpq(1, 2)).exp()], fmpq(1, 2))
     >>> V, rho = model.enclose(fmpq(1, 8), fmpq(1, 8), low=1)
@@ -129,8 +85,7 @@ class AnalyticModel:
 
     @classmethod
     def from_columns(cls, columns, M, r):
-        """The model whose column k has the Taylor coefficients ``columns[k][m]`` (a list of values, the rows,
-        per order m) and the bound M[k].
+        """The model whose column k has the Taylor coefficients ``columns[k][m]`` (the rows, per order m).
 
         >>> AnalyticModel.from_columns([[[1, 2], [3, 4]]], [arb(5)], fmpq(1, 2)).coeffs[1][1, 0]
         4.00000000000000
@@ -139,8 +94,8 @@ class AnalyticModel:
                     for m in range(len(columns[0]))], M, r)
 
     def enclose(self, h_lo, h_hi, low=0):
-        """(V, rho): f(h)/h^low lies in V[c, k] plus a complex ball of radius rho[k] for every h in
-        [h_lo, h_hi] (entries below h^low dropped: the caller knows them to be 0)."""
+        """(V, rho): f(h)/h^low lies in V[c, k] plus a complex ball of radius rho[k] for every h in [h_lo, h_hi]
+        (the coefficients below h^low dropped: the caller knows them to be 0)."""
         h = acb(ball(h_lo, h_hi))
         acc = self.coeffs[-1]
         for C in reversed(self.coeffs[low:-1]):
@@ -149,8 +104,8 @@ class AnalyticModel:
         return acc, [m * tail for m in self.M]
 
     def real_part(self, weights, h_lo, h_hi, low=0):
-        """Re sum_k weights[k] f_k(h)/h^low for every row (a list of arb), every h in [h_lo, h_hi]: the rows
-        of :meth:`enclose` times the weights (acb), and |Re w e| <= (|Re w| + |Im w|) rho for |e| <= rho."""
+        """Re sum_k weights[k] f_k(h)/h^low per row (arb), every h in [h_lo, h_hi]: |Re w e| <= (|Re w| + |Im w|) rho
+        for |e| <= rho."""
         V, rho = self.enclose(h_lo, h_hi, low)
         ws = [acb(w) for w in weights]
         vals = V * acb_mat([[w] for w in ws])

@@ -1,32 +1,20 @@
-"""Tensor-product Bernstein forms on boxes, de Casteljau subdivision and range enclosure.
+"""Tensor-product Bernstein forms on boxes: de Casteljau subdivision, range enclosure, det J (docs/rigorous.md).
 
-A :class:`BernsteinForm` of degrees ``(n_0, ..., n_{d-1})`` on the box ``B = prod [lo_i, hi_i]``
-(exact rational endpoints) stands for
+A form of degrees n on the box [lo, hi] stands for sum_k b[k] prod_i C(n_i, k_i) t_i^k_i (1 - t_i)^(n_i - k_i),
+t_i = (x_i - lo_i) / (hi_i - lo_i); the basis is non-negative and sums to one, so min b <= f <= max b on the box.
 
-    f(x) = sum_k b[k] prod_i C(n_i, k_i) t_i^k_i (1 - t_i)^(n_i - k_i),   t_i = (x_i - lo_i) / (hi_i - lo_i).
-
-Since the basis functions are non-negative and sum to one on ``B``, ``min b <= f <= max b`` there
-(:func:`range_enclosure`, :func:`certainly_positive`).  Coefficients are all ``fmpq`` (exact) or
-all ``arb``; in the ball case every returned coefficient encloses the exact coefficient for every
-choice of real inputs in the input balls.
-
->>> from ccproof.rigorous import Poly, bernstein_coefficients
->>> x, y = Poly.variable(0, 2), Poly.variable(1, 2)
->>> f = bernstein_coefficients(x * y - x / 4 + 1, box=[(0, 1), (0, 1)])
->>> f.coeffs
-[1, 1, 3/4, 7/4]
+>>> f = BernsteinForm((2, 2), [1, 1, fmpq(3, 4), fmpq(7, 4)])   # x y - x/4 + 1 on [0, 1]^2
 >>> left, right = f.split(0)
 >>> left.box[0], left.coeffs
 ((0, 1/2), [1, 1, 7/8, 11/8])
->>> range_enclosure(f), certainly_positive(f)
-((3/4, 7/4), True)
+>>> range_enclosure(f)
+(3/4, 7/4)
 """
-
 
 import flint
 from flint import arb, fmpq, fmpz
 
-from . import _tensor as T
+from . import tensor as T
 from .matrices import (
     binomials,
     conversion_matrix,
@@ -40,25 +28,12 @@ _HALF = fmpq(1, 2)
 
 
 class BernsteinForm:
-    """Bernstein coefficients ``coeffs`` (row-major, shape ``degrees + 1``) of a polynomial on ``box``.
+    """Bernstein coefficients ``coeffs`` (row-major, ``shape`` = degrees + 1, 1 to 4 axes) of a polynomial on the
+    exact ``box`` (default [0, 1]^d), exact (``prec`` None) or arb balls at ``prec`` bits; no basis conversion.
 
-    Build one with :func:`bernstein_coefficients`, or directly from Bezier control values (for
-    example the 4 x 4 net of a bicubic patch, row-major, ``shape=(4, 4)``) with this constructor,
-    which does no basis conversion; :meth:`to_poly` gives the power form in the box variables.
-
-    Parameters
-    ----------
-    shape : tuple of d int (1 <= d <= 4): ``degrees + 1`` per variable (Farin's tensor Bernstein basis)
-    coeffs : sequence of fmpq-convertible or arb, length ``prod(shape)``
-    box : sequence of d exact pairs (lo, hi), optional: default [0, 1]^d
-    prec : int, optional: bits of the arb balls; None (default) for exact coefficients
-
-    Examples
-    --------
-    >>> from ccproof.rigorous import Poly
-    >>> b = BernsteinForm((3,), [0, 0, 1])
-    >>> b.to_poly() == Poly.variable(0, 1) ** 2, b.degrees, b.box
-    (True, (2,), ((0, 1),))
+    >>> b = BernsteinForm((3,), [0, 0, 1])   # x^2
+    >>> b.degrees, b.box
+    ((2,), ((0, 1),))
     """
 
     __slots__ = ("shape", "coeffs", "box", "prec")
@@ -66,22 +41,16 @@ class BernsteinForm:
     POWER_AXES = 0
 
     def __init__(self, shape, coeffs, box=None, prec=None):
-        shape = tuple(shape)
-        if not 1 <= len(shape) <= T.MAX_VARS or any(
-            isinstance(n, bool) or not isinstance(n, int) or n < 1 for n in shape
-        ):
+        shape, coeffs, prec = tuple(shape), [T.scalar(c) for c in coeffs], T.check_prec(prec)
+        if not 1 <= len(shape) <= T.MAX_VARS or any(isinstance(n, bool) or not isinstance(n, int) or n < 1
+                                                    for n in shape):
             raise ValueError(f"bad shape {shape!r}")
-        coeffs = list(coeffs)
         if len(coeffs) != T.size(shape):
             raise ValueError(f"{len(coeffs)} coefficients for shape {shape}")
-        prec = T.check_prec(prec)
-        coeffs = [T.scalar(c) for c in coeffs]
         if prec is None and any(isinstance(c, arb) for c in coeffs):
             raise TypeError("arb coefficient in an exact Bernstein form: pass prec=...")
-        self.shape = shape
-        self.coeffs = T.convert(coeffs, prec)
+        self.shape, self.coeffs, self.prec = shape, T.convert(coeffs, prec), prec
         self.box = unit_box(len(shape)) if box is None else check_box(box, len(shape))
-        self.prec = prec
 
     @classmethod
     def from_raw(cls, shape, coeffs, box, prec):
@@ -98,29 +67,10 @@ class BernsteinForm:
     def degrees(self):
         return tuple(n - 1 for n in self.shape)
 
-    @property
-    def is_exact(self):
-        return self.prec is None
-
-    def __repr__(self):
-        kind = "exact" if self.prec is None else f"arb {self.prec} bits"
-        box = " x ".join(f"[{lo}, {hi}]" for lo, hi in self.box)
-        return f"BernsteinForm({kind}, degrees={self.degrees}, box={box})"
-
-    def to_arb(self, prec):
-        """Ball version at ``prec`` bits."""
-        if T.check_prec(prec) is None:
-            raise ValueError("to_arb needs a precision in bits")
-        return self.from_raw(self.shape, T.convert(self.coeffs, prec), self.box, prec)
-
     # ------------------------------------------------------------------ subdivision
 
     def split(self, axis, t=_HALF):
-        """De Casteljau split of ``box`` along ``axis`` at fraction ``t`` (default 1/2): ``(low, high)``.
-
-        With the default ``t = 1/2`` the sub-boxes of a dyadic box are dyadic and the matrices are
-        dyadic (exact in ``arb``); the result is exact for exact input.
-        """
+        """De Casteljau: the forms ``(low, high)`` on the two parts of the box cut along ``axis`` at fraction ``t``."""
         axis = self._axis(axis, bernstein=True)
         t = T.exact_scalar(t)
         if not 0 < t < 1:
@@ -164,12 +114,6 @@ class BernsteinForm:
         lo, hi = self.box[axis]
         return self._along(axis, derivative_matrix(n, hi - lo), self.box[axis])
 
-    def to_poly(self):
-        """The polynomial in the original (box) variables, in the power basis (:func:`.poly.to_poly`)."""
-        from .poly import to_poly
-
-        return to_poly(self)
-
     def bernstein(self):
         """The form with every axis in the Bernstein basis on its box (the power axes converted; else itself)."""
         f = self
@@ -204,46 +148,37 @@ class BernsteinForm:
         return T.convert(a.coeffs, prec), T.convert(b.coeffs, prec), a.shape, prec
 
     def __add__(self, other):
-        if not isinstance(other, BernsteinForm):
-            return self._shift(T.scalar(other), 1)
-        a, b, shape, prec = self._common(other)
-        with flint.ctx.workprec(prec or flint.ctx.prec):
-            return self.from_raw(shape, [x + y for x, y in zip(a, b)], self.box, prec)
+        return self._add(other, 1)
 
     __radd__ = __add__
 
     def __sub__(self, other):
-        if not isinstance(other, BernsteinForm):
-            return self._shift(T.scalar(other), -1)
-        a, b, shape, prec = self._common(other)
-        with flint.ctx.workprec(prec or flint.ctx.prec):
-            return self.from_raw(shape, [x - y for x, y in zip(a, b)], self.box, prec)
+        return self._add(other, -1)
 
     def __rsub__(self, other):
-        return (-self)._shift(T.scalar(other), 1)
+        return (-self)._add(other, 1)
 
     def __neg__(self):
         return self.from_raw(self.shape, [-c for c in self.coeffs], self.box, self.prec)
 
-    def _shift(self, c, sign):
-        # a constant is added to every coefficient (partition of unity) of the power axes' degree 0
-        self._check_scalar_kind(c)
-        n = T.size(self.shape[self.POWER_AXES:])
-        with flint.ctx.workprec(self.prec or flint.ctx.prec):
-            out = [x + c for x in self.coeffs[:n]] if sign > 0 else [x - c for x in self.coeffs[:n]]
-        return self.from_raw(self.shape, out + self.coeffs[n:], self.box, self.prec)
+    def _add(self, other, sign):
+        if isinstance(other, BernsteinForm):
+            a, b, shape, prec = self._common(other)
+        else:  # a constant: added to every coefficient (partition of unity) of the power axes' degree 0
+            b, n = T.scalar(other), T.size(self.shape[self.POWER_AXES:])
+            self._check_scalar_kind(b)
+            a, b, shape, prec = self.coeffs[:n], [b] * n, self.shape, self.prec
+        with flint.ctx.workprec(prec or flint.ctx.prec):
+            out = [x + y for x, y in zip(a, b)] if sign > 0 else [x - y for x, y in zip(a, b)]
+        return self.from_raw(shape, out + self.coeffs[len(out):], self.box, prec)  # the rest: a constant's
 
     def _check_scalar_kind(self, c):
         if isinstance(c, arb) and self.prec is None:
             raise TypeError("arb scalar with an exact Bernstein form: convert it with .to_arb(prec)")
 
     def __mul__(self, other):
-        """Product on the same box, of degree ``m + n``, computed in Bernstein form.
-
-        With ``a~_i = C(m, i) a_i`` (coefficients in the basis t^i (1-t)^(m-i)), the product's
-        scaled coefficients are the plain convolution of ``a~`` and ``b~``; divide by C(m+n, k). Along a power
-        axis the weights are 1 (a plain convolution).
-        """
+        """Product on the same box (degree m + n): the convolution of the coefficients scaled by C(m, i) and C(n, j),
+        divided by C(m + n, k); along a power axis a plain convolution."""
         if not isinstance(other, BernsteinForm):
             c = T.scalar(other)
             self._check_scalar_kind(c)
@@ -267,34 +202,13 @@ class BernsteinForm:
     def _weights(self, shape):
         return T.weights(shape, [[1] * n if a < self.POWER_AXES else binomials(n - 1) for a, n in enumerate(shape)])
 
-    def __truediv__(self, c):
-        """Division by a non-zero scalar."""
-        c = T.scalar(c)
-        self._check_scalar_kind(c)
-        if isinstance(c, fmpq):
-            if c == 0:
-                raise ZeroDivisionError("Bernstein form divided by zero")
-            return self * (1 / c)
-        with flint.ctx.workprec(self.prec):
-            return self.from_raw(self.shape, [x / c for x in self.coeffs], self.box, self.prec)
 
-
-# ---------------------------------------------------------------------------- conversion
+# ---------------------------------------------------------------------------- boxes, enclosures, det J
 
 
 def unit_box(nvars):
-    """The box [0, 1]^nvars with exact endpoints.
+    """The box [0, 1]^nvars (exact endpoints).
 
-    Parameters
-    ----------
-    nvars : int
-
-    Returns
-    -------
-    tuple of nvars (fmpq, fmpq)
-
-    Examples
-    --------
     >>> unit_box(2)
     ((0, 1), (0, 1))
     """
@@ -302,66 +216,26 @@ def unit_box(nvars):
 
 
 def check_box(box, nvars):
-    """``box`` as a tuple of ``nvars`` pairs ``(lo, hi)`` of fmpq with ``lo < hi``.
+    """``box`` as ``nvars`` exact pairs ``(lo, hi)`` with lo < hi, else ``ValueError``.
 
-    Parameters
-    ----------
-    box : sequence of nvars pairs of exact numbers (int, fmpq, "p/q")
-    nvars : int
-
-    Returns
-    -------
-    tuple of nvars (fmpq, fmpq)
-
-    Raises
-    ------
-    ValueError
-        On a wrong number of intervals or an empty or degenerate one.
-
-    Examples
-    --------
     >>> check_box([(0, 1), ("1/2", 1)], 2)
     ((0, 1), (1/2, 1))
-    >>> check_box([(1, 1)], 1)
-    Traceback (most recent call last):
-    ...
-    ValueError: empty or degenerate interval [1, 1]
     """
     box = tuple(box)
     if len(box) != nvars:
         raise ValueError(f"box with {len(box)} intervals for {nvars} variables")
-    out = []
-    for iv in box:
-        lo, hi = iv
-        lo, hi = T.exact_scalar(lo), T.exact_scalar(hi)
+    out = tuple((T.exact_scalar(lo), T.exact_scalar(hi)) for lo, hi in box)
+    for lo, hi in out:
         if not lo < hi:
             raise ValueError(f"empty or degenerate interval [{lo}, {hi}]")
-        out.append((lo, hi))
-    return tuple(out)
+    return out
 
 
 def range_enclosure(form):
-    """``(lo, hi)`` with ``lo <= f <= hi`` on the box: min and max of the coefficients.
+    """``(lo, hi)`` with lo <= f <= hi on the box: the least and greatest coefficient (exact forms: fmpq; balls:
+    zero-radius arb endpoints rounded outward, ``(-inf, +inf)`` for a NaN). Also takes a list of coefficients.
 
-    Exact forms give ``fmpq``; ball forms give zero-radius ``arb`` endpoints rounded outward
-    (``lo`` = min of the balls' lower endpoints, ``hi`` = max of upper endpoints); a NaN
-    coefficient gives ``(-inf, +inf)``.  Also accepts a plain list of coefficients.
-
-    Parameters
-    ----------
-    form : BernsteinForm or sequence of fmpq / arb
-
-    Returns
-    -------
-    (lo, hi) : fmpq or arb, the range enclosure of the module docstring (docs/rigorous.md "Guarantees")
-
-    Examples
-    --------
-    x (1 - x) has range [0, 1/4] on [0, 1]; its coefficients (0, 1/2, 0) enclose it:
-
-    >>> from ccproof.rigorous import Poly, bernstein_coefficients
-    >>> x = Poly.variable(0, 1)
-    >>> range_enclosure(bernstein_coefficients(x * (1 - x)))
+    >>> range_enclosure(BernsteinForm((3,), [0, fmpq(1, 2), 0]))
     (0, 1/2)
     """
     coeffs = _coefficients(form)
@@ -369,54 +243,14 @@ def range_enclosure(form):
         raise ValueError("no coefficients")
     if all(isinstance(c, fmpq) for c in coeffs):
         return min(coeffs), max(coeffs)
-    balls = [c if isinstance(c, arb) else None for c in coeffs]
-    if any(b is None for b in balls):
+    if not all(isinstance(c, arb) for c in coeffs):
         raise TypeError("mixed exact and ball coefficients")
-    if any(b.is_nan() for b in balls):
+    if any(b.is_nan() for b in coeffs):
         return arb.neg_inf(), arb.pos_inf()
     prec = max(form.prec if isinstance(form, BernsteinForm) and form.prec else 0, flint.ctx.prec)
     with flint.ctx.workprec(prec):  # endpoints rounded outward at (at least) the form's precision
-        lows = [b.lower() for b in balls]
-        highs = [b.upper() for b in balls]
-    # endpoints are exact (radius 0), so ``<`` is a total order on them (including +-inf)
-    lo = lows[0]
-    for x in lows[1:]:
-        if x < lo:
-            lo = x
-    hi = highs[0]
-    for x in highs[1:]:
-        if x > hi:
-            hi = x
-    return lo, hi
-
-
-def certainly_positive(form):
-    """True only when every coefficient is certainly > 0 (so the polynomial is > 0 on the box).
-
-    Exact ``fmpq`` coefficients are compared exactly; ``arb`` balls with arb's ``>`` (True only when
-    the whole ball is > 0) and must be finite.
-
-    Parameters
-    ----------
-    form : BernsteinForm, sequence of fmpq / arb, or one number
-
-    Returns
-    -------
-    bool
-
-    Examples
-    --------
-    >>> certainly_positive([arb(1), arb("0 +/- 0.1")]), certainly_positive(arb("nan"))
-    (False, False)
-    """
-    coeffs = _coefficients(form)
-    for c in coeffs:
-        if isinstance(c, arb):
-            if not (c.is_finite() and c > 0):
-                return False
-        elif not T.exact_scalar(c) > 0:
-            return False
-    return bool(coeffs)
+        lows, highs = [b.lower() for b in coeffs], [b.upper() for b in coeffs]
+    return min(lows), max(highs)  # exact endpoints (radius 0): < and > are a total order on them, +-inf included
 
 
 def _coefficients(form):
@@ -428,29 +262,11 @@ def _coefficients(form):
 
 
 def jacobian_determinant(components, variables=None):
-    """det of ``(d components[i] / d x_{variables[j]})`` for 1 to 4 components (Laplace expansion), in the
-    components' own arithmetic: power form, Bernstein form on their common box, or Taylor model (z kept).
+    """det (d components[i] / d x_variables[j]) of 1 to 4 components (default variables 0..n-1, the others
+    parameters) in their own arithmetic (Bernstein forms on one box, Taylor models with z kept).
 
-    ``variables`` defaults to ``0 .. len(components)-1``; extra variables act as parameters.
-
-    Parameters
-    ----------
-    components : sequence of n Poly, BernsteinForm or TaylorForm (1 <= n <= 4), anything with ``diff``
-    variables : tuple of n distinct int, optional (for a TaylorForm, x axes >= 1)
-
-    Returns
-    -------
-    Poly, BernsteinForm or TaylorForm
-        det J, whose sign decides local injectivity (docs/readings.md R7; e.g. det J_Phi of the
-        characteristic map).
-
-    Examples
-    --------
-    For z^2 = (x^2 - y^2, 2 x y) (Cauchy-Riemann: det J = |2 z|^2):
-
-    >>> from ccproof.rigorous import Poly
-    >>> x, y = Poly.variable(0, 2), Poly.variable(1, 2)
-    >>> jacobian_determinant([x**2 - y**2, 2 * x * y]) == 4 * x**2 + 4 * y**2
+    >>> x, y = BernsteinForm((2, 1), [0, 1]), BernsteinForm((1, 2), [0, 1])
+    >>> jacobian_determinant([x * x - y * y, 2 * x * y]).coeffs == (4 * x * x + 4 * y * y).coeffs
     True
     """
     components = list(components)
@@ -460,19 +276,14 @@ def jacobian_determinant(components, variables=None):
     variables = tuple(range(n)) if variables is None else tuple(variables)
     if len(variables) != n or len(set(variables)) != n:
         raise ValueError(f"need {n} distinct variables, got {variables!r}")
-    jac = [[g.diff(v) for v in variables] for g in components]
-    return _det(jac)
+    return _det([[g.diff(v) for v in variables] for g in components])
 
 
 def _det(m):
-    n = len(m)
-    if n == 1:
+    if len(m) == 1:
         return m[0][0]
-    if n == 2:
-        return m[0][0] * m[1][1] - m[0][1] * m[1][0]
     total = None
-    for j in range(n):
-        minor = [row[:j] + row[j + 1 :] for row in m[1:]]
-        term = m[0][j] * _det(minor)
+    for j in range(len(m)):
+        term = m[0][j] * _det([row[:j] + row[j + 1:] for row in m[1:]])
         total = term if total is None else (total + term if j % 2 == 0 else total - term)
     return total

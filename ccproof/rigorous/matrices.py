@@ -1,8 +1,19 @@
-"""The exact basis-change matrices of Bernstein forms and Taylor shifts (``fmpq_mat``, cached; internal).
+"""The exact basis-change matrices (``fmpq_mat``, cached) along one axis: power to Bernstein basis on [0, 1] (with
+degree elevation), elevation, de Casteljau split and restriction, derivative, the Taylor shift p(x) -> p(a + h x);
+the formulas: docs/rigorous.md, "Basis changes". :mod:`.tensor` applies them, exactly or enclosed in ``arb_mat``.
 
-Each maps the coefficient vector of a polynomial along one axis: power basis to Bernstein basis on [0, 1]
-(with degree elevation), back, elevation, de Casteljau split and restriction, derivative, and the Taylor shift
-p(x) -> p(a + h x). :mod:`._tensor` applies them along an axis, exactly or enclosed in ``arb_mat``.
+>>> (power_to_bernstein_matrix(1, 2) * fmpq_mat(2, 1, [0, 1])).entries()   # x in degree 2
+[0, 1/2, 1]
+>>> (elevation_matrix(1, 3) * fmpq_mat(2, 1, [0, 1])).entries()   # x in degree 3
+[0, 1/3, 2/3, 1]
+>>> (split_matrix(2, fmpq(1, 2), 0) * fmpq_mat(3, 1, [0, 0, 1])).entries()   # x^2 on [0, 1/2]
+[0, 0, 1/4]
+>>> (restrict_matrix(1, fmpq(1, 4), fmpq(1, 2)) * fmpq_mat(2, 1, [0, 1])).entries()   # x on [1/4, 1/2]
+[1/4, 1/2]
+>>> (derivative_matrix(2, fmpq(1, 2)) * fmpq_mat(3, 1, [0, 0, 1])).entries()   # 4 x^2 on [0, 1/2]
+[0, 4]
+>>> (taylor_shift_matrix(2, fmpq(1), fmpq(2)) * fmpq_mat(3, 1, [0, 0, 1])).entries()   # (1 + 2x)^2
+[1, 4, 4]
 """
 
 from math import comb
@@ -37,61 +48,18 @@ def binomials(n):
 
 
 def power_to_bernstein_matrix(n, d):
-    """(d+1) x (n+1) ``fmpq_mat``: power coefficients of degree n -> Bernstein ones of degree d >= n on [0,1].
-
-    b_k = sum_i C(k, i) / C(d, i) a_i.
-
-    Examples
-    --------
-    >>> (power_to_bernstein_matrix(1, 2) * fmpq_mat(2, 1, [0, 1])).entries()   # x in degree 2
-    [0, 1/2, 1]
-    """
+    """Power coefficients of degree n -> Bernstein ones of degree d >= n on [0, 1]: b_k = sum_i C(k, i)/C(d, i) a_i."""
     return _cached(("p2b", n, d), lambda: _matrix(d + 1, n + 1, lambda k, i: fmpq(_C(k, i), comb(d, i))))
 
 
-def bernstein_to_power_matrix(n):
-    """(n+1) x (n+1) ``fmpq_mat``: Bernstein coefficients of degree n on [0,1] -> power coefficients.
-
-    a_i = sum_k (-1)^(i-k) C(n, i) C(i, k) b_k (the inverse of :func:`power_to_bernstein_matrix` ``(n, n)``).
-
-    Examples
-    --------
-    >>> (bernstein_to_power_matrix(2) * fmpq_mat(3, 1, [0, 1, 0])).entries()   # 2 x (1 - x)
-    [0, 2, -2]
-    """
-
-    def entry(i, k):
-        return (-1) ** ((i - k) % 2) * _C(n, i) * _C(i, k)
-
-    return _cached(("b2p", n), lambda: _matrix(n + 1, n + 1, entry))
-
-
 def elevation_matrix(n, d):
-    """(d+1) x (n+1) ``fmpq_mat``: Bernstein degree elevation n -> d: b'_k = sum_i C(n,i) C(d-n,k-i) / C(d,k) b_i.
-
-    Examples
-    --------
-    >>> (elevation_matrix(1, 3) * fmpq_mat(2, 1, [0, 1])).entries()   # x in degree 3
-    [0, 1/3, 2/3, 1]
-    """
-
-    def entry(k, i):
-        return fmpq(_C(n, i) * _C(d - n, k - i), comb(d, k))
-
-    return _cached(("elev", n, d), lambda: _matrix(d + 1, n + 1, entry))
+    """Bernstein degree n -> d: b'_k = sum_i C(n, i) C(d - n, k - i) / C(d, k) b_i."""
+    return _cached(("elev", n, d), lambda: _matrix(d + 1, n + 1, lambda k, i: fmpq(_C(n, i) * _C(d - n, k - i),
+                                                                                     comb(d, k))))
 
 
 def split_matrix(n, t, side):
-    """De Casteljau at ``t``: side 0 gives the coefficients on [0, t], side 1 on [t, 1].
-
-    side 0: b'_i = sum_{j <= i} C(i, j) t^j (1-t)^(i-j) b_j;
-    side 1: b'_i = sum_{j >= i} C(n-i, j-i) t^(j-i) (1-t)^(n-j) b_j.  Exact (n+1) x (n+1) ``fmpq_mat``.
-
-    Examples
-    --------
-    >>> (split_matrix(2, fmpq(1, 2), 0) * fmpq_mat(3, 1, [0, 0, 1])).entries()   # x^2 on [0, 1/2]
-    [0, 0, 1/4]
-    """
+    """De Casteljau at ``t``: the coefficients on [0, t] (side 0) or on [t, 1] (side 1)."""
     s = 1 - t
 
     def left(i, j):
@@ -104,13 +72,7 @@ def split_matrix(n, t, side):
 
 
 def restrict_matrix(n, a, b):
-    """(n+1) x (n+1) ``fmpq_mat``: Bernstein coefficients of degree n on [0,1] -> on [a, b] (0 <= a < b <= 1).
-
-    Examples
-    --------
-    >>> (restrict_matrix(1, fmpq(1, 4), fmpq(1, 2)) * fmpq_mat(2, 1, [0, 1])).entries()   # x
-    [1/4, 1/2]
-    """
+    """Bernstein coefficients of degree n on [0, 1] -> on [a, b] (0 <= a < b <= 1): two splits."""
 
     def build():
         mat = split_matrix(n, b, 0) if b < 1 else None
@@ -123,56 +85,22 @@ def restrict_matrix(n, a, b):
 
 
 def derivative_matrix(n, h):
-    """n x (n+1) ``fmpq_mat`` (1 x 1 zero when n = 0): Bernstein coefficients of f' for an interval of width h.
-
-    Examples
-    --------
-    >>> (derivative_matrix(2, fmpq(1, 2)) * fmpq_mat(3, 1, [0, 0, 1])).entries()   # 4 x^2 on [0, 1/2]
-    [0, 4]
-    """
+    """Bernstein coefficients of f' (degree n - 1) on an interval of width h; 1 x 1 zero when n = 0."""
     if n == 0:
         return _cached(("diff", 0), lambda: fmpq_mat(1, 1, [0]))
-    return _cached(
-        ("diff", n, h),
-        lambda: _matrix(n, n + 1, lambda i, j: n / h if j == i + 1 else -n / h if j == i else 0),
-    )
+    return _cached(("diff", n, h), lambda: _matrix(n, n + 1, lambda i, j: n / h if j == i + 1 else -n / h if j == i
+                                                     else 0))
 
 
 def taylor_shift_matrix(n, a, h):
-    """Exact matrix sending the coefficients of p(x) (degree n) to those of p(a + h x).
-
-    Parameters
-    ----------
-    n : int
-    a, h : fmpq
-
-    Returns
-    -------
-    fmpq_mat, shape (n + 1, n + 1)
-        Entry (j, i) is ``C(i, j) a^(i-j) h^j``; the Taylor shift to a box before the Bernstein
-        conversion (docs/rigorous.md "API").
-
-    Examples
-    --------
-    x^2 becomes (1 + 2 x)^2 = 1 + 4 x + 4 x^2:
-
-    >>> taylor_shift_matrix(2, fmpq(1), fmpq(2)) * fmpq_mat(3, 1, [0, 0, 1])
-    [1]
-    [4]
-    [4]
-    """
-    def build():
-        return fmpq_mat(n + 1, n + 1, [fmpq(comb(i, j)) * a ** (i - j) * h**j if i >= j else fmpq(0)
-                                       for j in range(n + 1) for i in range(n + 1)])
-
-    return _cached(("shift", n, a, h), build)
+    """Coefficients of p(x) (degree n) -> those of p(a + h x): entry (j, i) is C(i, j) a^(i-j) h^j."""
+    return _cached(("shift", n, a, h), lambda: fmpq_mat(n + 1, n + 1, [
+        fmpq(comb(i, j)) * a ** (i - j) * h**j if i >= j else fmpq(0) for j in range(n + 1) for i in range(n + 1)]))
 
 
 def conversion_matrix(n, d, lo, hi):
-    """Power coefficients of degree n on [lo, hi] -> Bernstein ones of degree d >= n (cached)."""
+    """Power coefficients of degree n on [lo, hi] -> Bernstein ones of degree d >= n."""
     if (lo, hi) == (0, 1):
         return power_to_bernstein_matrix(n, d)
-    return _cached(
-        ("conv", n, d, lo, hi),
-        lambda: power_to_bernstein_matrix(n, d) * taylor_shift_matrix(n, lo, hi - lo),
-    )
+    return _cached(("conv", n, d, lo, hi),
+                   lambda: power_to_bernstein_matrix(n, d) * taylor_shift_matrix(n, lo, hi - lo))

@@ -1,71 +1,34 @@
-"""Taylor models in one parameter with Bernstein coefficients in the other variables.
-
-A :class:`TaylorForm` of shape ``(m, n_1, ..., n_d)`` (row-major coefficient balls ``c``) stands for
-
-    f(z, x) = sum_{e < m, k} c[e, k] z^e B_k(x),     z in [-1, 1],  x in [0, 1]^d,
-
-with ``B_k(x) = prod_i C(n_i - 1, k_i) x_i^k_i (1 - x_i)^(n_i - 1 - k_i)`` the tensor Bernstein basis on
-the unit box: a power series in the parameter ``z`` whose coefficients are Bernstein forms in ``x``.
-Every operation returns balls enclosing the exact result for every choice of the inputs in their
-balls, as :mod:`.bernstein` does. :meth:`TaylorForm.truncate` drops the powers ``z^e``, ``e > D``:
-since ``|z| <= 1`` and ``B_k >= 0``, ``c z^e B_k`` lies in ``[-|c|, |c|] B_k``, so each dropped ball
-is added (as ``[-|c|, |c|]``) to ``c[0, k]``. Keeping ``x`` in the Bernstein basis keeps those balls
-of the size of the values (a power basis in ``x`` would add the absolute values of its coefficients,
-which cancel heavily at high degree).
+"""Taylor models in one parameter z in [-1, 1] with Bernstein coefficients in x in [0, 1]^d (docs/rigorous.md,
+"Taylor models"): f(z, x) = sum_(e, k) c[e, k] z^e B_k(x), balls enclosing the exact result as in :mod:`.bernstein`.
 
 >>> from flint import arb
->>> from ccproof.rigorous import Poly
 >>> x = TaylorForm.variable(1, 1, prec=64)               # x_1 on [0,1]
->>> z = TaylorForm.from_poly(Poly.variable(0, 2), 64)   # z on [-1, 1]
+>>> z = TaylorForm((2, 1), [0, 1], 64)                   # z on [-1, 1]
 >>> f = (x * z + 1) * (x * z - 1)                        # x^2 z^2 - 1
 >>> f.shape, f.truncate(1).shape
 ((3, 3), (2, 3))
->>> t = f.truncate(1).coeffs
+>>> t = f.truncate(1).coeffs                             # x^2 z^2 (coefficient 1 on B_2 = x^2) -> [-1, 1] on B_2
 >>> t[0].str(3), t[1].str(3), bool(t[2].contains(-2)), bool(t[2].contains(0)), bool(t[2].rad() < 1 + arb("1e-6"))
 ('-1.00', '-1.00', True, True, True)
-
-The last ball is -1 + [-1, 1]: the dropped x^2 z^2 (Bernstein coefficient 1 on B_2 = x^2) bounded by [-1, 1].
 """
 
 import flint
 from flint import arb
 
-from . import _tensor as T
+from . import tensor as T
 from .bernstein import BernsteinForm, unit_box
-from .matrices import power_to_bernstein_matrix
 
 ZBOX = (T.exact_scalar(-1), T.exact_scalar(1))
 
 
 class TaylorForm(BernsteinForm):
-    """Polynomial in ``z`` in [-1, 1] (axis 0, power basis) with Bernstein coefficients in ``x`` in
-    [0, 1]^d (axes 1..d), all coefficients ``arb`` balls at ``prec`` bits (see the module docstring): a
-    :class:`BernsteinForm` on [-1, 1] x [0, 1]^d whose axis 0 is in the power basis (:attr:`POWER_AXES`), so
-    that sums, products and derivatives in x are the Bernstein ones (zeros appended and plain convolution
-    along z), :meth:`truncate` drops powers of z and :meth:`bernstein` converts z.
+    """A :class:`BernsteinForm` of arb balls on [-1, 1] x [0, 1]^d (``shape``: z degree + 1, then x degrees + 1)
+    whose axis 0 is in the power basis (:attr:`POWER_AXES`): sums, products and x derivatives are the Bernstein ones,
+    :meth:`truncate` drops powers of z, :meth:`bernstein` converts z.
 
-    Parameters
-    ----------
-    shape : tuple of int, length 1 + d (2..4)
-        ``(z degree + 1, x degrees + 1)``.
-    coeffs : sequence of arb-convertible, length ``prod(shape)`` (row-major)
-    prec : int
-        Bits of the balls.
-
-    Notes
-    -----
-    Taylor models in one parameter for every valence k >= k0 (docs/readings.md R10,
-    docs/appendix_a.md).
-
-    Examples
-    --------
-    x^2 + z y: z-degree 1, Bernstein coefficients in (x, y) of x^2 (0, 0, 1) and of y (0, 1):
-
-    >>> from ccproof.rigorous import Poly
-    >>> z, x, y = (Poly.variable(i, 3) for i in range(3))
-    >>> f = TaylorForm.from_poly(x * x + z * y, 53)
-    >>> f.shape, [c.str(3, radius=False) for c in f.coeffs]
-    ((2, 3, 2), ['0', '0', '0', '0', '1.00', '1.00', '0', '1.00', '0', '1.00', '0', '1.00'])
+    >>> f = TaylorForm((2, 3, 2), [0, 0, 0, 0, 1, 1, 0, 1, 0, 1, 0, 1], 53)   # x^2 + z y
+    >>> f.truncate(0).shape
+    (1, 3, 2)
     """
 
     __slots__ = ()
@@ -76,19 +39,6 @@ class TaylorForm(BernsteinForm):
         if T.check_prec(prec) is None or len(shape) < 2:
             raise ValueError(f"a TaylorForm holds balls (pass prec=...) in 2..4 variables, got {shape!r}, {prec!r}")
         super().__init__(shape, coeffs, _box(len(shape)), prec)
-
-    @classmethod
-    def from_poly(cls, poly, prec):
-        """The power-basis :class:`Poly` ``poly`` in (z, x_1, ..., x_d), x in the Bernstein basis on [0,1]^d."""
-        from .poly import Poly
-
-        if not isinstance(poly, Poly) or poly.nvars < 2:
-            raise TypeError("expected a Poly in (z, x_1, ...), at least 2 variables")
-        coeffs, shape = T.convert(poly.coeffs, prec), poly.shape
-        for axis in range(1, len(shape)):
-            coeffs, shape = T.apply_along_axis(coeffs, shape, axis,
-                                               power_to_bernstein_matrix(shape[axis] - 1, shape[axis] - 1), prec)
-        return cls.from_raw(shape, coeffs, _box(len(shape)), prec)
 
     @classmethod
     def constant(cls, c, nx, prec):
@@ -105,8 +55,7 @@ class TaylorForm(BernsteinForm):
                             _box(nx + 1), prec)
 
     def truncate(self, degree):
-        """Keep z^0 .. z^degree; each dropped coefficient c of z^e B_k (e > degree) is added as
-        [-|c|, |c|] to the coefficient of z^0 B_k (|z| <= 1 and B_k >= 0)."""
+        """Keep z^0 .. z^degree; each dropped c of z^e B_k is added as [-|c|, |c|] to the one of z^0 B_k."""
         if isinstance(degree, bool) or not isinstance(degree, int) or degree < 0:
             raise ValueError(f"degree must be a non-negative int, got {degree!r}")
         if self.shape[0] <= degree + 1:

@@ -13,10 +13,10 @@ from flint import arb, ctx, fmpq
 
 from ccproof.algebra.specialize import characteristic_map_patches
 from ccproof.certify import verify as V
+from ccproof.certify.poly import Poly, ball_contains
 from ccproof.certify.verify import interval as I
 from ccproof.certify.verify import replay as R
 from ccproof.certify.verify.statement import PATCHES, derivation
-from ccproof.rigorous import Poly, ball_contains
 from ccproof.tables.format import certificates_dir
 
 PREC = 128

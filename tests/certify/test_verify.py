@@ -197,7 +197,7 @@ def test_c1_tampering_rejected():
 
 def _compose(b, X):
     """b(X) for an fmpq_poly b and a Poly X (Horner)."""
-    from ccproof.rigorous import Poly
+    from ccproof.certify.poly import Poly
 
     c = b.coeffs()
     acc = Poly.constant(c[-1], X.nvars, X.prec)
@@ -211,13 +211,14 @@ def cell_det_poly(nets, lam, N, l, m, p, q, prec):
     from one form per piece restricted, as the verifier does); G = w y + (1 - w) Phi (docs/readings.md R6)."""
     from flint import ctx, fmpq
 
-    from ccproof.rigorous import Poly, jacobian_determinant
+    from ccproof.certify.poly import Poly, to_poly
+    from ccproof.rigorous import jacobian_determinant
 
     i, name, box = M.cell_geometry(l, m, N)
     with ctx.workprec(prec):
         li = lam**i
-        X = M.net_form(nets[name], 0, prec, box).to_poly() * li
-        Y = M.net_form(nets[name], 1, prec, box).to_poly() * li
+        X = to_poly(M.net_form(nets[name], 0, prec, box)) * li
+        Y = to_poly(M.net_form(nets[name], 1, prec, box)) * li
         s, t = Poly.variable(0, 2), Poly.variable(1, 2)
         y1, y2 = (s + l) * fmpq(1, 2**N), (t + m) * fmpq(1, 2**N)
         w = _compose(M.weight_piece(p), X) * _compose(M.weight_piece(q), Y)
@@ -235,7 +236,7 @@ def test_the_direct_cell_determinant_is_4_to_the_minus_N_for_the_identity_map():
 def test_mirror_symmetry_of_the_exact_nets_and_its_consequence():
     from flint import ctx
 
-    from ccproof.rigorous import bernstein_coefficients
+    from ccproof.certify.poly import bernstein_coefficients
 
     assert St.derivation().symmetric
     # consequence, checked on the determinants themselves: the Bernstein form of det J_G on the mirrored
@@ -269,7 +270,7 @@ def test_cell_forms_restricted_from_one_piece_form_equal_the_direct_cell_determi
     coefficients (the same polynomial in the same basis), and both balls must stay tight."""
     from flint import ctx
 
-    from ccproof.rigorous import bernstein_coefficients
+    from ccproof.certify.poly import bernstein_coefficients
 
     with ctx.workprec(128):
         nets = St.nets_for_valence(7, 128)

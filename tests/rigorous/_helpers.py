@@ -6,7 +6,7 @@ from math import comb
 import sympy as sp
 from flint import fmpq
 
-from ccproof.rigorous import Poly
+from ccproof.certify.poly import Poly
 
 SYMS = sp.symbols("x0:4")
 

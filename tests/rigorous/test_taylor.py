@@ -13,7 +13,8 @@ from math import comb
 import pytest
 from flint import arb, ctx, fmpq
 
-from ccproof.rigorous import Poly, TaylorForm, ball_contains, bernstein_coefficients, jacobian_determinant
+from ccproof.certify.poly import Poly, ball_contains, bernstein_coefficients, taylor_form
+from ccproof.rigorous import TaylorForm, jacobian_determinant
 
 PREC = 128
 
@@ -28,7 +29,7 @@ def random_poly(r, shape):
 
 
 def tf(p):
-    return TaylorForm.from_poly(p.to_arb(PREC) if hasattr(p, "to_arb") else p, PREC)
+    return taylor_form(p.to_arb(PREC) if hasattr(p, "to_arb") else p, PREC)
 
 
 def evaluate(f, z, x):

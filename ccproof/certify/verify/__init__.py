@@ -1,11 +1,5 @@
-"""The trusted verifier of ccproof certificates (``ccproof verify``).
-
-A certificate is a statement plus hints. The statement is fixed by the schema and the valence alone:
-this package derives c = cos(2 pi/k), lam(k), the subdominant eigenvector, the characteristic map's
-nets, the spectrum and every hypothesis the proofs use from k and the Catmull-Clark rules
-(:mod:`.rules`, :mod:`.statement`, :mod:`.spectrum`), reads no table, and replays the hints (dyadic
-boxes with claimed bounds, :mod:`.replay`) without searching. It imports only python-flint, the
-standard library and :mod:`ccproof.rigorous`; docs/trusted_base.md lists the modules it consists of.
+"""The trusted verifier of ccproof certificates (``ccproof verify``): the statement is derived from the schema and
+the valence, the hints replayed without search; docs/trusted_base.md lists the modules and their guarantees.
 
 >>> from ccproof.certify.verify import verify_file, certificate_files
 >>> from ccproof.tables.format import certificates_dir
@@ -35,29 +29,14 @@ MAX_FILE_BYTES = 4 * 2**20  # the published certificates: at most 64 KB; MAX_BOX
 #: what a malformed file can raise while it is being read; each ends in FAIL with the reason
 _MALFORMED = (CertificateError, ValueError, TypeError, KeyError, IndexError, AttributeError, RecursionError,
               OverflowError, ZeroDivisionError)
+#: what a file that is not a regular one is, by its type bits
+_NOT_REGULAR = {stat.S_IFIFO: "a FIFO", stat.S_IFDIR: "a directory", stat.S_IFCHR: "a character device",
+                stat.S_IFBLK: "a block device", stat.S_IFSOCK: "a socket"}
 
 
 def verify_certificate(cert, log=print, path=None):
-    """Check a parsed certificate (a dict) through the one route of the registry that takes its schema,
-    configuration and statement (:func:`.registry.route_of`). Returns a :class:`VerifyResult` with the
-    family, valence and statement it checked; never raises for bad input.
-
-    Parameters
-    ----------
-    cert : object
-        The parsed JSON (docs/certificates.md); anything else fails with a reason.
-    log : callable (str) -> None
-        Receives a PASS/FAIL line per part.
-    path : str or Path, optional
-        Recorded in the result.
-
-    Returns
-    -------
-    VerifyResult
-
-    Examples
-    --------
-    The C1 certificate of valence 5 (Reif's criterion, docs/certificates.md), then a forged precision:
+    """Check a parsed certificate through the one route of the registry that takes its schema, configuration and
+    statement (:func:`.registry.route_of`); a :class:`VerifyResult`, never an exception on bad input.
 
     >>> import json
     >>> from ccproof.tables.format import certificates_dir
@@ -69,13 +48,12 @@ def verify_certificate(cert, log=print, path=None):
     """
     res = VerifyResult(path=None if path is None else str(path))
     t0 = time.perf_counter()
-    part = Recorder(res, log)
     try:
-        route, res.family, res.valence = route_of(cert)  # the one route of the registry (.registry.ROUTES)
+        route, res.family, res.valence = route_of(cert)
         res.schema, res.statement = route.schema, route.statement
         check_size(cert)
         res.N = cert.get("N") if isinstance(cert.get("N"), int) and not isinstance(cert.get("N"), bool) else None
-        route.check(cert, res.family, res.valence, part, log)
+        route.check(cert, res.family, res.valence, Recorder(res, log), log)
     except _MALFORMED as exc:
         res.error = f"{type(exc).__name__}: {exc}" if not isinstance(exc, CertificateError) else str(exc)
     finally:
@@ -85,22 +63,8 @@ def verify_certificate(cert, log=print, path=None):
 
 
 def verify_file(path: str | Path, log: Callable[[str], object] = print) -> VerifyResult:
-    """Verify one certificate file; logs PASS/FAIL per part, then VERIFIED or FAILED with the reason.
-
-    Only a regular file of at most :data:`MAX_FILE_BYTES` is read (:func:`read_certificate_bytes`); a
-    FIFO, a device, a directory or a larger file FAILs at once, naming the file.
-
-    Parameters
-    ----------
-    path : str or Path
-        A certificate file (JSON, one of the schemas of :data:`.registry.ROUTES`).
-    log : callable
-        Receives each output line (default ``print``).
-
-    Returns
-    -------
-    VerifyResult
-        True as a bool exactly when every part passed; ``parts`` with their reasons, ``margins``.
+    """Verify one certificate file (a regular file of at most :data:`MAX_FILE_BYTES`: :func:`read_certificate_bytes`);
+    logs PASS/FAIL per part, then VERIFIED or FAILED with the reason.
 
     >>> from ccproof.tables.format import certificates_dir
     >>> res = verify_file(certificates_dir() / "c1" / "k005.json", log=lambda line: None)
@@ -126,30 +90,10 @@ def verify_file(path: str | Path, log: Callable[[str], object] = print) -> Verif
 
 
 def read_certificate_bytes(path, cap=MAX_FILE_BYTES):
-    """The bytes of a regular file of at most ``cap`` bytes; anything else is refused, without blocking.
+    """The bytes of a regular file of at most ``cap`` bytes, without blocking: opened non-blocking (a FIFO with no
+    writer does not wait), judged by ``fstat`` of the open descriptor (a link to ``/dev/zero``, a FIFO, a directory
+    or a device is refused), at most ``cap + 1`` bytes read (a file that grows is still refused).
 
-    The file is opened non-blocking (a FIFO with no writer does not wait), the open descriptor is
-    checked with ``fstat`` (so a symbolic link is judged by what it points to: ``/dev/zero``, a FIFO,
-    a directory or a device is refused), and at most ``cap + 1`` bytes are read (a file that grows, or
-    reports a wrong size, is still refused above the cap).
-
-    Parameters
-    ----------
-    path : str or Path
-    cap : int
-        Bytes; default :data:`MAX_FILE_BYTES`.
-
-    Returns
-    -------
-    bytes
-
-    Raises
-    ------
-    CertificateError
-        Naming the file and the reason; OSError when it cannot be opened.
-
-    Examples
-    --------
     >>> from ccproof.tables.format import certificates_dir
     >>> len(read_certificate_bytes(certificates_dir() / "c1" / "k005.json")) > 100
     True
@@ -162,15 +106,9 @@ def read_certificate_bytes(path, cap=MAX_FILE_BYTES):
     try:
         mode = os.fstat(fd).st_mode
         if not stat.S_ISREG(mode):
-            kind = ("a FIFO" if stat.S_ISFIFO(mode) else "a directory" if stat.S_ISDIR(mode) else
-                    "a character device" if stat.S_ISCHR(mode) else "a block device" if stat.S_ISBLK(mode) else
-                    "a socket" if stat.S_ISSOCK(mode) else "not a file")
-            raise CertificateError(f"{path}: not a regular file ({kind})")
+            raise CertificateError(f"{path}: not a regular file ({_NOT_REGULAR.get(stat.S_IFMT(mode), 'not a file')})")
         chunks, left = [], cap + 1
-        while left > 0:
-            chunk = os.read(fd, min(left, 2**20))
-            if not chunk:
-                break
+        while left > 0 and (chunk := os.read(fd, min(left, 2**20))):
             chunks.append(chunk)
             left -= len(chunk)
     finally:
@@ -182,20 +120,9 @@ def read_certificate_bytes(path, cap=MAX_FILE_BYTES):
 
 
 def certificate_files(directory):
-    """The certificate files under ``directory``: ``c1/k*.json``, the tagged configurations'
-    ``c1/{dart,crease,corner}/*.json``, then ``injectivity/k*.json``.
+    """The certificate files under ``directory``: ``c1/k*.json``, ``c1/{dart,crease,corner}/*.json``, then
+    ``injectivity/k*.json``, each folder sorted by name.
 
-    Parameters
-    ----------
-    directory : str or Path
-
-    Returns
-    -------
-    list of Path
-        Sorted by name within each folder.
-
-    Examples
-    --------
     >>> from ccproof.tables.format import certificates_dir
     >>> files = certificate_files(certificates_dir())
     >>> files[0].parent.name, files[0].name, files[-1].parent.name
@@ -204,4 +131,3 @@ def certificate_files(directory):
     d = Path(directory)
     tagged = sorted(f for fam in TAGGED for f in (d / "c1" / fam).glob("[kn]*.json"))
     return sorted((d / "c1").glob("k*.json")) + tagged + sorted((d / "injectivity").glob("k*.json"))
-

@@ -1,4 +1,4 @@
-"""Verdicts: the parts of a check with their reasons, and strict reading of certificate fields (trusted)."""
+"""Verdicts (the parts of a check with their reasons) and strict reading of certificate fields (trusted)."""
 
 from __future__ import annotations
 
@@ -11,18 +11,8 @@ from .errors import CertificateError
 
 @dataclass
 class Part:
-    """One checked claim: ``name``, ``ok``, a ``message`` (the reason when it failed) and, for box parts,
-    the smallest claimed bound that was re-checked (``bound``, an exact fmpq) in local coordinates.
+    """One checked claim; ``bound``: the smallest claimed bound re-checked (exact), for box parts.
 
-    Attributes
-    ----------
-    name : str
-    ok : bool
-    message : str
-    bound : fmpq or None
-
-    Examples
-    --------
     >>> Part("S", False, "not an eigenvector")
     Part(name='S', ok=False, message='not an eigenvector', bound=None)
     """
@@ -35,30 +25,10 @@ class Part:
 
 @dataclass
 class VerifyResult:
-    """The verdict on one certificate: ``ok`` only when every part passed; ``parts`` in order; ``error``
-    names why the file could not be checked at all (malformed, unknown field), else None. True as a bool
-    exactly when ``ok``. ``margins`` maps a section (``regularity``, ``cells``, ``corner``, ``star``) to the
-    smallest bound re-checked in this run. ``family``, ``valence`` and ``statement`` are what the verifier
-    checked (set by :func:`ccproof.certify.verify.verify_certificate` from the bytes it verified, before the
-    checks: a failed result may carry them too); ``configuration`` names the two first.
-
-    Attributes
-    ----------
-    path, schema : str or None
-    family : str or None
-        ``"smooth"``, ``"dart"``, ``"crease"`` or ``"corner"``.
-    valence : int or dict or None
-        k (N, K), or ``{"min": k0}`` for every k >= k0.
-    statement : str or None
-        ``"injective"``, ``"C1"`` or ``"not C1"``.
-    N : int or None
-    parts : list of Part
-    error : str or None
-    seconds : float
-    margins : dict[str, fmpq]
-
-    Examples
-    --------
+    """The verdict on one certificate, True exactly when every part passed and ``error`` (why the file could not
+    be checked) is None. ``family`` (smooth, dart, crease, corner), ``valence`` (k, N, or ``{"min": k0}``) and
+    ``statement`` (injective, C1, not C1) are what the verifier checked, set from the bytes it verified;
+    ``margins``: per section, the smallest bound re-checked.
 
     >>> r = VerifyResult(parts=[Part("A", True), Part("B", False, "a coefficient is not above the bound")])
     >>> bool(r), [p.name for p in r.failures()]
@@ -94,15 +64,8 @@ class VerifyResult:
 
 
 class Recorder:
-    """Collects the parts of a :class:`VerifyResult` and prints each as PASS/FAIL through ``log``.
+    """Collects the parts of a :class:`VerifyResult` and logs each as PASS/FAIL.
 
-    Parameters
-    ----------
-    result : VerifyResult
-    log : callable (str) -> None
-
-    Examples
-    --------
     >>> r = VerifyResult()
     >>> rec = Recorder(r, print)
     >>> rec("A", True, bound=fmpq(1, 3), section="cells"); rec("B", False, "too small")
@@ -128,22 +91,8 @@ class Recorder:
 
 
 def field_of(obj, key, kind, where):
-    """``obj[key]`` of type ``kind`` (bool is never an int here), else :class:`CertificateError`.
+    """``obj[key]`` of type ``kind`` (a bool is never an int here), else a :class:`CertificateError` naming ``where``.
 
-    Parameters
-    ----------
-    obj : object (a dict from JSON)
-    key : str
-    kind : type or tuple of types
-    where : str
-        Named in the error.
-
-    Returns
-    -------
-    The value.
-
-    Examples
-    --------
     >>> field_of({"N": 3}, "N", int, "hints")
     3
     >>> field_of({"N": True}, "N", int, "hints")
@@ -160,21 +109,8 @@ def field_of(obj, key, kind, where):
 
 
 def exact_keys(obj, keys, where):
-    """Reject unknown and missing keys: nothing in a certificate goes unchecked.
+    """Refuse an object with unknown or missing keys: nothing in a certificate goes unchecked.
 
-    Parameters
-    ----------
-    obj : object (a dict from JSON)
-    keys : sequence of str
-    where : str
-        Named in the error.
-
-    Raises
-    ------
-    CertificateError
-
-    Examples
-    --------
     >>> exact_keys({"path": "0L", "bound": "1", "x": 0}, ("path", "bound"), "box")
     Traceback (most recent call last):
     ...
@@ -191,19 +127,8 @@ def exact_keys(obj, keys, where):
 
 
 def read_valence(cert):
-    """An int k >= 3 or ``{"min": k0}`` with k0 >= 3 (at most 10^6, so every derived check stays fast).
+    """``cert["valence"]``: an int k or ``{"min": k0}``, within 3..10^6 (so every derived check stays fast).
 
-    Parameters
-    ----------
-    cert : dict
-        The certificate (its ``valence`` field is read).
-
-    Returns
-    -------
-    int or dict
-
-    Examples
-    --------
     >>> read_valence({"valence": 5}), read_valence({"valence": {"min": 7}})
     (5, {'min': 7})
     """
@@ -219,18 +144,8 @@ def read_valence(cert):
 
 
 def kname(k):
-    """Display name of a valence: ``"5"`` or ``">=7"``.
+    """``"5"`` or ``">=7"``.
 
-    Parameters
-    ----------
-    k : int or dict ``{"min": k0}``
-
-    Returns
-    -------
-    str
-
-    Examples
-    --------
     >>> kname(5), kname({"min": 7})
     ('5', '>=7')
     """

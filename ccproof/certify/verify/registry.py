@@ -1,13 +1,5 @@
-"""The certificate families: one registry that every entry point dispatches through, and the coverage of
-what the verifier proved, decided from its own verdicts (trusted).
-
-A :class:`Route` is one family of certificates: its schema, the configurations it speaks about (the
-grammar ``smooth:K``, ``smooth:>=K0``, ``dart:K``, ``crease:N``, ``corner:N``, ``dart:>=K0``,
-``crease:>=N0``, ``corner:>=N0``), the statement it proves (``"injective"``, ``"C1"``, ``"not C1"``) and
-its checker. :func:`route_of` reads the schema and the configuration of a parsed certificate and picks
-the one route that checks it; :func:`coverage` decides, from the :class:`~.record.VerifyResult` objects
-the verifier produced (never from a file), which configurations are certified and which are missing.
-The prover reads the same table (``ccproof.certify.prover.PROVERS`` has one prover per route).
+"""The certificate families: the one registry every entry point dispatches through, and the coverage of what the
+verifier proved, decided from its own verdicts, never from a file (trusted; docs/trusted_base.md).
 
 >>> [r.name for r in routes_for("crease:5")]
 ['tagged not C1', 'tagged C1']
@@ -17,8 +9,8 @@ The prover reads the same table (``ccproof.certify.prover.PROVERS`` has one prov
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
+from importlib import import_module
 
 from .errors import CertificateError
 from .record import field_of, read_valence
@@ -28,89 +20,53 @@ SCHEMA = "ccproof.injectivity/3"
 C1_SCHEMA = "ccproof.c1/2"
 TAGGED_SCHEMA = "ccproof.tagged-c1/1"
 TAGGED = ("dart", "crease", "corner")
+#: the arguments a checker takes after the certificate, before (part, log): n, or nothing, or N0 (with the family)
+_ARGS = {"n": lambda fam, n: (n,), "": lambda fam, n: (), "n0": lambda fam, n: (n["min"],),
+         "family n0": lambda fam, n: (fam, n["min"])}
 
 
 @dataclass(frozen=True)
 class Route:
-    """One family of certificates.
-
-    Attributes
-    ----------
-    name : str
-        How the prover and the reports refer to it.
-    schema : str
-    families : tuple of str
-        ``("smooth",)`` or some of :data:`TAGGED`.
-    sizes : tuple of str
-        ``"one"`` (a single valence or N), ``"every"`` (every K >= K0 at once), or both.
-    statement : str
-        ``"injective"``, ``"C1"`` or ``"not C1"``.
-    check : callable (cert, family, n, part, log) -> None
-        Records its parts into ``part``; raises :class:`CertificateError` on a malformed certificate.
-    """
+    """One family of certificates: the ``schema``, the ``families`` (``("smooth",)`` or some of :data:`TAGGED`) and
+    ``sizes`` (``"one"`` N, ``"every"`` N >= N0) it speaks about, its ``statement`` (injective, C1, not C1) and its
+    checker ``"module:function"`` with the arguments of :data:`_ARGS`, imported when the route is taken (verifying
+    one kind of certificate loads that kind's modules only)."""
 
     name: str
     schema: str
     families: tuple
     sizes: tuple
     statement: str
-    check: Callable
+    checker: str
+    args: str
 
     def takes(self, family, n):
         """Does this route speak about ``family`` with size ``n`` (an int or ``{"min": N0}``)?"""
         return family in self.families and ("every" if isinstance(n, dict) else "one") in self.sizes
 
-
-# The checkers, each imported when its route is taken (verifying one kind of certificate loads that kind's
-# modules only).
-def _injectivity(cert, fam, k, part, log):
-    from .injectivity import verify_injectivity
-
-    verify_injectivity(cert, k, part, log)
-
-
-def _c1(cert, fam, k, part, log):
-    from .c1 import verify_c1
-
-    verify_c1(cert, k, part, log)
-
-
-def _tagged_one(cert, fam, n, part, log):
-    from .tagged_c1 import verify_tagged
-
-    verify_tagged(cert, part, log)
-
-
-def _dart_tail(cert, fam, n, part, log):
-    from .dart_tail import verify_dart_tail
-
-    verify_dart_tail(cert, n["min"], part, log)
-
-
-def _tagged_tail(cert, fam, n, part, log):
-    from .tagged_limit import verify_tail
-
-    verify_tail(cert, fam, n["min"], part, log)
+    def check(self, cert, family, n, part, log):
+        """Run the checker: it records its parts into ``part``, raises :class:`CertificateError` if malformed."""
+        module, function = self.checker.split(":")
+        getattr(import_module(f".{module}", __package__), function)(cert, *_ARGS[self.args](family, n), part, log)
 
 
 #: every family of certificates the verifier checks, in the order the prover tries them for a configuration
 ROUTES = (
-    Route("smooth injective", SCHEMA, ("smooth",), ("one", "every"), "injective", _injectivity),
-    Route("smooth C1", C1_SCHEMA, ("smooth",), ("one", "every"), "C1", _c1),
-    Route("tagged not C1", TAGGED_SCHEMA, TAGGED, ("one",), "not C1", _tagged_one),
-    Route("tagged C1", TAGGED_SCHEMA, TAGGED, ("one",), "C1", _tagged_one),
-    Route("dart:>=K0 C1", TAGGED_SCHEMA, ("dart",), ("every",), "C1", _dart_tail),
-    Route("crease, corner:>=N0 not C1", TAGGED_SCHEMA, ("crease", "corner"), ("every",), "not C1", _tagged_tail),
+    Route("smooth injective", SCHEMA, ("smooth",), ("one", "every"), "injective", "injectivity:verify_injectivity",
+          "n"),
+    Route("smooth C1", C1_SCHEMA, ("smooth",), ("one", "every"), "C1", "c1:verify_c1", "n"),
+    Route("tagged not C1", TAGGED_SCHEMA, TAGGED, ("one",), "not C1", "tagged_c1:verify_tagged", ""),
+    Route("tagged C1", TAGGED_SCHEMA, TAGGED, ("one",), "C1", "tagged_c1:verify_tagged", ""),
+    Route("dart:>=K0 C1", TAGGED_SCHEMA, ("dart",), ("every",), "C1", "dart_tail:verify_dart_tail", "n0"),
+    Route("crease, corner:>=N0 not C1", TAGGED_SCHEMA, ("crease", "corner"), ("every",), "not C1",
+          "tagged_limit:verify_tail", "family n0"),
 )
 SCHEMAS = tuple(dict.fromkeys(r.schema for r in ROUTES))
 
 
 def configuration_of(name):
-    """``(family, n)`` of a configuration name: ``smooth:K``, ``smooth:>=K0`` or a tagged one
-    (:func:`.tagged.parse_configuration`); n is an int or ``{"min": N0}``.
+    """``(family, n)`` of ``smooth:K``, ``smooth:>=K0`` or a tagged name (:func:`.tagged.parse_configuration`).
 
-    Examples
-    --------
     >>> configuration_of("smooth:>=40"), configuration_of("dart:7")
     (('smooth', {'min': 40}), ('dart', 7))
     """
@@ -119,12 +75,10 @@ def configuration_of(name):
     fam, _, size = str(name).partition(":")
     if fam != "smooth":
         return parse_configuration(name)
-    every = size.startswith(">=")
-    digits = size[2:] if every else size
+    digits = size.removeprefix(">=")
     if not (digits.isascii() and digits.isdigit()) or len(digits) > 7:
         raise CertificateError(f"configuration {str(name)[:40]!r} is not smooth:K or smooth:>=K0")
-    k = read_valence({"valence": {"min": int(digits)} if every else int(digits)})
-    return fam, k
+    return fam, read_valence({"valence": {"min": int(digits)} if size.startswith(">=") else int(digits)})
 
 
 def routes_for(name):
@@ -134,17 +88,9 @@ def routes_for(name):
 
 
 def route_of(cert):
-    """``(route, family, n)`` for a parsed certificate: the schema picks the families, the configuration
-    (``valence`` of a smooth certificate, ``configuration`` of a tagged one) the size, and a tagged
-    certificate's ``statement`` the route among those that take the configuration.
+    """``(route, family, n)`` of a parsed certificate: its schema, its configuration (a smooth certificate's
+    ``valence``, a tagged one's ``configuration``) and a tagged one's ``statement`` pick the one route.
 
-    Raises
-    ------
-    CertificateError
-        An unknown schema, a malformed configuration, or a statement no route proves for it.
-
-    Examples
-    --------
     >>> route, fam, n = route_of({"schema": TAGGED_SCHEMA, "configuration": "corner:>=101", "statement": "not C1"})
     >>> route.name, fam, n
     ('crease, corner:>=N0 not C1', 'corner', {'min': 101})
@@ -158,8 +104,7 @@ def route_of(cert):
         raise CertificateError(f"unknown certificate schema {str(schema)[:60]!r} (expected one of "
                                f"{', '.join(map(repr, SCHEMAS))})")
     if schema != TAGGED_SCHEMA:
-        k = read_valence(cert)
-        return next(r for r in ROUTES if r.schema == schema), "smooth", k
+        return next(r for r in ROUTES if r.schema == schema), "smooth", read_valence(cert)
     from .tagged import parse_configuration
 
     fam, n = parse_configuration(field_of(cert, "configuration", str, "certificate"))
@@ -188,21 +133,9 @@ UNDECIDED = {
 
 
 def coverage(results):
-    """``(ok, lines)``: what the verified results cover, decided from the results alone (their family,
-    size and statement, set by the verifier; nothing is read from a file). Smooth C1 and injectivity:
-    every k >= 3 (:func:`check_coverage`); each tagged family: :func:`family_coverage`.
+    """``(ok, lines)``: what the verified results cover (their family, size and statement, set by the verifier):
+    every k >= 3 for smooth C1 and injectivity (:func:`check_coverage`), each tagged family (:func:`family_coverage`).
 
-    Parameters
-    ----------
-    results : iterable of VerifyResult
-        Failed results count for nothing.
-
-    Returns
-    -------
-    (bool, list of str)
-
-    Examples
-    --------
     >>> from ccproof.certify.verify.record import Part, VerifyResult
     >>> r = VerifyResult(family="smooth", valence={"min": 3}, statement="C1", parts=[Part("S", True)])
     >>> ok, lines = coverage([r, VerifyResult(family="smooth", valence={"min": 3}, statement="injective")])
@@ -223,19 +156,10 @@ def coverage(results):
 
 
 def family_coverage(fam, certified):
-    """``(ok, line)`` for one tagged family: the N certified C1 and not C1; ok unless a configuration is
-    certified twice (a statement and its negation, or a publishing mistake; a single N inside a
-    ``FAMILY:>=N0`` with the other statement), an N of :data:`TAGGED_RANGE` is neither certified nor in
-    :data:`UNDECIDED`, or no ``FAMILY:>=N0`` reaches past the range.
+    """``(ok, line)`` of one tagged family from the ``(n, statement)`` of its verified certificates: ok unless an N
+    is certified twice (two files, or one against a ``FAMILY:>=N0`` of the other statement), an N of
+    :data:`TAGGED_RANGE` is neither certified nor in :data:`UNDECIDED`, or no ``FAMILY:>=N0`` reaches past the range.
 
-    Parameters
-    ----------
-    fam : str
-    certified : list of (int or dict, str)
-        ``(n, statement)`` of each verified certificate of the family.
-
-    Examples
-    --------
     >>> family_coverage("crease", [(5, "not C1"), (5, "not C1")])[1][:49]
     'crease: CONTRADICTORY: certified twice: [5]; C1 f'
     >>> family_coverage("crease", [(5, "not C1")])[1][:60]
@@ -246,13 +170,14 @@ def family_coverage(fam, certified):
     """
     rows = [(n, st) for n, st in certified if not isinstance(n, dict)]
     tails = sorted((n["min"], st) for n, st in certified if isinstance(n, dict))
+    ns = [n for n, _ in rows]
     twice = _twice(rows, tails)
     lo, hi = TAGGED_RANGE[fam]
     n0 = min((t for t, _ in tails), default=hi + 2)
-    open_ = [n for n in range(lo, min(hi, n0 - 1) + 1) if n not in {n for n, _ in rows}]
+    open_ = [n for n in range(lo, min(hi, n0 - 1) + 1) if n not in ns]
     undecided = [n for n in open_ if f"{fam}:{n}" in UNDECIDED]
-    missing = [_ranges([n for n in open_ if n not in undecided])] + ([f">= {hi + 1}"] if n0 > hi + 1 else [])
-    missing = ", ".join(filter(None, missing))
+    missing = ", ".join(filter(None, [_ranges([n for n in open_ if n not in undecided])]
+                               + ([f">= {hi + 1}"] if n0 > hi + 1 else [])))
     said = {st: _said(rows, tails, st) for st in ("C1", "not C1")}
     status = (f"CONTRADICTORY: certified twice: {twice}; " if twice else f"INCOMPLETE: no certificate for {missing}; "
               if missing else f"OK ({fam}:{lo}-{hi}, every N): ")
@@ -275,24 +200,9 @@ def _said(rows, tails, statement):
 
 
 def check_coverage(valences):
-    """Do the valences (ints and {'min': k0}) cover every k >= 3? Returns (ok, message).
+    """``(ok, message)``: do the valences (ints, ``{"min": k0}``) cover every k >= 3? Each k below the least k0 by
+    its own certificate, at most once (a second file for one k is a publishing mistake); intervals may overlap.
 
-    Every k >= 3 must be covered at least once: k = 3..k0-1 each by its own certificate, where k0 is the
-    smallest interval certificate {'min': k0}. Interval certificates may overlap each other and single
-    valences (a k >= k0 certificate next to the k >= 40 one, or k = 39 next to k >= 10), since a
-    statement proved twice is still proved; a single valence may appear at most once (a second file
-    for the same k is a publishing mistake).
-
-    Parameters
-    ----------
-    valences : iterable of int or dict ``{"min": k0}``
-
-    Returns
-    -------
-    (bool, str)
-
-    Examples
-    --------
     >>> check_coverage([3, 4, {"min": 5}])
     (True, 'every k >= 3 covered (3..4 one by one, k >= 5)')
     >>> check_coverage([3, {"min": 5}])
@@ -304,13 +214,12 @@ def check_coverage(valences):
         return False, "a valence is claimed twice"
     if not tails:
         return False, "no interval k >= k0"
-    k0 = tails[0]
-    missing = sorted(set(range(3, k0)) - set(ints))
+    missing = sorted(set(range(3, tails[0])) - set(ints))
     if missing:
         return False, f"missing valences {missing}"
-    over = [k for k in ints if k >= k0]
-    return True, (f"every k >= 3 covered (3..{k0 - 1} one by one, k >= {k0}"
-                  + ("".join(f", k >= {t}" for t in tails[1:]))
+    over = [k for k in ints if k >= tails[0]]
+    return True, (f"every k >= 3 covered (3..{tails[0] - 1} one by one, k >= {tails[0]}"
+                  + "".join(f", k >= {t}" for t in tails[1:])
                   + (f"; covered twice: {over[0]}..{over[-1]}" if over else "") + ")")
 
 

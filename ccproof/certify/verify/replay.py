@@ -1,19 +1,19 @@
-"""Replaying the hints of a certificate: decimals, box paths, partitions, claimed bounds (trusted).
+"""Replaying the hints of a certificate: sizes, decimals, box paths, partitions, claimed bounds (trusted).
 
-Every cover in a certificate is one format, a split tree given by its leaves (docs/certificates.md has the
-grammar): a leaf names a box by halvings (a path, :func:`parse_path`) and claims a bound (a decimal). A box
-list ``[{"path", "bound"}]`` is the leaves of one tree over its root box; a dart tree ``{"grid", "leaves"}``
-cuts its root box into equal cells first and holds one tree per cell. Each tree is checked to partition its
-root exactly (:func:`box_tree`) before any arithmetic, its cost charged against the certificate's budget
-(:func:`charge_replay`), and replayed depth-first by :func:`walk`: on a Bernstein form (:func:`check_boxes`,
-de Casteljau halvings) or on exact boxes handed to an evaluator (:func:`read_tree`, :func:`replay_tree`).
-Sizes are bounded, so no input can make the verifier hang or crash. It never searches.
+Every cover is one format, a split tree given by its leaves (docs/certificates.md, the grammar and "Bounds"): a
+leaf names a box by halvings (:func:`parse_path`) and claims a bound. A box list (:func:`read_boxes`) is the leaves
+of one tree over its root; a grid tree (:func:`read_tree`) cuts its root into equal cells, one tree per cell. Each
+tree must partition its root (:func:`box_tree`) before any arithmetic, its cost is charged against the certificate's
+budget (:func:`charge_replay`), and it is replayed depth-first on a Bernstein form (:func:`check_boxes`) or leaf by
+leaf on exact boxes (:func:`replay_tree`). Sizes are bounded; nothing searches.
 """
 
 from __future__ import annotations
 
 import re
 from contextvars import ContextVar
+from decimal import Decimal
+from math import prod
 
 from flint import arb, fmpq
 
@@ -29,29 +29,13 @@ MAX_GRID = 64  # cells per axis of a grid tree
 MAX_JSON_VALUES = 8 * MAX_BOXES  # every JSON value of a certificate (a box is 3); the published: at most 2,863
 MAX_REPLAY_WORK = 400_000_000  # per certificate, about 6.5 s of CPU (:func:`replay_work`; the published: 81 million)
 _SPENT = ContextVar("replay work spent on the current certificate", default=None)
+_PARTITION = "the boxes do not partition the domain exactly"
 
 
 def check_size(cert):
-    """Refuse a parsed certificate above the size limits before anything else is read from it: at most
-    :data:`MAX_JSON_VALUES` JSON values and :data:`MAX_BOXES` boxes (dicts with a ``path``) in all.
-    With paths of at most :data:`MAX_PATH_TOKENS` halvings, these bound the verifier's time and memory
-    (docs/certificates.md, "Bounds").
+    """The number of boxes (dicts with a ``path``) of a parsed certificate, refused above :data:`MAX_JSON_VALUES`
+    JSON values or :data:`MAX_BOXES` boxes before anything else is read; opens the certificate's replay budget.
 
-    Parameters
-    ----------
-    cert : object (parsed JSON)
-
-    Returns
-    -------
-    int
-        The number of boxes.
-
-    Raises
-    ------
-    CertificateError
-
-    Examples
-    --------
     >>> check_size({"parts": {"P2": [{"path": "", "bound": "1"}]}})
     1
     >>> check_size([[0] * 9] * MAX_BOXES)
@@ -77,19 +61,14 @@ def check_size(cert):
 
 
 def close_budget():
-    """End the current certificate's replay budget (opened by :func:`check_size`): a box list checked
-    afterwards, outside a certificate, has the whole budget alone."""
+    """End the replay budget :func:`check_size` opened (a box list checked alone has the whole budget)."""
     _SPENT.set(None)
 
 
 def replay_work(form, nboxes):
-    """The cost of replaying ``nboxes`` boxes on ``form``, known before any split, in coefficient products
-    of a split (about 60 million a second at 128 bits on the machine of docs/certificates.md, "Bounds"):
-    B - 1 splits (each two halves of S (d + 1) products, S the form's size, d its largest degree) and B
-    checks of S coefficients (a comparison in Python costs about 16 products), doubled above 512 bits.
+    """The cost of replaying ``nboxes`` boxes on ``form`` in products of a split (docs/certificates.md, "Bounds"):
+    B - 1 splits of 2 S (d + 1), B checks of 16 S (S the form's size, d its largest degree), doubled above 512 bits.
 
-    Examples
-    --------
     >>> from ccproof.rigorous import BernsteinForm
     >>> replay_work(BernsteinForm((6, 6), [1] * 36, prec=128), 3)  # 2 splits of 2 x 36 x 6, 3 checks of 36
     2592
@@ -100,8 +79,7 @@ def replay_work(form, nboxes):
 
 
 def charge_replay(work, what):
-    """Add ``work`` (:func:`replay_work`) to the current certificate's spending and refuse, before any
-    split, when the total passes :data:`MAX_REPLAY_WORK` (a list checked alone has the whole budget)."""
+    """Add ``work`` to the certificate's spending; refuse, before any split, beyond :data:`MAX_REPLAY_WORK`."""
     spent = _SPENT.get()
     total = work + (spent[0] if spent is not None else 0)
     if total > MAX_REPLAY_WORK:
@@ -112,19 +90,8 @@ def charge_replay(work, what):
 
 
 def parse_decimal(s):
-    """Exact fmpq of a decimal string like ``'0.1234'`` or ``'-15e-4'``, of at most
-    :data:`MAX_DECIMAL_CHARS` characters and an exponent of at most :data:`MAX_EXPONENT` in magnitude.
-
-    Parameters
-    ----------
-    s : str
-
-    Returns
-    -------
-    fmpq
-
-    Examples
-    --------
+    """The exact fmpq of a decimal string of at most :data:`MAX_DECIMAL_CHARS` characters, exponent within
+    +-:data:`MAX_EXPONENT`.
 
     >>> parse_decimal("-15e-4"), parse_decimal("0.25")
     (-3/2000, 1/4)
@@ -135,31 +102,14 @@ def parse_decimal(s):
     m = _DECIMAL.fullmatch(s)
     if m is None:
         raise CertificateError(f"{s!r} is not a decimal string")
-    sign, intpart, frac, exp = m.group(1), m.group(2), m.group(3) or "", m.group(4)
-    e = int(exp) if exp else 0
-    if abs(e) > MAX_EXPONENT:
+    if abs(int(m.group(4) or 0)) > MAX_EXPONENT:
         raise CertificateError(f"decimal {s!r}: exponent beyond +-{MAX_EXPONENT}")
-    q = fmpq(int(intpart + frac), 10 ** len(frac))
-    q = q * fmpq(10) ** e if e >= 0 else q / fmpq(10) ** (-e)
-    return -q if sign else q
+    return fmpq(*Decimal(s).as_integer_ratio())
 
 
 def parse_path(path, nvars):
-    """The halvings of a box path: ``"0L1H"`` is the low half along axis 0, then the high half along 1.
+    """The halvings ``(axis, side)`` of a box path of at most :data:`MAX_PATH_TOKENS` tokens ``[0-3][LH]``.
 
-    Parameters
-    ----------
-    path : str
-        At most :data:`MAX_PATH_TOKENS` tokens ``[0-3][LH]`` (docs/certificates.md).
-    nvars : int
-        Axes must be below it.
-
-    Returns
-    -------
-    list of (int, str)
-
-    Examples
-    --------
     >>> parse_path("0L1H", 2)
     [(0, 'L'), (1, 'H')]
     """
@@ -172,26 +122,10 @@ def parse_path(path, nvars):
 
 
 def box_tree(paths, nvars):
-    """The split tree of the leaf paths, when they partition the root box exactly; else a
-    :class:`CertificateError` naming the path (no gap, no overlap, no duplicate, one axis per node).
+    """The split tree of the leaf paths when they partition the root box exactly (no gap, no overlap, one axis per
+    node), else a :class:`CertificateError` naming the path: a leaf ``{"leaf": i}``, an inner node ``{"axis": a,
+    "L": node, "H": node}`` (B leaves, B - 1 splits). Combinatorial, before any arithmetic.
 
-    A cheap combinatorial check, done before any arithmetic. Nodes are dicts: a leaf ``{"leaf": i}``
-    (index into ``paths``), an inner node ``{"axis": a, "L": node, "H": node}``. A valid tree of B
-    leaves has B - 1 inner nodes, so replaying it (:func:`check_boxes`) splits B - 1 times.
-
-    Parameters
-    ----------
-    paths : sequence of str
-        Box paths (:func:`parse_path`).
-    nvars : int
-
-    Returns
-    -------
-    dict
-        The root node.
-
-    Examples
-    --------
     >>> box_tree(["0L", "0H1L", "0H1H"], 2)["H"]["axis"]
     1
     >>> box_tree(["0L", "0H1L"], 2)
@@ -206,45 +140,29 @@ def box_tree(paths, nvars):
         node = root
         for a, side in parse_path(p, nvars):
             if "leaf" in node:
-                raise CertificateError(f"the boxes do not partition the domain exactly: {p!r} lies inside "
-                                       f"{paths[node['leaf']]!r} (overlap)")
+                raise CertificateError(f"{_PARTITION}: {p!r} lies inside {paths[node['leaf']]!r} (overlap)")
             if node.setdefault("axis", a) == a:  # ints
                 node = node.setdefault(side, {})
             else:
-                raise CertificateError(f"the boxes do not partition the domain exactly: {p!r} splits axis {a} "
-                                       f"where another box splits axis {node['axis']} (overlap)")
+                raise CertificateError(f"{_PARTITION}: {p!r} splits axis {a} where another box splits axis "
+                                       f"{node['axis']} (overlap)")
         if node:
-            raise CertificateError(f"the boxes do not partition the domain exactly: {p!r} contains or repeats "
-                                   "another box (overlap)")
+            raise CertificateError(f"{_PARTITION}: {p!r} contains or repeats another box (overlap)")
         node["leaf"] = i
     stack = [(root, "")]
     while stack:
         node, prefix = stack.pop()
-        if "leaf" not in node:
-            for side in "LH":
-                key = f"{prefix}{node['axis']}{side}"
-                if side not in node:
-                    raise CertificateError(f"the boxes do not partition the domain exactly: no box covers {key!r} "
-                                           "(gap)")
-                stack.append((node[side], key))
+        for side in "LH" if "leaf" not in node else "":
+            key = f"{prefix}{node['axis']}{side}"
+            if side not in node:
+                raise CertificateError(f"{_PARTITION}: no box covers {key!r} (gap)")
+            stack.append((node[side], key))
     return root
 
 
 def check_partition(paths, nvars):
-    """True iff the leaf paths partition the root box exactly (no gap, no overlap): :func:`box_tree`.
+    """Do the leaf paths partition the root box exactly (:func:`box_tree`)?
 
-    Parameters
-    ----------
-    paths : sequence of str
-        Box paths (:func:`parse_path`).
-    nvars : int
-
-    Returns
-    -------
-    bool
-
-    Examples
-    --------
     >>> check_partition(["0L", "0H1L", "0H1H"], 2), check_partition(["0L", "0H1L"], 2)
     (True, False)
     """
@@ -255,28 +173,35 @@ def check_partition(paths, nvars):
     return True
 
 
+def _tree(paths, nvars, where):
+    try:
+        return box_tree(paths, nvars)
+    except CertificateError as exc:
+        raise CertificateError(f"{where}: {exc}") from None
+
+
+def _leaf_list(leaves, keysets, where):
+    """``leaves`` if a non-empty list of at most :data:`MAX_BOXES` objects, each with one of the key sets."""
+    if not isinstance(leaves, list) or not leaves or len(leaves) > MAX_BOXES:
+        raise CertificateError(f"{where}: the boxes must be a non-empty list of at most {MAX_BOXES}")
+    if not all(isinstance(b, dict) and set(b) in keysets for b in leaves):
+        raise CertificateError(f"{where}: a box must be {' or '.join(map(str, map(sorted, keysets)))}")
+    return leaves
+
+
+def _bound(leaf, where, sign):
+    """A leaf's claimed bound, of the sign its claim needs (``sign`` +1: > 0, -1: < 0)."""
+    bound = parse_decimal(leaf["bound"])
+    if not (bound > 0 if sign > 0 else bound < 0):
+        raise CertificateError(f"{where}: box {str(leaf['path'])[:40]!r} claims a "
+                               f"{'non-positive' if sign > 0 else 'non-negative'} bound ({bound}): the wrong sign")
+    return bound
+
+
 def read_boxes(boxes, nvars, where):
-    """Check a box list before any arithmetic: a non-empty list of ``{"path", "bound"}`` with bounded
-    paths and decimals, each bound > 0, the paths partitioning the root box (:func:`box_tree`).
+    """``(split tree, bounds)`` of a box list ``[{"path", "bound"}]``, each bound > 0, checked before any
+    arithmetic (the partition: :func:`box_tree`).
 
-    Parameters
-    ----------
-    boxes : object (a list from JSON)
-    nvars : int
-    where : str
-        Named in the error.
-
-    Returns
-    -------
-    (dict, list of fmpq)
-        The split tree and the bounds, in the order of ``boxes``.
-
-    Raises
-    ------
-    CertificateError
-
-    Examples
-    --------
     >>> tree, bounds = read_boxes([{"path": "0L", "bound": "0.5"}, {"path": "0H", "bound": "1e-3"}], 1, "star")
     >>> tree["axis"], bounds
     (0, [1/2, 1/1000])
@@ -285,54 +210,19 @@ def read_boxes(boxes, nvars, where):
     ...
     ccproof.certify.verify.errors.CertificateError: star: the boxes do not partition ...: no box covers '0H' (gap)
     """
-    if not isinstance(boxes, list) or not boxes:
-        raise CertificateError(f"{where}: boxes must be a non-empty list")
-    if len(boxes) > MAX_BOXES:
-        raise CertificateError(f"{where}: more than {MAX_BOXES} boxes")
-    bounds = []
-    for b in boxes:
-        if not isinstance(b, dict) or set(b) != {"path", "bound"}:
-            raise CertificateError(f"{where}: a box must be {{'path', 'bound'}}")
-        bound = parse_decimal(b["bound"])
-        if not bound > 0:
-            raise CertificateError(f"{where}: box {str(b['path'])[:40]!r} claims a non-positive bound")
-        bounds.append(bound)
-    try:
-        tree = box_tree([b["path"] for b in boxes], nvars)
-    except CertificateError as exc:
-        raise CertificateError(f"{where}: {exc}") from None
-    return tree, bounds
+    bounds = [_bound(b, where, 1) for b in _leaf_list(boxes, [{"path", "bound"}], where)]
+    return _tree([b["path"] for b in boxes], nvars, where), bounds
 
 
 def check_boxes(root, boxes, what):
-    """Replay the split paths on the Bernstein form ``root``; each box's coefficients must all be
-    certainly > its claimed bound > 0 (de Casteljau halvings of :class:`ccproof.rigorous.BernsteinForm`).
+    """``(ok, reason, least bound)``: on every box of the list (:func:`read_boxes`, then charged) the Bernstein
+    form ``root`` split along the box's path has all coefficients certainly above the claimed bound. Depth-first:
+    each inner node split once, one pending sibling per level (memory O(depth x form size)).
 
-    The partition is checked first (:func:`read_boxes`), then the split tree is replayed depth-first with
-    a stack: each inner node is split once (shared prefixes once), a form is dropped as soon as it is
-    split, and the stack holds at most one pending sibling per level, so the memory is O(depth x form
-    size) and the time O(number of boxes x (one split + one check)).
-
-    Parameters
-    ----------
-    root : BernsteinForm
-        Ball coefficients on the root box.
-    boxes : list of dict ``{"path": str, "bound": decimal str}``
-        Must partition the root box (:func:`box_tree`).
-    what : str
-        Named in the messages.
-
-    Returns
-    -------
-    (bool, str, fmpq or None)
-        ok, the reason when not, and the smallest bound.
-
-    Examples
-    --------
     1 + x on [0, 1]: the halves have Bernstein coefficients (1, 3/2) and (3/2, 2):
 
-    >>> from ccproof.rigorous import Poly, bernstein_coefficients
-    >>> f = bernstein_coefficients(1 + Poly.variable(0, 1)).to_arb(53)
+    >>> from ccproof.rigorous import BernsteinForm
+    >>> f = BernsteinForm((2,), [1, 2], prec=53)
     >>> check_boxes(f, [{"path": "0L", "bound": "0.9"}, {"path": "0H", "bound": "1.4"}], "test")
     (True, '', 9/10)
     >>> check_boxes(f, [{"path": "0L", "bound": "1.1"}, {"path": "0H", "bound": "1.4"}], "test")[0]
@@ -343,127 +233,58 @@ def check_boxes(root, boxes, what):
         charge_replay(replay_work(root, len(boxes)), what)
     except CertificateError as exc:
         return False, str(exc), None
-
-    def leaf(i, f):
-        if not all(c.is_finite() and c > bounds[i] for c in f.coeffs):
-            worst = min(f.coeffs, key=lambda c: c.lower())
-            return (f"{what}: box {boxes[i]['path']!r}: a Bernstein coefficient ({worst.str(8)}) is not above the "
-                    f"claimed bound {boxes[i]['bound']}")
-        return None
-    failure = walk(tree, root, lambda f, axis: f.split(axis), leaf)
-    return (False, failure, None) if failure else (True, "", min(bounds))
-
-
-def walk(tree, root, split, leaf):
-    """Depth-first over a split tree (:func:`box_tree`) from the state ``root`` (a form, a box): each inner
-    node splits its state once (``split(state, axis)`` -> (low half, high half)), a state is dropped once
-    split, and the stack holds at most one pending sibling per level. ``leaf(index, state)`` returns None
-    to go on, anything else to stop: it is returned.
-
-    Examples
-    --------
-    >>> seen = []
-    >>> walk(box_tree(["0L", "0H0L", "0H0H"], 1), [(fmpq(0), fmpq(1))], halve, lambda i, b: seen.append((i, b)))
-    >>> seen
-    [(0, [(0, 1/2)]), (1, [(1/2, 3/4)]), (2, [(3/4, 1)])]
-    """
     stack = [(tree, root)]
     while stack:
-        node, state = stack.pop()
-        if "leaf" in node:
-            out = leaf(node["leaf"], state)
-            if out is not None:
-                return out
-            continue
-        lo, hi = split(state, node["axis"])
-        stack.append((node["H"], hi))
-        stack.append((node["L"], lo))
-    return None
-
-
-def halve(box, axis):
-    """The two halves of an exact box (a list of (fmpq, fmpq)) along ``axis``."""
-    lo, hi = box[axis]
-    mid = (lo + hi) / 2
-    return [*box[:axis], (lo, mid), *box[axis + 1:]], [*box[:axis], (mid, hi), *box[axis + 1:]]
-
-
-def _cell_box(root, grid, cell):
-    return [(lo + (hi - lo) * fmpq(c, g), lo + (hi - lo) * fmpq(c + 1, g)) for (lo, hi), g, c in zip(root, grid, cell)]
+        node, f = stack.pop()
+        if "leaf" not in node:
+            low, high = f.split(node["axis"])
+            stack += [(node["H"], high), (node["L"], low)]
+        elif not all(c.is_finite() and c > bounds[node["leaf"]] for c in f.coeffs):
+            box, worst = boxes[node["leaf"]], min(f.coeffs, key=lambda c: c.lower())
+            return False, (f"{what}: box {box['path']!r}: a Bernstein coefficient ({worst.str(8)}) is not above the "
+                           f"claimed bound {box['bound']}"), None
+    return True, "", min(bounds)
 
 
 def leaf_box(root, grid, cell, path):
-    """The exact box of a leaf: its grid cell of the root, then the path's halvings.
+    """The exact box of a leaf: its cell of the ``grid`` on the box ``root``, then the path's halvings.
 
-    Examples
-    --------
     >>> leaf_box([(fmpq(0), fmpq(1)), (fmpq(0), fmpq(1, 2))], [4, 1], [1, 0], "0H1L")
     [(3/8, 1/2), (0, 1/4)]
     """
-    box = _cell_box(root, grid, cell)
+    box = [(lo + (hi - lo) * fmpq(c, g), lo + (hi - lo) * fmpq(c + 1, g)) for (lo, hi), g, c in zip(root, grid, cell)]
     for axis, side in parse_path(path, len(root)):
-        box = halve(box, axis)[side == "H"]
+        lo, hi = box[axis]
+        box[axis] = (lo, (lo + hi) / 2) if side == "L" else ((lo + hi) / 2, hi)
     return box
 
 
-def _read_grid(tree, n, where):
+def _grid_cells(tree, n, where):
+    """The grid, the leaves and {cell: leaf paths} of a grid tree, every key and cell checked, no cell empty."""
     if not isinstance(tree, dict) or set(tree) != {"grid", "leaves"}:
         raise CertificateError(f"{where}: a tree must be {{'grid', 'leaves'}}")
-    grid, leaves = tree["grid"], tree["leaves"]
+    grid = tree["grid"]
     if not isinstance(grid, list) or len(grid) != n or not all(type(g) is int and 1 <= g <= MAX_GRID for g in grid):
         raise CertificateError(f"{where}: grid must be {n} ints in 1..{MAX_GRID}")
-    if not isinstance(leaves, list) or not leaves or len(leaves) > MAX_BOXES:
-        raise CertificateError(f"{where}: leaves must be a non-empty list of at most {MAX_BOXES}")
+    leaves = _leaf_list(tree["leaves"], [{"cell", "path", "bound"}, {"cell", "path", "outside"}], where)
     cells = {}
-    for i, leaf in enumerate(leaves):
-        cells.setdefault(_leaf_cell(leaf, grid, where), []).append(i)
-    total = 1
-    for g in grid:
-        total *= g
-    if len(cells) != total:
-        raise CertificateError(f"{where}: {total - len(cells)} of the {total} grid cells have no leaf (gap)")
+    for leaf in leaves:
+        cell = leaf["cell"]
+        if not isinstance(cell, list) or len(cell) != n or not all(type(c) is int and 0 <= c < g
+                                                                    for c, g in zip(cell, grid)):
+            raise CertificateError(f"{where}: cell {str(cell)[:40]} is not a cell of the grid {grid}")
+        cells.setdefault(tuple(cell), []).append(leaf["path"])
+    if len(cells) != prod(grid):
+        raise CertificateError(f"{where}: {prod(grid) - len(cells)} of the {prod(grid)} grid cells have no leaf (gap)")
     return grid, leaves, cells
 
 
-def _leaf_cell(leaf, grid, where):
-    """The grid cell (a tuple) a leaf of a grid tree names, its keys and indices checked."""
-    if not isinstance(leaf, dict) or set(leaf) not in ({"cell", "path", "bound"}, {"cell", "path", "outside"}):
-        raise CertificateError(f"{where}: a leaf must be {{'cell', 'path', 'bound'}} or {{'cell', 'path', "
-                               "'outside'}}")
-    cell = leaf["cell"]
-    if not isinstance(cell, list) or len(cell) != len(grid) or not all(type(c) is int and 0 <= c < g
-                                                                        for c, g in zip(cell, grid)):
-        raise CertificateError(f"{where}: cell {str(cell)[:40]} is not a cell of the grid {grid}")
-    return tuple(cell)
-
-
-def _claim(leaf, box, where, sign, k0, outside):
-    """A leaf's claim: None for an ``outside`` leaf (checked to lie beyond h = 1/k0), else its bound."""
-    if "outside" in leaf:
-        if leaf["outside"] is not True or not outside:
-            raise CertificateError(f"{where}: an 'outside' leaf is allowed only in the middle region, as true")
-        if not box[0][0] * box[1][0] > fmpq(1, k0):
-            raise CertificateError(f"{where}: 'outside' leaf {leaf['path']!r} of cell {leaf['cell']} meets "
-                                   f"h = s w <= 1/{k0} (s_lo w_lo = {box[0][0] * box[1][0]})")
-        return None
-    bound = parse_decimal(leaf["bound"])
-    if not (bound > 0 if sign > 0 else bound < 0):
-        raise CertificateError(f"{where}: leaf {leaf['path']!r} of cell {leaf['cell']} claims a bound of the "
-                               f"wrong sign ({bound}; the claim is {'> 0' if sign > 0 else '< 0'})")
-    return bound
-
-
 def read_tree(tree, root, where, sign, k0=None, outside=False):
-    """Check a grid tree against its root before any arithmetic; its leaves as (box, bound or None).
+    """The leaves ``(box, bound or None)`` of a grid tree on ``root`` (fixed by the region, never by the file),
+    checked before any arithmetic: each cell partitioned by its leaves (:func:`box_tree`), each bound of the sign the
+    claim needs (``sign`` +1: > 0, -1: < 0); an ``outside`` leaf (only where ``outside``: axes (s, w), h = s w) must
+    have s_lo w_lo > 1/k0 exactly, so that no K >= k0 meets it.
 
-    Every grid cell must hold leaves whose paths partition it (:func:`box_tree`); the boxes come from one
-    :func:`walk` of each cell's tree over exact boxes. A bound must have the sign its claim needs (``sign``
-    +1: > 0, -1: < 0); an ``outside`` leaf (only where ``outside``: the middle region, axes (s, w), h = s w)
-    must lie where s_lo w_lo > 1/k0 exactly, so that no K >= k0 meets it. ``root`` is fixed by the region,
-    never by the file; ``where`` is named in every error.
-
-    Examples
-    --------
     >>> root = [(fmpq(0), fmpq(1)), (fmpq(0), fmpq(1))]
     >>> t = {"grid": [2, 1], "leaves": [{"cell": [0, 0], "path": "", "bound": "0.5"},
     ...                                 {"cell": [1, 0], "path": "1L", "bound": "0.25"},
@@ -476,26 +297,29 @@ def read_tree(tree, root, where, sign, k0=None, outside=False):
     ...
     ccproof.certify.verify.errors.CertificateError: demo: cell [1, 0]: the boxes do not partition ...: no box ... (gap)
     """
-    grid, leaves, cells = _read_grid(tree, len(root), where)
-    boxes = [None] * len(leaves)
-    for cell, idx in cells.items():
-        try:
-            tree_ = box_tree([leaves[i]["path"] for i in idx], len(root))
-        except CertificateError as exc:
-            raise CertificateError(f"{where}: cell {list(cell)}: {exc}") from None
-        walk(tree_, _cell_box(root, grid, cell), halve, lambda j, box, idx=idx: boxes.__setitem__(idx[j], box))
-    return [(box, _claim(leaf, box, where, sign, k0, outside)) for leaf, box in zip(leaves, boxes)]
+    grid, leaves, cells = _grid_cells(tree, len(root), where)
+    for cell, paths in cells.items():
+        _tree(paths, len(root), f"{where}: cell {list(cell)}")
+    out = []
+    for leaf in leaves:
+        box = leaf_box(root, grid, leaf["cell"], leaf["path"])
+        if "bound" in leaf:
+            out.append((box, _bound(leaf, f"{where}: cell {leaf['cell']}", sign)))
+        elif leaf["outside"] is not True or not outside:
+            raise CertificateError(f"{where}: an 'outside' leaf is allowed only in the middle region, as true")
+        elif not box[0][0] * box[1][0] > fmpq(1, k0):
+            raise CertificateError(f"{where}: 'outside' leaf {leaf['path']!r} of cell {leaf['cell']} meets "
+                                   f"h = s w <= 1/{k0} (s_lo w_lo = {box[0][0] * box[1][0]})")
+        else:
+            out.append((box, None))
+    return out
 
 
 def replay_tree(leaves, evaluate, sign, where):
-    """Evaluate every leaf of :func:`read_tree` (``None`` bounds: ``outside``, skipped) and accept its bound
-    only when the enclosure ``evaluate(box)`` (an arb) certainly lies beyond it (``sign`` +1: >=, -1: <=).
-    Returns (leaves evaluated, the least bound in absolute value); raises CertificateError naming the first
-    leaf whose bound is not reached or whose evaluation fails.
+    """``(leaves evaluated, least |bound|)``: each leaf of :func:`read_tree` (``outside`` ones skipped) whose
+    enclosure ``evaluate(box)`` (an arb) certainly lies beyond its bound (``sign`` +1: >=, -1: <=); else a
+    :class:`CertificateError` naming the first leaf that fails.
 
-    Examples
-    --------
-    >>> from flint import arb
     >>> leaves = [([(fmpq(0), fmpq(1))], fmpq(1, 2)), ([(fmpq(1), fmpq(2))], fmpq(3, 2))]
     >>> replay_tree(leaves, lambda box: arb(box[0][0] + 1).union(arb(box[0][1] + 1)), 1, "demo")
     (2, 1/2)

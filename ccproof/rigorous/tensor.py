@@ -1,13 +1,6 @@
-"""Dense coefficient tensors shared by :mod:`.poly` and :mod:`.bernstein` (internal).
-
-A tensor is a flat Python list in row-major order together with its ``shape`` (a tuple of
-positive ints, one per variable).  Every entry is an ``fmpq`` (exact kind, ``prec is None``) or an
-``arb`` (ball kind, ``prec`` an int).  Arithmetic on balls always runs inside
-``flint.ctx.workprec(prec)``; the global precision is never changed.
-
-Exact rational matrices (basis changes) are built once as ``fmpq_mat`` and cached; for the ball
-kind they are converted to ``arb_mat`` at the working precision (which encloses each rational
-entry) and the product is flint's rigorous ``arb_mat`` product.
+"""Dense coefficient tensors: a row-major list of ``fmpq`` (``prec`` None) or ``arb`` (``prec`` bits, computed inside
+``flint.ctx.workprec``) with its ``shape``; exact basis changes along an axis (``fmpq_mat``, or the ``arb_mat`` that
+encloses it), Kronecker products. Shared by :mod:`.bernstein` and ``ccproof.certify.poly``.
 """
 
 from functools import lru_cache
@@ -22,54 +15,43 @@ _ZERO = fmpq(0)
 
 
 def check_prec(prec):
-    """Return ``prec`` (``None`` or an int >= 2), else raise ``ValueError``."""
-    if prec is None:
-        return None
-    if isinstance(prec, bool) or not isinstance(prec, int) or prec < 2:
+    """``prec`` if None or an int >= 2 (bits), else ``ValueError``."""
+    if prec is not None and (isinstance(prec, bool) or not isinstance(prec, int) or prec < 2):
         raise ValueError(f"precision must be an int >= 2 (bits) or None, got {prec!r}")
     return prec
 
 
 def join_prec(p, q):
     """Precision of a result combining kinds ``p`` and ``q`` (``None`` = exact)."""
-    if p is None:
-        return q
-    if q is None:
-        return p
-    return max(p, q)
+    return q if p is None else p if q is None else max(p, q)
 
 
 def exact_scalar(x):
-    """Coerce int/fmpz/fmpq/str (e.g. ``"1/3"``) to ``fmpq``; reject floats and the rest."""
+    """int, fmpz, fmpq or a string ``"p/q"`` as an ``fmpq``; floats and the rest refused."""
     if isinstance(x, fmpq):
         return x
     if isinstance(x, (int, fmpz)) and not isinstance(x, bool):
         return fmpq(x)
-    if isinstance(x, str):
-        try:
-            return fmpq(x)
-        except (ValueError, TypeError):
-            pass
-        raise ValueError(f"not a rational number: {x!r}")
-    raise TypeError(
-        f"expected an exact number (int, fmpz, fmpq or 'p/q' string), got {type(x).__name__}"
-    )
+    if not isinstance(x, str):
+        raise TypeError(f"expected an exact number (int, fmpz, fmpq or 'p/q' string), got {type(x).__name__}")
+    try:
+        return fmpq(x)
+    except (ValueError, TypeError):
+        raise ValueError(f"not a rational number: {x!r}") from None
 
 
 def scalar(x):
-    """Coerce a scalar to ``fmpq`` (exact) or keep an ``arb``; reject floats."""
-    if isinstance(x, arb):
-        return x
-    return exact_scalar(x)
+    """An ``arb`` kept, anything else through :func:`exact_scalar`."""
+    return x if isinstance(x, arb) else exact_scalar(x)
 
 
 def to_kind(x, prec):
     """``x`` (fmpq or arb) as an element of the kind ``prec`` (caller holds the workprec)."""
-    if prec is None:
-        if isinstance(x, arb):
-            raise TypeError("cannot convert an arb ball to an exact fmpq coefficient")
-        return x
-    return x if isinstance(x, arb) else arb(x)
+    if prec is not None:
+        return x if isinstance(x, arb) else arb(x)
+    if isinstance(x, arb):
+        raise TypeError("cannot convert an arb ball to an exact fmpq coefficient")
+    return x
 
 
 def convert(coeffs, prec):
@@ -88,21 +70,6 @@ def exact_fmpq(x):
     return fmpq(man) * fmpq(2) ** int(exp)
 
 
-def ball_contains(ball, value):
-    """True when the ball certainly contains ``value`` (an exact number or another ball).
-
-    Exact values are compared with the ball's endpoints in exact rational arithmetic (converting
-    them to a ball first would round them and could wrongly report a miss).
-    """
-    if isinstance(value, arb):
-        return bool(ball.contains(value))
-    value = exact_scalar(value)
-    if not ball.is_finite():
-        return bool(ball.contains(arb(value)))  # nan: False; infinite radius: True
-    mid, rad = exact_fmpq(ball.mid()), exact_fmpq(ball.rad())
-    return mid - rad <= value <= mid + rad
-
-
 def zero(prec):
     return _ZERO if prec is None else arb(0)
 
@@ -111,23 +78,16 @@ def size(shape):
     return prod(shape)
 
 
-# ---------------------------------------------------------------------------- matrices
-
-
 def to_matrix(mat, prec):
     """The exact ``fmpq_mat`` ``mat`` for kind ``prec``: itself, or an enclosing ``arb_mat``."""
-    if prec is None:
-        return mat
-    return _arb_matrix(mat, prec)
+    return mat if prec is None else _arb_matrix(mat, prec)
 
 
 _ARB_MATS = {}
 
 
 def _arb_matrix(mat, prec):
-    # fmpq_mat is unhashable: key on identity, keeping ``mat`` alive in the entry so that its id
-    # cannot be reused while the entry exists.  The exact matrices come from lru_caches, so the
-    # same object recurs for the same basis change.
+    # keyed on the identity of the cached exact matrix, kept alive in the entry (so its id is not reused)
     key = (id(mat), prec)
     hit = _ARB_MATS.get(key)
     if hit is not None and hit[0] is mat:
@@ -145,10 +105,7 @@ def new_matrix(rows, cols, entries, prec):
 
 
 def apply_along_axis(coeffs, shape, axis, mat, prec):
-    """Multiply the tensor by the exact matrix ``mat`` (m x shape[axis]) along ``axis``.
-
-    Returns ``(coeffs, shape)`` with ``shape[axis]`` replaced by ``m``.
-    """
+    """``(coeffs, shape)`` of the tensor multiplied along ``axis`` by the exact m x shape[axis] matrix ``mat``."""
     n = shape[axis]
     m = mat.nrows()
     if mat.ncols() != n:
@@ -171,12 +128,8 @@ def apply_along_axis(coeffs, shape, axis, mat, prec):
 
 
 def multiply(a, a_shape, b, b_shape, prec):
-    """Product of two dense polynomial tensors (Kronecker substitution, one flint product).
-
-    The exponent tuple ``e`` of either factor is sent to ``sum e_i * S_i`` with ``S`` the
-    row-major strides of the product's shape; exponents of the product never exceed that shape,
-    so the univariate product's coefficients are exactly the product tensor's coefficients.
-    """
+    """Product of two polynomial tensors: one flint product of the univariate polynomials that send exponents e to
+    sum e_i S_i (S the row-major strides of the product's shape, which no exponent of the product exceeds)."""
     shape = tuple(p + q - 1 for p, q in zip(a_shape, b_shape))
     strides = row_major_strides(shape)
     total = size(shape)
@@ -187,12 +140,7 @@ def multiply(a, a_shape, b, b_shape, prec):
     else:
         with flint.ctx.workprec(prec):
             c = (arb_poly(pa) * arb_poly(pb)).coeffs()
-    z = zero(prec)
-    if len(c) < total:
-        c = list(c) + [z] * (total - len(c))
-    elif len(c) > total:  # cannot happen; guard the invariant
-        raise AssertionError("Kronecker product longer than its shape")
-    return list(c), shape
+    return list(c) + [zero(prec)] * (total - len(c)), shape
 
 
 def row_major_strides(shape):
@@ -241,9 +189,8 @@ def pad(coeffs, shape, new_shape, prec):
 
 
 def truncate(coeffs, shape, axis, degree, prec):
-    """(coeffs, shape) of degree <= ``degree`` along ``axis``: every dropped coefficient c (of x_axis^j,
-    j > degree) added as [-|c|, |c|] to the coefficient of x_axis^0 with the same other exponents (a Taylor
-    model's remainder for |x_axis| <= 1)."""
+    """(coeffs, shape) of degree <= ``degree`` along ``axis``, each dropped coefficient c added as [-|c|, |c|] to the
+    one of x_axis^0 with the same other exponents (a Taylor model's remainder for |x_axis| <= 1)."""
     n, post = shape[axis], size(shape[axis + 1 :])
     out = []
     with flint.ctx.workprec(prec):

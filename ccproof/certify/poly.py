@@ -1,4 +1,6 @@
-"""Dense multivariate polynomials (1 to 4 variables) with exact ``fmpq`` or ball ``arb`` coefficients.
+"""Dense multivariate polynomials (1 to 4 variables) with exact ``fmpq`` or ball ``arb`` coefficients: the power
+basis of the prover and of the tests' exact references, and their Bernstein and Taylor forms (not trusted: the
+verifier never imports this module, an import-linter contract in pyproject.toml says so).
 
 A :class:`Poly` is either *exact* (``prec is None``, every coefficient an ``fmpq``) or a *ball*
 polynomial (``prec`` an int, every coefficient an ``arb``).  A ball polynomial stands for the set of
@@ -21,13 +23,16 @@ True
 True
 """
 
+from math import comb
+
 import flint
 from flint import arb, fmpq
 
-from . import _tensor as T
-from ._tensor import MAX_VARS
-from .bernstein import BernsteinForm, check_box, unit_box
-from .matrices import bernstein_to_power_matrix, conversion_matrix, taylor_shift_matrix
+from ccproof.rigorous import tensor as T
+from ccproof.rigorous.bernstein import BernsteinForm, check_box, unit_box
+from ccproof.rigorous.matrices import conversion_matrix, power_to_bernstein_matrix, taylor_shift_matrix
+from ccproof.rigorous.taylor import TaylorForm
+from ccproof.rigorous.tensor import MAX_VARS
 
 
 class Poly:
@@ -175,7 +180,7 @@ class Poly:
         shape = tuple(max(p, q) for p, q in zip(self.shape, other.shape))
         a = T.pad(self.coeffs, self.shape, shape, self.prec)
         b = T.pad(other.coeffs, other.shape, shape, other.prec)
-        return all(T.ball_contains(x, y) for x, y in zip(a, b))
+        return all(ball_contains(x, y) for x, y in zip(a, b))
 
     def __eq__(self, other):
         """Exact equality of exact polynomials (ball polynomials refuse ``==``)."""
@@ -449,7 +454,12 @@ def bernstein_coefficients(poly, box=None, degrees=None):
 
 
 def to_poly(form):
-    """The polynomial of a :class:`~.bernstein.BernsteinForm` in the original (box) variables, in the power basis."""
+    """The polynomial of a :class:`~ccproof.rigorous.BernsteinForm` in the original (box) variables, in the power
+    basis.
+
+    >>> to_poly(BernsteinForm((3,), [0, 0, 1])) == Poly.variable(0, 1) ** 2
+    True
+    """
     f = form.bernstein()
     mats = [bernstein_to_power_matrix(n - 1) for n in f.shape]
     c, shape = apply_all_axes(f.coeffs, f.shape, mats, f.prec)
@@ -487,3 +497,67 @@ def multi_indices(shape):
     for n in shape:
         out = [e + (k,) for e in out for k in range(n)]
     return out
+
+
+def bernstein_to_power_matrix(n):
+    """(n+1) x (n+1) ``fmpq_mat``: Bernstein coefficients of degree n on [0,1] -> power coefficients.
+
+    a_i = sum_k (-1)^(i-k) C(n, i) C(i, k) b_k (the inverse of ``power_to_bernstein_matrix(n, n)``).
+
+    >>> (bernstein_to_power_matrix(2) * flint.fmpq_mat(3, 1, [0, 1, 0])).entries()   # 2 x (1 - x)
+    [0, 2, -2]
+    """
+    return flint.fmpq_mat(n + 1, n + 1, [(-1) ** ((i - k) % 2) * comb(n, i) * comb(i, k) if k <= i else 0
+                                         for i in range(n + 1) for k in range(n + 1)])
+
+
+def taylor_form(poly, prec):
+    """The :class:`~ccproof.rigorous.TaylorForm` of the power-basis ``poly`` in (z, x_1, ..., x_d), x in the
+    Bernstein basis on [0,1]^d.
+
+    x^2 + z y: z-degree 1, Bernstein coefficients in (x, y) of x^2 (0, 0, 1) and of y (0, 1):
+
+    >>> z, x, y = (Poly.variable(i, 3) for i in range(3))
+    >>> f = taylor_form(x * x + z * y, 53)
+    >>> f.shape, [c.str(3, radius=False) for c in f.coeffs]
+    ((2, 3, 2), ['0', '0', '0', '0', '1.00', '1.00', '0', '1.00', '0', '1.00', '0', '1.00'])
+    """
+    if not isinstance(poly, Poly) or poly.nvars < 2:
+        raise TypeError("expected a Poly in (z, x_1, ...), at least 2 variables")
+    coeffs, shape = T.convert(poly.coeffs, prec), poly.shape
+    for axis in range(1, len(shape)):
+        coeffs, shape = T.apply_along_axis(coeffs, shape, axis,
+                                           power_to_bernstein_matrix(shape[axis] - 1, shape[axis] - 1), prec)
+    return TaylorForm.from_raw(shape, coeffs, TaylorForm.variable(1, len(shape) - 1, prec).box, prec)
+
+
+def ball_contains(ball, value):
+    """Does the ball certainly contain ``value`` (an exact number, compared with the exact endpoints, or a ball)?
+
+    >>> ball_contains(arb(1, fmpq(1, 2)), fmpq(3, 2)), ball_contains(arb(1), 2)
+    (True, False)
+    """
+    if isinstance(value, arb):
+        return bool(ball.contains(value))
+    value = T.exact_scalar(value)
+    if not ball.is_finite():
+        return bool(ball.contains(arb(value)))  # nan: False; infinite radius: True
+    mid, rad = T.exact_fmpq(ball.mid()), T.exact_fmpq(ball.rad())
+    return mid - rad <= value <= mid + rad
+
+
+def certainly_positive(form):
+    """True only when every coefficient is certainly > 0 and finite (so the polynomial is > 0 on the box).
+
+    >>> certainly_positive([arb(1), arb("0 +/- 0.1")]), certainly_positive(arb("nan"))
+    (False, False)
+    """
+    coeffs = form.bernstein().coeffs if isinstance(form, BernsteinForm) else [form] if isinstance(
+        form, (arb, fmpq, flint.fmpz, int)) and not isinstance(form, bool) else list(form)
+    for c in coeffs:
+        if isinstance(c, arb):
+            if not (c.is_finite() and c > 0):
+                return False
+        elif not T.exact_scalar(c) > 0:
+            return False
+    return bool(coeffs)
