@@ -108,15 +108,15 @@ REVIEWED = {
     ("tagged_c1.py", "one[0][1] != 1"): "fmpq or None (the exact value of a rational eigenvalue)",
     ("tagged_c1.py", "not ev[ia][0].real >= beta"): "fails unless alpha >= beta certainly: conservative",
     ("tagged_modes.py", "B * K != K * M"): "fmpq_mat (exact)",
-    ("tagged_modes.py", "image != mirrored"): "dicts of fmpq weights with int keys (exact)",
-    ("tagged_modes.py", "{j: x for j, x in folded.items() if x != 0} != {j: x for j, x in rows[i].items() if j not in "
-                        "cp}"): "dicts of fmpq weights (exact)",
+    ("tagged_modes.py", "image != {_reflect(d, q): x for (d, q), x in ring_stencil()[i].items()}"):
+        "dicts of fmpq weights with tuple keys (exact)",
+    ("tagged_modes.py", "_ring_row(p[1], p[2:], fold) != {j: x for j, x in rows[i].items() if j not in cp}"):
+        "dicts of fmpq weights (exact)",
+    ("tagged_modes.py", "ring != {j: x for j, x in rows[i].items() if j != 0}"): "dicts of fmpq weights (exact)",
     ("tagged_modes.py", "R[r, c] != 0"): "fmpq_mat entries (exact)",
     ("tagged_modes.py", "x != 0"): "fmpq folded weights (exact)",
     ("tagged_c1.py", "not l1.real > l2.real"): "fails unless lam1 > lam2 certainly: conservative",
     ("tagged_modes.py", "rows[refl[i]] != {refl[j]: x for j, x in rows[i].items()}"): "dicts of fmpq weights (exact)",
-    ("tagged_modes.py", "{j: x for j, x in ring.items() if x != 0} != {j: x for j, x in rows[i].items() if j != 0}"):
-        "dicts of fmpq weights (exact)",
     ("tagged_modes.py", "j != 0"): "ints (column indices)",
     ("tagged_modes.py", "SE[a, b] != 0"): "fmpq_mat entries (exact)",
     ("maps.py", "not (hi < BREAKS[p] or (p < 3 and lo > BREAKS[p + 1]))"): (
