@@ -129,7 +129,6 @@ REVIEWED = {
                                                          "conservative",
     ("tagged_limit.py", "g != 0"): "fmpq (exact decimal)",
     ("tagged_limit.py", "sum(row.values(), fmpq(0)) != 1"): "fmpq (exact)",
-    ("tagged_limit.py", "x != 0"): "fmpq (exact)",
     ("tagged_limit.py", "croots.count(1) != 1"): "ints (fmpq roots compared exactly)",
     ("tagged_limit.py", "not lam_of(arb(1)) < 1"): "fails unless lam(1) < 1 certainly: conservative",
     ("tagged_limit.py", "g != max(below)"): "fmpq (exact roots of the crease block)",
