@@ -86,7 +86,6 @@ REVIEWED = {
     ("tagged.py", "not abs(t[0]) < 1"): "fails unless every eigenvalue is certainly inside the unit disc: conservative",
     ("tagged_c1.py", "g != max(below)"): "fmpq (exact roots of the crease block)",
     ("tagged_c1.py", "not arb(g) < beta"): "fails unless gamma < beta certainly: conservative",
-    ("tagged_c1.py", "ev[i][2] != 1"): "ints (multiplicities)",
     ("tagged_c1.py", 'c != "x"'): "strings",
     ("tagged_c1.py", "leave != 0"): "fmpq (exact crease values)",
     ("tagged_c1.py", 'fam != "dart"'): "strings",

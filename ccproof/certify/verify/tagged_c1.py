@@ -96,14 +96,22 @@ def _verify_c1(cert, fam, n, prec, part):
               field_of(cert, "parts", dict, "certificate"), prec, part)
 
 
-def _isolated(ev, lo_hi, c):
-    """The index of the one entry of ``ev`` certainly inside [low, high] with no other touching it, else None."""
+def _isolated_coordinate(ev, spec, c, cp, cval, simple, what, solve):
+    """(i, vector, message) of a coordinate whose [low, high] isolates the entry i of ``ev`` (certainly inside, no
+    other touching it), real, ``simple(i)``, its crease values 0; ``solve(i, pivot)``: (vector or None, message).
+    (None, None, the reason) otherwise."""
+    lo_hi = field_of(spec, "eigenvalue", list, c)
     if len(lo_hi) != 2:
         raise CertificateError(f"{c}: the eigenvalue must be [low, high]")
     lo, hi = parse_decimal(lo_hi[0]), parse_decimal(lo_hi[1])
     inside = [j for j, t in enumerate(ev) if t[0].real > lo and t[0].real < hi]
     near = [j for j, t in enumerate(ev) if t[0].real.overlaps(arb(lo).union(arb(hi)))]
-    return inside[0] if len(inside) == 1 and near == inside else None
+    i = inside[0] if len(inside) == 1 and near == inside else None
+    if any(v != 0 for v in cval):
+        return None, None, "an irrational eigenvalue's eigenvector vanishes on the crease points"
+    if i is None or not ev[i][0].imag.is_zero() or not simple(i):
+        return None, None, f"[{lo_hi[0]}, {lo_hi[1]}] does not isolate {what}"
+    return (i,) + solve(i, _pivot(spec, c, len(ev), cp))
 
 
 def _dart_leading(k, ev):
@@ -217,31 +225,25 @@ def _pivot(spec, c, m, cp):  # the pivot of a coordinate: a non-crease point
     return pivot
 
 
-_ZERO_ON_CREASE = "an irrational eigenvalue's eigenvector vanishes on the crease points"
-
-
 def _mode_coordinate(fam, n, ev, spec, c, want=None):
     """(index in the mode list ``ev``, eigenvector with 1 at the pivot, message) of x or y, or (None, None, the
     reason): [low, high] isolates one simple real root of a mode (a dart's even part too; the entry ``want``,
     a dart's lam1 or lam2, when given), whose eigenvector vanishes on the crease points."""
     exact_keys(spec, ("eigenvalue", "crease", "pivot"), c)
-    lo_hi, cp = field_of(spec, "eigenvalue", list, c), [] if fam == "dart" else tg.crease_points(fam, n)
-    cval = _crease_values(spec, c, cp)
-    i = _isolated(ev, lo_hi, c)  # checks the [low, high] form
-    if any(v != 0 for v in cval):
-        return None, None, _ZERO_ON_CREASE
-    if i is None or want not in (None, i) or not ev[i][0].imag.is_zero() or ev[i][3] is None and fam != "dart":
-        what = ("one simple real root of a mode" if want is None else
-                f"lam{'1' if c == 'x' else '2'}: not the eigenvalue of lam1 / lam2")
-        return None, None, f"[{lo_hi[0]}, {lo_hi[1]}] does not isolate {what}"
-    pivot = _pivot(spec, c, len(ev), cp)
-    vec, j = normalized_vector(fam, n, ev, i, pivot), ev[i][3]
-    if vec is None:
-        return None, None, (f"the eigenvector is not certainly non-zero at the pivot {pivot} (or its system not "
-                            "certainly regular)")
-    how = (", simple; even: the bordered system on S_E" if j is None else
-           f" = lam(cos({2 * j if fam == 'dart' else j} pi/{n})), simple; closed form in mode {j}: its 6x6 system")
-    return i, vec, f"eigenvalue {ev[i][0].real.str(10)}{how} proved regular, pivot {tg.labels(fam, n)[pivot]}"
+    cp = [] if fam == "dart" else tg.crease_points(fam, n)
+
+    def solve(i, pivot):
+        vec, j = normalized_vector(fam, n, ev, i, pivot), ev[i][3]
+        if vec is None:
+            return None, f"the eigenvector is not certainly non-zero at the pivot {pivot} (or its system not " \
+                         "certainly regular)"
+        how = (", simple; even: the bordered system on S_E" if j is None else
+               f" = lam(cos({2 * j if fam == 'dart' else j} pi/{n})), simple; closed form in mode {j}: its 6x6 system")
+        return vec, f"eigenvalue {ev[i][0].real.str(10)}{how} proved regular, pivot {tg.labels(fam, n)[pivot]}"
+    return _isolated_coordinate(ev, spec, c, cp, _crease_values(spec, c, cp),
+                                lambda i: want in (None, i) and (ev[i][3] is not None or fam == "dart"),
+                                "one simple real root of a mode" if want is None else
+                                f"lam{'1' if c == 'x' else '2'}: not the eigenvalue of lam1 / lam2", solve)
 
 
 def read_z(spec):
@@ -295,23 +297,24 @@ def eigenvector_of(fam, n, spec, c, prec, chain=False):
 
 
 def _ball_eigenvector(fam, n, spec, c, cp, cval, prec):
-    ev, lo_hi = tg.eigenvalues(fam, n, prec), field_of(spec, "eigenvalue", list, c)
-    i = _isolated(ev, lo_hi, c)  # checks the [low, high] form
-    if i is None or not ev[i][0].imag.is_zero() or ev[i][2] != 1:
-        return None, None, f"[{lo_hi[0]}, {lo_hi[1]}] does not isolate one simple real eigenvalue of {fam}:{n}"
-    if any(v != 0 for v in cval):
-        return None, None, _ZERO_ON_CREASE
-    if cp and ev[i][1].gcd(tg.crease_block(fam, n).charpoly()).degree() > 0:
-        return None, None, "the eigenvalue is one of the crease block's"
-    S, lam = tg.sector_matrix(fam, n), ev[i][0].real
-    pivot, free = _pivot(spec, c, S.nrows(), cp), [j for j in range(S.nrows()) if j not in cp]
-    try:
-        sol = dict(zip(free, bordered_solve([[arb(S[a, b]) for b in free] for a in free], lam, free.index(pivot),
-                                            arb_mat)))
-    except ZeroDivisionError:
-        return None, None, f"the system for the eigenvector of {lam.str(8)} (pivot {pivot}) is not certainly regular"
-    return lam, [sol.get(j, arb(0)) for j in range(S.nrows())], \
-        f"eigenvalue {lam.str(10)} (simple root of {ev[i][1]}); vector in arb, pivot {tg.labels(fam, n)[pivot]}"
+    ev, S = tg.eigenvalues(fam, n, prec), tg.sector_matrix(fam, n)
+    free = [j for j in range(S.nrows()) if j not in cp]
+
+    def solve(i, pivot):
+        if cp and ev[i][1].gcd(tg.crease_block(fam, n).charpoly()).degree() > 0:
+            return None, "the eigenvalue is one of the crease block's"
+        try:
+            sol = dict(zip(free, bordered_solve([[arb(S[a, b]) for b in free] for a in free], ev[i][0].real,
+                                                free.index(pivot), arb_mat)))
+        except ZeroDivisionError:
+            return None, f"the system for the eigenvector of {ev[i][0].real.str(8)} (pivot {pivot}) is not certainly " \
+                         "regular"
+        return [sol.get(j, arb(0)) for j in range(S.nrows())], \
+            f"eigenvalue {ev[i][0].real.str(10)} (simple root of {ev[i][1]}); vector in arb, pivot " \
+            f"{tg.labels(fam, n)[pivot]}"
+    i, vec, msg = _isolated_coordinate(ev, spec, c, cp, cval, lambda i: ev[i][2] == 1,
+                                       f"one simple real eigenvalue of {fam}:{n}", solve)
+    return None if i is None else ev[i][0].real, vec, msg
 
 
 def _solve_exact(A, cp, cval):
