@@ -86,7 +86,7 @@ def _verify_c1(cert, fam, n, prec, part):
             val, (_, vec, msg) = ev[t][0].real, _mode_coordinate(fam, n, ev, field_of(mp, c, dict, "map"), c, t)
         else:
             val, vec, msg = eigenvector_of(fam, n, field_of(mp, c, dict, "map"), c, prec)
-        ok = vec is not None and (modes or same_root(t, val))
+        ok = vec is not None and (modes or _same_root(t, val))
         part(f"{c}: eigenvector of lam{'1' if c == 'x' else '2'}", ok,
              msg if vec is None or ok else "not the eigenvalue of lam1 / lam2")
         if not ok:
@@ -118,7 +118,7 @@ def _dart_leading(k, ev):
     """(i1, i2, why, message): a dart's lam1 and lam2 in the mode list, why None when the spectral part holds."""
     rest = sorted((i for i, t in enumerate(ev) if abs(t[0]) < 1), key=lambda i: -abs(ev[i][0]).mid())
     (i1, i2), (l1, l2) = rest[:2], (ev[rest[0]][0], ev[rest[1]][0])
-    why = mode_lead_why(ev, i1, i2) or (
+    why = _mode_lead_why(ev, i1, i2) or (
         "lam1 or lam2 is not certainly real and positive" if not all(z.imag.is_zero() and z.real > 0 for z in (l1, l2))
         else "lam1 > lam2 is not certain" if not l1.real > l2.real else None)
     where = [f"mode {ev[i][3]}" if ev[i][3] else "even" for i in (i1, i2)]
@@ -163,16 +163,16 @@ def _witness_exact(fam, n, w, prec, part):
     for c in ("x", "y") if fam == "dart" else ("x", "y", "z"):
         vals[c], vecs[c], msg = eigenvector_of(fam, n, field_of(w, c, dict, "witness"), c, prec,
                                                c != "x" and fam != "dart")
-        tops[c] = None if vecs[c] is None else chain_top(fam, n, vals[c], vecs[c])
+        tops[c] = None if vecs[c] is None else _chain_top(fam, n, vals[c], vecs[c])
         part(f"{c}: {'(generalized) ' if c == 'z' or tops[c] else ''}eigenvector of S", vecs[c] is not None, msg)
         if vecs[c] is None:
             return None
     if fam == "dart":
-        (ok, msg), title, second = flip_generic(n, vals["x"], vals["y"], prec), _G_FLIP, "J_xy"
+        (ok, msg), title, second = _flip_generic(n, vals["x"], vals["y"], prec), _G_FLIP, "J_xy"
     elif tops["y"] is not None:
-        (ok, msg), title, second = chain_generic(fam, n, vals, tops, prec), _G_CHAIN, "J_xe"
+        (ok, msg), title, second = _chain_generic(fam, n, vals, tops, prec), _G_CHAIN, "J_xe"
     else:
-        (ok, msg), title, second = ordering(fam, n, *(vals[c] for c in "xyz"), prec, tops["z"] is not None), \
+        (ok, msg), title, second = _ordering(fam, n, *(vals[c] for c in "xyz"), prec, tops["z"] is not None), \
             G_GENERIC, "J_xy"
     part(title, ok, msg)
     return (vecs, tops["y"] if second == "J_xe" else vecs["y"], second) if ok else None
@@ -199,7 +199,7 @@ def _witness_modes(fam, n, w, part):
     if why is not None:
         return None
     ia, ib = at["x"], at["y"]
-    why = mode_lead_why(ev, ia, ib) or crease_top_why(tg.crease_block(fam, n), g) or (
+    why = _mode_lead_why(ev, ia, ib) or _crease_top_why(tg.crease_block(fam, n), g) or (
         "gamma < beta is not certain" if not arb(g) < ev[ib][0].real else None)
     part(G_GENERIC, why is None, f"alpha = {ev[ia][0].real.str(8)} > beta = {ev[ib][0].real.str(8)} > |every other| "
          f"(each simple), 1 simple; gamma = {g} < beta" if why is None else why)
@@ -374,26 +374,22 @@ def vertex_tangents(val):
 
 
 # ----------------------------------------------------------------- part G (docs/tagged_c1.md, "not C1")
-def same_root(t, v):
-    """Is v (an fmpq, or the arb ball of an irrational root) the root t[0] of the factor t[1]?
-
-    >>> [same_root(t, fmpq(1, 4)) for t in tg.eigenvalues("dart", 2, 64)].count(True)
-    1
-    """
+def _same_root(t, v):
+    """Is v (an fmpq, or the arb ball of an irrational root) the root t[0] of the factor t[1]?"""
     if isinstance(v, fmpq):
         return t[1].degree() == 1 and -t[1][0] / t[1][1] == v
     return t[1].degree() > 1 and t[0].real.overlaps(v) and t[0].imag.is_zero()
 
 
 def _find(ev, v, skip=()):  # the first entry other than 1 and those in skip with the root v
-    return next((i for i, t in enumerate(ev) if i not in skip and t[1] != tg.ONE and same_root(t, v)), None)
+    return next((i for i, t in enumerate(ev) if i not in skip and t[1] != tg.ONE and _same_root(t, v)), None)
 
 
 def _below(ev, skip, bounds, what, tie=None):
     """The reason an entry other than 1, those in ``skip`` and roots equal to ``tie`` is not certainly below each
     of ``bounds`` in modulus, or None."""
     bad = [t for i, t in enumerate(ev) if i not in skip and t[1] != tg.ONE and not (
-        tie is not None and same_root(t, tie)) and not all(abs(t[0]) < b for b in bounds)]
+        tie is not None and _same_root(t, tie)) and not all(abs(t[0]) < b for b in bounds)]
     return f"an eigenvalue ({bad[0][0].str(6)}) is not certainly {what}" if bad else None
 
 
@@ -401,12 +397,8 @@ def _one_simple(ev):
     return None if sum(1 for t in ev if t[1] == tg.ONE) == 1 else "eigenvalue 1 is not simple"
 
 
-def chain_top(fam, n, lam, vec):
-    """(S - lam) vec exactly, or None when vec is an eigenvector (or lam is not rational).
-
-    >>> chain_top("corner", 4, fmpq(1, 2), [fmpq(0)] * len(tg.labels("corner", 4))) is None
-    True
-    """
+def _chain_top(fam, n, lam, vec):
+    """(S - lam) vec exactly, or None when vec is an eigenvector (or lam is not rational)."""
     if not isinstance(lam, fmpq) or any(not isinstance(v, fmpq) for v in vec):
         return None
     u = tg.sector_matrix(fam, n) * fmpq_mat([[v] for v in vec])
@@ -414,16 +406,9 @@ def chain_top(fam, n, lam, vec):
     return top if any(v != 0 for v in top) else None
 
 
-def flip_generic(n, a, b, prec):
+def _flip_generic(n, a, b, prec):
     """(ok, message): G of a dart's flip: 1 simple; alpha, beta simple, certainly of opposite signs, each certainly
-    larger in modulus than every other eigenvalue.
-
-    >>> ev = sorted(tg.eigenvalues("dart", 2, 128), key=lambda t: -abs(t[0]).mid())
-    >>> flip_generic(2, ev[1][0].real, ev[2][0].real, 128)[1][:56]
-    'alpha = 0.38784688, beta = -0.28114257: alpha beta < 0, '
-    >>> flip_generic(2, ev[1][0].real, fmpq(1, 4), 128)
-    (False, 'alpha beta < 0 is not certain')
-    """
+    larger in modulus than every other eigenvalue."""
     ev = tg.eigenvalues("dart", n, prec)
     ia = _find(ev, a)
     ib = None if ia is None else _find(ev, b, (ia,))
@@ -439,15 +424,9 @@ def flip_generic(n, a, b, prec):
                   f"> |every other| (at most {top.str(6, radius=False)}); 1 simple")
 
 
-def chain_generic(fam, n, vals, tops, prec):
+def _chain_generic(fam, n, vals, tops, prec):
     """(ok, message): G of a Jordan-chain witness; ``vals`` the eigenvalues of x, y, z, ``tops`` (S - lam) of each
-    (None for an eigenvector, :func:`chain_top`).
-
-    >>> ev = sorted(tg.eigenvalues("corner", 4, 128), key=lambda t: -abs(t[0]).mid())
-    >>> vals = {"x": ev[1][0].real, "y": fmpq(1, 2), "z": fmpq(1, 2)}
-    >>> chain_generic("corner", 4, vals, {"x": None, "y": None, "z": None}, 128)
-    (False, 'y is no generalized eigenvector of a rational beta, or z or x is one')
-    """
+    (None for an eigenvector, :func:`chain_top`)."""
     a, b, g = vals["x"], vals["y"], vals["z"]
     if tops["y"] is None or tops["z"] is not None or tops["x"] is not None or not isinstance(b, fmpq):
         return False, "y is no generalized eigenvector of a rational beta, or z or x is one"
@@ -455,13 +434,13 @@ def chain_generic(fam, n, vals, tops, prec):
         return False, "e = (S - beta) y is not 0 on the crease points"
     ev = tg.eigenvalues(fam, n, prec)
     ia = _find(ev, a)
-    at_b = [i for i, t in enumerate(ev) if same_root(t, b)]
+    at_b = [i for i, t in enumerate(ev) if _same_root(t, b)]
     why = _one_simple(ev) or (
         "alpha is not a simple eigenvalue" if ia is None or ev[ia][2] != 1 or ia in at_b else
         "alpha > beta > 0 is not certain" if not (b > 0 and ev[ia][0].real > b) else
         # beta's Jordan blocks have size <= 2 iff dim ker (S - beta)^2 is its algebraic multiplicity (exact)
         f"a Jordan block of size > 2 at beta = {b}" if tg.kernel_dim(fam, n, fmpq_poly([-b, 1]) ** 2) != len(at_b) else
-        _below(ev, [ia, *at_b], (b,), "below beta in modulus") or crease_top_why(tg.crease_block(fam, n), g) or
+        _below(ev, [ia, *at_b], (b,), "below beta in modulus") or _crease_top_why(tg.crease_block(fam, n), g) or
         ("gamma is not beta" if g != b else None))
     if why:
         return False, why
@@ -470,13 +449,8 @@ def chain_generic(fam, n, vals, tops, prec):
                   "(dim ker (S - beta)^2 = algebraic multiplicity); e = (S - beta) y != 0, 0 on the crease points")
 
 
-def crease_top_why(C, g):
-    """None if g is the largest eigenvalue below 1 of the crease block C (its factors all linear), else the reason.
-
-    >>> C = tg.crease_block("crease", 3)
-    >>> crease_top_why(C, fmpq(1, 2)), crease_top_why(C, fmpq(1, 4))
-    (None, "gamma is not the crease block's largest eigenvalue below 1 (1/2)")
-    """
+def _crease_top_why(C, g):
+    """None if g is the largest eigenvalue below 1 of the crease block C (its factors all linear), else the reason."""
     fac = [p for p, _ in C.charpoly().factor()[1]]
     if any(p.degree() > 1 for p in fac):
         return "the crease block has irrational eigenvalues"
@@ -486,14 +460,9 @@ def crease_top_why(C, g):
     return None
 
 
-def mode_lead_why(ev, ia, ib):
+def _mode_lead_why(ev, ia, ib):
     """The reason 1 (from the crease block, or a dart's even part) is not simple or the entries ia, ib of the mode
-    list (:func:`.tagged_modes.mode_spectrum`) do not lead (alpha >= beta > |every other|), or None.
-
-    >>> ev = mode_spectrum("crease", 5)
-    >>> mode_lead_why(ev, 0, 0)
-    'x and y are the same eigenvector (beta is not an eigenvalue distinct from alpha)'
-    """
+    list (:func:`.tagged_modes.mode_spectrum`) do not lead (alpha >= beta > |every other|), or None."""
     one = [t for t in ev if not abs(t[0]) < 1]
     beta = ev[ib][0].real
     others = [t for i, t in enumerate(ev) if i not in (ia, ib) and t[1] != 1]
@@ -504,15 +473,10 @@ def mode_lead_why(ev, ia, ib):
             if not all(abs(t[0]) < beta for t in others) else None)
 
 
-def ordering(fam, n, a, b, g, prec, generalized):
+def _ordering(fam, n, a, b, g, prec, generalized):
     """(ok, message): G of the generic pair: a = lam1 >= b = lam2 >= every other |lam| (1 simple, ties only with b
     itself), g the crease block's largest eigenvalue below 1, every eigenvalue of modulus possibly >= b
-    non-defective, and g < b when z is a generalized eigenvector.
-
-    >>> ordering("corner", 3, fmpq(1, 2), fmpq(1, 2), fmpq(1, 2), 64, False)[1][:40]   # lam1 = 0.58 is not alpha
-    'an eigenvalue ([0.579682 +/- 3.27e-7]) i'
-
-    """
+    non-defective, and g < b when z is a generalized eigenvector."""
     ev = tg.eigenvalues(fam, n, prec)  # each root once per unit of algebraic multiplicity
     ia = _find(ev, a)
     ib = None if ia is None else _find(ev, b, (ia,))
@@ -521,7 +485,7 @@ def ordering(fam, n, a, b, g, prec, generalized):
         "alpha is not an eigenvalue" if ia is None else "beta is not an eigenvalue (distinct from alpha's copy)"
         if ib is None else "alpha >= beta is not certain" if not (abs(ev[ia][0]) >= beta or ev[ia][1] == ev[ib][1])
         else _below(ev, (ia, ib), (beta,), "below beta (lam1, lam2 not alpha, beta)", b) or
-        crease_top_why(tg.crease_block(fam, n), g) or _jordan_at(ev, beta) or
+        _crease_top_why(tg.crease_block(fam, n), g) or _jordan_at(ev, beta) or
         ("z is a generalized eigenvector but gamma < beta is not certain" if generalized and not arb(g) < beta
          else None))
     if why:

@@ -103,19 +103,11 @@ def transversal_form(nets, curve, a1, a2, prec):
 AXES = {"+x": (1, 0), "-x": (-1, 0), "+y": (0, 1), "-y": (0, -1)}
 
 
-def crossings(nets, curve, paths, direction, prec):
+def _crossings(nets, curve, paths, direction, prec):
     """How often one outer cubic crosses the half-line H = {t d : t > 0} (``direction`` d = (a, b)), from a partition of
     [0, 1] into boxes each certainly off H (-b X + a Y of one sign, or a X + b Y < 0) or on its side (a X + b Y > 0),
     where a sign change of -b X + a Y between the ends is one crossing (one direction for all: T); or why a box
-    decides nothing.
-
-    >>> from ccproof.certify.verify.tagged import labels
-    >>> pts = labels("corner", 1)   # the identity map: x = a, y = b
-    >>> vx = [fmpq(p[2] if p[0] == "q" or p[:2] == ("r", 0) else 0) for p in pts]
-    >>> vy = [fmpq(p[3] if p[0] == "q" else p[2] if p[:2] == ("r", 1) else 0) for p in pts]
-    >>> crossings(quadrant_nets("corner", 1, vx, vy, 0, 64), "P1s1", ["0L", "0H"], (3, 1), 64)
-    1
-    """
+    decides nothing."""
     if not check_partition(paths, 1):
         return f"{curve}: the boxes do not partition [0, 1]"
     count = 0
@@ -167,18 +159,10 @@ def _box_crossings(fa, fp):
     return 1 if ends < 0 else 0
 
 
-def rays_on_axes(fam, n, vx, vy):
+def _rays_on_axes(fam, n, vx, vy):
     """(ok, message): E, the sharp rays' layer-0 segments lie on the half-axes: the limit curve of a sharp ray's
     segment is the cubic B-spline of its level-1 values at 0..3 (X = 0 when they are exactly 0; Y's sign from the
-    Bezier points).
-
-    >>> from ccproof.certify.verify.tagged import labels
-    >>> pts = labels("corner", 1)   # the identity map: x = a, y = b
-    >>> vx = [fmpq(p[2] if p[0] == "q" or p[:2] == ("r", 0) else 0) for p in pts]
-    >>> vy = [fmpq(p[3] if p[0] == "q" else p[2] if p[:2] == ("r", 1) else 0) for p in pts]
-    >>> rays_on_axes("corner", 1, vx, vy)[0]
-    True
-    """
+    Bezier points)."""
     X, Y = level1_values(fam, n, vx), level1_values(fam, n, vy)
     x0, y0 = [X(0, a, 0) for a in range(4)], [Y(0, a, 0) for a in range(4)]
     xn, yn = [X(n - 1, 0, b) for b in range(4)], [Y(n - 1, 0, b) for b in range(4)]
@@ -229,7 +213,7 @@ def check_map(fam, n, vx, vy, lam1, lam2, orient, parts, prec, part):
             part(title, True, note.format(worst), worst, hint)
         ray = fam == "dart" and isinstance(lam1, fmpq) and lam1 == lam2  # D a multiple of 1: every ray an orbit
         if _check_winding(fam, nets, curves, parts["winding"], ray, orient, prec, part) and fam != "dart":
-            part("E the sharp rays map onto half-axes", *rays_on_axes(fam, n, vx, vy))
+            part("E the sharp rays map onto half-axes", *_rays_on_axes(fam, n, vx, vy))
 
 
 def _check_keys(parts, regs, curves):
@@ -271,7 +255,7 @@ def _check_winding(fam, nets, curves, win, ray, orient, prec, part):
         paths = win["boxes"][key]
         if not isinstance(paths, list) or not paths or not all(isinstance(p, str) for p in paths):
             raise CertificateError(f"parts.winding.{key} must be a list of paths")
-        got = crossings(nets[int(q)], c, paths, direction, prec)
+        got = _crossings(nets[int(q)], c, paths, direction, prec)
         if isinstance(got, str):
             part(title, False, got)
             return False
