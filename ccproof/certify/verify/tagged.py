@@ -244,12 +244,8 @@ def eigenvalues(fam, n, prec):
     return tuple(out)
 
 
-def show(t):
-    """An eigenvalue entry (:func:`eigenvalues`) for a message: exact when rational.
-
-    >>> show((acb(0.5), fmpq_poly([-1, 2]), 1, 1))
-    '1/2'
-    """
+def _show(t):
+    """An eigenvalue entry for a message: exact when rational."""
     return str(-t[1][0] / t[1][1]) if t[1].degree() == 1 else t[0].real.str(5, radius=False)
 
 
@@ -279,19 +275,19 @@ def leading_spectrum(fam, n, prec):
                if any(not abs(t[0]) < 1 for t in rest) else  # reviewed (tests/certify/test_arb_comparisons.py)
                _not_simple_positive("lam1", l1) or _not_simple_positive("lam2", l2) or
                ("lam1 and lam2 are not separated" if not (same12 or l1[0].real > l2[0].real) else
-                f"lam2 = lam3 = {show(l2)} (multiplicity {l2[2]}): a tie" if l3[1] == l2[1] and l3[0].overlaps(l2[0])
-                else f"|lam3| is not certainly below lam2 = {show(l2)}"
+                f"lam2 = lam3 = {_show(l2)} (multiplicity {l2[2]}): a tie" if l3[1] == l2[1] and l3[0].overlaps(l2[0])
+                else f"|lam3| is not certainly below lam2 = {_show(l2)}"
                 if not all(abs(t[0]) < l2[0].real for t in rest[2:]) else None))
         if why:
             return False, f"{name}: {why}", ev[:4]
-        lead = (f"lam1 = lam2 = {show(l1)} (double, non-defective)" if same12 else
-                f"lam1 = {show(l1)} > lam2 = {show(l2)} (simple)")
-        return True, f"{name}: 1 simple; {lead} > |lam3| = {show(l3)}", ev[:4]
+        lead = (f"lam1 = lam2 = {_show(l1)} (double, non-defective)" if same12 else
+                f"lam1 = {_show(l1)} > lam2 = {_show(l2)} (simple)")
+        return True, f"{name}: 1 simple; {lead} > |lam3| = {_show(l3)}", ev[:4]
 
 
 def _not_simple_positive(lab, t):  # why the entry t is not certainly real, positive and non-defective
     if not (t[0].imag.is_zero() and t[0].real > 0):
-        return f"{lab} = {show(t)} is not certainly real and positive"
+        return f"{lab} = {_show(t)} is not certainly real and positive"
     if t[3] < t[2]:
-        return f"{lab} = {show(t)} lies in a Jordan block (algebraic multiplicity {t[2]}, geometric {t[3]})"
+        return f"{lab} = {_show(t)} lies in a Jordan block (algebraic multiplicity {t[2]}, geometric {t[3]})"
     return None
