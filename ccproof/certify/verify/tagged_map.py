@@ -5,6 +5,8 @@ ghost row 2 P(a, 0) - P(a, 1) across a sharp ray).
 
 from __future__ import annotations
 
+from functools import cache
+
 from flint import arb, ctx, fmpq
 
 from ccproof.rigorous import BernsteinForm
@@ -34,22 +36,15 @@ def level1_values(fam, n, v):
     """
     idx, at = point_index(fam, n)
     sharp = sharp_rays(fam, n)
-    rows, memo = sector_rows(fam, n), {}
-
-    def one(i):  # (S v)[i], sparse, on demand (a quadrant reads a few of them)
-        if i not in memo:
-            memo[i] = sum((w * v[j] for j, w in rows[i].items()), 0 * v[0])
-        return memo[i]
-
-    def quad(s):
-        return s % n if fam == "dart" else s
+    rows = sector_rows(fam, n)
+    one = cache(lambda i: sum((w * v[j] for j, w in rows[i].items()), 0 * v[0]))  # (S v)[i], sparse, on demand
 
     def value(q, A, B):
         if (A, B) == (0, 0):
             return one(0)
         if B == -1 and q in sharp:  # across the sharp ray q: the ghost row
             return 2 * value(q, A, 0) - value(q, A, 1)
-        if A == -1 and quad(q + 1) in sharp:  # across the sharp ray q + 1: the ghost column
+        if A == -1 and ((q + 1) % n if fam == "dart" else q + 1) in sharp:  # across the sharp ray q + 1
             return 2 * value(q, 0, B) - value(q, 1, B)
         key = position_key(fam, n, q, A, B)
         if key in idx:
