@@ -99,13 +99,9 @@ def limit_h(theta):
     return a1 * b2 - b1 * a2
 
 
-def check_disc(R, side):
+def _check_disc(R, side):
     """The number of boxes of the grid of ``side`` that meet |theta| <= R, each proved (H analytic there), or the
-    failing box as a string.
-
-    >>> check_disc(fmpq(1, 10), fmpq(1, 10))
-    4
-    """
+    failing box as a string."""
     m = int(-(-R.p * side.q // (R.q * side.p)))  # ceil(R / side)
     count = 0
     for u in range(-m, m):
@@ -127,13 +123,9 @@ def _on_circle(radius, k, arcs):
     return acb(arb(0), arb(2 * k) / arcs * arb.pi()).exp() * radius
 
 
-def circle_bound(R, arcs):
+def _circle_bound(R, arcs):
     """An upper bound M of |H| on |theta| = R from acb balls covering ``arcs`` arcs, or None if one is not proved (not
-    :func:`~ccproof.rigorous.analytic.disc_bound`: its square leaves the disc that :func:`check_disc` proves).
-
-    >>> circle_bound(fmpq(3, 10), 256) < fmpq(1, 5), circle_bound(fmpq(3, 10), 2048) < fmpq(3, 100)
-    (True, True)
-    """
+    :func:`~ccproof.rigorous.analytic.disc_bound`: its square leaves the disc that the disc check proves)."""
     top = arb(0)
     for k in range(arcs):
         ball = acb(arb(0), (arb(2 * k + 1) + arb(0, 1)) / arcs * arb.pi()).exp() * R  # covers arc k
@@ -144,16 +136,9 @@ def circle_bound(R, arcs):
     return top
 
 
-def winding(rho, arcs, R, M):
+def _winding(rho, arcs, R, M):
     """(the winding number of H along |theta| = rho (an arb ball), None) or (None, the reason); each arc's image lies
-    in a disc about H(z_k) that misses 0 (|H'| <= M R/(R - rho)^2 by Cauchy).
-
-    >>> wn, why = winding(fmpq(1, 5), 512, fmpq(3, 10), arb("0.0261"))
-    >>> wn.contains(4), why
-    (True, None)
-    >>> winding(fmpq(1, 5), 256, fmpq(3, 10), arb("0.0261"))[1][:37]
-    "arc 0 of 256: |H'| * length = [0.0038"
-    """
+    in a disc about H(z_k) that misses 0 (|H'| <= M R/(R - rho)^2 by Cauchy)."""
     slope = M * R / (R - rho) ** 2  # |H'| on |theta| = rho (Cauchy on |theta| = R)
     length = 2 * arb.pi() * rho / arcs
     vals = [limit_h(_on_circle(rho, k, arcs)) for k in range(arcs + 1)]
@@ -185,13 +170,8 @@ def _gap(croots, below, blocks, others, g, b0, n0):
          "gamma is possibly a multiple eigenvalue of I")) if bad()), None), cg
 
 
-def uniform_spectrum(fam, n0, g, C, blocks):
-    """(ok, message): part 2 for every N >= n0 with gamma = g (exact).
-
-    >>> C, *blocks = check_windows("corner")
-    >>> uniform_spectrum("corner", 101, fmpq(1, 2), C, blocks)[0]
-    True
-    """
+def _uniform_spectrum(fam, n0, g, C, blocks):
+    """(ok, message): part 2 for every N >= n0 with gamma = g (exact)."""
     fac = C.charpoly().factor()[1]
     if any(p.degree() > 1 for p, _ in fac):
         return False, "the crease block has irrational eigenvalues"
@@ -259,7 +239,7 @@ def _check_tail(fam, n0, g, cval, limit, part, log):
          why or f"C c = {g} c exactly on the crease points (the same C for every N)")
     if part.failed:
         return
-    ok, msg = uniform_spectrum(fam, n0, g, C, blocks)
+    ok, msg = _uniform_spectrum(fam, n0, g, C, blocks)
     part(G_GENERIC, ok, msg)
     if not ok:
         return
@@ -277,7 +257,7 @@ def _check_tail(fam, n0, g, cval, limit, part, log):
 def _check_normal(fam, n0, limit, part, log):
     """N for every N >= n0: H analytic on |theta| <= R, bounded on its circle, winding 4 times along |theta| = rho."""
     rho, R, side, arcs, outer = limit
-    got = check_disc(R, side)
+    got = _check_disc(R, side)
     ok = isinstance(got, int)
     part(f"x, y and N analytic: the bordered systems of modes 1 and 2 regular on |theta| <= {R}", ok,
          f"{got} boxes of side {side}, (1 + c)(9 + c) in the right half-plane: x, y = f(pi/N), f(2 pi/N) are the "
@@ -285,12 +265,12 @@ def _check_normal(fam, n0, limit, part, log):
          f"box {got}: not proved regular, or (1 + c)(9 + c) not certainly in the right half-plane")
     if not ok:
         return
-    M = circle_bound(R, outer)
+    M = _circle_bound(R, outer)
     part(f"N bound: |H| <= M on |theta| = {R}", M is not None,
          f"M = {M.str(5, radius=False)} ({outer} arc balls)" if M is not None else "an arc ball is not proved")
     if M is None:
         return
-    wn, why = winding(rho, arcs, R, M)
+    wn, why = _winding(rho, arcs, R, M)
     ok = wn is not None and wn > fmpq(7, 2) and wn < fmpq(9, 2)
     part(f"N winding: H winds 4 times around 0 along |theta| = {rho}, so J_xy != 0 for every N >= {n0}", ok,
          f"{wn.str(6)} ({arcs} arcs, each image in a disc off 0: |H'| <= M R/(R - rho)^2)" if ok else
