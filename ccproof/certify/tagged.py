@@ -406,7 +406,7 @@ def _map_specs(fam, n, lead, prec, choice=0):
 
 
 def _winding_paths(root_a, root_p, depth=12):
-    """Split a curve until each box is decided for the crossing count (see the verifier's ``crossings``)."""
+    """Split a curve until each box is decided for the crossing count (as the verifier's check_map counts them)."""
     out = []
     stack = [(root_a, root_p, "", 0)]
     while stack:

@@ -1,20 +1,8 @@
-"""The subdivision matrix of a tagged configuration and its leading spectrum, from the rules (trusted).
+"""The sector matrix S of a tagged configuration from OpenSubdiv's rules, its exact spectrum and the spectral
+part of the criterion (trusted; docs/tagged_c1.md, "Configurations and rules" and "Spectrum (exact)").
 
-A configuration is named ``"dart:K"``, ``"crease:N"`` or ``"corner:N"`` (docs/tagged_c1.md). Its
-sector complex is the grid of :mod:`.rules` around the centre C: rays r (an edge out of C) carry the
-positions (1, 0), (2, 0); quadrant q (the face between rays q and q + 1) the positions (1, 1), (2, 1),
-(1, 2), (2, 2).
-
-* ``crease:N``: N quadrants between the sharp rays 0 and N (a boundary vertex with N faces, or one
-  side of an interior crease: the points of a sector depend only on the crease points and their own,
-  so the sectors decouple, docs/tagged_c1.md);
-* ``corner:N``: the same complex with the centre fixed;
-* ``dart:K``: K quadrants around C (rays taken mod K), ray 0 sharp, the crease continuing beyond it.
-
-OpenSubdiv's rules (Sdc ``CATMARK``; written here once more, independently of the library): face
-point the centroid; smooth edge point (a + b + f0 + f1)/4, sharp edge point (a + b)/2; smooth vertex
-point (F + 2R + (n - 3)V)/n; crease vertex point (e0 + 6V + e1)/8; corner vertex point V. A dart
-centre takes the smooth rule, a crease centre the crease rule along its two sharp rays.
+Points: the centre ``("C",)``, ray r's ``("r", r, a, b)`` at RAY_POS, quadrant q's ``("q", q, a, b)`` at QUAD_POS;
+crease:N and corner:N have rays 0..N (sharp: 0 and N), dart:K rays 0..K-1 mod K (sharp: 0).
 """
 
 from __future__ import annotations
@@ -27,31 +15,17 @@ from flint import acb, ctx, fmpq, fmpq_mat, fmpq_poly
 from .errors import CertificateError
 from .rules import CENTRE, canonical, level1_rule
 
-RAY_POS = ((1, 0), (2, 0))
-QUAD_POS = ((1, 1), (2, 1), (1, 2), (2, 2))
-MAX_SIZE = 100  # N, K at most this (exact characteristic polynomials of 6K + 1 rows)
-_NAME = re.compile(r"(dart|crease|corner):(>=)?([0-9]{1,7})")
-MAX_TAIL = 10**6  # FAMILY:>=N0 needs N0 at most this
+RAY_POS, QUAD_POS = ((1, 0), (2, 0)), ((1, 1), (2, 1), (1, 2), (2, 2))
+MAX_SIZE, MAX_TAIL = 100, 10**6  # N, K at most MAX_SIZE; FAMILY:>=N0 needs N0 at most MAX_TAIL
 EXACT_BUDGET = 128**3  # work m^3 of the exact route for S of m points; the published use at most 27 points
+_NAME = re.compile(r"(dart|crease|corner):(>=)?([0-9]{1,7})")
+ONE = fmpq_poly([-1, 1])  # the factor of the eigenvalue 1
 
 
 def parse_configuration(name):
-    """``(family, n)`` from a configuration name such as ``"crease:4"``, or ``(family, {"min": N0})`` for
-    every N >= N0 at once (``"crease:>=101"``; :mod:`.tagged_limit`).
+    """``(family, n)`` from ``"dart:K"`` (2 <= K), ``"crease:N"``, ``"corner:N"`` (1 <= N; N, K <= MAX_SIZE), or
+    ``(family, {"min": N0})`` from ``"FAMILY:>=N0"`` (2 <= N0 <= MAX_TAIL); CertificateError otherwise.
 
-    Parameters
-    ----------
-    name : str
-        ``"dart:K"`` (K >= 2), ``"crease:N"`` or ``"corner:N"`` (N >= 1), at most :data:`MAX_SIZE`;
-        ``"FAMILY:>=N0"`` with 2 <= N0 <= :data:`MAX_TAIL`.
-
-    Raises
-    ------
-    CertificateError
-        For any other name.
-
-    Examples
-    --------
     >>> parse_configuration("dart:5"), parse_configuration("crease:>=101")
     (('dart', 5), ('crease', {'min': 101}))
     >>> parse_configuration("dart:1")
@@ -62,35 +36,18 @@ def parse_configuration(name):
     m = _NAME.fullmatch(name) if isinstance(name, str) else None
     if m is None:
         raise CertificateError(f"configuration {str(name)[:40]!r} is not dart:K, crease:N or corner:N (or FAMILY:>=N0)")
-    fam, n = m.group(1), int(m.group(3))
-    if m.group(2):
-        if not 2 <= n <= MAX_TAIL:
-            raise CertificateError(f"configuration {name!r}: {fam}:>=N0 needs 2 <= N0 <= {MAX_TAIL}")
-        return fam, {"min": n}
-    lo = 2 if fam == "dart" else 1
-    if not lo <= n <= MAX_SIZE:
-        raise CertificateError(f"configuration {name!r}: {fam}:{'K' if fam == 'dart' else 'N'} needs "
-                               f"{lo} <= {'K' if fam == 'dart' else 'N'} <= {MAX_SIZE}")
-    return fam, n
+    fam, tail, n = m.group(1), m.group(2), int(m.group(3))
+    lo, hi, v = (2, MAX_TAIL, "N0") if tail else (2 if fam == "dart" else 1, MAX_SIZE, "K" if fam == "dart" else "N")
+    if not lo <= n <= hi:
+        raise CertificateError(f"configuration {name!r}: {fam}:{tail or ''}{v} needs {lo} <= {v} <= {hi}")
+    return fam, {"min": n} if tail else n
 
 
 def check_exact_budget(fam, n):
-    """Refuse, before any arithmetic, a configuration whose exact route exceeds :data:`EXACT_BUDGET`.
+    """Refuse, before any arithmetic, a configuration whose exact route (about m^3 for S of m points, 9 s of CPU
+    for crease:100) exceeds EXACT_BUDGET; larger ones take the modes of :mod:`.tagged_modes` or nothing.
 
-    The exact route (the characteristic polynomial of the whole S over Q, its factors, the ranks of
-    p(S), :func:`exact_spectrum`) costs about m^3 operations on rationals for S of m points (m = 6N + 3,
-    6K + 1 for a dart), 9 s of CPU for crease:100. The budget, 128^3 (N, K <= 20; under 0.1 s), admits
-    every published certificate on that route (at most 27 points) with room; larger configurations are
-    decided through the modes of :mod:`.tagged_modes` or not at all.
-
-    Examples
-    --------
-    >>> check_exact_budget("crease", 20)
-    >>> try:
-    ...     check_exact_budget("crease", 100)
-    ... except CertificateError as exc:
-    ...     print(exc)
-    crease:100: the exact route on S of 603 points exceeds the budget (m^3 > 128^3: N, K <= 20)
+    >>> check_exact_budget("crease", 20)   # crease:100 is refused: leading_spectrum
     """
     m = len(labels(fam, n))
     if m**3 > EXACT_BUDGET:
@@ -99,15 +56,8 @@ def check_exact_budget(fam, n):
 
 
 def labels(fam, n):
-    """The points of the sector complex, in matrix order: centre, ray points, quadrant points.
+    """The points in matrix order: centre, ray points, quadrant points (6n + 3; a dart 6n + 1).
 
-    Returns
-    -------
-    list of tuple
-        ``("C",)``, ``("r", r, a, b)``, ``("q", q, a, b)``; 6n + 3 points (crease, corner) or 6n + 1 (dart).
-
-    Examples
-    --------
     >>> pts = labels("crease", 1)
     >>> len(pts), pts[:3]
     (9, [('C',), ('r', 0, 1, 0), ('r', 0, 2, 0)])
@@ -120,8 +70,6 @@ def labels(fam, n):
 def sharp_rays(fam, n):
     """The sharp rays: ray 0 for a dart, rays 0 and n otherwise.
 
-    Examples
-    --------
     >>> sharp_rays("dart", 5), sharp_rays("corner", 3)
     ((0,), (0, 3))
     """
@@ -129,11 +77,9 @@ def sharp_rays(fam, n):
 
 
 def position_key(fam, n, q, a, b):
-    """The label (:func:`labels`) of the raw grid position (a, b) of quadrant q (:func:`.rules.canonical`;
-    rays and quadrants mod K for a dart), whether or not the complex holds it.
+    """The label of the raw grid position (a, b) of quadrant q (:func:`.rules.canonical`; mod K for a dart),
+    whether or not the complex holds it.
 
-    Examples
-    --------
     >>> position_key("dart", 5, 4, 0, 2), position_key("crease", 2, 0, 1, -1), position_key("crease", 2, 1, 0, 0)
     (('r', 0, 2, 0), ('q', -1, 1, 1), ('C',))
     """
@@ -145,19 +91,16 @@ def position_key(fam, n, q, a, b):
 
 
 def point_index(fam, n):
-    """``(idx, at)``: the index of each label (:func:`labels`), and ``at(q, comb)``, a combination of raw grid
-    positions of quadrant q (:func:`position_key`) as ``{index: weight}``; raises for a position outside the
-    complex.
+    """``(idx, at)``: the index of each label, and ``at(q, comb)``: a combination of raw positions of quadrant q
+    as ``{index: weight}`` (raises for a position outside the complex).
 
-    Examples
-    --------
     >>> idx, at = point_index("crease", 2)
     >>> idx[("r", 2, 1, 0)], at(1, {(0, 1): fmpq(1, 2), (1, 0): fmpq(1, 2)})
     (5, {5: 1/2, 3: 1/2})
     """
     idx = {p: i for i, p in enumerate(labels(fam, n))}
 
-    def at(q, comb):  # raw positions of quadrant q -> {index: weight}
+    def at(q, comb):
         out = {}
         for (a, b), w in comb.items():
             key = position_key(fam, n, q, a, b)
@@ -170,36 +113,25 @@ def point_index(fam, n):
 
 @cache
 def sector_rows(fam, n):
-    """The rows of the sector matrix S as sparse dicts (column index -> weight), from the rules.
+    """The rows of S as sparse dicts {column: weight} (level-1 point i = sum_j row_i[j] level-0 point j).
 
-    Parameters
-    ----------
-    fam : str
-        ``"dart"``, ``"crease"`` or ``"corner"``.
-    n : int
-        K or N.
-
-    Returns
-    -------
-    tuple of dict[int, fmpq]
-        One per point of :func:`labels` (level-1 point i = sum_j row_i[j] level-0 point j).
-
-    Examples
-    --------
-    The crease centre (e0 + 6 V + e1)/8 (rays 0 and 2 start at indices 1 and 5):
-
-    >>> sector_rows("crease", 2)[0]
+    >>> sector_rows("crease", 2)[0]   # the crease centre (e0 + 6 V + e1)/8
     {0: 3/4, 1: 1/8, 5: 1/8}
     """
-    pts = labels(fam, n)
     idx, at = point_index(fam, n)
+    half, eighth, k = fmpq(1, 2), fmpq(1, 8), fmpq(n)
+    if fam == "dart":  # the smooth rule (F + 2R + (k - 3)V)/k: weights 1 - 7/(4k), 3/(2k^2), 1/(4k^2)
+        centre = {0: 1 - fmpq(7, 4) / k}
+        for r in range(n):
+            centre.update({idx[("r", r, 1, 0)]: fmpq(3, 2) / k**2, idx[("q", r, 1, 1)]: fmpq(1, 4) / k**2})
+    else:
+        centre = {0: fmpq(1)} if fam == "corner" else {0: 6 * eighth, idx[("r", 0, 1, 0)]: eighth,
+                                                       idx[("r", n, 1, 0)]: eighth}
     rows = []
-    sharp = sharp_rays(fam, n)
-    half, eighth = fmpq(1, 2), fmpq(1, 8)
-    for p in pts:
+    for p in labels(fam, n):
         if p == ("C",):
-            row = _centre_row(fam, n, idx)
-        elif p[0] == "r" and p[1] in sharp:
+            row = centre
+        elif p[0] == "r" and p[1] in sharp_rays(fam, n):
             e1, e2 = idx[("r", p[1], 1, 0)], idx[("r", p[1], 2, 0)]
             row = {0: half, e1: half} if p[2] == 1 else {0: eighth, e1: 6 * eighth, e2: eighth}
         else:  # a smooth ray (its b = -1 side is quadrant r - 1) or a quadrant point: the rule in that quadrant
@@ -209,16 +141,10 @@ def sector_rows(fam, n):
 
 
 def window_rows(fam, n):
-    """{window class: the row relative to its point} for fam:n; raises if one class has two rows.
-
-    A point's class is its kind, its ray or quadrant clipped to 3 from either end, and its position; a
-    column is the point's kind, its offset from the row's ray (mod K for a dart, taken in -K/2 .. K/2) and
-    its position. The centre row of a crease or corner reads rays 0 and N (``"N"``, N - ray); a dart's
-    centre row depends on K and is left out (:mod:`.dart_spectrum` checks it apart).
-
-    Examples
-    --------
-    The crease centre (e0 + 6 V + e1)/8 on rays 0 and N, and a dart's sharp midpoint (C + e1)/2:
+    """{window class: the row relative to its point}; raises if one class has two rows. A class is the kind,
+    the ray or quadrant clipped to 3 from either end, and the position; a column the kind, the offset from the
+    row's ray (mod K for a dart, in -K/2 .. K/2) and the position; the centre reads rays 0 and N (``"N"``,
+    N - ray); a dart's centre row is left out (:mod:`.dart_spectrum` checks it).
 
     >>> window_rows("crease", 7)[("C",)]
     {('C',): 3/4, ('r', 0, 1, 0): 1/8, ('r', 'N', 0, 1, 0): 1/8}
@@ -236,7 +162,7 @@ def window_rows(fam, n):
     return out
 
 
-def _window_column(p, q, n, ring):  # the column of point q in the row of point p (window_rows)
+def _window_column(p, q, n, ring):  # the column of point q in the row of point p
     if q == ("C",):
         return q
     if p == ("C",):
@@ -247,75 +173,19 @@ def _window_column(p, q, n, ring):  # the column of point q in the row of point 
 
 @cache
 def sector_matrix(fam, n):
-    """The exact subdivision matrix S of the configuration: level-1 point i = sum_j S[i, j] level-0 point j.
-
-    Parameters
-    ----------
-    fam : str
-        ``"dart"``, ``"crease"`` or ``"corner"``.
-    n : int
-        K or N.
-
-    Returns
-    -------
-    flint.fmpq_mat, shape (m, m)
-        m = len(labels(fam, n)); rows sum to 1 (:func:`sector_rows`, dense).
-
-    Examples
-    --------
-    The crease centre (e0 + 6 V + e1)/8 and a sharp edge midpoint:
+    """S as an exact fmpq_mat (rows sum to 1).
 
     >>> S = sector_matrix("crease", 2)
     >>> [S[0, j] for j in range(7)], S[1, 0], S[1, 1]
     ([3/4, 1/8, 0, 0, 0, 1/8, 0], 1/2, 1/2)
     """
     rows = sector_rows(fam, n)
-    m = len(rows)
-    return fmpq_mat([[row.get(j, fmpq(0)) for j in range(m)] for row in rows])
-
-
-def _centre_row(fam, n, idx):
-    if fam == "corner":
-        return {0: fmpq(1)}
-    if fam == "crease":
-        return {0: fmpq(3, 4), idx[("r", 0, 1, 0)]: fmpq(1, 8), idx[("r", n, 1, 0)]: fmpq(1, 8)}
-    k = fmpq(n)  # dart: smooth rule (F + 2R + (k - 3)V)/k, weights 1 - 7/(4k), 3/(2k^2), 1/(4k^2)
-    row = {0: 1 - fmpq(7, 4) / k}
-    for r in range(n):
-        row[idx[("r", r, 1, 0)]] = fmpq(3, 2) / (k * k)
-        row[idx[("q", r, 1, 1)]] = fmpq(1, 4) / (k * k)
-    return row
-
-
-@cache
-def exact_spectrum(fam, n):
-    """The characteristic polynomial's irreducible factors over Q with their algebraic multiplicity and
-    the geometric multiplicity of each of their roots (exact): for a factor p of multiplicity e > 1,
-    dim ker p(S) = deg(p) * (geometric multiplicity), so the roots are non-defective iff
-    dim ker p(S) = e deg(p).
-
-    Returns
-    -------
-    list of (fmpq_poly, int, int)
-        ``(p, algebraic multiplicity, geometric multiplicity)`` (p primitive with integer coefficients).
-
-    Examples
-    --------
-    The boundary vertex with one face: the cubic B-spline spectrum 1, 1/2, 1/4, 1/8 (twice) and the
-    face's own eigenvalues; 1/4 is defective (a Jordan block of size 2):
-
-    >>> sorted((str(p), a, g) for p, a, g in exact_spectrum("crease", 1))[:3]
-    [('16*x + (-1)', 2, 2), ('2*x + (-1)', 1, 1), ('4*x + (-1)', 2, 1)]
-    """
-    _, fac = sector_matrix(fam, n).charpoly().factor()
-    return [(p, e, 1 if e == 1 else kernel_dim(fam, n, p) // p.degree()) for p, e in fac]
+    return fmpq_mat([[row.get(j, fmpq(0)) for j in range(len(rows))] for row in rows])
 
 
 def kernel_dim(fam, n, p):
     """dim ker p(S) (exact; p(S) by Horner) for a polynomial p over Q.
 
-    Examples
-    --------
     >>> kernel_dim("crease", 1, fmpq_poly([-1, 4])), kernel_dim("crease", 1, fmpq_poly([-1, 4]) ** 2)
     (1, 2)
     """
@@ -328,11 +198,8 @@ def kernel_dim(fam, n, p):
 
 
 def crease_points(fam, n):
-    """Indices (in :func:`labels` order) of the crease points: the centre, then (1, 0), (2, 0) of each
-    sharp ray. Their rows involve only themselves for ``crease`` and ``corner`` (the block C).
+    """Indices of the crease points: the centre, then (1, 0), (2, 0) of each sharp ray.
 
-    Examples
-    --------
     >>> crease_points("crease", 3)
     [0, 1, 2, 7, 8]
     """
@@ -341,17 +208,10 @@ def crease_points(fam, n):
 
 
 def crease_block(fam, n):
-    """The block C of S on :func:`crease_points`, after checking exactly that those rows vanish elsewhere.
+    """The block C of S on the crease points, after checking exactly that their rows vanish elsewhere (raises
+    otherwise, and for a dart).
 
-    Raises
-    ------
-    CertificateError
-        If a crease row involves another point (never for the true rules; a tripwire), or for a dart.
-
-    Examples
-    --------
-    >>> C = crease_block("crease", 4)
-    >>> sorted(str(p) for p, _ in C.charpoly().factor()[1])
+    >>> sorted(str(p) for p, _ in crease_block("crease", 4).charpoly().factor()[1])
     ['2*x + (-1)', '4*x + (-1)', '8*x + (-1)', 'x + (-1)']
     """
     if fam == "dart":
@@ -363,48 +223,42 @@ def crease_block(fam, n):
     return fmpq_mat([[S[i, j] for j in cp] for i in cp])
 
 
+@cache
+def _factors(fam, n):  # (p, algebraic multiplicity e, geometric multiplicity dim ker p(S) / deg p) per factor
+    _, fac = sector_matrix(fam, n).charpoly().factor()
+    return [(p, e, 1 if e == 1 else kernel_dim(fam, n, p) // p.degree()) for p, e in fac]
+
+
 @lru_cache(maxsize=64)
 def eigenvalues(fam, n, prec):
-    """Every eigenvalue as (acb enclosure, its factor, algebraic multiplicity, geometric multiplicity),
-    each root listed once per unit of algebraic multiplicity; isolated by arb (``complex_roots``), real
-    roots with an exactly zero imaginary part.
+    """Every eigenvalue once per unit of algebraic multiplicity: (acb, its irreducible factor over Q, algebraic,
+    geometric multiplicity); real roots have an exactly zero imaginary part.
 
-    Examples
-    --------
-    >>> ev = eigenvalues("crease", 3, 64)
-    >>> len(ev), sum(1 for z, p, a, g in ev if z.real.contains(1) and z.imag.is_zero())
-    (21, 1)
+    >>> sorted({(str(p), a, g) for z, p, a, g in eigenvalues("crease", 1, 64)})[:3]   # 1/4: a Jordan block
+    [('16*x + (-1)', 2, 2), ('2*x + (-1)', 1, 1), ('4*x + (-1)', 2, 1)]
     """
     out = []
     with ctx.workprec(prec):
-        for p, e, g in exact_spectrum(fam, n):
-            for z, _ in p.complex_roots():
-                out += [(acb(z), p, e, g)] * e
+        for p, e, g in _factors(fam, n):
+            out += [(acb(z), p, e, g) for z, _ in p.complex_roots() for _ in range(e)]
     return tuple(out)
 
 
-def _key(item):  # ordering for display and for choosing candidates; every decision is re-checked in arb
-    return -abs(item[0]).mid()
+def _show(t):
+    """An eigenvalue entry for a message: exact when rational."""
+    return str(-t[1][0] / t[1][1]) if t[1].degree() == 1 else t[0].real.str(5, radius=False)
 
 
 def leading_spectrum(fam, n, prec):
-    """The spectral part of the generalized Reif criterion for a sector (docs/tagged_c1.md):
-    1 simple, lam1 >= lam2 > |every other| real and positive, lam1 and lam2 non-defective.
+    """(ok, reason, the leading entries of :func:`eigenvalues`, at most 4): 1 simple, lam1 >= lam2 > |others| real
+    and positive, lam1 and lam2 non-defective; refused beyond :func:`check_exact_budget`.
 
-    Returns
-    -------
-    (bool, str, list)
-        Whether the spectral part holds, the reason (which tie or Jordan block when not), and the
-        leading eigenvalues (acb, factor, algebraic multiplicity, geometric multiplicity), at most 4.
-
-    Examples
-    --------
     >>> leading_spectrum("crease", 2, 64)[:2]
     (True, 'crease:2: 1 simple; lam1 = lam2 = 1/2 (double, non-defective) > |lam3| = 1/4')
     >>> leading_spectrum("crease", 4, 64)[1]
     'crease:4: lam2 = 1/2 lies in a Jordan block (algebraic multiplicity 2, geometric 1)'
-    >>> leading_spectrum("crease", 100, 64)[:2]   # refused before any arithmetic (check_exact_budget)
-    (False, 'crease:100: the exact route on S of 603 points exceeds the budget (m^3 > 128^3: N, K <= 20)')
+    >>> leading_spectrum("crease", 100, 64)[1]
+    'crease:100: the exact route on S of 603 points exceeds the budget (m^3 > 128^3: N, K <= 20)'
     """
     name = f"{fam}:{n}"
     try:
@@ -412,40 +266,28 @@ def leading_spectrum(fam, n, prec):
     except CertificateError as exc:
         return False, str(exc), []
     with ctx.workprec(prec):
-        ev = sorted(eigenvalues(fam, n, prec), key=_key)
-        one = [t for t in ev if t[1] == fmpq_poly([-1, 1])]
-        if len(one) != 1:
-            return False, f"{name}: eigenvalue 1 has multiplicity {len(one)}", ev[:4]
-        rest = [t for t in ev if t[1] != fmpq_poly([-1, 1])]
-        if any(not abs(t[0]) < 1 for t in rest):  # reviewed (tests/certify/test_arb_comparisons.py)
-            return False, f"{name}: an eigenvalue other than 1 is not certainly inside the unit disc", ev[:4]
-        l1, l2, l3 = rest[0], rest[1], rest[2]
-        why = _not_simple_positive(name, "lam1", l1) or _not_simple_positive(name, "lam2", l2)
-        if why:
-            return False, why, ev[:4]
+        ev = sorted(eigenvalues(fam, n, prec), key=lambda t: -abs(t[0]).mid())  # order only: decisions in arb
+        rest = [t for t in ev if t[1] != ONE]
+        l1, l2, l3 = rest[:3]
         same12 = l1[1] == l2[1] and l1[0].overlaps(l2[0])
-        if not (same12 or l1[0].real > l2[0].real):
-            return False, f"{name}: lam1 and lam2 are not separated", ev[:4]
-        if l3[1] == l2[1] and l3[0].overlaps(l2[0]):
-            return False, f"{name}: lam2 = lam3 = {_show(l2)} (multiplicity {l2[2]}): a tie", ev[:4]
-        if not all(abs(t[0]) < l2[0].real for t in rest[2:]):
-            return False, f"{name}: |lam3| is not certainly below lam2 = {_show(l2)}", ev[:4]
+        why = (f"eigenvalue 1 has multiplicity {len(ev) - len(rest)}" if len(ev) - len(rest) != 1 else
+               "an eigenvalue other than 1 is not certainly inside the unit disc"
+               if any(not abs(t[0]) < 1 for t in rest) else  # reviewed (tests/certify/test_arb_comparisons.py)
+               _not_simple_positive("lam1", l1) or _not_simple_positive("lam2", l2) or
+               ("lam1 and lam2 are not separated" if not (same12 or l1[0].real > l2[0].real) else
+                f"lam2 = lam3 = {_show(l2)} (multiplicity {l2[2]}): a tie" if l3[1] == l2[1] and l3[0].overlaps(l2[0])
+                else f"|lam3| is not certainly below lam2 = {_show(l2)}"
+                if not all(abs(t[0]) < l2[0].real for t in rest[2:]) else None))
+        if why:
+            return False, f"{name}: {why}", ev[:4]
         lead = (f"lam1 = lam2 = {_show(l1)} (double, non-defective)" if same12 else
                 f"lam1 = {_show(l1)} > lam2 = {_show(l2)} (simple)")
         return True, f"{name}: 1 simple; {lead} > |lam3| = {_show(l3)}", ev[:4]
 
 
-def _not_simple_positive(name, lab, t):
-    """Why the eigenvalue t is not certainly real, positive and non-defective (None when it is)."""
+def _not_simple_positive(lab, t):  # why the entry t is not certainly real, positive and non-defective
     if not (t[0].imag.is_zero() and t[0].real > 0):
-        return f"{name}: {lab} = {_show(t)} is not certainly real and positive"
+        return f"{lab} = {_show(t)} is not certainly real and positive"
     if t[3] < t[2]:
-        return f"{name}: {lab} = {_show(t)} lies in a Jordan block (algebraic multiplicity {t[2]}, geometric {t[3]})"
+        return f"{lab} = {_show(t)} lies in a Jordan block (algebraic multiplicity {t[2]}, geometric {t[3]})"
     return None
-
-
-def _show(t):
-    z, p = t[0], t[1]
-    if p.degree() == 1:
-        return str(-p[0] / p[1])
-    return z.real.str(5, radius=False)

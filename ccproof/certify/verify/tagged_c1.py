@@ -1,104 +1,36 @@
-"""Certificates for tagged configurations (schema ``ccproof.tagged-c1/1``): "C1" and "not C1" (trusted).
+"""Tagged certificates of one configuration (schema ``ccproof.tagged-c1/1``), "C1" and "not C1" (trusted).
 
-The statement is derived from the configuration name alone (:mod:`.tagged`: the sector matrix S from
-OpenSubdiv's rules, its exact spectrum; for N, K >= 5 the same spectrum and the leading eigenvectors
-through the modes of :mod:`.tagged_modes`, in O(N) for creases and corners). A ``"not C1"``
-certificate names a control net
-P = (x, y, z) whose three coordinates are eigenvectors of S, with eigenvalues alpha, beta, gamma,
-alpha >= gamma > 0 and beta >= gamma, and a sharp ray r and a quadrant q. The verifier derives each
-eigenvector itself (exactly for a rational eigenvalue, given its values on the crease points; in arb
-for an irrational simple eigenvalue, whose crease values are exactly 0 because it is no eigenvalue of
-the crease block) and checks:
-
-* B (boundary segment): x = y = 0 on every crease point of r's limit curve (the centre and ray r; for a
-  crease centre both sharp rays; exact rationals), z's limit position at v is 0 (the crease limit mask
-  (e0 + 4 V + e1)/6 of a crease centre, V of a corner) and the limit position (z(C) + 4 z(r1) + z(r2))/6
-  of r's first point is not 0. Every limit point of that curve is an affine combination of crease
-  points, so the curve lies on the z-axis; it joins v = 0 to the limit of r's first point at every
-  level m (scaled by gamma^m != 0), so the limit surface contains a segment of the z-axis ending at v.
-  A C1 surface (with boundary) at v has e_z in its tangent plane T_v.
-* N (normal): at the regular vertex (1, 1) of quadrant q (valence 4, smooth edges: its 1-ring evolves
-  by the regular rules alone) the limit tangents are the B-spline masks T_a = sum w'(a) w(b) P(a, b),
-  T_b = sum w(a) w'(b) P(a, b), w = (1, 4, 1)/6, w' = (-1, 0, 1)/2, and J_xy = T_a(x) T_b(y) - T_b(x) T_a(y)
-  is certainly not 0. S^m P = (alpha^m x, beta^m y, gamma^m z + m gamma^(m-1) u), u = (S - gamma) z (0 for an
-  eigenvector; a generalized z needs gamma < beta, and u vanishes on the crease points so the boundary
-  curve of B is unchanged). The normal at the level-m copy p_m of that vertex, divided by
-  alpha^m beta^m, has the z-component J_xy and x-, y-components O(m (gamma/beta)^m) (or bounded when
-  gamma = beta and z is an eigenvector), so every limit n of the unit normals at p_m -> v has n_z != 0.
-
-A C1 surface at v would have a continuous unit normal, n(v) = lim n(p_m), orthogonal to T_v, which
-holds e_z: n_z = 0, a contradiction. So the limit surface of this control net is not C1 at v.
-
-G (generic): alpha = lam1 and beta = lam2 are the two leading eigenvalues of S below 1 (every other
-eigenvalue certainly smaller in modulus than beta, or beta itself), gamma is the crease block's largest
-eigenvalue below 1 (the tangent of the crease curve of a generic net), and no eigenvalue of modulus
-possibly >= beta is defective (a Jordan block below beta adds terms o(beta^m)). Then the witness is not
-a degenerate net: for every net whose lam1-, lam2- and gamma-coefficients a1, a2, a3 are linearly
-independent the same leading terms give the same contradiction (docs/tagged_c1.md), an open dense set
-of nets.
-
-Two witnesses beyond that generic pair, part G of each in :mod:`.tagged_refute`: a dart's flip (x, y and a
-quadrant; alpha beta < 0, part F: J_xy != 0, the normal changes sign with every level) and a Jordan chain
-(N < 5: y a generalized eigenvector of beta = gamma, part N on J_xe with e = (S - beta) y).
-
-A ``"C1"`` certificate (the generalized Reif criterion for a sector): the spectral part
-(:func:`.tagged.leading_spectrum`: 1 simple, lam1 >= lam2 > |others| real and non-defective), a tangent
-plane that sees the crease (lam1 or lam2 an eigenvalue of the crease block), the eigenvectors x of lam1
-and y of lam2 (hints: ``map``), and the characteristic map Phi = (X, Y) regular and injective on the
-sector (:func:`.tagged_map.check_map` on the boxes of ``parts``; docs/tagged_c1.md).
+"C1": the spectral part, the crease seen, the eigenvectors x, y, the map (:func:`.tagged_map.check_map`). "not C1":
+a witness net's x, y, z, part G (the generic pair; a dart's flip; a Jordan chain), then B and N (a flip: F). The
+arguments are in docs/tagged_c1.md, "What a certificate states" and "Two refutations beyond the generic pair".
 """
 
 from __future__ import annotations
 
-from flint import arb, arb_mat, ctx, fmpq, fmpq_mat
+from flint import arb, arb_mat, ctx, fmpq, fmpq_mat, fmpq_poly
 
+from . import tagged as tg
 from .c1 import read_prec
 from .errors import CertificateError
 from .record import exact_keys, field_of
-from .registry import TAGGED_SCHEMA
 from .replay import parse_decimal
-from .tagged import (
-    crease_block,
-    crease_points,
-    eigenvalues,
-    labels,
-    leading_spectrum,
-    parse_configuration,
-    sector_matrix,
-    sector_rows,
-    sharp_rays,
-)
 from .tagged_map import all_zero, check_map
 from .tagged_modes import MIN_N, bordered_solve, kernel_basis, mode_spectrum, normalized_vector
-from .tagged_refute import chain_generic, chain_top, flip_generic, mode_generic, mode_lead_why, ordering, same_root
 
 LIMIT_MASK = (fmpq(1, 6), fmpq(4, 6), fmpq(1, 6))  # a cubic B-spline's limit weights on three control points
 TANGENT_MASK = (fmpq(-1, 2), fmpq(0), fmpq(1, 2))  # and its tangent's
+G_GENERIC = ("G generic: alpha = lam1, beta = lam2, gamma = the crease block's largest eigenvalue below 1; "
+             "no Jordan block at |lam| >= beta; gamma < beta for a generalized z")
+_G_FLIP = ("G generic: alpha, beta simple, of opposite signs, each larger in modulus than every other eigenvalue "
+           "but 1 (simple)")
+_G_CHAIN = ("G generic (Jordan chain): alpha = lam1 simple > beta = gamma, the crease block's largest eigenvalue "
+            "below 1; Jordan blocks at beta of size <= 2, y's chain tops at e; every other |lam| < beta")
 
 
 def verify_tagged(cert, part, log):
-    """Check a tagged-configuration certificate (module docstring) into ``part``.
+    """Check a tagged certificate (``witness`` for "not C1", ``map`` and ``parts`` for "C1") into ``part``; the
+    configuration name, or CertificateError on a malformed certificate.
 
-    Parameters
-    ----------
-    cert : dict
-        ``schema``, ``configuration``, ``statement``, ``prec``; ``witness`` (``"not C1"``) or
-        ``map`` and ``parts`` (``"C1"``).
-    part : Recorder
-    log : callable (str) -> None
-
-    Returns
-    -------
-    str
-        The configuration name (for the verdict).
-
-    Raises
-    ------
-    CertificateError
-        On a malformed certificate.
-
-    Examples
-    --------
     >>> import json
     >>> from ccproof.tables.format import certificates_dir
     >>> from ccproof.certify.verify.record import Recorder, VerifyResult
@@ -108,16 +40,15 @@ def verify_tagged(cert, part, log):
     ('crease:5', True)
     """
     statement = field_of(cert, "statement", str, "certificate")  # "C1" or "not C1": the registry's route took it
-    keys = ("schema", "configuration", "statement", "prec") + (("witness",) if statement == "not C1" else
-                                                                ("map", "parts"))
-    exact_keys(cert, keys, "certificate")
+    exact_keys(cert, ("schema", "configuration", "statement", "prec") + (
+        ("witness",) if statement == "not C1" else ("map", "parts")), "certificate")
     name = field_of(cert, "configuration", str, "certificate")
-    fam, n = parse_configuration(name)
+    fam, n = tg.parse_configuration(name)
     prec = read_prec(cert)
     log(f"{statement} certificate for {name} ({prec} bits)")
-    rows = sector_rows(fam, n)
-    ok = all(sum(row.values(), fmpq(0)) == 1 for row in rows)
-    part("S sector matrix derived from the rules", ok, f"{len(rows)} points, rows sum to 1 (exact)")
+    rows = tg.sector_rows(fam, n)
+    part("S sector matrix derived from the rules", all(sum(row.values(), fmpq(0)) == 1 for row in rows),
+         f"{len(rows)} points, rows sum to 1 (exact)")
     with ctx.workprec(prec):
         if statement == "C1":
             _verify_c1(cert, fam, n, prec, part)
@@ -127,89 +58,82 @@ def verify_tagged(cert, part, log):
 
 
 def _verify_c1(cert, fam, n, prec, part):
-    """A "C1" certificate: the spectral part, the crease seen, x and y, the map. A dart with K >= MIN_N takes
-    :func:`.tagged_modes.mode_spectrum` (every eigenvalue enclosed, S_E's exactly, the odd half's through the
-    modes; lam1 and lam2 each isolated, so simple; x and y in closed form (odd) or from S_E (even)); every
-    other configuration its exact spectrum (:func:`.tagged.leading_spectrum`, :func:`eigenvector_of`)."""
+    """The spectral part (a dart with K >= MIN_N: the mode list, lam1 and lam2 isolated; else the exact spectrum),
+    the crease seen, x and y, the map."""
     modes = fam == "dart" and n >= MIN_N
     if modes:
         ev = mode_spectrum("dart", n)
         i1, i2, why, msg = _dart_leading(n, ev)
         ok, lead = why is None, (None, i1, i2)
     else:
-        ok, msg, lead = leading_spectrum(fam, n, prec)
+        ok, msg, lead = tg.leading_spectrum(fam, n, prec)
     part("spectral part of the generalized Reif criterion", ok, msg)
     if ok and fam != "dart":
-        cpoly = crease_block(fam, n).charpoly()
+        cpoly = tg.crease_block(fam, n).charpoly()
         ok = any(t[1].gcd(cpoly).degree() > 0 for t in lead[1:3])
         part("the tangent plane sees the crease: lam1 or lam2 is an eigenvalue of the crease block", ok,
              "" if ok else "both eigenvectors vanish on the crease points, so the characteristic map "
              "sends the sharp edges to v (not injective)")
     if part.failed:
         return
-    mp, orient = _map_field(cert)
+    mp = field_of(cert, "map", dict, "certificate")
+    exact_keys(mp, ("x", "y", "orientation"), "map")
+    if mp["orientation"] not in (1, -1) or isinstance(mp["orientation"], bool):
+        raise CertificateError("map.orientation must be 1 or -1")
     vecs, vals = {}, {}
     for c, t in (("x", lead[1]), ("y", lead[2])):
         if modes:
             val, (_, vec, msg) = ev[t][0].real, _mode_coordinate(fam, n, ev, field_of(mp, c, dict, "map"), c, t)
         else:
             val, vec, msg = eigenvector_of(fam, n, field_of(mp, c, dict, "map"), c, prec)
-        ok = vec is not None and (modes or same_root(t, val))
+        ok = vec is not None and (modes or _same_root(t, val))
         part(f"{c}: eigenvector of lam{'1' if c == 'x' else '2'}", ok,
              msg if vec is None or ok else "not the eigenvalue of lam1 / lam2")
         if not ok:
             return
         vals[c], vecs[c] = val, vec
-    check_map(fam, n, vecs["x"], vecs["y"], vals["x"], vals["y"], orient,
+    check_map(fam, n, vecs["x"], vecs["y"], vals["x"], vals["y"], mp["orientation"],
               field_of(cert, "parts", dict, "certificate"), prec, part)
 
 
-def _map_field(cert):
-    mp = field_of(cert, "map", dict, "certificate")
-    exact_keys(mp, ("x", "y", "orientation"), "map")
-    orient = mp["orientation"]
-    if orient not in (1, -1) or isinstance(orient, bool):
-        raise CertificateError("map.orientation must be 1 or -1")
-    return mp, orient
-
-
-def _where(t):
-    return f"mode {t[3]}" if t[3] else "even"
-
-
-def _isolated(ev, lo_hi, c):
-    """The index of the one entry of ``ev`` certainly inside the decimal interval [low, high] with no
-    other entry touching it, else None."""
+def _isolated_coordinate(ev, spec, c, cp, cval, simple, what, solve):
+    """(i, vector, message) of a coordinate whose [low, high] isolates the entry i of ``ev`` (certainly inside, no
+    other touching it), real, ``simple(i)``, its crease values 0; ``solve(i, pivot)``: (vector or None, message).
+    (None, None, the reason) otherwise."""
+    lo_hi = field_of(spec, "eigenvalue", list, c)
     if len(lo_hi) != 2:
         raise CertificateError(f"{c}: the eigenvalue must be [low, high]")
     lo, hi = parse_decimal(lo_hi[0]), parse_decimal(lo_hi[1])
     inside = [j for j, t in enumerate(ev) if t[0].real > lo and t[0].real < hi]
     near = [j for j, t in enumerate(ev) if t[0].real.overlaps(arb(lo).union(arb(hi)))]
-    return inside[0] if len(inside) == 1 and near == inside else None
+    i = inside[0] if len(inside) == 1 and near == inside else None
+    if any(v != 0 for v in cval):
+        return None, None, "an irrational eigenvalue's eigenvector vanishes on the crease points"
+    if i is None or not ev[i][0].imag.is_zero() or not simple(i):
+        return None, None, f"[{lo_hi[0]}, {lo_hi[1]}] does not isolate {what}"
+    return (i,) + solve(i, _pivot(spec, c, len(ev), cp))
 
 
 def _dart_leading(k, ev):
     """(i1, i2, why, message): a dart's lam1 and lam2 in the mode list, why None when the spectral part holds."""
     rest = sorted((i for i, t in enumerate(ev) if abs(t[0]) < 1), key=lambda i: -abs(ev[i][0]).mid())
-    i1, i2 = rest[0], rest[1]
-    l1, l2 = ev[i1][0], ev[i2][0]
-    why = mode_lead_why(ev, i1, i2) or (
+    (i1, i2), (l1, l2) = rest[:2], (ev[rest[0]][0], ev[rest[1]][0])
+    why = _mode_lead_why(ev, i1, i2) or (
         "lam1 or lam2 is not certainly real and positive" if not all(z.imag.is_zero() and z.real > 0 for z in (l1, l2))
         else "lam1 > lam2 is not certain" if not l1.real > l2.real else None)
-    msg = (f"dart:{k}: 1 simple; lam1 = {l1.real.str(5, radius=False)} ({_where(ev[i1])}) > lam2 = "
-           f"{l2.real.str(5, radius=False)} ({_where(ev[i2])}), each simple"
+    where = [f"mode {ev[i][3]}" if ev[i][3] else "even" for i in (i1, i2)]
+    msg = (f"dart:{k}: 1 simple; lam1 = {l1.real.str(5, radius=False)} ({where[0]}) > lam2 = "
+           f"{l2.real.str(5, radius=False)} ({where[1]}), each simple"
            f" > |lam3| = {abs(ev[rest[2]][0]).str(5, radius=False)}" if why is None else f"dart:{k}: {why}")
     return i1, i2, why, msg
 
 
 def _verify_witness(w, fam, n, prec, part, log):
-    """A "not C1" witness: a crease's or corner's x, y, z, G, then B and N (module docstring); a dart's flip
-    (x, y, quadrant; :mod:`.tagged_refute`): x, y eigenvectors of simple eigenvalues of opposite signs leading
-    the spectrum, and J_xy != 0 (part F): the normal flips at every level."""
+    """A "not C1" witness: x, y (, z), G, then B and N; a dart's flip (x, y, quadrant): G and F."""
     dart = fam == "dart"
     exact_keys(w, ("x", "y", "quadrant") if dart else ("x", "y", "z", "ray", "quadrant"), "witness")
     r, q = 0 if dart else field_of(w, "ray", int, "witness"), field_of(w, "quadrant", int, "witness")
-    if r not in sharp_rays(fam, n) or not 0 <= q < n:
+    if r not in tg.sharp_rays(fam, n) or not 0 <= q < n:
         raise CertificateError(f"witness: quadrant {q} outside 0..{n - 1}" if r == 0 or r == n else
                                f"witness: ray {r} is not sharp")
     if dart and n >= MIN_N:
@@ -222,9 +146,8 @@ def _verify_witness(w, fam, n, prec, part, log):
     if not dart:
         check_boundary(fam, n, r, vecs, part)
     J = _jacobian(fam, n, q, vecs["x"], second)
-    ok = J > 0 or J < 0
     part(f"F flip at vertex (1,1) of quadrant {q}: J_xy != 0, so the normal there is (alpha beta)^m J_xy e_z + "
-         "o(|alpha beta|^m)" if dart else f"N normal at vertex (1,1) of quadrant {q}: {label} != 0", ok,
+         "o(|alpha beta|^m)" if dart else f"N normal at vertex (1,1) of quadrant {q}: {label} != 0", J > 0 or J < 0,
          f"{label} = {J.str(6)}")
     if not part.failed:
         log(f"  the limit surface of this net is not C1 at the dart vertex: the unit normals at the level-m copies "
@@ -233,40 +156,31 @@ def _verify_witness(w, fam, n, prec, part, log):
             f"copies of quadrant {q}'s (1,1) tend to n_z != 0, yet e_z lies in T_v (ray {r})")
 
 
-G_GENERIC = ("G generic: alpha = lam1, beta = lam2, gamma = the crease block's largest eigenvalue below 1; "
-      "no Jordan block at |lam| >= beta; gamma < beta for a generalized z")
-
-
 def _witness_exact(fam, n, w, prec, part):
-    """Parts x, y, z (a dart: x, y) and G on the exact spectrum (N < MIN_N); (vectors, the vector paired with x
-    in part N or F, its name) or None. A generalized y (a Jordan chain at beta) pairs x with its top
-    e = (S - beta) y (:func:`.tagged_refute.chain_generic`)."""
+    """Parts x, y (, z) and G on the exact spectrum: (vectors, the vector paired with x in N or F, its name) or
+    None; a generalized y (a Jordan chain at beta) pairs x with its top e = (S - beta) y."""
     vecs, vals, tops = {}, {}, {}
     for c in ("x", "y") if fam == "dart" else ("x", "y", "z"):
         vals[c], vecs[c], msg = eigenvector_of(fam, n, field_of(w, c, dict, "witness"), c, prec,
                                                c != "x" and fam != "dart")
-        tops[c] = None if vecs[c] is None else chain_top(fam, n, vals[c], vecs[c])
+        tops[c] = None if vecs[c] is None else _chain_top(fam, n, vals[c], vecs[c])
         part(f"{c}: {'(generalized) ' if c == 'z' or tops[c] else ''}eigenvector of S", vecs[c] is not None, msg)
         if vecs[c] is None:
             return None
     if fam == "dart":
-        ok, msg = flip_generic(n, vals["x"], vals["y"], prec)
-        part("G generic: alpha, beta simple, of opposite signs, each larger in modulus than every other eigenvalue "
-             "but 1 (simple)", ok, msg)
-        return (vecs, vecs["y"], "J_xy") if ok else None
-    if tops["y"] is not None:
-        ok, msg = chain_generic(fam, n, vals, tops, prec)
-        part("G generic (Jordan chain): alpha = lam1 simple > beta = gamma, the crease block's largest eigenvalue "
-             "below 1; Jordan blocks at beta of size <= 2, y's chain tops at e; every other |lam| < beta", ok, msg)
-        return (vecs, tops["y"], "J_xe") if ok else None
-    ok, msg = ordering(fam, n, vals["x"], vals["y"], vals["z"], prec, tops["z"] is not None)
-    part(G_GENERIC, ok, msg)
-    return (vecs, vecs["y"], "J_xy") if ok else None
+        (ok, msg), title, second = _flip_generic(n, vals["x"], vals["y"], prec), _G_FLIP, "J_xy"
+    elif tops["y"] is not None:
+        (ok, msg), title, second = _chain_generic(fam, n, vals, tops, prec), _G_CHAIN, "J_xe"
+    else:
+        (ok, msg), title, second = _ordering(fam, n, *(vals[c] for c in "xyz"), prec, tops["z"] is not None), \
+            G_GENERIC, "J_xy"
+    part(title, ok, msg)
+    return (vecs, tops["y"] if second == "J_xe" else vecs["y"], second) if ok else None
 
 
 def _witness_modes(fam, n, w, part):
-    """Parts x, y, z and G for crease:N, corner:N, N >= MIN_N, from :mod:`.tagged_modes`: x and y
-    eigenvectors of simple mode roots (closed form), z's existence from its crease values."""
+    """Parts x, y, z and G for crease:N, corner:N, N >= MIN_N: x and y eigenvectors of simple mode roots (closed
+    form), z's existence from its crease values."""
     ev = mode_spectrum(fam, n)
     vecs, at = {}, {}
     for c in ("x", "y"):
@@ -274,104 +188,101 @@ def _witness_modes(fam, n, w, part):
         part(f"{c}: eigenvector of S", vecs[c] is not None, msg)
         if vecs[c] is None:
             return None
-    gz = _mode_z(fam, n, ev, field_of(w, "z", dict, "witness"), part)
-    if gz is None:
-        return None
-    g, cval = gz
-    ia, ib = at["x"], at["y"]
-    beta = ev[ib][0].real
-    why = mode_generic(ev, ia, ib, g, crease_block(fam, n))
-    part(G_GENERIC, why is None, f"alpha = {ev[ia][0].real.str(8)} > beta = {beta.str(8)} > |every other| (each "
-         f"simple), 1 simple; gamma = {g} < beta" if why is None else why)
-    if why is not None:
-        return None
-    cp = crease_points(fam, n)
-    vecs["z"] = [cval[cp.index(i)] if i in cp else None for i in range(len(ev))]  # B reads the crease points only
-    return vecs, vecs["y"], "J_xy"
-
-
-def _mode_coordinate(fam, n, ev, spec, c, want=None):
-    """(index in ``ev`` = :func:`.tagged_modes.mode_spectrum`, eigenvector with 1 at the pivot, message) of x or y,
-    or (None, None, the reason): [low, high] isolates one real root of a mode (or a dart's even part; the
-    entry ``want``, a dart's lam1 or lam2, when given), whose eigenvector vanishes on the crease points."""
-    exact_keys(spec, ("eigenvalue", "crease", "pivot"), c)
-    crease, lo_hi = field_of(spec, "crease", list, c), field_of(spec, "eigenvalue", list, c)
-    cp = [] if fam == "dart" else crease_points(fam, n)
-    if len(crease) != len(cp):
-        raise CertificateError(f"{c}: crease values must be {len(cp)} decimals (a dart's crease [])")
-    i = _isolated(ev, lo_hi, c)  # checks the [low, high] form
-    if any(parse_decimal(v) != 0 for v in crease):
-        return None, None, "an irrational eigenvalue's eigenvector vanishes on the crease points"
-    if i is None or want not in (None, i) or not ev[i][0].imag.is_zero() or ev[i][3] is None and fam != "dart":
-        what = ("one simple real root of a mode" if want is None else
-                f"lam{'1' if c == 'x' else '2'}: not the eigenvalue of lam1 / lam2")
-        return None, None, f"[{lo_hi[0]}, {lo_hi[1]}] does not isolate {what}"
-    pivot = field_of(spec, "pivot", int, c)
-    if not 0 <= pivot < len(ev) or pivot in cp:
-        raise CertificateError(f"{c}: pivot must index a non-crease point")
-    vec, j = normalized_vector(fam, n, ev, i, pivot), ev[i][3]
-    if vec is None:
-        return None, None, (f"the eigenvector is not certainly non-zero at the pivot {pivot} (or its system not "
-                            "certainly regular)")
-    how = (", simple; even: the bordered system on S_E" if j is None else
-           f" = lam(cos({2 * j if fam == 'dart' else j} pi/{n})), simple; closed form in mode {j}: its 6x6 system")
-    return i, vec, f"eigenvalue {ev[i][0].real.str(10)}{how} proved regular, pivot {labels(fam, n)[pivot]}"
-
-
-
-def read_z(spec):
-    """(gamma, crease values) of a witness's z: ``{"eigenvalue": decimal, "crease": 5 decimals}``, read exactly."""
-    exact_keys(spec, ("eigenvalue", "crease"), "z")
-    g, cval = field_of(spec, "eigenvalue", str, "z"), field_of(spec, "crease", list, "z")
-    if len(cval) != 5:
-        raise CertificateError("z: crease values must be 5 decimals")
-    return parse_decimal(g), [parse_decimal(v) for v in cval]
-
-
-def crease_eigen_why(C, g, cval):
-    """None when C c = g c exactly with c != 0 (c the crease values), else the reason."""
-    Cc = C * fmpq_mat([[v] for v in cval])
-    ok = any(v != 0 for v in cval) and all(Cc[i, 0] == g * v for i, v in enumerate(cval))
-    return None if ok else f"no eigenvector for {g} with the given crease values (C c = {g} c, c != 0 fails)"
-
-
-def _mode_z(fam, n, ev, spec, part):
-    """(gamma, crease values) once C c = gamma c exactly and gamma is at most a simple eigenvalue of I."""
-    g, cval = read_z(spec)
+    g, cval = read_z(field_of(w, "z", dict, "witness"))
     at_g = [t for t in ev if t[2] == "I" and (t[1] == g if t[1] is not None else t[0].real.overlaps(arb(g)))]
-    why = crease_eigen_why(crease_block(fam, n), g, cval) or (
+    why = crease_eigen_why(tg.crease_block(fam, n), g, cval) or (
         f"{g} is possibly a multiple eigenvalue of I" if len(at_g) > 1 else None)
     part("z: (generalized) eigenvector of S", why is None,
          f"eigenvalue {g}: C c = {g} c exactly on the crease points, and {g} is at most a simple eigenvalue of I, so "
          f"some z with these crease values has (S - {g})^2 z = 0 and (S - {g}) z = 0 on the crease points"
          if why is None else why)
-    return None if why is not None else (g, cval)
+    if why is not None:
+        return None
+    ia, ib = at["x"], at["y"]
+    why = _mode_lead_why(ev, ia, ib) or _crease_top_why(tg.crease_block(fam, n), g) or (
+        "gamma < beta is not certain" if not arb(g) < ev[ib][0].real else None)
+    part(G_GENERIC, why is None, f"alpha = {ev[ia][0].real.str(8)} > beta = {ev[ib][0].real.str(8)} > |every other| "
+         f"(each simple), 1 simple; gamma = {g} < beta" if why is None else why)
+    if why is not None:
+        return None
+    cp = tg.crease_points(fam, n)
+    vecs["z"] = [cval[cp.index(i)] if i in cp else None for i in range(len(ev))]  # B reads the crease points only
+    return vecs, vecs["y"], "J_xy"
+
+
+def _crease_values(spec, c, cp):  # the crease values of a coordinate, one decimal per crease point
+    crease = field_of(spec, "crease", list, c)
+    if len(crease) != len(cp):
+        raise CertificateError(f"{c}: crease values must be {len(cp)} decimals" + ("" if cp else
+                                                                                   " (a dart's crease [])"))
+    return [parse_decimal(v) for v in crease]
+
+
+def _pivot(spec, c, m, cp):  # the pivot of a coordinate: a non-crease point
+    pivot = field_of(spec, "pivot", int, c)
+    if not 0 <= pivot < m or pivot in cp:
+        raise CertificateError(f"{c}: pivot must index a non-crease point")
+    return pivot
+
+
+def _mode_coordinate(fam, n, ev, spec, c, want=None):
+    """(index in the mode list ``ev``, eigenvector with 1 at the pivot, message) of x or y, or (None, None, the
+    reason): [low, high] isolates one simple real root of a mode (a dart's even part too; the entry ``want``,
+    a dart's lam1 or lam2, when given), whose eigenvector vanishes on the crease points."""
+    exact_keys(spec, ("eigenvalue", "crease", "pivot"), c)
+    cp = [] if fam == "dart" else tg.crease_points(fam, n)
+
+    def solve(i, pivot):
+        vec, j = normalized_vector(fam, n, ev, i, pivot), ev[i][3]
+        if vec is None:
+            return None, f"the eigenvector is not certainly non-zero at the pivot {pivot} (or its system not " \
+                         "certainly regular)"
+        how = (", simple; even: the bordered system on S_E" if j is None else
+               f" = lam(cos({2 * j if fam == 'dart' else j} pi/{n})), simple; closed form in mode {j}: its 6x6 system")
+        return vec, f"eigenvalue {ev[i][0].real.str(10)}{how} proved regular, pivot {tg.labels(fam, n)[pivot]}"
+    return _isolated_coordinate(ev, spec, c, cp, _crease_values(spec, c, cp),
+                                lambda i: want in (None, i) and (ev[i][3] is not None or fam == "dart"),
+                                "one simple real root of a mode" if want is None else
+                                f"lam{'1' if c == 'x' else '2'}: not the eigenvalue of lam1 / lam2", solve)
+
+
+def read_z(spec):
+    """(gamma, crease values) of a witness's z ``{"eigenvalue": decimal, "crease": 5 decimals}``, read exactly.
+
+    >>> read_z({"eigenvalue": "0.5", "crease": ["0", "1", "2", "0", "0"]})
+    (1/2, [0, 1, 2, 0, 0])
+    """
+    exact_keys(spec, ("eigenvalue", "crease"), "z")
+    return parse_decimal(field_of(spec, "eigenvalue", str, "z")), _crease_values(spec, "z", range(5))
+
+
+def crease_eigen_why(C, g, cval):
+    """None when C c = g c exactly with c != 0 (c the crease values), else the reason.
+
+    >>> crease_eigen_why(tg.crease_block("corner", 7), fmpq(1, 2), [0, 1, 2, 0, 0])
+    """
+    Cc = C * fmpq_mat([[v] for v in cval])
+    ok = any(v != 0 for v in cval) and all(Cc[i, 0] == g * v for i, v in enumerate(cval))
+    return None if ok else f"no eigenvector for {g} with the given crease values (C c = {g} c, c != 0 fails)"
 
 
 def eigenvector_of(fam, n, spec, c, prec, chain=False):
-    """(eigenvalue, vector, message); vector None with the reason when the claim fails. With ``chain``
-    a rational eigenvalue may also have a generalized eigenvector z: (S - lam)^2 z = 0, (S - lam) z != 0."""
+    """(eigenvalue, vector, message) of a coordinate on the exact spectrum (vector None with the reason when the
+    claim fails): a rational eigenvalue exactly (with ``chain`` also a generalized eigenvector z: (S - lam)^2 z = 0,
+    (S - lam) z != 0 and 0 on the crease points), an irrational one by the bordered system in arb.
+
+    >>> eigenvector_of("crease", 2, {"eigenvalue": "0.5", "crease": ["0", "1", "2", "-1", "-2"]}, "x", 64)[2]
+    'eigenvalue 1/2; S v = 1/2 v exactly'
+    """
     exact_keys(spec, ("eigenvalue", "crease", "pivot") if "pivot" in spec else ("eigenvalue", "crease"), c)
-    crease = field_of(spec, "crease", list, c)
-    cp = crease_points(fam, n) if fam != "dart" else []  # a dart's sharp ray is no closed block
-    if len(crease) != len(cp):
-        raise CertificateError(f"{c}: crease values must be {len(cp)} decimals")
-    cval = [parse_decimal(v) for v in crease]
-    if isinstance(spec["eigenvalue"], str):  # rational eigenvalue: exact
-        return _exact_eigenvector(fam, n, spec, c, cp, cval, chain)
-    return _ball_eigenvector(fam, n, spec, c, cp, cval, prec)
-
-
-def _exact_eigenvector(fam, n, spec, c, cp, cval, chain):
-    S = sector_matrix(fam, n)
-    m = S.nrows()
+    cp = [] if fam == "dart" else tg.crease_points(fam, n)  # a dart's sharp ray is no closed block
+    cval, S = _crease_values(spec, c, cp), tg.sector_matrix(fam, n)
+    if not isinstance(spec["eigenvalue"], str):  # an irrational eigenvalue, [low, high]
+        return _ball_eigenvector(fam, n, spec, c, cp, cval, prec)
     lam = parse_decimal(spec["eigenvalue"])
-    A = S - lam * fmpq_mat([[1 if i == j else 0 for j in range(m)] for i in range(m)])
+    A = S - lam * fmpq_mat([[int(i == j) for j in range(S.nrows())] for i in range(S.nrows())])
     if "pivot" in spec:  # one more fixed coordinate: 1 at the pivot
-        pv = field_of(spec, "pivot", int, c)
-        if not 0 <= pv < m or pv in cp:
-            raise CertificateError(f"{c}: pivot must index a non-crease point")
-        cp, cval = cp + [pv], cval + [fmpq(1)]
+        cp, cval = cp + [_pivot(spec, c, S.nrows(), cp)], cval + [fmpq(1)]
     vec = _solve_exact(A, cp, cval)
     if vec is not None:
         return lam, vec, f"eigenvalue {lam}; S v = {lam} v exactly"
@@ -386,88 +297,74 @@ def _exact_eigenvector(fam, n, spec, c, cp, cval, chain):
 
 
 def _ball_eigenvector(fam, n, spec, c, cp, cval, prec):
-    ev, lo_hi = eigenvalues(fam, n, prec), field_of(spec, "eigenvalue", list, c)
-    i = _isolated(ev, lo_hi, c)  # checks the [low, high] form
-    if i is None or not ev[i][0].imag.is_zero() or ev[i][2] != 1:
-        return None, None, f"[{lo_hi[0]}, {lo_hi[1]}] does not isolate one simple real eigenvalue of {fam}:{n}"
-    z, p = ev[i][0], ev[i][1]
-    if any(v != 0 for v in cval):
-        return None, None, "an irrational eigenvalue's eigenvector vanishes on the crease points"
-    if cp and p.gcd(crease_block(fam, n).charpoly()).degree() > 0:
-        return None, None, "the eigenvalue is one of the crease block's"
-    pivot = field_of(spec, "pivot", int, c)
-    S = sector_matrix(fam, n)
-    free = [i for i in range(S.nrows()) if i not in cp]
-    if pivot not in free:
-        raise CertificateError(f"{c}: pivot must index a non-crease point")
-    lam = z.real
-    try:
-        sol = bordered_solve([[arb(S[i, j]) for j in free] for i in free], lam, free.index(pivot), arb_mat)
-    except ZeroDivisionError:
-        return None, None, f"the system for the eigenvector of {lam.str(8)} (pivot {pivot}) is not certainly regular"
-    vec = [arb(0)] * S.nrows()
-    for k, i in enumerate(free):
-        vec[i] = sol[k]
-    return lam, vec, f"eigenvalue {lam.str(10)} (simple root of {p}); vector in arb, pivot {labels(fam, n)[pivot]}"
+    ev, S = tg.eigenvalues(fam, n, prec), tg.sector_matrix(fam, n)
+    free = [j for j in range(S.nrows()) if j not in cp]
+
+    def solve(i, pivot):
+        if cp and ev[i][1].gcd(tg.crease_block(fam, n).charpoly()).degree() > 0:
+            return None, "the eigenvalue is one of the crease block's"
+        try:
+            sol = dict(zip(free, bordered_solve([[arb(S[a, b]) for b in free] for a in free], ev[i][0].real,
+                                                free.index(pivot), arb_mat)))
+        except ZeroDivisionError:
+            return None, f"the system for the eigenvector of {ev[i][0].real.str(8)} (pivot {pivot}) is not certainly " \
+                         "regular"
+        return [sol.get(j, arb(0)) for j in range(S.nrows())], \
+            f"eigenvalue {ev[i][0].real.str(10)} (simple root of {ev[i][1]}); vector in arb, pivot " \
+            f"{tg.labels(fam, n)[pivot]}"
+    i, vec, msg = _isolated_coordinate(ev, spec, c, cp, cval, lambda i: ev[i][2] == 1,
+                                       f"one simple real eigenvalue of {fam}:{n}", solve)
+    return None if i is None else ev[i][0].real, vec, msg
 
 
 def _solve_exact(A, cp, cval):
-    """A vector v with A v = 0 exactly and v = cval on the points cp (free unknowns 0), or None."""
+    """A vector v != 0 with A v = 0 exactly and v = cval on the points cp (free unknowns 0), or None."""
     m = A.nrows()
     free = [i for i in range(m) if i not in cp]
     sol = kernel_basis(fmpq_mat([[A[i, j] for j in free] + [sum((A[i, j] * cval[k] for k, j in enumerate(cp)), fmpq(0))]
                                  for i in range(m)])).get(len(free))  # consistent iff the last column is free
     if sol is None:
         return None
-    vec = [fmpq(0)] * m
-    for k, j in enumerate(cp):
-        vec[j] = cval[k]
-    for k, j in enumerate(free):
-        vec[j] = sol[k]
+    vec = dict(zip(cp, cval)) | dict(zip(free, sol))
+    vec = [vec[j] for j in range(m)]
     return vec if any(v != 0 for v in vec) else None
 
 
 def check_boundary(fam, n, r, vecs, part):
-    """Part B into ``part``: ray r's limit curve lies on the z-axis (x = y = 0 exactly on the crease points of
-    ``fam:n``) and z's limit leaves v (0 at v, not 0 at ray r's first point); ``vecs`` {"x", "y", "z": values}."""
-    pts = labels(fam, n)
-    rays = sharp_rays(fam, n) if fam == "crease" else (r,)
-    on_curve = [0] + [pts.index(("r", s, a, 0)) for s in rays for a in (1, 2)]
-    zero_xy = all_zero(vecs[c][i] for c in ("x", "y") for i in on_curve)
+    """Part B into ``part``: ray r's limit curve lies on the z-axis (x = y = 0 exactly on its crease points) and
+    z's limit leaves v (0 at v, not 0 at ray r's first point); ``vecs`` {"x", "y", "z": values}."""
+    pts = tg.labels(fam, n)
+    on_curve = [0] + [pts.index(("r", s, a, 0)) for s in (tg.sharp_rays(fam, n) if fam == "crease" else (r,))
+                      for a in (1, 2)]
     z = vecs["z"]
-    r1, r2 = pts.index(("r", r, 1, 0)), pts.index(("r", r, 2, 0))
     exact = all(isinstance(z[i], fmpq) for i in on_curve)
     at_v = (z[0] if fam == "corner" else (z[pts.index(("r", 0, 1, 0))] + 4 * z[0] + z[pts.index(("r", n, 1, 0))]) / 6
             ) if exact else None
-    leave = (z[0] + 4 * z[r1] + z[r2]) / 6 if exact else None
-    ok = zero_xy and exact and at_v == 0 and leave != 0
+    leave = (z[0] + 4 * z[pts.index(("r", r, 1, 0))] + z[pts.index(("r", r, 2, 0))]) / 6 if exact else None
+    ok = all_zero(vecs[c][i] for c in ("x", "y") for i in on_curve) and exact and at_v == 0 and leave != 0
     part(f"B boundary segment: ray {r}'s limit curve lies on the z-axis and leaves v", ok,
          f"x = y = 0 on its crease points, limit z at v = 0, limit z of ray {r}'s first point = {leave}" if ok
          else "x or y not exactly 0 on the curve, or z's limit curve does not start at v = 0 and leave it")
 
 
-def _jacobian(fam, n, q, x, y):
-    pts = labels(fam, n)
+def _jacobian(fam, n, q, x, y):  # J_xy at the vertex (1,1) of quadrant q
+    pts = tg.labels(fam, n)
 
     def index(a, b):
         if (a, b) == (0, 0):
             return 0
-        if b == 0:
-            return pts.index(("r", q, a, 0))
         if a == 0:
             return pts.index(("r", (q + 1) % n if fam == "dart" else q + 1, b, 0))
-        return pts.index(("q", q, a, b))
+        return pts.index(("r", q, a, 0) if b == 0 else ("q", q, a, b))
 
     (xa, xb), (ya, yb) = (vertex_tangents({(a, b): v[index(a, b)] for a in range(3) for b in range(3)}) for v in (x, y))
     return xa * yb - xb * ya
 
 
 def vertex_tangents(val):
-    """(T_a, T_b), the limit tangents at a regular vertex from the values ``val[a, b]`` (a, b = 0, 1, 2) of its
-    1-ring: the B-spline masks sum w'(a) w(b) val and sum w(a) w'(b) val (an arb, or an acb from acb values).
+    """(T_a, T_b), the limit tangents at a regular vertex from its 1-ring's values ``val[a, b]`` (a, b = 0, 1, 2):
+    the B-spline masks sum w'(a) w(b) val and sum w(a) w'(b) val (arb, or acb from acb values).
 
-    Examples
-    --------
     >>> ta, tb = vertex_tangents({(a, b): fmpq(a + 2 * b) for a in range(3) for b in range(3)})
     >>> ta.contains(1), tb.contains(2)
     (True, True)
@@ -476,5 +373,129 @@ def vertex_tangents(val):
                  for da, db in ((TANGENT_MASK, LIMIT_MASK), (LIMIT_MASK, TANGENT_MASK)))
 
 
-__all__ = ["G_GENERIC", "LIMIT_MASK", "TAGGED_SCHEMA", "TANGENT_MASK", "check_boundary", "crease_eigen_why", "read_z",
-           "verify_tagged", "vertex_tangents"]
+# ----------------------------------------------------------------- part G (docs/tagged_c1.md, "not C1")
+def _same_root(t, v):
+    """Is v (an fmpq, or the arb ball of an irrational root) the root t[0] of the factor t[1]?"""
+    if isinstance(v, fmpq):
+        return t[1].degree() == 1 and -t[1][0] / t[1][1] == v
+    return t[1].degree() > 1 and t[0].real.overlaps(v) and t[0].imag.is_zero()
+
+
+def _find(ev, v, skip=()):  # the first entry other than 1 and those in skip with the root v
+    return next((i for i, t in enumerate(ev) if i not in skip and t[1] != tg.ONE and _same_root(t, v)), None)
+
+
+def _below(ev, skip, bounds, what, tie=None):
+    """The reason an entry other than 1, those in ``skip`` and roots equal to ``tie`` is not certainly below each
+    of ``bounds`` in modulus, or None."""
+    bad = [t for i, t in enumerate(ev) if i not in skip and t[1] != tg.ONE and not (
+        tie is not None and _same_root(t, tie)) and not all(abs(t[0]) < b for b in bounds)]
+    return f"an eigenvalue ({bad[0][0].str(6)}) is not certainly {what}" if bad else None
+
+
+def _one_simple(ev):
+    return None if sum(1 for t in ev if t[1] == tg.ONE) == 1 else "eigenvalue 1 is not simple"
+
+
+def _chain_top(fam, n, lam, vec):
+    """(S - lam) vec exactly, or None when vec is an eigenvector (or lam is not rational)."""
+    if not isinstance(lam, fmpq) or any(not isinstance(v, fmpq) for v in vec):
+        return None
+    u = tg.sector_matrix(fam, n) * fmpq_mat([[v] for v in vec])
+    top = [u[i, 0] - lam * vec[i] for i in range(len(vec))]
+    return top if any(v != 0 for v in top) else None
+
+
+def _flip_generic(n, a, b, prec):
+    """(ok, message): G of a dart's flip: 1 simple; alpha, beta simple, certainly of opposite signs, each certainly
+    larger in modulus than every other eigenvalue."""
+    ev = tg.eigenvalues("dart", n, prec)
+    ia = _find(ev, a)
+    ib = None if ia is None else _find(ev, b, (ia,))
+    A, B = (None, None) if ib is None else (ev[ia][0].real, ev[ib][0].real)
+    why = _one_simple(ev) or ("alpha or beta is not an eigenvalue (distinct from the other)" if ib is None else
+                              "alpha or beta is not a simple eigenvalue" if ev[ia][2] != 1 or ev[ib][2] != 1 else
+                              "alpha beta < 0 is not certain" if not (A > 0 and B < 0 or A < 0 and B > 0) else
+                              _below(ev, (ia, ib), (abs(A), abs(B)), "smaller in modulus than alpha and beta"))
+    if why:
+        return False, why
+    top = max((abs(t[0]) for i, t in enumerate(ev) if i not in (ia, ib) and t[1] != tg.ONE), key=lambda z: z.mid())
+    return True, (f"alpha = {A.str(8, radius=False)}, beta = {B.str(8, radius=False)}: alpha beta < 0, each simple, "
+                  f"> |every other| (at most {top.str(6, radius=False)}); 1 simple")
+
+
+def _chain_generic(fam, n, vals, tops, prec):
+    """(ok, message): G of a Jordan-chain witness; ``vals`` the eigenvalues of x, y, z, ``tops`` (S - lam) of each
+    (None for an eigenvector, :func:`chain_top`)."""
+    a, b, g = vals["x"], vals["y"], vals["z"]
+    if tops["y"] is None or tops["z"] is not None or tops["x"] is not None or not isinstance(b, fmpq):
+        return False, "y is no generalized eigenvector of a rational beta, or z or x is one"
+    if any(tops["y"][i] != 0 for i in tg.crease_points(fam, n)):
+        return False, "e = (S - beta) y is not 0 on the crease points"
+    ev = tg.eigenvalues(fam, n, prec)
+    ia = _find(ev, a)
+    at_b = [i for i, t in enumerate(ev) if _same_root(t, b)]
+    why = _one_simple(ev) or (
+        "alpha is not a simple eigenvalue" if ia is None or ev[ia][2] != 1 or ia in at_b else
+        "alpha > beta > 0 is not certain" if not (b > 0 and ev[ia][0].real > b) else
+        # beta's Jordan blocks have size <= 2 iff dim ker (S - beta)^2 is its algebraic multiplicity (exact)
+        f"a Jordan block of size > 2 at beta = {b}" if tg.kernel_dim(fam, n, fmpq_poly([-b, 1]) ** 2) != len(at_b) else
+        _below(ev, [ia, *at_b], (b,), "below beta in modulus") or _crease_top_why(tg.crease_block(fam, n), g) or
+        ("gamma is not beta" if g != b else None))
+    if why:
+        return False, why
+    return True, (f"alpha = {ev[ia][0].real.str(8, radius=False)} > beta = {b} = gamma > |every other|, 1 simple; "
+                  f"beta: algebraic multiplicity {len(at_b)}, geometric {ev[at_b[0]][3]}, Jordan blocks of size <= 2 "
+                  "(dim ker (S - beta)^2 = algebraic multiplicity); e = (S - beta) y != 0, 0 on the crease points")
+
+
+def _crease_top_why(C, g):
+    """None if g is the largest eigenvalue below 1 of the crease block C (its factors all linear), else the reason."""
+    fac = [p for p, _ in C.charpoly().factor()[1]]
+    if any(p.degree() > 1 for p in fac):
+        return "the crease block has irrational eigenvalues"
+    below = [-p[0] / p[1] for p in fac if -p[0] / p[1] < 1]
+    if not isinstance(g, fmpq) or not below or g != max(below):
+        return f"gamma is not the crease block's largest eigenvalue below 1 ({max(below) if below else None})"
+    return None
+
+
+def _mode_lead_why(ev, ia, ib):
+    """The reason 1 (from the crease block, or a dart's even part) is not simple or the entries ia, ib of the mode
+    list (:func:`.tagged_modes.mode_spectrum`) do not lead (alpha >= beta > |every other|), or None."""
+    one = [t for t in ev if not abs(t[0]) < 1]
+    beta = ev[ib][0].real
+    others = [t for i, t in enumerate(ev) if i not in (ia, ib) and t[1] != 1]
+    return ("x and y are the same eigenvector (beta is not an eigenvalue distinct from alpha)" if ia == ib else
+            "eigenvalue 1 is not simple" if len(one) != 1 or one[0][1] != 1 or one[0][2] not in ("C", "E") else
+            "alpha >= beta is not certain" if not ev[ia][0].real >= beta else
+            "an eigenvalue is not certainly below beta (lam1, lam2 not alpha, beta)"
+            if not all(abs(t[0]) < beta for t in others) else None)
+
+
+def _ordering(fam, n, a, b, g, prec, generalized):
+    """(ok, message): G of the generic pair: a = lam1 >= b = lam2 >= every other |lam| (1 simple, ties only with b
+    itself), g the crease block's largest eigenvalue below 1, every eigenvalue of modulus possibly >= b
+    non-defective, and g < b when z is a generalized eigenvector."""
+    ev = tg.eigenvalues(fam, n, prec)  # each root once per unit of algebraic multiplicity
+    ia = _find(ev, a)
+    ib = None if ia is None else _find(ev, b, (ia,))
+    beta = None if ib is None else abs(ev[ib][0])
+    why = _one_simple(ev) or (
+        "alpha is not an eigenvalue" if ia is None else "beta is not an eigenvalue (distinct from alpha's copy)"
+        if ib is None else "alpha >= beta is not certain" if not (abs(ev[ia][0]) >= beta or ev[ia][1] == ev[ib][1])
+        else _below(ev, (ia, ib), (beta,), "below beta (lam1, lam2 not alpha, beta)", b) or
+        _crease_top_why(tg.crease_block(fam, n), g) or _jordan_at(ev, beta) or
+        ("z is a generalized eigenvector but gamma < beta is not certain" if generalized and not arb(g) < beta
+         else None))
+    if why:
+        return False, why
+    show = [str(v) if isinstance(v, fmpq) else v.str(8) for v in (a, b)]
+    return True, (f"alpha = {show[0]}, beta = {show[1]}, gamma = {g}{' (Jordan chain)' if generalized else ''}; "
+                  "1 simple; no Jordan block at |lam| >= beta")
+
+
+def _jordan_at(ev, beta):  # the reason if an eigenvalue of modulus possibly >= beta is defective
+    bad = [t for t in ev if t[3] < t[2] and not abs(t[0]) < beta]
+    return (f"a Jordan block at |lam| >= beta: {bad[0][1]} (algebraic multiplicity {bad[0][2]}, geometric {bad[0][3]})"
+            if bad else None)

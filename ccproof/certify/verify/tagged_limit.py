@@ -1,49 +1,6 @@
-"""Every ``crease:N`` (or ``corner:N``) with N >= N0 in one "not C1" certificate (trusted).
-
-The witness of ``crease:N``, N >= 5 (:mod:`.tagged_c1`), has the same shape for every N: x and y the
-real eigenvectors of the modes 1 and 2 (alpha = lam(cos theta), beta = lam(cos 2 theta), theta = pi/N,
-lam(c) = (5 + c + sqrt((1 + c)(9 + c)))/16), z the crease tangent of gamma = 1/2, ray 0, quadrant 0.
-This module checks each of its parts for every N >= N0 at once (docs/tagged_c1.md, "Every N >= N0"):
-
-1. **S for every N from one window.** Each row of S is the translate of one stencil that depends on the
-   point's position and on how far it is from the sharp rays 0 and N (the ring stencil reaches the
-   sectors t - 1 .. t + 2, :func:`.tagged_modes.check_ring`): on its window class
-   (min(t, 3), min(N - t, 3)). :func:`check_windows` checks that the rows of ``crease:7`` and
-   ``crease:8``, written relative to their point, are one row per class, the same in both, summing to 1,
-   with the same crease block C, and the folded-ring identity of :func:`.tagged_modes.check_structure`
-   for both; every class of an N >= 7 occurs there. So for every N >= 7, S = [[C, 0], [X, I]] with I the
-   smooth ring rule on the odd vectors, and the blocks of the modes w = +-1 are those of N = 7.
-2. **Spectrum and G for every N** (:func:`uniform_spectrum`). spec(S) = spec(C) + spec(M_+1) + spec(M_-1) +
-   for j = 1..N-1 {1/8, 1/16, 1/32, 1/64} and the roots lam(c_j), 1/(16 lam(c_j)) of
-   q_c(x) = x^2 - (5 + c) x/8 + 1/16, c_j = cos(j theta). lam is strictly increasing on [-1, 1]
-   (5 + c and (1 + c)(9 + c) are), lam(-1) = 1/4, so 1/(16 lam(c_j)) < 1/4 and lam(c_1) > lam(c_2) >
-   lam(c_j), j >= 3; beta = lam(c_2) >= b0 = lam(cos(2 pi/N0)). Checked: every other entry (C's but 1,
-   the blocks', the constants, the bound 1/4) is certainly below b0, gamma < b0, lam(1) < 1, 1 simple in
-   C and no root of the blocks or of any q_c (c <= 1). A rational g is a root of q_c only at
-   c*(g) = 8 g + 1/(2 g) - 5, so at most one mode has it, and simply unless (1 + c*)(9 + c*) = 0: then
-   gamma is at most a simple eigenvalue of I, and z exists (as in :mod:`.tagged_c1`).
-3. **Part N as one analytic function.** Let v^(s) solve the bordered 6 x 6 system of B(w), w = e^(i s),
-   for lam(cos s) with v^(1,0) = 1, f(s) the values of v - v o R at the nine points of the (1,1) vertex
-   of quadrant 0, and H(theta) = T_a(f(theta)) T_b(f(2 theta)) - T_b(f(theta)) T_a(f(2 theta)). For real
-   theta = pi/N, f(j theta) is a non-zero complex multiple of the real eigenvector of mode j, so the
-   witness's J_xy != 0 iff H(pi/N) != 0.
-4. **H(theta) = O(theta^4).** The exact identity B(1/w) R_w = R_w B(w) (:func:`reflection_identity`;
-   R_w: ray p -> v^(p), quadrant (a, b) -> v^(b, a)/w, the reflection in ray 0 on the modes) and the
-   uniqueness of the bordered solution give v^(-s) = R_w v^(s), hence f(-s) = -f(s):
-   (T_a, T_b)(f(s)) = s g(s) with g even and H(theta) = 2 theta^2 g(theta) x g(2 theta), an even
-   function vanishing at 0: a zero of order >= 4 at 0 (or H = 0).
-5. **No other zero for |theta| < rho.** H is analytic where both bordered systems are regular and
-   (1 + c)(9 + c) has a positive real part (principal root): :func:`check_disc` proves it on acb boxes
-   covering |theta| <= R. :func:`circle_bound` bounds |H| <= M on |theta| = R, so |H'| <= M R/(R - rho)^2
-   on |theta| = rho (Cauchy). :func:`winding` checks on each of ``arcs`` arcs of |theta| = rho that
-   |H'| * (arc length) < |H(z_k)| (the arc's image lies in a disc about H(z_k) that misses 0, so its turn
-   is the principal argument of H(z_(k+1))/H(z_k)) and that the total turn / 2 pi is certainly in
-   (3.5, 4.5). By the argument principle the order-4 zero at 0 is H's only zero in |theta| < rho, so
-   J_xy != 0 for every N with pi/N < rho: rho > pi/N0 is checked.
-
-The corner witness uses the same x, y, quadrant and ray (only z and C differ), so parts 3 to 5 serve both
-families. The hints (rho, R, the arc counts, the box side) only choose where to subdivide: the verifier
-derives every claim above itself.
+"""Every crease:N or corner:N with N >= N0 in one "not C1" certificate (trusted; docs/tagged_c1.md, "Every N >= N0 in
+one certificate", parts 1-5): S from the window of N = 7, 8, the spectrum uniformly in N, part N as the zeros of
+one analytic function H(theta) (the reflection identity, H analytic on acb boxes, a Cauchy bound, winding number 4).
 """
 
 from __future__ import annotations
@@ -65,9 +22,8 @@ from .tagged_modes import bordered_solve, charpoly_roots, check_ring, check_stru
 WINDOW = (7, 8)  # the window classes of every N >= 7 occur in both
 MIN_TAIL = WINDOW[0]
 MAX_ARCS = 8192  # arcs on either circle, and boxes on the disc (bounded work for a hostile file)
-# evaluations of H (arcs on both circles, boxes on the disc) weighted by (prec + 1024)/1024, checked before any
-# arithmetic: the published certificates need 3,042, the prover's widest hints (every N0 >= 7) about 21,000;
-# at the budget a file costs about 5 s of CPU
+# evaluations of H weighted by (prec + 1024)/1024, checked before any arithmetic: the published need 3,042, the
+# prover's widest hints (every N0 >= 7) about 21,000; at the budget a file costs about 5 s of CPU
 TAIL_BUDGET = 3 * 8192
 _LIMIT_KEYS = ("rho", "R", "arcs", "outer_arcs", "box")
 _PIVOT = RING_INDEX[(1, 0)]
@@ -75,16 +31,9 @@ _PIVOT = RING_INDEX[(1, 0)]
 
 @cache
 def check_windows(fam):
-    """Raise unless the rows of fam:7 and fam:8 are one row per window class, the same in both (module
-    docstring, part 1), summing to 1, with the same crease block and the folded-ring structure.
+    """Raise unless the rows of fam:7 and fam:8 are one row per window class, the same in both, summing to 1, with
+    the same crease block and folded-ring structure (part 1); the crease block C and the blocks of the modes +-1.
 
-    Returns
-    -------
-    tuple of flint.fmpq_mat
-        The crease block C and the blocks of the modes w = +-1 on their odd vectors (the same for every N).
-
-    Examples
-    --------
     >>> C, *blocks = check_windows("crease")
     >>> C.nrows(), [M.nrows() for M in blocks]
     (5, [1, 3])
@@ -105,13 +54,9 @@ def check_windows(fam):
 
 @cache
 def reflection_identity():
-    """Is B(1/w) R_w = R_w B(w) an identity of Laurent polynomials in w (exact)?
+    """Is B(1/w) R_w = R_w B(w) an identity of Laurent polynomials in w (exact)? w^3 times the difference is a
+    polynomial of degree <= 5 (the stencil reaches w^-1 .. w^2, R_w holds 1 and 1/w): zero at 12 points, zero.
 
-    The ring stencil reaches w^-1 .. w^2 (:func:`.tagged_modes.check_ring`) and R_w holds 1 and 1/w, so
-    w^3 times the difference is a polynomial of degree <= 5: zero at the 12 points checked, it is zero.
-
-    Examples
-    --------
     >>> reflection_identity()
     True
     """
@@ -124,8 +69,8 @@ def reflection_identity():
 
 
 def _tangents(theta, j):
-    """(T_a, T_b) of f(j theta) at the (1,1) vertex of quadrant 0 (acb); raises ZeroDivisionError unless
-    (1 + c)(9 + c) certainly has a positive real part and the bordered system is certainly regular."""
+    """(T_a, T_b) of f(j theta) at the (1,1) vertex of quadrant 0 (acb); ZeroDivisionError unless (1 + c)(9 + c)
+    certainly has a positive real part and the bordered system is certainly regular."""
     w = (acb(0, j) * theta).exp()
     c = (w + 1 / w) / 2
     disc = (1 + c) * (9 + c)
@@ -142,11 +87,8 @@ def _tangents(theta, j):
 
 
 def limit_h(theta):
-    """H(theta) (module docstring, part 3) for an acb ball theta; ZeroDivisionError where not proved analytic.
-
-    Examples
-    --------
-    H(pi/N) / theta^4 tends to about 1.37136:
+    """H(theta) for an acb ball theta (part 3); ZeroDivisionError where not proved analytic. H(pi/N)/theta^4 tends to
+    about 1.37136:
 
     >>> th = arb.pi() / 1000
     >>> (limit_h(acb(th)) / th ** 4).real.str(5, radius=False)
@@ -157,15 +99,9 @@ def limit_h(theta):
     return a1 * b2 - b1 * a2
 
 
-def check_disc(R, side):
-    """The number of boxes of the grid of ``side`` that meet |theta| <= R, each proved (H analytic there),
-    or the failing box as a string.
-
-    Examples
-    --------
-    >>> check_disc(fmpq(1, 10), fmpq(1, 10))
-    4
-    """
+def _check_disc(R, side):
+    """The number of boxes of the grid of ``side`` that meet |theta| <= R, each proved (H analytic there), or the
+    failing box as a string."""
     m = int(-(-R.p * side.q // (R.q * side.p)))  # ceil(R / side)
     count = 0
     for u in range(-m, m):
@@ -187,18 +123,9 @@ def _on_circle(radius, k, arcs):
     return acb(arb(0), arb(2 * k) / arcs * arb.pi()).exp() * radius
 
 
-def circle_bound(R, arcs):
-    """An upper bound M of |H| on |theta| = R (acb balls covering the arcs), or None if one is not proved.
-    Not :func:`~ccproof.rigorous.analytic.disc_bound`: its square [-R, R]^2 reaches outside the disc that
-    :func:`check_disc` proves analytic; with boxes of side 1/20 it bounds |H| by 47.3 where the arcs give 0.0261.
-
-    Examples
-    --------
-    The balls overestimate (H is O(theta^4) from products of O(theta) terms): 2048 arcs give 0.0261.
-
-    >>> circle_bound(fmpq(3, 10), 256) < fmpq(1, 5), circle_bound(fmpq(3, 10), 2048) < fmpq(3, 100)
-    (True, True)
-    """
+def _circle_bound(R, arcs):
+    """An upper bound M of |H| on |theta| = R from acb balls covering ``arcs`` arcs, or None if one is not proved (not
+    :func:`~ccproof.rigorous.analytic.disc_bound`: its square leaves the disc that the disc check proves)."""
     top = arb(0)
     for k in range(arcs):
         ball = acb(arb(0), (arb(2 * k + 1) + arb(0, 1)) / arcs * arb.pi()).exp() * R  # covers arc k
@@ -209,17 +136,9 @@ def circle_bound(R, arcs):
     return top
 
 
-def winding(rho, arcs, R, M):
-    """(the winding number of H along |theta| = rho (an arb ball), None) or (None, the reason).
-
-    Examples
-    --------
-    >>> wn, why = winding(fmpq(1, 5), 512, fmpq(3, 10), arb("0.0261"))
-    >>> wn.contains(4), why
-    (True, None)
-    >>> winding(fmpq(1, 5), 256, fmpq(3, 10), arb("0.0261"))[1][:37]
-    "arc 0 of 256: |H'| * length = [0.0038"
-    """
+def _winding(rho, arcs, R, M):
+    """(the winding number of H along |theta| = rho (an arb ball), None) or (None, the reason); each arc's image lies
+    in a disc about H(z_k) that misses 0 (|H'| <= M R/(R - rho)^2 by Cauchy)."""
     slope = M * R / (R - rho) ** 2  # |H'| on |theta| = rho (Cauchy on |theta| = R)
     length = 2 * arb.pi() * rho / arcs
     vals = [limit_h(_on_circle(rho, k, arcs)) for k in range(arcs + 1)]
@@ -232,36 +151,27 @@ def winding(rho, arcs, R, M):
     return turn / (2 * arb.pi()), None
 
 
-def _in_modes(x):  # is x a root of some q_c, c in [-1, 1]? c*(x) = 8 x + 1/(2 x) - 5
-    return x != 0 and -1 <= 8 * x + 1 / (2 * x) - 5 <= 1
+def _gap(croots, below, blocks, others, g, b0, n0):
+    """(the first reason 1 is not simple, alpha and beta do not lead, or gamma = g is not the crease block's largest
+    eigenvalue below 1, simple in I and below beta, or None; c*(g))."""
+    cstar = lambda x: 8 * x + 1 / (2 * fmpq(x)) - 5  # a rational x != 0 is a root of q_c only at c = c*(x)
+    cg = cstar(g) if g != 0 else None
+    return next((why for bad, why in (
+        (lambda: croots.count(1) != 1 or len(below) != 4, "eigenvalue 1 is not simple in the crease block"),
+        (lambda: -1 <= cstar(1) <= 1 or any(M.charpoly()(1) == 0 for M in blocks), "1 is an eigenvalue of the modes"),
+        (lambda: not lam_of(arb(1)) < 1, "lam(1) < 1 is not certain"),
+        (lambda: not all(x < b0 for x in others),
+         f"an eigenvalue other than alpha, beta is not certainly below lam(cos(2 pi/{n0}))"),
+        (lambda: g != max(below),
+         f"gamma is not the crease block's largest eigenvalue below 1 ({max(below, default=None)})"),
+        (lambda: not arb(g) < b0, f"gamma < lam(cos(2 pi/{n0})) is not certain"),
+        (lambda: g in SMALL_ROOTS or cg is None or (1 + cg) * (9 + cg) == 0 or any(M.charpoly()(g) == 0
+                                                                                    for M in blocks),
+         "gamma is possibly a multiple eigenvalue of I")) if bad()), None), cg
 
 
-def _leading_gap(croots, below, blocks, others, b0, n0):
-    """Why 1 is not simple or alpha, beta do not lead (None when they do)."""
-    if croots.count(1) != 1 or len(below) != 4:
-        return "eigenvalue 1 is not simple in the crease block"
-    if _in_modes(fmpq(1)) or any(M.charpoly()(1) == 0 for M in blocks):
-        return "1 is an eigenvalue of the modes"
-    if not lam_of(arb(1)) < 1:
-        return "lam(1) < 1 is not certain"
-    if not all(x < b0 for x in others):
-        return f"an eigenvalue other than alpha, beta is not certainly below lam(cos(2 pi/{n0}))"
-    return None
-
-
-def _gamma_gap(g, cg, below, blocks, b0, n0):
-    """Why gamma = g is not the crease block's largest eigenvalue below 1, simple and below beta (or None)."""
-    if g != max(below):
-        return f"gamma is not the crease block's largest eigenvalue below 1 ({max(below)})"
-    if not arb(g) < b0:
-        return f"gamma < lam(cos(2 pi/{n0})) is not certain"
-    if g in SMALL_ROOTS or cg is None or (1 + cg) * (9 + cg) == 0 or any(M.charpoly()(g) == 0 for M in blocks):
-        return "gamma is possibly a multiple eigenvalue of I"
-    return None
-
-
-def uniform_spectrum(fam, n0, g, C, blocks):
-    """(ok, message): part 2 of the module docstring for every N >= n0 with gamma = g (exact)."""
+def _uniform_spectrum(fam, n0, g, C, blocks):
+    """(ok, message): part 2 for every N >= n0 with gamma = g (exact)."""
     fac = C.charpoly().factor()[1]
     if any(p.degree() > 1 for p, _ in fac):
         return False, "the crease block has irrational eigenvalues"
@@ -270,8 +180,7 @@ def uniform_spectrum(fam, n0, g, C, blocks):
     b0 = lam_of(arb(fmpq(2, n0)).cos_pi())  # <= beta = lam(cos(2 pi/N)) for every N >= n0
     inner = [z for M in blocks for z, _ in charpoly_roots(M)]
     others = [arb(abs(r)) for r in below] + [abs(z) for z in inner] + [arb(s) for s in SMALL_ROOTS] + [arb(fmpq(1, 4))]
-    cg = 8 * g + 1 / (2 * g) - 5 if g != 0 else None
-    why = _leading_gap(croots, below, blocks, others, b0, n0) or _gamma_gap(g, cg, below, blocks, b0, n0)
+    why, cg = _gap(croots, below, blocks, others, g, b0, n0)
     if why is not None:
         return False, f"every N >= {n0}: {why}"
     return True, (f"every N >= {n0}: alpha = lam(cos(pi/N)) > beta = lam(cos(2 pi/N)) >= {b0.str(6, radius=False)} > "
@@ -280,27 +189,9 @@ def uniform_spectrum(fam, n0, g, C, blocks):
 
 
 def verify_tail(cert, fam, n0, part, log):
-    """Check a ``"FAMILY:>=N0"`` "not C1" certificate (module docstring) into ``part``.
+    """Check a ``"FAMILY:>=N0"`` "not C1" certificate (``witness`` {"z"}, ``limit`` {"rho", "R", "box": decimals,
+    "arcs", "outer_arcs": ints}) into ``part``; the configuration name, or CertificateError on a malformed one.
 
-    Parameters
-    ----------
-    cert : dict
-        ``schema``, ``configuration``, ``statement`` ("not C1": the only statement the registry routes here),
-        ``prec``, ``witness`` ({"z": coord}) and
-        ``limit`` ({"rho", "R", "box": decimals, "arcs", "outer_arcs": ints}).
-
-    Returns
-    -------
-    str
-        The configuration name (for the verdict).
-
-    Raises
-    ------
-    CertificateError
-        On a malformed certificate.
-
-    Examples
-    --------
     >>> import json
     >>> from ccproof.tables.format import certificates_dir
     >>> from ccproof.certify.verify.record import Recorder, VerifyResult
@@ -348,7 +239,7 @@ def _check_tail(fam, n0, g, cval, limit, part, log):
          why or f"C c = {g} c exactly on the crease points (the same C for every N)")
     if part.failed:
         return
-    ok, msg = uniform_spectrum(fam, n0, g, C, blocks)
+    ok, msg = _uniform_spectrum(fam, n0, g, C, blocks)
     part(G_GENERIC, ok, msg)
     if not ok:
         return
@@ -364,10 +255,9 @@ def _check_tail(fam, n0, g, cval, limit, part, log):
 
 
 def _check_normal(fam, n0, limit, part, log):
-    """N for every N >= n0: H analytic on the disc |theta| <= R, bounded on its circle, winding 4 times
-    (``limit`` the record's (rho, R, box, arcs, outer_arcs))."""
+    """N for every N >= n0: H analytic on |theta| <= R, bounded on its circle, winding 4 times along |theta| = rho."""
     rho, R, side, arcs, outer = limit
-    got = check_disc(R, side)
+    got = _check_disc(R, side)
     ok = isinstance(got, int)
     part(f"x, y and N analytic: the bordered systems of modes 1 and 2 regular on |theta| <= {R}", ok,
          f"{got} boxes of side {side}, (1 + c)(9 + c) in the right half-plane: x, y = f(pi/N), f(2 pi/N) are the "
@@ -375,12 +265,12 @@ def _check_normal(fam, n0, limit, part, log):
          f"box {got}: not proved regular, or (1 + c)(9 + c) not certainly in the right half-plane")
     if not ok:
         return
-    M = circle_bound(R, outer)
+    M = _circle_bound(R, outer)
     part(f"N bound: |H| <= M on |theta| = {R}", M is not None,
          f"M = {M.str(5, radius=False)} ({outer} arc balls)" if M is not None else "an arc ball is not proved")
     if M is None:
         return
-    wn, why = winding(rho, arcs, R, M)
+    wn, why = _winding(rho, arcs, R, M)
     ok = wn is not None and wn > fmpq(7, 2) and wn < fmpq(9, 2)
     part(f"N winding: H winds 4 times around 0 along |theta| = {rho}, so J_xy != 0 for every N >= {n0}", ok,
          f"{wn.str(6)} ({arcs} arcs, each image in a disc off 0: |H'| <= M R/(R - rho)^2)" if ok else
@@ -389,6 +279,3 @@ def _check_normal(fam, n0, limit, part, log):
         log(f"  the limit surface is not C1 at the {fam} vertex for every N >= {n0}: normals along the level-m "
             "copies of quadrant 0's (1,1) tend to n_z != 0, yet e_z lies in T_v (ray 0)")
 
-
-__all__ = ["MIN_TAIL", "check_disc", "check_windows", "circle_bound", "limit_h", "reflection_identity",
-           "uniform_spectrum", "verify_tail", "winding"]

@@ -1,26 +1,11 @@
-"""The characteristic map of a tagged sector and the checks of a "C1" certificate (trusted).
-
-Phi = (X, Y), X and Y the limit functions of the eigenvectors x, y of lam1 >= lam2 (:mod:`.tagged_c1`
-derives and checks them). On quadrant q the layer-0 pieces P1 = [1/2,1] x [0,1/2], P2 = [1/2,1]^2,
-P3 = [0,1/2] x [1/2,1] are uniform bicubic B-spline patches of the level-1 net S v: each is a level-1
-face none of whose corners is the centre, with four regular vertices (valence 4, or a regular crease
-vertex on a sharp ray, whose patch is the B-spline patch with the ghost row 2 P(a, 0) - P(a, 1): the
-crease rules (1,6,1)/8 and (1,1)/2 are the tensor rules on that extended grid, which keeps the
-linear extrapolation). Level-1 values off the two-ring (positions 3 and -1) come from
-:func:`.rules.level1_rule` in the right quadrant and from the crease rules on a sharp ray.
-
-Checks (docs/tagged_c1.md): R det J_Phi > 0 on every piece (times the certificate's orientation
-+-1); T the outer curve Gamma (sides u = 1, v = 1, quadrants in order) is transversal to the flow
-D^t p = (lam1^t x, lam2^t y): a1 X Y' - a2 Y X' > 0 with a_i = -ln lam_i; W Gamma crosses the D-orbit
-H (a half-axis, named by the certificate) the expected number of times: a dart's closed curve once
-(winding number 1); a crease sector's curve, from the -y to the +y half-axis, once for H = +x and
-never for H = -x (it stays in x > 0; mirrored for orientation -1); a corner's, from +x to +y, never
-for H = -x or -y (once each for orientation -1: the image is the other three quadrants); E the sharp
-rays map onto the half-axes (crease: X = 0 on them, Y < 0 on ray 0, Y > 0 on ray N; corner: Y = 0
-and X > 0 on ray 0, X = 0 and Y > 0 on ray N).
+"""The characteristic map Phi = (X, Y) of a tagged sector and the checks R, T, W, E of a "C1" certificate (trusted;
+docs/tagged_c1.md, "C1": the pieces P1, P2, P3 of quadrant q are B-spline patches of the level-1 net, with the
+ghost row 2 P(a, 0) - P(a, 1) across a sharp ray).
 """
 
 from __future__ import annotations
+
+from functools import cache
 
 from flint import arb, ctx, fmpq
 
@@ -39,40 +24,27 @@ _OFFSET = {"P1": (0, -1), "P2": (0, 0), "P3": (-1, 0)}  # level-1 position of B-
 
 
 def level1_values(fam, n, v):
-    """``value(q, A, B)``: the level-1 value of the vector v (on :func:`.tagged.labels`) at position
-    (A, B), -1 <= A, B <= 3, of quadrant q (ghost values across a sharp ray).
-
-    Examples
-    --------
-    The regular boundary with the linear vector x = a (on quadrant 0, a along ray 0): level 1 halves it,
-    and the ghost row across ray 0 continues it linearly:
+    """``value(q, A, B)``: the level-1 value of v at position (A, B), -1 <= A, B <= 3, of quadrant q (ghost values
+    across a sharp ray). The linear x = a on the regular boundary, halved, and continued across ray 0:
 
     >>> from ccproof.certify.verify.tagged import labels
-    >>> pts = labels("crease", 2)
-    >>> v = [fmpq(p[2]) if p[0] == "r" and p[1] == 0 else fmpq(-p[2]) if p[0] == "r" and p[1] == 2 else
-    ...      fmpq(p[2]) if p[0] == "q" and p[1] == 0 else fmpq(-p[3]) if p[0] == "q" else fmpq(0) for p in pts]
+    >>> v = [fmpq(p[2] if p[:2] in (("r", 0), ("q", 0)) else -p[2] if p[:2] == ("r", 2) else -p[3] if p[0] == "q"
+    ...           else 0) for p in labels("crease", 2)]
     >>> val = level1_values("crease", 2, v)
     >>> [val(0, a, b) for a, b in ((3, 0), (2, 2), (1, -1))]
     [3/2, 1, 1/2]
     """
     idx, at = point_index(fam, n)
     sharp = sharp_rays(fam, n)
-    rows, memo = sector_rows(fam, n), {}
-
-    def one(i):  # (S v)[i], sparse, on demand (a quadrant reads a few of them)
-        if i not in memo:
-            memo[i] = sum((w * v[j] for j, w in rows[i].items()), 0 * v[0])
-        return memo[i]
-
-    def quad(s):
-        return s % n if fam == "dart" else s
+    rows = sector_rows(fam, n)
+    one = cache(lambda i: sum((w * v[j] for j, w in rows[i].items()), 0 * v[0]))  # (S v)[i], sparse, on demand
 
     def value(q, A, B):
         if (A, B) == (0, 0):
             return one(0)
         if B == -1 and q in sharp:  # across the sharp ray q: the ghost row
             return 2 * value(q, A, 0) - value(q, A, 1)
-        if A == -1 and quad(q + 1) in sharp:  # across the sharp ray q + 1: the ghost column
+        if A == -1 and ((q + 1) % n if fam == "dart" else q + 1) in sharp:  # across the sharp ray q + 1
             return 2 * value(q, 0, B) - value(q, 1, B)
         key = position_key(fam, n, q, A, B)
         if key in idx:
@@ -87,16 +59,12 @@ def level1_values(fam, n, v):
 def quadrant_nets(fam, n, vx, vy, q, prec):
     """Bezier nets {P1, P2, P3: 4 x 4 of (arb, arb)} of Phi = (X, Y) on quadrant q.
 
-    Examples
-    --------
-    >>> from flint import fmpq
     >>> from ccproof.certify.verify.tagged import labels
-    >>> pts = labels("corner", 1)
-    >>> vx = [fmpq(p[2]) if p[0] == "r" and p[1] == 0 or p[0] == "q" else fmpq(0) for p in pts]
-    >>> vy = [fmpq(p[2]) if p[0] == "r" and p[1] == 1 else fmpq(p[3]) if p[0] == "q" else fmpq(0) for p in pts]
-    >>> x, y = quadrant_nets("corner", 1, vx, vy, 0, 64)["P2"][3][3]   # the corner (1, 1) of the face
-    >>> x.str(5, radius=False), y.str(5, radius=False)
-    ('1.0000', '1.0000')
+    >>> pts = labels("corner", 1)   # the identity map: x = a, y = b
+    >>> vx = [fmpq(p[2] if p[0] == "q" or p[:2] == ("r", 0) else 0) for p in pts]
+    >>> vy = [fmpq(p[3] if p[0] == "q" else p[2] if p[:2] == ("r", 1) else 0) for p in pts]
+    >>> [z.str(5, radius=False) for z in quadrant_nets("corner", 1, vx, vy, 0, 64)["P2"][3][3]]   # the corner (1, 1)
+    ['1.0000', '1.0000']
     """
     X, Y = level1_values(fam, n, vx), level1_values(fam, n, vy)
     out = {}
@@ -109,17 +77,13 @@ def quadrant_nets(fam, n, vx, vy, q, prec):
 
 
 def transversal_form(nets, curve, a1, a2, prec):
-    """Bernstein form (degree 5) of a1 X Y' - a2 Y X' along one outer cubic, oriented counterclockwise.
+    """Bernstein form (degree 5) of a1 X Y' - a2 Y X' along one outer cubic, oriented counterclockwise; the star form
+    x y' - y x' for the identity map and a1 = a2 = 1 (1/2 on u = 1 of P1 here):
 
-    Examples
-    --------
-    For the identity map and a1 = a2 = 1 this is the star form x y' - y x' (1/2 on u = 1 of P1 here):
-
-    >>> from flint import fmpq
     >>> from ccproof.certify.verify.tagged import labels
-    >>> pts = labels("corner", 1)
-    >>> vx = [fmpq(p[2]) if p[0] == "r" and p[1] == 0 or p[0] == "q" else fmpq(0) for p in pts]
-    >>> vy = [fmpq(p[2]) if p[0] == "r" and p[1] == 1 else fmpq(p[3]) if p[0] == "q" else fmpq(0) for p in pts]
+    >>> pts = labels("corner", 1)   # the identity map: x = a, y = b
+    >>> vx = [fmpq(p[2] if p[0] == "q" or p[:2] == ("r", 0) else 0) for p in pts]
+    >>> vy = [fmpq(p[3] if p[0] == "q" else p[2] if p[:2] == ("r", 1) else 0) for p in pts]
     >>> f = transversal_form(quadrant_nets("corner", 1, vx, vy, 0, 64), "P1s1", arb(1), arb(1), 64)
     >>> f.coeffs[0].str(5, radius=False)
     '0.50000'
@@ -134,17 +98,11 @@ def transversal_form(nets, curve, a1, a2, prec):
 AXES = {"+x": (1, 0), "-x": (-1, 0), "+y": (0, 1), "-y": (0, -1)}
 
 
-def crossings(nets, curve, paths, direction, prec):
-    """How often one outer cubic crosses the half-line H = {t d : t > 0} (``direction`` d = (a, b), ints),
-    from a partition of [0, 1] into boxes each certainly off H (the other coordinate -b X + a Y of one
-    sign, or a X + b Y < 0) or certainly on its side (a X + b Y > 0), where a sign change of -b X + a Y
-    between the box's ends is exactly one crossing (all crossings of an orbit have one direction by T).
-
-    Returns
-    -------
-    int or str
-        The count, or the reason why a box decides nothing.
-    """
+def _crossings(nets, curve, paths, direction, prec):
+    """How often one outer cubic crosses the half-line H = {t d : t > 0} (``direction`` d = (a, b)), from a partition of
+    [0, 1] into boxes each certainly off H (-b X + a Y of one sign, or a X + b Y < 0) or on its side (a X + b Y > 0),
+    where a sign change of -b X + a Y between the ends is one crossing (one direction for all: T); or why a box
+    decides nothing."""
     if not check_partition(paths, 1):
         return f"{curve}: the boxes do not partition [0, 1]"
     count = 0
@@ -162,16 +120,13 @@ def crossings(nets, curve, paths, direction, prec):
 
 
 def axis_forms(nets, curve, direction, prec):
-    """The Bernstein forms (degree 3) of a X + b Y (along H) and -b X + a Y (across H) on one outer cubic,
-    oriented counterclockwise, for ``direction`` (a, b) of the half-line H (:func:`crossings`).
+    """The Bernstein forms (degree 3) of a X + b Y (along H) and -b X + a Y (across H) on one outer cubic, oriented
+    counterclockwise, for ``direction`` (a, b) of the half-line H.
 
-    Examples
-    --------
-    >>> from flint import fmpq
     >>> from ccproof.certify.verify.tagged import labels
-    >>> pts = labels("corner", 1)
-    >>> vx = [fmpq(p[2]) if p[0] == "r" and p[1] == 0 or p[0] == "q" else fmpq(0) for p in pts]
-    >>> vy = [fmpq(p[2]) if p[0] == "r" and p[1] == 1 else fmpq(p[3]) if p[0] == "q" else fmpq(0) for p in pts]
+    >>> pts = labels("corner", 1)   # the identity map: x = a, y = b
+    >>> vx = [fmpq(p[2] if p[0] == "q" or p[:2] == ("r", 0) else 0) for p in pts]
+    >>> vy = [fmpq(p[3] if p[0] == "q" else p[2] if p[:2] == ("r", 1) else 0) for p in pts]
     >>> A, P = axis_forms(quadrant_nets("corner", 1, vx, vy, 0, 64), "P1s1", (0, 1), 64)
     >>> A.coeffs[3].str(3, radius=False), P.coeffs[0].str(3, radius=False)   # Y at the end, -X at the start
     ('0.500', '-1.00')
@@ -199,23 +154,10 @@ def _box_crossings(fa, fp):
     return 1 if ends < 0 else 0
 
 
-def rays_on_axes(fam, n, vx, vy):
-    """(ok, message): the sharp rays' layer-0 segments lie on the half-axes (E in the module docstring).
-
-    On a sharp ray the limit curve of the layer-0 segment is the cubic B-spline segment of the level-1
-    ray values at positions 0..3 (the ghost row drops out), so X = 0 there when those values are exactly
-    0, and the sign of Y follows from the segment's Bezier points.
-
-    Examples
-    --------
-    >>> from flint import fmpq
-    >>> from ccproof.certify.verify.tagged import labels
-    >>> pts = labels("corner", 1)
-    >>> vx = [fmpq(p[2]) if p[0] == "r" and p[1] == 0 or p[0] == "q" else fmpq(0) for p in pts]
-    >>> vy = [fmpq(p[2]) if p[0] == "r" and p[1] == 1 else fmpq(p[3]) if p[0] == "q" else fmpq(0) for p in pts]
-    >>> rays_on_axes("corner", 1, vx, vy)[0]
-    True
-    """
+def _rays_on_axes(fam, n, vx, vy):
+    """(ok, message): E, the sharp rays' layer-0 segments lie on the half-axes: the limit curve of a sharp ray's
+    segment is the cubic B-spline of its level-1 values at 0..3 (X = 0 when they are exactly 0; Y's sign from the
+    Bezier points)."""
     X, Y = level1_values(fam, n, vx), level1_values(fam, n, vy)
     x0, y0 = [X(0, a, 0) for a in range(4)], [Y(0, a, 0) for a in range(4)]
     xn, yn = [X(n - 1, 0, b) for b in range(4)], [Y(n - 1, 0, b) for b in range(4)]
@@ -229,7 +171,11 @@ def rays_on_axes(fam, n, vx, vy):
 
 
 def all_zero(vals):
-    """Is every value exactly 0 (an fmpq 0, or an arb that is the exact 0)?"""
+    """Is every value exactly 0 (an fmpq 0, or an arb that is the exact 0)?
+
+    >>> all_zero([fmpq(0), arb(0)]), all_zero([arb(0, 1)])
+    (True, False)
+    """
     return all(isinstance(z, fmpq) and z == 0 or isinstance(z, arb) and z.is_zero() for z in vals)
 
 
@@ -238,48 +184,31 @@ def _bez(vals):  # Bezier points of the segment [1, 2] of the B-spline with thes
 
 
 def check_map(fam, n, vx, vy, lam1, lam2, orient, parts, prec, part):
-    """Run R, T, W, E (module docstring) on the hints ``parts`` into ``part``.
-
-    Parameters
-    ----------
-    parts : dict
-        ``{"regularity": {"q:P": boxes}, "transversal": {"q:curve": boxes}, "winding": {"q:curve": [path]}}``.
-    """
+    """Run R, T, W, E on the hints ``parts`` ({"regularity": {"q:P": boxes}, "transversal": {"q:curve": boxes},
+    "winding": {"axis", "boxes": {"q:curve": [path]}}}) into ``part``."""
     regs = [f"{q}:{p}" for q in range(n) for p in PIECES]
     curves = [f"{q}:{c}" for q in range(n) for c in STAR_CURVES]
     _check_keys(parts, regs, curves)
     with ctx.workprec(prec):
         a1, a2 = -arb(lam1).log(), -arb(lam2).log()
         nets = [quadrant_nets(fam, n, vx, vy, q, prec) for q in range(n)]
-
-        def replay(hint, keys, form, title):
-            """Replay the boxes of ``parts[hint]`` on ``form(quadrant, name) * orient`` for every key; the
-            smallest bound, or None after a FAIL recorded under ``title``."""
-            worst = None
+        for hint, keys, form, title, note in (
+                ("regularity", regs, lambda net, c: regularity_form(net, c, prec), "R det J_Phi > 0 on every piece",
+                 f"{len(regs)} pieces, min bound {{}} (local s,t)"),
+                ("transversal", curves, lambda net, c: transversal_form(net, c, a1, a2, prec),
+                 "T the outer curve is transversal to the flow of diag(lam1, lam2)", "min bound {}")):
+            worst = None  # the smallest bound of the boxes of parts[hint] on form(quadrant, name) * orient
             for key in keys:
-                q, name = key.split(":")
-                ok, msg, mb = check_boxes(form(nets[int(q)], name) * orient, parts[hint][key], f"{hint} {key}")
+                q, c = key.split(":")
+                ok, msg, mb = check_boxes(form(nets[int(q)], c) * orient, parts[hint][key], f"{hint} {key}")
                 if not ok:
                     part(title, False, msg)
-                    return None
+                    return
                 worst = mb if worst is None or mb < worst else worst
-            return worst
-
-        title = "R det J_Phi > 0 on every piece"
-        worst = replay("regularity", regs, lambda net, name: regularity_form(net, name, prec), title)
-        if worst is None:
-            return
-        part(title, True, f"{len(regs)} pieces, min bound {worst} (local s,t)", worst, "regularity")
-        title = "T the outer curve is transversal to the flow of diag(lam1, lam2)"
-        worst = replay("transversal", curves, lambda net, c: transversal_form(net, c, a1, a2, prec), title)
-        if worst is None:
-            return
-        part(title, True, f"min bound {worst}", worst, "transversal")
-        if not _check_winding(fam, nets, curves, parts["winding"], _lam_ray(fam, lam1, lam2), orient, prec, part):
-            return
-        if fam != "dart":
-            ok, msg = rays_on_axes(fam, n, vx, vy)
-            part("E the sharp rays map onto half-axes", ok, msg)
+            part(title, True, note.format(worst), worst, hint)
+        ray = fam == "dart" and isinstance(lam1, fmpq) and lam1 == lam2  # D a multiple of 1: every ray an orbit
+        if _check_winding(fam, nets, curves, parts["winding"], ray, orient, prec, part) and fam != "dart":
+            part("E the sharp rays map onto half-axes", *_rays_on_axes(fam, n, vx, vy))
 
 
 def _check_keys(parts, regs, curves):
@@ -289,10 +218,6 @@ def _check_keys(parts, regs, curves):
                            ("winding.boxes", parts["winding"]["boxes"], curves)):
         if not isinstance(got, dict) or set(got) != set(keys):
             raise CertificateError(f"parts.{sec} must have exactly the keys {keys[:3]}... ({len(keys)})")
-
-
-def _lam_ray(fam, lam1, lam2):  # a dart with lam1 = lam2 (D a multiple of the identity): every ray is an orbit
-    return fam == "dart" and isinstance(lam1, fmpq) and lam1 == lam2
 
 
 # the half-axes a curve may be counted against, and how often it crosses each: from -y to +y through x > 0
@@ -315,8 +240,8 @@ def _direction(fam, axis, orient, ray):
 
 
 def _check_winding(fam, nets, curves, win, ray, orient, prec, part):
-    """W: the D-angle along Gamma is monotone (T); the count of crossings says it turns by exactly the
-    sector's angle. False when a box decides nothing (the count is then not recorded)."""
+    """W: the count of crossings says the D-angle (monotone by T) turns by exactly the sector's angle; False when a
+    box decides nothing."""
     axis = win.get("axis")
     direction, want = _direction(fam, axis, orient, ray)
     title, total = f"W the outer curve crosses the {axis} half-axis {want} time(s)", 0
@@ -325,7 +250,7 @@ def _check_winding(fam, nets, curves, win, ray, orient, prec, part):
         paths = win["boxes"][key]
         if not isinstance(paths, list) or not paths or not all(isinstance(p, str) for p in paths):
             raise CertificateError(f"parts.winding.{key} must be a list of paths")
-        got = crossings(nets[int(q)], c, paths, direction, prec)
+        got = _crossings(nets[int(q)], c, paths, direction, prec)
         if isinstance(got, str):
             part(title, False, got)
             return False
