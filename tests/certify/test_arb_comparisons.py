@@ -24,7 +24,7 @@ REVIEWED = {
     ("registry.py", 'fam != "smooth"'): "str (family names)",
     ("registry.py", "schema != TAGGED_SCHEMA"): "str (schema names)",
     ("registry.py", "st != st_t"): "str (statements)",
-    ("dart_models.py", "not z < L + 2"): "refuses unless |omega s| < L + 2 certainly: conservative",
+    ("dart_tail.py", "not z < L + 2"): "refuses unless |omega s| < L + 2 certainly: conservative",
     ("dart_family.py", "B * Ms[-1] + c[0] * eye != fmpq_mat(n, n)"): "fmpq_mat (exact)",
     ("dart_eigen.py", "not ((1 + c) * (9 + c)).real > 0"): "refuses unless Re > 0 certainly: conservative",
     ("dart_eigen.py", "lhs != p * kap[i]"): "fmpq_poly (exact)",

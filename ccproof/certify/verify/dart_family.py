@@ -21,7 +21,6 @@ quadrants next to the sharp ray (:func:`layer_nets`: ghost rows, the sharp midpo
 from __future__ import annotations
 
 from contextlib import contextmanager
-from dataclasses import dataclass
 
 from flint import acb, acb_mat, acb_poly, acb_series, arb, ctx, fmpq, fmpq_mat, fmpq_poly
 
@@ -30,25 +29,6 @@ from .maps import STAR_CURVES, curve_points
 from .rules import CENTRE, canonical, level1_rule
 from .statement import B2Z, horner, lam_of
 from .tagged_modes import RING_INDEX, bordered_matrix, bordered_solve, ring_block, ring_stencil
-
-
-@dataclass(frozen=True)
-class TaylorHints:
-    """The record's ``taylor`` hints (docs/certificates.md, "Every dart K >= K0"): they only choose orders and
-    boxes; every coefficient and bound is derived from them.
-
-    r : fmpq, the Cauchy radius (the complex h-square [-r, r]^2); disc_grid : int, grid x grid acb boxes
-    covering it; sigma_boxes : int, equal boxes of the sigma bracket; order, layer_order : int, Taylor orders
-    in h (bulk and middle; layer); exp_order : int, the middle's expansion of a_i(s) b_j(s) in s.
-    """
-
-    r: fmpq
-    disc_grid: int
-    sigma_boxes: int
-    order: int
-    layer_order: int
-    exp_order: int
-
 
 _OFFSET = {"P1": (0, -1), "P2": (0, 0), "P3": (-1, 0)}  # as tagged_map: level-1 position of net[0][0]
 
