@@ -16,7 +16,6 @@ from flint import acb, acb_mat, acb_series, arb, ctx, fmpq
 
 from ccproof.rigorous.analytic import AnalyticModel, ball, cauchy_factor, disc_bound, disc_boxes, hull
 
-from .dart_eigen import check_eigenvector
 from .dart_family import (
     PIECES,
     XB,
@@ -34,6 +33,7 @@ from .dart_family import (
 from .dart_spectrum import (
     SpectralRegions,
     check_construction,
+    check_eigenvector,
     check_mode0_roots,
     check_ranges,
     check_secular,
