@@ -90,11 +90,8 @@ class QS:
 
     __rmul__ = __mul__
 
-    def inv(self):
-        return QS(_inv_raw(self.p))
-
     def __truediv__(self, o):
-        return self * o.inv() if isinstance(o, QS) else QS(self.p / fmpq(o))
+        return QS((self.p * _inv_raw(o.p)) % _M3) if isinstance(o, QS) else QS(self.p / fmpq(o))
 
     def is_zero(self):
         return self.p.is_zero()
@@ -177,16 +174,11 @@ def _bordered(k, lam, stencil):
     return solve(bordered_matrix(B, lam, QS(0), 0), [QS(0)] * 6 + [QS(1)])[:6]
 
 
-class _Mode:
-    """lam(cos(k h)) and v^ for one angle unit k (and U(lam) for y's mode)."""
-
-    def __init__(self, k, stencil, with_u=False):
-        self.k = fmpq(k)
-        self.lam = _lam_series(self.k)
-        self.v = _bordered(self.k, self.lam, stencil)
-        if with_u:
-            den = _df.u_denominator(self.lam, L0_LOW)
-            self.U = [horner(p, self.lam, QS(0)) / den for p in _df.N_POLYS]
+def _mode(k, stencil):
+    """(lam(cos(k h)), v^, U(lam)) for one angle unit k."""
+    lam = _lam_series(k)
+    den = _df.u_denominator(lam, L0_LOW)
+    return lam, _bordered(k, lam, stencil), [horner(p, lam, QS(0)) / den for p in _df.N_POLYS]
 
 
 class ExactFamily(_df.Modes):
@@ -201,9 +193,8 @@ class ExactFamily(_df.Modes):
     def __init__(self, a, b, c, t, stencil=None, flip_alpha=False, _modes=None):
         stencil = ring_stencil() if stencil is None else stencil
         self.a, self.b, self.c, self.t = fmpq(a), fmpq(b), fmpq(c), fmpq(t)
-        mx, my = _modes or (_Mode(a, stencil), _Mode(b, stencil, with_u=True))
+        (self.lam1, self.vx, _), (self.lam2, self.vy, self.U) = _modes or (_mode(a, stencil), _mode(b, stencil))
         self.zero = QS(0)
-        self.lam1, self.lam2, self.vx, self.vy, self.U = mx.lam, my.lam, mx.v, my.v, my.U
         self.mode0(self.c, L0, flip_alpha)
         self.em, self.ep = QS(self.c) - I * self.t, QS(self.c) + I * self.t  # e^(-i sigma), e^(i sigma)
         self.i2, self.sign = I * 2, 1
@@ -367,11 +358,10 @@ def _run(points, ells, stencil, flip_alpha, stop):
     stencil = ring_stencil() if stencil is None else stencil
     tally, modes, cache = _Tally(stop), {}, {}
     for a, b, c, t in points:
-        if ("x", a) not in modes:
-            modes[("x", a)] = _Mode(a, stencil)
-        if ("y", b) not in modes:
-            modes[("y", b)] = _Mode(b, stencil, with_u=True)
-        fam = ExactFamily(a, b, c, t, stencil, flip_alpha, _modes=(modes[("x", a)], modes[("y", b)]))
+        for k in (a, b):
+            if k not in modes:
+                modes[k] = _mode(k, stencil)
+        fam = ExactFamily(a, b, c, t, stencil, flip_alpha, _modes=(modes[a], modes[b]))
         _check_point(fam, ells, tally, cache)
     return tally
 
