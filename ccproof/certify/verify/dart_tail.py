@@ -260,8 +260,9 @@ def middle_coeffs(model, om, m0, q, L=24):
 
 def middle_box(models, E, om, s_lo, s_hi, w_lo, w_hi, m0, q, L=24):
     """An arb holding Re F/(h^m0 s^q) on s in [s_lo, s_hi], w = h/s in [w_lo, w_hi] (F's s^l h^m with
-    l + m - m0 < q being 0): orders m < m0 + q expanded in s (:func:`middle_coeffs`, exponential tails past L
-    bounded), the rest direct, plus the Cauchy remainder (docs/tagged_c1.md, item 6)."""
+    l + m - m0 < q being 0): orders m < m0 + q expanded in s (:func:`middle_coeffs`; the tail past L at most
+    z^(L+1)/(L+1)!/(1 - z/(L + 2)), z = |omega| s), the rest direct, plus the Cauchy remainder
+    sum_k M_k s^(n+1-m0-q) w^(n+1-m0)/(r^(n+1) (1 - h/r)); K det J_Phi/s^2: m0 = 1, q = 2; Y/s: m0 = 0, q = 1."""
     s, w = acb(ball(s_lo, s_hi)), acb(ball(w_lo, w_hi))
     wmax = max((abs(x[1]).upper() for x in om), key=lambda x: x)
     z, sh, wh = wmax * arb(fmpq(s_hi)), arb(fmpq(s_hi)), arb(fmpq(w_hi))
