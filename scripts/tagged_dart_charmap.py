@@ -90,7 +90,7 @@ from types import SimpleNamespace
 
 from flint import acb, arb, ctx, fmpq
 
-from ccproof.certify.verify import dart_models as _M
+from ccproof.certify.verify import dart_tail as _M
 from ccproof.certify.verify.dart_family import (  # noqa: F401 (re-exported for the tests)
     B_AT_1,
     N_POLYS,
@@ -190,7 +190,7 @@ def _parts(T):
 
 
 def _select(table, tag, q=None):
-    """One quantity of the verifier's table (:func:`~ccproof.certify.verify.dart_models.quantities`), keyed
+    """One quantity of the verifier's table (:func:`~ccproof.certify.verify.dart_tail.quantities`), keyed
     without the tag: (i, j, piece or curve) or (basis part, curve) in the bulk; piece or curve on layer q."""
     if q is None:
         return {k[1:]: v for k, v in table.items() if k[0] == tag and isinstance(k[1], str)}
@@ -198,7 +198,7 @@ def _select(table, tag, q=None):
 
 
 def _models(tag, T, M, r, q=None):
-    """The verifier's analytic models (:func:`~ccproof.certify.verify.dart_models.group_models`) of a script
+    """The verifier's analytic models (:func:`~ccproof.certify.verify.dart_tail.group_models`) of a script
     table T (keyed as :func:`_select` gives them) with the disc bounds M."""
     def key(k):
         return (tag,) + k if q is None else (tag, q, k)
@@ -339,8 +339,8 @@ def layer_coord(q, sigma, n, r, grid=12, prec=128):
 def __getattr__(name):
     """The family, R, T and W functions now live in the trusted base (ccproof.certify.verify.dart_*); the
     tests and tagged_dart_zeros.py that load this script reach them through it."""
-    from ccproof.certify.verify import dart_family, dart_models, dart_zeros
-    for mod in (dart_family, dart_models, dart_zeros):
+    from ccproof.certify.verify import dart_family, dart_tail, dart_zeros
+    for mod in (dart_family, dart_tail, dart_zeros):
         if hasattr(mod, name):
             return getattr(mod, name)
     raise AttributeError(name)

@@ -2,7 +2,7 @@
 
 The verifier (:func:`ccproof.certify.verify.replay.replay_tree`) replays a tree and never searches; this module
 is the search. :func:`cover` bisects each grid cell of a region's root until the region's evaluator
-(:class:`~ccproof.certify.verify.dart_models.SigmaBox`) proves the claim's sign on every leaf, and records the
+(:class:`~ccproof.certify.verify.dart_tail.SigmaBox`) proves the claim's sign on every leaf, and records the
 leaves in the record's grammar (docs/certificates.md, "Every dart K >= K0 in one certificate"): a path of
 halvings per leaf, a bound a little inside the leaf's enclosure (floats choose the bound; the verifier
 decides), and ``outside`` leaves in the middle region where no K >= K0 lies. :func:`map_covers` builds the
@@ -17,7 +17,7 @@ import math
 
 from flint import fmpq
 
-from ccproof.certify.verify.dart_models import DartModels, map_regions
+from ccproof.certify.verify.dart_tail import DartModels, map_regions
 from ccproof.certify.verify.errors import CertificateError
 from ccproof.certify.verify.replay import leaf_box
 
@@ -170,7 +170,7 @@ def prove_dart_tail(name, prec=128, hints=None, progress=None):
     (dict or None, str)
     """
     from ccproof.certify.verify import TAGGED_SCHEMA
-    from ccproof.certify.verify.dart_family import TaylorHints
+    from ccproof.certify.verify.dart_tail import TaylorHints
     from ccproof.certify.verify.replay import parse_decimal
     from ccproof.certify.verify.tagged import parse_configuration
 

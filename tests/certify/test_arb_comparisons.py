@@ -24,15 +24,16 @@ REVIEWED = {
     ("registry.py", 'fam != "smooth"'): "str (family names)",
     ("registry.py", "schema != TAGGED_SCHEMA"): "str (schema names)",
     ("registry.py", "st != st_t"): "str (statements)",
-    ("dart_models.py", "not z < L + 2"): "refuses unless |omega s| < L + 2 certainly: conservative",
+    ("dart_tail.py", "not z < L + 2"): "refuses unless |omega s| < L + 2 certainly: conservative",
     ("dart_family.py", "B * Ms[-1] + c[0] * eye != fmpq_mat(n, n)"): "fmpq_mat (exact)",
-    ("dart_eigen.py", "not ((1 + c) * (9 + c)).real > 0"): "refuses unless Re > 0 certainly: conservative",
-    ("dart_eigen.py", "lhs != p * kap[i]"): "fmpq_poly (exact)",
-    ("dart_eigen.py", "not box.cos() < 0"): "refuses unless cos sigma < 0 certainly on the bracket: conservative",
-    ("dart_eigen.py", "P % q != 0"): "fmpq_poly (exact)",
+    ("dart_spectrum.py", "not ((1 + c) * (9 + c)).real > 0"): "refuses unless Re > 0 certainly: conservative",
+    ("dart_spectrum.py", "_X * N[i] - sum((B_AT_1[i, k] * N[k] for k in range(6)), fmpq_poly(0)) != p * kap[i]"):
+        "fmpq_poly (exact)",
+    ("dart_spectrum.py", "not box.cos() < 0"): "refuses unless cos sigma < 0 certainly on the bracket: conservative",
+    ("dart_spectrum.py", "sum((psi[i] * adj[i][j] for i in range(6)), fmpq_poly(0)) % q != 0"): "fmpq_poly (exact)",
     # a guard that the family's code matches the lemma's identities (it FAILs a flipped alpha); the lemma is
     # proved by the exact checks and the sign change, not by this test
-    ("dart_eigen.py", "z.contains(0)"): "a guard (above), never the proof",
+    ("dart_spectrum.py", "z.contains(0)"): "a guard (above), never the proof",
     ("dart_spectrum.py", "classes[0] != classes[1]"): "dicts of fmpq rows (exact)",
     ("dart_spectrum.py", "det2 != w * w * lam * lam - (5 * w * w + c2) * lam / 8 + w * w / 16"): "fmpq_mpoly (exact)",
     ("dart_spectrum.py", "64 * lam * g_num != 64 * lam * det2 + n2 * w * w"): "fmpq_mpoly (exact)",
@@ -40,7 +41,7 @@ REVIEWED = {
     ("dart_spectrum.py", "not abs(y) < fmpq(9, 10)"): "refuses unless |y| < 9/10 certainly: conservative",
     ("dart_spectrum.py", "not T > 0"): "refuses unless T > 0 certainly: conservative",
     ("dart_spectrum.py", "not 4 * arb(sig_r) < pi * k0"): "refuses unless certainly: conservative",
-    ("dart_spectrum.py", "_det3(b0(lam, h)) != (lam - 1) * P + h * detR"): "fmpq_mpoly (exact)",
+    ("dart_spectrum.py", "_det3(b0(lam, h)) != (lam - 1) * P + h * mode0_parts(lam, h)[1]"): "fmpq_mpoly (exact)",
     ("dart_spectrum.py", "rem != 0"): "fmpq_poly (exact)",
     ("dart_spectrum.py", "key != _C"): "tuples",
     # the sign of a square root is a choice (the expressions are even in it); _cot_far then refuses unless

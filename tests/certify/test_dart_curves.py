@@ -1,10 +1,9 @@
-"""T and W for every dart K >= K0 (verify.dart_models): the evaluators a record's leaves are replayed on."""
+"""T and W for every dart K >= K0 (verify.dart_tail): the evaluators a record's leaves are replayed on."""
 
 import pytest
 from flint import fmpq
 
-from ccproof.certify.verify.dart_family import TaylorHints
-from ccproof.certify.verify.dart_models import DartModels
+from ccproof.certify.verify.dart_tail import DartModels, TaylorHints
 
 LO, HI = fmpq(4484, 1000), fmpq(44935, 10000)  # the bracket of sigma(K), K >= 101
 H = (fmpq(0), fmpq(1, 101))  # every K >= 101

@@ -1,4 +1,4 @@
-"""The eigenvector lemma for every dart K >= K0 (ccproof.certify.verify.dart_eigen), cross-checked at single K
+"""The eigenvector lemma for every dart K >= K0 (ccproof.certify.verify.dart_spectrum), cross-checked at single K
 against the per-K verifier's exact even eigenvector and mode vector, and against S itself."""
 
 from functools import partial
@@ -6,7 +6,7 @@ from functools import partial
 import pytest
 from flint import acb, arb, ctx, fmpq
 
-from ccproof.certify.verify import dart_eigen as E
+from ccproof.certify.verify import dart_spectrum as E
 from ccproof.certify.verify.dart_family import Family
 from ccproof.certify.verify.errors import CertificateError
 from ccproof.certify.verify.tagged import labels, sector_rows

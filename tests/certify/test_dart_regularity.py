@@ -1,4 +1,4 @@
-"""R for every dart K >= K0 (verify.dart_models): the evaluators a record's leaves are replayed on."""
+"""R for every dart K >= K0 (verify.dart_tail): the evaluators a record's leaves are replayed on."""
 
 import importlib.util
 from pathlib import Path
@@ -6,8 +6,7 @@ from pathlib import Path
 import pytest
 from flint import arb, ctx, fmpq
 
-from ccproof.certify.verify.dart_family import TaylorHints
-from ccproof.certify.verify.dart_models import DartModels
+from ccproof.certify.verify.dart_tail import DartModels, TaylorHints
 from ccproof.certify.verify.tagged_map import PIECES
 
 LO, HI = fmpq(4484, 1000), fmpq(44935, 10000)  # the bracket of sigma(K), K >= 101

@@ -5,8 +5,7 @@ reason)."""
 import pytest
 from flint import arb, fmpq
 
-from ccproof.certify.verify.dart_family import TaylorHints
-from ccproof.certify.verify.dart_models import DartModels
+from ccproof.certify.verify.dart_tail import DartModels, TaylorHints
 from ccproof.certify.verify.errors import CertificateError
 from ccproof.certify.verify.replay import read_tree, replay_tree
 

@@ -5,8 +5,7 @@ import pytest
 from flint import arb, fmpq
 
 from ccproof.certify.tagged_dart import cover, map_covers
-from ccproof.certify.verify.dart_family import TaylorHints
-from ccproof.certify.verify.dart_models import DartModels, read_map, replay_map
+from ccproof.certify.verify.dart_tail import DartModels, TaylorHints, read_map, replay_map
 from ccproof.certify.verify.errors import CertificateError
 from ccproof.certify.verify.replay import read_tree, replay_tree
 

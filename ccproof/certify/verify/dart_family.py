@@ -1,27 +1,13 @@
-"""The characteristic map of ``dart:K`` for every K >= K0 as one family analytic in h = 1/K (trusted).
+"""The characteristic map of ``dart:K``, every K >= K0, as one family analytic in h = 1/K (trusted).
 
-x is the odd mode-1 eigenvector, y the even eigenvector of lam2 = lam(cos(2 sigma/K)) (docs/tagged_c1.md,
-"A plan for every dart K >= 101", items 4 and 6). Let v^_x(h) solve the bordered 6 x 6 system of the
-Fourier block B(w), w = e^(2 pi i h), for lam1 = lam(cos(2 pi h)) with v^(1,0) = 1, and v^_y(sigma, h) the
-same for w = e^(i phi), phi = 2 sigma h, lam = lam(cos phi). With s = t/K the angular position of quadrant
-t and delta the offset of a stencil point from it,
-
-    x(t, p) = Im(v^_x(p) e^(2 pi i s) e^(2 pi i delta h)),                x(centre) = 0,
-    y(t, p) = alpha U(p) + Re(v^_y(p) e^(i sigma (2 s - 1)) e^(2 i sigma delta h)),  y(centre) = alpha (lam - L0),
-
-L0 = lam(1), U(lam) = (lam - L0) (lam - B(1))^-1 kappa (kappa the centre's weights in the ring rows; the pole
-at L0 divided out exactly, :func:`big_u`) and alpha from the sharp midpoint's row. For sigma = sigma(K) (the
-root of the secular equation, :mod:`.dart_spectrum`) this is the eigenvector of lam2; for other sigma a family
-analytic in (sigma, h) near h = 0. The functions below take h as an acb ball (a point or a box of the complex
-h-square: the disc bounds) or as the power-series variable (acb_series: the Taylor coefficients), and build
-the Bezier nets of a bulk quadrant (:func:`basis_nets`, split by the dependence on s) and of the layer
-quadrants next to the sharp ray (:func:`layer_nets`: ghost rows, the sharp midpoint).
+x, y and their nets from the bordered Fourier systems (docs/tagged_c1.md, "Every dart K >= 101", item 6,
+"Closed forms without cancellation"): h an acb ball (the values, the disc bounds) or the series variable
+(acb_series: the Taylor coefficients); :class:`Modes` is shared with the exact family of :mod:`.dart_zeros`.
 """
 
 from __future__ import annotations
 
 from contextlib import contextmanager
-from dataclasses import dataclass
 
 from flint import acb, acb_mat, acb_poly, acb_series, arb, ctx, fmpq, fmpq_mat, fmpq_poly
 
@@ -31,31 +17,8 @@ from .rules import CENTRE, canonical, level1_rule
 from .statement import B2Z, horner, lam_of
 from .tagged_modes import RING_INDEX, bordered_matrix, bordered_solve, ring_block, ring_stencil
 
-
-@dataclass(frozen=True)
-class TaylorHints:
-    """The record's ``taylor`` hints (docs/certificates.md, "Every dart K >= K0"): they only choose orders and
-    boxes; every coefficient and bound is derived from them.
-
-    r : fmpq, the Cauchy radius (the complex h-square [-r, r]^2); disc_grid : int, grid x grid acb boxes
-    covering it; sigma_boxes : int, equal boxes of the sigma bracket; order, layer_order : int, Taylor orders
-    in h (bulk and middle; layer); exp_order : int, the middle's expansion of a_i(s) b_j(s) in s.
-    """
-
-    r: fmpq
-    disc_grid: int
-    sigma_boxes: int
-    order: int
-    layer_order: int
-    exp_order: int
-
-
 _OFFSET = {"P1": (0, -1), "P2": (0, 0), "P3": (-1, 0)}  # as tagged_map: level-1 position of net[0][0]
-
-
 PIECES = ("P1", "P2", "P3")
-
-
 
 
 def kappa():
@@ -76,14 +39,8 @@ def adjugate(B):
     return [[fmpq_poly([Ms[n - 1 - d][i, j] for d in range(n)]) for j in range(n)] for i in range(n)]
 
 
-def _adj_kappa_polys():
-    """N(lam) = adj(lam - B(1)) kappa as 6 exact polynomials (coefficient lists, degree <= 5)."""
-    B1 = fmpq_mat(ring_block(fmpq(1)))
-    adj, kap = adjugate(B1), kappa()
-    return [[sum((adj[i][k][d] * kap[k] for k in range(6)), fmpq(0)) for d in range(6)] for i in range(6)], B1
-
-
-N_POLYS, B_AT_1 = _adj_kappa_polys()  # N(lam) = adj(lam - B(1)) kappa (coefficient lists); B(1) (fmpq_mat)
+B_AT_1 = fmpq_mat(ring_block(fmpq(1)))  # B(1); N(lam) = adj(lam - B(1)) kappa as 6 coefficient lists (degree <= 5)
+N_POLYS = [[sum((a[k][d] * x for k, x in enumerate(kappa())), fmpq(0)) for d in range(6)] for a in adjugate(B_AT_1)]
 
 
 def l0():
@@ -104,9 +61,7 @@ def big_u(lam):
 
 
 def _lam_principal(c):
-    """lam(c) (:func:`.statement.lam_of`; acb, arb or acb_series). On an acb ball the square root's
-    argument must lie in the right half-plane (off the principal branch's cut, so the value is analytic
-    there: the Cauchy bounds need that); ZeroDivisionError otherwise."""
+    """lam(c) (:func:`.statement.lam_of`); on an acb ball ZeroDivisionError unless certainly off the cut."""
     if isinstance(c, acb) and not ((1 + c) * (9 + c)).real > 0:
         raise ZeroDivisionError("sqrt((1 + c)(9 + c)): the argument is not certainly off the branch cut")
     return lam_of(c)
@@ -114,9 +69,7 @@ def _lam_principal(c):
 
 @contextmanager
 def series_variable(n):
-    """Context: the series variable h to order n (acb_series [0, 1]) with ``ctx.cap`` >= n + 1 inside (restored
-    after): python-flint truncates every series to ``ctx.cap`` terms (10 by default) whatever its ``prec``, so
-    that no order is lost."""
+    """Context: the series variable h to order n, ``ctx.cap`` >= n + 1 inside (flint truncates series to it)."""
     old = ctx.cap
     ctx.cap = max(old, n + 1)
     try:
@@ -126,19 +79,14 @@ def series_variable(n):
 
 
 def series_coeffs(z, n, real=False):
-    """The first n Taylor coefficients of the series z (acb; zeros past its length; with ``real`` their real
-    parts, for a quantity real for real h); a value (acb, arb: the quantity at one h) is its own coefficient of
-    h^0, so every function below serves both."""
+    """The first n Taylor coefficients (acb; ``real``: their real parts) of a series, or of a value (its h^0)."""
     c = z.coeffs() if isinstance(z, acb_series) else [z]
     return [acb(c[i].real if real else c[i]) if i < len(c) else acb(0) for i in range(n)]
 
 
 def bordered(w, lam, pivot=0):
-    """v^ (6 values of w's type): B(w) v^ = lam v^, v^[pivot] = 1, from the bordered 7 x 7 system A v = e_7.
-
-    For acb balls :func:`.tagged_modes.bordered_solve` (arb proves A regular on the whole ball; ZeroDivisionError
-    otherwise). For power series in h (acb_series) the Taylor coefficients follow from A_0 v_k = -sum_(j >= 1)
-    A_j v_(k-j), A_0 the system at h = 0 (proved regular by arb)."""
+    """v^: B(w) v^ = lam v^, v^[pivot] = 1 (the bordered system A v = e_7): on acb balls
+    :func:`.tagged_modes.bordered_solve`; on series order by order, A_0 v_k = -sum_(j >= 1) A_j v_(k-j)."""
     if not isinstance(w, acb_series):
         return bordered_solve(ring_block(w), lam, pivot)
     A = bordered_matrix(ring_block(w), lam, w * 0, pivot)
@@ -164,22 +112,18 @@ def _eps(pos):
 
 
 class Modes:
-    """x and y from their modes, split by their dependence on s: x = E X+ + E^-1 X-, y = Y0 + F Y+ + F^-1 Y-,
-    E = e^(2 pi i s), F = e^(i sigma (2 s - 1)); one assembly for :class:`Family` (acb) and the exact family of
-    :mod:`.dart_zeros`. Needs vx, vy, U, alpha and yc (:meth:`mode0`), lam1, lam2, zero, i2 = 2i, sign, em, ep =
-    e^(-+ i sigma) and ``e(c, k)``: e^(i k a h) for c = "x", e^(i k b h) for "y" (a = 2 pi, b = 2 sigma). No
-    Re or Im: the conjugate of a mode is the mode of 1/w with the positions (a, b) swapped."""
+    """x = E X+ + E^-1 X-, y = Y0 + F Y+ + F^-1 Y- (E = e^(2 pi i s), F = e^(i sigma (2 s - 1))) from vx, vy, U,
+    lam1, lam2, zero, i2 = 2i, sign, em, ep = e^(-+ i sigma) and ``e(c, k)`` = e^(i k a h) ("x"), e^(i k b h) ("y");
+    no Re or Im (the conjugate of a mode is the mode of 1/w with (a, b) swapped)."""
 
     def mode0(self, cos_sigma, L0, flip=False):
-        """alpha = -(lam2 - 1/2) cos(sigma)/((lam2 - 1/2) U(1,0) - (lam2 - L0)/2) (the sharp midpoint's row;
-        -alpha with ``flip``, a control) and y's centre yc = alpha (lam2 - L0)."""
+        """alpha from the sharp midpoint's row (-alpha with ``flip``, a control), y's centre yc = alpha (lam2 - L0)."""
         lam, half = self.lam2, self.lam2 - fmpq(1, 2)
         self.alpha = -(half * cos_sigma) / (half * self.U[0] - (lam - L0) / 2) * (-1 if flip else 1)
         self.yc = self.alpha * (lam - L0)
 
     def parts(self):
-        """{name: (level0(delta, pos), centre, lam)} for X+, X-, Y0, Y+, Y-: level0 the level-0 value at sector
-        K s + delta and two-ring position pos."""
+        """{X+, X-, Y0, Y+, Y-: (level0(delta, pos), centre, lam)}, level0 at sector K s + delta, position pos."""
         vx, vy, e, i2, z = self.vx, self.vy, self.e, self.i2, self.zero
         return {
             "X+": (lambda d, p: vx[RING_INDEX[p]] * e("x", d) / i2, z, self.lam1),
@@ -190,10 +134,7 @@ class Modes:
         }
 
     def layer_level0(self, q=0):
-        """(x(t, p), y(t, p)) at integer sectors t (any sign; the same for every layer quadrant q):
-        x = (v^(p) w^t - v^(p~) w^(-t-eps))/(2i) (one mode, every t), y = alpha U(p) + (v^_y(p)
-        e^(i sigma (2 h t - 1)) + v^_y(p~) e^(-i sigma (2 h (t + eps) - 1)))/2 for t >= 0 and y's reflection
-        in ray 0 for t < 0 (ray t -> ray -t, quadrant t (a, b) -> quadrant -t-1 (b, a))."""
+        """(x(t, p), y(t, p)) at integer sectors t of any sign (y reflected in ray 0 for t < 0)."""
         vx, vy, e = self.vx, self.vy, self.e
 
         def x(t, pos):
@@ -208,16 +149,8 @@ class Modes:
 
 
 class Family(Modes):
-    """x and y of dart:K (:class:`Modes`) at one h (an acb ball, or the series variable: acb_series [0, 1])
-    and one sigma.
-
-    Parameters
-    ----------
-    h : acb or acb_series
-    sigma : arb
-    flip_mode0, smooth : bool
-        controls: alpha -> -alpha (a perturbed eigenvector), alpha = 0 (no kink at the sharp ray)
-    """
+    """x and y of dart:K at one h (acb, or the series variable) and sigma (arb); controls: ``flip_mode0``
+    (alpha -> -alpha), ``smooth`` (alpha = 0, the smooth valence's mode-1 cosine at sigma = pi)."""
 
     def __init__(self, h, sigma, flip_mode0=False, smooth=False):
         self.h, self.sigma = h, sigma
@@ -232,7 +165,7 @@ class Family(Modes):
         self.U = big_u(self.lam2)
         self.mode0(sigma.cos(), l0()[0], flip_mode0)
         self.sign = 1
-        if smooth:  # with sigma = pi: y = Re(v^ e^(2 pi i s)), the smooth valence's mode-1 cosine
+        if smooth:
             self.alpha, self.yc, self.sign = self.zero, self.zero, -1
         self._exp = {}
 
@@ -244,12 +177,9 @@ class Family(Modes):
 
 
 def quadrant_level1(level0, centre, lam, zero, q=None):
-    """``value(A, B)``: the level-1 value at position (A, B) of a quadrant: lam times the level-0 value on the
-    two-ring (the vector is an eigenvector of every ring row), the level-1 rule of :mod:`.rules` elsewhere.
-    ``q`` None: a bulk quadrant (no sharp ray within reach; ``level0(delta, pos)`` the level-0 value of sector
-    q + delta); else the layer quadrant q >= 0 (``level0(t, pos)`` at the sector t; ray 0 sharp, as
-    tagged_map.level1_values: the ghost row 2 P(A, 0) - P(A, 1) across ray 0, the sharp edge's midpoint at
-    ray 0's (3, 0))."""
+    """``value(A, B)``, the level-1 value at (A, B) of a quadrant: lam times level 0 on the two-ring, the rule of
+    :mod:`.rules` elsewhere; ``q`` None a bulk quadrant (``level0(delta, pos)``), else layer quadrant q
+    (``level0(t, pos)``; as tagged_map: the ghost row across ray 0, the sharp midpoint at its (3, 0))."""
     def lev0(d, a, b):
         dd, a2, b2 = canonical(a, b)
         return centre if (a2, b2) == CENTRE else level0(d + dd, (a2, b2))
@@ -273,16 +203,14 @@ def quadrant_level1(level0, centre, lam, zero, q=None):
 
 
 def _bezier(net, zero):
-    """4 x 4 B-spline control values -> Bezier (one coordinate, any ring): ``B2Z`` in both directions, integer
-    weights, one division by 36."""
+    """4 x 4 B-spline control values -> Bezier (any ring): ``B2Z`` both ways, one division by 36."""
     tmp = [[sum((net[r][j] * c for r, c in enumerate(B2Z[i]) if c), zero) for j in range(4)] for i in range(4)]
     return [[sum((tmp[i][r] * c for r, c in enumerate(B2Z[j]) if c), zero) / 36 for j in range(4)]
             for i in range(4)]
 
 
 def piece_nets(level0, centre, lam, zero, q=None):
-    """{piece: 4 x 4 Bezier net} of one coordinate (or one basis part) on a bulk quadrant (``q`` None) or on
-    the layer quadrant q (:func:`quadrant_level1`)."""
+    """{piece: 4 x 4 Bezier net} of one coordinate or basis part (:func:`quadrant_level1`)."""
     value, memo = quadrant_level1(level0, centre, lam, zero, q), {}
 
     def V(A, B):  # the three pieces share most of their level-1 points
@@ -294,17 +222,14 @@ def piece_nets(level0, centre, lam, zero, q=None):
 
 
 XB, YB = ("X+", "X-"), ("Y0", "Y+", "Y-")
-
-
 _SU, _SH = 6, 36  # Kronecker strides: a product of bicubic partials has degree <= 5 in u and in v
 _BIN = ((1,), (1, 1), (1, 2, 1), (1, 3, 3, 1), (1, 4, 6, 4, 1), (1, 5, 10, 10, 5, 1))  # C(d, i)
 _BIN2, _BIN3, _BIN5 = _BIN[2], _BIN[3], _BIN[5]
 
 
 def _packed(nets, axis, stride=_SH):
-    """One acb_poly holding, for every h^m coefficient net (4 x 4; 1 x 4 a curve, 1 x 1 a scalar), its partial
-    along ``axis`` (0: u, 1: v; None: the net itself) in Bernstein form times its binomial weights, at
-    x^(m stride + i _SU + j)."""
+    """One acb_poly: each h^m coefficient net's (4 x 4, 1 x 4 or 1 x 1) partial along ``axis`` (0: u, 1: v; None:
+    the net) times its binomial weights, at x^(m stride + i _SU + j) (Kronecker packing of (h, u, v))."""
     coeffs = [acb(0)] * (stride * len(nets))
     for m, net in enumerate(nets):
         rows, cols = len(net) - (axis == 0), len(net[0]) - (axis == 1)
@@ -317,8 +242,7 @@ def _packed(nets, axis, stride=_SH):
 
 
 def _unpacked(P, n, stride, rows):
-    """The h^m coefficients, m = 0..n, of a packed product of degree 5 (in u and v, ``rows`` = 6; or in the curve
-    parameter, ``rows`` = 1): the scaled Bernstein coefficients divided by their binomial weights."""
+    """The h^m coefficients, m <= n, of a packed product of degree 5 (``rows`` 6: in u, v; 1: a curve)."""
     c = P.coeffs()
     c += [acb(0)] * max(0, stride * (n + 1) - len(c))
     return [[c[m * stride + i * _SU + j] / (_BIN5[i] * _BIN5[j]) for i in range(rows) for j in range(6)]
@@ -326,18 +250,14 @@ def _unpacked(P, n, stride, rows):
 
 
 def packed_partials(nets):
-    """(u-partial, v-partial) of a net given by its h^m coefficient nets (:func:`_packed`), for
-    :func:`det_series`: pack each factor once when it enters several determinants."""
+    """(u-partial, v-partial) of a net's h^m coefficient nets, packed once for :func:`det_series`."""
     return _packed(nets, 0), _packed(nets, 1)
 
 
 def det_series(A, B, n):
-    """The h^m coefficients, m = 0..n, of D(A, B) = A_u B_v - A_v B_u for nets given by their h^m coefficient
-    nets ``A[m]``, ``B[m]`` (4 x 4, acb) or by their :func:`packed_partials`: the Cauchy products of
-    Bernstein forms as one polynomial product each (the scaled coefficients of a product are the plain
-    convolution of the scaled factors, as in :meth:`~ccproof.rigorous.BernsteinForm.__mul__`; h, u, v packed
-    with the strides above). Returns ``[[36 acb, (i, j) row-major] for m in 0..n]``: D's Bernstein
-    coefficients (degree (5, 5))."""
+    """[m <= n: D(A, B)'s 36 Bernstein coefficients (degree (5, 5), row-major)], D = A_u B_v - A_v B_u, of nets
+    given by their h^m coefficient nets or :func:`packed_partials`: one polynomial product (scaled Bernstein
+    coefficients of a product convolve)."""
     (Au, Av), (Bu, Bv) = (X if isinstance(X, tuple) else packed_partials(X) for X in (A, B))
     return _unpacked(Au * Bv - Av * Bu, n, _SH, 6)
 
@@ -367,8 +287,7 @@ def bezier_product(f, g):
 
 
 def series_curves(nets, n, real=False):
-    """{curve: [order m: 4 acb]} of one coordinate's nets {piece: 4 x 4 acb_series} (``real``: as
-    :func:`series_coeffs`)."""
+    """{curve: [order m: 4 acb]} of one coordinate's nets {piece: 4 x 4 series or values}."""
     out = {}
     for name in STAR_CURVES:
         pts = [series_coeffs(z, n + 1, real) for z in curve_points(nets, name, oriented=True)]
@@ -377,9 +296,8 @@ def series_curves(nets, n, real=False):
 
 
 def curve_trans_series(xc, yc, A1, A2, n):
-    """Taylor coefficients of a1 X Y' - a2 Y X' from the coordinates' (xc, yc: [m: 4 values]) and a_i's: the
-    Cauchy products in h of the degree-5 Bernstein products f g' (scaled coefficients convolve, then divide by
-    C(5, k)) as acb_poly products, h packed with stride 6 (:func:`_packed` of 1 x 4 and 1 x 1 nets)."""
+    """[m <= n: the 6 Bernstein coefficients of a1 X Y' - a2 Y X'] from the curves' (xc, yc: [m: 4 values]) and
+    a_i's Taylor coefficients, as packed acb_poly products (stride 6)."""
     a1, a2 = (_packed([[[z]] for z in A[:n + 1]], None, 6) for A in (A1, A2))
     X, Y = ([[pts] for pts in c] for c in (xc, yc))
     P = a1 * (_packed(X, None, 6) * _packed(Y, 1, 6)) - a2 * (_packed(Y, None, 6) * _packed(X, 1, 6))

@@ -1,66 +1,12 @@
-"""The spectrum of ``dart:K`` for every K >= K0 at once (trusted).
+"""The spectrum and the eigenvectors of ``dart:K`` for every K >= K0 at once (trusted).
 
-The statement (docs/tagged_c1.md, "A plan for every dart K >= 101", items 1 to 3): for every K >= K0,
-1 is a simple eigenvalue of S, lam1 = lam(cos(2 pi/K)) (odd, mode 1) and lam2 are simple, and every
-other eigenvalue has modulus below r = lam(cos(2 sigma_r/K)) < lam2 < lam1. lam2 = lam(cos(2 sigma*/K))
-with sigma* in the record's bracket comes from the eigenvector lemma (:mod:`.dart_eigen`), which needs the
-count shown here. The argument, with what is checked where:
-
-1. **Construction for every K** (:func:`check_construction`, exact). Every row of S but the centre's is
-   the translate of one row per window class (kind, min(t, 3), min(K - t, 3), position): the rows of
-   ``dart:7`` and ``dart:8`` relative to their point are one row per class, the same in both, and every
-   class of a K >= 7 occurs there. The centre row is the smooth rule with weights 1 - 7h/4, 3h^2/2 on each
-   ray's (1,0) and h^2/4 on each quadrant's (1,1), h = 1/K (checked for K = 7..12). :func:`.tagged_modes.
-   check_dart` at K = 7, 8 then holds for every K: S commutes with the reflection R in ray 0; S is the
-   ring operator L on the odd vectors (modes w_j = e^(2 pi i j/K), 1 <= j < K/2, and the odd parts of
-   w = 1, -1, whose blocks do not depend on K); the one-ring (C, every (1,0), every (1,1)) is closed;
-   every weight is >= 0, so the outer even rows' absolute sums are the window classes' and bound the
-   outer eigenvalues by 15/64 for every K.
-2. **Odd part.** Mode j has 1/8, 1/16, 1/32, 1/64, lam(c_j) and 1/(16 lam(c_j)) <= 1/4 (the block
-   polynomial, :func:`.tagged_modes.check_ring`), c_j = cos(2 pi j/K); lam is strictly increasing on
-   [-1, 1], so lam(c_1) = lam1 is the only one >= r when pi < sigma_r < 2 pi. The odd blocks of w = +-1
-   have every eigenvalue below 1/2 (exact characteristic polynomials, roots in arb); r > 1/2 because
-   2 sigma_r/K0 < pi/2. So the odd part has lam1 once and nothing else of modulus >= r.
-3. **The even one-ring: a secular equation.** On the one-ring of 2K + 1 points the dart's operator is the
-   smooth one S0 plus e_0 d^T (d: ray 0's sharp midpoint row minus the smooth edge row, derived from the
-   rows; R-invariant, so d^T vanishes on odd vectors), hence det(lam - S) = det(lam - S0)(1 - F(lam)),
-   F = d^T (lam - S0)^-1 e_0. In the Fourier modes of S0 (mode j != 0: the 2 x 2 block B1(w) of the ring
-   stencil on (1,0), (1,1), closed: checked; mode 0: the 3 x 3 block B0(h) on (C, E, F))
-
-       F = (1/K) [ sum_{j=1}^{K-1} g(lam, c_j) + g0(lam, h) ],   g = d_e(w) e^ + d_f(w) f^ = 1 + n*/(4 lam (c* - c)),
-
-   (e^, f^) = (lam - B1(w))^-1 (1, 0), d_e, d_f the sums of d's ray and quadrant weights times w^delta, g0 the
-   same with B0 and (0, 1, 0), c* = 8 lam - 5 + 1/(2 lam), n* = 4 (1 - c*)(lam - 1/4) - (1 + c*)
-   (:func:`check_secular`: the identity of g in Q(lam, w), exact with fmpq_mpoly), and by the classical
-   partial fractions of K z^(K-1)/(z^K - 1) (a stated lemma) sum_{j=0}^{K-1} 1/(cos phi - c_j) =
-   -K cot(K phi/2)/sin phi, c* = cos phi. So
-
-       1 - F = h (1 - g0) + n*/(4 lam) (cot(K phi/2)/sin phi + h/(c* - 1)).
-
-   det(lam - B0) = (lam - 1) P(lam) + h det R(lam), P = lam^2 - 3 lam/4 + 1/16 = -lam (1 - c*)/8 (exact):
-   the mode-0 pole is divided out where h -> 0.
-4. **The count.** S0's eigenvalues of modulus >= r: 1 (mode 0; simple: Q(1) > 0 below), lam(c_1) twice
-   (modes 1 and K - 1, one even and one odd combination); modes j >= 2 lie below r, 1/(16 lam) <= 1/4 < r,
-   and mode 0's other two, the roots of Q = det(x - B0)/(x - 1) = P + h l (l = det R/(x - 1), linear:
-   exact), are real, positive and below r: disc(Q) > 0, Q(0) > 0 > Q'(0), Q(r)/h > 0 and Q'(r) > 0 on h-balls
-   covering [0, 1/K0]
-   (:func:`check_mode0_roots`). None lies on the circle. If Re(1 - F) > 0 on |lam| = r (the record's trees over
-   the regions N, I, F below, for t = arg lam in [0, pi]; the lower half by conjugation), 1 - F does not
-   wind, so the one-ring operators of S and S0 have equally many eigenvalues outside the circle: 3. The
-   odd part is the same for both (lam1, once), so the even one-ring has exactly two: 1 and, by the
-   eigenvector lemma, lam(cos(2 sigma*/K)) with sigma* < sigma_hi < sigma_r; both simple. With 1. and 2.
-   this is the spectral part of the generalized Reif criterion for every K >= K0.
-
-The regions (each includes h = 0, K = infinity), on lam = r e^(it), r = lam(cos(2 sigma_r h)):
-
-* N, t = tau h^2, (tau, h) in [0, tau1] x [0, 1/K0]: h (1 - F), with D = (1 - c*)/h^2 analytic and
-  sigma^2 = D A(h^2 D)/2, A(x) = (asin(s)/s)^2 at s^2 = x/2 (its series with the tail as a ball);
-* I, t in [tau1 h^2, v0^2]: v = sqrt(t), w = h/v, (v, w) in [0, v0] x [0, w1] with w1^2 tau1 >= 1:
-  v (1 - F), cot(K phi/2) = -i plus a ball of radius 2 e^(-2T)/(1 - e^(-2T)), T = Im(K phi/2);
-* F, (t, h) in [v0^2, 355/113] x [0, 1/K0]: 1 - F, T >= Im(phi) K0/2.
-
-Each evaluator returns an arb enclosing Re of its quantity on a box (the multiplier h or v is > 0 for
-every finite K); the record's trees (:func:`.replay.read_tree`) bound it below by a positive number.
+The arguments are docs/tagged_c1.md, "Every dart K >= 101", items 3 and 7 (with "The spectral step" and "The
+eigenvector lemma" there). G: S is built alike for every K >= 7 (:func:`check_construction`); det(lam - S) =
+det(lam - S0)(1 - F) on the one-ring with the secular identities exact (:func:`check_secular`), mode 0's roots
+below the circle (:func:`check_mode0_roots`) and Re(1 - F) > 0 on the regions N, I, F (:class:`SpectralRegions`):
+only 1, lam1 and one even eigenvalue lie outside |lam| = lam(cos(2 sigma_r/K)). E: that one is lam(cos(2 sigma*/K))
+with sigma* in the bracket, and the family of :mod:`.dart_family` there (and x) are the eigenvectors
+(:func:`check_eigenvector`).
 """
 
 from __future__ import annotations
@@ -68,22 +14,26 @@ from __future__ import annotations
 from functools import cache
 from math import isqrt
 
-from flint import acb, arb, fmpq, fmpq_mpoly_ctx, fmpq_poly
+from flint import acb, arb, ctx, fmpq, fmpq_mat, fmpq_mpoly_ctx, fmpq_poly
 
 from ccproof.rigorous.analytic import ball
 
-from .dart_family import kappa
+from .dart_family import B_AT_1, N_POLYS, Family, adjugate, kappa, l0, u_denominator
 from .errors import CertificateError
+from .rules import TWO_RING
 from .statement import lam_of
 from .tagged import labels, sector_rows, window_rows
-from .tagged_modes import RING_INDEX, charpoly_roots, check_dart, check_ring, ring_stencil
+from .tagged_modes import RING_INDEX, charpoly_roots, check_dart, check_ring, ring_block, ring_stencil
 
 WINDOW = (7, 8)  # the window classes of every K >= 7 occur in both
 _C = ("C",)
 _E, _F = (1, 0), (1, 1)  # the one-ring positions
-_HALF, _QUARTER, _EIGHTH = fmpq(1, 2), fmpq(1, 4), fmpq(1, 8)
+_E10, _E20, _E11 = RING_INDEX[_E], RING_INDEX[(2, 0)], RING_INDEX[_F]
+_HALF, _QUARTER = fmpq(1, 2), fmpq(1, 4)
+_X = fmpq_poly([0, 1])
 T_PI = fmpq(355, 113)  # > pi: region F's end (boxes beyond pi are harmless: the circle continues)
 W_DEN = 1024  # w1 = m/W_DEN, the least m with m^2 tau1 >= W_DEN^2
+W_POINTS = 33  # the remainders of check_crease_row: w^-16 times polynomials of degree <= 32 in w
 
 
 def _centre_ok(k):
@@ -99,20 +49,29 @@ def _centre_ok(k):
 
 @cache
 def check_construction():
-    """Raise unless S is built the same way for every K >= 7 (item 1 of the module docstring); returns
-    (d, bound): d as {("C",) or (kind, delta, position): weight} relative to ray 0 (the sharp midpoint row
-    minus the smooth edge row) and the bound on the outer even rows.
+    """Raise unless S is built alike for every K >= 7; returns (d, bound): d = ray 0's sharp midpoint row minus
+    the smooth edge row, {("C",) or (kind, delta, position): weight}, and the outer even rows' bound.
 
-    Examples
-    --------
     >>> d, bound = check_construction()
     >>> d[("C",)], d[("r", 0, 1, 0)], d[("q", -1, 1, 1)], bound
     (1/8, 1/8, -1/16, 15/64)
     """
     sharp = _check_rows()
     bound = _outer_bound()
-    _check_one_ring_closed()
-    return _check_d(_construction_d(sharp)), bound
+    for pos in (_E, _F):  # the one-ring is closed in the ring stencil
+        if any(q not in (_E, _F) for _, q in ring_stencil()[RING_INDEX[pos]]):
+            raise CertificateError(f"the ring row of {pos} leaves the one-ring")
+    smooth = {("r" if q[1] == 0 else "q", dlt) + q: x for (dlt, q), x in ring_stencil()[_E10].items()}
+    smooth[_C] = kappa()[_E10]
+    d = {key: sharp.get(key, 0) - smooth.get(key, 0) for key in set(sharp) | set(smooth)}
+    d = {key: x for key, x in d.items() if x != 0}
+    for key in d:
+        if key != _C and (key[2:] not in (_E, _F) or not -1 <= key[1] <= 1):
+            raise CertificateError(f"dart: d reads {key} outside the one-ring window")
+        mirror = key if key == _C else (key[0], -key[1] if key[2:] == _E else -key[1] - 1) + key[2:]
+        if d.get(mirror, 0) != d[key]:
+            raise CertificateError("dart: d is not invariant under the reflection in ray 0")
+    return d, bound
 
 
 def _check_rows():
@@ -130,8 +89,8 @@ def _check_rows():
 
 
 def _outer_bound():
-    """The bound on the outer even rows over the window (raise if over 15/64, or if an odd block of the modes
-    +-1 has an eigenvalue >= 1/2)."""
+    """The outer even rows' bound over the window (raise over 15/64, or for an odd block of the modes +-1 with
+    an eigenvalue >= 1/2)."""
     bound = fmpq(0)
     for k in WINDOW:
         _, _, blocks, _, _, b = check_dart(k)
@@ -144,34 +103,8 @@ def _outer_bound():
     return bound
 
 
-def _check_one_ring_closed():
-    for pos in (_E, _F):  # the one-ring is closed in the ring stencil
-        if any(q not in (_E, _F) for _, q in ring_stencil()[RING_INDEX[pos]]):
-            raise CertificateError(f"the ring row of {pos} leaves the one-ring")
-
-
-def _construction_d(sharp):
-    """The sharp midpoint row minus the smooth edge row, zero weights dropped."""
-    smooth = {("r" if q[1] == 0 else "q", dlt) + q: x for (dlt, q), x in ring_stencil()[RING_INDEX[_E]].items()}
-    smooth[_C] = kappa()[RING_INDEX[_E]]
-    d = {key: sharp.get(key, 0) - smooth.get(key, 0) for key in set(sharp) | set(smooth)}
-    return {key: x for key, x in d.items() if x != 0}
-
-
-def _check_d(d):
-    """Raise unless d reads only the one-ring window and is invariant under the reflection in ray 0."""
-    for key in d:
-        if key != _C and (key[2:] not in (_E, _F) or not -1 <= key[1] <= 1):
-            raise CertificateError(f"dart: d reads {key} outside the one-ring window")
-        mirror = key if key == _C else (key[0], -key[1] if key[2:] == _E else -key[1] - 1) + key[2:]
-        if d.get(mirror, 0) != d[key]:
-            raise CertificateError("dart: d is not invariant under the reflection in ray 0")
-    return d
-
-
 def _b1w(w, zero):
-    """w B1(w), B1 the ring stencil's 2 x 2 block on (1,0), (1,1) (no negative power of w: w an fmpq or a
-    polynomial generator; ``zero`` of its ring)."""
+    """w B1(w), B1 the ring stencil's 2 x 2 block on (1,0), (1,1) (w an fmpq or a polynomial generator)."""
     out = [[zero, zero], [zero, zero]]
     for i, pos in enumerate((_E, _F)):
         for (dlt, q), x in ring_stencil()[RING_INDEX[pos]].items():
@@ -180,8 +113,7 @@ def _b1w(w, zero):
 
 
 def _dw(w, zero):
-    """(d_C, w d_e(w), w d_f(w)): d in the mode w (d_e = sum over rays delta of d w^delta, d_f over quadrants;
-    w and ``zero`` as :func:`_b1w`)."""
+    """(d_C, w d_e(w), w d_f(w)): d in the mode w (d_e sums d's rays' weights times w^delta, d_f its quadrants')."""
     d, _ = check_construction()
     de, df = zero, zero
     for key, x in d.items():
@@ -194,8 +126,8 @@ def _dw(w, zero):
 def b0(lam, h):
     """lam - B0(h), the mode-0 block on (C, E, F) (3 x 3 of lam's type)."""
     kap, B = kappa(), _b1w(fmpq(1), fmpq(0))  # B1(1)
-    rows = [[1 - fmpq(7, 4) * h, fmpq(3, 2) * h, _QUARTER * h], [kap[RING_INDEX[_E]], B[0][0], B[0][1]],
-            [kap[RING_INDEX[_F]], B[1][0], B[1][1]]]
+    rows = [[1 - fmpq(7, 4) * h, fmpq(3, 2) * h, _QUARTER * h], [kap[_E10], B[0][0], B[0][1]],
+            [kap[_E11], B[1][0], B[1][1]]]
     return [[(lam if i == j else 0) - rows[i][j] for j in range(3)] for i in range(3)]
 
 
@@ -205,50 +137,40 @@ def _det3(A):
 
 
 def mode0_parts(lam, h):
-    """(num, det R): g0 = num/(8 det(lam - B0))... precisely g0 = num/det(lam - B0), num = the Cramer
-    numerators of (lam - B0)^-1 (0, 1, 0) weighed by d's mode-0 part; det R = the h-coefficient of
-    det(lam - B0) (only B0's first row depends on h, affinely)."""
+    """(num, det R): g0 = num/det(lam - B0) (Cramer's numerators of (lam - B0)^-1 (0, 1, 0) weighed by d's mode-0
+    part) and det R, the h-coefficient of det(lam - B0) (only B0's first row depends on h, affinely)."""
     M = b0(lam, h)
-    dc, de, df = _dw(fmpq(1), fmpq(0))
     num = 0 * lam
-    for c, wt in enumerate((dc, de, df)):
+    for c, wt in enumerate(_dw(fmpq(1), fmpq(0))):
         num += wt * _det3([[(int(i == 1) if j == c else M[i][j]) for j in range(3)] for i in range(3)])
-    R = [[fmpq(7, 4), fmpq(-3, 2), -_QUARTER]] + b0(lam, 0)[1:]
-    return num, _det3(R)
+    return num, _det3([[fmpq(7, 4), fmpq(-3, 2), -_QUARTER]] + b0(lam, 0)[1:])
 
 
 @cache
 def check_secular():
-    """Raise unless the identities of item 3 hold exactly: det(lam - B1(w)) = lam^2 - (5 + c) lam/8 + 1/16,
-    g = 1 + n*/(4 lam (c* - c)) in Q(lam, w), P = -lam (1 - c*)/8, det(lam - B0) = (lam - 1) P + h det R,
-    and det R = (lam - 1) l with l linear.
+    """Raise unless the secular identities hold exactly (fmpq_mpoly): det(lam - B1(w)), g = 1 + n*/(4 lam (c* - c)),
+    P = -lam (1 - c*)/8, det(lam - B0) = (lam - 1) P + h det R, det R = (lam - 1) l, l linear.
 
-    Examples
-    --------
     >>> check_secular()
     True
     """
-    ctx = fmpq_mpoly_ctx.get(("l", "w", "h"), "lex")
-    lam, w, h = ctx.gens()
-    # clear w's negative powers: everything below is multiplied by w^2 (B1 reaches w^-1, d reaches w^-1)
-    B = _b1w(w, ctx.from_dict({}))
+    lam, w, h = fmpq_mpoly_ctx.get(("l", "w", "h"), "lex").gens()
+    zero = 0 * lam  # everything below is multiplied by w^2 (B1 and d reach w^-1)
+    B = _b1w(w, zero)
     c2 = (w * w + 1) * w / 2  # w^2 c
     det2 = (lam * w - B[0][0]) * (lam * w - B[1][1]) - B[0][1] * B[1][0]  # w^2 det(lam - B1)
     if det2 != w * w * lam * lam - (5 * w * w + c2) * lam / 8 + w * w / 16:
         raise CertificateError("the 2 x 2 one-ring block has another characteristic polynomial")
-    dc, de, df = _dw(w, ctx.from_dict({}))  # w d_e(w), w d_f(w)
+    dc, de, df = _dw(w, zero)
     g_num = (lam * w - B[1][1]) * de + B[1][0] * df  # w^2 det(lam - B1) g
-    # c* = 8 lam - 5 + 1/(2 lam); 2 lam n* = 4 (2 lam - 2 lam c*)(lam - 1/4) - (2 lam + 2 lam c*)
     lc = 16 * lam * lam - 10 * lam + 1  # 2 lam c*
     n2 = 4 * (2 * lam - lc) * (lam - _QUARTER) - (2 * lam + lc)  # 2 lam n*
-    # g det = det + n*/32 (c* - c = 8 det/lam), times 64 lam w^2
-    if 64 * lam * g_num != 64 * lam * det2 + n2 * w * w:
+    if 64 * lam * g_num != 64 * lam * det2 + n2 * w * w:  # g det = det + n*/32 (c* - c = 8 det/lam)
         raise CertificateError("the mode term g(lam, c) is not 1 + n*/(4 lam (c* - c))")
     P = lam * lam - 3 * lam / 4 + fmpq(1, 16)
-    if 8 * P * 2 != -(2 * lam - lc):  # 8 P = -lam (1 - c*), times 2
+    if 8 * P * 2 != -(2 * lam - lc):
         raise CertificateError("P is not -lam (1 - c*)/8")
-    _, detR = mode0_parts(lam, h)
-    if _det3(b0(lam, h)) != (lam - 1) * P + h * detR:
+    if _det3(b0(lam, h)) != (lam - 1) * P + h * mode0_parts(lam, h)[1]:
         raise CertificateError("det(lam - B0) is not (lam - 1) P + h det R")
     _ell()
     return True
@@ -256,34 +178,29 @@ def check_secular():
 
 def _ell():
     """l = det R/(lam - 1), raising unless det R (in Q[lam]) is (lam - 1) times a polynomial of degree <= 1."""
-    x = fmpq_poly([0, 1])
-    ell, rem = divmod(mode0_parts(x, 0)[1], x - 1)
+    ell, rem = divmod(mode0_parts(_X, 0)[1], _X - 1)
     if rem != 0 or ell.degree() > 1:
         raise CertificateError("det R is not (lam - 1) times a linear polynomial")
     return ell
 
 
 def check_mode0_roots(sig_r, k0, balls):
-    """Raise unless on ``balls`` h-balls covering [0, 1/k0]: disc(Q) > 0, Q(0) > 0 and Q'(0) < 0 (both roots
-    real and positive), Q(r)/h > 0, Q'(r) > 0 (both below r) and Q(1) > 0 (1 simple). Returns the least Q(r)/h.
+    """Raise unless on ``balls`` h-balls covering [0, 1/k0] Q's roots are real, positive and below r and
+    Q(1) > 0 (1 simple); returns the least Q(r)/h.
 
-    Examples
-    --------
-    >>> from flint import fmpq
     >>> check_mode0_roots(fmpq(27, 5), 101, 16) > 0
     True
     """
     ell = _ell()
-    l0, l1 = ell[0], ell[1]
+    l0_, l1 = ell[0], ell[1]
     sr = arb(sig_r)
     least = None
     for i in range(balls):
         h = ball(fmpq(i, balls * k0), fmpq(i + 1, balls * k0))
         r = lam_of((2 * sr * h).cos())  # the circle's radius (2 sigma_r h < pi/2: check_ranges)
-        q_over_h = l0 + l1 * r - r / 4 * sr ** 2 * h * (sr * h).sinc() ** 2  # P(r) = -r sigma_r^2 h^2 sinc^2/4
-        b, c = -fmpq(3, 4) + h * l1, fmpq(1, 16) + h * l0
-        ok = (b * b - 4 * c > 0 and c > 0 and b < 0 and q_over_h > 0 and 2 * r + b > 0 and 1 + b + c > 0)
-        if not ok:
+        q_over_h = l0_ + l1 * r - r / 4 * sr ** 2 * h * (sr * h).sinc() ** 2  # P(r) = -r sigma_r^2 h^2 sinc^2/4
+        b, c = -fmpq(3, 4) + h * l1, fmpq(1, 16) + h * l0_
+        if not (b * b - 4 * c > 0 and c > 0 and b < 0 and q_over_h > 0 and 2 * r + b > 0 and 1 + b + c > 0):
             raise CertificateError(f"mode 0: h-ball {i}: Q's roots are not certainly real and below r, or Q(1) = 0")
         least = q_over_h.lower() if least is None else min(least, q_over_h.lower())
     return least
@@ -295,8 +212,7 @@ def _e1(z):
 
 
 def _asin_ratio_sq(x, terms=40):
-    """A(x) = (asin(s)/s)^2, s^2 = x/2: the series sum c_n y^n/(2n + 1), y = x/2, c_n <= 1, tail <=
-    |y|^terms/(1 - |y|); raises ValueError unless |y| < 9/10."""
+    """A(x) = (asin(s)/s)^2, s^2 = x/2: sum c_n y^n/(2n + 1), y = x/2, c_n <= 1, tail <= |y|^terms/(1 - |y|)."""
     y = x / 2
     if not abs(y) < fmpq(9, 10):
         raise ValueError("asin series: |x/2| is not certainly below 9/10")
@@ -323,17 +239,9 @@ def _nstar(one_minus_c, lam):
 
 
 class SpectralRegions:
-    """The evaluators of Re h (1 - F), Re v (1 - F), Re (1 - F) on the boxes of regions N, I, F.
+    """The evaluators of Re h (1 - F), Re v (1 - F), Re (1 - F) on boxes of the regions N, I, F (the circle
+    |lam| = lam(cos(2 sigma_r/K))).
 
-    Parameters
-    ----------
-    sig_r : fmpq
-        The circle |lam| = lam(cos(2 sigma_r/K)).
-    k0 : int
-
-    Examples
-    --------
-    >>> from flint import fmpq
     >>> reg = SpectralRegions(fmpq(27, 5), 101)
     >>> bool(reg.n([(fmpq(0), fmpq(5, 4)), (fmpq(0), fmpq(1, 404))]) > 0)
     True
@@ -404,10 +312,8 @@ class SpectralRegions:
 
 
 def w1_of(tau1):
-    """w1 = m/W_DEN with m the least integer such that w1^2 tau1 >= 1 (exact: m^2 >= c, c the least integer
-    >= W_DEN^2/tau1).
+    """w1 = m/W_DEN, m the least integer with w1^2 tau1 >= 1 (exact).
 
-    >>> from flint import fmpq
     >>> w1_of(fmpq(50))
     145/1024
     """
@@ -421,7 +327,6 @@ def w1_of(tau1):
 def region_roots(k0, tau1, v0):
     """The root boxes of the regions N, I, F (fixed by K0, tau1, v0).
 
-    >>> from flint import fmpq
     >>> region_roots(101, fmpq(50), fmpq(2, 5))["I"]
     [(0, 2/5), (0, 145/1024)]
     """
@@ -441,5 +346,162 @@ def check_ranges(k0, sig_lo, sig_hi, sig_r, tau1, v0):
         raise CertificateError("spectrum: need tau1 > 0 and 0 < v0^2 < pi")
 
 
-__all__ = ["SpectralRegions", "T_PI", "WINDOW", "b0", "check_construction", "check_mode0_roots", "check_ranges",
-           "check_secular", "mode0_parts", "region_roots", "w1_of"]
+def check_reach():
+    """Raise unless a ray's ring row reads rays d = -1..1 and quadrants d = -1, 0, a quadrant's rays d = 0, 1 and
+    its own quadrant (the lemma's windows).
+
+    >>> check_reach()
+    True
+    """
+    for pos, row in zip(TWO_RING, ring_stencil()):
+        for d, q in row:
+            if pos[1] == 0:
+                ok = -1 <= d <= 1 if q[1] == 0 else d in (-1, 0)
+            else:
+                ok = d in (0, 1) if q[1] == 0 else d == 0
+            if not ok:
+                raise CertificateError(f"the ring row of {pos} reads {q} of sector +{d}: "
+                                       "beyond the windows of the lemma")
+    return True
+
+
+def check_mode0():
+    """Raise unless (x - B(1)) N(x) = det(x - B(1)) kappa for U's numerator N (exact in Q[x]).
+
+    >>> check_mode0()
+    True
+    """
+    p, kap = B_AT_1.charpoly(), kappa()
+    N = [fmpq_poly(c) for c in N_POLYS]
+    for i in range(6):
+        if _X * N[i] - sum((B_AT_1[i, k] * N[k] for k in range(6)), fmpq_poly(0)) != p * kap[i]:
+            raise CertificateError("U's numerator is not adj(x - B(1)) kappa: the mode-0 part misses its rows")
+    return True
+
+
+def check_crease_row(points=W_POINTS):
+    """Raise unless a1 b2 = a2 b1 on the curve lam = lam(c) (exact at w = 1..points): ray 0's crease vertex row
+    holds wherever its sharp midpoint's does.
+
+    >>> check_crease_row()
+    True
+    """
+    if points < W_POINTS:
+        raise CertificateError(f"{points} values of w cannot show an identity of degree {W_POINTS - 1}")
+    p = B_AT_1.charpoly()  # the product of check_ring's block polynomial at w = 1
+    N = [fmpq_poly(c) for c in N_POLYS]
+    if any(n.degree() > 5 for n in N):
+        raise CertificateError("U's numerator has degree > 5: the degree bound of the identity fails")
+    a1 = (_X - _HALF) * N[_E10] - p / 2
+    a2 = (_X - fmpq(1, 8)) * N[_E20] - fmpq(3, 4) * N[_E10] - p / 8
+    psi = [fmpq_poly(0)] * 6
+    psi[_E20] = a1 * (_X - fmpq(1, 8))
+    psi[_E10] = -fmpq(3, 4) * a1 - a2 * (_X - _HALF)
+    for w in range(1, points + 1):
+        q = _X * _X - (5 + (fmpq(w) + fmpq(1, w)) / 2) / 8 * _X + fmpq(1, 16)
+        adj = adjugate(fmpq_mat(ring_block(fmpq(w))))
+        for j in range(6):
+            if sum((psi[i] * adj[i][j] for i in range(6)), fmpq_poly(0)) % q != 0:
+                raise CertificateError(f"a1 b2 != a2 b1 at w = {w}: the crease vertex row of ray 0 fails")
+    return True
+
+
+def _nonzero(z, what):
+    if not (z.is_finite() and abs(z) > 0):
+        raise ZeroDivisionError(f"{what} is not certainly non-zero")
+
+
+def scaled_centre_residual(fam):
+    """r/h, the centre row's residual of S y - lam y over h, of a Family at an acb ball h (0 allowed) and an arb
+    sigma; ZeroDivisionError unless U's denominator, alpha's a1, lam - 1/2 and every division are regular.
+
+    >>> r = scaled_centre_residual(Family(acb(fmpq(1, 101)), arb("4.484")))
+    >>> r.real > 0, abs(r.imag) < 1e-10, abs(r.real - 0.0013118) < 1e-6
+    (True, True, True)
+    """
+    h, sigma, lam, (L0, L1) = fam.h, fam.sigma, fam.lam2, l0()
+    _nonzero(u_denominator(lam, L1), "U's denominator")
+    _nonzero((lam - _HALF) * fam.U[_E10] - (lam - L0) / 2, "alpha's denominator a1")
+    _nonzero(lam - _HALF, "lam - 1/2")
+    if not all(z.is_finite() for z in list(fam.U) + list(fam.vy) + list(fam.vx)):
+        raise ZeroDivisionError("U or a bordered solution is not finite")
+    sh = h * sigma
+    sinc = sh.sinc()
+    _nonzero(sinc, "sinc(sigma h)")
+    c = (2 * sh).cos()
+    if not ((1 + c) * (9 + c)).real > 0:
+        raise ZeroDivisionError("sqrt((1 + c)(9 + c)): the argument is not certainly off the branch cut")
+    root = ((1 + c) * (9 + c)).sqrt()
+    _nonzero(root + arb(20).sqrt(), "sqrt((1 + c)(9 + c)) + sqrt 20")
+    dl = -(sigma * sigma * h * sinc * sinc / 8) * (1 + (c + 11) / (root + arb(20).sqrt()))  # (lam - L0)/h
+    w = (2 * acb(0, 1) * sh).exp()
+    quot = (-acb(0, 1) * sh).exp() / (2 * acb(0, 1) * sigma * sinc)  # h/(w - 1)
+    U, v, alpha = fam.U, fam.vy, fam.alpha
+    out = ((1 - 7 * h / 4 - lam) * alpha * dl + alpha * (3 * U[_E10] / 2 + U[_E11] / 4)
+           + acb(0, 1) * sigma.sin() * quot * (3 * v[_E10] * (1 + w) / 2 + v[_E11] / 2))
+    if not out.is_finite():
+        raise ZeroDivisionError("r/h is not finite")
+    return out
+
+
+def _guard(fam, tol):
+    """Raise unless the Family computes the lemma's formula here: v^(1,0) = 1, y(C) = alpha (lam - L0), ray 0's
+    two sharp rows and the ring rows of sector 1 (balls containing 0, radii below tol: identities)."""
+    lam, L0 = fam.lam2, l0()[0]
+    y, yc = fam.layer_level0(0)[1], fam.yc
+    kap = kappa()
+    res = [fam.vy[_E10] - 1, yc - fam.alpha * (lam - L0), (lam - _HALF) * y(0, _E) - yc / 2,
+           (lam - fmpq(1, 8)) * y(0, (2, 0)) - fmpq(3, 4) * y(0, _E) - yc / 8]
+    for i, pos in enumerate(TWO_RING):
+        acc = kap[i] * yc - lam * y(1, pos)
+        for (d, q), x in ring_stencil()[i].items():
+            acc += x * y(1 + d, q)
+        res.append(acc)
+    for k, z in enumerate(res):
+        if not (z.contains(0) and abs(z) < tol):
+            raise CertificateError(f"the family misses identity {k} of the eigenvector lemma "
+                                   "(pivot, centre value, sharp midpoint, crease vertex, ring rows of sector 1)")
+
+
+def check_eigenvector(sig_lo, sig_hi, k0, prec, balls=64, family=Family):
+    """Show that for every K >= k0 the family member at sigma(K) in (sig_lo, sig_hi) is the eigenvector of lam2
+    (and x that of lam1), on ``balls`` h-balls covering [0, 1/k0]; one line, or CertificateError with the reason.
+    ``family(h, sigma)``: tests pass perturbed families.
+
+    >>> check_eigenvector(fmpq(4484, 1000), fmpq(44935, 10000), 101, 128).split(":")[0]
+    'eigenvector lemma for every K >= 101'
+    """
+    sig_lo, sig_hi = fmpq(sig_lo), fmpq(sig_hi)
+    if k0 < 7 or balls < 1:
+        raise CertificateError(f"eigenvector lemma: K0 = {k0} < 7 or no h-balls")
+    with ctx.workprec(prec):
+        pi = arb.pi()
+        if not (arb(sig_lo) > pi and arb(sig_hi) < 2 * pi and sig_lo < sig_hi):
+            raise CertificateError("eigenvector lemma: the bracket is not inside (pi, 2 pi)")
+        check_ring()
+        check_reach()
+        check_mode0()
+        check_crease_row()
+        box = ball(sig_lo, sig_hi)
+        if not box.cos() < 0:
+            raise CertificateError("eigenvector lemma: cos(sigma) is not certainly < 0 on the bracket (alpha != 0)")
+        tol = arb(2) ** (-(prec // 2))
+        for i in range(balls):
+            h = acb(ball(fmpq(i, balls * k0), fmpq(i + 1, balls * k0)))
+            try:
+                _guard(family(acb(fmpq(2 * i + 1, 2 * balls * k0)), arb(sig_lo)), tol)  # at the ball's centre
+                vals = [scaled_centre_residual(family(h, s)) for s in (arb(sig_lo), arb(sig_hi), box)]
+            except ZeroDivisionError as exc:
+                raise CertificateError(f"eigenvector lemma: h-ball {i}: {exc}") from None
+            lo, hi = vals[0].real, vals[1].real
+            if not (lo > 0 > hi or lo < 0 < hi):
+                raise CertificateError(f"eigenvector lemma: h-ball {i}: the centre residual r/h has no certain sign "
+                                       f"change over the bracket (at sig_lo {lo.str(3)}, at sig_hi {hi.str(3)})")
+        return (f"eigenvector lemma for every K >= {k0}: ring rows and ray 0's rows identically (exact: reach, "
+                f"mode 0, crease row at {W_POINTS} w), centre residual changes sign on ({sig_lo}, {sig_hi}) on "
+                f"{balls} h-balls, the family (x's and y's bordered systems, U, alpha) regular on the whole bracket")
+
+
+__all__ = ["SpectralRegions", "T_PI", "W_POINTS", "WINDOW", "b0", "check_construction", "check_crease_row",
+           "check_eigenvector", "check_mode0", "check_mode0_roots", "check_ranges", "check_reach", "check_secular",
+           "mode0_parts", "region_roots", "scaled_centre_residual", "w1_of"]

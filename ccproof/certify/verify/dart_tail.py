@@ -1,38 +1,39 @@
-"""Every ``dart:K`` with K >= K0 in one "C1" certificate: the record and its steps in order (trusted).
+"""Every ``dart:K``, K >= K0, in one "C1" certificate: the record, the models R, T, W and the steps (trusted).
 
-The grammar is docs/certificates.md, "Every dart K >= K0 in one certificate"; the argument is
-docs/tagged_c1.md, "A plan for every dart K >= 101". The statement is fixed by the configuration: for every
-K >= K0, 1 simple, lam1 = lam(cos(2 pi/K)) > lam2 = lam(cos(2 sigma(K)/K)) > |every other eigenvalue|, both
-simple; x the odd mode-1 eigenvector, y the even eigenvector of lam2 (y = 1 at ray K/2, orientation +1);
-det J_Phi > 0 on every piece of every quadrant, the transversality forms > 0 on the outer curves, and the
-outer curve crosses {Y = 0, X > 0} once. The record holds hints only. The steps, each a part:
-
-1. **Record** (:func:`read_record`): exactly the grammar's keys, every number in its range, every tree read
-   against the root its region fixes (:func:`.dart_spectrum.region_roots`, :func:`.dart_models.read_map`)
-   and the work the sizes declare within the budget (:func:`check_work`), before any arithmetic.
-2. **Construction** (:func:`.dart_spectrum.check_construction`): S for every K >= 7 from one window.
-3. **Exact zeros** (:func:`.dart_zeros.check_zeros`): every coefficient the Taylor models drop is 0.
-4. **Spectrum** (:mod:`.dart_spectrum`): the identities of the secular equation, mode 0's roots below the
-   circle, Re(1 - F) > 0 on every leaf of N, I, F: only 1, lam1 and one even eigenvalue outside the circle.
-5. **Eigenvector lemma** (:func:`.dart_eigen.check_eigenvector`): that even eigenvalue is
-   lam(cos(2 sigma*/K)), sigma* in the bracket, and the family member there (and x) are the eigenvectors.
-6. **Map** (:func:`.dart_models.replay_map`): R, T and W on every leaf, sigma box by sigma box.
-7. **Conclusion**: the reflection in ray 0 (x odd, y even) carries the quadrants q <= (K - 1)/2 to the
-   rest; with 2 to 6 the generalized Reif criterion holds for every K >= K0.
+The grammar and the steps are docs/certificates.md, "Every dart K >= K0 in one certificate"; the argument is
+docs/tagged_c1.md, "Every dart K >= 101" (items 6 to 8). Step 1 (:func:`read_record`) reads every field and
+tree and prices the declared work (:func:`record_work`) before any arithmetic; then S, Z, G, E, M in order.
+R (det J_Phi), T (a1 X Y' - a2 Y X' on the outer curves) and W (signs of X, Y on the outer curves' points)
+live on the bulk (s, h), the middle (s, w = 1/q) and the layer quadrants q (h); the bulk and middle are
+sum_k c_k e^(i omega_k s) f_k(h) over the basis parts (:func:`omegas`), each f_k an analytic model in h.
 """
 
 from __future__ import annotations
 
-from flint import arb, ctx, fmpq
+from dataclasses import dataclass
 
-from ccproof.rigorous.analytic import disc_boxes
+from flint import acb, acb_mat, acb_series, arb, ctx, fmpq
 
-from .dart_eigen import check_eigenvector
-from .dart_family import TaylorHints
-from .dart_models import read_map, replay_map
+from ccproof.rigorous.analytic import AnalyticModel, ball, cauchy_factor, disc_bound, disc_boxes, hull
+
+from .dart_family import (
+    PIECES,
+    XB,
+    YB,
+    Family,
+    basis_nets,
+    curve_trans_series,
+    det_series,
+    layer_nets,
+    packed_partials,
+    series_coeffs,
+    series_curves,
+    series_variable,
+)
 from .dart_spectrum import (
     SpectralRegions,
     check_construction,
+    check_eigenvector,
     check_mode0_roots,
     check_ranges,
     check_secular,
@@ -40,11 +41,12 @@ from .dart_spectrum import (
 )
 from .dart_zeros import check_zeros
 from .errors import CertificateError
+from .maps import STAR_CURVES
 from .record import exact_keys, field_of
 from .replay import MAX_BOXES, parse_decimal, read_tree, replay_tree
 
 MIN_K0 = 101  # the regions need 1/K0 < r, and the covers are shown from 101 on
-MAX_WORK = 100_000  # units of 0.1 ms of CPU (:func:`record_work`): 10 s; the published record declares 8.4 s
+MAX_WORK = 100_000  # units of 0.1 ms of CPU (:func:`record_work`): 10 s; the published record declares 8.6 s
 MAX_BALLS = 8192
 _DEC, _FRAC = "decimal", "fraction"
 #: the record's fields (:func:`read_fields`): a dict of fields (exactly those keys), a list (that many items),
@@ -58,15 +60,28 @@ GRAMMAR = {
     "regions": {"s0": _FRAC, "layer": (3, 64), "winding": [_FRAC, _FRAC]},
     "parts": dict,
 }
+#: quantity -> (the exact zeros below h^low in the bulk; the middle's (m0, q) of :func:`middle_box`, None: X has
+#: no middle; the layer's low order): R and T vanish at h = 0, to order 3 on the layer quadrants; Y to order 1
+QUANTITIES = {"R": (1, (1, 2), 3), "T": (1, (1, 2), 3), "X": (0, None, None), "Y": (0, (0, 1), 1)}
+
+
+@dataclass(frozen=True)
+class TaylorHints:
+    """The record's ``taylor`` hints: the Cauchy radius r (the h-square [-r, r]^2), its grid, the sigma boxes,
+    the Taylor orders in h (bulk and middle; layer) and the middle's order in s; they only choose."""
+
+    r: fmpq
+    disc_grid: int
+    sigma_boxes: int
+    order: int
+    layer_order: int
+    exp_order: int
 
 
 def read_fields(obj, spec, where):
-    """``obj`` read by ``spec`` (:data:`GRAMMAR`): a dict of specs gives a dict of the values (exactly its keys,
-    :func:`.record.exact_keys`), a list of specs a list of that length, (lo, hi) an int in lo..hi, "decimal" an
-    fmpq (:func:`.replay.parse_decimal`), "fraction" the fmpq of 'INT/INT', a type a value of that type.
+    """``obj`` read by ``spec`` (:data:`GRAMMAR`): dicts exactly their keys, lists their length, (lo, hi) an int in
+    range, "decimal" (:func:`.replay.parse_decimal`) and "fraction" an fmpq, a type a value of that type.
 
-    Examples
-    --------
     >>> read_fields({"a": [1, "3/4"]}, {"a": [(0, 9), _FRAC]}, "demo")
     {'a': [1, 3/4]}
     >>> read_fields({"a": 10}, {"a": (0, 9)}, "demo")
@@ -97,24 +112,8 @@ def read_fields(obj, spec, where):
 
 
 def read_record(cert, k0):
-    """Step 1: the record's hints as exact numbers and the spectral trees read (no arithmetic on forms).
-
-    Parameters
-    ----------
-    cert : dict
-    k0 : int
-
-    Returns
-    -------
-    dict
-        prec, sig_lo, sig_hi, sig_r, sigma_h, mode0_h, tau1, v0, re (name -> leaves), hints (TaylorHints),
-        s0, layer, winding, map (:func:`.dart_models.read_map`); its work checked (:func:`check_work`).
-
-    Raises
-    ------
-    CertificateError
-        Naming the field.
-    """
+    """Step 1: the record's fields (the spectrum's keys, prec, hints, layer; re and map as read trees), its work
+    checked (:func:`check_work`); CertificateError naming the field, before any arithmetic on forms."""
     if not MIN_K0 <= k0 <= 10**6:
         raise CertificateError(f"dart:>={k0}: the interval certificate needs {MIN_K0} <= K0 <= 10^6")
     if field_of(cert, "statement", str, "certificate") != "C1":
@@ -127,26 +126,17 @@ def read_record(cert, k0):
     if not fmpq(1, k0) < hints.r <= fmpq(1, 8):
         raise CertificateError("taylor: need 1/K0 < r <= 1/8")
     roots = region_roots(k0, sp["tau1"], sp["v0"])
-    out = {"prec": g["prec"], "sig_lo": sp["sigma"][0], "sig_hi": sp["sigma"][1], "sig_r": sp["circle"],
-           "sigma_h": sp["sigma_h"], "mode0_h": sp["mode0_h"], "tau1": sp["tau1"], "v0": sp["v0"], "hints": hints,
-           "re": {n: read_tree(sp["re"][n], roots[n], f"spectrum re {n}", 1) for n in ("N", "I", "F")},
-           "s0": rg["s0"], "layer": rg["layer"], "winding": tuple(rg["winding"])}
-    out["map"] = read_map(g["parts"], k0, hints, out["s0"], out["layer"], out["winding"])
-    check_work(out)
-    return out
+    rec = dict(sp, prec=g["prec"], hints=hints, layer=rg["layer"],
+               re={n: read_tree(sp["re"][n], roots[n], f"spectrum re {n}", 1) for n in "NIF"})
+    rec["map"] = read_map(g["parts"], k0, hints, rg["s0"], rg["layer"], tuple(rg["winding"]))
+    check_work(rec)
+    return rec
 
 
 def record_work(rec):
-    """The CPU work the record's sizes declare, in units of 0.1 ms (upper estimates measured on the reference
-    machine of docs/certificates.md, "Bounds", at 128 bits): the exact zeros (fixed), the disc bounds (one
-    family per acb box of the grid that meets the disc, with the T layer quadrants), the Taylor series of each
-    sigma box (order^2, and layer_order^2 per layer quadrant), each map leaf by its quantity and region (R in
-    the bulk: order; T, X, Y in the bulk: order/3; the middle: exp_order + order, times 0.45 for R and 0.2
-    otherwise; the layer: layer_order/3), each spectral leaf, each h-ball of the eigenvector and mode-0 checks;
-    all times ceil(prec/128).
+    """The CPU work the record's sizes declare, in units of 0.1 ms, priced per quantity and region from
+    measurements (docs/certificates.md, "Bounds").
 
-    Examples
-    --------
     >>> import json
     >>> from ccproof.tables.format import certificates_dir
     >>> rec = read_record(json.loads((certificates_dir() / "c1/dart/k_ge_101.json").read_text()), 101)
@@ -166,8 +156,7 @@ def record_work(rec):
 
 
 def check_work(rec):
-    """Refuse, before any arithmetic, a record whose declared work (:func:`record_work`) passes
-    :data:`MAX_WORK`, or which holds more than :data:`.replay.MAX_BOXES` leaves in all."""
+    """Refuse a record whose declared work passes :data:`MAX_WORK`, or with more than MAX_BOXES leaves in all."""
     leaves = sum(len(t) for _, _, _, trees in rec["map"] for t in trees) + sum(len(v) for v in rec["re"].values())
     if leaves > MAX_BOXES:
         raise CertificateError(f"more than {MAX_BOXES} leaves in all ({leaves})")
@@ -178,88 +167,310 @@ def check_work(rec):
                                f"{MAX_WORK // 10000} s (docs/certificates.md, \"Bounds\")")
 
 
-def verify_dart_tail(cert, k0, part, log):
-    """Check a ``"dart:>=K0"`` "C1" certificate (module docstring) into ``part``.
+def coefficient_nets(net, n, real=False):
+    """[the 4 x 4 net of the h^m Taylor coefficients (acb), m = 0..n] of a net of series or of values."""
+    cs = [[series_coeffs(z, n + 1, real) for z in row] for row in net]
+    return [[[c[m] for c in row] for row in cs] for m in range(n + 1)]
 
-    Parameters
-    ----------
-    cert : dict
-    k0 : int
-    part : Recorder
-    log : callable (str) -> None
 
-    Returns
-    -------
-    str
-        The configuration name.
+def _log_coeffs(fam, n, real=False):
+    """The Taylor coefficients of (a1, a2) = (-ln lam1, -ln lam2) (ZeroDivisionError near the branch cut)."""
+    if isinstance(fam.lam1, acb) and not (acb(fam.lam1).real > 0 and acb(fam.lam2).real > 0):
+        raise ZeroDivisionError("log lam: not certainly off the branch cut")
+    return [series_coeffs(-lam.log(), n + 1, real) for lam in (fam.lam1, fam.lam2)]
 
-    Raises
-    ------
-    CertificateError
-        On a malformed record (step 1).
+
+def quantities(fam, n, layers=(), bulk=True):
+    """{key: [h^m coefficient lists, m <= n]} of every quantity of a family (at an acb h, n = 0: the values):
+    bulk ("R", i, j, piece) D(X_i, Y_j)'s 36 Bernstein coefficients, ("T", i, j, curve) a1 X_i Y_j' - a2 Y_j X_i''s
+    6, ("X", i, curve), ("Y", j, curve) the 4 points; layer quadrant q ("R"/"T"/"Y", q, piece or curve)."""
+    out = {}
+    if bulk:
+        nets = basis_nets(fam)
+        parts = {(b, p): packed_partials(coefficient_nets(net, n)) for b, pn in nets.items() for p, net in pn.items()}
+        curves = {b: series_curves(nets[b], n) for b in nets}
+        A = _log_coeffs(fam, n)
+        for i in XB:
+            for j in YB:
+                out.update({("R", i, j, p): det_series(parts[(i, p)], parts[(j, p)], n) for p in PIECES})
+                out.update({("T", i, j, c): curve_trans_series(curves[i][c], curves[j][c], *A, n)
+                            for c in STAR_CURVES})
+        out.update({(t, b, c): curves[b][c] for t, bs in (("X", XB), ("Y", YB)) for b in bs for c in STAR_CURVES})
+    real = isinstance(fam.h, acb_series)
+    A = _log_coeffs(fam, n, real) if layers else None
+    for q in layers:
+        ln = layer_nets(fam, q)
+        out.update({("R", q, p): det_series(coefficient_nets(X, n, real), coefficient_nets(Y, n, real), n)
+                    for p, (X, Y) in ln.items()})
+        xs, ys = (series_curves({p: ln[p][k] for p in PIECES}, n, real) for k in (0, 1))
+        out.update({("T", q, c): curve_trans_series(xs[c], ys[c], *A, n) for c in STAR_CURVES})
+        out.update({("Y", q, c): ys[c] for c in STAR_CURVES})
+    return out
+
+
+def group_models(Q, M, r, quantity, q=None):
+    """{piece or curve: AnalyticModel} of one quantity of a :func:`quantities` table with disc bounds ``M``: the
+    entries of one piece or curve are the columns (bulk, ``q`` None), or layer quadrant q's one column each."""
+    groups = {}
+    for key in Q:
+        if key[0] == quantity and (isinstance(key[1], str) if q is None else key[1] == q):
+            groups.setdefault(key[-1], []).append(key)
+    return {g: AnalyticModel.from_columns([Q[k] for k in keys], [M[k] for k in keys], r) for g, keys in groups.items()}
+
+
+def omegas(quantity, sigma):
+    """[(c_k, omega_k)] of the bulk's columns, weights c_k e^(i omega_k s): E^(+-1), E = e^(2 pi i s), for X;
+    1, F, 1/F, F = e^(i sigma (2 s - 1)), for Y; their products (XB x YB) for R and T."""
+    tp, es = 2 * arb.pi(), acb(0, sigma).exp()
+    x = [(acb(1), tp), (acb(1), -tp)]
+    y = [(acb(1), arb(0)), (1 / es, 2 * sigma), (es, -2 * sigma)]
+    return {"X": x, "Y": y}.get(quantity) or [(c, a + w) for _, a in x for c, w in y]
+
+
+def mode_factors(quantity, s, sigma):
+    """The weights of :func:`omegas` at s, formed from E and F (one ball each: sigma's width enters once)."""
+    E, F = acb(0, 2 * arb.pi() * s).exp(), acb(0, sigma * (2 * s - 1)).exp()
+    x, y = [E, 1 / E], [acb(1), F, 1 / F]
+    return {"X": x, "Y": y}.get(quantity) or [a * b for a in x for b in y]
+
+
+def bulk_box(models, quantity, s_lo, s_hi, h_lo, h_hi, sigma):
+    """An arb holding Re sum_k c_k e^(i omega_k s) f_k(h)/h^low (every row of every model) on the (s, h) box."""
+    weights = mode_factors(quantity, ball(s_lo, s_hi), sigma)
+    low = QUANTITIES[quantity][0]
+    return hull(v for model in models.values() for v in model.real_part(weights, h_lo, h_hi, low=low))
+
+
+def layer_box(models, quantity, q, h_lo, h_hi):
+    """An arb holding f(h)/h^low on layer quadrant q; Y at ray 0's end point (q = 0, P1s1, point 0) /h^2."""
+    vals = []
+    for g, model in models.items():
+        v = model.real_part([1], h_lo, h_hi, low=QUANTITIES[quantity][2])
+        if quantity == "Y" and q == 0 and g == "P1s1":
+            v[0] = model.real_part([1], h_lo, h_hi, low=2)[0]
+        vals += v
+    return hull(vals)
+
+
+def middle_coeffs(model, om, m0, q, L=24):
+    """{(m, l): e_ml} (acb_mat): the coefficient of s^l h^m of sum_k c_k e^(i omega_k s) f_k(h), m0 <= m < m0 + q."""
+    return {(m, l): model.coeffs[m] * acb_mat([[c * acb(0, w) ** l / arb.fac_ui(l)] for c, w in om])
+            for m in range(m0, m0 + q) for l in range(L + 1)}
+
+
+def middle_box(models, E, om, s_lo, s_hi, w_lo, w_hi, m0, q, L=24):
+    """An arb holding Re F/(h^m0 s^q) on s in [s_lo, s_hi], w = h/s in [w_lo, w_hi] (F's s^l h^m with
+    l + m - m0 < q being 0): orders m < m0 + q expanded in s (:func:`middle_coeffs`; the tail past L at most
+    z^(L+1)/(L+1)!/(1 - z/(L + 2)), z = |omega| s), the rest direct, plus the Cauchy remainder
+    sum_k M_k s^(n+1-m0-q) w^(n+1-m0)/(r^(n+1) (1 - h/r)); K det J_Phi/s^2: m0 = 1, q = 2; Y/s: m0 = 0, q = 1."""
+    s, w = acb(ball(s_lo, s_hi)), acb(ball(w_lo, w_hi))
+    wmax = max((abs(x[1]).upper() for x in om), key=lambda x: x)
+    z, sh, wh = wmax * arb(fmpq(s_hi)), arb(fmpq(s_hi)), arb(fmpq(w_hi))
+    if not z < L + 2:
+        raise ValueError("s too large for the exponential series")
+    geo = 1 / (arb.fac_ui(L + 1) * (1 - z / (L + 2)))
+    ab = acb_mat([[c * (w_ * s * acb(0, 1)).exp()] for c, w_ in om])
+    vals = []
+    for key, model in models.items():
+        n, D = model.order, model.coeffs
+        rad = sum(model.M, arb(0)) * sh ** (n + 1 - m0 - q) * wh ** (n + 1 - m0) * cauchy_factor(
+            model.r, n, fmpq(s_hi) * fmpq(w_hi))
+        g = None
+        for j in range(q):
+            e = E[key]
+            dmax = max((abs(D[m0 + j][c, k]).upper() for c in range(D[m0 + j].nrows()) for k in range(len(om))),
+                       key=lambda x: x)
+            rad += len(om) * dmax * wh ** j * wmax ** (q - j) * z ** (L + 1 + j - q) * geo
+            acc = e[(m0 + j, L)]
+            for l in range(L - 1, q - j - 1, -1):
+                acc = acc * s + e[(m0 + j, l)]
+            g = acc * w ** j if g is None else g + acc * w ** j
+        for m in range(m0 + q, n + 1):
+            g = g + (D[m] * ab) * (s ** (m - m0 - q) * w ** (m - m0))
+        vals += [g[c, 0].real + arb(0, rad.upper()) for c in range(g.nrows())]
+    return hull(vals)
+
+
+class DartModels:
+    """The disc bounds of R, T and W over the whole sigma bracket, and one :class:`SigmaBox` per sigma box.
+
+    >>> hints = TaylorHints(r=fmpq(1, 32), disc_grid=6, sigma_boxes=10, order=12, layer_order=14, exp_order=24)
+    >>> box = DartModels(fmpq(4484, 1000), fmpq(44935, 10000), hints, 0, 128).sigma_box(0)
+    >>> box.evaluate("R", "bulk", [(fmpq(1, 4), fmpq(26, 100)), (fmpq(0), fmpq(1, 101))]) > 0  # K det J_Phi
+    True
     """
+
+    def __init__(self, sig_lo, sig_hi, hints, layer, prec):
+        self.hints, self.layer, self.prec = hints, layer, prec
+        self.edges = [fmpq(sig_lo) + (fmpq(sig_hi) - fmpq(sig_lo)) * fmpq(i, hints.sigma_boxes)
+                      for i in range(hints.sigma_boxes + 1)]
+        with ctx.workprec(prec):
+            sigma = ball(sig_lo, sig_hi)  # one family per acb box h, the values: the h^0 coefficients
+            self.M = disc_bound(lambda h: {k: v[0] for k, v in quantities(Family(h, sigma), 0, range(layer)).items()},
+                                hints.r, hints.disc_grid)
+        self._boxes = {}
+
+    def sigma_box(self, i):
+        """The models on sigma box i of ``hints.sigma_boxes`` equal boxes of the bracket (cached)."""
+        if not 0 <= i < self.hints.sigma_boxes:
+            raise IndexError(f"sigma box {i} of {self.hints.sigma_boxes}")
+        if i not in self._boxes:
+            self._boxes[i] = SigmaBox(self, i)
+        return self._boxes[i]
+
+
+class SigmaBox:
+    """The analytic models of R, T and W on one sigma box (bulk order ``hints.order``, layer ``layer_order``)."""
+
+    def __init__(self, models, i):
+        self.m, hn, r = models, models.hints, models.hints.r
+        with ctx.workprec(models.prec):
+            self.sigma = sigma = ball(models.edges[i], models.edges[i + 1])
+            with series_variable(hn.order) as h:
+                Q = quantities(Family(h, sigma), hn.order)
+            with series_variable(hn.layer_order) as h:
+                Q.update(quantities(Family(h, sigma), hn.layer_order, range(models.layer), bulk=False))
+            self.om = {t: omegas(t, sigma) for t in QUANTITIES}
+            self.models = {(t, None): group_models(Q, models.M, r, t) for t in QUANTITIES}
+            self.models.update({(t, q): group_models(Q, models.M, r, t, q) for t in "RTY" for q in range(models.layer)})
+            self.E = {t: {g: middle_coeffs(m, self.om[t], *mid, L=hn.exp_order)
+                          for g, m in self.models[(t, None)].items()} for t, (_, mid, _) in QUANTITIES.items() if mid}
+
+    def evaluator(self, method):
+        """(box) -> arb for method = (quantity, region, layer quadrant or None) of :func:`map_regions`."""
+        return lambda box: self.evaluate(*method[:2], box, method[2])
+
+    def evaluate(self, quantity, region, box, q=None):
+        """An arb holding the quantity's scaled values on a box (list of (lo, hi)) of its region: bulk K det J_Phi,
+        K T, X, Y; middle K^3 det J_Phi/q^2, K^3 T/q^2, Y/s; layer K^3 det J_Phi, K^3 T, K Y (K^2 Y at ray 0's end)."""
+        mid = QUANTITIES[quantity][1]
+        models = self.models[(quantity, q if region == "layer" else None)]
+        with ctx.workprec(self.m.prec):
+            if region == "layer":
+                return layer_box(models, quantity, q, *box[0])
+            (s_lo, s_hi), (t_lo, t_hi) = box
+            if region == "middle":
+                return middle_box(models, self.E[quantity], self.om[quantity], s_lo, s_hi, t_lo, t_hi, *mid,
+                                  L=self.m.hints.exp_order)
+            return bulk_box(models, quantity, s_lo, s_hi, t_lo, t_hi, self.sigma)
+
+
+def map_regions(k0, s0, layer, winding):
+    """Every tree list of ``parts``: (name, keys, root box, (quantity, region, layer quadrant), sign, ``outside``
+    allowed); the roots are fixed by K0 and the regions, never by the file.
+
+    >>> [r[:2] for r in map_regions(101, fmpq(1, 20), 3, (fmpq(1, 4), fmpq(7, 20)))][-1]
+    ('Y<0 layer 2', ('winding', 'Y<0 layer', '2'))
+    """
+    s_a, s_b = winding
+    half, h0 = fmpq(1, 2), fmpq(1, k0)
+    bulk, middle = [(s0, half), (fmpq(0), h0)], [(fmpq(0), s0), (fmpq(0), fmpq(1, layer))]
+    out = [("R bulk", ("regularity", "bulk"), bulk, ("R", "bulk", None), 1, False),
+           ("R middle", ("regularity", "middle"), middle, ("R", "middle", None), 1, True),
+           ("T bulk", ("transversal", "bulk"), bulk, ("T", "bulk", None), 1, False),
+           ("T middle", ("transversal", "middle"), middle, ("T", "middle", None), 1, True),
+           ("Y<0 bulk", ("winding", "Y<0 bulk"), [(s0, s_a), (fmpq(0), h0)], ("Y", "bulk", None), -1, False),
+           ("X>0 bulk", ("winding", "X>0 bulk"), [(s_a, s_b), (fmpq(0), h0)], ("X", "bulk", None), 1, False),
+           ("Y>0 bulk", ("winding", "Y>0 bulk"), [(s_b, half), (fmpq(0), h0)], ("Y", "bulk", None), 1, False),
+           ("Y<0 middle", ("winding", "Y<0 middle"), middle, ("Y", "middle", None), -1, True)]
+    for q in range(layer):
+        out += [(f"R layer {q}", ("regularity", "layer", str(q)), [(fmpq(0), h0)], ("R", "layer", q), 1, False),
+                (f"T layer {q}", ("transversal", "layer", str(q)), [(fmpq(0), h0)], ("T", "layer", q), 1, False),
+                (f"Y<0 layer {q}", ("winding", "Y<0 layer", str(q)), [(fmpq(0), h0)], ("Y", "layer", q), -1, False)]
+    return out
+
+
+def read_map(parts, k0, hints, s0, layer, winding):
+    """Step 1 for the map: [(name, method, sign, [leaves per sigma box])], every tree read against the root its
+    region fixes (no arithmetic); CertificateError naming the list and the leaf.
+
+    >>> read_map({}, 101, TaylorHints(fmpq(1, 32), 12, 10, 12, 14, 24), fmpq(1, 20), 3, (fmpq(1, 4), fmpq(7, 20)))
+    Traceback (most recent call last):
+    ...
+    ccproof.certify.verify.errors.CertificateError: parts: ...
+    """
+    s_a, s_b = winding
+    if not (0 < s0 < s_a < s_b < fmpq(1, 2) and layer >= 3 and fmpq(1, k0) < hints.r and s0 / layer < hints.r):
+        raise CertificateError("regions: need 0 < s0 < s_a < s_b < 1/2, T >= 3, 1/K0 < r and s0/T < r")
+    regions, spec = map_regions(k0, s0, layer, winding), {}
+    for _, keys, *_ in regions:  # the grammar of parts: exactly the keys the regions name, a list at each end
+        node = spec
+        for key in keys[:-1]:
+            node = node.setdefault(key, {})
+        node[keys[-1]] = list
+    parts, out = read_fields(parts, spec, "parts"), []
+    for name, keys, root, method, sign, outside in regions:
+        trees = parts
+        for key in keys:
+            trees = trees[key]
+        if len(trees) != hints.sigma_boxes:
+            raise CertificateError(f"{name}: one tree per sigma box ({hints.sigma_boxes}) is needed")
+        out.append((name, method, sign, [read_tree(t, root, f"{name}, sigma box {i}", sign, k0=k0, outside=outside)
+                                         for i, t in enumerate(trees)]))
+    return out
+
+
+def replay_map(lists, sig_lo, sig_hi, hints, layer, prec):
+    """Step M: the lists of :func:`read_map` replayed sigma box by sigma box; {name: (leaves, least bound)}."""
+    models = DartModels(sig_lo, sig_hi, hints, layer, prec)
+    summary = {}
+    for i in range(hints.sigma_boxes):
+        box = models.sigma_box(i)
+        for name, method, sign, leaves in lists:
+            count, least = replay_tree(leaves[i], box.evaluator(method), sign, f"{name}, sigma box {i}")
+            old = summary.get(name, (0, None))
+            best = least if old[1] is None or (least is not None and abs(least) < abs(old[1])) else old[1]
+            summary[name] = (old[0] + count, best)
+    return summary
+
+
+def _show(counts):
+    """{name: (count, least bound or None)} as one line (bounds to 3 digits by arb: no float)."""
+    return "; ".join(f"{n} {c}" + ("" if b is None else f" (>= {arb(b).str(3, radius=False)})")
+                     for n, (c, b) in counts.items())
+
+
+def verify_dart_tail(cert, k0, part, log):
+    """Check a ``"dart:>=K0"`` "C1" certificate into ``part`` (steps S, Z, G, E, M, C); returns its name.
+    A malformed record raises CertificateError (step 1)."""
     rec = read_record(cert, k0)
-    name = f"dart:>={k0}"
+    name, (lo, hi), sig_r = f"dart:>={k0}", rec["sigma"], rec["circle"]
     log(f"C1 certificate for {name} ({rec['prec']} bits)")
-    with ctx.workprec(rec["prec"]):
-        _steps(rec, k0, part, log)
-    return name
 
-
-def _attempt(part, title, fn):
-    try:
-        msg = fn()
-    except (CertificateError, ZeroDivisionError, ValueError) as exc:
-        part(title, False, str(exc))
-        return False
-    part(title, True, msg)
-    return True
-
-
-def _spectrum(rec, k0):
-    check_secular()
-    least0 = check_mode0_roots(rec["sig_r"], k0, rec["mode0_h"])
-    regions = SpectralRegions(rec["sig_r"], k0)
-    counts = {}
-    for name, fn in (("N", regions.n), ("I", regions.i), ("F", regions.f)):
-        counts[name] = replay_tree(rec["re"][name], fn, 1, f"spectrum re {name}")
-    return (f"every K >= {k0}: 1, lam1 = lam(cos(2 pi/K)) and one even eigenvalue (lam2) outside |lam| = "
-            f"lam(cos(2 x {rec['sig_r']}/K)), each simple; secular identities exact; mode 0's roots real and below "
-            f"r on {rec['mode0_h']} h-balls (Q(r)/h >= {least0.str(3, radius=False)}); Re(1 - F) > 0: "
-            + ", ".join(f"{n} {c} leaves (>= {_show(b)})" for n, (c, b) in counts.items()))
-
-
-def _map(rec, k0):
-    out = replay_map(rec["map"], rec["sig_lo"], rec["sig_hi"], rec["hints"], rec["layer"], rec["prec"])
-    return "; ".join(f"{n} {c} (>= {_show(b)})" if b is not None else f"{n} {c}" for n, (c, b) in out.items())
-
-
-def _show(q):
-    """A bound (fmpq) to 3 digits for the message (arb's decimal printing: no float)."""
-    return arb(q).str(3, radius=False)
-
-
-def _steps(rec, k0, part, log):
-    def construction():
-        _, bound = check_construction()
-        return (f"dart:7 and dart:8: one row per window class, the same in both; centre row (1 - 7h/4, 3h^2/2, "
-                f"h^2/4) for K = 7..12; R-symmetric, odd part the ring modes, one-ring closed, outer bound {bound}")
+    def spectrum():
+        check_secular()
+        least0, reg = check_mode0_roots(sig_r, k0, rec["mode0_h"]), SpectralRegions(sig_r, k0)
+        counts = {n: replay_tree(rec["re"][n], getattr(reg, n.lower()), 1, f"spectrum re {n}") for n in "NIF"}
+        return (f"every K >= {k0}: 1, lam1 = lam(cos(2 pi/K)) and one even eigenvalue (lam2) outside |lam| = "
+                f"lam(cos(2 x {sig_r}/K)), each simple; secular identities exact; mode 0's roots real and below "
+                f"r on {rec['mode0_h']} h-balls (Q(r)/h >= {least0.str(3, radius=False)}); Re(1 - F) > 0: "
+                + ", ".join(f"{n} {c} leaves (>= {arb(b).str(3, radius=False)})" for n, (c, b) in counts.items()))
 
     steps = [
-        ("S sector matrices of every K >= 7 from one window", construction),
+        ("S sector matrices of every K >= 7 from one window",
+         lambda: "dart:7 and dart:8: one row per window class, the same in both; centre row (1 - 7h/4, 3h^2/2, "
+                 "h^2/4) for K = 7..12; R-symmetric, odd part the ring modes, one-ring closed, outer bound "
+                 f"{check_construction()[1]}"),
         ("Z dropped Taylor coefficients are 0 (exact, Q(sqrt 5, i))", check_zeros),
-        (f"G spectrum for every K >= {k0}", lambda: _spectrum(rec, k0)),
-        (f"E eigenvectors: y at sigma* in ({rec['sig_lo']}, {rec['sig_hi']}) and x span lam2, lam1",
-         lambda: check_eigenvector(rec["sig_lo"], rec["sig_hi"], k0, rec["prec"], balls=rec["sigma_h"])),
+        (f"G spectrum for every K >= {k0}", spectrum),
+        (f"E eigenvectors: y at sigma* in ({lo}, {hi}) and x span lam2, lam1",
+         lambda: check_eigenvector(lo, hi, k0, rec["prec"], balls=rec["sigma_h"])),
         (f"M characteristic map regular (R), transversal (T), winding once (W) for every K >= {k0}",
-         lambda: _map(rec, k0)),
+         lambda: _show(replay_map(rec["map"], lo, hi, rec["hints"], rec["layer"], rec["prec"]))),
     ]
-    for title, fn in steps:
-        if not _attempt(part, title, fn):
-            return
+    with ctx.workprec(rec["prec"]):
+        for title, fn in steps:
+            try:
+                msg = fn()
+            except (CertificateError, ZeroDivisionError, ValueError) as exc:
+                part(title, False, str(exc))
+                return name
+            part(title, True, msg)
     part(f"C generalized Reif criterion for every K >= {k0}", True,
          "1 simple, lam1 > lam2 > |every other|, both simple; the reflection in ray 0 carries the quadrants "
          "q <= (K - 1)/2 to the rest (x odd, y even): Phi regular and injective, so dart:K is C1")
+    return name
 
 
-__all__ = ["MAX_WORK", "MIN_K0", "check_work", "read_record", "record_work", "verify_dart_tail"]
+__all__ = ["DartModels", "MAX_WORK", "MIN_K0", "TaylorHints", "check_work", "map_regions", "quantities",
+           "read_map", "read_record", "record_work", "replay_map", "verify_dart_tail"]

@@ -1,45 +1,8 @@
-"""The Taylor coefficients that the dart family's models drop, computed exactly and checked 0 (trusted).
+"""The Taylor coefficients the dart family's models drop, computed exactly and checked 0 (trusted).
 
-The Taylor models of det J_Phi (R), transversality (T) and winding (W) of ``dart:K``, every K >= K0, drop their
-lowest coefficients as 0 (docs/tagged_c1.md, "A plan for every dart K >= 101", item 6, part Z).
-:func:`check_zeros` computes each exactly and checks it is 0. The rows (:data:`ROWS`;
-every piece, outer curve, basis part X+-, Y0, Y+-): D_ij = det d(X_i, Y_j)/d(u, v) and T_ij at h^0; the
-middle's e_10, e_11, e_20 (s^0 h^0, s^1 h^0, s^0 h^1) of K det J_Phi and of K (a1 X Y' - a2 Y X'); Y at
-s = h = 0; on the layer quadrants q = 0, 1, 2 the h^0, h^1, h^2 of det J_Phi and of a1 X Y' - a2 Y X', and
-Y's h^0 on every curve point (h^1 too at ray 0's end point: q = 0, P1s1, point 0).
-
-**The degree argument (why the grid suffices).** Let a = 2 pi, b = 2 sigma (x's and y's angle units),
-c = cos(sigma), t = sin(sigma), l = ln L0. (i) x = E X+ + E^-1 X-, E = e^(i a s), X+- power series in a h
-(v^_x solves the bordered system of B(e^(i a h)) at lam(cos(a h)); the offsets e^(i a delta h)); no c, t, l.
-(ii) y = Y0 + F Y+ + F^-1 Y-, F = e^(i sigma (2 s - 1)) = e^(i b s) (c - i t), F^-1 = e^(-i b s) (c + i t),
-Y+- power series in b h, Y0 = alpha U(lam2), alpha = -c (lam2 - 1/2)/((lam2 - 1/2) U(1,0) - (lam2 - L0)/2):
-so y is a power series in (b h, b s) homogeneous linear in (c, t); the layer's values are these at s = t h
-(t the integer sector). (iii) a_i = -ln lam_i = -l - ln(lam_i/L0), the log a power series in a h (b h)
-without constant: affine in l. Every dropped quantity is bilinear in (x, y) (det J_Phi, X Y', Y X'; times
-a_i for T) or linear in y (W), with exact rational weights, and a monomial (a h)^i (a s)^j (b h)^i' (b s)^j'
-reaches s^k h^m only if i + i' = m, j + j' = k. So its coefficient of s^k h^m is a polynomial in
-(a, b, c, t, l) over Q(sqrt 5, i) of degree <= k + m in a and in b and <= 1 in each of c, t, l. Every dropped
-coefficient has k + m <= 2 (the middle's e_10, e_11, e_20 are det J_Phi's s^0 h^1, s^1 h^1, s^0 h^2, as
-K det J_Phi = det J_Phi/h; the layer's have k = 0, m <= 2). A polynomial of degree <= 2 in a, <= 2 in b,
-<= 1 in each of c, t, l vanishing on a, b in {1, 2, 3}, c, t, l in {1, 2} is 0 (in a: three roots for each
-fixed (b, c, t, l) of the grid, so each coefficient vanishes on the smaller grid; then b, c, t, l). Hence
-every dropped coefficient is 0 at (2 pi, 2 sigma, cos sigma, sin sigma, ln L0) for every sigma: no sigma
-bracket is used (nor c^2 + t^2 = 1: the identities are polynomial).
-
-**The exact arithmetic.** Q(theta) = Q(sqrt 5, i), theta = sqrt 5 + i, m(theta) = 0, m(x) = x^4 - 8 x^2 + 36.
-Series in h truncated after h^2 over Q(theta), the ring Q(theta)[h]/(h^3), are held as Q[x]/(m^3) (fmpq_poly
-modulo m^3: the arithmetic in C): theta -> theta~, the root of m lifting x (Newton; m(theta~) = 0 mod m^3
-checked at import), h -> m(x). This is an isomorphism (e(theta~) is a unit for e != 0 in Q(theta), so sum
-e_k(theta~) m^k = 0 mod m^3 forces e_0 = e_1 = e_2 = 0; both have dimension 12), and h^0 .. h^(k-1) all vanish
-exactly when m^k divides the representative: the checks are remainders, the coefficients are read off
-(:meth:`QS.coeffs`) only where one is not 0. Truncations are exact: e^(i k h) = 1 + i k h - k^2 h^2/2, sqrt(20
-(1 + z)) = 2 sqrt 5 (1 + z/2 - z^2/8), ln(1 + z) = z - z^2/2 for z in (h). The bordered 7 x 7 systems are
-solved as rational 84 x 84 ones (the ring is 12-dimensional over Q: :func:`solve`), U from
-:mod:`.dart_family`'s exact polynomials, and the nets by the family's own assembly (``piece_nets``,
-``quadrant_level1``, ``_bezier``). det J_Phi's h^m coefficient, of degree <= (5, 5) in the patch parameters (u,
-v), is checked on the 6 x 6 grid u, v in {0, 1/5, ..., 1}; T's and the curve points' as the Bernstein
-coefficients. Parts depending on fewer of (a, b, c, t) (X's nets on a, Y+-'s on b, Y0's on (b, c)) are computed
-once, counted at each grid point.
+The rows (:data:`ROWS`), the degree argument (a grid of (a, b, c, t, l) suffices for every sigma) and the exact
+arithmetic (Q(sqrt 5, i)[h]/(h^3) as Q[x]/(m^3), m = x^4 - 8 x^2 + 36) are docs/tagged_c1.md, "Every dart
+K >= 101", item 6, "The dropped coefficients" and "Part Z in the trusted base".
 """
 
 from __future__ import annotations
@@ -94,11 +57,8 @@ def _raw(z):
 
 
 class QS:
-    """A power series in h truncated after h^2 with coefficients in Q(sqrt 5, i), exact: the class of the
-    fmpq_poly ``p`` (degree < 12) in Q[x]/(m^3) (module docstring).
+    """A power series in h to h^2 over Q(sqrt 5, i), exact: the class of the fmpq_poly ``p`` in Q[x]/(m^3).
 
-    Examples
-    --------
     >>> e = QS(1) + I * 3 * H - H * H * fmpq(9, 2)  # e^(3 i h) to order 2
     >>> (e * (QS(1) - I * 3 * H - H * H * fmpq(9, 2)) - 1).is_zero(), (e - 1).vanishes(1), (e - 1).vanishes(2)
     (True, True, False)
@@ -130,11 +90,8 @@ class QS:
 
     __rmul__ = __mul__
 
-    def inv(self):
-        return QS(_inv_raw(self.p))
-
     def __truediv__(self, o):
-        return self * o.inv() if isinstance(o, QS) else QS(self.p / fmpq(o))
+        return QS((self.p * _inv_raw(o.p)) % _M3) if isinstance(o, QS) else QS(self.p / fmpq(o))
 
     def is_zero(self):
         return self.p.is_zero()
@@ -180,7 +137,7 @@ def _exp_i(k):
 
 
 def _lam_series(k):
-    """lam(cos(k h)) = (5 + c + sqrt((1 + c)(9 + c)))/16, c = cos(k h) = 1 - k^2 h^2/2, the root expanded at 20."""
+    """lam(cos(k h)), c = 1 - k^2 h^2/2, the root expanded at 20."""
     c = ONE - _H2 * (fmpq(k) ** 2 / 2)
     g = (c + 1) * (c + 9)
     z = g / 20 - 1
@@ -199,9 +156,8 @@ def _log_ratio(lam):
 
 
 def solve(A, b):
-    """The solution of A v = b over Q(sqrt 5, i)[h]/(h^3) = Q[x]/(m^3), a 12-dimensional Q-algebra: A as the
-    rational 12 n x 12 n matrix of its multiplications (column k of the block of z: z x^k mod m^3), solved by
-    fmpq_mat (exact; ZeroDivisionError unless A is invertible over the ring, i.e. A(h = 0) regular)."""
+    """v with A v = b over Q[x]/(m^3) (12-dimensional over Q): A as the rational matrix of its multiplications,
+    solved by fmpq_mat (exact; ZeroDivisionError unless A(h = 0) is regular)."""
     n = len(A)
     cols = [[[(z.p * _X ** k) % _M3 for k in range(12)] for z in row] for row in A]
     M = fmpq_mat([[cols[i][j][k][r] for j in range(n) for k in range(12)] for i in range(n) for r in range(12)])
@@ -218,30 +174,17 @@ def _bordered(k, lam, stencil):
     return solve(bordered_matrix(B, lam, QS(0), 0), [QS(0)] * 6 + [QS(1)])[:6]
 
 
-class _Mode:
-    """lam(cos(k h)) and v^ for one angle unit k (and U(lam) for y's mode)."""
-
-    def __init__(self, k, stencil, with_u=False):
-        self.k = fmpq(k)
-        self.lam = _lam_series(self.k)
-        self.v = _bordered(self.k, self.lam, stencil)
-        if with_u:
-            den = _df.u_denominator(self.lam, L0_LOW)
-            self.U = [horner(p, self.lam, QS(0)) / den for p in _df.N_POLYS]
+def _mode(k, stencil):
+    """(lam(cos(k h)), v^, U(lam)) for one angle unit k."""
+    lam = _lam_series(k)
+    den = _df.u_denominator(lam, L0_LOW)
+    return lam, _bordered(k, lam, stencil), [horner(p, lam, QS(0)) / den for p in _df.N_POLYS]
 
 
 class ExactFamily(_df.Modes):
-    """The family of :class:`.dart_family.Family` at one grid point (a, b, c, t), exact (:class:`QS` in h).
+    """The family of :class:`.dart_family.Family` at a grid point (a, b, c, t) (stand-ins for 2 pi, 2 sigma,
+    cos sigma, sin sigma), exact; ``stencil``, ``flip_alpha``: perturbations for the tests.
 
-    Parameters
-    ----------
-    a, b, c, t : int or fmpq
-        the angle units of x's mode (2 pi) and y's (2 sigma); stand-ins for cos(sigma), sin(sigma)
-    stencil : list of dict, optional; flip_alpha : bool
-        perturbations for the tests: the ring rows (``ring_stencil()``), alpha -> -alpha
-
-    Examples
-    --------
     >>> fam = ExactFamily(1, 2, 1, 2)
     >>> (fam.vx[0] - 1).is_zero(), (fam.lam1 - L0).vanishes(2), fam.yc.vanishes(2)  # the pivot, no h^1 terms
     (True, True, True)
@@ -250,9 +193,8 @@ class ExactFamily(_df.Modes):
     def __init__(self, a, b, c, t, stencil=None, flip_alpha=False, _modes=None):
         stencil = ring_stencil() if stencil is None else stencil
         self.a, self.b, self.c, self.t = fmpq(a), fmpq(b), fmpq(c), fmpq(t)
-        mx, my = _modes or (_Mode(a, stencil), _Mode(b, stencil, with_u=True))
+        (self.lam1, self.vx, _), (self.lam2, self.vy, self.U) = _modes or (_mode(a, stencil), _mode(b, stencil))
         self.zero = QS(0)
-        self.lam1, self.lam2, self.vx, self.vy, self.U = mx.lam, my.lam, mx.v, my.v, my.U
         self.mode0(self.c, L0, flip_alpha)
         self.em, self.ep = QS(self.c) - I * self.t, QS(self.c) + I * self.t  # e^(-i sigma), e^(i sigma)
         self.i2, self.sign = I * 2, 1
@@ -308,8 +250,7 @@ class _Tally:
         self.stop = stop
 
     def add(self, row, items, where, kind):
-        """items: [(raw element, the h-orders that must be 0)]; where, kind: the items' place and how they are
-        numbered (item k of ``kind``), for the reason."""
+        """items: [(raw element, the h-orders that must be 0)] at ``where``, numbered as ``kind``."""
         for k, (p, orders) in enumerate(items):
             self.rows[row][0] += len(orders)
             if (p % _MOD[max(orders) + 1]).is_zero():
@@ -334,10 +275,8 @@ def _trans(PQ, A):
 
 
 def _middle(G, fam):
-    """The middle's items from {(i, j): [raw G_ij at each place]}: sum_ij a_i(s) b_j(s) G_ij(h)/h with
-    a_i b_j = c_ij e^(i omega_ij s), c_ij = 1, e^(-i sigma), e^(i sigma) (Y0, Y+, Y-), omega_ij = +-a + (0, b, -b):
-    e_10, e_20 are h^1, h^2 of S = sum c_ij G_ij, e_11 is h^1 of S' = sum c_ij i omega_ij G_ij. Items alternate
-    (S, orders 1, 2), (S', order 1) per place."""
+    """The middle's items from {(i, j): [raw G_ij per place]}: e_10, e_20 = h^1, h^2 of S = sum c_ij G_ij, e_11
+    = h^1 of S' = sum c_ij i omega_ij G_ij (a_i b_j = c_ij e^(i omega_ij s)); (S, (1, 2)), (S', (1,)) per place."""
     cj = {"Y0": (ONE, 0), "Y+": (fam.em, fam.b), "Y-": (fam.ep, -fam.b)}
     om = {"X+": fam.a, "X-": -fam.a}
     f0 = {ij: cj[ij[1]][0].p for ij in G}
@@ -419,11 +358,10 @@ def _run(points, ells, stencil, flip_alpha, stop):
     stencil = ring_stencil() if stencil is None else stencil
     tally, modes, cache = _Tally(stop), {}, {}
     for a, b, c, t in points:
-        if ("x", a) not in modes:
-            modes[("x", a)] = _Mode(a, stencil)
-        if ("y", b) not in modes:
-            modes[("y", b)] = _Mode(b, stencil, with_u=True)
-        fam = ExactFamily(a, b, c, t, stencil, flip_alpha, _modes=(modes[("x", a)], modes[("y", b)]))
+        for k in (a, b):
+            if k not in modes:
+                modes[k] = _mode(k, stencil)
+        fam = ExactFamily(a, b, c, t, stencil, flip_alpha, _modes=(modes[a], modes[b]))
         _check_point(fam, ells, tally, cache)
     return tally
 
@@ -433,10 +371,8 @@ GRID = tuple(itertools.product(GRID_AB, GRID_AB, GRID_CT, GRID_CT))  # (a, b, c,
 
 def count_zeros(points=GRID, ells=GRID_CT, stencil=None, flip_alpha=False):
     """{row: (coefficients checked, non-zero among them)} at the points (a, b, c, t) and l in ``ells``;
-    ``stencil`` and ``flip_alpha`` perturb the rule or the family (then some must be non-zero).
+    ``stencil`` and ``flip_alpha`` perturb the rule or the family.
 
-    Examples
-    --------
     >>> res = count_zeros(points=[(1, 2, 1, 2)])
     >>> res["bulk det: D_ij h^0"], sum(n for n, _ in res.values()), sum(bad for _, bad in res.values())
     ((648, 0), 2873, 0)
@@ -445,13 +381,9 @@ def count_zeros(points=GRID, ells=GRID_CT, stencil=None, flip_alpha=False):
 
 
 def check_zeros(*, _stencil=None, _flip_alpha=False) -> str:
-    """Check exactly that every dropped Taylor coefficient of the dart family is 0 on the grid of the degree
-    argument (module docstring): a one-line summary with the counts per row, or CertificateError naming the
-    row, grid point and place of the first non-zero one (``_stencil``, ``_flip_alpha``: perturbations for the
-    tests).
+    """Every dropped coefficient exactly 0 on the grid: one line with the counts per row, or CertificateError
+    naming the row, grid point and place of the first non-zero one (``_stencil``, ``_flip_alpha``: for tests).
 
-    Examples
-    --------
     >>> print(check_zeros())
     dropped coefficients exactly 0 on the grid a, b in (1, 2, 3), c, t, l in (1, 2): ... 103428 in all
     """
