@@ -1,0 +1,185 @@
+"""The classic linear thin-shell benchmarks on Catmull-Clark limit surfaces: the Scordelis-Lo roof and the
+pinched cylinder (:mod:`ccproof.apps.iga.shell`).
+
+Both are cylinders with the axis along y and rigid diaphragms at the ends ``y = +-L/2`` (``u_x = u_z = 0``
+there, ``u_y`` and the rotations free). The mesh at ``n_theta x n_y`` faces is a *ghost-ring* grid: the
+faces over the shell (the region) and one more row of faces beyond every end (and beyond the roof's free
+edges), so that every region face is a regular bicubic patch and the space is the full bicubic spline space
+up to the boundary (docs/iga.md, open surfaces). Its control points lie on the circle of radius
+``r = 6 R / (4 + 2 cos dtheta)`` at equal angles ``dtheta`` and equal steps along y: the limit is then
+affine in y (exactly), passes through the circle of radius R at every knot and deviates from it by
+``O(dtheta^4) R`` between knots (the geometry converges with the level; a subdivided mesh would keep the
+coarse geometry).
+
+Boundary conditions, exact: across an end the trace of a component is ``(c_-1 + 4 c_0 + c_1) / 6`` per
+column of coefficients (the cubic B-spline's values at a knot), so ``u_x = u_z = 0`` on the end is the
+linear condition ``c_-1 = -4 c_0 - c_1`` on those components (:func:`end_conditions`), eliminated in the
+map ``c = T c_free``. The roof's free edges carry no condition (natural). Rigid translation along y is
+the one rigid motion the diaphragms leave free; the y-coefficient of one control point in the mid-span row
+is fixed, which the symmetric solution (u_y odd in y) satisfies anyway.
+
+>>> r = scordelis_lo(4)
+>>> r["dofs"], round(r["w"], 2)
+(118, 0.28)
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import scipy.sparse as sp
+
+from ccproof.errors import CCProofError
+
+__all__ = ["cylinder_grid", "end_conditions", "scordelis_lo", "pinched_cylinder", "SCORDELIS_LO_REFERENCE",
+           "PINCHED_CYLINDER_REFERENCE"]
+
+#: vertical displacement at the midpoint of the free edge (MacNeal and Harder 1985 quote 0.3024; deep-shell
+#: and Kirchhoff-Love solutions, e.g. Kiendl et al. 2009, give 0.3006)
+SCORDELIS_LO_REFERENCE = 0.3024
+
+#: radial displacement under the load (Belytschko et al. 1985)
+PINCHED_CYLINDER_REFERENCE = 1.8248e-5
+
+
+def cylinder_grid(radius, angles, y, closed=False):
+    """A ghost-ring grid of control points on a cylinder with the axis along y.
+
+    Parameters
+    ----------
+    radius : float
+        The radius R of the limit surface at the knots.
+    angles : ndarray (m,)
+        Equally spaced angles of the knots from the z axis toward x (``x = R sin a``, ``z = R cos a``);
+        with ``closed`` the full circle (m angles, periodic), otherwise the region's knots, one ghost angle
+        is added at each side.
+    y : ndarray (k,)
+        Equally spaced knots along the axis; one ghost knot is added at each end.
+
+    Returns
+    -------
+    mesh : QuadMesh
+        Vertex ``i + n_i j`` (i around, j along the axis), face ``i + n_f j``.
+    region : bool (n_faces,)
+        The faces between the first and last knots.
+    """
+    from ccproof.mesh import QuadMesh
+
+    angles, y = np.asarray(angles, np.float64), np.asarray(y, np.float64)
+    da, dy = angles[1] - angles[0], y[1] - y[0]
+    a = angles if closed else np.concatenate([[angles[0] - da], angles, [angles[-1] + da]])
+    yy = np.concatenate([[y[0] - dy], y, [y[-1] + dy]])
+    r = 6.0 * radius / (4.0 + 2.0 * math.cos(da))  # the limit (P_-1 + 4 P_0 + P_1) / 6 lies on radius R
+    A, Y = np.meshgrid(a, yy)  # row j: along the axis
+    V = np.stack([r * np.sin(A), Y, r * np.cos(A)], -1).reshape(-1, 3)
+    ni, nj = a.size, yy.size
+    idx = np.arange(ni * nj).reshape(nj, ni)
+    nxt = np.roll(idx, -1, axis=1) if closed else idx[:, 1:]
+    cur = idx if closed else idx[:, :-1]
+    F = np.stack([cur[:-1], nxt[:-1], nxt[1:], cur[1:]], -1).reshape(-1, 4)
+    nf = cur.shape[1]
+    fi, fj = np.meshgrid(np.arange(nf), np.arange(nj - 1))
+    inside = (fj >= 1) & (fj <= nj - 3)
+    if not closed:
+        inside &= (fi >= 1) & (fi <= nf - 2)
+    return QuadMesh(V, F), inside.ravel()
+
+
+def end_conditions(n_around, n_y, fixed_y_vertex):
+    """The map T (3 n, free) of the diaphragms ``u_x = u_z = 0`` at both ends of a ghost-ring cylinder
+    grid with ``n_around`` vertices per row and ``n_y + 3`` rows (module docstring), with the y-coefficient
+    of ``fixed_y_vertex`` fixed as well."""
+    m = n_y + 3
+    rows, cols, vals = [], [], []
+    for k in range(1, m - 1):  # c_1 .. c_(m-2) are free
+        rows.append(k), cols.append(k - 1), vals.append(1.0)
+    for ghost, c0, c1 in ((0, 0, 1), (m - 1, m - 3, m - 4)):  # c_ghost = -4 c_edge - c_next
+        rows += [ghost, ghost]
+        cols += [c0, c1]
+        vals += [-4.0, -1.0]
+    T1 = sp.csr_matrix((vals, (rows, cols)), shape=(m, m - 2))
+    Txz = sp.kron(T1, sp.identity(n_around), format="csr")
+    n = n_around * m
+    keep = np.setdiff1d(np.arange(n), [fixed_y_vertex])
+    Ty = sp.identity(n, format="csr")[:, keep]
+    return sp.block_diag([Txz, Ty, Txz], format="csr")
+
+
+def _solve(mesh, region, material, order, loads):
+    """Assemble on the region and solve with the diaphragms; ``loads(S, fields)`` gives the load vector."""
+    from ccproof.apps.iga.quadrature import surface_quadrature
+    from ccproof.apps.iga.shell import ShellFields, restrict_rule
+    from ccproof.evaluate import natural_limit_surface
+
+    S = natural_limit_surface(mesh)
+    F = ShellFields(S, restrict_rule(surface_quadrature(S, order, "plain"), region))
+    return S, F, F.stiffness(material), loads(S, F)
+
+
+def scordelis_lo(n, n_y=None, order=4, length=50.0, radius=25.0, half_angle=40.0, material=None, gravity=90.0):
+    """The Scordelis-Lo roof at ``n`` faces across (``n_y`` along the axis, default n).
+
+    A cylindrical roof (R = 25, L = 50, 40 degrees either side of the crown, t = 0.25, E = 4.32e8,
+    nu = 0) under its own weight, 90 per unit area downward (-z), on rigid diaphragms at its curved ends,
+    its straight edges free.
+
+    Returns
+    -------
+    dict
+        ``w``: the downward displacement at the midpoint of a free edge (reference
+        :data:`SCORDELIS_LO_REFERENCE`), ``dofs`` (free coefficients), ``c`` (3 n_vertices,), ``n``.
+    """
+    from ccproof.apps.iga.shell import ShellMaterial, solve_shell
+
+    n_y = n if n_y is None else int(n_y)
+    if int(n) < 2 or n_y < 2 or n_y % 2:
+        raise CCProofError(f"the roof needs n >= 2 and an even n_y >= 2, got n={n!r}, n_y={n_y!r}")
+    n = int(n)
+    material = material or ShellMaterial(4.32e8, 0.0, 0.25)
+    a = math.radians(half_angle)
+    mesh, region = cylinder_grid(radius, np.linspace(-a, a, n + 1), np.linspace(-length / 2, length / 2, n_y + 1))
+    ni = n + 3
+    mid = ni * (n_y // 2 + 1)  # the first vertex of the mid-span row
+    S, F, K, b = _solve(mesh, region, material, order, lambda S, F: F.load([0.0, 0.0, -gravity]))
+    T = end_conditions(ni, n_y, mid)
+    c = solve_shell(K, b, T)
+    face = n + (n + 2) * (n_y // 2 + 1)  # the region's last face across, at the mid-span knot: (u, v) = (1, 0)
+    P = S.basis([face], [1.0], [0.0], 0)["P"]
+    nv = mesh.n_vertices
+    return {"w": float(-(P @ c[2 * nv:])[0]), "dofs": int(T.shape[1]), "c": c, "n": n}
+
+
+def pinched_cylinder(n, n_y=None, order=4, length=600.0, radius=300.0, material=None, force=1.0):
+    """The pinched cylinder at ``n`` faces around (``n_y`` along the axis, default n / 2), the whole cylinder.
+
+    R = 300, L = 600, t = 3, E = 3e6, nu = 0.3, rigid diaphragms at the ends, two opposite point forces
+    ``force`` at mid-length pressing inward (at the top, -z, and the bottom, +z).
+
+    Returns
+    -------
+    dict
+        ``w``: the inward radial displacement under the top force (reference
+        :data:`PINCHED_CYLINDER_REFERENCE`), ``dofs``, ``c``, ``n``.
+    """
+    from ccproof.apps.iga.shell import ShellMaterial, point_load, solve_shell
+
+    n = int(n)
+    n_y = n // 2 if n_y is None else int(n_y)
+    if n < 4 or n % 2 or n_y < 2 or n_y % 2:
+        raise CCProofError(f"the cylinder needs an even n >= 4 and an even n_y >= 2, got n={n!r}, n_y={n_y!r}")
+    material = material or ShellMaterial(3e6, 0.3, 3.0)
+    mesh, region = cylinder_grid(radius, 2 * np.pi * np.arange(n) / n, np.linspace(-length / 2, length / 2, n_y + 1),
+                                 closed=True)
+    j = n_y // 2 + 1  # the mid-length knot row
+    top, bottom = n * j, n // 2 + n * j  # faces with corner (0, 0) there
+
+    def loads(S, F):
+        return point_load(S, [top, bottom], [0.0, 0.0], [0.0, 0.0], [[0.0, 0.0, -force], [0.0, 0.0, force]])
+
+    S, F, K, b = _solve(mesh, region, material, order, loads)
+    T = end_conditions(n, n_y, n * j + n // 4)
+    c = solve_shell(K, b, T)
+    P = S.basis([top], [0.0], [0.0], 0)["P"]
+    nv = mesh.n_vertices
+    return {"w": float(-(P @ c[2 * nv:])[0]), "dofs": int(T.shape[1]), "c": c, "n": n}
