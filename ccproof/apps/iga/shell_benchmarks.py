@@ -33,7 +33,9 @@ import scipy.sparse as sp
 from ccproof.errors import CCProofError
 
 __all__ = ["cylinder_grid", "end_conditions", "scordelis_lo", "pinched_cylinder", "SCORDELIS_LO_REFERENCE",
-           "PINCHED_CYLINDER_REFERENCE"]
+           "PINCHED_CYLINDER_REFERENCE", "END_CONDITIONS"]
+
+END_CONDITIONS = ("exact", "rows", "edge")
 
 #: vertical displacement at the midpoint of the free edge (MacNeal and Harder 1985 quote 0.3024; deep-shell
 #: and Kirchhoff-Love solutions, e.g. Kiendl et al. 2009, give 0.3006)
@@ -43,7 +45,7 @@ SCORDELIS_LO_REFERENCE = 0.3024
 PINCHED_CYLINDER_REFERENCE = 1.8248e-5
 
 
-def cylinder_grid(radius, angles, y, closed=False):
+def cylinder_grid(radius, angles, y, closed=False, end_ghosts=True):
     """A ghost-ring grid of control points on a cylinder with the axis along y.
 
     Parameters
@@ -55,7 +57,8 @@ def cylinder_grid(radius, angles, y, closed=False):
         with ``closed`` the full circle (m angles, periodic), otherwise the region's knots, one ghost angle
         is added at each side.
     y : ndarray (k,)
-        Equally spaced knots along the axis; one ghost knot is added at each end.
+        Equally spaced knots along the axis; one ghost knot is added at each end (with ``end_ghosts``;
+        without, the ends are boundaries of the mesh, OpenSubdiv's EDGE_ONLY rules there).
 
     Returns
     -------
@@ -69,7 +72,7 @@ def cylinder_grid(radius, angles, y, closed=False):
     angles, y = np.asarray(angles, np.float64), np.asarray(y, np.float64)
     da, dy = angles[1] - angles[0], y[1] - y[0]
     a = angles if closed else np.concatenate([[angles[0] - da], angles, [angles[-1] + da]])
-    yy = np.concatenate([[y[0] - dy], y, [y[-1] + dy]])
+    yy = np.concatenate([[y[0] - dy], y, [y[-1] + dy]]) if end_ghosts else y
     r = 6.0 * radius / (4.0 + 2.0 * math.cos(da))  # the limit (P_-1 + 4 P_0 + P_1) / 6 lies on radius R
     A, Y = np.meshgrid(a, yy)  # row j: along the axis
     V = np.stack([r * np.sin(A), Y, r * np.cos(A)], -1).reshape(-1, 3)
@@ -80,29 +83,34 @@ def cylinder_grid(radius, angles, y, closed=False):
     F = np.stack([cur[:-1], nxt[:-1], nxt[1:], cur[1:]], -1).reshape(-1, 4)
     nf = cur.shape[1]
     fi, fj = np.meshgrid(np.arange(nf), np.arange(nj - 1))
-    inside = (fj >= 1) & (fj <= nj - 3)
+    g = int(bool(end_ghosts))
+    inside = (fj >= g) & (fj <= nj - 2 - g)
     if not closed:
         inside &= (fi >= 1) & (fi <= nf - 2)
     return QuadMesh(V, F), inside.ravel()
 
 
-def end_conditions(n_around, n_y, fixed_y_vertex):
-    """The map T (3 n, free) of the diaphragms ``u_x = u_z = 0`` at both ends of a ghost-ring cylinder
-    grid with ``n_around`` vertices per row and ``n_y + 3`` rows (module docstring), with the y-coefficient
-    of ``fixed_y_vertex`` fixed as well."""
-    m = n_y + 3
-    rows, cols, vals = [], [], []
-    for k in range(1, m - 1):  # c_1 .. c_(m-2) are free
-        rows.append(k), cols.append(k - 1), vals.append(1.0)
-    for ghost, c0, c1 in ((0, 0, 1), (m - 1, m - 3, m - 4)):  # c_ghost = -4 c_edge - c_next
-        rows += [ghost, ghost]
-        cols += [c0, c1]
-        vals += [-4.0, -1.0]
-    T1 = sp.csr_matrix((vals, (rows, cols)), shape=(m, m - 2))
-    Txz = sp.kron(T1, sp.identity(n_around), format="csr")
+def end_conditions(n_around, n_y, fixed_y_vertex, ends="exact"):
+    """The map T (3 n, free) of the diaphragms ``u_x = u_z = 0`` at both ends of a cylinder grid with
+    ``n_around`` vertices per row, with the y-coefficient of ``fixed_y_vertex`` fixed as well.
+
+    ``ends``: ``"exact"`` (ghost rows, ``n_y + 3`` rows: ``c_-1 = -4 c_0 - c_1`` per column, module
+    docstring), ``"rows"`` (ghost rows: the x and z coefficients of the ghost row and the row on the end
+    set to zero, as if the functions interpolated their control points: a different condition, docs/iga.md)
+    or ``"edge"`` (no ghost rows, ``n_y + 1`` rows, EDGE_ONLY ends: the end rows' x and z coefficients set
+    to zero, exact there since the trace is spanned by the boundary vertices)."""
+    if ends not in END_CONDITIONS:
+        raise CCProofError(f"unknown end condition {ends!r}; use one of {', '.join(END_CONDITIONS)}")
+    m = n_y + 1 if ends == "edge" else n_y + 3
+    g = {"exact": 1, "rows": 2, "edge": 1}[ends]  # rows fixed or eliminated at each end
+    keep = np.arange(g, m - g)
+    T1 = sp.identity(m, format="lil")[:, keep]
+    if ends == "exact":  # c_ghost = -4 c_edge - c_next
+        T1[0, 0], T1[0, 1] = -4.0, -1.0
+        T1[m - 1, m - 3], T1[m - 1, m - 4] = -4.0, -1.0
+    Txz = sp.kron(T1.tocsr(), sp.identity(n_around), format="csr")
     n = n_around * m
-    keep = np.setdiff1d(np.arange(n), [fixed_y_vertex])
-    Ty = sp.identity(n, format="csr")[:, keep]
+    Ty = sp.identity(n, format="csr")[:, np.setdiff1d(np.arange(n), [fixed_y_vertex])]
     return sp.block_diag([Txz, Ty, Txz], format="csr")
 
 
@@ -117,12 +125,13 @@ def _solve(mesh, region, material, order, loads):
     return S, F, F.stiffness(material), loads(S, F)
 
 
-def scordelis_lo(n, n_y=None, order=4, length=50.0, radius=25.0, half_angle=40.0, material=None, gravity=90.0):
+def scordelis_lo(n, n_y=None, order=4, ends="exact", length=50.0, radius=25.0, half_angle=40.0, material=None,
+                 gravity=90.0):
     """The Scordelis-Lo roof at ``n`` faces across (``n_y`` along the axis, default n).
 
     A cylindrical roof (R = 25, L = 50, 40 degrees either side of the crown, t = 0.25, E = 4.32e8,
-    nu = 0) under its own weight, 90 per unit area downward (-z), on rigid diaphragms at its curved ends,
-    its straight edges free.
+    nu = 0) under its own weight, 90 per unit area downward (-z), on rigid diaphragms at its curved ends
+    (imposed as ``ends`` says: :func:`end_conditions`), its straight edges free.
 
     Returns
     -------
@@ -138,14 +147,14 @@ def scordelis_lo(n, n_y=None, order=4, length=50.0, radius=25.0, half_angle=40.0
     n = int(n)
     material = material or ShellMaterial(4.32e8, 0.0, 0.25)
     a = math.radians(half_angle)
-    mesh, region = cylinder_grid(radius, np.linspace(-a, a, n + 1), np.linspace(-length / 2, length / 2, n_y + 1))
-    ni = n + 3
-    mid = ni * (n_y // 2 + 1)  # the first vertex of the mid-span row
+    g = int(ends != "edge")  # ghost rows beyond the ends
+    mesh, region = cylinder_grid(radius, np.linspace(-a, a, n + 1), np.linspace(-length / 2, length / 2, n_y + 1),
+                                 end_ghosts=bool(g))
+    ni, j = n + 3, n_y // 2 + g  # vertices per row; the mid-span knot's row
+    T = end_conditions(ni, n_y, ni * j, ends)  # (checks ends first)
     S, F, K, b = _solve(mesh, region, material, order, lambda S, F: F.load([0.0, 0.0, -gravity]))
-    T = end_conditions(ni, n_y, mid)
     c = solve_shell(K, b, T)
-    face = n + (n + 2) * (n_y // 2 + 1)  # the region's last face across, at the mid-span knot: (u, v) = (1, 0)
-    P = S.basis([face], [1.0], [0.0], 0)["P"]
+    P = S.basis([n + (n + 2) * j], [1.0], [0.0], 0)["P"]  # the last region face across, at the knot: (1, 0)
     nv = mesh.n_vertices
     return {"w": float(-(P @ c[2 * nv:])[0]), "dofs": int(T.shape[1]), "c": c, "n": n}
 
