@@ -23,8 +23,10 @@ from ccproof.apps.iga.shell_benchmarks import (
     SCORDELIS_LO_REFERENCE,
     cylinder_grid,
     end_conditions,
+    ogrid_block_grid,
     pinched_cylinder,
     scordelis_lo,
+    scordelis_lo_ev,
 )
 from ccproof.errors import CCProofError
 from ccproof.evaluate import natural_limit_surface
@@ -151,6 +153,14 @@ def test_scordelis_lo_converges_to_the_published_displacement():
     assert abs(edge / 0.3006 - 1) < 1e-3
     rows = scordelis_lo(16, ends="rows")["w"]  # ghost and end rows fixed: a clamp of u_x, u_z, not a diaphragm
     assert abs(rows / 0.3006 - 1) > 0.03  # measured 0.2885
+
+
+def test_scordelis_lo_with_extraordinary_vertices():
+    m = ogrid_block_grid(4)
+    inner = ~np.asarray(m.is_boundary_vertex)
+    assert sorted(np.asarray(m.valence)[inner & (np.asarray(m.valence) != 4)].tolist()) == [3] * 4 + [5] * 4
+    e1, e2 = (abs(scordelis_lo_ev(level)["w"] / 0.3006 - 1) for level in (1, 2))
+    assert e2 < e1 / 2 and e2 < 0.015  # measured 0.0296, 0.0102 (0.0026 at level 3)
 
 
 @pytest.mark.slow

@@ -33,7 +33,7 @@ import scipy.sparse as sp
 from ccproof.errors import CCProofError
 
 __all__ = ["cylinder_grid", "end_conditions", "scordelis_lo", "pinched_cylinder", "SCORDELIS_LO_REFERENCE",
-           "PINCHED_CYLINDER_REFERENCE", "END_CONDITIONS"]
+           "PINCHED_CYLINDER_REFERENCE", "END_CONDITIONS", "ogrid_block_grid", "scordelis_lo_ev"]
 
 END_CONDITIONS = ("exact", "rows", "edge")
 
@@ -192,3 +192,132 @@ def pinched_cylinder(n, n_y=None, order=4, length=600.0, radius=300.0, material=
     P = S.basis([top], [0.0], [0.0], 0)["P"]
     nv = mesh.n_vertices
     return {"w": float(-(P @ c[2 * nv:])[0]), "dofs": int(T.shape[1]), "c": c, "n": n}
+
+
+def ogrid_block_grid(n, ghost=2):
+    """A flat ghost-ring grid in index units with extraordinary vertices: ``grid(n + 2 ghost)`` with vertex
+    (i, j) at ``(i - ghost, j - ghost)`` (the region ``[0, n]^2``), its central 2 x 2 faces replaced by the
+    once-subdivided o-grid (a square in a ring of four trapezoids): 20 faces, four interior vertices of
+    valence 3 (the inner square's corners) and the block's four corners of valence 5.
+
+    >>> m = ogrid_block_grid(4)
+    >>> m.n_faces, sorted(np.unique(m.valence[~m.is_boundary_vertex], return_counts=True)[1].tolist())
+    (80, [4, 4, 57])
+    """
+    from ccproof.mesh import QuadMesh
+    from ccproof.mesh.examples import grid
+
+    if int(n) < 4 or n % 2:
+        raise CCProofError(f"the o-grid block needs an even n >= 4, got n={n!r}")
+    N = n + 2 * ghost
+    g = grid(N, N)
+    V = list(np.asarray(g.vertices, dtype=np.float64) - [ghost, ghost, 0.0])
+    c = ghost + n // 2
+
+    def vid(i, j):
+        return (c + i) + (N + 1) * (c + j)
+
+    B = [vid(-1, -1), vid(1, -1), vid(1, 1), vid(-1, 1)]
+    M = [vid(0, -1), vid(1, 0), vid(0, 1), vid(-1, 0)]
+    C = vid(0, 0)
+    P = np.asarray(V)
+
+    def new(p):
+        V.append(np.asarray(p, dtype=np.float64))
+        return len(V) - 1
+
+    inner = [new(P[C] + 0.4 * (P[b] - P[C])) for b in B]
+    S = [new((P[b] + V[k]) / 2) for b, k in zip(B, inner)]
+    Nn = [new((V[inner[i]] + V[inner[(i + 1) % 4]]) / 2) for i in range(4)]
+    Q = [new((P[B[i]] + P[B[(i + 1) % 4]] + V[inner[(i + 1) % 4]] + V[inner[i]]) / 4) for i in range(4)]
+    F = [f for f in np.asarray(g.faces).tolist() if C not in f]  # the block's four faces share its centre
+    for i in range(4):
+        j = (i + 1) % 4
+        F += [[inner[i], Nn[i], C, Nn[i - 1]], [B[i], M[i], Q[i], S[i]], [M[i], B[j], S[j], Q[i]],
+              [Q[i], S[j], inner[j], Nn[i]], [S[i], Q[i], Nn[i], inner[i]]]
+    return QuadMesh(np.asarray(V), F)
+
+
+def _lattice_keys(X, scale):
+    """Integer lattice keys ``round(scale X[:, :2])`` and whether each point lies on the lattice."""
+    k = np.rint(X[:, :2] * scale)
+    return k.astype(np.int64), np.abs(X[:, :2] * scale - k).max(axis=1) < 1e-9
+
+
+def _ev_roof_map(P, n, level, active, fixed_y):
+    """The diaphragm map of the o-grid roof at ``level``: per lattice column at each end, the ghost row's
+    x and z coefficients are ``-4 c_end - c_next``; inactive vertices get no column."""
+    nv = P.shape[0]
+    h = 2**level
+    key, on = _lattice_keys(P, h)
+    index = {(int(a), int(b)): i for i, (a, b) in enumerate(key) if on[i]}
+    ghost_of = {}
+    for t_end, step in ((0, 1), (n * h, -1)):
+        for i in np.flatnonzero(on & (key[:, 1] == t_end - step) & active):
+            s = int(key[i, 0])
+            ghost_of[int(i)] = (index[s, t_end], index[s, t_end + step])
+    beyond = np.flatnonzero(active & ((P[:, 1] < 0) | (P[:, 1] > n)))
+    if set(beyond.tolist()) != set(ghost_of):  # every active vertex beyond an end: one lattice ghost row
+        raise CCProofError("the o-grid roof's ends are not regular lattice rows at this level")
+    free = [np.flatnonzero(active & ~np.isin(np.arange(nv), list(ghost_of)))] * 3
+    free[1] = np.setdiff1d(np.flatnonzero(active), [fixed_y])
+    col, cols = {}, 0
+    for k in range(3):
+        for i in free[k]:
+            col[k, int(i)] = cols
+            cols += 1
+    rows, cc, vals = [], [], []
+    for (k, i), j in col.items():
+        rows.append(k * nv + i), cc.append(j), vals.append(1.0)
+    for k in (0, 2):
+        for gv, (e, x) in ghost_of.items():
+            rows += [k * nv + gv, k * nv + gv]
+            cc += [col[k, e], col[k, x]]
+            vals += [-4.0, -1.0]
+    return sp.csr_matrix((vals, (rows, cc)), shape=(3 * nv, cols))
+
+
+def scordelis_lo_ev(level, n=4, order=4, depth=4, length=50.0, radius=25.0, half_angle=40.0, material=None,
+                    gravity=90.0):
+    """The Scordelis-Lo roof (:func:`scordelis_lo`) on a mesh with extraordinary vertices: the flat
+    :func:`ogrid_block_grid` at ``n`` faces across (four valence-3 and four valence-5 vertices around the
+    crown's centre), subdivided ``level`` times in the plane, then mapped onto the cylinder as
+    :func:`cylinder_grid` maps its lattice (``theta = -a + s dtheta``, ``y = -L/2 + t dy``, radius ``6 R /
+    (4 + 2 cos dtheta_level)``). Refinement is subdivision of the parameter mesh, the geometry built anew
+    on the cylinder at each level; the adaptive rule (``depth`` rings) on the region.
+
+    Returns
+    -------
+    dict
+        ``w`` (downward displacement at the midpoint of a free edge), ``dofs``, ``c``, ``level``.
+    """
+    from ccproof.apps.iga.quadrature import surface_quadrature
+    from ccproof.apps.iga.shell import ShellFields, ShellMaterial, restrict_rule, solve_shell
+    from ccproof.evaluate import natural_limit_surface
+    from ccproof.mesh import QuadMesh, subdivide
+
+    material = material or ShellMaterial(4.32e8, 0.0, 0.25)
+    m = ogrid_block_grid(n)
+    for _ in range(int(level)):
+        m = subdivide(m)
+    P = np.asarray(m.vertices)
+    a = math.radians(half_angle)
+    dth, dy = 2 * a / n, length / n
+    th = -a + P[:, 0] * dth
+    r = 6.0 * radius / (4.0 + 2.0 * math.cos(dth / 2**level))
+    mesh = QuadMesh(np.stack([r * np.sin(th), -length / 2 + P[:, 1] * dy, r * np.cos(th)], 1), m.faces)
+    cen = P[np.asarray(m.faces)].mean(axis=1)
+    region = ((cen[:, :2] > 0) & (cen[:, :2] < n)).all(axis=1)
+    S = natural_limit_surface(mesh)
+    F = ShellFields(S, restrict_rule(surface_quadrature(S, order, "adaptive", depth), region))
+    active = F.fields.W["P"].getnnz(axis=0) > 0
+    key, on = _lattice_keys(P, 2**level)
+    h = 2**level
+    mid = np.flatnonzero(on & (key[:, 1] == n * h // 2) & (key[:, 0] == n * h))  # the free edge's midpoint
+    T = _ev_roof_map(P, n, level, active, int(mid[0]))
+    c = solve_shell(F.stiffness(material), F.load([0.0, 0.0, -gravity]), T)
+    f, corner = np.argwhere((np.asarray(m.faces) == mid[0]) & region[:, None])[0]
+    uv = ((0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0))[corner]
+    W = S.basis([f], [uv[0]], [uv[1]], 0)["P"]
+    nv = mesh.n_vertices
+    return {"w": float(-(W @ c[2 * nv:])[0]), "dofs": int(T.shape[1]), "c": c, "level": int(level)}
