@@ -18,6 +18,10 @@ map ``c = T c_free``. The roof's free edges carry no condition (natural). Rigid 
 the one rigid motion the diaphragms leave free; the y-coefficient of one control point in the mid-span row
 is fixed, which the symmetric solution (u_y odd in y) satisfies anyway.
 
+The roof also on a mesh with extraordinary vertices (:func:`scordelis_lo_ev`, :func:`ogrid_block_grid`):
+the parameter mesh subdivided in the plane, then mapped onto the cylinder; near its extraordinary vertices
+the limit leaves the cylinder by O(h^2) (docs/iga.md).
+
 >>> r = scordelis_lo(4)
 >>> r["dofs"], round(r["w"], 2)
 (118, 0.28)
