@@ -261,7 +261,7 @@ def _ev_roof_map(P, n, level, active, fixed_y):
         for i in np.flatnonzero(on & (key[:, 1] == t_end - step) & active):
             s = int(key[i, 0])
             ghost_of[int(i)] = (index[s, t_end], index[s, t_end + step])
-    beyond = np.flatnonzero(active & ((P[:, 1] < 0) | (P[:, 1] > n)))
+    beyond = np.flatnonzero(active & ((P[:, 1] < -1e-9) | (P[:, 1] > n + 1e-9)))
     if set(beyond.tolist()) != set(ghost_of):  # every active vertex beyond an end: one lattice ghost row
         raise CCProofError("the o-grid roof's ends are not regular lattice rows at this level")
     free = [np.flatnonzero(active & ~np.isin(np.arange(nv), list(ghost_of)))] * 3
