@@ -52,7 +52,7 @@ class _Table(ctypes.Structure):
 _LIB = None
 _TRIED = False
 #: the version of the kernel's interface (``ccp_abi`` in _clib.c)
-_ABI = 6
+_ABI = 7
 #: calls on fewer points use no corner-net cache (CCP_CACHE_MIN in _clib.c)
 _CACHE_MIN = 256
 
@@ -83,6 +83,8 @@ def load():
             continue
         lib.ccp_evaluate.restype = _I
         lib.ccp_evaluate.argtypes = [ctypes.POINTER(_Table), _I, _P, _P, _P, _I, _P, _P, _P, _P, _P, _P, _P]
+        lib.ccp_evaluate_at.restype = _I
+        lib.ccp_evaluate_at.argtypes = [ctypes.POINTER(_Table), _I, _P, _P, _P, _P, _I, _P, _P, _P, _P, _P, _P, _P]
         lib.ccp_cache_words.restype = _I
         lib.ccp_cache_words.argtypes = []
         lib.ccp_corner_nets.restype = _I
@@ -250,26 +252,32 @@ class CTable:
         return CTable, (self.table, self.layers, self.grid, self.reciprocals, derived)
 
 
-def evaluate_block(lib, ct, f, u, v, d, outs):
+def evaluate_block(lib, ct, f, u, v, d, outs, rows=None):
     """Evaluate points ``f, u, v`` (contiguous int64 / float64, shape (n,)) into ``outs`` (the arrays
-    P, Pu, Pv, Puu, Puv, Pvv: contiguous float64 (n, 3), or None beyond derivative order ``d``).
+    P, Pu, Pv, Puu, Puv, Pvv: contiguous float64 (n, 3), or None beyond derivative order ``d``); with ``rows``
+    (contiguous int64, distinct rows of the inputs and outputs) the points of those rows, in that order.
 
-    Returns -1, or the index of the first point the kernel refuses (face out of range or a hole, (u, v)
-    outside [0, 1]^2 or NaN); the outputs from that point on are not written.
+    Returns -1, or the index (in ``rows`` where given) of the first point the kernel refuses (face out of
+    range or a hole, (u, v) outside [0, 1]^2 or NaN); the outputs from that point on are not written.
     """
     ptrs = [None if a is None else _addr(a) for a in outs]
-    if f.size < _CACHE_MIN:
-        return int(lib.ccp_evaluate(ct.ref, f.size, _addr(f), _addr(u), _addr(v), d, *ptrs, None))
-    cache = ct.take_cache(lib)
+    n = f.size if rows is None else rows.size
+    cache = ct.take_cache(lib) if n >= _CACHE_MIN else None
     try:
-        return int(lib.ccp_evaluate(ct.ref, f.size, _addr(f), _addr(u), _addr(v), d, *ptrs, _addr(cache)))
+        if rows is None:
+            return int(lib.ccp_evaluate(ct.ref, n, _addr(f), _addr(u), _addr(v), d, *ptrs,
+                                        None if cache is None else _addr(cache)))
+        return int(lib.ccp_evaluate_at(ct.ref, n, _addr(rows), _addr(f), _addr(u), _addr(v), d, *ptrs,
+                                       None if cache is None else _addr(cache)))
     finally:
-        ct.give_cache(cache)
+        if cache is not None:
+            ct.give_cache(cache)
 
 
-def point_blocks(lib, ct, f, u, v, d, outs):
+def point_blocks(lib, ct, f, u, v, d, outs, order=None):
     """``(block, back)`` for :func:`ccproof.evaluate.backend.evaluation_blocks`: ``block(lo, hi)`` calls
     :func:`evaluate_block` on the points lo:hi (``f, u, v`` contiguous) of the table ``ct`` (a :class:`CTable`);
+    with ``order`` (a permutation of the points) on the points ``order[lo:hi]``, each written to its own row;
     ``outs`` the six outputs (None where absent), those beyond derivative order ``d`` not written; ``back``:
     ``[(index, temporary)]`` for the outputs it cannot write in place (not contiguous float64 (n, 3))."""
     f, u, v = (np.ascontiguousarray(a) for a in (f, u, v))
@@ -282,6 +290,10 @@ def point_blocks(lib, ct, f, u, v, d, outs):
             back.append((i, np.empty((n, 3))))
             a = back[-1][1]
         arrs.append(a)
+
+    if order is not None:
+        order = np.ascontiguousarray(order, dtype=np.int64)
+        return (lambda lo, hi: evaluate_block(lib, ct, f, u, v, d, arrs, order[lo:hi])), back
 
     def block(lo, hi):
         return evaluate_block(lib, ct, f[lo:hi], u[lo:hi], v[lo:hi], d, [None if a is None else a[lo:hi] for a in arrs])

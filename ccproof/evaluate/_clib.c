@@ -44,9 +44,11 @@
 #if defined(__GNUC__)
 #define CCP_INLINE static inline __attribute__((always_inline))
 #define CCP_PREFETCH(p) __builtin_prefetch(p)
+#define CCP_PREFETCH_W(p) __builtin_prefetch(p, 1)
 #else
 #define CCP_INLINE static inline
 #define CCP_PREFETCH(p) ((void)(p))
+#define CCP_PREFETCH_W(p) ((void)(p))
 #endif
 
 #if defined(__GNUC__) && defined(__x86_64__) && defined(__linux__) && !defined(CCP_NO_CLONES)
@@ -252,7 +254,7 @@ CCP_INLINE const int32_t *ring_of(const ccp_table *T, int64_t job) {
 
 /* Net W (17 x 3) of the regular leaf vf of ``job``: row i the sum over the ring points j = 1, 2, ... in order,
  * from 0.0, of op[j, i] (X[ring[j]] - X[ring[0]]), row 16 that sum plus X[ring[0]] (op: vop, N x 17). */
-static void regular_net(const ccp_table *T, int64_t job, int64_t vf, double *W) {
+CCP_CLONES static void regular_net(const ccp_table *T, int64_t job, int64_t vf, double *W) {
     int64_t N = T->vn[vf];
     const double *op = T->vop + T->vop_start[vf];
     const int32_t *rg = ring_of(T, job);
@@ -286,7 +288,7 @@ static void regular_net(const ccp_table *T, int64_t job, int64_t vf, double *W) 
  * to the corner vertex first (rows 1 .. Nc - 1: Q @ (X[ring] - X[ring[0]]), the
  * sums over the ring points j = 1, 2, ... in order from 0.0; Q: vop, N x (Nc - 1)), then L[lay, code] @ that
  * ring summed over its points j = 1, 2, ... in order, from 0.0. */
-static void corner_net(const ccp_table *T, int64_t job, int64_t vf, int64_t cfg, int64_t lay, int64_t code,
+CCP_CLONES static void corner_net(const ccp_table *T, int64_t job, int64_t vf, int64_t cfg, int64_t lay, int64_t code,
                        int64_t ci, double *W) {
     int64_t Nc = T->op_size[cfg], N = T->vn[vf], m = Nc - 1;
     const double *op = T->ops + T->op_start[cfg] + (3 * lay + code) * 16 * Nc;
@@ -581,9 +583,11 @@ CCP_INLINE const double *locate(const ccp_table *T, int64_t job, int64_t vf, int
 #define BASIS basis
 #endif
 
-CCP_INLINE int64_t run(const ccp_table *T, int64_t n, const int64_t *f, const double *u, const double *v,
-                       const int D, double *P, double *Pu, double *Pv, double *Puu, double *Puv, double *Pvv,
-                       double *cache) {
+/* ix NULL: point k is (f[k], u[k], v[k]), its results row k; else point k is row ix[k] of the inputs and of the
+ * outputs (the rows of ix distinct: each output row written once, three coordinates at a time). */
+CCP_INLINE int64_t run(const ccp_table *T, int64_t n, const int64_t *ix, const int64_t *f, const double *u,
+                       const double *v, const int D, double *P, double *Pu, double *Pv, double *Puu, double *Puv,
+                       double *Pvv, double *cache) {
     int64_t *base = n >= CCP_CACHE_MIN ? (int64_t *)cache : NULL;
     double S[CCP_BLOCK], Tt[CCP_BLOCK], G[CCP_BLOCK];
     double BS[CCP_BLOCK][12], BT[CCP_BLOCK][12]; /* the basis functions at the block's (s, t) */
@@ -598,10 +602,28 @@ CCP_INLINE int64_t run(const ccp_table *T, int64_t n, const int64_t *f, const do
         int m = 0;
         /* pass 1: the virtual faces of the block's points (independent table reads, overlapped), then their
          * patches, prefetching the nets (or the cache slots of the deep corner nets) */
-        int64_t JB[CCP_BLOCK], VF[CCP_BLOCK];
+        int64_t JB[CCP_BLOCK], VF[CCP_BLOCK], AT[CCP_BLOCK];
         int KD[CCP_BLOCK];
+        if (ix != NULL) /* the next block's input rows, read in its pass 1, and output rows, written in its pass 2 */
+            for (int64_t j = k + CCP_BLOCK; j < n && j < k + 2 * CCP_BLOCK; j++) {
+                int64_t r = ix[j];
+                CCP_PREFETCH(f + r);
+                CCP_PREFETCH(u + r);
+                CCP_PREFETCH(v + r);
+                CCP_PREFETCH_W(P + 3 * r);
+                if (D >= 1) {
+                    CCP_PREFETCH_W(Pu + 3 * r);
+                    CCP_PREFETCH_W(Pv + 3 * r);
+                }
+                if (D >= 2) {
+                    CCP_PREFETCH_W(Puu + 3 * r);
+                    CCP_PREFETCH_W(Puv + 3 * r);
+                    CCP_PREFETCH_W(Pvv + 3 * r);
+                }
+            }
         for (; k < n && m < CCP_BLOCK; k++, m++) {
-            KD[m] = find_face(T, f[k], u[k], v[k], JB + m, VF + m);
+            int64_t r = AT[m] = ix != NULL ? ix[k] : k;
+            KD[m] = find_face(T, f[r], u[r], v[r], JB + m, VF + m);
             if (KD[m] < 0) {
                 bad = k;
                 break;
@@ -609,7 +631,7 @@ CCP_INLINE int64_t run(const ccp_table *T, int64_t n, const int64_t *f, const do
         }
         int DL[CCP_BLOCK], nd = 0; /* the points with deep corner nets, in order */
         for (int i = 0; i < m; i++) {
-            int64_t kk = k0 + i;
+            int64_t kk = AT[i];
             const double *net = locate(T, JB[i], VF[i], KD[i], u[kk], v[kk], dp + i, S + i, Tt + i, G + i);
             N[i] = net;
             BASIS(S[i], BS[i]);
@@ -644,7 +666,7 @@ CCP_INLINE int64_t run(const ccp_table *T, int64_t n, const int64_t *f, const do
             int64_t *sl = slot[i];
             if (sl[0] != key[i] + 1) {
                 if (sl[1] == block) {
-                    for (; i0 < i; i0++) bicubic(N[i0], BS[i0], BT[i0], G[i0], D, k0 + i0, k0 + i0 + 1 < n, P, Pu, Pv, Puu, Puv, Pvv);
+                    for (; i0 < i; i0++) bicubic(N[i0], BS[i0], BT[i0], G[i0], D, AT[i0], ix == NULL && k0 + i0 + 1 < n, P, Pu, Pv, Puu, Puv, Pvv);
                     block++;
                 }
                 deep_net(T, d, (double *)(sl + 5));
@@ -653,26 +675,26 @@ CCP_INLINE int64_t run(const ccp_table *T, int64_t n, const int64_t *f, const do
             sl[1] = block;
             N[i] = (const double *)(sl + 5);
         }
-        for (; i0 < m; i0++) bicubic(N[i0], BS[i0], BT[i0], G[i0], D, k0 + i0, k0 + i0 + 1 < n, P, Pu, Pv, Puu, Puv, Pvv);
+        for (; i0 < m; i0++) bicubic(N[i0], BS[i0], BT[i0], G[i0], D, AT[i0], ix == NULL && k0 + i0 + 1 < n, P, Pu, Pv, Puu, Puv, Pvv);
     }
     if (base != NULL) base[0] = block;
     return bad;
 }
 
-CCP_CLONES static int64_t run0(const ccp_table *T, int64_t n, const int64_t *f, const double *u, const double *v,
-                               double *P, double *cache) {
-    return run(T, n, f, u, v, 0, P, NULL, NULL, NULL, NULL, NULL, cache);
+CCP_CLONES static int64_t run0(const ccp_table *T, int64_t n, const int64_t *ix, const int64_t *f, const double *u,
+                               const double *v, double *P, double *cache) {
+    return run(T, n, ix, f, u, v, 0, P, NULL, NULL, NULL, NULL, NULL, cache);
 }
 
-CCP_CLONES static int64_t run1(const ccp_table *T, int64_t n, const int64_t *f, const double *u, const double *v,
-                               double *P, double *Pu, double *Pv, double *cache) {
-    return run(T, n, f, u, v, 1, P, Pu, Pv, NULL, NULL, NULL, cache);
+CCP_CLONES static int64_t run1(const ccp_table *T, int64_t n, const int64_t *ix, const int64_t *f, const double *u,
+                               const double *v, double *P, double *Pu, double *Pv, double *cache) {
+    return run(T, n, ix, f, u, v, 1, P, Pu, Pv, NULL, NULL, NULL, cache);
 }
 
-CCP_CLONES static int64_t run2(const ccp_table *T, int64_t n, const int64_t *f, const double *u, const double *v,
-                               double *P, double *Pu, double *Pv, double *Puu, double *Puv, double *Pvv,
-                               double *cache) {
-    return run(T, n, f, u, v, 2, P, Pu, Pv, Puu, Puv, Pvv, cache);
+CCP_CLONES static int64_t run2(const ccp_table *T, int64_t n, const int64_t *ix, const int64_t *f, const double *u,
+                               const double *v, double *P, double *Pu, double *Pv, double *Puu, double *Puv,
+                               double *Pvv, double *cache) {
+    return run(T, n, ix, f, u, v, 2, P, Pu, Pv, Puu, Puv, Pvv, cache);
 }
 
 /* Fill P (n x 3) and, for d >= 1, Pu, Pv, for d >= 2, Puu, Puv, Pvv (n x 3 each, C order) at the points
@@ -683,9 +705,22 @@ CCP_CLONES static int64_t run2(const ccp_table *T, int64_t n, const int64_t *f, 
  * written). */
 int64_t ccp_evaluate(const ccp_table *T, int64_t n, const int64_t *f, const double *u, const double *v, int64_t d,
                      double *P, double *Pu, double *Pv, double *Puu, double *Puv, double *Pvv, double *cache) {
-    if (d <= 0) return run0(T, n, f, u, v, P, cache);
-    if (d == 1) return run1(T, n, f, u, v, P, Pu, Pv, cache);
-    return run2(T, n, f, u, v, P, Pu, Pv, Puu, Puv, Pvv, cache);
+    if (d <= 0) return run0(T, n, NULL, f, u, v, P, cache);
+    if (d == 1) return run1(T, n, NULL, f, u, v, P, Pu, Pv, cache);
+    return run2(T, n, NULL, f, u, v, P, Pu, Pv, Puu, Puv, Pvv, cache);
+}
+
+/* ccp_evaluate on the points ix[0], ix[1], ... ix[n - 1] (distinct rows of f, u, v and of the outputs, which
+ * hold at least max(ix) + 1 rows), in that order: each point's results in its own row, the same bits as
+ * ccp_evaluate gives it (the caller orders the points by face: the table read in order, the nets of a patch
+ * found in the cache). Returns -1, or the position k (not the row ix[k]) of the first point refused; the
+ * points from position k on are not written. */
+int64_t ccp_evaluate_at(const ccp_table *T, int64_t n, const int64_t *ix, const int64_t *f, const double *u,
+                        const double *v, int64_t d, double *P, double *Pu, double *Pv, double *Puu, double *Puv,
+                        double *Pvv, double *cache) {
+    if (d <= 0) return run0(T, n, ix, f, u, v, P, cache);
+    if (d == 1) return run1(T, n, ix, f, u, v, P, Pu, Pv, cache);
+    return run2(T, n, ix, f, u, v, P, Pu, Pv, Puu, Puv, Pvv, cache);
 }
 
 /* The size of a corner-net cache, in doubles. */
@@ -755,7 +790,7 @@ int64_t ccp_grid(const ccp_table *T, int64_t *grid) {
 }
 
 /* The layout this file was compiled with: the binding refuses a library whose structure differs. */
-int64_t ccp_abi(void) { return 1000 * (int64_t)sizeof(ccp_table) + 6; }
+int64_t ccp_abi(void) { return 1000 * (int64_t)sizeof(ccp_table) + 7; }
 
 /* ------------------------------------------------------------------------------------------------------------
  * The ring walk of the table's setup (the numba kernel's _ring_walks, ccproof/evaluate/_numba_kernel.py, step
