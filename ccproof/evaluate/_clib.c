@@ -252,23 +252,77 @@ CCP_INLINE const int32_t *ring_of(const ccp_table *T, int64_t job) {
     return T->rings + ld(T->job_ring, T->wide[4], job);
 }
 
-/* Net W (17 x 3) of the regular leaf vf of ``job``: row i the sum over the ring points j = 1, 2, ... in order,
- * from 0.0, of op[j, i] (X[ring[j]] - X[ring[0]]), row 16 that sum plus X[ring[0]] (op: vop, N x 17). */
-CCP_CLONES static void regular_net(const ccp_table *T, int64_t job, int64_t vf, double *W) {
-    int64_t N = T->vn[vf];
-    const double *op = T->vop + T->vop_start[vf];
-    const int32_t *rg = ring_of(T, job);
-    const double *x0 = T->points + 3 * (int64_t)rg[0];
-    double a0[17], a1[17], a2[17];
-    for (int i = 0; i < 17; i++) a0[i] = a1[i] = a2[i] = 0.0;
-    for (int64_t j = 1; j < N; j++) {
-        const double *x = T->points + 3 * (int64_t)rg[j];
-        double r0 = x[0] - x0[0], r1 = x[1] - x0[1], r2 = x[2] - x0[2];
-        const double *w = op + 17 * j;
-        for (int i = 0; i < 17; i++) {
-            a0[i] += w[i] * r0;
-            a1[i] += w[i] * r1;
-            a2[i] += w[i] * r2;
+/* The difference of ring point j and the origin x0: X[rg[j]] - x0 (rg given), else row j - 1 of rel (n x 3, the
+ * ring relative to its vertex already). */
+CCP_INLINE void rel_point(const double *pts, const int32_t *rg, const double *x0, const double *rel, int64_t j,
+                          double *r) {
+    if (rg != NULL) {
+        const double *x = pts + 3 * (int64_t)rg[j];
+        r[0] = x[0] - x0[0];
+        r[1] = x[1] - x0[1];
+        r[2] = x[2] - x0[2];
+    } else {
+        r[0] = rel[3 * (j - 1)];
+        r[1] = rel[3 * (j - 1) + 1];
+        r[2] = rel[3 * (j - 1) + 2];
+    }
+}
+
+/* W[3 i + c] (i < 16) = the sum over j = 1, 2, ..., n - 1 in order, from 0.0, of M[stride j + i] r_j[c] (r_j:
+ * rel_point); with o, also e[c] = the same sum of o[ostride j] r_j[c]. */
+#if defined(__GNUC__) && !defined(CCP_SCALAR)
+CCP_INLINE void sums16(const double *pts, const int32_t *rg, const double *x0, const double *rel, int64_t n,
+                       const double *M, int64_t stride, const double *o, int64_t ostride, double *W, double *e) {
+    v4d a[12]; /* a[4 c + q]: lanes i = 4 q .. 4 q + 3 of coordinate c, each lane its own sum */
+    double e0 = 0.0, e1 = 0.0, e2 = 0.0, r[3];
+    for (int k = 0; k < 12; k++) a[k] = splat(0.0);
+    for (int64_t j = 1; j < n; j++) {
+        rel_point(pts, rg, x0, rel, j, r);
+        v4d R0 = splat(r[0]), R1 = splat(r[1]), R2 = splat(r[2]);
+        const double *w = M + stride * j;
+        for (int q = 0; q < 4; q++) {
+            v4d wq = ld4(w + 4 * q);
+            a[q] += wq * R0;
+            a[4 + q] += wq * R1;
+            a[8 + q] += wq * R2;
+        }
+        if (o != NULL) {
+            double oj = o[ostride * j];
+            e0 += oj * r[0];
+            e1 += oj * r[1];
+            e2 += oj * r[2];
+        }
+    }
+    double t[48];
+    memcpy(t, a, sizeof t);
+    for (int i = 0; i < 16; i++) {
+        W[3 * i] = t[i];
+        W[3 * i + 1] = t[16 + i];
+        W[3 * i + 2] = t[32 + i];
+    }
+    if (o != NULL) {
+        e[0] = e0;
+        e[1] = e1;
+        e[2] = e2;
+    }
+}
+#else
+CCP_INLINE void sums16(const double *pts, const int32_t *rg, const double *x0, const double *rel, int64_t n,
+                       const double *M, int64_t stride, const double *o, int64_t ostride, double *W, double *e) {
+    double a0[16], a1[16], a2[16], e0 = 0.0, e1 = 0.0, e2 = 0.0, r[3];
+    for (int i = 0; i < 16; i++) a0[i] = a1[i] = a2[i] = 0.0;
+    for (int64_t j = 1; j < n; j++) {
+        rel_point(pts, rg, x0, rel, j, r);
+        const double *w = M + stride * j;
+        for (int i = 0; i < 16; i++) {
+            a0[i] += w[i] * r[0];
+            a1[i] += w[i] * r[1];
+            a2[i] += w[i] * r[2];
+        }
+        if (o != NULL) {
+            e0 += o[ostride * j] * r[0];
+            e1 += o[ostride * j] * r[1];
+            e2 += o[ostride * j] * r[2];
         }
     }
     for (int i = 0; i < 16; i++) {
@@ -276,9 +330,25 @@ CCP_CLONES static void regular_net(const ccp_table *T, int64_t job, int64_t vf, 
         W[3 * i + 1] = a1[i];
         W[3 * i + 2] = a2[i];
     }
-    W[48] = a0[16] + x0[0];
-    W[49] = a1[16] + x0[1];
-    W[50] = a2[16] + x0[2];
+    if (o != NULL) {
+        e[0] = e0;
+        e[1] = e1;
+        e[2] = e2;
+    }
+}
+#endif
+
+/* Net W (17 x 3) of the regular leaf vf of ``job``: row i the sum over the ring points j = 1, 2, ... in order,
+ * from 0.0, of op[j, i] (X[ring[j]] - X[ring[0]]), row 16 that sum plus X[ring[0]] (op: vop, N x 17). */
+CCP_CLONES static void regular_net(const ccp_table *T, int64_t job, int64_t vf, double *W) {
+    const double *op = T->vop + T->vop_start[vf];
+    const int32_t *rg = ring_of(T, job);
+    const double *x0 = T->points + 3 * (int64_t)rg[0];
+    double e[3];
+    sums16(T->points, rg, x0, NULL, T->vn[vf], op, 17, op + 16, 17, W, e);
+    W[48] = e[0] + x0[0];
+    W[49] = e[1] + x0[1];
+    W[50] = e[2] + x0[2];
 }
 
 /* Net W (17 x 3, row 16 the limit point: the sum over j = 1, 2, ... of o[j] (X[ring[j]] - X[ring[0]]) from 0.0,
@@ -289,41 +359,22 @@ CCP_CLONES static void regular_net(const ccp_table *T, int64_t job, int64_t vf, 
  * sums over the ring points j = 1, 2, ... in order from 0.0; Q: vop, N x (Nc - 1)), then L[lay, code] @ that
  * ring summed over its points j = 1, 2, ... in order, from 0.0. */
 CCP_CLONES static void corner_net(const ccp_table *T, int64_t job, int64_t vf, int64_t cfg, int64_t lay, int64_t code,
-                       int64_t ci, double *W) {
+                                  int64_t ci, double *W) {
     int64_t Nc = T->op_size[cfg], N = T->vn[vf], m = Nc - 1;
     const double *op = T->ops + T->op_start[cfg] + (3 * lay + code) * 16 * Nc;
     const double *q = T->vop + T->vop_start[vf];
     const int32_t *rg = ring_of(T, job);
     const double *x0 = T->points + 3 * (int64_t)rg[0];
     const double *o = q + N * m; /* the limit point's weights */
-    double e0 = 0.0, e1 = 0.0, e2 = 0.0;
+    double e[3];
     if (lay < CCP_COMPOSED) { /* one product: the composed operator (N x 16) of this layer and code */
-        const double *M = o + N + (3 * lay + code) * N * 16;
-        double b0[16], b1[16], b2[16];
-        for (int i = 0; i < 16; i++) b0[i] = b1[i] = b2[i] = 0.0;
-        for (int64_t j = 1; j < N; j++) {
-            const double *x = T->points + 3 * (int64_t)rg[j];
-            double r0 = x[0] - x0[0], r1 = x[1] - x0[1], r2 = x[2] - x0[2];
-            const double *w = M + 16 * j;
-            for (int i = 0; i < 16; i++) {
-                b0[i] += w[i] * r0;
-                b1[i] += w[i] * r1;
-                b2[i] += w[i] * r2;
-            }
-            e0 += o[j] * r0;
-            e1 += o[j] * r1;
-            e2 += o[j] * r2;
-        }
-        for (int i = 0; i < 16; i++) {
-            W[3 * i] = b0[i];
-            W[3 * i + 1] = b1[i];
-            W[3 * i + 2] = b2[i];
-        }
-        W[48] = e0 + x0[0];
-        W[49] = e1 + x0[1];
-        W[50] = e2 + x0[2];
+        sums16(T->points, rg, x0, NULL, N, o + N + (3 * lay + code) * N * 16, 16, o, 1, W, e);
+        W[48] = e[0] + x0[0];
+        W[49] = e[1] + x0[1];
+        W[50] = e[2] + x0[2];
         return;
     }
+    double e0 = 0.0, e1 = 0.0, e2 = 0.0;
     double rc_[3 * (m > 0 ? m : 1)], *rc = rc_;
     int64_t kept = T->cor_ring != NULL ? T->cor_ring[ci] : -1;
     if (kept >= 0) { /* the kept ring (the same sums); the limit point's sum alone */
@@ -349,22 +400,7 @@ CCP_CLONES static void corner_net(const ccp_table *T, int64_t job, int64_t vf, i
         e1 += o[j] * r1;
         e2 += o[j] * r2;
     }
-    double a0[16], a1[16], a2[16];
-    for (int i = 0; i < 16; i++) a0[i] = a1[i] = a2[i] = 0.0;
-    for (int64_t j = 1; j < Nc; j++) {
-        double r0 = rc[3 * (j - 1)], r1 = rc[3 * (j - 1) + 1], r2 = rc[3 * (j - 1) + 2];
-        const double *w = op + 16 * j;
-        for (int i = 0; i < 16; i++) {
-            a0[i] += w[i] * r0;
-            a1[i] += w[i] * r1;
-            a2[i] += w[i] * r2;
-        }
-    }
-    for (int i = 0; i < 16; i++) {
-        W[3 * i] = a0[i];
-        W[3 * i + 1] = a1[i];
-        W[3 * i + 2] = a2[i];
-    }
+    sums16(T->points, NULL, x0, rc, Nc, op, 16, NULL, 0, W, e);
     W[48] = e0 + x0[0];
     W[49] = e1 + x0[1];
     W[50] = e2 + x0[2];
