@@ -18,6 +18,7 @@ import threading
 import numpy as np
 
 from ccproof.errors import CCProofError
+from ccproof.evaluate.nets import budget
 from ccproof.evaluate.patch_table import COMPOSED_LAYERS
 
 __all__ = ["load", "CTable", "evaluate_block", "point_blocks", "ring_walks"]
@@ -33,6 +34,13 @@ _COMPOSED = 2
 LAYER_NETS_BUDGET = 4 << 20
 #: the largest grid of cells (``ccp_grid``: 128 bytes per ptex face) the binding makes
 GRID_BUDGET = 32 << 20
+#: the bytes of the nets the binding computes where the table keeps none, by the kernel's own sums: the regular
+#: nets first (408 bytes per regular patch: a ptex face of a triangle scan has two, and they serve half its area),
+#: then layer 0 of the corner faces (1,224 bytes per corner face, a face of a scan has two: 3/8 of its area) in
+#: what is left. The environment variables ``CCPROOF_NETS_BUDGET`` and ``CCPROOF_HOT_BUDGET`` (bytes) replace
+#: the two shares (0: none, every such net computed when evaluated). At 327,680 triangles: the regular nets
+#: (800 MB), not layer 0 (2.4 GB).
+KEPT_NETS_BUDGET = 1536 << 20
 
 
 class _Table(ctypes.Structure):
@@ -89,6 +97,8 @@ def load():
         lib.ccp_cache_words.argtypes = []
         lib.ccp_corner_nets.restype = _I
         lib.ccp_corner_nets.argtypes = [ctypes.POINTER(_Table), _I, _I, _P]
+        lib.ccp_regular_nets.restype = _I
+        lib.ccp_regular_nets.argtypes = [ctypes.POINTER(_Table), _I, _P]
         lib.ccp_grid.restype = _I
         lib.ccp_grid.argtypes = [ctypes.POINTER(_Table), _P]
         lib.ccp_ring_walks.restype = _I
@@ -197,8 +207,9 @@ class CTable:
         self._keep = keep
         self.struct = s
         self.ref = ctypes.byref(s)
-        if s.n_hot:  # the corner nets of layers 0 (the table's) to n - 1 (computed here)
-            n = layers if layers is not None else 1 + min(2, LAYER_NETS_BUDGET // max(1, T.hot.nbytes))
+        self._kept_nets(derived)
+        if s.n_hot:  # the corner nets of layers 0 (the table's or computed here) to n - 1 (computed here)
+            n = layers if layers is not None else 1 + min(2, LAYER_NETS_BUDGET // max(1, keep["hot"].nbytes))
             if not 1 <= n <= _LAYER_NETS:
                 raise CCProofError(f"layers must be 1 to {_LAYER_NETS}, got {n}")
             nets = [keep["hot"]]
@@ -232,6 +243,34 @@ class CTable:
         self._caches = []  # corner-net caches not in use (one per concurrent call, kept between calls)
         self._lock = threading.Lock()
 
+    def _kept_nets(self, derived):
+        """The regular nets and the layer-0 corner nets the table does not keep, computed here by the kernel's
+        own sums (``ccp_regular_nets``, ``ccp_corner_nets``: the same bits as when evaluated) where they fit
+        :data:`KEPT_NETS_BUDGET` (or ``derived``'s, as a pickled CTable computed them)."""
+        T, s, keep, lib = self.table, self.struct, self._keep, load()
+        n_jobs = T.job_root.shape[0]
+        left = KEPT_NETS_BUDGET
+        if s.n_nets == 0 and T.n_regular:
+            w = derived.get("nets")
+            if (w is None or w.shape[0] != T.n_regular) and \
+                    T.n_regular * 408 <= budget("CCPROOF_NETS_BUDGET", KEPT_NETS_BUDGET):
+                w = np.empty((T.n_regular, 17, 3))
+                if lib.ccp_regular_nets(self.ref, n_jobs, _addr(w)) != 0:
+                    w = None  # a tree deeper than the walk's stack: computed when evaluated
+            if w is not None and w.shape[0] == T.n_regular:
+                keep["nets"] = w
+                s.nets, s.n_nets = _addr(w), T.n_regular
+                left -= w.nbytes
+        if s.n_hot == 0 and T.n_corner:
+            w = derived["layer_nets"][0] if "layer_nets" in derived else None
+            if w is None and 3 * T.n_corner * 408 <= budget("CCPROOF_HOT_BUDGET", left):
+                w = np.empty((3 * T.n_corner, 17, 3))
+                if lib.ccp_corner_nets(self.ref, n_jobs, 0, _addr(w)) != 0:
+                    w = None
+            if w is not None:
+                keep["hot"] = w
+                s.hot, s.n_hot = _addr(w), 3 * T.n_corner
+
     def take_cache(self, lib):
         """A corner-net cache for one call (:meth:`give_cache` it back after the call)."""
         with self._lock:
@@ -246,7 +285,7 @@ class CTable:
     def __reduce__(self):
         """Pickled with the arrays it computed (corner nets, grid): unpickled, it points into them again (a
         worker of a cluster maps them from shared memory instead of computing its own)."""
-        derived = {k: self._keep[k] for k in ("layer_nets", "grid") if k in self._keep}
+        derived = {k: self._keep[k] for k in ("layer_nets", "grid", "nets") if k in self._keep}
         if "grid" not in derived:
             derived["grid_none"] = True
         return CTable, (self.table, self.layers, self.grid, self.reciprocals, derived)

@@ -791,6 +791,26 @@ int64_t ccp_corner_nets(const ccp_table *T, int64_t n_jobs, int64_t lay, double 
     return 0;
 }
 
+/* The nets of every regular patch of the table's ``n_jobs`` jobs (W: n_regular x 17 x 3 doubles, row job_net + leaf),
+ * the sums the kernel computes at evaluation time (regular_net), for the binding's ``nets`` where the table keeps
+ * none. Returns 0, or -1 when a job's tree of virtual faces is deeper than the walk's stack. */
+int64_t ccp_regular_nets(const ccp_table *T, int64_t n_jobs, double *W) {
+    for (int64_t job = 0; job < n_jobs; job++) {
+        int64_t stack[CCP_STACK], ns = 0;
+        stack[ns++] = ld(T->job_root, T->wide[1], job);
+        while (ns > 0) {
+            int64_t vf = stack[--ns];
+            if (T->kind[vf] == CCP_SPLIT) {
+                if (ns + 4 > CCP_STACK) return -1;
+                for (int q = 0; q < 4; q++) stack[ns++] = T->child[4 * vf + q];
+            } else if (T->kind[vf] == CCP_REGULAR) {
+                regular_net(T, job, vf, W + CCP_NET * (ld(T->job_net, T->wide[2], job) + T->leaf[vf]));
+            }
+        }
+    }
+    return 0;
+}
+
 /* The grid of ``grid`` (16 n_ptex entries): per ptex face and cell (i, j) of its 4 x 4 cells (u in [i / 4, (i + 1)
  * / 4), the last closed, v likewise, entry 16 face + 4 j + i), the job of the cell's quadrant and the
  * smallest virtual face of that job that holds the whole cell (the kernel's comparisons at the cell's centre;

@@ -51,6 +51,8 @@ __all__ = ["natural_limit_surface", "LimitSurface"]
 CHUNK = 1 << 15
 #: calls on at least this many points (faces not in order) evaluate them batched by face
 SORT_MIN = 1 << 12
+#: ... on surfaces of at least this many ptex faces (their tables outgrow the caches)
+SORT_FACES = 1 << 14
 #: points per kernel call of the batched evaluation (bounds its temporaries: 8 bytes per point and output)
 SORT_CHUNK = 1 << 16
 
@@ -347,10 +349,10 @@ class LimitSurface:
 
     def _evaluate_compiled(self, name, kernel, f, u, v, derivatives, out, threads):
         """:meth:`evaluate` by the compiled kernel ``name`` (``"c"`` or ``"numba"``) into ``out``, in blocks;
-        from :data:`SORT_MIN` points on, on a table whose nets are computed at evaluation time (a large one),
-        unless the faces are in order already, batched by face (:meth:`_evaluate_by_face`)."""
+        from :data:`SORT_MIN` points on, on a surface of at least :data:`SORT_FACES` ptex faces, unless the faces
+        are in order already, batched by face (:meth:`_evaluate_by_face`)."""
         n = f.size
-        if n >= SORT_MIN and self._table.nets.shape[0] == 0 and (f[1:] < f[:-1]).any():
+        if n >= SORT_MIN and self.n_faces >= SORT_FACES and (f[1:] < f[:-1]).any():
             return self._evaluate_by_face(name, kernel, f, u, v, derivatives, out, threads)
         block, back = evaluation_blocks(name, kernel, self._kernel_tables, f, u, v, derivatives, out)
         # few blocks: each kernel call computes the corner nets it meets once (a cache per call)
