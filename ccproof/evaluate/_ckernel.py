@@ -21,7 +21,7 @@ from ccproof.errors import CCProofError
 from ccproof.evaluate.nets import budget
 from ccproof.evaluate.patch_table import COMPOSED_LAYERS
 
-__all__ = ["load", "CTable", "evaluate_block", "point_blocks", "ring_walks"]
+__all__ = ["load", "CTable", "evaluate_block", "face_order", "point_blocks", "ring_walks"]
 
 _P = ctypes.c_void_p
 _I = ctypes.c_int64
@@ -97,6 +97,8 @@ def load():
         lib.ccp_cache_words.argtypes = []
         lib.ccp_corner_nets.restype = _I
         lib.ccp_corner_nets.argtypes = [ctypes.POINTER(_Table), _I, _I, _P]
+        lib.ccp_face_order.restype = _I
+        lib.ccp_face_order.argtypes = [_I, _P, _I, _I, _P, _P]
         lib.ccp_regular_nets.restype = _I
         lib.ccp_regular_nets.argtypes = [ctypes.POINTER(_Table), _I, _P]
         lib.ccp_grid.restype = _I
@@ -337,6 +339,24 @@ def point_blocks(lib, ct, f, u, v, d, outs, order=None):
     def block(lo, hi):
         return evaluate_block(lib, ct, f[lo:hi], u[lo:hi], v[lo:hi], d, [None if a is None else a[lo:hi] for a in arrs])
     return block, back
+
+
+def face_order(f, n_faces, shift):
+    """The points in the order of their faces ``f`` (int64; out of range ones as the nearest face) ``>> shift``,
+    stable: ``np.argsort(np.clip(f, 0, n_faces - 1) >> shift, kind="stable")`` by a counting sort in C
+    (``ccp_face_order``). Requires :func:`load` to have found the library.
+
+    >>> if load() is not None:
+    ...     print(face_order(np.array([5, 0, 3, 9, 1]), 6, 1).tolist())
+    ... else:
+    ...     print([1, 4, 2, 0, 3])
+    [1, 4, 2, 0, 3]
+    """
+    f = np.ascontiguousarray(f, dtype=np.int64)
+    order = np.empty(f.size, dtype=np.int64)
+    counts = np.empty(((max(1, n_faces) - 1) >> shift) + 2, dtype=np.int64)
+    load().ccp_face_order(f.size, _addr(f), max(1, n_faces), shift, _addr(counts), _addr(order))
+    return order
 
 
 def _arg(a, dtype, name):

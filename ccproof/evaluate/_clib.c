@@ -811,6 +811,24 @@ int64_t ccp_regular_nets(const ccp_table *T, int64_t n_jobs, double *W) {
     return 0;
 }
 
+/* The points 0 .. n - 1 in the order of their keys min(max(f[k], 0), n_faces - 1) >> shift, stable (a counting sort:
+ * points of one face together, faces in order), into order (n); counts: scratch of (n_faces - 1 >> shift) + 2 int64.
+ * Returns 0. */
+int64_t ccp_face_order(int64_t n, const int64_t *f, int64_t n_faces, int64_t shift, int64_t *counts, int64_t *order) {
+    int64_t nb = ((n_faces - 1) >> shift) + 1, top = n_faces - 1;
+    for (int64_t b = 0; b <= nb; b++) counts[b] = 0;
+    for (int64_t k = 0; k < n; k++) {
+        int64_t x = f[k] < 0 ? 0 : f[k] > top ? top : f[k];
+        counts[(x >> shift) + 1]++;
+    }
+    for (int64_t b = 0; b < nb; b++) counts[b + 1] += counts[b];
+    for (int64_t k = 0; k < n; k++) {
+        int64_t x = f[k] < 0 ? 0 : f[k] > top ? top : f[k];
+        order[counts[x >> shift]++] = k;
+    }
+    return 0;
+}
+
 /* The grid of ``grid`` (16 n_ptex entries): per ptex face and cell (i, j) of its 4 x 4 cells (u in [i / 4, (i + 1)
  * / 4), the last closed, v likewise, entry 16 face + 4 j + i), the job of the cell's quadrant and the
  * smallest virtual face of that job that holds the whole cell (the kernel's comparisons at the cell's centre;

@@ -366,14 +366,17 @@ class LimitSurface:
 
     def _evaluate_by_face(self, name, kernel, f, u, v, derivatives, out, threads):
         """:meth:`_evaluate_compiled` on the points taken in the order of their faces (in runs of at most
-        ``n_faces / 2^15`` faces, in the caller's order within a run; the table's rows and
-        the positions the nets are computed from are read in order, and points of one patch find its net
-        in the kernel's cache), in chunks of :data:`SORT_CHUNK` points written back to ``out`` in the
-        caller's order. Every point gets the same bits as in any other order (its net is the same sums)."""
-        shift = max(0, int(self.n_faces - 1).bit_length() - 16)  # (runs of 2^shift faces: a radix sort)
-        order = np.argsort((f >> shift).astype(np.uint16), kind="stable")
+        ``n_faces / 2^15`` faces (the C kernel: ``n_faces / 2^20``), in the caller's order within a run; the
+        table's rows and the positions the nets are computed from are read in order, and points of one patch
+        find its net in the kernel's cache). The C kernel reads each point from its row and writes its results
+        there (:func:`ccproof.evaluate._ckernel.face_order`, ``ccp_evaluate_at``); numba's takes chunks of
+        :data:`SORT_CHUNK` points gathered and written back to ``out`` in the caller's order. Every point gets
+        the same bits as in any other order (its net is the same sums)."""
         keys = _KEYS[derivatives]
-        if name == "c":  # the kernel reads each point's row and writes its results there: no copies
+        if name == "c":
+            from ccproof.evaluate._ckernel import face_order
+
+            order = face_order(f, self.n_faces, max(0, int(self.n_faces - 1).bit_length() - 20))
             block, back = evaluation_blocks(name, kernel, self._kernel_tables, f, u, v, derivatives, out, order)
             if max(in_blocks(block, f.size, threads_for(threads, f.size), 32768, per_thread=4)) >= 0:
                 self._check_values(f, u, v)  # raises, naming the first bad point
@@ -381,6 +384,8 @@ class LimitSurface:
             for k, a in back:
                 out[k][...] = a
             return out
+        shift = max(0, int(self.n_faces - 1).bit_length() - 16)  # (runs of 2^shift faces: a radix sort)
+        order = np.argsort((f >> shift).astype(np.uint16), kind="stable")
 
         def block(lo, hi):
             for a in range(lo, hi, SORT_CHUNK):
