@@ -12,7 +12,10 @@
  * table reads of different points overlap), then their patches, parameters and scales and the basis
  * functions at the parameters (the divisions by 6 overlap the table reads), and prefetches their nets;
  * the second evaluates them. Corner nets of layers beyond the precomputed one are
- * kept in a cache the caller owns (one per thread, kept between calls on the same table).
+ * kept in a cache the caller owns (one per thread, kept between calls on the same table). ccp_evaluate_at
+ * takes the points in an order the caller gives (their faces' order: ccp_face_order), each read from and
+ * written to its own row. A net computed from its job's ring is a product of a (16 + 1)-row operator with
+ * the ring, taken four rows at a time in vectors (sums16), each lane its own sum in the scalar order.
  *
  * Threads: the kernel holds no global state; concurrent calls on disjoint blocks of points (ctypes
  * releases the GIL), each with its own cache, are safe, and their results do not depend on the blocks
