@@ -18,9 +18,10 @@ import threading
 import numpy as np
 
 from ccproof.errors import CCProofError
+from ccproof.evaluate.nets import budget
 from ccproof.evaluate.patch_table import COMPOSED_LAYERS
 
-__all__ = ["load", "CTable", "evaluate_block", "point_blocks", "ring_walks"]
+__all__ = ["load", "CTable", "evaluate_block", "face_order", "point_blocks", "ring_walks"]
 
 _P = ctypes.c_void_p
 _I = ctypes.c_int64
@@ -33,6 +34,13 @@ _COMPOSED = 2
 LAYER_NETS_BUDGET = 4 << 20
 #: the largest grid of cells (``ccp_grid``: 128 bytes per ptex face) the binding makes
 GRID_BUDGET = 32 << 20
+#: the bytes of the nets the binding computes where the table keeps none, by the kernel's own sums: the regular
+#: nets first (408 bytes per regular patch: a ptex face of a triangle scan has two, and they serve half its area),
+#: then layer 0 of the corner faces (1,224 bytes per corner face, a face of a scan has two: 3/8 of its area) in
+#: what is left. The environment variables ``CCPROOF_NETS_BUDGET`` and ``CCPROOF_HOT_BUDGET`` (bytes) replace
+#: the two shares (0: none, every such net computed when evaluated). At 327,680 triangles: the regular nets
+#: (800 MB), not layer 0 (2.4 GB).
+KEPT_NETS_BUDGET = 1536 << 20
 
 
 class _Table(ctypes.Structure):
@@ -52,7 +60,7 @@ class _Table(ctypes.Structure):
 _LIB = None
 _TRIED = False
 #: the version of the kernel's interface (``ccp_abi`` in _clib.c)
-_ABI = 6
+_ABI = 7
 #: calls on fewer points use no corner-net cache (CCP_CACHE_MIN in _clib.c)
 _CACHE_MIN = 256
 
@@ -83,10 +91,16 @@ def load():
             continue
         lib.ccp_evaluate.restype = _I
         lib.ccp_evaluate.argtypes = [ctypes.POINTER(_Table), _I, _P, _P, _P, _I, _P, _P, _P, _P, _P, _P, _P]
+        lib.ccp_evaluate_at.restype = _I
+        lib.ccp_evaluate_at.argtypes = [ctypes.POINTER(_Table), _I, _P, _P, _P, _P, _I, _P, _P, _P, _P, _P, _P, _P]
         lib.ccp_cache_words.restype = _I
         lib.ccp_cache_words.argtypes = []
         lib.ccp_corner_nets.restype = _I
         lib.ccp_corner_nets.argtypes = [ctypes.POINTER(_Table), _I, _I, _P]
+        lib.ccp_face_order.restype = _I
+        lib.ccp_face_order.argtypes = [_I, _P, _I, _I, _P, _P]
+        lib.ccp_regular_nets.restype = _I
+        lib.ccp_regular_nets.argtypes = [ctypes.POINTER(_Table), _I, _P]
         lib.ccp_grid.restype = _I
         lib.ccp_grid.argtypes = [ctypes.POINTER(_Table), _P]
         lib.ccp_ring_walks.restype = _I
@@ -195,8 +209,9 @@ class CTable:
         self._keep = keep
         self.struct = s
         self.ref = ctypes.byref(s)
-        if s.n_hot:  # the corner nets of layers 0 (the table's) to n - 1 (computed here)
-            n = layers if layers is not None else 1 + min(2, LAYER_NETS_BUDGET // max(1, T.hot.nbytes))
+        self._kept_nets(derived)
+        if s.n_hot:  # the corner nets of layers 0 (the table's or computed here) to n - 1 (computed here)
+            n = layers if layers is not None else 1 + min(2, LAYER_NETS_BUDGET // max(1, keep["hot"].nbytes))
             if not 1 <= n <= _LAYER_NETS:
                 raise CCProofError(f"layers must be 1 to {_LAYER_NETS}, got {n}")
             nets = [keep["hot"]]
@@ -230,6 +245,34 @@ class CTable:
         self._caches = []  # corner-net caches not in use (one per concurrent call, kept between calls)
         self._lock = threading.Lock()
 
+    def _kept_nets(self, derived):
+        """The regular nets and the layer-0 corner nets the table does not keep, computed here by the kernel's
+        own sums (``ccp_regular_nets``, ``ccp_corner_nets``: the same bits as when evaluated) where they fit
+        :data:`KEPT_NETS_BUDGET` (or ``derived``'s, as a pickled CTable computed them)."""
+        T, s, keep, lib = self.table, self.struct, self._keep, load()
+        n_jobs = T.job_root.shape[0]
+        left = KEPT_NETS_BUDGET
+        if s.n_nets == 0 and T.n_regular:
+            w = derived.get("nets")
+            if (w is None or w.shape[0] != T.n_regular) and \
+                    T.n_regular * 408 <= budget("CCPROOF_NETS_BUDGET", KEPT_NETS_BUDGET):
+                w = np.empty((T.n_regular, 17, 3))
+                if lib.ccp_regular_nets(self.ref, n_jobs, _addr(w)) != 0:
+                    w = None  # a tree deeper than the walk's stack: computed when evaluated
+            if w is not None and w.shape[0] == T.n_regular:
+                keep["nets"] = w
+                s.nets, s.n_nets = _addr(w), T.n_regular
+                left -= w.nbytes
+        if s.n_hot == 0 and T.n_corner:
+            w = derived["layer_nets"][0] if "layer_nets" in derived else None
+            if w is None and 3 * T.n_corner * 408 <= budget("CCPROOF_HOT_BUDGET", left):
+                w = np.empty((3 * T.n_corner, 17, 3))
+                if lib.ccp_corner_nets(self.ref, n_jobs, 0, _addr(w)) != 0:
+                    w = None
+            if w is not None:
+                keep["hot"] = w
+                s.hot, s.n_hot = _addr(w), 3 * T.n_corner
+
     def take_cache(self, lib):
         """A corner-net cache for one call (:meth:`give_cache` it back after the call)."""
         with self._lock:
@@ -244,32 +287,38 @@ class CTable:
     def __reduce__(self):
         """Pickled with the arrays it computed (corner nets, grid): unpickled, it points into them again (a
         worker of a cluster maps them from shared memory instead of computing its own)."""
-        derived = {k: self._keep[k] for k in ("layer_nets", "grid") if k in self._keep}
+        derived = {k: self._keep[k] for k in ("layer_nets", "grid", "nets") if k in self._keep}
         if "grid" not in derived:
             derived["grid_none"] = True
         return CTable, (self.table, self.layers, self.grid, self.reciprocals, derived)
 
 
-def evaluate_block(lib, ct, f, u, v, d, outs):
+def evaluate_block(lib, ct, f, u, v, d, outs, rows=None):
     """Evaluate points ``f, u, v`` (contiguous int64 / float64, shape (n,)) into ``outs`` (the arrays
-    P, Pu, Pv, Puu, Puv, Pvv: contiguous float64 (n, 3), or None beyond derivative order ``d``).
+    P, Pu, Pv, Puu, Puv, Pvv: contiguous float64 (n, 3), or None beyond derivative order ``d``); with ``rows``
+    (contiguous int64, distinct rows of the inputs and outputs) the points of those rows, in that order.
 
-    Returns -1, or the index of the first point the kernel refuses (face out of range or a hole, (u, v)
-    outside [0, 1]^2 or NaN); the outputs from that point on are not written.
+    Returns -1, or the index (in ``rows`` where given) of the first point the kernel refuses (face out of
+    range or a hole, (u, v) outside [0, 1]^2 or NaN); the outputs from that point on are not written.
     """
     ptrs = [None if a is None else _addr(a) for a in outs]
-    if f.size < _CACHE_MIN:
-        return int(lib.ccp_evaluate(ct.ref, f.size, _addr(f), _addr(u), _addr(v), d, *ptrs, None))
-    cache = ct.take_cache(lib)
+    n = f.size if rows is None else rows.size
+    cache = ct.take_cache(lib) if n >= _CACHE_MIN else None
     try:
-        return int(lib.ccp_evaluate(ct.ref, f.size, _addr(f), _addr(u), _addr(v), d, *ptrs, _addr(cache)))
+        if rows is None:
+            return int(lib.ccp_evaluate(ct.ref, n, _addr(f), _addr(u), _addr(v), d, *ptrs,
+                                        None if cache is None else _addr(cache)))
+        return int(lib.ccp_evaluate_at(ct.ref, n, _addr(rows), _addr(f), _addr(u), _addr(v), d, *ptrs,
+                                       None if cache is None else _addr(cache)))
     finally:
-        ct.give_cache(cache)
+        if cache is not None:
+            ct.give_cache(cache)
 
 
-def point_blocks(lib, ct, f, u, v, d, outs):
+def point_blocks(lib, ct, f, u, v, d, outs, order=None):
     """``(block, back)`` for :func:`ccproof.evaluate.backend.evaluation_blocks`: ``block(lo, hi)`` calls
     :func:`evaluate_block` on the points lo:hi (``f, u, v`` contiguous) of the table ``ct`` (a :class:`CTable`);
+    with ``order`` (a permutation of the points) on the points ``order[lo:hi]``, each written to its own row;
     ``outs`` the six outputs (None where absent), those beyond derivative order ``d`` not written; ``back``:
     ``[(index, temporary)]`` for the outputs it cannot write in place (not contiguous float64 (n, 3))."""
     f, u, v = (np.ascontiguousarray(a) for a in (f, u, v))
@@ -283,9 +332,31 @@ def point_blocks(lib, ct, f, u, v, d, outs):
             a = back[-1][1]
         arrs.append(a)
 
+    if order is not None:
+        order = np.ascontiguousarray(order, dtype=np.int64)
+        return (lambda lo, hi: evaluate_block(lib, ct, f, u, v, d, arrs, order[lo:hi])), back
+
     def block(lo, hi):
         return evaluate_block(lib, ct, f[lo:hi], u[lo:hi], v[lo:hi], d, [None if a is None else a[lo:hi] for a in arrs])
     return block, back
+
+
+def face_order(f, n_faces, shift):
+    """The points in the order of their faces ``f`` (int64; out of range ones as the nearest face) ``>> shift``,
+    stable: ``np.argsort(np.clip(f, 0, n_faces - 1) >> shift, kind="stable")`` by a counting sort in C
+    (``ccp_face_order``). Requires :func:`load` to have found the library.
+
+    >>> if load() is not None:
+    ...     print(face_order(np.array([5, 0, 3, 9, 1]), 6, 1).tolist())
+    ... else:
+    ...     print([1, 4, 2, 0, 3])
+    [1, 4, 2, 0, 3]
+    """
+    f = np.ascontiguousarray(f, dtype=np.int64)
+    order = np.empty(f.size, dtype=np.int64)
+    counts = np.empty(((max(1, n_faces) - 1) >> shift) + 2, dtype=np.int64)
+    load().ccp_face_order(f.size, _addr(f), max(1, n_faces), shift, _addr(counts), _addr(order))
+    return order
 
 
 def _arg(a, dtype, name):

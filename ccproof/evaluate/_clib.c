@@ -12,7 +12,10 @@
  * table reads of different points overlap), then their patches, parameters and scales and the basis
  * functions at the parameters (the divisions by 6 overlap the table reads), and prefetches their nets;
  * the second evaluates them. Corner nets of layers beyond the precomputed one are
- * kept in a cache the caller owns (one per thread, kept between calls on the same table).
+ * kept in a cache the caller owns (one per thread, kept between calls on the same table). ccp_evaluate_at
+ * takes the points in an order the caller gives (their faces' order: ccp_face_order), each read from and
+ * written to its own row. A net computed from its job's ring is a product of a (16 + 1)-row operator with
+ * the ring, taken four rows at a time in vectors (sums16), each lane its own sum in the scalar order.
  *
  * Threads: the kernel holds no global state; concurrent calls on disjoint blocks of points (ctypes
  * releases the GIL), each with its own cache, are safe, and their results do not depend on the blocks
@@ -44,9 +47,11 @@
 #if defined(__GNUC__)
 #define CCP_INLINE static inline __attribute__((always_inline))
 #define CCP_PREFETCH(p) __builtin_prefetch(p)
+#define CCP_PREFETCH_W(p) __builtin_prefetch(p, 1)
 #else
 #define CCP_INLINE static inline
 #define CCP_PREFETCH(p) ((void)(p))
+#define CCP_PREFETCH_W(p) ((void)(p))
 #endif
 
 #if defined(__GNUC__) && defined(__x86_64__) && defined(__linux__) && !defined(CCP_NO_CLONES)
@@ -250,23 +255,77 @@ CCP_INLINE const int32_t *ring_of(const ccp_table *T, int64_t job) {
     return T->rings + ld(T->job_ring, T->wide[4], job);
 }
 
-/* Net W (17 x 3) of the regular leaf vf of ``job``: row i the sum over the ring points j = 1, 2, ... in order,
- * from 0.0, of op[j, i] (X[ring[j]] - X[ring[0]]), row 16 that sum plus X[ring[0]] (op: vop, N x 17). */
-static void regular_net(const ccp_table *T, int64_t job, int64_t vf, double *W) {
-    int64_t N = T->vn[vf];
-    const double *op = T->vop + T->vop_start[vf];
-    const int32_t *rg = ring_of(T, job);
-    const double *x0 = T->points + 3 * (int64_t)rg[0];
-    double a0[17], a1[17], a2[17];
-    for (int i = 0; i < 17; i++) a0[i] = a1[i] = a2[i] = 0.0;
-    for (int64_t j = 1; j < N; j++) {
-        const double *x = T->points + 3 * (int64_t)rg[j];
-        double r0 = x[0] - x0[0], r1 = x[1] - x0[1], r2 = x[2] - x0[2];
-        const double *w = op + 17 * j;
-        for (int i = 0; i < 17; i++) {
-            a0[i] += w[i] * r0;
-            a1[i] += w[i] * r1;
-            a2[i] += w[i] * r2;
+/* The difference of ring point j and the origin x0: X[rg[j]] - x0 (rg given), else row j - 1 of rel (n x 3, the
+ * ring relative to its vertex already). */
+CCP_INLINE void rel_point(const double *pts, const int32_t *rg, const double *x0, const double *rel, int64_t j,
+                          double *r) {
+    if (rg != NULL) {
+        const double *x = pts + 3 * (int64_t)rg[j];
+        r[0] = x[0] - x0[0];
+        r[1] = x[1] - x0[1];
+        r[2] = x[2] - x0[2];
+    } else {
+        r[0] = rel[3 * (j - 1)];
+        r[1] = rel[3 * (j - 1) + 1];
+        r[2] = rel[3 * (j - 1) + 2];
+    }
+}
+
+/* W[3 i + c] (i < 16) = the sum over j = 1, 2, ..., n - 1 in order, from 0.0, of M[stride j + i] r_j[c] (r_j:
+ * rel_point); with o, also e[c] = the same sum of o[ostride j] r_j[c]. */
+#if defined(__GNUC__) && !defined(CCP_SCALAR)
+CCP_INLINE void sums16(const double *pts, const int32_t *rg, const double *x0, const double *rel, int64_t n,
+                       const double *M, int64_t stride, const double *o, int64_t ostride, double *W, double *e) {
+    v4d a[12]; /* a[4 c + q]: lanes i = 4 q .. 4 q + 3 of coordinate c, each lane its own sum */
+    double e0 = 0.0, e1 = 0.0, e2 = 0.0, r[3];
+    for (int k = 0; k < 12; k++) a[k] = splat(0.0);
+    for (int64_t j = 1; j < n; j++) {
+        rel_point(pts, rg, x0, rel, j, r);
+        v4d R0 = splat(r[0]), R1 = splat(r[1]), R2 = splat(r[2]);
+        const double *w = M + stride * j;
+        for (int q = 0; q < 4; q++) {
+            v4d wq = ld4(w + 4 * q);
+            a[q] += wq * R0;
+            a[4 + q] += wq * R1;
+            a[8 + q] += wq * R2;
+        }
+        if (o != NULL) {
+            double oj = o[ostride * j];
+            e0 += oj * r[0];
+            e1 += oj * r[1];
+            e2 += oj * r[2];
+        }
+    }
+    double t[48];
+    memcpy(t, a, sizeof t);
+    for (int i = 0; i < 16; i++) {
+        W[3 * i] = t[i];
+        W[3 * i + 1] = t[16 + i];
+        W[3 * i + 2] = t[32 + i];
+    }
+    if (o != NULL) {
+        e[0] = e0;
+        e[1] = e1;
+        e[2] = e2;
+    }
+}
+#else
+CCP_INLINE void sums16(const double *pts, const int32_t *rg, const double *x0, const double *rel, int64_t n,
+                       const double *M, int64_t stride, const double *o, int64_t ostride, double *W, double *e) {
+    double a0[16], a1[16], a2[16], e0 = 0.0, e1 = 0.0, e2 = 0.0, r[3];
+    for (int i = 0; i < 16; i++) a0[i] = a1[i] = a2[i] = 0.0;
+    for (int64_t j = 1; j < n; j++) {
+        rel_point(pts, rg, x0, rel, j, r);
+        const double *w = M + stride * j;
+        for (int i = 0; i < 16; i++) {
+            a0[i] += w[i] * r[0];
+            a1[i] += w[i] * r[1];
+            a2[i] += w[i] * r[2];
+        }
+        if (o != NULL) {
+            e0 += o[ostride * j] * r[0];
+            e1 += o[ostride * j] * r[1];
+            e2 += o[ostride * j] * r[2];
         }
     }
     for (int i = 0; i < 16; i++) {
@@ -274,9 +333,25 @@ static void regular_net(const ccp_table *T, int64_t job, int64_t vf, double *W) 
         W[3 * i + 1] = a1[i];
         W[3 * i + 2] = a2[i];
     }
-    W[48] = a0[16] + x0[0];
-    W[49] = a1[16] + x0[1];
-    W[50] = a2[16] + x0[2];
+    if (o != NULL) {
+        e[0] = e0;
+        e[1] = e1;
+        e[2] = e2;
+    }
+}
+#endif
+
+/* Net W (17 x 3) of the regular leaf vf of ``job``: row i the sum over the ring points j = 1, 2, ... in order,
+ * from 0.0, of op[j, i] (X[ring[j]] - X[ring[0]]), row 16 that sum plus X[ring[0]] (op: vop, N x 17). */
+CCP_CLONES static void regular_net(const ccp_table *T, int64_t job, int64_t vf, double *W) {
+    const double *op = T->vop + T->vop_start[vf];
+    const int32_t *rg = ring_of(T, job);
+    const double *x0 = T->points + 3 * (int64_t)rg[0];
+    double e[3];
+    sums16(T->points, rg, x0, NULL, T->vn[vf], op, 17, op + 16, 17, W, e);
+    W[48] = e[0] + x0[0];
+    W[49] = e[1] + x0[1];
+    W[50] = e[2] + x0[2];
 }
 
 /* Net W (17 x 3, row 16 the limit point: the sum over j = 1, 2, ... of o[j] (X[ring[j]] - X[ring[0]]) from 0.0,
@@ -286,42 +361,23 @@ static void regular_net(const ccp_table *T, int64_t job, int64_t vf, double *W) 
  * to the corner vertex first (rows 1 .. Nc - 1: Q @ (X[ring] - X[ring[0]]), the
  * sums over the ring points j = 1, 2, ... in order from 0.0; Q: vop, N x (Nc - 1)), then L[lay, code] @ that
  * ring summed over its points j = 1, 2, ... in order, from 0.0. */
-static void corner_net(const ccp_table *T, int64_t job, int64_t vf, int64_t cfg, int64_t lay, int64_t code,
-                       int64_t ci, double *W) {
+CCP_CLONES static void corner_net(const ccp_table *T, int64_t job, int64_t vf, int64_t cfg, int64_t lay, int64_t code,
+                                  int64_t ci, double *W) {
     int64_t Nc = T->op_size[cfg], N = T->vn[vf], m = Nc - 1;
     const double *op = T->ops + T->op_start[cfg] + (3 * lay + code) * 16 * Nc;
     const double *q = T->vop + T->vop_start[vf];
     const int32_t *rg = ring_of(T, job);
     const double *x0 = T->points + 3 * (int64_t)rg[0];
     const double *o = q + N * m; /* the limit point's weights */
-    double e0 = 0.0, e1 = 0.0, e2 = 0.0;
+    double e[3];
     if (lay < CCP_COMPOSED) { /* one product: the composed operator (N x 16) of this layer and code */
-        const double *M = o + N + (3 * lay + code) * N * 16;
-        double b0[16], b1[16], b2[16];
-        for (int i = 0; i < 16; i++) b0[i] = b1[i] = b2[i] = 0.0;
-        for (int64_t j = 1; j < N; j++) {
-            const double *x = T->points + 3 * (int64_t)rg[j];
-            double r0 = x[0] - x0[0], r1 = x[1] - x0[1], r2 = x[2] - x0[2];
-            const double *w = M + 16 * j;
-            for (int i = 0; i < 16; i++) {
-                b0[i] += w[i] * r0;
-                b1[i] += w[i] * r1;
-                b2[i] += w[i] * r2;
-            }
-            e0 += o[j] * r0;
-            e1 += o[j] * r1;
-            e2 += o[j] * r2;
-        }
-        for (int i = 0; i < 16; i++) {
-            W[3 * i] = b0[i];
-            W[3 * i + 1] = b1[i];
-            W[3 * i + 2] = b2[i];
-        }
-        W[48] = e0 + x0[0];
-        W[49] = e1 + x0[1];
-        W[50] = e2 + x0[2];
+        sums16(T->points, rg, x0, NULL, N, o + N + (3 * lay + code) * N * 16, 16, o, 1, W, e);
+        W[48] = e[0] + x0[0];
+        W[49] = e[1] + x0[1];
+        W[50] = e[2] + x0[2];
         return;
     }
+    double e0 = 0.0, e1 = 0.0, e2 = 0.0;
     double rc_[3 * (m > 0 ? m : 1)], *rc = rc_;
     int64_t kept = T->cor_ring != NULL ? T->cor_ring[ci] : -1;
     if (kept >= 0) { /* the kept ring (the same sums); the limit point's sum alone */
@@ -347,22 +403,7 @@ static void corner_net(const ccp_table *T, int64_t job, int64_t vf, int64_t cfg,
         e1 += o[j] * r1;
         e2 += o[j] * r2;
     }
-    double a0[16], a1[16], a2[16];
-    for (int i = 0; i < 16; i++) a0[i] = a1[i] = a2[i] = 0.0;
-    for (int64_t j = 1; j < Nc; j++) {
-        double r0 = rc[3 * (j - 1)], r1 = rc[3 * (j - 1) + 1], r2 = rc[3 * (j - 1) + 2];
-        const double *w = op + 16 * j;
-        for (int i = 0; i < 16; i++) {
-            a0[i] += w[i] * r0;
-            a1[i] += w[i] * r1;
-            a2[i] += w[i] * r2;
-        }
-    }
-    for (int i = 0; i < 16; i++) {
-        W[3 * i] = a0[i];
-        W[3 * i + 1] = a1[i];
-        W[3 * i + 2] = a2[i];
-    }
+    sums16(T->points, NULL, x0, rc, Nc, op, 16, NULL, 0, W, e);
     W[48] = e0 + x0[0];
     W[49] = e1 + x0[1];
     W[50] = e2 + x0[2];
@@ -581,9 +622,11 @@ CCP_INLINE const double *locate(const ccp_table *T, int64_t job, int64_t vf, int
 #define BASIS basis
 #endif
 
-CCP_INLINE int64_t run(const ccp_table *T, int64_t n, const int64_t *f, const double *u, const double *v,
-                       const int D, double *P, double *Pu, double *Pv, double *Puu, double *Puv, double *Pvv,
-                       double *cache) {
+/* ix NULL: point k is (f[k], u[k], v[k]), its results row k; else point k is row ix[k] of the inputs and of the
+ * outputs (the rows of ix distinct: each output row written once, three coordinates at a time). */
+CCP_INLINE int64_t run(const ccp_table *T, int64_t n, const int64_t *ix, const int64_t *f, const double *u,
+                       const double *v, const int D, double *P, double *Pu, double *Pv, double *Puu, double *Puv,
+                       double *Pvv, double *cache) {
     int64_t *base = n >= CCP_CACHE_MIN ? (int64_t *)cache : NULL;
     double S[CCP_BLOCK], Tt[CCP_BLOCK], G[CCP_BLOCK];
     double BS[CCP_BLOCK][12], BT[CCP_BLOCK][12]; /* the basis functions at the block's (s, t) */
@@ -598,10 +641,28 @@ CCP_INLINE int64_t run(const ccp_table *T, int64_t n, const int64_t *f, const do
         int m = 0;
         /* pass 1: the virtual faces of the block's points (independent table reads, overlapped), then their
          * patches, prefetching the nets (or the cache slots of the deep corner nets) */
-        int64_t JB[CCP_BLOCK], VF[CCP_BLOCK];
+        int64_t JB[CCP_BLOCK], VF[CCP_BLOCK], AT[CCP_BLOCK];
         int KD[CCP_BLOCK];
+        if (ix != NULL) /* the next block's input rows, read in its pass 1, and output rows, written in its pass 2 */
+            for (int64_t j = k + CCP_BLOCK; j < n && j < k + 2 * CCP_BLOCK; j++) {
+                int64_t r = ix[j];
+                CCP_PREFETCH(f + r);
+                CCP_PREFETCH(u + r);
+                CCP_PREFETCH(v + r);
+                CCP_PREFETCH_W(P + 3 * r);
+                if (D >= 1) {
+                    CCP_PREFETCH_W(Pu + 3 * r);
+                    CCP_PREFETCH_W(Pv + 3 * r);
+                }
+                if (D >= 2) {
+                    CCP_PREFETCH_W(Puu + 3 * r);
+                    CCP_PREFETCH_W(Puv + 3 * r);
+                    CCP_PREFETCH_W(Pvv + 3 * r);
+                }
+            }
         for (; k < n && m < CCP_BLOCK; k++, m++) {
-            KD[m] = find_face(T, f[k], u[k], v[k], JB + m, VF + m);
+            int64_t r = AT[m] = ix != NULL ? ix[k] : k;
+            KD[m] = find_face(T, f[r], u[r], v[r], JB + m, VF + m);
             if (KD[m] < 0) {
                 bad = k;
                 break;
@@ -609,7 +670,7 @@ CCP_INLINE int64_t run(const ccp_table *T, int64_t n, const int64_t *f, const do
         }
         int DL[CCP_BLOCK], nd = 0; /* the points with deep corner nets, in order */
         for (int i = 0; i < m; i++) {
-            int64_t kk = k0 + i;
+            int64_t kk = AT[i];
             const double *net = locate(T, JB[i], VF[i], KD[i], u[kk], v[kk], dp + i, S + i, Tt + i, G + i);
             N[i] = net;
             BASIS(S[i], BS[i]);
@@ -644,7 +705,7 @@ CCP_INLINE int64_t run(const ccp_table *T, int64_t n, const int64_t *f, const do
             int64_t *sl = slot[i];
             if (sl[0] != key[i] + 1) {
                 if (sl[1] == block) {
-                    for (; i0 < i; i0++) bicubic(N[i0], BS[i0], BT[i0], G[i0], D, k0 + i0, k0 + i0 + 1 < n, P, Pu, Pv, Puu, Puv, Pvv);
+                    for (; i0 < i; i0++) bicubic(N[i0], BS[i0], BT[i0], G[i0], D, AT[i0], ix == NULL && k0 + i0 + 1 < n, P, Pu, Pv, Puu, Puv, Pvv);
                     block++;
                 }
                 deep_net(T, d, (double *)(sl + 5));
@@ -653,26 +714,26 @@ CCP_INLINE int64_t run(const ccp_table *T, int64_t n, const int64_t *f, const do
             sl[1] = block;
             N[i] = (const double *)(sl + 5);
         }
-        for (; i0 < m; i0++) bicubic(N[i0], BS[i0], BT[i0], G[i0], D, k0 + i0, k0 + i0 + 1 < n, P, Pu, Pv, Puu, Puv, Pvv);
+        for (; i0 < m; i0++) bicubic(N[i0], BS[i0], BT[i0], G[i0], D, AT[i0], ix == NULL && k0 + i0 + 1 < n, P, Pu, Pv, Puu, Puv, Pvv);
     }
     if (base != NULL) base[0] = block;
     return bad;
 }
 
-CCP_CLONES static int64_t run0(const ccp_table *T, int64_t n, const int64_t *f, const double *u, const double *v,
-                               double *P, double *cache) {
-    return run(T, n, f, u, v, 0, P, NULL, NULL, NULL, NULL, NULL, cache);
+CCP_CLONES static int64_t run0(const ccp_table *T, int64_t n, const int64_t *ix, const int64_t *f, const double *u,
+                               const double *v, double *P, double *cache) {
+    return run(T, n, ix, f, u, v, 0, P, NULL, NULL, NULL, NULL, NULL, cache);
 }
 
-CCP_CLONES static int64_t run1(const ccp_table *T, int64_t n, const int64_t *f, const double *u, const double *v,
-                               double *P, double *Pu, double *Pv, double *cache) {
-    return run(T, n, f, u, v, 1, P, Pu, Pv, NULL, NULL, NULL, cache);
+CCP_CLONES static int64_t run1(const ccp_table *T, int64_t n, const int64_t *ix, const int64_t *f, const double *u,
+                               const double *v, double *P, double *Pu, double *Pv, double *cache) {
+    return run(T, n, ix, f, u, v, 1, P, Pu, Pv, NULL, NULL, NULL, cache);
 }
 
-CCP_CLONES static int64_t run2(const ccp_table *T, int64_t n, const int64_t *f, const double *u, const double *v,
-                               double *P, double *Pu, double *Pv, double *Puu, double *Puv, double *Pvv,
-                               double *cache) {
-    return run(T, n, f, u, v, 2, P, Pu, Pv, Puu, Puv, Pvv, cache);
+CCP_CLONES static int64_t run2(const ccp_table *T, int64_t n, const int64_t *ix, const int64_t *f, const double *u,
+                               const double *v, double *P, double *Pu, double *Pv, double *Puu, double *Puv,
+                               double *Pvv, double *cache) {
+    return run(T, n, ix, f, u, v, 2, P, Pu, Pv, Puu, Puv, Pvv, cache);
 }
 
 /* Fill P (n x 3) and, for d >= 1, Pu, Pv, for d >= 2, Puu, Puv, Pvv (n x 3 each, C order) at the points
@@ -683,9 +744,22 @@ CCP_CLONES static int64_t run2(const ccp_table *T, int64_t n, const int64_t *f, 
  * written). */
 int64_t ccp_evaluate(const ccp_table *T, int64_t n, const int64_t *f, const double *u, const double *v, int64_t d,
                      double *P, double *Pu, double *Pv, double *Puu, double *Puv, double *Pvv, double *cache) {
-    if (d <= 0) return run0(T, n, f, u, v, P, cache);
-    if (d == 1) return run1(T, n, f, u, v, P, Pu, Pv, cache);
-    return run2(T, n, f, u, v, P, Pu, Pv, Puu, Puv, Pvv, cache);
+    if (d <= 0) return run0(T, n, NULL, f, u, v, P, cache);
+    if (d == 1) return run1(T, n, NULL, f, u, v, P, Pu, Pv, cache);
+    return run2(T, n, NULL, f, u, v, P, Pu, Pv, Puu, Puv, Pvv, cache);
+}
+
+/* ccp_evaluate on the points ix[0], ix[1], ... ix[n - 1] (distinct rows of f, u, v and of the outputs, which
+ * hold at least max(ix) + 1 rows), in that order: each point's results in its own row, the same bits as
+ * ccp_evaluate gives it (the caller orders the points by face: the table read in order, the nets of a patch
+ * found in the cache). Returns -1, or the position k (not the row ix[k]) of the first point refused; the
+ * points from position k on are not written. */
+int64_t ccp_evaluate_at(const ccp_table *T, int64_t n, const int64_t *ix, const int64_t *f, const double *u,
+                        const double *v, int64_t d, double *P, double *Pu, double *Pv, double *Puu, double *Puv,
+                        double *Pvv, double *cache) {
+    if (d <= 0) return run0(T, n, ix, f, u, v, P, cache);
+    if (d == 1) return run1(T, n, ix, f, u, v, P, Pu, Pv, cache);
+    return run2(T, n, ix, f, u, v, P, Pu, Pv, Puu, Puv, Pvv, cache);
 }
 
 /* The size of a corner-net cache, in doubles. */
@@ -716,6 +790,44 @@ int64_t ccp_corner_nets(const ccp_table *T, int64_t n_jobs, int64_t lay, double 
                 }
             }
         }
+    }
+    return 0;
+}
+
+/* The nets of every regular patch of the table's ``n_jobs`` jobs (W: n_regular x 17 x 3 doubles, row job_net + leaf),
+ * the sums the kernel computes at evaluation time (regular_net), for the binding's ``nets`` where the table keeps
+ * none. Returns 0, or -1 when a job's tree of virtual faces is deeper than the walk's stack. */
+int64_t ccp_regular_nets(const ccp_table *T, int64_t n_jobs, double *W) {
+    for (int64_t job = 0; job < n_jobs; job++) {
+        int64_t stack[CCP_STACK], ns = 0;
+        stack[ns++] = ld(T->job_root, T->wide[1], job);
+        while (ns > 0) {
+            int64_t vf = stack[--ns];
+            if (T->kind[vf] == CCP_SPLIT) {
+                if (ns + 4 > CCP_STACK) return -1;
+                for (int q = 0; q < 4; q++) stack[ns++] = T->child[4 * vf + q];
+            } else if (T->kind[vf] == CCP_REGULAR) {
+                regular_net(T, job, vf, W + CCP_NET * (ld(T->job_net, T->wide[2], job) + T->leaf[vf]));
+            }
+        }
+    }
+    return 0;
+}
+
+/* The points 0 .. n - 1 in the order of their keys min(max(f[k], 0), n_faces - 1) >> shift, stable (a counting sort:
+ * points of one face together, faces in order), into order (n); counts: scratch of (n_faces - 1 >> shift) + 2 int64.
+ * Returns 0. */
+int64_t ccp_face_order(int64_t n, const int64_t *f, int64_t n_faces, int64_t shift, int64_t *counts, int64_t *order) {
+    int64_t nb = ((n_faces - 1) >> shift) + 1, top = n_faces - 1;
+    for (int64_t b = 0; b <= nb; b++) counts[b] = 0;
+    for (int64_t k = 0; k < n; k++) {
+        int64_t x = f[k] < 0 ? 0 : f[k] > top ? top : f[k];
+        counts[(x >> shift) + 1]++;
+    }
+    for (int64_t b = 0; b < nb; b++) counts[b + 1] += counts[b];
+    for (int64_t k = 0; k < n; k++) {
+        int64_t x = f[k] < 0 ? 0 : f[k] > top ? top : f[k];
+        order[counts[x >> shift]++] = k;
     }
     return 0;
 }
@@ -755,7 +867,7 @@ int64_t ccp_grid(const ccp_table *T, int64_t *grid) {
 }
 
 /* The layout this file was compiled with: the binding refuses a library whose structure differs. */
-int64_t ccp_abi(void) { return 1000 * (int64_t)sizeof(ccp_table) + 6; }
+int64_t ccp_abi(void) { return 1000 * (int64_t)sizeof(ccp_table) + 7; }
 
 /* ------------------------------------------------------------------------------------------------------------
  * The ring walk of the table's setup (the numba kernel's _ring_walks, ccproof/evaluate/_numba_kernel.py, step

@@ -106,15 +106,22 @@ def _numba(backend, name):
     return kernel
 
 
-def evaluation_blocks(name, kernel, tables, f, u, v, derivatives, out):
+def evaluation_blocks(name, kernel, tables, f, u, v, derivatives, out, order=None):
     """``(block, back)``: ``block(lo, hi)`` evaluates the points lo:hi into ``out`` (a dict of (n, 3) arrays by
     :data:`OUTPUTS` name) by the compiled kernel ``(name, kernel)`` of :func:`evaluation_kernel` and returns -1
     or the first point it refuses; ``back``: ``[(name, temporary)]`` to copy into ``out`` after the blocks (the
-    outputs a kernel cannot write in place). ``tables(name)``: the patch table as that backend reads it."""
+    outputs a kernel cannot write in place). ``tables(name)``: the patch table as that backend reads it.
+    ``order`` (the C kernel only): a permutation of the points; ``block(lo, hi)`` then evaluates the points
+    ``order[lo:hi]``, in that order, each into its own row."""
     if name == "c":
         from ccproof.evaluate._ckernel import point_blocks as blocks
     else:
+        if order is not None:
+            raise CCProofError(f"internal error: the {name} kernel takes the points in their own order")
         from ccproof.evaluate._numba_kernel import point_blocks as blocks
+    if order is not None:
+        block, back = blocks(kernel, tables(name), f, u, v, derivatives, [out.get(k) for k in OUTPUTS], order)
+        return block, [(OUTPUTS[i], a) for i, a in back]
     block, back = blocks(kernel, tables(name), f, u, v, derivatives, [out.get(k) for k in OUTPUTS])
     return block, [(OUTPUTS[i], a) for i, a in back]
 

@@ -45,9 +45,9 @@ def with_nets(T, groups):
     if sum(r for _, r in sizes) > RING_MEAN_PRECOMPUTED * sum(k for k, _ in sizes):
         return kept_rings(T, groups)
     n_cor = T.n_corner
-    if 0 < T.n_regular and T.n_regular * 17 * 3 * 8 <= _budget("CCPROOF_NETS_BUDGET", NETS_BUDGET):
+    if 0 < T.n_regular and T.n_regular * 17 * 3 * 8 <= budget("CCPROOF_NETS_BUDGET", NETS_BUDGET):
         T = T._replace(nets=regular_nets(T, groups))
-    if 0 < n_cor and n_cor * 3 * 17 * 3 * 8 <= _budget("CCPROOF_HOT_BUDGET", HOT_BUDGET):
+    if 0 < n_cor and n_cor * 3 * 17 * 3 * 8 <= budget("CCPROOF_HOT_BUDGET", HOT_BUDGET):
         T = T._replace(hot=layer0_nets(T, groups))
     return kept_rings(T, groups)
 
@@ -78,10 +78,10 @@ def kept_rings(T, groups):
     return T._replace(cor_ring=cor_ring, ring=np.concatenate(parts))
 
 
-def _budget(name, default):
+def budget(name, default):
     """The byte budget in the environment variable ``name`` (a non-negative integer), else ``default``.
 
-    >>> _budget("CCPROOF_NO_SUCH_BUDGET", 7)
+    >>> budget("CCPROOF_NO_SUCH_BUDGET", 7)
     7
     """
     import os

@@ -51,6 +51,8 @@ __all__ = ["natural_limit_surface", "LimitSurface"]
 CHUNK = 1 << 15
 #: calls on at least this many points (faces not in order) evaluate them batched by face
 SORT_MIN = 1 << 12
+#: ... on surfaces of at least this many ptex faces (their tables outgrow the caches)
+SORT_FACES = 1 << 14
 #: points per kernel call of the batched evaluation (bounds its temporaries: 8 bytes per point and output)
 SORT_CHUNK = 1 << 16
 
@@ -347,10 +349,10 @@ class LimitSurface:
 
     def _evaluate_compiled(self, name, kernel, f, u, v, derivatives, out, threads):
         """:meth:`evaluate` by the compiled kernel ``name`` (``"c"`` or ``"numba"``) into ``out``, in blocks;
-        from :data:`SORT_MIN` points on, on a table whose nets are computed at evaluation time (a large one),
-        unless the faces are in order already, batched by face (:meth:`_evaluate_by_face`)."""
+        from :data:`SORT_MIN` points on, on a surface of at least :data:`SORT_FACES` ptex faces, unless the faces
+        are in order already, batched by face (:meth:`_evaluate_by_face`)."""
         n = f.size
-        if n >= SORT_MIN and self._table.nets.shape[0] == 0 and (f[1:] < f[:-1]).any():
+        if n >= SORT_MIN and self.n_faces >= SORT_FACES and (f[1:] < f[:-1]).any():
             return self._evaluate_by_face(name, kernel, f, u, v, derivatives, out, threads)
         block, back = evaluation_blocks(name, kernel, self._kernel_tables, f, u, v, derivatives, out)
         # few blocks: each kernel call computes the corner nets it meets once (a cache per call)
@@ -364,13 +366,26 @@ class LimitSurface:
 
     def _evaluate_by_face(self, name, kernel, f, u, v, derivatives, out, threads):
         """:meth:`_evaluate_compiled` on the points taken in the order of their faces (in runs of at most
-        ``n_faces / 2^15`` faces, in the caller's order within a run; the table's rows and
-        the positions the nets are computed from are read in order, and points of one patch find its net
-        in the kernel's cache), in chunks of :data:`SORT_CHUNK` points written back to ``out`` in the
-        caller's order. Every point gets the same bits as in any other order (its net is the same sums)."""
+        ``n_faces / 2^15`` faces (the C kernel: ``n_faces / 2^20``), in the caller's order within a run; the
+        table's rows and the positions the nets are computed from are read in order, and points of one patch
+        find its net in the kernel's cache). The C kernel reads each point from its row and writes its results
+        there (:func:`ccproof.evaluate._ckernel.face_order`, ``ccp_evaluate_at``); numba's takes chunks of
+        :data:`SORT_CHUNK` points gathered and written back to ``out`` in the caller's order. Every point gets
+        the same bits as in any other order (its net is the same sums)."""
+        keys = _KEYS[derivatives]
+        if name == "c":
+            from ccproof.evaluate._ckernel import face_order
+
+            order = face_order(f, self.n_faces, max(0, int(self.n_faces - 1).bit_length() - 20))
+            block, back = evaluation_blocks(name, kernel, self._kernel_tables, f, u, v, derivatives, out, order)
+            if max(in_blocks(block, f.size, threads_for(threads, f.size), 32768, per_thread=4)) >= 0:
+                self._check_values(f, u, v)  # raises, naming the first bad point
+                raise CCProofError("internal error: the compiled kernel refused a point the checks accept")
+            for k, a in back:
+                out[k][...] = a
+            return out
         shift = max(0, int(self.n_faces - 1).bit_length() - 16)  # (runs of 2^shift faces: a radix sort)
         order = np.argsort((f >> shift).astype(np.uint16), kind="stable")
-        keys = _KEYS[derivatives]
 
         def block(lo, hi):
             for a in range(lo, hi, SORT_CHUNK):

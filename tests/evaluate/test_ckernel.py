@@ -106,6 +106,31 @@ def test_a_call_writes_only_its_own_rows(surface):
                 assert np.all(o[:lo] == -7.0) and np.all(o[hi:] == -7.0), (d, k, lo, hi)
 
 
+def test_rows_in_any_order_write_only_their_own_rows(surface):
+    """A call on given rows (``rows``: a shuffled subset, read and written in place, three coordinates at a time)
+    writes each chosen row with the numpy path's bits and leaves every other row alone; a refused point is
+    reported at its position in ``rows``."""
+    from ccproof.evaluate import _ckernel
+
+    f, u, v = _points(surface, 5000, 19)
+    ref = surface.evaluate(f, u, v, 2, backend="numpy")
+    lib, ct = _ckernel.load(), surface._c_table()
+    rng = np.random.default_rng(5)
+    for d, n_rows in ((0, 1), (1, 300), (2, 4001)):
+        keys = ("P", "Pu", "Pv", "Puu", "Puv", "Pvv")[:3 * d if d else 1]
+        rows = rng.permutation(f.size)[:n_rows].astype(np.int64)
+        outs = [np.full((f.size, 3), -7.0) if i < len(keys) else None for i in range(6)]
+        assert _ckernel.evaluate_block(lib, ct, f, u, v, d, outs, rows) == -1
+        rest = np.setdiff1d(np.arange(f.size), rows)
+        for k, o in zip(keys, outs):
+            assert np.array_equal(ref[k][rows].view(np.int64), o[rows].view(np.int64)), (d, k)
+            assert np.all(o[rest] == -7.0), (d, k)
+    bad_u = u.copy()
+    bad_u[rows[17]] = 1.5
+    outs = [np.empty((f.size, 3)) for _ in range(3)] + [None] * 3
+    assert _ckernel.evaluate_block(lib, ct, f, bad_u, v, 1, outs, rows) == 17
+
+
 @pytest.mark.skipif(shutil.which("gcc") is None, reason="no gcc to build the portable variant")
 def test_the_portable_code_gives_the_same_bits(surface, tmp_path):
     """_clib.c built with -DCCP_SCALAR -DCCP_NO_CLONES (the scalar code that compilers without GNU vector

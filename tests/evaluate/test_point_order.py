@@ -1,6 +1,6 @@
-"""Points in any order: the compiled kernels take large calls on tables whose nets are computed at
-evaluation time batched by face (``surface.SORT_MIN``) and write the results back in the caller's order;
-every point gets the bits it gets alone, on every backend, with the nets kept precomputed (no batching) or
+"""Points in any order: the compiled kernels take large calls on large surfaces batched by face
+(``surface.SORT_MIN``, ``surface.SORT_FACES``: here every surface is batched) and write the results back in the
+caller's order; every point gets the bits it gets alone, on every backend, with the nets kept precomputed or
 computed from the rings."""
 
 import numpy as np
@@ -10,6 +10,11 @@ from ccproof.evaluate import surface
 from ccproof.evaluate.backend import available_backends
 from ccproof.evaluate.surface import LimitSurface
 from ccproof.mesh.io import read_obj_tagged
+
+
+@pytest.fixture(autouse=True)
+def _batch_every_surface(monkeypatch):
+    monkeypatch.setattr(surface, "SORT_FACES", 0)
 
 
 @pytest.fixture(scope="module", params=["kept", "computed"])
@@ -22,9 +27,11 @@ def surf(request, refdir):
     mp.setenv("CCPROOF_HOT_BUDGET", "0")
     try:
         S = LimitSurface(mesh, progress=False)
+        ct = S._c_table() if "c" in available_backends() else None  # (the C kernel's nets: none either)
     finally:
         mp.undo()
     assert S._table.nets.shape[0] == 0 and S._table.hot.shape[0] == 0
+    assert ct is None or (ct.struct.n_nets == 0 and ct.struct.n_hot == 0)
     return S
 
 

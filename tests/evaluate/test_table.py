@@ -89,15 +89,21 @@ def test_bytes_per_ptex_face_flat_under_refinement_and_depth(refdir, monkeypatch
 
 
 def test_precomputed_layer_zero_gives_the_same_bits(refdir, monkeypatch):
-    """The layer-0 nets and the regular nets kept precomputed on small meshes are the sums the kernels
-    compute otherwise from the rings: the same numbers, bit for bit, on every backend (points in every
-    layer of every corner)."""
+    """The layer-0 nets and the regular nets kept precomputed (by the table on small meshes, by the C kernel's
+    table where the table keeps none) are the sums the kernels compute otherwise from the rings: the same
+    numbers, bit for bit, on every backend (points in every layer of every corner)."""
     from ccproof.evaluate import nets
 
     mesh = read_obj_tagged(refdir / "osd_features" / "meshes" / "catmark_smoothtris1.obj")
     hot = LimitSurface(mesh, progress=False)
     monkeypatch.setattr(nets, "HOT_BUDGET", 0)
     monkeypatch.setattr(nets, "NETS_BUDGET", 0)
+    mid = LimitSurface(mesh, progress=False)  # no nets in the table; the C kernel's table computes its own
+    if "c" in available_backends():
+        s = mid._c_table().struct
+        assert (s.n_nets, s.n_hot) == (mid._table.n_regular, 3 * mid._table.n_corner)
+    monkeypatch.setenv("CCPROOF_NETS_BUDGET", "0")  # nor the C kernel's own (its table is made when evaluating)
+    monkeypatch.setenv("CCPROOF_HOT_BUDGET", "0")
     cold = LimitSurface(mesh, progress=False)
     assert hot._table.hot.shape[0] == 3 * hot._table.n_corner > 0 and cold._table.hot.shape[0] == 0
     assert hot._table.nets.shape[0] == hot._table.n_regular > 0 and cold._table.nets.shape[0] == 0
@@ -110,8 +116,10 @@ def test_precomputed_layer_zero_gives_the_same_bits(refdir, monkeypatch):
     for backend in available_backends():
         a = hot.evaluate(f, u, v, 2, backend=backend)
         b = cold.evaluate(f, u, v, 2, backend=backend)
+        c = mid.evaluate(f, u, v, 2, backend=backend)
         for k in a:
             assert np.array_equal(a[k], b[k]), (backend, k)
+            assert np.array_equal(a[k], c[k]), (backend, k)
 
 
 # ------------------------------------------------------------------------------ brute force
