@@ -120,18 +120,19 @@ def read_pieces(cert, k, read):
     return pieces, ends
 
 
-def check_lam_range(k, ends, prec, part):
-    """Every k >= k0: the lam pieces hold lam(k) for every k >= k0 (:func:`.interval.lam_interval_ok`)."""
-    ok = lam_interval_ok(k["min"], ends[0][0], ends[-1][1], prec)
-    part(f"lam(k) in [{ends[0][0]}, {ends[-1][1]}] for every k >= {k['min']}", ok)
-    return ok
-
-
-def check_pieces(k, pieces, ends, prec, degree, layers, check, part):
-    """Each piece in turn until a part fails: its nets (one valence: lam(k)'s; a lam piece: the hulls of the Taylor
-    models of ``degree``), part H, then ``check(parts, nets, lam, znets of ``layers`` layers or None, tag)``."""
+def check_pieces(k, pieces, ends, prec, degree, layers, check, part, spectrum=lambda: True):
+    """Part S, ``spectrum()`` (C1), the lam range (every k >= k0), then each piece until a part fails: its nets (one
+    valence: lam(k)'s; a lam piece: the hulls of the Taylor models of ``degree``), part H, then ``check(parts, nets,
+    lam, znets of ``layers`` layers or None, tag)``."""
+    if not check_derivation(part) or not spectrum():
+        return
+    if ends:
+        part(f"lam(k) in [{ends[0][0]}, {ends[-1][1]}] for every k >= {k['min']}",
+             lam_interval_ok(k["min"], ends[0][0], ends[-1][1], prec))
     for idx, pc in enumerate(pieces):
         tag = f"[piece {idx}] " if ends else ""
+        if part.failed:
+            return
         with ctx.workprec(prec):
             try:
                 if ends:
@@ -146,8 +147,6 @@ def check_pieces(k, pieces, ends, prec, degree, layers, check, part):
             check_hypotheses(nets, lam, part, tag)
             if not part.failed:
                 check(pc["parts"], nets, lam, zn, tag)
-        if part.failed:
-            return
 
 
 def read_n_prec(cert):
@@ -244,8 +243,6 @@ def verify_injectivity(cert, k, part, log):
     log(f"certificate for valence {k} (N = {N}, {prec} bits)" if not every else
         f"certificate for valences k >= {k['min']} (N = {N}, {prec} bits, {len(pieces)} lam piece(s), "
         f"Taylor degree {deg}, truncation {D})")
-    if not check_derivation(part) or (every and not check_lam_range(k, ends, prec, part)):
-        return kname(k)
 
     def check(parts, nets, lam, zn, tag):
         cells = valence_cells(nets, lam, N, prec, sym) if zn is None else interval_cells(zn, N, D, prec, sym)

@@ -86,10 +86,8 @@ def parameter_nets(exact, La, Lb, layer, degree, prec):
 
 def hull_nets(znets, prec):
     """arb nets enclosing the zeta-polynomial nets for every zeta in [-1, 1] (Bernstein range)."""
-    def hull(co):
-        lo, hi = range_enclosure(_bern1(co, prec))
-        return lo.union(hi)
-    return {n: [[tuple(hull(co) for co in pt) for pt in row] for row in net] for n, net in znets.items()}
+    return {n: [[tuple(arb.union(*range_enclosure(_bern1(co, prec))) for co in pt) for pt in row] for row in net]
+            for n, net in znets.items()}
 
 
 def piece_det_form_z(znets, i, name, p, q, D, prec):

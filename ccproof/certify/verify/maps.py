@@ -64,14 +64,8 @@ def cell_geometry(l, m, N):
     i = N - 1 - (max(l, m).bit_length() - 1)
     scale = fmpq(2**i, 2**N)  # layer-0 coordinates of the cell: [l, l+1] * scale
     u0, v0 = l * scale, m * scale
-    half = fmpq(1, 2)
-    if u0 >= half and v0 < half:
-        name, s0, t0 = "P1", 2 * u0 - 1, 2 * v0
-    elif u0 >= half:
-        name, s0, t0 = "P2", 2 * u0 - 1, 2 * v0 - 1
-    else:
-        name, s0, t0 = "P3", 2 * u0, 2 * v0 - 1
-    h = 2 * scale
+    name = "P3" if u0 < fmpq(1, 2) else "P1" if v0 < fmpq(1, 2) else "P2"
+    s0, t0, h = 2 * (u0 - ORIGIN[name][0]), 2 * (v0 - ORIGIN[name][1]), 2 * scale
     return i, name, ((s0, s0 + h), (t0, t0 + h))
 
 
@@ -82,12 +76,10 @@ def cell_pieces(X, Y):
     >>> cell_pieces(net_form(nets["P1"], 0, 64), net_form(nets["P1"], 1, 64))
     [(2, 0), (2, 1), (2, 2), (2, 3), (3, 0), (3, 1), (3, 2), (3, 3)]
     """
-    rng = []
-    for F in (X, Y):
-        lo = min(c.lower() for c in F.coeffs)
-        hi = max(c.upper() for c in F.coeffs)
-        rng.append([p for p in range(4) if not (hi < BREAKS[p] or (p < 3 and lo > BREAKS[p + 1]))])
-    return [(p, q) for p in rng[0] for q in rng[1]]
+    def pieces(F):
+        lo, hi = min(c.lower() for c in F.coeffs), max(c.upper() for c in F.coeffs)
+        return [p for p in range(4) if not (hi < BREAKS[p] or (p < 3 and lo > BREAKS[p + 1]))]
+    return [(p, q) for p in pieces(X) for q in pieces(Y)]
 
 
 def det_form(X, Y, i, name, p, q, D):
@@ -139,12 +131,8 @@ def corner_det_form(nets, lam, N, name, prec):
         U = (Px3 + Py3) * 36 - r * Px3 * Py3 * 1296
         W = 1 - r * U
         gradU = (U.diff(2), U.diff(3))
-        J = [[None, None], [None, None]]
-        for a in range(2):
-            for b in range(2):
-                e = qv * (U * P[a].diff(2 + b) + P[a] * gradU[b]) - r * D[a] * gradU[b]
-                J[a][b] = e + W * half if a == b else e
-        return J[0][0] * J[1][1] - J[0][1] * J[1][0]
+        J = [[qv * (U * P[a].diff(2 + b) + P[a] * gradU[b]) - r * D[a] * gradU[b] for b in range(2)] for a in range(2)]
+        return (J[0][0] + W * half) * (J[1][1] + W * half) - J[0][1] * J[1][0]
 
 
 def regularity_form(nets, name, prec):
@@ -205,7 +193,4 @@ def _curve_avoids(curve, depth):
     half = fmpq(1, 2)
     if all(p[0] > half for p in curve) or all(p[1] > half for p in curve):
         return True
-    if depth == 0:
-        return False
-    left, right = split_half(curve)
-    return _curve_avoids(left, depth - 1) and _curve_avoids(right, depth - 1)
+    return depth > 0 and all(_curve_avoids(part, depth - 1) for part in split_half(curve))

@@ -65,12 +65,10 @@ def level1_rule(A, B):
     q, half = fmpq(1, 4), fmpq(1, 2)
     if A % 2 and B % 2:
         return face_point((A - 1) // 2, (B - 1) // 2)
-    if A % 2:  # edge (a, b)-(a+1, b); faces (a, b) and (a, b-1)
-        a, b = (A - 1) // 2, B // 2
-        return _mix(({(a, b): 1}, q), ({(a + 1, b): 1}, q), (face_point(a, b), q), (face_point(a, b - 1), q))
-    if B % 2:  # edge (a, b)-(a, b+1); faces (a, b) and (a-1, b)
-        a, b = A // 2, (B - 1) // 2
-        return _mix(({(a, b): 1}, q), ({(a, b + 1): 1}, q), (face_point(a, b), q), (face_point(a - 1, b), q))
+    if A % 2 or B % 2:  # edge (a, b)-(a + da, b + db); faces (a, b) and (a - db, b - da)
+        a, b, da, db = ((A - 1) // 2, B // 2, 1, 0) if A % 2 else (A // 2, (B - 1) // 2, 0, 1)
+        return _mix(({(a, b): 1}, q), ({(a + da, b + db): 1}, q), (face_point(a, b), q),
+                    (face_point(a - db, b - da), q))
     a, b = A // 2, B // 2  # vertex point, n = 4: V' = (F + 2R + V)/4
     return _mix(({(a, b): 1}, q), *((face_point(fa, fb), q / 4) for fa, fb in ((a, b), (a - 1, b), (a, b - 1),
                                                                                (a - 1, b - 1))),

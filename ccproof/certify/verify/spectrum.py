@@ -107,27 +107,19 @@ def spectral_ordering(k, prec):
     (True, True)
     """
     with ctx.workprec(prec):
-        if isinstance(k, dict):
-            k0 = k["min"]
-            c1 = arb(fmpq(2, k0)).cos_pi()
-            lam = lam_of(c1).union(lam_of(arb(1)))  # lam(k) for every k >= k0 (lam increases with c)
-            # p0(lam) > 0 for every k >= k0: 1 - c_1 <= 2 pi^2/k^2, so 28 lam - 3 > 4 pi^2 lam / k0 suffices
-            mode0 = 28 * lam - 3 > 4 * arb.pi() ** 2 * lam / k0
-            label = f"every k >= {k0}"
-        else:
-            c1 = arb(fmpq(2, k)).cos_pi()
-            lam = lam_of(c1)
-            mode0 = 28 * lam - 3 - 2 * k * (1 - c1) * lam > 0
-            label = f"k = {k}"
+        every, k0 = isinstance(k, dict), k["min"] if isinstance(k, dict) else k
+        c1 = arb(fmpq(2, k0)).cos_pi()
+        lam = lam_of(c1).union(lam_of(arb(1))) if every else lam_of(c1)  # every k >= k0: lam increases with c
+        # p0(lam) > 0; for every k >= k0: 1 - c_1 <= 2 pi^2/k^2, so 28 lam - 3 > 4 pi^2 lam / k0 suffices
+        mode0 = 28 * lam - 3 > 4 * arb.pi() ** 2 * lam / k0 if every else 28 * lam - 3 - 2 * k * (1 - c1) * lam > 0
+        label = f"every k >= {k0}" if every else f"k = {k}"
         checks = [
             (lam < 1, "lam < 1 (1 is the dominant eigenvalue, simple in mode 0)"),
             (lam > fmpq(1, 4), "lam > 1/4 >= the smaller roots and > 1/8"),
             ((1 + c1) * (9 + c1) > 0, "lam simple in modes 1 and k-1 (discriminant > 0)"),
             (mode0 and lam > fmpq(3, 8), "lam above both mode-0 roots (p0(lam) > 0, lam > 3/8)"),
         ]
-        if not isinstance(k, dict) and k >= 4:
+        if not every and k >= 4:
             checks.append((lam > lam_of(arb(fmpq(4, k)).cos_pi()), "lam > lam(c_2) (modes 2..k-2)"))
-        for ok, what in checks:
-            if not ok:
-                return False, f"{label}: {what} fails"
-        return True, f"{label}: " + "; ".join(w for _, w in checks)
+        bad = next((what for ok, what in checks if not ok), None)
+        return (False, f"{label}: {bad} fails") if bad else (True, f"{label}: " + "; ".join(w for _, w in checks))

@@ -4,7 +4,7 @@ F = Q(c)[lam]/(16 lam^2 - 2(5 + c) lam + 1), the mode-1 eigenvector, the layer-0
 sections 0 and 9.1; docs/readings.md R2-R4.
 
 >>> L, c = QL.lam(), QL.c()
->>> 16 * L * L - 2 * (5 + c) * L + 1 == 0, (1 / (4 * L - 1)) * (4 * L - 1) == 1
+>>> 16 * L * L - 2 * (5 + c) * L + 1 == 0, (4 * L - 1).inverse() * (4 * L - 1) == 1
 (True, True)
 """
 
@@ -26,10 +26,6 @@ B2Z = ((1, 4, 1, 0), (0, 4, 2, 0), (0, 2, 4, 0), (0, 1, 4, 1))
 _S = fmpq_poly([fmpq(10, 16), fmpq(2, 16)])  # lam + lam' = (10 + 2c)/16; lam lam' = 1/16
 
 
-def _poly(x):
-    return x if isinstance(x, fmpq_poly) else fmpq_poly([x])
-
-
 class QL:
     """(a + b lam)/d in F, a, b, d in Q[c] in lowest terms, d monic (docs/appendix_a.md section 9.1).
 
@@ -41,7 +37,7 @@ class QL:
     __slots__ = ("a", "b", "d")
 
     def __init__(self, a=0, b=0, d=1):
-        a, b, d = _poly(a), _poly(b), _poly(d)
+        a, b, d = (x if isinstance(x, fmpq_poly) else fmpq_poly([x]) for x in (a, b, d))
         if d == 0:
             raise ZeroDivisionError("zero denominator")
         g = a.gcd(b).gcd(d)  # monic, non-zero
@@ -76,9 +72,6 @@ class QL:
     def __sub__(self, other):
         return self + -QL.of(other)
 
-    def __rsub__(self, other):
-        return -self + other
-
     def __mul__(self, other):
         o = QL.of(other)
         bb = self.b * o.b  # lam^2 = ((10 + 2c) lam - 1)/16
@@ -94,9 +87,6 @@ class QL:
 
     def __truediv__(self, other):
         return self * QL.of(other).inverse()
-
-    def __rtruediv__(self, other):
-        return self.inverse() * other
 
     def integer_form(self):
         """``[A, B, D]``: integer coefficient lists (constant first) with self = (A(c) + B(c) lam)/D(c)."""
