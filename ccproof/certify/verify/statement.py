@@ -41,8 +41,10 @@ class QL:
         if d == 0:
             raise ZeroDivisionError("zero denominator")
         g = a.gcd(b).gcd(d)  # monic, non-zero
-        g *= (d / g).coeffs()[-1]  # exact division; then d / g is monic
-        self.a, self.b, self.d = a / g, b / g, d / g
+        if g.degree() > 0:
+            a, b, d = a / g, b / g, d / g  # exact division
+        lead = d.coeffs()[-1]
+        self.a, self.b, self.d = a / lead, b / lead, d / lead
 
     @classmethod
     def lam(cls):
