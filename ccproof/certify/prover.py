@@ -234,7 +234,7 @@ def _prove_piece(exact, La, Lb, N, degree, trunc, prec, progress, label):
 def _piece_task(task):
     """One lam piece as an independent task (for :func:`prove_interval` on a scheduler)."""
     a, b, N, taylor_degree, truncation_degree, prec, label = task
-    exact = derivation().integer_forms("bspline")
+    exact = derivation().integer_forms()
     return _prove_piece(exact, parse_decimal(a), parse_decimal(b), N, taylor_degree, truncation_degree, prec,
                         False, label)
 
@@ -330,7 +330,7 @@ def prove_interval(k0: ValenceLike, prec: int = DEFAULT_PREC, progress: bool = T
     if not v.interval:
         raise ValenceError(f"prove_interval proves every valence k >= k0: give k0 or '>=K0', got {k0!r}")
     k = v.to_json()
-    exact = derivation().integer_forms("bspline")
+    exact = derivation().integer_forms()
     ends = _lam_range(v.k, prec)
     with ctx.workprec(prec):
         La, Lb = parse_decimal(ends[0]), parse_decimal(ends[1])
@@ -484,7 +484,7 @@ def prove_c1(k: ValenceLike, prec: int = DEFAULT_PREC) -> dict[str, Any]:
         if v.interval:
             ends = _lam_range(v.k, prec)
             La, Lb = parse_decimal(ends[0]), parse_decimal(ends[1])
-            nets = hull_nets(parameter_nets(derivation().integer_forms("bspline"), La, Lb, 0, 3, prec), prec)
+            nets = hull_nets(parameter_nets(derivation().integer_forms(), La, Lb, 0, 3, prec), prec)
         else:
             nets = nets_for_valence(v.k, prec)
         reg = {n: prove_positive(regularity_form(nets, n, prec), (0, 1), f"det J_Phi on {n}") for n in PATCHES}

@@ -30,7 +30,7 @@ def cert():
 
 @pytest.fixture(scope="module")
 def exact():
-    return derivation().integer_forms("bspline")
+    return derivation().integer_forms()
 
 
 def lam_of(k):

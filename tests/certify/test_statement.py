@@ -26,7 +26,7 @@ def _same_form(f, g):
 def test_derived_nets_equal_the_sympy_tables(valence):
     """Two implementations (flint field + rules written out; sympy + grid stencils) give the same forms."""
     table = table_nets_exact(read_table_json(table_path(valence)))
-    mine = St.derivation().integer_forms("bspline")
+    mine = St.derivation().integer_forms()
     for n in St.PATCHES:
         for i in range(4):
             for j in range(4):
