@@ -27,7 +27,7 @@ MAX_PATH_TOKENS = 32  # the prover splits at most 14 times (prover.MAX_DEPTH)
 MAX_BOXES = 8192  # per certificate; the published ones hold at most 707
 MAX_GRID = 64  # cells per axis of a grid tree
 MAX_JSON_VALUES = 8 * MAX_BOXES  # every JSON value of a certificate (a box is 3); the published: at most 2,863
-MAX_REPLAY_WORK = 400_000_000  # per certificate, about 6.5 s of CPU (:func:`replay_work`; the published: 81 million)
+MAX_REPLAY_WORK = 250_000_000  # per certificate, about 4 s of CPU (:func:`replay_work`; the published: 81 million)
 _SPENT = ContextVar("replay work spent on the current certificate", default=None)
 _PARTITION = "the boxes do not partition the domain exactly"
 
