@@ -44,6 +44,7 @@ SMOKE = {
     "bench_scale.py": ["--smoke"],
     "bench_scans.py": ["--smoke"],
     "bench_step.py": ["--smoke"],
+    "bench_stop.py": ["--smoke"],
     "bench_tables.py": ["--smoke"],
     "bench_topology.py": ["--smoke"],
     "bench_with_vertices.py": ["--smoke"],
