@@ -37,6 +37,7 @@ SMOKE = {
     "bench_kernel_ab.py": ["--smoke"],
     "bench_memory.py": ["--smoke"],
     "bench_ngon.py": ["--smoke"],
+    "bench_ngon_table.py": ["--smoke"],
     "bench_project.py": ["--smoke"],
     "bench_refine.py": ["--smoke"],
     "bench_reparam.py": ["--smoke"],
