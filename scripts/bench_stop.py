@@ -34,7 +34,7 @@ import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _bench import load, ratio_line  # noqa: E402
+from _bench import load, missing, ratio_line  # noqa: E402
 
 _SITE = '''
 import os, time
@@ -164,6 +164,12 @@ def main():
     ap.add_argument("--smoke", action="store_true", help="one round")
     args = ap.parse_args()
     rounds = 1 if args.smoke else args.rounds
+    import importlib.util
+
+    if importlib.util.find_spec("distributed") is None:
+        missing("a local Dask cluster", "the extra 'scale' is not installed: pip install 'ccproof[scale]'")
+        print("no cluster start to signal: nothing measured")
+        return 0
     ratios, loads = [], []
     with tempfile.TemporaryDirectory() as d:
         tmp = Path(d)
