@@ -614,11 +614,13 @@ class LimitSurface:
                 out[verts[sel]] = r["P"]
         return out
 
-    def _corner_of_vertex(self):
-        """Mesh vertex -> ``(job, vf)`` of one corner face whose irregular corner is that vertex."""
-        out = {}
+    def _corners_of_vertices(self):
+        """``(vertices, jobs, vfs)``, sorted by vertex: each mesh vertex that is the irregular corner of a corner
+        face once, with the job and corner face (``vf``: of the first job of its template, the template's
+        representative) of its first such face in the order of the templates and their jobs."""
+        verts, jobs_of, vfs = [np.zeros(0, np.int64)], [np.zeros(0, np.int64)], [np.zeros(0, np.int64)]
         if self._vmap is None:
-            return out
+            return verts[0], jobs_of[0], vfs[0]
         T = self._table
         for t, jobs, rings in self._groups:
             if jobs is None or not jobs.size:
@@ -627,10 +629,12 @@ class LimitSurface:
                 if pos < 0:
                     continue
                 corner = next(i for i, k in enumerate(t.kind) if k == KIND_CORNER and t.leaf[i] == c)
-                vf = int(T.job_root[jobs[0]]) + corner
-                for job, vert in zip(jobs.tolist(), self._vmap[rings[:, pos]].tolist()):
-                    out.setdefault(int(vert), (job, vf))
-        return out
+                verts.append(np.asarray(self._vmap[rings[:, pos]], dtype=np.int64))
+                jobs_of.append(np.asarray(jobs, dtype=np.int64))
+                vfs.append(np.full(jobs.size, int(T.job_root[jobs[0]]) + corner, dtype=np.int64))
+        verts_all = np.concatenate(verts)
+        first = np.unique(verts_all, return_index=True)[1]  # sorted vertices, the first occurrence of each
+        return verts_all[first], np.concatenate(jobs_of)[first], np.concatenate(vfs)[first]
 
     def vertex_normals(self):
         """Unit limit normals at the control vertices, shape (n_vertices, 3).
@@ -654,32 +658,35 @@ class LimitSurface:
             return out
         Nn = limit_normals(self.mesh)
         bad = np.flatnonzero(np.isnan(Nn).any(axis=1))
-        if not bad.size:
-            return Nn
-        where = self._corner_of_vertex()
-        T = self._table
-        for v in bad:
-            item = where.get(int(v))
-            if item is None:
-                continue
-            job, vf = item
-            scheme, rel = self._corner_leaf(job, vf)
-            M = scheme.tangent_masks
-            if M is None:
-                continue
-            t1, t2 = M @ rel
-            nrm = np.cross(t1, t2)
-            # orientation: Pu x Pv just inside the corner's virtual face
-            U0, V0, H = T.u0[vf], T.v0[vf], T.h[vf]
-            d = 2.0**-12 * H
-            u = U0 + H - d if T.cu[vf] else U0 + d
-            w = V0 + H - d if T.cv[vf] else V0 + d
-            f = int(self._job_base[job])
-            r = self.evaluate([f], [u], [w], 1)
-            if np.dot(nrm, np.cross(r["Pu"][0], r["Pv"][0])) < 0:
-                nrm = -nrm
-            Nn[v] = nrm / np.linalg.norm(nrm)
+        if bad.size:
+            self._boundary_normals(Nn, bad)
         return Nn
+
+    def _boundary_normals(self, Nn, bad):
+        """Fill ``Nn[bad]`` (vertices without a closed-form mask: irregular boundary vertices) from the tangent masks
+        of one corner face at each, all at once: the masks times the rings of all the jobs of each corner face
+        (:meth:`_eigen_normals`), oriented like ``Pu x Pv`` evaluated just inside those corner faces in one batch."""
+        verts, jobs, vfs = self._corners_of_vertices()
+        at = np.minimum(np.searchsorted(verts, bad), max(verts.size - 1, 0))
+        found = verts.size > 0
+        has = (verts[at] == bad) if found else np.zeros(bad.size, bool)
+        if not has.any():
+            return
+        v, job, vf = bad[has], jobs[at[has]], vfs[at[has]]
+        nrm = self._eigen_normals(job, vf)  # unit, NaN where the tangent plane is not determined
+        ok = ~np.isnan(nrm).any(axis=1)
+        if not ok.any():
+            return
+        v, job, vf, nrm = v[ok], job[ok], vf[ok], nrm[ok]
+        # orientation: Pu x Pv at 2^-12 of the corner face's side inside it
+        T = self._table
+        U0, V0, H = T.u0[vf], T.v0[vf], T.h[vf]
+        d = 2.0**-12 * H
+        u = np.where(T.cu[vf], U0 + H - d, U0 + d)
+        w = np.where(T.cv[vf], V0 + H - d, V0 + d)
+        r = self.evaluate(self._job_base[job], u, w, 1)
+        flip = np.einsum("ij,ij->i", nrm, np.cross(r["Pu"], r["Pv"])) < 0
+        Nn[v] = np.where(flip[:, None], -nrm, nrm)
 
     # ------------------------------------------------------------------ moved control points
     def with_vertices(self, X):

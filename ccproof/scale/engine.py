@@ -32,6 +32,7 @@ from ccproof.scale.processes import (  # noqa: F401 (re-export)
     pid_alive,
     process_pool,
     signals_deferred,
+    start_interruptibly,
     stop_cluster_now,
 )
 
@@ -242,7 +243,8 @@ def client_for(scheduler):
     """A connected :class:`distributed.Client` for a local or address scheduler ``scheduler`` (str,
     :class:`Scheduler`, or a Client, yielded unchanged); a context manager. A local scheduler starts a
     ``LocalCluster`` of worker processes (one thread each), closed gracefully when the block ends, at once
-    (:func:`~ccproof.scale.processes.stop_cluster_now`) when it raises (Ctrl-C). :class:`CCProofError` for the
+    (:func:`~ccproof.scale.processes.stop_cluster_now`) when it raises (Ctrl-C); a signal during the start gives it
+    up at once (:func:`~ccproof.scale.processes.start_interruptibly`). :class:`CCProofError` for the
     serial scheduler or without the extra ``scale``. Starting a cluster takes seconds; the example is the refusal:
 
     >>> with client_for("serial"):
@@ -260,21 +262,11 @@ def client_for(scheduler):
         return
     s = parse_scheduler(scheduler)
     if s.kind == "local":
-        import logging
-
-        cluster = client = None
-        try:
-            with signals_deferred():  # the workers leave Ctrl-C to this process; one arriving now is raised after
-                # no dashboard; the scheduler's small HTTP server on a free port (its default 8787 may be
-                # taken: a warning line); the workers' own logs silenced below CRITICAL (a run stopped by
-                # Ctrl-C closes the scheduler under their heartbeats: 30 lines of tracebacks), the tasks'
-                # errors come back through their results
-                cluster = LocalCluster(n_workers=s.workers, threads_per_worker=1, processes=True,
-                                       dashboard_address=None, scheduler_kwargs={"dashboard_address": ":0"},
-                                       silence_logs=logging.CRITICAL)
-                client = Client(cluster)
-        except BaseException:  # a Ctrl-C or SIGTERM during the start: the cluster stopped, then one line
-            stop_cluster_now(client, cluster)
+        try:  # a Ctrl-C or SIGTERM during the start: the start given up at once, its processes killed, one line
+            cluster, client = start_interruptibly(partial(_start_local_cluster, LocalCluster, Client, s.workers))
+        except BaseException as exc:
+            part = getattr(exc, "ccproof_partial", {})
+            stop_cluster_now(part.get("client"), part.get("cluster"))
             raise
         try:
             yield client
@@ -288,6 +280,21 @@ def client_for(scheduler):
             yield client
     else:
         raise CCProofError("client_for needs a local or address scheduler, not 'serial'")
+
+
+def _start_local_cluster(LocalCluster, Client, workers, keep):
+    """A local cluster of ``workers`` single-threaded worker processes and its client, each stored in ``keep`` as
+    soon as it exists (an interrupted start closes what is there). No dashboard; the scheduler's small HTTP server
+    on a free port (its default 8787 may be taken: a warning line); the workers' own logs silenced below CRITICAL
+    (a run stopped by Ctrl-C closes the scheduler under their heartbeats: 30 lines of tracebacks), the tasks'
+    errors come back through their results."""
+    import logging
+
+    cluster = keep["cluster"] = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                                             dashboard_address=None, scheduler_kwargs={"dashboard_address": ":0"},
+                                             silence_logs=logging.CRITICAL)
+    client = keep["client"] = Client(cluster)
+    return cluster, client
 
 
 def _capped(s, n_tasks):

@@ -255,3 +255,23 @@ def test_eval_on_its_own_local_workers_maps_one_shared_surface_and_equals_serial
     with np.load(tmp_path / "a.npz") as a, np.load(tmp_path / "b.npz") as b:
         for name in ("face", "u", "v", "P", "Pu", "Pv", "Puu", "Puv", "Pvv"):
             assert a[name].tobytes() == b[name].tobytes(), name
+
+
+def test_eval_by_default_runs_its_chunks_in_process_with_the_compiled_kernel(refdir, tmp_path, capsys):
+    """Several chunks, no scheduler asked for: with the compiled kernel (threads on every core) the points are
+    evaluated in this process, not on a local cluster whose worker processes would add memory (1.37 x --serial
+    on 81,920 triangles, scripts/bench_eval_scheduler.py); the report says so, and the result is --serial's."""
+    from ccproof.evaluate.backend import evaluation_kernel
+
+    if evaluation_kernel(None)[1] is None:
+        pytest.skip("no compiled kernel: the default keeps the local cluster")
+    obj = str(refdir / "meshes" / "sector_k5.obj")
+    argv = ["eval", obj, "--samples", "3000", "--chunk", "1000", "--no-progress"]
+    assert main(argv + ["--out", str(tmp_path / "a.npz")]) == 0
+    out = capsys.readouterr().out
+    assert "default scheduler: the 3 chunks evaluated in this process" in out and "workers ready" not in out, out
+    assert main(argv + ["--serial", "--out", str(tmp_path / "b.npz")]) == 0
+    assert "default scheduler" not in capsys.readouterr().out
+    with np.load(tmp_path / "a.npz") as a, np.load(tmp_path / "b.npz") as b:
+        for name in ("face", "u", "v", "P", "Pu", "Pv"):
+            assert a[name].tobytes() == b[name].tobytes(), name
