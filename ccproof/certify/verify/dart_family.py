@@ -1,13 +1,11 @@
-"""The characteristic map of ``dart:K``, every K >= K0, as one family analytic in h = 1/K (trusted).
-
-x, y and their nets from the bordered Fourier systems (docs/tagged_c1.md, "Every dart K >= 101", item 6,
-"Closed forms without cancellation"): h an acb ball (the values, the disc bounds) or the series variable
-(acb_series: the Taylor coefficients); :class:`Modes` is shared with the exact family of :mod:`.dart_zeros`.
-"""
+"""The characteristic map of ``dart:K``, every K >= K0, as one family analytic in h = 1/K (trusted): x, y and their
+nets from the bordered Fourier systems (docs/tagged_c1.md, "Every dart K >= 101", item 6), h an acb ball or the
+series variable; :class:`Modes` is shared with the exact family of :mod:`.dart_zeros`."""
 
 from __future__ import annotations
 
 from contextlib import contextmanager
+from functools import cache
 
 from flint import acb, acb_mat, acb_poly, acb_series, arb, ctx, fmpq, fmpq_mat, fmpq_poly
 
@@ -54,9 +52,9 @@ def u_denominator(lam, low):
     return (lam - fmpq(1, 8)) * (lam - fmpq(1, 16)) * (lam - fmpq(1, 32)) * (lam - fmpq(1, 64)) * (lam - low)
 
 
-def big_u(lam):
-    """U(lam) (6 values of lam's type) = adj(lam - B(1)) kappa / :func:`u_denominator`."""
-    den = u_denominator(lam, l0()[1])
+def big_u(lam, low):
+    """U(lam) = adj(lam - B(1)) kappa / :func:`u_denominator` (6 values of lam's type)."""
+    den = u_denominator(lam, low)
     return [horner(p, lam, lam * 0) / den for p in N_POLYS]
 
 
@@ -133,19 +131,15 @@ class Modes:
             "Y-": (lambda d, p: vy[RING_INDEX[_swap(p)]] * e("y", -d - _eps(p)) * self.sign / 2, z, self.lam2),
         }
 
-    def layer_level0(self, q=0):
+    def layer_level0(self):
         """(x(t, p), y(t, p)) at integer sectors t of any sign (y reflected in ray 0 for t < 0)."""
-        vx, vy, e = self.vx, self.vy, self.e
-
-        def x(t, pos):
-            return (vx[RING_INDEX[pos]] * e("x", t) - vx[RING_INDEX[_swap(pos)]] * e("x", -t - _eps(pos))) / self.i2
+        f = {name: part[0] for name, part in self.parts().items()}
 
         def y(t, pos):
             if t < 0:
                 t, pos = (-t, pos) if pos[1] == 0 else (-t - 1, _swap(pos))
-            return (self.alpha * self.U[RING_INDEX[pos]] + (vy[RING_INDEX[pos]] * e("y", t) * self.em
-                    + vy[RING_INDEX[_swap(pos)]] * e("y", -t - _eps(pos)) * self.ep) / 2)
-        return x, y
+            return f["Y0"](t, pos) + (f["Y+"](t, pos) * self.em + f["Y-"](t, pos) * self.ep) * self.sign
+        return (lambda t, pos: f["X+"](t, pos) + f["X-"](t, pos)), y
 
 
 class Family(Modes):
@@ -162,8 +156,9 @@ class Family(Modes):
         self.vx = bordered((h * self.ix).exp(), self.lam1)
         self.lam2 = _lam_principal((h * (2 * sigma)).cos())
         self.vy = bordered((h * self.iy).exp(), self.lam2)
-        self.U = big_u(self.lam2)
-        self.mode0(sigma.cos(), l0()[0], flip_mode0)
+        L0, low = l0()
+        self.U = big_u(self.lam2, low)
+        self.mode0(sigma.cos(), L0, flip_mode0)
         self.sign = 1
         if smooth:
             self.alpha, self.yc, self.sign = self.zero, self.zero, -1
@@ -211,12 +206,7 @@ def _bezier(net, zero):
 
 def piece_nets(level0, centre, lam, zero, q=None):
     """{piece: 4 x 4 Bezier net} of one coordinate or basis part (:func:`quadrant_level1`)."""
-    value, memo = quadrant_level1(level0, centre, lam, zero, q), {}
-
-    def V(A, B):  # the three pieces share most of their level-1 points
-        if (A, B) not in memo:
-            memo[(A, B)] = value(A, B)
-        return memo[(A, B)]
+    V = cache(quadrant_level1(level0, centre, lam, zero, q))  # the three pieces share most level-1 points
     return {name: _bezier([[V(_OFFSET[name][0] + i, _OFFSET[name][1] + j) for j in range(4)] for i in range(4)], zero)
             for name in PIECES}
 
@@ -224,7 +214,6 @@ def piece_nets(level0, centre, lam, zero, q=None):
 XB, YB = ("X+", "X-"), ("Y0", "Y+", "Y-")
 _SU, _SH = 6, 36  # Kronecker strides: a product of bicubic partials has degree <= 5 in u and in v
 _BIN = ((1,), (1, 1), (1, 2, 1), (1, 3, 3, 1), (1, 4, 6, 4, 1), (1, 5, 10, 10, 5, 1))  # C(d, i)
-_BIN2, _BIN3, _BIN5 = _BIN[2], _BIN[3], _BIN[5]
 
 
 def _packed(nets, axis, stride=_SH):
@@ -245,7 +234,7 @@ def _unpacked(P, n, stride, rows):
     """The h^m coefficients, m <= n, of a packed product of degree 5 (``rows`` 6: in u, v; 1: a curve)."""
     c = P.coeffs()
     c += [acb(0)] * max(0, stride * (n + 1) - len(c))
-    return [[c[m * stride + i * _SU + j] / (_BIN5[i] * _BIN5[j]) for i in range(rows) for j in range(6)]
+    return [[c[m * stride + i * _SU + j] / (_BIN[5][i] * _BIN[5][j]) for i in range(rows) for j in range(6)]
             for m in range(n + 1)]
 
 
@@ -269,7 +258,7 @@ def basis_nets(fam):
 
 def layer_nets(fam, q):
     """{piece: (X net, Y net)} (4 x 4 Bezier, values of fam.h's type) of layer quadrant q."""
-    x, y = fam.layer_level0(q)
+    x, y = fam.layer_level0()
     X, Y = piece_nets(x, fam.zero, fam.lam1, fam.zero, q), piece_nets(y, fam.yc, fam.lam2, fam.zero, q)
     return {name: (X[name], Y[name]) for name in PIECES}
 
@@ -281,7 +270,7 @@ def bezier_product(f, g):
     for k in range(6):
         acc = 0 * f[0]
         for i in range(max(0, k - 2), min(3, k) + 1):
-            acc = acc + f[i] * gd[k - i] * fmpq(_BIN3[i] * _BIN2[k - i], _BIN5[k])
+            acc = acc + f[i] * gd[k - i] * fmpq(_BIN[3][i] * _BIN[2][k - i], _BIN[5][k])
         out.append(acc)
     return out
 

@@ -448,7 +448,7 @@ def _guard(fam, tol):
     """Raise unless the Family computes the lemma's formula here: v^(1,0) = 1, y(C) = alpha (lam - L0), ray 0's
     two sharp rows and the ring rows of sector 1 (balls containing 0, radii below tol: identities)."""
     lam, L0 = fam.lam2, l0()[0]
-    y, yc = fam.layer_level0(0)[1], fam.yc
+    y, yc = fam.layer_level0()[1], fam.yc
     kap = kappa()
     res = [fam.vy[_E10] - 1, yc - fam.alpha * (lam - L0), (lam - _HALF) * y(0, _E) - yc / 2,
            (lam - fmpq(1, 8)) * y(0, (2, 0)) - fmpq(3, 4) * y(0, _E) - yc / 8]
