@@ -11,12 +11,10 @@ from flint import acb, acb_mat, acb_poly, acb_series, arb, ctx, fmpq, fmpq_mat, 
 
 from .errors import CertificateError
 from .maps import STAR_CURVES, curve_points
-from .rules import CENTRE, canonical, level1_rule
-from .statement import B2Z, horner, lam_of
+from .rules import CENTRE, apply, canonical, level1_rule
+from .statement import B2Z, NET_OFFSETS, horner, lam_of
+from .statement import PATCHES as PIECES
 from .tagged_modes import RING_INDEX, bordered_matrix, bordered_solve, ring_block, ring_stencil
-
-_OFFSET = {"P1": (0, -1), "P2": (0, 0), "P3": (-1, 0)}  # as tagged_map: level-1 position of net[0][0]
-PIECES = ("P1", "P2", "P3")
 
 
 def kappa():
@@ -175,10 +173,6 @@ def quadrant_level1(level0, centre, lam, zero, q=None):
     """``value(A, B)``, the level-1 value at (A, B) of a quadrant: lam times level 0 on the two-ring, the rule of
     :mod:`.rules` elsewhere; ``q`` None a bulk quadrant (``level0(delta, pos)``), else layer quadrant q
     (``level0(t, pos)``; as tagged_map: the ghost row across ray 0, the sharp midpoint at its (3, 0))."""
-    def lev0(d, a, b):
-        dd, a2, b2 = canonical(a, b)
-        return centre if (a2, b2) == CENTRE else level0(d + dd, (a2, b2))
-
     def value(A, B):
         if (A, B) == (0, 0):
             return lam * centre
@@ -190,10 +184,7 @@ def quadrant_level1(level0, centre, lam, zero, q=None):
             return lam * level0(t, (A2, B2))
         if q is not None and B2 == 0 and t == 0:
             return (level0(0, (1, 0)) + level0(0, (2, 0))) / 2
-        acc = zero
-        for (a, b), w in level1_rule(A2, B2).items():
-            acc = acc + lev0(t, a, b) * w
-        return acc
+        return apply(level1_rule(A2, B2), lambda dd, p: centre if p == CENTRE else level0(t + dd, p), zero)
     return value
 
 
@@ -207,8 +198,8 @@ def _bezier(net, zero):
 def piece_nets(level0, centre, lam, zero, q=None):
     """{piece: 4 x 4 Bezier net} of one coordinate or basis part (:func:`quadrant_level1`)."""
     V = cache(quadrant_level1(level0, centre, lam, zero, q))  # the three pieces share most level-1 points
-    return {name: _bezier([[V(_OFFSET[name][0] + i, _OFFSET[name][1] + j) for j in range(4)] for i in range(4)], zero)
-            for name in PIECES}
+    return {name: _bezier([[V(NET_OFFSETS[name][0] + i, NET_OFFSETS[name][1] + j) for j in range(4)]
+                           for i in range(4)], zero) for name in PIECES}
 
 
 XB, YB = ("X+", "X-"), ("Y0", "Y+", "Y-")
