@@ -64,10 +64,16 @@ def check_construction():
             raise CertificateError(f"dart:{k}: an odd block of the modes +-1 has an eigenvalue >= 1/2")
     if bound > fmpq(15, 64):
         raise CertificateError(f"dart: the outer even rows bound {bound} > 15/64")
+    return _sharp_difference(classes[0][("r", 0, 3) + _E]), bound
+
+
+def _sharp_difference(sharp):
+    """d = ``sharp`` minus the smooth edge row, raising unless the one-ring is closed in the ring stencil and d
+    reads the one-ring window only, invariant under the reflection in ray 0."""
     if any(q not in (_E, _F) for pos in (_E, _F) for _, q in ring_stencil()[RING_INDEX[pos]]):
         raise CertificateError("the ring rows of the one-ring leave it")
     smooth = {("r" if q[1] == 0 else "q", dlt) + q: x for (dlt, q), x in ring_stencil()[_E10].items()}
-    smooth[_C], sharp = kappa()[_E10], classes[0][("r", 0, 3) + _E]
+    smooth[_C] = kappa()[_E10]
     d = {key: sharp.get(key, 0) - smooth.get(key, 0) for key in set(sharp) | set(smooth)}
     d = {key: x for key, x in d.items() if x != 0}
     for key in d:
@@ -76,7 +82,7 @@ def check_construction():
         mirror = key if key == _C else (key[0], -key[1] if key[2:] == _E else -key[1] - 1) + key[2:]
         if d.get(mirror, 0) != d[key]:
             raise CertificateError("dart: d is not invariant under the reflection in ray 0")
-    return d, bound
+    return d
 
 
 def _b1w(w, zero):

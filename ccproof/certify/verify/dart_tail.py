@@ -1,16 +1,14 @@
-"""Every ``dart:K``, K >= K0, in one "C1" certificate: the record, the models R, T, W and the steps (trusted).
-
-The grammar and the steps are docs/certificates.md, "Every dart K >= K0 in one certificate"; the argument is
-docs/tagged_c1.md, "Every dart K >= 101" (items 6 to 8). Step 1 (:func:`read_record`) reads every field and
-tree and prices the declared work (:func:`record_work`) before any arithmetic; then S, Z, G, E, M in order.
-R (det J_Phi), T (a1 X Y' - a2 Y X' on the outer curves) and W (signs of X, Y on the outer curves' points)
-live on the bulk (s, h), the middle (s, w = 1/q) and the layer quadrants q (h); the bulk and middle are
-sum_k c_k e^(i omega_k s) f_k(h) over the basis parts (:func:`omegas`), each f_k an analytic model in h.
+"""Every ``dart:K``, K >= K0, in one "C1" certificate (trusted): the record read and priced before any arithmetic,
+then the steps S, Z, G, E, M (docs/certificates.md, "Every dart K >= K0 in one certificate"; docs/tagged_c1.md,
+"Every dart K >= 101", items 6 to 8). R (det J_Phi), T (a1 X Y' - a2 Y X' on the outer curves) and W (signs of X,
+Y on their points) live on the bulk (s, h), the middle (s, w = 1/q) and the layer quadrants q (h); the bulk and
+middle are sum_k c_k e^(i omega_k s) f_k(h) over the basis parts (:func:`omegas`), each f_k an analytic model.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from itertools import product
 
 from flint import acb, acb_mat, acb_series, arb, ctx, fmpq
 
@@ -112,8 +110,8 @@ def read_fields(obj, spec, where):
 
 
 def read_record(cert, k0):
-    """Step 1: the record's fields (the spectrum's keys, prec, hints, layer; re and map as read trees), its work
-    checked (:func:`check_work`); CertificateError naming the field, before any arithmetic on forms."""
+    """Step 1: the record's fields (the spectrum's keys, prec, hints, layer; re and map as read trees), its leaves
+    and work (:func:`record_work`) within the budget; CertificateError naming the field, before any arithmetic."""
     if not MIN_K0 <= k0 <= 10**6:
         raise CertificateError(f"dart:>={k0}: the interval certificate needs {MIN_K0} <= K0 <= 10^6")
     if field_of(cert, "statement", str, "certificate") != "C1":
@@ -129,7 +127,13 @@ def read_record(cert, k0):
     rec = dict(sp, prec=g["prec"], hints=hints, layer=rg["layer"],
                re={n: read_tree(sp["re"][n], roots[n], f"spectrum re {n}", 1) for n in "NIF"})
     rec["map"] = read_map(g["parts"], k0, hints, rg["s0"], rg["layer"], tuple(rg["winding"]))
-    check_work(rec)
+    leaves = sum(len(t) for *_, trees in rec["map"] for t in trees) + sum(len(v) for v in rec["re"].values())
+    if leaves > MAX_BOXES:
+        raise CertificateError(f"more than {MAX_BOXES} leaves in all ({leaves})")
+    if (work := record_work(rec)) > MAX_WORK:
+        raise CertificateError(f"the record declares about {work // 10000} s of work ({work:,} units of 0.1 ms: "
+                               f"disc grid, sigma boxes, orders, leaves, prec), beyond the budget of "
+                               f"{MAX_WORK // 10000} s (docs/certificates.md, \"Bounds\")")
     return rec
 
 
@@ -155,18 +159,6 @@ def record_work(rec):
     return work * ((rec["prec"] + 127) // 128)
 
 
-def check_work(rec):
-    """Refuse a record whose declared work passes :data:`MAX_WORK`, or with more than MAX_BOXES leaves in all."""
-    leaves = sum(len(t) for _, _, _, trees in rec["map"] for t in trees) + sum(len(v) for v in rec["re"].values())
-    if leaves > MAX_BOXES:
-        raise CertificateError(f"more than {MAX_BOXES} leaves in all ({leaves})")
-    work = record_work(rec)
-    if work > MAX_WORK:
-        raise CertificateError(f"the record declares about {work // 10000} s of work ({work:,} units of 0.1 ms: "
-                               f"disc grid, sigma boxes, orders, leaves, prec), beyond the budget of "
-                               f"{MAX_WORK // 10000} s (docs/certificates.md, \"Bounds\")")
-
-
 def coefficient_nets(net, n, real=False):
     """[the 4 x 4 net of the h^m Taylor coefficients (acb), m = 0..n] of a net of series or of values."""
     cs = [[series_coeffs(z, n + 1, real) for z in row] for row in net]
@@ -185,26 +177,26 @@ def quantities(fam, n, layers=(), bulk=True):
     bulk ("R", i, j, piece) D(X_i, Y_j)'s 36 Bernstein coefficients, ("T", i, j, curve) a1 X_i Y_j' - a2 Y_j X_i''s
     6, ("X", i, curve), ("Y", j, curve) the 4 points; layer quadrant q ("R"/"T"/"Y", q, piece or curve)."""
     out = {}
+
+    def pair(key, part_x, part_y, curve_x, curve_y, A):
+        out.update({("R", *key, p): det_series(part_x[p], part_y[p], n) for p in PIECES})
+        out.update({("T", *key, c): curve_trans_series(curve_x[c], curve_y[c], *A, n) for c in STAR_CURVES})
     if bulk:
-        nets = basis_nets(fam)
-        parts = {(b, p): packed_partials(coefficient_nets(net, n)) for b, pn in nets.items() for p, net in pn.items()}
+        nets, A = basis_nets(fam), _log_coeffs(fam, n)
+        parts = {b: {p: packed_partials(coefficient_nets(net, n)) for p, net in pn.items()} for b, pn in nets.items()}
         curves = {b: series_curves(nets[b], n) for b in nets}
-        A = _log_coeffs(fam, n)
-        for i in XB:
-            for j in YB:
-                out.update({("R", i, j, p): det_series(parts[(i, p)], parts[(j, p)], n) for p in PIECES})
-                out.update({("T", i, j, c): curve_trans_series(curves[i][c], curves[j][c], *A, n)
-                            for c in STAR_CURVES})
+        for i, j in product(XB, YB):
+            pair((i, j), parts[i], parts[j], curves[i], curves[j], A)
         out.update({(t, b, c): curves[b][c] for t, bs in (("X", XB), ("Y", YB)) for b in bs for c in STAR_CURVES})
     real = isinstance(fam.h, acb_series)
     A = _log_coeffs(fam, n, real) if layers else None
     for q in layers:
         ln = layer_nets(fam, q)
-        out.update({("R", q, p): det_series(coefficient_nets(X, n, real), coefficient_nets(Y, n, real), n)
-                    for p, (X, Y) in ln.items()})
-        xs, ys = (series_curves({p: ln[p][k] for p in PIECES}, n, real) for k in (0, 1))
-        out.update({("T", q, c): curve_trans_series(xs[c], ys[c], *A, n) for c in STAR_CURVES})
-        out.update({("Y", q, c): ys[c] for c in STAR_CURVES})
+        nets = [{p: ln[p][k] for p in PIECES} for k in (0, 1)]
+        (px, py), (cx, cy) = ([{p: coefficient_nets(N[p], n, real) for p in PIECES} for N in nets],
+                              [series_curves(N, n, real) for N in nets])
+        pair((q,), px, py, cx, cy, A)
+        out.update({("Y", q, c): cy[c] for c in STAR_CURVES})
     return out
 
 
@@ -470,7 +462,3 @@ def verify_dart_tail(cert, k0, part, log):
          "1 simple, lam1 > lam2 > |every other|, both simple; the reflection in ray 0 carries the quadrants "
          "q <= (K - 1)/2 to the rest (x odd, y even): Phi regular and injective, so dart:K is C1")
     return name
-
-
-__all__ = ["DartModels", "MAX_WORK", "MIN_K0", "TaylorHints", "check_work", "map_regions", "quantities",
-           "read_map", "read_record", "record_work", "replay_map", "verify_dart_tail"]
