@@ -99,12 +99,9 @@ def bordered(w, lam, pivot=0):
     return [acb_series([vs[m][i, 0] for m in range(n)], prec=n) for i in range(6)]
 
 
-def _swap(pos):
-    return pos if pos[1] == 0 else (pos[1], pos[0])
-
-
-def _eps(pos):
-    return 0 if pos[1] == 0 else 1
+def _mirror(d, pos):
+    """The image of ring point (d, pos) under the reflection in ray 0: (-d, pos) on a ray, (-d - 1, (b, a)) else."""
+    return (-d, pos) if pos[1] == 0 else (-d - 1, (pos[1], pos[0]))
 
 
 class Modes:
@@ -121,12 +118,15 @@ class Modes:
     def parts(self):
         """{X+, X-, Y0, Y+, Y-: (level0(delta, pos), centre, lam)}, level0 at sector K s + delta, position pos."""
         vx, vy, e, i2, z = self.vx, self.vy, self.e, self.i2, self.zero
+
+        def mode(v, c, d, p):  # v^(p) e^(i k d h), k = a or b
+            return v[RING_INDEX[p]] * e(c, d)
         return {
-            "X+": (lambda d, p: vx[RING_INDEX[p]] * e("x", d) / i2, z, self.lam1),
-            "X-": (lambda d, p: -(vx[RING_INDEX[_swap(p)]] * e("x", -d - _eps(p))) / i2, z, self.lam1),
+            "X+": (lambda d, p: mode(vx, "x", d, p) / i2, z, self.lam1),
+            "X-": (lambda d, p: -mode(vx, "x", *_mirror(d, p)) / i2, z, self.lam1),
             "Y0": (lambda d, p: self.alpha * self.U[RING_INDEX[p]], self.yc, self.lam2),
-            "Y+": (lambda d, p: vy[RING_INDEX[p]] * e("y", d) * self.sign / 2, z, self.lam2),
-            "Y-": (lambda d, p: vy[RING_INDEX[_swap(p)]] * e("y", -d - _eps(p)) * self.sign / 2, z, self.lam2),
+            "Y+": (lambda d, p: mode(vy, "y", d, p) * self.sign / 2, z, self.lam2),
+            "Y-": (lambda d, p: mode(vy, "y", *_mirror(d, p)) * self.sign / 2, z, self.lam2),
         }
 
     def layer_level0(self):
@@ -135,7 +135,7 @@ class Modes:
 
         def y(t, pos):
             if t < 0:
-                t, pos = (-t, pos) if pos[1] == 0 else (-t - 1, _swap(pos))
+                t, pos = _mirror(t, pos)
             return f["Y0"](t, pos) + (f["Y+"](t, pos) * self.em + f["Y-"](t, pos) * self.ep) * self.sign
         return (lambda t, pos: f["X+"](t, pos) + f["X-"](t, pos)), y
 

@@ -7,7 +7,7 @@ middle are sum_k c_k e^(i omega_k s) f_k(h) over the basis parts (:func:`omegas`
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections import namedtuple
 from itertools import product
 
 from flint import acb, acb_mat, acb_series, arb, ctx, fmpq
@@ -63,17 +63,9 @@ GRAMMAR = {
 QUANTITIES = {"R": (1, (1, 2), 3), "T": (1, (1, 2), 3), "X": (0, None, None), "Y": (0, (0, 1), 1)}
 
 
-@dataclass(frozen=True)
-class TaylorHints:
-    """The record's ``taylor`` hints: the Cauchy radius r (the h-square [-r, r]^2), its grid, the sigma boxes,
-    the Taylor orders in h (bulk and middle; layer) and the middle's order in s; they only choose."""
-
-    r: fmpq
-    disc_grid: int
-    sigma_boxes: int
-    order: int
-    layer_order: int
-    exp_order: int
+#: the record's ``taylor`` hints (they only choose): the Cauchy radius r (the h-square [-r, r]^2), its grid, the
+#: sigma boxes, the Taylor orders in h (bulk and middle; layer) and the middle's order in s
+TaylorHints = namedtuple("TaylorHints", "r disc_grid sigma_boxes order layer_order exp_order")
 
 
 def read_fields(obj, spec, where):
