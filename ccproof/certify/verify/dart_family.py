@@ -266,13 +266,17 @@ def bezier_product(f, g):
     return out
 
 
+def coefficient_nets(zs, n, real=False):
+    """[the h^m Taylor coefficients (acb) of every entry of a list, or list of lists, of series or values, m <= n]."""
+    if not isinstance(zs, list):
+        return series_coeffs(zs, n + 1, real)
+    cols = [coefficient_nets(z, n, real) for z in zs]
+    return [[c[m] for c in cols] for m in range(n + 1)]
+
+
 def series_curves(nets, n, real=False):
     """{curve: [order m: 4 acb]} of one coordinate's nets {piece: 4 x 4 series or values}."""
-    out = {}
-    for name in STAR_CURVES:
-        pts = [series_coeffs(z, n + 1, real) for z in curve_points(nets, name, oriented=True)]
-        out[name] = [[pts[p][m] for p in range(4)] for m in range(n + 1)]
-    return out
+    return {name: coefficient_nets(curve_points(nets, name, oriented=True), n, real) for name in STAR_CURVES}
 
 
 def curve_trans_series(xc, yc, A1, A2, n):

@@ -8,6 +8,7 @@ middle are sum_k c_k e^(i omega_k s) f_k(h) over the basis parts (:func:`omegas`
 from __future__ import annotations
 
 from collections import namedtuple
+from functools import reduce
 from itertools import product
 
 from flint import acb, acb_mat, acb_series, arb, ctx, fmpq
@@ -20,6 +21,7 @@ from .dart_family import (
     YB,
     Family,
     basis_nets,
+    coefficient_nets,
     curve_trans_series,
     det_series,
     layer_nets,
@@ -149,12 +151,6 @@ def record_work(rec):
         work += per_leaf[("R" if quantity == "R" else "", region)] * sum(len(t) for t in trees)
     work += 2 * sum(len(v) for v in rec["re"].values()) + 15 * rec["sigma_h"] + rec["mode0_h"]
     return work * ((rec["prec"] + 127) // 128)
-
-
-def coefficient_nets(net, n, real=False):
-    """[the 4 x 4 net of the h^m Taylor coefficients (acb), m = 0..n] of a net of series or of values."""
-    cs = [[series_coeffs(z, n + 1, real) for z in row] for row in net]
-    return [[[c[m] for c in row] for row in cs] for m in range(n + 1)]
 
 
 def _log_coeffs(fam, n, real=False):
@@ -378,15 +374,10 @@ def read_map(parts, k0, hints, s0, layer, winding):
         raise CertificateError("regions: need 0 < s0 < s_a < s_b < 1/2, T >= 3, 1/K0 < r and s0/T < r")
     regions, spec = map_regions(k0, s0, layer, winding), {}
     for _, keys, *_ in regions:  # the grammar of parts: exactly the keys the regions name, a list at each end
-        node = spec
-        for key in keys[:-1]:
-            node = node.setdefault(key, {})
-        node[keys[-1]] = list
+        reduce(lambda node, key: node.setdefault(key, {}), keys[:-1], spec)[keys[-1]] = list
     parts, out = read_fields(parts, spec, "parts"), []
     for name, keys, root, method, sign, outside in regions:
-        trees = parts
-        for key in keys:
-            trees = trees[key]
+        trees = reduce(dict.__getitem__, keys, parts)
         if len(trees) != hints.sigma_boxes:
             raise CertificateError(f"{name}: one tree per sigma box ({hints.sigma_boxes}) is needed")
         out.append((name, method, sign, [read_tree(t, root, f"{name}, sigma box {i}", sign, k0=k0, outside=outside)
