@@ -92,10 +92,7 @@ def bordered(w, lam, pivot=0):
     inv0 = Ak[0].inv()
     vs = [inv0 * acb_mat([[0]] * 6 + [[1]])]
     for m in range(1, n):
-        rhs = acb_mat(7, 1)
-        for j in range(1, m + 1):
-            rhs -= Ak[j] * vs[m - j]
-        vs.append(inv0 * rhs)
+        vs.append(inv0 * sum((-(Ak[j] * vs[m - j]) for j in range(1, m + 1)), acb_mat(7, 1)))
     return [acb_series([vs[m][i, 0] for m in range(n)], prec=n) for i in range(6)]
 
 

@@ -36,7 +36,6 @@ from .dart_spectrum import (
     check_eigenvector,
     check_mode0_roots,
     check_ranges,
-    check_secular,
     region_roots,
 )
 from .dart_zeros import check_zeros
@@ -387,15 +386,14 @@ def read_map(parts, k0, hints, s0, layer, winding):
 
 def replay_map(lists, sig_lo, sig_hi, hints, layer, prec):
     """Step M: the lists of :func:`read_map` replayed sigma box by sigma box; {name: (leaves, least bound)}."""
-    models = DartModels(sig_lo, sig_hi, hints, layer, prec)
-    summary = {}
+    models, summary = DartModels(sig_lo, sig_hi, hints, layer, prec), {}
     for i in range(hints.sigma_boxes):
         box = models.sigma_box(i)
         for name, method, sign, leaves in lists:
             count, least = replay_tree(leaves[i], box.evaluator(method), sign, f"{name}, sigma box {i}")
-            old = summary.get(name, (0, None))
-            best = least if old[1] is None or (least is not None and abs(least) < abs(old[1])) else old[1]
-            summary[name] = (old[0] + count, best)
+            old, best = summary.get(name, (0, None))
+            summary[name] = (old + count, least if best is None or (least is not None and abs(least) < abs(best))
+                             else best)
     return summary
 
 
@@ -412,14 +410,13 @@ def verify_dart_tail(cert, k0, part, log):
     name, (lo, hi), sig_r = f"dart:>={k0}", rec["sigma"], rec["circle"]
     log(f"C1 certificate for {name} ({rec['prec']} bits)")
 
-    def spectrum():
-        check_secular()
+    def spectrum():  # SpectralRegions checks the secular identities first
         least0, reg = check_mode0_roots(sig_r, k0, rec["mode0_h"]), SpectralRegions(sig_r, k0)
         counts = {n: replay_tree(rec["re"][n], getattr(reg, n.lower()), 1, f"spectrum re {n}") for n in "NIF"}
         return (f"every K >= {k0}: 1, lam1 = lam(cos(2 pi/K)) and one even eigenvalue (lam2) outside |lam| = "
                 f"lam(cos(2 x {sig_r}/K)), each simple; secular identities exact; mode 0's roots real and below "
-                f"r on {rec['mode0_h']} h-balls (Q(r)/h >= {least0.str(3, radius=False)}); Re(1 - F) > 0: "
-                + ", ".join(f"{n} {c} leaves (>= {arb(b).str(3, radius=False)})" for n, (c, b) in counts.items()))
+                f"r on {rec['mode0_h']} h-balls (Q(r)/h >= {least0.str(3, radius=False)}); Re(1 - F) > 0 (leaves): "
+                + _show(counts))
 
     steps = [
         ("S sector matrices of every K >= 7 from one window",

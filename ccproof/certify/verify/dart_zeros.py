@@ -265,14 +265,9 @@ def _middle(G, fam):
     = h^1 of S' = sum c_ij i omega_ij G_ij (a_i b_j = c_ij e^(i omega_ij s)); (S, (1, 2)), (S', (1,)) per place."""
     cj = {"Y0": (ONE, 0), "Y+": (fam.em, fam.b), "Y-": (fam.ep, -fam.b)}
     om = {"X+": fam.a, "X-": -fam.a}
-    f0 = {ij: cj[ij[1]][0].p for ij in G}
-    f1 = {ij: (cj[ij[1]][0] * I * (om[ij[0]] + cj[ij[1]][1])).p for ij in G}
-    items = []
-    for k in range(len(next(iter(G.values())))):
-        s = sum((f0[ij] * vals[k] for ij, vals in G.items()), fmpq_poly([0]))
-        s1 = sum((f1[ij] * vals[k] for ij, vals in G.items()), fmpq_poly([0]))
-        items += [(s, (1, 2)), (s1, (1,))]
-    return items
+    f = {(i, j): (cj[j][0].p, (cj[j][0] * I * (om[i] + cj[j][1])).p) for i, j in G}  # the weights of S and S'
+    return [(sum((f[ij][d] * vals[k] for ij, vals in G.items()), fmpq_poly([0])), ((1, 2), (1,))[d])
+            for k in range(len(next(iter(G.values())))) for d in (0, 1)]
 
 
 def _nets(memo, key, make):
