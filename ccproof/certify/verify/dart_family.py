@@ -136,6 +136,11 @@ class Modes:
             return f["Y0"](t, pos) + (f["Y+"](t, pos) * self.em + f["Y-"](t, pos) * self.ep) * self.sign
         return (lambda t, pos: f["X+"](t, pos) + f["X-"](t, pos)), y
 
+    def layer_nets(self, q, coordinate):
+        """{piece: 4 x 4 Bezier net} of x (coordinate 0) or y (1) on layer quadrant q."""
+        return piece_nets(self.layer_level0()[coordinate], (self.zero, self.yc)[coordinate],
+                          (self.lam1, self.lam2)[coordinate], self.zero, q)
+
 
 class Family(Modes):
     """x and y of dart:K at one h (acb, or the series variable) and sigma (arb); controls: ``flip_mode0``
@@ -246,8 +251,7 @@ def basis_nets(fam):
 
 def layer_nets(fam, q):
     """{piece: (X net, Y net)} (4 x 4 Bezier, values of fam.h's type) of layer quadrant q."""
-    x, y = fam.layer_level0()
-    X, Y = piece_nets(x, fam.zero, fam.lam1, fam.zero, q), piece_nets(y, fam.yc, fam.lam2, fam.zero, q)
+    X, Y = fam.layer_nets(q, 0), fam.layer_nets(q, 1)
     return {name: (X[name], Y[name]) for name in PIECES}
 
 

@@ -192,11 +192,6 @@ class ExactFamily(_df.Modes):
         """e^(i k a h) (c = "x") or e^(i k b h) (c = "y"), exact."""
         return _exp_i((self.a if c == "x" else self.b) * k)
 
-    def layer_nets(self, q, coordinate):
-        """{piece: 4 x 4 Bezier net} of x (coordinate 0) or y (1) on layer quadrant q."""
-        return _df.piece_nets(self.layer_level0()[coordinate], (self.zero, self.yc)[coordinate],
-                              (self.lam1, self.lam2)[coordinate], self.zero, q)
-
 
 # --- det J as a polynomial in the patch parameters (u, v), on the 6 x 6 grid; raw fmpq_poly below -------
 
