@@ -322,16 +322,14 @@ class SigmaBox:
     def evaluate(self, quantity, region, box, q=None):
         """An arb holding the quantity's scaled values on a box (list of (lo, hi)) of its region: bulk K det J_Phi,
         K T, X, Y; middle K^3 det J_Phi/q^2, K^3 T/q^2, Y/s; layer K^3 det J_Phi, K^3 T, K Y (K^2 Y at ray 0's end)."""
-        mid = QUANTITIES[quantity][1]
         models = self.models[(quantity, q if region == "layer" else None)]
         with ctx.workprec(self.m.prec):
             if region == "layer":
                 return layer_box(models, quantity, q, *box[0])
-            (s_lo, s_hi), (t_lo, t_hi) = box
             if region == "middle":
-                return middle_box(models, self.E[quantity], self.om[quantity], s_lo, s_hi, t_lo, t_hi, *mid,
-                                  L=self.m.hints.exp_order)
-            return bulk_box(models, quantity, s_lo, s_hi, t_lo, t_hi, self.sigma)
+                return middle_box(models, self.E[quantity], self.om[quantity], *box[0], *box[1],
+                                  *QUANTITIES[quantity][1], L=self.m.hints.exp_order)
+            return bulk_box(models, quantity, *box[0], *box[1], self.sigma)
 
 
 def map_regions(k0, s0, layer, winding):
