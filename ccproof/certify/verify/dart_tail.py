@@ -24,7 +24,6 @@ from .dart_family import (
     coefficient_nets,
     curve_trans_series,
     det_series,
-    layer_nets,
     packed_partials,
     series_coeffs,
     series_curves,
@@ -178,8 +177,7 @@ def quantities(fam, n, layers=(), bulk=True):
     real = isinstance(fam.h, acb_series)
     A = _log_coeffs(fam, n, real) if layers else None
     for q in layers:
-        ln = layer_nets(fam, q)
-        nets = [{p: ln[p][k] for p in PIECES} for k in (0, 1)]
+        nets = [fam.layer_nets(q, k) for k in (0, 1)]  # x, y
         (px, py), (cx, cy) = ([{p: coefficient_nets(N[p], n, real) for p in PIECES} for N in nets],
                               [series_curves(N, n, real) for N in nets])
         pair((q,), px, py, cx, cy, A)
@@ -215,8 +213,7 @@ def mode_factors(quantity, s, sigma):
 
 def bulk_box(models, quantity, s_lo, s_hi, h_lo, h_hi, sigma):
     """An arb holding Re sum_k c_k e^(i omega_k s) f_k(h)/h^low (every row of every model) on the (s, h) box."""
-    weights = mode_factors(quantity, ball(s_lo, s_hi), sigma)
-    low = QUANTITIES[quantity][0]
+    weights, low = mode_factors(quantity, ball(s_lo, s_hi), sigma), QUANTITIES[quantity][0]
     return hull(v for model in models.values() for v in model.real_part(weights, h_lo, h_hi, low=low))
 
 
