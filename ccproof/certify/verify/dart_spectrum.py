@@ -439,8 +439,7 @@ def check_eigenvector(sig_lo, sig_hi, k0, prec, balls=64, family=Family):
     if k0 < 7 or balls < 1:
         raise CertificateError(f"eigenvector lemma: K0 = {k0} < 7 or no h-balls")
     with ctx.workprec(prec):
-        pi = arb.pi()
-        if not (arb(sig_lo) > pi and arb(sig_hi) < 2 * pi and sig_lo < sig_hi):
+        if not (arb(sig_lo) > arb.pi() and arb(sig_hi) < 2 * arb.pi() and sig_lo < sig_hi):
             raise CertificateError("eigenvector lemma: the bracket is not inside (pi, 2 pi)")
         for exact in (check_ring, check_reach, check_mode0, check_crease_row):
             exact()

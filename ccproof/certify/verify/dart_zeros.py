@@ -37,16 +37,11 @@ def _inv_raw(p):
     return s
 
 
-def _lift_theta():
-    th = _X
-    for _ in range(2):  # Newton: m(th) = 0 mod m^2, then mod m^4
-        th = (th - _MOD[1](th) * _inv_raw(_MOD[1].derivative()(th) % _M3)) % _M3
-    if not (_MOD[1](th) % _M3).is_zero() or not ((th - _X) % _MOD[1]).is_zero():
-        raise AssertionError("theta~ is not the root of m in Q[x]/(m^3) lifting x")
-    return th
-
-
-_TH = _lift_theta()
+_TH = _X  # theta~, the root of m in Q[x]/(m^3) lifting x (Newton: m(th) = 0 mod m^2, then mod m^4)
+for _ in range(2):
+    _TH = (_TH - _MOD[1](_TH) * _inv_raw(_MOD[1].derivative()(_TH) % _M3)) % _M3
+if not (_MOD[1](_TH) % _M3).is_zero() or not ((_TH - _X) % _MOD[1]).is_zero():
+    raise AssertionError("theta~ is not the root of m in Q[x]/(m^3) lifting x")
 
 
 def _raw(z):
@@ -183,10 +178,9 @@ class ExactFamily(_df.Modes):
         stencil = ring_stencil() if stencil is None else stencil
         self.a, self.b, self.c, self.t = fmpq(a), fmpq(b), fmpq(c), fmpq(t)
         (self.lam1, self.vx, _), (self.lam2, self.vy, self.U) = _modes or (_mode(a, stencil), _mode(b, stencil))
-        self.zero = QS(0)
         self.mode0(self.c, L0, flip_alpha)
         self.em, self.ep = QS(self.c) - I * self.t, QS(self.c) + I * self.t  # e^(-i sigma), e^(i sigma)
-        self.i2, self.sign = I * 2, 1
+        self.zero, self.i2, self.sign = QS(0), I * 2, 1
 
     def e(self, c, k):
         """e^(i k a h) (c = "x") or e^(i k b h) (c = "y"), exact."""
@@ -276,8 +270,7 @@ def _nets(memo, key, make):
 def _check_bulk(fam, A, tally, memo, pt):
     """The bulk's D_ij and T_ij at h^0, the middle's e_10, e_11, e_20 of K det J_Phi per piece and of
     K (a1 X Y' - a2 Y X') per outer curve, and Y at s = h = 0."""
-    a, b, c = fam.a, fam.b, fam.c
-    keys = {"X+": ("X+", a), "X-": ("X-", a), "Y0": ("Y0", b, c), "Y+": ("Y+", b), "Y-": ("Y-", b)}
+    keys = {n: (n, fam.a) for n in XB} | {"Y0": ("Y0", fam.b, fam.c), "Y+": ("Y+", fam.b), "Y-": ("Y-", fam.b)}
     nets, part = {}, {}
     for name, key in keys.items():  # X's nets depend on a only, Y+-'s on b, Y0's on (b, c)
         nets[name], part[name] = _nets(memo, key, lambda name=name: _df.piece_nets(*fam.parts()[name], fam.zero))
