@@ -256,13 +256,8 @@ def layer_nets(fam, q):
 def bezier_product(f, g):
     """Bernstein coefficients (degree 5) of f g' for cubic Bezier values f, g (any ring)."""
     gd = [3 * (g[i + 1] - g[i]) for i in range(3)]
-    out = []
-    for k in range(6):
-        acc = 0 * f[0]
-        for i in range(max(0, k - 2), min(3, k) + 1):
-            acc = acc + f[i] * gd[k - i] * fmpq(_BIN[3][i] * _BIN[2][k - i], _BIN[5][k])
-        out.append(acc)
-    return out
+    return [sum((f[i] * gd[k - i] * fmpq(_BIN[3][i] * _BIN[2][k - i], _BIN[5][k])
+                 for i in range(max(0, k - 2), min(3, k) + 1)), 0 * f[0]) for k in range(6)]
 
 
 def coefficient_nets(zs, n, real=False):
