@@ -40,10 +40,9 @@ def _centre_ok(k):
 
 @cache
 def check_construction():
-    """Raise unless S is built alike for every K >= 7 (the window classes of dart:7 and dart:8 agree, the centre
-    row is the rule's, no weight is negative, the odd blocks of the modes +-1 and the outer even rows are below
-    1/2 and 15/64, the one-ring is closed); returns (d, bound): d = ray 0's sharp midpoint row minus the smooth
-    edge row, {("C",) or (kind, delta, position): weight}, and the outer even rows' bound.
+    """Raise unless S is built alike for every K >= 7 (docs/tagged_c1.md, "The spectral step" (1)); returns (d,
+    bound): d = ray 0's sharp midpoint row minus the smooth edge row, {("C",) or (kind, delta, position):
+    weight}, and the outer even rows' bound.
 
     >>> d, bound = check_construction()
     >>> d[("C",)], d[("r", 0, 1, 0)], d[("q", -1, 1, 1)], bound
