@@ -1,7 +1,6 @@
 """The spectrum and the eigenvectors of ``dart:K`` for every K >= K0 at once (trusted): only 1, lam1 and one even
 eigenvalue lie outside |lam| = lam(cos(2 sigma_r/K)), and the family of :mod:`.dart_family` at sigma* is its
-eigenvector (docs/tagged_c1.md, "Every dart K >= 101", items 3 and 7, "The spectral step", "The eigenvector lemma").
-"""
+eigenvector (docs/tagged_c1.md, "Every dart K >= 101", items 3 and 7: "The spectral step", "The eigenvector lemma")."""
 
 from __future__ import annotations
 

@@ -2,8 +2,7 @@
 then the steps S, Z, G, E, M (docs/certificates.md, "Every dart K >= K0 in one certificate"; docs/tagged_c1.md,
 "Every dart K >= 101", items 6 to 8). R (det J_Phi), T (a1 X Y' - a2 Y X' on the outer curves) and W (signs of X,
 Y on their points) live on the bulk (s, h), the middle (s, w = 1/q) and the layer quadrants q (h); the bulk and
-middle are sum_k c_k e^(i omega_k s) f_k(h) over the basis parts (:func:`omegas`), each f_k an analytic model.
-"""
+middle are sum_k c_k e^(i omega_k s) f_k(h) over the basis parts (:func:`omegas`), each f_k an analytic model."""
 
 from __future__ import annotations
 
