@@ -341,9 +341,8 @@ def check_mode0():
     """
     p, kap = B_AT_1.charpoly(), kappa()
     N = [fmpq_poly(c) for c in N_POLYS]
-    for i in range(6):
-        if _X * N[i] - sum((B_AT_1[i, k] * N[k] for k in range(6)), fmpq_poly(0)) != p * kap[i]:
-            raise CertificateError("U's numerator is not adj(x - B(1)) kappa: the mode-0 part misses its rows")
+    if any(_X * N[i] - sum((B_AT_1[i, k] * N[k] for k in range(6)), fmpq_poly(0)) != p * kap[i] for i in range(6)):
+        raise CertificateError("U's numerator is not adj(x - B(1)) kappa: the mode-0 part misses its rows")
     return True
 
 
@@ -392,8 +391,7 @@ def scaled_centre_residual(fam):
     _nonzero(lam - _HALF, "lam - 1/2")
     if not all(z.is_finite() for z in list(fam.U) + list(fam.vy) + list(fam.vx)):
         raise ZeroDivisionError("U or a bordered solution is not finite")
-    sh = h * sigma
-    sinc = sh.sinc()
+    sh, sinc = h * sigma, (h * sigma).sinc()
     _nonzero(sinc, "sinc(sigma h)")
     c = (2 * sh).cos()
     if not ((1 + c) * (9 + c)).real > 0:
