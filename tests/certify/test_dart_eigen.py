@@ -80,7 +80,7 @@ def test_reach_fails_for_a_wider_stencil(monkeypatch):
 
 def _family_vector(fam, k):
     """y of the family on the points of labels('dart', k) (acb)."""
-    y, yc = fam.layer_level0(0)[1], fam.yc
+    y, yc = fam.layer_level0()[1], fam.yc
     return [acb(yc)] + [acb(y(p[1], p[2:])) for p in labels("dart", k)[1:]]
 
 
@@ -121,7 +121,7 @@ def test_family_at_the_exact_lam2_is_even_vector_and_x_is_mode_vector(k):
     exact = even_vector(k, lam2, piv)
     assert all(abs(a / y[piv] - b) < 1e-25 for a, b in zip(y, exact))
     assert abs(_residual(k, y, fam.lam2)[0]) < 1e-25  # the centre row too, at sigma(K)
-    x = fam.layer_level0(0)[0]
+    x = fam.layer_level0()[0]
     f = mode_vector("dart", k, 1, lam1)
     xs = [acb(0)] + [acb(x(p[1], p[2:])) * acb(0, 2) for p in pts[1:]]
     assert all(abs(a - b) < 1e-25 for a, b in zip(xs, f))

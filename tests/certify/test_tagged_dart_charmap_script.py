@@ -393,12 +393,12 @@ def test_the_exact_nets_are_the_acb_familys_nets():
             ln = mod.layer_nets(fam, q)
             el = []
             for e in exs:
-                x, y = e.layer_level0(q)
-                el.append({p: mod._bezier([[mod.quadrant_level1(y, e.yc, e.lam2, e.zero, q)(mod._OFFSET[p][0] + i,
-                                                                                            mod._OFFSET[p][1] + j)
+                x, y = e.layer_level0()
+                el.append({p: mod._bezier([[mod.quadrant_level1(y, e.yc, e.lam2, e.zero, q)(mod.NET_OFFSETS[p][0] + i,
+                                                                                            mod.NET_OFFSETS[p][1] + j)
                                              for j in range(4)] for i in range(4)], e.zero) for p in mod.PIECES})
-                x0 = {p: mod._bezier([[mod.quadrant_level1(x, e.zero, e.lam1, e.zero, q)(mod._OFFSET[p][0] + i,
-                                                                                     mod._OFFSET[p][1] + j)
+                x0 = {p: mod._bezier([[mod.quadrant_level1(x, e.zero, e.lam1, e.zero, q)(mod.NET_OFFSETS[p][0] + i,
+                                                                                     mod.NET_OFFSETS[p][1] + j)
                                        for j in range(4)] for i in range(4)], e.zero) for p in mod.PIECES}
             for p in mod.PIECES:
                 for i in range(4):

@@ -1,24 +1,20 @@
-"""The characteristic map of ``dart:K``, every K >= K0, as one family analytic in h = 1/K (trusted).
-
-x, y and their nets from the bordered Fourier systems (docs/tagged_c1.md, "Every dart K >= 101", item 6,
-"Closed forms without cancellation"): h an acb ball (the values, the disc bounds) or the series variable
-(acb_series: the Taylor coefficients); :class:`Modes` is shared with the exact family of :mod:`.dart_zeros`.
-"""
+"""The characteristic map of ``dart:K``, every K >= K0, as one family analytic in h = 1/K (trusted): x, y and their
+nets from the bordered Fourier systems (docs/tagged_c1.md, "Every dart K >= 101", item 6), h an acb ball or the
+series variable; :class:`Modes` is shared with the exact family of :mod:`.dart_zeros`."""
 
 from __future__ import annotations
 
 from contextlib import contextmanager
+from functools import cache
 
 from flint import acb, acb_mat, acb_poly, acb_series, arb, ctx, fmpq, fmpq_mat, fmpq_poly
 
 from .errors import CertificateError
 from .maps import STAR_CURVES, curve_points
-from .rules import CENTRE, canonical, level1_rule
-from .statement import B2Z, horner, lam_of
+from .rules import CENTRE, apply, canonical, level1_rule
+from .statement import B2Z, NET_OFFSETS, horner, lam_of
+from .statement import PATCHES as PIECES
 from .tagged_modes import RING_INDEX, bordered_matrix, bordered_solve, ring_block, ring_stencil
-
-_OFFSET = {"P1": (0, -1), "P2": (0, 0), "P3": (-1, 0)}  # as tagged_map: level-1 position of net[0][0]
-PIECES = ("P1", "P2", "P3")
 
 
 def kappa():
@@ -54,9 +50,9 @@ def u_denominator(lam, low):
     return (lam - fmpq(1, 8)) * (lam - fmpq(1, 16)) * (lam - fmpq(1, 32)) * (lam - fmpq(1, 64)) * (lam - low)
 
 
-def big_u(lam):
-    """U(lam) (6 values of lam's type) = adj(lam - B(1)) kappa / :func:`u_denominator`."""
-    den = u_denominator(lam, l0()[1])
+def big_u(lam, low):
+    """U(lam) = adj(lam - B(1)) kappa / :func:`u_denominator` (6 values of lam's type)."""
+    den = u_denominator(lam, low)
     return [horner(p, lam, lam * 0) / den for p in N_POLYS]
 
 
@@ -96,19 +92,13 @@ def bordered(w, lam, pivot=0):
     inv0 = Ak[0].inv()
     vs = [inv0 * acb_mat([[0]] * 6 + [[1]])]
     for m in range(1, n):
-        rhs = acb_mat(7, 1)
-        for j in range(1, m + 1):
-            rhs -= Ak[j] * vs[m - j]
-        vs.append(inv0 * rhs)
+        vs.append(inv0 * sum((-(Ak[j] * vs[m - j]) for j in range(1, m + 1)), acb_mat(7, 1)))
     return [acb_series([vs[m][i, 0] for m in range(n)], prec=n) for i in range(6)]
 
 
-def _swap(pos):
-    return pos if pos[1] == 0 else (pos[1], pos[0])
-
-
-def _eps(pos):
-    return 0 if pos[1] == 0 else 1
+def _mirror(d, pos):
+    """The image of ring point (d, pos) under the reflection in ray 0: (-d, pos) on a ray, (-d - 1, (b, a)) else."""
+    return (-d, pos) if pos[1] == 0 else (-d - 1, (pos[1], pos[0]))
 
 
 class Modes:
@@ -125,27 +115,31 @@ class Modes:
     def parts(self):
         """{X+, X-, Y0, Y+, Y-: (level0(delta, pos), centre, lam)}, level0 at sector K s + delta, position pos."""
         vx, vy, e, i2, z = self.vx, self.vy, self.e, self.i2, self.zero
+
+        def mode(v, c, d, p):  # v^(p) e^(i k d h), k = a or b
+            return v[RING_INDEX[p]] * e(c, d)
         return {
-            "X+": (lambda d, p: vx[RING_INDEX[p]] * e("x", d) / i2, z, self.lam1),
-            "X-": (lambda d, p: -(vx[RING_INDEX[_swap(p)]] * e("x", -d - _eps(p))) / i2, z, self.lam1),
+            "X+": (lambda d, p: mode(vx, "x", d, p) / i2, z, self.lam1),
+            "X-": (lambda d, p: -mode(vx, "x", *_mirror(d, p)) / i2, z, self.lam1),
             "Y0": (lambda d, p: self.alpha * self.U[RING_INDEX[p]], self.yc, self.lam2),
-            "Y+": (lambda d, p: vy[RING_INDEX[p]] * e("y", d) * self.sign / 2, z, self.lam2),
-            "Y-": (lambda d, p: vy[RING_INDEX[_swap(p)]] * e("y", -d - _eps(p)) * self.sign / 2, z, self.lam2),
+            "Y+": (lambda d, p: mode(vy, "y", d, p) * self.sign / 2, z, self.lam2),
+            "Y-": (lambda d, p: mode(vy, "y", *_mirror(d, p)) * self.sign / 2, z, self.lam2),
         }
 
-    def layer_level0(self, q=0):
+    def layer_level0(self):
         """(x(t, p), y(t, p)) at integer sectors t of any sign (y reflected in ray 0 for t < 0)."""
-        vx, vy, e = self.vx, self.vy, self.e
-
-        def x(t, pos):
-            return (vx[RING_INDEX[pos]] * e("x", t) - vx[RING_INDEX[_swap(pos)]] * e("x", -t - _eps(pos))) / self.i2
+        f = {name: part[0] for name, part in self.parts().items()}
 
         def y(t, pos):
             if t < 0:
-                t, pos = (-t, pos) if pos[1] == 0 else (-t - 1, _swap(pos))
-            return (self.alpha * self.U[RING_INDEX[pos]] + (vy[RING_INDEX[pos]] * e("y", t) * self.em
-                    + vy[RING_INDEX[_swap(pos)]] * e("y", -t - _eps(pos)) * self.ep) / 2)
-        return x, y
+                t, pos = _mirror(t, pos)
+            return f["Y0"](t, pos) + (f["Y+"](t, pos) * self.em + f["Y-"](t, pos) * self.ep) * self.sign
+        return (lambda t, pos: f["X+"](t, pos) + f["X-"](t, pos)), y
+
+    def layer_nets(self, q, coordinate):
+        """{piece: 4 x 4 Bezier net} of x (coordinate 0) or y (1) on layer quadrant q."""
+        return piece_nets(self.layer_level0()[coordinate], (self.zero, self.yc)[coordinate],
+                          (self.lam1, self.lam2)[coordinate], self.zero, q)
 
 
 class Family(Modes):
@@ -158,12 +152,11 @@ class Family(Modes):
         self.zero, self.i2 = h * 0, acb(0, 2)
         self.ix, self.iy = acb(0, 2) * pi, acb(0, 2) * sigma   # w_x = e^(ix h), w_y = e^(iy h)
         self.em, self.ep = (acb(0, -1) * sigma).exp(), (acb(0, 1) * sigma).exp()
-        self.lam1 = _lam_principal((h * (2 * pi)).cos())
-        self.vx = bordered((h * self.ix).exp(), self.lam1)
-        self.lam2 = _lam_principal((h * (2 * sigma)).cos())
-        self.vy = bordered((h * self.iy).exp(), self.lam2)
-        self.U = big_u(self.lam2)
-        self.mode0(sigma.cos(), l0()[0], flip_mode0)
+        self.lam1, self.lam2 = (_lam_principal((h * (2 * a)).cos()) for a in (pi, sigma))
+        self.vx, self.vy = bordered((h * self.ix).exp(), self.lam1), bordered((h * self.iy).exp(), self.lam2)
+        L0, low = l0()
+        self.U = big_u(self.lam2, low)
+        self.mode0(sigma.cos(), L0, flip_mode0)
         self.sign = 1
         if smooth:
             self.alpha, self.yc, self.sign = self.zero, self.zero, -1
@@ -180,10 +173,6 @@ def quadrant_level1(level0, centre, lam, zero, q=None):
     """``value(A, B)``, the level-1 value at (A, B) of a quadrant: lam times level 0 on the two-ring, the rule of
     :mod:`.rules` elsewhere; ``q`` None a bulk quadrant (``level0(delta, pos)``), else layer quadrant q
     (``level0(t, pos)``; as tagged_map: the ghost row across ray 0, the sharp midpoint at its (3, 0))."""
-    def lev0(d, a, b):
-        dd, a2, b2 = canonical(a, b)
-        return centre if (a2, b2) == CENTRE else level0(d + dd, (a2, b2))
-
     def value(A, B):
         if (A, B) == (0, 0):
             return lam * centre
@@ -195,10 +184,7 @@ def quadrant_level1(level0, centre, lam, zero, q=None):
             return lam * level0(t, (A2, B2))
         if q is not None and B2 == 0 and t == 0:
             return (level0(0, (1, 0)) + level0(0, (2, 0))) / 2
-        acc = zero
-        for (a, b), w in level1_rule(A2, B2).items():
-            acc = acc + lev0(t, a, b) * w
-        return acc
+        return apply(level1_rule(A2, B2), lambda dd, p: centre if p == CENTRE else level0(t + dd, p), zero)
     return value
 
 
@@ -211,20 +197,14 @@ def _bezier(net, zero):
 
 def piece_nets(level0, centre, lam, zero, q=None):
     """{piece: 4 x 4 Bezier net} of one coordinate or basis part (:func:`quadrant_level1`)."""
-    value, memo = quadrant_level1(level0, centre, lam, zero, q), {}
-
-    def V(A, B):  # the three pieces share most of their level-1 points
-        if (A, B) not in memo:
-            memo[(A, B)] = value(A, B)
-        return memo[(A, B)]
-    return {name: _bezier([[V(_OFFSET[name][0] + i, _OFFSET[name][1] + j) for j in range(4)] for i in range(4)], zero)
-            for name in PIECES}
+    V = cache(quadrant_level1(level0, centre, lam, zero, q))  # the three pieces share most level-1 points
+    return {name: _bezier([[V(NET_OFFSETS[name][0] + i, NET_OFFSETS[name][1] + j) for j in range(4)]
+                           for i in range(4)], zero) for name in PIECES}
 
 
 XB, YB = ("X+", "X-"), ("Y0", "Y+", "Y-")
 _SU, _SH = 6, 36  # Kronecker strides: a product of bicubic partials has degree <= 5 in u and in v
 _BIN = ((1,), (1, 1), (1, 2, 1), (1, 3, 3, 1), (1, 4, 6, 4, 1), (1, 5, 10, 10, 5, 1))  # C(d, i)
-_BIN2, _BIN3, _BIN5 = _BIN[2], _BIN[3], _BIN[5]
 
 
 def _packed(nets, axis, stride=_SH):
@@ -245,7 +225,7 @@ def _unpacked(P, n, stride, rows):
     """The h^m coefficients, m <= n, of a packed product of degree 5 (``rows`` 6: in u, v; 1: a curve)."""
     c = P.coeffs()
     c += [acb(0)] * max(0, stride * (n + 1) - len(c))
-    return [[c[m * stride + i * _SU + j] / (_BIN5[i] * _BIN5[j]) for i in range(rows) for j in range(6)]
+    return [[c[m * stride + i * _SU + j] / (_BIN[5][i] * _BIN[5][j]) for i in range(rows) for j in range(6)]
             for m in range(n + 1)]
 
 
@@ -269,30 +249,28 @@ def basis_nets(fam):
 
 def layer_nets(fam, q):
     """{piece: (X net, Y net)} (4 x 4 Bezier, values of fam.h's type) of layer quadrant q."""
-    x, y = fam.layer_level0(q)
-    X, Y = piece_nets(x, fam.zero, fam.lam1, fam.zero, q), piece_nets(y, fam.yc, fam.lam2, fam.zero, q)
+    X, Y = fam.layer_nets(q, 0), fam.layer_nets(q, 1)
     return {name: (X[name], Y[name]) for name in PIECES}
 
 
 def bezier_product(f, g):
     """Bernstein coefficients (degree 5) of f g' for cubic Bezier values f, g (any ring)."""
     gd = [3 * (g[i + 1] - g[i]) for i in range(3)]
-    out = []
-    for k in range(6):
-        acc = 0 * f[0]
-        for i in range(max(0, k - 2), min(3, k) + 1):
-            acc = acc + f[i] * gd[k - i] * fmpq(_BIN3[i] * _BIN2[k - i], _BIN5[k])
-        out.append(acc)
-    return out
+    return [sum((f[i] * gd[k - i] * fmpq(_BIN[3][i] * _BIN[2][k - i], _BIN[5][k])
+                 for i in range(max(0, k - 2), min(3, k) + 1)), 0 * f[0]) for k in range(6)]
+
+
+def coefficient_nets(zs, n, real=False):
+    """[the h^m Taylor coefficients (acb) of every entry of a list, or list of lists, of series or values, m <= n]."""
+    if not isinstance(zs, list):
+        return series_coeffs(zs, n + 1, real)
+    cols = [coefficient_nets(z, n, real) for z in zs]
+    return [[c[m] for c in cols] for m in range(n + 1)]
 
 
 def series_curves(nets, n, real=False):
     """{curve: [order m: 4 acb]} of one coordinate's nets {piece: 4 x 4 series or values}."""
-    out = {}
-    for name in STAR_CURVES:
-        pts = [series_coeffs(z, n + 1, real) for z in curve_points(nets, name, oriented=True)]
-        out[name] = [[pts[p][m] for p in range(4)] for m in range(n + 1)]
-    return out
+    return {name: coefficient_nets(curve_points(nets, name, oriented=True), n, real) for name in STAR_CURVES}
 
 
 def curve_trans_series(xc, yc, A1, A2, n):

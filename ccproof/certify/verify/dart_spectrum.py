@@ -1,13 +1,6 @@
-"""The spectrum and the eigenvectors of ``dart:K`` for every K >= K0 at once (trusted).
-
-The arguments are docs/tagged_c1.md, "Every dart K >= 101", items 3 and 7 (with "The spectral step" and "The
-eigenvector lemma" there). G: S is built alike for every K >= 7 (:func:`check_construction`); det(lam - S) =
-det(lam - S0)(1 - F) on the one-ring with the secular identities exact (:func:`check_secular`), mode 0's roots
-below the circle (:func:`check_mode0_roots`) and Re(1 - F) > 0 on the regions N, I, F (:class:`SpectralRegions`):
-only 1, lam1 and one even eigenvalue lie outside |lam| = lam(cos(2 sigma_r/K)). E: that one is lam(cos(2 sigma*/K))
-with sigma* in the bracket, and the family of :mod:`.dart_family` there (and x) are the eigenvectors
-(:func:`check_eigenvector`).
-"""
+"""The spectrum and the eigenvectors of ``dart:K`` for every K >= K0 at once (trusted): only 1, lam1 and one even
+eigenvalue lie outside |lam| = lam(cos(2 sigma_r/K)), and the family of :mod:`.dart_family` at sigma* is its
+eigenvector (docs/tagged_c1.md, "Every dart K >= 101", items 3 and 7: "The spectral step", "The eigenvector lemma")."""
 
 from __future__ import annotations
 
@@ -34,33 +27,49 @@ _X = fmpq_poly([0, 1])
 T_PI = fmpq(355, 113)  # > pi: region F's end (boxes beyond pi are harmless: the circle continues)
 W_DEN = 1024  # w1 = m/W_DEN, the least m with m^2 tau1 >= W_DEN^2
 W_POINTS = 33  # the remainders of check_crease_row: w^-16 times polynomials of degree <= 32 in w
+#: (a ray's row?, reading a ray?) -> the sectors delta it may read (the eigenvector lemma's windows)
+_REACH = {(True, True): (-1, 0, 1), (True, False): (-1, 0), (False, True): (0, 1), (False, False): (0,)}
 
 
 def _centre_ok(k):
-    pts, row = labels("dart", k), sector_rows("dart", k)[0]
-    want = {0: 1 - fmpq(7, 4 * k)}
-    for j, p in enumerate(pts):
-        if p[2:] == _E:
-            want[j] = fmpq(3, 2 * k * k)
-        elif p[0] == "q" and p[2:] == _F:
-            want[j] = fmpq(1, 4 * k * k)
-    return row == want
+    weight = {_E: fmpq(3, 2 * k * k), _F: fmpq(1, 4 * k * k)}  # per ray's (1,0), per quadrant's (1,1)
+    want = {0: 1 - fmpq(7, 4 * k)} | {j: weight[p[2:]] for j, p in enumerate(labels("dart", k)) if p[2:] in weight}
+    return sector_rows("dart", k)[0] == want
 
 
 @cache
 def check_construction():
-    """Raise unless S is built alike for every K >= 7; returns (d, bound): d = ray 0's sharp midpoint row minus
-    the smooth edge row, {("C",) or (kind, delta, position): weight}, and the outer even rows' bound.
+    """Raise unless S is built alike for every K >= 7 (docs/tagged_c1.md, "The spectral step" (1)); returns (d,
+    bound): d = ray 0's sharp midpoint row minus the smooth edge row, {("C",) or (kind, delta, position):
+    weight}, and the outer even rows' bound.
 
     >>> d, bound = check_construction()
     >>> d[("C",)], d[("r", 0, 1, 0)], d[("q", -1, 1, 1)], bound
     (1/8, 1/8, -1/16, 15/64)
     """
-    sharp = _check_rows()
-    bound = _outer_bound()
-    for pos in (_E, _F):  # the one-ring is closed in the ring stencil
-        if any(q not in (_E, _F) for _, q in ring_stencil()[RING_INDEX[pos]]):
-            raise CertificateError(f"the ring row of {pos} leaves the one-ring")
+    classes = [window_rows("dart", k) for k in WINDOW]
+    if classes[0] != classes[1]:
+        raise CertificateError(f"dart: the window classes of dart:{WINDOW[0]} and dart:{WINDOW[1]} differ")
+    if not all(_centre_ok(k) for k in range(7, 13)):
+        raise CertificateError("dart: the centre row is not (1 - 7h/4, 3h^2/2 per ray, h^2/4 per quadrant)")
+    if any(x < 0 for k in WINDOW for row in sector_rows("dart", k) for x in row.values()):
+        raise CertificateError("dart: a negative weight (the outer bound assumes none)")
+    bound = fmpq(0)
+    for k in WINDOW:  # check_dart checks the ring (check_ring) first
+        _, _, blocks, _, _, b = check_dart(k)
+        bound = max(bound, b)
+        if not all(abs(z) < _HALF for M in blocks for z, _ in charpoly_roots(M)):
+            raise CertificateError(f"dart:{k}: an odd block of the modes +-1 has an eigenvalue >= 1/2")
+    if bound > fmpq(15, 64):
+        raise CertificateError(f"dart: the outer even rows bound {bound} > 15/64")
+    return _sharp_difference(classes[0][("r", 0, 3) + _E]), bound
+
+
+def _sharp_difference(sharp):
+    """d = ``sharp`` minus the smooth edge row, raising unless the one-ring is closed in the ring stencil and d
+    reads the one-ring window only, invariant under the reflection in ray 0."""
+    if any(q not in (_E, _F) for pos in (_E, _F) for _, q in ring_stencil()[RING_INDEX[pos]]):
+        raise CertificateError("the ring rows of the one-ring leave it")
     smooth = {("r" if q[1] == 0 else "q", dlt) + q: x for (dlt, q), x in ring_stencil()[_E10].items()}
     smooth[_C] = kappa()[_E10]
     d = {key: sharp.get(key, 0) - smooth.get(key, 0) for key in set(sharp) | set(smooth)}
@@ -71,36 +80,7 @@ def check_construction():
         mirror = key if key == _C else (key[0], -key[1] if key[2:] == _E else -key[1] - 1) + key[2:]
         if d.get(mirror, 0) != d[key]:
             raise CertificateError("dart: d is not invariant under the reflection in ray 0")
-    return d, bound
-
-
-def _check_rows():
-    """Raise unless the window classes agree, the centre row is the rule's and no weight is negative; returns
-    the sharp midpoint row of ray 0."""
-    check_ring()
-    classes = [window_rows("dart", k) for k in WINDOW]
-    if classes[0] != classes[1]:
-        raise CertificateError(f"dart: the window classes of dart:{WINDOW[0]} and dart:{WINDOW[1]} differ")
-    if not all(_centre_ok(k) for k in range(7, 13)):
-        raise CertificateError("dart: the centre row is not (1 - 7h/4, 3h^2/2 per ray, h^2/4 per quadrant)")
-    if any(x < 0 for k in WINDOW for row in sector_rows("dart", k) for x in row.values()):
-        raise CertificateError("dart: a negative weight (the outer bound assumes none)")
-    return classes[0][("r", 0, 3) + _E]
-
-
-def _outer_bound():
-    """The outer even rows' bound over the window (raise over 15/64, or for an odd block of the modes +-1 with
-    an eigenvalue >= 1/2)."""
-    bound = fmpq(0)
-    for k in WINDOW:
-        _, _, blocks, _, _, b = check_dart(k)
-        bound = max(bound, b)
-        for M in blocks:
-            if not all(abs(z) < _HALF for z, _ in charpoly_roots(M)):
-                raise CertificateError(f"dart:{k}: an odd block of the modes +-1 has an eigenvalue >= 1/2")
-    if bound > fmpq(15, 64):
-        raise CertificateError(f"dart: the outer even rows bound {bound} > 15/64")
-    return bound
+    return d
 
 
 def _b1w(w, zero):
@@ -114,20 +94,15 @@ def _b1w(w, zero):
 
 def _dw(w, zero):
     """(d_C, w d_e(w), w d_f(w)): d in the mode w (d_e sums d's rays' weights times w^delta, d_f its quadrants')."""
-    d, _ = check_construction()
-    de, df = zero, zero
-    for key, x in d.items():
-        if key != _C:
-            t = x * w ** (key[1] + 1)
-            de, df = (de + t, df) if key[2:] == _E else (de, df + t)
+    d = check_construction()[0]
+    de, df = (sum((x * w ** (key[1] + 1) for key, x in d.items() if key[2:] == pos), zero) for pos in (_E, _F))
     return d.get(_C, fmpq(0)), de, df
 
 
 def b0(lam, h):
     """lam - B0(h), the mode-0 block on (C, E, F) (3 x 3 of lam's type)."""
     kap, B = kappa(), _b1w(fmpq(1), fmpq(0))  # B1(1)
-    rows = [[1 - fmpq(7, 4) * h, fmpq(3, 2) * h, _QUARTER * h], [kap[_E10], B[0][0], B[0][1]],
-            [kap[_E11], B[1][0], B[1][1]]]
+    rows = [[1 - fmpq(7, 4) * h, fmpq(3, 2) * h, _QUARTER * h], [kap[_E10], *B[0]], [kap[_E11], *B[1]]]
     return [[(lam if i == j else 0) - rows[i][j] for j in range(3)] for i in range(3)]
 
 
@@ -140,9 +115,8 @@ def mode0_parts(lam, h):
     """(num, det R): g0 = num/det(lam - B0) (Cramer's numerators of (lam - B0)^-1 (0, 1, 0) weighed by d's mode-0
     part) and det R, the h-coefficient of det(lam - B0) (only B0's first row depends on h, affinely)."""
     M = b0(lam, h)
-    num = 0 * lam
-    for c, wt in enumerate(_dw(fmpq(1), fmpq(0))):
-        num += wt * _det3([[(int(i == 1) if j == c else M[i][j]) for j in range(3)] for i in range(3)])
+    num = sum((wt * _det3([[(int(i == 1) if j == c else M[i][j]) for j in range(3)] for i in range(3)])
+               for c, wt in enumerate(_dw(fmpq(1), fmpq(0)))), 0 * lam)
     return num, _det3([[fmpq(7, 4), fmpq(-3, 2), -_QUARTER]] + b0(lam, 0)[1:])
 
 
@@ -192,9 +166,7 @@ def check_mode0_roots(sig_r, k0, balls):
     True
     """
     ell = _ell()
-    l0_, l1 = ell[0], ell[1]
-    sr = arb(sig_r)
-    least = None
+    l0_, l1, sr, least = ell[0], ell[1], arb(sig_r), None
     for i in range(balls):
         h = ball(fmpq(i, balls * k0), fmpq(i + 1, balls * k0))
         r = lam_of((2 * sr * h).cos())  # the circle's radius (2 sigma_r h < pi/2: check_ranges)
@@ -355,11 +327,7 @@ def check_reach():
     """
     for pos, row in zip(TWO_RING, ring_stencil()):
         for d, q in row:
-            if pos[1] == 0:
-                ok = -1 <= d <= 1 if q[1] == 0 else d in (-1, 0)
-            else:
-                ok = d in (0, 1) if q[1] == 0 else d == 0
-            if not ok:
+            if d not in _REACH[(pos[1] == 0, q[1] == 0)]:
                 raise CertificateError(f"the ring row of {pos} reads {q} of sector +{d}: "
                                        "beyond the windows of the lemma")
     return True
@@ -373,9 +341,8 @@ def check_mode0():
     """
     p, kap = B_AT_1.charpoly(), kappa()
     N = [fmpq_poly(c) for c in N_POLYS]
-    for i in range(6):
-        if _X * N[i] - sum((B_AT_1[i, k] * N[k] for k in range(6)), fmpq_poly(0)) != p * kap[i]:
-            raise CertificateError("U's numerator is not adj(x - B(1)) kappa: the mode-0 part misses its rows")
+    if any(_X * N[i] - sum((B_AT_1[i, k] * N[k] for k in range(6)), fmpq_poly(0)) != p * kap[i] for i in range(6)):
+        raise CertificateError("U's numerator is not adj(x - B(1)) kappa: the mode-0 part misses its rows")
     return True
 
 
@@ -400,9 +367,8 @@ def check_crease_row(points=W_POINTS):
     for w in range(1, points + 1):
         q = _X * _X - (5 + (fmpq(w) + fmpq(1, w)) / 2) / 8 * _X + fmpq(1, 16)
         adj = adjugate(fmpq_mat(ring_block(fmpq(w))))
-        for j in range(6):
-            if sum((psi[i] * adj[i][j] for i in range(6)), fmpq_poly(0)) % q != 0:
-                raise CertificateError(f"a1 b2 != a2 b1 at w = {w}: the crease vertex row of ray 0 fails")
+        if any(sum((psi[i] * adj[i][j] for i in range(6)), fmpq_poly(0)) % q != 0 for j in range(6)):
+            raise CertificateError(f"a1 b2 != a2 b1 at w = {w}: the crease vertex row of ray 0 fails")
     return True
 
 
@@ -425,8 +391,7 @@ def scaled_centre_residual(fam):
     _nonzero(lam - _HALF, "lam - 1/2")
     if not all(z.is_finite() for z in list(fam.U) + list(fam.vy) + list(fam.vx)):
         raise ZeroDivisionError("U or a bordered solution is not finite")
-    sh = h * sigma
-    sinc = sh.sinc()
+    sh, sinc = h * sigma, (h * sigma).sinc()
     _nonzero(sinc, "sinc(sigma h)")
     c = (2 * sh).cos()
     if not ((1 + c) * (9 + c)).real > 0:
@@ -447,16 +412,11 @@ def scaled_centre_residual(fam):
 def _guard(fam, tol):
     """Raise unless the Family computes the lemma's formula here: v^(1,0) = 1, y(C) = alpha (lam - L0), ray 0's
     two sharp rows and the ring rows of sector 1 (balls containing 0, radii below tol: identities)."""
-    lam, L0 = fam.lam2, l0()[0]
-    y, yc = fam.layer_level0(0)[1], fam.yc
-    kap = kappa()
-    res = [fam.vy[_E10] - 1, yc - fam.alpha * (lam - L0), (lam - _HALF) * y(0, _E) - yc / 2,
+    lam, y, yc, kap = fam.lam2, fam.layer_level0()[1], fam.yc, kappa()
+    res = [fam.vy[_E10] - 1, yc - fam.alpha * (lam - l0()[0]), (lam - _HALF) * y(0, _E) - yc / 2,
            (lam - fmpq(1, 8)) * y(0, (2, 0)) - fmpq(3, 4) * y(0, _E) - yc / 8]
-    for i, pos in enumerate(TWO_RING):
-        acc = kap[i] * yc - lam * y(1, pos)
-        for (d, q), x in ring_stencil()[i].items():
-            acc += x * y(1 + d, q)
-        res.append(acc)
+    res += [kap[i] * yc - lam * y(1, pos) + sum((x * y(1 + d, q) for (d, q), x in ring_stencil()[i].items()), 0 * yc)
+            for i, pos in enumerate(TWO_RING)]
     for k, z in enumerate(res):
         if not (z.contains(0) and abs(z) < tol):
             raise CertificateError(f"the family misses identity {k} of the eigenvector lemma "
@@ -475,13 +435,10 @@ def check_eigenvector(sig_lo, sig_hi, k0, prec, balls=64, family=Family):
     if k0 < 7 or balls < 1:
         raise CertificateError(f"eigenvector lemma: K0 = {k0} < 7 or no h-balls")
     with ctx.workprec(prec):
-        pi = arb.pi()
-        if not (arb(sig_lo) > pi and arb(sig_hi) < 2 * pi and sig_lo < sig_hi):
+        if not (arb(sig_lo) > arb.pi() and arb(sig_hi) < 2 * arb.pi() and sig_lo < sig_hi):
             raise CertificateError("eigenvector lemma: the bracket is not inside (pi, 2 pi)")
-        check_ring()
-        check_reach()
-        check_mode0()
-        check_crease_row()
+        for exact in (check_ring, check_reach, check_mode0, check_crease_row):
+            exact()
         box = ball(sig_lo, sig_hi)
         if not box.cos() < 0:
             raise CertificateError("eigenvector lemma: cos(sigma) is not certainly < 0 on the bracket (alpha != 0)")
@@ -500,8 +457,3 @@ def check_eigenvector(sig_lo, sig_hi, k0, prec, balls=64, family=Family):
         return (f"eigenvector lemma for every K >= {k0}: ring rows and ray 0's rows identically (exact: reach, "
                 f"mode 0, crease row at {W_POINTS} w), centre residual changes sign on ({sig_lo}, {sig_hi}) on "
                 f"{balls} h-balls, the family (x's and y's bordered systems, U, alpha) regular on the whole bracket")
-
-
-__all__ = ["SpectralRegions", "T_PI", "W_POINTS", "WINDOW", "b0", "check_construction", "check_crease_row",
-           "check_eigenvector", "check_mode0", "check_mode0_roots", "check_ranges", "check_reach", "check_secular",
-           "mode0_parts", "region_roots", "scaled_centre_residual", "w1_of"]

@@ -1,16 +1,14 @@
-"""Every ``dart:K``, K >= K0, in one "C1" certificate: the record, the models R, T, W and the steps (trusted).
-
-The grammar and the steps are docs/certificates.md, "Every dart K >= K0 in one certificate"; the argument is
-docs/tagged_c1.md, "Every dart K >= 101" (items 6 to 8). Step 1 (:func:`read_record`) reads every field and
-tree and prices the declared work (:func:`record_work`) before any arithmetic; then S, Z, G, E, M in order.
-R (det J_Phi), T (a1 X Y' - a2 Y X' on the outer curves) and W (signs of X, Y on the outer curves' points)
-live on the bulk (s, h), the middle (s, w = 1/q) and the layer quadrants q (h); the bulk and middle are
-sum_k c_k e^(i omega_k s) f_k(h) over the basis parts (:func:`omegas`), each f_k an analytic model in h.
-"""
+"""Every ``dart:K``, K >= K0, in one "C1" certificate (trusted): the record read and priced before any arithmetic,
+then the steps S, Z, G, E, M (docs/certificates.md, "Every dart K >= K0 in one certificate"; docs/tagged_c1.md,
+"Every dart K >= 101", items 6 to 8). R (det J_Phi), T (a1 X Y' - a2 Y X' on the outer curves) and W (signs of X,
+Y on their points) live on the bulk (s, h), the middle (s, w = 1/q) and the layer quadrants q (h); the bulk and
+middle are sum_k c_k e^(i omega_k s) f_k(h) over the basis parts (:func:`omegas`), each f_k an analytic model."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections import namedtuple
+from functools import reduce
+from itertools import product
 
 from flint import acb, acb_mat, acb_series, arb, ctx, fmpq
 
@@ -22,9 +20,9 @@ from .dart_family import (
     YB,
     Family,
     basis_nets,
+    coefficient_nets,
     curve_trans_series,
     det_series,
-    layer_nets,
     packed_partials,
     series_coeffs,
     series_curves,
@@ -36,7 +34,6 @@ from .dart_spectrum import (
     check_eigenvector,
     check_mode0_roots,
     check_ranges,
-    check_secular,
     region_roots,
 )
 from .dart_zeros import check_zeros
@@ -65,17 +62,9 @@ GRAMMAR = {
 QUANTITIES = {"R": (1, (1, 2), 3), "T": (1, (1, 2), 3), "X": (0, None, None), "Y": (0, (0, 1), 1)}
 
 
-@dataclass(frozen=True)
-class TaylorHints:
-    """The record's ``taylor`` hints: the Cauchy radius r (the h-square [-r, r]^2), its grid, the sigma boxes,
-    the Taylor orders in h (bulk and middle; layer) and the middle's order in s; they only choose."""
-
-    r: fmpq
-    disc_grid: int
-    sigma_boxes: int
-    order: int
-    layer_order: int
-    exp_order: int
+#: the record's ``taylor`` hints (they only choose): the Cauchy radius r (the h-square [-r, r]^2), its grid, the
+#: sigma boxes, the Taylor orders in h (bulk and middle; layer) and the middle's order in s
+TaylorHints = namedtuple("TaylorHints", "r disc_grid sigma_boxes order layer_order exp_order")
 
 
 def read_fields(obj, spec, where):
@@ -112,8 +101,8 @@ def read_fields(obj, spec, where):
 
 
 def read_record(cert, k0):
-    """Step 1: the record's fields (the spectrum's keys, prec, hints, layer; re and map as read trees), its work
-    checked (:func:`check_work`); CertificateError naming the field, before any arithmetic on forms."""
+    """Step 1: the record's fields (the spectrum's keys, prec, hints, layer; re and map as read trees), its leaves
+    and work (:func:`record_work`) within the budget; CertificateError naming the field, before any arithmetic."""
     if not MIN_K0 <= k0 <= 10**6:
         raise CertificateError(f"dart:>={k0}: the interval certificate needs {MIN_K0} <= K0 <= 10^6")
     if field_of(cert, "statement", str, "certificate") != "C1":
@@ -129,7 +118,13 @@ def read_record(cert, k0):
     rec = dict(sp, prec=g["prec"], hints=hints, layer=rg["layer"],
                re={n: read_tree(sp["re"][n], roots[n], f"spectrum re {n}", 1) for n in "NIF"})
     rec["map"] = read_map(g["parts"], k0, hints, rg["s0"], rg["layer"], tuple(rg["winding"]))
-    check_work(rec)
+    leaves = sum(len(t) for *_, trees in rec["map"] for t in trees) + sum(len(v) for v in rec["re"].values())
+    if leaves > MAX_BOXES:
+        raise CertificateError(f"more than {MAX_BOXES} leaves in all ({leaves})")
+    if (work := record_work(rec)) > MAX_WORK:
+        raise CertificateError(f"the record declares about {work // 10000} s of work ({work:,} units of 0.1 ms: "
+                               f"disc grid, sigma boxes, orders, leaves, prec), beyond the budget of "
+                               f"{MAX_WORK // 10000} s (docs/certificates.md, \"Bounds\")")
     return rec
 
 
@@ -155,24 +150,6 @@ def record_work(rec):
     return work * ((rec["prec"] + 127) // 128)
 
 
-def check_work(rec):
-    """Refuse a record whose declared work passes :data:`MAX_WORK`, or with more than MAX_BOXES leaves in all."""
-    leaves = sum(len(t) for _, _, _, trees in rec["map"] for t in trees) + sum(len(v) for v in rec["re"].values())
-    if leaves > MAX_BOXES:
-        raise CertificateError(f"more than {MAX_BOXES} leaves in all ({leaves})")
-    work = record_work(rec)
-    if work > MAX_WORK:
-        raise CertificateError(f"the record declares about {work // 10000} s of work ({work:,} units of 0.1 ms: "
-                               f"disc grid, sigma boxes, orders, leaves, prec), beyond the budget of "
-                               f"{MAX_WORK // 10000} s (docs/certificates.md, \"Bounds\")")
-
-
-def coefficient_nets(net, n, real=False):
-    """[the 4 x 4 net of the h^m Taylor coefficients (acb), m = 0..n] of a net of series or of values."""
-    cs = [[series_coeffs(z, n + 1, real) for z in row] for row in net]
-    return [[[c[m] for c in row] for row in cs] for m in range(n + 1)]
-
-
 def _log_coeffs(fam, n, real=False):
     """The Taylor coefficients of (a1, a2) = (-ln lam1, -ln lam2) (ZeroDivisionError near the branch cut)."""
     if isinstance(fam.lam1, acb) and not (acb(fam.lam1).real > 0 and acb(fam.lam2).real > 0):
@@ -185,26 +162,25 @@ def quantities(fam, n, layers=(), bulk=True):
     bulk ("R", i, j, piece) D(X_i, Y_j)'s 36 Bernstein coefficients, ("T", i, j, curve) a1 X_i Y_j' - a2 Y_j X_i''s
     6, ("X", i, curve), ("Y", j, curve) the 4 points; layer quadrant q ("R"/"T"/"Y", q, piece or curve)."""
     out = {}
+
+    def pair(key, part_x, part_y, curve_x, curve_y, A):
+        out.update({("R", *key, p): det_series(part_x[p], part_y[p], n) for p in PIECES})
+        out.update({("T", *key, c): curve_trans_series(curve_x[c], curve_y[c], *A, n) for c in STAR_CURVES})
     if bulk:
-        nets = basis_nets(fam)
-        parts = {(b, p): packed_partials(coefficient_nets(net, n)) for b, pn in nets.items() for p, net in pn.items()}
+        nets, A = basis_nets(fam), _log_coeffs(fam, n)
+        parts = {b: {p: packed_partials(coefficient_nets(net, n)) for p, net in pn.items()} for b, pn in nets.items()}
         curves = {b: series_curves(nets[b], n) for b in nets}
-        A = _log_coeffs(fam, n)
-        for i in XB:
-            for j in YB:
-                out.update({("R", i, j, p): det_series(parts[(i, p)], parts[(j, p)], n) for p in PIECES})
-                out.update({("T", i, j, c): curve_trans_series(curves[i][c], curves[j][c], *A, n)
-                            for c in STAR_CURVES})
+        for i, j in product(XB, YB):
+            pair((i, j), parts[i], parts[j], curves[i], curves[j], A)
         out.update({(t, b, c): curves[b][c] for t, bs in (("X", XB), ("Y", YB)) for b in bs for c in STAR_CURVES})
     real = isinstance(fam.h, acb_series)
     A = _log_coeffs(fam, n, real) if layers else None
     for q in layers:
-        ln = layer_nets(fam, q)
-        out.update({("R", q, p): det_series(coefficient_nets(X, n, real), coefficient_nets(Y, n, real), n)
-                    for p, (X, Y) in ln.items()})
-        xs, ys = (series_curves({p: ln[p][k] for p in PIECES}, n, real) for k in (0, 1))
-        out.update({("T", q, c): curve_trans_series(xs[c], ys[c], *A, n) for c in STAR_CURVES})
-        out.update({("Y", q, c): ys[c] for c in STAR_CURVES})
+        nets = [fam.layer_nets(q, k) for k in (0, 1)]  # x, y
+        (px, py), (cx, cy) = ([{p: coefficient_nets(N[p], n, real) for p in PIECES} for N in nets],
+                              [series_curves(N, n, real) for N in nets])
+        pair((q,), px, py, cx, cy, A)
+        out.update({("Y", q, c): cy[c] for c in STAR_CURVES})
     return out
 
 
@@ -236,8 +212,7 @@ def mode_factors(quantity, s, sigma):
 
 def bulk_box(models, quantity, s_lo, s_hi, h_lo, h_hi, sigma):
     """An arb holding Re sum_k c_k e^(i omega_k s) f_k(h)/h^low (every row of every model) on the (s, h) box."""
-    weights = mode_factors(quantity, ball(s_lo, s_hi), sigma)
-    low = QUANTITIES[quantity][0]
+    weights, low = mode_factors(quantity, ball(s_lo, s_hi), sigma), QUANTITIES[quantity][0]
     return hull(v for model in models.values() for v in model.real_part(weights, h_lo, h_hi, low=low))
 
 
@@ -343,16 +318,14 @@ class SigmaBox:
     def evaluate(self, quantity, region, box, q=None):
         """An arb holding the quantity's scaled values on a box (list of (lo, hi)) of its region: bulk K det J_Phi,
         K T, X, Y; middle K^3 det J_Phi/q^2, K^3 T/q^2, Y/s; layer K^3 det J_Phi, K^3 T, K Y (K^2 Y at ray 0's end)."""
-        mid = QUANTITIES[quantity][1]
         models = self.models[(quantity, q if region == "layer" else None)]
         with ctx.workprec(self.m.prec):
             if region == "layer":
                 return layer_box(models, quantity, q, *box[0])
-            (s_lo, s_hi), (t_lo, t_hi) = box
             if region == "middle":
-                return middle_box(models, self.E[quantity], self.om[quantity], s_lo, s_hi, t_lo, t_hi, *mid,
-                                  L=self.m.hints.exp_order)
-            return bulk_box(models, quantity, s_lo, s_hi, t_lo, t_hi, self.sigma)
+                return middle_box(models, self.E[quantity], self.om[quantity], *box[0], *box[1],
+                                  *QUANTITIES[quantity][1], L=self.m.hints.exp_order)
+            return bulk_box(models, quantity, *box[0], *box[1], self.sigma)
 
 
 def map_regions(k0, s0, layer, winding):
@@ -394,15 +367,10 @@ def read_map(parts, k0, hints, s0, layer, winding):
         raise CertificateError("regions: need 0 < s0 < s_a < s_b < 1/2, T >= 3, 1/K0 < r and s0/T < r")
     regions, spec = map_regions(k0, s0, layer, winding), {}
     for _, keys, *_ in regions:  # the grammar of parts: exactly the keys the regions name, a list at each end
-        node = spec
-        for key in keys[:-1]:
-            node = node.setdefault(key, {})
-        node[keys[-1]] = list
+        reduce(lambda node, key: node.setdefault(key, {}), keys[:-1], spec)[keys[-1]] = list
     parts, out = read_fields(parts, spec, "parts"), []
     for name, keys, root, method, sign, outside in regions:
-        trees = parts
-        for key in keys:
-            trees = trees[key]
+        trees = reduce(dict.__getitem__, keys, parts)
         if len(trees) != hints.sigma_boxes:
             raise CertificateError(f"{name}: one tree per sigma box ({hints.sigma_boxes}) is needed")
         out.append((name, method, sign, [read_tree(t, root, f"{name}, sigma box {i}", sign, k0=k0, outside=outside)
@@ -412,15 +380,14 @@ def read_map(parts, k0, hints, s0, layer, winding):
 
 def replay_map(lists, sig_lo, sig_hi, hints, layer, prec):
     """Step M: the lists of :func:`read_map` replayed sigma box by sigma box; {name: (leaves, least bound)}."""
-    models = DartModels(sig_lo, sig_hi, hints, layer, prec)
-    summary = {}
+    models, summary = DartModels(sig_lo, sig_hi, hints, layer, prec), {}
     for i in range(hints.sigma_boxes):
         box = models.sigma_box(i)
         for name, method, sign, leaves in lists:
             count, least = replay_tree(leaves[i], box.evaluator(method), sign, f"{name}, sigma box {i}")
-            old = summary.get(name, (0, None))
-            best = least if old[1] is None or (least is not None and abs(least) < abs(old[1])) else old[1]
-            summary[name] = (old[0] + count, best)
+            old, best = summary.get(name, (0, None))
+            summary[name] = (old + count, least if best is None or (least is not None and abs(least) < abs(best))
+                             else best)
     return summary
 
 
@@ -437,14 +404,13 @@ def verify_dart_tail(cert, k0, part, log):
     name, (lo, hi), sig_r = f"dart:>={k0}", rec["sigma"], rec["circle"]
     log(f"C1 certificate for {name} ({rec['prec']} bits)")
 
-    def spectrum():
-        check_secular()
+    def spectrum():  # SpectralRegions checks the secular identities first
         least0, reg = check_mode0_roots(sig_r, k0, rec["mode0_h"]), SpectralRegions(sig_r, k0)
         counts = {n: replay_tree(rec["re"][n], getattr(reg, n.lower()), 1, f"spectrum re {n}") for n in "NIF"}
         return (f"every K >= {k0}: 1, lam1 = lam(cos(2 pi/K)) and one even eigenvalue (lam2) outside |lam| = "
                 f"lam(cos(2 x {sig_r}/K)), each simple; secular identities exact; mode 0's roots real and below "
-                f"r on {rec['mode0_h']} h-balls (Q(r)/h >= {least0.str(3, radius=False)}); Re(1 - F) > 0: "
-                + ", ".join(f"{n} {c} leaves (>= {arb(b).str(3, radius=False)})" for n, (c, b) in counts.items()))
+                f"r on {rec['mode0_h']} h-balls (Q(r)/h >= {least0.str(3, radius=False)}); Re(1 - F) > 0 (leaves): "
+                + _show(counts))
 
     steps = [
         ("S sector matrices of every K >= 7 from one window",
@@ -470,7 +436,3 @@ def verify_dart_tail(cert, k0, part, log):
          "1 simple, lam1 > lam2 > |every other|, both simple; the reflection in ray 0 carries the quadrants "
          "q <= (K - 1)/2 to the rest (x odd, y even): Phi regular and injective, so dart:K is C1")
     return name
-
-
-__all__ = ["DartModels", "MAX_WORK", "MIN_K0", "TaylorHints", "check_work", "map_regions", "quantities",
-           "read_map", "read_record", "record_work", "replay_map", "verify_dart_tail"]

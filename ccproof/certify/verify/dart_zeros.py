@@ -1,13 +1,11 @@
-"""The Taylor coefficients the dart family's models drop, computed exactly and checked 0 (trusted).
-
-The rows (:data:`ROWS`), the degree argument (a grid of (a, b, c, t, l) suffices for every sigma) and the exact
-arithmetic (Q(sqrt 5, i)[h]/(h^3) as Q[x]/(m^3), m = x^4 - 8 x^2 + 36) are docs/tagged_c1.md, "Every dart
-K >= 101", item 6, "The dropped coefficients" and "Part Z in the trusted base".
-"""
+"""The Taylor coefficients the dart family's models drop, computed exactly and checked 0 (trusted): the rows, the
+degree argument (a grid of (a, b, c, t, l) suffices for every sigma) and the arithmetic (Q(sqrt 5, i)[h]/(h^3) as
+Q[x]/(m^3), m = x^4 - 8 x^2 + 36) are docs/tagged_c1.md, "Every dart K >= 101", item 6."""
 
 from __future__ import annotations
 
 import itertools
+from functools import cache
 
 from flint import fmpq, fmpq_mat, fmpq_poly
 
@@ -15,7 +13,6 @@ from . import dart_family as _df
 from .dart_family import PIECES, XB, YB
 from .errors import CertificateError
 from .maps import STAR_CURVES, curve_points
-from .statement import horner
 from .tagged_modes import RING_INDEX, bordered_matrix, ring_stencil
 
 GRID_AB = (1, 2, 3)  # degree <= 2 in a and in b
@@ -40,16 +37,11 @@ def _inv_raw(p):
     return s
 
 
-def _lift_theta():
-    th = _X
-    for _ in range(2):  # Newton: m(th) = 0 mod m^2, then mod m^4
-        th = (th - _MOD[1](th) * _inv_raw(_MOD[1].derivative()(th) % _M3)) % _M3
-    if not (_MOD[1](th) % _M3).is_zero() or not ((th - _X) % _MOD[1]).is_zero():
-        raise AssertionError("theta~ is not the root of m in Q[x]/(m^3) lifting x")
-    return th
-
-
-_TH = _lift_theta()
+_TH = _X  # theta~, the root of m in Q[x]/(m^3) lifting x (Newton: m(th) = 0 mod m^2, then mod m^4)
+for _ in range(2):
+    _TH = (_TH - _MOD[1](_TH) * _inv_raw(_MOD[1].derivative()(_TH) % _M3)) % _M3
+if not (_MOD[1](_TH) % _M3).is_zero() or not ((_TH - _X) % _MOD[1]).is_zero():
+    raise AssertionError("theta~ is not the root of m in Q[x]/(m^3) lifting x")
 
 
 def _raw(z):
@@ -125,15 +117,13 @@ if not ((I * I + 1).is_zero() and (SQRT20 * SQRT20 - 20).is_zero() and (H * H * 
     raise AssertionError("i, sqrt 5, h in Q[x]/(m^3)")
 L0 = (SQRT20 + 6) / 16  # lam(1), the root of 16 x^2 - 12 x + 1 with the + sign
 L0_LOW = (6 - SQRT20) / 16  # 1/(16 L0)
-_IH, _H2, _EXP = I * H, H * H, {}
+_IH, _H2 = I * H, H * H
 
 
+@cache
 def _exp_i(k):
     """e^(i k h) = 1 + i k h - k^2 h^2/2 (k an fmpq; memoized, QS is never changed in place)."""
-    k = fmpq(k)
-    if k not in _EXP:
-        _EXP[k] = ONE + _IH * k - _H2 * (k * k / 2)
-    return _EXP[k]
+    return ONE + _IH * k - _H2 * (k * k / 2)
 
 
 def _lam_series(k):
@@ -165,20 +155,14 @@ def solve(A, b):
     return [QS(fmpq_poly([v[12 * i + r, 0] for r in range(12)])) for i in range(n)]
 
 
-def _bordered(k, lam, stencil):
-    """v^ (6 QS): B(e^(i k h)) v^ = lam v^, v^(1,0) = 1 (the bordered 7 x 7 system A v = e_7)."""
-    B = [[QS(0) for _ in range(6)] for _ in range(6)]
+def _mode(k, stencil):
+    """(lam(cos(k h)), v^, U(lam)) for one angle unit k: B(e^(i k h)) v^ = lam v^, v^(1,0) = 1 (bordered)."""
+    lam, B = _lam_series(k), [[QS(0)] * 6 for _ in range(6)]
     for i, row in enumerate(stencil):
         for (d, pos), x in row.items():
-            B[i][RING_INDEX[pos]] = B[i][RING_INDEX[pos]] + _exp_i(fmpq(k) * d) * fmpq(x)
-    return solve(bordered_matrix(B, lam, QS(0), 0), [QS(0)] * 6 + [QS(1)])[:6]
-
-
-def _mode(k, stencil):
-    """(lam(cos(k h)), v^, U(lam)) for one angle unit k."""
-    lam = _lam_series(k)
-    den = _df.u_denominator(lam, L0_LOW)
-    return lam, _bordered(k, lam, stencil), [horner(p, lam, QS(0)) / den for p in _df.N_POLYS]
+            B[i][RING_INDEX[pos]] += _exp_i(fmpq(k) * d) * fmpq(x)
+    v = solve(bordered_matrix(B, lam, QS(0), 0), [QS(0)] * 6 + [ONE])[:6]
+    return lam, v, _df.big_u(lam, L0_LOW)
 
 
 class ExactFamily(_df.Modes):
@@ -194,19 +178,13 @@ class ExactFamily(_df.Modes):
         stencil = ring_stencil() if stencil is None else stencil
         self.a, self.b, self.c, self.t = fmpq(a), fmpq(b), fmpq(c), fmpq(t)
         (self.lam1, self.vx, _), (self.lam2, self.vy, self.U) = _modes or (_mode(a, stencil), _mode(b, stencil))
-        self.zero = QS(0)
         self.mode0(self.c, L0, flip_alpha)
         self.em, self.ep = QS(self.c) - I * self.t, QS(self.c) + I * self.t  # e^(-i sigma), e^(i sigma)
-        self.i2, self.sign = I * 2, 1
+        self.zero, self.i2, self.sign = QS(0), I * 2, 1
 
     def e(self, c, k):
         """e^(i k a h) (c = "x") or e^(i k b h) (c = "y"), exact."""
         return _exp_i((self.a if c == "x" else self.b) * k)
-
-    def layer_nets(self, q, coordinate):
-        """{piece: 4 x 4 Bezier net} of x (coordinate 0) or y (1) on layer quadrant q."""
-        return _df.piece_nets(self.layer_level0(q)[coordinate], (self.zero, self.yc)[coordinate],
-                              (self.lam1, self.lam2)[coordinate], self.zero, q)
 
 
 # --- det J as a polynomial in the patch parameters (u, v), on the 6 x 6 grid; raw fmpq_poly below -------
@@ -221,17 +199,12 @@ _COEF = "the 6 Bernstein coefficients per l"
 
 
 def _lin(ps, ws):
-    acc = fmpq_poly([0])
-    for p, w in zip(ps, ws):
-        if w != 0:
-            acc += p * w
-    return acc
+    return sum((p * w for p, w in zip(ps, ws) if w != 0), fmpq_poly([0]))
 
 
 def _partials(net):
     """[(X_u, X_v) at each (u, v) of the grid] (raw) of a 4 x 4 Bezier net of QS (tensor-product sums)."""
-    P = [[net[i][j].p for j in range(4)] for i in range(4)]
-    cols = [[P[i][j] for i in range(4)] for j in range(4)]
+    cols = [[net[i][j].p for i in range(4)] for j in range(4)]
     bu = [[_lin(cols[j], _BERN[u]) for j in range(4)] for u in range(6)]
     du = [[_lin(cols[j], _DBERN[u]) for j in range(4)] for u in range(6)]
     return [(_lin(du[u], _BERN[v]), _lin(bu[u], _DBERN[v])) for u in range(6) for v in range(6)]
@@ -242,22 +215,24 @@ def _det(px, py):
     return [(xu * yv - xv * yu) % _M3 for (xu, xv), (yu, yv) in zip(px, py)]
 
 
-class _Tally:
+class _Tally(dict):
     """{row: [checked, non-zero]}; with ``stop`` the first non-zero coefficient raises CertificateError."""
 
     def __init__(self, stop):
-        self.rows = {row: [0, 0] for row in ROWS}
+        super().__init__((row, [0, 0]) for row in ROWS)
         self.stop = stop
 
-    def add(self, row, items, where, kind):
-        """items: [(raw element, the h-orders that must be 0)] at ``where``, numbered as ``kind``."""
-        for k, (p, orders) in enumerate(items):
-            self.rows[row][0] += len(orders)
-            if (p % _MOD[max(orders) + 1]).is_zero():
+    def add(self, row, items, where, kind, orders=None):
+        """items: raw elements whose h-orders ``orders`` must be 0 (None: (element, orders) pairs) at ``where``,
+        numbered as ``kind``."""
+        for k, item in enumerate(items):
+            p, ords = item if orders is None else (item, orders)
+            self[row][0] += len(ords)
+            if (p % _MOD[max(ords) + 1]).is_zero():
                 continue
             cs = _h_coeffs(p % _M3)
-            bad = [m for m in orders if not cs[m].is_zero()]
-            self.rows[row][1] += len(bad)
+            bad = [m for m in ords if not cs[m].is_zero()]
+            self[row][1] += len(bad)
             if bad and self.stop:
                 raise CertificateError(f"dropped coefficient not 0: row '{row}', h^{bad[0]} coefficient "
                                        f"at {where}, item {k} of {kind}")
@@ -279,90 +254,68 @@ def _middle(G, fam):
     = h^1 of S' = sum c_ij i omega_ij G_ij (a_i b_j = c_ij e^(i omega_ij s)); (S, (1, 2)), (S', (1,)) per place."""
     cj = {"Y0": (ONE, 0), "Y+": (fam.em, fam.b), "Y-": (fam.ep, -fam.b)}
     om = {"X+": fam.a, "X-": -fam.a}
-    f0 = {ij: cj[ij[1]][0].p for ij in G}
-    f1 = {ij: (cj[ij[1]][0] * I * (om[ij[0]] + cj[ij[1]][1])).p for ij in G}
-    items = []
-    for k in range(len(next(iter(G.values())))):
-        s = s1 = fmpq_poly([0])
-        for ij, vals in G.items():
-            s += f0[ij] * vals[k]
-            s1 += f1[ij] * vals[k]
-        items += [(s, (1, 2)), (s1, (1,))]
-    return items
+    f = {(i, j): (cj[j][0].p, (cj[j][0] * I * (om[i] + cj[j][1])).p) for i, j in G}  # the weights of S and S'
+    return [(sum((f[ij][d] * vals[k] for ij, vals in G.items()), fmpq_poly([0])), ((1, 2), (1,))[d])
+            for k in range(len(next(iter(G.values())))) for d in (0, 1)]
 
 
-def _nets(cache, key, make):
+def _nets(memo, key, make):
     """(nets, their partials) {piece: ...} under ``key``, made once."""
-    if key not in cache:
+    if key not in memo:
         n = make()
-        cache[key] = (n, {p: _partials(n[p]) for p in PIECES})
-    return cache[key]
+        memo[key] = (n, {p: _partials(n[p]) for p in PIECES})
+    return memo[key]
 
 
-def _check_point(fam, ells, tally, cache):
-    """Add every dropped coefficient at the grid point of ``fam`` (and l in ``ells``) to ``tally``."""
-    a, b, c, t = fam.a, fam.b, fam.c, fam.t
-    pt = f"(a, b, c, t) = ({a}, {b}, {c}, {t})"
-    keys = {"X+": ("X+", a), "X-": ("X-", a), "Y0": ("Y0", b, c), "Y+": ("Y+", b), "Y-": ("Y-", b)}
+def _check_bulk(fam, A, tally, memo, pt):
+    """The bulk's D_ij and T_ij at h^0, the middle's e_10, e_11, e_20 of K det J_Phi per piece and of
+    K (a1 X Y' - a2 Y X') per outer curve, and Y at s = h = 0."""
+    keys = {n: (n, fam.a) for n in XB} | {"Y0": ("Y0", fam.b, fam.c), "Y+": ("Y+", fam.b), "Y-": ("Y-", fam.b)}
     nets, part = {}, {}
     for name, key in keys.items():  # X's nets depend on a only, Y+-'s on b, Y0's on (b, c)
-        nets[name], part[name] = _nets(cache, key, lambda name=name: _df.piece_nets(*fam.parts()[name], fam.zero))
-    A = [((-_log_ratio(fam.lam1) - ell).p, (-_log_ratio(fam.lam2) - ell).p) for ell in ells]  # -l - ln(lam_i/L0)
-    _check_pieces(fam, part, tally, pt)
-    _check_curves(fam, nets, keys, A, tally, cache, pt)
-    _check_layers(fam, A, tally, cache, pt)
-    return tally
-
-
-def _check_pieces(fam, part, tally, pt):
-    """The bulk's D_ij at h^0 and the middle's e_10, e_11, e_20 of K det J_Phi, per piece."""
+        nets[name], part[name] = _nets(memo, key, lambda name=name: _df.piece_nets(*fam.parts()[name], fam.zero))
     for piece in PIECES:
         G = {(i, j): _det(part[i][piece], part[j][piece]) for i in XB for j in YB}
         for (i, j), vals in G.items():
-            tally.add(ROWS[0], [(v, (0,)) for v in vals], f"{pt}, {piece}, D({i}, {j})", _UV)
+            tally.add(ROWS[0], vals, f"{pt}, {piece}, D({i}, {j})", _UV, (0,))
         tally.add(ROWS[1], _middle(G, fam), f"{pt}, {piece}", _MID)
-
-
-def _check_curves(fam, nets, keys, A, tally, cache, pt):
-    """The bulk's T_ij at h^0, the middle's of K (a1 X Y' - a2 Y X') and Y at s = h = 0, per outer curve."""
     for curve in STAR_CURVES:
-        pts = {n: curve_points(nets[n], curve, oriented=True) for n in nets}
+        pts, G = {n: curve_points(nets[n], curve, oriented=True) for n in nets}, {}
         for i, j in itertools.product(XB, YB):  # X Y', Y X' depend on (a, b) or (a, b, c) only
-            if (keys[i], keys[j], curve) not in cache:
-                cache[(keys[i], keys[j], curve)] = _xy(pts[i], pts[j])
-        G = {(i, j): _trans(cache[(keys[i], keys[j], curve)], A) for i in XB for j in YB}
-        for (i, j), vals in G.items():
-            tally.add(ROWS[2], [(v, (0,)) for v in vals], f"{pt}, {curve}, T({i}, {j})", _COEF)
+            if (keys[i], keys[j], curve) not in memo:
+                memo[(keys[i], keys[j], curve)] = _xy(pts[i], pts[j])
+            G[(i, j)] = _trans(memo[(keys[i], keys[j], curve)], A)
+            tally.add(ROWS[2], G[(i, j)], f"{pt}, {curve}, T({i}, {j})", _COEF, (0,))
         tally.add(ROWS[3], _middle(G, fam), f"{pt}, {curve}", "(S, S') alternating per " + _COEF)
-        tally.add(ROWS[4], [((pts["Y0"][p] + pts["Y+"][p] * fam.em + pts["Y-"][p] * fam.ep).p, (0,)) for p in range(4)],
-                  f"{pt}, {curve}", "the 4 Bezier points")
+        tally.add(ROWS[4], [(pts["Y0"][p] + pts["Y+"][p] * fam.em + pts["Y-"][p] * fam.ep).p for p in range(4)],
+                  f"{pt}, {curve}", "the 4 Bezier points", (0,))
 
 
-def _check_layers(fam, A, tally, cache, pt):
+def _check_layers(fam, A, tally, memo, pt):
     """On the layer quadrants q = 0, 1, 2: det J_Phi, the transversality and Y's curve points (h^0 .. h^2)."""
     for q in range(3):
-        xn, xp = _nets(cache, ("LX", fam.a, q), lambda q=q: fam.layer_nets(q, 0))
-        yn, yp = _nets(cache, ("LY", fam.b, fam.c, fam.t, q), lambda q=q: fam.layer_nets(q, 1))  # y: (b, c, t)
+        xn, xp = _nets(memo, ("LX", fam.a, q), lambda q=q: fam.layer_nets(q, 0))
+        yn, yp = _nets(memo, ("LY", fam.b, fam.c, fam.t, q), lambda q=q: fam.layer_nets(q, 1))  # y: (b, c, t)
         for piece in PIECES:
-            tally.add(ROWS[5], [(v, (0, 1, 2)) for v in _det(xp[piece], yp[piece])], f"{pt}, q = {q}, {piece}", _UV)
+            tally.add(ROWS[5], _det(xp[piece], yp[piece]), f"{pt}, q = {q}, {piece}", _UV, (0, 1, 2))
         for curve in STAR_CURVES:
             xs, ys = curve_points(xn, curve, oriented=True), curve_points(yn, curve, oriented=True)
-            tally.add(ROWS[6], [(v, (0, 1, 2)) for v in _trans(_xy(xs, ys), A)],
-                      f"{pt}, q = {q}, {curve}", _COEF)
+            tally.add(ROWS[6], _trans(_xy(xs, ys), A), f"{pt}, q = {q}, {curve}", _COEF, (0, 1, 2))
             end = q == 0 and curve == "P1s1"  # ray 0's end point: h^1 too
             tally.add(ROWS[7], [(y.p, (0, 1) if end and k == 0 else (0,)) for k, y in enumerate(ys)],
                       f"{pt}, q = {q}, {curve}", "the 4 Bezier points")
 
 
 def _run(points, ells, stencil, flip_alpha, stop):
+    """Every dropped coefficient at the points (a, b, c, t) and l in ``ells``, into a :class:`_Tally`."""
     stencil = ring_stencil() if stencil is None else stencil
-    tally, modes, cache = _Tally(stop), {}, {}
+    tally, memo, mode = _Tally(stop), {}, cache(lambda k: _mode(k, stencil))
     for a, b, c, t in points:
-        for k in (a, b):
-            if k not in modes:
-                modes[k] = _mode(k, stencil)
-        fam = ExactFamily(a, b, c, t, stencil, flip_alpha, _modes=(modes[a], modes[b]))
-        _check_point(fam, ells, tally, cache)
+        fam = ExactFamily(a, b, c, t, stencil, flip_alpha, _modes=(mode(a), mode(b)))
+        A = [((-_log_ratio(fam.lam1) - ell).p, (-_log_ratio(fam.lam2) - ell).p) for ell in ells]  # -l - ln(lam/L0)
+        pt = f"(a, b, c, t) = ({fam.a}, {fam.b}, {fam.c}, {fam.t})"
+        _check_bulk(fam, A, tally, memo, pt)
+        _check_layers(fam, A, tally, memo, pt)
     return tally
 
 
@@ -377,7 +330,7 @@ def count_zeros(points=GRID, ells=GRID_CT, stencil=None, flip_alpha=False):
     >>> res["bulk det: D_ij h^0"], sum(n for n, _ in res.values()), sum(bad for _, bad in res.values())
     ((648, 0), 2873, 0)
     """
-    return {row: tuple(v) for row, v in _run(points, ells, stencil, flip_alpha, stop=False).rows.items()}
+    return {row: tuple(v) for row, v in _run(points, ells, stencil, flip_alpha, stop=False).items()}
 
 
 def check_zeros(*, _stencil=None, _flip_alpha=False) -> str:
@@ -387,7 +340,7 @@ def check_zeros(*, _stencil=None, _flip_alpha=False) -> str:
     >>> print(check_zeros())
     dropped coefficients exactly 0 on the grid a, b in (1, 2, 3), c, t, l in (1, 2): ... 103428 in all
     """
-    rows = _run(GRID, GRID_CT, _stencil, _flip_alpha, stop=True).rows
+    rows = _run(GRID, GRID_CT, _stencil, _flip_alpha, stop=True)
     if not all(n > 0 for n, _ in rows.values()):
         raise CertificateError("a row of dropped coefficients checked nothing")
     return (f"dropped coefficients exactly 0 on the grid a, b in {GRID_AB}, c, t, l in {GRID_CT}: "
