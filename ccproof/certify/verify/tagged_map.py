@@ -1,6 +1,5 @@
 """The characteristic map Phi = (X, Y) of a tagged sector and the checks R, T, W, E of a "C1" certificate (trusted;
-docs/tagged_c1.md, "C1": the pieces P1, P2, P3 of quadrant q are B-spline patches of the level-1 net, with the
-ghost row 2 P(a, 0) - P(a, 1) across a sharp ray).
+docs/tagged_c1.md, "C1").
 """
 
 from __future__ import annotations
@@ -155,19 +154,18 @@ def _box_crossings(fa, fp):
 
 
 def _rays_on_axes(fam, n, vx, vy):
-    """(ok, message): E, the sharp rays' layer-0 segments lie on the half-axes: the limit curve of a sharp ray's
-    segment is the cubic B-spline of its level-1 values at 0..3 (X = 0 when they are exactly 0; Y's sign from the
-    Bezier points)."""
+    """(ok, message): E, the sharp rays' layer-0 segments lie on the half-axes: a segment's limit curve is the cubic
+    B-spline of its level-1 values at 0..3 (a coordinate 0 when they are exactly 0; the other's sign from the Bezier
+    points). Crease: X = 0, Y < 0 on ray 0; corner: Y = 0, X > 0; both: X = 0, Y > 0 on ray N."""
     X, Y = level1_values(fam, n, vx), level1_values(fam, n, vy)
-    x0, y0 = [X(0, a, 0) for a in range(4)], [Y(0, a, 0) for a in range(4)]
-    xn, yn = [X(n - 1, 0, b) for b in range(4)], [Y(n - 1, 0, b) for b in range(4)]
-    if fam == "crease":
-        ok = all_zero(x0 + xn) and _sign(_bez(y0)) < 0 and _sign(_bez(yn)) > 0
-        return ok, "X = 0 on both sharp rays, Y < 0 on ray 0 and Y > 0 on ray N" if ok else \
-            "the sharp rays are not mapped onto the negative and positive Y half-axes"
-    ok = all_zero(y0) and _sign(_bez(x0)) > 0 and all_zero(xn) and _sign(_bez(yn)) > 0
-    return ok, "ray 0 onto the positive X half-axis, ray N onto the positive Y half-axis" if ok else \
-        "the sharp rays are not mapped onto the positive half-axes"
+    ray0 = [X(0, a, 0) for a in range(4)], [Y(0, a, 0) for a in range(4)]
+    zero, signed, sign = (ray0[0], ray0[1], -1) if fam == "crease" else (ray0[1], ray0[0], 1)
+    ok = all_zero(zero + [X(n - 1, 0, b) for b in range(4)]) and _sign(_bez(signed)) == sign and _sign(
+        _bez([Y(n - 1, 0, b) for b in range(4)])) > 0
+    return ok, ("X = 0 on both sharp rays, Y < 0 on ray 0 and Y > 0 on ray N" if fam == "crease" else
+                "ray 0 onto the positive X half-axis, ray N onto the positive Y half-axis") if ok else \
+        f"the sharp rays are not mapped onto the {'negative and positive Y' if fam == 'crease' else 'positive'} " \
+        "half-axes"
 
 
 def all_zero(vals):
