@@ -271,7 +271,7 @@ def eigenvector_of(fam, n, spec, c, prec, chain=False):
     if not isinstance(spec["eigenvalue"], str):  # an irrational eigenvalue, [low, high]
         return _ball_eigenvector(fam, n, spec, c, cp, cval, prec)
     lam = parse_decimal(spec["eigenvalue"])
-    A = S - lam * fmpq_mat([[int(i == j) for j in range(S.nrows())] for i in range(S.nrows())])
+    A = S - lam * tg.identity(S.nrows())
     if "pivot" in spec:  # one more fixed coordinate: 1 at the pivot
         cp, cval = cp + [_pivot(spec, c, S.nrows(), cp)], cval + [fmpq(1)]
     vec = _solve_exact(A, cp, cval)
@@ -464,16 +464,19 @@ def _ordering(fam, n, vals, prec, generalized):
     ev = tg.eigenvalues(fam, n, prec)  # each root once per unit of algebraic multiplicity
     ia, ib = _pair(ev, a, b)
     beta = None if ib is None else abs(ev[ib][0])
-    defective = [t for t in ev if t[3] < t[2] and not abs(t[0]) < beta] if beta is not None else []
     why = _one_simple(ev) or (
         "alpha is not an eigenvalue" if ia is None else "beta is not an eigenvalue (distinct from alpha's copy)"
         if ib is None else "alpha >= beta is not certain" if not (abs(ev[ia][0]) >= beta or ev[ia][1] == ev[ib][1])
         else _below(ev, (ia, ib), (beta,), "below beta (lam1, lam2 not alpha, beta)", b) or
-        crease_top_why(tg.crease_block(fam, n), g) or
-        (f"a Jordan block at |lam| >= beta: {defective[0][1]} (algebraic multiplicity {defective[0][2]}, geometric "
-         f"{defective[0][3]})" if defective else None) or
+        crease_top_why(tg.crease_block(fam, n), g) or _jordan_at(ev, beta) or
         ("z is a generalized eigenvector but gamma < beta is not certain" if generalized and not arb(g) < beta
          else None))
     show = [str(v) if isinstance(v, fmpq) else v.str(8) for v in (a, b)] + [" (Jordan chain)" if generalized else ""]
     return why is None, why or f"alpha = {show[0]}, beta = {show[1]}, gamma = {g}{show[2]}; 1 simple; no Jordan " \
         "block at |lam| >= beta"
+
+
+def _jordan_at(ev, beta):  # the reason if an eigenvalue of modulus possibly >= beta is defective
+    bad = [t for t in ev if t[3] < t[2] and not abs(t[0]) < beta]
+    return (f"a Jordan block at |lam| >= beta: {bad[0][1]} (algebraic multiplicity {bad[0][2]}, geometric {bad[0][3]})"
+            if bad else None)

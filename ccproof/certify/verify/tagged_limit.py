@@ -145,24 +145,29 @@ def _uniform_spectrum(fam, n0, g, C, blocks):
         b0 = lam_of(arb(fmpq(2, n0)).cos_pi())  # <= beta = lam(cos(2 pi/N)) for every N >= n0
         others = [arb(abs(r)) for r in below] + [abs(z) for M in blocks for z, _ in charpoly_roots(M)] + [
             arb(s) for s in SMALL_ROOTS] + [arb(fmpq(1, 4))]
-        cstar = lambda x: 8 * x + 1 / (2 * fmpq(x)) - 5  # a rational x != 0 is a root of q_c only at c = c*(x)
-        cg = cstar(g) if g != 0 else None
-        why = next((why for bad, why in (
-            (lambda: croots.count(1) != 1 or len(below) != 4, "eigenvalue 1 is not simple in the crease block"),
-            (lambda: -1 <= cstar(1) <= 1 or any(M.charpoly()(1) == 0 for M in blocks),
-             "1 is an eigenvalue of the modes"),
-            (lambda: not lam_of(arb(1)) < 1, "lam(1) < 1 is not certain"),
-            (lambda: not all(x < b0 for x in others),
-             f"an eigenvalue other than alpha, beta is not certainly below lam(cos(2 pi/{n0}))"),
-            (lambda: not arb(g) < b0, f"gamma < lam(cos(2 pi/{n0})) is not certain"),
-            (lambda: g in SMALL_ROOTS or cg is None or (1 + cg) * (9 + cg) == 0 or any(M.charpoly()(g) == 0
-                                                                                        for M in blocks),
-             "gamma is possibly a multiple eigenvalue of I")) if bad()), None)
+        why, cg = _gap(croots, below, blocks, others, g, b0, n0)
     if why is not None:
         return False, f"every N >= {n0}: {why}"
     return True, (f"every N >= {n0}: alpha = lam(cos(pi/N)) > beta = lam(cos(2 pi/N)) >= {b0.str(6, radius=False)} > "
                   f"every other eigenvalue (<= {max(others, key=lambda x: x.mid()).str(4)}, each simple), 1 simple "
                   f"(crease block); gamma = {g} < beta, at most simple in I (only at c = {cg})")
+
+
+def _gap(croots, below, blocks, others, g, b0, n0):
+    """(the first reason 1 is not simple, alpha and beta do not lead, or gamma = g is not simple in I and below
+    beta, or None; c*(g))."""
+    cstar = lambda x: 8 * x + 1 / (2 * fmpq(x)) - 5  # a rational x != 0 is a root of q_c only at c = c*(x)
+    cg = cstar(g) if g != 0 else None
+    return next((why for bad, why in (
+        (lambda: croots.count(1) != 1 or len(below) != 4, "eigenvalue 1 is not simple in the crease block"),
+        (lambda: -1 <= cstar(1) <= 1 or any(M.charpoly()(1) == 0 for M in blocks), "1 is an eigenvalue of the modes"),
+        (lambda: not lam_of(arb(1)) < 1, "lam(1) < 1 is not certain"),
+        (lambda: not all(x < b0 for x in others),
+         f"an eigenvalue other than alpha, beta is not certainly below lam(cos(2 pi/{n0}))"),
+        (lambda: not arb(g) < b0, f"gamma < lam(cos(2 pi/{n0})) is not certain"),
+        (lambda: g in SMALL_ROOTS or cg is None or (1 + cg) * (9 + cg) == 0 or any(M.charpoly()(g) == 0
+                                                                                    for M in blocks),
+         "gamma is possibly a multiple eigenvalue of I")) if bad()), None), cg
 
 
 def verify_tail(cert, fam, n0, part, log):

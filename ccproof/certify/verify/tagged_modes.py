@@ -13,7 +13,7 @@ from .errors import CertificateError
 from .rules import TWO_RING
 from .spectrum import RING_INDEX, SMALL_ROOTS, mode_polynomials_hold, ring_block, ring_stencil
 from .statement import lam_of
-from .tagged import crease_block, crease_points, labels, sector_rows
+from .tagged import crease_block, crease_points, identity, labels, sector_rows
 
 MIN_N = 5  # crease:N, corner:N and dart:K with N, K >= MIN_N take the modes
 
@@ -89,8 +89,7 @@ def _odd_blocks(ends):
     has any, checked invariant (exact)."""
     out = []
     for w in ends:
-        cols = list(kernel_basis(fmpq_mat(mode_reflection(fmpq(w))) + fmpq_mat(
-            [[int(i == j) for j in range(6)] for i in range(6)])).values())
+        cols = list(kernel_basis(fmpq_mat(mode_reflection(fmpq(w))) + identity(6)).values())
         if cols:
             K, B = fmpq_mat([[v[i] for v in cols] for i in range(6)]), fmpq_mat(ring_block(fmpq(w)))
             out.append((K.transpose() * K).inv() * K.transpose() * B * K)
@@ -275,12 +274,15 @@ def check_dart(k):
     if 6 * ((k + 1) // 2 - 1) + sum(M.nrows() for M in blocks) != len(pts) - len(reps):
         raise CertificateError(f"dart:{k}: the modes do not account for every odd vector")
     inner = tuple(a for a, i in enumerate(reps) if pts[i] == ("C",) or pts[i][2:] in ((1, 0), (1, 1)))
+    return (SE, tuple(rep), blocks) + _one_ring(k, SE, inner)
+
+
+def _one_ring(k, SE, inner):  # S_in's factors, (inner, outer), the bound, after checking that the one-ring is closed
     outer = tuple(a for a in range(SE.nrows()) if a not in inner)
     if any(SE[a, b] != 0 for a in inner for b in outer):
         raise CertificateError(f"dart:{k}: the one-ring is not closed under the rules")
     bound = max(sum((abs(SE[a, b]) for b in outer), fmpq(0)) for a in outer)
-    fac = fmpq_mat([[SE[a, b] for b in inner] for a in inner]).charpoly().factor()[1]
-    return SE, tuple(rep), blocks, fac, (inner, outer), bound
+    return fmpq_mat([[SE[a, b] for b in inner] for a in inner]).charpoly().factor()[1], (inner, outer), bound
 
 
 def _check_dart_rows(k, pts, rows):
