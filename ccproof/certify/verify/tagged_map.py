@@ -76,21 +76,10 @@ def quadrant_nets(fam, n, vx, vy, q, prec):
 
 
 def transversal_form(nets, curve, a1, a2, prec):
-    """Bernstein form (degree 5) of a1 X Y' - a2 Y X' along one outer cubic, oriented counterclockwise; the star form
-    x y' - y x' for the identity map and a1 = a2 = 1 (1/2 on u = 1 of P1 here):
-
-    >>> from ccproof.certify.verify.tagged import labels
-    >>> pts = labels("corner", 1)   # the identity map: x = a, y = b
-    >>> vx = [fmpq(p[2] if p[0] == "q" or p[:2] == ("r", 0) else 0) for p in pts]
-    >>> vy = [fmpq(p[3] if p[0] == "q" else p[2] if p[:2] == ("r", 1) else 0) for p in pts]
-    >>> f = transversal_form(quadrant_nets("corner", 1, vx, vy, 0, 64), "P1s1", arb(1), arb(1), 64)
-    >>> f.coeffs[0].str(5, radius=False)
-    '0.50000'
-    """
-    pts = curve_points(nets, curve, oriented=True)
+    """Bernstein form (degree 5) of a1 X Y' - a2 Y X' along one outer cubic, oriented counterclockwise (for the
+    identity map and a1 = a2 = 1 the star form x y' - y x')."""
     with ctx.workprec(prec):
-        X = BernsteinForm((4,), [p[0] for p in pts], prec=prec)
-        Y = BernsteinForm((4,), [p[1] for p in pts], prec=prec)
+        X, Y = axis_forms(nets, curve, (1, 0), prec)
         return X * Y.diff(0) * a1 - Y * X.diff(0) * a2
 
 
