@@ -139,7 +139,7 @@ def _verify_witness(w, fam, n, prec, part, log):
         return
     vecs, second, label = got
     if not dart:
-        check_boundary(fam, n, r, vecs, part)
+        check_boundary(fam, n, r, (vecs["x"], vecs["y"]), vecs["z"], part)
     J = _jacobian(fam, n, q, vecs["x"], second)
     part(f"F flip at vertex (1,1) of quadrant {q}: J_xy != 0, so the normal there is (alpha beta)^m J_xy e_z + "
          "o(|alpha beta|^m)" if dart else f"N normal at vertex (1,1) of quadrant {q}: {label} != 0", J > 0 or J < 0,
@@ -162,14 +162,20 @@ def _witness_exact(fam, n, w, prec, part):
         part(f"{c}: {'(generalized) ' if c == 'z' or tops[c] else ''}eigenvector of S", vecs[c] is not None, msg)
         if vecs[c] is None:
             return None
+    ev = tg.eigenvalues(fam, n, prec)  # each root once per unit of algebraic multiplicity
     if fam == "dart":
-        (ok, msg), title, second = _flip_generic(n, vals["x"], vals["y"], prec), _G_FLIP, "J_xy"
+        title, second, check = _G_FLIP, "J_xy", lambda: _flip_generic(ev, vals["x"], vals["y"])
     elif tops["y"] is not None:
-        (ok, msg), title, second = _chain_generic(fam, n, vals, tops, prec), _G_CHAIN, "J_xe"
+        title, second, check = _G_CHAIN, "J_xe", lambda: _chain_generic(fam, n, ev, vals, tops)
     else:
-        (ok, msg), title, second = _ordering(fam, n, vals, prec, tops["z"] is not None), G_GENERIC, "J_xy"
+        title, second, check = G_GENERIC, "J_xy", lambda: _ordering(fam, n, ev, vals, tops["z"] is not None)
+    why = _one_simple(ev)
+    ok, msg = (False, why) if why else check()
     part(title, ok, msg)
-    return (vecs, tops["y"] if second == "J_xe" else vecs["y"], second) if ok else None
+    if ok:  # B reads z on the crease points
+        vecs["z"] = [vecs["z"][i] for i in tg.crease_points(fam, n)] if "z" in vecs else None
+        return vecs, tops["y"] if second == "J_xe" else vecs["y"], second
+    return None
 
 
 def _witness_modes(fam, n, w, part):
@@ -195,11 +201,8 @@ def _witness_modes(fam, n, w, part):
         "gamma < beta is not certain" if not arb(g) < ev[ib][0].real else None)
     part(G_GENERIC, why is None, why or f"alpha = {ev[ia][0].real.str(8)} > beta = {ev[ib][0].real.str(8)} > "
          f"|every other| (each simple), 1 simple; gamma = {g} < beta")
-    if why is not None:
-        return None
-    cp = tg.crease_points(fam, n)
-    vecs["z"] = [cval[cp.index(i)] if i in cp else None for i in range(len(ev))]  # B reads the crease points only
-    return vecs, vecs["y"], "J_xy"
+    vecs["z"] = cval
+    return None if why else (vecs, vecs["y"], "J_xy")
 
 
 def _crease_values(spec, c, cp):  # the crease values of a coordinate, one decimal per crease point
@@ -317,13 +320,13 @@ def _solve_exact(A, cp, cval):
     return [vec[j] for j in range(A.nrows())] if vec and any(v != 0 for v in vec.values()) else None
 
 
-def check_boundary(fam, n, r, vecs, part):
-    """Part B into ``part``: ray r's limit curve lies on the z-axis (x = y = 0 exactly on its crease points) and
-    z's limit leaves v (0 at v, not 0 at ray r's first point); ``vecs`` {"x", "y", "z": values}."""
+def check_boundary(fam, n, r, xy, zc, part):
+    """Part B into ``part``: ray r's limit curve lies on the z-axis (the vectors ``xy`` exactly 0 on its crease
+    points) and z's limit leaves v (0 at v, not 0 at ray r's first point); ``zc`` z on the crease points."""
     idx, _ = tg.point_index(fam, n)
     curve = [0] + [idx[("r", s, a, 0)] for s in (tg.sharp_rays(fam, n) if fam == "crease" else (r,)) for a in (1, 2)]
-    z, leave = vecs["z"], None
-    ok = all_zero(vecs[c][i] for c in ("x", "y") for i in curve) and all(isinstance(z[i], fmpq) for i in curve)
+    z, leave = dict(zip(tg.crease_points(fam, n), zc)), None
+    ok = all_zero(v[i] for v in xy for i in curve) and all(isinstance(z[i], fmpq) for i in curve)
     if ok:  # the limit of z at v and at ray r's first point (the B-spline limit mask)
         at_v = z[0] if fam == "corner" else (z[idx[("r", 0, 1, 0)]] + 4 * z[0] + z[idx[("r", n, 1, 0)]]) / 6
         leave = (z[0] + 4 * z[idx[("r", r, 1, 0)]] + z[idx[("r", r, 2, 0)]]) / 6
@@ -390,32 +393,30 @@ def _chain_top(fam, n, lam, vec):
     return top if any(v != 0 for v in top) else None
 
 
-def _flip_generic(n, a, b, prec):
-    """(ok, message): G of a dart's flip: 1 simple; alpha, beta simple, certainly of opposite signs, each certainly
+def _flip_generic(ev, a, b):
+    """(ok, message): G of a dart's flip (1 simple): alpha, beta simple, certainly of opposite signs, each certainly
     larger in modulus than every other eigenvalue."""
-    ev = tg.eigenvalues("dart", n, prec)
     ia, ib = _pair(ev, a, b)
     A, B = (None, None) if ib is None else (ev[ia][0].real, ev[ib][0].real)
-    why = _one_simple(ev) or ("alpha or beta is not an eigenvalue (distinct from the other)" if ib is None else
-                              "alpha or beta is not a simple eigenvalue" if ev[ia][2] != 1 or ev[ib][2] != 1 else
-                              "alpha beta < 0 is not certain" if not (A > 0 and B < 0 or A < 0 and B > 0) else
-                              _below(ev, (ia, ib), (abs(A), abs(B)), "smaller in modulus than alpha and beta"))
+    why = ("alpha or beta is not an eigenvalue (distinct from the other)" if ib is None else
+           "alpha or beta is not a simple eigenvalue" if ev[ia][2] != 1 or ev[ib][2] != 1 else
+           "alpha beta < 0 is not certain" if not (A > 0 and B < 0 or A < 0 and B > 0) else
+           _below(ev, (ia, ib), (abs(A), abs(B)), "smaller in modulus than alpha and beta"))
     return why is None, why or (f"alpha = {A.str(8, radius=False)}, beta = {B.str(8, radius=False)}: alpha beta < 0, "
                                 "each simple, > |every other|; 1 simple")
 
 
-def _chain_generic(fam, n, vals, tops, prec):
-    """(ok, message): G of a Jordan-chain witness; ``vals`` the eigenvalues of x, y, z, ``tops`` (S - lam) of each
-    (None for an eigenvector, :func:`_chain_top`)."""
+def _chain_generic(fam, n, ev, vals, tops):
+    """(ok, message): G of a Jordan-chain witness (1 simple); ``vals`` the eigenvalues of x, y, z, ``tops`` (S - lam)
+    of each (None for an eigenvector, :func:`_chain_top`)."""
     a, b, g = vals["x"], vals["y"], vals["z"]
     if tops["y"] is None or tops["z"] is not None or tops["x"] is not None or not isinstance(b, fmpq):
         return False, "y is no generalized eigenvector of a rational beta, or z or x is one"
     if any(tops["y"][i] != 0 for i in tg.crease_points(fam, n)):
         return False, "e = (S - beta) y is not 0 on the crease points"
-    ev = tg.eigenvalues(fam, n, prec)
     ia = _find(ev, a)
     at_b = [i for i, t in enumerate(ev) if _same_root(t, b)]
-    why = _one_simple(ev) or (
+    why = (
         "alpha is not a simple eigenvalue" if ia is None or ev[ia][2] != 1 or ia in at_b else
         "alpha > beta > 0 is not certain" if not (b > 0 and ev[ia][0].real > b) else
         # beta's Jordan blocks have size <= 2 iff dim ker (S - beta)^2 is its algebraic multiplicity (exact)
@@ -456,15 +457,14 @@ def _mode_lead_why(ev, ia, ib):
             if not all(abs(t[0]) < beta for t in others) else None)
 
 
-def _ordering(fam, n, vals, prec, generalized):
-    """(ok, message): G of the generic pair: a = lam1 >= b = lam2 >= every other |lam| (1 simple, ties only with b
+def _ordering(fam, n, ev, vals, generalized):
+    """(ok, message): G of the generic pair (1 simple): a = lam1 >= b = lam2 >= every other |lam| (ties only with b
     itself), g the crease block's largest eigenvalue below 1, every eigenvalue of modulus possibly >= b
     non-defective, and g < b when z is a generalized eigenvector."""
     a, b, g = vals["x"], vals["y"], vals["z"]
-    ev = tg.eigenvalues(fam, n, prec)  # each root once per unit of algebraic multiplicity
     ia, ib = _pair(ev, a, b)
     beta = None if ib is None else abs(ev[ib][0])
-    why = _one_simple(ev) or (
+    why = (
         "alpha is not an eigenvalue" if ia is None else "beta is not an eigenvalue (distinct from alpha's copy)"
         if ib is None else "alpha >= beta is not certain" if not (abs(ev[ia][0]) >= beta or ev[ia][1] == ev[ib][1])
         else _below(ev, (ia, ib), (beta,), "below beta (lam1, lam2 not alpha, beta)", b) or
