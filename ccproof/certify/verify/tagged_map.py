@@ -100,10 +100,13 @@ def _crossings(nets, curve, paths, direction, prec):
             fa, fp = A, P
             for ax, side in parse_path(path, 1):
                 fa, fp = (f.split(ax)[0 if side == "L" else 1] for f in (fa, fp))
-            got = _box_crossings(fa.coeffs, fp.coeffs)
-            if isinstance(got, str):
-                return f"{curve}: box {path!r}{got}"
-            count += got
+            fa, fp = fa.coeffs, fp.coeffs
+            if _sign(fp) or _sign(fa) < 0:  # off H
+                continue
+            if _sign(fa) <= 0 or _sign(fp[:1]) * _sign(fp[-1:]) == 0:
+                return f"{curve}: box {path!r}" + (" decides nothing" if _sign(fa) <= 0 else
+                                                   ": the sign at an end is not certain")
+            count += _sign(fp[:1]) * _sign(fp[-1:]) < 0  # on H's side: a sign change across H is one crossing
     return count
 
 
@@ -128,18 +131,6 @@ def axis_forms(nets, curve, direction, prec):
 def _sign(values):
     """+1 or -1 when every value is certainly of that sign, else 0."""
     return 1 if all(c > 0 for c in values) else -1 if all(c < 0 for c in values) else 0
-
-
-def _box_crossings(fa, fp):
-    """Crossings of H in one box (Bernstein coefficients along and across H), or why it decides nothing."""
-    if _sign(fp) or _sign(fa) < 0:
-        return 0
-    if _sign(fa) <= 0:
-        return " decides nothing"
-    ends = _sign(fp[:1]) * _sign(fp[-1:])
-    if ends == 0:
-        return ": the sign at an end is not certain"
-    return 1 if ends < 0 else 0
 
 
 def _rays_on_axes(fam, n, vx, vy):
@@ -215,22 +206,17 @@ _WANT = {"crease": {("+x", 1): 1, ("-x", 1): 0, ("+x", -1): 0, ("-x", -1): 1},
          "dart": {(a, o): 1 for a in AXES for o in (1, -1)}}
 
 
-def _direction(fam, axis, orient, ray):
-    """``(direction, crossings wanted)`` for the certificate's ``parts.winding.axis``."""
-    if ray and isinstance(axis, list) and len(axis) == 2 and axis != [0, 0] \
-            and all(type(c) is int and abs(c) <= 16 for c in axis):
-        return tuple(axis), 1
-    want = _WANT[fam].get((axis, orient)) if isinstance(axis, str) else None
-    if want is None:
-        raise CertificateError(f"parts.winding.axis {str(axis)[:12]!r} is not allowed for {fam}")
-    return AXES[axis], want
-
-
 def _check_winding(fam, nets, curves, win, ray, orient, prec, part):
     """W: the count of crossings says the D-angle (monotone by T) turns by exactly the sector's angle; False when a
-    box decides nothing."""
+    box decides nothing. A ray direction (integers) when every ray is an orbit of D, else a half-axis of _WANT."""
     axis = win.get("axis")
-    direction, want = _direction(fam, axis, orient, ray)
+    if ray and isinstance(axis, list) and len(axis) == 2 and axis != [0, 0] \
+            and all(type(c) is int and abs(c) <= 16 for c in axis):
+        direction, want = tuple(axis), 1
+    elif (want := _WANT[fam].get((axis, orient)) if isinstance(axis, str) else None) is not None:
+        direction = AXES[axis]
+    else:
+        raise CertificateError(f"parts.winding.axis {str(axis)[:12]!r} is not allowed for {fam}")
     title, total = f"W the outer curve crosses the {axis} half-axis {want} time(s)", 0
     for key in curves:
         q, c = key.split(":")

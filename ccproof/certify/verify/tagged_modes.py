@@ -25,12 +25,8 @@ def _reflect(t, pos):  # the reflection R in ray 0 on the ring: ray t -> ray -t,
 
 @cache
 def check_ring():
-    """Raise unless the ring stencil commutes with R, reaches sectors t - 1 .. t + 2 only, and its Fourier blocks
-    have the claimed characteristic polynomials (:func:`.spectrum.mode_polynomials_hold`).
-
-    >>> check_ring()
-    True
-    """
+    """True, or raise unless the ring stencil commutes with R, reaches sectors t - 1 .. t + 2 only, and its Fourier
+    blocks have the claimed characteristic polynomials (:func:`.spectrum.mode_polynomials_hold`)."""
     for i, pos in enumerate(TWO_RING):
         t, p = _reflect(0, pos)
         image = {(d + t, q): x for (d, q), x in ring_stencil()[RING_INDEX[p]].items()}
@@ -73,11 +69,7 @@ def kernel_basis(M):
 
 def mode_reflection(w):
     """R_w, the reflection R on the mode w: (v o R)(t, p) = w^-t (R_w v^)(p); rays p -> v^(p), quadrants (a, b) ->
-    v^(b, a)/w (rows of numbers like w).
-
-    >>> mode_reflection(fmpq(2))[RING_INDEX[(2, 1)]]
-    [0, 0, 0, 0, 1/2, 0]
-    """
+    v^(b, a)/w (rows of numbers like w)."""
     rows = [[0 * w] * 6 for _ in range(6)]
     for p, i in RING_INDEX.items():
         rows[i][RING_INDEX[p if p[1] == 0 else (p[1], p[0])]] += 1 if p[1] == 0 else 1 / w
@@ -129,11 +121,7 @@ def check_structure(fam, n):
 
 def charpoly_roots(M, fac=None):
     """(acb, fmpq or None) per eigenvalue of a rational matrix (or of the factors ``fac`` of a characteristic
-    polynomial), repeated by algebraic multiplicity.
-
-    >>> charpoly_roots(fmpq_mat([[1, 0], [0, 1]]))
-    [(1.00000000000000, 1), (1.00000000000000, 1)]
-    """
+    polynomial), repeated by algebraic multiplicity."""
     out = []
     for p, e in M.charpoly().factor()[1] if fac is None else fac:
         for z, _ in p.complex_roots():
@@ -168,7 +156,7 @@ def mode_spectrum(fam, n):
 
 
 def bordered_solve(B, lam, pivot, mat=acb_mat):
-    """The null vector v of B - lam with v[pivot] = 1 from the bordered system (:func:`bordered_matrix`) (v, s) =
+    """The null vector v of B - lam with v[pivot] = 1 from the bordered system [[B - lam, e_p], [e_p^T, 0]] (v, s) =
     (0, 1) in ``mat`` (acb_mat or arb_mat); ZeroDivisionError unless arb proves it regular for every lam of the
     ball (then lam is simple, v*[pivot] != 0 and v = v*/v*[pivot]: docs/tagged_c1.md).
 
@@ -180,11 +168,7 @@ def bordered_solve(B, lam, pivot, mat=acb_mat):
 
 
 def bordered_matrix(B, lam, zero, pivot):
-    """[[B - lam, e_pivot], [e_pivot^T, 0]] as a list of rows (``zero`` of B's ring: 0, an exact or a series zero).
-
-    >>> bordered_matrix([[2, 1], [1, 2]], 3, 0, 1)
-    [[-1, 1, 0], [1, -1, 1], [0, 1, 0]]
-    """
+    """[[B - lam, e_pivot], [e_pivot^T, 0]] as a list of rows (``zero`` of B's ring: 0, an exact or a series zero)."""
     k = len(B)
     A = [[(B[i][j] - lam) if i == j else B[i][j] for j in range(k)] + [zero + int(i == pivot)] for i in range(k)]
     return A + [[zero + int(j == pivot) for j in range(k)] + [zero]]
