@@ -267,8 +267,23 @@ def eigenvector_of(fam, n, spec, c, prec, chain=False):
     exact_keys(spec, ("eigenvalue", "crease", "pivot") if "pivot" in spec else ("eigenvalue", "crease"), c)
     cp = [] if fam == "dart" else tg.crease_points(fam, n)  # a dart's sharp ray is no closed block
     cval, S = _crease_values(spec, c, cp), tg.sector_matrix(fam, n)
-    if not isinstance(spec["eigenvalue"], str):  # an irrational eigenvalue, [low, high]
-        return _ball_eigenvector(fam, n, spec, c, cp, cval, prec)
+    if not isinstance(spec["eigenvalue"], str):  # an irrational eigenvalue, [low, high]: the bordered system in arb
+        ev, free = tg.eigenvalues(fam, n, prec), [j for j in range(S.nrows()) if j not in cp]
+
+        def solve(i, pivot):
+            if cp and ev[i][1].gcd(tg.crease_block(fam, n).charpoly()).degree() > 0:
+                return None, "the eigenvalue is one of the crease block's"
+            try:
+                sol = dict(zip(free, bordered_solve([[arb(S[a, b]) for b in free] for a in free], ev[i][0].real,
+                                                    free.index(pivot), arb_mat)))
+            except ZeroDivisionError:
+                return None, f"the system for the eigenvector of {ev[i][0].real.str(8)} (pivot {pivot}) is not " \
+                             "certainly regular"
+            return [sol.get(j, arb(0)) for j in range(S.nrows())], f"eigenvalue {ev[i][0].real.str(10)} (simple " \
+                f"root of {ev[i][1]}); vector in arb, pivot {tg.labels(fam, n)[pivot]}"
+        i, vec, msg = _isolated_coordinate(ev, spec, c, cp, cval, lambda i: ev[i][2] == 1,
+                                           f"one simple real eigenvalue of {fam}:{n}", solve)
+        return None if i is None else ev[i][0].real, vec, msg
     lam = parse_decimal(spec["eigenvalue"])
     A = S - lam * tg.identity(S.nrows())
     if "pivot" in spec:  # one more fixed coordinate: 1 at the pivot
@@ -284,27 +299,6 @@ def eigenvector_of(fam, n, spec, c, prec, chain=False):
         return lam, None, f"(S - {lam}) z is not 0 on the crease points"
     return lam, vec, f"eigenvalue {lam}; (S - {lam})^2 z = 0 exactly, (S - {lam}) z != 0 vanishes on the crease " \
                      "(generalized)"
-
-
-def _ball_eigenvector(fam, n, spec, c, cp, cval, prec):
-    ev, S = tg.eigenvalues(fam, n, prec), tg.sector_matrix(fam, n)
-    free = [j for j in range(S.nrows()) if j not in cp]
-
-    def solve(i, pivot):
-        if cp and ev[i][1].gcd(tg.crease_block(fam, n).charpoly()).degree() > 0:
-            return None, "the eigenvalue is one of the crease block's"
-        try:
-            sol = dict(zip(free, bordered_solve([[arb(S[a, b]) for b in free] for a in free], ev[i][0].real,
-                                                free.index(pivot), arb_mat)))
-        except ZeroDivisionError:
-            return None, f"the system for the eigenvector of {ev[i][0].real.str(8)} (pivot {pivot}) is not certainly " \
-                         "regular"
-        return [sol.get(j, arb(0)) for j in range(S.nrows())], \
-            f"eigenvalue {ev[i][0].real.str(10)} (simple root of {ev[i][1]}); vector in arb, pivot " \
-            f"{tg.labels(fam, n)[pivot]}"
-    i, vec, msg = _isolated_coordinate(ev, spec, c, cp, cval, lambda i: ev[i][2] == 1,
-                                       f"one simple real eigenvalue of {fam}:{n}", solve)
-    return None if i is None else ev[i][0].real, vec, msg
 
 
 def _solve_exact(A, cp, cval):
