@@ -204,11 +204,11 @@ def crease_block(fam, n):
     """
     if fam == "dart":
         raise CertificateError("a dart's sharp ray is not a closed block (its centre is smooth)")
-    S, cp = sector_matrix(fam, n), crease_points(fam, n)
-    for i in cp:
-        if any(S[i, j] != 0 for j in range(S.ncols()) if j not in cp):
-            raise CertificateError(f"{fam}:{n}: crease row {i} involves a non-crease point")
-    return fmpq_mat([[S[i, j] for j in cp] for i in cp])
+    rows, cp = sector_rows(fam, n), crease_points(fam, n)
+    bad = [i for i in cp if not set(rows[i]) <= set(cp)]  # the rows hold their non-zero weights only
+    if bad:
+        raise CertificateError(f"{fam}:{n}: crease row {bad[0]} involves a non-crease point")
+    return fmpq_mat([[rows[i].get(j, fmpq(0)) for j in cp] for i in cp])
 
 
 @cache

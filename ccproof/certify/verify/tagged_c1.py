@@ -145,10 +145,9 @@ def _verify_witness(w, fam, n, prec, part, log):
          "o(|alpha beta|^m)" if dart else f"N normal at vertex (1,1) of quadrant {q}: {label} != 0", J > 0 or J < 0,
          f"{label} = {J.str(6)}")
     if not part.failed:
-        log(f"  the limit surface of this net is not C1 at the dart vertex: the unit normals at the level-m copies "
-            f"of quadrant {q}'s (1,1) tend to (-1)^m sign(J_xy) e_z (no limit; the projection folds)" if dart else
-            f"  the limit surface of this net is not C1 at the {fam} vertex: normals along the level-m "
-            f"copies of quadrant {q}'s (1,1) tend to n_z != 0, yet e_z lies in T_v (ray {r})")
+        log(f"  the limit surface of this net is not C1 at the {fam} vertex: the unit normals at the level-m copies of "
+            f"quadrant {q}'s (1,1) tend to " + ("(-1)^m sign(J_xy) e_z (no limit; the projection folds)" if dart else
+                                                f"n_z != 0, yet e_z lies in T_v (ray {r})"))
 
 
 def _witness_exact(fam, n, w, prec, part):
@@ -171,10 +170,9 @@ def _witness_exact(fam, n, w, prec, part):
         title, second, check = G_GENERIC, "J_xy", lambda: _ordering(fam, n, ev, vals, tops["z"] is not None)
     ok, msg = (False, "eigenvalue 1 is not simple") if sum(1 for t in ev if t[1] == tg.ONE) != 1 else check()
     part(title, ok, msg)
-    if ok:  # B reads z on the crease points
-        vecs["z"] = [vecs["z"][i] for i in tg.crease_points(fam, n)] if "z" in vecs else None
-        return vecs, tops["y"] if second == "J_xe" else vecs["y"], second
-    return None
+    if ok and fam != "dart":  # B reads z on the crease points
+        vecs["z"] = [vecs["z"][i] for i in tg.crease_points(fam, n)]
+    return (vecs, tops["y"] if second == "J_xe" else vecs["y"], second) if ok else None
 
 
 def _witness_modes(fam, n, w, part):

@@ -181,10 +181,9 @@ def verify_tail(cert, fam, n0, part, log):
     if not MIN_TAIL <= n0 <= 10**6:
         raise CertificateError(f"{fam}:>={n0}: the window argument needs N0 >= {MIN_TAIL}")
     exact_keys(cert, ("schema", "configuration", "statement", "prec", "witness", "limit"), "certificate")
-    prec, w, lim = read_prec(cert), field_of(cert, "witness", dict, "certificate"), field_of(cert, "limit", dict,
-                                                                                              "certificate")
+    prec, w, lim = read_prec(cert), field_of(cert, "witness", dict, "certificate"), cert["limit"]
     exact_keys(w, ("z",), "witness")
-    exact_keys(lim, ("rho", "R", "arcs", "outer_arcs", "box"), "limit")
+    exact_keys(field_of(cert, "limit", dict, "certificate"), ("rho", "R", "arcs", "outer_arcs", "box"), "limit")
     g, cval = read_z(field_of(w, "z", dict, "witness"))
     rho, R, side = (parse_decimal(field_of(lim, k, str, "limit")) for k in ("rho", "R", "box"))
     arcs, outer = (field_of(lim, k, int, "limit") for k in ("arcs", "outer_arcs"))
@@ -203,9 +202,9 @@ def verify_tail(cert, fam, n0, part, log):
 
 def _check_tail(fam, n0, g, cval, limit, part, log):
     C, *blocks = check_windows(fam)
-    part("S sector matrices of every N >= 7 from one window", True,
-         f"{fam}:7 and {fam}:8: one row per window class (min(t, 3), min(N - t, 3)), the same in both, rows sum "
-         "to 1; crease block and odd blocks of the modes +-1 equal; non-crease rows the folded ring rule (exact)")
+    part("S sector matrices of every N >= 7 from one window", True, f"{fam}:7 and {fam}:8: one row per window class "
+         "(min(t, 3), min(N - t, 3)), the same in both, rows sum to 1; crease block and odd blocks of the modes +-1 "
+         "equal; non-crease rows the folded ring rule (exact)")
     ok = limit[0] > arb.pi() / n0
     part(f"range: pi/N < rho for every N >= {n0}", ok, f"rho = {limit[0]} > pi/{n0}" if ok else
          f"rho = {limit[0]} is not certainly above pi/{n0} = {(arb.pi() / n0).str(6)}")
