@@ -77,10 +77,9 @@ def _verify_c1(cert, fam, n, prec, part):
         raise CertificateError("map.orientation must be 1 or -1")
     vecs, vals = {}, {}
     for c, t in (("x", lead[1]), ("y", lead[2])):
-        if modes:
-            val, (_, vec, msg) = ev[t][0].real, _mode_coordinate(fam, n, ev, field_of(mp, c, dict, "map"), c, t)
-        else:
-            val, vec, msg = eigenvector_of(fam, n, field_of(mp, c, dict, "map"), c, prec)
+        spec = field_of(mp, c, dict, "map")  # a mode coordinate is the entry t itself, an exact one must be its root
+        val, vec, msg = (ev[t][0].real, *_mode_coordinate(fam, n, ev, spec, c, t)[1:]) if modes else \
+            eigenvector_of(fam, n, spec, c, prec)
         ok = vec is not None and (modes or _same_root(t, val))
         part(f"{c}: eigenvector of lam{'1' if c == 'x' else '2'}", ok,
              msg if vec is None or ok else "not the eigenvalue of lam1 / lam2")
