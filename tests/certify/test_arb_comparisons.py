@@ -112,7 +112,8 @@ REVIEWED = {
     ("tagged_modes.py", "SE[a, b] != 0"): "fmpq_mat entries (exact)",
     ("maps.py", "not (hi < BREAKS[p] or (p < 3 and lo > BREAKS[p + 1]))"): (
         "keeps a piece unless the hull is certainly outside it: conservative"),
-    ("tagged_limit.py", "not ((1 + c) * (9 + c)).real > 0"): "refuses the box unless Re (1 + c)(9 + c) > 0 certainly: conservative",
+    ("tagged_limit.py", "not ((1 + c) * (9 + c)).real > 0"): "refuses the box unless Re (1 + c)(9 + c) > 0 "
+                                                                "certainly: conservative",
     ("tagged_limit.py", "C != crease_block(fam, WINDOW[1])"): "fmpq_mat (exact)",
     ("tagged_limit.py", "blocks[0] != blocks[1]"): "tuples of fmpq_mat (exact)",
     ("tagged_limit.py", "Bi * R != R * B"): "fmpq_mat (w is an exact rational)",

@@ -87,10 +87,9 @@ AXES = {"+x": (1, 0), "-x": (-1, 0), "+y": (0, 1), "-y": (0, -1)}
 
 
 def _crossings(nets, curve, paths, direction, prec):
-    """How often one outer cubic crosses the half-line H = {t d : t > 0} (``direction`` d = (a, b)), from a partition of
-    [0, 1] into boxes each certainly off H (-b X + a Y of one sign, or a X + b Y < 0) or on its side (a X + b Y > 0),
-    where a sign change of -b X + a Y between the ends is one crossing (one direction for all: T); or why a box
-    decides nothing."""
+    """How often one outer cubic crosses the half-line H = {t d : t > 0} (d = (a, b)), or why a box decides nothing:
+    each box of a partition of [0, 1] is certainly off H (-b X + a Y of one sign, or a X + b Y < 0) or on its side
+    (a X + b Y > 0), where a sign change of -b X + a Y between the ends is one crossing (one direction for all: T)."""
     if not check_partition(paths, 1):
         return f"{curve}: the boxes do not partition [0, 1]"
     count = 0

@@ -180,9 +180,9 @@ def _unit(num, den):  # exp(i pi num/den), each from its own angle (no powers ac
 
 
 def mode_vector(fam, n, j, lam):
-    """The eigenvector of S for a simple eigenvalue lam (arb) of mode j, f = v - v o R (v(t, p) = w^t v^(p) on the
-    ring of 2N sectors, K for a dart; v^ from the bordered 6 x 6 system of B(w) at the first pivot proved regular),
-    0 on the crease points (a dart: the centre); a complex multiple of the real eigenvector, or None.
+    """The eigenvector f = v - v o R of S for a simple eigenvalue lam (arb) of mode j (v(t, p) = w^t v^(p) on the ring
+    of 2N sectors, K for a dart; v^ from B(w)'s bordered system at the first pivot proved regular), 0 on the crease
+    points (a dart: the centre); a complex multiple of the real eigenvector, or None.
 
     >>> f = mode_vector("crease", 5, 1, max(t[0].real for t in mode_spectrum("crease", 5) if t[3] == 1))
     >>> len(f), f[0]
@@ -232,10 +232,9 @@ def normalized_vector(fam, n, ev, i, pivot):
 
 @cache
 def check_dart(k):
-    """Raise unless dart:k's S commutes with the reflection R in the sharp ray, is the ring rule on every point but
-    the centre and ray 0, and S_E = [[S_in, 0], [*, S_out]] on the one-ring (centre, (1,0), (1,1)) (exact). (S_E on
-    one representative per R-orbit, each point's representative, the odd blocks of w = 1 (-1 for even k), the
-    factors of S_in's characteristic polynomial, (the one-ring's rows, the others), |S_out|_inf >= rho(S_out)).
+    """Raise unless dart:k's S commutes with the reflection R in the sharp ray, is the ring rule but at the centre and
+    ray 0, and S_E = [[S_in, 0], [*, S_out]] on the one-ring (exact); S_E (one row per R-orbit), each point's orbit,
+    the odd blocks of w = +-1, S_in's characteristic factors, (inner, outer rows), |S_out|_inf >= rho(S_out).
 
     >>> SE, rep, blocks, fac, (inner, outer), bound = check_dart(5)
     >>> SE.nrows(), len(rep), [M.nrows() for M in blocks], len(outer), bound
