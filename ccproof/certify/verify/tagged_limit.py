@@ -62,29 +62,27 @@ def reflection_identity():
     return True
 
 
-def _tangents(theta, j):
-    """(T_a, T_b) of f(j theta) at the (1,1) vertex of quadrant 0 (acb); ZeroDivisionError unless (1 + c)(9 + c)
-    certainly has a positive real part and the bordered system is certainly regular."""
-    w = (acb(0, j) * theta).exp()
-    c = (w + 1 / w) / 2
-    if not ((1 + c) * (9 + c)).real > 0:
-        raise ZeroDivisionError("(1 + c)(9 + c) is not certainly in the right half-plane")
-    sol = bordered_solve(ring_block(w), lam_of(c), RING_INDEX[(1, 0)])
-    vh = {p: sol[i] for p, i in RING_INDEX.items()}
-    # the centre and ray 0: 0; ray 1: v^(b,0)(w - 1/w); quadrant 0: v^(a,b) - v^(b,a)/w
-    return vertex_tangents({(a, b): acb(0) if b == 0 else vh[(b, 0)] * (w - 1 / w) if a == 0 else
-                            vh[(a, b)] - vh[(b, a)] / w for a in range(3) for b in range(3)})
-
-
 def limit_h(theta):
-    """H(theta) for an acb ball theta (part 3); ZeroDivisionError where not proved analytic. H(pi/N)/theta^4 tends to
-    about 1.37136:
+    """H(theta) = J_xy of f(theta), f(2 theta) at the (1,1) vertex of quadrant 0 for an acb ball theta (part 3);
+    ZeroDivisionError unless each (1 + c)(9 + c) certainly has a positive real part and each bordered system is
+    certainly regular (H analytic there). H(pi/N)/theta^4 tends to about 1.37136:
 
     >>> th = arb.pi() / 1000
     >>> (limit_h(acb(th)) / th ** 4).real.str(5, radius=False)
     '1.3714'
     """
-    (a1, b1), (a2, b2) = _tangents(theta, 1), _tangents(theta, 2)
+    tangents = []
+    for j in (1, 2):
+        w = (acb(0, j) * theta).exp()
+        c = (w + 1 / w) / 2
+        if not ((1 + c) * (9 + c)).real > 0:
+            raise ZeroDivisionError("(1 + c)(9 + c) is not certainly in the right half-plane")
+        sol = bordered_solve(ring_block(w), lam_of(c), RING_INDEX[(1, 0)])
+        vh = {p: sol[i] for p, i in RING_INDEX.items()}
+        # the centre and ray 0: 0; ray 1: v^(b,0)(w - 1/w); quadrant 0: v^(a,b) - v^(b,a)/w
+        tangents.append(vertex_tangents({(a, b): acb(0) if b == 0 else vh[(b, 0)] * (w - 1 / w) if a == 0 else
+                                         vh[(a, b)] - vh[(b, a)] / w for a in range(3) for b in range(3)}))
+    (a1, b1), (a2, b2) = tangents
     return a1 * b2 - b1 * a2
 
 
@@ -200,7 +198,7 @@ def verify_tail(cert, fam, n0, part, log):
     return f"{fam}:>={n0}"
 
 
-def _check_tail(fam, n0, g, cval, limit, part, log):
+def _check_tail(fam, n0, g, cval, limit, part, log):  # parts 1-5 in order, each only after the previous held
     C, *blocks = check_windows(fam)
     part("S sector matrices of every N >= 7 from one window", True, f"{fam}:7 and {fam}:8: one row per window class "
          "(min(t, 3), min(N - t, 3)), the same in both, rows sum to 1; crease block and odd blocks of the modes +-1 "
@@ -219,12 +217,8 @@ def _check_tail(fam, n0, g, cval, limit, part, log):
     ok = reflection_identity()
     part("N reflection: B(1/w) R_w = R_w B(w) (exact), so f is odd and H has a zero of order >= 4 at 0", ok,
          "" if ok else "the ring stencil breaks the reflection identity")
-    if not part.failed:
-        _check_normal(fam, n0, limit, part, log)
-
-
-def _check_normal(fam, n0, limit, part, log):
-    """N for every N >= n0: H analytic on |theta| <= R, bounded on its circle, winding 4 times along |theta| = rho."""
+    if part.failed:  # N for every N >= n0: H analytic on |theta| <= R, bounded on its circle, winding 4 times
+        return
     rho, R, side, arcs, outer = limit
     got = _check_disc(R, side)
     ok = isinstance(got, int)
