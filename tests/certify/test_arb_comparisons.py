@@ -84,6 +84,7 @@ REVIEWED = {
     ("tagged_c1.py", "not abs(t[0]) < beta"): "counts as a Jordan block that could reach beta unless certainly "
                                                      "below (or as an eigenvalue not below beta): conservative",
     ("tagged_c1.py", "ev[ia][2] != 1"): "ints (multiplicities)",
+    ("tagged_c1.py", "sum(1 for t in ev if t[1] == tg.ONE) != 1"): "ints (a count of exact factors)",
     ("tagged_c1.py", "ev[ib][2] != 1"): "ints (multiplicities)",
     ("tagged_c1.py", 'tops["y"][i] != 0'): "fmpq (exact: (S - beta) y in Q)",
     ("tagged_c1.py", "not abs(t[0]) < 1"): "collects every eigenvalue possibly on or outside the unit circle; "
@@ -97,7 +98,7 @@ REVIEWED = {
     ("spectrum.py", "w != 0"): "fmpq rule weights (exact)",
     ("tagged_c1.py", "one[0][1] != 1"): "fmpq or None (the exact value of a rational eigenvalue)",
     ("tagged_c1.py", "not ev[ia][0].real >= beta"): "fails unless alpha >= beta certainly: conservative",
-    ("tagged_modes.py", "B * K != K * M"): "fmpq_mat (exact)",
+    ("tagged_modes.py", "B * K != K * out[-1]"): "fmpq_mat (exact)",
     ("tagged_modes.py", "image != {_reflect(d, q): x for (d, q), x in ring_stencil()[i].items()}"):
         "dicts of fmpq weights with tuple keys (exact)",
     ("tagged_modes.py", "_ring_row(p[1], p[2:], fold) != {j: x for j, x in rows[i].items() if j not in cp}"):
@@ -111,17 +112,17 @@ REVIEWED = {
     ("tagged_modes.py", "SE[a, b] != 0"): "fmpq_mat entries (exact)",
     ("maps.py", "not (hi < BREAKS[p] or (p < 3 and lo > BREAKS[p + 1]))"): (
         "keeps a piece unless the hull is certainly outside it: conservative"),
-    ("tagged_limit.py", "not disc.real > 0"): "refuses the box unless Re (1 + c)(9 + c) > 0 certainly: conservative",
+    ("tagged_limit.py", "not ((1 + c) * (9 + c)).real > 0"): "refuses the box unless Re (1 + c)(9 + c) > 0 "
+                                                                "certainly: conservative",
     ("tagged_limit.py", "C != crease_block(fam, WINDOW[1])"): "fmpq_mat (exact)",
     ("tagged_limit.py", "blocks[0] != blocks[1]"): "tuples of fmpq_mat (exact)",
     ("tagged_limit.py", "Bi * R != R * B"): "fmpq_mat (w is an exact rational)",
-    ("tagged_limit.py", "not slope * length < abs(h0)"): "fails unless the arc's image certainly misses 0: "
+    ("tagged_limit.py", "not step < abs(h0)"): "fails unless the arc's image certainly misses 0: "
                                                          "conservative",
     ("tagged_limit.py", "g != 0"): "fmpq (exact decimal)",
     ("tagged_limit.py", "sum(row.values(), fmpq(0)) != 1"): "fmpq (exact)",
     ("tagged_limit.py", "croots.count(1) != 1"): "ints (fmpq roots compared exactly)",
     ("tagged_limit.py", "not lam_of(arb(1)) < 1"): "fails unless lam(1) < 1 certainly: conservative",
-    ("tagged_limit.py", "g != max(below)"): "fmpq (exact roots of the crease block)",
     ("tagged_limit.py", "not arb(g) < b0"): "fails unless gamma < beta certainly: conservative",
 }
 

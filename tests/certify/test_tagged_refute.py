@@ -339,3 +339,22 @@ def test_every_mutation_of_the_new_records_ends_in_a_verdict(name):
                 assert cert == base, (path, value)
             else:
                 assert res.error or res.failures(), (path, value)
+
+
+def test_a_witness_whose_alpha_or_beta_is_the_eigenvalue_1_fails_part_g():
+    """alpha or beta claimed as the eigenvalue 1 (x or y the constant vector) is refused by part G itself: its root
+    finder skips the factor x - 1. Without that, crease:2's record (alpha = 1 >= beta = gamma = 1/2, 1/2 double
+    and non-defective) passes G and only B and N (the constant's tangents vanish) fail; dart:2's flip with y = 1
+    would fail on the signs instead."""
+    crease2 = _cert("crease:2")
+    witness = {"x": {"eigenvalue": "1", "crease": ["1"] * 5}, "y": crease2["map"]["x"],
+               "z": {"eigenvalue": "0.5", "crease": ["0", "-0.5", "-1", "0.5", "1"]}, "ray": 0, "quadrant": 0}
+    forged = {k: crease2[k] for k in ("schema", "configuration", "prec")} | {"statement": "not C1", "witness": witness}
+    res, parts = _parts(forged)
+    assert not res and parts["x"].ok and parts["y"].ok and parts["z"].ok
+    assert not parts["G"].ok and parts["G"].message == "alpha is not an eigenvalue", parts["G"].message
+    flip = copy.deepcopy(_cert("dart:2"))
+    flip["witness"]["y"] = {"eigenvalue": "1", "crease": [], "pivot": 0}
+    res, parts = _parts(flip)
+    assert not res and parts["y"].ok
+    assert parts["G"].message == "alpha or beta is not an eigenvalue (distinct from the other)", parts["G"].message

@@ -44,11 +44,8 @@ def parse_configuration(name):
 
 
 def check_exact_budget(fam, n):
-    """Refuse, before any arithmetic, a configuration whose exact route (about m^3 for S of m points, 9 s of CPU
-    for crease:100) exceeds EXACT_BUDGET; larger ones take the modes of :mod:`.tagged_modes` or nothing.
-
-    >>> check_exact_budget("crease", 20)   # crease:100 is refused: leading_spectrum
-    """
+    """Refuse, before any arithmetic, a configuration whose exact route (about m^3 for S of m points, 9 s of CPU for
+    crease:100) exceeds EXACT_BUDGET; larger ones take the modes of :mod:`.tagged_modes` or nothing."""
     m = len(labels(fam, n))
     if m**3 > EXACT_BUDGET:
         raise CertificateError(f"{fam}:{n}: the exact route on S of {m} points exceeds the budget (m^3 > 128^3: "
@@ -68,11 +65,7 @@ def labels(fam, n):
 
 
 def sharp_rays(fam, n):
-    """The sharp rays: ray 0 for a dart, rays 0 and n otherwise.
-
-    >>> sharp_rays("dart", 5), sharp_rays("corner", 3)
-    ((0,), (0, 3))
-    """
+    """The sharp rays: ray 0 for a dart, rays 0 and n otherwise."""
     return (0,) if fam == "dart" else (0, n)
 
 
@@ -173,12 +166,7 @@ def _window_column(p, q, n, ring):  # the column of point q in the row of point 
 
 @cache
 def sector_matrix(fam, n):
-    """S as an exact fmpq_mat (rows sum to 1).
-
-    >>> S = sector_matrix("crease", 2)
-    >>> [S[0, j] for j in range(7)], S[1, 0], S[1, 1]
-    ([3/4, 1/8, 0, 0, 0, 1/8, 0], 1/2, 1/2)
-    """
+    """S as an exact fmpq_mat (:func:`sector_rows`)."""
     rows = sector_rows(fam, n)
     return fmpq_mat([[row.get(j, fmpq(0)) for j in range(len(rows))] for row in rows])
 
@@ -190,19 +178,19 @@ def kernel_dim(fam, n, p):
     (1, 2)
     """
     S = sector_matrix(fam, n)
-    m = S.nrows()
-    eye, P = fmpq_mat([[int(i == j) for j in range(m)] for i in range(m)]), fmpq_mat(m, m)
+    P = fmpq_mat(S.nrows(), S.nrows())
     for c in reversed(p.coeffs()):
-        P = P * S + eye * c
-    return m - P.rank()
+        P = P * S + identity(S.nrows()) * c
+    return S.nrows() - P.rank()
+
+
+def identity(m):
+    """The m x m identity as an fmpq_mat."""
+    return fmpq_mat([[int(i == j) for j in range(m)] for i in range(m)])
 
 
 def crease_points(fam, n):
-    """Indices of the crease points: the centre, then (1, 0), (2, 0) of each sharp ray.
-
-    >>> crease_points("crease", 3)
-    [0, 1, 2, 7, 8]
-    """
+    """Indices of the crease points: the centre, then (1, 0), (2, 0) of each sharp ray (crease:3: 0, 1, 2, 7, 8)."""
     pts = labels(fam, n)
     return [0] + [pts.index(("r", r) + p) for r in sharp_rays(fam, n) for p in RAY_POS]
 
@@ -216,11 +204,11 @@ def crease_block(fam, n):
     """
     if fam == "dart":
         raise CertificateError("a dart's sharp ray is not a closed block (its centre is smooth)")
-    S, cp = sector_matrix(fam, n), crease_points(fam, n)
-    for i in cp:
-        if any(S[i, j] != 0 for j in range(S.ncols()) if j not in cp):
-            raise CertificateError(f"{fam}:{n}: crease row {i} involves a non-crease point")
-    return fmpq_mat([[S[i, j] for j in cp] for i in cp])
+    rows, cp = sector_rows(fam, n), crease_points(fam, n)
+    bad = [i for i in cp if not set(rows[i]) <= set(cp)]  # the rows hold their non-zero weights only
+    if bad:
+        raise CertificateError(f"{fam}:{n}: crease row {bad[0]} involves a non-crease point")
+    return fmpq_mat([[rows[i].get(j, fmpq(0)) for j in cp] for i in cp])
 
 
 @cache
@@ -244,8 +232,7 @@ def eigenvalues(fam, n, prec):
     return tuple(out)
 
 
-def _show(t):
-    """An eigenvalue entry for a message: exact when rational."""
+def _show(t):  # an eigenvalue entry for a message: exact when rational
     return str(-t[1][0] / t[1][1]) if t[1].degree() == 1 else t[0].real.str(5, radius=False)
 
 
@@ -285,9 +272,9 @@ def leading_spectrum(fam, n, prec):
         return True, f"{name}: 1 simple; {lead} > |lam3| = {_show(l3)}", ev[:4]
 
 
+
 def _not_simple_positive(lab, t):  # why the entry t is not certainly real, positive and non-defective
     if not (t[0].imag.is_zero() and t[0].real > 0):
         return f"{lab} = {_show(t)} is not certainly real and positive"
-    if t[3] < t[2]:
-        return f"{lab} = {_show(t)} lies in a Jordan block (algebraic multiplicity {t[2]}, geometric {t[3]})"
-    return None
+    return f"{lab} = {_show(t)} lies in a Jordan block (algebraic multiplicity {t[2]}, geometric {t[3]})" \
+        if t[3] < t[2] else None

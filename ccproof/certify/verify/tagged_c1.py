@@ -2,7 +2,7 @@
 
 "C1": the spectral part, the crease seen, the eigenvectors x, y, the map (:func:`.tagged_map.check_map`). "not C1":
 a witness net's x, y, z, part G (the generic pair; a dart's flip; a Jordan chain), then B and N (a flip: F). The
-arguments are in docs/tagged_c1.md, "What a certificate states" and "Two refutations beyond the generic pair".
+arguments: docs/tagged_c1.md, "What a certificate states" and "Two refutations beyond the generic pair".
 """
 
 from __future__ import annotations
@@ -58,15 +58,10 @@ def verify_tagged(cert, part, log):
 
 
 def _verify_c1(cert, fam, n, prec, part):
-    """The spectral part (a dart with K >= MIN_N: the mode list, lam1 and lam2 isolated; else the exact spectrum),
-    the crease seen, x and y, the map."""
+    """The spectral part (a dart with K >= MIN_N from the mode list, else exact), the crease seen, x, y, the map."""
     modes = fam == "dart" and n >= MIN_N
-    if modes:
-        ev = mode_spectrum("dart", n)
-        i1, i2, why, msg = _dart_leading(n, ev)
-        ok, lead = why is None, (None, i1, i2)
-    else:
-        ok, msg, lead = tg.leading_spectrum(fam, n, prec)
+    ev = mode_spectrum("dart", n) if modes else None
+    ok, msg, lead = _dart_leading(n, ev) if modes else tg.leading_spectrum(fam, n, prec)
     part("spectral part of the generalized Reif criterion", ok, msg)
     if ok and fam != "dart":
         cpoly = tg.crease_block(fam, n).charpoly()
@@ -82,10 +77,9 @@ def _verify_c1(cert, fam, n, prec, part):
         raise CertificateError("map.orientation must be 1 or -1")
     vecs, vals = {}, {}
     for c, t in (("x", lead[1]), ("y", lead[2])):
-        if modes:
-            val, (_, vec, msg) = ev[t][0].real, _mode_coordinate(fam, n, ev, field_of(mp, c, dict, "map"), c, t)
-        else:
-            val, vec, msg = eigenvector_of(fam, n, field_of(mp, c, dict, "map"), c, prec)
+        spec = field_of(mp, c, dict, "map")  # a mode coordinate is the entry t itself, an exact one must be its root
+        val, vec, msg = (ev[t][0].real, *_mode_coordinate(fam, n, ev, spec, c, t)[1:]) if modes else \
+            eigenvector_of(fam, n, spec, c, prec)
         ok = vec is not None and (modes or _same_root(t, val))
         part(f"{c}: eigenvector of lam{'1' if c == 'x' else '2'}", ok,
              msg if vec is None or ok else "not the eigenvalue of lam1 / lam2")
@@ -94,6 +88,20 @@ def _verify_c1(cert, fam, n, prec, part):
         vals[c], vecs[c] = val, vec
     check_map(fam, n, vecs["x"], vecs["y"], vals["x"], vals["y"], mp["orientation"],
               field_of(cert, "parts", dict, "certificate"), prec, part)
+
+
+def _dart_leading(k, ev):
+    """(ok, message, (None, i1, i2)): a dart's lam1 and lam2 in the mode list and whether the spectral part holds."""
+    rest = sorted((i for i, t in enumerate(ev) if abs(t[0]) < 1), key=lambda i: -abs(ev[i][0]).mid())
+    (i1, i2), (l1, l2) = rest[:2], (ev[rest[0]][0], ev[rest[1]][0])
+    why = _mode_lead_why(ev, i1, i2) or (
+        "lam1 or lam2 is not certainly real and positive" if not all(z.imag.is_zero() and z.real > 0 for z in (l1, l2))
+        else "lam1 > lam2 is not certain" if not l1.real > l2.real else None)
+    where = [f"mode {ev[i][3]}" if ev[i][3] else "even" for i in (i1, i2)]
+    return why is None, (f"dart:{k}: 1 simple; lam1 = {l1.real.str(5, radius=False)} ({where[0]}) > lam2 = "
+                         f"{l2.real.str(5, radius=False)} ({where[1]}), each simple"
+                         f" > |lam3| = {abs(ev[rest[2]][0]).str(5, radius=False)}" if why is None else
+                         f"dart:{k}: {why}"), (None, i1, i2)
 
 
 def _isolated_coordinate(ev, spec, c, cp, cval, simple, what, solve):
@@ -114,20 +122,6 @@ def _isolated_coordinate(ev, spec, c, cp, cval, simple, what, solve):
     return (i,) + solve(i, _pivot(spec, c, len(ev), cp))
 
 
-def _dart_leading(k, ev):
-    """(i1, i2, why, message): a dart's lam1 and lam2 in the mode list, why None when the spectral part holds."""
-    rest = sorted((i for i, t in enumerate(ev) if abs(t[0]) < 1), key=lambda i: -abs(ev[i][0]).mid())
-    (i1, i2), (l1, l2) = rest[:2], (ev[rest[0]][0], ev[rest[1]][0])
-    why = _mode_lead_why(ev, i1, i2) or (
-        "lam1 or lam2 is not certainly real and positive" if not all(z.imag.is_zero() and z.real > 0 for z in (l1, l2))
-        else "lam1 > lam2 is not certain" if not l1.real > l2.real else None)
-    where = [f"mode {ev[i][3]}" if ev[i][3] else "even" for i in (i1, i2)]
-    msg = (f"dart:{k}: 1 simple; lam1 = {l1.real.str(5, radius=False)} ({where[0]}) > lam2 = "
-           f"{l2.real.str(5, radius=False)} ({where[1]}), each simple"
-           f" > |lam3| = {abs(ev[rest[2]][0]).str(5, radius=False)}" if why is None else f"dart:{k}: {why}")
-    return i1, i2, why, msg
-
-
 def _verify_witness(w, fam, n, prec, part, log):
     """A "not C1" witness: x, y (, z), G, then B and N; a dart's flip (x, y, quadrant): G and F."""
     dart = fam == "dart"
@@ -144,16 +138,15 @@ def _verify_witness(w, fam, n, prec, part, log):
         return
     vecs, second, label = got
     if not dart:
-        check_boundary(fam, n, r, vecs, part)
+        check_boundary(fam, n, r, (vecs["x"], vecs["y"]), vecs["z"], part)
     J = _jacobian(fam, n, q, vecs["x"], second)
     part(f"F flip at vertex (1,1) of quadrant {q}: J_xy != 0, so the normal there is (alpha beta)^m J_xy e_z + "
          "o(|alpha beta|^m)" if dart else f"N normal at vertex (1,1) of quadrant {q}: {label} != 0", J > 0 or J < 0,
          f"{label} = {J.str(6)}")
     if not part.failed:
-        log(f"  the limit surface of this net is not C1 at the dart vertex: the unit normals at the level-m copies "
-            f"of quadrant {q}'s (1,1) tend to (-1)^m sign(J_xy) e_z (no limit; the projection folds)" if dart else
-            f"  the limit surface of this net is not C1 at the {fam} vertex: normals along the level-m "
-            f"copies of quadrant {q}'s (1,1) tend to n_z != 0, yet e_z lies in T_v (ray {r})")
+        log(f"  the limit surface of this net is not C1 at the {fam} vertex: the unit normals at the level-m copies of "
+            f"quadrant {q}'s (1,1) tend to " + ("(-1)^m sign(J_xy) e_z (no limit; the projection folds)" if dart else
+                                                f"n_z != 0, yet e_z lies in T_v (ray {r})"))
 
 
 def _witness_exact(fam, n, w, prec, part):
@@ -167,22 +160,24 @@ def _witness_exact(fam, n, w, prec, part):
         part(f"{c}: {'(generalized) ' if c == 'z' or tops[c] else ''}eigenvector of S", vecs[c] is not None, msg)
         if vecs[c] is None:
             return None
+    ev = tg.eigenvalues(fam, n, prec)  # each root once per unit of algebraic multiplicity
     if fam == "dart":
-        (ok, msg), title, second = _flip_generic(n, vals["x"], vals["y"], prec), _G_FLIP, "J_xy"
+        title, second, check = _G_FLIP, "J_xy", lambda: _flip_generic(ev, vals["x"], vals["y"])
     elif tops["y"] is not None:
-        (ok, msg), title, second = _chain_generic(fam, n, vals, tops, prec), _G_CHAIN, "J_xe"
+        title, second, check = _G_CHAIN, "J_xe", lambda: _chain_generic(fam, n, ev, vals, tops)
     else:
-        (ok, msg), title, second = _ordering(fam, n, *(vals[c] for c in "xyz"), prec, tops["z"] is not None), \
-            G_GENERIC, "J_xy"
+        title, second, check = G_GENERIC, "J_xy", lambda: _ordering(fam, n, ev, vals, tops["z"] is not None)
+    ok, msg = (False, "eigenvalue 1 is not simple") if sum(1 for t in ev if t[1] == tg.ONE) != 1 else check()
     part(title, ok, msg)
+    if ok and fam != "dart":  # B reads z on the crease points
+        vecs["z"] = [vecs["z"][i] for i in tg.crease_points(fam, n)]
     return (vecs, tops["y"] if second == "J_xe" else vecs["y"], second) if ok else None
 
 
 def _witness_modes(fam, n, w, part):
     """Parts x, y, z and G for crease:N, corner:N, N >= MIN_N: x and y eigenvectors of simple mode roots (closed
     form), z's existence from its crease values."""
-    ev = mode_spectrum(fam, n)
-    vecs, at = {}, {}
+    ev, vecs, at = mode_spectrum(fam, n), {}, {}
     for c in ("x", "y"):
         at[c], vecs[c], msg = _mode_coordinate(fam, n, ev, field_of(w, c, dict, "witness"), c)
         part(f"{c}: eigenvector of S", vecs[c] is not None, msg)
@@ -192,29 +187,24 @@ def _witness_modes(fam, n, w, part):
     at_g = [t for t in ev if t[2] == "I" and (t[1] == g if t[1] is not None else t[0].real.overlaps(arb(g)))]
     why = crease_eigen_why(tg.crease_block(fam, n), g, cval) or (
         f"{g} is possibly a multiple eigenvalue of I" if len(at_g) > 1 else None)
-    part("z: (generalized) eigenvector of S", why is None,
+    part("z: (generalized) eigenvector of S", why is None, why or
          f"eigenvalue {g}: C c = {g} c exactly on the crease points, and {g} is at most a simple eigenvalue of I, so "
-         f"some z with these crease values has (S - {g})^2 z = 0 and (S - {g}) z = 0 on the crease points"
-         if why is None else why)
+         f"some z with these crease values has (S - {g})^2 z = 0 and (S - {g}) z = 0 on the crease points")
     if why is not None:
         return None
     ia, ib = at["x"], at["y"]
-    why = _mode_lead_why(ev, ia, ib) or _crease_top_why(tg.crease_block(fam, n), g) or (
+    why = _mode_lead_why(ev, ia, ib) or crease_top_why(tg.crease_block(fam, n), g) or (
         "gamma < beta is not certain" if not arb(g) < ev[ib][0].real else None)
-    part(G_GENERIC, why is None, f"alpha = {ev[ia][0].real.str(8)} > beta = {ev[ib][0].real.str(8)} > |every other| "
-         f"(each simple), 1 simple; gamma = {g} < beta" if why is None else why)
-    if why is not None:
-        return None
-    cp = tg.crease_points(fam, n)
-    vecs["z"] = [cval[cp.index(i)] if i in cp else None for i in range(len(ev))]  # B reads the crease points only
-    return vecs, vecs["y"], "J_xy"
+    part(G_GENERIC, why is None, why or f"alpha = {ev[ia][0].real.str(8)} > beta = {ev[ib][0].real.str(8)} > "
+         f"|every other| (each simple), 1 simple; gamma = {g} < beta")
+    vecs["z"] = cval
+    return None if why else (vecs, vecs["y"], "J_xy")
 
 
 def _crease_values(spec, c, cp):  # the crease values of a coordinate, one decimal per crease point
     crease = field_of(spec, "crease", list, c)
     if len(crease) != len(cp):
-        raise CertificateError(f"{c}: crease values must be {len(cp)} decimals" + ("" if cp else
-                                                                                   " (a dart's crease [])"))
+        raise CertificateError(f"{c}: crease values must be {len(cp)} decimals" + ("" if cp else " (dart: crease [])"))
     return [parse_decimal(v) for v in crease]
 
 
@@ -257,10 +247,7 @@ def read_z(spec):
 
 
 def crease_eigen_why(C, g, cval):
-    """None when C c = g c exactly with c != 0 (c the crease values), else the reason.
-
-    >>> crease_eigen_why(tg.crease_block("corner", 7), fmpq(1, 2), [0, 1, 2, 0, 0])
-    """
+    """None when C c = g c exactly with c != 0 (c the crease values), else the reason."""
     Cc = C * fmpq_mat([[v] for v in cval])
     ok = any(v != 0 for v in cval) and all(Cc[i, 0] == g * v for i, v in enumerate(cval))
     return None if ok else f"no eigenvector for {g} with the given crease values (C c = {g} c, c != 0 fails)"
@@ -277,10 +264,25 @@ def eigenvector_of(fam, n, spec, c, prec, chain=False):
     exact_keys(spec, ("eigenvalue", "crease", "pivot") if "pivot" in spec else ("eigenvalue", "crease"), c)
     cp = [] if fam == "dart" else tg.crease_points(fam, n)  # a dart's sharp ray is no closed block
     cval, S = _crease_values(spec, c, cp), tg.sector_matrix(fam, n)
-    if not isinstance(spec["eigenvalue"], str):  # an irrational eigenvalue, [low, high]
-        return _ball_eigenvector(fam, n, spec, c, cp, cval, prec)
+    if not isinstance(spec["eigenvalue"], str):  # an irrational eigenvalue, [low, high]: the bordered system in arb
+        ev, free = tg.eigenvalues(fam, n, prec), [j for j in range(S.nrows()) if j not in cp]
+
+        def solve(i, pivot):
+            if cp and ev[i][1].gcd(tg.crease_block(fam, n).charpoly()).degree() > 0:
+                return None, "the eigenvalue is one of the crease block's"
+            try:
+                sol = dict(zip(free, bordered_solve([[arb(S[a, b]) for b in free] for a in free], ev[i][0].real,
+                                                    free.index(pivot), arb_mat)))
+            except ZeroDivisionError:
+                return None, f"the system for the eigenvector of {ev[i][0].real.str(8)} (pivot {pivot}) is not " \
+                             "certainly regular"
+            return [sol.get(j, arb(0)) for j in range(S.nrows())], f"eigenvalue {ev[i][0].real.str(10)} (simple " \
+                f"root of {ev[i][1]}); vector in arb, pivot {tg.labels(fam, n)[pivot]}"
+        i, vec, msg = _isolated_coordinate(ev, spec, c, cp, cval, lambda i: ev[i][2] == 1,
+                                           f"one simple real eigenvalue of {fam}:{n}", solve)
+        return None if i is None else ev[i][0].real, vec, msg
     lam = parse_decimal(spec["eigenvalue"])
-    A = S - lam * fmpq_mat([[int(i == j) for j in range(S.nrows())] for i in range(S.nrows())])
+    A = S - lam * tg.identity(S.nrows())
     if "pivot" in spec:  # one more fixed coordinate: 1 at the pivot
         cp, cval = cp + [_pivot(spec, c, S.nrows(), cp)], cval + [fmpq(1)]
     vec = _solve_exact(A, cp, cval)
@@ -296,68 +298,35 @@ def eigenvector_of(fam, n, spec, c, prec, chain=False):
                      "(generalized)"
 
 
-def _ball_eigenvector(fam, n, spec, c, cp, cval, prec):
-    ev, S = tg.eigenvalues(fam, n, prec), tg.sector_matrix(fam, n)
-    free = [j for j in range(S.nrows()) if j not in cp]
-
-    def solve(i, pivot):
-        if cp and ev[i][1].gcd(tg.crease_block(fam, n).charpoly()).degree() > 0:
-            return None, "the eigenvalue is one of the crease block's"
-        try:
-            sol = dict(zip(free, bordered_solve([[arb(S[a, b]) for b in free] for a in free], ev[i][0].real,
-                                                free.index(pivot), arb_mat)))
-        except ZeroDivisionError:
-            return None, f"the system for the eigenvector of {ev[i][0].real.str(8)} (pivot {pivot}) is not certainly " \
-                         "regular"
-        return [sol.get(j, arb(0)) for j in range(S.nrows())], \
-            f"eigenvalue {ev[i][0].real.str(10)} (simple root of {ev[i][1]}); vector in arb, pivot " \
-            f"{tg.labels(fam, n)[pivot]}"
-    i, vec, msg = _isolated_coordinate(ev, spec, c, cp, cval, lambda i: ev[i][2] == 1,
-                                       f"one simple real eigenvalue of {fam}:{n}", solve)
-    return None if i is None else ev[i][0].real, vec, msg
-
-
 def _solve_exact(A, cp, cval):
     """A vector v != 0 with A v = 0 exactly and v = cval on the points cp (free unknowns 0), or None."""
-    m = A.nrows()
-    free = [i for i in range(m) if i not in cp]
+    free = [i for i in range(A.nrows()) if i not in cp]
     sol = kernel_basis(fmpq_mat([[A[i, j] for j in free] + [sum((A[i, j] * cval[k] for k, j in enumerate(cp)), fmpq(0))]
-                                 for i in range(m)])).get(len(free))  # consistent iff the last column is free
-    if sol is None:
-        return None
-    vec = dict(zip(cp, cval)) | dict(zip(free, sol))
-    vec = [vec[j] for j in range(m)]
-    return vec if any(v != 0 for v in vec) else None
+                                 for i in range(A.nrows())])).get(len(free))  # consistent iff the last column is free
+    vec = None if sol is None else dict(zip(cp, cval)) | dict(zip(free, sol))
+    return [vec[j] for j in range(A.nrows())] if vec and any(v != 0 for v in vec.values()) else None
 
 
-def check_boundary(fam, n, r, vecs, part):
-    """Part B into ``part``: ray r's limit curve lies on the z-axis (x = y = 0 exactly on its crease points) and
-    z's limit leaves v (0 at v, not 0 at ray r's first point); ``vecs`` {"x", "y", "z": values}."""
-    pts = tg.labels(fam, n)
-    on_curve = [0] + [pts.index(("r", s, a, 0)) for s in (tg.sharp_rays(fam, n) if fam == "crease" else (r,))
-                      for a in (1, 2)]
-    z = vecs["z"]
-    exact = all(isinstance(z[i], fmpq) for i in on_curve)
-    at_v = (z[0] if fam == "corner" else (z[pts.index(("r", 0, 1, 0))] + 4 * z[0] + z[pts.index(("r", n, 1, 0))]) / 6
-            ) if exact else None
-    leave = (z[0] + 4 * z[pts.index(("r", r, 1, 0))] + z[pts.index(("r", r, 2, 0))]) / 6 if exact else None
-    ok = all_zero(vecs[c][i] for c in ("x", "y") for i in on_curve) and exact and at_v == 0 and leave != 0
+def check_boundary(fam, n, r, xy, zc, part):
+    """Part B into ``part``: ray r's limit curve lies on the z-axis (the vectors ``xy`` exactly 0 on its crease
+    points) and z's limit leaves v (0 at v, not 0 at ray r's first point); ``zc`` z on the crease points."""
+    idx, _ = tg.point_index(fam, n)
+    curve = [0] + [idx[("r", s, a, 0)] for s in (tg.sharp_rays(fam, n) if fam == "crease" else (r,)) for a in (1, 2)]
+    z, leave = dict(zip(tg.crease_points(fam, n), zc)), None
+    ok = all_zero(v[i] for v in xy for i in curve) and all(isinstance(z[i], fmpq) for i in curve)
+    if ok:  # the limit of z at v and at ray r's first point (the B-spline limit mask)
+        at_v = z[0] if fam == "corner" else (z[idx[("r", 0, 1, 0)]] + 4 * z[0] + z[idx[("r", n, 1, 0)]]) / 6
+        leave = (z[0] + 4 * z[idx[("r", r, 1, 0)]] + z[idx[("r", r, 2, 0)]]) / 6
+        ok = at_v == 0 and leave != 0
     part(f"B boundary segment: ray {r}'s limit curve lies on the z-axis and leaves v", ok,
          f"x = y = 0 on its crease points, limit z at v = 0, limit z of ray {r}'s first point = {leave}" if ok
          else "x or y not exactly 0 on the curve, or z's limit curve does not start at v = 0 and leave it")
 
 
 def _jacobian(fam, n, q, x, y):  # J_xy at the vertex (1,1) of quadrant q
-    pts = tg.labels(fam, n)
-
-    def index(a, b):
-        if (a, b) == (0, 0):
-            return 0
-        if a == 0:
-            return pts.index(("r", (q + 1) % n if fam == "dart" else q + 1, b, 0))
-        return pts.index(("r", q, a, 0) if b == 0 else ("q", q, a, b))
-
-    (xa, xb), (ya, yb) = (vertex_tangents({(a, b): v[index(a, b)] for a in range(3) for b in range(3)}) for v in (x, y))
+    idx, _ = tg.point_index(fam, n)
+    (xa, xb), (ya, yb) = (vertex_tangents({(a, b): v[idx[tg.position_key(fam, n, q, a, b)]] for a in range(3)
+                                           for b in range(3)}) for v in (x, y))
     return xa * yb - xb * ya
 
 
@@ -385,16 +354,17 @@ def _find(ev, v, skip=()):  # the first entry other than 1 and those in skip wit
     return next((i for i, t in enumerate(ev) if i not in skip and t[1] != tg.ONE and _same_root(t, v)), None)
 
 
+def _pair(ev, a, b):  # the entries of alpha and beta (distinct, neither the eigenvalue 1), None where missing
+    ia = _find(ev, a)
+    return ia, None if ia is None else _find(ev, b, (ia,))
+
+
 def _below(ev, skip, bounds, what, tie=None):
     """The reason an entry other than 1, those in ``skip`` and roots equal to ``tie`` is not certainly below each
     of ``bounds`` in modulus, or None."""
     bad = [t for i, t in enumerate(ev) if i not in skip and t[1] != tg.ONE and not (
         tie is not None and _same_root(t, tie)) and not all(abs(t[0]) < b for b in bounds)]
     return f"an eigenvalue ({bad[0][0].str(6)}) is not certainly {what}" if bad else None
-
-
-def _one_simple(ev):
-    return None if sum(1 for t in ev if t[1] == tg.ONE) == 1 else "eigenvalue 1 is not simple"
 
 
 def _chain_top(fam, n, lam, vec):
@@ -406,51 +376,48 @@ def _chain_top(fam, n, lam, vec):
     return top if any(v != 0 for v in top) else None
 
 
-def _flip_generic(n, a, b, prec):
-    """(ok, message): G of a dart's flip: 1 simple; alpha, beta simple, certainly of opposite signs, each certainly
+def _flip_generic(ev, a, b):
+    """(ok, message): G of a dart's flip (1 simple): alpha, beta simple, certainly of opposite signs, each certainly
     larger in modulus than every other eigenvalue."""
-    ev = tg.eigenvalues("dart", n, prec)
-    ia = _find(ev, a)
-    ib = None if ia is None else _find(ev, b, (ia,))
+    ia, ib = _pair(ev, a, b)
     A, B = (None, None) if ib is None else (ev[ia][0].real, ev[ib][0].real)
-    why = _one_simple(ev) or ("alpha or beta is not an eigenvalue (distinct from the other)" if ib is None else
-                              "alpha or beta is not a simple eigenvalue" if ev[ia][2] != 1 or ev[ib][2] != 1 else
-                              "alpha beta < 0 is not certain" if not (A > 0 and B < 0 or A < 0 and B > 0) else
-                              _below(ev, (ia, ib), (abs(A), abs(B)), "smaller in modulus than alpha and beta"))
-    if why:
-        return False, why
-    top = max((abs(t[0]) for i, t in enumerate(ev) if i not in (ia, ib) and t[1] != tg.ONE), key=lambda z: z.mid())
-    return True, (f"alpha = {A.str(8, radius=False)}, beta = {B.str(8, radius=False)}: alpha beta < 0, each simple, "
-                  f"> |every other| (at most {top.str(6, radius=False)}); 1 simple")
+    why = ("alpha or beta is not an eigenvalue (distinct from the other)" if ib is None else
+           "alpha or beta is not a simple eigenvalue" if ev[ia][2] != 1 or ev[ib][2] != 1 else
+           "alpha beta < 0 is not certain" if not (A > 0 and B < 0 or A < 0 and B > 0) else
+           _below(ev, (ia, ib), (abs(A), abs(B)), "smaller in modulus than alpha and beta"))
+    return why is None, why or (f"alpha = {A.str(8, radius=False)}, beta = {B.str(8, radius=False)}: alpha beta < 0, "
+                                "each simple, > |every other|; 1 simple")
 
 
-def _chain_generic(fam, n, vals, tops, prec):
-    """(ok, message): G of a Jordan-chain witness; ``vals`` the eigenvalues of x, y, z, ``tops`` (S - lam) of each
-    (None for an eigenvector, :func:`chain_top`)."""
+def _chain_generic(fam, n, ev, vals, tops):
+    """(ok, message): G of a Jordan-chain witness (1 simple); ``vals`` the eigenvalues of x, y, z, ``tops`` (S - lam)
+    of each (None for an eigenvector, :func:`_chain_top`)."""
     a, b, g = vals["x"], vals["y"], vals["z"]
     if tops["y"] is None or tops["z"] is not None or tops["x"] is not None or not isinstance(b, fmpq):
         return False, "y is no generalized eigenvector of a rational beta, or z or x is one"
     if any(tops["y"][i] != 0 for i in tg.crease_points(fam, n)):
         return False, "e = (S - beta) y is not 0 on the crease points"
-    ev = tg.eigenvalues(fam, n, prec)
     ia = _find(ev, a)
     at_b = [i for i, t in enumerate(ev) if _same_root(t, b)]
-    why = _one_simple(ev) or (
+    why = (
         "alpha is not a simple eigenvalue" if ia is None or ev[ia][2] != 1 or ia in at_b else
         "alpha > beta > 0 is not certain" if not (b > 0 and ev[ia][0].real > b) else
         # beta's Jordan blocks have size <= 2 iff dim ker (S - beta)^2 is its algebraic multiplicity (exact)
         f"a Jordan block of size > 2 at beta = {b}" if tg.kernel_dim(fam, n, fmpq_poly([-b, 1]) ** 2) != len(at_b) else
-        _below(ev, [ia, *at_b], (b,), "below beta in modulus") or _crease_top_why(tg.crease_block(fam, n), g) or
+        _below(ev, [ia, *at_b], (b,), "below beta in modulus") or crease_top_why(tg.crease_block(fam, n), g) or
         ("gamma is not beta" if g != b else None))
-    if why:
-        return False, why
-    return True, (f"alpha = {ev[ia][0].real.str(8, radius=False)} > beta = {b} = gamma > |every other|, 1 simple; "
-                  f"beta: algebraic multiplicity {len(at_b)}, geometric {ev[at_b[0]][3]}, Jordan blocks of size <= 2 "
-                  "(dim ker (S - beta)^2 = algebraic multiplicity); e = (S - beta) y != 0, 0 on the crease points")
+    return why is None, why or (
+        f"alpha = {ev[ia][0].real.str(8, radius=False)} > beta = {b} = gamma > |every other|, 1 simple; beta: "
+        f"algebraic multiplicity {len(at_b)}, geometric {ev[at_b[0]][3]}, Jordan blocks of size <= 2 (dim ker "
+        "(S - beta)^2 = algebraic multiplicity); e = (S - beta) y != 0, 0 on the crease points")
 
 
-def _crease_top_why(C, g):
-    """None if g is the largest eigenvalue below 1 of the crease block C (its factors all linear), else the reason."""
+def crease_top_why(C, g):
+    """None if g is the largest eigenvalue below 1 of the crease block C (its factors all linear), else the reason.
+
+    >>> crease_top_why(tg.crease_block("crease", 7), fmpq(1, 2)), crease_top_why(tg.crease_block("crease", 7), 0)
+    (None, "gamma is not the crease block's largest eigenvalue below 1 (1/2)")
+    """
     fac = [p for p, _ in C.charpoly().factor()[1]]
     if any(p.degree() > 1 for p in fac):
         return "the crease block has irrational eigenvalues"
@@ -473,26 +440,23 @@ def _mode_lead_why(ev, ia, ib):
             if not all(abs(t[0]) < beta for t in others) else None)
 
 
-def _ordering(fam, n, a, b, g, prec, generalized):
-    """(ok, message): G of the generic pair: a = lam1 >= b = lam2 >= every other |lam| (1 simple, ties only with b
+def _ordering(fam, n, ev, vals, generalized):
+    """(ok, message): G of the generic pair (1 simple): a = lam1 >= b = lam2 >= every other |lam| (ties only with b
     itself), g the crease block's largest eigenvalue below 1, every eigenvalue of modulus possibly >= b
     non-defective, and g < b when z is a generalized eigenvector."""
-    ev = tg.eigenvalues(fam, n, prec)  # each root once per unit of algebraic multiplicity
-    ia = _find(ev, a)
-    ib = None if ia is None else _find(ev, b, (ia,))
+    a, b, g = vals["x"], vals["y"], vals["z"]
+    ia, ib = _pair(ev, a, b)
     beta = None if ib is None else abs(ev[ib][0])
-    why = _one_simple(ev) or (
+    why = (
         "alpha is not an eigenvalue" if ia is None else "beta is not an eigenvalue (distinct from alpha's copy)"
         if ib is None else "alpha >= beta is not certain" if not (abs(ev[ia][0]) >= beta or ev[ia][1] == ev[ib][1])
         else _below(ev, (ia, ib), (beta,), "below beta (lam1, lam2 not alpha, beta)", b) or
-        _crease_top_why(tg.crease_block(fam, n), g) or _jordan_at(ev, beta) or
+        crease_top_why(tg.crease_block(fam, n), g) or _jordan_at(ev, beta) or
         ("z is a generalized eigenvector but gamma < beta is not certain" if generalized and not arb(g) < beta
          else None))
-    if why:
-        return False, why
-    show = [str(v) if isinstance(v, fmpq) else v.str(8) for v in (a, b)]
-    return True, (f"alpha = {show[0]}, beta = {show[1]}, gamma = {g}{' (Jordan chain)' if generalized else ''}; "
-                  "1 simple; no Jordan block at |lam| >= beta")
+    show = [str(v) if isinstance(v, fmpq) else v.str(8) for v in (a, b)] + [" (Jordan chain)" if generalized else ""]
+    return why is None, why or f"alpha = {show[0]}, beta = {show[1]}, gamma = {g}{show[2]}; 1 simple; no Jordan " \
+        "block at |lam| >= beta"
 
 
 def _jordan_at(ev, beta):  # the reason if an eigenvalue of modulus possibly >= beta is defective

@@ -15,8 +15,8 @@ from .record import exact_keys, field_of
 from .replay import parse_decimal
 from .spectrum import RING_INDEX, SMALL_ROOTS, ring_block
 from .statement import lam_of
-from .tagged import crease_block, crease_points, labels, window_rows
-from .tagged_c1 import G_GENERIC, check_boundary, crease_eigen_why, read_z, vertex_tangents
+from .tagged import crease_block, window_rows
+from .tagged_c1 import G_GENERIC, check_boundary, crease_eigen_why, crease_top_why, read_z, vertex_tangents
 from .tagged_modes import bordered_solve, charpoly_roots, check_ring, check_structure, mode_reflection
 
 WINDOW = (7, 8)  # the window classes of every N >= 7 occur in both
@@ -25,8 +25,6 @@ MAX_ARCS = 8192  # arcs on either circle, and boxes on the disc (bounded work fo
 # evaluations of H weighted by (prec + 1024)/1024, checked before any arithmetic: the published need 3,042, the
 # prover's widest hints (every N0 >= 7) about 21,000; at the budget a file costs about 5 s of CPU
 TAIL_BUDGET = 3 * 8192
-_LIMIT_KEYS = ("rho", "R", "arcs", "outer_arcs", "box")
-_PIVOT = RING_INDEX[(1, 0)]
 
 
 @cache
@@ -55,11 +53,7 @@ def check_windows(fam):
 @cache
 def reflection_identity():
     """Is B(1/w) R_w = R_w B(w) an identity of Laurent polynomials in w (exact)? w^3 times the difference is a
-    polynomial of degree <= 5 (the stencil reaches w^-1 .. w^2, R_w holds 1 and 1/w): zero at 12 points, zero.
-
-    >>> reflection_identity()
-    True
-    """
+    polynomial of degree <= 5 (the stencil reaches w^-1 .. w^2, R_w holds 1 and 1/w): zero at 12 points, zero."""
     check_ring()
     for w in (fmpq(a, b) for a in (1, 2, 3, -1, -2, -3) for b in (1, 5)):
         B, Bi, R = (fmpq_mat(m) for m in (ring_block(w), ring_block(1 / w), mode_reflection(w)))
@@ -68,59 +62,44 @@ def reflection_identity():
     return True
 
 
-def _tangents(theta, j):
-    """(T_a, T_b) of f(j theta) at the (1,1) vertex of quadrant 0 (acb); ZeroDivisionError unless (1 + c)(9 + c)
-    certainly has a positive real part and the bordered system is certainly regular."""
-    w = (acb(0, j) * theta).exp()
-    c = (w + 1 / w) / 2
-    disc = (1 + c) * (9 + c)
-    if not disc.real > 0:
-        raise ZeroDivisionError("(1 + c)(9 + c) is not certainly in the right half-plane")
-    lam = lam_of(c)
-    sol = bordered_solve(ring_block(w), lam, _PIVOT)
-    vh = {p: sol[i] for p, i in RING_INDEX.items()}
-    val = {}
-    for a in range(3):
-        for b in range(3):  # the centre and ray 0: 0; ray 1: v^(b,0)(w - 1/w); quadrant 0: v^(a,b) - v^(b,a)/w
-            val[a, b] = (acb(0) if b == 0 else vh[(b, 0)] * (w - 1 / w) if a == 0 else vh[(a, b)] - vh[(b, a)] / w)
-    return vertex_tangents(val)
-
-
 def limit_h(theta):
-    """H(theta) for an acb ball theta (part 3); ZeroDivisionError where not proved analytic. H(pi/N)/theta^4 tends to
-    about 1.37136:
+    """H(theta) = J_xy of f(theta), f(2 theta) at the (1,1) vertex of quadrant 0 for an acb ball theta (part 3);
+    ZeroDivisionError unless each (1 + c)(9 + c) certainly has a positive real part and each bordered system is
+    certainly regular (H analytic there). H(pi/N)/theta^4 tends to about 1.37136:
 
     >>> th = arb.pi() / 1000
     >>> (limit_h(acb(th)) / th ** 4).real.str(5, radius=False)
     '1.3714'
     """
-    a1, b1 = _tangents(theta, 1)
-    a2, b2 = _tangents(theta, 2)
+    tangents = []
+    for j in (1, 2):
+        w = (acb(0, j) * theta).exp()
+        c = (w + 1 / w) / 2
+        if not ((1 + c) * (9 + c)).real > 0:
+            raise ZeroDivisionError("(1 + c)(9 + c) is not certainly in the right half-plane")
+        sol = bordered_solve(ring_block(w), lam_of(c), RING_INDEX[(1, 0)])
+        vh = {p: sol[i] for p, i in RING_INDEX.items()}
+        # the centre and ray 0: 0; ray 1: v^(b,0)(w - 1/w); quadrant 0: v^(a,b) - v^(b,a)/w
+        tangents.append(vertex_tangents({(a, b): acb(0) if b == 0 else vh[(b, 0)] * (w - 1 / w) if a == 0 else
+                                         vh[(a, b)] - vh[(b, a)] / w for a in range(3) for b in range(3)}))
+    (a1, b1), (a2, b2) = tangents
     return a1 * b2 - b1 * a2
 
 
 def _check_disc(R, side):
     """The number of boxes of the grid of ``side`` that meet |theta| <= R, each proved (H analytic there), or the
     failing box as a string."""
-    m = int(-(-R.p * side.q // (R.q * side.p)))  # ceil(R / side)
-    count = 0
-    for u in range(-m, m):
-        for v in range(-m, m):
-            lo = (u * side, v * side)
-            near = [0 if x <= 0 <= x + side else min(abs(x), abs(x + side)) for x in lo]
-            if near[0] ** 2 + near[1] ** 2 > R * R:
-                continue
-            box = acb(*(arb(x).union(arb(x + side)) for x in lo))
-            try:
-                limit_h(box)
-            except ZeroDivisionError:
-                return f"[{lo[0]}, {lo[0] + side}] x [{lo[1]}, {lo[1] + side}]"
-            count += 1
+    m, count = int(-(-R.p * side.q // (R.q * side.p))), 0  # m = ceil(R / side)
+    for lo in ((u * side, v * side) for u in range(-m, m) for v in range(-m, m)):
+        near = [0 if x <= 0 <= x + side else min(abs(x), abs(x + side)) for x in lo]
+        if near[0] ** 2 + near[1] ** 2 > R * R:
+            continue
+        try:
+            limit_h(acb(*(arb(x).union(arb(x + side)) for x in lo)))
+        except ZeroDivisionError:
+            return f"[{lo[0]}, {lo[0] + side}] x [{lo[1]}, {lo[1] + side}]"
+        count += 1
     return count
-
-
-def _on_circle(radius, k, arcs):
-    return acb(arb(0), arb(2 * k) / arcs * arb.pi()).exp() * radius
 
 
 def _circle_bound(R, arcs):
@@ -139,21 +118,38 @@ def _circle_bound(R, arcs):
 def _winding(rho, arcs, R, M):
     """(the winding number of H along |theta| = rho (an arb ball), None) or (None, the reason); each arc's image lies
     in a disc about H(z_k) that misses 0 (|H'| <= M R/(R - rho)^2 by Cauchy)."""
-    slope = M * R / (R - rho) ** 2  # |H'| on |theta| = rho (Cauchy on |theta| = R)
-    length = 2 * arb.pi() * rho / arcs
-    vals = [limit_h(_on_circle(rho, k, arcs)) for k in range(arcs + 1)]
+    step = M * R / (R - rho) ** 2 * 2 * arb.pi() * rho / arcs  # |H'| on |theta| = rho times an arc's length
+    vals = [limit_h(acb(arb(0), arb(2 * k) / arcs * arb.pi()).exp() * rho) for k in range(arcs + 1)]
     turn = arb(0)
     for k, (h0, h1) in enumerate(zip(vals, vals[1:])):
-        if not slope * length < abs(h0):
-            return None, f"arc {k} of {arcs}: |H'| * length = {(slope * length).str(3)} is not below |H| = " \
-                         f"{abs(h0).str(3)} (its image may touch 0)"
+        if not step < abs(h0):
+            return None, f"arc {k} of {arcs}: |H'| * length = {step.str(3)} is not below |H| = {abs(h0).str(3)} " \
+                         "(its image may touch 0)"
         turn += (h1 / h0).arg()
     return turn / (2 * arb.pi()), None
 
 
+def _uniform_spectrum(fam, n0, g, C, blocks):
+    """(ok, message): part 2 for every N >= n0 with gamma = g (exact): 1 simple, alpha and beta lead, gamma the crease
+    block's largest eigenvalue below 1, at most simple in I and below beta."""
+    why = crease_top_why(C, g)
+    if why is None:  # the crease block's roots are rational
+        croots = [q for _, q in charpoly_roots(C)]
+        below = [r for r in croots if r < 1]
+        b0 = lam_of(arb(fmpq(2, n0)).cos_pi())  # <= beta = lam(cos(2 pi/N)) for every N >= n0
+        others = [arb(abs(r)) for r in below] + [abs(z) for M in blocks for z, _ in charpoly_roots(M)] + [
+            arb(s) for s in SMALL_ROOTS] + [arb(fmpq(1, 4))]
+        why, cg = _gap(croots, below, blocks, others, g, b0, n0)
+    if why is not None:
+        return False, f"every N >= {n0}: {why}"
+    return True, (f"every N >= {n0}: alpha = lam(cos(pi/N)) > beta = lam(cos(2 pi/N)) >= {b0.str(6, radius=False)} > "
+                  f"every other eigenvalue (<= {max(others, key=lambda x: x.mid()).str(4)}, each simple), 1 simple "
+                  f"(crease block); gamma = {g} < beta, at most simple in I (only at c = {cg})")
+
+
 def _gap(croots, below, blocks, others, g, b0, n0):
-    """(the first reason 1 is not simple, alpha and beta do not lead, or gamma = g is not the crease block's largest
-    eigenvalue below 1, simple in I and below beta, or None; c*(g))."""
+    """(the first reason 1 is not simple, alpha and beta do not lead, or gamma = g is not simple in I and below
+    beta, or None; c*(g))."""
     cstar = lambda x: 8 * x + 1 / (2 * fmpq(x)) - 5  # a rational x != 0 is a root of q_c only at c = c*(x)
     cg = cstar(g) if g != 0 else None
     return next((why for bad, why in (
@@ -162,30 +158,10 @@ def _gap(croots, below, blocks, others, g, b0, n0):
         (lambda: not lam_of(arb(1)) < 1, "lam(1) < 1 is not certain"),
         (lambda: not all(x < b0 for x in others),
          f"an eigenvalue other than alpha, beta is not certainly below lam(cos(2 pi/{n0}))"),
-        (lambda: g != max(below),
-         f"gamma is not the crease block's largest eigenvalue below 1 ({max(below, default=None)})"),
         (lambda: not arb(g) < b0, f"gamma < lam(cos(2 pi/{n0})) is not certain"),
         (lambda: g in SMALL_ROOTS or cg is None or (1 + cg) * (9 + cg) == 0 or any(M.charpoly()(g) == 0
                                                                                     for M in blocks),
          "gamma is possibly a multiple eigenvalue of I")) if bad()), None), cg
-
-
-def _uniform_spectrum(fam, n0, g, C, blocks):
-    """(ok, message): part 2 for every N >= n0 with gamma = g (exact)."""
-    fac = C.charpoly().factor()[1]
-    if any(p.degree() > 1 for p, _ in fac):
-        return False, "the crease block has irrational eigenvalues"
-    croots = [r for p, e in fac for r in [-p[0] / p[1]] * e]
-    below = [r for r in croots if r < 1]
-    b0 = lam_of(arb(fmpq(2, n0)).cos_pi())  # <= beta = lam(cos(2 pi/N)) for every N >= n0
-    inner = [z for M in blocks for z, _ in charpoly_roots(M)]
-    others = [arb(abs(r)) for r in below] + [abs(z) for z in inner] + [arb(s) for s in SMALL_ROOTS] + [arb(fmpq(1, 4))]
-    why, cg = _gap(croots, below, blocks, others, g, b0, n0)
-    if why is not None:
-        return False, f"every N >= {n0}: {why}"
-    return True, (f"every N >= {n0}: alpha = lam(cos(pi/N)) > beta = lam(cos(2 pi/N)) >= {b0.str(6, radius=False)} > "
-                  f"every other eigenvalue (<= {max(others, key=lambda x: x.mid()).str(4)}, each simple), 1 simple "
-                  f"(crease block); gamma = {g} < beta, at most simple in I (only at c = {cg})")
 
 
 def verify_tail(cert, fam, n0, part, log):
@@ -203,12 +179,10 @@ def verify_tail(cert, fam, n0, part, log):
     if not MIN_TAIL <= n0 <= 10**6:
         raise CertificateError(f"{fam}:>={n0}: the window argument needs N0 >= {MIN_TAIL}")
     exact_keys(cert, ("schema", "configuration", "statement", "prec", "witness", "limit"), "certificate")
-    prec = read_prec(cert)
-    w = field_of(cert, "witness", dict, "certificate")
+    prec, w, lim = read_prec(cert), field_of(cert, "witness", dict, "certificate"), cert["limit"]
     exact_keys(w, ("z",), "witness")
+    exact_keys(field_of(cert, "limit", dict, "certificate"), ("rho", "R", "arcs", "outer_arcs", "box"), "limit")
     g, cval = read_z(field_of(w, "z", dict, "witness"))
-    lim = field_of(cert, "limit", dict, "certificate")
-    exact_keys(lim, _LIMIT_KEYS, "limit")
     rho, R, side = (parse_decimal(field_of(lim, k, str, "limit")) for k in ("rho", "R", "box"))
     arcs, outer = (field_of(lim, k, int, "limit") for k in ("arcs", "outer_arcs"))
     if not (1 <= arcs <= MAX_ARCS and 1 <= outer <= MAX_ARCS and 0 < rho < R <= 1 and 0 < side <= R
@@ -218,44 +192,33 @@ def verify_tail(cert, fam, n0, part, log):
     if evals * fmpq(prec + 1024, 1024) > TAIL_BUDGET:
         raise CertificateError(f"limit: {evals} evaluations of H at {prec} bits exceed the budget "
                                f"({TAIL_BUDGET} weighted by (prec + 1024)/1024)")
-    name = f"{fam}:>={n0}"
-    log(f"not C1 certificate for {name} ({prec} bits)")
+    log(f"not C1 certificate for {fam}:>={n0} ({prec} bits)")
     with ctx.workprec(prec):
         _check_tail(fam, n0, g, cval, (rho, R, side, arcs, outer), part, log)
-    return name
+    return f"{fam}:>={n0}"
 
 
-def _check_tail(fam, n0, g, cval, limit, part, log):
+def _check_tail(fam, n0, g, cval, limit, part, log):  # parts 1-5 in order, each only after the previous held
     C, *blocks = check_windows(fam)
-    part("S sector matrices of every N >= 7 from one window", True,
-         f"{fam}:7 and {fam}:8: one row per window class (min(t, 3), min(N - t, 3)), the same in both, rows sum "
-         "to 1; crease block and odd blocks of the modes +-1 equal; non-crease rows the folded ring rule (exact)")
-    rho = limit[0]
-    ok = rho > arb.pi() / n0
-    part(f"range: pi/N < rho for every N >= {n0}", ok, f"rho = {rho} > pi/{n0}" if ok else
-         f"rho = {rho} is not certainly above pi/{n0} = {(arb.pi() / n0).str(6)}")
+    part("S sector matrices of every N >= 7 from one window", True, f"{fam}:7 and {fam}:8: one row per window class "
+         "(min(t, 3), min(N - t, 3)), the same in both, rows sum to 1; crease block and odd blocks of the modes +-1 "
+         "equal; non-crease rows the folded ring rule (exact)")
+    ok = limit[0] > arb.pi() / n0
+    part(f"range: pi/N < rho for every N >= {n0}", ok, f"rho = {limit[0]} > pi/{n0}" if ok else
+         f"rho = {limit[0]} is not certainly above pi/{n0} = {(arb.pi() / n0).str(6)}")
     why = crease_eigen_why(C, g, cval)
     part("z: (generalized) eigenvector of S", why is None,
          why or f"C c = {g} c exactly on the crease points (the same C for every N)")
+    if not part.failed:
+        part(G_GENERIC, *_uniform_spectrum(fam, n0, g, C, blocks))
     if part.failed:
         return
-    ok, msg = _uniform_spectrum(fam, n0, g, C, blocks)
-    part(G_GENERIC, ok, msg)
-    if not ok:
-        return
-    cp = crease_points(fam, WINDOW[0])
-    zero = [fmpq(0) if i in cp else None for i in range(len(labels(fam, WINDOW[0])))]
-    vecs = {"x": zero, "y": zero, "z": [cval[cp.index(i)] if i in cp else None for i in range(len(zero))]}
-    check_boundary(fam, WINDOW[0], 0, vecs, part)  # reads the crease points only: the same for every N
+    check_boundary(fam, WINDOW[0], 0, (), cval, part)  # x, y are 0 on the crease points: the same for every N
     ok = reflection_identity()
     part("N reflection: B(1/w) R_w = R_w B(w) (exact), so f is odd and H has a zero of order >= 4 at 0", ok,
          "" if ok else "the ring stencil breaks the reflection identity")
-    if not part.failed:
-        _check_normal(fam, n0, limit, part, log)
-
-
-def _check_normal(fam, n0, limit, part, log):
-    """N for every N >= n0: H analytic on |theta| <= R, bounded on its circle, winding 4 times along |theta| = rho."""
+    if part.failed:  # N for every N >= n0: H analytic on |theta| <= R, bounded on its circle, winding 4 times
+        return
     rho, R, side, arcs, outer = limit
     got = _check_disc(R, side)
     ok = isinstance(got, int)
@@ -275,7 +238,6 @@ def _check_normal(fam, n0, limit, part, log):
     part(f"N winding: H winds 4 times around 0 along |theta| = {rho}, so J_xy != 0 for every N >= {n0}", ok,
          f"{wn.str(6)} ({arcs} arcs, each image in a disc off 0: |H'| <= M R/(R - rho)^2)" if ok else
          why or f"the winding number {wn.str(6)} is not certainly 4")
-    if not part.failed:
+    if ok:
         log(f"  the limit surface is not C1 at the {fam} vertex for every N >= {n0}: normals along the level-m "
             "copies of quadrant 0's (1,1) tend to n_z != 0, yet e_z lies in T_v (ray 0)")
-

@@ -1,6 +1,5 @@
 """The characteristic map Phi = (X, Y) of a tagged sector and the checks R, T, W, E of a "C1" certificate (trusted;
-docs/tagged_c1.md, "C1": the pieces P1, P2, P3 of quadrant q are B-spline patches of the level-1 net, with the
-ghost row 2 P(a, 0) - P(a, 1) across a sharp ray).
+docs/tagged_c1.md, "C1").
 """
 
 from __future__ import annotations
@@ -77,21 +76,10 @@ def quadrant_nets(fam, n, vx, vy, q, prec):
 
 
 def transversal_form(nets, curve, a1, a2, prec):
-    """Bernstein form (degree 5) of a1 X Y' - a2 Y X' along one outer cubic, oriented counterclockwise; the star form
-    x y' - y x' for the identity map and a1 = a2 = 1 (1/2 on u = 1 of P1 here):
-
-    >>> from ccproof.certify.verify.tagged import labels
-    >>> pts = labels("corner", 1)   # the identity map: x = a, y = b
-    >>> vx = [fmpq(p[2] if p[0] == "q" or p[:2] == ("r", 0) else 0) for p in pts]
-    >>> vy = [fmpq(p[3] if p[0] == "q" else p[2] if p[:2] == ("r", 1) else 0) for p in pts]
-    >>> f = transversal_form(quadrant_nets("corner", 1, vx, vy, 0, 64), "P1s1", arb(1), arb(1), 64)
-    >>> f.coeffs[0].str(5, radius=False)
-    '0.50000'
-    """
-    pts = curve_points(nets, curve, oriented=True)
+    """Bernstein form (degree 5) of a1 X Y' - a2 Y X' along one outer cubic, oriented counterclockwise (for the
+    identity map and a1 = a2 = 1 the star form x y' - y x')."""
     with ctx.workprec(prec):
-        X = BernsteinForm((4,), [p[0] for p in pts], prec=prec)
-        Y = BernsteinForm((4,), [p[1] for p in pts], prec=prec)
+        X, Y = axis_forms(nets, curve, (1, 0), prec)
         return X * Y.diff(0) * a1 - Y * X.diff(0) * a2
 
 
@@ -99,10 +87,9 @@ AXES = {"+x": (1, 0), "-x": (-1, 0), "+y": (0, 1), "-y": (0, -1)}
 
 
 def _crossings(nets, curve, paths, direction, prec):
-    """How often one outer cubic crosses the half-line H = {t d : t > 0} (``direction`` d = (a, b)), from a partition of
-    [0, 1] into boxes each certainly off H (-b X + a Y of one sign, or a X + b Y < 0) or on its side (a X + b Y > 0),
-    where a sign change of -b X + a Y between the ends is one crossing (one direction for all: T); or why a box
-    decides nothing."""
+    """How often one outer cubic crosses the half-line H = {t d : t > 0} (d = (a, b)), or why a box decides nothing:
+    each box of a partition of [0, 1] is certainly off H (-b X + a Y of one sign, or a X + b Y < 0) or on its side
+    (a X + b Y > 0), where a sign change of -b X + a Y between the ends is one crossing (one direction for all: T)."""
     if not check_partition(paths, 1):
         return f"{curve}: the boxes do not partition [0, 1]"
     count = 0
@@ -112,10 +99,13 @@ def _crossings(nets, curve, paths, direction, prec):
             fa, fp = A, P
             for ax, side in parse_path(path, 1):
                 fa, fp = (f.split(ax)[0 if side == "L" else 1] for f in (fa, fp))
-            got = _box_crossings(fa.coeffs, fp.coeffs)
-            if isinstance(got, str):
-                return f"{curve}: box {path!r}{got}"
-            count += got
+            fa, fp = fa.coeffs, fp.coeffs
+            if _sign(fp) or _sign(fa) < 0:  # off H
+                continue
+            if _sign(fa) <= 0 or _sign(fp[:1]) * _sign(fp[-1:]) == 0:
+                return f"{curve}: box {path!r}" + (" decides nothing" if _sign(fa) <= 0 else
+                                                   ": the sign at an end is not certain")
+            count += _sign(fp[:1]) * _sign(fp[-1:]) < 0  # on H's side: a sign change across H is one crossing
     return count
 
 
@@ -142,32 +132,19 @@ def _sign(values):
     return 1 if all(c > 0 for c in values) else -1 if all(c < 0 for c in values) else 0
 
 
-def _box_crossings(fa, fp):
-    """Crossings of H in one box (Bernstein coefficients along and across H), or why it decides nothing."""
-    if _sign(fp) or _sign(fa) < 0:
-        return 0
-    if _sign(fa) <= 0:
-        return " decides nothing"
-    ends = _sign(fp[:1]) * _sign(fp[-1:])
-    if ends == 0:
-        return ": the sign at an end is not certain"
-    return 1 if ends < 0 else 0
-
-
 def _rays_on_axes(fam, n, vx, vy):
-    """(ok, message): E, the sharp rays' layer-0 segments lie on the half-axes: the limit curve of a sharp ray's
-    segment is the cubic B-spline of its level-1 values at 0..3 (X = 0 when they are exactly 0; Y's sign from the
-    Bezier points)."""
+    """(ok, message): E, the sharp rays' layer-0 segments lie on the half-axes: a segment's limit curve is the cubic
+    B-spline of its level-1 values at 0..3 (a coordinate 0 when they are exactly 0; the other's sign from the Bezier
+    points). Crease: X = 0, Y < 0 on ray 0; corner: Y = 0, X > 0; both: X = 0, Y > 0 on ray N."""
     X, Y = level1_values(fam, n, vx), level1_values(fam, n, vy)
-    x0, y0 = [X(0, a, 0) for a in range(4)], [Y(0, a, 0) for a in range(4)]
-    xn, yn = [X(n - 1, 0, b) for b in range(4)], [Y(n - 1, 0, b) for b in range(4)]
-    if fam == "crease":
-        ok = all_zero(x0 + xn) and _sign(_bez(y0)) < 0 and _sign(_bez(yn)) > 0
-        return ok, "X = 0 on both sharp rays, Y < 0 on ray 0 and Y > 0 on ray N" if ok else \
-            "the sharp rays are not mapped onto the negative and positive Y half-axes"
-    ok = all_zero(y0) and _sign(_bez(x0)) > 0 and all_zero(xn) and _sign(_bez(yn)) > 0
-    return ok, "ray 0 onto the positive X half-axis, ray N onto the positive Y half-axis" if ok else \
-        "the sharp rays are not mapped onto the positive half-axes"
+    ray0 = [X(0, a, 0) for a in range(4)], [Y(0, a, 0) for a in range(4)]
+    zero, signed, sign = (ray0[0], ray0[1], -1) if fam == "crease" else (ray0[1], ray0[0], 1)
+    ok = all_zero(zero + [X(n - 1, 0, b) for b in range(4)]) and _sign(_bez(signed)) == sign and _sign(
+        _bez([Y(n - 1, 0, b) for b in range(4)])) > 0
+    return ok, ("X = 0 on both sharp rays, Y < 0 on ray 0 and Y > 0 on ray N" if fam == "crease" else
+                "ray 0 onto the positive X half-axis, ray N onto the positive Y half-axis") if ok else \
+        f"the sharp rays are not mapped onto the {'negative and positive Y' if fam == 'crease' else 'positive'} " \
+        "half-axes"
 
 
 def all_zero(vals):
@@ -228,22 +205,17 @@ _WANT = {"crease": {("+x", 1): 1, ("-x", 1): 0, ("+x", -1): 0, ("-x", -1): 1},
          "dart": {(a, o): 1 for a in AXES for o in (1, -1)}}
 
 
-def _direction(fam, axis, orient, ray):
-    """``(direction, crossings wanted)`` for the certificate's ``parts.winding.axis``."""
-    if ray and isinstance(axis, list) and len(axis) == 2 and axis != [0, 0] \
-            and all(type(c) is int and abs(c) <= 16 for c in axis):
-        return tuple(axis), 1
-    want = _WANT[fam].get((axis, orient)) if isinstance(axis, str) else None
-    if want is None:
-        raise CertificateError(f"parts.winding.axis {str(axis)[:12]!r} is not allowed for {fam}")
-    return AXES[axis], want
-
-
 def _check_winding(fam, nets, curves, win, ray, orient, prec, part):
     """W: the count of crossings says the D-angle (monotone by T) turns by exactly the sector's angle; False when a
-    box decides nothing."""
+    box decides nothing. A ray direction (integers) when every ray is an orbit of D, else a half-axis of _WANT."""
     axis = win.get("axis")
-    direction, want = _direction(fam, axis, orient, ray)
+    if ray and isinstance(axis, list) and len(axis) == 2 and axis != [0, 0] \
+            and all(type(c) is int and abs(c) <= 16 for c in axis):
+        direction, want = tuple(axis), 1
+    elif (want := _WANT[fam].get((axis, orient)) if isinstance(axis, str) else None) is not None:
+        direction = AXES[axis]
+    else:
+        raise CertificateError(f"parts.winding.axis {str(axis)[:12]!r} is not allowed for {fam}")
     title, total = f"W the outer curve crosses the {axis} half-axis {want} time(s)", 0
     for key in curves:
         q, c = key.split(":")

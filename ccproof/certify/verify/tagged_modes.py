@@ -1,6 +1,6 @@
 """The spectrum and leading eigenvectors of crease and corner sectors (N >= MIN_N) and darts' odd half in O(N)
-through the Fourier modes of the smooth ring, every structural claim checked exactly (trusted; the argument:
-docs/tagged_c1.md, "Spectrum in O(N)"); a dart's even half S_E exactly; the bordered systems of the eigenvectors.
+through the Fourier modes of the smooth ring, every structural claim checked exactly; a dart's even half S_E
+exactly; the bordered systems of the eigenvectors (trusted; docs/tagged_c1.md, "Spectrum in O(N)").
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ from .errors import CertificateError
 from .rules import TWO_RING
 from .spectrum import RING_INDEX, SMALL_ROOTS, mode_polynomials_hold, ring_block, ring_stencil
 from .statement import lam_of
-from .tagged import crease_block, crease_points, labels, sector_rows
+from .tagged import crease_block, crease_points, identity, labels, sector_rows
 
 MIN_N = 5  # crease:N, corner:N and dart:K with N, K >= MIN_N take the modes
 
@@ -25,12 +25,8 @@ def _reflect(t, pos):  # the reflection R in ray 0 on the ring: ray t -> ray -t,
 
 @cache
 def check_ring():
-    """Raise unless the ring stencil commutes with R, reaches sectors t - 1 .. t + 2 only, and its Fourier blocks
-    have the claimed characteristic polynomials (:func:`.spectrum.mode_polynomials_hold`).
-
-    >>> check_ring()
-    True
-    """
+    """True, or raise unless the ring stencil commutes with R, reaches sectors t - 1 .. t + 2 only, and its Fourier
+    blocks have the claimed characteristic polynomials (:func:`.spectrum.mode_polynomials_hold`)."""
     for i, pos in enumerate(TWO_RING):
         t, p = _reflect(0, pos)
         image = {(d + t, q): x for (d, q), x in ring_stencil()[RING_INDEX[p]].items()}
@@ -44,8 +40,8 @@ def check_ring():
 
 
 def _ring_row(t, pos, place):
-    """The ring rule of the ring point (t, pos) with its columns placed by ``place(sector, pos)``: (sign, column)
-    or None (weight dropped); zero weights left out."""
+    """The ring rule of the ring point (t, pos), its columns placed by ``place(sector, pos)``: (sign, column) or None
+    (weight dropped); zero weights left out."""
     out = {}
     for (d, q), x in ring_stencil()[RING_INDEX[pos]].items():
         f = place(t + d, q)
@@ -73,32 +69,25 @@ def kernel_basis(M):
 
 def mode_reflection(w):
     """R_w, the reflection R on the mode w: (v o R)(t, p) = w^-t (R_w v^)(p); rays p -> v^(p), quadrants (a, b) ->
-    v^(b, a)/w (rows of numbers like w).
-
-    >>> mode_reflection(fmpq(2))[RING_INDEX[(2, 1)]]
-    [0, 0, 0, 0, 1/2, 0]
-    """
+    v^(b, a)/w (rows of numbers like w)."""
     rows = [[0 * w] * 6 for _ in range(6)]
     for p, i in RING_INDEX.items():
         rows[i][RING_INDEX[p if p[1] == 0 else (p[1], p[0])]] += 1 if p[1] == 0 else 1 / w
     return rows
 
 
-def _odd_block(w):
-    """B(w) on the odd vectors (the kernel of R_w + 1) of the mode w = +-1, checked invariant, or None."""
-    cols = list(kernel_basis(fmpq_mat(mode_reflection(fmpq(w))) + fmpq_mat([[int(i == j) for j in range(6)]
-                                                                          for i in range(6)])).values())
-    if not cols:
-        return None
-    K, B = fmpq_mat([[v[i] for v in cols] for i in range(6)]), fmpq_mat(ring_block(fmpq(w)))
-    M = (K.transpose() * K).inv() * K.transpose() * B * K
-    if B * K != K * M:
-        raise CertificateError(f"the odd vectors of the mode w = {w} are not invariant")
-    return M
-
-
-def _odd_blocks(ends):  # the blocks of the modes w in ends (1, and -1 for an even ring) on their odd vectors
-    return tuple(M for M in (_odd_block(w) for w in ends) if M is not None)
+def _odd_blocks(ends):
+    """B(w) on the odd vectors (the kernel of R_w + 1) of each mode w in ``ends`` (1, and -1 for an even ring) that
+    has any, checked invariant (exact)."""
+    out = []
+    for w in ends:
+        cols = list(kernel_basis(fmpq_mat(mode_reflection(fmpq(w))) + identity(6)).values())
+        if cols:
+            K, B = fmpq_mat([[v[i] for v in cols] for i in range(6)]), fmpq_mat(ring_block(fmpq(w)))
+            out.append((K.transpose() * K).inv() * K.transpose() * B * K)
+            if B * K != K * out[-1]:
+                raise CertificateError(f"the odd vectors of the mode w = {w} are not invariant")
+    return tuple(out)
 
 
 @cache
@@ -132,11 +121,7 @@ def check_structure(fam, n):
 
 def charpoly_roots(M, fac=None):
     """(acb, fmpq or None) per eigenvalue of a rational matrix (or of the factors ``fac`` of a characteristic
-    polynomial), repeated by algebraic multiplicity.
-
-    >>> charpoly_roots(fmpq_mat([[1, 0], [0, 1]]))
-    [(1.00000000000000, 1), (1.00000000000000, 1)]
-    """
+    polynomial), repeated by algebraic multiplicity."""
     out = []
     for p, e in M.charpoly().factor()[1] if fac is None else fac:
         for z, _ in p.complex_roots():
@@ -173,7 +158,7 @@ def mode_spectrum(fam, n):
 def bordered_solve(B, lam, pivot, mat=acb_mat):
     """The null vector v of B - lam with v[pivot] = 1 from the bordered system [[B - lam, e_p], [e_p^T, 0]] (v, s) =
     (0, 1) in ``mat`` (acb_mat or arb_mat); ZeroDivisionError unless arb proves it regular for every lam of the
-    ball. Regular at the exact lam, lam is simple with v*[pivot] != 0 and v = v*/v*[pivot] (docs/tagged_c1.md).
+    ball (then lam is simple, v*[pivot] != 0 and v = v*/v*[pivot]: docs/tagged_c1.md).
 
     >>> [x.str(3) for x in bordered_solve([[2, 1], [1, 2]], arb(3), 0, arb_mat)]
     ['1.00', '1.00']
@@ -183,11 +168,7 @@ def bordered_solve(B, lam, pivot, mat=acb_mat):
 
 
 def bordered_matrix(B, lam, zero, pivot):
-    """[[B - lam, e_pivot], [e_pivot^T, 0]] as a list of rows (``zero`` of B's ring: 0, an exact or a series zero).
-
-    >>> bordered_matrix([[2, 1], [1, 2]], 3, 0, 1)
-    [[-1, 1, 0], [1, -1, 1], [0, 1, 0]]
-    """
+    """[[B - lam, e_pivot], [e_pivot^T, 0]] as a list of rows (``zero`` of B's ring: 0, an exact or a series zero)."""
     k = len(B)
     A = [[(B[i][j] - lam) if i == j else B[i][j] for j in range(k)] + [zero + int(i == pivot)] for i in range(k)]
     return A + [[zero + int(j == pivot) for j in range(k)] + [zero]]
@@ -199,23 +180,23 @@ def _unit(num, den):  # exp(i pi num/den), each from its own angle (no powers ac
 
 
 def mode_vector(fam, n, j, lam):
-    """The eigenvector of S for a simple eigenvalue lam (arb) of mode j, f = v - v o R (v(t, p) = w^t v^(p) on the
-    ring of 2N sectors, K for a dart; v^ from the bordered 6 x 6 system of B(w) at the first pivot proved regular),
-    0 on the crease points (a dart: the centre); a complex multiple of the real eigenvector, or None.
+    """The eigenvector f = v - v o R of S for a simple eigenvalue lam (arb) of mode j (v(t, p) = w^t v^(p) on the ring
+    of 2N sectors, K for a dart; v^ from B(w)'s bordered system at the first pivot proved regular), 0 on the crease
+    points (a dart: the centre); a complex multiple of the real eigenvector, or None.
 
     >>> f = mode_vector("crease", 5, 1, max(t[0].real for t in mode_spectrum("crease", 5) if t[3] == 1))
     >>> len(f), f[0]
     (33, 0)
     """
     ring = n if fam == "dart" else 2 * n
-    B, vh = ring_block(_unit(2 * j, ring)), None
+    B = ring_block(_unit(2 * j, ring))
     for pv in range(6):
         try:
             vh = bordered_solve(B, lam, pv)
             break
         except ZeroDivisionError:
             continue
-    if vh is None:
+    else:
         return None
     skip = {0} if fam == "dart" else set(crease_points(fam, n))
 
@@ -251,11 +232,9 @@ def normalized_vector(fam, n, ev, i, pivot):
 
 @cache
 def check_dart(k):
-    """Raise unless dart:k's S commutes with the reflection R in the sharp ray and is the ring rule on every point
-    but the centre and ray 0 (exact; then S is L on the odd vectors). (S_E on one representative per R-orbit, each
-    point's row in S_E, the odd blocks of w = 1 (and -1 for even k), the factors of S_E's characteristic polynomial
-    on the one-ring (closed: checked), (the one-ring's rows, the other rows), the infinity norm of S_E on the
-    others (a bound on their eigenvalues)).
+    """Raise unless dart:k's S commutes with the reflection R in the sharp ray, is the ring rule but at the centre and
+    ray 0, and S_E = [[S_in, 0], [*, S_out]] on the one-ring (exact); S_E (one row per R-orbit), each point's orbit,
+    the odd blocks of w = +-1, S_in's characteristic factors, (inner, outer rows), |S_out|_inf >= rho(S_out).
 
     >>> SE, rep, blocks, fac, (inner, outer), bound = check_dart(5)
     >>> SE.nrows(), len(rep), [M.nrows() for M in blocks], len(outer), bound
@@ -278,19 +257,15 @@ def check_dart(k):
     if 6 * ((k + 1) // 2 - 1) + sum(M.nrows() for M in blocks) != len(pts) - len(reps):
         raise CertificateError(f"dart:{k}: the modes do not account for every odd vector")
     inner = tuple(a for a, i in enumerate(reps) if pts[i] == ("C",) or pts[i][2:] in ((1, 0), (1, 1)))
-    fac, outer, bound = _one_ring(k, SE, inner)
-    return SE, tuple(rep), blocks, fac, (inner, outer), bound
+    return (SE, tuple(rep), blocks) + _one_ring(k, SE, inner)
 
 
-def _one_ring(k, SE, inner):
-    """S_E = [[S_in, 0], [*, S_out]] on the one-ring (centre, (1,0), (1,1); checked exactly): the factors of S_in's
-    characteristic polynomial, the outer rows and |S_out|_inf >= the spectral radius of S_out."""
+def _one_ring(k, SE, inner):  # S_in's factors, (inner, outer), the bound, after checking that the one-ring is closed
     outer = tuple(a for a in range(SE.nrows()) if a not in inner)
     if any(SE[a, b] != 0 for a in inner for b in outer):
         raise CertificateError(f"dart:{k}: the one-ring is not closed under the rules")
     bound = max(sum((abs(SE[a, b]) for b in outer), fmpq(0)) for a in outer)
-    fac = fmpq_mat([[SE[a, b] for b in inner] for a in inner]).charpoly().factor()[1]
-    return fac, outer, bound
+    return fmpq_mat([[SE[a, b] for b in inner] for a in inner]).charpoly().factor()[1], (inner, outer), bound
 
 
 def _check_dart_rows(k, pts, rows):
