@@ -38,21 +38,21 @@ class TaylorForm(BernsteinForm):
         shape = tuple(shape)
         if T.check_prec(prec) is None or len(shape) < 2:
             raise ValueError(f"a TaylorForm holds balls (pass prec=...) in 2..4 variables, got {shape!r}, {prec!r}")
-        super().__init__(shape, coeffs, _box(len(shape)), prec)
+        super().__init__(shape, coeffs, _box(len(shape) - 1), prec)
 
     @classmethod
     def constant(cls, c, nx, prec):
         """The constant ``c`` as a form in ``nx`` variables x (degree 0)."""
         with flint.ctx.workprec(prec):
-            return cls.from_raw((1,) * (nx + 1), [T.to_kind(T.scalar(c), prec)], _box(nx + 1), prec)
+            return cls.from_raw((1,) * (nx + 1), [T.to_kind(T.scalar(c), prec)], _box(nx), prec)
 
     @classmethod
     def variable(cls, axis, nx, prec):
         """The variable ``x_axis`` (1 <= axis <= nx), Bernstein coefficients (0, 1)."""
         if isinstance(axis, bool) or not isinstance(axis, int) or not 1 <= axis <= nx:
             raise ValueError(f"axis {axis!r} out of range 1..{nx}")
-        return cls.from_raw((1,) + tuple(2 if i == axis else 1 for i in range(1, nx + 1)), [arb(0), arb(1)],
-                            _box(nx + 1), prec)
+        return cls.from_raw((1,) + tuple(2 if i == axis else 1 for i in range(1, nx + 1)), [arb(0), arb(1)], _box(nx),
+                            prec)
 
     def truncate(self, degree):
         """Keep z^0 .. z^degree; each dropped c of z^e B_k is added as [-|c|, |c|] to the one of z^0 B_k."""
@@ -60,9 +60,8 @@ class TaylorForm(BernsteinForm):
             raise ValueError(f"degree must be a non-negative int, got {degree!r}")
         if self.shape[0] <= degree + 1:
             return self
-        c, shape = T.truncate(self.coeffs, self.shape, 0, degree, self.prec)
-        return self.from_raw(shape, c, self.box, self.prec)
+        return self.from_raw(*T.truncate(self.coeffs, self.shape, 0, degree, self.prec), self.box, self.prec)
 
 
-def _box(nvars):
-    return (ZBOX,) + unit_box(nvars - 1)
+def _box(nx):  # [-1, 1] x [0, 1]^nx
+    return (ZBOX,) + unit_box(nx)
