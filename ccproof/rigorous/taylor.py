@@ -60,7 +60,8 @@ class TaylorForm(BernsteinForm):
             raise ValueError(f"degree must be a non-negative int, got {degree!r}")
         if self.shape[0] <= degree + 1:
             return self
-        return self.from_raw(*T.truncate(self.coeffs, self.shape, 0, degree, self.prec), self.box, self.prec)
+        c, shape = T.truncate(self.coeffs, self.shape, 0, degree, self.prec)
+        return self.from_raw(shape, c, self.box, self.prec)
 
 
 def _box(nx):  # [-1, 1] x [0, 1]^nx
