@@ -14,28 +14,15 @@ ordering (:mod:`.spectrum`), det J_Phi > 0 on layer 0 and a star-shaped outer bo
 
 from __future__ import annotations
 
-from .errors import CertificateError
 from .injectivity import check_pieces, read_parts, read_pieces
 from .maps import STAR_CURVES, regularity_form, star_form
-from .record import exact_keys, field_of, kname
+from .record import exact_keys, kname, read_prec
 from .replay import check_boxes
 from .spectrum import check_block_polynomials, spectral_ordering
 from .statement import PATCHES
 
 PARTS = (("regularity", PATCHES, 2, regularity_form, "det J_Phi > 0 on"),
          ("star", tuple(STAR_CURVES), 1, star_form, "outer boundary star-shaped on"))
-
-
-def read_prec(cert):
-    """The working precision in bits of a C1 or tagged certificate (``prec``, 64..1024).
-
-    >>> read_prec({"prec": 128})
-    128
-    """
-    prec = field_of(cert, "prec", int, "certificate")
-    if not 64 <= prec <= 1024:
-        raise CertificateError("prec must lie in 64..1024")
-    return prec
 
 
 def verify_c1(cert, k, part, log):

@@ -18,7 +18,7 @@ from flint import arb, ctx, fmpq
 from .errors import CertificateError
 from .interval import hull_nets, interval_cells, lam_interval_ok, parameter_nets, valence_cells
 from .maps import STAR_CURVES, corner_containment, corner_det_form, curve_points, regularity_form, square_inside_image
-from .record import exact_keys, field_of, kname
+from .record import bounded_int, exact_keys, field_of, kname, read_prec
 from .registry import SCHEMA  # noqa: F401 (named in the examples)
 from .replay import check_boxes, parse_decimal, read_boxes
 from .statement import PATCHES, StatementError, c_lam, derivation, nets_for_valence
@@ -155,11 +155,7 @@ def read_n_prec(cert):
     >>> read_n_prec({"N": 3, "prec": 128})
     (3, 128)
     """
-    N = field_of(cert, "N", int, "certificate")
-    prec = field_of(cert, "prec", int, "certificate")
-    if not 64 <= prec <= 1024 or not 1 <= N <= MAX_LEVEL:
-        raise CertificateError(f"prec must lie in 64..1024 and N in 1..{MAX_LEVEL}")
-    return N, prec
+    return bounded_int(cert, "N", 1, MAX_LEVEL), read_prec(cert)
 
 
 def check_parts(parts, nets, lam, N, prec, cells, part, tag):

@@ -74,7 +74,8 @@ def parameter_nets(exact, La, Lb, layer, degree, prec):
     out = {}
     with ctx.workprec(prec):
         for name in PATCHES:  # (x, y) as one vector of 2m coefficients through the B-spline -> Bezier map
-            bs = [[[c for f in pt for c in entry_model(f, L, layer, degree, prec)] for pt in row] for row in exact[name]]
+            bs = [[[c for f in pt for c in entry_model(f, L, layer, degree, prec)] for pt in row]
+                  for row in exact[name]]
             out[name] = [[(list(p[:m]), list(p[m:])) for p in row] for row in bspline_to_bezier(bs, [arb(0)] * 2 * m)]
     return out
 

@@ -126,6 +126,25 @@ def exact_keys(obj, keys, where):
         raise CertificateError(f"{where}: missing field(s) {', '.join(map(repr, missing))}")
 
 
+def bounded_int(obj, key, lo, hi, where="certificate"):
+    """``obj[key]``, an int in lo..hi (:func:`field_of`), else a :class:`CertificateError`.
+
+    >>> bounded_int({"prec": 32}, "prec", 64, 1024)
+    Traceback (most recent call last):
+    ...
+    ccproof.certify.verify.errors.CertificateError: prec must lie in 64..1024
+    """
+    val = field_of(obj, key, int, where)
+    if not lo <= val <= hi:
+        raise CertificateError(f"{key} must lie in {lo}..{hi}")
+    return val
+
+
+def read_prec(cert):
+    """The working precision in bits of a certificate (``prec``, 64..1024)."""
+    return bounded_int(cert, "prec", 64, 1024)
+
+
 def read_valence(cert):
     """``cert["valence"]``: an int k or ``{"min": k0}``, within 3..10^6 (so every derived check stays fast).
 
@@ -135,9 +154,7 @@ def read_valence(cert):
     k = field_of(cert, "valence", (int, dict), "certificate")
     if isinstance(k, dict):
         exact_keys(k, ("min",), "valence")
-        k0 = k["min"]
-        if not isinstance(k0, int) or isinstance(k0, bool) or not 3 <= k0 <= 10**6:
-            raise CertificateError(f"valence interval must be {{'min': K0}} with 3 <= K0 <= 10^6, got {k!r}")
+        bounded_int(k, "min", 3, 10**6, "valence")
     elif not 3 <= k <= 10**6:
         raise CertificateError(f"valence {k} outside 3..10^6")
     return k
