@@ -25,7 +25,7 @@ from ccproof.rigorous.tensor import apply_along_axis
 
 from .errors import CertificateError
 from .maps import cell_geometry, cell_pieces, det_form
-from .statement import PATCHES, bspline_to_bezier, c_lam, derivation, nets_for_valence  # noqa: F401 (the examples)
+from .statement import PATCHES, bspline_to_bezier, c_lam, derivation, entrywise, nets_for_valence  # noqa: F401 (the examples)
 
 ZBOX = ((fmpq(-1), fmpq(1)), (fmpq(0), fmpq(1)), (fmpq(0), fmpq(1)))  # (zeta, s, t) of part D
 
@@ -82,8 +82,7 @@ def parameter_nets(exact, La, Lb, layer, degree, prec):
 
 def hull_nets(znets, prec):
     """arb nets enclosing the zeta-polynomial nets for every zeta in [-1, 1] (Bernstein range)."""
-    return {n: [[tuple(arb.union(*range_enclosure(_bern1(co, prec))) for co in pt) for pt in row] for row in net]
-            for n, net in znets.items()}
+    return entrywise(znets, lambda co: arb.union(*range_enclosure(_bern1(co, prec))))
 
 
 def piece_det_form_z(znets, i, name, p, q, D, prec):
@@ -143,8 +142,7 @@ def valence_cells(nets, lam, N, prec, symmetric=False):
     """Part D for one valence: :func:`interval_cells` of the arb nets times lam^i as Taylor models of degree 0, the
     zeta axis dropped from each root."""
     with ctx.workprec(prec):
-        zn = {i: {n: [[tuple([x * lam**i] for x in pt) for pt in row] for row in net] for n, net in nets.items()}
-              for i in range(N)}
+        zn = {i: entrywise(nets, lambda x, i=i: [x * lam**i]) for i in range(N)}
 
     def flat(build):
         f = build()

@@ -207,7 +207,8 @@ def split_half(curve):
     return left, right[::-1]
 
 
-def _entrywise(nets, f):
+def entrywise(nets, f):
+    """{piece: net} with ``f`` applied to every coordinate of every point."""
     return {n: [[tuple(f(q) for q in p) for p in row] for row in net] for n, net in nets.items()}
 
 
@@ -228,7 +229,7 @@ class Derivation:
 
     def integer_forms(self):
         """{piece: 4x4 of ([A,B,D], [A,B,D])}: the exact forms (A(c) + B(c) lam)/D(c) of the B-spline nets."""
-        return _entrywise(self.bspline, QL.integer_form)
+        return entrywise(self.bspline, QL.integer_form)
 
 
 @lru_cache(maxsize=1)
@@ -245,7 +246,7 @@ def derivation():
     if phi10[0].is_zero():
         raise StatementError("Phi(1, 0) = 0: the normalization is impossible")
     scale = phi10[0].inverse()
-    bs = _entrywise(raw, lambda q: q * scale)
+    bs = entrywise(raw, lambda q: q * scale)
     bz = {n: bspline_to_bezier(net) for n, net in bs.items()}
     vec = {p: tuple(q * scale for q in v) for p, v in vals.items()}
     return Derivation(vec, bs, bz, *_hypotheses(bz, all(e.is_zero() for e in residuals)))
@@ -312,6 +313,6 @@ def nets_for_valence(k, prec):
         try:
             for p in [*d.eigenvector.values(), *(p for net in d.bspline.values() for row in net for p in row)]:
                 [q.evaluate(c, lam) for q in p]  # every denominator checked
-            return _entrywise(d.bezier, lambda q: q.evaluate(c, lam))
+            return entrywise(d.bezier, lambda q: q.evaluate(c, lam))
         except ZeroDivisionError:
             raise StatementError(f"a denominator of the exact forms may vanish at c = cos(2 pi/{k})") from None
