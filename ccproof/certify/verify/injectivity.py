@@ -1,12 +1,6 @@
 """Appendix-A injectivity certificates (trusted): parts S, H, A-E for one valence, or for every k >= k0 on each
 lam piece (Taylor models in lam: :mod:`.interval`); the steps shared with the C1 certificates (the pieces, their
 nets, parts S and H). The statement and the parts: docs/certificates.md, docs/appendix_a.md sections 0-3, 6, 8.
-
->>> cert = {"schema": SCHEMA, "valence": 5, "N": 3, "prec": 128}
->>> verify_injectivity(cert, 5, None, None)
-Traceback (most recent call last):
-...
-ccproof.certify.verify.errors.CertificateError: certificate: missing field(s) 'parts'
 """
 
 from __future__ import annotations
@@ -18,7 +12,7 @@ from flint import arb, ctx, fmpq
 from .errors import CertificateError
 from .interval import hull_nets, interval_cells, lam_interval_ok, parameter_nets, valence_cells
 from .maps import STAR_CURVES, corner_containment, corner_det_form, curve_points, regularity_form, square_inside_image
-from .record import bounded_int, exact_keys, field_of, kname, read_prec
+from .record import bounded_int, exact_keys, field_of, read_prec
 from .registry import SCHEMA  # noqa: F401 (named in the examples)
 from .replay import check_boxes, parse_decimal, read_boxes
 from .statement import PATCHES, StatementError, c_lam, derivation, nets_for_valence
@@ -92,9 +86,8 @@ def read_parts(parts, sections):
 
 
 def read_pieces(cert, k, read):
-    """``(pieces, ends)``: one piece of ``parts`` (no ends) for one valence, or the 1..64 lam pieces
-    ``{"lam": [low, high], "parts": ...}`` with their exact ends, increasing and contiguous; ``read(parts)`` reads
-    each piece's hints.
+    """``(pieces, ends)``: one piece (no ends) for one valence, or the 1..64 lam pieces ``{"lam": [low, high],
+    "parts": ...}``, their exact ends increasing and contiguous; ``read(parts)`` reads each piece's hints.
 
     >>> read_pieces({"pieces": [{"lam": ["0.5", "0.6"], "parts": {}}, {"lam": ["0.6", "0.7"], "parts": {}}]},
     ...             {"min": 9}, print)
@@ -191,9 +184,8 @@ def check_parts(parts, nets, lam, N, prec, cells, part, tag):
 
 
 def _replay(roots, boxes, label, sec, part, tag, what=None):
-    """Replay ``boxes[key]`` on every (key, build root) of ``roots``: one failed part naming a key of ``boxes`` not
-    in ``roots`` or the first key (as ``what`` key) whose boxes fail or are missing, else one passed part ``label``
-    with the least bound (the margin of ``sec``, in the local variables)."""
+    """Replay ``boxes[key]`` on every (key, build root) of ``roots``: one failed part naming a key not required or
+    the first (``what`` key) whose boxes fail or are missing, else one passed part with the least bound."""
     what, least, count = what or sec, None, 0
     extra = sorted(set(boxes) - {key for key, _ in roots})
     if extra:
@@ -215,8 +207,8 @@ def _replay(roots, boxes, label, sec, part, tag, what=None):
 
 
 def verify_injectivity(cert, k, part, log):
-    """An injectivity certificate for the valence k or every k >= k0 (``{"min": k0}``) into ``part``; returns
-    :func:`.record.kname` of k; :class:`.errors.CertificateError` on a malformed one.
+    """An injectivity certificate for the valence k or every k >= k0 (``{"min": k0}``) into ``part``;
+    :class:`.errors.CertificateError` on a malformed one.
 
     >>> cert = {"schema": SCHEMA, "valence": {"min": 9}, "N": 3, "prec": 128, "pieces": [],
     ...         "parameter": {"variable": "c", "taylor_degree": 4, "truncation_degree": 2}}
@@ -244,7 +236,6 @@ def verify_injectivity(cert, k, part, log):
         cells = valence_cells(nets, lam, N, prec, sym) if zn is None else interval_cells(zn, N, D, prec, sym)
         check_parts(parts, nets, lam, N, prec, cells, part, tag)
     check_pieces(k, pieces, ends, prec, deg, N, check, part)
-    return kname(k)
 
 
 def _read_parameter(cert):
