@@ -4,12 +4,8 @@ the formulas: docs/rigorous.md, "Basis changes". :mod:`.tensor` applies them, ex
 
 >>> (power_to_bernstein_matrix(1, 2) * fmpq_mat(2, 1, [0, 1])).entries()   # x in degree 2
 [0, 1/2, 1]
->>> (elevation_matrix(1, 3) * fmpq_mat(2, 1, [0, 1])).entries()   # x in degree 3
-[0, 1/3, 2/3, 1]
 >>> (split_matrix(2, fmpq(1, 2), 0) * fmpq_mat(3, 1, [0, 0, 1])).entries()   # x^2 on [0, 1/2]
 [0, 0, 1/4]
->>> (restrict_matrix(1, fmpq(1, 4), fmpq(1, 2)) * fmpq_mat(2, 1, [0, 1])).entries()   # x on [1/4, 1/2]
-[1/4, 1/2]
 >>> (derivative_matrix(2, fmpq(1, 2)) * fmpq_mat(3, 1, [0, 0, 1])).entries()   # 4 x^2 on [0, 1/2]
 [0, 4]
 >>> (taylor_shift_matrix(2, fmpq(1), fmpq(2)) * fmpq_mat(3, 1, [0, 0, 1])).entries()   # (1 + 2x)^2

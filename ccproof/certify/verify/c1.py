@@ -1,15 +1,6 @@
 """C1 certificates (trusted): Reif's criterion for Catmull-Clark at the valence k or every k >= k0: the spectral
 ordering (:mod:`.spectrum`), det J_Phi > 0 on layer 0 and a star-shaped outer boundary (the boxes of
 ``parts.regularity`` and ``parts.star``); why these suffice: docs/appendix_a.md section 9.4.
-
->>> import json
->>> from ccproof.tables.format import certificates_dir
->>> from ccproof.certify.verify.record import Recorder, VerifyResult
->>> res = VerifyResult()
->>> verify_c1(json.loads((certificates_dir() / "c1" / "k005.json").read_text()), 5, Recorder(res, lambda s: None),
-...           lambda line: None)
->>> bool(res), res.parts[4].name
-(True, 'det J_Phi > 0 on P1')
 """
 
 from __future__ import annotations
@@ -26,7 +17,7 @@ PARTS = (("regularity", PATCHES, 2, regularity_form, "det J_Phi > 0 on"),
 
 
 def verify_c1(cert, k, part, log):
-    """A C1 certificate for the valence k or every k >= k0 (``{"min": k0}``) into ``part`` (module docstring);
+    """A C1 certificate for the valence k or every k >= k0 (``{"min": k0}``) into ``part``;
     :class:`.errors.CertificateError` on a malformed one."""
     exact_keys(cert, ("schema", "valence", "prec", "pieces" if isinstance(k, dict) else "parts"), "certificate")
     prec = read_prec(cert)
