@@ -11,18 +11,13 @@ t_i = (x_i - lo_i) / (hi_i - lo_i); the basis is non-negative and sums to one, s
 (3/4, 7/4)
 """
 
+from math import comb
+
 import flint
 from flint import arb, fmpq, fmpz
 
 from . import tensor as T
-from .matrices import (
-    binomials,
-    conversion_matrix,
-    derivative_matrix,
-    elevation_matrix,
-    restrict_matrix,
-    split_matrix,
-)
+from .matrices import conversion_matrix, derivative_matrix, elevation_matrix, restrict_matrix, split_matrix
 
 _HALF = fmpq(1, 2)
 
@@ -191,7 +186,9 @@ class BernsteinForm:
     __rmul__ = __mul__
 
     def _weights(self, shape):
-        return T.weights(shape, [[1] * n if a < self.POWER_AXES else binomials(n - 1) for a, n in enumerate(shape)])
+        """Per axis 1 (power) or the binomials C(n, i) scaling Bernstein coefficients of degree n."""
+        return T.weights(shape, [[1] * n if a < self.POWER_AXES else [comb(n - 1, i) for i in range(n)]
+                                 for a, n in enumerate(shape)])
 
 
 # ---------------------------------------------------------------------------- boxes, enclosures, det J

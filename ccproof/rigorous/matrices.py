@@ -14,7 +14,7 @@ the formulas: docs/rigorous.md, "Basis changes". :mod:`.tensor` applies them, ex
 
 from math import comb
 
-from flint import fmpq, fmpq_mat, fmpz
+from flint import fmpq, fmpq_mat
 
 _CACHE = {}
 
@@ -31,11 +31,6 @@ def _cached(key, build):
 
 def _matrix(rows, cols, entry):
     return fmpq_mat(rows, cols, [fmpq(entry(i, j)) for i in range(rows) for j in range(cols)])
-
-
-def binomials(n):
-    """[C(n, 0), ..., C(n, n)] (fmpz): the scaling of degree-n Bernstein coefficients."""
-    return [fmpz(comb(n, i)) for i in range(n + 1)]
 
 
 def power_to_bernstein_matrix(n, d):

@@ -131,10 +131,7 @@ def multiply(a, a_shape, b, b_shape, prec):
 
 def row_major_strides(shape):
     """The row-major strides of a dense array of ``shape``."""
-    s = [1] * len(shape)
-    for i in range(len(shape) - 2, -1, -1):
-        s[i] = s[i + 1] * shape[i + 1]
-    return tuple(s)
+    return tuple(prod(shape[i + 1 :]) for i in range(len(shape)))
 
 
 @lru_cache(maxsize=1024)
