@@ -129,7 +129,7 @@ def exact_keys(obj, keys, where):
 def bounded_int(obj, key, lo, hi, where="certificate"):
     """``obj[key]``, an int in lo..hi (:func:`field_of`), else a :class:`CertificateError` naming the range."""
     val = field_of(obj, key, int, where)
-    if not lo <= val <= hi:
+    if val < lo or val > hi:
         raise CertificateError(f"{key} must lie in {lo}..{hi}")
     return val
 

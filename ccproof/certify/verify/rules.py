@@ -24,7 +24,7 @@ def canonical(a, b):
     if (a, b) == CENTRE:
         return (0, 0, 0)
     for delta, a2, b2 in ((0, a, b), (1, b, -a), (-1, -b, a), (2, -a, -b)):  # (a, b) in the frame of sector delta
-        if a2 >= 1 and b2 >= 0 and (delta != 2 or b2 == 0):  # two sectors on: the ray only
+        if a2 >= 1 and b2 >= 0 and (delta < 2 or b2 == 0):  # two sectors on (delta 2): the ray only
             return delta, a2, b2
     raise ValueError(f"grid position ({a}, {b}) is more than one sector away")
 
