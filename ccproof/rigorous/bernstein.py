@@ -195,11 +195,7 @@ class BernsteinForm:
 
 
 def unit_box(nvars):
-    """The box [0, 1]^nvars (exact endpoints).
-
-    >>> unit_box(2)
-    ((0, 1), (0, 1))
-    """
+    """The box [0, 1]^nvars (exact endpoints)."""
     return ((fmpq(0), fmpq(1)),) * nvars
 
 

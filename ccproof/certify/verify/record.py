@@ -93,8 +93,6 @@ class Recorder:
 def field_of(obj, key, kind, where):
     """``obj[key]`` of type ``kind`` (a bool is never an int here), else a :class:`CertificateError` naming ``where``.
 
-    >>> field_of({"N": 3}, "N", int, "hints")
-    3
     >>> field_of({"N": True}, "N", int, "hints")
     Traceback (most recent call last):
     ...
@@ -155,9 +153,5 @@ def read_valence(cert):
 
 
 def kname(k):
-    """``"5"`` or ``">=7"``.
-
-    >>> kname(5), kname({"min": 7})
-    ('5', '>=7')
-    """
+    """``"5"`` or ``">=7"`` (:attr:`VerifyResult.configuration`'s example)."""
     return f">={k['min']}" if isinstance(k, dict) else str(k)

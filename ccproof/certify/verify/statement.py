@@ -117,11 +117,7 @@ def horner(p, x, acc=None):
 
 
 class StatementError(ValueError):
-    """The derivation of the statement failed (cannot happen for the true rules; a tripwire).
-
-    >>> issubclass(StatementError, ValueError), all(ok for _, ok in derivation().hypotheses)
-    (True, True)
-    """
+    """The derivation of the statement failed (cannot happen for the true rules; a tripwire)."""
 
 
 def rot(delta, p):
@@ -289,11 +285,7 @@ def lam_of(c):
 
 
 def c_lam(k, prec):
-    """Balls (c, lam) holding cos(2 pi/k) and lam(k) at ``prec`` bits.
-
-    >>> c_lam(4, 53)[1], c_lam(3, 53)[1].overlaps((9 + arb(17).sqrt()) / 32)
-    (0.500000000000000, True)
-    """
+    """Balls (c, lam) holding cos(2 pi/k) and lam(k) at ``prec`` bits."""
     with ctx.workprec(prec):
         c = arb(fmpq(2, k)).cos_pi()
         return c, lam_of(c)
