@@ -1,8 +1,6 @@
 """Functions analytic in one complex parameter h on a disc: Taylor coefficients and a Cauchy remainder (the bound:
 docs/rigorous.md, "Analytic models"); nothing here is specific to one quantity."""
 
-from __future__ import annotations
-
 from functools import reduce
 
 from flint import acb, acb_mat, arb, fmpq

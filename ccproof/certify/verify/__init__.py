@@ -1,8 +1,6 @@
 """The trusted verifier of ccproof certificates (``ccproof verify``): the statement is derived from the schema and
 the valence, the hints replayed without search; docs/trusted_base.md lists the modules and their guarantees."""
 
-from __future__ import annotations
-
 import json
 import os
 import stat

@@ -3,8 +3,6 @@ ordering (:mod:`.spectrum`), det J_Phi > 0 on layer 0 and a star-shaped outer bo
 ``parts.regularity`` and ``parts.star``); why these suffice: docs/appendix_a.md section 9.4.
 """
 
-from __future__ import annotations
-
 from .injectivity import check_pieces, read_parts, read_pieces
 from .maps import STAR_CURVES, regularity_form, star_form
 from .record import exact_keys, kname, read_prec

@@ -3,8 +3,6 @@ lam piece (Taylor models in lam: :mod:`.interval`); the steps shared with the C1
 nets, parts S and H). The statement and the parts: docs/certificates.md, docs/appendix_a.md sections 0-3, 6, 8.
 """
 
-from __future__ import annotations
-
 import re
 
 from flint import arb, ctx, fmpq

@@ -16,8 +16,6 @@ On the one-point piece lam = 1/2 (k = 4: Phi the identity, det dG/d(s, t) = 1/4 
 (True, ((0, 1), (0, 1)))
 """
 
-from __future__ import annotations
-
 from flint import arb, ctx, fmpq, fmpq_poly
 
 from ccproof.rigorous import BernsteinForm, TaylorForm, conversion_matrix, range_enclosure

@@ -8,8 +8,6 @@ sections 1-3, docs/certificates.md parts A-E).
 ((True, 0.125000000000000), False, True)
 """
 
-from __future__ import annotations
-
 from flint import arb, ctx, fmpq, fmpq_poly  # noqa: F401 (arb: the examples)
 
 from ccproof.rigorous import BernsteinForm, TaylorForm, exact_fmpq, jacobian_determinant, range_enclosure  # noqa: F401

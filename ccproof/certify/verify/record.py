@@ -1,7 +1,5 @@
 """Verdicts (the parts of a check with their reasons) and strict reading of certificate fields (trusted)."""
 
-from __future__ import annotations
-
 from dataclasses import dataclass, field
 
 from flint import fmpq

@@ -7,8 +7,6 @@ verifier proved, decided from its own verdicts, never from a file (trusted; docs
 ['smooth injective', 'smooth C1']
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass
 from importlib import import_module
 

@@ -4,8 +4,6 @@ halvings (:func:`parse_path`) with a claimed bound; a box list (:func:`read_boxe
 its cost is charged against the certificate's budget, and it is replayed without search (docs/certificates.md).
 """
 
-from __future__ import annotations
-
 import re
 from contextvars import ContextVar
 from decimal import Decimal

@@ -6,8 +6,6 @@ source of the scheme (trusted): face, edge and vertex points; sector j is the qu
 (9/16, 13/20)
 """
 
-from __future__ import annotations
-
 from flint import fmpq
 
 TWO_RING = ((1, 0), (2, 0), (1, 1), (2, 1), (1, 2), (2, 2))

@@ -6,8 +6,6 @@ B(w) (one stencil, shared by the smooth, tagged and dart routes) and B0(1/k), th
 (True, True)
 """
 
-from __future__ import annotations
-
 from functools import cache
 from math import prod
 

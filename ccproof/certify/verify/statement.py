@@ -8,8 +8,6 @@ sections 0 and 9.1; docs/readings.md R2-R4.
 (True, True)
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass
 from functools import lru_cache
 from math import lcm
