@@ -87,8 +87,7 @@ def piece_det_form_z(znets, i, name, p, q, D, prec):
     """det dG/d(sigma, tau) on ZBOX for layer i, piece ``name``, w piece (p, q), every lam of the piece at once:
     :func:`.maps.det_form` of the Taylor models (the net entries' Bernstein coefficients in (sigma, tau), their
     zeta polynomials the Taylor part, truncated to degree D)."""
-    with ctx.workprec(prec):
-        return det_form(*(_taylor(znets[i][name], d, prec).truncate(D) for d in range(2)), i, name, p, q, D)
+    return det_form(*(_taylor(znets[i][name], d, prec).truncate(D) for d in range(2)), i, name, p, q, D)
 
 
 def _taylor(net, d, prec):
@@ -108,8 +107,7 @@ def interval_cells(znets, N, D, prec, symmetric=False):
         if (i, name, p, q) not in forms:
             forms[i, name, p, q] = piece_det_form_z(znets, i, name, p, q, D, prec)
         h = box[0][1] - box[0][0]
-        with ctx.workprec(prec):
-            return forms[i, name, p, q].restrict((ZBOX[0],) + box) * (h * h)
+        return forms[i, name, p, q].restrict((ZBOX[0],) + box) * (h * h)  # the forms round at their own prec
 
     with ctx.workprec(prec):
         cells = [(l, m) for l in range(2**N) for m in range(2**N) if (l, m) != (0, 0) and not (symmetric and l > m)]

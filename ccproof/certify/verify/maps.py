@@ -139,8 +139,7 @@ def regularity_form(nets, name, prec):
     >>> [z.str(6, radius=False) for z in range_enclosure(regularity_form(nets_for_valence(4, 64), "P2", 64))]
     ['0.250000', '0.250000']
     """
-    with ctx.workprec(prec):
-        return jacobian_determinant([net_form(nets[name], 0, prec), net_form(nets[name], 1, prec)])
+    return jacobian_determinant([net_form(nets[name], 0, prec), net_form(nets[name], 1, prec)])
 
 
 def curve_points(nets, curve, oriented=False):
