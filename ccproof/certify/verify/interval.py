@@ -1,6 +1,5 @@
-"""Every valence k >= k0 in one certificate (trusted): lam = mid + zeta * half-width on a lam piece, the nets as
-Taylor models in zeta with exact remainders, their hulls (parts A, B, C, E) and the cells of part D, and one
-valence as Taylor models of degree 0 (docs/appendix_a.md section 6, docs/readings.md R2, R10).
+"""Every valence k >= k0 in one certificate (trusted): on a lam piece lam = mid + zeta * half-width, the nets as
+Taylor models in zeta with exact remainders, their hulls and the cells of part D (docs/appendix_a.md section 6).
 
 On the one-point piece lam = 1/2 (k = 4: Phi the identity, det dG/d(s, t) = 1/4 on a cell of layer 0):
 

@@ -1,7 +1,6 @@
-"""The maps of the statement as Bernstein forms (trusted): weight, cells, det J_G (one builder on Taylor models
-for one valence and every k >= k0), corner form, det J_Phi, outer curves. ``nets``: {piece: 4 x 4 Bezier net of
-(arb, arb)} enclosing :mod:`.statement`'s; forms on the unit box of the local parameters (docs/appendix_a.md
-sections 1-3, docs/certificates.md parts A-E).
+"""The maps of the statement as Bernstein forms on the unit box of the local parameters (trusted): weight, cells,
+det J_G, corner form, det J_Phi, outer curves, of ``nets`` {piece: 4 x 4 Bezier net of (arb, arb)} enclosing
+:mod:`.statement`'s (docs/appendix_a.md sections 1-3, docs/certificates.md parts A-E).
 
 >>> nets, lam = nets_for_valence(4, 64), c_lam(4, 64)[1]    # k = 4: Phi is the identity, lam = 1/2
 >>> corner_containment(nets, lam, 3), corner_containment(nets, lam, 2)[0], square_inside_image(nets)   # part A, C

@@ -78,9 +78,8 @@ class Recorder:
 
     def __call__(self, name, ok, msg="", bound=None, section=None):
         self.result.parts.append(Part(name, bool(ok), msg, bound))
-        if ok and bound is not None and section is not None:
-            old = self.result.margins.get(section)
-            self.result.margins[section] = bound if old is None or bound < old else old
+        if ok and bound is not None and section is not None:  # exact bounds: min is exact
+            self.result.margins[section] = min(bound, self.result.margins.get(section, bound))
         self.log(f"  {'PASS' if ok else 'FAIL'}  {name}{(': ' + msg) if msg else ''}")
 
     @property

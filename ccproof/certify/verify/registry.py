@@ -141,16 +141,12 @@ def coverage(results):
     (False, 'C1 (Reif) coverage: OK: every', 'injectivity (Appendix A) coverage: INCOMPLETE: no interval k >= k0')
     """
     verified = [r for r in results if r and r.family is not None and r.statement is not None]
-    ok_all, lines = True, []
+    rows = []
     for label, statement in (("C1 (Reif)", "C1"), ("injectivity (Appendix A)", "injective")):
         ok, msg = check_coverage([r.valence for r in verified if r.family == "smooth" and r.statement == statement])
-        lines.append(f"{label} coverage: {'OK' if ok else 'INCOMPLETE'}: {msg}")
-        ok_all &= ok
-    for fam in TAGGED:
-        ok, line = family_coverage(fam, [(r.valence, r.statement) for r in verified if r.family == fam])
-        lines.append(line)
-        ok_all &= ok
-    return ok_all, lines
+        rows.append((ok, f"{label} coverage: {'OK' if ok else 'INCOMPLETE'}: {msg}"))
+    rows += [family_coverage(fam, [(r.valence, r.statement) for r in verified if r.family == fam]) for fam in TAGGED]
+    return all(ok for ok, _ in rows), [line for _, line in rows]
 
 
 def family_coverage(fam, certified):
