@@ -55,11 +55,7 @@ def check_hypotheses(nets, lam, part, tag=""):
 
 
 def form_patches(symmetric):
-    """The pieces of parts B and E: P2 and P3 under the mirror symmetry (part S; docs/appendix_a.md section 8).
-
-    >>> form_patches(True), form_patches(False)
-    (('P2', 'P3'), ('P1', 'P2', 'P3'))
-    """
+    """The pieces of parts B and E: P2 and P3 under the mirror symmetry (part S; docs/appendix_a.md section 8)."""
     return ("P2", "P3") if symmetric else PATCHES
 
 
@@ -112,9 +108,8 @@ def read_pieces(cert, k, read):
 
 
 def check_pieces(k, pieces, ends, prec, degree, layers, check, part, spectrum=lambda: True):
-    """Part S, ``spectrum()`` (C1), the lam range (every k >= k0), then each piece until a part fails: its nets (one
-    valence: lam(k)'s; a lam piece: the hulls of the Taylor models of ``degree``), part H, then ``check(parts, nets,
-    lam, znets of ``layers`` layers or None, tag)``."""
+    """Part S, ``spectrum()`` (C1), the lam range (every k >= k0), then each piece until a part fails: its nets
+    (lam(k)'s or the Taylor models' hulls), part H, ``check(parts, nets, lam, znets (``layers``) or None, tag)``."""
     if not check_derivation(part) or not spectrum():
         return
     if ends:
@@ -141,11 +136,7 @@ def check_pieces(k, pieces, ends, prec, degree, layers, check, part, spectrum=la
 
 
 def read_n_prec(cert):
-    """The level N (1..:data:`MAX_LEVEL`) and the precision in bits (64..1024) of a certificate.
-
-    >>> read_n_prec({"N": 3, "prec": 128})
-    (3, 128)
-    """
+    """The level N (1..:data:`MAX_LEVEL`) and the precision in bits (64..1024) of a certificate."""
     return bounded_int(cert, "N", 1, MAX_LEVEL), read_prec(cert)
 
 

@@ -9,11 +9,7 @@ from .errors import CertificateError
 
 @dataclass
 class Part:
-    """One checked claim; ``bound``: the smallest claimed bound re-checked (exact), for box parts.
-
-    >>> Part("S", False, "not an eigenvector")
-    Part(name='S', ok=False, message='not an eigenvector', bound=None)
-    """
+    """One checked claim; ``bound``: the smallest claimed bound re-checked (exact), for box parts."""
 
     name: str
     ok: bool
