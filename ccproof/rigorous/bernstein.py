@@ -60,8 +60,6 @@ class BernsteinForm:
     def degrees(self):
         return tuple(n - 1 for n in self.shape)
 
-    # ------------------------------------------------------------------ subdivision
-
     def split(self, axis, t=_HALF):
         """De Casteljau: the forms ``(low, high)`` on the two parts of the box cut along ``axis`` at fraction ``t``."""
         axis = self._axis(axis)
@@ -125,8 +123,6 @@ class BernsteinForm:
             raise ValueError(f"axis {axis!r} is in the power basis (not an x axis)")
         return axis
 
-    # ------------------------------------------------------------------ arithmetic (same box)
-
     def _common(self, other):
         """The precision of a result of ``self`` and ``other``: forms of one type on one box (or a scalar)."""
         if not isinstance(other, BernsteinForm):
@@ -189,9 +185,6 @@ class BernsteinForm:
         """Per axis 1 (power) or the binomials C(n, i) scaling Bernstein coefficients of degree n."""
         return T.weights(shape, [[1] * n if a < self.POWER_AXES else [comb(n - 1, i) for i in range(n)]
                                  for a, n in enumerate(shape)])
-
-
-# ---------------------------------------------------------------------------- boxes, enclosures, det J
 
 
 def unit_box(nvars):
