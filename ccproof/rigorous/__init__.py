@@ -2,8 +2,7 @@
 
 Exact inputs give exact outputs; ball inputs give balls enclosing the exact result for every choice in the input
 balls (computed inside ``flint.ctx.workprec``, the global precision never changed). The guarantees and the API:
-docs/rigorous.md; an example: :mod:`.bernstein`.
-"""
+docs/rigorous.md; an example: :mod:`.bernstein`."""
 
 from .bernstein import BernsteinForm, jacobian_determinant, range_enclosure, unit_box
 from .matrices import conversion_matrix

@@ -1,7 +1,6 @@
 """Dense coefficient tensors: a row-major list of ``fmpq`` (``prec`` None) or ``arb`` (``prec`` bits, computed inside
 ``flint.ctx.workprec``) with its ``shape``; exact basis changes along an axis (``fmpq_mat``, or the ``arb_mat`` that
-encloses it), Kronecker products. Shared by :mod:`.bernstein` and ``ccproof.certify.poly``.
-"""
+encloses it), Kronecker products. Shared by :mod:`.bernstein` and ``ccproof.certify.poly``."""
 
 from functools import lru_cache
 from math import prod

@@ -1,7 +1,6 @@
 """C1 certificates (trusted): Reif's criterion for Catmull-Clark at the valence k or every k >= k0: the spectral
 ordering (:mod:`.spectrum`), det J_Phi > 0 on layer 0 and a star-shaped outer boundary (the boxes of
-``parts.regularity`` and ``parts.star``); why these suffice: docs/appendix_a.md section 9.4.
-"""
+``parts.regularity`` and ``parts.star``); why these suffice: docs/appendix_a.md section 9.4."""
 
 from .injectivity import check_pieces, read_parts, read_pieces
 from .maps import STAR_CURVES, regularity_form, star_form

@@ -1,7 +1,6 @@
 """Appendix-A injectivity certificates (trusted): parts S, H, A-E for one valence, or for every k >= k0 on each
 lam piece (Taylor models in lam: :mod:`.interval`); the steps shared with the C1 certificates (the pieces, their
-nets, parts S and H). The statement and the parts: docs/certificates.md, docs/appendix_a.md sections 0-3, 6, 8.
-"""
+nets, parts S and H). The statement and the parts: docs/certificates.md, docs/appendix_a.md sections 0-3, 6, 8."""
 
 import re
 

@@ -37,19 +37,13 @@ def weight_piece(p):
     return out
 
 
-def net_form(net, coord, prec, box=None):
-    """Bernstein form of one coordinate of a 4x4 Bezier net, restricted to the dyadic ``box`` and relabelled as
-    the unit box.
+def net_form(net, coord, prec):
+    """Bernstein form on the unit box of one coordinate of a 4x4 Bezier net.
 
-    >>> nets = nets_for_valence(4, 64)
-    >>> [[z.str(6, radius=False) for z in range_enclosure(net_form(nets["P1"], 1, 64, b))]
-    ...  for b in (None, ((0, 1), (0, "1/2")))]
-    [['0', '0.500000'], ['0', '0.250000']]
+    >>> [z.str(6, radius=False) for z in range_enclosure(net_form(nets_for_valence(4, 64)["P1"], 1, 64))]
+    ['0', '0.500000']
     """
-    f = BernsteinForm((4, 4), [net[i][j][coord] for i in range(4) for j in range(4)], prec=prec)
-    if box is not None:
-        f = f.restrict(box)
-    return BernsteinForm((4, 4), f.coeffs, prec=prec)  # relabel the sub-box as the unit box
+    return BernsteinForm((4, 4), [net[i][j][coord] for i in range(4) for j in range(4)], prec=prec)
 
 
 def cell_geometry(l, m, N):

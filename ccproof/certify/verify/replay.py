@@ -1,8 +1,7 @@
 """Replaying the hints of a certificate (trusted): one format, a split tree given by its leaves, each a box named by
 halvings (:func:`parse_path`) with a claimed bound; a box list (:func:`read_boxes`) is one tree, a grid tree
 (:func:`read_tree`) one per grid cell. Each tree must partition its root (:func:`box_tree`) before any arithmetic,
-its cost is charged against the certificate's budget, and it is replayed without search (docs/certificates.md).
-"""
+its cost is charged against the certificate's budget, and it is replayed without search (docs/certificates.md)."""
 
 import re
 from contextvars import ContextVar

@@ -1,7 +1,6 @@
 """The spectrum of the Catmull-Clark subdivision matrix re-derived from the rules (trusted): the Fourier blocks
 B(w) (one stencil, shared by the smooth, tagged and dart routes) and B0(1/k), their characteristic polynomials
-(exact) and the spectral ordering (arb). docs/appendix_a.md section 9.3; docs/readings.md R2.
-"""
+(exact) and the spectral ordering (arb). docs/appendix_a.md section 9.3; docs/readings.md R2."""
 
 from functools import cache
 from math import prod
