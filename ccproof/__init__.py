@@ -19,14 +19,9 @@ fit a surface to points             :func:`fit_points` (qmv98)
 errors                              :class:`CCProofError` and subclasses; the verifier's own :class:`CertificateError`
 ==================================  ======================================================================
 
-Every name loads on first use (PEP 562): the verifier's import loads nothing of ccproof outside the
-trusted base (docs/trusted_base.md), and importing numpy, scipy and numba costs ~0.5 s and
-``ccproof --help`` must start in < 0.3 s (``python -X importtime -c 'import ccproof'``: 2 ms with
-this lazy table, ~1 s if it were eager; see scripts/bench_reparam.py).
-
-Layers (docs/architecture.md): the proof branch ``algebra`` -> ``rigorous`` -> ``tables`` ->
-``certify`` and the numerics branch ``mesh`` -> ``evaluate`` -> ``inverse`` -> ``reparam``, fed by
-the certified tables; ``apps`` and the command line on top.
+Every name loads on first use (PEP 562): verifying loads nothing of ccproof outside the trusted base
+(docs/trusted_base.md), and ``import ccproof`` takes 2 ms, not ~1 s (numpy, scipy, numba). Layers:
+docs/architecture.md.
 
 >>> import ccproof
 >>> ccproof.Valence.parse(">=40"), ccproof.load_table(5).N
@@ -57,61 +52,31 @@ if TYPE_CHECKING:  # the lazy names of _LAZY below, seen by type checkers (mypy 
 __version__ = "0.1.0"
 
 #: lazily loaded public names -> defining module
-_LAZY = {
-    **dict.fromkeys(("CCProofError", "MeshError", "TableNotFoundError", "ValenceError"), "ccproof.errors"),
-    **dict.fromkeys(("Valence", "parse_valence"), "ccproof.valence"),
-    "load_table": "ccproof.tables.numeric",
-    "build_table": "ccproof.tables.build",
-    "prove_valence": "ccproof.certify.prover",
-    "prove_interval": "ccproof.certify.prover",
-    "prove_c1": "ccproof.certify.prover",
-    "verify_file": "ccproof.certify.verify",
-    "VerifyResult": "ccproof.certify.verify.record",
-    "CertificateError": "ccproof.certify.verify.errors",
-    "QuadMesh": "ccproof.mesh",
-    "PolyMesh": "ccproof.mesh",
-    "read_obj": "ccproof.mesh",
-    "read_mesh": "ccproof.mesh",
-    "limit_surface": "ccproof.reparam.surface",
-    "LimitSurface": "ccproof.evaluate",
-    "Parameterization": "ccproof.reparam",
-    "PatchTable": "ccproof.evaluate",
-    "characteristic_map": "ccproof.inverse.forward",
-    "inverse_characteristic_map": "ccproof.inverse.algorithm",
-    "parameterize": "ccproof.apps.arap.meshes",
-    "write_uv_mesh": "ccproof.apps.arap.export",
-    "fit_points": "ccproof.apps.dynamics.fit",
-}
+_LAZY = {name: module for module, names in {
+    "ccproof.errors": "CCProofError MeshError TableNotFoundError ValenceError",
+    "ccproof.valence": "Valence parse_valence",
+    "ccproof.tables.numeric": "load_table",
+    "ccproof.tables.build": "build_table",
+    "ccproof.certify.prover": "prove_valence prove_interval prove_c1",
+    "ccproof.certify.verify": "verify_file",
+    "ccproof.certify.verify.record": "VerifyResult",
+    "ccproof.certify.verify.errors": "CertificateError",
+    "ccproof.mesh": "QuadMesh PolyMesh read_obj read_mesh",
+    "ccproof.reparam.surface": "limit_surface",
+    "ccproof.evaluate": "LimitSurface PatchTable",
+    "ccproof.reparam": "Parameterization",
+    "ccproof.inverse.forward": "characteristic_map",
+    "ccproof.inverse.algorithm": "inverse_characteristic_map",
+    "ccproof.apps.arap.meshes": "parameterize",
+    "ccproof.apps.arap.export": "write_uv_mesh",
+    "ccproof.apps.dynamics.fit": "fit_points",
+}.items() for name in names.split()}
 
-__all__ = [
-    "CCProofError",
-    "CertificateError",
-    "LimitSurface",
-    "MeshError",
-    "Parameterization",
-    "PatchTable",
-    "PolyMesh",
-    "QuadMesh",
-    "TableNotFoundError",
-    "Valence",
-    "ValenceError",
-    "VerifyResult",
-    "build_table",
-    "characteristic_map",
-    "fit_points",
-    "inverse_characteristic_map",
-    "limit_surface",
-    "load_table",
-    "parameterize",
-    "parse_valence",
-    "prove_c1",
-    "prove_interval",
-    "prove_valence",
-    "read_mesh",
-    "read_obj",
-    "verify_file",
-    "write_uv_mesh",
-]
+__all__ = ["CCProofError", "CertificateError", "LimitSurface", "MeshError", "Parameterization", "PatchTable",
+           "PolyMesh", "QuadMesh", "TableNotFoundError", "Valence", "ValenceError", "VerifyResult", "build_table",
+           "characteristic_map", "fit_points", "inverse_characteristic_map", "limit_surface", "load_table",
+           "parameterize", "parse_valence", "prove_c1", "prove_interval", "prove_valence", "read_mesh", "read_obj",
+           "verify_file", "write_uv_mesh"]
 
 assert set(__all__) == set(_LAZY)
 

@@ -2,13 +2,7 @@
 
 Exact inputs give exact outputs; ball inputs give balls enclosing the exact result for every choice in the input
 balls (computed inside ``flint.ctx.workprec``, the global precision never changed). The guarantees and the API:
-docs/rigorous.md.
-
->>> from flint import fmpq
->>> f = BernsteinForm((2,), [fmpq(1, 2), 2])              # 1/2 + 3x/2 on [0, 1]
->>> range_enclosure(f), range_enclosure(f.split(0)[1])
-((1/2, 2), (5/4, 2))
-"""
+docs/rigorous.md; an example: :mod:`.bernstein`."""
 
 from .bernstein import BernsteinForm, jacobian_determinant, range_enclosure, unit_box
 from .matrices import conversion_matrix

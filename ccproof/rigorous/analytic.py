@@ -1,7 +1,7 @@
 """Functions analytic in one complex parameter h on a disc: Taylor coefficients and a Cauchy remainder (the bound:
 docs/rigorous.md, "Analytic models"); nothing here is specific to one quantity."""
 
-from __future__ import annotations
+from functools import reduce
 
 from flint import acb, acb_mat, arb, fmpq
 
@@ -119,11 +119,7 @@ def hull(balls):
     >>> hull([arb(1), arb(3), arb(2)]).contains(ball(1, 3))
     True
     """
-    it = iter(balls)
-    out = next(it)
-    for b in it:
-        out = out.union(b)
-    return out
+    return reduce(arb.union, balls)
 
 
 __all__ = ["AnalyticModel", "ball", "cauchy_factor", "disc_bound", "disc_boxes", "hull"]

@@ -11,18 +11,13 @@ t_i = (x_i - lo_i) / (hi_i - lo_i); the basis is non-negative and sums to one, s
 (3/4, 7/4)
 """
 
+from math import comb
+
 import flint
 from flint import arb, fmpq, fmpz
 
 from . import tensor as T
-from .matrices import (
-    binomials,
-    conversion_matrix,
-    derivative_matrix,
-    elevation_matrix,
-    restrict_matrix,
-    split_matrix,
-)
+from .matrices import conversion_matrix, derivative_matrix, elevation_matrix, restrict_matrix, split_matrix
 
 _HALF = fmpq(1, 2)
 
@@ -47,9 +42,7 @@ class BernsteinForm:
             raise ValueError(f"bad shape {shape!r}")
         if len(coeffs) != T.size(shape):
             raise ValueError(f"{len(coeffs)} coefficients for shape {shape}")
-        if prec is None and any(isinstance(c, arb) for c in coeffs):
-            raise TypeError("arb coefficient in an exact Bernstein form: pass prec=...")
-        self.shape, self.coeffs, self.prec = shape, T.convert(coeffs, prec), prec
+        self.shape, self.coeffs, self.prec = shape, T.convert(coeffs, prec), prec  # arb with prec None: TypeError
         self.box = unit_box(len(shape)) if box is None else check_box(box, len(shape))
 
     @classmethod
@@ -67,20 +60,16 @@ class BernsteinForm:
     def degrees(self):
         return tuple(n - 1 for n in self.shape)
 
-    # ------------------------------------------------------------------ subdivision
-
     def split(self, axis, t=_HALF):
         """De Casteljau: the forms ``(low, high)`` on the two parts of the box cut along ``axis`` at fraction ``t``."""
-        axis = self._axis(axis, bernstein=True)
+        axis = self._axis(axis)
         t = T.exact_scalar(t)
         if not 0 < t < 1:
             raise ValueError(f"split fraction must lie in (0, 1), got {t}")
         n = self.shape[axis] - 1
         lo, hi = self.box[axis]
         mid = lo + (hi - lo) * t
-        low = self._along(axis, split_matrix(n, t, 0), (lo, mid))
-        high = self._along(axis, split_matrix(n, t, 1), (mid, hi))
-        return low, high
+        return self._along(axis, split_matrix(n, t, 0), (lo, mid)), self._along(axis, split_matrix(n, t, 1), (mid, hi))
 
     def restrict(self, box):
         """Bernstein form of the same polynomial on a sub-box ``box`` of ``self.box``."""
@@ -109,10 +98,9 @@ class BernsteinForm:
 
     def diff(self, axis):
         """Bernstein form (degree one less along ``axis``) of the partial derivative on the box."""
-        axis = self._axis(axis, bernstein=True)
-        n = self.shape[axis] - 1
+        axis = self._axis(axis)
         lo, hi = self.box[axis]
-        return self._along(axis, derivative_matrix(n, hi - lo), self.box[axis])
+        return self._along(axis, derivative_matrix(self.shape[axis] - 1, hi - lo), self.box[axis])
 
     def bernstein(self):
         """The form with every axis in the Bernstein basis on its box (the power axes converted; else itself)."""
@@ -128,24 +116,28 @@ class BernsteinForm:
         box = self.box[:axis] + (interval,) + self.box[axis + 1 :]
         return self.from_raw(shape, c, box, self.prec)
 
-    def _axis(self, axis, bernstein=False):
+    def _axis(self, axis):
         if isinstance(axis, bool) or not isinstance(axis, int) or not 0 <= axis < self.nvars:
             raise ValueError(f"axis {axis!r} out of range for {self.nvars} variables")
-        if bernstein and axis < self.POWER_AXES:
+        if axis < self.POWER_AXES:
             raise ValueError(f"axis {axis!r} is in the power basis (not an x axis)")
         return axis
 
-    # ------------------------------------------------------------------ arithmetic (same box)
-
     def _common(self, other):
+        """The precision of a result of ``self`` and ``other``: forms of one type on one box (or a scalar)."""
+        if not isinstance(other, BernsteinForm):
+            return self.prec
         if type(other) is not type(self):
             raise TypeError(f"expected a {type(self).__name__}, got {type(other).__name__}")
         if other.box != self.box:
             raise ValueError(f"Bernstein forms on different boxes: {self.box} and {other.box}")
-        prec = T.join_prec(self.prec, other.prec)
-        degrees = tuple(max(p, q) - 1 for p, q in zip(self.shape, other.shape))
-        a, b = self.elevate(degrees), other.elevate(degrees)
-        return T.convert(a.coeffs, prec), T.convert(b.coeffs, prec), a.shape, prec
+        return T.join_prec(self.prec, other.prec)
+
+    def _scalar(self, c):
+        c = T.scalar(c)
+        if isinstance(c, arb) and self.prec is None:
+            raise TypeError("arb scalar with an exact Bernstein form: convert it with .to_arb(prec)")
+        return c
 
     def __add__(self, other):
         return self._add(other, 1)
@@ -162,56 +154,41 @@ class BernsteinForm:
         return self.from_raw(self.shape, [-c for c in self.coeffs], self.box, self.prec)
 
     def _add(self, other, sign):
+        prec = self._common(other)
         if isinstance(other, BernsteinForm):
-            a, b, shape, prec = self._common(other)
+            degrees = tuple(max(p, q) - 1 for p, q in zip(self.shape, other.shape))
+            a, b = (T.convert(f.elevate(degrees).coeffs, prec) for f in (self, other))
+            shape = tuple(d + 1 for d in degrees)
         else:  # a constant: added to every coefficient (partition of unity) of the power axes' degree 0
-            b, n = T.scalar(other), T.size(self.shape[self.POWER_AXES:])
-            self._check_scalar_kind(b)
-            a, b, shape, prec = self.coeffs[:n], [b] * n, self.shape, self.prec
+            n = T.size(self.shape[self.POWER_AXES:])
+            a, b, shape = self.coeffs[:n], [self._scalar(other)] * n, self.shape
         with flint.ctx.workprec(prec or flint.ctx.prec):
             out = [x + y for x, y in zip(a, b)] if sign > 0 else [x - y for x, y in zip(a, b)]
         return self.from_raw(shape, out + self.coeffs[len(out):], self.box, prec)  # the rest: a constant's
 
-    def _check_scalar_kind(self, c):
-        if isinstance(c, arb) and self.prec is None:
-            raise TypeError("arb scalar with an exact Bernstein form: convert it with .to_arb(prec)")
-
     def __mul__(self, other):
         """Product on the same box (degree m + n): the convolution of the coefficients scaled by C(m, i) and C(n, j),
         divided by C(m + n, k); along a power axis a plain convolution."""
+        prec = self._common(other)
         if not isinstance(other, BernsteinForm):
-            c = T.scalar(other)
-            self._check_scalar_kind(c)
-            with flint.ctx.workprec(self.prec or flint.ctx.prec):
-                return self.from_raw(self.shape, [x * c for x in self.coeffs], self.box, self.prec)
-        if type(other) is not type(self) or other.box != self.box:
-            raise ValueError(f"forms on different boxes or bases: {self.box} and {other.box}")
-        prec = T.join_prec(self.prec, other.prec)
-        wa, wb = self._weights(self.shape), self._weights(other.shape)
+            c = self._scalar(other)
+            with flint.ctx.workprec(prec or flint.ctx.prec):
+                return self.from_raw(self.shape, [x * c for x in self.coeffs], self.box, prec)
         with flint.ctx.workprec(prec or flint.ctx.prec):
-            a = [c * w for c, w in zip(T.convert(self.coeffs, prec), wa)]
-            b = [c * w for c, w in zip(T.convert(other.coeffs, prec), wb)]
-        c, shape = T.multiply(a, self.shape, b, other.shape, prec)
-        wc = self._weights(shape)
-        with flint.ctx.workprec(prec or flint.ctx.prec):
-            c = [x / w for x, w in zip(c, wc)]
-        return self.from_raw(shape, c, self.box, prec)
+            a, b = ([c * w for c, w in zip(T.convert(f.coeffs, prec), self._weights(f.shape))] for f in (self, other))
+            c, shape = T.multiply(a, self.shape, b, other.shape, prec)
+            return self.from_raw(shape, [x / w for x, w in zip(c, self._weights(shape))], self.box, prec)
 
     __rmul__ = __mul__
 
     def _weights(self, shape):
-        return T.weights(shape, [[1] * n if a < self.POWER_AXES else binomials(n - 1) for a, n in enumerate(shape)])
-
-
-# ---------------------------------------------------------------------------- boxes, enclosures, det J
+        """Per axis 1 (power) or the binomials C(n, i) scaling Bernstein coefficients of degree n."""
+        return T.weights(shape, [[1] * n if a < self.POWER_AXES else [comb(n - 1, i) for i in range(n)]
+                                 for a, n in enumerate(shape)])
 
 
 def unit_box(nvars):
-    """The box [0, 1]^nvars (exact endpoints).
-
-    >>> unit_box(2)
-    ((0, 1), (0, 1))
-    """
+    """The box [0, 1]^nvars (exact endpoints)."""
     return ((fmpq(0), fmpq(1)),) * nvars
 
 

@@ -24,12 +24,7 @@ ZBOX = (T.exact_scalar(-1), T.exact_scalar(1))
 class TaylorForm(BernsteinForm):
     """A :class:`BernsteinForm` of arb balls on [-1, 1] x [0, 1]^d (``shape``: z degree + 1, then x degrees + 1)
     whose axis 0 is in the power basis (:attr:`POWER_AXES`): sums, products and x derivatives are the Bernstein ones,
-    :meth:`truncate` drops powers of z, :meth:`bernstein` converts z.
-
-    >>> f = TaylorForm((2, 3, 2), [0, 0, 0, 0, 1, 1, 0, 1, 0, 1, 0, 1], 53)   # x^2 + z y
-    >>> f.truncate(0).shape
-    (1, 3, 2)
-    """
+    :meth:`truncate` drops powers of z, :meth:`bernstein` converts z."""
 
     __slots__ = ()
     POWER_AXES = 1
@@ -38,21 +33,21 @@ class TaylorForm(BernsteinForm):
         shape = tuple(shape)
         if T.check_prec(prec) is None or len(shape) < 2:
             raise ValueError(f"a TaylorForm holds balls (pass prec=...) in 2..4 variables, got {shape!r}, {prec!r}")
-        super().__init__(shape, coeffs, _box(len(shape)), prec)
+        super().__init__(shape, coeffs, _box(len(shape) - 1), prec)
 
     @classmethod
     def constant(cls, c, nx, prec):
         """The constant ``c`` as a form in ``nx`` variables x (degree 0)."""
         with flint.ctx.workprec(prec):
-            return cls.from_raw((1,) * (nx + 1), [T.to_kind(T.scalar(c), prec)], _box(nx + 1), prec)
+            return cls.from_raw((1,) * (nx + 1), [T.to_kind(T.scalar(c), prec)], _box(nx), prec)
 
     @classmethod
     def variable(cls, axis, nx, prec):
         """The variable ``x_axis`` (1 <= axis <= nx), Bernstein coefficients (0, 1)."""
         if isinstance(axis, bool) or not isinstance(axis, int) or not 1 <= axis <= nx:
             raise ValueError(f"axis {axis!r} out of range 1..{nx}")
-        return cls.from_raw((1,) + tuple(2 if i == axis else 1 for i in range(1, nx + 1)), [arb(0), arb(1)],
-                            _box(nx + 1), prec)
+        return cls.from_raw((1,) + tuple(2 if i == axis else 1 for i in range(1, nx + 1)), [arb(0), arb(1)], _box(nx),
+                            prec)
 
     def truncate(self, degree):
         """Keep z^0 .. z^degree; each dropped c of z^e B_k is added as [-|c|, |c|] to the one of z^0 B_k."""
@@ -64,5 +59,5 @@ class TaylorForm(BernsteinForm):
         return self.from_raw(shape, c, self.box, self.prec)
 
 
-def _box(nvars):
-    return (ZBOX,) + unit_box(nvars - 1)
+def _box(nx):  # [-1, 1] x [0, 1]^nx
+    return (ZBOX,) + unit_box(nx)

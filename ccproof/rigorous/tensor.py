@@ -1,7 +1,6 @@
 """Dense coefficient tensors: a row-major list of ``fmpq`` (``prec`` None) or ``arb`` (``prec`` bits, computed inside
 ``flint.ctx.workprec``) with its ``shape``; exact basis changes along an axis (``fmpq_mat``, or the ``arb_mat`` that
-encloses it), Kronecker products. Shared by :mod:`.bernstein` and ``ccproof.certify.poly``.
-"""
+encloses it), Kronecker products. Shared by :mod:`.bernstein` and ``ccproof.certify.poly``."""
 
 from functools import lru_cache
 from math import prod
@@ -10,8 +9,6 @@ import flint
 from flint import arb, arb_mat, arb_poly, fmpq, fmpq_mat, fmpq_poly, fmpz
 
 MAX_VARS = 4
-
-_ZERO = fmpq(0)
 
 
 def check_prec(prec):
@@ -56,10 +53,8 @@ def to_kind(x, prec):
 
 def convert(coeffs, prec):
     """Coefficients converted to kind ``prec`` (exact fmpq -> arb balls at ``prec`` bits)."""
-    if prec is None:
-        return [to_kind(c, None) for c in coeffs]
-    with flint.ctx.workprec(prec):
-        return [c if isinstance(c, arb) else arb(c) for c in coeffs]
+    with flint.ctx.workprec(prec or flint.ctx.prec):
+        return [to_kind(c, prec) for c in coeffs]
 
 
 def exact_fmpq(x):
@@ -71,33 +66,26 @@ def exact_fmpq(x):
 
 
 def zero(prec):
-    return _ZERO if prec is None else arb(0)
+    return fmpq(0) if prec is None else arb(0)
 
 
-def size(shape):
-    return prod(shape)
-
-
-def to_matrix(mat, prec):
-    """The exact ``fmpq_mat`` ``mat`` for kind ``prec``: itself, or an enclosing ``arb_mat``."""
-    return mat if prec is None else _arb_matrix(mat, prec)
-
-
+size = prod  # the number of entries of a shape
 _ARB_MATS = {}
 
 
-def _arb_matrix(mat, prec):
-    # keyed on the identity of the cached exact matrix, kept alive in the entry (so its id is not reused)
-    key = (id(mat), prec)
-    hit = _ARB_MATS.get(key)
-    if hit is not None and hit[0] is mat:
-        return hit[1]
-    with flint.ctx.workprec(prec):
-        out = arb_mat(mat)
-    if len(_ARB_MATS) > 4096:
-        _ARB_MATS.clear()
-    _ARB_MATS[key] = (mat, out)
-    return out
+def to_matrix(mat, prec):
+    """The exact ``fmpq_mat`` ``mat`` for kind ``prec``: itself, or an enclosing ``arb_mat`` (cached on the identity
+    of ``mat``, kept alive in the entry so that its id is not reused)."""
+    if prec is None:
+        return mat
+    hit = _ARB_MATS.get((id(mat), prec))
+    if hit is None or hit[0] is not mat:
+        with flint.ctx.workprec(prec):
+            hit = (mat, arb_mat(mat))
+        if len(_ARB_MATS) > 4096:
+            _ARB_MATS.clear()
+        _ARB_MATS[id(mat), prec] = hit
+    return hit[1]
 
 
 def new_matrix(rows, cols, entries, prec):
@@ -131,32 +119,18 @@ def multiply(a, a_shape, b, b_shape, prec):
     """Product of two polynomial tensors: one flint product of the univariate polynomials that send exponents e to
     sum e_i S_i (S the row-major strides of the product's shape, which no exponent of the product exceeds)."""
     shape = tuple(p + q - 1 for p, q in zip(a_shape, b_shape))
-    strides = row_major_strides(shape)
-    total = size(shape)
-    pa = _embed(a, a_shape, strides, prec)
-    pb = _embed(b, b_shape, strides, prec)
+    pa, pb = pad(a, a_shape, shape, prec), pad(b, b_shape, shape, prec)
     if prec is None:
         c = (fmpq_poly(pa) * fmpq_poly(pb)).coeffs()
     else:
         with flint.ctx.workprec(prec):
             c = (arb_poly(pa) * arb_poly(pb)).coeffs()
-    return list(c) + [zero(prec)] * (total - len(c)), shape
+    return list(c) + [zero(prec)] * (size(shape) - len(c)), shape
 
 
 def row_major_strides(shape):
     """The row-major strides of a dense array of ``shape``."""
-    s = [1] * len(shape)
-    for i in range(len(shape) - 2, -1, -1):
-        s[i] = s[i + 1] * shape[i + 1]
-    return tuple(s)
-
-
-def _embed(coeffs, shape, strides, prec):
-    idx = embed_indices(shape, strides)
-    out = [zero(prec)] * (idx[-1] + 1)
-    for c, i in zip(coeffs, idx):
-        out[i] = c
-    return out
+    return tuple(prod(shape[i + 1 :]) for i in range(len(shape)))
 
 
 @lru_cache(maxsize=1024)
@@ -178,12 +152,8 @@ def weights(shape, per_axis):
 
 def pad(coeffs, shape, new_shape, prec):
     """Zero-pad a tensor to a larger shape (same number of axes)."""
-    if shape == new_shape:
-        return list(coeffs)
-    z = zero(prec)
-    out = [z] * size(new_shape)
-    idx = embed_indices(shape, row_major_strides(new_shape))
-    for c, i in zip(coeffs, idx):
+    out = [zero(prec)] * size(new_shape)
+    for c, i in zip(coeffs, embed_indices(shape, row_major_strides(new_shape))):
         out[i] = c
     return out
 

@@ -68,7 +68,6 @@ REVIEWED = {
     ("bernstein.py", "not 0 < t < 1"): "t is an exact split fraction",
     ("taylor.py", "other.prec != self.prec"): "precisions are ints",
     ("interval.py", "(l, m) != (0, 0)"): "ints",
-    ("spectrum.py", "det != out"): "fmpq determinants (exact)",
     ("injectivity.py", "ends[i][1] != ends[i + 1][0]"): "fmpq (exact decimals)",
     ("injectivity.py", "not a < b"): "fmpq (exact decimals)",
     ("interval.py", "not (all(c > 0 for c in db) or all(c < 0 for c in db))"): "fmpq Bernstein coefficients",

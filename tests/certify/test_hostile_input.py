@@ -131,7 +131,7 @@ def hostile(kind, tmp_path):
         reason = "do not partition"
     elif kind == "level N = 8":  # a 2.6 KB file that made the verifier list 2^15 cells before failing
         c["N"] = 8
-        reason = "N in 1..6"
+        reason = "N must lie in 1..6"
     elif kind == "too many boxes":  # a valid partition of 2^14 boxes: above the per-certificate limit
         c["parts"]["cells"]["0,1,0,0"] = [{"path": q, "bound": "0.01"} for q in complete_tree(14, (0, 1))]
         reason = "boxes"

@@ -212,13 +212,13 @@ def cell_det_poly(nets, lam, N, l, m, p, q, prec):
     from flint import ctx, fmpq
 
     from ccproof.certify.poly import Poly, to_poly
-    from ccproof.rigorous import jacobian_determinant
+    from ccproof.rigorous import BernsteinForm, jacobian_determinant
 
     i, name, box = M.cell_geometry(l, m, N)
     with ctx.workprec(prec):
         li = lam**i
-        X = to_poly(M.net_form(nets[name], 0, prec, box)) * li
-        Y = to_poly(M.net_form(nets[name], 1, prec, box)) * li
+        X, Y = (to_poly(BernsteinForm((4, 4), M.net_form(nets[name], d, prec).restrict(box).coeffs, prec=prec)) * li
+                for d in range(2))  # the cell's restricted net, relabelled as the unit box
         s, t = Poly.variable(0, 2), Poly.variable(1, 2)
         y1, y2 = (s + l) * fmpq(1, 2**N), (t + m) * fmpq(1, 2**N)
         w = _compose(M.weight_piece(p), X) * _compose(M.weight_piece(q), Y)

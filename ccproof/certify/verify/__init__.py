@@ -1,14 +1,5 @@
 """The trusted verifier of ccproof certificates (``ccproof verify``): the statement is derived from the schema and
-the valence, the hints replayed without search; docs/trusted_base.md lists the modules and their guarantees.
-
->>> from ccproof.certify.verify import verify_file, certificate_files
->>> from ccproof.tables.format import certificates_dir
->>> res = verify_file(certificate_files(certificates_dir())[0], log=lambda line: None)  # c1/k003.json
->>> bool(res), res.valence, res.parts[0].name
-(True, 3, 'S statement derived from the rules')
-"""
-
-from __future__ import annotations
+the valence, the hints replayed without search; docs/trusted_base.md lists the modules and their guarantees."""
 
 import json
 import os
@@ -52,7 +43,7 @@ def verify_certificate(cert, log=print, path=None):
         route, res.family, res.valence = route_of(cert)
         res.schema, res.statement = route.schema, route.statement
         check_size(cert)
-        res.N = cert.get("N") if isinstance(cert.get("N"), int) and not isinstance(cert.get("N"), bool) else None
+        res.N = cert["N"] if type(cert.get("N")) is int else None
         route.check(cert, res.family, res.valence, Recorder(res, log), log)
     except _MALFORMED as exc:
         res.error = f"{type(exc).__name__}: {exc}" if not isinstance(exc, CertificateError) else str(exc)
@@ -90,9 +81,8 @@ def verify_file(path: str | Path, log: Callable[[str], object] = print) -> Verif
 
 
 def read_certificate_bytes(path, cap=MAX_FILE_BYTES):
-    """The bytes of a regular file of at most ``cap`` bytes, without blocking: opened non-blocking (a FIFO with no
-    writer does not wait), judged by ``fstat`` of the open descriptor (a link to ``/dev/zero``, a FIFO, a directory
-    or a device is refused), at most ``cap + 1`` bytes read (a file that grows is still refused).
+    """The bytes of a regular file of at most ``cap`` bytes: opened non-blocking (a FIFO does not wait), judged by
+    ``fstat`` of the descriptor (a FIFO, directory, device or link to one is refused), at most ``cap + 1`` bytes read.
 
     >>> from ccproof.tables.format import certificates_dir
     >>> len(read_certificate_bytes(certificates_dir() / "c1" / "k005.json")) > 100

@@ -1,23 +1,10 @@
 """C1 certificates (trusted): Reif's criterion for Catmull-Clark at the valence k or every k >= k0: the spectral
 ordering (:mod:`.spectrum`), det J_Phi > 0 on layer 0 and a star-shaped outer boundary (the boxes of
-``parts.regularity`` and ``parts.star``); why these suffice: docs/appendix_a.md section 9.4.
+``parts.regularity`` and ``parts.star``); why these suffice: docs/appendix_a.md section 9.4."""
 
->>> import json
->>> from ccproof.tables.format import certificates_dir
->>> from ccproof.certify.verify.record import Recorder, VerifyResult
->>> res = VerifyResult()
->>> verify_c1(json.loads((certificates_dir() / "c1" / "k005.json").read_text()), 5, Recorder(res, lambda s: None),
-...           lambda line: None)
->>> bool(res), res.parts[4].name
-(True, 'det J_Phi > 0 on P1')
-"""
-
-from __future__ import annotations
-
-from .errors import CertificateError
 from .injectivity import check_pieces, read_parts, read_pieces
 from .maps import STAR_CURVES, regularity_form, star_form
-from .record import exact_keys, field_of, kname
+from .record import exact_keys, kname, read_prec
 from .replay import check_boxes
 from .spectrum import check_block_polynomials, spectral_ordering
 from .statement import PATCHES
@@ -26,20 +13,8 @@ PARTS = (("regularity", PATCHES, 2, regularity_form, "det J_Phi > 0 on"),
          ("star", tuple(STAR_CURVES), 1, star_form, "outer boundary star-shaped on"))
 
 
-def read_prec(cert):
-    """The working precision in bits of a C1 or tagged certificate (``prec``, 64..1024).
-
-    >>> read_prec({"prec": 128})
-    128
-    """
-    prec = field_of(cert, "prec", int, "certificate")
-    if not 64 <= prec <= 1024:
-        raise CertificateError("prec must lie in 64..1024")
-    return prec
-
-
 def verify_c1(cert, k, part, log):
-    """A C1 certificate for the valence k or every k >= k0 (``{"min": k0}``) into ``part`` (module docstring);
+    """A C1 certificate for the valence k or every k >= k0 (``{"min": k0}``) into ``part``;
     :class:`.errors.CertificateError` on a malformed one."""
     exact_keys(cert, ("schema", "valence", "prec", "pieces" if isinstance(k, dict) else "parts"), "certificate")
     prec = read_prec(cert)

@@ -1,15 +1,6 @@
 """Appendix-A injectivity certificates (trusted): parts S, H, A-E for one valence, or for every k >= k0 on each
 lam piece (Taylor models in lam: :mod:`.interval`); the steps shared with the C1 certificates (the pieces, their
-nets, parts S and H). The statement and the parts: docs/certificates.md, docs/appendix_a.md sections 0-3, 6, 8.
-
->>> cert = {"schema": SCHEMA, "valence": 5, "N": 3, "prec": 128}
->>> verify_injectivity(cert, 5, None, None)
-Traceback (most recent call last):
-...
-ccproof.certify.verify.errors.CertificateError: certificate: missing field(s) 'parts'
-"""
-
-from __future__ import annotations
+nets, parts S and H). The statement and the parts: docs/certificates.md, docs/appendix_a.md sections 0-3, 6, 8."""
 
 import re
 
@@ -18,7 +9,7 @@ from flint import arb, ctx, fmpq
 from .errors import CertificateError
 from .interval import hull_nets, interval_cells, lam_interval_ok, parameter_nets, valence_cells
 from .maps import STAR_CURVES, corner_containment, corner_det_form, curve_points, regularity_form, square_inside_image
-from .record import exact_keys, field_of, kname
+from .record import bounded_int, exact_keys, field_of, read_prec
 from .registry import SCHEMA  # noqa: F401 (named in the examples)
 from .replay import check_boxes, parse_decimal, read_boxes
 from .statement import PATCHES, StatementError, c_lam, derivation, nets_for_valence
@@ -63,11 +54,7 @@ def check_hypotheses(nets, lam, part, tag=""):
 
 
 def form_patches(symmetric):
-    """The pieces of parts B and E: P2 and P3 under the mirror symmetry (part S; docs/appendix_a.md section 8).
-
-    >>> form_patches(True), form_patches(False)
-    (('P2', 'P3'), ('P1', 'P2', 'P3'))
-    """
+    """The pieces of parts B and E: P2 and P3 under the mirror symmetry (part S; docs/appendix_a.md section 8)."""
     return ("P2", "P3") if symmetric else PATCHES
 
 
@@ -92,9 +79,8 @@ def read_parts(parts, sections):
 
 
 def read_pieces(cert, k, read):
-    """``(pieces, ends)``: one piece of ``parts`` (no ends) for one valence, or the 1..64 lam pieces
-    ``{"lam": [low, high], "parts": ...}`` with their exact ends, increasing and contiguous; ``read(parts)`` reads
-    each piece's hints.
+    """``(pieces, ends)``: one piece (no ends) for one valence, or the 1..64 lam pieces ``{"lam": [low, high],
+    "parts": ...}``, their exact ends increasing and contiguous; ``read(parts)`` reads each piece's hints.
 
     >>> read_pieces({"pieces": [{"lam": ["0.5", "0.6"], "parts": {}}, {"lam": ["0.6", "0.7"], "parts": {}}]},
     ...             {"min": 9}, print)
@@ -121,9 +107,8 @@ def read_pieces(cert, k, read):
 
 
 def check_pieces(k, pieces, ends, prec, degree, layers, check, part, spectrum=lambda: True):
-    """Part S, ``spectrum()`` (C1), the lam range (every k >= k0), then each piece until a part fails: its nets (one
-    valence: lam(k)'s; a lam piece: the hulls of the Taylor models of ``degree``), part H, then ``check(parts, nets,
-    lam, znets of ``layers`` layers or None, tag)``."""
+    """Part S, ``spectrum()`` (C1), the lam range (every k >= k0), then each piece until a part fails: its nets
+    (lam(k)'s or the Taylor models' hulls), part H, ``check(parts, nets, lam, znets (``layers``) or None, tag)``."""
     if not check_derivation(part) or not spectrum():
         return
     if ends:
@@ -150,16 +135,8 @@ def check_pieces(k, pieces, ends, prec, degree, layers, check, part, spectrum=la
 
 
 def read_n_prec(cert):
-    """The level N (1..:data:`MAX_LEVEL`) and the precision in bits (64..1024) of a certificate.
-
-    >>> read_n_prec({"N": 3, "prec": 128})
-    (3, 128)
-    """
-    N = field_of(cert, "N", int, "certificate")
-    prec = field_of(cert, "prec", int, "certificate")
-    if not 64 <= prec <= 1024 or not 1 <= N <= MAX_LEVEL:
-        raise CertificateError(f"prec must lie in 64..1024 and N in 1..{MAX_LEVEL}")
-    return N, prec
+    """The level N (1..:data:`MAX_LEVEL`) and the precision in bits (64..1024) of a certificate."""
+    return bounded_int(cert, "N", 1, MAX_LEVEL), read_prec(cert)
 
 
 def check_parts(parts, nets, lam, N, prec, cells, part, tag):
@@ -195,9 +172,8 @@ def check_parts(parts, nets, lam, N, prec, cells, part, tag):
 
 
 def _replay(roots, boxes, label, sec, part, tag, what=None):
-    """Replay ``boxes[key]`` on every (key, build root) of ``roots``: one failed part naming a key of ``boxes`` not
-    in ``roots`` or the first key (as ``what`` key) whose boxes fail or are missing, else one passed part ``label``
-    with the least bound (the margin of ``sec``, in the local variables)."""
+    """Replay ``boxes[key]`` on every (key, build root) of ``roots``: one failed part naming a key not required or
+    the first (``what`` key) whose boxes fail or are missing, else one passed part with the least bound."""
     what, least, count = what or sec, None, 0
     extra = sorted(set(boxes) - {key for key, _ in roots})
     if extra:
@@ -219,8 +195,8 @@ def _replay(roots, boxes, label, sec, part, tag, what=None):
 
 
 def verify_injectivity(cert, k, part, log):
-    """An injectivity certificate for the valence k or every k >= k0 (``{"min": k0}``) into ``part``; returns
-    :func:`.record.kname` of k; :class:`.errors.CertificateError` on a malformed one.
+    """An injectivity certificate for the valence k or every k >= k0 (``{"min": k0}``) into ``part``;
+    :class:`.errors.CertificateError` on a malformed one.
 
     >>> cert = {"schema": SCHEMA, "valence": {"min": 9}, "N": 3, "prec": 128, "pieces": [],
     ...         "parameter": {"variable": "c", "taylor_degree": 4, "truncation_degree": 2}}
@@ -248,7 +224,6 @@ def verify_injectivity(cert, k, part, log):
         cells = valence_cells(nets, lam, N, prec, sym) if zn is None else interval_cells(zn, N, D, prec, sym)
         check_parts(parts, nets, lam, N, prec, cells, part, tag)
     check_pieces(k, pieces, ends, prec, deg, N, check, part)
-    return kname(k)
 
 
 def _read_parameter(cert):

@@ -1,6 +1,5 @@
-"""Every valence k >= k0 in one certificate (trusted): lam = mid + zeta * half-width on a lam piece, the nets as
-Taylor models in zeta with exact remainders, their hulls (parts A, B, C, E) and the cells of part D, and one
-valence as Taylor models of degree 0 (docs/appendix_a.md section 6, docs/readings.md R2, R10).
+"""Every valence k >= k0 in one certificate (trusted): on a lam piece lam = mid + zeta * half-width, the nets as
+Taylor models in zeta with exact remainders, their hulls and the cells of part D (docs/appendix_a.md section 6).
 
 On the one-point piece lam = 1/2 (k = 4: Phi the identity, det dG/d(s, t) = 1/4 on a cell of layer 0):
 
@@ -16,27 +15,22 @@ On the one-point piece lam = 1/2 (k = 4: Phi the identity, det dG/d(s, t) = 1/4 
 (True, ((0, 1), (0, 1)))
 """
 
-from __future__ import annotations
-
-from flint import arb, arb_mat, ctx, fmpq, fmpq_mat, fmpq_poly
+from flint import arb, ctx, fmpq, fmpq_poly
 
 from ccproof.rigorous import BernsteinForm, TaylorForm, conversion_matrix, range_enclosure
+from ccproof.rigorous.tensor import apply_along_axis
 
 from .errors import CertificateError
-from .maps import cell_geometry, cell_pieces, det_form, net_form
-from .statement import B2Z, PATCHES, c_lam, derivation, nets_for_valence  # noqa: F401 (derivation: the examples)
+from .maps import cell_geometry, cell_pieces, det_form
+from .statement import PATCHES, bspline_to_bezier, c_lam, derivation, entrywise, nets_for_valence  # noqa: F401 (the examples)
 
 ZBOX = ((fmpq(-1), fmpq(1)), (fmpq(0), fmpq(1)), (fmpq(0), fmpq(1)))  # (zeta, s, t) of part D
 
 
 def _bern1(p, prec=None):
     """Bernstein coefficients on zeta in [-1, 1] of an fmpq_poly (or a list of arb coefficients)."""
-    c = [p[i] for i in range(max(1, p.degree() + 1))] if isinstance(p, fmpq_poly) else p
-    M = conversion_matrix(len(c) - 1, len(c) - 1, *ZBOX[0])
-    if prec is None:
-        return (M * fmpq_mat(len(c), 1, c)).entries()
-    with ctx.workprec(prec):
-        return (arb_mat(M) * arb_mat(len(c), 1, c)).entries()
+    c = [p[i] for i in range(max(1, p.degree() + 1))] if isinstance(p, fmpq_poly) else list(p)
+    return apply_along_axis(c, (len(c),), 0, conversion_matrix(len(c) - 1, len(c) - 1, *ZBOX[0]), prec)[0]
 
 
 def entry_model(form, L, layer, degree, prec):
@@ -73,33 +67,32 @@ def entry_model(form, L, layer, degree, prec):
 def parameter_nets(exact, La, Lb, layer, degree, prec):
     """Bezier nets of lam^layer Phi for every lam in [La, Lb]: net[i][j] = (x, y), each the arb coefficients of a
     polynomial in zeta (:func:`entry_model` of the B-spline forms ``exact``: ``Derivation.integer_forms``)."""
-    L = fmpq_poly([(La + Lb) / 2, (Lb - La) / 2])
+    L, m = fmpq_poly([(La + Lb) / 2, (Lb - La) / 2]), degree + 1
     out = {}
     with ctx.workprec(prec):
-        for name in PATCHES:
-            bs = [[[entry_model(f, L, layer, degree, prec) for f in pt] for pt in row] for row in exact[name]]
-            out[name] = [[tuple([sum((bs[i][j][d][e] * B2Z[a][i] * B2Z[b][j] for i in range(4) for j in range(4)),
-                                     arb(0)) / 36 for e in range(degree + 1)] for d in range(2))
-                          for b in range(4)] for a in range(4)]
+        for name in PATCHES:  # (x, y) as one vector of 2m coefficients through the B-spline -> Bezier map
+            bs = [[[c for f in pt for c in entry_model(f, L, layer, degree, prec)] for pt in row]
+                  for row in exact[name]]
+            out[name] = [[(list(p[:m]), list(p[m:])) for p in row] for row in bspline_to_bezier(bs, [arb(0)] * 2 * m)]
     return out
 
 
 def hull_nets(znets, prec):
     """arb nets enclosing the zeta-polynomial nets for every zeta in [-1, 1] (Bernstein range)."""
-    return {n: [[tuple(arb.union(*range_enclosure(_bern1(co, prec))) for co in pt) for pt in row] for row in net]
-            for n, net in znets.items()}
+    return entrywise(znets, lambda co: arb.union(*range_enclosure(_bern1(co, prec))))
 
 
 def piece_det_form_z(znets, i, name, p, q, D, prec):
     """det dG/d(sigma, tau) on ZBOX for layer i, piece ``name``, w piece (p, q), every lam of the piece at once:
     :func:`.maps.det_form` of the Taylor models (the net entries' Bernstein coefficients in (sigma, tau), their
     zeta polynomials the Taylor part, truncated to degree D)."""
-    net = znets[i][name]
+    return det_form(*(_taylor(znets[i][name], d, prec).truncate(D) for d in range(2)), i, name, p, q, D)
+
+
+def _taylor(net, d, prec):
+    """Coordinate d of a net of zeta polynomials as a Taylor model in (zeta; sigma, tau)."""
     m = len(net[0][0][0])
-    with ctx.workprec(prec):
-        X, Y = (TaylorForm((m, 4, 4), [net[a][b][d][e] for e in range(m) for a in range(4) for b in range(4)],
-                           prec).truncate(D) for d in range(2))
-        return det_form(X, Y, i, name, p, q, D)
+    return TaylorForm((m, 4, 4), [net[a][b][d][e] for e in range(m) for a in range(4) for b in range(4)], prec)
 
 
 def interval_cells(znets, N, D, prec, symmetric=False):
@@ -113,8 +106,7 @@ def interval_cells(znets, N, D, prec, symmetric=False):
         if (i, name, p, q) not in forms:
             forms[i, name, p, q] = piece_det_form_z(znets, i, name, p, q, D, prec)
         h = box[0][1] - box[0][0]
-        with ctx.workprec(prec):
-            return forms[i, name, p, q].restrict((ZBOX[0],) + box) * (h * h)
+        return forms[i, name, p, q].restrict((ZBOX[0],) + box) * (h * h)  # the forms round at their own prec
 
     with ctx.workprec(prec):
         cells = [(l, m) for l in range(2**N) for m in range(2**N) if (l, m) != (0, 0) and not (symmetric and l > m)]
@@ -127,11 +119,7 @@ def interval_cells(znets, N, D, prec, symmetric=False):
 def _cell_maps(znets, N, l, m, D, prec):
     """(X, Y) = lam^i Phi on cell (l, m) as Bernstein forms on ZBOX in (zeta, s, t)."""
     i, name, box = cell_geometry(l, m, N)
-    net = znets[i][name]
-    n = len(net[0][0][0])
-    return [TaylorForm((n, 4, 4), [c for e in range(n) for c in net_form(
-        [[(pt[0][e], pt[1][e]) for pt in row] for row in net], d, prec, box).coeffs], prec).truncate(D).bernstein()
-            for d in range(2)]
+    return [_taylor(znets[i][name], d, prec).restrict((ZBOX[0],) + box).truncate(D).bernstein() for d in range(2)]
 
 
 def lam_interval_ok(k0, La, Lb, prec):
@@ -149,8 +137,7 @@ def valence_cells(nets, lam, N, prec, symmetric=False):
     """Part D for one valence: :func:`interval_cells` of the arb nets times lam^i as Taylor models of degree 0, the
     zeta axis dropped from each root."""
     with ctx.workprec(prec):
-        zn = {i: {n: [[tuple([x * lam**i] for x in pt) for pt in row] for row in net] for n, net in nets.items()}
-              for i in range(N)}
+        zn = {i: entrywise(nets, lambda x, i=i: [x * lam**i]) for i in range(N)}
 
     def flat(build):
         f = build()

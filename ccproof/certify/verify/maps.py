@@ -1,14 +1,11 @@
-"""The maps of the statement as Bernstein forms (trusted): weight, cells, det J_G (one builder on Taylor models
-for one valence and every k >= k0), corner form, det J_Phi, outer curves. ``nets``: {piece: 4 x 4 Bezier net of
-(arb, arb)} enclosing :mod:`.statement`'s; forms on the unit box of the local parameters (docs/appendix_a.md
-sections 1-3, docs/certificates.md parts A-E).
+"""The maps of the statement as Bernstein forms on the unit box of the local parameters (trusted): weight, cells,
+det J_G, corner form, det J_Phi, outer curves, of ``nets`` {piece: 4 x 4 Bezier net of (arb, arb)} enclosing
+:mod:`.statement`'s (docs/appendix_a.md sections 1-3, docs/certificates.md parts A-E).
 
 >>> nets, lam = nets_for_valence(4, 64), c_lam(4, 64)[1]    # k = 4: Phi is the identity, lam = 1/2
 >>> corner_containment(nets, lam, 3), corner_containment(nets, lam, 2)[0], square_inside_image(nets)   # part A, C
 ((True, 0.125000000000000), False, True)
 """
-
-from __future__ import annotations
 
 from flint import arb, ctx, fmpq, fmpq_poly  # noqa: F401 (arb: the examples)
 
@@ -40,19 +37,13 @@ def weight_piece(p):
     return out
 
 
-def net_form(net, coord, prec, box=None):
-    """Bernstein form of one coordinate of a 4x4 Bezier net, restricted to the dyadic ``box`` and relabelled as
-    the unit box.
+def net_form(net, coord, prec):
+    """Bernstein form on the unit box of one coordinate of a 4x4 Bezier net.
 
-    >>> nets = nets_for_valence(4, 64)
-    >>> [[z.str(6, radius=False) for z in range_enclosure(net_form(nets["P1"], 1, 64, b))]
-    ...  for b in (None, ((0, 1), (0, "1/2")))]
-    [['0', '0.500000'], ['0', '0.250000']]
+    >>> [z.str(6, radius=False) for z in range_enclosure(net_form(nets_for_valence(4, 64)["P1"], 1, 64))]
+    ['0', '0.500000']
     """
-    f = BernsteinForm((4, 4), [net[i][j][coord] for i in range(4) for j in range(4)], prec=prec)
-    if box is not None:
-        f = f.restrict(box)
-    return BernsteinForm((4, 4), f.coeffs, prec=prec)  # relabel the sub-box as the unit box
+    return BernsteinForm((4, 4), [net[i][j][coord] for i in range(4) for j in range(4)], prec=prec)
 
 
 def cell_geometry(l, m, N):
@@ -141,8 +132,7 @@ def regularity_form(nets, name, prec):
     >>> [z.str(6, radius=False) for z in range_enclosure(regularity_form(nets_for_valence(4, 64), "P2", 64))]
     ['0.250000', '0.250000']
     """
-    with ctx.workprec(prec):
-        return jacobian_determinant([net_form(nets[name], 0, prec), net_form(nets[name], 1, prec)])
+    return jacobian_determinant([net_form(nets[name], 0, prec), net_form(nets[name], 1, prec)])
 
 
 def curve_points(nets, curve, oriented=False):

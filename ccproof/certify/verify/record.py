@@ -1,7 +1,5 @@
 """Verdicts (the parts of a check with their reasons) and strict reading of certificate fields (trusted)."""
 
-from __future__ import annotations
-
 from dataclasses import dataclass, field
 
 from flint import fmpq
@@ -11,11 +9,7 @@ from .errors import CertificateError
 
 @dataclass
 class Part:
-    """One checked claim; ``bound``: the smallest claimed bound re-checked (exact), for box parts.
-
-    >>> Part("S", False, "not an eigenvector")
-    Part(name='S', ok=False, message='not an eigenvector', bound=None)
-    """
+    """One checked claim; ``bound``: the smallest claimed bound re-checked (exact), for box parts."""
 
     name: str
     ok: bool
@@ -80,9 +74,8 @@ class Recorder:
 
     def __call__(self, name, ok, msg="", bound=None, section=None):
         self.result.parts.append(Part(name, bool(ok), msg, bound))
-        if ok and bound is not None and section is not None:
-            old = self.result.margins.get(section)
-            self.result.margins[section] = bound if old is None or bound < old else old
+        if ok and bound is not None and section is not None:  # exact bounds: min is exact
+            self.result.margins[section] = min(bound, self.result.margins.get(section, bound))
         self.log(f"  {'PASS' if ok else 'FAIL'}  {name}{(': ' + msg) if msg else ''}")
 
     @property
@@ -93,8 +86,6 @@ class Recorder:
 def field_of(obj, key, kind, where):
     """``obj[key]`` of type ``kind`` (a bool is never an int here), else a :class:`CertificateError` naming ``where``.
 
-    >>> field_of({"N": 3}, "N", int, "hints")
-    3
     >>> field_of({"N": True}, "N", int, "hints")
     Traceback (most recent call last):
     ...
@@ -126,6 +117,19 @@ def exact_keys(obj, keys, where):
         raise CertificateError(f"{where}: missing field(s) {', '.join(map(repr, missing))}")
 
 
+def bounded_int(obj, key, lo, hi, where="certificate"):
+    """``obj[key]``, an int in lo..hi (:func:`field_of`), else a :class:`CertificateError` naming the range."""
+    val = field_of(obj, key, int, where)
+    if val < lo or val > hi:
+        raise CertificateError(f"{key} must lie in {lo}..{hi}")
+    return val
+
+
+def read_prec(cert):
+    """The working precision in bits of a certificate (``prec``, 64..1024)."""
+    return bounded_int(cert, "prec", 64, 1024)
+
+
 def read_valence(cert):
     """``cert["valence"]``: an int k or ``{"min": k0}``, within 3..10^6 (so every derived check stays fast).
 
@@ -135,18 +139,12 @@ def read_valence(cert):
     k = field_of(cert, "valence", (int, dict), "certificate")
     if isinstance(k, dict):
         exact_keys(k, ("min",), "valence")
-        k0 = k["min"]
-        if not isinstance(k0, int) or isinstance(k0, bool) or not 3 <= k0 <= 10**6:
-            raise CertificateError(f"valence interval must be {{'min': K0}} with 3 <= K0 <= 10^6, got {k!r}")
+        bounded_int(k, "min", 3, 10**6, "valence")
     elif not 3 <= k <= 10**6:
         raise CertificateError(f"valence {k} outside 3..10^6")
     return k
 
 
 def kname(k):
-    """``"5"`` or ``">=7"``.
-
-    >>> kname(5), kname({"min": 7})
-    ('5', '>=7')
-    """
+    """``"5"`` or ``">=7"`` (:attr:`VerifyResult.configuration`'s example)."""
     return f">={k['min']}" if isinstance(k, dict) else str(k)

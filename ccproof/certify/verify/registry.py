@@ -7,8 +7,6 @@ verifier proved, decided from its own verdicts, never from a file (trusted; docs
 ['smooth injective', 'smooth C1']
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass
 from importlib import import_module
 
@@ -143,16 +141,12 @@ def coverage(results):
     (False, 'C1 (Reif) coverage: OK: every', 'injectivity (Appendix A) coverage: INCOMPLETE: no interval k >= k0')
     """
     verified = [r for r in results if r and r.family is not None and r.statement is not None]
-    ok_all, lines = True, []
+    rows = []
     for label, statement in (("C1 (Reif)", "C1"), ("injectivity (Appendix A)", "injective")):
         ok, msg = check_coverage([r.valence for r in verified if r.family == "smooth" and r.statement == statement])
-        lines.append(f"{label} coverage: {'OK' if ok else 'INCOMPLETE'}: {msg}")
-        ok_all &= ok
-    for fam in TAGGED:
-        ok, line = family_coverage(fam, [(r.valence, r.statement) for r in verified if r.family == fam])
-        lines.append(line)
-        ok_all &= ok
-    return ok_all, lines
+        rows.append((ok, f"{label} coverage: {'OK' if ok else 'INCOMPLETE'}: {msg}"))
+    rows += [family_coverage(fam, [(r.valence, r.statement) for r in verified if r.family == fam]) for fam in TAGGED]
+    return all(ok for ok, _ in rows), [line for _, line in rows]
 
 
 def family_coverage(fam, certified):
@@ -225,11 +219,10 @@ def check_coverage(valences):
 
 def _ranges(ns):
     """``[1, 2, 3, 5]`` -> ``'1-3, 5'``."""
-    out, i = [], 0
-    while i < len(ns):
-        j = i
-        while j + 1 < len(ns) and ns[j + 1] == ns[j] + 1:
-            j += 1
-        out.append(str(ns[i]) if i == j else f"{ns[i]}-{ns[j]}")
-        i = j + 1
-    return ", ".join(out)
+    runs = []
+    for n in ns:
+        if runs and runs[-1][1] == n - 1:
+            runs[-1][1] = n
+        else:
+            runs.append([n, n])
+    return ", ".join(str(a) if a == b else f"{a}-{b}" for a, b in runs)

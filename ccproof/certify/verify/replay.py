@@ -1,14 +1,7 @@
-"""Replaying the hints of a certificate: sizes, decimals, box paths, partitions, claimed bounds (trusted).
-
-Every cover is one format, a split tree given by its leaves (docs/certificates.md, the grammar and "Bounds"): a
-leaf names a box by halvings (:func:`parse_path`) and claims a bound. A box list (:func:`read_boxes`) is the leaves
-of one tree over its root; a grid tree (:func:`read_tree`) cuts its root into equal cells, one tree per cell. Each
-tree must partition its root (:func:`box_tree`) before any arithmetic, its cost is charged against the certificate's
-budget (:func:`charge_replay`), and it is replayed depth-first on a Bernstein form (:func:`check_boxes`) or leaf by
-leaf on exact boxes (:func:`replay_tree`). Sizes are bounded; nothing searches.
-"""
-
-from __future__ import annotations
+"""Replaying the hints of a certificate (trusted): one format, a split tree given by its leaves, each a box named by
+halvings (:func:`parse_path`) with a claimed bound; a box list (:func:`read_boxes`) is one tree, a grid tree
+(:func:`read_tree`) one per grid cell. Each tree must partition its root (:func:`box_tree`) before any arithmetic,
+its cost is charged against the certificate's budget, and it is replayed without search (docs/certificates.md)."""
 
 import re
 from contextvars import ContextVar
@@ -161,16 +154,11 @@ def box_tree(paths, nvars):
 
 
 def check_partition(paths, nvars):
-    """Do the leaf paths partition the root box exactly (:func:`box_tree`)?
-
-    >>> check_partition(["0L", "0H1L", "0H1H"], 2), check_partition(["0L", "0H1L"], 2)
-    (True, False)
-    """
+    """Do the leaf paths partition the root box exactly (:func:`box_tree`)?"""
     try:
-        box_tree(paths, nvars)
+        return bool(box_tree(paths, nvars))
     except CertificateError:
         return False
-    return True
 
 
 def _tree(paths, nvars, where):

@@ -6,8 +6,6 @@ source of the scheme (trusted): face, edge and vertex points; sector j is the qu
 (9/16, 13/20)
 """
 
-from __future__ import annotations
-
 from flint import fmpq
 
 TWO_RING = ((1, 0), (2, 0), (1, 1), (2, 1), (1, 2), (2, 2))
@@ -21,16 +19,11 @@ def canonical(a, b):
     >>> canonical(2, 1), canonical(0, 2), canonical(-1, 0), canonical(1, -1)
     ((0, 2, 1), (1, 2, 0), (2, 1, 0), (-1, 1, 1))
     """
-    if a == 0 and b == 0:
+    if (a, b) == CENTRE:
         return (0, 0, 0)
-    if a >= 1 and b >= 0:
-        return (0, a, b)
-    if a <= 0 and b >= 1:
-        return (1, b, -a)
-    if a >= 0 and b <= -1:
-        return (-1, -b, a)
-    if b == 0 and a < 0:
-        return (2, -a, 0)
+    for delta, a2, b2 in ((0, a, b), (1, b, -a), (-1, -b, a), (2, -a, -b)):  # (a, b) in the frame of sector delta
+        if a2 >= 1 and b2 >= 0 and (delta < 2 or b2 == 0):  # two sectors on (delta 2): the ray only
+            return delta, a2, b2
     raise ValueError(f"grid position ({a}, {b}) is more than one sector away")
 
 

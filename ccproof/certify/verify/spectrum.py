@@ -1,14 +1,9 @@
 """The spectrum of the Catmull-Clark subdivision matrix re-derived from the rules (trusted): the Fourier blocks
 B(w) (one stencil, shared by the smooth, tagged and dart routes) and B0(1/k), their characteristic polynomials
-(exact) and the spectral ordering (arb). docs/appendix_a.md section 9.3; docs/readings.md R2.
-
->>> check_block_polynomials(), spectral_ordering(5, 64)[0]
-(True, True)
-"""
-
-from __future__ import annotations
+(exact) and the spectral ordering (arb). docs/appendix_a.md section 9.3; docs/readings.md R2."""
 
 from functools import cache
+from math import prod
 
 from flint import arb, ctx, fmpq, fmpq_mat
 
@@ -63,17 +58,13 @@ def _block0(t):
 
 
 def _identity_holds(block, claimed, params, xs):
-    """det(x - block(s)) == claimed(x, s) at every exact grid point (s in params, x in xs)."""
-    for s in params:
-        rows = block(fmpq(s))
+    """det(x - block(s)) == claimed(x, s) (x - 1/8)..(x - 1/64) at every exact grid point (s in params, x in xs)."""
+    for s in map(fmpq, params):
+        rows = block(s)
         n = len(rows)
-        for x in map(fmpq, xs):
-            out = claimed(x, fmpq(s))
-            for r in SMALL_ROOTS:
-                out *= x - r
-            det = fmpq_mat(n, n, [(x if i == j else 0) - rows[i][j] for i in range(n) for j in range(n)]).det()
-            if det != out:
-                return False
+        if not all(fmpq_mat(n, n, [(x if i == j else 0) - rows[i][j] for i in range(n) for j in range(n)]).det()
+                   == claimed(x, s) * prod(x - r for r in SMALL_ROOTS) for x in map(fmpq, xs)):
+            return False
     return True
 
 

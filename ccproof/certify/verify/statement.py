@@ -8,8 +8,6 @@ sections 0 and 9.1; docs/readings.md R2-R4.
 (True, True)
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass
 from functools import lru_cache
 from math import lcm
@@ -117,11 +115,7 @@ def horner(p, x, acc=None):
 
 
 class StatementError(ValueError):
-    """The derivation of the statement failed (cannot happen for the true rules; a tripwire).
-
-    >>> issubclass(StatementError, ValueError), all(ok for _, ok in derivation().hypotheses)
-    (True, True)
-    """
+    """The derivation of the statement failed (cannot happen for the true rules; a tripwire)."""
 
 
 def rot(delta, p):
@@ -207,7 +201,8 @@ def split_half(curve):
     return left, right[::-1]
 
 
-def _entrywise(nets, f):
+def entrywise(nets, f):
+    """{piece: net} with ``f`` applied to every coordinate of every point."""
     return {n: [[tuple(f(q) for q in p) for p in row] for row in net] for n, net in nets.items()}
 
 
@@ -228,7 +223,7 @@ class Derivation:
 
     def integer_forms(self):
         """{piece: 4x4 of ([A,B,D], [A,B,D])}: the exact forms (A(c) + B(c) lam)/D(c) of the B-spline nets."""
-        return _entrywise(self.bspline, QL.integer_form)
+        return entrywise(self.bspline, QL.integer_form)
 
 
 @lru_cache(maxsize=1)
@@ -245,7 +240,7 @@ def derivation():
     if phi10[0].is_zero():
         raise StatementError("Phi(1, 0) = 0: the normalization is impossible")
     scale = phi10[0].inverse()
-    bs = _entrywise(raw, lambda q: q * scale)
+    bs = entrywise(raw, lambda q: q * scale)
     bz = {n: bspline_to_bezier(net) for n, net in bs.items()}
     vec = {p: tuple(q * scale for q in v) for p, v in vals.items()}
     return Derivation(vec, bs, bz, *_hypotheses(bz, all(e.is_zero() for e in residuals)))
@@ -288,11 +283,7 @@ def lam_of(c):
 
 
 def c_lam(k, prec):
-    """Balls (c, lam) holding cos(2 pi/k) and lam(k) at ``prec`` bits.
-
-    >>> c_lam(4, 53)[1], c_lam(3, 53)[1].overlaps((9 + arb(17).sqrt()) / 32)
-    (0.500000000000000, True)
-    """
+    """Balls (c, lam) holding cos(2 pi/k) and lam(k) at ``prec`` bits."""
     with ctx.workprec(prec):
         c = arb(fmpq(2, k)).cos_pi()
         return c, lam_of(c)
@@ -312,6 +303,6 @@ def nets_for_valence(k, prec):
         try:
             for p in [*d.eigenvector.values(), *(p for net in d.bspline.values() for row in net for p in row)]:
                 [q.evaluate(c, lam) for q in p]  # every denominator checked
-            return _entrywise(d.bezier, lambda q: q.evaluate(c, lam))
+            return entrywise(d.bezier, lambda q: q.evaluate(c, lam))
         except ZeroDivisionError:
             raise StatementError(f"a denominator of the exact forms may vanish at c = cos(2 pi/{k})") from None
