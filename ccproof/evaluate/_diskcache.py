@@ -90,14 +90,15 @@ def report_bad(path, why):
                       CorruptCacheWarning, stacklevel=3)
 
 
-def read_entry(path, name, parse):
+def read_entry(path, name, parse, data=None):
     """``parse(body)`` of the verified cache file ``path`` written for ``name``, or None: missing or
     unreadable (silently), or corrupt (reported by :func:`report_bad`), including a ``parse`` that
-    raises ValueError or KeyError."""
-    try:
-        data = path.read_bytes()
-    except OSError:
-        return None
+    raises ValueError or KeyError. ``data``: the file's bytes when already read."""
+    if data is None:
+        try:
+            data = path.read_bytes()
+        except OSError:
+            return None
     try:
         return parse(unseal(data, name))
     except (ValueError, KeyError, UnicodeDecodeError) as e:

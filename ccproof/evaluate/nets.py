@@ -35,6 +35,9 @@ NETS_BUDGET = 32 << 20
 #: products in all: a lone 1000-gon's 3.4 s of CPU); they are then computed per point (the same bits)
 RING_MEAN_PRECOMPUTED = 64
 
+#: :func:`ring_products` adds all terms in one array operation up to this many terms (else term by term)
+_ACCUMULATE_MAX = 1 << 17
+
 
 def with_nets(T, groups):
     """``T`` with the precomputed nets that fit their budgets: the regular nets (:data:`NETS_BUDGET`, or the
@@ -107,6 +110,13 @@ def ring_products(op, X, rings):
     [[1.0, 1.0, 0.0]]
     """
     X0 = X[rings[:, 0]]
+    k, N = rings.shape
+    if 1 < N and k * (N - 1) * op.shape[1] * 3 <= _ACCUMULATE_MAX:
+        # small blocks (many calls on a small mesh): the same sums at once, np.add.accumulate adding the
+        # terms in order; ``+ 0.0`` gives the loop's +0.0 where every term is -0.0 (0.0 + (-0.0) = 0.0)
+        D = (X[rings[:, 1:]] - X0[:, None, :]).transpose(1, 0, 2)  # (N - 1, k, 3)
+        terms = op[1:, None, :, None] * D[:, :, None, :]  # (N - 1, k, r, 3)
+        return np.add.accumulate(terms, axis=0)[-1] + 0.0
     acc = np.zeros((rings.shape[0], op.shape[1], 3))
     for j in range(1, op.shape[0]):
         acc += op[j][None, :, None] * (X[rings[:, j]] - X0)[:, None, :]

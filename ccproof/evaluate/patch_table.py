@@ -190,15 +190,39 @@ def _configuration_ops(schemes):
     ops, op_start, op_size, n_layers, unit = [], [], [], [], []
     off = 0
     for scheme, orient in schemes:
-        L, u = oriented_layers(scheme, orient)
-        nl_, nc_ = scheme.n_layers, L.shape[1]
-        ops.append(L.reshape(nl_ * 3, 16, nc_).transpose(0, 2, 1).reshape(-1))  # (layer, code, j, i)
+        flat, u = _flat_layers(scheme, orient)
+        ops.append(flat)
         op_start.append(off)
-        op_size.append(L.shape[1])
+        op_size.append(scheme.layers.shape[-1])
         n_layers.append(scheme.n_layers)
         unit.append(u)
-        off += L.size
+        off += flat.size
     return ops, op_start, op_size, n_layers, unit
+
+
+#: per configuration (id of its corner scheme, orientation): (scheme, flat operators, unit), read-only, those of
+#: recent setups in this process, within :data:`_FLAT_BUDGET` bytes (the oldest dropped first)
+_FLAT: dict = {}
+_FLAT_BUDGET = 64 << 20
+
+
+def _flat_layers(scheme, orient):
+    """The layer operators of a configuration, flat (layer, code, j, i), and its ``unit``: the same array for
+    the same (scheme, orientation) while it stays within :data:`_FLAT_BUDGET` (the scheme is kept with it)."""
+    key = (id(scheme), orient)
+    hit = _FLAT.get(key)
+    if hit is not None and hit[0] is scheme:
+        return hit[1], hit[2]
+    L, u = oriented_layers(scheme, orient)
+    nl, nc = scheme.n_layers, L.shape[1]
+    flat = L.reshape(nl * 3, 16, nc).transpose(0, 2, 1).reshape(-1)
+    flat.setflags(write=False)
+    held = sum(x[1].nbytes for x in _FLAT.values())
+    while _FLAT and held + flat.nbytes > _FLAT_BUDGET:
+        held -= _FLAT.pop(next(iter(_FLAT)))[1].nbytes
+    if flat.nbytes <= _FLAT_BUDGET:
+        _FLAT[key] = (scheme, flat, u)
+    return flat, u
 
 
 def assemble(temps, schemes, n_jobs, X, top, refused):
