@@ -132,16 +132,21 @@ def regular_nets(T, groups):
         if not jobs.size:
             continue
         root = int(T.job_root[jobs[0]])
-        for vf, kind in enumerate(t.kind):
-            if kind != KIND_REGULAR:
-                continue
-            g = root + vf
-            st, N = int(T.vop_start[g]), int(T.vn[g])
-            for lo in range(0, jobs.size, _BLOCK):
-                R = rings[lo:lo + _BLOCK]
-                a = ring_products(T.vop[st:st + 17 * N].reshape(N, 17), X, R)
-                a[:, 16] += X[R[:, 0]]
-                nets[T.job_net[jobs[lo:lo + _BLOCK]] + t.leaf[vf]] = a
+        vfs = [vf for vf, kind in enumerate(t.kind) if kind == KIND_REGULAR]
+        if not vfs:
+            continue
+        # the regular patches of one template share their jobs' rings: their operators side by side, one
+        # ring_products per block of jobs (each entry's sum the same, in the same order)
+        N = int(T.vn[root + vfs[0]])
+        op = np.concatenate([T.vop[int(T.vop_start[root + vf]):int(T.vop_start[root + vf]) + 17 * N].reshape(N, 17)
+                             for vf in vfs], axis=1)
+        step = max(1, (_BLOCK * 17) // op.shape[1])
+        for lo in range(0, jobs.size, step):
+            R = rings[lo:lo + step]
+            a = ring_products(op, X, R).reshape(R.shape[0], len(vfs), 17, 3)
+            a[:, :, 16] += X[R[:, 0]][:, None, :]
+            for i, vf in enumerate(vfs):
+                nets[T.job_net[jobs[lo:lo + step]] + t.leaf[vf]] = a[:, i]
     return nets
 
 
@@ -203,19 +208,39 @@ def _sparse_parts(op):
 def layer0_nets(T, groups):
     """The nets of layer 0 of every corner face of table ``T`` (see :attr:`PatchTable.hot`): per
     corner face c and patch code the composed operator's sums (:func:`composed_nets`, the compiled
-    kernel's), row 16 the limit point. Shape (3 n_corner, 17, 3)."""
+    kernel's), row 16 the limit point (:func:`corner_limits`). Shape (3 n_corner, 17, 3).
+
+    The corner faces of one template share their jobs' rings: their operators go side by side into one
+    :func:`ring_products` per block of jobs (each entry's sum the same, in the same order)."""
     hot = np.empty((3 * T.n_corner, 17, 3))
     for t, jobs, _ in groups:
         if jobs is None or not jobs.size or not t.O.shape[0]:
             continue
         root = int(T.job_root[jobs[0]])
-        for vf, kind in enumerate(t.kind):
-            if kind != KIND_CORNER:
-                continue
-            for lo in range(0, jobs.size, _BLOCK):
-                jb = jobs[lo:lo + _BLOCK]
+        vfs = [vf for vf, kind in enumerate(t.kind) if kind == KIND_CORNER]
+        op = np.concatenate([_layer0_operator(T, root + vf) for vf in vfs], axis=1)  # (N, 49 per corner face)
+        N = op.shape[0]
+        step = max(1, (_BLOCK * 64) // op.shape[1])
+        for lo in range(0, jobs.size, step):
+            jb = jobs[lo:lo + step]
+            R = T.rings[T.job_ring[jb][:, None] + np.arange(N)]
+            acc = ring_products(op, T.points, R).reshape(jb.size, len(vfs), 49, 3)
+            X0 = T.points[R[:, 0]]
+            for i, vf in enumerate(vfs):
                 ci = T.job_corner[jb] + t.leaf[vf]
-                nets = composed_nets(T, jb, root + vf, 0)
+                nets = np.empty((jb.size, 3, 17, 3))
+                nets[:, :, :16] = acc[:, i, :48].reshape(-1, 3, 16, 3)
+                nets[:, :, 16] = (acc[:, i, 48] + X0)[:, None, :]
                 for code in range(3):
                     hot[3 * ci + code] = nets[:, code]
     return hot
+
+
+def _layer0_operator(T, vf):
+    """(N, 49): the composed operators of layer 0 of the corner face ``vf`` (the three patch codes' 16 columns,
+    :func:`composed_nets`), then its limit point's (:func:`corner_limits`)."""
+    N, st, Nc = int(T.vn[vf]), int(T.vop_start[vf]), int(T.op_size[T.cfg[vf]])
+    lim = T.vop[st + N * (Nc - 1):st + N * (Nc - 1) + N].reshape(N, 1)
+    st += N * (Nc - 1) + N
+    op = T.vop[st:st + 3 * N * 16].reshape(3, N, 16).transpose(1, 0, 2).reshape(N, 48)
+    return np.concatenate([op, lim], axis=1)

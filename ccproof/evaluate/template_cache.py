@@ -186,15 +186,23 @@ def cached_template(tkey, depth_semi, make):
 
 
 #: per cache name: (the file's bytes, the template parsed from them), the templates of recent setups in this
-#: process (a setup reads the file again and takes this one only where its bytes are these, byte for byte)
+#: process (a setup reads the file again and takes this one only where its bytes are these, byte for byte),
+#: within :data:`PARSED_BUDGET` bytes of files (the oldest dropped first)
 _PARSED: dict = {}
-_PARSED_MAX = 4096
+PARSED_BUDGET = 32 << 20
 
 
 def _remember(name, data, t):
-    if len(_PARSED) >= _PARSED_MAX:
-        _PARSED.pop(next(iter(_PARSED)))
-    _PARSED[name] = (data, _fresh(t))
+    held = sum(len(d) for d, _ in _PARSED.values())
+    while _PARSED and held + len(data) > PARSED_BUDGET:
+        held -= len(_PARSED.pop(next(iter(_PARSED)))[0])
+    if len(data) <= PARSED_BUDGET:
+        _PARSED[name] = (data, _fresh(t))
+
+
+def forget_parsed():
+    """Drop the templates this process keeps parsed (:func:`cached_template` parses their files again)."""
+    _PARSED.clear()
 
 
 def _fresh(t):
