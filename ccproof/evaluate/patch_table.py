@@ -266,7 +266,7 @@ def assemble(temps, schemes, n_jobs, X, top, refused):
         leaf += t.leaf
         cfg += t.cfg
         corner += t.corner
-        for ops_ in _leaf_operators(t, ops):
+        for ops_ in _cached_leaf_operators(t, ops):
             vop_start.append(n_vop if ops_ is not None else -1)
             vn.append(t.n)
             if ops_ is not None:
@@ -304,6 +304,30 @@ def assemble(temps, schemes, n_jobs, X, top, refused):
         unit=np.array(unit, dtype=np.float64).reshape(-1, 3, 3), hot=np.zeros((0, 17, 3)),
         cor_ring=np.zeros(0, np.int64), ring=np.zeros((0, 3)))
     return T, groups
+
+
+#: per template and configurations (the identities of its operators and of its configurations' flat layer
+#: operators, which are kept with it): the leaf operators of :func:`_leaf_operators`, those of recent setups in
+#: this process (a template read from the disk cache keeps its arrays), within :data:`_VOPS_BUDGET` bytes
+_VOPS: dict = {}
+_VOPS_BUDGET = 32 << 20
+
+
+def _cached_leaf_operators(t, ops):
+    """:func:`_leaf_operators` of ``t``, the same arrays again for the same template arrays and configurations."""
+    refs = (t.R, t.Q, t.O, *(ops[c] for c in t.cfg if c >= 0))
+    key = tuple(map(id, refs))
+    hit = _VOPS.get(key)
+    if hit is not None and len(hit[0]) == len(refs) and all(a is b for a, b in zip(hit[0], refs)):
+        return hit[1]
+    out = _leaf_operators(t, ops)
+    size = sum(x.nbytes for x in out if x is not None)
+    held = sum(h[2] for h in _VOPS.values())
+    while _VOPS and held + size > _VOPS_BUDGET:
+        held -= _VOPS.pop(next(iter(_VOPS)))[2]
+    if size <= _VOPS_BUDGET:
+        _VOPS[key] = (refs, out, size)
+    return out
 
 
 def _leaf_operators(t, ops):
