@@ -203,7 +203,7 @@ def _configuration_ops(schemes):
 #: per configuration (id of its corner scheme, orientation): (scheme, flat operators, unit), read-only, those of
 #: recent setups in this process, within :data:`_FLAT_BUDGET` bytes (the oldest dropped first)
 _FLAT: dict = {}
-_FLAT_BUDGET = 64 << 20
+_FLAT_BUDGET = 16 << 20
 
 
 def _flat_layers(scheme, orient):
@@ -310,7 +310,7 @@ def assemble(temps, schemes, n_jobs, X, top, refused):
 #: operators, which are kept with it): the leaf operators of :func:`_leaf_operators`, those of recent setups in
 #: this process (a template read from the disk cache keeps its arrays), within :data:`_VOPS_BUDGET` bytes
 _VOPS: dict = {}
-_VOPS_BUDGET = 32 << 20
+_VOPS_BUDGET = 8 << 20
 
 
 def _cached_leaf_operators(t, ops):

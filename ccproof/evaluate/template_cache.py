@@ -187,16 +187,17 @@ def cached_template(tkey, depth_semi, make):
 
 #: per cache name: (the file's bytes, the template parsed from them), the templates of recent setups in this
 #: process (a setup reads the file again and takes this one only where its bytes are these, byte for byte),
-#: within :data:`PARSED_BUDGET` bytes of files (the oldest dropped first)
+#: within :data:`PARSED_BUDGET` bytes (twice the files': their bytes and the parsed arrays; the oldest dropped
+#: first): the small meshes' setups, where these fixed costs count, keep theirs
 _PARSED: dict = {}
-PARSED_BUDGET = 32 << 20
+PARSED_BUDGET = 8 << 20
 
 
 def _remember(name, data, t):
-    held = sum(len(d) for d, _ in _PARSED.values())
-    while _PARSED and held + len(data) > PARSED_BUDGET:
-        held -= len(_PARSED.pop(next(iter(_PARSED)))[0])
-    if len(data) <= PARSED_BUDGET:
+    held = sum(2 * len(d) for d, _ in _PARSED.values())
+    while _PARSED and held + 2 * len(data) > PARSED_BUDGET:
+        held -= 2 * len(_PARSED.pop(next(iter(_PARSED)))[0])
+    if 2 * len(data) <= PARSED_BUDGET:
         _PARSED[name] = (data, _fresh(t))
 
 
