@@ -313,6 +313,12 @@ _VOPS: dict = {}
 _VOPS_BUDGET = 8 << 20
 
 
+def forget_kept():
+    """Drop the leaf and flat layer operators this process keeps from recent setups (computed again on use)."""
+    _VOPS.clear()
+    _FLAT.clear()
+
+
 def _cached_leaf_operators(t, ops):
     """:func:`_leaf_operators` of ``t``, the same arrays again for the same template arrays and configurations."""
     refs = (t.R, t.Q, t.O, *(ops[c] for c in t.cfg if c >= 0))
