@@ -141,12 +141,12 @@ def regular_nets(T, groups):
         op = np.concatenate([T.vop[int(T.vop_start[root + vf]):int(T.vop_start[root + vf]) + 17 * N].reshape(N, 17)
                              for vf in vfs], axis=1)
         step = max(1, (_BLOCK * 17) // op.shape[1])
+        leaves = np.array([t.leaf[vf] for vf in vfs], dtype=np.int64)
         for lo in range(0, jobs.size, step):
             R = rings[lo:lo + step]
             a = ring_products(op, X, R).reshape(R.shape[0], len(vfs), 17, 3)
             a[:, :, 16] += X[R[:, 0]][:, None, :]
-            for i, vf in enumerate(vfs):
-                nets[T.job_net[jobs[lo:lo + step]] + t.leaf[vf]] = a[:, i]
+            nets[(T.job_net[jobs[lo:lo + step]][:, None] + leaves[None, :]).reshape(-1)] = a.reshape(-1, 17, 3)
     return nets
 
 
@@ -219,20 +219,18 @@ def layer0_nets(T, groups):
         root = int(T.job_root[jobs[0]])
         vfs = [vf for vf, kind in enumerate(t.kind) if kind == KIND_CORNER]
         op = np.concatenate([_layer0_operator(T, root + vf) for vf in vfs], axis=1)  # (N, 49 per corner face)
-        N = op.shape[0]
+        N, nv = op.shape[0], len(vfs)
+        leaves = np.array([t.leaf[vf] for vf in vfs], dtype=np.int64)
         step = max(1, (_BLOCK * 64) // op.shape[1])
         for lo in range(0, jobs.size, step):
             jb = jobs[lo:lo + step]
             R = T.rings[T.job_ring[jb][:, None] + np.arange(N)]
-            acc = ring_products(op, T.points, R).reshape(jb.size, len(vfs), 49, 3)
-            X0 = T.points[R[:, 0]]
-            for i, vf in enumerate(vfs):
-                ci = T.job_corner[jb] + t.leaf[vf]
-                nets = np.empty((jb.size, 3, 17, 3))
-                nets[:, :, :16] = acc[:, i, :48].reshape(-1, 3, 16, 3)
-                nets[:, :, 16] = (acc[:, i, 48] + X0)[:, None, :]
-                for code in range(3):
-                    hot[3 * ci + code] = nets[:, code]
+            acc = ring_products(op, T.points, R).reshape(jb.size, nv, 49, 3)
+            nets = np.empty((jb.size, nv, 3, 17, 3))
+            nets[:, :, :, :16] = acc[:, :, :48].reshape(jb.size, nv, 3, 16, 3)
+            nets[:, :, :, 16] = (acc[:, :, 48] + T.points[R[:, 0]][:, None, :])[:, :, None, :]
+            ci = T.job_corner[jb][:, None] + leaves[None, :]  # (k, nv): the corner faces' rows
+            hot[(3 * ci[:, :, None] + np.arange(3)).reshape(-1)] = nets.reshape(-1, 17, 3)
     return hot
 
 
