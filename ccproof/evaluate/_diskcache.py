@@ -22,6 +22,7 @@ ValueError: digest mismatch
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import os
 import re
@@ -55,7 +56,12 @@ def cache_dir():
     ...     cache_dir() is None
     True
     """
-    d = os.environ.get("CCPROOF_CACHE")
+    return _cache_dir(os.environ.get("CCPROOF_CACHE"), os.environ.get("HOME"))
+
+
+@functools.lru_cache(maxsize=16)
+def _cache_dir(d, home):
+    """:func:`cache_dir` of these values of ``CCPROOF_CACHE`` and ``HOME`` (a setup asks once per template)."""
     if d is not None and d.strip().lower() in ("", "0", "off", "none", "no"):
         return None
     return Path(d) if d else Path.home() / ".cache" / "ccproof" / "corner_schemes"
@@ -90,14 +96,15 @@ def report_bad(path, why):
                       CorruptCacheWarning, stacklevel=3)
 
 
-def read_entry(path, name, parse):
+def read_entry(path, name, parse, data=None):
     """``parse(body)`` of the verified cache file ``path`` written for ``name``, or None: missing or
     unreadable (silently), or corrupt (reported by :func:`report_bad`), including a ``parse`` that
-    raises ValueError or KeyError."""
-    try:
-        data = path.read_bytes()
-    except OSError:
-        return None
+    raises ValueError or KeyError. ``data``: the file's bytes when already read."""
+    if data is None:
+        try:
+            data = path.read_bytes()
+        except OSError:
+            return None
     try:
         return parse(unseal(data, name))
     except (ValueError, KeyError, UnicodeDecodeError) as e:

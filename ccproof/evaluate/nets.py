@@ -35,6 +35,9 @@ NETS_BUDGET = 32 << 20
 #: products in all: a lone 1000-gon's 3.4 s of CPU); they are then computed per point (the same bits)
 RING_MEAN_PRECOMPUTED = 64
 
+#: :func:`ring_products` adds all terms in one array operation up to this many terms (else term by term)
+_ACCUMULATE_MAX = 1 << 17
+
 
 def with_nets(T, groups):
     """``T`` with the precomputed nets that fit their budgets: the regular nets (:data:`NETS_BUDGET`, or the
@@ -107,6 +110,13 @@ def ring_products(op, X, rings):
     [[1.0, 1.0, 0.0]]
     """
     X0 = X[rings[:, 0]]
+    k, N = rings.shape
+    if 1 < N and k * (N - 1) * op.shape[1] * 3 <= _ACCUMULATE_MAX:
+        # small blocks (many calls on a small mesh): the same sums at once, np.add.accumulate adding the
+        # terms in order; ``+ 0.0`` gives the loop's +0.0 where every term is -0.0 (0.0 + (-0.0) = 0.0)
+        D = (X[rings[:, 1:]] - X0[:, None, :]).transpose(1, 0, 2)  # (N - 1, k, 3)
+        terms = op[1:, None, :, None] * D[:, :, None, :]  # (N - 1, k, r, 3)
+        return np.add.accumulate(terms, axis=0)[-1] + 0.0
     acc = np.zeros((rings.shape[0], op.shape[1], 3))
     for j in range(1, op.shape[0]):
         acc += op[j][None, :, None] * (X[rings[:, j]] - X0)[:, None, :]
@@ -122,16 +132,21 @@ def regular_nets(T, groups):
         if not jobs.size:
             continue
         root = int(T.job_root[jobs[0]])
-        for vf, kind in enumerate(t.kind):
-            if kind != KIND_REGULAR:
-                continue
-            g = root + vf
-            st, N = int(T.vop_start[g]), int(T.vn[g])
-            for lo in range(0, jobs.size, _BLOCK):
-                R = rings[lo:lo + _BLOCK]
-                a = ring_products(T.vop[st:st + 17 * N].reshape(N, 17), X, R)
-                a[:, 16] += X[R[:, 0]]
-                nets[T.job_net[jobs[lo:lo + _BLOCK]] + t.leaf[vf]] = a
+        vfs = [vf for vf, kind in enumerate(t.kind) if kind == KIND_REGULAR]
+        if not vfs:
+            continue
+        # the regular patches of one template share their jobs' rings: their operators side by side, one
+        # ring_products per block of jobs (each entry's sum the same, in the same order)
+        N = int(T.vn[root + vfs[0]])
+        op = np.concatenate([T.vop[int(T.vop_start[root + vf]):int(T.vop_start[root + vf]) + 17 * N].reshape(N, 17)
+                             for vf in vfs], axis=1)
+        step = max(1, (_BLOCK * 17) // op.shape[1])
+        leaves = np.array([t.leaf[vf] for vf in vfs], dtype=np.int64)
+        for lo in range(0, jobs.size, step):
+            R = rings[lo:lo + step]
+            a = ring_products(op, X, R).reshape(R.shape[0], len(vfs), 17, 3)
+            a[:, :, 16] += X[R[:, 0]][:, None, :]
+            nets[(T.job_net[jobs[lo:lo + step]][:, None] + leaves[None, :]).reshape(-1)] = a.reshape(-1, 17, 3)
     return nets
 
 
@@ -193,19 +208,37 @@ def _sparse_parts(op):
 def layer0_nets(T, groups):
     """The nets of layer 0 of every corner face of table ``T`` (see :attr:`PatchTable.hot`): per
     corner face c and patch code the composed operator's sums (:func:`composed_nets`, the compiled
-    kernel's), row 16 the limit point. Shape (3 n_corner, 17, 3)."""
+    kernel's), row 16 the limit point (:func:`corner_limits`). Shape (3 n_corner, 17, 3).
+
+    The corner faces of one template share their jobs' rings: their operators go side by side into one
+    :func:`ring_products` per block of jobs (each entry's sum the same, in the same order)."""
     hot = np.empty((3 * T.n_corner, 17, 3))
     for t, jobs, _ in groups:
         if jobs is None or not jobs.size or not t.O.shape[0]:
             continue
         root = int(T.job_root[jobs[0]])
-        for vf, kind in enumerate(t.kind):
-            if kind != KIND_CORNER:
-                continue
-            for lo in range(0, jobs.size, _BLOCK):
-                jb = jobs[lo:lo + _BLOCK]
-                ci = T.job_corner[jb] + t.leaf[vf]
-                nets = composed_nets(T, jb, root + vf, 0)
-                for code in range(3):
-                    hot[3 * ci + code] = nets[:, code]
+        vfs = [vf for vf, kind in enumerate(t.kind) if kind == KIND_CORNER]
+        op = np.concatenate([_layer0_operator(T, root + vf) for vf in vfs], axis=1)  # (N, 49 per corner face)
+        N, nv = op.shape[0], len(vfs)
+        leaves = np.array([t.leaf[vf] for vf in vfs], dtype=np.int64)
+        step = max(1, (_BLOCK * 64) // op.shape[1])
+        for lo in range(0, jobs.size, step):
+            jb = jobs[lo:lo + step]
+            R = T.rings[T.job_ring[jb][:, None] + np.arange(N)]
+            acc = ring_products(op, T.points, R).reshape(jb.size, nv, 49, 3)
+            nets = np.empty((jb.size, nv, 3, 17, 3))
+            nets[:, :, :, :16] = acc[:, :, :48].reshape(jb.size, nv, 3, 16, 3)
+            nets[:, :, :, 16] = (acc[:, :, 48] + T.points[R[:, 0]][:, None, :])[:, :, None, :]
+            ci = T.job_corner[jb][:, None] + leaves[None, :]  # (k, nv): the corner faces' rows
+            hot[(3 * ci[:, :, None] + np.arange(3)).reshape(-1)] = nets.reshape(-1, 17, 3)
     return hot
+
+
+def _layer0_operator(T, vf):
+    """(N, 49): the composed operators of layer 0 of the corner face ``vf`` (the three patch codes' 16 columns,
+    :func:`composed_nets`), then its limit point's (:func:`corner_limits`)."""
+    N, st, Nc = int(T.vn[vf]), int(T.vop_start[vf]), int(T.op_size[T.cfg[vf]])
+    lim = T.vop[st + N * (Nc - 1):st + N * (Nc - 1) + N].reshape(N, 1)
+    st += N * (Nc - 1) + N
+    op = T.vop[st:st + 3 * N * 16].reshape(3, N, 16).transpose(1, 0, 2).reshape(N, 48)
+    return np.concatenate([op, lim], axis=1)

@@ -190,15 +190,39 @@ def _configuration_ops(schemes):
     ops, op_start, op_size, n_layers, unit = [], [], [], [], []
     off = 0
     for scheme, orient in schemes:
-        L, u = oriented_layers(scheme, orient)
-        nl_, nc_ = scheme.n_layers, L.shape[1]
-        ops.append(L.reshape(nl_ * 3, 16, nc_).transpose(0, 2, 1).reshape(-1))  # (layer, code, j, i)
+        flat, u = _flat_layers(scheme, orient)
+        ops.append(flat)
         op_start.append(off)
-        op_size.append(L.shape[1])
+        op_size.append(scheme.layers.shape[-1])
         n_layers.append(scheme.n_layers)
         unit.append(u)
-        off += L.size
+        off += flat.size
     return ops, op_start, op_size, n_layers, unit
+
+
+#: per configuration (id of its corner scheme, orientation): (scheme, flat operators, unit), read-only, those of
+#: recent setups in this process, within :data:`_FLAT_BUDGET` bytes (the oldest dropped first)
+_FLAT: dict = {}
+_FLAT_BUDGET = 16 << 20
+
+
+def _flat_layers(scheme, orient):
+    """The layer operators of a configuration, flat (layer, code, j, i), and its ``unit``: the same array for
+    the same (scheme, orientation) while it stays within :data:`_FLAT_BUDGET` (the scheme is kept with it)."""
+    key = (id(scheme), orient)
+    hit = _FLAT.get(key)
+    if hit is not None and hit[0] is scheme:
+        return hit[1], hit[2]
+    L, u = oriented_layers(scheme, orient)
+    nl, nc = scheme.n_layers, L.shape[1]
+    flat = L.reshape(nl * 3, 16, nc).transpose(0, 2, 1).reshape(-1)
+    flat.setflags(write=False)
+    held = sum(x[1].nbytes for x in _FLAT.values())
+    while _FLAT and held + flat.nbytes > _FLAT_BUDGET:
+        held -= _FLAT.pop(next(iter(_FLAT)))[1].nbytes
+    if flat.nbytes <= _FLAT_BUDGET:
+        _FLAT[key] = (scheme, flat, u)
+    return flat, u
 
 
 def assemble(temps, schemes, n_jobs, X, top, refused):
@@ -242,7 +266,7 @@ def assemble(temps, schemes, n_jobs, X, top, refused):
         leaf += t.leaf
         cfg += t.cfg
         corner += t.corner
-        for ops_ in _leaf_operators(t, ops):
+        for ops_ in _cached_leaf_operators(t, ops):
             vop_start.append(n_vop if ops_ is not None else -1)
             vn.append(t.n)
             if ops_ is not None:
@@ -280,6 +304,36 @@ def assemble(temps, schemes, n_jobs, X, top, refused):
         unit=np.array(unit, dtype=np.float64).reshape(-1, 3, 3), hot=np.zeros((0, 17, 3)),
         cor_ring=np.zeros(0, np.int64), ring=np.zeros((0, 3)))
     return T, groups
+
+
+#: per template and configurations (the identities of its operators and of its configurations' flat layer
+#: operators, which are kept with it): the leaf operators of :func:`_leaf_operators`, those of recent setups in
+#: this process (a template read from the disk cache keeps its arrays), within :data:`_VOPS_BUDGET` bytes
+_VOPS: dict = {}
+_VOPS_BUDGET = 8 << 20
+
+
+def forget_kept():
+    """Drop the leaf and flat layer operators this process keeps from recent setups (computed again on use)."""
+    _VOPS.clear()
+    _FLAT.clear()
+
+
+def _cached_leaf_operators(t, ops):
+    """:func:`_leaf_operators` of ``t``, the same arrays again for the same template arrays and configurations."""
+    refs = (t.R, t.Q, t.O, *(ops[c] for c in t.cfg if c >= 0))
+    key = tuple(map(id, refs))
+    hit = _VOPS.get(key)
+    if hit is not None and len(hit[0]) == len(refs) and all(a is b for a, b in zip(hit[0], refs)):
+        return hit[1]
+    out = _leaf_operators(t, ops)
+    size = sum(x.nbytes for x in out if x is not None)
+    held = sum(h[2] for h in _VOPS.values())
+    while _VOPS and held + size > _VOPS_BUDGET:
+        held -= _VOPS.pop(next(iter(_VOPS)))[2]
+    if size <= _VOPS_BUDGET:
+        _VOPS[key] = (refs, out, size)
+    return out
 
 
 def _leaf_operators(t, ops):

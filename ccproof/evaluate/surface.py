@@ -81,8 +81,9 @@ class LimitSurface:
     ----------
     mesh : QuadMesh or PolyMesh
     parameterizations : dict of str -> parameterization value
-        The names :meth:`evaluate` accepts besides ``"natural"`` (empty here; ``ccproof.limit_surface``
-        records ``"vanishing"`` and ``"characteristic"``, :class:`ccproof.reparam.Parameterization`).
+        The names :meth:`evaluate` accepts besides ``"natural"``: the ``parameterizations`` argument (given
+        when the surface is built; ``ccproof.limit_surface`` gives ``"vanishing"`` and ``"characteristic"``,
+        :class:`ccproof.reparam.Parameterization` values).
     n_patches : int
         Regular bicubic patches stored (17 x 3 floats each: net and origin).
     max_layers : int
@@ -118,8 +119,9 @@ class LimitSurface:
     [[-1.0, -1.0, -1.0], [-0.5, -0.5, 0.5]]
     """
 
-    def __init__(self, mesh: QuadMesh | PolyMesh, *, progress=None):
+    def __init__(self, mesh: QuadMesh | PolyMesh, *, progress=None, parameterizations=None):
         self.mesh = mesh
+        self.parameterizations = dict(parameterizations or {})
         if isinstance(mesh, PolyMesh):
             from ccproof.evaluate.tagged import build_tagged
 
@@ -151,7 +153,6 @@ class LimitSurface:
         self._moving = {}  # shared by the surfaces with_vertices derives: the tagged step (build_tagged's keep)
         self._vmap = b.vmap
         self._corner_normal = {}
-        self.parameterizations = {}
         T = self._table
         self.split_depth = T.split_depth
         self.patch_map = PatchMap(T)
@@ -778,7 +779,7 @@ def _one_per_vertex(verts, last):
     return verts.size - 1 - first_of_reversed
 
 
-def natural_limit_surface(mesh, *, progress=None):
+def natural_limit_surface(mesh, *, progress=None, parameterizations=None):
     """Prepare the exact evaluation of the limit surface of ``mesh`` in its natural parameterization.
 
     The package-wide entry point is :func:`ccproof.limit_surface` (the same surfaces, plus the
@@ -796,6 +797,8 @@ def natural_limit_surface(mesh, *, progress=None):
     progress : bool, optional
         Show a progress bar (tqdm, on stderr) when the setup takes more than 2 s; default: when
         stderr is a terminal.
+    parameterizations : dict of str -> parameterization value, optional
+        Names :meth:`LimitSurface.evaluate` accepts besides ``"natural"`` (:attr:`LimitSurface.parameterizations`).
 
     Returns
     -------
@@ -808,15 +811,15 @@ def natural_limit_surface(mesh, *, progress=None):
     (1, 3)
     """
     if isinstance(mesh, (QuadMesh, PolyMesh)):
-        return LimitSurface(mesh, progress=progress)
+        return LimitSurface(mesh, progress=progress, parameterizations=parameterizations)
     from ccproof.mesh.io import read_mesh
 
     mesh = read_mesh(mesh)
     if mesh.is_plain_quads:
         # a file holding an untagged manifold all-quad mesh: the QuadMesh evaluator, as before (same
         # numbers as the tagged one to round-off; ``S.mesh`` is a QuadMesh)
-        return LimitSurface(mesh.to_quad_mesh(), progress=progress)
-    return LimitSurface(mesh, progress=progress)
+        return LimitSurface(mesh.to_quad_mesh(), progress=progress, parameterizations=parameterizations)
+    return LimitSurface(mesh, progress=progress, parameterizations=parameterizations)
 
 
 #: former name, kept importable for ccproof/evaluate/cli.py, ccproof/reparam/cli.py and tests; the

@@ -10,6 +10,7 @@ operators of its regular patches and corner rings as linear functions of the rin
 
 from __future__ import annotations
 
+import copy
 import functools
 from array import array
 
@@ -167,9 +168,47 @@ def cached_template(tkey, depth_semi, make):
     if d is None:
         return finished(make())
     name = hashlib.sha256(f"template|{_template_version()}|{depth_semi}|{tkey!r}".encode()).hexdigest()
-    t = _diskcache.read_entry(d / f"{name}.tpl", name, _parse_template)
+    path = d / f"{name}.tpl"
+    try:
+        data = path.read_bytes()
+    except OSError:
+        data = None
+    seen = _PARSED.get(name)
+    if data is not None and seen is not None and seen[0] == data:
+        return _fresh(seen[1])  # the very bytes verified and parsed before in this process
+    t = _diskcache.read_entry(path, name, _parse_template, data)
     if t is not None:
-        return t
+        _remember(name, data, t)
+        return _fresh(t)
     t = finished(make())
     _diskcache.store(d, name, ".tpl", _template_bytes(t))
     return t
+
+
+#: per cache name: (the file's bytes, the template parsed from them), the templates of recent setups in this
+#: process (a setup reads the file again and takes this one only where its bytes are these, byte for byte),
+#: within :data:`PARSED_BUDGET` bytes (twice the files': their bytes and the parsed arrays; the oldest dropped
+#: first): the small meshes' setups, where these fixed costs count, keep theirs
+_PARSED: dict = {}
+PARSED_BUDGET = 8 << 20
+
+
+def _remember(name, data, t):
+    held = sum(2 * len(d) for d, _ in _PARSED.values())
+    while _PARSED and held + 2 * len(data) > PARSED_BUDGET:
+        held -= 2 * len(_PARSED.pop(next(iter(_PARSED)))[0])
+    if 2 * len(data) <= PARSED_BUDGET:
+        _PARSED[name] = (data, _fresh(t))
+
+
+def forget_parsed():
+    """Drop the templates this process keeps parsed (:func:`cached_template` parses their files again)."""
+    _PARSED.clear()
+
+
+def _fresh(t):
+    """A copy of a parsed template for one builder (the read-only operators shared; its jobs, rings and
+    configuration indices its own)."""
+    new = copy.copy(t)
+    new.jobs, new.rings = array("q"), array("i")
+    return new

@@ -292,6 +292,55 @@ class HalfEdges:
         new.vertex_values = None
         return new
 
+    def subset(self, faces):
+        """The half-edges of the faces ``faces`` of this mesh, in that order: a local neighbourhood as the
+        same kind of arrays (OpenSubdiv's Vtr levels of a sparse refinement are such subsets).
+
+        The vertex labels, the options and the tag arrays are this mesh's; a half-edge keeps its twin when the
+        twin's face is in the subset (-1 otherwise: the subset's boundary), so that an edge that is not
+        manifold in the mesh stays without twins in the subset (the undirected edge arrays, computed on first
+        use, are the subset's own). ``parent_halfedge`` (H',) and ``parent_face`` (m',) map the subset's
+        half-edges and faces back to this mesh's.
+
+        Parameters
+        ----------
+        faces : array_like of int
+            Distinct face indices of this mesh.
+
+        Returns
+        -------
+        HalfEdges
+
+        Examples
+        --------
+        Of two quads sharing the edge (1, 4), the second alone has no twins; both, in either order, keep theirs:
+
+        >>> he = HalfEdges([0, 1, 4, 3, 1, 2, 5, 4], [0, 4, 8], 6)
+        >>> he.subset([1]).twin.tolist(), he.subset([1]).org.tolist()
+        ([-1, -1, -1, -1], [1, 2, 5, 4])
+        >>> sub = he.subset([1, 0])
+        >>> sub.twin.tolist(), sub.parent_halfedge[sub.twin[3]].tolist()
+        ([-1, -1, -1, 5, -1, 3, -1, -1], 1)
+        """
+        fs = np.asarray(faces, dtype=np.int64).reshape(-1)
+        if fs.size and (fs.min() < 0 or fs.max() >= self.n_faces or np.unique(fs).size != fs.size):
+            raise ValueError(f"HalfEdges.subset: faces must be distinct faces in [0, {self.n_faces})")
+        sizes = self.sizes[fs]
+        off = np.r_[0, np.cumsum(sizes)].astype(np.int64)
+        h = np.repeat(self.start[fs] - off[:-1], sizes) + np.arange(int(off[-1]), dtype=np.int64)  # parent h
+        new = type(self)(self.org[h], off, self.n_vertices, self.options, edges=False)
+        # the parent's twins, where the twin's face is in the subset (its position: a sorted search of h)
+        order = np.argsort(h, kind="stable")
+        t = self.twin[h]
+        pos = np.minimum(np.searchsorted(h, t, sorter=order), max(h.size - 1, 0)) if h.size else t
+        inside = (t >= 0) & (h[order[pos]] == t) if h.size else t >= 0
+        new.twin = np.where(inside, order[pos] if h.size else t, -1)
+        new.__dict__.pop("_pairing", None)  # the edge arrays of the subset, recomputed on first use
+        new.edge_manifold = self.edge_manifold
+        new.edge_keys, new.edge_values, new.vertex_values = self.edge_keys, self.edge_values, self.vertex_values
+        new.parent_halfedge, new.parent_face = h, fs
+        return new
+
     # ------------------------------------------------------------------ tags
     def with_tags(self, edge_sharpness=None, vertex_sharpness=None, vertex_values=None):
         """The same arrays (shared, not copied) with the tags of ``edge_sharpness`` (dict ``{(a, b): s}``)

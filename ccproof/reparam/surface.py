@@ -4,8 +4,8 @@
 public evaluation, ``surface.evaluate(face, u, v, derivatives, parameterization=p)`` of
 :class:`~ccproof.evaluate.surface.LimitSurface`, which applies it around its natural evaluation
 (:meth:`Parameterization.evaluate_on`, through the evaluator's public ``evaluate`` and ``locate``
-only). :func:`limit_surface` (``ccproof.limit_surface``) records the values by name in the surface's
-``parameterizations``, so that ``parameterization="vanishing"`` works as well:
+only). :func:`limit_surface` (``ccproof.limit_surface``) builds the surface with the values by name (its
+``parameterizations``, given to the constructor), so that ``parameterization="vanishing"`` works as well:
 
 * ``natural``: the evaluator's own parameterization (Stam; bmz04 section 2);
 * ``vanishing``: f o F_b with F_i = F^alpha and w = b(|t|) (section 4.2);
@@ -155,17 +155,21 @@ class Parameterization:
         st = _state(surface)
         key = self._alpha_key()
         if key not in st.alphas:
-            out = {}
-            for k in st.kinds:
-                if self.alpha is None:
-                    a = default_alpha(k)
-                elif isinstance(self.alpha, dict):
-                    a = self.alpha[k] if k in self.alpha else default_alpha(k)
-                else:
-                    a = self.alpha
-                out[k] = check_alpha(a, k)
-            st.alphas[key] = out
+            st.alphas[key] = self._checked_alphas(st.kinds)
         return dict(st.alphas[key])
+
+    def _checked_alphas(self, kinds: list[int]) -> dict[int, float]:
+        """The exponent for every valence of ``kinds``, checked (:func:`~ccproof.reparam.quadrant.check_alpha`)."""
+        out = {}
+        for k in kinds:
+            if self.alpha is None:
+                a = default_alpha(k)
+            elif isinstance(self.alpha, dict):
+                a = self.alpha[k] if k in self.alpha else default_alpha(k)
+            else:
+                a = self.alpha
+            out[k] = check_alpha(a, k)
+        return out
 
     def evaluate_on(self, surface: LimitSurface, f: np.ndarray, u: np.ndarray, v: np.ndarray, derivatives: int = 1,
                     *, chunk: int = CHUNK, out: dict[str, np.ndarray] | None = None, backend: str | None = None,
@@ -300,7 +304,7 @@ class _SurfaceState:
     def __init__(self, mesh: QuadMesh) -> None:
         self.mesh = mesh
         self.corner_valence = corner_valence(mesh)
-        self.kinds = sorted({int(k) for k in np.unique(self.corner_valence) if k > 0})
+        self.kinds = corner_kinds(self.corner_valence)
         self.alphas: dict[Any, dict[int, float]] = {}
         self.rotated: dict[int, LimitSurface] = {}
         self.tangents: dict[tuple[int, int], Any] = {}
@@ -345,6 +349,11 @@ def corner_valence(mesh: QuadMesh) -> np.ndarray:
     val = np.asarray(mesh.valence, dtype=np.int64)
     code = np.where(mesh.is_boundary_vertex | (val == 4), 0, val)
     return code[mesh.faces]
+
+
+def corner_kinds(cv: np.ndarray) -> list[int]:
+    """The valences (sorted, distinct) of :func:`corner_valence`'s array ``cv`` where F_b acts."""
+    return sorted({int(k) for k in np.unique(cv) if k > 0})
 
 
 def corner_derivatives(surface: LimitSurface, face: int, corner: int) -> np.ndarray:
@@ -418,8 +427,8 @@ def limit_surface(mesh: QuadMesh | PolyMesh | str | os.PathLike[str], alpha: flo
     :func:`ccproof.evaluate.natural_limit_surface`, whose ``evaluate(face, u, v, derivatives,
     parameterization=...)`` takes ``"natural"`` (default; docs/evaluate.md) and, on an untagged
     all-quad mesh, ``"vanishing"`` or ``"characteristic"`` (bmz04 section 4, docs/reparam.md): the
-    names of the :class:`Parameterization` values this function records in the surface's
-    ``parameterizations`` (with ``alpha``). A :class:`Parameterization` value can be passed instead
+    names of the :class:`Parameterization` values this function builds the surface with (its
+    ``parameterizations``, with ``alpha``). A :class:`Parameterization` value can be passed instead
     of a name, on any quad mesh's surface. Tagged meshes (triangles, n-gons, creases, corners, holes)
     have the natural parameterization only.
 
@@ -476,8 +485,6 @@ def limit_surface(mesh: QuadMesh | PolyMesh | str | os.PathLike[str], alpha: flo
         if alpha is not None:
             raise CCProofError("alpha applies to the parameterizations of quad meshes only, not to a PolyMesh")
         return natural_limit_surface(mesh, progress=progress)
-    S = natural_limit_surface(mesh, progress=progress)
     named = named_parameterizations(alpha)
-    named["vanishing"].alphas(S)  # checked now: a bad alpha is an error of this call
-    S.parameterizations = named
-    return S
+    named["vanishing"]._checked_alphas(corner_kinds(corner_valence(mesh)))  # a bad alpha: an error of this call
+    return natural_limit_surface(mesh, progress=progress, parameterizations=named)

@@ -34,9 +34,15 @@ KEEP = 4  # rings kept around the vertex after each step
 # ------------------------------------------------------------------------------ memory
 def _table_bytes(build):
     """Bytes a built surface keeps (tracemalloc, the exact-data caches warmed by a first build)."""
+    from ccproof.evaluate.patch_table import forget_kept
+    from ccproof.evaluate.template_cache import forget_parsed
+
     build()
+    forget_parsed()  # the templates' operators are the surface's: allocated in the traced build
     tracemalloc.start()
     S = build()
+    forget_parsed()  # (the process's parsed templates and operators kept for the next setup are not the surface's)
+    forget_kept()
     cur, _ = tracemalloc.get_traced_memory()
     tracemalloc.stop()
     return S, cur

@@ -91,3 +91,29 @@ def test_with_tags_takes_an_edge_once_in_either_order():
     assert t.edge_sharpness_at([0, 2], [10, -2]).tolist() == [0.0, 0.0]  # no vertex 10 or -2 (keys 10 = 1 * 6 + 4)
     t = he.with_tags({(4, 1): 12.0, (1, 4): 0.0})
     assert t.edge_keys.size == 0 and not t.has_tags
+
+
+@pytest.mark.parametrize("path", FEATURES + NONMANIFOLD, ids=lambda p: p.name)
+def test_a_face_subset_keeps_the_twins_within_it(path):
+    """A random half of the faces, shuffled: against the dict pairing of the whole mesh restricted to them."""
+    m = _read(path)
+    polys = [list(p) for p in (m.polygons if isinstance(m, PolyMesh) else m.faces.tolist())]
+    hes, _, twin = _brute(polys)
+    rng = np.random.default_rng(len(polys))
+    faces = rng.permutation(len(polys))[: max(1, len(polys) // 2)]
+    sub = m.halfedges.subset(faces)
+    corners = [h for f in faces.tolist() for h, (_, _, g) in enumerate(hes) if g == f]  # in the subset's order
+    where = {h: i for i, h in enumerate(corners)}
+    assert sub.parent_halfedge.tolist() == corners and sub.parent_face.tolist() == faces.tolist()
+    assert sub.org.tolist() == [hes[h][0] for h in corners]
+    assert sub.org[sub.nxt].tolist() == [hes[h][1] for h in corners]
+    assert sub.twin.tolist() == [where.get(twin[h], -1) if twin[h] >= 0 else -1 for h in corners]
+    assert sub.n_vertices == m.halfedges.n_vertices and sub.n_faces == faces.size
+
+
+def test_subset_refuses_repeated_or_foreign_faces():
+    he = HalfEdges([0, 1, 4, 3, 1, 2, 5, 4], [0, 4, 8], 6)
+    for bad in ([0, 0], [2], [-1]):
+        with pytest.raises(ValueError, match="distinct faces"):
+            he.subset(bad)
+    assert he.subset([]).org.size == 0

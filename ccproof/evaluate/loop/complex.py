@@ -80,6 +80,9 @@ class TriComplex:
         self.corners = {int(v): float(x) for v, x in items if x > 0}
         self.complete = None if complete is None else frozenset(complete)
         self.boundary = boundary
+        #: the ends of the tagged edges (a ring without them has no tagged edge)
+        self.sharp_vertices = frozenset(v for e in self.sharp for v in e)
+        self._rules, self._regular = {}, {}  # rule(v), is_regular(v, start): a complex is not changed once built
 
     def is_complete(self, v):
         return self.complete is None or v in self.complete
@@ -114,9 +117,13 @@ class TriComplex:
 
     def rule(self, v):
         """(rule, fan) of a complete vertex: its Sdc rule and its neighbours (counter-clockwise)."""
-        fan, closed = self.fan(v, self.first[v])
-        return classify(self.corners.get(v, 0.0), [self.sharpness(v, w) for w in fan],
-                        not closed and len(fan) == 2 and self.boundary == "edge_and_corner"), fan
+        hit = self._rules.get(v)
+        if hit is None:
+            fan, closed = self.fan(v, self.first[v])
+            hit = self._rules[v] = (classify(self.corners.get(v, 0.0), [self.sharpness(v, w) for w in fan],
+                                             not closed and len(fan) == 2 and self.boundary == "edge_and_corner"),
+                                    fan)
+        return hit[0], list(hit[1])
 
     def sector(self, v, start):
         """Neighbours of ``v`` counter-clockwise in the sector of edge (v, start) (bounded by sharp edges and
@@ -139,11 +146,16 @@ class TriComplex:
     def is_regular(self, v, start):
         """Corner v of a triangle with next vertex ``start`` is regular: smooth of valence 6 without sharp
         edges, or a crease (boundary) vertex with three triangles in the triangle's sector."""
-        rule, fan = self.rule(v)
-        if rule == SMOOTH:
-            return len(fan) == 6 and not any(self.is_sharp(v, w) for w in fan)
-        return rule == CREASE and len(self.sector(v, start)[0]) == 4 and \
-            all(self.sharpness(v, w) in (0, math.inf) for w in fan)
+        hit = self._regular.get((v, start))
+        if hit is None:
+            rule, fan = self.rule(v)
+            if rule == SMOOTH:
+                hit = len(fan) == 6 and not any(self.is_sharp(v, w) for w in fan)
+            else:
+                hit = rule == CREASE and all(self.sharpness(v, w) in (0, math.inf) for w in fan) and \
+                    len(self.sector(v, start)[0]) == 4
+            self._regular[(v, start)] = hit
+        return hit
 
 
 def vertex_stencil(cx, v, one):
@@ -312,7 +324,8 @@ def canonical_triangle_ring(cx, tri):
         for p, q in zip(idx, idx[1:]):  # triangle (px, p, q), listed from its lowest label
             T.add((px, p, q) if px < p and px < q else (p, q, px) if p < q else (q, px, p))
     sharp, corners = [], []
-    if cx.sharp:  # the tagged edges of the ring's triangles (each edge once: from its lower label)
+    if cx.sharp and not cx.sharp_vertices.isdisjoint(ring):  # the tagged edges of the ring's triangles (each
+        # edge once: from its lower label)
         for t in T:
             for i, j in ((t[0], t[1]), (t[1], t[2]), (t[2], t[0])):
                 x = cx.sharp.get((min(ring[i], ring[j]), max(ring[i], ring[j])))

@@ -32,7 +32,7 @@ def _net_sources():
     return [where[p] for p in NET]
 
 
-def regular_triangles(F, n_vertices, tagged_vertices=()):
+def regular_triangles(F, n_vertices, tagged_vertices=(), twin=None):
     """(mask (m,) of the regular triangles, their control points' vertex labels (R, 12) in NET order, per
     vertex whether it is simple (interior, valence 6, untagged), per vertex whether it is on the boundary).
 
@@ -42,6 +42,9 @@ def regular_triangles(F, n_vertices, tagged_vertices=()):
     n_vertices : int
     tagged_vertices : iterable of int
         Vertices with a tagged edge or a corner tag (never regular here).
+    twin : ndarray of int, shape (3 m,), optional
+        The opposite of every half-edge ``3 f + i`` (-1 on the boundary), when known (a manifold mesh's
+        :attr:`HalfEdges.twin <ccproof.mesh.halfedges.HalfEdges.twin>`); else paired here.
 
     Examples
     --------
@@ -52,11 +55,12 @@ def regular_triangles(F, n_vertices, tagged_vertices=()):
     F = np.asarray(F, dtype=np.int64)
     src = F.reshape(-1)
     dst = np.roll(F, -1, axis=1).reshape(-1)
-    key = src * n_vertices + dst
-    order = np.argsort(key, kind="stable")
-    rev = dst * n_vertices + src
-    pos = np.minimum(np.searchsorted(key, rev, sorter=order), key.size - 1)
-    twin = np.where(key[order[pos]] == rev, order[pos], -1)
+    if twin is None:
+        key = src * n_vertices + dst
+        order = np.argsort(key, kind="stable")
+        rev = dst * n_vertices + src
+        pos = np.minimum(np.searchsorted(key, rev, sorter=order), key.size - 1)
+        twin = np.where(key[order[pos]] == rev, order[pos], -1)
     valence = np.bincount(src, minlength=n_vertices)
     boundary = np.zeros(n_vertices, dtype=bool)
     boundary[src[twin < 0]] = True
@@ -66,12 +70,12 @@ def regular_triangles(F, n_vertices, tagged_vertices=()):
     reg = simple[F].all(axis=1)
     faces = np.flatnonzero(reg)
     fans = np.empty((faces.size, 3, 6), dtype=np.int64)
-    for i in range(3):
-        h = 3 * faces + i
-        for j in range(6):
-            fans[:, i, j] = dst[h]
-            prev = h - h % 3 + (h % 3 + 2) % 3
-            h = twin[prev]
+    prev = np.arange(src.size, dtype=np.int64).reshape(-1, 3)[:, [2, 0, 1]].reshape(-1)
+    rot = twin[prev]  # the next half-edge counter-clockwise around the origin
+    h = 3 * faces[:, None] + np.arange(3)  # (R, 3)
+    for j in range(6):
+        fans[:, :, j] = dst[h]
+        h = rot[h]
     labels = np.empty((faces.size, 12), dtype=np.int64)
     for k, (i, j) in enumerate(_net_sources()):
         labels[:, k] = F[faces, i] if j < 0 else fans[:, i, j]

@@ -25,6 +25,7 @@ gather and product per patch kind.
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -142,31 +143,30 @@ class LoopSurface:
         # non-manifold edges and vertices as OpenSubdiv takes them: PolyMesh's split (the same faces, the
         # non-manifold vertices copied per fan and tagged infinitely sharp)
         mesh = mesh.manifold
-        tris = mesh.polygons
         self._holes = np.asarray(mesh.is_hole, dtype=bool) if mesh.is_hole.any() else None
         X = np.asarray(mesh.vertices, dtype=np.float64)
         self._kind, self._rot, self._ref, self._children, self._gid = [], [], [], [], []
         self._nets, self._groups = [], {}
         self.split_depth = 0
         tagged = {v for e in mesh.edge_sharpness for v in e} | set(mesh.vertex_sharpness)
-        F = np.array(tris, dtype=np.int64).reshape(-1, 3)
-        reg, labels, simple, boundary = regular_triangles(F, len(X), tagged)
+        F = mesh.indices.reshape(-1, 3)
+        reg, labels, simple, boundary = regular_triangles(F, len(X), tagged, mesh.halfedges.twin)
         # the complex of the other triangles' corners' fans (the rings walked below)
         near = np.zeros(len(X), dtype=bool)
         near[F[~reg].reshape(-1)] = True
-        self._cx = TriComplex([tris[f] for f in np.flatnonzero(near[F].any(axis=1)).tolist()],
+        self._cx = TriComplex(F[near[F].any(axis=1)].tolist(),
                               dict(mesh.edge_sharpness), dict(mesh.vertex_sharpness), None, mesh.options.boundary)
         # corners decided without the complex: simple ones regular, untagged interior others irregular
         ask = boundary.copy()
         ask[list(tagged)] = True
         self._simple, self._ask = simple.tolist(), ask.tolist()
-        self._root = np.empty(len(tris), dtype=np.int64)
+        self._root = np.empty(F.shape[0], dtype=np.int64)
         self._root[reg] = np.arange(labels.shape[0])  # the regular triangles first: nodes 0 .. R-1
         nr = labels.shape[0]
         self._nreg = nr  # nodes 0 .. nr - 1; the lists hold the nodes from nr on
-        self._net_block = X[labels]
-        for f in np.flatnonzero(~reg).tolist():
-            self._root[f] = self._add_face(X, tris[f])
+        self._labels, self._X = labels, X  # the regular triangles' nets: X[labels] (_finish)
+        for f, tri in zip(np.flatnonzero(~reg).tolist(), F[~reg].tolist()):
+            self._root[f] = self._add_face(X, tri)
         self._finish()
 
     def _add_face(self, X, tri):
@@ -186,7 +186,7 @@ class LoopSurface:
         self.split_depth = max(self.split_depth, depth)
         if isinstance(p, Regular):
             i = node - self._nreg
-            self._kind[i], self._ref[i] = _REGULAR, len(self._net_block) + len(self._nets)
+            self._kind[i], self._ref[i] = _REGULAR, self._nreg + len(self._nets)
             self._nets.append(p.net @ C)
         elif isinstance(p, Corner):
             g = self._groups.setdefault(id(p), (len(self._groups), p, []))
@@ -205,35 +205,45 @@ class LoopSurface:
         self._ref = np.r_[np.arange(nr, dtype=np.int64), np.array(self._ref, dtype=np.int64)]
         self._children = np.concatenate([np.full((nr, 4), -1, dtype=np.int64),
                                          np.array(self._children, dtype=np.int64).reshape(-1, 4)])
-        self._nets = np.concatenate([self._net_block, np.array(self._nets, dtype=np.float64).reshape(-1, 12, 3)])
-        self._net_block = None
+        local_nets = np.array(self._nets, dtype=np.float64).reshape(-1, 12, 3)  # of the local subdivisions
         self._gid = np.r_[np.full(nr, -1, dtype=np.int64), np.array(self._gid, dtype=np.int64)]
         self._corner_data = []
         groups = sorted(self._groups.values(), key=lambda g: g[0])
         for _, p, coords in groups:
             self._corner_data.append((p, np.array(coords)))
         self._groups = None
-        self.n_regular = len(self._nets)
+        self.n_regular = nr + local_nets.shape[0]
         self.n_corner = sum(len(c) for _, c in self._corner_data)
+        labels, X = self._labels, self._X
+        self._labels = self._X = None
         if self.backend == "numba":
-            self._kernel_tables()
+            self._nets = None
+            self._kernel_tables(X, labels, local_nets)
+        else:
+            self._nets = np.concatenate([X[labels], local_nets])
 
-    def _kernel_tables(self):
+    def _kernel_tables(self, X, labels, local_nets):
         """The flat tables of :func:`ccproof.evaluate.loop.kernel.evaluate_loop_points`: the quartic blocks (box-spline
         patches, then per corner piece its first layers, limit point included), per piece its first block, ring
-        offset and limit point, per configuration its ring size, layer count and layer offset."""
-        from ccproof.evaluate.loop.box_spline import basis_coefficients
+        offset and limit point, per configuration its ring size, layer count and layer offset. The blocks of the
+        regular triangles are summed from the vertices ``X`` and their nets' ``labels`` (:mod:`.blocks`), those of
+        the local subdivisions' box-spline patches from ``local_nets``."""
+        from ccproof.evaluate.loop.blocks import quartic_blocks
         from ccproof.evaluate.loop.kernel import PRECOMPUTED_LAYERS
 
-        K = np.array([[int(x.p) / int(x.q) for x in row] for row in basis_coefficients()])
+        K = _box_spline_matrix()
         counts = [len(c) for _, c in self._corner_data]
         start = np.cumsum([0] + counts)
         cref = self._ref.copy()
         corner = self._kind == _CORNER
         cref[corner] += start[self._gid[corner]]
-        blocks = [np.matmul(self._nets.transpose(0, 2, 1), K.T)]
+        nb = self.n_regular
+        n_blocks = nb + sum(3 * min(PRECOMPUTED_LAYERS, p.poly_layers.shape[0]) * len(c) for p, c in self._corner_data)
+        blocks = np.empty((n_blocks, 3, 15))
+        nr = labels.shape[0]
+        quartic_blocks(X, labels, K, blocks[:nr])
+        blocks[nr:nb] = np.matmul(local_nets.transpose(0, 2, 1), K.T)
         pblock, plim, kd = [], [], []
-        nb = len(self._nets)
         for p, coords in self._corner_data:
             KD = p.poly_layers  # (layers, 3, N, 15)
             kd.append(KD.reshape(-1))
@@ -242,9 +252,10 @@ class LoopSurface:
             m = len(coords)
             W = KD[:nl].transpose(0, 1, 3, 2).reshape(nl * 45, p.size)
             B = (W @ coords.transpose(1, 0, 2).reshape(p.size, 3 * m)).reshape(nl, 3, 15, m, 3)
-            B = np.ascontiguousarray(B.transpose(3, 0, 1, 4, 2))  # (m, layer, child, coordinate, monomial)
-            B[..., 0] += lim[:, None, None, :]
-            blocks.append(B.reshape(-1, 3, 15))
+            B = B.transpose(3, 0, 1, 4, 2)  # (m, layer, child, coordinate, monomial)
+            out = blocks[nb:nb + 3 * nl * m].reshape(m, nl, 3, 3, 15)
+            out[...] = B
+            out[..., 0] += lim[:, None, None, :]
             pblock.append(nb + 3 * nl * np.arange(m, dtype=np.int64))
             nb += 3 * nl * m
             plim.append(lim)
@@ -260,7 +271,7 @@ class LoopSurface:
         cref[split] = np.arange(int(split.sum()))
         info = cref * 16 + self._rot.astype(np.int64) * 4 + self._kind.astype(np.int64)
         cinfo = info[self._children[split]]
-        self._k = (info[self._root], cinfo.reshape(-1, 4), np.concatenate(blocks),
+        self._k = (info[self._root], cinfo.reshape(-1, 4), blocks,
                    (pieces, groups, np.concatenate(kd + [np.zeros(0)]), flat))
 
     # ------------------------------------------------------------------ evaluation
@@ -357,6 +368,16 @@ class LoopSurface:
             raise CCProofError(f"point {i}: face {int(face[i])}, (u, v) = ({float(u[i])!r}, {float(v[i])!r}) is not in "
                                f"a triangle of this mesh ({m} faces; u, v >= 0, u + v <= 1)")
         return face, u, v
+
+
+@functools.lru_cache(maxsize=1)
+def _box_spline_matrix():
+    """The box spline's (15, 12) coefficient matrix (rationals of denominators up to 12) in float64, read-only."""
+    from ccproof.evaluate.loop.box_spline import basis_coefficients
+
+    K = np.array([[int(x.p) / int(x.q) for x in row] for row in basis_coefficients()])
+    K.setflags(write=False)
+    return K
 
 
 def _child(u, v):
