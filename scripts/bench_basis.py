@@ -9,8 +9,8 @@ per round is printed as min, median, max, with the 1-minute load before the roun
 threads (default: the evaluator's default, all cores for large batches). Rows hold 16 weights and
 indices per point (regular patch), so the output is about 8x that of ``evaluate`` per derivative.
 
-The floor: in the same rounds, writing arrays of the size of W's (its data and indices, per key; numpy
-``fill``) without computing anything, ``write W's arrays / evaluate``. Arrays this large are fresh pages
+The floor: in the same rounds, writing arrays of the size of W's (its data per key and its index arrays:
+one, shared by the keys, where the rows are canonical; numpy ``fill``) without computing anything, ``write W's arrays / evaluate``. Arrays this large are fresh pages
 from the system in every call (glibc maps allocations over 32 MB anew), whose first touch costs what
 the machine's memory does: in a virtual machine that hands freed memory back to its host, this is most
 of the time of ``basis``, and the noise of the ratio. ``evaluate``'s outputs (under 32 MB each at 10^6
@@ -51,9 +51,10 @@ def _keep_freed_memory():
         raise SystemExit("--keep-memory: glibc's mallopt refused the thresholds")
 
 
-def _write_arrays(nnz, keys):
-    """Arrays of the size of W's, written once (the cost of their memory alone)."""
-    out = [np.empty(nnz) for _ in range(keys)] + [np.empty(nnz, dtype=np.int32) for _ in range(keys)]
+def _write_arrays(nnz, keys, index_arrays):
+    """Arrays of the size of W's (``keys`` data arrays, ``index_arrays`` of indices), written once (the
+    cost of their memory alone)."""
+    out = [np.empty(nnz) for _ in range(keys)] + [np.empty(nnz, dtype=np.int32) for _ in range(index_arrays)]
     for x in out:
         x.fill(1)
     return out
@@ -92,6 +93,7 @@ def main(argv=None):
         S.evaluate(f, u, v, d, threads=a.threads)  # warm-up: kernels loaded, operators built
         W = S.basis(f, u, v, d, threads=a.threads)
         nnz, keys = W["P"].nnz, len(W)
+        index_arrays = len({w.indices.__array_interface__["data"][0] for w in W.values()})  # shared or not
         t_ev, t_b, ratios, floor = [], [], [], []
         load = os.getloadavg()[0]
         for i in range(a.rounds):
@@ -104,14 +106,15 @@ def main(argv=None):
                 elif what == "b":
                     W = S.basis(f, u, v, d, threads=a.threads)
                 else:
-                    _write_arrays(nnz, keys)
+                    _write_arrays(nnz, keys, index_arrays)
                 acc.append(time.perf_counter() - t0)
             ratios.append(t_b[-1] / t_ev[-1])
             floor.append(t_w[-1] / t_ev[-1])
         print(f"derivatives {d}: evaluate {min(t_ev) * 1e3:7.1f} ms  basis {min(t_b) * 1e3:7.1f} ms "
               f"({nnz / a.points:.1f} weights per point)  basis/evaluate {_stats(ratios)}  (load {load:.1f})",
               flush=True)
-        print(f"    write W's arrays / evaluate (the floor) {_stats(floor)}", flush=True)
+        print(f"    write W's arrays ({keys} data, {index_arrays} index) / evaluate (the floor) {_stats(floor)}",
+              flush=True)
     return 0
 
 

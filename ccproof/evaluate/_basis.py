@@ -58,6 +58,11 @@ class _Topology:
         self._ops = []  # (dev, org, cols) per operator id
         self.arrays = None
         self.vertex_map = None
+        self.grid_order = np.zeros(16 * n_jobs, dtype=np.int8)  # per smooth regular job: its net by vertex
+        for t, jobs, rings in S._groups:
+            if getattr(t, "smooth_grid", None) is not None and jobs.size:
+                order = np.argsort(np.asarray(rings).reshape(jobs.size, 16), axis=1, kind="stable")
+                self.grid_order[(16 * jobs[:, None] + np.arange(16)).reshape(-1)] = order.reshape(-1)
 
     def operator_ids(self, S, key):
         """The operator id of every key (building the missing operators)."""
@@ -167,7 +172,8 @@ def _rows(name, bs, bt, h, dev, org):
 
 
 def _fill_numpy(top, loc, op, indptr, names, derivatives, indices, data):
-    """The reference path: the points of every operator at once, numpy products."""
+    """The reference path: the points of every operator at once, numpy products; every row sorted by
+    column. Returns the number of repeated columns within rows."""
     order = np.argsort(op, kind="stable")
     ids, first = np.unique(op[order], return_index=True)
     for i, sel in zip(ids.tolist(), np.split(order, first[1:])):
@@ -178,6 +184,15 @@ def _fill_numpy(top, loc, op, indptr, names, derivatives, indices, data):
         h = loc.scale[sel][:, None]
         for k, name in enumerate(names):
             data[k][where] = _rows(name, bs, bt, h, dev, org).reshape(-1)
+    # every row by column (stable: repeated columns keep the ring's order, as the kernel's insertion sort)
+    order = np.lexsort((indices, np.repeat(np.arange(indptr.size - 1), np.diff(indptr))))
+    indices[:] = indices[order]
+    for d in data:
+        d[:] = d[order]
+    repeat = np.zeros(indices.size, dtype=bool)
+    repeat[1:] = indices[1:] == indices[:-1]
+    repeat[indptr[:-1][indptr[:-1] < indices.size]] = False  # a row's first entry repeats nothing
+    return int(np.count_nonzero(repeat))
 
 
 class _Located(NamedTuple):
@@ -229,33 +244,53 @@ def basis_rows(S, f, u, v, derivatives, backend=None, threads=None):
     indices = np.empty(nnz, dtype=ix)
     data = [np.empty(nnz) for _ in names]  # separate arrays: scipy copies a view of a larger one
     if kernels is None:
-        _fill_numpy(top, loc, op, indptr, names, derivatives, indices, data)
+        repeats = _fill_numpy(top, loc, op, indptr, names, derivatives, indices, data)
     else:
         pad = [data[0]] * (6 - len(names))
-        pts = (loc.s, loc.t, loc.scale, op, loc.job, top.job_ring)
+        pts = (loc.s, loc.t, loc.scale, op, loc.job, top.job_ring, top.grid_order)
         ops = (cstart, ncols, dstart, cols, dev, org)
         data6 = tuple(data) + tuple(pad)
-        in_blocks(lambda lo, hi: kernels[1](lo, hi, pts, ops, top.ring, indptr, indices, len(names), data6),
-                  f.size, nt, 32768, per_thread=4)
+        repeats = sum(in_blocks(lambda lo, hi: kernels[1](lo, hi, pts, ops, top.ring, indptr, indices, len(names),
+                                                          data6), f.size, nt, 32768, per_thread=4))
+    return _matrices(names, data, indices, indptr, (f.size, n_cols), repeats == 0, M)
+
+
+def _matrices(names, data, indices, indptr, shape, canonical, M):
+    """The CSR matrices of the rows (sorted by column). Canonical rows (no column twice) share one pair
+    of index arrays, read-only (an in-place change of one matrix's structure, such as ``eliminate_zeros``,
+    raises instead of changing the others': ``.copy()`` first); else each matrix has its own."""
+    shared = canonical and len(names) > 1
+    if shared:
+        indices.flags.writeable = False
+        indptr.flags.writeable = False
     out = {}
     for k, name in enumerate(names):
-        # each matrix its own index arrays: scipy sorts a matrix's indices in place when it needs them sorted
-        ind, ptr = (indices, indptr) if k == 0 else (indices.copy(), indptr.copy())
-        W = sp.csr_matrix((data[k], ind, ptr), shape=(f.size, n_cols))
-        out[name] = W if M is None else (W @ M).tocsr()
+        ind, ptr = (indices, indptr) if shared or k == 0 else (indices.copy(), indptr.copy())
+        W = sp.csr_matrix((data[k], ind, ptr), shape=shape)
+        if canonical:
+            W.has_canonical_format = True
+        else:
+            W.has_sorted_indices = True
+        if M is not None:  # composed with the step: scipy's product, a column once per row
+            W = (W @ M).tocsr()
+            W.sort_indices()
+        out[name] = W
     return out
 
 
 def _fill_points(lo, hi, pts, ops, ring, indptr, indices, nk, data):
     """The rows of points lo..hi-1 into ``data[0 .. nk-1]`` (the numba kernel; the sums of :func:`_rows`
-    point by point). ``pts = (s, t, scale, op, job)`` per point and every job's ring start, ``ops`` the
-    flat operators (:meth:`_Topology.flat`). A smooth regular quad's row is written in one pass (its
-    net is its ring: no operator, no cancellation)."""
-    s, t, scale, op, job, job_ring = pts
+    point by point), every row sorted by column. ``pts = (s, t, scale, op, job, job_ring, grid_order)``
+    per point, every job's ring start and a smooth regular job's net by vertex, ``ops`` the flat
+    operators (:meth:`_Topology.flat`). A smooth regular quad's row is written in one pass (its net is
+    its ring, in ``grid_order``: no operator, no cancellation, no sort). Returns the number of repeated
+    columns within rows."""
+    s, t, scale, op, job, job_ring, grid_order = pts
     cstart, ncols, dstart, cols, dev, org = ops
     B = np.empty(16)
     bu = np.empty((3, 4))
     bv = np.empty((3, 4))
+    repeats = 0
     for p in range(lo, hi):
         o = op[p]
         nc = ncols[o]
@@ -267,15 +302,20 @@ def _fill_points(lo, hi, pts, ops, ring, indptr, indices, nk, data):
         g = scale[p]
         r0 = job_ring[job[p]]
         if ds < 0:  # a smooth regular quad: its net is its ring (cols 0..15), the weights are B itself
+            g0 = 16 * job[p]
             for c in range(16):
-                indices[q + c] = ring[r0 + c]
+                indices[q + c] = ring[r0 + grid_order[g0 + c]]
+                if c and indices[q + c] == indices[q + c - 1]:
+                    repeats += 1
             for k in range(nk):
                 dk = data[k]
                 a, b = _ORD_A[k], _ORD_B[k]
                 f = 1.0 if a + b == 0 else (g if a + b == 1 else g * g)
                 for j in range(4):
                     for i in range(4):
-                        dk[q + 4 * j + i] = bv[b, j] * bu[a, i] * f
+                        B[4 * j + i] = bv[b, j] * bu[a, i] * f
+                for c in range(16):
+                    dk[q + c] = B[grid_order[g0 + c]]
             continue
         for c in range(nc):
             indices[q + c] = ring[r0 + cols[c0 + c]]
@@ -297,6 +337,33 @@ def _fill_points(lo, hi, pts, ops, ring, indptr, indices, nk, data):
                 dk[q + 1 + c] = w
                 tot += w
             dk[q] = (1.0 if k == 0 else 0.0) - tot
+        repeats += _sort_row(q, nc, indices, nk, data)
+    return repeats
+
+
+def _sort_row(q, n, indices, nk, data):
+    """Insertion sort (stable) of the row at q..q+n-1 by column, carrying ``data[0 .. nk-1]``; returns the
+    number of repeated columns."""
+    for c in range(1, n):
+        x = indices[q + c]
+        e = c
+        while e > 0 and indices[q + e - 1] > x:
+            e -= 1
+        if e < c:
+            for k in range(nk):
+                dk = data[k]
+                w = dk[q + c]
+                for r in range(c, e, -1):
+                    dk[q + r] = dk[q + r - 1]
+                dk[q + e] = w
+            for r in range(c, e, -1):
+                indices[q + r] = indices[q + r - 1]
+            indices[q + e] = x
+    repeats = 0
+    for c in range(1, n):
+        if indices[q + c] == indices[q + c - 1]:
+            repeats += 1
+    return repeats
 
 
 def _locate_points(lo, hi, f, u, v, table, stride, out):
@@ -360,8 +427,9 @@ def _kernel():
         except ImportError:  # pragma: no cover - numba is a dependency
             _KERNEL.append(None)
         else:
-            global _bspline
+            global _bspline, _sort_row
             _bspline = numba.njit(cache=True, nogil=True, inline="always")(_bspline)
+            _sort_row = numba.njit(cache=True, nogil=True)(_sort_row)
             _KERNEL.append((numba.njit(cache=True, nogil=True)(_locate_points),
                             numba.njit(cache=True, nogil=True)(_fill_points)))
     return _KERNEL[0]
