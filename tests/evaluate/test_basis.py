@@ -267,13 +267,17 @@ def test_repeated_columns_are_counted_and_keep_their_own_arrays():
     from ccproof.evaluate import _basis
 
     kernels = _basis._kernel()
-    sort_row = _basis._sort_row
-    for fn in ([sort_row] if kernels is None else [sort_row, getattr(sort_row, "py_func", sort_row)]):
-        ind = np.array([9, 5, 7, 5, 1, 7], dtype=np.int32)
-        data = (np.arange(6.0), 10 * np.arange(6.0))
-        assert fn(0, 6, ind, 2, data) == 2
-        assert ind.tolist() == [1, 5, 5, 7, 7, 9] and data[0].tolist() == [4, 1, 3, 2, 5, 0]
-        assert data[1].tolist() == [40, 10, 30, 20, 50, 0]
+    fns = [(_basis._sort_row, _basis._permute)]
+    if kernels is not None:  # the compiled ones, and the Python functions they were made of
+        fns.append(tuple(getattr(fn, "py_func", fn) for fn in fns[0]))
+    for sort_row, permute in fns:
+        ind, place, tmp = np.array([0, 9, 5, 7, 5, 1, 7], dtype=np.int32), np.zeros(6, dtype=np.int64), np.zeros(6)
+        data = (np.arange(7.0) - 1, 10 * np.arange(7.0) - 10)
+        assert sort_row(1, 6, ind, place) == 2
+        for d in data:
+            permute(1, 6, place, tmp, d)
+        assert ind.tolist() == [0, 1, 5, 5, 7, 7, 9] and data[0].tolist() == [-1, 4, 1, 3, 2, 5, 0]
+        assert data[1].tolist() == [-10, 40, 10, 30, 20, 50, 0]
     ind, ptr = np.array([1, 5, 5], dtype=np.int32), np.array([0, 3], dtype=np.int32)
     W = _basis._matrices(("P", "Du"), [np.ones(3), np.ones(3)], ind, ptr, (1, 8), False, None)
     assert not np.shares_memory(W["P"].indices, W["Du"].indices) and W["P"].has_sorted_indices
