@@ -186,7 +186,7 @@ def test_errors_name_the_point():
 
 
 def test_bench_script_smoke(capsys):
-    """scripts/bench_basis.py --smoke runs and prints the ratio line per derivative order."""
+    """scripts/bench_basis.py --smoke [--cpu] runs and prints the ratio line per derivative order."""
     import importlib.util
     from pathlib import Path
 
@@ -194,9 +194,11 @@ def test_bench_script_smoke(capsys):
     spec = importlib.util.spec_from_file_location("bench_basis", path)
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)
-    assert mod.main(["--smoke"]) == 0
-    out = capsys.readouterr().out
-    assert out.count("basis/evaluate min") == 2 and "median" in out and "load" in out
+    for extra in ([], ["--cpu"]):
+        assert mod.main(["--smoke", *extra]) == 0
+        out = capsys.readouterr().out
+        assert out.count("basis/evaluate min") == 2 and "median" in out and "load" in out
+        assert ("CPU time of the thread" in out) == bool(extra)
 
 
 def test_no_points_and_derived_surfaces():
