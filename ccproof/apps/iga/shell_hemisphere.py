@@ -34,7 +34,7 @@ import scipy.sparse as sp
 from ccproof.errors import CCProofError
 
 __all__ = ["HEMISPHERE_REFERENCE", "HEMISPHERE_HOLE_REFERENCE", "hemisphere_grid", "hemisphere_with_hole",
-           "solve_free_shell"]
+           "hemisphere_ev_grid", "hemisphere_ev", "solve_free_shell"]
 
 #: radial displacement under a force, MacNeal and Harder 1985 (computed for the hemisphere without a hole)
 HEMISPHERE_REFERENCE = 0.094
@@ -76,6 +76,63 @@ def hemisphere_grid(n, radius=10.0, hole=18.0):
     mesh = QuadMesh(interpolating_control_points(mesh, targets), faces)
     rows = np.repeat(np.arange(n + 2), m)
     return mesh, (rows >= 1) & (rows <= n)
+
+
+def hemisphere_ev_grid(level, n=4, radius=10.0, hole=18.0):
+    """The hemisphere's grid (:func:`hemisphere_grid`, ``4 n x n`` faces) with an o-grid block centred at each
+    load point (:func:`~ccproof.apps.iga.shell_benchmarks.ogrid_block_faces`: per block four vertices of
+    valence 3, two in the shell and two in the ghost row below the equator, 0.4 faces from the load point,
+    and two of valence 5 at its upper corners, one face above the equator; its lower corners lie on the
+    mesh's boundary, beyond the ghost row), subdivided ``level``
+    times in the parameter plane and mapped onto the sphere, the control points interpolating it at every
+    vertex. The equator (the free edge) runs along mesh edges through the blocks, every vertex on it
+    regular; the patches of the extraordinary vertices touch it at level 0.
+
+    The parameter plane is embedded on a cylinder of circumference ``4 n`` (one unit per face around and
+    per face row up) so that the blocks across the seam at longitude 0 are built and subdivided without
+    wrapping; a vertex's longitude and latitude are its angle and height there.
+
+    Returns
+    -------
+    mesh : QuadMesh
+    region : bool (n_faces,)
+        The faces between the equator and the hole's edge.
+    loads : ndarray (4,)
+        The vertices at longitudes 0, 90, 180, 270 degrees on the equator (the blocks' centres).
+    """
+    from ccproof.apps.iga.shell_benchmarks import interpolating_control_points, ogrid_block_faces
+    from ccproof.mesh import QuadMesh, subdivide
+
+    n = int(n)
+    if n < 2:
+        raise CCProofError(f"the hemisphere with o-grid blocks needs n >= 2, got {n!r}")
+    m = 4 * n
+    rho = m / (2.0 * math.pi)
+    lam = 2.0 * math.pi * np.arange(m) / m
+    Lam, T = np.meshgrid(lam, np.arange(n + 3) - 1.0)
+    V = list(np.stack([rho * np.cos(Lam), rho * np.sin(Lam), T], -1).reshape(-1, 3))
+    idx = np.arange(len(V)).reshape(n + 3, m)
+    nxt = np.roll(idx, -1, axis=1)
+    faces = np.stack([idx[:-1], nxt[:-1], nxt[1:], idx[1:]], -1).reshape(-1, 4).tolist()
+    centres = [int(idx[1, k * n]) for k in range(4)]
+    F = [f for f in faces if not set(f) & set(centres)]
+    for k, c in enumerate(centres):
+        i = k * n
+        B = [idx[0, i - 1], idx[0, (i + 1) % m], idx[2, (i + 1) % m], idx[2, i - 1]]
+        M = [idx[0, i], idx[1, (i + 1) % m], idx[2, i], idx[1, i - 1]]
+        F += ogrid_block_faces(V, [int(b) for b in B], [int(x) for x in M], c)
+    mesh = QuadMesh(np.asarray(V), F)
+    for _ in range(int(level)):
+        mesh = subdivide(mesh)
+    X = np.asarray(mesh.vertices)
+    lon, t = np.arctan2(X[:, 1], X[:, 0]), X[:, 2]
+    phi = t * math.radians(90.0 - hole) / n
+    targets = radius * np.stack([np.cos(phi) * np.cos(lon), np.cos(phi) * np.sin(lon), np.sin(phi)], -1)
+    faces = np.asarray(mesh.faces)
+    tc = t[faces].mean(axis=1)
+    region = (tc > 0.0) & (tc < n)
+    loads = [int(np.argmin(np.abs(t) + np.abs(np.angle(np.exp(1j * (lon - a)))))) for a in np.pi / 2 * np.arange(4)]
+    return QuadMesh(interpolating_control_points(mesh, targets), faces), region, np.array(loads)
 
 
 def solve_free_shell(K, b, R):
@@ -139,3 +196,34 @@ def hemisphere_with_hole(n, order=4, material=None, force=2.0, radius=10.0, hole
     u = np.stack([P @ c[k * nv:(k + 1) * nv] for k in range(3)], 1)
     w_all = np.einsum("ij,ij->i", u, radial)
     return {"w": float(w_all[0]), "w_all": w_all, "dofs": 3 * nv - 6, "c": c, "n": int(n)}
+
+
+def hemisphere_ev(level, n=4, order=4, depth=4, material=None, force=2.0, radius=10.0, hole=18.0):
+    """The hemisphere with a hole on :func:`hemisphere_ev_grid` at ``level`` (``4 n 2^level`` faces around),
+    the adaptive rule (``depth`` rings) on the region; the loads and the result as
+    :func:`hemisphere_with_hole` (``w``, ``w_all``, ``dofs``, ``c``, ``level``)."""
+    from ccproof.apps.iga.quadrature import surface_quadrature
+    from ccproof.apps.iga.shell import ShellFields, ShellMaterial, point_load, restrict_rule, rigid_motions
+    from ccproof.evaluate import natural_limit_surface
+
+    material = material or ShellMaterial(6.825e7, 0.3, 0.04)
+    mesh, region, loads = hemisphere_ev_grid(level, n, radius, hole)
+    S = natural_limit_surface(mesh)
+    F = ShellFields(S, restrict_rule(surface_quadrature(S, order, "adaptive", depth), region))
+    faces = np.asarray(mesh.faces)
+    at = [np.argwhere((faces == v) & region[:, None])[0] for v in loads]  # (face, corner) in the shell
+    uv = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])[[c for _, c in at]]
+    f = np.array([a for a, _ in at])
+    radial = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]])
+    sign = np.array([1.0, -1.0, 1.0, -1.0])
+    b = point_load(S, f, uv[:, 0], uv[:, 1], force * sign[:, None] * radial)
+    nv = mesh.n_vertices
+    # the ghost row's vertices of the blocks whose functions vanish on the shell: no coefficient
+    keep = np.flatnonzero(np.tile(F.fields.W["P"].getnnz(axis=0) > 0, 3))
+    K = F.stiffness(material)[keep][:, keep]
+    c = np.zeros(3 * nv)
+    c[keep] = solve_free_shell(K, b[keep], rigid_motions(mesh.vertices)[keep])
+    P = S.basis(f, uv[:, 0], uv[:, 1], 0)["P"]
+    u = np.stack([P @ c[k * nv:(k + 1) * nv] for k in range(3)], 1)
+    w_all = np.einsum("ij,ij->i", u, radial)
+    return {"w": float(w_all[0]), "w_all": w_all, "dofs": int(keep.size) - 6, "c": c, "level": int(level)}
