@@ -10,7 +10,8 @@ threads (default: the evaluator's default, all cores for large batches). Rows ho
 indices per point (regular patch), so the output is about 8x that of ``evaluate`` per derivative.
 
 The floor: in the same rounds, writing arrays of the size of W's (its data per key and its index arrays:
-one, shared by the keys, where the rows are canonical; numpy ``fill``) without computing anything, ``write W's arrays / evaluate``. Arrays this large are fresh pages
+one, shared by the keys, where the rows are canonical; numpy ``fill``) without computing anything,
+``write W's arrays / evaluate``. Arrays this large are fresh pages
 from the system in every call (glibc maps allocations over 32 MB anew), whose first touch costs what
 the machine's memory does: in a virtual machine that hands freed memory back to its host, this is most
 of the time of ``basis``, and the noise of the ratio. ``evaluate``'s outputs (under 32 MB each at 10^6

@@ -16,7 +16,8 @@ four vertices of valence 3 and four of valence 5 beside the free equator), 16 x 
 subdivided per level, the adaptive rule. See docs/iga.md.
 
 Usage:
-  python scripts/iga_shell.py [--benchmark roof|roof-ev|pinched|hemisphere|hemisphere-ev] [--levels 5] [--start 0] [--ends exact|edge|rows]
+  python scripts/iga_shell.py [--benchmark roof|roof-ev|pinched|hemisphere|hemisphere-ev] [--levels 5] [--start 0]
+         [--ends exact|edge|rows]
          [--geometry interpolated|mapped]
 """
 
@@ -50,7 +51,8 @@ ROOF_KL = 0.3006
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--benchmark", choices=("roof", "roof-ev", "pinched", "hemisphere", "hemisphere-ev"), default="roof")
+    ap.add_argument("--benchmark", default="roof",
+                    choices=("roof", "roof-ev", "pinched", "hemisphere", "hemisphere-ev"))
     ap.add_argument("--levels", type=int, default=5)
     ap.add_argument("--start", type=int, default=0, help="first level")
     ap.add_argument("--ends", choices=END_CONDITIONS, default="exact",

@@ -212,7 +212,8 @@ def test_no_points_and_derived_surfaces():
 
 
 def test_rows_of_many_points_on_threads_equal_the_numpy_path():
-    """Over 8192 points (several kernel calls per block) on one and two threads: the same matrices bit for bit, whose indices are those of the numpy path."""
+    """Over 8192 points (several kernel calls per block) on one and two threads: the same matrices bit for
+    bit, whose indices are those of the numpy path."""
     S = natural_limit_surface(cube())
     f, u, v = _points(S, 20000, seed=6)
     fc, uc, vc = S._check(f, u, v)

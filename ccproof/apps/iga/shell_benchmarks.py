@@ -254,7 +254,6 @@ def ogrid_block_faces(V, corners, mids, centre):
         F += [[inner[i], Nn[i], C, Nn[i - 1]], [B[i], M[i], Q[i], S[i]], [M[i], B[j], S[j], Q[i]],
               [Q[i], S[j], inner[j], Nn[i]], [S[i], Q[i], Nn[i], inner[i]]]
     return F
-    return QuadMesh(np.asarray(V), F)
 
 
 def _lattice_keys(X, scale):
