@@ -9,8 +9,9 @@ per round is printed as min, median, max, with the 1-minute load before the roun
 threads (default: the evaluator's default, all cores for large batches). Rows hold 16 weights and
 indices per point (regular patch), so the output is about 8x that of ``evaluate`` per derivative.
 
-The floor: in the same rounds, writing arrays of the size of W's (its data and indices, per key; numpy
-``fill``) without computing anything, ``write W's arrays / evaluate``. Arrays this large are fresh pages
+The floor: in the same rounds, writing arrays of the size of W's (its data per key and its index arrays:
+one, shared by the keys, where the rows are canonical; numpy ``fill``) without computing anything,
+``write W's arrays / evaluate``. Arrays this large are fresh pages
 from the system in every call (glibc maps allocations over 32 MB anew), whose first touch costs what
 the machine's memory does: in a virtual machine that hands freed memory back to its host, this is most
 of the time of ``basis``, and the noise of the ratio. ``evaluate``'s outputs (under 32 MB each at 10^6
@@ -18,7 +19,11 @@ points) are served again from the process's heap. ``--keep-memory`` puts both on
 keeps every freed allocation in the heap (``mallopt`` M_MMAP_THRESHOLD 1 GiB, M_TRIM_THRESHOLD 2 GiB, as
 ``MALLOC_MMAP_THRESHOLD_`` would; a setting of this benchmark's process, not of the package).
 
-Usage: python scripts/bench_basis.py [--points 1000000] [--rounds 5] [--threads N] [--keep-memory] [--smoke]
+``--cpu``: one thread, and each call timed by the CPU time of the calling thread (``time.thread_time``: user
+and system time, page faults included) instead of the wall clock: on a machine shared with other jobs the
+wall clock also counts the time the thread waits for a core, which the CPU time does not.
+
+Usage: python scripts/bench_basis.py [--points 1000000] [--rounds 5] [--threads N] [--keep-memory] [--cpu] [--smoke]
 (``--smoke``: 10^4 points, 2 rounds: checks that it runs).
 """
 
@@ -51,9 +56,10 @@ def _keep_freed_memory():
         raise SystemExit("--keep-memory: glibc's mallopt refused the thresholds")
 
 
-def _write_arrays(nnz, keys):
-    """Arrays of the size of W's, written once (the cost of their memory alone)."""
-    out = [np.empty(nnz) for _ in range(keys)] + [np.empty(nnz, dtype=np.int32) for _ in range(keys)]
+def _write_arrays(nnz, keys, index_arrays):
+    """Arrays of the size of W's (``keys`` data arrays, ``index_arrays`` of indices), written once (the
+    cost of their memory alone)."""
+    out = [np.empty(nnz) for _ in range(keys)] + [np.empty(nnz, dtype=np.int32) for _ in range(index_arrays)]
     for x in out:
         x.fill(1)
     return out
@@ -71,9 +77,13 @@ def main(argv=None):
     ap.add_argument("--threads", type=int, default=None)
     ap.add_argument("--smoke", action="store_true")
     ap.add_argument("--keep-memory", action="store_true", help="glibc keeps freed memory in the heap")
+    ap.add_argument("--cpu", action="store_true", help="one thread, timed by its CPU time (not the wall clock)")
     a = ap.parse_args(argv)
     if a.keep_memory:
         _keep_freed_memory()
+    clock = time.perf_counter
+    if a.cpu:
+        a.threads, clock = 1, time.thread_time
     if a.smoke:
         a.points, a.rounds, a.levels = 10**4, 2, 2
     from ccproof.evaluate import natural_limit_surface
@@ -86,32 +96,35 @@ def main(argv=None):
     S = natural_limit_surface(mesh, progress=False)
     f, u, v = _points(S, a.points)
     print(f"cube subdivided {a.levels} times: {S.n_faces:,} faces; {a.points:,} points; {os.cpu_count()} cpus; "
-          f"threads {a.threads or 'default'}; rounds {a.rounds}{'; freed memory kept' if a.keep_memory else ''}",
+          f"threads {a.threads or 'default'}; rounds {a.rounds}{'; freed memory kept' if a.keep_memory else ''}"
+          f"{'; CPU time of the thread' if a.cpu else ''}",
           flush=True)
     for d in (0, 1):
         S.evaluate(f, u, v, d, threads=a.threads)  # warm-up: kernels loaded, operators built
         W = S.basis(f, u, v, d, threads=a.threads)
         nnz, keys = W["P"].nnz, len(W)
+        index_arrays = len({w.indices.__array_interface__["data"][0] for w in W.values()})  # shared or not
         t_ev, t_b, ratios, floor = [], [], [], []
         load = os.getloadavg()[0]
         for i in range(a.rounds):
             t_w = []
             order = [("e", t_ev), ("b", t_b), ("w", t_w)]
             for what, acc in (order if i % 2 == 0 else order[::-1]):
-                t0 = time.perf_counter()
+                t0 = clock()
                 if what == "e":
                     S.evaluate(f, u, v, d, threads=a.threads)
                 elif what == "b":
                     W = S.basis(f, u, v, d, threads=a.threads)
                 else:
-                    _write_arrays(nnz, keys)
-                acc.append(time.perf_counter() - t0)
+                    _write_arrays(nnz, keys, index_arrays)
+                acc.append(clock() - t0)
             ratios.append(t_b[-1] / t_ev[-1])
             floor.append(t_w[-1] / t_ev[-1])
         print(f"derivatives {d}: evaluate {min(t_ev) * 1e3:7.1f} ms  basis {min(t_b) * 1e3:7.1f} ms "
               f"({nnz / a.points:.1f} weights per point)  basis/evaluate {_stats(ratios)}  (load {load:.1f})",
               flush=True)
-        print(f"    write W's arrays / evaluate (the floor) {_stats(floor)}", flush=True)
+        print(f"    write W's arrays ({keys} data, {index_arrays} index) / evaluate (the floor) {_stats(floor)}",
+              flush=True)
     return 0
 
 

@@ -58,6 +58,20 @@ class _Topology:
         self._ops = []  # (dev, org, cols) per operator id
         self.arrays = None
         self.vertex_map = None
+        # per smooth regular job (its net is its ring): the net's vertices by column and every net entry's
+        # place among them (the rows sorted by column without a sort per point)
+        self.grid_net = np.zeros(16 * n_jobs, dtype=np.int64)
+        self.grid_rank = np.zeros(16 * n_jobs, dtype=np.int8)
+        self.grid_repeats = 0  # columns repeated in those nets (a small periodic mesh), in all jobs
+        for t, jobs, rings in S._groups:
+            if getattr(t, "smooth_grid", None) is not None and jobs.size:
+                net = np.asarray(rings, dtype=np.int64).reshape(jobs.size, 16)
+                order = np.argsort(net, axis=1, kind="stable")
+                at = (16 * jobs[:, None] + np.arange(16)).reshape(-1)
+                self.grid_net[at] = np.take_along_axis(net, order, axis=1).reshape(-1)
+                self.grid_rank[at] = np.argsort(order, axis=1).reshape(-1)
+                by_column = self.grid_net[at].reshape(jobs.size, 16)
+                self.grid_repeats += int(np.count_nonzero(by_column[:, 1:] == by_column[:, :-1]))
 
     def operator_ids(self, S, key):
         """The operator id of every key (building the missing operators)."""
@@ -167,7 +181,8 @@ def _rows(name, bs, bt, h, dev, org):
 
 
 def _fill_numpy(top, loc, op, indptr, names, derivatives, indices, data):
-    """The reference path: the points of every operator at once, numpy products."""
+    """The reference path: the points of every operator at once, numpy products; every row sorted by
+    column. Returns the number of repeated columns within rows."""
     order = np.argsort(op, kind="stable")
     ids, first = np.unique(op[order], return_index=True)
     for i, sel in zip(ids.tolist(), np.split(order, first[1:])):
@@ -178,6 +193,15 @@ def _fill_numpy(top, loc, op, indptr, names, derivatives, indices, data):
         h = loc.scale[sel][:, None]
         for k, name in enumerate(names):
             data[k][where] = _rows(name, bs, bt, h, dev, org).reshape(-1)
+    # every row by column (stable: repeated columns keep the ring's order, as the kernel's insertion sort)
+    order = np.lexsort((indices, np.repeat(np.arange(indptr.size - 1), np.diff(indptr))))
+    indices[:] = indices[order]
+    for d in data:
+        d[:] = d[order]
+    repeat = np.zeros(indices.size, dtype=bool)
+    repeat[1:] = indices[1:] == indices[:-1]
+    repeat[indptr[:-1][indptr[:-1] < indices.size]] = False  # a row's first entry repeats nothing
+    return int(np.count_nonzero(repeat))
 
 
 class _Located(NamedTuple):
@@ -229,74 +253,162 @@ def basis_rows(S, f, u, v, derivatives, backend=None, threads=None):
     indices = np.empty(nnz, dtype=ix)
     data = [np.empty(nnz) for _ in names]  # separate arrays: scipy copies a view of a larger one
     if kernels is None:
-        _fill_numpy(top, loc, op, indptr, names, derivatives, indices, data)
+        repeats = _fill_numpy(top, loc, op, indptr, names, derivatives, indices, data)
     else:
         pad = [data[0]] * (6 - len(names))
-        pts = (loc.s, loc.t, loc.scale, op, loc.job, top.job_ring)
+        pts = (loc.s, loc.t, loc.scale, op, loc.job, top.job_ring, top.grid_net, top.grid_rank)
         ops = (cstart, ncols, dstart, cols, dev, org)
         data6 = tuple(data) + tuple(pad)
-        in_blocks(lambda lo, hi: kernels[1](lo, hi, pts, ops, top.ring, indptr, indices, len(names), data6),
-                  f.size, nt, 32768, per_thread=4)
+        repeats = sum(in_blocks(lambda lo, hi: kernels[1](lo, hi, pts, ops, top.ring, indptr, indices, len(names),
+                                                          data6), f.size, nt, 32768, per_thread=4))
+    canonical = repeats == 0 and top.grid_repeats == 0  # (a repeat in any smooth job's net: conservative)
+    return _matrices(names, data, indices, indptr, (f.size, n_cols), canonical, M)
+
+
+def _matrices(names, data, indices, indptr, shape, canonical, M):
+    """The CSR matrices of the rows (sorted by column). Canonical rows (no column twice) share one pair
+    of index arrays, read-only (an in-place change of one matrix's structure, such as ``eliminate_zeros``,
+    raises instead of changing the others': ``.copy()`` first); else each matrix has its own."""
+    shared = canonical and len(names) > 1
+    if shared:
+        indices.flags.writeable = False
+        indptr.flags.writeable = False
     out = {}
     for k, name in enumerate(names):
-        # each matrix its own index arrays: scipy sorts a matrix's indices in place when it needs them sorted
-        ind, ptr = (indices, indptr) if k == 0 else (indices.copy(), indptr.copy())
-        W = sp.csr_matrix((data[k], ind, ptr), shape=(f.size, n_cols))
-        out[name] = W if M is None else (W @ M).tocsr()
+        ind, ptr = (indices, indptr) if shared or k == 0 else (indices.copy(), indptr.copy())
+        W = sp.csr_matrix((data[k], ind, ptr), shape=shape)
+        if canonical:
+            W.has_canonical_format = True
+        else:
+            W.has_sorted_indices = True
+        if M is not None:  # composed with the step: scipy's product, a column once per row
+            W = (W @ M).tocsr()
+            W.sort_indices()
+        out[name] = W
     return out
 
 
 def _fill_points(lo, hi, pts, ops, ring, indptr, indices, nk, data):
     """The rows of points lo..hi-1 into ``data[0 .. nk-1]`` (the numba kernel; the sums of :func:`_rows`
-    point by point). ``pts = (s, t, scale, op, job)`` per point and every job's ring start, ``ops`` the
-    flat operators (:meth:`_Topology.flat`). A smooth regular quad's row is written in one pass (its
-    net is its ring: no operator, no cancellation)."""
-    s, t, scale, op, job, job_ring = pts
+    point by point), every row sorted by column. ``pts = (s, t, scale, op, job, job_ring, grid_net,
+    grid_rank)``: per point, then per job its ring's start and a smooth regular job's net by column and
+    places (:class:`_Topology`); ``ops`` the flat operators (:meth:`_Topology.flat`). A smooth regular
+    quad's row is written in one pass (:func:`_grid_row`: no operator, no cancellation, no sort). Returns
+    the number of repeated columns within the other rows (the smooth quads' nets:
+    :attr:`_Topology.grid_repeats`). ``data`` is indexed by constants only (a tuple indexed at run time
+    is kept in memory, and every store would reload it)."""
+    s, t, scale, op, job, job_ring, grid_net, grid_rank = pts
     cstart, ncols, dstart, cols, dev, org = ops
     B = np.empty(16)
     bu = np.empty((3, 4))
     bv = np.empty((3, 4))
+    width = 16
+    for o in range(ncols.shape[0]):
+        width = max(width, ncols[o])
+    place = np.empty(width, dtype=np.int64)  # a corner row's sort
+    tmp = np.empty(width)
+    repeats = 0
     for p in range(lo, hi):
         o = op[p]
-        nc = ncols[o]
-        c0 = cstart[o]
         q = indptr[p]
         ds = dstart[o]
         _bspline(s[p], bu)
         _bspline(t[p], bv)
         g = scale[p]
-        r0 = job_ring[job[p]]
         if ds < 0:  # a smooth regular quad: its net is its ring (cols 0..15), the weights are B itself
-            for c in range(16):
-                indices[q + c] = ring[r0 + c]
-            for k in range(nk):
-                dk = data[k]
-                a, b = _ORD_A[k], _ORD_B[k]
-                f = 1.0 if a + b == 0 else (g if a + b == 1 else g * g)
-                for j in range(4):
-                    for i in range(4):
-                        dk[q + 4 * j + i] = bv[b, j] * bu[a, i] * f
+            g0 = 16 * job[p]
+            _grid_row(q, grid_net[g0:g0 + 16], grid_rank[g0:g0 + 16], bu, bv, g, indices, nk, data)
             continue
+        nc, c0, r0 = ncols[o], cstart[o], job_ring[job[p]]
         for c in range(nc):
             indices[q + c] = ring[r0 + cols[c0 + c]]
-        for k in range(nk):
-            dk = data[k]
-            a, b = _ORD_A[k], _ORD_B[k]
-            f = 1.0 if a + b == 0 else (g if a + b == 1 else g * g)
-            for j in range(4):
-                for i in range(4):
-                    B[4 * j + i] = bv[b, j] * bu[a, i] * f
-            m = nc - 1
-            tot = 0.0
-            for c in range(m):
-                w = 0.0
-                for i in range(16):
-                    w += B[i] * dev[ds + i * m + c]
-                if k == 0:
-                    w += org[ds // 16 + c]
-                dk[q + 1 + c] = w
-                tot += w
-            dk[q] = (1.0 if k == 0 else 0.0) - tot
+        row = (q, nc, ds, dev, org, bu, bv, B)
+        _corner_key(row, 0, 0, 1.0, data[0])
+        if nk > 1:
+            _corner_key(row, 1, 0, g, data[1])
+            _corner_key(row, 0, 1, g, data[2])
+        if nk > 3:
+            _corner_key(row, 2, 0, g * g, data[3])
+            _corner_key(row, 1, 1, g * g, data[4])
+            _corner_key(row, 0, 2, g * g, data[5])
+        repeats += _sort_row(q, nc, indices, place)
+        _permute(q, nc, place, tmp, data[0])
+        if nk > 1:
+            _permute(q, nc, place, tmp, data[1])
+            _permute(q, nc, place, tmp, data[2])
+        if nk > 3:
+            _permute(q, nc, place, tmp, data[3])
+            _permute(q, nc, place, tmp, data[4])
+            _permute(q, nc, place, tmp, data[5])
+    return repeats
+
+
+def _corner_key(row, a, b, f, dk):
+    """One key (order a in s, b in t, scale f) of a corner face's row: the net's deviation and limit point
+    as weights of the ring's columns 1.., column 0 the rest (the sums of :func:`_rows`, point by point)."""
+    q, nc, ds, dev, org, bu, bv, B = row
+    for j in range(4):
+        for i in range(4):
+            B[4 * j + i] = bv[b, j] * bu[a, i] * f
+    m = nc - 1
+    tot = 0.0
+    for c in range(m):
+        w = 0.0
+        for i in range(16):
+            w += B[i] * dev[ds + i * m + c]
+        if a + b == 0:
+            w += org[ds // 16 + c]
+        dk[q + 1 + c] = w
+        tot += w
+    dk[q] = (1.0 if a + b == 0 else 0.0) - tot
+
+
+def _grid_row(q, net, rank, bu, bv, g, indices, nk, data):
+    """The row of a point of a smooth regular quad at q..q+15: its net's vertices by column ``net``, and
+    their tensor B-spline weights (net entry 4 j + i, i along s) at ``q + rank[4 j + i]``, all keys."""
+    for c in range(16):
+        indices[q + c] = net[c]
+    g2 = g * g
+    for j in range(4):
+        v0, v1, v2 = bv[0, j], bv[1, j], bv[2, j]
+        for i in range(4):  # (v u) g: the products of the numpy path, in its order
+            k = q + rank[4 * j + i]
+            data[0][k] = v0 * bu[0, i]
+            if nk > 1:
+                data[1][k] = v0 * bu[1, i] * g
+                data[2][k] = v1 * bu[0, i] * g
+            if nk > 3:
+                data[3][k] = v0 * bu[2, i] * g2
+                data[4][k] = v1 * bu[1, i] * g2
+                data[5][k] = v2 * bu[0, i] * g2
+
+
+def _sort_row(q, n, indices, place):
+    """Insertion sort (stable) of the row's columns at q..q+n-1; ``place[c]``: the entry now at c came from
+    q + place[c]. Returns the number of repeated columns."""
+    for c in range(n):
+        place[c] = c
+    for c in range(1, n):
+        x, e = indices[q + c], c
+        while e > 0 and indices[q + e - 1] > x:
+            indices[q + e] = indices[q + e - 1]
+            place[e] = place[e - 1]
+            e -= 1
+        indices[q + e] = x
+        place[e] = c
+    repeats = 0
+    for c in range(1, n):
+        if indices[q + c] == indices[q + c - 1]:
+            repeats += 1
+    return repeats
+
+
+def _permute(q, n, place, tmp, dk):
+    """``dk[q + c] = dk[q + place[c]]`` for c < n (the sort of :func:`_sort_row`)."""
+    for c in range(n):
+        tmp[c] = dk[q + place[c]]
+    for c in range(n):
+        dk[q + c] = tmp[c]
 
 
 def _locate_points(lo, hi, f, u, v, table, stride, out):
@@ -347,8 +459,6 @@ def _bspline(x, out):
     out[2, 0], out[2, 1], out[2, 2], out[2, 3] = t, 3 * x - 2, -3 * x + 1, x
 
 
-_ORD_A = np.array([o[0] for o in _ORDERS.values()], dtype=np.int64)
-_ORD_B = np.array([o[1] for o in _ORDERS.values()], dtype=np.int64)
 _KERNEL = []
 
 
@@ -360,8 +470,11 @@ def _kernel():
         except ImportError:  # pragma: no cover - numba is a dependency
             _KERNEL.append(None)
         else:
-            global _bspline
+            global _bspline, _grid_row, _corner_key, _sort_row, _permute
             _bspline = numba.njit(cache=True, nogil=True, inline="always")(_bspline)
+            _grid_row = numba.njit(cache=True, nogil=True, inline="always")(_grid_row)
+            _corner_key, _sort_row, _permute = (numba.njit(cache=True, nogil=True)(fn)
+                                                for fn in (_corner_key, _sort_row, _permute))
             _KERNEL.append((numba.njit(cache=True, nogil=True)(_locate_points),
                             numba.njit(cache=True, nogil=True)(_fill_points)))
     return _KERNEL[0]

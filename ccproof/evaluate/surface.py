@@ -431,7 +431,10 @@ class LimitSurface:
         dict of scipy.sparse.csr_matrix, shape (n, n_vertices)
             ``"P"``; with ``derivatives >= 1`` also ``"Du"``, ``"Dv"``; with 2 also ``"Duu"``, ``"Duv"``,
             ``"Dvv"`` (derivatives with respect to the face's own (u, v)). Columns: the vertices of
-            :attr:`mesh` (a PolyMesh's own vertices; an unused vertex's column is empty).
+            :attr:`mesh` (a PolyMesh's own vertices; an unused vertex's column is empty). Rows sorted by
+            column (canonical format); the matrices may share one pair of read-only index arrays (rows
+            of the file's vertices themselves), so change one's structure in place (``eliminate_zeros``)
+            only on a ``.copy()``.
 
         Examples
         --------

@@ -186,7 +186,7 @@ def test_errors_name_the_point():
 
 
 def test_bench_script_smoke(capsys):
-    """scripts/bench_basis.py --smoke runs and prints the ratio line per derivative order."""
+    """scripts/bench_basis.py --smoke [--cpu] runs and prints the ratio line per derivative order."""
     import importlib.util
     from pathlib import Path
 
@@ -194,9 +194,11 @@ def test_bench_script_smoke(capsys):
     spec = importlib.util.spec_from_file_location("bench_basis", path)
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)
-    assert mod.main(["--smoke"]) == 0
-    out = capsys.readouterr().out
-    assert out.count("basis/evaluate min") == 2 and "median" in out and "load" in out
+    for extra in ([], ["--cpu"]):
+        assert mod.main(["--smoke", *extra]) == 0
+        out = capsys.readouterr().out
+        assert out.count("basis/evaluate min") == 2 and "median" in out and "load" in out
+        assert ("CPU time of the thread" in out) == bool(extra)
 
 
 def test_no_points_and_derived_surfaces():
@@ -210,8 +212,8 @@ def test_no_points_and_derived_surfaces():
 
 
 def test_rows_of_many_points_on_threads_equal_the_numpy_path():
-    """Over 8192 points (several kernel calls per block, each copying its indices to the other matrices)
-    on one and two threads: the same matrices bit for bit, whose indices are those of the numpy path."""
+    """Over 8192 points (several kernel calls per block) on one and two threads: the same matrices bit for
+    bit, whose indices are those of the numpy path."""
     S = natural_limit_surface(cube())
     f, u, v = _points(S, 20000, seed=6)
     fc, uc, vc = S._check(f, u, v)
@@ -225,25 +227,66 @@ def test_rows_of_many_points_on_threads_equal_the_numpy_path():
         assert (D <= 1e-10 * np.maximum(1.0, abs(ref[key]).max(axis=1).toarray().ravel())).all(), key
 
 
-def test_each_matrix_owns_its_arrays():
-    """Sorting or pruning one matrix in place (scipy does when it needs to) leaves the others as they were."""
-    S = natural_limit_surface(cube())
+def _strictly_increasing_rows(W):
+    """Every row's columns strictly increasing (checked here, not by scipy's flags)."""
+    step = np.diff(W.indices.astype(np.int64))
+    inside = np.ones(W.nnz, dtype=bool)
+    inside[W.indptr[:-1][W.indptr[:-1] < W.nnz]] = False  # a row's first entry follows nothing
+    return bool((step[inside[1:]] > 0).all())
+
+
+@pytest.mark.parametrize("name", ["cube", "cube_corner", "catmark_xord_boundary", "catmark_nonquads"])
+def test_rows_sorted_by_column_and_shared_index_arrays(surfaces, name):
+    """Rows sorted by column, each column once (canonical CSR, flagged so); the matrices of one call share
+    one pair of read-only index arrays: an in-place change of one's structure (eliminate_zeros) raises and
+    leaves all as they were, its copy can be pruned, and sort_indices / sum_duplicates change nothing."""
+    S = surfaces[name]
     f, u, v = _points(S, 3000, seed=7)
     W = S.basis(f, u, v, 1)
-    for key in W:
-        for other in W:
-            if other != key:
-                assert not np.shares_memory(W[key].indices, W[other].indices), (key, other)
-                assert not np.shares_memory(W[key].indptr, W[other].indptr), (key, other)
-    dv = [getattr(W["Dv"], a).copy() for a in ("indptr", "indices", "data")]
-    assert not W["P"].has_sorted_indices  # the rows list the ring's vertices in its order
-    W["P"].sort_indices()
-    W["Du"].eliminate_zeros()
-    assert all(np.array_equal(getattr(W["Dv"], a), b) for a, b in zip(("indptr", "indices", "data"), dv))
-    X = np.asarray(cube().vertices, dtype=float)
-    r = S.evaluate(f, u, v, 1)
-    for key, ref in (("P", "P"), ("Du", "Pu"), ("Dv", "Pv")):
-        assert np.abs(W[key] @ X - r[ref]).max() <= 1e-13, key
+    before = {k: [getattr(w, a).copy() for a in ("indptr", "indices", "data")] for k, w in W.items()}
+    for key, w in W.items():
+        assert _strictly_increasing_rows(w) and w.has_canonical_format, key
+    if S._ptex_face is None:  # rows of the file's vertices themselves (a step's rows are scipy's products)
+        assert np.shares_memory(W["P"].indices, W["Du"].indices) and not W["P"].indices.flags.writeable
+        with pytest.raises(ValueError):
+            W["Du"].eliminate_zeros()
+    D = W["Du"].copy()
+    D.eliminate_zeros()
+    assert D.nnz <= W["Du"].nnz and abs(D - W["Du"]).max() == 0.0
+    for w in W.values():
+        w.sort_indices()
+        w.sum_duplicates()
+    for key, w in W.items():
+        assert all(np.array_equal(getattr(w, a), b) for a, b in zip(("indptr", "indices", "data"), before[key]))
+    X = np.asarray(S.mesh.vertices, dtype=float)  # (the accuracy per key: test_rows_reproduce_evaluate)
+    assert np.abs(W["P"] @ X - S.evaluate(f, u, v)["P"]).max() <= 1e-14 * max(1.0, float(np.abs(X).max()))
+
+
+def test_repeated_columns_are_counted_and_keep_their_own_arrays():
+    """A row naming a column twice (no mesh here does; the kernel counts them): the sort is stable, the
+    count is returned, and such matrices get their own index arrays, sorted but not canonical."""
+    import scipy.sparse as sp
+
+    from ccproof.evaluate import _basis
+
+    kernels = _basis._kernel()
+    fns = [(_basis._sort_row, _basis._permute)]
+    if kernels is not None:  # the compiled ones, and the Python functions they were made of
+        fns.append(tuple(getattr(fn, "py_func", fn) for fn in fns[0]))
+    for sort_row, permute in fns:
+        ind, place, tmp = np.array([0, 9, 5, 7, 5, 1, 7], dtype=np.int32), np.zeros(6, dtype=np.int64), np.zeros(6)
+        data = (np.arange(7.0) - 1, 10 * np.arange(7.0) - 10)
+        assert sort_row(1, 6, ind, place) == 2
+        for d in data:
+            permute(1, 6, place, tmp, d)
+        assert ind.tolist() == [0, 1, 5, 5, 7, 7, 9] and data[0].tolist() == [-1, 4, 1, 3, 2, 5, 0]
+        assert data[1].tolist() == [-10, 40, 10, 30, 20, 50, 0]
+    ind, ptr = np.array([1, 5, 5], dtype=np.int32), np.array([0, 3], dtype=np.int32)
+    W = _basis._matrices(("P", "Du"), [np.ones(3), np.ones(3)], ind, ptr, (1, 8), False, None)
+    assert not np.shares_memory(W["P"].indices, W["Du"].indices) and W["P"].has_sorted_indices
+    W["P"].sum_duplicates()
+    assert W["P"].nnz == 2 and W["Du"].nnz == 3 and W["Du"].indices.tolist() == [1, 5, 5]
+    assert abs(W["Du"] - sp.csr_matrix(([1.0, 2.0], [1, 5], [0, 2]), shape=(1, 8))).max() == 0.0
 
 
 def test_operators_first_needed_in_a_later_batch():

@@ -37,7 +37,7 @@ import scipy.sparse as sp
 from ccproof.errors import CCProofError
 
 __all__ = ["cylinder_grid", "end_conditions", "scordelis_lo", "pinched_cylinder", "SCORDELIS_LO_REFERENCE",
-           "PINCHED_CYLINDER_REFERENCE", "END_CONDITIONS", "ogrid_block_grid", "scordelis_lo_ev",
+           "PINCHED_CYLINDER_REFERENCE", "END_CONDITIONS", "ogrid_block_grid", "ogrid_block_faces", "scordelis_lo_ev",
            "interpolating_control_points"]
 
 END_CONDITIONS = ("exact", "rows", "edge")
@@ -225,22 +225,35 @@ def ogrid_block_grid(n, ghost=2):
     B = [vid(-1, -1), vid(1, -1), vid(1, 1), vid(-1, 1)]
     M = [vid(0, -1), vid(1, 0), vid(0, 1), vid(-1, 0)]
     C = vid(0, 0)
-    P = np.asarray(V)
+    F = [f for f in np.asarray(g.faces).tolist() if C not in f]  # the block's four faces share its centre
+    F += ogrid_block_faces(V, B, M, C)  # (appends the new vertices to V)
+    return QuadMesh(np.asarray(V), F)
+
+
+def ogrid_block_faces(V, corners, mids, centre):
+    """The 20 faces of the once-subdivided o-grid that replaces the 2 x 2 faces around vertex ``centre``
+    (``corners`` and ``mids``: the block's corner and edge-midpoint vertices, counter-clockwise, ``mids[i]``
+    between ``corners[i]`` and ``corners[i + 1]``); the 12 new vertices are appended to the list ``V`` of
+    positions. The inner square's corners (valence 3) lie 0.4 of the way from the centre to the corners
+    (valence 5 once the block is in its grid)."""
+    B, M, C = list(corners), list(mids), int(centre)
+    P = [np.asarray(V[i], dtype=np.float64) for i in range(len(V))]
 
     def new(p):
         V.append(np.asarray(p, dtype=np.float64))
+        P.append(V[-1])
         return len(V) - 1
 
     inner = [new(P[C] + 0.4 * (P[b] - P[C])) for b in B]
-    S = [new((P[b] + V[k]) / 2) for b, k in zip(B, inner)]
-    Nn = [new((V[inner[i]] + V[inner[(i + 1) % 4]]) / 2) for i in range(4)]
-    Q = [new((P[B[i]] + P[B[(i + 1) % 4]] + V[inner[(i + 1) % 4]] + V[inner[i]]) / 4) for i in range(4)]
-    F = [f for f in np.asarray(g.faces).tolist() if C not in f]  # the block's four faces share its centre
+    S = [new((P[b] + P[k]) / 2) for b, k in zip(B, inner)]
+    Nn = [new((P[inner[i]] + P[inner[(i + 1) % 4]]) / 2) for i in range(4)]
+    Q = [new((P[B[i]] + P[B[(i + 1) % 4]] + P[inner[(i + 1) % 4]] + P[inner[i]]) / 4) for i in range(4)]
+    F = []
     for i in range(4):
         j = (i + 1) % 4
         F += [[inner[i], Nn[i], C, Nn[i - 1]], [B[i], M[i], Q[i], S[i]], [M[i], B[j], S[j], Q[i]],
               [Q[i], S[j], inner[j], Nn[i]], [S[i], Q[i], Nn[i], inner[i]]]
-    return QuadMesh(np.asarray(V), F)
+    return F
 
 
 def _lattice_keys(X, scale):
