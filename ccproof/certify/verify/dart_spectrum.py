@@ -16,7 +16,7 @@ from .errors import CertificateError
 from .rules import TWO_RING
 from .statement import lam_of
 from .tagged import labels, sector_rows, window_rows
-from .tagged_modes import RING_INDEX, charpoly_roots, check_dart, check_ring, ring_block, ring_stencil
+from .tagged_modes import RING_INDEX, charpoly_roots, check_dart, check_ring, off_cut, ring_block, ring_stencil
 
 WINDOW = (7, 8)  # the window classes of every K >= 7 occur in both
 _C = ("C",)
@@ -394,9 +394,7 @@ def scaled_centre_residual(fam):
     sh, sinc = h * sigma, (h * sigma).sinc()
     _nonzero(sinc, "sinc(sigma h)")
     c = (2 * sh).cos()
-    if not ((1 + c) * (9 + c)).real > 0:
-        raise ZeroDivisionError("sqrt((1 + c)(9 + c)): the argument is not certainly off the branch cut")
-    root = ((1 + c) * (9 + c)).sqrt()
+    root = off_cut(c).sqrt()
     _nonzero(root + arb(20).sqrt(), "sqrt((1 + c)(9 + c)) + sqrt 20")
     dl = -(sigma * sigma * h * sinc * sinc / 8) * (1 + (c + 11) / (root + arb(20).sqrt()))  # (lam - L0)/h
     w = (2 * acb(0, 1) * sh).exp()

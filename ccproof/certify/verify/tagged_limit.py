@@ -11,13 +11,18 @@ from flint import acb, arb, ctx, fmpq, fmpq_mat
 
 from .c1 import read_prec
 from .errors import CertificateError
-from .record import exact_keys, field_of
-from .replay import parse_decimal
 from .spectrum import RING_INDEX, SMALL_ROOTS, ring_block
 from .statement import lam_of
-from .tagged import crease_block, window_rows
+from .tagged import DECIMAL, crease_block, read_fields, window_rows
 from .tagged_c1 import G_GENERIC, check_boundary, crease_eigen_why, crease_top_why, read_z, vertex_tangents
-from .tagged_modes import bordered_solve, charpoly_roots, check_ring, check_structure, mode_reflection
+from .tagged_modes import (
+    bordered_solve,
+    charpoly_roots,
+    check_ring,
+    check_structure,
+    lam_principal,
+    mode_reflection,
+)
 
 WINDOW = (7, 8)  # the window classes of every N >= 7 occur in both
 MIN_TAIL = WINDOW[0]
@@ -25,6 +30,10 @@ MAX_ARCS = 8192  # arcs on either circle, and boxes on the disc (bounded work fo
 # evaluations of H weighted by (prec + 1024)/1024, checked before any arithmetic: the published need 3,042, the
 # prover's widest hints (every N0 >= 7) about 21,000; at the budget a file costs about 5 s of CPU
 TAIL_BUDGET = 3 * 8192
+#: the record's fields (:func:`.tagged.read_fields`; ``prec`` by :func:`.c1.read_prec`, ``z`` by
+#: :func:`.tagged_c1.read_z`); the limit's values in this order
+GRAMMAR = {"schema": str, "configuration": str, "statement": str, "prec": int, "witness": {"z": dict},
+           "limit": {"rho": DECIMAL, "R": DECIMAL, "box": DECIMAL, "arcs": (1, MAX_ARCS), "outer_arcs": (1, MAX_ARCS)}}
 
 
 @cache
@@ -75,9 +84,7 @@ def limit_h(theta):
     for j in (1, 2):
         w = (acb(0, j) * theta).exp()
         c = (w + 1 / w) / 2
-        if not ((1 + c) * (9 + c)).real > 0:
-            raise ZeroDivisionError("(1 + c)(9 + c) is not certainly in the right half-plane")
-        sol = bordered_solve(ring_block(w), lam_of(c), RING_INDEX[(1, 0)])
+        sol = bordered_solve(ring_block(w), lam_principal(c), RING_INDEX[(1, 0)])
         vh = {p: sol[i] for p, i in RING_INDEX.items()}
         # the centre and ray 0: 0; ray 1: v^(b,0)(w - 1/w); quadrant 0: v^(a,b) - v^(b,a)/w
         tangents.append(vertex_tangents({(a, b): acb(0) if b == 0 else vh[(b, 0)] * (w - 1 / w) if a == 0 else
@@ -178,16 +185,12 @@ def verify_tail(cert, fam, n0, part, log):
     """
     if not MIN_TAIL <= n0 <= 10**6:
         raise CertificateError(f"{fam}:>={n0}: the window argument needs N0 >= {MIN_TAIL}")
-    exact_keys(cert, ("schema", "configuration", "statement", "prec", "witness", "limit"), "certificate")
-    prec, w, lim = read_prec(cert), field_of(cert, "witness", dict, "certificate"), cert["limit"]
-    exact_keys(w, ("z",), "witness")
-    exact_keys(field_of(cert, "limit", dict, "certificate"), ("rho", "R", "arcs", "outer_arcs", "box"), "limit")
-    g, cval = read_z(field_of(w, "z", dict, "witness"))
-    rho, R, side = (parse_decimal(field_of(lim, k, str, "limit")) for k in ("rho", "R", "box"))
-    arcs, outer = (field_of(lim, k, int, "limit") for k in ("arcs", "outer_arcs"))
-    if not (1 <= arcs <= MAX_ARCS and 1 <= outer <= MAX_ARCS and 0 < rho < R <= 1 and 0 < side <= R
-            and (2 * R / side + 2) ** 2 <= MAX_ARCS):
-        raise CertificateError(f"limit: need 0 < rho < R <= 1, 0 < box <= R, at most {MAX_ARCS} arcs and boxes")
+    prec = read_prec(cert)
+    rec = read_fields(cert, GRAMMAR, "certificate")
+    g, cval = read_z(rec["witness"]["z"])
+    rho, R, side, arcs, outer = rec["limit"].values()
+    if not (0 < rho < R <= 1 and 0 < side <= R and (2 * R / side + 2) ** 2 <= MAX_ARCS):
+        raise CertificateError(f"limit: need 0 < rho < R <= 1, 0 < box <= R, at most {MAX_ARCS} boxes")
     evals = arcs + outer + (2 * ((R / side).ceil())) ** 2  # at most (2 ceil(R/box))^2 boxes meet the disc
     if evals * fmpq(prec + 1024, 1024) > TAIL_BUDGET:
         raise CertificateError(f"limit: {evals} evaluations of H at {prec} bits exceed the budget "

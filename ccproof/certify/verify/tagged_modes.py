@@ -155,6 +155,22 @@ def mode_spectrum(fam, n):
     return out
 
 
+def off_cut(c):
+    """(1 + c)(9 + c) for an acb ball c, ZeroDivisionError unless it certainly lies in the right half-plane (there
+    its principal square root, and so :func:`lam_principal`, is analytic in c)."""
+    d = (1 + c) * (9 + c)
+    if not d.real > 0:
+        raise ZeroDivisionError("(1 + c)(9 + c) is not certainly in the right half-plane (off the branch cut)")
+    return d
+
+
+def lam_principal(c):
+    """lam(c) (:func:`.statement.lam_of`), on an acb ball c only where :func:`off_cut` proves it analytic."""
+    if isinstance(c, acb):
+        off_cut(c)
+    return lam_of(c)
+
+
 def bordered_solve(B, lam, pivot, mat=acb_mat):
     """The null vector v of B - lam with v[pivot] = 1 from the bordered system [[B - lam, e_p], [e_p^T, 0]] (v, s) =
     (0, 1) in ``mat`` (acb_mat or arb_mat); ZeroDivisionError unless arb proves it regular for every lam of the
