@@ -9,6 +9,8 @@ from functools import cache
 
 from flint import acb, arb, ctx, fmpq, fmpq_mat
 
+from ccproof.rigorous.analytic import disc_boxes
+
 from .c1 import read_prec
 from .errors import CertificateError
 from .spectrum import RING_INDEX, SMALL_ROOTS, ring_block
@@ -93,19 +95,15 @@ def limit_h(theta):
     return a1 * b2 - b1 * a2
 
 
-def _check_disc(R, side):
-    """The number of boxes of the grid of ``side`` that meet |theta| <= R, each proved (H analytic there), or the
-    failing box as a string."""
-    m, count = int(-(-R.p * side.q // (R.q * side.p))), 0  # m = ceil(R / side)
-    for lo in ((u * side, v * side) for u in range(-m, m) for v in range(-m, m)):
-        near = [0 if x <= 0 <= x + side else min(abs(x), abs(x + side)) for x in lo]
-        if near[0] ** 2 + near[1] ** 2 > R * R:
-            continue
+def _check_disc(R, grid):
+    """The number of boxes of the grid x grid grid on [-R, R]^2 that meet |theta| <= R (:func:`disc_boxes`), each
+    proved (H analytic there), or the failing box as a string."""
+    count = 0
+    for count, box in enumerate(disc_boxes(R, grid), 1):
         try:
-            limit_h(acb(*(arb(x).union(arb(x + side)) for x in lo)))
+            limit_h(box)
         except ZeroDivisionError:
-            return f"[{lo[0]}, {lo[0] + side}] x [{lo[1]}, {lo[1] + side}]"
-        count += 1
+            return str(box)
     return count
 
 
@@ -189,15 +187,16 @@ def verify_tail(cert, fam, n0, part, log):
     rec = read_fields(cert, GRAMMAR, "certificate")
     g, cval = read_z(rec["witness"]["z"])
     rho, R, side, arcs, outer = rec["limit"].values()
-    if not (0 < rho < R <= 1 and 0 < side <= R and (2 * R / side + 2) ** 2 <= MAX_ARCS):
-        raise CertificateError(f"limit: need 0 < rho < R <= 1, 0 < box <= R, at most {MAX_ARCS} boxes")
-    evals = arcs + outer + (2 * ((R / side).ceil())) ** 2  # at most (2 ceil(R/box))^2 boxes meet the disc
+    if not (0 < rho < R <= 1 and 0 < side <= R and (grid := 2 * R / side).q == 1 and grid ** 2 <= MAX_ARCS):
+        raise CertificateError(f"limit: need 0 < rho < R <= 1, 0 < box <= R, 2R/box an integer, at most {MAX_ARCS} "
+                               "boxes")
+    evals = arcs + outer + grid ** 2  # at most grid^2 boxes meet the disc
     if evals * fmpq(prec + 1024, 1024) > TAIL_BUDGET:
         raise CertificateError(f"limit: {evals} evaluations of H at {prec} bits exceed the budget "
                                f"({TAIL_BUDGET} weighted by (prec + 1024)/1024)")
     log(f"not C1 certificate for {fam}:>={n0} ({prec} bits)")
     with ctx.workprec(prec):
-        _check_tail(fam, n0, g, cval, (rho, R, side, arcs, outer), part, log)
+        _check_tail(fam, n0, g, cval, (rho, R, side, arcs, outer, int(grid.p)), part, log)
     return f"{fam}:>={n0}"
 
 
@@ -222,8 +221,8 @@ def _check_tail(fam, n0, g, cval, limit, part, log):  # parts 1-5 in order, each
          "" if ok else "the ring stencil breaks the reflection identity")
     if part.failed:  # N for every N >= n0: H analytic on |theta| <= R, bounded on its circle, winding 4 times
         return
-    rho, R, side, arcs, outer = limit
-    got = _check_disc(R, side)
+    rho, R, side, arcs, outer, grid = limit
+    got = _check_disc(R, grid)
     ok = isinstance(got, int)
     part(f"x, y and N analytic: the bordered systems of modes 1 and 2 regular on |theta| <= {R}", ok,
          f"{got} boxes of side {side}, (1 + c)(9 + c) in the right half-plane: x, y = f(pi/N), f(2 pi/N) are the "
