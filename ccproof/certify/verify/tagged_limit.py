@@ -98,13 +98,13 @@ def limit_h(theta):
 def _check_disc(R, grid):
     """The number of boxes of the grid x grid grid on [-R, R]^2 that meet |theta| <= R (:func:`disc_boxes`), each
     proved (H analytic there), or the failing box as a string."""
-    count = 0
-    for count, box in enumerate(disc_boxes(R, grid), 1):
+    boxes = list(disc_boxes(R, grid))
+    for box in boxes:
         try:
             limit_h(box)
         except ZeroDivisionError:
             return str(box)
-    return count
+    return len(boxes)
 
 
 def _circle_bound(R, arcs):
