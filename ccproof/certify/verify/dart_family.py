@@ -11,10 +11,10 @@ from flint import acb, acb_mat, acb_poly, acb_series, arb, ctx, fmpq, fmpq_mat, 
 from .errors import CertificateError
 from .maps import STAR_CURVES, curve_points
 from .rules import CENTRE
-from .statement import B2Z, NET_OFFSETS, horner
+from .statement import B2Z, NET_OFFSETS, horner, lam_of
 from .statement import PATCHES as PIECES
 from .tagged import quadrant_level1
-from .tagged_modes import RING_INDEX, bordered_matrix, bordered_solve, lam_principal, ring_block, ring_stencil
+from .tagged_modes import RING_INDEX, bordered_matrix, bordered_solve, off_cut, ring_block, ring_stencil
 
 
 def kappa():
@@ -145,7 +145,7 @@ class Family(Modes):
         self.zero, self.i2 = h * 0, acb(0, 2)
         self.ix, self.iy = acb(0, 2) * pi, acb(0, 2) * sigma   # w_x = e^(ix h), w_y = e^(iy h)
         self.em, self.ep = (acb(0, -1) * sigma).exp(), (acb(0, 1) * sigma).exp()
-        self.lam1, self.lam2 = (lam_principal((h * (2 * a)).cos()) for a in (pi, sigma))
+        self.lam1, self.lam2 = (lam_of(off_cut((h * (2 * a)).cos())) for a in (pi, sigma))
         self.vx, self.vy = bordered((h * self.ix).exp(), self.lam1), bordered((h * self.iy).exp(), self.lam2)
         L0, low = l0()
         self.U = big_u(self.lam2, low)

@@ -394,7 +394,7 @@ def scaled_centre_residual(fam):
     sh, sinc = h * sigma, (h * sigma).sinc()
     _nonzero(sinc, "sinc(sigma h)")
     c = (2 * sh).cos()
-    root = off_cut(c).sqrt()
+    root = ((1 + c) * (9 + off_cut(c))).sqrt()  # the principal root, analytic off the cut
     _nonzero(root + arb(20).sqrt(), "sqrt((1 + c)(9 + c)) + sqrt 20")
     dl = -(sigma * sigma * h * sinc * sinc / 8) * (1 + (c + 11) / (root + arb(20).sqrt()))  # (lam - L0)/h
     w = (2 * acb(0, 1) * sh).exp()

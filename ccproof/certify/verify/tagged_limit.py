@@ -22,8 +22,8 @@ from .tagged_modes import (
     charpoly_roots,
     check_ring,
     check_structure,
-    lam_principal,
     mode_reflection,
+    off_cut,
 )
 
 WINDOW = (7, 8)  # the window classes of every N >= 7 occur in both
@@ -86,7 +86,7 @@ def limit_h(theta):
     for j in (1, 2):
         w = (acb(0, j) * theta).exp()
         c = (w + 1 / w) / 2
-        sol = bordered_solve(ring_block(w), lam_principal(c), RING_INDEX[(1, 0)])
+        sol = bordered_solve(ring_block(w), lam_of(off_cut(c)), RING_INDEX[(1, 0)])
         vh = {p: sol[i] for p, i in RING_INDEX.items()}
         # the centre and ray 0: 0; ray 1: v^(b,0)(w - 1/w); quadrant 0: v^(a,b) - v^(b,a)/w
         tangents.append(vertex_tangents({(a, b): acb(0) if b == 0 else vh[(b, 0)] * (w - 1 / w) if a == 0 else

@@ -156,19 +156,11 @@ def mode_spectrum(fam, n):
 
 
 def off_cut(c):
-    """(1 + c)(9 + c) for an acb ball c, ZeroDivisionError unless it certainly lies in the right half-plane (there
-    its principal square root, and so :func:`lam_principal`, is analytic in c)."""
-    d = (1 + c) * (9 + c)
-    if not d.real > 0:
+    """c, raising ZeroDivisionError where c is an acb ball whose (1 + c)(9 + c) is not certainly in the right
+    half-plane: elsewhere its principal square root, and lam(c) (:func:`.statement.lam_of`), are analytic in c."""
+    if isinstance(c, acb) and not ((1 + c) * (9 + c)).real > 0:
         raise ZeroDivisionError("(1 + c)(9 + c) is not certainly in the right half-plane (off the branch cut)")
-    return d
-
-
-def lam_principal(c):
-    """lam(c) (:func:`.statement.lam_of`), on an acb ball c only where :func:`off_cut` proves it analytic."""
-    if isinstance(c, acb):
-        off_cut(c)
-    return lam_of(c)
+    return c
 
 
 def bordered_solve(B, lam, pivot, mat=acb_mat):
