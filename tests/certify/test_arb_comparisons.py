@@ -33,7 +33,7 @@ REVIEWED = {
     # a guard that the family's code matches the lemma's identities (it FAILs a flipped alpha); the lemma is
     # proved by the exact checks and the sign change, not by this test
     ("dart_spectrum.py", "z.contains(0)"): "a guard (above), never the proof",
-    ("dart_spectrum.py", "classes[0] != classes[1]"): "dicts of fmpq rows (exact)",
+    ("tagged.py", "a != b"): "dicts of fmpq rows (exact)",
     ("dart_spectrum.py", "det2 != w * w * lam * lam - (5 * w * w + c2) * lam / 8 + w * w / 16"): "fmpq_mpoly (exact)",
     ("dart_spectrum.py", "64 * lam * g_num != 64 * lam * det2 + n2 * w * w"): "fmpq_mpoly (exact)",
     ("dart_spectrum.py", "8 * P * 2 != -(2 * lam - lc)"): "fmpq_mpoly (exact)",

@@ -23,6 +23,7 @@ MAX_SIZE, MAX_TAIL = 100, 10**6  # N, K at most MAX_SIZE; FAMILY:>=N0 needs N0 a
 EXACT_BUDGET = 128**3  # work m^3 of the exact route for S of m points; the published use at most 27 points
 _NAME = re.compile(r"(dart|crease|corner):(>=)?([0-9]{1,7})")
 ONE = fmpq_poly([-1, 1])  # the factor of the eigenvalue 1
+WINDOW = (7, 8)  # the window classes of every N >= 7 occur in both
 DECIMAL, FRACTION = "decimal", "fraction"  # field kinds of :func:`read_fields`
 
 
@@ -213,6 +214,15 @@ def window_rows(fam, n):
         if len(rel) != len(row) or out.setdefault(key, rel) != rel:
             raise CertificateError(f"{fam}:{n}: two points of window class {key} have different rows")
     return out
+
+
+def window_classes(fam):
+    """The rows of fam:N by window class (:func:`window_rows`), one table for every N >= 7: raise unless those of
+    fam:7 and fam:8 (:data:`WINDOW`), in which every class occurs, are the same."""
+    a, b = (window_rows(fam, n) for n in WINDOW)
+    if a != b:
+        raise CertificateError(f"{fam}: the window classes of {fam}:{WINDOW[0]} and {fam}:{WINDOW[1]} differ")
+    return a
 
 
 def _window_column(p, q, n, ring):  # the column of point q in the row of point p
