@@ -26,7 +26,6 @@ REVIEWED = {
     ("registry.py", "st != st_t"): "str (statements)",
     ("dart_tail.py", "not z < L + 2"): "refuses unless |omega s| < L + 2 certainly: conservative",
     ("dart_family.py", "B * Ms[-1] + c[0] * eye != fmpq_mat(n, n)"): "fmpq_mat (exact)",
-    ("dart_spectrum.py", "not ((1 + c) * (9 + c)).real > 0"): "refuses unless Re > 0 certainly: conservative",
     ("dart_spectrum.py", "_X * N[i] - sum((B_AT_1[i, k] * N[k] for k in range(6)), fmpq_poly(0)) != p * kap[i]"):
         "fmpq_poly (exact)",
     ("dart_spectrum.py", "not box.cos() < 0"): "refuses unless cos sigma < 0 certainly on the bracket: conservative",
@@ -34,7 +33,7 @@ REVIEWED = {
     # a guard that the family's code matches the lemma's identities (it FAILs a flipped alpha); the lemma is
     # proved by the exact checks and the sign change, not by this test
     ("dart_spectrum.py", "z.contains(0)"): "a guard (above), never the proof",
-    ("dart_spectrum.py", "classes[0] != classes[1]"): "dicts of fmpq rows (exact)",
+    ("tagged.py", "a != b"): "dicts of fmpq rows (exact)",
     ("dart_spectrum.py", "det2 != w * w * lam * lam - (5 * w * w + c2) * lam / 8 + w * w / 16"): "fmpq_mpoly (exact)",
     ("dart_spectrum.py", "64 * lam * g_num != 64 * lam * det2 + n2 * w * w"): "fmpq_mpoly (exact)",
     ("dart_spectrum.py", "8 * P * 2 != -(2 * lam - lc)"): "fmpq_mpoly (exact)",
@@ -52,12 +51,12 @@ REVIEWED = {
     ("dart_spectrum.py", "not tau1 > 0"): "fmpq (exact)",
     ("dart_spectrum.py", "not m > 0"): "refuses unless m > 0 certainly: conservative",
     ("dart_spectrum.py", "not -1 <= key[1] <= 1"): "ints",
-    ("dart_tail.py", "not spec[0] <= obj <= spec[1]"): "ints",
+    ("tagged.py", "not spec[0] <= obj <= spec[1]"): "ints",
     ("dart_tail.py", 'field_of(cert, "statement", str, "certificate") != "C1"'): "strings",
     ("dart_tail.py", 'g["map"]["orientation"] != 1'): "ints",
     ("dart_tail.py", "not fmpq(1, k0) < hints.r <= fmpq(1, 8)"): "fmpq (exact)",
     ("dart_family.py", "got != n_at(x)"): "lists of fmpq (exact)",
-    ("dart_family.py", "not ((1 + c) * (9 + c)).real > 0"): "refuses unless certainly off the cut: conservative",
+    ("tagged_modes.py", "not ((1 + c) * (9 + c)).real > 0"): "refuses unless certainly off the cut: conservative",
     ("dart_zeros.py", "(s * p) % _M3 != 1"): "fmpq_poly (exact)",
     ("dart_zeros.py", "w != 0"): "fmpq Bernstein weights (exact)",
     ("injectivity.py", 'param["variable"] != "lam"'): "strings",
@@ -111,8 +110,6 @@ REVIEWED = {
     ("tagged_modes.py", "SE[a, b] != 0"): "fmpq_mat entries (exact)",
     ("maps.py", "not (hi < BREAKS[p] or (p < 3 and lo > BREAKS[p + 1]))"): (
         "keeps a piece unless the hull is certainly outside it: conservative"),
-    ("tagged_limit.py", "not ((1 + c) * (9 + c)).real > 0"): "refuses the box unless Re (1 + c)(9 + c) > 0 "
-                                                                "certainly: conservative",
     ("tagged_limit.py", "C != crease_block(fam, WINDOW[1])"): "fmpq_mat (exact)",
     ("tagged_limit.py", "blocks[0] != blocks[1]"): "tuples of fmpq_mat (exact)",
     ("tagged_limit.py", "Bi * R != R * B"): "fmpq_mat (w is an exact rational)",

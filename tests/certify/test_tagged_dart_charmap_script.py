@@ -394,12 +394,8 @@ def test_the_exact_nets_are_the_acb_familys_nets():
             el = []
             for e in exs:
                 x, y = e.layer_level0()
-                el.append({p: mod._bezier([[mod.quadrant_level1(y, e.yc, e.lam2, e.zero, q)(mod.NET_OFFSETS[p][0] + i,
-                                                                                            mod.NET_OFFSETS[p][1] + j)
-                                             for j in range(4)] for i in range(4)], e.zero) for p in mod.PIECES})
-                x0 = {p: mod._bezier([[mod.quadrant_level1(x, e.zero, e.lam1, e.zero, q)(mod.NET_OFFSETS[p][0] + i,
-                                                                                     mod.NET_OFFSETS[p][1] + j)
-                                       for j in range(4)] for i in range(4)], e.zero) for p in mod.PIECES}
+                el.append(mod.piece_nets(y, e.yc, e.lam2, e.zero, q))
+                x0 = mod.piece_nets(x, e.zero, e.lam1, e.zero, q)
             for p in mod.PIECES:
                 for i in range(4):
                     for j in range(4):

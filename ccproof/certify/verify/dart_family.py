@@ -5,16 +5,16 @@ series variable; :class:`Modes` is shared with the exact family of :mod:`.dart_z
 from __future__ import annotations
 
 from contextlib import contextmanager
-from functools import cache
 
 from flint import acb, acb_mat, acb_poly, acb_series, arb, ctx, fmpq, fmpq_mat, fmpq_poly
 
 from .errors import CertificateError
 from .maps import STAR_CURVES, curve_points
-from .rules import CENTRE, apply, canonical, level1_rule
+from .rules import CENTRE
 from .statement import B2Z, NET_OFFSETS, horner, lam_of
 from .statement import PATCHES as PIECES
-from .tagged_modes import RING_INDEX, bordered_matrix, bordered_solve, ring_block, ring_stencil
+from .tagged import quadrant_level1
+from .tagged_modes import RING_INDEX, bordered_matrix, bordered_solve, off_cut, ring_block, ring_stencil
 
 
 def kappa():
@@ -54,13 +54,6 @@ def big_u(lam, low):
     """U(lam) = adj(lam - B(1)) kappa / :func:`u_denominator` (6 values of lam's type)."""
     den = u_denominator(lam, low)
     return [horner(p, lam, lam * 0) / den for p in N_POLYS]
-
-
-def _lam_principal(c):
-    """lam(c) (:func:`.statement.lam_of`); on an acb ball ZeroDivisionError unless certainly off the cut."""
-    if isinstance(c, acb) and not ((1 + c) * (9 + c)).real > 0:
-        raise ZeroDivisionError("sqrt((1 + c)(9 + c)): the argument is not certainly off the branch cut")
-    return lam_of(c)
 
 
 @contextmanager
@@ -152,7 +145,7 @@ class Family(Modes):
         self.zero, self.i2 = h * 0, acb(0, 2)
         self.ix, self.iy = acb(0, 2) * pi, acb(0, 2) * sigma   # w_x = e^(ix h), w_y = e^(iy h)
         self.em, self.ep = (acb(0, -1) * sigma).exp(), (acb(0, 1) * sigma).exp()
-        self.lam1, self.lam2 = (_lam_principal((h * (2 * a)).cos()) for a in (pi, sigma))
+        self.lam1, self.lam2 = (lam_of(off_cut((h * (2 * a)).cos())) for a in (pi, sigma))
         self.vx, self.vy = bordered((h * self.ix).exp(), self.lam1), bordered((h * self.iy).exp(), self.lam2)
         L0, low = l0()
         self.U = big_u(self.lam2, low)
@@ -169,25 +162,6 @@ class Family(Modes):
         return self._exp[(c, k)]
 
 
-def quadrant_level1(level0, centre, lam, zero, q=None):
-    """``value(A, B)``, the level-1 value at (A, B) of a quadrant: lam times level 0 on the two-ring, the rule of
-    :mod:`.rules` elsewhere; ``q`` None a bulk quadrant (``level0(delta, pos)``), else layer quadrant q
-    (``level0(t, pos)``; as tagged_map: the ghost row across ray 0, the sharp midpoint at its (3, 0))."""
-    def value(A, B):
-        if (A, B) == (0, 0):
-            return lam * centre
-        if B == -1 and q == 0:
-            return 2 * value(A, 0) - value(A, 1)
-        d, A2, B2 = canonical(A, B)
-        t = d if q is None else q + d
-        if (A2, B2) in RING_INDEX:
-            return lam * level0(t, (A2, B2))
-        if q is not None and B2 == 0 and t == 0:
-            return (level0(0, (1, 0)) + level0(0, (2, 0))) / 2
-        return apply(level1_rule(A2, B2), lambda dd, p: centre if p == CENTRE else level0(t + dd, p), zero)
-    return value
-
-
 def _bezier(net, zero):
     """4 x 4 B-spline control values -> Bezier (any ring): ``B2Z`` both ways, one division by 36."""
     tmp = [[sum((net[r][j] * c for r, c in enumerate(B2Z[i]) if c), zero) for j in range(4)] for i in range(4)]
@@ -196,8 +170,11 @@ def _bezier(net, zero):
 
 
 def piece_nets(level0, centre, lam, zero, q=None):
-    """{piece: 4 x 4 Bezier net} of one coordinate or basis part (:func:`quadrant_level1`)."""
-    V = cache(quadrant_level1(level0, centre, lam, zero, q))  # the three pieces share most level-1 points
+    """{piece: 4 x 4 Bezier net} of one coordinate or basis part (:func:`.tagged.quadrant_level1`: lam times level 0
+    on the two-ring, an eigenvector's level 1): ``q`` None a bulk quadrant (``level0(delta, pos)``, no sharp ray),
+    else layer quadrant q (``level0(t, pos)``, ray 0 sharp)."""
+    V = quadrant_level1(q or 0, (lambda s: False) if q is None else (lambda s: s == 0), lam * centre,
+                        lambda s, p: lam * level0(s, p), lambda s, p: centre if p == CENTRE else level0(s, p), zero)
     return {name: _bezier([[V(NET_OFFSETS[name][0] + i, NET_OFFSETS[name][1] + j) for j in range(4)]
                            for i in range(4)], zero) for name in PIECES}
 

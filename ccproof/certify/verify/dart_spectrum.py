@@ -15,10 +15,9 @@ from .dart_family import B_AT_1, N_POLYS, Family, adjugate, kappa, l0, u_denomin
 from .errors import CertificateError
 from .rules import TWO_RING
 from .statement import lam_of
-from .tagged import labels, sector_rows, window_rows
-from .tagged_modes import RING_INDEX, charpoly_roots, check_dart, check_ring, ring_block, ring_stencil
+from .tagged import WINDOW, labels, sector_rows, window_classes
+from .tagged_modes import RING_INDEX, charpoly_roots, check_dart, check_ring, off_cut, ring_block, ring_stencil
 
-WINDOW = (7, 8)  # the window classes of every K >= 7 occur in both
 _C = ("C",)
 _E, _F = (1, 0), (1, 1)  # the one-ring positions
 _E10, _E20, _E11 = RING_INDEX[_E], RING_INDEX[(2, 0)], RING_INDEX[_F]
@@ -47,9 +46,7 @@ def check_construction():
     >>> d[("C",)], d[("r", 0, 1, 0)], d[("q", -1, 1, 1)], bound
     (1/8, 1/8, -1/16, 15/64)
     """
-    classes = [window_rows("dart", k) for k in WINDOW]
-    if classes[0] != classes[1]:
-        raise CertificateError(f"dart: the window classes of dart:{WINDOW[0]} and dart:{WINDOW[1]} differ")
+    classes = window_classes("dart")
     if not all(_centre_ok(k) for k in range(7, 13)):
         raise CertificateError("dart: the centre row is not (1 - 7h/4, 3h^2/2 per ray, h^2/4 per quadrant)")
     if any(x < 0 for k in WINDOW for row in sector_rows("dart", k) for x in row.values()):
@@ -62,7 +59,7 @@ def check_construction():
             raise CertificateError(f"dart:{k}: an odd block of the modes +-1 has an eigenvalue >= 1/2")
     if bound > fmpq(15, 64):
         raise CertificateError(f"dart: the outer even rows bound {bound} > 15/64")
-    return _sharp_difference(classes[0][("r", 0, 3) + _E]), bound
+    return _sharp_difference(classes[("r", 0, 3) + _E]), bound
 
 
 def _sharp_difference(sharp):
@@ -394,9 +391,7 @@ def scaled_centre_residual(fam):
     sh, sinc = h * sigma, (h * sigma).sinc()
     _nonzero(sinc, "sinc(sigma h)")
     c = (2 * sh).cos()
-    if not ((1 + c) * (9 + c)).real > 0:
-        raise ZeroDivisionError("sqrt((1 + c)(9 + c)): the argument is not certainly off the branch cut")
-    root = ((1 + c) * (9 + c)).sqrt()
+    root = ((1 + c) * (9 + off_cut(c))).sqrt()  # the principal root, analytic off the cut
     _nonzero(root + arb(20).sqrt(), "sqrt((1 + c)(9 + c)) + sqrt 20")
     dl = -(sigma * sigma * h * sinc * sinc / 8) * (1 + (c + 11) / (root + arb(20).sqrt()))  # (lam - L0)/h
     w = (2 * acb(0, 1) * sh).exp()

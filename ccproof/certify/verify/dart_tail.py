@@ -39,22 +39,22 @@ from .dart_spectrum import (
 from .dart_zeros import check_zeros
 from .errors import CertificateError
 from .maps import STAR_CURVES
-from .record import exact_keys, field_of
-from .replay import MAX_BOXES, parse_decimal, read_tree, replay_tree
+from .record import field_of
+from .replay import MAX_BOXES, read_tree, replay_tree
+from .tagged import DECIMAL, FRACTION, read_fields
 
 MIN_K0 = 101  # the regions need 1/K0 < r, and the covers are shown from 101 on
 MAX_WORK = 100_000  # units of 0.1 ms of CPU (:func:`record_work`): 10 s; the published record declares 8.6 s
 MAX_BALLS = 8192
-_DEC, _FRAC = "decimal", "fraction"
-#: the record's fields (:func:`read_fields`): a dict of fields (exactly those keys), a list (that many items),
+#: the record's fields (:func:`.tagged.read_fields`): a dict of fields (exactly those keys), a list (that many items),
 #: (lo, hi) an int in lo..hi, a decimal string, a fraction 'INT/INT', or a type (read by the step that needs it)
 GRAMMAR = {
     "schema": str, "configuration": str, "statement": str, "prec": (64, 1024), "map": {"orientation": int},
-    "spectrum": {"sigma": [_DEC, _DEC], "sigma_h": (1, MAX_BALLS), "circle": _DEC, "mode0_h": (1, MAX_BALLS),
-                 "tau1": _DEC, "v0": _DEC, "re": {"N": dict, "I": dict, "F": dict}},
-    "taylor": {"r": _DEC, "disc_grid": (1, 64), "sigma_boxes": (1, 256), "order": (3, 24), "layer_order": (3, 24),
+    "spectrum": {"sigma": [DECIMAL, DECIMAL], "sigma_h": (1, MAX_BALLS), "circle": DECIMAL, "mode0_h": (1, MAX_BALLS),
+                 "tau1": DECIMAL, "v0": DECIMAL, "re": {"N": dict, "I": dict, "F": dict}},
+    "taylor": {"r": DECIMAL, "disc_grid": (1, 64), "sigma_boxes": (1, 256), "order": (3, 24), "layer_order": (3, 24),
                "exp_order": (2, 64)},
-    "regions": {"s0": _FRAC, "layer": (3, 64), "winding": [_FRAC, _FRAC]},
+    "regions": {"s0": FRACTION, "layer": (3, 64), "winding": [FRACTION, FRACTION]},
     "parts": dict,
 }
 #: quantity -> (the exact zeros below h^low in the bulk; the middle's (m0, q) of :func:`middle_box`, None: X has
@@ -65,39 +65,6 @@ QUANTITIES = {"R": (1, (1, 2), 3), "T": (1, (1, 2), 3), "X": (0, None, None), "Y
 #: the record's ``taylor`` hints (they only choose): the Cauchy radius r (the h-square [-r, r]^2), its grid, the
 #: sigma boxes, the Taylor orders in h (bulk and middle; layer) and the middle's order in s
 TaylorHints = namedtuple("TaylorHints", "r disc_grid sigma_boxes order layer_order exp_order")
-
-
-def read_fields(obj, spec, where):
-    """``obj`` read by ``spec`` (:data:`GRAMMAR`): dicts exactly their keys, lists their length, (lo, hi) an int in
-    range, "decimal" (:func:`.replay.parse_decimal`) and "fraction" an fmpq, a type a value of that type.
-
-    >>> read_fields({"a": [1, "3/4"]}, {"a": [(0, 9), _FRAC]}, "demo")
-    {'a': [1, 3/4]}
-    >>> read_fields({"a": 10}, {"a": (0, 9)}, "demo")
-    Traceback (most recent call last):
-    ...
-    ccproof.certify.verify.errors.CertificateError: demo a must lie in 0..9
-    """
-    if isinstance(spec, dict):
-        exact_keys(obj, tuple(spec), where)
-        return {k: read_fields(obj[k], s, f"{where} {k}") for k, s in spec.items()}
-    if isinstance(spec, list):
-        if not isinstance(obj, list) or len(obj) != len(spec):
-            raise CertificateError(f"{where}: a list of {len(spec)} is needed")
-        return [read_fields(x, s, where) for x, s in zip(obj, spec)]
-    if spec == _DEC:
-        return parse_decimal(obj)
-    kind = int if isinstance(spec, tuple) else str if spec == _FRAC else spec
-    if not isinstance(obj, kind) or isinstance(obj, bool):
-        raise CertificateError(f"{where} has the wrong type")
-    if isinstance(spec, tuple) and not spec[0] <= obj <= spec[1]:
-        raise CertificateError(f"{where} must lie in {spec[0]}..{spec[1]}")
-    if spec == _FRAC:
-        a, _, b = obj.partition("/")
-        if len(obj) > 40 or not (a.isdigit() and b.isdigit() and int(b) > 0):
-            raise CertificateError(f"{where}: a fraction 'INT/INT' is needed")
-        return fmpq(int(a), int(b))
-    return obj
 
 
 def read_record(cert, k0):

@@ -1,5 +1,6 @@
 """The sector matrix S of a tagged configuration from OpenSubdiv's rules, its exact spectrum and the spectral
-part of the criterion (trusted; docs/tagged_c1.md, "Configurations and rules" and "Spectrum (exact)").
+part of the criterion, a quadrant's level-1 values (the nets of a sector and of the dart family), the grammar of
+the FAMILY:>=N0 records (trusted; docs/tagged_c1.md, "Configurations and rules" and "Spectrum (exact)").
 
 Points: the centre ``("C",)``, ray r's ``("r", r, a, b)`` at RAY_POS, quadrant q's ``("q", q, a, b)`` at QUAD_POS;
 crease:N and corner:N have rays 0..N (sharp: 0 and N), dart:K rays 0..K-1 mod K (sharp: 0).
@@ -13,13 +14,17 @@ from functools import cache, lru_cache
 from flint import acb, ctx, fmpq, fmpq_mat, fmpq_poly
 
 from .errors import CertificateError
-from .rules import CENTRE, canonical, level1_rule
+from .record import exact_keys
+from .replay import parse_decimal
+from .rules import CENTRE, TWO_RING, apply, canonical, level1_rule
 
 RAY_POS, QUAD_POS = ((1, 0), (2, 0)), ((1, 1), (2, 1), (1, 2), (2, 2))
 MAX_SIZE, MAX_TAIL = 100, 10**6  # N, K at most MAX_SIZE; FAMILY:>=N0 needs N0 at most MAX_TAIL
 EXACT_BUDGET = 128**3  # work m^3 of the exact route for S of m points; the published use at most 27 points
 _NAME = re.compile(r"(dart|crease|corner):(>=)?([0-9]{1,7})")
 ONE = fmpq_poly([-1, 1])  # the factor of the eigenvalue 1
+WINDOW = (7, 8)  # the window classes of every N >= 7 occur in both
+DECIMAL, FRACTION = "decimal", "fraction"  # field kinds of :func:`read_fields`
 
 
 def parse_configuration(name):
@@ -41,6 +46,40 @@ def parse_configuration(name):
     if not lo <= n <= hi:
         raise CertificateError(f"configuration {name!r}: {fam}:{tail or ''}{v} needs {lo} <= {v} <= {hi}")
     return fam, {"min": n} if tail else n
+
+
+def read_fields(obj, spec, where):
+    """``obj`` read by ``spec``, the one record grammar of the FAMILY:>=N0 records (:data:`.dart_tail.GRAMMAR`,
+    :data:`.tagged_limit.GRAMMAR`): dicts exactly their keys, lists their length, (lo, hi) an int in range,
+    "decimal" (:func:`.replay.parse_decimal`) and "fraction" an fmpq, a type a value of that type.
+
+    >>> read_fields({"a": [1, "3/4"]}, {"a": [(0, 9), FRACTION]}, "demo")
+    {'a': [1, 3/4]}
+    >>> read_fields({"a": 10}, {"a": (0, 9)}, "demo")
+    Traceback (most recent call last):
+    ...
+    ccproof.certify.verify.errors.CertificateError: demo a must lie in 0..9
+    """
+    if isinstance(spec, dict):
+        exact_keys(obj, tuple(spec), where)
+        return {k: read_fields(obj[k], s, f"{where} {k}") for k, s in spec.items()}
+    if isinstance(spec, list):
+        if not isinstance(obj, list) or len(obj) != len(spec):
+            raise CertificateError(f"{where}: a list of {len(spec)} is needed")
+        return [read_fields(x, s, where) for x, s in zip(obj, spec)]
+    if spec == DECIMAL:
+        return parse_decimal(obj)
+    kind = int if isinstance(spec, tuple) else str if spec == FRACTION else spec
+    if not isinstance(obj, kind) or isinstance(obj, bool):
+        raise CertificateError(f"{where} has the wrong type")
+    if isinstance(spec, tuple) and not spec[0] <= obj <= spec[1]:
+        raise CertificateError(f"{where} must lie in {spec[0]}..{spec[1]}")
+    if spec == FRACTION:
+        a, _, b = obj.partition("/")
+        if len(obj) > 40 or not (a.isdigit() and b.isdigit() and int(b) > 0):
+            raise CertificateError(f"{where}: a fraction 'INT/INT' is needed")
+        return fmpq(int(a), int(b))
+    return obj
 
 
 def check_exact_budget(fam, n):
@@ -81,6 +120,28 @@ def position_key(fam, n, q, a, b):
         return ("C",)
     s = (q + delta) % n if fam == "dart" else q + delta
     return ("r", s, a2, b2) if b2 == 0 else ("q", s, a2, b2)
+
+
+def quadrant_level1(q, sharp, centre, ring, level0, zero):
+    """``value(A, B)`` (memoized): the level-1 value at position (A, B), -1 <= A, B <= 3, of quadrant q, for a
+    tagged sector and the dart family alike: ``centre`` at (0, 0), ``ring(s, pos)`` at a two-ring position of sector
+    s, ghost values across a sharp ray (``sharp(s)``), the midpoint of level-0 (1, 0), (2, 0) at (3, 0) of a sharp
+    ray, elsewhere the rule of :mod:`.rules` on the level-0 values ``level0(s, pos)`` (pos CENTRE: the centre)."""
+    @cache
+    def value(A, B):
+        if (A, B) == CENTRE:
+            return centre
+        if B == -1 and sharp(q):  # across the sharp ray q: the ghost row
+            return 2 * value(A, 0) - value(A, 1)
+        if A == -1 and sharp(q + 1):  # across the sharp ray q + 1
+            return 2 * value(0, B) - value(1, B)
+        d, A2, B2 = canonical(A, B)
+        if (A2, B2) in TWO_RING:
+            return ring(q + d, (A2, B2))
+        if B2 == 0 and sharp(q + d):  # (3, 0) on a sharp ray
+            return (level0(q + d, (1, 0)) + level0(q + d, (2, 0))) / 2
+        return apply(level1_rule(A2, B2), lambda dd, p: level0(q + d + dd, p), zero)
+    return value
 
 
 def point_index(fam, n):
@@ -153,6 +214,15 @@ def window_rows(fam, n):
         if len(rel) != len(row) or out.setdefault(key, rel) != rel:
             raise CertificateError(f"{fam}:{n}: two points of window class {key} have different rows")
     return out
+
+
+def window_classes(fam):
+    """The rows of fam:N by window class (:func:`window_rows`), one table for every N >= 7: raise unless those of
+    fam:7 and fam:8 (:data:`WINDOW`), in which every class occurs, are the same."""
+    a, b = (window_rows(fam, n) for n in WINDOW)
+    if a != b:
+        raise CertificateError(f"{fam}: the window classes of {fam}:{WINDOW[0]} and {fam}:{WINDOW[1]} differ")
+    return a
 
 
 def _window_column(p, q, n, ring):  # the column of point q in the row of point p

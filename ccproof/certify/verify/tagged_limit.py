@@ -9,22 +9,32 @@ from functools import cache
 
 from flint import acb, arb, ctx, fmpq, fmpq_mat
 
+from ccproof.rigorous.analytic import disc_boxes
+
 from .c1 import read_prec
 from .errors import CertificateError
-from .record import exact_keys, field_of
-from .replay import parse_decimal
 from .spectrum import RING_INDEX, SMALL_ROOTS, ring_block
 from .statement import lam_of
-from .tagged import crease_block, window_rows
+from .tagged import DECIMAL, WINDOW, crease_block, read_fields, window_classes
 from .tagged_c1 import G_GENERIC, check_boundary, crease_eigen_why, crease_top_why, read_z, vertex_tangents
-from .tagged_modes import bordered_solve, charpoly_roots, check_ring, check_structure, mode_reflection
+from .tagged_modes import (
+    bordered_solve,
+    charpoly_roots,
+    check_ring,
+    check_structure,
+    mode_reflection,
+    off_cut,
+)
 
-WINDOW = (7, 8)  # the window classes of every N >= 7 occur in both
 MIN_TAIL = WINDOW[0]
 MAX_ARCS = 8192  # arcs on either circle, and boxes on the disc (bounded work for a hostile file)
 # evaluations of H weighted by (prec + 1024)/1024, checked before any arithmetic: the published need 3,042, the
 # prover's widest hints (every N0 >= 7) about 21,000; at the budget a file costs about 5 s of CPU
 TAIL_BUDGET = 3 * 8192
+#: the record's fields (:func:`.tagged.read_fields`; ``prec`` by :func:`.c1.read_prec`, ``z`` by
+#: :func:`.tagged_c1.read_z`); the limit's values in this order
+GRAMMAR = {"schema": str, "configuration": str, "statement": str, "prec": int, "witness": {"z": dict},
+           "limit": {"rho": DECIMAL, "R": DECIMAL, "box": DECIMAL, "arcs": (1, MAX_ARCS), "outer_arcs": (1, MAX_ARCS)}}
 
 
 @cache
@@ -38,10 +48,7 @@ def check_windows(fam):
     """
     if fam not in ("crease", "corner"):
         raise CertificateError(f"{fam}: the interval certificate is defined for crease and corner sectors")
-    a, b = (window_rows(fam, n) for n in WINDOW)
-    if a != b:
-        raise CertificateError(f"{fam}: the window classes of {fam}:{WINDOW[0]} and {fam}:{WINDOW[1]} differ")
-    if any(sum(row.values(), fmpq(0)) != 1 for row in a.values()):
+    if any(sum(row.values(), fmpq(0)) != 1 for row in window_classes(fam).values()):
         raise CertificateError(f"{fam}: a row does not sum to 1")
     blocks = [check_structure(fam, n) for n in WINDOW]
     C = crease_block(fam, WINDOW[0])
@@ -75,9 +82,7 @@ def limit_h(theta):
     for j in (1, 2):
         w = (acb(0, j) * theta).exp()
         c = (w + 1 / w) / 2
-        if not ((1 + c) * (9 + c)).real > 0:
-            raise ZeroDivisionError("(1 + c)(9 + c) is not certainly in the right half-plane")
-        sol = bordered_solve(ring_block(w), lam_of(c), RING_INDEX[(1, 0)])
+        sol = bordered_solve(ring_block(w), lam_of(off_cut(c)), RING_INDEX[(1, 0)])
         vh = {p: sol[i] for p, i in RING_INDEX.items()}
         # the centre and ray 0: 0; ray 1: v^(b,0)(w - 1/w); quadrant 0: v^(a,b) - v^(b,a)/w
         tangents.append(vertex_tangents({(a, b): acb(0) if b == 0 else vh[(b, 0)] * (w - 1 / w) if a == 0 else
@@ -86,20 +91,16 @@ def limit_h(theta):
     return a1 * b2 - b1 * a2
 
 
-def _check_disc(R, side):
-    """The number of boxes of the grid of ``side`` that meet |theta| <= R, each proved (H analytic there), or the
-    failing box as a string."""
-    m, count = int(-(-R.p * side.q // (R.q * side.p))), 0  # m = ceil(R / side)
-    for lo in ((u * side, v * side) for u in range(-m, m) for v in range(-m, m)):
-        near = [0 if x <= 0 <= x + side else min(abs(x), abs(x + side)) for x in lo]
-        if near[0] ** 2 + near[1] ** 2 > R * R:
-            continue
+def _check_disc(R, grid):
+    """The number of boxes of the grid x grid grid on [-R, R]^2 that meet |theta| <= R (:func:`disc_boxes`), each
+    proved (H analytic there), or the failing box as a string."""
+    boxes = list(disc_boxes(R, grid))
+    for box in boxes:
         try:
-            limit_h(acb(*(arb(x).union(arb(x + side)) for x in lo)))
+            limit_h(box)
         except ZeroDivisionError:
-            return f"[{lo[0]}, {lo[0] + side}] x [{lo[1]}, {lo[1] + side}]"
-        count += 1
-    return count
+            return str(box)
+    return len(boxes)
 
 
 def _circle_bound(R, arcs):
@@ -178,23 +179,20 @@ def verify_tail(cert, fam, n0, part, log):
     """
     if not MIN_TAIL <= n0 <= 10**6:
         raise CertificateError(f"{fam}:>={n0}: the window argument needs N0 >= {MIN_TAIL}")
-    exact_keys(cert, ("schema", "configuration", "statement", "prec", "witness", "limit"), "certificate")
-    prec, w, lim = read_prec(cert), field_of(cert, "witness", dict, "certificate"), cert["limit"]
-    exact_keys(w, ("z",), "witness")
-    exact_keys(field_of(cert, "limit", dict, "certificate"), ("rho", "R", "arcs", "outer_arcs", "box"), "limit")
-    g, cval = read_z(field_of(w, "z", dict, "witness"))
-    rho, R, side = (parse_decimal(field_of(lim, k, str, "limit")) for k in ("rho", "R", "box"))
-    arcs, outer = (field_of(lim, k, int, "limit") for k in ("arcs", "outer_arcs"))
-    if not (1 <= arcs <= MAX_ARCS and 1 <= outer <= MAX_ARCS and 0 < rho < R <= 1 and 0 < side <= R
-            and (2 * R / side + 2) ** 2 <= MAX_ARCS):
-        raise CertificateError(f"limit: need 0 < rho < R <= 1, 0 < box <= R, at most {MAX_ARCS} arcs and boxes")
-    evals = arcs + outer + (2 * ((R / side).ceil())) ** 2  # at most (2 ceil(R/box))^2 boxes meet the disc
+    prec = read_prec(cert)
+    rec = read_fields(cert, GRAMMAR, "certificate")
+    g, cval = read_z(rec["witness"]["z"])
+    rho, R, side, arcs, outer = rec["limit"].values()
+    if not (0 < rho < R <= 1 and 0 < side <= R and (grid := 2 * R / side).q == 1 and grid ** 2 <= MAX_ARCS):
+        raise CertificateError(f"limit: need 0 < rho < R <= 1, 0 < box <= R, 2R/box an integer, at most {MAX_ARCS} "
+                               "boxes")
+    evals = arcs + outer + grid ** 2  # at most grid^2 boxes meet the disc
     if evals * fmpq(prec + 1024, 1024) > TAIL_BUDGET:
         raise CertificateError(f"limit: {evals} evaluations of H at {prec} bits exceed the budget "
                                f"({TAIL_BUDGET} weighted by (prec + 1024)/1024)")
     log(f"not C1 certificate for {fam}:>={n0} ({prec} bits)")
     with ctx.workprec(prec):
-        _check_tail(fam, n0, g, cval, (rho, R, side, arcs, outer), part, log)
+        _check_tail(fam, n0, g, cval, (rho, R, side, arcs, outer, int(grid.p)), part, log)
     return f"{fam}:>={n0}"
 
 
@@ -219,8 +217,8 @@ def _check_tail(fam, n0, g, cval, limit, part, log):  # parts 1-5 in order, each
          "" if ok else "the ring stencil breaks the reflection identity")
     if part.failed:  # N for every N >= n0: H analytic on |theta| <= R, bounded on its circle, winding 4 times
         return
-    rho, R, side, arcs, outer = limit
-    got = _check_disc(R, side)
+    rho, R, side, arcs, outer, grid = limit
+    got = _check_disc(R, grid)
     ok = isinstance(got, int)
     part(f"x, y and N analytic: the bordered systems of modes 1 and 2 regular on |theta| <= {R}", ok,
          f"{got} boxes of side {side}, (1 + c)(9 + c) in the right half-plane: x, y = f(pi/N), f(2 pi/N) are the "

@@ -14,12 +14,9 @@ from .errors import CertificateError
 from .maps import STAR_CURVES, curve_points, regularity_form
 from .record import exact_keys
 from .replay import check_boxes, check_partition, parse_path
-from .rules import level1_rule
-from .statement import B2Z, bspline_to_bezier
-from .tagged import point_index, position_key, sector_rows, sharp_rays
-
-PIECES = ("P1", "P2", "P3")
-_OFFSET = {"P1": (0, -1), "P2": (0, 0), "P3": (-1, 0)}  # level-1 position of B-spline net[0][0]
+from .statement import B2Z, NET_OFFSETS, bspline_to_bezier
+from .statement import PATCHES as PIECES
+from .tagged import point_index, position_key, quadrant_level1, sector_rows, sharp_rays
 
 
 def level1_values(fam, n, v):
@@ -33,26 +30,18 @@ def level1_values(fam, n, v):
     >>> [val(0, a, b) for a, b in ((3, 0), (2, 2), (1, -1))]
     [3/2, 1, 1/2]
     """
-    idx, at = point_index(fam, n)
-    sharp = sharp_rays(fam, n)
+    idx, _ = point_index(fam, n)
     rows = sector_rows(fam, n)
     one = cache(lambda i: sum((w * v[j] for j, w in rows[i].items()), 0 * v[0]))  # (S v)[i], sparse, on demand
 
-    def value(q, A, B):
-        if (A, B) == (0, 0):
-            return one(0)
-        if B == -1 and q in sharp:  # across the sharp ray q: the ghost row
-            return 2 * value(q, A, 0) - value(q, A, 1)
-        if A == -1 and ((q + 1) % n if fam == "dart" else q + 1) in sharp:  # across the sharp ray q + 1
-            return 2 * value(q, 0, B) - value(q, 1, B)
-        key = position_key(fam, n, q, A, B)
-        if key in idx:
-            return one(idx[key])
-        _, s, A2, B2 = key
-        if B2 == 0 and s in sharp:  # (3, 0) on a sharp ray: the midpoint of level-0 (1,0), (2,0)
-            return (v[idx[("r", s, 1, 0)]] + v[idx[("r", s, 2, 0)]]) / 2
-        return sum((v[j] * w for j, w in at(s, level1_rule(A2, B2)).items()), 0 * v[0])
-    return value
+    def key(s, pos):  # the index of level-0 position pos of sector s
+        if (k := position_key(fam, n, s, *pos)) not in idx:
+            raise CertificateError(f"{fam}:{n}: position {pos} of sector {s} outside the complex")
+        return idx[k]
+    sharp = (lambda s: s % n in sharp_rays(fam, n)) if fam == "dart" else (lambda s: s in sharp_rays(fam, n))
+    quadrant = cache(lambda q: quadrant_level1(q, sharp, one(0), lambda s, p: one(key(s, p)),
+                                               lambda s, p: v[key(s, p)], 0 * v[0]))
+    return lambda q, A, B: quadrant(q)(A, B)
 
 
 def quadrant_nets(fam, n, vx, vy, q, prec):
@@ -69,7 +58,7 @@ def quadrant_nets(fam, n, vx, vy, q, prec):
     out = {}
     with ctx.workprec(prec):
         for name in PIECES:
-            oa, ob = _OFFSET[name]
+            oa, ob = NET_OFFSETS[name]
             net = [[(arb(X(q, oa + i, ob + j)), arb(Y(q, oa + i, ob + j))) for j in range(4)] for i in range(4)]
             out[name] = bspline_to_bezier(net, (arb(0), arb(0)))
     return out

@@ -155,6 +155,14 @@ def mode_spectrum(fam, n):
     return out
 
 
+def off_cut(c):
+    """c, raising ZeroDivisionError where c is an acb ball whose (1 + c)(9 + c) is not certainly in the right
+    half-plane: elsewhere its principal square root, and lam(c) (:func:`.statement.lam_of`), are analytic in c."""
+    if isinstance(c, acb) and not ((1 + c) * (9 + c)).real > 0:
+        raise ZeroDivisionError("(1 + c)(9 + c) is not certainly in the right half-plane (off the branch cut)")
+    return c
+
+
 def bordered_solve(B, lam, pivot, mat=acb_mat):
     """The null vector v of B - lam with v[pivot] = 1 from the bordered system [[B - lam, e_p], [e_p^T, 0]] (v, s) =
     (0, 1) in ``mat`` (acb_mat or arb_mat); ZeroDivisionError unless arb proves it regular for every lam of the
