@@ -613,6 +613,12 @@ CCP_INLINE const double *locate(const ccp_table *T, int64_t job, int64_t vf, int
     return net;
 }
 
+/* Prefetch the positions of the ring a deep net (locate's *dp) is computed from. */
+CCP_INLINE void prefetch_ring(const ccp_table *T, const ccp_deep *d) {
+    const int32_t *rg = ring_of(T, d->job);
+    for (int64_t j = 0; j < T->vn[d->vf]; j++) CCP_PREFETCH(T->points + 3 * (int64_t)rg[j]);
+}
+
 /* Points per block: the first pass locates them (and prefetches their nets), the second evaluates them. */
 #define CCP_BLOCK 32
 
@@ -636,6 +642,10 @@ CCP_INLINE int64_t run(const ccp_table *T, int64_t n, const int64_t *ix, const i
     int64_t *slot[CCP_BLOCK];
     int64_t key[CCP_BLOCK];
     int64_t bad = -1, k = 0, block = base != NULL ? base[0] : 0;
+    /* the rings of deep nets prefetched once their slots show them missing: where the table keeps the layer-0
+     * corner nets, deep nets are those of the few corner faces' deeper layers, which the cache mostly holds; else
+     * (every corner net deep, few found) with the slots, in pass 1 */
+    const int late = base != NULL && T->n_layer_nets > 0;
     while (k < n && bad < 0) {
         int64_t k0 = k;
         int m = 0;
@@ -678,8 +688,7 @@ CCP_INLINE int64_t run(const ccp_table *T, int64_t n, const int64_t *ix, const i
             DL[nd] = i;
             nd += net == CCP_DEEP;
             if (net == CCP_DEEP) {
-                const int32_t *rg = ring_of(T, dp[i].job); /* the ring's positions, read in pass 2 */
-                for (int64_t j = 0; j < T->vn[dp[i].vf]; j++) CCP_PREFETCH(T->points + 3 * (int64_t)rg[j]);
+                if (base == NULL || late == 0) prefetch_ring(T, dp + i); /* (computed in pass 2, or likely to be) */
                 if (base == NULL) continue;
                 key[i] = dp[i].cfg < 0 ? 3 * T->max_layers * T->n_corner + dp[i].ci
                                        : 3 * (T->max_layers * dp[i].ci + dp[i].lay) + dp[i].code;
@@ -689,6 +698,9 @@ CCP_INLINE int64_t run(const ccp_table *T, int64_t n, const int64_t *ix, const i
             for (int j = 0; j < CCP_NET; j += 8) CCP_PREFETCH(net + j);
             CCP_PREFETCH(net + CCP_NET + 4);
         }
+        if (late) /* the rings of the deep nets not in the cache (their slots' tags, prefetched above) */
+            for (int jd = 0; jd < nd; jd++)
+                if (slot[DL[jd]][0] != key[DL[jd]] + 1) prefetch_ring(T, dp + DL[jd]);
         /* pass 2: the deep corner nets (found in the cache, or computed; only the points of DL, without a
          * branch per point on whether a net is deep), then the bicubics in order; a slot taken by an
          * earlier point of this block and wanted by another net: the points before are evaluated first */
