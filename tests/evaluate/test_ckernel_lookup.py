@@ -8,6 +8,7 @@ levels deep; and the layer-0 nets the kernel computes equal the table's own (com
 
 from __future__ import annotations
 
+import mmap
 from pathlib import Path
 
 import numpy as np
@@ -184,6 +185,27 @@ def test_grid_in_32_and_64_bits(surface):
     if vf.max() >= 2:
         assert lib.ccp_grid(ct.ref, g64.ctypes.data, 0, 1) == -1
     assert lib.ccp_grid(ct.ref, g64.ctypes.data, 0, 32) == -1
+
+
+def test_arrays_on_mappings_of_their_own_give_the_same_bits(surface, monkeypatch):
+    """With every array the binding fills on an anonymous mapping of its own (``fresh`` from 0 bytes: the kept
+    nets, the layer nets, the grid), the kernel gives the numpy bits."""
+    from ccproof.evaluate import _ckernel
+
+    monkeypatch.setattr(_ckernel, "FRESH_MIN", 0)
+    T = surface._table
+    ct = _ckernel.CTable(T._replace(nets=T.nets[:0], hot=T.hot[:0]), layers=3, grid=True)
+    for name in ("nets", "hot", "grid"):
+        base = ct._keep[name]
+        while isinstance(base, (np.ndarray, memoryview)):
+            base = base.obj if isinstance(base, memoryview) else base.base
+        assert isinstance(base, mmap.mmap), name
+    f, u, v = _points(surface, 3000, 9)
+    ref = surface.evaluate(f, u, v, 1, backend="numpy")
+    outs = [np.full((f.size, 3), np.nan) for _ in range(3)] + [None] * 3
+    assert _ckernel.evaluate_block(_ckernel.load(), ct, f, u, v, 1, outs) == -1
+    for key, o in zip(_KEYS, outs[:3]):
+        assert np.array_equal(ref[key].view(np.int64), o.view(np.int64)), key
 
 
 def test_a_tree_deeper_than_the_walk_falls_back_to_the_cache():
