@@ -151,20 +151,67 @@ class _Pinned:
         os.sched_setaffinity(0, self.before)
 
 
-def interleaved(cases, rounds):
+def interleaved(cases, rounds, cpu=None):
     """Run every case once per round, in turn, ``rounds`` times; seconds per case and round, and the
-    1-minute load before each round."""
+    1-minute load before each round. ``cpu`` (a dict): also the CPU seconds of this thread per case and round
+    (the cases run on the calling thread: on a loaded machine the time it was not scheduled is left out)."""
     times = {name: [] for name in cases}
+    if cpu is not None:
+        cpu.update({name: [] for name in cases})
     load = []
     for r in range(rounds):
         load.append(_loadavg())
         names = list(cases)
         names = names[r % len(names):] + names[:r % len(names)]  # rotate who goes first
         for name in names:
-            w0 = time.perf_counter()
+            c0, w0 = time.thread_time(), time.perf_counter()
             cases[name]()
             times[name].append(time.perf_counter() - w0)
+            if cpu is not None:
+                cpu[name].append(time.thread_time() - c0)
     return times, load
+
+
+def chase_latency(lib, mib=256, steps=2_000_000):
+    """Seconds per dependent load of a random cycle through ``mib`` MiB (one miss each once it outgrows the
+    caches): ``chase`` of bench_ideal.c."""
+    import ctypes
+
+    lib.chase.argtypes = [ctypes.c_int64, ctypes.c_void_p]
+    lib.chase.restype = ctypes.c_int64
+    n = (mib << 20) // 8
+    order = np.random.default_rng(7).permutation(n)
+    nxt = np.empty(n, dtype=np.int64)
+    nxt[order] = np.roll(order, -1)  # one cycle through every entry
+    lib.chase(min(steps, n), nxt.ctypes.data)  # warm the page tables
+    w0 = time.perf_counter()
+    lib.chase(steps, nxt.ctypes.data)
+    return (time.perf_counter() - w0) / steps
+
+
+def gather_case(lib, n_faces, f, s, t):
+    """A callable running ``ideal_gather`` (bench_ideal.c) on the points (f, s, t) with a table of one random
+    net per ptex face, and the table's bytes: the latency bound of a table that stores every net."""
+    import ctypes
+
+    lib.ideal_gather.argtypes = [ctypes.c_int64] + [ctypes.c_void_p] * 7
+    lib.ideal_gather.restype = None
+    nets = np.random.default_rng(3).random((n_faces, 48))
+    f, s, t = (np.ascontiguousarray(a) for a in (np.asarray(f, dtype=np.int64), s, t))
+    out = [np.empty((f.size, 3)) for _ in range(3)]
+    keep = (f, s, t, nets, *out)  # alive as long as the callable (it passes their addresses)
+    return lambda: lib.ideal_gather(f.size, *(a.ctypes.data for a in keep)), nets.nbytes
+
+
+def roofline_line(rate, compute, memory, gather=None, table=0, latency_s=float("nan")):
+    """One line: the median rate ``rate`` (points/s) against the compute, bandwidth and (``gather``: the median
+    rate of :func:`gather_case` on the same points, its table ``table`` bytes) latency bounds."""
+    line = (f"roofline: ours {rate / 1e6:.2f} M points/s = {rate / compute:.1%} of compute, {rate / memory:.1%} of "
+            "bandwidth")
+    if gather:
+        line += (f", {rate / gather:.2f}x the latency bound ({gather / 1e6:.2f} M points/s gathering one net per face "
+                 f"from {table / 2**20:.1f} MiB; one dependent miss {latency_s * 1e9:.0f} ns)")
+    return line
 
 
 def _ideal_lib():
@@ -267,6 +314,28 @@ def _ideal_numba():
     return ideal
 
 
+def _print_rates(n, times, cpu, bounds, default, gather, table):
+    """The lines of one case of :func:`osd_side_by_side`: per implementation its rate and its ratio to Far, round
+    by round, in wall-clock and in CPU time (the pinned thread's: the time other processes took the CPU left out),
+    and the roofline line of ``default`` (``bounds``: compute and bandwidth in points/s, a dependent miss in s).
+    Returns the per-round ratios to Far, wall-clock and CPU time."""
+    compute, memory, latency_s = bounds
+    rate = {k: n / np.asarray(v) for k, v in times.items()}
+    ratio = {k: rate[k] / rate["far"] for k in rate}  # per round: the same round's Far
+    for k in rate:
+        lo, md, hi = _stats(rate[k])
+        rlo, rmd, rhi = _stats(ratio[k])
+        b = f"; {md / compute:5.1%} of compute bound, {md / memory:5.1%} of memory bound" if compute else ""
+        print(f"      {k:6s} {md / 1e6:6.2f} M points/s (min {lo / 1e6:.2f}, max {hi / 1e6:.2f}); "
+              f"/ far: median {rmd:.2f} ({rlo:.2f}-{rhi:.2f}){b}")
+    cpu_ratio = {k: np.asarray(cpu["far"]) / np.asarray(cpu[k]) for k in cpu if k != "far"}
+    print("      in CPU time / far, median (min-max): " + ", ".join(
+        f"{k} {np.median(r):.2f} ({r.min():.2f}-{r.max():.2f})" for k, r in cpu_ratio.items()))
+    if compute:
+        print("      " + roofline_line(float(np.median(rate[default])), compute, memory, gather, table, latency_s))
+    return ratio, cpu_ratio
+
+
 def _stats(x):
     x = np.asarray(x, dtype=float)
     return float(x.min()), float(np.median(x)), float(x.max())
@@ -288,9 +357,11 @@ def osd_side_by_side(n, rng, quick=False, rounds=7):
     threads = len(os.sched_getaffinity(0))
     rounds = 2 if quick else rounds
     compute, memory, bw = hardware_bounds(quick)
+    ideal_lib = _ideal_lib()
+    latency_s = chase_latency(ideal_lib, 32 if quick else 256) if ideal_lib is not None else float("nan")
     print(f"   this machine, one thread: ideal compiled work {compute / 1e6:.1f} M points/s (compute bound); "
           f"read bandwidth {bw / 2**30:.1f} GiB/s / {BYTES_PER_POINT} B = {memory / 1e6:.1f} M points/s "
-          f"(memory bound)")
+          f"(memory bound); one dependent miss {latency_s * 1e9:.0f} ns")
     default = available_backends()[0]  # what evaluate uses without backend=
     print(f"   backends: {', '.join(available_backends())} (default {default})")
     rows = []
@@ -327,12 +398,16 @@ def osd_side_by_side(n, rng, quick=False, rounds=7):
                 cases["numba"] = lambda: ours("numba", 1, "numba")
             if "c" in available_backends():
                 cases["c"] = lambda: ours("c", 1, "c")
+            table = 0
+            if ideal_lib is not None:
+                cases["gather"], table = gather_case(ideal_lib, mesh.n_faces, f, s, t)
             for c in cases.values():  # warm up (compile)
                 c()
+            cpu = {}
             with _Pinned():
-                times, load = interleaved(cases, rounds)
-            rate = {k: n / np.asarray(v) for k, v in times.items()}
-            ratio = {k: rate[k] / rate["far"] for k in rate}  # per round: the same round's Far
+                times, load = interleaved(cases, rounds, cpu)
+            gather = float(np.median(n / np.asarray(times.pop("gather")))) if "gather" in times else None
+            cpu.pop("gather", None)
             oP = outs["far"][0]
             P = outs[default][0]
             dP = np.abs(P - oP).max() / diag
@@ -341,14 +416,7 @@ def osd_side_by_side(n, rng, quick=False, rounds=7):
             extra = f", {npairs} extraordinary corners" if dist != "uniform" else ""
             print(f"   {label}, {dist} ({n:,} points{extra}); load {min(load):.2f}-{max(load):.2f}; "
                   f"{rounds} rounds, one pinned CPU")
-            for k in rate:
-                lo, md, hi = _stats(rate[k])
-                rlo, rmd, rhi = _stats(ratio[k])
-                bounds = ""
-                if compute:
-                    bounds = f"; {md / compute:5.1%} of compute bound, {md / memory:5.1%} of memory bound"
-                print(f"      {k:6s} {md / 1e6:6.2f} M points/s (min {lo / 1e6:.2f}, max {hi / 1e6:.2f}); "
-                      f"/ far: median {rmd:.2f} ({rlo:.2f}-{rhi:.2f}){bounds}")
+            ratio, cpu_ratio = _print_rates(n, times, cpu, (compute, memory, latency_s), default, gather, table)
             two = None
             if default != "numpy" and threads > 1:
                 two = two_threads(lambda th: ours(default, th, default), f, s, t, threads, 2 * rounds + 1)
@@ -356,7 +424,8 @@ def osd_side_by_side(n, rng, quick=False, rounds=7):
             print(f"      max |P ours - P far| / diagonal {dP:.1e} (median over points {med_dP:.1e}); "
                   f"bfr (approximation level 10) vs far {dB:.1e}; Far's Gregory end caps at extraordinary "
                   f"vertices are approximations")
-            rows.append((label, dist, {k: _stats(ratio[k]) for k in rate}, two, load))
+            rows.append((label, dist, {k: _stats(r) for k, r in ratio.items()}, two, load,
+                         {k: _stats(r) for k, r in cpu_ratio.items()}))
         far.close()
         bfr.close()
     return rows
@@ -981,11 +1050,13 @@ def main(argv=None):
         print(f"   {be}: {rates[be][1] / 1e6:.2f} M points/s (P + first derivatives, single thread, CPU time)")
     if osd:
         print("   / OpenSubdiv Far, one pinned CPU, median over rounds (min-max):")
-        for label, dist, ratios, two, load in osd:
+        for label, dist, ratios, two, load, cpu in osd:
             parts = ", ".join(f"{k} {md:.2f} ({lo:.2f}-{hi:.2f})" for k, (lo, md, hi) in ratios.items() if k != "far")
             tt = (f"; 2 threads / 1: {two['ours']['speedup'][1]:.2f} (ceiling {two['ceiling']['speedup'][1]:.2f})"
                   if two else "")
-            print(f"      {label:15s} {dist:9s} {parts}{tt}; load {min(load):.2f}-{max(load):.2f}")
+            c = cpu.get(available_backends()[0])
+            tc = f"; in CPU time {c[1]:.2f} ({c[0]:.2f}-{c[2]:.2f})" if c else ""
+            print(f"      {label:15s} {dist:9s} {parts}{tt}{tc}; load {min(load):.2f}-{max(load):.2f}")
     return 0
 
 

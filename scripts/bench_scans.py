@@ -32,7 +32,6 @@ measured alone.
 from __future__ import annotations
 
 import argparse
-import ctypes
 import sys
 import tempfile
 import time
@@ -42,39 +41,21 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _bench import missing, ratio_line  # noqa: E402
-from bench_evaluate import _ideal_lib, _Pinned, hardware_bounds, interleaved, uniform_points  # noqa: E402
+from bench_evaluate import (  # noqa: E402
+    _ideal_lib,
+    _Pinned,
+    chase_latency,
+    gather_case,
+    hardware_bounds,
+    interleaved,
+    roofline_line,
+    uniform_points,
+)
 from bench_memory import icosphere, write_obj  # noqa: E402
 
 from ccproof.evaluate import available_backends  # noqa: E402
 from ccproof.evaluate import natural_limit_surface as limit_surface  # noqa: E402
 from ccproof.mesh import read_mesh  # noqa: E402
-
-
-def chase_latency(lib, mib=256, steps=2_000_000):
-    """Seconds per dependent load of a random cycle through ``mib`` MiB (one miss each once it outgrows the
-    caches): ``chase`` of bench_ideal.c."""
-    lib.chase.argtypes = [ctypes.c_int64, ctypes.c_void_p]
-    lib.chase.restype = ctypes.c_int64
-    n = (mib << 20) // 8
-    order = np.random.default_rng(7).permutation(n)
-    nxt = np.empty(n, dtype=np.int64)
-    nxt[order] = np.roll(order, -1)  # one cycle through every entry
-    lib.chase(min(steps, n), nxt.ctypes.data)  # warm the page tables
-    w0 = time.perf_counter()
-    lib.chase(steps, nxt.ctypes.data)
-    return (time.perf_counter() - w0) / steps
-
-
-def gather_case(lib, n_faces, f, s, t):
-    """A callable running ``ideal_gather`` (bench_ideal.c) on the points (f, s, t) with a table of one random
-    net per ptex face."""
-    lib.ideal_gather.argtypes = [ctypes.c_int64] + [ctypes.c_void_p] * 7
-    lib.ideal_gather.restype = None
-    nets = np.random.default_rng(3).random((n_faces, 48))
-    f = np.ascontiguousarray(f, dtype=np.int64)
-    out = [np.empty((f.size, 3)) for _ in range(3)]
-    keep = (f, s, t, nets, *out)  # alive as long as the callable (it passes their addresses)
-    return lambda: lib.ideal_gather(f.size, *(a.ctypes.data for a in keep)), nets.nbytes
 
 
 def scan_mesh(level, folder):
@@ -121,28 +102,25 @@ def one_mesh(level, n, rounds, far_max, bounds, folder):
     for k, e in ev.items():
         o = tuple(np.empty((n, 3)) for _ in range(3))
         cases[k] = lambda e=e, o=o: e.evaluate(f, s, t, out=o)
-    lib = _ideal_lib()
+    lib, table = _ideal_lib(), 0
     if lib is not None:
         cases["gather"], table = gather_case(lib, S.n_faces, f, s, t)
     for c in cases.values():
         c()
+    cpu = {}
     with _Pinned():
-        times, load = interleaved(cases, rounds)
+        times, load = interleaved(cases, rounds, cpu)
     rate = {k: n / np.asarray(v) for k, v in times.items()}
     for k in ev:
         print(ratio_line(f"   ours ({be}) / {k}, {n:,} points, one pinned CPU:", rate["ours"] / rate[k], load))
+        print(ratio_line(f"   the same in CPU time (other processes' time left out), ours / {k}:",
+                         np.asarray(cpu[k]) / np.asarray(cpu["ours"]), load))
     if "bfr" in ev:
         dP = np.abs(ev["bfr"].evaluate(f[:1000], s[:1000], t[:1000])[0] - out["P"][:1000]).max()
         print(f"   max |P ours - P bfr| on 1,000 points: {dP:.1e} (Bfr approximates at extraordinary vertices)")
-    md = float(np.median(rate["ours"]))
     compute, memory, latency_s = bounds
-    line = (f"   roofline: ours {md / 1e6:.2f} M points/s = {md / compute:.1%} of compute, {md / memory:.1%} of "
-            "bandwidth")
-    if "gather" in rate:
-        g = float(np.median(rate["gather"]))
-        line += (f", {md / g:.2f}x the latency bound ({g / 1e6:.2f} M points/s gathering one net per face from "
-                 f"{table / 2**20:.1f} MiB; one dependent miss {latency_s * 1e9:.0f} ns)")
-    print(line)
+    gather = float(np.median(rate["gather"])) if "gather" in rate else None
+    print("   " + roofline_line(float(np.median(rate["ours"])), compute, memory, gather, table, latency_s))
     for e in ev.values():
         e.close()
     return rate["ours"] / rate["bfr"] if "bfr" in rate else None

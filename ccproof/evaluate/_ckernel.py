@@ -29,11 +29,14 @@ _I = ctypes.c_int64
 _LAYER_NETS = 4
 #: layers of a corner face with composed operators (CCP_COMPOSED in _clib.c)
 _COMPOSED = 2
+#: the kinds of virtual face whose nets ``ccp_nets`` computes (CCP_REGULAR, CCP_CORNER in _clib.c)
+_REGULAR, _CORNER = 0, 1
 #: the bytes the precomputed corner nets of layers 1, 2, ... may take together (layer 0 is the table's own
 #: ``hot``): a point in layer n of a corner face reads its net there instead of the kernel's corner-net cache
 LAYER_NETS_BUDGET = 4 << 20
-#: the largest grid of cells (``ccp_grid``: 128 bytes per ptex face) the binding makes
-GRID_BUDGET = 32 << 20
+#: the largest grid of cells the binding makes (``ccp_grid``: 64 bytes per ptex face where a job and a virtual face fit
+#: 32 bits together, else 128): 983,040 ptex faces (327,680 triangles) in 60 MiB
+GRID_BUDGET = 64 << 20
 #: the bytes of the nets the binding computes where the table keeps none, by the kernel's own sums: the regular
 #: nets first (408 bytes per regular patch: a ptex face of a triangle scan has two, and they serve half its area),
 #: then layer 0 of the corner faces (1,224 bytes per corner face, a face of a scan has two: 3/8 of its area) in
@@ -53,14 +56,15 @@ class _Table(ctypes.Structure):
                 ("max_layers", _I), ("n_corner", _I), ("n_nets", _I), ("nets", _P), ("ops", _P),
                 ("op_start", _P), ("op_size", _P), ("n_layers", _P), ("unit", _P), ("hot", _P), ("n_hot", _I),
                 ("cor_ring", _P), ("ring", _P),
-                ("layer_nets", _P * _LAYER_NETS), ("n_layer_nets", _I), ("grid", _P), ("inv_h", _P),
+                ("layer_nets", _P * _LAYER_NETS), ("n_layer_nets", _I), ("grid", _P), ("grid_wide", _I),
+                ("grid_shift", _I), ("inv_h", _P),
                 ("inv_unit", _P)]
 
 
 _LIB = None
 _TRIED = False
 #: the version of the kernel's interface (``ccp_abi`` in _clib.c)
-_ABI = 7
+_ABI = 8
 #: calls on fewer points use no corner-net cache (CCP_CACHE_MIN in _clib.c)
 _CACHE_MIN = 256
 
@@ -95,19 +99,42 @@ def load():
         lib.ccp_evaluate_at.argtypes = [ctypes.POINTER(_Table), _I, _P, _P, _P, _P, _I, _P, _P, _P, _P, _P, _P, _P]
         lib.ccp_cache_words.restype = _I
         lib.ccp_cache_words.argtypes = []
-        lib.ccp_corner_nets.restype = _I
-        lib.ccp_corner_nets.argtypes = [ctypes.POINTER(_Table), _I, _I, _P]
+        lib.ccp_nets.restype = _I
+        lib.ccp_nets.argtypes = [ctypes.POINTER(_Table), _I, _I, _I, _P]
         lib.ccp_face_order.restype = _I
         lib.ccp_face_order.argtypes = [_I, _P, _I, _I, _P, _P]
-        lib.ccp_regular_nets.restype = _I
-        lib.ccp_regular_nets.argtypes = [ctypes.POINTER(_Table), _I, _P]
         lib.ccp_grid.restype = _I
-        lib.ccp_grid.argtypes = [ctypes.POINTER(_Table), _P]
+        lib.ccp_grid.argtypes = [ctypes.POINTER(_Table), _P, _I, _I]
         lib.ccp_ring_walks.restype = _I
         lib.ccp_ring_walks.argtypes = [_P] * 6 + [_I, _P, _P, _P, _I, _P, _P, _I, _P, _P]
         _LIB = lib
         break
     return _LIB
+
+
+#: arrays of at least this many bytes that the binding fills (the kept nets, the grid) get memory of their own
+#: (:func:`fresh`)
+FRESH_MIN = 64 << 20
+
+
+def fresh(shape, dtype=np.float64):
+    """An array to fill once: ``np.empty``, or from :data:`FRESH_MIN` bytes on an anonymous mapping of its own.
+
+    numpy advises the system to back large allocations with huge pages (``MADV_HUGEPAGE``); where transparent huge
+    pages compact memory on demand for such advice (``defrag`` ``madvise``, as on the machine these figures come
+    from) and find none, every first write stalls: filling the 800 MB of regular nets of 327,680 triangles took the
+    first evaluation 8.4 s instead of 1.5 s, with no huge page obtained either way (``AnonHugePages`` 0). A mapping
+    without that advice is faulted in small pages (in huge pages where the system gives them to every mapping).
+
+    >>> a = fresh((4, 3)); a.shape, a.dtype.name, a.flags.writeable
+    ((4, 3), 'float64', True)
+    """
+    n = int(np.prod(shape)) * np.dtype(dtype).itemsize
+    if n < FRESH_MIN:
+        return np.empty(shape, dtype=dtype)
+    import mmap
+
+    return np.frombuffer(mmap.mmap(-1, n), dtype=dtype).reshape(shape)
 
 
 def _addr(a):
@@ -139,11 +166,12 @@ class CTable:
     table : PatchTable
     layers : int, optional
         Layers of corner nets to keep precomputed, 1 to 4 (layer 0 is the table's ``hot``; the others are
-        computed here by the kernel's own sums, ``ccp_corner_nets``). Default: 3, fewer where they would
+        computed here by the kernel's own sums, ``ccp_nets``). Default: 3, fewer where they would
         exceed :data:`LAYER_NETS_BUDGET`; none where the table has no ``hot``.
     grid : bool, optional
         Make the grid of 4 x 4 cells per ptex face (``ccp_grid``: a point's job and virtual face in one
-        read). Default: where it takes at most :data:`GRID_BUDGET` bytes. None is made (whatever ``grid``
+        read, uint32 where the numbers of both fit 32 bits, else int64). Default: where it takes at most
+        :data:`GRID_BUDGET` bytes. None is made (whatever ``grid``
         says) where a job's face does not hold whole cells.
     reciprocals : bool, optional
         Store the reciprocals of the sides (1 / h per virtual face, of the corner patches' unit sides) so that
@@ -217,8 +245,8 @@ class CTable:
             nets = [keep["hot"]]
             lib = load()
             for lay in range(1, n) if "layer_nets" not in derived else ():
-                w = np.empty_like(keep["hot"])
-                if lib.ccp_corner_nets(self.ref, T.job_root.shape[0], lay, _addr(w)) != 0:
+                w = fresh(keep["hot"].shape)
+                if lib.ccp_nets(self.ref, T.job_root.shape[0], _CORNER, lay, _addr(w)) != 0:
                     break  # a tree of virtual faces deeper than the walk's stack: the cache serves these layers
                 nets.append(w)
             nets = derived.get("layer_nets", nets)
@@ -226,16 +254,7 @@ class CTable:
             keep["layer_nets"] = nets
             s.layer_nets = (_P * _LAYER_NETS)(*[_addr(a) for a in nets])
             s.n_layer_nets = n
-        n_ptex = T.refused.shape[0]
-        if "grid" in derived:
-            keep["grid"] = derived["grid"]
-            s.grid = _addr(derived["grid"])
-        elif ("grid_none" not in derived
-              and (grid if grid is not None else (0 < n_ptex and 128 * n_ptex <= GRID_BUDGET))):
-            g = np.empty(16 * n_ptex, dtype=np.int64)
-            if load().ccp_grid(self.ref, _addr(g)) == 0:
-                keep["grid"] = g
-                s.grid = _addr(g)
+        self._make_grid(grid, derived)
         sides = T.unit[:, :, 2].reshape(-1)
         if reciprocals if reciprocals is not None else (_powers_of_two(T.h) and _powers_of_two(sides)):
             if not (_powers_of_two(T.h) and _powers_of_two(sides)):
@@ -245,9 +264,29 @@ class CTable:
         self._caches = []  # corner-net caches not in use (one per concurrent call, kept between calls)
         self._lock = threading.Lock()
 
+    def _make_grid(self, grid, derived):
+        """The grid of cells (``ccp_grid``) where ``grid`` asks for it (None: within :data:`GRID_BUDGET`), or
+        ``derived``'s; its entries ``job << shift | virtual face``, shift the bits of the largest virtual face:
+        uint32 where the largest job fits the bits left, else int64."""
+        T, s = self.table, self.struct
+        n_ptex = T.refused.shape[0]
+        shift = max(1, int(T.kind.shape[0] - 1).bit_length())
+        wide = int(shift + max(1, int(T.job_root.shape[0] - 1).bit_length()) > 32)
+        if "grid" in derived:
+            g = derived["grid"]
+        elif "grid_none" in derived or not (grid if grid is not None
+                                            else 0 < n_ptex and 64 * (1 + wide) * n_ptex <= GRID_BUDGET):
+            return
+        else:
+            g = fresh(16 * n_ptex, dtype=np.int64 if wide else np.uint32)
+            if load().ccp_grid(self.ref, _addr(g), wide, shift) != 0:
+                return
+        self._keep["grid"] = g
+        s.grid, s.grid_wide, s.grid_shift = _addr(g), int(g.dtype == np.int64), shift
+
     def _kept_nets(self, derived):
         """The regular nets and the layer-0 corner nets the table does not keep, computed here by the kernel's
-        own sums (``ccp_regular_nets``, ``ccp_corner_nets``: the same bits as when evaluated) where they fit
+        own sums (``ccp_nets``: the same bits as when evaluated) where they fit
         :data:`KEPT_NETS_BUDGET` (or ``derived``'s, as a pickled CTable computed them)."""
         T, s, keep, lib = self.table, self.struct, self._keep, load()
         n_jobs = T.job_root.shape[0]
@@ -256,8 +295,8 @@ class CTable:
             w = derived.get("nets")
             if (w is None or w.shape[0] != T.n_regular) and \
                     T.n_regular * 408 <= budget("CCPROOF_NETS_BUDGET", KEPT_NETS_BUDGET):
-                w = np.empty((T.n_regular, 17, 3))
-                if lib.ccp_regular_nets(self.ref, n_jobs, _addr(w)) != 0:
+                w = fresh((T.n_regular, 17, 3))
+                if lib.ccp_nets(self.ref, n_jobs, _REGULAR, 0, _addr(w)) != 0:
                     w = None  # a tree deeper than the walk's stack: computed when evaluated
             if w is not None and w.shape[0] == T.n_regular:
                 keep["nets"] = w
@@ -266,8 +305,8 @@ class CTable:
         if s.n_hot == 0 and T.n_corner:
             w = derived["layer_nets"][0] if "layer_nets" in derived else None
             if w is None and 3 * T.n_corner * 408 <= budget("CCPROOF_HOT_BUDGET", left):
-                w = np.empty((3 * T.n_corner, 17, 3))
-                if lib.ccp_corner_nets(self.ref, n_jobs, 0, _addr(w)) != 0:
+                w = fresh((3 * T.n_corner, 17, 3))
+                if lib.ccp_nets(self.ref, n_jobs, _CORNER, 0, _addr(w)) != 0:
                     w = None
             if w is not None:
                 keep["hot"] = w

@@ -42,7 +42,6 @@
 #define CCP_NET 51 /* 17 x 3 doubles: 16 net rows relative to row 16, the origin */
 #define CCP_LAYER_NETS 4 /* most layers of corner nets kept precomputed */
 #define CCP_COMPOSED 2   /* layers of a corner face with composed operators (_table.COMPOSED_LAYERS) */
-#define CCP_VF_BITS 24 /* bits of the virtual face in a grid cell */
 
 #if defined(__GNUC__)
 #define CCP_INLINE static inline __attribute__((always_inline))
@@ -90,12 +89,13 @@ typedef struct {
     const int64_t *cor_ring; /* NULL, or per corner face the row of its kept ring in ``ring`` (-1: none) */
     const double *ring;
     /* the nets of layers 0 .. n_layer_nets - 1 of every corner face, per layer 3 n_corner x 17 x 3 (layer 0:
-     * ``hot``; the others filled by ccp_corner_nets when the binding makes the table) */
+     * ``hot``; the others filled by ccp_nets when the binding makes the table) */
     const double *layer_nets[CCP_LAYER_NETS];
     int64_t n_layer_nets;
-    /* NULL, or per ptex face its 4 x 4 cells (row (v) major): job << CCP_VF_BITS | the virtual face that holds
-     * the cell (ccp_grid) */
-    const int64_t *grid;
+    /* NULL, or per ptex face its 4 x 4 cells (row (v) major): job << grid_shift | the virtual face that holds
+     * the cell (ccp_grid), uint32 or (grid_wide) int64 */
+    const void *grid;
+    int64_t grid_wide, grid_shift;
     /* NULL, or 1 / h per virtual face and 1 / (the patch side of ``unit``) per configuration and code (3 per
      * configuration), where every side is a power of two (the binding checks): then dividing by a side is
      * multiplying by its reciprocal, bit for bit (both the exact quotient, rounded once) */
@@ -464,10 +464,10 @@ CCP_INLINE int find_face(const ccp_table *T, int64_t pf, double uu, double ww, i
     int64_t q, job, vf;
     int kind;
     if (T->grid != NULL) { /* the cell's job and virtual face in one read, then the splits finer than the cell */
-        int64_t e = T->grid[16 * pf + 4 * ((ww >= 0.25) + (ww >= 0.5) + (ww >= 0.75)) + (uu >= 0.25) + (uu >= 0.5) +
-                            (uu >= 0.75)];
-        job = e >> CCP_VF_BITS;
-        vf = e & ((1 << CCP_VF_BITS) - 1);
+        int64_t i = 16 * pf + 4 * ((ww >= 0.25) + (ww >= 0.5) + (ww >= 0.75)) + (uu >= 0.25) + (uu >= 0.5) + (uu >= 0.75);
+        int64_t e = T->grid_wide ? ((const int64_t *)T->grid)[i] : (int64_t)((const uint32_t *)T->grid)[i];
+        job = e >> T->grid_shift;
+        vf = e & (((int64_t)1 << T->grid_shift) - 1);
         kind = T->kind[vf];
         for (int64_t it = 0; it < T->split_depth && kind == CCP_SPLIT; it++) {
             double half = T->h[vf] * 0.5;
@@ -613,6 +613,12 @@ CCP_INLINE const double *locate(const ccp_table *T, int64_t job, int64_t vf, int
     return net;
 }
 
+/* Prefetch the positions of the ring a deep net (locate's *dp) is computed from. */
+CCP_INLINE void prefetch_ring(const ccp_table *T, const ccp_deep *d) {
+    const int32_t *rg = ring_of(T, d->job);
+    for (int64_t j = 0; j < T->vn[d->vf]; j++) CCP_PREFETCH(T->points + 3 * (int64_t)rg[j]);
+}
+
 /* Points per block: the first pass locates them (and prefetches their nets), the second evaluates them. */
 #define CCP_BLOCK 32
 
@@ -636,6 +642,10 @@ CCP_INLINE int64_t run(const ccp_table *T, int64_t n, const int64_t *ix, const i
     int64_t *slot[CCP_BLOCK];
     int64_t key[CCP_BLOCK];
     int64_t bad = -1, k = 0, block = base != NULL ? base[0] : 0;
+    /* the rings of deep nets prefetched once their slots show them missing: where the table keeps the layer-0
+     * corner nets, deep nets are those of the few corner faces' deeper layers, which the cache mostly holds; else
+     * (every corner net deep, few found) with the slots, in pass 1 */
+    const int late = base != NULL && T->n_layer_nets > 0;
     while (k < n && bad < 0) {
         int64_t k0 = k;
         int m = 0;
@@ -678,8 +688,7 @@ CCP_INLINE int64_t run(const ccp_table *T, int64_t n, const int64_t *ix, const i
             DL[nd] = i;
             nd += net == CCP_DEEP;
             if (net == CCP_DEEP) {
-                const int32_t *rg = ring_of(T, dp[i].job); /* the ring's positions, read in pass 2 */
-                for (int64_t j = 0; j < T->vn[dp[i].vf]; j++) CCP_PREFETCH(T->points + 3 * (int64_t)rg[j]);
+                if (base == NULL || late == 0) prefetch_ring(T, dp + i); /* (computed in pass 2, or likely to be) */
                 if (base == NULL) continue;
                 key[i] = dp[i].cfg < 0 ? 3 * T->max_layers * T->n_corner + dp[i].ci
                                        : 3 * (T->max_layers * dp[i].ci + dp[i].lay) + dp[i].code;
@@ -689,6 +698,9 @@ CCP_INLINE int64_t run(const ccp_table *T, int64_t n, const int64_t *ix, const i
             for (int j = 0; j < CCP_NET; j += 8) CCP_PREFETCH(net + j);
             CCP_PREFETCH(net + CCP_NET + 4);
         }
+        if (late) /* the rings of the deep nets not in the cache (their slots' tags, prefetched above) */
+            for (int jd = 0; jd < nd; jd++)
+                if (slot[DL[jd]][0] != key[DL[jd]] + 1) prefetch_ring(T, dp + DL[jd]);
         /* pass 2: the deep corner nets (found in the cache, or computed; only the points of DL, without a
          * branch per point on whether a net is deep), then the bicubics in order; a slot taken by an
          * earlier point of this block and wanted by another net: the points before are evaluated first */
@@ -766,11 +778,15 @@ int64_t ccp_evaluate_at(const ccp_table *T, int64_t n, const int64_t *ix, const 
 int64_t ccp_cache_words(void) { return CCP_CACHE_WORDS; }
 
 #define CCP_STACK 256
-/* The nets of layer ``lay`` of every corner face of the table's ``n_jobs`` jobs (W: 3 n_corner x 17 x 3 doubles,
- * row 3 ci + code the net of patch ``code`` of corner face ci; rows of corner faces with fewer layers are zero):
- * the same sums as the corner nets the kernel computes at evaluation time (corner_net), for
- * ``layer_nets``. Returns 0, or -1 when a job's tree of virtual faces is deeper than the walk's stack. */
-int64_t ccp_corner_nets(const ccp_table *T, int64_t n_jobs, int64_t lay, double *W) {
+/* The nets the binding keeps, by the sums the kernel computes at evaluation time, walking the tree of virtual
+ * faces of each of the table's ``n_jobs`` jobs once. ``kind`` CCP_CORNER: layer ``lay`` of every corner face
+ * (corner_net; W: 3 n_corner x 17 x 3 doubles, row 3 ci + code the net of patch ``code`` of corner face ci; rows
+ * of corner faces with fewer layers are zero), for ``layer_nets``; ``kind`` CCP_REGULAR: every regular patch
+ * (regular_net; W: n_regular x 17 x 3 doubles, row job_net + leaf; ``lay`` unused), for ``nets`` where the table
+ * keeps none. Returns 0, -1 when a job's tree of virtual faces is deeper than the walk's stack, or -2 for
+ * another ``kind``. */
+int64_t ccp_nets(const ccp_table *T, int64_t n_jobs, int64_t kind, int64_t lay, double *W) {
+    if (kind != CCP_REGULAR && kind != CCP_CORNER) return -2;
     for (int64_t job = 0; job < n_jobs; job++) {
         int64_t stack[CCP_STACK], ns = 0; /* 3 more per level: 44 levels of splits at most in a table */
         stack[ns++] = ld(T->job_root, T->wide[1], job);
@@ -779,7 +795,9 @@ int64_t ccp_corner_nets(const ccp_table *T, int64_t n_jobs, int64_t lay, double 
             if (T->kind[vf] == CCP_SPLIT) {
                 if (ns + 4 > CCP_STACK) return -1;
                 for (int q = 0; q < 4; q++) stack[ns++] = T->child[4 * vf + q];
-            } else if (T->kind[vf] == CCP_CORNER) {
+            } else if (T->kind[vf] == kind && kind == CCP_REGULAR) {
+                regular_net(T, job, vf, W + CCP_NET * (ld(T->job_net, T->wide[2], job) + T->leaf[vf]));
+            } else if (T->kind[vf] == kind) {
                 int64_t cfg = T->cfg[vf], ci = ld(T->job_corner, T->wide[3], job) + T->leaf[vf];
                 for (int64_t code = 0; code < 3; code++) {
                     double *w = W + CCP_NET * (3 * ci + code);
@@ -788,26 +806,6 @@ int64_t ccp_corner_nets(const ccp_table *T, int64_t n_jobs, int64_t lay, double 
                     else
                         memset(w, 0, CCP_NET * sizeof(double));
                 }
-            }
-        }
-    }
-    return 0;
-}
-
-/* The nets of every regular patch of the table's ``n_jobs`` jobs (W: n_regular x 17 x 3 doubles, row job_net + leaf),
- * the sums the kernel computes at evaluation time (regular_net), for the binding's ``nets`` where the table keeps
- * none. Returns 0, or -1 when a job's tree of virtual faces is deeper than the walk's stack. */
-int64_t ccp_regular_nets(const ccp_table *T, int64_t n_jobs, double *W) {
-    for (int64_t job = 0; job < n_jobs; job++) {
-        int64_t stack[CCP_STACK], ns = 0;
-        stack[ns++] = ld(T->job_root, T->wide[1], job);
-        while (ns > 0) {
-            int64_t vf = stack[--ns];
-            if (T->kind[vf] == CCP_SPLIT) {
-                if (ns + 4 > CCP_STACK) return -1;
-                for (int q = 0; q < 4; q++) stack[ns++] = T->child[4 * vf + q];
-            } else if (T->kind[vf] == CCP_REGULAR) {
-                regular_net(T, job, vf, W + CCP_NET * (ld(T->job_net, T->wide[2], job) + T->leaf[vf]));
             }
         }
     }
@@ -832,42 +830,49 @@ int64_t ccp_face_order(int64_t n, const int64_t *f, int64_t n_faces, int64_t shi
     return 0;
 }
 
-/* The grid of ``grid`` (16 n_ptex entries): per ptex face and cell (i, j) of its 4 x 4 cells (u in [i / 4, (i + 1)
- * / 4), the last closed, v likewise, entry 16 face + 4 j + i), the job of the cell's quadrant and the
- * smallest virtual face of that job that holds the whole cell (the kernel's comparisons at the cell's centre;
- * virtual faces are dyadic squares, so every point of the cell makes the same choices down to it; a child that
- * does not hold the whole cell is not taken). Refused faces get 0. Returns 0, -1 when a virtual face's number
- * does not fit CCP_VF_BITS, or -2 when a job's face does not hold a whole cell (no grid then). */
+/* The grid of ``grid`` (16 n_ptex entries, uint32 or, ``wide``, int64): per ptex face and cell (i, j) of its 4 x 4
+ * cells (u in [i / 4, (i + 1) / 4), the last closed, v likewise, entry 16 face + 4 j + i), the job of the cell's
+ * quadrant << ``shift`` | the smallest virtual face of that job that holds the whole cell (the kernel's comparisons
+ * at the cell's centre; virtual faces are dyadic squares, so every point of the cell makes the same choices down to
+ * it; a child that does not hold the whole cell is not taken). Refused faces get 0. Returns 0, -1 when a virtual
+ * face's number does not fit ``shift`` bits or a job's the bits left (32 or 63 in all), or -2 when a job's face does
+ * not hold a whole cell (no grid then). */
 CCP_INLINE int holds(const ccp_table *T, int64_t vf, int64_t i, int64_t j) {
     return T->u0[vf] <= 0.25 * i && T->u0[vf] + T->h[vf] >= 0.25 * (i + 1) && T->v0[vf] <= 0.25 * j &&
            T->v0[vf] + T->h[vf] >= 0.25 * (j + 1);
 }
 
-int64_t ccp_grid(const ccp_table *T, int64_t *grid) {
+int64_t ccp_grid(const ccp_table *T, void *grid, int64_t wide, int64_t shift) {
+    int64_t bits = wide ? 63 : 32;
+    if (shift < 0 || shift >= bits) return -1;
     for (int64_t pf = 0; pf < T->n_ptex; pf++)
         for (int64_t j = 0; j < 4; j++)
             for (int64_t i = 0; i < 4; i++) {
-                int64_t *e = grid + 16 * pf + 4 * j + i;
-                *e = 0;
-                if (T->refused[pf]) continue;
-                double uu = (i + 0.5) / 4, ww = (j + 0.5) / 4;
-                int64_t job = ld(T->top, T->wide[0], 4 * pf + (uu >= 0.5) + 2 * (ww >= 0.5));
-                int64_t vf = ld(T->job_root, T->wide[1], job);
-                if (!holds(T, vf, i, j)) return -2;
-                for (int64_t it = 0; it < T->split_depth && T->kind[vf] == CCP_SPLIT; it++) {
-                    double half = T->h[vf] * 0.5;
-                    int64_t c = T->child[4 * vf + (uu >= T->u0[vf] + half) + 2 * (ww >= T->v0[vf] + half)];
-                    if (!holds(T, c, i, j)) break;
-                    vf = c;
+                int64_t e = 0, c = 16 * pf + 4 * j + i;
+                if (!T->refused[pf]) {
+                    double uu = (i + 0.5) / 4, ww = (j + 0.5) / 4;
+                    int64_t job = ld(T->top, T->wide[0], 4 * pf + (uu >= 0.5) + 2 * (ww >= 0.5));
+                    int64_t vf = ld(T->job_root, T->wide[1], job);
+                    if (!holds(T, vf, i, j)) return -2;
+                    for (int64_t it = 0; it < T->split_depth && T->kind[vf] == CCP_SPLIT; it++) {
+                        double half = T->h[vf] * 0.5;
+                        int64_t ch = T->child[4 * vf + (uu >= T->u0[vf] + half) + 2 * (ww >= T->v0[vf] + half)];
+                        if (!holds(T, ch, i, j)) break;
+                        vf = ch;
+                    }
+                    if (vf >> shift != 0 || job >> (bits - shift) != 0) return -1;
+                    e = job << shift | vf;
                 }
-                if (vf >= (1 << CCP_VF_BITS)) return -1;
-                *e = job << CCP_VF_BITS | vf;
+                if (wide)
+                    ((int64_t *)grid)[c] = e;
+                else
+                    ((uint32_t *)grid)[c] = (uint32_t)e;
             }
     return 0;
 }
 
 /* The layout this file was compiled with: the binding refuses a library whose structure differs. */
-int64_t ccp_abi(void) { return 1000 * (int64_t)sizeof(ccp_table) + 7; }
+int64_t ccp_abi(void) { return 1000 * (int64_t)sizeof(ccp_table) + 8; }
 
 /* ------------------------------------------------------------------------------------------------------------
  * The ring walk of the table's setup (the numba kernel's _ring_walks, ccproof/evaluate/_numba_kernel.py, step

@@ -8,6 +8,7 @@ levels deep; and the layer-0 nets the kernel computes equal the table's own (com
 
 from __future__ import annotations
 
+import mmap
 from pathlib import Path
 
 import numpy as np
@@ -97,18 +98,25 @@ def test_default_lookup_and_threads(surface):
 
 
 def test_layer_nets_of_the_kernel_equal_the_tables(surface):
-    """Layer 0 computed by the kernel's own sums (ccp_corner_nets) equals the table's ``hot`` (numpy's
-    layer0_nets), bit for bit; deeper layers differ from it."""
+    """Layer 0 computed by the kernel's own sums (ccp_nets, corner kind) equals the table's ``hot`` (numpy's
+    layer0_nets), bit for bit; deeper layers differ from it. The regular nets (ccp_nets, regular kind) equal
+    the table's ``nets`` (numpy's); another kind is refused."""
     from ccproof.evaluate import _ckernel
 
     T = surface._table
     ct = _ckernel.CTable(T, layers=2)
+    lib = _ckernel.load()
     w = np.empty_like(T.hot)
-    assert _ckernel.load().ccp_corner_nets(ct.ref, T.job_root.shape[0], 0, w.ctypes.data) == 0
+    assert lib.ccp_nets(ct.ref, T.job_root.shape[0], _ckernel._CORNER, 0, w.ctypes.data) == 0
     assert np.array_equal(w.view(np.int64), np.ascontiguousarray(T.hot).view(np.int64))
     deeper = ct._keep["layer_nets"][1]
     assert deeper.shape == T.hot.shape and not np.array_equal(deeper[:, :16], T.hot[:, :16])
     assert np.array_equal(deeper[:, 16], T.hot[:, 16])  # the corner's limit point, in every layer
+    assert T.nets.shape[0] == T.n_regular  # small tables keep them (numpy's sums)
+    r = np.full((T.n_regular, 17, 3), np.nan)
+    assert lib.ccp_nets(ct.ref, T.job_root.shape[0], _ckernel._REGULAR, 0, r.ctypes.data) == 0
+    assert np.array_equal(r.view(np.int64), np.ascontiguousarray(T.nets).view(np.int64))
+    assert lib.ccp_nets(ct.ref, T.job_root.shape[0], 2, 0, r.ctypes.data) == -2
 
 
 def test_a_wrong_number_of_layers_is_refused(surface):
@@ -139,6 +147,65 @@ def test_no_grid_where_a_face_does_not_hold_whole_cells(surface):
     assert _ckernel.CTable(T, layers=1, grid=True).struct.grid
     shifted = T._replace(u0=T.u0 + 1.0 / 12)
     assert not _ckernel.CTable(shifted, layers=1, grid=True).struct.grid
+
+
+def test_grid_in_32_and_64_bits(surface):
+    """The grid's entries ``job << shift | virtual face`` in uint32 (what the binding makes on these meshes) and
+    in int64 are the same numbers; each names its cell's job (``top`` of the cell's quadrant) and a virtual face
+    of that job's tree that holds the whole cell; the kernel gives the numpy bits with either; a shift that
+    leaves the virtual faces too few bits is refused."""
+    from ccproof.evaluate import _ckernel
+
+    T = surface._table
+    lib = _ckernel.load()
+    ct = _ckernel.CTable(T, layers=1, grid=True)
+    g32, shift = ct._keep["grid"], ct.struct.grid_shift
+    assert g32.dtype == np.uint32 and ct.struct.grid_wide == 0
+    g64 = np.empty(g32.size, dtype=np.int64)
+    assert lib.ccp_grid(ct.ref, g64.ctypes.data, 1, shift) == 0
+    assert np.array_equal(g64, g32.astype(np.int64))
+    n_ptex = T.refused.shape[0]
+    pf, j, i = (a.ravel() for a in np.meshgrid(np.arange(n_ptex), np.arange(4), np.arange(4), indexing="ij"))
+    ok = ~np.asarray(T.refused, dtype=bool)[pf]
+    job, vf = g64 >> shift, g64 & ((1 << shift) - 1)
+    top = np.asarray(T.top).reshape(n_ptex, 4)
+    assert np.array_equal(job[ok], top[pf, (i >= 2) + 2 * (j >= 2)][ok])
+    vf, i, j = vf[ok], i[ok], j[ok]
+    assert np.all((T.u0[vf] <= i / 4) & (T.u0[vf] + T.h[vf] >= (i + 1) / 4) & (T.v0[vf] <= j / 4)
+                  & (T.v0[vf] + T.h[vf] >= (j + 1) / 4))
+    f, u, v = _points(surface, 3000, 5)
+    ref = surface.evaluate(f, u, v, 1, backend="numpy")
+    for g in (g32, g64):
+        ct._keep["grid"] = g
+        ct.struct.grid, ct.struct.grid_wide = g.ctypes.data, int(g.dtype == np.int64)
+        outs = [np.full((f.size, 3), np.nan) for _ in range(3)] + [None] * 3
+        assert _ckernel.evaluate_block(lib, ct, f, u, v, 1, outs) == -1
+        for key, o in zip(_KEYS, outs[:3]):
+            assert np.array_equal(ref[key].view(np.int64), o.view(np.int64)), (key, g.dtype)
+    if vf.max() >= 2:
+        assert lib.ccp_grid(ct.ref, g64.ctypes.data, 0, 1) == -1
+    assert lib.ccp_grid(ct.ref, g64.ctypes.data, 0, 32) == -1
+
+
+def test_arrays_on_mappings_of_their_own_give_the_same_bits(surface, monkeypatch):
+    """With every array the binding fills on an anonymous mapping of its own (``fresh`` from 0 bytes: the kept
+    nets, the layer nets, the grid), the kernel gives the numpy bits."""
+    from ccproof.evaluate import _ckernel
+
+    monkeypatch.setattr(_ckernel, "FRESH_MIN", 0)
+    T = surface._table
+    ct = _ckernel.CTable(T._replace(nets=T.nets[:0], hot=T.hot[:0]), layers=3, grid=True)
+    for name in ("nets", "hot", "grid"):
+        base = ct._keep[name]
+        while isinstance(base, (np.ndarray, memoryview)):
+            base = base.obj if isinstance(base, memoryview) else base.base
+        assert isinstance(base, mmap.mmap), name
+    f, u, v = _points(surface, 3000, 9)
+    ref = surface.evaluate(f, u, v, 1, backend="numpy")
+    outs = [np.full((f.size, 3), np.nan) for _ in range(3)] + [None] * 3
+    assert _ckernel.evaluate_block(_ckernel.load(), ct, f, u, v, 1, outs) == -1
+    for key, o in zip(_KEYS, outs[:3]):
+        assert np.array_equal(ref[key].view(np.int64), o.view(np.int64)), key
 
 
 def test_a_tree_deeper_than_the_walk_falls_back_to_the_cache():
