@@ -24,8 +24,8 @@ from ccproof.apps.iga.assembly import AmbientFunction, solve_screened_poisson
 from ccproof.apps.iga.quadrature import surface_quadrature
 from ccproof.errors import CCProofError
 
-__all__ = ["STUDY_MESHES", "OPEN_MESHES", "PROBLEMS", "study_mesh", "open_study_mesh", "convergence_study", "rates",
-           "fit_rate"]
+__all__ = ["STUDY_MESHES", "OPEN_MESHES", "PROBLEMS", "study_mesh", "open_study_mesh", "half_fan",
+           "convergence_study", "rates", "fit_rate"]
 
 STUDY_MESHES = ("torus", "cube", "icosahedron", "prism6")
 
@@ -33,8 +33,9 @@ STUDY_MESHES = ("torus", "cube", "icosahedron", "prism6")
 #: face), ``annulus`` (12 x 2 quads between radii 0.5 and 1.5; every vertex regular), ``ogrid`` (a square in
 #: a ring of four trapezoids: four interior vertices of valence 3, a regular boundary), ``disk5`` (the planar
 #: 5-regular complex of 5 sectors of 2 x 2 quads scaled by 1/2: one interior vertex of valence 5, five
-#: boundary corners with one face)
-OPEN_MESHES = ("grid", "annulus", "ogrid", "disk5")
+#: boundary corners with one face), ``fan3`` and ``fan5`` (:func:`half_fan`, two rings: a boundary vertex with 3
+#: or 5 faces on a straight boundary, the boundary extraordinary vertices ``crease:3`` and ``crease:5``)
+OPEN_MESHES = ("grid", "annulus", "ogrid", "disk5", "fan3", "fan5")
 
 PROBLEMS = ("screened", "biharmonic", "plate")
 
@@ -75,6 +76,41 @@ def _ogrid(sizes):
     return V, F
 
 
+def half_fan(k, rings=2):
+    """A planar open fan of ``k`` parallelogram sectors of ``rings x rings`` quads over the upper half-disk:
+    sector j is spanned by ``e_j = (cos(pi j / k), sin(pi j / k))`` and ``e_(j+1)``, its vertex (a, b) at
+    ``(a e_j + b e_(j+1)) / rings``; the centre (vertex 0, at the origin) is a boundary vertex with k faces
+    on the straight boundary along rays 0 and k (the x-axis).
+
+    >>> m = half_fan(3)
+    >>> m.n_faces, int(np.bincount(np.asarray(m.faces).ravel())[0]), bool(m.is_boundary_vertex[0])
+    (12, 3, True)
+    """
+    from ccproof.mesh import QuadMesh
+
+    if int(k) != k or k < 2 or rings < 1:
+        raise CCProofError(f"half_fan needs k >= 2 sectors and rings >= 1, got k={k}, rings={rings}")
+    k, R = int(k), int(rings)
+    last = 1 + k * R * (R + 1)  # the vertices (a, 0) of ray k, a = 1 .. R
+
+    def vid(j, a, b):
+        if a == 0 and b == 0:
+            return 0
+        if a == 0:
+            return vid(j + 1, b, 0) if j + 1 < k else last + b - 1
+        return 1 + (j * R + a - 1) * (R + 1) + b
+
+    e = np.stack([np.cos(np.pi * np.arange(k + 1) / k), np.sin(np.pi * np.arange(k + 1) / k)], 1)
+    V = np.zeros((last + R, 3))
+    for j in range(k):
+        for a in range(R + 1):
+            for b in range(R + 1):
+                V[vid(j, a, b), :2] = (a * e[j] + b * e[j + 1]) / R
+    F = [[vid(j, a, b), vid(j, a + 1, b), vid(j, a + 1, b + 1), vid(j, a, b + 1)]
+         for j in range(k) for a in range(R) for b in range(R)]
+    return QuadMesh(V, F)
+
+
 def open_study_mesh(name, ghost=False):
     """The level-0 QuadMesh of a flat open study mesh (:data:`OPEN_MESHES`) and its region (bool per face).
 
@@ -92,6 +128,11 @@ def open_study_mesh(name, ghost=False):
     if name not in OPEN_MESHES:
         raise CCProofError(f"unknown open study mesh {name!r}; use one of {', '.join(OPEN_MESHES)}")
     g = int(bool(ghost))
+    if name.startswith("fan"):
+        if ghost:
+            raise CCProofError(f"the open mesh {name!r} has no ghost ring: it would make its boundary EV interior")
+        m = half_fan(int(name[3:]))
+        return m, np.ones(m.n_faces, dtype=bool)
     if name == "grid":
         m = grid(4 + 2 * g, 4 + 2 * g)
         V = (m.vertices - [g, g, 0.0]) / 4
