@@ -25,7 +25,7 @@ from ccproof.apps.iga.quadrature import surface_quadrature
 from ccproof.errors import CCProofError
 
 __all__ = ["STUDY_MESHES", "OPEN_MESHES", "PROBLEMS", "study_mesh", "open_study_mesh", "half_fan",
-           "FlatBoundaryFunction", "convergence_study", "rates", "fit_rate"]
+           "FlatBoundaryFunction", "fan_contraction", "convergence_study", "rates", "fit_rate"]
 
 STUDY_MESHES = ("torus", "cube", "icosahedron", "prism6")
 
@@ -256,8 +256,13 @@ def convergence_study(mesh, levels=4, kind="adaptive", parameterization="natural
             yield {"level": L, "faces": 16 * 4**L, **{k: r[k] for k in ("dofs", "L2", "H1", "H2")}}
         return
     if isinstance(mesh, str) and mesh in OPEN_MESHES:
+        if problem == "screened" and graded is not None and mesh.startswith("fan") and opt["ghost"] \
+                and opt["bc"] == "neumann":
+            yield from _fan_graded_study(mesh, levels, graded, exact, start)
+            return
         if problem != "screened" or graded is not None:
-            raise CCProofError(f"the open mesh {mesh!r} takes the screened Poisson problem on a uniform space")
+            raise CCProofError(f"the open mesh {mesh!r} takes the screened Poisson problem on a uniform space "
+                               "(a graded space: fan3 or fan5 with ghost=True and bc='neumann')")
         yield from _open_study(mesh, levels, (kind, order, depth), exact, start, opt["bc"], opt["ghost"])
         return
     from ccproof.mesh import subdivide
@@ -335,6 +340,54 @@ def _open_study(name, levels, rule, exact, start, bc, ghost):
                                             error_rule=surface_quadrature(S, 6, "adaptive", 14),
                                             region=region if ghost else None)
             yield {"level": L, "faces": int(region.sum()), "dofs": r["dofs"], "L2": r["L2"], "H1": r["H1"]}
+        if L + 1 < start + levels:
+            M, region = subdivide(M), np.repeat(region, 4)
+
+
+def fan_contraction(k, steps=7):
+    """The cross-boundary contraction ``mu`` of the boundary vertex with ``k`` faces (the centre of
+    :func:`half_fan`): the ratio of its one-ring's height above the boundary line between the last two of
+    ``steps`` uniform subdivisions (the mesh is symmetric under x -> -x: the 1/2 of the boundary curve's
+    tangent is along x; the height contracts at the largest eigenvalue of the other eigenvectors).
+
+    >>> round(fan_contraction(2), 12)
+    0.5
+    """
+    from ccproof.mesh import subdivide
+
+    m, heights = half_fan(k), []
+    for i in range(steps + 1):
+        F = np.asarray(m.faces)
+        ring = np.unique(F[(F == 0).any(axis=1)])
+        heights.append(float(np.abs(m.vertices[ring, 1]).max()))
+        if i < steps:
+            m = subdivide(m)
+    return heights[-1] / heights[-2]
+
+
+def _fan_graded_study(name, levels, graded, exact, start):
+    """:func:`convergence_study` on ``fan3`` / ``fan5`` with the curved side's ghost ring, Neumann, in the
+    space graded toward the boundary EV: at level L ``graded_levels(.., lam=mu, orders=(4, 3))`` extra
+    levels (``mu`` = :func:`fan_contraction`; the solution has no quadratic part at the vertex: its errors
+    there are ``mu^(4L)``, ``mu^(3L)``) over ``graded_rings(.., lam=mu)`` rings (``graded`` as in
+    :func:`convergence_study`: ``("auto[:margin]", rings, width)``)."""
+    from ccproof.apps.iga.graded import graded_levels, graded_rings, solve_graded
+    from ccproof.mesh import subdivide
+
+    extra, rings = str(graded[0]), int(graded[1])
+    width = float(graded[2]) if len(graded) > 2 else 0.0
+    name_, _, margin = extra.partition(":")
+    if name_ != "auto":
+        raise CCProofError(f"a graded fan study takes extra 'auto[:margin]', got {graded[0]!r}")
+    M, region = open_study_mesh(name, ghost=True)
+    mu, n = fan_contraction(int(name[3:])), int(M.valence[0])
+    exact = FlatBoundaryFunction() if exact is None else exact
+    for L in range(start + levels):
+        if L >= start:
+            s = graded_levels(n, L, int(margin or 1), lam=mu, orders=(4, 3))
+            R = [graded_rings(n, L, j, rings, width, lam=mu) if width > 0 else rings for j in range(1, s + 1)]
+            r = solve_graded(M, s, exact, rings={n: R}, vertices=[0], region=region)
+            yield {"level": L, "faces": int(region.sum()), **{k: r[k] for k in ("dofs", "L2", "H1", "leaves")}}
         if L + 1 < start + levels:
             M, region = subdivide(M), np.repeat(region, 4)
 

@@ -53,21 +53,25 @@ _D1 = np.roll(_C, -1, axis=0) - _C
 _D2 = np.roll(_C, 1, axis=0) - _C
 
 
-def graded_levels(valence, level, margin=1):
+def graded_levels(valence, level, margin=1, lam=None, orders=(3, 2)):
     """Extra levels ``s`` around an EV of ``valence`` on a mesh of uniform ``level`` L (h ~ 2^-L) so that
     its ring's errors ``lam^(3(L+s))`` (L2) and ``lam^(2(L+s))`` (H1) fall like the regular ``2^(-4L)`` and
     ``2^(-3L)``: ``ceil(L (max(4 / (3 a), 3 / (2 a)) - 1)) + margin`` with ``a = log2(1/lam)``; 0 at valence 4.
 
+    With ``lam`` (a boundary EV's cross-boundary contraction, docs/iga.md) the errors are ``lam^(p L)``,
+    ``lam^(q L)`` for ``orders = (p, q)`` (``(4, 3)`` for a solution with no quadratic part at the vertex).
+
     >>> [graded_levels(5, L, 0) for L in range(6)]
     [0, 1, 2, 3, 3, 4]
     """
-    if valence == 4:
+    if valence == 4 and lam is None:
         return 0
-    a = -math.log2(subdominant_lambda(valence))
-    return max(0, math.ceil(level * (max(4 / (3 * a), 3 / (2 * a)) - 1) - 1e-12)) + int(margin)
+    a = -math.log2(subdominant_lambda(valence) if lam is None else float(lam))
+    p, q = orders
+    return max(0, math.ceil(level * (max(4 / (p * a), 3 / (q * a)) - 1) - 1e-12)) + int(margin)
 
 
-def graded_rings(valence, level, j, rings=5, width=0.5):
+def graded_rings(valence, level, j, rings=5, width=0.5, lam=None):
     """Face rings of level ``L + j`` refined around an EV of ``valence`` on a mesh of uniform ``level`` L:
     ``max(rings, ceil(width 2^L 2^(-j (1/g - 1))))``, g = ``1 - log2(1/lam) / 3``.
 
@@ -80,10 +84,12 @@ def graded_rings(valence, level, j, rings=5, width=0.5):
     ``rho <= 2^(-j/g)``: ``2^(L + j - j/g)`` of its rings, times ``width`` (rho where the grading starts,
     in level-0 faces), and at least ``rings``.
 
+    ``lam`` replaces the subdominant eigenvalue (a boundary EV's cross-boundary contraction).
+
     >>> [graded_rings(5, 5, j) for j in range(1, 6)], [graded_rings(3, 5, j) for j in (1, 2)]
     ([13, 10, 7, 6, 5], [10, 6])
     """
-    a = -math.log2(subdominant_lambda(valence))
+    a = -math.log2(subdominant_lambda(valence) if lam is None else float(lam))
     g = 1 - a / 3
     return max(int(rings), math.ceil(width * 2.0 ** (level - j * (1 / g - 1)) - 1e-9))
 
