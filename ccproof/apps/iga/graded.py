@@ -26,6 +26,11 @@ the quadrature is the adaptive rule on the leaves of the refinement. With ``ring
 the second ring of level j get all their level-j functions (a function's support is two face rings
 around its vertex), so each dyadic ring around the EV is resolved at its own level.
 
+With ``vertices`` the space is graded toward given vertices instead, boundary vertices included (a
+boundary EV, whose ring's height contracts by a measured ``mu``: ``lam=mu`` in :func:`graded_levels` and
+:func:`graded_rings`), and :func:`solve_graded` takes a ``region`` of an open mesh with the natural
+boundary condition (docs/iga.md, the fans).
+
 >>> from ccproof.mesh.examples import cube
 >>> H = HierarchicalSpace(cube(), extra=1, rings=1)
 >>> H.n_dofs, [int(a.sum()) for a in H.active]          # 8 coarse functions replaced near the 8 EVs
