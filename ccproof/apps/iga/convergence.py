@@ -24,8 +24,8 @@ from ccproof.apps.iga.assembly import AmbientFunction, solve_screened_poisson
 from ccproof.apps.iga.quadrature import surface_quadrature
 from ccproof.errors import CCProofError
 
-__all__ = ["STUDY_MESHES", "OPEN_MESHES", "PROBLEMS", "study_mesh", "open_study_mesh", "convergence_study", "rates",
-           "fit_rate"]
+__all__ = ["STUDY_MESHES", "OPEN_MESHES", "PROBLEMS", "study_mesh", "open_study_mesh", "half_fan",
+           "FlatBoundaryFunction", "fan_contraction", "convergence_study", "rates", "fit_rate"]
 
 STUDY_MESHES = ("torus", "cube", "icosahedron", "prism6")
 
@@ -33,8 +33,9 @@ STUDY_MESHES = ("torus", "cube", "icosahedron", "prism6")
 #: face), ``annulus`` (12 x 2 quads between radii 0.5 and 1.5; every vertex regular), ``ogrid`` (a square in
 #: a ring of four trapezoids: four interior vertices of valence 3, a regular boundary), ``disk5`` (the planar
 #: 5-regular complex of 5 sectors of 2 x 2 quads scaled by 1/2: one interior vertex of valence 5, five
-#: boundary corners with one face)
-OPEN_MESHES = ("grid", "annulus", "ogrid", "disk5")
+#: boundary corners with one face), ``fan3`` and ``fan5`` (:func:`half_fan`, two rings: a boundary vertex with 3
+#: or 5 faces on a straight boundary, the boundary extraordinary vertices ``crease:3`` and ``crease:5``)
+OPEN_MESHES = ("grid", "annulus", "ogrid", "disk5", "fan3", "fan5")
 
 PROBLEMS = ("screened", "biharmonic", "plate")
 
@@ -75,12 +76,79 @@ def _ogrid(sizes):
     return V, F
 
 
+class FlatBoundaryFunction(AmbientFunction):
+    """``u = y^3 cos(a x)`` (flat meshes): its Hessian vanishes on the line ``y = 0``, so on a straight
+    EDGE_ONLY boundary there it meets the space's end condition (a zero second derivative across the
+    boundary, docs/iga.md), and what is left of the error at the boundary is its vertices'.
+
+    >>> u = FlatBoundaryFunction()
+    >>> x = np.array([[0.3, 0.0, 0.0]])
+    >>> float(np.abs(u.hessian(x)).max()), float(np.abs(u.gradient(x)).max())
+    (0.0, 0.0)
+    """
+
+    def __init__(self, a=math.pi):
+        super().__init__(a, 0.0, 0.0)
+
+    def value(self, X):
+        return X[:, 1] ** 3 * np.cos(self.a * X[:, 0])
+
+    def gradient(self, X):
+        a, x, y = self.a, X[:, 0], X[:, 1]
+        return np.stack([-a * y**3 * np.sin(a * x), 3 * y**2 * np.cos(a * x), 0 * x], axis=1)
+
+    def hessian(self, X):
+        a, x, y = self.a, X[:, 0], X[:, 1]
+        H = np.zeros((X.shape[0], 3, 3))
+        H[:, 0, 0] = -a * a * y**3 * np.cos(a * x)
+        H[:, 0, 1] = H[:, 1, 0] = -3 * a * y**2 * np.sin(a * x)
+        H[:, 1, 1] = 6 * y * np.cos(a * x)
+        return H
+
+
+def half_fan(k, rings=2):
+    """A planar open fan of ``k`` parallelogram sectors of ``rings x rings`` quads over the upper half-disk:
+    sector j is spanned by ``e_j = (cos(pi j / k), sin(pi j / k))`` and ``e_(j+1)``, its vertex (a, b) at
+    ``(a e_j + b e_(j+1)) / rings``; the centre (vertex 0, at the origin) is a boundary vertex with k faces
+    on the straight boundary along rays 0 and k (the x-axis).
+
+    >>> m = half_fan(3)
+    >>> m.n_faces, int(np.bincount(np.asarray(m.faces).ravel())[0]), bool(m.is_boundary_vertex[0])
+    (12, 3, True)
+    """
+    from ccproof.mesh import QuadMesh
+
+    if int(k) != k or k < 2 or rings < 1:
+        raise CCProofError(f"half_fan needs k >= 2 sectors and rings >= 1, got k={k}, rings={rings}")
+    k, R = int(k), int(rings)
+    last = 1 + k * R * (R + 1)  # the vertices (a, 0) of ray k, a = 1 .. R
+
+    def vid(j, a, b):
+        if a == 0 and b == 0:
+            return 0
+        if a == 0:
+            return vid(j + 1, b, 0) if j + 1 < k else last + b - 1
+        return 1 + (j * R + a - 1) * (R + 1) + b
+
+    e = np.stack([np.cos(np.pi * np.arange(k + 1) / k), np.sin(np.pi * np.arange(k + 1) / k)], 1)
+    V = np.zeros((last + R, 3))
+    for j in range(k):
+        for a in range(R + 1):
+            for b in range(R + 1):
+                V[vid(j, a, b), :2] = (a * e[j] + b * e[j + 1]) / R
+    F = [[vid(j, a, b), vid(j, a + 1, b), vid(j, a + 1, b + 1), vid(j, a, b + 1)]
+         for j in range(k) for a in range(R) for b in range(R)]
+    return QuadMesh(V, F)
+
+
 def open_study_mesh(name, ghost=False):
     """The level-0 QuadMesh of a flat open study mesh (:data:`OPEN_MESHES`) and its region (bool per face).
 
     With ``ghost``, one more ring of faces outside, its vertices at ``2 B - I`` (B a boundary vertex, I its
     neighbour inside): the region (the original faces) is then surrounded by free ghost vertices, and its
-    limit is a regular bicubic surface up to its boundary (on ``grid``: exactly the unit square).
+    limit is a regular bicubic surface up to its boundary (on ``grid``: exactly the unit square). On
+    ``fan3`` and ``fan5`` the ring is added on the curved side only (a third ring of the sectors): the
+    straight boundary and its extraordinary vertex stay a boundary of the mesh (EDGE_ONLY).
 
     >>> m, region = open_study_mesh("grid", ghost=True)
     >>> m.n_vertices, int(region.sum()), float(m.vertices[:, :2].min()), float(m.vertices[:, :2].max())
@@ -92,6 +160,10 @@ def open_study_mesh(name, ghost=False):
     if name not in OPEN_MESHES:
         raise CCProofError(f"unknown open study mesh {name!r}; use one of {', '.join(OPEN_MESHES)}")
     g = int(bool(ghost))
+    if name.startswith("fan"):
+        m, R = half_fan(int(name[3:]), rings=2 + g), 2 + g  # sector j, face (j R + a) R + b
+        a, b = np.divmod(np.arange(m.n_faces) % (R * R), R)
+        return QuadMesh(m.vertices * R / 2, m.faces), (a < 2) & (b < 2)
     if name == "grid":
         m = grid(4 + 2 * g, 4 + 2 * g)
         V = (m.vertices - [g, g, 0.0]) / 4
@@ -184,8 +256,13 @@ def convergence_study(mesh, levels=4, kind="adaptive", parameterization="natural
             yield {"level": L, "faces": 16 * 4**L, **{k: r[k] for k in ("dofs", "L2", "H1", "H2")}}
         return
     if isinstance(mesh, str) and mesh in OPEN_MESHES:
+        if problem == "screened" and graded is not None and mesh.startswith("fan") and opt["ghost"] \
+                and opt["bc"] == "neumann":
+            yield from _fan_graded_study(mesh, levels, graded, exact, start)
+            return
         if problem != "screened" or graded is not None:
-            raise CCProofError(f"the open mesh {mesh!r} takes the screened Poisson problem on a uniform space")
+            raise CCProofError(f"the open mesh {mesh!r} takes the screened Poisson problem on a uniform space "
+                               "(a graded space: fan3 or fan5 with ghost=True and bc='neumann')")
         yield from _open_study(mesh, levels, (kind, order, depth), exact, start, opt["bc"], opt["ghost"])
         return
     from ccproof.mesh import subdivide
@@ -254,7 +331,8 @@ def _open_study(name, levels, rule, exact, start, bc, ghost):
     from ccproof.mesh import subdivide
 
     M, region = open_study_mesh(name, ghost)
-    exact = AmbientFunction(math.pi, math.pi, 0.0) if exact is None else exact
+    if exact is None:
+        exact = FlatBoundaryFunction() if name.startswith("fan") else AmbientFunction(math.pi, math.pi, 0.0)
     for L in range(start + levels):
         if L >= start:
             S = natural_limit_surface(M)
@@ -262,6 +340,54 @@ def _open_study(name, levels, rule, exact, start, bc, ghost):
                                             error_rule=surface_quadrature(S, 6, "adaptive", 14),
                                             region=region if ghost else None)
             yield {"level": L, "faces": int(region.sum()), "dofs": r["dofs"], "L2": r["L2"], "H1": r["H1"]}
+        if L + 1 < start + levels:
+            M, region = subdivide(M), np.repeat(region, 4)
+
+
+def fan_contraction(k, steps=7):
+    """The cross-boundary contraction ``mu`` of the boundary vertex with ``k`` faces (the centre of
+    :func:`half_fan`): the ratio of its one-ring's height above the boundary line between the last two of
+    ``steps`` uniform subdivisions (the mesh is symmetric under x -> -x: the 1/2 of the boundary curve's
+    tangent is along x; the height contracts at the largest eigenvalue of the other eigenvectors).
+
+    >>> round(fan_contraction(2), 12)
+    0.5
+    """
+    from ccproof.mesh import subdivide
+
+    m, heights = half_fan(k), []
+    for i in range(steps + 1):
+        F = np.asarray(m.faces)
+        ring = np.unique(F[(F == 0).any(axis=1)])
+        heights.append(float(np.abs(m.vertices[ring, 1]).max()))
+        if i < steps:
+            m = subdivide(m)
+    return heights[-1] / heights[-2]
+
+
+def _fan_graded_study(name, levels, graded, exact, start):
+    """:func:`convergence_study` on ``fan3`` / ``fan5`` with the curved side's ghost ring, Neumann, in the
+    space graded toward the boundary EV: at level L ``graded_levels(.., lam=mu, orders=(4, 3))`` extra
+    levels (``mu`` = :func:`fan_contraction`; the solution has no quadratic part at the vertex: its errors
+    there are ``mu^(4L)``, ``mu^(3L)``) over ``graded_rings(.., lam=mu)`` rings (``graded`` as in
+    :func:`convergence_study`: ``("auto[:margin]", rings, width)``)."""
+    from ccproof.apps.iga.graded import graded_levels, graded_rings, solve_graded
+    from ccproof.mesh import subdivide
+
+    extra, rings = str(graded[0]), int(graded[1])
+    width = float(graded[2]) if len(graded) > 2 else 0.0
+    name_, _, margin = extra.partition(":")
+    if name_ != "auto":
+        raise CCProofError(f"a graded fan study takes extra 'auto[:margin]', got {graded[0]!r}")
+    M, region = open_study_mesh(name, ghost=True)
+    mu, n = fan_contraction(int(name[3:])), int(M.valence[0])
+    exact = FlatBoundaryFunction() if exact is None else exact
+    for L in range(start + levels):
+        if L >= start:
+            s = graded_levels(n, L, int(margin or 1), lam=mu, orders=(4, 3))
+            R = [graded_rings(n, L, j, rings, width, lam=mu) if width > 0 else rings for j in range(1, s + 1)]
+            r = solve_graded(M, s, exact, rings={n: R}, vertices=[0], region=region)
+            yield {"level": L, "faces": int(region.sum()), **{k: r[k] for k in ("dofs", "L2", "H1", "leaves")}}
         if L + 1 < start + levels:
             M, region = subdivide(M), np.repeat(region, 4)
 

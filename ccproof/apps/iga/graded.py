@@ -26,6 +26,11 @@ the quadrature is the adaptive rule on the leaves of the refinement. With ``ring
 the second ring of level j get all their level-j functions (a function's support is two face rings
 around its vertex), so each dyadic ring around the EV is resolved at its own level.
 
+With ``vertices`` the space is graded toward given vertices instead, boundary vertices included (a
+boundary EV, whose ring's height contracts by a measured ``mu``: ``lam=mu`` in :func:`graded_levels` and
+:func:`graded_rings`), and :func:`solve_graded` takes a ``region`` of an open mesh with the natural
+boundary condition (docs/iga.md, the fans).
+
 >>> from ccproof.mesh.examples import cube
 >>> H = HierarchicalSpace(cube(), extra=1, rings=1)
 >>> H.n_dofs, [int(a.sum()) for a in H.active]          # 8 coarse functions replaced near the 8 EVs
@@ -53,21 +58,25 @@ _D1 = np.roll(_C, -1, axis=0) - _C
 _D2 = np.roll(_C, 1, axis=0) - _C
 
 
-def graded_levels(valence, level, margin=1):
+def graded_levels(valence, level, margin=1, lam=None, orders=(3, 2)):
     """Extra levels ``s`` around an EV of ``valence`` on a mesh of uniform ``level`` L (h ~ 2^-L) so that
     its ring's errors ``lam^(3(L+s))`` (L2) and ``lam^(2(L+s))`` (H1) fall like the regular ``2^(-4L)`` and
     ``2^(-3L)``: ``ceil(L (max(4 / (3 a), 3 / (2 a)) - 1)) + margin`` with ``a = log2(1/lam)``; 0 at valence 4.
 
+    With ``lam`` (a boundary EV's cross-boundary contraction, docs/iga.md) the errors are ``lam^(p L)``,
+    ``lam^(q L)`` for ``orders = (p, q)`` (``(4, 3)`` for a solution with no quadratic part at the vertex).
+
     >>> [graded_levels(5, L, 0) for L in range(6)]
     [0, 1, 2, 3, 3, 4]
     """
-    if valence == 4:
+    if valence == 4 and lam is None:
         return 0
-    a = -math.log2(subdominant_lambda(valence))
-    return max(0, math.ceil(level * (max(4 / (3 * a), 3 / (2 * a)) - 1) - 1e-12)) + int(margin)
+    a = -math.log2(subdominant_lambda(valence) if lam is None else float(lam))
+    p, q = orders
+    return max(0, math.ceil(level * (max(4 / (p * a), 3 / (q * a)) - 1) - 1e-12)) + int(margin)
 
 
-def graded_rings(valence, level, j, rings=5, width=0.5):
+def graded_rings(valence, level, j, rings=5, width=0.5, lam=None):
     """Face rings of level ``L + j`` refined around an EV of ``valence`` on a mesh of uniform ``level`` L:
     ``max(rings, ceil(width 2^L 2^(-j (1/g - 1))))``, g = ``1 - log2(1/lam) / 3``.
 
@@ -80,10 +89,12 @@ def graded_rings(valence, level, j, rings=5, width=0.5):
     ``rho <= 2^(-j/g)``: ``2^(L + j - j/g)`` of its rings, times ``width`` (rho where the grading starts,
     in level-0 faces), and at least ``rings``.
 
+    ``lam`` replaces the subdominant eigenvalue (a boundary EV's cross-boundary contraction).
+
     >>> [graded_rings(5, 5, j) for j in range(1, 6)], [graded_rings(3, 5, j) for j in (1, 2)]
     ([13, 10, 7, 6, 5], [10, 6])
     """
-    a = -math.log2(subdominant_lambda(valence))
+    a = -math.log2(subdominant_lambda(valence) if lam is None else float(lam))
     g = 1 - a / 3
     return max(int(rings), math.ceil(width * 2.0 ** (level - j * (1 / g - 1)) - 1e-9))
 
@@ -175,13 +186,16 @@ class HierarchicalSpace:
     Parameters
     ----------
     mesh : QuadMesh
-        Level 0 (closed).
+        Level 0 (closed, or open with ``vertices``).
     extra : int or dict
         Levels of local refinement beyond level 0 around every EV, or per valence (``{5: 4, 3: 2}``;
-        valences not listed: 0).
+        valences not listed: 0); an int with ``vertices``.
     rings : int or dict
         Face rings around every EV that make up its domain at each level, or per valence the list of them
         for levels 1, 2, ... (:func:`graded_rings`).
+    vertices : int array, optional
+        Grade toward these vertices (boundary vertices too: a boundary extraordinary vertex) instead of
+        the interior vertices of valence != 4.
 
     Attributes
     ----------
@@ -196,10 +210,16 @@ class HierarchicalSpace:
     n_dofs : int
     """
 
-    def __init__(self, mesh, extra, rings=5):
+    def __init__(self, mesh, extra, rings=5, vertices=None):
         from ccproof.evaluate import natural_limit_surface
 
-        ev, s = _ev_levels(mesh, extra)
+        if vertices is None:
+            ev, s = _ev_levels(mesh, extra)
+        else:
+            ev = np.asarray(vertices, dtype=np.int64).reshape(-1)
+            s = np.full(ev.size, int(extra), dtype=np.int64)
+            if (s < 0).any() or ((ev < 0) | (ev >= mesh.n_vertices)).any():
+                raise CCProofError(f"vertices must be vertices of the mesh and extra >= 0, got {vertices!r}, {extra!r}")
         R = _ev_rings(mesh, ev, s, rings)
         self.meshes, self.kept, self.omega = [mesh], [], [np.ones(mesh.n_faces, dtype=bool)]
         for j in range(1, int(s.max(initial=0)) + 1):
@@ -254,12 +274,21 @@ class HierarchicalSpace:
                 mine = (mine & split)[self.kept[j][np.arange(self.meshes[j + 1].n_faces) // 4]]
         return out
 
-    def quadrature(self, order=4, depth=12):
-        """Per level the adaptive rule restricted to its leaves: list of QuadratureRule (level j's faces)."""
+    def regions(self, region):
+        """Per level its faces whose level-0 ancestor is in ``region`` (bool per level-0 face)."""
+        out = [np.asarray(region, dtype=bool)]
+        for j in range(1, len(self.meshes)):
+            out.append(out[-1][self.kept[j - 1][np.arange(self.meshes[j].n_faces) // 4]])
+        return out
+
+    def quadrature(self, order=4, depth=12, region=None):
+        """Per level the adaptive rule restricted to its leaves (and to ``region``, bool per level-0 face):
+        list of QuadratureRule (level j's faces)."""
         rules = []
+        inside = self.regions(np.ones(self.meshes[0].n_faces, dtype=bool) if region is None else region)
         for j, leaf in enumerate(self.leaves()):
             cells = quadrature_cells(self.surfaces[j], "adaptive", depth)
-            keep = leaf[cells[0]]
+            keep = (leaf & inside[j])[cells[0]]
             rules.append(cells_rule(tuple(a[keep] for a in cells), order))
         return rules
 
@@ -291,12 +320,12 @@ class HierarchicalSpace:
             out[key] = sp.hstack(parts, format="csr")
         return out
 
-    def fields(self, order=4, depth=12, curvature=True):
-        """Per level: SurfaceFields at the leaves' adaptive rule, with the hierarchical rows as ``W``."""
+    def fields(self, order=4, depth=12, curvature=True, region=None):
+        """Per level: SurfaceFields at the leaves' adaptive rule (in ``region``), the hierarchical rows as ``W``."""
         from ccproof.apps.iga.assembly import SurfaceFields
 
         out = []
-        for j, rule in enumerate(self.quadrature(order, depth)):
+        for j, rule in enumerate(self.quadrature(order, depth, region)):
             if rule.face.size == 0:
                 continue
             F = SurfaceFields(self.surfaces[j], rule, curvature=curvature)
@@ -305,17 +334,35 @@ class HierarchicalSpace:
         return out
 
 
-def solve_graded(mesh, extra, exact, rings=5):
+def solve_graded(mesh, extra, exact, rings=5, vertices=None, region=None):
     """Galerkin solution of ``-Laplace_Gamma u + u = f`` in the graded space: dict ``L2``, ``H1``, ``dofs``
-    and ``leaves`` (per level the L2 and H1 errors on its leaves; ``extra`` and ``rings`` as in
-    :class:`HierarchicalSpace`)."""
+    and ``leaves`` (per level the L2 and H1 errors on its leaves; ``extra``, ``rings`` and ``vertices`` as
+    in :class:`HierarchicalSpace`).
+
+    On an open mesh (``region``: the faces solved on, bool per level-0 face; every function nonzero there
+    is a dof) the boundary condition is the natural one, ``grad u . m = g`` on the region's boundary, and
+    its load ``int f phi + int_boundary g phi`` is taken in the form Green's identity gives it for the
+    manufactured u, ``int (u phi + grad u . grad phi)`` (no boundary rule on the leaves needed): the
+    solution is the H1 projection of u, as the Neumann problem's Galerkin solution is."""
     from ccproof.apps.iga.assembly import solve_spd
 
-    H = HierarchicalSpace(mesh, extra, rings)
-    Fs = H.fields()
-    A = sum(F.stiffness() + F.mass() for F in Fs)
-    b = sum(F.load(exact.screened_poisson_rhs(F)) for F in Fs)
-    c = solve_spd(A, b)
-    leaves = [tuple(float(e) for e in F.errors(c, exact)) for F in H.fields(order=6, depth=14, curvature=False)]
+    H = HierarchicalSpace(mesh, extra, rings, vertices)
+    Fs = H.fields(region=region)
+    A = sum(F.stiffness() + F.mass() for F in Fs).tocsr()
+    b = sum(F.load(exact.screened_poisson_rhs(F)) if region is None else _h1_load(F, exact) for F in Fs)
+    c = np.zeros(A.shape[0])
+    free = np.flatnonzero(A.diagonal() > 0)
+    c[free] = solve_spd(A[free][:, free].tocsr(), b[free])
+    leaves = [tuple(float(e) for e in F.errors(c, exact))
+              for F in H.fields(order=6, depth=14, curvature=False, region=region)]
     e2, h2 = (np.asarray(leaves) ** 2).sum(axis=0)
-    return {"L2": float(np.sqrt(e2)), "H1": float(np.sqrt(h2)), "dofs": H.n_dofs, "leaves": leaves}
+    return {"L2": float(np.sqrt(e2)), "H1": float(np.sqrt(h2)), "dofs": int(free.size), "leaves": leaves}
+
+
+def _h1_load(F, exact):
+    """``int (u phi_i + grad u . grad_Gamma phi_i)`` at the rule of the SurfaceFields F."""
+    g = exact.gradient(F.P)
+    pu, pv = np.einsum("ij,ij->i", F.Pu, g), np.einsum("ij,ij->i", F.Pv, g)
+    G = F.Ginv
+    return (F.W["P"].T @ (F.dA * exact.value(F.P)) + F.W["Du"].T @ (F.dA * (G[:, 0, 0] * pu + G[:, 0, 1] * pv))
+            + F.W["Dv"].T @ (F.dA * (G[:, 1, 0] * pu + G[:, 1, 1] * pv)))
