@@ -165,9 +165,60 @@ class LoopSurface:
         nr = labels.shape[0]
         self._nreg = nr  # nodes 0 .. nr - 1; the lists hold the nodes from nr on
         self._labels, self._X = labels, X  # the regular triangles' nets: X[labels] (_finish)
+        known = self._ring_groups(mesh, F, near[F].any(axis=1), reg, simple, ask)
         for f, tri in zip(np.flatnonzero(~reg).tolist(), F[~reg].tolist()):
-            self._root[f] = self._add_face(X, tri)
+            hit = known.get(f)
+            if hit is None:
+                self._root[f] = self._add_face(X, tri)
+            elif hit is not True:
+                self._root[f] = self._add(hit[0], 0, X[hit[1]], 0)
         self._finish()
+
+    def _ring_groups(self, mesh, F, in_cx, reg, simple, ask):
+        """The rings of the triangles without a corner known irregular, read at once (:mod:`.rings`) and grouped by
+        key: per face (plan, ring labels); ``True`` for those whose box-spline nets are stored here at once (their
+        roots set). Each group's key and ring are read once the per-triangle way and checked against the group's."""
+        from ccproof.evaluate.loop.rings import triangle_rings
+
+        ok = np.asarray(simple) | ask
+        faces = np.flatnonzero(~reg & ok[F].all(axis=1))
+        if not faces.size:
+            return {}
+        twin = mesh.halfedges.twin.copy()
+        twin[~in_cx[np.maximum(twin, 0) // 3] | (twin < 0)] = -1
+        rings, rows = triangle_rings(F, twin, _halfedge_sharpness(F, mesh.edge_sharpness),
+                                     _vertex_corners(len(ok), mesh.vertex_sharpness), faces,
+                                     int(np.bincount(F.reshape(-1)).max()) + 1)
+        _, first, group = np.unique(rows, axis=0, return_index=True, return_inverse=True)
+        group = group.reshape(-1)
+        known = {}
+        for g, i in enumerate(first.tolist()):
+            tri = F[faces[i]].tolist()
+            r, ring, key = oriented_ring(self._cx, tri)
+            n = len(ring)
+            if r != 0 or rings[i, :n].tolist() != ring or rings[i, n:n + 1].tolist() not in ([], [-1]):
+                continue
+            p = plan(key)
+            members = np.flatnonzero(group == g)
+            if isinstance(p, Regular):
+                self._add_regular(p, faces[members], rings[members, :n])
+                known.update(dict.fromkeys(faces[members].tolist(), True))
+            else:
+                known.update((f, (p, rg)) for f, rg in zip(faces[members].tolist(), rings[members, :n]))
+        return known
+
+    def _add_regular(self, p, faces, rings):
+        """Box-spline nodes for triangles of one configuration: nets ``p.net @ X[ring]`` in one batched product."""
+        m = faces.size
+        node = self._nreg + len(self._kind)
+        self._root[faces] = node + np.arange(m)
+        ref = self._nreg + len(self._nets)
+        self._kind += [_REGULAR] * m
+        self._rot += [0] * m
+        self._ref += range(ref, ref + m)
+        self._children += [(-1, -1, -1, -1)] * m
+        self._gid += [-1] * m
+        self._nets += list(np.matmul(p.net, self._X[rings]))
 
     def _add_face(self, X, tri):
         cx, simple, ask = self._cx, self._simple, self._ask
@@ -368,6 +419,29 @@ class LoopSurface:
             raise CCProofError(f"point {i}: face {int(face[i])}, (u, v) = ({float(u[i])!r}, {float(v[i])!r}) is not in "
                                f"a triangle of this mesh ({m} faces; u, v >= 0, u + v <= 1)")
         return face, u, v
+
+
+def _halfedge_sharpness(F, edge_sharpness):
+    """Per half-edge ``3 f + i`` of triangles ``F`` the sharpness of its edge (0 untagged)."""
+    out = np.zeros(F.size)
+    if edge_sharpness:
+        n = int(F.max()) + 1
+        E = np.array(list(edge_sharpness), dtype=np.int64).reshape(-1, 2)
+        code = np.minimum(E[:, 0], E[:, 1]) * n + np.maximum(E[:, 0], E[:, 1])
+        order = np.argsort(code)
+        a, b = F.reshape(-1), np.roll(F, -1, axis=1).reshape(-1)
+        h = np.minimum(a, b) * n + np.maximum(a, b)
+        pos = np.minimum(np.searchsorted(code, h, sorter=order), code.size - 1)
+        hit = code[order[pos]] == h
+        out[hit] = np.array(list(edge_sharpness.values()), dtype=np.float64)[order[pos[hit]]]
+    return out
+
+
+def _vertex_corners(n, vertex_sharpness):
+    out = np.zeros(n)
+    if vertex_sharpness:
+        out[np.array(list(vertex_sharpness), dtype=np.int64)] = list(vertex_sharpness.values())
+    return out
 
 
 @functools.lru_cache(maxsize=1)
