@@ -63,15 +63,15 @@ def _label(ring, n, x):
 
 
 @numba.njit(cache=True)
-def _one(F, twin, hsharp, vcorner, f, ring, row, cap_t):
+def _one(F, twin, hsharp, vcorner, f, rot, ring, row, cap_t):
     n = 3
     for i in range(3):
-        ring[i] = F[f, i]
+        ring[i] = F[f, (rot + i) % 3]
     fan = np.empty((2, ring.size), dtype=np.int64)
     faces = np.full(cap_t, -1, dtype=np.int64)
     nf = 0
     for i in range(3):
-        k, closed = _fan(F, twin, 3 * f + i, fan)
+        k, closed = _fan(F, twin, 3 * f + (rot + i) % 3, fan)
         for j in range(k):
             _, n = _label(ring, n, fan[0, j])
         for j in range(k if closed else k - 1):
@@ -123,13 +123,14 @@ def _one(F, twin, hsharp, vcorner, f, ring, row, cap_t):
 
 
 @numba.njit(cache=True)
-def _all(F, twin, hsharp, vcorner, faces, rings, rows, cap_t):
+def _all(F, twin, hsharp, vcorner, faces, rot, rings, rows, cap_t):
     for r in range(faces.size):
-        _one(F, twin, hsharp, vcorner, faces[r], rings[r], rows[r], cap_t)
+        _one(F, twin, hsharp, vcorner, faces[r], rot[r], rings[r], rows[r], cap_t)
 
 
-def triangle_rings(F, twin, hsharp, vcorner, faces, max_fan):
-    """(rings (R, cap) padded with -1, key encodings (R, W)) of the triangles ``faces`` read from corner 0.
+def triangle_rings(F, twin, hsharp, vcorner, faces, max_fan, rot=None):
+    """(rings (R, cap) padded with -1, key encodings (R, W)) of the triangles ``faces`` read from their corner
+    ``rot`` (0 where not given), as :func:`~ccproof.evaluate.loop.plan.oriented_ring` lists a triangle from its corner r.
 
     Parameters
     ----------
@@ -143,6 +144,7 @@ def triangle_rings(F, twin, hsharp, vcorner, faces, max_fan):
     faces : ndarray (R,) of int
     max_fan : int
         At least the number of neighbours of any corner of these triangles.
+    rot : ndarray (R,) of int, optional
 
     Examples
     --------
@@ -162,5 +164,7 @@ def triangle_rings(F, twin, hsharp, vcorner, faces, max_fan):
     if faces.size:
         _all(np.ascontiguousarray(F, dtype=np.int64), np.ascontiguousarray(twin, dtype=np.int64),
              np.ascontiguousarray(hsharp, dtype=np.float64), np.ascontiguousarray(vcorner, dtype=np.float64),
-             np.ascontiguousarray(faces, dtype=np.int64), rings, rows, cap_t)
+             np.ascontiguousarray(faces, dtype=np.int64),
+             np.zeros(faces.size, dtype=np.int64) if rot is None else np.ascontiguousarray(rot, dtype=np.int64),
+             rings, rows, cap_t)
     return rings, rows

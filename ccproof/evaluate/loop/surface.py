@@ -33,10 +33,14 @@ import numpy as np
 from ccproof.errors import CCProofError
 from ccproof.evaluate.loop.box_spline import basis
 from ccproof.evaluate.loop.complex import TriComplex
-from ccproof.evaluate.loop.plan import MAX_DEPTH, Corner, Regular, oriented_ring, plan
+from ccproof.evaluate.loop.plan import MAX_DEPTH, Corner, Regular, irregular_corners, oriented_ring, plan
 from ccproof.evaluate.loop.regular import regular_triangles
 
 __all__ = ["LoopSurface", "ROTATIONS", "loop_limit_surface"]
+
+#: per ring-key encoding (:mod:`ccproof.evaluate.loop.rings`) with the boundary mode: the rotation (read from
+#: corner 0) or the plan (read from corner r)
+_RING_PLANS: dict = {}
 
 #: (Jacobian, offset) of the parameter of a triangle listed from its corner r: (u', v') = J (u, v) + o
 ROTATIONS = (
@@ -154,8 +158,9 @@ class LoopSurface:
         # the complex of the other triangles' corners' fans (the rings walked below)
         near = np.zeros(len(X), dtype=bool)
         near[F[~reg].reshape(-1)] = True
-        self._cx = TriComplex(F[near[F].any(axis=1)].tolist(),
-                              dict(mesh.edge_sharpness), dict(mesh.vertex_sharpness), None, mesh.options.boundary)
+        self._cx = None  # built when a ring is read the per-triangle way (_complex)
+        self._cx_faces = F[near[F].any(axis=1)]
+        self._tags = (dict(mesh.edge_sharpness), dict(mesh.vertex_sharpness), None, mesh.options.boundary)
         # corners decided without the complex: simple ones regular, untagged interior others irregular
         ask = boundary.copy()
         ask[list(tagged)] = True
@@ -171,41 +176,72 @@ class LoopSurface:
             if hit is None:
                 self._root[f] = self._add_face(X, tri)
             elif hit is not True:
-                self._root[f] = self._add(hit[0], 0, X[hit[1]], 0)
+                self._root[f] = self._add(hit[0], hit[1], X[hit[2]], 0)
         self._finish()
+
+    def _complex(self):
+        """The complex of the fans of the non-regular triangles' corners (the rings read the per-triangle way)."""
+        if self._cx is None:
+            self._cx = TriComplex(self._cx_faces.tolist(), *self._tags)
+        return self._cx
 
     def _ring_groups(self, mesh, F, in_cx, reg, simple, ask):
         """The rings of the triangles without a corner known irregular, read at once (:mod:`.rings`) and grouped by
-        key: per face (plan, ring labels); ``True`` for those whose box-spline nets are stored here at once (their
-        roots set). Each group's key and ring are read once the per-triangle way and checked against the group's."""
+        key: per face (plan, rotation, ring labels); ``True`` for those whose box-spline nets are stored here at once
+        (their roots set). A key's plan and rotation are read once the per-triangle way (the ring checked against the
+        compiled one) and kept for the process; faces left out go the per-triangle way."""
         from ccproof.evaluate.loop.rings import triangle_rings
 
-        ok = np.asarray(simple) | ask
-        faces = np.flatnonzero(~reg & ok[F].all(axis=1))
+        faces = np.flatnonzero(~reg & (simple | ask)[F].all(axis=1))
         if not faces.size:
             return {}
         twin = mesh.halfedges.twin.copy()
-        twin[~in_cx[np.maximum(twin, 0) // 3] | (twin < 0)] = -1
-        rings, rows = triangle_rings(F, twin, _halfedge_sharpness(F, mesh.edge_sharpness),
-                                     _vertex_corners(len(ok), mesh.vertex_sharpness), faces,
-                                     int(np.bincount(F.reshape(-1)).max()) + 1)
-        _, first, group = np.unique(rows, axis=0, return_index=True, return_inverse=True)
-        group = group.reshape(-1)
+        twin[(twin < 0) | ~in_cx[np.maximum(twin, 0) // 3]] = -1
+        args = (F, twin, _halfedge_sharpness(F, mesh.edge_sharpness), _vertex_corners(len(ask), mesh.vertex_sharpness))
+        max_fan = int(np.bincount(F.reshape(-1)).max()) + 1
+
+        def read(f, r):  # the rings of faces f from their corner r, and their encodings
+            return triangle_rings(*args, f, max_fan, np.full(f.size, r))
+
+        rings, rows = triangle_rings(*args, faces, max_fan)
         known = {}
-        for g, i in enumerate(first.tolist()):
-            tri = F[faces[i]].tolist()
-            r, ring, key = oriented_ring(self._cx, tri)
-            n = len(ring)
-            if r != 0 or rings[i, :n].tolist() != ring or rings[i, n:n + 1].tolist() not in ([], [-1]):
-                continue
-            p = plan(key)
-            members = np.flatnonzero(group == g)
-            if isinstance(p, Regular):
-                self._add_regular(p, faces[members], rings[members, :n])
-                known.update(dict.fromkeys(faces[members].tolist(), True))
-            else:
-                known.update((f, (p, rg)) for f, rg in zip(faces[members].tolist(), rings[members, :n]))
+        for i, members in _groups(rows):
+            r = self._rotation(rows[i], F[faces[i]].tolist())
+            rg, rw = (rings[members], rows[members]) if r == 0 else read(faces[members], r)
+            for j, sub in ([(0, np.arange(members.size))] if r == 0 else _groups(rw)):
+                p = self._ring_plan(r, rw[j], F[faces[members[j]]].tolist(), rg[j])
+                if p is None:
+                    continue
+                fs, x = faces[members[sub]], rg[sub, :int(rw[j, 0])]
+                if isinstance(p, Regular) and r == 0:
+                    self._add_regular(p, fs, x)
+                    known.update(dict.fromkeys(fs.tolist(), True))
+                else:
+                    known.update((f, (p, r, y)) for f, y in zip(fs.tolist(), x))
         return known
+
+    def _rotation(self, row, tri):
+        """The corner r a triangle's ring is read from (:func:`~ccproof.evaluate.loop.plan.oriented_ring`), per key
+        encoding ``row`` (read from corner 0) of the triangle ``tri`` (kept for the process)."""
+        key = ("rotation", self._tags[3], row.tobytes())
+        if key not in _RING_PLANS:
+            irr = irregular_corners(self._complex(), tri)
+            _RING_PLANS[key] = irr[0] if len(irr) == 1 else 0
+        return _RING_PLANS[key]
+
+    def _ring_plan(self, r, row, tri, ring):
+        """The plan of the triangles of key encoding ``row`` from their corner r (the triangle ``tri`` one of them,
+        its compiled ring ``ring``), or None where the compiled ring is not the per-triangle one (kept for the
+        process)."""
+        key = (r, self._tags[3], row.tobytes())
+        hit = _RING_PLANS.get(key)
+        if hit is None:
+            r2, labels, k = oriented_ring(self._complex(), tri)
+            n = len(labels)
+            if r2 != r or ring[:n].tolist() != labels or ring[n:n + 1].tolist() not in ([], [-1]):
+                return None
+            hit = _RING_PLANS[key] = plan(k)
+        return hit
 
     def _add_regular(self, p, faces, rings):
         """Box-spline nodes for triangles of one configuration: nets ``p.net @ X[ring]`` in one batched product."""
@@ -221,7 +257,7 @@ class LoopSurface:
         self._nets += list(np.matmul(p.net, self._X[rings]))
 
     def _add_face(self, X, tri):
-        cx, simple, ask = self._cx, self._simple, self._ask
+        cx, simple, ask = self._complex(), self._simple, self._ask
         irr = [i for i in range(3) if not simple[tri[i]]
                and (not ask[tri[i]] or not cx.is_regular(tri[i], tri[(i + 1) % 3]))]
         r, ring, key = oriented_ring(cx, tri, irr)
@@ -419,6 +455,18 @@ class LoopSurface:
             raise CCProofError(f"point {i}: face {int(face[i])}, (u, v) = ({float(u[i])!r}, {float(v[i])!r}) is not in "
                                f"a triangle of this mesh ({m} faces; u, v >= 0, u + v <= 1)")
         return face, u, v
+
+
+def _groups(rows):
+    """(first row, rows) of the groups of equal rows of ``rows`` (a hash of each, then each row compared with its
+    group's first: rows of a colliding hash are left out)."""
+    w = np.random.default_rng(12345).integers(1, 2**62, rows.shape[1]) | 1
+    _, first, group = np.unique(rows @ w, return_index=True, return_inverse=True)
+    group = group.reshape(-1)
+    group[~(rows == rows[first[group]]).all(axis=1)] = -1
+    order = np.argsort(group, kind="stable")
+    bounds = np.searchsorted(group[order], np.arange(first.size + 1))
+    return [(int(first[g]), order[bounds[g]:bounds[g + 1]]) for g in range(first.size)]
 
 
 def _halfedge_sharpness(F, edge_sharpness):
