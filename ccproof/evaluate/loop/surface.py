@@ -200,24 +200,29 @@ class LoopSurface:
         args = (F, twin, _halfedge_sharpness(F, mesh.edge_sharpness), _vertex_corners(len(ask), mesh.vertex_sharpness))
         max_fan = int(np.bincount(F.reshape(-1)).max()) + 1
 
-        def read(f, r):  # the rings of faces f from their corner r, and their encodings
-            return triangle_rings(*args, f, max_fan, np.full(f.size, r))
-
         rings, rows = triangle_rings(*args, faces, max_fan)
-        known = {}
+        rot, groups = np.zeros(faces.size, dtype=np.int64), []
         for i, members in _groups(rows):
-            r = self._rotation(rows[i], F[faces[i]].tolist())
-            rg, rw = (rings[members], rows[members]) if r == 0 else read(faces[members], r)
-            for j, sub in ([(0, np.arange(members.size))] if r == 0 else _groups(rw)):
-                p = self._ring_plan(r, rw[j], F[faces[members[j]]].tolist(), rg[j])
-                if p is None:
-                    continue
-                fs, x = faces[members[sub]], rg[sub, :int(rw[j, 0])]
-                if isinstance(p, Regular) and r == 0:
-                    self._add_regular(p, fs, x)
-                    known.update(dict.fromkeys(fs.tolist(), True))
-                else:
-                    known.update((f, (p, r, y)) for f, y in zip(fs.tolist(), x))
+            rot[members] = r = self._rotation(rows[i], F[faces[i]].tolist())
+            if r == 0:
+                groups.append((0, rings, rows, i, members))
+        turned = np.flatnonzero(rot)  # rings read from corner r; grouped again (their keys from there)
+        if turned.size:
+            rt, wt = triangle_rings(*args, faces[turned], max_fan, rot[turned])
+            groups += [(int(rot[turned[j]]), rt, wt, j, sub)
+                       for j, sub in _groups(np.column_stack([rot[turned], wt]))]
+        known = {}
+        for r, rg, rw, j, sub in groups:
+            f0 = faces[j] if r == 0 else faces[turned[j]]
+            p = self._ring_plan(r, rw[j], F[f0].tolist(), rg[j])
+            if p is None:
+                continue
+            fs, x = (faces[sub] if r == 0 else faces[turned[sub]]), rg[sub, :int(rw[j, 0])]
+            if isinstance(p, Regular) and r == 0:
+                self._add_regular(p, fs, x)
+                known.update(dict.fromkeys(fs.tolist(), True))
+            else:
+                known.update((f, (p, r, y)) for f, y in zip(fs.tolist(), x))
         return known
 
     def _rotation(self, row, tri):
