@@ -17,12 +17,11 @@ __all__ = ["triangle_rings"]
 
 
 @numba.njit(cache=True)
-def _fan(F, twin, h0, out):
+def _fan(F, twin, h0, out, ccw, cw):
     """Neighbours of the origin of half-edge h0 as ``TriComplex.fan`` lists them from h0's end: written to
     ``out`` with their faces (``out[1]``: the face between out[0][k] and out[0][k + 1]); (count, closed)."""
     start = F[h0 // 3, (h0 % 3 + 1) % 3]
     n, h = 1, h0
-    ccw = np.empty((2, out.shape[1]), dtype=np.int64)
     ccw[0, 0] = start
     while True:  # counter-clockwise: the third vertex of h's face, then the half-edge to it
         f = h // 3
@@ -37,7 +36,6 @@ def _fan(F, twin, h0, out):
         if h < 0:
             break
     m, h = 0, h0
-    cw = np.empty((2, out.shape[1]), dtype=np.int64)
     while twin[h] >= 0:  # clockwise from start
         t = twin[h]
         f = t // 3
@@ -63,15 +61,14 @@ def _label(ring, n, x):
 
 
 @numba.njit(cache=True)
-def _one(F, twin, hsharp, vcorner, f, rot, ring, row, cap_t):
-    n = 3
+def _ring(F, twin, f, rot, ring, scratch, faces):
+    """The ring of triangle f from its corner rot into ``ring``, its triangles into ``faces``: (size, count)."""
+    n, nf = 3, 0
     for i in range(3):
         ring[i] = F[f, (rot + i) % 3]
-    fan = np.empty((2, ring.size), dtype=np.int64)
-    faces = np.full(cap_t, -1, dtype=np.int64)
-    nf = 0
+    fan, ccw, cw = scratch[0:2], scratch[2:4], scratch[4:6]
     for i in range(3):
-        k, closed = _fan(F, twin, 3 * f + (rot + i) % 3, fan)
+        k, closed = _fan(F, twin, 3 * f + (rot + i) % 3, fan, ccw, cw)
         for j in range(k):
             _, n = _label(ring, n, fan[0, j])
         for j in range(k if closed else k - 1):
@@ -82,9 +79,15 @@ def _one(F, twin, hsharp, vcorner, f, rot, ring, row, cap_t):
             if new:
                 faces[nf] = g
                 nf += 1
-    size = ring.size
-    codes = np.empty(nf, dtype=np.int64)
-    lab = np.empty((nf, 3), dtype=np.int64)
+    return n, nf
+
+
+@numba.njit(cache=True)
+def _one(F, twin, hsharp, hbits, vbits, f, rot, ring, row, scratch, faces, lab, pairs):
+    """Ring and key encoding of one triangle: [size, count, triangles..., count, (edge, bits)..., count,
+    (label, bits)...], labels packed 20 bits each; returns the encoding's length."""
+    n, nf = _ring(F, twin, f, rot, ring, scratch, faces)
+    codes = pairs[:nf, 0]
     for q in range(nf):
         for j in range(3):
             lab[q, j] = _label(ring, n, F[faces[q], j])[0]
@@ -92,45 +95,49 @@ def _one(F, twin, hsharp, vcorner, f, rot, ring, row, cap_t):
         for j in range(3):
             if lab[q, j] < lab[q, s]:
                 s = j
-        codes[q] = (lab[q, s] * size + lab[q, (s + 1) % 3]) * size + lab[q, (s + 2) % 3]
-    row[:] = -1
+        codes[q] = (lab[q, s] << 40) | (lab[q, (s + 1) % 3] << 20) | lab[q, (s + 2) % 3]
     row[0], row[1] = n, nf
     row[2:2 + nf] = np.sort(codes)
-    p = 2 + cap_t
-    sharp = np.empty((3 * nf, 2), dtype=np.int64)
-    ns = 0
+    p, ns = 2 + nf, 0
     for q in range(nf):
         for j in range(3):
             h = 3 * faces[q] + j
             a, b = lab[q, j], lab[q, (j + 1) % 3]
             if hsharp[h] > 0 and (a < b or twin[h] < 0):
-                sharp[ns, 0] = min(a, b) * size + max(a, b)
-                sharp[ns, 1] = np.array([hsharp[h]]).view(np.int64)[0]
+                pairs[ns, 0] = (min(a, b) << 20) | max(a, b)
+                pairs[ns, 1] = hbits[h]
                 ns += 1
-    order = np.argsort(sharp[:ns, 0], kind="mergesort")
+    order = np.argsort(pairs[:ns, 0])
     row[p] = ns
-    for q in range(ns):  # sorted and unique (an edge seen from its two triangles once)
-        row[p + 1 + 2 * q] = sharp[order[q], 0]
-        row[p + 2 + 2 * q] = sharp[order[q], 1]
-    p += 1 + 6 * cap_t
+    for q in range(ns):  # an edge once (the key's selection): sorted by its labels
+        row[p + 1 + 2 * q] = pairs[order[q], 0]
+        row[p + 2 + 2 * q] = pairs[order[q], 1]
+    p += 1 + 2 * ns
     nc = 0
     for i in range(n):
-        if vcorner[ring[i]] > 0:
+        if vbits[ring[i]] != 0:
             row[p + 1 + 2 * nc] = i
-            row[p + 2 + 2 * nc] = np.array([vcorner[ring[i]]]).view(np.int64)[0]
+            row[p + 2 + 2 * nc] = vbits[ring[i]]
             nc += 1
     row[p] = nc
+    return p + 1 + 2 * nc
 
 
 @numba.njit(cache=True)
-def _all(F, twin, hsharp, vcorner, faces, rot, rings, rows, cap_t):
+def _all(F, twin, hsharp, vcorner, faces, rot, rings, rows, lengths, cap_t):
+    hbits, vbits = hsharp.view(np.int64), vcorner.view(np.int64)
+    scratch = np.empty((6, rings.shape[1]), dtype=np.int64)
+    tri = np.empty(cap_t, dtype=np.int64)
+    lab = np.empty((cap_t, 3), dtype=np.int64)
+    pairs = np.empty((3 * cap_t, 2), dtype=np.int64)
     for r in range(faces.size):
-        _one(F, twin, hsharp, vcorner, faces[r], rot[r], rings[r], rows[r], cap_t)
+        lengths[r] = _one(F, twin, hsharp, hbits, vbits, faces[r], rot[r], rings[r], rows[r], scratch, tri, lab, pairs)
 
 
 def triangle_rings(F, twin, hsharp, vcorner, faces, max_fan, rot=None):
-    """(rings (R, cap) padded with -1, key encodings (R, W)) of the triangles ``faces`` read from their corner
-    ``rot`` (0 where not given), as :func:`~ccproof.evaluate.loop.plan.oriented_ring` lists a triangle from its corner r.
+    """(rings (R, cap) padded with -1, key encodings (R, W) padded with -1, their lengths (R,)) of the triangles
+    ``faces`` read from their corner ``rot`` (0 where not given), as :func:`~ccproof.evaluate.loop.plan.oriented_ring`
+    lists a triangle from its corner r. Equal encodings (``rows[i, :lengths[i]]``, of any mesh) are equal keys.
 
     Parameters
     ----------
@@ -148,23 +155,24 @@ def triangle_rings(F, twin, hsharp, vcorner, faces, max_fan, rot=None):
 
     Examples
     --------
-    Two triangles of a square: the ring of triangle 0 is the four vertices, its triangles both, coded as
-    ``(a cap + b) cap + c`` with ``cap = 3 + 3 max_fan`` (12 here):
+    Two triangles of a square: the ring of triangle 0 is the four vertices, its triangles both, as labels of
+    20 bits each (``(a << 40) | (b << 20) | c``), no tagged edge, no tagged vertex:
 
     >>> F = np.array([[0, 1, 2], [1, 3, 2]])
     >>> twin = np.array([-1, 5, -1, -1, -1, 1])
-    >>> rings, rows = triangle_rings(F, twin, np.zeros(6), np.zeros(4), np.array([0]), 3)
-    >>> rings[0, :4].tolist(), rows[0, :4].tolist()
-    ([0, 1, 2, 3], [4, 2, 14, 182])
+    >>> rings, rows, lengths = triangle_rings(F, twin, np.zeros(6), np.zeros(4), np.array([0]), 3)
+    >>> rings[0, :4].tolist(), rows[0].tolist() == [4, 2, 2**20 + 2, 2**40 + 3 * 2**20 + 2, 0, 0]
+    ([0, 1, 2, 3], True)
     """
     cap = 3 + 3 * max_fan
     cap_t = 3 * max_fan
     rings = np.full((faces.size, cap), -1, dtype=np.int64)
-    rows = np.empty((faces.size, 3 + 7 * cap_t + 1 + 2 * cap), dtype=np.int64)
+    rows = np.full((faces.size, 4 + 7 * cap_t + 2 * cap), -1, dtype=np.int64)
+    lengths = np.zeros(faces.size, dtype=np.int64)
     if faces.size:
         _all(np.ascontiguousarray(F, dtype=np.int64), np.ascontiguousarray(twin, dtype=np.int64),
              np.ascontiguousarray(hsharp, dtype=np.float64), np.ascontiguousarray(vcorner, dtype=np.float64),
              np.ascontiguousarray(faces, dtype=np.int64),
              np.zeros(faces.size, dtype=np.int64) if rot is None else np.ascontiguousarray(rot, dtype=np.int64),
-             rings, rows, cap_t)
-    return rings, rows
+             rings, rows, lengths, cap_t)
+    return rings, rows[:, :int(lengths.max(initial=0))], lengths

@@ -200,16 +200,16 @@ class LoopSurface:
         args = (F, twin, _halfedge_sharpness(F, mesh.edge_sharpness), _vertex_corners(len(ask), mesh.vertex_sharpness))
         max_fan = int(np.bincount(F.reshape(-1)).max()) + 1
 
-        rings, rows = triangle_rings(*args, faces, max_fan)
+        rings, rows, lengths = triangle_rings(*args, faces, max_fan)
         rot, groups = np.zeros(faces.size, dtype=np.int64), []
         for i, members in _groups(rows):
-            rot[members] = r = self._rotation(rows[i], F[faces[i]].tolist())
+            rot[members] = r = self._rotation(rows[i, :lengths[i]], F[faces[i]].tolist())
             if r == 0:
-                groups.append((0, rings, rows, i, members))
+                groups.append((0, rings, rows[:, :lengths[i]], i, members))
         turned = np.flatnonzero(rot)  # rings read from corner r; grouped again (their keys from there)
         if turned.size:
-            rt, wt = triangle_rings(*args, faces[turned], max_fan, rot[turned])
-            groups += [(int(rot[turned[j]]), rt, wt, j, sub)
+            rt, wt, lt = triangle_rings(*args, faces[turned], max_fan, rot[turned])
+            groups += [(int(rot[turned[j]]), rt, wt[:, :lt[j]], j, sub)
                        for j, sub in _groups(np.column_stack([rot[turned], wt]))]
         known = {}
         for r, rg, rw, j, sub in groups:
@@ -462,11 +462,15 @@ class LoopSurface:
         return face, u, v
 
 
+@functools.lru_cache(maxsize=8)
+def _hash_weights(n):
+    return np.random.default_rng(12345).integers(1, 2**62, n) | 1
+
+
 def _groups(rows):
     """(first row, rows) of the groups of equal rows of ``rows`` (a hash of each, then each row compared with its
     group's first: rows of a colliding hash are left out)."""
-    w = np.random.default_rng(12345).integers(1, 2**62, rows.shape[1]) | 1
-    _, first, group = np.unique(rows @ w, return_index=True, return_inverse=True)
+    _, first, group = np.unique(rows @ _hash_weights(rows.shape[1]), return_index=True, return_inverse=True)
     group = group.reshape(-1)
     group[~(rows == rows[first[group]]).all(axis=1)] = -1
     order = np.argsort(group, kind="stable")
@@ -493,7 +497,7 @@ def _halfedge_sharpness(F, edge_sharpness):
 def _vertex_corners(n, vertex_sharpness):
     out = np.zeros(n)
     if vertex_sharpness:
-        out[np.array(list(vertex_sharpness), dtype=np.int64)] = list(vertex_sharpness.values())
+        out[np.array(list(vertex_sharpness), dtype=np.int64)] = np.maximum(list(vertex_sharpness.values()), 0.0)
     return out
 
 
