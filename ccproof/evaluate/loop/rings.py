@@ -52,45 +52,46 @@ def _fan(F, twin, h0, out, ccw, cw):
 
 
 @numba.njit(cache=True)
-def _label(ring, n, x):
-    for i in range(n):
-        if ring[i] == x:
-            return i, n
+def _label(ring, n, x, seen, at):
+    """The label of vertex x in the ring (added where new): (label, size); ``seen[x] == at[0]`` where x has
+    one in the ring of triangle ``at[0]``, ``at[1] + x``."""
+    if seen[x] == at[0]:
+        return at[1 + x], n
+    seen[x] = at[0]
+    at[1 + x] = n
     ring[n] = x
     return n, n + 1
 
 
 @numba.njit(cache=True)
-def _ring(F, twin, f, rot, ring, scratch, faces):
+def _ring(F, twin, f, rot, ring, scratch, faces, seen, at, fseen):
     """The ring of triangle f from its corner rot into ``ring``, its triangles into ``faces``: (size, count)."""
-    n, nf = 3, 0
+    n, nf = 0, 0
     for i in range(3):
-        ring[i] = F[f, (rot + i) % 3]
+        _, n = _label(ring, n, F[f, (rot + i) % 3], seen, at)
     fan, ccw, cw = scratch[0:2], scratch[2:4], scratch[4:6]
     for i in range(3):
         k, closed = _fan(F, twin, 3 * f + (rot + i) % 3, fan, ccw, cw)
         for j in range(k):
-            _, n = _label(ring, n, fan[0, j])
+            _, n = _label(ring, n, fan[0, j], seen, at)
         for j in range(k if closed else k - 1):
             g = fan[1, j]
-            new = True
-            for q in range(nf):
-                new = new and faces[q] != g
-            if new:
+            if fseen[g] != at[0]:
+                fseen[g] = at[0]
                 faces[nf] = g
                 nf += 1
     return n, nf
 
 
 @numba.njit(cache=True)
-def _one(F, twin, hsharp, hbits, vbits, f, rot, ring, row, scratch, faces, lab, pairs):
+def _one(F, twin, hsharp, hbits, vbits, f, rot, ring, row, scratch, faces, lab, pairs, seen, at, fseen):
     """Ring and key encoding of one triangle: [size, count, triangles..., count, (edge, bits)..., count,
     (label, bits)...], labels packed 20 bits each; returns the encoding's length."""
-    n, nf = _ring(F, twin, f, rot, ring, scratch, faces)
+    n, nf = _ring(F, twin, f, rot, ring, scratch, faces, seen, at, fseen)
     codes = pairs[:nf, 0]
     for q in range(nf):
         for j in range(3):
-            lab[q, j] = _label(ring, n, F[faces[q], j])[0]
+            lab[q, j] = _label(ring, n, F[faces[q], j], seen, at)[0]
         s = 0
         for j in range(3):
             if lab[q, j] < lab[q, s]:
@@ -130,8 +131,13 @@ def _all(F, twin, hsharp, vcorner, faces, rot, rings, rows, lengths, cap_t):
     tri = np.empty(cap_t, dtype=np.int64)
     lab = np.empty((cap_t, 3), dtype=np.int64)
     pairs = np.empty((3 * cap_t, 2), dtype=np.int64)
+    seen = np.full(vbits.size, -1, dtype=np.int64)  # per vertex and face: the last triangle whose ring holds it
+    at = np.empty(1 + vbits.size, dtype=np.int64)
+    fseen = np.full(F.shape[0], -1, dtype=np.int64)
     for r in range(faces.size):
-        lengths[r] = _one(F, twin, hsharp, hbits, vbits, faces[r], rot[r], rings[r], rows[r], scratch, tri, lab, pairs)
+        at[0] = r
+        lengths[r] = _one(F, twin, hsharp, hbits, vbits, faces[r], rot[r], rings[r], rows[r], scratch, tri, lab, pairs,
+                          seen, at, fseen)
 
 
 def triangle_rings(F, twin, hsharp, vcorner, faces, max_fan, rot=None):

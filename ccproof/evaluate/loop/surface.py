@@ -150,7 +150,7 @@ class LoopSurface:
         self._holes = np.asarray(mesh.is_hole, dtype=bool) if mesh.is_hole.any() else None
         X = np.asarray(mesh.vertices, dtype=np.float64)
         self._kind, self._rot, self._ref, self._children, self._gid = [], [], [], [], []
-        self._nets, self._groups = [], {}
+        self._nets, self._n_nets, self._groups = [], 0, {}  # nets: (12, 3) or (m, 12, 3) each
         self.split_depth = 0
         tagged = {v for e in mesh.edge_sharpness for v in e} | set(mesh.vertex_sharpness)
         F = mesh.indices.reshape(-1, 3)
@@ -253,13 +253,14 @@ class LoopSurface:
         m = faces.size
         node = self._nreg + len(self._kind)
         self._root[faces] = node + np.arange(m)
-        ref = self._nreg + len(self._nets)
+        ref = self._nreg + self._n_nets
         self._kind += [_REGULAR] * m
         self._rot += [0] * m
         self._ref += range(ref, ref + m)
         self._children += [(-1, -1, -1, -1)] * m
         self._gid += [-1] * m
-        self._nets += list(np.matmul(p.net, self._X[rings]))
+        self._nets.append(np.matmul(p.net, self._X[rings]))
+        self._n_nets += m
 
     def _add_face(self, X, tri):
         cx, simple, ask = self._complex(), self._simple, self._ask
@@ -278,8 +279,9 @@ class LoopSurface:
         self.split_depth = max(self.split_depth, depth)
         if isinstance(p, Regular):
             i = node - self._nreg
-            self._kind[i], self._ref[i] = _REGULAR, self._nreg + len(self._nets)
+            self._kind[i], self._ref[i] = _REGULAR, self._nreg + self._n_nets
             self._nets.append(p.net @ C)
+            self._n_nets += 1
         elif isinstance(p, Corner):
             g = self._groups.setdefault(id(p), (len(self._groups), p, []))
             i = node - self._nreg
@@ -297,7 +299,7 @@ class LoopSurface:
         self._ref = np.r_[np.arange(nr, dtype=np.int64), np.array(self._ref, dtype=np.int64)]
         self._children = np.concatenate([np.full((nr, 4), -1, dtype=np.int64),
                                          np.array(self._children, dtype=np.int64).reshape(-1, 4)])
-        local_nets = np.array(self._nets, dtype=np.float64).reshape(-1, 12, 3)  # of the local subdivisions
+        local_nets = np.concatenate([x.reshape(-1, 12, 3) for x in self._nets] + [np.zeros((0, 12, 3))])
         self._gid = np.r_[np.full(nr, -1, dtype=np.int64), np.array(self._gid, dtype=np.int64)]
         self._corner_data = []
         groups = sorted(self._groups.values(), key=lambda g: g[0])
