@@ -1,11 +1,12 @@
-"""The one-rings of many triangles at once (numba), read as :func:`~ccproof.evaluate.loop.complex.canonical_triangle_ring`
-reads them, with an encoding of their keys: triangles with equal encodings have equal ring keys.
+"""The one-rings of many triangles at once (numba), read as
+:func:`~ccproof.evaluate.loop.complex.canonical_triangle_ring` reads them, with an encoding of their keys: triangles
+with equal encodings have equal ring keys (the key computed once per encoding, at setup).
 
 Half-edge ``h = 3 f + i`` runs from corner i of triangle f to corner i + 1; ``twin[h]`` is its opposite
-(-1 where the complex of the rings has none). The encoding of a ring is one row of integers: the ring's size,
-its triangles (in ring labels, each listed from its lowest label, sorted), its tagged edges (the key's
-selection: from the lower label, or on the boundary; with the bits of their sharpness) and its tagged
-vertices (with the bits of their sharpness), each list with its length, padded with -1.
+(-1 where the complex of the rings has none). The encoding of a ring is a row of integers: the ring's size,
+its triangles (in ring labels of 20 bits, each triangle listed from its lowest label, sorted), its tagged edges
+(the key's selection: from the lower label, or on the boundary; with the bits of their sharpness) and its tagged
+vertices (with the bits of their sharpness), each list after its length.
 """
 
 from __future__ import annotations
