@@ -218,8 +218,8 @@ class LoopSurface:
             if p is None:
                 continue
             fs, x = (faces[sub] if r == 0 else faces[turned[sub]]), rg[sub, :int(rw[j, 0])]
-            if isinstance(p, Regular) and r == 0:
-                self._add_regular(p, fs, x)
+            if isinstance(p, (Regular, Corner)):
+                (self._add_regular if isinstance(p, Regular) else self._add_corners)(p, r, fs, x)
                 known.update(dict.fromkeys(fs.tolist(), True))
             else:
                 known.update((f, (p, r, y)) for f, y in zip(fs.tolist(), x))
@@ -248,14 +248,27 @@ class LoopSurface:
             hit = _RING_PLANS[key] = plan(k)
         return hit
 
-    def _add_regular(self, p, faces, rings):
-        """Box-spline nodes for triangles of one configuration: nets ``p.net @ X[ring]`` in one batched product."""
+    def _add_corners(self, p, r, faces, rings):
+        """Corner nodes (Stam's layers, read from corner r) for triangles of one configuration: their rings' points."""
+        m = faces.size
+        g = self._groups.setdefault(id(p), (len(self._groups), p, []))
+        self._root[faces] = self._nreg + len(self._kind) + np.arange(m)
+        self._kind += [_CORNER] * m
+        self._rot += [r] * m
+        self._ref += range(len(g[2]), len(g[2]) + m)
+        self._children += [(-1, -1, -1, -1)] * m
+        self._gid += [g[0]] * m
+        g[2].extend(self._X[rings])
+
+    def _add_regular(self, p, r, faces, rings):
+        """Box-spline nodes for triangles of one configuration (read from corner r): nets ``p.net @ X[ring]`` in one
+        batched product."""
         m = faces.size
         node = self._nreg + len(self._kind)
         self._root[faces] = node + np.arange(m)
         ref = self._nreg + self._n_nets
         self._kind += [_REGULAR] * m
-        self._rot += [0] * m
+        self._rot += [r] * m
         self._ref += range(ref, ref + m)
         self._children += [(-1, -1, -1, -1)] * m
         self._gid += [-1] * m
