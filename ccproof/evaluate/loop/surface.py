@@ -171,11 +171,13 @@ class LoopSurface:
         self._nreg = nr  # nodes 0 .. nr - 1; the lists hold the nodes from nr on
         self._labels, self._X = labels, X  # the regular triangles' nets: X[labels] (_finish)
         known = self._ring_groups(mesh, F, near[F].any(axis=1), reg, simple, ask)
-        for f, tri in zip(np.flatnonzero(~reg).tolist(), F[~reg].tolist()):
+        rest = ~reg
+        rest[[f for f, hit in known.items() if hit is True]] = False
+        for f, tri in zip(np.flatnonzero(rest).tolist(), F[rest].tolist()):
             hit = known.get(f)
             if hit is None:
                 self._root[f] = self._add_face(X, tri)
-            elif hit is not True:
+            else:
                 self._root[f] = self._add(hit[0], hit[1], X[hit[2]], 0)
         self._finish()
 
@@ -357,7 +359,7 @@ class LoopSurface:
             nl = min(PRECOMPUTED_LAYERS, KD.shape[0])
             lim = np.einsum("N,mNk->mk", p.limit_mask, coords)  # (m, 3)
             m = len(coords)
-            W = KD[:nl].transpose(0, 1, 3, 2).reshape(nl * 45, p.size)
+            W = _layer_matrix(p, nl)
             B = (W @ coords.transpose(1, 0, 2).reshape(p.size, 3 * m)).reshape(nl, 3, 15, m, 3)
             B = B.transpose(3, 0, 1, 4, 2)  # (m, layer, child, coordinate, monomial)
             out = blocks[nb:nb + 3 * nl * m].reshape(m, nl, 3, 3, 15)
@@ -491,6 +493,18 @@ def _groups(rows):
     order = np.argsort(group, kind="stable")
     bounds = np.searchsorted(group[order], np.arange(first.size + 1))
     return [(int(first[g]), order[bounds[g]:bounds[g + 1]]) for g in range(first.size)]
+
+
+_LAYER_MATRICES: dict = {}
+
+
+def _layer_matrix(p, nl):
+    """The first ``nl`` layers of a corner configuration's monomial form as one (nl 45, N) matrix (kept)."""
+    hit = _LAYER_MATRICES.get((id(p), nl))
+    if hit is None or hit[0] is not p:
+        W = p.poly_layers[:nl].transpose(0, 1, 3, 2).reshape(nl * 45, p.size)
+        hit = _LAYER_MATRICES[(id(p), nl)] = (p, W)
+    return hit[1]
 
 
 def _halfedge_sharpness(F, edge_sharpness):
