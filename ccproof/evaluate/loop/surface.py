@@ -352,10 +352,9 @@ class LoopSurface:
         nr = labels.shape[0]
         quartic_blocks(X, labels, K, blocks[:nr])
         blocks[nr:nb] = np.matmul(local_nets.transpose(0, 2, 1), K.T)
-        pblock, plim, kd = [], [], []
+        pblock, plim = [], []
         for p, coords in self._corner_data:
             KD = p.poly_layers  # (layers, 3, N, 15)
-            kd.append(KD.reshape(-1))
             nl = min(PRECOMPUTED_LAYERS, KD.shape[0])
             lim = np.einsum("N,mNk->mk", p.limit_mask, coords)  # (m, 3)
             m = len(coords)
@@ -373,7 +372,7 @@ class LoopSurface:
                   np.r_[0, np.cumsum(np.repeat(sizes * 3, counts))][:-1].astype(np.int64),
                   np.concatenate(plim + [np.zeros((0, 3))]))
         groups = (sizes, np.array([p.layers.shape[0] for p, _ in self._corner_data], dtype=np.int64),
-                  np.cumsum([0] + [x.size for x in kd])[:-1].astype(np.int64))
+                  np.cumsum([0] + [p.poly_layers.size for p, _ in self._corner_data])[:-1].astype(np.int64))
         flat = np.concatenate([c.reshape(-1) for _, c in self._corner_data] + [np.zeros(0)])
         # per node one word: its reference (block; piece; for a split its row of cinfo), rotation and kind
         split = self._kind == _SPLIT
@@ -381,7 +380,7 @@ class LoopSurface:
         info = cref * 16 + self._rot.astype(np.int64) * 4 + self._kind.astype(np.int64)
         cinfo = info[self._children[split]]
         self._k = (info[self._root], cinfo.reshape(-1, 4), blocks,
-                   (pieces, groups, np.concatenate(kd + [np.zeros(0)]), flat))
+                   (pieces, groups, _flat_layers(tuple(p for p, _ in self._corner_data)), flat))
 
     # ------------------------------------------------------------------ evaluation
     def evaluate(self, face, u, v, derivatives=0, *, parameterization="natural", threads=None):
@@ -496,6 +495,19 @@ def _groups(rows):
 
 
 _LAYER_MATRICES: dict = {}
+_FLAT_LAYERS: dict = {}
+
+
+def _flat_layers(plans):
+    """The layer tables (monomial form) of corner configurations one after the other, flat (kept for the last few
+    sequences of configurations: the same mesh set up again shares them; the kernel only reads them)."""
+    key = tuple(id(p) for p in plans)
+    hit = _FLAT_LAYERS.get(key)
+    if hit is None or any(a is not b for a, b in zip(hit[0], plans)):
+        if len(_FLAT_LAYERS) >= 8:
+            _FLAT_LAYERS.clear()
+        hit = _FLAT_LAYERS[key] = (plans, np.concatenate([p.poly_layers.reshape(-1) for p in plans] + [np.zeros(0)]))
+    return hit[1]
 
 
 def _layer_matrix(p, nl):
