@@ -11,10 +11,12 @@ vertices (with the bits of their sharpness), each list after its length.
 
 from __future__ import annotations
 
+import functools
+
 import numba
 import numpy as np
 
-__all__ = ["triangle_rings"]
+__all__ = ["triangle_rings", "equal_rows", "halfedge_sharpness", "vertex_corners"]
 
 
 @numba.njit(cache=True)
@@ -183,3 +185,42 @@ def triangle_rings(F, twin, hsharp, vcorner, faces, max_fan, rot=None):
              np.zeros(faces.size, dtype=np.int64) if rot is None else np.ascontiguousarray(rot, dtype=np.int64),
              rings, rows, lengths, cap_t)
     return rings, rows[:, :int(lengths.max(initial=0))], lengths
+
+
+@functools.lru_cache(maxsize=8)
+def _hash_weights(n):
+    return np.random.default_rng(12345).integers(1, 2**62, n) | 1
+
+
+def equal_rows(rows):
+    """(first row, rows) of the groups of equal rows of ``rows`` (a hash of each, then each row compared with its
+    group's first: rows of a colliding hash are left out)."""
+    _, first, group = np.unique(rows @ _hash_weights(rows.shape[1]), return_index=True, return_inverse=True)
+    group = group.reshape(-1)
+    group[~(rows == rows[first[group]]).all(axis=1)] = -1
+    order = np.argsort(group, kind="stable")
+    bounds = np.searchsorted(group[order], np.arange(first.size + 1))
+    return [(int(first[g]), order[bounds[g]:bounds[g + 1]]) for g in range(first.size)]
+
+
+def halfedge_sharpness(F, edge_sharpness):
+    """Per half-edge ``3 f + i`` of triangles ``F`` the sharpness of its edge (0 untagged)."""
+    out = np.zeros(F.size)
+    if edge_sharpness:
+        n = int(F.max()) + 1
+        E = np.array(list(edge_sharpness), dtype=np.int64).reshape(-1, 2)
+        code = np.minimum(E[:, 0], E[:, 1]) * n + np.maximum(E[:, 0], E[:, 1])
+        order = np.argsort(code)
+        a, b = F.reshape(-1), np.roll(F, -1, axis=1).reshape(-1)
+        h = np.minimum(a, b) * n + np.maximum(a, b)
+        pos = np.minimum(np.searchsorted(code, h, sorter=order), code.size - 1)
+        hit = code[order[pos]] == h
+        out[hit] = np.array(list(edge_sharpness.values()), dtype=np.float64)[order[pos[hit]]]
+    return out
+
+
+def vertex_corners(n, vertex_sharpness):
+    out = np.zeros(n)
+    if vertex_sharpness:
+        out[np.array(list(vertex_sharpness), dtype=np.int64)] = np.maximum(list(vertex_sharpness.values()), 0.0)
+    return out

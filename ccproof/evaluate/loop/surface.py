@@ -192,19 +192,19 @@ class LoopSurface:
         key: per face (plan, rotation, ring labels); ``True`` for those whose box-spline nets are stored here at once
         (their roots set). A key's plan and rotation are read once the per-triangle way (the ring checked against the
         compiled one) and kept for the process; faces left out go the per-triangle way."""
-        from ccproof.evaluate.loop.rings import triangle_rings
+        from ccproof.evaluate.loop.rings import equal_rows, halfedge_sharpness, triangle_rings, vertex_corners
 
         faces = np.flatnonzero(~reg & (simple | ask)[F].all(axis=1))
         if not faces.size:
             return {}
         twin = mesh.halfedges.twin.copy()
         twin[(twin < 0) | ~in_cx[np.maximum(twin, 0) // 3]] = -1
-        args = (F, twin, _halfedge_sharpness(F, mesh.edge_sharpness), _vertex_corners(len(ask), mesh.vertex_sharpness))
+        args = (F, twin, halfedge_sharpness(F, mesh.edge_sharpness), vertex_corners(len(ask), mesh.vertex_sharpness))
         max_fan = int(np.bincount(F.reshape(-1)).max()) + 1
 
         rings, rows, lengths = triangle_rings(*args, faces, max_fan)
         rot, groups = np.zeros(faces.size, dtype=np.int64), []
-        for i, members in _groups(rows):
+        for i, members in equal_rows(rows):
             rot[members] = r = self._rotation(rows[i, :lengths[i]], F[faces[i]].tolist())
             if r == 0:
                 groups.append((0, rings, rows[:, :lengths[i]], i, members))
@@ -212,7 +212,7 @@ class LoopSurface:
         if turned.size:
             rt, wt, lt = triangle_rings(*args, faces[turned], max_fan, rot[turned])
             groups += [(int(rot[turned[j]]), rt, wt[:, :lt[j]], j, sub)
-                       for j, sub in _groups(np.column_stack([rot[turned], wt]))]
+                       for j, sub in equal_rows(np.column_stack([rot[turned], wt]))]
         known = {}
         for r, rg, rw, j, sub in groups:
             f0 = faces[j] if r == 0 else faces[turned[j]]
@@ -478,22 +478,6 @@ class LoopSurface:
         return face, u, v
 
 
-@functools.lru_cache(maxsize=8)
-def _hash_weights(n):
-    return np.random.default_rng(12345).integers(1, 2**62, n) | 1
-
-
-def _groups(rows):
-    """(first row, rows) of the groups of equal rows of ``rows`` (a hash of each, then each row compared with its
-    group's first: rows of a colliding hash are left out)."""
-    _, first, group = np.unique(rows @ _hash_weights(rows.shape[1]), return_index=True, return_inverse=True)
-    group = group.reshape(-1)
-    group[~(rows == rows[first[group]]).all(axis=1)] = -1
-    order = np.argsort(group, kind="stable")
-    bounds = np.searchsorted(group[order], np.arange(first.size + 1))
-    return [(int(first[g]), order[bounds[g]:bounds[g + 1]]) for g in range(first.size)]
-
-
 _LAYER_MATRICES: dict = {}
 _FLAT_LAYERS: dict = {}
 
@@ -517,29 +501,6 @@ def _layer_matrix(p, nl):
         W = p.poly_layers[:nl].transpose(0, 1, 3, 2).reshape(nl * 45, p.size)
         hit = _LAYER_MATRICES[(id(p), nl)] = (p, W)
     return hit[1]
-
-
-def _halfedge_sharpness(F, edge_sharpness):
-    """Per half-edge ``3 f + i`` of triangles ``F`` the sharpness of its edge (0 untagged)."""
-    out = np.zeros(F.size)
-    if edge_sharpness:
-        n = int(F.max()) + 1
-        E = np.array(list(edge_sharpness), dtype=np.int64).reshape(-1, 2)
-        code = np.minimum(E[:, 0], E[:, 1]) * n + np.maximum(E[:, 0], E[:, 1])
-        order = np.argsort(code)
-        a, b = F.reshape(-1), np.roll(F, -1, axis=1).reshape(-1)
-        h = np.minimum(a, b) * n + np.maximum(a, b)
-        pos = np.minimum(np.searchsorted(code, h, sorter=order), code.size - 1)
-        hit = code[order[pos]] == h
-        out[hit] = np.array(list(edge_sharpness.values()), dtype=np.float64)[order[pos[hit]]]
-    return out
-
-
-def _vertex_corners(n, vertex_sharpness):
-    out = np.zeros(n)
-    if vertex_sharpness:
-        out[np.array(list(vertex_sharpness), dtype=np.int64)] = np.maximum(list(vertex_sharpness.values()), 0.0)
-    return out
 
 
 @functools.lru_cache(maxsize=1)
