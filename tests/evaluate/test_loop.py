@@ -342,6 +342,52 @@ def test_vectorized_regular_nets_equal_the_per_configuration_path():
         assert np.array_equal(p.net @ one.V[ring], one.V[labels[k]])
 
 
+def _tagged_meshes():
+    V, T = grid(6)
+    T = flip_edges(T, 6, seed=3)
+    out = [PolyMesh(V, T, options={"boundary": b}) for b in ("edge_only", "edge_and_corner")]
+    V, T = grid(8)
+    creases = {(i, i + 1): math.inf for i in range(36, 44)} | {(9 * i + 4, 9 * i + 13): math.inf for i in range(8)}
+    out.append(PolyMesh(V, T, creases=creases, corners={40: math.inf}))
+    V, T = icosahedron(seed=3)
+    one = Level(V, T).subdivide()
+    F = flip_edges(one.F, 25, seed=1)
+    rng = np.random.default_rng(1)
+    E = sorted({(min(a, b), max(a, b)) for f in F for a, b in zip(f, f[1:] + f[:1])})
+    creases = {E[i]: float(rng.choice([0.25, 1.0, 1.5, 2.75, math.inf])) for i in rng.choice(len(E), 25, replace=False)}
+    corners = {int(x): float(rng.choice([0.625, 2.25, math.inf])) for x in rng.choice(len(one.V), 3, replace=False)}
+    out.append(PolyMesh(one.V, F, creases=creases, corners=corners, holes=[5, 17]))
+    two = one.subdivide()  # creases on every 40th edge: rings whose keys from corner 0 agree, from corner 1 not
+    E = sorted({(min(a, b), max(a, b)) for f in two.F for a, b in zip(f, f[1:] + f[:1])})
+    out.append(PolyMesh(two.V, two.F, creases=dict.fromkeys(E[::40], math.inf)))
+    return out
+
+
+@pytest.mark.parametrize("backend", ["numba", "numpy"])
+def test_rings_read_at_once_equal_the_per_triangle_path(monkeypatch, backend):
+    """The rings of the boundary, crease and corner triangles read at once and grouped by key (compiled) give the
+    same surface, to the bit, as each triangle's ring read on its own (grids with boundary corners in both
+    boundary modes, creases and a corner tag, semi-sharp tags and holes); the per-triangle way is kept for a
+    new key only."""
+    from ccproof.evaluate.loop import surface
+
+    rng = np.random.default_rng(4)
+    for mesh in _tagged_meshes():
+        f = np.flatnonzero(~mesh.is_hole)[rng.integers(0, int((~mesh.is_hole).sum()), 2000)]
+        u, v = rng.random(f.size), rng.random(f.size)
+        flip = u + v > 1
+        u[flip], v[flip] = 1 - u[flip], 1 - v[flip]
+        u[:40], v[:40] = 2.0 ** -rng.integers(1, 60, 40), 0.0
+        fast = LoopSurface(mesh, backend=backend)
+        with monkeypatch.context() as m:
+            m.setattr(surface.LoopSurface, "_ring_groups", lambda *a: {})
+            slow = LoopSurface(mesh, backend=backend)
+        assert fast.n_regular == slow.n_regular and fast.n_corner == slow.n_corner
+        A, B = fast.evaluate(f, u, v, 2), slow.evaluate(f, u, v, 2)
+        for k in KEYS:
+            assert A[k].tobytes() == B[k].tobytes(), k
+
+
 @pytest.mark.parametrize("k", range(3, 13))
 def test_scheme_masks_are_left_eigenvectors(k):
     """The limit and tangent masks of ccproof.mesh.scheme on the one-ring subdivision matrices written here:

@@ -33,10 +33,14 @@ import numpy as np
 from ccproof.errors import CCProofError
 from ccproof.evaluate.loop.box_spline import basis
 from ccproof.evaluate.loop.complex import TriComplex
-from ccproof.evaluate.loop.plan import MAX_DEPTH, Corner, Regular, oriented_ring, plan
+from ccproof.evaluate.loop.plan import MAX_DEPTH, Corner, Regular, irregular_corners, oriented_ring, plan
 from ccproof.evaluate.loop.regular import regular_triangles
 
 __all__ = ["LoopSurface", "ROTATIONS", "loop_limit_surface"]
+
+#: per ring-key encoding (:mod:`ccproof.evaluate.loop.rings`) with the boundary mode: the rotation (read from
+#: corner 0) or the plan (read from corner r)
+_RING_PLANS: dict = {}
 
 #: (Jacobian, offset) of the parameter of a triangle listed from its corner r: (u', v') = J (u, v) + o
 ROTATIONS = (
@@ -146,7 +150,7 @@ class LoopSurface:
         self._holes = np.asarray(mesh.is_hole, dtype=bool) if mesh.is_hole.any() else None
         X = np.asarray(mesh.vertices, dtype=np.float64)
         self._kind, self._rot, self._ref, self._children, self._gid = [], [], [], [], []
-        self._nets, self._groups = [], {}
+        self._nets, self._n_nets, self._groups = [], 0, {}  # nets: (12, 3) or (m, 12, 3) each
         self.split_depth = 0
         tagged = {v for e in mesh.edge_sharpness for v in e} | set(mesh.vertex_sharpness)
         F = mesh.indices.reshape(-1, 3)
@@ -154,8 +158,9 @@ class LoopSurface:
         # the complex of the other triangles' corners' fans (the rings walked below)
         near = np.zeros(len(X), dtype=bool)
         near[F[~reg].reshape(-1)] = True
-        self._cx = TriComplex(F[near[F].any(axis=1)].tolist(),
-                              dict(mesh.edge_sharpness), dict(mesh.vertex_sharpness), None, mesh.options.boundary)
+        self._cx = None  # built when a ring is read the per-triangle way (_complex)
+        self._cx_faces = F[near[F].any(axis=1)]
+        self._tags = (dict(mesh.edge_sharpness), dict(mesh.vertex_sharpness), None, mesh.options.boundary)
         # corners decided without the complex: simple ones regular, untagged interior others irregular
         ask = boundary.copy()
         ask[list(tagged)] = True
@@ -165,12 +170,115 @@ class LoopSurface:
         nr = labels.shape[0]
         self._nreg = nr  # nodes 0 .. nr - 1; the lists hold the nodes from nr on
         self._labels, self._X = labels, X  # the regular triangles' nets: X[labels] (_finish)
-        for f, tri in zip(np.flatnonzero(~reg).tolist(), F[~reg].tolist()):
-            self._root[f] = self._add_face(X, tri)
+        known = self._ring_groups(mesh, F, near[F].any(axis=1), reg, simple, ask)
+        rest = ~reg
+        rest[[f for f, hit in known.items() if hit is True]] = False
+        for f, tri in zip(np.flatnonzero(rest).tolist(), F[rest].tolist()):
+            hit = known.get(f)
+            if hit is None:
+                self._root[f] = self._add_face(X, tri)
+            else:
+                self._root[f] = self._add(hit[0], hit[1], X[hit[2]], 0)
         self._finish()
 
+    def _complex(self):
+        """The complex of the fans of the non-regular triangles' corners (the rings read the per-triangle way)."""
+        if self._cx is None:
+            self._cx = TriComplex(self._cx_faces.tolist(), *self._tags)
+        return self._cx
+
+    def _ring_groups(self, mesh, F, in_cx, reg, simple, ask):
+        """The rings of the triangles without a corner known irregular, read at once (:mod:`.rings`) and grouped by
+        key: per face (plan, rotation, ring labels); ``True`` for those whose box-spline nets are stored here at once
+        (their roots set). A key's plan and rotation are read once the per-triangle way (the ring checked against the
+        compiled one) and kept for the process; faces left out go the per-triangle way."""
+        from ccproof.evaluate.loop.rings import equal_rows, halfedge_sharpness, triangle_rings, vertex_corners
+
+        faces = np.flatnonzero(~reg & (simple | ask)[F].all(axis=1))
+        if not faces.size:
+            return {}
+        twin = mesh.halfedges.twin.copy()
+        twin[(twin < 0) | ~in_cx[np.maximum(twin, 0) // 3]] = -1
+        args = (F, twin, halfedge_sharpness(F, mesh.edge_sharpness), vertex_corners(len(ask), mesh.vertex_sharpness))
+        max_fan = int(np.bincount(F.reshape(-1)).max()) + 1
+
+        rings, rows, lengths = triangle_rings(*args, faces, max_fan)
+        rot, groups = np.zeros(faces.size, dtype=np.int64), []
+        for i, members in equal_rows(rows):
+            rot[members] = r = self._rotation(rows[i, :lengths[i]], F[faces[i]].tolist())
+            if r == 0:
+                groups.append((0, rings, rows[:, :lengths[i]], i, members))
+        turned = np.flatnonzero(rot)  # rings read from corner r; grouped again (their keys from there)
+        if turned.size:
+            rt, wt, lt = triangle_rings(*args, faces[turned], max_fan, rot[turned])
+            groups += [(int(rot[turned[j]]), rt, wt[:, :lt[j]], j, sub)
+                       for j, sub in equal_rows(np.column_stack([rot[turned], wt]))]
+        known = {}
+        for r, rg, rw, j, sub in groups:
+            f0 = faces[j] if r == 0 else faces[turned[j]]
+            p = self._ring_plan(r, rw[j], F[f0].tolist(), rg[j])
+            if p is None:
+                continue
+            fs, x = (faces[sub] if r == 0 else faces[turned[sub]]), rg[sub, :int(rw[j, 0])]
+            if isinstance(p, (Regular, Corner)):
+                (self._add_regular if isinstance(p, Regular) else self._add_corners)(p, r, fs, x)
+                known.update(dict.fromkeys(fs.tolist(), True))
+            else:
+                known.update((f, (p, r, y)) for f, y in zip(fs.tolist(), x))
+        return known
+
+    def _rotation(self, row, tri):
+        """The corner r a triangle's ring is read from (:func:`~ccproof.evaluate.loop.plan.oriented_ring`), per key
+        encoding ``row`` (read from corner 0) of the triangle ``tri`` (kept for the process)."""
+        key = ("rotation", self._tags[3], row.tobytes())
+        if key not in _RING_PLANS:
+            irr = irregular_corners(self._complex(), tri)
+            _RING_PLANS[key] = irr[0] if len(irr) == 1 else 0
+        return _RING_PLANS[key]
+
+    def _ring_plan(self, r, row, tri, ring):
+        """The plan of the triangles of key encoding ``row`` from their corner r (the triangle ``tri`` one of them,
+        its compiled ring ``ring``), or None where the compiled ring is not the per-triangle one (kept for the
+        process)."""
+        key = (r, self._tags[3], row.tobytes())
+        hit = _RING_PLANS.get(key)
+        if hit is None:
+            r2, labels, k = oriented_ring(self._complex(), tri)
+            n = len(labels)
+            if r2 != r or ring[:n].tolist() != labels or ring[n:n + 1].tolist() not in ([], [-1]):
+                return None
+            hit = _RING_PLANS[key] = plan(k)
+        return hit
+
+    def _add_corners(self, p, r, faces, rings):
+        """Corner nodes (Stam's layers, read from corner r) for triangles of one configuration: their rings' points."""
+        m = faces.size
+        g = self._groups.setdefault(id(p), (len(self._groups), p, []))
+        self._root[faces] = self._nreg + len(self._kind) + np.arange(m)
+        self._kind += [_CORNER] * m
+        self._rot += [r] * m
+        self._ref += range(len(g[2]), len(g[2]) + m)
+        self._children += [(-1, -1, -1, -1)] * m
+        self._gid += [g[0]] * m
+        g[2].extend(self._X[rings])
+
+    def _add_regular(self, p, r, faces, rings):
+        """Box-spline nodes for triangles of one configuration (read from corner r): nets ``p.net @ X[ring]`` in one
+        batched product."""
+        m = faces.size
+        node = self._nreg + len(self._kind)
+        self._root[faces] = node + np.arange(m)
+        ref = self._nreg + self._n_nets
+        self._kind += [_REGULAR] * m
+        self._rot += [r] * m
+        self._ref += range(ref, ref + m)
+        self._children += [(-1, -1, -1, -1)] * m
+        self._gid += [-1] * m
+        self._nets.append(np.matmul(p.net, self._X[rings]))
+        self._n_nets += m
+
     def _add_face(self, X, tri):
-        cx, simple, ask = self._cx, self._simple, self._ask
+        cx, simple, ask = self._complex(), self._simple, self._ask
         irr = [i for i in range(3) if not simple[tri[i]]
                and (not ask[tri[i]] or not cx.is_regular(tri[i], tri[(i + 1) % 3]))]
         r, ring, key = oriented_ring(cx, tri, irr)
@@ -186,8 +294,9 @@ class LoopSurface:
         self.split_depth = max(self.split_depth, depth)
         if isinstance(p, Regular):
             i = node - self._nreg
-            self._kind[i], self._ref[i] = _REGULAR, self._nreg + len(self._nets)
+            self._kind[i], self._ref[i] = _REGULAR, self._nreg + self._n_nets
             self._nets.append(p.net @ C)
+            self._n_nets += 1
         elif isinstance(p, Corner):
             g = self._groups.setdefault(id(p), (len(self._groups), p, []))
             i = node - self._nreg
@@ -205,7 +314,7 @@ class LoopSurface:
         self._ref = np.r_[np.arange(nr, dtype=np.int64), np.array(self._ref, dtype=np.int64)]
         self._children = np.concatenate([np.full((nr, 4), -1, dtype=np.int64),
                                          np.array(self._children, dtype=np.int64).reshape(-1, 4)])
-        local_nets = np.array(self._nets, dtype=np.float64).reshape(-1, 12, 3)  # of the local subdivisions
+        local_nets = np.concatenate([x.reshape(-1, 12, 3) for x in self._nets] + [np.zeros((0, 12, 3))])
         self._gid = np.r_[np.full(nr, -1, dtype=np.int64), np.array(self._gid, dtype=np.int64)]
         self._corner_data = []
         groups = sorted(self._groups.values(), key=lambda g: g[0])
@@ -243,14 +352,13 @@ class LoopSurface:
         nr = labels.shape[0]
         quartic_blocks(X, labels, K, blocks[:nr])
         blocks[nr:nb] = np.matmul(local_nets.transpose(0, 2, 1), K.T)
-        pblock, plim, kd = [], [], []
+        pblock, plim = [], []
         for p, coords in self._corner_data:
             KD = p.poly_layers  # (layers, 3, N, 15)
-            kd.append(KD.reshape(-1))
             nl = min(PRECOMPUTED_LAYERS, KD.shape[0])
             lim = np.einsum("N,mNk->mk", p.limit_mask, coords)  # (m, 3)
             m = len(coords)
-            W = KD[:nl].transpose(0, 1, 3, 2).reshape(nl * 45, p.size)
+            W = _layer_matrix(p, nl)
             B = (W @ coords.transpose(1, 0, 2).reshape(p.size, 3 * m)).reshape(nl, 3, 15, m, 3)
             B = B.transpose(3, 0, 1, 4, 2)  # (m, layer, child, coordinate, monomial)
             out = blocks[nb:nb + 3 * nl * m].reshape(m, nl, 3, 3, 15)
@@ -264,7 +372,7 @@ class LoopSurface:
                   np.r_[0, np.cumsum(np.repeat(sizes * 3, counts))][:-1].astype(np.int64),
                   np.concatenate(plim + [np.zeros((0, 3))]))
         groups = (sizes, np.array([p.layers.shape[0] for p, _ in self._corner_data], dtype=np.int64),
-                  np.cumsum([0] + [x.size for x in kd])[:-1].astype(np.int64))
+                  np.cumsum([0] + [p.poly_layers.size for p, _ in self._corner_data])[:-1].astype(np.int64))
         flat = np.concatenate([c.reshape(-1) for _, c in self._corner_data] + [np.zeros(0)])
         # per node one word: its reference (block; piece; for a split its row of cinfo), rotation and kind
         split = self._kind == _SPLIT
@@ -272,7 +380,7 @@ class LoopSurface:
         info = cref * 16 + self._rot.astype(np.int64) * 4 + self._kind.astype(np.int64)
         cinfo = info[self._children[split]]
         self._k = (info[self._root], cinfo.reshape(-1, 4), blocks,
-                   (pieces, groups, np.concatenate(kd + [np.zeros(0)]), flat))
+                   (pieces, groups, _flat_layers(tuple(p for p, _ in self._corner_data)), flat))
 
     # ------------------------------------------------------------------ evaluation
     def evaluate(self, face, u, v, derivatives=0, *, parameterization="natural", threads=None):
@@ -368,6 +476,31 @@ class LoopSurface:
             raise CCProofError(f"point {i}: face {int(face[i])}, (u, v) = ({float(u[i])!r}, {float(v[i])!r}) is not in "
                                f"a triangle of this mesh ({m} faces; u, v >= 0, u + v <= 1)")
         return face, u, v
+
+
+_LAYER_MATRICES: dict = {}
+_FLAT_LAYERS: dict = {}
+
+
+def _flat_layers(plans):
+    """The layer tables (monomial form) of corner configurations one after the other, flat (kept for the last few
+    sequences of configurations: the same mesh set up again shares them; the kernel only reads them)."""
+    key = tuple(id(p) for p in plans)
+    hit = _FLAT_LAYERS.get(key)
+    if hit is None or any(a is not b for a, b in zip(hit[0], plans)):
+        if len(_FLAT_LAYERS) >= 8:
+            _FLAT_LAYERS.clear()
+        hit = _FLAT_LAYERS[key] = (plans, np.concatenate([p.poly_layers.reshape(-1) for p in plans] + [np.zeros(0)]))
+    return hit[1]
+
+
+def _layer_matrix(p, nl):
+    """The first ``nl`` layers of a corner configuration's monomial form as one (nl 45, N) matrix (kept)."""
+    hit = _LAYER_MATRICES.get((id(p), nl))
+    if hit is None or hit[0] is not p:
+        W = p.poly_layers[:nl].transpose(0, 1, 3, 2).reshape(nl * 45, p.size)
+        hit = _LAYER_MATRICES[(id(p), nl)] = (p, W)
+    return hit[1]
 
 
 @functools.lru_cache(maxsize=1)
