@@ -334,8 +334,7 @@ def replay_map(lists, sig_lo, sig_hi, hints, layer, prec):
         for name, method, sign, leaves in lists:
             count, least = replay_tree(leaves[i], box.evaluator(method), sign, f"{name}, sigma box {i}")
             old, best = summary.get(name, (0, None))
-            summary[name] = (old + count, least if best is None or (least is not None and abs(least) < abs(best))
-                             else best)
+            summary[name] = (old + count, min((b for b in (least, best) if b is not None), key=abs, default=None))
     return summary
 
 
