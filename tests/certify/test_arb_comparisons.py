@@ -84,7 +84,6 @@ REVIEWED = {
     ("tagged_c1.py", "ev[ia][2] != 1"): "ints (multiplicities)",
     ("tagged_c1.py", "sum(1 for t in ev if t[1] == tg.ONE) != 1"): "ints (a count of exact factors)",
     ("tagged_c1.py", "ev[ib][2] != 1"): "ints (multiplicities)",
-    ("tagged_c1.py", 'tops["y"][i] != 0'): "fmpq (exact: (S - beta) y in Q)",
     ("tagged_c1.py", "not abs(t[0]) < 1"): "collects every eigenvalue possibly on or outside the unit circle; "
                                                "one (the exact 1 of the crease block or S_E) is allowed: conservative",
     ("tagged_c1.py", "u[i, 0] != 0"): "fmpq_mat entries (exact)",

@@ -284,6 +284,9 @@ def test_corner4_witness_changed():
     forged = copy.deepcopy(cert)
     forged["witness"]["x"]["eigenvalue"] = ["0.3", "0.4"]  # x: lam = 0.366, the next root of the quartic
     _fails(forged, "alpha > beta > 0 is not certain")
+    forged = copy.deepcopy(cert)
+    forged["witness"]["y"]["pivot"] = 3  # a chain with y = 1 at point 3, where its top (S - 1/2) y is not 0: the
+    _fails(forged, "(S - 1/2) z is not 0 on the crease points")  # one check of the top on the fixed points
 
 
 def test_statement_flipped_to_c1():

@@ -14,28 +14,8 @@ from flint import acb, acb_mat, acb_series, arb, ctx, fmpq
 
 from ccproof.rigorous.analytic import AnalyticModel, ball, cauchy_factor, disc_bound, disc_boxes, hull
 
-from .dart_family import (
-    PIECES,
-    XB,
-    YB,
-    Family,
-    basis_nets,
-    coefficient_nets,
-    curve_trans_series,
-    det_series,
-    packed_partials,
-    series_coeffs,
-    series_curves,
-    series_variable,
-)
-from .dart_spectrum import (
-    SpectralRegions,
-    check_construction,
-    check_eigenvector,
-    check_mode0_roots,
-    check_ranges,
-    region_roots,
-)
+from . import dart_family as df
+from . import dart_spectrum as ds
 from .dart_zeros import check_zeros
 from .errors import CertificateError
 from .maps import STAR_CURVES
@@ -78,10 +58,10 @@ def read_record(cert, k0):
     sp, rg, hints = g["spectrum"], g["regions"], TaylorHints(**g["taylor"])
     if g["map"]["orientation"] != 1:
         raise CertificateError("map: the statement fixes orientation +1 (x sine-like, y = 1 at ray K/2)")
-    check_ranges(k0, *sp["sigma"], sp["circle"], sp["tau1"], sp["v0"])
+    ds.check_ranges(k0, *sp["sigma"], sp["circle"], sp["tau1"], sp["v0"])
     if not fmpq(1, k0) < hints.r <= fmpq(1, 8):
         raise CertificateError("taylor: need 1/K0 < r <= 1/8")
-    roots = region_roots(k0, sp["tau1"], sp["v0"])
+    roots = ds.region_roots(k0, sp["tau1"], sp["v0"])
     rec = dict(sp, prec=g["prec"], hints=hints, layer=rg["layer"],
                re={n: read_tree(sp["re"][n], roots[n], f"spectrum re {n}", 1) for n in "NIF"})
     rec["map"] = read_map(g["parts"], k0, hints, rg["s0"], rg["layer"], tuple(rg["winding"]))
@@ -121,7 +101,7 @@ def _log_coeffs(fam, n, real=False):
     """The Taylor coefficients of (a1, a2) = (-ln lam1, -ln lam2) (ZeroDivisionError near the branch cut)."""
     if isinstance(fam.lam1, acb) and not (acb(fam.lam1).real > 0 and acb(fam.lam2).real > 0):
         raise ZeroDivisionError("log lam: not certainly off the branch cut")
-    return [series_coeffs(-lam.log(), n + 1, real) for lam in (fam.lam1, fam.lam2)]
+    return [df.series_coeffs(-lam.log(), n + 1, real) for lam in (fam.lam1, fam.lam2)]
 
 
 def quantities(fam, n, layers=(), bulk=True):
@@ -131,21 +111,22 @@ def quantities(fam, n, layers=(), bulk=True):
     out = {}
 
     def pair(key, part_x, part_y, curve_x, curve_y, A):
-        out.update({("R", *key, p): det_series(part_x[p], part_y[p], n) for p in PIECES})
-        out.update({("T", *key, c): curve_trans_series(curve_x[c], curve_y[c], *A, n) for c in STAR_CURVES})
+        out.update({("R", *key, p): df.det_series(part_x[p], part_y[p], n) for p in df.PIECES})
+        out.update({("T", *key, c): df.curve_trans_series(curve_x[c], curve_y[c], *A, n) for c in STAR_CURVES})
     if bulk:
-        nets, A = basis_nets(fam), _log_coeffs(fam, n)
-        parts = {b: {p: packed_partials(coefficient_nets(net, n)) for p, net in pn.items()} for b, pn in nets.items()}
-        curves = {b: series_curves(nets[b], n) for b in nets}
-        for i, j in product(XB, YB):
+        nets, A = df.basis_nets(fam), _log_coeffs(fam, n)
+        parts = {b: {p: df.packed_partials(df.coefficient_nets(net, n)) for p, net in pn.items()}
+                 for b, pn in nets.items()}
+        curves = {b: df.series_curves(nets[b], n) for b in nets}
+        for i, j in product(df.XB, df.YB):
             pair((i, j), parts[i], parts[j], curves[i], curves[j], A)
-        out.update({(t, b, c): curves[b][c] for t, bs in (("X", XB), ("Y", YB)) for b in bs for c in STAR_CURVES})
+        out.update({(t, b, c): curves[b][c] for t, bs in (("X", df.XB), ("Y", df.YB)) for b in bs for c in STAR_CURVES})
     real = isinstance(fam.h, acb_series)
     A = _log_coeffs(fam, n, real) if layers else None
     for q in layers:
         nets = [fam.layer_nets(q, k) for k in (0, 1)]  # x, y
-        (px, py), (cx, cy) = ([{p: coefficient_nets(N[p], n, real) for p in PIECES} for N in nets],
-                              [series_curves(N, n, real) for N in nets])
+        (px, py), (cx, cy) = ([{p: df.coefficient_nets(N[p], n, real) for p in df.PIECES} for N in nets],
+                              [df.series_curves(N, n, real) for N in nets])
         pair((q,), px, py, cx, cy, A)
         out.update({("Y", q, c): cy[c] for c in STAR_CURVES})
     return out
@@ -247,8 +228,8 @@ class DartModels:
         self.edges = [fmpq(sig_lo) + (fmpq(sig_hi) - fmpq(sig_lo)) * fmpq(i, hints.sigma_boxes)
                       for i in range(hints.sigma_boxes + 1)]
         with ctx.workprec(prec):
-            sigma = ball(sig_lo, sig_hi)  # one family per acb box h, the values: the h^0 coefficients
-            self.M = disc_bound(lambda h: {k: v[0] for k, v in quantities(Family(h, sigma), 0, range(layer)).items()},
+            sigma, layers = ball(sig_lo, sig_hi), range(layer)  # one family per acb box h; the h^0 coefficients
+            self.M = disc_bound(lambda h: {k: v[0] for k, v in quantities(df.Family(h, sigma), 0, layers).items()},
                                 hints.r, hints.disc_grid)
         self._boxes = {}
 
@@ -268,10 +249,10 @@ class SigmaBox:
         self.m, hn, r = models, models.hints, models.hints.r
         with ctx.workprec(models.prec):
             self.sigma = sigma = ball(models.edges[i], models.edges[i + 1])
-            with series_variable(hn.order) as h:
-                Q = quantities(Family(h, sigma), hn.order)
-            with series_variable(hn.layer_order) as h:
-                Q.update(quantities(Family(h, sigma), hn.layer_order, range(models.layer), bulk=False))
+            with df.series_variable(hn.order) as h:
+                Q = quantities(df.Family(h, sigma), hn.order)
+            with df.series_variable(hn.layer_order) as h:
+                Q.update(quantities(df.Family(h, sigma), hn.layer_order, range(models.layer), bulk=False))
             self.om = {t: omegas(t, sigma) for t in QUANTITIES}
             self.models = {(t, None): group_models(Q, models.M, r, t) for t in QUANTITIES}
             self.models.update({(t, q): group_models(Q, models.M, r, t, q) for t in "RTY" for q in range(models.layer)})
@@ -353,8 +334,7 @@ def replay_map(lists, sig_lo, sig_hi, hints, layer, prec):
         for name, method, sign, leaves in lists:
             count, least = replay_tree(leaves[i], box.evaluator(method), sign, f"{name}, sigma box {i}")
             old, best = summary.get(name, (0, None))
-            summary[name] = (old + count, least if best is None or (least is not None and abs(least) < abs(best))
-                             else best)
+            summary[name] = (old + count, min((b for b in (least, best) if b is not None), key=abs, default=None))
     return summary
 
 
@@ -372,7 +352,7 @@ def verify_dart_tail(cert, k0, part, log):
     log(f"C1 certificate for {name} ({rec['prec']} bits)")
 
     def spectrum():  # SpectralRegions checks the secular identities first
-        least0, reg = check_mode0_roots(sig_r, k0, rec["mode0_h"]), SpectralRegions(sig_r, k0)
+        least0, reg = ds.check_mode0_roots(sig_r, k0, rec["mode0_h"]), ds.SpectralRegions(sig_r, k0)
         counts = {n: replay_tree(rec["re"][n], getattr(reg, n.lower()), 1, f"spectrum re {n}") for n in "NIF"}
         return (f"every K >= {k0}: 1, lam1 = lam(cos(2 pi/K)) and one even eigenvalue (lam2) outside |lam| = "
                 f"lam(cos(2 x {sig_r}/K)), each simple; secular identities exact; mode 0's roots real and below "
@@ -383,11 +363,11 @@ def verify_dart_tail(cert, k0, part, log):
         ("S sector matrices of every K >= 7 from one window",
          lambda: "dart:7 and dart:8: one row per window class, the same in both; centre row (1 - 7h/4, 3h^2/2, "
                  "h^2/4) for K = 7..12; R-symmetric, odd part the ring modes, one-ring closed, outer bound "
-                 f"{check_construction()[1]}"),
+                 f"{ds.check_construction()[1]}"),
         ("Z dropped Taylor coefficients are 0 (exact, Q(sqrt 5, i))", check_zeros),
         (f"G spectrum for every K >= {k0}", spectrum),
         (f"E eigenvectors: y at sigma* in ({lo}, {hi}) and x span lam2, lam1",
-         lambda: check_eigenvector(lo, hi, k0, rec["prec"], balls=rec["sigma_h"])),
+         lambda: ds.check_eigenvector(lo, hi, k0, rec["prec"], balls=rec["sigma_h"])),
         (f"M characteristic map regular (R), transversal (T), winding once (W) for every K >= {k0}",
          lambda: _show(replay_map(rec["map"], lo, hi, rec["hints"], rec["layer"], rec["prec"]))),
     ]

@@ -391,12 +391,11 @@ def _flip_generic(ev, a, b):
 
 def _chain_generic(fam, n, ev, vals, tops):
     """(ok, message): G of a Jordan-chain witness (1 simple); ``vals`` the eigenvalues of x, y, z, ``tops`` (S - lam)
-    of each (None for an eigenvector, :func:`_chain_top`)."""
+    of each (None for an eigenvector, :func:`_chain_top`); e = (S - beta) y is 0 on the crease points (and the
+    pivot) by :func:`eigenvector_of`, which returns a generalized y only then."""
     a, b, g = vals["x"], vals["y"], vals["z"]
     if tops["y"] is None or tops["z"] is not None or tops["x"] is not None or not isinstance(b, fmpq):
         return False, "y is no generalized eigenvector of a rational beta, or z or x is one"
-    if any(tops["y"][i] != 0 for i in tg.crease_points(fam, n)):
-        return False, "e = (S - beta) y is not 0 on the crease points"
     ia = _find(ev, a)
     at_b = [i for i, t in enumerate(ev) if _same_root(t, b)]
     why = (
