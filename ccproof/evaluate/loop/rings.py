@@ -16,7 +16,7 @@ import functools
 import numba
 import numpy as np
 
-__all__ = ["triangle_rings", "equal_rows", "halfedge_sharpness", "vertex_corners"]
+__all__ = ["triangle_rings", "equal_rows", "halfedge_sharpness", "vertex_sharpness_array"]
 
 
 @numba.njit(cache=True)
@@ -219,7 +219,7 @@ def halfedge_sharpness(F, edge_sharpness):
     return out
 
 
-def vertex_corners(n, vertex_sharpness):
+def vertex_sharpness_array(n, vertex_sharpness):
     out = np.zeros(n)
     if vertex_sharpness:
         out[np.array(list(vertex_sharpness), dtype=np.int64)] = np.maximum(list(vertex_sharpness.values()), 0.0)

@@ -192,14 +192,15 @@ class LoopSurface:
         key: per face (plan, rotation, ring labels); ``True`` for those whose box-spline nets are stored here at once
         (their roots set). A key's plan and rotation are read once the per-triangle way (the ring checked against the
         compiled one) and kept for the process; faces left out go the per-triangle way."""
-        from ccproof.evaluate.loop.rings import equal_rows, halfedge_sharpness, triangle_rings, vertex_corners
+        from ccproof.evaluate.loop.rings import equal_rows, halfedge_sharpness, triangle_rings, vertex_sharpness_array
 
         faces = np.flatnonzero(~reg & (simple | ask)[F].all(axis=1))
         if not faces.size:
             return {}
         twin = mesh.halfedges.twin.copy()
         twin[(twin < 0) | ~in_cx[np.maximum(twin, 0) // 3]] = -1
-        args = (F, twin, halfedge_sharpness(F, mesh.edge_sharpness), vertex_corners(len(ask), mesh.vertex_sharpness))
+        args = (F, twin, halfedge_sharpness(F, mesh.edge_sharpness),
+                vertex_sharpness_array(len(ask), mesh.vertex_sharpness))
         max_fan = int(np.bincount(F.reshape(-1)).max()) + 1
 
         rings, rows, lengths = triangle_rings(*args, faces, max_fan)
