@@ -150,15 +150,9 @@ class HalfEdges:
         (``full=False``: the twins, the face counts and ``same`` alone). Few fresh (H,) arrays: buffers reused."""
         org, n = self.org, self.n_vertices
         H = org.size
-        buf = org[self.nxt]  # the destinations
-        key = np.minimum(org, buf)
-        key *= n
-        key += np.maximum(org, buf, out=buf)  # lo * n + hi
+        key = _edge_keys(org, self.nxt, n)
         order = np.argsort(key, kind="stable")
-        sk = np.take(key, order, out=buf)
-        new = np.empty(H, dtype=bool)  # the first half-edge of an edge, in sorted order
-        new[:1] = True
-        np.not_equal(sk[1:], sk[:-1], out=new[1:])
+        new = _run_starts(key, order)  # the first half-edge of an edge, in sorted order
         starts = np.flatnonzero(new)
         counts = np.diff(np.r_[starts, H])
         two = np.flatnonzero(counts == 2)
@@ -171,10 +165,10 @@ class HalfEdges:
         twin = key  # (the key's buffer)
         twin.fill(-1)
         twin[h1[~same]], twin[h2[~same]] = h2[~same], h1[~same]
-        del h1, h2, f1, f2, sk
+        del h1, h2, f1, f2
         out = {"twin": twin, "edge_face_count": counts, "same": two[same]}
         if full:
-            edge_of = buf  # (the destinations' buffer)
+            edge_of = np.empty(H, dtype=np.int64)
             rank = np.cumsum(new, dtype=np.int64)
             rank -= 1
             edge_of[order] = rank
@@ -496,6 +490,31 @@ class HalfEdges:
             return np.unique(self.face_of[corners[ptr[v[0]]:ptr[v[0] + 1]]])
         cs = np.concatenate([corners[ptr[x]:ptr[x + 1]] for x in v.tolist()])
         return np.unique(self.face_of[cs])
+
+
+_CHUNK = 1 << 15  # (H,) work in pieces this long: small temporaries, reused by the allocator
+
+
+def _edge_keys(org, nxt, n):
+    """int64 (H,): ``lo * n + hi`` of every half-edge's ends, computed in pieces (no (H,) temporaries)."""
+    key = np.empty(org.size, dtype=np.int64)
+    for s in range(0, org.size, _CHUNK):
+        o, d = org[s:s + _CHUNK], org[nxt[s:s + _CHUNK]]
+        k = np.minimum(o, d)
+        k *= n
+        k += np.maximum(o, d, out=d)
+        key[s:s + _CHUNK] = k
+    return key
+
+
+def _run_starts(key, order):
+    """bool (H,): ``key[order[i]] != key[order[i - 1]]`` (True at 0), computed in pieces."""
+    new = np.empty(key.size, dtype=bool)
+    new[:1] = True
+    for s in range(0, key.size, _CHUNK):
+        ks = key[order[s:s + _CHUNK + 1]]
+        np.not_equal(ks[1:], ks[:-1], out=new[s + 1:s + 1 + ks.size - 1])
+    return new
 
 
 def _step_edges(parent, edge_of_halfedge=None):
