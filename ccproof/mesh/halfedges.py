@@ -147,7 +147,8 @@ class HalfEdges:
 
     def _pair(self, full=True):
         """The undirected edges (sorted by ``lo * n + hi``, a stable sort of the half-edges) and the twins
-        (``full=False``: the twins, the face counts and ``same`` alone). Few fresh (H,) arrays: buffers reused."""
+        (``full=False``: the twins, the face counts and ``same`` alone). Few fresh (H,) arrays (each costs page
+        faults under numpy's huge-page advice): the keys in pieces, their buffer made the twins."""
         org, n = self.org, self.n_vertices
         H = org.size
         key = _edge_keys(org, self.nxt, n)
