@@ -122,21 +122,20 @@ class HalfEdges:
         self.options = options
         #: the one face size of every face (4: all quads), or 0 (mixed sizes)
         self.uniform = int(sizes[0]) if sizes.size and (sizes == sizes[0]).all() else 0
-        if self.uniform:  # no per-corner face index needed
+        # next and previous corner: h + 1 and h - 1, wrapped at the faces' ends (one array each, no
+        # temporaries: numpy's huge-page advice makes every fresh large array cost page faults)
+        self.nxt = np.arange(1, H + 1, dtype=np.int64)
+        self.prv = np.arange(-1, H - 1, dtype=np.int64)
+        if self.uniform:
             k = self.uniform
-            h = np.arange(H, dtype=np.int64)
-            loc = h % k
-            h -= loc
-            self.nxt = h + (loc + 1) % k
-            self.prv = h + (loc - 1) % k
-            del h, loc
+            self.nxt.reshape(-1, k)[:, -1] -= k
+            self.prv.reshape(-1, k)[:, 0] += k
         else:
-            face_of = self.face_of
-            loc = np.arange(H, dtype=np.int64) - off[face_of]
-            self.nxt = off[face_of] + (loc + 1) % sizes[face_of]
-            self.prv = off[face_of] + (loc - 1) % sizes[face_of]
-            del loc
-        pairing = self._pair()
+            used = sizes > 0
+            first, last = off[:-1][used], off[1:][used] - 1
+            self.nxt[last] = first
+            self.prv[first] = last
+        pairing = self._pair(full=edges)
         self.twin = pairing["twin"]
         #: every edge has one or two faces, traversed in opposite directions by different faces
         self.edge_manifold = bool(not (pairing["edge_face_count"] > 2).any() and not pairing["same"].size)
@@ -146,20 +145,16 @@ class HalfEdges:
         self.edge_values = np.zeros(0, dtype=np.float64)
         self.vertex_values = None
 
-    def _pair(self):
-        """The undirected edges (sorted by ``lo * n + hi``, a stable sort of the half-edges) and the twins."""
+    def _pair(self, full=True):
+        """The undirected edges (sorted by ``lo * n + hi``, a stable sort of the half-edges) and the twins
+        (``full=False``: the twins, the face counts and ``same`` alone). Few fresh (H,) arrays (each costs page
+        faults under numpy's huge-page advice): the keys in pieces, their buffer made the twins."""
         org, n = self.org, self.n_vertices
         H = org.size
-        dst = org[self.nxt]
-        lo = np.minimum(org, dst)
-        hi = np.maximum(org, dst)
-        del dst
-        key = lo * n + hi
+        key = _edge_keys(org, self.nxt, n)
         order = np.argsort(key, kind="stable")
-        sk = key[order]
-        del key
-        starts = np.flatnonzero(np.r_[True, sk[1:] != sk[:-1]]) if H else np.zeros(0, dtype=np.int64)
-        del sk
+        new = _run_starts(key, order)  # the first half-edge of an edge, in sorted order
+        starts = np.flatnonzero(new)
         counts = np.diff(np.r_[starts, H])
         two = np.flatnonzero(counts == 2)
         h1, h2 = order[starts[two]], order[starts[two] + 1]
@@ -168,14 +163,22 @@ class HalfEdges:
         else:
             f1, f2 = self.face_of[h1], self.face_of[h2]
         same = (org[h1] == org[h2]) | (f1 == f2)  # same direction, or twice in one face
-        twin = np.full(H, -1, dtype=np.int64)
+        twin = key  # (the key's buffer)
+        twin.fill(-1)
         twin[h1[~same]], twin[h2[~same]] = h2[~same], h1[~same]
         del h1, h2, f1, f2
-        edge_of = np.empty(H, dtype=np.int64)
-        edge_of[order] = np.repeat(np.arange(starts.size), counts)
-        first = order[starts]
-        return {"twin": twin, "edge_of": edge_of, "edges": np.stack([lo[first], hi[first]], axis=1),
-                "edge_face_count": counts, "edge_halfedge": first, "same": two[same]}
+        out = {"twin": twin, "edge_face_count": counts, "same": two[same]}
+        if full:
+            edge_of = np.empty(H, dtype=np.int64)
+            rank = np.cumsum(new, dtype=np.int64)
+            rank -= 1
+            edge_of[order] = rank
+            del rank
+            first = order[starts]
+            a, b = org[first], org[self.nxt[first]]
+            out.update(edge_of=edge_of, edges=np.stack([np.minimum(a, b), np.maximum(a, b)], axis=1),
+                       edge_halfedge=first)
+        return out
 
     @functools.cached_property
     def _pairing(self):
@@ -488,6 +491,31 @@ class HalfEdges:
             return np.unique(self.face_of[corners[ptr[v[0]]:ptr[v[0] + 1]]])
         cs = np.concatenate([corners[ptr[x]:ptr[x + 1]] for x in v.tolist()])
         return np.unique(self.face_of[cs])
+
+
+_CHUNK = 1 << 15  # (H,) work in pieces this long: small temporaries, reused by the allocator
+
+
+def _edge_keys(org, nxt, n):
+    """int64 (H,): ``lo * n + hi`` of every half-edge's ends, computed in pieces (no (H,) temporaries)."""
+    key = np.empty(org.size, dtype=np.int64)
+    for s in range(0, org.size, _CHUNK):
+        o, d = org[s:s + _CHUNK], org[nxt[s:s + _CHUNK]]
+        k = np.minimum(o, d)
+        k *= n
+        k += np.maximum(o, d, out=d)
+        key[s:s + _CHUNK] = k
+    return key
+
+
+def _run_starts(key, order):
+    """bool (H,): ``key[order[i]] != key[order[i - 1]]`` (True at 0), computed in pieces."""
+    new = np.empty(key.size, dtype=bool)
+    new[:1] = True
+    for s in range(0, key.size, _CHUNK):
+        ks = key[order[s:s + _CHUNK + 1]]
+        np.not_equal(ks[1:], ks[:-1], out=new[s + 1:s + 1 + ks.size - 1])
+    return new
 
 
 def _step_edges(parent, edge_of_halfedge=None):
