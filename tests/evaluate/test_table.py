@@ -39,6 +39,7 @@ def _table_bytes(build):
 
     build()
     forget_parsed()  # the templates' operators are the surface's: allocated in the traced build
+    forget_kept()  # (and the table's concatenated operators, shared with the last setup's where kept)
     tracemalloc.start()
     S = build()
     forget_parsed()  # (the process's parsed templates and operators kept for the next setup are not the surface's)
