@@ -41,7 +41,9 @@ Measures, in one run:
 The bunny mesh is read from the repository's test data (``tests/data/meshes/bunny_quads.obj``).
 
 Usage: python scripts/bench_evaluate.py [--points 1000000] [--memory-points 10000000] [--quick] [--osd-only]
-[--setup-only]  (``--setup-only``: only the setup in a fresh process, imports and reading the OBJ included:
+[--setup-only] [--setup-in-process]  (``--setup-in-process``: only the setup after imports in this process,
+ours/Far in CPU time, alternating; ``--setup-only``: only the setup in a fresh process, imports and reading the
+OBJ included:
 ours, ``python -c`` with the per-configuration disk cache filled and empty, against OpenSubdiv Far's setup as
 a program of its own, ``scripts/osd_setup_driver.cpp``, reading the same OBJ; every process timed from start
 to exit, in turn round by round; and the floors of a Python process: ``python -c pass``, numpy's import,
@@ -334,6 +336,30 @@ def _print_rates(n, times, cpu, bounds, default, gather, table):
     if compute:
         print("      " + roofline_line(float(np.median(rate[default])), compute, memory, gather, table, latency_s))
     return ratio, cpu_ratio
+
+
+def setup_in_process(rounds=15):
+    """Setup after imports, in this process (the disk cache and the kept arrays warm): ours (``limit_surface``)
+    against OpenSubdiv Far (refiner, adaptive patch table, patch map, local points; the C API of scripts/_osd.py)
+    on every mesh of :data:`SHAPES`, alternating round by round; the CPU time of this thread (a loaded machine's
+    waits left out): ours/Far per round, min, median, max, and each side's best."""
+    print("\nsetup in this process after imports (mesh read; disk cache warm), CPU time of this thread")
+    import _osd
+
+    why = _osd.why_unavailable()
+    if why:
+        missing("OpenSubdiv", why)
+        return
+    lib = _osd.load()
+    for label, path in SHAPES:
+        mesh = read_mesh(path)
+        limit_surface(mesh)  # warm-up: the disk cache filled, the per-process kept arrays
+        _osd.Evaluator(lib, "far", mesh).close()
+        cpu = {}
+        _, load = interleaved({"far": lambda m=mesh: _osd.Evaluator(lib, "far", m).close(),
+                               "ours": lambda m=mesh: limit_surface(m)}, rounds, cpu=cpu)
+        print(ratio_line(f"   {label}: setup ours/far CPU time (best: ours {min(cpu['ours']) * 1e3:.2f} ms, far "
+                         f"{min(cpu['far']) * 1e3:.2f} ms):", np.array(cpu["ours"]) / np.array(cpu["far"]), load))
 
 
 def _stats(x):
@@ -893,6 +919,7 @@ def smoke(n=20_000, rounds=2):
         print(ratio_line(f"bunny P + Pu + Pv, {n:,} points, {be}/numpy time:",
                          np.array(times[be]) / np.array(times["numpy"]), load))
     osd_side_by_side(n, rng, True, rounds=rounds)
+    setup_in_process(rounds)
     return 0
 
 
@@ -909,6 +936,8 @@ def main(argv=None):
     ap.add_argument("--osd-only", action="store_true", help="only part 5 (OpenSubdiv side by side)")
     ap.add_argument("--rounds", type=int, default=7, help="interleaved rounds of part 5 (at least 7)")
     ap.add_argument("--setup-only", action="store_true", help="only the setup times of part 5")
+    ap.add_argument("--setup-in-process", action="store_true",
+                    help="only the setup after imports in this process, ours/Far in CPU time (--rounds, 15 or more)")
     ap.add_argument("--threads-only", action="store_true",
                     help="only part 5's two threads against one, with this machine's ceiling (no OpenSubdiv)")
     ap.add_argument("--startup", action="store_true",
@@ -918,6 +947,9 @@ def main(argv=None):
         return smoke()
     if args.setup_only:
         fresh_process_setup(args.rounds)
+        return 0
+    if args.setup_in_process:
+        setup_in_process(args.rounds)
         return 0
     if args.threads_only:
         threads_only(args.osd_points if not args.quick else 20_000, np.random.default_rng(2024), args.rounds)

@@ -66,6 +66,17 @@ class Depth(NamedTuple):
         return Depth(self.local, self.semi + 1)
 
 
+def _same_as_first(rep, nring, faces, nfaces, tv=None):
+    """Per walked ring: whether it is the ring ``rep`` of its group, face by face (the first ``nfaces`` of
+    ``faces``), in size (``nring``, ``nfaces``) and, where ``tv`` (the rings' tag rows) is given, tag by tag."""
+    used = np.arange(faces.shape[1]) < nfaces[:, None]
+    same = (nfaces == nfaces[rep]) & (nring == nring[rep]) & \
+        ((faces == faces[rep]).all(axis=2) | ~used).all(axis=1)
+    if tv is not None:
+        same &= (tv == tv[rep]).all(axis=1)
+    return same
+
+
 class _BlockWalk(NamedTuple):
     """What every block of :meth:`Builder._walk_all` shares: the half-edges ``he``, the compiled ring walk
     ``walks`` and its scratch arrays ``pos`` and ``seen``, the :class:`Jobs` and the id ``j0`` of the first,
@@ -303,32 +314,31 @@ class Builder:
         _, first, inv = np.unique(sig, axis=0, return_index=True, return_inverse=True)
         inv = inv.reshape(-1)
         order = np.argsort(inv, kind="stable")
-        bounds = np.searchsorted(inv[order], np.arange(first.size + 1))
+        bounds = np.searchsorted(inv[order], np.arange(first.size + 1)).tolist()
+        same = _same_as_first(first[inv], nring, faces, nfaces, tv if tagged else None)
+        n_other = np.bincount(inv, weights=~same, minlength=first.size).tolist()  # per group: not its first's
         retry = []
-        for gi in range(first.size):
+        nring_l, nfaces_l, r_l, corner_l = nring.tolist(), nfaces.tolist(), r.tolist(), at_corner.tolist()
+        for gi, rep in enumerate(first.tolist()):
             mem = order[bounds[gi]:bounds[gi + 1]]
-            rep = first[gi]
-            if nring[rep] < 0:
+            if nring_l[rep] < 0:
                 continue
-            nf, n = int(nfaces[rep]), int(nring[rep])
-            same = (nfaces[mem] == nf) & (nring[mem] == n) & (faces[mem, :nf] == faces[rep, :nf]).all(axis=(1, 2))
-            if tagged:
-                same &= (tv[mem] == tv[rep]).all(axis=1)
-            if not same.all():  # a hash collision: those jobs by the Python walk
-                fallback.append(idx[mem[~same]])
-                mem = mem[same]
+            nf, n = nfaces_l[rep], nring_l[rep]
+            if n_other[gi]:  # a hash collision: those jobs by the Python walk
+                fallback.append(idx[mem[~same[mem]]])
+                mem = mem[same[mem]]
             ftup = tuple(map(tuple, faces[rep, :nf].tolist()))
             if tagged:
                 key = ring_key(view, rings[rep, :n].tolist(), ftup, 4)
             else:
                 key = (ftup, (), (), w.opts)
-            if tagged and self.depth_semi != 1 and has_semi_sharp(key) and not at_corner[rep]:
+            if tagged and self.depth_semi != 1 and has_semi_sharp(key) and not corner_l[rep]:
                 fallback.append(idx[mem])  # the Chaikin phase reads the two-ring: the Python walk
                 continue
             frame = jobs.frames[jobs.fid[idx[rep]]]
             base = int(jobs.base[idx[rep]])
-            rr = int(r[rep])
-            if at_corner[rep]:
+            rr = r_l[rep]
+            if corner_l[rep]:
                 if not self._corner_ok(key):
                     retry.append(idx[mem])
                     continue

@@ -10,6 +10,8 @@ the nets the numpy backend computes at evaluation time (:func:`composed_nets`, :
 
 from __future__ import annotations
 
+import weakref
+
 import numpy as np
 
 from ccproof.errors import MeshError
@@ -137,9 +139,7 @@ def regular_nets(T, groups):
             continue
         # the regular patches of one template share their jobs' rings: their operators side by side, one
         # ring_products per block of jobs (each entry's sum the same, in the same order)
-        N = int(T.vn[root + vfs[0]])
-        op = np.concatenate([T.vop[int(T.vop_start[root + vf]):int(T.vop_start[root + vf]) + 17 * N].reshape(N, 17)
-                             for vf in vfs], axis=1)
+        op = _kept_operator(T, "regular", root, vfs)
         step = max(1, (_BLOCK * 17) // op.shape[1])
         leaves = np.array([t.leaf[vf] for vf in vfs], dtype=np.int64)
         for lo in range(0, jobs.size, step):
@@ -218,7 +218,7 @@ def layer0_nets(T, groups):
             continue
         root = int(T.job_root[jobs[0]])
         vfs = [vf for vf, kind in enumerate(t.kind) if kind == KIND_CORNER]
-        op = np.concatenate([_layer0_operator(T, root + vf) for vf in vfs], axis=1)  # (N, 49 per corner face)
+        op = _kept_operator(T, "layer 0", root, vfs)  # (N, 49 per corner face)
         N, nv = op.shape[0], len(vfs)
         leaves = np.array([t.leaf[vf] for vf in vfs], dtype=np.int64)
         step = max(1, (_BLOCK * 64) // op.shape[1])
@@ -232,6 +232,47 @@ def layer0_nets(T, groups):
             ci = T.job_corner[jb][:, None] + leaves[None, :]  # (k, nv): the corner faces' rows
             hot[(3 * ci[:, :, None] + np.arange(3)).reshape(-1)] = nets.reshape(-1, 17, 3)
     return hot
+
+
+#: per (kind of net, the table's shared leaf operators' identity, the slices of them read): the operators of a
+#: template's patches side by side (:func:`regular_nets`, :func:`layer0_nets`), read-only, those of recent setups
+#: in this process (a weak reference to the shared array kept with them: they do not keep it alive) within
+#: :data:`_KEPT_BUDGET` bytes (the oldest dropped first)
+_KEPT: dict = {}
+_KEPT_BUDGET = 8 << 20
+
+
+def _side_by_side(T, kind, root, vfs):
+    """The operators of the patches ``vfs`` of the template at ``root`` side by side: ``kind`` "regular", each
+    leaf's (N, 17); "layer 0", each corner face's (N, 49) of :func:`_layer0_operator`."""
+    if kind == "regular":
+        N = int(T.vn[root + vfs[0]])
+        return np.concatenate([T.vop[int(T.vop_start[root + vf]):int(T.vop_start[root + vf]) + 17 * N].reshape(N, 17)
+                               for vf in vfs], axis=1)
+    return np.concatenate([_layer0_operator(T, root + vf) for vf in vfs], axis=1)
+
+
+def _kept_operator(T, kind, root, vfs):
+    """:func:`_side_by_side` of ``T`` (a new array or one kept), the same array again while ``T.vop`` is a
+    read-only view of the same shared read-only array and the slices read the same
+    (their starts, sizes and ring sizes: the array's content is all the result depends on)."""
+    base = T.vop.base
+    if base is None or T.vop.flags.writeable or base.flags.writeable or T.vop.size != base.size:
+        return _side_by_side(T, kind, root, vfs)
+    idx = root + np.asarray(vfs, dtype=np.int64)
+    key = (kind, id(base), tuple(T.vop_start[idx].tolist()), tuple(T.vn[idx].tolist()),
+           tuple(T.op_size[T.cfg[idx]].tolist()) if kind != "regular" else ())
+    hit = _KEPT.get(key)
+    if hit is not None and hit[0]() is base:
+        return hit[1]
+    op = _side_by_side(T, kind, root, vfs)
+    op.setflags(write=False)
+    held = sum(h[1].nbytes for h in _KEPT.values())
+    while _KEPT and held + op.nbytes > _KEPT_BUDGET:
+        held -= _KEPT.pop(next(iter(_KEPT)))[1].nbytes
+    if op.nbytes <= _KEPT_BUDGET:
+        _KEPT[key] = (weakref.ref(base), op)
+    return op
 
 
 def _layer0_operator(T, vf):

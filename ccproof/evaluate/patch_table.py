@@ -270,7 +270,7 @@ def assemble(temps, schemes, n_jobs, X, top, refused):
             vop_start.append(n_vop if ops_ is not None else -1)
             vn.append(t.n)
             if ops_ is not None:
-                vop.append(ops_.reshape(-1))
+                vop.append(ops_)
                 n_vop += ops_.size
         dv = np.zeros(len(t.kind), dtype=np.int64)
         for v, ch in enumerate(t.child):  # children are created after their parents
@@ -297,13 +297,51 @@ def assemble(temps, schemes, n_jobs, X, top, refused):
         u0=d[:, 0].copy(), v0=d[:, 1].copy(), h=d[:, 2].copy(), leaf=np.array(leaf, dtype=np.int64),
         cfg=np.array(cfg, dtype=np.int64), cu=c[:, 0].copy(), cv=c[:, 1].copy(),
         vop_start=np.array(vop_start, dtype=np.int64), vn=np.array(vn, dtype=np.int64),
-        vop=np.concatenate(vop) if vop else np.zeros(0), split_depth=depth, n_regular=n_reg, n_corner=n_cor,
+        vop=_shared_concatenation(vop), split_depth=depth, n_regular=n_reg, n_corner=n_cor,
         points=X, rings=rings_flat, nets=np.zeros((0, 17, 3)),
-        ops=np.concatenate(ops) if ops else np.zeros(0), op_start=np.array(op_start, dtype=np.int64),
+        ops=_shared_concatenation(ops), op_start=np.array(op_start, dtype=np.int64),
         op_size=np.array(op_size, dtype=np.int64), n_layers=np.array(n_layers, dtype=np.int64),
         unit=np.array(unit, dtype=np.float64).reshape(-1, 3, 3), hot=np.zeros((0, 17, 3)),
         cor_ring=np.zeros(0, np.int64), ring=np.zeros((0, 3)))
     return T, groups
+
+
+#: per sequence of operator arrays (their identities): (the arrays, their concatenation, read-only), those of
+#: recent setups in this process within :data:`_CONCAT_BUDGET` bytes (the oldest dropped first)
+_CONCAT: dict = {}
+_CONCAT_BUDGET = 32 << 20
+
+
+def _shared_concatenation(parts):
+    """The arrays ``parts`` flattened and concatenated (float64), read-only: a view of the same concatenation
+    again for the same arrays (a setup of the same mesh shares its tables' operators with the last one's; no
+    copy of them is writable: the view's base is read-only, so the view cannot be made writable either).
+
+    >>> a, b = np.arange(2.0), np.ones((1, 2))
+    >>> c = _shared_concatenation([a, b]); c.tolist(), c.flags.writeable
+    ([0.0, 1.0, 1.0, 1.0], False)
+    >>> d = _shared_concatenation([a, b]); d.base is c.base
+    True
+    >>> d.setflags(write=True)
+    Traceback (most recent call last):
+    ...
+    ValueError: cannot set WRITEABLE flag to True of this array
+    """
+    key = tuple(map(id, parts))
+    hit = _CONCAT.get(key)
+    if hit is None or len(hit[0]) != len(parts) or not all(a is b for a, b in zip(hit[0], parts)):
+        whole = np.concatenate([np.asarray(a, dtype=np.float64).reshape(-1) for a in parts]) if parts \
+            else np.zeros(0)
+        whole.setflags(write=False)
+        hit = (tuple(parts), whole)
+        held = sum(h[1].nbytes for h in _CONCAT.values())
+        while _CONCAT and held + whole.nbytes > _CONCAT_BUDGET:
+            held -= _CONCAT.pop(next(iter(_CONCAT)))[1].nbytes
+        if whole.nbytes <= _CONCAT_BUDGET:
+            _CONCAT[key] = hit
+    view = hit[1][:]
+    view.setflags(write=False)
+    return view
 
 
 #: per template and configurations (the identities of its operators and of its configurations' flat layer
@@ -317,6 +355,7 @@ def forget_kept():
     """Drop the leaf and flat layer operators this process keeps from recent setups (computed again on use)."""
     _VOPS.clear()
     _FLAT.clear()
+    _CONCAT.clear()
 
 
 def _cached_leaf_operators(t, ops):

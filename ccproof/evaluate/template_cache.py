@@ -162,17 +162,12 @@ def cached_template(tkey, depth_semi, make):
     corrupt one reported once. A cached template is the built one bit for bit; with every file
     present a setup does no exact local step.
     """
-    import hashlib
-
     d = _diskcache.cache_dir()
     if d is None:
         return finished(make())
-    name = hashlib.sha256(f"template|{_template_version()}|{depth_semi}|{tkey!r}".encode()).hexdigest()
+    name = _template_name(tkey, depth_semi)
     path = d / f"{name}.tpl"
-    try:
-        data = path.read_bytes()
-    except OSError:
-        data = None
+    data = _read_bytes(path)
     seen = _PARSED.get(name)
     if data is not None and seen is not None and seen[0] == data:
         return _fresh(seen[1])  # the very bytes verified and parsed before in this process
@@ -183,6 +178,48 @@ def cached_template(tkey, depth_semi, make):
     t = finished(make())
     _diskcache.store(d, name, ".tpl", _template_bytes(t))
     return t
+
+
+#: per (template key, depth_semi, template version): the template's cache name, those of recent setups in this
+#: process (at most :data:`_NAMES_MAX`; cleared when full)
+_NAMES: dict = {}
+_NAMES_MAX = 1 << 14
+
+
+def _template_name(tkey, depth_semi):
+    """The cache name of the template ``tkey`` built with ``depth_semi``: SHA-256 of the template version, of
+    ``depth_semi`` and of ``repr(tkey)`` (computed once per key in this process: the key's hash is cheaper)."""
+    import hashlib
+
+    version = _template_version()
+    k = (tkey, depth_semi, version)
+    name = _NAMES.get(k)
+    if name is None:
+        if len(_NAMES) >= _NAMES_MAX:
+            _NAMES.clear()
+        name = _NAMES[k] = hashlib.sha256(f"template|{version}|{depth_semi}|{tkey!r}".encode()).hexdigest()
+    return name
+
+
+def _read_bytes(path):
+    """The bytes of the file ``path``, or None where it cannot be read (one open, fstat and read: a setup
+    reads each of its templates' files, most of them a few kB, where the buffered reader's overhead counts)."""
+    import os
+
+    try:
+        fd = os.open(path, os.O_RDONLY)
+    except OSError:
+        return None
+    try:
+        size = os.fstat(fd).st_size
+        parts = [os.read(fd, size + 1)]
+        while parts[-1]:  # (a file that grew meanwhile: read to its end)
+            parts.append(os.read(fd, 1 << 20))
+        return b"".join(parts)
+    except OSError:
+        return None
+    finally:
+        os.close(fd)
 
 
 #: per cache name: (the file's bytes, the template parsed from them), the templates of recent setups in this

@@ -39,6 +39,7 @@ def _table_bytes(build):
 
     build()
     forget_parsed()  # the templates' operators are the surface's: allocated in the traced build
+    forget_kept()  # (and the table's concatenated operators, shared with the last setup's where kept)
     tracemalloc.start()
     S = build()
     forget_parsed()  # (the process's parsed templates and operators kept for the next setup are not the surface's)
@@ -342,3 +343,32 @@ def test_kept_rings_of_large_corners_give_the_same_bits(monkeypatch):
             for key in r:
                 assert np.array_equal(r[key], ref[key]), (backend, key)
     assert LimitSurface(k_regular_disk(15, 2), progress=False)._table.ring.shape[0] == 0
+
+
+@pytest.mark.parametrize("name", ["catmark_cubes_infsharp", "catmark_smoothtris1"])
+def test_setups_sharing_kept_operators_give_the_same_bits(refdir, name):
+    """A second setup of a mesh in the process takes the operators the first one kept (the table's ``ops`` and
+    ``vop`` views of one read-only concatenation, the nets' side-by-side operators): its table is the first's bit
+    for bit, field by field, after the process's kept arrays were dropped before the first; no user of either
+    table can write the shared operators (nor make them writable)."""
+    from ccproof.evaluate.patch_table import forget_kept
+    from ccproof.evaluate.template_cache import forget_parsed
+
+    mesh = read_obj_tagged(refdir / "osd_features" / "meshes" / f"{name}.obj")
+    forget_kept()
+    forget_parsed()
+    first = LimitSurface(mesh, progress=False).patch_map.table
+    second = LimitSurface(mesh, progress=False).patch_map.table
+    assert second.ops.base is first.ops.base and second.vop.base is first.vop.base  # shared, not copied
+    for f in first._fields:
+        a, b = getattr(first, f), getattr(second, f)
+        if isinstance(a, np.ndarray):
+            assert a.dtype == b.dtype and a.shape == b.shape and a.tobytes() == b.tobytes(), f
+        else:
+            assert a == b, f
+    for T in (first, second):
+        for a in (T.ops, T.vop):
+            with pytest.raises(ValueError):
+                a[0] = 1.0
+            with pytest.raises(ValueError):
+                a.setflags(write=True)

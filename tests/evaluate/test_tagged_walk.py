@@ -169,3 +169,15 @@ def test_compiled_walk_on_refined_tagged_meshes(name, monkeypatch):
     assert bc.n_jobs > 200
     assert "TaggedHalfEdges" in walked and "python" not in walked
     assert _classification(bc) == _classification(bp)
+
+
+@pytest.mark.parametrize("name", ["catmark_cubes_infsharp", "catmark_inf_crease1", "catmark_pyramid_creases1"])
+def test_rings_of_colliding_hashes_go_to_the_python_walk(name, monkeypatch):
+    """With every ring's tag hash made equal (a forced hash collision), the rings of one group whose tags are
+    not those of its first ring are walked by Python: the classification is still the Python walk's."""
+    _needs_walk()
+    mesh = read_obj_tagged(MESHES / f"{name}.obj")
+    monkeypatch.setattr(factory, "_row_hash", lambda a: np.zeros(a.shape[0], dtype=np.int64))
+    (bc, *_), (bp, *_), walked = _both(mesh, monkeypatch)
+    assert "python" in walked  # the collision was seen
+    assert _classification(bc) == _classification(bp)
