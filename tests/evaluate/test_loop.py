@@ -342,13 +342,9 @@ def test_vectorized_regular_nets_equal_the_per_configuration_path():
         assert np.array_equal(p.net @ one.V[ring], one.V[labels[k]])
 
 
-def _tagged_meshes():
-    V, T = grid(6)
-    T = flip_edges(T, 6, seed=3)
-    out = [PolyMesh(V, T, options={"boundary": b}) for b in ("edge_only", "edge_and_corner")]
-    V, T = grid(8)
-    creases = {(i, i + 1): math.inf for i in range(36, 44)} | {(9 * i + 4, 9 * i + 13): math.inf for i in range(8)}
-    out.append(PolyMesh(V, T, creases=creases, corners={40: math.inf}))
+def _random_tags_icosphere():
+    """A flipped level-1 icosphere with random semi-sharp and infinitely sharp creases, corners and holes: the
+    level, the mesh and the generator (its stream goes on where the tags left it)."""
     V, T = icosahedron(seed=3)
     one = Level(V, T).subdivide()
     F = flip_edges(one.F, 25, seed=1)
@@ -356,7 +352,18 @@ def _tagged_meshes():
     E = sorted({(min(a, b), max(a, b)) for f in F for a, b in zip(f, f[1:] + f[:1])})
     creases = {E[i]: float(rng.choice([0.25, 1.0, 1.5, 2.75, math.inf])) for i in rng.choice(len(E), 25, replace=False)}
     corners = {int(x): float(rng.choice([0.625, 2.25, math.inf])) for x in rng.choice(len(one.V), 3, replace=False)}
-    out.append(PolyMesh(one.V, F, creases=creases, corners=corners, holes=[5, 17]))
+    return one, PolyMesh(one.V, F, creases=creases, corners=corners, holes=[5, 17]), rng
+
+
+def _tagged_meshes():
+    V, T = grid(6)
+    T = flip_edges(T, 6, seed=3)
+    out = [PolyMesh(V, T, options={"boundary": b}) for b in ("edge_only", "edge_and_corner")]
+    V, T = grid(8)
+    creases = {(i, i + 1): math.inf for i in range(36, 44)} | {(9 * i + 4, 9 * i + 13): math.inf for i in range(8)}
+    out.append(PolyMesh(V, T, creases=creases, corners={40: math.inf}))
+    one, mesh, _ = _random_tags_icosphere()
+    out.append(mesh)
     two = one.subdivide()  # creases on every 40th edge: rings whose keys from corner 0 agree, from corner 1 not
     E = sorted({(min(a, b), max(a, b)) for f in two.F for a, b in zip(f, f[1:] + f[:1])})
     out.append(PolyMesh(two.V, two.F, creases=dict.fromkeys(E[::40], math.inf)))
@@ -490,14 +497,7 @@ def test_random_tags_against_opensubdiv():
     values have few bits, so that OpenSubdiv's float32 sums of three or more tags changing rule at one
     vertex do not depend on its order of the edges (which ours does not follow: docs/evaluate.md)."""
     _osd_mod, lib = _osd()
-    V, T = icosahedron(seed=3)
-    one = Level(V, T).subdivide()
-    F = flip_edges(one.F, 25, seed=1)
-    rng = np.random.default_rng(1)
-    E = sorted({(min(a, b), max(a, b)) for f in F for a, b in zip(f, f[1:] + f[:1])})
-    creases = {E[i]: float(rng.choice([0.25, 1.0, 1.5, 2.75, math.inf])) for i in rng.choice(len(E), 25, replace=False)}
-    corners = {int(x): float(rng.choice([0.625, 2.25, math.inf])) for x in rng.choice(len(one.V), 3, replace=False)}
-    mesh = PolyMesh(one.V, F, creases=creases, corners=corners, holes=[5, 17])
+    _, mesh, rng = _random_tags_icosphere()
     ok = np.flatnonzero(~mesh.is_hole)
     f = ok[rng.integers(0, ok.size, 4000)]
     u, v = rng.random(f.size), rng.random(f.size)
